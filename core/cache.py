@@ -1,0 +1,167 @@
+"""Bounded, thread-safe caches for the solver's pure stages.
+
+Each stage of the pipeline (kernel operator, basis, Galerkin matrix, gap vector, modes,
+time solve) is a pure function of a few inputs. A :class:`StageCache` memoises one stage
+on exactly those inputs, bounded both in items and in bytes, and counts how often the
+stage was really evaluated, so tests can prove that a load slider never recomputes the
+kernel matrix or the basis.
+
+Keys are built with :func:`fingerprint`, which hashes numpy arrays by content.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Hashable
+from dataclasses import fields, is_dataclass
+from typing import Any, TypeVar
+
+import numpy as np
+
+T = TypeVar("T")
+
+_REGISTRY: dict[str, StageCache] = {}
+_REGISTRY_LOCK = threading.Lock()
+
+
+def fingerprint(*parts: Any) -> str:
+    """A content hash of numbers, strings, tuples and numpy arrays (hex string).
+
+    Floats are hashed by their exact bit pattern, arrays by dtype, shape and bytes.
+    """
+    h = hashlib.blake2b(digest_size=16)
+
+    def feed(obj: Any) -> None:
+        if isinstance(obj, np.ndarray):
+            arr = np.ascontiguousarray(obj)
+            h.update(b"A" + str(arr.dtype).encode() + str(arr.shape).encode())
+            h.update(arr.tobytes())
+        elif isinstance(obj, (tuple, list)):
+            h.update(b"(" + str(len(obj)).encode())
+            for item in obj:
+                feed(item)
+            h.update(b")")
+        elif isinstance(obj, (float, np.floating)):
+            h.update(b"f" + np.float64(obj).tobytes())
+        elif isinstance(obj, (bool, int, np.integer, str)) or obj is None:
+            h.update(b"s" + repr(obj).encode())
+        else:
+            raise TypeError(f"cannot fingerprint object of type {type(obj).__name__}")
+
+    for part in parts:
+        feed(part)
+    return h.hexdigest()
+
+
+def _nbytes(obj: Any, depth: int = 0) -> int:
+    """Approximate memory held by a cached value (arrays dominate)."""
+    if depth > 4:
+        return 0
+    if isinstance(obj, np.ndarray):
+        return int(obj.nbytes)
+    if isinstance(obj, (tuple, list)):
+        return sum(_nbytes(o, depth + 1) for o in obj)
+    if isinstance(obj, dict):
+        return sum(_nbytes(o, depth + 1) for o in obj.values())
+    if is_dataclass(obj):
+        return sum(_nbytes(getattr(obj, f.name), depth + 1) for f in fields(obj))
+    return 64
+
+
+class StageCache:
+    """LRU memo for one pipeline stage, bounded in items and bytes, safe across threads.
+
+    Concurrent requests for the same key compute the value once: later callers wait for
+    the first one instead of repeating the work.
+    """
+
+    def __init__(self, name: str, max_items: int = 32, max_bytes: int = 256 * 2**20) -> None:
+        self.name = name
+        self.max_items = max_items
+        self.max_bytes = max_bytes
+        self._data: OrderedDict[Hashable, tuple[Any, int]] = OrderedDict()
+        self._bytes = 0
+        self._lock = threading.Lock()
+        self._in_flight: dict[Hashable, threading.Event] = {}
+        self.evaluations = 0
+        self.hits = 0
+        with _REGISTRY_LOCK:
+            _REGISTRY[name] = self
+
+    def get_or_compute(self, key: Hashable, compute: Callable[[], T]) -> tuple[T, bool]:
+        """Return ``(value, was_cached)`` for ``key``, calling ``compute()`` on a miss."""
+        while True:
+            with self._lock:
+                if key in self._data:
+                    self._data.move_to_end(key)
+                    self.hits += 1
+                    return self._data[key][0], True
+                event = self._in_flight.get(key)
+                if event is None:
+                    event = threading.Event()
+                    self._in_flight[key] = event
+                    break
+            event.wait()
+        try:
+            value = compute()
+        except BaseException:
+            with self._lock:
+                self._in_flight.pop(key, None)
+            event.set()
+            raise
+        size = _nbytes(value)
+        with self._lock:
+            self.evaluations += 1
+            self._in_flight.pop(key, None)
+            if size <= self.max_bytes:
+                self._data[key] = (value, size)
+                self._bytes += size
+                while len(self._data) > self.max_items or self._bytes > self.max_bytes:
+                    _, (_, old) = self._data.popitem(last=False)
+                    self._bytes -= old
+        event.set()
+        return value, False
+
+    def clear(self) -> None:
+        """Drop every cached value (the counters are kept)."""
+        with self._lock:
+            self._data.clear()
+            self._bytes = 0
+
+    @property
+    def size_bytes(self) -> int:
+        """Bytes currently held (approximate)."""
+        return self._bytes
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+
+def stage_counts() -> dict[str, int]:
+    """Number of real evaluations of every stage since start (cache hits not counted)."""
+    with _REGISTRY_LOCK:
+        return {name: cache.evaluations for name, cache in _REGISTRY.items()}
+
+
+def cache_report() -> dict[str, dict[str, int]]:
+    """Per stage: evaluations, hits, items and bytes held."""
+    with _REGISTRY_LOCK:
+        return {
+            name: {
+                "evaluations": c.evaluations,
+                "hits": c.hits,
+                "items": len(c),
+                "bytes": c.size_bytes,
+            }
+            for name, c in _REGISTRY.items()
+        }
+
+
+def clear_caches() -> None:
+    """Empty every stage cache (for tests and benchmarks measuring cold solves)."""
+    with _REGISTRY_LOCK:
+        caches = list(_REGISTRY.values())
+    for cache in caches:
+        cache.clear()
