@@ -1,20 +1,27 @@
 """Scalar Volterra equations of the modes, solved in time.
 
-After the modal decomposition (:mod:`core.statements`) every mode obeys
+After the modal decomposition (:mod:`core.statements`) every mode ``w_k`` obeys
 
-    d(t) w(t) - (V w)(t) = r(t),      (V w)(t) = int_1^t K(t, tau) w(tau) dtau,   t >= 1,
+    d_k(t) w_k(t) - (V w_k)(t) = r_k(t) + sum_j C_kj (V u_j)(t),     t >= 1,
+    (V f)(t) = int_1^t K(t, tau) f(tau) dtau,
 
-with ``d(t) = 1 + c(t)/gamma >= 1`` (one equation per mode, many modes at once), and the
-known rows need ``V u`` for a few known functions ``u(t)``. The requested times are
-outputs, not the step: each solver chooses its own steps and meets ``tol`` at them.
+with ``d_k(t) = 1 + c(t)/gamma_k >= 1`` and a few *known* functions ``u_j(t)`` (the given
+force and moment, ``1/c``) whose creep history also drives the modes. Keeping ``V u`` as
+a coupling term, rather than substituting ``w = z + u/gamma``, avoids a cancellation that
+loses ``log10(c/gamma)`` digits in the modes of small eigenvalue ``gamma``.
 
-* :func:`solve_degenerate` — for ``K(t, tau) = b(tau) + sum_r a_r(tau) exp(-rate_r (t - tau))``
-  (every shipped creep model). ``V w`` is the sum of states ``S_0' = b w`` and
-  ``S_r' = -rate_r S_r + a_r w``, so each mode is a small linear ODE. It is stepped by the
-  3-stage Radau IIA collocation method (order 5, L-stable, so a fast, stiff exponential
-  costs nothing extra), all modes at once, each step O(1) per mode. Step size from
-  step-doubling error estimates, error per unit step.
-* :func:`solve_general` — any vectorized ``K(t, tau)``: product trapezoid rule on grids
+The requested times are outputs, not the step: each solver chooses its own steps and
+meets ``tol`` at them.
+
+* :func:`solve_degenerate` for ``K(t, tau) = b(tau) + sum_r a_r(tau) exp(-rate_r (t - tau))``
+  (every shipped creep model). ``V f`` is the sum of states ``S_0' = b f`` and
+  ``S_r' = -rate_r S_r + a_r f``, so each mode is a small linear ODE. It is stepped by the
+  3-stage Radau IIA collocation method (order 5, L-stable: a fast, stiff exponential costs
+  nothing extra), all modes at once, O(1) work per mode and step. The known channels are
+  stepped first; the modes then see their stage values (the coupled system is block
+  triangular, so this is the exact Radau step of the whole system). Step sizes come from
+  step-doubling error estimates with error per unit step control.
+* :func:`solve_general` for any vectorized ``K(t, tau)``: product trapezoid rule on grids
   containing every requested time, halved until the Richardson estimate meets ``tol``
   (O(steps^2) per mode, as any method for a general kernel must be).
 """
@@ -39,12 +46,34 @@ RADAU_ORDER = 5
 
 
 @dataclass(frozen=True)
+class ModalProblem:
+    """``d w - V w = r + coupling @ V u`` for ``modes`` unknowns and ``known`` functions u.
+
+    ``d(t)``, ``r(t)`` return arrays (modes, len(t)); ``u(t)`` (known, len(t));
+    ``coupling`` is (modes, known). All dimensionless.
+    """
+
+    d: TimeFunction
+    r: TimeFunction
+    u: TimeFunction
+    coupling: np.ndarray
+
+    @property
+    def n_modes(self) -> int:
+        return self.coupling.shape[0]
+
+    @property
+    def n_known(self) -> int:
+        return self.coupling.shape[1]
+
+
+@dataclass(frozen=True)
 class VolterraSolution:
     """Solution at the output times.
 
-    ``w`` and ``vw`` (= ``V w``) have shape (modes, times); ``vu`` (known functions, times).
-    ``error_estimate`` bounds the error of ``vw`` relative to ``max|w|`` (and of ``vu``
-    relative to ``max|u|``); ``steps`` counts accepted steps.
+    ``w`` and ``vw`` (= ``V w``) have shape (modes, times); ``vu`` (known, times).
+    ``error_estimate`` estimates the global error of ``w`` relative to ``max|w|`` (and of
+    ``vu`` relative to ``max|u|``); ``steps`` counts accepted steps.
     """
 
     w: np.ndarray
@@ -53,234 +82,237 @@ class VolterraSolution:
     error_estimate: float
     steps: int
     rejected: int
+    success: bool
     message: str
 
 
-def _stage_matrices(kernel, t_stage: np.ndarray, d: np.ndarray, unknown: bool) -> tuple:
-    """Per-stage ODE matrices ``A_j`` and forcing factors for every channel.
+def _scales(problem: ModalProblem, t_end: float) -> tuple[np.ndarray, np.ndarray]:
+    """Sizes of the unknowns and known functions, for a relative error norm."""
+    probe = np.linspace(1.0, t_end, 17)
+    w_scale = np.ones(problem.n_modes)
+    if problem.n_modes:
+        d = problem.d(probe)
+        forcing = problem.r(probe)
+        if problem.n_known:
+            u = problem.u(probe)
+            forcing = np.abs(forcing) + np.abs(problem.coupling) @ np.abs(u)
+        w_scale = np.full(problem.n_modes, float(np.max(np.abs(forcing / d))) or 1.0)
+    u_scale = np.ones(problem.n_known)
+    if problem.n_known:
+        u_scale = np.maximum(np.max(np.abs(problem.u(probe)), axis=1), 1e-300)
+    return w_scale, u_scale
 
-    ``d`` (channels, stages). Returns ``beta`` (states, stages) and the system matrices
-    (channels, stages, states, states).
-    """
+
+def _kernel_factors(kernel, t_stage: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``beta`` (states, stages): forcing factors; ``decay`` (states,): state decay rates."""
     rates = np.asarray(kernel.rates, dtype=float)
-    beta = np.concatenate([kernel.tau_part(t_stage)[None, :],
-                           kernel.exponential_parts(t_stage).reshape(len(rates), -1)], axis=0)
-    decay = np.concatenate([[0.0], rates])
-    ns = len(decay)
-    base = -np.diag(decay)
-    if unknown:
-        # A = -diag(decay) + (beta / d) 1^T
-        mats = base[None, None] + (beta.T[None, :, :, None] / d[:, :, None, None]) * np.ones(ns)
-    else:
-        mats = np.broadcast_to(base, (d.shape[0], len(t_stage), ns, ns))
-    return beta, mats
+    beta = np.concatenate([np.asarray(kernel.tau_part(t_stage), dtype=float)[None, :],
+                           np.asarray(kernel.exponential_parts(t_stage),
+                                      dtype=float).reshape(len(rates), -1)], axis=0)
+    return beta, np.concatenate([[0.0], rates])
 
 
-def _radau_step(kernel, t0: float, h: float, s0: np.ndarray, d_fn, r_fn, u_fn,
-                n_unknown: int) -> tuple[np.ndarray, np.ndarray]:
-    """One Radau IIA step for all channels. Returns the new states and stage values of w.
+def _radau_step(kernel, problem: ModalProblem, t0: float, h: float,
+                s_modes: np.ndarray, s_known: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One Radau IIA step of all channels. Returns the new mode and known-channel states.
 
-    ``s0`` (channels, states); the first ``n_unknown`` channels are unknown modes
-    (``w = (r + sum S)/d``), the rest known functions (``w = u``).
+    ``s_modes`` (modes, states), ``s_known`` (known, states).
     """
     ts = t0 + RADAU_C * h
-    nch, ns = s0.shape
-    blocks = []
-    forcing = []
-    wfac = []
-    if n_unknown:
-        d = d_fn(ts)  # (modes, 3)
-        r = r_fn(ts)
-        beta, mats = _stage_matrices(kernel, ts, d, True)
-        blocks.append(mats)
-        forcing.append(beta.T[None] * (r / d)[:, :, None])  # (modes, 3, states)
-        wfac.append((d, r))
-    if nch > n_unknown:
-        u = u_fn(ts)  # (known, 3)
-        beta, mats = _stage_matrices(kernel, ts, np.ones_like(u), False)
-        blocks.append(mats)
-        forcing.append(beta.T[None] * u[:, :, None])
-    mats = np.concatenate(blocks, axis=0)  # (channels, 3, ns, ns)
-    f = np.concatenate(forcing, axis=0)  # (channels, 3, ns)
-    big = np.zeros((nch, 3 * ns, 3 * ns))
+    beta, decay = _kernel_factors(kernel, ts)
+    ns = len(decay)
     eye = np.eye(ns)
-    for i in range(3):
-        for j in range(3):
-            big[:, i * ns:(i + 1) * ns, j * ns:(j + 1) * ns] = (
-                (eye if i == j else 0.0) - h * RADAU_A[i, j] * mats[:, j])
-    rhs = np.repeat(s0[:, None, :], 3, axis=1) + h * np.einsum("ij,cjs->cis", RADAU_A, f)
-    y = np.linalg.solve(big, rhs.reshape(nch, 3 * ns, 1)).reshape(nch, 3, ns)
-    return y[:, 2, :].copy(), y
+    base = -np.diag(decay)
+    # Known channels: S' = -decay S + beta u; one matrix for all of them.
+    known_stage_sums = None
+    new_known = s_known
+    if problem.n_known:
+        big = np.zeros((3 * ns, 3 * ns))
+        for i in range(3):
+            for j in range(3):
+                big[i * ns:(i + 1) * ns, j * ns:(j + 1) * ns] = (
+                    (eye if i == j else 0.0) - h * RADAU_A[i, j] * base)
+        u = problem.u(ts)  # (known, 3)
+        f = beta.T[None] * u[:, :, None]  # (known, 3, states)
+        rhs = np.repeat(s_known[:, None, :], 3, axis=1) + h * np.einsum("ij,cjs->cis",
+                                                                       RADAU_A, f)
+        y = np.linalg.solve(big, rhs.reshape(-1, 3 * ns).T).T.reshape(-1, 3, ns)
+        new_known = y[:, 2, :].copy()
+        known_stage_sums = y.sum(axis=2)  # (known, 3): V u at the stage times
+    new_modes = s_modes
+    if problem.n_modes:
+        d = problem.d(ts)  # (modes, 3)
+        r = problem.r(ts)
+        if known_stage_sums is not None:
+            r = r + problem.coupling @ known_stage_sums
+        # w = (r + sum S)/d, so S' = -decay S + beta (r + sum S)/d
+        mats = base[None, None] + (beta.T[None, :, :, None] / d[:, :, None, None])
+        f = beta.T[None] * (r / d)[:, :, None]  # (modes, 3, states)
+        nm = problem.n_modes
+        big = np.zeros((nm, 3 * ns, 3 * ns))
+        for i in range(3):
+            for j in range(3):
+                big[:, i * ns:(i + 1) * ns, j * ns:(j + 1) * ns] = (
+                    (eye if i == j else 0.0) - h * RADAU_A[i, j] * mats[:, j])
+        rhs = np.repeat(s_modes[:, None, :], 3, axis=1) + h * np.einsum("ij,cjs->cis",
+                                                                       RADAU_A, f)
+        y = np.linalg.solve(big, rhs.reshape(nm, 3 * ns, 1)).reshape(nm, 3, ns)
+        new_modes = y[:, 2, :].copy()
+    return new_modes, new_known
 
 
-def solve_degenerate(kernel, times: np.ndarray, d_fn: TimeFunction, r_fn: TimeFunction,
-                     u_fn: TimeFunction | None, n_unknown: int, n_known: int, *,
-                     tol: float, max_steps: int = 20000) -> VolterraSolution:
-    """Solve ``d w - V w = r`` (``n_unknown`` modes) and compute ``V u`` (``n_known``).
+def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: float,
+                     max_steps: int = 20000) -> VolterraSolution:
+    """Solve ``problem`` at ``times`` (increasing, >= 1) for a degenerate kernel.
 
-    ``d_fn(t)``, ``r_fn(t)`` return arrays (modes, len(t)); ``u_fn(t)`` (known, len(t)).
-    ``tol`` is the target for the global error relative to the size of ``w`` and ``u``.
+    ``kernel`` has ``rates``, ``tau_part(tau)`` and ``exponential_parts(tau)`` (see
+    :class:`core.creep.DegenerateKernel`). ``tol`` bounds the global error relative to the
+    size of the unknowns.
     """
     times = np.asarray(times, dtype=float)
-    ns = 1 + len(kernel.rates)
-    nch = n_unknown + n_known
-    state = np.zeros((nch, ns))
-    t_now = 1.0
-    w_out = np.zeros((n_unknown, len(times)))
-    vw_out = np.zeros((n_unknown, len(times)))
-    vu_out = np.zeros((n_known, len(times)))
-
-    # Scales for the error norm: sizes of the unknowns and of the known functions.
-    probe = np.linspace(1.0, times[-1], 9)
-    w_scale = 1.0
-    if n_unknown:
-        w_scale = float(np.max(np.abs(r_fn(probe) / d_fn(probe)))) or 1.0
-    u_scale = np.ones(n_known)
-    if n_known:
-        u_scale = np.maximum(np.max(np.abs(u_fn(probe)), axis=1), 1e-300)
-    scale = np.concatenate([np.full(n_unknown, w_scale), u_scale])[:, None]
-    span = max(times[-1] - 1.0, 1e-300)
+    ns = 1 + len(np.atleast_1d(kernel.rates))
+    nm, nk = problem.n_modes, problem.n_known
+    s_modes = np.zeros((nm, ns))
+    s_known = np.zeros((nk, ns))
+    w_out = np.zeros((nm, len(times)))
+    vw_out = np.zeros((nm, len(times)))
+    vu_out = np.zeros((nk, len(times)))
+    w_scale, u_scale = _scales(problem, float(times[-1]))
+    scale = np.concatenate([w_scale, u_scale])
+    span = max(float(times[-1]) - 1.0, 1e-300)
+    # A tenth of tol per unit of time, so the accumulated error stays below tol.
     local_tol = 0.1 * tol
 
-    def record(k: int, t: float, s: np.ndarray) -> None:
-        sums = s.sum(axis=1)
-        if n_unknown:
+    def record(k: int, t: float) -> None:
+        vu = s_known.sum(axis=1)
+        vu_out[:, k] = vu
+        if nm:
             tt = np.array([t])
-            d = d_fn(tt)[:, 0]
-            r = r_fn(tt)[:, 0]
-            w = (r + sums[:n_unknown]) / d
-            w_out[:, k] = w
-            vw_out[:, k] = sums[:n_unknown]
-        if n_known:
-            vu_out[:, k] = sums[n_unknown:]
+            vw = s_modes.sum(axis=1)
+            forcing = problem.r(tt)[:, 0] + (problem.coupling @ vu if nk else 0.0)
+            w_out[:, k] = (forcing + vw) / problem.d(tt)[:, 0]
+            vw_out[:, k] = vw
 
     k_out = 0
     while k_out < len(times) and times[k_out] <= 1.0:
-        record(k_out, 1.0, state)
+        record(k_out, 1.0)
         k_out += 1
-    h = min(span / 50.0, 0.1) if span > 0 else 0.0
+    h = min(span / 20.0, 0.5)
+    t_now = 1.0
     total_error = 0.0
     steps = rejected = 0
-    last_free_h = h
     while k_out < len(times):
         if steps + rejected > max_steps:
-            return VolterraSolution(w_out, vw_out, vu_out, np.inf, steps, rejected,
-                                    f"time stepping stopped after {max_steps} steps")
-        target = times[k_out]
+            return VolterraSolution(w_out, vw_out, vu_out, np.inf, steps, rejected, False,
+                                    f"time stepping stopped after {max_steps} steps at "
+                                    f"t = {t_now:.6g}")
+        target = float(times[k_out])
         h_try = min(h, target - t_now)
-        forced = h_try < target - t_now or h_try < 0.5 * h
-        if h_try < 0.5 * last_free_h and h_try < h:
-            # An output time forces a step much shorter than an accepted one: its error is
-            # below the last estimate by (h_try/h)^6, so no new estimate is needed.
-            s_new, _ = _radau_step(kernel, t_now, h_try, state, d_fn, r_fn, u_fn, n_unknown)
-            err = 0.0
-        else:
-            s_full, _ = _radau_step(kernel, t_now, h_try, state, d_fn, r_fn, u_fn, n_unknown)
-            s_half, _ = _radau_step(kernel, t_now, h_try / 2, state, d_fn, r_fn, u_fn,
-                                    n_unknown)
-            s_new, _ = _radau_step(kernel, t_now + h_try / 2, h_try / 2, s_half, d_fn, r_fn,
-                                   u_fn, n_unknown)
-            diff = np.abs(s_new.sum(axis=1) - s_full.sum(axis=1))[:, None] / scale
-            err = float(np.max(diff)) / (2**RADAU_ORDER - 1)
-            allowed = local_tol * max(h_try / span, 1e-3)
-            if err > allowed and h_try > 1e-12 * span:
-                rejected += 1
-                h = h_try * max(0.2, 0.9 * (allowed / err) ** (1 / RADAU_ORDER))
-                continue
-            factor = 4.0 if err == 0 else min(4.0, max(0.2, 0.9 * (allowed / err) ** (
-                1 / RADAU_ORDER)))
-            if not forced or h_try >= h:
-                h = h_try * factor
-                last_free_h = h_try
-        state = s_new
-        t_now = t_now + h_try
+        full = _radau_step(kernel, problem, t_now, h_try, s_modes, s_known)
+        half = _radau_step(kernel, problem, t_now, h_try / 2, s_modes, s_known)
+        fine = _radau_step(kernel, problem, t_now + h_try / 2, h_try / 2, *half)
+        diff = np.concatenate([np.abs(fine[0].sum(axis=1) - full[0].sum(axis=1)),
+                               np.abs(fine[1].sum(axis=1) - full[1].sum(axis=1))]) / scale
+        # Richardson: the two-half-step answer carries 1/(2^p - 1) of the difference.
+        err = float(np.max(diff, initial=0.0)) / (2**RADAU_ORDER - 1)
+        allowed = local_tol * max(h_try / span, 1e-6)
+        if err > allowed and h_try > 1e-10 * span:
+            rejected += 1
+            h = h_try * max(0.2, 0.9 * (allowed / err) ** (1 / (RADAU_ORDER + 1)))
+            continue
+        s_modes, s_known = fine
+        t_now += h_try
         total_error += err
         steps += 1
-        if abs(t_now - target) <= 1e-13 * max(1.0, target):
+        grow = 4.0 if err == 0 else min(4.0, max(0.5, 0.9 * (allowed / err) ** (
+            1 / (RADAU_ORDER + 1))))
+        # A step shortened only to land on an output time says nothing about the next one.
+        if h_try >= 0.99 * h or grow < 1:
+            h = h_try * grow
+        if abs(t_now - target) <= 1e-12 * max(1.0, target):
             t_now = target
-            record(k_out, t_now, state)
+            record(k_out, t_now)
             k_out += 1
     est = max(total_error, 1e-15)
-    return VolterraSolution(w_out, vw_out, vu_out, est, steps, rejected, "ok")
+    return VolterraSolution(w_out, vw_out, vu_out, est, steps, rejected, True, "ok")
 
 
-def _trapezoid_solve(kernel: Callable, grid: np.ndarray, d_fn, r_fn, u_fn, n_unknown: int,
-                     n_known: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _trapezoid_weights(grid: np.ndarray, i: int) -> np.ndarray:
+    """Weights of the trapezoid rule for int_{grid[0]}^{grid[i]} on the nodes 0..i."""
+    h = np.diff(grid[: i + 1])
+    om = np.zeros(i + 1)
+    om[:-1] += h / 2
+    om[1:] += h / 2
+    return om
+
+
+def _trapezoid_solve(kernel: Callable, problem: ModalProblem,
+                     grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Product trapezoid rule on ``grid`` (which starts at 1). Values on the grid."""
     n = len(grid)
-    h = np.diff(grid)
     kmat = np.tril(np.asarray(kernel(grid[:, None], grid[None, :]), dtype=float))
-    w = np.zeros((n_unknown, n))
-    vw = np.zeros((n_unknown, n))
-    d = d_fn(grid) if n_unknown else None
-    r = r_fn(grid) if n_unknown else None
-    if n_unknown:
+    if not np.all(np.isfinite(kmat)):
+        raise ValueError("kernel: returned non-finite values K(t, tau) for 1 <= tau <= t")
+    nm, nk = problem.n_modes, problem.n_known
+    vu = np.zeros((nk, n))
+    if nk:
+        u = problem.u(grid)
+        for i in range(1, n):
+            vu[:, i] = u[:, : i + 1] @ (kmat[i, : i + 1] * _trapezoid_weights(grid, i))
+    w = np.zeros((nm, n))
+    vw = np.zeros((nm, n))
+    if nm:
+        d = problem.d(grid)
+        r = problem.r(grid) + (problem.coupling @ vu if nk else 0.0)
         w[:, 0] = r[:, 0] / d[:, 0]
-    for i in range(1, n):
-        # weights of int_1^{t_i}: h_1/2, (h_j + h_{j+1})/2, ..., h_i/2
-        om = np.empty(i + 1)
-        om[0] = h[0] / 2
-        om[1:i] = (h[: i - 1] + h[1:i]) / 2
-        om[i] = h[i - 1] / 2
-        kw = kmat[i, : i + 1] * om
-        if n_unknown:
+        for i in range(1, n):
+            kw = kmat[i, : i + 1] * _trapezoid_weights(grid, i)
             hist = w[:, :i] @ kw[:i]
             w[:, i] = (r[:, i] + hist) / (d[:, i] - kw[i])
             vw[:, i] = hist + kw[i] * w[:, i]
-    vu = np.zeros((n_known, n))
-    if n_known:
-        u = u_fn(grid)
-        for i in range(1, n):
-            om = np.empty(i + 1)
-            om[0] = h[0] / 2
-            om[1:i] = (h[: i - 1] + h[1:i]) / 2
-            om[i] = h[i - 1] / 2
-            vu[:, i] = u[:, : i + 1] @ (kmat[i, : i + 1] * om)
     return w, vw, vu
 
 
-def solve_general(kernel: Callable, times: np.ndarray, d_fn: TimeFunction, r_fn: TimeFunction,
-                  u_fn: TimeFunction | None, n_unknown: int, n_known: int, *, tol: float,
+def solve_general(kernel: Callable, problem: ModalProblem, times: np.ndarray, *, tol: float,
                   max_points: int = 4097) -> VolterraSolution:
     """Same problem as :func:`solve_degenerate` for any vectorized kernel ``K(t, tau)``.
 
     Trapezoid product quadrature on a grid containing every output time, refined by
-    halving; Richardson extrapolation of the last two grids gives the answer and the
-    difference of the two the error estimate.
+    halving; Richardson extrapolation of the last two grids gives the answer and their
+    difference the error estimate.
     """
     times = np.asarray(times, dtype=float)
     anchors = np.unique(np.concatenate([[1.0], times]))
     span = max(anchors[-1] - 1.0, 1e-300)
     sub = np.maximum(1, np.ceil(np.diff(anchors) / (span / 16)).astype(int))
+    w_scale, u_scale = _scales(problem, float(anchors[-1]))
     previous = None
-    w_scale = 1.0
-    probe = np.linspace(1.0, anchors[-1], 9)
-    if n_unknown:
-        w_scale = float(np.max(np.abs(r_fn(probe) / d_fn(probe)))) or 1.0
-    u_scale = (np.maximum(np.max(np.abs(u_fn(probe)), axis=1), 1e-300)[:, None]
-               if n_known else None)
-    message = "ok"
-    est = np.inf
-    steps = 0
+    previous_extrapolated = None
     while True:
         grid = np.concatenate([[anchors[0]]] + [
             np.linspace(a, b, s + 1)[1:] for a, b, s in zip(anchors[:-1], anchors[1:], sub,
                                                            strict=True)])
         idx = np.searchsorted(grid, times)
-        w, vw, vu = _trapezoid_solve(kernel, grid, d_fn, r_fn, u_fn, n_unknown, n_known)
+        w, vw, vu = _trapezoid_solve(kernel, problem, grid)
         current = (w[:, idx], vw[:, idx], vu[:, idx])
-        steps = len(grid) - 1
         if previous is not None:
-            # The trapezoid error is c h^2 + O(h^4): halving h leaves a quarter of it, so the
-            # difference of the last two grids is three times the error of the finer one.
-            err_w = np.max(np.abs(current[1] - previous[1])) / 3 / w_scale if n_unknown else 0
-            err_u = (np.max(np.abs(current[2] - previous[2]) / u_scale) / 3) if n_known else 0
-            est = float(max(err_w, err_u))
-            if est <= 0.1 * tol or 2 * len(grid) > max_points:
-                if est > 0.1 * tol:
-                    message = (f"general-kernel time stepping reached {len(grid)} points "
-                               f"with estimated error {est:.1e}")
-                return VolterraSolution(current[0], current[1], current[2], max(est, 1e-15),
-                                        steps, 0, message)
+            # Error c h^2 + d h^4: (4 fine - coarse)/3 removes the h^2 term.
+            extrapolated = tuple((4 * c - p) / 3 for c, p in zip(current, previous,
+                                                                 strict=True))
+            if previous_extrapolated is not None:
+                # Two extrapolations differ by 15x the finer one's O(h^4) error.
+                err_w = (float(np.max(np.abs(extrapolated[0] - previous_extrapolated[0])
+                                      / w_scale[:, None])) if problem.n_modes else 0.0)
+                err_u = (float(np.max(np.abs(extrapolated[2] - previous_extrapolated[2])
+                                      / u_scale[:, None])) if problem.n_known else 0.0)
+                est = max(err_w, err_u) / 15
+                if est <= tol or 2 * len(grid) > max_points:
+                    ok = est <= tol
+                    message = "ok" if ok else (
+                        f"general-kernel time stepping reached {len(grid)} points with "
+                        f"estimated error {est:.1e}")
+                    return VolterraSolution(*extrapolated, max(est, 1e-15), len(grid) - 1,
+                                            0, ok, message)
+            previous_extrapolated = extrapolated
         previous = current
         sub = sub * 2

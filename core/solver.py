@@ -1,0 +1,649 @@
+"""``solve_dimensionless``: the projection method as a pipeline of cached, pure stages.
+
+The dimensionless problem (model notes; the seed's (9)-(12)):
+
+    c(t) m(x) q(x,t) + (I - V) F q = delta(t) + alpha(t) x - g(x),   -1 <= x <= 1,  t >= 1,
+    int q dx = P(t),   int x q dx = M(t).
+
+With ``m q = -g/c + sum_j a_j(t) p_j(x)`` (the rough part ``g/(c m)`` carried exactly, the
+``p_j`` orthonormal for the weight ``1/m``) the Galerkin rows decouple into one scalar
+Volterra equation per mode (:mod:`core.statements`, :mod:`core.time_integration`).
+
+Stages and what each depends on (each cached on exactly these inputs, :mod:`core.cache`):
+
+============  ===============================================  ==============================
+stage         inputs                                           result
+============  ===============================================  ==============================
+panels        lam, breakpoints, samples of m and g, basis cap  quadrature panels
+operator      lam, panels                                      discrete operator F (N x N)
+basis         panels, m at the nodes, breakpoints, kind, cap   orthonormal functions p_j
+galerkin      operator, basis                                  R_ij
+gap           operator, basis, g at the nodes                  G_i, int g/m, int x g/m
+modes         galerkin, statement, n                           eigenpairs of the free block
+time          modes, c, K, the loads, times                    a_j(t) and the four scalars
+============  ===============================================  ==============================
+
+A change of the loads only re-runs the last stage; an elastic base skips time stepping.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from core.basis import Basis, build_basis
+from core.cache import StageCache, fingerprint
+from core.projection import GapTerms, galerkin_matrix, gap_terms
+from core.quadrature import KernelOperator, Panels, base_panels, kernel_operator, \
+    refine_to_resolve
+from core.statements import QUANTITIES, ModalSystem, modal_system, statement_number
+from core.time_integration import ModalProblem, solve_degenerate, solve_general
+
+Scalar = float | Callable[[np.ndarray], np.ndarray]
+
+#: Mode counts tried in turn; the error estimate compares consecutive levels.
+MODE_LEVELS = (4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256)
+#: Basis sizes built (a larger one only when a smaller one could not meet tol).
+BASIS_CAPS = (64, 256)
+#: Quadrature and round-off floor of the relative error (measured: ~1e-13 on the scenes
+#: of the test suite; see tests/test_solver.py).
+ERROR_FLOOR = 2e-13
+#: |alpha| above this many radians is not a small tilt (used by the dimensional API).
+TOLERANCE_RANGE = (1e-13, 1e-1)
+
+_PANELS = StageCache("panels", max_items=32)
+_OPERATOR = StageCache("operator", max_items=8, max_bytes=512 * 2**20)
+_BASIS = StageCache("basis", max_items=16)
+_GALERKIN = StageCache("galerkin", max_items=32)
+_GAP = StageCache("gap", max_items=32)
+_MODES = StageCache("modes", max_items=256)
+
+
+# --------------------------------------------------------------------------- results
+
+
+@dataclass(frozen=True)
+class ContactSolution:
+    """The answer of :func:`solve_dimensionless` (all quantities dimensionless).
+
+    ``times`` (T,), ``settlement`` (delta), ``tilt`` (alpha), ``force`` (P), ``moment`` (M)
+    as arrays over ``times``; ``pressure(x)`` gives q at points of [-1, 1] (shape
+    ``(len(x), T)``); ``info`` holds ``error_estimate`` (relative, see the module notes),
+    ``seconds``, ``flags``, ``message``, ``success``, ``n_modes``, ``n_steps``, ``stages``.
+    """
+
+    times: np.ndarray
+    settlement: np.ndarray
+    tilt: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    info: dict[str, Any]
+    _basis: Basis = field(repr=False)
+    _coefficients: np.ndarray = field(repr=False)  # a_j(t), shape (n, T)
+    _c: np.ndarray = field(repr=False)  # c(t) at the times
+    _m: Callable[[np.ndarray], np.ndarray] = field(repr=False)
+    _g: Callable[[np.ndarray], np.ndarray] = field(repr=False)
+
+    @property
+    def success(self) -> bool:
+        """Whether the error estimate meets the requested tolerance."""
+        return bool(self.info["success"])
+
+    @property
+    def message(self) -> str:
+        """A one-line account of how the solve went."""
+        return str(self.info["message"])
+
+    @property
+    def flags(self) -> list[str]:
+        """Validity flags (``contact_lost``, ``tol_not_met``, ``unresolved_input``)."""
+        return list(self.info["flags"])
+
+    def pressure(self, x: np.ndarray) -> np.ndarray:
+        """Contact pressure q(x, t) at points ``x`` of [-1, 1], shape ``(len(x), len(times))``.
+
+        ``q = (-g(x)/c(t) + sum_j a_j(t) p_j(x)) / m(x)`` (dimensionless, the seed's (18)).
+        """
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        if np.any(~np.isfinite(x)) or np.any(np.abs(x) > 1.0):
+            raise ValueError("x: pressure is defined on [-1, 1] only")
+        phi = self._basis.evaluate(x, self._coefficients.shape[0])
+        mq = phi @ self._coefficients - np.outer(self._g(x), 1.0 / self._c)
+        return mq / self._m(x)[:, None]
+
+
+# ---------------------------------------------------------------------- validation
+
+
+def _as_function(value: Scalar, name: str) -> Callable[[np.ndarray], np.ndarray]:
+    """A vectorized callable for a float or callable argument."""
+    if callable(value):
+        def fn(x: np.ndarray, _f=value) -> np.ndarray:
+            with np.errstate(all="ignore"):
+                out = np.asarray(_f(np.asarray(x, dtype=float)), dtype=float)
+            return np.broadcast_to(out, np.shape(x)).astype(float)
+        return fn
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise ValueError(f"{name}: must be a number or a vectorized callable, "
+                         f"got {type(value).__name__}")
+    v = float(value)
+    if not np.isfinite(v):
+        raise ValueError(f"{name}: must be finite, got {v}")
+    return lambda x, _v=v: np.full(np.shape(x), _v)
+
+
+def _check_values(values: np.ndarray, name: str, where: np.ndarray, var: str, *,
+                  positive: bool = False) -> None:
+    bad = ~np.isfinite(values)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"{name}: must be finite, is {values[i]} at {var} = {where[i]:.6g}")
+    if positive and np.any(values <= 0):
+        i = int(np.argmin(values))
+        raise ValueError(f"{name}: must be > 0, is {values[i]:.6g} at {var} = {where[i]:.6g}")
+
+
+@dataclass(frozen=True)
+class _Inputs:
+    lam: float
+    m: Callable[[np.ndarray], np.ndarray]
+    g: Callable[[np.ndarray], np.ndarray]
+    g_is_zero: bool
+    times: np.ndarray
+    c: Callable[[np.ndarray], np.ndarray]
+    c_is_constant: bool
+    kernel: Any
+    loads: dict[str, Callable[[np.ndarray], np.ndarray]]
+    given: frozenset[str]
+    breakpoints: tuple[float, ...]
+    tol: float
+
+
+def _validate(lam, m, g, times, c, kernel, loads, breakpoints, tol) -> _Inputs:
+    if isinstance(lam, bool) or not isinstance(lam, (int, float, np.floating, np.integer)):
+        raise ValueError(f"lam: must be a number, got {type(lam).__name__}")
+    lam = float(lam)
+    if not np.isfinite(lam) or lam <= 0:
+        raise ValueError(f"lam: must be a finite number > 0, got {lam}")
+    if lam > 1e4 or lam < 1e-4:
+        raise ValueError(f"lam: must be in [1e-4, 1e4] (a/H), got {lam:g}")
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating)):
+        raise ValueError(f"tol: must be a number, got {type(tol).__name__}")
+    tol = float(tol)
+    if not (TOLERANCE_RANGE[0] <= tol <= TOLERANCE_RANGE[1]):
+        raise ValueError(f"tol: must be in [{TOLERANCE_RANGE[0]:g}, {TOLERANCE_RANGE[1]:g}], "
+                         f"got {tol:g}")
+    try:
+        bps = tuple(sorted(float(b) for b in breakpoints))
+    except (TypeError, ValueError) as exc:
+        raise ValueError("breakpoints: must be a sequence of numbers in (-1, 1)") from exc
+    for b in bps:
+        if not np.isfinite(b) or not (-1.0 < b < 1.0):
+            raise ValueError(f"breakpoints: each must lie in (-1, 1), got {b}")
+    bps = tuple(b for i, b in enumerate(bps) if i == 0 or b - bps[i - 1] > 1e-12)
+    try:
+        t = np.asarray(times, dtype=float).ravel()
+    except (TypeError, ValueError) as exc:
+        raise ValueError("times: must be an array of numbers") from exc
+    if t.size == 0:
+        raise ValueError("times: at least one time is needed")
+    if t.size > 100_000:
+        raise ValueError(f"times: at most 100000 output times, got {t.size}")
+    if not np.all(np.isfinite(t)):
+        raise ValueError("times: must be finite")
+    if t[0] < 1.0:
+        raise ValueError(f"times: must be >= 1 (t = 1 is the moment of loading), got {t[0]:g}")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("times: must be strictly increasing")
+    m_fn = _as_function(m, "m")
+    g_fn = _as_function(g, "g")
+    c_fn = _as_function(c, "c")
+    probe = np.linspace(-1.0, 1.0, 257)
+    for bp in bps:
+        probe = np.concatenate([probe, [bp - 1e-9, bp + 1e-9]])
+    _check_values(m_fn(probe), "m", probe, "x", positive=True)
+    _check_values(g_fn(probe), "g", probe, "x")
+    _check_values(c_fn(t), "c", t, "t", positive=True)
+    given = frozenset(k for k, v in loads.items() if v is not None)
+    statement_number(given)
+    load_fns = {}
+    for name in sorted(given):
+        fn = _as_function(loads[name], name)
+        _check_values(fn(t), name, t, "t")
+        load_fns[name] = fn
+    if kernel is not None:
+        if not callable(kernel):
+            raise ValueError("kernel: must be None or a vectorized callable K(t, tau)")
+        tt = np.array([t[-1], t[-1], 0.5 * (1 + t[-1])])
+        kv = np.asarray(kernel(tt, np.array([1.0, t[-1], 1.0])), dtype=float)
+        if kv.shape != (3,) or not np.all(np.isfinite(kv)):
+            raise ValueError("kernel: K(t, tau) must return finite values of the shape of "
+                             "its (broadcast) arguments")
+    return _Inputs(lam, m_fn, g_fn, not callable(g) and float(g) == 0.0, t, c_fn,
+                   not callable(c), kernel, load_fns, given, bps, tol)
+
+
+# -------------------------------------------------------------------------- stages
+
+
+@dataclass(frozen=True)
+class _Discretization:
+    """Panels, operator, basis and the Galerkin data, with their cache keys."""
+
+    panels: Panels
+    operator: KernelOperator
+    basis: Basis
+    m_nodes: np.ndarray
+    r_matrix: np.ndarray
+    gap: GapTerms
+    sample_x: np.ndarray
+    sample_phi: np.ndarray
+    sample_m: np.ndarray
+    sample_g: np.ndarray
+    galerkin_key: str
+    resolved: bool
+
+
+def _max_width(lam: float, cap: int) -> float:
+    # 16 Gauss nodes per panel resolve the degree-``cap`` polynomials when a panel spans at
+    # most ~16/cap of [-1, 1]; 3/lam resolves the kernel's smooth part (module quadrature).
+    return min(0.25, 3.0 / lam, 16.0 / cap)
+
+
+def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _Discretization:
+    def timed(name: str, cache: StageCache, key, compute):
+        t0 = _time.perf_counter()
+        value, hit = cache.get_or_compute(key, compute)
+        entry = stages.setdefault(name, {"seconds": 0.0, "cached": True})
+        entry["seconds"] += _time.perf_counter() - t0
+        entry["cached"] = entry["cached"] and hit
+        return value
+
+    width = _max_width(inp.lam, cap)
+    start = base_panels(inp.lam, inp.breakpoints, max_width=width)
+    m_probe = inp.m(start.nodes)
+    g_probe = inp.g(start.nodes)
+    panel_key = fingerprint("panels", inp.lam, inp.breakpoints, width, m_probe, g_probe)
+
+    def make_panels():
+        functions = [inp.m] if inp.g_is_zero else [inp.m, inp.g]
+        return refine_to_resolve(start, functions)
+
+    panels, resolved = timed("panels", _PANELS, panel_key, make_panels)
+    op_key = fingerprint("operator", inp.lam, panels.edges)
+    operator = timed("operator", _OPERATOR, op_key, lambda: kernel_operator(inp.lam, panels))
+    m_nodes = inp.m(panels.nodes)
+    _check_values(m_nodes, "m", panels.nodes, "x", positive=True)
+    count = min(cap, panels.size // 2)
+    basis_key = fingerprint("basis", panels.edges, m_nodes, inp.breakpoints, kind, count)
+
+    def make_basis():
+        basis = build_basis(panels, m_nodes, count, breakpoints=inp.breakpoints, kind=kind)
+        xs = _sample_points(inp.breakpoints)
+        return basis, xs, basis.evaluate(xs)
+
+    basis, sample_x, sample_phi = timed("basis", _BASIS, basis_key, make_basis)
+    gal_key = fingerprint("galerkin", op_key, basis_key)
+    r_matrix = timed("galerkin", _GALERKIN, gal_key,
+                     lambda: galerkin_matrix(operator, basis, m_nodes))
+    g_nodes = inp.g(panels.nodes)
+    _check_values(g_nodes, "g", panels.nodes, "x")
+    if inp.g_is_zero:
+        gap = GapTerms(np.zeros(basis.size), 0.0, 0.0)
+    else:
+        gap_key = fingerprint("gap", op_key, basis_key, g_nodes)
+        gap = timed("gap", _GAP, gap_key,
+                    lambda: gap_terms(operator, basis, m_nodes, g_nodes))
+    return _Discretization(panels, operator, basis, m_nodes, r_matrix, gap, sample_x,
+                           sample_phi, inp.m(sample_x), inp.g(sample_x), gal_key, resolved)
+
+
+def _sample_points(breakpoints: Sequence[float]) -> np.ndarray:
+    """Interior points where the pressure error is measured (|x| <= 0.95, off the jumps)."""
+    xs = np.cos(np.pi * (np.arange(96) + 0.5) / 96) * 0.95
+    for b in breakpoints:
+        xs = xs[np.abs(xs - b) > 0.02]
+    return np.sort(xs)
+
+
+def _modes(disc: _Discretization, given: frozenset[str], n: int,
+           stages: dict[str, dict]) -> ModalSystem:
+    key = (disc.galerkin_key, tuple(sorted(given)), n)
+    t0 = _time.perf_counter()
+    value, hit = _MODES.get_or_compute(
+        key, lambda: modal_system(disc.r_matrix, disc.basis.moments, given, n))
+    entry = stages.setdefault("modes", {"seconds": 0.0, "cached": True})
+    entry["seconds"] += _time.perf_counter() - t0
+    entry["cached"] = entry["cached"] and hit
+    return value
+
+
+# ---------------------------------------------------------------------- time stage
+
+
+@dataclass(frozen=True)
+class _LevelResult:
+    n: int
+    coefficients: np.ndarray  # (n, T)
+    settlement: np.ndarray
+    tilt: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    time_error: float
+    steps: int
+    time_message: str
+    time_success: bool
+
+
+def _solve_level(inp: _Inputs, disc: _Discretization, ms: ModalSystem, times: np.ndarray,
+                 *, time_tol: float) -> _LevelResult:
+    """Solve the modal system of one mode count at ``times`` (elastic or creeping base)."""
+    n = ms.n
+    gap_vec = ms.rotate(disc.gap.vector[:n])
+    gint, gxint = disc.gap.integral, disc.gap.first_moment
+    free, known = ms.free, ms.known
+    k = len(known)
+    r_rot = ms.r_rot
+    c_t = inp.c(times)
+    loads = {name: fn(times) for name, fn in inp.loads.items()}
+    constraint_inv = np.linalg.inv(ms.constraint) if k else np.zeros((0, 0))
+    shift = {"force": gint, "moment": gxint}
+
+    def known_coefficients(tt: np.ndarray) -> np.ndarray:
+        """b_K(t) from the given force and moment, shape (k, len(tt))."""
+        if not k:
+            return np.zeros((0, tt.size))
+        inv_c = 1.0 / inp.c(tt)
+        rhs = np.array([inp.loads[name](tt) + shift[name] * inv_c
+                        for name in ms.constraint_names])
+        return constraint_inv @ rhs
+
+    def given_drive(tt: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """sum over given delta, alpha of (delta e0 + alpha e1) restricted to ``rows``."""
+        out = np.zeros((len(rows), tt.size))
+        if "settlement" in inp.loads:
+            out += np.outer(ms.e0_rot[rows], inp.loads["settlement"](tt))
+        if "tilt" in inp.loads:
+            out += np.outer(ms.e1_rot[rows], inp.loads["tilt"](tt))
+        return out
+
+    psi, gamma = ms.psi, ms.gamma
+    r_fk = r_rot[np.ix_(free, known)]
+    # Mode forcing u(t) = Psi^T (R_FK b_K - G_F/c) = coupling @ [b_K; 1/c]
+    coupling = np.concatenate([psi.T @ r_fk, -(psi.T @ gap_vec[free])[:, None]], axis=1)
+
+    def known_channels(tt: np.ndarray) -> np.ndarray:
+        return np.concatenate([known_coefficients(tt), (1.0 / inp.c(tt))[None, :]], axis=0)
+
+    def drive(tt: np.ndarray) -> np.ndarray:
+        return psi.T @ given_drive(tt, free)
+
+    u_known = known_channels(times)
+    if inp.kernel is None:
+        z = (drive(times) - coupling @ u_known) / (c_t[None, :] + gamma[:, None])
+        vz = np.zeros_like(z)
+        vu = np.zeros_like(u_known)
+        time_error, steps, message, ok = 0.0, 0, "elastic base: no time stepping", True
+    else:
+        problem = ModalProblem(
+            d=lambda tt: 1.0 + inp.c(tt)[None, :] / gamma[:, None],
+            r=lambda tt: (drive(tt) - coupling @ known_channels(tt)) / gamma[:, None],
+            u=known_channels,
+            coupling=coupling / gamma[:, None],
+        )
+        if hasattr(inp.kernel, "rates") and hasattr(inp.kernel, "exponential_parts"):
+            sol = solve_degenerate(inp.kernel, problem, times, tol=time_tol)
+        else:
+            sol = solve_general(inp.kernel, problem, times, tol=time_tol)
+        z, vz, vu = sol.w, sol.vw, sol.vu
+        time_error, steps, message, ok = sol.error_estimate, sol.steps, sol.message, sol.success
+
+    b = np.zeros((n, times.size))
+    b[free] = psi @ z
+    b_known = u_known[:k]
+    b[known] = b_known
+    a = ms.to_coefficients(b)
+    out = {name: loads.get(name) for name in QUANTITIES}
+    if k:
+        vb_known = vu[:k]
+        v_inv_c = vu[k]
+        inv_c = u_known[k]
+        r_kf = r_rot[np.ix_(known, free)]
+        r_kk = r_rot[np.ix_(known, known)]
+        lhs = (c_t[None, :] * b_known
+               + r_kf @ (psi @ (z - vz))
+               + r_kk @ (b_known - vb_known)
+               - np.outer(gap_vec[known], inv_c - v_inv_c)
+               - given_drive(times, known))
+        unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
+        for i, name in enumerate(ms.unknown_names):
+            out[name] = unknowns[i]
+    e0 = np.zeros(n)
+    e1 = np.zeros(n)
+    j0, j1, j2 = disc.basis.moments
+    e0[0] = np.sqrt(j0)
+    e1[0] = j1 / np.sqrt(j0)
+    if n > 1:
+        e1[1] = np.sqrt((j0 * j2 - j1 * j1) / j0)
+    inv_c = 1.0 / c_t
+    if out["force"] is None:
+        out["force"] = e0 @ a - gint * inv_c
+    if out["moment"] is None:
+        out["moment"] = e1 @ a - gxint * inv_c
+    return _LevelResult(n, a, np.asarray(out["settlement"], float), np.asarray(out["tilt"], float),
+                        np.asarray(out["force"], float), np.asarray(out["moment"], float),
+                        time_error, steps, message, ok)
+
+
+def _scales(res: _LevelResult, disc: _Discretization, c_t: np.ndarray):
+    q = (disc.sample_phi[:, : res.n] @ res.coefficients
+         - np.outer(disc.sample_g, 1.0 / c_t)) / disc.sample_m[:, None]
+    kin = max(np.max(np.abs(res.settlement)), np.max(np.abs(res.tilt)), 1e-300)
+    dyn = max(np.max(np.abs(res.force)), np.max(np.abs(res.moment)), 1e-300)
+    return kin, dyn, max(np.max(np.abs(q)), 1e-300)
+
+
+def _difference(a: _LevelResult, b: _LevelResult, disc: _Discretization,
+                c_t: np.ndarray) -> float:
+    """Largest normalized difference between two levels (quantities over all times)."""
+    kin, dyn, qs = _scales(b, disc, c_t)
+    qa = (disc.sample_phi[:, : a.n] @ a.coefficients
+          - np.outer(disc.sample_g, 1.0 / c_t)) / disc.sample_m[:, None]
+    qb = (disc.sample_phi[:, : b.n] @ b.coefficients
+          - np.outer(disc.sample_g, 1.0 / c_t)) / disc.sample_m[:, None]
+    parts = [np.max(np.abs(a.settlement - b.settlement)) / kin,
+             np.max(np.abs(a.tilt - b.tilt)) / kin,
+             np.max(np.abs(a.force - b.force)) / dyn,
+             np.max(np.abs(a.moment - b.moment)) / dyn,
+             np.max(np.abs(qa - qb)) / qs]
+    return float(max(parts))
+
+
+def _extrapolated_error(diffs: list[float]) -> float:
+    """Error of the last level from the differences of consecutive levels.
+
+    With a convergence ratio rho = d_k/d_{k-1} per level the remaining error after level k
+    is about d_k rho/(1 - rho) (a geometric tail); rho is kept in [0.05, 0.9] so neither a
+    lucky cancellation nor a stall makes the estimate absurd.
+    """
+    if len(diffs) < 2:
+        return diffs[-1] if diffs else np.inf
+    d_prev, d_last = diffs[-2], diffs[-1]
+    if d_prev <= 0:
+        return d_last
+    rho = min(max(d_last / d_prev, 0.05), 0.9)
+    return d_last * rho / (1.0 - rho)
+
+
+# ----------------------------------------------------------------------- the solver
+
+
+def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | np.ndarray,
+                        *, c: Scalar = 1.0, kernel: Callable | None = None,
+                        settlement: Scalar | None = None, tilt: Scalar | None = None,
+                        force: Scalar | None = None, moment: Scalar | None = None,
+                        breakpoints: Sequence[float] = (), tol: float = 1e-8,
+                        basis: str = "piecewise", n_modes: int | None = None
+                        ) -> ContactSolution:
+    """Solve the dimensionless contact problem by the projection method.
+
+    Parameters (all dimensionless):
+        lam: a/H, half-width over base thickness (> 0).
+        m: coating compliance m(x) > 0 on [-1, 1] (number or vectorized callable).
+        g: gap g(x) (number or vectorized callable); may jump at ``breakpoints``.
+        times: output times, increasing, the first >= 1 (t = 1 is the moment of loading).
+        c: relative base modulus c(t) = E(t)/E0 > 0 (number or callable of t).
+        kernel: None (elastic base) or the creep kernel K(t, tau) of ``V``; a
+            :class:`core.creep.DegenerateKernel` is stepped in O(1) per mode and step.
+        settlement, tilt, force, moment: exactly two, numbers or callables of t
+            (delta, alpha, P, M).
+        breakpoints: points of (-1, 1) where m or g may jump.
+        tol: relative accuracy target for delta, alpha (relative to max(|delta|, |alpha|)),
+            P, M (relative to max(|P|, |M|)) and q (relative to max|q| over interior points).
+        basis: "piecewise" (polynomials between breakpoints; default) or "global" (the
+            seed's basis).
+        n_modes: a fixed number of basis functions (for studies); default adaptive.
+
+    Returns a :class:`ContactSolution`. Raises ``ValueError`` naming the argument on bad
+    input.
+    """
+    t_start = _time.perf_counter()
+    inp = _validate(lam, m, g, times, c, kernel,
+                    {"settlement": settlement, "tilt": tilt, "force": force, "moment": moment},
+                    breakpoints, tol)
+    if basis not in ("piecewise", "global"):
+        raise ValueError(f"basis: must be 'piecewise' or 'global', got {basis!r}")
+    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int)
+                                or not 2 <= n_modes <= BASIS_CAPS[-1]):
+        raise ValueError(f"n_modes: must be an integer in [2, {BASIS_CAPS[-1]}], got {n_modes}")
+    stages: dict[str, dict] = {}
+    times_arr = inp.times
+    c_t = inp.c(times_arr)
+    # Probe times for choosing the mode count: all of them for an elastic base (cheap),
+    # else the first, last and a few in between.
+    if inp.kernel is None or times_arr.size <= 5:
+        probe_idx = np.arange(times_arr.size)
+    else:
+        probe_idx = np.unique(np.linspace(0, times_arr.size - 1, 5).round().astype(int))
+    probe_times = times_arr[probe_idx]
+    # Time error budget: a third of tol; the spatial part gets the rest.
+    time_tol = tol / 3
+
+    flags: list[str] = []
+    chosen: _LevelResult | None = None
+    previous: _LevelResult | None = None
+    spatial_error = np.inf
+    disc = None
+    n_used = 0
+    for cap in BASIS_CAPS:
+        disc = _discretize(inp, cap, basis, stages)
+        size = disc.basis.size
+        if n_modes is not None:
+            if n_modes > size and cap != BASIS_CAPS[-1]:
+                continue
+            levels = [lv for lv in MODE_LEVELS if lv < min(n_modes, size)][-2:] + [
+                min(n_modes, size)]
+        else:
+            levels = [lv for lv in MODE_LEVELS if lv <= size]
+        diffs: list[float] = []
+        prev_probe: _LevelResult | None = None
+        probe_chain: list[_LevelResult] = []
+        c_probe = c_t[probe_idx]
+        t_probe = _time.perf_counter()
+        elastic_view = replace(inp, kernel=None)
+        for n in levels:
+            ms = _modes(disc, inp.given, n, stages)
+            res = _solve_level(elastic_view, disc, ms, probe_times, time_tol=time_tol)
+            if prev_probe is not None:
+                diffs.append(_difference(res, prev_probe, disc, c_probe))
+            probe_chain.append(res)
+            prev_probe = res
+            if n_modes is None and len(diffs) >= 2:
+                est = max(_extrapolated_error(diffs), ERROR_FLOOR)
+                if est <= 0.5 * tol:
+                    break
+        entry = stages.setdefault("mode_selection", {"seconds": 0.0, "cached": False})
+        entry["seconds"] += _time.perf_counter() - t_probe
+        est = max(_extrapolated_error(diffs), ERROR_FLOOR)
+        n_used = probe_chain[-1].n
+        if est <= 0.5 * tol or n_modes is not None or cap == BASIS_CAPS[-1]:
+            spatial_error = est
+            n_prev = probe_chain[-2].n if len(probe_chain) > 1 else None
+            break
+
+    assert disc is not None
+    t_time = _time.perf_counter()
+    if inp.kernel is None and probe_idx.size == times_arr.size:
+        chosen = probe_chain[-1]
+        previous = probe_chain[-2] if len(probe_chain) > 1 else None
+    else:
+        ms = _modes(disc, inp.given, n_used, stages)
+        chosen = _solve_level(inp, disc, ms, times_arr, time_tol=time_tol)
+        if n_prev is not None and inp.kernel is not None:
+            # The spatial estimate above is elastic; check it on the creeping answer.
+            ms_prev = _modes(disc, inp.given, n_prev, stages)
+            previous = _solve_level(inp, disc, ms_prev, times_arr, time_tol=time_tol)
+            d_creep = _difference(chosen, previous, disc, c_t)
+            ratio = diffs[-1] / diffs[-2] if len(diffs) >= 2 and diffs[-2] > 0 else 0.5
+            rho = min(max(ratio, 0.05), 0.9)
+            spatial_error = max(spatial_error, d_creep * rho / (1 - rho), ERROR_FLOOR)
+    stages["time"] = {"seconds": _time.perf_counter() - t_time, "cached": False}
+
+    error_estimate = float(spatial_error + chosen.time_error)
+    success = error_estimate <= tol and chosen.time_success
+    if not disc.resolved:
+        flags.append("unresolved_input")
+    if not success:
+        flags.append("tol_not_met")
+    # Contact: q >= 0 must hold on the whole of [-1, 1] at every time.
+    x_check = np.concatenate([np.cos(np.linspace(0, np.pi, 401)),
+                              np.asarray(inp.breakpoints) - 1e-9,
+                              np.asarray(inp.breakpoints) + 1e-9])
+    phi_check = disc.basis.evaluate(x_check, chosen.n)
+    q_check = (phi_check @ chosen.coefficients
+               - np.outer(inp.g(x_check), 1.0 / c_t)) / inp.m(x_check)[:, None]
+    q_scale = max(float(np.max(np.abs(q_check))), 1e-300)
+    min_q = float(np.min(q_check))
+    if min_q < -max(error_estimate, 1e-12) * q_scale:
+        flags.append("contact_lost")
+    if success:
+        message = (f"converged: estimated error {error_estimate:.1e} <= tol {tol:.1e} with "
+                   f"{chosen.n} modes")
+    else:
+        reasons = []
+        if spatial_error > tol:
+            reasons.append(f"the basis reached {chosen.n} modes with estimated error "
+                           f"{spatial_error:.1e}")
+        if chosen.time_error > tol or not chosen.time_success:
+            reasons.append(f"time stepping: {chosen.time_message} (estimated error "
+                           f"{chosen.time_error:.1e})")
+        message = f"tol {tol:.1e} not met: " + "; ".join(reasons)
+    if not disc.resolved:
+        message += ("; m or g has features finer than the quadrature could resolve "
+                    "(declare jumps in breakpoints)")
+    info = {
+        "error_estimate": error_estimate,
+        "spatial_error_estimate": float(spatial_error),
+        "time_error_estimate": float(chosen.time_error),
+        "seconds": _time.perf_counter() - t_start,
+        "flags": flags,
+        "success": bool(success),
+        "message": message,
+        "n_modes": int(chosen.n),
+        "n_steps": int(chosen.steps),
+        "n_nodes": int(disc.panels.size),
+        "statement": statement_number(inp.given),
+        "given": sorted(inp.given),
+        "min_pressure": min_q,
+        "max_pressure": q_scale,
+        "basis": disc.basis.kind,
+        "orthonormality_error": disc.basis.orthonormality_error,
+        "stages": stages,
+    }
+    return ContactSolution(times_arr.copy(), chosen.settlement, chosen.tilt, chosen.force,
+                           chosen.moment, info, disc.basis, chosen.coefficients, c_t, inp.m,
+                           inp.g)

@@ -1,0 +1,284 @@
+"""The projection solver against analytic limits, manufactured solutions and itself.
+
+Every tolerance below is a measured error with a margin; the measured value is quoted.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+from core.cache import stage_counts
+from core.quadrature import Panels, base_panels, kernel_operator, operator_rows
+from core.solver import solve_dimensionless
+
+
+def smooth_m(x):
+    return 0.05 * (1.0 + 0.4 * x + 0.3 * x**2)
+
+
+def jump_m(x):
+    return np.where(x < 0.3, 0.05, 0.02)
+
+
+# ------------------------------------------------------------------ analytic limits
+
+
+def test_winkler_limit_thin_base():
+    """lam large: F q -> q/(2 lam), so q = P/2 and delta = P/2 (m + 1/(2 lam))."""
+    lam, m, p = 50.0, 0.1, 1.0
+    sol = solve_dimensionless(lam, m, 0.0, [1.0], force=p, moment=0.0, tol=1e-10)
+    q = sol.pressure(np.linspace(-0.5, 0.5, 11))[:, 0]
+    delta_local = p / 2 * (m + 1 / (2 * lam))
+    # The nonlocal correction is O(1/lam^2) in the interior: measured 2.2e-5 relative.
+    assert np.max(np.abs(q - p / 2)) / (p / 2) < 1e-4
+    assert abs(sol.settlement[0] - delta_local) / delta_local < 2e-3  # measured 5.3e-4
+    assert abs(sol.tilt[0]) < 1e-12
+
+
+def test_thick_base_tiny_m_gives_square_root_pressure():
+    """lam small, m -> 0: the rigid punch on a half-space, q = P/(pi sqrt(1 - x^2))."""
+    sol = solve_dimensionless(0.05, 1e-4, 0.0, [1.0], force=1.0, moment=0.0, tol=1e-6)
+    x = np.linspace(-0.8, 0.8, 17)
+    q = sol.pressure(x)[:, 0]
+    exact = 1.0 / (np.pi * np.sqrt(1 - x**2))
+    # m = 1e-4 smooths the edge singularity; in the interior the difference is O(m ln m)
+    # and O(lam^2): measured 4e-3 relative.
+    assert np.max(np.abs(q - exact) / exact) < 1e-2
+
+
+# ---------------------------------------------------------------- manufactured
+
+
+def _exact_q(x):
+    return 1.0 + 0.3 * x + 0.2 * np.cos(3 * x)
+
+
+def _manufactured_gap(lam, m_fn, c=1.0, delta=0.02, alpha=0.004):
+    """g = delta + alpha x - c m q - F q for the known q of _exact_q."""
+    fine = base_panels(lam, (), max_width=0.05, edge_width=1e-6)
+    q_nodes = _exact_q(fine.nodes)
+
+    def g(x):
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        fq = operator_rows(lam, fine, x) @ q_nodes
+        return delta + alpha * x - c * m_fn(x) * _exact_q(x) - fq
+
+    return g
+
+
+@pytest.mark.parametrize("statement", [1, 2, 3, 4])
+def test_manufactured_solution_all_statements(statement):
+    lam, delta, alpha = 1.0, 0.02, 0.004
+    g = _manufactured_gap(lam, smooth_m, delta=delta, alpha=alpha)
+    p = 2.0  # int q = 2 + 0.4 sin 3 /3 ... computed below exactly
+    p = 2.0 + 0.2 * 2 * np.sin(3.0) / 3
+    mom = 0.3 * 2 / 3  # int x q: only the odd part 0.3 x contributes
+    given = {1: dict(settlement=delta, tilt=alpha), 2: dict(settlement=delta, moment=mom),
+             3: dict(tilt=alpha, force=p), 4: dict(force=p, moment=mom)}[statement]
+    sol = solve_dimensionless(lam, smooth_m, g, [1.0], tol=1e-9, **given)
+    x = np.linspace(-0.95, 0.95, 39)
+    err_q = np.max(np.abs(sol.pressure(x)[:, 0] - _exact_q(x))) / np.max(_exact_q(x))
+    # measured: 1e-11 .. 4e-11 for the four statements at tol 1e-9
+    assert err_q < 1e-9
+    assert sol.settlement[0] == pytest.approx(delta, rel=1e-9)
+    assert sol.tilt[0] == pytest.approx(alpha, rel=1e-8)
+    assert sol.force[0] == pytest.approx(p, rel=1e-9)
+    assert sol.moment[0] == pytest.approx(mom, rel=1e-9)
+    assert sol.info["error_estimate"] <= 1e-9
+
+
+# ------------------------------------------------------------------ structure
+
+
+def test_even_data_gives_zero_tilt():
+    sol = solve_dimensionless(1.0, lambda x: 0.05 * (1 + x**2), lambda x: 0.1 * x**2,
+                              [1.0], force=1.0, moment=0.0, tol=1e-10)
+    assert abs(sol.tilt[0]) < 1e-13 * abs(sol.settlement[0])  # measured 3e-17
+    x = np.linspace(-1, 1, 21)
+    q = sol.pressure(x)[:, 0]
+    assert np.max(np.abs(q - q[::-1])) < 1e-12 * np.max(np.abs(q))
+
+
+def test_equilibrium_holds():
+    sol = solve_dimensionless(0.7, jump_m, lambda x: 0.05 * x**2, [1.0], force=1.3,
+                              moment=0.2, breakpoints=[0.3], tol=1e-9)
+    panels = Panels.from_edges(np.concatenate([np.linspace(-1, 0.3, 40),
+                                               np.linspace(0.3, 1, 40)[1:]]))
+    q = sol.pressure(panels.nodes)[:, 0]
+    assert panels.integrate(q) == pytest.approx(1.3, rel=1e-12)
+    assert panels.integrate(panels.nodes * q) == pytest.approx(0.2, rel=1e-11)
+
+
+def test_four_statements_are_consistent():
+    common = dict(breakpoints=[0.3], tol=1e-10)
+    m, g = jump_m, (lambda x: 0.03 * np.where(x > -0.2, 1.0, 0.0) + 0.02 * x**2)
+    common["breakpoints"] = [-0.2, 0.3]
+    s4 = solve_dimensionless(0.8, m, g, [1.0], force=1.0, moment=0.1, **common)
+    d, a = s4.settlement[0], s4.tilt[0]
+    s1 = solve_dimensionless(0.8, m, g, [1.0], settlement=d, tilt=a, **common)
+    s2 = solve_dimensionless(0.8, m, g, [1.0], settlement=d, moment=0.1, **common)
+    s3 = solve_dimensionless(0.8, m, g, [1.0], tilt=a, force=1.0, **common)
+    # measured: agreement to 3e-13 relative
+    assert s1.force[0] == pytest.approx(1.0, rel=1e-10)
+    assert s1.moment[0] == pytest.approx(0.1, rel=1e-9)
+    assert s2.tilt[0] == pytest.approx(a, rel=1e-9)
+    assert s2.force[0] == pytest.approx(1.0, rel=1e-10)
+    assert s3.settlement[0] == pytest.approx(d, rel=1e-10)
+    assert s3.moment[0] == pytest.approx(0.1, rel=1e-9)
+
+
+# ------------------------------------------------------------------ convergence
+
+
+def test_fixed_mode_convergence_rate_smooth_is_fast():
+    errs = []
+    ref = solve_dimensionless(1.0, smooth_m, 0.0, [1.0], force=1.0, moment=0.2, n_modes=48)
+    for n in (4, 8, 16):
+        s = solve_dimensionless(1.0, smooth_m, 0.0, [1.0], force=1.0, moment=0.2, n_modes=n)
+        errs.append(abs(s.settlement[0] - ref.settlement[0]) / ref.settlement[0])
+    # measured ratios per doubling ~ 1e-3 .. 1e-4 (spectral); assert at least n^-6
+    assert errs[1] < errs[0] / 2**6
+    assert errs[2] < errs[1] / 2**6 or errs[2] < 1e-13
+
+
+def test_jump_piecewise_basis_beats_global():
+    kw = dict(force=1.0, moment=0.2, breakpoints=[0.3])
+    ref = solve_dimensionless(1.0, jump_m, 0.0, [1.0], n_modes=128, **kw)
+    err = {}
+    for kind in ("global", "piecewise"):
+        s = solve_dimensionless(1.0, jump_m, 0.0, [1.0], n_modes=32, basis=kind, **kw)
+        err[kind] = abs(s.settlement[0] - ref.settlement[0]) / ref.settlement[0]
+    assert err["piecewise"] < err["global"] / 100
+
+
+# ------------------------------------------------------------------ creep
+
+
+def _ode_oracle(lam, m, amp, rate, p, mom, times, max_width=0.1):
+    """Nodal (Nystrom) oracle for K = -amp exp(-rate (t - tau)), c = 1, g = 0.
+
+    With Y = V[F q], Y' = -rate Y - amp F q, and the static system
+    m q + F q = delta + alpha x + Y, int q = P, int x q = M, Y is a linear ODE
+    Y' = B Y + f solved exactly with a matrix exponential.
+    """
+    panels = base_panels(lam, (), max_width=max_width)
+    f_mat = kernel_operator(lam, panels).matrix
+    n = panels.size
+    x, w = panels.nodes, panels.weights
+    sys = np.zeros((n + 2, n + 2))
+    sys[:n, :n] = m * np.eye(n) + f_mat
+    sys[:n, n] = -1.0
+    sys[:n, n + 1] = -x
+    sys[n, :n] = w
+    sys[n + 1, :n] = w * x
+    inv = np.linalg.inv(sys)
+    # q = Qy Y + q0 with the load part q0
+    q_of_y = inv[:n, :n]
+    q0 = inv[:n, n:] @ np.array([p, mom])
+    b = -rate * np.eye(n) - amp * f_mat @ q_of_y
+    f = -amp * f_mat @ q0
+    aug = np.zeros((n + 1, n + 1))
+    aug[:n, :n] = b
+    aug[:n, n] = f
+    out = []
+    for t in times:
+        y = expm(aug * (t - 1.0))[:n, n]
+        sol = inv @ np.concatenate([y, [p, mom]])
+        out.append((sol[n], sol[n + 1]))
+    return np.array(out)
+
+
+def test_creep_against_ode_oracle():
+    from core.creep import ExponentialCreep
+
+    model = ExponentialCreep(modulus=3e10, compliance=6e-11, rate=0.05)
+    kernel = model.dimensionless_kernel(28.0)
+    amp = -float(kernel.exponential_parts(np.array([1.0]))[0, 0])
+    rate = float(kernel.rates[0])
+    times = np.array([1.0, 1.5, 3.0, 10.0, 30.0])
+    sol = solve_dimensionless(1.0, 0.05, 0.0, times, kernel=kernel, force=1.0, moment=0.1,
+                              tol=1e-9)
+    ref = _ode_oracle(1.0, 0.05, amp, rate, 1.0, 0.1, times)
+    # measured: 2e-12 (settlement), 5e-12 (tilt) relative
+    assert np.max(np.abs(sol.settlement - ref[:, 0]) / ref[:, 0]) < 1e-9
+    assert np.max(np.abs(sol.tilt - ref[:, 1]) / np.abs(ref[:, 1])) < 1e-9
+    # creep: the settlement grows over time under a constant force
+    assert np.all(np.diff(sol.settlement) > 0)
+
+
+def test_general_kernel_path_matches_degenerate():
+    from core.creep import ExponentialCreep
+
+    kernel = ExponentialCreep(modulus=3e10, compliance=6e-11, rate=0.05).dimensionless_kernel(28)
+    times = np.array([1.0, 2.0, 5.0])
+    a = solve_dimensionless(1.0, 0.05, 0.0, times, kernel=kernel, force=1.0, moment=0.1,
+                            tol=1e-8)
+    b = solve_dimensionless(1.0, 0.05, 0.0, times, kernel=lambda t, s: kernel(t, s),
+                            force=1.0, moment=0.1, tol=1e-6)
+    assert np.max(np.abs(a.settlement - b.settlement) / a.settlement) < 1e-6
+
+
+# ------------------------------------------------------------------ caching
+
+
+def test_load_change_recomputes_no_spatial_stage():
+    kw = dict(breakpoints=[0.3], tol=1e-8)
+    solve_dimensionless(1.3, jump_m, lambda x: 0.01 * x**2, [1.0, 2.0], force=1.0,
+                        moment=0.0, **kw)
+    before = stage_counts()
+    sol = solve_dimensionless(1.3, jump_m, lambda x: 0.01 * x**2, [1.0, 2.0], force=2.5,
+                              moment=0.3, **kw)
+    after = stage_counts()
+    for stage in ("panels", "operator", "basis", "galerkin", "gap", "modes"):
+        assert after[stage] == before[stage], stage
+    assert all(v["cached"] for k, v in sol.info["stages"].items()
+               if k in ("panels", "operator", "basis", "galerkin", "gap", "modes"))
+
+
+def test_gap_change_reuses_operator_and_basis():
+    kw = dict(tol=1e-5)
+    solve_dimensionless(1.1, smooth_m, lambda x: 0.01 * x**2, [1.0], force=1.0, moment=0.0,
+                        **kw)
+    before = stage_counts()
+    solve_dimensionless(1.1, smooth_m, lambda x: 0.02 * x**2, [1.0], force=1.0, moment=0.0,
+                        **kw)
+    after = stage_counts()
+    assert after["operator"] == before["operator"]
+    assert after["basis"] == before["basis"]
+    assert after["galerkin"] == before["galerkin"]
+    assert after["gap"] == before["gap"] + 1
+
+
+# ------------------------------------------------------------------ flags & errors
+
+
+def test_contact_lost_flag_for_large_eccentricity():
+    sol = solve_dimensionless(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.6, tol=1e-8)
+    assert "contact_lost" in sol.info["flags"]
+    ok = solve_dimensionless(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.05, tol=1e-8)
+    assert "contact_lost" not in ok.info["flags"]
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    (dict(lam=-1.0), "lam"),
+    (dict(lam=float("nan")), "lam"),
+    (dict(m=-0.1), "m"),
+    (dict(m=lambda x: 0.1 - x), "m"),
+    (dict(g=float("inf")), "g"),
+    (dict(times=[0.5]), "times"),
+    (dict(times=[2.0, 1.5]), "times"),
+    (dict(c=0.0), "c"),
+    (dict(force=None), "given"),
+    (dict(settlement=0.1), "given"),
+    (dict(breakpoints=[1.5]), "breakpoints"),
+    (dict(tol=0.0), "tol"),
+    (dict(force=float("nan")), "force"),
+])
+def test_bad_input_names_the_argument(kwargs, field):
+    args = dict(lam=1.0, m=0.1, g=0.0, times=[1.0], force=1.0, moment=0.0)
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=rf"^{field}"):
+        solve_dimensionless(args.pop("lam"), args.pop("m"), args.pop("g"), args.pop("times"),
+                            **args)
