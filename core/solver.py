@@ -38,8 +38,7 @@ import numpy as np
 from core.basis import Basis, build_basis
 from core.cache import StageCache, fingerprint
 from core.projection import GapTerms, galerkin_matrix, gap_terms
-from core.quadrature import KernelOperator, Panels, base_panels, kernel_operator, \
-    refine_to_resolve
+from core.quadrature import KernelOperator, Panels, base_panels, kernel_operator, refine_to_resolve
 from core.statements import QUANTITIES, ModalSystem, modal_system, statement_number
 from core.time_integration import ModalProblem, solve_degenerate, solve_general
 
@@ -339,104 +338,139 @@ class _LevelResult:
     time_success: bool
 
 
-def _solve_level(inp: _Inputs, disc: _Discretization, ms: ModalSystem, times: np.ndarray,
-                 *, time_tol: float) -> _LevelResult:
-    """Solve the modal system of one mode count at ``times`` (elastic or creeping base)."""
-    n = ms.n
-    gap_vec = ms.rotate(disc.gap.vector[:n])
-    gint, gxint = disc.gap.integral, disc.gap.first_moment
-    free, known = ms.free, ms.known
-    k = len(known)
-    r_rot = ms.r_rot
-    c_t = inp.c(times)
-    loads = {name: fn(times) for name, fn in inp.loads.items()}
-    constraint_inv = np.linalg.inv(ms.constraint) if k else np.zeros((0, 0))
-    shift = {"force": gint, "moment": gxint}
+class _LevelSetup:
+    """The time-dependent pieces of one mode count's modal system.
 
-    def known_coefficients(tt: np.ndarray) -> np.ndarray:
-        """b_K(t) from the given force and moment, shape (k, len(tt))."""
-        if not k:
-            return np.zeros((0, tt.size))
-        inv_c = 1.0 / inp.c(tt)
-        rhs = np.array([inp.loads[name](tt) + shift[name] * inv_c
-                        for name in ms.constraint_names])
-        return constraint_inv @ rhs
+    Free rows, per mode: ``(c + gamma) z - gamma V z = s(t) - (I - V) u(t)`` with
+    ``s = Psi^T (delta e0_F + alpha e1_F)`` (the given ones) and
+    ``u = Psi^T (R_FK b_K - G_F / c) = coupling @ [b_K; 1/c]`` (the known channels).
+    """
 
-    def given_drive(tt: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        """sum over given delta, alpha of (delta e0 + alpha e1) restricted to ``rows``."""
-        out = np.zeros((len(rows), tt.size))
-        if "settlement" in inp.loads:
-            out += np.outer(ms.e0_rot[rows], inp.loads["settlement"](tt))
-        if "tilt" in inp.loads:
-            out += np.outer(ms.e1_rot[rows], inp.loads["tilt"](tt))
+    def __init__(self, inp: _Inputs, disc: _Discretization, ms: ModalSystem) -> None:
+        self.inp, self.disc, self.ms = inp, disc, ms
+        n = ms.n
+        self.gap_vec = ms.rotate(disc.gap.vector[:n])
+        self.k = len(ms.known)
+        self.constraint_inv = np.linalg.inv(ms.constraint) if self.k else np.zeros((0, 0))
+        r_fk = ms.r_rot[np.ix_(ms.free, ms.known)]
+        self.coupling = np.concatenate(
+            [ms.psi.T @ r_fk, -(ms.psi.T @ self.gap_vec[ms.free])[:, None]], axis=1)
+
+    def known_channels(self, tt: np.ndarray, inv_c: np.ndarray,
+                       loads: dict[str, np.ndarray]) -> np.ndarray:
+        """``[b_K(t); 1/c(t)]``: b_K from the given force and moment, shape (k + 1, T)."""
+        shift = {"force": self.disc.gap.integral, "moment": self.disc.gap.first_moment}
+        rows = [self.constraint_inv @ np.array([loads[name] + shift[name] * inv_c
+                                                for name in self.ms.constraint_names])
+                ] if self.k else []
+        return np.concatenate(rows + [inv_c[None, :]], axis=0)
+
+    def given_drive(self, rows: np.ndarray, loads: dict[str, np.ndarray],
+                    size: int) -> np.ndarray:
+        """``delta e0 + alpha e1`` (the given ones) restricted to ``rows``."""
+        out = np.zeros((len(rows), size))
+        if "settlement" in loads:
+            out += np.outer(self.ms.e0_rot[rows], loads["settlement"])
+        if "tilt" in loads:
+            out += np.outer(self.ms.e1_rot[rows], loads["tilt"])
         return out
 
-    psi, gamma = ms.psi, ms.gamma
-    r_fk = r_rot[np.ix_(free, known)]
-    # Mode forcing u(t) = Psi^T (R_FK b_K - G_F/c) = coupling @ [b_K; 1/c]
-    coupling = np.concatenate([psi.T @ r_fk, -(psi.T @ gap_vec[free])[:, None]], axis=1)
+    def drive(self, loads: dict[str, np.ndarray], size: int) -> np.ndarray:
+        return self.ms.psi.T @ self.given_drive(self.ms.free, loads, size)
 
-    def known_channels(tt: np.ndarray) -> np.ndarray:
-        return np.concatenate([known_coefficients(tt), (1.0 / inp.c(tt))[None, :]], axis=0)
+    def finish(self, times: np.ndarray, c_t: np.ndarray, loads: dict[str, np.ndarray],
+               u_known: np.ndarray, z: np.ndarray, vz: np.ndarray, vu: np.ndarray,
+               time_error: float, steps: int, message: str, ok: bool) -> _LevelResult:
+        """Coefficients and the four scalars from the modal coordinates."""
+        ms, k = self.ms, self.k
+        n = ms.n
+        b = np.zeros((n, times.size))
+        b[ms.free] = ms.psi @ z
+        b_known = u_known[:k]
+        b[ms.known] = b_known
+        a = ms.to_coefficients(b)
+        out: dict[str, np.ndarray | None] = {name: loads.get(name) for name in QUANTITIES}
+        inv_c = 1.0 / c_t
+        if k:
+            # Known rows: c b_K + (I - V)[R_KF b_F + R_KK b_K - G_K/c] = delta e0_K + alpha e1_K
+            r_kf = ms.r_rot[np.ix_(ms.known, ms.free)]
+            r_kk = ms.r_rot[np.ix_(ms.known, ms.known)]
+            lhs = (c_t[None, :] * b_known
+                   + r_kf @ (ms.psi @ (z - vz))
+                   + r_kk @ (b_known - vu[:k])
+                   - np.outer(self.gap_vec[ms.known], inv_c) + np.outer(
+                       self.gap_vec[ms.known], vu[k])
+                   - self.given_drive(ms.known, loads, times.size))
+            unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
+            for i, name in enumerate(ms.unknown_names):
+                out[name] = unknowns[i]
+        j0, j1, j2 = self.disc.basis.moments
+        e0 = np.zeros(n)
+        e1 = np.zeros(n)
+        e0[0] = np.sqrt(j0)
+        e1[0] = j1 / np.sqrt(j0)
+        if n > 1:
+            e1[1] = np.sqrt((j0 * j2 - j1 * j1) / j0)
+        if out["force"] is None:
+            out["force"] = e0 @ a - self.disc.gap.integral * inv_c
+        if out["moment"] is None:
+            out["moment"] = e1 @ a - self.disc.gap.first_moment * inv_c
+        return _LevelResult(n, a, *(np.asarray(out[q], dtype=float) for q in QUANTITIES),
+                            time_error, steps, message, ok)
 
-    def drive(tt: np.ndarray) -> np.ndarray:
-        return psi.T @ given_drive(tt, free)
 
-    u_known = known_channels(times)
+def _solve_levels(inp: _Inputs, disc: _Discretization, systems: Sequence[ModalSystem],
+                  times: np.ndarray, *, time_tol: float) -> list[_LevelResult]:
+    """Solve the modal systems of several mode counts at ``times`` in one time integration.
+
+    The modes of all levels are independent scalar equations driven by the same known
+    channels, so they are stacked and stepped together.
+    """
+    setups = [_LevelSetup(inp, disc, ms) for ms in systems]
+    c_t = inp.c(times)
+    loads = {name: fn(times) for name, fn in inp.loads.items()}
+    u_known = setups[0].known_channels(times, 1.0 / c_t, loads)
     if inp.kernel is None:
-        z = (drive(times) - coupling @ u_known) / (c_t[None, :] + gamma[:, None])
-        vz = np.zeros_like(z)
-        vu = np.zeros_like(u_known)
-        time_error, steps, message, ok = 0.0, 0, "elastic base: no time stepping", True
-    else:
-        problem = ModalProblem(
-            d=lambda tt: 1.0 + inp.c(tt)[None, :] / gamma[:, None],
-            r=lambda tt: (drive(tt) - coupling @ known_channels(tt)) / gamma[:, None],
-            u=known_channels,
-            coupling=coupling / gamma[:, None],
-        )
-        if hasattr(inp.kernel, "rates") and hasattr(inp.kernel, "exponential_parts"):
-            sol = solve_degenerate(inp.kernel, problem, times, tol=time_tol)
-        else:
-            sol = solve_general(inp.kernel, problem, times, tol=time_tol)
-        z, vz, vu = sol.w, sol.vw, sol.vu
-        time_error, steps, message, ok = sol.error_estimate, sol.steps, sol.message, sol.success
+        results = []
+        for st in setups:
+            z = (st.drive(loads, times.size) - st.coupling @ u_known) / (
+                c_t[None, :] + st.ms.gamma[:, None])
+            results.append(st.finish(times, c_t, loads, u_known, z, np.zeros_like(z),
+                                     np.zeros_like(u_known), 0.0, 0,
+                                     "elastic base: no time stepping", True))
+        return results
+    gamma = np.concatenate([st.ms.gamma for st in setups])
+    coupling = np.concatenate([st.coupling for st in setups], axis=0)
+    memo: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
-    b = np.zeros((n, times.size))
-    b[free] = psi @ z
-    b_known = u_known[:k]
-    b[known] = b_known
-    a = ms.to_coefficients(b)
-    out = {name: loads.get(name) for name in QUANTITIES}
-    if k:
-        vb_known = vu[:k]
-        v_inv_c = vu[k]
-        inv_c = u_known[k]
-        r_kf = r_rot[np.ix_(known, free)]
-        r_kk = r_rot[np.ix_(known, known)]
-        lhs = (c_t[None, :] * b_known
-               + r_kf @ (psi @ (z - vz))
-               + r_kk @ (b_known - vb_known)
-               - np.outer(gap_vec[known], inv_c - v_inv_c)
-               - given_drive(times, known))
-        unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
-        for i, name in enumerate(ms.unknown_names):
-            out[name] = unknowns[i]
-    e0 = np.zeros(n)
-    e1 = np.zeros(n)
-    j0, j1, j2 = disc.basis.moments
-    e0[0] = np.sqrt(j0)
-    e1[0] = j1 / np.sqrt(j0)
-    if n > 1:
-        e1[1] = np.sqrt((j0 * j2 - j1 * j1) / j0)
-    inv_c = 1.0 / c_t
-    if out["force"] is None:
-        out["force"] = e0 @ a - gint * inv_c
-    if out["moment"] is None:
-        out["moment"] = e1 @ a - gxint * inv_c
-    return _LevelResult(n, a, np.asarray(out["settlement"], float), np.asarray(out["tilt"], float),
-                        np.asarray(out["force"], float), np.asarray(out["moment"], float),
-                        time_error, steps, message, ok)
+    def evaluate(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        # d, r and u are asked for at the same stage times: evaluate the loads once.
+        key = tt.tobytes()
+        if key not in memo:
+            memo.clear()
+            c_s = inp.c(tt)
+            ld = {name: fn(tt) for name, fn in inp.loads.items()}
+            u = setups[0].known_channels(tt, 1.0 / c_s, ld)
+            drive = np.concatenate([st.drive(ld, tt.size) for st in setups], axis=0)
+            d = 1.0 + c_s[None, :] / gamma[:, None]
+            memo[key] = (d, (drive - coupling @ u) / gamma[:, None], u)
+        return memo[key]
+
+    problem = ModalProblem(d=lambda tt: evaluate(tt)[0], r=lambda tt: evaluate(tt)[1],
+                           u=lambda tt: evaluate(tt)[2], coupling=coupling / gamma[:, None])
+    if hasattr(inp.kernel, "rates") and hasattr(inp.kernel, "exponential_parts"):
+        sol = solve_degenerate(inp.kernel, problem, times, tol=time_tol)
+    else:
+        sol = solve_general(inp.kernel, problem, times, tol=time_tol)
+    results = []
+    start = 0
+    for st in setups:
+        stop = start + st.ms.gamma.size
+        results.append(st.finish(times, c_t, loads, u_known, sol.w[start:stop],
+                                 sol.vw[start:stop], sol.vu, sol.error_estimate, sol.steps,
+                                 sol.message, sol.success))
+        start = stop
+    return results
 
 
 def _scales(res: _LevelResult, disc: _Discretization, c_t: np.ndarray):
@@ -535,7 +569,6 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
 
     flags: list[str] = []
     chosen: _LevelResult | None = None
-    previous: _LevelResult | None = None
     spatial_error = np.inf
     disc = None
     n_used = 0
@@ -557,7 +590,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         elastic_view = replace(inp, kernel=None)
         for n in levels:
             ms = _modes(disc, inp.given, n, stages)
-            res = _solve_level(elastic_view, disc, ms, probe_times, time_tol=time_tol)
+            res = _solve_levels(elastic_view, disc, [ms], probe_times, time_tol=time_tol)[0]
             if prev_probe is not None:
                 diffs.append(_difference(res, prev_probe, disc, c_probe))
             probe_chain.append(res)
@@ -579,15 +612,15 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     t_time = _time.perf_counter()
     if inp.kernel is None and probe_idx.size == times_arr.size:
         chosen = probe_chain[-1]
-        previous = probe_chain[-2] if len(probe_chain) > 1 else None
     else:
-        ms = _modes(disc, inp.given, n_used, stages)
-        chosen = _solve_level(inp, disc, ms, times_arr, time_tol=time_tol)
+        systems = [_modes(disc, inp.given, n_used, stages)]
         if n_prev is not None and inp.kernel is not None:
             # The spatial estimate above is elastic; check it on the creeping answer.
-            ms_prev = _modes(disc, inp.given, n_prev, stages)
-            previous = _solve_level(inp, disc, ms_prev, times_arr, time_tol=time_tol)
-            d_creep = _difference(chosen, previous, disc, c_t)
+            systems.append(_modes(disc, inp.given, n_prev, stages))
+        results = _solve_levels(inp, disc, systems, times_arr, time_tol=time_tol)
+        chosen = results[0]
+        if len(results) > 1:
+            d_creep = _difference(chosen, results[1], disc, c_t)
             ratio = diffs[-1] / diffs[-2] if len(diffs) >= 2 and diffs[-2] > 0 else 0.5
             rho = min(max(ratio, 0.05), 0.9)
             spatial_error = max(spatial_error, d_creep * rho / (1 - rho), ERROR_FLOOR)
