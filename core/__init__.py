@@ -1,0 +1,62 @@
+"""coated-punch: contact of a rigid punch on a coated, aging viscoelastic layer.
+
+The public entry points are loaded on first use, so that importing one submodule (say
+:mod:`core.kernel`) does not load the whole pipeline:
+
+- :func:`solve_dimensionless`, :class:`ContactSolution` (:mod:`core.solver`): the
+  dimensionless problem;
+- :func:`solve`, :class:`Scene`, :class:`SceneSolution`, :func:`scene_from_dict`,
+  :func:`load_scene`, :func:`save_scene` (:mod:`core.scene`): dimensional scenes in SI
+  units with time in days.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from core.scene import (
+        Scene,
+        SceneSolution,
+        load_scene,
+        save_scene,
+        scene_from_dict,
+        solve,
+    )
+    from core.solver import ContactSolution, solve_dimensionless
+
+_EXPORTS: dict[str, str] = {
+    "solve_dimensionless": "core.solver",
+    "ContactSolution": "core.solver",
+    "solve": "core.scene",
+    "Scene": "core.scene",
+    "SceneSolution": "core.scene",
+    "scene_from_dict": "core.scene",
+    "load_scene": "core.scene",
+    "save_scene": "core.scene",
+}
+
+__all__ = [
+    "solve_dimensionless",
+    "ContactSolution",
+    "solve",
+    "Scene",
+    "SceneSolution",
+    "scene_from_dict",
+    "load_scene",
+    "save_scene",
+]
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'core' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later lookups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + __all__)

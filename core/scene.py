@@ -1,0 +1,1012 @@
+"""The dimensional scene: schema (version 1), validation, JSON files and conversion.
+
+A *scene* describes one physical problem in SI units with time in days: the punch, the
+coating layers, the aging base, the loading and the output times (the schema is
+documented in ``core/SCENES.md``). :func:`scene_from_dict` validates a JSON-like dict
+and builds a :class:`Scene`; :func:`solve` converts it to the dimensionless problem of
+:func:`core.solver.solve_dimensionless` (model notes, "Dimensionless problem") and the
+answer back to a :class:`SceneSolution` in SI units.
+
+Conversion (``a`` half-width, ``H`` base thickness, ``nu`` base Poisson ratio,
+``tau0`` age at loading, ``E0 = E(tau0)``, ``t`` days after loading, ``age = tau0 + t``):
+
+    x* = x / a,    lam = a / H,    t* = age / tau0 = (tau0 + t) / tau0,
+    m*(x*) = E0 / (2 (1 - nu^2) a) * sum_k (1 - nu_k^2) h_k / E_k,
+    g(x) = f(x) - sum_k h_k(x) - min over [-a, a] of the same,   g* = g / a,
+    c(t*) = E(age) / E0,   delta* = delta / a,   alpha* = alpha,
+    P* = 2 (1 - nu^2) P / (E(age) a),   M* = 2 (1 - nu^2) M / (E(age) a^2),
+    q = E(age) q* / (2 (1 - nu^2)).
+
+The base is taken to be made at age 0 (the seed's ``tau_b = 0``), so ages are counted
+from its casting and the loading starts at ``age = tau0``. ``E0`` is the modulus at
+loading so that ``c(1) = 1``.
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import hashlib
+import json
+import math
+import numbers
+import os
+import re
+import tempfile
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from core.creep import creep_model_from_spec
+from core.profiles import Profile, check_range, profile_from_spec
+
+if TYPE_CHECKING:
+    from core.solver import ContactSolution
+
+#: The schema version this program writes and reads.
+SCHEMA_VERSION = 1
+#: Largest scene file accepted by :func:`load_scene` [bytes].
+MAX_SCENE_BYTES = 1_000_000
+#: Number of coating layers accepted.
+MAX_LAYERS = 10
+#: Largest number of output times.
+MAX_TIMES = 2000
+#: Accepted range of the solver's relative tolerance, and its default.
+TOL_RANGE = (1e-12, 1e-2)
+DEFAULT_TOL = 1e-6
+#: The loads, in the order the histories are reported.
+QUANTITIES = ("settlement", "tilt", "force", "moment")
+#: The four statements of the seed (section 3), as pairs of given quantities.
+STATEMENTS: dict[frozenset[str], int] = {
+    frozenset({"settlement", "tilt"}): 1,
+    frozenset({"settlement", "moment"}): 2,
+    frozenset({"tilt", "force"}): 3,
+    frozenset({"force", "moment"}): 4,
+}
+#: The thin-coating model is doubtful where sum h_k exceeds this fraction of 2a.
+THICK_COATING_RATIO = 0.1
+#: Tilts beyond this many radians are not small.
+LARGE_TILT = 0.01
+#: Points of the default plotting grid :attr:`SceneSolution.x`.
+PLOT_POINTS = 201
+#: Uniform samples of [-a, a] for the gap minimum and the coating checks (on top of each
+#: profile's own sample points).
+DENSE_SAMPLES = 4001
+
+#: One-line explanations of the flags a solution may carry.
+FLAG_MESSAGES: dict[str, str] = {
+    "contact_lost": "The computed pressure is negative somewhere: part of the punch base "
+                    "lifts off, so this full-contact answer is not physical.",
+    "thick_coating": f"The coating is thicker than {THICK_COATING_RATIO:g} of the punch width "
+                     "somewhere: the thin (Winkler) coating model is doubtful.",
+    "stiff_coating": "A coating layer is stiffer than the base at loading somewhere: the "
+                     "thin-coating model assumes soft coatings.",
+    "large_tilt": f"The tilt exceeds {LARGE_TILT:g} rad: the small-angle assumption is "
+                  "doubtful.",
+    "tol_not_met": "The solver could not reach the requested tolerance: see info.message.",
+    "unresolved_input": "A profile has features finer than the quadrature resolves: "
+                        "see info.message.",
+}
+
+UNITS: dict[str, str] = {
+    "times": "day (after loading)",
+    "settlement": "m",
+    "tilt": "rad",
+    "force": "N/m",
+    "moment": "N",
+    "x": "m (from the punch centre)",
+    "pressure": "Pa (rows: x, columns: times)",
+}
+
+#: Migrations from older schema versions: version -> function returning the next version.
+#: Version 1 is the first; there is nothing to migrate yet.
+_MIGRATIONS: dict[int, Callable[[dict], dict]] = {}
+
+
+# --------------------------------------------------------------------- small validators
+
+
+def _show(value: Any) -> str:
+    """A value as it should appear in an error message."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if value is None:
+        return "null"
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        return f"{float(value):.6g}"
+    if isinstance(value, Mapping):
+        return "an object"
+    if isinstance(value, (list, tuple)):
+        return "a list"
+    return repr(value)
+
+
+def _join(parent: str, key: str) -> str:
+    return f"{parent}.{key}" if parent else key
+
+
+def _check_fields(obj: Any, path: str, required: Sequence[str],
+                  optional: Sequence[str] = ()) -> Mapping[str, Any]:
+    """``obj`` as a mapping with exactly the allowed fields, or a ValueError."""
+    where = path or "scene"
+    if not isinstance(obj, Mapping):
+        raise ValueError(f"{where}: must be an object, got {_show(obj)}")
+    allowed = list(required) + list(optional)
+    for key in obj:
+        if key not in allowed:
+            hint = difflib.get_close_matches(str(key), allowed, n=1)
+            extra = f" (did you mean '{hint[0]}'?)" if hint else \
+                f" (allowed: {', '.join(allowed)})"
+            raise ValueError(f"{where}: unknown field {str(key)[:40]!r}{extra}")
+    for key in required:
+        if key not in obj:
+            raise ValueError(f"{_join(path, key)}: required field is missing")
+    return obj
+
+
+def _number(value: Any, path: str) -> float:
+    """A finite float, refusing bools, strings and null."""
+    # bool is an int to Python, but true/false in a scene file is a mistake
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{path}: must be a number, got {_show(value)}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{path}: must be a finite number, got {value!r}")
+    return x
+
+
+def _positive(value: Any, path: str) -> float:
+    x = _number(value, path)
+    if x <= 0:
+        raise ValueError(f"{path}: must be > 0, got {_show(value)}")
+    return x
+
+
+def _poisson(value: Any, path: str) -> float:
+    x = _number(value, path)
+    if not -1.0 < x < 0.5:
+        raise ValueError(f"{path}: must be in (-1, 0.5), got {_show(value)}")
+    return x
+
+
+def _integer(value: Any, path: str, lo: int, hi: int) -> int:
+    x = _number(value, path)
+    if not x.is_integer():
+        raise ValueError(f"{path}: must be an integer, got {_show(value)}")
+    if not lo <= x <= hi:
+        raise ValueError(f"{path}: must be an integer from {lo} to {hi}, got {int(x)}")
+    return int(x)
+
+
+def _text(value: Any, path: str, *, allow_empty: bool) -> str:
+    if not isinstance(value, str):
+        raise ValueError(f"{path}: must be a string, got {_show(value)}")
+    if not allow_empty and not value.strip():
+        raise ValueError(f"{path}: must not be empty")
+    return value
+
+
+def _jsonable(obj: Any) -> Any:
+    """A deep copy of ``obj`` with numpy and tuple values turned into plain JSON types."""
+    if isinstance(obj, Mapping):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, numbers.Integral):
+        return int(obj)
+    if isinstance(obj, numbers.Real):
+        x = float(obj)
+        # JSON has no NaN or infinity; null marks a value that could not be computed
+        return x if math.isfinite(x) else None
+    return copy.deepcopy(obj)
+
+
+# ------------------------------------------------------------------------ schema versions
+
+
+def migrate(d: Mapping[str, Any]) -> dict[str, Any]:
+    """Bring a scene dict of an older schema version to :data:`SCHEMA_VERSION`.
+
+    Returns a new dict (the input is not modified). Version 1 is the first version of the
+    schema, so today this only checks ``schema_version``; later versions will register
+    one step per version in ``_MIGRATIONS``.
+    """
+    if not isinstance(d, Mapping):
+        raise ValueError(f"scene: must be a JSON object, got {_show(d)}")
+    if "schema_version" not in d:
+        raise ValueError(f"schema_version: required field is missing (this program reads "
+                         f"{SCHEMA_VERSION})")
+    raw = d["schema_version"]
+    if isinstance(raw, bool) or not isinstance(raw, numbers.Real) \
+            or not math.isfinite(float(raw)) or not float(raw).is_integer():
+        raise ValueError(f"schema_version: must be an integer, got {_show(raw)}")
+    version = int(raw)
+    if version > SCHEMA_VERSION:
+        raise ValueError(f"schema_version: unsupported version {version} "
+                         f"(this program reads {SCHEMA_VERSION})")
+    if version < 1:
+        raise ValueError(f"schema_version: version {version} does not exist (the first "
+                         f"version of the schema is 1; this program reads {SCHEMA_VERSION})")
+    out = dict(d)
+    while version < SCHEMA_VERSION:
+        out = _MIGRATIONS[version](out)
+        version += 1
+        out["schema_version"] = version
+    return out
+
+
+# ---------------------------------------------------------------------------- the scene
+
+
+@dataclass(frozen=True, eq=False)
+class Layer:
+    """One coating layer: profiles of x [m] for ``thickness`` [m], ``modulus`` [Pa], ``poisson``."""
+
+    thickness: Profile
+    modulus: Profile
+    poisson: Profile
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A validated scene (build it with :func:`scene_from_dict` or :func:`load_scene`).
+
+    Lengths in metres, moduli in pascals, times in days. ``shape`` and the layer
+    profiles are functions of ``x`` [m] on ``[-a, a]``; the loads are functions of the time
+    after loading [day]; ``times`` are the output times [day after loading]. Two scenes are
+    equal when their canonical dicts (:meth:`to_dict`) are equal.
+    """
+
+    name: str
+    description: str
+    half_width: float
+    shape: Profile
+    coating: tuple[Layer, ...]
+    base_thickness: float
+    base_poisson: float
+    age_at_loading: float
+    creep: Any
+    loading: Mapping[str, Profile]
+    times: np.ndarray
+    tol: float
+    _data: dict = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The canonical JSON-able dict of the scene (schema version 1, defaults filled in)."""
+        return copy.deepcopy(self._data)
+
+    @cached_property
+    def key(self) -> str:
+        """A content hash of the canonical dict (hex), equal for equal scenes."""
+        text = json.dumps(self._data, sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Scene) and other.key == self.key
+
+    def __hash__(self) -> int:
+        return hash(self.key)
+
+    @property
+    def given(self) -> frozenset[str]:
+        """The two given quantities (of settlement, tilt, force, moment)."""
+        return frozenset(self.loading)
+
+    @property
+    def statement(self) -> int:
+        """The statement number (1-4) of the seed, section 3."""
+        return STATEMENTS[self.given]
+
+    @cached_property
+    def breakpoints(self) -> tuple[float, ...]:
+        """Points of (-a, a) [m] where the punch shape or a coating profile may jump."""
+        points: list[float] = []
+        profiles = [self.shape] + [p for layer in self.coating
+                                   for p in (layer.thickness, layer.modulus, layer.poisson)]
+        a = self.half_width
+        for profile in profiles:
+            points.extend(float(b) for b in getattr(profile, "breakpoints", ()))
+        inside = sorted(b for b in points if -a < b < a)
+        merged: list[float] = []
+        for b in inside:
+            # two profiles breaking at the same place would give a zero-width panel
+            if not merged or b - merged[-1] > 1e-12 * a:
+                merged.append(b)
+        return tuple(merged)
+
+    @cached_property
+    def sample_x(self) -> np.ndarray:
+        """Dense points of [-a, a] [m] where the x-profiles show their extremes: a uniform
+        grid, both sides of every breakpoint and each family's known extremes."""
+        a = self.half_width
+        profiles = [self.shape] + [p for layer in self.coating
+                                   for p in (layer.thickness, layer.modulus, layer.poisson)]
+        parts = [np.linspace(-a, a, DENSE_SAMPLES)]
+        parts += [p.sample_points((-a, a)) for p in profiles]
+        return np.unique(np.concatenate(parts))
+
+    def modulus_at_loading(self) -> float:
+        """``E0 = E(age_at_loading)`` [Pa], the base modulus when the load is applied."""
+        return float(np.asarray(self.creep.modulus(self.age_at_loading), dtype=float))
+
+    def coating_compliance(self, x: Any) -> np.ndarray:
+        """``sum_k (1 - nu_k^2) h_k / E_k`` [m/Pa] at points ``x`` [m] (vectorized)."""
+        x = np.asarray(x, dtype=float)
+        total = np.zeros(x.shape)
+        for layer in self.coating:
+            nu = _values(layer.poisson, x)
+            total = total + (1.0 - nu * nu) * _values(layer.thickness, x) \
+                / _values(layer.modulus, x)
+        return total
+
+    def coating_thickness(self, x: Any) -> np.ndarray:
+        """``sum_k h_k`` [m] at points ``x`` [m] (vectorized)."""
+        x = np.asarray(x, dtype=float)
+        total = np.zeros(x.shape)
+        for layer in self.coating:
+            total = total + _values(layer.thickness, x)
+        return total
+
+    @cached_property
+    def _gap_parts(self) -> tuple[Profile, ...]:
+        """``f`` and the ``h_k`` less their constant parts (see :func:`_without_offset`)."""
+        return (_without_offset(self.shape),) + tuple(
+            _without_offset(layer.thickness) for layer in self.coating)
+
+    def gap_variation(self, x: Any) -> np.ndarray:
+        """``f(x) - sum_k h_k(x)`` [m] at points ``x`` [m], up to a constant.
+
+        The gap of a crowned punch on a 12 mm coating is micrometres: computed as
+        ``f - 0.012 + 0.012`` it would carry rounding noise of ~1e-13 of itself, which the
+        solver's resolution test on ``g`` takes for unresolved features. Dropping the
+        constant parts first keeps the gap accurate to rounding of its own size.
+        """
+        x = np.asarray(x, dtype=float)
+        shape, *layers = self._gap_parts
+        total = _values(shape, x)
+        for part in layers:
+            total = total - _values(part, x)
+        return total
+
+    @cached_property
+    def gap_minimum(self) -> float:
+        """``min over [-a, a]`` of :meth:`gap_variation` [m]: dense samples, refined locally."""
+        x = self.sample_x
+        values = self.gap_variation(x)
+        i = int(np.argmin(values))
+        best = float(values[i])
+        lo, hi = x[max(i - 1, 0)], x[min(i + 1, x.size - 1)]
+        if hi > lo:
+            # a smooth minimum can fall between samples: golden-section search on the
+            # bracket; any value it finds is a true value of the function, so taking the
+            # smaller one is always safe (also next to a jump)
+            best = min(best, _golden_minimum(
+                lambda s: float(self.gap_variation(np.array([s]))[0]), float(lo), float(hi)))
+        return best
+
+    def gap(self, x: Any) -> np.ndarray:
+        """The gap ``g(x) = f(x) - sum_k h_k(x) - min(...)`` [m] at points ``x`` [m]."""
+        return self.gap_variation(x) - self.gap_minimum
+
+    @cached_property
+    def dimensionless(self) -> DimensionlessProblem:
+        """The dimensionless problem of this scene (built once, see the module docstring)."""
+        return _to_dimensionless(self)
+
+
+def _values(profile: Profile, x: np.ndarray) -> np.ndarray:
+    """A profile's values at ``x`` as a float array of x's shape."""
+    return np.broadcast_to(np.asarray(profile(x), dtype=float), np.shape(x)).astype(float)
+
+
+def _without_offset(profile: Profile) -> Profile:
+    """The profile less a constant part that its spec separates exactly.
+
+    ``constant`` gives 0; ``sine`` and ``bump`` drop ``mean``, ``polynomial`` its
+    constant coefficient, ``linear``, ``step`` and ``table`` their first value (the
+    differences of nearby values are exact in floating point). Formulas are kept as they
+    are. Only differences of the result are meaningful.
+    """
+    spec = profile.spec
+    kind = profile.kind
+    if kind == "constant":
+        return profile_from_spec(0.0, field="gap", variable=profile.variable,
+                                 domain=profile.domain)
+    if not isinstance(spec, dict):
+        return profile
+    spec = dict(spec)
+    if kind in ("sine", "bump"):
+        spec["mean"] = 0.0
+    elif kind == "polynomial":
+        spec["coefficients"] = [0.0] + list(spec["coefficients"][1:])
+    elif kind == "linear":
+        spec["start"], spec["end"] = 0.0, spec["end"] - spec["start"]
+    elif kind == "step":
+        first = spec["values"][0]
+        spec["values"] = [v - first for v in spec["values"]]
+    elif kind == "table":
+        first = spec["points"][0][1]
+        spec["points"] = [[v, y - first] for v, y in spec["points"]]
+    else:
+        return profile
+    return profile_from_spec(spec, field="gap", variable=profile.variable,
+                             domain=profile.domain)
+
+
+def _golden_minimum(fn: Callable[[float], float], lo: float, hi: float,
+                    iterations: int = 60) -> float:
+    """Smallest value of ``fn`` met by a golden-section search on ``[lo, hi]``."""
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    c = hi - ratio * (hi - lo)
+    d = lo + ratio * (hi - lo)
+    fc, fd = fn(c), fn(d)
+    best = min(fc, fd)
+    for _ in range(iterations):
+        if fc < fd:
+            hi, d, fd = d, c, fc
+            c = hi - ratio * (hi - lo)
+            fc = fn(c)
+        else:
+            lo, c, fc = c, d, fd
+            d = lo + ratio * (hi - lo)
+            fd = fn(d)
+        best = min(best, fc, fd)
+    return best
+
+
+# ---------------------------------------------------------------------------- validation
+
+
+def _profile(spec: Any, path: str, variable: str, domain: tuple[float, float], *,
+             lower: float | None = None, upper: float | None = None) -> Profile:
+    """Build a profile and check that its values lie in the open range (lower, upper)."""
+    profile = profile_from_spec(spec, field=path, variable=variable, domain=domain)
+    try:
+        check_range(profile, field=path, domain=domain, lower=lower, upper=upper)
+    except ValueError as exc:
+        message = str(exc)
+        # the position is in metres (x) or days after loading (t): say so
+        unit = " m" if variable == "x" else " days after loading"
+        if re.search(rf" at {variable} = \S+$", message):
+            message += unit
+        raise ValueError(message) from None
+    return profile
+
+
+def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
+    """The output times [day after loading] and their canonical spec."""
+    if isinstance(spec, Mapping):
+        _check_fields(spec, path, ("end", "count"), ("spacing",))
+        end = _positive(spec["end"], f"{path}.end")
+        count = _integer(spec["count"], f"{path}.count", 1, MAX_TIMES)
+        spacing = spec.get("spacing", "linear")
+        if spacing not in ("linear", "log"):
+            raise ValueError(f"{path}.spacing: must be 'linear' or 'log', got {_show(spacing)}")
+        if count == 1:
+            times = np.array([end])
+        elif spacing == "linear":
+            times = np.linspace(0.0, end, count)
+        else:
+            # the instant of loading, then count - 1 times geometrically spaced over the
+            # last three decades before ``end`` (creep is fastest just after loading)
+            times = np.concatenate([[0.0], np.geomspace(end * 1e-3, end, count - 1)])
+        times[-1] = end
+        return times, {"end": end, "count": count, "spacing": spacing}
+    if isinstance(spec, (list, tuple)):
+        if not 1 <= len(spec) <= MAX_TIMES:
+            raise ValueError(f"{path}: must list 1 to {MAX_TIMES} times, got {len(spec)}")
+        values = []
+        for i, value in enumerate(spec):
+            t = _number(value, f"{path}[{i}]")
+            if t < 0:
+                raise ValueError(f"{path}[{i}]: must be >= 0 days after loading (times before "
+                                 f"loading are not part of the problem), got {_show(value)}")
+            if values and t <= values[-1]:
+                raise ValueError(f"{path}[{i}]: times must increase, got {_show(value)} after "
+                                 f"{_show(values[-1])}")
+            values.append(t)
+        if values[-1] <= 0:
+            raise ValueError(f"{path}: the last time must be > 0 days after loading (the "
+                             "loads are functions of time on [0, last time])")
+        return np.array(values), values
+    raise ValueError(f"{path}: must be an object {{end, count, spacing}} or a list of days "
+                     f"after loading, got {_show(spec)}")
+
+
+def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
+    """Validate a scene dict (schema in ``core/SCENES.md``) and build a :class:`Scene`.
+
+    Units: SI (m, Pa, N/m, N, rad), times in days. Every field is checked; a problem
+    raises ``ValueError`` whose message starts with the full path of the field, e.g.
+    ``coating[1].modulus: must be > 0, ...``. A :class:`Scene` is returned unchanged.
+    """
+    if isinstance(d, Scene):
+        return d
+    d = migrate(d)
+    _check_fields(d, "", ("schema_version", "name", "punch", "coating", "base", "loading",
+                          "times"), ("description", "solver"))
+    name = _text(d["name"], "name", allow_empty=False)
+    description = _text(d.get("description", ""), "description", allow_empty=True)
+
+    punch = _check_fields(d["punch"], "punch", ("half_width",), ("shape",))
+    a = _positive(punch["half_width"], "punch.half_width")
+    x_domain = (-a, a)
+    shape_spec = punch.get("shape", 0.0)
+    shape = _profile(shape_spec, "punch.shape", "x", x_domain)
+
+    layers_spec = d["coating"]
+    if not isinstance(layers_spec, (list, tuple)):
+        raise ValueError(f"coating: must be a list of layers, got {_show(layers_spec)}")
+    if not 1 <= len(layers_spec) <= MAX_LAYERS:
+        raise ValueError(f"coating: must hold 1 to {MAX_LAYERS} layers, got {len(layers_spec)}")
+    layers = []
+    for k, spec in enumerate(layers_spec):
+        path = f"coating[{k}]"
+        _check_fields(spec, path, ("thickness", "modulus", "poisson"))
+        layers.append(Layer(
+            thickness=_profile(spec["thickness"], f"{path}.thickness", "x", x_domain,
+                               lower=0.0),
+            modulus=_profile(spec["modulus"], f"{path}.modulus", "x", x_domain, lower=0.0),
+            poisson=_profile(spec["poisson"], f"{path}.poisson", "x", x_domain, lower=-1.0,
+                             upper=0.5),
+        ))
+
+    base = _check_fields(d["base"], "base", ("thickness", "poisson", "age_at_loading", "creep"))
+    h_base = _positive(base["thickness"], "base.thickness")
+    nu = _poisson(base["poisson"], "base.poisson")
+    tau0 = _positive(base["age_at_loading"], "base.age_at_loading")
+    creep = creep_model_from_spec(base["creep"], field="base.creep")
+    if not math.isfinite(a / h_base) or not 1e-4 <= a / h_base <= 1e4:
+        raise ValueError(f"base.thickness: the ratio punch.half_width / base.thickness must be "
+                         f"in [1e-4, 1e4], got {a / h_base:.6g}")
+
+    times, times_spec = _times(d["times"], "times")
+
+    loading = d["loading"]
+    _check_fields(loading, "loading", (), QUANTITIES)
+    given = frozenset(loading)
+    if len(given) != 2:
+        raise ValueError("loading: exactly two of settlement, tilt, force, moment are needed, "
+                         "got " + (", ".join(q for q in QUANTITIES if q in given) or "none"))
+    if given not in STATEMENTS:
+        raise ValueError("loading: " + " and ".join(q for q in QUANTITIES if q in given)
+                         + " is not one of the four statements (settlement+tilt, "
+                         "settlement+moment, tilt+force, force+moment)")
+    t_domain = (0.0, float(times[-1]))
+    loads = {q: _profile(loading[q], f"loading.{q}", "t", t_domain)
+             for q in QUANTITIES if q in given}
+    # the solver's time is the age over tau0: times closer than its rounding would merge
+    ages = (tau0 + times) / tau0
+    if np.any(np.diff(ages) <= 0):
+        i = int(np.argmax(np.diff(ages) <= 0)) + 1
+        raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
+                         f"an age at loading of {tau0:g} days")
+
+    solver = _check_fields(d.get("solver", {}), "solver", (), ("tol",))
+    tol = _number(solver.get("tol", DEFAULT_TOL), "solver.tol")
+    if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
+        raise ValueError(f"solver.tol: must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], "
+                         f"got {_show(tol)}")
+
+    data = {
+        "schema_version": SCHEMA_VERSION,
+        "name": name,
+        "description": description,
+        "punch": {"half_width": a, "shape": _jsonable(_spec_of(shape, shape_spec))},
+        "coating": [{"thickness": _jsonable(_spec_of(layer.thickness, s["thickness"])),
+                     "modulus": _jsonable(_spec_of(layer.modulus, s["modulus"])),
+                     "poisson": _jsonable(_spec_of(layer.poisson, s["poisson"]))}
+                    for layer, s in zip(layers, layers_spec, strict=True)],
+        "base": {"thickness": h_base, "poisson": nu, "age_at_loading": tau0,
+                 "creep": _jsonable(creep.spec)},
+        "loading": {q: _jsonable(_spec_of(loads[q], loading[q])) for q in loads},
+        "times": _jsonable(times_spec),
+        "solver": {"tol": tol},
+    }
+    times.setflags(write=False)
+    return Scene(name, description, a, shape, tuple(layers), h_base, nu, tau0, creep,
+                 MappingProxyType(loads), times, tol, data)
+
+
+def _spec_of(profile: Profile, given: Any) -> Any:
+    """The canonical spec of a profile (its ``spec`` when it has one, else what was given)."""
+    spec = getattr(profile, "spec", None)
+    return given if spec is None else spec
+
+
+# ------------------------------------------------------------------------------- files
+
+
+def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"duplicate field {key!r} in one JSON object")
+        out[key] = value
+    return out
+
+
+def parse_scene_json(text: str, source: str = "scene") -> Scene:
+    """Parse and validate the JSON text of a scene; errors name ``source`` or the field."""
+    try:
+        data = json.loads(text, object_pairs_hook=_no_duplicates)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{source}: not valid JSON ({exc.msg} at line {exc.lineno}, "
+                         f"column {exc.colno})") from None
+    except ValueError as exc:
+        raise ValueError(f"{source}: {exc}") from None
+    except RecursionError:
+        raise ValueError(f"{source}: not valid JSON (nested too deeply)") from None
+    return scene_from_dict(data)
+
+
+def load_scene(path: str | os.PathLike) -> Scene:
+    """Read and validate a scene file (JSON, UTF-8, at most 1 MB).
+
+    Raises ``ValueError`` (message starting with the file path or the field path) for a
+    file that is too large, not JSON or not a valid scene, ``OSError`` if it cannot be read.
+    """
+    path = Path(path)
+    size = path.stat().st_size
+    if size > MAX_SCENE_BYTES:
+        raise ValueError(f"{path}: file is {size} bytes, over the limit of {MAX_SCENE_BYTES} "
+                         "bytes (1 MB) for a scene file")
+    with path.open("rb") as fh:
+        # read one byte past the limit: the file may have grown since stat()
+        raw = fh.read(MAX_SCENE_BYTES + 1)
+    if len(raw) > MAX_SCENE_BYTES:
+        raise ValueError(f"{path}: file is over the limit of {MAX_SCENE_BYTES} bytes (1 MB) "
+                         "for a scene file")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file in UTF-8 (a scene file is JSON)") from None
+    return parse_scene_json(text, str(path))
+
+
+def atomic_write_text(path: str | os.PathLike, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically: a temporary file in the same
+    directory, flushed to disk, then renamed over ``path``.
+
+    Readers see either the old file or the complete new one, never a partial write.
+    """
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        # mkstemp creates the file readable by its owner only; keep an existing file's
+        # mode, else use the usual mode of a new file
+        try:
+            mode = path.stat().st_mode & 0o777
+        except FileNotFoundError:
+            mode = 0o644
+        os.chmod(tmp, mode)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def scene_to_json(scene: Scene | Mapping[str, Any]) -> str:
+    """The canonical JSON text of a scene (validated first when given as a dict)."""
+    scene = scene_from_dict(scene)
+    return json.dumps(scene.to_dict(), indent=2, allow_nan=False) + "\n"
+
+
+def save_scene(scene: Scene | Mapping[str, Any], path: str | os.PathLike) -> None:
+    """Write a scene as JSON to ``path`` atomically (a dict is validated first)."""
+    atomic_write_text(path, scene_to_json(scene))
+
+
+# -------------------------------------------------------------------------- conversion
+
+
+@dataclass(frozen=True, eq=False)
+class DimensionlessProblem:
+    """The arguments of :func:`core.solver.solve_dimensionless` for one scene.
+
+    ``m``, ``g`` are numbers or vectorized callables of ``x*``; ``c`` and the ``loads``
+    numbers or callables of ``t*``; ``times`` are ``t*`` values; ``breakpoints`` in ``x*``.
+    The reference values convert back: ``half_width`` [m], ``modulus_at_loading`` E0 [Pa],
+    ``age_at_loading`` tau0 [day], ``plane_factor`` ``2 (1 - nu^2)`` [-].
+    """
+
+    lam: float
+    m: float | Callable[[np.ndarray], np.ndarray]
+    g: float | Callable[[np.ndarray], np.ndarray]
+    c: float | Callable[[np.ndarray], np.ndarray]
+    kernel: Any
+    loads: Mapping[str, float | Callable[[np.ndarray], np.ndarray]]
+    times: np.ndarray
+    breakpoints: tuple[float, ...]
+    tol: float
+    half_width: float
+    modulus_at_loading: float
+    age_at_loading: float
+    plane_factor: float
+    modulus: Callable[[np.ndarray], np.ndarray]
+
+    def modulus_after_loading(self, t: Any) -> np.ndarray:
+        """``E(tau0 + t)`` [Pa] at ``t`` days after loading."""
+        return np.asarray(self.modulus(self.age_at_loading + np.asarray(t, dtype=float)),
+                          dtype=float)
+
+    def pressure_scale(self, t: Any) -> np.ndarray:
+        """``q / q* = E(age) / (2 (1 - nu^2))`` [Pa] at ``t`` days after loading."""
+        return self.modulus_after_loading(t) / self.plane_factor
+
+    def solve(self) -> ContactSolution:
+        """Run :func:`core.solver.solve_dimensionless` on these arguments."""
+        # imported here: validating a scene should not load the numerical pipeline
+        from core.solver import solve_dimensionless
+
+        return solve_dimensionless(self.lam, self.m, self.g, self.times, c=self.c,
+                                   kernel=self.kernel, breakpoints=self.breakpoints,
+                                   tol=self.tol, **self.loads)
+
+
+def _is_constant(profile: Profile) -> bool:
+    return getattr(profile, "kind", None) == "constant"
+
+
+def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
+    """Convert a scene (see the module docstring for the formulas)."""
+    a = scene.half_width
+    nu = scene.base_poisson
+    tau0 = scene.age_at_loading
+    plane = 2.0 * (1.0 - nu * nu)
+    e0 = scene.modulus_at_loading()
+    creep = scene.creep
+    t_end = float(scene.times[-1])
+
+    def modulus(age: Any) -> np.ndarray:
+        return np.asarray(creep.modulus(age), dtype=float)
+
+    # Every callable below is a pure function of the scene, so the solver's caches, which
+    # key on sampled values, see equal inputs for equal scenes.
+    m_factor = e0 / (plane * a)
+    coating_constant = all(_is_constant(p) for layer in scene.coating
+                           for p in (layer.thickness, layer.modulus, layer.poisson))
+    if coating_constant:
+        m_value: Any = float(m_factor * scene.coating_compliance(np.zeros(1))[0])
+    else:
+        def m_value(xs: np.ndarray) -> np.ndarray:
+            return m_factor * scene.coating_compliance(a * np.asarray(xs, dtype=float))
+
+    if coating_constant and _is_constant(scene.shape):
+        g_value: Any = 0.0
+    else:
+        g_min = scene.gap_minimum
+
+        def g_value(xs: np.ndarray) -> np.ndarray:
+            return (scene.gap_variation(a * np.asarray(xs, dtype=float)) - g_min) / a
+
+    c_value = creep.relative_modulus(tau0)
+    aging = callable(c_value)
+
+    def days(ts: np.ndarray) -> np.ndarray:
+        # the solver may probe a hair outside [1, t*_end]; profiles are defined on [0, end]
+        return np.clip(tau0 * (np.asarray(ts, dtype=float) - 1.0), 0.0, t_end)
+
+    loads: dict[str, Any] = {}
+    for name, profile in scene.loading.items():
+        if name in ("settlement", "tilt"):
+            scale = 1.0 / a if name == "settlement" else 1.0
+            if _is_constant(profile):
+                loads[name] = float(scale * _values(profile, np.zeros(1))[0])
+            else:
+                loads[name] = _kinematic_load(profile, scale, days)
+        else:
+            power = 1 if name == "force" else 2
+            if _is_constant(profile) and not aging:
+                loads[name] = float(plane * _values(profile, np.zeros(1))[0] / (e0 * a**power))
+            else:
+                loads[name] = _static_load(profile, plane / a**power, days, modulus, tau0)
+
+    times_star = (tau0 + np.asarray(scene.times, dtype=float)) / tau0
+    times_star[0] = max(times_star[0], 1.0)
+    return DimensionlessProblem(
+        lam=a / scene.base_thickness,
+        m=m_value,
+        g=g_value,
+        c=c_value,
+        kernel=creep.dimensionless_kernel(tau0),
+        loads=loads,
+        times=times_star,
+        breakpoints=tuple(b / a for b in scene.breakpoints),
+        tol=scene.tol,
+        half_width=a,
+        modulus_at_loading=e0,
+        age_at_loading=tau0,
+        plane_factor=plane,
+        modulus=modulus,
+    )
+
+
+def _kinematic_load(profile: Profile, scale: float,
+                    days: Callable[[np.ndarray], np.ndarray]) -> Callable:
+    def load(ts: np.ndarray) -> np.ndarray:
+        t = days(ts)
+        return scale * _values(profile, t)
+    return load
+
+
+def _static_load(profile: Profile, scale: float, days: Callable[[np.ndarray], np.ndarray],
+                 modulus: Callable[[Any], np.ndarray], tau0: float) -> Callable:
+    def load(ts: np.ndarray) -> np.ndarray:
+        t = days(ts)
+        return scale * _values(profile, t) / modulus(tau0 + t)
+    return load
+
+
+# ---------------------------------------------------------------------------- solution
+
+
+def plotting_grid(half_width: float, count: int = PLOT_POINTS) -> np.ndarray:
+    """``count`` points of ``[-a, a]`` [m], clustered toward the edges (Chebyshev-Lobatto)."""
+    x = -half_width * np.cos(np.pi * np.arange(count) / (count - 1))
+    x[0], x[-1] = -half_width, half_width
+    if count % 2:
+        x[count // 2] = 0.0
+    return x
+
+
+class SceneSolution:
+    """The answer for a scene in SI units (see :func:`solve`).
+
+    ``times`` [day after loading], ``settlement`` [m], ``tilt`` [rad], ``force`` [N/m],
+    ``moment`` [N] are arrays over ``times``; ``pressure(x)`` gives q [Pa] at points
+    ``x`` [m] of ``[-a, a]``; ``x`` is a default plotting grid [m]; ``flags`` names what
+    makes the answer doubtful or unphysical (``flag_messages`` explains each).
+    """
+
+    def __init__(self, scene: Scene, problem: DimensionlessProblem,
+                 solution: ContactSolution) -> None:
+        self.scene = scene
+        self.problem = problem
+        self.dimensionless = solution
+        a = scene.half_width
+        self.times = np.array(scene.times, dtype=float)
+        modulus = problem.modulus_after_loading(self.times)
+        self._pressure_scale = modulus / problem.plane_factor
+        self.settlement = a * np.asarray(solution.settlement, dtype=float)
+        self.tilt = np.asarray(solution.tilt, dtype=float).copy()
+        self.force = np.asarray(solution.force, dtype=float) * self._pressure_scale * a
+        self.moment = np.asarray(solution.moment, dtype=float) * self._pressure_scale * a * a
+        self.x = plotting_grid(a)
+        self.flags = self._flags(solution)
+        self.flag_messages = {
+            name: FLAG_MESSAGES.get(name, f"{name}: {solution.info.get('message', '')}")
+            for name in self.flags}
+        self.info = dict(solution.info)
+        self.info["flags"] = list(self.flags)
+        self.info["dimensional"] = self._extras()
+
+    def _flags(self, solution: ContactSolution) -> list[str]:
+        scene = self.scene
+        flags = [str(f) for f in solution.info.get("flags", [])]
+        x = scene.sample_x
+        if np.max(scene.coating_thickness(x)) / (2 * scene.half_width) > THICK_COATING_RATIO:
+            flags.append("thick_coating")
+        e0 = self.problem.modulus_at_loading
+        if any(np.max(_values(layer.modulus, x)) > e0 for layer in scene.coating):
+            flags.append("stiff_coating")
+        if self.tilt.size and np.max(np.abs(self.tilt)) > LARGE_TILT:
+            flags.append("large_tilt")
+        return list(dict.fromkeys(flags))
+
+    def _extras(self) -> dict[str, Any]:
+        scene, problem = self.scene, self.problem
+        x = scene.sample_x
+        m_star = problem.m(x / scene.half_width) if callable(problem.m) \
+            else np.full(x.shape, problem.m)
+        return {
+            "scene_key": scene.key,
+            "statement": scene.statement,
+            "lam": problem.lam,
+            "modulus_at_loading_Pa": problem.modulus_at_loading,
+            "age_at_loading_days": problem.age_at_loading,
+            "m_star_min": float(np.min(m_star)),
+            "m_star_max": float(np.max(m_star)),
+            "gap_max_m": float(np.max(scene.gap(x))),
+            "coating_thickness_max_m": float(np.max(scene.coating_thickness(x))),
+            "breakpoints_m": list(scene.breakpoints),
+            "min_pressure_Pa": float(np.min(self.pressure_on_grid)),
+            "max_pressure_Pa": float(np.max(self.pressure_on_grid)),
+        }
+
+    @property
+    def contact_lost(self) -> bool:
+        """Whether the pressure is negative somewhere (the answer is then not physical)."""
+        return "contact_lost" in self.flags
+
+    def pressure(self, x: Any) -> np.ndarray:
+        """Contact pressure q [Pa] at points ``x`` [m] of ``[-a, a]``, shape (len(x), len(times)).
+
+        Points outside ``[-a, a]`` are refused (ValueError).
+        """
+        a = self.scene.half_width
+        xs = np.atleast_1d(np.asarray(x, dtype=float))
+        if np.any(~np.isfinite(xs)) or np.any(np.abs(xs) > a * (1 + 1e-12)):
+            raise ValueError(f"x: the pressure is defined on [-a, a] = [{-a:g}, {a:g}] m only")
+        # x = +-a can land a rounding error outside [-1, 1] after the division
+        q_star = self.dimensionless.pressure(np.clip(xs / a, -1.0, 1.0))
+        return q_star * self._pressure_scale[None, :]
+
+    @cached_property
+    def pressure_on_grid(self) -> np.ndarray:
+        """``pressure(x)`` on the plotting grid, shape (201, len(times)) [Pa]."""
+        return self.pressure(self.x)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-able dict: the scene, the histories, q on ``x`` at every time, info, flags.
+
+        Units are listed under ``units``; non-finite numbers become ``null``.
+        """
+        return _jsonable({
+            "format": "coated-punch solution",
+            "schema_version": SCHEMA_VERSION,
+            "scene": self.scene.to_dict(),
+            "units": UNITS,
+            "times": self.times,
+            "settlement": self.settlement,
+            "tilt": self.tilt,
+            "force": self.force,
+            "moment": self.moment,
+            "x": self.x,
+            "pressure": self.pressure_on_grid,
+            "flags": self.flags,
+            "flag_messages": self.flag_messages,
+            "info": self.info,
+        })
+
+    def to_json(self) -> str:
+        """:meth:`to_dict` as compact JSON text."""
+        return json.dumps(self.to_dict(), separators=(",", ":"), allow_nan=False)
+
+    def to_csv(self) -> str:
+        """The histories as CSV: time [day], settlement [m], tilt [rad], force [N/m], moment [N]."""
+        lines = ["time_day,settlement_m,tilt_rad,force_N_per_m,moment_N"]
+        for row in zip(self.times, self.settlement, self.tilt, self.force, self.moment,
+                       strict=True):
+            lines.append(",".join(repr(float(v)) for v in row))
+        return "\n".join(lines) + "\n"
+
+    def pressure_csv(self, x: Any = None) -> str:
+        """q(x, t) as CSV in long form: time [day], x [m], pressure [Pa] (default x: ``.x``)."""
+        xs = self.x if x is None else np.atleast_1d(np.asarray(x, dtype=float))
+        q = self.pressure_on_grid if x is None else self.pressure(xs)
+        lines = ["time_day,x_m,pressure_Pa"]
+        for j, t in enumerate(self.times):
+            tt = repr(float(t))
+            lines.extend(f"{tt},{float(xi)!r},{float(qi)!r}" for xi, qi in zip(xs, q[:, j],
+                                                                               strict=True))
+        return "\n".join(lines) + "\n"
+
+
+def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
+    """Solve a scene (a :class:`Scene` or a scene dict, validated first).
+
+    Returns a :class:`SceneSolution` in SI units (m, rad, N/m, N, Pa; days after loading).
+    """
+    scene = scene_from_dict(scene)
+    problem = scene.dimensionless
+    return SceneSolution(scene, problem, problem.solve())
