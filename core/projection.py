@@ -30,20 +30,29 @@ class GapTerms:
     first_moment: float
 
 
-def galerkin_matrix(operator: KernelOperator, basis: Basis, m_values: np.ndarray) -> np.ndarray:
-    """``R`` (n x n) for all functions of ``basis`` (dimensionless)."""
+def galerkin_matrix(operator: KernelOperator, basis: Basis, m_values: np.ndarray,
+                    correction: np.ndarray | None = None) -> np.ndarray:
+    """``R`` (n x n) for all functions of ``basis`` (dimensionless).
+
+    ``correction``: :func:`core.quadrature.galerkin_correction` of the operator's panels,
+    needed by a basis with kinks or jumps at panel ends (the ``"graded"`` basis).
+    """
     phi = basis.values / m_values[:, None]
     weighted = operator.panels.weights[:, None] * phi
     r = weighted.T @ (operator.matrix @ phi)
+    if correction is not None:
+        r = r + phi.T @ (correction @ phi)
     return 0.5 * (r + r.T)
 
 
 def gap_terms(operator: KernelOperator, basis: Basis, m_values: np.ndarray,
-              g_values: np.ndarray) -> GapTerms:
+              g_values: np.ndarray, correction: np.ndarray | None = None) -> GapTerms:
     """``G_i`` and the gap moments for gap values ``g_values`` at the nodes."""
     psi = g_values / m_values
     phi = basis.values / m_values[:, None]
     w = operator.panels.weights
     vector = (w[:, None] * phi).T @ (operator.matrix @ psi)
+    if correction is not None:
+        vector = vector + phi.T @ (correction @ psi)
     x = operator.panels.nodes
     return GapTerms(vector, float(np.sum(w * psi)), float(np.sum(w * x * psi)))
