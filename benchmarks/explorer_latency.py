@@ -1,0 +1,172 @@
+"""Latency of the explorer as a user sees it, measured in a real browser.
+
+Starts ``python -m explorer`` on a free port (or uses ``--url``), drives Debian's Chromium
+with Playwright and reports medians of:
+
+- first page load: navigation start -> the first frame painted after the pressure plot
+  received its data (a fresh page, hence a fresh session, each time);
+- load slider: key press on the force slider -> the second animation frame after the
+  pressure plot's data changed (the frame that shows it);
+- coating thickness, punch half-width, base thickness: the same, for sliders whose
+  change re-solves on release (a key press is a release).
+
+Every key press moves a slider to a value not seen before, so no result comes from the
+explorer's result cache; the core's stage caches work as they do for a user.
+Not part of the test suite. Usage::
+
+    python benchmarks/explorer_latency.py [--repeats 9] [--loads 5] [--url URL]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
+                 "--disable-background-networking", "--disable-component-update",
+                 "--no-first-run", "--disable-sync"]
+
+READY = """() => {
+  const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];
+  const src = doc && doc.get_model_by_name('q_source');
+  if (!src || !src.data.q || src.data.q.length < 2) return null;
+  return new Promise(r => requestAnimationFrame(() => requestAnimationFrame(
+    () => r(performance.now()))));
+}"""
+
+# Records, for every change of the pressure plot's data, the time from the last key press
+# to the second animation frame after the change.
+INSTRUMENT = """() => {
+  const src = Bokeh.documents[0].get_model_by_name('q_source');
+  window.__latencies = [];
+  window.__keyTime = null;
+  document.addEventListener('keydown', e => { window.__keyTime = performance.now(); }, true);
+  src.change.connect(() => {
+    const t0 = window.__keyTime;
+    if (t0 === null) return;
+    window.__keyTime = null;
+    requestAnimationFrame(() => requestAnimationFrame(
+      () => window.__latencies.push(performance.now() - t0)));
+  });
+}"""
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("localhost", 0))
+        return s.getsockname()[1]
+
+
+def start_server() -> tuple[subprocess.Popen, str]:
+    port = free_port()
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
+    proc = subprocess.Popen([sys.executable, "-m", "explorer", "--port", str(port)],
+                            cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    url = f"http://localhost:{port}"
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline:
+        try:
+            with urllib.request.urlopen(url + "/liveness", timeout=2):
+                return proc, url
+        except OSError:
+            if proc.poll() is not None:
+                raise SystemExit("the explorer server exited") from None
+            time.sleep(0.5)
+    proc.kill()
+    raise SystemExit("the explorer server did not start")
+
+
+def measure_slider(page, tab: str, css: str, presses: int, key: str) -> list[float]:
+    """Press ``key`` on a slider's handle ``presses`` times; latency of each [ms]."""
+    page.locator(".bk-tab", has_text=tab).first.click()
+    handle = page.locator(f"{css} .noUi-handle").first
+    handle.focus()
+    out, solves = [], []
+    for _ in range(presses):
+        before = page.evaluate("() => window.__latencies.length")
+        handle.press(key)
+        page.wait_for_function(f"() => window.__latencies.length > {before}", timeout=120_000)
+        out.append(page.evaluate("() => window.__latencies[window.__latencies.length - 1]"))
+        time.sleep(0.3)
+        status = page.locator(".solve-status").first.inner_text()
+        found = re.search(r"Solved in (\d+) ms", status)
+        solves.append(float(found.group(1)) if found else float("nan"))
+    return out, solves
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--url", help="an explorer already running (default: start one)")
+    parser.add_argument("--repeats", type=int, default=9, help="slider moves per control")
+    parser.add_argument("--loads", type=int, default=5, help="page loads")
+    parser.add_argument("--json", help="also write the numbers to this file")
+    args = parser.parse_args()
+
+    from playwright.sync_api import sync_playwright
+
+    proc = None
+    url = args.url
+    if url is None:
+        proc, url = start_server()
+    results: dict[str, list[float]] = {}
+    solves: dict[str, list[float]] = {}
+    try:
+        with sync_playwright() as p, tempfile.TemporaryDirectory() as profile:
+            context = p.chromium.launch_persistent_context(
+                profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
+                viewport={"width": 1500, "height": 1300})
+            loads = []
+            for _ in range(args.loads + 1):
+                page = context.new_page()
+                page.goto(url + "/app", wait_until="commit")
+                handle = page.wait_for_function(READY, timeout=120_000, polling=20)
+                loads.append(handle.json_value())
+                page.close()
+            results["first page load"] = loads[1:]  # the first warms the browser's cache
+
+            page = context.new_page()
+            page.goto(url + "/app")
+            page.wait_for_function(READY, timeout=120_000)
+            page.evaluate(INSTRUMENT)
+            for name, tab, css in (("load slider (force)", "Scene", ".load-0-value"),
+                                   ("coating thickness", "Coating", ".coating-thickness"),
+                                   ("punch half-width", "Punch", ".punch-half-width"),
+                                   ("base thickness", "Base", ".base-thickness")):
+                results[name], solves[name] = measure_slider(page, tab, css, args.repeats,
+                                                             "ArrowRight")
+            context.close()
+    finally:
+        if proc is not None:
+            proc.terminate()
+            proc.wait(timeout=20)
+
+    goals = {"first page load": 3000, "load slider (force)": 100, "coating thickness": 250,
+             "punch half-width": 250, "base thickness": 400}
+    print(f"{'control':24s} {'median':>9s} {'min':>9s} {'max':>9s} {'goal':>7s} "
+          f"{'core solve':>11s}  (ms; core solve: median of the server's own timing)")
+    for name, values in results.items():
+        core = solves.get(name)
+        core_text = f"{statistics.median(core):11.0f}" if core else f"{'':11s}"
+        print(f"{name:24s} {statistics.median(values):9.0f} {min(values):9.0f} "
+              f"{max(values):9.0f} {goals[name]:7d} {core_text}  n={len(values)}")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"browser": results, "core_solve": solves},
+                                              indent=2))
+
+
+if __name__ == "__main__":
+    main()

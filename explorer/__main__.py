@@ -1,0 +1,70 @@
+"""Serve the explorer: ``python -m explorer [--port 5006] [--show]``.
+
+The page is served at ``/app``; ``/`` redirects there. By default the server listens on
+localhost only and opens no browser.
+"""
+
+from __future__ import annotations
+
+import argparse
+import socket
+import sys
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m explorer",
+        description="Serve the coated-punch explorer. Open http://localhost:PORT/app "
+                    "(/ redirects there). Add ?preset=NAME to start from a preset scene; "
+                    "the address bar always holds a link to the scene on screen.")
+    parser.add_argument("--port", type=int, default=5006,
+                        help="port to listen on (default 5006)")
+    parser.add_argument("--address", default="localhost",
+                        help="address to listen on (default localhost; 0.0.0.0 exposes the "
+                             "explorer on every network interface)")
+    parser.add_argument("--allow-websocket-origin", action="append", default=None,
+                        metavar="HOST[:PORT]",
+                        help="host allowed to open the page's websocket (repeatable); needed "
+                             "when the page is reached under a name other than localhost")
+    parser.add_argument("--show", action="store_true",
+                        help="open the page in the default browser")
+    parser.add_argument("--warm-up", choices=("default", "all", "none"), default="default",
+                        help="preset scenes solved before serving, so that visitors find them "
+                             "ready: the default one (default), all of them (slower start), "
+                             "or none")
+    parser.add_argument("--solver-threads", type=int, default=2,
+                        help="threads solving scenes, shared by all sessions (default 2)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``python -m explorer`` and the ``coated-punch-explorer`` script."""
+    args = build_parser().parse_args(argv)
+    import panel as pn
+
+    from explorer.app import create_app, warm_up
+    from explorer.controller import shared_pool
+    from explorer.presets import ORDER
+
+    shared_pool(max(1, args.solver_threads))
+    if args.warm_up != "none":
+        keys = ORDER if args.warm_up == "all" else ORDER[:1]
+        print(f"Solving {len(keys)} preset scene(s) once before serving...", file=sys.stderr,
+              flush=True)
+        warm_up(keys)
+    origins = args.allow_websocket_origin
+    if origins is None and args.address not in ("localhost", "127.0.0.1"):
+        host = socket.gethostname() if args.address in ("0.0.0.0", "::") else args.address
+        origins = [f"localhost:{args.port}", f"{host}:{args.port}"]
+        print("Pages are accepted from " + ", ".join(origins) + " (add others with "
+              "--allow-websocket-origin)", file=sys.stderr, flush=True)
+    print(f"Serving the explorer at http://{args.address}:{args.port}/app", file=sys.stderr,
+          flush=True)
+    pn.serve({"app": create_app}, port=args.port, address=args.address, show=args.show,
+             websocket_origin=origins, title="Coated punch explorer", threaded=False,
+             liveness=True, start=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,765 @@
+"""The explorer page: a thin Panel view over the state, the solve controller and the plots.
+
+``create_app()`` builds one :class:`ExplorerApp` per browser session (serve the factory,
+not an instance). The page calls only the public API of ``core`` (through the
+controller); every number the user sets lives in :class:`~explorer.state.ExplorerState`.
+"""
+
+from __future__ import annotations
+
+import html
+import io
+import json
+import logging
+import re
+from collections.abc import Callable
+from typing import Any
+
+import panel as pn
+import param
+from panel.io.state import set_curdoc
+
+from .controller import SolveController, format_error
+from .links import decode_scene, encode_scene
+from .plots import Figures
+from .presets import DEFAULT_PRESET, preset_label, presets
+from .results import ResultView
+from .state import (
+    CREEP_MODELS,
+    QUANTITIES,
+    QUANTITY_UNITS,
+    SCREEN_LAYERS,
+    STATEMENTS,
+    ExplorerState,
+)
+from .widgets import NAMES, Binding, HistoryEditor, ProfileEditor, fine_slider, slider
+
+log = logging.getLogger(__name__)
+
+#: Which validity flags are shown next to which plot.
+BADGES: dict[str, dict[str, tuple[str, str]]] = {
+    # group: flag -> (text when raised, text when the check passes)
+    "scene": {"thick_coating": ("coating not thin", "coating thin"),
+              "stiff_coating": ("coating stiffer than base", "coating softer than base")},
+    "pressure": {"contact_lost": ("contact lost: q < 0 (shaded)", "full contact")},
+    "history": {"large_tilt": ("large tilt", "small tilt")},
+    "status": {"tol_not_met": ("tolerance not met", ""),
+               "unresolved_input": ("input finer than the quadrature", "")},
+}
+
+CSS = """
+.cp-badge {display: inline-block; padding: 1px 8px; margin: 2px 4px 2px 0;
+           border-radius: 10px; font-size: 12px; font-weight: 600;}
+.cp-bad {background: #fde2e1; color: #9b1c1c; border: 1px solid #f5a3a0;}
+.cp-ok {background: #e3f5e6; color: #1d6b2c; border: 1px solid #a8dcb2;}
+.cp-msg {font-size: 12px; color: #9b1c1c; margin-left: 4px;}
+.cp-status {font-size: 12px; color: #444;}
+.cp-readout td, .cp-readout th {padding: 1px 8px; font-size: 13px; text-align: right;}
+.cp-readout th:first-child, .cp-readout td:first-child {text-align: left;}
+.cp-given {color: #777;}
+"""
+
+SPACINGS = {"linear": "linear", "log": "log"}
+
+
+def _html(text: str = "", **kwargs: Any) -> pn.pane.HTML:
+    """An HTML pane carrying the page's style sheet (panes render in their own shadow DOM)."""
+    return pn.pane.HTML(text, stylesheets=[CSS], **kwargs)
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_").lower() or "scene"
+
+
+def _fmt(value: float) -> str:
+    return f"{value:.5g}" if abs(value) < 1e5 else f"{value:.4e}"
+
+
+def badges_html(view: ResultView | None, group: str) -> str:
+    """Validity badges of one plot group (flag names as CSS classes, messages as tooltips)."""
+    if view is None:
+        return ""
+    parts = []
+    for flag, (bad, good) in BADGES[group].items():
+        if flag in view.flags:
+            message = html.escape(view.flag_messages.get(flag, ""))
+            parts.append(f'<span class="cp-badge cp-bad flag-{flag}" title="{message}">'
+                         f"⚠ {bad}</span><span class='cp-msg'>{message}</span>")
+        elif good:
+            parts.append(f'<span class="cp-badge cp-ok ok-{flag}">✓ {good}</span>')
+    return "".join(parts)
+
+
+def status_html(view: ResultView | None, busy: bool) -> str:
+    """The status line: time per stage, what the cache reused, modes, steps, error."""
+    if view is None:
+        return "<span class='cp-status'>Solving…</span>" if busy else ""
+    info = view.info
+    stages = info.get("stages", {}) or {}
+    computed = [f"{name} {1e3 * float(s.get('seconds', 0.0)):.1f} ms"
+                for name, s in stages.items() if not s.get("cached")]
+    reused = [name for name, s in stages.items() if s.get("cached")]
+    tol = view.scene.get("solver", {}).get("tol", 1e-6)
+    err = info.get("error_estimate")
+    err_text = f"{err:.1e}" if isinstance(err, (int, float)) else "n/a"
+    text = (f"Solved in {1e3 * float(info.get('seconds', 0.0)):.0f} ms · "
+            f"computed: {', '.join(computed) or 'nothing'} · "
+            f"reused from cache: {', '.join(reused) or 'nothing'} · "
+            f"{info.get('n_modes', '?')} modes, {info.get('n_steps', '?')} time steps · "
+            f"error estimate {err_text} (target {tol:g})")
+    if info.get("reused"):
+        text = ("Identical to an earlier scene: its result is reused, no new solve. That "
+                "solve: " + text[0].lower() + text[1:])
+    if busy:
+        text = "Solving the newest change… showing the previous result. " + text
+    return f"<span class='cp-status solve-status'>{html.escape(text)}</span>"
+
+
+def readout_html(view: ResultView | None, index: int, pinned: ResultView | None) -> str:
+    """Values at the selected time: current, pinned and their difference."""
+    if view is None:
+        return ""
+    t = float(view.times[index])
+    head = "<tr><th></th><th>current</th>"
+    head += "<th>pinned</th><th>change</th></tr>" if pinned is not None else "</tr>"
+    rows = [head]
+    j = pinned.time_index(t) if pinned is not None else 0
+    for q in QUANTITIES:
+        unit = QUANTITY_UNITS[q][0]
+        value = float(view.display(q)[index])
+        role = "given" if q in view.given else "computed"
+        cls = "cp-given" if role == "given" else ""
+        row = (f"<tr class='{cls}'><td>{NAMES[q]} [{unit}] ({role})</td>"
+               f"<td class='readout-{q}'>{_fmt(value)}</td>")
+        if pinned is not None:
+            other = float(pinned.display(q)[j])
+            change = f"{100 * (value - other) / abs(other):+.2f} %" if other else "n/a"
+            row += f"<td class='pinned-{q}'>{_fmt(other)}</td><td>{change}</td>"
+        rows.append(row + "</tr>")
+    force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
+    ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
+    return (f"<div class='readout'><b>At t = {t:.4g} days after loading</b> · {ecc}"
+            f"<table class='cp-readout'>{''.join(rows)}</table></div>")
+
+
+class ExplorerApp(pn.viewable.Viewer):
+    """One session of the explorer: widgets, plots, status, files and the link."""
+
+    notice = param.String(default="", doc="A problem with a file or a link (not a solve).")
+    time_index = param.Integer(default=0, doc="Index of the output time shown.")
+
+    def __init__(self, scene: dict[str, Any] | None = None, *,
+                 query: dict[str, str] | None = None,
+                 solve: Callable[[dict[str, Any]], Any] | None = None,
+                 executor: Any = "shared", **params: Any) -> None:
+        super().__init__(**params)
+        self._doc = pn.state.curdoc
+        self._location = pn.state.location if self._served else None
+        self.state = ExplorerState()
+        self.controller = SolveController(self.state, solve=solve, executor=executor,
+                                          dispatch=self._dispatch, auto=False)
+        self.pinned: ResultView | None = None
+        self.presets = presets()
+        self.figures = Figures()
+        self._drawn: ResultView | None = None
+        self._initial_scene(scene, query or {})
+        self._build_widgets()
+        self._layout = self._build_layout()
+        # Changes to plain Bokeh models made after the page was generated but before its
+        # websocket connects would never reach the browser: hold them until it does.
+        self._initializing = True
+        self._connected = not self._served
+        if self._served:
+            pn.state.onload(self._on_load)
+        self.controller.param.watch(self._on_view, "view")
+        self.controller.param.watch(self._on_status, ["error", "busy"])
+        self.param.watch(self._on_time, "time_index")
+        self.param.watch(self._on_notice, "notice")
+        self.state.param.watch(self._on_revision, "revision")
+        # A known answer (a preset solved at start-up) is shown before the page is sent;
+        # anything else is solved in the background while the page loads.
+        self.controller.start()
+        if self.controller.view is None and self.controller.error:
+            self._fallback_to_default()
+        self._initializing = False
+
+    # -- plumbing --------------------------------------------------------------------
+    @property
+    def _served(self) -> bool:
+        return bool(self._doc is not None and self._doc.session_context)
+
+    def _dispatch(self, callback: Callable[[], None]) -> None:
+        """Run ``callback`` (from a solver thread) on this session's event loop."""
+        doc = self._doc
+        if doc is None or not doc.session_context:
+            callback()
+            return
+
+        def run() -> None:
+            with set_curdoc(doc):
+                callback()
+
+        try:
+            doc.add_next_tick_callback(run)
+        except Exception:  # the session was closed while solving
+            log.debug("result dropped: session gone")
+
+    def _initial_scene(self, scene: dict[str, Any] | None, query: dict[str, str]) -> None:
+        from core import scene_from_dict
+
+        default = self.presets.get(DEFAULT_PRESET) or next(iter(self.presets.values()), None)
+        chosen = scene
+        if chosen is None and query.get("scene"):
+            try:
+                chosen = decode_scene(query["scene"])
+                scene_from_dict(chosen)
+            except ValueError as exc:
+                self.notice = (f"The scene in the link was not used: {format_error(str(exc))}"
+                               ". Showing the default scene instead.")
+                chosen = None
+        if chosen is None and query.get("preset"):
+            chosen = self.presets.get(query["preset"])
+            if chosen is None:
+                self.notice = (f"Unknown preset {query['preset'][:40]!r} in the link; "
+                               "showing the default scene.")
+        chosen = chosen or default
+        if chosen is not None:
+            try:
+                self.state.load_scene(chosen)
+            except ValueError as exc:
+                self.notice = f"The scene could not be shown: {exc}"
+        self._preset_key = next((k for k, s in self.presets.items() if s == chosen), None)
+
+    def _fallback_to_default(self) -> None:
+        default = self.presets.get(DEFAULT_PRESET)
+        if default is None:
+            return
+        self.notice = (f"The scene could not be solved ({self.controller.error}); showing "
+                       "the default scene instead.")
+        self.state.load_scene(default)
+        self.controller.solve_now()
+
+    # -- widgets ---------------------------------------------------------------------
+    def _build_widgets(self) -> None:
+        s = self.state
+        reject = self._reject
+        # presets
+        options = {"(custom scene)": ""}
+        options.update({preset_label(k, v): k for k, v in self.presets.items()})
+        self.preset = pn.widgets.Select(label="Preset scene", options=options,
+                                        value=self._preset_key or "",
+                                        sizing_mode="stretch_width")
+        self.preset_description = pn.pane.Markdown(self._preset_text(), margin=(0, 10),
+                                                   styles={"font-size": "13px"})
+        self.preset.param.watch(self._on_preset, "value")
+
+        # punch
+        self.punch = Binding(reject)
+        pb = self.punch
+        self.half_width = pb.add("half_width", slider("half-width a [m]", 0.1, 5.0, 0.01,
+                                                      css_classes=["punch-half-width"]))
+        self.shape = pb.add("shape", pn.widgets.Select(label="base shape", options={
+            "flat": "flat", "crowned (parabolic, radius R)": "parabolic",
+            "wedge (slope of each face)": "wedge", "single step (height, position)": "stepped",
+            "central land (raised middle)": "land",
+            "wavy / rough (amplitude, wavelength)": "wavy",
+            "custom table (CSV upload or file)": "custom"}, sizing_mode="stretch_width"))
+        self.radius = pb.add("radius", fine_slider("crown radius R [km]", 1.0, 500.0, 0.5, "0[.]0"))
+        self.slope = pb.add("slope", fine_slider("slope of each face [µrad]", 0.0, 200.0, 0.5,
+                                            "0[.]0"))
+        self.step_height = pb.add("step_height", fine_slider(
+            "step height [µm] (right part raised)", -100.0, 100.0, 0.5, "0[.]0"))
+        self.step_position = pb.add("step_position", fine_slider("step position x [m]", -1.0, 1.0,
+                                                             0.01))
+        self.land_height = pb.add("land_height", fine_slider(
+            "land height [µm] (middle protrudes)", 0.0, 100.0, 0.5, "0[.]0"))
+        self.land_width = pb.add("land_width", fine_slider("land width [m]", 0.05, 2.0, 0.01))
+        self.wave_amplitude = pb.add("wave_amplitude", fine_slider("wave amplitude [µm]", 0.0, 50.0,
+                                                              0.1, "0[.]0"))
+        self.wave_length = pb.add("wave_length", fine_slider("wavelength [m]", 0.02, 5.0, 0.01))
+        self.shape_file = pn.widgets.FileInput(accept=".csv,.txt", multiple=False,
+                                               sizing_mode="stretch_width")
+        self.shape_file.param.watch(self._on_shape_file, "value")
+        self.shape_note = _html("", styles={"font-size": "12px", "color": "#666"})
+        pb.bind(s.punch)
+        s.punch.param.watch(lambda *e: self._refresh_punch(), ["shape", "half_width",
+                                                              "custom_label"])
+
+        # coating
+        self.n_layers = pn.widgets.IntSlider(label="number of layers", start=1,
+                                             end=SCREEN_LAYERS, value=min(s.n_layers,
+                                                                          SCREEN_LAYERS),
+                                             sizing_mode="stretch_width")
+        self.n_layers.param.watch(lambda e: setattr(s, "n_layers", e.new), "value_throttled")
+        self.layer = pn.widgets.RadioButtonGroup(label="edit layer", options=["1"], value="1",
+                                                 color="primary", variant="outline",
+                                                 sizing_mode="stretch_width")
+        self.layer.param.watch(lambda *e: self._bind_layer(), "value")
+        self.thickness_editor = ProfileEditor("thickness", "mm", 0.5, 50.0, 0.1, "0[.]00",
+                                              amplitude=("µm", -1000.0, 1000.0, 0.5),
+                                              css="coating-thickness")
+        self.modulus_editor = ProfileEditor("Young's modulus", "MPa", 1.0, 10000.0, 1.0,
+                                            "0[.]0")
+        self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
+                                            variations=False)
+        self.layer_note = _html("", styles={"font-size": "12px", "color": "#666"})
+        s.param.watch(lambda *e: self._refresh_layers(), "n_layers")
+        self._refresh_layers()
+
+        # base
+        self.base = Binding(reject)
+        bb = self.base
+        self.base_thickness = bb.add("thickness", slider("thickness H [m]", 0.1, 20.0, 0.05,
+                                                         "0[.]00", css_classes=["base-thickness"]))
+        self.base_poisson = bb.add("poisson", slider("Poisson ratio", 0.0, 0.49, 0.01))
+        self.base_modulus = bb.add("modulus", slider("Young's modulus E [GPa]", 0.1, 60.0, 0.1,
+                                                     "0[.]0"))
+        self.creep_model = bb.add("creep_model", pn.widgets.Select(
+            label="creep model", options={v: k for k, v in CREEP_MODELS.items()},
+            sizing_mode="stretch_width"))
+        self.compliance = bb.add("compliance", fine_slider("final creep compliance C∞ [1/GPa]",
+                                                      0.0, 0.1, 0.0005, "0[.]0000"))
+        self.rate = bb.add("rate", fine_slider("creep rate γ [1/day]", 0.001, 1.0, 0.001,
+                                               "0[.]000"))
+        self.beta = bb.add("beta", fine_slider("modulus aging β [-]", 0.0, 0.95, 0.01))
+        self.alpha = bb.add("alpha", fine_slider("modulus aging rate α [1/day]", 0.001, 1.0,
+                                                 0.001))
+        self.aging = bb.add("aging", fine_slider("aging creep A [day/GPa]", 0.0, 5.0, 0.01,
+                                            "0[.]00"))
+        self.age = bb.add("age_at_loading", slider("age at loading τ₀ [days]", 1.0, 3650.0,
+                                                   1.0, "0[.]0"))
+        self.creep_note = _html("", styles={"font-size": "12px", "color": "#666"})
+        bb.bind(s.base)
+        s.base.param.watch(lambda *e: self._refresh_base(), ["creep_model"])
+
+        # loading
+        self.statement = pn.widgets.Select(label="statement (which two are given)",
+                                           options=list(STATEMENTS), value=s.loading.statement,
+                                           sizing_mode="stretch_width",
+                                           css_classes=["statement-select"])
+        self.statement.param.watch(lambda e: setattr(s.loading, "statement", e.new), "value")
+        s.loading.param.watch(self._on_statement, "statement")
+        self.history_editors = (HistoryEditor("load-0"), HistoryEditor("load-1"))
+        self.unknowns_note = _html("", styles={"font-size": "13px"})
+
+        # times and accuracy
+        self.global_binding = Binding(reject)
+        gb = self.global_binding
+        self.time_end = gb.add("time_end", slider("time span [days after loading]", 1.0,
+                                                  3650.0, 1.0, "0[.]0"))
+        self.time_count = gb.add("time_count", pn.widgets.EditableIntSlider(
+            label="output times", start=2, end=200, step=1, sizing_mode="stretch_width"))
+        self.time_spacing = gb.add("time_spacing", pn.widgets.RadioButtonGroup(
+            label="spacing", options=list(SPACINGS), sizing_mode="stretch_width"))
+        self.tol = gb.add("tol", pn.widgets.Select(
+            label="accuracy target (relative)", options={f"{v:g}": v for v in
+                                                        s.param.tol.objects},
+            sizing_mode="stretch_width"))
+        self.scene_name = gb.add("scene_name", pn.widgets.TextInput(
+            label="scene name", sizing_mode="stretch_width"))
+        gb.bind(s)
+        s.param.watch(lambda *e: self._refresh_tol(), "tol")
+
+        # files
+        self.save_scene = pn.widgets.FileDownload(callback=self._scene_file,
+                                                  filename="scene.json",
+                                                  label="Save scene (JSON)",
+                                                  color="primary",
+                                                  sizing_mode="stretch_width")
+        self.load_file = pn.widgets.FileInput(accept=".json", multiple=False,
+                                              sizing_mode="stretch_width")
+        self.load_file.param.watch(self._on_scene_file, "value")
+        self.csv_download = pn.widgets.FileDownload(callback=self._csv_file,
+                                                    filename="results.csv",
+                                                    label="Results: histories (CSV)",
+                                                    sizing_mode="stretch_width")
+        self.pressure_download = pn.widgets.FileDownload(callback=self._pressure_file,
+                                                         filename="pressure.csv",
+                                                         label="Results: q(x, t) (CSV)",
+                                                         sizing_mode="stretch_width")
+        self.json_download = pn.widgets.FileDownload(callback=self._json_file,
+                                                     filename="results.json",
+                                                     label="Results: everything (JSON)",
+                                                     sizing_mode="stretch_width")
+
+        # display
+        self.alert = pn.pane.Alert("", alert_type="danger", visible=False,
+                                   sizing_mode="stretch_width", css_classes=["solve-error"])
+        self.notice_alert = pn.pane.Alert(self.notice, alert_type="warning",
+                                          visible=bool(self.notice),
+                                          sizing_mode="stretch_width",
+                                          css_classes=["notice"])
+        self.spinner = pn.indicators.LoadingSpinner(value=False, size=20, label="",
+                                                    margin=(5, 5))
+        self.status = _html("", sizing_mode="stretch_width", margin=(5, 5))
+        self.scene_badges = _html("", margin=(0, 5))
+        self.pressure_badges = _html("", margin=(0, 5))
+        self.history_badges = _html("", margin=(0, 5))
+        self.status_badges = _html("", margin=(0, 5))
+        self.player = pn.widgets.Player(label="time", start=0, end=1, value=0, interval=250,
+                                        loop_policy="once", show_loop_controls=False,
+                                        sizing_mode="stretch_width", show_value=False)
+        self.player.param.watch(lambda e: setattr(self, "time_index", int(e.new)), "value")
+        self.time_label = _html("", margin=(12, 10))
+        self.readout = _html("", sizing_mode="stretch_width")
+        self.pin_button = pn.widgets.Button(label="Pin this result", color="default")
+        self.unpin_button = pn.widgets.Button(label="Clear pin", color="light",
+                                              disabled=True)
+        self.pin_button.on_click(lambda e: self.pin())
+        self.unpin_button.on_click(lambda e: self.unpin())
+        self._refresh_punch()
+        self._refresh_base()
+        self._on_statement()
+        self._refresh_tol()
+
+    # -- layout ----------------------------------------------------------------------
+    def _build_layout(self) -> pn.viewable.Viewable:
+        column = {"sizing_mode": "stretch_width", "margin": (4, 0)}
+        # Only the open tab is rendered (dynamic): the page arrives with a fifth of the
+        # widget models, and the others are built when their tab is first opened.
+        sidebar = pn.Tabs(
+            ("Scene", pn.Column(
+                self.preset, self.preset_description,
+                _html("<b>Loading</b> (updates while you drag)", margin=(10, 10, 0, 10)),
+                self.statement, self.history_editors[0].panel, self.history_editors[1].panel,
+                self.unknowns_note, **column)),
+            ("Punch", pn.Column(
+                self.half_width, self.shape, self.radius, self.slope, self.step_height,
+                self.step_position, self.land_height, self.land_width, self.wave_amplitude,
+                self.wave_length, self.shape_note,
+                _html("<small>Upload a shape table: CSV with two columns, x [m] and "
+                      "f(x) [m], f the height of the punch base above its lowest point."
+                      "</small>"),
+                self.shape_file, **column)),
+            ("Coating", pn.Column(
+                _html("<small>Layer 1 touches the punch. Changes apply when you release "
+                      "a slider.</small>"),
+                self.n_layers, self.layer, self.layer_note, self.thickness_editor.panel,
+                self.modulus_editor.panel, self.poisson_editor.panel, **column)),
+            ("Base", pn.Column(
+                self.base_thickness, self.base_poisson, self.creep_model, self.base_modulus,
+                self.compliance, self.rate, self.beta, self.alpha, self.aging, self.age,
+                self.creep_note, **column)),
+            ("Time", pn.Column(self.time_end, self.time_count, self.time_spacing, self.tol,
+                               **column)),
+            ("Files", pn.Column(
+                self.scene_name, self.save_scene,
+                _html("<small>Load a scene (the JSON the command line reads):</small>"),
+                self.load_file, self.csv_download, self.pressure_download, self.json_download,
+                _html("<small>Downloads hold the result on screen. The address bar holds "
+                      "a link to it.</small>"), **column)),
+            dynamic=True, width=370, margin=(0, 10, 0, 0), css_classes=["sidebar-tabs"],
+        )
+        f = self.figures
+        bokeh = {"sizing_mode": "stretch_width", "margin": (0, 5)}
+        self._bokeh_panes = [pn.pane.Bokeh(fig, **bokeh) for fig in (
+            f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES))]
+        scene_pane, q_pane, image_pane, *history_panes = self._bokeh_panes
+        main = pn.Column(
+            self.notice_alert,
+            self.alert,
+            pn.Row(self.spinner, self.status, self.status_badges, sizing_mode="stretch_width"),
+            self.scene_badges,
+            scene_pane,
+            self.pressure_badges,
+            pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
+            pn.Row(self.player, self.time_label, sizing_mode="stretch_width"),
+            pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button),
+                   sizing_mode="stretch_width"),
+            self.history_badges,
+            pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
+            sizing_mode="stretch_width",
+        )
+        header = _html(
+            "<h2 style='margin:4px 0'>Coated punch explorer</h2>"
+            "<div style='font-size:13px;color:#555'>A rigid punch on thin elastic coatings "
+            "over an aging viscoelastic layer (plane strain, per metre out of plane). "
+            "Loads update while you drag; geometry and materials when you release.</div>",
+            sizing_mode="stretch_width")
+        return pn.Column(header, pn.Row(sidebar, main, sizing_mode="stretch_width"),
+                         sizing_mode="stretch_width")
+
+    def __panel__(self) -> pn.viewable.Viewable:
+        return self._layout
+
+    # -- refreshers of widget visibility ---------------------------------------------
+    def _preset_text(self) -> str:
+        key = getattr(self, "preset", None) and self.preset.value
+        scene = self.presets.get(key) if key else None
+        if scene is None:
+            return "Your own scene: start from a preset, a file or a link."
+        return str(scene.get("description", ""))
+
+    def _refresh_punch(self) -> None:
+        p = self.state.punch
+        a = p.half_width
+        self.step_position.param.update(start=-a, end=a)
+        shape = p.shape
+        self.radius.visible = shape == "parabolic"
+        self.slope.visible = shape == "wedge"
+        self.step_height.visible = self.step_position.visible = shape == "stepped"
+        self.land_height.visible = self.land_width.visible = shape == "land"
+        self.wave_amplitude.visible = self.wave_length.visible = shape == "wavy"
+        if shape == "custom":
+            source = p.custom_label or "a file"
+            self.shape_note.object = (f"Custom shape from {html.escape(source)}." if p.custom
+                                      is not None else "Upload a CSV table below.")
+        else:
+            self.shape_note.object = ""
+        self.shape_note.visible = bool(self.shape_note.object)
+        self.shape_file.visible = True
+
+    def _refresh_layers(self) -> None:
+        n = self.state.n_layers
+        shown = min(n, SCREEN_LAYERS)
+        options = [str(k + 1) for k in range(shown)]
+        if self.layer.value not in options:
+            self.layer.value = options[-1]
+        self.layer.options = options
+        self.n_layers.value = shown
+        self.layer_note.object = (f"This scene has {n} layers; the screen edits the first "
+                                  f"{SCREEN_LAYERS}." if n > SCREEN_LAYERS else "")
+        self.layer_note.visible = bool(self.layer_note.object)
+        self._bind_layer()
+
+    def _bind_layer(self) -> None:
+        k = int(self.layer.value) - 1
+        layer = self.state.layers[k]
+        a = self.state.punch.half_width
+        self.thickness_editor.bind(layer.thickness, a)
+        self.modulus_editor.bind(layer.modulus, a)
+        self.poisson_editor.bind(layer.poisson, a)
+
+    def _refresh_base(self) -> None:
+        model = self.state.base.creep_model
+        creeps = model in ("exponential", "arutyunyan")
+        self.compliance.visible = self.rate.visible = creeps
+        self.beta.visible = self.alpha.visible = self.aging.visible = model == "arutyunyan"
+        self.base_modulus.label = ("final Young's modulus E∞ [GPa]" if model == "arutyunyan"
+                                   else "Young's modulus E [GPa]")
+        self.base_modulus.visible = model != "custom"
+        self.creep_note.object = ("A creep model from a file (kept as it is); choose another "
+                                  "model to replace it." if model == "custom" else "")
+        self.creep_note.visible = model == "custom"
+
+    def _refresh_tol(self) -> None:
+        options = {f"{v:g}": v for v in self.state.param.tol.objects}
+        if options != self.tol.options:
+            self.tol.options = options
+        self.tol.value = self.state.tol
+
+    def _on_statement(self, *events: Any) -> None:
+        loading = self.state.loading
+        if self.statement.value != loading.statement:
+            self.statement.value = loading.statement
+        for editor, q in zip(self.history_editors, loading.given, strict=True):
+            editor.bind(loading.histories[q], self.state.time_end)
+        unknowns = " and ".join(NAMES[q] for q in loading.unknowns)
+        self.unknowns_note.object = f"Computed: <b>{unknowns}</b> (and the pressure)."
+
+    # -- events ----------------------------------------------------------------------
+    def _reject(self, message: str) -> None:
+        self.notice = f"Value not accepted: {message}"
+
+    def _on_revision(self, event: Any) -> None:
+        self.controller.request()
+
+    def _on_preset(self, event: Any) -> None:
+        key = event.new
+        self.preset_description.object = self._preset_text()
+        if not key or key not in self.presets:
+            return
+        self.load_scene(self.presets[key])
+
+    def load_scene(self, scene: dict[str, Any]) -> bool:
+        """Validate a scene dict with the core and show it; False (and a notice) if bad."""
+        from core import scene_from_dict
+
+        try:
+            scene_from_dict(scene)
+            self.state.load_scene(scene)
+        except ValueError as exc:
+            self.notice = f"The scene was not loaded: {format_error(str(exc))}"
+            return False
+        self.notice = ""
+        return True
+
+    def _on_scene_file(self, event: Any) -> None:
+        data = event.new
+        if not data:
+            return
+        try:
+            scene = json.loads(data.decode("utf-8-sig") if isinstance(data, bytes) else data)
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            self.notice = f"The file {self.load_file.filename!r} is not valid JSON: {exc}"
+            return
+        if not isinstance(scene, dict):
+            self.notice = "The file does not hold a scene (a JSON object)."
+            return
+        if self.load_scene(scene):
+            self.preset.value = ""
+
+    def _on_shape_file(self, event: Any) -> None:
+        data = event.new
+        if not data:
+            return
+        from core.profiles import profile_from_csv
+
+        a = self.state.punch.half_width
+        try:
+            profile = profile_from_csv(data, field="punch.shape", variable="x",
+                                       domain=(-a, a))
+        except ValueError as exc:
+            self.notice = f"The shape table was not used: {format_error(str(exc))}"
+            return
+        self.notice = ""
+        self.state.punch.param.update(custom=profile.spec, shape="custom",
+                                      custom_label=self.shape_file.filename or "a CSV file")
+
+    def _on_notice(self, event: Any) -> None:
+        self.notice_alert.object = self.notice
+        self.notice_alert.visible = bool(self.notice)
+
+    def _on_status(self, *events: Any) -> None:
+        error = self.controller.error
+        self.alert.object = (f"**Not solved:** {error}  \nThe plots still show the last good "
+                             "result." if error else "")
+        self.alert.visible = bool(error)
+        self.spinner.value = self.controller.busy
+        self.status.object = status_html(self.controller.view, self.controller.busy)
+
+    def _on_load(self) -> None:
+        self._connected = True
+        if self.controller.view is not None and self.controller.view is not self._drawn:
+            self._on_view(None)
+
+    def _on_view(self, event: Any) -> None:
+        view = self.controller.view
+        if view is None or not (self._connected or self._initializing):
+            return
+        n = len(view.times)
+        old = self._drawn
+        if old is None or len(old.times) != n:
+            index = n - 1
+        else:
+            index = min(self.time_index, n - 1)
+        self._drawn = view
+        with pn.io.hold():
+            self.figures.show(view, index, self.pinned)
+            self.player.param.update(end=max(n - 1, 1), value=index)
+            with param.discard_events(self):
+                self.time_index = index
+            self._show_time_texts(view, index)
+            self.status.object = status_html(view, self.controller.busy)
+            self.scene_badges.object = badges_html(view, "scene")
+            self.pressure_badges.object = badges_html(view, "pressure")
+            self.history_badges.object = badges_html(view, "history")
+            self.status_badges.object = badges_html(view, "status")
+            slug = _slug(view.scene.get("name", "scene"))
+            self.save_scene.filename = f"{slug}.json"
+            self.csv_download.filename = f"{slug}_results.csv"
+            self.pressure_download.filename = f"{slug}_pressure.csv"
+            self.json_download.filename = f"{slug}_results.json"
+        self._push()
+        if self._location is not None and not self.controller.busy:
+            try:
+                self._location.update_query(scene=encode_scene(view.scene))
+            except Exception:  # the link is a convenience; the page must not fail for it
+                log.exception("could not update the link")
+
+    def _on_time(self, event: Any) -> None:
+        view = self._drawn
+        if view is None:
+            return
+        index = min(max(int(event.new), 0), len(view.times) - 1)
+        with pn.io.hold():
+            self.figures.show_time(view, index, self.pinned)
+            self._show_time_texts(view, index)
+        self._push()
+
+    def _show_time_texts(self, view: ResultView, index: int) -> None:
+        self.time_label.object = (f"<span class='time-label'>t = "
+                                  f"{float(view.times[index]):.4g} days</span>")
+        self.readout.object = readout_html(view, index, self.pinned)
+
+    def pin(self) -> None:
+        """Keep the result on screen for comparison with the next ones."""
+        self.pinned = self._drawn
+        self.unpin_button.disabled = self.pinned is None
+        self._redraw_pin()
+
+    def unpin(self) -> None:
+        self.pinned = None
+        self.unpin_button.disabled = True
+        self._redraw_pin()
+
+    def _redraw_pin(self) -> None:
+        view = self._drawn
+        if view is None:
+            return
+        with pn.io.hold():
+            self.figures.show_pinned(view, self.pinned, self.time_index)
+            self._show_time_texts(view, self.time_index)
+        self._push()
+
+    def _push(self) -> None:
+        """In a notebook, plain Bokeh models changed in place must be pushed by hand."""
+        if not self._served and self._bokeh_panes:
+            pn.io.push_notebook(*self._bokeh_panes)
+
+    # -- files -------------------------------------------------------------------------
+    def _shown(self) -> ResultView | None:
+        return self._drawn
+
+    def _scene_file(self) -> io.StringIO:
+        view = self._shown()
+        scene = view.scene if view is not None else self.state.to_scene()
+        return io.StringIO(json.dumps(scene, indent=2) + "\n")
+
+    def _csv_file(self) -> io.StringIO:
+        view = self._shown()
+        return io.StringIO(view.solution.to_csv() if view is not None else "")
+
+    def _pressure_file(self) -> io.StringIO:
+        view = self._shown()
+        return io.StringIO(view.solution.pressure_csv() if view is not None else "")
+
+    def _json_file(self) -> io.StringIO:
+        view = self._shown()
+        return io.StringIO(view.solution.to_json() if view is not None else "{}")
+
+
+def warm_up(keys: tuple[str, ...] = (DEFAULT_PRESET,)) -> None:
+    """Solve some presets now, so that the first visitors find them in the caches."""
+    available = presets()
+    for key in keys:
+        scene = available.get(key)
+        if scene is None:
+            continue
+        state = ExplorerState()
+        state.load_scene(scene)
+        SolveController(state, executor=None, auto=False).solve_now()
+
+
+def _query_from_session() -> dict[str, str]:
+    """The page's query arguments (first value of each, as text)."""
+    out: dict[str, str] = {}
+    for key, values in (pn.state.session_args or {}).items():
+        if values:
+            raw = values[0]
+            out[key] = raw.decode("utf-8", "replace") if isinstance(raw, bytes) else str(raw)
+    return out
+
+
+def create_app(**kwargs: Any) -> ExplorerApp:
+    """A new explorer session (serve this factory so each browser gets its own state).
+
+    Served, it solves on a shared thread pool; inline in a notebook (no server session)
+    it solves in the kernel, each change when it happens.
+    """
+    pn.extension(notifications=False)
+    served = bool(pn.state.curdoc is not None and pn.state.curdoc.session_context)
+    kwargs.setdefault("executor", "shared" if served else None)
+    if "query" not in kwargs:
+        kwargs["query"] = _query_from_session()
+    return ExplorerApp(**kwargs)

@@ -1,0 +1,256 @@
+"""Solving off the UI thread: requests, coalescing, stale results and error messages.
+
+A :class:`SolveController` watches an :class:`~explorer.state.ExplorerState`. Every
+change asks for a solve. At most one solve per session runs at a time; requests made
+meanwhile collapse into one pending request (the newest), so a slider dragged through
+twenty values costs a handful of solves, not twenty. An outcome is shown only if no
+newer outcome has been shown already, so a slow old solve can never overwrite a newer
+answer. A rejected scene sets ``error`` (the core's message, naming the field) and leaves
+``view`` (the last good result) on screen.
+
+Nothing here imports Panel: ``dispatch`` is how outcomes get back to the UI (the app
+passes one that schedules on its Bokeh document); the default applies them at once.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import threading
+from collections import OrderedDict
+from collections.abc import Callable
+from concurrent.futures import Executor, ThreadPoolExecutor
+from dataclasses import replace
+from typing import Any
+
+import param
+
+from .results import ResultView, prepare_view
+from .state import ExplorerState
+
+log = logging.getLogger(__name__)
+
+# Shared by all sessions: solves are numpy-heavy and release the GIL only in part, so a
+# few workers suffice and bound the load a crowd of sessions can put on the machine.
+_POOL: ThreadPoolExecutor | None = None
+_POOL_LOCK = threading.Lock()
+
+
+def shared_pool(max_workers: int = 4) -> ThreadPoolExecutor:
+    """The process-wide thread pool the explorer solves on."""
+    global _POOL
+    with _POOL_LOCK:
+        if _POOL is None:
+            _POOL = ThreadPoolExecutor(max_workers=max_workers, thread_name_prefix="solve")
+        return _POOL
+
+
+def _default_solve(scene: dict[str, Any]) -> Any:
+    from core import solve
+
+    return solve(scene)
+
+
+class _ResultCache:
+    """Process-wide LRU of prepared results of the core solver, keyed by the scene JSON.
+
+    A new session opening a preset, or a slider going back to an earlier value, then
+    costs nothing. Views are never modified after they are made, so sessions share them.
+    """
+
+    def __init__(self, max_items: int = 24) -> None:
+        self.max_items = max_items
+        self._data: OrderedDict[str, ResultView] = OrderedDict()
+        self._lock = threading.Lock()
+
+    @staticmethod
+    def key(scene: dict[str, Any]) -> str | None:
+        try:
+            return json.dumps(scene, sort_keys=True, separators=(",", ":"), allow_nan=False)
+        except (TypeError, ValueError):
+            return None
+
+    def get(self, key: str | None) -> ResultView | None:
+        if key is None:
+            return None
+        with self._lock:
+            view = self._data.get(key)
+            if view is not None:
+                self._data.move_to_end(key)
+            return view
+
+    def put(self, key: str | None, view: ResultView) -> None:
+        if key is None:
+            return
+        with self._lock:
+            self._data[key] = view
+            self._data.move_to_end(key)
+            while len(self._data) > self.max_items:
+                self._data.popitem(last=False)
+
+    def clear(self) -> None:
+        with self._lock:
+            self._data.clear()
+
+
+RESULTS = _ResultCache()
+
+
+#: Translation of the first part of a core field path into words on screen.
+_FIELD_WORDS = {
+    "punch": "Punch",
+    "coating": "Coating",
+    "base": "Base",
+    "loading": "Loading",
+    "times": "Time span",
+    "solver": "Solver",
+}
+
+
+def describe_field(path: str) -> str:
+    """A field path of the core (``coating[1].thickness``) in words (``Coating layer 2,
+    thickness``); unknown paths come back unchanged."""
+    head, _, rest = path.partition(".")
+    if head.startswith("coating[") and head.endswith("]"):
+        try:
+            index = int(head[len("coating["):-1])
+        except ValueError:
+            return path
+        words = f"Coating layer {index + 1}"
+    elif head in _FIELD_WORDS:
+        words = _FIELD_WORDS[head]
+    else:
+        return path
+    return f"{words}, {rest.replace('.', ', ').replace('_', ' ')}" if rest else words
+
+
+def format_error(message: str) -> str:
+    """The core's ``"field.path: reason"`` message with the field also named in words."""
+    path, sep, reason = message.partition(":")
+    if not sep or " " in path.strip():
+        return message
+    words = describe_field(path.strip())
+    if words == path.strip():
+        return message
+    return f"{words} ({path.strip()}):{reason}"
+
+
+class SolveController(param.Parameterized):
+    """Turns state changes into solves and solves into a displayed :class:`ResultView`."""
+
+    view = param.ClassSelector(class_=ResultView, default=None, allow_None=True,
+                               doc="The result on screen (the last good one).")
+    error = param.String(default="", doc="Why the newest request was not solved ('' if ok).")
+    busy = param.Boolean(default=False, doc="A newer request than the one shown is running.")
+    requests = param.Integer(default=0, doc="Requests made.")
+    solves = param.Integer(default=0, doc="Outcomes delivered (results and errors).")
+
+    def __init__(self, state: ExplorerState,
+                 solve: Callable[[dict[str, Any]], Any] | None = None,
+                 executor: Executor | None | str = "shared",
+                 dispatch: Callable[[Callable[[], None]], None] | None = None,
+                 auto: bool = True, **params: Any) -> None:
+        """``executor``: ``"shared"`` (the process pool), an Executor, or None to solve
+        synchronously in the caller (tests, scripts). ``auto``: solve on every change."""
+        super().__init__(**params)
+        self.state = state
+        self._solve = solve or _default_solve
+        self._executor = shared_pool() if executor == "shared" else executor
+        self._dispatch = dispatch or (lambda callback: callback())
+        self._lock = threading.Lock()
+        self._latest = 0          # id of the newest request
+        self._shown = 0           # id of the newest outcome shown
+        self._running = False
+        self._pending: tuple[int, dict[str, Any]] | None = None
+        if auto:
+            state.param.watch(lambda event: self.request(), "revision")
+
+    # -- requests --------------------------------------------------------------------
+    def request(self) -> int:
+        """Ask for a solve of the current state; returns the request id."""
+        with self._lock:
+            self._latest += 1
+            rid = self._latest
+        self.requests = rid
+        scene = self.state.to_scene()
+        if self._executor is None:
+            self._deliver(rid, self._compute(scene))
+            return rid
+        self.busy = True
+        with self._lock:
+            if self._running:
+                self._pending = (rid, scene)
+                return rid
+            self._running = True
+        self._executor.submit(self._work, rid, scene)
+        return rid
+
+    def start(self) -> int:
+        """First request of a session: shown at once when the result is already known
+        (the page then arrives with its plots), else solved in the background."""
+        scene = self.state.to_scene()
+        if self._executor is None or (self._solve is _default_solve
+                                      and RESULTS.get(RESULTS.key(scene)) is not None):
+            return self.solve_now()
+        return self.request()
+
+    def solve_now(self) -> int:
+        """Solve the current state in the caller and show the outcome (first paint)."""
+        with self._lock:
+            self._latest += 1
+            rid = self._latest
+        self.requests = rid
+        self._deliver(rid, self._compute(self.state.to_scene()))
+        return rid
+
+    def _work(self, rid: int, scene: dict[str, Any]) -> None:
+        while True:
+            outcome = self._compute(scene)
+            self._dispatch(lambda rid=rid, outcome=outcome: self._deliver(rid, outcome))
+            with self._lock:
+                if self._pending is None:
+                    self._running = False
+                    return
+                rid, scene = self._pending
+                self._pending = None
+
+    def _compute(self, scene: dict[str, Any]) -> ResultView | str:
+        shared = self._solve is _default_solve
+        key = RESULTS.key(scene) if shared else None
+        cached = RESULTS.get(key)
+        if cached is not None:
+            return replace(cached, info={**cached.info, "reused": True})
+        try:
+            solution = self._solve(scene)
+            view = prepare_view(solution, scene)
+            if shared:
+                RESULTS.put(key, view)
+            return view
+        except ValueError as exc:
+            return format_error(str(exc))
+        except Exception as exc:  # the session must survive any failure of a solve
+            log.exception("solve failed")
+            return f"The solver failed on this scene ({type(exc).__name__}: {exc})."
+
+    def _deliver(self, rid: int, outcome: ResultView | str) -> None:
+        if rid < self._shown:
+            return
+        self._shown = rid
+        with self._lock:
+            latest = self._latest
+        if isinstance(outcome, str):
+            self.param.update(error=outcome, busy=rid < latest, solves=self.solves + 1)
+        else:
+            self.param.update(view=outcome, error="", busy=rid < latest,
+                              solves=self.solves + 1)
+
+    def wait(self, timeout: float = 60.0) -> bool:
+        """Block until the newest request has been delivered (for scripts and tests)."""
+        import time
+
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self._shown >= self._latest and not self._running:
+                return True
+            time.sleep(0.005)
+        return False

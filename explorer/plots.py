@@ -1,0 +1,331 @@
+"""Bokeh figures of the explorer, built once and updated in place.
+
+Every figure is created once per session; a new result or a new time only replaces the
+``data`` of ``ColumnDataSource`` objects and a few properties (titles, axis labels,
+span locations). Rebuilding figures would cost a full re-render in the browser and lose
+the user's zoom. Nothing here imports Panel.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+from bokeh.models import (
+    Arrow,
+    ColorBar,
+    ColumnDataSource,
+    HoverTool,
+    Label,
+    LinearColorMapper,
+    LogColorMapper,
+    NormalHead,
+    Range1d,
+    Span,
+)
+from bokeh.palettes import Viridis256
+from bokeh.plotting import figure
+
+from .results import ResultView, negative_intervals
+from .state import QUANTITIES, QUANTITY_UNITS
+
+SYMBOLS = {"settlement": "δ", "tilt": "α", "force": "P", "moment": "M"}
+TITLES = {"settlement": "Settlement", "tilt": "Tilt", "force": "Force", "moment": "Moment"}
+UNKNOWN_COLOR = "#1f77b4"
+GIVEN_COLOR = "#8c8c8c"
+PINNED_COLOR = "#d62728"
+
+# Number of slabs each coating layer is drawn with (its colour follows E(x)).
+_SLABS = 120
+
+_TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
+
+
+def _nice(value: float) -> float:
+    """The largest of 1, 2, 5 times a power of ten not above ``value`` (at least 1)."""
+    if not np.isfinite(value) or value <= 1:
+        return 1.0
+    power = 10 ** math.floor(math.log10(value))
+    for step in (5, 2, 1):
+        if step * power <= value:
+            return float(step * power)
+    return float(power)
+
+
+def _empty(*columns: str) -> dict[str, list]:
+    return {c: [] for c in columns}
+
+
+class Figures:
+    """All figures of one session and the sources behind them."""
+
+    def __init__(self) -> None:
+        self.modulus_mapper = LogColorMapper(palette=Viridis256, low=1.0, high=1e5)
+        self._build_scene()
+        self._build_pressure()
+        self._build_image()
+        self._build_histories()
+
+    # -- construction ----------------------------------------------------------------
+    def _build_scene(self) -> None:
+        p = figure(height=300, sizing_mode="stretch_width", tools=_TOOLS,
+                   x_range=Range1d(-1.5, 1.5), y_range=Range1d(-1.5, 1.0),
+                   title="Scene", toolbar_location="above", name="scene_figure")
+        p.toolbar.autohide = True
+        p.xaxis.axis_label = "x [m]"
+        p.yaxis.axis_label = "y [m] (coating and punch profile exaggerated)"
+        self.base_src = ColumnDataSource(_empty("left", "right", "bottom", "top", "E"),
+                                         name="base_source")
+        self.layer_src = ColumnDataSource(
+            _empty("left", "right", "bottom", "top", "E", "layer", "h_mm"),
+            name="layer_source")
+        self.punch_src = ColumnDataSource(_empty("x", "y"), name="punch_source")
+        self.cut_src = ColumnDataSource(_empty("x", "y"), name="cut_source")
+        fill = {"field": "E", "transform": self.modulus_mapper}
+        p.quad(left="left", right="right", bottom="bottom", top="top", source=self.base_src,
+               fill_color=fill, line_color=None, fill_alpha=0.55)
+        layers = p.quad(left="left", right="right", bottom="bottom", top="top",
+                        source=self.layer_src, fill_color=fill, line_color=fill)
+        p.patch(x="x", y="y", source=self.punch_src, fill_color="#b0b7c3", line_color="#333",
+                line_width=1.5)
+        p.line(x="x", y="y", source=self.cut_src, line_dash="dashed", line_color="#333")
+        p.add_tools(HoverTool(renderers=[layers], tooltips=[
+            ("layer", "@layer"), ("thickness", "@h_mm{0.00} mm"), ("E", "@E{0.0} MPa")]))
+        self.arrow = Arrow(end=NormalHead(size=12, fill_color="#d62728", line_color="#d62728"),
+                           x_start=0, y_start=1, x_end=0, y_end=0.5, line_width=3,
+                           line_color="#d62728", visible=False)
+        p.add_layout(self.arrow)
+        self.arrow_label = Label(x=0, y=0, text="", text_font_size="11px",
+                                 text_color="#d62728", x_offset=6)
+        p.add_layout(self.arrow_label)
+        self.base_label = Label(x=0, y=0, text="", text_font_size="11px", text_color="#333",
+                                x_offset=4, y_offset=4)
+        p.add_layout(self.base_label)
+        p.add_layout(ColorBar(color_mapper=self.modulus_mapper, title="E [MPa]", width=8),
+                     "right")
+        self.scene_fig = p
+
+    def _build_pressure(self) -> None:
+        p = figure(height=280, sizing_mode="stretch_width", tools=_TOOLS,
+                   title="Contact pressure q(x)", toolbar_location="above",
+                   name="pressure_figure")
+        p.toolbar.autohide = True
+        p.xaxis.axis_label = "x [m]"
+        p.yaxis.axis_label = "q [kPa]"
+        # one point until the first result, so the auto ranges have something to fit
+        self.q_src = ColumnDataSource({"x": [0.0], "q": [0.0]}, name="q_source")
+        self.q_pin_src = ColumnDataSource(_empty("x", "q"), name="q_pin_source")
+        self.neg_src = ColumnDataSource(_empty("left", "right"), name="negative_source")
+        p.vstrip(x0="left", x1="right", source=self.neg_src, fill_color="#d62728",
+                 fill_alpha=0.18, line_color=None, legend_label="q < 0 (contact lost)")
+        p.add_layout(Span(location=0, dimension="width", line_color="#555", line_width=1))
+        self.q_pin_line = p.line(x="x", y="q", source=self.q_pin_src, line_color=PINNED_COLOR,
+                                 line_dash="dashed", line_width=2, legend_label="pinned")
+        line = p.line(x="x", y="q", source=self.q_src, line_color=UNKNOWN_COLOR, line_width=2.5,
+                      legend_label="current")
+        p.add_tools(HoverTool(renderers=[line], tooltips=[("x", "@x{0.000} m"), ("q", "@q")],
+                              mode="vline"))
+        legend = p.legend[0]
+        legend.orientation = "horizontal"
+        legend.click_policy = "hide"
+        legend.margin = 0
+        legend.padding = 2
+        p.add_layout(legend, "above")
+        self.q_fig = p
+
+    def _build_image(self) -> None:
+        p = figure(height=280, sizing_mode="stretch_width", tools=_TOOLS,
+                   title="q(x, t)", toolbar_location="above", name="image_figure",
+                   x_range=Range1d(-1, 1), y_range=Range1d(0, 1))
+        p.toolbar.autohide = True
+        p.xaxis.axis_label = "x [m]"
+        p.yaxis.axis_label = "t [days after loading]"
+        self.image_mapper = LinearColorMapper(palette=Viridis256, low=0, high=1)
+        self.image_src = ColumnDataSource(_empty("image", "x", "y", "dw", "dh"),
+                                          name="image_source")
+        p.image(image="image", x="x", y="y", dw="dw", dh="dh", source=self.image_src,
+                color_mapper=self.image_mapper)
+        self.image_bar = ColorBar(color_mapper=self.image_mapper, title="q [kPa]", width=8)
+        p.add_layout(self.image_bar, "right")
+        self.image_cursor = Span(location=0, dimension="width", line_color="white",
+                                 line_width=2, line_dash="dashed")
+        p.add_layout(self.image_cursor)
+        self.image_fig = p
+
+    def _build_histories(self) -> None:
+        self.history_src: dict[str, ColumnDataSource] = {}
+        self.history_pin_src: dict[str, ColumnDataSource] = {}
+        self.history_point_src: dict[str, ColumnDataSource] = {}
+        self.history_fig = {}
+        self.history_line = {}
+        self.history_cursor = {}
+        shared_x = None
+        for q in QUANTITIES:
+            unit = QUANTITY_UNITS[q][0]
+            kwargs = {"x_range": shared_x} if shared_x is not None else {}
+            p = figure(height=210, sizing_mode="stretch_width", tools=_TOOLS,
+                       toolbar_location="above", name=f"{q}_figure",
+                       title=f"{TITLES[q]} {SYMBOLS[q]} [{unit}]", **kwargs)
+            shared_x = p.x_range
+            p.toolbar.autohide = True
+            p.xaxis.axis_label = "t [days after loading]"
+            p.yaxis.axis_label = f"{SYMBOLS[q]} [{unit}]"
+            src = ColumnDataSource({"t": [0.0], "v": [0.0]}, name=f"{q}_source")
+            pin = ColumnDataSource(_empty("t", "v"), name=f"{q}_pin_source")
+            point = ColumnDataSource(_empty("t", "v"), name=f"{q}_point_source")
+            p.line(x="t", y="v", source=pin, line_color=PINNED_COLOR, line_dash="dashed",
+                   line_width=2)
+            line = p.line(x="t", y="v", source=src, line_color=UNKNOWN_COLOR, line_width=2.5)
+            p.scatter(x="t", y="v", source=point, size=8, color="#d62728")
+            p.add_tools(HoverTool(renderers=[line], mode="vline",
+                                  tooltips=[("t", "@t{0.0} d"), (SYMBOLS[q], "@v")]))
+            cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted")
+            p.add_layout(cursor)
+            self.history_src[q], self.history_pin_src[q] = src, pin
+            self.history_point_src[q] = point
+            self.history_fig[q], self.history_line[q] = p, line
+            self.history_cursor[q] = cursor
+
+    # -- updates ---------------------------------------------------------------------
+    def show(self, view: ResultView, index: int, pinned: ResultView | None) -> None:
+        """Draw a new result (call inside ``pn.io.hold`` to send one message)."""
+        # A change of the loads leaves the drawing as it is: do not send it again.
+        key = json.dumps([view.scene.get(k) for k in ("name", "punch", "coating", "base")],
+                         sort_keys=True, default=str)
+        if key != self._scene_key:
+            self._show_scene(view)
+            self._scene_key = key
+        self._show_image(view)
+        for q in QUANTITIES:
+            given = q in view.given
+            self.history_src[q].data = {"t": view.times, "v": view.display(q)}
+            self.history_line[q].glyph.line_color = GIVEN_COLOR if given else UNKNOWN_COLOR
+            state = "given" if given else "computed"
+            unit = QUANTITY_UNITS[q][0]
+            self.history_fig[q].title.text = f"{TITLES[q]} {SYMBOLS[q]} [{unit}]: {state}"
+        self.show_pinned(view, pinned, index)
+        self.show_time(view, index, pinned)
+
+    def show_pinned(self, view: ResultView, pinned: ResultView | None, index: int) -> None:
+        """Overlay (or clear) a pinned result on the histories."""
+        for q in QUANTITIES:
+            if pinned is None:
+                self.history_pin_src[q].data = {"t": [], "v": []}
+            else:
+                self.history_pin_src[q].data = {"t": pinned.times, "v": pinned.display(q)}
+        self._show_pinned_pressure(view, pinned, index)
+
+    def _show_pinned_pressure(self, view: ResultView, pinned: ResultView | None,
+                              index: int) -> None:
+        if pinned is None:
+            self.q_pin_src.data = {"x": [], "q": []}
+            return
+        unit, size = view.pressure_unit
+        j = pinned.time_index(float(view.times[index]))
+        self.q_pin_src.data = {"x": pinned.x, "q": pinned.pressure[:, j] / size}
+
+    def show_time(self, view: ResultView, index: int, pinned: ResultView | None) -> None:
+        """Move every time cursor to output ``index`` (no solve)."""
+        unit, size = view.pressure_unit
+        t = float(view.times[index])
+        q = view.pressure[:, index]
+        self.q_src.data = {"x": view.x, "q": q / size}
+        intervals = negative_intervals(view.x, q)
+        self.neg_src.data = {"left": [lo for lo, _ in intervals],
+                             "right": [hi for _, hi in intervals]}
+        self.q_fig.title.text = f"Contact pressure q(x) at t = {t:.4g} days"
+        self.q_fig.yaxis.axis_label = f"q [{unit}]"
+        self._show_pinned_pressure(view, pinned, index)
+        self.image_cursor.location = t
+        for name in QUANTITIES:
+            self.history_cursor[name].location = t
+            self.history_point_src[name].data = {"t": [t], "v": [view.display(name)[index]]}
+        self._show_arrow(view, index)
+
+    def _show_arrow(self, view: ResultView, index: int) -> None:
+        g = view.geometry
+        force = float(view.values["force"][index])
+        moment = float(view.values["moment"][index])
+        top = self._punch_top
+        if force > 0 and np.isfinite(moment):
+            e = moment / force
+            inside = abs(e) <= 1.45 * g.half_width
+            xe = float(np.clip(e, -1.45 * g.half_width, 1.45 * g.half_width))
+            self.arrow.update(x_start=xe, x_end=xe, y_start=top + 0.45 * g.half_width,
+                              y_end=top + 0.02 * g.half_width, visible=True)
+            where = f"e = M/P = {e:.3g} m" + ("" if inside else " (off the drawing)")
+            self.arrow_label.update(x=xe, y=top + 0.3 * g.half_width,
+                                    text=f"P = {force / 1e3:.4g} kN/m, {where}")
+        else:
+            self.arrow.visible = False
+            self.arrow_label.update(x=-g.half_width, y=top + 0.3 * g.half_width,
+                                    text=f"P = {force / 1e3:.4g} kN/m (no compressive load)")
+
+    def _show_scene(self, view: ResultView) -> None:
+        g = view.geometry
+        a = g.half_width
+        depth = min(g.base_thickness, 1.2 * a)
+        total = np.sum(g.thickness, axis=0)
+        t_max = float(np.max(total)) if total.size else 0.0
+        scale = _nice(0.15 * depth / t_max) if t_max > 0 else 1.0
+        # slabs: boundaries and values at the centres, interpolated from the fine grid
+        edges = np.linspace(-a, a, _SLABS + 1)
+        centres = 0.5 * (edges[1:] + edges[:-1])
+        bottom = np.zeros(_SLABS)
+        cols: dict[str, list] = {k: [] for k in ("left", "right", "bottom", "top", "E",
+                                                 "layer", "h_mm")}
+        # layer 1 is drawn on top, in contact with the punch
+        for k in reversed(range(len(g.thickness))):
+            h = np.interp(centres, g.x, g.thickness[k])
+            e = np.interp(centres, g.x, g.modulus[k])
+            top = bottom + scale * h
+            cols["left"].extend(edges[:-1])
+            cols["right"].extend(edges[1:])
+            cols["bottom"].extend(bottom)
+            cols["top"].extend(top)
+            cols["E"].extend(e / 1e6)
+            cols["layer"].extend([k + 1] * _SLABS)
+            cols["h_mm"].extend(h * 1e3)
+            bottom = top
+        self.layer_src.data = cols
+        self.base_src.data = {"left": [-1.5 * a], "right": [1.5 * a], "bottom": [-depth],
+                              "top": [0.0], "E": [g.base_modulus / 1e6]}
+        if g.base_thickness > depth:
+            self.cut_src.data = {"x": [-1.5 * a, 1.5 * a], "y": [-depth, -depth]}
+            self.base_label.update(x=-1.5 * a, y=-depth,
+                                   text=f"base continues to H = {g.base_thickness:.3g} m")
+        else:
+            self.cut_src.data = {"x": [], "y": []}
+            self.base_label.update(x=-1.5 * a, y=-depth,
+                                   text=f"base H = {g.base_thickness:.3g} m on rigid ground")
+        lift = float(np.min(g.shape - total))
+        bottom_y = scale * (g.shape - lift)
+        punch_top = float(np.max(bottom_y)) + 0.35 * a
+        self._punch_top = punch_top
+        self.punch_src.data = {"x": np.concatenate([g.x, [a, -a]]),
+                               "y": np.concatenate([bottom_y, [punch_top, punch_top]])}
+        self.scene_fig.x_range.update(start=-1.55 * a, end=1.55 * a)
+        self.scene_fig.y_range.update(start=-1.08 * depth, end=punch_top + 0.55 * a)
+        note = f"coating and punch profile drawn ×{scale:g} vertically" if scale > 1 else \
+            "drawn to scale"
+        self.scene_fig.title.text = f"Scene: {view.scene.get('name', '')} ({note})"
+
+    def _show_image(self, view: ResultView) -> None:
+        unit, size = view.pressure_unit
+        a = view.geometry.half_width
+        t0, t1 = float(view.times[0]), float(view.times[-1])
+        span = max(t1 - t0, 1e-9)
+        img = view.image / size
+        self.image_src.data = {"image": [img], "x": [-a], "y": [t0], "dw": [2 * a],
+                               "dh": [span]}
+        lo, hi = float(np.nanmin(img)), float(np.nanmax(img))
+        if hi <= lo:
+            hi = lo + 1.0
+        self.image_mapper.update(low=min(lo, 0.0), high=hi)
+        self.image_bar.title = f"q [{unit}]"
+        self.image_fig.x_range.update(start=-a, end=a)
+        self.image_fig.y_range.update(start=t0, end=t0 + span)
+
+    _punch_top = 0.0
+    _scene_key: str | None = None

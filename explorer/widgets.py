@@ -1,0 +1,267 @@
+"""Widgets bound to the state classes, in both directions, with no feedback loops.
+
+The state (``explorer.state``) is the single source of truth: a widget writes into it
+(on every drag step for loads, on release for everything costly) and follows it when
+it changes from Python (a preset, a file, a link). A :class:`Binding` can be re-pointed
+at another object of the same class, so one set of widgets edits the selected coating
+layer or whichever two loads are given.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import panel as pn
+import param
+
+from .state import QUANTITY_RANGES, HistoryState, ProfileState
+
+
+def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
+           **kwargs: Any) -> pn.widgets.EditableFloatSlider:
+    """A float slider with an input box (any value can be typed; the core validates it)."""
+    return pn.widgets.EditableFloatSlider(label=label, start=start, end=end, step=step,
+                                          format=fmt, sizing_mode="stretch_width", **kwargs)
+
+
+def fine_slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
+                **kwargs: Any) -> pn.widgets.FloatSlider:
+    """A plain slider for secondary parameters (a quarter of the cost of an editable one
+    to build and to render, which adds up over a page of them)."""
+    return pn.widgets.FloatSlider(label=label, start=start, end=end, step=step, format=fmt,
+                                  sizing_mode="stretch_width", **kwargs)
+
+
+def _set_widget(widget: pn.widgets.Widget, value: Any) -> None:
+    """Show ``value`` in ``widget`` as if the user had set it, throttled value included."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
+        start, end = getattr(widget, "start", None), getattr(widget, "end", None)
+        if start is not None and value < start:
+            widget.start = value
+        if end is not None and value > end:
+            widget.end = value
+    widget.value = value
+    # Setting ``value`` from Python leaves ``value_throttled`` stale (holoviz/panel#2675):
+    # the next release at that old value would then send no event at all. The inner
+    # widgets of a composite slider carry their own copy.
+    for part in (widget, getattr(widget, "_slider", None), getattr(widget, "_value_edit", None)):
+        if part is not None and "value_throttled" in part.param:
+            with param.edit_constant(part):
+                part.param.update(value_throttled=value)
+
+
+class Binding:
+    """Widgets editing parameters of one Parameterized at a time (re-bindable)."""
+
+    def __init__(self, on_reject: Callable[[str], None] | None = None) -> None:
+        self._pairs: list[tuple[str, pn.widgets.Widget]] = []
+        self._target: param.Parameterized | None = None
+        self._watcher: Any = None
+        self._syncing = False
+        self._on_reject = on_reject
+
+    @property
+    def target(self) -> param.Parameterized | None:
+        return self._target
+
+    def add(self, name: str, widget: pn.widgets.Widget, live: bool = False) -> Any:
+        """Edit parameter ``name`` with ``widget``; ``live`` updates while dragging,
+        otherwise on release (``value_throttled``) where the widget has it."""
+        event = "value" if live or "value_throttled" not in widget.param else "value_throttled"
+        widget.param.watch(lambda e, name=name: self._to_target(name, e.new), event)
+        self._pairs.append((name, widget))
+        return widget
+
+    def bind(self, target: param.Parameterized) -> None:
+        """Point every widget at ``target`` and show its values."""
+        if self._target is not None and self._watcher is not None:
+            self._target.param.unwatch(self._watcher)
+        self._target = target
+        self._syncing = True
+        try:
+            for name, widget in self._pairs:
+                _set_widget(widget, getattr(target, name))
+        finally:
+            self._syncing = False
+        self._watcher = target.param.watch(self._from_target,
+                                           sorted({name for name, _ in self._pairs}))
+
+    def _to_target(self, name: str, value: Any) -> None:
+        if self._syncing or self._target is None or value is None:
+            return
+        try:
+            setattr(self._target, name, value)
+        except ValueError as exc:  # a type the parameter refuses outright
+            if self._on_reject is not None:
+                self._on_reject(str(exc))
+
+    def _from_target(self, *events: param.parameterized.Event) -> None:
+        self._syncing = True
+        try:
+            for event in events:
+                for name, widget in self._pairs:
+                    if name == event.name and widget.value != event.new:
+                        _set_widget(widget, event.new)
+        finally:
+            self._syncing = False
+
+
+PROFILE_KINDS = {
+    "constant": "none",
+    "linear across the punch": "linear",
+    "step at a position": "step",
+    "patch (a band of another value)": "patch",
+    "sine (waviness)": "sine",
+    "bump (local patch)": "bump",
+    "custom (from file)": "custom",
+}
+
+
+class ProfileEditor:
+    """Level, variation kind and its parameters for one :class:`ProfileState`."""
+
+    def __init__(self, label: str, unit: str, start: float, end: float, step: float,
+                 fmt: str = "0[.]00", variations: bool = True,
+                 amplitude: tuple[str, float, float, float] = ("%", -90.0, 500.0, 1.0),
+                 css: str = "") -> None:
+        """``amplitude``: unit of the variation ('%' of the level, or an absolute unit),
+        its slider range and step. Without ``variations`` only the level is offered."""
+        self.binding = Binding()
+        self.variations = variations
+        self.mean = self.binding.add("mean", slider(f"{label} [{unit}]", start, end, step, fmt,
+                                                    css_classes=[css] if css else []))
+        self.note = pn.pane.HTML("", margin=(0, 10), visible=False,
+                                 styles={"font-size": "12px", "color": "#666"})
+        widgets: list[Any] = [self.mean]
+        if variations:
+            self.kind = self.binding.add("kind", pn.widgets.Select(
+                label=f"{label}: variation across the punch", options=PROFILE_KINDS,
+                sizing_mode="stretch_width"))
+            a_unit, a_lo, a_hi, a_step = amplitude
+            a_label = f"{a_unit} of the level" if a_unit == "%" else a_unit
+            self.amplitude = self.binding.add("amplitude", fine_slider(
+                f"variation A [{a_label}]", a_lo, a_hi, a_step, "0[.]0"))
+            self.position = self.binding.add("position", fine_slider(
+                "step position / patch or bump centre [m]", -1.0, 1.0, 0.01))
+            self.length = self.binding.add("length", fine_slider(
+                "wavelength / patch or bump width [m]", 0.02, 2.0, 0.01))
+            widgets += [self.kind, self.amplitude, self.position, self.length]
+        self.panel = pn.Column(*widgets, self.note, sizing_mode="stretch_width", margin=0)
+        self._watched: ProfileState | None = None
+        self._watcher: Any = None
+
+    def bind(self, profile: ProfileState, half_width: float) -> None:
+        if self.variations:
+            self.position.param.update(start=-half_width, end=half_width)
+            self.length.end = max(self.length.end, 2 * half_width)
+        self.binding.bind(profile)
+        if self._watched is not None and self._watcher is not None:
+            self._watched.param.unwatch(self._watcher)
+        self._watched = profile
+        self._watcher = profile.param.watch(lambda *e: self.refresh(), ["kind", "custom"])
+        self.refresh()
+
+    def refresh(self) -> None:
+        profile = self.binding.target
+        if profile is None:
+            return
+        kind = profile.kind
+        custom = kind == "custom" and profile.custom is not None
+        if self.variations:
+            self.amplitude.visible = kind in ("linear", "step", "patch", "sine", "bump")
+            self.position.visible = kind in ("step", "patch", "bump")
+            self.length.visible = kind in ("sine", "patch", "bump")
+            self.mean.visible = not custom
+            note = ("Custom profile from a file (kept as it is). Choose another variation "
+                    "to replace it." if custom else "")
+        elif custom:
+            note = "Varies across the punch (from a file); the level above is not used."
+        elif kind != "none":
+            note = "Varies across the punch (from a file) about the level above."
+        else:
+            note = ""
+        self.note.object = note
+        self.note.visible = bool(note)
+
+
+HISTORY_KINDS = {"constant": "constant", "ramp": "ramp", "step": "step", "sine": "sine",
+                 "custom (from file)": "custom"}
+
+_VALUE_LABELS = {"constant": "{q}", "ramp": "{q} at the end of the ramp",
+                 "step": "{q} before the step", "sine": "mean {q}", "custom": "{q}"}
+_SECOND_LABELS = {"ramp": "{q} at loading (ramp start)", "step": "{q} after the step",
+                  "sine": "amplitude of {q}"}
+_TIME_LABELS = {"ramp": "ramp duration [days]", "step": "time of the step [days]",
+                "sine": "period [days]"}
+NAMES = {"settlement": "settlement δ", "tilt": "tilt α", "force": "force P",
+         "moment": "moment M"}
+
+
+def _fit(widget: pn.widgets.Widget, value: float, default: tuple[float, float]) -> None:
+    """Slider range: the default one, widened to keep ``value`` well inside."""
+    lo, hi = default
+    if value > hi or value < lo:
+        span = 2 * abs(value) if value else 1.0
+        lo, hi = min(lo, -span if lo < 0 else 0.0, value), max(hi, span, value)
+    widget.param.update(start=lo, end=hi)
+
+
+class HistoryEditor:
+    """Shape and parameters of the history of one given quantity (live while dragging)."""
+
+    def __init__(self, css: str = "") -> None:
+        self.binding = Binding()
+        self.title = pn.pane.HTML("", margin=(8, 10, 0, 10))
+        self.kind = self.binding.add("kind", pn.widgets.Select(
+            label="history", options=HISTORY_KINDS, sizing_mode="stretch_width"))
+        self.value = self.binding.add("value", slider("value", 0.0, 1.0, 0.001, "0[.]0000",
+                                                      css_classes=[f"{css}-value"] if css
+                                                      else []), live=True)
+        self.second = self.binding.add("second", fine_slider("second", 0.0, 1.0, 0.001,
+                                                        "0[.]0000"), live=True)
+        self.time = self.binding.add("time", fine_slider("time [days]", 0.1, 365.0, 0.1, "0[.]0"),
+                                     live=True)
+        self.note = pn.pane.HTML("", margin=(0, 10), styles={"font-size": "12px",
+                                                              "color": "#666"})
+        self.panel = pn.Column(self.title, self.kind, self.value, self.second, self.time,
+                               self.note, sizing_mode="stretch_width", margin=0)
+        self._watched: HistoryState | None = None
+        self._watcher: Any = None
+
+    def bind(self, history: HistoryState, time_end: float) -> None:
+        q = history.quantity
+        lo, hi = QUANTITY_RANGES[q]
+        step = (hi - lo) / 1000
+        self.value.step = self.second.step = step
+        _fit(self.value, history.value, (lo, hi))
+        _fit(self.second, history.second, (min(lo, -hi) if q in ("tilt", "moment") else lo, hi))
+        self.time.end = max(time_end, history.time)
+        self.binding.bind(history)
+        if self._watched is not None and self._watcher is not None:
+            self._watched.param.unwatch(self._watcher)
+        self._watched = history
+        self._watcher = history.param.watch(lambda *e: self.refresh(), ["kind", "custom"])
+        self.refresh()
+
+    def refresh(self) -> None:
+        history = self._watched
+        if history is None:
+            return
+        q = history.quantity
+        name = NAMES[q]
+        unit = history.unit
+        kind = history.kind
+        self.title.object = f"<b>Given {name} [{unit}]</b>"
+        self.value.label = _VALUE_LABELS[kind].format(q=name) + f" [{unit}]"
+        self.second.visible = kind in _SECOND_LABELS
+        self.time.visible = kind in _TIME_LABELS
+        if kind in _SECOND_LABELS:
+            self.second.label = _SECOND_LABELS[kind].format(q=name) + f" [{unit}]"
+            self.time.label = _TIME_LABELS[kind]
+        custom = kind == "custom" and history.custom is not None
+        self.value.visible = not custom
+        self.note.object = ("Custom history from a file (kept as it is). Choose another "
+                            "shape to replace it." if custom else "")
+        self.note.visible = custom

@@ -1,0 +1,305 @@
+"""The explorer in a real browser: Debian's Chromium driven by Playwright.
+
+One server (``python -m explorer``) for the module, on a free port, and one fresh browser
+profile. Each test opens its own page (its own session). The checks read what the user
+sees: DOM text for readouts and messages, and the data of the named Bokeh sources for
+the plots (a canvas has no text to read).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
+
+playwright_api = pytest.importorskip("playwright.sync_api")
+
+ROOT = Path(__file__).resolve().parent.parent
+ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
+                 "--disable-background-networking", "--disable-component-update",
+                 "--no-first-run", "--disable-sync"]
+
+if not os.path.exists(CHROMIUM):
+    pytest.skip("Debian's chromium is not installed", allow_module_level=True)
+
+# JavaScript helpers run in the page.
+JS_DOC = "() => (window.Bokeh && Bokeh.documents && Bokeh.documents[0]) || null"
+JS_READY = """() => {
+  const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];
+  if (!doc) return false;
+  const src = doc.get_model_by_name('q_source');
+  return !!src && src.data.q && src.data.q.length > 1;
+}"""
+JS_Q = """() => Array.from(Bokeh.documents[0].get_model_by_name('q_source').data.q)"""
+JS_TITLE = """(name) => Bokeh.documents[0].get_model_by_name(name).title.text"""
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("localhost", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[str]:
+    port = _free_port()
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
+    log = tempfile.TemporaryFile()
+    proc = subprocess.Popen([sys.executable, "-m", "explorer", "--port", str(port)],
+                            cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
+    url = f"http://localhost:{port}"
+    deadline = time.monotonic() + 180  # includes solving the default scene once
+    try:
+        while True:
+            if proc.poll() is not None:
+                log.seek(0)
+                pytest.fail("the explorer server exited:\n" + log.read().decode(errors="replace"))
+            try:
+                with urllib.request.urlopen(url + "/liveness", timeout=2) as response:
+                    if response.status == 200:
+                        break
+            except OSError:
+                pass
+            if time.monotonic() > deadline:
+                pytest.fail("the explorer server did not start in time")
+            time.sleep(0.5)
+        yield url
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+        log.seek(0)
+        output = log.read().decode(errors="replace")
+        log.close()
+        assert not _app_tracebacks(output), output
+
+
+# Closing a page while the server still writes to its websocket makes tornado log a
+# "Task exception was never retrieved" traceback: that is the test closing pages, not a
+# failure of the explorer.
+_CLOSED_SOCKET = ("WebSocketClosedError", "StreamClosedError")
+
+
+def _app_tracebacks(output: str) -> list[str]:
+    blocks = output.split("Traceback (most recent call last)")[1:]
+    return [b for b in blocks if not any(name in b[:3000] for name in _CLOSED_SOCKET)]
+
+
+@pytest.fixture(scope="module")
+def browser_context() -> Iterator[object]:
+    profile = tempfile.mkdtemp(prefix="explorer-chromium-")
+    with playwright_api.sync_playwright() as p:
+        context = p.chromium.launch_persistent_context(
+            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
+            viewport={"width": 1500, "height": 1300})
+        yield context
+        context.close()
+    shutil.rmtree(profile, ignore_errors=True)
+
+
+class Page:
+    """A page of the explorer with the console watched."""
+
+    def __init__(self, context: object, url: str, path: str = "/app") -> None:
+        self.page = context.new_page()
+        self.errors: list[str] = []
+        self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+        self.page.goto(url + path)
+        self.page.wait_for_function(JS_READY, timeout=60_000)
+
+    def q(self) -> list[float]:
+        return self.page.evaluate(JS_Q)
+
+    def title(self, figure: str) -> str:
+        return self.page.evaluate(JS_TITLE, figure)
+
+    def text(self, selector: str) -> str:
+        return self.page.locator(selector).first.inner_text()
+
+    def pane_text(self, selector: str) -> str:
+        """Text of a Panel pane (its content lives in the element's shadow root)."""
+        return self.page.locator(selector).first.evaluate(
+            "e => (e.shadowRoot || e).textContent")
+
+    def wait_text_change(self, selector: str, old: str, timeout: float = 60.0) -> str:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            new = self.text(selector)
+            if new != old:
+                return new
+            time.sleep(0.05)
+        raise AssertionError(f"{selector} stayed at {old!r}")
+
+    def open_tab(self, name: str) -> None:
+        """Open a tab of the sidebar (its widgets are rendered when first opened)."""
+        self.page.locator(".bk-tab", has_text=name).first.click()
+
+    def type_into(self, css: str, value: str) -> None:
+        """Type a value in the number box of a slider and confirm it with Enter."""
+        box = self.page.locator(f"{css} input").first
+        box.click()
+        box.press("Control+a")
+        box.type(value)
+        box.press("Enter")
+
+    def close(self) -> None:
+        self.page.close()
+
+
+@pytest.fixture()
+def page(server: str, browser_context: object) -> Iterator[Page]:
+    p = Page(browser_context, server)
+    yield p
+    p.close()
+
+
+def test_page_loads_without_errors_and_screenshot(page: Page):
+    body = page.page.content()
+    assert "Traceback" not in body
+    assert page.errors == []
+    assert len(page.q()) > 100
+    assert float(page.text(".readout-settlement")) > 0
+    # the default scene: force and moment given, settlement and tilt computed
+    assert page.title("settlement_figure").endswith("computed")
+    assert page.title("force_figure").endswith("given")
+    assert "full contact" in page.text(".ok-contact_lost")
+    assert "Solved in" in page.text(".solve-status") or "reused" in page.text(".solve-status")
+    ARTIFACTS.mkdir(exist_ok=True)
+    time.sleep(0.5)  # let the canvases finish painting
+    page.page.screenshot(path=str(ARTIFACTS / "explorer.png"), full_page=True)
+    assert (ARTIFACTS / "explorer.png").stat().st_size > 20_000
+
+
+def test_moving_a_load_slider_changes_settlement_and_pressure(page: Page):
+    settlement = page.text(".readout-settlement")
+    force = page.text(".readout-force")
+    q_before = page.q()
+    handle = page.page.locator(".load-0-value .noUi-handle").first
+    box = handle.bounding_box()
+    assert box is not None
+    # drag the force slider to the right, as a user would
+    page.page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.page.mouse.down()
+    for dx in range(10, 80, 10):
+        page.page.mouse.move(box["x"] + box["width"] / 2 + dx, box["y"] + box["height"] / 2)
+        time.sleep(0.05)
+    page.page.mouse.up()
+    new_settlement = page.wait_text_change(".readout-settlement", settlement)
+    assert float(new_settlement) > float(settlement)
+    assert float(page.text(".readout-force")) > float(force)
+    page.page.wait_for_function(
+        "(old) => { const q = Bokeh.documents[0].get_model_by_name('q_source').data.q;"
+        " return q.length > 0 && Math.abs(q[Math.floor(q.length / 2)] -"
+        " old[Math.floor(old.length / 2)]) > 1e-9; }", arg=q_before, timeout=60_000)
+    assert page.errors == []
+
+
+def test_switching_the_statement_changes_the_unknowns(page: Page):
+    assert page.title("force_figure").endswith("given")
+    page.page.locator(".statement-select select").first.select_option(
+        "settlement + tilt given")
+    page.page.wait_for_function(
+        "() => Bokeh.documents[0].get_model_by_name('force_figure').title.text"
+        ".endsWith('computed')", timeout=60_000)
+    assert page.title("moment_figure").endswith("computed")
+    assert page.title("settlement_figure").endswith("given")
+    assert page.title("tilt_figure").endswith("given")
+    assert "(computed)" in page.page.locator("tr:has(.readout-force)").first.inner_text()
+    assert page.page.get_by_text("Given settlement δ").count() >= 1
+    assert page.errors == []
+
+
+def test_a_bad_value_shows_its_message_and_keeps_the_plots(page: Page):
+    q_before = page.q()
+    settlement = page.text(".readout-settlement")
+    page.open_tab("Coating")
+    page.type_into(".coating-thickness", "-2")
+    alert = page.page.locator(".solve-error").first
+    alert.wait_for(state="visible", timeout=60_000)
+    message = page.pane_text(".solve-error")
+    assert "coating[0].thickness" in message and "must be > 0" in message
+    assert page.q() == q_before
+    assert page.text(".readout-settlement") == settlement
+    # the session keeps working
+    page.type_into(".coating-thickness", "15")
+    alert.wait_for(state="hidden", timeout=60_000)
+    page.wait_text_change(".readout-settlement", settlement)
+    assert "Traceback" not in page.page.content()
+    assert page.errors == []
+
+
+def test_a_bad_link_shows_a_message_and_the_default_scene(server: str, browser_context):
+    p = Page(browser_context, server, "/app?scene=1.not-a-scene")
+    try:
+        notice = p.page.locator(".notice").first
+        notice.wait_for(state="visible", timeout=30_000)
+        text = p.pane_text(".notice")
+        assert "link" in text and "default scene" in text
+        assert len(p.q()) > 100
+    finally:
+        p.close()
+
+
+def test_pin_link_and_downloads_match_the_screen(server: str, browser_context, page: Page):
+    from explorer.links import decode_scene
+
+    settlement = page.text(".readout-settlement")
+    page.page.get_by_text("Pin this result").first.click()
+    page.page.locator(".pinned-settlement").first.wait_for(timeout=30_000)
+    assert page.page.evaluate(
+        "() => Bokeh.documents[0].get_model_by_name('q_pin_source').data.q.length") > 1
+
+    page.type_into(".load-0-value", "650")
+    new = page.wait_text_change(".readout-settlement", settlement)
+    assert page.text(".pinned-settlement") == settlement  # the pin stays as it was
+    assert page.text(".readout-force") == "650"
+
+    # the address bar holds the scene on screen
+    page.page.wait_for_function("() => window.location.search.includes('scene=1.')",
+                                timeout=30_000)
+    link = page.page.url
+    value = link.split("scene=", 1)[1].split("&", 1)[0]
+    scene = decode_scene(value)
+    assert scene["loading"]["force"] == 650e3
+
+    # downloads hold the same scene and result
+    page.open_tab("Files")
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.get_by_text("Save scene (JSON)").first.click()
+    saved = json.loads(Path(info.value.path()).read_text())
+    assert saved == scene
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.get_by_text("Results: histories (CSV)").first.click()
+    rows = Path(info.value.path()).read_text().strip().splitlines()
+    assert rows[0].startswith("time_day,settlement_m")
+    last = [float(v) for v in rows[-1].split(",")]
+    assert last[3] == 650e3
+    assert f"{last[1] * 1e3:.5g}" == new
+
+    # the link reproduces the screen in a new session
+    other = Page(browser_context, link.split("/app", 1)[0], "/app" + link.split("/app", 1)[1])
+    try:
+        assert other.text(".readout-settlement") == new
+        assert other.text(".readout-force") == "650"
+        assert other.errors == []
+    finally:
+        other.close()
+    assert page.errors == []

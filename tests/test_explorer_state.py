@@ -1,0 +1,534 @@
+"""The explorer's state and solve logic, without a server or a browser.
+
+Widget values -> scene dicts the core accepts; presets in and out of the state; the
+statement switch; bad values give a message naming the field and keep the last good
+result; a change of the load re-solves without re-evaluating any geometric stage.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import threading
+import zlib
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
+
+import numpy as np
+import param
+import pytest
+
+from core import scene_from_dict, solve
+from core.cache import stage_counts
+from explorer.controller import SolveController, describe_field, format_error
+from explorer.links import decode_scene, encode_scene
+from explorer.presets import presets
+from explorer.results import negative_intervals
+from explorer.state import (
+    CREEP_MODELS,
+    QUANTITIES,
+    STATEMENTS,
+    ExplorerState,
+    ProfileState,
+)
+
+PRESETS = presets()
+
+# Stages of the pipeline that depend on the geometry and materials only: a change of the
+# load must never evaluate them again.
+GEOMETRIC_STAGES = ("panels", "operator", "basis", "galerkin", "gap", "modes")
+
+
+def canonical(scene: dict[str, Any]) -> dict[str, Any]:
+    return scene_from_dict(scene).to_dict()
+
+
+def assert_same(a: Any, b: Any, path: str = "scene") -> None:
+    """Structural equality with floats compared to 1e-12 relative."""
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and set(a) == set(b), f"{path}: keys {set(a) ^ set(b)}"
+        for key in a:
+            assert_same(a[key], b[key], f"{path}.{key}")
+    elif isinstance(a, (list, tuple)):
+        assert isinstance(b, (list, tuple)) and len(a) == len(b), f"{path}: length"
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            assert_same(x, y, f"{path}[{i}]")
+    elif isinstance(a, float) or isinstance(b, float):
+        assert math.isclose(a, b, rel_tol=1e-12, abs_tol=1e-300), f"{path}: {a} != {b}"
+    else:
+        assert a == b, f"{path}: {a!r} != {b!r}"
+
+
+def small(state: ExplorerState) -> ExplorerState:
+    """Few output times keep the real solves of these tests quick."""
+    state.param.update(time_count=8)
+    return state
+
+
+# ------------------------------------------------------------------ state -> scene dict
+
+
+def test_default_state_is_a_valid_scene():
+    scene = ExplorerState().to_scene()
+    assert scene["schema_version"] == 1
+    built = scene_from_dict(scene)
+    assert set(built.loading) == {"force", "moment"}
+
+
+@pytest.mark.parametrize("shape", ["flat", "parabolic", "wedge", "stepped", "land", "wavy"])
+def test_every_punch_shape_gives_a_valid_scene(shape):
+    state = ExplorerState()
+    state.punch.shape = shape
+    scene = state.to_scene()
+    built = scene_from_dict(scene)
+    x = np.linspace(-1, 1, 201)
+    f = np.asarray(built.shape(x))
+    # shapes are micrometre features, not millimetres
+    assert np.all(np.abs(f) < 1e-3)
+
+
+def test_punch_shape_units():
+    state = ExplorerState()
+    p = state.punch
+    p.param.update(shape="parabolic", radius=20.0)          # km
+    assert state.to_scene()["punch"]["shape"]["coefficients"][2] == pytest.approx(2.5e-5)
+    p.param.update(shape="stepped", step_height=15.0, step_position=0.25)   # µm, m
+    assert state.to_scene()["punch"]["shape"] == {"kind": "step",
+                                                  "values": [0.0, pytest.approx(15e-6)],
+                                                  "breaks": [0.25]}
+    p.param.update(shape="wedge", slope=50.0)                # µrad
+    table = scene_from_dict(state.to_scene()).shape
+    assert float(table(np.array([1.0]))[0]) == pytest.approx(50e-6)
+
+
+@pytest.mark.parametrize("kind", ["none", "linear", "step", "patch", "sine", "bump"])
+def test_every_coating_variation_gives_a_valid_scene(kind):
+    state = ExplorerState()
+    layer = state.layers[0]
+    layer.thickness.param.update(kind=kind, mean=10.0, amplitude=20.0, position=0.2,
+                                 length=0.4)
+    layer.modulus.param.update(kind=kind, mean=500.0, amplitude=50.0, position=-0.1,
+                               length=0.3)
+    built = scene_from_dict(state.to_scene())
+    x = np.linspace(-1, 1, 401)
+    h = np.asarray(built.coating[0].thickness(x))
+    e = np.asarray(built.coating[0].modulus(x))
+    # the thickness amplitude is absolute (µm), the modulus one relative (%)
+    assert np.max(np.abs(h - 0.010)) <= 20e-6 * (1 + 1e-9)
+    assert np.max(np.abs(e - 500e6)) <= 0.5 * 500e6 * (1 + 1e-9)
+    if kind != "none":
+        assert np.ptp(h) > 0 and np.ptp(e) > 0
+
+
+@pytest.mark.parametrize("model", [m for m in CREEP_MODELS if m != "custom"])
+def test_every_creep_model_gives_a_valid_scene(model):
+    state = ExplorerState()
+    state.base.creep_model = model
+    built = scene_from_dict(state.to_scene())
+    assert built.modulus_at_loading() > 0
+
+
+@pytest.mark.parametrize("kind", ["constant", "ramp", "step", "sine"])
+@pytest.mark.parametrize("statement", list(STATEMENTS))
+def test_every_statement_and_history_gives_a_valid_scene(statement, kind):
+    state = ExplorerState()
+    state.loading.statement = statement
+    for q in QUANTITIES:
+        state.loading.histories[q].param.update(kind=kind, time=30.0)
+    scene = state.to_scene()
+    assert set(scene["loading"]) == set(STATEMENTS[statement])
+    scene_from_dict(scene)
+
+
+def test_layers_count():
+    state = ExplorerState()
+    state.n_layers = 3
+    state.layers[2].modulus.mean = 3000.0
+    scene = state.to_scene()
+    assert len(scene["coating"]) == 3
+    assert scene["coating"][2]["modulus"] == pytest.approx(3e9)
+    assert len(scene_from_dict(scene).coating) == 3
+
+
+def test_revision_counts_each_change_and_a_load_once():
+    state = ExplorerState()
+    start = state.revision
+    state.loading.histories["force"].value = 700.0
+    assert state.revision == start + 1
+    state.load_scene(PRESETS["worn_coating"])
+    assert state.revision == start + 2
+
+
+# ------------------------------------------------------------------------- presets
+
+
+def test_presets_are_there_and_described():
+    expected = {"uniform_flat", "worn_coating", "patched_insert", "rounded_graded",
+                "eccentric_creep", "stepped_punch"}
+    assert expected <= set(PRESETS)
+    for key, scene in PRESETS.items():
+        assert scene.get("name"), key
+        assert len(scene.get("description", "")) > 40, key
+
+
+@pytest.mark.parametrize("key", sorted(PRESETS))
+def test_each_preset_loads_into_the_state_and_back(key):
+    preset = PRESETS[key]
+    state = ExplorerState()
+    state.load_scene(preset)
+    assert_same(canonical(state.to_scene()), canonical(preset))
+
+
+def test_presets_use_the_on_screen_controls():
+    """The presets are meant to be edited: their profiles map onto widgets, not 'custom'."""
+    state = ExplorerState()
+    state.load_scene(PRESETS["worn_coating"])
+    thickness = state.layers[0].thickness
+    assert thickness.kind == "bump" and thickness.amplitude == pytest.approx(-20.0)  # µm
+    state.load_scene(PRESETS["patched_insert"])
+    assert state.layers[0].modulus.kind == "patch"
+    assert state.layers[0].modulus.amplitude == pytest.approx(500.0)  # % of the level
+    state.load_scene(PRESETS["stepped_punch"])
+    assert state.punch.shape == "land" and state.punch.land_height == pytest.approx(15.0)
+    state.load_scene(PRESETS["rounded_graded"])
+    assert state.punch.shape == "parabolic" and state.punch.radius == pytest.approx(20.0)
+    assert state.n_layers == 3
+
+
+def test_unknown_profiles_travel_verbatim():
+    spec = {"kind": "table", "points": [[-1.0, 0.01], [0.0, 0.012], [1.0, 0.01]],
+            "interpolation": "pchip"}
+    profile = ProfileState(scale=1e-3, amplitude_scale=1e-6)
+    profile.load_spec(spec)
+    assert profile.kind == "custom"
+    assert profile.to_spec() == spec
+    scene = ExplorerState().to_scene()
+    scene["coating"][0]["modulus"] = {"expr": "1e9 * (1 + 0.1 * x^2)"}
+    scene["times"] = [1.0, 10.0, 100.0]
+    state = ExplorerState()
+    state.load_scene(scene)
+    assert_same(canonical(state.to_scene()), canonical(scene))
+    state.time_end = 50.0  # a change of the time span replaces the explicit list
+    assert state.to_scene()["times"]["end"] == 50.0
+
+
+def test_a_scene_the_screen_cannot_show_leaves_the_state_unchanged():
+    state = ExplorerState()
+    before = state.to_scene()
+    bad = json.loads(json.dumps(before))
+    bad["loading"] = {"settlement": 0.0, "force": 1.0}
+    with pytest.raises(ValueError, match="loading"):
+        state.load_scene(bad)
+    assert state.to_scene() == before
+
+
+# -------------------------------------------------------------------- statements
+
+
+def test_statement_switch_changes_the_given_pair_and_keeps_histories():
+    state = ExplorerState()
+    state.loading.histories["force"].value = 640.0
+    state.loading.statement = "settlement + tilt given"
+    assert set(state.to_scene()["loading"]) == {"settlement", "tilt"}
+    assert state.loading.unknowns == ("force", "moment")
+    state.loading.statement = "tilt + force given"
+    loading = state.to_scene()["loading"]
+    assert set(loading) == {"tilt", "force"}
+    assert loading["force"] == pytest.approx(640e3)
+    assert state.loading.unknowns == ("settlement", "moment")
+
+
+def test_statement_switch_changes_which_quantities_the_result_computes():
+    state = small(ExplorerState())
+    controller = SolveController(state, executor=None)
+    controller.request()
+    first = controller.view
+    assert first.given == ("force", "moment")
+    settlement = first.values["settlement"][-1]
+    state.loading.statement = "settlement + tilt given"
+    view = controller.view
+    assert view is not first and view.given == ("settlement", "tilt")
+    assert set(view.unknowns) == {"force", "moment"}
+    assert view.values["settlement"][-1] == pytest.approx(
+        state.loading.histories["settlement"].value * 1e-3)
+    assert view.values["force"][-1] > 0
+    assert settlement > 0
+
+
+# ----------------------------------------------------------- bad values and errors
+
+
+def test_bad_value_gives_a_message_naming_the_field_and_keeps_the_last_result():
+    state = small(ExplorerState())
+    controller = SolveController(state, executor=None)
+    controller.request()
+    good = controller.view
+    assert good is not None and controller.error == ""
+
+    state.layers[0].thickness.mean = -5.0  # mm
+    assert "coating[0].thickness" in controller.error
+    assert "Coating layer 1" in controller.error
+    assert controller.view is good  # the plots keep the last good result
+
+    state.layers[0].thickness.mean = 12.0
+    assert controller.error == ""
+    fixed = controller.view
+    assert fixed is not good
+    state.base.poisson = 0.7
+    assert "base.poisson" in controller.error
+    assert controller.view is fixed
+
+    # the session keeps working once the values are fixed
+    state.base.poisson = 0.2
+    assert controller.error == ""
+    assert controller.view is not fixed
+    assert controller.view.scene["coating"][0]["thickness"] == pytest.approx(0.012)
+
+
+def test_solver_crash_is_a_message_not_an_exception():
+    state = small(ExplorerState())
+
+    def broken(scene):
+        raise RuntimeError("boom")
+
+    controller = SolveController(state, solve=broken, executor=None)
+    controller.request()
+    assert "boom" in controller.error and controller.view is None
+
+
+def test_format_error_names_the_field_in_words():
+    assert describe_field("coating[1].thickness") == "Coating layer 2, thickness"
+    assert describe_field("base.creep.rate") == "Base, creep, rate"
+    assert format_error("coating[0].modulus: must be > 0, got -1") == (
+        "Coating layer 1, modulus (coating[0].modulus): must be > 0, got -1")
+    assert format_error("no field here") == "no field here"
+
+
+# ----------------------------------------------------------------- caching of stages
+
+
+def test_moving_a_load_reuses_every_geometric_stage():
+    state = small(ExplorerState())
+    state.load_scene(PRESETS["eccentric_creep"])
+    state.time_count = 8
+    controller = SolveController(state, executor=None)
+    controller.request()
+    first = controller.view
+    before = stage_counts()
+    for q in GEOMETRIC_STAGES:
+        assert q in before, f"stage {q!r} is not counted by core.cache"
+
+    for force in (700.0, 720.0, 740.0):
+        state.loading.histories["force"].value = force
+    after = stage_counts()
+    view = controller.view
+    assert view is not first and controller.error == ""
+    assert view.values["force"][0] == pytest.approx(740e3)
+    assert view.values["settlement"][-1] != pytest.approx(first.values["settlement"][-1])
+    for q in GEOMETRIC_STAGES:
+        assert after[q] == before[q], f"a load change re-evaluated the {q!r} stage"
+    for q in GEOMETRIC_STAGES:
+        assert view.info["stages"].get(q, {"cached": True})["cached"], q
+
+    # a change of geometry does evaluate again (the counter is live)
+    state.base.thickness = 5.0
+    assert sum(stage_counts()[q] for q in GEOMETRIC_STAGES) > sum(
+        after[q] for q in GEOMETRIC_STAGES)
+
+
+# ------------------------------------------------------------- threads and staleness
+
+
+def test_older_results_never_replace_newer_ones():
+    state = small(ExplorerState())
+    gate = threading.Event()
+    calls: list[float] = []
+
+    def slow_first(scene):
+        calls.append(scene["loading"]["force"])
+        if len(calls) == 1:
+            gate.wait(10)
+        return solve(scene)
+
+    with ThreadPoolExecutor(2) as pool:
+        controller = SolveController(state, solve=slow_first, executor=pool)
+        for force in (100.0, 200.0, 300.0, 400.0):
+            state.loading.histories["force"].value = force
+        assert controller.busy
+        gate.set()
+        assert controller.wait(60)
+    # requests made while a solve ran collapse into the newest one
+    assert calls == [100e3, 400e3]
+    assert controller.view.values["force"][0] == pytest.approx(400e3)
+    assert not controller.busy and controller.error == ""
+
+
+def test_a_late_old_result_is_dropped():
+    state = small(ExplorerState())
+    controller = SolveController(state, executor=None, auto=False)
+    old_scene = state.to_scene()
+    controller.request()
+    state.loading.histories["force"].value = 900.0
+    controller.request()
+    newest = controller.view
+    controller._deliver(1, controller._compute(old_scene))  # a straggler arrives
+    assert controller.view is newest
+
+
+def test_results_arrive_through_the_dispatcher():
+    state = small(ExplorerState())
+    delivered: list[Any] = []
+
+    def dispatch(callback):
+        delivered.append(threading.current_thread().name)
+        callback()
+
+    with ThreadPoolExecutor(1, thread_name_prefix="worker") as pool:
+        controller = SolveController(state, executor=pool, dispatch=dispatch)
+        controller.request()
+        assert controller.wait(60)
+    assert delivered and delivered[0].startswith("worker")
+    assert controller.view is not None
+
+
+# ------------------------------------------------------------------------- links
+
+
+def test_link_round_trip_is_compact():
+    for scene in PRESETS.values():
+        text = encode_scene(scene)
+        assert len(text) < 2000
+        assert all(c.isalnum() or c in "-_." for c in text)
+        assert decode_scene(text) == scene
+
+
+@pytest.mark.parametrize("value, reason", [
+    ("", "empty"),
+    ("2.abc", "unknown format"),
+    ("1.%%%", "base64"),
+    ("1.AAAA", "damaged"),
+    ("1." + "A" * 7000, "too long"),
+])
+def test_bad_links_are_refused_with_a_reason(value, reason):
+    with pytest.raises(ValueError, match=reason):
+        decode_scene(value)
+
+
+def test_link_bombs_and_non_objects_are_refused():
+    import base64
+
+    def pack(data: bytes) -> str:
+        return "1." + base64.urlsafe_b64encode(zlib.compress(data, 9)).decode().rstrip("=")
+
+    with pytest.raises(ValueError, match="too large"):
+        decode_scene(pack(b" " * 1_000_000))
+    with pytest.raises(ValueError, match="not a JSON object"):
+        decode_scene(pack(b"[1, 2]"))
+    with pytest.raises(ValueError, match="not valid JSON"):
+        decode_scene(pack(b"{nope"))
+
+
+def test_app_uses_a_good_link_and_falls_back_on_a_bad_one():
+    from explorer.app import ExplorerApp
+
+    scene = json.loads(json.dumps(PRESETS["worn_coating"]))
+    app = ExplorerApp(query={"scene": encode_scene(scene)}, executor=None)
+    assert app.notice == ""
+    assert app.state.scene_name == scene["name"]
+    assert app.controller.view is not None
+
+    scene["coating"][0]["modulus"] = -1.0
+    app = ExplorerApp(query={"scene": encode_scene(scene)}, executor=None)
+    assert "coating[0].modulus" in app.notice and "default" in app.notice
+    assert app.state.scene_name == PRESETS["uniform_flat"]["name"]
+    assert app.controller.view is not None and app.controller.error == ""
+
+    app = ExplorerApp(query={"scene": "1.garbage!"}, executor=None)
+    assert "link" in app.notice and app.controller.view is not None
+
+
+def release(widget, value):
+    """What a browser sends when a slider is let go at ``value``."""
+    widget.value = value
+    with param.edit_constant(widget):
+        widget.value_throttled = value
+
+
+def test_app_widgets_follow_and_drive_the_state():
+    from explorer.app import ExplorerApp
+
+    app = ExplorerApp(executor=None)
+    app.preset.value = "patched_insert"
+    assert app.state.loading.statement == "settlement + tilt given"
+    assert app.statement.value == "settlement + tilt given"
+    assert app.controller.view.scene["name"] == PRESETS["patched_insert"]["name"]
+    assert "Given settlement" in app.history_editors[0].title.object
+    # a load slider writes while dragging (value), a geometry slider on release
+    editor = app.history_editors[0]
+    editor.value.value = 0.06
+    assert app.state.loading.histories["settlement"].value == pytest.approx(0.06)
+    app.base_thickness.value = 3.5
+    assert app.state.base.thickness != 3.5
+    release(app.base_thickness, 3.5)
+    assert app.state.base.thickness == pytest.approx(3.5)
+    # bad input: message in the alert, plots keep the last good result
+    view = app.controller.view
+    release(app.thickness_editor.mean, -1.0)
+    assert app.alert.visible and "coating[0].thickness" in app.alert.object
+    assert app.controller.view is view
+    # downloads hold what is on screen
+    assert app._scene_file().getvalue().strip().startswith("{")
+    assert json.loads(app._scene_file().getvalue()) == view.scene
+    assert app._csv_file().getvalue().startswith("time_day")
+
+
+# ------------------------------------------------------------------ pressure shading
+
+
+def test_negative_intervals():
+    x = np.linspace(-1, 1, 5)                       # -1, -0.5, 0, 0.5, 1
+    assert negative_intervals(x, np.array([1, 1, 1, 1, 1.0])) == []
+    assert negative_intervals(x, np.array([-1, 1, 1, 1, -1.0])) == [(-1.0, -0.75),
+                                                                   (0.75, 1.0)]
+    assert negative_intervals(x, np.array([1, -1, -1, 1, 1.0])) == [(-0.75, 0.25)]
+
+
+def test_time_is_quick_to_scrub():
+    """Moving the time slider only slices arrays that already exist (no solve)."""
+    state = small(ExplorerState())
+    controller = SolveController(state, executor=None)
+    controller.request()
+    view = controller.view
+    solves = controller.solves
+    assert view.pressure.shape == (len(view.x), len(view.times))
+    for i in range(len(view.times)):
+        view.negative_intervals(i)
+    assert controller.solves == solves
+
+
+def test_scene_files_load_and_bad_files_explain_themselves():
+    from explorer.app import ExplorerApp
+
+    app = ExplorerApp(executor=None)
+    scene = PRESETS["rounded_graded"]
+    app.load_file.filename = "rounded.json"
+    app.load_file.value = json.dumps(scene).encode()
+    assert app.notice == ""
+    assert app.state.n_layers == 3 and app.layer.options == ["1", "2", "3"]
+    assert app.controller.view.scene["name"] == scene["name"]
+    shown = app.controller.view
+
+    app.load_file.value = b"{not json"
+    assert "not valid JSON" in app.notice
+    bad = json.loads(json.dumps(scene))
+    bad["base"]["thickness"] = -1
+    app.load_file.value = json.dumps(bad).encode()
+    assert "base.thickness" in app.notice
+    assert app.controller.view is shown and app.state.n_layers == 3
+
+    app.shape_file.filename = "shape.csv"
+    app.shape_file.value = b"x,f\n-0.5,0.00002\n0,0\n0.5,0.00001\n"
+    assert app.state.punch.shape == "custom" and app.controller.error == ""
+    assert "shape.csv" in app.shape_note.object
+    app.shape_file.value = b"x,f\n-0.5,abc\n0,0\n"
+    assert "punch.shape" in app.notice and "line 2" in app.notice
