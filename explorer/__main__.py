@@ -7,8 +7,15 @@ localhost only and opens no browser.
 from __future__ import annotations
 
 import argparse
+import os
 import socket
 import sys
+
+# The solver works on small dense matrices from several threads at once; BLAS threads on
+# top of those only fight for the cores (a cold solve measured 1.5 s instead of 0.09 s on
+# 2 cores). Set before numpy is first imported; an explicit setting is respected.
+for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
 
 
 def build_parser() -> argparse.ArgumentParser:
