@@ -171,8 +171,8 @@ def base_panels(lam: float, breakpoints: Sequence[float] = (), *,
 
 
 def refine_to_resolve(panels: Panels, functions: Sequence[Callable[[np.ndarray], np.ndarray]],
-                      *, rel_tol: float = 1e-13, min_width: float = 1e-9,
-                      max_panels: int = 600) -> tuple[Panels, bool]:
+                      *, rel_tol: float = 1e-12, min_width: float = 1e-9,
+                      max_panels: int = 160) -> tuple[Panels, bool]:
     """Bisect panels until every function's Legendre tail is below ``rel_tol`` of its scale.
 
     Returns the refined panels and whether everything was resolved within the limits
@@ -207,8 +207,10 @@ def legendre_log_moments(z: np.ndarray, degree: int) -> np.ndarray:
     minimal solution and the forward recurrence loses ~2n log10(|z| + sqrt(z^2 - 1)) digits.
     """
     z = np.asarray(z, dtype=float)
-    # M_n is continuous at |z| = 1 but Q_n is not defined there: step just inside.
-    z = np.where(np.abs(np.abs(z) - 1.0) < 1e-13, np.sign(z) * (1.0 - 1e-13), z)
+    ends = np.abs(np.abs(z) - 1.0) < 1e-13
+    # M_n is continuous at |z| = 1 but Q_n is not defined there: step just inside (the
+    # exact end values replace the result below).
+    z = np.where(ends, np.sign(z) * (1.0 - 1e-13), z)
     nq = degree + 2
     q = np.empty((z.size, nq))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -259,6 +261,12 @@ def legendre_log_moments(z: np.ndarray, degree: int) -> np.ndarray:
     m[:, 0] = a + b - 2.0
     n = np.arange(1, degree + 1)
     m[:, 1:] = 2.0 * (q[:, 2 : degree + 2] - q[:, 0:degree]) / (2 * n + 1)
+    # On a panel end the recurrence ran just inside; use the exact end values instead:
+    # M_0(1) = 2 ln 2 - 2, M_n(1) = -2/(n (n + 1)), M_n(-1) = (-1)^n M_n(1).
+    if ends.any():
+        exact = np.concatenate([[2.0 * np.log(2.0) - 2.0], -2.0 / (n * (n + 1.0))])
+        parity = np.where(z[ends, None] < 0, (-1.0) ** np.arange(degree + 1)[None, :], 1.0)
+        m[ends] = exact[None, :] * parity
     return m
 
 
