@@ -258,6 +258,8 @@ class _Discretization:
     galerkin_key: str
     resolved: bool
     cuts: tuple[float, ...]
+    check_x: np.ndarray
+    check_phi: np.ndarray
 
 
 def _max_width(lam: float, cap: int) -> float:
@@ -306,9 +308,11 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
         basis = build_basis(panels, m_nodes, count, breakpoints=inp.breakpoints, kind=kind,
                             cuts=cuts)
         xs = _sample_points(inp.breakpoints)
-        return basis, xs, basis.evaluate(xs)
+        xc = _check_points(inp.breakpoints)
+        return basis, xs, basis.evaluate(xs), xc, basis.evaluate(xc)
 
-    basis, sample_x, sample_phi = timed("basis", _BASIS, basis_key, make_basis)
+    basis, sample_x, sample_phi, check_x, check_phi = timed("basis", _BASIS, basis_key,
+                                                            make_basis)
     correction = None
     if kind == "graded":
         correction = timed("correction", _CORRECTION, fingerprint("correction", panels.edges),
@@ -326,7 +330,13 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
                     lambda: gap_terms(operator, basis, m_nodes, g_nodes, correction))
     return _Discretization(panels, operator, basis, m_nodes, r_matrix, gap, sample_x,
                            sample_phi, inp.m(sample_x), inp.g(sample_x), gal_key, resolved,
-                           tuple(cuts))
+                           tuple(cuts), check_x, check_phi)
+
+
+def _check_points(breakpoints: Sequence[float]) -> np.ndarray:
+    """Points where q >= 0 is checked: Chebyshev points of [-1, 1] and both sides of jumps."""
+    bps = np.asarray(breakpoints, dtype=float)
+    return np.concatenate([np.cos(np.linspace(0, np.pi, 401)), bps - 1e-9, bps + 1e-9])
 
 
 def _sample_points(breakpoints: Sequence[float]) -> np.ndarray:
@@ -525,62 +535,67 @@ def _combine(parts: Sequence[tuple[float, _LevelResult]]) -> _LevelResult:
     return replace(combined, time_error=float(absolute / size))
 
 
-def _time_stage(inp: _Inputs, disc: _Discretization, systems: Sequence[ModalSystem],
-                times: np.ndarray, *, time_tol: float) -> tuple[list[_LevelResult], bool]:
+class _Superposition:
     """The time stage by superposition: one cached response per given load and the gap.
 
     The answer is linear in the loads and the gap, so it is the sum of the responses to
     each given load alone (normalized to unit peak) and to the gap alone. Each response
     is cached on the modes, the times, c, K and the load's *shape*, so moving a load
-    slider (a change of amplitude) costs a few array operations. Returns the results and
-    whether every response came from the cache.
+    slider (a change of amplitude) costs a few array operations. Everything that does not
+    depend on the mode count is prepared once per solve.
     """
-    kernel_key = (None if inp.kernel is None else getattr(inp.kernel, "key", None))
-    cacheable = inp.kernel is None or kernel_key is not None
-    probe = np.unique(np.concatenate([np.linspace(1.0, times[-1], 129), times]))
-    base_key = (tuple(ms.n for ms in systems), disc.galerkin_key, tuple(sorted(inp.given)),
-                fingerprint(times, inp.c(probe), repr(kernel_key), time_tol))
-    no_gap = replace(disc, gap=GapTerms(np.zeros_like(disc.gap.vector), 0.0, 0.0))
-    parts: list[tuple[float, list[_LevelResult]]] = []
-    all_hit = True
-    for name, fn in sorted(inp.loads.items()):
-        values = fn(probe)
-        amplitude = float(values[np.argmax(np.abs(values))])
-        if amplitude == 0.0:
-            continue
-        unit = replace(inp, loads={k: ((lambda tt, f=fn, a=amplitude: f(tt) / a)
-                                       if k == name else _zero) for k in inp.loads})
-        key = (base_key, name, fingerprint(values / amplitude))
 
-        def compute(unit=unit):
-            return _solve_levels(unit, no_gap, systems, times, time_tol=time_tol)
+    def __init__(self, inp: _Inputs, disc: _Discretization, times: np.ndarray,
+                 time_tol: float) -> None:
+        self.disc, self.times, self.time_tol = disc, times, time_tol
+        kernel_key = None if inp.kernel is None else getattr(inp.kernel, "key", None)
+        self.cacheable = inp.kernel is None or kernel_key is not None
+        probe = np.unique(np.concatenate([np.linspace(1.0, times[-1], 129), times]))
+        self.base_key = (disc.galerkin_key, tuple(sorted(inp.given)),
+                         fingerprint(times, inp.c(probe), repr(kernel_key), time_tol))
+        self.no_gap = replace(disc, gap=GapTerms(np.zeros_like(disc.gap.vector), 0.0, 0.0))
+        # (weight, key, inputs, discretization) of each part
+        self.parts: list[tuple[float, tuple, _Inputs, _Discretization]] = []
+        for name, fn in sorted(inp.loads.items()):
+            values = fn(probe)
+            amplitude = float(values[np.argmax(np.abs(values))])
+            if amplitude == 0.0:
+                continue
+            unit = replace(inp, loads={k: ((lambda tt, f=fn, a=amplitude: f(tt) / a)
+                                           if k == name else _zero) for k in inp.loads})
+            self.parts.append((amplitude, (name, fingerprint(values / amplitude)), unit,
+                               self.no_gap))
+        gap = disc.gap
+        if not inp.g_is_zero and (np.any(gap.vector != 0) or gap.integral != 0
+                                  or gap.first_moment != 0):
+            gap_only = replace(inp, loads={k: _zero for k in inp.loads})
+            key = ("gap", fingerprint(gap.vector, gap.integral, gap.first_moment))
+            self.parts.append((1.0, key, gap_only, disc))
+        self.zero_inputs = replace(inp, loads={k: _zero for k in inp.loads})
 
-        if cacheable:
-            response, hit = _RESPONSE.get_or_compute(key, compute)
-        else:
-            response, hit = compute(), False
-        all_hit = all_hit and hit
-        parts.append((amplitude, response))
-    if not inp.g_is_zero and (np.any(disc.gap.vector != 0) or disc.gap.integral != 0
-                              or disc.gap.first_moment != 0):
-        gap_only = replace(inp, loads={k: _zero for k in inp.loads})
-        key = (base_key, "gap", fingerprint(disc.gap.vector, disc.gap.integral,
-                                            disc.gap.first_moment))
+    def solve(self, systems: Sequence[ModalSystem]) -> tuple[list[_LevelResult], bool]:
+        """Results for each modal system, and whether every response came from the cache."""
+        if not self.parts:  # every load is zero and there is no gap: the answer is zero
+            return _solve_levels(self.zero_inputs, self.no_gap, systems, self.times,
+                                 time_tol=self.time_tol), False
+        sizes = tuple(ms.n for ms in systems)
+        responses = []
+        all_hit = True
+        for weight, part_key, inputs, disc in self.parts:
+            def compute(inputs=inputs, disc=disc):
+                return _solve_levels(inputs, disc, systems, self.times, time_tol=self.time_tol)
 
-        def compute_gap():
-            return _solve_levels(gap_only, disc, systems, times, time_tol=time_tol)
-
-        if cacheable:
-            response, hit = _RESPONSE.get_or_compute(key, compute_gap)
-        else:
-            response, hit = compute_gap(), False
-        all_hit = all_hit and hit
-        parts.append((1.0, response))
-    if not parts:  # every load is zero and there is no gap: the answer is zero
-        zero_inp = replace(inp, loads={k: _zero for k in inp.loads})
-        return _solve_levels(zero_inp, no_gap, systems, times, time_tol=time_tol), False
-    results = [_combine([(w, resp[i]) for w, resp in parts]) for i in range(len(systems))]
-    return results, all_hit
+            if self.cacheable:
+                response, hit = _RESPONSE.get_or_compute((self.base_key, sizes, part_key),
+                                                         compute)
+            else:
+                response, hit = compute(), False
+            all_hit = all_hit and hit
+            responses.append((weight, response))
+        if len(responses) == 1 and responses[0][0] == 1.0:
+            return list(responses[0][1]), all_hit
+        return [_combine([(w, r[i]) for w, r in responses]) for i in range(len(systems))], \
+            all_hit
 
 
 def _scales(res: _LevelResult, disc: _Discretization, c_t: np.ndarray):
@@ -698,10 +713,10 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         probe_chain: list[_LevelResult] = []
         c_probe = c_t[probe_idx]
         t_probe = _time.perf_counter()
-        elastic_view = replace(inp, kernel=None)
+        probe_stage = _Superposition(replace(inp, kernel=None), disc, probe_times, time_tol)
         for n in levels:
             ms = _modes(disc, inp.given, n, stages)
-            res = _solve_levels(elastic_view, disc, [ms], probe_times, time_tol=time_tol)[0]
+            res = probe_stage.solve([ms])[0][0]
             if prev_probe is not None:
                 diffs.append(_difference(res, prev_probe, disc, c_probe))
             probe_chain.append(res)
@@ -729,7 +744,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         if n_prev is not None and inp.kernel is not None:
             # The spatial estimate above is elastic; check it on the creeping answer.
             systems.append(_modes(disc, inp.given, n_prev, stages))
-        results, time_cached = _time_stage(inp, disc, systems, times_arr, time_tol=time_tol)
+        results, time_cached = _Superposition(inp, disc, times_arr, time_tol).solve(systems)
         chosen = results[0]
         if len(results) > 1:
             d_creep = _difference(chosen, results[1], disc, c_t)
@@ -745,10 +760,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     if not success:
         flags.append("tol_not_met")
     # Contact: q >= 0 must hold on the whole of [-1, 1] at every time.
-    x_check = np.concatenate([np.cos(np.linspace(0, np.pi, 401)),
-                              np.asarray(inp.breakpoints) - 1e-9,
-                              np.asarray(inp.breakpoints) + 1e-9])
-    phi_check = disc.basis.evaluate(x_check, chosen.n)
+    x_check = disc.check_x
+    phi_check = disc.check_phi[:, : chosen.n]
     q_check = (phi_check @ chosen.coefficients
                - np.outer(inp.g(x_check), 1.0 / c_t)) / inp.m(x_check)[:, None]
     q_scale = max(float(np.max(np.abs(q_check))), 1e-300)
