@@ -302,6 +302,12 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
     m_nodes = inp.m(panels.nodes)
     _check_values(m_nodes, "m", panels.nodes, "x", positive=True)
     count = cap if kind == "graded" else min(cap, panels.size // 2)
+    if kind == "graded":
+        # Panels added to resolve m or g (a rough punch, a wavy coating) become elements
+        # too: the remainder of m q oscillates with g/m, and elements of degree <= 15 as
+        # wide as the graded mesh's middle cannot follow twenty wavelengths.
+        added = np.setdiff1d(panels.edges[1:-1], start.edges)
+        cuts = tuple(sorted(set(cuts) | set(added.tolist())))
     basis_key = fingerprint("basis", panels.edges, m_nodes, inp.breakpoints, kind, cuts, count)
 
     def make_basis():
