@@ -44,6 +44,7 @@ from core.quadrature import (
     base_panels,
     galerkin_correction,
     kernel_operator,
+    operator_rows,
     refine_to_resolve,
 )
 from core.statements import QUANTITIES, ModalSystem, modal_system, statement_number
@@ -72,6 +73,7 @@ _CORRECTION = StageCache("correction", max_items=8, max_bytes=512 * 2**20)
 _GAP = StageCache("gap", max_items=32)
 _MODES = StageCache("modes", max_items=256)
 _RESPONSE = StageCache("response", max_items=256, max_bytes=256 * 2**20)
+_SAMPLE_ROWS = StageCache("sample_rows", max_items=16)
 
 
 # --------------------------------------------------------------------------- results
@@ -260,6 +262,7 @@ class _Discretization:
     cuts: tuple[float, ...]
     check_x: np.ndarray
     check_phi: np.ndarray
+    sample_rows: np.ndarray  # F at the sample points (for the residual check)
 
 
 def _max_width(lam: float, cap: int) -> float:
@@ -306,7 +309,11 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
         # Panels added to resolve m or g (a rough punch, a wavy coating) become elements
         # too: the remainder of m q oscillates with g/m, and elements of degree <= 15 as
         # wide as the graded mesh's middle cannot follow twenty wavelengths.
-        added = np.setdiff1d(panels.edges[1:-1], start.edges)
+        # Only panels of some size: refinement that chases an end-point singularity of an
+        # undeclared kind (bisecting toward +-1 or a jump) must not litter the mesh.
+        widths = np.diff(panels.edges)
+        wide = np.minimum(widths[:-1], widths[1:]) >= 1e-2
+        added = np.setdiff1d(panels.edges[1:-1][wide], start.edges)
         cuts = tuple(sorted(set(cuts) | set(added.tolist())))
     basis_key = fingerprint("basis", panels.edges, m_nodes, inp.breakpoints, kind, cuts, count)
 
@@ -323,6 +330,8 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
     if kind == "graded":
         correction = timed("correction", _CORRECTION, fingerprint("correction", panels.edges),
                            lambda: galerkin_correction(panels))
+    sample_rows = timed("sample_rows", _SAMPLE_ROWS, fingerprint("rows", op_key, sample_x),
+                        lambda: operator_rows(inp.lam, panels, sample_x))
     gal_key = fingerprint("galerkin", op_key, basis_key)
     r_matrix = timed("galerkin", _GALERKIN, gal_key,
                      lambda: galerkin_matrix(operator, basis, m_nodes, correction))
@@ -336,7 +345,7 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
                     lambda: gap_terms(operator, basis, m_nodes, g_nodes, correction))
     return _Discretization(panels, operator, basis, m_nodes, r_matrix, gap, sample_x,
                            sample_phi, inp.m(sample_x), inp.g(sample_x), gal_key, resolved,
-                           tuple(cuts), check_x, check_phi)
+                           tuple(cuts), check_x, check_phi, sample_rows)
 
 
 def _check_points(breakpoints: Sequence[float]) -> np.ndarray:
@@ -628,6 +637,29 @@ def _difference(a: _LevelResult, b: _LevelResult, disc: _Discretization,
     return float(max(parts))
 
 
+def _relative_residual(res: _LevelResult, disc: _Discretization, inp: _Inputs,
+                       times: np.ndarray) -> float:
+    """Residual of the integral equation at the sample points, relative to its terms.
+
+    ``c m q + F q - (delta + alpha x - g)`` for the elastic equation at ``times``. It does
+    not depend on comparing mode counts, so it catches what the level differences cannot
+    see: a feature no level of the basis resolves (all levels then agree on a wrong q).
+    """
+    c_t = inp.c(times)
+    q_nodes = ((disc.basis.values[:, : res.n] @ res.coefficients
+                - np.outer(inp.g(disc.panels.nodes), 1.0 / c_t))
+               / disc.m_nodes[:, None])
+    q_s = ((disc.sample_phi[:, : res.n] @ res.coefficients
+            - np.outer(disc.sample_g, 1.0 / c_t)) / disc.sample_m[:, None])
+    local = c_t[None, :] * disc.sample_m[:, None] * q_s
+    nonlocal_ = disc.sample_rows @ q_nodes
+    rhs = (res.settlement[None, :] + np.outer(disc.sample_x, res.tilt)
+           - disc.sample_g[:, None])
+    scale = max(np.max(np.abs(local)), np.max(np.abs(nonlocal_)), np.max(np.abs(rhs)),
+                1e-300)
+    return float(np.max(np.abs(local + nonlocal_ - rhs)) / scale)
+
+
 def _extrapolated_error(diffs: list[float]) -> float:
     """Error of the last level from the differences of consecutive levels.
 
@@ -733,7 +765,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                     break
         entry = stages.setdefault("mode_selection", {"seconds": 0.0, "cached": False})
         entry["seconds"] += _time.perf_counter() - t_probe
-        est = max(_extrapolated_error(diffs), ERROR_FLOOR)
+        est = max(_extrapolated_error(diffs), ERROR_FLOOR,
+                  _relative_residual(probe_chain[-1], disc, inp, probe_times))
         n_used = probe_chain[-1].n
         if est <= 0.5 * tol or n_modes is not None or cap == BASIS_CAPS[-1]:
             spatial_error = est
