@@ -62,6 +62,9 @@ DIRECT_LARGEST_BELOW = 1e-7
 #: Quadrature and round-off floor of the relative error (measured: ~1e-13 on the scenes
 #: of the test suite; see tests/test_solver.py).
 ERROR_FLOOR = 2e-13
+#: Success is claimed only when the error estimate is this many times below tol: the
+#: estimate itself can read ~3x low (see _extrapolated_error).
+SUCCESS_MARGIN = 3.0
 #: |alpha| above this many radians is not a small tilt (used by the dimensional API).
 TOLERANCE_RANGE = (1e-13, 1e-1)
 
@@ -544,7 +547,8 @@ def _combine(parts: Sequence[tuple[float, _LevelResult]]) -> _LevelResult:
     combined = _LevelResult(first.n, total("coefficients"), total("settlement"),
                             total("tilt"), total("force"), total("moment"), 0.0,
                             max(r.steps for _, r in parts),
-                            "; ".join(sorted({r.time_message for _, r in parts})),
+                            "; ".join(sorted({r.time_message for _, r in parts
+                                              if not r.time_success})) or first.time_message,
                             all(r.time_success for _, r in parts))
     size = max(np.max(np.abs(combined.settlement)), np.max(np.abs(combined.force)), 1e-300)
     return replace(combined, time_error=float(absolute / size))
@@ -665,7 +669,9 @@ def _extrapolated_error(diffs: list[float]) -> float:
 
     With a convergence ratio rho = d_k/d_{k-1} per level the remaining error after level k
     is about d_k rho/(1 - rho) (a geometric tail); rho is kept in [0.05, 0.9] so neither a
-    lucky cancellation nor a stall makes the estimate absurd.
+    lucky cancellation nor a stall makes the estimate absurd. The graded basis converges
+    in steps, so this reads up to ~3x low or ~6x high (measured on the hard cases of
+    tests/test_hard_cases.py); ``SUCCESS_MARGIN`` keeps a claim of success honest.
     """
     if len(diffs) < 2:
         return diffs[-1] if diffs else np.inf
@@ -701,8 +707,9 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         breakpoints: points of (-1, 1) where m or g may jump.
         tol: relative accuracy target for delta, alpha (relative to max(|delta|, |alpha|)),
             P, M (relative to max(|P|, |M|)) and q (relative to max|q| over interior points).
-        basis: "piecewise" (polynomials between breakpoints; default) or "global" (the
-            seed's basis).
+        basis: "graded" (default: continuous piecewise polynomials on meshes graded toward
+            the edges and jumps), "piecewise" (polynomials between breakpoints) or "global"
+            (the seed's basis).
         n_modes: a fixed number of basis functions (for studies); default adaptive.
 
     Returns a :class:`ContactSolution`. Raises ``ValueError`` naming the argument on bad
@@ -727,17 +734,24 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     else:
         probe_idx = np.unique(np.linspace(0, times_arr.size - 1, 5).round().astype(int))
     probe_times = times_arr[probe_idx]
-    # Time error budget: a third of tol; the spatial part gets the rest.
-    time_tol = tol / 3
+    # Time error budget: the step-doubling estimate adds local errors (an upper bound that
+    # read up to ~20x the true error on decaying creep), so the steps aim ten times lower
+    # than the share they would need, keeping the reported estimate close to the truth.
+    time_tol = tol / 30
 
     flags: list[str] = []
     chosen: _LevelResult | None = None
     spatial_error = np.inf
     disc = None
     n_used = 0
-    caps = BASIS_CAPS
-    if (n_modes is not None and n_modes > BASIS_CAPS[0]) or inp.tol < DIRECT_LARGEST_BELOW:
+    # The basis built (and, for the seed's bases, the panels) depends on the cap, so a
+    # fixed mode count always uses the same one whatever tol says.
+    if n_modes is not None:
+        caps = next((cap,) for cap in BASIS_CAPS if n_modes <= cap)
+    elif inp.tol < DIRECT_LARGEST_BELOW:
         caps = BASIS_CAPS[-1:]
+    else:
+        caps = BASIS_CAPS
     for cap in caps:
         disc = _discretize(inp, cap, basis, stages)
         size = disc.basis.size
@@ -761,14 +775,15 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
             prev_probe = res
             if n_modes is None and len(diffs) >= 2:
                 est = max(_extrapolated_error(diffs), ERROR_FLOOR)
-                if est <= 0.5 * tol:
+                if est <= 0.5 * tol / SUCCESS_MARGIN and _relative_residual(
+                        res, disc, inp, probe_times) <= 0.5 * tol / SUCCESS_MARGIN:
                     break
         entry = stages.setdefault("mode_selection", {"seconds": 0.0, "cached": False})
         entry["seconds"] += _time.perf_counter() - t_probe
         est = max(_extrapolated_error(diffs), ERROR_FLOOR,
                   _relative_residual(probe_chain[-1], disc, inp, probe_times))
         n_used = probe_chain[-1].n
-        if est <= 0.5 * tol or n_modes is not None or cap == BASIS_CAPS[-1]:
+        if est <= 0.5 * tol / SUCCESS_MARGIN or n_modes is not None or cap == BASIS_CAPS[-1]:
             spatial_error = est
             n_prev = probe_chain[-2].n if len(probe_chain) > 1 else None
             break
@@ -787,13 +802,13 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         chosen = results[0]
         if len(results) > 1:
             d_creep = _difference(chosen, results[1], disc, c_t)
-            ratio = diffs[-1] / diffs[-2] if len(diffs) >= 2 and diffs[-2] > 0 else 0.5
-            rho = min(max(ratio, 0.05), 0.9)
-            spatial_error = max(spatial_error, d_creep * rho / (1 - rho), ERROR_FLOOR)
+            creep_diffs = [d_creep * diffs[-2] / diffs[-1], d_creep] if (
+                len(diffs) >= 2 and diffs[-1] > 0) else [d_creep]
+            spatial_error = max(spatial_error, _extrapolated_error(creep_diffs), ERROR_FLOOR)
     stages["time"] = {"seconds": _time.perf_counter() - t_time, "cached": time_cached}
 
     error_estimate = float(spatial_error + chosen.time_error)
-    success = error_estimate <= tol and chosen.time_success
+    success = error_estimate * SUCCESS_MARGIN <= tol and chosen.time_success
     if not disc.resolved:
         flags.append("unresolved_input")
     if not success:
@@ -808,17 +823,18 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     if min_q < -max(error_estimate, 1e-12) * q_scale:
         flags.append("contact_lost")
     if success:
-        message = (f"converged: estimated error {error_estimate:.1e} <= tol {tol:.1e} with "
-                   f"{chosen.n} modes")
+        message = (f"converged: estimated error {error_estimate:.1e} <= tol {tol:.1e}/"
+                   f"{SUCCESS_MARGIN:g} with {chosen.n} modes")
     else:
         reasons = []
-        if spatial_error > tol:
+        if spatial_error * SUCCESS_MARGIN > tol:
             reasons.append(f"the basis reached {chosen.n} modes with estimated error "
                            f"{spatial_error:.1e}")
-        if chosen.time_error > tol or not chosen.time_success:
+        if chosen.time_error * SUCCESS_MARGIN > tol or not chosen.time_success:
             reasons.append(f"time stepping: {chosen.time_message} (estimated error "
                            f"{chosen.time_error:.1e})")
-        message = f"tol {tol:.1e} not met: " + "; ".join(reasons)
+        message = (f"tol {tol:.1e} not met (success needs the estimate below tol/"
+                   f"{SUCCESS_MARGIN:g}): " + "; ".join(reasons))
     if not disc.resolved:
         message += ("; m or g has features finer than the quadrature could resolve "
                     "(declare jumps in breakpoints)")

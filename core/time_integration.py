@@ -205,6 +205,8 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     t_final = float(times[-1])
     while k_out < len(times):
         if steps + rejected > max_steps:
+            # No answer is better than a wrong one: the times not reached are NaN.
+            w_out[:, k_out:] = vw_out[:, k_out:] = vu_out[:, k_out:] = np.nan
             return VolterraSolution(w_out, vw_out, vu_out, np.inf, steps, rejected, False,
                                     f"time stepping stopped after {max_steps} steps at "
                                     f"t = {t_now:.6g}")
@@ -216,7 +218,8 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
                                np.abs(fine[1].sum(axis=1) - full[1].sum(axis=1))]) / scale
         # Richardson: the two-half-step answer carries 1/(2^p - 1) of the difference.
         err = float(np.max(diff, initial=0.0)) / (2**RADAU_ORDER - 1)
-        allowed = local_tol * max(h_try / span, 1e-6)
+        # Below ~100 ulp the step-doubling difference is round-off, not truncation error.
+        allowed = max(local_tol * max(h_try / span, 1e-6), 100 * np.finfo(float).eps)
         if err > allowed and h_try > 1e-10 * span:
             rejected += 1
             h = h_try * max(0.2, 0.9 * (allowed / err) ** (1 / (RADAU_ORDER + 1)))
