@@ -367,11 +367,12 @@ TIGHT_TIME_TOL = {"aging": 1e-11, "eccentric": 1e-10}
 @pytest.mark.parametrize("loads_key", list(CREEP_LOADS))
 def test_creep_converges_in_time_at_high_order(loads_key):
     # At fixed n = 32, error against the tight run over the time tolerance (tol 1e-3 to
-    # 1e-6; the steps aim at tol/30). Measured, aging: steps 16, 25, 38, 59 -> errors 5.5e-7, 7.0e-8, 6.8e-9,
-    # 4.9e-10, order 5.4 in the number of steps (3-stage Radau IIA, order 5), time
-    # estimate / error 0.54, 0.81, 1.3, 2.4. Cyclic load: steps 64, 102, 161, 254 ->
-    # 4.8e-7, 1.4e-8, 1.8e-9, 5.1e-11, order 6.4; estimate / error 3.3, 12, 9.5, 33: the
-    # estimate adds up local error estimates, which the oscillating load makes cancel.
+    # 1e-6; the steps aim at tol/30). Measured, aging: steps 16, 25, 38, 59 -> errors
+    # 5.5e-7, 7.0e-8, 6.8e-9, 4.9e-10, order 5.4 in the number of steps (3-stage Radau
+    # IIA, order 5), time estimate / error 0.54, 0.81, 1.3, 2.4. Cyclic load: steps
+    # 64, 102, 161, 254 -> 4.8e-7, 1.4e-8, 1.8e-9, 5.1e-11, order 6.4; estimate / error
+    # 3.3, 12, 9.5, 33: the estimate adds up local error estimates, which the oscillating
+    # load makes cancel.
     kw = dict(c=C_OF_T, kernel=KERNEL, n_modes=32, **CREEP_LOADS[loads_key])
     xs = sample_points()
     tight = solve_dimensionless(1.0, smooth_m, 0.0, CREEP_TIMES, tol=TIGHT_TIME_TOL[loads_key],
