@@ -5,10 +5,11 @@
 force and moment) and optionally the pressure ``q(x, t)`` to ``--pressure-csv``; without
 ``--output`` it prints a short summary. ``validate`` only checks the scene file.
 
-Exit codes: 0 success, 1 the solver failed, 2 bad input (an unreadable, oversized or
-invalid scene file, or bad arguments). Every error is one line ``error: <field>: <reason>``
-on stderr; validity flags of a solution (for instance ``contact_lost``) are reported as
-``warning: <flag>: <explanation>`` lines on stderr with exit code 0.
+Exit codes: 0 success, 1 the solver failed (or an internal error), 2 bad input (an
+unreadable, oversized or invalid scene file, or bad arguments). Every error is one line
+``error: <field>: <reason>`` on stderr; validity flags of a solution (for instance
+``contact_lost``) are reported as ``warning: <flag>: <explanation>`` lines on stderr with
+exit code 0.
 """
 
 from __future__ import annotations
@@ -155,3 +156,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:  # the promise is one line on stderr, never a traceback
+        print(f"error: internal error ({type(exc).__name__}: {_one_line(exc)}); please "
+              "report it with the scene file", file=sys.stderr)
+        return EXIT_SOLVER_FAILED

@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from core.creep import creep_model_from_spec
+from core.creep import UserKernel, creep_model_from_spec
 from core.profiles import Profile, check_range, profile_from_spec
 
 if TYPE_CHECKING:
@@ -74,6 +74,21 @@ THICK_COATING_RATIO = 0.1
 LARGE_TILT = 0.01
 #: Points of the default plotting grid :attr:`SceneSolution.x`.
 PLOT_POINTS = 201
+#: Most points of (-a, a) where a profile may jump or kink (see ``_check_breakpoints``).
+MAX_BREAKPOINTS = 16
+#: Accepted range of the dimensionless coating compliance m*: physical coatings are far
+#: inside it; the solver was measured finite for 1e-100 to 1e100.
+M_STAR_RANGE = (1e-30, 1e30)
+#: Largest accepted gap between punch and coating surface, in half-widths a.
+MAX_GAP_RATIO = 1e3
+#: Accepted range of a / H. The quadrature resolves the layer kernel on the scale H, so
+#: the nodes grow with a / H: measured 1216 nodes, 1 s, 155 MB at 100; 4448 nodes, 5 s,
+#: 1 GB at 400; 10880 nodes, 27 s, 5.5 GB at 1000 (the solver itself accepts 1e4).
+LAM_RANGE = (1e-4, 100.0)
+#: Largest accepted creep coefficient E(tau0) C(t_end, tau0) (concrete: 1 to 5). The
+#: time stepping was measured at 1.9 s for 1000 (tol 1e-8), 32 s for 1e4 (tol 1e-8) and
+#: 13 s for 9e7 (tol 1e-3), the last two stopping at the step limit.
+MAX_CREEP_COEFFICIENT = 1e3
 #: Uniform samples of [-a, a] for the gap minimum and the coating checks (on top of each
 #: profile's own sample points).
 DENSE_SAMPLES = 4001
@@ -118,7 +133,9 @@ def _show(value: Any) -> str:
     if value is None:
         return "null"
     if isinstance(value, numbers.Integral):
-        return str(int(value))
+        text = str(int(value))
+        # a 4000-digit integer is valid JSON; the message stays one readable line
+        return text if len(text) <= 40 else f"{text[:12]}... ({len(text)} digits)"
     if isinstance(value, numbers.Real):
         return f"{float(value):.6g}"
     if isinstance(value, Mapping):
@@ -156,7 +173,12 @@ def _number(value: Any, path: str) -> float:
     # bool is an int to Python, but true/false in a scene file is a mistake
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(f"{path}: must be a number, got {_show(value)}")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:
+        # a JSON integer of 400 digits is valid JSON but no double
+        raise ValueError(f"{path}: must be a finite number, got an integer too large for "
+                         "a double") from None
     if not math.isfinite(x):
         raise ValueError(f"{path}: must be a finite number, got {value!r}")
     return x
@@ -228,10 +250,14 @@ def migrate(d: Mapping[str, Any]) -> dict[str, Any]:
         raise ValueError(f"schema_version: required field is missing (this program reads "
                          f"{SCHEMA_VERSION})")
     raw = d["schema_version"]
-    if isinstance(raw, bool) or not isinstance(raw, numbers.Real) \
-            or not math.isfinite(float(raw)) or not float(raw).is_integer():
+    if isinstance(raw, bool) or not isinstance(raw, numbers.Real):
         raise ValueError(f"schema_version: must be an integer, got {_show(raw)}")
-    version = int(raw)
+    if isinstance(raw, numbers.Integral):
+        version = int(raw)  # float() of a huge integer would overflow
+    elif not math.isfinite(float(raw)) or not float(raw).is_integer():
+        raise ValueError(f"schema_version: must be an integer, got {_show(raw)}")
+    else:
+        version = int(raw)
     if version > SCHEMA_VERSION:
         raise ValueError(f"schema_version: unsupported version {version} "
                          f"(this program reads {SCHEMA_VERSION})")
@@ -566,10 +592,15 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     h_base = _positive(base["thickness"], "base.thickness")
     nu = _poisson(base["poisson"], "base.poisson")
     tau0 = _positive(base["age_at_loading"], "base.age_at_loading")
-    creep = creep_model_from_spec(base["creep"], field="base.creep")
-    if not math.isfinite(a / h_base) or not 1e-4 <= a / h_base <= 1e4:
+    try:
+        creep = creep_model_from_spec(base["creep"], field="base.creep")
+    except OverflowError:
+        # core.creep converts with float(), which raises for a huge JSON integer
+        raise ValueError("base.creep: a number is too large for a double (must be a finite "
+                         "number)") from None
+    if not math.isfinite(a / h_base) or not LAM_RANGE[0] <= a / h_base <= LAM_RANGE[1]:
         raise ValueError(f"base.thickness: the ratio punch.half_width / base.thickness must be "
-                         f"in [1e-4, 1e4], got {a / h_base:.6g}")
+                         f"in [{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}], got {a / h_base:.6g}")
 
     times, times_spec = _times(d["times"], "times")
 
@@ -615,8 +646,155 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         "solver": {"tol": tol},
     }
     times.setflags(write=False)
-    return Scene(name, description, a, shape, tuple(layers), h_base, nu, tau0, creep,
-                 MappingProxyType(loads), times, tol, data)
+    scene = Scene(name, description, a, shape, tuple(layers), h_base, nu, tau0, creep,
+                  MappingProxyType(loads), times, tol, data)
+    _check_breakpoints(scene)
+    _check_solvable(scene)
+    return scene
+
+
+def _x_profiles(scene: Scene) -> list[tuple[str, Profile]]:
+    """The x-profiles of a scene with their field paths."""
+    return [("punch.shape", scene.shape)] + [
+        (f"coating[{k}].{name}", getattr(layer, name))
+        for k, layer in enumerate(scene.coating) for name in ("thickness", "modulus", "poisson")]
+
+
+def _check_breakpoints(scene: Scene) -> None:
+    """Refuse more jumps and kinks across the punch than the solver can afford.
+
+    Each breakpoint adds a graded cluster of quadrature panels (about 140 nodes), and the
+    kernel operator is dense in the nodes: 16 breakpoints measured 2448 nodes, 1.9 s and
+    360 MB for one solve, 40 breakpoints 9 s and 1.7 GB, a 10000-row table asked for a
+    15 TiB matrix. A served explorer must not let one scene take the machine.
+    """
+    count = len(scene.breakpoints)
+    if count <= MAX_BREAKPOINTS:
+        return
+    a = scene.half_width
+    path, most = max(((p, sum(1 for b in prof.breakpoints if -a < b < a))
+                      for p, prof in _x_profiles(scene)), key=lambda item: item[1])
+    raise ValueError(
+        f"{path}: has {most} points where its value or slope jumps (table rows, step "
+        f"breaks or formula switches), {count} in the whole scene, more than the "
+        f"{MAX_BREAKPOINTS} the solver allows: use fewer rows or breaks, a 'pchip' table "
+        "(smooth between its end rows) or a smooth formula")
+
+
+def _check_solvable(scene: Scene) -> None:
+    """Refuse a scene whose dimensionless problem leaves double precision or the range the
+    solver handles, naming the field to change.
+
+    Every value may pass its own check (a coating modulus of 1e300 Pa is > 0) while the
+    combination is not computable: ``m*`` underflows, a load over ``E a`` overflows, an
+    aging term ``A / age^2`` is infinite at a tiny age at loading. Such scenes are far from
+    physical sizes; refusing them here keeps NaN out of results and bounds the work.
+    """
+    with np.errstate(all="ignore"):
+        problem = scene.dimensionless
+        a = scene.half_width
+        x = scene.sample_x
+        xs = x / a
+        m = np.broadcast_to(problem.m(xs) if callable(problem.m) else problem.m, xs.shape)
+        lo, hi = M_STAR_RANGE
+        bad = ~np.isfinite(m) | (m < lo) | (m > hi)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise ValueError(
+                f"coating: the coating compliance relative to the base, m* = E0 sum_k (1 - "
+                f"nu_k^2) h_k / E_k / (2 (1 - nu^2) a), is {m[i]:.3g} at x = {x[i]:.6g} m, "
+                f"outside [{lo:g}, {hi:g}]: the layers are too stiff or soft, thin or thick "
+                "against the base to be solved in double precision")
+        if callable(problem.g):
+            g = problem.g(xs)
+            bad = ~np.isfinite(g) | (np.abs(g) > MAX_GAP_RATIO)
+            if bad.any():
+                i = int(np.argmax(bad))
+                f_range = float(np.ptp(_values(scene.shape, x)))
+                h_range = float(np.ptp(scene.coating_thickness(x)))
+                where = "punch.shape" if not f_range < h_range else "coating"
+                raise ValueError(
+                    f"{where}: the gap between the punch base and the coating surface is "
+                    f"{g[i]:.3g} half-widths at x = {x[i]:.6g} m (at most "
+                    f"{MAX_GAP_RATIO:g}): far beyond the shallow contact of this model")
+        _check_creep(scene, problem)
+        ts = problem.times
+        for name, load in problem.loads.items():
+            values = np.broadcast_to(load(ts) if callable(load) else load, ts.shape)
+            bad = ~np.isfinite(values)
+            if bad.any():
+                i = int(np.argmax(bad))
+                raise ValueError(
+                    f"loading.{name}: cannot be scaled by the base modulus and the "
+                    f"half-width in double precision at t = {scene.times[i]:.6g} days after "
+                    "loading (the sizes in the scene are too far apart)")
+
+
+def _check_creep(scene: Scene, problem: DimensionlessProblem) -> None:
+    """The relative modulus and the creep kernel at the ages of the solve: finite, and for
+    a kernel given as a formula, never positive (a positive ``K`` makes the compliance
+    decrease in time)."""
+    tau0 = scene.age_at_loading
+    ts = problem.times
+    c = np.broadcast_to(problem.c(ts) if callable(problem.c) else problem.c, ts.shape)
+    bad = ~np.isfinite(c) | (c <= 0)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(
+            f"base.creep: the modulus E(age) / E(age at loading) is {c[i]:.3g} at the age "
+            f"{tau0 * ts[i]:.6g} days: the creep parameters or base.age_at_loading are "
+            "too extreme for double precision")
+    kernel = problem.kernel
+    if kernel is None:
+        return
+    # the output times and a few between, all pairs t >= tau
+    grid = np.unique(np.concatenate([ts[np.linspace(0, ts.size - 1, min(ts.size, 17))
+                                        .round().astype(int)],
+                                     np.linspace(ts[0], ts[-1], 17)]))
+    t_star, tau_star = np.meshgrid(grid, grid, indexing="ij")
+    keep = t_star >= tau_star
+    t_star, tau_star = t_star[keep], tau_star[keep]
+    try:
+        k = np.asarray(kernel(t_star, tau_star), dtype=float)
+    except ValueError as exc:  # a formula kernel refuses its own non-finite values
+        where = "base.creep.expr" if isinstance(scene.creep, UserKernel) else "base.creep"
+        raise ValueError(f"{where}: {exc}") from None
+    bad = ~np.isfinite(k)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(
+            f"base.creep: the creep kernel K(t, tau) is {k[i]} at the ages t = "
+            f"{tau0 * t_star[i]:.6g}, tau = {tau0 * tau_star[i]:.6g} days: the creep "
+            "parameters or base.age_at_loading are too extreme for double precision")
+    user = isinstance(scene.creep, UserKernel)
+    if user:
+        # the shipped models are <= 0 by their coefficient checks; a formula is checked
+        # on samples, with room for rounding of a kernel that is 0 somewhere
+        scale = float(np.max(np.abs(k))) if k.size else 0.0
+        bad = k > 1e-9 * scale
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise ValueError(
+                f"base.creep.expr: K(t, tau) must be <= 0 (the base creeps), is "
+                f"{k[i] / tau0:.3g} per day at the ages t = {tau0 * t_star[i]:.6g}, tau = "
+                f"{tau0 * tau_star[i]:.6g} days: a positive kernel makes the compliance "
+                "decrease in time")
+        # creep strain per elastic strain under a unit stress held from loading:
+        # -int_1^t* K*(t*, s) ds, on points graded toward s = t* where a fast kernel lives
+        u = np.concatenate([[0.0], np.geomspace(1e-12, 1.0, 400)])
+        s = ts[-1] - (ts[-1] - ts[0]) * u
+        line = np.asarray(kernel(np.full(s.shape, ts[-1]), s), dtype=float)
+        phi = float(np.sum(0.5 * (line[1:] + line[:-1]) * (s[:-1] - s[1:])))
+        phi = -phi
+    else:
+        phi = float(scene.modulus_at_loading()
+                    * np.asarray(scene.creep.compliance(tau0 * ts[-1], tau0), dtype=float))
+    if not phi <= MAX_CREEP_COEFFICIENT:
+        raise ValueError(
+            f"{'base.creep.expr' if user else 'base.creep'}: the creep coefficient (creep "
+            "strain over elastic strain under a stress held from loading to the last output "
+            f"time) is {phi:.3g}, more than {MAX_CREEP_COEFFICIENT:g}: far beyond real "
+            "materials, and beyond what the time stepping can follow in reasonable time")
 
 
 def _spec_of(profile: Profile, given: Any) -> Any:
@@ -637,10 +815,16 @@ def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     return out
 
 
+def _parse_int(text: str) -> int | float:
+    # no double holds more than 309 digits; Python's int() of a few thousand digits raises
+    # an error about its own limits, so such a number becomes inf, refused by its field
+    return int(text) if len(text) <= 400 else (-math.inf if text[0] == "-" else math.inf)
+
+
 def parse_scene_json(text: str, source: str = "scene") -> Scene:
     """Parse and validate the JSON text of a scene; errors name ``source`` or the field."""
     try:
-        data = json.loads(text, object_pairs_hook=_no_duplicates)
+        data = json.loads(text, object_pairs_hook=_no_duplicates, parse_int=_parse_int)
     except json.JSONDecodeError as exc:
         raise ValueError(f"{source}: not valid JSON ({exc.msg} at line {exc.lineno}, "
                          f"column {exc.colno})") from None
@@ -815,11 +999,13 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
             else:
                 loads[name] = _kinematic_load(profile, scale, days)
         else:
-            power = 1 if name == "force" else 2
+            # a * a, not a**2: Python's float power raises OverflowError for a huge a,
+            # products give inf, which the checks of scene_from_dict report
+            a_power = a if name == "force" else a * a
             if _is_constant(profile) and not aging:
-                loads[name] = float(plane * _values(profile, np.zeros(1))[0] / (e0 * a**power))
+                loads[name] = float(plane * _values(profile, np.zeros(1))[0] / (e0 * a_power))
             else:
-                loads[name] = _static_load(profile, plane / a**power, days, modulus, tau0)
+                loads[name] = _static_load(profile, plane / a_power, days, modulus, tau0)
 
     times_star = (tau0 + np.asarray(scene.times, dtype=float)) / tau0
     times_star[0] = max(times_star[0], 1.0)
@@ -1009,4 +1195,23 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
     """
     scene = scene_from_dict(scene)
     problem = scene.dimensionless
-    return SceneSolution(scene, problem, problem.solve())
+    with np.errstate(all="ignore"):
+        result = SceneSolution(scene, problem, problem.solve())
+    _check_finite(result)
+    return result
+
+
+def _check_finite(result: SceneSolution) -> None:
+    """Refuse an answer with a non-finite value: the last guard of the promise that a
+    result never holds NaN or infinity (the checks of :func:`scene_from_dict` catch the
+    known causes first, with the field to change)."""
+    parts = [(q, getattr(result, q)) for q in QUANTITIES]
+    parts.append(("pressure", result.pressure_on_grid))
+    for name, values in parts:
+        bad = ~np.isfinite(np.asarray(values, dtype=float))
+        if bad.any():
+            j = int(np.argwhere(bad)[0][-1])  # the time index (last axis)
+            raise ValueError(
+                f"scene: the computed {name} is not finite at t = {result.times[j]:.6g} days "
+                "after loading: the sizes in this scene (moduli, loads, lengths) are too far "
+                "apart for double precision")

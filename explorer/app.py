@@ -385,7 +385,7 @@ class ExplorerApp(pn.viewable.Viewer):
         # display
         self.alert = pn.pane.Alert("", alert_type="danger", visible=False,
                                    sizing_mode="stretch_width", css_classes=["solve-error"])
-        self.notice_alert = pn.pane.Alert(self.notice, alert_type="warning",
+        self.notice_alert = pn.pane.Alert(html.escape(self.notice), alert_type="warning",
                                           visible=bool(self.notice),
                                           sizing_mode="stretch_width",
                                           css_classes=["notice"])
@@ -588,10 +588,22 @@ class ExplorerApp(pn.viewable.Viewer):
         data = event.new
         if not data:
             return
+        from core.scene import MAX_SCENE_BYTES
+
+        # the same limit as the command line: a browser may send up to the websocket's
+        # message size, and parsing costs memory and time on the shared server
+        if len(data) > MAX_SCENE_BYTES:
+            self.notice = (f"The file {self.load_file.filename!r} is too large ({len(data)} "
+                           f"bytes; a scene file has at most {MAX_SCENE_BYTES})")
+            return
         try:
             scene = json.loads(data.decode("utf-8-sig") if isinstance(data, bytes) else data)
         except (UnicodeDecodeError, json.JSONDecodeError) as exc:
             self.notice = f"The file {self.load_file.filename!r} is not valid JSON: {exc}"
+            return
+        except RecursionError:
+            self.notice = (f"The file {self.load_file.filename!r} is not valid JSON: nested "
+                           "too deeply")
             return
         if not isinstance(scene, dict):
             self.notice = "The file does not hold a scene (a JSON object)."
@@ -617,13 +629,16 @@ class ExplorerApp(pn.viewable.Viewer):
                                       custom_label=self.shape_file.filename or "a CSV file")
 
     def _on_notice(self, event: Any) -> None:
-        self.notice_alert.object = self.notice
+        # notices echo user text (file names, field names, formulas, links): the alert
+        # renders Markdown, which passes raw HTML through, so the text is escaped
+        self.notice_alert.object = html.escape(self.notice)
         self.notice_alert.visible = bool(self.notice)
 
     def _on_status(self, *events: Any) -> None:
         error = self.controller.error
-        self.alert.object = (f"**Not solved:** {error}  \nThe plots still show the last good "
-                             "result." if error else "")
+        # the core's messages echo user text (see _on_notice)
+        self.alert.object = (f"**Not solved:** {html.escape(error)}  \nThe plots still show "
+                             "the last good result." if error else "")
         self.alert.visible = bool(error)
         self.spinner.value = self.controller.busy
         self.status.object = status_html(self.controller.view, self.controller.busy)

@@ -63,6 +63,9 @@ def decode_scene(value: str) -> dict[str, Any]:
         scene = json.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ValueError(f"the scene in the link is not valid JSON ({exc})") from exc
+    except RecursionError:
+        # 100000 nested brackets deflate to a few hundred characters
+        raise ValueError("the scene in the link is not valid JSON (nested too deeply)") from None
     if not isinstance(scene, dict):
         raise ValueError("the scene in the link is not a JSON object")
     return scene

@@ -259,8 +259,10 @@ class PunchState(param.Parameterized):
         """The shape ``f(x)`` as a profile spec in metres."""
         a = self.half_width
         if self.shape == "parabolic":
-            return {"kind": "polynomial",
-                    "coefficients": [0.0, 0.0, 1.0 / (2.0 * self.radius * _KM)]}
+            radius = self.radius * _KM
+            # a zero radius must reach the core, which names the field, not crash here
+            curvature = 1.0 / (2.0 * radius) if radius != 0 else math.inf
+            return {"kind": "polynomial", "coefficients": [0.0, 0.0, curvature]}
         if self.shape == "wedge":
             rise = self.slope * _URAD * a
             return {"kind": "table", "points": [[-a, rise], [0.0, 0.0], [a, rise]],
