@@ -1,0 +1,691 @@
+"""Load test of the served explorer: many sessions moving sliders at once.
+
+Starts ``python -m explorer`` on 127.0.0.1 (loopback only). First one session alone (the
+reference), then ``--sessions`` sessions at once, each moving sliders for ``--minutes``
+like a student: the force slider most of the time (updates while dragging), now and then
+the coating thickness (a new geometry, solved on release, after opening its tab). Every
+move is one slider step; the session records the time from the move to the new pressure
+data arriving in its document.
+
+Two kinds of session (``--client``):
+
+- ``browser``: real Chromium pages (Playwright, one browser process); a key press on the
+  slider's handle, the time measured in the page to the data change ("data") and to the
+  second animation frame after it ("frame").
+- ``protocol`` (default): the Bokeh websocket protocol, as a browser speaks it
+  (``bokeh.client``: the page's document is pulled, "document ready" is sent, widget
+  values are patched, the server's patches applied); no rendering. On the 2-core test
+  machine 20 Chromium pages saturate both cores by themselves (see the report), so the
+  browser measures its own starvation rather than the server; the protocol client costs
+  a fraction of that and leaves the cores to the server.
+
+Reported: errors (failed connections, updates that never came, solve errors shown in a
+session, tracebacks in the server's log; goal 0), latency percentiles of the crowd
+against the single session (goal p95 <= 2x), the server's resident memory over time from
+``/proc/PID/status`` (goal: flat, under 1 GiB) and CPU use of the server and the machine.
+The run is bounded in time (``--minutes`` after the last session is ready, a hard deadline
+on top) and in requests (``--max-requests`` per session), and stops by itself. Not part
+of the test suite. Usage::
+
+    python benchmarks/load_test.py --sessions 20 --minutes 3 [--client protocol|browser]
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import os
+import platform
+import random
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import urllib.request
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parent.parent
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
+                 "--disable-background-networking", "--disable-component-update",
+                 "--no-first-run", "--disable-sync",
+                 # pages of one browser compete for its renderers: none may be throttled
+                 # as a background tab
+                 "--disable-background-timer-throttling", "--disable-renderer-backgrounding",
+                 "--disable-backgrounding-occluded-windows"]
+HOST = "127.0.0.1"
+#: Index of the "Coating" tab of the sidebar, and the step of a thickness move [mm].
+COATING_TAB = 2
+THICKNESS_STEP = 0.1
+#: A session waits this long for the plot to follow a move before counting an error [s].
+UPDATE_TIMEOUT = 30.0
+
+READY = """() => {
+  const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];
+  const src = doc && doc.get_model_by_name('q_source');
+  return !!src && !!src.data.q && src.data.q.length > 1;
+}"""
+
+# For every change of the pressure data after a key press: the time to the change
+# ("data") and to the second animation frame after it ("frame"), in ms.
+INSTRUMENT = """() => {
+  const src = Bokeh.documents[0].get_model_by_name('q_source');
+  window.__data = []; window.__frame = []; window.__key = null;
+  document.addEventListener('keydown', () => { window.__key = performance.now(); }, true);
+  src.change.connect(() => {
+    const t0 = window.__key;
+    if (t0 === null) return;
+    window.__key = null;
+    window.__data.push(performance.now() - t0);
+    requestAnimationFrame(() => requestAnimationFrame(
+      () => window.__frame.push(performance.now() - t0)));
+  });
+}"""
+
+
+@dataclass
+class Stats:
+    """What the sessions of one phase saw (appended to from several threads)."""
+
+    data: list[float] = field(default_factory=list)     # ms
+    frame: list[float] = field(default_factory=list)    # ms
+    requests: int = 0
+    geometry_requests: int = 0
+    errors: list[str] = field(default_factory=list)
+    sessions_ready: int = 0
+    lock: threading.Lock = field(default_factory=threading.Lock)
+
+    def count(self, geometry: bool) -> None:
+        with self.lock:
+            self.requests += 1
+            self.geometry_requests += geometry
+
+    def ready(self) -> None:
+        with self.lock:
+            self.sessions_ready += 1
+
+    def error(self, text: str) -> None:
+        with self.lock:
+            self.errors.append(text)
+
+
+class Clock:
+    """When the sessions of a phase stop: ``seconds`` after the last one is ready, never
+    after ``hard_end`` (monotonic times). Safe across threads."""
+
+    def __init__(self, sessions: int, seconds: float, hard_end: float) -> None:
+        self.sessions = sessions
+        self.seconds = seconds
+        self.hard_end = hard_end
+        self.end: float | None = None
+        self.all_ready = threading.Event()
+        self._ready = 0
+        self._lock = threading.Lock()
+
+    def arrived(self) -> None:
+        with self._lock:
+            self._ready += 1
+            if self._ready == self.sessions:
+                self.end = time.monotonic() + self.seconds
+                self.all_ready.set()
+
+    def running(self) -> bool:
+        now = time.monotonic()
+        return now < self.hard_end and (self.end is None or now < self.end)
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind((HOST, 0))
+        return s.getsockname()[1]
+
+
+def rss_bytes(pid: int) -> int | None:
+    """Resident memory of a process [bytes], from /proc (None once it is gone)."""
+    try:
+        with open(f"/proc/{pid}/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
+
+
+def cpu_seconds(pid: int) -> float | None:
+    """User + system CPU time of a process [s], from /proc."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as fh:
+            fields = fh.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except OSError:
+        return None
+
+
+def machine_ticks() -> tuple[int, int]:
+    """(busy, total) CPU ticks of the whole machine since boot, from /proc/stat."""
+    with open("/proc/stat", encoding="ascii") as fh:
+        values = [int(v) for v in fh.readline().split()[1:]]
+    idle = values[3] + (values[4] if len(values) > 4 else 0)
+    return sum(values) - idle, sum(values)
+
+
+class Sampler(threading.Thread):
+    """Samples the server's RSS and CPU time and the machine's CPU use every ``period``
+    seconds; ``mark`` records events on the same clock."""
+
+    def __init__(self, pid: int, period: float = 2.0) -> None:
+        super().__init__(daemon=True)
+        self.pid = pid
+        self.period = period
+        # (s since start, RSS bytes, server CPU s, machine busy ticks, machine ticks)
+        self.samples: list[tuple[float, int, float, int, int]] = []
+        self.marks: list[tuple[float, str]] = []
+        self._halt = threading.Event()
+        self.t0 = time.monotonic()
+
+    def mark(self, label: str) -> None:
+        self.marks.append((time.monotonic() - self.t0, label))
+
+    def run(self) -> None:
+        while not self._halt.is_set():
+            rss, cpu = rss_bytes(self.pid), cpu_seconds(self.pid)
+            if rss is not None and cpu is not None:
+                self.samples.append((time.monotonic() - self.t0, rss, cpu, *machine_ticks()))
+            self._halt.wait(self.period)
+
+    def stop(self) -> None:
+        self._halt.set()
+        self.join(timeout=10)
+
+    def between(self, start: str, stop: str) -> dict[str, float]:
+        """Server CPU [% of one core] and machine CPU [% of all cores] between two marks."""
+        marks = {label: t for t, label in self.marks}
+        inside = [s for s in self.samples if marks[start] <= s[0] <= marks[stop]]
+        if len(inside) < 2:
+            return {"server": float("nan"), "machine": float("nan")}
+        (t0, _, c0, b0, n0), (t1, _, c1, b1, n1) = inside[0], inside[-1]
+        return {"server": 100 * (c1 - c0) / max(t1 - t0, 1e-9),
+                "machine": 100 * (b1 - b0) / max(n1 - n0, 1)}
+
+
+def start_server(log_path: Path, solver_threads: int) -> tuple[subprocess.Popen, str]:
+    port = free_port()
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
+    env.setdefault("OPENBLAS_NUM_THREADS", "1")
+    log = log_path.open("wb")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "explorer", "--address", HOST, "--port", str(port),
+         "--allow-websocket-origin", f"{HOST}:{port}",
+         "--solver-threads", str(solver_threads)],
+        cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
+    url = f"http://{HOST}:{port}"
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline:
+        try:
+            with urllib.request.urlopen(url + "/liveness", timeout=2):
+                return proc, url
+        except OSError:
+            if proc.poll() is not None:
+                raise SystemExit(f"the explorer server exited; see {log_path}") from None
+            time.sleep(0.5)
+    proc.kill()
+    raise SystemExit("the explorer server did not start")
+
+
+def next_step(rng: random.Random, position: dict[str, int], name: str) -> int:
+    """A random walk that stays near the start: values repeat across sessions as they do
+    in a classroom, and the caches help as they would there."""
+    step = rng.choice((-1, 1)) if abs(position[name]) < 15 else \
+        (-1 if position[name] > 0 else 1)
+    position[name] += step
+    return step
+
+
+# ----------------------------------------------------------------- the protocol client
+
+
+def _models_with_class(doc: Any, css: str) -> list[Any]:
+    return [m for m in list(doc.models) if css in (getattr(m, "css_classes", None) or [])]
+
+
+def _part(tabs: Any, tab: int, css: str, kind: str) -> Any | None:
+    """The Bokeh model of type ``kind`` inside the widget with CSS class ``css`` on the
+    sidebar's tab ``tab``, once the server has switched to that tab.
+
+    The explorer's tabs are dynamic: the server replaces an inactive tab's content by a
+    Spacer and builds the active one. Until the server's patches for a switch arrive, the
+    client still holds the old contents; a value set on them then is lost (the server
+    detaches those models), so the switch must be seen complete: every other tab a
+    Spacer, this one not.
+    """
+    for k, panel in enumerate(tabs.tabs):
+        if (type(panel.child).__name__ == "Spacer") == (k == tab):
+            return None
+    content = tabs.tabs[tab].child
+    for holder in content.references():
+        if css in (getattr(holder, "css_classes", None) or []):
+            for ref in holder.references():
+                if type(ref).__name__ == kind:
+                    return ref
+    return None
+
+
+def _iterative_message_loop() -> None:
+    """Make ``bokeh.client`` handle incoming messages in a loop.
+
+    Its connection handles each message one coroutine level deeper than the one before
+    (``_handle_messages`` -> ``_next`` -> ``_handle_messages`` ...): fine for the short
+    scripts it is meant for, a RecursionError after a few minutes of slider patches.
+    """
+    from bokeh.client import connection
+    from bokeh.client.states import CONNECTED_AFTER_ACK, DISCONNECTED, ErrorReason
+
+    async def handle_messages(self: Any) -> None:
+        while True:
+            message = await self._pop_message()
+            if message is None:
+                await self._transition_to_disconnected(
+                    DISCONNECTED(ErrorReason.HTTP_ERROR, 500, "Internal server error."))
+                return
+            if message.msgtype == "PATCH-DOC":
+                self._session._handle_patch(message)
+            # what _next() would do before the next message, without going deeper
+            if self._until_predicate is not None and self._until_predicate():
+                self._until_predicate = None
+                self._loop.stop()
+                return
+            if not isinstance(self._state, CONNECTED_AFTER_ACK):
+                await self._next()
+                return
+
+    connection.ClientConnection._handle_messages = handle_messages
+
+
+def protocol_session(url: str, seed: int, clock: Clock, max_requests: int, stats: Stats,
+                     geometry_share: float, think: tuple[float, float]) -> None:
+    """One student on the Bokeh protocol, in its own thread and event loop."""
+    import panel  # noqa: F401  (registers Panel's models, so its documents deserialize)
+    from bokeh.client import pull_session
+    from bokeh.events import DocumentReady
+
+    tag = f"session {seed}"
+    rng = random.Random(seed)
+    try:
+        session = pull_session(url=url + "/app")
+    except Exception as exc:  # a refused connection is an error to report
+        stats.error(f"{tag}: could not open a session: {type(exc).__name__}: {exc}")
+        clock.arrived()
+        return
+    doc = session.document
+    loop = session._connection.io_loop
+    q_source = doc.select_one({"name": "q_source"})
+    arrived: dict[str, Any] = {"future": None}
+
+    def on_pressure(attr: str, old: Any, new: Any) -> None:
+        future = arrived["future"]
+        if future is not None and not future.done():
+            future.set_result(time.perf_counter())
+
+    q_source.on_change("data", on_pressure)
+
+    async def wait_for(predicate: Any, timeout: float) -> Any:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            found = predicate()
+            if found is not None:
+                return found
+            await asyncio.sleep(0.05)
+        return None
+
+    async def behave() -> None:
+        requests = 0
+        position = {"force": 0, "thickness": 0}
+        try:
+            # what BokehJS sends once the page is rendered: Panel's onload callbacks run
+            doc.callbacks.send_event(DocumentReady())
+            stats.ready()
+            clock.arrived()
+            tabs = next(m for m in doc.models if type(m).__name__ == "Tabs")
+            while clock.running() and requests < max_requests:
+                geometry = rng.random() < geometry_share
+                if geometry:
+                    tabs.active = COATING_TAB  # opening a tab builds its widgets
+                    target = await wait_for(lambda: _part(tabs, COATING_TAB,
+                                                          "coating-thickness", "Spinner"),
+                                            UPDATE_TIMEOUT)
+                    name = "thickness"
+                else:
+                    target = await wait_for(lambda: _part(tabs, 0, "load-0-value", "Slider"),
+                                            UPDATE_TIMEOUT)
+                    name = "force"
+                if target is None:
+                    shown = [type(panel.child).__name__ for panel in tabs.tabs]
+                    stats.error(f"{tag}: the {name} widget did not appear within "
+                                f"{UPDATE_TIMEOUT:g} s (tab {tabs.active} active, contents "
+                                f"{shown})")
+                    break
+                step = next_step(rng, position, name)
+                future = asyncio.get_running_loop().create_future()
+                arrived["future"] = future
+                sent = time.perf_counter()
+                if geometry:
+                    value = round(float(target.value) + step * THICKNESS_STEP, 6)
+                    # a typed value, confirmed: what the page sends on Enter
+                    target.value = value
+                    target.set_from_json("value_throttled", value)
+                else:
+                    target.value = float(target.value) + step * float(target.step)
+                stats.count(geometry)
+                requests += 1
+                try:
+                    received = await asyncio.wait_for(future, UPDATE_TIMEOUT)
+                    with stats.lock:
+                        stats.data.append(1e3 * (received - sent))
+                except asyncio.TimeoutError:
+                    stats.error(f"{tag}: no plot update within {UPDATE_TIMEOUT:g} s after "
+                                f"a {name} move")
+                if geometry:
+                    tabs.active = 0
+                    # seen through before the next move (see _part)
+                    await wait_for(lambda: _part(tabs, 0, "load-0-value", "Slider"),
+                                   UPDATE_TIMEOUT)
+                await asyncio.sleep(rng.uniform(*think))
+            alert = _models_with_class(doc, "solve-error")
+            if alert and getattr(alert[0], "visible", False):
+                stats.error(f"{tag}: the session shows a solve error")
+        except Exception as exc:  # reported; the other sessions go on
+            stats.error(f"{tag}: {type(exc).__name__}: {str(exc)[:200]}")
+        finally:
+            session.close()
+
+    loop.add_callback(behave)
+    session._loop_until_closed()
+
+
+def run_protocol_phase(url: str, sessions: int, seconds: float, max_requests: int,
+                       geometry_share: float, think: tuple[float, float], stagger: float,
+                       sampler: Sampler, label: str) -> Stats:
+    _iterative_message_loop()
+    stats = Stats()
+    clock = Clock(sessions, seconds, time.monotonic() + stagger * sessions + 180 + seconds)
+    sampler.mark(f"{label}: {sessions} session(s) arriving")
+    threads = []
+    for k in range(sessions):
+        thread = threading.Thread(target=protocol_session, daemon=True, args=(
+            url, 1000 * sessions + k, clock, max_requests, stats, geometry_share, think))
+        thread.start()
+        threads.append(thread)
+        time.sleep(stagger)
+    clock.all_ready.wait(timeout=max(clock.hard_end - time.monotonic(), 0))
+    sampler.mark(f"{label}: all sessions ready")
+    for thread in threads:
+        thread.join(timeout=max(clock.hard_end - time.monotonic(), 0) + 60)
+        if thread.is_alive():
+            stats.error(f"{label}: a session did not stop by the hard deadline")
+    sampler.mark(f"{label}: sessions closed")
+    return stats
+
+
+# ------------------------------------------------------------------ the browser client
+
+
+async def browser_session(context: Any, url: str, seed: int, clock: Clock, max_requests: int,
+                          stats: Stats, geometry_share: float, think: tuple[float, float]
+                          ) -> None:
+    """One student in a Chromium page."""
+    rng = random.Random(seed)
+    page = await context.new_page()
+    tag = f"session {seed}"
+    page.on("pageerror", lambda e: stats.error(f"{tag}: page error: {e}"))
+    page.on("console", lambda m: m.type == "error" and stats.error(
+        f"{tag}: console error: {m.text[:200]}"))
+    try:
+        await page.goto(url + "/app", wait_until="commit", timeout=120_000)
+        await page.wait_for_function(READY, timeout=180_000, polling=200)
+        await page.evaluate(INSTRUMENT)
+        stats.ready()
+        clock.arrived()
+        force = page.locator(".load-0-value .noUi-handle").first
+        position = {"force": 0, "thickness": 0}
+        requests = 0
+        while clock.running() and requests < max_requests:
+            geometry = rng.random() < geometry_share
+            if geometry:
+                await page.locator(".bk-tab", has_text="Coating").first.click()
+                handle = page.locator(".coating-thickness .noUi-handle").first
+                name = "thickness"
+            else:
+                handle, name = force, "force"
+            step = next_step(rng, position, name)
+            before = await page.evaluate("() => window.__data.length")
+            await handle.press("ArrowRight" if step > 0 else "ArrowLeft")
+            requests += 1
+            stats.count(geometry)
+            try:
+                await page.wait_for_function(f"() => window.__data.length > {before}",
+                                             timeout=1e3 * UPDATE_TIMEOUT, polling=100)
+            except Exception:  # any failure to update is an error to report
+                stats.error(f"{tag}: no plot update within {UPDATE_TIMEOUT:g} s after a "
+                            f"{name} move")
+            if geometry:
+                await page.locator(".bk-tab", has_text="Scene").first.click()
+            await asyncio.sleep(rng.uniform(*think))
+        await asyncio.sleep(1.0)  # let the last frames land
+        data = await page.evaluate("() => window.__data")
+        frame = await page.evaluate("() => window.__frame")
+        with stats.lock:
+            stats.data.extend(data)
+            stats.frame.extend(frame)
+        if await page.locator(".solve-error").first.is_visible():
+            stats.error(f"{tag}: the page shows a solve error")
+    except Exception as exc:  # reported; the other sessions go on
+        stats.error(f"{tag}: {type(exc).__name__}: {str(exc)[:200]}")
+    finally:
+        await page.close()
+
+
+async def _browser_phase(url: str, sessions: int, seconds: float, max_requests: int,
+                         geometry_share: float, think: tuple[float, float], stagger: float,
+                         sampler: Sampler, label: str) -> Stats:
+    from playwright.async_api import async_playwright
+
+    stats = Stats()
+    with tempfile.TemporaryDirectory(prefix="load-test-chromium-") as profile:
+        async with async_playwright() as p:
+            context = await p.chromium.launch_persistent_context(
+                profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
+                viewport={"width": 1280, "height": 1000})
+            try:
+                sampler.mark(f"{label}: {sessions} session(s) arriving")
+                clock = Clock(sessions, seconds,
+                              time.monotonic() + stagger * sessions + 180 + seconds)
+                tasks = []
+                for k in range(sessions):
+                    tasks.append(asyncio.create_task(browser_session(
+                        context, url, 1000 * sessions + k, clock, max_requests, stats,
+                        geometry_share, think)))
+                    await asyncio.sleep(stagger)
+                while not clock.all_ready.is_set() and time.monotonic() < clock.hard_end:
+                    await asyncio.sleep(0.2)
+                sampler.mark(f"{label}: all sessions ready")
+                await asyncio.wait_for(asyncio.gather(*tasks),
+                                       timeout=clock.hard_end - time.monotonic() + 60)
+            finally:
+                sampler.mark(f"{label}: sessions closed")
+                await context.close()
+    return stats
+
+
+def run_browser_phase(*args: Any) -> Stats:
+    return asyncio.run(_browser_phase(*args))
+
+
+# ---------------------------------------------------------------------------- report
+
+
+def percentiles(values: list[float]) -> dict[str, float]:
+    if len(values) < 2:
+        return {"p50": float("nan"), "p95": float("nan"), "p99": float("nan")}
+    q = statistics.quantiles(values, n=100, method="inclusive")
+    return {"p50": statistics.median(values), "p95": q[94], "p99": q[98]}
+
+
+def server_tracebacks(log_path: Path) -> list[str]:
+    text = log_path.read_text(errors="replace")
+    blocks = text.split("Traceback (most recent call last)")[1:]
+    # a client that left while the server wrote to its websocket: no failure of the app
+    closed = ("WebSocketClosedError", "StreamClosedError")
+    return [b[:400] for b in blocks if not any(c in b[:3000] for c in closed)]
+
+
+def report(args: argparse.Namespace, single: Stats, crowd: Stats, sampler: Sampler,
+           log_errors: list[str], command: str) -> str:
+    s_data, c_data = percentiles(single.data), percentiles(crowd.data)
+    samples = sampler.samples
+    peak = max(s[1] for s in samples)
+    marks = {label: t for t, label in sampler.marks}
+    start, stop = marks["crowd: all sessions ready"], marks["crowd: sessions closed"]
+    crowd_rss = [s[1] for s in samples if start <= s[0] <= stop]
+    half = [(s[0], s[1]) for s in samples if (start + stop) / 2 <= s[0] <= stop]
+    slope = 0.0
+    if len(half) >= 2:
+        mt = statistics.fmean(t for t, _ in half)
+        mr = statistics.fmean(r for _, r in half)
+        slope = sum((t - mt) * (r - mr) for t, r in half) / max(
+            sum((t - mt) ** 2 for t, _ in half), 1e-9)
+    cpu_single = sampler.between("single: all sessions ready", "single: sessions closed")
+    cpu_crowd = sampler.between("crowd: all sessions ready", "crowd: sessions closed")
+    errors = single.errors + crowd.errors + [f"server log: {e}" for e in log_errors]
+    client = ("real Chromium pages (Playwright, one browser process)" if args.client ==
+              "browser" else "Bokeh websocket protocol clients (bokeh.client, one thread "
+              "each, no rendering)")
+
+    def row(name: str, s: dict[str, float], c: dict[str, float]) -> str:
+        return (f"| {name} | {s['p50']:.0f} / {s['p95']:.0f} / {s['p99']:.0f} | "
+                f"{c['p50']:.0f} / {c['p95']:.0f} / {c['p99']:.0f} | "
+                f"{c['p95'] / s['p95']:.2f} |")
+
+    lines = [
+        f"## {args.sessions} sessions, {args.client} client, {args.minutes:g} min",
+        "",
+        "Command (from the repository root):",
+        "",
+        f"    {command}",
+        "",
+        f"Machine: {os.cpu_count()} cores ({platform.machine()}), Python "
+        f"{platform.python_version()}; server, clients and driver share it. Server: "
+        f"`python -m explorer --address {HOST} --solver-threads {args.solver_threads}` "
+        "(loopback only).",
+        "",
+        f"Sessions: {args.sessions} {client}, arriving {args.stagger:g} s apart, all moving "
+        f"sliders until {args.minutes:g} min after the last was ready: one step of the force "
+        f"slider (live update) or, with probability {args.geometry_share:g}, of the coating "
+        f"thickness (a new geometry; its tab opened first), then a pause of "
+        f"{args.think[0]:g}-{args.think[1]:g} s. Single session: the same for "
+        f"{args.baseline_seconds:g} s, alone on the same server, before the crowd.",
+        "",
+        f"- Errors: **{len(errors)}** (goal 0): failed sessions, updates that never came "
+        f"(within {UPDATE_TIMEOUT:g} s), solve errors shown, page or console errors "
+        "(browser), tracebacks in the server log.",
+        f"- Moves: single {single.requests} ({single.geometry_requests} geometry), crowd "
+        f"{crowd.requests} ({crowd.geometry_requests} geometry) from "
+        f"{crowd.sessions_ready}/{args.sessions} sessions; updates timed: single "
+        f"{len(single.data)}, crowd {len(crowd.data)}.",
+        f"- Server memory (RSS): peak **{peak / 2**20:.0f} MiB** (goal < 1024 MiB); during "
+        f"the crowd {min(crowd_rss) / 2**20:.0f} to {max(crowd_rss) / 2**20:.0f} MiB, trend "
+        f"over its second half {slope * 60 / 2**20:+.1f} MiB/min.",
+        f"- CPU: server {cpu_single['server']:.0f} % of one core alone, "
+        f"{cpu_crowd['server']:.0f} % with the crowd; the whole machine "
+        f"{cpu_single['machine']:.0f} % and {cpu_crowd['machine']:.0f} % of its "
+        f"{os.cpu_count()} cores.",
+        "",
+        "Latency from the move, ms (p50 / p95 / p99):",
+        "",
+        "| measured to | single session | crowd | p95 crowd / single (goal <= 2) |",
+        "| --- | --- | --- | --- |",
+        row("new pressure data in the session", s_data, c_data),
+    ]
+    if args.client == "browser":
+        lines.append(row("second frame painted after it", percentiles(single.frame),
+                         percentiles(crowd.frame)))
+    lines += ["", "Server memory over time (RSS; t from the server's start):", "",
+              "| t [s] | RSS [MiB] | event |", "| --- | --- | --- |"]
+    step = max(1, int(30 / sampler.period))
+    for i, (t, rss, *_rest) in enumerate(samples):
+        events = [label for m, label in sampler.marks if abs(m - t) <= sampler.period / 2]
+        if i % step == 0 or events or i == len(samples) - 1:
+            lines.append(f"| {t:.0f} | {rss / 2**20:.0f} | {', '.join(events)} |")
+    if errors:
+        lines += ["", "Errors (first 20):", ""] + [f"- {e}" for e in errors[:20]]
+    return "\n".join(lines) + "\n"
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--sessions", type=int, default=20, help="concurrent sessions")
+    parser.add_argument("--minutes", type=float, default=3.0,
+                        help="minutes the crowd moves sliders once all have arrived")
+    parser.add_argument("--client", choices=("protocol", "browser"), default="protocol",
+                        help="Bokeh websocket protocol clients (default) or Chromium pages")
+    parser.add_argument("--baseline-seconds", type=float, default=60.0,
+                        help="seconds of the single-session reference")
+    parser.add_argument("--max-requests", type=int, default=2000,
+                        help="most moves per session (a bound on the run)")
+    parser.add_argument("--geometry-share", type=float, default=0.15,
+                        help="share of moves of the coating thickness")
+    parser.add_argument("--think", type=float, nargs=2, default=(0.3, 1.2),
+                        metavar=("MIN", "MAX"), help="pause after each update [s]")
+    parser.add_argument("--stagger", type=float, default=1.0,
+                        help="seconds between the arrivals of two sessions")
+    parser.add_argument("--solver-threads", type=int, default=2)
+    parser.add_argument("--after-seconds", type=float, default=45.0,
+                        help="seconds of memory samples after the crowd has left")
+    parser.add_argument("--report", help="append the report (Markdown) to this file")
+    args = parser.parse_args()
+    command = "python benchmarks/load_test.py " + " ".join(sys.argv[1:])
+    phase = run_browser_phase if args.client == "browser" else run_protocol_phase
+
+    with tempfile.TemporaryDirectory(prefix="load-test-") as tmp:
+        log_path = Path(tmp) / "server.log"
+        proc, url = start_server(log_path, args.solver_threads)
+        sampler = Sampler(proc.pid)
+        sampler.start()
+        sampler.mark("server ready")
+        try:
+            think = tuple(args.think)
+            single = phase(url, 1, args.baseline_seconds, args.max_requests,
+                           args.geometry_share, think, 0.0, sampler, "single")
+            crowd = phase(url, args.sessions, 60 * args.minutes, args.max_requests,
+                          args.geometry_share, think, args.stagger, sampler, "crowd")
+            time.sleep(args.after_seconds)
+            sampler.mark("end")
+            time.sleep(sampler.period)
+        finally:
+            try:
+                sampler.stop()
+            finally:
+                proc.terminate()
+                try:
+                    proc.wait(timeout=20)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+        log_errors = server_tracebacks(log_path)
+    text = report(args, single, crowd, sampler, log_errors, command)
+    print(text)
+    if args.report:
+        path = Path(args.report)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with path.open("a", encoding="utf-8") as fh:
+            fh.write(text + "\n")
+    return 0 if not (single.errors or crowd.errors or log_errors) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
