@@ -263,11 +263,11 @@ def _part(tabs: Any, tab: int, css: str, kind: str) -> Any | None:
     Spacer and builds the active one. Until the server's patches for a switch arrive, the
     client still holds the old contents; a value set on them then is lost (the server
     detaches those models), so the switch must be seen complete: every other tab a
-    Spacer, this one not.
+    Spacer, this one not. (Tabs built all at once have no Spacers: nothing to wait for.)
     """
-    for k, panel in enumerate(tabs.tabs):
-        if (type(panel.child).__name__ == "Spacer") == (k == tab):
-            return None
+    spacers = [type(panel.child).__name__ == "Spacer" for panel in tabs.tabs]
+    if any(spacers) and any(spacer == (k == tab) for k, spacer in enumerate(spacers)):
+        return None
     content = tabs.tabs[tab].child
     for holder in content.references():
         if css in (getattr(holder, "css_classes", None) or []):
