@@ -16,6 +16,7 @@ import math
 import os
 import re
 import signal
+import time
 from collections import Counter
 from collections.abc import Iterator
 from typing import Any
@@ -66,16 +67,22 @@ class Hang(Exception):
 
 @contextlib.contextmanager
 def hang_guard(seconds: float = HANG_SECONDS) -> Iterator[None]:
+    """Raise :class:`Hang` in the block after ``seconds``; an outer alarm (pytest-timeout
+    uses the same signal) is put back afterwards with the time it had left."""
     def alarm(signum: int, frame: Any) -> None:
         raise Hang(f"no answer after {seconds} s")
 
+    start = time.monotonic()
     previous = signal.signal(signal.SIGALRM, alarm)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
+    outer, interval = signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
         yield
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
+        if outer > 0:
+            left = max(outer - (time.monotonic() - start), 1e-3)
+            signal.setitimer(signal.ITIMER_REAL, left, interval)
 
 
 def assert_names_a_field(message: str) -> None:
