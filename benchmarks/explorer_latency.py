@@ -21,18 +21,19 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import re
-import socket
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
-import urllib.request
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from explorer.serving import ExplorerProcess, ExplorerStartError  # noqa: E402
+
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
                  "--disable-background-networking", "--disable-component-update",
@@ -63,33 +64,6 @@ INSTRUMENT = """() => {
 }"""
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("localhost", 0))
-        return s.getsockname()[1]
-
-
-def start_server() -> tuple[subprocess.Popen, str]:
-    port = free_port()
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
-    proc = subprocess.Popen([sys.executable, "-m", "explorer", "--port", str(port)],
-                            cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
-    url = f"http://localhost:{port}"
-    deadline = time.monotonic() + 300
-    while time.monotonic() < deadline:
-        try:
-            with urllib.request.urlopen(url + "/liveness", timeout=2):
-                return proc, url
-        except OSError:
-            if proc.poll() is not None:
-                raise SystemExit("the explorer server exited") from None
-            time.sleep(0.5)
-    proc.kill()
-    raise SystemExit("the explorer server did not start")
-
-
 def measure_slider(page, tab: str, css: str, presses: int, key: str) -> list[float]:
     """Press ``key`` on a slider's handle ``presses`` times; latency of each [ms]."""
     page.locator(".bk-tab", has_text=tab).first.click()
@@ -118,10 +92,14 @@ def main() -> None:
 
     from playwright.sync_api import sync_playwright
 
-    proc = None
+    server = None
     url = args.url
     if url is None:
-        proc, url = start_server()
+        server = ExplorerProcess(ready_timeout=300, stop_timeout=20)
+        try:
+            url = server.start().url
+        except ExplorerStartError as err:
+            raise SystemExit(str(err)) from None
     results: dict[str, list[float]] = {}
     solves: dict[str, list[float]] = {}
     try:
@@ -150,9 +128,8 @@ def main() -> None:
                                                              "ArrowRight")
             context.close()
     finally:
-        if proc is not None:
-            proc.terminate()
-            proc.wait(timeout=20)
+        if server is not None:
+            server.stop()
 
     goals = {"first page load": 3000, "load slider (force)": 100, "coating thickness": 250,
              "punch half-width": 250, "base thickness": 400}

@@ -37,19 +37,21 @@ import asyncio
 import os
 import platform
 import random
-import socket
 import statistics
-import subprocess
 import sys
 import tempfile
 import threading
 import time
-import urllib.request
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from explorer.serving import ExplorerProcess, ExplorerStartError  # noqa: E402
+
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
                  "--disable-background-networking", "--disable-component-update",
@@ -139,12 +141,6 @@ class Clock:
         return now < self.hard_end and (self.end is None or now < self.end)
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind((HOST, 0))
-        return s.getsockname()[1]
-
-
 def rss_bytes(pid: int) -> int | None:
     """Resident memory of a process [bytes], from /proc (None once it is gone)."""
     try:
@@ -212,31 +208,6 @@ class Sampler(threading.Thread):
         (t0, _, c0, b0, n0), (t1, _, c1, b1, n1) = inside[0], inside[-1]
         return {"server": 100 * (c1 - c0) / max(t1 - t0, 1e-9),
                 "machine": 100 * (b1 - b0) / max(n1 - n0, 1)}
-
-
-def start_server(log_path: Path, solver_threads: int) -> tuple[subprocess.Popen, str]:
-    port = free_port()
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
-    env.setdefault("OPENBLAS_NUM_THREADS", "1")
-    log = log_path.open("wb")
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "explorer", "--address", HOST, "--port", str(port),
-         "--allow-websocket-origin", f"{HOST}:{port}",
-         "--solver-threads", str(solver_threads)],
-        cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
-    url = f"http://{HOST}:{port}"
-    deadline = time.monotonic() + 300
-    while time.monotonic() < deadline:
-        try:
-            with urllib.request.urlopen(url + "/liveness", timeout=2):
-                return proc, url
-        except OSError:
-            if proc.poll() is not None:
-                raise SystemExit(f"the explorer server exited; see {log_path}") from None
-            time.sleep(0.5)
-    proc.kill()
-    raise SystemExit("the explorer server did not start")
 
 
 def next_step(rng: random.Random, position: dict[str, int], name: str) -> int:
@@ -654,8 +625,16 @@ def main() -> int:
 
     with tempfile.TemporaryDirectory(prefix="load-test-") as tmp:
         log_path = Path(tmp) / "server.log"
-        proc, url = start_server(log_path, args.solver_threads)
-        sampler = Sampler(proc.pid)
+        server = ExplorerProcess(
+            args=["--solver-threads", str(args.solver_threads)], host=HOST,
+            env={"OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "1")},
+            log=log_path, ready_timeout=300, stop_timeout=20)
+        try:
+            url = server.start().url
+        except ExplorerStartError as err:
+            # the log is in the temporary directory, gone once this exits: quoted instead
+            raise SystemExit(str(err)) from None
+        sampler = Sampler(server.pid)
         sampler.start()
         sampler.mark("server ready")
         try:
@@ -671,11 +650,7 @@ def main() -> int:
             try:
                 sampler.stop()
             finally:
-                proc.terminate()
-                try:
-                    proc.wait(timeout=20)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
+                server.stop()
         log_errors = server_tracebacks(log_path)
     text = report(args, single, crowd, sampler, log_errors, command)
     print(text)

@@ -11,22 +11,19 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import socket
-import subprocess
-import sys
 import tempfile
 import time
-import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
+from explorer.serving import ExplorerProcess
+
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
 playwright_api = pytest.importorskip("playwright.sync_api")
 
-ROOT = Path(__file__).resolve().parent.parent
 ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
@@ -48,47 +45,13 @@ JS_Q = """() => Array.from(Bokeh.documents[0].get_model_by_name('q_source').data
 JS_TITLE = """(name) => Bokeh.documents[0].get_model_by_name(name).title.text"""
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("localhost", 0))
-        return s.getsockname()[1]
-
-
 @pytest.fixture(scope="module")
 def server() -> Iterator[str]:
-    port = _free_port()
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
-    log = tempfile.TemporaryFile()
-    proc = subprocess.Popen([sys.executable, "-m", "explorer", "--port", str(port)],
-                            cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
-    url = f"http://localhost:{port}"
-    deadline = time.monotonic() + 180  # includes solving the default scene once
-    try:
-        while True:
-            if proc.poll() is not None:
-                log.seek(0)
-                pytest.fail("the explorer server exited:\n" + log.read().decode(errors="replace"))
-            try:
-                with urllib.request.urlopen(url + "/liveness", timeout=2) as response:
-                    if response.status == 200:
-                        break
-            except OSError:
-                pass
-            if time.monotonic() > deadline:
-                pytest.fail("the explorer server did not start in time")
-            time.sleep(0.5)
-        yield url
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-        log.seek(0)
-        output = log.read().decode(errors="replace")
-        log.close()
-        assert not _app_tracebacks(output), output
+    # 180 s: the server solves the default scene once before it answers
+    with ExplorerProcess(ready_timeout=180) as explorer:
+        yield explorer.url
+    output = explorer.output()
+    assert not _app_tracebacks(output), output
 
 
 # Closing a page while the server still writes to its websocket makes tornado log a
