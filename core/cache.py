@@ -77,10 +77,15 @@ class StageCache:
     the first one instead of repeating the work.
     """
 
-    def __init__(self, name: str, max_items: int = 32, max_bytes: int = 256 * 2**20) -> None:
+    def __init__(self, name: str, max_items: int = 32, max_bytes: int = 256 * 2**20,
+                 sizeof: Callable[[Any], int] | None = None) -> None:
+        """``max_bytes`` bounds the sum of ``sizeof(value)`` over the values held [bytes];
+        ``sizeof`` defaults to the buffers of numpy arrays in tuples, dicts and
+        dataclasses."""
         self.name = name
         self.max_items = max_items
         self.max_bytes = max_bytes
+        self._sizeof = sizeof or _nbytes
         self._data: OrderedDict[Hashable, tuple[Any, int]] = OrderedDict()
         self._bytes = 0
         self._lock = threading.Lock()
@@ -111,18 +116,43 @@ class StageCache:
                 self._in_flight.pop(key, None)
             event.set()
             raise
-        size = _nbytes(value)
+        # measured outside the lock: sizing a large value takes milliseconds
+        size = self._sizeof(value)
         with self._lock:
             self.evaluations += 1
             self._in_flight.pop(key, None)
-            if size <= self.max_bytes:
-                self._data[key] = (value, size)
-                self._bytes += size
-                while len(self._data) > self.max_items or self._bytes > self.max_bytes:
-                    _, (_, old) = self._data.popitem(last=False)
-                    self._bytes -= old
+            self._store(key, value, size)
         event.set()
         return value, False
+
+    def get(self, key: Hashable) -> Any | None:
+        """The value held for ``key``, or None (nothing is computed)."""
+        with self._lock:
+            entry = self._data.get(key)
+            if entry is None:
+                return None
+            self._data.move_to_end(key)
+            self.hits += 1
+            return entry[0]
+
+    def put(self, key: Hashable, value: Any) -> None:
+        """Hold ``value`` for ``key`` (replacing an older one), within the bounds."""
+        size = self._sizeof(value)
+        with self._lock:
+            self._store(key, value, size)
+
+    def _store(self, key: Hashable, value: Any, size: int) -> None:
+        # caller holds the lock; a value larger than the whole budget is not kept
+        old = self._data.pop(key, None)
+        if old is not None:
+            self._bytes -= old[1]
+        if size > self.max_bytes:
+            return
+        self._data[key] = (value, size)
+        self._bytes += size
+        while len(self._data) > self.max_items or self._bytes > self.max_bytes:
+            _, (_, dropped) = self._data.popitem(last=False)
+            self._bytes -= dropped
 
     def clear(self) -> None:
         """Drop every cached value (the counters are kept)."""

@@ -17,7 +17,6 @@ from __future__ import annotations
 import json
 import logging
 import threading
-from collections import OrderedDict
 from collections.abc import Callable, Mapping
 from concurrent.futures import Executor, ThreadPoolExecutor
 from dataclasses import fields, is_dataclass, replace
@@ -25,6 +24,8 @@ from typing import Any
 
 import numpy as np
 import param
+
+from core.cache import StageCache
 
 from .results import ResultView, prepare_view
 from .state import ExplorerState
@@ -83,72 +84,22 @@ def approx_bytes(obj: Any, _seen: set[int] | None = None, _depth: int = 0) -> in
     return 24
 
 
-class _ResultCache:
-    """Process-wide LRU of prepared results of the core solver, keyed by the scene JSON.
-
-    A new session opening a preset, or a slider going back to an earlier value, then
-    costs nothing. Views are never modified after they are made, so sessions share them.
-    Bounded in items and in bytes (:func:`approx_bytes` of the view and its key): one view
-    of 2000 output times measured 4.5 MB (tracemalloc), 4.75 MB by the estimate.
-    Safe across threads.
-    """
-
-    def __init__(self, max_items: int = 24, max_bytes: int = 128 * 2**20) -> None:
-        self.max_items = max_items
-        self.max_bytes = max_bytes
-        self._data: OrderedDict[str, tuple[ResultView, int]] = OrderedDict()
-        self._bytes = 0
-        self._lock = threading.Lock()
-
-    @staticmethod
-    def key(scene: dict[str, Any]) -> str | None:
-        try:
-            return json.dumps(scene, sort_keys=True, separators=(",", ":"), allow_nan=False)
-        except (TypeError, ValueError):
-            return None
-
-    def get(self, key: str | None) -> ResultView | None:
-        if key is None:
-            return None
-        with self._lock:
-            entry = self._data.get(key)
-            if entry is None:
-                return None
-            self._data.move_to_end(key)
-            return entry[0]
-
-    def put(self, key: str | None, view: ResultView) -> None:
-        if key is None:
-            return
-        # measured outside the lock: walking a view takes a few milliseconds
-        size = approx_bytes(view) + len(key)
-        if size > self.max_bytes:
-            return
-        with self._lock:
-            old = self._data.pop(key, None)
-            if old is not None:
-                self._bytes -= old[1]
-            self._data[key] = (view, size)
-            self._bytes += size
-            while len(self._data) > self.max_items or self._bytes > self.max_bytes:
-                _, (_, dropped) = self._data.popitem(last=False)
-                self._bytes -= dropped
-
-    def clear(self) -> None:
-        with self._lock:
-            self._data.clear()
-            self._bytes = 0
-
-    @property
-    def size_bytes(self) -> int:
-        """Bytes held (approximate, see :func:`approx_bytes`)."""
-        return self._bytes
-
-    def __len__(self) -> int:
-        return len(self._data)
+def result_key(scene: dict[str, Any]) -> str | None:
+    """The key of a scene in :data:`RESULTS` (its canonical JSON), None if not JSON."""
+    try:
+        return json.dumps(scene, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    except (TypeError, ValueError):
+        return None
 
 
-RESULTS = _ResultCache()
+#: Process-wide cache of prepared results, keyed by :func:`result_key`: a new session
+#: opening a preset, or a slider going back to an earlier value, then costs nothing, and
+#: sessions asking for the same scene at once solve it once. Views are never modified
+#: after they are made, so sessions share them. One view of 2000 output times measured
+#: 4.5 MB (tracemalloc), 4.75 MB by :func:`approx_bytes`; the byte bound keeps the
+#: server (with the solver's own 512 MiB of stage caches) under 1 GiB.
+RESULTS = StageCache("explorer_results", max_items=24, max_bytes=96 * 2**20,
+                     sizeof=approx_bytes)
 
 
 #: Translation of the first part of a core field path into words on screen.
@@ -245,7 +196,7 @@ class SolveController(param.Parameterized):
         (the page then arrives with its plots), else solved in the background."""
         scene = self.state.to_scene()
         if self._executor is None or (self._solve is _default_solve
-                                      and RESULTS.get(RESULTS.key(scene)) is not None):
+                                      and RESULTS.get(result_key(scene)) is not None):
             return self.solve_now()
         return self.request()
 
@@ -270,17 +221,13 @@ class SolveController(param.Parameterized):
                 self._pending = None
 
     def _compute(self, scene: dict[str, Any]) -> ResultView | str:
-        shared = self._solve is _default_solve
-        key = RESULTS.key(scene) if shared else None
-        cached = RESULTS.get(key)
-        if cached is not None:
-            return replace(cached, info={**cached.info, "reused": True})
+        key = result_key(scene) if self._solve is _default_solve else None
         try:
-            solution = self._solve(scene)
-            view = prepare_view(solution, scene)
-            if shared:
-                RESULTS.put(key, view)
-            return view
+            if key is None:
+                return prepare_view(self._solve(scene), scene)
+            view, reused = RESULTS.get_or_compute(
+                key, lambda: prepare_view(self._solve(scene), scene))
+            return replace(view, info={**view.info, "reused": True}) if reused else view
         except ValueError as exc:
             return format_error(str(exc))
         except Exception as exc:  # the session must survive any failure of a solve

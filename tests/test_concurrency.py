@@ -21,7 +21,7 @@ import pytest
 
 from core import scene_from_dict, solve
 from core.cache import _REGISTRY, _REGISTRY_LOCK, StageCache, cache_report, clear_caches
-from explorer.controller import RESULTS, SolveController, _ResultCache, approx_bytes
+from explorer.controller import RESULTS, SolveController, approx_bytes
 from explorer.presets import presets
 from explorer.state import ExplorerState
 
@@ -196,7 +196,7 @@ def test_the_result_cache_is_bounded_in_items_and_bytes_across_threads() -> None
     # the estimate is close to what the view really holds: its arrays at least
     arrays = view.pressure.nbytes + view.image.nbytes + view.x.nbytes
     assert arrays <= size <= 20 * 2**20
-    cache = _ResultCache(max_items=10, max_bytes=4 * size)
+    cache = StageCache("test-results", max_items=10, max_bytes=4 * size, sizeof=approx_bytes)
     errors: list[BaseException] = []
 
     def worker(seed: int) -> None:
@@ -220,9 +220,24 @@ def test_the_result_cache_is_bounded_in_items_and_bytes_across_threads() -> None
         t.join(timeout=120)
     assert errors == []
     assert 0 < len(cache) <= 4 and cache.size_bytes <= 4 * size
+    with _REGISTRY_LOCK:
+        _REGISTRY.pop("test-results", None)
     # the process-wide cache has bounds too
     assert RESULTS.max_items >= 1 and RESULTS.max_bytes <= 256 * 2**20
     assert len(RESULTS) <= RESULTS.max_items and RESULTS.size_bytes <= RESULTS.max_bytes
+
+
+def test_all_shared_caches_together_stay_under_the_memory_budget() -> None:
+    """The solver's stage caches within STAGE_CACHE_BYTES, and with the explorer's result
+    cache under 640 MiB: the server measured ~130 MiB idle and ~7 MiB per session
+    (benchmarks/results/load_test.md), so 20 sessions stay under 1 GiB."""
+    from core import solver
+
+    stages = [solver._PANELS, solver._OPERATOR, solver._BASIS, solver._GALERKIN,
+              solver._CORRECTION, solver._GAP, solver._MODES, solver._RESPONSE,
+              solver._SAMPLE_ROWS]
+    assert sum(c.max_bytes for c in stages) <= solver.STAGE_CACHE_BYTES <= 512 * 2**20
+    assert solver.STAGE_CACHE_BYTES + RESULTS.max_bytes <= 640 * 2**20
 
 
 # --------------------------------------------------------------------------- sessions
