@@ -39,13 +39,20 @@ modulus is ``c(t*) = E(tau0 t*) / E(tau0)``.
 
 from __future__ import annotations
 
-import math
-import numbers
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
+
+from core.validation import (
+    PYTHON_STYLE,
+    finite_number,
+    nonnegative_number,
+    positive_number,
+    show_python,
+)
 
 #: Largest accepted creep rate [1/day]. Faster creep is instantaneous on any time scale
 #: the model is meant for, and would only make the modal equations needlessly stiff.
@@ -60,45 +67,17 @@ ArrayLike = Any
 # ----------------------------------------------------------------------------- validation
 
 
-def _show(value: Any) -> str:
-    """A value as it should appear in an error message."""
-    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
-        return str(int(value))
-    if isinstance(value, numbers.Real) and not isinstance(value, bool):
-        return repr(float(value))
-    return repr(value)
-
-
-def _number(value: Any, field: str) -> float:
-    """``value`` as a finite float, or a ValueError naming ``field``."""
-    # bool is an int to Python, but a true/false in a scene file is a mistake, not a number
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{field}: must be a number, got {_show(value)}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise ValueError(f"{field}: must be finite, got {_show(value)}")
-    return x
-
-
-def _positive(value: Any, field: str) -> float:
-    x = _number(value, field)
-    if x <= 0:
-        raise ValueError(f"{field}: must be > 0, got {_show(value)}")
-    return x
-
-
-def _nonnegative(value: Any, field: str) -> float:
-    x = _number(value, field)
-    if x < 0:
-        raise ValueError(f"{field}: must be >= 0, got {_show(value)}")
-    return x
+# Models are built from Python as often as from scene files: their messages quote reprs.
+_number = partial(finite_number, style=PYTHON_STYLE)
+_positive = partial(positive_number, style=PYTHON_STYLE)
+_nonnegative = partial(nonnegative_number, style=PYTHON_STYLE)
 
 
 def _creep_coefficient(value: Any, field: str) -> float:
     x = _number(value, field)
     if x < 0:
         raise ValueError(
-            f"{field}: must be >= 0, got {_show(value)}: a negative value makes the "
+            f"{field}: must be >= 0, got {show_python(value)}: a negative value makes the "
             "compliance decrease in time, which is not creep")
     return x
 
@@ -106,7 +85,7 @@ def _creep_coefficient(value: Any, field: str) -> float:
 def _rate(value: Any, field: str) -> float:
     x = _positive(value, field)
     if x > MAX_RATE:
-        raise ValueError(f"{field}: must be <= {MAX_RATE:g} per day, got {_show(value)}")
+        raise ValueError(f"{field}: must be <= {MAX_RATE:g} per day, got {show_python(value)}")
     return x
 
 
@@ -115,7 +94,7 @@ def _beta(value: Any, field: str) -> float:
     if not 0 <= x < 1:
         raise ValueError(
             f"{field}: must be >= 0 and < 1 (the modulus at age 0 is "
-            f"modulus_final (1 - beta)), got {_show(value)}")
+            f"modulus_final (1 - beta)), got {show_python(value)}")
     return x
 
 
@@ -276,7 +255,7 @@ def _check_arutyunyan(values: Mapping[str, Any], field: str) -> dict[str, float]
 def _check_terms(terms: Any, field: str) -> Terms:
     """Prony terms as a tuple of (C_r, A_r, gamma_r) float triples, validated."""
     if isinstance(terms, (str, bytes)) or not isinstance(terms, (list, tuple)):
-        raise ValueError(f"{field}: must be a list of terms, got {_show(terms)}")
+        raise ValueError(f"{field}: must be a list of terms, got {show_python(terms)}")
     if not 1 <= len(terms) <= MAX_TERMS:
         raise ValueError(f"{field}: must hold 1 to {MAX_TERMS} terms, got {len(terms)}")
     checked = []
@@ -285,7 +264,7 @@ def _check_terms(terms: Any, field: str) -> Terms:
         if isinstance(term, (str, bytes)) or not isinstance(term, (list, tuple)) \
                 or len(term) != 3:
             raise ValueError(f"{where}: must be a (compliance, aging, rate) triple, "
-                             f"got {_show(term)}")
+                             f"got {show_python(term)}")
         checked.append((_creep_coefficient(term[0], f"{where}.compliance"),
                         _creep_coefficient(term[1], f"{where}.aging"),
                         _rate(term[2], f"{where}.rate")))
@@ -490,9 +469,9 @@ class UserKernel:
     def __init__(self, modulus: float, kernel: Callable[[np.ndarray, np.ndarray], Any],
                  expr: str | None = None) -> None:
         if not callable(kernel):
-            raise ValueError(f"UserKernel.kernel: must be callable, got {_show(kernel)}")
+            raise ValueError(f"UserKernel.kernel: must be callable, got {show_python(kernel)}")
         if expr is not None and not isinstance(expr, str):
-            raise ValueError(f"UserKernel.expr: must be a string, got {_show(expr)}")
+            raise ValueError(f"UserKernel.expr: must be a string, got {show_python(expr)}")
         if not isinstance(kernel, CausalKernel):
             kernel = CausalKernel(kernel)
         _set(self, instantaneous_modulus=_positive(modulus, "UserKernel.modulus"),
@@ -584,7 +563,8 @@ def creep_model_from_spec(spec: dict, *, field: str = "base.creep") -> CreepMode
     Errors are ValueErrors whose message starts with the offending field under ``field``.
     """
     if not isinstance(spec, Mapping):
-        raise ValueError(f"{field}: must be an object with a 'model' field, got {_show(spec)}")
+        raise ValueError(f"{field}: must be an object with a 'model' field, "
+                         f"got {show_python(spec)}")
     known = ", ".join(KNOWN_MODELS)
     if "model" not in spec:
         raise ValueError(f"{field}.model: missing; known models: {known}")
@@ -603,13 +583,13 @@ def creep_model_from_spec(spec: dict, *, field: str = "base.creep") -> CreepMode
         modulus = _positive(spec["modulus"], f"{field}.modulus")
         terms = spec["terms"]
         if isinstance(terms, (str, bytes)) or not isinstance(terms, (list, tuple)):
-            raise ValueError(f"{field}.terms: must be a list of terms, got {_show(terms)}")
+            raise ValueError(f"{field}.terms: must be a list of terms, got {show_python(terms)}")
         triples = []
         for r, term in enumerate(terms):
             where = f"{field}.terms[{r}]"
             if not isinstance(term, Mapping):
                 raise ValueError(f"{where}: must be an object with compliance, aging, rate; "
-                                 f"got {_show(term)}")
+                                 f"got {show_python(term)}")
             _check_keys(term, _TERM_FIELDS, where, "a Prony term")
             triples.append((term["compliance"], term.get("aging", 0.0), term["rate"]))
         return PronySeries(modulus, _check_terms(triples, f"{field}.terms"))
@@ -617,7 +597,7 @@ def creep_model_from_spec(spec: dict, *, field: str = "base.creep") -> CreepMode
     modulus = _positive(spec["modulus"], f"{field}.modulus")
     text = spec["expr"]
     if not isinstance(text, str) or not text.strip():
-        raise ValueError(f"{field}.expr: must be a formula in t and tau, got {_show(text)}")
+        raise ValueError(f"{field}.expr: must be a formula in t and tau, got {show_python(text)}")
     # imported here so that the rest of the module does not depend on the parser
     from core.expressions import parse_expression
 

@@ -44,6 +44,7 @@ import numpy as np
 
 from core.creep import UserKernel, creep_model_from_spec
 from core.profiles import Profile, check_range, profile_from_spec
+from core.validation import finite_number, positive_number, show_value
 
 if TYPE_CHECKING:
     from core.solver import ContactSolution
@@ -79,6 +80,9 @@ MAX_BREAKPOINTS = 16
 #: Accepted range of the dimensionless coating compliance m*: physical coatings are far
 #: inside it; the solver was measured finite for 1e-100 to 1e100.
 M_STAR_RANGE = (1e-30, 1e30)
+#: Largest accepted load after scaling by the base modulus and the half-width (the
+#: solver's own bound, core.solver.VALUE_RANGE): beyond it results overflow.
+MAX_DIMENSIONLESS_LOAD = 1e100
 #: Largest accepted gap between punch and coating surface, in half-widths a.
 MAX_GAP_RATIO = 1e3
 #: Accepted range of a / H. The quadrature resolves the layer kernel on the scale H, so
@@ -126,25 +130,6 @@ _MIGRATIONS: dict[int, Callable[[dict], dict]] = {}
 # --------------------------------------------------------------------- small validators
 
 
-def _show(value: Any) -> str:
-    """A value as it should appear in an error message."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if value is None:
-        return "null"
-    if isinstance(value, numbers.Integral):
-        text = str(int(value))
-        # a 4000-digit integer is valid JSON; the message stays one readable line
-        return text if len(text) <= 40 else f"{text[:12]}... ({len(text)} digits)"
-    if isinstance(value, numbers.Real):
-        return f"{float(value):.6g}"
-    if isinstance(value, Mapping):
-        return "an object"
-    if isinstance(value, (list, tuple)):
-        return "a list"
-    return repr(value)
-
-
 def _join(parent: str, key: str) -> str:
     return f"{parent}.{key}" if parent else key
 
@@ -154,7 +139,7 @@ def _check_fields(obj: Any, path: str, required: Sequence[str],
     """``obj`` as a mapping with exactly the allowed fields, or a ValueError."""
     where = path or "scene"
     if not isinstance(obj, Mapping):
-        raise ValueError(f"{where}: must be an object, got {_show(obj)}")
+        raise ValueError(f"{where}: must be an object, got {show_value(obj)}")
     allowed = list(required) + list(optional)
     for key in obj:
         if key not in allowed:
@@ -168,40 +153,17 @@ def _check_fields(obj: Any, path: str, required: Sequence[str],
     return obj
 
 
-def _number(value: Any, path: str) -> float:
-    """A finite float, refusing bools, strings and null."""
-    # bool is an int to Python, but true/false in a scene file is a mistake
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{path}: must be a number, got {_show(value)}")
-    try:
-        x = float(value)
-    except OverflowError:
-        # a JSON integer of 400 digits is valid JSON but no double
-        raise ValueError(f"{path}: must be a finite number, got an integer too large for "
-                         "a double") from None
-    if not math.isfinite(x):
-        raise ValueError(f"{path}: must be a finite number, got {value!r}")
-    return x
-
-
-def _positive(value: Any, path: str) -> float:
-    x = _number(value, path)
-    if x <= 0:
-        raise ValueError(f"{path}: must be > 0, got {_show(value)}")
-    return x
-
-
 def _poisson(value: Any, path: str) -> float:
-    x = _number(value, path)
+    x = finite_number(value, path)
     if not -1.0 < x < 0.5:
-        raise ValueError(f"{path}: must be in (-1, 0.5), got {_show(value)}")
+        raise ValueError(f"{path}: must be in (-1, 0.5), got {show_value(value)}")
     return x
 
 
 def _integer(value: Any, path: str, lo: int, hi: int) -> int:
-    x = _number(value, path)
+    x = finite_number(value, path)
     if not x.is_integer():
-        raise ValueError(f"{path}: must be an integer, got {_show(value)}")
+        raise ValueError(f"{path}: must be an integer, got {show_value(value)}")
     if not lo <= x <= hi:
         raise ValueError(f"{path}: must be an integer from {lo} to {hi}, got {int(x)}")
     return int(x)
@@ -209,7 +171,7 @@ def _integer(value: Any, path: str, lo: int, hi: int) -> int:
 
 def _text(value: Any, path: str, *, allow_empty: bool) -> str:
     if not isinstance(value, str):
-        raise ValueError(f"{path}: must be a string, got {_show(value)}")
+        raise ValueError(f"{path}: must be a string, got {show_value(value)}")
     if not allow_empty and not value.strip():
         raise ValueError(f"{path}: must not be empty")
     return value
@@ -245,17 +207,17 @@ def migrate(d: Mapping[str, Any]) -> dict[str, Any]:
     one step per version in ``_MIGRATIONS``.
     """
     if not isinstance(d, Mapping):
-        raise ValueError(f"scene: must be a JSON object, got {_show(d)}")
+        raise ValueError(f"scene: must be a JSON object, got {show_value(d)}")
     if "schema_version" not in d:
         raise ValueError(f"schema_version: required field is missing (this program reads "
                          f"{SCHEMA_VERSION})")
     raw = d["schema_version"]
     if isinstance(raw, bool) or not isinstance(raw, numbers.Real):
-        raise ValueError(f"schema_version: must be an integer, got {_show(raw)}")
+        raise ValueError(f"schema_version: must be an integer, got {show_value(raw)}")
     if isinstance(raw, numbers.Integral):
         version = int(raw)  # float() of a huge integer would overflow
     elif not math.isfinite(float(raw)) or not float(raw).is_integer():
-        raise ValueError(f"schema_version: must be an integer, got {_show(raw)}")
+        raise ValueError(f"schema_version: must be an integer, got {show_value(raw)}")
     else:
         version = int(raw)
     if version > SCHEMA_VERSION:
@@ -514,11 +476,12 @@ def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
     """The output times [day after loading] and their canonical spec."""
     if isinstance(spec, Mapping):
         _check_fields(spec, path, ("end", "count"), ("spacing",))
-        end = _positive(spec["end"], f"{path}.end")
+        end = positive_number(spec["end"], f"{path}.end")
         count = _integer(spec["count"], f"{path}.count", 1, MAX_TIMES)
         spacing = spec.get("spacing", "linear")
         if spacing not in ("linear", "log"):
-            raise ValueError(f"{path}.spacing: must be 'linear' or 'log', got {_show(spacing)}")
+            raise ValueError(f"{path}.spacing: must be 'linear' or 'log', "
+                             f"got {show_value(spacing)}")
         if count == 1:
             times = np.array([end])
         elif spacing == "linear":
@@ -534,20 +497,20 @@ def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
             raise ValueError(f"{path}: must list 1 to {MAX_TIMES} times, got {len(spec)}")
         values = []
         for i, value in enumerate(spec):
-            t = _number(value, f"{path}[{i}]")
+            t = finite_number(value, f"{path}[{i}]")
             if t < 0:
                 raise ValueError(f"{path}[{i}]: must be >= 0 days after loading (times before "
-                                 f"loading are not part of the problem), got {_show(value)}")
+                                 f"loading are not part of the problem), got {show_value(value)}")
             if values and t <= values[-1]:
-                raise ValueError(f"{path}[{i}]: times must increase, got {_show(value)} after "
-                                 f"{_show(values[-1])}")
+                raise ValueError(f"{path}[{i}]: times must increase, got {show_value(value)} after "
+                                 f"{show_value(values[-1])}")
             values.append(t)
         if values[-1] <= 0:
             raise ValueError(f"{path}: the last time must be > 0 days after loading (the "
                              "loads are functions of time on [0, last time])")
         return np.array(values), values
     raise ValueError(f"{path}: must be an object {{end, count, spacing}} or a list of days "
-                     f"after loading, got {_show(spec)}")
+                     f"after loading, got {show_value(spec)}")
 
 
 def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
@@ -566,14 +529,14 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     description = _text(d.get("description", ""), "description", allow_empty=True)
 
     punch = _check_fields(d["punch"], "punch", ("half_width",), ("shape",))
-    a = _positive(punch["half_width"], "punch.half_width")
+    a = positive_number(punch["half_width"], "punch.half_width")
     x_domain = (-a, a)
     shape_spec = punch.get("shape", 0.0)
     shape = _profile(shape_spec, "punch.shape", "x", x_domain)
 
     layers_spec = d["coating"]
     if not isinstance(layers_spec, (list, tuple)):
-        raise ValueError(f"coating: must be a list of layers, got {_show(layers_spec)}")
+        raise ValueError(f"coating: must be a list of layers, got {show_value(layers_spec)}")
     if not 1 <= len(layers_spec) <= MAX_LAYERS:
         raise ValueError(f"coating: must hold 1 to {MAX_LAYERS} layers, got {len(layers_spec)}")
     layers = []
@@ -589,13 +552,14 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         ))
 
     base = _check_fields(d["base"], "base", ("thickness", "poisson", "age_at_loading", "creep"))
-    h_base = _positive(base["thickness"], "base.thickness")
+    h_base = positive_number(base["thickness"], "base.thickness")
     nu = _poisson(base["poisson"], "base.poisson")
-    tau0 = _positive(base["age_at_loading"], "base.age_at_loading")
+    tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
     try:
         creep = creep_model_from_spec(base["creep"], field="base.creep")
     except OverflowError:
-        # core.creep converts with float(), which raises for a huge JSON integer
+        # a creep parameter too large for a double (NumberTooLarge is an OverflowError):
+        # the file reader turns the same number into inf, refused with the precise field
         raise ValueError("base.creep: a number is too large for a double (must be a finite "
                          "number)") from None
     if not math.isfinite(a / h_base) or not LAM_RANGE[0] <= a / h_base <= LAM_RANGE[1]:
@@ -625,10 +589,10 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
                          f"an age at loading of {tau0:g} days")
 
     solver = _check_fields(d.get("solver", {}), "solver", (), ("tol",))
-    tol = _number(solver.get("tol", DEFAULT_TOL), "solver.tol")
+    tol = finite_number(solver.get("tol", DEFAULT_TOL), "solver.tol")
     if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
         raise ValueError(f"solver.tol: must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], "
-                         f"got {_show(tol)}")
+                         f"got {show_value(tol)}")
 
     data = {
         "schema_version": SCHEMA_VERSION,
@@ -721,7 +685,7 @@ def _check_solvable(scene: Scene) -> None:
         ts = problem.times
         for name, load in problem.loads.items():
             values = np.broadcast_to(load(ts) if callable(load) else load, ts.shape)
-            bad = ~np.isfinite(values)
+            bad = ~np.isfinite(values) | (np.abs(values) > MAX_DIMENSIONLESS_LOAD)
             if bad.any():
                 i = int(np.argmax(bad))
                 raise ValueError(
