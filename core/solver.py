@@ -68,15 +68,31 @@ SUCCESS_MARGIN = 3.0
 #: |alpha| above this many radians is not a small tilt (used by the dimensional API).
 TOLERANCE_RANGE = (1e-13, 1e-1)
 
-_PANELS = StageCache("panels", max_items=32)
-_OPERATOR = StageCache("operator", max_items=8, max_bytes=512 * 2**20)
-_BASIS = StageCache("basis", max_items=16)
-_GALERKIN = StageCache("galerkin", max_items=32)
-_CORRECTION = StageCache("correction", max_items=8, max_bytes=512 * 2**20)
-_GAP = StageCache("gap", max_items=32)
-_MODES = StageCache("modes", max_items=256)
-_RESPONSE = StageCache("response", max_items=256, max_bytes=256 * 2**20)
-_SAMPLE_ROWS = StageCache("sample_rows", max_items=16)
+#: Accepted magnitudes of the coefficient functions (m, g: dimensionless; c: relative
+#: modulus; the given loads: at most 1e100). Beyond them the Galerkin matrix over- or
+#: underflows in double precision (m = 1e200 made it singular, m = 1e-300 gave NaN);
+#: physical scenes are far inside.
+VALUE_RANGE = {"m": (1e-100, 1e100), "g": (0.0, 1e100), "c": (1e-100, 1e100)}
+#: Accepted a/H. The operator's nodes grow like a/H and its memory like its square:
+#: measured 155 MB at 100 and 5.5 GB at 1000 (tests/test_security.py documents the
+#: scene limit, which is tighter).
+LAM_RANGE = (1e-4, 1e3)
+
+# Bytes per stage sum to STAGE_CACHE_BYTES (512 MiB), sized from the largest items
+# measured on the hard cases of benchmarks/scenes.py: operator and correction ~9 MiB,
+# basis ~8 MiB, all modes of a scene ~3 MiB, responses ~5 MiB.
+_MiB = 2**20
+_PANELS = StageCache("panels", max_items=32, max_bytes=8 * _MiB)
+_OPERATOR = StageCache("operator", max_items=8, max_bytes=128 * _MiB)
+_BASIS = StageCache("basis", max_items=16, max_bytes=64 * _MiB)
+_GALERKIN = StageCache("galerkin", max_items=32, max_bytes=32 * _MiB)
+_CORRECTION = StageCache("correction", max_items=8, max_bytes=128 * _MiB)
+_GAP = StageCache("gap", max_items=32, max_bytes=8 * _MiB)
+_MODES = StageCache("modes", max_items=256, max_bytes=64 * _MiB)
+_RESPONSE = StageCache("response", max_items=256, max_bytes=64 * _MiB)
+_SAMPLE_ROWS = StageCache("sample_rows", max_items=16, max_bytes=16 * _MiB)
+#: Upper bound of the memory all stage caches of the solver may hold together [bytes].
+STAGE_CACHE_BYTES = 512 * _MiB
 
 
 # --------------------------------------------------------------------------- results
@@ -161,6 +177,15 @@ def _check_values(values: np.ndarray, name: str, where: np.ndarray, var: str, *,
     if positive and np.any(values <= 0):
         i = int(np.argmin(values))
         raise ValueError(f"{name}: must be > 0, is {values[i]:.6g} at {var} = {where[i]:.6g}")
+    lo, hi = VALUE_RANGE.get(name, (0.0, 1e100))
+    if not positive:
+        lo = 0.0
+    magnitude = np.abs(values)
+    out = (magnitude > hi) | (magnitude < lo)
+    if out.any():
+        i = int(np.argmax(out))
+        raise ValueError(f"{name}: must lie in [{lo:g}, {hi:g}] in magnitude, is "
+                         f"{values[i]:.6g} at {var} = {where[i]:.6g}")
 
 
 @dataclass(frozen=True)
@@ -185,8 +210,9 @@ def _validate(lam, m, g, times, c, kernel, loads, breakpoints, tol) -> _Inputs:
     lam = float(lam)
     if not np.isfinite(lam) or lam <= 0:
         raise ValueError(f"lam: must be a finite number > 0, got {lam}")
-    if lam > 1e4 or lam < 1e-4:
-        raise ValueError(f"lam: must be in [1e-4, 1e4] (a/H), got {lam:g}")
+    if not LAM_RANGE[0] <= lam <= LAM_RANGE[1]:
+        raise ValueError(f"lam: must be in [{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}] (a/H), "
+                         f"got {lam:g}")
     if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating)):
         raise ValueError(f"tol: must be a number, got {type(tol).__name__}")
     tol = float(tol)
@@ -318,17 +344,28 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
         wide = np.minimum(widths[:-1], widths[1:]) >= 1e-2
         added = np.setdiff1d(panels.edges[1:-1][wide], start.edges)
         cuts = tuple(sorted(set(cuts) | set(added.tolist())))
-    basis_key = fingerprint("basis", panels.edges, m_nodes, inp.breakpoints, kind, cuts, count)
+    # The basis is orthonormal for the weight 1/m: for m = s m1 it is sqrt(s) times the
+    # basis for m1. Built for m / max(m), it serves every uniform coating (and every
+    # coating scaled as a whole), so a thickness or modulus slider of such a coating
+    # reuses it.
+    m_scale = float(np.max(m_nodes))
+    m_unit = m_nodes / m_scale
+    unit_key = fingerprint("basis", panels.edges, m_unit, inp.breakpoints, kind, cuts, count)
 
     def make_basis():
-        basis = build_basis(panels, m_nodes, count, breakpoints=inp.breakpoints, kind=kind,
+        basis = build_basis(panels, m_unit, count, breakpoints=inp.breakpoints, kind=kind,
                             cuts=cuts)
         xs = _sample_points(inp.breakpoints)
         xc = _check_points(inp.breakpoints)
         return basis, xs, basis.evaluate(xs), xc, basis.evaluate(xc)
 
-    basis, sample_x, sample_phi, check_x, check_phi = timed("basis", _BASIS, basis_key,
-                                                            make_basis)
+    unit, sample_x, unit_sample_phi, check_x, unit_check_phi = timed("basis", _BASIS,
+                                                                     unit_key, make_basis)
+    root = np.sqrt(m_scale)
+    basis = replace(unit, values=unit.values * root, transform=unit.transform * root,
+                    moments=tuple(j / m_scale for j in unit.moments))
+    sample_phi, check_phi = unit_sample_phi * root, unit_check_phi * root
+    basis_key = fingerprint(unit_key, m_scale)
     correction = None
     if kind == "graded":
         correction = timed("correction", _CORRECTION, fingerprint("correction", panels.edges),

@@ -306,6 +306,12 @@ def test_contact_lost_flag_for_large_eccentricity():
     (dict(breakpoints=[1.5]), "breakpoints"),
     (dict(tol=0.0), "tol"),
     (dict(force=float("nan")), "force"),
+    # beyond double precision in the Galerkin matrix: once LinAlgError or NaN
+    (dict(m=1e200), "m"),
+    (dict(m=1e-300), "m"),
+    (dict(g=lambda x: 1e150 * x**2), "g"),
+    (dict(force=1e120), "force"),
+    (dict(lam=1e4), "lam"),  # a 550 GB operator
 ])
 def test_bad_input_names_the_argument(kwargs, field):
     args = dict(lam=1.0, m=0.1, g=0.0, times=[1.0], force=1.0, moment=0.0)
