@@ -282,6 +282,22 @@ def test_gap_change_reuses_operator_and_basis():
     assert after["gap"] == before["gap"] + 1
 
 
+def test_a_coating_scaled_as_a_whole_reuses_the_basis():
+    """The basis for m = s m1 is sqrt(s) times the basis for m1: a thickness or modulus
+    slider of a uniform coating builds no new basis, and the answers stay right. (Only
+    while the graded mesh keeps its layers: 0.05 and 0.052 both get six toward each end.)"""
+    times = [1.0]
+    first = solve_dimensionless(1.0, 0.05, 0.0, times, force=1.0, moment=0.1, tol=1e-10)
+    before = stage_counts()
+    second = solve_dimensionless(1.0, 0.052, 0.0, times, force=1.0, moment=0.1, tol=1e-10)
+    after = stage_counts()
+    assert after["basis"] == before["basis"]
+    assert after["galerkin"] == before["galerkin"] + 1
+    # a softer coating settles more; both answers claim tol
+    assert second.settlement[0] > first.settlement[0]
+    assert first.info["success"] and second.info["success"]
+
+
 # ------------------------------------------------------------------ flags & errors
 
 
