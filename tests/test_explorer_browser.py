@@ -112,7 +112,7 @@ class Page:
         raise AssertionError(f"{selector} stayed at {old!r}")
 
     def open_tab(self, name: str) -> None:
-        """Open a tab of the sidebar (its widgets are rendered when first opened)."""
+        """Open a tab of the sidebar (its widgets arrive just after the page)."""
         self.page.locator(".bk-tab", has_text=name).first.click()
 
     def type_into(self, css: str, value: str) -> None:
