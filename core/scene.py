@@ -42,6 +42,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from core.cache import StageCache, fingerprint
 from core.creep import UserKernel, creep_model_from_spec
 from core.profiles import Profile, check_range, profile_from_spec
 from core.validation import finite_number, positive_number, show_value
@@ -83,6 +84,7 @@ M_STAR_RANGE = (1e-30, 1e30)
 #: Largest accepted load after scaling by the base modulus and the half-width (the
 #: solver's own bound, core.solver.VALUE_RANGE): beyond it results overflow.
 MAX_DIMENSIONLESS_LOAD = 1e100
+_GAP_MINIMUM = StageCache("gap_minimum", max_items=256, max_bytes=2**20)
 #: Largest accepted gap between punch and coating surface, in half-widths a.
 MAX_GAP_RATIO = 1e3
 #: Accepted range of a / H. The quadrature resolves the layer kernel on the scale H, so
@@ -369,7 +371,17 @@ class Scene:
 
     @cached_property
     def gap_minimum(self) -> float:
-        """``min over [-a, a]`` of :meth:`gap_variation` [m]: dense samples, refined locally."""
+        """``min over [-a, a]`` of :meth:`gap_variation` [m]: dense samples, refined locally.
+
+        Shared by scenes of the same geometry (a load slider makes a new scene each
+        step; the search costs ~4 ms of the ~15 ms such a step takes)."""
+        # the samples depend on every x-profile (their breakpoints and extremes)
+        key = fingerprint("gap_minimum", json.dumps(
+            [self._data["punch"], self._data["coating"]], sort_keys=True,
+            separators=(",", ":")))
+        return _GAP_MINIMUM.get_or_compute(key, self._search_gap_minimum)[0]
+
+    def _search_gap_minimum(self) -> float:
         x = self.sample_x
         values = self.gap_variation(x)
         i = int(np.argmin(values))
@@ -785,10 +797,12 @@ def _parse_int(text: str) -> int | float:
     return int(text) if len(text) <= 400 else (-math.inf if text[0] == "-" else math.inf)
 
 
-def parse_scene_json(text: str, source: str = "scene") -> Scene:
-    """Parse and validate the JSON text of a scene; errors name ``source`` or the field."""
+def read_scene_json(text: str, source: str = "scene") -> Any:
+    """The JSON value of a scene file's text, read strictly: a field repeated in one
+    object, a nesting too deep or a number beyond any double is refused (``ValueError``
+    naming ``source``). The value is not yet validated as a scene."""
     try:
-        data = json.loads(text, object_pairs_hook=_no_duplicates, parse_int=_parse_int)
+        return json.loads(text, object_pairs_hook=_no_duplicates, parse_int=_parse_int)
     except json.JSONDecodeError as exc:
         raise ValueError(f"{source}: not valid JSON ({exc.msg} at line {exc.lineno}, "
                          f"column {exc.colno})") from None
@@ -796,7 +810,11 @@ def parse_scene_json(text: str, source: str = "scene") -> Scene:
         raise ValueError(f"{source}: {exc}") from None
     except RecursionError:
         raise ValueError(f"{source}: not valid JSON (nested too deeply)") from None
-    return scene_from_dict(data)
+
+
+def parse_scene_json(text: str, source: str = "scene") -> Scene:
+    """Parse and validate the JSON text of a scene; errors name ``source`` or the field."""
+    return scene_from_dict(read_scene_json(text, source))
 
 
 def load_scene(path: str | os.PathLike) -> Scene:

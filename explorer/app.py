@@ -607,7 +607,7 @@ class ExplorerApp(pn.viewable.Viewer):
         data = event.new
         if not data:
             return
-        from core.scene import MAX_SCENE_BYTES
+        from core.scene import MAX_SCENE_BYTES, read_scene_json
 
         # the same limit as the command line: a browser may send up to the websocket's
         # message size, and parsing costs memory and time on the shared server
@@ -615,14 +615,16 @@ class ExplorerApp(pn.viewable.Viewer):
             self.notice = (f"The file {self.load_file.filename!r} is too large ({len(data)} "
                            f"bytes; a scene file has at most {MAX_SCENE_BYTES})")
             return
+        name = self.load_file.filename or "the file"
         try:
-            scene = json.loads(data.decode("utf-8-sig") if isinstance(data, bytes) else data)
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            self.notice = f"The file {self.load_file.filename!r} is not valid JSON: {exc}"
+            text = data.decode("utf-8-sig") if isinstance(data, bytes) else data
+            # read as the command line reads it: a repeated field is refused, not dropped
+            scene = read_scene_json(text, repr(name))
+        except UnicodeDecodeError:
+            self.notice = f"The file {name!r} is not text in UTF-8 (a scene file is JSON)."
             return
-        except RecursionError:
-            self.notice = (f"The file {self.load_file.filename!r} is not valid JSON: nested "
-                           "too deeply")
+        except ValueError as exc:
+            self.notice = f"The file {exc}"
             return
         if not isinstance(scene, dict):
             self.notice = "The file does not hold a scene (a JSON object)."

@@ -570,6 +570,25 @@ def test_uploads_over_the_limits_are_refused_with_a_notice() -> None:
     assert app.controller.view is shown and app.controller.error == ""
 
 
+def test_an_uploaded_scene_is_read_as_strictly_as_the_command_line_reads_it() -> None:
+    """A field given twice is refused (json.loads would silently keep the second), as are
+    text that is not UTF-8 and numbers beyond any double; the result on screen stays."""
+    app = _explorer_app()
+    shown = app.controller.view
+    text = json.dumps(base_scene())
+    app.load_file.filename = "twice.json"
+    app.load_file.value = text.replace('"name":', '"name": "first", "name":', 1).encode()
+    assert app.notice == "The file 'twice.json': duplicate field 'name' in one JSON object"
+    app.load_file.filename = "latin1.json"
+    app.load_file.value = b'{"name": "caf\xe9"}'  # Latin-1
+    assert "not text in UTF-8" in app.notice
+    app.load_file.filename = "huge.json"
+    app.load_file.value = text.replace('"schema_version": 1', '"schema_version": ' + "9" * 500,
+                                       1).encode()
+    assert app.notice.startswith("The scene was not loaded"), app.notice
+    assert app.controller.view is shown and app.controller.error == ""
+
+
 def test_an_uploaded_table_with_too_many_rows_for_the_solver_keeps_the_last_result() -> None:
     app = _explorer_app()
     shown = app.controller.view
