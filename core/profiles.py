@@ -632,9 +632,13 @@ def _cell_number(cell: str) -> float | None:
     return float(cell)
 
 
+#: Largest CSV table accepted for a profile [bytes] (1 MB).
+MAX_TABLE_BYTES = 1_000_000
+
+
 def profile_from_csv(data: bytes | str, *, field: str, variable: str = "x",
                      domain: tuple[float, float], interpolation: str = "linear",
-                     max_bytes: int = 1_000_000, max_rows: int = 10_000) -> Profile:
+                     max_bytes: int = MAX_TABLE_BYTES, max_rows: int = 10_000) -> Profile:
     """A table profile from an uploaded CSV file of two numeric columns.
 
     Columns: the variable (unit of the variable) and the value (unit of the quantity).

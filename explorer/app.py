@@ -19,6 +19,9 @@ import panel as pn
 import param
 from panel.io.state import set_curdoc
 
+from core.profiles import MAX_TABLE_BYTES
+from core.scene import MAX_SCENE_BYTES
+
 from .controller import SolveController, format_error
 from .links import decode_scene, encode_scene
 from .plots import Figures
@@ -35,6 +38,7 @@ from .state import (
 from .widgets import (
     NAMES,
     Binding,
+    BoundedUpload,
     EditableIntSlider,
     HistoryEditor,
     ProfileEditor,
@@ -286,8 +290,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.wave_amplitude = pb.add("wave_amplitude", fine_slider("wave amplitude [µm]", 0.0, 50.0,
                                                               0.1, "0[.]0"))
         self.wave_length = pb.add("wave_length", fine_slider("wavelength [m]", 0.02, 5.0, 0.01))
-        self.shape_file = pn.widgets.FileInput(accept=".csv,.txt", multiple=False,
-                                               sizing_mode="stretch_width")
+        self.shape_file = BoundedUpload(accept=(".csv", ".txt"), max_bytes=MAX_TABLE_BYTES)
         self.shape_file.param.watch(self._on_shape_file, "value")
         self.shape_note = _html("", styles={"font-size": "12px", "color": "#666"})
         pb.bind(s.punch)
@@ -375,8 +378,7 @@ class ExplorerApp(pn.viewable.Viewer):
                                                   label="Save scene (JSON)",
                                                   color="primary",
                                                   sizing_mode="stretch_width")
-        self.load_file = pn.widgets.FileInput(accept=".json", multiple=False,
-                                              sizing_mode="stretch_width")
+        self.load_file = BoundedUpload(accept=(".json",), max_bytes=MAX_SCENE_BYTES)
         self.load_file.param.watch(self._on_scene_file, "value")
         self.csv_download = pn.widgets.FileDownload(callback=self._csv_file,
                                                     filename="results.csv",
@@ -607,7 +609,7 @@ class ExplorerApp(pn.viewable.Viewer):
         data = event.new
         if not data:
             return
-        from core.scene import MAX_SCENE_BYTES, read_scene_json
+        from core.scene import read_scene_json
 
         # the same limit as the command line: a browser may send up to the websocket's
         # message size, and parsing costs memory and time on the shared server
@@ -800,7 +802,7 @@ def create_app(**kwargs: Any) -> ExplorerApp:
     Served, it solves on a shared thread pool; inline in a notebook (no server session)
     it solves in the kernel, each change when it happens.
     """
-    pn.extension(notifications=False)
+    pn.extension("filedropper", notifications=False)
     served = bool(pn.state.curdoc is not None and pn.state.curdoc.session_context)
     kwargs.setdefault("executor", "shared" if served else None)
     if "query" not in kwargs:

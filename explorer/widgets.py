@@ -10,7 +10,7 @@ layer or whichever two loads are given.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import panel as pn
@@ -59,6 +59,38 @@ class EditableIntSlider(pn.widgets.EditableIntSlider):
 
     _slider_widget = PromptIntSlider
     _input_widget = PromptIntInput
+
+
+class BoundedUpload(pn.viewable.Viewer):
+    """A one-file upload that refuses a file over ``max_bytes`` in the browser, before
+    sending it. ``filename`` and ``value`` (the file's bytes) follow the last file.
+
+    A plain FileInput sends the whole file in one websocket message: a file over the
+    server's message limit (20 MB) closed the session's connection and left a dead page
+    (measured with 25 MB). The dropper checks the size in the page and sends in chunks.
+    """
+
+    filename = param.String(default="", doc="Name of the last file.")
+    value = param.Bytes(default=None, allow_None=True, doc="Contents of the last file.")
+
+    def __init__(self, accept: Sequence[str], max_bytes: int, **params: Any) -> None:
+        super().__init__(**params)
+        self.max_bytes = max_bytes
+        self._dropper = pn.widgets.FileDropper(
+            accepted_filetypes=list(accept), multiple=False,
+            max_file_size=f"{max(1, max_bytes // 1000)}KB", sizing_mode="stretch_width",
+            height=90)
+        self._dropper.param.watch(self._on_drop, "value")
+
+    def _on_drop(self, event: Any) -> None:
+        for name, data in (event.new or {}).items():
+            raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+            # the same file again is a new request (e.g. after fixing the scene on screen)
+            self.param.update(filename=str(name), value=None)
+            self.value = raw
+
+    def __panel__(self) -> pn.viewable.Viewable:
+        return self._dropper
 
 
 def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",

@@ -266,3 +266,27 @@ def test_pin_link_and_downloads_match_the_screen(server: str, browser_context, p
     finally:
         other.close()
     assert page.errors == []
+
+
+def test_an_oversized_upload_is_refused_in_the_page_and_a_scene_file_loads(page: Page):
+    """A file over the limit never leaves the browser (a plain file input sent it in one
+    websocket message and a 25 MB file closed the session); a scene file then loads."""
+    disconnected: list[str] = []
+    page.page.on("console", lambda m: "Lost websocket" in m.text and disconnected.append(m.text))
+    page.open_tab("Files")
+    upload = page.page.locator("input[type=file]").last
+    upload.wait_for(state="attached", timeout=30_000)
+    upload.set_input_files(files=[{"name": "big.json", "mimeType": "application/json",
+                                   "buffer": b"{" + b" " * (25 * 2**20) + b"}"}])
+    page.page.get_by_text("File is too large").first.wait_for(timeout=30_000)
+    root = Path(__file__).resolve().parent.parent
+    scene = json.loads((root / "assets" / "scenes" / "stepped_punch.json").read_text())
+    scene["name"] = "uploaded in the browser"
+    settlement = page.text(".readout-settlement")
+    upload.set_input_files(files=[{"name": "scene.json", "mimeType": "application/json",
+                                   "buffer": json.dumps(scene).encode()}])
+    page.wait_text_change(".readout-settlement", settlement)
+    page.page.wait_for_function(
+        "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text"
+        ".includes('uploaded in the browser')", timeout=30_000)
+    assert disconnected == [] and page.errors == []
