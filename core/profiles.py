@@ -373,6 +373,10 @@ def _formula_breakpoints(expression: Expression, lo: float, hi: float) -> list[f
     return found
 
 
+class _SlopeOverflow(Exception):
+    """A table's pchip slopes are not finite (caught and named by the caller)."""
+
+
 def _table(points: list[tuple[float, float]], interpolation: str, variable: str,
            domain: tuple[float, float], spec: dict[str, Any]) -> Profile:
     xs = np.array([p[0] for p in points])
@@ -392,8 +396,13 @@ def _table(points: list[tuple[float, float]], interpolation: str, variable: str,
         breaks = tuple(xs[1:].tolist())
         extra = ()
     else:
-        with np.errstate(all="ignore"):  # extreme tables may overflow the slopes: NaN
-            interpolant = PchipInterpolator(xs, ys, extrapolate=False)
+        with np.errstate(all="ignore"):
+            try:
+                interpolant = PchipInterpolator(xs, ys, extrapolate=False)
+            except ValueError:
+                # SciPy refuses slopes that overflow (rows ~1e-300 apart): refused here
+                # with the field named by the caller
+                raise _SlopeOverflow from None
         x0, x1 = float(xs[0]), float(xs[-1])
 
         y0, y1 = float(ys[0]), float(ys[-1])
@@ -547,7 +556,12 @@ def profile_from_spec(spec: Any, *, field: str, variable: str = "x",
                              f"{', '.join(INTERPOLATIONS)}, is {shown}")
         canonical = {"kind": kind, "points": [list(p) for p in points],
                      "interpolation": interpolation}
-        return _table(points, interpolation, variable, domain, canonical)
+        try:
+            return _table(points, interpolation, variable, domain, canonical)
+        except _SlopeOverflow:
+            raise ValueError(f"{field}.points: the slopes between rows overflow a double "
+                             "(rows too close together for 'pchip'); spread them or use "
+                             "'linear'") from None
 
     # kind == "expr"
     text = spec["expr"]

@@ -605,3 +605,12 @@ def test_random_csv_is_accepted_or_refused_with_value_error(data: bytes | str) -
         return
     event("accepted")
     assert p.kind == "table" and len(p.spec["points"]) >= 2
+
+
+def test_a_pchip_table_whose_slopes_overflow_is_refused_naming_the_field():
+    """Found by the property test: rows 1.6e-304 apart make SciPy's pchip slopes
+    infinite, and its own ValueError named no field."""
+    spec = {"kind": "table", "points": [[0.0, 0.0], [1.635348361109492e-304, 29399.0]],
+            "interpolation": "pchip"}
+    with pytest.raises(ValueError, match=r"^punch\.shape\.points: the slopes between rows"):
+        profile_from_spec(spec, field="punch.shape", variable="x", domain=(-0.15, 0.25))
