@@ -84,6 +84,11 @@ M_STAR_RANGE = (1e-30, 1e30)
 #: Largest accepted load after scaling by the base modulus and the half-width (the
 #: solver's own bound, core.solver.VALUE_RANGE): beyond it results overflow.
 MAX_DIMENSIONLESS_LOAD = 1e100
+# Shared between scenes (a slider step makes a new scene and changes one field): each
+# keyed on exactly what it depends on. A validated profile holds its spec and a closure
+# (a 10000-row table ~0.5 MB); the samples of one geometry are ~4100 points, 33 kB.
+_PROFILES = StageCache("profiles", max_items=512, max_bytes=32 * 2**20)
+_SAMPLE_X = StageCache("sample_x", max_items=128, max_bytes=16 * 2**20)
 _GAP_MINIMUM = StageCache("gap_minimum", max_items=256, max_bytes=2**20)
 #: Largest accepted gap between punch and coating surface, in half-widths a.
 MAX_GAP_RATIO = 1e3
@@ -316,15 +321,28 @@ class Scene:
         return tuple(merged)
 
     @cached_property
+    def _geometry_key(self) -> str:
+        """Content hash of the punch and the coating (what the x-profiles depend on)."""
+        return fingerprint("geometry", json.dumps(
+            [self._data["punch"], self._data["coating"]], sort_keys=True,
+            separators=(",", ":")))
+
+    @cached_property
     def sample_x(self) -> np.ndarray:
         """Dense points of [-a, a] [m] where the x-profiles show their extremes: a uniform
-        grid, both sides of every breakpoint and each family's known extremes."""
+        grid, both sides of every breakpoint and each family's known extremes (shared,
+        read-only, by scenes of the same geometry)."""
+        return _SAMPLE_X.get_or_compute(self._geometry_key, self._sample_points)[0]
+
+    def _sample_points(self) -> np.ndarray:
         a = self.half_width
         profiles = [self.shape] + [p for layer in self.coating
                                    for p in (layer.thickness, layer.modulus, layer.poisson)]
         parts = [np.linspace(-a, a, DENSE_SAMPLES)]
         parts += [p.sample_points((-a, a)) for p in profiles]
-        return np.unique(np.concatenate(parts))
+        points = np.unique(np.concatenate(parts))
+        points.setflags(write=False)
+        return points
 
     def modulus_at_loading(self) -> float:
         """``E0 = E(age_at_loading)`` [Pa], the base modulus when the load is applied."""
@@ -376,10 +394,7 @@ class Scene:
         Shared by scenes of the same geometry (a load slider makes a new scene each
         step; the search costs ~4 ms of the ~15 ms such a step takes)."""
         # the samples depend on every x-profile (their breakpoints and extremes)
-        key = fingerprint("gap_minimum", json.dumps(
-            [self._data["punch"], self._data["coating"]], sort_keys=True,
-            separators=(",", ":")))
-        return _GAP_MINIMUM.get_or_compute(key, self._search_gap_minimum)[0]
+        return _GAP_MINIMUM.get_or_compute(self._geometry_key, self._search_gap_minimum)[0]
 
     def _search_gap_minimum(self) -> float:
         x = self.sample_x
@@ -470,7 +485,23 @@ def _golden_minimum(fn: Callable[[float], float], lo: float, hi: float,
 
 def _profile(spec: Any, path: str, variable: str, domain: tuple[float, float], *,
              lower: float | None = None, upper: float | None = None) -> Profile:
-    """Build a profile and check that its values lie in the open range (lower, upper)."""
+    """Build a profile and check that its values lie in the open range (lower, upper).
+
+    Profiles are immutable, so a validated one is shared by every scene that has it: a
+    slider step changes one field, and checking every profile again on thousands of
+    points was as costly as the solve itself (measured under 20 sessions)."""
+    try:
+        key = fingerprint("profile", json.dumps(spec, sort_keys=True, separators=(",", ":"),
+                                                allow_nan=False),
+                          path, variable, domain, lower, upper)
+    except (TypeError, ValueError):  # not plain JSON: validated without the memo
+        return _checked_profile(spec, path, variable, domain, lower, upper)
+    return _PROFILES.get_or_compute(
+        key, lambda: _checked_profile(spec, path, variable, domain, lower, upper))[0]
+
+
+def _checked_profile(spec: Any, path: str, variable: str, domain: tuple[float, float],
+                     lower: float | None, upper: float | None) -> Profile:
     profile = profile_from_spec(spec, field=path, variable=variable, domain=domain)
     try:
         check_range(profile, field=path, domain=domain, lower=lower, upper=upper)
