@@ -283,6 +283,7 @@ def protocol_session(url: str, seed: int, clock: Clock, max_requests: int, stats
                      geometry_share: float, think: tuple[float, float]) -> None:
     """One student on the Bokeh protocol, in its own thread and event loop."""
     import panel  # noqa: F401  (registers Panel's models, so its documents deserialize)
+    import panel.models.file_dropper  # noqa: F401  (loaded lazily by Panel: the uploads)
     from bokeh.client import pull_session
     from bokeh.events import DocumentReady
 
