@@ -32,12 +32,12 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from explorer.serving import ExplorerProcess, ExplorerStartError  # noqa: E402
-
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
-                 "--disable-background-networking", "--disable-component-update",
-                 "--no-first-run", "--disable-sync"]
+from explorer.serving import (  # noqa: E402
+    CHROMIUM,
+    CHROMIUM_ARGS,
+    ExplorerProcess,
+    ExplorerStartError,
+)
 
 READY = """() => {
   const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];

@@ -50,12 +50,10 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from explorer.serving import ExplorerProcess, ExplorerStartError  # noqa: E402
+from explorer.serving import CHROMIUM, ExplorerProcess, ExplorerStartError  # noqa: E402
+from explorer.serving import CHROMIUM_ARGS as BROWSER_ARGS  # noqa: E402
 
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
-                 "--disable-background-networking", "--disable-component-update",
-                 "--no-first-run", "--disable-sync",
+CHROMIUM_ARGS = [*BROWSER_ARGS,
                  # pages of one browser compete for its renderers: none may be throttled
                  # as a background tab
                  "--disable-background-timer-throttling", "--disable-renderer-backgrounding",

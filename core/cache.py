@@ -121,7 +121,12 @@ class StageCache:
         with self._lock:
             self.evaluations += 1
             self._in_flight.pop(key, None)
-            self._store(key, value, size)
+            if size <= self.max_bytes:  # a value larger than the whole budget is not kept
+                self._data[key] = (value, size)
+                self._bytes += size
+                while len(self._data) > self.max_items or self._bytes > self.max_bytes:
+                    _, (_, dropped) = self._data.popitem(last=False)
+                    self._bytes -= dropped
         event.set()
         return value, False
 
@@ -135,24 +140,6 @@ class StageCache:
             self.hits += 1
             return entry[0]
 
-    def put(self, key: Hashable, value: Any) -> None:
-        """Hold ``value`` for ``key`` (replacing an older one), within the bounds."""
-        size = self._sizeof(value)
-        with self._lock:
-            self._store(key, value, size)
-
-    def _store(self, key: Hashable, value: Any, size: int) -> None:
-        # caller holds the lock; a value larger than the whole budget is not kept
-        old = self._data.pop(key, None)
-        if old is not None:
-            self._bytes -= old[1]
-        if size > self.max_bytes:
-            return
-        self._data[key] = (value, size)
-        self._bytes += size
-        while len(self._data) > self.max_items or self._bytes > self.max_bytes:
-            _, (_, dropped) = self._data.popitem(last=False)
-            self._bytes -= dropped
 
     def clear(self) -> None:
         """Drop every cached value (the counters are kept)."""

@@ -24,7 +24,15 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
 
-__all__ = ["ExplorerProcess", "ExplorerStartError", "free_port"]
+__all__ = ["CHROMIUM", "CHROMIUM_ARGS", "ExplorerProcess", "ExplorerStartError", "free_port"]
+
+#: The browser the tests and benchmarks drive the served page with: Debian's Chromium
+#: (installed by tests/run.sh; Playwright's own download does not work everywhere).
+CHROMIUM = "/usr/bin/chromium"
+#: Its flags: headless, no sandbox (containers), nothing fetched from the network.
+CHROMIUM_ARGS = ("--headless=new", "--no-sandbox", "--disable-gpu",
+                 "--disable-background-networking", "--disable-component-update",
+                 "--no-first-run", "--disable-sync")
 
 # The directory holding the `explorer` and `core` packages (the repository root in a
 # checkout): the child must import the same code as its parent, wherever it was started.

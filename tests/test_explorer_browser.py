@@ -18,20 +18,17 @@ from pathlib import Path
 
 import pytest
 
-from explorer.serving import ExplorerProcess
+from explorer.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
 playwright_api = pytest.importorskip("playwright.sync_api")
 
 ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
-                 "--disable-background-networking", "--disable-component-update",
-                 "--no-first-run", "--disable-sync"]
 
 if not os.path.exists(CHROMIUM):
-    pytest.skip("Debian's chromium is not installed", allow_module_level=True)
+    pytest.skip(f"Debian's chromium is not at {CHROMIUM}: `bash tests/run.sh` installs it",
+                allow_module_level=True)
 
 # JavaScript helpers run in the page.
 JS_DOC = "() => (window.Bokeh && Bokeh.documents && Bokeh.documents[0]) || null"

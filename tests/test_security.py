@@ -39,7 +39,7 @@ from core.scene import (
     solve,
 )
 from explorer.links import MAX_JSON, PREFIX, decode_scene, encode_scene
-from explorer.serving import ExplorerProcess
+from explorer.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "assets" / "scenes"
@@ -634,16 +634,12 @@ def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:
 
 # ------------------------------------------------------------------ in a real browser
 
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu",
-                 "--disable-background-networking", "--disable-component-update",
-                 "--no-first-run", "--disable-sync"]
 
 
 @pytest.fixture(scope="module")
 def served() -> Iterator[str]:
     if not os.path.exists(CHROMIUM):
-        pytest.skip("Debian's chromium is not installed")
+        pytest.skip(f"Debian's chromium is not at {CHROMIUM}: `bash tests/run.sh` installs it")
     pytest.importorskip("playwright.sync_api")
     with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as server:
         yield server.url
