@@ -52,6 +52,14 @@ log = logging.getLogger(__name__)
 #: Time after a page connects before the sidebar tabs not yet opened are filled in the
 #: background [ms]: after the first paint and a first look (see _fill_idle_tab).
 FILL_TABS_AFTER_MS = 3000
+#: A solve shows the busy indicator only once it has run this long [ms]. A slider step
+#: is solved in 10-50 ms: its new plots are the feedback, and switching the indicator on
+#: and off costs three more messages to the page per step (a sixth of the server's work
+#: with 20 busy sessions, measured with py-spy).
+BUSY_AFTER_MS = 250
+#: The page's address follows the scene on screen at most this often [ms]: rewriting it
+#: at every slider step would cost a message per step, for a link nobody copies mid-drag.
+LINK_EVERY_MS = 1000
 
 #: Which validity flags are shown next to which plot.
 BADGES: dict[str, dict[str, tuple[str, str]]] = {
@@ -179,6 +187,10 @@ class ExplorerApp(pn.viewable.Viewer):
         self.presets = presets()
         self.figures = Figures()
         self._drawn: ResultView | None = None
+        self._busy_shown = False
+        self._busy_due = False
+        self._link_due = False
+        self._linked = ""
         self._initial_scene(scene, query or {})
         self._build_widgets()
         self._layout = self._build_layout()
@@ -668,8 +680,25 @@ class ExplorerApp(pn.viewable.Viewer):
         self.alert.object = (f"**Not solved:** {html.escape(error)}  \nThe plots still show "
                              "the last good result." if error else "")
         self.alert.visible = bool(error)
-        self.spinner.value = self.controller.busy
-        self.status.object = status_html(self.controller.view, self.controller.busy)
+        if not self.controller.busy:
+            self._show_busy(False)
+        elif not self._served:  # no event loop to wait on: show it at once
+            self._show_busy(True)
+        elif not (self._busy_shown or self._busy_due):
+            self._busy_due = True
+            self._later(self._busy_timeout, BUSY_AFTER_MS)
+
+    def _busy_timeout(self) -> None:
+        self._busy_due = False
+        if self.controller.busy:
+            self._show_busy(True)
+
+    def _show_busy(self, busy: bool) -> None:
+        if busy == self._busy_shown:
+            return
+        self._busy_shown = busy
+        self.spinner.value = busy
+        self.status.object = status_html(self.controller.view, busy)
 
     def _on_load(self) -> None:
         self._connected = True
@@ -733,7 +762,7 @@ class ExplorerApp(pn.viewable.Viewer):
             with param.discard_events(self):
                 self.time_index = index
             self._show_time_texts(view, index)
-            self.status.object = status_html(view, self.controller.busy)
+            self.status.object = status_html(view, self._busy_shown)
             self.scene_badges.object = badges_html(view, "scene")
             self.pressure_badges.object = badges_html(view, "pressure")
             self.history_badges.object = badges_html(view, "history")
@@ -744,11 +773,23 @@ class ExplorerApp(pn.viewable.Viewer):
             self.pressure_download.filename = f"{slug}_pressure.csv"
             self.json_download.filename = f"{slug}_results.json"
         self._push()
-        if self._location is not None and not self.controller.busy:
-            try:
-                self._location.update_query(scene=encode_scene(view.scene))
-            except Exception:  # the link is a convenience; the page must not fail for it
-                log.exception("could not update the link")
+        if self._location is not None and not self._link_due:
+            self._link_due = True
+            self._later(self._update_link, LINK_EVERY_MS)
+
+    def _update_link(self) -> None:
+        """Put the scene on screen into the page's address (a link that reproduces it)."""
+        self._link_due = False
+        view = self._drawn
+        if view is None or self._location is None or self.controller.busy:
+            return  # a newer result is coming, and will ask again
+        try:
+            link = encode_scene(view.scene)
+            if link != self._linked:
+                self._location.update_query(scene=link)
+                self._linked = link
+        except Exception:  # the link is a convenience; the page must not fail for it
+            log.exception("could not update the link")
 
     def _on_time(self, event: Any) -> None:
         view = self._drawn

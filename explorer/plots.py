@@ -57,6 +57,28 @@ def _empty(*columns: str) -> dict[str, list]:
     return {c: [] for c in columns}
 
 
+def _same(old: object, new: object) -> bool:
+    try:
+        return bool(np.array_equal(np.asarray(old, dtype=float), np.asarray(new, dtype=float),
+                                   equal_nan=True))
+    except (TypeError, ValueError):  # text columns, ragged lists: assume changed
+        return False
+
+
+def set_data(source: ColumnDataSource, data: dict) -> bool:
+    """Give ``source`` new ``data`` unless it holds the same numbers already; True if set.
+
+    Bokeh sends every assignment to the page, which redraws the glyphs behind it. A load
+    step leaves the drawing, the pinned curves and the given histories as they were:
+    resending them cost the server and the browser work for nothing.
+    """
+    old = source.data
+    if old.keys() == data.keys() and all(_same(old[k], v) for k, v in data.items()):
+        return False
+    source.data = data
+    return True
+
+
 class Figures:
     """All figures of one session and the sources behind them."""
 
@@ -199,7 +221,7 @@ class Figures:
         self._show_image(view)
         for q in QUANTITIES:
             given = q in view.given
-            self.history_src[q].data = {"t": view.times, "v": view.display(q)}
+            set_data(self.history_src[q], {"t": view.times, "v": view.display(q)})
             self.history_line[q].glyph.line_color = GIVEN_COLOR if given else UNKNOWN_COLOR
             state = "given" if given else "computed"
             unit = QUANTITY_UNITS[q][0]
@@ -211,36 +233,36 @@ class Figures:
         """Overlay (or clear) a pinned result on the histories."""
         for q in QUANTITIES:
             if pinned is None:
-                self.history_pin_src[q].data = {"t": [], "v": []}
+                set_data(self.history_pin_src[q], {"t": [], "v": []})
             else:
-                self.history_pin_src[q].data = {"t": pinned.times, "v": pinned.display(q)}
+                set_data(self.history_pin_src[q], {"t": pinned.times, "v": pinned.display(q)})
         self._show_pinned_pressure(view, pinned, index)
 
     def _show_pinned_pressure(self, view: ResultView, pinned: ResultView | None,
                               index: int) -> None:
         if pinned is None:
-            self.q_pin_src.data = {"x": [], "q": []}
+            set_data(self.q_pin_src, {"x": [], "q": []})
             return
         unit, size = view.pressure_unit
         j = pinned.time_index(float(view.times[index]))
-        self.q_pin_src.data = {"x": pinned.x, "q": pinned.pressure[:, j] / size}
+        set_data(self.q_pin_src, {"x": pinned.x, "q": pinned.pressure[:, j] / size})
 
     def show_time(self, view: ResultView, index: int, pinned: ResultView | None) -> None:
         """Move every time cursor to output ``index`` (no solve)."""
         unit, size = view.pressure_unit
         t = float(view.times[index])
         q = view.pressure[:, index]
-        self.q_src.data = {"x": view.x, "q": q / size}
+        set_data(self.q_src, {"x": view.x, "q": q / size})
         intervals = negative_intervals(view.x, q)
-        self.neg_src.data = {"left": [lo for lo, _ in intervals],
-                             "right": [hi for _, hi in intervals]}
+        set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
+                                "right": [hi for _, hi in intervals]})
         self.q_fig.title.text = f"Contact pressure q(x) at t = {t:.4g} days"
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self._show_pinned_pressure(view, pinned, index)
         self.image_cursor.location = t
         for name in QUANTITIES:
             self.history_cursor[name].location = t
-            self.history_point_src[name].data = {"t": [t], "v": [view.display(name)[index]]}
+            set_data(self.history_point_src[name], {"t": [t], "v": [view.display(name)[index]]})
         self._show_arrow(view, index)
 
     def _show_arrow(self, view: ResultView, index: int) -> None:

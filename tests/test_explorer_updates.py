@@ -1,0 +1,149 @@
+"""What a session sends to its page: only what changed, no busy flicker, a calm link.
+
+Every assignment to a Bokeh model is a message to the browser and a redraw there; with
+many sessions on one server these messages were most of its work (py-spy, 20 sessions:
+six messages and 17 data sources per load step before, two and 6 after).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from bokeh.models import ColumnDataSource
+
+from explorer.app import BUSY_AFTER_MS, LINK_EVERY_MS, ExplorerApp
+from explorer.plots import set_data
+
+
+def test_set_data_skips_equal_numbers_and_sends_changes() -> None:
+    source = ColumnDataSource({"t": [0.0, 1.0], "v": [1.0, np.nan]})
+    changes: list[str] = []
+    source.on_change("data", lambda attr, old, new: changes.append(attr))
+    assert not set_data(source, {"t": np.array([0.0, 1.0]), "v": np.array([1.0, np.nan])})
+    assert changes == []
+    assert set_data(source, {"t": [0.0, 1.0], "v": [1.0, 2.0]})          # a value
+    assert set_data(source, {"t": [0.0, 1.0, 2.0], "v": [1.0, 2.0, 3.0]})  # a length
+    assert set_data(source, {"t": [0.0], "w": [1.0]})                      # a column
+    assert set_data(source, {"t": ["a"], "w": [1.0]})                      # not numbers
+    assert len(changes) == 4
+
+
+def _count_changes(app: ExplorerApp) -> dict[str, list[int]]:
+    figures = app.figures
+    sources = {"layers": figures.layer_src, "punch": figures.punch_src,
+               "base": figures.base_src, "q": figures.q_src, "q_pin": figures.q_pin_src}
+    for q in ("settlement", "tilt", "force", "moment"):
+        sources[q] = figures.history_src[q]
+        sources[f"{q}_pin"] = figures.history_pin_src[q]
+    counts: dict[str, list[int]] = {name: [0] for name in sources}
+    for name, source in sources.items():
+        source.on_change("data", lambda attr, old, new, c=counts[name]: c.__setitem__(0, c[0] + 1))
+    return counts
+
+
+def test_a_load_step_resends_only_the_data_that_changed() -> None:
+    app = ExplorerApp(executor=None)
+    assert set(app.state.to_scene()["loading"]) == {"force", "moment"}  # P = 500 kN/m, M = 0
+    counts = _count_changes(app)
+    force = app.state.loading.histories["force"]
+    force.value = force.value * 1.1
+    assert app.controller.wait(60) and app.controller.error == ""
+    sent = {name: c[0] for name, c in counts.items()}
+    # a new force: new pressure, settlement and force history
+    assert sent["q"] == 1 and sent["settlement"] == 1 and sent["force"] == 1
+    # the drawing, the empty pinned curves and the zero tilt and moment stay as they are
+    for name in ("layers", "punch", "base", "q_pin", "tilt", "moment", "settlement_pin",
+                 "tilt_pin", "force_pin", "moment_pin"):
+        assert sent[name] == 0, name
+    # pinning then sends the pinned curves once
+    app.pin()
+    assert counts["q_pin"][0] == 1 and counts["settlement_pin"][0] == 1
+
+
+class _Timers:
+    """Stands in for the session's event loop: callbacks wait until run by the test."""
+
+    def __init__(self) -> None:
+        self.pending: list[tuple[Any, float]] = []
+
+    def __call__(self, callback: Any, delay_ms: float) -> None:
+        self.pending.append((callback, delay_ms))
+
+    def run(self) -> list[float]:
+        due, self.pending = self.pending, []
+        for callback, _ in due:
+            callback()
+        return [delay for _, delay in due]
+
+
+@pytest.fixture
+def served_app(monkeypatch: pytest.MonkeyPatch) -> tuple[ExplorerApp, _Timers]:
+    app = ExplorerApp(executor=None)
+    timers = _Timers()
+    monkeypatch.setattr(ExplorerApp, "_served", property(lambda self: True))
+    monkeypatch.setattr(app, "_later", timers)
+    return app, timers
+
+
+def test_the_busy_indicator_waits_for_a_slow_solve(served_app) -> None:
+    app, timers = served_app
+    # a quick solve: over before the indicator is due, never shown
+    app.controller.busy = True
+    assert not app.spinner.value and "Solving" not in app.status.object
+    app.controller.busy = False
+    assert timers.run() == [BUSY_AFTER_MS]
+    assert not app.spinner.value
+    # a slow one: shown when due, gone with the result
+    app.controller.busy = True
+    app.controller.busy = False
+    app.controller.busy = True          # one timer for the whole busy spell
+    assert timers.run() == [BUSY_AFTER_MS]
+    assert app.spinner.value and "Solving the newest change" in app.status.object
+    app.controller.busy = False
+    assert not app.spinner.value and "Solving" not in app.status.object
+
+
+def test_the_busy_indicator_shows_at_once_outside_a_server() -> None:
+    app = ExplorerApp(executor=None)
+    app.controller.busy = True
+    assert app.spinner.value
+    app.controller.busy = False
+    assert not app.spinner.value
+
+
+class _Location:
+    def __init__(self) -> None:
+        self.calls: list[str] = []
+
+    def update_query(self, scene: str) -> None:
+        self.calls.append(scene)
+
+
+def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
+    from explorer.links import decode_scene
+
+    app, timers = served_app
+    location = _Location()
+    app._location = location
+    force = app.state.loading.histories["force"]
+    for value in (510.0, 520.0, 530.0):   # a drag: three results, one link
+        force.value = value
+        assert app.controller.wait(60)
+    assert location.calls == []
+    assert timers.run() == [LINK_EVERY_MS]
+    assert len(location.calls) == 1
+    assert decode_scene(location.calls[0]) == app._drawn.scene
+    assert decode_scene(location.calls[0])["loading"]["force"] == 530e3
+    # nothing new on screen: the address is not written again
+    app._on_view(None)
+    timers.run()
+    assert len(location.calls) == 1
+    # a newer result on its way: the link waits for it
+    force.value = 540.0
+    assert app.controller.wait(60)
+    app.controller.busy = True
+    timers.run()
+    assert len(location.calls) == 1
+    app.controller.busy = False
