@@ -24,6 +24,7 @@ from core.scene import MAX_SCENE_BYTES
 
 from .controller import SolveController, format_error
 from .links import decode_scene, encode_scene
+from .panel_fixes import install as install_panel_fixes
 from .plots import Figures
 from .presets import DEFAULT_PRESET, preset_label, presets
 from .results import ResultView
@@ -48,6 +49,7 @@ from .widgets import (
 )
 
 log = logging.getLogger(__name__)
+install_panel_fixes()
 
 #: Time after a page connects before the sidebar tabs not yet opened are filled in the
 #: background [ms]: after the first paint and a first look (see _fill_idle_tab).

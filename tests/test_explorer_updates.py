@@ -147,3 +147,42 @@ def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
     timers.run()
     assert len(location.calls) == 1
     app.controller.busy = False
+
+
+def test_a_message_left_queued_by_a_finished_write_task_is_still_sent() -> None:
+    """The state Panel's write queue can be left in (see explorer/panel_fixes.py): a
+    message queued and no write flag. Seen under load as a slider step whose plots never
+    arrived; the guard sends it."""
+    import asyncio
+
+    from bokeh.document import Document
+    from panel.io import document as pdoc
+
+    from explorer.panel_fixes import install
+
+    assert install()
+
+    class Socket:  # stands in for a websocket; Panel writes to it through its hook
+        pass
+
+    class Connection:
+        _socket = Socket()
+
+    sent: list[str] = []
+    pdoc.extra_socket_handlers[Socket] = lambda conn, msg=None: sent.append(msg) or []
+    doc, connection = Document(), Connection()
+    try:
+        async def scenario() -> None:
+            pdoc._WRITE_MSGS[doc] = {connection: ["the last result"]}
+            pdoc._WRITE_BLOCK.pop(doc, None)
+            await pdoc._dispatch_msgs(doc)        # the task that finds no flag
+            for _ in range(20):                   # let the task it schedules run
+                await asyncio.sleep(0)
+
+        asyncio.run(scenario())
+        assert sent == ["the last result"]
+        assert doc not in pdoc._WRITE_MSGS and doc not in pdoc._WRITE_BLOCK
+    finally:
+        pdoc.extra_socket_handlers.pop(Socket, None)
+        pdoc._WRITE_MSGS.pop(doc, None)
+        pdoc._WRITE_BLOCK.pop(doc, None)
