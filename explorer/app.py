@@ -684,6 +684,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.alert.visible = bool(error)
         if not self.controller.busy:
             self._show_busy(False)
+            self._schedule_link()  # a link skipped while busy, if no newer result came
         elif not self._served:  # no event loop to wait on: show it at once
             self._show_busy(True)
         elif not (self._busy_shown or self._busy_due):
@@ -775,7 +776,10 @@ class ExplorerApp(pn.viewable.Viewer):
             self.pressure_download.filename = f"{slug}_pressure.csv"
             self.json_download.filename = f"{slug}_results.json"
         self._push()
-        if self._location is not None and not self._link_due:
+        self._schedule_link()
+
+    def _schedule_link(self) -> None:
+        if self._location is not None and self._drawn is not None and not self._link_due:
             self._link_due = True
             self._later(self._update_link, LINK_EVERY_MS)
 

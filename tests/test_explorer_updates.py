@@ -146,7 +146,11 @@ def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
     app.controller.busy = True
     timers.run()
     assert len(location.calls) == 1
+    # ... and if none comes (the newer change was refused), the link still follows
     app.controller.busy = False
+    timers.run()
+    assert len(location.calls) == 2
+    assert decode_scene(location.calls[1])["loading"]["force"] == 540e3
 
 
 def test_a_message_left_queued_by_a_finished_write_task_is_still_sent() -> None:
