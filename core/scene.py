@@ -45,7 +45,7 @@ import numpy as np
 from core.cache import StageCache, fingerprint
 from core.creep import UserKernel, creep_model_from_spec
 from core.profiles import Profile, check_range, profile_from_spec
-from core.validation import finite_number, positive_number, show_value
+from core.validation import MAX_MAGNITUDE, finite_number, positive_number, show_value
 
 if TYPE_CHECKING:
     from core.solver import ContactSolution
@@ -81,9 +81,6 @@ MAX_BREAKPOINTS = 16
 #: Accepted range of the dimensionless coating compliance m*: physical coatings are far
 #: inside it; the solver was measured finite for 1e-100 to 1e100.
 M_STAR_RANGE = (1e-30, 1e30)
-#: Largest accepted load after scaling by the base modulus and the half-width (the
-#: solver's own bound, core.solver.VALUE_RANGE): beyond it results overflow.
-MAX_DIMENSIONLESS_LOAD = 1e100
 # Shared between scenes (a slider step makes a new scene and changes one field): each
 # keyed on exactly what it depends on. A validated profile holds its spec and a closure
 # (a 10000-row table ~0.5 MB); the samples of one geometry are ~4100 points, 33 kB.
@@ -728,7 +725,7 @@ def _check_solvable(scene: Scene) -> None:
         ts = problem.times
         for name, load in problem.loads.items():
             values = np.broadcast_to(load(ts) if callable(load) else load, ts.shape)
-            bad = ~np.isfinite(values) | (np.abs(values) > MAX_DIMENSIONLESS_LOAD)
+            bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
             if bad.any():
                 i = int(np.argmax(bad))
                 raise ValueError(

@@ -49,6 +49,7 @@ from core.quadrature import (
 )
 from core.statements import QUANTITIES, ModalSystem, modal_system, statement_number
 from core.time_integration import ModalProblem, solve_degenerate, solve_general
+from core.validation import MAX_MAGNITUDE
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
@@ -72,7 +73,8 @@ TOLERANCE_RANGE = (1e-13, 1e-1)
 #: modulus; the given loads: at most 1e100). Beyond them the Galerkin matrix over- or
 #: underflows in double precision (m = 1e200 made it singular, m = 1e-300 gave NaN);
 #: physical scenes are far inside.
-VALUE_RANGE = {"m": (1e-100, 1e100), "g": (0.0, 1e100), "c": (1e-100, 1e100)}
+VALUE_RANGE = {"m": (1 / MAX_MAGNITUDE, MAX_MAGNITUDE), "g": (0.0, MAX_MAGNITUDE),
+               "c": (1 / MAX_MAGNITUDE, MAX_MAGNITUDE)}
 #: Accepted a/H. The operator's nodes grow like a/H and its memory like its square:
 #: measured 155 MB at 100 and 5.5 GB at 1000 (tests/test_security.py documents the
 #: scene limit, which is tighter).
@@ -177,7 +179,7 @@ def _check_values(values: np.ndarray, name: str, where: np.ndarray, var: str, *,
     if positive and np.any(values <= 0):
         i = int(np.argmin(values))
         raise ValueError(f"{name}: must be > 0, is {values[i]:.6g} at {var} = {where[i]:.6g}")
-    lo, hi = VALUE_RANGE.get(name, (0.0, 1e100))
+    lo, hi = VALUE_RANGE.get(name, (0.0, MAX_MAGNITUDE))
     if not positive:
         lo = 0.0
     magnitude = np.abs(values)

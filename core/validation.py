@@ -22,6 +22,10 @@ from typing import Any
 #: Integers with more digits are quoted by their first digits and their length, so that a
 #: 4000-digit integer (valid JSON) still gives a one-line message.
 MAX_QUOTED_DIGITS = 40
+#: Largest magnitude of a dimensionless input the solver computes with (coefficients and
+#: loads). Beyond it the Galerkin matrix over- or underflows in double precision
+#: (m = 1e200 made it singular); physical scenes are far inside.
+MAX_MAGNITUDE = 1e100
 
 
 class NumberTooLarge(ValueError, OverflowError):

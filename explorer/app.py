@@ -220,20 +220,12 @@ class ExplorerApp(pn.viewable.Viewer):
         return bool(self._doc is not None and self._doc.session_context)
 
     def _dispatch(self, callback: Callable[[], None]) -> None:
-        """Run ``callback`` (from a solver thread) on this session's event loop."""
-        doc = self._doc
-        if doc is None or not doc.session_context:
+        """Run ``callback`` (from a solver thread) on this session's event loop, or at
+        once where there is none (a notebook, a script)."""
+        if self._served:
+            self._later(callback, 0)
+        else:
             callback()
-            return
-
-        def run() -> None:
-            with set_curdoc(doc):
-                callback()
-
-        try:
-            doc.add_next_tick_callback(run)
-        except Exception:  # the session was closed while solving
-            log.debug("result dropped: session gone")
 
     def _initial_scene(self, scene: dict[str, Any] | None, query: dict[str, str]) -> None:
         from core import scene_from_dict
@@ -745,7 +737,7 @@ class ExplorerApp(pn.viewable.Viewer):
                 doc.add_timeout_callback(run, delay_ms)
             else:
                 doc.add_next_tick_callback(run)
-        except Exception:  # the session was closed meanwhile
+        except Exception:  # the session was closed meanwhile (a result, a timer)
             log.debug("callback dropped: session gone")
 
     def _on_view(self, event: Any) -> None:

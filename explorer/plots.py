@@ -226,17 +226,20 @@ class Figures:
             state = "given" if given else "computed"
             unit = QUANTITY_UNITS[q][0]
             self.history_fig[q].title.text = f"{TITLES[q]} {SYMBOLS[q]} [{unit}]: {state}"
-        self.show_pinned(view, pinned, index)
-        self.show_time(view, index, pinned)
+        self._show_pinned_histories(pinned)
+        self.show_time(view, index, pinned)  # the pinned pressure included
 
     def show_pinned(self, view: ResultView, pinned: ResultView | None, index: int) -> None:
-        """Overlay (or clear) a pinned result on the histories."""
+        """Overlay (or clear) a pinned result on the histories and the pressure."""
+        self._show_pinned_histories(pinned)
+        self._show_pinned_pressure(view, pinned, index)
+
+    def _show_pinned_histories(self, pinned: ResultView | None) -> None:
         for q in QUANTITIES:
             if pinned is None:
                 set_data(self.history_pin_src[q], {"t": [], "v": []})
             else:
                 set_data(self.history_pin_src[q], {"t": pinned.times, "v": pinned.display(q)})
-        self._show_pinned_pressure(view, pinned, index)
 
     def _show_pinned_pressure(self, view: ResultView, pinned: ResultView | None,
                               index: int) -> None:

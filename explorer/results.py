@@ -8,6 +8,7 @@ only slices arrays that already exist.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -55,9 +56,10 @@ class ResultView:
     def unknowns(self) -> tuple[str, ...]:
         return tuple(q for q in QUANTITIES if q not in self.given)
 
-    @property
+    @cached_property
     def pressure_unit(self) -> tuple[str, float]:
-        """Display unit of pressure (kPa below 1 MPa peak, else MPa) and its size [Pa]."""
+        """Display unit of pressure (kPa below 1 MPa peak, else MPa) and its size [Pa]
+        (a scan of the whole pressure array, asked for by every plot of a redraw)."""
         peak = float(np.nanmax(np.abs(self.pressure))) if self.pressure.size else 0.0
         return ("MPa", 1e6) if peak >= 1e6 else ("kPa", 1e3)
 
