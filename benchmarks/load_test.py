@@ -98,6 +98,7 @@ class Stats:
     """What the sessions of one phase saw (appended to from several threads)."""
 
     data: list[float] = field(default_factory=list)     # ms
+    by_move: dict[str, list[float]] = field(default_factory=dict)  # ms, per slider moved
     frame: list[float] = field(default_factory=list)    # ms
     requests: int = 0
     geometry_requests: int = 0
@@ -174,16 +175,37 @@ def machine_ticks() -> tuple[int, int]:
     return sum(values) - idle, sum(values)
 
 
+def process_tree(pid: int) -> list[int]:
+    """``pid`` and all its descendants (the server and its solver processes), from /proc."""
+    out, todo = [], [pid]
+    while todo:
+        current = todo.pop()
+        out.append(current)
+        try:
+            tasks = os.listdir(f"/proc/{current}/task")
+        except OSError:
+            continue
+        for task in tasks:
+            try:
+                with open(f"/proc/{current}/task/{task}/children", encoding="ascii") as fh:
+                    todo.extend(int(child) for child in fh.read().split())
+            except OSError:
+                continue
+    return out
+
+
 class Sampler(threading.Thread):
-    """Samples the server's RSS and CPU time and the machine's CPU use every ``period``
-    seconds; ``mark`` records events on the same clock."""
+    """Samples the RSS and CPU time of the server with its solver processes, the server
+    process's own CPU time, and the machine's CPU use every ``period`` seconds; ``mark``
+    records events on the same clock."""
 
     def __init__(self, pid: int, period: float = 2.0) -> None:
         super().__init__(daemon=True)
         self.pid = pid
         self.period = period
-        # (s since start, RSS bytes, server CPU s, machine busy ticks, machine ticks)
-        self.samples: list[tuple[float, int, float, int, int]] = []
+        # (s since start, RSS bytes and CPU s of the server with its solver processes,
+        #  machine busy ticks, machine ticks, CPU s of the server's own process)
+        self.samples: list[tuple[float, int, float, int, int, float]] = []
         self.marks: list[tuple[float, str]] = []
         self._halt = threading.Event()
         self.t0 = time.monotonic()
@@ -193,9 +215,15 @@ class Sampler(threading.Thread):
 
     def run(self) -> None:
         while not self._halt.is_set():
-            rss, cpu = rss_bytes(self.pid), cpu_seconds(self.pid)
-            if rss is not None and cpu is not None:
-                self.samples.append((time.monotonic() - self.t0, rss, cpu, *machine_ticks()))
+            own = cpu_seconds(self.pid)
+            tree = process_tree(self.pid)
+            rss = [rss_bytes(p) for p in tree]
+            cpu = [cpu_seconds(p) for p in tree]
+            if own is not None:
+                self.samples.append((time.monotonic() - self.t0,
+                                     sum(r for r in rss if r is not None),
+                                     sum(c for c in cpu if c is not None),
+                                     *machine_ticks(), own))
             self._halt.wait(self.period)
 
     def stop(self) -> None:
@@ -203,13 +231,15 @@ class Sampler(threading.Thread):
         self.join(timeout=10)
 
     def between(self, start: str, stop: str) -> dict[str, float]:
-        """Server CPU [% of one core] and machine CPU [% of all cores] between two marks."""
+        """CPU between two marks: the server with its solver processes and the server's
+        own process [% of one core], the machine [% of all cores]."""
         marks = {label: t for t, label in self.marks}
         inside = [s for s in self.samples if marks[start] <= s[0] <= marks[stop]]
         if len(inside) < 2:
-            return {"server": float("nan"), "machine": float("nan")}
-        (t0, _, c0, b0, n0), (t1, _, c1, b1, n1) = inside[0], inside[-1]
+            return {"server": float("nan"), "machine": float("nan"), "own": float("nan")}
+        (t0, _, c0, b0, n0, o0), (t1, _, c1, b1, n1, o1) = inside[0], inside[-1]
         return {"server": 100 * (c1 - c0) / max(t1 - t0, 1e-9),
+                "own": 100 * (o1 - o0) / max(t1 - t0, 1e-9),
                 "machine": 100 * (b1 - b0) / max(n1 - n0, 1)}
 
 
@@ -376,6 +406,7 @@ def protocol_session(url: str, seed: int, clock: Clock, max_requests: int, stats
                     received = await asyncio.wait_for(future, UPDATE_TIMEOUT)
                     with stats.lock:
                         stats.data.append(1e3 * (received - sent))
+                        stats.by_move.setdefault(name, []).append(1e3 * (received - sent))
                 except asyncio.TimeoutError:
                     stats.error(f"{tag}: no plot update within {UPDATE_TIMEOUT:g} s after "
                                 f"a {name} move")
@@ -533,6 +564,13 @@ def server_tracebacks(log_path: Path) -> list[str]:
     return [b[:400] for b in blocks if not any(c in b[:3000] for c in closed)]
 
 
+def server_options(args: argparse.Namespace) -> str:
+    """The options of ``python -m explorer`` that set where the server solves."""
+    if args.solver_processes:
+        return f"--solver-processes {args.solver_processes}"
+    return f"--solver-processes 0 --solver-threads {args.solver_threads}"
+
+
 def report(args: argparse.Namespace, single: Stats, crowd: Stats, sampler: Sampler,
            log_errors: list[str], command: str) -> str:
     s_data, c_data = percentiles(single.data), percentiles(crowd.data)
@@ -569,8 +607,7 @@ def report(args: argparse.Namespace, single: Stats, crowd: Stats, sampler: Sampl
         "",
         f"Machine: {os.cpu_count()} cores ({platform.machine()}), Python "
         f"{platform.python_version()}; server, clients and driver share it. Server: "
-        f"`python -m explorer --address {HOST} --solver-threads {args.solver_threads}` "
-        "(loopback only).",
+        f"`python -m explorer --address {HOST} {server_options(args)}` (loopback only).",
         "",
         f"Sessions: {args.sessions} {client}, arriving {args.stagger:g} s apart, all moving "
         f"sliders until {args.minutes:g} min after the last was ready: one step of the force "
@@ -586,11 +623,13 @@ def report(args: argparse.Namespace, single: Stats, crowd: Stats, sampler: Sampl
         f"{crowd.requests} ({crowd.geometry_requests} geometry) from "
         f"{crowd.sessions_ready}/{args.sessions} sessions; updates timed: single "
         f"{len(single.data)}, crowd {len(crowd.data)}.",
-        f"- Server memory (RSS): peak **{peak / 2**20:.0f} MiB** (goal < 1024 MiB); during "
+        f"- Server memory (RSS, summed over the server and its solver processes): peak "
+        f"**{peak / 2**20:.0f} MiB** (goal < 1024 MiB); during "
         f"the crowd {min(crowd_rss) / 2**20:.0f} to {max(crowd_rss) / 2**20:.0f} MiB, trend "
         f"over its second half {slope * 60 / 2**20:+.1f} MiB/min.",
-        f"- CPU: server {cpu_single['server']:.0f} % of one core alone, "
-        f"{cpu_crowd['server']:.0f} % with the crowd; the whole machine "
+        f"- CPU: server with its solver processes {cpu_single['server']:.0f} % of one core "
+        f"alone, {cpu_crowd['server']:.0f} % with the crowd (the server's own process "
+        f"{cpu_single['own']:.0f} % and {cpu_crowd['own']:.0f} %); the whole machine "
         f"{cpu_single['machine']:.0f} % and {cpu_crowd['machine']:.0f} % of its "
         f"{os.cpu_count()} cores.",
         "",
@@ -599,6 +638,9 @@ def report(args: argparse.Namespace, single: Stats, crowd: Stats, sampler: Sampl
         "| measured to | single session | crowd | p95 crowd / single (goal <= 2) |",
         "| --- | --- | --- | --- |",
         row("plots showing the moved value", s_data, c_data),
+        *[row(f"... of a {name} step only", percentiles(single.by_move.get(name, [])),
+              percentiles(crowd.by_move.get(name, [])))
+          for name in ("force", "thickness")],
     ]
     if args.client == "browser":
         lines.append(row("second frame painted after it", percentiles(single.frame),
@@ -632,7 +674,10 @@ def main() -> int:
                         metavar=("MIN", "MAX"), help="pause after each update [s]")
     parser.add_argument("--stagger", type=float, default=1.0,
                         help="seconds between the arrivals of two sessions")
-    parser.add_argument("--solver-threads", type=int, default=2)
+    parser.add_argument("--solver-processes", type=int, default=1,
+                        help="the server's --solver-processes (0: solve in its threads)")
+    parser.add_argument("--solver-threads", type=int, default=2,
+                        help="the server's --solver-threads (used with --solver-processes 0)")
     parser.add_argument("--after-seconds", type=float, default=45.0,
                         help="seconds of memory samples after the crowd has left")
     parser.add_argument("--report", help="append the report (Markdown) to this file")
@@ -643,7 +688,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="load-test-") as tmp:
         log_path = Path(tmp) / "server.log"
         server = ExplorerProcess(
-            args=["--solver-threads", str(args.solver_threads)], host=HOST,
+            args=server_options(args).split(), host=HOST,
             env={"OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "1")},
             log=log_path, ready_timeout=300, stop_timeout=20)
         try:

@@ -18,6 +18,16 @@ for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_name, "1")
 
 
+#: Worker processes by default: the server's own process keeps a core for the pages; two
+#: at least, so that one slow solve cannot hold up every session (measured on 2 cores,
+#: benchmarks/results/load_test.md: 2 workers gave the crowd's p95 1.6x the single
+#: session's, 1 worker 1.8x, solving in the server's threads 4.1x).
+DEFAULT_SOLVER_PROCESSES = max(2, min(4, (os.cpu_count() or 2) - 1))
+#: Threads waiting for the worker processes, for all sessions together; beyond this many
+#: sessions with a request out at once, requests queue before reaching the workers.
+WAITING_THREADS = 64
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m explorer",
@@ -39,8 +49,14 @@ def build_parser() -> argparse.ArgumentParser:
                         help="preset scenes solved before serving, so that visitors find them "
                              "ready: the default one (default), all of them (slower start), "
                              "or none")
+    parser.add_argument("--solver-processes", type=int, default=DEFAULT_SOLVER_PROCESSES,
+                        help="worker processes solving scenes for all sessions (default "
+                             f"{DEFAULT_SOLVER_PROCESSES} on this machine: one per core but "
+                             "one, at least 2, at most 4); 0 solves in the server's own "
+                             "process, on --solver-threads threads")
     parser.add_argument("--solver-threads", type=int, default=2,
-                        help="threads solving scenes, shared by all sessions (default 2)")
+                        help="with --solver-processes 0: threads solving scenes, shared by "
+                             "all sessions (default 2)")
     return parser
 
 
@@ -50,10 +66,21 @@ def main(argv: list[str] | None = None) -> int:
     import panel as pn
 
     from explorer.app import create_app, warm_up
-    from explorer.controller import shared_pool
+    from explorer.controller import shared_pool, use_worker_processes
     from explorer.presets import ORDER
 
-    shared_pool(max(1, args.solver_threads))
+    if args.solver_processes < 0 or args.solver_threads < 1:
+        print("--solver-processes must be 0 or more and --solver-threads 1 or more",
+              file=sys.stderr)
+        return 2
+    if args.solver_processes:
+        print(f"Starting {args.solver_processes} solver process(es)...", file=sys.stderr,
+              flush=True)
+        use_worker_processes(args.solver_processes)
+        # these threads only wait for the workers: one per session with a request out
+        shared_pool(WAITING_THREADS)
+    else:
+        shared_pool(args.solver_threads)
     if args.warm_up != "none":
         keys = ORDER if args.warm_up == "all" else ORDER[:1]
         print(f"Solving {len(keys)} preset scene(s) once before serving...", file=sys.stderr,

@@ -22,7 +22,7 @@ from panel.io.state import set_curdoc
 from core.profiles import MAX_TABLE_BYTES
 from core.scene import MAX_SCENE_BYTES
 
-from .controller import SolveController, format_error
+from .controller import SolveController, format_error, worker_processes
 from .links import decode_scene, encode_scene
 from .panel_fixes import install as install_panel_fixes
 from .plots import Figures
@@ -47,6 +47,7 @@ from .widgets import (
     fine_slider,
     slider,
 )
+from .workers import solve_view
 
 log = logging.getLogger(__name__)
 install_panel_fixes()
@@ -838,17 +839,26 @@ class ExplorerApp(pn.viewable.Viewer):
         scene = view.scene if view is not None else self.state.to_scene()
         return io.StringIO(json.dumps(scene, indent=2) + "\n")
 
-    def _csv_file(self) -> io.StringIO:
+    def _download(self, kind: str, empty: str) -> io.StringIO:
         view = self._shown()
-        return io.StringIO(view.solution.to_csv() if view is not None else "")
+        if view is None:
+            return io.StringIO(empty)
+        try:
+            return io.StringIO(self.controller.download(view, kind))
+        except Exception as exc:
+            # no file is better than a wrong one; say why on the page
+            self.alert.object = f"**Download failed:** {html.escape(str(exc))}"
+            self.alert.visible = True
+            raise
+
+    def _csv_file(self) -> io.StringIO:
+        return self._download("to_csv", "")
 
     def _pressure_file(self) -> io.StringIO:
-        view = self._shown()
-        return io.StringIO(view.solution.pressure_csv() if view is not None else "")
+        return self._download("pressure_csv", "")
 
     def _json_file(self) -> io.StringIO:
-        view = self._shown()
-        return io.StringIO(view.solution.to_json() if view is not None else "{}")
+        return self._download("to_json", "{}")
 
 
 def warm_up(keys: tuple[str, ...] = (DEFAULT_PRESET,)) -> None:
@@ -861,6 +871,10 @@ def warm_up(keys: tuple[str, ...] = (DEFAULT_PRESET,)) -> None:
         state = ExplorerState()
         state.load_scene(scene)
         SolveController(state, executor=None, auto=False).solve_now()
+        processes = worker_processes()
+        if processes is not None and processes.lanes > 1:
+            # the first solve warmed one worker; the others get the same caches
+            processes.run_everywhere(solve_view, state.to_scene())
 
 
 def _query_from_session() -> dict[str, str]:

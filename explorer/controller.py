@@ -8,6 +8,11 @@ newer outcome has been shown already, so a slow old solve can never overwrite a 
 answer. A rejected scene sets ``error`` (the core's message, naming the field) and leaves
 ``view`` (the last good result) on screen.
 
+Where solves run: on the thread that waits for them (a shared thread pool, or the caller),
+or, once :func:`use_worker_processes` has started them, in worker processes
+(:mod:`explorer.workers`), the thread then only waiting. ``python -m explorer`` uses
+worker processes, so that the server's own process keeps its time for the pages.
+
 Nothing here imports Panel: ``dispatch`` is how outcomes get back to the UI (the app
 passes one that schedules on its Bokeh document); the default applies them at once.
 """
@@ -29,11 +34,14 @@ from core.cache import StageCache
 
 from .results import ResultView, prepare_view
 from .state import ExplorerState
+from .workers import SolverProcesses, WorkerFailed, download_text, solution_text, solve_view
 
 log = logging.getLogger(__name__)
 
-# Shared by all sessions: solves are numpy-heavy and release the GIL only in part, so a
-# few workers suffice and bound the load a crowd of sessions can put on the machine.
+# Shared by all sessions. Solving in this process: solves are numpy-heavy and release the
+# GIL only in part, so a few threads suffice and bound the load a crowd of sessions can put
+# on the machine. With worker processes, the threads only wait for the workers, one per
+# session with a request out at most; the server then sizes the pool for its sessions.
 _POOL: ThreadPoolExecutor | None = None
 _POOL_LOCK = threading.Lock()
 
@@ -51,6 +59,37 @@ def _default_solve(scene: dict[str, Any]) -> Any:
     from core import solve
 
     return solve(scene)
+
+
+#: The worker processes the explorer solves in, once :func:`use_worker_processes` has
+#: started them (``python -m explorer`` does); None: solves run on the threads that ask.
+_PROCESSES: SolverProcesses | None = None
+
+
+def use_worker_processes(lanes: int, stage_cache_bytes: int | None = None) -> SolverProcesses:
+    """Solve in ``lanes`` worker processes from now on (all sessions of this process).
+
+    ``stage_cache_bytes`` [bytes] bounds the solver's stage caches of each worker; the
+    default divides the solver's budget (``core.solver.STAGE_CACHE_BYTES``) among them,
+    so the memory the caches may hold does not grow with the number of workers. Sessions
+    created before the call keep solving where they did.
+    """
+    global _PROCESSES
+    from core.solver import STAGE_CACHE_BYTES
+
+    if stage_cache_bytes is None:
+        stage_cache_bytes = STAGE_CACHE_BYTES // max(1, lanes)
+    processes = SolverProcesses(lanes, stage_cache_bytes)
+    processes.start()
+    old, _PROCESSES = _PROCESSES, processes
+    if old is not None:
+        old.shutdown()
+    return processes
+
+
+def worker_processes() -> SolverProcesses | None:
+    """The worker processes in use (None when solves run in this process)."""
+    return _PROCESSES
 
 
 def approx_bytes(obj: Any, _seen: set[int] | None = None, _depth: int = 0) -> int:
@@ -162,6 +201,9 @@ class SolveController(param.Parameterized):
         self.state = state
         self._solve = solve or _default_solve
         self._executor = shared_pool() if executor == "shared" else executor
+        # the lane of the worker processes this session prefers (its stage caches are there)
+        self._processes = _PROCESSES if solve is None else None
+        self._lane = self._processes.assign() if self._processes is not None else 0
         self._dispatch = dispatch or (lambda callback: callback())
         self._lock = threading.Lock()
         self._latest = 0          # id of the newest request
@@ -220,16 +262,22 @@ class SolveController(param.Parameterized):
                 rid, scene = self._pending
                 self._pending = None
 
+    def _view(self, scene: dict[str, Any]) -> ResultView:
+        if self._processes is not None:
+            return self._processes.run(self._lane, solve_view, scene)
+        return prepare_view(self._solve(scene), scene)
+
     def _compute(self, scene: dict[str, Any]) -> ResultView | str:
         key = result_key(scene) if self._solve is _default_solve else None
         try:
             if key is None:
-                return prepare_view(self._solve(scene), scene)
-            view, reused = RESULTS.get_or_compute(
-                key, lambda: prepare_view(self._solve(scene), scene))
+                return self._view(scene)
+            view, reused = RESULTS.get_or_compute(key, lambda: self._view(scene))
             return replace(view, info={**view.info, "reused": True}) if reused else view
         except ValueError as exc:
             return format_error(str(exc))
+        except WorkerFailed as exc:
+            return f"The solver failed on this scene: {exc}."
         except Exception as exc:  # the session must survive any failure of a solve
             log.exception("solve failed")
             return f"The solver failed on this scene ({type(exc).__name__}: {exc})."
@@ -245,6 +293,18 @@ class SolveController(param.Parameterized):
         else:
             self.param.update(view=outcome, error="", busy=rid < latest,
                               solves=self.solves + 1)
+
+    def download(self, view: ResultView, kind: str) -> str:
+        """The text of a download of ``view``: ``"to_csv"`` (the histories),
+        ``"pressure_csv"`` (q(x, t)) or ``"to_json"`` (everything), in SI units.
+
+        The shown scene is solved again (where this session's solves run, with its
+        caches warm): the solver is deterministic, so the file holds the numbers on screen;
+        the JSON's solve report is the one of the result on screen.
+        """
+        if self._processes is not None:
+            return self._processes.run(self._lane, download_text, view.scene, kind, view.info)
+        return solution_text(self._solve(view.scene), kind, view.info)
 
     def wait(self, timeout: float = 60.0) -> bool:
         """Block until the newest request has been delivered (for scripts and tests)."""

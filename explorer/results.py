@@ -37,10 +37,12 @@ class Geometry:
 
 @dataclass
 class ResultView:
-    """One solved scene, ready to draw. Pressure in Pa, times in days."""
+    """One solved scene, ready to draw. Pressure in Pa, times in days.
+
+    It holds arrays and plain values only, so that it pickles (it is made in a worker
+    process when the server has them); the downloads solve ``scene`` again."""
 
     scene: dict[str, Any]
-    solution: Any
     given: tuple[str, ...]
     times: np.ndarray
     values: dict[str, np.ndarray]          # SI histories of the four quantities
@@ -177,6 +179,6 @@ def prepare_view(solution: Any, scene: dict[str, Any]) -> ResultView:
     flags = list(getattr(solution, "flags", info.get("flags", [])) or [])
     messages = dict(getattr(solution, "flag_messages", {}) or {})
     given = tuple(q for q in QUANTITIES if q in scene["loading"])
-    return ResultView(scene=scene, solution=solution, given=given, times=times, values=values,
+    return ResultView(scene=scene, given=given, times=times, values=values,
                       x=x, pressure=pressure, image=image, geometry=scene_geometry(scene_obj),
                       flags=flags, flag_messages=messages, info=info)

@@ -1,0 +1,284 @@
+"""Solving in worker processes, so that the server's event loop keeps a core of its own.
+
+Python runs one thread of a process at a time. Served with solver threads, a solve of
+10-60 ms holds that lock for most of its time, and every page's messages wait behind it:
+with 20 sessions the server ran at ~70 % of one core and the slowest 5 % of slider steps
+took 4x as long as for a single session (benchmarks/results/load_test.md, run J).
+
+A :class:`SolverProcesses` runs *lanes*: each lane is one worker process (started with
+the spawn method: a fork would copy the server's threads and locks in whatever state they
+are). A worker does one request at a time. A session keeps to its lane, so the solver's
+stage caches in that process (kernel operator, basis) serve its next slider step; a
+request that has waited :data:`SPILL_AFTER_S` for its lane takes any idle one, so a slow
+solve of one session delays the others by that much at most.
+
+A worker returns a :class:`~explorer.results.ResultView`, which pickles in well under a
+millisecond (~250 kB). The core's solution object stays in the worker; the downloads solve
+the shown scene again (:func:`download_text`): the solver is deterministic, so the file
+holds the numbers on screen, and with the stage caches warm that costs 5-11 ms.
+
+Nothing here imports Panel; the workers import only ``core`` and :mod:`explorer.results`.
+"""
+
+from __future__ import annotations
+
+import collections
+import logging
+import multiprocessing
+import multiprocessing.connection
+import os
+import signal
+import threading
+import time
+from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from typing import Any
+
+from .results import ResultView, prepare_view
+
+log = logging.getLogger(__name__)
+
+#: What :func:`download_text` can produce: the histories as CSV, q(x, t) as CSV, and the
+#: whole solution as JSON (the methods of ``core.SceneSolution`` of the same names).
+DOWNLOADS = ("to_csv", "pressure_csv", "to_json")
+
+#: A request waits this long for its session's lane [s] before it takes any idle one.
+#: Its own lane holds the stage caches of its session's scene (a force step costs ~10 ms
+#: there, a solve from cold caches 50-300 ms elsewhere); past this the lane is taken to
+#: be held up by a slow solve, which then delays the others by no more than this.
+SPILL_AFTER_S = 0.25
+
+#: Longest a request may wait for its worker [s]. A solve of a valid scene takes at most a
+#: few seconds (tests/test_property_inputs.py); past this the worker is taken to be stuck,
+#: is stopped, and the lane starts a new one.
+REQUEST_TIMEOUT_S = 120.0
+
+
+class WorkerFailed(RuntimeError):
+    """A worker process died or got stuck; the message says which and what to do."""
+
+
+# -- what runs in a worker ---------------------------------------------------------------
+def _watch_parent() -> None:
+    # Killed without a chance to stop its workers (SIGKILL, or SIGTERM, which the server
+    # does not catch), the server would leave them behind, waiting for work forever.
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+    multiprocessing.connection.wait([parent.sentinel])
+    os._exit(0)
+
+
+def _start_worker(stage_cache_bytes: int) -> None:
+    # Ctrl+C in the terminal reaches the whole process group: the server stops its
+    # workers itself, and a worker's traceback would only clutter the terminal.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from core import solver
+
+    solver.set_stage_cache_budget(stage_cache_bytes)
+    threading.Thread(target=_watch_parent, name="watch-parent", daemon=True).start()
+
+
+def solve_view(scene: dict[str, Any]) -> ResultView:
+    """Solve ``scene`` (a scene dict) and prepare what the explorer draws.
+
+    Runs in a worker. An invalid scene raises the core's ValueError, which names the field.
+    """
+    from core import solve
+
+    return prepare_view(solve(scene), scene)
+
+
+def download_text(scene: dict[str, Any], kind: str,
+                  info: dict[str, Any] | None = None) -> str:
+    """The file ``kind`` (one of :data:`DOWNLOADS`) of the solution of ``scene``: the
+    histories as CSV (time [day], settlement [m], tilt [rad], force [N/m], moment [N]),
+    q(x, t) as CSV [Pa], or the whole solution as JSON.
+
+    ``info``: the solve report of the result on screen (``ResultView.info``), written into
+    the JSON in place of the new solve's (whose timings and cache hits differ; its numbers
+    do not).
+    """
+    from core import solve
+
+    return solution_text(solve(scene), kind, info)
+
+
+def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None) -> str:
+    """``solution.to_csv()``, ``.pressure_csv()`` or ``.to_json()`` (``kind``), with the
+    solve report ``info`` in the JSON if given (see :func:`download_text`)."""
+    if kind not in DOWNLOADS:
+        raise ValueError(f"kind: unknown download {kind!r}; known: {', '.join(DOWNLOADS)}")
+    if info is not None and kind == "to_json":
+        solution.info = {k: v for k, v in info.items() if k != "reused"}
+    return getattr(solution, kind)()
+
+
+def worker_info() -> dict[str, int]:
+    """The worker's process id and the bound of its solver stage caches [bytes]."""
+    from core import solver
+
+    return {"pid": os.getpid(),
+            "stage_cache_bytes": sum(cache.max_bytes for cache in solver._STAGES)}
+
+
+# -- the server's side -------------------------------------------------------------------
+class _Lane:
+    """One worker process, whether it is working, and the requests waiting for it."""
+
+    def __init__(self, index: int, stage_cache_bytes: int) -> None:
+        self.index = index
+        self.stage_cache_bytes = stage_cache_bytes
+        self.busy = False                         # a request is in the worker
+        self.waiting: collections.deque[object] = collections.deque()  # requests, in order
+        self.restarts = 0
+        self.executor = self._new_executor()
+
+    def _new_executor(self) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=_start_worker,
+                                   initargs=(self.stage_cache_bytes,))
+
+    def restart(self) -> None:
+        """Stop the worker (whatever it is doing) and start a new one."""
+        old, self.executor = self.executor, self._new_executor()
+        self.restarts += 1
+        processes = list(getattr(old, "_processes", {}).values())
+        old.shutdown(wait=False, cancel_futures=True)
+        for process in processes:  # a stuck worker would never read the shutdown
+            if process.is_alive():
+                process.kill()
+
+
+class SolverProcesses:
+    """``lanes`` worker processes solving for all sessions of a server.
+
+    ``stage_cache_bytes`` [bytes] bounds the solver's stage caches of each worker (the
+    machine's budget divided among the lanes). Workers start at the first request, or at
+    :meth:`start`.
+    """
+
+    def __init__(self, lanes: int, stage_cache_bytes: int) -> None:
+        if not (isinstance(lanes, int) and lanes >= 1):
+            raise ValueError(f"lanes: must be a positive integer, got {lanes!r}")
+        self._lock = threading.Lock()
+        self._cond = threading.Condition(self._lock)
+        self._lanes = [_Lane(i, stage_cache_bytes) for i in range(lanes)]
+        self._next = 0
+        self._closed = False
+
+    @property
+    def lanes(self) -> int:
+        """Number of worker processes."""
+        return len(self._lanes)
+
+    def assign(self) -> int:
+        """A lane for a new session (round robin)."""
+        with self._lock:
+            index = self._next % len(self._lanes)
+            self._next += 1
+            return index
+
+    def run(self, preferred: int, fn: Any, *args: Any) -> Any:
+        """Call ``fn(*args)`` in a worker and return its value (blocks the calling thread).
+
+        A worker does one request at a time. The request waits for lane ``preferred``
+        (first come, first served), or, after :data:`SPILL_AFTER_S`, takes any lane that
+        is idle with nobody waiting. Exceptions of ``fn`` are raised here. A worker found
+        dead before the work was given to it is replaced and the work given to the new
+        one; a worker that dies during the work, or takes longer than
+        :data:`REQUEST_TIMEOUT_S`, is replaced and :class:`WorkerFailed` raised.
+        """
+        lane = self._acquire(preferred)
+        try:
+            future, executor = self._submit(lane, fn, args)
+            try:
+                return future.result(timeout=REQUEST_TIMEOUT_S)
+            except BrokenProcessPool:
+                self._replace(lane, executor)
+                raise WorkerFailed("the solver process stopped during this solve (out of "
+                                   "memory?); a new one was started, please try again") \
+                    from None
+            except TimeoutError:
+                self._replace(lane, executor)
+                raise WorkerFailed(f"the solve took longer than {REQUEST_TIMEOUT_S:.0f} s "
+                                   "and was stopped") from None
+        finally:
+            with self._cond:
+                lane.busy = False
+                self._cond.notify_all()
+
+    def _acquire(self, preferred: int) -> _Lane:
+        own = self._lanes[preferred % len(self._lanes)]
+        ticket = object()
+        spill_at = time.monotonic() + SPILL_AFTER_S
+        with self._cond:
+            own.waiting.append(ticket)
+            try:
+                while True:
+                    if self._closed:
+                        raise WorkerFailed("the server is stopping")
+                    if not own.busy and own.waiting[0] is ticket:
+                        own.busy = True
+                        return own
+                    now = time.monotonic()
+                    if now >= spill_at:
+                        for lane in self._lanes:
+                            if not lane.busy and not lane.waiting:
+                                lane.busy = True
+                                return lane
+                    self._cond.wait(timeout=None if now >= spill_at else spill_at - now)
+            finally:
+                own.waiting.remove(ticket)
+                self._cond.notify_all()  # the next in the queue may go now
+
+    def _submit(self, lane: _Lane, fn: Any,
+                args: tuple[Any, ...]) -> tuple[Future[Any], ProcessPoolExecutor]:
+        for _attempt in range(2):
+            with self._lock:
+                if self._closed:
+                    raise WorkerFailed("the server is stopping")
+                executor = lane.executor
+            try:
+                future: Future[Any] = executor.submit(fn, *args)
+            except BrokenProcessPool:  # died while idle: nothing was lost, start anew
+                self._replace(lane, executor)
+                continue
+            return future, executor
+        raise WorkerFailed("the solver process could not be started")
+
+    def _replace(self, lane: _Lane, broken: ProcessPoolExecutor) -> None:
+        with self._lock:
+            # another request on the same lane may have replaced the worker already
+            if not self._closed and lane.executor is broken:
+                log.warning("restarting solver process %d", lane.index)
+                lane.restart()
+
+    def run_everywhere(self, fn: Any, *args: Any) -> list[Any]:
+        """Call ``fn(*args)`` in every worker at once (to start them, or to warm their
+        caches with a scene) and return the values, lane by lane."""
+        with self._lock:
+            executors = [lane.executor for lane in self._lanes]
+        futures = [executor.submit(fn, *args) for executor in executors]
+        return [f.result(timeout=REQUEST_TIMEOUT_S) for f in futures]
+
+    def start(self) -> list[dict[str, int]]:
+        """Start every worker now rather than at the first request; returns
+        :func:`worker_info` of each."""
+        return self.run_everywhere(worker_info)
+
+    def pids(self) -> list[int]:
+        """Process ids of the running workers."""
+        with self._lock:
+            return [p.pid for lane in self._lanes
+                    for p in getattr(lane.executor, "_processes", {}).values()
+                    if p.pid is not None]
+
+    def shutdown(self) -> None:
+        """Stop every worker (requests still waiting get :class:`WorkerFailed`)."""
+        with self._cond:
+            self._closed = True
+            self._cond.notify_all()
+            executors = [lane.executor for lane in self._lanes]
+        for executor in executors:
+            executor.shutdown(wait=True, cancel_futures=True)

@@ -1,0 +1,256 @@
+"""Solving in worker processes (explorer/workers.py), as ``python -m explorer`` does.
+
+A worker must give the view a solve here gives, bit for bit, and downloads that hold the
+numbers on screen. A slow solve holds up other sessions by ``SPILL_AFTER_S`` at most; a
+worker that dies or gets stuck is replaced and the request answered with a message; and
+workers never outlive the server.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import explorer.controller as controller_module
+import explorer.workers as workers
+from core import solve, solver
+from explorer.controller import RESULTS, SolveController
+from explorer.presets import DEFAULT_PRESET, presets
+from explorer.results import prepare_view
+from explorer.state import QUANTITIES, ExplorerState
+from explorer.workers import (
+    SolverProcesses,
+    WorkerFailed,
+    download_text,
+    solve_view,
+    worker_info,
+)
+
+pytestmark = pytest.mark.timeout(300)
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def small_scene(force: float = 400.0) -> dict[str, Any]:
+    scene = copy.deepcopy(presets()[DEFAULT_PRESET])
+    scene["times"] = {"end": 200.0, "count": 6, "spacing": "log"}
+    scene["solver"] = {"tol": 1e-5}
+    scene["loading"]["force"] = {"kind": "constant", "value": force * 1e3}
+    return scene
+
+
+@pytest.fixture(scope="module")
+def processes() -> Iterator[SolverProcesses]:
+    pool = SolverProcesses(2, solver.STAGE_CACHE_BYTES // 2)
+    pool.start()
+    yield pool
+    pool.shutdown()
+
+
+def gone(pid: int) -> bool:
+    """The process has exited (a zombie not yet reaped counts as exited)."""
+    try:
+        with open(f"/proc/{pid}/status", encoding="ascii") as fh:
+            return any(line.startswith("State:") and "Z" in line.split()[1] for line in fh)
+    except OSError:
+        return True
+
+
+def wait_until(condition: Any, timeout: float = 20.0) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+def test_a_view_solved_in_a_worker_is_the_view_solved_here(processes) -> None:
+    scene = small_scene()
+    there = processes.run(0, solve_view, scene)
+    here = prepare_view(solve(scene), scene)
+    for q in QUANTITIES:
+        assert np.array_equal(there.values[q], here.values[q]), q
+    assert np.array_equal(there.x, here.x) and np.array_equal(there.times, here.times)
+    assert np.array_equal(there.pressure, here.pressure)
+    assert np.array_equal(there.image, here.image)
+    assert np.array_equal(there.geometry.shape, here.geometry.shape)
+    assert there.flags == here.flags and there.scene == scene
+
+
+def test_downloads_from_a_worker_hold_the_numbers_on_screen(processes, monkeypatch) -> None:
+    monkeypatch.setattr(controller_module, "_PROCESSES", processes)
+    RESULTS.clear()
+    state = ExplorerState()
+    state.param.update(time_count=5, tol=1e-5)
+    session = SolveController(state, executor=None, auto=False)
+    session.solve_now()
+    view = session.view
+    assert session.error == "" and view is not None
+    here = solve(view.scene)
+    assert session.download(view, "to_csv") == here.to_csv()
+    assert session.download(view, "pressure_csv") == here.pressure_csv()
+    # the numbers of a new solve, the solve report of the one on screen
+    assert here.info != view.info  # timings and cache hits differ
+    here.info = view.info
+    assert session.download(view, "to_json") == here.to_json()
+    rows = np.loadtxt(session.download(view, "to_csv").splitlines(), delimiter=",",
+                      skiprows=1)
+    assert np.array_equal(rows[:, 1], view.values["settlement"])
+    with pytest.raises(ValueError, match="kind: unknown download"):
+        download_text(view.scene, "to_pickle")
+
+
+def test_a_bad_scene_from_a_worker_names_its_field(processes, monkeypatch) -> None:
+    scene = small_scene()
+    scene["coating"][0]["thickness"] = {"kind": "constant", "value": -0.01}
+    with pytest.raises(ValueError, match=r"coating\[0\]\.thickness"):
+        processes.run(0, solve_view, scene)
+    monkeypatch.setattr(controller_module, "_PROCESSES", processes)
+    state = ExplorerState()
+    state.param.update(time_count=5, tol=1e-5)
+    session = SolveController(state, executor=None, auto=False)
+    session.solve_now()
+    good = session.view
+    state.layers[0].thickness.mean = -1.0
+    session.solve_now()
+    assert "coating[0].thickness" in session.error and session.view is good
+
+
+def test_each_worker_holds_its_share_of_the_stage_cache_budget(processes) -> None:
+    share = solver.STAGE_CACHE_BYTES // 2
+    infos = processes.run_everywhere(worker_info)
+    assert len({info["pid"] for info in infos}) == 2 and os.getpid() not in \
+        {info["pid"] for info in infos}
+    for info in infos:  # each stage's bound rounds down: at most one byte per stage lost
+        assert share - 16 <= info["stage_cache_bytes"] <= share
+
+
+def test_the_stage_cache_budget_is_shared_in_proportion() -> None:
+    default = {cache.name: cache.max_bytes for cache in solver._STAGES}
+    try:
+        solver.set_stage_cache_budget(solver.STAGE_CACHE_BYTES // 4)
+        for cache in solver._STAGES:
+            assert cache.max_bytes == default[cache.name] // 4
+        for bad in (0, -1, 1.5, "1", True):
+            with pytest.raises(ValueError, match="total_bytes"):
+                solver.set_stage_cache_budget(bad)
+    finally:
+        solver.set_stage_cache_budget(solver.STAGE_CACHE_BYTES)
+    assert {cache.name: cache.max_bytes for cache in solver._STAGES} == default
+
+
+def test_a_slow_solve_holds_up_another_session_by_the_spill_time_only(processes) -> None:
+    pids = [info["pid"] for info in processes.run_everywhere(worker_info)]
+    slow = threading.Thread(target=processes.run, args=(0, time.sleep, 3.0))
+    slow.start()
+    try:
+        time.sleep(0.3)  # the slow request is in lane 0's worker
+        t0 = time.monotonic()
+        pid = processes.run(0, os.getpid)
+        waited = time.monotonic() - t0
+        # it waited for its own lane for SPILL_AFTER_S, then took the idle one; 3 s of
+        # sleep minus 0.3 s would remain in lane 0
+        assert pid == pids[1]
+        assert workers.SPILL_AFTER_S - 0.01 <= waited < 2.0
+        t0 = time.monotonic()
+        assert processes.run(1, os.getpid) == pids[1]  # an idle own lane: no waiting
+        assert time.monotonic() - t0 < 2.0
+    finally:
+        slow.join()
+    assert processes.run(0, os.getpid) == pids[0]  # back to its own lane once free
+
+
+def test_a_worker_killed_during_a_solve_is_replaced() -> None:
+    pool = SolverProcesses(1, 64 * 2**20)
+    try:
+        first = pool.start()[0]["pid"]
+        outcome: list[Any] = []
+
+        def sleep_there() -> None:
+            try:
+                outcome.append(pool.run(0, time.sleep, 30.0))
+            except WorkerFailed as exc:
+                outcome.append(exc)
+
+        waiting = threading.Thread(target=sleep_there)
+        waiting.start()
+        time.sleep(0.5)
+        os.kill(first, signal.SIGKILL)
+        waiting.join(30)
+        assert isinstance(outcome[0], WorkerFailed)
+        assert "stopped during this solve" in str(outcome[0])
+        second = pool.run(0, os.getpid)
+        assert second != first
+        # killed while idle: nothing was lost, so the next request is simply served by a
+        # new worker (or, if the death was not yet noticed, refused once with a message)
+        os.kill(second, signal.SIGKILL)
+        assert wait_until(lambda: gone(second))
+        try:
+            third = pool.run(0, os.getpid)
+        except WorkerFailed as exc:
+            assert "stopped" in str(exc)
+            third = pool.run(0, os.getpid)
+        assert third not in (first, second)
+    finally:
+        pool.shutdown()
+
+
+def test_a_stuck_worker_is_stopped_and_replaced(monkeypatch) -> None:
+    monkeypatch.setattr(workers, "REQUEST_TIMEOUT_S", 1.0)
+    pool = SolverProcesses(1, 64 * 2**20)
+    try:
+        first = pool.start()[0]["pid"]
+        with pytest.raises(WorkerFailed, match="longer than 1 s and was stopped"):
+            pool.run(0, time.sleep, 60.0)
+        assert wait_until(lambda: gone(first))
+        assert pool.run(0, os.getpid) != first
+    finally:
+        pool.shutdown()
+
+
+def test_after_shutdown_requests_are_refused_and_workers_are_gone() -> None:
+    pool = SolverProcesses(2, 64 * 2**20)
+    pids = [info["pid"] for info in pool.start()]
+    pool.shutdown()
+    assert all(wait_until(lambda pid=pid: gone(pid)) for pid in pids)
+    with pytest.raises(WorkerFailed, match="stopping"):
+        pool.run(0, os.getpid)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT])
+def test_workers_do_not_outlive_the_server(sig: int) -> None:
+    script = textwrap.dedent("""
+        import sys, time
+        from explorer.controller import use_worker_processes
+
+        if __name__ == "__main__":
+            pool = use_worker_processes(2)
+            print(" ".join(str(pid) for pid in pool.pids()), flush=True)
+            time.sleep(120)
+    """)
+    env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get(
+        "PYTHONPATH", "")}
+    server = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                              stderr=subprocess.DEVNULL, env=env, text=True)
+    try:
+        pids = [int(p) for p in server.stdout.readline().split()]
+        assert len(pids) == 2 and all(not gone(pid) for pid in pids)
+        server.send_signal(sig)
+        server.wait(30)
+        assert all(wait_until(lambda pid=pid: gone(pid)) for pid in pids)
+    finally:
+        server.kill()
+        server.wait()
