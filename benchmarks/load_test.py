@@ -65,6 +65,8 @@ COATING_TAB = 2
 THICKNESS_STEP = 0.1
 #: A session waits this long for the plot to follow a move before counting an error [s].
 UPDATE_TIMEOUT = 30.0
+#: Moves answered later than this [ms] are listed in the report, with when they came.
+SLOW_MS = 1000.0
 
 READY = """() => {
   const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];
@@ -99,6 +101,8 @@ class Stats:
 
     data: list[float] = field(default_factory=list)     # ms
     by_move: dict[str, list[float]] = field(default_factory=dict)  # ms, per slider moved
+    slow: list[tuple[float, float, str]] = field(default_factory=list)  # (monotonic s, ms,
+    # slider) of the moves answered after more than SLOW_MS
     frame: list[float] = field(default_factory=list)    # ms
     requests: int = 0
     geometry_requests: int = 0
@@ -407,6 +411,9 @@ def protocol_session(url: str, seed: int, clock: Clock, max_requests: int, stats
                     with stats.lock:
                         stats.data.append(1e3 * (received - sent))
                         stats.by_move.setdefault(name, []).append(1e3 * (received - sent))
+                        if 1e3 * (received - sent) > SLOW_MS:
+                            stats.slow.append((time.monotonic(), 1e3 * (received - sent),
+                                               name))
                 except asyncio.TimeoutError:
                     stats.error(f"{tag}: no plot update within {UPDATE_TIMEOUT:g} s after "
                                 f"a {name} move")
@@ -566,6 +573,10 @@ def server_tracebacks(log_path: Path) -> list[str]:
 
 def server_options(args: argparse.Namespace) -> str:
     """The options of ``python -m explorer`` that set where the server solves."""
+    if args.solver_processes is None:
+        from explorer.__main__ import DEFAULT_SOLVER_PROCESSES
+
+        return f"--solver-processes {DEFAULT_SOLVER_PROCESSES}"
     if args.solver_processes:
         return f"--solver-processes {args.solver_processes}"
     return f"--solver-processes 0 --solver-threads {args.solver_threads}"
@@ -645,6 +656,15 @@ def report(args: argparse.Namespace, single: Stats, crowd: Stats, sampler: Sampl
     if args.client == "browser":
         lines.append(row("second frame painted after it", percentiles(single.frame),
                          percentiles(crowd.frame)))
+    slow = sorted(single.slow + crowd.slow)
+    if slow:
+        ready = marks["crowd: all sessions ready"]
+        lines += ["", f"Moves answered after more than {SLOW_MS:.0f} ms: {len(slow)}, "
+                  f"{sum(t - sampler.t0 < ready for t, _, _ in slow)} of them before the "
+                  "last session was ready. When (s from the server's start), how long "
+                  "(ms), which slider:", "",
+                  "    " + ", ".join(f"{t - sampler.t0:.0f} s {ms:.0f} {name}"
+                                     for t, ms, name in slow[:60])]
     lines += ["", "Server memory over time (RSS; t from the server's start):", "",
               "| t [s] | RSS [MiB] | event |", "| --- | --- | --- |"]
     step = max(1, int(30 / sampler.period))
@@ -674,8 +694,9 @@ def main() -> int:
                         metavar=("MIN", "MAX"), help="pause after each update [s]")
     parser.add_argument("--stagger", type=float, default=1.0,
                         help="seconds between the arrivals of two sessions")
-    parser.add_argument("--solver-processes", type=int, default=1,
-                        help="the server's --solver-processes (0: solve in its threads)")
+    parser.add_argument("--solver-processes", type=int, default=None,
+                        help="the server's --solver-processes (default: the server's "
+                             "default; 0: solve in the server's threads)")
     parser.add_argument("--solver-threads", type=int, default=2,
                         help="the server's --solver-threads (used with --solver-processes 0)")
     parser.add_argument("--after-seconds", type=float, default=45.0,
