@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import socket
 import sys
 
@@ -66,7 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     import panel as pn
 
     from explorer.app import create_app, warm_up
-    from explorer.controller import shared_pool, use_worker_processes
+    from explorer.controller import shared_pool, use_worker_processes, worker_processes
     from explorer.presets import ORDER
 
     if args.solver_processes < 0 or args.solver_threads < 1:
@@ -94,10 +95,25 @@ def main(argv: list[str] | None = None) -> int:
               "--allow-websocket-origin)", file=sys.stderr, flush=True)
     print(f"Serving the explorer at http://{args.address}:{args.port}/app", file=sys.stderr,
           flush=True)
-    pn.serve({"app": create_app}, port=args.port, address=args.address, show=args.show,
-             websocket_origin=origins, title="Coated punch explorer", threaded=False,
-             liveness=True, start=True)
+    # SIGTERM (a service manager, a test harness) ends the server like Ctrl+C: the event
+    # loop unwinds and the worker processes are stopped in order.
+    previous = signal.signal(signal.SIGTERM, _stop_on_sigterm)
+    try:
+        pn.serve({"app": create_app}, port=args.port, address=args.address, show=args.show,
+                 websocket_origin=origins, title="Coated punch explorer", threaded=False,
+                 liveness=True, start=True)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        processes = worker_processes()
+        if processes is not None:
+            processes.shutdown()
     return 0
+
+
+def _stop_on_sigterm(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":

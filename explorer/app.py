@@ -22,6 +22,7 @@ from panel.io.state import set_curdoc
 from core.profiles import MAX_TABLE_BYTES
 from core.scene import MAX_SCENE_BYTES
 
+from . import gc_policy
 from .controller import SolveController, format_error, worker_processes
 from .links import decode_scene, encode_scene
 from .panel_fixes import install as install_panel_fixes
@@ -722,6 +723,8 @@ class ExplorerApp(pn.viewable.Viewer):
             self._fill(min(self._deferred_tabs))
         if self._deferred_tabs:
             self._later(self._fill_idle_tab, 0)
+        elif self._served:
+            gc_policy.page_built()  # the page is complete; it lives as long as the session
 
     def _later(self, callback: Callable[[], None], delay_ms: float) -> None:
         """Run ``callback`` on this session's event loop after ``delay_ms`` [ms]."""
@@ -890,12 +893,15 @@ def _query_from_session() -> dict[str, str]:
 def create_app(**kwargs: Any) -> ExplorerApp:
     """A new explorer session (serve this factory so each browser gets its own state).
 
-    Served, it solves on a shared thread pool; inline in a notebook (no server session)
-    it solves in the kernel, each change when it happens.
+    Served, it solves off the page's thread (in the server's worker processes when
+    ``python -m explorer`` started them, else on a shared thread pool); inline in a
+    notebook (no server session) it solves in the kernel, each change when it happens.
     """
     pn.extension("filedropper", notifications=False)
     served = bool(pn.state.curdoc is not None and pn.state.curdoc.session_context)
     kwargs.setdefault("executor", "shared" if served else None)
+    if served:
+        pn.state.on_session_destroyed(gc_policy.session_ended)
     if "query" not in kwargs:
         kwargs["query"] = _query_from_session()
     return ExplorerApp(**kwargs)
