@@ -60,8 +60,8 @@ class WorkerFailed(RuntimeError):
 
 # -- what runs in a worker ---------------------------------------------------------------
 def _watch_parent() -> None:
-    # Killed without a chance to stop its workers (SIGKILL, or SIGTERM, which the server
-    # does not catch), the server would leave them behind, waiting for work forever.
+    # Killed without a chance to stop its workers (SIGKILL, a crash), the server would
+    # leave them behind, waiting for work forever.
     parent = multiprocessing.parent_process()
     if parent is None:
         return
