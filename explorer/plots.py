@@ -340,7 +340,12 @@ class Figures:
         unit, size = view.pressure_unit
         a = view.geometry.half_width
         t0, t1 = float(view.times[0]), float(view.times[-1])
-        span = max(t1 - t0, 1e-9)
+        span = t1 - t0
+        if not span > 0:
+            # one output time: a band around it, so that the axis reads that time (a
+            # zero-height image gave ticks like 10.000000001)
+            span = max(0.1 * abs(t0), 1.0)
+            t0 -= span / 2
         img = view.image / size
         self.image_src.data = {"image": [img], "x": [-a], "y": [t0], "dw": [2 * a],
                                "dh": [span]}

@@ -219,3 +219,15 @@ def test_a_complete_page_is_frozen_out_of_the_collectors_reach(served_app, monke
         assert gc.collect() >= 1  # the cycle made after the freeze is still found
     finally:
         gc.unfreeze()
+
+
+def test_one_output_time_draws_q_x_t_as_a_band_around_it() -> None:
+    app = ExplorerApp(executor=None)
+    app.state.time_count = 1
+    assert app.controller.wait(60) and app.controller.error == ""
+    (t,) = app.controller.view.times
+    data = app.figures.image_src.data
+    y, dh = data["y"][0], data["dh"][0]
+    assert dh >= 1.0 and y == pytest.approx(t - dh / 2)  # t [days] in the middle
+    y_range = app.figures.image_fig.y_range
+    assert y_range.start == pytest.approx(y) and y_range.end == pytest.approx(y + dh)

@@ -644,7 +644,13 @@ def served() -> Iterator[str]:
         if os.environ.get("CI"):  # the set-up installs it there: its absence is a failure
             pytest.fail(reason, pytrace=False)
         pytest.skip(reason)
-    pytest.importorskip("playwright.sync_api")
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        reason = "playwright is not installed: `bash tests/run.sh` installs it"
+        if os.environ.get("CI"):
+            pytest.fail(reason, pytrace=False)
+        pytest.skip(reason)
     with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as server:
         yield server.url
 
