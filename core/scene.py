@@ -45,7 +45,13 @@ import numpy as np
 from core.cache import StageCache, fingerprint
 from core.creep import UserKernel, creep_model_from_spec
 from core.profiles import Profile, check_range, profile_from_spec
-from core.validation import MAX_MAGNITUDE, finite_number, positive_number, show_value
+from core.validation import (
+    MAX_MAGNITUDE,
+    NumberTooLarge,
+    finite_number,
+    positive_number,
+    show_value,
+)
 
 if TYPE_CHECKING:
     from core.solver import ContactSolution
@@ -597,9 +603,10 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
     try:
         creep = creep_model_from_spec(base["creep"], field="base.creep")
+    except NumberTooLarge:
+        raise  # a ValueError that names the parameter (base.creep.modulus)
     except OverflowError:
-        # a creep parameter too large for a double (NumberTooLarge is an OverflowError):
-        # the file reader turns the same number into inf, refused with the precise field
+        # an overflow in a creep computation, with no parameter to name
         raise ValueError("base.creep: a number is too large for a double (must be a finite "
                          "number)") from None
     if not math.isfinite(a / h_base) or not LAM_RANGE[0] <= a / h_base <= LAM_RANGE[1]:
