@@ -632,6 +632,9 @@ def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:
     assert entry.main([*base, "--address", "0.0.0.0",
                        "--allow-websocket-origin", "lab.example.org:80"]) == 0
     assert served[-1]["websocket_origin"] == ["lab.example.org:80"]
+    count = len(served)
+    assert entry.main([*base[:-1], "-1"]) == 2  # --solver-processes -1: refused, not served
+    assert len(served) == count
 
 
 # ------------------------------------------------------------------ in a real browser
