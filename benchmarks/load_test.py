@@ -101,10 +101,8 @@ class Stats:
     """What the sessions of one phase saw (appended to from several threads)."""
 
     data: list[float] = field(default_factory=list)     # ms
-    by_move: dict[str, list[float]] = field(default_factory=dict)  # ms, per slider moved
-    slow: list[tuple[float, float, str]] = field(default_factory=list)  # (monotonic s, ms,
-    # slider) of the moves answered after more than SLOW_MS
-    timed: list[tuple[float, float]] = field(default_factory=list)  # (monotonic s, ms)
+    # (monotonic s when answered, ms, slider) of each move (protocol client)
+    moves: list[tuple[float, float, str]] = field(default_factory=list)
     frame: list[float] = field(default_factory=list)    # ms
     requests: int = 0
     geometry_requests: int = 0
@@ -428,11 +426,7 @@ def protocol_session(url: str, seed: int, clock: Clock, max_requests: int, stats
                     received = await asyncio.wait_for(future, UPDATE_TIMEOUT)
                     with stats.lock:
                         stats.data.append(1e3 * (received - sent))
-                        stats.by_move.setdefault(name, []).append(1e3 * (received - sent))
-                        stats.timed.append((time.monotonic(), 1e3 * (received - sent)))
-                        if 1e3 * (received - sent) > SLOW_MS:
-                            stats.slow.append((time.monotonic(), 1e3 * (received - sent),
-                                               name))
+                        stats.moves.append((time.monotonic(), 1e3 * (received - sent), name))
                 except asyncio.TimeoutError:
                     stats.error(f"{tag}: no plot update within {UPDATE_TIMEOUT:g} s after "
                                 f"a {name} move")
@@ -668,17 +662,18 @@ def report(args: argparse.Namespace, single: Stats, crowd: Stats, sampler: Sampl
         "| measured to | single session | crowd | p95 crowd / single (goal <= 2) |",
         "| --- | --- | --- | --- |",
         row("plots showing the moved value", s_data, c_data),
-        *[row(f"... of a {name} step only", percentiles(single.by_move.get(name, [])),
-              percentiles(crowd.by_move.get(name, [])))
+        *[row(f"... of a {name} step only",
+              percentiles([ms for _, ms, moved in single.moves if moved == name]),
+              percentiles([ms for _, ms, moved in crowd.moves if moved == name]))
           for name in ("force", "thickness")],
         row("... once the last session was ready (no page being built)", s_data,
-            percentiles([ms for t, ms in crowd.timed
+            percentiles([ms for t, ms, _ in crowd.moves
                          if t - sampler.t0 >= marks["crowd: all sessions ready"]])),
     ]
     if args.client == "browser":
         lines.append(row("second frame painted after it", percentiles(single.frame),
                          percentiles(crowd.frame)))
-    slow = sorted(single.slow + crowd.slow)
+    slow = sorted(move for move in single.moves + crowd.moves if move[1] > SLOW_MS)
     if slow:
         ready = marks["crowd: all sessions ready"]
         lines += ["", f"Moves answered after more than {SLOW_MS:.0f} ms: {len(slow)}, "

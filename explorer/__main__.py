@@ -20,9 +20,10 @@ for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 
 #: Worker processes by default: the server's own process keeps a core for the pages; two
-#: at least, so that one slow solve cannot hold up every session (measured on 2 cores,
-#: benchmarks/results/load_test.md: 2 workers gave the crowd's p95 1.6x the single
-#: session's, 1 worker 1.8x, solving in the server's threads 4.1x).
+#: at least, so that one slow solve cannot hold up every session (measured on 2 cores with
+#: 20 sessions, benchmarks/results/load_test.md: 2 workers gave the crowd's p95 1.75-1.92x
+#: the single session's in three runs, solving in the server's threads 4.1x; one worker
+#: measured no faster than two).
 DEFAULT_SOLVER_PROCESSES = max(2, min(4, (os.cpu_count() or 2) - 1))
 #: Threads waiting for the worker processes, for all sessions together; beyond this many
 #: sessions with a request out at once, requests queue before reaching the workers.

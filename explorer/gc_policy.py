@@ -11,32 +11,23 @@ exist then out of the collector's reach (``gc.freeze``). Objects made later are 
 as before, and reference counting frees non-cyclic garbage whatever its generation; only
 cyclic garbage among the frozen objects waits. When a session ends,
 :func:`session_ended` gives everything back to the collector (``gc.unfreeze``), so the
-closed page's cycles are freed by the next full collection. Used by served sessions only.
+closed page's cycles are freed by the next full collection. Used by served sessions only,
+on the server's event loop.
 """
 
 from __future__ import annotations
 
 import gc
-import threading
 from typing import Any
-
-_LOCK = threading.Lock()
 
 
 def page_built() -> None:
     """A page is complete: collect the young garbage of its building, then freeze."""
-    with _LOCK:
-        gc.collect(1)  # garbage made while building goes now, not into the frozen set
-        gc.freeze()
+    gc.collect(1)  # garbage made while building goes now, not into the frozen set
+    gc.freeze()
 
 
 def session_ended(session_context: Any) -> None:
     """A session has ended: let the collector see every object again (Bokeh's
     session-destroyed callback; ``session_context`` is not needed)."""
-    with _LOCK:
-        gc.unfreeze()
-
-
-def frozen_objects() -> int:
-    """Objects currently out of the collector's reach."""
-    return gc.get_freeze_count()
+    gc.unfreeze()

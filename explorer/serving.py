@@ -24,7 +24,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
 
-__all__ = ["CHROMIUM", "CHROMIUM_ARGS", "ExplorerProcess", "ExplorerStartError", "free_port"]
+__all__ = ["CHROMIUM", "CHROMIUM_ARGS", "ExplorerProcess", "ExplorerStartError", "browser_missing",
+           "free_port"]
 
 #: The browser the tests and benchmarks drive the served page with: Debian's Chromium
 #: (installed by tests/run.sh; Playwright's own download does not work everywhere).
@@ -40,6 +41,18 @@ _PACKAGE_PARENT = Path(__file__).resolve().parent.parent
 
 # Lines of the server's output quoted when it fails to start: enough for a traceback.
 _TAIL_LINES = 60
+
+
+def browser_missing() -> str | None:
+    """Why the served page cannot be driven in a browser here (Chromium or Playwright
+    absent, and how to install them), or None when both are present."""
+    import importlib.util
+
+    if not os.path.exists(CHROMIUM):
+        return f"Debian's chromium is not at {CHROMIUM}: `bash tests/run.sh` installs it"
+    if importlib.util.find_spec("playwright") is None:
+        return "playwright is not installed: `bash tests/run.sh` installs it"
+    return None
 
 
 def free_port(host: str = "127.0.0.1") -> int:

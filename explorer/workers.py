@@ -131,7 +131,6 @@ class _Lane:
         self.stage_cache_bytes = stage_cache_bytes
         self.busy = False                         # a request is in the worker
         self.waiting: collections.deque[object] = collections.deque()  # requests, in order
-        self.restarts = 0
         self.executor = self._new_executor()
 
     def _new_executor(self) -> ProcessPoolExecutor:
@@ -142,7 +141,6 @@ class _Lane:
     def restart(self) -> None:
         """Stop the worker (whatever it is doing) and start a new one."""
         old, self.executor = self.executor, self._new_executor()
-        self.restarts += 1
         processes = list(getattr(old, "_processes", {}).values())
         old.shutdown(wait=False, cancel_futures=True)
         for process in processes:  # a stuck worker would never read the shutdown

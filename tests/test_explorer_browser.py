@@ -18,25 +18,19 @@ from pathlib import Path
 
 import pytest
 
-from explorer.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess
+from explorer.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
-try:
-    import playwright.sync_api as playwright_api
-except ImportError:
-    if os.environ.get("CI"):  # the test set-up installs it: its absence is a failure
-        raise
-    pytest.skip("playwright is not installed: `bash tests/run.sh` installs it",
-                allow_module_level=True)
+_missing = browser_missing()
+if _missing:
+    if os.environ.get("CI"):  # the test set-up installs both: their absence is a failure
+        pytest.fail(_missing, pytrace=False)
+    pytest.skip(_missing, allow_module_level=True)
+
+import playwright.sync_api as playwright_api  # noqa: E402
 
 ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
-
-if not os.path.exists(CHROMIUM):
-    _reason = f"Debian's chromium is not at {CHROMIUM}: `bash tests/run.sh` installs it"
-    if os.environ.get("CI"):  # the set-up installs it there: its absence is a failure
-        pytest.fail(_reason, pytrace=False)
-    pytest.skip(_reason, allow_module_level=True)
 
 # JavaScript helpers run in the page.
 JS_DOC = "() => (window.Bokeh && Bokeh.documents && Bokeh.documents[0]) || null"

@@ -39,7 +39,7 @@ from core.scene import (
     solve,
 )
 from explorer.links import MAX_JSON, PREFIX, decode_scene, encode_scene
-from explorer.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess
+from explorer.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "assets" / "scenes"
@@ -643,18 +643,11 @@ def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:
 
 @pytest.fixture(scope="module")
 def served() -> Iterator[str]:
-    if not os.path.exists(CHROMIUM):
-        reason = f"Debian's chromium is not at {CHROMIUM}: `bash tests/run.sh` installs it"
-        if os.environ.get("CI"):  # the set-up installs it there: its absence is a failure
-            pytest.fail(reason, pytrace=False)
-        pytest.skip(reason)
-    try:
-        import playwright.sync_api  # noqa: F401
-    except ImportError:
-        reason = "playwright is not installed: `bash tests/run.sh` installs it"
-        if os.environ.get("CI"):
-            pytest.fail(reason, pytrace=False)
-        pytest.skip(reason)
+    missing = browser_missing()
+    if missing:
+        if os.environ.get("CI"):  # the test set-up installs both: their absence is a failure
+            pytest.fail(missing, pytrace=False)
+        pytest.skip(missing)
     with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as server:
         yield server.url
 
