@@ -307,15 +307,17 @@ def operator_rows(lam: float, panels: Panels, targets: np.ndarray) -> np.ndarray
         log_d = np.log(ad)
     smooth = plane_kernel_regular(lam * ad) - np.log(lam)
     rows = (smooth - np.where(ad > 0, log_d, 0.0)) * panels.weights[None, :]
-    for p in range(panels.n_panels):
-        c, h = panels.centers[p], panels.half_widths[p]
-        near = np.abs(targets - c) <= NEAR_FIELD * h
-        if not near.any():
-            continue
-        cols = slice(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
-        idx = np.nonzero(near)[0]
-        rows[idx, cols] = (smooth[idx, cols] * panels.weights[None, cols]
-                           - log_product_weights(c, h, targets[idx]))
+    # Near pairs (target, panel) all at once: one batched call of the Legendre log moments
+    # instead of a Python loop over panels (which cost ~20 ms for 20 panels).
+    near_t, near_p = np.nonzero(np.abs(targets[:, None] - panels.centers[None, :])
+                                <= NEAR_FIELD * panels.half_widths[None, :])
+    if near_t.size:
+        c, h = panels.centers[near_p], panels.half_widths[near_p]
+        moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1)
+        log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + moments @ _TO_COEF)
+        cols = near_p[:, None] * NODES_PER_PANEL + np.arange(NODES_PER_PANEL)[None, :]
+        rows[near_t[:, None], cols] = (smooth[near_t[:, None], cols]
+                                       * panels.weights[cols] - log_weights)
     return rows / np.pi
 
 
