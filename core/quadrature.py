@@ -404,3 +404,28 @@ def galerkin_correction(panels: Panels, *, reach: float = 1.0) -> np.ndarray:
             cols = slice(q[k] * NODES_PER_PANEL, (q[k] + 1) * NODES_PER_PANEL)
             out[rows, cols] = block[k]
     return out
+
+
+def panel_legendre_coefficients(values: np.ndarray) -> np.ndarray:
+    """Legendre coefficients of node values on each panel.
+
+    ``values`` has shape (N, ...) with N = 16 P; returns shape (P, 16, ...): coefficient
+    ``k`` of the degree-15 interpolant on panel ``p`` (dimensionless, units of the values).
+    """
+    values = np.asarray(values, dtype=float)
+    per_panel = values.reshape((-1, NODES_PER_PANEL) + values.shape[1:])
+    return np.einsum("kj,pj...->pk...", _TO_COEF, per_panel)
+
+
+def interpolation_weights(panels: Panels, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Panel index (len(x),) and weights (len(x), 16) of the panel-wise interpolant at ``x``.
+
+    ``f(x_i) ~ sum_j weights[i, j] f(node j of panel index[i])``: the degree-15 polynomial
+    through the panel's 16 Gauss nodes. A point on a panel end belongs to the panel on
+    its right (the last end to the last panel), so evaluate a jump's two sides slightly
+    off it.
+    """
+    x = np.asarray(x, dtype=float)
+    index = np.clip(np.searchsorted(panels.edges, x, side="right") - 1, 0, panels.n_panels - 1)
+    t = (x - panels.centers[index]) / panels.half_widths[index]
+    return index, npleg.legvander(t, NODES_PER_PANEL - 1) @ _TO_COEF

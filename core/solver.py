@@ -37,6 +37,11 @@ import numpy as np
 
 from core.basis import Basis, build_basis, graded_cuts
 from core.cache import StageCache, fingerprint
+from core.inputs import (
+    check_values,
+    validate_geometry,
+    validate_time_inputs,
+)
 from core.projection import GapTerms, galerkin_matrix, gap_terms
 from core.quadrature import (
     KernelOperator,
@@ -49,7 +54,6 @@ from core.quadrature import (
 )
 from core.statements import QUANTITIES, ModalSystem, modal_system, statement_number
 from core.time_integration import ModalProblem, solve_degenerate, solve_general
-from core.validation import MAX_MAGNITUDE
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
@@ -66,20 +70,6 @@ ERROR_FLOOR = 2e-13
 #: Success is claimed only when the error estimate is this many times below tol: the
 #: estimate itself can read ~3x low (see _extrapolated_error).
 SUCCESS_MARGIN = 3.0
-#: |alpha| above this many radians is not a small tilt (used by the dimensional API).
-TOLERANCE_RANGE = (1e-13, 1e-1)
-
-#: Accepted magnitudes of the coefficient functions (m, g: dimensionless; c: relative
-#: modulus; the given loads: at most 1e100). Beyond them the Galerkin matrix over- or
-#: underflows in double precision (m = 1e200 made it singular, m = 1e-300 gave NaN);
-#: physical scenes are far inside.
-VALUE_RANGE = {"m": (1 / MAX_MAGNITUDE, MAX_MAGNITUDE), "g": (0.0, MAX_MAGNITUDE),
-               "c": (1 / MAX_MAGNITUDE, MAX_MAGNITUDE)}
-#: Accepted a/H. The operator's nodes grow like a/H and its memory like its square:
-#: measured 155 MB at 100 and 5.5 GB at 1000 (tests/test_security.py documents the
-#: scene limit, which is tighter).
-LAM_RANGE = (1e-4, 1e3)
-
 # Bytes per stage sum to STAGE_CACHE_BYTES (512 MiB), sized from the largest items
 # measured on the hard cases of benchmarks/scenes.py: operator and correction ~9 MiB,
 # basis ~8 MiB, all modes of a scene ~3 MiB, responses ~5 MiB.
@@ -172,43 +162,6 @@ class ContactSolution:
 # ---------------------------------------------------------------------- validation
 
 
-def _as_function(value: Scalar, name: str) -> Callable[[np.ndarray], np.ndarray]:
-    """A vectorized callable for a float or callable argument."""
-    if callable(value):
-        def fn(x: np.ndarray, _f=value) -> np.ndarray:
-            with np.errstate(all="ignore"):
-                out = np.asarray(_f(np.asarray(x, dtype=float)), dtype=float)
-            return np.broadcast_to(out, np.shape(x)).astype(float)
-        return fn
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ValueError(f"{name}: must be a number or a vectorized callable, "
-                         f"got {type(value).__name__}")
-    v = float(value)
-    if not np.isfinite(v):
-        raise ValueError(f"{name}: must be finite, got {v}")
-    return lambda x, _v=v: np.full(np.shape(x), _v)
-
-
-def _check_values(values: np.ndarray, name: str, where: np.ndarray, var: str, *,
-                  positive: bool = False) -> None:
-    bad = ~np.isfinite(values)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise ValueError(f"{name}: must be finite, is {values[i]} at {var} = {where[i]:.6g}")
-    if positive and np.any(values <= 0):
-        i = int(np.argmin(values))
-        raise ValueError(f"{name}: must be > 0, is {values[i]:.6g} at {var} = {where[i]:.6g}")
-    lo, hi = VALUE_RANGE.get(name, (0.0, MAX_MAGNITUDE))
-    if not positive:
-        lo = 0.0
-    magnitude = np.abs(values)
-    out = (magnitude > hi) | (magnitude < lo)
-    if out.any():
-        i = int(np.argmax(out))
-        raise ValueError(f"{name}: must lie in [{lo:g}, {hi:g}] in magnitude, is "
-                         f"{values[i]:.6g} at {var} = {where[i]:.6g}")
-
-
 @dataclass(frozen=True)
 class _Inputs:
     lam: float
@@ -226,68 +179,11 @@ class _Inputs:
 
 
 def _validate(lam, m, g, times, c, kernel, loads, breakpoints, tol) -> _Inputs:
-    if isinstance(lam, bool) or not isinstance(lam, (int, float, np.floating, np.integer)):
-        raise ValueError(f"lam: must be a number, got {type(lam).__name__}")
-    lam = float(lam)
-    if not np.isfinite(lam) or lam <= 0:
-        raise ValueError(f"lam: must be a finite number > 0, got {lam}")
-    if not LAM_RANGE[0] <= lam <= LAM_RANGE[1]:
-        raise ValueError(f"lam: must be in [{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}] (a/H), "
-                         f"got {lam:g}")
-    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating)):
-        raise ValueError(f"tol: must be a number, got {type(tol).__name__}")
-    tol = float(tol)
-    if not (TOLERANCE_RANGE[0] <= tol <= TOLERANCE_RANGE[1]):
-        raise ValueError(f"tol: must be in [{TOLERANCE_RANGE[0]:g}, {TOLERANCE_RANGE[1]:g}], "
-                         f"got {tol:g}")
-    try:
-        bps = tuple(sorted(float(b) for b in breakpoints))
-    except (TypeError, ValueError) as exc:
-        raise ValueError("breakpoints: must be a sequence of numbers in (-1, 1)") from exc
-    for b in bps:
-        if not np.isfinite(b) or not (-1.0 < b < 1.0):
-            raise ValueError(f"breakpoints: each must lie in (-1, 1), got {b}")
-    bps = tuple(b for i, b in enumerate(bps) if i == 0 or b - bps[i - 1] > 1e-12)
-    try:
-        t = np.asarray(times, dtype=float).ravel()
-    except (TypeError, ValueError) as exc:
-        raise ValueError("times: must be an array of numbers") from exc
-    if t.size == 0:
-        raise ValueError("times: at least one time is needed")
-    if t.size > 100_000:
-        raise ValueError(f"times: at most 100000 output times, got {t.size}")
-    if not np.all(np.isfinite(t)):
-        raise ValueError("times: must be finite")
-    if t[0] < 1.0:
-        raise ValueError(f"times: must be >= 1 (t = 1 is the moment of loading), got {t[0]:g}")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("times: must be strictly increasing")
-    m_fn = _as_function(m, "m")
-    g_fn = _as_function(g, "g")
-    c_fn = _as_function(c, "c")
-    probe = np.linspace(-1.0, 1.0, 257)
-    for bp in bps:
-        probe = np.concatenate([probe, [bp - 1e-9, bp + 1e-9]])
-    _check_values(m_fn(probe), "m", probe, "x", positive=True)
-    _check_values(g_fn(probe), "g", probe, "x")
-    _check_values(c_fn(t), "c", t, "t", positive=True)
-    given = frozenset(k for k, v in loads.items() if v is not None)
-    statement_number(given)
-    load_fns = {}
-    for name in sorted(given):
-        fn = _as_function(loads[name], name)
-        _check_values(fn(t), name, t, "t")
-        load_fns[name] = fn
-    if kernel is not None:
-        if not callable(kernel):
-            raise ValueError("kernel: must be None or a vectorized callable K(t, tau)")
-        tt = np.array([t[-1], t[-1], 0.5 * (1 + t[-1])])
-        kv = np.asarray(kernel(tt, np.array([1.0, t[-1], 1.0])), dtype=float)
-        if kv.shape != (3,) or not np.all(np.isfinite(kv)):
-            raise ValueError("kernel: K(t, tau) must return finite values of the shape of "
-                             "its (broadcast) arguments")
-    return _Inputs(lam, m_fn, g_fn, not callable(g) and float(g) == 0.0, t, c_fn,
-                   not callable(c), kernel, load_fns, given, bps, tol)
+    geometry = validate_geometry(lam, m, g, breakpoints, tol)
+    timing = validate_time_inputs(times, c, kernel, loads)
+    return _Inputs(geometry.lam, geometry.m, geometry.g, geometry.g_is_zero, timing.times,
+                   timing.c, timing.c_is_constant, timing.kernel, timing.loads, timing.given,
+                   geometry.breakpoints, geometry.tol)
 
 
 # -------------------------------------------------------------------------- stages
@@ -353,7 +249,7 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
     op_key = fingerprint("operator", inp.lam, panels.edges)
     operator = timed("operator", _OPERATOR, op_key, lambda: kernel_operator(inp.lam, panels))
     m_nodes = inp.m(panels.nodes)
-    _check_values(m_nodes, "m", panels.nodes, "x", positive=True)
+    check_values(m_nodes, "m", panels.nodes, "x", positive=True)
     count = cap if kind == "graded" else min(cap, panels.size // 2)
     if kind == "graded":
         # Panels added to resolve m or g (a rough punch, a wavy coating) become elements
@@ -397,7 +293,7 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
     r_matrix = timed("galerkin", _GALERKIN, gal_key,
                      lambda: galerkin_matrix(operator, basis, m_nodes, correction))
     g_nodes = inp.g(panels.nodes)
-    _check_values(g_nodes, "g", panels.nodes, "x")
+    check_values(g_nodes, "g", panels.nodes, "x")
     if inp.g_is_zero:
         gap = GapTerms(np.zeros(basis.size), 0.0, 0.0)
     else:
