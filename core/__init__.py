@@ -5,6 +5,8 @@ The public entry points are loaded on first use, so that importing one submodule
 
 - :func:`solve_dimensionless`, :class:`ContactSolution` (:mod:`core.solver`): the
   dimensionless problem;
+- :func:`prepare` (:mod:`core.prepared`): prepare a geometry once, ``.solve(...)`` the
+  loads many times;
 - :func:`solve`, :class:`Scene`, :class:`SceneSolution`, :func:`scene_from_dict`,
   :func:`load_scene`, :func:`save_scene` (:mod:`core.scene`): dimensional scenes in SI
   units with time in days.
@@ -16,6 +18,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from core.prepared import prepare
     from core.scene import (
         Scene,
         SceneSolution,
@@ -28,6 +31,7 @@ if TYPE_CHECKING:
 
 _EXPORTS: dict[str, str] = {
     "solve_dimensionless": "core.solver",
+    "prepare": "core.prepared",
     "ContactSolution": "core.solver",
     "solve": "core.scene",
     "Scene": "core.scene",
@@ -39,6 +43,7 @@ _EXPORTS: dict[str, str] = {
 
 __all__ = [
     "solve_dimensionless",
+    "prepare",
     "ContactSolution",
     "solve",
     "Scene",

@@ -130,6 +130,8 @@ class ContactSolution:
     _c: np.ndarray = field(repr=False)  # c(t) at the times
     _m: Callable[[np.ndarray], np.ndarray] = field(repr=False)
     _g: Callable[[np.ndarray], np.ndarray] = field(repr=False)
+    #: q(x) at points x, shape (len(x), T), for engines without a basis (Nystrom).
+    _evaluate: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
 
     @property
     def success(self) -> bool:
@@ -154,6 +156,8 @@ class ContactSolution:
         x = np.atleast_1d(np.asarray(x, dtype=float))
         if np.any(~np.isfinite(x)) or np.any(np.abs(x) > 1.0):
             raise ValueError("x: pressure is defined on [-1, 1] only")
+        if self._evaluate is not None:
+            return self._evaluate(x)
         phi = self._basis.evaluate(x, self._coefficients.shape[0])
         mq = phi @ self._coefficients - np.outer(self._g(x), 1.0 / self._c)
         return mq / self._m(x)[:, None]
@@ -644,9 +648,9 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                         settlement: Scalar | None = None, tilt: Scalar | None = None,
                         force: Scalar | None = None, moment: Scalar | None = None,
                         breakpoints: Sequence[float] = (), tol: float = 1e-8,
-                        basis: str = "graded", n_modes: int | None = None
-                        ) -> ContactSolution:
-    """Solve the dimensionless contact problem by the projection method.
+                        basis: str = "graded", n_modes: int | None = None,
+                        method: str | None = None) -> ContactSolution:
+    """Solve the dimensionless contact problem (Nystrom by default, or the seed's projection).
 
     Parameters (all dimensionless):
         lam: a/H, half-width over base thickness (> 0).
@@ -665,10 +669,23 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
             the edges and jumps), "piecewise" (polynomials between breakpoints) or "global"
             (the seed's basis).
         n_modes: a fixed number of basis functions (for studies); default adaptive.
+        method: "nystrom" (the default: a direct solve on graded panels, adaptively
+            refined, :mod:`core.prepared`) or "projection" (the seed's series; the default
+            when ``basis`` or ``n_modes`` is given, which only it uses).
 
     Returns a :class:`ContactSolution`. Raises ``ValueError`` naming the argument on bad
     input.
     """
+    if method is None:
+        method = "projection" if (n_modes is not None or basis != "graded") else "nystrom"
+    if method == "nystrom":
+        from core.prepared import solve_with_prepared
+
+        return solve_with_prepared(lam, m, g, times, c=c, kernel=kernel,
+                                   settlement=settlement, tilt=tilt, force=force,
+                                   moment=moment, breakpoints=breakpoints, tol=tol)
+    if method != "projection":
+        raise ValueError(f"method: must be 'nystrom' or 'projection', got {method!r}")
     t_start = _time.perf_counter()
     inp = _validate(lam, m, g, times, c, kernel,
                     {"settlement": settlement, "tilt": tilt, "force": force, "moment": moment},

@@ -77,6 +77,8 @@ class ModalSystem:
     constraint_names: tuple[str, ...]  # which of force, moment each row fixes
     unknown_names: tuple[str, ...]  # which of settlement, tilt the known rows determine
     unknown_rhs: np.ndarray  # (k x k)
+    #: ``psi^-1``: ``psi.T`` for a symmetric ``R``; the inverse for a Nystrom ``R``.
+    psi_inv: np.ndarray | None = None
 
     def to_coefficients(self, b: np.ndarray) -> np.ndarray:
         """Map rotated coefficients ``b`` (n, ...) back to ``a = T b``."""
@@ -92,11 +94,14 @@ class ModalSystem:
 
 
 def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
-                 given: frozenset[str], n: int) -> ModalSystem:
+                 given: frozenset[str], n: int, *, symmetric: bool = True) -> ModalSystem:
     """Build the decoupled system for a statement at ``n`` functions of the basis.
 
     ``r_matrix`` is the Galerkin matrix ``R`` (at least n x n, symmetric positive definite);
-    ``moments`` are ``J_0, J_1, J_2``.
+    ``moments`` are ``J_0, J_1, J_2``. With ``symmetric=False`` (the Nystrom matrix, whose
+    product-integration rows are not symmetric) the free block is diagonalized as it is,
+    ``R_FF = psi diag(gamma) psi^-1``; its eigenvalues are real and positive up to
+    round-off (the operator is similar to a symmetric positive one), else ``ValueError``.
     """
     statement_number(given)
     j0, j1, j2 = moments
@@ -128,13 +133,24 @@ def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
     t[:2, :2] = rotation
     r = r_matrix[:n, :n]
     r_rot = t.T @ r @ t
-    r_rot = 0.5 * (r_rot + r_rot.T)
     e0_rot = t.T @ e0
     e1_rot = t.T @ e1
-    gamma, psi = np.linalg.eigh(r_rot[np.ix_(free, free)])
+    if symmetric:
+        r_rot = 0.5 * (r_rot + r_rot.T)
+        gamma, psi = np.linalg.eigh(r_rot[np.ix_(free, free)])
+        psi_inv = psi.T
+    else:
+        gamma, psi = np.linalg.eig(r_rot[np.ix_(free, free)])
+        scale = float(np.max(np.abs(gamma))) if gamma.size else 1.0
+        if gamma.size and (np.max(np.abs(gamma.imag)) > 1e-8 * scale
+                           or np.min(gamma.real) <= 0):
+            raise ValueError("operator: eigenvalues not real and positive; the grid does "
+                             "not resolve the problem")
+        gamma, psi = gamma.real, psi.real
+        psi_inv = np.linalg.inv(psi)
     constraint = np.array([[(e0_rot if name == "force" else e1_rot)[i] for i in known]
                            for name in constraint_names]).reshape(k, k)
     unknown_rhs = np.array([[(e0_rot if name == "settlement" else e1_rot)[i]
                              for name in unknown_names] for i in known]).reshape(k, k)
     return ModalSystem(given, n, rotation, free, known, gamma, psi, r_rot, e0_rot, e1_rot,
-                       constraint, constraint_names, unknown_names, unknown_rhs)
+                       constraint, constraint_names, unknown_names, unknown_rhs, psi_inv)

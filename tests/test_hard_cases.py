@@ -34,7 +34,12 @@ from core.basis import build_basis, graded_cuts
 from core.collocation import solve_collocation
 from core.creep import Arutyunyan, ExponentialCreep
 from core.quadrature import base_panels
-from core.solver import solve_dimensionless
+from core.solver import solve_dimensionless as _solve_dimensionless
+
+
+def solve_dimensionless(*args: Any, **kwargs: Any):
+    """The projection method (this file checks it; tests/test_nystrom.py the default)."""
+    return _solve_dimensionless(*args, method="projection", **kwargs)
 
 # ------------------------------------------------------------------------------ cases
 

@@ -1,0 +1,167 @@
+"""The Nystrom equations in modal form, for a creeping base or a modulus that varies in time.
+
+With ``D = diag(m_i)`` and ``A`` the discrete layer operator, the nodal equations read
+
+    c(t) D q + (I - V) A q = delta 1 + alpha x - g.
+
+In the inner product ``<u, v> = u^T W D v`` (``W`` the quadrature weights) the vectors
+``D^-1 1`` and ``D^-1 x`` carry both the drive (``delta``, ``alpha``) and the balance
+(``P = <q, D^-1 1>``, ``M = <q, D^-1 x>``). An orthonormal basis whose first two vectors
+span them (the discrete analogue of the seed's ``p_0``, ``p_1``) turns the nodal equations
+into exactly the seed's Galerkin rows,
+
+    c a_i + (I - V) sum_j R_ij a_j = delta e0_i + alpha e1_i + f_i,   R = P^T W A P,
+
+with the gap as a constant drive ``f = -P^T W g``, so :func:`core.statements.modal_system`
+decouples them (its free block diagonalized as it is: the product-integration rows of
+``A`` are not symmetric, but the operator is similar to a symmetric positive one) and
+:mod:`core.time_integration` steps one scalar Volterra equation per mode.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from core.nystrom import NystromGrid
+from core.statements import ModalSystem, modal_system
+from core.time_integration import ModalProblem, solve_degenerate, solve_general
+
+Function = Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class ModalAnswer:
+    """Nodal pressures (N, T), the four scalars over the times and the time stepping's report.
+
+    ``effective`` holds ``q - V q`` at the nodes (N, T): the density whose ``F`` enters the
+    equation, for the Nystrom formula between the nodes.
+    """
+
+    nodal: np.ndarray
+    effective: np.ndarray
+    scalars: dict[str, np.ndarray]
+    time_error: float
+    steps: int
+    success: bool
+    message: str
+
+
+class ModalForm:
+    """One statement of the Nystrom equations in decoupled modal coordinates."""
+
+    def __init__(self, grid: NystromGrid, given: frozenset[str]) -> None:
+        w, m, x = grid.panels.weights, grid.m, grid.nodes
+        s_in = np.sqrt(w / m)  # row scaling S^-1 W
+        s_out = 1.0 / np.sqrt(w * m)  # column scaling S^-1
+        first = np.column_stack([s_in, s_in * x])
+        q, r = np.linalg.qr(first, mode="complete")
+        q[:, :2] *= np.sign(np.diag(r[:2, :2]))[None, :]
+        moments = (float(np.sum(w / m)), float(np.sum(w * x / m)), float(np.sum(w * x * x / m)))
+        galerkin = q.T @ ((s_in[:, None] * grid.operator * s_out[None, :]) @ q)
+        self.ms: ModalSystem = modal_system(galerkin, moments, given, grid.size,
+                                            symmetric=False)
+        self.to_nodes = s_out[:, None] * q
+        ms = self.ms
+        self.gap = ms.rotate(-(q.T @ (s_in * grid.g)))
+        self.k = len(ms.known)
+        self.constraint_inv = np.linalg.inv(ms.constraint) if self.k else np.zeros((0, 0))
+        r_fk = ms.r_rot[np.ix_(ms.free, ms.known)]
+        self.coupling = ms.psi_inv @ r_fk if self.k else np.zeros((len(ms.free), 1))
+        self.gap_free = ms.psi_inv @ self.gap[ms.free]
+        self.e0 = np.zeros(grid.size)
+        self.e1 = np.zeros(grid.size)
+        self.e0[0] = np.sqrt(moments[0])
+        self.e1[0] = moments[1] / np.sqrt(moments[0])
+        self.e1[1] = np.sqrt((moments[0] * moments[2] - moments[1] ** 2) / moments[0])
+
+    def known(self, loads: dict[str, np.ndarray], size: int) -> np.ndarray:
+        """Known coordinates from the given force and moment, shape (max(k, 1), T)."""
+        if not self.k:
+            return np.zeros((1, size))
+        return self.constraint_inv @ np.array([loads[name]
+                                               for name in self.ms.constraint_names])
+
+    def _given(self, rows: np.ndarray, loads: dict[str, np.ndarray], size: int) -> np.ndarray:
+        out = np.zeros((len(rows), size))
+        if "settlement" in loads:
+            out += np.outer(self.ms.e0_rot[rows], loads["settlement"])
+        if "tilt" in loads:
+            out += np.outer(self.ms.e1_rot[rows], loads["tilt"])
+        return out
+
+    def drive(self, loads: dict[str, np.ndarray], size: int) -> np.ndarray:
+        """Modal drive of the given settlement and tilt and of the gap, shape (F, T)."""
+        return (self.ms.psi_inv @ self._given(self.ms.free, loads, size)
+                + self.gap_free[:, None])
+
+    def finish(self, c_t: np.ndarray, loads: dict[str, np.ndarray], known: np.ndarray,
+               z: np.ndarray, vz: np.ndarray, vu: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, dict]:
+        """Nodal pressures, ``q - V q`` at the nodes and the four scalars."""
+        ms, k = self.ms, self.k
+        size = c_t.size
+        b = np.zeros((ms.n, size))
+        b[ms.free] = ms.psi @ z
+        if k:
+            b[ms.known] = known[:k]
+        a = ms.to_coefficients(b)
+        b_eff = np.zeros_like(b)
+        b_eff[ms.free] = ms.psi @ (z - vz)
+        if k:
+            b_eff[ms.known] = known[:k] - vu[:k]
+        effective = self.to_nodes @ ms.to_coefficients(b_eff)
+        out = {name: np.asarray(v, dtype=float) for name, v in loads.items()}
+        if k:
+            # Known rows: c b_K + (I - V)[R_KF b_F + R_KK b_K] = drive_K + unknown drive.
+            r_kf = ms.r_rot[np.ix_(ms.known, ms.free)]
+            r_kk = ms.r_rot[np.ix_(ms.known, ms.known)]
+            lhs = (c_t[None, :] * known[:k] + r_kf @ (ms.psi @ (z - vz))
+                   + r_kk @ (known[:k] - vu[:k]) - self.gap[ms.known][:, None]
+                   - self._given(ms.known, loads, size))
+            unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
+            for i, name in enumerate(ms.unknown_names):
+                out[name] = unknowns[i]
+        out.setdefault("force", self.e0 @ a)
+        out.setdefault("moment", self.e1 @ a)
+        return self.to_nodes @ a, effective, out
+
+    def solve(self, times: np.ndarray, c: Function, kernel, loads: dict[str, Function],
+              time_tol: float, breaks: np.ndarray | None = None) -> ModalAnswer:
+        """The answer at ``times`` for relative modulus ``c(t)`` and creep kernel ``kernel``."""
+        c_t = c(times)
+        values = {name: fn(times) for name, fn in loads.items()}
+        known = self.known(values, times.size)
+        gamma = self.ms.gamma
+        if kernel is None:
+            z = (self.drive(values, times.size) - self.coupling @ known) / (
+                c_t[None, :] + gamma[:, None])
+            nodal, effective, scalars = self.finish(c_t, values, known, z, np.zeros_like(z),
+                                                    np.zeros_like(known))
+            return ModalAnswer(nodal, effective, scalars, 0.0, 0, True,
+                               "no creep: no time stepping")
+        memo: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+
+        def evaluate(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            key = tt.tobytes()
+            if key not in memo:
+                memo.clear()
+                ld = {name: fn(tt) for name, fn in loads.items()}
+                u = self.known(ld, tt.size)
+                d = 1.0 + c(tt)[None, :] / gamma[:, None]
+                memo[key] = (d, (self.drive(ld, tt.size) - self.coupling @ u)
+                             / gamma[:, None], u)
+            return memo[key]
+
+        problem = ModalProblem(d=lambda tt: evaluate(tt)[0], r=lambda tt: evaluate(tt)[1],
+                               u=lambda tt: evaluate(tt)[2],
+                               coupling=self.coupling / gamma[:, None])
+        if hasattr(kernel, "rates") and hasattr(kernel, "exponential_parts"):
+            sol = solve_degenerate(kernel, problem, times, tol=time_tol)
+        else:
+            sol = solve_general(kernel, problem, times, tol=time_tol)
+        nodal, effective, scalars = self.finish(c_t, values, known, sol.w, sol.vw, sol.vu)
+        return ModalAnswer(nodal, effective, scalars, float(sol.error_estimate), int(sol.steps),
+                           bool(sol.success), sol.message)

@@ -1,0 +1,334 @@
+"""Prepare once, solve many: the two-stage interface of the default (Nystrom) engine.
+
+    prepared = core.prepare(lam, m, g, breakpoints=..., tol=1e-8)   # geometry: once
+    sol = prepared.solve(times, force=P, moment=M, c=..., kernel=...)  # loads: cheap
+
+:func:`prepare` validates the geometry, grades and refines the panels until the pressure
+is resolved to ``tol`` (:mod:`core.nystrom`) and keeps the grid. Everything a solve needs
+beyond that is built on first use and kept on the object, keyed by exactly what it
+depends on:
+
+==============  ==================================  =========================================
+member          depends on                           holds
+==============  ==================================  =========================================
+``_bordered``   statement, constant ``c``            LU of the bordered matrix, unit responses
+``_modal``      statement                            modal decomposition (creep, or c(t))
+``_rows``       the evaluation points                rows of F there (Nystrom formula)
+==============  ==================================  =========================================
+
+A change of the loads (same statement, same ``c``) is then a few array operations: a
+combination of cached unit responses. ``counts`` records how often each member was
+built, so tests can check that a load change builds nothing geometric.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from collections import Counter
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from core.inputs import Geometry, Scalar, TimeInputs, validate_geometry, validate_time_inputs
+from core.nystrom import BorderedSystem, adapt
+from core.nystrom_time import ModalForm
+from core.solver import ContactSolution
+from core.statements import QUANTITIES, statement_number
+
+#: The time stepping aims this many times below its share of tol: its step-doubling
+#: estimate read up to ~20x the true error on decaying creep (see core/solver.py).
+TIME_SHARE = 30.0
+#: Points (Chebyshev, plus both sides of every jump) where q >= 0 is checked.
+CHECK_POINTS = 401
+#: Bound of the cached operator rows at evaluation points [bytes].
+ROWS_BYTES = 64 * 2**20
+#: Samples of the load histories between the output times where the validity of the
+#: answer (q >= 0) is checked as well, so a peak between outputs is not missed.
+HISTORY_SAMPLES = 512
+
+
+def _check_points(breakpoints: Sequence[float]) -> np.ndarray:
+    bps = np.asarray(breakpoints, dtype=float)
+    return np.concatenate([np.cos(np.linspace(0.0, np.pi, CHECK_POINTS)), bps - 1e-9,
+                           bps + 1e-9])
+
+
+class PreparedContact:
+    """The geometry of one problem, discretized once (see the module notes).
+
+    Attributes: ``geometry`` (validated inputs), ``grid`` (:class:`core.nystrom.NystromGrid`),
+    ``spatial_error`` (estimated relative error of q), ``resolved``, ``counts``
+    (evaluations of each cached member), ``seconds`` (time spent preparing).
+    """
+
+    method = "nystrom"
+
+    def __init__(self, geometry: Geometry) -> None:
+        t0 = _time.perf_counter()
+        self.geometry = geometry
+        self.counts: Counter[str] = Counter()
+        adaptive = adapt(geometry.lam, geometry.m, geometry.g, geometry.g_is_zero,
+                         geometry.breakpoints, geometry.tol)
+        self.counts["grid"] += 1
+        self.grid = adaptive.grid
+        self.spatial_error = adaptive.spatial_error
+        self.resolved = adaptive.resolved
+        self._bordered: dict[tuple, tuple[BorderedSystem, dict[str, np.ndarray]]] = {}
+        self._modal: dict[frozenset[str], ModalForm] = {}
+        self._rows: dict[bytes, np.ndarray] = {}
+        self._check_x = _check_points(geometry.breakpoints)
+        self._solves = 0
+        self.seconds = _time.perf_counter() - t0
+
+    # ------------------------------------------------------------- cached members
+
+    def bordered(self, given: frozenset[str], c: float
+                 ) -> tuple[BorderedSystem, dict[str, np.ndarray]]:
+        """Factorized bordered system and its unit responses for a statement and constant c."""
+        key = (given, c)
+        if key not in self._bordered:
+            system = BorderedSystem(self.grid, c, given)
+            self._bordered[key] = (system, system.unit_responses())
+            self.counts["bordered"] += 1
+            while len(self._bordered) > 8:  # a few statements and moduli at once
+                self._bordered.pop(next(iter(self._bordered)))
+        return self._bordered[key]
+
+    def modal(self, given: frozenset[str]) -> ModalForm:
+        """Modal decomposition of a statement (for creep or a modulus varying in time)."""
+        if given not in self._modal:
+            self._modal[given] = ModalForm(self.grid, given)
+            self.counts["modal"] += 1
+        return self._modal[given]
+
+    def rows(self, x: np.ndarray) -> np.ndarray:
+        """Rows of the operator F at points ``x`` (len(x), N), cached by the points."""
+        key = x.tobytes()
+        if key not in self._rows:
+            self._rows[key] = self.grid.rows(x)
+            self.counts["rows"] += 1
+            while sum(r.nbytes for r in self._rows.values()) > ROWS_BYTES and len(
+                    self._rows) > 1:
+                self._rows.pop(next(iter(self._rows)))
+        return self._rows[key]
+
+    def nystrom_pressure(self, x: np.ndarray, drive: np.ndarray, c: np.ndarray,
+                         effective: np.ndarray) -> np.ndarray:
+        """``q(x, t) = [drive(x, t) - (F (q - V q))(x, t)] / (c(t) m(x))``, shape (len(x), T).
+
+        ``drive = delta + alpha x - g(x)`` at the points, ``effective`` the nodal
+        ``q - V q`` (just q for an elastic base).
+        """
+        x = np.ascontiguousarray(x, dtype=float)
+        m_x = self.geometry.m(x)
+        return (drive - self.rows(x) @ effective) / (m_x[:, None] * c[None, :])
+
+    # --------------------------------------------------------------------- solve
+
+    def solve(self, times: Sequence[float] | np.ndarray, *, c: Scalar = 1.0,
+              kernel: Callable | None = None, settlement: Scalar | None = None,
+              tilt: Scalar | None = None, force: Scalar | None = None,
+              moment: Scalar | None = None) -> ContactSolution:
+        """Solve for the loads at ``times`` (dimensionless; see ``solve_dimensionless``)."""
+        inputs = validate_time_inputs(times, c, kernel, {"settlement": settlement, "tilt": tilt,
+                                                         "force": force, "moment": moment})
+        return self.solve_validated(inputs)
+
+    def solve_validated(self, inputs: TimeInputs) -> ContactSolution:
+        """:meth:`solve` for inputs already checked by :func:`core.inputs.validate_time_inputs`."""
+        t0 = _time.perf_counter()
+        geometry = self.geometry
+        times = inputs.times
+        built_before = Counter(self.counts)
+        probe = self._history_times(times)
+        g = self.geometry.g
+        if inputs.kernel is None and inputs.c_is_constant:
+            c0 = float(inputs.c(times[:1])[0])
+            _, units = self.bordered(inputs.given, c0)
+            names = sorted(inputs.given)
+            n = self.grid.size
+            unknown_names = [q for q in QUANTITIES if q not in inputs.given]
+            columns = names + ["gap"]
+            unit_matrix = np.column_stack([units[k] for k in columns])
+            # delta and alpha of each unit response (given: 1 for its own unit).
+            unit_delta = np.array([1.0 if k == "settlement" else 0.0 for k in columns])
+            unit_alpha = np.array([1.0 if k == "tilt" else 0.0 for k in columns])
+            for i, name in enumerate(unknown_names):
+                if name == "settlement":
+                    unit_delta = unit_matrix[n + i]
+                elif name == "tilt":
+                    unit_alpha = unit_matrix[n + i]
+            unit_gap = np.array([1.0 if k == "gap" else 0.0 for k in columns])
+            nodal_units = unit_matrix[:n]
+            c_unit = np.ones(len(columns)) * c0
+
+            def weights(tt: np.ndarray) -> np.ndarray:
+                return np.vstack([inputs.loads[k](tt) for k in names] + [np.ones(tt.size)])
+
+            def unit_pressure(x: np.ndarray) -> np.ndarray:
+                drive = (unit_delta[None, :] + np.outer(x, unit_alpha)
+                         - np.outer(g(x), unit_gap))
+                per_unit = self.nystrom_pressure(x, drive, c_unit, nodal_units)
+                return per_unit
+
+            load_matrix = weights(times)
+            solved = unit_matrix @ load_matrix
+            scalars = {k: inputs.loads[k](times) for k in names}
+            for i, name in enumerate(unknown_names):
+                scalars[name] = solved[n + i]
+            q_check = unit_pressure(self._check_x) @ weights(probe)
+            time_error, steps, time_ok, time_message = 0.0, 0, True, "elastic base"
+
+            def pressure(x: np.ndarray) -> np.ndarray:
+                return unit_pressure(x) @ load_matrix
+        else:
+            form = self.modal(inputs.given)
+            time_tol = geometry.tol / TIME_SHARE
+            merged = np.union1d(times, probe)
+            answer = form.solve(merged, inputs.c, inputs.kernel, inputs.loads, time_tol)
+            c_merged = inputs.c(merged)
+            sc = answer.scalars
+
+            def merged_pressure(x: np.ndarray, at: np.ndarray | slice) -> np.ndarray:
+                drive = (sc["settlement"][at][None, :] + np.outer(x, sc["tilt"][at])
+                         - g(x)[:, None])
+                return self.nystrom_pressure(x, drive, c_merged[at],
+                                             answer.effective[:, at])
+
+            at = np.searchsorted(merged, times)
+            scalars = {k: v[at] for k, v in sc.items()}
+            q_check = merged_pressure(self._check_x, slice(None))
+            time_error, steps = answer.time_error, answer.steps
+            time_ok, time_message = answer.success, answer.message
+
+            def pressure(x: np.ndarray) -> np.ndarray:
+                return merged_pressure(x, at)
+        built = {k: self.counts[k] - built_before[k] for k in self.counts}
+        return self._result(inputs, scalars, pressure, q_check, time_error, steps, time_ok,
+                            time_message, _time.perf_counter() - t0, built)
+
+    def _history_times(self, times: np.ndarray) -> np.ndarray:
+        """Output times plus samples between them, where the answer's validity is checked."""
+        if times.size == 1:
+            return times
+        return np.union1d(times, np.linspace(times[0], times[-1], HISTORY_SAMPLES))
+
+    def _result(self, inputs: TimeInputs, scalars: dict[str, np.ndarray],
+                pressure: Callable[[np.ndarray], np.ndarray], q_check: np.ndarray,
+                time_error: float, steps: int, time_ok: bool, time_message: str,
+                seconds: float, built: dict[str, int]) -> ContactSolution:
+        tol = self.geometry.tol
+        error = float(self.spatial_error + time_error)
+        success = error <= tol and self.resolved and time_ok
+        flags = []
+        if not self.resolved:
+            flags.append("unresolved_input")
+        if not success:
+            flags.append("tol_not_met")
+        q_scale = max(float(np.max(np.abs(q_check))), 1e-300)
+        min_q = float(np.min(q_check))
+        if min_q < -max(error, 1e-12) * q_scale:
+            flags.append("contact_lost")
+        n = self.grid.size
+        if success:
+            message = (f"converged: estimated error {error:.1e} <= tol {tol:.1e} "
+                       f"({n} nodes, {self.grid.panels.n_panels} panels)")
+        else:
+            reasons = []
+            if self.spatial_error > tol or not self.resolved:
+                reasons.append(f"the grid reached {self.grid.panels.n_panels} panels with "
+                               f"estimated error {self.spatial_error:.1e} in q")
+            if time_error > tol or not time_ok:
+                reasons.append(f"time stepping: {time_message} (estimated error "
+                               f"{time_error:.1e})")
+            message = f"tol {tol:.1e} not met: " + "; ".join(reasons or ["see the estimate"])
+        info = {
+            "method": "nystrom",
+            "error_estimate": error,
+            "spatial_error_estimate": float(self.spatial_error),
+            "time_error_estimate": float(time_error),
+            "seconds": seconds,
+            "prepare_seconds": self.seconds,
+            "flags": flags,
+            "success": bool(success),
+            "message": message,
+            "n_modes": n,
+            "n_nodes": n,
+            "n_panels": self.grid.panels.n_panels,
+            "n_steps": int(steps),
+            "statement": statement_number(inputs.given),
+            "given": sorted(inputs.given),
+            "min_pressure": min_q,
+            "max_pressure": q_scale,
+            "basis": "nystrom",
+            "element_ends": sorted(set(self.grid.panels.edges[1:-1].tolist())
+                                   | set(self.geometry.breakpoints)),
+            # "grid" is the geometric stage (prepared once); "bordered"/"modal" the
+            # factorization of a statement; "cached" says whether this solve built it.
+            "stages": {"grid": {"seconds": self.seconds, "cached": self._solves > 0},
+                       **{k: {"seconds": 0.0, "cached": built.get(k, 0) == 0}
+                          for k in ("bordered", "modal") if k in self.counts},
+                       "solve": {"seconds": seconds, "cached": False}},
+            "builds": dict(self.counts),
+        }
+        self._solves += 1
+        return ContactSolution(inputs.times.copy(), *(np.asarray(scalars[q], dtype=float)
+                                                      for q in QUANTITIES),
+                               info, None, None, None, self.geometry.m, self.geometry.g,
+                               pressure)
+
+
+def prepare(lam: float, m: Scalar, g: Scalar, *, breakpoints: Sequence[float] = (),
+            tol: float = 1e-8, method: str = "nystrom") -> Any:
+    """Discretize the geometry once (dimensionless); ``.solve(times, ...)`` takes the loads.
+
+    ``lam = a/H``; ``m(x) > 0`` the coating compliance; ``g(x) >= 0`` the gap; jumps of m
+    or g declared in ``breakpoints``; ``tol`` the relative accuracy target of delta,
+    alpha, P, M and of q on the whole of [-1, 1]. Only ``method="nystrom"`` has a prepared
+    form; ``solve_dimensionless(method="projection")`` runs the seed's method.
+    """
+    if method != "nystrom":
+        raise ValueError(f"method: prepare supports 'nystrom' only, got {method!r}")
+    return PreparedContact(validate_geometry(lam, m, g, breakpoints, tol))
+
+
+#: Prepared geometries kept for :func:`solve_with_prepared`, most recent last. A grid of
+#: 256 panels holds a 4096^2 operator (128 MiB); typical ones hold 0.5-5 MiB.
+_PREPARED: dict[str, PreparedContact] = {}
+_PREPARED_BYTES = 256 * 2**20
+
+
+def _geometry_key(geometry: Geometry) -> str:
+    from core.cache import fingerprint
+
+    probe = np.cos(np.linspace(0.0, np.pi, 2049))
+    bps = np.asarray(geometry.breakpoints, dtype=float)
+    probe = np.concatenate([probe, bps - 1e-9, bps + 1e-9])
+    return fingerprint("nystrom", geometry.lam, geometry.breakpoints, geometry.tol,
+                       geometry.m(probe), geometry.g(probe))
+
+
+def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scalar = 1.0,
+                        kernel: Callable | None = None, settlement: Scalar | None = None,
+                        tilt: Scalar | None = None, force: Scalar | None = None,
+                        moment: Scalar | None = None, breakpoints: Sequence[float] = (),
+                        tol: float = 1e-8) -> ContactSolution:
+    """``solve_dimensionless(method="nystrom")``: prepare (or reuse) the geometry, then solve.
+
+    Geometries are recognised by their values on 2049 Chebyshev points (and both sides of
+    each jump), so a repeated call with only other loads reuses the prepared grid.
+    """
+    geometry = validate_geometry(lam, m, g, breakpoints, tol)
+    inputs = validate_time_inputs(times, c, kernel, {"settlement": settlement, "tilt": tilt,
+                                                     "force": force, "moment": moment})
+    key = _geometry_key(geometry)
+    prepared = _PREPARED.pop(key, None)
+    if prepared is None:
+        prepared = PreparedContact(geometry)
+    _PREPARED[key] = prepared
+    total = sum(p.grid.operator.nbytes for p in _PREPARED.values())
+    while total > _PREPARED_BYTES and len(_PREPARED) > 1:
+        oldest = _PREPARED.pop(next(iter(_PREPARED)))
+        total -= oldest.grid.operator.nbytes
+    return prepared.solve_validated(inputs)

@@ -1,0 +1,171 @@
+"""The default engine (direct graded-panel Nystrom, core/nystrom.py, core/prepared.py).
+
+Accuracy is measured as the engine claims it: q on the whole of [-1, 1] (3001 Chebyshev
+points, both ends and both sides of every jump) relative to max|q|, and delta, alpha, P,
+M relative to their scales, against (a) the same engine at tol 1e-12 (convergence under
+refinement) and (b) the independent projection method at tol 1e-10 on interior points.
+The measured values quoted in the comments come from benchmarks/scenes.py's scenes on
+this version (errors/estimates 0.11-0.38 at tol 1e-4, 1e-6, 1e-8).
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+import pytest
+
+import core
+from benchmarks.scenes import jump_m, smooth_m, stepped_g, tiny_m
+from core.creep import Arutyunyan
+from core.solver import solve_dimensionless
+
+SCENES = {
+    "smooth": dict(lam=1.0, m=smooth_m, g=0.0, breakpoints=()),
+    "modulus_jump": dict(lam=1.0, m=jump_m, g=0.0, breakpoints=(0.3,)),
+    "stepped_punch": dict(lam=1.0, m=smooth_m, g=stepped_g, breakpoints=(-0.5, 0.25)),
+    "no_coating": dict(lam=1.0, m=tiny_m, g=0.0, breakpoints=()),
+}
+LOADS = {"force": 1.0, "moment": 0.1}
+
+
+def whole_interval(breakpoints) -> np.ndarray:
+    x = np.cos(np.linspace(0.0, np.pi, 3001))
+    for b in breakpoints:
+        x = np.concatenate([x[np.abs(x - b) > 1e-7], [b - 1e-9, b + 1e-9]])
+    return np.sort(x)
+
+
+@cache
+def reference(name: str):
+    s = SCENES[name]
+    return solve_dimensionless(s["lam"], s["m"], s["g"], [1.0], tol=1e-12,
+                               breakpoints=s["breakpoints"], **LOADS)
+
+
+def errors(sol, ref, x):
+    q, qr = sol.pressure(x)[:, 0], ref.pressure(x)[:, 0]
+    e_q = np.max(np.abs(q - qr)) / np.max(np.abs(qr))
+    kin = max(abs(ref.settlement[0]), abs(ref.tilt[0]))
+    e_kin = max(abs(sol.settlement[0] - ref.settlement[0]),
+                abs(sol.tilt[0] - ref.tilt[0])) / kin
+    return e_q, e_kin
+
+
+@pytest.mark.parametrize("tol", (1e-4, 1e-6, 1e-8))
+@pytest.mark.parametrize("name", list(SCENES))
+def test_estimate_is_never_below_the_error_on_the_whole_interval(name, tol):
+    # Measured error / estimate: smooth 0.24, 0.24, 0.11; jump 0.38, 0.38, 0.28; stepped
+    # 0.28, 0.28, 0.24; nearly uncoated 0.34, 0.34, 0.27: the estimate is the larger.
+    s = SCENES[name]
+    sol = solve_dimensionless(s["lam"], s["m"], s["g"], [1.0], tol=tol,
+                              breakpoints=s["breakpoints"], **LOADS)
+    assert sol.success, sol.message
+    e_q, e_kin = errors(sol, reference(name), whole_interval(s["breakpoints"]))
+    assert e_q <= sol.info["error_estimate"] <= tol
+    assert e_kin <= sol.info["error_estimate"]
+
+
+@pytest.mark.parametrize("name", ["smooth", "modulus_jump", "stepped_punch"])
+def test_agrees_with_the_projection_method(name):
+    # Independent method, interior q (|x| <= 0.95, 0.03 off jumps): measured 1.2e-9,
+    # 1.6e-8, 2.2e-8 (the projection's own error at tol 1e-9); scalars <= 2.5e-10.
+    s = SCENES[name]
+    sol = solve_dimensionless(s["lam"], s["m"], s["g"], [1.0], tol=1e-8,
+                              breakpoints=s["breakpoints"], **LOADS)
+    other = solve_dimensionless(s["lam"], s["m"], s["g"], [1.0], tol=1e-9,
+                                breakpoints=s["breakpoints"], method="projection", **LOADS)
+    x = np.linspace(-0.95, 0.95, 301)
+    x = x[[all(abs(v - b) > 0.03 for b in s["breakpoints"]) for v in x]]
+    qa, qb = sol.pressure(x), other.pressure(x)
+    assert np.max(np.abs(qa - qb)) / np.max(np.abs(qb)) < 5e-8
+    for q in ("settlement", "tilt"):
+        assert getattr(sol, q)[0] == pytest.approx(getattr(other, q)[0], rel=1e-8, abs=1e-9)
+
+
+@pytest.mark.parametrize("given", [("settlement", "tilt"), ("settlement", "moment"),
+                                   ("tilt", "force"), ("force", "moment")])
+def test_four_statements_reproduce_each_other(given):
+    # Solve statement 4, feed two of its answers into each statement: measured <= 3e-13.
+    base = solve_dimensionless(1.0, jump_m, stepped_g, [1.0], breakpoints=(-0.5, 0.25, 0.3),
+                               tol=1e-8, **LOADS)
+    loads = {q: float(getattr(base, q)[0]) for q in given}
+    sol = solve_dimensionless(1.0, jump_m, stepped_g, [1.0], breakpoints=(-0.5, 0.25, 0.3),
+                              tol=1e-8, **loads)
+    for q in ("settlement", "tilt", "force", "moment"):
+        assert getattr(sol, q)[0] == pytest.approx(getattr(base, q)[0], rel=1e-10, abs=1e-12)
+
+
+def test_equilibrium_on_the_engine_nodes():
+    prepared = core.prepare(0.7, jump_m, lambda x: 0.05 * x**2, breakpoints=[0.3], tol=1e-9)
+    sol = prepared.solve([1.0], force=1.3, moment=0.2)
+    nodes = prepared.grid.panels
+    q = sol.pressure(nodes.nodes)[:, 0]
+    # The Nystrom formula reproduces the nodal values, which balance P and M exactly:
+    # measured 4e-16 and 2e-16.
+    assert nodes.integrate(q) == pytest.approx(1.3, rel=1e-13)
+    assert nodes.integrate(nodes.nodes * q) == pytest.approx(0.2, rel=1e-13)
+
+
+def test_a_load_change_builds_nothing_geometric():
+    prepared = core.prepare(1.0, smooth_m, stepped_g, breakpoints=(-0.5, 0.25), tol=1e-7)
+    assert dict(prepared.counts) == {"grid": 1}
+    first = prepared.solve(np.linspace(1, 5, 9), force=1.0, moment=0.1)
+    builds = dict(prepared.counts)
+    x = np.linspace(-1, 1, 400)
+    first.pressure(x)
+    rows = prepared.counts["rows"]
+    for force in (0.5, 2.0, 3.0):
+        sol = prepared.solve(np.linspace(1, 5, 9), force=lambda t, f=force: f * t,
+                             moment=0.1)
+        sol.pressure(x)
+    assert prepared.counts["grid"] == builds["grid"] == 1
+    assert prepared.counts["bordered"] == builds["bordered"] == 1
+    assert prepared.counts["rows"] == rows  # rows at the same 400 points are cached
+    assert sol.force[-1] == pytest.approx(15.0)
+
+
+def test_many_output_times_equal_single_solves():
+    prepared = core.prepare(1.0, smooth_m, 0.0, tol=1e-8)
+    times = np.linspace(1.0, 100.0, 10_000)
+    sol = prepared.solve(times, force=lambda t: 1.0 + np.sin(t), moment=0.05)
+    for k in (0, 4321, 9999):
+        one = prepared.solve([times[k]], force=1.0 + np.sin(times[k]), moment=0.05)
+        assert sol.settlement[k] == pytest.approx(one.settlement[0], rel=1e-13)
+        assert sol.tilt[k] == pytest.approx(one.tilt[0], rel=1e-12, abs=1e-15)
+
+
+CONCRETE = Arutyunyan(modulus_final=3.0e10, beta=0.5, alpha=0.03, compliance_final=0.9e-11,
+                      aging=4.8e-10, rate=0.03)
+
+
+def test_aging_creep_agrees_with_the_projection_method():
+    # Modal form of the Nystrom equations, Radau time stepping; against the projection at
+    # tol 1e-9 over 200 days: measured q 2.7e-9, settlement and tilt 1.7e-9.
+    times = 1.0 + np.linspace(0.0, 200.0 / 28.0, 12)
+    kw = dict(c=CONCRETE.relative_modulus(28.0), kernel=CONCRETE.dimensionless_kernel(28.0),
+              **LOADS)
+    sol = solve_dimensionless(1.0, smooth_m, 0.0, times, tol=1e-7, **kw)
+    ref = solve_dimensionless(1.0, smooth_m, 0.0, times, tol=1e-9, method="projection", **kw)
+    assert sol.success, sol.message
+    scale = np.max(np.abs(ref.settlement))
+    assert np.max(np.abs(sol.settlement - ref.settlement)) / scale < 1e-7
+    assert np.max(np.abs(sol.tilt - ref.tilt)) / scale < 1e-7
+    x = np.linspace(-0.95, 0.95, 101)
+    q, qr = sol.pressure(x), ref.pressure(x)
+    assert np.max(np.abs(q - qr)) / np.max(np.abs(qr)) < 1e-7
+    # creep: the settlement grows under the constant load
+    assert np.all(np.diff(sol.settlement) > 0)
+
+
+def test_lost_contact_between_output_times_is_flagged():
+    # A moment that swings through M = 0.45 P between the outputs (t = 1, 2, 3 where it
+    # is 0): q < 0 at an edge only between them.
+    sol = solve_dimensionless(1.0, 1e-3, 0.0, [1.0, 2.0, 3.0], force=1.0,
+                              moment=lambda t: 0.45 * np.sin(np.pi * (t - 1.0)), tol=1e-6)
+    assert "contact_lost" in sol.flags
+
+
+def test_unknown_method_is_refused():
+    with pytest.raises(ValueError, match="method"):
+        solve_dimensionless(1.0, 0.1, 0.0, [1.0], force=1.0, moment=0.0, method="magic")
