@@ -16,6 +16,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from core.code_creep import creep_coefficient_curve
     from core.scene import (
         Scene,
         SceneSolution,
@@ -35,6 +36,7 @@ _EXPORTS: dict[str, str] = {
     "scene_from_dict": "core.scene",
     "load_scene": "core.scene",
     "save_scene": "core.scene",
+    "creep_coefficient_curve": "core.code_creep",
 }
 
 __all__ = [
@@ -46,6 +48,7 @@ __all__ = [
     "scene_from_dict",
     "load_scene",
     "save_scene",
+    "creep_coefficient_curve",
 ]
 
 

@@ -273,8 +273,15 @@ class RelativeCodeModulus:
         """The relative modulus at dimensionless times ``t*``."""
         modulus = _FORMULAS[self.inputs.model][0]
         tau0 = self.age_at_loading
-        return modulus(self.inputs, tau0 * np.asarray(t, dtype=float)) / modulus(
-            self.inputs, tau0)
+        return modulus(self.inputs, tau0 * np.asarray(t, dtype=float)) / self._at_loading
+
+    @property
+    def _at_loading(self) -> float:
+        value = self.__dict__.get("_e0")
+        if value is None:
+            value = float(_FORMULAS[self.inputs.model][0](self.inputs, self.age_at_loading))
+            object.__setattr__(self, "_e0", value)
+        return value
 
     def log_slope(self, t: Any) -> np.ndarray:
         """``c'(t*)/c(t*)`` [-]."""

@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
-from core.cache import StageCache
+from core.cache import StageCache, fingerprint
 
 ArrayLike = Any
 
@@ -68,6 +68,8 @@ PER_DECADE = 3
 AGE_NODES = 24
 #: The shortest retardation time, as a fraction of ``resolution``.
 THETA_BELOW_RESOLUTION = 1e-3
+#: Ridge weight of the direct fit of a general kernel, relative to its weighted rows.
+RIDGE = 1e-6
 #: Relative allowance of the age range (the solver's stage times may round past the end).
 _AGE_SLACK = 1e-9
 
@@ -92,6 +94,7 @@ class FittedKernel:
     fit_error: float
     resolution: float
     key: tuple
+    direct: bool = False               # coef holds b (column 0) and a_r, not A_r
 
     @property
     def rates(self) -> np.ndarray:
@@ -104,8 +107,19 @@ class FittedKernel:
         return float(self.edges[-1])
 
     def amplitudes(self, tau: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """``A_r(tau)`` and ``dA_r/dtau``, each of shape (R,) + tau.shape."""
+        """``A_r(tau)`` and ``dA_r/dtau``, each of shape (R,) + tau.shape (for a direct
+        fit: ``b`` and the ``a_r`` stacked, and zeros)."""
         tau = np.asarray(tau, dtype=float)
+        # the time stepping asks for b and a_r at the same stage times, one after the other
+        memo = self.__dict__.get("_last")
+        token = (tau.shape, tau.tobytes())
+        if memo is not None and memo[0] == token:
+            return memo[1]
+        result = self._amplitudes(tau)
+        object.__setattr__(self, "_last", (token, result))
+        return result
+
+    def _amplitudes(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         flat = tau.ravel()
         lo, hi = 1.0 - _AGE_SLACK, self.end * (1.0 + _AGE_SLACK)
         bad = ~((flat >= lo) & (flat <= hi))
@@ -114,18 +128,19 @@ class FittedKernel:
                              f"asked at {flat[bad][0]:.6g}")
         n_pieces = self.coef.shape[0]
         piece = np.clip(np.searchsorted(self.edges, flat, side="right") - 1, 0, n_pieces - 1)
-        amp = np.empty((flat.size, self.thetas.size))
+        amp = np.empty((flat.size, self.coef.shape[2]))
         slope = np.empty_like(amp)
         for p in range(n_pieces):
             sel = piece == p if n_pieces > 1 else slice(None)
             a, b = np.log(self.edges[p]), np.log(self.edges[p + 1])
             x = np.clip(2.0 * (np.log(np.clip(flat[sel], self.edges[p], self.edges[p + 1]))
                                - a) / (b - a) - 1.0, -1.0, 1.0)
-            vander = cheb.chebvander(x, self.coef.shape[1] - 1)
+            # T_k(x) = cos(k arccos x): one call instead of chebvander's recurrence loop
+            vander = np.cos(np.arccos(x)[:, None] * np.arange(self.coef.shape[1])[None, :])
             amp[sel] = vander @ self.coef[p]
             slope[sel] = (vander @ self.dcoef[p]) * (2.0 / (b - a) / np.maximum(
                 flat[sel], 1.0))[:, None]
-        shape = (self.thetas.size,) + tau.shape
+        shape = (self.coef.shape[2],) + tau.shape
         return amp.T.reshape(shape), slope.T.reshape(shape)
 
     def _modulus(self, tau: np.ndarray) -> tuple[np.ndarray | float, np.ndarray | float]:
@@ -137,6 +152,8 @@ class FittedKernel:
     def tau_part(self, tau: ArrayLike) -> np.ndarray:
         """``b(tau)`` [-], the part of the kernel that does not depend on ``t``."""
         tau = np.asarray(tau, dtype=float)
+        if self.direct:
+            return self.amplitudes(tau)[0][0]
         _, slope = self.amplitudes(tau)
         e, log_slope = self._modulus(tau)
         return -log_slope + e * slope.sum(axis=0)
@@ -145,6 +162,8 @@ class FittedKernel:
         """``a_r(tau)`` [-], amplitudes of ``exp(-rate_r (t - tau))``; shape (R,) + tau.shape."""
         tau = np.asarray(tau, dtype=float)
         amp, slope = self.amplitudes(tau)
+        if self.direct:
+            return amp[1:]
         e, _ = self._modulus(tau)
         theta = self.thetas.reshape((-1,) + (1,) * tau.ndim)
         return -e * (slope + amp / theta)
@@ -159,8 +178,11 @@ class FittedKernel:
         return np.where(t >= tau, value, 0.0)
 
     def compliance(self, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
-        """The fitted ``J~(t, tau) = 1/e(tau) + sum_r A_r(tau)(1 - exp(-(t - tau)/theta_r))``."""
+        """The fitted ``J~(t, tau) = 1/e(tau) + sum_r A_r(tau)(1 - exp(-(t - tau)/theta_r))``
+        (for a direct fit ``1 - int_tau^t K~(t, u) du`` by quadrature)."""
         t, tau = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(tau, dtype=float))
+        if self.direct:
+            return 1.0 + integrated_kernel(self, t, tau)
         lag = np.maximum(t - tau, 0.0)
         amp, _ = self.amplitudes(tau)
         e, _ = self._modulus(tau)
@@ -193,6 +215,12 @@ def _age_nodes(lo: float, hi: float, n: int) -> tuple[np.ndarray, np.ndarray]:
     return x, np.exp(np.log(lo) + 0.5 * (x + 1.0) * np.log(hi / lo))
 
 
+def _test_points(x_nodes: np.ndarray) -> np.ndarray:
+    """Both ends and the points half-way between neighbours of [-1, nodes, 1]."""
+    xs = np.concatenate([[-1.0], np.sort(x_nodes), [1.0]])
+    return np.concatenate([[-1.0], 0.5 * (xs[1:] + xs[:-1]), [1.0]])
+
+
 def _fit(creep: Callable, modulus: Callable | None, log_slope: Callable | None, end: float,
          breaks: tuple[float, ...], resolution: float, per_decade: float, age_nodes: int,
          key: tuple) -> FittedKernel:
@@ -220,8 +248,7 @@ def _fit(creep: Callable, modulus: Callable | None, log_slope: Callable | None, 
         coef[p] = cheb.chebfit(x_nodes, amplitudes, age_nodes - 1)
         dcoef[p, :-1] = cheb.chebder(coef[p])
         # independent check: ages half-way between the nodes (in x) and at both ends
-        xs = np.sort(x_nodes)
-        x_test = np.concatenate([[-1.0], 0.5 * (xs[1:] + xs[:-1]), [1.0]])
+        x_test = _test_points(x_nodes)
         age_test.append(np.exp(np.log(edges[p]) + 0.5 * (x_test + 1.0)
                                * np.log(edges[p + 1] / edges[p])))
     fitted = FittedKernel(thetas, edges, coef, dcoef, modulus, log_slope, np.inf,
@@ -292,26 +319,71 @@ def integrated_kernel(kernel: Callable, t: ArrayLike, tau: ArrayLike) -> np.ndar
     return -lag * (values @ _LAG_WEIGHTS)
 
 
+def _fit_direct(kernel: Callable, end: float, resolution: float, per_decade: float,
+                age_nodes: int, key: tuple) -> FittedKernel:
+    """Least-squares fit of ``K(tau + d, tau)`` over durations d at Chebyshev ages."""
+    thetas, durations, test = _grids(end, resolution, per_decade)
+    durations = np.concatenate([[0.0], durations])
+    # rows weighted by the duration they stand for (the integral of K is what counts)
+    weight = np.concatenate([[THETA_BELOW_RESOLUTION * resolution], durations[1:]])
+    columns = np.hstack([np.ones((durations.size, 1)),
+                         np.exp(-durations[:, None] / thetas[None, :])])
+    x_nodes, ages = _age_nodes(1.0, end, age_nodes)
+    # every age sees the same durations (up to the whole span, past the end for late
+    # ages), so the fit is one linear map of smooth data and smooth in the age
+    values = np.asarray(kernel(ages[:, None] + durations[None, :],
+                               np.broadcast_to(ages[:, None], (ages.size, durations.size))),
+                        dtype=float)
+    if not np.all(np.isfinite(values)):
+        raise ValueError("creep kernel: not finite where it is fitted")
+    rows = columns * weight[:, None]
+    lhs = np.vstack([rows, RIDGE * float(np.linalg.norm(rows)) * np.eye(thetas.size + 1)])
+    rhs = np.vstack([(values * weight[None, :]).T, np.zeros((thetas.size + 1, age_nodes))])
+    parts = np.linalg.lstsq(lhs, rhs, rcond=None)[0].T
+    coef = cheb.chebfit(x_nodes, parts, age_nodes - 1)[None]
+    fitted = FittedKernel(thetas, np.array([1.0, end]), coef, np.zeros_like(coef), None,
+                          None, np.inf, float(resolution), key, direct=True)
+    x_test = _test_points(x_nodes)
+    age_test = np.exp(0.5 * (x_test + 1.0) * np.log(end))
+    t_test = np.minimum(age_test[:, None] + test[None, :], end)
+    tau_test = np.broadcast_to(age_test[:, None], t_test.shape)
+    exact = 1.0 + integrated_kernel(kernel, t_test, tau_test)
+    error = float(np.max(np.abs(fitted.compliance(t_test, tau_test) - exact) / np.abs(exact)))
+    return FittedKernel(thetas, np.array([1.0, end]), coef, np.zeros_like(coef), None, None,
+                        error if np.isfinite(error) else np.inf, float(resolution), key,
+                        direct=True)
+
+
 def fit_kernel(kernel: Callable[[np.ndarray, np.ndarray], np.ndarray], *, end: float,
                resolution: float | None = None, key: Hashable | None = None,
                per_decade: float = PER_DECADE, age_nodes: int = AGE_NODES) -> FittedKernel:
     """Fit a general dimensionless kernel ``K(t, tau)`` on ``1 <= tau <= t <= end`` (cached).
 
-    The compliance ``J(t, tau) = 1 - int_tau^t K(t, u) du`` (constant modulus) is fitted
-    as in :func:`fit_compliance`; ``resolution`` defaults to ``1e-6 (end - 1)``. ``key``
-    identifies the kernel (default: the kernel object itself, which must be hashable).
+    The kernel itself is fitted (``b(tau)`` and ``a_r(tau)`` by least squares in the
+    duration at Chebyshev nodes in ``ln tau``, interpolated between them): its compliance
+    ``J = 1 - int K`` need not grow monotonically (an aging modulus inside ``K`` bends it
+    back), so the non-negative spectrum of :func:`fit_compliance` does not apply, and an
+    unconstrained fit of ``J`` has rough amplitudes whose age slopes would spoil ``K``.
+    ``fit_error`` is the relative error of ``J`` on the independent grid, both ``J`` by
+    graded quadrature. ``resolution`` defaults to ``1e-6 (end - 1)``; ``key`` identifies
+    the kernel (default: a fingerprint of its values on 529 fixed pairs).
     """
     span = float(end) - 1.0
     if not span > 0:
         raise ValueError(f"end: must be > 1, got {end!r}")
     res = 1e-6 * span if resolution is None else float(resolution)
-    ident = ("kernel", kernel if key is None else key)
-
-    def creep(t: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        return integrated_kernel(kernel, t, tau)
-
-    return fit_compliance(creep, end=end, resolution=res, key=ident, per_decade=per_decade,
-                          age_nodes=age_nodes)
+    if key is None:
+        # identified by its values on a fixed set of pairs (a plain callable has no
+        # content to hash, and its id may be reused once it is gone)
+        u = np.linspace(0.0, 1.0, 23)
+        tau_probe = 1.0 + span * u[:, None] ** 2
+        t_probe = tau_probe + (end - tau_probe) * u[None, :] ** 3
+        key = fingerprint(np.asarray(kernel(t_probe, np.broadcast_to(tau_probe, t_probe.shape)),
+                                     dtype=float))
+    full_key = ("kernel", key, float(end), res, float(per_decade), int(age_nodes))
+    fitted, _ = _FITS.get_or_compute(full_key, lambda: _fit_direct(
+        kernel, float(end), res, per_decade, age_nodes, full_key))
+    return fitted
 
 
 def nonpositive_violation(fitted: FittedKernel, samples: int = 41) -> float:
