@@ -135,8 +135,11 @@ class FittedKernel:
             a, b = np.log(self.edges[p]), np.log(self.edges[p + 1])
             x = np.clip(2.0 * (np.log(np.clip(flat[sel], self.edges[p], self.edges[p + 1]))
                                - a) / (b - a) - 1.0, -1.0, 1.0)
-            # T_k(x) = cos(k arccos x): one call instead of chebvander's recurrence loop
-            vander = np.cos(np.arccos(x)[:, None] * np.arange(self.coef.shape[1])[None, :])
+            if x.size <= 64:
+                # T_k(x) = cos(k arccos x): one call where chebvander's loop would dominate
+                vander = np.cos(np.arccos(x)[:, None] * np.arange(self.coef.shape[1])[None, :])
+            else:
+                vander = cheb.chebvander(x, self.coef.shape[1] - 1)
             amp[sel] = vander @ self.coef[p]
             slope[sel] = (vander @ self.dcoef[p]) * (2.0 / (b - a) / np.maximum(
                 flat[sel], 1.0))[:, None]
