@@ -124,8 +124,9 @@ class FittedKernel:
         lo, hi = 1.0 - _AGE_SLACK, self.end * (1.0 + _AGE_SLACK)
         bad = ~((flat >= lo) & (flat <= hi))
         if bad.any():
-            raise ValueError(f"creep kernel: fitted for dimensionless ages 1 to {self.end:.6g}, "
-                             f"asked at {flat[bad][0]:.6g}")
+            raise ValueError(f"creep kernel: fitted for dimensionless ages 1 to {self.end:.6g} "
+                             f"(age over the age at loading), asked at {flat[bad][0]:.6g}: "
+                             "the times reach beyond the range it was fitted for")
         n_pieces = self.coef.shape[0]
         piece = np.clip(np.searchsorted(self.edges, flat, side="right") - 1, 0, n_pieces - 1)
         amp = np.empty((flat.size, self.coef.shape[2]))

@@ -266,6 +266,11 @@ def test_ages_outside_the_range_are_named():
     data["base"]["age_at_loading"] = 0.5
     with pytest.raises(ValueError, match=r"^base\.age_at_loading: must be in \[1, 3650\]"):
         scene_from_dict(data)
+    data["base"]["age_at_loading"] = 7.0
+    data["times"]["end"] = 40000.0  # beyond the 100 years the code kernels are fitted for
+    with pytest.raises(ValueError, match=r"^base\.creep: creep kernel: fitted for .* the "
+                                         "times reach beyond"):
+        scene_from_dict(data)
     model = CodeCreep("eurocode2", C30)
     with pytest.raises(ValueError, match="durations"):
         creep_coefficient_curve({"model": "eurocode2", **C30}, 28.0, [-1.0])
