@@ -319,25 +319,32 @@ def integrated_kernel(kernel: Callable, t: ArrayLike, tau: ArrayLike) -> np.ndar
     t, tau = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(tau, dtype=float))
     lag = np.maximum(t - tau, 0.0)
     u = t[..., None] - lag[..., None] * _LAG_NODES
-    values = np.asarray(kernel(np.broadcast_to(t[..., None], u.shape), u), dtype=float)
-    return -lag * (values @ _LAG_WEIGHTS)
+    values = np.broadcast_to(np.asarray(kernel(np.broadcast_to(t[..., None], u.shape), u),
+                                        dtype=float), u.shape)
+    # nodes closer to t than rounding can tell apart see t - u = 0 (where a weakly singular
+    # kernel is infinite): they are left out, a part of the integral of the order of
+    # K times 1e-15 t
+    resolved = lag[..., None] * _LAG_NODES > 8.0 * np.finfo(float).eps * np.maximum(
+        np.abs(t[..., None]), 1.0)
+    return -lag * (np.where(resolved, values, 0.0) @ _LAG_WEIGHTS)
 
 
 def _fit_direct(kernel: Callable, end: float, resolution: float, per_decade: float,
                 age_nodes: int, key: tuple) -> FittedKernel:
     """Least-squares fit of ``K(tau + d, tau)`` over durations d at Chebyshev ages."""
     thetas, durations, test = _grids(end, resolution, per_decade)
-    durations = np.concatenate([[0.0], durations])
-    # rows weighted by the duration they stand for (the integral of K is what counts)
-    weight = np.concatenate([[THETA_BELOW_RESOLUTION * resolution], durations[1:]])
+    # rows weighted by the duration they stand for (the integral of K is what counts);
+    # no row at zero duration, where a weakly singular kernel is infinite
+    weight = durations
     columns = np.hstack([np.ones((durations.size, 1)),
                          np.exp(-durations[:, None] / thetas[None, :])])
     x_nodes, ages = _age_nodes(1.0, end, age_nodes)
     # every age sees the same durations (up to the whole span, past the end for late
     # ages), so the fit is one linear map of smooth data and smooth in the age
-    values = np.asarray(kernel(ages[:, None] + durations[None, :],
-                               np.broadcast_to(ages[:, None], (ages.size, durations.size))),
-                        dtype=float)
+    shape = (ages.size, durations.size)
+    values = np.broadcast_to(np.asarray(kernel(ages[:, None] + durations[None, :],
+                                               np.broadcast_to(ages[:, None], shape)),
+                                        dtype=float), shape)
     if not np.all(np.isfinite(values)):
         raise ValueError("creep kernel: not finite where it is fitted")
     rows = columns * weight[:, None]
