@@ -178,7 +178,6 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     w_scale, u_scale = _scales(problem, float(times[-1]))
     scale = np.concatenate([w_scale, u_scale])
     span = max(float(times[-1]) - 1.0, 1e-300)
-    log_span = max(float(np.log(times[-1])), 1e-300)
     # A tenth of tol per unit of time, so the accumulated error stays below tol.
     local_tol = 0.1 * tol
 
@@ -217,11 +216,7 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         # Richardson: the two-half-step answer carries 1/(2^p - 1) of the difference.
         err = float(np.max(diff, initial=0.0)) / (2**RADAU_ORDER - 1)
         # Below ~100 ulp the step-doubling difference is round-off, not truncation error.
-        # The budget is shared half per unit of time, half per unit of log-time: creep is
-        # fastest just after loading, and over decades a per-time share alone would ask
-        # the first days for the accuracy of the last years. The shares sum to local_tol.
-        share = 0.5 * (h_try / span + np.log1p(h_try / t_now) / log_span)
-        allowed = max(local_tol * max(share, 1e-6), 100 * np.finfo(float).eps)
+        allowed = max(local_tol * max(h_try / span, 1e-6), 100 * np.finfo(float).eps)
         if err > allowed and h_try > 1e-10 * span:
             rejected += 1
             h = h_try * max(0.2, 0.9 * (allowed / err) ** (1 / (RADAU_ORDER + 1)))
