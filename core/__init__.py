@@ -18,6 +18,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from core.code_creep import creep_coefficient_curve
     from core.prepared import prepare
     from core.scene import (
         Scene,
@@ -39,6 +40,7 @@ _EXPORTS: dict[str, str] = {
     "scene_from_dict": "core.scene",
     "load_scene": "core.scene",
     "save_scene": "core.scene",
+    "creep_coefficient_curve": "core.code_creep",
 }
 
 __all__ = [
@@ -51,6 +53,7 @@ __all__ = [
     "scene_from_dict",
     "load_scene",
     "save_scene",
+    "creep_coefficient_curve",
 ]
 
 

@@ -46,6 +46,8 @@ from typing import Any
 
 import numpy as np
 
+from core.code_creep import SPEC_FIELDS as _CODE_SPEC_FIELDS
+from core.code_creep import CodeCreep
 from core.validation import (
     PYTHON_STYLE,
     finite_number,
@@ -521,7 +523,7 @@ class UserKernel:
         return {"model": "kernel", "modulus": self.instantaneous_modulus, "expr": self.expr}
 
 
-CreepModel = Elastic | ExponentialCreep | Arutyunyan | PronySeries | UserKernel
+CreepModel = Elastic | ExponentialCreep | Arutyunyan | PronySeries | UserKernel | CodeCreep
 
 #: Spec fields of each model: (required, optional).
 _SPEC_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
@@ -531,6 +533,7 @@ _SPEC_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "exponential": (("modulus", "compliance", "rate"), ()),
     "kernel": (("modulus", "expr"), ()),
     "prony": (("modulus", "terms"), ()),
+    **_CODE_SPEC_FIELDS,
 }
 KNOWN_MODELS: tuple[str, ...] = tuple(sorted(_SPEC_FIELDS))
 _TERM_FIELDS = (("compliance", "rate"), ("aging",))
@@ -559,7 +562,11 @@ def creep_model_from_spec(spec: dict, *, field: str = "base.creep") -> CreepMode
     "compliance", "rate"}``, ``{"model": "arutyunyan", "modulus_final", "beta", "alpha",
     "compliance_final", "aging", "rate"}``, ``{"model": "prony", "modulus", "terms":
     [{"compliance", "aging" (default 0), "rate"}, ...]}``, ``{"model": "kernel",
-    "modulus", "expr"}`` (``expr`` a formula in ``t`` and ``tau`` giving ``K`` in 1/day).
+    "modulus", "expr"}`` (``expr`` a formula in ``t`` and ``tau`` giving ``K`` in 1/day),
+    and the design-code models ``{"model": "fib_mc2010" | "eurocode2", "fcm" [MPa] or
+    "strength_class" ("C30/37"), "cement" ("S", "N", "R"; default "N"),
+    "relative_humidity" [%], "notional_size" [mm], "temperature" [deg C, default 20]}``
+    (code units, see :mod:`core.code_creep`).
     Errors are ValueErrors whose message starts with the offending field under ``field``.
     """
     if not isinstance(spec, Mapping):
@@ -573,6 +580,8 @@ def creep_model_from_spec(spec: dict, *, field: str = "base.creep") -> CreepMode
         raise ValueError(f"{field}.model: unknown model {name!r}; known models: {known}")
     _check_keys(spec, _SPEC_FIELDS[name], field, f"model {name!r}", ignore=("model",))
 
+    if name in _CODE_SPEC_FIELDS:
+        return CodeCreep(name, dict(spec), field)
     if name == "elastic":
         return Elastic(_positive(spec["modulus"], f"{field}.modulus"))
     if name == "exponential":

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from core.inputs import Geometry, Scalar, TimeInputs, validate_geometry, validate_time_inputs
+from core.kernel_fit import stepping_kernel
 from core.nystrom import BorderedSystem, adapt
 from core.nystrom_time import ModalForm
 from core.solver import ContactSolution
@@ -186,7 +187,9 @@ class PreparedContact:
             form = self.modal(inputs.given)
             time_tol = geometry.tol / TIME_SHARE
             merged = np.union1d(times, probe)
-            answer = form.solve(merged, inputs.c, inputs.kernel, inputs.loads, time_tol)
+            kernel, fit_error = stepping_kernel(inputs.kernel, float(times[-1]),
+                                                0.5 * geometry.tol)
+            answer = form.solve(merged, inputs.c, kernel, inputs.loads, time_tol)
             c_merged = inputs.c(merged)
             sc = answer.scalars
 
@@ -199,7 +202,7 @@ class PreparedContact:
             at = np.searchsorted(merged, times)
             scalars = {k: v[at] for k, v in sc.items()}
             q_check = merged_pressure(self._check_x, slice(None))
-            time_error, steps = answer.time_error, answer.steps
+            time_error, steps = answer.time_error + fit_error, answer.steps
             time_ok, time_message = answer.success, answer.message
 
             def pressure(x: np.ndarray) -> np.ndarray:

@@ -1000,7 +1000,7 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
         def g_value(xs: np.ndarray) -> np.ndarray:
             return (scene.gap_variation(a * np.asarray(xs, dtype=float)) - g_min) / a
 
-    c_value = creep.relative_modulus(tau0)
+    c_value = creep.relative_modulus(tau0, field="base.age_at_loading")
     aging = callable(c_value)
 
     def days(ts: np.ndarray) -> np.ndarray:
@@ -1031,7 +1031,7 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
         m=m_value,
         g=g_value,
         c=c_value,
-        kernel=creep.dimensionless_kernel(tau0),
+        kernel=creep.dimensionless_kernel(tau0, field="base.age_at_loading"),
         loads=loads,
         times=times_star,
         breakpoints=tuple(b / a for b in scene.breakpoints),

@@ -643,6 +643,15 @@ def _extrapolated_error(diffs: list[float]) -> float:
 # ----------------------------------------------------------------------- the solver
 
 
+def _fast_kernel(inp: _Inputs) -> tuple[_Inputs, float]:
+    """The kernel to step with, and the error of its fit (see core.kernel_fit.stepping_kernel)."""
+    from core.kernel_fit import stepping_kernel
+
+    kernel, fit_error = stepping_kernel(inp.kernel, float(inp.times[-1]),
+                                        0.5 * inp.tol / SUCCESS_MARGIN)
+    return replace(inp, kernel=kernel), fit_error
+
+
 def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | np.ndarray,
                         *, c: Scalar = 1.0, kernel: Callable | None = None,
                         settlement: Scalar | None = None, tilt: Scalar | None = None,
@@ -692,6 +701,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                     breakpoints, tol)
     if basis not in ("piecewise", "global", "graded"):
         raise ValueError(f"basis: must be 'piecewise', 'global' or 'graded', got {basis!r}")
+    inp, kernel_fit_error = _fast_kernel(inp)
     if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int)
                                 or not 2 <= n_modes <= BASIS_CAPS[-1]):
         raise ValueError(f"n_modes: must be an integer in [2, {BASIS_CAPS[-1]}], got {n_modes}")
@@ -778,7 +788,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
             spatial_error = max(spatial_error, _extrapolated_error(creep_diffs), ERROR_FLOOR)
     stages["time"] = {"seconds": _time.perf_counter() - t_time, "cached": time_cached}
 
-    error_estimate = float(spatial_error + chosen.time_error)
+    error_estimate = float(spatial_error + chosen.time_error + kernel_fit_error)
     success = error_estimate * SUCCESS_MARGIN <= tol and chosen.time_success
     if not disc.resolved:
         flags.append("unresolved_input")
@@ -804,6 +814,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         if chosen.time_error * SUCCESS_MARGIN > tol or not chosen.time_success:
             reasons.append(f"time stepping: {chosen.time_message} (estimated error "
                            f"{chosen.time_error:.1e})")
+        if kernel_fit_error * SUCCESS_MARGIN > tol:
+            reasons.append(f"the creep kernel's exponential fit has error {kernel_fit_error:.1e}")
         message = (f"tol {tol:.1e} not met (success needs the estimate below tol/"
                    f"{SUCCESS_MARGIN:g}): " + "; ".join(reasons))
     if not disc.resolved:
@@ -813,6 +825,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         "error_estimate": error_estimate,
         "spatial_error_estimate": float(spatial_error),
         "time_error_estimate": float(chosen.time_error),
+        "kernel_fit_error": float(kernel_fit_error),
         "seconds": _time.perf_counter() - t_start,
         "flags": flags,
         "success": bool(success),

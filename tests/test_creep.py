@@ -452,7 +452,8 @@ def _term(r, **changes):
 
 _DROP = object()
 DECREASE = ": a negative value makes the compliance decrease in time, which is not creep"
-KNOWN = "known models: arutyunyan, elastic, exponential, kernel, prony"
+KNOWN = ("known models: arutyunyan, elastic, eurocode2, exponential, fib_mc2010, kernel, "
+         "prony")
 
 BAD_SPECS = [
     (_with(EXP, rate=-1), "base.creep.rate: must be > 0, got -1"),
@@ -566,4 +567,5 @@ def test_bad_python_call_is_refused(call, message):
 
 
 def test_known_models_listed():
-    assert KNOWN_MODELS == ("arutyunyan", "elastic", "exponential", "kernel", "prony")
+    assert KNOWN_MODELS == ("arutyunyan", "elastic", "eurocode2", "exponential", "fib_mc2010",
+                            "kernel", "prony")

@@ -72,10 +72,11 @@ DELETE = object()
 # ------------------------------------------------------------------------ shipped scenes
 
 
-def test_there_are_six_shipped_scenes():
+def test_there_are_seven_shipped_scenes():
     names = {p.name for p in SCENE_FILES}
     assert names == {"uniform_flat.json", "worn_coating.json", "patched_insert.json",
-                     "rounded_graded.json", "eccentric_creep.json", "stepped_punch.json"}
+                     "rounded_graded.json", "eccentric_creep.json", "stepped_punch.json",
+                     "young_concrete_50_years.json"}
 
 
 @pytest.mark.parametrize("path", SCENE_FILES, ids=lambda p: p.stem)
