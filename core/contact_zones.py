@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.polynomial import legendre as npleg
+from scipy.linalg import lu_factor, lu_solve
 from scipy.optimize import brentq
 
 from core.quadrature import NODES_PER_PANEL, Panels, base_panels, kernel_operator, operator_rows
@@ -111,8 +112,41 @@ def subset(panels: Panels, keep: np.ndarray) -> Panels:
                   panels.weights[node_keep], panels.centers[keep], panels.half_widths[keep])
 
 
+class StepSolver:
+    """Solves the bordered systems of one panel rule, keeping the last factorization.
+
+    Consecutive creep steps change only ``c`` and ``scale`` by a little, and the contact
+    set rarely: the kept LU factors of the last matrix with the same contact nodes
+    precondition a few steps of iterative refinement (each O(N^2)) instead of a new
+    factorization (O(N^3)); a new one is made when the refinement does not converge
+    within ``_REFINE_STEPS`` steps.
+    """
+
+    _REFINE_STEPS = 12
+
+    def __init__(self) -> None:
+        self._key: tuple | None = None
+        self._lu = None
+        self.factorizations = 0
+
+    def solve(self, a: np.ndarray, b: np.ndarray, key: tuple) -> np.ndarray:
+        if self._key == key and self._lu is not None:
+            x = lu_solve(self._lu, b, check_finite=False)
+            scale = max(float(np.max(np.abs(b))), 1e-300)
+            for _ in range(self._REFINE_STEPS):
+                r = b - a @ x
+                if float(np.max(np.abs(r))) <= 1e-14 * scale:
+                    return x
+                x = x + lu_solve(self._lu, r, check_finite=False)
+        self._lu = lu_factor(a, check_finite=False)
+        self._key = key
+        self.factorizations += 1
+        return lu_solve(self._lu, b, check_finite=False)
+
+
 def _bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, step: Step,
-                    rhs: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, float, float]:
+                    rhs: np.ndarray, idx: np.ndarray,
+                    solver: StepSolver | None = None) -> tuple[np.ndarray, float, float]:
     """Solve the equation on the nodes ``idx`` (q = 0 elsewhere) with the given loads.
 
     Returns (q on idx, settlement, tilt). ``rhs`` = ``delta_g + alpha_g x - g + e`` at all
@@ -139,7 +173,11 @@ def _bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray,
         a[:n, n:] = np.array(cols).T
         a[n:, :n] = np.array(rows)
         a[n:, n:] = 0.0
-    sol = np.linalg.solve(a, np.concatenate([rhs[idx], extra]))
+    b = np.concatenate([rhs[idx], extra])
+    if solver is None:
+        sol = np.linalg.solve(a, b)
+    else:
+        sol = solver.solve(a, b, (idx.tobytes(), tuple(sorted(given))))
     tail = list(sol[n:])
     delta = tail.pop(0) if "settlement" not in given else given["settlement"]
     alpha = tail.pop(0) if "tilt" not in given else given["tilt"]
@@ -152,8 +190,8 @@ def _given_rhs(step: Step, x: np.ndarray, g: np.ndarray, memory: np.ndarray | No
 
 
 def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarray, step: Step,
-                     memory: np.ndarray | None = None,
-                     start: np.ndarray | None = None) -> tuple[NodalState, int, bool]:
+                     memory: np.ndarray | None = None, start: np.ndarray | None = None,
+                     solver: StepSolver | None = None) -> tuple[NodalState, int, bool]:
     """Primal-dual active set on the nodes of ``panels``.
 
     ``op`` is the Nystrom matrix of F there, ``m``, ``g`` and ``memory`` (e(x)) the node
@@ -182,7 +220,7 @@ def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarra
         elif idx.size < 3 and not {"settlement", "tilt"} <= set(step.given):
             raise NoContact("the contact shrinks to a point")
         else:
-            q[idx], delta, alpha = _bordered_solve(op, m, x, w, step, rhs, idx)
+            q[idx], delta, alpha = _bordered_solve(op, m, x, w, step, rhs, idx, solver)
         nystrom = (delta + alpha * x - g + (0.0 if memory is None else memory)
                    - step.scale * (op @ q)) / (step.c * m)
         # Keep the contact nodes the equation solved exactly (rounding must not flip them).
@@ -359,13 +397,15 @@ def _walls(ends: list[float], pinned: list[bool], k: int) -> tuple[float, float]
 
 
 def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[bool],
-                     slopes: list[float], res: Resolution, *, tol: float) -> Refined:
+                     slopes: list[float], res: Resolution, *, tol: float,
+                     max_levels: int = MAX_LEVELS) -> Refined:
     """Locate every free end as the root of ``Q(end) = 0`` and estimate the error.
 
     Quasi-Newton (Broyden) on the free ends, starting from the Jacobian ``diag(dQ/dx)``
     of the nodal estimate; at each resolution the converged ends are checked against the
     next finer rule (their shift ``-J^-1 dQ`` and the change of the outputs); the
-    resolution is refined until both meet ``ZONE_END_TOL`` and ``tol`` (a third of each).
+    resolution is refined until both meet ``ZONE_END_TOL`` and ``tol`` (a third of each),
+    at most ``max_levels`` times.
     """
     ends = list(ends)
     pinned = list(pinned)
@@ -379,7 +419,7 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
     converged = not free
     end_error = output_error = np.inf
     level = 0
-    for _ in range(MAX_LEVELS):
+    for _ in range(max_levels):
         level += 1
         if free:
             r = sol.end_values[free] / sol.q_scale
