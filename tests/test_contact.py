@@ -199,13 +199,14 @@ def test_active_set_agrees_with_a_complementarity_solver(moment):
 
 def test_two_zones_meet_the_contact_conditions():
     # The refined answer: q >= 0 on the zones, q(end) = 0 at the free ends, equilibrium,
-    # and the gap open between the zones. Measured: Q(end) 1.7e-15 of max q; force and
+    # and the gap open between the zones. Measured: Q(end) 0 (clipped) to 1.7e-15 of
+    # max q; end error estimate 1.5e-10; force and
     # moment by the trapezoid rule on 2001 points 1.5e-5 / 3.0e-5 off (the rule's error).
     r = solve_unilateral(1.0, 0.05, worn_patch, [1.0], force=0.01, moment=0.002)
     zones = r.contact_set[0]
     assert len(zones) == 2 and zones[0][0] == -1.0 and zones[1][1] == 1.0
     assert r.success and r.flags == []
-    assert r.info["zone_end_error"] < 1e-6  # measured 1.5e-12
+    assert r.info["zone_end_error"] < 1e-6  # measured 1.5e-10
     x = np.linspace(-1.0, 1.0, 2001)
     q = r.pressure(x)[:, 0]
     assert np.all(q >= 0.0)
@@ -223,7 +224,8 @@ def test_two_zones_meet_the_contact_conditions():
 def test_zone_end_converges_under_refinement_and_the_estimate_holds():
     # One free end (e = 0.45, m = 0.05): the end found on successively finer rules
     # (panels halved, end grading quartered). Measured ends differ from the finest by
-    # 4.4e-9, 2.7e-10, 1.6e-11 against estimates 3.9e-9, 2.3e-10, 1.6e-11.
+    # 4.4e-9, 2.7e-10, 1.6e-11 against estimates (each level against the coarser one)
+    # 6.7e-8, 4.1e-9, 2.6e-10: safe by the convergence ratio of a level, ~16.
     space = Space(1.0, constant(0.05), constant(0.0), ())
     step = Step(1.0, 1.0, {"force": 1.0, "moment": 0.45})
     res = Resolution(0.5, 1e-2)
@@ -244,7 +246,7 @@ def test_zone_end_converges_under_refinement_and_the_estimate_holds():
     assert np.all(np.diff(diffs) < 0.0), diffs
     assert diffs[-1] < 1e-8
     for k in range(len(diffs)):
-        assert diffs[k] <= 10.0 * estimates[k] + 1e-13, (diffs, estimates)
+        assert diffs[k] <= estimates[k], (diffs, estimates)
 
 
 # --------------------------------------------------------------------------- creep
