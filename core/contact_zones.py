@@ -127,19 +127,29 @@ class StepSolver:
     def __init__(self) -> None:
         self._key: tuple | None = None
         self._lu = None
+        self._sub: np.ndarray | None = None  # F on the contact nodes of _key
         self.factorizations = 0
 
-    def solve(self, a: np.ndarray, b: np.ndarray, key: tuple) -> np.ndarray:
-        if self._key == key and self._lu is not None:
+    def submatrix(self, op: np.ndarray, idx: np.ndarray, key: tuple) -> np.ndarray:
+        """``op`` restricted to the nodes ``idx`` (kept while the contact nodes stay)."""
+        if self._key != key or self._sub is None:
+            self._sub = op[np.ix_(idx, idx)]
+            self._key = key
+            self._lu = None
+        return self._sub
+
+    def solve(self, build: Callable[[], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
+              b: np.ndarray) -> np.ndarray:
+        """Solve ``A x = b`` for the matrix ``build()`` whose product is ``apply``."""
+        if self._lu is not None:
             x = lu_solve(self._lu, b, check_finite=False)
             scale = max(float(np.max(np.abs(b))), 1e-300)
             for _ in range(self._REFINE_STEPS):
-                r = b - a @ x
-                if float(np.max(np.abs(r))) <= 1e-14 * scale:
+                r = b - apply(x)
+                if float(np.max(np.abs(r))) <= 1e-13 * scale:
                     return x
                 x = x + lu_solve(self._lu, r, check_finite=False)
-        self._lu = lu_factor(a, check_finite=False)
-        self._key = key
+        self._lu = lu_factor(build(), check_finite=False)
         self.factorizations += 1
         return lu_solve(self._lu, b, check_finite=False)
 
@@ -166,18 +176,27 @@ def _bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray,
         rows.append(w[idx] * x[idx])
         extra.append(given["moment"])
     k = len(cols)
-    a = np.empty((n + k, n + k))
-    a[:n, :n] = step.scale * op[np.ix_(idx, idx)]
-    a[np.arange(n), np.arange(n)] += step.c * m[idx]
-    if k:
-        a[:n, n:] = np.array(cols).T
-        a[n:, :n] = np.array(rows)
-        a[n:, n:] = 0.0
+    border_cols = np.array(cols).T.reshape(n, k)
+    border_rows = np.array(rows).reshape(k, n)
+    key = (idx.tobytes(), tuple(sorted(given)))
+    sub = op[np.ix_(idx, idx)] if solver is None else solver.submatrix(op, idx, key)
+    diagonal = step.c * m[idx]
+
+    def build() -> np.ndarray:
+        a = np.zeros((n + k, n + k))
+        a[:n, :n] = step.scale * sub
+        a[np.arange(n), np.arange(n)] += diagonal
+        a[:n, n:] = border_cols
+        a[n:, :n] = border_rows
+        return a
+
+    def apply(z: np.ndarray) -> np.ndarray:
+        zq = z[:n]
+        top = diagonal * zq + step.scale * (sub @ zq) + border_cols @ z[n:]
+        return np.concatenate([top, border_rows @ zq])
+
     b = np.concatenate([rhs[idx], extra])
-    if solver is None:
-        sol = np.linalg.solve(a, b)
-    else:
-        sol = solver.solve(a, b, (idx.tobytes(), tuple(sorted(given))))
+    sol = np.linalg.solve(build(), b) if solver is None else solver.solve(build, apply, b)
     tail = list(sol[n:])
     delta = tail.pop(0) if "settlement" not in given else given["settlement"]
     alpha = tail.pop(0) if "tilt" not in given else given["tilt"]
