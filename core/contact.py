@@ -405,11 +405,21 @@ def with_contact_model(full, contact: str, arguments: dict[str, Any]):
     ``"full"``, or ``"auto"`` while full contact holds: ``full`` with ``contact_set`` the
     whole base at every time and ``info["contact"] = "full"``. ``"auto"`` when the
     full-contact pressure is negative somewhere (flag ``contact_lost``): the unilateral
-    answer, whose ``info["full_contact"]`` keeps what the full-contact model said.
+    answer, whose ``info["full_contact"]`` keeps what the full-contact model said; if the
+    loads pull the punch away (no unilateral answer exists), the flagged full-contact
+    answer with ``info["unilateral_refused"]`` giving the reason.
     ``arguments`` are those of :func:`solve_unilateral`.
     """
     if contact == "auto" and "contact_lost" in full.info.get("flags", []):
-        result = solve_unilateral(**arguments)
+        try:
+            result = solve_unilateral(**arguments)
+        except ValueError as exc:
+            # The loads pull the punch away (arguments were validated by the full solve):
+            # no unilateral answer exists, and the flagged full-contact one says so.
+            full.info["contact"] = "full"
+            full.info["unilateral_refused"] = str(exc)
+            full.info["message"] += f"; unilateral contact refused: {exc}"
+            return replace(full, contact_set=[list(FULL_CONTACT) for _ in full.times])
         result.info["full_contact"] = {
             "flags": list(full.info["flags"]),
             "min_pressure": full.info.get("min_pressure"),

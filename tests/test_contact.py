@@ -318,6 +318,11 @@ def test_contact_argument_and_refusals():
         solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=-1.0)
     with pytest.raises(ValueError, match="^time_steps"):
         solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.0, time_steps=0)
+    # "auto" with a pulling punch: no unilateral answer exists, the flagged full-contact
+    # answer stays (with the reason), rather than an error
+    pulled = solve_dimensionless(1.0, 0.05, 0.0, [1.0], force=-1.0, moment=0.0)
+    assert pulled.info["contact"] == "full" and "contact_lost" in pulled.flags
+    assert pulled.info["unilateral_refused"].startswith("force: must be > 0")
 
 
 def test_full_contact_result_carries_the_whole_base():
