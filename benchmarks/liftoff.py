@@ -165,10 +165,12 @@ def speed() -> list[str]:
         result = fn()
         info = result.info if hasattr(result, "info") else {}
         lines.append(f"| {label} | {seconds * 1e3:.0f} | {goal} | "
+                     f"{'yes' if seconds * 1e3 <= goal else 'no'} | "
                      f"{info.get('n_steps', '')} | {info.get('error_estimate', float('nan')):.1e} "
                      f"| {info.get('zone_end_error', float('nan')):.1e} |")
-    return (["| case | ms (median) | goal ms | steps | error estimate | zone-end estimate |",
-             "| --- | --- | --- | --- | --- | --- |"] + lines)
+    return (["| case | ms (median) | goal ms | goal met | steps | error estimate | "
+             "zone-end estimate |",
+             "| --- | --- | --- | --- | --- | --- | --- |"] + lines)
 
 
 def main() -> None:
