@@ -218,6 +218,23 @@ def test_two_zones_meet_the_contact_conditions():
     assert abs(np.trapezoid(x * q, x) - 0.002) < 1e-3 * 0.002
 
 
+def test_four_statements_agree():
+    # Statement 4 (P, M given) gives delta and alpha; statements 1-3 given the matching
+    # pairs must find the same contact zone and loads. Measured: zone ends within 1.3e-10,
+    # P, M, delta within 1.4e-10 (the error estimate of each solve is ~1e-7).
+    ref = solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.45, tol=1e-8)
+    d, a = float(ref.settlement[0]), float(ref.tilt[0])
+    for given in ({"settlement": d, "tilt": a}, {"settlement": d, "moment": 0.45},
+                  {"tilt": a, "force": 1.0}):
+        r = solve_unilateral(1.0, 0.05, 0.0, [1.0], tol=1e-8, **given)
+        assert r.flags == [], r.message
+        (zone,) = r.contact_set[0]
+        assert abs(zone[0] - ref.contact_set[0][0][0]) < 1e-8 and zone[1] == 1.0
+        for name, value in (("settlement", d), ("tilt", a), ("force", 1.0),
+                            ("moment", 0.45)):
+            assert abs(getattr(r, name)[0] - value) < 1e-8 * max(abs(value), 1e-3), name
+
+
 # ------------------------------------------------------------------- refinement
 
 
