@@ -351,17 +351,18 @@ def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: 
         snap = _Snapshot(state.panels, zero, state.settlement, state.tilt, step, [])
         return snap, {"zone_end_error": 0.0, "error_estimate": 0.0, "verified": True,
                       "converged": True, "builds": 0, "force": 0.0, "moment": 0.0}
-    ends, pinned, slopes = zones_from_nodes(state)
+    ends, pinned, slopes = zones_from_nodes(state, space.breakpoints)
     refined = refine_zone_ends(space, step, ends, pinned, slopes, res, tol=tol)
     sol = refined.solution
-    # A pinned end (at +-1) with Q < 0 there is a free end within a node of the edge.
-    bad_pin = [k for k, p in enumerate(pinned) if p and sol.end_values[k] < -1e-9 * sol.q_scale]
+    bad_pin = _bad_pins(space, step, sol, pinned)
     if bad_pin:
+        ends = list(sol.ends)
         for k in bad_pin:
             pinned[k] = False
-            ends[k] = float(np.sign(ends[k]) * (1.0 - 1e-6))
-            slopes[k] = -np.sign(ends[k]) * sol.q_scale * 1e3
-        refined = refine_zone_ends(space, step, sol.ends, pinned, slopes, res, tol=tol)
+            if abs(ends[k]) == 1.0:
+                ends[k] = float(np.sign(ends[k]) * (1.0 - 1e-6))
+            slopes[k] = (1.0 if k % 2 == 0 else -1.0) * sol.q_scale * 1e3
+        refined = refine_zone_ends(space, step, ends, pinned, slopes, res, tol=tol)
         sol = refined.solution
     zones = [(float(sol.ends[2 * i]), float(sol.ends[2 * i + 1]))
              for i in range(len(sol.ends) // 2)]
@@ -370,6 +371,31 @@ def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: 
     return snap, {"zone_end_error": refined.end_error, "error_estimate": refined.output_error,
                   "verified": verified, "converged": refined.converged,
                   "builds": refined.builds, "force": sol.force, "moment": sol.moment}
+
+
+def _bad_pins(space: Space, step: Step, sol, pinned: list[bool]) -> list[int]:
+    """Pinned ends that are free ends in fact.
+
+    At +-1 or a breakpoint the zone may end with q > 0 (a corner of the punch); it must
+    not end with Q < 0 inside (the zone is shorter: a free end within a node of it) nor
+    with Q > 0 just outside (the surfaces would overlap there: the zone is longer).
+    """
+    bad = []
+    scale = 1e-9 * sol.q_scale
+    for k, is_pinned in enumerate(pinned):
+        if not is_pinned:
+            continue
+        if sol.end_values[k] < -scale:
+            bad.append(k)
+            continue
+        end = sol.ends[k]
+        if abs(end) < 1.0:
+            outward = -1.0 if k % 2 == 0 else 1.0
+            outside = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement,
+                                       sol.tilt, np.array([end]), np.array([outward]))[0]
+            if outside > scale:
+                bad.append(k)
+    return bad
 
 
 def _verify(space: Space, step: Step, sol, base: Panels, zones) -> bool:

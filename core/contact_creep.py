@@ -44,10 +44,11 @@ FIRST_STEPS = 16
 MAX_HALVINGS = 4
 
 
-def _zones(state: NodalState) -> tuple[list[tuple[float, float]], list[float]]:
+def _zones(state: NodalState, breakpoints: tuple[float, ...]
+           ) -> tuple[list[tuple[float, float]], list[float]]:
     if not state.active.any():
         return [], []
-    ends, _, _ = zones_from_nodes(state)
+    ends, _, _ = zones_from_nodes(state, breakpoints)
     return [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)], ends
 
 
@@ -97,13 +98,14 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
         if n in wanted:
             states[wanted[n]] = (state, step, memory_density)
     return {"states": states, "sweeps": sweeps, "unsettled": unsettled, "steps": steps - 1,
+            "breakpoints": space.breakpoints,
             "factorizations": solver.factorizations}
 
 
 def _outputs(run: dict[str, Any]) -> dict[str, Any]:
     """The outputs of one march, with what the pressure needs (all linear in the steps)."""
     states = run["states"]
-    zones, ends = zip(*(_zones(s) for s, _, _ in states), strict=True)
+    zones, ends = zip(*(_zones(s, run["breakpoints"]) for s, _, _ in states), strict=True)
     return {
         "settlement": np.array([s.settlement for s, _, _ in states]),
         "tilt": np.array([s.tilt for s, _, _ in states]),
@@ -231,7 +233,7 @@ def _spatial_check(space: Space, base, op, m, g, inp: Any, res: Resolution,
     state, _, _ = nodal_active_set(base, op, m, g, step)
     if not state.active.any():
         return 0.0, 0.0
-    ends, pinned, slopes = zones_from_nodes(state)
+    ends, pinned, slopes = zones_from_nodes(state, space.breakpoints)
     refined = refine_zone_ends(space, step, ends, pinned, slopes, res, tol=tol)
     sol = refined.solution
     if len(sol.ends) != len(ends):

@@ -282,11 +282,15 @@ def _crossing(panels: Panels, values: np.ndarray, i: int) -> float:
     return float(brentq(f, x[i], x[i + 1], xtol=1e-14))
 
 
-def zones_from_nodes(state: NodalState) -> tuple[list[float], list[bool], list[float]]:
+def zones_from_nodes(state: NodalState, breakpoints: Sequence[float] = ()
+                     ) -> tuple[list[float], list[bool], list[float]]:
     """Zone ends from the nodal contact set: (ends, pinned flags, slopes of Q at the ends).
 
-    ``ends`` is sorted, two per zone; an end at a node next to x = -1 or 1 is pinned there.
+    ``ends`` is sorted, two per zone; an end at a node next to x = -1 or 1 is pinned there,
+    and one whose sign change of Q straddles a breakpoint is pinned at the breakpoint (a
+    step of the punch: the zone ends at its corner, where Q jumps and has no root).
     """
+    cuts = np.asarray(sorted(breakpoints), dtype=float)
     active = state.active
     x = state.panels.nodes
     n = x.size
@@ -308,6 +312,12 @@ def zones_from_nodes(state: NodalState) -> tuple[list[float], list[bool], list[f
                 slopes.append(0.0)
                 continue
             lo = k - 1 if side < 0 else k
+            inside = cuts[(cuts > x[lo]) & (cuts < x[lo + 1])]
+            if inside.size:
+                ends.append(float(inside[0]))
+                pinned.append(True)
+                slopes.append(0.0)
+                continue
             end = _crossing(state.panels, state.nystrom, lo)
             ends.append(end)
             pinned.append(False)

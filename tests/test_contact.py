@@ -235,6 +235,31 @@ def test_four_statements_agree():
             assert abs(getattr(r, name)[0] - value) < 1e-8 * max(abs(value), 1e-3), name
 
 
+def test_stepped_punch_zone_ends_at_the_step_corner():
+    # A punch whose middle protrudes by 0.01 (g jumps at x = +-0.4): pressed by less than
+    # the step, it touches on the middle only and the zone ends at the corners (q > 0
+    # there, the gap open outside); pressed harder with a moment, the outer parts touch
+    # too, with free ends. Both pass the final check of the contact conditions.
+    def step_gap(x):
+        return np.where(np.abs(np.asarray(x)) > 0.4, 0.01, 0.0)
+
+    kw = dict(breakpoints=(-0.4, 0.4), tol=1e-8)
+    middle = solve_unilateral(1.0, 0.05, step_gap, [1.0], settlement=0.008, moment=0.0, **kw)
+    assert middle.contact_set[0] == [(-0.4, 0.4)] and middle.flags == []
+    assert np.min(middle.pressure([-0.4, 0.4])) > 0.0
+    both = solve_unilateral(1.0, 0.05, step_gap, [1.0], settlement=0.0133, moment=0.002,
+                            **kw)
+    zones = both.contact_set[0]
+    assert both.flags == [], both.message
+    # three zones: the middle one pinned at the corners, two outer ones with free ends
+    # (measured [-1, -0.7932], [-0.4, 0.4], [0.6868, 1]: the moment makes them unequal)
+    assert len(zones) == 3 and zones[1] == (-0.4, 0.4)
+    assert zones[0][0] == -1.0 and -1.0 < zones[0][1] < -0.4
+    assert zones[2][1] == 1.0 and 0.4 < zones[2][0] < 1.0
+    assert abs(zones[0][1] + zones[2][0]) > 0.05
+    assert both.info["zone_end_error"] < 1e-6
+
+
 # ------------------------------------------------------------------- refinement
 
 
