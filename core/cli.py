@@ -1,8 +1,9 @@
 """The command line: ``python -m core solve SCENE.json`` and ``python -m core validate SCENE.json``.
 
 ``solve`` writes the solution to ``--output`` (``.json``: everything, see
-:meth:`core.scene.SceneSolution.to_dict`; ``.csv``: the histories of settlement, tilt,
-force and moment) and optionally the pressure ``q(x, t)`` to ``--pressure-csv``; without
+:meth:`core.scene.SceneSolution.to_dict`, with the contact set per time; ``.csv``: the
+histories of settlement, tilt, force and moment, and the contact zones when the punch
+lifts off) and optionally the pressure ``q(x, t)`` to ``--pressure-csv``; without
 ``--output`` it prints a short summary. ``validate`` only checks the scene file.
 
 Exit codes: 0 success, 1 the solver failed (or an internal error), 2 bad input (an
@@ -84,6 +85,10 @@ def _summary(result: SceneSolution) -> str:
     for i in rows:
         values = [getattr(result, q)[i] for q in QUANTITIES]
         lines.append(f"{result.times[i]:12.6g} " + " ".join(f"{v:16.8g}" for v in values))
+    if result.info.get("contact") == "unilateral":
+        for i in rows:
+            zones = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in result.contact_set[i])
+            lines.append(f"contact at {result.times[i]:g} days: {zones or 'none'} m")
     lines.append(str(result.info.get("message", "")))
     return "\n".join(lines)
 

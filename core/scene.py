@@ -120,6 +120,8 @@ FLAG_MESSAGES: dict[str, str] = {
     "tol_not_met": "The solver could not reach the requested tolerance: see info.message.",
     "unresolved_input": "A profile has features finer than the quadrature resolves: "
                         "see info.message.",
+    "contact_set_unverified": "The unilateral contact set failed its final check (q < 0 "
+                              "on it, or the surfaces overlap off it): see info.message.",
 }
 
 UNITS: dict[str, str] = {
@@ -279,6 +281,8 @@ class Scene:
     times: np.ndarray
     tol: float
     _data: dict = field(repr=False)
+    #: Contact model: "auto" (full contact unless it is lost), "full" or "unilateral".
+    contact: str = "auto"
 
     def to_dict(self) -> dict[str, Any]:
         """The canonical JSON-able dict of the scene (schema version 1, defaults filled in)."""
@@ -635,11 +639,18 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
                          f"an age at loading of {tau0:g} days")
 
-    solver = _check_fields(d.get("solver", {}), "solver", (), ("tol",))
+    solver = _check_fields(d.get("solver", {}), "solver", (), ("tol", "contact"))
     tol = finite_number(solver.get("tol", DEFAULT_TOL), "solver.tol")
     if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
         raise ValueError(f"solver.tol: must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], "
                          f"got {show_value(tol)}")
+    contact = solver.get("contact", "auto")
+    if contact != "auto":
+        from core.contact import CONTACT_MODELS  # the solver's list (loaded only when asked)
+
+        if not isinstance(contact, str) or contact not in CONTACT_MODELS:
+            raise ValueError(f"solver.contact: must be one of {', '.join(CONTACT_MODELS)}, "
+                             f"got {show_value(contact)}")
 
     data = {
         "schema_version": SCHEMA_VERSION,
@@ -654,11 +665,12 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
                  "creep": _jsonable(creep.spec)},
         "loading": {q: _jsonable(_spec_of(loads[q], loading[q])) for q in loads},
         "times": _jsonable(times_spec),
-        "solver": {"tol": tol},
+        # the default contact model is left out, so existing scenes keep their keys
+        "solver": {"tol": tol} if contact == "auto" else {"tol": tol, "contact": contact},
     }
     times.setflags(write=False)
     scene = Scene(name, description, a, shape, tuple(layers), h_base, nu, tau0, creep,
-                  MappingProxyType(loads), times, tol, data)
+                  MappingProxyType(loads), times, tol, data, contact)
     _check_breakpoints(scene)
     _check_solvable(scene)
     return scene
@@ -944,6 +956,7 @@ class DimensionlessProblem:
     age_at_loading: float
     plane_factor: float
     modulus: Callable[[np.ndarray], np.ndarray]
+    contact: str = "auto"
 
     def modulus_after_loading(self, t: Any) -> np.ndarray:
         """``E(tau0 + t)`` [Pa] at ``t`` days after loading."""
@@ -961,7 +974,7 @@ class DimensionlessProblem:
 
         return solve_dimensionless(self.lam, self.m, self.g, self.times, c=self.c,
                                    kernel=self.kernel, breakpoints=self.breakpoints,
-                                   tol=self.tol, **self.loads)
+                                   tol=self.tol, contact=self.contact, **self.loads)
 
 
 def _is_constant(profile: Profile) -> bool:
@@ -1036,6 +1049,7 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
         times=times_star,
         breakpoints=tuple(b / a for b in scene.breakpoints),
         tol=scene.tol,
+        contact=scene.contact,
         half_width=a,
         modulus_at_loading=e0,
         age_at_loading=tau0,
@@ -1079,6 +1093,9 @@ class SceneSolution:
     ``moment`` [N] are arrays over ``times``; ``pressure(x)`` gives q [Pa] at points
     ``x`` [m] of ``[-a, a]``; ``x`` is a default plotting grid [m]; ``flags`` names what
     makes the answer doubtful or unphysical (``flag_messages`` explains each).
+    ``contact_set[k]`` lists the ``(start, end)`` intervals [m] where q > 0 at ``times[k]``
+    (``[(-a, a)]`` in full contact); ``info["contact"]`` names the contact model that
+    answered (``"full"`` or ``"unilateral"``).
     """
 
     def __init__(self, scene: Scene, problem: DimensionlessProblem,
@@ -1095,6 +1112,8 @@ class SceneSolution:
         self.force = np.asarray(solution.force, dtype=float) * self._pressure_scale * a
         self.moment = np.asarray(solution.moment, dtype=float) * self._pressure_scale * a * a
         self.x = plotting_grid(a)
+        self.contact_set = [[(a * lo, a * hi) for lo, hi in zones]
+                            for zones in getattr(solution, "contact_set", [])]
         self.flags = self._flags(solution)
         self.flag_messages = {
             name: FLAG_MESSAGES.get(name, f"{name}: {solution.info.get('message', '')}")
@@ -1178,6 +1197,7 @@ class SceneSolution:
             "pressure": self.pressure_on_grid,
             "flags": self.flags,
             "flag_messages": self.flag_messages,
+            "contact_set": [[list(zone) for zone in zones] for zones in self.contact_set],
             "info": self.info,
         })
 
@@ -1186,11 +1206,28 @@ class SceneSolution:
         return json.dumps(self.to_dict(), separators=(",", ":"), allow_nan=False)
 
     def to_csv(self) -> str:
-        """The histories as CSV: time [day], settlement [m], tilt [rad], force [N/m], moment [N]."""
-        lines = ["time_day,settlement_m,tilt_rad,force_N_per_m,moment_N"]
-        for row in zip(self.times, self.settlement, self.tilt, self.force, self.moment,
-                       strict=True):
-            lines.append(",".join(repr(float(v)) for v in row))
+        """The histories as CSV: time [day], settlement [m], tilt [rad], force [N/m], moment [N].
+
+        When the unilateral contact model answered, the contact set follows: the contact
+        length [m] and the ends of each zone [m] (``zone1_start_m, zone1_end_m, ...``,
+        ``nan`` where a time has fewer zones).
+        """
+        header = "time_day,settlement_m,tilt_rad,force_N_per_m,moment_N"
+        zones = max((len(z) for z in self.contact_set), default=0)
+        unilateral = self.info.get("contact") == "unilateral"
+        if unilateral:
+            header += ",contact_length_m" + "".join(
+                f",zone{k + 1}_start_m,zone{k + 1}_end_m" for k in range(zones))
+        lines = [header]
+        for k, row in enumerate(zip(self.times, self.settlement, self.tilt, self.force,
+                                    self.moment, strict=True)):
+            values = [float(v) for v in row]
+            if unilateral:
+                current = self.contact_set[k]
+                values.append(sum(hi - lo for lo, hi in current))
+                for j in range(zones):
+                    values.extend(current[j] if j < len(current) else (math.nan, math.nan))
+            lines.append(",".join(repr(float(v)) for v in values))
         return "\n".join(lines) + "\n"
 
     def pressure_csv(self, x: Any = None) -> str:

@@ -116,7 +116,9 @@ class ContactSolution:
     ``times`` (T,), ``settlement`` (delta), ``tilt`` (alpha), ``force`` (P), ``moment`` (M)
     as arrays over ``times``; ``pressure(x)`` gives q at points of [-1, 1] (shape
     ``(len(x), T)``); ``info`` holds ``error_estimate`` (relative, see the module notes),
-    ``seconds``, ``flags``, ``message``, ``success``, ``n_modes``, ``n_steps``, ``stages``.
+    ``seconds``, ``flags``, ``message``, ``success``, ``n_modes``, ``n_steps``, ``stages``,
+    ``contact`` (``"full"``). ``contact_set`` holds, per time, the intervals of x where
+    q > 0: ``[(-1.0, 1.0)]`` (full contact is assumed).
     """
 
     times: np.ndarray
@@ -132,6 +134,7 @@ class ContactSolution:
     _g: Callable[[np.ndarray], np.ndarray] = field(repr=False)
     #: q(x) at points x, shape (len(x), T), for engines without a basis (Nystrom).
     _evaluate: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
+    contact_set: list[list[tuple[float, float]]] = field(default_factory=list)
 
     @property
     def success(self) -> bool:
@@ -658,7 +661,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                         force: Scalar | None = None, moment: Scalar | None = None,
                         breakpoints: Sequence[float] = (), tol: float = 1e-8,
                         basis: str = "graded", n_modes: int | None = None,
-                        method: str | None = None) -> ContactSolution:
+                        method: str | None = None, contact: str = "auto") -> ContactSolution:
     """Solve the dimensionless contact problem (Nystrom by default, or the seed's projection).
 
     Parameters (all dimensionless):
@@ -681,24 +684,43 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         method: "nystrom" (the default: a direct solve on graded panels, adaptively
             refined, :mod:`core.prepared`) or "projection" (the seed's series; the default
             when ``basis`` or ``n_modes`` is given, which only it uses).
+        contact: "full" (q may come out negative: flag ``contact_lost``), "unilateral"
+            (q >= 0 with an unknown contact set, :func:`core.contact.solve_unilateral`) or
+            "auto" (full contact first, unilateral only when it is lost).
 
-    Returns a :class:`ContactSolution`. Raises ``ValueError`` naming the argument on bad
-    input.
+    Returns a :class:`ContactSolution` (or, when the unilateral model answered, a
+    :class:`core.contact.UnilateralSolution` with the same attributes); ``contact_set``
+    and ``info["contact"]`` say which contact model answered. Raises ``ValueError``
+    naming the argument on bad input.
     """
+    from core.contact import check_contact_model, solve_unilateral, with_contact_model
+
+    t_start = _time.perf_counter()
+    contact = check_contact_model(contact)
     if method is None:
         method = "projection" if (n_modes is not None or basis != "graded") else "nystrom"
+    if method not in ("nystrom", "projection"):
+        raise ValueError(f"method: must be 'nystrom' or 'projection', got {method!r}")
     if method == "nystrom":
         from core.prepared import solve_with_prepared
 
-        return solve_with_prepared(lam, m, g, times, c=c, kernel=kernel,
+        unilateral_args = dict(lam=lam, m=m, g=g, times=times, c=c, kernel=kernel,
+                               settlement=settlement, tilt=tilt, force=force, moment=moment,
+                               breakpoints=breakpoints, tol=tol)
+        if contact == "unilateral":
+            return solve_unilateral(**unilateral_args)
+        full = solve_with_prepared(lam, m, g, times, c=c, kernel=kernel,
                                    settlement=settlement, tilt=tilt, force=force,
                                    moment=moment, breakpoints=breakpoints, tol=tol)
-    if method != "projection":
-        raise ValueError(f"method: must be 'nystrom' or 'projection', got {method!r}")
-    t_start = _time.perf_counter()
+        return with_contact_model(full, contact, unilateral_args)
     inp = _validate(lam, m, g, times, c, kernel,
                     {"settlement": settlement, "tilt": tilt, "force": force, "moment": moment},
                     breakpoints, tol)
+    unilateral_args = dict(lam=lam, m=m, g=g, times=times, c=c, kernel=kernel,
+                           settlement=settlement, tilt=tilt, force=force, moment=moment,
+                           breakpoints=breakpoints, tol=tol)
+    if contact == "unilateral":
+        return solve_unilateral(**unilateral_args)
     if basis not in ("piecewise", "global", "graded"):
         raise ValueError(f"basis: must be 'piecewise', 'global' or 'graded', got {basis!r}")
     inp, kernel_fit_error = _fast_kernel(inp)
@@ -843,6 +865,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         "orthonormality_error": disc.basis.orthonormality_error,
         "stages": stages,
     }
-    return ContactSolution(times_arr.copy(), chosen.settlement, chosen.tilt, chosen.force,
+    full = ContactSolution(times_arr.copy(), chosen.settlement, chosen.tilt, chosen.force,
                            chosen.moment, info, disc.basis, chosen.coefficients, c_t, inp.m,
                            inp.g)
+    return with_contact_model(full, contact, unilateral_args)

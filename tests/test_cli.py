@@ -90,6 +90,7 @@ def test_flags_are_warnings(tmp_path: Path):
     d = scene_dict()
     d["loading"] = {"force": 5e5, "moment": 5e5 * 0.6}
     d["times"] = {"end": 1.0, "count": 1}
+    d.setdefault("solver", {})["contact"] = "full"  # "auto" would answer with lift-off
     path = tmp_path / "eccentric.json"
     path.write_text(json.dumps(d))
     proc = run("solve", path, "--output", tmp_path / "r.json")

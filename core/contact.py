@@ -1,0 +1,457 @@
+"""Unilateral contact: the punch may lift off, and the contact set is part of the answer.
+
+:func:`solve_unilateral` solves the dimensionless problem of ``core/README.md`` with
+``q >= 0`` and an unknown contact set ``S(t)`` in [-1, 1] (may have several pieces):
+
+    c m q + (I - V) F q = delta + alpha x - g   on S(t),  q > 0 there,
+    (I - V) F q >= delta + alpha x - g          off S(t), q = 0 there (the gap is open),
+    int q dx = P,  int x q dx = M               (two of delta, alpha, P, M given).
+
+Elastic base (``kernel=None``): each time is solved on its own, the zone ends located to
+``ZONE_END_TOL`` by :mod:`core.contact_zones`. Creep: implicit trapezoid stepping with the
+active set found at every step (:mod:`core.contact_creep`).
+
+:func:`contact_set_from_pressure` turns sampled pressures of any engine into contact
+sets; :func:`with_contact_model` is the ``contact=`` switch of
+:func:`core.solver.solve_dimensionless`.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from core.contact_zones import (
+    ZONE_END_TOL,
+    NoContact,
+    Resolution,
+    Space,
+    Step,
+    nodal_active_set,
+    nystrom_pressure,
+    refine_zone_ends,
+    zones_from_nodes,
+)
+from core.quadrature import Panels, base_panels, kernel_operator
+
+#: The contact models of ``solve_dimensionless(..., contact=...)``.
+CONTACT_MODELS = ("full", "unilateral", "auto")
+#: The contact set of full contact.
+FULL_CONTACT: list[tuple[float, float]] = [(-1.0, 1.0)]
+#: Panels of the nodal active set (at most ``_NODAL_WIDTH`` wide: it must see every zone)
+#: and of the first refinement level (at most ``_WIDTH``), graded to at most ``_EDGE`` at
+#: +-1, breakpoints and zone ends (finer when the coating is thinner: its boundary layer
+#: is ~m wide). Measured on four lift-off cases: the first level already meets 1e-6 for
+#: the ends (estimates 1e-10 to 6e-9); tighter tol refines further.
+_NODAL_WIDTH = 0.25
+_WIDTH = 0.5
+_EDGE = 1e-2
+#: The fixed rule of creep steps: interior panels at most this wide, graded to this width
+#: at +-1 and the breakpoints (finer for a thin coating).
+_CREEP_WIDTH = 0.125
+_CREEP_EDGE = 1e-2
+_QUANTITIES = ("settlement", "tilt", "force", "moment")
+
+Scalar = float | Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class _Snapshot:
+    """What the pressure at one output time needs: the Nystrom pressure on ``panels``."""
+
+    panels: Panels
+    q: np.ndarray
+    settlement: float
+    tilt: float
+    step: Step
+    zones: list[tuple[float, float]]
+    memory: np.ndarray | None = None  # creep memory density at the nodes (F of it is e(x))
+
+
+@dataclass(frozen=True)
+class UnilateralSolution:
+    """The answer of :func:`solve_unilateral` (dimensionless, like ``ContactSolution``).
+
+    ``times`` (T,); ``settlement`` (delta), ``tilt`` (alpha), ``force`` (P), ``moment`` (M)
+    over ``times``; ``contact_set[k]`` the list of ``(start, end)`` intervals of x in
+    [-1, 1] where q > 0 at ``times[k]``; ``pressure(x)`` q of shape ``(len(x), T)`` (0 off
+    contact); ``info`` with ``error_estimate``, ``zone_end_error`` [half-widths],
+    ``success``, ``message``, ``flags``, ``contact`` (``"unilateral"``), ``seconds``.
+    """
+
+    times: np.ndarray
+    settlement: np.ndarray
+    tilt: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    contact_set: list[list[tuple[float, float]]]
+    info: dict[str, Any]
+    _space: Space = field(repr=False)
+    _snapshots: list[_Snapshot] = field(repr=False)
+
+    @property
+    def success(self) -> bool:
+        """Whether the error estimates meet the tolerances."""
+        return bool(self.info["success"])
+
+    @property
+    def message(self) -> str:
+        """A one-line account of how the solve went."""
+        return str(self.info["message"])
+
+    @property
+    def flags(self) -> list[str]:
+        """Validity flags (``tol_not_met``, ``contact_set_unverified``)."""
+        return list(self.info["flags"])
+
+    def pressure(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Contact pressure q(x, t) at points of [-1, 1], shape ``(len(x), len(times))``.
+
+        The Nystrom formula on the contact set, exactly 0 off it (dimensionless).
+        """
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        if x.ndim != 1 or np.any(~np.isfinite(x)) or np.any(np.abs(x) > 1.0):
+            raise ValueError("x: pressure is defined on [-1, 1] only")
+        out = np.zeros((x.size, len(self._snapshots)))
+        for k, snap in enumerate(self._snapshots):
+            inside = np.zeros(x.size, dtype=bool)
+            for lo, hi in snap.zones:
+                inside |= (x >= lo) & (x <= hi)
+            if not inside.any():
+                continue
+            memory_at = None
+            if snap.memory is not None:
+                from core.quadrature import operator_rows
+
+                def memory_at(t, _v=snap.memory, _p=snap.panels):
+                    return operator_rows(self._space.lam, _p, t) @ _v
+            xi = x[inside]
+            # Sample m and g from inside the zone at its ends (they may jump there).
+            inward = np.zeros(xi.size)
+            for lo, hi in snap.zones:
+                inward[xi == lo] = 1.0
+                inward[xi == hi] = -1.0
+            values = nystrom_pressure(self._space, snap.step, snap.panels, snap.q,
+                                      snap.settlement, snap.tilt, xi, inward, memory_at)
+            out[inside, k] = np.maximum(values, 0.0)
+        return out
+
+
+def contact_set_from_pressure(x: Sequence[float] | np.ndarray, q: np.ndarray, *,
+                              threshold: float = 0.0) -> list[list[tuple[float, float]]]:
+    """Contact sets from sampled pressures: intervals of x where ``q > threshold``.
+
+    ``x`` sorted points of [-1, 1] (dimensionless), ``q`` of shape ``(len(x),)`` or
+    ``(len(x), T)``. Each interval's ends are interpolated linearly where q crosses the
+    threshold between samples and are +-1 where the samples reach the edges with
+    ``q > threshold``. Returns one list per column of ``q`` (usable with any engine's
+    ``pressure``; its accuracy is that of the sampling).
+    """
+    x = np.asarray(x, dtype=float)
+    values = np.asarray(q, dtype=float)
+    if values.ndim == 1:
+        values = values[:, None]
+    if x.ndim != 1 or values.shape[0] != x.size or np.any(np.diff(x) <= 0):
+        raise ValueError("x: must be increasing points matching the rows of q")
+    sets: list[list[tuple[float, float]]] = []
+    for col in values.T:
+        on = col > threshold
+        zones: list[tuple[float, float]] = []
+        i = 0
+        while i < x.size:
+            if not on[i]:
+                i += 1
+                continue
+            j = i
+            while j + 1 < x.size and on[j + 1]:
+                j += 1
+            lo = x[i] if i == 0 else _cross(x[i - 1], x[i], col[i - 1], col[i], threshold)
+            hi = x[j] if j == x.size - 1 else _cross(x[j], x[j + 1], col[j], col[j + 1],
+                                                     threshold)
+            if i == 0 and x[0] <= -1.0 + 1e-12:
+                lo = -1.0
+            if j == x.size - 1 and x[-1] >= 1.0 - 1e-12:
+                hi = 1.0
+            zones.append((float(lo), float(hi)))
+            i = j + 1
+        sets.append(zones)
+    return sets
+
+
+def _cross(xa: float, xb: float, fa: float, fb: float, level: float) -> float:
+    return xa + (level - fa) * (xb - xa) / (fb - fa) if fb != fa else xa
+
+
+# ----------------------------------------------------------------------- the solver
+
+
+def _function(value: Any, name: str) -> Callable[[np.ndarray], np.ndarray]:
+    if callable(value):
+        def fn(x, _f=value):
+            out = np.asarray(_f(np.asarray(x, dtype=float)), dtype=float)
+            return np.broadcast_to(out, np.shape(x)).astype(float)
+        return fn
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name}: must be a number or a vectorized callable")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{name}: must be finite, got {v}")
+    return lambda x, _v=v: np.full(np.shape(x), _v)
+
+
+def _check_loads(statement_given: frozenset[str], loads: dict[str, np.ndarray],
+                 times: np.ndarray) -> None:
+    """Refuse loads that pull the punch away (no contact can carry them)."""
+    if "force" in loads:
+        bad = loads["force"] <= 0.0
+        if bad.any():
+            t = times[int(np.argmax(bad))]
+            raise ValueError(f"force: must be > 0 for the punch to touch (a punch pulled away "
+                             f"has no contact), got {loads['force'][bad][0]:.6g} at t = {t:g}")
+        if "moment" in loads:
+            e = loads["moment"] / loads["force"]
+            bad = np.abs(e) >= 1.0
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise ValueError(f"moment: the eccentricity M/P = {e[k]:.6g} at t = "
+                                 f"{times[k]:g} puts the load outside the punch (|M/P| must "
+                                 "be < 1 half-width): no contact can carry it")
+
+
+def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | np.ndarray,
+                     *, c: Scalar = 1.0, kernel: Callable | None = None,
+                     settlement: Scalar | None = None, tilt: Scalar | None = None,
+                     force: Scalar | None = None, moment: Scalar | None = None,
+                     breakpoints: Sequence[float] = (), tol: float = 1e-8,
+                     time_steps: int | None = None) -> UnilateralSolution:
+    """Solve the dimensionless problem with unilateral contact (the punch may lift off).
+
+    Arguments as :func:`core.solver.solve_dimensionless` (all dimensionless): ``lam`` =
+    a/H; ``m(x) > 0`` coating compliance; ``g(x)`` gap; ``times`` >= 1 increasing; ``c(t)``
+    relative modulus; ``kernel`` K(t, tau) of V or None (elastic); exactly two of
+    ``settlement`` (delta), ``tilt`` (alpha), ``force`` (P), ``moment`` (M); ``breakpoints``
+    where m or g may jump; ``tol`` for delta, alpha, P, M (relative, as in the solver).
+    ``time_steps``: nominal steps of the first creep grid over ``[1, times[-1]]`` (default
+    ``core.contact_creep.FIRST_STEPS``; the grid is then halved until ``tol`` is met).
+
+    Returns a :class:`UnilateralSolution` whose ``contact_set`` gives the contact zones
+    at each time (free ends located to ``ZONE_END_TOL`` half-widths on an elastic base).
+    Raises ``ValueError`` naming the argument on bad input and naming the load when the
+    loads pull the punch away (``force <= 0`` in statement 4 or 3, ``|moment/force| >= 1``).
+    """
+    from core.solver import _validate  # one source of truth for the input rules
+
+    started = _time.perf_counter()
+    if time_steps is not None and (isinstance(time_steps, bool) or not isinstance(
+            time_steps, (int, np.integer)) or not 1 <= time_steps <= 4096):
+        raise ValueError(f"time_steps: must be an integer in [1, 4096], got {time_steps!r}")
+    inp = _validate(lam, m, g, times, c, kernel,
+                    {"settlement": settlement, "tilt": tilt, "force": force,
+                     "moment": moment}, breakpoints, tol)
+    times_arr = inp.times
+    c_t = inp.c(times_arr)
+    loads = {name: np.asarray(fn(times_arr), dtype=float) for name, fn in inp.loads.items()}
+    _check_loads(inp.given, loads, times_arr)
+    space = Space(inp.lam, inp.m, inp.g, inp.breakpoints)
+    m_probe = inp.m(np.linspace(-1.0, 1.0, 257))
+    res = Resolution(min(_WIDTH, 3.0 / inp.lam), min(_EDGE, 0.25 * float(np.min(m_probe))))
+    nodal_res = Resolution(min(_NODAL_WIDTH, 3.0 / inp.lam), res.edge)
+    if inp.kernel is None:
+        out = _solve_elastic(space, c_t, loads, times_arr, nodal_res, res, inp.tol)
+    else:
+        from core.contact_creep import solve_creep
+
+        # The zone ends move through the interior panels of the fixed rule of the steps:
+        # their width sets the error of the ends (measured at t = 1 on the lift-off
+        # preset: 1.3e-4 half-widths for panels 0.25 wide, 2.1e-5 for 0.125, 2.7e-6 for
+        # 0.0625, with 256, 352, 576 nodes).
+        creep_res = Resolution(min(_CREEP_WIDTH, 3.0 / inp.lam), max(res.edge, min(
+            _CREEP_EDGE, 0.25 * float(np.min(m_probe)))))
+        out = solve_creep(space, inp, c_t, loads, creep_res,
+                          **({} if time_steps is None else {"first_steps": time_steps}))
+    out["info"]["seconds"] = _time.perf_counter() - started
+    return UnilateralSolution(times_arr.copy(), out["settlement"], out["tilt"], out["force"],
+                              out["moment"], out["contact_set"], out["info"], space,
+                              out["snapshots"])
+
+
+def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
+                   times: np.ndarray, nodal_res: Resolution, res: Resolution,
+                   tol: float) -> dict[str, Any]:
+    """Every time on its own (equal data solved once)."""
+    base = base_panels(space.lam, space.breakpoints, edge_width=nodal_res.edge,
+                       max_width=nodal_res.width)
+    op = kernel_operator(space.lam, base).matrix
+    m_nodes = space.m(base.nodes)
+    g_nodes = space.g(base.nodes)
+    results: dict[tuple, tuple] = {}
+    per_time = []
+    for k in range(times.size):
+        given = {name: float(v[k]) for name, v in loads.items()}
+        key = (float(c_t[k]),) + tuple(sorted(given.items()))
+        if key not in results:
+            step = Step(float(c_t[k]), 1.0, given)
+            results[key] = _solve_one(space, step, base, op, m_nodes, g_nodes, res, tol)
+        per_time.append(results[key])
+    snapshots = [r[0] for r in per_time]
+    end_error = max(r[1]["zone_end_error"] for r in per_time)
+    error = max(r[1]["error_estimate"] for r in per_time)
+    verified = all(r[1]["verified"] for r in per_time)
+    converged = all(r[1]["converged"] for r in per_time)
+    success = error * 3.0 <= tol and end_error <= ZONE_END_TOL and verified and converged
+    flags = [] if success else ["tol_not_met"]
+    if not verified:
+        flags.append("contact_set_unverified")
+    message = (f"unilateral contact (elastic): estimated error {error:.1e}, zone ends to "
+               f"{end_error:.1e} half-widths")
+    if not success:
+        message += (f"; not within tol {tol:.1e} / zone-end tolerance {ZONE_END_TOL:g}"
+                    + ("" if verified else "; the contact set failed its check (q < 0 on "
+                       "it or the surfaces overlap off it)"))
+    info = {
+        "contact": "unilateral",
+        "error_estimate": float(error),
+        "zone_end_error": float(end_error),
+        "success": bool(success),
+        "flags": flags,
+        "message": message,
+        "n_steps": int(times.size),
+        "n_solves": len(results),
+        "n_nodes": max(int(r[0].panels.size) for r in per_time),
+        "operator_builds": sum(r[1]["builds"] for r in results.values()),
+        "min_pressure": 0.0,
+    }
+    return {
+        "settlement": np.array([s.settlement for s in snapshots]),
+        "tilt": np.array([s.tilt for s in snapshots]),
+        "force": np.array([r[1]["force"] for r in per_time]),
+        "moment": np.array([r[1]["moment"] for r in per_time]),
+        "contact_set": [list(s.zones) for s in snapshots],
+        "snapshots": snapshots,
+        "info": info,
+    }
+
+
+def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: np.ndarray,
+               g_nodes: np.ndarray, res: Resolution, tol: float) -> tuple[_Snapshot, dict]:
+    try:
+        state, _, _ = nodal_active_set(base, op, m_nodes, g_nodes, step)
+    except NoContact as exc:
+        name = "force" if "force" in step.given else "moment" if "moment" in step.given \
+            else "settlement"
+        raise ValueError(f"{name}: the loads pull the punch away ({exc})") from None
+    if not state.active.any():
+        # Only a given settlement and tilt can leave the punch above the surface.
+        zero = np.zeros(state.q.size)
+        snap = _Snapshot(state.panels, zero, state.settlement, state.tilt, step, [])
+        return snap, {"zone_end_error": 0.0, "error_estimate": 0.0, "verified": True,
+                      "converged": True, "builds": 0, "force": 0.0, "moment": 0.0}
+    ends, pinned, slopes = zones_from_nodes(state, space.breakpoints)
+    refined = refine_zone_ends(space, step, ends, pinned, slopes, res, tol=tol)
+    sol = refined.solution
+    bad_pin = _bad_pins(space, step, sol, pinned)
+    if bad_pin:
+        ends = list(sol.ends)
+        for k in bad_pin:
+            pinned[k] = False
+            if abs(ends[k]) == 1.0:
+                ends[k] = float(np.sign(ends[k]) * (1.0 - 1e-6))
+            slopes[k] = (1.0 if k % 2 == 0 else -1.0) * sol.q_scale * 1e3
+        refined = refine_zone_ends(space, step, ends, pinned, slopes, res, tol=tol)
+        sol = refined.solution
+    zones = [(float(sol.ends[2 * i]), float(sol.ends[2 * i + 1]))
+             for i in range(len(sol.ends) // 2)]
+    verified = _verify(space, step, sol, base, zones)
+    snap = _Snapshot(sol.panels, sol.q, sol.settlement, sol.tilt, step, zones)
+    return snap, {"zone_end_error": refined.end_error, "error_estimate": refined.output_error,
+                  "verified": verified, "converged": refined.converged,
+                  "builds": refined.builds, "force": sol.force, "moment": sol.moment}
+
+
+def _bad_pins(space: Space, step: Step, sol, pinned: list[bool]) -> list[int]:
+    """Pinned ends that are free ends in fact.
+
+    At +-1 or a breakpoint the zone may end with q > 0 (a corner of the punch); it must
+    not end with Q < 0 inside (the zone is shorter: a free end within a node of it) nor
+    with Q > 0 just outside (the surfaces would overlap there: the zone is longer).
+    """
+    bad = []
+    scale = 1e-9 * sol.q_scale
+    for k, is_pinned in enumerate(pinned):
+        if not is_pinned:
+            continue
+        if sol.end_values[k] < -scale:
+            bad.append(k)
+            continue
+        end = sol.ends[k]
+        if abs(end) < 1.0:
+            outward = -1.0 if k % 2 == 0 else 1.0
+            outside = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement,
+                                       sol.tilt, np.array([end]), np.array([outward]))[0]
+            if outside > scale:
+                bad.append(k)
+    return bad
+
+
+def _verify(space: Space, step: Step, sol, base: Panels, zones) -> bool:
+    """q >= 0 on the zones and the gap open (Q <= 0) at the base nodes off them."""
+    scale = sol.q_scale
+    if np.min(sol.q) < -1e-8 * scale:
+        return False
+    x = base.nodes
+    inside = np.zeros(x.size, dtype=bool)
+    for lo, hi in zones:
+        inside |= (x >= lo) & (x <= hi)
+    off = x[~inside]
+    if off.size == 0:
+        return True
+    values = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, off)
+    return bool(np.max(values) <= 1e-8 * scale)
+
+
+# ---------------------------------------------------------------- the contact switch
+
+
+def check_contact_model(contact: object) -> str:
+    """The ``contact`` argument checked: one of :data:`CONTACT_MODELS`."""
+    if not isinstance(contact, str) or contact not in CONTACT_MODELS:
+        raise ValueError(f"contact: must be one of {', '.join(CONTACT_MODELS)}, "
+                         f"got {contact!r}")
+    return contact
+
+
+def with_contact_model(full, contact: str, arguments: dict[str, Any]):
+    """The answer for ``contact`` given the full-contact answer ``full``.
+
+    ``"full"``, or ``"auto"`` while full contact holds: ``full`` with ``contact_set`` the
+    whole base at every time and ``info["contact"] = "full"``. ``"auto"`` when the
+    full-contact pressure is negative somewhere (flag ``contact_lost``): the unilateral
+    answer, whose ``info["full_contact"]`` keeps what the full-contact model said; if the
+    loads pull the punch away (no unilateral answer exists), the flagged full-contact
+    answer with ``info["unilateral_refused"]`` giving the reason.
+    ``arguments`` are those of :func:`solve_unilateral`.
+    """
+    if contact == "auto" and "contact_lost" in full.info.get("flags", []):
+        try:
+            result = solve_unilateral(**arguments)
+        except ValueError as exc:
+            # The loads pull the punch away (arguments were validated by the full solve):
+            # no unilateral answer exists, and the flagged full-contact one says so.
+            full.info["contact"] = "full"
+            full.info["unilateral_refused"] = str(exc)
+            full.info["message"] += f"; unilateral contact refused: {exc}"
+            return replace(full, contact_set=[list(FULL_CONTACT) for _ in full.times])
+        result.info["full_contact"] = {
+            "flags": list(full.info["flags"]),
+            "min_pressure": full.info.get("min_pressure"),
+            "seconds": full.info.get("seconds"),
+        }
+        result.info["seconds"] += float(full.info.get("seconds", 0.0))
+        return result
+    full.info["contact"] = "full"
+    return replace(full, contact_set=[list(FULL_CONTACT) for _ in full.times])

@@ -1,0 +1,511 @@
+"""Unilateral contact on Gauss-Legendre panels: the nodal active set and exact zone ends.
+
+At one time the unilateral problem (model notes, dimensionless) reads: find ``q >= 0`` and
+the contact set ``S`` with
+
+    c m q + s F q = delta + alpha x - g + e(x)   on S   (q > 0: the surfaces touch)
+    h(x) = s F q - (delta + alpha x - g + e(x)) >= 0   off S   (q = 0: the gap is open)
+
+and the two given ones of ``delta, alpha, P = int q, M = int x q``. ``s`` weighs the current
+pressure (1 elastic; ``1 - K(t, t) dt/2`` in an implicit creep step) and ``e(x)`` is the
+displacement of the creep memory (0 elastic). Both conditions are one continuous function,
+the *Nystrom pressure*
+
+    Q(x) = [delta + alpha x - g(x) + e(x) - s F q (x)] / (c m(x)),
+
+which equals ``q`` on S and ``-h / (c m)`` off it: S is where ``Q > 0``, and at a free end
+of a zone ``Q`` passes through zero (``q`` is continuous and vanishes there: ``h >= 0`` just
+outside forces ``q(end) <= 0``, ``q >= 0`` just inside forces ``>= 0``).
+
+Two stages: (1) a primal-dual active set on the nodes of a fixed panel rule (each sweep
+makes the contact nodes those with ``Q > 0``; it stops when the set repeats) gives the
+topology and ends to within a node; (2) each free end is then located as the root of
+``Q(end) = 0`` of the problem solved on the contact set alone, with panels broken at and
+graded toward the current end estimates (quasi-Newton on the ends), and checked against
+a finer rule.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import legendre as npleg
+from scipy.linalg import lu_factor, lu_solve
+from scipy.optimize import brentq
+
+from core.quadrature import NODES_PER_PANEL, Panels, base_panels, kernel_operator, operator_rows
+
+#: Accuracy aimed at for every free zone end [half-widths] (issue 13).
+ZONE_END_TOL = 1e-6
+#: Sweeps of the nodal active set before it is declared cycling.
+MAX_SWEEPS = 60
+#: Quasi-Newton iterations on the zone ends per resolution level.
+MAX_END_ITERATIONS = 25
+#: Resolution levels of the zone-end refinement (panel width and end grading shrink).
+MAX_LEVELS = 4
+
+_T, _W = npleg.leggauss(NODES_PER_PANEL)
+# Node values on a panel -> Legendre coefficients of their interpolant.
+_TO_COEF = (npleg.legvander(_T, NODES_PER_PANEL - 1) * _W[:, None]).T * (
+    np.arange(NODES_PER_PANEL) + 0.5)[:, None]
+
+
+@dataclass(frozen=True)
+class Space:
+    """The scene's functions of x: ``lam`` = a/H, coating compliance ``m`` and gap ``g``
+    (vectorized callables on [-1, 1]), and ``breakpoints`` where m or g may jump."""
+
+    lam: float
+    m: Callable[[np.ndarray], np.ndarray]
+    g: Callable[[np.ndarray], np.ndarray]
+    breakpoints: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class Step:
+    """One time's data: relative modulus ``c``, weight ``scale`` of F on the current
+    pressure, and the two given ones of settlement, tilt, force, moment (dimensionless)."""
+
+    c: float
+    scale: float
+    given: dict[str, float]
+
+
+@dataclass
+class NodalState:
+    """A solution on the nodes of ``panels``: pressure ``q`` (0 off contact), the four
+    scalars, the contact nodes ``active`` and the Nystrom pressure ``nystrom`` (Q)."""
+
+    panels: Panels
+    q: np.ndarray
+    settlement: float
+    tilt: float
+    active: np.ndarray
+    nystrom: np.ndarray
+
+    @property
+    def force(self) -> float:
+        return float(self.panels.weights @ self.q)
+
+    @property
+    def moment(self) -> float:
+        return float((self.panels.weights * self.panels.nodes) @ self.q)
+
+
+class NoContact(ValueError):
+    """The loads leave no contact (the punch is pulled away)."""
+
+
+def subset(panels: Panels, keep: np.ndarray) -> Panels:
+    """The panels flagged in ``keep`` (one flag per panel) as a rule of their own.
+
+    The kept panels need not touch; only nodes, weights, centres and half-widths are used
+    by the operator, and ``edges`` holds the (lower, upper) ends of each kept panel.
+    """
+    keep = np.asarray(keep, dtype=bool)
+    node_keep = np.repeat(keep, NODES_PER_PANEL)
+    lo = panels.centers[keep] - panels.half_widths[keep]
+    hi = panels.centers[keep] + panels.half_widths[keep]
+    return Panels(np.column_stack([lo, hi]).ravel(), panels.nodes[node_keep],
+                  panels.weights[node_keep], panels.centers[keep], panels.half_widths[keep])
+
+
+class StepSolver:
+    """Solves the bordered systems of one panel rule, keeping the last factorization.
+
+    Consecutive creep steps change only ``c`` and ``scale`` by a little, and the contact
+    set rarely: the kept LU factors of the last matrix with the same contact nodes
+    precondition a few steps of iterative refinement (each O(N^2)) instead of a new
+    factorization (O(N^3)); a new one is made when the refinement does not converge
+    within ``_REFINE_STEPS`` steps.
+    """
+
+    _REFINE_STEPS = 12
+
+    def __init__(self) -> None:
+        self._key: tuple | None = None
+        self._lu = None
+        self._sub: np.ndarray | None = None  # F on the contact nodes of _key
+        self.factorizations = 0
+
+    def submatrix(self, op: np.ndarray, idx: np.ndarray, key: tuple) -> np.ndarray:
+        """``op`` restricted to the nodes ``idx`` (kept while the contact nodes stay)."""
+        if self._key != key or self._sub is None:
+            self._sub = op[np.ix_(idx, idx)]
+            self._key = key
+            self._lu = None
+        return self._sub
+
+    def solve(self, build: Callable[[], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
+              b: np.ndarray) -> np.ndarray:
+        """Solve ``A x = b`` for the matrix ``build()`` whose product is ``apply``."""
+        if self._lu is not None:
+            x = lu_solve(self._lu, b, check_finite=False)
+            scale = max(float(np.max(np.abs(b))), 1e-300)
+            for _ in range(self._REFINE_STEPS):
+                r = b - apply(x)
+                if float(np.max(np.abs(r))) <= 1e-13 * scale:
+                    return x
+                x = x + lu_solve(self._lu, r, check_finite=False)
+        self._lu = lu_factor(build(), check_finite=False)
+        self.factorizations += 1
+        return lu_solve(self._lu, b, check_finite=False)
+
+
+def _bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, step: Step,
+                    rhs: np.ndarray, idx: np.ndarray,
+                    solver: StepSolver | None = None) -> tuple[np.ndarray, float, float]:
+    """Solve the equation on the nodes ``idx`` (q = 0 elsewhere) with the given loads.
+
+    Returns (q on idx, settlement, tilt). ``rhs`` = ``delta_g + alpha_g x - g + e`` at all
+    nodes (with the given ones of delta, alpha; 0 for the unknown ones).
+    """
+    given = step.given
+    n = idx.size
+    cols, rows, extra = [], [], []
+    if "settlement" not in given:
+        cols.append(-np.ones(n))
+    if "tilt" not in given:
+        cols.append(-x[idx])
+    if "force" in given:
+        rows.append(w[idx])
+        extra.append(given["force"])
+    if "moment" in given:
+        rows.append(w[idx] * x[idx])
+        extra.append(given["moment"])
+    k = len(cols)
+    border_cols = np.array(cols).T.reshape(n, k)
+    border_rows = np.array(rows).reshape(k, n)
+    key = (idx.tobytes(), tuple(sorted(given)))
+    sub = op[np.ix_(idx, idx)] if solver is None else solver.submatrix(op, idx, key)
+    diagonal = step.c * m[idx]
+
+    def build() -> np.ndarray:
+        a = np.zeros((n + k, n + k))
+        a[:n, :n] = step.scale * sub
+        a[np.arange(n), np.arange(n)] += diagonal
+        a[:n, n:] = border_cols
+        a[n:, :n] = border_rows
+        return a
+
+    def apply(z: np.ndarray) -> np.ndarray:
+        zq = z[:n]
+        top = diagonal * zq + step.scale * (sub @ zq) + border_cols @ z[n:]
+        return np.concatenate([top, border_rows @ zq])
+
+    b = np.concatenate([rhs[idx], extra])
+    sol = np.linalg.solve(build(), b) if solver is None else solver.solve(build, apply, b)
+    tail = list(sol[n:])
+    delta = tail.pop(0) if "settlement" not in given else given["settlement"]
+    alpha = tail.pop(0) if "tilt" not in given else given["tilt"]
+    return sol[:n], float(delta), float(alpha)
+
+
+def _given_rhs(step: Step, x: np.ndarray, g: np.ndarray, memory: np.ndarray | None) -> np.ndarray:
+    rhs = step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g
+    return rhs if memory is None else rhs + memory
+
+
+def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarray, step: Step,
+                     memory: np.ndarray | None = None, start: np.ndarray | None = None,
+                     solver: StepSolver | None = None) -> tuple[NodalState, int, bool]:
+    """Primal-dual active set on the nodes of ``panels``.
+
+    ``op`` is the Nystrom matrix of F there, ``m``, ``g`` and ``memory`` (e(x)) the node
+    values; ``start`` the first guess of the contact nodes (default: all). Returns the
+    state, the number of sweeps and whether the set settled (it may cycle between two
+    sets on a degenerate node; the last one is kept). Raises :class:`NoContact` when
+    no node stays in contact under a given force or moment.
+    """
+    x, w = panels.nodes, panels.weights
+    rhs = _given_rhs(step, x, g, memory)
+    active = np.ones(x.size, dtype=bool) if start is None else start.copy()
+    seen: set[bytes] = set()
+    settled = False
+    sweeps = 0
+    q = np.zeros(x.size)
+    delta = step.given.get("settlement", 0.0)
+    alpha = step.given.get("tilt", 0.0)
+    for _ in range(MAX_SWEEPS):
+        sweeps += 1
+        idx = np.nonzero(active)[0]
+        q = np.zeros(x.size)
+        if idx.size == 0:
+            if {"force", "moment"} & set(step.given) and any(
+                    step.given.get(k, 0.0) != 0.0 for k in ("force", "moment")):
+                raise NoContact("no node stays in contact")
+        elif idx.size < 3 and not {"settlement", "tilt"} <= set(step.given):
+            raise NoContact("the contact shrinks to a point")
+        else:
+            q[idx], delta, alpha = _bordered_solve(op, m, x, w, step, rhs, idx, solver)
+        nystrom = (delta + alpha * x - g + (0.0 if memory is None else memory)
+                   - step.scale * (op @ q)) / (step.c * m)
+        # Keep the contact nodes the equation solved exactly (rounding must not flip them).
+        nystrom[idx] = q[idx]
+        new = nystrom > 0.0
+        key = new.tobytes()
+        if np.array_equal(new, active):
+            settled = True
+            break
+        if key in seen:
+            break
+        seen.add(active.tobytes())
+        active = new
+    return NodalState(panels, q, delta, alpha, active, nystrom), sweeps, settled
+
+
+def _panel_interpolant(panels: Panels, values: np.ndarray, p: int) -> np.ndarray:
+    return _TO_COEF @ values[p * NODES_PER_PANEL:(p + 1) * NODES_PER_PANEL]
+
+
+def _crossing(panels: Panels, values: np.ndarray, i: int) -> float:
+    """Where the nodal function ``values`` changes sign between nodes i and i + 1."""
+    x = panels.nodes
+    p, p1 = i // NODES_PER_PANEL, (i + 1) // NODES_PER_PANEL
+    fa, fb = values[i], values[i + 1]
+    linear = float(x[i] - fa * (x[i + 1] - x[i]) / (fb - fa)) if fb != fa else float(x[i])
+    if p != p1:
+        return linear
+    coef = _panel_interpolant(panels, values, p)
+    c, h = panels.centers[p], panels.half_widths[p]
+
+    def f(xx: float) -> float:
+        return float(npleg.legval((xx - c) / h, coef))
+
+    ya, yb = f(x[i]), f(x[i + 1])
+    if ya == 0.0:
+        return float(x[i])
+    if ya * yb > 0.0:
+        return linear
+    return float(brentq(f, x[i], x[i + 1], xtol=1e-14))
+
+
+def zones_from_nodes(state: NodalState, breakpoints: Sequence[float] = ()
+                     ) -> tuple[list[float], list[bool], list[float]]:
+    """Zone ends from the nodal contact set: (ends, pinned flags, slopes of Q at the ends).
+
+    ``ends`` is sorted, two per zone; an end at a node next to x = -1 or 1 is pinned there,
+    and one whose sign change of Q straddles a breakpoint is pinned at the breakpoint (a
+    step of the punch: the zone ends at its corner, where Q jumps and has no root).
+    """
+    cuts = np.asarray(sorted(breakpoints), dtype=float)
+    active = state.active
+    x = state.panels.nodes
+    n = x.size
+    ends: list[float] = []
+    pinned: list[bool] = []
+    slopes: list[float] = []
+    i = 0
+    while i < n:
+        if not active[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < n and active[j + 1]:
+            j += 1
+        for k, side in ((i, -1), (j, 1)):
+            if (k == 0 and side < 0) or (k == n - 1 and side > 0):
+                ends.append(float(side))
+                pinned.append(True)
+                slopes.append(0.0)
+                continue
+            lo = k - 1 if side < 0 else k
+            inside = cuts[(cuts > x[lo]) & (cuts < x[lo + 1])]
+            if inside.size:
+                ends.append(float(inside[0]))
+                pinned.append(True)
+                slopes.append(0.0)
+                continue
+            end = _crossing(state.panels, state.nystrom, lo)
+            ends.append(end)
+            pinned.append(False)
+            dx = x[lo + 1] - x[lo]
+            slopes.append(float((state.nystrom[lo + 1] - state.nystrom[lo]) / dx))
+        i = j + 1
+    return ends, pinned, slopes
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """A panel rule for the refined problem: panels at most ``width`` wide, graded to
+    ``edge`` at +-1, at the breakpoints and at every zone end."""
+
+    width: float
+    edge: float
+
+    def finer(self) -> Resolution:
+        return Resolution(self.width / 2.0, self.edge / 4.0)
+
+    def coarser(self) -> Resolution:
+        return Resolution(min(2.0 * self.width, 1.0), 4.0 * self.edge)
+
+
+@dataclass
+class ZoneSolution:
+    """The problem solved on given zones: the rule on the contact set, nodal q, the
+    scalars, and Q (the Nystrom pressure) at every end."""
+
+    ends: list[float]
+    panels: Panels
+    q: np.ndarray
+    settlement: float
+    tilt: float
+    end_values: np.ndarray
+    q_scale: float
+
+    @property
+    def force(self) -> float:
+        return float(self.panels.weights @ self.q)
+
+    @property
+    def moment(self) -> float:
+        return float((self.panels.weights * self.panels.nodes) @ self.q)
+
+
+def zone_panels(space: Space, ends: Sequence[float], res: Resolution) -> Panels:
+    """Panels covering the zones ``(ends[0], ends[1]), (ends[2], ends[3]), ...``."""
+    cuts = sorted({round(float(e), 15) for e in ends if -1.0 < e < 1.0}
+                  | set(space.breakpoints))
+    merged = [c for k, c in enumerate(cuts) if k == 0 or c - cuts[k - 1] > 1e-12]
+    panels = base_panels(space.lam, merged, edge_width=res.edge, max_width=res.width)
+    lo, hi = np.array(ends[0::2]), np.array(ends[1::2])
+    c = panels.centers
+    keep = np.any((c[:, None] > lo[None, :]) & (c[:, None] < hi[None, :]), axis=1)
+    return subset(panels, keep)
+
+
+def nystrom_pressure(space: Space, step: Step, panels: Panels, q: np.ndarray, delta: float,
+                     alpha: float, targets: np.ndarray, inward: np.ndarray | None = None,
+                     memory_at: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
+    """Q at ``targets`` for the nodal pressure ``q`` on ``panels`` (see the module notes).
+
+    ``inward`` (+-1 per target) says from which side m and g are sampled at a jump.
+    """
+    targets = np.asarray(targets, dtype=float)
+    side = targets if inward is None else np.clip(targets + 1e-13 * inward, -1.0, 1.0)
+    fq = operator_rows(space.lam, panels, targets) @ q
+    memory = 0.0 if memory_at is None else memory_at(targets)
+    return (delta + alpha * targets - space.g(side) + memory - step.scale * fq) / (
+        step.c * space.m(side))
+
+
+def solve_on_zones(space: Space, step: Step, ends: Sequence[float],
+                   res: Resolution) -> ZoneSolution:
+    """Solve the equation on the zones given by ``ends`` (full contact there)."""
+    panels = zone_panels(space, ends, res)
+    x = panels.nodes
+    op = kernel_operator(space.lam, panels).matrix
+    m = space.m(x)
+    g = space.g(x)
+    rhs = _given_rhs(step, x, g, None)
+    idx = np.arange(x.size)
+    q, delta, alpha = _bordered_solve(op, m, x, panels.weights, step, rhs, idx)
+    ends_arr = np.asarray(ends, dtype=float)
+    inward = np.tile([1.0, -1.0], len(ends) // 2)
+    values = nystrom_pressure(space, step, panels, q, delta, alpha, ends_arr, inward)
+    return ZoneSolution(list(ends), panels, q, delta, alpha, values,
+                        max(float(np.max(np.abs(q))), 1e-300))
+
+
+@dataclass
+class Refined:
+    """Result of :func:`refine_zone_ends`: the final solution, the estimated error of the
+    ends [half-widths] and of the outputs (relative), and what the refinement did."""
+
+    solution: ZoneSolution
+    end_error: float
+    output_error: float
+    builds: int
+    levels: int
+    converged: bool
+
+
+def _walls(ends: list[float], pinned: list[bool], k: int) -> tuple[float, float]:
+    lo = -1.0 if k == 0 else ends[k - 1]
+    hi = 1.0 if k == len(ends) - 1 else ends[k + 1]
+    return lo, hi
+
+
+def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[bool],
+                     slopes: list[float], res: Resolution, *, tol: float,
+                     max_levels: int = MAX_LEVELS) -> Refined:
+    """Locate every free end as the root of ``Q(end) = 0`` and estimate the error.
+
+    Quasi-Newton (Broyden) on the free ends, starting from the Jacobian ``diag(dQ/dx)``
+    of the nodal estimate. At each resolution the converged ends are compared with the
+    next coarser rule (the shift ``-J^-1 dQ`` it would give them, and the change of the
+    outputs): that difference is the error estimate, an overestimate by the convergence
+    ratio of a level (measured ~16 for the ends), and a coarser check costs a quarter of
+    a finer one. The resolution is refined until both meet ``ZONE_END_TOL`` and ``tol``
+    (a third of each), at most ``max_levels`` times.
+    """
+    ends = list(ends)
+    pinned = list(pinned)
+    free = [k for k, p in enumerate(pinned) if not p]
+    builds = 0
+    # The nodal Q is in units of q; the residual is Q / max q.
+    sol = solve_on_zones(space, step, ends, res)
+    builds += 1
+    jac = np.diag([s / sol.q_scale if s != 0.0 else 1.0 for s in
+                   (slopes[k] for k in free)]) if free else np.zeros((0, 0))
+    converged = not free
+    end_error = output_error = np.inf
+    level = 0
+    for _ in range(max_levels):
+        level += 1
+        if free:
+            r = sol.end_values[free] / sol.q_scale
+            converged = False
+            for _ in range(MAX_END_ITERATIONS):
+                if np.max(np.abs(r)) < 1e-15:
+                    converged = True  # at the root to rounding: no step can improve it
+                    break
+                try:
+                    move = -np.linalg.solve(jac, r)
+                except np.linalg.LinAlgError:
+                    move = -r / np.maximum(np.abs(np.diag(jac)), 1e-300)
+                # Never jump past a neighbouring end or more than a tenth of a half-width.
+                move = np.clip(move, -0.1, 0.1)
+                trial = list(ends)
+                for j, k in enumerate(free):
+                    lo, hi = _walls(ends, pinned, k)
+                    span = hi - lo
+                    trial[k] = float(np.clip(ends[k] + move[j], lo + 1e-3 * span,
+                                             hi - 1e-3 * span))
+                new = solve_on_zones(space, step, trial, res)
+                builds += 1
+                r_new = new.end_values[free] / new.q_scale
+                ds = np.array([trial[k] - ends[k] for k in free])
+                if np.dot(ds, ds) > 0.0:
+                    jac = jac + np.outer(r_new - r - jac @ ds, ds) / np.dot(ds, ds)
+                ends, sol, r = trial, new, r_new
+                if np.max(np.abs(ds)) < 1e-2 * ZONE_END_TOL:
+                    converged = True
+                    break
+        fine = solve_on_zones(space, step, ends, res.coarser())
+        builds += 1
+        if free:
+            r_fine = fine.end_values[free] / fine.q_scale
+            try:
+                shift = -np.linalg.solve(jac, r_fine)
+            except np.linalg.LinAlgError:
+                shift = np.full(len(free), np.inf)
+            end_error = float(np.max(np.abs(shift)))
+        else:
+            end_error = 0.0
+        kin = max(abs(sol.settlement), abs(sol.tilt), 1e-300)
+        dyn = max(abs(sol.force), abs(sol.moment), 1e-300)
+        output_error = max(abs(sol.settlement - fine.settlement) / kin,
+                           abs(sol.tilt - fine.tilt) / kin,
+                           abs(sol.force - fine.force) / dyn,
+                           abs(sol.moment - fine.moment) / dyn)
+        if end_error <= ZONE_END_TOL / 3 and output_error <= tol / 3:
+            break
+        if level == max_levels:
+            break
+        res = res.finer()
+        sol = solve_on_zones(space, step, ends, res)
+        builds += 1
+    return Refined(sol, end_error, output_error, builds, level, converged)

@@ -1,0 +1,448 @@
+"""Unilateral contact (core.contact): limits, a second method, refinement, creep, the API.
+
+Every tolerance is a measured error with a margin; the measured value is quoted next to
+it (double-precision kernel, OPENBLAS_NUM_THREADS=1).
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core import scene_from_dict, solve, solve_dimensionless
+from core.contact import (
+    FULL_CONTACT,
+    contact_set_from_pressure,
+    solve_unilateral,
+)
+from core.contact_zones import (
+    Resolution,
+    Space,
+    Step,
+    nodal_active_set,
+    refine_zone_ends,
+    solve_on_zones,
+    zones_from_nodes,
+)
+from core.quadrature import base_panels, kernel_operator
+
+ROOT = Path(__file__).resolve().parent.parent
+PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"
+
+
+def worn_patch(x):
+    """A gap bump in the middle (a worn coating patch): contact in two pieces."""
+    return 0.01 * np.exp(-(np.asarray(x) / 0.2) ** 2)
+
+
+def constant(value):
+    return lambda x: np.full(np.shape(x), float(value))
+
+
+# ---------------------------------------------------------------------- the limits
+
+
+def test_winkler_limit_of_a_compliant_coating():
+    # Winkler bed (c m q = delta + alpha x): q = P/2 + 3 M x / 2 in full contact, zero at
+    # x = -1 when e = M/P = 1/3; beyond it q = k (x - x0) on [x0, 1] with the centroid
+    # x0 + 2 (1 - x0)/3 = e, so the contact length is 1 - x0 = 3 (1 - e) and k = 2 P/L^2.
+    # A compliant coating (m >> the base's compliance ~1) approaches it like 1/m:
+    # measured end errors 4.61e-4 (m = 100) and 4.62e-5 (m = 1000).
+    e = 0.5
+    x0 = 1.0 - 3.0 * (1.0 - e)
+    errors = []
+    for m in (100.0, 1000.0):
+        r = solve_unilateral(1.0, m, 0.0, [1.0], force=1.0, moment=e)
+        (zone,) = r.contact_set[0]
+        assert zone[1] == 1.0
+        errors.append(abs(zone[0] - x0))
+        assert r.success, r.message
+    assert errors[1] < 1e-4
+    assert 8.0 < errors[0] / errors[1] < 12.0  # first order in 1/m (measured 9.98)
+    # the triangular pressure (measured max deviation 1.4e-4 of the peak at m = 1000)
+    x = np.linspace(-1.0, 1.0, 401)
+    length = 1.0 - x0
+    triangle = np.where(x > x0, 2.0 / length**2 * (x - x0), 0.0)
+    q = r.pressure(x)[:, 0]
+    assert np.max(np.abs(q - triangle)) < 1e-3 * np.max(triangle)
+
+
+def test_winkler_threshold_one_third():
+    # Full contact holds up to e = 1/3 (+ O(1/m)); "auto" switches to the unilateral
+    # model only past it. m = 1000: measured lift-off end -0.98006 at e = 0.34
+    # (Winkler: 1 - 3 * 0.66 = -0.98; 5.5e-5 off).
+    below = solve_dimensionless(1.0, 1000.0, 0.0, [1.0], force=1.0, moment=0.33)
+    assert below.info["contact"] == "full"
+    assert below.contact_set == [FULL_CONTACT]
+    above = solve_dimensionless(1.0, 1000.0, 0.0, [1.0], force=1.0, moment=0.34)
+    assert above.info["contact"] == "unilateral"
+    assert "contact_lost" in above.info["full_contact"]["flags"]
+    (zone,) = above.contact_set[0]
+    assert abs(zone[0] - (1.0 - 3.0 * 0.66)) < 1e-3
+
+
+def _lift_off_threshold(lam: float, m: float) -> float:
+    """e = M/P at which the full-contact pressure vanishes at x = -1."""
+    space = Space(lam, constant(m), constant(0.0), ())
+    res = Resolution(0.25, min(1e-3, m / 4))
+    q_force = solve_on_zones(space, Step(1.0, 1.0, {"force": 1.0, "moment": 0.0}),
+                             [-1.0, 1.0], res).end_values[0]
+    q_moment = solve_on_zones(space, Step(1.0, 1.0, {"force": 0.0, "moment": 1.0}),
+                              [-1.0, 1.0], res).end_values[0]
+    return -q_force / q_moment
+
+
+def test_half_space_limit_threshold_and_contact_length():
+    # Thick base (lam = 0.01, kernel -ln|x - xi|/pi + const + O(lam^2)), thin coating:
+    # full contact q = [P/pi + 2 M x/pi]/sqrt(1 - x^2) loses contact at e = 1/2. Past it
+    # the bounded-at-the-free-end solution on [b, 1] is q = C sqrt((x - b)/(1 - x)) with
+    # e = 1 - (1 - b)/4: contact length 4 (1 - e).
+    # Thresholds measured 0.498771 (m = 1e-3) and 0.499817 (m = 1e-4).
+    thresholds = [_lift_off_threshold(0.01, m) for m in (1e-3, 1e-4)]
+    assert 0.5 - thresholds[0] < 2e-3
+    assert 0.5 - thresholds[1] < 3e-4
+    assert 0.0 < 0.5 - thresholds[1] < 0.5 - thresholds[0]
+    # Contact length at e = 0.7: ends measured -0.19549 (m = 1e-3), -0.19938 (1e-4).
+    e = 0.7
+    exact = 1.0 - 4.0 * (1.0 - e)
+    errors = []
+    for m in (1e-3, 1e-4):
+        r = solve_unilateral(0.01, m, 0.0, [1.0], force=1.0, moment=e)
+        (zone,) = r.contact_set[0]
+        errors.append(abs(zone[0] - exact))
+        assert r.success, r.message
+    assert errors[1] < 1e-3
+    assert errors[0] / errors[1] > 5.0  # measured 7.3
+
+
+def test_rounded_punch_against_the_half_space_contact_width():
+    # 2D Hertz for the model's kernel as lam -> 0: (1/pi) PV int q/(x - xi) = g' = x/R
+    # gives q = (b/R) sqrt(1 - x^2/b^2) and P = pi b^2/(2R), so b = sqrt(2 R P/pi).
+    # R = 1 (g = x^2/2), P = 0.2: b = 0.356825; measured 0.357137 with m = 1e-4
+    # (3.1e-4 off; 2.4e-3 with m = 1e-3: the coating's share shrinks like m).
+    radius, force = 1.0, 0.2
+    b = math.sqrt(2.0 * radius * force / math.pi)
+    r = solve_unilateral(0.01, 1e-4, lambda x: x**2 / (2 * radius), [1.0], force=force,
+                         moment=0.0)
+    (zone,) = r.contact_set[0]
+    assert abs(zone[1] - b) < 1e-3
+    assert abs(zone[0] + zone[1]) < 1e-9  # symmetric (measured 2e-14)
+    assert r.success, r.message
+
+
+# ------------------------------------------------------------- a second method
+
+
+def _fischer_burmeister(op, m, g, x, w, force, moment):
+    """Semismooth Newton on phi(q, h) = q + h - sqrt(q^2 + h^2) = 0 (statement 4).
+
+    An independent unilateral method on the same nodes: no active set, every node's
+    complementarity is one smooth-almost-everywhere equation, with the equilibrium rows.
+    """
+    n = x.size
+    a = np.diag(m) + op
+
+    def residual(z):
+        q, delta, alpha = z[:n], z[n], z[n + 1]
+        h = a @ q - delta - alpha * x + g
+        r = np.sqrt(q * q + h * h)
+        return np.concatenate([q + h - r, [w @ q - force, (w * x) @ q - moment]]), q, h, r
+
+    z = np.concatenate([np.full(n, force / 2.0), [0.0, 0.0]])
+    for _ in range(200):
+        phi, q, h, r = residual(z)
+        norm = float(np.linalg.norm(phi))
+        if norm < 1e-15:
+            break
+        safe = np.where(r > 0.0, r, 1.0)
+        dq = np.where(r > 0.0, 1.0 - q / safe, 1.0 - 1.0 / math.sqrt(2.0))
+        dh = np.where(r > 0.0, 1.0 - h / safe, 1.0 - 1.0 / math.sqrt(2.0))
+        jac = np.zeros((n + 2, n + 2))
+        jac[:n, :n] = np.diag(dq) + dh[:, None] * a
+        jac[:n, n] = -dh
+        jac[:n, n + 1] = -dh * x
+        jac[n, :n] = w
+        jac[n + 1, :n] = w * x
+        step = np.linalg.solve(jac, -phi)
+        t = 1.0
+        while t > 1e-8 and np.linalg.norm(residual(z + t * step)[0]) > (1 - 1e-4 * t) * norm:
+            t *= 0.5
+        z = z + t * step
+    return z[:n], z[n], z[n + 1]
+
+
+@pytest.mark.parametrize("moment", [0.0, 0.002])
+def test_active_set_agrees_with_a_complementarity_solver(moment):
+    # Two contact zones around a worn patch. Measured differences: q 2.8e-15 and 2.3e-14
+    # of max q, delta and alpha below 3e-18 (delta ~ 3e-3); 4 sweeps.
+    panels = base_panels(1.0, (), edge_width=1e-2, max_width=0.25)
+    op = kernel_operator(1.0, panels).matrix
+    x, w = panels.nodes, panels.weights
+    m = np.full(x.size, 0.05)
+    g = worn_patch(x)
+    step = Step(1.0, 1.0, {"force": 0.01, "moment": moment})
+    state, sweeps, settled = nodal_active_set(panels, op, m, g, step)
+    assert settled and sweeps < 10
+    q_ref, delta_ref, alpha_ref = _fischer_burmeister(op, m, g, x, w, 0.01, moment)
+    scale = np.max(q_ref)
+    assert np.max(np.abs(state.q - q_ref)) < 1e-11 * scale
+    assert abs(state.settlement - delta_ref) < 1e-12
+    assert abs(state.tilt - alpha_ref) < 1e-12
+    ends, _, _ = zones_from_nodes(state)
+    assert len(ends) == 4  # two zones
+
+
+def test_two_zones_meet_the_contact_conditions():
+    # The refined answer: q >= 0 on the zones, q(end) = 0 at the free ends, equilibrium,
+    # and the gap open between the zones. Measured: Q(end) 0 (clipped) to 1.7e-15 of
+    # max q; end error estimate 1.5e-10; force and
+    # moment by the trapezoid rule on 2001 points 1.5e-5 / 3.0e-5 off (the rule's error).
+    r = solve_unilateral(1.0, 0.05, worn_patch, [1.0], force=0.01, moment=0.002)
+    zones = r.contact_set[0]
+    assert len(zones) == 2 and zones[0][0] == -1.0 and zones[1][1] == 1.0
+    assert r.success and r.flags == []
+    assert r.info["zone_end_error"] < 1e-6  # measured 1.5e-10
+    x = np.linspace(-1.0, 1.0, 2001)
+    q = r.pressure(x)[:, 0]
+    assert np.all(q >= 0.0)
+    gap = (x > zones[0][1]) & (x < zones[1][0])
+    assert np.all(q[gap] == 0.0)
+    inner_ends = [zones[0][1], zones[1][0]]
+    assert np.max(r.pressure(inner_ends)) < 1e-9 * np.max(q)
+    assert abs(np.trapezoid(q, x) - 0.01) < 1e-4 * 0.01
+    assert abs(np.trapezoid(x * q, x) - 0.002) < 1e-3 * 0.002
+
+
+def test_four_statements_agree():
+    # Statement 4 (P, M given) gives delta and alpha; statements 1-3 given the matching
+    # pairs must find the same contact zone and loads. Measured: zone ends within 1.3e-10,
+    # P, M, delta within 1.4e-10 (the error estimate of each solve is ~1e-7).
+    ref = solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.45, tol=1e-8)
+    d, a = float(ref.settlement[0]), float(ref.tilt[0])
+    for given in ({"settlement": d, "tilt": a}, {"settlement": d, "moment": 0.45},
+                  {"tilt": a, "force": 1.0}):
+        r = solve_unilateral(1.0, 0.05, 0.0, [1.0], tol=1e-8, **given)
+        assert r.flags == [], r.message
+        (zone,) = r.contact_set[0]
+        assert abs(zone[0] - ref.contact_set[0][0][0]) < 1e-8 and zone[1] == 1.0
+        for name, value in (("settlement", d), ("tilt", a), ("force", 1.0),
+                            ("moment", 0.45)):
+            assert abs(getattr(r, name)[0] - value) < 1e-8 * max(abs(value), 1e-3), name
+
+
+def test_stepped_punch_zone_ends_at_the_step_corner():
+    # A punch whose middle protrudes by 0.01 (g jumps at x = +-0.4): pressed by less than
+    # the step, it touches on the middle only and the zone ends at the corners (q > 0
+    # there, the gap open outside); pressed harder with a moment, the outer parts touch
+    # too, with free ends. Both pass the final check of the contact conditions.
+    def step_gap(x):
+        return np.where(np.abs(np.asarray(x)) > 0.4, 0.01, 0.0)
+
+    kw = dict(breakpoints=(-0.4, 0.4), tol=1e-8)
+    middle = solve_unilateral(1.0, 0.05, step_gap, [1.0], settlement=0.008, moment=0.0, **kw)
+    assert middle.contact_set[0] == [(-0.4, 0.4)] and middle.flags == []
+    assert np.min(middle.pressure([-0.4, 0.4])) > 0.0
+    both = solve_unilateral(1.0, 0.05, step_gap, [1.0], settlement=0.0133, moment=0.002,
+                            **kw)
+    zones = both.contact_set[0]
+    assert both.flags == [], both.message
+    # three zones: the middle one pinned at the corners, two outer ones with free ends
+    # (measured [-1, -0.7932], [-0.4, 0.4], [0.6868, 1]: the moment makes them unequal)
+    assert len(zones) == 3 and zones[1] == (-0.4, 0.4)
+    assert zones[0][0] == -1.0 and -1.0 < zones[0][1] < -0.4
+    assert zones[2][1] == 1.0 and 0.4 < zones[2][0] < 1.0
+    assert abs(zones[0][1] + zones[2][0]) > 0.05
+    assert both.info["zone_end_error"] < 1e-6
+
+
+# ------------------------------------------------------------------- refinement
+
+
+def test_zone_end_converges_under_refinement_and_the_estimate_holds():
+    # One free end (e = 0.45, m = 0.05): the end found on successively finer rules
+    # (panels halved, end grading quartered). Measured ends differ from the finest by
+    # 4.4e-9, 2.7e-10, 1.6e-11 against estimates (each level against the coarser one)
+    # 6.7e-8, 4.1e-9, 2.6e-10: safe by the convergence ratio of a level, ~16.
+    space = Space(1.0, constant(0.05), constant(0.0), ())
+    step = Step(1.0, 1.0, {"force": 1.0, "moment": 0.45})
+    res = Resolution(0.5, 1e-2)
+    panels = base_panels(1.0, (), edge_width=res.edge, max_width=res.width)
+    op = kernel_operator(1.0, panels).matrix
+    state, _, _ = nodal_active_set(panels, op, np.full(panels.size, 0.05),
+                                   np.zeros(panels.size), step)
+    ends, pinned, slopes = zones_from_nodes(state)
+    found, estimates = [], []
+    for _ in range(4):
+        refined = refine_zone_ends(space, step, ends, pinned, slopes, res, tol=1e-8,
+                                   max_levels=1)
+        assert refined.converged
+        found.append(refined.solution.ends[0])
+        estimates.append(refined.end_error)
+        res = res.finer()
+    diffs = np.abs(np.array(found[:-1]) - found[-1])
+    assert np.all(np.diff(diffs) < 0.0), diffs
+    assert diffs[-1] < 1e-8
+    for k in range(len(diffs)):
+        assert diffs[k] <= estimates[k], (diffs, estimates)
+
+
+# --------------------------------------------------------------------------- creep
+
+
+def _preset_problem(**changes):
+    scene = json.loads(PRESET.read_text())
+    scene["times"] = {"end": 1000.0, "count": 5, "spacing": "log"}
+    for key, value in changes.items():
+        scene["loading"][key] = value
+    return scene_from_dict(scene).dimensionless
+
+
+def _creep_args(problem):
+    return dict(c=problem.c, kernel=problem.kernel, breakpoints=problem.breakpoints,
+                **problem.loads)
+
+
+def test_creep_in_full_contact_agrees_with_the_projection_method():
+    # e = 0.1 m: no lift-off, so the unilateral stepping must reproduce the full-contact
+    # projection method (an independent discretization in space and time). Measured
+    # relative difference 8.6e-7 in settlement and tilt, against an estimate of 8.2e-7.
+    pb = _preset_problem(moment=8.0e4)
+    uni = solve_unilateral(pb.lam, pb.m, pb.g, pb.times, tol=1e-5, **_creep_args(pb))
+    full = solve_dimensionless(pb.lam, pb.m, pb.g, pb.times, tol=1e-8, contact="full",
+                               **_creep_args(pb))
+    assert uni.contact_set == [FULL_CONTACT] * pb.times.size
+    scale = np.max(np.abs(full.settlement))
+    diff = max(np.max(np.abs(uni.settlement - full.settlement)),
+               np.max(np.abs(uni.tilt - full.tilt))) / scale
+    assert diff < 3.0 * uni.info["error_estimate"]
+    assert diff < 1e-4
+
+
+def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
+    # The preset (e = 0.6 m): the zone end moves from -0.306 to -0.349 half-widths over
+    # 1000 days as the base creeps. Two first grids (8 and 16 nominal steps) give ends
+    # 1.3e-7 apart (measured; estimate 2.5e-5 each); the motion is far larger. Force by
+    # the trapezoid rule on 4001 points: 3.4e-6 off.
+    pb = _preset_problem()
+    runs = [solve_unilateral(pb.lam, pb.m, pb.g, pb.times, tol=1e-4, time_steps=steps,
+                             **_creep_args(pb)) for steps in (8, 16)]
+    ends = [np.array([zones[0][0] for zones in r.contact_set]) for r in runs]
+    for r in runs:
+        assert all(len(z) == 1 and z[0][1] == 1.0 for z in r.contact_set)
+        assert r.info["contact"] == "unilateral"
+    motion = abs(ends[1][-1] - ends[1][0])
+    assert motion > 0.03
+    assert np.max(np.abs(ends[0] - ends[1])) < 1e-4
+    assert runs[1].info["zone_end_error"] < 1e-4
+    # equilibrium holds at every time (statement 4: P and M are given)
+    x = np.linspace(-1.0, 1.0, 4001)
+    q = runs[1].pressure(x)
+    assert np.all(q >= 0.0)
+    force = np.trapezoid(q, x, axis=0)
+    assert np.max(np.abs(force - runs[1].force) / runs[1].force) < 1e-3
+
+
+# ----------------------------------------------------------------- the interface
+
+
+def test_contact_argument_and_refusals():
+    with pytest.raises(ValueError, match="contact: must be one of"):
+        solve_dimensionless(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.0, contact="half")
+    with pytest.raises(ValueError, match="^force: must be > 0"):
+        solve_dimensionless(1.0, 0.05, 0.0, [1.0], force=0.0, moment=0.0,
+                            contact="unilateral")
+    with pytest.raises(ValueError, match="^moment: the eccentricity"):
+        solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=-1.0)
+    with pytest.raises(ValueError, match="^time_steps"):
+        solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.0, time_steps=0)
+    # "auto" with a pulling punch: no unilateral answer exists, the flagged full-contact
+    # answer stays (with the reason), rather than an error
+    pulled = solve_dimensionless(1.0, 0.05, 0.0, [1.0], force=-1.0, moment=0.0)
+    assert pulled.info["contact"] == "full" and "contact_lost" in pulled.flags
+    assert pulled.info["unilateral_refused"].startswith("force: must be > 0")
+
+
+def test_full_contact_result_carries_the_whole_base():
+    r = solve_dimensionless(1.0, 0.05, 0.0, [1.0, 2.0], force=1.0, moment=0.45,
+                            contact="full")
+    assert r.info["contact"] == "full" and "contact_lost" in r.flags
+    assert r.contact_set == [[(-1.0, 1.0)], [(-1.0, 1.0)]]
+    auto = solve_dimensionless(1.0, 0.05, 0.0, [1.0, 2.0], force=1.0, moment=0.45)
+    assert auto.info["contact"] == "unilateral" and auto.flags == []
+    assert len(auto.contact_set) == 2 and auto.contact_set[0] == auto.contact_set[1]
+
+
+def test_contact_set_from_pressure():
+    x = np.linspace(-1.0, 1.0, 5)
+    q = np.column_stack([[1.0, 1.0, 1.0, 1.0, 1.0], [-1.0, 1.0, -1.0, -1.0, 1.0]])
+    full, split = contact_set_from_pressure(x, q)
+    assert full == [(-1.0, 1.0)]
+    assert split == [(-0.75, -0.25), (0.75, 1.0)]
+    with pytest.raises(ValueError, match="^x:"):
+        contact_set_from_pressure(x[::-1], q)
+
+
+# ---------------------------------------------------------------------- scenes, CLI
+
+
+def _elastic_preset(contact: str | None = None) -> dict:
+    scene = json.loads(PRESET.read_text())
+    scene["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
+    scene["times"] = [0.0, 10.0]
+    if contact is not None:
+        scene["solver"]["contact"] = contact
+    return scene
+
+
+def test_scene_contact_field_and_dimensional_contact_set():
+    bad = _elastic_preset("sometimes")
+    with pytest.raises(ValueError, match="^solver.contact: must be one of"):
+        scene_from_dict(bad)
+    assert "contact" not in scene_from_dict(_elastic_preset()).to_dict()["solver"]
+    assert scene_from_dict(_elastic_preset("full")).to_dict()["solver"]["contact"] == "full"
+    full = solve(_elastic_preset("full"))
+    assert full.contact_lost and full.contact_set == [[(-1.0, 1.0)]] * 2
+    result = solve(_elastic_preset())
+    assert result.info["contact"] == "unilateral" and result.flags == []
+    (zone,) = result.contact_set[0]
+    a = result.scene.half_width
+    assert zone[1] == a and -a < zone[0] < 0.0
+    # the zone in metres is the dimensionless zone times a
+    assert zone[0] == pytest.approx(a * result.dimensionless.contact_set[0][0][0], rel=1e-15)
+    data = result.to_dict()
+    assert data["contact_set"][0] == [list(zone)]
+    lines = result.to_csv().splitlines()
+    assert lines[0].endswith(",contact_length_m,zone1_start_m,zone1_end_m")
+    row = [float(v) for v in lines[1].split(",")]
+    assert row[-3] == pytest.approx(zone[1] - zone[0]) and row[-2:] == list(zone)
+
+
+def test_cli_writes_the_contact_set(tmp_path: Path):
+    from core.cli import main
+
+    scene_path = tmp_path / "scene.json"
+    scene_path.write_text(json.dumps(_elastic_preset()))
+    out = tmp_path / "out.json"
+    assert main(["solve", str(scene_path), "--output", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["info"]["contact"] == "unilateral"
+    assert len(data["contact_set"]) == 2 and len(data["contact_set"][0]) == 1
+    csv = tmp_path / "out.csv"
+    assert main(["solve", str(scene_path), "--output", str(csv)]) == 0
+    rows = np.loadtxt(csv.read_text().splitlines(), delimiter=",", skiprows=1)
+    assert rows.shape == (2, 8)
+
+
+def test_lift_off_preset_lifts_off_and_meets_its_tolerance():
+    scene = copy.deepcopy(json.loads(PRESET.read_text()))
+    scene["times"] = {"end": 1000.0, "count": 5, "spacing": "log"}
+    result = solve(scene)
+    assert result.info["contact"] == "unilateral"
+    assert result.flags == [], result.flag_messages
+    assert all(len(z) == 1 and z[0][0] > -result.scene.half_width
+               for z in result.contact_set)
