@@ -180,6 +180,7 @@ class PreparedContact:
                 scalars[name] = solved[n + i]
             q_check = unit_pressure(self._check_x) @ weights(probe)
             time_error, steps, time_ok, time_message = 0.0, 0, True, "elastic base"
+            fit_error = 0.0
 
             def pressure(x: np.ndarray) -> np.ndarray:
                 return unit_pressure(x) @ load_matrix
@@ -209,7 +210,7 @@ class PreparedContact:
                 return merged_pressure(x, at)
         built = {k: self.counts[k] - built_before[k] for k in self.counts}
         return self._result(inputs, scalars, pressure, q_check, time_error, steps, time_ok,
-                            time_message, _time.perf_counter() - t0, built)
+                            time_message, _time.perf_counter() - t0, built, fit_error)
 
     def _history_times(self, times: np.ndarray) -> np.ndarray:
         """Output times plus samples between them, where the answer's validity is checked."""
@@ -220,7 +221,8 @@ class PreparedContact:
     def _result(self, inputs: TimeInputs, scalars: dict[str, np.ndarray],
                 pressure: Callable[[np.ndarray], np.ndarray], q_check: np.ndarray,
                 time_error: float, steps: int, time_ok: bool, time_message: str,
-                seconds: float, built: dict[str, int]) -> ContactSolution:
+                seconds: float, built: dict[str, int], fit_error: float = 0.0
+                ) -> ContactSolution:
         tol = self.geometry.tol
         error = float(self.spatial_error + time_error)
         success = error <= tol and self.resolved and time_ok
@@ -251,6 +253,8 @@ class PreparedContact:
             "error_estimate": error,
             "spatial_error_estimate": float(self.spatial_error),
             "time_error_estimate": float(time_error),
+            # the creep kernel's sum-of-exponentials fit (included in the time estimate)
+            "kernel_fit_error": float(fit_error),
             "seconds": seconds,
             "prepare_seconds": self.seconds,
             "flags": flags,
