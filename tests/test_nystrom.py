@@ -2,7 +2,7 @@
 
 Accuracy is measured as the engine claims it: q on the whole of [-1, 1] (3001 Chebyshev
 points, both ends and both sides of every jump) relative to max|q|, and delta, alpha, P,
-M relative to their scales, against (a) the same engine at tol 1e-12 (convergence under
+M relative to their scales, against (a) the same engine at tol 1e-10 (convergence under
 refinement) and (b) the independent projection method at tol 1e-10 on interior points.
 The measured values quoted in the comments come from benchmarks/scenes.py's scenes on
 this version (errors/estimates 0.11-0.38 at tol 1e-4, 1e-6, 1e-8).
@@ -39,7 +39,7 @@ def whole_interval(breakpoints) -> np.ndarray:
 @cache
 def reference(name: str):
     s = SCENES[name]
-    return solve_dimensionless(s["lam"], s["m"], s["g"], [1.0], tol=1e-12,
+    return solve_dimensionless(s["lam"], s["m"], s["g"], [1.0], tol=1e-10,
                                breakpoints=s["breakpoints"], **LOADS)
 
 
@@ -162,7 +162,8 @@ def test_lost_contact_between_output_times_is_flagged():
     # A moment that swings through M = 0.45 P between the outputs (t = 1, 2, 3 where it
     # is 0): q < 0 at an edge only between them.
     sol = solve_dimensionless(1.0, 1e-3, 0.0, [1.0, 2.0, 3.0], force=1.0,
-                              moment=lambda t: 0.45 * np.sin(np.pi * (t - 1.0)), tol=1e-6)
+                              moment=lambda t: 0.45 * np.sin(np.pi * (t - 1.0)), tol=1e-6,
+                              contact="full")
     assert "contact_lost" in sol.flags
 
 
