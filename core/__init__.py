@@ -7,7 +7,9 @@ The public entry points are loaded on first use, so that importing one submodule
   dimensionless problem;
 - :func:`solve`, :class:`Scene`, :class:`SceneSolution`, :func:`scene_from_dict`,
   :func:`load_scene`, :func:`save_scene` (:mod:`core.scene`): dimensional scenes in SI
-  units with time in days.
+  units with time in days;
+- :func:`sweep` (:mod:`core.sweeps`), :func:`load_study`, :func:`study_from_dict`
+  (:mod:`core.study`): design studies (parameter sweeps, Monte Carlo) run on Dask.
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ if TYPE_CHECKING:
         solve,
     )
     from core.solver import ContactSolution, solve_dimensionless
+    from core.study import load_study, study_from_dict
+    from core.sweeps import sweep
 
 _EXPORTS: dict[str, str] = {
     "solve_dimensionless": "core.solver",
@@ -35,6 +39,9 @@ _EXPORTS: dict[str, str] = {
     "scene_from_dict": "core.scene",
     "load_scene": "core.scene",
     "save_scene": "core.scene",
+    "sweep": "core.sweeps",
+    "load_study": "core.study",
+    "study_from_dict": "core.study",
 }
 
 __all__ = [
@@ -46,6 +53,9 @@ __all__ = [
     "scene_from_dict",
     "load_scene",
     "save_scene",
+    "sweep",
+    "load_study",
+    "study_from_dict",
 ]
 
 
