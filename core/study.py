@@ -293,15 +293,18 @@ def _base_scene(spec: Any, base_dir: Path | None) -> dict[str, Any]:
         raise ValueError(f"scene: {exc}") from None
 
 
-def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = None) -> Study:
+def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = None, *,
+                    max_points: int = MAX_STUDY_POINTS) -> Study:
     """Validate a study dict (format in ``core/SCENES.md``) and build a :class:`Study`.
 
     ``base_dir`` resolves a relative ``scene`` path. Every problem raises ``ValueError``
     whose message starts with the field (``vary[1].linspace.count: ...``); the base scene's
     own problems are prefixed ``scene:``. The scene at each end of every grid (and at the
     centre of every distribution) must be valid; the number of points is at most
-    :data:`MAX_STUDY_POINTS`.
+    ``max_points`` (default and upper bound :data:`MAX_STUDY_POINTS`; a server offering
+    studies to untrusted users passes a smaller one).
     """
+    max_points = min(int(max_points), MAX_STUDY_POINTS)
     _check_fields(d, "", ("study_version", "name", "scene", "vary"),
                   ("description", "samples", "seed", "outputs", "times"))
     _integer(d["study_version"], "study_version", STUDY_VERSION, STUDY_VERSION)
@@ -349,9 +352,9 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     outputs = tuple(dict.fromkeys(outputs_spec))
 
     n = math.prod(len(p.values) for p in params if p.is_grid) * samples
-    if n > MAX_STUDY_POINTS:
+    if n > max_points:
         raise ValueError(f"vary: the study has {n:,} points (grid sizes times samples), more "
-                         f"than the limit of {MAX_STUDY_POINTS:,}")
+                         f"than the limit of {max_points:,}")
 
     for i, p in enumerate(params):
         for where, value in _extremes(p):
@@ -361,6 +364,24 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
                 raise ValueError(f"vary[{i}].{where}: the scene is invalid at {p.path} = "
                                  f"{value:.6g} ({exc})") from None
     return Study(name.strip(), base, params, samples, seed, outputs, times)
+
+
+def numeric_fields(scene: Mapping[str, Any], prefix: str = "") -> list[tuple[str, float]]:
+    """Every field of a scene dict that a study can vary, with its current value: the
+    numbers outside ``times`` and the schema fields, as ``(path, value)`` in document
+    order (``[("punch.half_width", 1.0), ("coating[0].thickness", 0.02), ...]``)."""
+    out: list[tuple[str, float]] = []
+    items = scene.items() if isinstance(scene, Mapping) else enumerate(scene)
+    for key, value in items:
+        path = (f"{prefix}[{key}]" if isinstance(key, int)
+                else f"{prefix}.{key}" if prefix else str(key))
+        if not prefix and key in _FIXED_ROOTS:
+            continue
+        if isinstance(value, (Mapping, list)):
+            out.extend(numeric_fields(value, path))
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            out.append((path, float(value)))
+    return out
 
 
 def load_study(path: str | os.PathLike) -> Study:

@@ -18,6 +18,7 @@ from core.study import (
     MAX_STUDY_POINTS,
     apply_point,
     load_study,
+    numeric_fields,
     parse_path,
     point_table,
     study_from_dict,
@@ -170,6 +171,17 @@ def test_points_are_a_pure_function_of_the_study(tmp_path: Path):
     point = apply_point(base, {"coating[0].modulus": 1.0, "loading.force": 2.0})
     assert point["coating"][0]["modulus"] == 1.0 and point["loading"]["force"] == 2.0
     assert json.dumps(base) == before
+
+
+def test_fields_a_study_can_vary_and_a_smaller_limit():
+    fields = dict(numeric_fields(study_from_dict(small_study()).base))
+    assert fields["coating[0].modulus"] == 8e8 and fields["loading.moment"] == 0.0
+    assert fields["base.creep.modulus"] == 3e10
+    assert not any(path.startswith(("times", "schema_version")) for path in fields)
+    for path in fields:  # each one is accepted by a study
+        study_from_dict(small_study(vary=[{"field": path, "values": [fields[path]]}]))
+    with pytest.raises(ValueError, match=r"^vary: the study has 12 points .* limit of 10$"):
+        study_from_dict(small_study(), max_points=10)
 
 
 # ------------------------------------------------------------------------- execution
