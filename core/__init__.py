@@ -9,7 +9,9 @@ The public entry points are loaded on first use, so that importing one submodule
   loads many times;
 - :func:`solve`, :class:`Scene`, :class:`SceneSolution`, :func:`scene_from_dict`,
   :func:`load_scene`, :func:`save_scene` (:mod:`core.scene`): dimensional scenes in SI
-  units with time in days.
+  units with time in days;
+- :func:`sweep` (:mod:`core.sweeps`), :func:`load_study`, :func:`study_from_dict`
+  (:mod:`core.study`): design studies (parameter sweeps, Monte Carlo) run on Dask.
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ if TYPE_CHECKING:
         solve,
     )
     from core.solver import ContactSolution, solve_dimensionless
+    from core.study import load_study, study_from_dict
+    from core.sweeps import sweep
 
 _EXPORTS: dict[str, str] = {
     "solve_dimensionless": "core.solver",
@@ -41,6 +45,9 @@ _EXPORTS: dict[str, str] = {
     "load_scene": "core.scene",
     "save_scene": "core.scene",
     "creep_coefficient_curve": "core.code_creep",
+    "sweep": "core.sweeps",
+    "load_study": "core.study",
+    "study_from_dict": "core.study",
 }
 
 __all__ = [
@@ -54,6 +61,9 @@ __all__ = [
     "load_scene",
     "save_scene",
     "creep_coefficient_curve",
+    "sweep",
+    "load_study",
+    "study_from_dict",
 ]
 
 

@@ -1,4 +1,6 @@
-"""The command line: ``python -m core solve SCENE.json`` and ``python -m core validate SCENE.json``.
+"""The command line: ``python -m core solve SCENE.json``, ``python -m core validate SCENE.json``
+and ``python -m core sweep STUDY.json --output RESULT.nc`` (a design study, see
+:mod:`core.sweeps`).
 
 ``solve`` writes the solution to ``--output`` (``.json``: everything, see
 :meth:`core.scene.SceneSolution.to_dict`, with the contact set per time; ``.csv``: the
@@ -16,6 +18,7 @@ exit code 0.
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -126,12 +129,47 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    # imported here: a plain solve must not load Dask
+    from core.study import load_study
+    from core.sweeps import check_output, sweep
+
+    output = Path(args.output)
+    try:
+        check_output(output)
+        study = load_study(args.study)
+    except ValueError as exc:
+        raise _InputError(str(exc)) from None
+    except OSError as exc:
+        raise _InputError(f"{args.study}: {exc.strerror or exc}") from None
+    own_parts = args.work_dir is None
+    work_dir = Path(args.work_dir) if args.work_dir else \
+        output.with_name(output.name + ".parts")
+    try:
+        info = sweep(study, scheduler=args.scheduler, work_dir=work_dir, output=output,
+                     batch_points=args.batch_points,
+                     progress=not args.quiet and sys.stderr.isatty(),
+                     return_dataset=False)
+    except ValueError as exc:
+        raise _InputError(str(exc)) from None
+    print(f"{study.n_points} points in {info['batches']} batches ({info['batches_reused']} "
+          f"reused), {info['points_failed']} failed, {info['points_flagged']} flagged, "
+          f"{info['seconds']:.1f} s; written to {output}")
+    if info["batches_lost"]:
+        print(f"error: sweep: {info['batches_lost']} batches were lost; run the same command "
+              f"again to compute them (the others are kept in {work_dir})", file=sys.stderr)
+        return EXIT_SOLVER_FAILED
+    if own_parts:
+        shutil.rmtree(work_dir, ignore_errors=True)
+    return EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``python -m core``."""
     parser = _Parser(prog="python -m core",
                      description="Contact of a rigid punch on a coated, aging viscoelastic "
                                  "layer (scene files: see core/SCENES.md).")
-    sub = parser.add_subparsers(dest="command", metavar="{solve,validate}",
+    sub = parser.add_subparsers(dest="command", metavar="{solve,validate,sweep}",
                                 parser_class=_Parser)
     sub.required = True
     p_solve = sub.add_parser("solve", help="solve a scene and write the result")
@@ -147,6 +185,24 @@ def build_parser() -> argparse.ArgumentParser:
     p_validate = sub.add_parser("validate", help="check a scene file")
     p_validate.add_argument("scene", help="scene file (JSON)")
     p_validate.set_defaults(run=_cmd_validate)
+    p_sweep = sub.add_parser("sweep", help="run a design study (core/SCENES.md, "
+                                           "'Study files') on Dask")
+    p_sweep.add_argument("study", help="study file (JSON)")
+    p_sweep.add_argument("--output", "-o", metavar="PATH", required=True,
+                         help="result file: .nc (xarray dataset), .csv or .parquet (a row "
+                              "per point and time)")
+    p_sweep.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                         help="an existing Dask scheduler (default: the Dask config's "
+                              "scheduler-address, else a local cluster on all cores)")
+    p_sweep.add_argument("--work-dir", metavar="DIR",
+                         help="keep the finished batches here (default: OUTPUT.parts, "
+                              "removed when the study is complete); an interrupted study "
+                              "resumes from it")
+    p_sweep.add_argument("--batch-points", type=int, metavar="N",
+                         help="points per task (default: about 64 tasks, at most 500 points "
+                              "each)")
+    p_sweep.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+    p_sweep.set_defaults(run=_cmd_sweep)
     return parser
 
 

@@ -1,0 +1,254 @@
+"""Design studies on Dask: throughput, speed-up with workers, and a design chart.
+
+    python -m benchmarks.sweep              # the report (about 10 minutes on 2 cores)
+    python -m benchmarks.sweep --quick      # smaller studies, one repeat (about 2 minutes)
+    python -m benchmarks.sweep --chart-only # only the design chart
+
+Measured (``core.sweep`` on a local Dask cluster of single-threaded worker processes on
+127.0.0.1, a fresh cluster for every run so that no worker starts with warm caches; the
+cluster's start is timed separately):
+
+* 10,000 elastic points over two loads (force x moment, 100 x 100, one output time):
+  goal <= 10 s on 2 workers;
+* 1,000 points over the coating modulus (a new geometry per point): goal <= 30 s;
+* the same two studies on 1 worker (speed-up 1 vs 2 workers), and a serial loop in this
+  process on a tenth of the points (the cost of a point without Dask);
+* the design chart of ``assets/studies/eccentric_design.json`` (settlement and tilt 50
+  years after loading over the eccentricity and the coating modulus, the region where the
+  full-contact answer loses contact hatched).
+
+Output: ``benchmarks/results/sweep.md`` and ``benchmarks/results/sweep_design_chart.png``
+(``--quick``: ``benchmarks/results/quick/``, not kept in the repository).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from core.study import Study, study_from_dict  # noqa: E402
+from core.sweeps import sweep  # noqa: E402
+
+RESULTS = ROOT / "benchmarks" / "results"
+DESIGN_STUDY = ROOT / "assets" / "studies" / "eccentric_design.json"
+GOALS = {"loads": 10.0, "modulus": 30.0}
+
+
+def elastic_scene() -> dict[str, Any]:
+    """The uniform-coating preset on an elastic base, one output time (a year)."""
+    scene = json.loads((ROOT / "assets" / "scenes" / "uniform_flat.json").read_text())
+    scene["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
+    scene["times"] = [365.0]
+    return scene
+
+
+def loads_study(n_side: int) -> Study:
+    """``n_side``^2 points over force [N/m] and moment [N]."""
+    return study_from_dict({
+        "study_version": 1, "name": "loads", "scene": elastic_scene(),
+        "vary": [{"field": "loading.force", "linspace": {"start": 1e5, "stop": 1e6,
+                                                         "count": n_side}},
+                 {"field": "loading.moment", "linspace": {"start": 0.0, "stop": 2e5,
+                                                          "count": n_side}}]})
+
+
+def modulus_study(n: int) -> Study:
+    """``n`` points over the coating modulus [Pa], 50 MPa to 20 GPa."""
+    return study_from_dict({
+        "study_version": 1, "name": "modulus", "scene": elastic_scene(),
+        "vary": [{"field": "coating[0].modulus", "logspace": {"start": 5e7, "stop": 2e10,
+                                                              "count": n}}]})
+
+
+def on_fresh_cluster(study: Study, workers: int) -> dict[str, float]:
+    """Run ``study`` on a new local cluster of ``workers`` processes; seconds of the start
+    and of the study, and the points that failed."""
+    from distributed import Client, LocalCluster
+
+    start = time.perf_counter()
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                           host="127.0.0.1", dashboard_address=None,
+                           env={"OPENBLAS_NUM_THREADS": "1"})
+    client = Client(cluster)
+    client.wait_for_workers(workers)
+    started = time.perf_counter() - start
+    try:
+        start = time.perf_counter()
+        info = sweep(study, client=client, return_dataset=False)
+        seconds = time.perf_counter() - start
+    finally:
+        client.close()
+        cluster.close()
+    return {"start": started, "seconds": seconds, "load": os.getloadavg()[0],
+            "failed": info["points_failed"],
+            "flagged": info["points_flagged"], "batches": info["batches"]}
+
+
+def serial_seconds_per_point(study: Study, points: int) -> float:
+    """Seconds per point of a serial loop in this process over the first ``points``
+    points of a grid study (the same batching, no Dask)."""
+    from dataclasses import replace
+
+    first = study.parameters[0]
+    per_value = study.n_points // len(first.values)
+    keep = max(1, points // per_value)
+    cut = replace(study, parameters=(replace(first, values=first.values[:keep]),)
+                  + study.parameters[1:])
+    start = time.perf_counter()
+    sweep(cut, client="serial", return_dataset=False)
+    return (time.perf_counter() - start) / cut.n_points
+
+
+def measure(name: str, study: Study, repeats: int) -> dict[str, Any]:
+    runs = {w: [on_fresh_cluster(study, w) for _ in range(repeats)] for w in (2, 1)}
+    med = {w: statistics.median(r["seconds"] for r in runs[w]) for w in runs}
+    return {"name": name, "points": study.n_points, "runs": runs, "median": med,
+            "speedup": med[1] / med[2],
+            "serial_per_point": serial_seconds_per_point(study, study.n_points // 10)}
+
+
+def design_chart(path: Path) -> dict[str, Any]:
+    """Run the design study on a local cluster (2 workers) and draw the chart."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    start = time.perf_counter()
+    ds = sweep(DESIGN_STUDY, batch_points=26)
+    seconds = time.perf_counter() - start
+    shape = json.loads(ds.attrs["grid_shape"])
+    modulus = ds.coating_0_modulus.values.reshape(shape)[:, 0]
+    force = json.loads(ds.attrs["base_scene"])["loading"]["force"]
+    ecc = ds.loading_moment.values.reshape(shape)[0] / force
+    last = -1
+    settlement = 1e3 * ds.settlement.values[:, last].reshape(shape)
+    tilt = 1e3 * ds.tilt.values[:, last].reshape(shape)
+    lost = ds.flag_contact_lost.values.reshape(shape)
+    failed = ds.failed.values.reshape(shape)
+    years = ds.time.values[last] / 365.25
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), constrained_layout=True)
+    for ax, values, label in ((axes[0], settlement, "settlement [mm]"),
+                              (axes[1], tilt, "tilt [mrad]")):
+        filled = ax.contourf(ecc, modulus / 1e6, values, levels=14, cmap="viridis")
+        lines = ax.contour(ecc, modulus / 1e6, values, levels=7, colors="white",
+                           linewidths=0.6)
+        ax.clabel(lines, fontsize=7, fmt="%.3g")
+        fig.colorbar(filled, ax=ax, label=f"{label}, {years:.0f} years after loading")
+        if lost.any():
+            ax.contourf(ecc, modulus / 1e6, lost.astype(float), levels=[0.5, 1.5],
+                        colors="none", hatches=["///"])
+            ax.contour(ecc, modulus / 1e6, lost.astype(float), levels=[0.5], colors="red",
+                       linewidths=1.2)
+        if failed.any():
+            ee, mm = np.meshgrid(ecc, modulus / 1e6)
+            ax.plot(ee[failed], mm[failed], "rx", ms=4, label="failed")
+        ax.set_yscale("log")
+        ax.set_xlabel("eccentricity e = M / P [m]")
+        ax.set_ylabel("coating modulus [MPa]")
+    axes[0].set_title("hatched, right of the red line: contact lost (full-contact answer "
+                      "not physical)", fontsize=8)
+    fig.suptitle(ds.attrs["study"], fontsize=10)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return {"points": int(ds.sizes["point"]), "seconds": seconds,
+            "failed": int(ds.failed.sum()), "contact_lost": int(lost.sum())}
+
+
+def environment() -> str:
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                                capture_output=True, text=True, timeout=10).stdout.strip()
+    except OSError:
+        commit = "?"
+    import dask
+
+    return (f"{os.cpu_count()} cores ({platform.machine()}), Python "
+            f"{platform.python_version()}, numpy {np.__version__}, dask {dask.__version__}, "
+            f"commit {commit}; the machine was shared with other work, so times are noisy")
+
+
+def report(results: list[dict[str, Any]], chart: dict[str, Any] | None, command: str,
+           repeats: int) -> str:
+    lines = ["# Design studies on Dask: measured", "",
+             f"Command: `{command}`  ", f"Machine: {environment()}.", "",
+             "Each run starts a fresh local cluster (single-threaded worker processes on "
+             "127.0.0.1; its start is not counted) so that no worker begins with warm "
+             f"solver caches; median of {repeats} run(s). Measured with today's default "
+             "solver engine (projection): a faster engine is being introduced, so the "
+             "absolute times will change; the batching and the speed-up are what this "
+             "measures.", "",
+             "| study | points | 2 workers [s] | goal | met | 1 worker [s] | speed-up | "
+             "serial loop, no Dask [ms/point] | cluster start [s] |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in results:
+        goal = GOALS.get(r["name"])
+        two, one = r["median"][2], r["median"][1]
+        start = statistics.median(x["start"] for x in r["runs"][2])
+        lines.append(f"| {r['name']} | {r['points']:,} | {two:.1f} | "
+                     f"{'' if goal is None else f'<= {goal:g} s'} | "
+                     f"{'' if goal is None else ('yes' if two <= goal else 'no')} | "
+                     f"{one:.1f} | {r['speedup']:.2f}x | {1e3 * r['serial_per_point']:.2f} | "
+                     f"{start:.1f} |")
+    lines += ["", "All runs (seconds, 2 workers then 1):", ""]
+    for r in results:
+        runs = ", ".join(f"{x['seconds']:.1f}" for x in r["runs"][2]) + " / " + \
+            ", ".join(f"{x['seconds']:.1f}" for x in r["runs"][1])
+        load = ", ".join(f"{x['load']:.1f}" for w in (2, 1) for x in r["runs"][w])
+        lines.append(f"- {r['name']}: {runs} (load average after each: {load}); failed points: "
+                     f"{r['runs'][2][0]['failed']}, flagged: {r['runs'][2][0]['flagged']}, "
+                     f"batches: {r['runs'][2][0]['batches']}")
+    if chart is not None:
+        lines += ["", "## Design chart", "",
+                  "![design chart](sweep_design_chart.png)", "",
+                  f"`{DESIGN_STUDY.relative_to(ROOT)}`: {chart['points']} points in "
+                  f"{chart['seconds']:.1f} s on a local cluster (all cores, its start "
+                  f"included), {chart['failed']} failed, {chart['contact_lost']} with "
+                  "contact lost. The same study from the shell: `python -m core sweep "
+                  f"{DESIGN_STUDY.relative_to(ROOT)} --output design.nc`."]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="small studies, one repeat")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--chart-only", action="store_true")
+    args = parser.parse_args(argv)
+    out = RESULTS / "quick" if args.quick else RESULTS
+    out.mkdir(parents=True, exist_ok=True)
+    command = "python -m benchmarks.sweep " + " ".join(argv if argv is not None
+                                                        else sys.argv[1:])
+    chart = design_chart(out / "sweep_design_chart.png")
+    print(f"chart: {chart}", flush=True)
+    if args.chart_only:
+        return 0
+    repeats = 1 if args.quick else args.repeats
+    results = []
+    for name, study in (("loads", loads_study(45 if args.quick else 100)),
+                        ("modulus", modulus_study(200 if args.quick else 1000))):
+        results.append(measure(name, study, repeats))
+        print(f"{name}: {results[-1]['median']} speed-up {results[-1]['speedup']:.2f}",
+              flush=True)
+    (out / "sweep.md").write_text(report(results, chart, command.strip(), repeats))
+    print((out / "sweep.md").read_text())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

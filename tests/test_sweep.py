@@ -1,0 +1,365 @@
+"""Design studies: validation names the field, a real Dask cluster on loopback gives what a
+serial loop gives, failed points are recorded, an interrupted study resumes."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.scene import solve
+from core.study import (
+    MAX_STUDY_POINTS,
+    apply_point,
+    load_study,
+    numeric_fields,
+    parse_path,
+    point_table,
+    study_from_dict,
+)
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENES = ROOT / "assets" / "scenes"
+OUTPUTS = ("settlement", "tilt", "force", "moment", "q_max", "q_min", "contact_width")
+
+
+def elastic_scene() -> dict:
+    scene = json.loads((SCENES / "uniform_flat.json").read_text())
+    scene["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
+    return scene
+
+
+def small_study(**extra) -> dict:
+    """Loads on a 3 x 2 grid and two coating moduli: 12 points, 2 geometries."""
+    study = {"study_version": 1, "name": "small", "scene": elastic_scene(),
+             "vary": [{"field": "coating[0].modulus", "values": [8e8, 4e8]},
+                      {"field": "loading.force", "linspace": {"start": 2e5, "stop": 6e5,
+                                                              "count": 3}},
+                      {"field": "loading.moment", "values": [0.0, 1e5]}],
+             "times": [1.0, 365.0]}
+    study.update(extra)
+    return study
+
+
+def serial_loop(study) -> dict[str, np.ndarray]:
+    """The reference: every point solved with core.solve, one after another."""
+    table = point_table(study)
+    paths = [p.path for p in study.parameters]
+    out = {name: np.full((study.n_points, len(study.times)), np.nan) for name in OUTPUTS}
+    for i in range(study.n_points):
+        result = solve(apply_point(study.base, {p: table[p][i] for p in paths}))
+        q = result.pressure_on_grid
+        out["settlement"][i] = result.settlement
+        out["tilt"][i] = result.tilt
+        out["force"][i] = result.force
+        out["moment"][i] = result.moment
+        out["q_max"][i] = q.max(axis=0)
+        out["q_min"][i] = q.min(axis=0)
+        # full contact at a time: the whole width; else left to test_contact_width
+        out["contact_width"][i] = np.where(q.min(axis=0) >= 0, 2 * result.scene.half_width,
+                                           np.nan)
+    return out
+
+
+def assert_equal_to_serial(ds, study) -> None:
+    reference = serial_loop(study)
+    assert not ds.failed.any()
+    for name in OUTPUTS:
+        got = ds[name].values
+        want = reference[name]
+        if name == "contact_width":
+            full = np.isfinite(want)
+            np.testing.assert_allclose(got[full], want[full], rtol=1e-14)
+            assert np.all(got[~full] < np.nanmax(want))
+            continue
+        # the same solver with the same inputs: measured bitwise equal (difference 0.0);
+        # 1e-12 leaves room for a cache prepared by another point on another worker
+        scale = np.max(np.abs(want), axis=0, keepdims=True)
+        np.testing.assert_allclose(got / np.where(scale > 0, scale, 1.0),
+                                   want / np.where(scale > 0, scale, 1.0), rtol=0, atol=1e-12)
+
+
+# ------------------------------------------------------------------------- validation
+
+
+@pytest.mark.parametrize(("change", "starts"), [
+    ({"vary": [{"field": "coating[2].modulus", "values": [1e8]}]}, "vary[0].field: coating[2]"),
+    ({"vary": [{"field": "loading.forse", "values": [1e5]}]}, "vary[0].field: loading.forse"),
+    ({"vary": [{"field": "coating[0]modulus", "values": [1e8]}]}, "vary[0].field:"),
+    ({"vary": [{"field": "base.creep", "values": [1]}]}, "vary[0].field: 'base.creep' holds"),
+    ({"vary": [{"field": "times.end", "values": [1]}]}, "vary[0].field: 'times.end' cannot"),
+    ({"vary": [{"field": "coating[0].modulus", "values": [1e8, -1e8]}]},
+     "vary[0].values: the scene is invalid at coating[0].modulus = -1e+08 "
+     "(coating[0].modulus: must be > 0"),
+    ({"vary": [{"field": "base.poisson", "uniform": {"low": 0.1, "high": 0.5}}],
+      "samples": 4}, "vary[0].uniform.high: the scene is invalid"),
+    ({"vary": [{"field": "base.poisson", "uniform": {"low": 0.3, "high": 0.1}}],
+      "samples": 4}, "vary[0].uniform.high: must be greater than low"),
+    ({"vary": [{"field": "loading.force", "logspace": {"start": 0, "stop": 1e5,
+                                                       "count": 3}}]},
+     "vary[0].logspace.start: must be > 0"),
+    ({"vary": [{"field": "loading.force", "linspace": {"start": 1, "stop": 2,
+                                                       "count": 2.5}}]},
+     "vary[0].linspace.count: must be an integer"),
+    ({"vary": [{"field": "loading.force", "linspace": {"start": 1, "stop": 1,
+                                                       "count": 3}}]},
+     "vary[0].linspace.stop: equals start"),
+    ({"vary": [{"field": "loading.force", "normal": {"mean": 1e5, "std": -1}}],
+      "samples": 3}, "vary[0].normal.std: must be > 0"),
+    ({"vary": [{"field": "loading.force", "normal": {"mean": 1e5, "std": 1e4}}]},
+     "samples: required"),
+    ({"vary": [{"field": "loading.force", "values": [1e5, 2e5],
+                "linspace": {"start": 1, "stop": 2, "count": 2}}]},
+     "vary[0]: give exactly one"),
+    ({"vary": [{"field": "loading.force", "values": [1e5]},
+               {"field": "loading.force", "values": [2e5]}]},
+     "vary[1].field: 'loading.force' is already varied by vary[0]"),
+    ({"vary": [{"field": "loading.force", "linspace": {"start": 1, "stop": 2, "count": 1001}},
+               {"field": "loading.moment", "linspace": {"start": 0, "stop": 1,
+                                                        "count": 1000}}]},
+     f"vary: the study has 1,001,000 points (grid sizes times samples), more than the "
+     f"limit of {MAX_STUDY_POINTS:,}"),
+    ({"outputs": ["settlement", "qmax"]}, "outputs[1]: unknown output"),
+    ({"times": [5.0, 1.0]}, "times[1]"),
+    ({"study_version": 2}, "study_version: must be an integer from 1 to 1"),
+    ({"vary": []}, "vary: must be a list of 1 to"),
+    ({"extra": 1}, "scene: unknown field 'extra'"),
+])
+def test_bad_study_names_the_field(change, starts):
+    with pytest.raises(ValueError) as info:
+        study_from_dict(small_study(**change))
+    assert str(info.value).startswith(starts), str(info.value)
+
+
+def test_bad_base_scene_and_paths(tmp_path: Path):
+    bad = elastic_scene()
+    bad["base"]["poisson"] = 0.7
+    with pytest.raises(ValueError, match=r"^scene: base\.poisson: must be in"):
+        study_from_dict(small_study(scene=bad))
+    with pytest.raises(ValueError, match=r"^scene: cannot read 'missing\.json'"):
+        study_from_dict(small_study(scene="missing.json"), base_dir=tmp_path)
+    assert parse_path("coating[0].modulus") == ("coating", 0, "modulus")
+    with pytest.raises(ValueError, match=r"^field: "):
+        parse_path("coating[-1].modulus")
+
+
+def test_points_are_a_pure_function_of_the_study(tmp_path: Path):
+    (tmp_path / "scene.json").write_text(json.dumps(elastic_scene()))
+    spec = small_study(scene="scene.json")
+    spec["vary"].append({"field": "base.thickness", "lognormal": {"median": 4.0,
+                                                                  "sigma": 0.1}})
+    spec["samples"] = 5
+    (tmp_path / "study.json").write_text(json.dumps(spec))
+    study = load_study(tmp_path / "study.json")
+    assert study.n_points == 2 * 3 * 2 * 5
+    table, again = point_table(study), point_table(load_study(tmp_path / "study.json"))
+    for path in table:
+        np.testing.assert_array_equal(table[path], again[path])
+    # the grid in study order (the last axis fastest), the samples innermost and shared
+    assert list(table["coating[0].modulus"][:60:30]) == [8e8, 4e8]
+    assert list(table["loading.moment"][:10:5]) == [0.0, 1e5]
+    draws = table["base.thickness"].reshape(12, 5)
+    assert np.all(draws == draws[0]) and np.all(draws > 0)
+    base = study.base
+    before = json.dumps(base)
+    point = apply_point(base, {"coating[0].modulus": 1.0, "loading.force": 2.0})
+    assert point["coating"][0]["modulus"] == 1.0 and point["loading"]["force"] == 2.0
+    assert json.dumps(base) == before
+
+
+def test_fields_a_study_can_vary_and_a_smaller_limit():
+    fields = dict(numeric_fields(study_from_dict(small_study()).base))
+    assert fields["coating[0].modulus"] == 8e8 and fields["loading.moment"] == 0.0
+    assert fields["base.creep.modulus"] == 3e10
+    assert not any(path.startswith(("times", "schema_version")) for path in fields)
+    for path in fields:  # each one is accepted by a study
+        study_from_dict(small_study(vary=[{"field": path, "values": [fields[path]]}]))
+    with pytest.raises(ValueError, match=r"^vary: the study has 12 points .* limit of 10$"):
+        study_from_dict(small_study(), max_points=10)
+
+
+# ------------------------------------------------------------------------- execution
+
+
+def test_contact_width_of_a_pressure_linear_in_x():
+    from core.sweeps import _contact_width
+
+    x = -np.cos(np.linspace(0, np.pi, 201))  # uneven, like the plotting grid
+    q = np.stack([x - 0.5, 1 + 0 * x, -1 - x * 0, 0.3 - x], axis=1)
+    # linear between points, so exact for a linear q: measured error 2e-16
+    np.testing.assert_allclose(_contact_width(x, q), [0.5, 2.0, 0.0, 1.3], atol=1e-14)
+
+
+def test_serial_run_equals_the_loop_and_batches_follow_geometry():
+    from core.sweeps import plan_batches, sweep
+
+    study = study_from_dict(small_study())
+    ds = sweep(study, client="serial", batch_points=4)
+    assert_equal_to_serial(ds, study)
+    assert ds.settlement.attrs["units"] == "m" and ds.q_max.attrs["units"] == "Pa"
+    assert ds.coating_0_modulus.attrs["field"] == "coating[0].modulus"
+    assert ds.attrs["batches"] == 3 and ds.attrs["points_failed"] == 0
+    # a geometry's points are neighbours, loads in lexicographic order inside it
+    table = point_table(study)
+    order = np.concatenate(plan_batches(study, table, 4))
+    moduli = table["coating[0].modulus"][order]
+    assert np.count_nonzero(np.diff(moduli)) == 1
+    pairs = list(zip(table["loading.force"][order][:6], table["loading.moment"][order][:6],
+                     strict=True))
+    assert pairs == sorted(pairs)
+
+
+def test_failed_point_is_recorded_and_the_study_goes_on():
+    from core.sweeps import sweep
+
+    spec = small_study(vary=[{"field": "base.poisson", "normal": {"mean": 0.3, "std": 0.15}}],
+                       samples=12, seed=3)
+    study = study_from_dict(spec)
+    draws = point_table(study)["base.poisson"]
+    bad = draws >= 0.5
+    assert 0 < bad.sum() < len(draws)  # seed 3 draws both kinds
+    ds = sweep(study, client="serial")
+    np.testing.assert_array_equal(ds.failed.values, bad)
+    for message in ds.error.values[bad]:
+        assert message.startswith("base.poisson: must be in (-1, 0.5)")
+    assert np.all(np.isnan(ds.settlement.values[bad]))
+    assert np.all(np.isfinite(ds.settlement.values[~bad]))
+    assert ds.attrs["points_failed"] == bad.sum()
+
+
+def test_interrupted_study_resumes_without_recomputing(tmp_path: Path):
+    from core.sweeps import StudyInterrupted, sweep
+
+    study = study_from_dict(small_study())
+    work = tmp_path / "parts"
+    calls = []
+
+    def stop_after_two_batches(done: int, total: int) -> bool:
+        calls.append(done)
+        return len(calls) < 2
+
+    with pytest.raises(StudyInterrupted):
+        sweep(study, client="serial", work_dir=work, batch_points=4,
+              progress=stop_after_two_batches)
+    written = {p.name: p.stat().st_mtime_ns for p in (work / "parts").glob("*.npz")}
+    assert len(written) == 2
+    ds = sweep(study, client="serial", work_dir=work, batch_points=4)
+    assert ds.attrs["batches_reused"] == 2 and ds.attrs["batches_computed"] == 1
+    for name, mtime in written.items():
+        assert (work / "parts" / name).stat().st_mtime_ns == mtime
+    assert not list((work / "parts").glob(".*"))  # no temporary file left behind
+    assert_equal_to_serial(ds, study)
+    other = study_from_dict(small_study(times=[365.0]))
+    with pytest.raises(ValueError, match=r"^work_dir: .* holds the parts of another study"):
+        sweep(other, client="serial", work_dir=work)
+
+
+@pytest.fixture(scope="module")
+def loopback_cluster(tmp_path_factory):
+    """A ``dask scheduler`` and two single-threaded ``dask worker`` processes on 127.0.0.1,
+    started as separate programs, as a user would start a cluster (without nannies: they
+    only slow the shutdown here)."""
+    pytest.importorskip("distributed")
+    where = tmp_path_factory.mktemp("cluster")
+    scheduler_file = where / "scheduler.json"
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1",
+               PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    common = ["--scheduler-file", str(scheduler_file)]
+    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler",
+                               "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                               *common], cwd=where, env=env, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)]
+    address = None
+    try:
+        deadline = time.monotonic() + 60
+        while not scheduler_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert scheduler_file.exists(), "the scheduler did not start in 60 s"
+        address = json.loads(scheduler_file.read_text())["address"]
+        assert address.startswith("tcp://127.0.0.1:")
+        procs.extend(subprocess.Popen(
+            [sys.executable, "-m", "distributed.cli.dask_worker", "--no-nanny",
+             "--nthreads", "1", "--host", "127.0.0.1", "--no-dashboard", *common],
+            cwd=where, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            for _ in range(2))
+        from distributed import Client
+
+        with Client(address, timeout=60) as client:
+            client.wait_for_workers(2, timeout=60)
+        yield address
+    finally:
+        # the workers hold nothing worth an orderly exit (a graceful one waited up to 20 s
+        # here for a scheduler going down at the same time)
+        for proc in procs[1:]:
+            proc.kill()
+        procs[0].terminate()
+        for proc in procs:
+            try:
+                proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(timeout=20)
+
+
+def test_study_on_a_separately_started_cluster_equals_a_serial_loop(loopback_cluster):
+    from distributed import Client
+
+    from core.sweeps import sweep
+
+    study = study_from_dict(small_study())
+    with Client(loopback_cluster, timeout=60) as client:
+        ds = sweep(study, client=client, batch_points=3)
+        assert len({w for w in client.scheduler_info()["workers"]}) == 2
+    assert ds.attrs["batches"] == 4 and ds.attrs["batches_lost"] == 0
+    assert_equal_to_serial(ds, study)
+
+
+def test_cli_sweep_on_the_cluster_writes_each_format(loopback_cluster, tmp_path: Path):
+    import pandas as pd
+    import xarray as xr
+
+    from core.sweeps import sweep
+
+    (tmp_path / "study.json").write_text(json.dumps(small_study()))
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    proc = subprocess.run([sys.executable, "-m", "core", "sweep", "study.json", "--output",
+                           "r.csv", "--scheduler", loopback_cluster], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith("12 points in "), proc.stdout
+    assert not (tmp_path / "r.csv.parts").exists()  # its own work directory, removed
+    for name in ("r.nc", "r.parquet"):
+        sweep(tmp_path / "study.json", scheduler=loopback_cluster, output=tmp_path / name,
+              return_dataset=False)
+    ds = xr.open_dataset(tmp_path / "r.nc", engine="scipy")
+    assert ds.settlement.attrs["units"] == "m"
+    rows = pd.read_csv(tmp_path / "r.csv").sort_values(["point", "time_day"])
+    assert len(rows) == 12 * 2
+    np.testing.assert_array_equal(rows["settlement_m"].to_numpy(),
+                                  ds.settlement.values.reshape(-1))
+    table = pd.read_parquet(tmp_path / "r.parquet").sort_values(["point", "time_day"])
+    np.testing.assert_array_equal(table["q_max_Pa"].to_numpy(), ds.q_max.values.reshape(-1))
+    ds.close()
+    bad = subprocess.run([sys.executable, "-m", "core", "sweep", "study.json", "--output",
+                          "r.txt"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                         timeout=60)
+    assert bad.returncode == 2
+    assert bad.stderr.strip() == ("error: output: unsupported extension '.txt' (use .nc, "
+                                  ".csv or .parquet)")
+
+
+def test_solving_does_not_import_dask():
+    code = ("import sys, core, core.cli; core.cli.main(['solve', "
+            f"{str(SCENES / 'uniform_flat.json')!r}]); core.solve; core.load_study; "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in "
+            "('dask', 'distributed', 'xarray')))")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().splitlines()[-1] == "[]"
