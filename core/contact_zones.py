@@ -33,7 +33,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.polynomial import legendre as npleg
 from scipy.linalg import lu_factor, lu_solve
-from scipy.optimize import brentq
 
 from core.quadrature import NODES_PER_PANEL, Panels, base_panels, kernel_operator, operator_rows
 
@@ -279,6 +278,9 @@ def _crossing(panels: Panels, values: np.ndarray, i: int) -> float:
         return float(x[i])
     if ya * yb > 0.0:
         return linear
+    # imported here: scipy.optimize would be half of a cold CLI start's imports
+    from scipy.optimize import brentq
+
     return float(brentq(f, x[i], x[i + 1], xtol=1e-14))
 
 

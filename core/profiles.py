@@ -48,7 +48,6 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 from core.expressions import ALIASES, CONSTANTS, FUNCTIONS, Expression, parse_expression
 
@@ -398,6 +397,9 @@ def _table(points: list[tuple[float, float]], interpolation: str, variable: str,
     else:
         with np.errstate(all="ignore"):
             try:
+                # imported here: scipy.interpolate is 2/3 of a cold CLI start's imports
+                from scipy.interpolate import PchipInterpolator
+
                 interpolant = PchipInterpolator(xs, ys, extrapolate=False)
             except ValueError:
                 # SciPy refuses slopes that overflow (rows ~1e-300 apart): refused here
