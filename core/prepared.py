@@ -23,6 +23,7 @@ built, so tests can check that a load change builds nothing geometric.
 
 from __future__ import annotations
 
+import threading
 import time as _time
 from collections import Counter
 from collections.abc import Callable, Sequence
@@ -30,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from core.cache import StageCache
 from core.inputs import Geometry, Scalar, TimeInputs, validate_geometry, validate_time_inputs
 from core.kernel_fit import stepping_kernel
 from core.nystrom import BorderedSystem, adapt
@@ -80,6 +82,8 @@ class PreparedContact:
         self._rows: dict[bytes, np.ndarray] = {}
         self._check_x = _check_points(geometry.breakpoints)
         self._solves = 0
+        # Solves of one prepared geometry may run in several threads (the explorer's).
+        self._lock = threading.RLock()
         self.seconds = _time.perf_counter() - t0
 
     # ------------------------------------------------------------- cached members
@@ -88,6 +92,11 @@ class PreparedContact:
                  ) -> tuple[BorderedSystem, dict[str, np.ndarray]]:
         """Factorized bordered system and its unit responses for a statement and constant c."""
         key = (given, c)
+        with self._lock:
+            return self._bordered_locked(key, given, c)
+
+    def _bordered_locked(self, key: tuple, given: frozenset[str], c: float
+                         ) -> tuple[BorderedSystem, dict[str, np.ndarray]]:
         if key not in self._bordered:
             system = BorderedSystem(self.grid, c, given)
             self._bordered[key] = (system, system.unit_responses())
@@ -98,14 +107,19 @@ class PreparedContact:
 
     def modal(self, given: frozenset[str]) -> ModalForm:
         """Modal decomposition of a statement (for creep or a modulus varying in time)."""
-        if given not in self._modal:
-            self._modal[given] = ModalForm(self.grid, given)
-            self.counts["modal"] += 1
-        return self._modal[given]
+        with self._lock:
+            if given not in self._modal:
+                self._modal[given] = ModalForm(self.grid, given)
+                self.counts["modal"] += 1
+            return self._modal[given]
 
     def rows(self, x: np.ndarray) -> np.ndarray:
         """Rows of the operator F at points ``x`` (len(x), N), cached by the points."""
         key = x.tobytes()
+        with self._lock:
+            return self._rows_locked(key, x)
+
+    def _rows_locked(self, key: bytes, x: np.ndarray) -> np.ndarray:
         if key not in self._rows:
             self._rows[key] = self.grid.rows(x)
             self.counts["rows"] += 1
@@ -124,6 +138,15 @@ class PreparedContact:
         x = np.ascontiguousarray(x, dtype=float)
         m_x = self.geometry.m(x)
         return (drive - self.rows(x) @ effective) / (m_x[:, None] * c[None, :])
+
+    @property
+    def nbytes(self) -> int:
+        """Memory held by the grid and the cached members [bytes] (approximate)."""
+        total = self.grid.operator.nbytes * 2
+        total += sum(r.nbytes for r in self._rows.values())
+        total += sum(2 * self.grid.operator.nbytes for _ in self._bordered)
+        total += sum(3 * self.grid.operator.nbytes for _ in self._modal)
+        return int(total)
 
     # --------------------------------------------------------------------- solve
 
@@ -300,10 +323,12 @@ def prepare(lam: float, m: Scalar, g: Scalar, *, breakpoints: Sequence[float] = 
     return PreparedContact(validate_geometry(lam, m, g, breakpoints, tol))
 
 
-#: Prepared geometries kept for :func:`solve_with_prepared`, most recent last. A grid of
-#: 256 panels holds a 4096^2 operator (128 MiB); typical ones hold 0.5-5 MiB.
-_PREPARED: dict[str, PreparedContact] = {}
-_PREPARED_BYTES = 256 * 2**20
+#: Prepared geometries kept for :func:`solve_with_prepared` (LRU, safe across threads,
+#: cleared by core.cache.clear_caches). A grid of 128 panels holds a 2048^2 operator
+#: (32 MiB, more with its factorizations); typical ones hold 0.5-5 MiB.
+PREPARED_BYTES = 256 * 2**20
+PREPARED = StageCache("prepared", max_items=32, max_bytes=PREPARED_BYTES,
+                      sizeof=lambda prepared: prepared.nbytes)
 
 
 def _geometry_key(geometry: Geometry) -> str:
@@ -329,13 +354,6 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
     geometry = validate_geometry(lam, m, g, breakpoints, tol)
     inputs = validate_time_inputs(times, c, kernel, {"settlement": settlement, "tilt": tilt,
                                                      "force": force, "moment": moment})
-    key = _geometry_key(geometry)
-    prepared = _PREPARED.pop(key, None)
-    if prepared is None:
-        prepared = PreparedContact(geometry)
-    _PREPARED[key] = prepared
-    total = sum(p.grid.operator.nbytes for p in _PREPARED.values())
-    while total > _PREPARED_BYTES and len(_PREPARED) > 1:
-        oldest = _PREPARED.pop(next(iter(_PREPARED)))
-        total -= oldest.grid.operator.nbytes
+    prepared, _ = PREPARED.get_or_compute(_geometry_key(geometry),
+                                          lambda: PreparedContact(geometry))
     return prepared.solve_validated(inputs)
