@@ -249,7 +249,14 @@ def _build_mesh(stack: Stack, extent: float, level: int):
     xm = np.clip(a * xs, -a, a)
     layers = list(stack.coating)[::-1]  # bottom-up
     regions = [(None, rows_base)] + [(layer, fractions) for layer in layers]
-    for layer, ys in regions:
+    for number, (layer, ys) in enumerate(regions):
+        if number == len(regions) - 1 and layer is not None:
+            # the punch edge's singularity lies in the top layer: rows geometric toward
+            # its top (sized on its thinnest point)
+            h_min = float(np.min(np.asarray(layer.thickness(xm), dtype=float))) / a
+            ys = 1.0 - _graded(0.0, 1.0, True, False, EDGE_SIZE / h_min,
+                               1.0 / COATING_ROWS)[::-1]
+            ys = _bisect(np.sort(ys), level)
         if layer is None:
             yy = ys[:, None] + 0 * xs[None, :]
         else:
