@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from core.coating_model import NEGLIGIBLE_SHARE
 from core.fem_check import CoatingStrip, Stack, solve_stack
 from core.scene import QUANTITIES, Scene, scene_from_dict, solve
 
@@ -79,7 +80,7 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0, *,
     # pair (a moment of a centred load): then relative to the pair's scale
     errors = {}
     for name in QUANTITIES:
-        scale = max(abs(exact[name]), 1e-3 * scales[name])
+        scale = max(abs(exact[name]), NEGLIGIBLE_SHARE * scales[name])
         errors[name] = (quick[name] - exact[name]) / scale if scale > 0 else 0.0
     x = np.linspace(-PRESSURE_REACH * a, PRESSURE_REACH * a, 181)
     q_fe = fe.pressure(x, exact["settlement"], exact["tilt"])

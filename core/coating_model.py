@@ -39,6 +39,9 @@ DEFAULT_INTERFACE = "smooth"
 DEFAULT_MODEL_TOL = 0.02
 #: Accepted range of ``solver.model_tol``.
 MODEL_TOL_RANGE = (1e-4, 1.0)
+#: A tilt (moment) smaller than this share of the settlement (force) is not weighed on
+#: its own: its error is measured against its pair's size (also by the FE check).
+NEGLIGIBLE_SHARE = 1e-3
 #: Points of [-a, a] where the map is read (the estimate is the largest).
 ESTIMATE_POINTS = 41
 
@@ -105,7 +108,15 @@ def mapped_error(thickness_ratio: Any, modulus_ratio: Any, coating_poisson: Any,
     return {part: scale * maps[interface, part](pts) for part in ("force", "moment")}
 
 
-def model_error_estimate(scene: Any) -> dict[str, Any]:
+def tilt_share(half_width: float, settlement: Any, tilt: Any) -> float:
+    """``max |a alpha| / max(|delta|, |a alpha|)`` over the times [-]: how much of the punch
+    displacement is tilt (0 for a centred load, 1 for a pure rotation)."""
+    d = float(np.max(np.abs(settlement), initial=0.0))
+    r = half_width * float(np.max(np.abs(tilt), initial=0.0))
+    return r / max(d, r) if max(d, r) > 0 else 0.0
+
+
+def model_error_estimate(scene: Any, share_of_tilt: float = 1.0) -> dict[str, Any]:
     """The coating model's error for a scene, from the measured map.
 
     Reads the map at :data:`ESTIMATE_POINTS` points of ``[-a, a]`` with the local stack:
@@ -113,7 +124,10 @@ def model_error_estimate(scene: Any) -> dict[str, Any]:
     the base modulus at loading, ``nu_c`` the thickness-weighted mean, ``"bonded"`` if any
     layer is bonded. Returns ``{"estimate": largest |relative error| of force and moment
     (equally of settlement and tilt when those are the unknowns), "force": signed, "moment":
-    signed, "where_m": x [m] of the largest}``.
+    signed, "where_m": x [m] of the largest}``. The moment part (the relative error of the
+    moment, or of the tilt) counts fully once ``share_of_tilt`` (:func:`tilt_share` of the
+    answer) reaches :data:`NEGLIGIBLE_SHARE`, and fades to nothing below: a centred load
+    has no moment to be wrong about.
     """
     a = scene.half_width
     x = np.linspace(-a, a, ESTIMATE_POINTS)
@@ -131,7 +145,8 @@ def model_error_estimate(scene: Any) -> dict[str, Any]:
     e0 = scene.modulus_at_loading()
     parts = mapped_error(total / (2 * a), total / softness / e0, poisson / total, interface,
                          scene.base_thickness / a)
-    worst = np.maximum(np.abs(parts["force"]), np.abs(parts["moment"]))
+    weight = min(1.0, share_of_tilt / NEGLIGIBLE_SHARE)
+    worst = np.maximum(np.abs(parts["force"]), weight * np.abs(parts["moment"]))
     i = int(np.argmax(worst))
     return {"estimate": float(worst[i]), "force": float(parts["force"][i]),
             "moment": float(parts["moment"][i]), "where_m": float(x[i])}

@@ -50,6 +50,7 @@ from core.coating_model import (
     MODEL_TOL_RANGE,
     layer_compliance,
     model_error_estimate,
+    tilt_share,
 )
 from core.creep import UserKernel, creep_model_from_spec
 from core.profiles import Profile, check_range, profile_from_spec
@@ -1125,7 +1126,8 @@ class SceneSolution:
         self.force = np.asarray(solution.force, dtype=float) * self._pressure_scale * a
         self.moment = np.asarray(solution.moment, dtype=float) * self._pressure_scale * a * a
         self.x = plotting_grid(a)
-        self.model_error = model_error_estimate(scene)
+        self.model_error = model_error_estimate(
+            scene, tilt_share(a, self.settlement, self.tilt))
         self.flags = self._flags(solution)
         self.flag_messages = {
             name: FLAG_MESSAGES.get(name, f"{name}: {solution.info.get('message', '')}")
