@@ -22,8 +22,10 @@ to a unit tilt; any of the four statements then follows from two equations.
 Measured against the project's kernel solution of the uncoated layer (``nu = 0.3``,
 ``benchmarks/coating_validity.py --fe-study``): relative error of P per unit settlement /
 M per unit tilt at H = a: level 0 1.0e-4 / 2.3e-4 (25k unknowns, ~1 s), level 1 8.2e-6 /
-2.0e-5 (99k, ~8 s); at H = 4a: 2.0e-4 / 3.3e-4 and 1.5e-5 / 2.6e-5 (observed order ~3.6
-in the element size; timings on a shared 2-core machine).
+2.0e-5 (99k, ~7 s); at H = 4a: 2.0e-4 / 3.3e-4 (32k, ~2 s) and 1.5e-5 / 2.6e-5 (129k, ~14 s):
+observed order 3.6-3.7 in the element size (timings on a shared 2-core machine).
+Coated, ``sum h / 2a = 0.02``, ``E_c / E = 0.05``, ``nu_c = 0.45``, H = a: levels 0 and
+1 differ by 4e-5 / 9e-5 (smooth) and 5e-5 / 1.3e-4 (bonded).
 """
 
 from __future__ import annotations
@@ -39,8 +41,9 @@ from scipy.sparse.linalg import splu
 #: Interfaces of a coating layer with what lies under it.
 INTERFACES = ("smooth", "bonded")
 #: Lateral extent of the base beyond the punch edge, in base thicknesses (the kernel of
-#: the layer decays like exp(-2.1 x / H); the truncation study measured the change of the
-#: force from 6 H to 10 H at 3e-7 for H = a and H = 4a).
+#: the layer decays like exp(-2.1 x / H); ``--fe-study`` measured the change of the force
+#: against 10 H: 2.5e-4 / 6.2e-4 at 2 H, 4e-8 / 8e-8 at 4 H, 6e-11 / 7e-11 at 6 H for
+#: H = a / H = 4a).
 TRUNCATION_DEPTHS = 6.0
 #: Smallest element next to a punch edge, in half-widths (level 0).
 EDGE_SIZE = 1e-5
