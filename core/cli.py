@@ -130,6 +130,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from core.coating_check import check_scene
 
     scene = _read(args.scene)
+    end = float(scene.times[-1])
+    if not 0.0 <= args.time <= end:  # also refuses nan
+        raise _InputError(f"--time: must be in [0, {end:g}] days after loading (the scene's "
+                          f"output times), got {args.time:g}")
     try:
         report = check_scene(scene, args.time, level=args.level)
     except (ArithmeticError, ValueError, RuntimeError, MemoryError) as exc:

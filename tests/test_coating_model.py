@@ -132,3 +132,6 @@ def test_cli_check_prints_the_model_error(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "core", "solve", str(path)], cwd=ROOT,
                           env=env, capture_output=True, text=True, timeout=300)
     assert "coating model error" in proc.stdout
+    proc = subprocess.run([sys.executable, "-m", "core", "check", str(path), "--time", "5"],
+                          cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2 and proc.stderr.startswith("error: --time: must be in")
