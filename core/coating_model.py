@@ -122,7 +122,9 @@ def model_error_estimate(scene: Any, share_of_tilt: float = 1.0) -> dict[str, An
     Reads the map at :data:`ESTIMATE_POINTS` points of ``[-a, a]`` with the local stack:
     ``sum h / 2a``, ``E_c`` the thickness-weighted harmonic mean of the layer moduli over
     the base modulus at loading, ``nu_c`` the thickness-weighted mean, ``"bonded"`` if any
-    layer is bonded. Returns ``{"estimate": largest |relative error| of force and moment
+    layer is bonded (the base modulus is taken at loading: as a base creeps, its effective
+    modulus falls and the coating weighs less in the answer). Returns ``{"estimate":
+    largest |relative error| of force and moment
     (equally of settlement and tilt when those are the unknowns), "force": signed, "moment":
     signed, "where_m": x [m] of the largest}``. The moment part (the relative error of the
     moment, or of the tilt) counts fully once ``share_of_tilt`` (:func:`tilt_share` of the
