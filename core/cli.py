@@ -1,6 +1,7 @@
 """The command line: ``python -m core solve SCENE.json``, ``python -m core validate SCENE.json``
 and ``python -m core sweep STUDY.json --output RESULT.nc`` (a design study, see
-:mod:`core.sweeps`).
+:mod:`core.sweeps`) and ``python -m core check SCENE.json`` (the coating model against
+resolved finite elements).
 
 ``solve`` writes the solution to ``--output`` (``.json``: everything, see
 :meth:`core.scene.SceneSolution.to_dict`, with the contact set per time; ``.csv``: the
@@ -93,6 +94,10 @@ def _summary(result: SceneSolution) -> str:
             zones = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in result.contact_set[i])
             lines.append(f"contact at {result.times[i]:g} days: {zones or 'none'} m")
     lines.append(str(result.info.get("message", "")))
+    estimate = result.info.get("model_error_estimate")
+    if estimate is not None:
+        lines.append(f"coating model error (estimate from measurements): {100 * estimate:.2g} % "
+                     f"(solver.model_tol {100 * result.scene.model_tol:g} %)")
     return "\n".join(lines)
 
 
@@ -164,12 +169,44 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_check(args: argparse.Namespace) -> int:
+    from core.coating_check import check_scene
+
+    scene = _read(args.scene)
+    end = float(scene.times[-1])
+    if not 0.0 <= args.time <= end:  # also refuses nan
+        raise _InputError(f"--time: must be in [0, {end:g}] days after loading (the scene's "
+                          f"output times), got {args.time:g}")
+    try:
+        report = check_scene(scene, args.time, level=args.level)
+    except (ArithmeticError, ValueError, RuntimeError, MemoryError) as exc:
+        print(f"error: check: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_SOLVER_FAILED
+    print(f"checked {_describe(scene)}")
+    print(f"resolved finite-element model at {report['time_day']:g} days after loading "
+          f"(base elastic at that modulus): {report['fe_dofs']} unknowns, "
+          f"{report['fe_seconds']:.1f} s")
+    print(f"{'quantity':>12} {'fast':>16} {'resolved':>16} {'error':>9}")
+    for q in QUANTITIES:
+        print(f"{q + '_' + _UNITS[q]:>12} {report['fast'][q]:16.8g} {report['fe'][q]:16.8g} "
+              f"{100 * report['errors'][q]:8.2f}%")
+    print(f"{'pressure':>12} {'':>16} {'':>16} {100 * report['errors']['pressure']:8.2f}% "
+          "(largest on |x| <= 0.9 a)")
+    print(f"model error of the fast answer: {100 * report['model_error']:.2f} % "
+          f"(estimate carried by results: {100 * report['estimate']:.2f} %, "
+          f"solver.model_tol {100 * scene.model_tol:g} %)")
+    if report["model_error"] > scene.model_tol:
+        print("warning: model_error: the fast answer's coating model errs by more than "
+              "solver.model_tol", file=sys.stderr)
+    return EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``python -m core``."""
     parser = _Parser(prog="python -m core",
                      description="Contact of a rigid punch on a coated, aging viscoelastic "
                                  "layer (scene files: see core/SCENES.md).")
-    sub = parser.add_subparsers(dest="command", metavar="{solve,validate,sweep}",
+    sub = parser.add_subparsers(dest="command", metavar="{solve,validate,sweep,check}",
                                 parser_class=_Parser)
     sub.required = True
     p_solve = sub.add_parser("solve", help="solve a scene and write the result")
@@ -203,6 +240,14 @@ def build_parser() -> argparse.ArgumentParser:
                               "each)")
     p_sweep.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     p_sweep.set_defaults(run=_cmd_sweep)
+    p_check = sub.add_parser("check", help="model error of the fast answer against a "
+                                           "resolved finite-element model of the coating")
+    p_check.add_argument("scene", help="scene file (JSON)")
+    p_check.add_argument("--time", type=float, default=0.0, metavar="DAYS",
+                         help="days after loading: base modulus and given loads (default 0)")
+    p_check.add_argument("--level", type=int, choices=(0, 1), default=0,
+                         help="FE mesh level: 0 (~1 s, force to ~2e-4) or 1 (~10 s, ~2e-5)")
+    p_check.set_defaults(run=_cmd_check)
     return parser
 
 

@@ -43,6 +43,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.cache import StageCache, fingerprint
+from core.coating_model import (
+    DEFAULT_INTERFACE,
+    DEFAULT_MODEL_TOL,
+    INTERFACES,
+    MODEL_TOL_RANGE,
+    layer_compliance,
+    model_error_estimate,
+    tilt_share,
+)
 from core.creep import UserKernel, creep_model_from_spec
 from core.profiles import Profile, check_range, profile_from_spec
 from core.validation import (
@@ -117,6 +126,9 @@ FLAG_MESSAGES: dict[str, str] = {
                      "thin-coating model assumes soft coatings.",
     "large_tilt": f"The tilt exceeds {LARGE_TILT:g} rad: the small-angle assumption is "
                   "doubtful.",
+    "model_error": "The estimated error of the thin-coating model (info.model_error_estimate, "
+                   "from measurements against a resolved finite-element model) exceeds "
+                   "solver.model_tol: check the coating model (python -m core check).",
     "tol_not_met": "The solver could not reach the requested tolerance: see info.message.",
     "unresolved_input": "A profile has features finer than the quadrature resolves: "
                         "see info.message.",
@@ -251,11 +263,13 @@ def migrate(d: Mapping[str, Any]) -> dict[str, Any]:
 
 @dataclass(frozen=True, eq=False)
 class Layer:
-    """One coating layer: profiles of x [m] for ``thickness`` [m], ``modulus`` [Pa], ``poisson``."""
+    """One coating layer: profiles of x [m] for ``thickness`` [m], ``modulus`` [Pa], ``poisson``;
+    ``interface``: how it is joined to what lies under it (``"smooth"`` or ``"bonded"``)."""
 
     thickness: Profile
     modulus: Profile
     poisson: Profile
+    interface: str = DEFAULT_INTERFACE
 
 
 @dataclass(frozen=True, eq=False)
@@ -355,14 +369,21 @@ class Scene:
         """``E0 = E(age_at_loading)`` [Pa], the base modulus when the load is applied."""
         return float(np.asarray(self.creep.modulus(self.age_at_loading), dtype=float))
 
+    @property
+    def model_tol(self) -> float:
+        """``solver.model_tol``: the coating-model error a result may carry unflagged [-]."""
+        return float(self._data["solver"]["model_tol"])
+
     def coating_compliance(self, x: Any) -> np.ndarray:
-        """``sum_k (1 - nu_k^2) h_k / E_k`` [m/Pa] at points ``x`` [m] (vectorized)."""
+        """``sum_k c_k`` [m/Pa] at points ``x`` [m] (vectorized): ``c_k = (1 - nu_k^2) h_k /
+        E_k`` for a smooth interface, the laterally constrained ``(1 + nu_k)(1 - 2 nu_k) h_k
+        / ((1 - nu_k) E_k)`` for a bonded one (:mod:`core.coating_model`)."""
         x = np.asarray(x, dtype=float)
         total = np.zeros(x.shape)
         for layer in self.coating:
-            nu = _values(layer.poisson, x)
-            total = total + (1.0 - nu * nu) * _values(layer.thickness, x) \
-                / _values(layer.modulus, x)
+            total = total + layer_compliance(_values(layer.thickness, x),
+                                             _values(layer.modulus, x),
+                                             _values(layer.poisson, x), layer.interface)
         return total
 
     def coating_thickness(self, x: Any) -> np.ndarray:
@@ -592,13 +613,18 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     layers = []
     for k, spec in enumerate(layers_spec):
         path = f"coating[{k}]"
-        _check_fields(spec, path, ("thickness", "modulus", "poisson"))
+        _check_fields(spec, path, ("thickness", "modulus", "poisson"), ("interface",))
+        interface = spec.get("interface", DEFAULT_INTERFACE)
+        if interface not in INTERFACES:
+            raise ValueError(f"{path}.interface: must be 'smooth' or 'bonded', got "
+                             f"{show_value(interface)}")
         layers.append(Layer(
             thickness=_profile(spec["thickness"], f"{path}.thickness", "x", x_domain,
                                lower=0.0),
             modulus=_profile(spec["modulus"], f"{path}.modulus", "x", x_domain, lower=0.0),
             poisson=_profile(spec["poisson"], f"{path}.poisson", "x", x_domain, lower=-1.0,
                              upper=0.5),
+            interface=interface,
         ))
 
     base = _check_fields(d["base"], "base", ("thickness", "poisson", "age_at_loading", "creep"))
@@ -639,7 +665,7 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
                          f"an age at loading of {tau0:g} days")
 
-    solver = _check_fields(d.get("solver", {}), "solver", (), ("tol", "contact"))
+    solver = _check_fields(d.get("solver", {}), "solver", (), ("tol", "contact", "model_tol"))
     tol = finite_number(solver.get("tol", DEFAULT_TOL), "solver.tol")
     if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
         raise ValueError(f"solver.tol: must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], "
@@ -651,6 +677,10 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         if not isinstance(contact, str) or contact not in CONTACT_MODELS:
             raise ValueError(f"solver.contact: must be one of {', '.join(CONTACT_MODELS)}, "
                              f"got {show_value(contact)}")
+    model_tol = finite_number(solver.get("model_tol", DEFAULT_MODEL_TOL), "solver.model_tol")
+    if not MODEL_TOL_RANGE[0] <= model_tol <= MODEL_TOL_RANGE[1]:
+        raise ValueError(f"solver.model_tol: must be in [{MODEL_TOL_RANGE[0]:g}, "
+                         f"{MODEL_TOL_RANGE[1]:g}], got {show_value(model_tol)}")
 
     data = {
         "schema_version": SCHEMA_VERSION,
@@ -659,14 +689,16 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         "punch": {"half_width": a, "shape": _jsonable(_spec_of(shape, shape_spec))},
         "coating": [{"thickness": _jsonable(_spec_of(layer.thickness, s["thickness"])),
                      "modulus": _jsonable(_spec_of(layer.modulus, s["modulus"])),
-                     "poisson": _jsonable(_spec_of(layer.poisson, s["poisson"]))}
+                     "poisson": _jsonable(_spec_of(layer.poisson, s["poisson"])),
+                     "interface": layer.interface}
                     for layer, s in zip(layers, layers_spec, strict=True)],
         "base": {"thickness": h_base, "poisson": nu, "age_at_loading": tau0,
                  "creep": _jsonable(creep.spec)},
         "loading": {q: _jsonable(_spec_of(loads[q], loading[q])) for q in loads},
         "times": _jsonable(times_spec),
         # the default contact model is left out, so existing scenes keep their keys
-        "solver": {"tol": tol} if contact == "auto" else {"tol": tol, "contact": contact},
+        "solver": ({"tol": tol, "model_tol": model_tol} if contact == "auto" else
+                   {"tol": tol, "model_tol": model_tol, "contact": contact}),
     }
     times.setflags(write=False)
     scene = Scene(name, description, a, shape, tuple(layers), h_base, nu, tau0, creep,
@@ -1114,12 +1146,16 @@ class SceneSolution:
         self.x = plotting_grid(a)
         self.contact_set = [[(a * lo, a * hi) for lo, hi in zones]
                             for zones in getattr(solution, "contact_set", [])]
+        self.model_error = model_error_estimate(
+            scene, tilt_share(a, self.settlement, self.tilt))
         self.flags = self._flags(solution)
         self.flag_messages = {
             name: FLAG_MESSAGES.get(name, f"{name}: {solution.info.get('message', '')}")
             for name in self.flags}
         self.info = dict(solution.info)
         self.info["flags"] = list(self.flags)
+        self.info["model_error_estimate"] = self.model_error["estimate"]
+        self.info["model_error"] = dict(self.model_error)
         self.info["dimensional"] = self._extras()
 
     def _flags(self, solution: ContactSolution) -> list[str]:
@@ -1128,6 +1164,8 @@ class SceneSolution:
         x = scene.sample_x
         if np.max(scene.coating_thickness(x)) / (2 * scene.half_width) > THICK_COATING_RATIO:
             flags.append("thick_coating")
+        if self.model_error["estimate"] > scene.model_tol:
+            flags.append("model_error")
         e0 = self.problem.modulus_at_loading
         if any(np.max(_values(layer.modulus, x)) > e0 for layer in scene.coating):
             flags.append("stiff_coating")

@@ -549,7 +549,8 @@ def test_scene_equality_and_key():
     d = base_dict()
     del d["solver"], d["description"], d["punch"]["shape"]
     canonical = scene_from_dict(d).to_dict()
-    assert canonical["solver"] == {"tol": 1e-6}
+    assert canonical["solver"] == {"tol": 1e-6, "model_tol": 0.02}
+    assert all(layer["interface"] == "smooth" for layer in canonical["coating"])
     assert canonical["description"] == ""
     assert canonical["punch"]["shape"] == 0.0
 

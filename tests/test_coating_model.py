@@ -1,0 +1,137 @@
+"""The coating model: the resolved FE check, the compliance per interface, the error map."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core import solve_dimensionless
+from core.coating_check import check_scene
+from core.coating_model import layer_compliance, mapped_error
+from core.fem_check import CoatingStrip, Stack, solve_stack
+from core.scene import scene_from_dict, scene_to_json, solve
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def constant(value: float):
+    return lambda x: np.full(np.shape(x), value)
+
+
+def scene_dict(**coating) -> dict:
+    d = json.loads((ROOT / "assets" / "scenes" / "uniform_flat.json").read_text())
+    d["coating"] = [{"thickness": 0.02, "modulus": 3e9, "poisson": 0.3, **coating}]
+    d["base"]["creep"] = {"model": "elastic", "modulus": 3e10}
+    d["base"]["thickness"] = 1.0
+    d["loading"] = {"settlement": 1e-4, "tilt": 1e-5}
+    d["times"] = [1.0]
+    return d
+
+
+def test_fe_matches_the_kernel_solution_of_the_uncoated_layer():
+    stack = Stack(1.0, (), 1.0, 1.0, 0.3)
+    fe = solve_stack(stack, level=0)
+    plane = 2 * (1 - 0.09)
+    s1 = solve_dimensionless(1.0, 1e-7, 0.0, [1.0], settlement=1.0, tilt=0.0, tol=1e-9)
+    s2 = solve_dimensionless(1.0, 1e-7, 0.0, [1.0], settlement=0.0, tilt=1.0, tol=1e-9)
+    # measured at level 0: 1.0e-4 (force), 2.3e-4 (moment); level 1: 8e-6, 2e-5
+    assert fe.force_parts[1] / (s1.force[0] / plane) - 1 == pytest.approx(0, abs=3e-4)
+    assert fe.moment_parts[2] / (s2.moment[0] / plane) - 1 == pytest.approx(0, abs=5e-4)
+    # symmetric: a settlement gives no moment, a tilt no force (rounding only)
+    assert abs(fe.moment_parts[1]) < 1e-10 * fe.force_parts[1]
+    assert abs(fe.force_parts[2]) < 1e-10 * fe.force_parts[1]
+
+
+def test_bonded_layer_of_the_base_material_is_a_thicker_base():
+    h = 0.1
+    same = CoatingStrip(constant(h), constant(1.0), constant(0.3), "bonded")
+    coated = solve_stack(Stack(1.0, (same,), 1.0, 1.0, 0.3), level=0)
+    thicker = solve_stack(Stack(1.0, (), 1.0 + h, 1.0, 0.3), level=0)
+    # two meshes of one body: measured 3.2e-5 (force), 8.5e-5 (moment) apart at level 0,
+    # 2.2e-6, 5.9e-6 at level 1
+    assert coated.force_parts[1] / thicker.force_parts[1] - 1 == pytest.approx(0, abs=1e-4)
+    assert coated.moment_parts[2] / thicker.moment_parts[2] - 1 == pytest.approx(0, abs=2.5e-4)
+
+
+def test_fe_statements_agree():
+    layer = CoatingStrip(constant(0.02), constant(0.1), constant(0.3), "smooth")
+    fe = solve_stack(Stack(1.0, (layer,), 1.0, 1.0, 0.2), level=0)
+    full = fe.complete({"settlement": 0.01, "tilt": 0.002})
+    back = fe.complete({"force": full["force"], "moment": full["moment"]})
+    assert back["settlement"] == pytest.approx(0.01, rel=1e-10)
+    assert back["tilt"] == pytest.approx(0.002, rel=1e-10)
+    # the recovered P2 pressure carries exactly the nodal forces (Simpson is exact on P2)
+    xn = fe.x_nodes
+    q = fe.pressure(xn, 0.01, 0.002)
+    length = xn[2::2] - xn[0:-2:2]
+    force = np.sum(length * (q[0:-2:2] + 4 * q[1::2] + q[2::2]) / 6)
+    assert force == pytest.approx(full["force"], rel=1e-9)
+
+
+def test_compliance_per_interface():
+    assert layer_compliance(0.01, 1e9, 0.3, "smooth") == pytest.approx(0.91e-11)
+    assert layer_compliance(0.01, 1e9, 0.3, "bonded") == pytest.approx(1.3 * 0.4 / 0.7 * 1e-11)
+    with pytest.raises(ValueError, match="interface"):
+        layer_compliance(0.01, 1e9, 0.3, "glued")
+
+
+def test_scene_interface_and_model_tol_are_validated_and_saved():
+    scene = scene_from_dict(scene_dict(interface="bonded"))
+    d = json.loads(scene_to_json(scene))
+    assert d["coating"][0]["interface"] == "bonded"
+    assert d["solver"]["model_tol"] == 0.02
+    plain = scene_from_dict(scene_dict())
+    assert plain.to_dict()["coating"][0]["interface"] == "smooth"
+    assert scene.coating_compliance(np.zeros(1))[0] < plain.coating_compliance(np.zeros(1))[0]
+    with pytest.raises(ValueError, match=r"^coating\[0\]\.interface: must be"):
+        scene_from_dict(scene_dict(interface="glued"))
+    bad = scene_dict()
+    bad["solver"] = {"model_tol": -1}
+    with pytest.raises(ValueError, match=r"^solver\.model_tol: must be in"):
+        scene_from_dict(bad)
+
+
+def test_every_result_carries_the_estimate_and_the_flag():
+    d = scene_dict()
+    result = solve(d)
+    estimate = result.info["model_error_estimate"]
+    assert 0 < estimate < 0.02 and "model_error" not in result.flags
+    d["solver"] = {"model_tol": 1e-4}
+    flagged = solve(d)
+    assert "model_error" in flagged.flags and "model_error" in flagged.flag_messages
+
+
+def test_map_scales_with_thickness_outside_its_range():
+    inside = mapped_error(0.002, 0.3, 0.3, "smooth", 1.0)["force"]
+    thinner = mapped_error(0.001, 0.3, 0.3, "smooth", 1.0)["force"]
+    assert thinner == pytest.approx(0.5 * inside)
+
+
+@pytest.mark.parametrize("interface", ["smooth", "bonded"])
+def test_check_confirms_the_estimate_within_a_factor_3(interface):
+    report = check_scene(scene_dict(interface=interface))
+    assert report["model_error"] > 0
+    assert report["estimate"] / 3 <= report["model_error"] <= 3 * report["estimate"]
+
+
+def test_cli_check_prints_the_model_error(tmp_path):
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene_dict(interface="bonded")))
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
+    proc = subprocess.run([sys.executable, "-m", "core", "check", str(path)], cwd=ROOT,
+                          env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "model error of the fast answer" in proc.stdout
+    proc = subprocess.run([sys.executable, "-m", "core", "solve", str(path)], cwd=ROOT,
+                          env=env, capture_output=True, text=True, timeout=300)
+    assert "coating model error" in proc.stdout
+    proc = subprocess.run([sys.executable, "-m", "core", "check", str(path), "--time", "5"],
+                          cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2 and proc.stderr.startswith("error: --time: must be in")
