@@ -201,7 +201,12 @@ class PreparedContact:
             scalars = {k: inputs.loads[k](times) for k in names}
             for i, name in enumerate(unknown_names):
                 scalars[name] = solved[n + i]
-            q_check = unit_pressure(self._check_x) @ weights(probe)
+            probe_weights = weights(probe)
+            q_check = unit_pressure(self._check_x) @ probe_weights
+            if "tilt" in inputs.given:
+                tilt_history = inputs.loads["tilt"](probe)
+            else:
+                tilt_history = unit_matrix[n + unknown_names.index("tilt")] @ probe_weights
             time_error, steps, time_ok, time_message = 0.0, 0, True, "elastic base"
             fit_error = 0.0
 
@@ -226,6 +231,7 @@ class PreparedContact:
             at = np.searchsorted(merged, times)
             scalars = {k: v[at] for k, v in sc.items()}
             q_check = merged_pressure(self._check_x, slice(None))
+            tilt_history = sc["tilt"]
             time_error, steps = answer.time_error + fit_error, answer.steps
             time_ok, time_message = answer.success, answer.message
 
@@ -233,7 +239,8 @@ class PreparedContact:
                 return merged_pressure(x, at)
         built = {k: self.counts[k] - built_before[k] for k in self.counts}
         return self._result(inputs, scalars, pressure, q_check, time_error, steps, time_ok,
-                            time_message, _time.perf_counter() - t0, built, fit_error)
+                            time_message, _time.perf_counter() - t0, built, fit_error,
+                            float(np.max(np.abs(tilt_history))))
 
     def _history_times(self, times: np.ndarray) -> np.ndarray:
         """Output times plus samples between them, where the answer's validity is checked."""
@@ -244,8 +251,8 @@ class PreparedContact:
     def _result(self, inputs: TimeInputs, scalars: dict[str, np.ndarray],
                 pressure: Callable[[np.ndarray], np.ndarray], q_check: np.ndarray,
                 time_error: float, steps: int, time_ok: bool, time_message: str,
-                seconds: float, built: dict[str, int], fit_error: float = 0.0
-                ) -> ContactSolution:
+                seconds: float, built: dict[str, int], fit_error: float = 0.0,
+                max_abs_tilt: float = 0.0) -> ContactSolution:
         tol = self.geometry.tol
         error = float(self.spatial_error + time_error)
         success = error <= tol and self.resolved and time_ok
@@ -289,7 +296,9 @@ class PreparedContact:
             "n_steps": int(steps),
             "statement": statement_number(inputs.given),
             "given": sorted(inputs.given),
+            # over the output times and the samples between them (HISTORY_SAMPLES)
             "min_pressure": min_q,
+            "max_abs_tilt": max_abs_tilt,
             "max_pressure": q_scale,
             "basis": "nystrom",
             "element_ends": sorted(set(self.grid.panels.edges[1:-1].tolist())

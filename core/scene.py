@@ -1169,7 +1169,10 @@ class SceneSolution:
         e0 = self.problem.modulus_at_loading
         if any(np.max(_values(layer.modulus, x)) > e0 for layer in scene.coating):
             flags.append("stiff_coating")
-        if self.tilt.size and np.max(np.abs(self.tilt)) > LARGE_TILT:
+        # between the output times too (the default engine samples the load histories)
+        largest_tilt = max(float(np.max(np.abs(self.tilt))) if self.tilt.size else 0.0,
+                           float(solution.info.get("max_abs_tilt", 0.0)))
+        if largest_tilt > LARGE_TILT:
             flags.append("large_tilt")
         return list(dict.fromkeys(flags))
 

@@ -38,8 +38,10 @@ def test_fe_matches_the_kernel_solution_of_the_uncoated_layer():
     stack = Stack(1.0, (), 1.0, 1.0, 0.3)
     fe = solve_stack(stack, level=0)
     plane = 2 * (1 - 0.09)
-    s1 = solve_dimensionless(1.0, 1e-7, 0.0, [1.0], settlement=1.0, tilt=0.0, tol=1e-9)
-    s2 = solve_dimensionless(1.0, 1e-7, 0.0, [1.0], settlement=0.0, tilt=1.0, tol=1e-9)
+    s1 = solve_dimensionless(1.0, 1e-7, 0.0, [1.0], settlement=1.0, tilt=0.0, tol=1e-9,
+                            contact="full")
+    s2 = solve_dimensionless(1.0, 1e-7, 0.0, [1.0], settlement=0.0, tilt=1.0, tol=1e-9,
+                            contact="full")  # the FE model is in full contact
     # measured at level 0: 1.0e-4 (force), 2.3e-4 (moment); level 1: 8e-6, 2e-5
     assert fe.force_parts[1] / (s1.force[0] / plane) - 1 == pytest.approx(0, abs=3e-4)
     assert fe.moment_parts[2] / (s2.moment[0] / plane) - 1 == pytest.approx(0, abs=5e-4)

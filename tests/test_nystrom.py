@@ -165,6 +165,8 @@ def test_lost_contact_between_output_times_is_flagged():
                               moment=lambda t: 0.45 * np.sin(np.pi * (t - 1.0)), tol=1e-6,
                               contact="full")
     assert "contact_lost" in sol.flags
+    # and the largest tilt, which the dimensional result checks against its limit
+    assert sol.info["max_abs_tilt"] > 10 * np.max(np.abs(sol.tilt))
 
 
 def test_unknown_method_is_refused():
