@@ -92,13 +92,13 @@ class ModalForm:
             out += np.outer(self.ms.e1_rot[rows], loads["tilt"])
         return out
 
-    def drive(self, loads: dict[str, np.ndarray], size: int) -> np.ndarray:
-        """Modal drive of the given settlement and tilt and of the gap, shape (F, T)."""
+    def drive(self, loads: dict[str, np.ndarray], size: int, gap: float = 1.0) -> np.ndarray:
+        """Modal drive of the given settlement and tilt and of ``gap`` times the gap (F, T)."""
         return (self.ms.psi_inv @ self._given(self.ms.free, loads, size)
-                + self.gap_free[:, None])
+                + gap * self.gap_free[:, None])
 
     def finish(self, c_t: np.ndarray, loads: dict[str, np.ndarray], known: np.ndarray,
-               z: np.ndarray, vz: np.ndarray, vu: np.ndarray
+               z: np.ndarray, vz: np.ndarray, vu: np.ndarray, gap: float = 1.0
                ) -> tuple[np.ndarray, np.ndarray, dict]:
         """Nodal pressures, ``q - V q`` at the nodes and the four scalars."""
         ms, k = self.ms, self.k
@@ -119,7 +119,7 @@ class ModalForm:
             r_kf = ms.r_rot[np.ix_(ms.known, ms.free)]
             r_kk = ms.r_rot[np.ix_(ms.known, ms.known)]
             lhs = (c_t[None, :] * known[:k] + r_kf @ (ms.psi @ (z - vz))
-                   + r_kk @ (known[:k] - vu[:k]) - self.gap[ms.known][:, None]
+                   + r_kk @ (known[:k] - vu[:k]) - gap * self.gap[ms.known][:, None]
                    - self._given(ms.known, loads, size))
             unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
             for i, name in enumerate(ms.unknown_names):
@@ -129,17 +129,20 @@ class ModalForm:
         return self.to_nodes @ a, effective, out
 
     def solve(self, times: np.ndarray, c: Function, kernel, loads: dict[str, Function],
-              time_tol: float, breaks: np.ndarray | None = None) -> ModalAnswer:
-        """The answer at ``times`` for relative modulus ``c(t)`` and creep kernel ``kernel``."""
+              time_tol: float, gap: float = 1.0) -> ModalAnswer:
+        """The answer at ``times`` for relative modulus ``c(t)`` and creep kernel ``kernel``.
+
+        ``gap`` scales the gap's drive (0: the response to the loads alone).
+        """
         c_t = c(times)
         values = {name: fn(times) for name, fn in loads.items()}
         known = self.known(values, times.size)
         gamma = self.ms.gamma
         if kernel is None:
-            z = (self.drive(values, times.size) - self.coupling @ known) / (
+            z = (self.drive(values, times.size, gap) - self.coupling @ known) / (
                 c_t[None, :] + gamma[:, None])
             nodal, effective, scalars = self.finish(c_t, values, known, z, np.zeros_like(z),
-                                                    np.zeros_like(known))
+                                                    np.zeros_like(known), gap)
             return ModalAnswer(nodal, effective, scalars, 0.0, 0, True,
                                "no creep: no time stepping")
         memo: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
@@ -151,7 +154,7 @@ class ModalForm:
                 ld = {name: fn(tt) for name, fn in loads.items()}
                 u = self.known(ld, tt.size)
                 d = 1.0 + c(tt)[None, :] / gamma[:, None]
-                memo[key] = (d, (self.drive(ld, tt.size) - self.coupling @ u)
+                memo[key] = (d, (self.drive(ld, tt.size, gap) - self.coupling @ u)
                              / gamma[:, None], u)
             return memo[key]
 
@@ -162,6 +165,7 @@ class ModalForm:
             sol = solve_degenerate(kernel, problem, times, tol=time_tol)
         else:
             sol = solve_general(kernel, problem, times, tol=time_tol)
-        nodal, effective, scalars = self.finish(c_t, values, known, sol.w, sol.vw, sol.vu)
+        nodal, effective, scalars = self.finish(c_t, values, known, sol.w, sol.vw, sol.vu,
+                                                gap)
         return ModalAnswer(nodal, effective, scalars, float(sol.error_estimate), int(sol.steps),
                            bool(sol.success), sol.message)

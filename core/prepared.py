@@ -27,6 +27,7 @@ import threading
 import time as _time
 from collections import Counter
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -35,7 +36,7 @@ from core.cache import StageCache
 from core.inputs import Geometry, Scalar, TimeInputs, validate_geometry, validate_time_inputs
 from core.kernel_fit import stepping_kernel
 from core.nystrom import BorderedSystem, adapt
-from core.nystrom_time import ModalForm
+from core.nystrom_time import ModalAnswer, ModalForm
 from core.solver import ContactSolution
 from core.statements import QUANTITIES, statement_number
 
@@ -48,7 +49,20 @@ CHECK_POINTS = 401
 ROWS_BYTES = 64 * 2**20
 #: Samples of the load histories between the output times where the validity of the
 #: answer (q >= 0) is checked as well, so a peak between outputs is not missed.
-HISTORY_SAMPLES = 512
+HISTORY_SAMPLES = 256
+
+
+@dataclass(frozen=True)
+class _Superposed:
+    """A time-stepped answer combined from cached responses (see ``_superposed``)."""
+
+    scalars: dict[str, np.ndarray]
+    effective: Callable[[np.ndarray | slice], np.ndarray]  # q - V q at the nodes
+    q_check: np.ndarray
+    time_error: float
+    steps: int
+    success: bool
+    message: str
 
 
 def _check_points(breakpoints: Sequence[float]) -> np.ndarray:
@@ -80,6 +94,8 @@ class PreparedContact:
         self._bordered: dict[tuple, tuple[BorderedSystem, dict[str, np.ndarray]]] = {}
         self._modal: dict[frozenset[str], ModalForm] = {}
         self._rows: dict[bytes, np.ndarray] = {}
+        self._unit_pressure: dict[tuple, np.ndarray] = {}
+        self._responses: dict[tuple, tuple[ModalAnswer, np.ndarray]] = {}
         self._check_x = _check_points(geometry.breakpoints)
         self._solves = 0
         # Solves of one prepared geometry may run in several threads (the explorer's).
@@ -191,10 +207,20 @@ class PreparedContact:
                 return np.vstack([inputs.loads[k](tt) for k in names] + [np.ones(tt.size)])
 
             def unit_pressure(x: np.ndarray) -> np.ndarray:
-                drive = (unit_delta[None, :] + np.outer(x, unit_alpha)
-                         - np.outer(g(x), unit_gap))
-                per_unit = self.nystrom_pressure(x, drive, c_unit, nodal_units)
-                return per_unit
+                # q at x of each unit response; kept per points, so that a load change
+                # evaluates q at the same points with one small matrix product
+                key = (inputs.given, c0, np.ascontiguousarray(x, dtype=float).tobytes())
+                with self._lock:
+                    cached = self._unit_pressure.get(key)
+                if cached is None:
+                    drive = (unit_delta[None, :] + np.outer(x, unit_alpha)
+                             - np.outer(g(x), unit_gap))
+                    cached = self.nystrom_pressure(x, drive, c_unit, nodal_units)
+                    with self._lock:
+                        self._unit_pressure[key] = cached
+                        while len(self._unit_pressure) > 16:
+                            self._unit_pressure.pop(next(iter(self._unit_pressure)))
+                return cached
 
             load_matrix = weights(times)
             solved = unit_matrix @ load_matrix
@@ -218,7 +244,8 @@ class PreparedContact:
             merged = np.union1d(times, probe)
             kernel, fit_error = stepping_kernel(inputs.kernel, float(times[-1]),
                                                 0.5 * geometry.tol)
-            answer = form.solve(merged, inputs.c, kernel, inputs.loads, time_tol)
+            answer = self._superposed(form, merged, inputs, kernel, time_tol)
+            q_check = answer.q_check
             c_merged = inputs.c(merged)
             sc = answer.scalars
 
@@ -226,11 +253,10 @@ class PreparedContact:
                 drive = (sc["settlement"][at][None, :] + np.outer(x, sc["tilt"][at])
                          - g(x)[:, None])
                 return self.nystrom_pressure(x, drive, c_merged[at],
-                                             answer.effective[:, at])
+                                             answer.effective(at))
 
             at = np.searchsorted(merged, times)
             scalars = {k: v[at] for k, v in sc.items()}
-            q_check = merged_pressure(self._check_x, slice(None))
             tilt_history = sc["tilt"]
             time_error, steps = answer.time_error + fit_error, answer.steps
             time_ok, time_message = answer.success, answer.message
@@ -241,6 +267,75 @@ class PreparedContact:
         return self._result(inputs, scalars, pressure, q_check, time_error, steps, time_ok,
                             time_message, _time.perf_counter() - t0, built, fit_error,
                             float(np.max(np.abs(tilt_history))))
+
+    def _superposed(self, form: ModalForm, times: np.ndarray, inputs: TimeInputs, kernel: Any,
+                    time_tol: float) -> _Superposed:
+        """The time-stepped answer as a sum of cached responses to each load and the gap.
+
+        The problem is linear: each given load is split into its amplitude and its shape
+        (normalized to unit peak), and the response to a shape (other loads zero, no gap)
+        is kept, keyed by the times, c, the kernel and the shape. A load slider changes an
+        amplitude, so it costs a few array operations instead of a time integration.
+        """
+        from core.cache import fingerprint
+
+        c_t = inputs.c(times)
+        try:
+            kernel_key = fingerprint(getattr(kernel, "key", None) or id(kernel))
+        except TypeError:  # a key of objects the fingerprint does not know: the instance
+            kernel_key = fingerprint(id(kernel))
+        common = fingerprint("modal", tuple(sorted(inputs.given)), times, c_t, kernel_key,
+                             time_tol)
+        zero = {name: (lambda tt: np.zeros(np.shape(tt))) for name in inputs.loads}
+        parts: list[tuple[float, tuple, dict[str, Callable], float]] = []
+        for name, fn in sorted(inputs.loads.items()):
+            values = fn(times)
+            amplitude = float(values[np.argmax(np.abs(values))])
+            if amplitude == 0.0:
+                continue
+            unit = dict(zero)
+            unit[name] = lambda tt, f=fn, a=amplitude: f(tt) / a
+            parts.append((amplitude, (common, name, fingerprint(values / amplitude)), unit,
+                          0.0))
+        if not self.geometry.g_is_zero or not parts:
+            parts.append((1.0, (common, "gap"), zero, 1.0))
+        weighted_error = 0.0
+        q_check = np.zeros((self._check_x.size, times.size))
+        x = self._check_x
+        terms: list[tuple[float, ModalAnswer]] = []
+        for weight, key, loads, gap in parts:
+            with self._lock:
+                cached = self._responses.get(key)
+            if cached is None:
+                response = form.solve(times, inputs.c, kernel, loads, time_tol, gap)
+                sc = response.scalars
+                drive = (sc["settlement"][None, :] + np.outer(x, sc["tilt"])
+                         - gap * self.geometry.g(x)[:, None])
+                check = self.nystrom_pressure(x, drive, c_t, response.effective)
+                cached = (response, check)
+                self.counts["time_response"] += 1
+                with self._lock:
+                    self._responses[key] = cached
+                    while len(self._responses) > 24:
+                        self._responses.pop(next(iter(self._responses)))
+            response, check = cached
+            q_check += weight * check
+            terms.append((weight, response))
+            size = max(float(np.max(np.abs(response.scalars["settlement"]))),
+                       float(np.max(np.abs(response.scalars["force"]))), 1e-300)
+            weighted_error += abs(weight) * response.time_error * size
+        scalars = {k: sum(w * r.scalars[k] for w, r in terms) for k in terms[0][1].scalars}
+        size = max(float(np.max(np.abs(scalars["settlement"]))),
+                   float(np.max(np.abs(scalars["force"]))), 1e-300)
+        failed = [r.message for _, r in terms if not r.success]
+
+        def effective(at: np.ndarray | slice) -> np.ndarray:
+            # combined only where q is asked for (the output times), not on every sample
+            return sum(w * r.effective[:, at] for w, r in terms)
+
+        return _Superposed(scalars, effective, q_check, float(weighted_error / size),
+                           max(r.steps for _, r in terms), not failed,
+                           "; ".join(failed) or terms[0][1].message)
 
     def _history_times(self, times: np.ndarray) -> np.ndarray:
         """Output times plus samples between them, where the answer's validity is checked."""
