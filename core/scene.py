@@ -32,18 +32,18 @@ import math
 import numbers
 import os
 import re
-import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from core import limits
 from core.cache import StageCache, fingerprint
 from core.creep import UserKernel, creep_model_from_spec
+from core.files import atomic_write_text, read_regular_file
 from core.profiles import Profile, check_range, profile_from_spec
 from core.validation import (
     MAX_MAGNITUDE,
@@ -59,11 +59,11 @@ if TYPE_CHECKING:
 #: The schema version this program writes and reads.
 SCHEMA_VERSION = 1
 #: Largest scene file accepted by :func:`load_scene` [bytes].
-MAX_SCENE_BYTES = 1_000_000
+MAX_SCENE_BYTES = limits.MAX_SCENE_BYTES
 #: Number of coating layers accepted.
 MAX_LAYERS = 10
 #: Largest number of output times.
-MAX_TIMES = 2000
+MAX_TIMES = limits.MAX_SCENE_TIMES
 #: Accepted range of the solver's relative tolerance, and its default.
 TOL_RANGE = (1e-12, 1e-2)
 DEFAULT_TOL = 1e-6
@@ -83,7 +83,7 @@ LARGE_TILT = 0.01
 #: Points of the default plotting grid :attr:`SceneSolution.x`.
 PLOT_POINTS = 201
 #: Most points of (-a, a) where a profile may jump or kink (see ``_check_breakpoints``).
-MAX_BREAKPOINTS = 16
+MAX_BREAKPOINTS = limits.MAX_BREAKPOINTS
 #: Accepted range of the dimensionless coating compliance m*: physical coatings are far
 #: inside it; the solver was measured finite for 1e-100 to 1e100.
 M_STAR_RANGE = (1e-30, 1e30)
@@ -179,9 +179,12 @@ def _integer(value: Any, path: str, lo: int, hi: int) -> int:
     return int(x)
 
 
-def _text(value: Any, path: str, *, allow_empty: bool) -> str:
+def _text(value: Any, path: str, *, allow_empty: bool, most: int) -> str:
     if not isinstance(value, str):
         raise ValueError(f"{path}: must be a string, got {show_value(value)}")
+    # checked first: a text field is echoed into titles, links and file names
+    if len(value) > most:
+        raise ValueError(f"{path}: must be at most {most} characters, has {len(value)}")
     if not allow_empty and not value.strip():
         raise ValueError(f"{path}: must not be empty")
     return value
@@ -571,8 +574,9 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     d = migrate(d)
     _check_fields(d, "", ("schema_version", "name", "punch", "coating", "base", "loading",
                           "times"), ("description", "solver"))
-    name = _text(d["name"], "name", allow_empty=False)
-    description = _text(d.get("description", ""), "description", allow_empty=True)
+    name = _text(d["name"], "name", allow_empty=False, most=limits.MAX_NAME_CHARS)
+    description = _text(d.get("description", ""), "description", allow_empty=True,
+                        most=limits.MAX_DESCRIPTION_CHARS)
 
     punch = _check_fields(d["punch"], "punch", ("half_width",), ("shape",))
     a = positive_number(punch["half_width"], "punch.half_width")
@@ -856,54 +860,15 @@ def load_scene(path: str | os.PathLike) -> Scene:
     """Read and validate a scene file (JSON, UTF-8, at most 1 MB).
 
     Raises ``ValueError`` (message starting with the file path or the field path) for a
-    file that is too large, not JSON or not a valid scene, ``OSError`` if it cannot be read.
+    file that is too large, not a regular file (a named pipe is refused, not waited on),
+    not JSON or not a valid scene, ``OSError`` if it cannot be read.
     """
-    path = Path(path)
-    size = path.stat().st_size
-    if size > MAX_SCENE_BYTES:
-        raise ValueError(f"{path}: file is {size} bytes, over the limit of {MAX_SCENE_BYTES} "
-                         "bytes (1 MB) for a scene file")
-    with path.open("rb") as fh:
-        # read one byte past the limit: the file may have grown since stat()
-        raw = fh.read(MAX_SCENE_BYTES + 1)
-    if len(raw) > MAX_SCENE_BYTES:
-        raise ValueError(f"{path}: file is over the limit of {MAX_SCENE_BYTES} bytes (1 MB) "
-                         "for a scene file")
+    raw = read_regular_file(path, MAX_SCENE_BYTES)
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a text file in UTF-8 (a scene file is JSON)") from None
     return parse_scene_json(text, str(path))
-
-
-def atomic_write_text(path: str | os.PathLike, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path`` atomically: a temporary file in the same
-    directory, flushed to disk, then renamed over ``path``.
-
-    Readers see either the old file or the complete new one, never a partial write.
-    """
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        # mkstemp creates the file readable by its owner only; keep an existing file's
-        # mode, else use the usual mode of a new file
-        try:
-            mode = path.stat().st_mode & 0o777
-        except FileNotFoundError:
-            mode = 0o644
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
 
 
 def scene_to_json(scene: Scene | Mapping[str, Any]) -> str:
