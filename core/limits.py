@@ -62,9 +62,11 @@ MAX_SOLVER_TIMES = 10_000
 #: points^2 x modes. Every output time is a grid point, so this also bounds the output
 #: times of such a scene; a grid that would exceed it is never built.
 MAX_KERNEL_GRID_POINTS = 4_097
-#: Rows of the kernel matrix evaluated together (so a formula's temporaries stay within
-#: :data:`MAX_FORMULA_ELEMENTS` whatever the grid).
-KERNEL_BLOCK_ELEMENTS = 2**20
+#: Values of the kernel matrix evaluated together, in blocks of rows, so a formula's
+#: temporaries stay within :data:`MAX_FORMULA_ELEMENTS` whatever the grid: a formula
+#: within the depth and part limits holds at most ~45 live arrays (two per nesting
+#: level), below the 64 this block allows for.
+KERNEL_BLOCK_ELEMENTS = MAX_FORMULA_ELEMENTS // 64
 #: Most steps (accepted and rejected) of the degenerate-kernel time stepper per solve.
 #: A load that varies faster than this many steps can follow is refused up front
 #: (``core.load_rates``).

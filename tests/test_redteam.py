@@ -15,6 +15,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from core import limits
@@ -130,3 +131,125 @@ def test_text_fields_are_bounded(field: str, limit: int, tmp_path: Path):
     with pytest.raises(ValueError, match=rf"^{field}: "):
         load_scene(write_scene(tmp_path / "long.json", elastic_dict(**{field: "y" * (
             limit + 1)})))
+
+
+# ------------------------------------------------------- item 1: a work budget per solve
+
+
+class _ExponentialKernel:
+    """``K(t, tau) = -amplitude exp(-rate (t - tau))`` (non-aging): degenerate, and a
+    plain callable for the general path. Records the largest block it is asked for."""
+
+    def __init__(self, amplitude: float, rate: float) -> None:
+        self.amplitude, self.rate_value = amplitude, rate
+        self.rates = np.array([rate])
+        self.largest_call = 0
+
+    def tau_part(self, tau):
+        return np.zeros(np.shape(tau))
+
+    def exponential_parts(self, tau):
+        return np.full((1,) + np.shape(tau), -self.amplitude)
+
+    def __call__(self, t, tau):
+        t, tau = np.broadcast_arrays(np.asarray(t, float), np.asarray(tau, float))
+        self.largest_call = max(self.largest_call, t.size)
+        return np.where(t >= tau, -self.amplitude * np.exp(-self.rate_value * (t - tau)), 0.0)
+
+
+def _one_mode(load, d: float = 2.0):
+    from core.time_integration import ModalProblem
+    return ModalProblem(d=lambda t: np.full((1, np.size(t)), d),
+                        r=lambda t: np.asarray(load(np.asarray(t, float)), float)[None, :],
+                        u=lambda t: np.zeros((0, np.size(t))), coupling=np.zeros((1, 0)))
+
+
+def _exact_step_response(times, t_break, d, amplitude, rate, before=1.0, after=3.0):
+    """``d w - V w = r`` for r = ``before`` up to ``t_break``, ``after`` from it on:
+    ``S = V w`` obeys ``S' = -(rate + amplitude/d) S - amplitude r / d`` (closed form on
+    each piece), and ``w = (r + S)/d``."""
+    lam, beta = rate + amplitude / d, amplitude / d
+
+    def piece(t, t0, s0, r):
+        s_inf = -beta * r / lam
+        return s_inf + (s0 - s_inf) * np.exp(-lam * (t - t0))
+
+    s_break = piece(t_break, 1.0, 0.0, before)
+    t = np.asarray(times, float)
+    s = np.where(t < t_break, piece(t, 1.0, 0.0, before), piece(t, t_break, s_break, after))
+    r = np.where(t < t_break, before, after)
+    return (r + s) / d
+
+
+def test_general_kernel_grid_is_checked_before_it_is_built():
+    """5000 output times used to ask for a 20001-point grid (a 3.2 GB matrix)."""
+    from core.time_integration import solve_general
+    kernel = _ExponentialKernel(0.5, 1.0)
+    times = np.linspace(1.0, 3.0, 5000)
+    with pytest.raises(ValueError, match=r"^times: 5000 output times need .* more than "
+                                         rf"the {limits.MAX_KERNEL_GRID_POINTS}"):
+        solve_general(kernel, _one_mode(lambda t: np.ones_like(t)), times, tol=1e-8)
+    assert kernel.largest_call == 0  # refused before any kernel evaluation
+
+
+def test_general_kernel_grid_stays_within_its_limit():
+    """2000 output times: grids of 2001 and 4001 points; the next (8001) is never built,
+    and the kernel matrix is evaluated in blocks within the formula budget."""
+    from core.time_integration import solve_general
+    kernel = _ExponentialKernel(0.5, 1.0)
+    times = np.linspace(1.0, 3.0, 2000)
+    sol = solve_general(kernel, _one_mode(lambda t: np.ones_like(t)), times, tol=1e-12)
+    assert sol.steps + 1 <= limits.MAX_KERNEL_GRID_POINTS
+    assert kernel.largest_call <= limits.KERNEL_BLOCK_ELEMENTS
+    exact = _exact_step_response(times, 10.0, 2.0, 0.5, 1.0)
+    error = float(np.max(np.abs(sol.w[0] - exact)) / np.max(np.abs(exact)))
+    # measured 3.3e-16 (extrapolated, two grids) against an estimate of 3.1e-09
+    assert error <= sol.error_estimate
+    assert not sol.success and "3999 points" in sol.message
+
+
+def test_formula_temporaries_are_bounded():
+    from core.expressions import parse_expression
+    expr = parse_expression("t - (tau - (t - (tau - (t - tau))))", ("t", "tau"))
+    n = 3000  # 9e6 points times the formula's live arrays: over the budget
+    with pytest.raises(ValueError, match="evaluate it in blocks"):
+        expr(np.ones((n, 1)), np.ones((1, n)))
+    assert expr(np.ones((100, 1)), np.ones((1, 100))).shape == (100, 100)
+
+
+GUARD = """
+import resource, sys, time, json
+resource.setrlimit(resource.RLIMIT_AS, ({limit_mib} * 2**20,) * 2)
+sys.path.insert(0, {root!r})
+from core.scene import scene_from_dict, solve
+d = json.loads({scene!r})
+t0 = time.perf_counter()
+try:
+    result = solve(scene_from_dict(d))
+    print(json.dumps({{"solved": True, "message": result.info["message"],
+                      "flags": result.flags}}))
+except ValueError as exc:
+    print(json.dumps({{"solved": False, "message": str(exc)}}))
+"""
+
+
+def _nested_kernel_scene() -> dict:
+    e = "exp(-0.03*(t-tau))"
+    for k in range(8):
+        e = f"(0.5+0.5*{e})*(1+0*(t-tau+{k}))"
+    d = scene_dict()
+    d["base"]["creep"] = {"model": "kernel", "modulus": 3e10, "expr": f"-0.01*{e}"}
+    d["times"] = {"end": 365.0, "count": 2000}
+    return d
+
+
+def test_small_scene_with_a_nested_kernel_formula_is_bounded():
+    """A 1.1 kB scene (a nested kernel formula, 2000 output times) took 2.6 GB here
+    (9.5 GiB in the report): it must now solve within 1.2 GiB of address space."""
+    script = GUARD.format(limit_mib=1200, root=str(ROOT),
+                          scene=json.dumps(_nested_kernel_scene()))
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    outcome = json.loads(proc.stdout.splitlines()[-1])
+    assert outcome["solved"], outcome
