@@ -250,6 +250,21 @@ class Profile:
         or the slope may be discontinuous."""
         return self._breakpoints
 
+    def nonsmooth_points(self, lo: float | None = None,
+                         hi: float | None = None) -> tuple[float, ...]:
+        """Sorted points strictly inside ``(lo, hi)`` (default: the domain; unit of the
+        variable) where the value or the slope may jump: step breaks, the ramp's corner,
+        table rows (all for "linear", all but the first for "step", the end rows for
+        "pchip"), the switches of a formula.
+
+        For a load history these are the times the time stepper must land on exactly
+        (``breaks`` of :func:`core.time_integration.solve_degenerate`): a step across a
+        jump loses the method's order and fools its error estimate.
+        """
+        low = self._domain[0] if lo is None else float(lo)
+        high = self._domain[1] if hi is None else float(hi)
+        return tuple(b for b in self._breakpoints if low < b < high)
+
     @property
     def variable(self) -> str:
         """Name of the variable (``"x"`` or ``"t"``)."""

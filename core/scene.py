@@ -42,8 +42,9 @@ import numpy as np
 
 from core import limits
 from core.cache import StageCache, fingerprint
-from core.creep import UserKernel, creep_model_from_spec
+from core.creep import Elastic, UserKernel, creep_model_from_spec
 from core.files import atomic_write_text, read_regular_file
+from core.load_rates import check_step_limit, oscillations
 from core.profiles import Profile, check_range, profile_from_spec
 from core.validation import (
     MAX_MAGNITUDE,
@@ -665,7 +666,20 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
                   MappingProxyType(loads), times, tol, data)
     _check_breakpoints(scene)
     _check_solvable(scene)
+    _check_load_rates(scene)
     return scene
+
+
+def _check_load_rates(scene: Scene) -> None:
+    """Refuse a load that varies faster than the time stepping can follow (an elastic
+    base has no time stepping; a formula kernel's grid has its own point limit)."""
+    if isinstance(scene.creep, Elastic):
+        return
+    general = isinstance(scene.creep, UserKernel)
+    check_step_limit({f"loading.{q}": p for q, p in scene.loading.items()}, 0.0,
+                     float(scene.times[-1]), scene.tol,
+                     limits.MAX_KERNEL_GRID_POINTS if general else limits.MAX_TIME_STEPS,
+                     "the time grid's limit" if general else "the time stepping's limit")
 
 
 def _x_profiles(scene: Scene) -> list[tuple[str, Profile]]:
@@ -1193,7 +1207,23 @@ def _check_finite(result: SceneSolution) -> None:
         bad = ~np.isfinite(np.asarray(values, dtype=float))
         if bad.any():
             j = int(np.argwhere(bad)[0][-1])  # the time index (last axis)
+            message = str(result.info.get("message", ""))
+            if "stopped at its limit" in message:
+                # the stepper gave up, which says nothing of double precision
+                raise ValueError(f"{_fastest_load(result.scene)}: the time stepping could "
+                                 "not follow the loads: "
+                                 + message.split("time stepping: ", 1)[-1])
             raise ValueError(
                 f"scene: the computed {name} is not finite at t = {result.times[j]:.6g} days "
                 "after loading: the sizes in this scene (moduli, loads, lengths) are too far "
                 "apart for double precision")
+
+
+def _fastest_load(scene: Scene) -> str:
+    """The field of the load that oscillates most over the solved times (``loading``
+    when none oscillates)."""
+    end = float(scene.times[-1])
+    counts = {q: oscillations(p, 0.0, end) + len(p.breakpoints)
+              for q, p in scene.loading.items()}
+    name = max(counts, key=lambda q: counts[q])
+    return f"loading.{name}" if counts[name] > 0 else "loading"
