@@ -969,7 +969,11 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
         m_value: Any = float(m_factor * scene.coating_compliance(np.zeros(1))[0])
     else:
         def m_value(xs: np.ndarray) -> np.ndarray:
-            return m_factor * scene.coating_compliance(a * np.asarray(xs, dtype=float))
+            x = a * np.asarray(xs, dtype=float)
+            values = m_factor * scene.coating_compliance(x)
+            if not np.all(np.isfinite(values) & (values > 0)):
+                _check_x_profiles_at(scene, x)
+            return values
 
     if coating_constant and _is_constant(scene.shape):
         g_value: Any = 0.0
@@ -977,7 +981,11 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
         g_min = scene.gap_minimum
 
         def g_value(xs: np.ndarray) -> np.ndarray:
-            return (scene.gap_variation(a * np.asarray(xs, dtype=float)) - g_min) / a
+            x = a * np.asarray(xs, dtype=float)
+            values = (scene.gap_variation(x) - g_min) / a
+            if not np.all(np.isfinite(values)):
+                _check_x_profiles_at(scene, x)
+            return values
 
     c_value = creep.relative_modulus(tau0)
     aging = callable(c_value)
@@ -1021,6 +1029,35 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
         plane_factor=plane,
         modulus=modulus,
     )
+
+
+#: Open bounds of the values of each x-profile of a layer, as the loader checks them.
+_LAYER_BOUNDS = {"thickness": (0.0, None), "modulus": (0.0, None), "poisson": (-1.0, 0.5)}
+
+
+def _check_x_profiles_at(scene: Scene, x: np.ndarray) -> None:
+    """Refuse, naming the field, an x-profile that is not finite or out of its range at
+    points ``x`` [m] the solver asked for: the loader checks profiles on samples, and a
+    formula's pole or spike between them would otherwise surface under the solver's
+    internal names (``m``, ``g``)."""
+    candidates = [("punch.shape", scene.shape, (None, None))] + [
+        (f"coating[{k}].{name}", getattr(layer, name), bounds)
+        for k, layer in enumerate(scene.coating) for name, bounds in _LAYER_BOUNDS.items()]
+    for path, profile, (lower, upper) in candidates:
+        values = _values(profile, x)
+        checks = [(~np.isfinite(values), "must be finite")]
+        if lower is not None:
+            checks.append((values <= lower, f"must be > {lower:g}"))
+        if upper is not None:
+            checks.append((values >= upper, f"must be < {upper:g}"))
+        for bad, rule in checks:
+            if bad.any():
+                i = int(np.argmax(bad))
+                raise ValueError(
+                    f"{path}: {rule}, is {values.flat[i]:.6g} at x = {x.flat[i]:.10g} m, "
+                    f"between the points where the scene was checked (a pole or a spike "
+                    "of a formula narrower than the checks): keep it finite and in range "
+                    "on the whole punch")
 
 
 def _kinematic_load(profile: Profile, scale: float,

@@ -362,3 +362,36 @@ def test_profiles_expose_their_jumps_and_kinks():
         pytest.approx((10.0,), abs=1e-9)
     assert history({"kind": "sine", "mean": 1, "amplitude": 1, "wavelength": 9}
                    ).nonsmooth_points() == ()
+
+
+# ------------------------------------------------------------ item 9: names of refusals
+
+
+def test_a_formula_pole_between_check_samples_names_the_scene_field():
+    """Was refused as "m: must be > 0" (the solver's internal name)."""
+    from core.scene import solve
+    d = elastic_dict()
+    d["coating"][0]["thickness"] = {"expr": "0.02 + 1e-7/(x - 0.123456789)"}
+    scene = scene_from_dict(d)  # the 4097 check samples miss the pole
+    with pytest.raises(ValueError, match=r"^coating\[0\]\.thickness: must be > 0, is -\S+ "
+                                         r"at x = 0\.1234\d* m, between the points"):
+        solve(scene)
+
+
+def test_an_uploaded_shape_table_beyond_the_solver_limit_is_refused_on_upload():
+    """A 40-row shape table was accepted by the upload (10,000 rows allowed) and then
+    always refused when the scene was built (16 kinks at most in a scene)."""
+    from core.profiles import profile_from_csv
+    rows = "x,f\n" + "".join(f"{-1 + 2 * k / 39:.6f},{1e-4 * (k % 2)}\n" for k in range(40))
+    with pytest.raises(ValueError, match=rf"^punch\.shape: a table of 40 rows with 'linear' "
+                                         rf".* more than the {limits.MAX_BREAKPOINTS} .*"
+                                         "'pchip'"):
+        profile_from_csv(rows, field="punch.shape", variable="x", domain=(-1.0, 1.0))
+    smooth = profile_from_csv(rows, field="punch.shape", variable="x", domain=(-1.0, 1.0),
+                              interpolation="pchip")
+    d = elastic_dict()
+    d["punch"]["shape"] = smooth.spec
+    scene_from_dict(d)  # the solver's limit agrees: accepted
+    # a load history in time has no such limit
+    history = "t,f\n" + "".join(f"{k},{k % 2}\n" for k in range(40))
+    profile_from_csv(history, field="loading.force", variable="t", domain=(0.0, 50.0))
