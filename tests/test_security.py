@@ -600,7 +600,7 @@ def test_an_uploaded_table_with_too_many_rows_for_the_solver_keeps_the_last_resu
     # every row of a linear table is a kink, the end rows too (the held value begins):
     # more than the solver allows, so the upload itself is refused, naming the limit
     assert app.state.punch.shape == "flat"
-    assert "punch.shape: a table of 40 rows" in app.notice and "16" in app.notice
+    assert "(punch.shape): a table of 40 rows" in app.notice and "16" in app.notice
     assert app.controller.view is shown
 
 
