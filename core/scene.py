@@ -1160,10 +1160,16 @@ class SceneSolution:
     def pressure(self, x: Any) -> np.ndarray:
         """Contact pressure q [Pa] at points ``x`` [m] of ``[-a, a]``, shape (len(x), len(times)).
 
-        Points outside ``[-a, a]`` are refused (ValueError).
+        Points outside ``[-a, a]`` are refused (ValueError), and so are more points than
+        :data:`core.limits.MAX_PRESSURE_VALUES` values allow (checked before any work).
         """
         a = self.scene.half_width
         xs = np.atleast_1d(np.asarray(x, dtype=float))
+        if xs.size * self.times.size > limits.MAX_PRESSURE_VALUES:
+            raise ValueError(
+                f"x: {xs.size} points at {self.times.size} times are more than the "
+                f"{limits.MAX_PRESSURE_VALUES} pressure values one call may compute; ask "
+                "for fewer points (or in several calls)")
         if np.any(~np.isfinite(xs)) or np.any(np.abs(xs) > a * (1 + 1e-12)):
             raise ValueError(f"x: the pressure is defined on [-a, a] = [{-a:g}, {a:g}] m only")
         # x = +-a can land a rounding error outside [-1, 1] after the division

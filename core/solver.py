@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from core import limits
 from core.basis import Basis, build_basis, graded_cuts
 from core.cache import StageCache, fingerprint
 from core.projection import GapTerms, galerkin_matrix, gap_terms
@@ -254,8 +255,8 @@ def _validate(lam, m, g, times, c, kernel, loads, breakpoints, tol) -> _Inputs:
         raise ValueError("times: must be an array of numbers") from exc
     if t.size == 0:
         raise ValueError("times: at least one time is needed")
-    if t.size > 100_000:
-        raise ValueError(f"times: at most 100000 output times, got {t.size}")
+    if t.size > limits.MAX_SOLVER_TIMES:
+        raise ValueError(f"times: at most {limits.MAX_SOLVER_TIMES} output times, got {t.size}")
     if not np.all(np.isfinite(t)):
         raise ValueError("times: must be finite")
     if t[0] < 1.0:

@@ -395,3 +395,16 @@ def test_an_uploaded_shape_table_beyond_the_solver_limit_is_refused_on_upload():
     # a load history in time has no such limit
     history = "t,f\n" + "".join(f"{k},{k % 2}\n" for k in range(40))
     profile_from_csv(history, field="loading.force", variable="t", domain=(0.0, 50.0))
+
+
+def test_output_times_and_pressure_points_are_bounded():
+    from core.scene import solve
+    from core.solver import solve_dimensionless
+    times = 1.0 + np.arange(limits.MAX_SOLVER_TIMES + 1) * 1e-3
+    with pytest.raises(ValueError, match=rf"^times: at most {limits.MAX_SOLVER_TIMES}"):
+        solve_dimensionless(1.0, 0.05, 0.0, times, force=1.0, moment=0.0)
+    result = solve(elastic_dict())
+    points = limits.MAX_PRESSURE_VALUES // result.times.size + 1
+    with pytest.raises(ValueError, match=r"^x: .* more than the"):
+        result.pressure(np.zeros(points))
+    assert result.pressure(np.zeros(points - 1)).shape == (points - 1, result.times.size)
