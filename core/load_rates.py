@@ -10,9 +10,10 @@ the field, from a lower bound of the steps its history needs.
 Steps per period of a sine force on the uniform preset (``benchmarks``-style runs of
 ``core.scene.solve``, wavelength 5 days over 365 days): 3.8 at tol 1e-2, 9.5 at 1e-4,
 23.3 at 1e-6, 48.7 at 1e-8; the same per period for wavelengths 1 to 20 days. That is
-``3.8 (1e-2 / tol)^0.185``; half of it is taken as the lower bound (a smaller
-oscillation is cheaper: the step count falls about as ``amplitude^(1/6)``, which the
-bound includes for a sine).
+``3.8 (1e-2 / tol)^0.185`` for that relative amplitude (0.29). A smaller oscillation is
+cheaper: the step count falls about as ``amplitude^(1/6)``, so a full-amplitude sine needs
+``3.8 / 0.29^(1/6) = 4.7`` steps per period at tol 1e-2; the bound takes 3.0 of them
+(about 2/3, for scenes that differ from the preset).
 """
 
 from __future__ import annotations
@@ -23,9 +24,10 @@ import numpy as np
 
 from core.profiles import Profile
 
-#: Steps per period at tol 1e-2 (measured 3.8, halved for a lower bound) and their
-#: growth with 1/tol (measured exponent 0.185 from 1e-2 to 1e-8).
-STEPS_PER_PERIOD = 1.9
+#: Steps per period of a full-amplitude oscillation at tol 1e-2 (measured 4.7, about
+#: 2/3 of it for a lower bound) and their growth with 1/tol (measured exponent 0.185
+#: from 1e-2 to 1e-8).
+STEPS_PER_PERIOD = 3.0
 STEPS_GROWTH = 0.185
 #: Samples of a formula history when counting its oscillations.
 FORMULA_SAMPLES = 2**15 + 1
