@@ -260,8 +260,9 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         while j_next < len(jumps) and jumps[j_next] <= t_now:
             j_next += 1
         t_stop = float(jumps[j_next]) if j_next < len(jumps) else t_final
-        at_jump = j_next < len(jumps) and h >= t_stop - t_now
-        h_try = min(h, t_stop - t_now)
+        # a step that would end within a millionth of its length before a jump takes it
+        at_jump = j_next < len(jumps) and h >= (t_stop - t_now) * (1 - 1e-6)
+        h_try = t_stop - t_now if at_jump else min(h, t_final - t_now)
         full = _radau_step(kernel, problem, t_now, h_try, s_modes, s_known,
                            before_jump=at_jump)
         half = _radau_step(kernel, problem, t_now, h_try / 2, s_modes, s_known)
