@@ -69,6 +69,11 @@ def error(sol: Any, ref: Any, x: np.ndarray, q_ref: np.ndarray) -> float:
     return float(max(parts))
 
 
+def loads_of(scene: Scene, scale: float = 1.0) -> dict[str, Any]:
+    """The time-side arguments of ``PreparedContact.solve`` (loads times ``scale``)."""
+    return {k: v for k, v in scene.arguments(scale).items() if k != "breakpoints"}
+
+
 def fresh() -> None:
     """Forget every cached geometry of both engines."""
     clear_caches()  # the projection's stage caches and the prepared geometries
@@ -114,7 +119,7 @@ def sweep(scene: Scene, repeats: int) -> dict[str, Any]:
 
                 def warm_call(prep=prep, xs400=xs400, warm_scale=warm_scale):
                     s = next(warm_scale)
-                    out = prep.solve(scene.times, **scene.arguments(s))
+                    out = prep.solve(scene.times, **loads_of(scene, s))
                     out.pressure(xs400)
                     return out
             else:
@@ -153,7 +158,7 @@ def goals(repeats: int) -> dict[str, float]:
         prep = core.prepare(scene.lam, scene.m, scene.g, tol=1e-6)
         scales = iter(np.linspace(1.01, 1.5, 1000))
         warm, _ = median_time(lambda prep=prep, scene=scene, scales=scales: prep.solve(
-            scene.times, **scene.arguments(next(scales))), repeats, None)
+            scene.times, **loads_of(scene, next(scales))), repeats, None)
         out[f"creep_{count}_loads_ms"] = warm * 1e3
     smooth = suite()[0]
     prep = core.prepare(smooth.lam, smooth.m, smooth.g, tol=1e-6)

@@ -9,6 +9,12 @@ histories of settlement, tilt, force and moment, and the contact zones when the 
 lifts off) and optionally the pressure ``q(x, t)`` to ``--pressure-csv``; without
 ``--output`` it prints a short summary. ``validate`` only checks the scene file.
 
+Files: an output may not be the scene file itself, two outputs may not name one file,
+and an existing output must be a regular, writable file (a read-only file is refused,
+never replaced); a symbolic link is written through (its target is replaced, the link
+stays). The scene file must be a regular file (a named pipe is refused at once). All of
+this is checked before solving (see :mod:`core.files`).
+
 Exit codes: 0 success, 1 the solver failed (or an internal error), 2 bad input (an
 unreadable, oversized or invalid scene file, or bad arguments). Every error is one line
 ``error: <field>: <reason>`` on stderr; validity flags of a solution (for instance
@@ -25,6 +31,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
+from core.files import same_file, writable_target
 from core.scene import (
     QUANTITIES,
     Scene,
@@ -67,9 +74,29 @@ def _read(path: str) -> Scene:
         raise _InputError(f"{path}: {exc.strerror or exc}") from None
 
 
+def _check_outputs(scene: str, outputs: Sequence[tuple[str, Path | None]]) -> None:
+    """Refuse, before solving, an output that is the scene file itself, two outputs to
+    one file, and an output that may not be replaced (read-only, not a regular file)."""
+    given = [(option, path) for option, path in outputs if path is not None]
+    for i, (option, path) in enumerate(given):
+        if same_file(path, scene):
+            raise _InputError(f"{option}: {path} is the scene file being solved; it is not "
+                              "overwritten (choose another file)")
+        for earlier, other in given[:i]:
+            if same_file(path, other):
+                raise _InputError(f"{option}: {path} is also the {earlier} file; give two "
+                                  "different files")
+        try:
+            writable_target(path)
+        except ValueError as exc:
+            raise _InputError(f"{option}: {exc}") from None
+
+
 def _write(path: Path, text: str) -> None:
     try:
         atomic_write_text(path, text)
+    except ValueError as exc:
+        raise _InputError(str(exc)) from None
     except OSError as exc:
         raise _InputError(f"{path}: cannot write ({exc.strerror or exc})") from None
 
@@ -113,6 +140,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         raise _InputError(f"--output: unsupported extension {output.suffix!r} "
                           "(use .json or .csv)")
     pressure_out = Path(args.pressure_csv) if args.pressure_csv else None
+    _check_outputs(args.scene, [("--output", output), ("--pressure-csv", pressure_out)])
     scene = _read(args.scene)
     try:
         result = solve(scene)

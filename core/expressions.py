@@ -48,14 +48,16 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from core import limits
+
 #: Longest accepted formula, in characters.
-MAX_LENGTH = 500
+MAX_LENGTH = limits.MAX_FORMULA_CHARS
 #: Deepest accepted nesting; parentheses, function calls and exponents each add a level.
-MAX_DEPTH = 20
+MAX_DEPTH = limits.MAX_FORMULA_DEPTH
 #: Most accepted parts (numbers, names, operators, calls).
-MAX_NODES = 200
+MAX_NODES = limits.MAX_FORMULA_PARTS
 #: Largest accepted magnitude of an exponent that does not depend on the variables.
-MAX_CONSTANT_EXPONENT = 64.0
+MAX_CONSTANT_EXPONENT = limits.MAX_CONSTANT_EXPONENT
 
 # The tables are read-only views, so no other code can widen the whitelist at run time.
 
@@ -435,6 +437,16 @@ class _Parser:
         return self.apply(function, args, text, _ATOM, tok.pos, switches)
 
 
+def _live_arrays(program: tuple[_Instr, ...]) -> int:
+    """Most arrays alive at once while ``program`` runs: its deepest stack, plus the
+    result of the operation that empties it."""
+    height = peak = 0
+    for ins in program:
+        height += 1 if ins[0] in ("c", "v") else 1 - ins[2]
+        peak = max(peak, height)
+    return peak + 1
+
+
 def _run(program: tuple[_Instr, ...], arrays: list[np.ndarray]) -> Any:
     stack: list[Any] = []
     for ins in program:
@@ -461,10 +473,13 @@ class Expression:
     days), broadcasts them, and returns a new float array of the broadcast shape,
     evaluated under ``np.errstate(all="ignore")``: results may be non-finite (``sqrt(x)``
     for ``x < 0``) and are for the caller to range-check. Two expressions are equal when
-    their normalized texts and variables are.
+    their normalized texts and variables are. One evaluation may hold at most
+    :data:`core.limits.MAX_FORMULA_ELEMENTS` values (the points times
+    :attr:`live_arrays`); a larger request is refused before any work (ValueError), so
+    callers with many points evaluate in blocks.
     """
 
-    __slots__ = ("_text", "_variables", "_program", "_value", "_switches")
+    __slots__ = ("_text", "_variables", "_program", "_value", "_switches", "_live")
 
     def __init__(self, *, _text: str, _variables: tuple[str, ...],
                  _program: tuple[_Instr, ...], _value: float | None,
@@ -474,6 +489,7 @@ class Expression:
         object.__setattr__(self, "_program", _program)
         object.__setattr__(self, "_value", _value)
         object.__setattr__(self, "_switches", _switches)
+        object.__setattr__(self, "_live", _live_arrays(_program))
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise AttributeError("Expression is immutable")
@@ -491,6 +507,11 @@ class Expression:
     def variables(self) -> tuple[str, ...]:
         """The variable names, in the order ``__call__`` takes them."""
         return self._variables
+
+    @property
+    def live_arrays(self) -> int:
+        """Most intermediate arrays of the evaluated shape one evaluation holds at once."""
+        return self._live
 
     @property
     def is_constant(self) -> bool:
@@ -522,6 +543,14 @@ class Expression:
                             f"array(s) ({', '.join(self._variables)}), got {len(arrays)}")
         args = [np.asarray(a, dtype=float) for a in arrays]
         shape = np.broadcast_shapes(*(a.shape for a in args)) if args else ()
+        # checked before any work: the evaluation holds live_arrays arrays of this shape
+        size = int(np.prod(shape, dtype=np.int64)) if shape else 1
+        if size * self._live > limits.MAX_FORMULA_ELEMENTS:
+            raise ValueError(
+                f"formula {self._text[:60]!r}: evaluating it at {size} points holds "
+                f"{self._live} arrays of that size, more than the "
+                f"{limits.MAX_FORMULA_ELEMENTS} values allowed at once; evaluate it in "
+                f"blocks of at most {limits.MAX_FORMULA_ELEMENTS // self._live} points")
         with np.errstate(all="ignore"):
             result = _run(self._program, args)
         return np.array(np.broadcast_to(result, shape), dtype=float)

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from core import limits
 from core.statements import statement_number
 from core.validation import MAX_MAGNITUDE
 
@@ -30,8 +31,6 @@ VALUE_RANGE = {"m": (1 / MAX_MAGNITUDE, MAX_MAGNITUDE), "g": (0.0, MAX_MAGNITUDE
 #: Accepted a/H. The operator's nodes grow like a/H and its memory like its square:
 #: measured 155 MB at 100 and 5.5 GB at 1000 (the scene limit, core/scene.py, is tighter).
 LAM_RANGE = (1e-4, 1e3)
-#: Most output times of one solve.
-MAX_TIMES = 100_000
 
 
 def as_function(value: Scalar, name: str) -> Function:
@@ -139,8 +138,9 @@ def validate_times(times: Any) -> np.ndarray:
         raise ValueError("times: must be an array of numbers") from exc
     if t.size == 0:
         raise ValueError("times: at least one time is needed")
-    if t.size > MAX_TIMES:
-        raise ValueError(f"times: at most {MAX_TIMES} output times, got {t.size}")
+    if t.size > limits.MAX_SOLVER_TIMES:
+        raise ValueError(f"times: at most {limits.MAX_SOLVER_TIMES} output times, "
+                         f"got {t.size}")
     if not np.all(np.isfinite(t)):
         raise ValueError("times: must be finite")
     if t[0] < 1.0:

@@ -129,10 +129,12 @@ class ModalForm:
         return self.to_nodes @ a, effective, out
 
     def solve(self, times: np.ndarray, c: Function, kernel, loads: dict[str, Function],
-              time_tol: float, gap: float = 1.0) -> ModalAnswer:
+              time_tol: float, gap: float = 1.0, breaks: np.ndarray | None = None
+              ) -> ModalAnswer:
         """The answer at ``times`` for relative modulus ``c(t)`` and creep kernel ``kernel``.
 
-        ``gap`` scales the gap's drive (0: the response to the loads alone).
+        ``gap`` scales the gap's drive (0: the response to the loads alone); ``breaks``
+        are times where a load jumps, which the time steps land on.
         """
         c_t = c(times)
         values = {name: fn(times) for name, fn in loads.items()}
@@ -158,13 +160,14 @@ class ModalForm:
                              / gamma[:, None], u)
             return memo[key]
 
+        jumps = tuple(np.asarray(breaks, dtype=float).tolist()) if breaks is not None else ()
         problem = ModalProblem(d=lambda tt: evaluate(tt)[0], r=lambda tt: evaluate(tt)[1],
                                u=lambda tt: evaluate(tt)[2],
                                coupling=self.coupling / gamma[:, None])
         if hasattr(kernel, "rates") and hasattr(kernel, "exponential_parts"):
-            sol = solve_degenerate(kernel, problem, times, tol=time_tol)
+            sol = solve_degenerate(kernel, problem, times, tol=time_tol, breaks=jumps)
         else:
-            sol = solve_general(kernel, problem, times, tol=time_tol)
+            sol = solve_general(kernel, problem, times, tol=time_tol, breaks=jumps)
         nodal, effective, scalars = self.finish(c_t, values, known, sol.w, sol.vw, sol.vu,
                                                 gap)
         return ModalAnswer(nodal, effective, scalars, float(sol.error_estimate), int(sol.steps),

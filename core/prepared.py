@@ -169,19 +169,29 @@ class PreparedContact:
     def solve(self, times: Sequence[float] | np.ndarray, *, c: Scalar = 1.0,
               kernel: Callable | None = None, settlement: Scalar | None = None,
               tilt: Scalar | None = None, force: Scalar | None = None,
-              moment: Scalar | None = None) -> ContactSolution:
+              moment: Scalar | None = None, time_breaks: Sequence[float] = ()
+              ) -> ContactSolution:
         """Solve for the loads at ``times`` (dimensionless; see ``solve_dimensionless``)."""
         inputs = validate_time_inputs(times, c, kernel, {"settlement": settlement, "tilt": tilt,
                                                          "force": force, "moment": moment})
-        return self.solve_validated(inputs)
+        return self.solve_validated(inputs, time_breaks)
 
-    def solve_validated(self, inputs: TimeInputs) -> ContactSolution:
-        """:meth:`solve` for inputs already checked by :func:`core.inputs.validate_time_inputs`."""
+    def solve_validated(self, inputs: TimeInputs, time_breaks: Sequence[float] = ()
+                        ) -> ContactSolution:
+        """:meth:`solve` for inputs already checked by :func:`core.inputs.validate_time_inputs`.
+
+        ``time_breaks``: times where a given history jumps or kinks (dimensionless).
+        """
         t0 = _time.perf_counter()
         geometry = self.geometry
         times = inputs.times
         built_before = Counter(self.counts)
+        breaks = np.array([b for b in np.asarray(time_breaks, dtype=float).ravel()
+                           if np.isfinite(b) and times[0] < b < times[-1]])
         probe = self._history_times(times)
+        if breaks.size:  # both sides of every jump are checked too
+            probe = np.union1d(probe, np.concatenate([breaks * (1 - 1e-12),
+                                                      breaks * (1 + 1e-12)]))
         g = self.geometry.g
         if inputs.kernel is None and inputs.c_is_constant:
             c0 = float(inputs.c(times[:1])[0])
@@ -244,7 +254,7 @@ class PreparedContact:
             merged = np.union1d(times, probe)
             kernel, fit_error = stepping_kernel(inputs.kernel, float(times[-1]),
                                                 0.5 * geometry.tol)
-            answer = self._superposed(form, merged, inputs, kernel, time_tol)
+            answer = self._superposed(form, merged, inputs, kernel, time_tol, breaks)
             q_check = answer.q_check
             c_merged = inputs.c(merged)
             sc = answer.scalars
@@ -269,7 +279,7 @@ class PreparedContact:
                             float(np.max(np.abs(tilt_history))))
 
     def _superposed(self, form: ModalForm, times: np.ndarray, inputs: TimeInputs, kernel: Any,
-                    time_tol: float) -> _Superposed:
+                    time_tol: float, breaks: np.ndarray) -> _Superposed:
         """The time-stepped answer as a sum of cached responses to each load and the gap.
 
         The problem is linear: each given load is split into its amplitude and its shape
@@ -285,7 +295,7 @@ class PreparedContact:
         except TypeError:  # a key of objects the fingerprint does not know: the instance
             kernel_key = fingerprint(id(kernel))
         common = fingerprint("modal", tuple(sorted(inputs.given)), times, c_t, kernel_key,
-                             time_tol)
+                             time_tol, breaks)
         zero = {name: (lambda tt: np.zeros(np.shape(tt))) for name in inputs.loads}
         parts: list[tuple[float, tuple, dict[str, Callable], float]] = []
         for name, fn in sorted(inputs.loads.items()):
@@ -307,7 +317,7 @@ class PreparedContact:
             with self._lock:
                 cached = self._responses.get(key)
             if cached is None:
-                response = form.solve(times, inputs.c, kernel, loads, time_tol, gap)
+                response = form.solve(times, inputs.c, kernel, loads, time_tol, gap, breaks)
                 sc = response.scalars
                 drive = (sc["settlement"][None, :] + np.outer(x, sc["tilt"])
                          - gap * self.geometry.g(x)[:, None])
@@ -449,7 +459,8 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
                         kernel: Callable | None = None, settlement: Scalar | None = None,
                         tilt: Scalar | None = None, force: Scalar | None = None,
                         moment: Scalar | None = None, breakpoints: Sequence[float] = (),
-                        tol: float = 1e-8) -> ContactSolution:
+                        tol: float = 1e-8, time_breaks: Sequence[float] = ()
+                        ) -> ContactSolution:
     """``solve_dimensionless(method="nystrom")``: prepare (or reuse) the geometry, then solve.
 
     Geometries are recognised by their values on 2049 Chebyshev points (and both sides of
@@ -460,4 +471,4 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
                                                      "force": force, "moment": moment})
     prepared, _ = PREPARED.get_or_compute(_geometry_key(geometry),
                                           lambda: PreparedContact(geometry))
-    return prepared.solve_validated(inputs)
+    return prepared.solve_validated(inputs, time_breaks)

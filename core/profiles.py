@@ -49,12 +49,13 @@ from typing import Any
 
 import numpy as np
 
+from core import limits
 from core.expressions import ALIASES, CONSTANTS, FUNCTIONS, Expression, parse_expression
 
 #: Most rows of a table (and most breaks of a step profile).
-MAX_TABLE_ROWS = 10_000
+MAX_TABLE_ROWS = limits.MAX_TABLE_ROWS
 #: Most coefficients of a polynomial (degree 15).
-MAX_POLYNOMIAL_COEFFICIENTS = 16
+MAX_POLYNOMIAL_COEFFICIENTS = limits.MAX_POLYNOMIAL_COEFFICIENTS
 #: Samples of the uniform part of :func:`check_range`'s grid.
 RANGE_SAMPLES = 4097
 #: Samples used to locate the switching points of a formula (see ``Profile.breakpoints``).
@@ -248,6 +249,21 @@ class Profile:
         """Sorted points strictly inside the domain (unit of the variable) where the value
         or the slope may be discontinuous."""
         return self._breakpoints
+
+    def nonsmooth_points(self, lo: float | None = None,
+                         hi: float | None = None) -> tuple[float, ...]:
+        """Sorted points strictly inside ``(lo, hi)`` (default: the domain; unit of the
+        variable) where the value or the slope may jump: step breaks, the ramp's corner,
+        table rows (all for "linear", all but the first for "step", the end rows for
+        "pchip"), the switches of a formula.
+
+        For a load history these are the times the time stepper must land on exactly
+        (``breaks`` of :func:`core.time_integration.solve_degenerate`): a step across a
+        jump loses the method's order and fools its error estimate.
+        """
+        low = self._domain[0] if lo is None else float(lo)
+        high = self._domain[1] if hi is None else float(hi)
+        return tuple(b for b in self._breakpoints if low < b < high)
 
     @property
     def variable(self) -> str:
@@ -649,12 +665,13 @@ def _cell_number(cell: str) -> float | None:
 
 
 #: Largest CSV table accepted for a profile [bytes] (1 MB).
-MAX_TABLE_BYTES = 1_000_000
+MAX_TABLE_BYTES = limits.MAX_TABLE_BYTES
 
 
 def profile_from_csv(data: bytes | str, *, field: str, variable: str = "x",
                      domain: tuple[float, float], interpolation: str = "linear",
-                     max_bytes: int = MAX_TABLE_BYTES, max_rows: int = 10_000) -> Profile:
+                     max_bytes: int = MAX_TABLE_BYTES, max_rows: int = MAX_TABLE_ROWS,
+                     max_breakpoints: int | None = None) -> Profile:
     """A table profile from an uploaded CSV file of two numeric columns.
 
     Columns: the variable (unit of the variable) and the value (unit of the quantity).
@@ -663,7 +680,10 @@ def profile_from_csv(data: bytes | str, *, field: str, variable: str = "x",
     ``table`` profile with ``interpolation``. Raises ValueError naming ``field`` and the
     1-based line for: a file over ``max_bytes`` bytes, over ``max_rows`` data rows, fewer
     than 2 rows, a wrong number of columns, a cell that is not a number, values not
-    strictly increasing in the variable.
+    strictly increasing in the variable; and naming the limit for a table with more
+    than ``max_breakpoints`` points inside the domain where its value or slope jumps
+    (default: :data:`core.limits.MAX_BREAKPOINTS` for an x-profile, which the solver
+    allows for a whole scene, so such a table could never be solved; none for ``t``).
     """
     if isinstance(data, (bytes, bytearray, memoryview)):
         raw = bytes(data)
@@ -725,6 +745,17 @@ def profile_from_csv(data: bytes | str, *, field: str, variable: str = "x",
             raise ValueError(f"{field}: {variable} values must be strictly increasing "
                              f"(line {n}: {_fmt(row[0])} after {_fmt(points[-1][0])})")
         points.append(row)
-    return profile_from_spec({"kind": "table", "points": points,
-                              "interpolation": interpolation},
-                             field=field, variable=variable, domain=domain)
+    profile = profile_from_spec({"kind": "table", "points": points,
+                                 "interpolation": interpolation},
+                                field=field, variable=variable, domain=domain)
+    if max_breakpoints is None and variable == "x":
+        max_breakpoints = limits.MAX_BREAKPOINTS
+    jumps = len(profile.breakpoints)
+    if max_breakpoints is not None and jumps > max_breakpoints:
+        raise ValueError(
+            f"{field}: a table of {len(points)} rows with {interpolation!r} interpolation "
+            f"has {jumps} points inside the domain where its value or slope jumps, more "
+            f"than the {max_breakpoints} the solver allows in a whole scene: use at most "
+            f"{max_breakpoints} rows inside the domain, or 'pchip' interpolation (smooth "
+            "between its end rows)")
+    return profile

@@ -32,16 +32,15 @@ import math
 import numbers
 import os
 import re
-import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from core import limits
 from core.cache import StageCache, fingerprint
 from core.coating_model import (
     DEFAULT_INTERFACE,
@@ -52,7 +51,9 @@ from core.coating_model import (
     model_error_estimate,
     tilt_share,
 )
-from core.creep import UserKernel, creep_model_from_spec
+from core.creep import Elastic, UserKernel, creep_model_from_spec
+from core.files import atomic_write_text, read_regular_file
+from core.load_rates import check_step_limit, oscillations
 from core.profiles import Profile, check_range, profile_from_spec
 from core.validation import (
     MAX_MAGNITUDE,
@@ -68,11 +69,11 @@ if TYPE_CHECKING:
 #: The schema version this program writes and reads.
 SCHEMA_VERSION = 1
 #: Largest scene file accepted by :func:`load_scene` [bytes].
-MAX_SCENE_BYTES = 1_000_000
+MAX_SCENE_BYTES = limits.MAX_SCENE_BYTES
 #: Number of coating layers accepted.
 MAX_LAYERS = 10
 #: Largest number of output times.
-MAX_TIMES = 2000
+MAX_TIMES = limits.MAX_SCENE_TIMES
 #: Accepted range of the solver's relative tolerance, and its default.
 TOL_RANGE = (1e-12, 1e-2)
 DEFAULT_TOL = 1e-6
@@ -92,7 +93,7 @@ LARGE_TILT = 0.01
 #: Points of the default plotting grid :attr:`SceneSolution.x`.
 PLOT_POINTS = 201
 #: Most points of (-a, a) where a profile may jump or kink (see ``_check_breakpoints``).
-MAX_BREAKPOINTS = 16
+MAX_BREAKPOINTS = limits.MAX_BREAKPOINTS
 #: Accepted range of the dimensionless coating compliance m*: physical coatings are far
 #: inside it; the solver was measured finite for 1e-100 to 1e100.
 M_STAR_RANGE = (1e-30, 1e30)
@@ -193,9 +194,12 @@ def _integer(value: Any, path: str, lo: int, hi: int) -> int:
     return int(x)
 
 
-def _text(value: Any, path: str, *, allow_empty: bool) -> str:
+def _text(value: Any, path: str, *, allow_empty: bool, most: int) -> str:
     if not isinstance(value, str):
         raise ValueError(f"{path}: must be a string, got {show_value(value)}")
+    # checked first: a text field is echoed into titles, links and file names
+    if len(value) > most:
+        raise ValueError(f"{path}: must be at most {most} characters, has {len(value)}")
     if not allow_empty and not value.strip():
         raise ValueError(f"{path}: must not be empty")
     return value
@@ -596,8 +600,9 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     d = migrate(d)
     _check_fields(d, "", ("schema_version", "name", "punch", "coating", "base", "loading",
                           "times"), ("description", "solver"))
-    name = _text(d["name"], "name", allow_empty=False)
-    description = _text(d.get("description", ""), "description", allow_empty=True)
+    name = _text(d["name"], "name", allow_empty=False, most=limits.MAX_NAME_CHARS)
+    description = _text(d.get("description", ""), "description", allow_empty=True,
+                        most=limits.MAX_DESCRIPTION_CHARS)
 
     punch = _check_fields(d["punch"], "punch", ("half_width",), ("shape",))
     a = positive_number(punch["half_width"], "punch.half_width")
@@ -705,7 +710,20 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
                   MappingProxyType(loads), times, tol, data, contact)
     _check_breakpoints(scene)
     _check_solvable(scene)
+    _check_load_rates(scene)
     return scene
+
+
+def _check_load_rates(scene: Scene) -> None:
+    """Refuse a load that varies faster than the time stepping can follow (an elastic
+    base has no time stepping; a formula kernel's grid has its own point limit)."""
+    if isinstance(scene.creep, Elastic):
+        return
+    general = isinstance(scene.creep, UserKernel)
+    check_step_limit({f"loading.{q}": p for q, p in scene.loading.items()}, 0.0,
+                     float(scene.times[-1]), scene.tol,
+                     limits.MAX_KERNEL_GRID_POINTS if general else limits.MAX_TIME_STEPS,
+                     "the time grid's limit" if general else "the time stepping's limit")
 
 
 def _x_profiles(scene: Scene) -> list[tuple[str, Profile]]:
@@ -900,54 +918,15 @@ def load_scene(path: str | os.PathLike) -> Scene:
     """Read and validate a scene file (JSON, UTF-8, at most 1 MB).
 
     Raises ``ValueError`` (message starting with the file path or the field path) for a
-    file that is too large, not JSON or not a valid scene, ``OSError`` if it cannot be read.
+    file that is too large, not a regular file (a named pipe is refused, not waited on),
+    not JSON or not a valid scene, ``OSError`` if it cannot be read.
     """
-    path = Path(path)
-    size = path.stat().st_size
-    if size > MAX_SCENE_BYTES:
-        raise ValueError(f"{path}: file is {size} bytes, over the limit of {MAX_SCENE_BYTES} "
-                         "bytes (1 MB) for a scene file")
-    with path.open("rb") as fh:
-        # read one byte past the limit: the file may have grown since stat()
-        raw = fh.read(MAX_SCENE_BYTES + 1)
-    if len(raw) > MAX_SCENE_BYTES:
-        raise ValueError(f"{path}: file is over the limit of {MAX_SCENE_BYTES} bytes (1 MB) "
-                         "for a scene file")
+    raw = read_regular_file(path, MAX_SCENE_BYTES)
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a text file in UTF-8 (a scene file is JSON)") from None
     return parse_scene_json(text, str(path))
-
-
-def atomic_write_text(path: str | os.PathLike, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path`` atomically: a temporary file in the same
-    directory, flushed to disk, then renamed over ``path``.
-
-    Readers see either the old file or the complete new one, never a partial write.
-    """
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        # mkstemp creates the file readable by its owner only; keep an existing file's
-        # mode, else use the usual mode of a new file
-        try:
-            mode = path.stat().st_mode & 0o777
-        except FileNotFoundError:
-            mode = 0o644
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
 
 
 def scene_to_json(scene: Scene | Mapping[str, Any]) -> str:
@@ -989,6 +968,8 @@ class DimensionlessProblem:
     plane_factor: float
     modulus: Callable[[np.ndarray], np.ndarray]
     contact: str = "auto"
+    #: ``t*`` where a given history jumps or kinks (the time stepper lands on them).
+    time_breaks: tuple[float, ...] = ()
 
     def modulus_after_loading(self, t: Any) -> np.ndarray:
         """``E(tau0 + t)`` [Pa] at ``t`` days after loading."""
@@ -1006,7 +987,8 @@ class DimensionlessProblem:
 
         return solve_dimensionless(self.lam, self.m, self.g, self.times, c=self.c,
                                    kernel=self.kernel, breakpoints=self.breakpoints,
-                                   tol=self.tol, contact=self.contact, **self.loads)
+                                   tol=self.tol, contact=self.contact,
+                                   time_breaks=self.time_breaks, **self.loads)
 
 
 def _is_constant(profile: Profile) -> bool:
@@ -1035,7 +1017,11 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
         m_value: Any = float(m_factor * scene.coating_compliance(np.zeros(1))[0])
     else:
         def m_value(xs: np.ndarray) -> np.ndarray:
-            return m_factor * scene.coating_compliance(a * np.asarray(xs, dtype=float))
+            x = a * np.asarray(xs, dtype=float)
+            values = m_factor * scene.coating_compliance(x)
+            if not np.all(np.isfinite(values) & (values > 0)):
+                _check_x_profiles_at(scene, x)
+            return values
 
     if coating_constant and _is_constant(scene.shape):
         g_value: Any = 0.0
@@ -1043,7 +1029,11 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
         g_min = scene.gap_minimum
 
         def g_value(xs: np.ndarray) -> np.ndarray:
-            return (scene.gap_variation(a * np.asarray(xs, dtype=float)) - g_min) / a
+            x = a * np.asarray(xs, dtype=float)
+            values = (scene.gap_variation(x) - g_min) / a
+            if not np.all(np.isfinite(values)):
+                _check_x_profiles_at(scene, x)
+            return values
 
     c_value = creep.relative_modulus(tau0, field="base.age_at_loading")
     aging = callable(c_value)
@@ -1071,6 +1061,9 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
 
     times_star = (tau0 + np.asarray(scene.times, dtype=float)) / tau0
     times_star[0] = max(times_star[0], 1.0)
+    jumps = sorted({(tau0 + d) / tau0 for profile in scene.loading.values()
+                    if hasattr(profile, "nonsmooth_points")
+                    for d in profile.nonsmooth_points(0.0, t_end)})
     return DimensionlessProblem(
         lam=a / scene.base_thickness,
         m=m_value,
@@ -1082,12 +1075,42 @@ def _to_dimensionless(scene: Scene) -> DimensionlessProblem:
         breakpoints=tuple(b / a for b in scene.breakpoints),
         tol=scene.tol,
         contact=scene.contact,
+        time_breaks=tuple(jumps),
         half_width=a,
         modulus_at_loading=e0,
         age_at_loading=tau0,
         plane_factor=plane,
         modulus=modulus,
     )
+
+
+#: Open bounds of the values of each x-profile of a layer, as the loader checks them.
+_LAYER_BOUNDS = {"thickness": (0.0, None), "modulus": (0.0, None), "poisson": (-1.0, 0.5)}
+
+
+def _check_x_profiles_at(scene: Scene, x: np.ndarray) -> None:
+    """Refuse, naming the field, an x-profile that is not finite or out of its range at
+    points ``x`` [m] the solver asked for: the loader checks profiles on samples, and a
+    formula's pole or spike between them would otherwise surface under the solver's
+    internal names (``m``, ``g``)."""
+    candidates = [("punch.shape", scene.shape, (None, None))] + [
+        (f"coating[{k}].{name}", getattr(layer, name), bounds)
+        for k, layer in enumerate(scene.coating) for name, bounds in _LAYER_BOUNDS.items()]
+    for path, profile, (lower, upper) in candidates:
+        values = _values(profile, x)
+        checks = [(~np.isfinite(values), "must be finite")]
+        if lower is not None:
+            checks.append((values <= lower, f"must be > {lower:g}"))
+        if upper is not None:
+            checks.append((values >= upper, f"must be < {upper:g}"))
+        for bad, rule in checks:
+            if bad.any():
+                i = int(np.argmax(bad))
+                raise ValueError(
+                    f"{path}: {rule}, is {values.flat[i]:.6g} at x = {x.flat[i]:.10g} m, "
+                    f"between the points where the scene was checked (a pole or a spike "
+                    "of a formula narrower than the checks): keep it finite and in range "
+                    "on the whole punch")
 
 
 def _kinematic_load(profile: Profile, scale: float,
@@ -1204,10 +1227,16 @@ class SceneSolution:
     def pressure(self, x: Any) -> np.ndarray:
         """Contact pressure q [Pa] at points ``x`` [m] of ``[-a, a]``, shape (len(x), len(times)).
 
-        Points outside ``[-a, a]`` are refused (ValueError).
+        Points outside ``[-a, a]`` are refused (ValueError), and so are more points than
+        :data:`core.limits.MAX_PRESSURE_VALUES` values allow (checked before any work).
         """
         a = self.scene.half_width
         xs = np.atleast_1d(np.asarray(x, dtype=float))
+        if xs.size * self.times.size > limits.MAX_PRESSURE_VALUES:
+            raise ValueError(
+                f"x: {xs.size} points at {self.times.size} times are more than the "
+                f"{limits.MAX_PRESSURE_VALUES} pressure values one call may compute; ask "
+                "for fewer points (or in several calls)")
         if np.any(~np.isfinite(xs)) or np.any(np.abs(xs) > a * (1 + 1e-12)):
             raise ValueError(f"x: the pressure is defined on [-a, a] = [{-a:g}, {a:g}] m only")
         # x = +-a can land a rounding error outside [-1, 1] after the division
@@ -1306,7 +1335,23 @@ def _check_finite(result: SceneSolution) -> None:
         bad = ~np.isfinite(np.asarray(values, dtype=float))
         if bad.any():
             j = int(np.argwhere(bad)[0][-1])  # the time index (last axis)
+            message = str(result.info.get("message", ""))
+            if "stopped at its limit" in message:
+                # the stepper gave up, which says nothing of double precision
+                raise ValueError(f"{_fastest_load(result.scene)}: the time stepping could "
+                                 "not follow the loads: "
+                                 + message.split("time stepping: ", 1)[-1])
             raise ValueError(
                 f"scene: the computed {name} is not finite at t = {result.times[j]:.6g} days "
                 "after loading: the sizes in this scene (moduli, loads, lengths) are too far "
                 "apart for double precision")
+
+
+def _fastest_load(scene: Scene) -> str:
+    """The field of the load that oscillates most over the solved times (``loading``
+    when none oscillates)."""
+    end = float(scene.times[-1])
+    counts = {q: oscillations(p, 0.0, end) + len(p.breakpoints)
+              for q, p in scene.loading.items()}
+    name = max(counts, key=lambda q: counts[q])
+    return f"loading.{name}" if counts[name] > 0 else "loading"

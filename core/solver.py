@@ -665,7 +665,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                         force: Scalar | None = None, moment: Scalar | None = None,
                         breakpoints: Sequence[float] = (), tol: float = 1e-8,
                         basis: str = "graded", n_modes: int | None = None,
-                        method: str | None = None, contact: str = "auto") -> ContactSolution:
+                        method: str | None = None, contact: str = "auto",
+                        time_breaks: Sequence[float] = ()) -> ContactSolution:
     """Solve the dimensionless contact problem (Nystrom by default, or the seed's projection).
 
     Parameters (all dimensionless):
@@ -691,6 +692,9 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         contact: "full" (q may come out negative: flag ``contact_lost``), "unilateral"
             (q >= 0 with an unknown contact set, :func:`core.contact.solve_unilateral`) or
             "auto" (full contact first, unilateral only when it is lost).
+        time_breaks: times where a given load history jumps or kinks; the default engine's
+            time steps land on them (a step across a jump loses the order and fools the
+            step-doubling estimate).
 
     Returns a :class:`ContactSolution` (or, when the unilateral model answered, a
     :class:`core.contact.UnilateralSolution` with the same attributes); ``contact_set``
@@ -715,7 +719,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
             return solve_unilateral(**unilateral_args)
         full = solve_with_prepared(lam, m, g, times, c=c, kernel=kernel,
                                    settlement=settlement, tilt=tilt, force=force,
-                                   moment=moment, breakpoints=breakpoints, tol=tol)
+                                   moment=moment, breakpoints=breakpoints, tol=tol,
+                                   time_breaks=time_breaks)
         return with_contact_model(full, contact, unilateral_args)
     inp = _validate(lam, m, g, times, c, kernel,
                     {"settlement": settlement, "tilt": tilt, "force": force, "moment": moment},

@@ -597,10 +597,11 @@ def test_an_uploaded_table_with_too_many_rows_for_the_solver_keeps_the_last_resu
                    for x in np.linspace(-0.9, 0.9, 40))
     app.shape_file.filename = "measured.csv"
     app.shape_file.value = ("x,f\n" + rows).encode()
-    assert app.state.punch.shape == "custom"
-    # every row of a linear table is a kink, the end rows too (the held value begins)
-    assert "(punch.shape): has 40 points" in app.controller.error
-    assert app.alert.visible and app.controller.view is shown
+    # every row of a linear table is a kink, the end rows too (the held value begins):
+    # more than the solver allows, so the upload itself is refused, naming the limit
+    assert app.state.punch.shape == "flat"
+    assert "(punch.shape): a table of 40 rows" in app.notice and "16" in app.notice
+    assert app.controller.view is shown
 
 
 def test_a_deeply_nested_link_is_refused() -> None:

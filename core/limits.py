@@ -1,0 +1,79 @@
+"""Every limit on the size of an input and the work one solve may cause, in one place.
+
+The explorer is served to untrusted users, so a scene (a file, a dict, a link) must not
+be able to take the machine: each limit below bounds one kind of work or memory and is
+checked *before* that work is done, with a ``ValueError`` naming the field to change.
+``core/SCENES.md`` ("Limits") lists each with the work it bounds. Other modules import
+their limits from here (some keep a local alias under their historic name); this module
+imports nothing from ``core``.
+
+Measured figures quoted below were taken on the development machine (2 cores, shared);
+they are orders of magnitude, not promises.
+"""
+
+from __future__ import annotations
+
+# ----------------------------------------------------------------------------- text
+
+#: Largest scene file read by ``core.scene.load_scene`` [bytes].
+MAX_SCENE_BYTES = 1_000_000
+#: Longest scene name [characters]: a title, shown in a page title and file names.
+MAX_NAME_CHARS = 200
+#: Longest scene description [characters]: the presets use under 500.
+MAX_DESCRIPTION_CHARS = 5_000
+#: Longest formula [characters] (also for its normal form).
+MAX_FORMULA_CHARS = 500
+
+# ----------------------------------------------------------------------------- formulas
+
+#: Deepest nesting of a formula (parentheses, calls, exponents each add a level).
+MAX_FORMULA_DEPTH = 20
+#: Most parts of a formula (numbers, names, operators, calls).
+MAX_FORMULA_PARTS = 200
+#: Largest magnitude of an exponent that does not depend on the variables.
+MAX_CONSTANT_EXPONENT = 64.0
+#: Most array elements one evaluation of a formula may hold at once: the points asked
+#: for times the formula's largest number of live intermediate arrays (its evaluation
+#: stack). 2**24 doubles are 128 MiB. Callers with more points evaluate in blocks.
+MAX_FORMULA_ELEMENTS = 2**24
+
+# ----------------------------------------------------------------------------- profiles
+
+#: Most rows of a table profile (and most breaks of a step profile).
+MAX_TABLE_ROWS = 10_000
+#: Largest CSV table accepted for a profile [bytes].
+MAX_TABLE_BYTES = 1_000_000
+#: Most coefficients of a polynomial profile (degree 15).
+MAX_POLYNOMIAL_COEFFICIENTS = 16
+#: Most points of (-a, a) where an x-profile's value or slope jumps, over the whole
+#: scene: each adds ~140 quadrature nodes to a dense operator (16: 2448 nodes, 1.9 s,
+#: 360 MB; 40: 9 s, 1.7 GB).
+MAX_BREAKPOINTS = 16
+
+# ----------------------------------------------------------------------------- times
+
+#: Most output times of a scene (``times.count`` or the length of the ``times`` list).
+MAX_SCENE_TIMES = 2_000
+#: Most output times of ``core.solver.solve_dimensionless``: every output time is a
+#: column of each mode's history (256 modes x 3 arrays x 10000 times: 60 MB).
+MAX_SOLVER_TIMES = 10_000
+#: Most points of the general-kernel time grid (a formula creep kernel): the kernel
+#: matrix is dense, points^2 doubles (4097: 134 MB), and the stepping costs
+#: points^2 x modes. Every output time is a grid point, so this also bounds the output
+#: times of such a scene; a grid that would exceed it is never built.
+MAX_KERNEL_GRID_POINTS = 4_097
+#: Values of the kernel matrix evaluated together, in blocks of rows, so a formula's
+#: temporaries stay within :data:`MAX_FORMULA_ELEMENTS` whatever the grid: a formula
+#: within the depth and part limits holds at most ~45 live arrays (two per nesting
+#: level), below the 64 this block allows for.
+KERNEL_BLOCK_ELEMENTS = MAX_FORMULA_ELEMENTS // 64
+#: Most steps (accepted and rejected) of the degenerate-kernel time stepper per solve.
+#: A load that varies faster than this many steps can follow is refused up front
+#: (``core.load_rates``).
+MAX_TIME_STEPS = 20_000
+
+# ----------------------------------------------------------------------------- results
+
+#: Most pressure values one call of ``SceneSolution.pressure`` may compute (points x
+#: output times): 4e6 doubles are 32 MB (the plotting grid: 201 x 2000 = 4e5).
+MAX_PRESSURE_VALUES = 4_000_000
