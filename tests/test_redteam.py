@@ -328,10 +328,12 @@ def test_the_step_limit_is_named_when_it_is_hit(monkeypatch):
     """The stepper's own limit, when hit, is reported as such with the load's field."""
     import functools
 
+    import core.nystrom_time
     import core.solver
     from core.time_integration import solve_degenerate
-    monkeypatch.setattr(core.solver, "solve_degenerate",
-                        functools.partial(solve_degenerate, max_steps=40))
+    for engine in (core.solver, core.nystrom_time):  # the projection and the default
+        monkeypatch.setattr(engine, "solve_degenerate",
+                            functools.partial(solve_degenerate, max_steps=40))
     from core.scene import solve
     with pytest.raises(ValueError, match=r"^loading\.force: the time stepping could not "
                                          r"follow the loads: .*limit of 40 steps.*vary "
