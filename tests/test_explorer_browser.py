@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from explorer.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
+from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 

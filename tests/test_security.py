@@ -39,7 +39,7 @@ from core.scene import (
     solve,
 )
 from explorer.links import MAX_JSON, PREFIX, decode_scene, encode_scene
-from explorer.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
+from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "assets" / "scenes"
