@@ -22,20 +22,24 @@ from panel.io.state import set_curdoc
 from core.profiles import MAX_TABLE_BYTES
 from core.scene import MAX_SCENE_BYTES
 
-from . import gc_policy
+from . import exports, gc_policy
 from .controller import SolveController, format_error, worker_processes
 from .links import decode_scene, encode_scene
 from .panel_fixes import install as install_panel_fixes
 from .plots import Figures
 from .presets import DEFAULT_PRESET, preset_label, presets
 from .results import ResultView
+from .scales import DisplayScales
 from .state import (
     CREEP_MODELS,
+    MAX_DESCRIPTION_CHARS,
+    MAX_NAME_CHARS,
     QUANTITIES,
     QUANTITY_UNITS,
     SCREEN_LAYERS,
     STATEMENTS,
     ExplorerState,
+    check_text,
 )
 from .widgets import (
     NAMES,
@@ -64,6 +68,9 @@ BUSY_AFTER_MS = 250
 #: The page's address follows the scene on screen at most this often [ms]: rewriting it
 #: at every slider step would cost a message per step, for a link nobody copies mid-drag.
 LINK_EVERY_MS = 1000
+#: Geometry and material sliders apply each drag step (not only the release) while the
+#: last solve took less than this [s]: then a step's answer arrives before the next step.
+LIVE_SOLVE_S = 0.030
 
 #: Which validity flags are shown next to which plot.
 BADGES: dict[str, dict[str, tuple[str, str]]] = {
@@ -81,7 +88,7 @@ CSS = """
            border-radius: 10px; font-size: 12px; font-weight: 600;}
 .cp-bad {background: #fde2e1; color: #9b1c1c; border: 1px solid #f5a3a0;}
 .cp-ok {background: #e3f5e6; color: #1d6b2c; border: 1px solid #a8dcb2;}
-.cp-msg {font-size: 12px; color: #9b1c1c; margin-left: 4px;}
+.cp-msg {font-size: 12px; color: #9b1c1c; margin-left: 4px; overflow-wrap: anywhere;}
 .cp-status {font-size: 12px; color: #444;}
 .cp-readout td, .cp-readout th {padding: 1px 8px; font-size: 13px; text-align: right;}
 .cp-readout th:first-child, .cp-readout td:first-child {text-align: left;}
@@ -111,7 +118,7 @@ def badges_html(view: ResultView | None, group: str) -> str:
     parts = []
     for flag, (bad, good) in BADGES[group].items():
         if flag in view.flags:
-            message = html.escape(view.flag_messages.get(flag, ""))
+            message = html.escape(exports.flag_message(view, flag))
             parts.append(f'<span class="cp-badge cp-bad flag-{flag}" title="{message}">'
                          f"⚠ {bad}</span><span class='cp-msg'>{message}</span>")
         elif good:
@@ -122,7 +129,8 @@ def badges_html(view: ResultView | None, group: str) -> str:
 def status_html(view: ResultView | None, busy: bool) -> str:
     """The status line: time per stage, what the cache reused, modes, steps, error."""
     if view is None:
-        return "<span class='cp-status'>Solving…</span>" if busy else ""
+        return ("<span class='cp-status solve-status first-solve'>Solving this scene for the "
+                "first time… the plots appear when it is done.</span>") if busy else ""
     info = view.info
     stages = info.get("stages", {}) or {}
     computed = [f"{name} {1e3 * float(s.get('seconds', 0.0)):.1f} ms"
@@ -189,7 +197,8 @@ class ExplorerApp(pn.viewable.Viewer):
                                           dispatch=self._dispatch, auto=False)
         self.pinned: ResultView | None = None
         self.presets = presets()
-        self.figures = Figures()
+        self.scales = DisplayScales()
+        self.figures = Figures(self.scales)
         self._drawn: ResultView | None = None
         self._busy_shown = False
         self._busy_due = False
@@ -214,6 +223,9 @@ class ExplorerApp(pn.viewable.Viewer):
         self.controller.start()
         if self.controller.view is None and self.controller.error:
             self._fallback_to_default()
+        if self.controller.view is None:
+            # a slow first solve (a link to a long history): say so, not a blank page
+            self.status.object = status_html(None, True)
         self._initializing = False
 
     # -- plumbing --------------------------------------------------------------------
@@ -261,25 +273,34 @@ class ExplorerApp(pn.viewable.Viewer):
             return
         self.notice = (f"The scene could not be solved ({self.controller.error}); showing "
                        "the default scene instead.")
+        self.scales.reset()
         self.state.load_scene(default)
         self.controller.solve_now()
 
     # -- widgets ---------------------------------------------------------------------
+    def _fast_solves(self) -> bool:
+        """Whether the last solve was quick enough for sliders to apply every drag step."""
+        view = self.controller.view
+        seconds = view.info.get("seconds") if view is not None else None
+        return isinstance(seconds, (int, float)) and seconds < LIVE_SOLVE_S
+
     def _build_widgets(self) -> None:
         s = self.state
         reject = self._reject
+        live = self._fast_solves
         # presets
         options = {"(custom scene)": ""}
         options.update({preset_label(k, v): k for k, v in self.presets.items()})
         self.preset = pn.widgets.Select(label="Preset scene", options=options,
                                         value=self._preset_key or "",
-                                        sizing_mode="stretch_width")
+                                        sizing_mode="stretch_width",
+                                        css_classes=["preset-select"])
         self.preset_description = pn.pane.Markdown(self._preset_text(), margin=(0, 10),
                                                    styles={"font-size": "13px"})
         self.preset.param.watch(self._on_preset, "value")
 
         # punch
-        self.punch = Binding(reject)
+        self.punch = Binding(reject, live_when=live)
         pb = self.punch
         self.half_width = pb.add("half_width", slider("half-width a [m]", 0.1, 5.0, 0.01,
                                                       css_classes=["punch-half-width"]))
@@ -321,17 +342,17 @@ class ExplorerApp(pn.viewable.Viewer):
         self.layer.param.watch(lambda *e: self._bind_layer(), "value")
         self.thickness_editor = ProfileEditor("thickness", "mm", 0.5, 50.0, 0.1, "0[.]00",
                                               amplitude=("µm", -1000.0, 1000.0, 0.5),
-                                              css="coating-thickness")
+                                              css="coating-thickness", live_when=live)
         self.modulus_editor = ProfileEditor("Young's modulus", "MPa", 1.0, 10000.0, 1.0,
-                                            "0[.]0")
+                                            "0[.]0", live_when=live)
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
-                                            variations=False)
+                                            variations=False, live_when=live)
         self.layer_note = _html("", styles={"font-size": "12px", "color": "#666"})
         s.param.watch(lambda *e: self._refresh_layers(), "n_layers")
         self._refresh_layers()
 
         # base
-        self.base = Binding(reject)
+        self.base = Binding(reject, live_when=live)
         bb = self.base
         self.base_thickness = bb.add("thickness", slider("thickness H [m]", 0.1, 20.0, 0.05,
                                                          "0[.]00", css_classes=["base-thickness"]))
@@ -340,7 +361,7 @@ class ExplorerApp(pn.viewable.Viewer):
                                                      "0[.]0"))
         self.creep_model = bb.add("creep_model", pn.widgets.Select(
             label="creep model", options={v: k for k, v in CREEP_MODELS.items()},
-            sizing_mode="stretch_width"))
+            sizing_mode="stretch_width", css_classes=["creep-select"]))
         self.compliance = bb.add("compliance", fine_slider("final creep compliance C∞ [1/GPa]",
                                                       0.0, 0.1, 0.0005, "0[.]0000"))
         self.rate = bb.add("rate", fine_slider("creep rate γ [1/day]", 0.001, 1.0, 0.001,
@@ -354,7 +375,7 @@ class ExplorerApp(pn.viewable.Viewer):
                                                    1.0, "0[.]0"))
         self.creep_note = _html("", styles={"font-size": "12px", "color": "#666"})
         bb.bind(s.base)
-        s.base.param.watch(lambda *e: self._refresh_base(), ["creep_model"])
+        s.base.param.watch(lambda *e: self._refresh_base(), ["creep_model", "custom"])
 
         # loading
         self.statement = pn.widgets.Select(label="statement (which two are given)",
@@ -367,7 +388,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.unknowns_note = _html("", styles={"font-size": "13px"})
 
         # times and accuracy
-        self.global_binding = Binding(reject)
+        self.global_binding = Binding(reject, live_when=live)
         gb = self.global_binding
         self.time_end = gb.add("time_end", slider("time span [days after loading]", 1.0,
                                                   3650.0, 1.0, "0[.]0"))
@@ -378,9 +399,15 @@ class ExplorerApp(pn.viewable.Viewer):
         self.tol = gb.add("tol", pn.widgets.Select(
             label="accuracy target (relative)", options={f"{v:g}": v for v in
                                                         s.param.tol.objects},
-            sizing_mode="stretch_width"))
+            sizing_mode="stretch_width", css_classes=["tol-select"]))
         self.scene_name = gb.add("scene_name", pn.widgets.TextInput(
-            label="scene name", sizing_mode="stretch_width"))
+            label="scene name", sizing_mode="stretch_width", max_length=MAX_NAME_CHARS,
+            css_classes=["scene-name"]),
+            check=lambda v: check_text("scene name", v, MAX_NAME_CHARS))
+        self.description = gb.add("description", pn.widgets.TextAreaInput(
+            label="description (saved with the scene)", sizing_mode="stretch_width",
+            max_length=MAX_DESCRIPTION_CHARS, height=90, css_classes=["scene-description"]),
+            check=lambda v: check_text("description", v, MAX_DESCRIPTION_CHARS))
         gb.bind(s)
         s.param.watch(lambda *e: self._refresh_tol(), "tol")
 
@@ -415,14 +442,13 @@ class ExplorerApp(pn.viewable.Viewer):
         self.spinner = pn.indicators.LoadingSpinner(value=False, size=20, label="",
                                                     margin=(5, 5))
         self.status = _html("", sizing_mode="stretch_width", margin=(5, 5))
-        self.scene_badges = _html("", margin=(0, 5))
-        self.pressure_badges = _html("", margin=(0, 5))
-        self.history_badges = _html("", margin=(0, 5))
-        self.status_badges = _html("", margin=(0, 5))
-        self.player = pn.widgets.Player(label="time", start=0, end=1, value=0, interval=250,
-                                        loop_policy="once", show_loop_controls=False,
-                                        sizing_mode="stretch_width", show_value=False)
-        self.player.param.watch(lambda e: setattr(self, "time_index", int(e.new)), "value")
+        badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
+        self.scene_badges = _html("", **badge)
+        self.pressure_badges = _html("", **badge)
+        self.history_badges = _html("", **badge)
+        self.status_badges = _html("", **badge)
+        self.player = self._new_player(1, 0)
+        self.player_box = pn.Row(self.player, sizing_mode="stretch_width", margin=0)
         self.time_label = _html("", margin=(12, 10))
         self.readout = _html("", sizing_mode="stretch_width")
         self.pin_button = pn.widgets.Button(label="Pin this result", color="default")
@@ -464,7 +490,7 @@ class ExplorerApp(pn.viewable.Viewer):
             ("Time", pn.Column(self.time_end, self.time_count, self.time_spacing, self.tol,
                                **column)),
             ("Files", pn.Column(
-                self.scene_name, self.save_scene,
+                self.scene_name, self.description, self.save_scene,
                 _html("<small>Load a scene (the JSON the command line reads):</small>"),
                 self.load_file, self.csv_download, self.pressure_download, self.json_download,
                 _html("<small>Downloads hold the result on screen. The address bar holds "
@@ -492,12 +518,13 @@ class ExplorerApp(pn.viewable.Viewer):
         main = pn.Column(
             self.notice_alert,
             self.alert,
-            pn.Row(self.spinner, self.status, self.status_badges, sizing_mode="stretch_width"),
+            pn.Row(self.spinner, self.status, sizing_mode="stretch_width"),
+            self.status_badges,
             self.scene_badges,
             scene_pane,
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
-            pn.Row(self.player, self.time_label, sizing_mode="stretch_width"),
+            pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
             pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button),
                    sizing_mode="stretch_width"),
             self.history_badges,
@@ -572,6 +599,12 @@ class ExplorerApp(pn.viewable.Viewer):
         self.base_modulus.label = ("final Young's modulus E∞ [GPa]" if model == "arutyunyan"
                                    else "Young's modulus E [GPa]")
         self.base_modulus.visible = model != "custom"
+        # "other model (from file)" is offered only while the scene holds one: picked
+        # without it, the base was silently solved as elastic
+        offered = {v: k for k, v in CREEP_MODELS.items()
+                   if k != "custom" or self.state.base.custom is not None}
+        if offered != self.creep_model.options:
+            self.creep_model.options = offered
         self.creep_note.object = ("A creep model from a file (kept as it is); choose another "
                                   "model to replace it." if model == "custom" else "")
         self.creep_note.visible = model == "custom"
@@ -615,6 +648,7 @@ class ExplorerApp(pn.viewable.Viewer):
         except ValueError as exc:
             self.notice = f"The scene was not loaded: {format_error(str(exc))}"
             return False
+        self.scales.reset()
         self.notice = ""
         return True
 
@@ -673,8 +707,10 @@ class ExplorerApp(pn.viewable.Viewer):
     def _on_status(self, *events: Any) -> None:
         error = self.controller.error
         # the core's messages echo user text (see _on_notice)
-        self.alert.object = (f"**Not solved:** {html.escape(error)}  \nThe plots still show "
-                             "the last good result." if error else "")
+        after = ("The plots still show the last good result." if self.controller.view
+                 is not None else "There is no result to show yet: change the scene, or "
+                 "choose a preset.")
+        self.alert.object = f"**Not solved:** {html.escape(error)}  \n{after}" if error else ""
         self.alert.visible = bool(error)
         if not self.controller.busy:
             self._show_busy(False)
@@ -757,7 +793,10 @@ class ExplorerApp(pn.viewable.Viewer):
         self._drawn = view
         with pn.io.hold():
             self.figures.show(view, index, self.pinned)
-            self.player.param.update(end=max(n - 1, 1), value=index)
+            if old is None or len(old.times) != n:
+                self._replace_player(max(n - 1, 1), index)
+            else:
+                self.player.value = index
             with param.discard_events(self):
                 self.time_index = index
             self._show_time_texts(view, index)
@@ -766,7 +805,7 @@ class ExplorerApp(pn.viewable.Viewer):
             self.pressure_badges.object = badges_html(view, "pressure")
             self.history_badges.object = badges_html(view, "history")
             self.status_badges.object = badges_html(view, "status")
-            slug = _slug(view.scene.get("name", "scene"))
+            slug = _slug(str(view.scene.get("name", "scene"))[:60])
             self.save_scene.filename = f"{slug}.json"
             self.csv_download.filename = f"{slug}_results.csv"
             self.pressure_download.filename = f"{slug}_pressure.csv"
@@ -807,6 +846,21 @@ class ExplorerApp(pn.viewable.Viewer):
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{float(view.times[index]):.4g} days</span>")
         self.readout.object = readout_html(view, index, self.pinned)
+
+    def _new_player(self, end: int, value: int) -> pn.widgets.Player:
+        player = pn.widgets.Player(label="time", start=0, end=end, value=value, interval=250,
+                                   loop_policy="once", show_loop_controls=False,
+                                   sizing_mode="stretch_width", show_value=False,
+                                   css_classes=["time-player"])
+        player.param.watch(lambda e: setattr(self, "time_index", int(e.new)), "value")
+        return player
+
+    def _replace_player(self, end: int, value: int) -> None:
+        """A new player for a new number of output times: the page's player redraws its
+        range only when its value changes, so a new range with the same value (or a value
+        arriving before the range) left the old range on screen."""
+        self.player = self._new_player(end, value)
+        self.player_box.objects = [self.player]
 
     def pin(self) -> None:
         """Keep the result on screen for comparison with the next ones."""
@@ -855,10 +909,14 @@ class ExplorerApp(pn.viewable.Viewer):
             raise
 
     def _csv_file(self) -> io.StringIO:
-        return self._download("to_csv", "")
+        view = self._shown()
+        return io.StringIO(exports.histories_csv(view) if view is not None else "")
 
     def _pressure_file(self) -> io.StringIO:
-        return self._download("pressure_csv", "")
+        view = self._shown()
+        if view is None:
+            return io.StringIO("")
+        return io.StringIO(exports.pressure_csv(view, self.scales.pressure_unit(view)))
 
     def _json_file(self) -> io.StringIO:
         return self._download("to_json", "{}")
