@@ -24,10 +24,12 @@ from core.scene import MAX_SCENE_BYTES
 
 from . import exports, gc_policy
 from .controller import SolveController, format_error, worker_processes
+from .design import DesignLimits, check_html, design_check
 from .links import decode_scene, encode_scene
 from .panel_fixes import install as install_panel_fixes
 from .plots import Figures
 from .presets import DEFAULT_PRESET, preset_label, presets
+from .report import report_html
 from .results import ResultView
 from .scales import DisplayScales
 from .state import (
@@ -41,6 +43,7 @@ from .state import (
     ExplorerState,
     check_text,
 )
+from .status import status_html
 from .widgets import (
     NAMES,
     Binding,
@@ -126,32 +129,6 @@ def badges_html(view: ResultView | None, group: str) -> str:
     return "".join(parts)
 
 
-def status_html(view: ResultView | None, busy: bool) -> str:
-    """The status line: time per stage, what the cache reused, modes, steps, error."""
-    if view is None:
-        return ("<span class='cp-status solve-status first-solve'>Solving this scene for the "
-                "first time… the plots appear when it is done.</span>") if busy else ""
-    info = view.info
-    stages = info.get("stages", {}) or {}
-    computed = [f"{name} {1e3 * float(s.get('seconds', 0.0)):.1f} ms"
-                for name, s in stages.items() if not s.get("cached")]
-    reused = [name for name, s in stages.items() if s.get("cached")]
-    tol = view.scene.get("solver", {}).get("tol", 1e-6)
-    err = info.get("error_estimate")
-    err_text = f"{err:.1e}" if isinstance(err, (int, float)) else "n/a"
-    text = (f"Solved in {1e3 * float(info.get('seconds', 0.0)):.0f} ms · "
-            f"computed: {', '.join(computed) or 'nothing'} · "
-            f"reused from cache: {', '.join(reused) or 'nothing'} · "
-            f"{info.get('n_modes', '?')} modes, {info.get('n_steps', '?')} time steps · "
-            f"error estimate {err_text} (target {tol:g})")
-    if info.get("reused"):
-        text = ("Identical to an earlier scene: its result is reused, no new solve. That "
-                "solve: " + text[0].lower() + text[1:])
-    if busy:
-        text = "Solving the newest change… showing the previous result. " + text
-    return f"<span class='cp-status solve-status'>{html.escape(text)}</span>"
-
-
 def readout_html(view: ResultView | None, index: int, pinned: ResultView | None) -> str:
     """Values at the selected time: current, pinned and their difference."""
     if view is None:
@@ -198,6 +175,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.pinned: ResultView | None = None
         self.presets = presets()
         self.scales = DisplayScales()
+        self.limits = DesignLimits()
         self.figures = Figures(self.scales)
         self._drawn: ResultView | None = None
         self._busy_shown = False
@@ -427,6 +405,30 @@ class ExplorerApp(pn.viewable.Viewer):
                                                          filename="pressure.csv",
                                                          label="Results: q(x, t) (CSV)",
                                                          sizing_mode="stretch_width")
+        self.report_download = pn.widgets.FileDownload(
+            callback=self._report_file, filename="report.html", color="primary",
+            label="Printable report (HTML)", sizing_mode="stretch_width",
+            css_classes=["report-download"])
+
+        # design check
+        def limit(label: str, name: str, css: str) -> pn.widgets.FloatInput:
+            box = pn.widgets.FloatInput(label=label, value=None, start=0,
+                                        sizing_mode="stretch_width", css_classes=[css])
+            box.param.watch(lambda e: setattr(self.limits, name, e.new), "value")
+            return box
+
+        self.allowable_pressure = limit("allowable bearing pressure [kPa]",
+                                        "allowable_pressure", "limit-pressure")
+        self.settlement_limit = limit("settlement limit [mm]", "settlement_limit",
+                                      "limit-settlement")
+        self.tilt_limit = limit("tilt limit [mrad]", "tilt_limit", "limit-tilt")
+        self.eccentricity = pn.widgets.FloatInput(
+            label="eccentricity e = M/P [m] (sets the moment)", value=None,
+            sizing_mode="stretch_width", css_classes=["eccentricity-input"])
+        self.eccentricity.param.watch(self._on_eccentricity, "value")
+        self.design = _html("", sizing_mode="stretch_width", css_classes=["design-pane"])
+        self.limits.param.watch(lambda *e: self._show_design(), list(
+            n for n in self.limits.param if n != "name"))
         self.json_download = pn.widgets.FileDownload(callback=self._json_file,
                                                      filename="results.json",
                                                      label="Results: everything (JSON)",
@@ -489,8 +491,13 @@ class ExplorerApp(pn.viewable.Viewer):
                 self.creep_note, **column)),
             ("Time", pn.Column(self.time_end, self.time_count, self.time_spacing, self.tol,
                                **column)),
+            ("Check", pn.Column(
+                _html("<small>Limits of the design check (leave empty: not checked). "
+                      "The check covers the whole history.</small>"),
+                self.allowable_pressure, self.settlement_limit, self.tilt_limit,
+                self.eccentricity, **column)),
             ("Files", pn.Column(
-                self.scene_name, self.description, self.save_scene,
+                self.report_download, self.scene_name, self.description, self.save_scene,
                 _html("<small>Load a scene (the JSON the command line reads):</small>"),
                 self.load_file, self.csv_download, self.pressure_download, self.json_download,
                 _html("<small>Downloads hold the result on screen. The address bar holds "
@@ -527,6 +534,7 @@ class ExplorerApp(pn.viewable.Viewer):
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
             pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button),
                    sizing_mode="stretch_width"),
+            self.design,
             self.history_badges,
             pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
             sizing_mode="stretch_width",
@@ -805,11 +813,13 @@ class ExplorerApp(pn.viewable.Viewer):
             self.pressure_badges.object = badges_html(view, "pressure")
             self.history_badges.object = badges_html(view, "history")
             self.status_badges.object = badges_html(view, "status")
+            self._show_design()
             slug = _slug(str(view.scene.get("name", "scene"))[:60])
             self.save_scene.filename = f"{slug}.json"
             self.csv_download.filename = f"{slug}_results.csv"
             self.pressure_download.filename = f"{slug}_pressure.csv"
             self.json_download.filename = f"{slug}_results.json"
+            self.report_download.filename = f"{slug}_report.html"
         self._push()
         self._schedule_link()
 
@@ -846,6 +856,32 @@ class ExplorerApp(pn.viewable.Viewer):
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{float(view.times[index]):.4g} days</span>")
         self.readout.object = readout_html(view, index, self.pinned)
+
+    def _show_design(self) -> None:
+        view = self._drawn
+        self.design.object = check_html(design_check(view, self.limits)) if view else ""
+
+    def _on_eccentricity(self, event: Any) -> None:
+        """Set the moment so that M = e P (force and moment given, constant force)."""
+        e = event.new
+        loading = self.state.loading
+        if e is None:
+            return
+        force = loading.histories["force"]
+        if loading.given != ("force", "moment") or force.kind != "constant":
+            self.notice = ("Value not accepted: the eccentricity sets the moment when force "
+                           "and moment are given and the force is constant.")
+            return
+        moment = loading.histories["moment"]
+        moment.param.update(kind="constant", value=float(e) * force.value)
+
+    def _report_file(self) -> io.StringIO:
+        view = self._shown()
+        if view is None:
+            return io.StringIO("")
+        index = min(self.time_index, len(view.times) - 1)
+        return io.StringIO(report_html(view, self.limits, index,
+                                       self.scales.pressure_unit(view)))
 
     def _new_player(self, end: int, value: int) -> pn.widgets.Player:
         player = pn.widgets.Player(label="time", start=0, end=end, value=value, interval=250,

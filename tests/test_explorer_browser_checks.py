@@ -299,3 +299,42 @@ def test_the_creep_model_from_a_file_is_offered_only_with_one(page: Page):
     options = select.evaluate("s => [...s.options].map(o => o.textContent)")
     assert "other model (from file)" not in options
     assert "aging creep (Arutyunyan)" in options
+
+
+def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
+    """Feature 1 (design check), 2 (report) and 9 (status in words, details)."""
+    # the status in plain words, the solver's numbers behind "details"
+    status = page.text(".solve-status")
+    assert "accurate to about" in status or "NOT met" in status
+    details = page.page.locator(".solve-details").first
+    assert "stages:" not in details.inner_text()
+    details.locator("summary").click()
+    _until(lambda: "stages:" in details.inner_text(), "the stage timings")
+    # the check, no limit yet
+    _until(lambda: "no limits set" in page.text(".design-check"), "the design check")
+    page.open_tab("Check")
+    box = page.page.locator(".limit-pressure input").first
+    box.wait_for(timeout=30_000)
+    box.fill("1")  # kPa: any footing fails this
+    box.press("Enter")
+    _until(lambda: "a limit is exceeded" in page.text(".design-check"), "FAIL")
+    box.fill("100000")
+    box.press("Enter")
+    _until(lambda: "all set limits hold" in page.text(".design-check"), "pass")
+    # e = M/P typed: the moment follows, the readout says so
+    ecc = page.page.locator(".eccentricity-input input").first
+    ecc.fill("0.2")
+    ecc.press("Enter")
+    _until(lambda: page.text(".readout-moment") == "100", "M = 0.2 m x 500 kN/m")
+    _until(lambda: "e = M/P = 0.2 m" in page.text(".design-check"), "e in the check")
+    # the report holds the check, the flags' verdict, the accuracy and the version
+    page.open_tab("Files")
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.get_by_text("Printable report (HTML)").first.click()
+    text = Path(info.value.path()).read_text()
+    from explorer.exports import project_version
+
+    assert "Design check" in text and "all set limits hold" in text
+    assert project_version() in text and "estimated relative error" in text
+    assert text.count("<svg") == 7
+    assert page.errors == []

@@ -216,3 +216,47 @@ def test_the_command_line_shows_the_solver_message_not_a_pointer(tmp_path):
                           capture_output=True, text=True, timeout=120)
     assert "warning: tol_not_met" in proc.stderr
     assert "see info.message" not in proc.stderr and "not met" in proc.stderr
+
+
+# ------------------------------------------------------------------ design check, report
+def test_the_design_check_finds_the_extremes_and_judges_the_limits():
+    from explorer.design import DesignLimits, design_check
+
+    _, controller = solved("eccentric_creep")
+    view = controller.view
+    check = design_check(view)
+    q = view.pressure / 1e3
+    assert check.q_max.value == pytest.approx(float(q.max()))
+    assert check.q_min.value == pytest.approx(float(q.min()))
+    assert check.passed is None  # no limit set
+    # e = M/P of the preset: 1.2e5 N / 8e5 N/m = 0.15 m
+    assert check.eccentricity == pytest.approx(0.15, rel=1e-12)
+    assert check.contact_width == pytest.approx(2.0)  # full contact
+    limits = DesignLimits(allowable_pressure=check.q_max.value * 1.01)
+    assert design_check(view, limits).passed is True
+    limits.allowable_pressure = check.q_max.value * 0.99
+    assert design_check(view, limits).passed is False
+    limits.param.update(allowable_pressure=None, settlement_limit=0.05)  # 0.087 mm reached
+    assert design_check(view, limits).passed is False
+
+
+def test_the_report_holds_inputs_plots_flags_accuracy_and_version():
+    from explorer.exports import project_version
+    from explorer.report import report_html
+
+    _, controller = solved(tol=1e-8)
+    text = report_html(controller.view)
+    assert text.startswith("<!DOCTYPE html>") and text.count("<svg") == 7
+    assert "tol_not_met" in text and "NOT met" in text and project_version() in text
+    assert "Design check" in text and "Inputs" in text and "<script" not in text
+
+
+def test_the_status_speaks_plainly_and_keeps_the_numbers_in_details():
+    from explorer.status import status_html
+
+    state, controller = solved()
+    text = status_html(controller.view, False)
+    assert "accurate to about" in text and "<details" in text and "modes" in text
+    state.loading.histories["force"].value = 651.37  # a force no other test solves
+    controller.request()
+    assert "only the response to the loads was recomputed" in status_html(controller.view, False)
