@@ -44,6 +44,7 @@ from .state import (
     check_text,
 )
 from .status import status_html
+from .undo import UndoStack
 from .widgets import (
     NAMES,
     Binding,
@@ -176,6 +177,9 @@ class ExplorerApp(pn.viewable.Viewer):
         self.presets = presets()
         self.scales = DisplayScales()
         self.limits = DesignLimits()
+        self.undo_stack = UndoStack()
+        self._undoing = False
+        self._loaded_scene: dict[str, Any] | None = None
         self.figures = Figures(self.scales)
         self._drawn: ResultView | None = None
         self._busy_shown = False
@@ -241,8 +245,10 @@ class ExplorerApp(pn.viewable.Viewer):
         if chosen is not None:
             try:
                 self.state.load_scene(chosen)
+                self._loaded_scene = chosen
             except ValueError as exc:
                 self.notice = f"The scene could not be shown: {exc}"
+        self._remember()
         self._preset_key = next((k for k, s in self.presets.items() if s == chosen), None)
 
     def _fallback_to_default(self) -> None:
@@ -453,6 +459,15 @@ class ExplorerApp(pn.viewable.Viewer):
         self.player_box = pn.Row(self.player, sizing_mode="stretch_width", margin=0)
         self.time_label = _html("", margin=(12, 10))
         self.readout = _html("", sizing_mode="stretch_width")
+        self.undo_button = pn.widgets.Button(label="↶ Undo", disabled=True,
+                                             css_classes=["undo-button"])
+        self.undo_button.on_click(lambda e: self.undo())
+        self.reset_button = pn.widgets.Button(label="Reset to the loaded scene",
+                                              css_classes=["reset-button"])
+        self.reset_button.on_click(lambda e: self.reset())
+        self.classical = pn.widgets.Checkbox(label="classical solutions on q(x)",
+                                             css_classes=["classical-toggle"])
+        self.classical.param.watch(self._on_classical, "value")
         self.pin_button = pn.widgets.Button(label="Pin this result", color="default")
         self.unpin_button = pn.widgets.Button(label="Clear pin", color="light",
                                               disabled=True)
@@ -468,7 +483,8 @@ class ExplorerApp(pn.viewable.Viewer):
         column = {"sizing_mode": "stretch_width", "margin": (4, 0)}
         tabs = (
             ("Scene", pn.Column(
-                self.preset, self.preset_description,
+                self.preset, pn.Row(self.undo_button, self.reset_button),
+                self.preset_description,
                 _html("<b>Loading</b> (updates while you drag)", margin=(10, 10, 0, 10)),
                 self.statement, self.history_editors[0].panel, self.history_editors[1].panel,
                 self.unknowns_note, **column)),
@@ -532,7 +548,8 @@ class ExplorerApp(pn.viewable.Viewer):
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
-            pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button),
+            pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button,
+                                           self.classical),
                    sizing_mode="stretch_width"),
             self.design,
             self.history_badges,
@@ -637,7 +654,35 @@ class ExplorerApp(pn.viewable.Viewer):
         self.notice = f"Value not accepted: {message}"
 
     def _on_revision(self, event: Any) -> None:
+        self._remember()
         self.controller.request()
+
+    def _remember(self) -> None:
+        if self._undoing:
+            return
+        try:
+            self.undo_stack.push(self.state.to_scene())
+        except ValueError:
+            return  # a state that is no scene (its message comes with the solve)
+        if hasattr(self, "undo_button"):
+            self.undo_button.disabled = not self.undo_stack.can_undo
+
+    def undo(self) -> None:
+        """Go back to the scene before the last change."""
+        scene = self.undo_stack.undo()
+        if scene is None:
+            return
+        self._undoing = True
+        try:
+            self.state.load_scene(scene)
+        finally:
+            self._undoing = False
+        self.undo_button.disabled = not self.undo_stack.can_undo
+
+    def reset(self) -> None:
+        """Back to the scene as it was loaded (the preset, the file, the link)."""
+        if self._loaded_scene is not None:
+            self.state.load_scene(self._loaded_scene)
 
     def _on_preset(self, event: Any) -> None:
         key = event.new
@@ -657,6 +702,7 @@ class ExplorerApp(pn.viewable.Viewer):
             self.notice = f"The scene was not loaded: {format_error(str(exc))}"
             return False
         self.scales.reset()
+        self._loaded_scene = scene
         self.notice = ""
         return True
 
@@ -856,6 +902,11 @@ class ExplorerApp(pn.viewable.Viewer):
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{float(view.times[index]):.4g} days</span>")
         self.readout.object = readout_html(view, index, self.pinned)
+
+    def _on_classical(self, event: Any) -> None:
+        with pn.io.hold():
+            self.figures.set_classical(self._drawn, self.time_index, bool(event.new))
+        self._push()
 
     def _show_design(self) -> None:
         view = self._drawn

@@ -27,6 +27,7 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
+from .classical import bearing_rule_pressure, half_space_pressure
 from .results import ResultView
 from .scales import DisplayScales
 from .state import QUANTITIES, QUANTITY_UNITS
@@ -169,6 +170,15 @@ class Figures:
         p.add_layout(Span(location=0, dimension="width", line_color="#555", line_width=1))
         self.q_pin_line = p.line(x="x", y="q", source=self.q_pin_src, line_color=PINNED_COLOR,
                                  line_dash="dashed", line_width=2, legend_label="pinned")
+        self.classic_src = ColumnDataSource(_empty("x", "half_space", "bearing_rule"),
+                                            name="classical_source")
+        self.classic_lines = [
+            p.line(x="x", y="half_space", source=self.classic_src, line_color="#7f7f7f",
+                   line_dash="dotdash", line_width=1.5, visible=False,
+                   legend_label="rigid punch, elastic half-space"),
+            p.line(x="x", y="bearing_rule", source=self.classic_src, line_color="#2ca02c",
+                   line_dash="dotted", line_width=2, visible=False,
+                   legend_label="Winkler / trapezoid rule")]
         line = p.line(x="x", y="q", source=self.q_src, line_color=UNKNOWN_COLOR, line_width=2.5,
                       legend_label="current")
         self.q_hover = HoverTool(renderers=[line], tooltips=[("x", "@x{0.000} m"),
@@ -296,12 +306,35 @@ class Figures:
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
         self._show_pinned_pressure(view, pinned, index)
+        self._show_classical(view, index)
         self.image_cursor.location = t
         for name in QUANTITIES:
             self.history_cursor[name].location = t
             set_data(self.history_point_src[name],
                      {"t": [t], "v": [float(view.display(name)[index])]})
         self._show_arrow(view, index)
+
+    def set_classical(self, view: ResultView | None, index: int, shown: bool) -> None:
+        """Show or hide the classical answers on the pressure plot."""
+        self.classical = shown
+        for line in self.classic_lines:
+            line.visible = shown
+        if view is not None:
+            self._show_classical(view, index)
+
+    def _show_classical(self, view: ResultView, index: int) -> None:
+        if not self.classical:
+            return
+        size = self.scales.pressure_unit(view)[1]
+        a = view.geometry.half_width
+        force = float(view.values["force"][index])
+        moment = float(view.values["moment"][index])
+        x = view.x
+        set_data(self.classic_src, {
+            "x": f32(x), "half_space": f32(half_space_pressure(x, force, moment, a) / size),
+            "bearing_rule": f32(bearing_rule_pressure(x, force, moment, a) / size)})
+
+    classical = False
 
     def _show_arrow(self, view: ResultView, index: int) -> None:
         g = view.geometry

@@ -563,7 +563,7 @@ class ExplorerState(param.Parameterized):
             self._loaded_name = None  # the user names the scene now
             return
         self._loaded_name = None
-        if self.scene_name != loaded:
+        if self.scene_name != loaded or loaded.endswith(" (modified)"):
             return
         self._batch += 1
         try:

@@ -338,3 +338,26 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     assert project_version() in text and "estimated relative error" in text
     assert text.count("<svg") == 7
     assert page.errors == []
+
+
+def test_classical_solutions_undo_and_reset(page: Page):
+    """Feature 6 (classical answers on request) and 7 (typed entry, undo, reset)."""
+    doc = "Bokeh.documents[0]"
+    page.page.locator(".classical-toggle input").first.check()
+    _wait(page, f"() => {doc}.get_model_by_name('classical_source').data.x.length > 100")
+    # full contact, centred: the bearing rule is uniform at P / 2a = 250 kPa
+    rule = page.page.evaluate(
+        f"() => Array.from({doc}.get_model_by_name('classical_source').data.bearing_rule)")
+    assert max(rule) == pytest.approx(250.0) and min(rule) == pytest.approx(250.0)
+    force = page.text(".readout-force")
+    page.type_into(".load-0-value", "650")
+    _until(lambda: page.text(".readout-force") == "650", "force 650")
+    _wait(page, f"() => Math.max(...{doc}.get_model_by_name('classical_source')"
+          ".data.bearing_rule) > 300")
+    page.page.locator(".undo-button button").first.click()
+    _until(lambda: page.text(".readout-force") == force, "undo to the first force")
+    page.type_into(".load-0-value", "700")
+    _until(lambda: page.text(".readout-force") == "700", "force 700")
+    page.page.locator(".reset-button button").first.click()
+    _until(lambda: page.text(".readout-force") == force, "reset to the preset")
+    assert page.errors == []

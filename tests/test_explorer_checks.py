@@ -260,3 +260,50 @@ def test_the_status_speaks_plainly_and_keeps_the_numbers_in_details():
     state.loading.histories["force"].value = 651.37  # a force no other test solves
     controller.request()
     assert "only the response to the loads was recomputed" in status_html(controller.view, False)
+
+
+# ------------------------------------------------------------------ undo, reset, classical
+def test_undo_and_reset_return_to_earlier_scenes():
+    from explorer.app import ExplorerApp
+
+    app = ExplorerApp(executor=None)
+    start = app.state.to_scene()
+    assert app.undo_button.disabled
+    app.state.loading.histories["force"].value = 600.0
+    app.state.punch.half_width = 1.1
+    assert not app.undo_button.disabled
+    app.undo()
+    assert app.state.punch.half_width == 1.0
+    assert app.state.loading.histories["force"].value == 600.0
+    app.undo()
+    assert app.state.to_scene()["loading"] == start["loading"]
+    app.state.punch.half_width = 1.4
+    app.reset()
+    assert app.state.to_scene() == start
+    assert app.controller.view.scene == start
+
+
+def test_classical_solutions_carry_the_force_and_moment():
+    """The half-space and bearing-rule pressures integrate to P and M (Chebyshev-Gauss
+    for the edge singularity, measured agreement 1e-15; trapezoid rule on 2e5 intervals
+    for the rule, measured 5e-11)."""
+    from numpy.polynomial.chebyshev import chebgauss
+
+    from explorer.classical import EDGE_CAP, bearing_rule_pressure, half_space_pressure
+
+    a, force = 1.2, 5e5
+    x = np.linspace(-a, a, 200_001)
+    for moment in (0.0, 5e4, 2.5e5):  # e = 0, inside and outside the middle third
+        q = bearing_rule_pressure(x, force, moment, a)
+        assert np.trapezoid(q, x) == pytest.approx(force, rel=1e-9)
+        assert np.trapezoid(q * x, x) == pytest.approx(moment, rel=1e-9, abs=1e-3)
+        assert np.all(q >= 0)
+    t, w = chebgauss(64)
+    moment = 5e4
+    q_root = half_space_pressure(a * t, force, moment, a) * np.sqrt(a * a - (a * t) ** 2)
+    # away from the capped edges the formula holds exactly: compare to its closed form
+    inner = np.abs(t) < 0.9
+    closed = (force + 2 * moment * a * t / a**2) / np.pi
+    np.testing.assert_allclose(q_root[inner], closed[inner], rtol=1e-12)
+    assert np.sum(w * closed) * a / a == pytest.approx(force, rel=1e-14)
+    assert np.max(half_space_pressure(x, force, moment, a)) <= EDGE_CAP * force / (2 * a)
