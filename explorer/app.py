@@ -25,7 +25,7 @@ from core.scene import MAX_SCENE_BYTES
 from . import exports, gc_policy
 from .controller import SolveController, format_error, worker_processes
 from .design import DesignLimits, check_html, design_check
-from .links import decode_scene, encode_scene
+from .links import decode_scene
 from .panel_fixes import install as install_panel_fixes
 from .plots import Figures
 from .presets import DEFAULT_PRESET, preset_label, presets
@@ -45,6 +45,7 @@ from .state import (
 )
 from .status import status_html
 from .undo import UndoStack
+from .view_link import read_view_query, view_query
 from .widgets import (
     NAMES,
     Binding,
@@ -189,6 +190,16 @@ class ExplorerApp(pn.viewable.Viewer):
         self._initial_scene(scene, query or {})
         self._build_widgets()
         self._layout = self._build_layout()
+        self._wanted_index, tab, pin_scene, pin_message = read_view_query(
+            query or {}, len(self.sidebar))
+        if tab:
+            self._fill(tab)
+            self.sidebar.active = tab
+        self._pin_controller: SolveController | None = None
+        if pin_scene is not None:
+            self._solve_pin(pin_scene)
+        if pin_message and not self.notice:
+            self.notice = pin_message
         # Changes to plain Bokeh models made after the page was generated but before its
         # websocket connects would never reach the browser: hold them until it does.
         self._initializing = True
@@ -459,6 +470,12 @@ class ExplorerApp(pn.viewable.Viewer):
         self.player_box = pn.Row(self.player, sizing_mode="stretch_width", margin=0)
         self.time_label = _html("", margin=(12, 10))
         self.readout = _html("", sizing_mode="stretch_width")
+        # The address bar is written by the page itself when this hidden box changes:
+        # Panel's location model delayed an update until the next one (its push waits
+        # for the document's first idle signal, which a replaced view never sees).
+        self._address = pn.widgets.TextInput(value="", visible=False)
+        self._address.jscallback(value="if (cb_obj.value) { window.history.replaceState("
+                                       "null, '', cb_obj.value) }")
         self.undo_button = pn.widgets.Button(label="↶ Undo", disabled=True,
                                              css_classes=["undo-button"])
         self.undo_button.on_click(lambda e: self.undo())
@@ -532,6 +549,7 @@ class ExplorerApp(pn.viewable.Viewer):
         sidebar = pn.Tabs(*tabs, dynamic=False, width=370, margin=(0, 10, 0, 0),
                           css_classes=["sidebar-tabs"])
         sidebar.param.watch(self._fill_tab, "active")
+        sidebar.param.watch(lambda e: self._schedule_link(), "active")
         self.sidebar = sidebar
         f = self.figures
         bokeh = {"sizing_mode": "stretch_width", "margin": (0, 5)}
@@ -539,6 +557,7 @@ class ExplorerApp(pn.viewable.Viewer):
             f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES))]
         scene_pane, q_pane, image_pane, *history_panes = self._bokeh_panes
         main = pn.Column(
+            self._address,
             self.notice_alert,
             self.alert,
             pn.Row(self.spinner, self.status, sizing_mode="stretch_width"),
@@ -840,7 +859,9 @@ class ExplorerApp(pn.viewable.Viewer):
             return
         n = len(view.times)
         old = self._drawn
-        if old is None or len(old.times) != n:
+        if old is None and self._wanted_index is not None:
+            index = min(self._wanted_index, n - 1)  # the time the link was made at
+        elif old is None or len(old.times) != n:
             index = n - 1
         else:
             index = min(self.time_index, n - 1)
@@ -881,9 +902,12 @@ class ExplorerApp(pn.viewable.Viewer):
         if view is None or self._location is None or self.controller.busy:
             return  # a newer result is coming, and will ask again
         try:
-            link = encode_scene(view.scene)
+            pin = self.pinned.scene if self.pinned is not None else None
+            query = view_query(view.scene, self.time_index, self.sidebar.active, pin)
+            # the whole query at once: the values are URL-safe already (base64url, digits)
+            link = "?" + "&".join(f"{k}={v}" for k, v in query.items() if v)
             if link != self._linked:
-                self._location.update_query(scene=link)
+                self._address.value = link
                 self._linked = link
         except Exception:  # the link is a convenience; the page must not fail for it
             log.exception("could not update the link")
@@ -897,11 +921,35 @@ class ExplorerApp(pn.viewable.Viewer):
             self.figures.show_time(view, index, self.pinned)
             self._show_time_texts(view, index)
         self._push()
+        self._schedule_link()
 
     def _show_time_texts(self, view: ResultView, index: int) -> None:
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{float(view.times[index]):.4g} days</span>")
         self.readout.object = readout_html(view, index, self.pinned)
+
+    def _solve_pin(self, scene: dict[str, Any]) -> None:
+        """Solve the pinned scene of a link (off the page's thread), then pin it."""
+        from core import scene_from_dict
+
+        state = ExplorerState()
+        try:
+            scene_from_dict(scene)
+            state.load_scene(scene)
+        except ValueError as exc:
+            self.notice = f"The pinned result in the link was not used: {format_error(str(exc))}"
+            return
+        executor = self.controller.executor
+        self._pin_controller = SolveController(state, executor=executor,
+                                               dispatch=self._dispatch, auto=False)
+        self._pin_controller.param.watch(self._on_pin_view, "view")
+        self._pin_controller.request()
+
+    def _on_pin_view(self, event: Any) -> None:
+        if event.new is not None:
+            self.pinned = event.new
+            self.unpin_button.disabled = False
+            self._redraw_pin()
 
     def _on_classical(self, event: Any) -> None:
         with pn.io.hold():
@@ -954,11 +1002,13 @@ class ExplorerApp(pn.viewable.Viewer):
         self.pinned = self._drawn
         self.unpin_button.disabled = self.pinned is None
         self._redraw_pin()
+        self._schedule_link()
 
     def unpin(self) -> None:
         self.pinned = None
         self.unpin_button.disabled = True
         self._redraw_pin()
+        self._schedule_link()
 
     def _redraw_pin(self) -> None:
         view = self._drawn

@@ -213,6 +213,11 @@ class SolveController(param.Parameterized):
         if auto:
             state.param.watch(lambda event: self.request(), "revision")
 
+    @property
+    def executor(self) -> Executor | None:
+        """Where this controller's solves run (None: in the caller)."""
+        return self._executor
+
     # -- requests --------------------------------------------------------------------
     def request(self) -> int:
         """Ask for a solve of the current state; returns the request id."""

@@ -361,3 +361,34 @@ def test_classical_solutions_undo_and_reset(page: Page):
     page.page.locator(".reset-button button").first.click()
     _until(lambda: page.text(".readout-force") == force, "reset to the preset")
     assert page.errors == []
+
+
+def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
+                                                   browser_context: object):
+    """Feature 4: a copied link reopens the same view, pin included."""
+    page.page.get_by_text("Pin this result").first.click()
+    page.page.locator(".pinned-settlement").first.wait_for(timeout=30_000)
+    page.type_into(".load-0-value", "650")
+    _until(lambda: page.text(".readout-force") == "650", "force 650")
+    page.page.locator(".time-player input[type=range]").first.fill("5")
+    _until(lambda: "t = 365" not in page.text(".time-label"), "time 5")
+    label = page.text(".time-label")
+    pinned = page.text(".pinned-settlement")  # the pin at the time shown
+    page.open_tab("Base")
+
+    def href() -> str:  # from the page: Playwright's own page.url may lag behind
+        return page.page.evaluate("() => window.location.href")
+
+    _until(lambda: all(part in href() for part in ("t=5", "tab=3", "pin=1.")),
+           "the link with t, tab and pin")
+    other = Page(browser_context, server, "/app?" + href().split("?", 1)[1])
+    try:
+        _until(lambda: other.text(".time-label") == label, "the same time")
+        other.page.locator(".pinned-settlement").first.wait_for(timeout=60_000)
+        _until(lambda: other.text(".pinned-settlement") == pinned, "the same pin")
+        assert other.text(".readout-force") == "650"
+        other.page.locator(".creep-select select").first.wait_for(state="visible",
+                                                                 timeout=30_000)
+        assert other.errors == []
+    finally:
+        other.close()
