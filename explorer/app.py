@@ -581,8 +581,25 @@ class ExplorerApp(pn.viewable.Viewer):
             "over an aging viscoelastic layer (plane strain, per metre out of plane). "
             "Loads update while you drag; geometry and materials when you release.</div>",
             sizing_mode="stretch_width")
-        return pn.Column(header, pn.Row(sidebar, main, sizing_mode="stretch_width"),
+        self.header = header
+        self.presenting = pn.widgets.Toggle(label="Presentation mode", width=170,
+                                            css_classes=["presentation-toggle"])
+        self.presenting.param.watch(self._on_presentation, "value")
+        return pn.Column(pn.Row(header, self.presenting, sizing_mode="stretch_width"),
+                         pn.Row(sidebar, main, sizing_mode="stretch_width"),
                          sizing_mode="stretch_width")
+
+    def _on_presentation(self, event: Any) -> None:
+        """Presentation mode: large fonts, the whole story on a 1024x768 projector."""
+        on = bool(event.new)
+        with pn.io.hold():
+            self.figures.set_presentation(on)
+            self.header.visible = not on
+            self.sidebar.width = 300 if on else 370
+            size = "17px" if on else ""
+            for pane in (self.readout, self.status, self.design):
+                pane.styles = {"font-size": size} if on else {}
+        self._push()
 
     def __panel__(self) -> pn.viewable.Viewable:
         return self._layout

@@ -43,6 +43,9 @@ _SLABS = 120
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
+#: Font size of ticks, axis labels and titles in presentation mode (a projector).
+PRESENTATION_FONT = "18px"
+
 #: Longest scene name shown in the drawing's title [characters]: a Bokeh title does not
 #: wrap, and at 1024 px a longer one was cut off.
 TITLE_CHARS = 40
@@ -115,7 +118,7 @@ class Figures:
                    title="Scene", toolbar_location="above", name="scene_figure")
         p.toolbar.autohide = True
         p.xaxis.axis_label = "x [m]"
-        p.yaxis.axis_label = "y [m] (coating and punch profile exaggerated)"
+        p.yaxis.axis_label = "y [m] (exaggerated)"
         self.base_src = ColumnDataSource(_empty("left", "right", "bottom", "top", "E"),
                                          name="base_source")
         self.layer_src = ColumnDataSource(
@@ -302,7 +305,7 @@ class Figures:
         intervals = view.negative_intervals(index)
         set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
                                 "right": [hi for _, hi in intervals]})
-        self.q_fig.title.text = f"Contact pressure q(x) at t = {t:.4g} days"
+        self.q_fig.title.text = f"Pressure q(x), t = {t:.4g} days"
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
         self._show_pinned_pressure(view, pinned, index)
@@ -335,6 +338,30 @@ class Figures:
             "bearing_rule": f32(bearing_rule_pressure(x, force, moment, a) / size)})
 
     classical = False
+
+    def all_figures(self) -> list:
+        """Every figure of the session."""
+        return [self.scene_fig, self.q_fig, self.image_fig,
+                *(self.history_fig[q] for q in QUANTITIES)]
+
+    def set_presentation(self, on: bool) -> None:
+        """Fonts a projector shows from the back of a room (ticks and labels of
+        :data:`PRESENTATION_FONT`), or the normal ones."""
+        tick, label, title = ((PRESENTATION_FONT, PRESENTATION_FONT, PRESENTATION_FONT)
+                              if on else ("11px", "13px", "13px"))
+        for fig in self.all_figures():
+            fig.title.text_font_size = title
+            for axis in (*fig.xaxis, *fig.yaxis):
+                axis.major_label_text_font_size = tick
+                axis.axis_label_text_font_size = label
+            fig.toolbar_location = None if on else "above"
+        legend = self.q_fig.legend[0]
+        legend.label_text_font_size = "11px" if on else "13px"
+        legend.glyph_width = 14 if on else 20
+        for q in QUANTITIES:
+            self.history_fig[q].height = 170 if on else 210
+        self.scene_fig.height = 240 if on else 300
+        self.q_fig.height = self.image_fig.height = 240 if on else 280
 
     def _show_arrow(self, view: ResultView, index: int) -> None:
         g = view.geometry

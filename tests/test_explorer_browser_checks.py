@@ -392,3 +392,18 @@ def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
         assert other.errors == []
     finally:
         other.close()
+
+
+def test_presentation_mode_has_projector_fonts_at_1024(page: Page):
+    """Feature 5: at 1024x768, ticks of at least 18 px; the plots stay on screen."""
+    page.page.set_viewport_size({"width": 1024, "height": 768})
+    page.page.locator(".presentation-toggle button").first.click()
+    doc = "Bokeh.documents[0]"
+    _wait(page, f"() => {doc}.get_model_by_name('pressure_figure').left[0]"
+          ".major_label_text_font_size === '18px'")
+    for name in ("scene_figure", "pressure_figure", "settlement_figure"):
+        size = page.page.evaluate(f"(n) => {doc}.get_model_by_name(n).below[0]"
+                                  ".major_label_text_font_size", name)
+        assert int(size.rstrip("px")) >= 18, (name, size)
+    assert page.page.evaluate(JS_VIEW_WIDTH, "pressure_figure") > 250
+    assert page.errors == []
