@@ -15,7 +15,6 @@ from typing import Any
 
 import panel as pn
 import param
-from panel.io.state import set_curdoc
 
 from .state import QUANTITY_RANGES, HistoryState, ProfileState
 
@@ -67,8 +66,6 @@ MAX_FILENAME_CHARS = 120
 #: Size of the pieces an upload is sent in [bytes]: well below the server's limit of one
 #: websocket message (``WEBSOCKET_MAX_BYTES`` in explorer/__main__.py).
 UPLOAD_CHUNK_BYTES = 256 * 1024
-#: Time after a file arrived before its dropper is replaced by an empty one [ms].
-RENEW_AFTER_MS = 1500
 
 
 class BoundedUpload(pn.viewable.Viewer):
@@ -86,17 +83,12 @@ class BoundedUpload(pn.viewable.Viewer):
     def __init__(self, accept: Sequence[str], max_bytes: int, **params: Any) -> None:
         super().__init__(**params)
         self.max_bytes = max_bytes
-        self._accept = list(accept)
-        self._box = pn.Column(self._new_dropper(), sizing_mode="stretch_width", margin=0)
-
-    def _new_dropper(self) -> pn.widgets.FileDropper:
         # chunks well below the server's websocket message limit (explorer/__main__.py)
-        dropper = pn.widgets.FileDropper(
-            accepted_filetypes=self._accept, multiple=False,
-            max_file_size=f"{max(1, self.max_bytes // 1000)}KB", chunk_size=UPLOAD_CHUNK_BYTES,
+        self._box = pn.widgets.FileDropper(
+            accepted_filetypes=list(accept), multiple=False,
+            max_file_size=f"{max(1, max_bytes // 1000)}KB", chunk_size=UPLOAD_CHUNK_BYTES,
             sizing_mode="stretch_width", height=90, css_classes=["file-dropper"])
-        dropper.param.watch(self._on_drop, "value")
-        return dropper
+        self._box.param.watch(self._on_drop, "value")
 
     def _on_drop(self, event: Any) -> None:
         for name, data in (event.new or {}).items():
@@ -104,22 +96,6 @@ class BoundedUpload(pn.viewable.Viewer):
             # the same file again is a new request (e.g. after fixing the scene on screen)
             self.param.update(filename=str(name)[:MAX_FILENAME_CHARS], value=None)
             self.value = raw
-        # A fresh dropper for the next file: the used one said "Upload complete" even when
-        # the file was then refused, and took a second file only after its x was found.
-        # Served, it comes a moment later: the page's dropper is still finishing its
-        # animation of the last chunk, and removed at once it raised errors in the page.
-        doc = pn.state.curdoc
-        if doc is not None and doc.session_context:
-            def renew() -> None:
-                with set_curdoc(doc):
-                    self._renew()
-
-            doc.add_timeout_callback(renew, RENEW_AFTER_MS)
-        else:
-            self._renew()
-
-    def _renew(self) -> None:
-        self._box.objects = [self._new_dropper()]
 
     def __panel__(self) -> pn.viewable.Viewable:
         return self._box
