@@ -32,7 +32,7 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from explorer.serving import (  # noqa: E402
+from benchmarks.serving import (  # noqa: E402
     CHROMIUM,
     CHROMIUM_ARGS,
     ExplorerProcess,

@@ -158,7 +158,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     if pressure_out is not None:
         _write(pressure_out, result.pressure_csv())
     for name in result.flags:
-        print(f"warning: {name}: {_one_line(result.flag_messages[name])}", file=sys.stderr)
+        print(f"warning: {name}: {_one_line(result.flag_messages[name].replace('see info.message', result.info.get('message', '')))}", file=sys.stderr)  # noqa: E501
     return EXIT_OK
 
 

@@ -30,6 +30,13 @@ DEFAULT_SOLVER_PROCESSES = max(2, min(4, (os.cpu_count() or 2) - 1))
 WAITING_THREADS = 64
 
 
+#: Largest message the server accepts from a page [bytes]. Uploads arrive in chunks of
+#: 256 KiB (explorer/widgets.py) and every other message is small: a larger one (a
+#: 15-million-character scene name held 380 MiB of the server's memory) closes that
+#: page's connection instead of being read.
+WEBSOCKET_MAX_BYTES = 4 * 2**20
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m explorer",
@@ -102,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         pn.serve({"app": create_app}, port=args.port, address=args.address, show=args.show,
                  websocket_origin=origins, title="Coated punch explorer", threaded=False,
-                 liveness=True, start=True)
+                 liveness=True, start=True, websocket_max_message_size=WEBSOCKET_MAX_BYTES)
     except KeyboardInterrupt:
         pass
     finally:

@@ -22,21 +22,30 @@ from panel.io.state import set_curdoc
 from core.profiles import MAX_TABLE_BYTES
 from core.scene import MAX_SCENE_BYTES
 
-from . import gc_policy
+from . import exports, gc_policy
 from .controller import SolveController, format_error, worker_processes
-from .links import decode_scene, encode_scene
+from .design import DesignLimits, check_html, design_check
+from .links import decode_scene
 from .panel_fixes import install as install_panel_fixes
 from .plots import Figures
 from .presets import DEFAULT_PRESET, preset_label, presets
+from .report import report_html
 from .results import ResultView
+from .scales import DisplayScales
 from .state import (
     CREEP_MODELS,
+    MAX_DESCRIPTION_CHARS,
+    MAX_NAME_CHARS,
     QUANTITIES,
     QUANTITY_UNITS,
     SCREEN_LAYERS,
     STATEMENTS,
     ExplorerState,
+    check_text,
 )
+from .status import status_html
+from .undo import UndoStack
+from .view_link import read_view_query, view_query
 from .widgets import (
     NAMES,
     Binding,
@@ -64,6 +73,9 @@ BUSY_AFTER_MS = 250
 #: The page's address follows the scene on screen at most this often [ms]: rewriting it
 #: at every slider step would cost a message per step, for a link nobody copies mid-drag.
 LINK_EVERY_MS = 1000
+#: Geometry and material sliders apply each drag step (not only the release) while the
+#: last solve took less than this [s]: then a step's answer arrives before the next step.
+LIVE_SOLVE_S = 0.030
 
 #: Which validity flags are shown next to which plot.
 BADGES: dict[str, dict[str, tuple[str, str]]] = {
@@ -81,7 +93,7 @@ CSS = """
            border-radius: 10px; font-size: 12px; font-weight: 600;}
 .cp-bad {background: #fde2e1; color: #9b1c1c; border: 1px solid #f5a3a0;}
 .cp-ok {background: #e3f5e6; color: #1d6b2c; border: 1px solid #a8dcb2;}
-.cp-msg {font-size: 12px; color: #9b1c1c; margin-left: 4px;}
+.cp-msg {font-size: 12px; color: #9b1c1c; margin-left: 4px; overflow-wrap: anywhere;}
 .cp-status {font-size: 12px; color: #444;}
 .cp-readout td, .cp-readout th {padding: 1px 8px; font-size: 13px; text-align: right;}
 .cp-readout th:first-child, .cp-readout td:first-child {text-align: left;}
@@ -111,37 +123,12 @@ def badges_html(view: ResultView | None, group: str) -> str:
     parts = []
     for flag, (bad, good) in BADGES[group].items():
         if flag in view.flags:
-            message = html.escape(view.flag_messages.get(flag, ""))
+            message = html.escape(exports.flag_message(view, flag))
             parts.append(f'<span class="cp-badge cp-bad flag-{flag}" title="{message}">'
                          f"⚠ {bad}</span><span class='cp-msg'>{message}</span>")
         elif good:
             parts.append(f'<span class="cp-badge cp-ok ok-{flag}">✓ {good}</span>')
     return "".join(parts)
-
-
-def status_html(view: ResultView | None, busy: bool) -> str:
-    """The status line: time per stage, what the cache reused, modes, steps, error."""
-    if view is None:
-        return "<span class='cp-status'>Solving…</span>" if busy else ""
-    info = view.info
-    stages = info.get("stages", {}) or {}
-    computed = [f"{name} {1e3 * float(s.get('seconds', 0.0)):.1f} ms"
-                for name, s in stages.items() if not s.get("cached")]
-    reused = [name for name, s in stages.items() if s.get("cached")]
-    tol = view.scene.get("solver", {}).get("tol", 1e-6)
-    err = info.get("error_estimate")
-    err_text = f"{err:.1e}" if isinstance(err, (int, float)) else "n/a"
-    text = (f"Solved in {1e3 * float(info.get('seconds', 0.0)):.0f} ms · "
-            f"computed: {', '.join(computed) or 'nothing'} · "
-            f"reused from cache: {', '.join(reused) or 'nothing'} · "
-            f"{info.get('n_modes', '?')} modes, {info.get('n_steps', '?')} time steps · "
-            f"error estimate {err_text} (target {tol:g})")
-    if info.get("reused"):
-        text = ("Identical to an earlier scene: its result is reused, no new solve. That "
-                "solve: " + text[0].lower() + text[1:])
-    if busy:
-        text = "Solving the newest change… showing the previous result. " + text
-    return f"<span class='cp-status solve-status'>{html.escape(text)}</span>"
 
 
 def readout_html(view: ResultView | None, index: int, pinned: ResultView | None) -> str:
@@ -189,7 +176,12 @@ class ExplorerApp(pn.viewable.Viewer):
                                           dispatch=self._dispatch, auto=False)
         self.pinned: ResultView | None = None
         self.presets = presets()
-        self.figures = Figures()
+        self.scales = DisplayScales()
+        self.limits = DesignLimits()
+        self.undo_stack = UndoStack()
+        self._undoing = False
+        self._loaded_scene: dict[str, Any] | None = None
+        self.figures = Figures(self.scales)
         self._drawn: ResultView | None = None
         self._busy_shown = False
         self._busy_due = False
@@ -198,6 +190,16 @@ class ExplorerApp(pn.viewable.Viewer):
         self._initial_scene(scene, query or {})
         self._build_widgets()
         self._layout = self._build_layout()
+        self._wanted_index, tab, pin_scene, pin_message = read_view_query(
+            query or {}, len(self.sidebar))
+        if tab:
+            self._fill(tab)
+            self.sidebar.active = tab
+        self._pin_controller: SolveController | None = None
+        if pin_scene is not None:
+            self._solve_pin(pin_scene)
+        if pin_message and not self.notice:
+            self.notice = pin_message
         # Changes to plain Bokeh models made after the page was generated but before its
         # websocket connects would never reach the browser: hold them until it does.
         self._initializing = True
@@ -214,6 +216,9 @@ class ExplorerApp(pn.viewable.Viewer):
         self.controller.start()
         if self.controller.view is None and self.controller.error:
             self._fallback_to_default()
+        if self.controller.view is None:
+            # a slow first solve (a link to a long history): say so, not a blank page
+            self.status.object = status_html(None, True)
         self._initializing = False
 
     # -- plumbing --------------------------------------------------------------------
@@ -251,8 +256,10 @@ class ExplorerApp(pn.viewable.Viewer):
         if chosen is not None:
             try:
                 self.state.load_scene(chosen)
+                self._loaded_scene = chosen
             except ValueError as exc:
                 self.notice = f"The scene could not be shown: {exc}"
+        self._remember()
         self._preset_key = next((k for k, s in self.presets.items() if s == chosen), None)
 
     def _fallback_to_default(self) -> None:
@@ -261,25 +268,34 @@ class ExplorerApp(pn.viewable.Viewer):
             return
         self.notice = (f"The scene could not be solved ({self.controller.error}); showing "
                        "the default scene instead.")
+        self.scales.reset()
         self.state.load_scene(default)
         self.controller.solve_now()
 
     # -- widgets ---------------------------------------------------------------------
+    def _fast_solves(self) -> bool:
+        """Whether the last solve was quick enough for sliders to apply every drag step."""
+        view = self.controller.view
+        seconds = view.info.get("seconds") if view is not None else None
+        return isinstance(seconds, (int, float)) and seconds < LIVE_SOLVE_S
+
     def _build_widgets(self) -> None:
         s = self.state
         reject = self._reject
+        live = self._fast_solves
         # presets
         options = {"(custom scene)": ""}
         options.update({preset_label(k, v): k for k, v in self.presets.items()})
         self.preset = pn.widgets.Select(label="Preset scene", options=options,
                                         value=self._preset_key or "",
-                                        sizing_mode="stretch_width")
+                                        sizing_mode="stretch_width",
+                                        css_classes=["preset-select"])
         self.preset_description = pn.pane.Markdown(self._preset_text(), margin=(0, 10),
                                                    styles={"font-size": "13px"})
         self.preset.param.watch(self._on_preset, "value")
 
         # punch
-        self.punch = Binding(reject)
+        self.punch = Binding(reject, live_when=live)
         pb = self.punch
         self.half_width = pb.add("half_width", slider("half-width a [m]", 0.1, 5.0, 0.01,
                                                       css_classes=["punch-half-width"]))
@@ -321,17 +337,17 @@ class ExplorerApp(pn.viewable.Viewer):
         self.layer.param.watch(lambda *e: self._bind_layer(), "value")
         self.thickness_editor = ProfileEditor("thickness", "mm", 0.5, 50.0, 0.1, "0[.]00",
                                               amplitude=("µm", -1000.0, 1000.0, 0.5),
-                                              css="coating-thickness")
+                                              css="coating-thickness", live_when=live)
         self.modulus_editor = ProfileEditor("Young's modulus", "MPa", 1.0, 10000.0, 1.0,
-                                            "0[.]0")
+                                            "0[.]0", live_when=live)
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
-                                            variations=False)
+                                            variations=False, live_when=live)
         self.layer_note = _html("", styles={"font-size": "12px", "color": "#666"})
         s.param.watch(lambda *e: self._refresh_layers(), "n_layers")
         self._refresh_layers()
 
         # base
-        self.base = Binding(reject)
+        self.base = Binding(reject, live_when=live)
         bb = self.base
         self.base_thickness = bb.add("thickness", slider("thickness H [m]", 0.1, 20.0, 0.05,
                                                          "0[.]00", css_classes=["base-thickness"]))
@@ -340,7 +356,7 @@ class ExplorerApp(pn.viewable.Viewer):
                                                      "0[.]0"))
         self.creep_model = bb.add("creep_model", pn.widgets.Select(
             label="creep model", options={v: k for k, v in CREEP_MODELS.items()},
-            sizing_mode="stretch_width"))
+            sizing_mode="stretch_width", css_classes=["creep-select"]))
         self.compliance = bb.add("compliance", fine_slider("final creep compliance C∞ [1/GPa]",
                                                       0.0, 0.1, 0.0005, "0[.]0000"))
         self.rate = bb.add("rate", fine_slider("creep rate γ [1/day]", 0.001, 1.0, 0.001,
@@ -354,7 +370,7 @@ class ExplorerApp(pn.viewable.Viewer):
                                                    1.0, "0[.]0"))
         self.creep_note = _html("", styles={"font-size": "12px", "color": "#666"})
         bb.bind(s.base)
-        s.base.param.watch(lambda *e: self._refresh_base(), ["creep_model"])
+        s.base.param.watch(lambda *e: self._refresh_base(), ["creep_model", "custom"])
 
         # loading
         self.statement = pn.widgets.Select(label="statement (which two are given)",
@@ -367,7 +383,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.unknowns_note = _html("", styles={"font-size": "13px"})
 
         # times and accuracy
-        self.global_binding = Binding(reject)
+        self.global_binding = Binding(reject, live_when=live)
         gb = self.global_binding
         self.time_end = gb.add("time_end", slider("time span [days after loading]", 1.0,
                                                   3650.0, 1.0, "0[.]0"))
@@ -378,9 +394,15 @@ class ExplorerApp(pn.viewable.Viewer):
         self.tol = gb.add("tol", pn.widgets.Select(
             label="accuracy target (relative)", options={f"{v:g}": v for v in
                                                         s.param.tol.objects},
-            sizing_mode="stretch_width"))
+            sizing_mode="stretch_width", css_classes=["tol-select"]))
         self.scene_name = gb.add("scene_name", pn.widgets.TextInput(
-            label="scene name", sizing_mode="stretch_width"))
+            label="scene name", sizing_mode="stretch_width", max_length=MAX_NAME_CHARS,
+            css_classes=["scene-name"]),
+            check=lambda v: check_text("scene name", v, MAX_NAME_CHARS))
+        self.description = gb.add("description", pn.widgets.TextAreaInput(
+            label="description (saved with the scene)", sizing_mode="stretch_width",
+            max_length=MAX_DESCRIPTION_CHARS, height=90, css_classes=["scene-description"]),
+            check=lambda v: check_text("description", v, MAX_DESCRIPTION_CHARS))
         gb.bind(s)
         s.param.watch(lambda *e: self._refresh_tol(), "tol")
 
@@ -400,6 +422,30 @@ class ExplorerApp(pn.viewable.Viewer):
                                                          filename="pressure.csv",
                                                          label="Results: q(x, t) (CSV)",
                                                          sizing_mode="stretch_width")
+        self.report_download = pn.widgets.FileDownload(
+            callback=self._report_file, filename="report.html", color="primary",
+            label="Printable report (HTML)", sizing_mode="stretch_width",
+            css_classes=["report-download"])
+
+        # design check
+        def limit(label: str, name: str, css: str) -> pn.widgets.FloatInput:
+            box = pn.widgets.FloatInput(label=label, value=None, start=0,
+                                        sizing_mode="stretch_width", css_classes=[css])
+            box.param.watch(lambda e: setattr(self.limits, name, e.new), "value")
+            return box
+
+        self.allowable_pressure = limit("allowable bearing pressure [kPa]",
+                                        "allowable_pressure", "limit-pressure")
+        self.settlement_limit = limit("settlement limit [mm]", "settlement_limit",
+                                      "limit-settlement")
+        self.tilt_limit = limit("tilt limit [mrad]", "tilt_limit", "limit-tilt")
+        self.eccentricity = pn.widgets.FloatInput(
+            label="eccentricity e = M/P [m] (sets the moment)", value=None,
+            sizing_mode="stretch_width", css_classes=["eccentricity-input"])
+        self.eccentricity.param.watch(self._on_eccentricity, "value")
+        self.design = _html("", sizing_mode="stretch_width", css_classes=["design-pane"])
+        self.limits.param.watch(lambda *e: self._show_design(), list(
+            n for n in self.limits.param if n != "name"))
         self.json_download = pn.widgets.FileDownload(callback=self._json_file,
                                                      filename="results.json",
                                                      label="Results: everything (JSON)",
@@ -415,16 +461,30 @@ class ExplorerApp(pn.viewable.Viewer):
         self.spinner = pn.indicators.LoadingSpinner(value=False, size=20, label="",
                                                     margin=(5, 5))
         self.status = _html("", sizing_mode="stretch_width", margin=(5, 5))
-        self.scene_badges = _html("", margin=(0, 5))
-        self.pressure_badges = _html("", margin=(0, 5))
-        self.history_badges = _html("", margin=(0, 5))
-        self.status_badges = _html("", margin=(0, 5))
-        self.player = pn.widgets.Player(label="time", start=0, end=1, value=0, interval=250,
-                                        loop_policy="once", show_loop_controls=False,
-                                        sizing_mode="stretch_width", show_value=False)
-        self.player.param.watch(lambda e: setattr(self, "time_index", int(e.new)), "value")
+        badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
+        self.scene_badges = _html("", **badge)
+        self.pressure_badges = _html("", **badge)
+        self.history_badges = _html("", **badge)
+        self.status_badges = _html("", **badge)
+        self.player = self._new_player(1, 0)
+        self.player_box = pn.Row(self.player, sizing_mode="stretch_width", margin=0)
         self.time_label = _html("", margin=(12, 10))
         self.readout = _html("", sizing_mode="stretch_width")
+        # The address bar is written by the page itself when this hidden box changes:
+        # Panel's location model delayed an update until the next one (its push waits
+        # for the document's first idle signal, which a replaced view never sees).
+        self._address = pn.widgets.TextInput(value="", visible=False)
+        self._address.jscallback(value="if (cb_obj.value) { window.history.replaceState("
+                                       "null, '', cb_obj.value) }")
+        self.undo_button = pn.widgets.Button(label="↶ Undo", disabled=True,
+                                             css_classes=["undo-button"])
+        self.undo_button.on_click(lambda e: self.undo())
+        self.reset_button = pn.widgets.Button(label="Reset to the loaded scene",
+                                              css_classes=["reset-button"])
+        self.reset_button.on_click(lambda e: self.reset())
+        self.classical = pn.widgets.Checkbox(label="classical solutions on q(x)",
+                                             css_classes=["classical-toggle"])
+        self.classical.param.watch(self._on_classical, "value")
         self.pin_button = pn.widgets.Button(label="Pin this result", color="default")
         self.unpin_button = pn.widgets.Button(label="Clear pin", color="light",
                                               disabled=True)
@@ -440,7 +500,8 @@ class ExplorerApp(pn.viewable.Viewer):
         column = {"sizing_mode": "stretch_width", "margin": (4, 0)}
         tabs = (
             ("Scene", pn.Column(
-                self.preset, self.preset_description,
+                self.preset, pn.Row(self.undo_button, self.reset_button),
+                self.preset_description,
                 _html("<b>Loading</b> (updates while you drag)", margin=(10, 10, 0, 10)),
                 self.statement, self.history_editors[0].panel, self.history_editors[1].panel,
                 self.unknowns_note, **column)),
@@ -463,8 +524,13 @@ class ExplorerApp(pn.viewable.Viewer):
                 self.creep_note, **column)),
             ("Time", pn.Column(self.time_end, self.time_count, self.time_spacing, self.tol,
                                **column)),
+            ("Check", pn.Column(
+                _html("<small>Limits of the design check (leave empty: not checked). "
+                      "The check covers the whole history.</small>"),
+                self.allowable_pressure, self.settlement_limit, self.tilt_limit,
+                self.eccentricity, **column)),
             ("Files", pn.Column(
-                self.scene_name, self.save_scene,
+                self.report_download, self.scene_name, self.description, self.save_scene,
                 _html("<small>Load a scene (the JSON the command line reads):</small>"),
                 self.load_file, self.csv_download, self.pressure_download, self.json_download,
                 _html("<small>Downloads hold the result on screen. The address bar holds "
@@ -483,6 +549,7 @@ class ExplorerApp(pn.viewable.Viewer):
         sidebar = pn.Tabs(*tabs, dynamic=False, width=370, margin=(0, 10, 0, 0),
                           css_classes=["sidebar-tabs"])
         sidebar.param.watch(self._fill_tab, "active")
+        sidebar.param.watch(lambda e: self._schedule_link(), "active")
         self.sidebar = sidebar
         f = self.figures
         bokeh = {"sizing_mode": "stretch_width", "margin": (0, 5)}
@@ -490,16 +557,20 @@ class ExplorerApp(pn.viewable.Viewer):
             f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES))]
         scene_pane, q_pane, image_pane, *history_panes = self._bokeh_panes
         main = pn.Column(
+            self._address,
             self.notice_alert,
             self.alert,
-            pn.Row(self.spinner, self.status, self.status_badges, sizing_mode="stretch_width"),
+            pn.Row(self.spinner, self.status, sizing_mode="stretch_width"),
+            self.status_badges,
             self.scene_badges,
             scene_pane,
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
-            pn.Row(self.player, self.time_label, sizing_mode="stretch_width"),
-            pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button),
+            pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
+            pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button,
+                                           self.classical),
                    sizing_mode="stretch_width"),
+            self.design,
             self.history_badges,
             pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
             sizing_mode="stretch_width",
@@ -510,8 +581,25 @@ class ExplorerApp(pn.viewable.Viewer):
             "over an aging viscoelastic layer (plane strain, per metre out of plane). "
             "Loads update while you drag; geometry and materials when you release.</div>",
             sizing_mode="stretch_width")
-        return pn.Column(header, pn.Row(sidebar, main, sizing_mode="stretch_width"),
+        self.header = header
+        self.presenting = pn.widgets.Toggle(label="Presentation mode", width=170,
+                                            css_classes=["presentation-toggle"])
+        self.presenting.param.watch(self._on_presentation, "value")
+        return pn.Column(pn.Row(header, self.presenting, sizing_mode="stretch_width"),
+                         pn.Row(sidebar, main, sizing_mode="stretch_width"),
                          sizing_mode="stretch_width")
+
+    def _on_presentation(self, event: Any) -> None:
+        """Presentation mode: large fonts, the whole story on a 1024x768 projector."""
+        on = bool(event.new)
+        with pn.io.hold():
+            self.figures.set_presentation(on)
+            self.header.visible = not on
+            self.sidebar.width = 300 if on else 370
+            size = "17px" if on else ""
+            for pane in (self.readout, self.status, self.design):
+                pane.styles = {"font-size": size} if on else {}
+        self._push()
 
     def __panel__(self) -> pn.viewable.Viewable:
         return self._layout
@@ -572,6 +660,12 @@ class ExplorerApp(pn.viewable.Viewer):
         self.base_modulus.label = ("final Young's modulus E∞ [GPa]" if model == "arutyunyan"
                                    else "Young's modulus E [GPa]")
         self.base_modulus.visible = model != "custom"
+        # "other model (from file)" is offered only while the scene holds one: picked
+        # without it, the base was silently solved as elastic
+        offered = {v: k for k, v in CREEP_MODELS.items()
+                   if k != "custom" or self.state.base.custom is not None}
+        if offered != self.creep_model.options:
+            self.creep_model.options = offered
         self.creep_note.object = ("A creep model from a file (kept as it is); choose another "
                                   "model to replace it." if model == "custom" else "")
         self.creep_note.visible = model == "custom"
@@ -596,7 +690,35 @@ class ExplorerApp(pn.viewable.Viewer):
         self.notice = f"Value not accepted: {message}"
 
     def _on_revision(self, event: Any) -> None:
+        self._remember()
         self.controller.request()
+
+    def _remember(self) -> None:
+        if self._undoing:
+            return
+        try:
+            self.undo_stack.push(self.state.to_scene())
+        except ValueError:
+            return  # a state that is no scene (its message comes with the solve)
+        if hasattr(self, "undo_button"):
+            self.undo_button.disabled = not self.undo_stack.can_undo
+
+    def undo(self) -> None:
+        """Go back to the scene before the last change."""
+        scene = self.undo_stack.undo()
+        if scene is None:
+            return
+        self._undoing = True
+        try:
+            self.state.load_scene(scene)
+        finally:
+            self._undoing = False
+        self.undo_button.disabled = not self.undo_stack.can_undo
+
+    def reset(self) -> None:
+        """Back to the scene as it was loaded (the preset, the file, the link)."""
+        if self._loaded_scene is not None:
+            self.state.load_scene(self._loaded_scene)
 
     def _on_preset(self, event: Any) -> None:
         key = event.new
@@ -615,6 +737,8 @@ class ExplorerApp(pn.viewable.Viewer):
         except ValueError as exc:
             self.notice = f"The scene was not loaded: {format_error(str(exc))}"
             return False
+        self.scales.reset()
+        self._loaded_scene = scene
         self.notice = ""
         return True
 
@@ -673,8 +797,10 @@ class ExplorerApp(pn.viewable.Viewer):
     def _on_status(self, *events: Any) -> None:
         error = self.controller.error
         # the core's messages echo user text (see _on_notice)
-        self.alert.object = (f"**Not solved:** {html.escape(error)}  \nThe plots still show "
-                             "the last good result." if error else "")
+        after = ("The plots still show the last good result." if self.controller.view
+                 is not None else "There is no result to show yet: change the scene, or "
+                 "choose a preset.")
+        self.alert.object = f"**Not solved:** {html.escape(error)}  \n{after}" if error else ""
         self.alert.visible = bool(error)
         if not self.controller.busy:
             self._show_busy(False)
@@ -750,14 +876,19 @@ class ExplorerApp(pn.viewable.Viewer):
             return
         n = len(view.times)
         old = self._drawn
-        if old is None or len(old.times) != n:
+        if old is None and self._wanted_index is not None:
+            index = min(self._wanted_index, n - 1)  # the time the link was made at
+        elif old is None or len(old.times) != n:
             index = n - 1
         else:
             index = min(self.time_index, n - 1)
         self._drawn = view
         with pn.io.hold():
             self.figures.show(view, index, self.pinned)
-            self.player.param.update(end=max(n - 1, 1), value=index)
+            if old is None or len(old.times) != n:
+                self._replace_player(max(n - 1, 1), index)
+            else:
+                self.player.value = index
             with param.discard_events(self):
                 self.time_index = index
             self._show_time_texts(view, index)
@@ -766,11 +897,13 @@ class ExplorerApp(pn.viewable.Viewer):
             self.pressure_badges.object = badges_html(view, "pressure")
             self.history_badges.object = badges_html(view, "history")
             self.status_badges.object = badges_html(view, "status")
-            slug = _slug(view.scene.get("name", "scene"))
+            self._show_design()
+            slug = _slug(str(view.scene.get("name", "scene"))[:60])
             self.save_scene.filename = f"{slug}.json"
             self.csv_download.filename = f"{slug}_results.csv"
             self.pressure_download.filename = f"{slug}_pressure.csv"
             self.json_download.filename = f"{slug}_results.json"
+            self.report_download.filename = f"{slug}_report.html"
         self._push()
         self._schedule_link()
 
@@ -786,9 +919,12 @@ class ExplorerApp(pn.viewable.Viewer):
         if view is None or self._location is None or self.controller.busy:
             return  # a newer result is coming, and will ask again
         try:
-            link = encode_scene(view.scene)
+            pin = self.pinned.scene if self.pinned is not None else None
+            query = view_query(view.scene, self.time_index, self.sidebar.active, pin)
+            # the whole query at once: the values are URL-safe already (base64url, digits)
+            link = "?" + "&".join(f"{k}={v}" for k, v in query.items() if v)
             if link != self._linked:
-                self._location.update_query(scene=link)
+                self._address.value = link
                 self._linked = link
         except Exception:  # the link is a convenience; the page must not fail for it
             log.exception("could not update the link")
@@ -802,22 +938,94 @@ class ExplorerApp(pn.viewable.Viewer):
             self.figures.show_time(view, index, self.pinned)
             self._show_time_texts(view, index)
         self._push()
+        self._schedule_link()
 
     def _show_time_texts(self, view: ResultView, index: int) -> None:
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{float(view.times[index]):.4g} days</span>")
         self.readout.object = readout_html(view, index, self.pinned)
 
+    def _solve_pin(self, scene: dict[str, Any]) -> None:
+        """Solve the pinned scene of a link (off the page's thread), then pin it."""
+        from core import scene_from_dict
+
+        state = ExplorerState()
+        try:
+            scene_from_dict(scene)
+            state.load_scene(scene)
+        except ValueError as exc:
+            self.notice = f"The pinned result in the link was not used: {format_error(str(exc))}"
+            return
+        executor = self.controller.executor
+        self._pin_controller = SolveController(state, executor=executor,
+                                               dispatch=self._dispatch, auto=False)
+        self._pin_controller.param.watch(self._on_pin_view, "view")
+        self._pin_controller.request()
+
+    def _on_pin_view(self, event: Any) -> None:
+        if event.new is not None:
+            self.pinned = event.new
+            self.unpin_button.disabled = False
+            self._redraw_pin()
+
+    def _on_classical(self, event: Any) -> None:
+        with pn.io.hold():
+            self.figures.set_classical(self._drawn, self.time_index, bool(event.new))
+        self._push()
+
+    def _show_design(self) -> None:
+        view = self._drawn
+        self.design.object = check_html(design_check(view, self.limits)) if view else ""
+
+    def _on_eccentricity(self, event: Any) -> None:
+        """Set the moment so that M = e P (force and moment given, constant force)."""
+        e = event.new
+        loading = self.state.loading
+        if e is None:
+            return
+        force = loading.histories["force"]
+        if loading.given != ("force", "moment") or force.kind != "constant":
+            self.notice = ("Value not accepted: the eccentricity sets the moment when force "
+                           "and moment are given and the force is constant.")
+            return
+        moment = loading.histories["moment"]
+        moment.param.update(kind="constant", value=float(e) * force.value)
+
+    def _report_file(self) -> io.StringIO:
+        view = self._shown()
+        if view is None:
+            return io.StringIO("")
+        index = min(self.time_index, len(view.times) - 1)
+        return io.StringIO(report_html(view, self.limits, index,
+                                       self.scales.pressure_unit(view)))
+
+    def _new_player(self, end: int, value: int) -> pn.widgets.Player:
+        player = pn.widgets.Player(label="time", start=0, end=end, value=value, interval=250,
+                                   loop_policy="once", show_loop_controls=False,
+                                   sizing_mode="stretch_width", show_value=False,
+                                   css_classes=["time-player"])
+        player.param.watch(lambda e: setattr(self, "time_index", int(e.new)), "value")
+        return player
+
+    def _replace_player(self, end: int, value: int) -> None:
+        """A new player for a new number of output times: the page's player redraws its
+        range only when its value changes, so a new range with the same value (or a value
+        arriving before the range) left the old range on screen."""
+        self.player = self._new_player(end, value)
+        self.player_box.objects = [self.player]
+
     def pin(self) -> None:
         """Keep the result on screen for comparison with the next ones."""
         self.pinned = self._drawn
         self.unpin_button.disabled = self.pinned is None
         self._redraw_pin()
+        self._schedule_link()
 
     def unpin(self) -> None:
         self.pinned = None
         self.unpin_button.disabled = True
         self._redraw_pin()
+        self._schedule_link()
 
     def _redraw_pin(self) -> None:
         view = self._drawn
@@ -855,10 +1063,14 @@ class ExplorerApp(pn.viewable.Viewer):
             raise
 
     def _csv_file(self) -> io.StringIO:
-        return self._download("to_csv", "")
+        view = self._shown()
+        return io.StringIO(exports.histories_csv(view) if view is not None else "")
 
     def _pressure_file(self) -> io.StringIO:
-        return self._download("pressure_csv", "")
+        view = self._shown()
+        if view is None:
+            return io.StringIO("")
+        return io.StringIO(exports.pressure_csv(view, self.scales.pressure_unit(view)))
 
     def _json_file(self) -> io.StringIO:
         return self._download("to_json", "{}")

@@ -213,6 +213,11 @@ class SolveController(param.Parameterized):
         if auto:
             state.param.watch(lambda event: self.request(), "revision")
 
+    @property
+    def executor(self) -> Executor | None:
+        """Where this controller's solves run (None: in the caller)."""
+        return self._executor
+
     # -- requests --------------------------------------------------------------------
     def request(self) -> int:
         """Ask for a solve of the current state; returns the request id."""
@@ -220,7 +225,11 @@ class SolveController(param.Parameterized):
             self._latest += 1
             rid = self._latest
         self.requests = rid
-        scene = self.state.to_scene()
+        try:
+            scene = self.state.to_scene()
+        except ValueError as exc:  # a state the screen cannot turn into a scene
+            self._deliver(rid, format_error(str(exc)))
+            return rid
         if self._executor is None:
             self._deliver(rid, self._compute(scene))
             return rid
@@ -236,7 +245,10 @@ class SolveController(param.Parameterized):
     def start(self) -> int:
         """First request of a session: shown at once when the result is already known
         (the page then arrives with its plots), else solved in the background."""
-        scene = self.state.to_scene()
+        try:
+            scene = self.state.to_scene()
+        except ValueError:
+            return self.solve_now()  # delivers the message
         if self._executor is None or (self._solve is _default_solve
                                       and RESULTS.get(result_key(scene)) is not None):
             return self.solve_now()
@@ -248,7 +260,11 @@ class SolveController(param.Parameterized):
             self._latest += 1
             rid = self._latest
         self.requests = rid
-        self._deliver(rid, self._compute(self.state.to_scene()))
+        try:
+            outcome: ResultView | str = self._compute(self.state.to_scene())
+        except ValueError as exc:
+            outcome = format_error(str(exc))
+        self._deliver(rid, outcome)
         return rid
 
     def _work(self, rid: int, scene: dict[str, Any]) -> None:

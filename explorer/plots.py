@@ -27,7 +27,9 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from .results import ResultView, negative_intervals
+from .classical import bearing_rule_pressure, half_space_pressure
+from .results import ResultView
+from .scales import DisplayScales
 from .state import QUANTITIES, QUANTITY_UNITS
 
 SYMBOLS = {"settlement": "δ", "tilt": "α", "force": "P", "moment": "M"}
@@ -40,6 +42,25 @@ PINNED_COLOR = "#d62728"
 _SLABS = 120
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
+
+#: Font size of ticks, axis labels and titles in presentation mode (a projector).
+PRESENTATION_FONT = "18px"
+
+#: Longest scene name shown in the drawing's title [characters]: a Bokeh title does not
+#: wrap, and at 1024 px a longer one was cut off.
+TITLE_CHARS = 40
+
+
+def f32(values: object) -> np.ndarray:
+    """Plot data as float32: half the bytes to the page, and 7 significant digits, more
+    than a screen resolves (the files keep the full numbers)."""
+    return np.asarray(values, dtype=np.float32)
+
+
+def short(text: str, limit: int = TITLE_CHARS) -> str:
+    """``text`` cut to ``limit`` characters with an ellipsis."""
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 1].rstrip() + "…"
 
 
 def _nice(value: float) -> float:
@@ -82,7 +103,8 @@ def set_data(source: ColumnDataSource, data: dict) -> bool:
 class Figures:
     """All figures of one session and the sources behind them."""
 
-    def __init__(self) -> None:
+    def __init__(self, scales: DisplayScales | None = None) -> None:
+        self.scales = scales or DisplayScales()
         self.modulus_mapper = LogColorMapper(palette=Viridis256, low=1.0, high=1e5)
         self._build_scene()
         self._build_pressure()
@@ -96,7 +118,7 @@ class Figures:
                    title="Scene", toolbar_location="above", name="scene_figure")
         p.toolbar.autohide = True
         p.xaxis.axis_label = "x [m]"
-        p.yaxis.axis_label = "y [m] (coating and punch profile exaggerated)"
+        p.yaxis.axis_label = "y [m] (exaggerated)"
         self.base_src = ColumnDataSource(_empty("left", "right", "bottom", "top", "E"),
                                          name="base_source")
         self.layer_src = ColumnDataSource(
@@ -124,6 +146,13 @@ class Figures:
         self.base_label = Label(x=0, y=0, text="", text_font_size="11px", text_color="#333",
                                 x_offset=4, y_offset=4)
         p.add_layout(self.base_label)
+        # the vertical exaggeration, inside the plot: in the title it made the title too
+        # long for a 1024 px screen
+        self.scale_label = Label(x=4, y=4, x_units="screen", y_units="screen", text="",
+                                 text_font_size="11px", text_color="#555",
+                                 background_fill_color="white", background_fill_alpha=0.7,
+                                 name="scale_label")
+        p.add_layout(self.scale_label)
         p.add_layout(ColorBar(color_mapper=self.modulus_mapper, title="E [MPa]", width=8),
                      "right")
         self.scene_fig = p
@@ -144,10 +173,21 @@ class Figures:
         p.add_layout(Span(location=0, dimension="width", line_color="#555", line_width=1))
         self.q_pin_line = p.line(x="x", y="q", source=self.q_pin_src, line_color=PINNED_COLOR,
                                  line_dash="dashed", line_width=2, legend_label="pinned")
+        self.classic_src = ColumnDataSource(_empty("x", "half_space", "bearing_rule"),
+                                            name="classical_source")
+        self.classic_lines = [
+            p.line(x="x", y="half_space", source=self.classic_src, line_color="#7f7f7f",
+                   line_dash="dotdash", line_width=1.5, visible=False,
+                   legend_label="rigid punch, elastic half-space"),
+            p.line(x="x", y="bearing_rule", source=self.classic_src, line_color="#2ca02c",
+                   line_dash="dotted", line_width=2, visible=False,
+                   legend_label="Winkler / trapezoid rule")]
         line = p.line(x="x", y="q", source=self.q_src, line_color=UNKNOWN_COLOR, line_width=2.5,
                       legend_label="current")
-        p.add_tools(HoverTool(renderers=[line], tooltips=[("x", "@x{0.000} m"), ("q", "@q")],
-                              mode="vline"))
+        self.q_hover = HoverTool(renderers=[line], tooltips=[("x", "@x{0.000} m"),
+                                                             ("q", "@q{0.000} kPa")],
+                                 mode="vline", name="q_hover")
+        p.add_tools(self.q_hover)
         legend = p.legend[0]
         legend.orientation = "horizontal"
         legend.click_policy = "hide"
@@ -163,11 +203,15 @@ class Figures:
         p.toolbar.autohide = True
         p.xaxis.axis_label = "x [m]"
         p.yaxis.axis_label = "t [days after loading]"
-        self.image_mapper = LinearColorMapper(palette=Viridis256, low=0, high=1)
+        self.image_mapper = LinearColorMapper(palette=Viridis256, low=0, high=1,
+                                              name="image_mapper")
         self.image_src = ColumnDataSource(_empty("image", "x", "y", "dw", "dh"),
                                           name="image_source")
-        p.image(image="image", x="x", y="y", dw="dw", dh="dh", source=self.image_src,
-                color_mapper=self.image_mapper)
+        image = p.image(image="image", x="x", y="y", dw="dw", dh="dh", source=self.image_src,
+                        color_mapper=self.image_mapper)
+        self.image_hover = HoverTool(renderers=[image], name="image_hover", tooltips=[
+            ("x", "$x{0.000} m"), ("t", "$y{0.0} days"), ("q", "@image{0.000} kPa")])
+        p.add_tools(self.image_hover)
         self.image_bar = ColorBar(color_mapper=self.image_mapper, title="q [kPa]", width=8)
         p.add_layout(self.image_bar, "right")
         self.image_cursor = Span(location=0, dimension="width", line_color="white",
@@ -200,8 +244,8 @@ class Figures:
                    line_width=2)
             line = p.line(x="t", y="v", source=src, line_color=UNKNOWN_COLOR, line_width=2.5)
             p.scatter(x="t", y="v", source=point, size=8, color="#d62728")
-            p.add_tools(HoverTool(renderers=[line], mode="vline",
-                                  tooltips=[("t", "@t{0.0} d"), (SYMBOLS[q], "@v")]))
+            p.add_tools(HoverTool(renderers=[line], mode="vline", tooltips=[
+                ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
             cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted")
             p.add_layout(cursor)
             self.history_src[q], self.history_pin_src[q] = src, pin
@@ -213,15 +257,16 @@ class Figures:
     def show(self, view: ResultView, index: int, pinned: ResultView | None) -> None:
         """Draw a new result (call inside ``pn.io.hold`` to send one message)."""
         # A change of the loads leaves the drawing as it is: do not send it again.
-        key = json.dumps([view.scene.get(k) for k in ("name", "punch", "coating", "base")],
+        key = json.dumps([view.scene.get(k) for k in ("punch", "coating", "base")],
                          sort_keys=True, default=str)
         if key != self._scene_key:
             self._show_scene(view)
             self._scene_key = key
+        self.scene_fig.title.text = f"Scene: {short(view.scene.get('name', ''))}"
         self._show_image(view)
         for q in QUANTITIES:
             given = q in view.given
-            set_data(self.history_src[q], {"t": view.times, "v": view.display(q)})
+            set_data(self.history_src[q], {"t": f32(view.times), "v": f32(view.display(q))})
             self.history_line[q].glyph.line_color = GIVEN_COLOR if given else UNKNOWN_COLOR
             state = "given" if given else "computed"
             unit = QUANTITY_UNITS[q][0]
@@ -239,34 +284,84 @@ class Figures:
             if pinned is None:
                 set_data(self.history_pin_src[q], {"t": [], "v": []})
             else:
-                set_data(self.history_pin_src[q], {"t": pinned.times, "v": pinned.display(q)})
+                set_data(self.history_pin_src[q], {"t": f32(pinned.times),
+                                                   "v": f32(pinned.display(q))})
 
     def _show_pinned_pressure(self, view: ResultView, pinned: ResultView | None,
                               index: int) -> None:
         if pinned is None:
             set_data(self.q_pin_src, {"x": [], "q": []})
             return
-        unit, size = view.pressure_unit
+        unit, size = self.scales.pressure_unit(view)
         j = pinned.time_index(float(view.times[index]))
-        set_data(self.q_pin_src, {"x": pinned.x, "q": pinned.pressure[:, j] / size})
+        set_data(self.q_pin_src, {"x": f32(pinned.x), "q": f32(pinned.pressure[:, j] / size)})
 
     def show_time(self, view: ResultView, index: int, pinned: ResultView | None) -> None:
         """Move every time cursor to output ``index`` (no solve)."""
-        unit, size = view.pressure_unit
+        unit, size = self.scales.pressure_unit(view)
         t = float(view.times[index])
         q = view.pressure[:, index]
-        set_data(self.q_src, {"x": view.x, "q": q / size})
-        intervals = negative_intervals(view.x, q)
+        set_data(self.q_src, {"x": f32(view.x), "q": f32(q / size)})
+        intervals = view.negative_intervals(index)
         set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
                                 "right": [hi for _, hi in intervals]})
-        self.q_fig.title.text = f"Contact pressure q(x) at t = {t:.4g} days"
+        self.q_fig.title.text = f"Pressure q(x), t = {t:.4g} days"
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
+        self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
         self._show_pinned_pressure(view, pinned, index)
+        self._show_classical(view, index)
         self.image_cursor.location = t
         for name in QUANTITIES:
             self.history_cursor[name].location = t
-            set_data(self.history_point_src[name], {"t": [t], "v": [view.display(name)[index]]})
+            set_data(self.history_point_src[name],
+                     {"t": [t], "v": [float(view.display(name)[index])]})
         self._show_arrow(view, index)
+
+    def set_classical(self, view: ResultView | None, index: int, shown: bool) -> None:
+        """Show or hide the classical answers on the pressure plot."""
+        self.classical = shown
+        for line in self.classic_lines:
+            line.visible = shown
+        if view is not None:
+            self._show_classical(view, index)
+
+    def _show_classical(self, view: ResultView, index: int) -> None:
+        if not self.classical:
+            return
+        size = self.scales.pressure_unit(view)[1]
+        a = view.geometry.half_width
+        force = float(view.values["force"][index])
+        moment = float(view.values["moment"][index])
+        x = view.x
+        set_data(self.classic_src, {
+            "x": f32(x), "half_space": f32(half_space_pressure(x, force, moment, a) / size),
+            "bearing_rule": f32(bearing_rule_pressure(x, force, moment, a) / size)})
+
+    classical = False
+
+    def all_figures(self) -> list:
+        """Every figure of the session."""
+        return [self.scene_fig, self.q_fig, self.image_fig,
+                *(self.history_fig[q] for q in QUANTITIES)]
+
+    def set_presentation(self, on: bool) -> None:
+        """Fonts a projector shows from the back of a room (ticks and labels of
+        :data:`PRESENTATION_FONT`), or the normal ones."""
+        tick, label, title = ((PRESENTATION_FONT, PRESENTATION_FONT, PRESENTATION_FONT)
+                              if on else ("11px", "13px", "13px"))
+        for fig in self.all_figures():
+            fig.title.text_font_size = title
+            for axis in (*fig.xaxis, *fig.yaxis):
+                axis.major_label_text_font_size = tick
+                axis.axis_label_text_font_size = label
+            fig.toolbar_location = None if on else "above"
+        legend = self.q_fig.legend[0]
+        legend.label_text_font_size = "11px" if on else "13px"
+        legend.glyph_width = 14 if on else 20
+        for q in QUANTITIES:
+            self.history_fig[q].height = 170 if on else 210
+        self.scene_fig.height = 240 if on else 300
+        self.q_fig.height = self.image_fig.height = 240 if on else 280
 
     def _show_arrow(self, view: ResultView, index: int) -> None:
         g = view.geometry
@@ -334,10 +429,10 @@ class Figures:
         self.scene_fig.y_range.update(start=-1.08 * depth, end=punch_top + 0.55 * a)
         note = f"coating and punch profile drawn ×{scale:g} vertically" if scale > 1 else \
             "drawn to scale"
-        self.scene_fig.title.text = f"Scene: {view.scene.get('name', '')} ({note})"
+        self.scale_label.text = note
 
     def _show_image(self, view: ResultView) -> None:
-        unit, size = view.pressure_unit
+        unit, size = self.scales.pressure_unit(view)
         a = view.geometry.half_width
         t0, t1 = float(view.times[0]), float(view.times[-1])
         span = t1 - t0
@@ -346,14 +441,14 @@ class Figures:
             # zero-height image gave ticks like 10.000000001)
             span = max(0.1 * abs(t0), 1.0)
             t0 -= span / 2
-        img = view.image / size
-        self.image_src.data = {"image": [img], "x": [-a], "y": [t0], "dw": [2 * a],
-                               "dh": [span]}
-        lo, hi = float(np.nanmin(img)), float(np.nanmax(img))
-        if hi <= lo:
-            hi = lo + 1.0
-        self.image_mapper.update(low=min(lo, 0.0), high=hi)
+        img = f32(view.image / size)
+        set_data(self.image_src, {"image": [img], "x": [-a], "y": [t0], "dw": [2 * a],
+                                  "dh": [span]})
+        lo, hi = self.scales.image_range(view)
+        self.image_mapper.update(low=lo, high=hi)
         self.image_bar.title = f"q [{unit}]"
+        self.image_hover.tooltips = [("x", "$x{0.000} m"), ("t", "$y{0.0} days"),
+                                     ("q", f"@image{{0.000}} {unit}")]
         self.image_fig.x_range.update(start=-a, end=a)
         self.image_fig.y_range.update(start=t0, end=t0 + span)
 

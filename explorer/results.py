@@ -73,9 +73,28 @@ class ResultView:
         """Index of the output time nearest to ``t`` [days]."""
         return int(np.argmin(np.abs(self.times - t)))
 
+    def lift_off_band(self) -> float:
+        """Pressure [Pa] below which (q < -band) the punch is taken to lift off.
+
+        The solver raises ``contact_lost`` only when the pressure is negative beyond its
+        own error band (estimated relative error times the largest pressure): a pressure
+        just below zero within that band is round-off of a full contact. The shading and
+        the files follow the same rule, so they never contradict the badge. Without the
+        flag nothing lies beyond the band (infinite band)."""
+        if "contact_lost" not in self.flags:
+            return float("inf")
+        err = self.info.get("error_estimate")
+        err = float(err) if isinstance(err, (int, float)) and np.isfinite(err) else 0.0
+        peak = float(np.nanmax(np.abs(self.pressure))) if self.pressure.size else 0.0
+        return max(err, 1e-12) * peak
+
     def negative_intervals(self, index: int) -> list[tuple[float, float]]:
-        """Intervals of ``x`` [m] where the pressure at output ``index`` is negative."""
-        return negative_intervals(self.x, self.pressure[:, index])
+        """Intervals of ``x`` [m] where the pressure at output ``index`` is negative
+        beyond the error band (see :meth:`lift_off_band`)."""
+        band = self.lift_off_band()
+        if not np.isfinite(band):
+            return []
+        return negative_intervals(self.x, self.pressure[:, index] + band)
 
 
 def negative_intervals(x: np.ndarray, q: np.ndarray) -> list[tuple[float, float]]:

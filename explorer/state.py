@@ -216,6 +216,23 @@ class LayerState(param.Parameterized):
         self.poisson.load_spec(layer["poisson"])
 
 
+#: Longest scene name and description the explorer accepts [characters], from a file, a
+#: link or the page: a name is echoed into the drawing's title, the file names and the
+#: address bar (a 15-million-character name once went into all three).
+MAX_NAME_CHARS = 200
+MAX_DESCRIPTION_CHARS = 4000
+
+
+def check_text(field: str, value: Any, limit: int) -> str:
+    """``value`` if it is text of at most ``limit`` characters, else a ValueError naming
+    ``field`` (the text itself is not repeated: it may be huge)."""
+    if not isinstance(value, str):
+        raise ValueError(f"{field}: must be text, got {type(value).__name__}")
+    if len(value) > limit:
+        raise ValueError(f"{field}: at most {limit} characters, got {len(value)}")
+    return value
+
+
 #: Layers the state holds (the schema allows ten; the screen offers five).
 MAX_LAYERS = 10
 SCREEN_LAYERS = 5
@@ -354,7 +371,11 @@ class BaseState(param.Parameterized):
                     "beta": self.beta, "alpha": self.alpha,
                     "compliance_final": self.compliance / _GPA,
                     "aging": self.aging / _GPA, "rate": self.rate}
-        if self.creep_model == "custom" and self.custom is not None:
+        if self.creep_model == "custom":
+            if self.custom is None:
+                # never solve another model than the one named on screen
+                raise ValueError("base.creep: 'other model (from file)' needs a creep model "
+                                 "from a scene file; choose one of the models offered")
             return copy.deepcopy(self.custom)
         return {"model": "elastic", "modulus": self.modulus * _GPA}
 
@@ -508,6 +529,8 @@ class ExplorerState(param.Parameterized):
         self.base = BaseState(name="base")
         self.loading = LoadingState(name="loading")
         self._extra: dict[str, Any] = {}
+        # name of the scene as loaded, while it is shown unchanged (see _rename_modified)
+        self._loaded_name: str | None = None
         self._batch = 0
         self._dirty = False
         watched = [self.punch, self.base, self.loading,
@@ -525,8 +548,30 @@ class ExplorerState(param.Parameterized):
     def _on_change(self, *events: param.parameterized.Event) -> None:
         if self._batch:
             self._dirty = True
-        else:
-            self.revision += 1
+            return
+        self._rename_modified(events)
+        self.revision += 1
+
+    def _rename_modified(self, events: tuple[param.parameterized.Event, ...]) -> None:
+        """The first change of a loaded scene renames it "... (modified)" and says where
+        it came from, so that a saved file does not pass for the preset; a name or
+        description the user typed is kept."""
+        loaded = self._loaded_name
+        if loaded is None:
+            return
+        if any(e.obj is self and e.name in ("scene_name", "description") for e in events):
+            self._loaded_name = None  # the user names the scene now
+            return
+        self._loaded_name = None
+        if self.scene_name != loaded or loaded.endswith(" (modified)"):
+            return
+        self._batch += 1
+        try:
+            self.param.update(
+                scene_name=f"{loaded[: MAX_NAME_CHARS - 11]} (modified)",
+                description=f"Changed on screen from the scene “{loaded}”.")
+        finally:
+            self._batch -= 1
 
     def _on_times(self, *events: param.parameterized.Event) -> None:
         if not self._batch and self.time_list is not None:
@@ -557,6 +602,8 @@ class ExplorerState(param.Parameterized):
         Raises ``ValueError`` (naming the field) when the scene cannot be represented; the
         state is then left unchanged.
         """
+        check_text("name", scene.get("name", ""), MAX_NAME_CHARS)
+        check_text("description", scene.get("description", ""), MAX_DESCRIPTION_CHARS)
         layers = scene["coating"]
         if not 1 <= len(layers) <= MAX_LAYERS:
             raise ValueError(f"coating: between 1 and {MAX_LAYERS} layers are supported, "
@@ -575,6 +622,7 @@ class ExplorerState(param.Parameterized):
             self._batch -= 1
         if not self._batch:
             self._dirty = False
+            self._loaded_name = self.scene_name
             self.revision += 1
 
     def _load(self, scene: dict[str, Any]) -> None:

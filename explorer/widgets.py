@@ -61,6 +61,13 @@ class EditableIntSlider(pn.widgets.EditableIntSlider):
     _input_widget = PromptIntInput
 
 
+#: Longest file name kept from an upload [characters] (it is echoed into messages).
+MAX_FILENAME_CHARS = 120
+#: Size of the pieces an upload is sent in [bytes]: well below the server's limit of one
+#: websocket message (``WEBSOCKET_MAX_BYTES`` in explorer/__main__.py).
+UPLOAD_CHUNK_BYTES = 256 * 1024
+
+
 class BoundedUpload(pn.viewable.Viewer):
     """A one-file upload that refuses a file over ``max_bytes`` in the browser, before
     sending it. ``filename`` and ``value`` (the file's bytes) follow the last file.
@@ -76,21 +83,22 @@ class BoundedUpload(pn.viewable.Viewer):
     def __init__(self, accept: Sequence[str], max_bytes: int, **params: Any) -> None:
         super().__init__(**params)
         self.max_bytes = max_bytes
-        self._dropper = pn.widgets.FileDropper(
+        # chunks well below the server's websocket message limit (explorer/__main__.py)
+        self._box = pn.widgets.FileDropper(
             accepted_filetypes=list(accept), multiple=False,
-            max_file_size=f"{max(1, max_bytes // 1000)}KB", sizing_mode="stretch_width",
-            height=90)
-        self._dropper.param.watch(self._on_drop, "value")
+            max_file_size=f"{max(1, max_bytes // 1000)}KB", chunk_size=UPLOAD_CHUNK_BYTES,
+            sizing_mode="stretch_width", height=90, css_classes=["file-dropper"])
+        self._box.param.watch(self._on_drop, "value")
 
     def _on_drop(self, event: Any) -> None:
         for name, data in (event.new or {}).items():
             raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
             # the same file again is a new request (e.g. after fixing the scene on screen)
-            self.param.update(filename=str(name), value=None)
+            self.param.update(filename=str(name)[:MAX_FILENAME_CHARS], value=None)
             self.value = raw
 
     def __panel__(self) -> pn.viewable.Viewable:
-        return self._dropper
+        return self._box
 
 
 def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
@@ -129,8 +137,14 @@ def _set_widget(widget: pn.widgets.Widget, value: Any) -> None:
 class Binding:
     """Widgets editing parameters of one Parameterized at a time (re-bindable)."""
 
-    def __init__(self, on_reject: Callable[[str], None] | None = None) -> None:
+    def __init__(self, on_reject: Callable[[str], None] | None = None,
+                 live_when: Callable[[], bool] | None = None) -> None:
+        """``live_when``: asked at each drag step of a slider that updates on release;
+        when it answers True the step is applied at once (a fast solver makes every
+        slider live)."""
         self._pairs: list[tuple[str, pn.widgets.Widget]] = []
+        self._checks: dict[str, Callable[[Any], Any]] = {}
+        self._live_when = live_when
         self._target: param.Parameterized | None = None
         self._watcher: Any = None
         self._syncing = False
@@ -140,13 +154,24 @@ class Binding:
     def target(self) -> param.Parameterized | None:
         return self._target
 
-    def add(self, name: str, widget: pn.widgets.Widget, live: bool = False) -> Any:
+    def add(self, name: str, widget: pn.widgets.Widget, live: bool = False,
+            check: Callable[[Any], Any] | None = None) -> Any:
         """Edit parameter ``name`` with ``widget``; ``live`` updates while dragging,
-        otherwise on release (``value_throttled``) where the widget has it."""
+        otherwise on release (``value_throttled``) where the widget has it, and while
+        dragging too when ``live_when`` says so. ``check`` refuses a value (ValueError)
+        before it reaches the state; the widget then shows the state's value again."""
         event = "value" if live or "value_throttled" not in widget.param else "value_throttled"
         widget.param.watch(lambda e, name=name: self._to_target(name, e.new), event)
+        if event == "value_throttled" and self._live_when is not None:
+            widget.param.watch(lambda e, name=name: self._drag_step(name, e.new), "value")
+        if check is not None:
+            self._checks[name] = check
         self._pairs.append((name, widget))
         return widget
+
+    def _drag_step(self, name: str, value: Any) -> None:
+        if self._live_when is not None and self._live_when():
+            self._to_target(name, value)
 
     def bind(self, target: param.Parameterized) -> None:
         """Point every widget at ``target`` and show its values."""
@@ -166,10 +191,19 @@ class Binding:
         if self._syncing or self._target is None or value is None:
             return
         try:
+            if name in self._checks:
+                self._checks[name](value)
             setattr(self._target, name, value)
         except ValueError as exc:  # a type the parameter refuses outright
             if self._on_reject is not None:
                 self._on_reject(str(exc))
+            self._syncing = True
+            try:
+                for other, widget in self._pairs:
+                    if other == name:
+                        _set_widget(widget, getattr(self._target, name))
+            finally:
+                self._syncing = False
 
     def _from_target(self, *events: param.parameterized.Event) -> None:
         self._syncing = True
@@ -199,10 +233,11 @@ class ProfileEditor:
     def __init__(self, label: str, unit: str, start: float, end: float, step: float,
                  fmt: str = "0[.]00", variations: bool = True,
                  amplitude: tuple[str, float, float, float] = ("%", -90.0, 500.0, 1.0),
-                 css: str = "") -> None:
+                 css: str = "", live_when: Callable[[], bool] | None = None) -> None:
         """``amplitude``: unit of the variation ('%' of the level, or an absolute unit),
-        its slider range and step. Without ``variations`` only the level is offered."""
-        self.binding = Binding()
+        its slider range and step. Without ``variations`` only the level is offered.
+        ``live_when``: see :class:`Binding`."""
+        self.binding = Binding(live_when=live_when)
         self.variations = variations
         self.mean = self.binding.add("mean", slider(f"{label} [{unit}]", start, end, step, fmt,
                                                     css_classes=[css] if css else []))

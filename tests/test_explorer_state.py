@@ -451,9 +451,12 @@ def release(widget, value):
         widget.value_throttled = value
 
 
-def test_app_widgets_follow_and_drive_the_state():
+def test_app_widgets_follow_and_drive_the_state(monkeypatch):
+    from explorer import app as app_module
     from explorer.app import ExplorerApp
 
+    # solves slower than the live threshold: geometry sliders apply on release only
+    monkeypatch.setattr(app_module, "LIVE_SOLVE_S", 0.0)
     app = ExplorerApp(executor=None)
     app.preset.value = "patched_insert"
     assert app.state.loading.statement == "settlement + tilt given"
@@ -468,6 +471,10 @@ def test_app_widgets_follow_and_drive_the_state():
     assert app.state.base.thickness != 3.5
     release(app.base_thickness, 3.5)
     assert app.state.base.thickness == pytest.approx(3.5)
+    # solves faster than the threshold (the last one measured): every drag step applies
+    monkeypatch.setattr(app_module, "LIVE_SOLVE_S", float("inf"))
+    app.base_thickness.value = 3.6
+    assert app.state.base.thickness == pytest.approx(3.6)
     # bad input: message in the alert, plots keep the last good result
     view = app.controller.view
     release(app.thickness_editor.mean, -1.0)
@@ -476,7 +483,8 @@ def test_app_widgets_follow_and_drive_the_state():
     # downloads hold what is on screen
     assert app._scene_file().getvalue().strip().startswith("{")
     assert json.loads(app._scene_file().getvalue()) == view.scene
-    assert app._csv_file().getvalue().startswith("time_day")
+    csv = app._csv_file().getvalue()
+    assert csv.startswith("# coated-punch explorer") and "\ntime_day,settlement_mm," in csv
 
 
 # ------------------------------------------------------------------ pressure shading

@@ -114,18 +114,22 @@ def test_the_busy_indicator_shows_at_once_outside_a_server() -> None:
 
 
 class _Location:
-    def __init__(self) -> None:
-        self.calls: list[str] = []
+    """Records what the page is told to put in its address bar (the scene part)."""
 
-    def update_query(self, scene: str) -> None:
-        self.calls.append(scene)
+    def __init__(self, app) -> None:
+        self.calls: list[str] = []
+        app._address.param.watch(self._record, "value")
+
+    def _record(self, event) -> None:
+        query = dict(part.split("=", 1) for part in event.new.lstrip("?").split("&"))
+        self.calls.append(query["scene"])
 
 
 def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
     from explorer.links import decode_scene
 
     app, timers = served_app
-    location = _Location()
+    location = _Location(app)
     app._location = location
     force = app.state.loading.histories["force"]
     for value in (510.0, 520.0, 530.0):   # a drag: three results, one link

@@ -26,6 +26,7 @@ import numpy as np
 import pytest
 
 import core.scene as scene_module
+from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
 from core.cli import main as cli_main
 from core.profiles import profile_from_csv
 from core.scene import (
@@ -39,7 +40,6 @@ from core.scene import (
     solve,
 )
 from explorer.links import MAX_JSON, PREFIX, decode_scene, encode_scene
-from explorer.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "assets" / "scenes"

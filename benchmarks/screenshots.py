@@ -1,0 +1,63 @@
+"""Screenshots of the explorer for the README: 1400x900, and 1024x768 in presentation mode.
+
+Starts ``python -m explorer`` on a free port, drives Debian's Chromium and writes
+``assets/explorer.png`` and ``assets/explorer_presentation_1024.png``. Usage::
+
+    python benchmarks/screenshots.py
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess  # noqa: E402
+
+READY = """() => {
+  const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];
+  const src = doc && doc.get_model_by_name('q_source');
+  return !!src && src.data.q && src.data.q.length > 1;
+}"""
+# two animation frames after a condition: the canvases have painted what it waited for
+PAINTED = "() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))"
+
+
+def main() -> int:
+    """Write the two screenshots into ``assets/``."""
+    import playwright.sync_api as pw
+
+    assets = ROOT / "assets"
+    with ExplorerProcess(ready_timeout=300) as server, pw.sync_playwright() as p:
+        profile = tempfile.mkdtemp(prefix="explorer-shots-")
+        context = p.chromium.launch_persistent_context(
+            profile, executable_path=CHROMIUM, headless=True, args=list(CHROMIUM_ARGS),
+            viewport={"width": 1400, "height": 900})
+        page = context.new_page()
+        page.goto(server.url + "/app?preset=eccentric_creep")
+        page.wait_for_function(READY, timeout=120_000)
+        page.locator(".classical-toggle input").first.check()
+        page.wait_for_function("() => Bokeh.documents[0].get_model_by_name("
+                               "'classical_source').data.x.length > 0", timeout=60_000)
+        page.evaluate("() => window.scrollTo(0, 0)")
+        page.evaluate(PAINTED)
+        page.screenshot(path=str(assets / "explorer.png"))
+        page.set_viewport_size({"width": 1024, "height": 768})
+        page.locator(".presentation-toggle button").first.click()
+        page.wait_for_function("() => Bokeh.documents[0].get_model_by_name('pressure_figure')"
+                               ".left[0].major_label_text_font_size === '18px'",
+                               timeout=60_000)
+        page.evaluate("() => window.scrollTo(0, 0)")
+        page.evaluate(PAINTED)
+        page.screenshot(path=str(assets / "explorer_presentation_1024.png"))
+        context.close()
+    print("wrote assets/explorer.png and assets/explorer_presentation_1024.png")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,60 @@
+"""Units and colour ranges that stay put while a scene is being edited.
+
+A *scene family* is what the user loaded (a preset, a file, a link) and every edit made
+to it since. Within a family the pressure keeps one unit (kPa or MPa, chosen from the
+first result) and the q(x, t) image keeps one colour scale, widened (to a round number)
+only when a result falls outside it: so that dragging a slider changes the colours, not
+the meaning of the colours, and a peak crossing 1 MPa does not relabel every axis.
+Nothing here imports Panel or Bokeh.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .results import ResultView
+
+
+def nice_ceiling(value: float) -> float:
+    """The smallest of 1, 2, 2.5, 5 times a power of ten at or above ``value`` (> 0)."""
+    if not math.isfinite(value) or value <= 0:
+        return 1.0
+    power = 10.0 ** math.floor(math.log10(value))
+    for step in (1.0, 2.0, 2.5, 5.0, 10.0):
+        if step * power >= value * (1 - 1e-12):
+            return step * power
+    return 10.0 * power
+
+
+class DisplayScales:
+    """The pressure unit and the q(x, t) colour range of the current scene family."""
+
+    def __init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        """A new family starts (a scene was loaded): the next result chooses again."""
+        self._unit: tuple[str, float] | None = None
+        self._range: tuple[float, float] | None = None
+
+    def pressure_unit(self, view: ResultView) -> tuple[str, float]:
+        """Display unit of pressure and its size [Pa], fixed for the family."""
+        if self._unit is None:
+            self._unit = view.pressure_unit
+        return self._unit
+
+    def image_range(self, view: ResultView) -> tuple[float, float]:
+        """Colour range of q(x, t) [display unit]: round numbers that cover every result
+        of the family seen so far (zero included, so that lift-off reads at a glance)."""
+        size = self.pressure_unit(view)[1]
+        img = view.image
+        lo = float(np.nanmin(img)) / size if img.size else 0.0
+        hi = float(np.nanmax(img)) / size if img.size else 1.0
+        lo = -nice_ceiling(-lo) if lo < 0 else 0.0
+        hi = nice_ceiling(hi) if hi > 0 else 1.0
+        if self._range is not None:
+            lo, hi = min(lo, self._range[0]), max(hi, self._range[1])
+        self._range = (lo, hi)
+        return self._range

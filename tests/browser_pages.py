@@ -1,0 +1,81 @@
+"""Helpers of the browser tests: a page of the served explorer, read as a user sees it.
+
+Imported by the browser test modules only (after their check that Chromium and
+Playwright are present).
+"""
+
+from __future__ import annotations
+
+import time
+
+# JavaScript helpers run in the page.
+JS_DOC = "() => (window.Bokeh && Bokeh.documents && Bokeh.documents[0]) || null"
+JS_READY = """() => {
+  const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];
+  if (!doc) return false;
+  const src = doc.get_model_by_name('q_source');
+  return !!src && src.data.q && src.data.q.length > 1;
+}"""
+JS_Q = """() => Array.from(Bokeh.documents[0].get_model_by_name('q_source').data.q)"""
+JS_TITLE = """(name) => Bokeh.documents[0].get_model_by_name(name).title.text"""
+
+
+# Closing a page while the server still writes to its websocket makes tornado log a
+# "Task exception was never retrieved" traceback: that is the test closing pages, not a
+# failure of the explorer.
+_CLOSED_SOCKET = ("WebSocketClosedError", "StreamClosedError")
+
+
+def _app_tracebacks(output: str) -> list[str]:
+    blocks = output.split("Traceback (most recent call last)")[1:]
+    return [b for b in blocks if not any(name in b[:3000] for name in _CLOSED_SOCKET)]
+
+
+class Page:
+    """A page of the explorer with the console watched."""
+
+    def __init__(self, context: object, url: str, path: str = "/app") -> None:
+        self.page = context.new_page()
+        self.errors: list[str] = []
+        self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+        self.page.goto(url + path)
+        self.page.wait_for_function(JS_READY, timeout=60_000)
+
+    def q(self) -> list[float]:
+        return self.page.evaluate(JS_Q)
+
+    def title(self, figure: str) -> str:
+        return self.page.evaluate(JS_TITLE, figure)
+
+    def text(self, selector: str) -> str:
+        return self.page.locator(selector).first.inner_text()
+
+    def pane_text(self, selector: str) -> str:
+        """Text of a Panel pane (its content lives in the element's shadow root)."""
+        return self.page.locator(selector).first.evaluate(
+            "e => (e.shadowRoot || e).textContent")
+
+    def wait_text_change(self, selector: str, old: str, timeout: float = 60.0) -> str:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            new = self.text(selector)
+            if new != old:
+                return new
+            time.sleep(0.05)
+        raise AssertionError(f"{selector} stayed at {old!r}")
+
+    def open_tab(self, name: str) -> None:
+        """Open a tab of the sidebar (its widgets arrive just after the page)."""
+        self.page.locator(".bk-tab", has_text=name).first.click()
+
+    def type_into(self, css: str, value: str) -> None:
+        """Type a value in the number box of a slider and confirm it with Enter."""
+        box = self.page.locator(f"{css} input").first
+        box.click()
+        box.press("Control+a")
+        box.type(value)
+        box.press("Enter")
+
+    def close(self) -> None:
+        self.page.close()

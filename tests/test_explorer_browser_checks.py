@@ -1,0 +1,384 @@
+"""What a teacher, a design engineer and a careless user found, checked in a real browser.
+
+Each test reproduces one finding of the explorer's review (time slider after a preset
+switch, layout at 1024 px, dangling messages, saved names, uploads, units, what a load
+step sends) in Debian's Chromium. Every wait is on a condition in the page.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
+
+_missing = browser_missing()
+if _missing:
+    if os.environ.get("CI"):
+        pytest.fail(_missing, pytrace=False)
+    pytest.skip(_missing, allow_module_level=True)
+
+import playwright.sync_api as playwright_api  # noqa: E402
+
+from tests.browser_pages import Page, _app_tracebacks  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# The page's Bokeh view of a named figure (its drawn size), found from the roots down.
+JS_VIEW_WIDTH = """(name) => {
+  const stack = Object.values(Bokeh.index);
+  while (stack.length) {
+    const v = stack.pop();
+    if (v.model && v.model.name === name) return v.el.getBoundingClientRect().width;
+    if (v.child_views) stack.push(...v.child_views);
+    else if (v.renderer_views) stack.push(...v.renderer_views.values());
+  }
+  return null;
+}"""
+# Whether some element of the page (shadow roots included) shows the text.
+JS_SHOWN = """(text) => {
+  const roots = [document];
+  while (roots.length) {
+    const r = roots.pop();
+    for (const e of r.querySelectorAll('*')) {
+      if (!e.shadowRoot) continue;
+      if (e.shadowRoot.textContent.includes(text)) return true;
+      roots.push(e.shadowRoot);
+    }
+  }
+  return false;
+}"""
+# Width [px] of a figure title in the font Bokeh draws it with (bold 13px helvetica).
+JS_TITLE_WIDTH = """(name) => {
+  const fig = Bokeh.documents[0].get_model_by_name(name);
+  const ctx = document.createElement('canvas').getContext('2d');
+  ctx.font = 'bold 13px helvetica';
+  return ctx.measureText(fig.title.text).width;
+}"""
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[str]:
+    with ExplorerProcess(ready_timeout=180) as explorer:
+        yield explorer.url
+    output = explorer.output()
+    assert not _app_tracebacks(output), output
+
+
+@pytest.fixture(scope="module")
+def browser_context() -> Iterator[object]:
+    profile = tempfile.mkdtemp(prefix="explorer-chromium-")
+    with playwright_api.sync_playwright() as p:
+        context = p.chromium.launch_persistent_context(
+            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
+            viewport={"width": 1400, "height": 900}, accept_downloads=True)
+        yield context
+        context.close()
+    shutil.rmtree(profile, ignore_errors=True)
+
+
+@pytest.fixture()
+def page(server: str, browser_context: object) -> Iterator[Page]:
+    p = Page(browser_context, server)
+    yield p
+    p.close()
+
+
+def _until(check: Callable[[], bool], what: str, timeout: float = 60.0) -> None:
+    """Poll ``check`` (a look at the page) until it holds; fail after ``timeout`` [s]."""
+    deadline = time.monotonic() + timeout
+    while not check():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"not seen within {timeout:g} s: {what}")
+        time.sleep(0.05)
+
+
+def _wait(page: Page, js: str, arg: object = None, timeout: float = 60_000) -> None:
+    page.page.wait_for_function(js, arg=arg, timeout=timeout)
+
+
+def _choose_preset(page: Page, key: str, title_part: str) -> None:
+    from explorer.presets import preset_label, presets
+
+    label = preset_label(key, presets()[key])
+    page.page.locator(".preset-select select").first.select_option(label=label)
+    _wait(page, "(t) => Bokeh.documents[0].get_model_by_name('scene_figure').title.text"
+          ".includes(t)", title_part)
+
+
+def _player_range(page: Page) -> dict:
+    return page.page.locator(".time-player input[type=range]").first.evaluate(
+        "e => ({min: e.min, max: e.max, value: e.value})")
+
+
+def test_time_slider_range_follows_a_preset_switch(page: Page):
+    """40 output times, then a preset with 60: the slider must reach the 60th."""
+    assert _player_range(page)["max"] == "39"
+    _choose_preset(page, "eccentric_creep", "Eccentric")
+    _until(lambda: _player_range(page)["max"] == "59", "the slider reaching 59")
+    assert _player_range(page)["value"] == "59"
+    # the first time, then the last, land where they say
+    slider = page.page.locator(".time-player input[type=range]").first
+    slider.fill("0")
+    _until(lambda: "t = 0 days" in page.text(".time-label"), "t = 0")
+    slider.fill("59")
+    _until(lambda: "t = 1000 days" in page.text(".time-label"), "t = 1000")
+    # the preset's text says what its curve shows (it levels off; not "for years")
+    assert page.page.evaluate(JS_SHOWN, "level off after about 250 days")
+    assert not page.page.evaluate(JS_SHOWN, "keep growing for years")
+    assert page.errors == []
+
+
+def test_tolerance_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: Page):
+    from explorer.exports import parse_csv
+
+    page.page.set_viewport_size({"width": 1024, "height": 768})
+    _wait(page, "() => window.innerWidth === 1024")
+    scene_top = page.page.locator(".bk-panel-models-layout-Column").first.bounding_box()
+    status = page.page.locator(".solve-status").first
+    status.wait_for(timeout=30_000)
+    before_top = _figure_top(page)
+    page.open_tab("Time")
+    page.page.locator(".tol-select select").first.select_option("1e-08")
+    page.page.locator(".flag-tol_not_met").first.wait_for(timeout=60_000)
+    # the status keeps the width of the main column; the plots hardly move
+    width = status.bounding_box()["width"]
+    assert width > 400, width
+    moved = _figure_top(page) - before_top
+    assert moved < 120, moved
+    assert scene_top is not None
+    # the flag's explanation is the solver's own words, not a pointer to a report
+    badges = page.page.locator(".flag-tol_not_met").first.evaluate(
+        "e => e.getRootNode().host ? e.getRootNode().textContent : e.textContent")
+    assert "see info.message" not in badges and "not met" in badges
+    # the drawing's title fits its figure
+    assert page.page.evaluate(JS_TITLE_WIDTH, "scene_figure") < \
+        page.page.evaluate(JS_VIEW_WIDTH, "scene_figure") - 60
+    # the flagged result's CSV carries the flag and the units on screen
+    page.open_tab("Files")
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.get_by_text("Results: histories (CSV)").first.click()
+    meta, names, table = parse_csv(Path(info.value.path()).read_text())
+    assert "WARNING" in meta and "flag tol_not_met" in meta
+    assert names == ["time_day", "settlement_mm", "tilt_mrad", "force_kN_per_m",
+                     "moment_kN_m_per_m"]
+    assert table[0, 3] == 500  # kN/m: exactly the preset's 5e5 N/m, no round-off tail
+    text = Path(info.value.path()).read_text()
+    assert "9999999" not in text and "0000001" not in text
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.get_by_text("Results: q(x, t) (CSV)").first.click()
+    meta, names, table = parse_csv(Path(info.value.path()).read_text())
+    assert names == ["time_day", "x_m", "q_kPa"] and "flag tol_not_met" in meta
+    assert page.errors == []
+
+
+def _figure_top(page: Page) -> float:
+    box = page.page.locator(".bk-panel-models-layout-Column .bk-Figure, .bk-Figure").first
+    return float(box.bounding_box()["y"])
+
+
+def test_a_changed_scene_is_saved_under_its_own_name_and_description(page: Page):
+    page.type_into(".load-0-value", "650")
+    _until(lambda: page.text(".readout-force") == "650", "force 650")
+    page.open_tab("Files")
+    name = page.page.locator(".scene-name input").first
+    name.wait_for(timeout=30_000)
+    _until(lambda: name.input_value().endswith("(modified)"), "the name '... (modified)'")
+    area = page.page.locator(".scene-description textarea").first
+    area.fill("Strip footing B-12, checked for 650 kN/m")
+    area.blur()
+    page.page.wait_for_function(
+        "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text"
+        ".includes('(modified)')", timeout=60_000)
+    saved = None
+    for _ in range(50):  # the description reaches the server on blur: read until it has
+        with page.page.expect_download(timeout=60_000) as info:
+            page.page.get_by_text("Save scene (JSON)").first.click()
+        saved = json.loads(Path(info.value.path()).read_text())
+        if saved["description"].startswith("Strip footing"):
+            break
+        page.page.wait_for_timeout(100)
+    assert saved is not None and saved["name"].endswith("(modified)")
+    assert saved["description"] == "Strip footing B-12, checked for 650 kN/m"
+    assert saved["loading"]["force"] == 650e3
+    assert page.errors == []
+
+
+def test_units_stay_put_and_a_load_step_sends_only_what_changed(page: Page):
+    doc = "Bokeh.documents[0]"
+    assert page.page.evaluate(f"() => {doc}.get_model_by_name('pressure_figure')"
+                              ".left[0].axis_label") == "q [kPa]"
+    tips = page.page.evaluate(f"() => {doc}.get_model_by_name('q_hover').tooltips")
+    assert any("kPa" in str(t) for t in tips)
+    assert page.page.evaluate(
+        f"() => {doc}.get_model_by_name('q_source').data.q instanceof Float32Array")
+    high = page.page.evaluate(f"() => {doc}.get_model_by_name('image_mapper').high")
+    # count what reaches the page: the q(x, t) image, the drawing
+    page.page.evaluate(f"""() => {{
+      window.__sent = {{image: 0, layers: 0}};
+      {doc}.get_model_by_name('image_source').change.connect(() => window.__sent.image++);
+      {doc}.get_model_by_name('layer_source').change.connect(() => window.__sent.layers++);
+    }}""")
+    # a time step sends no image and no drawing
+    slider = page.page.locator(".time-player input[type=range]").first
+    slider.fill("3")
+    _until(lambda: "365" not in page.text(".time-label"), "a new time")
+    assert page.page.evaluate("() => window.__sent") == {"image": 0, "layers": 0}
+    # a much larger force: the peak passes 1 MPa, the unit stays kPa, the colours widen
+    page.type_into(".load-0-value", "5000")
+    _wait(page, f"() => {doc}.get_model_by_name('image_mapper').high > {high}")
+    assert page.page.evaluate(f"() => {doc}.get_model_by_name('pressure_figure')"
+                              ".left[0].axis_label") == "q [kPa]"
+    sent = page.page.evaluate("() => window.__sent")
+    assert sent["layers"] == 0 and sent["image"] >= 1
+    new_high = page.page.evaluate(f"() => {doc}.get_model_by_name('image_mapper').high")
+    # back to the first force: the colour scale stays (it is the family's, fixed)
+    page.type_into(".load-0-value", "500")
+    _wait(page, f"() => {doc}.get_model_by_name('q_source').data.q.length > 1")
+    _until(lambda: page.text(".readout-force") == "500", "force 500")
+    assert page.page.evaluate(
+        f"() => {doc}.get_model_by_name('image_mapper').high") == new_high
+    assert page.errors == []
+
+
+def test_an_overlong_name_from_the_page_is_refused(page: Page):
+    page.open_tab("Files")
+    page.page.locator(".scene-name input").first.wait_for(timeout=30_000)
+    # bypass the input's own length limit, as a crafted message would
+    page.page.evaluate("""() => {
+      const doc = Bokeh.documents[0];
+      for (const m of doc.all_models) {
+        if (m.css_classes && m.css_classes.includes('scene-name')) m.value = 'x'.repeat(5000);
+      }
+    }""")
+    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000)
+    assert "at most 200 characters" in page.pane_text(".notice")
+    assert "xxxxxxxxxx" not in page.page.evaluate(
+        "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text")
+    assert page.errors == []
+
+
+def test_the_creep_model_from_a_file_is_offered_only_with_one(page: Page):
+    page.open_tab("Base")
+    select = page.page.locator(".creep-select select").first
+    select.wait_for(timeout=30_000)
+    options = select.evaluate("s => [...s.options].map(o => o.textContent)")
+    assert "other model (from file)" not in options
+    assert "aging creep (Arutyunyan)" in options
+
+
+def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
+    """Feature 1 (design check), 2 (report) and 9 (status in words, details)."""
+    # the status in plain words, the solver's numbers behind "details"
+    status = page.text(".solve-status")
+    assert "accurate to about" in status or "NOT met" in status
+    details = page.page.locator(".solve-details").first
+    assert "stages:" not in details.inner_text()
+    details.locator("summary").click()
+    _until(lambda: "stages:" in details.inner_text(), "the stage timings")
+    # the check, no limit yet
+    _until(lambda: "no limits set" in page.text(".design-check"), "the design check")
+    page.open_tab("Check")
+    box = page.page.locator(".limit-pressure input").first
+    box.wait_for(timeout=30_000)
+    box.fill("1")  # kPa: any footing fails this
+    box.press("Enter")
+    _until(lambda: "a limit is exceeded" in page.text(".design-check"), "FAIL")
+    box.fill("100000")
+    box.press("Enter")
+    _until(lambda: "all set limits hold" in page.text(".design-check"), "pass")
+    # e = M/P typed: the moment follows, the readout says so
+    ecc = page.page.locator(".eccentricity-input input").first
+    ecc.fill("0.2")
+    ecc.press("Enter")
+    _until(lambda: page.text(".readout-moment") == "100", "M = 0.2 m x 500 kN/m")
+    _until(lambda: "e = M/P = 0.2 m" in page.text(".design-check"), "e in the check")
+    # the report holds the check, the flags' verdict, the accuracy and the version
+    page.open_tab("Files")
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.get_by_text("Printable report (HTML)").first.click()
+    text = Path(info.value.path()).read_text()
+    from explorer.exports import project_version
+
+    assert "Design check" in text and "all set limits hold" in text
+    assert project_version() in text and "estimated relative error" in text
+    assert text.count("<svg") == 7
+    assert page.errors == []
+
+
+def test_classical_solutions_undo_and_reset(page: Page):
+    """Feature 6 (classical answers on request) and 7 (typed entry, undo, reset)."""
+    doc = "Bokeh.documents[0]"
+    page.page.locator(".classical-toggle input").first.check()
+    _wait(page, f"() => {doc}.get_model_by_name('classical_source').data.x.length > 100")
+    # full contact, centred: the bearing rule is uniform at P / 2a = 250 kPa
+    rule = page.page.evaluate(
+        f"() => Array.from({doc}.get_model_by_name('classical_source').data.bearing_rule)")
+    assert max(rule) == pytest.approx(250.0) and min(rule) == pytest.approx(250.0)
+    force = page.text(".readout-force")
+    page.type_into(".load-0-value", "650")
+    _until(lambda: page.text(".readout-force") == "650", "force 650")
+    _wait(page, f"() => Math.max(...{doc}.get_model_by_name('classical_source')"
+          ".data.bearing_rule) > 300")
+    page.page.locator(".undo-button button").first.click()
+    _until(lambda: page.text(".readout-force") == force, "undo to the first force")
+    page.type_into(".load-0-value", "700")
+    _until(lambda: page.text(".readout-force") == "700", "force 700")
+    page.page.locator(".reset-button button").first.click()
+    _until(lambda: page.text(".readout-force") == force, "reset to the preset")
+    assert page.errors == []
+
+
+def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
+                                                   browser_context: object):
+    """Feature 4: a copied link reopens the same view, pin included."""
+    page.page.get_by_text("Pin this result").first.click()
+    page.page.locator(".pinned-settlement").first.wait_for(timeout=30_000)
+    page.type_into(".load-0-value", "650")
+    _until(lambda: page.text(".readout-force") == "650", "force 650")
+    page.page.locator(".time-player input[type=range]").first.fill("5")
+    _until(lambda: "t = 365" not in page.text(".time-label"), "time 5")
+    label = page.text(".time-label")
+    pinned = page.text(".pinned-settlement")  # the pin at the time shown
+    page.open_tab("Base")
+
+    def href() -> str:  # from the page: Playwright's own page.url may lag behind
+        return page.page.evaluate("() => window.location.href")
+
+    _until(lambda: all(part in href() for part in ("t=5", "tab=3", "pin=1.")),
+           "the link with t, tab and pin")
+    other = Page(browser_context, server, "/app?" + href().split("?", 1)[1])
+    try:
+        _until(lambda: other.text(".time-label") == label, "the same time")
+        other.page.locator(".pinned-settlement").first.wait_for(timeout=60_000)
+        _until(lambda: other.text(".pinned-settlement") == pinned, "the same pin")
+        assert other.text(".readout-force") == "650"
+        other.page.locator(".creep-select select").first.wait_for(state="visible",
+                                                                 timeout=30_000)
+        assert other.errors == []
+    finally:
+        other.close()
+
+
+def test_presentation_mode_has_projector_fonts_at_1024(page: Page):
+    """Feature 5: at 1024x768, ticks of at least 18 px; the plots stay on screen."""
+    page.page.set_viewport_size({"width": 1024, "height": 768})
+    page.page.locator(".presentation-toggle button").first.click()
+    doc = "Bokeh.documents[0]"
+    _wait(page, f"() => {doc}.get_model_by_name('pressure_figure').left[0]"
+          ".major_label_text_font_size === '18px'")
+    for name in ("scene_figure", "pressure_figure", "settlement_figure"):
+        size = page.page.evaluate(f"(n) => {doc}.get_model_by_name(n).below[0]"
+                                  ".major_label_text_font_size", name)
+        assert int(size.rstrip("px")) >= 18, (name, size)
+    assert page.page.evaluate(JS_VIEW_WIDTH, "pressure_figure") > 250
+    assert page.errors == []

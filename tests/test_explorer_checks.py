@@ -1,0 +1,309 @@
+"""The explorer's files, units, names and messages, without a browser (fast).
+
+Each test pins down one finding of the explorer's review (issue 15) or of the red-team
+pass (issue 19, items 5, 6 and the explorer's part of 9); the browser tests in
+``test_explorer_browser_checks.py`` show the same on the page.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from concurrent.futures import Executor, Future
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from explorer.controller import SolveController
+from explorer.exports import histories_csv, number, parse_csv, pressure_csv
+from explorer.presets import presets
+from explorer.scales import DisplayScales, nice_ceiling
+from explorer.state import MAX_NAME_CHARS, ExplorerState
+
+PRESETS = presets()
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def solved(key: str = "uniform_flat", **solver: float):
+    state = ExplorerState()
+    scene = json.loads(json.dumps(PRESETS[key]))
+    scene["solver"] = {**scene.get("solver", {}), **solver}
+    state.load_scene(scene)
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    assert controller.view is not None, controller.error
+    return state, controller
+
+
+# ------------------------------------------------------------------ files
+def test_numbers_are_written_without_round_off_tails():
+    assert number(799999.9999999999) == "800000"
+    assert number(0.1 + 0.2) == "0.3"
+    assert number(-0.0) == "0"
+    assert number(1.2345678901234e-7) == "1.23456789e-07"
+
+
+def test_a_flagged_result_leaves_with_its_flag_in_the_units_on_screen():
+    _, controller = solved(tol=1e-8)
+    view = controller.view
+    assert "tol_not_met" in view.flags
+    meta, names, table = parse_csv(histories_csv(view))
+    assert names == ["time_day", "settlement_mm", "tilt_mrad", "force_kN_per_m",
+                     "moment_kN_m_per_m"]
+    assert "WARNING" in meta and "not met" in meta["flag tol_not_met"]
+    assert "see info.message" not in histories_csv(view)
+    assert np.all(table[:, 3] == 500.0)  # the preset's 5e5 N/m in kN/m, exactly
+    # the columns are the plotted numbers to the digits written (10 significant)
+    np.testing.assert_allclose(table[:, 1], view.display("settlement"), rtol=1e-9)
+    meta, names, table = parse_csv(pressure_csv(view, ("kPa", 1e3)))
+    assert names == ["time_day", "x_m", "q_kPa"] and "flag tol_not_met" in meta
+    np.testing.assert_allclose(table[: len(view.x), 2], view.pressure[:, 0] / 1e3,
+                               rtol=1e-9)
+
+
+def test_an_unflagged_result_says_so():
+    _, controller = solved()
+    meta, _, _ = parse_csv(histories_csv(controller.view))
+    assert meta["flags"] == "none" and "WARNING" not in meta
+    assert meta["accuracy"].startswith("estimated relative error")
+
+
+# ------------------------------------------------------------------ units and colours
+def test_one_pressure_unit_and_a_widening_colour_scale_per_scene_family():
+    assert [nice_ceiling(v) for v in (0.7, 1.0, 1.3, 2.2, 3.0, 7.0, 420.0)] == \
+        [1.0, 1.0, 2.0, 2.5, 5.0, 10.0, 500.0]
+    state, controller = solved()
+    low = controller.view
+    scales = DisplayScales()
+    assert scales.pressure_unit(low) == ("kPa", 1e3)
+    first = scales.image_range(low)
+    high = replace(low, pressure=low.pressure * 20, image=low.image * 20)
+    assert high.pressure_unit == ("MPa", 1e6)            # alone it would switch ...
+    assert scales.pressure_unit(high) == ("kPa", 1e3)    # ... within the family it stays
+    widened = scales.image_range(high)
+    assert widened[1] > first[1]
+    assert scales.image_range(low) == widened           # never shrinks back
+    scales.reset()
+    assert scales.pressure_unit(high) == ("MPa", 1e6)
+
+
+def test_pressure_just_below_zero_within_the_error_band_is_not_shaded():
+    _, controller = solved()
+    view = controller.view
+    peak = float(np.max(np.abs(view.pressure)))
+    tiny = view.pressure.copy()
+    tiny[0, :] = -1e-9 * peak                             # within the band: round-off
+    quiet = replace(view, pressure=tiny, flags=[])
+    assert quiet.negative_intervals(0) == []
+    err = 1e-6
+    lifted = replace(view, pressure=tiny, flags=["contact_lost"],
+                     info={**view.info, "error_estimate": err})
+    assert lifted.negative_intervals(0) == []             # still inside err * peak
+    deep = view.pressure.copy()
+    deep[:5, :] = -1e-3 * peak
+    lifted = replace(view, pressure=deep, flags=["contact_lost"],
+                     info={**view.info, "error_estimate": err})
+    assert len(lifted.negative_intervals(0)) == 1
+
+
+# ------------------------------------------------------------------ names and text
+def test_a_changed_preset_is_renamed_and_a_typed_name_is_kept():
+    state = ExplorerState()
+    state.load_scene(PRESETS["worn_coating"])
+    name = PRESETS["worn_coating"]["name"]
+    assert state.scene_name == name
+    state.loading.histories["force"].value = 650.0
+    assert state.scene_name == f"{name} (modified)"
+    assert name in state.description and "Changed on screen" in state.description
+    state.scene_name = "Footing B-12"
+    state.punch.half_width = 1.2
+    assert state.scene_name == "Footing B-12"
+    # a fresh load names the scene again; the user's own name before any change stays
+    state.load_scene(PRESETS["worn_coating"])
+    state.scene_name = "mine"
+    state.punch.half_width = 1.3
+    assert state.scene_name == "mine"
+
+
+def test_overlong_text_is_refused_from_files_links_and_the_page():
+    from explorer.app import ExplorerApp
+
+    state = ExplorerState()
+    scene = json.loads(json.dumps(PRESETS["uniform_flat"]))
+    scene["name"] = "x" * (MAX_NAME_CHARS + 1)
+    with pytest.raises(ValueError, match="name: at most 200 characters, got 201"):
+        state.load_scene(scene)
+    app = ExplorerApp(executor=None)
+    before = app.state.scene_name
+    app.scene_name.value = "y" * 100_000
+    assert app.state.scene_name == before and app.scene_name.value == before
+    assert "at most 200 characters" in app.notice and "yyyy" not in app.notice
+    app.description.value = "z" * 5000
+    assert "at most 4000 characters" in app.notice
+
+
+def test_other_creep_model_without_a_file_is_never_solved_as_elastic():
+    from explorer.app import ExplorerApp
+
+    state, controller = solved("eccentric_creep")
+    shown = controller.view
+    state.base.creep_model = "custom"                    # nothing from a file to use
+    controller.request()
+    assert "base.creep" in controller.error and "from a scene file" in controller.error
+    assert controller.view is shown
+    app = ExplorerApp(executor=None)
+    assert "other model (from file)" not in app.creep_model.options
+    scene = json.loads(json.dumps(PRESETS["eccentric_creep"]))
+    creep = scene["base"]["creep"]
+    scene["base"]["creep"] = {"model": "prony", "modulus": creep["modulus_final"],
+                              "terms": [{"compliance": 1e-11, "rate": 0.03}]}
+    assert app.load_scene(scene), app.notice  # a model the screen does not offer ...
+    assert app.state.base.creep_model == "custom"  # ... is kept and offered by name
+    assert "other model (from file)" in app.creep_model.options
+    assert app.controller.view.scene["base"]["creep"]["model"] == "prony"
+
+
+# ------------------------------------------------------------------ messages
+class _Never(Executor):
+    """An executor that accepts work and never runs it (a solve that takes forever)."""
+
+    def submit(self, fn, /, *args, **kwargs):  # noqa: ANN001
+        return Future()
+
+
+def test_a_slow_first_solve_says_so_and_a_failure_claims_no_last_result():
+    from explorer.app import ExplorerApp
+    from explorer.workers import WorkerFailed
+
+    slow = json.loads(json.dumps(PRESETS["eccentric_creep"]))
+    slow["times"] = {"end": 1000.0, "count": 77, "spacing": "log"}  # in no cache
+    app = ExplorerApp(scene=slow, executor=_Never())
+    assert app.controller.view is None and "first time" in app.status.object
+
+    def lost(scene):
+        raise WorkerFailed("the worker process died")
+
+    app = ExplorerApp(scene=slow, executor=None, solve=lost)
+    assert app.controller.view is None or app.notice  # the default scene may stand in
+    if app.controller.view is None:
+        assert "last good result" not in app.alert.object
+        assert "no result to show yet" in app.alert.object
+
+
+def test_the_eccentric_creep_preset_says_what_its_curve_does():
+    """Its text: grows by about half, levels off after about 250 days."""
+    text = PRESETS["eccentric_creep"]["description"]
+    assert "level off after about 250 days" in text and "for years" not in text
+    _, controller = solved("eccentric_creep")
+    view = controller.view
+    d = view.values["settlement"]
+    t = view.times
+    late = d[t >= 250]
+    # measured: +47 % from loading to the end, +0.05 % after day 250
+    assert 1.4 < d[-1] / d[0] < 1.6
+    assert (late[-1] - late[0]) / late[-1] < 0.005
+
+
+def test_the_command_line_shows_the_solver_message_not_a_pointer(tmp_path):
+    scene = json.loads((ROOT / "assets" / "scenes" / "uniform_flat.json").read_text())
+    scene["solver"] = {"tol": 1e-8}
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene))
+    proc = subprocess.run([sys.executable, "-m", "core", "solve", str(path)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=120)
+    assert "warning: tol_not_met" in proc.stderr
+    assert "see info.message" not in proc.stderr and "not met" in proc.stderr
+
+
+# ------------------------------------------------------------------ design check, report
+def test_the_design_check_finds_the_extremes_and_judges_the_limits():
+    from explorer.design import DesignLimits, design_check
+
+    _, controller = solved("eccentric_creep")
+    view = controller.view
+    check = design_check(view)
+    q = view.pressure / 1e3
+    assert check.q_max.value == pytest.approx(float(q.max()))
+    assert check.q_min.value == pytest.approx(float(q.min()))
+    assert check.passed is None  # no limit set
+    # e = M/P of the preset: 1.2e5 N / 8e5 N/m = 0.15 m
+    assert check.eccentricity == pytest.approx(0.15, rel=1e-12)
+    assert check.contact_width == pytest.approx(2.0)  # full contact
+    limits = DesignLimits(allowable_pressure=check.q_max.value * 1.01)
+    assert design_check(view, limits).passed is True
+    limits.allowable_pressure = check.q_max.value * 0.99
+    assert design_check(view, limits).passed is False
+    limits.param.update(allowable_pressure=None, settlement_limit=0.05)  # 0.087 mm reached
+    assert design_check(view, limits).passed is False
+
+
+def test_the_report_holds_inputs_plots_flags_accuracy_and_version():
+    from explorer.exports import project_version
+    from explorer.report import report_html
+
+    _, controller = solved(tol=1e-8)
+    text = report_html(controller.view)
+    assert text.startswith("<!DOCTYPE html>") and text.count("<svg") == 7
+    assert "tol_not_met" in text and "NOT met" in text and project_version() in text
+    assert "Design check" in text and "Inputs" in text and "<script" not in text
+
+
+def test_the_status_speaks_plainly_and_keeps_the_numbers_in_details():
+    from explorer.status import status_html
+
+    state, controller = solved()
+    text = status_html(controller.view, False)
+    assert "accurate to about" in text and "<details" in text and "modes" in text
+    state.loading.histories["force"].value = 651.37  # a force no other test solves
+    controller.request()
+    assert "only the response to the loads was recomputed" in status_html(controller.view, False)
+
+
+# ------------------------------------------------------------------ undo, reset, classical
+def test_undo_and_reset_return_to_earlier_scenes():
+    from explorer.app import ExplorerApp
+
+    app = ExplorerApp(executor=None)
+    start = app.state.to_scene()
+    assert app.undo_button.disabled
+    app.state.loading.histories["force"].value = 600.0
+    app.state.punch.half_width = 1.1
+    assert not app.undo_button.disabled
+    app.undo()
+    assert app.state.punch.half_width == 1.0
+    assert app.state.loading.histories["force"].value == 600.0
+    app.undo()
+    assert app.state.to_scene()["loading"] == start["loading"]
+    app.state.punch.half_width = 1.4
+    app.reset()
+    assert app.state.to_scene() == start
+    assert app.controller.view.scene == start
+
+
+def test_classical_solutions_carry_the_force_and_moment():
+    """The half-space and bearing-rule pressures integrate to P and M (Chebyshev-Gauss
+    for the edge singularity, measured agreement 1e-15; trapezoid rule on 2e5 intervals
+    for the rule, measured 5e-11)."""
+    from numpy.polynomial.chebyshev import chebgauss
+
+    from explorer.classical import EDGE_CAP, bearing_rule_pressure, half_space_pressure
+
+    a, force = 1.2, 5e5
+    x = np.linspace(-a, a, 200_001)
+    for moment in (0.0, 5e4, 2.5e5):  # e = 0, inside and outside the middle third
+        q = bearing_rule_pressure(x, force, moment, a)
+        assert np.trapezoid(q, x) == pytest.approx(force, rel=1e-9)
+        assert np.trapezoid(q * x, x) == pytest.approx(moment, rel=1e-9, abs=1e-3)
+        assert np.all(q >= 0)
+    t, w = chebgauss(64)
+    moment = 5e4
+    q_root = half_space_pressure(a * t, force, moment, a) * np.sqrt(a * a - (a * t) ** 2)
+    # away from the capped edges the formula holds exactly: compare to its closed form
+    inner = np.abs(t) < 0.9
+    closed = (force + 2 * moment * a * t / a**2) / np.pi
+    np.testing.assert_allclose(q_root[inner], closed[inner], rtol=1e-12)
+    assert np.sum(w * closed) * a / a == pytest.approx(force, rel=1e-14)
+    assert np.max(half_space_pressure(x, force, moment, a)) <= EDGE_CAP * force / (2 * a)
