@@ -81,7 +81,9 @@ LIVE_SOLVE_S = 0.030
 BADGES: dict[str, dict[str, tuple[str, str]]] = {
     # group: flag -> (text when raised, text when the check passes)
     "scene": {"thick_coating": ("coating not thin", "coating thin"),
-              "stiff_coating": ("coating stiffer than base", "coating softer than base")},
+              "stiff_coating": ("coating stiffer than base", "coating softer than base"),
+              "model_error": ("coating model error above solver.model_tol",
+                              "coating model within solver.model_tol")},
     "pressure": {"contact_lost": ("contact lost: q < 0 (shaded)", "full contact")},
     "history": {"large_tilt": ("large tilt", "small tilt")},
     "status": {"tol_not_met": ("tolerance not met", ""),

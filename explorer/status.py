@@ -22,10 +22,15 @@ STAGE_WORDS = {
     "modes": "the creep modes",
     "mode_selection": "the choice of modes",
     "time": "the time history",
+    # the default engine's stages (core/prepared.py)
+    "grid": "the grid and the foundation's response",
+    "bordered": "the contact equations",
+    "modal": "the creep modes",
+    "solve": "the response to the loads",
 }
 
 #: Stages a change of the loads alone redoes (in words).
-LOAD_STAGES = {STAGE_WORDS["mode_selection"], STAGE_WORDS["time"]}
+LOAD_STAGES = {STAGE_WORDS["mode_selection"], STAGE_WORDS["time"], STAGE_WORDS["solve"]}
 
 
 def _seconds(value: object) -> float:
