@@ -176,7 +176,7 @@ def test_fitted_stepping_against_product_quadrature():
     answers = []
     for n in (32, 64, 128, 256, 512):
         grid = np.linspace(1.0, end, n + 1)
-        w, _, _ = _trapezoid_solve(plain, problem, grid)
+        w, _, _ = _trapezoid_solve(plain, problem, grid, grid)
         answers.append(w[0, np.searchsorted(grid, times)])
     changes = [np.max(np.abs(a - b)) for a, b in zip(answers[:-1], answers[1:], strict=True)]
     ratios = np.array(changes[:-1]) / np.array(changes[1:])
