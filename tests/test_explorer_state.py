@@ -19,7 +19,6 @@ import param
 import pytest
 
 from core import scene_from_dict, solve
-from core.cache import stage_counts
 from explorer.controller import SolveController, describe_field, format_error
 from explorer.links import decode_scene, encode_scene
 from explorer.presets import presets
@@ -307,20 +306,20 @@ def test_format_error_names_the_field_in_words():
 # ----------------------------------------------------------------- caching of stages
 
 
-def test_moving_a_load_reuses_every_geometric_stage():
+def test_moving_a_load_reuses_every_geometric_stage(stage_evaluations):
     state = small(ExplorerState())
     state.load_scene(PRESETS["eccentric_creep"])
     state.time_count = 8
     controller = SolveController(state, executor=None)
     controller.request()
     first = controller.view
-    before = stage_counts()
+    before = stage_evaluations()
     for q in GEOMETRIC_STAGES:
         assert q in before, f"stage {q!r} is not counted by core.cache"
 
     for force in (700.0, 720.0, 740.0):
         state.loading.histories["force"].value = force
-    after = stage_counts()
+    after = stage_evaluations()
     view = controller.view
     assert view is not first and controller.error == ""
     assert view.values["force"][0] == pytest.approx(740e3)
@@ -332,7 +331,7 @@ def test_moving_a_load_reuses_every_geometric_stage():
 
     # a change of geometry does evaluate again (the counter is live)
     state.base.thickness = 5.0
-    assert sum(stage_counts()[q] for q in GEOMETRIC_STAGES) > sum(
+    assert sum(stage_evaluations()[q] for q in GEOMETRIC_STAGES) > sum(
         after[q] for q in GEOMETRIC_STAGES)
 
 

@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
-from core.cache import stage_counts
 from core.creep import creep_model_from_spec
 from core.scene import (
     MAX_SCENE_BYTES,
@@ -400,17 +399,17 @@ def test_flag_large_tilt():
     assert result.tilt[0] == 0.015
 
 
-def test_a_load_change_reuses_every_cached_stage():
+def test_a_load_change_reuses_every_cached_stage(stage_evaluations):
     """The conversion builds equal callables for equal scenes, so the solver's stage caches
     (keyed on sampled values) hit when only the loads change."""
     d = json.loads((SCENES_DIR / "patched_insert.json").read_text())
     d["times"] = [0.0, 100.0]
     solve(d)
-    before = stage_counts()
+    before = stage_evaluations()
     d["loading"]["settlement"] = 4e-5
     d["loading"]["tilt"] = 1e-5
     result = solve(scene_from_dict(d))
-    after = stage_counts()
+    after = stage_evaluations()
     # the mode count is chosen per load, so only the stages before it must be reused
     stages = ("panels", "operator", "basis", "galerkin")
     assert [after[k] - before[k] for k in stages] == [0, 0, 0, 0]
@@ -617,4 +616,3 @@ def test_scene_types():
     assert scene.statement == 4 and scene.given == {"force", "moment"}
     assert math.isclose(scene.modulus_at_loading(), 3e10)
     assert not scene.times.flags.writeable
-    assert SceneSolution.__name__ == "SceneSolution"
