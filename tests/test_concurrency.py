@@ -9,6 +9,7 @@ result on screen, also while a newer solve runs.
 
 from __future__ import annotations
 
+import asyncio
 import copy
 import json
 import random
@@ -329,7 +330,8 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
             assert gate.wait(120)
         return solve(scene)
 
-    pool = ThreadPoolExecutor(max_workers=1)
+    # two threads: a download is work of the pool too, and here the solve holds one
+    pool = ThreadPoolExecutor(max_workers=2)
     try:
         scene = small(PRESETS["uniform_flat"], count=5)
         app = ExplorerApp(scene=scene, solve=gated, executor=pool)
@@ -338,10 +340,10 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
         assert shown is app.controller.view
 
         def check_downloads_match(view: Any) -> None:
-            rows = app._csv_file().getvalue().strip().splitlines()
+            rows = asyncio.run(app._csv_file()).getvalue().strip().splitlines()
             assert rows[0] == "time_day,settlement_m,tilt_rad,force_N_per_m,moment_N"
             table = np.array([[float(v) for v in row.split(",")] for row in rows[1:]])
-            result = json.loads(app._json_file().getvalue())
+            result = json.loads(asyncio.run(app._json_file()).getvalue())
             saved = json.loads(app._scene_file().getvalue())
             assert saved == view.scene
             assert scene_from_dict(saved) == scene_from_dict(result["scene"])
@@ -357,7 +359,7 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
             q_file = np.asarray(result["pressure"])[:, index]
             np.testing.assert_allclose(q_file / unit, app.figures.q_src.data["q"],
                                        rtol=1e-15, atol=0)
-            long = app._pressure_file().getvalue().strip().splitlines()
+            long = asyncio.run(app._pressure_file()).getvalue().strip().splitlines()
             assert len(long) == 1 + len(result["times"]) * len(result["x"])
 
         check_downloads_match(shown)
@@ -367,13 +369,13 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
         assert started.wait(60)
         assert app.controller.busy and app._drawn is shown
         check_downloads_match(shown)
-        table = app._csv_file().getvalue().strip().splitlines()
+        table = asyncio.run(app._csv_file()).getvalue().strip().splitlines()
         assert float(table[1].split(",")[3]) == old_force
         gate.set()
         assert app.controller.wait(120)
         assert app._drawn is app.controller.view and app._drawn is not shown
         check_downloads_match(app._drawn)
-        table = app._csv_file().getvalue().strip().splitlines()
+        table = asyncio.run(app._csv_file()).getvalue().strip().splitlines()
         assert float(table[1].split(",")[3]) == pytest.approx(650e3, rel=1e-12)
     finally:
         gate.set()

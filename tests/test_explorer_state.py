@@ -7,6 +7,7 @@ result; a change of the load re-solves without re-evaluating any geometric stage
 
 from __future__ import annotations
 
+import asyncio
 import json
 import math
 import threading
@@ -478,7 +479,7 @@ def test_app_widgets_follow_and_drive_the_state():
     # downloads hold what is on screen
     assert app._scene_file().getvalue().strip().startswith("{")
     assert json.loads(app._scene_file().getvalue()) == view.scene
-    assert app._csv_file().getvalue().startswith("time_day")
+    assert asyncio.run(app._csv_file()).getvalue().startswith("time_day")
 
 
 # ------------------------------------------------------------------ pressure shading

@@ -135,29 +135,49 @@ def test_the_stage_cache_budget_is_shared_in_proportion() -> None:
     assert {cache.name: cache.max_bytes for cache in solver._STAGES} == default
 
 
+def release(gate: Path, wait_until: Any) -> None:
+    """Let the worker waiting on the named pipe ``gate`` go: opening the pipe for writing
+    succeeds once a reader has it open (a worker killed and replaced opens it again)."""
+    def opened() -> bool:
+        try:
+            os.close(os.open(gate, os.O_WRONLY | os.O_NONBLOCK))
+        except OSError:  # no reader yet
+            return False
+        return True
+
+    assert wait_until(opened, timeout=60)
+
+
 @contextlib.contextmanager
-def held_worker(processes: SolverProcesses, lane: int,
-                tmp_path: Path) -> Iterator[threading.Thread]:
+def held_worker(processes: SolverProcesses, lane: int, tmp_path: Path,
+                wait_until: Any) -> Iterator[tuple[threading.Thread, list[Any]]]:
     """A request in ``lane``'s worker that lasts until the block ends: the worker opens a
-    named pipe for reading, which returns only once this side opens it for writing."""
+    named pipe for reading, which returns only once this side opens it for writing. Yields
+    the thread waiting for the request and the list receiving its outcome."""
     gate = tmp_path / f"gate-{lane}"
     os.mkfifo(gate)
-    request = threading.Thread(target=processes.run, args=(lane, os.open, str(gate),
-                                                            os.O_RDONLY))
-    request.start()
+    outcome: list[Any] = []
+
+    def request() -> None:
+        try:
+            outcome.append(processes.run(lane, os.open, str(gate), os.O_RDONLY))
+        except WorkerFailed as exc:
+            outcome.append(exc)
+
+    waiting = threading.Thread(target=request)
+    waiting.start()
     try:
-        yield request
+        yield waiting, outcome
     finally:
-        # the worker is (or will be) waiting on the pipe: opening it releases the worker
-        fd = os.open(gate, os.O_WRONLY)
-        os.close(fd)
-        request.join(60)
+        if waiting.is_alive():
+            release(gate, wait_until)
+        waiting.join(60)
 
 
 def test_a_slow_solve_holds_up_another_session_by_the_spill_time_only(processes, tmp_path,
                                                                        wait_until) -> None:
     pids = [info["pid"] for info in processes.run_everywhere(worker_info)]
-    with held_worker(processes, 0, tmp_path) as slow:
+    with held_worker(processes, 0, tmp_path, wait_until) as (slow, _):
         assert wait_until(lambda: processes._lanes[0].busy)
         # lane 0 is held until the block ends: a request for it takes the idle lane 1
         # (after SPILL_AFTER_S), while the slow one is still there
@@ -169,37 +189,44 @@ def test_a_slow_solve_holds_up_another_session_by_the_spill_time_only(processes,
     assert processes.run(0, os.getpid) == pids[0]  # back to its own lane once free
 
 
-def test_a_worker_killed_during_a_solve_is_replaced(wait_until) -> None:
+def test_a_request_whose_worker_is_killed_runs_again_on_a_new_one(tmp_path,
+                                                                   wait_until) -> None:
     pool = SolverProcesses(1, 64 * 2**20)
     try:
         first = pool.start()[0]["pid"]
-        outcome: list[Any] = []
+        with held_worker(pool, 0, tmp_path, wait_until) as (waiting, outcome):
+            assert wait_until(lambda: pool._lanes[0].busy)
+            os.kill(first, signal.SIGKILL)
+            # the death is noticed at once and the request given to a new worker
+            assert wait_until(lambda: pool.pids() not in ([], [first]), timeout=60)
+            release(tmp_path / "gate-0", wait_until)
+            waiting.join(60)
+        assert len(outcome) == 1 and isinstance(outcome[0], int), outcome  # answered
+        assert pool.run(0, os.getpid) not in (first,)
+    finally:
+        pool.shutdown()
 
-        def sleep_there() -> None:
-            try:
-                outcome.append(pool.run(0, time.sleep, 30.0))
-            except WorkerFailed as exc:
-                outcome.append(exc)
 
-        waiting = threading.Thread(target=sleep_there)
-        waiting.start()
-        assert wait_until(lambda: pool._lanes[0].busy)
-        os.kill(first, signal.SIGKILL)
-        waiting.join(30)
-        assert isinstance(outcome[0], WorkerFailed)
-        assert "stopped during this solve" in str(outcome[0])
-        second = pool.run(0, os.getpid)
-        assert second != first
-        # killed while idle: nothing was lost, so the next request is simply served by a
-        # new worker (or, if the death was not yet noticed, refused once with a message)
-        os.kill(second, signal.SIGKILL)
-        assert wait_until(lambda: gone(second))
-        try:
-            third = pool.run(0, os.getpid)
-        except WorkerFailed as exc:
-            assert "stopped" in str(exc)
-            third = pool.run(0, os.getpid)
+def test_a_request_whose_worker_dies_twice_is_answered_with_a_message(tmp_path,
+                                                                      wait_until) -> None:
+    pool = SolverProcesses(1, 64 * 2**20)
+    try:
+        first = pool.start()[0]["pid"]
+        with held_worker(pool, 0, tmp_path, wait_until) as (waiting, outcome):
+            assert wait_until(lambda: pool._lanes[0].busy)
+            os.kill(first, signal.SIGKILL)
+            assert wait_until(lambda: pool.pids() not in ([], [first]), timeout=60)
+            second = pool.pids()[0]
+            os.kill(second, signal.SIGKILL)
+            waiting.join(60)
+        assert len(outcome) == 1 and isinstance(outcome[0], WorkerFailed), outcome
+        assert "stopped during this solve twice" in str(outcome[0])
+        # killed while idle: nothing was lost, the next request is served by a new worker
+        third = pool.run(0, os.getpid)
         assert third not in (first, second)
+        os.kill(third, signal.SIGKILL)
+        assert wait_until(lambda: gone(third))
+        assert pool.run(0, os.getpid) not in (first, second, third)
     finally:
         pool.shutdown()
 
