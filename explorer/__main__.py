@@ -66,6 +66,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--solver-threads", type=int, default=2,
                         help="with --solver-processes 0: threads solving scenes, shared by "
                              "all sessions (default 2)")
+    parser.add_argument("--session-linger", type=float, default=15.0, metavar="SECONDS",
+                        help="how long a page's session is kept after its connection is "
+                             "lost, for the page to reconnect, before everything it holds "
+                             "is given back (default 15)")
     return parser
 
 
@@ -74,6 +78,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     import panel as pn
 
+    from explorer import closed_pages
     from explorer.app import create_app, warm_up
     from explorer.controller import shared_pool, use_worker_processes, worker_processes
     from explorer.presets import ORDER
@@ -82,6 +87,10 @@ def main(argv: list[str] | None = None) -> int:
         print("--solver-processes must be 0 or more and --solver-threads 1 or more",
               file=sys.stderr)
         return 2
+    if not 0.5 <= args.session_linger <= 3600:
+        print("--session-linger must be between 0.5 and 3600 seconds", file=sys.stderr)
+        return 2
+    closed_pages.install()  # a tab closed abruptly is a debug line, not a traceback
     if args.solver_processes:
         print(f"Starting {args.solver_processes} solver process(es)...", file=sys.stderr,
               flush=True)
@@ -103,13 +112,16 @@ def main(argv: list[str] | None = None) -> int:
               "--allow-websocket-origin)", file=sys.stderr, flush=True)
     print(f"Serving the explorer at http://{args.address}:{args.port}/app", file=sys.stderr,
           flush=True)
+    linger_ms = int(args.session_linger * 1000)
     # SIGTERM (a service manager, a test harness) ends the server like Ctrl+C: the event
     # loop unwinds and the worker processes are stopped in order.
     previous = signal.signal(signal.SIGTERM, _stop_on_sigterm)
     try:
         pn.serve({"app": create_app}, port=args.port, address=args.address, show=args.show,
                  websocket_origin=origins, title="Coated punch explorer", threaded=False,
-                 liveness=True, start=True, websocket_max_message_size=WEBSOCKET_MAX_BYTES)
+                 liveness=True, start=True, websocket_max_message_size=WEBSOCKET_MAX_BYTES,
+                 unused_session_lifetime_milliseconds=linger_ms,
+                 check_unused_sessions_milliseconds=linger_ms)
     except KeyboardInterrupt:
         pass
     finally:

@@ -7,6 +7,7 @@ controller); every number the user sets lives in :class:`~explorer.state.Explore
 
 from __future__ import annotations
 
+import asyncio
 import html
 import io
 import json
@@ -22,7 +23,7 @@ from panel.io.state import set_curdoc
 from core.profiles import MAX_TABLE_BYTES
 from core.scene import MAX_SCENE_BYTES
 
-from . import exports, gc_policy
+from . import closed_pages, exports, gc_policy
 from .controller import SolveController, format_error, worker_processes
 from .design import DesignLimits, check_html, design_check
 from .links import decode_scene
@@ -222,6 +223,11 @@ class ExplorerApp(pn.viewable.Viewer):
             # a slow first solve (a link to a long history): say so, not a blank page
             self.status.object = status_html(None, True)
         self._initializing = False
+
+    def page_parts(self) -> list[Any]:
+        """Every viewable of the page: the layout and the sidebar tabs not filled yet."""
+        return [self._layout] + [obj for _, objects in self._deferred_tabs.values()
+                                 for obj in objects]
 
     # -- plumbing --------------------------------------------------------------------
     @property
@@ -852,7 +858,8 @@ class ExplorerApp(pn.viewable.Viewer):
         if self._deferred_tabs:
             self._later(self._fill_idle_tab, 0)
         elif self._served:
-            gc_policy.page_built()  # the page is complete; it lives as long as the session
+            # the page is complete; it lives as long as the session
+            gc_policy.page_built(getattr(self._doc, "session_context", None))
 
     def _later(self, callback: Callable[[], None], delay_ms: float) -> None:
         """Run ``callback`` on this session's event loop after ``delay_ms`` [ms]."""
@@ -1052,12 +1059,15 @@ class ExplorerApp(pn.viewable.Viewer):
         scene = view.scene if view is not None else self.state.to_scene()
         return io.StringIO(json.dumps(scene, indent=2) + "\n")
 
-    def _download(self, kind: str, empty: str) -> io.StringIO:
+    async def _download(self, kind: str, empty: str) -> io.StringIO:
+        # awaited, not waited for: the worker's answer must not hold the event loop, and
+        # with it every page of the server
         view = self._shown()
         if view is None:
             return io.StringIO(empty)
         try:
-            return io.StringIO(self.controller.download(view, kind))
+            return io.StringIO(await asyncio.wrap_future(
+                self.controller.download_later(view, kind)))
         except Exception as exc:
             # no file is better than a wrong one; say why on the page
             self.alert.object = f"**Download failed:** {html.escape(str(exc))}"
@@ -1074,8 +1084,8 @@ class ExplorerApp(pn.viewable.Viewer):
             return io.StringIO("")
         return io.StringIO(exports.pressure_csv(view, self.scales.pressure_unit(view)))
 
-    def _json_file(self) -> io.StringIO:
-        return self._download("to_json", "{}")
+    async def _json_file(self) -> io.StringIO:
+        return await self._download("to_json", "{}")
 
 
 def warm_up(keys: tuple[str, ...] = (DEFAULT_PRESET,)) -> None:
@@ -1118,4 +1128,7 @@ def create_app(**kwargs: Any) -> ExplorerApp:
         pn.state.on_session_destroyed(gc_policy.session_ended)
     if "query" not in kwargs:
         kwargs["query"] = _query_from_session()
-    return ExplorerApp(**kwargs)
+    app = ExplorerApp(**kwargs)
+    if served:
+        pn.state.on_session_destroyed(closed_pages.page_releaser(app.page_parts))
+    return app

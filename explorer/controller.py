@@ -23,7 +23,7 @@ import json
 import logging
 import threading
 from collections.abc import Callable, Mapping
-from concurrent.futures import Executor, ThreadPoolExecutor
+from concurrent.futures import Executor, Future, ThreadPoolExecutor
 from dataclasses import fields, is_dataclass, replace
 from typing import Any
 
@@ -321,6 +321,19 @@ class SolveController(param.Parameterized):
         if self._processes is not None:
             return self._processes.run(self._lane, download_text, view.scene, kind, view.info)
         return solution_text(self._solve(view.scene), kind, view.info)
+
+    def download_later(self, view: ResultView, kind: str) -> Future[str]:
+        """:meth:`download` off the calling thread: a future of the text, done when the
+        worker has answered (at once where solves run in the caller). The server's event
+        loop awaits it (``asyncio.wrap_future``) and keeps serving every page meanwhile."""
+        if self._executor is None:
+            done: Future[str] = Future()
+            try:
+                done.set_result(self.download(view, kind))
+            except Exception as exc:
+                done.set_exception(exc)
+            return done
+        return self._executor.submit(self.download, view, kind)
 
     def wait(self, timeout: float = 60.0) -> bool:
         """Block until the newest request has been delivered (for scripts and tests)."""

@@ -9,6 +9,7 @@ result on screen, also while a newer solve runs.
 
 from __future__ import annotations
 
+import asyncio
 import copy
 import json
 import random
@@ -329,7 +330,8 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
             assert gate.wait(120)
         return solve(scene)
 
-    pool = ThreadPoolExecutor(max_workers=1)
+    # two threads: a download is work of the pool too, and here the solve holds one
+    pool = ThreadPoolExecutor(max_workers=2)
     try:
         scene = small(PRESETS["uniform_flat"], count=5)
         app = ExplorerApp(scene=scene, solve=gated, executor=pool)
@@ -344,7 +346,7 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
             # 10 significant digits; the JSON the solver's SI numbers in full
             _, names, table = parse_csv(app._csv_file().getvalue())
             assert names[:4] == ["time_day", "settlement_mm", "tilt_mrad", "force_kN_per_m"]
-            result = json.loads(app._json_file().getvalue())
+            result = json.loads(asyncio.run(app._json_file()).getvalue())
             saved = json.loads(app._scene_file().getvalue())
             assert saved == view.scene
             assert scene_from_dict(saved) == scene_from_dict(result["scene"])

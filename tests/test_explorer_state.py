@@ -306,7 +306,7 @@ def test_format_error_names_the_field_in_words():
 # ----------------------------------------------------------------- caching of stages
 
 
-def test_moving_a_load_reuses_every_geometric_stage():
+def test_moving_a_load_reuses_every_geometric_stage(stage_evaluations):
     state = small(ExplorerState())
     state.load_scene(PRESETS["eccentric_creep"])
     state.time_count = 8

@@ -7,6 +7,7 @@ six messages and 17 data sources per load step before, two and 6 after).
 
 from __future__ import annotations
 
+import weakref
 from typing import Any
 
 import numpy as np
@@ -206,21 +207,46 @@ def test_a_complete_page_is_frozen_out_of_the_collectors_reach(served_app, monke
 
     app, timers = served_app
     frozen: list[int] = []
-    monkeypatch.setattr(gc_policy, "page_built", lambda: frozen.append(1))
+    monkeypatch.setattr(gc_policy, "page_built", lambda context=None: frozen.append(1))
     app._on_load()
     while timers.pending and not frozen:  # the tabs are filled one by one
         timers.run()
     assert frozen == [1] and not app._deferred_tabs
     try:
         monkeypatch.undo()
-        gc_policy.page_built()
+        assert gc_policy.page_built()
         assert gc.get_freeze_count() > 0
-        cycle: list[Any] = []
-        cycle.append(cycle)
+
+        class Node:
+            pass
+
+        cycle = Node()
+        cycle.me = cycle
+        alive = weakref.ref(cycle)
+        gc.freeze()  # the cycle is among the frozen objects, as a closed page's are
         del cycle
-        gc_policy.session_ended(None)
+        assert gc.collect() == 0 or alive() is not None  # out of reach while frozen
+        gc_policy.session_ended(None)  # no event loop here: collected at once
+        assert alive() is None  # freed by the full collection
+        assert gc.get_freeze_count() > 0  # the pages still open are frozen again
+    finally:
+        gc.unfreeze()
+
+
+def test_a_page_completed_after_its_session_ended_is_not_frozen() -> None:
+    """Frozen, a closed page would never be freed (rounds of 50 dropped sessions grew the
+    server by ~350 MiB each, none returned)."""
+    import gc
+
+    from explorer import gc_policy
+
+    class Ended:
+        destroyed = True
+
+    try:
+        gc.unfreeze()
+        assert not gc_policy.page_built(Ended())
         assert gc.get_freeze_count() == 0
-        assert gc.collect() >= 1  # the cycle made after the freeze is still found
     finally:
         gc.unfreeze()
 

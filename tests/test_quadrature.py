@@ -24,11 +24,11 @@ def test_log_moments_at_panel_ends_are_exact(z):
 @pytest.mark.parametrize("z", [-3.0, -1.2, -0.7, 0.0, 0.31, 0.999, 1.04, 2.5])
 def test_log_moments_match_mpmath(z):
     """Against mpmath quadrature (25 digits), split at the log point."""
-    mpmath.mp.dps = 25
     got = legendre_log_moments(np.array([z]), 15)[0]
     for k in (0, 1, 2, 7, 15):
         pts = [-1, z, 1] if -1 < z < 1 else [-1, 1]
-        ref = float(mpmath.quad(lambda t, k=k: mpmath.log(abs(mpmath.mpf(z) - t))
-                                * mpmath.legendre(k, t), pts))
+        with mpmath.workdps(25):  # restored on leaving: no precision leaks to other tests
+            ref = float(mpmath.quad(lambda t, k=k: mpmath.log(abs(mpmath.mpf(z) - t))
+                                    * mpmath.legendre(k, t), pts))
         # measured: <= 2.2e-16 (0.31, 0.999, 1.04)
         assert got[k] == pytest.approx(ref, abs=1e-14)

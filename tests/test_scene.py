@@ -629,4 +629,3 @@ def test_scene_types():
     assert scene.statement == 4 and scene.given == {"force", "moment"}
     assert math.isclose(scene.modulus_at_loading(), 3e10)
     assert not scene.times.flags.writeable
-    assert SceneSolution.__name__ == "SceneSolution"

@@ -8,7 +8,7 @@ workers never outlive the server.
 
 from __future__ import annotations
 
-import copy
+import contextlib
 import os
 import signal
 import subprocess
@@ -27,7 +27,6 @@ import explorer.controller as controller_module
 import explorer.workers as workers
 from core import solve, solver
 from explorer.controller import RESULTS, SolveController
-from explorer.presets import DEFAULT_PRESET, presets
 from explorer.results import prepare_view
 from explorer.state import QUANTITIES, ExplorerState
 from explorer.workers import (
@@ -41,14 +40,6 @@ from explorer.workers import (
 pytestmark = pytest.mark.timeout(300)
 
 ROOT = Path(__file__).resolve().parent.parent
-
-
-def small_scene(force: float = 400.0) -> dict[str, Any]:
-    scene = copy.deepcopy(presets()[DEFAULT_PRESET])
-    scene["times"] = {"end": 200.0, "count": 6, "spacing": "log"}
-    scene["solver"] = {"tol": 1e-5}
-    scene["loading"]["force"] = {"kind": "constant", "value": force * 1e3}
-    return scene
 
 
 @pytest.fixture(scope="module")
@@ -68,17 +59,8 @@ def gone(pid: int) -> bool:
         return True
 
 
-def wait_until(condition: Any, timeout: float = 20.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if condition():
-            return True
-        time.sleep(0.05)
-    return False
-
-
-def test_a_view_solved_in_a_worker_is_the_view_solved_here(processes) -> None:
-    scene = small_scene()
+def test_a_view_solved_in_a_worker_is_the_view_solved_here(processes, small_preset) -> None:
+    scene = small_preset(force_kN=400.0)
     there = processes.run(0, solve_view, scene)
     here = prepare_view(solve(scene), scene)
     for q in QUANTITIES:
@@ -113,8 +95,9 @@ def test_downloads_from_a_worker_hold_the_numbers_on_screen(processes, monkeypat
         download_text(view.scene, "to_pickle")
 
 
-def test_a_bad_scene_from_a_worker_names_its_field(processes, monkeypatch) -> None:
-    scene = small_scene()
+def test_a_bad_scene_from_a_worker_names_its_field(processes, monkeypatch,
+                                                  small_preset) -> None:
+    scene = small_preset(force_kN=400.0)
     scene["coating"][0]["thickness"] = {"kind": "constant", "value": -0.01}
     with pytest.raises(ValueError, match=r"coating\[0\]\.thickness"):
         processes.run(0, solve_view, scene)
@@ -152,63 +135,103 @@ def test_the_stage_cache_budget_is_shared_in_proportion() -> None:
     assert {cache.name: cache.max_bytes for cache in solver._STAGES} == default
 
 
-def test_a_slow_solve_holds_up_another_session_by_the_spill_time_only(processes) -> None:
-    pids = [info["pid"] for info in processes.run_everywhere(worker_info)]
-    slow = threading.Thread(target=processes.run, args=(0, time.sleep, 3.0))
-    slow.start()
+def release(gate: Path, wait_until: Any) -> None:
+    """Let the worker waiting on the named pipe ``gate`` go: opening the pipe for writing
+    succeeds once a reader has it open (a worker killed and replaced opens it again)."""
+    def opened() -> bool:
+        try:
+            os.close(os.open(gate, os.O_WRONLY | os.O_NONBLOCK))
+        except OSError:  # no reader yet
+            return False
+        return True
+
+    assert wait_until(opened, timeout=60)
+
+
+@contextlib.contextmanager
+def held_worker(processes: SolverProcesses, lane: int, tmp_path: Path,
+                wait_until: Any) -> Iterator[tuple[threading.Thread, list[Any]]]:
+    """A request in ``lane``'s worker that lasts until the block ends: the worker opens a
+    named pipe for reading, which returns only once this side opens it for writing. Yields
+    the thread waiting for the request and the list receiving its outcome."""
+    gate = tmp_path / f"gate-{lane}"
+    os.mkfifo(gate)
+    outcome: list[Any] = []
+
+    def request() -> None:
+        try:
+            outcome.append(processes.run(lane, os.open, str(gate), os.O_RDONLY))
+        except WorkerFailed as exc:
+            outcome.append(exc)
+
+    waiting = threading.Thread(target=request)
+    waiting.start()
     try:
-        time.sleep(0.3)  # the slow request is in lane 0's worker
-        t0 = time.monotonic()
-        pid = processes.run(0, os.getpid)
-        waited = time.monotonic() - t0
-        # it waited for its own lane for SPILL_AFTER_S, then took the idle one; 3 s of
-        # sleep minus 0.3 s would remain in lane 0
-        assert pid == pids[1]
-        assert workers.SPILL_AFTER_S - 0.01 <= waited < 2.0
-        t0 = time.monotonic()
-        assert processes.run(1, os.getpid) == pids[1]  # an idle own lane: no waiting
-        assert time.monotonic() - t0 < 2.0
+        yield waiting, outcome
     finally:
-        slow.join()
+        if waiting.is_alive():
+            release(gate, wait_until)
+        waiting.join(60)
+
+
+def test_a_slow_solve_holds_up_another_session_by_the_spill_time_only(processes, tmp_path,
+                                                                       wait_until) -> None:
+    pids = [info["pid"] for info in processes.run_everywhere(worker_info)]
+    with held_worker(processes, 0, tmp_path, wait_until) as (slow, _):
+        assert wait_until(lambda: processes._lanes[0].busy)
+        # lane 0 is held until the block ends: a request for it takes the idle lane 1
+        # (after SPILL_AFTER_S), while the slow one is still there
+        assert processes.run(0, os.getpid) == pids[1]
+        assert slow.is_alive()
+        assert processes.run(1, os.getpid) == pids[1]  # an idle own lane
+        assert slow.is_alive()
+    assert not slow.is_alive()
     assert processes.run(0, os.getpid) == pids[0]  # back to its own lane once free
 
 
-def test_a_worker_killed_during_a_solve_is_replaced() -> None:
+def test_a_request_whose_worker_is_killed_runs_again_on_a_new_one(tmp_path,
+                                                                   wait_until) -> None:
     pool = SolverProcesses(1, 64 * 2**20)
     try:
         first = pool.start()[0]["pid"]
-        outcome: list[Any] = []
-
-        def sleep_there() -> None:
-            try:
-                outcome.append(pool.run(0, time.sleep, 30.0))
-            except WorkerFailed as exc:
-                outcome.append(exc)
-
-        waiting = threading.Thread(target=sleep_there)
-        waiting.start()
-        time.sleep(0.5)
-        os.kill(first, signal.SIGKILL)
-        waiting.join(30)
-        assert isinstance(outcome[0], WorkerFailed)
-        assert "stopped during this solve" in str(outcome[0])
-        second = pool.run(0, os.getpid)
-        assert second != first
-        # killed while idle: nothing was lost, so the next request is simply served by a
-        # new worker (or, if the death was not yet noticed, refused once with a message)
-        os.kill(second, signal.SIGKILL)
-        assert wait_until(lambda: gone(second))
-        try:
-            third = pool.run(0, os.getpid)
-        except WorkerFailed as exc:
-            assert "stopped" in str(exc)
-            third = pool.run(0, os.getpid)
-        assert third not in (first, second)
+        with held_worker(pool, 0, tmp_path, wait_until) as (waiting, outcome):
+            assert wait_until(lambda: pool._lanes[0].busy)
+            os.kill(first, signal.SIGKILL)
+            # the death is noticed at once and the request given to a new worker
+            assert wait_until(lambda: pool.pids() not in ([], [first]), timeout=60)
+            release(tmp_path / "gate-0", wait_until)
+            waiting.join(60)
+        assert len(outcome) == 1 and isinstance(outcome[0], int), outcome  # answered
+        assert pool.run(0, os.getpid) not in (first,)
     finally:
         pool.shutdown()
 
 
-def test_a_stuck_worker_is_stopped_and_replaced(monkeypatch) -> None:
+def test_a_request_whose_worker_dies_twice_is_answered_with_a_message(tmp_path,
+                                                                      wait_until) -> None:
+    pool = SolverProcesses(1, 64 * 2**20)
+    try:
+        first = pool.start()[0]["pid"]
+        with held_worker(pool, 0, tmp_path, wait_until) as (waiting, outcome):
+            assert wait_until(lambda: pool._lanes[0].busy)
+            os.kill(first, signal.SIGKILL)
+            assert wait_until(lambda: pool.pids() not in ([], [first]), timeout=60)
+            second = pool.pids()[0]
+            os.kill(second, signal.SIGKILL)
+            waiting.join(60)
+        assert len(outcome) == 1 and isinstance(outcome[0], WorkerFailed), outcome
+        assert "stopped during this solve twice" in str(outcome[0])
+        # killed while idle: nothing was lost, the next request is served by a new worker
+        third = pool.run(0, os.getpid)
+        assert third not in (first, second)
+        os.kill(third, signal.SIGKILL)
+        assert wait_until(lambda: gone(third))
+        assert pool.run(0, os.getpid) not in (first, second, third)
+    finally:
+        pool.shutdown()
+
+
+def test_a_stuck_worker_is_stopped_and_replaced(monkeypatch, wait_until) -> None:
     monkeypatch.setattr(workers, "REQUEST_TIMEOUT_S", 1.0)
     pool = SolverProcesses(1, 64 * 2**20)
     try:
@@ -221,7 +244,7 @@ def test_a_stuck_worker_is_stopped_and_replaced(monkeypatch) -> None:
         pool.shutdown()
 
 
-def test_after_shutdown_requests_are_refused_and_workers_are_gone() -> None:
+def test_after_shutdown_requests_are_refused_and_workers_are_gone(wait_until) -> None:
     pool = SolverProcesses(2, 64 * 2**20)
     pids = [info["pid"] for info in pool.start()]
     pool.shutdown()
@@ -231,7 +254,7 @@ def test_after_shutdown_requests_are_refused_and_workers_are_gone() -> None:
 
 
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT])
-def test_workers_do_not_outlive_the_server(sig: int) -> None:
+def test_workers_do_not_outlive_the_server(sig: int, wait_until) -> None:
     script = textwrap.dedent("""
         import sys, time
         from explorer.controller import use_worker_processes

@@ -1,0 +1,94 @@
+"""Shared fixtures and scenes of the test suite.
+
+- No state leaks between tests: mpmath's working precision is restored after every test
+  (a test that needs more digits uses ``mpmath.workdps``), and stage evaluations are
+  counted from a fixture that starts from empty stage caches (:func:`stage_evaluations`),
+  so a count does not depend on which tests ran before.
+- Tests wait on conditions, never on the clock: :func:`wait_until` polls a condition and
+  returns False when a generous bound runs out (a failure bound, not a measurement).
+- Scenes: the dimensionless benchmark problems come from ``benchmarks/scenes.py`` (one
+  definition for the benchmarks and the tests); :func:`small_preset` is a preset of the
+  explorer cut to a few output times, for tests that need a quick real solve.
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import mpmath
+import pytest
+
+from benchmarks import scenes as benchmark_scenes
+
+
+def wait_until(condition: Callable[[], Any], timeout: float = 30.0,
+               every: float = 0.02) -> bool:
+    """True as soon as ``condition()`` is true; False if it is not within ``timeout`` [s]."""
+    deadline = time.monotonic() + timeout
+    while True:
+        if condition():
+            return True
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(every)
+
+
+@pytest.fixture(name="wait_until")
+def wait_until_fixture() -> Callable[..., bool]:
+    """:func:`wait_until` for the tests: ``assert wait_until(lambda: done, timeout=60)``."""
+    return wait_until
+
+
+@pytest.fixture(autouse=True)
+def _mpmath_precision_restored() -> Iterator[None]:
+    saved = mpmath.mp.prec
+    yield
+    mpmath.mp.prec = saved
+
+
+@pytest.fixture
+def stage_evaluations() -> Callable[[], dict[str, int]]:
+    """Evaluations of each solver stage since the test began, from empty stage caches.
+
+    The caches are process-wide; emptied here, a test's counts are those of its own
+    solves, whatever ran before it.
+    """
+    from core.cache import clear_caches, stage_counts
+
+    clear_caches()
+    start = stage_counts()
+
+    def since_start() -> dict[str, int]:
+        return {name: count - start.get(name, 0) for name, count in stage_counts().items()}
+
+    return since_start
+
+
+@pytest.fixture(scope="session")
+def scenes() -> Any:
+    """The benchmark problems' module (``benchmarks/scenes.py``): ``smooth_m``,
+    ``jump_m``, ``stepped_g``, ``CONCRETE``, ``suite()`` ..."""
+    return benchmark_scenes
+
+
+def small_preset_scene(key: str | None = None, count: int = 6, tol: float = 1e-5,
+                       force_kN: float | None = None) -> dict[str, Any]:
+    """A preset of the explorer (the default one if ``key`` is None) with ``count`` output
+    times over 200 days, tolerance ``tol`` and, if given, a constant force [kN/m]."""
+    from explorer.presets import DEFAULT_PRESET, presets
+
+    scene = copy.deepcopy(presets()[key or DEFAULT_PRESET])
+    scene["times"] = {"end": 200.0, "count": count, "spacing": "log"}
+    scene["solver"] = {"tol": tol}
+    if force_kN is not None:
+        scene["loading"]["force"] = {"kind": "constant", "value": force_kN * 1e3}
+    return scene
+
+
+@pytest.fixture(name="small_preset")
+def small_preset_fixture() -> Callable[..., dict[str, Any]]:
+    """:func:`small_preset_scene` for the tests."""
+    return small_preset_scene
