@@ -702,9 +702,11 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     naming the argument on bad input.
     """
     from core.contact import check_contact_model, solve_unilateral, with_contact_model
+    from core.statements import UnresolvedOperator
 
     t_start = _time.perf_counter()
     contact = check_contact_model(contact)
+    method_defaulted = method is None
     if method is None:
         method = "projection" if (n_modes is not None or basis != "graded") else "nystrom"
     if method not in ("nystrom", "projection"):
@@ -717,10 +719,24 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                                breakpoints=breakpoints, tol=tol)
         if contact == "unilateral":
             return solve_unilateral(**unilateral_args)
-        full = solve_with_prepared(lam, m, g, times, c=c, kernel=kernel,
-                                   settlement=settlement, tilt=tilt, force=force,
-                                   moment=moment, breakpoints=breakpoints, tol=tol,
-                                   time_breaks=time_breaks)
+        try:
+            full = solve_with_prepared(lam, m, g, times, c=c, kernel=kernel,
+                                       settlement=settlement, tilt=tilt, force=force,
+                                       moment=moment, breakpoints=breakpoints, tol=tol,
+                                       time_breaks=time_breaks)
+        except UnresolvedOperator as exc:
+            if not method_defaulted:
+                raise
+            # the symmetric Galerkin projection steps such a scene (positive definite by
+            # construction); say which engine answered and why
+            full = solve_dimensionless(lam, m, g, times, c=c, kernel=kernel,
+                                       settlement=settlement, tilt=tilt, force=force,
+                                       moment=moment, breakpoints=breakpoints, tol=tol,
+                                       method="projection", contact="full",
+                                       time_breaks=time_breaks)
+            full.info["method"] = "projection"
+            full.info["fallback"] = f"default engine declined ({exc}); projection answered"
+            return with_contact_model(full, contact, unilateral_args)
         return with_contact_model(full, contact, unilateral_args)
     inp = _validate(lam, m, g, times, c, kernel,
                     {"settlement": settlement, "tilt": tilt, "force": force, "moment": moment},

@@ -53,6 +53,12 @@ def statement_number(given: frozenset[str]) -> int:
     return STATEMENTS[given]
 
 
+class UnresolvedOperator(ValueError):
+    """The discrete operator has no real, positive spectrum: it cannot be stepped in modal
+    form. Seen with a Nystrom grid on a first-kind limit (no coating, m ~ 1e-15, thin
+    base), where product integration leaves spurious complex eigenvalues near zero."""
+
+
 @dataclass(frozen=True)
 class ModalSystem:
     """The decoupled form of one statement at ``n`` basis functions.
@@ -144,7 +150,7 @@ def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
         scale = float(np.max(np.abs(gamma))) if gamma.size else 1.0
         if gamma.size and (np.max(np.abs(gamma.imag)) > 1e-8 * scale
                            or np.min(gamma.real) <= 0):
-            raise ValueError("operator: eigenvalues not real and positive; the grid does "
+            raise UnresolvedOperator("operator: eigenvalues not real and positive; the grid does "
                              "not resolve the problem")
         gamma, psi = gamma.real, psi.real
         psi_inv = np.linalg.inv(psi)

@@ -6,6 +6,8 @@
   so a count does not depend on which tests ran before.
 - Tests wait on conditions, never on the clock: :func:`wait_until` polls a condition and
   returns False when a generous bound runs out (a failure bound, not a measurement).
+- Property tests draw the same examples on every run (hypothesis profile ``suite``,
+  derandomized); ``HYPOTHESIS_PROFILE=explore`` draws new ones.
 - Scenes: the dimensionless benchmark problems come from ``benchmarks/scenes.py`` (one
   definition for the benchmarks and the tests); :func:`small_preset` is a preset of the
   explorer cut to a few output times, for tests that need a quick real solve.
@@ -14,14 +16,22 @@
 from __future__ import annotations
 
 import copy
+import os
 import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
 import mpmath
 import pytest
+from hypothesis import settings
 
 from benchmarks import scenes as benchmark_scenes
+
+# The suite draws the same examples on every run, so it cannot flake on a rare draw;
+# HYPOTHESIS_PROFILE=explore draws new ones when digging by hand.
+settings.register_profile("suite", derandomize=True, database=None)
+settings.register_profile("explore", derandomize=False)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "suite"))
 
 
 def wait_until(condition: Callable[[], Any], timeout: float = 30.0,

@@ -186,3 +186,28 @@ def test_a_force_step_in_time_is_stepped_exactly_with_its_break():
     assert sol.success, sol.message
     error = np.max(np.abs(sol.settlement - ref.settlement)) / np.max(ref.settlement)
     assert error <= sol.info["error_estimate"] <= 1e-6
+
+
+def test_first_kind_creep_scene_falls_back_to_the_projection():
+    """A scene the property test found: a 100 m footing on a 4 m base (lam = 25) under a
+    coating 1e12 times stiffer than concrete (m ~ 3e-15, a first-kind equation) with creep.
+    The Nystrom matrix then has spurious complex eigenvalues near zero (|Im| ~ 5e-3), so it
+    cannot be stepped in modal form; the default answers with the projection and says so."""
+    from core import scene_from_dict, solve
+
+    scene = {
+        "schema_version": 1, "name": "first kind", "description": "",
+        "punch": {"half_width": 100.0, "shape": 0.0},
+        "coating": [{"thickness": 0.01, "modulus": 5.0e20, "poisson": 0.3}],
+        "base": {"thickness": 4.0, "poisson": 0.2, "age_at_loading": 28.0,
+                 "creep": {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11,
+                           "rate": 0.05}},
+        "loading": {"force": 5.0e5, "moment": 0.0},
+        "times": {"end": 100.0, "count": 3, "spacing": "linear"},
+        "solver": {"tol": 1e-3},
+    }
+    result = solve(scene_from_dict(scene))
+    assert result.info["method"] == "projection"
+    assert "default engine declined" in result.info["fallback"]
+    assert result.info["success"]
+    assert np.all(np.isfinite(result.settlement)) and np.all(np.diff(result.settlement) > 0)
