@@ -32,7 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.polynomial import legendre as npleg
-from scipy.linalg import lu_factor, lu_solve
+from scipy.linalg import lu_factor
+from scipy.linalg.lapack import dgetrs
 
 from core.quadrature import NODES_PER_PANEL, Panels, base_panels, kernel_operator, operator_rows
 
@@ -137,20 +138,25 @@ class StepSolver:
             self._lu = None
         return self._sub
 
+    def _back(self, r: np.ndarray) -> np.ndarray:
+        # LAPACK directly: the checked wrapper costs more than the O(N^2) solve here.
+        x, _ = dgetrs(self._lu[0], self._lu[1], r)
+        return x
+
     def solve(self, build: Callable[[], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
               b: np.ndarray) -> np.ndarray:
         """Solve ``A x = b`` for the matrix ``build()`` whose product is ``apply``."""
         if self._lu is not None:
-            x = lu_solve(self._lu, b, check_finite=False)
-            scale = max(float(np.max(np.abs(b))), 1e-300)
+            scale = max(float(np.abs(b).max()), 1e-300)
+            x = self._back(b)
             for _ in range(self._REFINE_STEPS):
                 r = b - apply(x)
-                if float(np.max(np.abs(r))) <= 1e-13 * scale:
+                if float(np.abs(r).max()) <= 1e-13 * scale:
                     return x
-                x = x + lu_solve(self._lu, r, check_finite=False)
+                x = x + self._back(r)
         self._lu = lu_factor(build(), check_finite=False)
         self.factorizations += 1
-        return lu_solve(self._lu, b, check_finite=False)
+        return self._back(b)
 
 
 def _bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, step: Step,
