@@ -53,11 +53,16 @@ async def _websocket_dropped(host: str, port: int, path: str, way: str,
                              rng: random.Random) -> None:
     from bokeh.protocol import Protocol
     from bokeh.util.token import generate_jwt_token, generate_session_id
+    from tornado.httpclient import HTTPRequest
     from tornado.websocket import websocket_connect
 
     token = generate_jwt_token(generate_session_id())
+    # tornado's own 20 s connect/request limits ran out on a loaded 2-core machine while
+    # the server built other pages; the outer 120 s bound is the one meant
+    request = HTTPRequest(f"ws://{host}:{port}{path}/ws", connect_timeout=120,
+                          request_timeout=120)
     conn = await asyncio.wait_for(
-        websocket_connect(f"ws://{host}:{port}{path}/ws", subprotocols=["bokeh", token],
+        websocket_connect(request, subprotocols=["bokeh", token],
                           max_message_size=512 * 2**20), timeout=120)
     try:
         await _read_message(conn)  # ACK
