@@ -65,3 +65,21 @@ def test_a_change_of_a_fidelity_field_is_a_scene_change(change) -> None:
     change(state)
     assert state.revision == before + 1
     scene_from_dict(state.to_scene())
+
+
+def test_widgets_edit_and_show_the_fidelity_fields() -> None:
+    from explorer.app import ExplorerApp
+
+    app = ExplorerApp(executor=None)
+    view = app.fidelity
+    view.interface.value = "bonded"
+    assert app.state.layers[0].interface == "bonded"
+    view.contact.value = "unilateral"
+    view.model_tol.value = 5.0
+    saved = app.state.to_scene()
+    assert saved["solver"]["contact"] == "unilateral" and saved["solver"]["model_tol"] == 0.05
+    scene = _scene()
+    scene["coating"][0]["interface"] = "smooth"
+    app.state.load_scene(scene)                      # a loaded scene shows its values
+    assert view.interface.value == "smooth"
+    assert view.contact.value == "unilateral" and view.model_tol.value == 5.0
