@@ -74,3 +74,22 @@ def test_fidelity_fields_set_on_the_page_reach_the_saved_scene(page: Page):
     assert saved["coating"][0].get("interface") == "bonded", saved["coating"][0]
     assert saved["solver"] == {**saved["solver"], "contact": "unilateral", "model_tol": 0.05}
     assert page.errors == []
+
+
+def test_liftoff_preset_shades_the_lifted_heel_on_the_page(page: Page):
+    from explorer.presets import preset_label, presets
+
+    key = "eccentric_footing_liftoff"
+    page.open_tab("Scene")
+    page.page.locator(".preset-select select").first.select_option(
+        label=preset_label(key, presets()[key]))
+    # the lifted part arrives as one shaded strip from the left edge of the base
+    page.page.wait_for_function(
+        """() => {
+          const s = Bokeh.documents[0].get_model_by_name('negative_source');
+          return s.data.left.length === 1 && s.data.right[0] > s.data.left[0];
+        }""", timeout=120_000)
+    left = page.page.evaluate(
+        "() => Bokeh.documents[0].get_model_by_name('negative_source').data.left[0]")
+    assert left == pytest.approx(-1.0)   # the base's edge x = -a (a = 1 m in the preset)
+    assert page.errors == []
