@@ -42,3 +42,15 @@ def test_liftoff_preset_shows_its_contact_zone() -> None:
                     for z in view.contact_set)
     assert check.contact_width == pytest.approx(narrowest, rel=1e-12)
     assert check.contact_width < 2 * a
+
+
+def test_design_check_text_gives_the_lift_off_length() -> None:
+    from explorer.design import check_html
+
+    state = ExplorerState()
+    state.load_scene(json.loads(json.dumps(presets()["eccentric_footing_liftoff"])))
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    check = design_check(controller.view)
+    text = check_html(check)
+    assert f"lift-off length {check.full_width - check.contact_width:.4g} m" in text
