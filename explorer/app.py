@@ -351,6 +351,9 @@ class ExplorerApp(pn.viewable.Viewer):
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
                                             variations=False, live_when=live)
         self.layer_note = _html("", styles={"font-size": "12px", "color": "#666"})
+        # model fidelity: layer interface, contact model, coating-model tolerance
+        from explorer.fidelity_view import FidelityView
+        self.fidelity = FidelityView(s, reject)
         s.param.watch(lambda *e: self._refresh_layers(), "n_layers")
         self._refresh_layers()
 
@@ -525,13 +528,14 @@ class ExplorerApp(pn.viewable.Viewer):
                 _html("<small>Layer 1 touches the punch. Changes apply when you release "
                       "a slider.</small>"),
                 self.n_layers, self.layer, self.layer_note, self.thickness_editor.panel,
-                self.modulus_editor.panel, self.poisson_editor.panel, **column)),
+                self.modulus_editor.panel, self.poisson_editor.panel,
+                self.fidelity.interface_panel, **column)),
             ("Base", pn.Column(
                 self.base_thickness, self.base_poisson, self.creep_model, self.base_modulus,
                 self.compliance, self.rate, self.beta, self.alpha, self.aging, self.age,
                 self.creep_note, **column)),
             ("Time", pn.Column(self.time_end, self.time_count, self.time_spacing, self.tol,
-                               **column)),
+                               self.fidelity.solver_panel, **column)),
             ("Check", pn.Column(
                 _html("<small>Limits of the design check (leave empty: not checked). "
                       "The check covers the whole history.</small>"),
@@ -659,6 +663,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.thickness_editor.bind(layer.thickness, a)
         self.modulus_editor.bind(layer.modulus, a)
         self.poisson_editor.bind(layer.poisson, a)
+        self.fidelity.bind_layer(layer)
 
     def _refresh_base(self) -> None:
         model = self.state.base.creep_model

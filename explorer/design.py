@@ -121,10 +121,12 @@ def check_html(check: DesignCheck) -> str:
                     f"<td>{html.escape(c.where)}</td><td>{limit}</td>"
                     f"<td class='{cls}'>{c.verdict if c.limit is not None else ''}</td></tr>")
     share = 100 * check.contact_width / check.full_width if check.full_width else 0.0
+    lift = check.full_width - check.contact_width
+    lifted = f", lift-off length {lift:.4g} m" if lift > 0 else ""
     ecc = ("e = M/P = undefined (P ≤ 0)" if check.eccentricity is None else
            f"e = M/P = {check.eccentricity:.4g} m (B/6 = {check.full_width / 6:.4g} m)")
     return (f"<div class='design-check'><b>Design check</b> (whole history) {head}"
             f"<table class='cp-readout'><tr><th></th><th>value</th><th>where</th>"
             f"<th>limit</th><th></th></tr>{''.join(rows)}</table>"
             f"<div class='cp-status'>contact width {check.contact_width:.4g} m of "
-            f"{check.full_width:.4g} m ({share:.0f} %) · {ecc}</div></div>")
+            f"{check.full_width:.4g} m ({share:.0f} %){lifted} · {ecc}</div></div>")

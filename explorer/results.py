@@ -53,6 +53,9 @@ class ResultView:
     flags: list[str] = field(default_factory=list)
     flag_messages: dict[str, str] = field(default_factory=dict)
     info: dict[str, Any] = field(default_factory=dict)
+    # per output time, the intervals of x [m] in contact (solver's contact_set); empty
+    # when the solution does not say
+    contact_set: list[list[tuple[float, float]]] = field(default_factory=list)
 
     @property
     def unknowns(self) -> tuple[str, ...]:
@@ -90,11 +93,31 @@ class ResultView:
 
     def negative_intervals(self, index: int) -> list[tuple[float, float]]:
         """Intervals of ``x`` [m] where the pressure at output ``index`` is negative
-        beyond the error band (see :meth:`lift_off_band`)."""
+        beyond the error band (see :meth:`lift_off_band`), or, when the unilateral
+        contact model lifted part of the base off, the lifted parts of the base."""
+        if index < len(self.contact_set):
+            lifted = lifted_intervals(self.contact_set[index], self.geometry.half_width)
+            if lifted:
+                return lifted
         band = self.lift_off_band()
         if not np.isfinite(band):
             return []
         return negative_intervals(self.x, self.pressure[:, index] + band)
+
+
+def lifted_intervals(zones: list[tuple[float, float]],
+                     half_width: float) -> list[tuple[float, float]]:
+    """Parts of the base ``[-a, a]`` [m] outside the contact ``zones`` [m] (lift-off)."""
+    lifted: list[tuple[float, float]] = []
+    edge = -half_width
+    for lo, hi in sorted(zones):
+        if lo > edge:
+            lifted.append((edge, min(lo, half_width)))
+        edge = max(edge, hi)
+    if edge < half_width:
+        lifted.append((edge, half_width))
+    # a gap narrower than round-off of the zone ends is not a lift-off
+    return [(lo, hi) for lo, hi in lifted if hi - lo > 1e-9 * half_width]
 
 
 def negative_intervals(x: np.ndarray, q: np.ndarray) -> list[tuple[float, float]]:
@@ -200,4 +223,6 @@ def prepare_view(solution: Any, scene: dict[str, Any]) -> ResultView:
     given = tuple(q for q in QUANTITIES if q in scene["loading"])
     return ResultView(scene=scene, given=given, times=times, values=values,
                       x=x, pressure=pressure, image=image, geometry=scene_geometry(scene_obj),
-                      flags=flags, flag_messages=messages, info=info)
+                      flags=flags, flag_messages=messages, info=info,
+                      contact_set=[[(float(lo), float(hi)) for lo, hi in zones]
+                                   for zones in getattr(solution, "contact_set", None) or []])

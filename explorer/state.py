@@ -19,6 +19,12 @@ from typing import Any
 
 import param
 
+from core.coating_model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
+
+#: Contact models of ``solver.contact``, as the solver names them ("auto" is the default).
+CONTACT_MODELS = ("auto", "full", "unilateral")
+DEFAULT_CONTACT = "auto"
+
 #: The four statements (which two quantities are given), as shown on screen.
 STATEMENTS: dict[str, tuple[str, str]] = {
     "settlement + tilt given": ("settlement", "tilt"),
@@ -192,7 +198,12 @@ class ProfileState(param.Parameterized):
 
 
 class LayerState(param.Parameterized):
-    """One coating layer: thickness [mm], Young's modulus [MPa], Poisson ratio."""
+    """One coating layer: thickness [mm], Young's modulus [MPa], Poisson ratio, and how it
+    is joined to what lies under it (``interface``)."""
+
+    interface = param.Selector(
+        default=DEFAULT_INTERFACE, objects=list(INTERFACES),
+        doc="Joint with the layer (or base) below: smooth (free to slide) or bonded.")
 
     def __init__(self, **params: Any) -> None:
         super().__init__(**params)
@@ -207,10 +218,14 @@ class LayerState(param.Parameterized):
 
     def to_dict(self) -> dict[str, Any]:
         """The layer of the scene schema (SI)."""
-        return {"thickness": self.thickness.to_spec(), "modulus": self.modulus.to_spec(),
-                "poisson": self.poisson.to_spec()}
+        layer = {"thickness": self.thickness.to_spec(), "modulus": self.modulus.to_spec(),
+                 "poisson": self.poisson.to_spec()}
+        if self.interface != DEFAULT_INTERFACE:  # the default is left implicit, as in files
+            layer["interface"] = self.interface
+        return layer
 
     def load(self, layer: dict[str, Any]) -> None:
+        self.interface = layer.get("interface", DEFAULT_INTERFACE)
         self.thickness.load_spec(layer["thickness"])
         self.modulus.load_spec(layer["modulus"])
         self.poisson.load_spec(layer["poisson"])
@@ -520,6 +535,13 @@ class ExplorerState(param.Parameterized):
                                "change of the time span, count or spacing.")
     tol = param.Selector(default=1e-6, objects=[1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8],
                          doc="Accuracy target of the solver (relative).")
+    contact = param.Selector(default=DEFAULT_CONTACT, objects=list(CONTACT_MODELS),
+                             doc="Contact model (solver.contact): auto (full contact unless "
+                                 "it is lost), full, or unilateral (the base may lift off).")
+    model_tol_percent = param.Number(
+        default=100.0 * DEFAULT_MODEL_TOL,
+        bounds=(100.0 * MODEL_TOL_RANGE[0], 100.0 * MODEL_TOL_RANGE[1]),
+        doc="Coating-model error a result may carry unflagged (solver.model_tol) [%].")
     revision = param.Integer(default=0, doc="Counts changes of the scene.")
 
     def __init__(self, **params: Any) -> None:
@@ -536,12 +558,13 @@ class ExplorerState(param.Parameterized):
         watched = [self.punch, self.base, self.loading,
                    *self.loading.histories.values(),
                    *(p for layer in self.layers for p in layer.profiles)]
+        watched += self.layers
         for obj in watched:
             names = [n for n in obj.param if n != "name"]
             obj.param.watch(self._on_change, names)
         self.param.watch(self._on_change, ["scene_name", "description", "n_layers",
                                            "time_end", "time_count", "time_spacing", "tol",
-                                           "time_list"])
+                                           "time_list", "contact", "model_tol_percent"])
         self.param.watch(self._on_times, ["time_end", "time_count", "time_spacing"])
 
     # -- change tracking -------------------------------------------------------------
@@ -590,11 +613,22 @@ class ExplorerState(param.Parameterized):
             "times": (list(self.time_list) if self.time_list is not None else
                       {"end": self.time_end, "count": self.time_count,
                        "spacing": self.time_spacing}),
-            "solver": {"tol": self.tol},
+            "solver": self._solver_dict(),
         }
         for key, value in self._extra.items():
             scene.setdefault(key, copy.deepcopy(value))
         return scene
+
+    def _solver_dict(self) -> dict[str, Any]:
+        """``solver`` of the scene; fields at their defaults are left implicit."""
+        solver: dict[str, Any] = {"tol": self.tol}
+        if self.contact != DEFAULT_CONTACT:
+            solver["contact"] = self.contact
+        # to 12 digits, so that a loaded 0.05 (shown as 5 %) is saved as 0.05 again
+        model_tol = float(f"{self.model_tol_percent / 100.0:.12g}")
+        if not math.isclose(model_tol, DEFAULT_MODEL_TOL, rel_tol=_RTOL):
+            solver["model_tol"] = model_tol
+        return solver
 
     def load_scene(self, scene: dict[str, Any]) -> None:
         """Fill every value from a scene dict (assumed valid) as one change.
@@ -652,6 +686,8 @@ class ExplorerState(param.Parameterized):
             time_count=times.get("count", self.time_count),
             time_spacing=times.get("spacing", self.time_spacing),
             tol=tol,
+            contact=solver.get("contact", DEFAULT_CONTACT),
+            model_tol_percent=100.0 * float(solver.get("model_tol", DEFAULT_MODEL_TOL)),
             time_list=time_list,
         )
 

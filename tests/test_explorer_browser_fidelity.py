@@ -1,0 +1,95 @@
+"""The model-fidelity widgets in a real browser: a layer's interface, the contact model and
+the coating-model tolerance set on the page reach the saved scene file.
+
+Debian's Chromium through Playwright; every wait is on a condition in the page or file.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
+from explorer.fidelity_view import CONTACT_LABELS
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
+
+_missing = browser_missing()
+if _missing:
+    if os.environ.get("CI"):
+        pytest.fail(_missing, pytrace=False)
+    pytest.skip(_missing, allow_module_level=True)
+
+import playwright.sync_api as playwright_api  # noqa: E402
+
+from tests.browser_pages import Page, _app_tracebacks  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def page() -> Iterator[Page]:
+    profile = tempfile.mkdtemp(prefix="explorer-chromium-")
+    with ExplorerProcess(ready_timeout=180) as explorer:
+        with playwright_api.sync_playwright() as p:
+            context = p.chromium.launch_persistent_context(
+                profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
+                viewport={"width": 1400, "height": 900}, accept_downloads=True)
+            shown = Page(context, explorer.url)
+            yield shown
+            shown.close()
+            context.close()
+    shutil.rmtree(profile, ignore_errors=True)
+    assert not _app_tracebacks(explorer.output()), explorer.output()
+
+
+def _saved_scene(page: Page) -> dict:
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.get_by_text("Save scene (JSON)").first.click()
+    return json.loads(Path(info.value.path()).read_text())
+
+
+def test_fidelity_fields_set_on_the_page_reach_the_saved_scene(page: Page):
+    page.open_tab("Coating")
+    page.page.locator(".layer-interface button", has_text="bonded").first.click()
+    page.open_tab("Time")
+    page.page.locator(".contact-select select").first.select_option(
+        label=CONTACT_LABELS["unilateral"])
+    box = page.page.locator(".model-tol-input input").first
+    box.fill("5")
+    box.press("Enter")
+    page.open_tab("Files")
+    saved: dict = {}
+    for _ in range(100):  # each widget reaches the server on its own message: read until all
+        saved = _saved_scene(page)
+        if (saved["coating"][0].get("interface") == "bonded"
+                and saved["solver"].get("contact") == "unilateral"
+                and saved["solver"].get("model_tol") == 0.05):
+            break
+        page.page.wait_for_timeout(100)
+    assert saved["coating"][0].get("interface") == "bonded", saved["coating"][0]
+    assert saved["solver"] == {**saved["solver"], "contact": "unilateral", "model_tol": 0.05}
+    assert page.errors == []
+
+
+def test_liftoff_preset_shades_the_lifted_heel_on_the_page(page: Page):
+    from explorer.presets import preset_label, presets
+
+    key = "eccentric_footing_liftoff"
+    page.open_tab("Scene")
+    page.page.locator(".preset-select select").first.select_option(
+        label=preset_label(key, presets()[key]))
+    # the lifted part arrives as one shaded strip from the left edge of the base
+    page.page.wait_for_function(
+        """() => {
+          const s = Bokeh.documents[0].get_model_by_name('negative_source');
+          return s.data.left.length === 1 && s.data.right[0] > s.data.left[0];
+        }""", timeout=120_000)
+    left = page.page.evaluate(
+        "() => Bokeh.documents[0].get_model_by_name('negative_source').data.left[0]")
+    assert left == pytest.approx(-1.0)   # the base's edge x = -a (a = 1 m in the preset)
+    assert page.errors == []

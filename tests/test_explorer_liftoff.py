@@ -1,0 +1,56 @@
+"""Lift-off on screen: the contact set of a unilateral solve becomes the shaded lifted
+parts of q(x) and the contact width of the design check."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from explorer.controller import SolveController
+from explorer.design import design_check
+from explorer.presets import presets
+from explorer.results import lifted_intervals
+from explorer.state import ExplorerState
+
+
+@pytest.mark.parametrize(("zones", "lifted"), [
+    ([(-1.0, 1.0)], []),
+    ([(-0.3, 1.0)], [(-1.0, -0.3)]),
+    ([(-1.0, -0.5), (0.2, 0.6)], [(-0.5, 0.2), (0.6, 1.0)]),
+    ([], [(-1.0, 1.0)]),
+])
+def test_lifted_parts_are_the_complement_of_the_contact_zones(zones, lifted) -> None:
+    assert lifted_intervals(zones, 1.0) == lifted
+
+
+def test_liftoff_preset_shows_its_contact_zone() -> None:
+    state = ExplorerState()
+    state.load_scene(json.loads(json.dumps(presets()["eccentric_footing_liftoff"])))
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    view = controller.view
+    assert view is not None, controller.error
+    assert len(view.contact_set) == len(view.times)
+    a = view.geometry.half_width
+    last = len(view.times) - 1
+    (lo, hi), = view.negative_intervals(last)   # one lifted part, at the heel
+    assert lo == -a and -a < hi < a
+    check = design_check(view)
+    # the design check reads the narrowest contact width from the same contact set
+    narrowest = min(2 * a - sum(h - lo_ for lo_, h in lifted_intervals(z, a))
+                    for z in view.contact_set)
+    assert check.contact_width == pytest.approx(narrowest, rel=1e-12)
+    assert check.contact_width < 2 * a
+
+
+def test_design_check_text_gives_the_lift_off_length() -> None:
+    from explorer.design import check_html
+
+    state = ExplorerState()
+    state.load_scene(json.loads(json.dumps(presets()["eccentric_footing_liftoff"])))
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    check = design_check(controller.view)
+    text = check_html(check)
+    assert f"lift-off length {check.full_width - check.contact_width:.4g} m" in text
