@@ -64,3 +64,26 @@ def test_figure_shows_the_curve_or_empties_on_refusal():
     state.relative_humidity = 10.0
     message = update_creep_figure(fig, source, state, 7.0)
     assert "relative_humidity" in message and len(source.data["phi"]) == 0
+
+
+def test_base_state_offers_the_code_models_and_round_trips_the_preset():
+    import json
+    from pathlib import Path
+
+    from explorer.state import CREEP_MODELS, ExplorerState
+
+    assert {"fib_mc2010", "eurocode2"} <= set(CREEP_MODELS)
+    scene = json.loads((Path(__file__).resolve().parent.parent
+                        / "assets/scenes/young_concrete_50_years.json").read_text())
+    state = ExplorerState()
+    state._load(scene)
+    assert state.base.creep_model == "fib_mc2010"  # by name, not as "other model"
+    assert state.to_scene()["base"]["creep"] == scene["base"]["creep"]
+    before = state.revision
+    state.base.code.relative_humidity = 80.0
+    assert state.revision == before + 1  # a code input is a change of the scene
+    state.base.creep_model = "eurocode2"
+    assert state.to_scene()["base"]["creep"]["model"] == "eurocode2"
+    state.base.code.relative_humidity = 20.0
+    with pytest.raises(ValueError, match="base.creep.relative_humidity"):
+        state.to_scene()
