@@ -25,6 +25,7 @@ from core.scene import MAX_SCENE_BYTES
 
 from . import closed_pages, exports, gc_policy
 from .controller import SolveController, format_error, worker_processes
+from .creep_view import CODE_CREEP_MODELS, CodeCreepPanel
 from .design import DesignLimits, check_html, design_check
 from .links import decode_scene
 from .panel_fixes import install as install_panel_fixes
@@ -382,6 +383,8 @@ class ExplorerApp(pn.viewable.Viewer):
         self.creep_note = _html("", styles={"font-size": "12px", "color": "#666"})
         bb.bind(s.base)
         s.base.param.watch(lambda *e: self._refresh_base(), ["creep_model", "custom"])
+        # design-code creep (fib MC2010, Eurocode 2): inputs and phi(t, t0) plot
+        self.code_creep = CodeCreepPanel(s.base, Binding(reject))
 
         # loading
         self.statement = pn.widgets.Select(label="statement (which two are given)",
@@ -533,7 +536,7 @@ class ExplorerApp(pn.viewable.Viewer):
             ("Base", pn.Column(
                 self.base_thickness, self.base_poisson, self.creep_model, self.base_modulus,
                 self.compliance, self.rate, self.beta, self.alpha, self.aging, self.age,
-                self.creep_note, **column)),
+                self.creep_note, self.code_creep.panel, **column)),
             ("Time", pn.Column(self.time_end, self.time_count, self.time_spacing, self.tol,
                                self.fidelity.solver_panel, **column)),
             ("Check", pn.Column(
@@ -672,7 +675,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.beta.visible = self.alpha.visible = self.aging.visible = model == "arutyunyan"
         self.base_modulus.label = ("final Young's modulus E∞ [GPa]" if model == "arutyunyan"
                                    else "Young's modulus E [GPa]")
-        self.base_modulus.visible = model != "custom"
+        self.base_modulus.visible = model not in ("custom", *CODE_CREEP_MODELS)
         # "other model (from file)" is offered only while the scene holds one: picked
         # without it, the base was silently solved as elastic
         offered = {v: k for k, v in CREEP_MODELS.items()

@@ -21,6 +21,8 @@ import param
 
 from core.coating_model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
 
+from .creep_view import CODE_CREEP_MODELS, CodeCreepState
+
 #: Contact models of ``solver.contact``, as the solver names them ("auto" is the default).
 CONTACT_MODELS = ("auto", "full", "unilateral")
 DEFAULT_CONTACT = "auto"
@@ -55,6 +57,8 @@ CREEP_MODELS: dict[str, str] = {
     "elastic": "elastic (no creep)",
     "exponential": "non-aging exponential creep",
     "arutyunyan": "aging creep (Arutyunyan)",
+    "fib_mc2010": "concrete, fib Model Code 2010",
+    "eurocode2": "concrete, Eurocode 2",
     "custom": "other model (from file)",
 }
 
@@ -377,7 +381,14 @@ class BaseState(param.Parameterized):
                              doc="A creep spec (SI) of a model not offered on screen, kept "
                                  "verbatim (Prony series, user kernel).")
 
+    def __init__(self, **params: Any) -> None:
+        super().__init__(**params)
+        #: inputs of the design-code models, in the codes' units
+        self.code = CodeCreepState(name="base_code")
+
     def creep_dict(self) -> dict[str, Any]:
+        if self.creep_model in CODE_CREEP_MODELS:
+            return self.code.spec(model=self.creep_model)
         if self.creep_model == "exponential":
             return {"model": "exponential", "modulus": self.modulus * _GPA,
                     "compliance": self.compliance / _GPA, "rate": self.rate}
@@ -413,6 +424,8 @@ class BaseState(param.Parameterized):
                           rate=creep["rate"])
         elif model == "elastic":
             values.update(modulus=creep["modulus"] / _GPA)
+        elif model in CODE_CREEP_MODELS:
+            self.code.load(creep)
         else:
             values.update(creep_model="custom", custom=copy.deepcopy(creep))
             if isinstance(creep.get("modulus"), (int, float)):
@@ -555,7 +568,7 @@ class ExplorerState(param.Parameterized):
         self._loaded_name: str | None = None
         self._batch = 0
         self._dirty = False
-        watched = [self.punch, self.base, self.loading,
+        watched = [self.punch, self.base, self.base.code, self.loading,
                    *self.loading.histories.values(),
                    *(p for layer in self.layers for p in layer.profiles)]
         watched += self.layers
