@@ -55,6 +55,7 @@ from core.creep import Elastic, UserKernel, creep_model_from_spec
 from core.files import atomic_write_text, read_regular_file
 from core.load_rates import check_step_limit, oscillations
 from core.profiles import Profile, check_range, profile_from_spec
+from core.statements import QUANTITIES, STATEMENTS  # noqa: F401 (re-exported)
 from core.validation import (
     MAX_MAGNITUDE,
     NumberTooLarge,
@@ -77,15 +78,6 @@ MAX_TIMES = limits.MAX_SCENE_TIMES
 #: Accepted range of the solver's relative tolerance, and its default.
 TOL_RANGE = (1e-12, 1e-2)
 DEFAULT_TOL = 1e-6
-#: The loads, in the order the histories are reported.
-QUANTITIES = ("settlement", "tilt", "force", "moment")
-#: The four statements of the seed (section 3), as pairs of given quantities.
-STATEMENTS: dict[frozenset[str], int] = {
-    frozenset({"settlement", "tilt"}): 1,
-    frozenset({"settlement", "moment"}): 2,
-    frozenset({"tilt", "force"}): 3,
-    frozenset({"force", "moment"}): 4,
-}
 #: The thin-coating model is doubtful where sum h_k exceeds this fraction of 2a.
 THICK_COATING_RATIO = 0.1
 #: Tilts beyond this many radians are not small.
@@ -105,10 +97,8 @@ _SAMPLE_X = StageCache("sample_x", max_items=128, max_bytes=16 * 2**20)
 _GAP_MINIMUM = StageCache("gap_minimum", max_items=256, max_bytes=2**20)
 #: Largest accepted gap between punch and coating surface, in half-widths a.
 MAX_GAP_RATIO = 1e3
-#: Accepted range of a / H. The quadrature resolves the layer kernel on the scale H, so
-#: the nodes grow with a / H: measured 1216 nodes, 1 s, 155 MB at 100; 4448 nodes, 5 s,
-#: 1 GB at 400; 10880 nodes, 27 s, 5.5 GB at 1000 (the solver itself accepts 1e4).
-LAM_RANGE = (1e-4, 100.0)
+#: Accepted range of a / H (the limits and their measured cost: core/limits.py).
+LAM_RANGE = (limits.MIN_LAM, limits.MAX_SCENE_LAM)
 #: Largest accepted creep coefficient E(tau0) C(t_end, tau0) (concrete: 1 to 5). The
 #: time stepping was measured at 1.9 s for 1000 (tol 1e-8), 32 s for 1e4 (tol 1e-8) and
 #: 13 s for 9e7 (tol 1e-3), the last two stopping at the step limit.

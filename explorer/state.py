@@ -19,6 +19,8 @@ from typing import Any
 
 import param
 
+from core.scene import QUANTITIES
+
 #: The four statements (which two quantities are given), as shown on screen.
 STATEMENTS: dict[str, tuple[str, str]] = {
     "settlement + tilt given": ("settlement", "tilt"),
@@ -27,7 +29,6 @@ STATEMENTS: dict[str, tuple[str, str]] = {
     "force + moment given": ("force", "moment"),
 }
 
-QUANTITIES = ("settlement", "tilt", "force", "moment")
 
 #: Display unit and its size in SI for each loading quantity.
 QUANTITY_UNITS: dict[str, tuple[str, float]] = {
