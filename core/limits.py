@@ -67,6 +67,9 @@ MAX_SOLVER_LAM = 1e3
 
 #: Most output times of a scene (``times.count`` or the length of the ``times`` list).
 MAX_SCENE_TIMES = 2_000
+#: Most load durations of one ``core.creep_coefficient_curve`` call (a plotted curve
+#: needs a few hundred; each costs a few array operations).
+MAX_CURVE_POINTS = 100_000
 #: Most output times of ``core.solver.solve_dimensionless``: every output time is a
 #: column of each mode's history (256 modes x 3 arrays x 10000 times: 60 MB).
 MAX_SOLVER_TIMES = 10_000
