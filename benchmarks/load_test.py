@@ -29,6 +29,11 @@ on top) and in requests (``--max-requests`` per session), and stops by itself. N
 of the test suite. Usage::
 
     python benchmarks/load_test.py --sessions 20 --minutes 3 [--client protocol|browser]
+
+``--mode abandon`` instead opens sessions and drops them abruptly (200 by default) and
+reports the server's memory after each round (``benchmarks/load_abandon.py``)::
+
+    python benchmarks/load_test.py --mode abandon --dropped 200 --report FILE.md
 """
 
 from __future__ import annotations
@@ -719,8 +724,37 @@ def main() -> int:
     parser.add_argument("--after-seconds", type=float, default=45.0,
                         help="seconds of memory samples after the crowd has left")
     parser.add_argument("--report", help="append the report (Markdown) to this file")
+    parser.add_argument("--mode", choices=("crowd", "abandon"), default="crowd",
+                        help="crowd: sessions moving sliders (default); abandon: sessions "
+                             "opened and dropped, memory after each round "
+                             "(benchmarks/load_abandon.py)")
+    parser.add_argument("--dropped", type=int, default=200,
+                        help="abandon: sessions dropped after the warm-up")
+    parser.add_argument("--round", type=int, default=25,
+                        help="abandon: sessions dropped per round")
+    parser.add_argument("--at-once", type=int, default=10,
+                        help="abandon: sessions being dropped at the same time")
+    parser.add_argument("--session-linger", type=float, default=2.0,
+                        help="abandon: the server's --session-linger [s] (its default 15 "
+                             "only makes the rounds longer)")
+    parser.add_argument("--trend-goal", type=float, default=10.0,
+                        help="abandon: largest settled growth counted flat [MiB per 100 "
+                             "dropped sessions]")
     args = parser.parse_args()
     command = "python benchmarks/load_test.py " + " ".join(sys.argv[1:])
+    if args.mode == "abandon":
+        if not (1 <= args.dropped <= 10_000 and 1 <= args.round and 1 <= args.at_once <= 100):
+            parser.error("--dropped must be 1 to 10000, --round >= 1, --at-once 1 to 100")
+        from benchmarks.load_abandon import run_abandon
+
+        text, ok = run_abandon(args, command)
+        print(text)
+        if args.report:
+            path = Path(args.report)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with path.open("a", encoding="utf-8") as fh:
+                fh.write(text + "\n")
+        return 0 if ok else 1
     phase = run_browser_phase if args.client == "browser" else run_protocol_phase
 
     with tempfile.TemporaryDirectory(prefix="load-test-") as tmp:

@@ -67,6 +67,7 @@ from typing import Any
 
 import numpy as np
 
+from core import limits
 from core.validation import PYTHON_STYLE, finite_number, show_python
 
 #: alpha of 5.1-73 / B.9 and s of Table 5.1-9 / 3.1.2(6), by cement class.
@@ -396,11 +397,20 @@ def creep_coefficient_curve(spec: dict, age_at_loading: float, durations: Any, *
     ``spec`` is a ``{"model": "fib_mc2010" | "eurocode2", ...}`` creep spec (SCENES.md),
     ``age_at_loading`` t0 [day]. Durations must be >= 0 and at most ``MAX_DURATION``.
     """
-    if not isinstance(spec, dict) or spec.get("model") not in _FORMULAS:
+    # a list or object as the model name is unhashable: test its type before the lookup
+    if not isinstance(spec, dict) or not isinstance(spec.get("model"), str) \
+            or spec["model"] not in _FORMULAS:
         raise ValueError(f"{field}.model: must be one of " + ", ".join(sorted(_FORMULAS)))
     model = CodeCreep(spec["model"], spec, field)
     t0 = model._age_at_loading(age_at_loading, "age_at_loading")
-    d = np.asarray(durations, dtype=float)
+    try:
+        d = np.asarray(durations, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError("durations: must be a number or an array of numbers [day], got "
+                         f"{show_python(durations)[:60]}") from None
+    if d.size > limits.MAX_CURVE_POINTS:
+        raise ValueError(f"durations: at most {limits.MAX_CURVE_POINTS:,} values, got "
+                         f"{d.size:,}")
     if not np.all(np.isfinite(d)) or np.any(d < 0) or np.any(d > MAX_DURATION):
         raise ValueError(f"durations: must be finite, in [0, {MAX_DURATION:g}] days")
     return model.creep_coefficient(t0 + d, t0)

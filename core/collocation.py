@@ -39,17 +39,12 @@ import numpy as np
 from scipy.linalg import lu_factor, lu_solve, rsf2csf, schur, solve_triangular
 
 from core.quadrature import Panels, base_panels, kernel_operator, operator_rows
+from core.statements import QUANTITIES as _QUANTITIES
+from core.statements import STATEMENTS as _STATEMENTS
+from core.validation import PYTHON_STYLE, finite_number, positive_number
 
 TimeInput = float | Callable[[np.ndarray], np.ndarray]
 
-_QUANTITIES = ("settlement", "tilt", "force", "moment")
-#: Statement number (seed, section 3) for each admissible pair of given quantities.
-_STATEMENTS = {
-    frozenset({"settlement", "tilt"}): 1,
-    frozenset({"settlement", "moment"}): 2,
-    frozenset({"tilt", "force"}): 3,
-    frozenset({"force", "moment"}): 4,
-}
 #: Default relative accuracy aimed at in time when ``time_points`` is not given.
 DEFAULT_TIME_TOL = 1e-6
 #: Coarsest nominal grid of the automatic time refinement, and the finest allowed.
@@ -507,13 +502,7 @@ def _adaptive_grids(system: _System, times: np.ndarray, richardson: bool,
 
 
 def _positive_number(value: object, name: str) -> float:
-    try:
-        number = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: must be a number, got {value!r}") from None
-    if not math.isfinite(number) or number <= 0.0:
-        raise ValueError(f"{name}: must be finite and > 0, got {value!r}")
-    return number
+    return positive_number(value, name, style=PYTHON_STYLE)
 
 
 def _check_times(times: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -559,13 +548,8 @@ def _time_function(value: object, name: str) -> Callable[[np.ndarray], np.ndarra
 
 
 def _finite_number(value: object, name: str) -> float:
-    try:
-        number = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: must be a number or a callable, got {value!r}") from None
-    if not math.isfinite(number):
-        raise ValueError(f"{name}: must be finite, got {value!r}")
-    return number
+    # reached only for values that are not callables, so a number is what is missing
+    return finite_number(value, name, style=PYTHON_STYLE)
 
 
 def _eval_space(fn: Callable, x: np.ndarray, name: str) -> np.ndarray:

@@ -55,7 +55,6 @@ _EDGE = 1e-2
 #: at +-1 and the breakpoints (finer for a thin coating).
 _CREEP_WIDTH = 0.125
 _CREEP_EDGE = 1e-2
-_QUANTITIES = ("settlement", "tilt", "force", "moment")
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 

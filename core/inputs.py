@@ -28,9 +28,8 @@ TOLERANCE_RANGE = (1e-13, 1e-1)
 #: gave NaN); physical scenes are far inside.
 VALUE_RANGE = {"m": (1 / MAX_MAGNITUDE, MAX_MAGNITUDE), "g": (0.0, MAX_MAGNITUDE),
                "c": (1 / MAX_MAGNITUDE, MAX_MAGNITUDE)}
-#: Accepted a/H. The operator's nodes grow like a/H and its memory like its square:
-#: measured 155 MB at 100 and 5.5 GB at 1000 (the scene limit, core/scene.py, is tighter).
-LAM_RANGE = (1e-4, 1e3)
+#: Accepted a/H (the limits and their measured cost: core/limits.py).
+LAM_RANGE = (limits.MIN_LAM, limits.MAX_SOLVER_LAM)
 
 
 def as_function(value: Scalar, name: str) -> Function:

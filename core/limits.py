@@ -50,10 +50,26 @@ MAX_POLYNOMIAL_COEFFICIENTS = 16
 #: 360 MB; 40: 9 s, 1.7 GB).
 MAX_BREAKPOINTS = 16
 
+# ----------------------------------------------------------------------------- geometry
+
+#: Smallest accepted a/H (the paper's lam), for scenes and the solver alike.
+MIN_LAM = 1e-4
+#: Largest a/H of a scene. The quadrature resolves the layer kernel on the scale H, so the
+#: nodes grow with a/H: measured 1216 nodes, 1 s, 155 MB at 100; 4448 nodes, 5 s, 1 GB at
+#: 400; 10880 nodes, 27 s, 5.5 GB at 1000. A scene comes from untrusted users, so it is
+#: held to the figure a shared machine can afford.
+MAX_SCENE_LAM = 100.0
+#: Largest a/H of ``core.solver.solve_dimensionless``: a trusted caller may spend the
+#: 5.5 GB of a/H = 1000 (beyond it the operator no longer fits in memory).
+MAX_SOLVER_LAM = 1e3
+
 # ----------------------------------------------------------------------------- times
 
 #: Most output times of a scene (``times.count`` or the length of the ``times`` list).
 MAX_SCENE_TIMES = 2_000
+#: Most load durations of one ``core.creep_coefficient_curve`` call (a plotted curve
+#: needs a few hundred; each costs a few array operations).
+MAX_CURVE_POINTS = 100_000
 #: Most output times of ``core.solver.solve_dimensionless``: every output time is a
 #: column of each mode's history (256 modes x 3 arrays x 10000 times: 60 MB).
 MAX_SOLVER_TIMES = 10_000

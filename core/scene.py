@@ -30,7 +30,6 @@ import hashlib
 import json
 import math
 import numbers
-import os
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -52,9 +51,18 @@ from core.coating_model import (
     tilt_share,
 )
 from core.creep import Elastic, UserKernel, creep_model_from_spec
-from core.files import atomic_write_text, read_regular_file
+from core.files import atomic_write_text, read_regular_file  # noqa: F401 (re-exported)
+from core.golden_section import golden_minimum
 from core.load_rates import check_step_limit, oscillations
 from core.profiles import Profile, check_range, profile_from_spec
+from core.scene_files import (  # noqa: F401 (re-exported: core.scene is the public path)
+    load_scene,
+    parse_scene_json,
+    read_scene_json,
+    save_scene,
+    scene_to_json,
+)
+from core.statements import QUANTITIES, STATEMENTS  # noqa: F401 (re-exported)
 from core.validation import (
     MAX_MAGNITUDE,
     NumberTooLarge,
@@ -77,15 +85,6 @@ MAX_TIMES = limits.MAX_SCENE_TIMES
 #: Accepted range of the solver's relative tolerance, and its default.
 TOL_RANGE = (1e-12, 1e-2)
 DEFAULT_TOL = 1e-6
-#: The loads, in the order the histories are reported.
-QUANTITIES = ("settlement", "tilt", "force", "moment")
-#: The four statements of the seed (section 3), as pairs of given quantities.
-STATEMENTS: dict[frozenset[str], int] = {
-    frozenset({"settlement", "tilt"}): 1,
-    frozenset({"settlement", "moment"}): 2,
-    frozenset({"tilt", "force"}): 3,
-    frozenset({"force", "moment"}): 4,
-}
 #: The thin-coating model is doubtful where sum h_k exceeds this fraction of 2a.
 THICK_COATING_RATIO = 0.1
 #: Tilts beyond this many radians are not small.
@@ -105,10 +104,8 @@ _SAMPLE_X = StageCache("sample_x", max_items=128, max_bytes=16 * 2**20)
 _GAP_MINIMUM = StageCache("gap_minimum", max_items=256, max_bytes=2**20)
 #: Largest accepted gap between punch and coating surface, in half-widths a.
 MAX_GAP_RATIO = 1e3
-#: Accepted range of a / H. The quadrature resolves the layer kernel on the scale H, so
-#: the nodes grow with a / H: measured 1216 nodes, 1 s, 155 MB at 100; 4448 nodes, 5 s,
-#: 1 GB at 400; 10880 nodes, 27 s, 5.5 GB at 1000 (the solver itself accepts 1e4).
-LAM_RANGE = (1e-4, 100.0)
+#: Accepted range of a / H (the limits and their measured cost: core/limits.py).
+LAM_RANGE = (limits.MIN_LAM, limits.MAX_SCENE_LAM)
 #: Largest accepted creep coefficient E(tau0) C(t_end, tau0) (concrete: 1 to 5). The
 #: time stepping was measured at 1.9 s for 1000 (tol 1e-8), 32 s for 1e4 (tol 1e-8) and
 #: 13 s for 9e7 (tol 1e-3), the last two stopping at the step limit.
@@ -438,7 +435,7 @@ class Scene:
             # a smooth minimum can fall between samples: golden-section search on the
             # bracket; any value it finds is a true value of the function, so taking the
             # smaller one is always safe (also next to a jump)
-            best = min(best, _golden_minimum(
+            best = min(best, golden_minimum(
                 lambda s: float(self.gap_variation(np.array([s]))[0]), float(lo), float(hi)))
         return best
 
@@ -489,27 +486,6 @@ def _without_offset(profile: Profile) -> Profile:
         return profile
     return profile_from_spec(spec, field="gap", variable=profile.variable,
                              domain=profile.domain)
-
-
-def _golden_minimum(fn: Callable[[float], float], lo: float, hi: float,
-                    iterations: int = 60) -> float:
-    """Smallest value of ``fn`` met by a golden-section search on ``[lo, hi]``."""
-    ratio = (math.sqrt(5.0) - 1.0) / 2.0
-    c = hi - ratio * (hi - lo)
-    d = lo + ratio * (hi - lo)
-    fc, fd = fn(c), fn(d)
-    best = min(fc, fd)
-    for _ in range(iterations):
-        if fc < fd:
-            hi, d, fd = d, c, fc
-            c = hi - ratio * (hi - lo)
-            fc = fn(c)
-        else:
-            lo, c, fc = c, d, fd
-            d = lo + ratio * (hi - lo)
-            fd = fn(d)
-        best = min(best, fc, fd)
-    return best
 
 
 # ---------------------------------------------------------------------------- validation
@@ -874,70 +850,6 @@ def _spec_of(profile: Profile, given: Any) -> Any:
     """The canonical spec of a profile (its ``spec`` when it has one, else what was given)."""
     spec = getattr(profile, "spec", None)
     return given if spec is None else spec
-
-
-# ------------------------------------------------------------------------------- files
-
-
-def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for key, value in pairs:
-        if key in out:
-            raise ValueError(f"duplicate field {key!r} in one JSON object")
-        out[key] = value
-    return out
-
-
-def _parse_int(text: str) -> int | float:
-    # no double holds more than 309 digits; Python's int() of a few thousand digits raises
-    # an error about its own limits, so such a number becomes inf, refused by its field
-    return int(text) if len(text) <= 400 else (-math.inf if text[0] == "-" else math.inf)
-
-
-def read_scene_json(text: str, source: str = "scene") -> Any:
-    """The JSON value of a scene file's text, read strictly: a field repeated in one
-    object, a nesting too deep or a number beyond any double is refused (``ValueError``
-    naming ``source``). The value is not yet validated as a scene."""
-    try:
-        return json.loads(text, object_pairs_hook=_no_duplicates, parse_int=_parse_int)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{source}: not valid JSON ({exc.msg} at line {exc.lineno}, "
-                         f"column {exc.colno})") from None
-    except ValueError as exc:
-        raise ValueError(f"{source}: {exc}") from None
-    except RecursionError:
-        raise ValueError(f"{source}: not valid JSON (nested too deeply)") from None
-
-
-def parse_scene_json(text: str, source: str = "scene") -> Scene:
-    """Parse and validate the JSON text of a scene; errors name ``source`` or the field."""
-    return scene_from_dict(read_scene_json(text, source))
-
-
-def load_scene(path: str | os.PathLike) -> Scene:
-    """Read and validate a scene file (JSON, UTF-8, at most 1 MB).
-
-    Raises ``ValueError`` (message starting with the file path or the field path) for a
-    file that is too large, not a regular file (a named pipe is refused, not waited on),
-    not JSON or not a valid scene, ``OSError`` if it cannot be read.
-    """
-    raw = read_regular_file(path, MAX_SCENE_BYTES)
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise ValueError(f"{path}: not a text file in UTF-8 (a scene file is JSON)") from None
-    return parse_scene_json(text, str(path))
-
-
-def scene_to_json(scene: Scene | Mapping[str, Any]) -> str:
-    """The canonical JSON text of a scene (validated first when given as a dict)."""
-    scene = scene_from_dict(scene)
-    return json.dumps(scene.to_dict(), indent=2, allow_nan=False) + "\n"
-
-
-def save_scene(scene: Scene | Mapping[str, Any], path: str | os.PathLike) -> None:
-    """Write a scene as JSON to ``path`` atomically (a dict is validated first)."""
-    atomic_write_text(path, scene_to_json(scene))
 
 
 # -------------------------------------------------------------------------- conversion

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+#: The loads, in the order the histories are reported (the one definition; core.scene
+#: and the explorer import it from here).
 QUANTITIES = ("settlement", "tilt", "force", "moment")
 
 #: Statement number (seed, section 3) for each pair of given quantities.

@@ -305,8 +305,16 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     studies to untrusted users passes a smaller one).
     """
     max_points = min(int(max_points), MAX_STUDY_POINTS)
-    _check_fields(d, "", ("study_version", "name", "scene", "vary"),
-                  ("description", "samples", "seed", "outputs", "times"))
+    try:
+        _check_fields(d, "", ("study_version", "name", "scene", "vary"),
+                      ("description", "samples", "seed", "outputs", "times"))
+    except ValueError as exc:
+        # the scene checker names the top level "scene", which in a study is the field
+        # holding the base scene: a stray study field must not be blamed on it
+        msg = str(exc)
+        if msg.startswith("scene: "):
+            raise ValueError("study: " + msg[len("scene: "):]) from None
+        raise
     _integer(d["study_version"], "study_version", STUDY_VERSION, STUDY_VERSION)
     name = d["name"]
     if not isinstance(name, str) or not name.strip():
@@ -346,7 +354,8 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     if not isinstance(outputs_spec, (list, tuple)) or not outputs_spec:
         raise ValueError(f"outputs: must be a non-empty list of {', '.join(OUTPUT_UNITS)}")
     for i, o in enumerate(outputs_spec):
-        if o not in OUTPUT_UNITS:
+        # a list or object in the list is unhashable: test the type before the lookup
+        if not isinstance(o, str) or o not in OUTPUT_UNITS:
             raise ValueError(f"outputs[{i}]: unknown output {show_value(o)} (known: "
                              f"{', '.join(OUTPUT_UNITS)})")
     outputs = tuple(dict.fromkeys(outputs_spec))

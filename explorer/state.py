@@ -20,6 +20,7 @@ from typing import Any
 import param
 
 from core.coating_model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
+from core.scene import QUANTITIES
 
 from .creep_view import CODE_CREEP_MODELS, CodeCreepState
 
@@ -35,7 +36,6 @@ STATEMENTS: dict[str, tuple[str, str]] = {
     "force + moment given": ("force", "moment"),
 }
 
-QUANTITIES = ("settlement", "tilt", "force", "moment")
 
 #: Display unit and its size in SI for each loading quantity.
 QUANTITY_UNITS: dict[str, tuple[str, float]] = {

@@ -119,10 +119,9 @@ def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None) 
 
 def worker_info() -> dict[str, int]:
     """The worker's process id and the bound of its solver stage caches [bytes]."""
-    from core import solver
+    from core.stage_budget import stage_cache_bytes
 
-    return {"pid": os.getpid(),
-            "stage_cache_bytes": sum(cache.max_bytes for cache in solver._STAGES)}
+    return {"pid": os.getpid(), "stage_cache_bytes": stage_cache_bytes()}
 
 
 # -- the server's side -------------------------------------------------------------------

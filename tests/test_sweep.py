@@ -129,7 +129,7 @@ def assert_equal_to_serial(ds, study) -> None:
     ({"times": [5.0, 1.0]}, "times[1]"),
     ({"study_version": 2}, "study_version: must be an integer from 1 to 1"),
     ({"vary": []}, "vary: must be a list of 1 to"),
-    ({"extra": 1}, "scene: unknown field 'extra'"),
+    ({"extra": 1}, "study: unknown field 'extra'"),
 ])
 def test_bad_study_names_the_field(change, starts):
     with pytest.raises(ValueError) as info:

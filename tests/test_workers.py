@@ -26,6 +26,7 @@ import pytest
 import explorer.controller as controller_module
 import explorer.workers as workers
 from core import solve, solver
+from core.stage_budget import stage_cache_bounds
 from explorer.controller import RESULTS, SolveController
 from explorer.results import prepare_view
 from explorer.state import QUANTITIES, ExplorerState
@@ -122,17 +123,16 @@ def test_each_worker_holds_its_share_of_the_stage_cache_budget(processes) -> Non
 
 
 def test_the_stage_cache_budget_is_shared_in_proportion() -> None:
-    default = {cache.name: cache.max_bytes for cache in solver._STAGES}
+    default = stage_cache_bounds()
     try:
         solver.set_stage_cache_budget(solver.STAGE_CACHE_BYTES // 4)
-        for cache in solver._STAGES:
-            assert cache.max_bytes == default[cache.name] // 4
+        assert stage_cache_bounds() == {name: size // 4 for name, size in default.items()}
         for bad in (0, -1, 1.5, "1", True):
             with pytest.raises(ValueError, match="total_bytes"):
                 solver.set_stage_cache_budget(bad)
     finally:
         solver.set_stage_cache_budget(solver.STAGE_CACHE_BYTES)
-    assert {cache.name: cache.max_bytes for cache in solver._STAGES} == default
+    assert stage_cache_bounds() == default
 
 
 def release(gate: Path, wait_until: Any) -> None:
