@@ -65,12 +65,7 @@ class _LevelSetup:
     def given_drive(self, rows: np.ndarray, loads: dict[str, np.ndarray],
                     size: int) -> np.ndarray:
         """``delta e0 + alpha e1`` (the given ones) restricted to ``rows``."""
-        out = np.zeros((len(rows), size))
-        if "settlement" in loads:
-            out += np.outer(self.ms.e0_rot[rows], loads["settlement"])
-        if "tilt" in loads:
-            out += np.outer(self.ms.e1_rot[rows], loads["tilt"])
-        return out
+        return self.ms.given_drive(rows, loads, size)
 
     def drive(self, loads: dict[str, np.ndarray], size: int) -> np.ndarray:
         return self.ms.psi.T @ self.given_drive(self.ms.free, loads, size)
