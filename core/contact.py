@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from core.contact_solution import SolveOutcome
 from core.contact_zones import (
     ZONE_END_TOL,
     NoContact,
@@ -73,7 +74,7 @@ class _Snapshot:
 
 
 @dataclass(frozen=True)
-class UnilateralSolution:
+class UnilateralSolution(SolveOutcome):
     """The answer of :func:`solve_unilateral` (dimensionless, like ``ContactSolution``).
 
     ``times`` (T,); ``settlement`` (delta), ``tilt`` (alpha), ``force`` (P), ``moment`` (M)
@@ -92,21 +93,6 @@ class UnilateralSolution:
     info: dict[str, Any]
     _space: Space = field(repr=False)
     _snapshots: list[_Snapshot] = field(repr=False)
-
-    @property
-    def success(self) -> bool:
-        """Whether the error estimates meet the tolerances."""
-        return bool(self.info["success"])
-
-    @property
-    def message(self) -> str:
-        """A one-line account of how the solve went."""
-        return str(self.info["message"])
-
-    @property
-    def flags(self) -> list[str]:
-        """Validity flags (``tol_not_met``, ``contact_set_unverified``)."""
-        return list(self.info["flags"])
 
     def pressure(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
         """Contact pressure q(x, t) at points of [-1, 1], shape ``(len(x), len(times))``.

@@ -113,6 +113,21 @@ def _set(obj: Any, **values: Any) -> None:
 # ------------------------------------------------------------------ the degenerate kernel
 
 
+def separable_kernel_value(kernel: Any, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
+    """``K(t, tau) = b(tau) + sum_r a_r(tau) exp(-rate_r (t - tau))`` [-], 0 where ``t < tau``.
+
+    For any kernel with ``rates`` (R,), ``tau_part(tau)`` (b) and ``exponential_parts(tau)``
+    (a_r, shape (R,) + tau.shape): the aging Prony series below and the fitted kernels of
+    :mod:`core.kernel_fit` share this one causal evaluation. ``t`` broadcasts against ``tau``.
+    """
+    t, tau = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(tau, dtype=float))
+    lag = np.maximum(t - tau, 0.0)
+    rates = kernel.rates.reshape((-1,) + (1,) * lag.ndim)
+    value = kernel.tau_part(tau) + np.sum(
+        kernel.exponential_parts(tau) * np.exp(-rates * lag[None]), axis=0)
+    return np.where(t >= tau, value, 0.0)
+
+
 @dataclass(frozen=True)
 class DegenerateKernel:
     """``K*(t*, tau*) = b(tau*) + sum_r a_r(tau*) exp(-rate_r (t* - tau*))``, aging Prony series.
@@ -173,12 +188,7 @@ class DegenerateKernel:
 
     def __call__(self, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
         """``K*(t*, tau*)`` [-], broadcasting ``t`` against ``tau``; 0 where ``t < tau``."""
-        t, tau = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(tau, dtype=float))
-        lag = np.maximum(t - tau, 0.0)
-        rates = self.rates.reshape((-1,) + (1,) * lag.ndim)
-        value = self.tau_part(tau) + np.sum(
-            self.exponential_parts(tau) * np.exp(-rates * lag[None]), axis=0)
-        return np.where(t >= tau, value, 0.0)
+        return separable_kernel_value(self, t, tau)
 
 
 @dataclass(frozen=True)

@@ -58,6 +58,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
 from core.cache import StageCache, fingerprint
+from core.creep import separable_kernel_value
 
 ArrayLike = Any
 
@@ -174,12 +175,7 @@ class FittedKernel:
 
     def __call__(self, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
         """``K(t, tau)`` [-], broadcasting ``t`` against ``tau``; 0 where ``t < tau``."""
-        t, tau = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(tau, dtype=float))
-        lag = np.maximum(t - tau, 0.0)
-        rates = self.rates.reshape((-1,) + (1,) * lag.ndim)
-        value = self.tau_part(tau) + np.sum(
-            self.exponential_parts(tau) * np.exp(-rates * lag[None]), axis=0)
-        return np.where(t >= tau, value, 0.0)
+        return separable_kernel_value(self, t, tau)
 
     def compliance(self, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
         """The fitted ``J~(t, tau) = 1/e(tau) + sum_r A_r(tau)(1 - exp(-(t - tau)/theta_r))``

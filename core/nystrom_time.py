@@ -84,17 +84,9 @@ class ModalForm:
         return self.constraint_inv @ np.array([loads[name]
                                                for name in self.ms.constraint_names])
 
-    def _given(self, rows: np.ndarray, loads: dict[str, np.ndarray], size: int) -> np.ndarray:
-        out = np.zeros((len(rows), size))
-        if "settlement" in loads:
-            out += np.outer(self.ms.e0_rot[rows], loads["settlement"])
-        if "tilt" in loads:
-            out += np.outer(self.ms.e1_rot[rows], loads["tilt"])
-        return out
-
     def drive(self, loads: dict[str, np.ndarray], size: int, gap: float = 1.0) -> np.ndarray:
         """Modal drive of the given settlement and tilt and of ``gap`` times the gap (F, T)."""
-        return (self.ms.psi_inv @ self._given(self.ms.free, loads, size)
+        return (self.ms.psi_inv @ self.ms.given_drive(self.ms.free, loads, size)
                 + gap * self.gap_free[:, None])
 
     def finish(self, c_t: np.ndarray, loads: dict[str, np.ndarray], known: np.ndarray,
@@ -120,7 +112,7 @@ class ModalForm:
             r_kk = ms.r_rot[np.ix_(ms.known, ms.known)]
             lhs = (c_t[None, :] * known[:k] + r_kf @ (ms.psi @ (z - vz))
                    + r_kk @ (known[:k] - vu[:k]) - gap * self.gap[ms.known][:, None]
-                   - self._given(ms.known, loads, size))
+                   - self.ms.given_drive(ms.known, loads, size))
             unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
             for i, name in enumerate(ms.unknown_names):
                 out[name] = unknowns[i]

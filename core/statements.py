@@ -94,6 +94,17 @@ class ModalSystem:
         a[:2] = np.tensordot(self.rotation, b[:2], axes=(1, 0))
         return a
 
+    def given_drive(self, rows: np.ndarray, loads: dict[str, np.ndarray],
+                    size: int) -> np.ndarray:
+        """``delta e0 + alpha e1`` (of the given ones) in the rotated ``rows``, shape
+        ``(len(rows), size)`` for load histories over ``size`` times (dimensionless)."""
+        out = np.zeros((len(rows), size))
+        if "settlement" in loads:
+            out += np.outer(self.e0_rot[rows], loads["settlement"])
+        if "tilt" in loads:
+            out += np.outer(self.e1_rot[rows], loads["tilt"])
+        return out
+
     def rotate(self, v: np.ndarray) -> np.ndarray:
         """``T^T v`` for a vector over the basis (n,)."""
         out = v.copy()

@@ -329,9 +329,10 @@ def test_the_step_limit_is_named_when_it_is_hit(monkeypatch):
     import functools
 
     import core.nystrom_time
-    import core.solver
+    import core.projection_levels
     from core.time_integration import solve_degenerate
-    for engine in (core.solver, core.nystrom_time):  # the projection and the default
+    # the projection's time stage and the default engine's
+    for engine in (core.projection_levels, core.nystrom_time):
         monkeypatch.setattr(engine, "solve_degenerate",
                             functools.partial(solve_degenerate, max_steps=40))
     from core.scene import solve
