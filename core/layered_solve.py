@@ -30,10 +30,14 @@ from core.layered_kernel import RegularPartTable, UniformLayer, symbol_at_infini
 
 __all__ = ["FlatPunchStiffness", "flat_punch_stiffness"]
 
-#: Chebyshev modes of the pressure and Gauss-Chebyshev nodes of the smooth part, as
-#: multiples of ``sqrt(a / h_min)`` (the edge boundary layer of width ``h`` is
-#: ``sqrt(h / a)`` wide in the angle of ``t = cos(theta)``) and of the modes.
-DEFAULT_MODES = 64
+#: Chebyshev modes of the pressure per ``sqrt(a / h_min)``: the edge boundary layer of
+#: width ``h`` is ``sqrt(h / a)`` wide in the angle of ``t = cos(theta)``. Measured (smooth,
+#: E_c = 0.3 E, H = a): h = 0.04 a, 64 modes: force and moment settled to 1e-10; h = 0.002 a:
+#: 128 modes 6e-5, 256 modes 1e-7 (relative change to the next doubling).
+MODES_PER_ROOT = 12
+#: Fewest modes.
+MIN_MODES = 32
+#: Gauss-Chebyshev nodes of the smooth part per mode.
 NODES_PER_MODE = 4
 
 
@@ -53,10 +57,17 @@ class FlatPunchStiffness:
 
 def flat_punch_stiffness(half_width: float, layers: Sequence[UniformLayer],
                          base_thickness: float, base_modulus: float, base_poisson: float,
-                         *, modes: int = DEFAULT_MODES,
+                         *, modes: int | None = None,
                          nodes: int | None = None) -> FlatPunchStiffness:
     """Force per unit settlement and moment per unit tilt of a flat punch of half-width a
-    [m] on ``layers`` (top first) over the base (H [m], E [Pa], nu), all SI units."""
+    [m] on ``layers`` (top first) over the base (H [m], E [Pa], nu), all SI units.
+
+    ``modes`` defaults to ``max(MIN_MODES, MODES_PER_ROOT sqrt(a / h_min))``, ``nodes`` to
+    ``NODES_PER_MODE * modes``.
+    """
+    if modes is None:
+        thinnest = min([lay.thickness for lay in layers] + [half_width])
+        modes = max(MIN_MODES, int(np.ceil(MODES_PER_ROOT * np.sqrt(half_width / thinnest))))
     if half_width <= 0 or not np.isfinite(half_width):
         raise ValueError(f"half_width: must be a finite positive number, got {half_width!r}")
     n_nodes = nodes or NODES_PER_MODE * modes
@@ -65,7 +76,11 @@ def flat_punch_stiffness(half_width: float, layers: Sequence[UniformLayer],
     table = RegularPartTable(2 * lam, layers, base_thickness, base_modulus, base_poisson)
     theta = np.pi * (np.arange(n_nodes) + 0.5) / n_nodes
     t = np.cos(theta)
-    smooth = table(lam * (t[:, None] - t[None, :])) - l_inf * np.log(lam)
+    smooth = np.empty((n_nodes, n_nodes))
+    for start in range(0, n_nodes, 64):  # blocks keep the table's temporaries small
+        rows = slice(start, start + 64)
+        smooth[rows] = table(lam * (t[rows, None] - t[None, :]))
+    smooth -= l_inf * np.log(lam)
     cheb = np.cos(np.outer(np.arange(modes), theta))  # T_m(t_i)
     weight = np.pi / n_nodes
     matrix = weight * weight * (cheb @ smooth @ cheb.T)
