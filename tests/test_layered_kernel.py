@@ -210,3 +210,10 @@ def test_bad_layers_are_refused():
         UniformLayer(1.0, 1.0, 0.3, "glued")
     with pytest.raises(ValueError, match="modulus"):
         UniformLayer(1.0, float("nan"), 0.3)
+
+
+def test_results_say_which_coating_model_answered(small_preset):
+    from core import solve
+
+    result = solve(small_preset(count=2))
+    assert result.info["coating_model"] == "thin layer"
