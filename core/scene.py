@@ -1090,6 +1090,9 @@ class SceneSolution:
         self.info = dict(solution.info)
         self.info["flags"] = list(self.flags)
         self.info["model_error_estimate"] = self.model_error["estimate"]
+        # the default solve answers with the thin-layer model everywhere so far; the exact
+        # layered kernel (core.layered_kernel) is not yet wired into it
+        self.info["coating_model"] = "thin layer"
         self.info["model_error"] = dict(self.model_error)
         self.info["dimensional"] = self._extras()
 

@@ -1,0 +1,278 @@
+"""The exact plane-strain response of uniform coating layers on the base layer.
+
+A stack of elastic layers of constant thickness ``h_k``, modulus ``E_k`` and Poisson ratio
+``nu_k`` (top first), each joined to what lies under it ``"smooth"`` (frictionless) or
+``"bonded"``, lies on the base layer (thickness ``H``, modulus ``E``, Poisson ``nu``), which
+lies without friction on a rigid bed. A normal surface pressure ``p(x)`` (no shear) settles
+the surface by
+
+    w(x) = 2 (1 - nu^2) / (pi E) int k_stack((x - xi) / H) p(xi) dxi,
+    k_stack(s) = int_0^inf L_stack(u) / u cos(s u) du,
+
+the base's normalisation (model notes, ``core/kernel.py``): ``u`` is the wavenumber times
+``H``, so without coating ``L_stack = L`` of :mod:`core.kernel` and ``k_stack = k_pl``.
+
+Fourier symbol. In each layer a Papkovich-Neuber pair ``phi = cos(kx) f(z)``, ``psi =
+cos(kx) g(z)`` (``z`` down, ``f, g`` combinations of ``exp(-kz)`` and ``exp(kz)``) gives
+
+    2 mu U = -k (f + z g),             2 mu W = f' + z g' - (3 - 4 nu) g,
+    T = f'' + z g'' - 2 (1 - nu) g',   S = -k [f' + z g' - (1 - 2 nu) g],
+
+for ``u_x = U sin kx``, ``u_z = W cos kx``, ``sigma_zz = T cos kx``, ``sigma_xz = S sin kx``.
+The decaying pair is written from the layer's top and the growing pair from its bottom
+(``exp(k (z - h))``), so every entry is bounded by 1 + 1/e whatever ``k h``: the linear
+system of the boundary and interface conditions (``4 (N + 1)`` unknowns) has no
+``exp(k h)`` in it, and for large ``k h`` it decouples instead of overflowing. It is solved
+per wavenumber (batched); ``L_stack = 2 mu_b k W / (2 (1 - nu))`` at the surface for unit
+pressure, ``mu_b`` the base's shear modulus.
+
+Limits (tests in ``tests/test_layered_kernel.py``): no coating gives ``L`` exactly;
+``L_stack -> L_inf = (1 - nu_1^2) E / ((1 - nu^2) E_1)`` as ``u -> inf`` (the top coating as a
+half-space); for ``u h << 1`` a coating adds to ``L`` the thin-layer term ``u c_k E /
+(2 (1 - nu^2) H)`` with the Winkler compliance ``c_k`` of :func:`core.coating_model.
+layer_compliance` for a smooth interface to leading order in ``h``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from core.coating_model import INTERFACES
+
+__all__ = ["RegularPartTable", "UniformLayer", "stack_kernel", "stack_kernel_regular",
+           "stack_symbol", "symbol_at_infinity"]
+
+
+@dataclass(frozen=True)
+class UniformLayer:
+    """One coating layer of constant ``thickness`` h [m], ``modulus`` E_k [Pa], Poisson ratio
+    ``poisson`` nu_k [-], joined to what lies under it by ``interface`` (smooth|bonded)."""
+
+    thickness: float
+    modulus: float
+    poisson: float
+    interface: str = "smooth"
+
+    def __post_init__(self) -> None:
+        for name in ("thickness", "modulus"):
+            value = getattr(self, name)
+            if not np.isfinite(value) or value <= 0:
+                raise ValueError(f"{name}: must be a finite positive number, got {value!r}")
+        if not np.isfinite(self.poisson) or not -1.0 < self.poisson < 0.5:
+            raise ValueError(f"poisson: must lie in (-1, 0.5), got {self.poisson!r}")
+        if self.interface not in INTERFACES:
+            raise ValueError(f"interface: must be 'smooth' or 'bonded', got {self.interface!r}")
+
+
+def symbol_at_infinity(layers: Sequence[UniformLayer], base_modulus: float,
+                       base_poisson: float) -> float:
+    """``L_inf = lim L_stack(u)`` as ``u -> inf`` [-]: the top layer's half-space compliance
+    ``(1 - nu_1^2) / E_1`` over the base's ``(1 - nu^2) / E`` (1 without coating)."""
+    if not layers:
+        return 1.0
+    top = layers[0]
+    return (1 - top.poisson**2) * base_modulus / ((1 - base_poisson**2) * top.modulus)
+
+
+def _rows(zeta_top: np.ndarray, zeta_bot: np.ndarray, nu: float, shear_ratio: float):
+    """(U~, W~, S, T) at one face for the four basis solutions of a layer.
+
+    ``zeta_top = k z`` (distance from the layer's top, >= 0) and ``zeta_bot = k (z - h)``
+    (<= 0) at that face, arrays over the wavenumbers. Displacements are scaled as
+    ``U~ = 2 mu_b k U`` (``shear_ratio = mu_b / mu``). Columns: decaying f, decaying g,
+    growing f, growing g. Returns an array (n, 4 quantities, 4 columns).
+    """
+    e1 = np.exp(-zeta_top)
+    e2 = np.exp(zeta_bot)
+    z1, z2 = zeta_top, zeta_bot
+    out = np.empty(zeta_top.shape + (4, 4))
+    # decaying pair: f = a exp(-kz) / k^2, g = b exp(-kz) / k
+    out[..., 0, 0] = -shear_ratio * e1
+    out[..., 0, 1] = -shear_ratio * z1 * e1
+    out[..., 1, 0] = -shear_ratio * e1
+    out[..., 1, 1] = -shear_ratio * (z1 + 3 - 4 * nu) * e1
+    out[..., 2, 0] = e1
+    out[..., 2, 1] = (z1 + 1 - 2 * nu) * e1
+    out[..., 3, 0] = e1
+    out[..., 3, 1] = (z1 + 2 * (1 - nu)) * e1
+    # growing pair: f = c exp(k(z-h)) / k^2, g = d exp(k(z-h)) / k
+    out[..., 0, 2] = -shear_ratio * e2
+    out[..., 0, 3] = -shear_ratio * z2 * e2
+    out[..., 1, 2] = shear_ratio * e2
+    out[..., 1, 3] = shear_ratio * (z2 - 3 + 4 * nu) * e2
+    out[..., 2, 2] = -e2
+    out[..., 2, 3] = -(z2 - 1 + 2 * nu) * e2
+    out[..., 3, 2] = e2
+    out[..., 3, 3] = (z2 - 2 * (1 - nu)) * e2
+    return out
+
+
+_U, _W, _S, _T = range(4)
+
+
+def stack_symbol(u: ArrayLike, layers: Sequence[UniformLayer], base_thickness: float,
+                 base_modulus: float, base_poisson: float) -> np.ndarray:
+    """``L_stack(u)`` [-] for wavenumbers ``u`` [-] (times the base thickness H [m]), u > 0.
+
+    ``layers`` top first (SI units), the base: ``base_thickness`` H [m], ``base_modulus``
+    E [Pa], ``base_poisson`` nu. Odd in ``u`` like ``L``; here ``u > 0`` (u = 0 gives NaN:
+    ``L_stack(u) / u`` tends to a finite limit there, evaluate it at a small ``u``).
+    """
+    k = np.atleast_1d(np.asarray(u, dtype=float))
+    shape = k.shape
+    k = k.ravel()
+    if base_thickness <= 0 or base_modulus <= 0 or not -1 < base_poisson < 0.5:
+        raise ValueError("base: thickness and modulus must be positive, poisson in (-1, 0.5)")
+    mu_b = base_modulus / (2 * (1 + base_poisson))
+    mats = [(lay.thickness / base_thickness, lay.modulus / (2 * (1 + lay.poisson)),
+             lay.poisson, lay.interface) for lay in layers]
+    mats.append((1.0, mu_b, base_poisson, "bed"))
+    n = 4 * len(mats)
+    system = np.zeros((k.size, n, n))
+    rhs = np.zeros((k.size, n))
+    zero = np.zeros_like(k)
+    faces = []
+    for h, mu, nu, _ in mats:
+        kh = k * h
+        faces.append((_rows(zero, -kh, nu, mu_b / mu), _rows(kh, zero, nu, mu_b / mu)))
+    row = 0
+    # top: no shear, unit pressure (sigma_zz = -1)
+    top = faces[0][0]
+    system[:, row, 0:4] = top[:, _S]
+    system[:, row + 1, 0:4] = top[:, _T]
+    rhs[:, row + 1] = -1.0
+    row += 2
+    for j in range(len(mats) - 1):
+        above, below = faces[j][1], faces[j + 1][0]
+        ca, cb = slice(4 * j, 4 * j + 4), slice(4 * j + 4, 4 * j + 8)
+        if mats[j][3] == "bonded":
+            for q in (_U, _W, _S, _T):
+                system[:, row, ca] = above[:, q]
+                system[:, row, cb] = -below[:, q]
+                row += 1
+        else:
+            for q in (_W, _T):
+                system[:, row, ca] = above[:, q]
+                system[:, row, cb] = -below[:, q]
+                row += 1
+            system[:, row, ca] = above[:, _S]
+            system[:, row + 1, cb] = below[:, _S]
+            row += 2
+    bottom = faces[-1][1]
+    system[:, row, n - 4:] = bottom[:, _W]
+    system[:, row + 1, n - 4:] = bottom[:, _S]
+    coef = np.linalg.solve(system, rhs[..., None])[..., 0]
+    w_scaled = np.einsum("ij,ij->i", top[:, _W], coef[:, 0:4])
+    return (w_scaled / (2 * (1 - base_poisson))).reshape(shape)
+
+
+# ------------------------------------------------------------------------ the kernel
+
+#: Gauss-Legendre points per panel of the u-integral.
+_GAUSS_POINTS = 24
+#: The u-integral stops where the coating's share ``exp(-2 u h_min)`` is below 1e-17.
+_TAIL_DECAY = 40.0
+
+
+def _u_rule(layers: Sequence[UniformLayer], base_thickness: float,
+            largest_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes and weights in u for ``int_0^U r(u) cos(s u) du``, |s| <= ``largest_s``.
+
+    Panels of width <= 1 (the base's scale) and <= 4 / largest_s (a few periods of the
+    cosine per panel) up to ``U = _TAIL_DECAY / min(h_k / H, 1) + _TAIL_DECAY``.
+    """
+    thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
+    end = _TAIL_DECAY / thinnest + _TAIL_DECAY
+    width = min(1.0, 4.0 / max(largest_s, 1e-300))
+    edges = np.linspace(0.0, end, int(np.ceil(end / width)) + 1)
+    x, w = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
+    half = 0.5 * np.diff(edges)
+    mid = 0.5 * (edges[1:] + edges[:-1])
+    return (mid[:, None] + half[:, None] * x).ravel(), (half[:, None] * w).ravel()
+
+
+def stack_kernel_regular(s: ArrayLike, layers: Sequence[UniformLayer],
+                         base_thickness: float, base_modulus: float,
+                         base_poisson: float) -> np.ndarray:
+    """``k_stack(s) + L_inf ln|s|`` [-], even and smooth in ``s`` [-] (distance over H).
+
+    Exact split: ``k_stack(s) = L_inf ln(1 + 1/s^2) / 2 + int_0^inf r(u) cos(s u) du`` with
+    ``r(u) = [L_stack(u) - L_inf (1 - exp(-u))] / u``, smooth and exponentially decaying
+    (rate ``2 h_min / H``); the integral by composite Gauss-Legendre (:func:`_u_rule`).
+    """
+    s = np.abs(np.asarray(s, dtype=float))
+    flat = s.ravel()
+    l_inf = symbol_at_infinity(layers, base_modulus, base_poisson)
+    u, w = _u_rule(layers, base_thickness, float(flat.max(initial=0.0)))
+    symbol = stack_symbol(u, layers, base_thickness, base_modulus, base_poisson)
+    r = (symbol - l_inf * -np.expm1(-u)) / u
+    out = np.empty_like(flat)
+    for start in range(0, flat.size, 256):
+        block = flat[start:start + 256]
+        out[start:start + 256] = np.cos(np.outer(block, u)) @ (w * r)
+    out += 0.5 * l_inf * np.log1p(flat * flat)
+    return out.reshape(s.shape)
+
+
+def stack_kernel(s: ArrayLike, layers: Sequence[UniformLayer], base_thickness: float,
+                 base_modulus: float, base_poisson: float) -> np.ndarray:
+    """``k_stack(s) = int_0^inf L_stack(u) / u cos(s u) du`` [-], s [-] the distance over H;
+    ``+inf`` at 0 (log singularity of coefficient ``L_inf``)."""
+    s = np.asarray(s, dtype=float)
+    l_inf = symbol_at_infinity(layers, base_modulus, base_poisson)
+    with np.errstate(divide="ignore"):
+        return stack_kernel_regular(s, layers, base_thickness, base_modulus,
+                                    base_poisson) - l_inf * np.log(np.abs(s))
+
+
+#: Chebyshev degree of the interpolant of the regular part on each panel of s.
+_PANEL_DEGREE = 24
+#: Largest panel of s (in base thicknesses): the base's kernel varies on scale 1.
+_PANEL_WIDTH = 0.5
+
+
+class RegularPartTable:
+    """``k_stack(s) + L_inf ln|s|`` on ``0 <= s <= largest_s``, tabulated once.
+
+    Panels of s: ``[0, h_min / 2H]``, then doubling up to :data:`_PANEL_WIDTH` (the part
+    varies on the coating's scale near 0 and on the base's beyond), each with a Chebyshev
+    interpolant of degree :data:`_PANEL_DEGREE` of :func:`stack_kernel_regular`.
+    """
+
+    def __init__(self, largest_s: float, layers: Sequence[UniformLayer],
+                 base_thickness: float, base_modulus: float, base_poisson: float) -> None:
+        thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
+        edges = [0.0]
+        width = 0.5 * thinnest
+        while edges[-1] < largest_s:
+            edges.append(edges[-1] + width)
+            width = min(2 * width, _PANEL_WIDTH)
+        self.edges = np.array(edges)
+        n = _PANEL_DEGREE + 1
+        nodes = np.cos(np.pi * (np.arange(n) + 0.5) / n)
+        centre = 0.5 * (self.edges[1:] + self.edges[:-1])
+        half = 0.5 * np.diff(self.edges)
+        points = centre[:, None] + half[:, None] * nodes
+        values = stack_kernel_regular(points, layers, base_thickness, base_modulus,
+                                      base_poisson)
+        vander = np.polynomial.chebyshev.chebvander(nodes, _PANEL_DEGREE)
+        self.coefficients = np.linalg.solve(vander, values.T).T  # (panels, degree + 1)
+        self.centre, self.half = centre, half
+
+    def __call__(self, s: ArrayLike) -> np.ndarray:
+        """The regular part at ``s`` [-] (|s| up to the table's end)."""
+        a = np.abs(np.asarray(s, dtype=float))
+        idx = np.clip(np.searchsorted(self.edges, a, side="right") - 1, 0,
+                      self.centre.size - 1)
+        x = (a - self.centre[idx]) / self.half[idx]
+        c = self.coefficients[idx]
+        # Clenshaw, vectorized over points with their own panel's coefficients
+        b1 = np.zeros_like(x)
+        b2 = np.zeros_like(x)
+        for j in range(_PANEL_DEGREE, 0, -1):
+            b1, b2 = 2 * x * b1 - b2 + c[..., j], b1
+        return x * b1 - b2 + c[..., 0]
