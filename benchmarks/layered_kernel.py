@@ -32,12 +32,8 @@ COATING_POISSON = (0.3, 0.45)
 INTERFACES = ("smooth", "bonded")
 ROOT = Path(__file__).resolve().parent.parent
 THIN_LAYER_NOTE = (
-    "The thin-layer moment column reads about -51 % even where "
-    "`benchmarks/results/coating_validity.md` has a few %: on this revision "
-    "`benchmarks.coating_validity.fast_stiffness` returns about half the moment per unit "
-    "tilt that the FE model and the layered kernel give (also for a vanishing coating, "
-    "0.583 against 1.164 at H = a), i.e. its moment (or tilt) convention changed after "
-    "that table was made; the thin-layer force column is unaffected.\n")
+    "The thin-layer columns are the fast model's unit stiffnesses in full contact (the FE "
+    "model ties the punch to the surface), as in `benchmarks/coating_validity.py`.\n")
 
 
 def _strip(h: float, modulus: float, poisson: float, interface: str) -> CoatingStrip:
