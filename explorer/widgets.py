@@ -83,12 +83,26 @@ class BoundedUpload(pn.viewable.Viewer):
     def __init__(self, accept: Sequence[str], max_bytes: int, **params: Any) -> None:
         super().__init__(**params)
         self.max_bytes = max_bytes
+        self._accept = list(accept)
+        self._box = self._new_box()
+        self._holder = pn.Column(self._box, sizing_mode="stretch_width", margin=0)
+
+    def _new_box(self) -> pn.widgets.FileDropper:
         # chunks well below the server's websocket message limit (explorer/__main__.py)
-        self._box = pn.widgets.FileDropper(
-            accepted_filetypes=list(accept), multiple=False,
-            max_file_size=f"{max(1, max_bytes // 1000)}KB", chunk_size=UPLOAD_CHUNK_BYTES,
-            sizing_mode="stretch_width", height=90, css_classes=["file-dropper"])
-        self._box.param.watch(self._on_drop, "value")
+        box = pn.widgets.FileDropper(
+            accepted_filetypes=self._accept, multiple=False,
+            max_file_size=f"{max(1, self.max_bytes // 1000)}KB",
+            chunk_size=UPLOAD_CHUNK_BYTES, sizing_mode="stretch_width", height=90,
+            css_classes=["file-dropper"])
+        box.param.watch(self._on_drop, "value")
+        return box
+
+    def clear(self) -> None:
+        """Empty the box on the page, ready for the next file (``filename`` and ``value``
+        keep the last file). The dropper cannot be emptied from the server: a new one
+        takes its place."""
+        self._box = self._new_box()
+        self._holder.objects = [self._box]
 
     def _on_drop(self, event: Any) -> None:
         for name, data in (event.new or {}).items():
@@ -98,7 +112,7 @@ class BoundedUpload(pn.viewable.Viewer):
             self.value = raw
 
     def __panel__(self) -> pn.viewable.Viewable:
-        return self._box
+        return self._holder
 
 
 def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
