@@ -83,26 +83,28 @@ class BoundedUpload(pn.viewable.Viewer):
     def __init__(self, accept: Sequence[str], max_bytes: int, **params: Any) -> None:
         super().__init__(**params)
         self.max_bytes = max_bytes
-        self._accept = list(accept)
-        self._box = self._new_box()
-        self._holder = pn.Column(self._box, sizing_mode="stretch_width", margin=0)
-
-    def _new_box(self) -> pn.widgets.FileDropper:
         # chunks well below the server's websocket message limit (explorer/__main__.py)
-        box = pn.widgets.FileDropper(
-            accepted_filetypes=self._accept, multiple=False,
-            max_file_size=f"{max(1, self.max_bytes // 1000)}KB",
-            chunk_size=UPLOAD_CHUNK_BYTES, sizing_mode="stretch_width", height=90,
-            css_classes=["file-dropper"])
-        box.param.watch(self._on_drop, "value")
-        return box
+        self._box = pn.widgets.FileDropper(
+            accepted_filetypes=list(accept), multiple=False,
+            max_file_size=f"{max(1, max_bytes // 1000)}KB", chunk_size=UPLOAD_CHUNK_BYTES,
+            sizing_mode="stretch_width", height=90, css_classes=["file-dropper"])
+        self._box.param.watch(self._on_drop, "value")
+        # The dropper has no way to be emptied from the server: a hidden counter asks the
+        # page to remove its files (a new dropper in its place broke the old one's
+        # preview script, still drawing the file it had just sent).
+        self._clears = pn.widgets.IntInput(value=0, visible=False)
+        self._clears.jscallback(value="""
+            const view = Bokeh.index.find_one(box);
+            if (view && view._file_pond) { view._file_pond.removeFiles(); }""",
+                                args={"box": self._box})
+        self._holder = pn.Column(self._box, self._clears, sizing_mode="stretch_width",
+                                 margin=0)
 
     def clear(self) -> None:
         """Empty the box on the page, ready for the next file (``filename`` and ``value``
-        keep the last file). The dropper cannot be emptied from the server: a new one
-        takes its place."""
-        self._box = self._new_box()
-        self._holder.objects = [self._box]
+        keep the last file): a refused file no longer shows "Upload complete", and the
+        next file needs no click on the first one's x."""
+        self._clears.value += 1
 
     def _on_drop(self, event: Any) -> None:
         for name, data in (event.new or {}).items():
