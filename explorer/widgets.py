@@ -89,6 +89,22 @@ class BoundedUpload(pn.viewable.Viewer):
             max_file_size=f"{max(1, max_bytes // 1000)}KB", chunk_size=UPLOAD_CHUNK_BYTES,
             sizing_mode="stretch_width", height=90, css_classes=["file-dropper"])
         self._box.param.watch(self._on_drop, "value")
+        # The dropper has no way to be emptied from the server: a hidden counter asks the
+        # page to remove its files (a new dropper in its place broke the old one's
+        # preview script, still drawing the file it had just sent).
+        self._clears = pn.widgets.IntInput(value=0, visible=False)
+        self._clears.jscallback(value="""
+            const view = Bokeh.index.find_one(box);
+            if (view && view._file_pond) { view._file_pond.removeFiles(); }""",
+                                args={"box": self._box})
+        self._holder = pn.Column(self._box, self._clears, sizing_mode="stretch_width",
+                                 margin=0)
+
+    def clear(self) -> None:
+        """Empty the box on the page, ready for the next file (``filename`` and ``value``
+        keep the last file): a refused file no longer shows "Upload complete", and the
+        next file needs no click on the first one's x."""
+        self._clears.value += 1
 
     def _on_drop(self, event: Any) -> None:
         for name, data in (event.new or {}).items():
@@ -98,7 +114,7 @@ class BoundedUpload(pn.viewable.Viewer):
             self.value = raw
 
     def __panel__(self) -> pn.viewable.Viewable:
-        return self._box
+        return self._holder
 
 
 def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",

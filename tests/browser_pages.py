@@ -79,3 +79,59 @@ class Page:
 
     def close(self) -> None:
         self.page.close()
+
+
+# Whether some element of the page (shadow roots included) shows the text.
+JS_SHOWN = """(text) => {
+  const roots = [document];
+  while (roots.length) {
+    const r = roots.pop();
+    for (const e of r.querySelectorAll('*')) {
+      if (!e.shadowRoot) continue;
+      if (e.shadowRoot.textContent.includes(text)) return true;
+      roots.push(e.shadowRoot);
+    }
+  }
+  return false;
+}"""
+
+
+def until(check, what: str, timeout: float = 60.0) -> None:
+    """Poll ``check`` (a look at the page) until it holds; fail after ``timeout`` [s]."""
+    deadline = time.monotonic() + timeout
+    while not check():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"not seen within {timeout:g} s: {what}")
+        time.sleep(0.05)
+
+
+def served_explorer():
+    """A served explorer (``python -m explorer``) for a test module: yields its address,
+    then fails on a traceback of the page's code in the server's output."""
+    from benchmarks.serving import ExplorerProcess
+
+    # 180 s: the server solves the default scene once before it answers
+    with ExplorerProcess(ready_timeout=180) as explorer:
+        yield explorer.url
+    output = explorer.output()
+    assert not _app_tracebacks(output), output
+
+
+def chromium_context(width: int, height: int, **options):
+    """A fresh Chromium profile (Debian's browser) with a window of ``width`` x ``height``
+    [px]; yields the Playwright context, then removes the profile."""
+    import shutil
+    import tempfile
+
+    import playwright.sync_api as playwright_api
+
+    from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS
+
+    profile = tempfile.mkdtemp(prefix="explorer-chromium-")
+    with playwright_api.sync_playwright() as p:
+        context = p.chromium.launch_persistent_context(
+            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
+            viewport={"width": width, "height": height}, **options)
+        yield context
+        context.close()
+    shutil.rmtree(profile, ignore_errors=True)

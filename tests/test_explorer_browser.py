@@ -10,15 +10,13 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
-import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
+from benchmarks.serving import browser_missing
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
@@ -28,32 +26,19 @@ if _missing:
         pytest.fail(_missing, pytrace=False)
     pytest.skip(_missing, allow_module_level=True)
 
-import playwright.sync_api as playwright_api  # noqa: E402
-
-from tests.browser_pages import Page, _app_tracebacks  # noqa: E402
+from tests.browser_pages import Page, chromium_context, served_explorer  # noqa: E402
 
 ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
 
 
 @pytest.fixture(scope="module")
 def server() -> Iterator[str]:
-    # 180 s: the server solves the default scene once before it answers
-    with ExplorerProcess(ready_timeout=180) as explorer:
-        yield explorer.url
-    output = explorer.output()
-    assert not _app_tracebacks(output), output
+    yield from served_explorer()
 
 
 @pytest.fixture(scope="module")
 def browser_context() -> Iterator[object]:
-    profile = tempfile.mkdtemp(prefix="explorer-chromium-")
-    with playwright_api.sync_playwright() as p:
-        context = p.chromium.launch_persistent_context(
-            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
-            viewport={"width": 1500, "height": 1300})
-        yield context
-        context.close()
-    shutil.rmtree(profile, ignore_errors=True)
+    yield from chromium_context(1500, 1300)
 
 
 @pytest.fixture()

@@ -9,15 +9,12 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
-import tempfile
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
+from benchmarks.serving import browser_missing
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
@@ -27,9 +24,13 @@ if _missing:
         pytest.fail(_missing, pytrace=False)
     pytest.skip(_missing, allow_module_level=True)
 
-import playwright.sync_api as playwright_api  # noqa: E402
-
-from tests.browser_pages import Page, _app_tracebacks  # noqa: E402
+from tests.browser_pages import (  # noqa: E402
+    JS_SHOWN,
+    Page,
+    chromium_context,
+    served_explorer,
+    until,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -44,19 +45,6 @@ JS_VIEW_WIDTH = """(name) => {
   }
   return null;
 }"""
-# Whether some element of the page (shadow roots included) shows the text.
-JS_SHOWN = """(text) => {
-  const roots = [document];
-  while (roots.length) {
-    const r = roots.pop();
-    for (const e of r.querySelectorAll('*')) {
-      if (!e.shadowRoot) continue;
-      if (e.shadowRoot.textContent.includes(text)) return true;
-      roots.push(e.shadowRoot);
-    }
-  }
-  return false;
-}"""
 # Width [px] of a figure title in the font Bokeh draws it with (bold 13px helvetica).
 JS_TITLE_WIDTH = """(name) => {
   const fig = Bokeh.documents[0].get_model_by_name(name);
@@ -68,22 +56,12 @@ JS_TITLE_WIDTH = """(name) => {
 
 @pytest.fixture(scope="module")
 def server() -> Iterator[str]:
-    with ExplorerProcess(ready_timeout=180) as explorer:
-        yield explorer.url
-    output = explorer.output()
-    assert not _app_tracebacks(output), output
+    yield from served_explorer()
 
 
 @pytest.fixture(scope="module")
 def browser_context() -> Iterator[object]:
-    profile = tempfile.mkdtemp(prefix="explorer-chromium-")
-    with playwright_api.sync_playwright() as p:
-        context = p.chromium.launch_persistent_context(
-            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
-            viewport={"width": 1400, "height": 900}, accept_downloads=True)
-        yield context
-        context.close()
-    shutil.rmtree(profile, ignore_errors=True)
+    yield from chromium_context(1400, 900, accept_downloads=True)
 
 
 @pytest.fixture()
@@ -91,15 +69,6 @@ def page(server: str, browser_context: object) -> Iterator[Page]:
     p = Page(browser_context, server)
     yield p
     p.close()
-
-
-def _until(check: Callable[[], bool], what: str, timeout: float = 60.0) -> None:
-    """Poll ``check`` (a look at the page) until it holds; fail after ``timeout`` [s]."""
-    deadline = time.monotonic() + timeout
-    while not check():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"not seen within {timeout:g} s: {what}")
-        time.sleep(0.05)
 
 
 def _wait(page: Page, js: str, arg: object = None, timeout: float = 60_000) -> None:
@@ -124,14 +93,14 @@ def test_time_slider_range_follows_a_preset_switch(page: Page):
     """40 output times, then a preset with 60: the slider must reach the 60th."""
     assert _player_range(page)["max"] == "39"
     _choose_preset(page, "eccentric_creep", "Eccentric")
-    _until(lambda: _player_range(page)["max"] == "59", "the slider reaching 59")
+    until(lambda: _player_range(page)["max"] == "59", "the slider reaching 59")
     assert _player_range(page)["value"] == "59"
     # the first time, then the last, land where they say
     slider = page.page.locator(".time-player input[type=range]").first
     slider.fill("0")
-    _until(lambda: "t = 0 days" in page.text(".time-label"), "t = 0")
+    until(lambda: "t = 0 days" in page.text(".time-label"), "t = 0")
     slider.fill("59")
-    _until(lambda: "t = 1000 days" in page.text(".time-label"), "t = 1000")
+    until(lambda: "t = 1000 days" in page.text(".time-label"), "t = 1000")
     # the preset's text says what its curve shows (it levels off; not "for years")
     assert page.page.evaluate(JS_SHOWN, "level off after about 250 days")
     assert not page.page.evaluate(JS_SHOWN, "keep growing for years")
@@ -189,11 +158,11 @@ def _figure_top(page: Page) -> float:
 
 def test_a_changed_scene_is_saved_under_its_own_name_and_description(page: Page):
     page.type_into(".load-0-value", "650")
-    _until(lambda: page.text(".readout-force") == "650", "force 650")
+    until(lambda: page.text(".readout-force") == "650", "force 650")
     page.open_tab("Files")
     name = page.page.locator(".scene-name input").first
     name.wait_for(timeout=30_000)
-    _until(lambda: name.input_value().endswith("(modified)"), "the name '... (modified)'")
+    until(lambda: name.input_value().endswith("(modified)"), "the name '... (modified)'")
     area = page.page.locator(".scene-description textarea").first
     area.fill("Strip footing B-12, checked for 650 kN/m")
     area.blur()
@@ -232,7 +201,7 @@ def test_units_stay_put_and_a_load_step_sends_only_what_changed(page: Page):
     # a time step sends no image and no drawing
     slider = page.page.locator(".time-player input[type=range]").first
     slider.fill("3")
-    _until(lambda: "365" not in page.text(".time-label"), "a new time")
+    until(lambda: "365" not in page.text(".time-label"), "a new time")
     assert page.page.evaluate("() => window.__sent") == {"image": 0, "layers": 0}
     # a much larger force: the peak passes 1 MPa, the unit stays kPa, the colours widen
     page.type_into(".load-0-value", "5000")
@@ -245,7 +214,7 @@ def test_units_stay_put_and_a_load_step_sends_only_what_changed(page: Page):
     # back to the first force: the colour scale stays (it is the family's, fixed)
     page.type_into(".load-0-value", "500")
     _wait(page, f"() => {doc}.get_model_by_name('q_source').data.q.length > 1")
-    _until(lambda: page.text(".readout-force") == "500", "force 500")
+    until(lambda: page.text(".readout-force") == "500", "force 500")
     assert page.page.evaluate(
         f"() => {doc}.get_model_by_name('image_mapper').high") == new_high
     assert page.errors == []
@@ -285,24 +254,24 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     details = page.page.locator(".solve-details").first
     assert "stages:" not in details.inner_text()
     details.locator("summary").click()
-    _until(lambda: "stages:" in details.inner_text(), "the stage timings")
+    until(lambda: "stages:" in details.inner_text(), "the stage timings")
     # the check, no limit yet
-    _until(lambda: "no limits set" in page.text(".design-check"), "the design check")
+    until(lambda: "no limits set" in page.text(".design-check"), "the design check")
     page.open_tab("Check")
     box = page.page.locator(".limit-pressure input").first
     box.wait_for(timeout=30_000)
     box.fill("1")  # kPa: any footing fails this
     box.press("Enter")
-    _until(lambda: "a limit is exceeded" in page.text(".design-check"), "FAIL")
+    until(lambda: "a limit is exceeded" in page.text(".design-check"), "FAIL")
     box.fill("100000")
     box.press("Enter")
-    _until(lambda: "all set limits hold" in page.text(".design-check"), "pass")
+    until(lambda: "all set limits hold" in page.text(".design-check"), "pass")
     # e = M/P typed: the moment follows, the readout says so
     ecc = page.page.locator(".eccentricity-input input").first
     ecc.fill("0.2")
     ecc.press("Enter")
-    _until(lambda: page.text(".readout-moment") == "100", "M = 0.2 m x 500 kN/m")
-    _until(lambda: "e = M/P = 0.2 m" in page.text(".design-check"), "e in the check")
+    until(lambda: page.text(".readout-moment") == "100", "M = 0.2 m x 500 kN/m")
+    until(lambda: "e = M/P = 0.2 m" in page.text(".design-check"), "e in the check")
     # the report holds the check, the flags' verdict, the accuracy and the version
     page.open_tab("Files")
     with page.page.expect_download(timeout=60_000) as info:
@@ -327,15 +296,15 @@ def test_classical_solutions_undo_and_reset(page: Page):
     assert max(rule) == pytest.approx(250.0) and min(rule) == pytest.approx(250.0)
     force = page.text(".readout-force")
     page.type_into(".load-0-value", "650")
-    _until(lambda: page.text(".readout-force") == "650", "force 650")
+    until(lambda: page.text(".readout-force") == "650", "force 650")
     _wait(page, f"() => Math.max(...{doc}.get_model_by_name('classical_source')"
           ".data.bearing_rule) > 300")
     page.page.locator(".undo-button button").first.click()
-    _until(lambda: page.text(".readout-force") == force, "undo to the first force")
+    until(lambda: page.text(".readout-force") == force, "undo to the first force")
     page.type_into(".load-0-value", "700")
-    _until(lambda: page.text(".readout-force") == "700", "force 700")
+    until(lambda: page.text(".readout-force") == "700", "force 700")
     page.page.locator(".reset-button button").first.click()
-    _until(lambda: page.text(".readout-force") == force, "reset to the preset")
+    until(lambda: page.text(".readout-force") == force, "reset to the preset")
     assert page.errors == []
 
 
@@ -345,9 +314,9 @@ def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
     page.page.get_by_text("Pin this result").first.click()
     page.page.locator(".pinned-settlement").first.wait_for(timeout=30_000)
     page.type_into(".load-0-value", "650")
-    _until(lambda: page.text(".readout-force") == "650", "force 650")
+    until(lambda: page.text(".readout-force") == "650", "force 650")
     page.page.locator(".time-player input[type=range]").first.fill("5")
-    _until(lambda: "t = 365" not in page.text(".time-label"), "time 5")
+    until(lambda: "t = 365" not in page.text(".time-label"), "time 5")
     label = page.text(".time-label")
     pinned = page.text(".pinned-settlement")  # the pin at the time shown
     page.open_tab("Base")
@@ -355,13 +324,13 @@ def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
     def href() -> str:  # from the page: Playwright's own page.url may lag behind
         return page.page.evaluate("() => window.location.href")
 
-    _until(lambda: all(part in href() for part in ("t=5", "tab=3", "pin=1.")),
+    until(lambda: all(part in href() for part in ("t=5", "tab=3", "pin=1.")),
            "the link with t, tab and pin")
     other = Page(browser_context, server, "/app?" + href().split("?", 1)[1])
     try:
-        _until(lambda: other.text(".time-label") == label, "the same time")
+        until(lambda: other.text(".time-label") == label, "the same time")
         other.page.locator(".pinned-settlement").first.wait_for(timeout=60_000)
-        _until(lambda: other.text(".pinned-settlement") == pinned, "the same pin")
+        until(lambda: other.text(".pinned-settlement") == pinned, "the same pin")
         assert other.text(".readout-force") == "650"
         other.page.locator(".creep-select select").first.wait_for(state="visible",
                                                                  timeout=30_000)
@@ -382,4 +351,42 @@ def test_presentation_mode_has_projector_fonts_at_1024(page: Page):
                                   ".major_label_text_font_size", name)
         assert int(size.rstrip("px")) >= 18, (name, size)
     assert page.page.evaluate(JS_VIEW_WIDTH, "pressure_figure") > 250
+    assert page.errors == []
+
+
+# Files held by the drop boxes of the page (FilePond's list, in Panel's view of the box).
+JS_DROPPED = """() => {
+  let n = 0;
+  for (const v of Bokeh.index.all_views()) if (v._file_pond) n += v._file_pond.getFiles().length;
+  return n;
+}"""
+
+
+def _upload_complete_shown(page: Page) -> bool:
+    # a file still in a box, or its status line on show (the box's hidden announcer for
+    # screen readers repeats the words, so the text alone is no sign of a file on show)
+    status = page.page.locator(".filepond--file-status-main", has_text="Upload complete")
+    return page.page.evaluate(JS_DROPPED) > 0 or status.filter(visible=True).count() > 0
+
+
+def test_a_refused_scene_file_leaves_the_box_ready_for_the_next(page: Page):
+    """A refused file showed a green "Upload complete" beside the refusal, and a second
+    file could be dropped only after finding the x of the first."""
+    page.open_tab("Files")
+    upload = page.page.locator("input[type=file]").last
+    upload.wait_for(state="attached", timeout=30_000)
+    upload.set_input_files(files=[{"name": "broken.json", "mimeType": "application/json",
+                                   "buffer": b'{"name": "x", "punch": '}])
+    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000)
+    until(lambda: "broken.json" in page.pane_text(".notice"), "the refusal of broken.json")
+    until(lambda: not _upload_complete_shown(page), "the box emptied after the refusal")
+    scene = json.loads((ROOT / "assets" / "scenes" / "stepped_punch.json").read_text())
+    scene["name"] = "second file"
+    upload = page.page.locator("input[type=file]").last
+    upload.wait_for(state="attached", timeout=30_000)
+    upload.set_input_files(files=[{"name": "scene.json", "mimeType": "application/json",
+                                   "buffer": json.dumps(scene).encode()}])
+    _wait(page, "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text"
+          ".includes('second file')", timeout=30_000)
+    until(lambda: not _upload_complete_shown(page), "the box emptied after the accepted file")
     assert page.errors == []

@@ -1,0 +1,58 @@
+"""The Check tab: limits of the design check and the eccentricity of the load."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import panel as pn
+
+from .style import TAB_COLUMN, html_pane
+
+if TYPE_CHECKING:
+    from ..app import ExplorerApp
+
+
+class CheckView:
+    """Inputs of the session's :class:`~explorer.design.DesignLimits` and of e = M/P."""
+
+    title = "Check"
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self.app = app
+        self.allowable_pressure = self._limit("allowable bearing pressure [kPa]",
+                                              "allowable_pressure", "limit-pressure")
+        self.settlement_limit = self._limit("settlement limit [mm]", "settlement_limit",
+                                            "limit-settlement")
+        self.tilt_limit = self._limit("tilt limit [mrad]", "tilt_limit", "limit-tilt")
+        self.eccentricity = pn.widgets.FloatInput(
+            label="eccentricity e = M/P [m] (sets the moment)", value=None,
+            sizing_mode="stretch_width", css_classes=["eccentricity-input"])
+        self.eccentricity.param.watch(self._on_eccentricity, "value")
+
+    def _limit(self, label: str, name: str, css: str) -> pn.widgets.FloatInput:
+        box = pn.widgets.FloatInput(label=label, value=None, start=0,
+                                    sizing_mode="stretch_width", css_classes=[css])
+        box.param.watch(lambda e: setattr(self.app.limits, name, e.new), "value")
+        return box
+
+    def content(self) -> pn.Column:
+        """The tab's column."""
+        return pn.Column(
+            html_pane("<small>Limits of the design check (leave empty: not checked). "
+                      "The check covers the whole history.</small>"),
+            self.allowable_pressure, self.settlement_limit, self.tilt_limit,
+            self.eccentricity, **TAB_COLUMN)
+
+    def _on_eccentricity(self, event: Any) -> None:
+        """Set the moment so that M = e P (force and moment given, constant force)."""
+        e = event.new
+        loading = self.app.state.loading
+        if e is None:
+            return
+        force = loading.histories["force"]
+        if loading.given != ("force", "moment") or force.kind != "constant":
+            self.app.notice = ("Value not accepted: the eccentricity sets the moment when "
+                               "force and moment are given and the force is constant.")
+            return
+        moment = loading.histories["moment"]
+        moment.param.update(kind="constant", value=float(e) * force.value)

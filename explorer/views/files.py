@@ -1,0 +1,165 @@
+"""The Files tab: scene name and description, saving and loading scenes, downloads."""
+
+from __future__ import annotations
+
+import asyncio
+import html
+import io
+import json
+from typing import TYPE_CHECKING, Any
+
+import panel as pn
+
+from core.scene import MAX_SCENE_BYTES
+
+from .. import exports
+from ..report import report_html
+from ..results import ResultView
+from ..state import MAX_DESCRIPTION_CHARS, MAX_NAME_CHARS, check_text
+from ..widgets import Binding, BoundedUpload
+from .style import TAB_COLUMN, html_pane, slug
+
+if TYPE_CHECKING:
+    from ..app import ExplorerApp
+
+
+class FilesView:
+    """The scene file (save, load) and the result files of the result on screen."""
+
+    title = "Files"
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self.app = app
+        s = app.state
+        self.naming = Binding(app.reject, live_when=app.fast_solves)
+        self.scene_name = self.naming.add("scene_name", pn.widgets.TextInput(
+            label="scene name", sizing_mode="stretch_width", max_length=MAX_NAME_CHARS,
+            css_classes=["scene-name"]),
+            check=lambda v: check_text("scene name", v, MAX_NAME_CHARS))
+        self.description = self.naming.add("description", pn.widgets.TextAreaInput(
+            label="description (saved with the scene)", sizing_mode="stretch_width",
+            max_length=MAX_DESCRIPTION_CHARS, height=90, css_classes=["scene-description"]),
+            check=lambda v: check_text("description", v, MAX_DESCRIPTION_CHARS))
+        self.naming.bind(s)
+        stretch = {"sizing_mode": "stretch_width"}
+        self.save_scene = pn.widgets.FileDownload(callback=self._scene_file,
+                                                  filename="scene.json",
+                                                  label="Save scene (JSON)", color="primary",
+                                                  **stretch)
+        self.load_file = BoundedUpload(accept=(".json",), max_bytes=MAX_SCENE_BYTES)
+        self.load_file.param.watch(self._on_scene_file, "value")
+        self.csv_download = pn.widgets.FileDownload(callback=self._csv_file,
+                                                    filename="results.csv",
+                                                    label="Results: histories (CSV)", **stretch)
+        self.pressure_download = pn.widgets.FileDownload(callback=self._pressure_file,
+                                                         filename="pressure.csv",
+                                                         label="Results: q(x, t) (CSV)",
+                                                         **stretch)
+        self.report_download = pn.widgets.FileDownload(
+            callback=self._report_file, filename="report.html", color="primary",
+            label="Printable report (HTML)", css_classes=["report-download"], **stretch)
+        self.json_download = pn.widgets.FileDownload(callback=self._json_file,
+                                                     filename="results.json",
+                                                     label="Results: everything (JSON)",
+                                                     **stretch)
+
+    def content(self) -> pn.Column:
+        """The tab's column."""
+        return pn.Column(
+            self.report_download, self.scene_name, self.description, self.save_scene,
+            html_pane("<small>Load a scene (the JSON the command line reads):</small>"),
+            self.load_file, self.csv_download, self.pressure_download, self.json_download,
+            html_pane("<small>Downloads hold the result on screen. The address bar holds "
+                      "a link to it.</small>"), **TAB_COLUMN)
+
+    def name_files(self, view: ResultView) -> None:
+        """Name the downloads after the scene on screen."""
+        stem = slug(str(view.scene.get("name", "scene"))[:60])
+        self.save_scene.filename = f"{stem}.json"
+        self.csv_download.filename = f"{stem}_results.csv"
+        self.pressure_download.filename = f"{stem}_pressure.csv"
+        self.json_download.filename = f"{stem}_results.json"
+        self.report_download.filename = f"{stem}_report.html"
+
+    # -- loading ---------------------------------------------------------------------
+    def _on_scene_file(self, event: Any) -> None:
+        data = event.new
+        if not data:
+            return
+        try:
+            self._read_scene_file(data)
+        finally:
+            # accepted or refused, the box is ready for the next file: a refused file
+            # left a green "Upload complete" beside the refusal, and a second file could
+            # be dropped only after removing the first
+            self.load_file.clear()
+
+    def _read_scene_file(self, data: bytes) -> None:
+        from core.scene import read_scene_json
+
+        app = self.app
+        # the same limit as the command line: a browser may send up to the websocket's
+        # message size, and parsing costs memory and time on the shared server
+        if len(data) > MAX_SCENE_BYTES:
+            app.notice = (f"The file {self.load_file.filename!r} is too large ({len(data)} "
+                          f"bytes; a scene file has at most {MAX_SCENE_BYTES})")
+            return
+        name = self.load_file.filename or "the file"
+        try:
+            text = data.decode("utf-8-sig") if isinstance(data, bytes) else data
+            # read as the command line reads it: a repeated field is refused, not dropped
+            scene = read_scene_json(text, repr(name))
+        except UnicodeDecodeError:
+            app.notice = f"The file {name!r} is not text in UTF-8 (a scene file is JSON)."
+            return
+        except ValueError as exc:
+            app.notice = f"The file {exc}"
+            return
+        if not isinstance(scene, dict):
+            app.notice = "The file does not hold a scene (a JSON object)."
+            return
+        if app.load_scene(scene):
+            app.preset.value = ""
+
+    # -- downloads -------------------------------------------------------------------
+    def _scene_file(self) -> io.StringIO:
+        view = self.app.shown()
+        scene = view.scene if view is not None else self.app.state.to_scene()
+        return io.StringIO(json.dumps(scene, indent=2) + "\n")
+
+    async def _download(self, kind: str, empty: str) -> io.StringIO:
+        # awaited, not waited for: the worker's answer must not hold the event loop, and
+        # with it every page of the server
+        view = self.app.shown()
+        if view is None:
+            return io.StringIO(empty)
+        try:
+            return io.StringIO(await asyncio.wrap_future(
+                self.app.controller.download_later(view, kind)))
+        except Exception as exc:
+            # no file is better than a wrong one; say why on the page
+            alert = self.app.alert
+            alert.object = f"**Download failed:** {html.escape(str(exc))}"
+            alert.visible = True
+            raise
+
+    def _csv_file(self) -> io.StringIO:
+        view = self.app.shown()
+        return io.StringIO(exports.histories_csv(view) if view is not None else "")
+
+    def _pressure_file(self) -> io.StringIO:
+        view = self.app.shown()
+        if view is None:
+            return io.StringIO("")
+        return io.StringIO(exports.pressure_csv(view, self.app.scales.pressure_unit(view)))
+
+    async def _json_file(self) -> io.StringIO:
+        return await self._download("to_json", "{}")
+
+    def _report_file(self) -> io.StringIO:
+        view = self.app.shown()
+        if view is None:
+            return io.StringIO("")
+        index = min(self.app.time_index, len(view.times) - 1)
+        return io.StringIO(report_html(view, self.app.limits, index,
+                                       self.app.scales.pressure_unit(view)))

@@ -1,0 +1,112 @@
+"""The Punch tab: half-width and base shape of the punch, and a shape table upload."""
+
+from __future__ import annotations
+
+import html
+from typing import TYPE_CHECKING, Any
+
+import panel as pn
+
+from core.profiles import MAX_TABLE_BYTES
+
+from ..controller import format_error
+from ..widgets import Binding, BoundedUpload, fine_slider, slider
+from .style import NOTE_STYLE, TAB_COLUMN, html_pane
+
+if TYPE_CHECKING:
+    from ..app import ExplorerApp
+
+SHAPES = {
+    "flat": "flat", "crowned (parabolic, radius R)": "parabolic",
+    "wedge (slope of each face)": "wedge", "single step (height, position)": "stepped",
+    "central land (raised middle)": "land", "wavy / rough (amplitude, wavelength)": "wavy",
+    "custom table (CSV upload or file)": "custom"}
+
+
+class PunchView:
+    """Widgets of ``state.punch``: the half-width a and the base shape f(x)."""
+
+    title = "Punch"
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self.app = app
+        s = app.state
+        self.punch = Binding(app.reject, live_when=app.fast_solves)
+        pb = self.punch
+        self.half_width = pb.add("half_width", slider("half-width a [m]", 0.1, 5.0, 0.01,
+                                                      css_classes=["punch-half-width"]))
+        self.shape = pb.add("shape", pn.widgets.Select(label="base shape", options=SHAPES,
+                                                       sizing_mode="stretch_width"))
+        self.radius = pb.add("radius", fine_slider("crown radius R [km]", 1.0, 500.0, 0.5,
+                                                   "0[.]0"))
+        self.slope = pb.add("slope", fine_slider("slope of each face [µrad]", 0.0, 200.0,
+                                                 0.5, "0[.]0"))
+        self.step_height = pb.add("step_height", fine_slider(
+            "step height [µm] (right part raised)", -100.0, 100.0, 0.5, "0[.]0"))
+        self.step_position = pb.add("step_position", fine_slider(
+            "step position x [m]", -1.0, 1.0, 0.01))
+        self.land_height = pb.add("land_height", fine_slider(
+            "land height [µm] (middle protrudes)", 0.0, 100.0, 0.5, "0[.]0"))
+        self.land_width = pb.add("land_width", fine_slider("land width [m]", 0.05, 2.0, 0.01))
+        self.wave_amplitude = pb.add("wave_amplitude", fine_slider(
+            "wave amplitude [µm]", 0.0, 50.0, 0.1, "0[.]0"))
+        self.wave_length = pb.add("wave_length", fine_slider("wavelength [m]", 0.02, 5.0,
+                                                             0.01))
+        self.shape_file = BoundedUpload(accept=(".csv", ".txt"), max_bytes=MAX_TABLE_BYTES)
+        self.shape_file.param.watch(self._on_shape_file, "value")
+        self.shape_note = html_pane("", styles=NOTE_STYLE)
+        pb.bind(s.punch)
+        s.punch.param.watch(lambda *e: self.refresh(), ["shape", "half_width",
+                                                       "custom_label"])
+        self.refresh()
+
+    def content(self) -> pn.Column:
+        """The tab's column."""
+        return pn.Column(
+            self.half_width, self.shape, self.radius, self.slope, self.step_height,
+            self.step_position, self.land_height, self.land_width, self.wave_amplitude,
+            self.wave_length, self.shape_note,
+            html_pane("<small>Upload a shape table: CSV with two columns, x [m] and "
+                      "f(x) [m], f the height of the punch base above its lowest point."
+                      "</small>"),
+            self.shape_file, **TAB_COLUMN)
+
+    def refresh(self) -> None:
+        """Show the sliders of the chosen shape only."""
+        p = self.app.state.punch
+        a = p.half_width
+        self.step_position.param.update(start=-a, end=a)
+        shape = p.shape
+        self.radius.visible = shape == "parabolic"
+        self.slope.visible = shape == "wedge"
+        self.step_height.visible = self.step_position.visible = shape == "stepped"
+        self.land_height.visible = self.land_width.visible = shape == "land"
+        self.wave_amplitude.visible = self.wave_length.visible = shape == "wavy"
+        if shape == "custom":
+            source = p.custom_label or "a file"
+            self.shape_note.object = (f"Custom shape from {html.escape(source)}." if p.custom
+                                      is not None else "Upload a CSV table below.")
+        else:
+            self.shape_note.object = ""
+        self.shape_note.visible = bool(self.shape_note.object)
+        self.shape_file.visible = True
+
+    def _on_shape_file(self, event: Any) -> None:
+        data = event.new
+        if not data:
+            return
+        from core.profiles import profile_from_csv
+
+        app = self.app
+        a = app.state.punch.half_width
+        try:
+            profile = profile_from_csv(data, field="punch.shape", variable="x",
+                                       domain=(-a, a))
+        except ValueError as exc:
+            app.notice = f"The shape table was not used: {format_error(str(exc))}"
+            return
+        finally:
+            self.shape_file.clear()
+        app.notice = ""
+        app.state.punch.param.update(custom=profile.spec, shape="custom",
+                                     custom_label=self.shape_file.filename or "a CSV file")

@@ -1,0 +1,217 @@
+"""The results column: messages, status, plots, time player, readout, pin and design check."""
+
+from __future__ import annotations
+
+import html
+from typing import TYPE_CHECKING, Any
+
+import panel as pn
+import param
+
+from .. import exports
+from ..design import check_html, design_check
+from ..results import ResultView
+from ..state import QUANTITIES, QUANTITY_UNITS
+from ..status import status_html
+from ..widgets import NAMES
+from .style import html_pane
+
+if TYPE_CHECKING:
+    from ..app import ExplorerApp
+
+#: Which validity flags are shown next to which plot.
+BADGES: dict[str, dict[str, tuple[str, str]]] = {
+    # group: flag -> (text when raised, text when the check passes)
+    "scene": {"thick_coating": ("coating not thin", "coating thin"),
+              "stiff_coating": ("coating stiffer than base", "coating softer than base"),
+              "model_error": ("coating model error above solver.model_tol",
+                              "coating model within solver.model_tol")},
+    "pressure": {"contact_lost": ("contact lost: q < 0 (shaded)", "full contact")},
+    "history": {"large_tilt": ("large tilt", "small tilt")},
+    "status": {"tol_not_met": ("tolerance not met", ""),
+               "unresolved_input": ("input finer than the quadrature", "")},
+}
+
+
+def _fmt(value: float) -> str:
+    return f"{value:.5g}" if abs(value) < 1e5 else f"{value:.4e}"
+
+
+def badges_html(view: ResultView | None, group: str) -> str:
+    """Validity badges of one plot group (flag names as CSS classes, messages as tooltips)."""
+    if view is None:
+        return ""
+    parts = []
+    for flag, (bad, good) in BADGES[group].items():
+        if flag in view.flags:
+            message = html.escape(exports.flag_message(view, flag))
+            parts.append(f'<span class="cp-badge cp-bad flag-{flag}" title="{message}">'
+                         f"⚠ {bad}</span><span class='cp-msg'>{message}</span>")
+        elif good:
+            parts.append(f'<span class="cp-badge cp-ok ok-{flag}">✓ {good}</span>')
+    return "".join(parts)
+
+
+def readout_html(view: ResultView | None, index: int, pinned: ResultView | None) -> str:
+    """Values at the selected time: current, pinned and their difference."""
+    if view is None:
+        return ""
+    t = float(view.times[index])
+    head = "<tr><th></th><th>current</th>"
+    head += "<th>pinned</th><th>change</th></tr>" if pinned is not None else "</tr>"
+    rows = [head]
+    j = pinned.time_index(t) if pinned is not None else 0
+    for q in QUANTITIES:
+        unit = QUANTITY_UNITS[q][0]
+        value = float(view.display(q)[index])
+        role = "given" if q in view.given else "computed"
+        cls = "cp-given" if role == "given" else ""
+        row = (f"<tr class='{cls}'><td>{NAMES[q]} [{unit}] ({role})</td>"
+               f"<td class='readout-{q}'>{_fmt(value)}</td>")
+        if pinned is not None:
+            other = float(pinned.display(q)[j])
+            change = f"{100 * (value - other) / abs(other):+.2f} %" if other else "n/a"
+            row += f"<td class='pinned-{q}'>{_fmt(other)}</td><td>{change}</td>"
+        rows.append(row + "</tr>")
+    force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
+    ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
+    return (f"<div class='readout'><b>At t = {t:.4g} days after loading</b> · {ecc}"
+            f"<table class='cp-readout'>{''.join(rows)}</table></div>")
+
+
+class ResultsView:
+    """The page's main column: what the result on screen is, and how far to trust it."""
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self.app = app
+        self.alert = pn.pane.Alert("", alert_type="danger", visible=False,
+                                   sizing_mode="stretch_width", css_classes=["solve-error"])
+        self.notice_alert = pn.pane.Alert(html.escape(app.notice), alert_type="warning",
+                                          visible=bool(app.notice),
+                                          sizing_mode="stretch_width",
+                                          css_classes=["notice"])
+        self.spinner = pn.indicators.LoadingSpinner(value=False, size=20, label="",
+                                                    margin=(5, 5))
+        self.status = html_pane("", sizing_mode="stretch_width", margin=(5, 5))
+        badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
+        self.scene_badges = html_pane("", **badge)
+        self.pressure_badges = html_pane("", **badge)
+        self.history_badges = html_pane("", **badge)
+        self.status_badges = html_pane("", **badge)
+        self.player = self._new_player(1, 0)
+        self.player_box = pn.Row(self.player, sizing_mode="stretch_width", margin=0)
+        self.time_label = html_pane("", margin=(12, 10))
+        self.readout = html_pane("", sizing_mode="stretch_width")
+        self.design = html_pane("", sizing_mode="stretch_width", css_classes=["design-pane"])
+        # The address bar is written by the page itself when this hidden box changes:
+        # Panel's location model delayed an update until the next one (its push waits
+        # for the document's first idle signal, which a replaced view never sees).
+        self._address = pn.widgets.TextInput(value="", visible=False)
+        self._address.jscallback(value="if (cb_obj.value) { window.history.replaceState("
+                                       "null, '', cb_obj.value) }")
+        self.classical = pn.widgets.Checkbox(label="classical solutions on q(x)",
+                                             css_classes=["classical-toggle"])
+        self.classical.param.watch(self._on_classical, "value")
+        self.pin_button = pn.widgets.Button(label="Pin this result", color="default")
+        self.unpin_button = pn.widgets.Button(label="Clear pin", color="light",
+                                              disabled=True)
+        self.pin_button.on_click(lambda e: app.pin())
+        self.unpin_button.on_click(lambda e: app.unpin())
+        app.limits.param.watch(lambda *e: self.show_design(), list(
+            n for n in app.limits.param if n != "name"))
+        f = app.figures
+        bokeh = {"sizing_mode": "stretch_width", "margin": (0, 5)}
+        self._bokeh_panes = [pn.pane.Bokeh(fig, **bokeh) for fig in (
+            f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES))]
+
+    def content(self) -> pn.Column:
+        """The main column of the page."""
+        scene_pane, q_pane, image_pane, *history_panes = self._bokeh_panes
+        return pn.Column(
+            self._address,
+            self.notice_alert,
+            self.alert,
+            pn.Row(self.spinner, self.status, sizing_mode="stretch_width"),
+            self.status_badges,
+            self.scene_badges,
+            scene_pane,
+            self.pressure_badges,
+            pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
+            pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
+            pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button,
+                                           self.classical),
+                   sizing_mode="stretch_width"),
+            self.design,
+            self.history_badges,
+            pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
+            sizing_mode="stretch_width",
+        )
+
+    def draw(self, view: ResultView, index: int, new_range: bool) -> None:
+        """Show a new result at output time ``index`` (call inside ``pn.io.hold()``)."""
+        app = self.app
+        app.figures.show(view, index, app.pinned)
+        if new_range:
+            self._replace_player(max(len(view.times) - 1, 1), index)
+        else:
+            self.player.value = index
+        with param.discard_events(app):
+            app.time_index = index
+        self.show_time_texts(view, index)
+        self.status.object = status_html(view, app.busy_shown)
+        self.scene_badges.object = badges_html(view, "scene")
+        self.pressure_badges.object = badges_html(view, "pressure")
+        self.history_badges.object = badges_html(view, "history")
+        self.status_badges.object = badges_html(view, "status")
+        self.show_design()
+
+    def show_time_texts(self, view: ResultView, index: int) -> None:
+        """The time label and the readout at output time ``index``."""
+        self.time_label.object = (f"<span class='time-label'>t = "
+                                  f"{float(view.times[index]):.4g} days</span>")
+        self.readout.object = readout_html(view, index, self.app.pinned)
+
+    def show_design(self) -> None:
+        """The design check of the result on screen against the session's limits."""
+        view = self.app.shown()
+        self.design.object = check_html(design_check(view, self.app.limits)) if view else ""
+
+    def show_error(self, error: str, has_view: bool) -> None:
+        """The solver's refusal (empty: none), and what the plots show meanwhile."""
+        # the core's messages echo user text (see ExplorerApp._on_notice)
+        after = ("The plots still show the last good result." if has_view
+                 else "There is no result to show yet: change the scene, or choose a preset.")
+        self.alert.object = f"**Not solved:** {html.escape(error)}  \n{after}" if error else ""
+        self.alert.visible = bool(error)
+
+    def set_presentation(self, on: bool) -> None:
+        """Projector fonts for the texts of the column (the figures set their own)."""
+        size = "17px" if on else ""
+        for pane in (self.readout, self.status, self.design):
+            pane.styles = {"font-size": size} if on else {}
+
+    def _on_classical(self, event: Any) -> None:
+        app = self.app
+        with pn.io.hold():
+            app.figures.set_classical(app.shown(), app.time_index, bool(event.new))
+        self.push()
+
+    def _new_player(self, end: int, value: int) -> pn.widgets.Player:
+        player = pn.widgets.Player(label="time", start=0, end=end, value=value, interval=250,
+                                   loop_policy="once", show_loop_controls=False,
+                                   sizing_mode="stretch_width", show_value=False,
+                                   css_classes=["time-player"])
+        player.param.watch(lambda e: setattr(self.app, "time_index", int(e.new)), "value")
+        return player
+
+    def _replace_player(self, end: int, value: int) -> None:
+        """A new player for a new number of output times: the page's player redraws its
+        range only when its value changes, so a new range with the same value (or a value
+        arriving before the range) left the old range on screen."""
+        self.player = self._new_player(end, value)
+        self.player_box.objects = [self.player]
+
+    def push(self) -> None:
+        """In a notebook, plain Bokeh models changed in place must be pushed by hand."""
+        if not self.app.served and self._bokeh_panes:
+            pn.io.push_notebook(*self._bokeh_panes)

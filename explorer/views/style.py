@@ -1,0 +1,35 @@
+"""The page's style sheet and the HTML pane that carries it."""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import panel as pn
+
+CSS = """
+.cp-badge {display: inline-block; padding: 1px 8px; margin: 2px 4px 2px 0;
+           border-radius: 10px; font-size: 12px; font-weight: 600;}
+.cp-bad {background: #fde2e1; color: #9b1c1c; border: 1px solid #f5a3a0;}
+.cp-ok {background: #e3f5e6; color: #1d6b2c; border: 1px solid #a8dcb2;}
+.cp-msg {font-size: 12px; color: #9b1c1c; margin-left: 4px; overflow-wrap: anywhere;}
+.cp-status {font-size: 12px; color: #444;}
+.cp-readout td, .cp-readout th {padding: 1px 8px; font-size: 13px; text-align: right;}
+.cp-readout th:first-child, .cp-readout td:first-child {text-align: left;}
+.cp-given {color: #777;}
+"""
+
+#: Style of the small grey notes under a group of widgets.
+NOTE_STYLE = {"font-size": "12px", "color": "#666"}
+#: Keyword arguments of the column that holds one sidebar tab.
+TAB_COLUMN = {"sizing_mode": "stretch_width", "margin": (4, 0)}
+
+
+def html_pane(text: str = "", **kwargs: Any) -> pn.pane.HTML:
+    """An HTML pane carrying the page's style sheet (panes render in their own shadow DOM)."""
+    return pn.pane.HTML(text, stylesheets=[CSS], **kwargs)
+
+
+def slug(text: str) -> str:
+    """A file-name-safe form of a scene name (``"scene"`` when nothing is left)."""
+    return re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_").lower() or "scene"

@@ -1,0 +1,52 @@
+"""The Time tab: output times and the accuracy target."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import panel as pn
+
+from ..widgets import Binding, EditableIntSlider, slider
+from .style import TAB_COLUMN
+
+if TYPE_CHECKING:
+    from ..app import ExplorerApp
+
+SPACINGS = {"linear": "linear", "log": "log"}
+
+
+class TimesView:
+    """Widgets of the state's time span [days], output times and tolerance."""
+
+    title = "Time"
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self.app = app
+        s = app.state
+        self.global_binding = Binding(app.reject, live_when=app.fast_solves)
+        gb = self.global_binding
+        self.time_end = gb.add("time_end", slider("time span [days after loading]", 1.0,
+                                                  3650.0, 1.0, "0[.]0"))
+        self.time_count = gb.add("time_count", EditableIntSlider(
+            label="output times", start=2, end=200, step=1, sizing_mode="stretch_width"))
+        self.time_spacing = gb.add("time_spacing", pn.widgets.RadioButtonGroup(
+            label="spacing", options=list(SPACINGS), sizing_mode="stretch_width"))
+        self.tol = gb.add("tol", pn.widgets.Select(
+            label="accuracy target (relative)",
+            options={f"{v:g}": v for v in s.param.tol.objects},
+            sizing_mode="stretch_width", css_classes=["tol-select"]))
+        gb.bind(s)
+        s.param.watch(lambda *e: self.refresh(), "tol")
+        self.refresh()
+
+    def content(self) -> pn.Column:
+        """The tab's column."""
+        return pn.Column(self.time_end, self.time_count, self.time_spacing, self.tol,
+                         self.app.fidelity.solver_panel, **TAB_COLUMN)
+
+    def refresh(self) -> None:
+        """Offer the tolerances the state allows; show the one set."""
+        options = {f"{v:g}": v for v in self.app.state.param.tol.objects}
+        if options != self.tol.options:
+            self.tol.options = options
+        self.tol.value = self.app.state.tol
