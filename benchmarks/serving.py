@@ -49,7 +49,8 @@ def browser_missing() -> str | None:
     import importlib.util
 
     if not os.path.exists(CHROMIUM):
-        return f"Debian's chromium is not at {CHROMIUM}: `bash tests/run.sh` installs it"
+        return (f"Debian's chromium is not at {CHROMIUM}: `bash tests/run.sh` installs it with "
+                "apt-get (on a system without apt-get, install Chromium there)")
     if importlib.util.find_spec("playwright") is None:
         return "playwright is not installed: `bash tests/run.sh` installs it"
     return None

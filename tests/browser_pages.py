@@ -1,12 +1,26 @@
 """Helpers of the browser tests: a page of the served explorer, read as a user sees it.
 
-Imported by the browser test modules only (after their check that Chromium and
-Playwright are present).
+Imported by the browser test modules only; each first calls :func:`require_browser`.
 """
 
 from __future__ import annotations
 
+import os
 import time
+
+
+def require_browser() -> None:
+    """Skip the calling test module, saying why, when Chromium or Playwright is absent;
+    under CI (where the test set-up installs both) their absence fails instead."""
+    import pytest
+
+    from benchmarks.serving import browser_missing
+
+    missing = browser_missing()
+    if missing:
+        if os.environ.get("CI"):
+            pytest.fail(missing, pytrace=False)
+        pytest.skip(missing, allow_module_level=True)
 
 # JavaScript helpers run in the page.
 JS_DOC = "() => (window.Bokeh && Bokeh.documents && Bokeh.documents[0]) || null"

@@ -9,22 +9,17 @@ the plots (a canvas has no text to read).
 from __future__ import annotations
 
 import json
-import os
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from benchmarks.serving import browser_missing
-
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
-_missing = browser_missing()
-if _missing:
-    if os.environ.get("CI"):  # the test set-up installs both: their absence is a failure
-        pytest.fail(_missing, pytrace=False)
-    pytest.skip(_missing, allow_module_level=True)
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
 
 from tests.browser_pages import Page, chromium_context, served_explorer  # noqa: E402
 

@@ -8,21 +8,16 @@ step sends) in Debian's Chromium. Every wait is on a condition in the page.
 from __future__ import annotations
 
 import json
-import os
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from benchmarks.serving import browser_missing
-
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
-_missing = browser_missing()
-if _missing:
-    if os.environ.get("CI"):
-        pytest.fail(_missing, pytrace=False)
-    pytest.skip(_missing, allow_module_level=True)
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
 
 from tests.browser_pages import (  # noqa: E402
     JS_SHOWN,

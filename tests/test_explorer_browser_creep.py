@@ -2,22 +2,19 @@
 
 from __future__ import annotations
 
-import os
 import shutil
 import tempfile
 from collections.abc import Iterator
 
 import pytest
 
-from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
+from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
-_missing = browser_missing()
-if _missing:
-    if os.environ.get("CI"):
-        pytest.fail(_missing, pytrace=False)
-    pytest.skip(_missing, allow_module_level=True)
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
 
 import playwright.sync_api as playwright_api  # noqa: E402
 

@@ -7,7 +7,6 @@ Debian's Chromium through Playwright; every wait is on a condition in the page o
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import tempfile
 from collections.abc import Iterator
@@ -15,16 +14,14 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
+from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess
 from explorer.fidelity_view import CONTACT_LABELS
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
-_missing = browser_missing()
-if _missing:
-    if os.environ.get("CI"):
-        pytest.fail(_missing, pytrace=False)
-    pytest.skip(_missing, allow_module_level=True)
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
 
 import playwright.sync_api as playwright_api  # noqa: E402
 
