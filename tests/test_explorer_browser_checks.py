@@ -40,6 +40,9 @@ JS_VIEW_WIDTH = """(name) => {
   }
   return null;
 }"""
+# Top [px] of a named figure in the viewport, or null while it is not drawn.
+JS_VIEW_TOP = JS_VIEW_WIDTH.replace("getBoundingClientRect().width",
+                                    "getBoundingClientRect().top")
 # Width [px] of a figure title in the font Bokeh draws it with (bold 13px helvetica).
 JS_TITLE_WIDTH = """(name) => {
   const fig = Bokeh.documents[0].get_model_by_name(name);
@@ -147,8 +150,18 @@ def test_a_flag_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: P
 
 
 def _figure_top(page: Page) -> float:
-    box = page.page.locator(".bk-panel-models-layout-Column .bk-Figure, .bk-Figure").first
-    return float(box.bounding_box()["y"])
+    # by name: the first figure in the page's order is, once the idle sidebar tabs are
+    # filled, a hidden one (the creep coefficient plot of the Base tab)
+    tops: list[float] = []
+
+    def measured() -> bool:
+        top = page.page.evaluate(JS_VIEW_TOP, "scene_figure")
+        if top is not None:
+            tops.append(float(top))
+        return bool(tops)
+
+    until(measured, "the scene figure drawn")
+    return tops[-1]
 
 
 def test_a_changed_scene_is_saved_under_its_own_name_and_description(page: Page):
