@@ -146,20 +146,20 @@ class CodeCreepPanel:
         self._base = base
         b = binding
         self.strength_class = b.add("strength_class", pn.widgets.Select(
-            name="strength class (or f_cm)", options=list(STRENGTH_CLASSES) + ["fcm"],
+            label="strength class (or f_cm)", options=list(STRENGTH_CLASSES) + ["fcm"],
             sizing_mode="stretch_width", css_classes=["code-strength"]))
         self.fcm = b.add("fcm", pn.widgets.FloatInput(
-            name="mean strength f_cm [MPa]", step=1.0, sizing_mode="stretch_width"))
+            label="mean strength f_cm [MPa]", step=1.0, sizing_mode="stretch_width"))
         self.cement = b.add("cement", pn.widgets.Select(
-            name="cement class", options={"S (slow)": "S", "N (normal)": "N", "R (rapid)": "R"},
+            label="cement class", options={"S (slow)": "S", "N (normal)": "N", "R (rapid)": "R"},
             sizing_mode="stretch_width"))
         self.relative_humidity = b.add("relative_humidity", pn.widgets.FloatInput(
-            name="relative humidity RH [%]", step=5.0, sizing_mode="stretch_width",
+            label="relative humidity RH [%]", step=5.0, sizing_mode="stretch_width",
             css_classes=["code-rh"]))
         self.notional_size = b.add("notional_size", pn.widgets.FloatInput(
-            name="notional size h = 2A/u [mm]", step=10.0, sizing_mode="stretch_width"))
+            label="notional size h = 2A/u [mm]", step=10.0, sizing_mode="stretch_width"))
         self.temperature = b.add("temperature", pn.widgets.FloatInput(
-            name="temperature T [°C]", step=1.0, sizing_mode="stretch_width"))
+            label="temperature T [°C]", step=1.0, sizing_mode="stretch_width"))
         b.bind(base.code)
         self.figure, self.source = creep_coefficient_figure()
         self.note = pn.pane.HTML("", styles={"color": "#b00020", "font-size": "12px"},
