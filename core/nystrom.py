@@ -39,13 +39,16 @@ from scipy.linalg import lu_factor, lu_solve
 
 from core.quadrature import (
     NODES_PER_PANEL,
+    KernelOperator,
     Panels,
     base_panels,
     interpolation_weights,
     kernel_operator,
     operator_rows,
     panel_legendre_coefficients,
+    panel_nodes,
     refine_to_resolve,
+    shared_panels,
 )
 
 Function = Callable[[np.ndarray], np.ndarray]
@@ -62,6 +65,8 @@ TWO_LEVEL_RATIO = 16.0
 SAFETY = 3.0
 #: Relative round-off floor of the pressure (measured: ~1e-13 against the projection).
 ROUND_OFF = 2e-13
+#: m and g are resolved on the starting panels to this share of the target.
+RESOLVE_SHARE = 0.1
 #: Rounds of each refinement loop.
 MAX_ROUNDS = 12
 
@@ -101,10 +106,17 @@ class NystromGrid:
         return operator_rows(self.lam, self.panels, np.asarray(x, dtype=float))
 
 
-def build_grid(lam: float, edges: np.ndarray, m: Function, g: Function) -> NystromGrid:
-    """The discretization on panels with the given ``edges`` (dimensionless)."""
+def build_grid(lam: float, edges: np.ndarray, m: Function, g: Function,
+               previous: NystromGrid | None = None) -> NystromGrid:
+    """The discretization on panels with the given ``edges`` (dimensionless).
+
+    ``previous``: a grid of the same ``lam`` whose operator blocks between the panels both
+    share are reused (only rows and columns of new panels are computed).
+    """
     panels = Panels.from_edges(edges)
-    operator = kernel_operator(lam, panels).matrix
+    before = (None if previous is None
+              else KernelOperator(previous.lam, previous.panels, previous.operator))
+    operator = kernel_operator(lam, panels, before).matrix
     return NystromGrid(lam, panels, operator, np.asarray(m(panels.nodes), dtype=float),
                        np.asarray(g(panels.nodes), dtype=float))
 
@@ -120,8 +132,16 @@ def elastic_responses(grid: NystromGrid, c: float, with_gap: bool) -> np.ndarray
     Solves ``(c m + A) q = [1, x, -g]``: every answer of the elastic problem is a
     combination of these columns (statement 1 form).
     """
+    return factored_responses(grid, c, with_gap)[0]
+
+
+def factored_responses(grid: NystromGrid, c: float, with_gap: bool
+                       ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+    """:func:`elastic_responses` and the LU factors of ``c m + A`` (kept for the bordered
+    solves of :class:`BorderedSystem` at the same ``c``)."""
     matrix = grid.operator + np.diag(c * grid.m)
-    return np.linalg.solve(matrix, _rhs(grid.nodes, grid.g, with_gap))
+    factor = lu_factor(matrix, overwrite_a=True, check_finite=False)
+    return lu_solve(factor, _rhs(grid.nodes, grid.g, with_gap), check_finite=False), factor
 
 
 def touches(panels: Panels, points: np.ndarray) -> np.ndarray:
@@ -175,6 +195,8 @@ class AdaptiveGrid:
     spatial_error: float  # estimated error of q relative to max|q| on [-1, 1]
     resolved: bool  # the target was met within the panel budget
     rounds: int
+    c_ref: float = 1.0  # the relative modulus of ``factor``
+    factor: tuple[np.ndarray, np.ndarray] | None = None  # LU of c_ref m + A on ``grid``
 
 
 def widest_panel(lam: float, target: float) -> float:
@@ -213,16 +235,20 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
     singular = np.array([-1.0, 1.0, *breakpoints])
     # The kernel's quadrature error is not seen by the two-level estimate: keep it 1e3 below.
     start = Panels.from_edges(start_edges(lam, breakpoints, m_min, 1e-3 * target))
+    # m and g need resolving only as far as q does (its own tails are checked below):
+    # resolving them to 1e-12 at any tol took the rough punch from ~400 to 1312 nodes.
     panels, resolved = refine_to_resolve(start, [m] if g_is_zero else [m, g],
+                                         rel_tol=RESOLVE_SHARE * target,
                                          max_panels=MAX_PANELS)
     edges = panels.edges
     rounds = 0
     # 1. Interior panels: bisect where q is not resolved.
     tails = np.zeros(1)
+    grid: NystromGrid | None = None
     for _ in range(MAX_ROUNDS):
         rounds += 1
-        grid = build_grid(lam, edges, m, g)
-        responses = elastic_responses(grid, c_ref, with_gap)
+        grid = build_grid(lam, edges, m, g, grid)
+        responses, factor = factored_responses(grid, c_ref, with_gap)
         tails = interior_tails(grid, responses, singular)
         flagged = tails > INTERIOR_SHARE * target
         if not flagged.any():
@@ -240,15 +266,21 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
         if len(fine_edges) - 1 > MAX_PANELS:
             resolved = False
             break
-        fine = build_grid(lam, fine_edges, m, g)
-        fine_responses = elastic_responses(fine, c_ref, with_gap)
-        coarse_at_fine = nystrom_values(grid, c_ref, fine.nodes, fine.m, fine.g, responses,
-                                        with_gap)
+        fine = build_grid(lam, fine_edges, m, g, grid)
+        fine_responses, fine_factor = factored_responses(fine, c_ref, with_gap)
+        # The coarse answer at the fine nodes: its nodal values where the panel is shared
+        # (the Nystrom formula returns them there), the formula at the new nodes only.
+        kept_new, kept_old, fresh = shared_panels(grid.panels, fine.panels)
+        coarse_at_fine = np.empty_like(fine_responses)
+        coarse_at_fine[panel_nodes(kept_new)] = responses[panel_nodes(kept_old)]
+        fn = panel_nodes(fresh)
+        coarse_at_fine[fn] = nystrom_values(grid, c_ref, fine.nodes[fn], fine.m[fn],
+                                            fine.g[fn], responses, with_gap)
         scale = np.max(np.abs(fine_responses), axis=0)
         scale[scale == 0] = 1.0
         difference = float(np.max(np.abs(coarse_at_fine - fine_responses) / scale))
         estimate = SAFETY * difference / (TWO_LEVEL_RATIO - 1.0) + interior
-        grid, responses = fine, fine_responses
+        grid, responses, factor = fine, fine_responses, fine_factor
         if estimate <= target:
             break
         # Each further level gains ~4x: add the missing ones (beyond the two just made).
@@ -258,10 +290,11 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             if len(edges) - 1 > MAX_PANELS:
                 resolved = False
                 break
-            grid = build_grid(lam, edges, m, g)
-            responses = elastic_responses(grid, c_ref, with_gap)
+            grid = build_grid(lam, edges, m, g, grid)
+            responses, factor = factored_responses(grid, c_ref, with_gap)
     estimate = max(estimate, ROUND_OFF)
-    return AdaptiveGrid(grid, estimate, resolved and estimate <= target, rounds)
+    return AdaptiveGrid(grid, estimate, resolved and estimate <= target, rounds, c_ref,
+                        factor)
 
 
 # ------------------------------------------------------------------- bordered solves
@@ -277,23 +310,46 @@ class BorderedSystem:
     given quantity and for the gap; any loads are then a linear combination.
     """
 
-    def __init__(self, grid: NystromGrid, c: float, given: frozenset[str]) -> None:
+    def __init__(self, grid: NystromGrid, c: float, given: frozenset[str],
+                 factor: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+        """``factor``: LU factors of ``c m + A`` on this grid, if known (from :func:`adapt`);
+        then the border is eliminated by a 2 x 2 Schur complement instead of a new LU."""
         n = grid.size
         self.grid, self.c, self.given = grid, c, given
         self.unknown_names = tuple(q for q in ("settlement", "tilt", "force", "moment")
                                    if q not in given)
-        matrix = np.zeros((n + 2, n + 2))
-        matrix[:n, :n] = grid.operator
-        matrix[np.arange(n), np.arange(n)] += c * grid.m
-        matrix[n, :n] = grid.panels.weights
-        matrix[n + 1, :n] = grid.panels.weights * grid.nodes
+        # Border: columns B (N x 2) and corner D (2 x 2) of the unknown scalars, rows C
+        # (2 x N) of force and moment balance.
+        border = np.zeros((n + 2, 2))
         columns = {"settlement": (slice(0, n), -np.ones(n)),
                    "tilt": (slice(0, n), -grid.nodes),
                    "force": (n, -1.0), "moment": (n + 1, -1.0)}
         for k, name in enumerate(self.unknown_names):
             rows, values = columns[name]
-            matrix[rows, n + k] = values
-        self._lu = lu_factor(matrix, check_finite=False)
+            border[rows, k] = values
+        self._balance = np.vstack([grid.panels.weights, grid.panels.weights * grid.nodes])
+        self._border = border
+        self._factor = factor
+        self._lu = None
+        if factor is None:
+            matrix = np.zeros((n + 2, n + 2))
+            matrix[:n, :n] = grid.operator
+            matrix[np.arange(n), np.arange(n)] += c * grid.m
+            matrix[n:, :n] = self._balance
+            matrix[:, n:] = border
+            self._lu = lu_factor(matrix, overwrite_a=True, check_finite=False)
+
+    def _solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solutions (N + 2, k) of the bordered system for right-hand sides (N + 2, k)."""
+        if self._lu is not None:
+            return lu_solve(self._lu, rhs, check_finite=False)
+        n, k = self.grid.size, rhs.shape[1]
+        solved = lu_solve(self._factor, np.column_stack([rhs[:n], self._border[:n]]),
+                          check_finite=False)
+        y_rhs, y_border = solved[:, :k], solved[:, k:]
+        schur = self._border[n:] - self._balance @ y_border
+        scalars = np.linalg.solve(schur, rhs[n:] - self._balance @ y_rhs)
+        return np.vstack([y_rhs - y_border @ scalars, scalars])
 
     def unit_responses(self) -> dict[str, np.ndarray]:
         """Solution vectors (N + 2,) for each given quantity = 1 and for the gap."""
@@ -314,6 +370,5 @@ class BorderedSystem:
         gap[:n] = -self.grid.g
         rhs["gap"] = gap
         keys = list(rhs)
-        solved = lu_solve(self._lu, np.column_stack([rhs[k] for k in keys]),
-                          check_finite=False)
+        solved = self._solve(np.column_stack([rhs[k] for k in keys]))
         return {k: solved[:, i] for i, k in enumerate(keys)}
