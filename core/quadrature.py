@@ -86,8 +86,9 @@ class Panels:
 
 
 def _graded_interval(a: float, b: float, grade_a: bool, grade_b: bool, finest: float,
-                     widest: float, *, finest_b: float | None = None) -> list[float]:
-    """Panel edges on [a, b], geometric (ratio 2) from the finest width at graded ends.
+                     widest: float, *, finest_b: float | None = None,
+                     ratio: float = 2.0) -> list[float]:
+    """Panel edges on [a, b], geometric (``ratio``) from the finest width at graded ends.
 
     ``finest`` is the finest width at ``a`` (and at ``b`` unless ``finest_b`` is given).
     """
@@ -98,11 +99,11 @@ def _graded_interval(a: float, b: float, grade_a: bool, grade_b: bool, finest: f
     # Grading from both ends must not overlap: stop each at a third of the interval.
     while grade_a and w < min(widest, length / 3):
         left.append(w)
-        w *= 2.0
+        w *= ratio
     w = finest if finest_b is None else finest_b
     while grade_b and w < min(widest, length / 3):
         right.append(w)
-        w *= 2.0
+        w *= ratio
     # Each geometric run can sum to nearly 2/3 of the interval, so on a short interval the
     # two runs overlapped (a negative panel width, e.g. on [0.3, 1] with max_width 0.25).
     # Drop the widest graded panels until the middle is at least 1/8 of them wide (valid
@@ -120,7 +121,8 @@ def _graded_interval(a: float, b: float, grade_a: bool, grade_b: bool, finest: f
 
 def base_panels(lam: float, breakpoints: Sequence[float] = (), *,
                 edge_width: float | None = 1e-4, max_width: float = 0.25,
-                soft_cuts: Sequence[float] = (), soft_width: float | None = None) -> Panels:
+                soft_cuts: Sequence[float] = (), soft_width: float | None = None,
+                ratio: float = 2.0) -> Panels:
     """Panels on [-1, 1] broken at ``breakpoints`` and graded toward them and toward +-1.
 
     ``edge_width`` is the width of the finest panel at each graded point; panels are at
@@ -145,7 +147,8 @@ def base_panels(lam: float, breakpoints: Sequence[float] = (), *,
     if not len(soft_cuts) and np.isfinite(edge_width):
         edges: list[float] = [-1.0]
         for a, b in zip(hard[:-1], hard[1:], strict=True):
-            sub = _graded_interval(a, b, True, True, min(edge_width, (b - a) / 8), widest)
+            sub = _graded_interval(a, b, True, True, min(edge_width, (b - a) / 8), widest,
+                                   ratio=ratio)
             edges.extend(sub[1:])
         return Panels.from_edges(np.array(edges))
     soft = sorted({float(c) for c in soft_cuts})
@@ -325,6 +328,8 @@ def _near_pairs(panels: Panels, targets: np.ndarray, sources: np.ndarray
 def _log_weights(panels: Panels, targets: np.ndarray, near_t: np.ndarray,
                  near_p: np.ndarray) -> np.ndarray:
     """Product weights of ``ln|x - xi|`` (pairs x 16) for target/panel pairs, one batch."""
+    if not near_t.size:
+        return np.empty((0, NODES_PER_PANEL))
     c, h = panels.centers[near_p], panels.half_widths[near_p]
     moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1)
     return h[:, None] * (np.log(h)[:, None] * _W[None, :] + moments @ _TO_COEF)
@@ -348,6 +353,68 @@ def operator_rows(lam: float, panels: Panels, targets: np.ndarray,
     targets = np.asarray(targets, dtype=float)
     sources = (np.arange(panels.n_panels) if sources is None
                else np.asarray(sources, dtype=np.intp))
+    near_t, near_s = _near_pairs(panels, targets, sources)
+    log_weights = _log_weights(panels, targets, near_t, sources[near_s])
+    return _rows(lam, panels, targets, sources, near_t, near_s, log_weights)
+
+
+def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: np.ndarray,
+              sources: np.ndarray | None = None) -> np.ndarray:
+    """:func:`operator_rows` at the nodes of the panels ``target_panels[target_index]``.
+
+    The same numbers (to ~1e-15), but the product weights come from tables of reference
+    panel pairs: a target panel and a source panel are, up to an affine map, fixed by the
+    ratio of their half-widths and the offset of their centres, and on graded panels a few
+    such pairs recur (neighbours of equal width, of half or double width).
+    """
+    target_index = np.asarray(target_index, dtype=np.intp)
+    sources = (np.arange(panels.n_panels) if sources is None
+               else np.asarray(sources, dtype=np.intp))
+    targets = target_panels.nodes.reshape(-1, NODES_PER_PANEL)[target_index].ravel()
+    tc = target_panels.centers[target_index]
+    th = target_panels.half_widths[target_index]
+    sc, sh = panels.centers[sources], panels.half_widths[sources]
+    # Panel pairs with a target node possibly within NEAR_FIELD source half-widths.
+    pair_t, pair_s = np.nonzero(np.abs(tc[:, None] - sc[None, :])
+                                <= NEAR_FIELD * sh[None, :] + th[:, None])
+    if not pair_t.size:
+        return _rows(lam, panels, targets, sources, pair_t, pair_s, np.empty((0, 16)))
+    ratio = np.round(th[pair_t] / sh[pair_s], 12)
+    offset = np.round((tc[pair_t] - sc[pair_s]) / sh[pair_s], 12)
+    keys = list(zip(ratio.tolist(), offset.tolist(), strict=True))
+    # Looked up into a local dict first: another thread may empty the shared one.
+    found = {k: _PAIR_TABLES.get(k) for k in dict.fromkeys(keys)}
+    missing = [k for k, v in found.items() if v is None]
+    if missing:
+        z = np.array([[o + r * t for t in _T] for r, o in missing])  # (missing, 16)
+        moments = legendre_log_moments(z.ravel(), NODES_PER_PANEL - 1) @ _TO_COEF
+        moments = moments.reshape(len(missing), NODES_PER_PANEL, NODES_PER_PANEL)
+        new = {key: (np.abs(zk) <= NEAR_FIELD, table)
+               for key, zk, table in zip(missing, z, moments, strict=True)}
+        found.update(new)
+        if len(_PAIR_TABLES) + len(new) > _PAIR_TABLES_MAX:
+            _PAIR_TABLES.clear()
+        _PAIR_TABLES.update(new)
+    tables = [found[k] for k in keys]
+    near = np.array([t[0] for t in tables])  # (pairs, 16 target nodes)
+    which, node = np.nonzero(near)
+    reference = np.array([t[1] for t in tables])[which, node]  # (near pairs, 16)
+    h = sh[pair_s[which]]
+    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + reference)
+    near_t = pair_t[which] * NODES_PER_PANEL + node
+    return _rows(lam, panels, targets, sources, near_t, pair_s[which], log_weights)
+
+
+#: Reference tables of :func:`node_rows`, keyed by (half-width ratio, centre offset) of a
+#: (target, source) panel pair rounded to 1e-12 (moments move by ~1e-12 of their size):
+#: near mask (16,) and ``M(z) @ _TO_COEF`` (16 x 16). Emptied when it holds more.
+_PAIR_TABLES: dict[tuple[float, float], tuple[np.ndarray, np.ndarray]] = {}
+_PAIR_TABLES_MAX = 4096
+
+
+def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
+          near_t: np.ndarray, near_s: np.ndarray, log_weights: np.ndarray) -> np.ndarray:
+    """Operator rows given the near (target, source position) pairs and their log weights."""
     cols_all = (sources[:, None] * NODES_PER_PANEL + _J[None, :]).ravel()
     nodes = panels.nodes[cols_all]
     weights = panels.weights[cols_all] / np.pi
@@ -363,12 +430,10 @@ def operator_rows(lam: float, panels: Panels, targets: np.ndarray,
         block -= distance
         block -= log_lam
         block *= weights[None, :]
-    near_t, near_s = _near_pairs(panels, targets, sources)
     if near_t.size:
         cols = near_s[:, None] * NODES_PER_PANEL + _J[None, :]  # positions among sources
         smooth = plane_kernel_regular(lam * np.abs(targets[near_t, None] - nodes[cols]))
         smooth -= log_lam
-        log_weights = _log_weights(panels, targets, near_t, sources[near_s])
         rows[near_t[:, None], cols] = smooth * weights[cols] - log_weights / np.pi
     return rows
 
@@ -404,18 +469,19 @@ def kernel_operator(lam: float, panels: Panels, previous: KernelOperator | None 
     refinement). Blocks between panels both grids share (same ends) are copied from it,
     so only the rows and columns of new panels are computed.
     """
+    every = np.arange(panels.n_panels)
     if previous is None or previous.lam != lam:
-        return KernelOperator(lam, panels, operator_rows(lam, panels, panels.nodes))
+        return KernelOperator(lam, panels, node_rows(lam, panels, panels, every))
     kept_new, kept_old, fresh = shared_panels(previous.panels, panels)
     if not kept_new.size:
-        return KernelOperator(lam, panels, operator_rows(lam, panels, panels.nodes))
+        return KernelOperator(lam, panels, node_rows(lam, panels, panels, every))
     matrix = np.empty((panels.size, panels.size))
     kn, ko = panel_nodes(kept_new), panel_nodes(kept_old)
     matrix[np.ix_(kn, kn)] = previous.matrix[np.ix_(ko, ko)]
     if fresh.size:
         fn = panel_nodes(fresh)
-        matrix[fn, :] = operator_rows(lam, panels, panels.nodes[fn])
-        matrix[np.ix_(kn, fn)] = operator_rows(lam, panels, panels.nodes[kn], fresh)
+        matrix[fn, :] = node_rows(lam, panels, panels, fresh)
+        matrix[np.ix_(kn, fn)] = node_rows(lam, panels, panels, kept_new, fresh)
     return KernelOperator(lam, panels, matrix)
 
 
