@@ -38,6 +38,7 @@ import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 
 from core.quadrature import (
+    FULL_ACCURACY,
     NODES_PER_PANEL,
     KernelOperator,
     Panels,
@@ -73,6 +74,9 @@ ROUND_OFF = 2e-13
 #: slightly fewer (352-896 against 368-896).
 GRADING_RATIO = (4.0, 2.0)
 COARSE_GRADING_TARGET = 1e-7
+#: The kernel values are evaluated to this share of the target (absolute; they are
+#: O(0.1-1)): like the kernel's quadrature (widest_panel), out of sight of the estimate.
+KERNEL_SHARE = 1e-4
 #: m and g are resolved on the starting panels to this share of the target.
 RESOLVE_SHARE = 0.1
 #: Rounds of each refinement loop.
@@ -92,6 +96,7 @@ class NystromGrid:
     operator: np.ndarray
     m: np.ndarray
     g: np.ndarray
+    kernel_accuracy: float = FULL_ACCURACY  # absolute accuracy of the kernel values
 
     @property
     def nodes(self) -> np.ndarray:
@@ -111,22 +116,25 @@ class NystromGrid:
 
     def rows(self, x: np.ndarray) -> np.ndarray:
         """Rows of ``F`` at points ``x``: ``(F q)(x) = rows @ q`` (len(x), N)."""
-        return operator_rows(self.lam, self.panels, np.asarray(x, dtype=float))
+        return operator_rows(self.lam, self.panels, np.asarray(x, dtype=float),
+                             accuracy=self.kernel_accuracy)
 
 
 def build_grid(lam: float, edges: np.ndarray, m: Function, g: Function,
-               previous: NystromGrid | None = None) -> NystromGrid:
+               previous: NystromGrid | None = None,
+               kernel_accuracy: float = FULL_ACCURACY) -> NystromGrid:
     """The discretization on panels with the given ``edges`` (dimensionless).
 
-    ``previous``: a grid of the same ``lam`` whose operator blocks between the panels both
-    share are reused (only rows and columns of new panels are computed).
+    ``previous``: a grid of the same ``lam`` and kernel accuracy whose operator blocks
+    between the panels both share are reused (only rows and columns of new panels are
+    computed). ``kernel_accuracy``: absolute accuracy of the kernel values.
     """
     panels = Panels.from_edges(edges)
-    before = (None if previous is None
+    before = (None if previous is None or previous.kernel_accuracy != kernel_accuracy
               else KernelOperator(previous.lam, previous.panels, previous.operator))
-    operator = kernel_operator(lam, panels, before).matrix
+    operator = kernel_operator(lam, panels, before, kernel_accuracy).matrix
     return NystromGrid(lam, panels, operator, np.asarray(m(panels.nodes), dtype=float),
-                       np.asarray(g(panels.nodes), dtype=float))
+                       np.asarray(g(panels.nodes), dtype=float), kernel_accuracy)
 
 
 def _rhs(x: np.ndarray, g: np.ndarray, with_gap: bool) -> np.ndarray:
@@ -252,6 +260,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
     singular = np.array([-1.0, 1.0, *breakpoints])
     # The kernel's quadrature error is not seen by the two-level estimate: keep it 1e3 below.
     ratio = GRADING_RATIO[0] if target >= COARSE_GRADING_TARGET else GRADING_RATIO[1]
+    accuracy = KERNEL_SHARE * target
     start = Panels.from_edges(start_edges(lam, breakpoints, m_min, 1e-3 * target, ratio))
     # m and g need resolving only as far as q does (its own tails are checked below):
     # resolving them to 1e-12 at any tol took the rough punch from ~400 to 1312 nodes.
@@ -265,7 +274,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
     grid: NystromGrid | None = None
     for _ in range(MAX_ROUNDS):
         rounds += 1
-        grid = build_grid(lam, edges, m, g, grid)
+        grid = build_grid(lam, edges, m, g, grid, accuracy)
         responses, factor = factored_responses(grid, c_ref, with_gap)
         tails = interior_tails(grid, responses, singular)
         flagged = tails > INTERIOR_SHARE * target
@@ -284,7 +293,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
         if len(fine_edges) - 1 > MAX_PANELS:
             resolved = False
             break
-        fine = build_grid(lam, fine_edges, m, g, grid)
+        fine = build_grid(lam, fine_edges, m, g, grid, accuracy)
         fine_responses, fine_factor = factored_responses(fine, c_ref, with_gap)
         # The coarse answer at the fine nodes: its nodal values where the panel is shared
         # (the Nystrom formula returns them there), the formula at the new nodes only.
@@ -294,7 +303,8 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
         fn = panel_nodes(fresh)
         coarse_at_fine[fn] = nystrom_values(grid, c_ref, fine.nodes[fn], fine.m[fn],
                                             fine.g[fn], responses, with_gap,
-                                            node_rows(lam, grid.panels, fine.panels, fresh))
+                                            node_rows(lam, grid.panels, fine.panels, fresh,
+                                                      accuracy=accuracy))
         scale = np.max(np.abs(fine_responses), axis=0)
         scale[scale == 0] = 1.0
         difference = float(np.max(np.abs(coarse_at_fine - fine_responses) / scale))
@@ -309,7 +319,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             if len(edges) - 1 > MAX_PANELS:
                 resolved = False
                 break
-            grid = build_grid(lam, edges, m, g, grid)
+            grid = build_grid(lam, edges, m, g, grid, accuracy)
             responses, factor = factored_responses(grid, c_ref, with_gap)
     estimate = max(estimate, ROUND_OFF)
     return AdaptiveGrid(grid, estimate, resolved and estimate <= target, rounds, c_ref,

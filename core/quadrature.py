@@ -31,6 +31,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.polynomial import chebyshev as npcheb
 from numpy.polynomial import legendre as npleg
 
 from core.kernel import plane_kernel_regular
@@ -206,6 +207,10 @@ def refine_to_resolve(panels: Panels, functions: Sequence[Callable[[np.ndarray],
     return Panels.from_edges(edges), False
 
 
+#: Points outside [-1.05, 1.05] from which Miller's recurrence runs in bands of |z|.
+_MILLER_BANDS_FROM = 2048
+
+
 def _q_outside(z: np.ndarray, nq: int) -> np.ndarray:
     """``Q_n(z)``, n < nq, for |z| > 1 by Miller's backward recurrence (shape (len(z), nq))."""
     zo = np.abs(z)
@@ -216,9 +221,10 @@ def _q_outside(z: np.ndarray, nq: int) -> np.ndarray:
     qb = np.full(zo.size, 1e-280)
     vals = np.empty((zo.size, nq))
     for n in range(start, 0, -1):
-        # (n) Q_{n-1} = (2n+1) z Q_n - (n+1) Q_{n+1}
-        qc = ((2 * n + 1) * zo * qb - (n + 1) * qa) / n
-        qa, qb = qb, qc
+        # (n) Q_{n-1} = (2n+1) z Q_n - (n+1) Q_{n+1}, in place: qa becomes Q_{n-1}
+        qa *= -(n + 1) / n
+        qa += ((2 * n + 1) / n) * zo * qb
+        qa, qb = qb, qa
         if n - 1 < nq:
             vals[:, n - 1] = qb
         # Rescale every 4th step: 4 steps grow |Q| by less than (3 |z| + 3)^4, far below
@@ -264,10 +270,11 @@ def legendre_log_moments(z: np.ndarray, degree: int) -> np.ndarray:
             qi[:, n + 1] = ((2 * n + 1) * zi * qi[:, n] - n * qi[:, n - 1]) / (n + 1)
         q[inner] = qi
     outer = ~inner
-    # Miller's recurrence from an index set by the smallest rho of a group: in bands of
-    # |z|, so that the many targets well outside a panel do not run the ~90 steps the
-    # few just outside need.
-    bands = (1.05, 1.2, 1.5, 2.2, np.inf)
+    # Miller's recurrence from an index set by the smallest rho of a group. Many points:
+    # in bands of |z|, so that the many well outside a panel do not run the ~90 steps the
+    # few just outside need; few points: one group (the steps' overhead dominates).
+    bands = (1.05, 1.2, 1.5, 2.2, np.inf) if outer.sum() > _MILLER_BANDS_FROM else (
+        1.05, np.inf)
     for low, high in zip(bands[:-1], bands[1:], strict=True):
         group = outer & (np.abs(z) > low) & (np.abs(z) <= high)
         if group.any():
@@ -335,6 +342,66 @@ def _log_weights(panels: Panels, targets: np.ndarray, near_t: np.ndarray,
     return h[:, None] * (np.log(h)[:, None] * _W[None, :] + moments @ _TO_COEF)
 
 
+#: Default absolute accuracy of the kernel values in the operator: beyond rounding.
+FULL_ACCURACY = 1e-17
+#: |k_pl(s)| <= KERNEL_ENVELOPE exp(-KERNEL_DECAY s) for s >= 2 (core.kernel: 2 pi |c_1|
+#: exp(-Im(u_1) s)); far pairs where that is below the accuracy are exactly 0.
+KERNEL_ENVELOPE = 1.6075
+KERNEL_DECAY = 2.10619611524533
+_EVEN_TABLES: dict[int, np.ndarray] = {}
+
+
+def _even_coefficients(accuracy: float) -> np.ndarray:
+    """Monomial coefficients in y = s^2/2 - 1 of ``k_reg`` on |s| <= 2 to ``accuracy``.
+
+    The Chebyshev series of ``k_reg`` in y falls like (3 + 2 sqrt 2)^-k (its nearest
+    singularity is at y = -3): truncated where the tail is below the accuracy, a tol of
+    1e-6 needs degree ~13 instead of 24, and the Horner steps are most of the kernel's cost.
+    """
+    cheb = _EVEN_TABLES.get(-1)
+    if cheb is None:
+        y = np.cos(np.pi * (np.arange(25) + 0.5) / 25)
+        cheb = npcheb.chebfit(y, plane_kernel_regular(np.sqrt(2.0 * (y + 1.0))), 24)
+        _EVEN_TABLES[-1] = cheb
+    tail = np.cumsum(np.abs(cheb[::-1]))[::-1]  # tail[k] = sum_{j >= k} |c_j|
+    degree = int(np.argmax(np.append(tail, 0.0) <= 0.5 * accuracy)) - 1
+    degree = max(degree, 1)
+    table = _EVEN_TABLES.get(degree)
+    if table is None:
+        table = npcheb.cheb2poly(cheb[:degree + 1])
+        _EVEN_TABLES[degree] = table
+    return table
+
+
+def _kernel_regular(s: np.ndarray, accuracy: float) -> np.ndarray:
+    """``k_reg(s)`` (s >= 0, any shape) to within ``accuracy`` (absolute)."""
+    if accuracy <= FULL_ACCURACY or not s.size or s.max() >= 2.0:
+        return plane_kernel_regular(s)
+    coef = _even_coefficients(accuracy)
+    y = 0.5 * s * s
+    y -= 1.0
+    out = np.full_like(y, coef[-1])
+    for c in coef[-2::-1]:
+        out *= y
+        out += c
+    return out
+
+
+def _kernel_block(s: np.ndarray, accuracy: float) -> np.ndarray:
+    """``k_pl(s) = k_reg(s) - ln s`` (s > 0, any shape) to within ``accuracy`` (absolute);
+    exactly 0 where its envelope is below the accuracy."""
+    cut = np.log(KERNEL_ENVELOPE / max(accuracy, 1e-300)) / KERNEL_DECAY
+    if s.size and s.max() >= cut:
+        out = np.zeros_like(s)
+        inside = s < cut
+        out[inside] = _kernel_block(s[inside], accuracy)
+        return out
+    out = _kernel_regular(s, accuracy)
+    with np.errstate(divide="ignore"):  # a target on a node: a near pair, replaced
+        out -= np.log(s)
+    return out
+
+
 #: Target rows per block of :func:`operator_rows`: rows x nodes about this many entries,
 #: so that every temporary of a block stays in cache (whole-matrix temporaries made the
 #: element-wise passes, not the kernel, the main cost: 18 of 30 ms at 704 nodes).
@@ -342,24 +409,27 @@ _BLOCK_ENTRIES = 1 << 15
 
 
 def operator_rows(lam: float, panels: Panels, targets: np.ndarray,
-                  sources: np.ndarray | None = None) -> np.ndarray:
+                  sources: np.ndarray | None = None, accuracy: float = FULL_ACCURACY
+                  ) -> np.ndarray:
     """Rows of the discrete operator for arbitrary targets (len(targets) x N).
 
     ``sources`` (panel indices, default all) restricts the columns to the nodes of those
     panels, in that order (len(targets) x 16 len(sources)). Far pairs take the Gauss rule
     of the whole kernel ``k_reg(lam d) - ln(lam d)``; near pairs the Gauss rule of its
-    smooth part and product integration of the log part.
+    smooth part and product integration of the log part. ``accuracy``: absolute accuracy
+    of the kernel values (default: rounding; a looser one evaluates them faster).
     """
     targets = np.asarray(targets, dtype=float)
     sources = (np.arange(panels.n_panels) if sources is None
                else np.asarray(sources, dtype=np.intp))
     near_t, near_s = _near_pairs(panels, targets, sources)
     log_weights = _log_weights(panels, targets, near_t, sources[near_s])
-    return _rows(lam, panels, targets, sources, near_t, near_s, log_weights)
+    return _rows(lam, panels, targets, sources, near_t, near_s, log_weights, accuracy)
 
 
 def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: np.ndarray,
-              sources: np.ndarray | None = None) -> np.ndarray:
+              sources: np.ndarray | None = None, accuracy: float = FULL_ACCURACY
+              ) -> np.ndarray:
     """:func:`operator_rows` at the nodes of the panels ``target_panels[target_index]``.
 
     The same numbers (to ~1e-15), but the product weights come from tables of reference
@@ -378,7 +448,8 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
     pair_t, pair_s = np.nonzero(np.abs(tc[:, None] - sc[None, :])
                                 <= NEAR_FIELD * sh[None, :] + th[:, None])
     if not pair_t.size:
-        return _rows(lam, panels, targets, sources, pair_t, pair_s, np.empty((0, 16)))
+        return _rows(lam, panels, targets, sources, pair_t, pair_s, np.empty((0, 16)),
+                     accuracy)
     ratio = np.round(th[pair_t] / sh[pair_s], 12)
     offset = np.round((tc[pair_t] - sc[pair_s]) / sh[pair_s], 12)
     keys = list(zip(ratio.tolist(), offset.tolist(), strict=True))
@@ -402,7 +473,8 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
     h = sh[pair_s[which]]
     log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + reference)
     near_t = pair_t[which] * NODES_PER_PANEL + node
-    return _rows(lam, panels, targets, sources, near_t, pair_s[which], log_weights)
+    return _rows(lam, panels, targets, sources, near_t, pair_s[which], log_weights,
+                 accuracy)
 
 
 #: Reference tables of :func:`node_rows`, keyed by (half-width ratio, centre offset) of a
@@ -413,27 +485,27 @@ _PAIR_TABLES_MAX = 4096
 
 
 def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
-          near_t: np.ndarray, near_s: np.ndarray, log_weights: np.ndarray) -> np.ndarray:
-    """Operator rows given the near (target, source position) pairs and their log weights."""
+          near_t: np.ndarray, near_s: np.ndarray, log_weights: np.ndarray,
+          accuracy: float = FULL_ACCURACY) -> np.ndarray:
+    """Operator rows given the near (target, source position) pairs and their log weights.
+
+    ``accuracy``: absolute accuracy of the kernel values (see :func:`_kernel_block`).
+    """
     cols_all = (sources[:, None] * NODES_PER_PANEL + _J[None, :]).ravel()
     nodes = panels.nodes[cols_all]
     weights = panels.weights[cols_all] / np.pi
-    log_lam = np.log(lam)
     rows = np.empty((targets.size, nodes.size))
     step = max(1, _BLOCK_ENTRIES // max(nodes.size, 1))
     for start in range(0, targets.size, step):
         block = rows[start:start + step]
         distance = np.abs(targets[start:start + step, None] - nodes[None, :])
-        block[...] = plane_kernel_regular(lam * distance)
-        with np.errstate(divide="ignore"):  # a target on a node: a near pair, replaced
-            np.log(distance, out=distance)
-        block -= distance
-        block -= log_lam
+        distance *= lam
+        block[...] = _kernel_block(distance, accuracy)
         block *= weights[None, :]
     if near_t.size:
         cols = near_s[:, None] * NODES_PER_PANEL + _J[None, :]  # positions among sources
-        smooth = plane_kernel_regular(lam * np.abs(targets[near_t, None] - nodes[cols]))
-        smooth -= log_lam
+        smooth = _kernel_regular(lam * np.abs(targets[near_t, None] - nodes[cols]), accuracy)
+        smooth -= np.log(lam)
         rows[near_t[:, None], cols] = smooth * weights[cols] - log_weights / np.pi
     return rows
 
@@ -461,27 +533,30 @@ def panel_nodes(panel_index: np.ndarray) -> np.ndarray:
             + _J[None, :]).ravel()
 
 
-def kernel_operator(lam: float, panels: Panels, previous: KernelOperator | None = None
-                    ) -> KernelOperator:
+def kernel_operator(lam: float, panels: Panels, previous: KernelOperator | None = None,
+                    accuracy: float = FULL_ACCURACY) -> KernelOperator:
     """The discrete operator F on the nodes of ``panels`` (N x N, units of the density).
 
     ``previous``: the operator on an earlier grid with the same ``lam`` (e.g. before a
     refinement). Blocks between panels both grids share (same ends) are copied from it,
-    so only the rows and columns of new panels are computed.
+    so only the rows and columns of new panels are computed. ``accuracy``: absolute
+    accuracy of the kernel values (as in :func:`operator_rows`).
     """
     every = np.arange(panels.n_panels)
     if previous is None or previous.lam != lam:
-        return KernelOperator(lam, panels, node_rows(lam, panels, panels, every))
+        return KernelOperator(lam, panels, node_rows(lam, panels, panels, every,
+                                                     accuracy=accuracy))
     kept_new, kept_old, fresh = shared_panels(previous.panels, panels)
     if not kept_new.size:
-        return KernelOperator(lam, panels, node_rows(lam, panels, panels, every))
+        return KernelOperator(lam, panels, node_rows(lam, panels, panels, every,
+                                                     accuracy=accuracy))
     matrix = np.empty((panels.size, panels.size))
     kn, ko = panel_nodes(kept_new), panel_nodes(kept_old)
     matrix[np.ix_(kn, kn)] = previous.matrix[np.ix_(ko, ko)]
     if fresh.size:
         fn = panel_nodes(fresh)
-        matrix[fn, :] = node_rows(lam, panels, panels, fresh)
-        matrix[np.ix_(kn, fn)] = node_rows(lam, panels, panels, kept_new, fresh)
+        matrix[fn, :] = node_rows(lam, panels, panels, fresh, accuracy=accuracy)
+        matrix[np.ix_(kn, fn)] = node_rows(lam, panels, panels, kept_new, fresh, accuracy)
     return KernelOperator(lam, panels, matrix)
 
 
