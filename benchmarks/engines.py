@@ -345,7 +345,10 @@ def main(argv: list[str] | None = None) -> int:
     for scene in scenes:
         print(scene.key, flush=True)
         results.append(sweep(scene, repeats))
-        plot(results[-1], args.out / f"engine_{scene.key}.png")
+        try:
+            plot(results[-1], args.out / f"engine_{scene.key}.png")
+        except ModuleNotFoundError as exc:  # matplotlib comes with the [bench] extra
+            print(f"  no figure: {exc}", flush=True)
     goal = goals(repeats)
     command = "python benchmarks/engines.py" + (" --quick" if args.quick else "")
     report(results, goal, command, args.out)

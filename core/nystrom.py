@@ -155,7 +155,8 @@ def factored_responses(grid: NystromGrid, c: float, with_gap: bool
                        ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
     """:func:`elastic_responses` and the LU factors of ``c m + A`` (kept for the bordered
     solves of :class:`BorderedSystem` at the same ``c``)."""
-    matrix = grid.operator + np.diag(c * grid.m)
+    matrix = grid.operator.copy()
+    matrix.flat[::grid.size + 1] += c * grid.m
     factor = lu_factor(matrix, overwrite_a=True, check_finite=False)
     return lu_solve(factor, _rhs(grid.nodes, grid.g, with_gap), check_finite=False), factor
 
