@@ -251,6 +251,9 @@ def goal_rows(results: list[dict], goal: dict[str, float]
                   statistics.median(wall), statistics.median(cpu), 5.0, "ms"),
                  ("new elastic scene at tol 1e-6, the hardest", max(wall), max(cpu), 20.0,
                   "ms"),
+                 ("loads only, q at 400 points, median of the scenes",
+                  statistics.median(run["warm_s"] * 1e3 for run in at_target),
+                  statistics.median(run["warm_cpu_s"] * 1e3 for run in at_target), 0.2, "ms"),
                  ("loads only, q at 400 points, the slowest scene",
                   max(run["warm_s"] * 1e3 for run in at_target),
                   max(run["warm_cpu_s"] * 1e3 for run in at_target), 0.2, "ms")]

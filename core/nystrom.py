@@ -27,6 +27,11 @@ Refinement, in two parts:
   error there falls like h^2 (h the finest width; measured 13-21x per 4-5x in h), so
   two solves whose grading differs by two levels (h/4) give the error of the finer one,
   about their difference / 15, and the number of levels still missing.
+
+Work of a new scene: the operator of each grid reuses the blocks of the panels it shares
+with the previous one, the coarse answer is evaluated by the formula only at the new
+nodes, the kernel values are computed to ``KERNEL_SHARE * tol`` (not to rounding), and the
+LU of the last grid serves the bordered solve of the loads (a 2 x 2 Schur complement).
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 
+from core.block_lu import BlockLU
 from core.quadrature import (
     FULL_ACCURACY,
     NODES_PER_PANEL,
@@ -151,14 +157,45 @@ def elastic_responses(grid: NystromGrid, c: float, with_gap: bool) -> np.ndarray
     return factored_responses(grid, c, with_gap)[0]
 
 
-def factored_responses(grid: NystromGrid, c: float, with_gap: bool
-                       ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
-    """:func:`elastic_responses` and the LU factors of ``c m + A`` (kept for the bordered
-    solves of :class:`BorderedSystem` at the same ``c``)."""
+def factored_responses(grid: NystromGrid, c: float, with_gap: bool,
+                       singular: np.ndarray | None = None,
+                       previous: BlockLU | None = None
+                       ) -> tuple[np.ndarray, BlockLU]:
+    """:func:`elastic_responses` and the factors of ``c m + A`` (kept for the bordered
+    solves of :class:`BorderedSystem` at the same ``c``).
+
+    The factors are split (:class:`core.block_lu.BlockLU`) into the panels that do not end
+    at a ``singular`` point and the rest; ``previous``: the factors on the grid this one
+    refines, whose first block is reused when it is the same (the grading toward the
+    singular points left those panels as they were).
+    """
     matrix = grid.operator.copy()
     matrix.flat[::grid.size + 1] += c * grid.m
-    factor = lu_factor(matrix, overwrite_a=True, check_finite=False)
-    return lu_solve(factor, _rhs(grid.nodes, grid.g, with_gap), check_finite=False), factor
+    edges = grid.panels.edges
+
+    def block_key(kept_panels: np.ndarray) -> tuple:
+        # The kept block is the same matrix when its panels, lam, kernel accuracy and c m
+        # are: the panel ends as pairs, and the rest as bytes.
+        return (grid.lam, grid.kernel_accuracy,
+                tuple(zip(edges[kept_panels].tolist(), edges[kept_panels + 1].tolist(),
+                          strict=True)),
+                (c * grid.m[panel_nodes(kept_panels)]).tobytes())
+
+    reuse, key, kept_panels = None, None, None
+    if previous is not None and previous.key is not None:
+        before = set(previous.key[2])
+        pairs = zip(edges[:-1].tolist(), edges[1:].tolist(), strict=True)
+        kept_panels = np.array([i for i, pair in enumerate(pairs) if pair in before],
+                               dtype=np.intp)
+        key = block_key(kept_panels)
+        if key == previous.key:
+            reuse = previous.kept_factor
+    if reuse is None:
+        kept_panels = (np.arange(grid.panels.n_panels) if singular is None
+                       else np.nonzero(~touches(grid.panels, singular))[0])
+        key = block_key(kept_panels)
+    factor = BlockLU(matrix, panel_nodes(kept_panels), reuse, key)
+    return factor.solve(_rhs(grid.nodes, grid.g, with_gap)), factor
 
 
 def touches(panels: Panels, points: np.ndarray) -> np.ndarray:
@@ -218,7 +255,7 @@ class AdaptiveGrid:
     resolved: bool  # the target was met within the panel budget
     rounds: int
     c_ref: float = 1.0  # the relative modulus of ``factor``
-    factor: tuple[np.ndarray, np.ndarray] | None = None  # LU of c_ref m + A on ``grid``
+    factor: BlockLU | None = None  # factors of c_ref m + A on ``grid``
 
 
 def widest_panel(lam: float, target: float) -> float:
@@ -276,7 +313,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
     for _ in range(MAX_ROUNDS):
         rounds += 1
         grid = build_grid(lam, edges, m, g, grid, accuracy)
-        responses, factor = factored_responses(grid, c_ref, with_gap)
+        responses, factor = factored_responses(grid, c_ref, with_gap, singular)
         tails = interior_tails(grid, responses, singular)
         flagged = tails > INTERIOR_SHARE * target
         if not flagged.any():
@@ -295,7 +332,8 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             resolved = False
             break
         fine = build_grid(lam, fine_edges, m, g, grid, accuracy)
-        fine_responses, fine_factor = factored_responses(fine, c_ref, with_gap)
+        fine_responses, fine_factor = factored_responses(fine, c_ref, with_gap, singular,
+                                                         factor)
         # The coarse answer at the fine nodes: its nodal values where the panel is shared
         # (the Nystrom formula returns them there), the formula at the new nodes only.
         kept_new, kept_old, fresh = shared_panels(grid.panels, fine.panels)
@@ -321,7 +359,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
                 resolved = False
                 break
             grid = build_grid(lam, edges, m, g, grid, accuracy)
-            responses, factor = factored_responses(grid, c_ref, with_gap)
+            responses, factor = factored_responses(grid, c_ref, with_gap, singular)
     estimate = max(estimate, ROUND_OFF)
     return AdaptiveGrid(grid, estimate, resolved and estimate <= target, rounds, c_ref,
                         factor)
@@ -341,8 +379,8 @@ class BorderedSystem:
     """
 
     def __init__(self, grid: NystromGrid, c: float, given: frozenset[str],
-                 factor: tuple[np.ndarray, np.ndarray] | None = None) -> None:
-        """``factor``: LU factors of ``c m + A`` on this grid, if known (from :func:`adapt`);
+                 factor: BlockLU | None = None) -> None:
+        """``factor``: factors of ``c m + A`` on this grid, if known (from :func:`adapt`);
         then the border is eliminated by a 2 x 2 Schur complement instead of a new LU."""
         n = grid.size
         self.grid, self.c, self.given = grid, c, given
@@ -374,8 +412,7 @@ class BorderedSystem:
         if self._lu is not None:
             return lu_solve(self._lu, rhs, check_finite=False)
         n, k = self.grid.size, rhs.shape[1]
-        solved = lu_solve(self._factor, np.column_stack([rhs[:n], self._border[:n]]),
-                          check_finite=False)
+        solved = self._factor.solve(np.column_stack([rhs[:n], self._border[:n]]))
         y_rhs, y_border = solved[:, :k], solved[:, k:]
         schur = self._border[n:] - self._balance @ y_border
         scalars = np.linalg.solve(schur, rhs[n:] - self._balance @ y_rhs)

@@ -14,6 +14,12 @@ plain rule is accurate to ~2e-15. The smooth part ``k_reg(lam d)`` has its neare
 complex singularities at ``d = +-2i/lam``, so panels no wider than ``3/lam`` integrate
 it to machine precision.
 
+Assembly: rows are built in cache-sized blocks of targets; at panel nodes the product
+weights come from tables of reference panel pairs (:func:`node_rows`); an operator on a
+refined grid copies the blocks of the panels it shares with the coarser one
+(:func:`kernel_operator`); the kernel values may be asked for to a looser absolute accuracy
+than rounding (a truncated series, and exact zeros where the kernel has decayed below it).
+
 Panels break at every point where the coating compliance ``m`` or the gap ``g`` may
 jump, are graded geometrically toward those points and toward ``x = +-1`` (where the
 densities and ``F phi`` have end-point behaviour), and are refined adaptively until the
@@ -31,10 +37,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.polynomial import chebyshev as npcheb
 from numpy.polynomial import legendre as npleg
 
-from core.kernel import plane_kernel_regular
+from core.kernel_values import FULL_ACCURACY, kernel_block, kernel_regular
+from core.log_moments import legendre_log_moments
 
 NODES_PER_PANEL = 16
 _T, _W = npleg.leggauss(NODES_PER_PANEL)
@@ -207,96 +213,6 @@ def refine_to_resolve(panels: Panels, functions: Sequence[Callable[[np.ndarray],
     return Panels.from_edges(edges), False
 
 
-#: Points outside [-1.05, 1.05] from which Miller's recurrence runs in bands of |z|.
-_MILLER_BANDS_FROM = 2048
-
-
-def _q_outside(z: np.ndarray, nq: int) -> np.ndarray:
-    """``Q_n(z)``, n < nq, for |z| > 1 by Miller's backward recurrence (shape (len(z), nq))."""
-    zo = np.abs(z)
-    rho = zo + np.sqrt(zo * zo - 1.0)
-    # Start index so that rho^-2(start - n) < 1e-18 for every needed n.
-    start = nq + int(np.ceil(18 * np.log(10) / (2 * np.log(rho.min())))) + 5
-    qa = np.zeros(zo.size)
-    qb = np.full(zo.size, 1e-280)
-    vals = np.empty((zo.size, nq))
-    for n in range(start, 0, -1):
-        # (n) Q_{n-1} = (2n+1) z Q_n - (n+1) Q_{n+1}, in place: qa becomes Q_{n-1}
-        qa *= -(n + 1) / n
-        qa += ((2 * n + 1) / n) * zo * qb
-        qa, qb = qb, qa
-        if n - 1 < nq:
-            vals[:, n - 1] = qb
-        # Rescale every 4th step: 4 steps grow |Q| by less than (3 |z| + 3)^4, far below
-        # the 1e108 left above 1e200 for any |z| < 1e20.
-        if n % 4 == 0:
-            big = np.abs(qb) > 1e200
-            if big.any():
-                qa[big] *= 1e-200
-                qb[big] *= 1e-200
-                vals[big] *= 1e-200
-    exact0 = 0.5 * np.log((zo + 1.0) / (zo - 1.0))
-    vals *= (exact0 / vals[:, 0])[:, None]
-    # Q_n(-z) = (-1)^(n+1) Q_n(z)
-    neg = z < 0
-    if neg.any():
-        vals[neg] *= ((-1.0) ** (np.arange(nq) + 1))[None, :]
-    return vals
-
-
-def legendre_log_moments(z: np.ndarray, degree: int) -> np.ndarray:
-    """``M_n(z) = int_{-1}^{1} ln|z - t| P_n(t) dt`` for n = 0..degree (shape (len(z), degree+1)).
-
-    Uses Legendre functions of the second kind ``Q_n``: forward recurrence where it is
-    stable (|z| <= 1.05) and Miller's backward recurrence outside, where ``Q_n`` is the
-    minimal solution and the forward recurrence loses ~2n log10(|z| + sqrt(z^2 - 1)) digits.
-    """
-    z = np.asarray(z, dtype=float)
-    ends = np.abs(np.abs(z) - 1.0) < 1e-13
-    # M_n is continuous at |z| = 1 but Q_n is not defined there: step just inside (the
-    # exact end values replace the result below).
-    z = np.where(ends, np.sign(z) * (1.0 - 1e-13), z)
-    nq = degree + 2
-    q = np.empty((z.size, nq))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        q0 = 0.5 * np.log(np.abs((1.0 + z) / (1.0 - z)))
-    inner = np.abs(z) <= 1.05
-    if inner.any():
-        zi = z[inner]
-        qi = np.empty((zi.size, nq))
-        qi[:, 0] = q0[inner]
-        qi[:, 1] = zi * qi[:, 0] - 1.0
-        for n in range(1, nq - 1):
-            qi[:, n + 1] = ((2 * n + 1) * zi * qi[:, n] - n * qi[:, n - 1]) / (n + 1)
-        q[inner] = qi
-    outer = ~inner
-    # Miller's recurrence from an index set by the smallest rho of a group. Many points:
-    # in bands of |z|, so that the many well outside a panel do not run the ~90 steps the
-    # few just outside need; few points: one group (the steps' overhead dominates).
-    bands = (1.05, 1.2, 1.5, 2.2, np.inf) if outer.sum() > _MILLER_BANDS_FROM else (
-        1.05, np.inf)
-    for low, high in zip(bands[:-1], bands[1:], strict=True):
-        group = outer & (np.abs(z) > low) & (np.abs(z) <= high)
-        if group.any():
-            q[group] = _q_outside(z[group], nq)
-    m = np.empty((z.size, degree + 1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a = (1.0 + z) * np.log(np.abs(1.0 + z))
-        b = (1.0 - z) * np.log(np.abs(1.0 - z))
-    a = np.where(np.isfinite(a), a, 0.0)
-    b = np.where(np.isfinite(b), b, 0.0)
-    m[:, 0] = a + b - 2.0
-    n = np.arange(1, degree + 1)
-    m[:, 1:] = 2.0 * (q[:, 2 : degree + 2] - q[:, 0:degree]) / (2 * n + 1)
-    # On a panel end the recurrence ran just inside; use the exact end values instead:
-    # M_0(1) = 2 ln 2 - 2, M_n(1) = -2/(n (n + 1)), M_n(-1) = (-1)^n M_n(1).
-    if ends.any():
-        exact = np.concatenate([[2.0 * np.log(2.0) - 2.0], -2.0 / (n * (n + 1.0))])
-        parity = np.where(z[ends, None] < 0, (-1.0) ** np.arange(degree + 1)[None, :], 1.0)
-        m[ends] = exact[None, :] * parity
-    return m
-
-
 def log_product_weights(center: float, half_width: float, targets: np.ndarray) -> np.ndarray:
     """Weights ``W`` (targets x 16) with ``sum_j W[i, j] phi(x_j) = int_panel ln|x_i - xi| phi``.
 
@@ -340,66 +256,6 @@ def _log_weights(panels: Panels, targets: np.ndarray, near_t: np.ndarray,
     c, h = panels.centers[near_p], panels.half_widths[near_p]
     moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1)
     return h[:, None] * (np.log(h)[:, None] * _W[None, :] + moments @ _TO_COEF)
-
-
-#: Default absolute accuracy of the kernel values in the operator: beyond rounding.
-FULL_ACCURACY = 1e-17
-#: |k_pl(s)| <= KERNEL_ENVELOPE exp(-KERNEL_DECAY s) for s >= 2 (core.kernel: 2 pi |c_1|
-#: exp(-Im(u_1) s)); far pairs where that is below the accuracy are exactly 0.
-KERNEL_ENVELOPE = 1.6075
-KERNEL_DECAY = 2.10619611524533
-_EVEN_TABLES: dict[int, np.ndarray] = {}
-
-
-def _even_coefficients(accuracy: float) -> np.ndarray:
-    """Monomial coefficients in y = s^2/2 - 1 of ``k_reg`` on |s| <= 2 to ``accuracy``.
-
-    The Chebyshev series of ``k_reg`` in y falls like (3 + 2 sqrt 2)^-k (its nearest
-    singularity is at y = -3): truncated where the tail is below the accuracy, a tol of
-    1e-6 needs degree ~13 instead of 24, and the Horner steps are most of the kernel's cost.
-    """
-    cheb = _EVEN_TABLES.get(-1)
-    if cheb is None:
-        y = np.cos(np.pi * (np.arange(25) + 0.5) / 25)
-        cheb = npcheb.chebfit(y, plane_kernel_regular(np.sqrt(2.0 * (y + 1.0))), 24)
-        _EVEN_TABLES[-1] = cheb
-    tail = np.cumsum(np.abs(cheb[::-1]))[::-1]  # tail[k] = sum_{j >= k} |c_j|
-    degree = int(np.argmax(np.append(tail, 0.0) <= 0.5 * accuracy)) - 1
-    degree = max(degree, 1)
-    table = _EVEN_TABLES.get(degree)
-    if table is None:
-        table = npcheb.cheb2poly(cheb[:degree + 1])
-        _EVEN_TABLES[degree] = table
-    return table
-
-
-def _kernel_regular(s: np.ndarray, accuracy: float) -> np.ndarray:
-    """``k_reg(s)`` (s >= 0, any shape) to within ``accuracy`` (absolute)."""
-    if accuracy <= FULL_ACCURACY or not s.size or s.max() >= 2.0:
-        return plane_kernel_regular(s)
-    coef = _even_coefficients(accuracy)
-    y = 0.5 * s * s
-    y -= 1.0
-    out = np.full_like(y, coef[-1])
-    for c in coef[-2::-1]:
-        out *= y
-        out += c
-    return out
-
-
-def _kernel_block(s: np.ndarray, accuracy: float) -> np.ndarray:
-    """``k_pl(s) = k_reg(s) - ln s`` (s > 0, any shape) to within ``accuracy`` (absolute);
-    exactly 0 where its envelope is below the accuracy."""
-    cut = np.log(KERNEL_ENVELOPE / max(accuracy, 1e-300)) / KERNEL_DECAY
-    if s.size and s.max() >= cut:
-        out = np.zeros_like(s)
-        inside = s < cut
-        out[inside] = _kernel_block(s[inside], accuracy)
-        return out
-    out = _kernel_regular(s, accuracy)
-    with np.errstate(divide="ignore"):  # a target on a node: a near pair, replaced
-        out -= np.log(s)
-    return out
 
 
 #: Target rows per block of :func:`operator_rows`: rows x nodes about this many entries,
@@ -489,7 +345,8 @@ def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
           accuracy: float = FULL_ACCURACY) -> np.ndarray:
     """Operator rows given the near (target, source position) pairs and their log weights.
 
-    ``accuracy``: absolute accuracy of the kernel values (see :func:`_kernel_block`).
+    ``accuracy``: absolute accuracy of the kernel values (see
+    :func:`core.kernel_values.kernel_block`).
     """
     cols_all = (sources[:, None] * NODES_PER_PANEL + _J[None, :]).ravel()
     nodes = panels.nodes[cols_all]
@@ -500,11 +357,11 @@ def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
         block = rows[start:start + step]
         distance = np.abs(targets[start:start + step, None] - nodes[None, :])
         distance *= lam
-        block[...] = _kernel_block(distance, accuracy)
+        block[...] = kernel_block(distance, accuracy)
         block *= weights[None, :]
     if near_t.size:
         cols = near_s[:, None] * NODES_PER_PANEL + _J[None, :]  # positions among sources
-        smooth = _kernel_regular(lam * np.abs(targets[near_t, None] - nodes[cols]), accuracy)
+        smooth = kernel_regular(lam * np.abs(targets[near_t, None] - nodes[cols]), accuracy)
         smooth -= np.log(lam)
         rows[near_t[:, None], cols] = smooth * weights[cols] - log_weights / np.pi
     return rows
