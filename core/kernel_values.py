@@ -8,6 +8,8 @@ far pairs where the kernel has decayed below it are exact zeros.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from numpy.polynomial import chebyshev as npcheb
 
@@ -19,9 +21,14 @@ FULL_ACCURACY = 1e-17
 #: exp(-Im(u_1) s)); far pairs where that is below the accuracy are exactly 0.
 KERNEL_ENVELOPE = 1.6075
 KERNEL_DECAY = 2.10619611524533
-_EVEN_TABLES: dict[int, np.ndarray] = {}
+@lru_cache(maxsize=1)
+def _even_chebyshev() -> np.ndarray:
+    """Chebyshev coefficients in y = s^2/2 - 1 of ``k_reg`` on |s| <= 2 (degree 24)."""
+    y = np.cos(np.pi * (np.arange(25) + 0.5) / 25)
+    return npcheb.chebfit(y, plane_kernel_regular(np.sqrt(2.0 * (y + 1.0))), 24)
 
 
+@lru_cache(maxsize=64)
 def _even_coefficients(accuracy: float) -> np.ndarray:
     """Monomial coefficients in y = s^2/2 - 1 of ``k_reg`` on |s| <= 2 to ``accuracy``.
 
@@ -29,19 +36,10 @@ def _even_coefficients(accuracy: float) -> np.ndarray:
     singularity is at y = -3): truncated where the tail is below the accuracy, a tol of
     1e-6 needs degree ~13 instead of 24, and the Horner steps are most of the kernel's cost.
     """
-    cheb = _EVEN_TABLES.get(-1)
-    if cheb is None:
-        y = np.cos(np.pi * (np.arange(25) + 0.5) / 25)
-        cheb = npcheb.chebfit(y, plane_kernel_regular(np.sqrt(2.0 * (y + 1.0))), 24)
-        _EVEN_TABLES[-1] = cheb
+    cheb = _even_chebyshev()
     tail = np.cumsum(np.abs(cheb[::-1]))[::-1]  # tail[k] = sum_{j >= k} |c_j|
     degree = int(np.argmax(np.append(tail, 0.0) <= 0.5 * accuracy)) - 1
-    degree = max(degree, 1)
-    table = _EVEN_TABLES.get(degree)
-    if table is None:
-        table = npcheb.cheb2poly(cheb[:degree + 1])
-        _EVEN_TABLES[degree] = table
-    return table
+    return npcheb.cheb2poly(cheb[:max(degree, 1) + 1])
 
 
 def kernel_regular(s: np.ndarray, accuracy: float) -> np.ndarray:
