@@ -17,9 +17,12 @@ report). Times are medians of repeated runs after a warm-up:
   default engine, with q at 400 points; the projection with its caches warm).
 
 Then the goals of the engine: creep with 100 and 1000 outputs, 10,000 elastic outputs,
-and ``python -m core solve`` of a shipped scene from a cold process. Output:
-``benchmarks/results/engines.md``, ``engines.json`` and one PNG per scene
-(``engine_<scene>.png``).
+and ``python -m core solve`` of a shipped scene from a cold process. Every time is given
+as wall-clock and as CPU time of the process (the machine is shared; run with
+``OPENBLAS_NUM_THREADS=1``). A full run takes ~6 minutes on the shared machine (load
+average ~13), ``--quick`` about a third of that. Output: ``benchmarks/results/engines.md``,
+``engines.json`` and one PNG per scene (``engine_<scene>.png``; needs matplotlib, from the
+``[bench]`` extra, else the report is written without them).
 """
 
 from __future__ import annotations
