@@ -4,7 +4,7 @@
     sol = prepared.solve(times, force=P, moment=M, c=..., kernel=...)  # loads: cheap
 
 :func:`prepare` validates the geometry, grades and refines the panels until the pressure
-is resolved to ``tol`` (:mod:`core.nystrom`) and keeps the grid. Everything a solve needs
+is resolved to ``tol`` (:mod:`core.nystrom_adapt`) and keeps the grid. Everything a solve needs
 beyond that is built on first use and kept on the object, keyed by exactly what it
 depends on:
 
@@ -35,7 +35,8 @@ import numpy as np
 from core.cache import StageCache
 from core.inputs import Geometry, Scalar, TimeInputs, validate_geometry, validate_time_inputs
 from core.kernel_fit import stepping_kernel
-from core.nystrom import BorderedSystem, adapt, touches
+from core.nystrom import BorderedSystem, touches
+from core.nystrom_adapt import adapt
 from core.nystrom_time import ModalAnswer, ModalForm
 from core.quadrature import interpolation_weights
 from core.solver import ContactSolution

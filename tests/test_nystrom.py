@@ -218,7 +218,8 @@ def test_first_kind_creep_scene_falls_back_to_the_projection():
                                    frozenset({"settlement", "moment"})])
 def test_bordered_solve_on_the_refinement_lu_matches_its_own_lu(given):
     """The 2 x 2 Schur complement on the refinement's LU gives the bordered LU's answer."""
-    from core.nystrom import BorderedSystem, adapt
+    from core.nystrom import BorderedSystem
+    from core.nystrom_adapt import adapt
 
     adaptive = adapt(1.0, jump_m, stepped_g, False, (-0.5, 0.25, 0.3), 1e-6)
     schur = BorderedSystem(adaptive.grid, adaptive.c_ref, given, adaptive.factor)

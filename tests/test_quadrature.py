@@ -44,7 +44,7 @@ def _graded(lam: float, breakpoints: tuple[float, ...], edge: float):
 @pytest.mark.parametrize(("lam", "breakpoints"), [(1.0, (0.3,)), (50.0, ()), (0.05, (-0.5,))])
 def test_operator_reused_on_a_refined_grid_equals_a_new_one(lam, breakpoints):
     """Blocks of shared panels are copied, the rest computed: the same matrix exactly."""
-    from core.nystrom import grade
+    from core.nystrom_adapt import grade
     from core.quadrature import Panels, kernel_operator
 
     coarse = _graded(lam, breakpoints, 1e-3)
@@ -57,7 +57,7 @@ def test_operator_reused_on_a_refined_grid_equals_a_new_one(lam, breakpoints):
 
 def test_node_rows_from_reference_tables_match_operator_rows():
     """The tables of reference panel pairs give the batched moments' numbers."""
-    from core.nystrom import grade
+    from core.nystrom_adapt import grade
     from core.quadrature import Panels, node_rows, operator_rows
 
     coarse = _graded(1.0, (0.3,), 1e-3)
