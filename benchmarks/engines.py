@@ -272,7 +272,14 @@ def goal_rows(results: list[dict], goal: dict[str, float]
     return rows
 
 
-def report(results: list[dict], goal: dict[str, float], command: str, out: Path) -> None:
+#: The report's note when the figures could not be drawn.
+FIGURES_MISSING = ("Figures: not drawn in this run (matplotlib, from the `[bench]` extra, was "
+                   "missing); the PNGs next to this report are from an earlier run of the "
+                   "previous version.")
+
+
+def report(results: list[dict], goal: dict[str, float], command: str, out: Path,
+           figures: bool = True) -> None:
     lines = ["# The two engines: speed against error", "",
              f"Made by `{command}` on a 2-core machine (load average at the start: "
              f"{os.getloadavg()[0]:.1f}; the machine was shared, so absolute times are "
@@ -282,6 +289,7 @@ def report(results: list[dict], goal: dict[str, float], command: str, out: Path)
              "(edges and both sides of jumps included) against the default engine at tol "
              "1e-10; 'reference check' is that reference against the projection at tol "
              "1e-10 on interior points.", "",
+             *([] if figures else [FIGURES_MISSING, ""]),
              "## Cheapest setting with error <= 1e-6", "",
              "| scene | Nystrom, new scene [ms] (CPU) | Nystrom, loads only [ms] (CPU) | "
              "projection, new scene [ms] | projection, loads only [ms] | speed-up, new scene "
@@ -348,6 +356,7 @@ def main(argv: list[str] | None = None) -> int:
     repeats = 3 if args.quick else args.repeats
     args.out.mkdir(parents=True, exist_ok=True)
     results = []
+    figures = True
     for scene in scenes:
         print(scene.key, flush=True)
         results.append(sweep(scene, repeats))
@@ -355,9 +364,10 @@ def main(argv: list[str] | None = None) -> int:
             plot(results[-1], args.out / f"engine_{scene.key}.png")
         except ModuleNotFoundError as exc:  # matplotlib comes with the [bench] extra
             print(f"  no figure: {exc}", flush=True)
+            figures = False
     goal = goals(repeats)
     command = "python benchmarks/engines.py" + (" --quick" if args.quick else "")
-    report(results, goal, command, args.out)
+    report(results, goal, command, args.out, figures)
     (args.out / "engines.json").write_text(json.dumps({"scenes": results, "goals": goal},
                                                       indent=1))
     print(json.dumps(goal, indent=1))
