@@ -313,7 +313,8 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
     found = {k: _PAIR_TABLES.get(k) for k in dict.fromkeys(keys)}
     missing = [k for k, v in found.items() if v is None]
     if missing:
-        z = np.array([[o + r * t for t in _T] for r, o in missing])  # (missing, 16)
+        keys_array = np.array(missing)  # (missing, 2): ratio, offset
+        z = keys_array[:, 1:] + keys_array[:, :1] * _T[None, :]  # (missing, 16)
         moments = legendre_log_moments(z.ravel(), NODES_PER_PANEL - 1) @ _TO_COEF
         moments = moments.reshape(len(missing), NODES_PER_PANEL, NODES_PER_PANEL)
         new = {key: (np.abs(zk) <= NEAR_FIELD, table)
