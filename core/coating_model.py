@@ -61,9 +61,35 @@ def layer_compliance(thickness: Any, modulus: Any, poisson: Any,
     raise ValueError(f"interface: must be 'smooth' or 'bonded', got {interface!r}")
 
 
-def _interpolator():
-    from scipy.interpolate import RegularGridInterpolator
+def _multilinear(axes: tuple[np.ndarray, ...], values: np.ndarray) -> Any:
+    """Multilinear interpolation on a rectangular grid, for points inside it (..., dims).
 
+    Written out (a few lines) because scipy.interpolate was 2/3 of a cold CLI solve's
+    imports.
+    """
+    def evaluate(pts: np.ndarray) -> np.ndarray:
+        pts = np.asarray(pts, dtype=float)
+        lower, frac = [], []
+        for k, axis in enumerate(axes):
+            i = np.clip(np.searchsorted(axis, pts[..., k], side="right") - 1, 0,
+                        len(axis) - 2)
+            lower.append(i)
+            frac.append((pts[..., k] - axis[i]) / (axis[i + 1] - axis[i]))
+        out = np.zeros(pts.shape[:-1])
+        for corner in range(2 ** len(axes)):
+            weight = np.ones(pts.shape[:-1])
+            index = []
+            for k in range(len(axes)):
+                up = (corner >> k) & 1
+                weight = weight * (frac[k] if up else 1.0 - frac[k])
+                index.append(lower[k] + up)
+            out = out + weight * values[tuple(index)]
+        return out
+
+    return evaluate
+
+
+def _interpolator():
     from core import coating_error_table as table
 
     axes = (np.log(table.THICKNESS_RATIOS), np.log(table.MODULUS_RATIOS),
@@ -72,7 +98,7 @@ def _interpolator():
     for interface in INTERFACES:
         for part in ("force", "moment"):
             values = np.array(table.ERRORS[interface][part], dtype=float)
-            out[interface, part] = RegularGridInterpolator(axes, values, method="linear")
+            out[interface, part] = _multilinear(axes, values)
     return out, table
 
 

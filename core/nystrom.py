@@ -20,51 +20,30 @@ and far better than interpolating: next to ``+-1`` and every jump ``q`` has an
 (measured on a smooth coating with 192 nodes: nodal values 5e-8, the formula 9e-8, panel
 interpolation 2.4e-4 off).
 
-Refinement, in two parts:
-- away from ``+-1`` and the jumps q is analytic: a panel whose last three Legendre
-  coefficients exceed the target is bisected (a per-panel indicator);
-- the panels ending at ``+-1`` or a jump are graded geometrically toward it; the nodal
-  error there falls like h^2 (h the finest width; measured 13-21x per 4-5x in h), so
-  two solves whose grading differs by two levels (h/4) give the error of the finer one,
-  about their difference / 15, and the number of levels still missing.
+Refinement and the error estimate: :mod:`core.nystrom_adapt`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 
+from core.block_lu import BlockLU
 from core.quadrature import (
+    FULL_ACCURACY,
     NODES_PER_PANEL,
+    KernelOperator,
     Panels,
-    base_panels,
     interpolation_weights,
     kernel_operator,
     operator_rows,
-    panel_legendre_coefficients,
-    refine_to_resolve,
+    panel_nodes,
 )
 
 Function = Callable[[np.ndarray], np.ndarray]
-
-#: Largest number of panels of an adaptive grid (16 nodes each): the dense operator of
-#: 128 panels holds 2048^2 doubles = 32 MiB and its LU costs ~0.3 s, the bound of one
-#: solve's memory and work. A scene that needs more is answered with ``tol_not_met``.
-MAX_PANELS = 128
-#: An interior panel is bisected while its Legendre tail exceeds this share of the target.
-INTERIOR_SHARE = 0.25
-#: Error reduction of the nodal pressure per two levels of grading (h -> h/4): ~h^2.
-TWO_LEVEL_RATIO = 16.0
-#: The two-level estimate is multiplied by this (the observed order was 1.9-2.1).
-SAFETY = 3.0
-#: Relative round-off floor of the pressure (measured: ~1e-13 against the projection).
-ROUND_OFF = 2e-13
-#: Rounds of each refinement loop.
-MAX_ROUNDS = 12
-
 
 @dataclass(frozen=True)
 class NystromGrid:
@@ -79,6 +58,7 @@ class NystromGrid:
     operator: np.ndarray
     m: np.ndarray
     g: np.ndarray
+    kernel_accuracy: float = FULL_ACCURACY  # absolute accuracy of the kernel values
 
     @property
     def nodes(self) -> np.ndarray:
@@ -98,15 +78,25 @@ class NystromGrid:
 
     def rows(self, x: np.ndarray) -> np.ndarray:
         """Rows of ``F`` at points ``x``: ``(F q)(x) = rows @ q`` (len(x), N)."""
-        return operator_rows(self.lam, self.panels, np.asarray(x, dtype=float))
+        return operator_rows(self.lam, self.panels, np.asarray(x, dtype=float),
+                             accuracy=self.kernel_accuracy)
 
 
-def build_grid(lam: float, edges: np.ndarray, m: Function, g: Function) -> NystromGrid:
-    """The discretization on panels with the given ``edges`` (dimensionless)."""
+def build_grid(lam: float, edges: np.ndarray, m: Function, g: Function,
+               previous: NystromGrid | None = None,
+               kernel_accuracy: float = FULL_ACCURACY) -> NystromGrid:
+    """The discretization on panels with the given ``edges`` (dimensionless).
+
+    ``previous``: a grid of the same ``lam`` and kernel accuracy whose operator blocks
+    between the panels both share are reused (only rows and columns of new panels are
+    computed). ``kernel_accuracy``: absolute accuracy of the kernel values.
+    """
     panels = Panels.from_edges(edges)
-    operator = kernel_operator(lam, panels).matrix
+    before = (None if previous is None or previous.kernel_accuracy != kernel_accuracy
+              else KernelOperator(previous.lam, previous.panels, previous.operator))
+    operator = kernel_operator(lam, panels, before, kernel_accuracy).matrix
     return NystromGrid(lam, panels, operator, np.asarray(m(panels.nodes), dtype=float),
-                       np.asarray(g(panels.nodes), dtype=float))
+                       np.asarray(g(panels.nodes), dtype=float), kernel_accuracy)
 
 
 def _rhs(x: np.ndarray, g: np.ndarray, with_gap: bool) -> np.ndarray:
@@ -120,8 +110,48 @@ def elastic_responses(grid: NystromGrid, c: float, with_gap: bool) -> np.ndarray
     Solves ``(c m + A) q = [1, x, -g]``: every answer of the elastic problem is a
     combination of these columns (statement 1 form).
     """
-    matrix = grid.operator + np.diag(c * grid.m)
-    return np.linalg.solve(matrix, _rhs(grid.nodes, grid.g, with_gap))
+    return factored_responses(grid, c, with_gap)[0]
+
+
+def factored_responses(grid: NystromGrid, c: float, with_gap: bool,
+                       singular: np.ndarray | None = None,
+                       previous: BlockLU | None = None
+                       ) -> tuple[np.ndarray, BlockLU]:
+    """:func:`elastic_responses` and the factors of ``c m + A`` (kept for the bordered
+    solves of :class:`BorderedSystem` at the same ``c``).
+
+    The factors are split (:class:`core.block_lu.BlockLU`) into the panels that do not end
+    at a ``singular`` point and the rest; ``previous``: the factors on the grid this one
+    refines, whose first block is reused when it is the same (the grading toward the
+    singular points left those panels as they were).
+    """
+    matrix = grid.operator.copy()
+    matrix.flat[::grid.size + 1] += c * grid.m
+    edges = grid.panels.edges
+
+    def block_key(kept_panels: np.ndarray) -> tuple:
+        # The kept block is the same matrix when its panels, lam, kernel accuracy and c m
+        # are: the panel ends as pairs, and the rest as bytes.
+        return (grid.lam, grid.kernel_accuracy,
+                tuple(zip(edges[kept_panels].tolist(), edges[kept_panels + 1].tolist(),
+                          strict=True)),
+                (c * grid.m[panel_nodes(kept_panels)]).tobytes())
+
+    reuse, key, kept_panels = None, None, None
+    if previous is not None and previous.key is not None:
+        before = set(previous.key[2])
+        pairs = zip(edges[:-1].tolist(), edges[1:].tolist(), strict=True)
+        kept_panels = np.array([i for i, pair in enumerate(pairs) if pair in before],
+                               dtype=np.intp)
+        key = block_key(kept_panels)
+        if key == previous.key:
+            reuse = previous.kept_factor
+    if reuse is None:
+        kept_panels = (np.arange(grid.panels.n_panels) if singular is None
+                       else np.nonzero(~touches(grid.panels, singular))[0])
+        key = block_key(kept_panels)
+    factor = BlockLU(matrix, panel_nodes(kept_panels), reuse, key)
+    return factor.solve(_rhs(grid.nodes, grid.g, with_gap)), factor
 
 
 def touches(panels: Panels, points: np.ndarray) -> np.ndarray:
@@ -132,136 +162,15 @@ def touches(panels: Panels, points: np.ndarray) -> np.ndarray:
     return left | right
 
 
-def interior_tails(grid: NystromGrid, responses: np.ndarray, singular: np.ndarray
-                   ) -> np.ndarray:
-    """Legendre tail of q on each panel relative to ``max|q|``; 0 on panels at a singular point."""
-    scale = np.max(np.abs(responses), axis=0)
-    scale[scale == 0] = 1.0
-    coef = panel_legendre_coefficients(responses / scale)  # (P, 16, k)
-    tail = np.max(np.abs(coef[:, -3:, :]), axis=(1, 2))
-    return np.where(touches(grid.panels, singular), 0.0, tail)
-
-
-def grade(edges: np.ndarray, singular: np.ndarray, levels: int) -> np.ndarray:
-    """Cut every panel that ends at a singular point geometrically, ``levels`` times, toward it."""
-    new: list[float] = []
-    for a, b in zip(edges[:-1], edges[1:], strict=True):
-        at_a = bool(np.any(np.abs(singular - a) < 1e-14))
-        at_b = bool(np.any(np.abs(singular - b) < 1e-14))
-        steps = 0.5 ** np.arange(1, levels + 1)
-        if at_a and at_b:
-            mid = 0.5 * (a + b)
-            new.append(mid)
-            new.extend(a + (mid - a) * steps)
-            new.extend(b - (b - mid) * steps)
-        elif at_a:
-            new.extend(a + (b - a) * steps)
-        elif at_b:
-            new.extend(b - (b - a) * steps)
-    return np.unique(np.concatenate([edges, new]))
-
-
 def nystrom_values(grid: NystromGrid, c: float, x: np.ndarray, m_x: np.ndarray,
-                   g_x: np.ndarray, nodal: np.ndarray, with_gap: bool) -> np.ndarray:
-    """The Nystrom formula for the statement-1 responses at points ``x`` (len(x), 2|3)."""
-    return (_rhs(x, g_x, with_gap) - grid.rows(x) @ nodal) / (c * m_x[:, None])
+                   g_x: np.ndarray, nodal: np.ndarray, with_gap: bool,
+                   rows: np.ndarray | None = None) -> np.ndarray:
+    """The Nystrom formula for the statement-1 responses at points ``x`` (len(x), 2|3).
 
-
-@dataclass(frozen=True)
-class AdaptiveGrid:
-    """The grid the adaptive loop settled on and what it measured on it."""
-
-    grid: NystromGrid
-    spatial_error: float  # estimated error of q relative to max|q| on [-1, 1]
-    resolved: bool  # the target was met within the panel budget
-    rounds: int
-
-
-def widest_panel(lam: float, target: float) -> float:
-    """Widest panel whose Gauss rule integrates the kernel's smooth part to ~target/10.
-
-    ``k_reg(lam d)`` is analytic up to ``d = +-2i/lam``: on a panel of half-width h the
-    16-point rule errs like rho^-32 with rho = a + sqrt(a^2 + 1), a = 2/(lam h). At
-    target 1e-14 this gives the 3/lam of core.quadrature; at 1e-6 about 9/lam.
+    ``rows``: the rows of the grid's operator at ``x``, if already known.
     """
-    rho = (0.1 * max(target, 1e-15)) ** (-1.0 / (2 * NODES_PER_PANEL))
-    a = 0.5 * (rho - 1.0 / rho)
-    return min(0.5, 4.0 / (lam * a))
-
-
-def start_edges(lam: float, breakpoints: Sequence[float], m_min: float,
-                target: float = 1e-14) -> np.ndarray:
-    """Initial panel ends: graded toward +-1 and every jump down to ~m (dimensionless)."""
-    edge = float(np.clip(m_min, 1e-9, 0.1))
-    widest = widest_panel(lam, target)
-    # base_panels caps widths at 3/lam' as well: pass the lam' for which that is `widest`.
-    panels = base_panels(3.0 / widest, breakpoints, edge_width=edge, max_width=widest)
-    return panels.edges
-
-
-def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
-          breakpoints: Sequence[float], target: float, *, c_ref: float = 1.0
-          ) -> AdaptiveGrid:
-    """Refine until the estimated error of q (relative to ``max|q|``) is below ``target``.
-
-    ``c_ref`` is the relative modulus the error is measured at (geometry is prepared
-    before the times are known; c(1) = 1 in the scenes' scaling).
-    """
-    probe = np.linspace(-1.0, 1.0, 513)
-    m_min = float(np.min(m(probe)))
-    with_gap = not g_is_zero
-    singular = np.array([-1.0, 1.0, *breakpoints])
-    # The kernel's quadrature error is not seen by the two-level estimate: keep it 1e3 below.
-    start = Panels.from_edges(start_edges(lam, breakpoints, m_min, 1e-3 * target))
-    panels, resolved = refine_to_resolve(start, [m] if g_is_zero else [m, g],
-                                         max_panels=MAX_PANELS)
-    edges = panels.edges
-    rounds = 0
-    # 1. Interior panels: bisect where q is not resolved.
-    tails = np.zeros(1)
-    for _ in range(MAX_ROUNDS):
-        rounds += 1
-        grid = build_grid(lam, edges, m, g)
-        responses = elastic_responses(grid, c_ref, with_gap)
-        tails = interior_tails(grid, responses, singular)
-        flagged = tails > INTERIOR_SHARE * target
-        if not flagged.any():
-            break
-        edges = np.unique(np.concatenate([edges, grid.panels.centers[flagged]]))
-        if len(edges) - 1 > MAX_PANELS:
-            resolved = False
-            break
-    interior = float(np.max(tails))
-    # 2. Grading toward +-1 and the jumps: two solves two levels apart.
-    estimate = np.inf
-    for _ in range(MAX_ROUNDS):
-        rounds += 1
-        fine_edges = grade(grid.panels.edges, singular, 2)
-        if len(fine_edges) - 1 > MAX_PANELS:
-            resolved = False
-            break
-        fine = build_grid(lam, fine_edges, m, g)
-        fine_responses = elastic_responses(fine, c_ref, with_gap)
-        coarse_at_fine = nystrom_values(grid, c_ref, fine.nodes, fine.m, fine.g, responses,
-                                        with_gap)
-        scale = np.max(np.abs(fine_responses), axis=0)
-        scale[scale == 0] = 1.0
-        difference = float(np.max(np.abs(coarse_at_fine - fine_responses) / scale))
-        estimate = SAFETY * difference / (TWO_LEVEL_RATIO - 1.0) + interior
-        grid, responses = fine, fine_responses
-        if estimate <= target:
-            break
-        # Each further level gains ~4x: add the missing ones (beyond the two just made).
-        missing = int(np.ceil(np.log(estimate / target) / np.log(4.0)))
-        if missing > 2:
-            edges = grade(grid.panels.edges, singular, missing - 2)
-            if len(edges) - 1 > MAX_PANELS:
-                resolved = False
-                break
-            grid = build_grid(lam, edges, m, g)
-            responses = elastic_responses(grid, c_ref, with_gap)
-    estimate = max(estimate, ROUND_OFF)
-    return AdaptiveGrid(grid, estimate, resolved and estimate <= target, rounds)
+    rows = grid.rows(x) if rows is None else rows
+    return (_rhs(x, g_x, with_gap) - rows @ nodal) / (c * m_x[:, None])
 
 
 # ------------------------------------------------------------------- bordered solves
@@ -277,23 +186,45 @@ class BorderedSystem:
     given quantity and for the gap; any loads are then a linear combination.
     """
 
-    def __init__(self, grid: NystromGrid, c: float, given: frozenset[str]) -> None:
+    def __init__(self, grid: NystromGrid, c: float, given: frozenset[str],
+                 factor: BlockLU | None = None) -> None:
+        """``factor``: factors of ``c m + A`` on this grid, if known (from :func:`adapt`);
+        then the border is eliminated by a 2 x 2 Schur complement instead of a new LU."""
         n = grid.size
         self.grid, self.c, self.given = grid, c, given
         self.unknown_names = tuple(q for q in ("settlement", "tilt", "force", "moment")
                                    if q not in given)
-        matrix = np.zeros((n + 2, n + 2))
-        matrix[:n, :n] = grid.operator
-        matrix[np.arange(n), np.arange(n)] += c * grid.m
-        matrix[n, :n] = grid.panels.weights
-        matrix[n + 1, :n] = grid.panels.weights * grid.nodes
+        # Border: columns B (N x 2) and corner D (2 x 2) of the unknown scalars, rows C
+        # (2 x N) of force and moment balance.
+        border = np.zeros((n + 2, 2))
         columns = {"settlement": (slice(0, n), -np.ones(n)),
                    "tilt": (slice(0, n), -grid.nodes),
                    "force": (n, -1.0), "moment": (n + 1, -1.0)}
         for k, name in enumerate(self.unknown_names):
             rows, values = columns[name]
-            matrix[rows, n + k] = values
-        self._lu = lu_factor(matrix, check_finite=False)
+            border[rows, k] = values
+        self._balance = np.vstack([grid.panels.weights, grid.panels.weights * grid.nodes])
+        self._border = border
+        self._factor = factor
+        self._lu = None
+        if factor is None:
+            matrix = np.zeros((n + 2, n + 2))
+            matrix[:n, :n] = grid.operator
+            matrix[np.arange(n), np.arange(n)] += c * grid.m
+            matrix[n:, :n] = self._balance
+            matrix[:, n:] = border
+            self._lu = lu_factor(matrix, overwrite_a=True, check_finite=False)
+
+    def _solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solutions (N + 2, k) of the bordered system for right-hand sides (N + 2, k)."""
+        if self._lu is not None:
+            return lu_solve(self._lu, rhs, check_finite=False)
+        n, k = self.grid.size, rhs.shape[1]
+        solved = self._factor.solve(np.column_stack([rhs[:n], self._border[:n]]))
+        y_rhs, y_border = solved[:, :k], solved[:, k:]
+        schur = self._border[n:] - self._balance @ y_border
+        scalars = np.linalg.solve(schur, rhs[n:] - self._balance @ y_rhs)
+        return np.vstack([y_rhs - y_border @ scalars, scalars])
 
     def unit_responses(self) -> dict[str, np.ndarray]:
         """Solution vectors (N + 2,) for each given quantity = 1 and for the gap."""
@@ -314,6 +245,5 @@ class BorderedSystem:
         gap[:n] = -self.grid.g
         rhs["gap"] = gap
         keys = list(rhs)
-        solved = lu_solve(self._lu, np.column_stack([rhs[k] for k in keys]),
-                          check_finite=False)
+        solved = self._solve(np.column_stack([rhs[k] for k in keys]))
         return {k: solved[:, i] for i, k in enumerate(keys)}

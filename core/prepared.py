@@ -4,7 +4,7 @@
     sol = prepared.solve(times, force=P, moment=M, c=..., kernel=...)  # loads: cheap
 
 :func:`prepare` validates the geometry, grades and refines the panels until the pressure
-is resolved to ``tol`` (:mod:`core.nystrom`) and keeps the grid. Everything a solve needs
+is resolved to ``tol`` (:mod:`core.nystrom_adapt`) and keeps the grid. Everything a solve needs
 beyond that is built on first use and kept on the object, keyed by exactly what it
 depends on:
 
@@ -35,8 +35,10 @@ import numpy as np
 from core.cache import StageCache
 from core.inputs import Geometry, Scalar, TimeInputs, validate_geometry, validate_time_inputs
 from core.kernel_fit import stepping_kernel
-from core.nystrom import BorderedSystem, adapt
+from core.nystrom import BorderedSystem, touches
+from core.nystrom_adapt import adapt
 from core.nystrom_time import ModalAnswer, ModalForm
+from core.quadrature import interpolation_weights
 from core.solver import ContactSolution
 from core.statements import QUANTITIES, statement_number
 
@@ -93,12 +95,22 @@ class PreparedContact:
         self.grid = adaptive.grid
         self.spatial_error = adaptive.spatial_error
         self.resolved = adaptive.resolved
+        # LU of c m + A at the modulus the grid was refined at: the bordered system of a
+        # statement at that c needs only a 2 x 2 Schur complement on top of it.
+        self._factor_c, self._factor = adaptive.c_ref, adaptive.factor
         self._bordered: dict[tuple, tuple[BorderedSystem, dict[str, np.ndarray]]] = {}
         self._modal: dict[frozenset[str], ModalForm] = {}
         self._rows: dict[bytes, np.ndarray] = {}
         self._unit_pressure: dict[tuple, np.ndarray] = {}
         self._responses: dict[tuple, tuple[ModalAnswer, np.ndarray]] = {}
         self._check_x = _check_points(geometry.breakpoints)
+        # Check points on panels ending at +-1 or a jump take the Nystrom formula (q has
+        # (x - e) ln|x - e| terms there); elsewhere q is analytic and its panel interpolant
+        # is resolved to the refinement's tail bound, so it is interpolated (the formula at
+        # all 405 points cost as much as the operator itself).
+        singular = np.array([-1.0, 1.0, *geometry.breakpoints])
+        panel_of = interpolation_weights(self.grid.panels, self._check_x)[0]
+        self._check_formula = touches(self.grid.panels, singular)[panel_of]
         self._solves = 0
         # Solves of one prepared geometry may run in several threads (the explorer's).
         self._lock = threading.RLock()
@@ -116,7 +128,8 @@ class PreparedContact:
     def _bordered_locked(self, key: tuple, given: frozenset[str], c: float
                          ) -> tuple[BorderedSystem, dict[str, np.ndarray]]:
         if key not in self._bordered:
-            system = BorderedSystem(self.grid, c, given)
+            system = BorderedSystem(self.grid, c, given,
+                                    self._factor if c == self._factor_c else None)
             self._bordered[key] = (system, system.unit_responses())
             self.counts["bordered"] += 1
             while len(self._bordered) > 8:  # a few statements and moduli at once
@@ -240,7 +253,8 @@ class PreparedContact:
             for i, name in enumerate(unknown_names):
                 scalars[name] = solved[n + i]
             probe_weights = weights(probe)
-            q_check = unit_pressure(self._check_x) @ probe_weights
+            q_check = self._check_pressure(inputs.given, c0, nodal_units,
+                                           unit_pressure) @ probe_weights
             if "tilt" in inputs.given:
                 tilt_history = inputs.loads["tilt"](probe)
             else:
@@ -348,6 +362,21 @@ class PreparedContact:
         return _Superposed(scalars, effective, q_check, float(weighted_error / size),
                            max(r.steps for _, r in terms), not failed,
                            "; ".join(failed) or terms[0][1].message)
+
+    def _check_pressure(self, given: frozenset[str], c0: float, nodal_units: np.ndarray,
+                        unit_pressure: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+        """Unit-response pressures at the check points (see ``__init__``), cached."""
+        key = ("check", given, c0)
+        with self._lock:
+            cached = self._unit_pressure.get(key)
+        if cached is None:
+            x, formula = self._check_x, self._check_formula
+            cached = np.empty((x.size, nodal_units.shape[1]))
+            cached[~formula] = self.grid.interpolate(x[~formula], nodal_units)
+            cached[formula] = unit_pressure(x[formula])
+            with self._lock:
+                self._unit_pressure[key] = cached
+        return cached
 
     def _history_times(self, times: np.ndarray, kind: str) -> np.ndarray:
         """Output times plus samples between them, where the answer's validity is checked."""

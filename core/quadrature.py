@@ -8,11 +8,17 @@ with ``k_pl(s) = -ln|s| + k_reg(s)`` (``k_reg`` smooth, see :mod:`core.kernel`).
 panel the density is represented by its Legendre interpolant on 16 Gauss nodes; the log
 part is integrated *exactly* against that interpolant (product integration, using
 ``int_{-1}^{1} ln|z - t| P_n(t) dt = 2 [Q_{n+1}(z) - Q_{n-1}(z)] / (2n + 1)``) whenever the
-target lies within four half-widths of the panel centre, and by the plain Gauss rule
-farther away, where the log is analytic in a Bernstein ellipse with rho >= 7.9 and the
-plain rule is accurate to ~1e-16. The smooth part ``k_reg(lam d)`` has its nearest
+target lies within three half-widths of the panel centre, and by the plain Gauss rule
+farther away, where the log is analytic in a Bernstein ellipse with rho >= 5.8 and the
+plain rule is accurate to ~2e-15. The smooth part ``k_reg(lam d)`` has its nearest
 complex singularities at ``d = +-2i/lam``, so panels no wider than ``3/lam`` integrate
 it to machine precision.
+
+Assembly: rows are built in cache-sized blocks of targets; at panel nodes the product
+weights come from tables of reference panel pairs (:func:`node_rows`); an operator on a
+refined grid copies the blocks of the panels it shares with the coarser one
+(:func:`kernel_operator`); the kernel values may be asked for to a looser absolute accuracy
+than rounding (a truncated series, and exact zeros where the kernel has decayed below it).
 
 Panels break at every point where the coating compliance ``m`` or the gap ``g`` may
 jump, are graded geometrically toward those points and toward ``x = +-1`` (where the
@@ -33,16 +39,21 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.polynomial import legendre as npleg
 
-from core.kernel import plane_kernel, plane_kernel_regular
+from core.kernel_values import FULL_ACCURACY, kernel_block, kernel_regular
+from core.log_moments import legendre_log_moments
 
 NODES_PER_PANEL = 16
 _T, _W = npleg.leggauss(NODES_PER_PANEL)
 # Values P_n(t_j), n < 16, and the interpolation matrix nodes -> Legendre coefficients.
 _P = npleg.legvander(_T, NODES_PER_PANEL - 1)  # (16 nodes, 16 degrees)
 _TO_COEF = (_P * _W[:, None]).T * (np.arange(NODES_PER_PANEL) + 0.5)[:, None]  # (deg, node)
+_J = np.arange(NODES_PER_PANEL)
 
 #: Targets closer than this many half-widths to a panel centre use product integration.
-NEAR_FIELD = 4.0
+#: Farther out the plain Gauss rule integrates ``ln|z - t| P_n(t)``, n <= 15, to within
+#: (measured against the exact moments) 2.5e-15 at |z| = 3 and 1.3e-15 at 4, but 4.8e-12
+#: at 2 (P_15 grows like rho^15 on the ellipse, so the rule errs like rho^(15 - 32)).
+NEAR_FIELD = 3.0
 
 
 @dataclass(frozen=True)
@@ -82,8 +93,9 @@ class Panels:
 
 
 def _graded_interval(a: float, b: float, grade_a: bool, grade_b: bool, finest: float,
-                     widest: float, *, finest_b: float | None = None) -> list[float]:
-    """Panel edges on [a, b], geometric (ratio 2) from the finest width at graded ends.
+                     widest: float, *, finest_b: float | None = None,
+                     ratio: float = 2.0) -> list[float]:
+    """Panel edges on [a, b], geometric (``ratio``) from the finest width at graded ends.
 
     ``finest`` is the finest width at ``a`` (and at ``b`` unless ``finest_b`` is given).
     """
@@ -94,11 +106,11 @@ def _graded_interval(a: float, b: float, grade_a: bool, grade_b: bool, finest: f
     # Grading from both ends must not overlap: stop each at a third of the interval.
     while grade_a and w < min(widest, length / 3):
         left.append(w)
-        w *= 2.0
+        w *= ratio
     w = finest if finest_b is None else finest_b
     while grade_b and w < min(widest, length / 3):
         right.append(w)
-        w *= 2.0
+        w *= ratio
     # Each geometric run can sum to nearly 2/3 of the interval, so on a short interval the
     # two runs overlapped (a negative panel width, e.g. on [0.3, 1] with max_width 0.25).
     # Drop the widest graded panels until the middle is at least 1/8 of them wide (valid
@@ -116,7 +128,8 @@ def _graded_interval(a: float, b: float, grade_a: bool, grade_b: bool, finest: f
 
 def base_panels(lam: float, breakpoints: Sequence[float] = (), *,
                 edge_width: float | None = 1e-4, max_width: float = 0.25,
-                soft_cuts: Sequence[float] = (), soft_width: float | None = None) -> Panels:
+                soft_cuts: Sequence[float] = (), soft_width: float | None = None,
+                ratio: float = 2.0) -> Panels:
     """Panels on [-1, 1] broken at ``breakpoints`` and graded toward them and toward +-1.
 
     ``edge_width`` is the width of the finest panel at each graded point; panels are at
@@ -141,7 +154,8 @@ def base_panels(lam: float, breakpoints: Sequence[float] = (), *,
     if not len(soft_cuts) and np.isfinite(edge_width):
         edges: list[float] = [-1.0]
         for a, b in zip(hard[:-1], hard[1:], strict=True):
-            sub = _graded_interval(a, b, True, True, min(edge_width, (b - a) / 8), widest)
+            sub = _graded_interval(a, b, True, True, min(edge_width, (b - a) / 8), widest,
+                                   ratio=ratio)
             edges.extend(sub[1:])
         return Panels.from_edges(np.array(edges))
     soft = sorted({float(c) for c in soft_cuts})
@@ -199,77 +213,6 @@ def refine_to_resolve(panels: Panels, functions: Sequence[Callable[[np.ndarray],
     return Panels.from_edges(edges), False
 
 
-def legendre_log_moments(z: np.ndarray, degree: int) -> np.ndarray:
-    """``M_n(z) = int_{-1}^{1} ln|z - t| P_n(t) dt`` for n = 0..degree (shape (len(z), degree+1)).
-
-    Uses Legendre functions of the second kind ``Q_n``: forward recurrence where it is
-    stable (|z| <= 1.05) and Miller's backward recurrence outside, where ``Q_n`` is the
-    minimal solution and the forward recurrence loses ~2n log10(|z| + sqrt(z^2 - 1)) digits.
-    """
-    z = np.asarray(z, dtype=float)
-    ends = np.abs(np.abs(z) - 1.0) < 1e-13
-    # M_n is continuous at |z| = 1 but Q_n is not defined there: step just inside (the
-    # exact end values replace the result below).
-    z = np.where(ends, np.sign(z) * (1.0 - 1e-13), z)
-    nq = degree + 2
-    q = np.empty((z.size, nq))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        q0 = 0.5 * np.log(np.abs((1.0 + z) / (1.0 - z)))
-    inner = np.abs(z) <= 1.05
-    if inner.any():
-        zi = z[inner]
-        qi = np.empty((zi.size, nq))
-        qi[:, 0] = q0[inner]
-        qi[:, 1] = zi * qi[:, 0] - 1.0
-        for n in range(1, nq - 1):
-            qi[:, n + 1] = ((2 * n + 1) * zi * qi[:, n] - n * qi[:, n - 1]) / (n + 1)
-        q[inner] = qi
-    outer = ~inner
-    if outer.any():
-        zo = np.abs(z[outer])
-        rho = zo + np.sqrt(zo * zo - 1.0)
-        # Start index so that rho^-2(start - n) < 1e-18 for every needed n.
-        start = nq + int(np.ceil(18 * np.log(10) / (2 * np.log(rho.min())))) + 5
-        qa = np.zeros(zo.size)
-        qb = np.full(zo.size, 1e-280)
-        vals = np.empty((zo.size, nq))
-        for n in range(start, 0, -1):
-            # (n) Q_{n-1} = (2n+1) z Q_n - (n+1) Q_{n+1}
-            qc = ((2 * n + 1) * zo * qb - (n + 1) * qa) / n
-            qa, qb = qb, qc
-            if n - 1 < nq:
-                vals[:, n - 1] = qb
-            big = np.abs(qb) > 1e250
-            if big.any():
-                qa[big] *= 1e-250
-                qb[big] *= 1e-250
-                vals[big] *= 1e-250
-        exact0 = 0.5 * np.log((zo + 1.0) / (zo - 1.0))
-        vals *= (exact0 / vals[:, 0])[:, None]
-        # Q_n(-z) = (-1)^(n+1) Q_n(z)
-        neg = z[outer] < 0
-        if neg.any():
-            signs = (-1.0) ** (np.arange(nq) + 1)
-            vals[neg] *= signs[None, :]
-        q[outer] = vals
-    m = np.empty((z.size, degree + 1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a = (1.0 + z) * np.log(np.abs(1.0 + z))
-        b = (1.0 - z) * np.log(np.abs(1.0 - z))
-    a = np.where(np.isfinite(a), a, 0.0)
-    b = np.where(np.isfinite(b), b, 0.0)
-    m[:, 0] = a + b - 2.0
-    n = np.arange(1, degree + 1)
-    m[:, 1:] = 2.0 * (q[:, 2 : degree + 2] - q[:, 0:degree]) / (2 * n + 1)
-    # On a panel end the recurrence ran just inside; use the exact end values instead:
-    # M_0(1) = 2 ln 2 - 2, M_n(1) = -2/(n (n + 1)), M_n(-1) = (-1)^n M_n(1).
-    if ends.any():
-        exact = np.concatenate([[2.0 * np.log(2.0) - 2.0], -2.0 / (n * (n + 1.0))])
-        parity = np.where(z[ends, None] < 0, (-1.0) ** np.arange(degree + 1)[None, :], 1.0)
-        m[ends] = exact[None, :] * parity
-    return m
-
-
 def log_product_weights(center: float, half_width: float, targets: np.ndarray) -> np.ndarray:
     """Weights ``W`` (targets x 16) with ``sum_j W[i, j] phi(x_j) = int_panel ln|x_i - xi| phi``.
 
@@ -298,31 +241,181 @@ class KernelOperator:
         return operator_rows(self.lam, self.panels, targets) @ values
 
 
-def operator_rows(lam: float, panels: Panels, targets: np.ndarray) -> np.ndarray:
-    """Rows of the discrete operator for arbitrary targets (len(targets) x N)."""
+def _near_pairs(panels: Panels, targets: np.ndarray, sources: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """(target, source position) pairs closer than NEAR_FIELD half-widths to the centre."""
+    return np.nonzero(np.abs(targets[:, None] - panels.centers[None, sources])
+                      <= NEAR_FIELD * panels.half_widths[None, sources])
+
+
+def _log_weights(panels: Panels, targets: np.ndarray, near_t: np.ndarray,
+                 near_p: np.ndarray) -> np.ndarray:
+    """Product weights of ``ln|x - xi|`` (pairs x 16) for target/panel pairs, one batch."""
+    if not near_t.size:
+        return np.empty((0, NODES_PER_PANEL))
+    c, h = panels.centers[near_p], panels.half_widths[near_p]
+    moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1)
+    return h[:, None] * (np.log(h)[:, None] * _W[None, :] + moments @ _TO_COEF)
+
+
+#: Target rows per block of :func:`operator_rows`: rows x nodes about this many entries,
+#: so that every temporary of a block stays in cache (whole-matrix temporaries made the
+#: element-wise passes, not the kernel, the main cost: 18 of 30 ms at 704 nodes).
+_BLOCK_ENTRIES = 1 << 15
+
+
+def operator_rows(lam: float, panels: Panels, targets: np.ndarray,
+                  sources: np.ndarray | None = None, accuracy: float = FULL_ACCURACY
+                  ) -> np.ndarray:
+    """Rows of the discrete operator for arbitrary targets (len(targets) x N).
+
+    ``sources`` (panel indices, default all) restricts the columns to the nodes of those
+    panels, in that order (len(targets) x 16 len(sources)). Far pairs take the Gauss rule
+    of the whole kernel ``k_reg(lam d) - ln(lam d)``; near pairs the Gauss rule of its
+    smooth part and product integration of the log part. ``accuracy``: absolute accuracy
+    of the kernel values (default: rounding; a looser one evaluates them faster).
+    """
     targets = np.asarray(targets, dtype=float)
-    ad = np.abs(targets[:, None] - panels.nodes[None, :])
-    # Far pairs: the Gauss rule on the whole kernel k_pl(lam d) (its log included).
-    with np.errstate(divide="ignore"):
-        rows = plane_kernel(lam * ad)
-    rows *= panels.weights[None, :]
-    # Near pairs (target, panel) all at once: one batched call of the Legendre log moments
-    # instead of a Python loop over panels (which cost ~20 ms for 20 panels).
-    near_t, near_p = np.nonzero(np.abs(targets[:, None] - panels.centers[None, :])
-                                <= NEAR_FIELD * panels.half_widths[None, :])
+    sources = (np.arange(panels.n_panels) if sources is None
+               else np.asarray(sources, dtype=np.intp))
+    near_t, near_s = _near_pairs(panels, targets, sources)
+    log_weights = _log_weights(panels, targets, near_t, sources[near_s])
+    return _rows(lam, panels, targets, sources, near_t, near_s, log_weights, accuracy)
+
+
+def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: np.ndarray,
+              sources: np.ndarray | None = None, accuracy: float = FULL_ACCURACY
+              ) -> np.ndarray:
+    """:func:`operator_rows` at the nodes of the panels ``target_panels[target_index]``.
+
+    The same numbers (to ~1e-15), but the product weights come from tables of reference
+    panel pairs: a target panel and a source panel are, up to an affine map, fixed by the
+    ratio of their half-widths and the offset of their centres, and on graded panels a few
+    such pairs recur (neighbours of equal width, of half or double width).
+    """
+    target_index = np.asarray(target_index, dtype=np.intp)
+    sources = (np.arange(panels.n_panels) if sources is None
+               else np.asarray(sources, dtype=np.intp))
+    targets = target_panels.nodes.reshape(-1, NODES_PER_PANEL)[target_index].ravel()
+    tc = target_panels.centers[target_index]
+    th = target_panels.half_widths[target_index]
+    sc, sh = panels.centers[sources], panels.half_widths[sources]
+    # Panel pairs with a target node possibly within NEAR_FIELD source half-widths.
+    pair_t, pair_s = np.nonzero(np.abs(tc[:, None] - sc[None, :])
+                                <= NEAR_FIELD * sh[None, :] + th[:, None])
+    if not pair_t.size:
+        return _rows(lam, panels, targets, sources, pair_t, pair_s, np.empty((0, 16)),
+                     accuracy)
+    ratio = np.round(th[pair_t] / sh[pair_s], 12)
+    offset = np.round((tc[pair_t] - sc[pair_s]) / sh[pair_s], 12)
+    keys = list(zip(ratio.tolist(), offset.tolist(), strict=True))
+    # Looked up into a local dict first: another thread may empty the shared one.
+    found = {k: _PAIR_TABLES.get(k) for k in dict.fromkeys(keys)}
+    missing = [k for k, v in found.items() if v is None]
+    if missing:
+        keys_array = np.array(missing)  # (missing, 2): ratio, offset
+        z = keys_array[:, 1:] + keys_array[:, :1] * _T[None, :]  # (missing, 16)
+        moments = legendre_log_moments(z.ravel(), NODES_PER_PANEL - 1) @ _TO_COEF
+        moments = moments.reshape(len(missing), NODES_PER_PANEL, NODES_PER_PANEL)
+        new = {key: (np.abs(zk) <= NEAR_FIELD, table)
+               for key, zk, table in zip(missing, z, moments, strict=True)}
+        found.update(new)
+        if len(_PAIR_TABLES) + len(new) > _PAIR_TABLES_MAX:
+            _PAIR_TABLES.clear()
+        _PAIR_TABLES.update(new)
+    tables = [found[k] for k in keys]
+    near = np.array([t[0] for t in tables])  # (pairs, 16 target nodes)
+    which, node = np.nonzero(near)
+    reference = np.array([t[1] for t in tables])[which, node]  # (near pairs, 16)
+    h = sh[pair_s[which]]
+    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + reference)
+    near_t = pair_t[which] * NODES_PER_PANEL + node
+    return _rows(lam, panels, targets, sources, near_t, pair_s[which], log_weights,
+                 accuracy)
+
+
+#: Reference tables of :func:`node_rows`, keyed by (half-width ratio, centre offset) of a
+#: (target, source) panel pair rounded to 1e-12 (moments move by ~1e-12 of their size):
+#: near mask (16,) and ``M(z) @ _TO_COEF`` (16 x 16). Emptied when it holds more.
+_PAIR_TABLES: dict[tuple[float, float], tuple[np.ndarray, np.ndarray]] = {}
+_PAIR_TABLES_MAX = 4096
+
+
+def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
+          near_t: np.ndarray, near_s: np.ndarray, log_weights: np.ndarray,
+          accuracy: float = FULL_ACCURACY) -> np.ndarray:
+    """Operator rows given the near (target, source position) pairs and their log weights.
+
+    ``accuracy``: absolute accuracy of the kernel values (see
+    :func:`core.kernel_values.kernel_block`).
+    """
+    cols_all = (sources[:, None] * NODES_PER_PANEL + _J[None, :]).ravel()
+    nodes = panels.nodes[cols_all]
+    weights = panels.weights[cols_all] / np.pi
+    rows = np.empty((targets.size, nodes.size))
+    step = max(1, _BLOCK_ENTRIES // max(nodes.size, 1))
+    for start in range(0, targets.size, step):
+        block = rows[start:start + step]
+        distance = np.abs(targets[start:start + step, None] - nodes[None, :])
+        distance *= lam
+        block[...] = kernel_block(distance, accuracy)
+        block *= weights[None, :]
     if near_t.size:
-        c, h = panels.centers[near_p], panels.half_widths[near_p]
-        moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1)
-        log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + moments @ _TO_COEF)
-        cols = near_p[:, None] * NODES_PER_PANEL + np.arange(NODES_PER_PANEL)[None, :]
-        smooth = plane_kernel_regular(lam * ad[near_t[:, None], cols]) - np.log(lam)
-        rows[near_t[:, None], cols] = smooth * panels.weights[cols] - log_weights
-    return rows / np.pi
+        cols = near_s[:, None] * NODES_PER_PANEL + _J[None, :]  # positions among sources
+        smooth = kernel_regular(lam * np.abs(targets[near_t, None] - nodes[cols]), accuracy)
+        smooth -= np.log(lam)
+        rows[near_t[:, None], cols] = smooth * weights[cols] - log_weights / np.pi
+    return rows
 
 
-def kernel_operator(lam: float, panels: Panels) -> KernelOperator:
-    """The discrete operator F on the nodes of ``panels`` (N x N, units of the density)."""
-    return KernelOperator(lam, panels, operator_rows(lam, panels, panels.nodes))
+def shared_panels(old: Panels, new: Panels) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Panels of ``new`` that ``old`` has too (same ends): their indices in ``new`` and in
+    ``old``, and the indices in ``new`` of the other (fresh) panels."""
+    old_index = {key: i for i, key in enumerate(zip(old.edges[:-1].tolist(),
+                                                    old.edges[1:].tolist(), strict=True))}
+    kept_new, kept_old, fresh = [], [], []
+    for i, key in enumerate(zip(new.edges[:-1].tolist(), new.edges[1:].tolist(),
+                                strict=True)):
+        if key in old_index:
+            kept_new.append(i)
+            kept_old.append(old_index[key])
+        else:
+            fresh.append(i)
+    as_index = lambda v: np.asarray(v, dtype=np.intp)  # noqa: E731
+    return as_index(kept_new), as_index(kept_old), as_index(fresh)
+
+
+def panel_nodes(panel_index: np.ndarray) -> np.ndarray:
+    """Node indices of the panels ``panel_index`` (16 each, in panel order)."""
+    return (np.asarray(panel_index, dtype=np.intp)[:, None] * NODES_PER_PANEL
+            + _J[None, :]).ravel()
+
+
+def kernel_operator(lam: float, panels: Panels, previous: KernelOperator | None = None,
+                    accuracy: float = FULL_ACCURACY) -> KernelOperator:
+    """The discrete operator F on the nodes of ``panels`` (N x N, units of the density).
+
+    ``previous``: the operator on an earlier grid with the same ``lam`` (e.g. before a
+    refinement). Blocks between panels both grids share (same ends) are copied from it,
+    so only the rows and columns of new panels are computed. ``accuracy``: absolute
+    accuracy of the kernel values (as in :func:`operator_rows`).
+    """
+    every = np.arange(panels.n_panels)
+    if previous is None or previous.lam != lam:
+        return KernelOperator(lam, panels, node_rows(lam, panels, panels, every,
+                                                     accuracy=accuracy))
+    kept_new, kept_old, fresh = shared_panels(previous.panels, panels)
+    if not kept_new.size:
+        return KernelOperator(lam, panels, node_rows(lam, panels, panels, every,
+                                                     accuracy=accuracy))
+    matrix = np.empty((panels.size, panels.size))
+    kn, ko = panel_nodes(kept_new), panel_nodes(kept_old)
+    matrix[np.ix_(kn, kn)] = previous.matrix[np.ix_(ko, ko)]
+    if fresh.size:
+        fn = panel_nodes(fresh)
+        matrix[fn, :] = node_rows(lam, panels, panels, fresh, accuracy=accuracy)
+        matrix[np.ix_(kn, fn)] = node_rows(lam, panels, panels, kept_new, fresh, accuracy)
+    return KernelOperator(lam, panels, matrix)
 
 
 #: Dyadic levels of the outer rule of :func:`galerkin_correction` toward a singular end:

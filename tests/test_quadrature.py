@@ -32,3 +32,49 @@ def test_log_moments_match_mpmath(z):
                                     * mpmath.legendre(k, t), pts))
         # measured: <= 2.2e-16 (0.31, 0.999, 1.04)
         assert got[k] == pytest.approx(ref, abs=1e-14)
+
+
+def _graded(lam: float, breakpoints: tuple[float, ...], edge: float):
+    from core.quadrature import base_panels
+
+    return base_panels(lam, breakpoints, edge_width=edge, max_width=min(0.5, 3.0 / lam),
+                       ratio=4.0)
+
+
+@pytest.mark.parametrize(("lam", "breakpoints"), [(1.0, (0.3,)), (50.0, ()), (0.05, (-0.5,))])
+def test_operator_reused_on_a_refined_grid_equals_a_new_one(lam, breakpoints):
+    """Blocks of shared panels are copied, the rest computed: the same matrix exactly."""
+    from core.nystrom_adapt import grade
+    from core.quadrature import Panels, kernel_operator
+
+    coarse = _graded(lam, breakpoints, 1e-3)
+    fine = Panels.from_edges(grade(coarse.edges, np.array([-1.0, 1.0, *breakpoints]), 2))
+    new = kernel_operator(lam, fine).matrix
+    reused = kernel_operator(lam, fine, kernel_operator(lam, coarse)).matrix
+    # measured: 0 (lam 1), 1.7e-18 and 3.5e-18 (lam 50, 0.05; entries up to 0.08)
+    assert np.max(np.abs(reused - new)) <= 1e-16
+
+
+def test_node_rows_from_reference_tables_match_operator_rows():
+    """The tables of reference panel pairs give the batched moments' numbers."""
+    from core.nystrom_adapt import grade
+    from core.quadrature import Panels, node_rows, operator_rows
+
+    coarse = _graded(1.0, (0.3,), 1e-3)
+    fine = Panels.from_edges(grade(coarse.edges, np.array([-1.0, 1.0, 0.3]), 3))
+    tables = node_rows(1.0, coarse, fine, np.arange(fine.n_panels))
+    batched = operator_rows(1.0, coarse, fine.nodes)
+    # measured: 3.0e-15 (entries up to 0.08): the keys are rounded to 1e-12
+    assert np.max(np.abs(tables - batched)) <= 3e-14
+
+
+@pytest.mark.parametrize("accuracy", [1e-6, 1e-9, 1e-12])
+def test_kernel_values_meet_the_asked_accuracy(accuracy):
+    """The truncated series and the zeros beyond the envelope stay within ``accuracy``."""
+    from core.kernel import plane_kernel
+    from core.kernel_values import kernel_block
+
+    s = np.linspace(1e-6, 40.0, 400_001)
+    error = np.max(np.abs(kernel_block(s.copy(), accuracy) - plane_kernel(s)))
+    # measured: 4.4e-7, 4.4e-10, 3.4e-13 (the tail is cut at half the accuracy)
+    assert error <= accuracy
