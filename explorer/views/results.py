@@ -9,6 +9,7 @@ import panel as pn
 import param
 
 from .. import exports
+from ..contact_zone import contact_text
 from ..design import check_html, design_check
 from ..results import ResultView
 from ..state import QUANTITIES, QUANTITY_UNITS
@@ -75,8 +76,10 @@ def readout_html(view: ResultView | None, index: int, pinned: ResultView | None)
         rows.append(row + "</tr>")
     force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
     ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
+    contact = html.escape(contact_text(view, index))
     return (f"<div class='readout'><b>At t = {t:.4g} days after loading</b> · {ecc}"
-            f"<table class='cp-readout'>{''.join(rows)}</table></div>")
+            f"<table class='cp-readout'>{''.join(rows)}</table>"
+            f"<div class='contact-readout'>{contact}</div></div>")
 
 
 class ResultsView:
@@ -122,11 +125,15 @@ class ResultsView:
         f = app.figures
         bokeh = {"sizing_mode": "stretch_width", "margin": (0, 5)}
         self._bokeh_panes = [pn.pane.Bokeh(fig, **bokeh) for fig in (
-            f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES))]
+            f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES),
+            f.contact_fig)]
+        # the inset of small features keeps its own width beside the drawing
+        self._bokeh_panes.append(pn.pane.Bokeh(f.inset_fig, margin=(0, 5)))
 
     def content(self) -> pn.Column:
         """The main column of the page."""
-        scene_pane, q_pane, image_pane, *history_panes = self._bokeh_panes
+        scene_pane, q_pane, image_pane, *history_panes, contact_pane, inset_pane = \
+            self._bokeh_panes
         return pn.Column(
             self._address,
             self.notice_alert,
@@ -134,7 +141,7 @@ class ResultsView:
             pn.Row(self.spinner, self.status, sizing_mode="stretch_width"),
             self.status_badges,
             self.scene_badges,
-            scene_pane,
+            pn.Row(scene_pane, inset_pane, sizing_mode="stretch_width"),
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
@@ -143,7 +150,7 @@ class ResultsView:
                    sizing_mode="stretch_width"),
             self.design,
             self.history_badges,
-            pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
+            pn.GridBox(*history_panes, contact_pane, ncols=2, sizing_mode="stretch_width"),
             sizing_mode="stretch_width",
         )
 
