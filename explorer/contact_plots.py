@@ -12,10 +12,12 @@ from bokeh.models import ColumnDataSource, HoverTool, Label, Range1d, Span
 from bokeh.plotting import figure
 
 from .bokeh_data import f32, set_data
-from .contact_zone import contact_widths, contact_zones, lifts_off, model_name
+from .contact_zone import contact_widths, contact_zones, lifts_off
 from .results import Geometry, ResultView
 
-CONTACT_COLOR = "#2ca02c"
+# navy: apart from the viridis colours of the coating it lies on; red as the lifted
+# (shaded) parts of q(x)
+CONTACT_COLOR = "#08306b"
 LIFTED_COLOR = "#d62728"
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
@@ -39,12 +41,13 @@ class ContactDrawing:
         self.zone_src = ColumnDataSource({"xs": [], "ys": []}, name="contact_zone_source")
         self.lifted_src = ColumnDataSource({"xs": [], "ys": []}, name="lifted_zone_source")
         scene_fig.multi_line(xs="xs", ys="ys", source=self.zone_src, line_color=CONTACT_COLOR,
-                             line_width=5, line_alpha=0.9, legend_label="in contact")
+                             line_width=6, line_alpha=0.9, legend_label="in contact")
         scene_fig.multi_line(xs="xs", ys="ys", source=self.lifted_src,
-                             line_color=LIFTED_COLOR, line_width=4, line_dash="dashed",
+                             line_color=LIFTED_COLOR, line_width=5, line_dash="dashed",
                              legend_label="lifted off (gap open)")
         legend = scene_fig.legend[0]
-        legend.location = "top_left"
+        # in the base's corner: the load's arrow and its label use the top of the drawing
+        legend.location = "bottom_right"
         legend.label_text_font_size = "11px"
         legend.background_fill_alpha = 0.7
         legend.padding = 2
@@ -81,11 +84,11 @@ class ContactDrawing:
                                  line_dash="dotted")
         p.add_layout(self.width_cursor)
         legend = p.legend[0]
-        legend.location = "center_right"
+        legend.orientation = "horizontal"
         legend.label_text_font_size = "11px"
-        legend.background_fill_alpha = 0.7
+        legend.margin = 0
         legend.padding = 2
-        legend.spacing = 0
+        p.add_layout(legend, "above")
         self.width_fig = p
         self._widths = np.zeros(1)
 
@@ -102,12 +105,11 @@ class ContactDrawing:
                                   "lifted": f32(2 * a - widths)})
         self.width_fig.y_range.start = 0.0
         self.width_fig.y_range.end = 2.1 * a
+        # short titles: at 1024 px this figure is ~300 px wide
         if lifts_off(view):
-            self.width_fig.title.text = (f"Contact width and lift-off length [m] "
-                                         f"({model_name(view)})")
+            self.width_fig.title.text = "Contact width [m]: lift-off"
         else:
-            self.width_fig.title.text = (f"Contact width [m]: full contact, 2a = {2 * a:.3g} m "
-                                         f"at all times")
+            self.width_fig.title.text = "Contact width [m]: full contact"
 
     def show_time(self, view: ResultView, index: int) -> None:
         """The zone under the punch and the cursor at output ``index``."""
@@ -142,7 +144,7 @@ class FeatureInset:
     """
 
     def __init__(self) -> None:
-        p = figure(height=300, width=250, tools="pan,wheel_zoom,reset", toolbar_location=None,
+        p = figure(height=300, width=220, tools="pan,wheel_zoom,reset", toolbar_location=None,
                    title="Small features [µm]", name="features_figure", visible=False)
         p.xaxis.axis_label = "x [m]"
         p.yaxis.axis_label = "height [µm]"
@@ -158,7 +160,7 @@ class FeatureInset:
             ("x", "@x{0.000} m"), ("punch base", "@punch{0.00} µm"),
             ("coating top", "@surface{0.00} µm")]))
         legend = p.legend[0]
-        legend.location = "bottom_center"
+        legend.location = "bottom_right"
         legend.label_text_font_size = "10px"
         legend.background_fill_alpha = 0.7
         legend.padding = 2

@@ -12,6 +12,7 @@ import json
 import math
 
 import numpy as np
+from bokeh.core.properties import value as fixed_label
 from bokeh.models import (
     Arrow,
     ColorBar,
@@ -37,6 +38,10 @@ from .state import QUANTITIES, QUANTITY_UNITS
 SYMBOLS = {"settlement": "δ", "tilt": "α", "force": "P", "moment": "M"}
 TITLES = {"settlement": "Settlement", "tilt": "Tilt", "force": "Force", "moment": "Moment"}
 UNKNOWN_COLOR = "#1f77b4"
+#: What the shaded strips of q(x) are: negative pressure of the full-contact model, or
+#: the parts a unilateral solve lifted off (q = 0 there).
+LOST_LABEL = "q < 0 (contact lost)"
+LIFTED_LABEL = "lifted off (q = 0)"
 GIVEN_COLOR = "#8c8c8c"
 PINNED_COLOR = "#d62728"
 
@@ -148,8 +153,9 @@ class Figures:
         self.q_src = ColumnDataSource({"x": [0.0], "q": [0.0]}, name="q_source")
         self.q_pin_src = ColumnDataSource(_empty("x", "q"), name="q_pin_source")
         self.neg_src = ColumnDataSource(_empty("left", "right"), name="negative_source")
-        p.vstrip(x0="left", x1="right", source=self.neg_src, fill_color="#d62728",
-                 fill_alpha=0.18, line_color=None, legend_label="q < 0 (contact lost)")
+        self.neg_strip = p.vstrip(x0="left", x1="right", source=self.neg_src,
+                                  fill_color="#d62728", fill_alpha=0.18, line_color=None,
+                                  legend_label=LOST_LABEL)
         p.add_layout(Span(location=0, dimension="width", line_color="#555", line_width=1))
         self.q_pin_line = p.line(x="x", y="q", source=self.q_pin_src, line_color=PINNED_COLOR,
                                  line_dash="dashed", line_width=2, legend_label="pinned")
@@ -288,6 +294,7 @@ class Figures:
         set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
                                 "right": [hi for _, hi in intervals]})
         self.q_fig.title.text = f"Pressure q(x), t = {t:.4g} days"
+        self._label_strips(view)
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
         self._show_pinned_pressure(view, pinned, index)
@@ -299,6 +306,12 @@ class Figures:
                      {"t": [t], "v": [float(view.display(name)[index])]})
         self._show_arrow(view, index)
         self.contact.show_time(view, index)
+
+    def _label_strips(self, view: ResultView) -> None:
+        label = LIFTED_LABEL if view.info.get("contact") == "unilateral" else LOST_LABEL
+        for item in self.q_fig.legend[0].items:
+            if self.neg_strip in item.renderers and item.label != fixed_label(label):
+                item.label = fixed_label(label)
 
     def set_classical(self, view: ResultView | None, index: int, shown: bool) -> None:
         """Show or hide the classical answers on the pressure plot."""

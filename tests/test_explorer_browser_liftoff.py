@@ -98,7 +98,7 @@ def test_the_zone_moves_with_time_and_with_the_eccentricity_slider(page: Page):
     start = preset.contact_set[-1][0][0]
     until(lambda: _starts_at(page, start), "the zone at 1000 days", timeout=120)
     assert [z[0] for z in _zones(page, "lifted_zone_source")] == [-1.0]
-    assert "unilateral" in page.page.evaluate(JS_TITLE, "contact_width_figure")
+    assert "lift-off" in page.page.evaluate(JS_TITLE, "contact_width_figure")
     assert page.page.evaluate(JS_VIEW_WIDTH, "contact_width_figure") > 200
     until(lambda: page.page.evaluate(JS_SHOWN, "contact 1.349 m of 2 m"), "the readout")
     # time passes under creep: at loading the zone is shorter

@@ -76,7 +76,7 @@ def test_the_width_plot_gives_the_zone_lengths_and_the_lifted_length_in_metres()
     assert fig.xaxis[0].axis_label == "t [days after loading]"
     tooltips = dict(fig.tools[-1].tooltips)
     assert tooltips["contact width"].endswith(" m") and tooltips["t"].endswith(" days")
-    assert "unilateral" in fig.title.text
+    assert fig.title.text == "Contact width [m]: lift-off"
     # under this creeping base the zone grows (the heel settles back) and then stays
     assert expected[-1] > expected[0]
 
@@ -132,3 +132,18 @@ def test_a_load_step_in_full_contact_does_not_resend_the_bar() -> None:
     assert sent[0] == 0
     # a force step changes the histories: the width plot's point moves, its data stays
     assert app.figures.contact.width_point.data["t"] == [float(app.shown().times[-1])]
+
+
+def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
+    from bokeh.core.properties import value
+
+    from explorer.views.results import badges_html
+
+    view = _solved("eccentric_footing_liftoff")
+    badges = badges_html(view, "pressure")
+    assert "lift-off" in badges and "full contact" not in badges
+    assert "full contact" in badges_html(_solved("uniform_flat"), "pressure")
+    figures, _, _ = _drawn("eccentric_footing_liftoff")
+    labels = [item.label for item in figures.q_fig.legend[0].items
+              if figures.neg_strip in item.renderers]
+    assert labels == [value("lifted off (q = 0)")]

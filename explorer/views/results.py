@@ -9,7 +9,7 @@ import panel as pn
 import param
 
 from .. import exports
-from ..contact_zone import contact_text
+from ..contact_zone import contact_text, lifts_off
 from ..design import check_html, design_check
 from ..results import ResultView
 from ..state import QUANTITIES, QUANTITY_UNITS
@@ -43,7 +43,13 @@ def badges_html(view: ResultView | None, group: str) -> str:
     if view is None:
         return ""
     parts = []
+    lifted = group == "pressure" and lifts_off(view) and "contact_lost" not in view.flags
+    if lifted:  # a unilateral solve: no q < 0, and no full contact either
+        parts.append('<span class="cp-badge cp-bad lift-off">⚠ lift-off: part of the base '
+                     'carries no load (shaded)</span>')
     for flag, (bad, good) in BADGES[group].items():
+        if lifted and flag == "contact_lost":
+            continue
         if flag in view.flags:
             message = html.escape(exports.flag_message(view, flag))
             parts.append(f'<span class="cp-badge cp-bad flag-{flag}" title="{message}">'
