@@ -147,3 +147,13 @@ def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
     labels = [item.label for item in figures.q_fig.legend[0].items
               if figures.neg_strip in item.renderers]
     assert labels == [value("lifted off (q = 0)")]
+
+
+def test_the_report_carries_the_contact_zone_and_its_history() -> None:
+    from explorer.report import report_html
+
+    text = report_html(_solved("eccentric_footing_liftoff"), index=0)
+    assert "At t = 0 days: contact 1.306 m of 2 m (65 %)" in text
+    assert "report-contact" in text and "lift-off length" in text
+    flat = report_html(_solved("uniform_flat"))
+    assert "full contact: the whole width" in flat and "report-contact'" not in flat
