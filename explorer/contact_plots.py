@@ -8,6 +8,7 @@ Built once per session and updated in place, like the other figures
 from __future__ import annotations
 
 import numpy as np
+from bokeh.core.properties import value as fixed_label
 from bokeh.models import ColumnDataSource, HoverTool, Label, Range1d, Span
 from bokeh.plotting import figure
 
@@ -19,6 +20,10 @@ from .results import Geometry, ResultView
 # (shaded) parts of q(x)
 CONTACT_COLOR = "#08306b"
 LIFTED_COLOR = "#d62728"
+#: The dashed parts: a gap a unilateral solve opened, or where the full-contact model
+#: pulls (q < 0), which a real base would not do.
+GAP_LABEL = "lifted off (gap open)"
+PULL_LABEL = "q < 0 (full-contact model)"
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
 #: Geometric features of less than this [m] are not drawn in the inset: below the
@@ -42,9 +47,10 @@ class ContactDrawing:
         self.lifted_src = ColumnDataSource({"xs": [], "ys": []}, name="lifted_zone_source")
         scene_fig.multi_line(xs="xs", ys="ys", source=self.zone_src, line_color=CONTACT_COLOR,
                              line_width=6, line_alpha=0.9, legend_label="in contact")
-        scene_fig.multi_line(xs="xs", ys="ys", source=self.lifted_src,
-                             line_color=LIFTED_COLOR, line_width=5, line_dash="dashed",
-                             legend_label="lifted off (gap open)")
+        self.lifted_line = scene_fig.multi_line(xs="xs", ys="ys", source=self.lifted_src,
+                                                line_color=LIFTED_COLOR, line_width=5,
+                                                line_dash="dashed", legend_label=GAP_LABEL)
+        self.scene_legend = scene_fig.legend[0]
         legend = scene_fig.legend[0]
         # in the base's corner: the load's arrow and its label use the top of the drawing
         legend.location = "bottom_right"
@@ -105,6 +111,11 @@ class ContactDrawing:
                                   "lifted": f32(2 * a - widths)})
         self.width_fig.y_range.start = 0.0
         self.width_fig.y_range.end = 2.1 * a
+        label = fixed_label(GAP_LABEL if view.info.get("contact") == "unilateral"
+                            else PULL_LABEL)
+        for item in self.scene_legend.items:
+            if self.lifted_line in item.renderers and item.label != label:
+                item.label = label
         # short titles: at 1024 px this figure is ~300 px wide
         if lifts_off(view):
             self.width_fig.title.text = "Contact width [m]: lift-off"

@@ -119,13 +119,15 @@ def test_no_inset_without_small_features() -> None:
     assert not figures.inset_fig.visible
 
 
-def test_a_load_step_in_full_contact_does_not_resend_the_bar() -> None:
+def test_a_load_step_in_full_contact_resends_nothing_of_the_contact() -> None:
     from explorer.app import ExplorerApp
 
     app = ExplorerApp(executor=None)
     sent = [0]
-    app.figures.contact.zone_src.on_change(
-        "data", lambda attr, old, new: sent.__setitem__(0, sent[0] + 1))
+    contact = app.figures.contact
+    for source in (contact.zone_src, contact.lifted_src, contact.width_src,
+                   contact.width_point, app.figures.inset.src):
+        source.on_change("data", lambda attr, old, new: sent.__setitem__(0, sent[0] + 1))
     force = app.state.loading.histories["force"]
     force.value = force.value * 1.1
     assert app.controller.wait(60) and app.controller.error == ""
@@ -147,6 +149,9 @@ def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
     labels = [item.label for item in figures.q_fig.legend[0].items
               if figures.neg_strip in item.renderers]
     assert labels == [value("lifted off (q = 0)")]
+    labels = [item.label for item in figures.contact.scene_legend.items
+              if figures.contact.lifted_line in item.renderers]
+    assert labels == [value("lifted off (gap open)")]
 
 
 def test_the_report_carries_the_contact_zone_and_its_history() -> None:
@@ -157,3 +162,26 @@ def test_the_report_carries_the_contact_zone_and_its_history() -> None:
     assert "report-contact" in text and "lift-off length" in text
     flat = report_html(_solved("uniform_flat"))
     assert "full contact: the whole width" in flat and "report-contact'" not in flat
+
+
+def test_the_full_contact_model_marks_its_pull_zone_not_a_gap() -> None:
+    from bokeh.core.properties import value
+
+    scene = json.loads(json.dumps(presets()["eccentric_footing_liftoff"]))
+    scene["solver"]["contact"] = "full"
+    state = ExplorerState()
+    state.load_scene(scene)
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    view = controller.view
+    assert "contact_lost" in view.flags
+    figures = Figures()
+    figures.show(view, 0, None)
+    drawing = figures.contact
+    (lifted,) = drawing.lifted_src.data["xs"]
+    (lo, hi), = view.negative_intervals(0)   # where q < 0 beyond the error band
+    assert (lifted[0], lifted[-1]) == (lo, hi) and lo == -1.0
+    labels = [item.label for item in drawing.scene_legend.items
+              if drawing.lifted_line in item.renderers]
+    assert labels == [value("q < 0 (full-contact model)")]
+    assert "q < 0 (contact lost)" in contact_text(view, 0)
