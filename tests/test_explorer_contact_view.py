@@ -185,3 +185,19 @@ def test_the_full_contact_model_marks_its_pull_zone_not_a_gap() -> None:
               if drawing.lifted_line in item.renderers]
     assert labels == [value("q < 0 (full-contact model)")]
     assert "q < 0 (contact lost)" in contact_text(view, 0)
+
+
+def test_the_contact_figures_join_the_page_only_when_a_result_needs_them() -> None:
+    from explorer.app import ExplorerApp
+
+    app = ExplorerApp(executor=None)          # the default scene: full contact, flat
+    slots = app.results.contact_panes
+    assert not slots.width_slot.visible and slots.width_slot.objects == []
+    assert not slots.inset_slot.visible and slots.inset_slot.objects == []
+    for key, width, inset in (("eccentric_footing_liftoff", True, False),
+                              ("worn_coating", False, True), ("uniform_flat", False, False)):
+        assert app.load_scene(json.loads(json.dumps(presets()[key])))
+        assert app.controller.wait(120) and app.controller.error == ""
+        assert (slots.width_slot.visible, slots.inset_slot.visible) == (width, inset), key
+    # once sent, a figure stays on the page (hidden), ready for the next scene that needs it
+    assert len(slots.width_slot.objects) == len(slots.inset_slot.objects) == 1

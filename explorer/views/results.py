@@ -15,6 +15,7 @@ from ..results import ResultView
 from ..state import QUANTITIES, QUANTITY_UNITS
 from ..status import status_html
 from ..widgets import NAMES
+from .contact import ContactPanes
 from .style import html_pane
 
 if TYPE_CHECKING:
@@ -131,15 +132,12 @@ class ResultsView:
         f = app.figures
         bokeh = {"sizing_mode": "stretch_width", "margin": (0, 5)}
         self._bokeh_panes = [pn.pane.Bokeh(fig, **bokeh) for fig in (
-            f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES),
-            f.contact_fig)]
-        # the inset of small features keeps its own width beside the drawing
-        self._bokeh_panes.append(pn.pane.Bokeh(f.inset_fig, margin=(0, 5)))
+            f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES))]
+        self.contact_panes = ContactPanes(f, self._bokeh_panes)
 
     def content(self) -> pn.Column:
         """The main column of the page."""
-        scene_pane, q_pane, image_pane, *history_panes, contact_pane, inset_pane = \
-            self._bokeh_panes
+        scene_pane, q_pane, image_pane, *history_panes = self._bokeh_panes
         return pn.Column(
             self._address,
             self.notice_alert,
@@ -147,7 +145,7 @@ class ResultsView:
             pn.Row(self.spinner, self.status, sizing_mode="stretch_width"),
             self.status_badges,
             self.scene_badges,
-            pn.Row(scene_pane, inset_pane, sizing_mode="stretch_width"),
+            pn.Row(scene_pane, self.contact_panes.inset_slot, sizing_mode="stretch_width"),
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
@@ -156,7 +154,8 @@ class ResultsView:
                    sizing_mode="stretch_width"),
             self.design,
             self.history_badges,
-            pn.GridBox(*history_panes, contact_pane, ncols=2, sizing_mode="stretch_width"),
+            pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
+            self.contact_panes.width_slot,
             sizing_mode="stretch_width",
         )
 
@@ -164,6 +163,7 @@ class ResultsView:
         """Show a new result at output time ``index`` (call inside ``pn.io.hold()``)."""
         app = self.app
         app.figures.show(view, index, app.pinned)
+        self.contact_panes.update(view)
         if new_range:
             self._replace_player(max(len(view.times) - 1, 1), index)
         else:
