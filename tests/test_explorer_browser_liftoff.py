@@ -32,6 +32,11 @@ JS_ZONES = """(name) => {
   const s = Bokeh.documents[0].get_model_by_name(name);
   return Array.from(s.data.xs).map(xs => [xs[0], xs[xs.length - 1]]);
 }"""
+# Whether the inset of small features is on the page and shown (it is sent when needed).
+JS_INSET_SHOWN = """() => {
+  const fig = Bokeh.documents[0].get_model_by_name('features_figure');
+  return !!fig && fig.visible;
+}"""
 JS_TITLE = "(name) => Bokeh.documents[0].get_model_by_name(name).title.text"
 # Width on the page of the view of a named model [px] (0 or null: not shown).
 JS_VIEW_WIDTH = """(name) => {
@@ -114,10 +119,9 @@ def test_the_zone_moves_with_time_and_with_the_eccentricity_slider(page: Page):
 
 
 def test_small_features_get_an_inset_and_a_flat_scene_none(page: Page):
+    assert not page.page.evaluate(JS_INSET_SHOWN)   # not even sent with the first page
     _choose(page, "worn_coating")
-    until(lambda: page.page.evaluate(
-        "() => Bokeh.documents[0].get_model_by_name('features_figure').visible"),
-        "the inset", timeout=120)
+    until(lambda: page.page.evaluate(JS_INSET_SHOWN), "the inset", timeout=120)
     until(lambda: (page.page.evaluate(JS_VIEW_WIDTH, "features_figure") or 0) > 200,
           "the inset drawn on the page")
     surface = page.page.evaluate(
@@ -126,7 +130,6 @@ def test_small_features_get_an_inset_and_a_flat_scene_none(page: Page):
     # the 20 µm wear bump of the preset, in micrometres (401-point grid: within 0.1 %)
     assert min(surface) == pytest.approx(-20.0, rel=1e-3)
     _choose(page, "uniform_flat")
-    until(lambda: not page.page.evaluate(
-        "() => Bokeh.documents[0].get_model_by_name('features_figure').visible"),
-        "the inset hidden", timeout=120)
+    until(lambda: not page.page.evaluate(JS_INSET_SHOWN), "the inset hidden", timeout=120)
+    assert not page.page.evaluate(JS_VIEW_WIDTH, "features_figure")
     assert page.errors == []
