@@ -113,9 +113,12 @@ class ContactDrawing:
         self.width_fig.y_range.end = 2.1 * a
         label = fixed_label(GAP_LABEL if view.info.get("contact") == "unilateral"
                             else PULL_LABEL)
+        lifting = lifts_off(view)
         for item in self.scene_legend.items:
-            if self.lifted_line in item.renderers and item.label != label:
-                item.label = label
+            if self.lifted_line in item.renderers:
+                if item.label != label:
+                    item.label = label
+                item.visible = lifting  # listed only when some time has a lifted part
         # short titles: at 1024 px this figure is ~300 px wide
         if lifts_off(view):
             self.width_fig.title.text = "Contact width [m]: lift-off"
@@ -156,13 +159,14 @@ class FeatureInset:
 
     def __init__(self) -> None:
         p = figure(height=300, width=220, tools="pan,wheel_zoom,reset", toolbar_location=None,
-                   title="Small features [µm]", name="features_figure", visible=False)
+                   title="Features [µm]", name="features_figure", visible=False)
         p.xaxis.axis_label = "x [m]"
         p.yaxis.axis_label = "height [µm]"
         self.src = ColumnDataSource({"x": [], "punch": [], "surface": []},
                                     name="features_source")
-        p.varea(x="x", y1="surface", y2="punch", source=self.src, fill_color="#ffbb78",
-                fill_alpha=0.6, legend_label="gap before loading")
+        self.gap_area = p.varea(x="x", y1="surface", y2="punch", source=self.src,
+                                fill_color="#ffbb78", fill_alpha=0.6,
+                                legend_label="gap before loading")
         p.line(x="x", y="surface", source=self.src, line_color="#8c564b", line_width=2,
                legend_label="coating top")
         punch = p.line(x="x", y="punch", source=self.src, line_color="#333", line_width=2,
@@ -193,4 +197,9 @@ class FeatureInset:
             return
         self.src.data = {"x": f32(g.x), "punch": f32(punch * 1e6),
                          "surface": f32(surface * 1e6)}
-        self.fig.title.text = f"Features: gap up to {float(np.max(gap)) * 1e6:.3g} µm"
+        # the size in the legend: a title longer than "Features [µm]" overflowed the
+        # inset's 220 px in presentation mode
+        label = fixed_label(f"gap before loading (≤ {float(np.max(gap)) * 1e6:.3g} µm)")
+        for item in self.fig.legend[0].items:
+            if self.gap_area in item.renderers and item.label != label:
+                item.label = label

@@ -60,6 +60,9 @@ def test_full_contact_draws_one_bar_over_the_whole_width() -> None:
     assert [(xs[0], xs[-1]) for xs in data["xs"]] == [(-1.0, 1.0)]
     assert figures.contact.lifted_src.data["xs"] == []
     assert figures.contact.zone_label.text.startswith("full contact")
+    # nothing lifts: the legend does not list the dashed part
+    assert [item.visible for item in figures.contact.scene_legend.items
+            if figures.contact.lifted_line in item.renderers] == [False]
 
 
 def test_the_width_plot_gives_the_zone_lengths_and_the_lifted_length_in_metres() -> None:
@@ -112,6 +115,9 @@ def test_small_features_show_in_the_inset_in_micrometres(key: str, feature_um: f
     assert gap.max() == pytest.approx(feature_um, rel=1e-3)
     assert gap.min() == pytest.approx(0.0, abs=1e-9)
     assert inset.yaxis[0].axis_label == "height [µm]"
+    labels = [item.label["value"] for item in inset.legend[0].items
+              if figures.inset.gap_area in item.renderers]
+    assert labels == [f"gap before loading (≤ {gap.max():.3g} µm)"]
 
 
 def test_no_inset_without_small_features() -> None:
