@@ -71,7 +71,9 @@ class EccentricityControl:
         a = self.app.state.punch.half_width
         self.slider.param.update(start=-SLIDER_SPAN * a, end=SLIDER_SPAN * a)
         e = self.eccentricity()
+        # not applicable: the note says why, without a dead slider taking the room
         self.slider.disabled = e is None
+        self.slider.visible = e is not None
         self.note.object = "" if e is not None else NOT_APPLICABLE
         self.note.visible = e is None
         # the value the slider already shows is left alone: a round trip through M = e P

@@ -57,8 +57,8 @@ class SceneView:
             self.preset, pn.Row(self.undo_button, self.reset_button),
             self.preset_description,
             html_pane("<b>Loading</b> (updates while you drag)", margin=(10, 10, 0, 10)),
-            self.statement, self.history_editors[0].panel, self.history_editors[1].panel,
-            self.unknowns_note, self.eccentric_load.panel, **TAB_COLUMN)
+            self.statement, self.eccentric_load.panel, self.history_editors[0].panel,
+            self.history_editors[1].panel, self.unknowns_note, **TAB_COLUMN)
 
     def _preset_text(self) -> str:
         key = getattr(self, "preset", None) and self.preset.value
