@@ -12,6 +12,7 @@ import json
 import math
 
 import numpy as np
+from bokeh.core.properties import value as fixed_label
 from bokeh.models import (
     Arrow,
     ColorBar,
@@ -27,7 +28,9 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
+from .bokeh_data import f32, set_data
 from .classical import bearing_rule_pressure, half_space_pressure
+from .contact_plots import ContactDrawing, FeatureInset
 from .results import ResultView
 from .scales import DisplayScales
 from .state import QUANTITIES, QUANTITY_UNITS
@@ -35,6 +38,10 @@ from .state import QUANTITIES, QUANTITY_UNITS
 SYMBOLS = {"settlement": "δ", "tilt": "α", "force": "P", "moment": "M"}
 TITLES = {"settlement": "Settlement", "tilt": "Tilt", "force": "Force", "moment": "Moment"}
 UNKNOWN_COLOR = "#1f77b4"
+#: What the shaded strips of q(x) are: negative pressure of the full-contact model, or
+#: the parts a unilateral solve lifted off (q = 0 there).
+LOST_LABEL = "q < 0 (contact lost)"
+LIFTED_LABEL = "lifted off (q = 0)"
 GIVEN_COLOR = "#8c8c8c"
 PINNED_COLOR = "#d62728"
 
@@ -49,12 +56,6 @@ PRESENTATION_FONT = "18px"
 #: Longest scene name shown in the drawing's title [characters]: a Bokeh title does not
 #: wrap, and at 1024 px a longer one was cut off.
 TITLE_CHARS = 40
-
-
-def f32(values: object) -> np.ndarray:
-    """Plot data as float32: half the bytes to the page, and 7 significant digits, more
-    than a screen resolves (the files keep the full numbers)."""
-    return np.asarray(values, dtype=np.float32)
 
 
 def short(text: str, limit: int = TITLE_CHARS) -> str:
@@ -78,28 +79,6 @@ def _empty(*columns: str) -> dict[str, list]:
     return {c: [] for c in columns}
 
 
-def _same(old: object, new: object) -> bool:
-    try:
-        return bool(np.array_equal(np.asarray(old, dtype=float), np.asarray(new, dtype=float),
-                                   equal_nan=True))
-    except (TypeError, ValueError):  # text columns, ragged lists: assume changed
-        return False
-
-
-def set_data(source: ColumnDataSource, data: dict) -> bool:
-    """Give ``source`` new ``data`` unless it holds the same numbers already; True if set.
-
-    Bokeh sends every assignment to the page, which redraws the glyphs behind it. A load
-    step leaves the drawing, the pinned curves and the given histories as they were:
-    resending them cost the server and the browser work for nothing.
-    """
-    old = source.data
-    if old.keys() == data.keys() and all(_same(old[k], v) for k, v in data.items()):
-        return False
-    source.data = data
-    return True
-
-
 class Figures:
     """All figures of one session and the sources behind them."""
 
@@ -110,6 +89,12 @@ class Figures:
         self._build_pressure()
         self._build_image()
         self._build_histories()
+        # the contact zone under the punch, the width history (its time axis shared with
+        # the other histories) and the inset of small features
+        self.contact = ContactDrawing(self.scene_fig, self.history_fig["settlement"].x_range)
+        self.contact_fig = self.contact.width_fig
+        self.inset = FeatureInset()
+        self.inset_fig = self.inset.fig
 
     # -- construction ----------------------------------------------------------------
     def _build_scene(self) -> None:
@@ -168,8 +153,9 @@ class Figures:
         self.q_src = ColumnDataSource({"x": [0.0], "q": [0.0]}, name="q_source")
         self.q_pin_src = ColumnDataSource(_empty("x", "q"), name="q_pin_source")
         self.neg_src = ColumnDataSource(_empty("left", "right"), name="negative_source")
-        p.vstrip(x0="left", x1="right", source=self.neg_src, fill_color="#d62728",
-                 fill_alpha=0.18, line_color=None, legend_label="q < 0 (contact lost)")
+        self.neg_strip = p.vstrip(x0="left", x1="right", source=self.neg_src,
+                                  fill_color="#d62728", fill_alpha=0.18, line_color=None,
+                                  legend_label=LOST_LABEL)
         p.add_layout(Span(location=0, dimension="width", line_color="#555", line_width=1))
         self.q_pin_line = p.line(x="x", y="q", source=self.q_pin_src, line_color=PINNED_COLOR,
                                  line_dash="dashed", line_width=2, legend_label="pinned")
@@ -261,7 +247,9 @@ class Figures:
                          sort_keys=True, default=str)
         if key != self._scene_key:
             self._show_scene(view)
+            self.inset.show(view.geometry)
             self._scene_key = key
+        self.contact.show(view)
         self.scene_fig.title.text = f"Scene: {short(view.scene.get('name', ''))}"
         self._show_image(view)
         for q in QUANTITIES:
@@ -306,6 +294,7 @@ class Figures:
         set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
                                 "right": [hi for _, hi in intervals]})
         self.q_fig.title.text = f"Pressure q(x), t = {t:.4g} days"
+        self._label_strips(view)
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
         self._show_pinned_pressure(view, pinned, index)
@@ -316,6 +305,13 @@ class Figures:
             set_data(self.history_point_src[name],
                      {"t": [t], "v": [float(view.display(name)[index])]})
         self._show_arrow(view, index)
+        self.contact.show_time(view, index)
+
+    def _label_strips(self, view: ResultView) -> None:
+        label = LIFTED_LABEL if view.info.get("contact") == "unilateral" else LOST_LABEL
+        for item in self.q_fig.legend[0].items:
+            if self.neg_strip in item.renderers and item.label != fixed_label(label):
+                item.label = fixed_label(label)
 
     def set_classical(self, view: ResultView | None, index: int, shown: bool) -> None:
         """Show or hide the classical answers on the pressure plot."""
@@ -342,7 +338,7 @@ class Figures:
     def all_figures(self) -> list:
         """Every figure of the session."""
         return [self.scene_fig, self.q_fig, self.image_fig,
-                *(self.history_fig[q] for q in QUANTITIES)]
+                *(self.history_fig[q] for q in QUANTITIES), self.contact_fig, self.inset_fig]
 
     def set_presentation(self, on: bool) -> None:
         """Fonts a projector shows from the back of a room (ticks and labels of
@@ -360,7 +356,8 @@ class Figures:
         legend.glyph_width = 14 if on else 20
         for q in QUANTITIES:
             self.history_fig[q].height = 170 if on else 210
-        self.scene_fig.height = 240 if on else 300
+        self.scene_fig.height = self.inset_fig.height = 240 if on else 300
+        self.contact_fig.height = 170 if on else 210
         self.q_fig.height = self.image_fig.height = 240 if on else 280
 
     def _show_arrow(self, view: ResultView, index: int) -> None:
@@ -423,6 +420,7 @@ class Figures:
         bottom_y = scale * (g.shape - lift)
         punch_top = float(np.max(bottom_y)) + 0.35 * a
         self._punch_top = punch_top
+        self.contact.set_surface(g.x, scale * total)
         self.punch_src.data = {"x": np.concatenate([g.x, [a, -a]]),
                                "y": np.concatenate([bottom_y, [punch_top, punch_top]])}
         self.scene_fig.x_range.update(start=-1.55 * a, end=1.55 * a)

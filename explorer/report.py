@@ -15,6 +15,7 @@ from datetime import datetime, timezone
 
 import numpy as np
 
+from .contact_zone import contact_text, contact_widths, lifts_off
 from .design import DesignLimits, check_html, design_check
 from .exports import accuracy_statement, flag_lines, project_version
 from .results import ResultView
@@ -125,6 +126,12 @@ def report_html(view: ResultView, limits: DesignLimits | None = None,
         role = "given" if q in view.given else "computed"
         plots.append(_svg_line(view.times, [(view.display(q), "#1f77b4")],
                                f"{q} [{u}] ({role})", "t [days after loading]", u))
+    if lifts_off(view):
+        widths = contact_widths(view)
+        lifted = 2 * view.geometry.half_width - widths
+        plots.append(_svg_line(view.times, [(widths, "#08306b"), (lifted, "#d62728")],
+                               "contact width (navy) and lift-off length (red) [m]",
+                               "t [days after loading]", "m", "report-contact"))
     stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     title = html.escape(str(view.scene.get("name", "scene")))
     return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>Report: {title}"
@@ -136,6 +143,8 @@ def report_html(view: ResultView, limits: DesignLimits | None = None,
             f"<h2>Accuracy</h2><p class='report-accuracy'>"
             f"{html.escape(accuracy_statement(view))}</p>"
             f"<h2>Design check</h2>{check_html(design_check(view, limits))}"
+            f"<p class='report-contact-text'>At t = {t:.4g} days: "
+            f"{html.escape(contact_text(view, index))}</p>"
             f"<h2>Inputs</h2>{_inputs(view)}"
             f"<h2>Drawing and plots</h2><div class='plots'>{''.join(plots)}</div>"
             f"<h2>Units</h2><p>x in m from the punch centre; t in days after loading; "

@@ -9,11 +9,13 @@ import panel as pn
 import param
 
 from .. import exports
+from ..contact_zone import contact_text, lifts_off
 from ..design import check_html, design_check
 from ..results import ResultView
 from ..state import QUANTITIES, QUANTITY_UNITS
 from ..status import status_html
 from ..widgets import NAMES
+from .contact import ContactPanes
 from .style import html_pane
 
 if TYPE_CHECKING:
@@ -42,7 +44,13 @@ def badges_html(view: ResultView | None, group: str) -> str:
     if view is None:
         return ""
     parts = []
+    lifted = group == "pressure" and lifts_off(view) and "contact_lost" not in view.flags
+    if lifted:  # a unilateral solve: no q < 0, and no full contact either
+        parts.append('<span class="cp-badge cp-bad lift-off">⚠ lift-off: part of the base '
+                     'carries no load (shaded)</span>')
     for flag, (bad, good) in BADGES[group].items():
+        if lifted and flag == "contact_lost":
+            continue
         if flag in view.flags:
             message = html.escape(exports.flag_message(view, flag))
             parts.append(f'<span class="cp-badge cp-bad flag-{flag}" title="{message}">'
@@ -75,8 +83,10 @@ def readout_html(view: ResultView | None, index: int, pinned: ResultView | None)
         rows.append(row + "</tr>")
     force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
     ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
+    contact = html.escape(contact_text(view, index))
     return (f"<div class='readout'><b>At t = {t:.4g} days after loading</b> · {ecc}"
-            f"<table class='cp-readout'>{''.join(rows)}</table></div>")
+            f"<table class='cp-readout'>{''.join(rows)}</table>"
+            f"<div class='contact-readout'>{contact}</div></div>")
 
 
 class ResultsView:
@@ -123,6 +133,7 @@ class ResultsView:
         bokeh = {"sizing_mode": "stretch_width", "margin": (0, 5)}
         self._bokeh_panes = [pn.pane.Bokeh(fig, **bokeh) for fig in (
             f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES))]
+        self.contact_panes = ContactPanes(f, self._bokeh_panes)
 
     def content(self) -> pn.Column:
         """The main column of the page."""
@@ -134,7 +145,7 @@ class ResultsView:
             pn.Row(self.spinner, self.status, sizing_mode="stretch_width"),
             self.status_badges,
             self.scene_badges,
-            scene_pane,
+            pn.Row(scene_pane, self.contact_panes.inset_slot, sizing_mode="stretch_width"),
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
@@ -144,6 +155,7 @@ class ResultsView:
             self.design,
             self.history_badges,
             pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
+            self.contact_panes.width_slot,
             sizing_mode="stretch_width",
         )
 
@@ -151,6 +163,7 @@ class ResultsView:
         """Show a new result at output time ``index`` (call inside ``pn.io.hold()``)."""
         app = self.app
         app.figures.show(view, index, app.pinned)
+        self.contact_panes.update(view)
         if new_range:
             self._replace_player(max(len(view.times) - 1, 1), index)
         else:

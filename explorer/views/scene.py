@@ -9,6 +9,7 @@ import panel as pn
 from ..presets import preset_label
 from ..state import STATEMENTS
 from ..widgets import NAMES, HistoryEditor
+from .eccentricity import EccentricityControl
 from .style import TAB_COLUMN, html_pane
 
 if TYPE_CHECKING:
@@ -47,6 +48,7 @@ class SceneView:
         s.loading.param.watch(self.refresh, "statement")
         self.history_editors = (HistoryEditor("load-0"), HistoryEditor("load-1"))
         self.unknowns_note = html_pane("", styles={"font-size": "13px"})
+        self.eccentric_load = EccentricityControl(app)
         self.refresh()
 
     def content(self) -> pn.Column:
@@ -55,8 +57,8 @@ class SceneView:
             self.preset, pn.Row(self.undo_button, self.reset_button),
             self.preset_description,
             html_pane("<b>Loading</b> (updates while you drag)", margin=(10, 10, 0, 10)),
-            self.statement, self.history_editors[0].panel, self.history_editors[1].panel,
-            self.unknowns_note, **TAB_COLUMN)
+            self.statement, self.eccentric_load.panel, self.history_editors[0].panel,
+            self.history_editors[1].panel, self.unknowns_note, **TAB_COLUMN)
 
     def _preset_text(self) -> str:
         key = getattr(self, "preset", None) and self.preset.value

@@ -1,0 +1,209 @@
+"""The contact zone on screen: the bar under the punch, the contact width over time, the
+readout, and the inset of small features (state level, no browser)."""
+
+from __future__ import annotations
+
+import json
+from functools import cache
+
+import numpy as np
+import pytest
+
+from explorer.contact_zone import contact_text, contact_widths, contact_zones
+from explorer.controller import SolveController
+from explorer.plots import Figures
+from explorer.presets import presets
+from explorer.results import ResultView
+from explorer.state import ExplorerState
+
+
+@cache
+def _solved(key: str) -> ResultView:
+    state = ExplorerState()
+    state.load_scene(json.loads(json.dumps(presets()[key])))
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    assert controller.view is not None, controller.error
+    return controller.view
+
+
+def _drawn(key: str, index: int = -1) -> tuple[Figures, ResultView, int]:
+    view = _solved(key)
+    index = index % len(view.times)
+    figures = Figures()
+    figures.show(view, index, None)
+    return figures, view, index
+
+
+def test_the_bar_under_the_punch_is_the_contact_set_and_follows_the_time() -> None:
+    figures, view, last = _drawn("eccentric_footing_liftoff")
+    drawing = figures.contact
+    (start, end), = view.contact_set[last]           # one zone, at the toe
+    (xs,) = drawing.zone_src.data["xs"]
+    assert (xs[0], xs[-1]) == (start, end)
+    (lifted,) = drawing.lifted_src.data["xs"]
+    assert (lifted[0], lifted[-1]) == (-1.0, start)  # the heel, drawn differently
+    # the bar lies on the coating's top as drawn (exaggerated thickness)
+    (ys,) = drawing.zone_src.data["ys"]
+    x, top = drawing._surface
+    assert np.allclose(ys, np.interp(xs, x, top))
+    # under creep the zone moves: the time slider moves the bar with it
+    figures.show_time(view, 0, None)
+    (xs0,) = drawing.zone_src.data["xs"]
+    assert xs0[0] == view.contact_set[0][0][0] != start
+    assert "contact 1.306 m of 2 m at t = 0 days" == drawing.zone_label.text
+
+
+def test_full_contact_draws_one_bar_over_the_whole_width() -> None:
+    figures, view, last = _drawn("uniform_flat")
+    data = figures.contact.zone_src.data
+    assert [(xs[0], xs[-1]) for xs in data["xs"]] == [(-1.0, 1.0)]
+    assert figures.contact.lifted_src.data["xs"] == []
+    assert figures.contact.zone_label.text.startswith("full contact")
+    # nothing lifts: the legend does not list the dashed part
+    assert [item.visible for item in figures.contact.scene_legend.items
+            if figures.contact.lifted_line in item.renderers] == [False]
+
+
+def test_the_width_plot_gives_the_zone_lengths_and_the_lifted_length_in_metres() -> None:
+    figures, view, _ = _drawn("eccentric_footing_liftoff")
+    a = view.geometry.half_width
+    expected = [sum(hi - lo for lo, hi in zones) for zones in view.contact_set]
+    data = figures.contact.width_src.data
+    # float32 on the page: 7 digits (relative 6e-8 of 2 m), far below a pixel
+    assert np.allclose(data["width"], expected, rtol=1e-6)
+    assert np.allclose(data["lifted"], 2 * a - np.asarray(expected), atol=1e-6)
+    assert np.allclose(data["t"], view.times, rtol=1e-6)
+    fig = figures.contact_fig
+    assert fig.yaxis[0].axis_label == "length [m]"
+    assert fig.xaxis[0].axis_label == "t [days after loading]"
+    tooltips = dict(fig.tools[-1].tooltips)
+    assert tooltips["contact width"].endswith(" m") and tooltips["t"].endswith(" days")
+    assert fig.title.text == "Contact width [m]: lift-off"
+    # under this creeping base the zone grows (the heel settles back) and then stays
+    assert expected[-1] > expected[0]
+
+
+def test_in_full_contact_the_width_plot_says_so() -> None:
+    figures, view, _ = _drawn("uniform_flat")
+    assert "full contact" in figures.contact_fig.title.text
+    assert np.all(contact_widths(view) == 2 * view.geometry.half_width)
+
+
+def test_the_readout_names_the_contact_zone() -> None:
+    from explorer.views.results import readout_html
+
+    view = _solved("eccentric_footing_liftoff")
+    text = readout_html(view, 0, None)
+    assert "contact 1.306 m of 2 m (65 %), lifted 0.694 m: x = -1 to -0.306 m" in text
+    assert contact_zones(view, 0) == view.contact_set[0]
+    assert "full contact" in contact_text(_solved("uniform_flat"), 0)
+
+
+@pytest.mark.parametrize(("key", "feature_um"), [
+    ("worn_coating", 20.0),      # a 20 µm wear bump in a 20 mm coating
+    ("stepped_punch", 15.0),     # outer parts of the base raised 15 µm
+    ("rounded_graded", 6.25),    # x^2 / 2R at the edge x = 0.5 m, 1/2R = 2.5e-5 / m
+])
+def test_small_features_show_in_the_inset_in_micrometres(key: str, feature_um: float) -> None:
+    figures, view, _ = _drawn(key)
+    inset = figures.inset_fig
+    assert inset.visible
+    data = figures.inset.src.data
+    gap = np.asarray(data["punch"]) - np.asarray(data["surface"])
+    # the 401-point drawing grid may miss the exact peak of a bump by 0.03 %
+    assert gap.max() == pytest.approx(feature_um, rel=1e-3)
+    assert gap.min() == pytest.approx(0.0, abs=1e-9)
+    assert inset.yaxis[0].axis_label == "height [µm]"
+    labels = [item.label["value"] for item in inset.legend[0].items
+              if figures.inset.gap_area in item.renderers]
+    assert labels == [f"gap before loading (≤ {gap.max():.3g} µm)"]
+
+
+def test_no_inset_without_small_features() -> None:
+    figures, _, _ = _drawn("uniform_flat")
+    assert not figures.inset_fig.visible
+
+
+def test_a_load_step_in_full_contact_resends_nothing_of_the_contact() -> None:
+    from explorer.app import ExplorerApp
+
+    app = ExplorerApp(executor=None)
+    sent = [0]
+    contact = app.figures.contact
+    for source in (contact.zone_src, contact.lifted_src, contact.width_src,
+                   contact.width_point, app.figures.inset.src):
+        source.on_change("data", lambda attr, old, new: sent.__setitem__(0, sent[0] + 1))
+    force = app.state.loading.histories["force"]
+    force.value = force.value * 1.1
+    assert app.controller.wait(60) and app.controller.error == ""
+    assert sent[0] == 0
+    # a force step changes the histories: the width plot's point moves, its data stays
+    assert app.figures.contact.width_point.data["t"] == [float(app.shown().times[-1])]
+
+
+def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
+    from bokeh.core.properties import value
+
+    from explorer.views.results import badges_html
+
+    view = _solved("eccentric_footing_liftoff")
+    badges = badges_html(view, "pressure")
+    assert "lift-off" in badges and "full contact" not in badges
+    assert "full contact" in badges_html(_solved("uniform_flat"), "pressure")
+    figures, _, _ = _drawn("eccentric_footing_liftoff")
+    labels = [item.label for item in figures.q_fig.legend[0].items
+              if figures.neg_strip in item.renderers]
+    assert labels == [value("lifted off (q = 0)")]
+    labels = [item.label for item in figures.contact.scene_legend.items
+              if figures.contact.lifted_line in item.renderers]
+    assert labels == [value("lifted off (gap open)")]
+
+
+def test_the_report_carries_the_contact_zone_and_its_history() -> None:
+    from explorer.report import report_html
+
+    text = report_html(_solved("eccentric_footing_liftoff"), index=0)
+    assert "At t = 0 days: contact 1.306 m of 2 m (65 %)" in text
+    assert "report-contact" in text and "lift-off length" in text
+    flat = report_html(_solved("uniform_flat"))
+    assert "full contact: the whole width" in flat and "report-contact'" not in flat
+
+
+def test_the_full_contact_model_marks_its_pull_zone_not_a_gap() -> None:
+    from bokeh.core.properties import value
+
+    scene = json.loads(json.dumps(presets()["eccentric_footing_liftoff"]))
+    scene["solver"]["contact"] = "full"
+    state = ExplorerState()
+    state.load_scene(scene)
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    view = controller.view
+    assert "contact_lost" in view.flags
+    figures = Figures()
+    figures.show(view, 0, None)
+    drawing = figures.contact
+    (lifted,) = drawing.lifted_src.data["xs"]
+    (lo, hi), = view.negative_intervals(0)   # where q < 0 beyond the error band
+    assert (lifted[0], lifted[-1]) == (lo, hi) and lo == -1.0
+    labels = [item.label for item in drawing.scene_legend.items
+              if drawing.lifted_line in item.renderers]
+    assert labels == [value("q < 0 (full-contact model)")]
+    assert "q < 0 (contact lost)" in contact_text(view, 0)
+
+
+def test_the_contact_figures_join_the_page_only_when_a_result_needs_them() -> None:
+    from explorer.app import ExplorerApp
+
+    app = ExplorerApp(executor=None)          # the default scene: full contact, flat
+    slots = app.results.contact_panes
+    assert not slots.width_slot.visible and slots.width_slot.objects == []
+    assert not slots.inset_slot.visible and slots.inset_slot.objects == []
+    for key, width, inset in (("eccentric_footing_liftoff", True, False),
+                              ("worn_coating", False, True), ("uniform_flat", False, False)):
+        assert app.load_scene(json.loads(json.dumps(presets()[key])))
+        assert app.controller.wait(120) and app.controller.error == ""
+        assert (slots.width_slot.visible, slots.inset_slot.visible) == (width, inset), key
+    # once sent, a figure stays on the page (hidden), ready for the next scene that needs it
+    assert len(slots.width_slot.objects) == len(slots.inset_slot.objects) == 1
