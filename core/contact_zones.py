@@ -123,12 +123,16 @@ class StepSolver:
     """
 
     _REFINE_STEPS = 12
+    _RESIDUAL = 1e-13
+    REFRESH_AFTER = 6
 
     def __init__(self) -> None:
         self._key: tuple | None = None
         self._lu = None
         self._sub: np.ndarray | None = None  # F on the contact nodes of _key
+        self._last: np.ndarray | None = None  # the last solution with these factors
         self.factorizations = 0
+        self.back_substitutions = 0
 
     def submatrix(self, op: np.ndarray, idx: np.ndarray, key: tuple) -> np.ndarray:
         """``op`` restricted to the nodes ``idx`` (kept while the contact nodes stay)."""
@@ -136,6 +140,7 @@ class StepSolver:
             self._sub = op[np.ix_(idx, idx)]
             self._key = key
             self._lu = None
+            self._last = None
         return self._sub
 
     def _back(self, r: np.ndarray) -> np.ndarray:
@@ -145,18 +150,30 @@ class StepSolver:
 
     def solve(self, build: Callable[[], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
               b: np.ndarray) -> np.ndarray:
-        """Solve ``A x = b`` for the matrix ``build()`` whose product is ``apply``."""
+        """Solve ``A x = b`` for the matrix ``build()`` whose product is ``apply``.
+
+        The refinement starts from the last solution on the same contact nodes (the next
+        step's is close to it) and stops at a residual of ``_RESIDUAL`` relative to ``b``.
+        """
+        if self._lu is None and self._sub is not None and self._last is not None:
+            self._lu = lu_factor(build(), check_finite=False)
+            self.factorizations += 1
         if self._lu is not None:
             scale = max(float(np.abs(b).max()), 1e-300)
-            x = self._back(b)
-            for _ in range(self._REFINE_STEPS):
+            x = self._last if self._last is not None else self._back(b)
+            for count in range(self._REFINE_STEPS):
                 r = b - apply(x)
-                if float(np.abs(r).max()) <= 1e-13 * scale:
+                if float(np.abs(r).max()) <= self._RESIDUAL * scale:
+                    self._last = x
+                    if count > self.REFRESH_AFTER:
+                        self._lu = None  # c/s has drifted: new factors next time
                     return x
                 x = x + self._back(r)
+                self.back_substitutions += 1
         self._lu = lu_factor(build(), check_finite=False)
         self.factorizations += 1
-        return self._back(b)
+        self._last = self._back(b)
+        return self._last
 
 
 def _bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, step: Step,
@@ -185,11 +202,14 @@ def _bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray,
     border_rows = np.array(rows).reshape(k, n)
     key = (idx.tobytes(), tuple(sorted(given)))
     sub = op[np.ix_(idx, idx)] if solver is None else solver.submatrix(op, idx, key)
-    diagonal = step.c * m[idx]
+    # Divided by the weight s of F, the system depends on c and s only through c/s (and
+    # the border unknowns come out divided by s): kept factors then precondition the
+    # next steps up to the change of c/s alone.
+    diagonal = (step.c / step.scale) * m[idx]
 
     def build() -> np.ndarray:
         a = np.zeros((n + k, n + k))
-        a[:n, :n] = step.scale * sub
+        a[:n, :n] = sub
         a[np.arange(n), np.arange(n)] += diagonal
         a[:n, n:] = border_cols
         a[n:, :n] = border_rows
@@ -197,11 +217,12 @@ def _bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray,
 
     def apply(z: np.ndarray) -> np.ndarray:
         zq = z[:n]
-        top = diagonal * zq + step.scale * (sub @ zq) + border_cols @ z[n:]
+        top = diagonal * zq + sub @ zq + border_cols @ z[n:]
         return np.concatenate([top, border_rows @ zq])
 
-    b = np.concatenate([rhs[idx], extra])
+    b = np.concatenate([rhs[idx] / step.scale, extra])
     sol = np.linalg.solve(build(), b) if solver is None else solver.solve(build, apply, b)
+    sol[n:] *= step.scale
     tail = list(sol[n:])
     delta = tail.pop(0) if "settlement" not in given else given["settlement"]
     alpha = tail.pop(0) if "tilt" not in given else given["tilt"]
