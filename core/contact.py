@@ -103,28 +103,51 @@ class UnilateralSolution(SolveOutcome):
         if x.ndim != 1 or np.any(~np.isfinite(x)) or np.any(np.abs(x) > 1.0):
             raise ValueError("x: pressure is defined on [-1, 1] only")
         out = np.zeros((x.size, len(self._snapshots)))
+        # Snapshots on one panel rule (every time of a creep solve) share the rows of F
+        # at x: one evaluation of them and one matrix product for all times.
+        rows: dict[int, np.ndarray] = {}
         for k, snap in enumerate(self._snapshots):
             inside = np.zeros(x.size, dtype=bool)
+            at_end = np.zeros(x.size, dtype=bool)
             for lo, hi in snap.zones:
                 inside |= (x >= lo) & (x <= hi)
+                at_end |= (x == lo) | (x == hi)
             if not inside.any():
                 continue
-            memory_at = None
-            if snap.memory is not None:
-                from core.quadrature import operator_rows
+            if snap.memory is None:
+                key = id(snap.panels)
+                if key not in rows:
+                    from core.quadrature import operator_rows
 
-                def memory_at(t, _v=snap.memory, _p=snap.panels):
-                    return operator_rows(self._space.lam, _p, t) @ _v
-            xi = x[inside]
-            # Sample m and g from inside the zone at its ends (they may jump there).
-            inward = np.zeros(xi.size)
-            for lo, hi in snap.zones:
-                inward[xi == lo] = 1.0
-                inward[xi == hi] = -1.0
-            values = nystrom_pressure(self._space, snap.step, snap.panels, snap.q,
-                                      snap.settlement, snap.tilt, xi, inward, memory_at)
-            out[inside, k] = np.maximum(values, 0.0)
+                    rows[key] = operator_rows(self._space.lam, snap.panels, x)
+                xi = x[inside]
+                fq = rows[key][inside] @ snap.q
+                values = (snap.settlement + snap.tilt * xi - self._space.g(xi)
+                          - snap.step.scale * fq) / (snap.step.c * self._space.m(xi))
+                out[inside, k] = np.maximum(values, 0.0)
+                # m and g sampled from inside the zone where it ends on a jump of them
+                at_end &= np.isin(x, self._space.breakpoints)
+                if at_end.any():
+                    out[at_end, k] = self._pressure_one(snap, x[at_end])
+                continue
+            out[inside, k] = self._pressure_one(snap, x[inside])
         return out
+
+    def _pressure_one(self, snap: _Snapshot, xi: np.ndarray) -> np.ndarray:
+        memory_at = None
+        if snap.memory is not None:
+            from core.quadrature import operator_rows
+
+            def memory_at(t, _v=snap.memory, _p=snap.panels):
+                return operator_rows(self._space.lam, _p, t) @ _v
+        # Sample m and g from inside the zone at its ends (they may jump there).
+        inward = np.zeros(xi.size)
+        for lo, hi in snap.zones:
+            inward[xi == lo] = 1.0
+            inward[xi == hi] = -1.0
+        values = nystrom_pressure(self._space, snap.step, snap.panels, snap.q,
+                                  snap.settlement, snap.tilt, xi, inward, memory_at)
+        return np.maximum(values, 0.0)
 
 
 def contact_set_from_pressure(x: Sequence[float] | np.ndarray, q: np.ndarray, *,
@@ -408,6 +431,55 @@ def check_contact_model(contact: object) -> str:
         raise ValueError(f"contact: must be one of {', '.join(CONTACT_MODELS)}, "
                          f"got {contact!r}")
     return contact
+
+
+def predicted_unilateral(arguments: dict[str, Any]):
+    """The unilateral answer when a cheap check shows full contact lost, else None.
+
+    ``contact="auto"`` would solve full contact over all times and then, finding q < 0,
+    solve again with lift-off: under creep the first solve is wasted work (it roughly
+    doubled the cost of a 100-time scene). The check solves full contact at the first
+    time only, elastic at the loading instant: from the prepared geometry the default
+    engine would use (shared with it: a later full solve reuses it), a few ms cold. Only
+    a pressure the full-contact model itself flags ``contact_lost`` counts. Applies to an
+    elastic base (any first time) and to creep when the first time is t = 1 (at
+    loading the base is elastic); otherwise, or when no unilateral answer exists (loads
+    pulling the punch away) or the check fails on the input, returns None and the caller
+    takes the full-contact path, whose messages and flags then speak.
+    ``arguments`` are those of :func:`solve_unilateral`.
+    """
+    from core.inputs import validate_time_inputs
+    from core.prepared import solve_with_prepared
+
+    loads = {k: arguments.get(k) for k in ("settlement", "tilt", "force", "moment")}
+    try:
+        inputs = validate_time_inputs(arguments["times"], arguments.get("c", 1.0),
+                                      arguments.get("kernel"), loads)
+        first = float(inputs.times[0])
+        if inputs.kernel is not None and first != 1.0:
+            return None
+        at = np.array([first])
+        values = {k: float(inputs.loads[k](at)[0]) for k in inputs.given}
+        check = solve_with_prepared(arguments["lam"], arguments["m"], arguments["g"], [first],
+                                    c=float(inputs.c(at)[0]),
+                                    breakpoints=arguments.get("breakpoints", ()),
+                                    tol=arguments.get("tol", 1e-8), **values)
+    except ValueError:
+        return None
+    if "contact_lost" not in check.info["flags"]:
+        return None
+    try:
+        result = solve_unilateral(**arguments)
+    except ValueError:
+        return None
+    result.info["full_contact"] = {
+        "flags": list(check.info["flags"]),
+        "min_pressure": check.info.get("min_pressure"),
+        "seconds": check.info.get("seconds"),
+        "checked_at": first,
+    }
+    result.info["seconds"] += float(check.info.get("seconds", 0.0))
+    return result
 
 
 def with_contact_model(full, contact: str, arguments: dict[str, Any]):

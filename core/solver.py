@@ -160,6 +160,12 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                                breakpoints=breakpoints, tol=tol)
         if contact == "unilateral":
             return solve_unilateral(**unilateral_args)
+        if contact == "auto":
+            from core.contact import predicted_unilateral
+
+            predicted = predicted_unilateral(unilateral_args)
+            if predicted is not None:
+                return predicted
         try:
             full = solve_with_prepared(lam, m, g, times, c=c, kernel=kernel,
                                        settlement=settlement, tilt=tilt, force=force,
