@@ -54,7 +54,7 @@ _WIDTH = 0.5
 _EDGE = 1e-2
 #: The fixed rule of creep steps: interior panels at most this wide, graded to this width
 #: at +-1 and the breakpoints (finer for a thin coating).
-_CREEP_WIDTH = 0.125
+_CREEP_WIDTH = 0.5
 _CREEP_EDGE = 1e-2
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
