@@ -52,8 +52,10 @@ FULL_CONTACT: list[tuple[float, float]] = [(-1.0, 1.0)]
 _NODAL_WIDTH = 0.25
 _WIDTH = 0.5
 _EDGE = 1e-2
-#: The fixed rule of creep steps: interior panels at most this wide, graded to this width
-#: at +-1 and the breakpoints (finer for a thin coating).
+#: The base of the fixed rule of creep steps: panels at most this wide, graded to this
+#: width at +-1 and the breakpoints (finer for a thin coating); the bands the zone ends
+#: sweep get finer panels (core/contact_bands.py: outside them 0.5 and 0.0625 gave the
+#: same ends to 1e-14 on the lift-off preset).
 _CREEP_WIDTH = 0.5
 _CREEP_EDGE = 1e-2
 
@@ -274,10 +276,6 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     else:
         from core.contact_creep import solve_creep
 
-        # The zone ends move through the interior panels of the fixed rule of the steps:
-        # their width sets the error of the ends (measured at t = 1 on the lift-off
-        # preset: 1.3e-4 half-widths for panels 0.25 wide, 2.1e-5 for 0.125, 2.7e-6 for
-        # 0.0625, with 256, 352, 576 nodes).
         creep_res = Resolution(min(_CREEP_WIDTH, 3.0 / inp.lam), max(res.edge, min(
             _CREEP_EDGE, 0.25 * float(np.min(m_probe)))))
         out = solve_creep(space, inp, c_t, loads, creep_res,
