@@ -47,9 +47,8 @@ MAX_END_ITERATIONS = 25
 MAX_LEVELS = 4
 
 _T, _W = npleg.leggauss(NODES_PER_PANEL)
-# Node values on a panel -> Legendre coefficients of their interpolant.
-_TO_COEF = (npleg.legvander(_T, NODES_PER_PANEL - 1) * _W[:, None]).T * (
-    np.arange(NODES_PER_PANEL) + 0.5)[:, None]
+# Barycentric weights of the Gauss-Legendre nodes: (-1)^j sqrt((1 - t_j^2) w_j).
+_BARYCENTRIC = (-1.0) ** np.arange(NODES_PER_PANEL) * np.sqrt((1.0 - _T**2) * _W)
 
 
 @dataclass(frozen=True)
@@ -282,10 +281,6 @@ def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarra
     return NodalState(panels, q, delta, alpha, active, nystrom), sweeps, settled
 
 
-def _panel_interpolant(panels: Panels, values: np.ndarray, p: int) -> np.ndarray:
-    return _TO_COEF @ values[p * NODES_PER_PANEL:(p + 1) * NODES_PER_PANEL]
-
-
 def _crossing(panels: Panels, values: np.ndarray, i: int) -> float:
     """Where the nodal function ``values`` changes sign between nodes i and i + 1."""
     x = panels.nodes
@@ -294,11 +289,17 @@ def _crossing(panels: Panels, values: np.ndarray, i: int) -> float:
     linear = float(x[i] - fa * (x[i + 1] - x[i]) / (fb - fa)) if fb != fa else float(x[i])
     if p != p1:
         return linear
-    coef = _panel_interpolant(panels, values, p)
     c, h = panels.centers[p], panels.half_widths[p]
+    local = values[p * NODES_PER_PANEL:(p + 1) * NODES_PER_PANEL]
 
     def f(xx: float) -> float:
-        return float(npleg.legval((xx - c) / h, coef))
+        # barycentric form of the panel's interpolant: O(16), stable (Gauss nodes)
+        d = (xx - c) / h - _T
+        hit = np.nonzero(d == 0.0)[0]
+        if hit.size:
+            return float(local[hit[0]])
+        ratio = _BARYCENTRIC / d
+        return float(ratio @ local / ratio.sum())
 
     ya, yb = f(x[i]), f(x[i + 1])
     if ya == 0.0:
