@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from core.cache import StageCache
 from core.contact_solution import SolveOutcome
 from core.contact_zones import (
     ZONE_END_TOL,
@@ -286,13 +287,32 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
                               out["snapshots"])
 
 
+#: The operator of the nodal rule depends on lam and the panels only (not on m, g or the
+#: loads): kept, so that moving a load (the explorer's eccentricity slider) rebuilds only
+#: what the zone ends need.
+_NODAL_OPERATORS = StageCache("contact_nodal_operator", max_items=8, max_bytes=64 * 2**20)
+
+
+def nodal_operator(lam: float, breakpoints: tuple[float, ...], res: Resolution
+                   ) -> tuple[Panels, np.ndarray]:
+    """The panels of ``res`` on [-1, 1] and the Nystrom matrix of F there (cached)."""
+    key = (float(lam), tuple(float(b) for b in breakpoints), float(res.width),
+           float(res.edge))
+
+    def build() -> tuple[Panels, np.ndarray]:
+        panels = base_panels(lam, breakpoints, edge_width=res.edge, max_width=res.width)
+        matrix = kernel_operator(lam, panels).matrix
+        matrix.flags.writeable = False  # shared by every solve on this rule
+        return panels, matrix
+
+    return _NODAL_OPERATORS.get_or_compute(key, build)[0]
+
+
 def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
                    times: np.ndarray, nodal_res: Resolution, res: Resolution,
                    tol: float) -> dict[str, Any]:
     """Every time on its own (equal data solved once)."""
-    base = base_panels(space.lam, space.breakpoints, edge_width=nodal_res.edge,
-                       max_width=nodal_res.width)
-    op = kernel_operator(space.lam, base).matrix
+    base, op = nodal_operator(space.lam, space.breakpoints, nodal_res)
     m_nodes = space.m(base.nodes)
     g_nodes = space.g(base.nodes)
     results: dict[tuple, tuple] = {}

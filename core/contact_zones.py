@@ -514,6 +514,15 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
                 if np.max(np.abs(ds)) < 1e-2 * ZONE_END_TOL:
                     converged = True
                     break
+                # The step the updated Jacobian would take next: when it is already far
+                # below the tolerance the solve it needs is not made (one build saved).
+                try:
+                    ahead = float(np.max(np.abs(np.linalg.solve(jac, r))))
+                except np.linalg.LinAlgError:
+                    ahead = np.inf
+                if ahead < 1e-2 * ZONE_END_TOL:
+                    converged = True
+                    break
         fine = solve_on_zones(space, step, ends, res.coarser())
         builds += 1
         if free:
