@@ -74,13 +74,14 @@ def band_rule(space: Space, res: Resolution, bands: Sequence[tuple[float, float]
     for lo, hi in bands:
         inside |= (base.edges > lo - 0.3 * width) & (base.edges < hi + 0.3 * width)
     near_added = np.min(np.abs(base.edges[:, None] - added_arr[None, :]), axis=1) < 0.3 * width
-    # Base edges inside a band go unless they are hard or belong to the (finer) grading.
+    # Base edges inside a band go unless they are hard or belong to a grading finer than
+    # the band panels (toward +-1 or a breakpoint).
     fine = np.zeros(base.edges.size, dtype=bool)
     widths = np.diff(base.edges)
-    fine[:-1] |= widths < 0.5 * width
-    fine[1:] |= widths < 0.5 * width
+    fine[:-1] |= widths < width
+    fine[1:] |= widths < width
     is_hard = np.isin(base.edges, hard)
-    keep = is_hard | ~(inside | near_added) | (fine & ~near_added)
+    keep = is_hard | ~(inside | near_added) | fine
     edges = np.unique(np.concatenate([base.edges[keep], added_arr]))
     # Merge what is left closer than a tenth of a band panel (never a hard point).
     merged = [edges[0]]

@@ -365,6 +365,32 @@ def _creep_rule_march(pb, tol, rule_for, level=0):
     return np.array([e[0] for e in out["ends"]]), out
 
 
+def test_band_rule_covers_the_bands_finely_and_keeps_the_breaks():
+    from core.contact_bands import band_rule, bands_from_ends
+
+    space = Space(1.0, constant(0.05), constant(0.0), (-0.5, 0.3))
+    res = Resolution(0.5, 1e-2)
+    # ends pinned at +-1 and at the breakpoints need no band; free ones get one each,
+    # merged where their margins overlap
+    bands = bands_from_ends([[-1.0, -0.31, 0.3, 0.97], [-1.0, -0.30, 0.3, 0.985]],
+                            space.breakpoints)
+    assert len(bands) == 2 and bands[0][0] < -0.31 and bands[0][1] > -0.30
+    assert bands[1][1] == 1.0
+    panels = band_rule(space, res, bands, 0.02)
+    edges = panels.edges
+    assert edges[0] == -1.0 and edges[-1] == 1.0 and np.all(np.diff(edges) > 0.0)
+    for b in space.breakpoints:
+        assert np.any(edges == b)
+    widths = np.diff(edges)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    for lo, hi in bands:
+        inside = (centres > lo) & (centres < hi)
+        assert inside.any() and np.all(widths[inside] <= 0.02 + 1e-12)
+    # the edge grading at +-1 survives next to a band
+    assert widths[-1] <= 1e-2 + 1e-12 and widths[0] <= 1e-2 + 1e-12
+    assert abs(np.sum(panels.weights) - 2.0) < 1e-13
+
+
 def test_creep_zone_ends_converge_over_the_band_and_the_space_estimate_holds():
     # The preset at 5 output times, one time grid: the free end on rules with panels
     # 0.04, 0.02, 0.01 wide over the band it sweeps, against 0.0025. Measured largest
