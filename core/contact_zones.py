@@ -370,6 +370,7 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
     jac = np.diag([s / sol.q_scale if s != 0.0 else 1.0 for s in
                    (slopes[k] for k in free)]) if free else np.zeros((0, 0))
     converged = not free
+    unmade = 0.0  # the step the root-find judged too small to make (added to the estimate)
     end_error = output_error = np.inf
     level = 0
     for _ in range(max_levels):
@@ -377,6 +378,7 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
         if free:
             r = sol.end_values[free] / sol.q_scale
             converged = False
+            unmade = 0.0
             for _ in range(MAX_END_ITERATIONS):
                 if np.max(np.abs(r)) < 1e-15:
                     converged = True  # at the root to rounding: no step can improve it
@@ -409,8 +411,9 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
                     ahead = float(np.max(np.abs(np.linalg.solve(jac, r))))
                 except np.linalg.LinAlgError:
                     ahead = np.inf
-                if ahead < 1e-2 * ZONE_END_TOL:
+                if ahead < 1e-2 * min(ZONE_END_TOL, tol):
                     converged = True
+                    unmade = ahead
                     break
         fine = solve_on_zones(space, step, ends, res.coarser())
         builds += 1
@@ -420,7 +423,7 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
                 shift = -np.linalg.solve(jac, r_fine)
             except np.linalg.LinAlgError:
                 shift = np.full(len(free), np.inf)
-            end_error = float(np.max(np.abs(shift)))
+            end_error = float(np.max(np.abs(shift))) + unmade
         else:
             end_error = 0.0
         kin = max(abs(sol.settlement), abs(sol.tilt), 1e-300)
