@@ -228,10 +228,11 @@ def main() -> None:
         "100 output times under creep, on a quiet machine; the CPU time of this process "
         "stands for that when the machine is loaded (the wall clock then reads several "
         "times slow).", "",
-        "Elastic: the solve builds the operator of the nodal rule once and about five "
-        "operators on the contact set (the root-find on the zone ends and the check "
-        "against a coarser rule); each build is dense in the kernel (N^2 evaluations and "
-        "the near-field product weights), which is where the time goes. Through "
+        "Elastic: the solve builds the operator of the nodal rule (kept: it depends on lam "
+        "and the panels only, so the slider row reuses it) and four or five operators on "
+        "the contact set (the root-find on the zone ends and the check against a coarser "
+        "rule); each build is dense in the kernel (N^2 evaluations and the near-field "
+        "product weights), which is where the time goes. Through "
         "`solve_dimensionless` a full-contact check at the first time comes first (the "
         "prepared geometry of the default engine, built cold here).", "",
         "Creep (the 100-time preset): a first march on 12 of the output times finds the "
