@@ -35,19 +35,27 @@ def bands_from_ends(ends: Sequence[Sequence[float]], breakpoints: Sequence[float
     """Intervals covering every free zone end of ``ends`` (one list of ends per time).
 
     Ends at +-1 or at a breakpoint are pinned there (a corner of the punch) and need no
-    band. Each free end's range, widened by ``margin``, is merged with overlapping ones.
+    band. Between consecutive times with as many ends, each free end is taken to have
+    travelled between its two places (the steps between them put their kinks there too).
+    Each range, widened by ``margin``, is merged with overlapping ones.
     """
     pinned = {-1.0, 1.0, *(float(b) for b in breakpoints)}
-    free = sorted(float(e) for row in ends for e in row
-                  if all(abs(float(e) - p) > 1e-12 for p in pinned))
+
+    def free(e: float) -> bool:
+        return all(abs(float(e) - p) > 1e-12 for p in pinned)
+
+    spans = [(float(e), float(e)) for row in ends for e in row if free(e)]
+    for before, after in zip(ends[:-1], ends[1:], strict=False):
+        if len(before) == len(after):
+            spans += [(min(a, b), max(a, b)) for a, b in zip(before, after, strict=True)
+                      if free(a) and free(b)]
     bands: list[list[float]] = []
-    for e in free:
-        lo, hi = max(e - margin, -1.0), min(e + margin, 1.0)
+    for lo, hi in sorted((max(a - margin, -1.0), min(b + margin, 1.0)) for a, b in spans):
         if bands and lo <= bands[-1][1]:
             bands[-1][1] = max(bands[-1][1], hi)
         else:
             bands.append([lo, hi])
-    return [(lo, hi) for lo, hi in bands]
+    return [(float(lo), float(hi)) for lo, hi in bands]
 
 
 def band_rule(space: Space, res: Resolution, bands: Sequence[tuple[float, float]],

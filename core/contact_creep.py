@@ -255,36 +255,18 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     end_tol = max(ZONE_END_TOL, tol)
     base, space_error, space_shift, band_note = _select_rule(space, inp, res, first_steps,
                                                              tol, end_tol)
-    op = kernel_operator(space.lam, base).matrix
-    m = space.m(base.nodes)
-    g = space.g(base.nodes)
-    plain: list[dict[str, Any]] = []
-    extrapolated: list[dict[str, Any]] = []
-    time_error = end_shift = np.inf
-    unsettled = 0
-    sweeps = steps = 0
-    for level in range(MAX_HALVINGS + 1):
-        grid, widths, index = time_grid(times, first_steps, level)
-        run = _march(space, inp, base, op, m, g, grid, widths, index)
-        unsettled, sweeps, steps = run["unsettled"], run["sweeps"], run["steps"]
-        plain.append(_outputs(run))
-        if len(plain) >= 2:
-            extrapolated.append(_extrapolate(plain[-1], plain[-2]))
-        if len(plain) == 2:
-            # Two grids: the extrapolated outputs are reported, with the error of the finer
-            # plain ones, |fine - coarse| / 3 (order 2), as a conservative estimate.
-            diff, shift = _distance(plain[-1], plain[-2])
-            time_error, end_shift = diff / 3.0, shift / 3.0
-            if time_error <= tol / 3 and end_shift <= end_tol / 3:
-                break
-        if len(extrapolated) >= 2:
-            diff, shift = _distance(extrapolated[-1], extrapolated[-2])
-            # Order 4 after one extrapolation: the newer one ~16 times closer.
-            time_error, end_shift = diff / 15.0, shift / 15.0
-            if time_error <= tol / 3 and end_shift <= end_tol / 3:
-                break
-    out = extrapolated[-1] if extrapolated else plain[-1]
+    out, time_error, end_shift, run = _in_time(space, inp, base, first_steps, tol, end_tol)
     strays = _outside_bands(out["ends"], band_note["bands"], space.breakpoints)
+    if strays:
+        # An end went where the first march did not see it (between its few times, or as
+        # a zone opening late): the bands of every output time, and everything again.
+        bands = _merge(band_note["bands"] + bands_from_ends(out["ends"], space.breakpoints))
+        base, space_error, space_shift, band_note = _select_rule(
+            space, inp, res, first_steps, tol, end_tol, bands=bands)
+        out, time_error, end_shift, run = _in_time(space, inp, base, first_steps, tol,
+                                                   end_tol)
+        strays = _outside_bands(out["ends"], band_note["bands"], space.breakpoints)
+    unsettled, sweeps, steps = run["unsettled"], run["sweeps"], run["steps"]
 
     error = float(time_error + space_error)
     end_error = float(end_shift + space_shift)
@@ -326,6 +308,49 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
             "info": info}
 
 
+def _in_time(space: Space, inp: Any, base: Panels, first_steps: int, tol: float,
+             end_tol: float) -> tuple[dict[str, Any], float, float, dict[str, Any]]:
+    """March on halved grids until the time estimate meets tol / 3 (module notes):
+    (outputs, their time error, the zone ends' time error, the last march)."""
+    op = kernel_operator(space.lam, base).matrix
+    m = space.m(base.nodes)
+    g = space.g(base.nodes)
+    plain: list[dict[str, Any]] = []
+    extrapolated: list[dict[str, Any]] = []
+    time_error = end_shift = np.inf
+    for level in range(MAX_HALVINGS + 1):
+        grid, widths, index = time_grid(inp.times, first_steps, level)
+        run = _march(space, inp, base, op, m, g, grid, widths, index)
+        plain.append(_outputs(run))
+        if len(plain) >= 2:
+            extrapolated.append(_extrapolate(plain[-1], plain[-2]))
+        if len(plain) == 2:
+            # Two grids: the extrapolated outputs are reported, with the error of the finer
+            # plain ones, |fine - coarse| / 3 (order 2), as a conservative estimate.
+            diff, shift = _distance(plain[-1], plain[-2])
+            time_error, end_shift = diff / 3.0, shift / 3.0
+            if time_error <= tol / 3 and end_shift <= end_tol / 3:
+                break
+        if len(extrapolated) >= 2:
+            diff, shift = _distance(extrapolated[-1], extrapolated[-2])
+            # Order 4 after one extrapolation: the newer one ~16 times closer.
+            time_error, end_shift = diff / 15.0, shift / 15.0
+            if time_error <= tol / 3 and end_shift <= end_tol / 3:
+                break
+    out = extrapolated[-1] if extrapolated else plain[-1]
+    return out, float(time_error), float(end_shift), run
+
+
+def _merge(bands: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    merged: list[list[float]] = []
+    for lo, hi in sorted(bands):
+        if merged and lo <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], hi)
+        else:
+            merged.append([lo, hi])
+    return [(float(lo), float(hi)) for lo, hi in merged]
+
+
 def _check_times(times: np.ndarray, count: int = 0) -> np.ndarray:
     """At most ``count`` (default ``CHECK_OUTPUTS``) of the output times, spread over them
     (the first and last kept)."""
@@ -336,7 +361,8 @@ def _check_times(times: np.ndarray, count: int = 0) -> np.ndarray:
 
 
 def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol: float,
-                 end_tol: float) -> tuple[Panels, float, float, dict[str, Any]]:
+                 end_tol: float, bands: list[tuple[float, float]] | None = None
+                 ) -> tuple[Panels, float, float, dict[str, Any]]:
     """The panel rule of the stepping and its spatial error (outputs, zone ends).
 
     On the first time grid of a few of the output times: a march on the base rule finds
@@ -357,13 +383,15 @@ def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol:
     # The bands need the ends only to well within their margin: fewer times and a
     # coarser grading at the edges do (ends within ~1e-4 of the finer rules' on the
     # preset), at a quarter of the cost of a check march.
-    locate = _check_times(inp.times, LOCATE_OUTPUTS)
-    grid_l, widths_l, index_l = time_grid(locate, first_steps, 0)
-    coarse = band_rule(space, Resolution(res.width, max(res.edge, LOCATE_EDGE)), [], 0.0)
-    op_l = kernel_operator(space.lam, coarse).matrix
-    located = _march(space, inp, coarse, op_l, space.m(coarse.nodes), space.g(coarse.nodes),
-                     grid_l, widths_l, index_l)
-    bands = bands_from_ends(_outputs(located)["ends"], space.breakpoints)
+    if bands is None:
+        locate = _check_times(inp.times, LOCATE_OUTPUTS)
+        grid_l, widths_l, index_l = time_grid(locate, first_steps, 0)
+        coarse = band_rule(space, Resolution(res.width, max(res.edge, LOCATE_EDGE)), [],
+                           0.0)
+        op_l = kernel_operator(space.lam, coarse).matrix
+        located = _march(space, inp, coarse, op_l, space.m(coarse.nodes),
+                         space.g(coarse.nodes), grid_l, widths_l, index_l)
+        bands = bands_from_ends(_outputs(located)["ends"], space.breakpoints)
     finer = Resolution(res.width / 2.0, res.edge)
     width = BAND_WIDTHS[0]
     rule = band_rule(space, res, bands, width)

@@ -433,6 +433,30 @@ def test_creep_zone_ends_to_1e_6_at_two_time_resolutions():
     assert gap <= runs[0].info["zone_end_error"] + runs[1].info["zone_end_error"], gap
 
 
+def test_creep_zone_opening_late_gets_its_band():
+    # The eccentricity grows from 0.3 to 0.5 over the first 20 time units: full contact
+    # first, lift-off later, the free end travelling from -1 inward. Every free end at
+    # every output time must lie in a finely paneled band (else the spatial estimate
+    # would not hold there and the run is flagged).
+    scene = json.loads(PRESET.read_text())
+    scene["times"] = {"end": 1000.0, "count": 12, "spacing": "log"}
+    pb = scene_from_dict(scene).dimensionless
+    force = pb.loads["force"]
+
+    def moment(t):
+        return (0.3 + 0.2 * np.clip((np.asarray(t) - 1.0) / 20.0, 0.0, 1.0)) * force(t)
+
+    r = solve_unilateral(pb.lam, pb.m, pb.g, pb.times, c=pb.c, kernel=pb.kernel,
+                         tol=1e-4, force=force, moment=moment)
+    assert r.success, r.message
+    assert r.contact_set[0] == [(-1.0, 1.0)]
+    assert r.contact_set[-1][0][0] > -0.9
+    for zones in r.contact_set:
+        for lo, _ in zones:
+            if lo > -1.0:
+                assert any(a <= lo <= b for a, b in r.info["end_bands"]), (lo, r.info)
+
+
 def test_separable_memory_agrees_with_the_general_kernel_path():
     # The aging kernel as a plain callable takes the trapezoid on K q (O(n) per step);
     # as a degenerate kernel, the recursion with exponential product integration. Both
