@@ -366,10 +366,12 @@ def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol:
     """The panel rule of the stepping and its spatial error (outputs, zone ends).
 
     On the first time grid of a few of the output times: a march on the base rule finds
-    the bands the free ends sweep; then a rule with band panels ``w`` is compared with one
-    where every panel is halved (``w / 2`` over the bands, half the base width), halving
-    ``w`` until ``SPACE_FACTOR`` times their difference meets a third of ``tol`` and of the
-    zone-end tolerance (or ``BAND_WIDTHS`` run out).
+    the bands the free ends sweep (unless ``bands`` are given); then a rule with band
+    panels ``w`` is compared with one where every panel is finer (``w / 2`` over the
+    bands, half the base width and half its grading at +-1 and the breakpoints, so that
+    a rule without bands is checked too), halving ``w`` until ``SPACE_FACTOR`` times
+    their difference meets a third of ``tol`` and of the zone-end tolerance (or
+    ``BAND_WIDTHS`` run out).
     """
     check = _check_times(inp.times)
     grid, widths, index = time_grid(check, first_steps, 0)
@@ -392,7 +394,8 @@ def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol:
         located = _march(space, inp, coarse, op_l, space.m(coarse.nodes),
                          space.g(coarse.nodes), grid_l, widths_l, index_l)
         bands = bands_from_ends(_outputs(located)["ends"], space.breakpoints)
-    finer = Resolution(res.width / 2.0, res.edge)
+    # every panel finer: the base width halved, its grading at +-1 and the breakpoints too
+    finer = Resolution(res.width / 2.0, res.edge / 2.0)
     width = BAND_WIDTHS[0]
     rule = band_rule(space, res, bands, width)
     current = march(rule)
