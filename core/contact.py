@@ -272,7 +272,7 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     space = Space(inp.lam, inp.m, inp.g, inp.breakpoints)
     m_probe = inp.m(np.linspace(-1.0, 1.0, 257))
     res = Resolution(min(_WIDTH, 3.0 / inp.lam), min(_EDGE, 0.25 * float(np.min(m_probe))))
-    nodal_res = Resolution(min(_NODAL_WIDTH, 3.0 / inp.lam), res.edge)
+    nodal_res = nodal_resolution(inp.lam, inp.m)
     if inp.kernel is None:
         out = _solve_elastic(space, c_t, loads, times_arr, nodal_res, res, inp.tol)
     else:
@@ -292,6 +292,13 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
 #: loads): kept, so that moving a load (the explorer's eccentricity slider) rebuilds only
 #: what the zone ends need.
 _NODAL_OPERATORS = StageCache("contact_nodal_operator", max_items=8, max_bytes=64 * 2**20)
+
+
+def nodal_resolution(lam: float, m: Callable[[np.ndarray], np.ndarray]) -> Resolution:
+    """The rule of the nodal active set: panels at most ``_NODAL_WIDTH`` (and 3/lam)
+    wide, graded to ``_EDGE`` at +-1 and the breakpoints, finer for a thin coating."""
+    m_probe = m(np.linspace(-1.0, 1.0, 257))
+    return Resolution(min(_NODAL_WIDTH, 3.0 / lam), min(_EDGE, 0.25 * float(np.min(m_probe))))
 
 
 def nodal_operator(lam: float, breakpoints: tuple[float, ...], res: Resolution

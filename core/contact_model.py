@@ -39,10 +39,12 @@ def predicted_unilateral(arguments: dict[str, Any]):
     takes the full-contact path, whose messages and flags then speak.
     ``arguments`` are those of :func:`solve_unilateral`.
     """
-    from core.inputs import validate_time_inputs
-    from core.prepared import solve_with_prepared
+    from core.inputs import validate_geometry, validate_time_inputs
+    from core.prepared import PREPARED, _geometry_key, solve_with_prepared
 
     loads = {k: arguments.get(k) for k in ("settlement", "tilt", "force", "moment")}
+    breakpoints = arguments.get("breakpoints", ())
+    tol = arguments.get("tol", 1e-8)
     try:
         inputs = validate_time_inputs(arguments["times"], arguments.get("c", 1.0),
                                       arguments.get("kernel"), loads)
@@ -51,26 +53,60 @@ def predicted_unilateral(arguments: dict[str, Any]):
             return None
         at = np.array([first])
         values = {k: float(inputs.loads[k](at)[0]) for k in inputs.given}
-        check = solve_with_prepared(arguments["lam"], arguments["m"], arguments["g"], [first],
-                                    c=float(inputs.c(at)[0]),
-                                    breakpoints=arguments.get("breakpoints", ()),
-                                    tol=arguments.get("tol", 1e-8), **values)
+        c_first = float(inputs.c(at)[0])
+        geometry = validate_geometry(arguments["lam"], arguments["m"], arguments["g"],
+                                     breakpoints, tol)
+        if inputs.kernel is None and PREPARED.get(_geometry_key(geometry)) is None:
+            # A new elastic geometry: preparing it for the check cost more than the
+            # unilateral solve itself; the unilateral solver's own nodal rule (kept for
+            # that solve) decides when contact is clearly lost.
+            seen = _nodal_check(geometry, c_first, values)
+            if seen is None:
+                return None
+            check_info = {"flags": ["contact_lost"], "min_pressure": seen, "seconds": 0.0,
+                          "check": "nodal rule"}
+        else:
+            check = solve_with_prepared(arguments["lam"], arguments["m"], arguments["g"],
+                                        [first], c=c_first, breakpoints=breakpoints,
+                                        tol=tol, **values)
+            if "contact_lost" not in check.info["flags"]:
+                return None
+            check_info = {"flags": list(check.info["flags"]),
+                          "min_pressure": check.info.get("min_pressure"),
+                          "seconds": check.info.get("seconds")}
     except ValueError:
-        return None
-    if "contact_lost" not in check.info["flags"]:
         return None
     try:
         result = solve_unilateral(**arguments)
     except ValueError:
         return None
-    result.info["full_contact"] = {
-        "flags": list(check.info["flags"]),
-        "min_pressure": check.info.get("min_pressure"),
-        "seconds": check.info.get("seconds"),
-        "checked_at": first,
-    }
-    result.info["seconds"] += float(check.info.get("seconds", 0.0))
+    result.info["full_contact"] = {**check_info, "checked_at": first}
+    result.info["seconds"] += float(check_info.get("seconds") or 0.0)
     return result
+
+
+#: The nodal check calls contact lost only when q is below this fraction of max q: far
+#: beyond its discretization error (~1e-5 at the edges), so that near the threshold the
+#: full-contact model, whose own flag is exact to its estimate, decides.
+CLEARLY_LOST = 1e-3
+
+
+def _nodal_check(geometry, c: float, loads: dict[str, float]) -> float | None:
+    """Full contact on the unilateral solver's nodal rule: min q / max q when below
+    ``-CLEARLY_LOST``, else None (dimensionless)."""
+    from core.contact import nodal_operator, nodal_resolution
+    from core.contact_zones import Step, _bordered_solve, _given_rhs
+
+    res = nodal_resolution(geometry.lam, geometry.m)
+    panels, op = nodal_operator(geometry.lam, geometry.breakpoints, res)
+    x, w = panels.nodes, panels.weights
+    m, g = geometry.m(x), geometry.g(x)
+    step = Step(c, 1.0, loads)
+    idx = np.arange(x.size)
+    q, _, _ = _bordered_solve(op, m, x, w, step, _given_rhs(step, x, g, None), idx)
+    scale = float(np.max(np.abs(q)))
+    low = float(np.min(q)) / scale if scale > 0.0 else 0.0
+    return low if low < -CLEARLY_LOST else None
 
 
 def with_contact_model(full, contact: str, arguments: dict[str, Any]):

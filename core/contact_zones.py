@@ -404,10 +404,13 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
                 move = np.clip(move, -0.1, 0.1)
                 trial = list(ends)
                 for j, k in enumerate(free):
+                    # At most 90% of the way to a neighbouring end or +-1: an end close to
+                    # the punch's edge is approached geometrically (a fixed margin of
+                    # 1e-3 of the span held it 2e-3 away, just past the lift-off
+                    # threshold).
                     lo, hi = _walls(ends, pinned, k)
-                    span = hi - lo
-                    trial[k] = float(np.clip(ends[k] + move[j], lo + 1e-3 * span,
-                                             hi - 1e-3 * span))
+                    trial[k] = float(np.clip(ends[k] + move[j], ends[k] - 0.9 * (ends[k] - lo),
+                                             ends[k] + 0.9 * (hi - ends[k])))
                 new = solve_on_zones(space, step, trial, res)
                 builds += 1
                 r_new = new.end_values[free] / new.q_scale
