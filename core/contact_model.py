@@ -31,8 +31,10 @@ def predicted_unilateral(arguments: dict[str, Any]):
     solve again with lift-off: under creep the first solve is wasted work (it roughly
     doubled the cost of a 100-time scene). The check solves full contact at the first
     time only, elastic at the loading instant: from the prepared geometry the default
-    engine would use (shared with it: a later full solve reuses it), a few ms cold. Only
-    a pressure the full-contact model itself flags ``contact_lost`` counts. Applies to an
+    engine would use (shared with it: a later full solve reuses it; only a pressure the
+    full-contact model itself flags ``contact_lost`` counts), or, for an elastic base
+    whose geometry is not prepared yet, on the nodal rule of the unilateral solver (kept
+    for it; only a clearly lost contact counts, see ``CLEARLY_LOST``). Applies to an
     elastic base (any first time) and to creep when the first time is t = 1 (at
     loading the base is elastic); otherwise, or when no unilateral answer exists (loads
     pulling the punch away) or the check fails on the input, returns None and the caller
