@@ -310,7 +310,7 @@ def _creep_args(problem):
 def test_creep_in_full_contact_agrees_with_the_projection_method():
     # e = 0.1 m: no lift-off, so the unilateral stepping must reproduce the full-contact
     # projection method (an independent discretization in space and time). Measured
-    # relative difference 8.6e-7 in settlement and tilt, against an estimate of 8.2e-7.
+    # relative difference 1.2e-6 in settlement and tilt, against an estimate of 1.0e-6.
     pb = _preset_problem(moment=8.0e4)
     uni = solve_unilateral(pb.lam, pb.m, pb.g, pb.times, tol=1e-5, **_creep_args(pb))
     full = solve_dimensionless(pb.lam, pb.m, pb.g, pb.times, tol=1e-8, contact="full",
@@ -326,8 +326,8 @@ def test_creep_in_full_contact_agrees_with_the_projection_method():
 def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
     # The preset (e = 0.6 m): the zone end moves from -0.306 to -0.349 half-widths over
     # 1000 days as the base creeps. Two first grids (8 and 16 nominal steps) give ends
-    # 1.3e-7 apart (measured; estimate 2.5e-5 each); the motion is far larger. Force by
-    # the trapezoid rule on 4001 points: 3.4e-6 off.
+    # 3.6e-6 apart (measured; estimates 5.2e-6 and 9.4e-6); the motion is far larger.
+    # Force by the trapezoid rule on 4001 points: 1.1e-6 off.
     pb = _preset_problem()
     runs = [solve_unilateral(pb.lam, pb.m, pb.g, pb.times, tol=1e-4, time_steps=steps,
                              **_creep_args(pb)) for steps in (8, 16)]
