@@ -685,6 +685,17 @@ def summary_table(results: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
+#: Partial contact has its own report (the scenes above are in full contact).
+PARTIAL_CONTACT = [
+    "## Partial contact (lift-off)", "",
+    "Scenes past lift-off (an eccentric footing and a worn patch on an elastic base, the "
+    "lift-off preset under creep): zone ends, q and the outputs against resolution and "
+    "time, the solver swept over tol against a finer reference and against the nodal "
+    "active set without refinement of the ends, in "
+    "[work_precision_liftoff.md](work_precision_liftoff.md) "
+    "(`OPENBLAS_NUM_THREADS=1 python benchmarks/work_precision_liftoff.py`).", ""]
+
+
 def write_report(results: list[dict[str, Any]], aging100: list[Run], plan: Plan, out: Path,
                  command: str, elapsed: float) -> None:
     lines = ["# Work-precision report", "",
@@ -724,6 +735,7 @@ def write_report(results: list[dict[str, Any]], aging100: list[Run], plan: Plan,
              "time_points), `time` = time_points sweep at fixed panels.", ""]
     lines += summary_table(results)
     lines += goals_section(results, aging100)
+    lines += PARTIAL_CONTACT
     lines += ["## Scenes", ""]
     for res in results:
         lines += scene_section(res, f"{res['scene'].key}.png")

@@ -8,11 +8,12 @@
     int q dx = P,  int x q dx = M               (two of delta, alpha, P, M given).
 
 Elastic base (``kernel=None``): each time is solved on its own, the zone ends located to
-``ZONE_END_TOL`` by :mod:`core.contact_zones`. Creep: implicit trapezoid stepping with the
-active set found at every step (:mod:`core.contact_creep`).
+``ZONE_END_TOL`` by :mod:`core.contact_zones`. Creep: implicit stepping with the active
+set found at every step, on a rule refined where the zone ends travel
+(:mod:`core.contact_creep`, :mod:`core.contact_bands`).
 
 :func:`contact_set_from_pressure` turns sampled pressures of any engine into contact
-sets; :func:`with_contact_model` is the ``contact=`` switch of
+sets; :mod:`core.contact_model` holds the ``contact=`` switch of
 :func:`core.solver.solve_dimensionless`.
 """
 
@@ -21,11 +22,12 @@ from __future__ import annotations
 import math
 import time as _time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from core.cache import StageCache
 from core.contact_solution import SolveOutcome
 from core.contact_zones import (
     ZONE_END_TOL,
@@ -52,9 +54,11 @@ FULL_CONTACT: list[tuple[float, float]] = [(-1.0, 1.0)]
 _NODAL_WIDTH = 0.25
 _WIDTH = 0.5
 _EDGE = 1e-2
-#: The fixed rule of creep steps: interior panels at most this wide, graded to this width
-#: at +-1 and the breakpoints (finer for a thin coating).
-_CREEP_WIDTH = 0.125
+#: The base of the fixed rule of creep steps: panels at most this wide, graded to this
+#: width at +-1 and the breakpoints (finer for a thin coating); the bands the zone ends
+#: sweep get finer panels (core/contact_bands.py: outside them 0.5 and 0.0625 gave the
+#: same ends to 1e-14 on the lift-off preset).
+_CREEP_WIDTH = 0.5
 _CREEP_EDGE = 1e-2
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
@@ -103,28 +107,51 @@ class UnilateralSolution(SolveOutcome):
         if x.ndim != 1 or np.any(~np.isfinite(x)) or np.any(np.abs(x) > 1.0):
             raise ValueError("x: pressure is defined on [-1, 1] only")
         out = np.zeros((x.size, len(self._snapshots)))
+        # Snapshots on one panel rule (every time of a creep solve) share the rows of F
+        # at x: one evaluation of them and one matrix product for all times.
+        rows: dict[int, np.ndarray] = {}
         for k, snap in enumerate(self._snapshots):
             inside = np.zeros(x.size, dtype=bool)
+            at_end = np.zeros(x.size, dtype=bool)
             for lo, hi in snap.zones:
                 inside |= (x >= lo) & (x <= hi)
+                at_end |= (x == lo) | (x == hi)
             if not inside.any():
                 continue
-            memory_at = None
-            if snap.memory is not None:
-                from core.quadrature import operator_rows
+            if snap.memory is None:
+                key = id(snap.panels)
+                if key not in rows:
+                    from core.quadrature import operator_rows
 
-                def memory_at(t, _v=snap.memory, _p=snap.panels):
-                    return operator_rows(self._space.lam, _p, t) @ _v
-            xi = x[inside]
-            # Sample m and g from inside the zone at its ends (they may jump there).
-            inward = np.zeros(xi.size)
-            for lo, hi in snap.zones:
-                inward[xi == lo] = 1.0
-                inward[xi == hi] = -1.0
-            values = nystrom_pressure(self._space, snap.step, snap.panels, snap.q,
-                                      snap.settlement, snap.tilt, xi, inward, memory_at)
-            out[inside, k] = np.maximum(values, 0.0)
+                    rows[key] = operator_rows(self._space.lam, snap.panels, x)
+                xi = x[inside]
+                fq = rows[key][inside] @ snap.q
+                values = (snap.settlement + snap.tilt * xi - self._space.g(xi)
+                          - snap.step.scale * fq) / (snap.step.c * self._space.m(xi))
+                out[inside, k] = np.maximum(values, 0.0)
+                # m and g sampled from inside the zone where it ends on a jump of them
+                at_end &= np.isin(x, self._space.breakpoints)
+                if at_end.any():
+                    out[at_end, k] = self._pressure_one(snap, x[at_end])
+                continue
+            out[inside, k] = self._pressure_one(snap, x[inside])
         return out
+
+    def _pressure_one(self, snap: _Snapshot, xi: np.ndarray) -> np.ndarray:
+        memory_at = None
+        if snap.memory is not None:
+            from core.quadrature import operator_rows
+
+            def memory_at(t, _v=snap.memory, _p=snap.panels):
+                return operator_rows(self._space.lam, _p, t) @ _v
+        # Sample m and g from inside the zone at its ends (they may jump there).
+        inward = np.zeros(xi.size)
+        for lo, hi in snap.zones:
+            inward[xi == lo] = 1.0
+            inward[xi == hi] = -1.0
+        values = nystrom_pressure(self._space, snap.step, snap.panels, snap.q,
+                                  snap.settlement, snap.tilt, xi, inward, memory_at)
+        return np.maximum(values, 0.0)
 
 
 def contact_set_from_pressure(x: Sequence[float] | np.ndarray, q: np.ndarray, *,
@@ -245,16 +272,12 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     space = Space(inp.lam, inp.m, inp.g, inp.breakpoints)
     m_probe = inp.m(np.linspace(-1.0, 1.0, 257))
     res = Resolution(min(_WIDTH, 3.0 / inp.lam), min(_EDGE, 0.25 * float(np.min(m_probe))))
-    nodal_res = Resolution(min(_NODAL_WIDTH, 3.0 / inp.lam), res.edge)
+    nodal_res = nodal_resolution(inp.lam, inp.m)
     if inp.kernel is None:
         out = _solve_elastic(space, c_t, loads, times_arr, nodal_res, res, inp.tol)
     else:
         from core.contact_creep import solve_creep
 
-        # The zone ends move through the interior panels of the fixed rule of the steps:
-        # their width sets the error of the ends (measured at t = 1 on the lift-off
-        # preset: 1.3e-4 half-widths for panels 0.25 wide, 2.1e-5 for 0.125, 2.7e-6 for
-        # 0.0625, with 256, 352, 576 nodes).
         creep_res = Resolution(min(_CREEP_WIDTH, 3.0 / inp.lam), max(res.edge, min(
             _CREEP_EDGE, 0.25 * float(np.min(m_probe)))))
         out = solve_creep(space, inp, c_t, loads, creep_res,
@@ -265,13 +288,39 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
                               out["snapshots"])
 
 
+#: The operator of the nodal rule depends on lam and the panels only (not on m, g or the
+#: loads): kept, so that moving a load (the explorer's eccentricity slider) rebuilds only
+#: what the zone ends need.
+_NODAL_OPERATORS = StageCache("contact_nodal_operator", max_items=8, max_bytes=64 * 2**20)
+
+
+def nodal_resolution(lam: float, m: Callable[[np.ndarray], np.ndarray]) -> Resolution:
+    """The rule of the nodal active set: panels at most ``_NODAL_WIDTH`` (and 3/lam)
+    wide, graded to ``_EDGE`` at +-1 and the breakpoints, finer for a thin coating."""
+    m_probe = m(np.linspace(-1.0, 1.0, 257))
+    return Resolution(min(_NODAL_WIDTH, 3.0 / lam), min(_EDGE, 0.25 * float(np.min(m_probe))))
+
+
+def nodal_operator(lam: float, breakpoints: tuple[float, ...], res: Resolution
+                   ) -> tuple[Panels, np.ndarray]:
+    """The panels of ``res`` on [-1, 1] and the Nystrom matrix of F there (cached)."""
+    key = (float(lam), tuple(float(b) for b in breakpoints), float(res.width),
+           float(res.edge))
+
+    def build() -> tuple[Panels, np.ndarray]:
+        panels = base_panels(lam, breakpoints, edge_width=res.edge, max_width=res.width)
+        matrix = kernel_operator(lam, panels).matrix
+        matrix.flags.writeable = False  # shared by every solve on this rule
+        return panels, matrix
+
+    return _NODAL_OPERATORS.get_or_compute(key, build)[0]
+
+
 def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
                    times: np.ndarray, nodal_res: Resolution, res: Resolution,
                    tol: float) -> dict[str, Any]:
     """Every time on its own (equal data solved once)."""
-    base = base_panels(space.lam, space.breakpoints, edge_width=nodal_res.edge,
-                       max_width=nodal_res.width)
-    op = kernel_operator(space.lam, base).matrix
+    base, op = nodal_operator(space.lam, space.breakpoints, nodal_res)
     m_nodes = space.m(base.nodes)
     g_nodes = space.g(base.nodes)
     results: dict[tuple, tuple] = {}
@@ -397,46 +446,3 @@ def _verify(space: Space, step: Step, sol, base: Panels, zones) -> bool:
         return True
     values = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, off)
     return bool(np.max(values) <= 1e-8 * scale)
-
-
-# ---------------------------------------------------------------- the contact switch
-
-
-def check_contact_model(contact: object) -> str:
-    """The ``contact`` argument checked: one of :data:`CONTACT_MODELS`."""
-    if not isinstance(contact, str) or contact not in CONTACT_MODELS:
-        raise ValueError(f"contact: must be one of {', '.join(CONTACT_MODELS)}, "
-                         f"got {contact!r}")
-    return contact
-
-
-def with_contact_model(full, contact: str, arguments: dict[str, Any]):
-    """The answer for ``contact`` given the full-contact answer ``full``.
-
-    ``"full"``, or ``"auto"`` while full contact holds: ``full`` with ``contact_set`` the
-    whole base at every time and ``info["contact"] = "full"``. ``"auto"`` when the
-    full-contact pressure is negative somewhere (flag ``contact_lost``): the unilateral
-    answer, whose ``info["full_contact"]`` keeps what the full-contact model said; if the
-    loads pull the punch away (no unilateral answer exists), the flagged full-contact
-    answer with ``info["unilateral_refused"]`` giving the reason.
-    ``arguments`` are those of :func:`solve_unilateral`.
-    """
-    if contact == "auto" and "contact_lost" in full.info.get("flags", []):
-        try:
-            result = solve_unilateral(**arguments)
-        except ValueError as exc:
-            # The loads pull the punch away (arguments were validated by the full solve):
-            # no unilateral answer exists, and the flagged full-contact one says so.
-            full.info["contact"] = "full"
-            full.info["unilateral_refused"] = str(exc)
-            full.info["message"] += f"; unilateral contact refused: {exc}"
-            return replace(full, contact_set=[list(FULL_CONTACT) for _ in full.times])
-        result.info["full_contact"] = {
-            "flags": list(full.info["flags"]),
-            "min_pressure": full.info.get("min_pressure"),
-            "seconds": full.info.get("seconds"),
-        }
-        result.info["seconds"] += float(full.info.get("seconds", 0.0))
-        return result
-    full.info["contact"] = "full"
-    return replace(full, contact_set=[list(FULL_CONTACT) for _ in full.times])

@@ -142,7 +142,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     and ``info["contact"]`` say which contact model answered. Raises ``ValueError``
     naming the argument on bad input.
     """
-    from core.contact import check_contact_model, solve_unilateral, with_contact_model
+    from core.contact import solve_unilateral
+    from core.contact_model import check_contact_model, with_contact_model
     from core.statements import UnresolvedOperator
 
     t_start = _time.perf_counter()
@@ -160,6 +161,12 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                                breakpoints=breakpoints, tol=tol)
         if contact == "unilateral":
             return solve_unilateral(**unilateral_args)
+        if contact == "auto":
+            from core.contact_model import predicted_unilateral
+
+            predicted = predicted_unilateral(unilateral_args)
+            if predicted is not None:
+                return predicted
         try:
             full = solve_with_prepared(lam, m, g, times, c=c, kernel=kernel,
                                        settlement=settlement, tilt=tilt, force=force,
