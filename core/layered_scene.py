@@ -18,8 +18,8 @@ Where it does not apply the thin-layer model answers, with its measured error
 - a coating that varies along ``x``;
 - a punch shape that jumps (a step on an elastic solid has an infinite force in full
   contact: the thin layer's finite answer is the model's);
-- a coating thinner than ``(MODES_PER_ROOT / MAX_MODES)^2 a`` (5.5e-4 a), whose corner
-  layer would need more modes than the cap (its thin-layer error is smallest there);
+- a coating layer thinner than ``NODES_PER_THICKNESS a / MAX_NODES`` (2.3e-3 a), which
+  would need more quadrature nodes than the cap (the thin-layer error is smallest there);
 - ``contact = "unilateral"``, or ``"auto"`` when the pressure comes out negative (lift-off:
   the unilateral solver of the thin-layer model answers).
 
@@ -40,7 +40,7 @@ import numpy as np
 from core.coating_model import model_error_estimate, tilt_share
 from core.contact_solution import ContactSolution
 from core.layered_kernel import UniformLayer
-from core.layered_solve import MAX_MODES, default_modes, solve_layered
+from core.layered_solve import MAX_MODES, MAX_NODES, default_modes, node_count, solve_layered
 
 __all__ = ["layered_declines", "solve_scene_layered"]
 
@@ -82,7 +82,9 @@ def layered_declines(scene: Any, problem: Any) -> str | None:
     if not all(getattr(p, "kind", None) == "constant" for layer in scene.coating
                for p in (layer.thickness, layer.modulus, layer.poisson)):
         return "the coating varies along x"
-    if default_modes(scene.half_width, _layers(scene)) > MAX_MODES:
+    layers = _layers(scene)
+    modes = default_modes(scene.half_width, layers)
+    if modes > MAX_MODES or node_count(scene.half_width, layers, modes) > MAX_NODES:
         return "the coating is thinner than the layered solve resolves"
     if _shape_jumps(scene, problem):
         return "the punch shape jumps"
