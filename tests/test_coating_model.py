@@ -99,14 +99,29 @@ def test_scene_interface_and_model_tol_are_validated_and_saved():
         scene_from_dict(bad)
 
 
+def creeping_scene_dict(**coating) -> dict:
+    """:func:`scene_dict` on the creeping base of the preset: the thin layer answers."""
+    d = scene_dict(**coating)
+    d["base"]["creep"] = json.loads((ROOT / "assets" / "scenes" / "uniform_flat.json")
+                                    .read_text())["base"]["creep"]
+    return d
+
+
 def test_every_result_carries_the_estimate_and_the_flag():
-    d = scene_dict()
+    d = creeping_scene_dict()
     result = solve(d)
+    assert result.info["coating_model"] == "thin layer"
     estimate = result.info["model_error_estimate"]
     assert 0 < estimate < 0.02 and "model_error" not in result.flags
     d["solver"] = {"model_tol": 1e-4}
     flagged = solve(d)
     assert "model_error" in flagged.flags and "model_error" in flagged.flag_messages
+    # on an elastic base the exact layered kernel answers: no model error to flag
+    exact = scene_dict()
+    exact["solver"] = {"model_tol": 1e-4}
+    result = solve(exact)
+    assert result.info["coating_model"] == "exact layered"
+    assert result.info["model_error_estimate"] < 1e-8 and "model_error" not in result.flags
 
 
 def test_map_scales_with_thickness_outside_its_range():
@@ -117,7 +132,8 @@ def test_map_scales_with_thickness_outside_its_range():
 
 @pytest.mark.parametrize("interface", ["smooth", "bonded"])
 def test_check_confirms_the_estimate_within_a_factor_3(interface):
-    report = check_scene(scene_dict(interface=interface))
+    report = check_scene(creeping_scene_dict(interface=interface))
+    assert report["coating_model"] == "thin layer"
     assert report["model_error"] > 0
     assert report["estimate"] / 3 <= report["model_error"] <= 3 * report["estimate"]
 
