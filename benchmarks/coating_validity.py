@@ -168,13 +168,29 @@ def fe_study() -> None:
                   f"{fe.moment_parts[2] / km - 1:.2e} (kernel solution, m = 1e-7)")
 
 
+def _elastic_copy(d: dict) -> dict:
+    """The scene with its base elastic at the modulus at loading (the exact layered kernel
+    then answers a uniform coating)."""
+    from core.scene import scene_from_dict
+
+    out = dict(d)
+    out["base"] = dict(d["base"])
+    out["base"]["creep"] = {"model": "elastic",
+                            "modulus": scene_from_dict(d).modulus_at_loading()}
+    return out
+
+
 def presets() -> None:
-    """The FE check on every preset scene: model error against the carried estimate."""
+    """The FE check on every preset scene: model error against the carried estimate, for
+    the scene as it is and for its copy on an elastic base (where a uniform coating is
+    answered by the exact layered kernel)."""
     from core.coating_check import check_scene
     from core.scene import load_scene
 
-    lines = ["| scene | interface | statement | FE model error | estimate | ratio | FE s |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
+    lines = ["| scene | interface | statement | model | FE model error | estimate | ratio | "
+             "elastic copy: model | FE difference | estimate | FE s |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    within, total = 0, 0
     for path in sorted((ROOT / "assets" / "scenes").glob("*.json")):
         scene = load_scene(path)
         for interface in INTERFACES:
@@ -182,19 +198,34 @@ def presets() -> None:
             for layer in d["coating"]:
                 layer["interface"] = interface
             report = check_scene(d)
+            copy = check_scene(_elastic_copy(d))
             ratio = report["model_error"] / report["estimate"]
+            total += 1
+            within += 1 / 3 <= ratio <= 3
             lines.append(f"| {path.stem} | {interface} | {scene.statement} | "
+                         f"{report['coating_model']} | "
                          f"{100 * report['model_error']:.2f} % | "
                          f"{100 * report['estimate']:.2f} % | {ratio:.2f} | "
-                         f"{report['fe_seconds']:.1f} |")
+                         f"{copy['coating_model']} | {100 * copy['model_error']:.4f} % | "
+                         f"{100 * copy['estimate']:.2g} % | "
+                         f"{report['fe_seconds'] + copy['fe_seconds']:.1f} |")
             print(lines[-1], flush=True)
     out = ROOT / "benchmarks" / "results" / "coating_validity.md"
     text = out.read_text() if out.exists() else ""
     marker = "## Preset scenes"
+    rest = text.split(marker)[1] if marker in text else ""
+    tail = rest[rest.index("\n## "):] if "\n## " in rest else ""
     text = text.split(marker)[0].rstrip() + "\n\n" + marker + "\n\n" + (
         "Made by `python -m benchmarks.coating_validity --presets`: `python -m core check` "
         "on each preset (time 0, FE level 0), every layer smooth, then every layer "
-        "bonded.\n\n") + "\n".join(lines) + "\n"
+        "bonded; then the same on the scene's copy with its base elastic at the modulus at "
+        "loading, where a uniform coating is answered by the exact layered kernel. "
+        f"Estimate within a factor 3 of the FE-measured error: {within} of {total} "
+        "(thin-layer answers). For the exact layered answers the FE difference is the FE "
+        "model's own level-0 error (1.0e-4 / 2.3e-4 in force / moment at H = a, 2.0e-4 / "
+        "3.3e-4 at H = 4a, uncoated; `--fe-study`), far above the layered solve's "
+        "estimate: FE level 0 cannot confirm it, it only bounds the error by its own.\n\n"
+    ) + "\n".join(lines) + "\n" + tail
     out.write_text(text)
 
 
