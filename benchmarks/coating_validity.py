@@ -3,6 +3,7 @@
     python -m benchmarks.coating_validity --table      # the map and the validity table
     python -m benchmarks.coating_validity --fe-study   # FE truncation and mesh convergence
     python -m benchmarks.coating_validity --presets    # the check on the preset scenes
+    python -m benchmarks.coating_validity --aging      # aging bases, early and late
 
 ``--table`` solves, for a flat punch with a uniform coating, the fast model (with the
 compliance of :func:`core.coating_model.layer_compliance`) and the FE model of
@@ -229,11 +230,51 @@ def presets() -> None:
     out.write_text(text)
 
 
+#: Presets on an aging base, checked early and late by ``--aging``.
+AGING_PRESETS = ("eccentric_creep", "young_concrete_50_years")
+
+
+def aging() -> None:
+    """The thin-layer answer of an aging base checked at loading and at the last output
+    time: the FE model with the base elastic at E(t) against the fast model at E(t)."""
+    from core.coating_check import check_scene
+    from core.scene import load_scene
+
+    lines = ["| scene | interface | time [day] | E(t) / E(tau0) | FE model error | "
+             "estimate (at loading) | FE s |", "| --- | --- | --- | --- | --- | --- | --- |"]
+    for name in AGING_PRESETS:
+        scene = load_scene(ROOT / "assets" / "scenes" / f"{name}.json")
+        e0 = scene.modulus_at_loading()
+        for interface in INTERFACES:
+            d = scene.to_dict()
+            for layer in d["coating"]:
+                layer["interface"] = interface
+            for time_day in (0.0, float(scene.times[-1])):
+                report = check_scene(d, time_day)
+                e_t = float(scene.creep.modulus(scene.age_at_loading + time_day))
+                lines.append(f"| {name} | {interface} | {time_day:g} | {e_t / e0:.3f} | "
+                             f"{100 * report['model_error']:.2f} % | "
+                             f"{100 * report['estimate']:.2f} % | "
+                             f"{report['fe_seconds']:.1f} |")
+                print(lines[-1], flush=True)
+    out = ROOT / "benchmarks" / "results" / "coating_validity.md"
+    text = out.read_text()
+    marker = "## Aging base, early and late"
+    before, _, after = text.partition(marker)
+    tail = after[after.index("\n## "):] if "\n## " in after else ""
+    out.write_text(before.rstrip() + "\n\n" + marker + "\n\n" + (
+        "Made by `python -m benchmarks.coating_validity --aging`: `python -m core check "
+        "--time` at loading and at the last output time (the thin layer answers an aging "
+        "base; FE level 0, base elastic at E(t), the given loads at that time).\n\n")
+        + "\n".join(lines) + "\n" + tail)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--table", action="store_true")
     parser.add_argument("--fe-study", action="store_true")
     parser.add_argument("--presets", action="store_true")
+    parser.add_argument("--aging", action="store_true")
     args = parser.parse_args()
     if args.fe_study:
         fe_study()
@@ -241,6 +282,8 @@ def main() -> None:
         table()
     if args.presets:
         presets()
+    if args.aging:
+        aging()
 
 
 if __name__ == "__main__":
