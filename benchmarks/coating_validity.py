@@ -201,12 +201,15 @@ def presets() -> None:
             report = check_scene(d)
             copy = check_scene(_elastic_copy(d))
             ratio = report["model_error"] / report["estimate"]
-            total += 1
-            within += 1 / 3 <= ratio <= 3
-            lines.append(f"| {path.stem} | {interface} | {scene.statement} | "
-                         f"{report['coating_model']} | "
-                         f"{100 * report['model_error']:.2f} % | "
-                         f"{100 * report['estimate']:.2f} % | {ratio:.2f} | "
+            thin = report["coating_model"] == "thin layer"
+            if thin:
+                total += 1
+                within += 1 / 3 <= ratio <= 3
+            model = report["coating_model"] + (" (lifts off)" if report["contact_lost"] else "")
+            lines.append(f"| {path.stem} | {interface} | {scene.statement} | {model} | "
+                         f"{100 * report['model_error']:.{2 if thin else 4}f} % | "
+                         f"{100 * report['estimate']:.2g} % | "
+                         f"{f'{ratio:.2f}' if thin else '-'} | "
                          f"{copy['coating_model']} | {100 * copy['model_error']:.4f} % | "
                          f"{100 * copy['estimate']:.2g} % | "
                          f"{report['fe_seconds'] + copy['fe_seconds']:.1f} |")
@@ -220,7 +223,10 @@ def presets() -> None:
         "Made by `python -m benchmarks.coating_validity --presets`: `python -m core check` "
         "on each preset (time 0, FE level 0), every layer smooth, then every layer "
         "bonded; then the same on the scene's copy with its base elastic at the modulus at "
-        "loading, where a uniform coating is answered by the exact layered kernel. "
+        "loading, where a uniform coating is answered by the exact layered kernel. Both "
+        "models in full contact, as the FE model ('lifts off': the full-contact answer has "
+        "q < 0 somewhere, the scene's own answer is then the unilateral one, which the check "
+        "does not cover). "
         f"Estimate within a factor 3 of the FE-measured error: {within} of {total} "
         "(thin-layer answers). For the exact layered answers the FE difference is the FE "
         "model's own level-0 error (1.0e-4 / 2.3e-4 in force / moment at H = a, 2.0e-4 / "

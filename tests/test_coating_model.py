@@ -153,3 +153,13 @@ def test_cli_check_prints_the_model_error(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "core", "check", str(path), "--time", "5"],
                           cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 2 and proc.stderr.startswith("error: --time: must be in")
+
+
+def test_check_compares_in_full_contact_as_the_fe_model():
+    from core.coating_check import elastic_scene
+
+    d = creeping_scene_dict()
+    d["loading"] = {"force": 5e5, "moment": 4e5}  # e = 0.8 a: the scene's answer lifts off
+    copy = elastic_scene(scene_from_dict(d))
+    assert copy.contact == "full" and copy.creep.spec["model"] == "elastic"
+    assert solve(copy).contact_lost

@@ -105,7 +105,10 @@ def check_report_html(report: dict[str, Any]) -> str:
         f"{report['fe_seconds']:.1f} s). Coating model: {report['coating_model']}.</small>"
         f"<br><b>model error: measured {100 * report['model_error']:.3g} %, "
         f"estimated {100 * report['estimate']:.3g} %</b>"
-        "<table class='cp-readout'><tr><th></th><th>fast</th><th>FE</th><th>error [%]</th>"
+        + ("<br><span class='cp-msg'>The punch lifts off here: both models are compared "
+           "in full contact, as the FE model ties the punch to the surface.</span>"
+           if report.get("contact_lost") else "")
+        + "<table class='cp-readout'><tr><th></th><th>fast</th><th>FE</th><th>error [%]</th>"
         "</tr>" + "".join(rows) + "</table></div>")
 
 
