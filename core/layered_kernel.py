@@ -44,7 +44,7 @@ from numpy.typing import ArrayLike
 from core.coating_model import INTERFACES
 
 __all__ = ["RegularPartTable", "UniformLayer", "stack_kernel", "stack_kernel_regular",
-           "stack_symbol", "symbol_at_infinity"]
+           "stack_symbol", "symbol_at_infinity", "table_cost"]
 
 
 @dataclass(frozen=True)
@@ -261,6 +261,39 @@ _PANEL_DEGREE = 24
 _PANEL_WIDTH = 0.5
 
 
+def _table_edges(largest_s: float, layers: Sequence[UniformLayer],
+                 base_thickness: float) -> np.ndarray:
+    thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
+    edges = [0.0]
+    width = 0.5 * thinnest
+    while edges[-1] < largest_s:
+        edges.append(edges[-1] + width)
+        width = min(2 * width, _PANEL_WIDTH)
+    return np.array(edges)
+
+
+def table_cost(largest_s: float, layers: Sequence[UniformLayer],
+               base_thickness: float) -> float:
+    """Cosines [-] a :class:`RegularPartTable` reaching ``largest_s`` [-] evaluates (table
+    points times u-nodes of their band in :func:`stack_kernel_regular`), without building
+    it: ~2e-8 s of CPU each (measured: 1.1e9 in 21.5 s at ``a / H = 100``)."""
+    edges = _table_edges(largest_s, layers, base_thickness)
+
+    tops = edges[1:]
+    thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
+    cost, top = 0.0, float(tops[-1]) if tops.size else 0.0
+    remaining = np.ones(tops.size, dtype=bool)
+    while remaining.any():
+        low = 0.25 * top if top > 8.0 * thinnest else -1.0
+        band = remaining & (tops > low)
+        remaining &= ~band
+        count = np.count_nonzero(band) * (_PANEL_DEGREE + 1)
+        cost += count * _u_rule(layers, base_thickness, top)[0].size
+        top = low
+
+    return float(cost)
+
+
 class RegularPartTable:
     """``k_stack(s) + L_inf ln|s|`` on ``0 <= s <= largest_s``, tabulated once.
 
@@ -271,13 +304,7 @@ class RegularPartTable:
 
     def __init__(self, largest_s: float, layers: Sequence[UniformLayer],
                  base_thickness: float, base_modulus: float, base_poisson: float) -> None:
-        thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
-        edges = [0.0]
-        width = 0.5 * thinnest
-        while edges[-1] < largest_s:
-            edges.append(edges[-1] + width)
-            width = min(2 * width, _PANEL_WIDTH)
-        self.edges = np.array(edges)
+        self.edges = _table_edges(largest_s, layers, base_thickness)
         n = _PANEL_DEGREE + 1
         nodes = np.cos(np.pi * (np.arange(n) + 0.5) / n)
         centre = 0.5 * (self.edges[1:] + self.edges[:-1])

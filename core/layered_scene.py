@@ -20,7 +20,9 @@ Where it does not apply the thin-layer model answers, with its measured error
   force in full contact: the thin layer's finite answer is the model's) or a kink (the
   pressure is log-singular there and the series converges slowly);
 - a coating layer thinner than ``NODES_PER_THICKNESS a / MAX_NODES`` (2.3e-3 a), which
-  would need more quadrature nodes than the cap (the thin-layer error is smallest there);
+  would need more quadrature nodes than the cap (the thin-layer error is smallest there),
+  or a stack whose kernel table would cost more than :data:`MAX_TABLE_COST` cosines
+  (a base much thinner than the punch, ``a / H`` above ~10-20, under a thin coating);
 - ``contact = "unilateral"``, or ``"auto"`` when the pressure comes out negative (lift-off:
   the unilateral solver of the thin-layer model answers).
 
@@ -40,13 +42,17 @@ import numpy as np
 
 from core.coating_model import model_error_estimate, tilt_share
 from core.contact_solution import ContactSolution
-from core.layered_kernel import UniformLayer
+from core.layered_kernel import UniformLayer, table_cost
 from core.layered_solve import MAX_MODES, MAX_NODES, default_modes, node_count, solve_layered
 
 __all__ = ["layered_declines", "solve_scene_layered"]
 
 #: Time samples of the load histories for the largest tilt between output times.
 TILT_SAMPLES = 257
+#: Most cosines the stack's kernel table may take (:func:`core.layered_kernel.table_cost`):
+#: measured 3.1e7 in 0.4 s of CPU (a / H = 20, h = a / 20), 1.4e8 in 5.9 s (a / H = 10,
+#: h = 0.003 a), 1.2e9 in 21.5 s (a / H = 100): beyond, the thin layer answers (~0.1 s).
+MAX_TABLE_COST = 5e7
 #: A pressure below this share of its largest value is taken as lift-off.
 LIFT_OFF_SHARE = 1e-9
 
@@ -76,6 +82,9 @@ def layered_declines(scene: Any, problem: Any) -> str | None:
     modes = default_modes(scene.half_width, layers)
     if modes > MAX_MODES or node_count(scene.half_width, layers, modes) > MAX_NODES:
         return "the coating is thinner than the layered solve resolves"
+    if table_cost(2 * scene.half_width / scene.base_thickness, layers,
+                  scene.base_thickness) > MAX_TABLE_COST:
+        return "the stack's kernel table would take too long (a thin base or coating)"
     if problem.breakpoints:
         # a jump has an infinite force in full contact, a kink a log-singular pressure
         # (the Chebyshev series converges like 1/n there: 1 % in q with 340 modes)
