@@ -123,8 +123,9 @@ def _summary(result: SceneSolution) -> str:
     lines.append(str(result.info.get("message", "")))
     estimate = result.info.get("model_error_estimate")
     if estimate is not None:
-        lines.append(f"coating model error (estimate from measurements): {100 * estimate:.2g} % "
-                     f"(solver.model_tol {100 * result.scene.model_tol:g} %)")
+        lines.append(f"coating model error ({result.info.get('coating_model')}, estimate): "
+                     f"{100 * estimate:.2g} % (solver.model_tol "
+                     f"{100 * result.scene.model_tol:g} %)")
     return "\n".join(lines)
 
 
@@ -221,7 +222,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
     print(f"{'pressure':>12} {'':>16} {'':>16} {100 * report['errors']['pressure']:8.2f}% "
           "(largest on |x| <= 0.9 a)")
     print(f"model error of the fast answer: {100 * report['model_error']:.2f} % "
-          f"(estimate carried by results: {100 * report['estimate']:.2f} %, "
+          f"({report['coating_model']}; estimate carried by results: "
+          f"{100 * report['estimate']:.2g} %, "
           f"solver.model_tol {100 * scene.model_tol:g} %)")
     if report["model_error"] > scene.model_tol:
         print("warning: model_error: the fast answer's coating model errs by more than "

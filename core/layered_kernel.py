@@ -44,7 +44,7 @@ from numpy.typing import ArrayLike
 from core.coating_model import INTERFACES
 
 __all__ = ["RegularPartTable", "UniformLayer", "stack_kernel", "stack_kernel_regular",
-           "stack_symbol", "symbol_at_infinity"]
+           "stack_symbol", "symbol_at_infinity", "table_cost"]
 
 
 @dataclass(frozen=True)
@@ -176,22 +176,36 @@ def stack_symbol(u: ArrayLike, layers: Sequence[UniformLayer], base_thickness: f
 _GAUSS_POINTS = 24
 #: The u-integral stops where the coating's share ``exp(-2 u h_min)`` is below 1e-17.
 _TAIL_DECAY = 40.0
+#: Beyond this u the base's own share ``exp(-2 u)`` is below 1e-17: only the coating's
+#: scale ``H / h`` (and the cosine) limits the panels there.
+_BASE_REACH = 20.0
+#: Growth of the panels beyond :data:`_BASE_REACH` (``r(u)`` behaves like ``1 / u`` there
+#: until the coating's scale: panels ``[u, 1.5 u]`` keep Gauss-Legendre at full accuracy).
+_PANEL_GROWTH = 1.5
 
 
 def _u_rule(layers: Sequence[UniformLayer], base_thickness: float,
             largest_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Nodes and weights in u for ``int_0^U r(u) cos(s u) du``, |s| <= ``largest_s``.
 
-    Panels of width <= 1 (the base's scale) and <= 4 / largest_s (a few periods of the
-    cosine per panel) up to ``U = _TAIL_DECAY / min(h_k / H, 1) + _TAIL_DECAY``.
+    Up to ``U = _TAIL_DECAY / min(h_k / H, 1) + _TAIL_DECAY``: panels of width <= 1 (the
+    base's scale) up to :data:`_BASE_REACH`, then growing geometrically to half the
+    coating's scale ``H / 2 h_min``; all of width <= 4 / largest_s (a few periods of the
+    cosine per panel). Uniform panels of width 1 all the way cost ``~40 H / h`` panels:
+    12 s of the 12.4 s of a flat-punch solve at ``h = 0.001 H`` before the grading.
     """
     thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
     end = _TAIL_DECAY / thinnest + _TAIL_DECAY
-    width = min(1.0, 4.0 / max(largest_s, 1e-300))
-    edges = np.linspace(0.0, end, int(np.ceil(end / width)) + 1)
+    cosine = 4.0 / max(largest_s, 1e-300)
+    near = min(end, _BASE_REACH)
+    edges = list(np.linspace(0.0, near, int(np.ceil(near / min(1.0, cosine))) + 1))
+    widest = min(cosine, max(1.0, 0.5 / thinnest))
+    while edges[-1] < end:
+        edges.append(min(end, edges[-1] + min(widest, (_PANEL_GROWTH - 1) * edges[-1])))
+    edges_arr = np.array(edges)
     x, w = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
-    half = 0.5 * np.diff(edges)
-    mid = 0.5 * (edges[1:] + edges[:-1])
+    half = 0.5 * np.diff(edges_arr)
+    mid = 0.5 * (edges_arr[1:] + edges_arr[:-1])
     return (mid[:, None] + half[:, None] * x).ravel(), (half[:, None] * w).ravel()
 
 
@@ -207,13 +221,25 @@ def stack_kernel_regular(s: ArrayLike, layers: Sequence[UniformLayer],
     s = np.abs(np.asarray(s, dtype=float))
     flat = s.ravel()
     l_inf = symbol_at_infinity(layers, base_modulus, base_poisson)
-    u, w = _u_rule(layers, base_thickness, float(flat.max(initial=0.0)))
-    symbol = stack_symbol(u, layers, base_thickness, base_modulus, base_poisson)
-    r = (symbol - l_inf * -np.expm1(-u)) / u
     out = np.empty_like(flat)
-    for start in range(0, flat.size, 256):
-        block = flat[start:start + 256]
-        out[start:start + 256] = np.cos(np.outer(block, u)) @ (w * r)
+    # Bands of s, each a quarter of the one above, get their own u-rule: the cosine
+    # limits the panels to 4 / s, so small s (the coating's scale near 0) need far fewer
+    # nodes than the largest s asks for.
+    thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
+    top = float(flat.max(initial=0.0))
+    remaining = np.ones(flat.size, dtype=bool)
+    while remaining.any():
+        low = 0.25 * top if top > 8.0 * thinnest else -1.0
+        band = remaining & (flat > low)
+        idx = np.flatnonzero(band)
+        remaining &= ~band
+        u, w = _u_rule(layers, base_thickness, top)
+        symbol = stack_symbol(u, layers, base_thickness, base_modulus, base_poisson)
+        weights = w * (symbol - l_inf * -np.expm1(-u)) / u
+        for start in range(0, idx.size, 256):
+            block = idx[start:start + 256]
+            out[block] = np.cos(np.outer(flat[block], u)) @ weights
+        top = low
     out += 0.5 * l_inf * np.log1p(flat * flat)
     return out.reshape(s.shape)
 
@@ -235,6 +261,39 @@ _PANEL_DEGREE = 24
 _PANEL_WIDTH = 0.5
 
 
+def _table_edges(largest_s: float, layers: Sequence[UniformLayer],
+                 base_thickness: float) -> np.ndarray:
+    thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
+    edges = [0.0]
+    width = 0.5 * thinnest
+    while edges[-1] < largest_s:
+        edges.append(edges[-1] + width)
+        width = min(2 * width, _PANEL_WIDTH)
+    return np.array(edges)
+
+
+def table_cost(largest_s: float, layers: Sequence[UniformLayer],
+               base_thickness: float) -> float:
+    """Cosines [-] a :class:`RegularPartTable` reaching ``largest_s`` [-] evaluates (table
+    points times u-nodes of their band in :func:`stack_kernel_regular`), without building
+    it: ~2e-8 s of CPU each (measured: 1.1e9 in 21.5 s at ``a / H = 100``)."""
+    edges = _table_edges(largest_s, layers, base_thickness)
+
+    tops = edges[1:]
+    thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
+    cost, top = 0.0, float(tops[-1]) if tops.size else 0.0
+    remaining = np.ones(tops.size, dtype=bool)
+    while remaining.any():
+        low = 0.25 * top if top > 8.0 * thinnest else -1.0
+        band = remaining & (tops > low)
+        remaining &= ~band
+        count = np.count_nonzero(band) * (_PANEL_DEGREE + 1)
+        cost += count * _u_rule(layers, base_thickness, top)[0].size
+        top = low
+
+    return float(cost)
+
+
 class RegularPartTable:
     """``k_stack(s) + L_inf ln|s|`` on ``0 <= s <= largest_s``, tabulated once.
 
@@ -245,13 +304,7 @@ class RegularPartTable:
 
     def __init__(self, largest_s: float, layers: Sequence[UniformLayer],
                  base_thickness: float, base_modulus: float, base_poisson: float) -> None:
-        thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
-        edges = [0.0]
-        width = 0.5 * thinnest
-        while edges[-1] < largest_s:
-            edges.append(edges[-1] + width)
-            width = min(2 * width, _PANEL_WIDTH)
-        self.edges = np.array(edges)
+        self.edges = _table_edges(largest_s, layers, base_thickness)
         n = _PANEL_DEGREE + 1
         nodes = np.cos(np.pi * (np.arange(n) + 0.5) / n)
         centre = 0.5 * (self.edges[1:] + self.edges[:-1])

@@ -1081,7 +1081,9 @@ class SceneSolution:
         self.x = plotting_grid(a)
         self.contact_set = [[(a * lo, a * hi) for lo, hi in zones]
                             for zones in getattr(solution, "contact_set", [])]
-        self.model_error = model_error_estimate(
+        # the exact layered kernel (core.layered_scene) carries its own estimate
+        layered = solution.info.get("layered_model_error")
+        self.model_error = dict(layered) if layered else model_error_estimate(
             scene, tilt_share(a, self.settlement, self.tilt))
         self.flags = self._flags(solution)
         self.flag_messages = {
@@ -1090,9 +1092,7 @@ class SceneSolution:
         self.info = dict(solution.info)
         self.info["flags"] = list(self.flags)
         self.info["model_error_estimate"] = self.model_error["estimate"]
-        # the default solve answers with the thin-layer model everywhere so far; the exact
-        # layered kernel (core.layered_kernel) is not yet wired into it
-        self.info["coating_model"] = "thin layer"
+        self.info["coating_model"] = solution.info.get("coating_model", "thin layer")
         self.info["model_error"] = dict(self.model_error)
         self.info["dimensional"] = self._extras()
 
@@ -1100,12 +1100,14 @@ class SceneSolution:
         scene = self.scene
         flags = [str(f) for f in solution.info.get("flags", [])]
         x = scene.sample_x
-        if np.max(scene.coating_thickness(x)) / (2 * scene.half_width) > THICK_COATING_RATIO:
+        thin = solution.info.get("coating_model") != "exact layered"
+        if thin and np.max(scene.coating_thickness(x)) / (2 * scene.half_width) \
+                > THICK_COATING_RATIO:
             flags.append("thick_coating")
         if self.model_error["estimate"] > scene.model_tol:
             flags.append("model_error")
         e0 = self.problem.modulus_at_loading
-        if any(np.max(_values(layer.modulus, x)) > e0 for layer in scene.coating):
+        if thin and any(np.max(_values(layer.modulus, x)) > e0 for layer in scene.coating):
             flags.append("stiff_coating")
         # between the output times too (the default engine samples the load histories)
         largest_tilt = max(float(np.max(np.abs(self.tilt))) if self.tilt.size else 0.0,
@@ -1234,8 +1236,11 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
     """
     scene = scene_from_dict(scene)
     problem = scene.dimensionless
+    from core.layered_scene import solve_scene_layered  # uniform coating, elastic base
+
     with np.errstate(all="ignore"):
-        result = SceneSolution(scene, problem, problem.solve())
+        answer = solve_scene_layered(scene, problem)
+        result = SceneSolution(scene, problem, problem.solve() if answer is None else answer)
     _check_finite(result)
     return result
 

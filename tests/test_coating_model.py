@@ -99,14 +99,29 @@ def test_scene_interface_and_model_tol_are_validated_and_saved():
         scene_from_dict(bad)
 
 
+def creeping_scene_dict(**coating) -> dict:
+    """:func:`scene_dict` on the creeping base of the preset: the thin layer answers."""
+    d = scene_dict(**coating)
+    d["base"]["creep"] = json.loads((ROOT / "assets" / "scenes" / "uniform_flat.json")
+                                    .read_text())["base"]["creep"]
+    return d
+
+
 def test_every_result_carries_the_estimate_and_the_flag():
-    d = scene_dict()
+    d = creeping_scene_dict()
     result = solve(d)
+    assert result.info["coating_model"] == "thin layer"
     estimate = result.info["model_error_estimate"]
     assert 0 < estimate < 0.02 and "model_error" not in result.flags
     d["solver"] = {"model_tol": 1e-4}
     flagged = solve(d)
     assert "model_error" in flagged.flags and "model_error" in flagged.flag_messages
+    # on an elastic base the exact layered kernel answers: no model error to flag
+    exact = scene_dict()
+    exact["solver"] = {"model_tol": 1e-4}
+    result = solve(exact)
+    assert result.info["coating_model"] == "exact layered"
+    assert result.info["model_error_estimate"] < 1e-8 and "model_error" not in result.flags
 
 
 def test_map_scales_with_thickness_outside_its_range():
@@ -117,7 +132,8 @@ def test_map_scales_with_thickness_outside_its_range():
 
 @pytest.mark.parametrize("interface", ["smooth", "bonded"])
 def test_check_confirms_the_estimate_within_a_factor_3(interface):
-    report = check_scene(scene_dict(interface=interface))
+    report = check_scene(creeping_scene_dict(interface=interface))
+    assert report["coating_model"] == "thin layer"
     assert report["model_error"] > 0
     assert report["estimate"] / 3 <= report["model_error"] <= 3 * report["estimate"]
 
@@ -137,3 +153,13 @@ def test_cli_check_prints_the_model_error(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "core", "check", str(path), "--time", "5"],
                           cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 2 and proc.stderr.startswith("error: --time: must be in")
+
+
+def test_check_compares_in_full_contact_as_the_fe_model():
+    from core.coating_check import elastic_scene
+
+    d = creeping_scene_dict()
+    d["loading"] = {"force": 5e5, "moment": 4e5}  # e = 0.8 a: the scene's answer lifts off
+    copy = elastic_scene(scene_from_dict(d))
+    assert copy.contact == "full" and copy.creep.spec["model"] == "elastic"
+    assert solve(copy).contact_lost

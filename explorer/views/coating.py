@@ -1,8 +1,10 @@
-"""The Coating tab: the number of layers and the profiles of the layer being edited."""
+"""The Coating tab: the number of layers, the profiles of the layer being edited, and the
+"check the coating model" button (the resolved finite-element check of the scene)."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import logging
+from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
@@ -12,6 +14,14 @@ from .style import NOTE_STYLE, TAB_COLUMN, html_pane
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp
+
+log = logging.getLogger(__name__)
+
+#: FE mesh level of the check (0, the coarsest: ~1-3 s of one core; P and M to ~2e-4).
+CHECK_LEVEL = 0
+#: Rows of the check's table: quantity, unit shown, factor from SI.
+CHECK_ROWS = (("settlement", "mm", 1e3), ("tilt", "mrad", 1e3), ("force", "kN/m", 1e-3),
+              ("moment", "kN·m/m", 1e-3))
 
 
 class CoatingView:
@@ -39,6 +49,7 @@ class CoatingView:
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
                                             variations=False, live_when=live)
         self.layer_note = html_pane("", styles=NOTE_STYLE)
+        self.check = CoatingCheckView(app)
         s.param.watch(lambda *e: self.refresh(), "n_layers")
         self.refresh()
 
@@ -49,7 +60,7 @@ class CoatingView:
                       "a slider.</small>"),
             self.n_layers, self.layer, self.layer_note, self.thickness_editor.panel,
             self.modulus_editor.panel, self.poisson_editor.panel,
-            self.app.fidelity.interface_panel, **TAB_COLUMN)
+            self.app.fidelity.interface_panel, self.check.panel, **TAB_COLUMN)
 
     def refresh(self) -> None:
         """Offer one button per layer on screen; say so when the scene has more."""
@@ -74,3 +85,95 @@ class CoatingView:
         self.modulus_editor.bind(layer.modulus, a)
         self.poisson_editor.bind(layer.poisson, a)
         self.app.fidelity.bind_layer(layer)
+
+
+def check_report_html(report: dict[str, Any]) -> str:
+    """The FE check's report (:func:`core.coating_check.check_scene`) as HTML: the model
+    error of the fast answer beside its estimate, and a row per quantity."""
+    errors = report["errors"]
+    given = report.get("given", ())
+    rows = []
+    for name, unit, factor in CHECK_ROWS:
+        error = "given" if name in given else f"{100 * errors[name]:+.3f}"
+        rows.append(f"<tr><td>{name} [{unit}]</td><td>{factor * report['fast'][name]:.5g}</td>"
+                    f"<td>{factor * report['fe'][name]:.5g}</td><td>{error}</td></tr>")
+    rows.append(f"<tr><td>pressure, |x| &le; 0.9 a</td><td></td><td></td>"
+                f"<td>{100 * errors['pressure']:.3f}</td></tr>")
+    return (
+        f"<div class='coating-check-report'><small>At loading, against the resolved "
+        f"finite-element model ({report['fe_dofs']:,} unknowns, "
+        f"{report['fe_seconds']:.1f} s). Coating model: {report['coating_model']}.</small>"
+        f"<br><b>model error: measured {100 * report['model_error']:.3g} %, "
+        f"estimated {100 * report['estimate']:.3g} %</b>"
+        + ("<br><span class='cp-msg'>The punch lifts off here: both models are compared "
+           "in full contact, as the FE model ties the punch to the surface.</span>"
+           if report.get("contact_lost") else "")
+        + "<table class='cp-readout'><tr><th></th><th>fast</th><th>FE</th><th>error [%]</th>"
+        "</tr>" + "".join(rows) + "</table></div>")
+
+
+class CoatingCheckView:
+    """The "check the coating model" button: runs :func:`core.coating_check.check_scene`
+    on the scene on screen where the session's solves run (a worker process, or a thread
+    of the solver pool; never the page's event loop), shows a progress bar meanwhile and
+    the report when it is done."""
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self.app = app
+        self.button = pn.widgets.Button(name="check the coating model", button_type="default",
+                                        sizing_mode="stretch_width",
+                                        css_classes=["coating-check-button"])
+        self.progress = pn.indicators.Progress(active=True, visible=False,
+                                               sizing_mode="stretch_width",
+                                               css_classes=["coating-check-progress"])
+        self.result = html_pane("", css_classes=["coating-check-result"],
+                                sizing_mode="stretch_width")
+        self.button.on_click(lambda event: self.run())
+        self.panel = pn.Column(
+            html_pane("<small>Compare the answer with a finite-element model that resolves "
+                      "the coating (at loading, a few seconds).</small>", styles=NOTE_STYLE),
+            self.button, self.progress, self.result, margin=0, sizing_mode="stretch_width")
+
+    def run(self) -> None:
+        """Start the check of the current scene (the outcome arrives by :meth:`show`)."""
+        try:
+            scene = self.app.state.to_scene()
+        except ValueError as exc:
+            self.result.object = f"<span class='cp-msg'>Not checked: {exc}</span>"
+            return
+        self.button.disabled = True
+        self.progress.visible = True
+        self.result.object = "<small>Solving the resolved model…</small>"
+        executor = self.app.controller.executor
+        if executor is None:
+            self.show(_check(scene))
+        else:
+            executor.submit(lambda: self._finish(_check(scene)))
+
+    def _finish(self, outcome: dict[str, Any] | str) -> None:
+        self.app._dispatch(lambda: self.show(outcome))
+
+    def show(self, outcome: dict[str, Any] | str) -> None:
+        """Show a report (dict) or a message (str) and make the button ready again."""
+        self.progress.visible = False
+        self.button.disabled = False
+        self.result.object = (check_report_html(outcome) if isinstance(outcome, dict)
+                              else f"<span class='cp-msg'>{outcome}</span>")
+
+
+def _check(scene: dict[str, Any]) -> dict[str, Any] | str:
+    """The check's report, or why there is none (runs off the event loop)."""
+    from core.coating_check import check_scene
+
+    from ..controller import worker_processes
+
+    try:
+        processes = worker_processes()
+        if processes is not None:
+            return processes.run(processes.assign(), check_scene, scene, 0.0, CHECK_LEVEL)
+        return check_scene(scene, 0.0, level=CHECK_LEVEL)
+    except ValueError as exc:
+        return f"Not checked: {exc}"
+    except Exception as exc:  # the session must survive a failed check
+        log.exception("coating check failed")
+        return f"The check failed ({type(exc).__name__}: {exc})."

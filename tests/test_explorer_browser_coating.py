@@ -1,0 +1,49 @@
+"""The "check the coating model" button in a real browser: a click runs the resolved
+finite-element check of the scene on screen and shows its model error beside the estimate.
+
+Debian's Chromium through Playwright; every wait is on a condition in the page.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
+
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
+
+from tests.browser_pages import (  # noqa: E402
+    JS_SHOWN,
+    Page,
+    chromium_context,
+    served_explorer,
+    until,
+)
+
+
+@pytest.fixture(scope="module")
+def page() -> Iterator[Page]:
+    for url in served_explorer():
+        for context in chromium_context(1400, 900):
+            shown = Page(context, url)
+            yield shown
+            shown.close()
+
+
+def test_check_button_shows_the_measured_model_error_beside_the_estimate(page: Page):
+    page.open_tab("Coating")
+    button = page.page.locator(".coating-check-button button").first
+    button.click()
+    # the progress bar shows while the FE model solves (or the report is already there)
+    bar = page.page.locator(".coating-check-progress").first
+    until(lambda: bar.is_visible() or page.page.evaluate(JS_SHOWN, "model error: measured"),
+          "the check's progress bar", timeout=60)
+    page.page.wait_for_function(JS_SHOWN, arg="model error: measured", timeout=180_000)
+    for text in ("estimated", "settlement [mm]", "pressure", "Coating model: thin layer"):
+        assert page.page.evaluate(JS_SHOWN, text), text
+    assert button.is_enabled()
+    assert page.errors == []

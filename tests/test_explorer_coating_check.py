@@ -1,0 +1,49 @@
+"""The explorer's "check the coating model" button, without a browser."""
+
+from __future__ import annotations
+
+from explorer.app import ExplorerApp
+from explorer.views.coating import CoatingView, check_report_html
+
+
+class _Held:
+    """An executor that keeps the work until the test runs it."""
+
+    def __init__(self) -> None:
+        self.work: list = []
+
+    def submit(self, fn, *args):
+        self.work.append((fn, args))
+
+
+def _check_view(app: ExplorerApp):
+    return next(v for v in app.views if isinstance(v, CoatingView)).check
+
+
+def test_the_check_runs_off_the_page_and_shows_the_model_error_beside_its_estimate():
+    held = _Held()
+    app = ExplorerApp(executor=None)
+    app.controller._executor = held  # the check goes where the session's solves go
+    check = _check_view(app)
+    check.run()
+    # while the FE model solves, the page shows progress and the button waits
+    assert len(held.work) == 1 and check.progress.visible and check.button.disabled
+    fn, args = held.work.pop()
+    fn(*args)
+    assert not check.progress.visible and not check.button.disabled
+    text = check.result.object
+    assert "model error: measured" in text and "estimated" in text, text
+    assert "Coating model: thin layer" in text  # the default preset's base creeps
+    for row in ("settlement [mm]", "tilt [mrad]", "pressure"):
+        assert row in text
+
+
+def test_report_marks_the_given_quantities():
+    report = {"errors": {"settlement": 0.01, "tilt": 0.02, "force": 0.0, "moment": 0.0,
+                         "pressure": 0.03},
+              "fast": {"settlement": 1e-3, "tilt": 1e-4, "force": 1e5, "moment": 1e4},
+              "fe": {"settlement": 0.99e-3, "tilt": 0.98e-4, "force": 1e5, "moment": 1e4},
+              "model_error": 0.02, "estimate": 0.015, "coating_model": "thin layer",
+              "given": ["force", "moment"], "fe_dofs": 25000, "fe_seconds": 1.2}
+    text = check_report_html(report)
+    assert text.count("given") == 2 and "+1.000" in text and "measured 2 %" in text
