@@ -52,6 +52,10 @@ ROWS_BYTES = 64 * 2**20
 #: elastic (a matrix product per sample) and creeping (each sample is an output of the
 #: time stepping: 256 took a 100-output aging scene from 89 to 179 ms, 64 to 106 ms).
 HISTORY_SAMPLES = {"elastic": 256, "creep": 64}
+#: Digits of a load's shape (the history over its peak) that key its cached creep
+#: response: far above the rounding of a unit conversion (1e-16), far below any tol, so a
+#: load change that only scales a load reuses the response of its shape.
+SHAPE_DIGITS = 12
 
 
 @dataclass(frozen=True)
@@ -307,8 +311,10 @@ class PreparedContact:
                 continue
             unit = dict(zero)
             unit[name] = lambda tt, f=fn, a=amplitude: f(tt) / a
-            parts.append((amplitude, (common, name, fingerprint(values / amplitude)), unit,
-                          0.0))
+            # the shape to SHAPE_DIGITS digits: a load scaled in other units (a force in
+            # N turned dimensionless) differs from the cached shape by rounding alone
+            shape = np.round(values / amplitude, SHAPE_DIGITS) + 0.0
+            parts.append((amplitude, (common, name, fingerprint(shape)), unit, 0.0))
         if not self.geometry.g_is_zero or not parts:
             parts.append((1.0, (common, "gap"), zero, 1.0))
         weighted_error = 0.0
