@@ -53,6 +53,20 @@ RADAU_A = np.array([
     [(16 - _S6) / 36, (16 + _S6) / 36, 1 / 9],
 ])
 RADAU_ORDER = 5
+# inv(I + x A) = adj(I + x A) / det(I + x A) with, for a 3x3 matrix (Cayley-Hamilton),
+# adj(I + x A) = I + x P1 + x^2 P2, P1 = a I - A, P2 = (a^2 - b)/2 I - a A + A^2
+# (a = tr A, b = tr A^2), and det = 1 + a x + (a^2 - b)/2 x^2 + det(A) x^3, whose
+# coefficients are positive (the eigenvalues of A have positive real parts): no
+# cancellation for any x >= 0. _Q = _P A gives inv A = (A + x Q1 + x^2 Q2) / det.
+_TR, _TR2 = float(np.trace(RADAU_A)), float(np.trace(RADAU_A @ RADAU_A))
+_P1 = _TR * np.eye(3) - RADAU_A
+_P2 = 0.5 * (_TR**2 - _TR2) * np.eye(3) - _TR * RADAU_A + RADAU_A @ RADAU_A
+_Q1, _Q2 = _P1 @ RADAU_A, _P2 @ RADAU_A
+_P1_ROWS, _P2_ROWS = _P1.sum(axis=1), _P2.sum(axis=1)
+_DET = (_TR, 0.5 * (_TR**2 - _TR2), float(np.linalg.det(RADAU_A)))
+#: h * decay beyond which a state is fully relaxed within a step (inv ~ 1/x): capped so
+#: that x^3 stays finite
+_X_MAX = 1e60
 #: Relative distance from a jump at which a history is read on the side before it (and,
 #: at an output time on a jump, after it): far above the rounding of converting times
 #: (days to the dimensionless time and back), far below any tolerance.
@@ -155,47 +169,97 @@ def _radau_step(kernel, problem: ModalProblem, t0: float, h: float,
 
     ``s_modes`` (modes, states), ``s_known`` (known, states). ``before_jump``: the step
     ends where a history jumps, so its last stage (at the step's end) reads the history
-    just before the jump.
+    just before the jump. See :func:`_radau_steps`, of which this is the case of one step.
+    """
+    modes, known = _radau_steps(kernel, problem, t0, np.array([float(h)]), s_modes, s_known,
+                                before_jump=np.array([before_jump]))
+    return modes[0], known[0]
+
+
+def _radau_steps(kernel, problem: ModalProblem, t0: float, hs: np.ndarray,
+                 s_modes: np.ndarray, s_known: np.ndarray, *,
+                 before_jump: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Radau IIA steps of lengths ``hs`` (B,), all from ``t0`` and the same states, at once.
+
+    Returns the new states, (B, modes, states) and (B, known, states). ``before_jump``
+    (B,) bools: that step ends where a history jumps, so its last stage reads the
+    history just before it. One call evaluates the kernel and the histories at the stage
+    times of every step together, so a step and its half (step doubling) and the side
+    steps to the output times inside it cost one set of array operations.
 
     The states of one channel couple only through their sum ``V w``: a state obeys
     ``S_s' = -decay_s S_s + beta_s(t) z(t)`` with ``z = (r + V w)/d`` shared by all of them.
     Eliminating the states, whose stage operator ``I + h decay_s A`` is the same for every
-    mode, leaves one 3x3 system in the stage values of ``z`` per mode: the step costs
+    mode, leaves one 3x3 system in the stage values of ``z`` per mode: a step costs
     O(modes) small operations instead of a (3 states)^2 solve per mode.
     """
-    ts = t0 + RADAU_C * h
-    if before_jump:
-        ts[-1] = _before(t0 + h)
-    beta, decay = _kernel_factors(kernel, ts)               # (states, 3), (states,)
-    hA = h * RADAU_A
-    # inv(I + h decay_s A) for every state s: (states, 3, 3)
-    inv = np.linalg.inv(np.eye(3)[None] + decay[:, None, None] * hA[None])
-    carry = inv.sum(axis=2)                                  # (states, 3): inv_s @ 1
-    # forcing of the stages of state s by z at the stages: inv_s h A diag(beta_s)
-    drive = (inv @ hA) * beta[:, None, :]                    # (states, 3, 3)
-    total = drive.sum(axis=0)                                # (3, 3): sum over the states
-    last_carry = carry[:, 2]                                 # the step's end (c_3 = 1)
-    last_drive = drive[:, 2, :]                              # (states, 3)
-    new_known = s_known
+    hs = np.asarray(hs, dtype=float)
+    n_steps = hs.size
+    ts = t0 + hs[:, None] * RADAU_C[None, :]                 # (B, 3)
+    if before_jump is not None and np.any(before_jump):
+        ends = t0 + hs[before_jump]
+        ts[before_jump, -1] = ends - JUMP_SIDE * np.maximum(1.0, np.abs(ends))
+    flat = ts.ravel()
+    beta, decay = _kernel_factors(kernel, flat)             # (states, 3B), (states,)
+    n_states = decay.size
+    beta = beta.reshape(n_states, n_steps, 3).transpose(1, 0, 2)   # (B, states, 3)
+    # inv(I + x A), x = h decay_s, for every step and state, by the adjugate (module
+    # constants): (I + x P1 + x^2 P2) / det(x), det with positive coefficients
+    x = np.minimum(hs[:, None] * decay[None, :], _X_MAX)     # (B, states)
+    x2 = x * x
+    det = 1.0 + x * _DET[0] + x2 * _DET[1] + x2 * x * _DET[2]
+    carry = (1.0 + x[..., None] * _P1_ROWS + x2[..., None] * _P2_ROWS) / det[..., None]
+    # inv h A diag(beta_s): forcing of the stages of state s by z at the stages
+    scaled = beta / det[..., None]                           # (B, states, 3)
+    g0 = scaled.sum(axis=1)                                  # (B, 3)
+    g1 = np.einsum("bs,bsj->bj", x, scaled)
+    g2 = np.einsum("bs,bsj->bj", x2, scaled)
+    h3 = hs[:, None, None]
+    total = h3 * (RADAU_A[None] * g0[:, None, :] + _Q1[None] * g1[:, None, :]
+                  + _Q2[None] * g2[:, None, :])              # (B, 3, 3): over the states
+    last_carry = carry[:, :, 2]                              # (B, states): step's end
+    last_drive = h3 * (RADAU_A[2] + x[..., None] * _Q1[2] + x2[..., None] * _Q2[2]) * scaled
+    new_known = np.broadcast_to(s_known, (n_steps,) + s_known.shape)
     known_stage_sums = None
     if problem.n_known:
         # known channels: z = u, given
-        u = problem.u(ts)                                    # (known, 3)
-        known_stage_sums = s_known @ carry + u @ total.T     # V u at the stage times
-        new_known = s_known * last_carry[None, :] + u @ last_drive.T
-    new_modes = s_modes
+        u = problem.u(flat).reshape(-1, n_steps, 3).transpose(1, 0, 2)   # (B, known, 3)
+        known_stage_sums = s_known @ carry + u @ total.transpose(0, 2, 1)  # V u at stages
+        new_known = (s_known[None] * last_carry[:, None, :]
+                     + u @ last_drive.transpose(0, 2, 1))
+    new_modes = np.broadcast_to(s_modes, (n_steps,) + s_modes.shape)
     if problem.n_modes:
-        d = problem.d(ts)                                    # (modes, 3)
-        r = problem.r(ts)
+        d = problem.d(flat).reshape(-1, n_steps, 3).transpose(1, 0, 2)   # (B, modes, 3)
+        r = problem.r(flat).reshape(-1, n_steps, 3).transpose(1, 0, 2)
         if known_stage_sums is not None:
-            r = r + problem.coupling @ known_stage_sums
+            r = r + problem.coupling[None] @ known_stage_sums
         # V w = d z - r at the stages, and V w = s @ carry + total z: solve for z
-        system = np.zeros((problem.n_modes, 3, 3))
-        system[:, [0, 1, 2], [0, 1, 2]] = d
-        system -= total[None]
-        z = np.linalg.solve(system, (s_modes @ carry + r)[:, :, None])[:, :, 0]
-        new_modes = s_modes * last_carry[None, :] + z @ last_drive.T
+        z = _solve_stages(d, total, s_modes @ carry + r)
+        new_modes = (s_modes[None] * last_carry[:, None, :]
+                     + z @ last_drive.transpose(0, 2, 1))
     return new_modes, new_known
+
+
+def _solve_stages(d: np.ndarray, total: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Solve ``(diag(d[b, k]) - total[b]) z[b, k] = rhs[b, k]`` for every step b and mode k.
+
+    ``d``, ``rhs`` (B, modes, 3), ``total`` (B, 3, 3). Cramer's rule over the arrays, which
+    avoids a LAPACK call per system: the systems are well conditioned (``d >= 1`` on the
+    diagonal, ``total`` the creep of one step), checked against the full stage system in
+    tests/test_time_integration.py.
+    """
+    t = total[:, None]                                       # (B, 1, 3, 3)
+    m00, m11, m22 = d[..., 0] - t[..., 0, 0], d[..., 1] - t[..., 1, 1], d[..., 2] - t[..., 2, 2]
+    m01, m02, m10 = -t[..., 0, 1], -t[..., 0, 2], -t[..., 1, 0]
+    m12, m20, m21 = -t[..., 1, 2], -t[..., 2, 0], -t[..., 2, 1]
+    # the adjugate (cofactors, transposed) and the determinant by the first row
+    c00, c01, c02 = m11 * m22 - m12 * m21, m02 * m21 - m01 * m22, m01 * m12 - m02 * m11
+    c10, c11, c12 = m12 * m20 - m10 * m22, m00 * m22 - m02 * m20, m02 * m10 - m00 * m12
+    c20, c21, c22 = m10 * m21 - m11 * m20, m01 * m20 - m00 * m21, m00 * m11 - m01 * m10
+    det = m00 * c00 + m01 * c10 + m02 * c20
+    r0, r1, r2 = rhs[..., 0], rhs[..., 1], rhs[..., 2]
+    return np.stack([c00 * r0 + c01 * r1 + c02 * r2, c10 * r0 + c11 * r1 + c12 * r2,
+                     c20 * r0 + c21 * r1 + c22 * r2], axis=-1) / det[..., None]
 
 
 def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: float,
@@ -219,7 +283,6 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     nm, nk = problem.n_modes, problem.n_known
     s_modes = np.zeros((nm, ns))
     s_known = np.zeros((nk, ns))
-    w_out = np.zeros((nm, len(times)))
     vw_out = np.zeros((nm, len(times)))
     vu_out = np.zeros((nk, len(times)))
     w_scale, u_scale = _scales(problem, float(times[-1]))
@@ -228,19 +291,22 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     # A tenth of tol per unit of time, so the accumulated error stays below tol.
     local_tol = 0.1 * tol
 
-    def record(k: int, t: float, sm: np.ndarray, sk: np.ndarray) -> None:
-        vu = sk.sum(axis=1)
-        vu_out[:, k] = vu
-        if nm:
-            tt = np.array([_after(t) if t in jump_set else t])
-            vw = sm.sum(axis=1)
-            forcing = problem.r(tt)[:, 0] + (problem.coupling @ vu if nk else 0.0)
-            w_out[:, k] = (forcing + vw) / problem.d(tt)[:, 0]
-            vw_out[:, k] = vw
+    def record(k: slice | int, sm: np.ndarray, sk: np.ndarray) -> None:
+        # V w and V u now; w itself is formed for all times at once at the end
+        vu_out[:, k] = sk.sum(axis=-1).T
+        vw_out[:, k] = sm.sum(axis=-1).T
+
+    def finish() -> np.ndarray:
+        if not nm:
+            return np.zeros((0, len(times)))
+        # an output time on a jump reports the value after it
+        tt = np.array([_after(t) if t in jump_set else t for t in times.tolist()])
+        forcing = problem.r(tt) + (problem.coupling @ vu_out if nk else 0.0)
+        return (forcing + vw_out) / problem.d(tt)
 
     k_out = 0
     while k_out < len(times) and times[k_out] <= 1.0:
-        record(k_out, 1.0, s_modes, s_known)
+        record(k_out, s_modes, s_known)
         k_out += 1
     h = min(span / 20.0, 0.5)
     t_now = 1.0
@@ -251,6 +317,7 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     while k_out < len(times):
         if steps + rejected > max_steps:
             # No answer is better than a wrong one: the times not reached are NaN.
+            w_out = finish()
             w_out[:, k_out:] = vw_out[:, k_out:] = vu_out[:, k_out:] = np.nan
             return VolterraSolution(
                 w_out, vw_out, vu_out, np.inf, steps, rejected, False,
@@ -263,13 +330,29 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         # a step that would end within a millionth of its length before a jump takes it
         at_jump = j_next < len(jumps) and h >= (t_stop - t_now) * (1 - 1e-6)
         h_try = t_stop - t_now if at_jump else min(h, t_final - t_now)
-        full = _radau_step(kernel, problem, t_now, h_try, s_modes, s_known,
-                           before_jump=at_jump)
-        half = _radau_step(kernel, problem, t_now, h_try / 2, s_modes, s_known)
-        fine = _radau_step(kernel, problem, t_now + h_try / 2, h_try / 2, *half,
-                           before_jump=at_jump)
-        diff = np.concatenate([np.abs(fine[0].sum(axis=1) - full[0].sum(axis=1)),
-                               np.abs(fine[1].sum(axis=1) - full[1].sum(axis=1))]) / scale
+        t_next = t_stop if at_jump else t_now + h_try
+        if t_final - t_next <= 1e-12 * max(1.0, t_final):
+            t_next = t_final
+        # output times inside the step: reached by side steps from its start, batched
+        # with the step and its first half
+        k_end = k_out
+        while k_end < len(times) and times[k_end] < t_next - 1e-12 * max(1.0, t_next):
+            k_end += 1
+        k_side = k_out
+        while k_side < k_end and times[k_side] - t_now <= 1e-12 * max(1.0, times[k_side]):
+            k_side += 1
+        hs = np.concatenate([[h_try, h_try / 2], times[k_side:k_end] - t_now])
+        flags = np.zeros(hs.size, dtype=bool)
+        flags[0] = at_jump
+        batch_modes, batch_known = _radau_steps(kernel, problem, t_now, hs, s_modes, s_known,
+                                                before_jump=flags)
+        fine_modes, fine_known = _radau_steps(kernel, problem, t_now + h_try / 2,
+                                              np.array([h_try / 2]), batch_modes[1],
+                                              batch_known[1], before_jump=np.array([at_jump]))
+        fine = (fine_modes[0], fine_known[0])
+        diff = np.concatenate([np.abs(fine[0].sum(axis=1) - batch_modes[0].sum(axis=1)),
+                               np.abs(fine[1].sum(axis=1) - batch_known[0].sum(axis=1))]
+                              ) / scale
         # Richardson: the two-half-step answer carries 1/(2^p - 1) of the difference.
         err = float(np.max(diff, initial=0.0)) / (2**RADAU_ORDER - 1)
         # Below ~100 ulp the step-doubling difference is round-off, not truncation error.
@@ -278,29 +361,23 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
             rejected += 1
             h = h_try * max(0.2, 0.9 * (allowed / err) ** (1 / (RADAU_ORDER + 1)))
             continue
-        t_next = t_stop if at_jump else t_now + h_try
-        if t_final - t_next <= 1e-12 * max(1.0, t_final):
-            t_next = t_final
-        while k_out < len(times) and times[k_out] < t_next - 1e-12 * max(1.0, t_next):
-            tk = float(times[k_out])
-            if tk - t_now <= 1e-12 * max(1.0, tk):
-                record(k_out, tk, s_modes, s_known)
-            else:
-                record(k_out, tk, *_radau_step(kernel, problem, t_now, tk - t_now, s_modes,
-                                               s_known))
-            k_out += 1
+        if k_side > k_out:
+            record(slice(k_out, k_side), s_modes[None], s_known[None])
+        if k_end > k_side:
+            record(slice(k_side, k_end), batch_modes[2:], batch_known[2:])
+        k_out = k_end
         s_modes, s_known = fine
         t_now = t_next
         total_error += err
         steps += 1
         while k_out < len(times) and abs(times[k_out] - t_now) <= 1e-12 * max(1.0, t_now):
-            record(k_out, t_now, s_modes, s_known)
+            record(k_out, s_modes, s_known)
             k_out += 1
         grow = 4.0 if err == 0 else min(4.0, max(0.5, 0.9 * (allowed / err) ** (
             1 / (RADAU_ORDER + 1))))
         h = h_try * grow
     est = max(total_error, 1e-15)
-    return VolterraSolution(w_out, vw_out, vu_out, est, steps, rejected, True, "ok")
+    return VolterraSolution(finish(), vw_out, vu_out, est, steps, rejected, True, "ok")
 
 
 def _trapezoid_weights(grid: np.ndarray, i: int) -> np.ndarray:
