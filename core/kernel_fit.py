@@ -163,6 +163,17 @@ class FittedKernel:
         e, log_slope = self._modulus(tau)
         return -log_slope + e * slope.sum(axis=0)
 
+    def factors(self, tau: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """``b(tau)`` and ``a_r(tau)`` [-] together (:meth:`tau_part`,
+        :meth:`exponential_parts`), the amplitudes and the modulus evaluated once."""
+        tau = np.asarray(tau, dtype=float)
+        amp, slope = self.amplitudes(tau)
+        if self.direct:
+            return amp[0], amp[1:]
+        e, log_slope = self._modulus(tau)
+        theta = self.thetas.reshape((-1,) + (1,) * tau.ndim)
+        return -log_slope + e * slope.sum(axis=0), -e * (slope + amp / theta)
+
     def exponential_parts(self, tau: ArrayLike) -> np.ndarray:
         """``a_r(tau)`` [-], amplitudes of ``exp(-rate_r (t - tau))``; shape (R,) + tau.shape."""
         tau = np.asarray(tau, dtype=float)

@@ -66,6 +66,14 @@ _P2 = 0.5 * (_TR**2 - _TR2) * np.eye(3) - _TR * RADAU_A + RADAU_A @ RADAU_A
 _Q1, _Q2 = _P1 @ RADAU_A, _P2 @ RADAU_A
 _P1_ROWS, _P2_ROWS = _P1.sum(axis=1), _P2.sum(axis=1)
 _DET = (_TR, 0.5 * (_TR**2 - _TR2), float(np.linalg.det(RADAU_A)))
+# Index pairs of the 3x3 adjugate, row-major over its entries (i, j): the cofactor of
+# entry (j, i) is M[j+1, i+1] M[j+2, i+2] - M[j+1, i+2] M[j+2, i+1], indices mod 3.
+_DIAG = np.arange(3)
+_I, _J = np.divmod(np.arange(9), 3)
+_CA = ((_J + 1) % 3, (_I + 1) % 3)
+_CB = ((_J + 2) % 3, (_I + 2) % 3)
+_CC = ((_J + 1) % 3, (_I + 2) % 3)
+_CD = ((_J + 2) % 3, (_I + 1) % 3)
 #: h * decay beyond which a state is fully relaxed within a step (inv ~ 1/x): capped so
 #: that x^3 stays finite
 _X_MAX = 1e60
@@ -172,10 +180,60 @@ def _scales(problem: ModalProblem, t_end: float) -> tuple[np.ndarray, np.ndarray
 def _kernel_factors(kernel, t_stage: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``beta`` (states, stages): forcing factors; ``decay`` (states,): state decay rates."""
     rates = np.asarray(kernel.rates, dtype=float)
-    beta = np.concatenate([np.asarray(kernel.tau_part(t_stage), dtype=float)[None, :],
-                           np.asarray(kernel.exponential_parts(t_stage),
-                                      dtype=float).reshape(len(rates), -1)], axis=0)
+    if hasattr(kernel, "factors"):  # b and a_r in one evaluation (a fitted kernel)
+        b, a = kernel.factors(t_stage)
+    else:
+        b, a = kernel.tau_part(t_stage), kernel.exponential_parts(t_stage)
+    beta = np.concatenate([np.asarray(b, dtype=float)[None, :],
+                           np.asarray(a, dtype=float).reshape(len(rates), -1)], axis=0)
     return beta, np.concatenate([[0.0], rates])
+
+
+@dataclass(frozen=True)
+class _Stages:
+    """What B Radau steps read at their stage times: step lengths ``hs`` (B,), kernel
+    factors ``beta`` (B, states, 3) and decay rates (states,), the histories ``d``, ``r``
+    (B, modes, 3) and ``u`` (B, known, 3) (None where there are no modes or knowns)."""
+
+    hs: np.ndarray
+    beta: np.ndarray
+    decay: np.ndarray
+    d: np.ndarray | None
+    r: np.ndarray | None
+    u: np.ndarray | None
+
+    def take(self, which) -> _Stages:
+        """The steps ``which`` (an index array or slice) of these."""
+        return _Stages(self.hs[which], self.beta[which], self.decay,
+                       *(None if v is None else v[which] for v in (self.d, self.r, self.u)))
+
+
+def _stage_values(kernel, problem: ModalProblem, starts: np.ndarray, hs: np.ndarray,
+                  before_jump: np.ndarray | None = None) -> _Stages:
+    """Kernel and histories at the stage times of steps ``starts`` -> ``starts + hs``.
+
+    All steps are read in one evaluation of the kernel and of the histories, whatever
+    their starts: a step, its two halves and the side steps to the output times inside it
+    cost one set of calls. ``before_jump`` (B,) bools: that step ends where a history
+    jumps, so its last stage reads the history just before it.
+    """
+    hs = np.asarray(hs, dtype=float)
+    n_steps = hs.size
+    ts = np.asarray(starts, dtype=float)[:, None] + hs[:, None] * RADAU_C[None, :]  # (B, 3)
+    if before_jump is not None and np.any(before_jump):
+        ends = ts[before_jump, -1]
+        ts[before_jump, -1] = ends - JUMP_SIDE * np.maximum(1.0, np.abs(ends))
+    flat = ts.ravel()
+    beta, decay = _kernel_factors(kernel, flat)             # (states, 3B), (states,)
+    beta = beta.reshape(decay.size, n_steps, 3).transpose(1, 0, 2)   # (B, states, 3)
+
+    def read(fn) -> np.ndarray:
+        return fn(flat).reshape(-1, n_steps, 3).transpose(1, 0, 2)
+
+    u = read(problem.u) if problem.n_known else None
+    d = read(problem.d) if problem.n_modes else None
+    r = read(problem.r) if problem.n_modes else None
+    return _Stages(hs, beta, decay, d, r, u)
 
 
 def _radau_step(kernel, problem: ModalProblem, t0: float, h: float,
@@ -197,11 +255,18 @@ def _radau_steps(kernel, problem: ModalProblem, t0: float, hs: np.ndarray,
                  before_jump: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Radau IIA steps of lengths ``hs`` (B,), all from ``t0`` and the same states, at once.
 
-    Returns the new states, (B, modes, states) and (B, known, states). ``before_jump``
-    (B,) bools: that step ends where a history jumps, so its last stage reads the
-    history just before it. One call evaluates the kernel and the histories at the stage
-    times of every step together, so a step and its half (step doubling) and the side
-    steps to the output times inside it cost one set of array operations.
+    Returns the new states, (B, modes, states) and (B, known, states); see
+    :func:`_stage_values` for ``before_jump`` and :func:`_advance` for the step.
+    """
+    hs = np.asarray(hs, dtype=float)
+    stages = _stage_values(kernel, problem, np.full(hs.size, float(t0)), hs, before_jump)
+    return _advance(stages, problem.coupling, s_modes, s_known)
+
+
+def _advance(stages: _Stages, coupling: np.ndarray, s_modes: np.ndarray,
+             s_known: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The Radau IIA steps ``stages`` from the states ``s_modes`` (modes, states) and
+    ``s_known`` (known, states): new states (B, modes, states), (B, known, states).
 
     The states of one channel couple only through their sum ``V w``: a state obeys
     ``S_s' = -decay_s S_s + beta_s(t) z(t)`` with ``z = (r + V w)/d`` shared by all of them.
@@ -209,16 +274,8 @@ def _radau_steps(kernel, problem: ModalProblem, t0: float, hs: np.ndarray,
     mode, leaves one 3x3 system in the stage values of ``z`` per mode: a step costs
     O(modes) small operations instead of a (3 states)^2 solve per mode.
     """
-    hs = np.asarray(hs, dtype=float)
+    hs, beta, decay = stages.hs, stages.beta, stages.decay
     n_steps = hs.size
-    ts = t0 + hs[:, None] * RADAU_C[None, :]                 # (B, 3)
-    if before_jump is not None and np.any(before_jump):
-        ends = t0 + hs[before_jump]
-        ts[before_jump, -1] = ends - JUMP_SIDE * np.maximum(1.0, np.abs(ends))
-    flat = ts.ravel()
-    beta, decay = _kernel_factors(kernel, flat)             # (states, 3B), (states,)
-    n_states = decay.size
-    beta = beta.reshape(n_states, n_steps, 3).transpose(1, 0, 2)   # (B, states, 3)
     # inv(I + x A), x = h decay_s, for every step and state, by the adjugate (module
     # constants): (I + x P1 + x^2 P2) / det(x), det with positive coefficients
     x = np.minimum(hs[:, None] * decay[None, :], _X_MAX)     # (B, states)
@@ -237,20 +294,19 @@ def _radau_steps(kernel, problem: ModalProblem, t0: float, hs: np.ndarray,
     last_drive = h3 * (RADAU_A[2] + x[..., None] * _Q1[2] + x2[..., None] * _Q2[2]) * scaled
     new_known = np.broadcast_to(s_known, (n_steps,) + s_known.shape)
     known_stage_sums = None
-    if problem.n_known:
+    if stages.u is not None:
         # known channels: z = u, given
-        u = problem.u(flat).reshape(-1, n_steps, 3).transpose(1, 0, 2)   # (B, known, 3)
+        u = stages.u                                         # (B, known, 3)
         known_stage_sums = s_known @ carry + u @ total.transpose(0, 2, 1)  # V u at stages
         new_known = (s_known[None] * last_carry[:, None, :]
                      + u @ last_drive.transpose(0, 2, 1))
     new_modes = np.broadcast_to(s_modes, (n_steps,) + s_modes.shape)
-    if problem.n_modes:
-        d = problem.d(flat).reshape(-1, n_steps, 3).transpose(1, 0, 2)   # (B, modes, 3)
-        r = problem.r(flat).reshape(-1, n_steps, 3).transpose(1, 0, 2)
+    if stages.d is not None:
+        r = stages.r
         if known_stage_sums is not None:
-            r = r + problem.coupling[None] @ known_stage_sums
+            r = r + coupling[None] @ known_stage_sums
         # V w = d z - r at the stages, and V w = s @ carry + total z: solve for z
-        z = _solve_stages(d, total, s_modes @ carry + r)
+        z = _solve_stages(stages.d, total, s_modes @ carry + r)
         new_modes = (s_modes[None] * last_carry[:, None, :]
                      + z @ last_drive.transpose(0, 2, 1))
     return new_modes, new_known
@@ -264,18 +320,14 @@ def _solve_stages(d: np.ndarray, total: np.ndarray, rhs: np.ndarray) -> np.ndarr
     diagonal, ``total`` the creep of one step), checked against the full stage system in
     tests/test_time_integration.py.
     """
-    t = total[:, None]                                       # (B, 1, 3, 3)
-    m00, m11, m22 = d[..., 0] - t[..., 0, 0], d[..., 1] - t[..., 1, 1], d[..., 2] - t[..., 2, 2]
-    m01, m02, m10 = -t[..., 0, 1], -t[..., 0, 2], -t[..., 1, 0]
-    m12, m20, m21 = -t[..., 1, 2], -t[..., 2, 0], -t[..., 2, 1]
-    # the adjugate (cofactors, transposed) and the determinant by the first row
-    c00, c01, c02 = m11 * m22 - m12 * m21, m02 * m21 - m01 * m22, m01 * m12 - m02 * m11
-    c10, c11, c12 = m12 * m20 - m10 * m22, m00 * m22 - m02 * m20, m02 * m10 - m00 * m12
-    c20, c21, c22 = m10 * m21 - m11 * m20, m01 * m20 - m00 * m21, m00 * m11 - m01 * m10
-    det = m00 * c00 + m01 * c10 + m02 * c20
-    r0, r1, r2 = rhs[..., 0], rhs[..., 1], rhs[..., 2]
-    return np.stack([c00 * r0 + c01 * r1 + c02 * r2, c10 * r0 + c11 * r1 + c12 * r2,
-                     c20 * r0 + c21 * r1 + c22 * r2], axis=-1) / det[..., None]
+    system = np.repeat(-total[:, None], d.shape[1], axis=1)  # (B, modes, 3, 3)
+    system[..., _DIAG, _DIAG] += d
+    # all nine cofactors at once: adj[i, j] = cofactor of entry (j, i)
+    adj = (system[..., _CA[0], _CA[1]] * system[..., _CB[0], _CB[1]]
+           - system[..., _CC[0], _CC[1]] * system[..., _CD[0], _CD[1]])   # (B, modes, 9)
+    adj = adj.reshape(d.shape + (3,))
+    det = np.einsum("...j,...j->...", system[..., 0, :], adj[..., :, 0])
+    return np.einsum("...ij,...j->...i", adj, rhs) / det[..., None]
 
 
 def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: float,
@@ -358,14 +410,19 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         k_side = k_out
         while k_side < k_end and times[k_side] - t_now <= 1e-12 * max(1.0, times[k_side]):
             k_side += 1
-        hs = np.concatenate([[h_try, h_try / 2], times[k_side:k_end] - t_now])
-        flags = np.zeros(hs.size, dtype=bool)
-        flags[0] = at_jump
-        batch_modes, batch_known = _radau_steps(kernel, problem, t_now, hs, s_modes, s_known,
-                                                before_jump=flags)
-        fine_modes, fine_known = _radau_steps(kernel, problem, t_now + h_try / 2,
-                                              np.array([h_try / 2]), batch_modes[1],
-                                              batch_known[1], before_jump=np.array([at_jump]))
+        # the step, its halves and the side steps: the kernel and histories read at once
+        sides = times[k_side:k_end] - t_now
+        starts = np.full(3 + sides.size, t_now)
+        starts[2] = t_now + h_try / 2
+        flags = np.zeros(starts.size, dtype=bool)
+        flags[[0, 2]] = at_jump
+        stages = _stage_values(kernel, problem, starts,
+                               np.concatenate([[h_try, h_try / 2, h_try / 2], sides]), flags)
+        from_start = np.r_[0, 1, 3:starts.size]
+        batch_modes, batch_known = _advance(stages.take(from_start), problem.coupling,
+                                            s_modes, s_known)
+        fine_modes, fine_known = _advance(stages.take(slice(2, 3)), problem.coupling,
+                                          batch_modes[1], batch_known[1])
         fine = (fine_modes[0], fine_known[0])
         diff = np.concatenate([np.abs(fine[0].sum(axis=1) - batch_modes[0].sum(axis=1)),
                                np.abs(fine[1].sum(axis=1) - batch_known[0].sum(axis=1))]
