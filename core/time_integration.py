@@ -260,13 +260,20 @@ def _radau_steps(kernel, problem: ModalProblem, t0: float, hs: np.ndarray,
     """
     hs = np.asarray(hs, dtype=float)
     stages = _stage_values(kernel, problem, np.full(hs.size, float(t0)), hs, before_jump)
-    return _advance(stages, problem.coupling, s_modes, s_known)
+    new_modes, new_known, _, _ = _advance(stages, problem.coupling, s_modes, s_known)
+    return new_modes, new_known
 
 
 def _advance(stages: _Stages, coupling: np.ndarray, s_modes: np.ndarray,
-             s_known: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+             s_known: np.ndarray, keep: int | None = None
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The Radau IIA steps ``stages`` from the states ``s_modes`` (modes, states) and
-    ``s_known`` (known, states): new states (B, modes, states), (B, known, states).
+    ``s_known`` (known, states).
+
+    Returns the new states of the first ``keep`` steps (all: None), (keep, modes, states)
+    and (keep, known, states), and the sums over the states (``V w``, ``V u``) at the end
+    of every step, (B, modes) and (B, known): a step that only reports (a side step to an
+    output time, the full step of step doubling) needs no more than these.
 
     The states of one channel couple only through their sum ``V w``: a state obeys
     ``S_s' = -decay_s S_s + beta_s(t) z(t)`` with ``z = (r + V w)/d`` shared by all of them.
@@ -292,24 +299,31 @@ def _advance(stages: _Stages, coupling: np.ndarray, s_modes: np.ndarray,
                   + _Q2[None] * g2[:, None, :])              # (B, 3, 3): over the states
     last_carry = carry[:, :, 2]                              # (B, states): step's end
     last_drive = h3 * (RADAU_A[2] + x[..., None] * _Q1[2] + x2[..., None] * _Q2[2]) * scaled
-    new_known = np.broadcast_to(s_known, (n_steps,) + s_known.shape)
+    kept = slice(None) if keep is None else slice(0, keep)
+    n_kept = len(range(n_steps)[kept])
+    drive_sum = last_drive.sum(axis=1)                       # (B, 3)
+    new_known = np.broadcast_to(s_known, (n_kept,) + s_known.shape)
+    known_sums = np.broadcast_to(s_known.sum(axis=1), (n_steps, s_known.shape[0]))
     known_stage_sums = None
     if stages.u is not None:
         # known channels: z = u, given
         u = stages.u                                         # (B, known, 3)
         known_stage_sums = s_known @ carry + u @ total.transpose(0, 2, 1)  # V u at stages
-        new_known = (s_known[None] * last_carry[:, None, :]
-                     + u @ last_drive.transpose(0, 2, 1))
-    new_modes = np.broadcast_to(s_modes, (n_steps,) + s_modes.shape)
+        new_known = (s_known[None] * last_carry[kept, None, :]
+                     + u[kept] @ last_drive[kept].transpose(0, 2, 1))
+        known_sums = last_carry @ s_known.T + np.einsum("bkj,bj->bk", u, drive_sum)
+    new_modes = np.broadcast_to(s_modes, (n_kept,) + s_modes.shape)
+    mode_sums = np.broadcast_to(s_modes.sum(axis=1), (n_steps, s_modes.shape[0]))
     if stages.d is not None:
         r = stages.r
         if known_stage_sums is not None:
             r = r + coupling[None] @ known_stage_sums
         # V w = d z - r at the stages, and V w = s @ carry + total z: solve for z
         z = _solve_stages(stages.d, total, s_modes @ carry + r)
-        new_modes = (s_modes[None] * last_carry[:, None, :]
-                     + z @ last_drive.transpose(0, 2, 1))
-    return new_modes, new_known
+        new_modes = (s_modes[None] * last_carry[kept, None, :]
+                     + z[kept] @ last_drive[kept].transpose(0, 2, 1))
+        mode_sums = last_carry @ s_modes.T + np.einsum("bkj,bj->bk", z, drive_sum)
+    return new_modes, new_known, mode_sums, known_sums
 
 
 def _solve_stages(d: np.ndarray, total: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -360,10 +374,11 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     # STEP_BUDGET): the accumulated error stays below tol.
     local_tol = 0.1 * tol
 
-    def record(k: slice | int, sm: np.ndarray, sk: np.ndarray) -> None:
-        # V w and V u now; w itself is formed for all times at once at the end
-        vu_out[:, k] = sk.sum(axis=-1).T
-        vw_out[:, k] = sm.sum(axis=-1).T
+    def record(k: slice | int, vw: np.ndarray, vu: np.ndarray) -> None:
+        # V w and V u (sums over the states; (count, channels) for a slice); w itself is
+        # formed for all times at once at the end
+        vw_out[:, k] = vw.T
+        vu_out[:, k] = vu.T
 
     def finish() -> np.ndarray:
         if not nm:
@@ -375,7 +390,7 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
 
     k_out = 0
     while k_out < len(times) and times[k_out] <= 1.0:
-        record(k_out, s_modes, s_known)
+        record(k_out, s_modes.sum(axis=1), s_known.sum(axis=1))
         k_out += 1
     h = min(span / 20.0, 0.5)
     t_now = 1.0
@@ -418,39 +433,39 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         flags[[0, 2]] = at_jump
         stages = _stage_values(kernel, problem, starts,
                                np.concatenate([[h_try, h_try / 2, h_try / 2], sides]), flags)
-        from_start = np.r_[0, 1, 3:starts.size]
-        batch_modes, batch_known = _advance(stages.take(from_start), problem.coupling,
-                                            s_modes, s_known)
-        fine_modes, fine_known = _advance(stages.take(slice(2, 3)), problem.coupling,
-                                          batch_modes[1], batch_known[1])
-        fine = (fine_modes[0], fine_known[0])
-        diff = np.concatenate([np.abs(fine[0].sum(axis=1) - batch_modes[0].sum(axis=1)),
-                               np.abs(fine[1].sum(axis=1) - batch_known[0].sum(axis=1))]
-                              ) / scale
+        # from the start: the first half (its states go on), the whole step and the side
+        # steps (their sums over the states are all that is read)
+        from_start = np.r_[1, 0, 3:starts.size]
+        half_modes, half_known, batch_vw, batch_vu = _advance(
+            stages.take(from_start), problem.coupling, s_modes, s_known, keep=1)
+        fine_modes, fine_known, fine_vw, fine_vu = _advance(
+            stages.take(slice(2, 3)), problem.coupling, half_modes[0], half_known[0], keep=1)
+        diff = np.concatenate([np.abs(fine_vw[0] - batch_vw[1]),
+                               np.abs(fine_vu[0] - batch_vu[1])]) / scale
         # Richardson: the two-half-step answer carries 1/(2^p - 1) of the difference.
         err = float(np.max(diff, initial=0.0)) / (2**RADAU_ORDER - 1)
-        # Below ~100 ulp the step-doubling difference is round-off, not truncation error.
         # The budget of a step is the largest of its share of the time, of the log-time
         # since loading and of the steps: creep follows log time, so early steps are short
         # and would otherwise be solved to the accuracy per day of the last years.
         share = max(h_try / span, h_try / ((t_now - 1.0 + h_try) * LOG_TIME_BUDGET), 1e-6,
                     1.0 / STEP_BUDGET if steps < STEP_BUDGET else 0.0)
+        # Below ~100 ulp the step-doubling difference is round-off, not truncation error.
         allowed = max(local_tol * share, 100 * np.finfo(float).eps)
         if err > allowed and h_try > 1e-10 * span:
             rejected += 1
             h = h_try * max(0.2, 0.9 * (allowed / err) ** (1 / (RADAU_ORDER + 1)))
             continue
         if k_side > k_out:
-            record(slice(k_out, k_side), s_modes[None], s_known[None])
+            record(slice(k_out, k_side), s_modes.sum(axis=1)[None], s_known.sum(axis=1)[None])
         if k_end > k_side:
-            record(slice(k_side, k_end), batch_modes[2:], batch_known[2:])
+            record(slice(k_side, k_end), batch_vw[2:], batch_vu[2:])
         k_out = k_end
-        s_modes, s_known = fine
+        s_modes, s_known = fine_modes[0], fine_known[0]
         t_now = t_next
         total_error += err
         steps += 1
         while k_out < len(times) and abs(times[k_out] - t_now) <= 1e-12 * max(1.0, t_now):
-            record(k_out, s_modes, s_known)
+            record(k_out, fine_vw[0], fine_vu[0])
             k_out += 1
         grow = 4.0 if err == 0 else min(4.0, max(0.5, 0.9 * (allowed / err) ** (
             1 / (RADAU_ORDER + 1))))
