@@ -422,21 +422,22 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         k_side = k_out
         while k_side < k_end and times[k_side] - t_now <= 1e-12 * max(1.0, times[k_side]):
             k_side += 1
-        # the step, its halves and the side steps: the kernel and histories read at once
-        sides = times[k_side:k_end] - t_now
-        starts = np.full(3 + sides.size, t_now)
-        starts[2] = t_now + h_try / 2
-        flags = np.zeros(starts.size, dtype=bool)
-        flags[[0, 2]] = at_jump
-        stages = _stage_values(kernel, problem, starts,
-                               np.concatenate([[h_try, h_try / 2, h_try / 2], sides]), flags)
+        # the step, its halves and the side steps: the kernel and histories read at once;
         # from the start: the first half (its states go on), the whole step and the side
-        # steps (their sums over the states are all that is read)
-        from_start = np.r_[1, 0, 3:starts.size]
+        # steps (their sums over the states are all that is read); last the second half
+        sides = times[k_side:k_end] - t_now
+        n_batch = 3 + sides.size
+        starts = np.full(n_batch, t_now)
+        starts[-1] = t_now + h_try / 2
+        flags = np.zeros(n_batch, dtype=bool)
+        flags[[1, -1]] = at_jump
+        stages = _stage_values(kernel, problem, starts,
+                               np.concatenate([[h_try / 2, h_try], sides, [h_try / 2]]), flags)
         half_modes, half_known, batch_vw, batch_vu = _advance(
-            stages.take(from_start), problem.coupling, s_modes, s_known, keep=1)
+            stages.take(slice(0, n_batch - 1)), problem.coupling, s_modes, s_known, keep=1)
         fine_modes, fine_known, fine_vw, fine_vu = _advance(
-            stages.take(slice(2, 3)), problem.coupling, half_modes[0], half_known[0], keep=1)
+            stages.take(slice(n_batch - 1, n_batch)), problem.coupling, half_modes[0],
+            half_known[0], keep=1)
         diff = np.concatenate([np.abs(fine_vw[0] - batch_vw[1]),
                                np.abs(fine_vu[0] - batch_vu[1])]) / scale
         # Richardson: the two-half-step answer carries 1/(2^p - 1) of the difference.
