@@ -321,22 +321,27 @@ class PreparedContact:
         q_check = np.zeros((self._check_x.size, times.size))
         x = self._check_x
         terms: list[tuple[float, ModalAnswer]] = []
-        for weight, key, loads, gap in parts:
-            with self._lock:
-                cached = self._responses.get(key)
-            if cached is None:
-                response = form.solve(times, inputs.c, kernel, loads, time_tol, gap, breaks)
+        with self._lock:
+            found = {key: self._responses.get(key) for _, key, _, _ in parts}
+        missing = [(key, loads, gap) for _, key, loads, gap in parts if found[key] is None]
+        if missing:
+            # the responses not cached yet in one time march (force and moment together)
+            answers = form.solve_parts(times, inputs.c, kernel,
+                                       [(loads, gap) for _, loads, gap in missing],
+                                       time_tol, breaks)
+            for (key, _, gap), response in zip(missing, answers, strict=True):
                 sc = response.scalars
                 drive = (sc["settlement"][None, :] + np.outer(x, sc["tilt"])
                          - gap * self.geometry.g(x)[:, None])
-                check = self.nystrom_pressure(x, drive, c_t, response.effective)
-                cached = (response, check)
+                found[key] = (response, self.nystrom_pressure(x, drive, c_t,
+                                                              response.effective))
                 self.counts["time_response"] += 1
                 with self._lock:
-                    self._responses[key] = cached
+                    self._responses[key] = found[key]
                     while len(self._responses) > 24:
                         self._responses.pop(next(iter(self._responses)))
-            response, check = cached
+        for weight, key, _, _ in parts:
+            response, check = found[key]
             q_check += weight * check
             terms.append((weight, response))
             size = max(float(np.max(np.abs(response.scalars["settlement"]))),
