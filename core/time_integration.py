@@ -66,6 +66,8 @@ _P2 = 0.5 * (_TR**2 - _TR2) * np.eye(3) - _TR * RADAU_A + RADAU_A @ RADAU_A
 _Q1, _Q2 = _P1 @ RADAU_A, _P2 @ RADAU_A
 _P1_ROWS, _P2_ROWS = _P1.sum(axis=1), _P2.sum(axis=1)
 _DET = (_TR, 0.5 * (_TR**2 - _TR2), float(np.linalg.det(RADAU_A)))
+#: Step-doubling differences below this are round-off, not truncation error (~100 ulp).
+_ROUNDOFF = 100 * float(np.finfo(float).eps)
 #: h * decay beyond which a state is fully relaxed within a step (inv ~ 1/x): capped so
 #: that x^3 stays finite
 _X_MAX = 1e60
@@ -294,19 +296,21 @@ def _advance(stages: _Stages, coupling: np.ndarray, s_modes: np.ndarray,
     kept = slice(None) if keep is None else slice(0, keep)
     n_kept = len(range(n_steps)[kept])
     drive_sum = last_drive.sum(axis=1)                       # (B, 3)
-    new_known = np.broadcast_to(s_known, (n_kept,) + s_known.shape)
-    known_sums = np.broadcast_to(s_known.sum(axis=1), (n_steps, s_known.shape[0]))
     known_stage_sums = None
-    if stages.u is not None:
+    if stages.u is None:  # no known channels: nothing to step
+        new_known = np.zeros((n_kept,) + s_known.shape)
+        known_sums = np.zeros((n_steps, s_known.shape[0]))
+    else:
         # known channels: z = u, given
         u = stages.u                                         # (B, known, 3)
         known_stage_sums = s_known @ carry + u @ total.transpose(0, 2, 1)  # V u at stages
         new_known = (s_known[None] * last_carry[kept, None, :]
                      + u[kept] @ last_drive[kept].transpose(0, 2, 1))
         known_sums = last_carry @ s_known.T + (u @ drive_sum[:, :, None])[..., 0]
-    new_modes = np.broadcast_to(s_modes, (n_kept,) + s_modes.shape)
-    mode_sums = np.broadcast_to(s_modes.sum(axis=1), (n_steps, s_modes.shape[0]))
-    if stages.d is not None:
+    if stages.d is None:  # no modes
+        new_modes = np.zeros((n_kept,) + s_modes.shape)
+        mode_sums = np.zeros((n_steps, s_modes.shape[0]))
+    else:
         r = stages.r
         if known_stage_sums is not None:
             r = r + coupling[None] @ known_stage_sums
@@ -448,7 +452,7 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         share = max(h_try / span, h_try / ((t_now - 1.0 + h_try) * LOG_TIME_BUDGET), 1e-6,
                     1.0 / STEP_BUDGET if steps < STEP_BUDGET else 0.0)
         # Below ~100 ulp the step-doubling difference is round-off, not truncation error.
-        allowed = max(local_tol * share, 100 * np.finfo(float).eps)
+        allowed = max(local_tol * share, _ROUNDOFF)
         if err > allowed and h_try > 1e-10 * span:
             rejected += 1
             h = h_try * max(0.2, 0.9 * (allowed / err) ** (1 / (RADAU_ORDER + 1)))
