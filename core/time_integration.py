@@ -21,8 +21,10 @@ meets ``tol`` at them.
   stepped first; the modes then see their stage values (the coupled system is block
   triangular, so this is the exact Radau step of the whole system). Step sizes come from
   step-doubling error estimates; a step may spend its share of the time or of the
-  log-time since loading (:data:`LOG_TIME_BUDGET`), whichever is larger. A step, its
-  first half and the side steps to the output times inside it are one batched call.
+  log-time since loading (:data:`LOG_TIME_BUDGET`) or of the steps
+  (:data:`STEP_BUDGET`), whichever is largest. A step, both its halves and the side steps
+  to the output times inside it read the kernel and the histories once (the batched
+  step itself is :mod:`core.radau`).
 * :func:`solve_general` for any vectorized ``K(t, tau)``: product trapezoid rule on grids
   containing every requested time, halved until the Richardson estimate meets ``tol``
   (O(steps^2) per mode, as any method for a general kernel must be). The grid's size is
@@ -44,33 +46,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from core import limits
+from core.radau import (  # noqa: F401 (RADAU_A, RADAU_C, _radau_step(s): re-exported)
+    JUMP_SIDE,
+    RADAU_A,
+    RADAU_C,
+    RADAU_ORDER,
+    _advance,
+    _radau_step,
+    _radau_steps,
+    _stage_values,
+)
 
 TimeFunction = Callable[[np.ndarray], np.ndarray]
 
-_S6 = np.sqrt(6.0)
-RADAU_C = np.array([(4 - _S6) / 10, (4 + _S6) / 10, 1.0])
-RADAU_A = np.array([
-    [(88 - 7 * _S6) / 360, (296 - 169 * _S6) / 1800, (-2 + 3 * _S6) / 225],
-    [(296 + 169 * _S6) / 1800, (88 + 7 * _S6) / 360, (-2 - 3 * _S6) / 225],
-    [(16 - _S6) / 36, (16 + _S6) / 36, 1 / 9],
-])
-RADAU_ORDER = 5
-# inv(I + x A) = adj(I + x A) / det(I + x A) with, for a 3x3 matrix (Cayley-Hamilton),
-# adj(I + x A) = I + x P1 + x^2 P2, P1 = a I - A, P2 = (a^2 - b)/2 I - a A + A^2
-# (a = tr A, b = tr A^2), and det = 1 + a x + (a^2 - b)/2 x^2 + det(A) x^3, whose
-# coefficients are positive (the eigenvalues of A have positive real parts): no
-# cancellation for any x >= 0. _Q = _P A gives inv A = (A + x Q1 + x^2 Q2) / det.
-_TR, _TR2 = float(np.trace(RADAU_A)), float(np.trace(RADAU_A @ RADAU_A))
-_P1 = _TR * np.eye(3) - RADAU_A
-_P2 = 0.5 * (_TR**2 - _TR2) * np.eye(3) - _TR * RADAU_A + RADAU_A @ RADAU_A
-_Q1, _Q2 = _P1 @ RADAU_A, _P2 @ RADAU_A
-_P1_ROWS, _P2_ROWS = _P1.sum(axis=1), _P2.sum(axis=1)
-_DET = (_TR, 0.5 * (_TR**2 - _TR2), float(np.linalg.det(RADAU_A)))
 #: Step-doubling differences below this are round-off, not truncation error (~100 ulp).
 _ROUNDOFF = 100 * float(np.finfo(float).eps)
-#: h * decay beyond which a state is fully relaxed within a step (inv ~ 1/x): capped so
-#: that x^3 stays finite
-_X_MAX = 1e60
 #: Log-time share of the error budget: a step may spend ``h / ((t - 1 + h) LOG_TIME_BUDGET)``
 #: of it. Summed over steps from the shortest one taken (1e-10 of the span) to the end,
 #: ``h / (t - 1 + h)`` adds up to at most ``1 + ln(1e10)``, about 24, so this share adds at
@@ -85,12 +75,6 @@ LOG_TIME_BUDGET = 100.0
 #: Measured on the 50-year fib MC2010 preset: 193 -> 147 steps (400: 163, 100: 134); the
 #: stiff exponential's closed form (tests/test_hard_cases.py) held to 4.6e-13.
 STEP_BUDGET = 200
-#: Relative distance from a jump at which a history is read on the side before it (and,
-#: at an output time on a jump, after it): far above the rounding of converting times
-#: (days to the dimensionless time and back), far below any tolerance.
-JUMP_SIDE = 1e-12
-
-
 def _before(t: float) -> float:
     return t - JUMP_SIDE * max(1.0, abs(t))
 
@@ -169,180 +153,6 @@ def _scales(problem: ModalProblem, t_end: float) -> tuple[np.ndarray, np.ndarray
     if problem.n_known:
         u_scale = np.maximum(np.max(np.abs(problem.u(probe)), axis=1), 1e-300)
     return w_scale, u_scale
-
-
-def _kernel_factors(kernel, t_stage: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``beta`` (states, stages): forcing factors; ``decay`` (states,): state decay rates."""
-    rates = np.asarray(kernel.rates, dtype=float)
-    if hasattr(kernel, "factors"):  # b and a_r in one evaluation (a fitted kernel)
-        b, a = kernel.factors(t_stage)
-    else:
-        b, a = kernel.tau_part(t_stage), kernel.exponential_parts(t_stage)
-    beta = np.concatenate([np.asarray(b, dtype=float)[None, :],
-                           np.asarray(a, dtype=float).reshape(len(rates), -1)], axis=0)
-    return beta, np.concatenate([[0.0], rates])
-
-
-@dataclass(frozen=True)
-class _Stages:
-    """What B Radau steps read at their stage times: step lengths ``hs`` (B,), kernel
-    factors ``beta`` (B, states, 3) and decay rates (states,), the histories ``d``, ``r``
-    (B, modes, 3) and ``u`` (B, known, 3) (None where there are no modes or knowns)."""
-
-    hs: np.ndarray
-    beta: np.ndarray
-    decay: np.ndarray
-    d: np.ndarray | None
-    r: np.ndarray | None
-    u: np.ndarray | None
-
-    def take(self, which) -> _Stages:
-        """The steps ``which`` (an index array or slice) of these."""
-        return _Stages(self.hs[which], self.beta[which], self.decay,
-                       *(None if v is None else v[which] for v in (self.d, self.r, self.u)))
-
-
-def _stage_values(kernel, problem: ModalProblem, starts: np.ndarray, hs: np.ndarray,
-                  before_jump: np.ndarray | None = None) -> _Stages:
-    """Kernel and histories at the stage times of steps ``starts`` -> ``starts + hs``.
-
-    All steps are read in one evaluation of the kernel and of the histories, whatever
-    their starts: a step, its two halves and the side steps to the output times inside it
-    cost one set of calls. ``before_jump`` (B,) bools: that step ends where a history
-    jumps, so its last stage reads the history just before it.
-    """
-    hs = np.asarray(hs, dtype=float)
-    n_steps = hs.size
-    ts = np.asarray(starts, dtype=float)[:, None] + hs[:, None] * RADAU_C[None, :]  # (B, 3)
-    if before_jump is not None and np.any(before_jump):
-        ends = ts[before_jump, -1]
-        ts[before_jump, -1] = ends - JUMP_SIDE * np.maximum(1.0, np.abs(ends))
-    flat = ts.ravel()
-    beta, decay = _kernel_factors(kernel, flat)             # (states, 3B), (states,)
-    beta = beta.reshape(decay.size, n_steps, 3).transpose(1, 0, 2)   # (B, states, 3)
-
-    def read(fn) -> np.ndarray:
-        return fn(flat).reshape(-1, n_steps, 3).transpose(1, 0, 2)
-
-    u = read(problem.u) if problem.n_known else None
-    d = read(problem.d) if problem.n_modes else None
-    r = read(problem.r) if problem.n_modes else None
-    return _Stages(hs, beta, decay, d, r, u)
-
-
-def _radau_step(kernel, problem: ModalProblem, t0: float, h: float,
-                s_modes: np.ndarray, s_known: np.ndarray, *, before_jump: bool = False
-                ) -> tuple[np.ndarray, np.ndarray]:
-    """One Radau IIA step of all channels. Returns the new mode and known-channel states.
-
-    ``s_modes`` (modes, states), ``s_known`` (known, states). ``before_jump``: the step
-    ends where a history jumps, so its last stage (at the step's end) reads the history
-    just before the jump. See :func:`_radau_steps`, of which this is the case of one step.
-    """
-    modes, known = _radau_steps(kernel, problem, t0, np.array([float(h)]), s_modes, s_known,
-                                before_jump=np.array([before_jump]))
-    return modes[0], known[0]
-
-
-def _radau_steps(kernel, problem: ModalProblem, t0: float, hs: np.ndarray,
-                 s_modes: np.ndarray, s_known: np.ndarray, *,
-                 before_jump: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Radau IIA steps of lengths ``hs`` (B,), all from ``t0`` and the same states, at once.
-
-    Returns the new states, (B, modes, states) and (B, known, states); see
-    :func:`_stage_values` for ``before_jump`` and :func:`_advance` for the step.
-    """
-    hs = np.asarray(hs, dtype=float)
-    stages = _stage_values(kernel, problem, np.full(hs.size, float(t0)), hs, before_jump)
-    new_modes, new_known, _, _ = _advance(stages, problem.coupling, s_modes, s_known)
-    return new_modes, new_known
-
-
-def _advance(stages: _Stages, coupling: np.ndarray, s_modes: np.ndarray,
-             s_known: np.ndarray, keep: int | None = None
-             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The Radau IIA steps ``stages`` from the states ``s_modes`` (modes, states) and
-    ``s_known`` (known, states).
-
-    Returns the new states of the first ``keep`` steps (all: None), (keep, modes, states)
-    and (keep, known, states), and the sums over the states (``V w``, ``V u``) at the end
-    of every step, (B, modes) and (B, known): a step that only reports (a side step to an
-    output time, the full step of step doubling) needs no more than these.
-
-    The states of one channel couple only through their sum ``V w``: a state obeys
-    ``S_s' = -decay_s S_s + beta_s(t) z(t)`` with ``z = (r + V w)/d`` shared by all of them.
-    Eliminating the states, whose stage operator ``I + h decay_s A`` is the same for every
-    mode, leaves one 3x3 system in the stage values of ``z`` per mode: a step costs
-    O(modes) small operations instead of a (3 states)^2 solve per mode.
-    """
-    hs, beta, decay = stages.hs, stages.beta, stages.decay
-    n_steps = hs.size
-    # inv(I + x A), x = h decay_s, for every step and state, by the adjugate (module
-    # constants): (I + x P1 + x^2 P2) / det(x), det with positive coefficients
-    x = np.minimum(hs[:, None] * decay[None, :], _X_MAX)     # (B, states)
-    x2 = x * x
-    det = 1.0 + x * _DET[0] + x2 * _DET[1] + x2 * x * _DET[2]
-    carry = (1.0 + x[..., None] * _P1_ROWS + x2[..., None] * _P2_ROWS) / det[..., None]
-    # inv h A diag(beta_s): forcing of the stages of state s by z at the stages
-    scaled = beta / det[..., None]                           # (B, states, 3)
-    g0 = scaled.sum(axis=1)                                  # (B, 3)
-    g1 = (x[:, None, :] @ scaled)[:, 0, :]
-    g2 = (x2[:, None, :] @ scaled)[:, 0, :]
-    h3 = hs[:, None, None]
-    total = h3 * (RADAU_A[None] * g0[:, None, :] + _Q1[None] * g1[:, None, :]
-                  + _Q2[None] * g2[:, None, :])              # (B, 3, 3): over the states
-    last_carry = carry[:, :, 2]                              # (B, states): step's end
-    last_drive = h3 * (RADAU_A[2] + x[..., None] * _Q1[2] + x2[..., None] * _Q2[2]) * scaled
-    kept = slice(None) if keep is None else slice(0, keep)
-    n_kept = len(range(n_steps)[kept])
-    drive_sum = last_drive.sum(axis=1)                       # (B, 3)
-    known_stage_sums = None
-    if stages.u is None:  # no known channels: nothing to step
-        new_known = np.zeros((n_kept,) + s_known.shape)
-        known_sums = np.zeros((n_steps, s_known.shape[0]))
-    else:
-        # known channels: z = u, given
-        u = stages.u                                         # (B, known, 3)
-        known_stage_sums = s_known @ carry + u @ total.transpose(0, 2, 1)  # V u at stages
-        new_known = (s_known[None] * last_carry[kept, None, :]
-                     + u[kept] @ last_drive[kept].transpose(0, 2, 1))
-        known_sums = last_carry @ s_known.T + (u @ drive_sum[:, :, None])[..., 0]
-    if stages.d is None:  # no modes
-        new_modes = np.zeros((n_kept,) + s_modes.shape)
-        mode_sums = np.zeros((n_steps, s_modes.shape[0]))
-    else:
-        r = stages.r
-        if known_stage_sums is not None:
-            r = r + coupling[None] @ known_stage_sums
-        # V w = d z - r at the stages, and V w = s @ carry + total z: solve for z
-        z = _solve_stages(stages.d, total, s_modes @ carry + r)
-        new_modes = (s_modes[None] * last_carry[kept, None, :]
-                     + z[kept] @ last_drive[kept].transpose(0, 2, 1))
-        mode_sums = last_carry @ s_modes.T + (z @ drive_sum[:, :, None])[..., 0]
-    return new_modes, new_known, mode_sums, known_sums
-
-
-def _solve_stages(d: np.ndarray, total: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Solve ``(diag(d[b, k]) - total[b]) z[b, k] = rhs[b, k]`` for every step b and mode k.
-
-    ``d``, ``rhs`` (B, modes, 3), ``total`` (B, 3, 3). Cramer's rule over the arrays, which
-    avoids a LAPACK call per system: the systems are well conditioned (``d >= 1`` on the
-    diagonal, ``total`` the creep of one step), checked against the full stage system in
-    tests/test_time_integration.py.
-    """
-    t = total[:, None]                                       # (B, 1, 3, 3)
-    m00, m11, m22 = d[..., 0] - t[..., 0, 0], d[..., 1] - t[..., 1, 1], d[..., 2] - t[..., 2, 2]
-    m01, m02, m10 = -t[..., 0, 1], -t[..., 0, 2], -t[..., 1, 0]
-    m12, m20, m21 = -t[..., 1, 2], -t[..., 2, 0], -t[..., 2, 1]
-    # the adjugate (cofactors, transposed) and the determinant by the first row; written
-    # out entry by entry: gathering them with index tables was 5x slower on 6000 systems
-    c00, c01, c02 = m11 * m22 - m12 * m21, m02 * m21 - m01 * m22, m01 * m12 - m02 * m11
-    c10, c11, c12 = m12 * m20 - m10 * m22, m00 * m22 - m02 * m20, m02 * m10 - m00 * m12
-    c20, c21, c22 = m10 * m21 - m11 * m20, m01 * m20 - m00 * m21, m00 * m11 - m01 * m10
-    det = m00 * c00 + m01 * c10 + m02 * c20
-    r0, r1, r2 = rhs[..., 0], rhs[..., 1], rhs[..., 2]
-    return np.stack([c00 * r0 + c01 * r1 + c02 * r2, c10 * r0 + c11 * r1 + c12 * r2,
-                     c20 * r0 + c21 * r1 + c22 * r2], axis=-1) / det[..., None]
 
 
 def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: float,
