@@ -143,6 +143,9 @@ class FittedKernel:
             else:
                 vander = cheb.chebvander(x, self.coef.shape[1] - 1)
             amp[sel] = vander @ self.coef[p]
+            if self.direct:  # a direct fit reads no slope (its dcoef is zero)
+                slope[sel] = 0.0
+                continue
             slope[sel] = (vander @ self.dcoef[p]) * (2.0 / (b - a) / np.maximum(
                 flat[sel], 1.0))[:, None]
         shape = (self.coef.shape[2],) + tau.shape
