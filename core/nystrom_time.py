@@ -27,7 +27,7 @@ import numpy as np
 
 from core.nystrom import NystromGrid
 from core.statements import ModalSystem, modal_system
-from core.time_integration import ModalProblem, _scales, solve_degenerate, solve_general
+from core.time_integration import ModalProblem, solve_degenerate, solve_general
 
 Function = Callable[[np.ndarray], np.ndarray]
 
@@ -137,9 +137,8 @@ class ModalForm:
 
         The parts share ``c``, the kernel and the times, so their modal equations are
         stepped together as one problem with the modes of every part (the force part and
-        the moment part of a load in one pass). Each part's time error estimate is the
-        march's estimate converted to that part's own size, so a small part is not
-        judged against a large one.
+        the moment part of a load in one pass). Each part's error is measured against its
+        own size (``ModalProblem.parts``), as in a march of its own.
         """
         c_t = c(times)
         values = [{name: fn(times) for name, fn in loads.items()} for loads, _ in parts]
@@ -174,34 +173,24 @@ class ModalForm:
                              np.concatenate(rs), np.concatenate(us))
             return memo[key]
 
-        def problem_of(rows: slice, known_rows: slice, coupling: np.ndarray) -> ModalProblem:
-            return ModalProblem(d=lambda tt: evaluate(tt)[0][rows],
-                                r=lambda tt: evaluate(tt)[1][rows],
-                                u=lambda tt: evaluate(tt)[2][known_rows], coupling=coupling)
-
         single = self.coupling / gamma[:, None]
-        problem = problem_of(slice(None), slice(None),
-                             np.kron(np.eye(n_parts), single) if n_parts > 1 else single)
+        problem = ModalProblem(d=lambda tt: evaluate(tt)[0], r=lambda tt: evaluate(tt)[1],
+                               u=lambda tt: evaluate(tt)[2],
+                               coupling=(np.kron(np.eye(n_parts), single) if n_parts > 1
+                                         else single), parts=n_parts)
         jumps = tuple(np.asarray(breaks, dtype=float).tolist()) if breaks is not None else ()
         if hasattr(kernel, "rates") and hasattr(kernel, "exponential_parts"):
             sol = solve_degenerate(kernel, problem, times, tol=time_tol, breaks=jumps)
         else:
             sol = solve_general(kernel, problem, times, tol=time_tol, breaks=jumps)
-        t_end = float(times[-1])
-        march_scale = _scales(problem, t_end)[0][:1] if n_parts > 1 else None
+        # each part's estimate relative to its own size (the largest when not given)
+        estimates = sol.part_errors or (sol.error_estimate,) * n_parts
         answers = []
         for p, (_, gap) in enumerate(parts):
             rows = slice(p * n_free, (p + 1) * n_free)
             known_rows = slice(p * n_known, (p + 1) * n_known)
-            estimate = float(sol.error_estimate)
-            if march_scale is not None and march_scale.size:
-                # the march's estimate is relative to the largest part; this part's own
-                # size (same measure) turns it into this part's relative error
-                own = _scales(problem_of(rows, known_rows, single), t_end)[0][:1]
-                if own.size:
-                    estimate *= float(march_scale[0] / own[0])
             nodal, effective, scalars = self.finish(c_t, values[p], known[p], sol.w[rows],
                                                     sol.vw[rows], sol.vu[known_rows], gap)
-            answers.append(ModalAnswer(nodal, effective, scalars, estimate, int(sol.steps),
-                                       bool(sol.success), sol.message))
+            answers.append(ModalAnswer(nodal, effective, scalars, float(estimates[p]),
+                                       int(sol.steps), bool(sol.success), sol.message))
         return answers

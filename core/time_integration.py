@@ -102,13 +102,16 @@ class ModalProblem:
     """``d w - V w = r + coupling @ V u`` for ``modes`` unknowns and ``known`` functions u.
 
     ``d(t)``, ``r(t)`` return arrays (modes, len(t)); ``u(t)`` (known, len(t));
-    ``coupling`` is (modes, known). All dimensionless.
+    ``coupling`` is (modes, known). All dimensionless. ``parts``: the modes and the known
+    functions are that many equal consecutive groups, independent problems stepped
+    together (the same steps for all); their sizes and errors are measured per group.
     """
 
     d: TimeFunction
     r: TimeFunction
     u: TimeFunction
     coupling: np.ndarray
+    parts: int = 1
 
     @property
     def n_modes(self) -> int:
@@ -125,7 +128,9 @@ class VolterraSolution:
 
     ``w`` and ``vw`` (= ``V w``) have shape (modes, times); ``vu`` (known, times).
     ``error_estimate`` estimates the global error of ``w`` relative to ``max|w|`` (and of
-    ``vu`` relative to ``max|u|``); ``steps`` counts accepted steps.
+    ``vu`` relative to ``max|u|``); ``steps`` counts accepted steps. ``part_errors``: the
+    estimate of each group of :attr:`ModalProblem.parts`, relative to its own size
+    (``error_estimate`` is their largest).
     """
 
     w: np.ndarray
@@ -136,6 +141,7 @@ class VolterraSolution:
     rejected: int
     success: bool
     message: str
+    part_errors: tuple[float, ...] = ()
 
 
 def _scales(problem: ModalProblem, t_end: float) -> tuple[np.ndarray, np.ndarray]:
@@ -148,7 +154,9 @@ def _scales(problem: ModalProblem, t_end: float) -> tuple[np.ndarray, np.ndarray
         if problem.n_known:
             u = problem.u(probe)
             forcing = np.abs(forcing) + np.abs(problem.coupling) @ np.abs(u)
-        w_scale = np.full(problem.n_modes, float(np.max(np.abs(forcing / d))) or 1.0)
+        # one size per group of modes (per problem stepped together)
+        size = np.max(np.abs(forcing / d).reshape(problem.parts, -1), axis=1)
+        w_scale = np.repeat(np.where(size > 0, size, 1.0), problem.n_modes // problem.parts)
     u_scale = np.ones(problem.n_known)
     if problem.n_known:
         u_scale = np.maximum(np.max(np.abs(problem.u(probe)), axis=1), 1e-300)
@@ -179,7 +187,9 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     vw_out = np.zeros((nm, len(times)))
     vu_out = np.zeros((nk, len(times)))
     w_scale, u_scale = _scales(problem, float(times[-1]))
-    scale = np.concatenate([w_scale, u_scale])
+    # laid out like the differences below: per group, its modes then its known functions
+    scale = np.concatenate([w_scale.reshape(problem.parts, -1),
+                            u_scale.reshape(problem.parts, -1)], axis=1)
     span = max(float(times[-1]) - 1.0, 1e-300)
     # A tenth of tol per unit of time, of log-time or per step (LOG_TIME_BUDGET,
     # STEP_BUDGET): the accumulated error stays below tol.
@@ -205,7 +215,7 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         k_out += 1
     h = min(span / 20.0, 0.5)
     t_now = 1.0
-    total_error = 0.0
+    total_error = np.zeros(problem.parts)
     steps = rejected = 0
     t_final = float(times[-1])
     j_next = 0
@@ -252,10 +262,13 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         fine_modes, fine_known, fine_vw, fine_vu = _advance(
             stages.take(slice(n_batch - 1, n_batch)), problem.coupling, half_modes[0],
             half_known[0], keep=1)
-        diff = np.concatenate([np.abs(fine_vw[0] - batch_vw[1]),
-                               np.abs(fine_vu[0] - batch_vu[1])]) / scale
+        diff = np.concatenate([
+            np.abs(fine_vw[0] - batch_vw[1]).reshape(problem.parts, -1),
+            np.abs(fine_vu[0] - batch_vu[1]).reshape(problem.parts, -1)], axis=1
+        ) / scale
         # Richardson: the two-half-step answer carries 1/(2^p - 1) of the difference.
-        err = float(np.max(diff, initial=0.0)) / (2**RADAU_ORDER - 1)
+        errors = np.max(diff, axis=1, initial=0.0) / (2**RADAU_ORDER - 1)
+        err = float(np.max(errors))
         # The budget of a step is the largest of its share of the time, of the log-time
         # since loading and of the steps: creep follows log time, so early steps are short
         # and would otherwise be solved to the accuracy per day of the last years.
@@ -274,7 +287,7 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         k_out = k_end
         s_modes, s_known = fine_modes[0], fine_known[0]
         t_now = t_next
-        total_error += err
+        total_error += errors
         steps += 1
         while k_out < len(times) and abs(times[k_out] - t_now) <= 1e-12 * max(1.0, t_now):
             record(k_out, fine_vw[0], fine_vu[0])
@@ -282,8 +295,9 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         grow = 4.0 if err == 0 else min(4.0, max(0.5, 0.9 * (allowed / err) ** (
             1 / (RADAU_ORDER + 1))))
         h = h_try * grow
-    est = max(total_error, 1e-15)
-    return VolterraSolution(finish(), vw_out, vu_out, est, steps, rejected, True, "ok")
+    part_errors = tuple(float(max(e, 1e-15)) for e in total_error)
+    return VolterraSolution(finish(), vw_out, vu_out, max(part_errors), steps, rejected,
+                            True, "ok", part_errors)
 
 
 def _trapezoid_weights(grid: np.ndarray, i: int) -> np.ndarray:
