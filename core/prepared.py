@@ -101,7 +101,7 @@ class PreparedContact:
         self._modal: dict[frozenset[str], ModalForm] = {}
         self._rows: dict[bytes, np.ndarray] = {}
         self._unit_pressure: dict[tuple, np.ndarray] = {}
-        self._responses: dict[tuple, tuple[ModalAnswer, np.ndarray]] = {}
+        self._responses: dict[tuple, list[tuple[ModalAnswer, np.ndarray]]] = {}
         self._check_x = _check_points(geometry.breakpoints)
         self._solves = 0
         # Solves of one prepared geometry may run in several threads (the explorer's).
@@ -289,9 +289,10 @@ class PreparedContact:
         """The time-stepped answer as a sum of cached responses to each load and the gap.
 
         The problem is linear: each given load is split into its amplitude and its shape
-        (normalized to unit peak), and the response to a shape (other loads zero, no gap)
-        is kept, keyed by the times, c, the kernel and the shape. A load slider changes an
-        amplitude, so it costs a few array operations instead of a time integration.
+        (normalized to unit peak), and the responses to the shapes (each with the other
+        loads zero and no gap; the gap's alone) are stepped in one time march and kept
+        together, keyed by the times, c, the kernel and the shapes. A load slider changes
+        an amplitude, so it costs a few array operations instead of a time integration.
         """
         from core.cache import fingerprint
 
@@ -321,27 +322,29 @@ class PreparedContact:
         q_check = np.zeros((self._check_x.size, times.size))
         x = self._check_x
         terms: list[tuple[float, ModalAnswer]] = []
+        # All parts are stepped in one time march (force and moment together), so they are
+        # cached together: the steps depend on every part, and an answer must not depend
+        # on which parts happened to be cached before.
+        joint_key = tuple(key for _, key, _, _ in parts)
         with self._lock:
-            found = {key: self._responses.get(key) for _, key, _, _ in parts}
-        missing = [(key, loads, gap) for _, key, loads, gap in parts if found[key] is None]
-        if missing:
-            # the responses not cached yet in one time march (force and moment together)
+            found = self._responses.get(joint_key)
+        if found is None:
             answers = form.solve_parts(times, inputs.c, kernel,
-                                       [(loads, gap) for _, loads, gap in missing],
+                                       [(loads, gap) for _, _, loads, gap in parts],
                                        time_tol, breaks)
-            for (key, _, gap), response in zip(missing, answers, strict=True):
+            found = []
+            for (_, _, _, gap), response in zip(parts, answers, strict=True):
                 sc = response.scalars
                 drive = (sc["settlement"][None, :] + np.outer(x, sc["tilt"])
                          - gap * self.geometry.g(x)[:, None])
-                found[key] = (response, self.nystrom_pressure(x, drive, c_t,
-                                                              response.effective))
+                found.append((response, self.nystrom_pressure(x, drive, c_t,
+                                                              response.effective)))
                 self.counts["time_response"] += 1
-                with self._lock:
-                    self._responses[key] = found[key]
-                    while len(self._responses) > 24:
-                        self._responses.pop(next(iter(self._responses)))
-        for weight, key, _, _ in parts:
-            response, check = found[key]
+            with self._lock:
+                self._responses[joint_key] = found
+                while len(self._responses) > 24:
+                    self._responses.pop(next(iter(self._responses)))
+        for (weight, _, _, _), (response, check) in zip(parts, found, strict=True):
             q_check += weight * check
             terms.append((weight, response))
             size = max(float(np.max(np.abs(response.scalars["settlement"]))),
