@@ -15,13 +15,15 @@ EN 1992-1-1, 200 output times over 50 years, tol 1e-4):
 * a plain callable kernel (Arutyunyan, 100 output times over 1000 days, tol 1e-4):
   stepped through its exponential fit against the product-quadrature path.
 
-Timings are medians of ``--repeats`` runs on a shared machine: noisy.
+Timings are medians of ``--repeats`` runs on a shared machine: noisy; the CPU time of the
+process is printed next to the wall time (it is inflated far less by other work).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import time
 from pathlib import Path
 from statistics import median
@@ -40,13 +42,17 @@ PRESET = Path(__file__).resolve().parents[1] / "assets" / "scenes" / \
 
 
 def _timed(fn, repeats: int, before=None) -> tuple[float, object]:
-    seconds, out = [], None
+    """Median wall time [s] of ``repeats`` runs and the last answer (CPU time in
+    ``_timed.cpu``: on a shared machine it is inflated far less than the wall time)."""
+    seconds, cpu, out = [], [], None
     for _ in range(repeats):
         if before is not None:
             before()
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         out = fn()
         seconds.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - start_cpu)
+    _timed.cpu = median(cpu)
     return median(seconds), out
 
 
@@ -72,11 +78,13 @@ def code_scene(model_name: str, repeats: int) -> dict:
     fit_s, _ = _timed(lambda: model.dimensionless_kernel(tau0), repeats, clear_caches)
     new_s, result = _timed(lambda: scene_from_dict(data).dimensionless.solve(), repeats,
                            clear_caches)
+    new_cpu = _timed.cpu
     loads = [dict(data, loading={"force": 6.0e5 * (1 + 0.01 * (k + 1)), "moment": 0.0})
              for k in range(repeats)]
     problems = [scene_from_dict(d).dimensionless for d in loads]
     it = iter(problems)
     load_s, _ = _timed(lambda: next(it).solve(), repeats)
+    load_cpu = _timed.cpu
 
     problem = scene.dimensionless
     reference = solve_dimensionless(problem.lam, problem.m, problem.g, problem.times,
@@ -85,7 +93,9 @@ def code_scene(model_name: str, repeats: int) -> dict:
     size = float(np.max(np.abs(reference.settlement)))
     error = float(np.max(np.abs(result.settlement - reference.settlement))) / size
     return {"model": model_name, "fit_ms": 1e3 * fit_s, "new_scene_ms": 1e3 * new_s,
-            "load_change_ms": 1e3 * load_s, "settlement_error": error,
+            "load_change_ms": 1e3 * load_s,
+            "new_scene_cpu_ms": 1e3 * new_cpu, "load_change_cpu_ms": 1e3 * load_cpu,
+            "settlement_error": error,
             "error_estimate": result.info["error_estimate"],
             "kernel_fit_error": result.info["kernel_fit_error"],
             "steps": result.info["n_steps"], "reference_success": reference.info["success"]}
@@ -100,6 +110,7 @@ def plain_callable(repeats: int, count: int) -> dict:
     reference = solve_dimensionless(0.5, 0.05, 0.0, times, kernel=exact,
                                     **dict(args, tol=1e-9))
     size = float(np.max(np.abs(reference.settlement)))
+    import core.prepared as prepared
     import core.solver as solver
 
     def plain(t: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -110,18 +121,21 @@ def plain_callable(repeats: int, count: int) -> dict:
 
     out = {}
     for name in ("fitted, cold", "fitted, load change", "product quadrature"):
-        keep = solver._fast_kernel
+        keep, keep_prepared = solver._fast_kernel, prepared.stepping_kernel
         if name == "product quadrature":
             # the path a plain callable took before: keep the kernel from being fitted
+            # (in both engines)
             solver._fast_kernel = lambda inp: (inp, 0.0)
+            prepared.stepping_kernel = lambda kernel, t_end, budget: (kernel, 0.0)
         # a load change keeps the fit (cached on the kernel's values)
         before = None if name == "fitted, load change" else clear_caches
         try:
             seconds, sol = _timed(run, repeats if count <= 100 or name != "product quadrature"
                                   else 1, before)
         finally:
-            solver._fast_kernel = keep
-        out[name] = {"ms": 1e3 * seconds, "error": float(np.max(np.abs(
+            solver._fast_kernel, prepared.stepping_kernel = keep, keep_prepared
+        out[name] = {"ms": 1e3 * seconds, "cpu_ms": 1e3 * _timed.cpu,
+                     "error": float(np.max(np.abs(
             sol.settlement - reference.settlement))) / size,
             "estimate": sol.info["error_estimate"]}
     return out
@@ -131,20 +145,24 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
-    print(f"50 years, 200 output times, tol 1e-4 (medians of {args.repeats} runs)")
-    print(f"{'model':12s} {'fit ms':>8s} {'new ms':>8s} {'load ms':>8s} {'error':>9s} "
-          f"{'estimate':>9s} {'fit err':>9s} {'steps':>6s}")
+    print(f"50 years, 200 output times, tol 1e-4 (medians of {args.repeats} runs; load "
+          f"average {os.getloadavg()[0]:.1f}); wall and CPU ms")
+    print(f"{'model':12s} {'fit ms':>8s} {'new ms':>8s} {'new cpu':>8s} {'load ms':>8s} "
+          f"{'load cpu':>8s} {'error':>9s} {'estimate':>9s} {'fit err':>9s} {'steps':>6s}")
     for name in ("fib_mc2010", "eurocode2"):
         r = code_scene(name, args.repeats)
         print(f"{r['model']:12s} {r['fit_ms']:8.1f} {r['new_scene_ms']:8.0f} "
-              f"{r['load_change_ms']:8.1f} {r['settlement_error']:9.1e} "
+              f"{r['new_scene_cpu_ms']:8.0f} {r['load_change_ms']:8.1f} "
+              f"{r['load_change_cpu_ms']:8.1f} {r['settlement_error']:9.1e} "
               f"{r['error_estimate']:9.1e} {r['kernel_fit_error']:9.1e} {r['steps']:6d}")
     for count in (100, 1000):
         print(f"\nplain callable kernel (Arutyunyan), {count} output times over 1000 days, "
               "tol 1e-4")
         for name, r in plain_callable(args.repeats, count).items():
-            print(f"{name:20s} {r['ms']:8.1f} ms  error {r['error']:.1e}  "
+            print(f"{name:20s} {r['ms']:8.1f} ms (cpu {r['cpu_ms']:8.1f})  error "
+                  f"{r['error']:.1e}  "
                   f"estimate {r['estimate']:.1e}")
+    print(f"load average at the end {os.getloadavg()[0]:.1f}")
 
 
 if __name__ == "__main__":

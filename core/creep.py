@@ -186,6 +186,19 @@ class DegenerateKernel:
         c, a, g = coef[:, 0], coef[:, 1], coef[:, 2]
         return tau0 * modulus * (a / age**2 - g * (c + a / age))
 
+    def factors(self, tau: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """``b(tau*)`` and ``a_r(tau*)`` [-] together (:meth:`tau_part`,
+        :meth:`exponential_parts`), the modulus evaluated once."""
+        tau0 = self.age_at_loading
+        age = tau0 * np.asarray(tau, dtype=float)
+        modulus, log_rate = self._age_modulus(age)
+        coef = np.array(self.terms, dtype=float).reshape((len(self.terms), 3)
+                                                           + (1,) * age.ndim)
+        c, a, g = coef[:, 0], coef[:, 1], coef[:, 2]
+        aging = sum(a_r for _, a_r, _ in self.terms)
+        return (tau0 * (log_rate - modulus * aging / age**2),
+                tau0 * modulus * (a / age**2 - g * (c + a / age)))
+
     def __call__(self, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
         """``K*(t*, tau*)`` [-], broadcasting ``t`` against ``tau``; 0 where ``t < tau``."""
         return separable_kernel_value(self, t, tau)

@@ -143,6 +143,9 @@ class FittedKernel:
             else:
                 vander = cheb.chebvander(x, self.coef.shape[1] - 1)
             amp[sel] = vander @ self.coef[p]
+            if self.direct:  # a direct fit reads no slope (its dcoef is zero)
+                slope[sel] = 0.0
+                continue
             slope[sel] = (vander @ self.dcoef[p]) * (2.0 / (b - a) / np.maximum(
                 flat[sel], 1.0))[:, None]
         shape = (self.coef.shape[2],) + tau.shape
@@ -162,6 +165,17 @@ class FittedKernel:
         _, slope = self.amplitudes(tau)
         e, log_slope = self._modulus(tau)
         return -log_slope + e * slope.sum(axis=0)
+
+    def factors(self, tau: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """``b(tau)`` and ``a_r(tau)`` [-] together (:meth:`tau_part`,
+        :meth:`exponential_parts`), the amplitudes and the modulus evaluated once."""
+        tau = np.asarray(tau, dtype=float)
+        amp, slope = self.amplitudes(tau)
+        if self.direct:
+            return amp[0], amp[1:]
+        e, log_slope = self._modulus(tau)
+        theta = self.thetas.reshape((-1,) + (1,) * tau.ndim)
+        return -log_slope + e * slope.sum(axis=0), -e * (slope + amp / theta)
 
     def exponential_parts(self, tau: ArrayLike) -> np.ndarray:
         """``a_r(tau)`` [-], amplitudes of ``exp(-rate_r (t - tau))``; shape (R,) + tau.shape."""

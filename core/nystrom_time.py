@@ -128,39 +128,69 @@ class ModalForm:
         ``gap`` scales the gap's drive (0: the response to the loads alone); ``breaks``
         are times where a load jumps, which the time steps land on.
         """
+        return self.solve_parts(times, c, kernel, [(loads, gap)], time_tol, breaks)[0]
+
+    def solve_parts(self, times: np.ndarray, c: Function, kernel,
+                    parts: list[tuple[dict[str, Function], float]], time_tol: float,
+                    breaks: np.ndarray | None = None) -> list[ModalAnswer]:
+        """:meth:`solve` for several ``(loads, gap)`` at once, in one time march.
+
+        The parts share ``c``, the kernel and the times, so their modal equations are
+        stepped together as one problem with the modes of every part (the force part and
+        the moment part of a load in one pass). Each part's error is measured against its
+        own size (``ModalProblem.parts``), as in a march of its own.
+        """
         c_t = c(times)
-        values = {name: fn(times) for name, fn in loads.items()}
-        known = self.known(values, times.size)
+        values = [{name: fn(times) for name, fn in loads.items()} for loads, _ in parts]
+        known = [self.known(v, times.size) for v in values]
         gamma = self.ms.gamma
         if kernel is None:
-            z = (self.drive(values, times.size, gap) - self.coupling @ known) / (
-                c_t[None, :] + gamma[:, None])
-            nodal, effective, scalars = self.finish(c_t, values, known, z, np.zeros_like(z),
-                                                    np.zeros_like(known), gap)
-            return ModalAnswer(nodal, effective, scalars, 0.0, 0, True,
-                               "no creep: no time stepping")
+            answers = []
+            for (_, gap), vals, kn in zip(parts, values, known, strict=True):
+                z = (self.drive(vals, times.size, gap) - self.coupling @ kn) / (
+                    c_t[None, :] + gamma[:, None])
+                nodal, effective, scalars = self.finish(c_t, vals, kn, z, np.zeros_like(z),
+                                                        np.zeros_like(kn), gap)
+                answers.append(ModalAnswer(nodal, effective, scalars, 0.0, 0, True,
+                                           "no creep: no time stepping"))
+            return answers
+        n_parts, n_free, n_known = len(parts), gamma.size, self.coupling.shape[1]
         memo: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
         def evaluate(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             key = tt.tobytes()
             if key not in memo:
                 memo.clear()
-                ld = {name: fn(tt) for name, fn in loads.items()}
-                u = self.known(ld, tt.size)
                 d = 1.0 + c(tt)[None, :] / gamma[:, None]
-                memo[key] = (d, (self.drive(ld, tt.size, gap) - self.coupling @ u)
-                             / gamma[:, None], u)
+                rs, us = [], []
+                for loads, gap in parts:
+                    ld = {name: fn(tt) for name, fn in loads.items()}
+                    u = self.known(ld, tt.size)
+                    rs.append((self.drive(ld, tt.size, gap) - self.coupling @ u)
+                              / gamma[:, None])
+                    us.append(u)
+                memo[key] = (np.tile(d, (n_parts, 1)) if n_parts > 1 else d,
+                             np.concatenate(rs), np.concatenate(us))
             return memo[key]
 
-        jumps = tuple(np.asarray(breaks, dtype=float).tolist()) if breaks is not None else ()
+        single = self.coupling / gamma[:, None]
         problem = ModalProblem(d=lambda tt: evaluate(tt)[0], r=lambda tt: evaluate(tt)[1],
                                u=lambda tt: evaluate(tt)[2],
-                               coupling=self.coupling / gamma[:, None])
+                               coupling=(np.kron(np.eye(n_parts), single) if n_parts > 1
+                                         else single), parts=n_parts)
+        jumps = tuple(np.asarray(breaks, dtype=float).tolist()) if breaks is not None else ()
         if hasattr(kernel, "rates") and hasattr(kernel, "exponential_parts"):
             sol = solve_degenerate(kernel, problem, times, tol=time_tol, breaks=jumps)
         else:
             sol = solve_general(kernel, problem, times, tol=time_tol, breaks=jumps)
-        nodal, effective, scalars = self.finish(c_t, values, known, sol.w, sol.vw, sol.vu,
-                                                gap)
-        return ModalAnswer(nodal, effective, scalars, float(sol.error_estimate), int(sol.steps),
-                           bool(sol.success), sol.message)
+        # each part's estimate relative to its own size (the largest when not given)
+        estimates = sol.part_errors or (sol.error_estimate,) * n_parts
+        answers = []
+        for p, (_, gap) in enumerate(parts):
+            rows = slice(p * n_free, (p + 1) * n_free)
+            known_rows = slice(p * n_known, (p + 1) * n_known)
+            nodal, effective, scalars = self.finish(c_t, values[p], known[p], sol.w[rows],
+                                                    sol.vw[rows], sol.vu[known_rows], gap)
+            answers.append(ModalAnswer(nodal, effective, scalars, float(estimates[p]),
+                                       int(sol.steps), bool(sol.success), sol.message))
+        return answers

@@ -54,6 +54,10 @@ ROWS_BYTES = 64 * 2**20
 #: elastic (a matrix product per sample) and creeping (each sample is an output of the
 #: time stepping: 256 took a 100-output aging scene from 89 to 179 ms, 64 to 106 ms).
 HISTORY_SAMPLES = {"elastic": 256, "creep": 64}
+#: Digits of a load's shape (the history over its peak) that key its cached creep
+#: response: far above the rounding of a unit conversion (1e-16), far below any tol, so a
+#: load change that only scales a load reuses the response of its shape.
+SHAPE_DIGITS = 12
 
 
 @dataclass(frozen=True)
@@ -102,7 +106,7 @@ class PreparedContact:
         self._modal: dict[frozenset[str], ModalForm] = {}
         self._rows: dict[bytes, np.ndarray] = {}
         self._unit_pressure: dict[tuple, np.ndarray] = {}
-        self._responses: dict[tuple, tuple[ModalAnswer, np.ndarray]] = {}
+        self._responses: dict[tuple, list[tuple[ModalAnswer, np.ndarray]]] = {}
         self._check_x = _check_points(geometry.breakpoints)
         # Check points on panels ending at +-1 or a jump take the Nystrom formula (q has
         # (x - e) ln|x - e| terms there); elsewhere q is analytic and its panel interpolant
@@ -299,9 +303,10 @@ class PreparedContact:
         """The time-stepped answer as a sum of cached responses to each load and the gap.
 
         The problem is linear: each given load is split into its amplitude and its shape
-        (normalized to unit peak), and the response to a shape (other loads zero, no gap)
-        is kept, keyed by the times, c, the kernel and the shape. A load slider changes an
-        amplitude, so it costs a few array operations instead of a time integration.
+        (normalized to unit peak), and the responses to the shapes (each with the other
+        loads zero and no gap; the gap's alone) are stepped in one time march and kept
+        together, keyed by the times, c, the kernel and the shapes. A load slider changes
+        an amplitude, so it costs a few array operations instead of a time integration.
         """
         from core.cache import fingerprint
 
@@ -321,30 +326,39 @@ class PreparedContact:
                 continue
             unit = dict(zero)
             unit[name] = lambda tt, f=fn, a=amplitude: f(tt) / a
-            parts.append((amplitude, (common, name, fingerprint(values / amplitude)), unit,
-                          0.0))
+            # the shape to SHAPE_DIGITS digits: a load scaled in other units (a force in
+            # N turned dimensionless) differs from the cached shape by rounding alone
+            shape = np.round(values / amplitude, SHAPE_DIGITS) + 0.0
+            parts.append((amplitude, (common, name, fingerprint(shape)), unit, 0.0))
         if not self.geometry.g_is_zero or not parts:
             parts.append((1.0, (common, "gap"), zero, 1.0))
         weighted_error = 0.0
         q_check = np.zeros((self._check_x.size, times.size))
         x = self._check_x
         terms: list[tuple[float, ModalAnswer]] = []
-        for weight, key, loads, gap in parts:
-            with self._lock:
-                cached = self._responses.get(key)
-            if cached is None:
-                response = form.solve(times, inputs.c, kernel, loads, time_tol, gap, breaks)
+        # All parts are stepped in one time march (force and moment together), so they are
+        # cached together: the steps depend on every part, and an answer must not depend
+        # on which parts happened to be cached before.
+        joint_key = tuple(key for _, key, _, _ in parts)
+        with self._lock:
+            found = self._responses.get(joint_key)
+        if found is None:
+            answers = form.solve_parts(times, inputs.c, kernel,
+                                       [(loads, gap) for _, _, loads, gap in parts],
+                                       time_tol, breaks)
+            found = []
+            for (_, _, _, gap), response in zip(parts, answers, strict=True):
                 sc = response.scalars
                 drive = (sc["settlement"][None, :] + np.outer(x, sc["tilt"])
                          - gap * self.geometry.g(x)[:, None])
-                check = self.nystrom_pressure(x, drive, c_t, response.effective)
-                cached = (response, check)
+                found.append((response, self.nystrom_pressure(x, drive, c_t,
+                                                              response.effective)))
                 self.counts["time_response"] += 1
-                with self._lock:
-                    self._responses[key] = cached
-                    while len(self._responses) > 24:
-                        self._responses.pop(next(iter(self._responses)))
-            response, check = cached
+            with self._lock:
+                self._responses[joint_key] = found
+                while len(self._responses) > 24:
+                    self._responses.pop(next(iter(self._responses)))
+        for (weight, _, _, _), (response, check) in zip(parts, found, strict=True):
             q_check += weight * check
             terms.append((weight, response))
             size = max(float(np.max(np.abs(response.scalars["settlement"]))),
