@@ -215,7 +215,7 @@ class PreparedContact:
         t0 = _time.perf_counter()
         geometry = self.geometry
         times = inputs.times
-        built_before = Counter(self.counts)
+        built_before = dict(self.counts)
         breaks = np.array([b for b in np.asarray(time_breaks, dtype=float).ravel()
                            if np.isfinite(b) and times[0] < b < times[-1]])
         probe = self._history_times(times, "elastic" if inputs.kernel is None else "creep")
@@ -254,7 +254,7 @@ class PreparedContact:
 
             def pressure(x: np.ndarray) -> np.ndarray:
                 return merged_pressure(x, at)
-        built = {k: self.counts[k] - built_before[k] for k in self.counts}
+        built = {k: self.counts[k] - built_before.get(k, 0) for k in self.counts}
         first_solve = self._solves == 0
         self._solves += 1
         return nystrom_solution(self, inputs, scalars, pressure, q_extremes, time_side,
