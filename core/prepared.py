@@ -100,6 +100,7 @@ class PreparedContact:
         # LU of c m + A at the modulus the grid was refined at: the bordered system of a
         # statement at that c needs only a 2 x 2 Schur complement on top of it.
         self._factor_c, self._factor = adaptive.c_ref, adaptive.factor
+        self._factor_responses = adaptive.responses
         self._bordered: dict[tuple, tuple[BorderedSystem, dict[str, np.ndarray]]] = {}
         self._modal: dict[frozenset[str], ModalForm] = {}
         self._rows: dict[bytes, np.ndarray] = {}
@@ -132,8 +133,9 @@ class PreparedContact:
     def _bordered_locked(self, key: tuple, given: frozenset[str], c: float
                          ) -> tuple[BorderedSystem, dict[str, np.ndarray]]:
         if key not in self._bordered:
-            system = BorderedSystem(self.grid, c, given,
-                                    self._factor if c == self._factor_c else None)
+            same_c = c == self._factor_c
+            system = BorderedSystem(self.grid, c, given, self._factor if same_c else None,
+                                    self._factor_responses if same_c else None)
             self._bordered[key] = (system, system.unit_responses())
             self.counts["bordered"] += 1
             while len(self._bordered) > 8:  # a few statements and moduli at once
