@@ -7,6 +7,7 @@ takes. Each check raises ``ValueError`` whose message starts with the argument's
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -44,7 +45,7 @@ def as_function(value: Scalar, name: str) -> Function:
         raise ValueError(f"{name}: must be a number or a vectorized callable, "
                          f"got {type(value).__name__}")
     v = float(value)
-    if not np.isfinite(v):
+    if not math.isfinite(v):  # a number: math's test is ~20x cheaper than numpy's
         raise ValueError(f"{name}: must be finite, got {v}")
     return lambda x, _v=v: np.full(np.shape(x), _v)
 
@@ -52,6 +53,16 @@ def as_function(value: Scalar, name: str) -> Function:
 def check_values(values: np.ndarray, name: str, where: np.ndarray, var: str, *,
                  positive: bool = False) -> None:
     """Refuse non-finite values, and non-positive ones if ``positive``, naming the point."""
+    lo, hi = VALUE_RANGE.get(name, (0.0, MAX_MAGNITUDE))
+    # Accepted values pass one vectorized test (NaN fails every comparison); only a
+    # refusal looks for the reason below. A load change validates its histories here.
+    magnitude = np.abs(values)
+    if positive:
+        good = (values > 0.0) & (magnitude >= lo) & (magnitude <= hi)
+    else:
+        good = magnitude <= hi
+    if good.all():
+        return
     bad = ~np.isfinite(values)
     if bad.any():
         i = int(np.argmax(bad))
@@ -59,10 +70,8 @@ def check_values(values: np.ndarray, name: str, where: np.ndarray, var: str, *,
     if positive and np.any(values <= 0):
         i = int(np.argmin(values))
         raise ValueError(f"{name}: must be > 0, is {values[i]:.6g} at {var} = {where[i]:.6g}")
-    lo, hi = VALUE_RANGE.get(name, (0.0, MAX_MAGNITUDE))
     if not positive:
         lo = 0.0
-    magnitude = np.abs(values)
     out = (magnitude > hi) | (magnitude < lo)
     if out.any():
         i = int(np.argmax(out))
@@ -144,7 +153,7 @@ def validate_times(times: Any) -> np.ndarray:
         raise ValueError("times: must be finite")
     if t[0] < 1.0:
         raise ValueError(f"times: must be >= 1 (t = 1 is the moment of loading), got {t[0]:g}")
-    if np.any(np.diff(t) <= 0):
+    if t.size > 1 and np.any(np.diff(t) <= 0):
         raise ValueError("times: must be strictly increasing")
     return t
 

@@ -187,9 +187,12 @@ class BorderedSystem:
     """
 
     def __init__(self, grid: NystromGrid, c: float, given: frozenset[str],
-                 factor: BlockLU | None = None) -> None:
+                 factor: BlockLU | None = None, responses: np.ndarray | None = None) -> None:
         """``factor``: factors of ``c m + A`` on this grid, if known (from :func:`adapt`);
-        then the border is eliminated by a 2 x 2 Schur complement instead of a new LU."""
+        then the border is eliminated by a 2 x 2 Schur complement instead of a new LU.
+        ``responses``: ``(c m + A)^-1 [1, x(, -g)]`` (N, 2|3) by those factors, if known:
+        every nodal right-hand side of :meth:`unit_responses` is one of their columns (or
+        zero), so no solve with the factors is needed at all."""
         n = grid.size
         self.grid, self.c, self.given = grid, c, given
         self.unknown_names = tuple(q for q in ("settlement", "tilt", "force", "moment")
@@ -206,6 +209,7 @@ class BorderedSystem:
         self._balance = np.vstack([grid.panels.weights, grid.panels.weights * grid.nodes])
         self._border = border
         self._factor = factor
+        self._responses = responses if factor is not None else None
         self._lu = None
         if factor is None:
             matrix = np.zeros((n + 2, n + 2))
@@ -215,12 +219,16 @@ class BorderedSystem:
             matrix[:, n:] = border
             self._lu = lu_factor(matrix, overwrite_a=True, check_finite=False)
 
-    def _solve(self, rhs: np.ndarray) -> np.ndarray:
-        """Solutions (N + 2, k) of the bordered system for right-hand sides (N + 2, k)."""
+    def _solve(self, rhs: np.ndarray, nodal_solved: np.ndarray | None = None) -> np.ndarray:
+        """Solutions (N + 2, k) of the bordered system for right-hand sides (N + 2, k).
+
+        ``nodal_solved``: ``(c m + A)^-1 [rhs[:N], border[:N]]`` (N, k + 2) if known.
+        """
         if self._lu is not None:
             return lu_solve(self._lu, rhs, check_finite=False)
         n, k = self.grid.size, rhs.shape[1]
-        solved = self._factor.solve(np.column_stack([rhs[:n], self._border[:n]]))
+        solved = (self._factor.solve(np.column_stack([rhs[:n], self._border[:n]]))
+                  if nodal_solved is None else nodal_solved)
         y_rhs, y_border = solved[:, :k], solved[:, k:]
         schur = self._border[n:] - self._balance @ y_border
         scalars = np.linalg.solve(schur, rhs[n:] - self._balance @ y_rhs)
@@ -245,5 +253,22 @@ class BorderedSystem:
         gap[:n] = -self.grid.g
         rhs["gap"] = gap
         keys = list(rhs)
-        solved = self._solve(np.column_stack([rhs[k] for k in keys]))
+        solved = self._solve(np.column_stack([rhs[k] for k in keys]),
+                             self._nodal_solved(keys))
         return {k: solved[:, i] for i, k in enumerate(keys)}
+
+    def _nodal_solved(self, keys: list[str]) -> np.ndarray | None:
+        """``(c m + A)^-1`` of the nodal parts of the unit right-hand sides ``keys`` and of
+        the border, from the known responses to ``[1, x, -g]`` (None if not known)."""
+        if self._responses is None:
+            return None
+        r = self._responses
+        zero = np.zeros(self.grid.size)
+        # nodal right-hand side: settlement 1, tilt x, force and moment 0, gap -g (a zero
+        # gap has no response column: its solution is zero)
+        of = {"settlement": r[:, 0], "tilt": r[:, 1], "force": zero, "moment": zero,
+              "gap": r[:, 2] if r.shape[1] > 2 else zero}
+        # border: -1 for an unknown settlement, -x for an unknown tilt, 0 otherwise
+        border = {"settlement": -r[:, 0], "tilt": -r[:, 1], "force": zero, "moment": zero}
+        return np.column_stack([of[k] for k in keys]
+                               + [border[name] for name in self.unknown_names])

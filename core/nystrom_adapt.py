@@ -111,6 +111,8 @@ class AdaptiveGrid:
     rounds: int
     c_ref: float = 1.0  # the relative modulus of ``factor``
     factor: BlockLU | None = None  # factors of c_ref m + A on ``grid``
+    # (c_ref m + A)^-1 [1, x(, -g)] on ``grid``: the statement-1 responses the loop solved
+    responses: np.ndarray | None = None
 
 
 def widest_panel(lam: float, target: float) -> float:
@@ -224,4 +226,4 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             responses, factor = factored_responses(grid, c_ref, with_gap, singular)
     estimate = max(estimate, ROUND_OFF)
     return AdaptiveGrid(grid, estimate, resolved and estimate <= target, rounds, c_ref,
-                        factor)
+                        factor, responses)

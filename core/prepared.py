@@ -13,6 +13,7 @@ member          depends on                           holds
 ==============  ==================================  =========================================
 ``_bordered``   statement, constant ``c``            LU of the bordered matrix, unit responses
 ``_modal``      statement                            modal decomposition (creep, or c(t))
+``_elastic``    statement, constant ``c``            unit responses as arrays, q at points
 ``_rows``       the evaluation points                rows of F there (Nystrom formula)
 ==============  ==================================  =========================================
 
@@ -33,14 +34,15 @@ from typing import Any
 import numpy as np
 
 from core.cache import StageCache
+from core.contact_solution import ContactSolution
 from core.inputs import Geometry, Scalar, TimeInputs, validate_geometry, validate_time_inputs
 from core.kernel_fit import stepping_kernel
 from core.nystrom import BorderedSystem, touches
 from core.nystrom_adapt import adapt
+from core.nystrom_result import TimeSide, nystrom_solution
 from core.nystrom_time import ModalAnswer, ModalForm
-from core.quadrature import interpolation_weights
-from core.solver import ContactSolution
-from core.statements import QUANTITIES, statement_number
+from core.panels import interpolation_weights
+from core.prepared_elastic import ElasticUnits, elastic_answer
 
 #: The time stepping aims this many times below its share of tol: its step-doubling
 #: estimate read up to ~20x the true error on decaying creep (see core/solver.py).
@@ -102,19 +104,22 @@ class PreparedContact:
         # LU of c m + A at the modulus the grid was refined at: the bordered system of a
         # statement at that c needs only a 2 x 2 Schur complement on top of it.
         self._factor_c, self._factor = adaptive.c_ref, adaptive.factor
+        self._factor_responses = adaptive.responses
         self._bordered: dict[tuple, tuple[BorderedSystem, dict[str, np.ndarray]]] = {}
         self._modal: dict[frozenset[str], ModalForm] = {}
         self._rows: dict[bytes, np.ndarray] = {}
-        self._unit_pressure: dict[tuple, np.ndarray] = {}
+        self._elastic: dict[tuple, ElasticUnits] = {}
         self._responses: dict[tuple, list[tuple[ModalAnswer, np.ndarray]]] = {}
-        self._check_x = _check_points(geometry.breakpoints)
+        self.check_x = _check_points(geometry.breakpoints)
         # Check points on panels ending at +-1 or a jump take the Nystrom formula (q has
         # (x - e) ln|x - e| terms there); elsewhere q is analytic and its panel interpolant
         # is resolved to the refinement's tail bound, so it is interpolated (the formula at
         # all 405 points cost as much as the operator itself).
         singular = np.array([-1.0, 1.0, *geometry.breakpoints])
-        panel_of = interpolation_weights(self.grid.panels, self._check_x)[0]
-        self._check_formula = touches(self.grid.panels, singular)[panel_of]
+        panel_of = interpolation_weights(self.grid.panels, self.check_x)[0]
+        self.check_formula = touches(self.grid.panels, singular)[panel_of]
+        self.element_ends = tuple(sorted(set(self.grid.panels.edges[1:-1].tolist())
+                                         | set(geometry.breakpoints)))
         self._solves = 0
         # Solves of one prepared geometry may run in several threads (the explorer's).
         self._lock = threading.RLock()
@@ -132,8 +137,9 @@ class PreparedContact:
     def _bordered_locked(self, key: tuple, given: frozenset[str], c: float
                          ) -> tuple[BorderedSystem, dict[str, np.ndarray]]:
         if key not in self._bordered:
-            system = BorderedSystem(self.grid, c, given,
-                                    self._factor if c == self._factor_c else None)
+            same_c = c == self._factor_c
+            system = BorderedSystem(self.grid, c, given, self._factor if same_c else None,
+                                    self._factor_responses if same_c else None)
             self._bordered[key] = (system, system.unit_responses())
             self.counts["bordered"] += 1
             while len(self._bordered) > 8:  # a few statements and moduli at once
@@ -147,6 +153,17 @@ class PreparedContact:
                 self._modal[given] = ModalForm(self.grid, given)
                 self.counts["modal"] += 1
             return self._modal[given]
+
+    def _elastic_units(self, given: frozenset[str], c0: float) -> ElasticUnits:
+        """Unit responses of a statement at constant c (see :mod:`core.prepared_elastic`)."""
+        key = (given, c0)
+        with self._lock:
+            units = self._elastic.get(key)
+            if units is None:
+                units = self._elastic[key] = ElasticUnits(self, given, c0)
+                while len(self._elastic) > 8:  # as many as bordered systems are kept
+                    self._elastic.pop(next(iter(self._elastic)))
+            return units
 
     def rows(self, x: np.ndarray) -> np.ndarray:
         """Rows of the operator F at points ``x`` (len(x), N), cached by the points."""
@@ -204,78 +221,28 @@ class PreparedContact:
         t0 = _time.perf_counter()
         geometry = self.geometry
         times = inputs.times
-        built_before = Counter(self.counts)
+        built_before = dict(self.counts)
         breaks = np.array([b for b in np.asarray(time_breaks, dtype=float).ravel()
                            if np.isfinite(b) and times[0] < b < times[-1]])
         probe = self._history_times(times, "elastic" if inputs.kernel is None else "creep")
         if breaks.size:  # both sides of every jump are checked too
             probe = np.union1d(probe, np.concatenate([breaks * (1 - 1e-12),
                                                       breaks * (1 + 1e-12)]))
-        g = self.geometry.g
         if inputs.kernel is None and inputs.c_is_constant:
-            c0 = float(inputs.c(times[:1])[0])
-            _, units = self.bordered(inputs.given, c0)
-            names = sorted(inputs.given)
-            n = self.grid.size
-            unknown_names = [q for q in QUANTITIES if q not in inputs.given]
-            columns = names + ["gap"]
-            unit_matrix = np.column_stack([units[k] for k in columns])
-            # delta and alpha of each unit response (given: 1 for its own unit).
-            unit_delta = np.array([1.0 if k == "settlement" else 0.0 for k in columns])
-            unit_alpha = np.array([1.0 if k == "tilt" else 0.0 for k in columns])
-            for i, name in enumerate(unknown_names):
-                if name == "settlement":
-                    unit_delta = unit_matrix[n + i]
-                elif name == "tilt":
-                    unit_alpha = unit_matrix[n + i]
-            unit_gap = np.array([1.0 if k == "gap" else 0.0 for k in columns])
-            nodal_units = unit_matrix[:n]
-            c_unit = np.ones(len(columns)) * c0
-
-            def weights(tt: np.ndarray) -> np.ndarray:
-                return np.vstack([inputs.loads[k](tt) for k in names] + [np.ones(tt.size)])
-
-            def unit_pressure(x: np.ndarray) -> np.ndarray:
-                # q at x of each unit response; kept per points, so that a load change
-                # evaluates q at the same points with one small matrix product
-                key = (inputs.given, c0, np.ascontiguousarray(x, dtype=float).tobytes())
-                with self._lock:
-                    cached = self._unit_pressure.get(key)
-                if cached is None:
-                    drive = (unit_delta[None, :] + np.outer(x, unit_alpha)
-                             - np.outer(g(x), unit_gap))
-                    cached = self.nystrom_pressure(x, drive, c_unit, nodal_units)
-                    with self._lock:
-                        self._unit_pressure[key] = cached
-                        while len(self._unit_pressure) > 16:
-                            self._unit_pressure.pop(next(iter(self._unit_pressure)))
-                return cached
-
-            load_matrix = weights(times)
-            solved = unit_matrix @ load_matrix
-            scalars = {k: inputs.loads[k](times) for k in names}
-            for i, name in enumerate(unknown_names):
-                scalars[name] = solved[n + i]
-            probe_weights = weights(probe)
-            q_check = self._check_pressure(inputs.given, c0, nodal_units,
-                                           unit_pressure) @ probe_weights
-            if "tilt" in inputs.given:
-                tilt_history = inputs.loads["tilt"](probe)
-            else:
-                tilt_history = unit_matrix[n + unknown_names.index("tilt")] @ probe_weights
-            time_error, steps, time_ok, time_message = 0.0, 0, True, "elastic base"
-            fit_error = 0.0
-
-            def pressure(x: np.ndarray) -> np.ndarray:
-                return unit_pressure(x) @ load_matrix
+            units = self._elastic_units(inputs.given, float(inputs.c(times[:1])[0]))
+            answer = elastic_answer(units, inputs, probe)
+            scalars, pressure = answer.scalars, answer.pressure
+            q_extremes, max_abs_tilt = answer.q_extremes, answer.max_abs_tilt
+            time_side = TimeSide()
         else:
+            g = self.geometry.g
             form = self.modal(inputs.given)
             time_tol = geometry.tol / TIME_SHARE
             merged = np.union1d(times, probe)
             kernel, fit_error = stepping_kernel(inputs.kernel, float(times[-1]),
                                                 0.5 * geometry.tol)
             answer = self._superposed(form, merged, inputs, kernel, time_tol, breaks)
-            q_check = answer.q_check
+            q_extremes = (float(np.min(answer.q_check)), float(np.max(np.abs(answer.q_check))))
             c_merged = inputs.c(merged)
             sc = answer.scalars
 
@@ -287,16 +254,17 @@ class PreparedContact:
 
             at = np.searchsorted(merged, times)
             scalars = {k: v[at] for k, v in sc.items()}
-            tilt_history = sc["tilt"]
-            time_error, steps = answer.time_error + fit_error, answer.steps
-            time_ok, time_message = answer.success, answer.message
+            max_abs_tilt = float(np.max(np.abs(sc["tilt"])))
+            time_side = TimeSide(answer.time_error + fit_error, answer.steps, answer.success,
+                                 answer.message, fit_error)
 
             def pressure(x: np.ndarray) -> np.ndarray:
                 return merged_pressure(x, at)
-        built = {k: self.counts[k] - built_before[k] for k in self.counts}
-        return self._result(inputs, scalars, pressure, q_check, time_error, steps, time_ok,
-                            time_message, _time.perf_counter() - t0, built, fit_error,
-                            float(np.max(np.abs(tilt_history))))
+        built = {k: self.counts[k] - built_before.get(k, 0) for k in self.counts}
+        first_solve = self._solves == 0
+        self._solves += 1
+        return nystrom_solution(self, inputs, scalars, pressure, q_extremes, time_side,
+                                _time.perf_counter() - t0, built, max_abs_tilt, first_solve)
 
     def _superposed(self, form: ModalForm, times: np.ndarray, inputs: TimeInputs, kernel: Any,
                     time_tol: float, breaks: np.ndarray) -> _Superposed:
@@ -333,8 +301,8 @@ class PreparedContact:
         if not self.geometry.g_is_zero or not parts:
             parts.append((1.0, (common, "gap"), zero, 1.0))
         weighted_error = 0.0
-        q_check = np.zeros((self._check_x.size, times.size))
-        x = self._check_x
+        q_check = np.zeros((self.check_x.size, times.size))
+        x = self.check_x
         terms: list[tuple[float, ModalAnswer]] = []
         # All parts are stepped in one time march (force and moment together), so they are
         # cached together: the steps depend on every part, and an answer must not depend
@@ -377,95 +345,11 @@ class PreparedContact:
                            max(r.steps for _, r in terms), not failed,
                            "; ".join(failed) or terms[0][1].message)
 
-    def _check_pressure(self, given: frozenset[str], c0: float, nodal_units: np.ndarray,
-                        unit_pressure: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-        """Unit-response pressures at the check points (see ``__init__``), cached."""
-        key = ("check", given, c0)
-        with self._lock:
-            cached = self._unit_pressure.get(key)
-        if cached is None:
-            x, formula = self._check_x, self._check_formula
-            cached = np.empty((x.size, nodal_units.shape[1]))
-            cached[~formula] = self.grid.interpolate(x[~formula], nodal_units)
-            cached[formula] = unit_pressure(x[formula])
-            with self._lock:
-                self._unit_pressure[key] = cached
-        return cached
-
     def _history_times(self, times: np.ndarray, kind: str) -> np.ndarray:
         """Output times plus samples between them, where the answer's validity is checked."""
         if times.size == 1:
             return times
         return np.union1d(times, np.linspace(times[0], times[-1], HISTORY_SAMPLES[kind]))
-
-    def _result(self, inputs: TimeInputs, scalars: dict[str, np.ndarray],
-                pressure: Callable[[np.ndarray], np.ndarray], q_check: np.ndarray,
-                time_error: float, steps: int, time_ok: bool, time_message: str,
-                seconds: float, built: dict[str, int], fit_error: float = 0.0,
-                max_abs_tilt: float = 0.0) -> ContactSolution:
-        tol = self.geometry.tol
-        error = float(self.spatial_error + time_error)
-        success = error <= tol and self.resolved and time_ok
-        flags = []
-        if not self.resolved:
-            flags.append("unresolved_input")
-        if not success:
-            flags.append("tol_not_met")
-        q_scale = max(float(np.max(np.abs(q_check))), 1e-300)
-        min_q = float(np.min(q_check))
-        if min_q < -max(error, 1e-12) * q_scale:
-            flags.append("contact_lost")
-        n = self.grid.size
-        if success:
-            message = (f"converged: estimated error {error:.1e} <= tol {tol:.1e} "
-                       f"({n} nodes, {self.grid.panels.n_panels} panels)")
-        else:
-            reasons = []
-            if self.spatial_error > tol or not self.resolved:
-                reasons.append(f"the grid reached {self.grid.panels.n_panels} panels with "
-                               f"estimated error {self.spatial_error:.1e} in q")
-            if time_error > tol or not time_ok:
-                reasons.append(f"time stepping: {time_message} (estimated error "
-                               f"{time_error:.1e})")
-            message = f"tol {tol:.1e} not met: " + "; ".join(reasons or ["see the estimate"])
-        info = {
-            "method": "nystrom",
-            "error_estimate": error,
-            "spatial_error_estimate": float(self.spatial_error),
-            "time_error_estimate": float(time_error),
-            # the creep kernel's sum-of-exponentials fit (included in the time estimate)
-            "kernel_fit_error": float(fit_error),
-            "seconds": seconds,
-            "prepare_seconds": self.seconds,
-            "flags": flags,
-            "success": bool(success),
-            "message": message,
-            "n_modes": n,
-            "n_nodes": n,
-            "n_panels": self.grid.panels.n_panels,
-            "n_steps": int(steps),
-            "statement": statement_number(inputs.given),
-            "given": sorted(inputs.given),
-            # over the output times and the samples between them (HISTORY_SAMPLES)
-            "min_pressure": min_q,
-            "max_abs_tilt": max_abs_tilt,
-            "max_pressure": q_scale,
-            "basis": "nystrom",
-            "element_ends": sorted(set(self.grid.panels.edges[1:-1].tolist())
-                                   | set(self.geometry.breakpoints)),
-            # "grid" is the geometric stage (prepared once); "bordered"/"modal" the
-            # factorization of a statement; "cached" says whether this solve built it.
-            "stages": {"grid": {"seconds": self.seconds, "cached": self._solves > 0},
-                       **{k: {"seconds": 0.0, "cached": built.get(k, 0) == 0}
-                          for k in ("bordered", "modal") if k in self.counts},
-                       "solve": {"seconds": seconds, "cached": False}},
-            "builds": dict(self.counts),
-        }
-        self._solves += 1
-        return ContactSolution(inputs.times.copy(), *(np.asarray(scalars[q], dtype=float)
-                                                      for q in QUANTITIES),
-                               info, None, None, None, self.geometry.m, self.geometry.g,
-                               pressure)
 
 
 def prepare(lam: float, m: Scalar, g: Scalar, *, breakpoints: Sequence[float] = (),

@@ -34,7 +34,7 @@ def galerkin_matrix(operator: KernelOperator, basis: Basis, m_values: np.ndarray
                     correction: np.ndarray | None = None) -> np.ndarray:
     """``R`` (n x n) for all functions of ``basis`` (dimensionless).
 
-    ``correction``: :func:`core.quadrature.galerkin_correction` of the operator's panels,
+    ``correction``: :func:`core.galerkin.galerkin_correction` of the operator's panels,
     needed by a basis with kinks or jumps at panel ends (the ``"graded"`` basis).
     """
     phi = basis.values / m_values[:, None]

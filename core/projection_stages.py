@@ -15,13 +15,13 @@ import numpy as np
 
 from core.basis import Basis, build_basis, graded_cuts
 from core.cache import StageCache, fingerprint
+from core.galerkin import galerkin_correction
 from core.inputs import check_values, validate_geometry, validate_time_inputs
 from core.projection import GapTerms, galerkin_matrix, gap_terms
 from core.quadrature import (
     KernelOperator,
     Panels,
     base_panels,
-    galerkin_correction,
     kernel_operator,
     operator_rows,
     refine_to_resolve,

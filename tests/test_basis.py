@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 
 from core.basis import GRADED_DEPTH, GRADED_RATIO, Basis, build_basis, graded_cuts
+from core.galerkin import galerkin_correction
 from core.projection import galerkin_matrix
 from core.quadrature import (
     Panels,
     base_panels,
-    galerkin_correction,
     kernel_operator,
     operator_rows,
 )
