@@ -70,7 +70,7 @@ def predicted_unilateral(arguments: dict[str, Any]):
         else:
             check = solve_with_prepared(arguments["lam"], arguments["m"], arguments["g"],
                                         [first], c=c_first, breakpoints=breakpoints,
-                                        tol=tol, **values)
+                                        tol=tol, check_only=True, **values)
             if "contact_lost" not in check.info["flags"]:
                 return None
             check_info = {"flags": list(check.info["flags"]),

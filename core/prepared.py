@@ -212,11 +212,14 @@ class PreparedContact:
                                                          "force": force, "moment": moment})
         return self.solve_validated(inputs, time_breaks)
 
-    def solve_validated(self, inputs: TimeInputs, time_breaks: Sequence[float] = ()
-                        ) -> ContactSolution:
+    def solve_validated(self, inputs: TimeInputs, time_breaks: Sequence[float] = (),
+                        *, check_only: bool = False) -> ContactSolution:
         """:meth:`solve` for inputs already checked by :func:`core.inputs.validate_time_inputs`.
 
         ``time_breaks``: times where a given history jumps or kinks (dimensionless).
+        ``check_only``: a preliminary solve (the contact check of ``contact="auto"``) that
+        leaves the geometry's first solve, and its stage report "grid built", to the
+        answer that follows.
         """
         t0 = _time.perf_counter()
         geometry = self.geometry
@@ -262,7 +265,8 @@ class PreparedContact:
                 return merged_pressure(x, at)
         built = {k: self.counts[k] - built_before.get(k, 0) for k in self.counts}
         first_solve = self._solves == 0
-        self._solves += 1
+        if not check_only:
+            self._solves += 1
         return nystrom_solution(self, inputs, scalars, pressure, q_extremes, time_side,
                                 _time.perf_counter() - t0, built, max_abs_tilt, first_solve)
 
@@ -388,9 +392,11 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
                         kernel: Callable | None = None, settlement: Scalar | None = None,
                         tilt: Scalar | None = None, force: Scalar | None = None,
                         moment: Scalar | None = None, breakpoints: Sequence[float] = (),
-                        tol: float = 1e-8, time_breaks: Sequence[float] = ()
-                        ) -> ContactSolution:
+                        tol: float = 1e-8, time_breaks: Sequence[float] = (),
+                        check_only: bool = False) -> ContactSolution:
     """``solve_dimensionless(method="nystrom")``: prepare (or reuse) the geometry, then solve.
+
+    ``check_only``: see :meth:`PreparedContact.solve_validated`.
 
     Geometries are recognised by their values on 2049 Chebyshev points (and both sides of
     each jump), so a repeated call with only other loads reuses the prepared grid.
@@ -400,4 +406,4 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
                                                      "force": force, "moment": moment})
     prepared, _ = PREPARED.get_or_compute(_geometry_key(geometry),
                                           lambda: PreparedContact(geometry))
-    return prepared.solve_validated(inputs, time_breaks)
+    return prepared.solve_validated(inputs, time_breaks, check_only=check_only)
