@@ -34,10 +34,10 @@ def test_set_data_skips_equal_numbers_and_sends_changes() -> None:
 def _count_changes(app: ExplorerApp) -> dict[str, list[int]]:
     figures = app.figures
     sources = {"layers": figures.layer_src, "punch": figures.punch_src,
-               "base": figures.base_src, "q": figures.q_src, "q_pin": figures.q_pin_src}
+               "base": figures.base_src, "q": figures.q_src, "q_pin": figures.pins.q_src[0]}
     for q in ("settlement", "tilt", "force", "moment"):
         sources[q] = figures.history_src[q]
-        sources[f"{q}_pin"] = figures.history_pin_src[q]
+        sources[f"{q}_pin"] = figures.pins.history_src[q][0]
     counts: dict[str, list[int]] = {name: [0] for name in sources}
     for name, source in sources.items():
         source.on_change("data", lambda attr, old, new, c=counts[name]: c.__setitem__(0, c[0] + 1))

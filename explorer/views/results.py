@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import html
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import panel as pn
@@ -10,6 +11,8 @@ import param
 
 from .. import exports
 from ..design import check_html, design_check
+from ..pin_plots import PIN_COLORS
+from ..pins import Pin
 from ..results import ResultView
 from ..state import QUANTITIES, QUANTITY_UNITS
 from ..status import status_html
@@ -52,15 +55,19 @@ def badges_html(view: ResultView | None, group: str) -> str:
     return "".join(parts)
 
 
-def readout_html(view: ResultView | None, index: int, pinned: ResultView | None) -> str:
-    """Values at the selected time: current, pinned and their difference."""
+def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) -> str:
+    """Values at the selected time: current, and each pin with the change to it."""
     if view is None:
         return ""
     t = float(view.times[index])
     head = "<tr><th></th><th>current</th>"
-    head += "<th>pinned</th><th>change</th></tr>" if pinned is not None else "</tr>"
-    rows = [head]
-    j = pinned.time_index(t) if pinned is not None else 0
+    for k, pin in enumerate(pins):
+        color = PIN_COLORS[k]
+        head += (f"<th style='border-bottom:3px dashed {color}'>{html.escape(pin.label)}"
+                 "</th><th>change</th>")
+    rows = [head + "</tr>"]
+    others = [pin.view for pin in pins]
+    times = [other.time_index(t) for other in others]
     for q in QUANTITIES:
         unit = QUANTITY_UNITS[q][0]
         value = float(view.display(q)[index])
@@ -68,10 +75,11 @@ def readout_html(view: ResultView | None, index: int, pinned: ResultView | None)
         cls = "cp-given" if role == "given" else ""
         row = (f"<tr class='{cls}'><td>{NAMES[q]} [{unit}] ({role})</td>"
                f"<td class='readout-{q}'>{_fmt(value)}</td>")
-        if pinned is not None:
+        for k, (pinned, j) in enumerate(zip(others, times, strict=True)):
             other = float(pinned.display(q)[j])
             change = f"{100 * (value - other) / abs(other):+.2f} %" if other else "n/a"
-            row += f"<td class='pinned-{q}'>{_fmt(other)}</td><td>{change}</td>"
+            row += (f"<td class='pinned-{q} pin-{k}-{q}'>{_fmt(other)}</td>"
+                    f"<td>{change}</td>")
         rows.append(row + "</tr>")
     force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
     ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
@@ -112,11 +120,6 @@ class ResultsView:
         self.classical = pn.widgets.Checkbox(label="classical solutions on q(x)",
                                              css_classes=["classical-toggle"])
         self.classical.param.watch(self._on_classical, "value")
-        self.pin_button = pn.widgets.Button(label="Pin this result", color="default")
-        self.unpin_button = pn.widgets.Button(label="Clear pin", color="light",
-                                              disabled=True)
-        self.pin_button.on_click(lambda e: app.pin())
-        self.unpin_button.on_click(lambda e: app.unpin())
         app.limits.param.watch(lambda *e: self.show_design(), list(
             n for n in app.limits.param if n != "name"))
         f = app.figures
@@ -138,8 +141,7 @@ class ResultsView:
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
-            pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button,
-                                           self.classical),
+            pn.Row(self.readout, pn.Column(self.app.pins.content(), self.classical),
                    sizing_mode="stretch_width"),
             self.design,
             self.history_badges,
@@ -150,7 +152,7 @@ class ResultsView:
     def draw(self, view: ResultView, index: int, new_range: bool) -> None:
         """Show a new result at output time ``index`` (call inside ``pn.io.hold()``)."""
         app = self.app
-        app.figures.show(view, index, app.pinned)
+        app.figures.show(view, index, app.pins.board.pins)
         if new_range:
             self._replace_player(max(len(view.times) - 1, 1), index)
         else:
@@ -169,7 +171,7 @@ class ResultsView:
         """The time label and the readout at output time ``index``."""
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{float(view.times[index]):.4g} days</span>")
-        self.readout.object = readout_html(view, index, self.app.pinned)
+        self.readout.object = readout_html(view, index, self.app.pins.board.pins)
 
     def show_design(self) -> None:
         """The design check of the result on screen against the session's limits."""

@@ -1,0 +1,96 @@
+"""The pinned results on the figures: one dashed line per pin, named in the legend.
+
+The lines are made once per session, :data:`~explorer.pins.MAX_PINS` of them per figure,
+and hidden while their slot is empty: pinning fills a slot's data, it never adds models
+to the page. Nothing here imports Panel.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from bokeh.models import ColumnDataSource, LegendItem
+
+from .pins import MAX_PINS, Pin
+from .results import ResultView
+from .state import QUANTITIES
+
+if TYPE_CHECKING:
+    from .plots import Figures
+
+#: Colours of the pins, in pin order (none of them the blue of the current result).
+PIN_COLORS = ("#d62728", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2")
+assert len(PIN_COLORS) >= MAX_PINS
+
+
+def _f32(values: object):
+    from .plots import f32
+
+    return f32(values)
+
+
+class PinLines:
+    """Dashed lines of the pinned results on the pressure plot and the histories."""
+
+    def __init__(self, figures: Figures) -> None:
+        self.figures = figures
+        self.q_src: list[ColumnDataSource] = []
+        self.q_lines = []
+        self.history_src: dict[str, list[ColumnDataSource]] = {q: [] for q in QUANTITIES}
+        self.history_lines: dict[str, list] = {q: [] for q in QUANTITIES}
+        legend = figures.q_fig.legend[0]
+        for k in range(MAX_PINS):
+            color = PIN_COLORS[k]
+            src = ColumnDataSource({"x": [], "q": []}, name=f"q_pin_source_{k}")
+            line = figures.q_fig.line(x="x", y="q", source=src, line_color=color,
+                                      line_dash="dashed", line_width=2, visible=False)
+            self.q_src.append(src)
+            self.q_lines.append(line)
+            for q in QUANTITIES:
+                hsrc = ColumnDataSource({"t": [], "v": []}, name=f"{q}_pin_source_{k}")
+                hline = figures.history_fig[q].line(x="t", y="v", source=hsrc,
+                                                    line_color=color, line_dash="dashed",
+                                                    line_width=2, visible=False)
+                self.history_src[q].append(hsrc)
+                self.history_lines[q].append(hline)
+        # a legend entry per pin, after "q < 0" and before the classical lines
+        self.legend_items = [LegendItem(label=f"pin {k + 1}", renderers=[line],
+                                        visible=False, name=f"pin_legend_{k}")
+                             for k, line in enumerate(self.q_lines)]
+        legend.items = legend.items[:1] + self.legend_items + legend.items[1:]
+        self._labels = [f"pin {k + 1}" for k in range(MAX_PINS)]
+
+    def show(self, view: ResultView, pins: Sequence[Pin], index: int) -> None:
+        """Draw the pins (histories and pressure at the time shown of ``view``)."""
+        from .plots import set_data
+
+        for k in range(MAX_PINS):
+            pin = pins[k] if k < len(pins) else None
+            shown = pin is not None
+            self.q_lines[k].visible = shown
+            self.legend_items[k].visible = shown
+            if shown and self._labels[k] != pin.label:  # a message only when renamed
+                self.legend_items[k].label = pin.label
+                self._labels[k] = pin.label
+            for q in QUANTITIES:
+                self.history_lines[q][k].visible = shown
+                data = ({"t": _f32(pin.view.times), "v": _f32(pin.view.display(q))}
+                        if shown else {"t": [], "v": []})
+                set_data(self.history_src[q][k], data)
+        self.show_time(view, pins, index)
+
+    def show_time(self, view: ResultView, pins: Sequence[Pin], index: int) -> None:
+        """The pinned pressures at the output time of ``view`` shown (nearest time)."""
+        from .plots import set_data
+
+        size = self.figures.scales.pressure_unit(view)[1]
+        t = float(view.times[index])
+        for k in range(MAX_PINS):
+            if k < len(pins):
+                other = pins[k].view
+                j = other.time_index(t)
+                data = {"x": _f32(other.x), "q": _f32(other.pressure[:, j] / size)}
+            else:
+                data = {"x": [], "q": []}
+            set_data(self.q_src[k], data)
