@@ -37,6 +37,7 @@ from .views.check import CheckView
 from .views.coating import CoatingView
 from .views.files import FilesView
 from .views.history import SceneHistory
+from .views.lessons import LessonsView
 from .views.link import LINK_EVERY_MS, AddressLink
 from .views.pins import PinsView
 from .views.punch import PunchView
@@ -62,7 +63,7 @@ LIVE_SOLVE_S = 0.030
 #: (with a ``title`` and a ``content()`` column). A new tab is one more entry here; the
 #: index of a tab is part of the page's links (``view_link``), so append, do not insert.
 SIDEBAR_VIEWS: tuple[type, ...] = (SceneView, PunchView, CoatingView, BaseView, TimesView,
-                                   CheckView, FilesView)
+                                   CheckView, FilesView, LessonsView)
 #: Names the views share; never looked up on the session (see ExplorerApp.__getattr__).
 _VIEW_COMMON = frozenset({"app", "title", "content", "refresh"})
 

@@ -93,7 +93,12 @@ def field_text(path: str, value: Any) -> str:
     number = _number(value)
     if number is None:
         return f"{symbol} = {str(value)[:12]}"
-    return f"{symbol} = {number / size:.3g}" + (f" {unit}" if unit else "")
+    return f"{symbol} = {_short(number / size)}" + (f" {unit}" if unit else "")
+
+
+def _short(number: float) -> str:
+    """Three significant digits, without an exponent for the thousands (1000 kN/m)."""
+    return f"{number:.0f}" if 1e3 <= abs(number) < 1e6 else f"{number:.3g}"
 
 
 def _differing(flats: list[dict[str, Any]]) -> list[str]:
@@ -115,12 +120,10 @@ def pin_labels(scenes: list[dict[str, Any]]) -> list[str]:
     ecc = [eccentricity(scene) for scene in scenes]
     use_e = (bool(keys) and "loading.moment" in keys and None not in ecc
              and len({round(e, 12) for e in ecc if e is not None}) > 1)
-    if use_e:
-        keys = [k for k in keys if k != "loading.moment"]
     labels = []
     for k, (scene, flat) in enumerate(zip(scenes, flats, strict=True)):
-        parts = [f"e = {ecc[k]:.3g} m"] if use_e else []
-        parts += [field_text(key, flat.get(key)) for key in keys]
+        parts = [f"e = {_short(ecc[k] or 0.0)} m" if use_e and key == "loading.moment"
+                 else field_text(key, flat.get(key)) for key in keys]
         parts = parts[:LABEL_FIELDS]
         if not parts:
             parts = [f"{k + 1}: {scene.get('name', 'pinned')}"]

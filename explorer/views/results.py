@@ -16,6 +16,7 @@ from ..pins import Pin
 from ..results import ResultView
 from ..state import QUANTITIES, QUANTITY_UNITS
 from ..status import status_html
+from ..time_axis import set_log_time
 from ..widgets import NAMES
 from .style import html_pane
 
@@ -120,6 +121,10 @@ class ResultsView:
         self.classical = pn.widgets.Checkbox(label="classical solutions on q(x)",
                                              css_classes=["classical-toggle"])
         self.classical.param.watch(self._on_classical, "value")
+        # long creep histories change most in their first days: a log axis shows both
+        self.log_time = pn.widgets.Checkbox(label="log time axis", css_classes=["log-time"],
+                                            margin=(5, 10))
+        self.log_time.param.watch(self._on_log_time, "value")
         app.limits.param.watch(lambda *e: self.show_design(), list(
             n for n in app.limits.param if n != "name"))
         f = app.figures
@@ -144,7 +149,7 @@ class ResultsView:
             pn.Row(self.readout, pn.Column(self.app.pins.content(), self.classical),
                    sizing_mode="stretch_width"),
             self.design,
-            self.history_badges,
+            pn.Row(self.history_badges, self.log_time, sizing_mode="stretch_width"),
             pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
             sizing_mode="stretch_width",
         )
@@ -196,6 +201,12 @@ class ResultsView:
         app = self.app
         with pn.io.hold():
             app.figures.set_classical(app.shown(), app.time_index, bool(event.new))
+        self.push()
+
+    def _on_log_time(self, event: Any) -> None:
+        figures = self.app.figures
+        with pn.io.hold():
+            set_log_time([figures.history_fig[q] for q in QUANTITIES], bool(event.new))
         self.push()
 
     def _new_player(self, end: int, value: int) -> pn.widgets.Player:
