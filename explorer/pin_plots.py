@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+from bokeh.core.properties import value
 from bokeh.models import ColumnDataSource, LegendItem
 
 from .pins import MAX_PINS, Pin
@@ -55,7 +56,7 @@ class PinLines:
                 self.history_src[q].append(hsrc)
                 self.history_lines[q].append(hline)
         # a legend entry per pin, after "q < 0" and before the classical lines
-        self.legend_items = [LegendItem(label=f"pin {k + 1}", renderers=[line],
+        self.legend_items = [LegendItem(label=value(f"pin {k + 1}"), renderers=[line],
                                         visible=False, name=f"pin_legend_{k}")
                              for k, line in enumerate(self.q_lines)]
         legend.items = legend.items[:1] + self.legend_items + legend.items[1:]
@@ -71,7 +72,8 @@ class PinLines:
             self.q_lines[k].visible = shown
             self.legend_items[k].visible = shown
             if shown and self._labels[k] != pin.label:  # a message only when renamed
-                self.legend_items[k].label = pin.label
+                # a plain string would be read as a column name (a "field") by the page
+                self.legend_items[k].label = value(pin.label)
                 self._labels[k] = pin.label
             for q in QUANTITIES:
                 self.history_lines[q][k].visible = shown

@@ -111,6 +111,8 @@ class PinsView:
         if view is not None:
             with pn.io.hold():
                 app.figures.show_pinned(view, self.board.pins, app.time_index)
+                if app.results.time_axis.on:
+                    app.results.time_axis.fit()
                 app.results.show_time_texts(view, app.time_index)
             app.results.push()
         app.link.schedule()

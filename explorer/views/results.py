@@ -16,7 +16,7 @@ from ..pins import Pin
 from ..results import ResultView
 from ..state import QUANTITIES, QUANTITY_UNITS
 from ..status import status_html
-from ..time_axis import set_log_time
+from ..time_axis import LogTime
 from ..widgets import NAMES
 from .style import html_pane
 
@@ -125,6 +125,7 @@ class ResultsView:
         self.log_time = pn.widgets.Checkbox(label="log time axis", css_classes=["log-time"],
                                             margin=(5, 10))
         self.log_time.param.watch(self._on_log_time, "value")
+        self.time_axis = LogTime([app.figures.history_fig[q] for q in QUANTITIES])
         app.limits.param.watch(lambda *e: self.show_design(), list(
             n for n in app.limits.param if n != "name"))
         f = app.figures
@@ -170,6 +171,8 @@ class ResultsView:
         self.pressure_badges.object = badges_html(view, "pressure")
         self.history_badges.object = badges_html(view, "history")
         self.status_badges.object = badges_html(view, "status")
+        if self.time_axis.on:
+            self.time_axis.fit()
         self.show_design()
 
     def show_time_texts(self, view: ResultView, index: int) -> None:
@@ -204,9 +207,8 @@ class ResultsView:
         self.push()
 
     def _on_log_time(self, event: Any) -> None:
-        figures = self.app.figures
         with pn.io.hold():
-            set_log_time([figures.history_fig[q] for q in QUANTITIES], bool(event.new))
+            self.time_axis.set(bool(event.new))
         self.push()
 
     def _new_player(self, end: int, value: int) -> pn.widgets.Player:
