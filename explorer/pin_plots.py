@@ -80,6 +80,8 @@ class PinLines:
                 data = ({"t": _f32(pin.view.times), "v": _f32(pin.view.display(q))}
                         if shown else {"t": [], "v": []})
                 set_data(self.history_src[q][k], data)
+        # two rows of legend entries with pins: one row was wider than the plot
+        self.figures.q_fig.legend[0].nrows = 2 if pins else "auto"
         self.show_time(view, pins, index)
 
     def show_time(self, view: ResultView, pins: Sequence[Pin], index: int) -> None:

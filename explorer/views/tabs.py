@@ -14,6 +14,9 @@ if TYPE_CHECKING:
 #: Time after a page connects before the sidebar tabs not yet opened are filled in the
 #: background [ms]: after the first paint and a first look (see DeferredTabs.fill_idle).
 FILL_TABS_AFTER_MS = 3000
+#: Style of the sidebar's tab titles: several lines when they do not fit one.
+WRAP_TITLES = (".bk-header, .bk-headers-wrapper, .bk-headers {flex-wrap: wrap; "
+               "overflow: visible; height: auto;}")
 
 
 class DeferredTabs:
@@ -31,8 +34,10 @@ class DeferredTabs:
             if k and app.served:
                 self.deferred[k] = (content, list(content.objects))
                 content.objects = []
+        # the tab titles wrap onto a second line: in one line the last tabs were out of
+        # reach at 1024 px (presentation mode) and behind the first ones' width at 1400
         self.sidebar = pn.Tabs(*tabs, dynamic=False, width=370, margin=(0, 10, 0, 0),
-                               css_classes=["sidebar-tabs"])
+                               css_classes=["sidebar-tabs"], stylesheets=[WRAP_TITLES])
         self.sidebar.param.watch(lambda e: self.fill(e.new), "active")
 
     def fill(self, index: int) -> None:
