@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
+
+import param
 
 from ..status import status_html
+from .style import html_pane
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp
@@ -14,6 +17,34 @@ if TYPE_CHECKING:
 #: and off costs three more messages to the page per step (a sixth of the server's work
 #: with 20 busy sessions, measured with py-spy).
 BUSY_AFTER_MS = 250
+
+
+#: A spinning ring drawn by CSS alone (inside the pane's own shadow root).
+_RING = ("<style>@keyframes cp-spin {to {transform: rotate(360deg)}}</style>"
+         "<div class='cp-spinner' style='width:14px;height:14px;margin:3px;"
+         "border:3px solid #ddd;border-top-color:#1f77b4;border-radius:50%;"
+         "animation:cp-spin 0.8s linear infinite'></div>")
+
+
+class BusySpinner(param.Parameterized):
+    """A spinner that turns by changing its text only.
+
+    Panel's LoadingSpinner turns by changing its CSS classes, and a change of classes
+    makes the page lay out every figure again: measured in Chromium, two whole-page
+    layouts per slow solve (on and off), most of the page's work for a geometry step."""
+
+    value = param.Boolean(default=False, doc="Whether the spinner turns.")
+
+    def __init__(self, **params: Any) -> None:
+        super().__init__(**params)
+        # a fixed size: a new text never changes the layout around it
+        self.pane = html_pane("", width=26, height=26, margin=(5, 5),
+                              css_classes=["busy-spinner"])
+        self.param.watch(lambda e: setattr(self.pane, "object", _RING if e.new else ""),
+                         "value")
+
+    def __panel__(self) -> Any:
+        return self.pane
 
 
 class BusyIndicator:

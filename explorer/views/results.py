@@ -18,6 +18,7 @@ from ..state import QUANTITIES, QUANTITY_UNITS
 from ..status import status_html
 from ..time_axis import LogTime
 from ..widgets import NAMES
+from .busy import BusySpinner
 from .style import html_pane
 
 if TYPE_CHECKING:
@@ -99,8 +100,7 @@ class ResultsView:
                                           visible=bool(app.notice),
                                           sizing_mode="stretch_width",
                                           css_classes=["notice"])
-        self.spinner = pn.indicators.LoadingSpinner(value=False, size=20, label="",
-                                                    margin=(5, 5))
+        self.spinner = BusySpinner()
         self.status = html_pane("", sizing_mode="stretch_width", margin=(5, 5))
         badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
         self.scene_badges = html_pane("", **badge)
@@ -140,7 +140,7 @@ class ResultsView:
             self._address,
             self.notice_alert,
             self.alert,
-            pn.Row(self.spinner, self.status, sizing_mode="stretch_width"),
+            pn.Row(self.spinner.pane, self.status, sizing_mode="stretch_width"),
             self.status_badges,
             self.scene_badges,
             scene_pane,
