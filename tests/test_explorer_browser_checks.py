@@ -147,7 +147,8 @@ def test_a_flag_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: P
 
 
 def _figure_top(page: Page) -> float:
-    box = page.page.locator(".bk-panel-models-layout-Column .bk-Figure, .bk-Figure").first
+    # the first figure on screen: the sidebar's tabs not open hold figures too (hidden)
+    box = page.page.locator(".bk-Figure >> visible=true").first
     return float(box.bounding_box()["y"])
 
 
