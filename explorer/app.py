@@ -151,10 +151,6 @@ class ExplorerApp(pn.viewable.Viewer):
         """Whether the page shows the busy indicator now."""
         return self.busy.shown
 
-    @property
-    def _deferred_tabs(self) -> dict[int, Any]:
-        return self.tabs.deferred
-
     # -- plumbing --------------------------------------------------------------------
     @property
     def _served(self) -> bool:

@@ -211,7 +211,7 @@ def test_a_complete_page_is_frozen_out_of_the_collectors_reach(served_app, monke
     app._on_load()
     while timers.pending and not frozen:  # the tabs are filled one by one
         timers.run()
-    assert frozen == [1] and not app._deferred_tabs
+    assert frozen == [1] and not app.tabs.deferred
     try:
         monkeypatch.undo()
         assert gc_policy.page_built()
