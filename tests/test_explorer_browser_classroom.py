@@ -20,7 +20,7 @@ from tests.browser_pages import Page, chromium_context, served_explorer, until  
 # Label of a pin's legend entry (a value spec in the page: {value: ...} or plain text).
 JS_LEGEND = """(k) => {
   const item = Bokeh.documents[0].get_model_by_name('pin_legend_' + k);
-  if (!item.visible) return null;
+  if (!item || !item.visible) return null;   // a slot never used has no entry
   const label = item.label;
   return label && label.value !== undefined ? label.value : label;
 }"""

@@ -43,7 +43,8 @@ def test_pins_compare_several_results_and_go_one_by_one() -> None:
     board = app.pins.board
     assert [pin.label for pin in board] == ["P = 500 kN/m", "P = 600 kN/m", "P = 700 kN/m"]
     lines = app.figures.pins
-    assert [line.visible for line in lines.q_lines[:4]] == [True, True, True, False]
+    # three slots made, all shown (a page without pins has no pin lines)
+    assert [line.visible for line in lines.q_lines] == [True, True, True]
     assert [getattr(item.label, "value", item.label) for item in lines.legend_items[:3]] == [
         "P = 500 kN/m", "P = 600 kN/m", "P = 700 kN/m"]
     assert app.readout.object.count("pinned-settlement") == 3
