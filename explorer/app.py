@@ -30,36 +30,31 @@ from .results import ResultView
 from .scales import DisplayScales
 from .state import ExplorerState
 from .status import status_html
-from .undo import UndoStack
-from .view_link import read_view_query, view_query
+from .view_link import read_view_query
 from .views.base import BaseView
+from .views.busy import BUSY_AFTER_MS, BusyIndicator
 from .views.check import CheckView
 from .views.coating import CoatingView
 from .views.files import FilesView
+from .views.history import SceneHistory
+from .views.lessons import LessonsView
+from .views.link import LINK_EVERY_MS, AddressLink
+from .views.pins import PinsView
 from .views.punch import PunchView
 from .views.results import BADGES, ResultsView, badges_html, readout_html
 from .views.scene import SceneView
 from .views.style import CSS, html_pane
+from .views.tabs import FILL_TABS_AFTER_MS, DeferredTabs
 from .views.times import TimesView
 from .workers import solve_view
 
-__all__ = ["BADGES", "CSS", "ExplorerApp", "SIDEBAR_VIEWS", "badges_html", "create_app",
-           "readout_html", "warm_up"]
+__all__ = ["BADGES", "BUSY_AFTER_MS", "CSS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS",
+           "ExplorerApp", "SIDEBAR_VIEWS", "badges_html", "create_app", "readout_html",
+           "warm_up"]
 
 log = logging.getLogger(__name__)
 install_panel_fixes()
 
-#: Time after a page connects before the sidebar tabs not yet opened are filled in the
-#: background [ms]: after the first paint and a first look (see _fill_idle_tab).
-FILL_TABS_AFTER_MS = 3000
-#: A solve shows the busy indicator only once it has run this long [ms]. A slider step
-#: is solved in 10-50 ms: its new plots are the feedback, and switching the indicator on
-#: and off costs three more messages to the page per step (a sixth of the server's work
-#: with 20 busy sessions, measured with py-spy).
-BUSY_AFTER_MS = 250
-#: The page's address follows the scene on screen at most this often [ms]: rewriting it
-#: at every slider step would cost a message per step, for a link nobody copies mid-drag.
-LINK_EVERY_MS = 1000
 #: Geometry and material sliders apply each drag step (not only the release) while the
 #: last solve took less than this [s]: then a step's answer arrives before the next step.
 LIVE_SOLVE_S = 0.030
@@ -68,7 +63,7 @@ LIVE_SOLVE_S = 0.030
 #: (with a ``title`` and a ``content()`` column). A new tab is one more entry here; the
 #: index of a tab is part of the page's links (``view_link``), so append, do not insert.
 SIDEBAR_VIEWS: tuple[type, ...] = (SceneView, PunchView, CoatingView, BaseView, TimesView,
-                                   CheckView, FilesView)
+                                   CheckView, FilesView, LessonsView)
 #: Names the views share; never looked up on the session (see ExplorerApp.__getattr__).
 _VIEW_COMMON = frozenset({"app", "title", "content", "refresh"})
 
@@ -89,36 +84,31 @@ class ExplorerApp(pn.viewable.Viewer):
         self.state = ExplorerState()
         self.controller = SolveController(self.state, solve=solve, executor=executor,
                                           dispatch=self._dispatch, auto=False)
-        self.pinned: ResultView | None = None
         self.presets = presets()
         self.scales = DisplayScales()
         self.limits = DesignLimits()
-        self.undo_stack = UndoStack()
-        self._undoing = False
-        self._loaded_scene: dict[str, Any] | None = None
+        self.history = SceneHistory(self)
         self.figures = Figures(self.scales)
         self._drawn: ResultView | None = None
-        self.busy_shown = False
-        self._busy_due = False
-        self._link_due = False
-        self._linked = ""
+        self.busy = BusyIndicator(self)
         self._views: list[Any] = []
         self._initial_scene(scene, query or {})
+        self.link = AddressLink(self)
+        self.pins = PinsView(self)
         self.results = ResultsView(self)
         # model fidelity (layer interface, contact model, coating-model tolerance): one
         # view whose widgets sit in the Coating and Time tabs
         self.fidelity = FidelityView(self.state, self.reject)
         self.views = [view(self) for view in SIDEBAR_VIEWS]
-        self._views = [self.results, *self.views]
+        self._views = [self.results, self.pins, *self.views]
         self._layout = self._build_layout()
-        self._wanted_index, tab, pin_scene, pin_message = read_view_query(
+        self._wanted_index, tab, pin_scenes, pin_message = read_view_query(
             query or {}, len(self.sidebar))
         if tab:
-            self._fill(tab)
+            self.tabs.fill(tab)
             self.sidebar.active = tab
-        self._pin_controller: SolveController | None = None
-        if pin_scene is not None:
-            self._solve_pin(pin_scene)
+        if pin_scenes:
+            self.pins.solve_from_link(pin_scenes)
         if pin_message and not self.notice:
             self.notice = pin_message
         # Changes to plain Bokeh models made after the page was generated but before its
@@ -128,7 +118,7 @@ class ExplorerApp(pn.viewable.Viewer):
         if self.served:
             pn.state.onload(self._on_load)
         self.controller.param.watch(self._on_view, "view")
-        self.controller.param.watch(self._on_status, ["error", "busy"])
+        self.controller.param.watch(self.busy.on_status, ["error", "busy"])
         self.param.watch(self._on_time, "time_index")
         self.param.watch(self._on_notice, "notice")
         self.state.param.watch(self._on_revision, "revision")
@@ -154,8 +144,12 @@ class ExplorerApp(pn.viewable.Viewer):
 
     def page_parts(self) -> list[Any]:
         """Every viewable of the page: the layout and the sidebar tabs not filled yet."""
-        return [self._layout] + [obj for _, objects in self._deferred_tabs.values()
-                                 for obj in objects]
+        return [self._layout, *self.tabs.parts()]
+
+    @property
+    def busy_shown(self) -> bool:
+        """Whether the page shows the busy indicator now."""
+        return self.busy.shown
 
     # -- plumbing --------------------------------------------------------------------
     @property
@@ -201,10 +195,10 @@ class ExplorerApp(pn.viewable.Viewer):
         if chosen is not None:
             try:
                 self.state.load_scene(chosen)
-                self._loaded_scene = chosen
+                self.history.loaded = chosen
             except ValueError as exc:
                 self.notice = f"The scene could not be shown: {exc}"
-        self._remember()
+        self.history.remember()
         self.preset_key = next((k for k, s in self.presets.items() if s == chosen), None)
 
     def _fallback_to_default(self) -> None:
@@ -225,21 +219,9 @@ class ExplorerApp(pn.viewable.Viewer):
 
     # -- layout ----------------------------------------------------------------------
     def _build_layout(self) -> pn.viewable.Viewable:
-        tabs = [(view.title, view.content()) for view in self.views]
-        # A served page arrives with the first tab only (a fifth of the widget models,
-        # 0.4 s less to the first paint); another tab gets its widgets when first opened,
-        # or a few seconds after the page, and keeps them (see _fill_idle_tab). Panel's
-        # dynamic tabs would rebuild a tab at every switch:
-        # measured 110 ms of server time each, which made 20 sessions 8x slower.
-        self._deferred_tabs: dict[int, tuple[pn.Column, list[Any]]] = {}
-        for k, (_title, content) in enumerate(tabs):
-            if k and self.served:
-                self._deferred_tabs[k] = (content, list(content.objects))
-                content.objects = []
-        sidebar = pn.Tabs(*tabs, dynamic=False, width=370, margin=(0, 10, 0, 0),
-                          css_classes=["sidebar-tabs"])
-        sidebar.param.watch(self._fill_tab, "active")
-        sidebar.param.watch(lambda e: self._schedule_link(), "active")
+        self.tabs = DeferredTabs(self, [(view.title, view.content()) for view in self.views])
+        sidebar = self.tabs.sidebar
+        sidebar.param.watch(lambda e: self.link.schedule(), "active")
         self.sidebar = sidebar
         header = html_pane(
             "<h2 style='margin:4px 0'>Coated punch explorer</h2>"
@@ -273,36 +255,17 @@ class ExplorerApp(pn.viewable.Viewer):
         """Say on the page that a value typed or dragged was refused, and why."""
         self.notice = f"Value not accepted: {message}"
 
-    def _on_revision(self, event: Any) -> None:
-        self._remember()
-        self.controller.request()
-
-    def _remember(self) -> None:
-        if self._undoing:
-            return
-        try:
-            self.undo_stack.push(self.state.to_scene())
-        except ValueError:
-            return  # a state that is no scene (its message comes with the solve)
-        if self._views:
-            self.undo_button.disabled = not self.undo_stack.can_undo
-
     def undo(self) -> None:
         """Go back to the scene before the last change."""
-        scene = self.undo_stack.undo()
-        if scene is None:
-            return
-        self._undoing = True
-        try:
-            self.state.load_scene(scene)
-        finally:
-            self._undoing = False
-        self.undo_button.disabled = not self.undo_stack.can_undo
+        self.history.undo()
 
     def reset(self) -> None:
         """Back to the scene as it was loaded (the preset, the file, the link)."""
-        if self._loaded_scene is not None:
-            self.state.load_scene(self._loaded_scene)
+        self.history.reset()
+
+    def _on_revision(self, event: Any) -> None:
+        self.history.remember()
+        self.controller.request()
 
     def load_scene(self, scene: dict[str, Any]) -> bool:
         """Validate a scene dict with the core and show it; False (and a notice) if bad."""
@@ -315,7 +278,7 @@ class ExplorerApp(pn.viewable.Viewer):
             self.notice = f"The scene was not loaded: {format_error(str(exc))}"
             return False
         self.scales.reset()
-        self._loaded_scene = scene
+        self.history.loaded = scene
         self.notice = ""
         return True
 
@@ -325,58 +288,11 @@ class ExplorerApp(pn.viewable.Viewer):
         self.notice_alert.object = html.escape(self.notice)
         self.notice_alert.visible = bool(self.notice)
 
-    def _on_status(self, *events: Any) -> None:
-        self.results.show_error(self.controller.error, self.controller.view is not None)
-        if not self.controller.busy:
-            self._show_busy(False)
-            self._schedule_link()  # a link skipped while busy, if no newer result came
-        elif not self.served:  # no event loop to wait on: show it at once
-            self._show_busy(True)
-        elif not (self.busy_shown or self._busy_due):
-            self._busy_due = True
-            self._later(self._busy_timeout, BUSY_AFTER_MS)
-
-    def _busy_timeout(self) -> None:
-        self._busy_due = False
-        if self.controller.busy:
-            self._show_busy(True)
-
-    def _show_busy(self, busy: bool) -> None:
-        if busy == self.busy_shown:
-            return
-        self.busy_shown = busy
-        self.spinner.value = busy
-        self.status.object = status_html(self.controller.view, busy)
-
     def _on_load(self) -> None:
         self._connected = True
         if self.controller.view is not None and self.controller.view is not self._drawn:
             self._on_view(None)
-        self._later(self._fill_idle_tab, FILL_TABS_AFTER_MS)
-
-    def _fill_tab(self, event: Any) -> None:
-        """Give a sidebar tab its widgets when it is first opened; they then stay."""
-        self._fill(event.new)
-
-    def _fill(self, index: int) -> None:
-        content = self._deferred_tabs.pop(index, None)
-        if content is not None:
-            column, objects = content
-            column.objects = objects
-
-    def _fill_idle_tab(self) -> None:
-        """Fill the next unopened tab, then the others one per turn of the event loop.
-
-        Under load the server can miss a tab click (measured once in ~600 first openings
-        with 20 sessions: the client showed the tab, the server never heard of it), and
-        the tab stayed empty; filled in the background it cannot."""
-        if self._deferred_tabs:
-            self._fill(min(self._deferred_tabs))
-        if self._deferred_tabs:
-            self._later(self._fill_idle_tab, 0)
-        elif self.served:
-            # the page is complete; it lives as long as the session
-            gc_policy.page_built(getattr(self._doc, "session_context", None))
+        self._later(self.tabs.fill_idle, FILL_TABS_AFTER_MS)
 
     def _later(self, callback: Callable[[], None], delay_ms: float) -> None:
         """Run ``callback`` on this session's event loop after ``delay_ms`` [ms]."""
@@ -409,38 +325,17 @@ class ExplorerApp(pn.viewable.Viewer):
         else:
             index = min(self.time_index, n - 1)
         self._drawn = view
+        self.pins.on_result(view)
         with pn.io.hold():
             self.results.draw(view, index, new_range=old is None or len(old.times) != n)
             self.files_view.name_files(view)
         self.results.push()
-        self._schedule_link()
+        self.link.schedule()
 
     @property
     def files_view(self) -> FilesView:
         """The Files tab (it names the downloads after the scene on screen)."""
         return next(v for v in self.views if isinstance(v, FilesView))
-
-    def _schedule_link(self) -> None:
-        if self._location is not None and self._drawn is not None and not self._link_due:
-            self._link_due = True
-            self._later(self._update_link, LINK_EVERY_MS)
-
-    def _update_link(self) -> None:
-        """Put the scene on screen into the page's address (a link that reproduces it)."""
-        self._link_due = False
-        view = self._drawn
-        if view is None or self._location is None or self.controller.busy:
-            return  # a newer result is coming, and will ask again
-        try:
-            pin = self.pinned.scene if self.pinned is not None else None
-            query = view_query(view.scene, self.time_index, self.sidebar.active, pin)
-            # the whole query at once: the values are URL-safe already (base64url, digits)
-            link = "?" + "&".join(f"{k}={v}" for k, v in query.items() if v)
-            if link != self._linked:
-                self._address.value = link
-                self._linked = link
-        except Exception:  # the link is a convenience; the page must not fail for it
-            log.exception("could not update the link")
 
     def _on_time(self, event: Any) -> None:
         view = self._drawn
@@ -448,57 +343,10 @@ class ExplorerApp(pn.viewable.Viewer):
             return
         index = min(max(int(event.new), 0), len(view.times) - 1)
         with pn.io.hold():
-            self.figures.show_time(view, index, self.pinned)
+            self.figures.show_time(view, index, self.pins.board.pins)
             self.results.show_time_texts(view, index)
         self.results.push()
-        self._schedule_link()
-
-    # -- the pinned result -------------------------------------------------------------
-    def _solve_pin(self, scene: dict[str, Any]) -> None:
-        """Solve the pinned scene of a link (off the page's thread), then pin it."""
-        from core import scene_from_dict
-
-        state = ExplorerState()
-        try:
-            scene_from_dict(scene)
-            state.load_scene(scene)
-        except ValueError as exc:
-            self.notice = f"The pinned result in the link was not used: {format_error(str(exc))}"
-            return
-        executor = self.controller.executor
-        self._pin_controller = SolveController(state, executor=executor,
-                                               dispatch=self._dispatch, auto=False)
-        self._pin_controller.param.watch(self._on_pin_view, "view")
-        self._pin_controller.request()
-
-    def _on_pin_view(self, event: Any) -> None:
-        if event.new is not None:
-            self.pinned = event.new
-            self.unpin_button.disabled = False
-            self._redraw_pin()
-
-    def pin(self) -> None:
-        """Keep the result on screen for comparison with the next ones."""
-        self.pinned = self._drawn
-        self.unpin_button.disabled = self.pinned is None
-        self._redraw_pin()
-        self._schedule_link()
-
-    def unpin(self) -> None:
-        """Drop the pinned result."""
-        self.pinned = None
-        self.unpin_button.disabled = True
-        self._redraw_pin()
-        self._schedule_link()
-
-    def _redraw_pin(self) -> None:
-        view = self._drawn
-        if view is None:
-            return
-        with pn.io.hold():
-            self.figures.show_pinned(view, self.pinned, self.time_index)
-            self.results.show_time_texts(view, self.time_index)
-        self.results.push()
+        self.link.schedule()
 
 
 def warm_up(keys: tuple[str, ...] = (DEFAULT_PRESET,)) -> None:

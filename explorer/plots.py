@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from bokeh.core.properties import value as fixed_label
@@ -31,6 +32,8 @@ from bokeh.plotting import figure
 from .bokeh_data import f32, set_data
 from .classical import bearing_rule_pressure, half_space_pressure
 from .contact_plots import ContactDrawing, FeatureInset
+from .pin_plots import PinLines
+from .pins import Pin
 from .results import ResultView
 from .scales import DisplayScales
 from .state import QUANTITIES, QUANTITY_UNITS
@@ -43,7 +46,6 @@ UNKNOWN_COLOR = "#1f77b4"
 LOST_LABEL = "q < 0 (contact lost)"
 LIFTED_LABEL = "lifted off (q = 0)"
 GIVEN_COLOR = "#8c8c8c"
-PINNED_COLOR = "#d62728"
 
 # Number of slabs each coating layer is drawn with (its colour follows E(x)).
 _SLABS = 120
@@ -95,6 +97,7 @@ class Figures:
         self.contact_fig = self.contact.width_fig
         self.inset = FeatureInset()
         self.inset_fig = self.inset.fig
+        self.pins = PinLines(self)
 
     # -- construction ----------------------------------------------------------------
     def _build_scene(self) -> None:
@@ -151,14 +154,11 @@ class Figures:
         p.yaxis.axis_label = "q [kPa]"
         # one point until the first result, so the auto ranges have something to fit
         self.q_src = ColumnDataSource({"x": [0.0], "q": [0.0]}, name="q_source")
-        self.q_pin_src = ColumnDataSource(_empty("x", "q"), name="q_pin_source")
         self.neg_src = ColumnDataSource(_empty("left", "right"), name="negative_source")
         self.neg_strip = p.vstrip(x0="left", x1="right", source=self.neg_src,
                                   fill_color="#d62728", fill_alpha=0.18, line_color=None,
                                   legend_label=LOST_LABEL)
         p.add_layout(Span(location=0, dimension="width", line_color="#555", line_width=1))
-        self.q_pin_line = p.line(x="x", y="q", source=self.q_pin_src, line_color=PINNED_COLOR,
-                                 line_dash="dashed", line_width=2, legend_label="pinned")
         self.classic_src = ColumnDataSource(_empty("x", "half_space", "bearing_rule"),
                                             name="classical_source")
         self.classic_lines = [
@@ -207,7 +207,6 @@ class Figures:
 
     def _build_histories(self) -> None:
         self.history_src: dict[str, ColumnDataSource] = {}
-        self.history_pin_src: dict[str, ColumnDataSource] = {}
         self.history_point_src: dict[str, ColumnDataSource] = {}
         self.history_fig = {}
         self.history_line = {}
@@ -224,23 +223,20 @@ class Figures:
             p.xaxis.axis_label = "t [days after loading]"
             p.yaxis.axis_label = f"{SYMBOLS[q]} [{unit}]"
             src = ColumnDataSource({"t": [0.0], "v": [0.0]}, name=f"{q}_source")
-            pin = ColumnDataSource(_empty("t", "v"), name=f"{q}_pin_source")
             point = ColumnDataSource(_empty("t", "v"), name=f"{q}_point_source")
-            p.line(x="t", y="v", source=pin, line_color=PINNED_COLOR, line_dash="dashed",
-                   line_width=2)
             line = p.line(x="t", y="v", source=src, line_color=UNKNOWN_COLOR, line_width=2.5)
             p.scatter(x="t", y="v", source=point, size=8, color="#d62728")
             p.add_tools(HoverTool(renderers=[line], mode="vline", tooltips=[
                 ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
             cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted")
             p.add_layout(cursor)
-            self.history_src[q], self.history_pin_src[q] = src, pin
+            self.history_src[q] = src
             self.history_point_src[q] = point
             self.history_fig[q], self.history_line[q] = p, line
             self.history_cursor[q] = cursor
 
     # -- updates ---------------------------------------------------------------------
-    def show(self, view: ResultView, index: int, pinned: ResultView | None) -> None:
+    def show(self, view: ResultView, index: int, pins: Sequence[Pin] = ()) -> None:
         """Draw a new result (call inside ``pn.io.hold`` to send one message)."""
         # A change of the loads leaves the drawing as it is: do not send it again.
         key = json.dumps([view.scene.get(k) for k in ("punch", "coating", "base")],
@@ -259,32 +255,15 @@ class Figures:
             state = "given" if given else "computed"
             unit = QUANTITY_UNITS[q][0]
             self.history_fig[q].title.text = f"{TITLES[q]} {SYMBOLS[q]} [{unit}]: {state}"
-        self._show_pinned_histories(pinned)
-        self.show_time(view, index, pinned)  # the pinned pressure included
+        self.pins.show(view, pins, index)
+        self.show_time(view, index, pins, pinned_drawn=True)
 
-    def show_pinned(self, view: ResultView, pinned: ResultView | None, index: int) -> None:
-        """Overlay (or clear) a pinned result on the histories and the pressure."""
-        self._show_pinned_histories(pinned)
-        self._show_pinned_pressure(view, pinned, index)
+    def show_pinned(self, view: ResultView, pins: Sequence[Pin], index: int) -> None:
+        """Overlay (or clear) the pinned results on the histories and the pressure."""
+        self.pins.show(view, pins, index)
 
-    def _show_pinned_histories(self, pinned: ResultView | None) -> None:
-        for q in QUANTITIES:
-            if pinned is None:
-                set_data(self.history_pin_src[q], {"t": [], "v": []})
-            else:
-                set_data(self.history_pin_src[q], {"t": f32(pinned.times),
-                                                   "v": f32(pinned.display(q))})
-
-    def _show_pinned_pressure(self, view: ResultView, pinned: ResultView | None,
-                              index: int) -> None:
-        if pinned is None:
-            set_data(self.q_pin_src, {"x": [], "q": []})
-            return
-        unit, size = self.scales.pressure_unit(view)
-        j = pinned.time_index(float(view.times[index]))
-        set_data(self.q_pin_src, {"x": f32(pinned.x), "q": f32(pinned.pressure[:, j] / size)})
-
-    def show_time(self, view: ResultView, index: int, pinned: ResultView | None) -> None:
+    def show_time(self, view: ResultView, index: int, pins: Sequence[Pin] = (),
+                  pinned_drawn: bool = False) -> None:
         """Move every time cursor to output ``index`` (no solve)."""
         unit, size = self.scales.pressure_unit(view)
         t = float(view.times[index])
@@ -297,7 +276,8 @@ class Figures:
         self._label_strips(view)
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
-        self._show_pinned_pressure(view, pinned, index)
+        if not pinned_drawn:
+            self.pins.show_time(view, pins, index)
         self._show_classical(view, index)
         self.image_cursor.location = t
         for name in QUANTITIES:

@@ -139,7 +139,7 @@ def test_pin_link_and_downloads_match_the_screen(server: str, browser_context, p
     page.page.get_by_text("Pin this result").first.click()
     page.page.locator(".pinned-settlement").first.wait_for(timeout=30_000)
     assert page.page.evaluate(
-        "() => Bokeh.documents[0].get_model_by_name('q_pin_source').data.q.length") > 1
+        "() => Bokeh.documents[0].get_model_by_name('q_pin_source_0').data.q.length") > 1
 
     page.type_into(".load-0-value", "650")
     new = page.wait_text_change(".readout-settlement", settlement)

@@ -34,10 +34,13 @@ def test_set_data_skips_equal_numbers_and_sends_changes() -> None:
 def _count_changes(app: ExplorerApp) -> dict[str, list[int]]:
     figures = app.figures
     sources = {"layers": figures.layer_src, "punch": figures.punch_src,
-               "base": figures.base_src, "q": figures.q_src, "q_pin": figures.q_pin_src}
+               "base": figures.base_src, "q": figures.q_src}
     for q in ("settlement", "tilt", "force", "moment"):
         sources[q] = figures.history_src[q]
-        sources[f"{q}_pin"] = figures.history_pin_src[q]
+    if figures.pins.q_src:
+        sources["q_pin"] = figures.pins.q_src[0]
+        for q in ("settlement", "tilt", "force", "moment"):
+            sources[f"{q}_pin"] = figures.pins.history_src[q][0]
     counts: dict[str, list[int]] = {name: [0] for name in sources}
     for name, source in sources.items():
         source.on_change("data", lambda attr, old, new, c=counts[name]: c.__setitem__(0, c[0] + 1))
@@ -54,13 +57,18 @@ def test_a_load_step_resends_only_the_data_that_changed() -> None:
     sent = {name: c[0] for name, c in counts.items()}
     # a new force: new pressure, settlement and force history
     assert sent["q"] == 1 and sent["settlement"] == 1 and sent["force"] == 1
-    # the drawing, the empty pinned curves and the zero tilt and moment stay as they are
-    for name in ("layers", "punch", "base", "q_pin", "tilt", "moment", "settlement_pin",
-                 "tilt_pin", "force_pin", "moment_pin"):
+    # the drawing and the zero tilt and moment stay as they are; no pin, no pin lines
+    for name in ("layers", "punch", "base", "tilt", "moment"):
         assert sent[name] == 0, name
-    # pinning then sends the pinned curves once
+    assert app.figures.pins.q_src == []
+    # pinning makes the pin's lines; a load step then leaves the pinned curves alone
     app.pin()
-    assert counts["q_pin"][0] == 1 and counts["settlement_pin"][0] == 1
+    counts = _count_changes(app)
+    force.value = force.value * 1.1
+    assert app.controller.wait(60) and app.controller.error == ""
+    assert counts["q"][0] == 1
+    for name in ("q_pin", "settlement_pin", "tilt_pin", "force_pin", "moment_pin"):
+        assert counts[name][0] == 0, name
 
 
 class _Timers:
@@ -211,7 +219,7 @@ def test_a_complete_page_is_frozen_out_of_the_collectors_reach(served_app, monke
     app._on_load()
     while timers.pending and not frozen:  # the tabs are filled one by one
         timers.run()
-    assert frozen == [1] and not app._deferred_tabs
+    assert frozen == [1] and not app.tabs.deferred
     try:
         monkeypatch.undo()
         assert gc_policy.page_built()

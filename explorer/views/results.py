@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import html
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import panel as pn
@@ -11,10 +12,14 @@ import param
 from .. import exports
 from ..contact_zone import contact_text, lifts_off
 from ..design import check_html, design_check
+from ..pin_plots import PIN_COLORS
+from ..pins import Pin
 from ..results import ResultView
 from ..state import QUANTITIES, QUANTITY_UNITS
 from ..status import status_html
+from ..time_axis import LogTime
 from ..widgets import NAMES
+from .busy import BusySpinner
 from .contact import ContactPanes
 from .style import html_pane
 
@@ -60,15 +65,19 @@ def badges_html(view: ResultView | None, group: str) -> str:
     return "".join(parts)
 
 
-def readout_html(view: ResultView | None, index: int, pinned: ResultView | None) -> str:
-    """Values at the selected time: current, pinned and their difference."""
+def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) -> str:
+    """Values at the selected time: current, and each pin with the change to it."""
     if view is None:
         return ""
     t = float(view.times[index])
     head = "<tr><th></th><th>current</th>"
-    head += "<th>pinned</th><th>change</th></tr>" if pinned is not None else "</tr>"
-    rows = [head]
-    j = pinned.time_index(t) if pinned is not None else 0
+    for k, pin in enumerate(pins):
+        color = PIN_COLORS[k]
+        head += (f"<th style='border-bottom:3px dashed {color}'>{html.escape(pin.label)}"
+                 "</th><th>change</th>")
+    rows = [head + "</tr>"]
+    others = [pin.view for pin in pins]
+    times = [other.time_index(t) for other in others]
     for q in QUANTITIES:
         unit = QUANTITY_UNITS[q][0]
         value = float(view.display(q)[index])
@@ -76,10 +85,11 @@ def readout_html(view: ResultView | None, index: int, pinned: ResultView | None)
         cls = "cp-given" if role == "given" else ""
         row = (f"<tr class='{cls}'><td>{NAMES[q]} [{unit}] ({role})</td>"
                f"<td class='readout-{q}'>{_fmt(value)}</td>")
-        if pinned is not None:
+        for k, (pinned, j) in enumerate(zip(others, times, strict=True)):
             other = float(pinned.display(q)[j])
             change = f"{100 * (value - other) / abs(other):+.2f} %" if other else "n/a"
-            row += f"<td class='pinned-{q}'>{_fmt(other)}</td><td>{change}</td>"
+            row += (f"<td class='pinned-{q} pin-{k}-{q}'>{_fmt(other)}</td>"
+                    f"<td>{change}</td>")
         rows.append(row + "</tr>")
     force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
     ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
@@ -100,8 +110,7 @@ class ResultsView:
                                           visible=bool(app.notice),
                                           sizing_mode="stretch_width",
                                           css_classes=["notice"])
-        self.spinner = pn.indicators.LoadingSpinner(value=False, size=20, label="",
-                                                    margin=(5, 5))
+        self.spinner = BusySpinner()
         self.status = html_pane("", sizing_mode="stretch_width", margin=(5, 5))
         badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
         self.scene_badges = html_pane("", **badge)
@@ -122,11 +131,11 @@ class ResultsView:
         self.classical = pn.widgets.Checkbox(label="classical solutions on q(x)",
                                              css_classes=["classical-toggle"])
         self.classical.param.watch(self._on_classical, "value")
-        self.pin_button = pn.widgets.Button(label="Pin this result", color="default")
-        self.unpin_button = pn.widgets.Button(label="Clear pin", color="light",
-                                              disabled=True)
-        self.pin_button.on_click(lambda e: app.pin())
-        self.unpin_button.on_click(lambda e: app.unpin())
+        # long creep histories change most in their first days: a log axis shows both
+        self.log_time = pn.widgets.Checkbox(label="log time axis", css_classes=["log-time"],
+                                            margin=(5, 10))
+        self.log_time.param.watch(self._on_log_time, "value")
+        self.time_axis = LogTime([app.figures.history_fig[q] for q in QUANTITIES])
         app.limits.param.watch(lambda *e: self.show_design(), list(
             n for n in app.limits.param if n != "name"))
         f = app.figures
@@ -142,18 +151,17 @@ class ResultsView:
             self._address,
             self.notice_alert,
             self.alert,
-            pn.Row(self.spinner, self.status, sizing_mode="stretch_width"),
+            pn.Row(self.spinner.pane, self.status, sizing_mode="stretch_width"),
             self.status_badges,
             self.scene_badges,
             pn.Row(scene_pane, self.contact_panes.inset_slot, sizing_mode="stretch_width"),
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
-            pn.Row(self.readout, pn.Column(self.pin_button, self.unpin_button,
-                                           self.classical),
+            pn.Row(self.readout, pn.Column(self.app.pins.content(), self.classical),
                    sizing_mode="stretch_width"),
             self.design,
-            self.history_badges,
+            pn.Row(self.history_badges, self.log_time, sizing_mode="stretch_width"),
             pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
             self.contact_panes.width_slot,
             sizing_mode="stretch_width",
@@ -162,7 +170,7 @@ class ResultsView:
     def draw(self, view: ResultView, index: int, new_range: bool) -> None:
         """Show a new result at output time ``index`` (call inside ``pn.io.hold()``)."""
         app = self.app
-        app.figures.show(view, index, app.pinned)
+        app.figures.show(view, index, app.pins.board.pins)
         self.contact_panes.update(view)
         if new_range:
             self._replace_player(max(len(view.times) - 1, 1), index)
@@ -176,13 +184,15 @@ class ResultsView:
         self.pressure_badges.object = badges_html(view, "pressure")
         self.history_badges.object = badges_html(view, "history")
         self.status_badges.object = badges_html(view, "status")
+        if self.time_axis.on:
+            self.time_axis.fit()
         self.show_design()
 
     def show_time_texts(self, view: ResultView, index: int) -> None:
         """The time label and the readout at output time ``index``."""
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{float(view.times[index]):.4g} days</span>")
-        self.readout.object = readout_html(view, index, self.app.pinned)
+        self.readout.object = readout_html(view, index, self.app.pins.board.pins)
 
     def show_design(self) -> None:
         """The design check of the result on screen against the session's limits."""
@@ -207,6 +217,11 @@ class ResultsView:
         app = self.app
         with pn.io.hold():
             app.figures.set_classical(app.shown(), app.time_index, bool(event.new))
+        self.push()
+
+    def _on_log_time(self, event: Any) -> None:
+        with pn.io.hold():
+            self.time_axis.set(bool(event.new))
         self.push()
 
     def _new_player(self, end: int, value: int) -> pn.widgets.Player:

@@ -17,6 +17,7 @@ CSS = """
 .cp-readout td, .cp-readout th {padding: 1px 8px; font-size: 13px; text-align: right;}
 .cp-readout th:first-child, .cp-readout td:first-child {text-align: left;}
 .cp-given {color: #777;}
+.readout {overflow-x: auto;}
 """
 
 #: Style of the small grey notes under a group of widgets.

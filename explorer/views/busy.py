@@ -1,0 +1,84 @@
+"""The busy indicator: shown only for a solve that takes long enough to be noticed."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import param
+
+from ..status import status_html
+from .style import html_pane
+
+if TYPE_CHECKING:
+    from ..app import ExplorerApp
+
+#: A solve shows the busy indicator only once it has run this long [ms]. A slider step
+#: is solved in 10-50 ms: its new plots are the feedback, and switching the indicator on
+#: and off costs three more messages to the page per step (a sixth of the server's work
+#: with 20 busy sessions, measured with py-spy).
+BUSY_AFTER_MS = 250
+
+
+#: A spinning ring drawn by CSS alone (inside the pane's own shadow root).
+_RING = ("<style>@keyframes cp-spin {to {transform: rotate(360deg)}}</style>"
+         "<div class='cp-spinner' style='width:14px;height:14px;margin:3px;"
+         "border:3px solid #ddd;border-top-color:#1f77b4;border-radius:50%;"
+         "animation:cp-spin 0.8s linear infinite'></div>")
+
+
+class BusySpinner(param.Parameterized):
+    """A spinner that turns by changing its text only.
+
+    Panel's LoadingSpinner turns by changing its CSS classes, and a change of classes
+    makes the page lay out every figure again: measured in Chromium, two whole-page
+    layouts per slow solve (on and off), most of the page's work for a geometry step."""
+
+    value = param.Boolean(default=False, doc="Whether the spinner turns.")
+
+    def __init__(self, **params: Any) -> None:
+        super().__init__(**params)
+        # a fixed size: a new text never changes the layout around it
+        self.pane = html_pane("", width=26, height=26, margin=(5, 5),
+                              css_classes=["busy-spinner"])
+        self.param.watch(lambda e: setattr(self.pane, "object", _RING if e.new else ""),
+                         "value")
+
+    def __panel__(self) -> Any:
+        return self.pane
+
+
+class BusyIndicator:
+    """Follows the controller's ``busy`` and ``error`` for the page's spinner and status."""
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self.app = app
+        self.shown = False
+        self._due = False
+
+    def on_status(self, *events: object) -> None:
+        """The controller started or finished a solve, or refused a scene."""
+        app = self.app
+        controller = app.controller
+        app.results.show_error(controller.error, controller.view is not None)
+        if not controller.busy:
+            self.show(False)
+            app.link.schedule()  # a link skipped while busy, if no newer result came
+        elif not app.served:  # no event loop to wait on: show it at once
+            self.show(True)
+        elif not (self.shown or self._due):
+            self._due = True
+            app._later(self._timeout, BUSY_AFTER_MS)
+
+    def _timeout(self) -> None:
+        self._due = False
+        if self.app.controller.busy:
+            self.show(True)
+
+    def show(self, busy: bool) -> None:
+        """Show or hide the spinner and say so in the status line."""
+        if busy == self.shown:
+            return
+        self.shown = busy
+        results = self.app.results
+        results.spinner.value = busy
+        results.status.object = status_html(self.app.controller.view, busy)

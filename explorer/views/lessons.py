@@ -1,0 +1,75 @@
+"""The Lessons tab: a preset taken step by step, a short note at each step."""
+
+from __future__ import annotations
+
+import html
+from typing import TYPE_CHECKING
+
+import panel as pn
+
+from ..lessons import Lesson, lessons, step_scene
+from .style import TAB_COLUMN, html_pane
+
+if TYPE_CHECKING:
+    from ..app import ExplorerApp
+
+
+class LessonsView:
+    """Choose a lesson, then go through its steps with next and previous."""
+
+    title = "Lessons"
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self.app = app
+        self.lessons = lessons()
+        self.lesson: Lesson | None = None
+        self.step = 0
+        options = {"(choose a lesson)": ""} | {v.title: k for k, v in self.lessons.items()}
+        self.lesson_select = pn.widgets.Select(label="lesson", options=options, value="",
+                                               sizing_mode="stretch_width",
+                                               css_classes=["lesson-select"])
+        self.lesson_select.param.watch(lambda e: self.start(e.new), "value")
+        self.previous_button = pn.widgets.Button(label="◀ previous", disabled=True,
+                                                 css_classes=["lesson-previous"])
+        self.next_button = pn.widgets.Button(label="next ▶", disabled=True,
+                                             color="primary",
+                                             css_classes=["lesson-next"])
+        self.previous_button.on_click(lambda e: self.go(self.step - 1))
+        self.next_button.on_click(lambda e: self.go(self.step + 1))
+        self.lesson_note = html_pane("<small>A lesson loads a preset and changes a few "
+                                     "values at each step; each step stays pinned for "
+                                     "comparison.</small>", sizing_mode="stretch_width",
+                                     css_classes=["lesson-note"])
+
+    def content(self) -> pn.Column:
+        """The tab's column."""
+        return pn.Column(self.lesson_select,
+                         pn.Row(self.previous_button, self.next_button),
+                         self.lesson_note, **TAB_COLUMN)
+
+    def start(self, key: str) -> None:
+        """Begin the lesson ``key`` at its first step (clears the pins)."""
+        self.lesson = self.lessons.get(key)
+        if self.lesson is None:
+            self.previous_button.disabled = self.next_button.disabled = True
+            return
+        self.app.pins.unpin()
+        self.go(0, pin=False)
+
+    def go(self, index: int, pin: bool = True) -> None:
+        """Show step ``index`` (0 = first); the step left stays pinned going forward."""
+        lesson = self.lesson
+        if lesson is None or not 0 <= index < len(lesson.steps):
+            return
+        if pin and lesson.pin_steps and index > self.step:
+            self.app.pins.pin()
+        step = lesson.steps[index]
+        self.step = index
+        if step.log_time is not None:
+            self.app.results.log_time.value = step.log_time
+        self.app.load_scene(step_scene(lesson, index))
+        self.previous_button.disabled = index == 0
+        self.next_button.disabled = index == len(lesson.steps) - 1
+        self.lesson_note.object = (
+            f"<div class='cp-lesson'><b>Step {index + 1} of {len(lesson.steps)}</b>"
+            f"<p style='font-size:15px;line-height:1.35'>{html.escape(step.note)}</p></div>")

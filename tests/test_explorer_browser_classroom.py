@@ -1,0 +1,137 @@
+"""Classroom features in a real browser: several pins, the log time axis, lessons.
+
+Debian's Chromium drives the served explorer; every wait is on a condition in the page.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
+
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
+
+from tests.browser_pages import Page, chromium_context, served_explorer, until  # noqa: E402
+
+# Label of a pin's legend entry (a value spec in the page: {value: ...} or plain text).
+JS_LEGEND = """(k) => {
+  const item = Bokeh.documents[0].get_model_by_name('pin_legend_' + k);
+  if (!item || !item.visible) return null;   // a slot never used has no entry
+  const label = item.label;
+  return label && label.value !== undefined ? label.value : label;
+}"""
+# Screen x [px] of t = 1, 10 and 100 days on a figure's drawn frame.
+JS_FRAME_X = """(name) => {
+  const stack = Object.values(Bokeh.index);
+  while (stack.length) {
+    const v = stack.pop();
+    if (v.model && v.model.name === name && v.frame)
+      return [1, 10, 100].map(t => v.frame.x_scale.compute(t));
+    if (v.child_views) stack.push(...v.child_views);
+  }
+  return null;
+}"""
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[str]:
+    yield from served_explorer()
+
+
+@pytest.fixture(scope="module")
+def browser_context() -> Iterator[object]:
+    yield from chromium_context(1400, 900)
+
+
+@pytest.fixture()
+def page(server: str, browser_context: object) -> Iterator[Page]:
+    p = Page(browser_context, server)
+    yield p
+    p.close()
+
+
+def _pins(page: Page) -> int:
+    return page.page.locator(".pinned-settlement").count()
+
+
+def test_several_pins_named_in_the_legend_removed_one_by_one_and_linked(
+        page: Page, server: str, browser_context: object) -> None:
+    """Feature 3: pins to compare, each named after what differs; the link keeps them."""
+    page.page.get_by_text("Pin this result").first.click()
+    until(lambda: _pins(page) == 1, "one pin")
+    page.type_into(".load-0-value", "650")
+    until(lambda: page.text(".readout-force") == "650", "force 650")
+    page.page.get_by_text("Pin this result").first.click()
+    until(lambda: _pins(page) == 2, "two pins")
+    until(lambda: [page.page.evaluate(JS_LEGEND, k) for k in range(3)]
+          == ["P = 500 kN/m", "P = 650 kN/m", None], "the legend names the pins")
+    assert page.text(".pin-0-settlement") != page.text(".pin-1-settlement")
+
+    def href() -> str:
+        return page.page.evaluate("() => window.location.href")
+
+    until(lambda: "pin=1." in href(), "the pins in the link")
+    other = Page(browser_context, server, "/app?" + href().split("?", 1)[1])
+    try:
+        until(lambda: _pins(other) == 2, "both pins from the link")
+        until(lambda: other.page.evaluate(JS_LEGEND, 1) == "P = 650 kN/m", "named alike")
+        assert other.errors == []
+    finally:
+        other.close()
+
+    page.page.locator(".unpin-0 button").first.click()   # remove the first pin only
+    until(lambda: _pins(page) == 1, "one pin left")
+    assert page.page.evaluate("() => Bokeh.documents[0].get_model_by_name("
+                              "'q_pin_source_1').data.q.length") == 0
+    assert page.page.evaluate(JS_LEGEND, 1) is None
+    assert page.errors == []
+
+
+def test_pin_every_step_keeps_the_steps_of_a_slider(page: Page) -> None:
+    page.page.locator(".pin-every-step input").first.check()
+    for force in ("600", "700", "800"):
+        page.type_into(".load-0-value", force)
+        until(lambda force=force: page.text(".readout-force") == force, f"force {force}")
+    until(lambda: _pins(page) == 3, "three steps pinned")
+    assert page.page.evaluate(JS_LEGEND, 2) == "P = 800 kN/m"
+    assert page.errors == []
+
+
+def test_the_histories_switch_to_a_log_time_axis_and_back(page: Page) -> None:
+    """Feature 5: a log time axis for long creep histories, on the same figures."""
+    def spacing() -> tuple[float, float]:
+        x1, x10, x100 = page.page.evaluate(JS_FRAME_X, "settlement_figure")
+        return x10 - x1, x100 - x10
+
+    first, second = spacing()
+    assert second > 5 * first          # linear: 90 days take ten times the width of 9
+    page.page.locator(".log-time input").first.check()
+    until(lambda: abs(spacing()[1] - spacing()[0]) < 1.0, "equal decades")
+    assert page.page.evaluate("() => Bokeh.documents[0].get_model_by_name("
+                              "'tilt_figure').x_scale.type") == "LogScale"
+    page.page.locator(".log-time input").first.uncheck()
+    until(lambda: spacing()[1] > 5 * spacing()[0], "linear again")
+    assert page.errors == []
+
+
+def test_a_lesson_step_by_step_with_notes_and_pins(page: Page) -> None:
+    """Feature 5: a lesson from a preset, next and previous, a note at each step."""
+    page.open_tab("Lessons")
+    select = page.page.locator(".lesson-select select").first
+    select.wait_for(state="visible", timeout=30_000)
+    select.select_option(label="Force, eccentricity and tilt")
+    until(lambda: "Step 1 of 4" in page.pane_text(".lesson-note"), "step 1")
+    page.page.locator(".lesson-next button").first.click()
+    until(lambda: page.text(".readout-force") == "1000", "step 2: the force doubled")
+    until(lambda: "Step 2 of 4" in page.pane_text(".lesson-note"), "the note of step 2")
+    assert "settlement doubles" in page.pane_text(".lesson-note")
+    until(lambda: _pins(page) == 1, "step 1 pinned")
+    page.page.locator(".lesson-next button").first.click()
+    until(lambda: page.text(".readout-moment") == "200", "step 3: e = 0.2 m")
+    page.page.locator(".lesson-previous button").first.click()
+    until(lambda: page.text(".readout-moment") == "0", "back to step 2")
+    assert page.errors == []

@@ -1,0 +1,95 @@
+"""Several pinned results: names after what differs, limits, removal, links, every step."""
+
+from __future__ import annotations
+
+import copy
+
+from explorer.app import ExplorerApp
+from explorer.pins import MAX_PINS, pin_labels
+from explorer.presets import presets
+from explorer.view_link import read_view_query, view_query
+
+
+def _scene(**loading: float) -> dict:
+    scene = copy.deepcopy(presets()["uniform_flat"])
+    scene["loading"].update(loading)
+    return scene
+
+
+def test_pins_are_named_after_what_differs() -> None:
+    base = _scene()
+    assert pin_labels([base]) == ["1: Uniform coating, flat punch"]
+    assert pin_labels([base, _scene(force=6.5e5)]) == ["P = 500 kN/m", "P = 650 kN/m"]
+    # the same force, another moment: the eccentricity e = M/P names them
+    assert pin_labels([_scene(moment=1.5e5), _scene(moment=0.5e5)]) == ["e = 0.3 m",
+                                                                         "e = 0.1 m"]
+    thin = copy.deepcopy(base)
+    thin["coating"][0]["thickness"] = 0.005
+    assert pin_labels([base, thin]) == ["h1 = 20 mm", "h1 = 5 mm"]
+    # a name and a description are no difference
+    renamed = copy.deepcopy(base)
+    renamed["name"], renamed["description"] = "other", "other"
+    assert pin_labels([base, renamed]) == ["1: Uniform coating, flat punch", "2: other"]
+
+
+def test_pins_compare_several_results_and_go_one_by_one() -> None:
+    app = ExplorerApp(executor=None)
+    force = app.state.loading.histories["force"]
+    for value in (500.0, 600.0, 700.0):
+        force.value = value
+        assert app.controller.wait(60)
+        app.pin()
+    app.pin()  # the same result again: not pinned twice
+    board = app.pins.board
+    assert [pin.label for pin in board] == ["P = 500 kN/m", "P = 600 kN/m", "P = 700 kN/m"]
+    lines = app.figures.pins
+    # three slots made, all shown (a page without pins has no pin lines)
+    assert [line.visible for line in lines.q_lines] == [True, True, True]
+    assert [getattr(item.label, "value", item.label) for item in lines.legend_items[:3]] == [
+        "P = 500 kN/m", "P = 600 kN/m", "P = 700 kN/m"]
+    assert app.readout.object.count("pinned-settlement") == 3
+    # the settlement is linear in the force (elastic coating, linear creep): the
+    # readout's change against the 500 kN/m pin is +40 %
+    assert "+40.00 %" in app.readout.object
+    assert [b.label for b in app.pins.pin_list.objects] == [
+        "✕ P = 500 kN/m", "✕ P = 600 kN/m", "✕ P = 700 kN/m"]
+    app.pins.pin_list.objects[1].clicks += 1   # remove the middle one
+    assert [pin.label for pin in board] == ["P = 500 kN/m", "P = 700 kN/m"]
+    assert not lines.q_lines[2].visible and len(lines.q_src[2].data["q"]) == 0
+    app.unpin()
+    assert len(board) == 0 and app.pins.unpin_button.disabled
+    assert "pinned-settlement" not in app.readout.object
+
+
+def test_pin_every_step_keeps_the_last_steps() -> None:
+    app = ExplorerApp(executor=None)
+    app.pins.every_step.value = True
+    moment = app.state.loading.histories["moment"]
+    for step in range(MAX_PINS + 2):
+        moment.value = 50.0 * step
+        assert app.controller.wait(60)
+    labels = [pin.label for pin in app.pins.board]
+    assert len(labels) == MAX_PINS
+    # the oldest steps went; e = M/P with P = 500 kN/m
+    assert labels[0] == "e = 0.2 m" and labels[-1] == "e = 0.7 m"
+
+
+def test_a_link_keeps_several_pins() -> None:
+    scenes = [_scene(moment=m) for m in (0.0, 1e5, 2e5)]
+    query = view_query(scenes[0], 4, 2, scenes)
+    # three scenes that differ in one number deflate to little more than one
+    assert len(query["pin"]) < 1.5 * len(query["scene"])
+    index, tab, pins, message = read_view_query(query, 7)
+    assert (index, tab, pins, message) == (4, 2, scenes, "")
+    one = view_query(scenes[0], 0, 0, scenes[:1])
+    assert read_view_query(one, 7)[2] == scenes[:1]
+    assert view_query(scenes[0], 0, 0, [])["pin"] == ""
+    app = ExplorerApp(executor=None, query={k: v for k, v in query.items()})
+    assert [pin.label for pin in app.pins.board] == ["e = 0 m", "e = 0.2 m", "e = 0.4 m"]
+
+
+def test_a_link_with_too_many_pins_says_so() -> None:
+    scenes = [_scene(moment=1e4 * k) for k in range(MAX_PINS + 1)]
+    query = view_query(scenes[0], 0, 0, scenes)
+    _, _, pins, message = read_view_query(query, 7)
+    assert pins == [] and f"at most {MAX_PINS}" in message
