@@ -31,7 +31,7 @@ def _drawn(key: str, index: int = -1) -> tuple[Figures, ResultView, int]:
     view = _solved(key)
     index = index % len(view.times)
     figures = Figures()
-    figures.show(view, index, None)
+    figures.show(view, index, ())
     return figures, view, index
 
 
@@ -48,7 +48,7 @@ def test_the_bar_under_the_punch_is_the_contact_set_and_follows_the_time() -> No
     x, top = drawing._surface
     assert np.allclose(ys, np.interp(xs, x, top))
     # under creep the zone moves: the time slider moves the bar with it
-    figures.show_time(view, 0, None)
+    figures.show_time(view, 0, ())
     (xs0,) = drawing.zone_src.data["xs"]
     assert xs0[0] == view.contact_set[0][0][0] != start
     assert "contact 1.306 m of 2 m at t = 0 days" == drawing.zone_label.text
@@ -94,7 +94,7 @@ def test_the_readout_names_the_contact_zone() -> None:
     from explorer.views.results import readout_html
 
     view = _solved("eccentric_footing_liftoff")
-    text = readout_html(view, 0, None)
+    text = readout_html(view, 0, ())
     assert "contact 1.306 m of 2 m (65 %), lifted 0.694 m: x = -1 to -0.306 m" in text
     assert contact_zones(view, 0) == view.contact_set[0]
     assert "full contact" in contact_text(_solved("uniform_flat"), 0)
@@ -182,7 +182,7 @@ def test_the_full_contact_model_marks_its_pull_zone_not_a_gap() -> None:
     view = controller.view
     assert "contact_lost" in view.flags
     figures = Figures()
-    figures.show(view, 0, None)
+    figures.show(view, 0, ())
     drawing = figures.contact
     (lifted,) = drawing.lifted_src.data["xs"]
     (lo, hi), = view.negative_intervals(0)   # where q < 0 beyond the error band
