@@ -25,9 +25,11 @@ Output: ``benchmarks/results/sweep.md`` and ``benchmarks/results/sweep_design_ch
 from __future__ import annotations
 
 import argparse
+import faulthandler
 import json
 import os
 import platform
+import signal
 import statistics
 import subprocess
 import sys
@@ -133,7 +135,11 @@ def _cut_points(study: Study, points: int) -> int:
 
 
 def measure(name: str, study: Study, repeats: int) -> dict[str, Any]:
-    runs = {w: [on_fresh_cluster(study, w) for _ in range(repeats)] for w in (2, 1)}
+    runs: dict[int, list[dict[str, float]]] = {2: [], 1: []}
+    for w in runs:
+        for _ in range(repeats):
+            runs[w].append(on_fresh_cluster(study, w))
+            print(f"{name}, {w} worker(s): {runs[w][-1]}", flush=True)
     med = {w: statistics.median(r["seconds"] for r in runs[w]) for w in runs}
     wall, cpu = serial_cpu_per_point(study, study.n_points // 10)
     cpu_med = {w: statistics.median(r["cpu"] for r in runs[w]) for w in runs}
@@ -256,6 +262,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="measure only; keep the design chart drawn before (it needs "
                              "matplotlib)")
     args = parser.parse_args(argv)
+    # `kill -USR1 PID` prints where a run on a loaded machine is waiting
+    faulthandler.register(signal.SIGUSR1)
     out = RESULTS / "quick" if args.quick else RESULTS
     out.mkdir(parents=True, exist_ok=True)
     command = "python -m benchmarks.sweep " + " ".join(argv if argv is not None

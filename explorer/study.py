@@ -25,10 +25,11 @@ from core.study import Study, numeric_fields, study_from_dict
 from .exports import number, project_version
 
 #: Most points of a study started from the page (grid product). The page is served to
-#: untrusted users on a shared machine: a point over a geometric field costs 10-40 ms
-#: (1,000 coating moduli: 9.7-42 ms per point in a serial loop, benchmarks/results/
-#: sweep.md), up to 0.7 s for the slowest valid scene, so 400 points are seconds to a
-#: few minutes of one core. Larger studies belong to ``python -m core sweep``.
+#: untrusted users on a shared machine: a point differing only in its loads costs a few
+#: ms, a new geometry 10-40 ms on an elastic base (benchmarks/results/sweep.md) and
+#: ~0.3 s of CPU for the default preset's creeping base at 40 output times (measured),
+#: up to 0.7 s for the slowest valid scene: 400 points are seconds to about two minutes
+#: of one core. Larger studies belong to ``python -m core sweep``.
 MAX_POINTS = 400
 #: Most values along one parameter (a line of more points shows nothing new on screen).
 MAX_AXIS_POINTS = 200

@@ -1,8 +1,8 @@
 """The design chart of a study: a line over one parameter, a heat map over two.
 
-A :class:`DesignChart` is built for a study's result (the axis types follow its spacing,
-so a new study gets a new figure); switching the output or the time shown only replaces
-the data of its sources (the figure, and the user's zoom, stay). Points the solver
+A session's :class:`DesignChart` holds three figures built once (a line over a linear or a
+log axis, a heat map); a new result, the output or the time shown only replace the data
+of their sources and a few properties. Points the solver
 flagged are marked with a red cross; failed points have no value (a gap in the line, a
 grey cell). Nothing here imports Panel.
 """
@@ -17,6 +17,7 @@ from bokeh.models import (
     FixedTicker,
     HoverTool,
     LinearColorMapper,
+    Range1d,
 )
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
@@ -50,85 +51,112 @@ def flag_note(result: StudyResult) -> str:
     return note + (f", {failed} failed (no value)" if failed else "")
 
 
-def empty_figure() -> figure:
-    """The chart before a study has run."""
-    fig = figure(height=300, sizing_mode="stretch_width", tools=_TOOLS,
-                 title="Run a study to see its design chart", name="study_chart")
-    fig.toolbar.logo = None
-    return fig
-
-
 class DesignChart:
-    """The figure of one study's result; :meth:`show` picks the output and the time."""
+    """The study charts of one session, built once: a line over a linear axis, one over a
+    log axis (both drawing the source named ``study_source``) and a heat map (the source
+    ``study_map_source``). :meth:`draw` shows a new result on the one that fits; switching
+    the output or the time replaces data in place (the figures, and the zoom, stay)."""
 
-    def __init__(self, result: StudyResult, output: str = "settlement",
-                 time_index: int = -1) -> None:
+    def __init__(self) -> None:
+        self.result: StudyResult | None = None
+        self.source = ColumnDataSource({"x": [], "y": [], "flags": []}, name="study_source")
+        self.flagged = ColumnDataSource({"x": [], "y": []}, name="study_flagged")
+        self.map_source = ColumnDataSource({"i": [], "j": [], "x": [], "y": [], "value": [],
+                                            "flags": []}, name="study_map_source")
+        self.map_flagged = ColumnDataSource({"i": [], "j": []}, name="study_map_flagged")
+        self.lines = {kind: self._line_figure(kind) for kind in ("linear", "log")}
+        self.map = self._map_figure()
+        self.lines["linear"].title.text = "Run a study to see its design chart"
+        self.shown = self.lines["linear"]
+
+    def _line_figure(self, kind: str) -> figure:
+        fig = figure(height=300, sizing_mode="stretch_width", tools=_TOOLS, x_axis_type=kind,
+                     name=f"study_line_{kind}")
+        fig.line("x", "y", source=self.source, line_width=2)
+        fig.scatter("x", "y", source=self.source, size=6)
+        fig.scatter("x", "y", source=self.flagged, marker="x", size=12, line_width=2,
+                    color=FLAG_COLOR, legend_label="flagged")
+        fig.legend.location = "top_left"
+        fig.legend.background_fill_alpha = 0.6
+        fig.add_tools(HoverTool(tooltips=[("x", "@x"), ("value", "@y"), ("flags", "@flags")]))
+        fig.toolbar.logo = None
+        return fig
+
+    def _map_figure(self) -> figure:
+        fig = figure(height=330, sizing_mode="stretch_width", tools=_TOOLS,
+                     x_range=Range1d(-0.5, 0.5), y_range=Range1d(-0.5, 0.5),
+                     name="study_map")
+        self.mapper = LinearColorMapper(palette=Viridis256, nan_color="#cccccc")
+        fig.rect("i", "j", width=1, height=1, source=self.map_source,
+                 fill_color={"field": "value", "transform": self.mapper}, line_color=None)
+        fig.scatter("i", "j", source=self.map_flagged, marker="x", size=9, line_width=2,
+                    color=FLAG_COLOR)
+        self.color_bar = ColorBar(color_mapper=self.mapper, ticker=BasicTicker(), width=10,
+                                  title="")
+        fig.add_layout(self.color_bar, "right")
+        self.map_hover = HoverTool(tooltips=[("x", "@x"), ("y", "@y"), ("value", "@value"),
+                                             ("flags", "@flags")])
+        fig.add_tools(self.map_hover)
+        fig.toolbar.logo = None
+        return fig
+
+    @property
+    def figures(self) -> list[figure]:
+        """Every figure (one of them shown at a time)."""
+        return [self.lines["linear"], self.lines["log"], self.map]
+
+    def draw(self, result: StudyResult, output: str, time_index: int) -> figure:
+        """Show a new result; returns the figure to show."""
         self.result = result
         planned = result.planned
-        self.two = len(planned.values) == 2
-        self.source = ColumnDataSource(name="study_source")
-        self.flagged = ColumnDataSource(name="study_flagged")
         first = planned.choices[0]
-        log_x = planned.is_log(0)
-        if not self.two:
-            fig = figure(height=300, sizing_mode="stretch_width", tools=_TOOLS,
-                         x_axis_type="log" if log_x else "linear", name="study_chart",
-                         x_axis_label=first.title)
-            fig.line("x", "y", source=self.source, line_width=2)
-            fig.scatter("x", "y", source=self.source, size=6)
-            fig.scatter("x", "y", source=self.flagged, marker="x", size=12, line_width=2,
-                        color=FLAG_COLOR, legend_label="flagged")
-            fig.legend.location = "top_left"
-            fig.legend.background_fill_alpha = 0.6
-            fig.add_tools(HoverTool(tooltips=[(first.label, "@x{0.0000}"), ("value", "@y"),
-                                              ("flags", "@flags")]))
+        if len(planned.values) == 1:
+            fig = self.lines["log" if planned.is_log(0) else "linear"]
+            fig.xaxis.axis_label = first.title
+            fig.select_one(HoverTool).tooltips = [(first.label, "@x"), ("value", "@y"),
+                                                  ("flags", "@flags")]
         else:
+            fig = self.map
             second = planned.choices[1]
             n1, n2 = planned.shape
-            fig = figure(height=330, sizing_mode="stretch_width", tools=_TOOLS,
-                         x_range=(-0.5, n1 - 0.5), y_range=(-0.5, n2 - 0.5),
-                         name="study_chart", x_axis_label=first.title,
-                         y_axis_label=second.title)
-            self.mapper = LinearColorMapper(palette=Viridis256, nan_color="#cccccc")
-            fig.rect("i", "j", width=1, height=1, source=self.source,
-                     fill_color={"field": "value", "transform": self.mapper},
-                     line_color=None)
-            fig.scatter("i", "j", source=self.flagged, marker="x", size=9, line_width=2,
-                        color=FLAG_COLOR)
-            for axis, values in ((fig.xaxis, planned.values[0]), (fig.yaxis, planned.values[1])):
+            fig.x_range.update(start=-0.5, end=n1 - 0.5)
+            fig.y_range.update(start=-0.5, end=n2 - 0.5)
+            fig.xaxis.axis_label, fig.yaxis.axis_label = first.title, second.title
+            for axis, values in ((fig.xaxis, planned.values[0]),
+                                 (fig.yaxis, planned.values[1])):
                 ticks = tick_indices(len(values))
                 axis.ticker = FixedTicker(ticks=ticks)
                 axis.major_label_overrides = {int(k): fmt(float(values[k])) for k in ticks}
-            self.color_bar = ColorBar(color_mapper=self.mapper, ticker=BasicTicker(),
-                                      width=10, title="")
-            fig.add_layout(self.color_bar, "right")
-            fig.add_tools(HoverTool(tooltips=[(first.label, "@x"), (second.label, "@y"),
-                                              ("value", "@value"), ("flags", "@flags")]))
-        fig.toolbar.logo = None
-        self.figure = fig
+            self.map_hover.tooltips = [(first.label, "@x"), (second.label, "@y"),
+                                       ("value", "@value"), ("flags", "@flags")]
+        self.shown = fig
         self.show(output, time_index)
+        return fig
 
     def show(self, output: str, time_index: int) -> None:
-        """Draw ``output`` at output time ``time_index`` (in place)."""
+        """Draw ``output`` at output time ``time_index`` of the result (in place)."""
         result = self.result
+        if result is None:
+            return
         planned = result.planned
         z = result.shown(output, time_index)
         flags = result.flags
         mark = result.flagged
         name, unit, _ = OUTPUTS[output]
-        self.figure.title.text = chart_title(result, output, time_index)
-        if not self.two:
+        self.shown.title.text = chart_title(result, output, time_index)
+        if len(planned.values) == 1:
             x = planned.values[0]
             self.source.data = {"x": x, "y": z, "flags": list(flags)}
             self.flagged.data = {"x": x[mark], "y": z[mark]}
-            self.figure.yaxis.axis_label = f"{name} [{unit}]"
+            self.shown.yaxis.axis_label = f"{name} [{unit}]"
             return
         n1, n2 = planned.shape
         i, j = np.meshgrid(np.arange(n1), np.arange(n2), indexing="ij")
         x, y = np.meshgrid(*planned.values, indexing="ij")
-        self.source.data = {"i": i.ravel(), "j": j.ravel(), "x": x.ravel(), "y": y.ravel(),
-                            "value": z.ravel(), "flags": list(flags.ravel())}
-        self.flagged.data = {"i": i[mark], "j": j[mark]}
+        self.map_source.data = {"i": i.ravel(), "j": j.ravel(), "x": x.ravel(),
+                                "y": y.ravel(), "value": z.ravel(),
+                                "flags": list(flags.ravel())}
+        self.map_flagged.data = {"i": i[mark], "j": j[mark]}
         finite = z[np.isfinite(z)]
         low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
         if high <= low:  # one value everywhere: a band around it

@@ -41,15 +41,22 @@ log = logging.getLogger(__name__)
 #: machine also serves every page's slider solves.
 MAX_RUNNING_STUDIES = 1
 #: A study of the page is stopped after this long [s]: :data:`explorer.study.MAX_POINTS`
-#: points at the slowest valid scene's 0.7 s per point are ~280 s.
-STUDY_TIMEOUT_S = 300.0
+#: points at the slowest valid scene's 0.7 s per point are ~280 s of CPU, and a loaded
+#: machine stretches that.
+STUDY_TIMEOUT_S = 600.0
 #: Batches per study: the progress bar moves (and a cancelled study is noticed) once per
 #: batch; a batch also costs a small file write.
 PROGRESS_STEPS = 50
 #: Least time between two progress updates sent to the page [s].
 PROGRESS_EVERY_S = 0.1
-#: Modules the fork server imports once, so that a study's process starts warm.
-_PRELOAD = ["core.sweeps", "core.scene", "core.study", "xarray"]
+#: Modules the fork server imports once, so that a study's process starts warm: the
+#: solver's modules and scipy's parts it uses cost ~1 s of CPU to import (measured), which
+#: every study would pay again.
+_PRELOAD = ["core.sweeps", "core.scene", "core.study", "core.solver", "core.nystrom",
+            "core.prepared", "core.projection", "core.contact", "core.contact_zones",
+            "core.kernel_fit", "core.time_integration", "core.nystrom_time", "scipy.linalg",
+            "scipy.interpolate", "scipy.optimize", "scipy.special", "scipy.sparse",
+            "scipy.fft", "xarray"]
 
 _SLOTS = threading.BoundedSemaphore(MAX_RUNNING_STUDIES)
 _CONTEXT: Any = None

@@ -147,14 +147,14 @@ def test_the_tab_draws_the_chart_and_writes_the_files():
     assert tab.start()
     assert tab.study_run.wait(300)
     assert tab.study_run.status == "done", tab.study_run.message
-    data = tab._chart.source.data
+    data = tab.study_charts.source.data
     np.testing.assert_allclose(data["x"], [300.0, 500.0, 700.0])
     result = tab.study_run.result
     np.testing.assert_allclose(data["y"], result.outputs["settlement"][:, -1] * 1e3)
     tab.study_output.value = "q_max"
-    np.testing.assert_allclose(tab._chart.source.data["y"],
+    np.testing.assert_allclose(tab.study_charts.source.data["y"],
                                result.outputs["q_max"][:, -1] * 1e-3)
-    assert "kPa" in tab._chart.figure.yaxis.axis_label
+    assert "kPa" in tab.study_charts.shown.yaxis.axis_label
     csv = tab._csv().getvalue().splitlines()
     header = next(line for line in csv if not line.startswith("#"))
     assert header.startswith("loading_force_p_kN_per_m,time_day,settlement_mm")

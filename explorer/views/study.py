@@ -25,7 +25,7 @@ from ..study import (
     plan_study,
     study_choices,
 )
-from ..study_plots import DesignChart, empty_figure, flag_note
+from ..study_plots import DesignChart, flag_note
 from ..study_png import design_chart_png
 from ..study_runner import StudyRun
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
@@ -100,14 +100,15 @@ class StudyView:
                                                      css_classes=["study-progress"],
                                                      **stretch)
         self.study_status = html_pane("", css_classes=["study-status"], **stretch)
-        self.study_chart = pn.pane.Bokeh(empty_figure(), **stretch)
+        self.study_charts = DesignChart()
+        self._chart_panes = [pn.pane.Bokeh(fig, visible=k == 0, **stretch)
+                             for k, fig in enumerate(self.study_charts.figures)]
         self.study_csv = pn.widgets.FileDownload(callback=self._csv, filename="study.csv",
                                                  label="Study data (CSV)", disabled=True,
                                                  css_classes=["study-csv"], **stretch)
         self.study_png = pn.widgets.FileDownload(callback=self._png, filename="study.png",
                                                  label="Design chart (PNG)", disabled=True,
                                                  css_classes=["study-png"], **stretch)
-        self._chart: DesignChart | None = None
         self.study_first.field.param.watch(lambda e: self._on_field(self.study_first),
                                            "value")
         self.study_second.field.param.watch(lambda e: self._on_field(self.study_second),
@@ -132,7 +133,7 @@ class StudyView:
                       "Every point is a full solve.</small>"),
             self.study_first.panel(), self.study_second.panel(), self.study_output,
             pn.Row(self.study_run_button, self.study_cancel_button, **stretch_row()),
-            self.study_progress, self.study_status, self.study_chart, self.study_time,
+            self.study_progress, self.study_status, *self._chart_panes, self.study_time,
             html_pane("<small>Red x: the solver flagged the point (outside the model's "
                       "validity, e.g. contact lost); grey or a gap: the point failed. The "
                       "CSV holds every output at every time.</small>", styles=NOTE_STYLE),
@@ -206,8 +207,10 @@ class StudyView:
         times = {f"{t:.4g} days": k for k, t in enumerate(result.times)}
         self.study_time.options = times
         self.study_time.value = len(result.times) - 1
-        self._chart = DesignChart(result, self.study_output.value, self.study_time.value)
-        self.study_chart.object = self._chart.figure
+        shown = self.study_charts.draw(result, self.study_output.value,
+                                       self.study_time.value)
+        for pane in self._chart_panes:
+            pane.visible = pane.object is shown
         stem = slug(str(result.planned.study.base.get("name", "scene"))[:60])
         self.study_csv.filename = f"{stem}_study.csv"
         self.study_png.filename = f"{stem}_study.png"
@@ -215,9 +218,8 @@ class StudyView:
         self._say(f"Done: {self.study_run.message}. Marks: {flag_note(result)}.")
 
     def _redraw(self) -> None:
-        chart = self._chart
-        if chart is not None and self.study_time.value is not None:
-            chart.show(self.study_output.value, int(self.study_time.value))
+        if self.study_time.value is not None:
+            self.study_charts.show(self.study_output.value, int(self.study_time.value))
 
     # -- files -----------------------------------------------------------------------------
     def _csv(self) -> io.StringIO:
