@@ -66,7 +66,6 @@ class DesignChart:
         self.map_flagged = ColumnDataSource({"i": [], "j": []}, name="study_map_flagged")
         self.lines = {kind: self._line_figure(kind) for kind in ("linear", "log")}
         self.map = self._map_figure()
-        self.lines["linear"].title.text = "Run a study to see its design chart"
         self.shown = self.lines["linear"]
 
     def _line_figure(self, kind: str) -> figure:

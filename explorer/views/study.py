@@ -100,9 +100,13 @@ class StudyView:
                                                      css_classes=["study-progress"],
                                                      **stretch)
         self.study_status = html_pane("", css_classes=["study-status"], **stretch)
-        self.study_charts = DesignChart()
-        self._chart_panes = [pn.pane.Bokeh(fig, visible=k == 0, **stretch)
-                             for k, fig in enumerate(self.study_charts.figures)]
+        # the figures are built at the first result: three Bokeh figures cost ~70 ms of
+        # the server's CPU (measured), a seventh of a new session, for a tab few open
+        self.study_charts: DesignChart | None = None
+        self._chart_panes: list[pn.pane.Bokeh] = []
+        self._chart_box = pn.Column(
+            html_pane("<small><i>Run a study to see its design chart here.</i></small>"),
+            **stretch)
         self.study_csv = pn.widgets.FileDownload(callback=self._csv, filename="study.csv",
                                                  label="Study data (CSV)", disabled=True,
                                                  css_classes=["study-csv"], **stretch)
@@ -133,7 +137,7 @@ class StudyView:
                       "Every point is a full solve.</small>"),
             self.study_first.panel(), self.study_second.panel(), self.study_output,
             pn.Row(self.study_run_button, self.study_cancel_button, **stretch_row()),
-            self.study_progress, self.study_status, *self._chart_panes, self.study_time,
+            self.study_progress, self.study_status, self._chart_box, self.study_time,
             html_pane("<small>Red x: the solver flagged the point (outside the model's "
                       "validity, e.g. contact lost); grey or a gap: the point failed. The "
                       "CSV holds every output at every time.</small>", styles=NOTE_STYLE),
@@ -207,6 +211,12 @@ class StudyView:
         times = {f"{t:.4g} days": k for k, t in enumerate(result.times)}
         self.study_time.options = times
         self.study_time.value = len(result.times) - 1
+        if self.study_charts is None:
+            self.study_charts = DesignChart()
+            self._chart_panes = [pn.pane.Bokeh(fig, visible=False,
+                                               sizing_mode="stretch_width")
+                                 for fig in self.study_charts.figures]
+            self._chart_box.objects = self._chart_panes
         shown = self.study_charts.draw(result, self.study_output.value,
                                        self.study_time.value)
         for pane in self._chart_panes:
@@ -218,7 +228,7 @@ class StudyView:
         self._say(f"Done: {self.study_run.message}. Marks: {flag_note(result)}.")
 
     def _redraw(self) -> None:
-        if self.study_time.value is not None:
+        if self.study_charts is not None and self.study_time.value is not None:
             self.study_charts.show(self.study_output.value, int(self.study_time.value))
 
     # -- files -----------------------------------------------------------------------------
