@@ -163,3 +163,8 @@ def test_the_tab_draws_the_chart_and_writes_the_files():
     assert png.startswith(b"\x89PNG\r\n\x1a\n") and len(png) > 5000
     assert not tab.study_csv.disabled and not tab.study_png.disabled
     assert set(OUTPUTS) <= set(result.outputs)
+    # the fields offered follow the scene on screen
+    assert "coating[1].modulus" not in tab.study_second.field.options.values()
+    app.state.n_layers = 2
+    assert "coating[1].modulus" in tab.study_second.field.options.values()
+    assert tab.study_first.field.value == "loading.force"  # the choice made is kept
