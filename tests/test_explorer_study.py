@@ -165,6 +165,7 @@ def test_the_tab_draws_the_chart_and_writes_the_files():
     assert set(OUTPUTS) <= set(result.outputs)
     # the fields offered follow the scene on screen
     assert "coating[1].modulus" not in tab.study_second.field.options.values()
-    app.state.n_layers = 2
+    app.state.n_layers = 2  # solved at once: no server here
+    assert app.controller.view.scene["coating"][1]
     assert "coating[1].modulus" in tab.study_second.field.options.values()
     assert tab.study_first.field.value == "loading.force"  # the choice made is kept

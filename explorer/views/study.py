@@ -33,8 +33,6 @@ from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
 if TYPE_CHECKING:
     from ..app import ExplorerApp
 
-#: The fields offered follow the scene at most this long after a change [ms].
-REFRESH_AFTER_MS = 500
 #: The second parameter's choice for "no second parameter".
 NONE = "(none: a line over parameter 1)"
 
@@ -125,8 +123,9 @@ class StudyView:
         self.study_cancel_button.on_click(lambda e: self.study_run.cancel())
         self.study_run.param.watch(self._on_run, ["status", "done", "total", "message"])
         self.study_run.param.watch(self._on_result, "result")
-        self._refresh_due = False
-        app.state.param.watch(lambda e: self._refresh_soon(), "revision")
+        # the fields offered follow each result on screen (a solve, not every slider step)
+        app.controller.param.watch(lambda e: self.refresh(getattr(e.new, "scene", None)),
+                                   "view")
         if app.served:
             # a closed page stops its study
             pn.state.on_session_destroyed(lambda ctx: self.study_run.cancel())
@@ -147,25 +146,14 @@ class StudyView:
             self.study_csv, self.study_png, **TAB_COLUMN)
 
     # -- choices -------------------------------------------------------------------------
-    def _refresh_soon(self) -> None:
-        """Refresh the choices once after a burst of changes (a slider drag is one
-        change per step; the refresh costs ~2 ms of the server's time, measured)."""
-        if not self.app.served:
-            self.refresh()
-        elif not self._refresh_due:
-            self._refresh_due = True
-            self.app._later(self._refresh_now, REFRESH_AFTER_MS)
-
-    def _refresh_now(self) -> None:
-        self._refresh_due = False
-        self.refresh()
-
-    def refresh(self) -> None:
-        """Offer the fields of the scene on screen (kept when they are still there)."""
-        try:
-            scene = self.app.state.to_scene()
-        except ValueError:
-            return  # not a scene now; its message comes with the solve
+    def refresh(self, scene: dict[str, Any] | None = None) -> None:
+        """Offer the fields of ``scene`` (default: the scene of the state), keeping the
+        fields chosen when they are still there."""
+        if scene is None:
+            try:
+                scene = self.app.state.to_scene()
+            except ValueError:
+                return  # not a scene now; its message comes with the solve
         choices = {c.key: c for c in study_choices(scene)}
         if list(choices) == list(self._choices):
             self._choices = choices
