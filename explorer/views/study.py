@@ -212,7 +212,7 @@ class StudyView:
         result = event.new
         if result is None:
             return
-        times = {f"{t:.4g} days": k for k, t in enumerate(result.times)}
+        times = {f"{t:.6g} days": k for k, t in enumerate(result.times)}
         self.study_time.options = times
         self.study_time.value = len(result.times) - 1
         if self.study_charts is None:
