@@ -7,7 +7,7 @@ naming the field of the tab, e.g. ``parameter 2, points: ...``), and a
 :class:`StudyResult` holds the answers on the grid, in SI units, with the flags of every
 point and the CSV file of the tab. Running it is :mod:`explorer.study_runner`'s job.
 
-Nothing here imports Panel.
+Nothing here imports Panel (the study's process imports this module).
 """
 
 from __future__ import annotations
@@ -21,8 +21,6 @@ from typing import Any
 import numpy as np
 
 from core.study import Study, numeric_fields, study_from_dict
-
-from .exports import number, project_version
 
 #: Most points of a study started from the page (grid product). The page is served to
 #: untrusted users on a shared machine: a point differing only in its loads costs a few
@@ -277,6 +275,10 @@ class StudyResult:
         """The whole study as CSV: ``#`` lines saying what was varied, then one row per
         point and output time (the parameters and outputs in the units on screen,
         ``flags`` and ``error`` of the point)."""
+        # imported here: the study's process unpickles this module, and the exports
+        # import the page's state classes (and with them Panel)
+        from .exports import number, project_version
+
         planned = self.planned
         base = planned.study.base
         lines = [f"# coated-punch {project_version()}: design study around the scene "

@@ -56,7 +56,7 @@ _PRELOAD = ["core.sweeps", "core.scene", "core.study", "core.solver", "core.nyst
             "core.prepared", "core.projection", "core.contact", "core.contact_zones",
             "core.kernel_fit", "core.time_integration", "core.nystrom_time", "scipy.linalg",
             "scipy.interpolate", "scipy.optimize", "scipy.special", "scipy.sparse",
-            "scipy.fft", "xarray"]
+            "scipy.fft", "xarray", "explorer.study_runner"]
 
 _SLOTS = threading.BoundedSemaphore(MAX_RUNNING_STUDIES)
 _CONTEXT: Any = None
