@@ -169,3 +169,23 @@ def test_the_tab_draws_the_chart_and_writes_the_files():
     assert app.controller.view.scene["coating"][1]
     assert "coating[1].modulus" in tab.study_second.field.options.values()
     assert tab.study_first.field.value == "loading.force"  # the choice made is kept
+
+
+def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
+    from explorer.study_plots import DesignChart
+
+    scene = screen_scene()
+    scene["solver"]["contact"] = "full"  # the full-contact answer, flagged when q < 0
+    planned = plan_study(scene, [Axis(ECCENTRICITY, 0.0, 0.6, 4)])
+    runner = run(planned)
+    assert runner.status == "done", runner.message
+    result = runner.result
+    # e = 0.6 m > a/3 under a 2 m wide punch: the pressure at the heel is negative
+    assert list(result.flagged) == [False, False, False, True]
+    assert "contact_lost" in result.flags[-1]
+    chart = DesignChart()
+    chart.draw(result, "q_min", 1)
+    np.testing.assert_allclose(chart.flagged.data["x"], [0.6])
+    assert chart.flagged.data["y"][0] < 0  # kPa: the tension the flag is about
+    rows = [line for line in result.to_csv().splitlines() if not line.startswith("#")]
+    assert rows[-1].endswith('"contact_lost",""')
