@@ -68,8 +68,11 @@ def _context() -> Any:
     global _CONTEXT
     with _CONTEXT_LOCK:
         if _CONTEXT is None:
-            ctx = multiprocessing.get_context("forkserver")
-            ctx.set_forkserver_preload(_PRELOAD)
+            if "forkserver" in multiprocessing.get_all_start_methods():
+                ctx = multiprocessing.get_context("forkserver")
+                ctx.set_forkserver_preload(_PRELOAD)
+            else:  # Windows: a fresh interpreter per study (a slower start)
+                ctx = multiprocessing.get_context("spawn")
             _CONTEXT = ctx
         return _CONTEXT
 
