@@ -3,6 +3,7 @@
     python -m benchmarks.sweep              # the report (about 10 minutes on 2 cores)
     python -m benchmarks.sweep --quick      # smaller studies, one repeat (about 2 minutes)
     python -m benchmarks.sweep --chart-only # only the design chart
+    python -m benchmarks.sweep --no-chart   # only the measurements (no matplotlib needed)
 
 Measured (``core.sweep`` on a local Dask cluster of single-threaded worker processes on
 127.0.0.1, a fresh cluster for every run so that no worker starts with warm caches; the
@@ -24,9 +25,11 @@ Output: ``benchmarks/results/sweep.md`` and ``benchmarks/results/sweep_design_ch
 from __future__ import annotations
 
 import argparse
+import faulthandler
 import json
 import os
 import platform
+import signal
 import statistics
 import subprocess
 import sys
@@ -87,13 +90,18 @@ def on_fresh_cluster(study: Study, workers: int) -> dict[str, float]:
     client.wait_for_workers(workers)
     started = time.perf_counter() - start
     try:
+        cpu_before = client.run(time.process_time)
         start = time.perf_counter()
         info = sweep(study, client=client, return_dataset=False)
         seconds = time.perf_counter() - start
+        # the workers' own CPU time: on a shared machine the wall time also counts the
+        # time other people's processes held the cores
+        cpu_after = client.run(time.process_time)
+        cpu = sum(cpu_after[w] - cpu_before.get(w, 0.0) for w in cpu_after)
     finally:
         client.close()
         cluster.close()
-    return {"start": started, "seconds": seconds, "load": os.getloadavg()[0],
+    return {"start": started, "seconds": seconds, "cpu": cpu, "load": os.getloadavg()[0],
             "failed": info["points_failed"],
             "flagged": info["points_flagged"], "batches": info["batches"]}
 
@@ -113,12 +121,31 @@ def serial_seconds_per_point(study: Study, points: int) -> float:
     return (time.perf_counter() - start) / cut.n_points
 
 
+def serial_cpu_per_point(study: Study, points: int) -> tuple[float, float]:
+    """Wall and CPU seconds per point of :func:`serial_seconds_per_point`'s loop."""
+    cpu = time.process_time()
+    wall = serial_seconds_per_point(study, points)
+    return wall, (time.process_time() - cpu) / max(1, _cut_points(study, points))
+
+
+def _cut_points(study: Study, points: int) -> int:
+    first = study.parameters[0]
+    per_value = study.n_points // len(first.values)
+    return max(1, points // per_value) * per_value
+
+
 def measure(name: str, study: Study, repeats: int) -> dict[str, Any]:
-    runs = {w: [on_fresh_cluster(study, w) for _ in range(repeats)] for w in (2, 1)}
+    runs: dict[int, list[dict[str, float]]] = {2: [], 1: []}
+    for w in runs:
+        for _ in range(repeats):
+            runs[w].append(on_fresh_cluster(study, w))
+            print(f"{name}, {w} worker(s): {runs[w][-1]}", flush=True)
     med = {w: statistics.median(r["seconds"] for r in runs[w]) for w in runs}
+    wall, cpu = serial_cpu_per_point(study, study.n_points // 10)
+    cpu_med = {w: statistics.median(r["cpu"] for r in runs[w]) for w in runs}
     return {"name": name, "points": study.n_points, "runs": runs, "median": med,
-            "speedup": med[1] / med[2],
-            "serial_per_point": serial_seconds_per_point(study, study.n_points // 10)}
+            "cpu_median": cpu_med, "speedup": med[1] / med[2],
+            "serial_per_point": wall, "serial_cpu_per_point": cpu}
 
 
 def design_chart(path: Path) -> dict[str, Any]:
@@ -194,8 +221,9 @@ def report(results: list[dict[str, Any]], chart: dict[str, Any] | None, command:
              "absolute times will change; the batching and the speed-up are what this "
              "measures.", "",
              "| study | points | 2 workers [s] | goal | met | 1 worker [s] | speed-up | "
-             "serial loop, no Dask [ms/point] | cluster start [s] |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "workers' CPU, 2 / 1 workers [s] | serial loop, no Dask, wall / CPU "
+             "[ms/point] | cluster start [s] |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in results:
         goal = GOALS.get(r["name"])
         two, one = r["median"][2], r["median"][1]
@@ -203,8 +231,9 @@ def report(results: list[dict[str, Any]], chart: dict[str, Any] | None, command:
         lines.append(f"| {r['name']} | {r['points']:,} | {two:.1f} | "
                      f"{'' if goal is None else f'<= {goal:g} s'} | "
                      f"{'' if goal is None else ('yes' if two <= goal else 'no')} | "
-                     f"{one:.1f} | {r['speedup']:.2f}x | {1e3 * r['serial_per_point']:.2f} | "
-                     f"{start:.1f} |")
+                     f"{one:.1f} | {r['speedup']:.2f}x | {r['cpu_median'][2]:.1f} / "
+                     f"{r['cpu_median'][1]:.1f} | {1e3 * r['serial_per_point']:.2f} / "
+                     f"{1e3 * r['serial_cpu_per_point']:.2f} | {start:.1f} |")
     lines += ["", "All runs (seconds, 2 workers then 1):", ""]
     for r in results:
         runs = ", ".join(f"{x['seconds']:.1f}" for x in r["runs"][2]) + " / " + \
@@ -229,12 +258,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small studies, one repeat")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--chart-only", action="store_true")
+    parser.add_argument("--no-chart", action="store_true",
+                        help="measure only; keep the design chart drawn before (it needs "
+                             "matplotlib)")
     args = parser.parse_args(argv)
+    # `kill -USR1 PID` prints where a run on a loaded machine is waiting
+    faulthandler.register(signal.SIGUSR1)
     out = RESULTS / "quick" if args.quick else RESULTS
     out.mkdir(parents=True, exist_ok=True)
     command = "python -m benchmarks.sweep " + " ".join(argv if argv is not None
                                                         else sys.argv[1:])
-    chart = design_chart(out / "sweep_design_chart.png")
+    chart = None if args.no_chart else design_chart(out / "sweep_design_chart.png")
     print(f"chart: {chart}", flush=True)
     if args.chart_only:
         return 0

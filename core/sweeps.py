@@ -156,8 +156,13 @@ def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
 class WorkDir:
     """The parts of one study on disk: ``manifest.json`` and one ``.npz`` per batch."""
 
-    def __init__(self, path: str | os.PathLike, study: Study, batch_points: int) -> None:
+    def __init__(self, path: str | os.PathLike, study: Study, batch_points: int,
+                 durable: bool = True) -> None:
         self.path = Path(path)
+        # a scratch directory removed at the end serves no resume: no need to wait for
+        # the disk after every batch (41 fsyncs were a quarter of the 1.4 s of an
+        # 81-point study of the explorer's Study tab, measured at load 8)
+        self.durable = durable
         self.parts = self.path / "parts"
         self.parts.mkdir(parents=True, exist_ok=True)
         manifest = self.path / "manifest.json"
@@ -188,7 +193,8 @@ class WorkDir:
             with os.fdopen(fd, "wb") as fh:
                 np.savez(fh, index=index, **arrays)
                 fh.flush()
-                os.fsync(fh.fileno())
+                if self.durable:
+                    os.fsync(fh.fileno())
             os.replace(tmp, self.part(k))
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
@@ -331,7 +337,8 @@ def sweep(study: Study | Mapping[str, Any] | str | os.PathLike, client: Any = No
         check_output(Path(output))
     with tempfile.TemporaryDirectory(prefix="study-") as scratch:
         parts = WorkDir(work_dir or scratch, study,
-                        batch_points or default_batch_points(study.n_points))
+                        batch_points or default_batch_points(study.n_points),
+                        durable=work_dir is not None)
         table = point_table(study)
         batches = plan_batches(study, table, parts.batch_points)
         job = _Job(study, table)

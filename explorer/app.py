@@ -43,6 +43,7 @@ from .views.pins import PinsView
 from .views.punch import PunchView
 from .views.results import BADGES, ResultsView, badges_html, readout_html
 from .views.scene import SceneView
+from .views.study import StudyView
 from .views.style import CSS, html_pane
 from .views.tabs import FILL_TABS_AFTER_MS, DeferredTabs
 from .views.times import TimesView
@@ -63,7 +64,7 @@ LIVE_SOLVE_S = 0.030
 #: (with a ``title`` and a ``content()`` column). A new tab is one more entry here; the
 #: index of a tab is part of the page's links (``view_link``), so append, do not insert.
 SIDEBAR_VIEWS: tuple[type, ...] = (SceneView, PunchView, CoatingView, BaseView, TimesView,
-                                   CheckView, FilesView, LessonsView)
+                                   CheckView, FilesView, LessonsView, StudyView)
 #: Names the views share; never looked up on the session (see ExplorerApp.__getattr__).
 _VIEW_COMMON = frozenset({"app", "title", "content", "refresh"})
 

@@ -117,12 +117,14 @@ JS_SHOWN = """(text) => {
 }"""
 
 
-def until(check, what: str, timeout: float = 60.0) -> None:
-    """Poll ``check`` (a look at the page) until it holds; fail after ``timeout`` [s]."""
+def until(check, what: str, timeout: float = 60.0, describe=None) -> None:
+    """Poll ``check`` (a look at the page) until it holds; fail after ``timeout`` [s]
+    (saying what ``describe()``, if given, sees on the page then)."""
     deadline = time.monotonic() + timeout
     while not check():
         if time.monotonic() > deadline:
-            raise AssertionError(f"not seen within {timeout:g} s: {what}")
+            seen = f" (the page shows: {describe()!r})" if describe is not None else ""
+            raise AssertionError(f"not seen within {timeout:g} s: {what}{seen}")
         time.sleep(0.05)
 
 

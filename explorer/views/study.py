@@ -1,0 +1,253 @@
+"""The Study tab: a design chart over one or two fields of the scene on screen.
+
+The user picks the fields (loads, coating, base, punch: :func:`explorer.study.
+study_choices`), their ranges and the output; Run builds the study from the scene on
+screen (:func:`explorer.study.plan_study`, refused with a message naming the field) and
+runs it off the page's event loop (:class:`explorer.study_runner.StudyRun`, a process of
+its own, cancellable). The chart (:class:`explorer.study_plots.DesignChart`) shows the
+output at a chosen time; it downloads as CSV (every output at every time) and PNG.
+"""
+
+from __future__ import annotations
+
+import html
+import io
+from typing import TYPE_CHECKING, Any
+
+import panel as pn
+
+from ..study import (
+    MAX_POINTS,
+    OUTPUTS,
+    SPACINGS,
+    Axis,
+    default_range,
+    plan_study,
+    study_choices,
+)
+from ..study_plots import DesignChart, flag_note
+from ..study_png import design_chart_png
+from ..study_runner import StudyRun
+from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
+
+if TYPE_CHECKING:
+    from ..app import ExplorerApp
+
+#: The second parameter's choice for "no second parameter".
+NONE = "(none: a line over parameter 1)"
+
+
+class _AxisInputs:
+    """The widgets of one parameter: the field, from, to, points, spacing."""
+
+    def __init__(self, n: int, optional: bool) -> None:
+        css = f"study-p{n}"
+        self.optional = optional
+        self.field = pn.widgets.Select(label=f"parameter {n}", sizing_mode="stretch_width",
+                                       css_classes=[f"{css}-field"])
+        self.start = pn.widgets.FloatInput(label="from", width=95, css_classes=[f"{css}-from"])
+        self.stop = pn.widgets.FloatInput(label="to", width=95, css_classes=[f"{css}-to"])
+        self.count = pn.widgets.IntInput(label="points", value=9, start=2, width=70,
+                                         css_classes=[f"{css}-count"])
+        self.spacing = pn.widgets.Select(label="spacing", options=list(SPACINGS), width=80,
+                                         css_classes=[f"{css}-spacing"])
+        self.row = pn.Row(self.start, self.stop, self.count, self.spacing,
+                          sizing_mode="stretch_width", margin=0)
+
+    def panel(self) -> pn.Column:
+        return pn.Column(self.field, self.row, sizing_mode="stretch_width", margin=0)
+
+    def fill(self, axis: Axis) -> None:
+        """Show ``axis``'s range."""
+        self.start.value, self.stop.value = float(axis.start), float(axis.stop)
+        self.count.value, self.spacing.value = int(axis.count), axis.spacing
+
+    def axis(self) -> Axis | None:
+        """The parameter typed, or None (the second left out)."""
+        if self.field.value in (None, NONE):
+            return None
+        return Axis(self.field.value, _number(self.start.value), _number(self.stop.value),
+                    self.count.value if self.count.value is not None else 0,
+                    self.spacing.value)
+
+
+def _number(value: Any) -> float:
+    return float("nan") if value is None else float(value)
+
+
+class StudyView:
+    """Widgets, progress and chart of the session's design study."""
+
+    title = "Study"
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self.app = app
+        self.study_run = StudyRun(dispatch=app._dispatch)
+        self._choices: dict[str, Any] = {}
+        self.study_first = _AxisInputs(1, optional=False)
+        self.study_second = _AxisInputs(2, optional=True)
+        stretch = {"sizing_mode": "stretch_width"}
+        self.study_output = pn.widgets.Select(
+            label="output", options={f"{n} [{u}]": k for k, (n, u, _) in OUTPUTS.items()},
+            css_classes=["study-output"], **stretch)
+        self.study_time = pn.widgets.Select(label="at time after loading", options={},
+                                            css_classes=["study-time"], **stretch)
+        self.study_run_button = pn.widgets.Button(label="Run study", color="primary",
+                                                  css_classes=["study-run"], **stretch)
+        self.study_cancel_button = pn.widgets.Button(label="Cancel", disabled=True,
+                                                     css_classes=["study-cancel"], **stretch)
+        self.study_progress = pn.indicators.Progress(value=0, max=1, visible=False,
+                                                     css_classes=["study-progress"],
+                                                     **stretch)
+        self.study_status = html_pane("", css_classes=["study-status"], **stretch)
+        # the figures are built at the first result: three Bokeh figures cost ~70 ms of
+        # the server's CPU (measured), a seventh of a new session, for a tab few open
+        self.study_charts: DesignChart | None = None
+        self._chart_panes: list[pn.pane.Bokeh] = []
+        self._chart_box = pn.Column(
+            html_pane("<small><i>Run a study to see its design chart here.</i></small>"),
+            **stretch)
+        self.study_csv = pn.widgets.FileDownload(callback=self._csv, filename="study.csv",
+                                                 label="Study data (CSV)", disabled=True,
+                                                 css_classes=["study-csv"], **stretch)
+        self.study_png = pn.widgets.FileDownload(callback=self._png, filename="study.png",
+                                                 label="Design chart (PNG)", disabled=True,
+                                                 css_classes=["study-png"], **stretch)
+        self.study_first.field.param.watch(lambda e: self._on_field(self.study_first),
+                                           "value")
+        self.study_second.field.param.watch(lambda e: self._on_field(self.study_second),
+                                            "value")
+        self.study_output.param.watch(lambda e: self._redraw(), "value")
+        self.study_time.param.watch(lambda e: self._redraw(), "value")
+        self.study_run_button.on_click(lambda e: self.start())
+        self.study_cancel_button.on_click(lambda e: self.study_run.cancel())
+        self.study_run.param.watch(self._on_run, ["status", "done", "total", "message"])
+        self.study_run.param.watch(self._on_result, "result")
+        # the fields offered follow each result on screen (a solve, not every slider step)
+        app.controller.param.watch(lambda e: self.refresh(getattr(e.new, "scene", None)),
+                                   "view")
+        if app.served:
+            # a closed page stops its study
+            pn.state.on_session_destroyed(lambda ctx: self.study_run.cancel())
+        self.refresh()
+
+    def content(self) -> pn.Column:
+        """The tab's column."""
+        return pn.Column(
+            html_pane("<small>A design chart around the scene on screen: one field over a "
+                      f"range (a line) or two (a heat map), at most {MAX_POINTS} points. "
+                      "Every point is a full solve.</small>"),
+            self.study_first.panel(), self.study_second.panel(), self.study_output,
+            pn.Row(self.study_run_button, self.study_cancel_button, **stretch_row()),
+            self.study_progress, self.study_status, self._chart_box, self.study_time,
+            html_pane("<small>Red x: the solver flagged the point (outside the model's "
+                      "validity, e.g. contact lost); grey or a gap: the point failed. The "
+                      "CSV holds every output at every time.</small>", styles=NOTE_STYLE),
+            self.study_csv, self.study_png, **TAB_COLUMN)
+
+    # -- choices -------------------------------------------------------------------------
+    def refresh(self, scene: dict[str, Any] | None = None) -> None:
+        """Offer the fields of ``scene`` (default: the scene of the state), keeping the
+        fields chosen when they are still there."""
+        if scene is None:
+            try:
+                scene = self.app.state.to_scene()
+            except ValueError:
+                return  # not a scene now; its message comes with the solve
+        choices = {c.key: c for c in study_choices(scene)}
+        if list(choices) == list(self._choices):
+            self._choices = choices
+            return
+        self._choices = choices
+        self._half_width = float(scene["punch"]["half_width"])
+        options = {c.title: c.key for c in choices.values()}
+        for inputs, extra in ((self.study_first, {}), (self.study_second, {NONE: NONE})):
+            keep = inputs.field.value
+            inputs.field.options = extra | options
+            if keep in inputs.field.options.values():
+                inputs.field.value = keep
+            else:
+                inputs.field.value = NONE if inputs.optional else next(iter(choices), None)
+                self._on_field(inputs)
+
+    def _on_field(self, inputs: _AxisInputs) -> None:
+        """A new field: its first range around the value on screen."""
+        choice = self._choices.get(inputs.field.value)
+        inputs.row.visible = choice is not None
+        if choice is not None:
+            inputs.fill(default_range(choice, getattr(self, "_half_width", 1.0)))
+
+    # -- running ---------------------------------------------------------------------------
+    def start(self) -> bool:
+        """Build the study from the scene on screen and run it; False (and the reason on
+        the page) if it is refused."""
+        if self.study_run.running:
+            return False
+        axes = [a for a in (self.study_first.axis(), self.study_second.axis())
+                if a is not None]
+        try:
+            planned = plan_study(self.app.state.to_scene(), axes)
+        except ValueError as exc:
+            self._say(f"Not run: {exc}", bad=True)
+            return False
+        self.study_run.start(planned)
+        return True
+
+    def _say(self, text: str, bad: bool = False) -> None:
+        color = "#9b1c1c" if bad else "#333"
+        self.study_status.object = (f"<div class='study-message' style='font-size:13px;"
+                                    f"color:{color}'>{html.escape(text)}</div>")
+
+    def _on_run(self, *events: Any) -> None:
+        run = self.study_run
+        busy = run.status in ("waiting", "running")
+        self.study_run_button.disabled = busy
+        self.study_cancel_button.disabled = not busy
+        self.study_progress.visible = busy
+        self.study_progress.max = max(run.total, 1)
+        self.study_progress.value = min(run.done, max(run.total, 1))
+        self._say(run.message, bad=run.status == "failed")
+
+    def _on_result(self, event: Any) -> None:
+        result = event.new
+        if result is None:
+            return
+        times = {f"{t:.6g} days": k for k, t in enumerate(result.times)}
+        self.study_time.options = times
+        self.study_time.value = len(result.times) - 1
+        if self.study_charts is None:
+            self.study_charts = DesignChart()
+            self._chart_panes = [pn.pane.Bokeh(fig, visible=False,
+                                               sizing_mode="stretch_width")
+                                 for fig in self.study_charts.figures]
+            self._chart_box.objects = self._chart_panes
+        shown = self.study_charts.draw(result, self.study_output.value,
+                                       self.study_time.value)
+        for pane in self._chart_panes:
+            pane.visible = pane.object is shown
+        stem = slug(str(result.planned.study.base.get("name", "scene"))[:60])
+        self.study_csv.filename = f"{stem}_study.csv"
+        self.study_png.filename = f"{stem}_study.png"
+        self.study_csv.disabled = self.study_png.disabled = False
+        self._say(f"Done: {self.study_run.message}. Marks: {flag_note(result)}.")
+
+    def _redraw(self) -> None:
+        if self.study_charts is not None and self.study_time.value is not None:
+            self.study_charts.show(self.study_output.value, int(self.study_time.value))
+
+    # -- files -----------------------------------------------------------------------------
+    def _csv(self) -> io.StringIO:
+        result = self.study_run.result
+        return io.StringIO(result.to_csv() if result is not None else "")
+
+    def _png(self) -> io.BytesIO:
+        result = self.study_run.result
+        if result is None:
+            return io.BytesIO(b"")
+        return io.BytesIO(design_chart_png(result, self.study_output.value,
+                                           int(self.study_time.value or 0)))
+
+
+def stretch_row() -> dict[str, Any]:
+    """Keyword arguments of a full-width row without margins."""
+    return {"sizing_mode": "stretch_width", "margin": 0}

@@ -1,0 +1,105 @@
+"""The Study tab in a real browser (Debian's Chromium): a small study runs and draws its
+chart, its CSV and PNG download, and a larger one is cancelled. Every wait is on a
+condition in the page."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(600)]
+
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
+
+from tests.browser_pages import (  # noqa: E402
+    JS_SHOWN,
+    Page,
+    chromium_context,
+    served_explorer,
+    until,
+)
+
+# The points of the line chart (the source named study_source) and of the heat map
+# (study_map_source); empty before a study of that kind has run.
+JS_STUDY_Y = """() => {
+  const src = Bokeh.documents[0].get_model_by_name('study_source');
+  return src && src.data.y ? Array.from(src.data.y) : null;
+}"""
+JS_STUDY_VALUES = """() => {
+  const src = Bokeh.documents[0].get_model_by_name('study_map_source');
+  return src && src.data.value ? Array.from(src.data.value) : null;
+}"""
+
+
+def status(page: Page) -> str:
+    """The tab's message (what the study did, or why it was not run)."""
+    return page.pane_text(".study-status")
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[str]:
+    yield from served_explorer()
+
+
+@pytest.fixture(scope="module")
+def browser_context() -> Iterator[object]:
+    yield from chromium_context(1400, 900, accept_downloads=True)
+
+
+@pytest.fixture()
+def page(server: str, browser_context: object) -> Iterator[Page]:
+    p = Page(browser_context, server)
+    yield p
+    p.close()
+
+
+def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
+    page.open_tab("Study")
+    page.page.locator(".study-run button").first.wait_for(timeout=60_000)
+    # parameter 1: the force (the default), 3 points from 250 to 750 kN/m
+    page.type_into(".study-p1-count", "3")
+    page.page.locator(".study-run button").first.click()
+    assert page.page.evaluate(JS_STUDY_Y) is None  # the chart comes with a result
+    until(lambda: len(page.page.evaluate(JS_STUDY_Y) or []) == 3, "the chart of 3 points",
+          240, lambda: status(page))
+    y = page.page.evaluate(JS_STUDY_Y)
+    assert all(v > 0 for v in y) and y[0] < y[1] < y[2]  # settlement grows with the force
+    until(lambda: page.page.evaluate(JS_SHOWN, "Done: 3 points"), "the study's summary")
+
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.locator(".study-csv").first.click()
+    text = Path(info.value.path()).read_text()
+    rows = [line for line in text.splitlines() if not line.startswith("#")]
+    assert rows[0].startswith("loading_force_p_kN_per_m,time_day,settlement_mm")
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.locator(".study-png").first.click()
+    assert Path(info.value.path()).read_bytes().startswith(b"\x89PNG")
+
+    # a 9 x 9 study over the force and the coating modulus (81 solves), cancelled
+    page.page.locator(".study-p2-field select").first.select_option(
+        label="coating 1: Young's modulus [MPa]")
+    page.type_into(".study-p1-count", "9")
+    page.page.locator(".study-run button").first.click()
+    until(lambda: page.page.evaluate(JS_SHOWN, "running:"), "the study running", 120,
+          lambda: status(page))
+    cancel = page.page.locator(".study-cancel button").first
+    until(lambda: cancel.is_enabled(), "Cancel enabled")
+    cancel.click()
+    until(lambda: page.page.evaluate(JS_SHOWN, "cancelled: the study was stopped"),
+          "the study cancelled", 60, lambda: status(page))
+    assert page.page.locator(".study-run button").first.is_enabled()
+    # the chart still shows the first study (the cancelled one drew nothing)
+    assert page.page.evaluate(JS_STUDY_Y) == y
+    assert page.page.evaluate(JS_STUDY_VALUES) == []  # no heat map yet
+
+    # the second study runs to its heat map when it is small
+    page.type_into(".study-p1-count", "2")
+    page.type_into(".study-p2-count", "2")
+    page.page.locator(".study-run button").first.click()
+    until(lambda: len(page.page.evaluate(JS_STUDY_VALUES) or []) == 4,
+          "the heat map of 2 x 2", 240, lambda: status(page))
+    assert page.errors == []

@@ -1,0 +1,191 @@
+"""The Study tab without a browser: the study built from the scene on screen gives what a
+serial loop of solves gives, bad ranges are refused naming the field, Cancel stops the
+study's process, and the chart, CSV and PNG hold the result."""
+
+from __future__ import annotations
+
+import copy
+import time
+
+import numpy as np
+import pytest
+
+from core import solve
+from core.study import apply_point
+from explorer.presets import presets
+from explorer.state import ExplorerState
+from explorer.study import (
+    ECCENTRICITY,
+    MAX_POINTS,
+    OUTPUTS,
+    Axis,
+    plan_study,
+    study_choices,
+)
+from explorer.study_runner import StudyRun
+
+
+def screen_scene(times=(1.0, 365.0)) -> dict:
+    """The scene on screen: the default preset with two output times (a short history)."""
+    scene = copy.deepcopy(presets()["uniform_flat"])
+    scene["times"] = list(times)
+    state = ExplorerState()
+    state.load_scene(scene)
+    return state.to_scene()
+
+
+def run(planned, timeout: float = 300.0) -> StudyRun:
+    runner = StudyRun()
+    runner.start(planned)
+    assert runner.wait(timeout), "the study did not end"
+    return runner
+
+
+def test_study_from_the_scene_on_screen_equals_a_serial_loop():
+    scene = screen_scene()
+    planned = plan_study(scene, [Axis("loading.force", 300.0, 700.0, 3),
+                                 Axis("coating[0].modulus", 200.0, 800.0, 2, "log")])
+    runner = run(planned)
+    assert runner.status == "done", runner.message
+    result = runner.result
+    assert result.flags.shape == (3, 2) and not result.failed.any()
+    forces = [3e5, 5e5, 7e5]  # kN/m on screen -> N/m
+    moduli = [2e8, 8e8]       # MPa on screen -> Pa
+    for i, force in enumerate(forces):
+        for j, modulus in enumerate(moduli):
+            want = solve(apply_point(scene, {"loading.force": force,
+                                             "coating[0].modulus": modulus}))
+            q = want.pressure_on_grid
+            expected = {"settlement": want.settlement, "tilt": want.tilt,
+                        "q_max": q.max(axis=0), "q_min": q.min(axis=0)}
+            for name, values in expected.items():
+                got = result.outputs[name][i, j]
+                # the same solver on the same scene: measured bitwise equal; 1e-12 of the
+                # output's scale leaves room for stage caches prepared in another order
+                scale = max(np.max(np.abs(values)), 1e-300)
+                np.testing.assert_allclose(got / scale, np.asarray(values) / scale,
+                                           rtol=0, atol=1e-12, err_msg=name)
+            # full contact (q_min > 0 here): the contact width is the punch's width
+            assert np.all(q.min(axis=0) > 0)
+            np.testing.assert_allclose(result.outputs["contact_width"][i, j], 2.0,
+                                       rtol=1e-12)
+    shown = result.shown("settlement", 1)
+    np.testing.assert_allclose(shown, result.outputs["settlement"][..., 1] * 1e3)
+
+
+def test_eccentricity_sets_the_moment_from_the_force():
+    scene = screen_scene()
+    keys = [c.key for c in study_choices(scene)]
+    assert keys[:3] == ["loading.force", "loading.moment", ECCENTRICITY]
+    planned = plan_study(scene, [Axis(ECCENTRICITY, 0.0, 0.3, 4)])
+    (param,) = planned.study.parameters
+    assert param.path == "loading.moment"
+    force = scene["loading"]["force"]
+    np.testing.assert_allclose(param.values, force * np.linspace(0.0, 0.3, 4), rtol=1e-15)
+    np.testing.assert_allclose(planned.values[0], np.linspace(0.0, 0.3, 4))
+
+
+@pytest.mark.parametrize(("axes", "starts"), [
+    ([Axis("loading.force", 100.0, 900.0, 20), Axis("coating[0].modulus", 1.0, 9.0, 21)],
+     f"parameter 2, points: the study has 420 points (20 x 21), more than the limit of "
+     f"{MAX_POINTS}"),
+    ([Axis("loading.force", 100.0, 900.0, 1)], "parameter 1, points: must be a whole number"),
+    ([Axis("loading.force", 0.0, 900.0, 5, "log")], "parameter 1, from: a log spacing"),
+    ([Axis("loading.force", 500.0, 500.0, 5)], "parameter 1, to: equals 'from'"),
+    ([Axis("loading.force", float("nan"), 500.0, 5)], "parameter 1, from: must be a number"),
+    ([Axis("loading.force", 100.0, 900.0, 5), Axis("loading.force", 1.0, 2.0, 3)],
+     "parameter 2: the same field as parameter 1"),
+    ([Axis("loading.force", 100.0, 900.0, 5), Axis(ECCENTRICITY, 0.0, 0.2, 3)],
+     "parameter 2: the eccentricity sets the moment"),
+    ([Axis("solver.tol", 1e-6, 1e-4, 3)], "parameter 1: 'solver.tol' is not a field"),
+    ([Axis("coating[0].modulus", -100.0, 900.0, 3)],
+     "parameter 1 (coating 1: Young's modulus): the scene is invalid at "
+     "coating[0].modulus = -1e+08"),
+])
+def test_a_bad_study_is_refused_naming_the_field(axes, starts):
+    with pytest.raises(ValueError) as info:
+        plan_study(screen_scene(), axes)
+    assert str(info.value).startswith(starts), str(info.value)
+
+
+def test_cancel_stops_the_study_process():
+    # 60 coating moduli: each a new geometry, several seconds of work on any machine
+    scene = screen_scene(times=(1.0, 30.0, 365.0))
+    planned = plan_study(scene, [Axis("coating[0].modulus", 50.0, 5000.0, 60, "log")])
+    runner = StudyRun()
+    runner.start(planned)
+    deadline = time.monotonic() + 120
+    while runner.status != "running" or runner.process is None:
+        assert time.monotonic() < deadline, runner.message
+        time.sleep(0.02)
+    process = runner.process
+    runner.cancel()
+    assert runner.wait(30)
+    assert runner.status == "cancelled", runner.message
+    assert runner.result is None
+    assert not process.is_alive() and process.exitcode is not None
+    # the page can run the next study at once
+    again = run(plan_study(scene, [Axis("loading.force", 300.0, 600.0, 2)]))
+    assert again.status == "done", again.message
+
+
+def test_the_tab_draws_the_chart_and_writes_the_files():
+    from explorer.app import create_app
+    from explorer.views.study import NONE, StudyView
+
+    state_scene = screen_scene()
+    app = create_app(scene=state_scene)
+    tab = next(v for v in app.views if isinstance(v, StudyView))
+    assert tab.study_first.field.value == "loading.force"
+    assert tab.study_second.field.value == NONE
+    tab.study_first.fill(Axis("loading.force", 300.0, 700.0, 3))
+    # refused: the message names the field, nothing runs
+    tab.study_first.count.value = MAX_POINTS + 1
+    assert not tab.start()
+    assert "parameter 1, points" in tab.study_status.object
+    tab.study_first.count.value = 3
+    assert tab.start()
+    assert tab.study_run.wait(300)
+    assert tab.study_run.status == "done", tab.study_run.message
+    data = tab.study_charts.source.data
+    np.testing.assert_allclose(data["x"], [300.0, 500.0, 700.0])
+    result = tab.study_run.result
+    np.testing.assert_allclose(data["y"], result.outputs["settlement"][:, -1] * 1e3)
+    tab.study_output.value = "q_max"
+    np.testing.assert_allclose(tab.study_charts.source.data["y"],
+                               result.outputs["q_max"][:, -1] * 1e-3)
+    assert "kPa" in tab.study_charts.shown.yaxis.axis_label
+    csv = tab._csv().getvalue().splitlines()
+    header = next(line for line in csv if not line.startswith("#"))
+    assert header.startswith("loading_force_p_kN_per_m,time_day,settlement_mm")
+    assert len([line for line in csv if not line.startswith("#")]) == 1 + 3 * 2
+    png = tab._png().getvalue()
+    assert png.startswith(b"\x89PNG\r\n\x1a\n") and len(png) > 5000
+    assert not tab.study_csv.disabled and not tab.study_png.disabled
+    assert set(OUTPUTS) <= set(result.outputs)
+    # the fields offered follow the scene on screen
+    assert "coating[1].modulus" not in tab.study_second.field.options.values()
+    app.state.n_layers = 2  # solved at once: no server here
+    assert app.controller.view.scene["coating"][1]
+    assert "coating[1].modulus" in tab.study_second.field.options.values()
+    assert tab.study_first.field.value == "loading.force"  # the choice made is kept
+
+
+def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
+    from explorer.study_plots import DesignChart
+
+    scene = screen_scene()
+    scene["solver"]["contact"] = "full"  # the full-contact answer, flagged when q < 0
+    planned = plan_study(scene, [Axis(ECCENTRICITY, 0.0, 0.6, 4)])
+    runner = run(planned)
+    assert runner.status == "done", runner.message
+    result = runner.result
+    # e = 0.6 m > a/3 under a 2 m wide punch: the pressure at the heel is negative
+    assert list(result.flagged) == [False, False, False, True]
+    assert "contact_lost" in result.flags[-1]
+    chart = DesignChart()
+    chart.draw(result, "q_min", 1)
+    np.testing.assert_allclose(chart.flagged.data["x"], [0.6])
+    assert chart.flagged.data["y"][0] < 0  # kPa: the tension the flag is about
+    rows = [line for line in result.to_csv().splitlines() if not line.startswith("#")]
+    assert rows[-1].endswith('"contact_lost",""')
