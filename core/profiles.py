@@ -51,6 +51,7 @@ import numpy as np
 
 from core import limits
 from core.expressions import ALIASES, CONSTANTS, FUNCTIONS, Expression, parse_expression
+from core.immutable import Immutable
 
 #: Most rows of a table (and most breaks of a step profile).
 MAX_TABLE_ROWS = limits.MAX_TABLE_ROWS
@@ -198,7 +199,7 @@ def _canonical_json(obj: Any) -> str:
     return json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=False)
 
 
-class Profile:
+class Profile(Immutable):
     """A validated function of one variable: an immutable, vectorized callable.
 
     ``profile(values)`` takes an array of positions [m] or times [day] (the unit of the
@@ -227,12 +228,6 @@ class Profile:
                             ("_breakpoints", tuple(inside)), ("_extra", tuple(extra)),
                             ("_evaluate", evaluate), ("_key", key)):
             object.__setattr__(self, name, value)
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        raise AttributeError("Profile is immutable")
-
-    def __delattr__(self, name: str) -> None:
-        raise AttributeError("Profile is immutable")
 
     @property
     def kind(self) -> str:

@@ -15,21 +15,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core import limits
+from core import scene_schema as schema
 from core.coating_model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
 from core.creep import Elastic, UserKernel, creep_model_from_spec
 from core.load_rates import check_step_limit
 from core.profiles import Profile
 from core.scene_model import Layer, Scene, _values
 from core.scene_schema import (
-    DEFAULT_TOL,
-    LAM_RANGE,
-    M_STAR_RANGE,
-    MAX_BREAKPOINTS,
-    MAX_CREEP_COEFFICIENT,
-    MAX_GAP_RATIO,
-    MAX_LAYERS,
-    SCHEMA_VERSION,
-    TOL_RANGE,
     _check_fields,
     _jsonable,
     _poisson,
@@ -43,8 +35,10 @@ from core.statements import QUANTITIES, STATEMENTS
 from core.validation import (
     MAX_MAGNITUDE,
     NumberTooLarge,
+    bounded_list,
     finite_number,
     positive_number,
+    refuse_first,
     show_value,
 )
 
@@ -74,11 +68,8 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     shape_spec = punch.get("shape", 0.0)
     shape = _profile(shape_spec, "punch.shape", "x", x_domain)
 
-    layers_spec = d["coating"]
-    if not isinstance(layers_spec, (list, tuple)):
-        raise ValueError(f"coating: must be a list of layers, got {show_value(layers_spec)}")
-    if not 1 <= len(layers_spec) <= MAX_LAYERS:
-        raise ValueError(f"coating: must hold 1 to {MAX_LAYERS} layers, got {len(layers_spec)}")
+    layers_spec = bounded_list(d["coating"], "coating", least=1, most=schema.MAX_LAYERS,
+                               what="layers")
     layers = []
     for k, spec in enumerate(layers_spec):
         path = f"coating[{k}]"
@@ -108,9 +99,10 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         # an overflow in a creep computation, with no parameter to name
         raise ValueError("base.creep: a number is too large for a double (must be a finite "
                          "number)") from None
-    if not math.isfinite(a / h_base) or not LAM_RANGE[0] <= a / h_base <= LAM_RANGE[1]:
+    lam_lo, lam_hi = schema.LAM_RANGE
+    if not math.isfinite(a / h_base) or not lam_lo <= a / h_base <= lam_hi:
         raise ValueError(f"base.thickness: the ratio punch.half_width / base.thickness must be "
-                         f"in [{LAM_RANGE[0]:g}, {LAM_RANGE[1]:g}], got {a / h_base:.6g}")
+                         f"in [{lam_lo:g}, {lam_hi:g}], got {a / h_base:.6g}")
 
     times, times_spec = _times(d["times"], "times")
 
@@ -135,9 +127,10 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
                          f"an age at loading of {tau0:g} days")
 
     solver = _check_fields(d.get("solver", {}), "solver", (), ("tol", "contact", "model_tol"))
-    tol = finite_number(solver.get("tol", DEFAULT_TOL), "solver.tol")
-    if not TOL_RANGE[0] <= tol <= TOL_RANGE[1]:
-        raise ValueError(f"solver.tol: must be in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}], "
+    tol = finite_number(solver.get("tol", schema.DEFAULT_TOL), "solver.tol")
+    tol_lo, tol_hi = schema.TOL_RANGE
+    if not tol_lo <= tol <= tol_hi:
+        raise ValueError(f"solver.tol: must be in [{tol_lo:g}, {tol_hi:g}], "
                          f"got {show_value(tol)}")
     contact = solver.get("contact", "auto")
     if contact != "auto":
@@ -152,7 +145,7 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
                          f"{MODEL_TOL_RANGE[1]:g}], got {show_value(model_tol)}")
 
     data = {
-        "schema_version": SCHEMA_VERSION,
+        "schema_version": schema.SCHEMA_VERSION,
         "name": name,
         "description": description,
         "punch": {"half_width": a, "shape": _jsonable(_spec_of(shape, shape_spec))},
@@ -206,7 +199,7 @@ def _check_breakpoints(scene: Scene) -> None:
     15 TiB matrix. A served explorer must not let one scene take the machine.
     """
     count = len(scene.breakpoints)
-    if count <= MAX_BREAKPOINTS:
+    if count <= schema.MAX_BREAKPOINTS:
         return
     a = scene.half_width
     path, most = max(((p, sum(1 for b in prof.breakpoints if -a < b < a))
@@ -214,7 +207,7 @@ def _check_breakpoints(scene: Scene) -> None:
     raise ValueError(
         f"{path}: has {most} points where its value or slope jumps (table rows, step "
         f"breaks or formula switches), {count} in the whole scene, more than the "
-        f"{MAX_BREAKPOINTS} the solver allows: use fewer rows or breaks, a 'pchip' table "
+        f"{schema.MAX_BREAKPOINTS} the solver allows: use fewer rows or breaks, a 'pchip' table "
         "(smooth between its end rows) or a smooth formula")
 
 
@@ -233,38 +226,34 @@ def _check_solvable(scene: Scene) -> None:
         x = scene.sample_x
         xs = x / a
         m = np.broadcast_to(problem.m(xs) if callable(problem.m) else problem.m, xs.shape)
-        lo, hi = M_STAR_RANGE
-        bad = ~np.isfinite(m) | (m < lo) | (m > hi)
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise ValueError(
-                f"coating: the coating compliance relative to the base, m* = E0 sum_k (1 - "
-                f"nu_k^2) h_k / E_k / (2 (1 - nu^2) a), is {m[i]:.3g} at x = {x[i]:.6g} m, "
-                f"outside [{lo:g}, {hi:g}]: the layers are too stiff or soft, thin or thick "
-                "against the base to be solved in double precision")
+        lo, hi = schema.M_STAR_RANGE
+        refuse_first(~np.isfinite(m) | (m < lo) | (m > hi), lambda i: (
+            f"coating: the coating compliance relative to the base, m* = E0 sum_k (1 - "
+            f"nu_k^2) h_k / E_k / (2 (1 - nu^2) a), is {m[i]:.3g} at x = {x[i]:.6g} m, "
+            f"outside [{lo:g}, {hi:g}]: the layers are too stiff or soft, thin or thick "
+            "against the base to be solved in double precision"))
         if callable(problem.g):
             g = problem.g(xs)
-            bad = ~np.isfinite(g) | (np.abs(g) > MAX_GAP_RATIO)
-            if bad.any():
-                i = int(np.argmax(bad))
+
+            def gap_message(i: int) -> str:
+                # the field to change: the punch or the coating, whichever varies more
                 f_range = float(np.ptp(_values(scene.shape, x)))
                 h_range = float(np.ptp(scene.coating_thickness(x)))
                 where = "punch.shape" if not f_range < h_range else "coating"
-                raise ValueError(
-                    f"{where}: the gap between the punch base and the coating surface is "
-                    f"{g[i]:.3g} half-widths at x = {x[i]:.6g} m (at most "
-                    f"{MAX_GAP_RATIO:g}): far beyond the shallow contact of this model")
+                return (f"{where}: the gap between the punch base and the coating surface "
+                        f"is {g[i]:.3g} half-widths at x = {x[i]:.6g} m (at most "
+                        f"{schema.MAX_GAP_RATIO:g}): far beyond the shallow contact of this model")
+
+            refuse_first(~np.isfinite(g) | (np.abs(g) > schema.MAX_GAP_RATIO), gap_message)
         _check_creep(scene, problem)
         ts = problem.times
         for name, load in problem.loads.items():
             values = np.broadcast_to(load(ts) if callable(load) else load, ts.shape)
-            bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
-            if bad.any():
-                i = int(np.argmax(bad))
-                raise ValueError(
-                    f"loading.{name}: cannot be scaled by the base modulus and the "
-                    f"half-width in double precision at t = {scene.times[i]:.6g} days after "
-                    "loading (the sizes in the scene are too far apart)")
+            refuse_first(~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE),
+                         lambda i, name=name: (
+                             f"loading.{name}: cannot be scaled by the base modulus and the "
+                             f"half-width in double precision at t = {scene.times[i]:.6g} "
+                             "days after loading (the sizes in the scene are too far apart)"))
 
 
 def _check_creep(scene: Scene, problem: DimensionlessProblem) -> None:
@@ -274,13 +263,10 @@ def _check_creep(scene: Scene, problem: DimensionlessProblem) -> None:
     tau0 = scene.age_at_loading
     ts = problem.times
     c = np.broadcast_to(problem.c(ts) if callable(problem.c) else problem.c, ts.shape)
-    bad = ~np.isfinite(c) | (c <= 0)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise ValueError(
-            f"base.creep: the modulus E(age) / E(age at loading) is {c[i]:.3g} at the age "
-            f"{tau0 * ts[i]:.6g} days: the creep parameters or base.age_at_loading are "
-            "too extreme for double precision")
+    refuse_first(~np.isfinite(c) | (c <= 0), lambda i: (
+        f"base.creep: the modulus E(age) / E(age at loading) is {c[i]:.3g} at the age "
+        f"{tau0 * ts[i]:.6g} days: the creep parameters or base.age_at_loading are "
+        "too extreme for double precision"))
     kernel = problem.kernel
     if kernel is None:
         return
@@ -296,26 +282,20 @@ def _check_creep(scene: Scene, problem: DimensionlessProblem) -> None:
     except ValueError as exc:  # a formula kernel refuses its own non-finite values
         where = "base.creep.expr" if isinstance(scene.creep, UserKernel) else "base.creep"
         raise ValueError(f"{where}: {exc}") from None
-    bad = ~np.isfinite(k)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise ValueError(
-            f"base.creep: the creep kernel K(t, tau) is {k[i]} at the ages t = "
-            f"{tau0 * t_star[i]:.6g}, tau = {tau0 * tau_star[i]:.6g} days: the creep "
-            "parameters or base.age_at_loading are too extreme for double precision")
+    refuse_first(~np.isfinite(k), lambda i: (
+        f"base.creep: the creep kernel K(t, tau) is {k[i]} at the ages t = "
+        f"{tau0 * t_star[i]:.6g}, tau = {tau0 * tau_star[i]:.6g} days: the creep "
+        "parameters or base.age_at_loading are too extreme for double precision"))
     user = isinstance(scene.creep, UserKernel)
     if user:
         # the shipped models are <= 0 by their coefficient checks; a formula is checked
         # on samples, with room for rounding of a kernel that is 0 somewhere
         scale = float(np.max(np.abs(k))) if k.size else 0.0
-        bad = k > 1e-9 * scale
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise ValueError(
-                f"base.creep.expr: K(t, tau) must be <= 0 (the base creeps), is "
-                f"{k[i] / tau0:.3g} per day at the ages t = {tau0 * t_star[i]:.6g}, tau = "
-                f"{tau0 * tau_star[i]:.6g} days: a positive kernel makes the compliance "
-                "decrease in time")
+        refuse_first(k > 1e-9 * scale, lambda i: (
+            f"base.creep.expr: K(t, tau) must be <= 0 (the base creeps), is "
+            f"{k[i] / tau0:.3g} per day at the ages t = {tau0 * t_star[i]:.6g}, tau = "
+            f"{tau0 * tau_star[i]:.6g} days: a positive kernel makes the compliance "
+            "decrease in time"))
         # creep strain per elastic strain under a unit stress held from loading:
         # -int_1^t* K*(t*, s) ds, on points graded toward s = t* where a fast kernel lives
         u = np.concatenate([[0.0], np.geomspace(1e-12, 1.0, 400)])
@@ -326,9 +306,9 @@ def _check_creep(scene: Scene, problem: DimensionlessProblem) -> None:
     else:
         phi = float(scene.modulus_at_loading()
                     * np.asarray(scene.creep.compliance(tau0 * ts[-1], tau0), dtype=float))
-    if not phi <= MAX_CREEP_COEFFICIENT:
+    if not phi <= schema.MAX_CREEP_COEFFICIENT:
         raise ValueError(
             f"{'base.creep.expr' if user else 'base.creep'}: the creep coefficient (creep "
             "strain over elastic strain under a stress held from loading to the last output "
-            f"time) is {phi:.3g}, more than {MAX_CREEP_COEFFICIENT:g}: far beyond real "
+            f"time) is {phi:.3g}, more than {schema.MAX_CREEP_COEFFICIENT:g}: far beyond real "
             "materials, and beyond what the time stepping can follow in reasonable time")

@@ -618,12 +618,10 @@ def test_a_deeply_nested_link_is_refused() -> None:
 
 
 def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:
-    import panel as pn
-
     import explorer.__main__ as entry
 
-    served: list[dict[str, Any]] = []
-    monkeypatch.setattr(pn, "serve", lambda *a, **k: served.append(k))
+    served: list[dict[str, Any]] = []  # the options pn.serve would be given
+    monkeypatch.setattr(entry, "_serve", lambda pn, apps, **k: served.append(k))
     base = ["--port", "5999", "--warm-up", "none", "--solver-processes", "0"]
     assert entry.main(base) == 0
     assert served[-1]["address"] == "localhost" and served[-1]["websocket_origin"] is None
