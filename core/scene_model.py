@@ -21,7 +21,7 @@ import numpy as np
 from core.cache import StageCache, fingerprint
 from core.coating_model import DEFAULT_INTERFACE, layer_compliance
 from core.golden_section import golden_minimum
-from core.profiles import Profile, profile_from_spec
+from core.profiles import Profile, without_offset
 from core.statements import STATEMENTS
 
 if TYPE_CHECKING:
@@ -172,9 +172,9 @@ class Scene:
 
     @cached_property
     def _gap_parts(self) -> tuple[Profile, ...]:
-        """``f`` and the ``h_k`` less their constant parts (see :func:`_without_offset`)."""
-        return (_without_offset(self.shape),) + tuple(
-            _without_offset(layer.thickness) for layer in self.coating)
+        """``f`` and the ``h_k`` less their constant parts (see :func:`core.profiles.without_offset`)."""
+        return (without_offset(self.shape),) + tuple(
+            without_offset(layer.thickness) for layer in self.coating)
 
     def gap_variation(self, x: Any) -> np.ndarray:
         """``f(x) - sum_k h_k(x)`` [m] at points ``x`` [m], up to a constant.
@@ -230,37 +230,3 @@ class Scene:
 def _values(profile: Profile, x: np.ndarray) -> np.ndarray:
     """A profile's values at ``x`` as a float array of x's shape."""
     return np.broadcast_to(np.asarray(profile(x), dtype=float), np.shape(x)).astype(float)
-
-
-def _without_offset(profile: Profile) -> Profile:
-    """The profile less a constant part that its spec separates exactly.
-
-    ``constant`` gives 0; ``sine`` and ``bump`` drop ``mean``, ``polynomial`` its
-    constant coefficient, ``linear``, ``step`` and ``table`` their first value (the
-    differences of nearby values are exact in floating point). Formulas are kept as they
-    are. Only differences of the result are meaningful.
-    """
-    spec = profile.spec
-    kind = profile.kind
-    if kind == "constant":
-        return profile_from_spec(0.0, field="gap", variable=profile.variable,
-                                 domain=profile.domain)
-    if not isinstance(spec, dict):
-        return profile
-    spec = dict(spec)
-    if kind in ("sine", "bump"):
-        spec["mean"] = 0.0
-    elif kind == "polynomial":
-        spec["coefficients"] = [0.0] + list(spec["coefficients"][1:])
-    elif kind == "linear":
-        spec["start"], spec["end"] = 0.0, spec["end"] - spec["start"]
-    elif kind == "step":
-        first = spec["values"][0]
-        spec["values"] = [v - first for v in spec["values"]]
-    elif kind == "table":
-        first = spec["points"][0][1]
-        spec["points"] = [[v, y - first] for v, y in spec["points"]]
-    else:
-        return profile
-    return profile_from_spec(spec, field="gap", variable=profile.variable,
-                             domain=profile.domain)
