@@ -172,7 +172,8 @@ class Scene:
 
     @cached_property
     def _gap_parts(self) -> tuple[Profile, ...]:
-        """``f`` and the ``h_k`` less their constant parts (see :func:`core.profiles.without_offset`)."""
+        """``f`` and the ``h_k`` less their constant parts
+        (:func:`core.profiles.without_offset`)."""
         return (without_offset(self.shape),) + tuple(
             without_offset(layer.thickness) for layer in self.coating)
 
