@@ -39,7 +39,9 @@ CSV files are 1-based, as an editor shows them.
 One registry, :data:`FAMILIES`, holds everything done by family: its fields, how it is
 built (canonical spec, breakpoints, known extremes), the constant part it separates
 exactly (:func:`without_offset`, for the gap) and the forms in which the explorer's
-screen shows a function of ``x`` (:data:`VARIATIONS`, :func:`variation_of`). The
+screen shows a function of ``x`` (:data:`VARIATIONS`, :func:`variation_of`) or a load
+history (:data:`HISTORY_FORMS`, :func:`history_form_of`; the forms themselves are in
+:mod:`core.profile_forms`). The
 :class:`Profile` value and the helpers of single families are in
 :mod:`core.profile_base`, CSV uploads in :mod:`core.profile_csv`; both are re-exported
 here.
@@ -56,6 +58,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from core import profile_forms as forms
 from core.expressions import parse_expression
 from core.profile_base import (  # noqa: F401 (re-exported: core.profiles is the public path)
     FORMULA_BREAK_SAMPLES,
@@ -82,6 +85,7 @@ from core.profile_base import (  # noqa: F401 (re-exported: core.profiles is the
     _table,
     profile_key,
 )
+from core.profile_forms import ScreenForm
 
 # ----------------------------------------------------------------------------- families
 
@@ -278,74 +282,6 @@ def _offset_table(spec: Spec) -> Spec:
 
 
 @dataclass(frozen=True)
-class Variation:
-    """A form in which the explorer's screen shows a function of ``x``: a level and a
-    variation of size ``amplitude`` about it, placed by ``position`` and sized by
-    ``length`` (both in metres) where the form has them (``uses``).
-
-    ``spec(level, amplitude, position, length)`` gives the canonical spec (values in the
-    unit of the quantity); ``read(spec)`` gives those four numbers back for a spec of this
-    form (any missing one 0.0), or ``None`` when the spec has another form.
-    """
-
-    name: str
-    label: str
-    uses: tuple[str, ...]
-    spec: Callable[[float, float, float, float], Spec]
-    read: Callable[[Any], tuple[float, float, float, float] | None]
-
-
-def _numeric(*values: Any) -> bool:
-    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
-
-
-def _read_none(spec: Any) -> tuple[float, float, float, float] | None:
-    if _numeric(spec):
-        return (float(spec), 0.0, 0.0, 0.0)
-    # the long form of a constant reads back as the plain number, which is the same
-    if set(spec) == {"kind", "value"} and _numeric(spec["value"]):
-        return (float(spec["value"]), 0.0, 0.0, 0.0)
-    return None
-
-
-def _read_linear(spec: Any) -> tuple[float, float, float, float] | None:
-    if not _numeric(spec["start"], spec["end"]):
-        return None
-    return (0.5 * (spec["start"] + spec["end"]), 0.5 * (spec["end"] - spec["start"]),
-            0.0, 0.0)
-
-
-def _read_step(spec: Any) -> tuple[float, float, float, float] | None:
-    values, breaks = spec["values"], spec["breaks"]
-    if not (isinstance(values, list) and isinstance(breaks, list) and len(values) == 2
-            and len(breaks) == 1 and _numeric(*values, *breaks)):
-        return None
-    return (0.5 * (values[0] + values[1]), 0.5 * (values[1] - values[0]), breaks[0], 0.0)
-
-
-def _read_patch(spec: Any) -> tuple[float, float, float, float] | None:
-    values, breaks = spec["values"], spec["breaks"]
-    if not (isinstance(values, list) and isinstance(breaks, list) and len(values) == 3
-            and len(breaks) == 2 and _numeric(*values, *breaks) and values[0] == values[2]):
-        return None
-    return (values[0], values[1] - values[0], 0.5 * (breaks[0] + breaks[1]),
-            breaks[1] - breaks[0])
-
-
-def _read_sine(spec: Any) -> tuple[float, float, float, float] | None:
-    if not _numeric(spec["mean"], spec["amplitude"], spec["wavelength"]) \
-            or spec.get("phase", 0.0) != 0:
-        return None
-    return (spec["mean"], spec["amplitude"], 0.0, spec["wavelength"])
-
-
-def _read_bump(spec: Any) -> tuple[float, float, float, float] | None:
-    if not _numeric(spec["mean"], spec["amplitude"], spec["center"], spec["width"]):
-        return None
-    return (spec["mean"], spec["amplitude"], spec["center"], spec["width"])
-
-
-@dataclass(frozen=True)
 class Family:
     """One family of profiles, and everything the program does by family.
 
@@ -353,7 +289,8 @@ class Family:
     ``kind``; ``build(spec, at)``: the validated :class:`Profile` with its canonical spec,
     breakpoints and known extremes; ``offset(spec)``: the canonical spec less a constant
     part that the family separates exactly (``None``: nothing is dropped, as for a
-    formula); ``variations``: the forms in which the explorer's screen shows it.
+    formula); ``variations`` and ``histories``: the forms in which the explorer's screen
+    shows it as a function of ``x`` and as a load history (:mod:`core.profile_forms`).
     """
 
     kind: str
@@ -361,36 +298,23 @@ class Family:
     optional: tuple[str, ...]
     build: Callable[[Mapping[str, Any], _At], Profile]
     offset: Callable[[Spec], Spec] | None = None
-    variations: tuple[Variation, ...] = ()
+    variations: tuple[ScreenForm, ...] = ()
+    histories: tuple[ScreenForm, ...] = ()
 
 
-#: The families of profiles, by kind (the registry: building, fields, offsets, screen).
+#: The families of profiles, by kind (the registry: fields, building, offsets, screen).
 FAMILIES: Mapping[str, Family] = MappingProxyType({f.kind: f for f in (
-    Family("constant", ("value",), (), _build_constant, _offset_none, (
-        Variation("none", "constant", (), lambda m, a, p, w: m, _read_none),)),
-    Family("linear", ("start", "end"), (), _build_linear, _offset_linear, (
-        Variation("linear", "linear across the punch", ("amplitude",),
-                  lambda m, a, p, w: {"kind": "linear", "start": m - a, "end": m + a},
-                  _read_linear),)),
-    Family("step", ("values", "breaks"), (), _build_step, _offset_step, (
-        Variation("step", "step at a position", ("amplitude", "position"),
-                  lambda m, a, p, w: {"kind": "step", "values": [m - a, m + a],
-                                      "breaks": [p]}, _read_step),
-        Variation("patch", "patch (a band of another value)",
-                  ("amplitude", "position", "length"),
-                  lambda m, a, p, w: {"kind": "step", "values": [m, m + a, m],
-                                      "breaks": [p - 0.5 * w, p + 0.5 * w]}, _read_patch))),
+    Family("constant", ("value",), (), _build_constant, _offset_none,
+           (forms.X_NONE,), (forms.T_CONSTANT,)),
+    Family("linear", ("start", "end"), (), _build_linear, _offset_linear, (forms.X_LINEAR,)),
+    Family("step", ("values", "breaks"), (), _build_step, _offset_step,
+           (forms.X_STEP, forms.X_PATCH), (forms.T_STEP,)),
     Family("sine", ("mean", "amplitude", "wavelength"), ("phase",), _build_sine,
-           _offset_mean, (
-               Variation("sine", "sine (waviness)", ("amplitude", "length"),
-                         lambda m, a, p, w: {"kind": "sine", "mean": m, "amplitude": a,
-                                             "wavelength": w, "phase": 0.0}, _read_sine),)),
+           _offset_mean, (forms.X_SINE,), (forms.T_SINE,)),
     Family("polynomial", ("coefficients",), (), _build_polynomial, _offset_polynomial),
-    Family("bump", ("mean", "amplitude", "center", "width"), (), _build_bump, _offset_mean, (
-        Variation("bump", "bump (local patch)", ("amplitude", "position", "length"),
-                  lambda m, a, p, w: {"kind": "bump", "mean": m, "amplitude": a,
-                                      "center": p, "width": w}, _read_bump),)),
-    Family("ramp", ("start", "end", "duration"), (), _build_ramp),
+    Family("bump", ("mean", "amplitude", "center", "width"), (), _build_bump, _offset_mean,
+           (forms.X_BUMP,)),
+    Family("ramp", ("start", "end", "duration"), (), _build_ramp, None, (), (forms.T_RAMP,)),
     Family("table", ("points",), ("interpolation",), _build_table, _offset_table),
     Family("expr", ("expr",), (), _build_expr),
 )})
@@ -398,29 +322,37 @@ FAMILIES: Mapping[str, Family] = MappingProxyType({f.kind: f for f in (
 #: The kinds of profiles, in the order the module docstring lists them.
 KINDS: tuple[str, ...] = tuple(FAMILIES)
 
-#: The screen's forms of a function of x, by name, in the order the screen lists them.
-VARIATIONS: Mapping[str, Variation] = MappingProxyType(
+#: The screen's forms of a function of x and of a load history, by name, in the order
+#: the screen lists them.
+VARIATIONS: Mapping[str, ScreenForm] = MappingProxyType(
     {v.name: v for family in FAMILIES.values() for v in family.variations})
+HISTORY_FORMS: Mapping[str, ScreenForm] = MappingProxyType(
+    {h.name: h for family in FAMILIES.values() for h in family.histories})
 
 
-def variation_of(spec: Any) -> tuple[str, tuple[float, float, float, float]] | None:
-    """The screen's form of a profile spec and its ``(level, amplitude, position,
-    length)`` (values in the unit of the quantity, positions and lengths in metres), or
-    ``None`` when no form of the screen shows it (a table, a formula, a sine with a
-    phase, ...). The spec is not validated here."""
-    if _numeric(spec):
-        return "none", (float(spec), 0.0, 0.0, 0.0)
-    family = FAMILIES.get(spec.get("kind")) if isinstance(spec, Mapping) else None
-    if family is None:
-        return None
-    for variation in family.variations:
-        try:
-            numbers = variation.read(spec)
-        except (KeyError, TypeError):  # a field missing or of another type
-            numbers = None
+def _form_of(spec: Any, which: str) -> tuple[str, dict[str, float]] | None:
+    kind = "constant" if forms.numeric(spec) else (
+        spec.get("kind") if isinstance(spec, Mapping) else None)
+    family = FAMILIES.get(kind) if isinstance(kind, str) else None
+    for form in getattr(family, which, ()):
+        numbers = form.numbers_of(spec)
         if numbers is not None:
-            return variation.name, numbers
+            return form.name, numbers
     return None
+
+
+def variation_of(spec: Any) -> tuple[str, dict[str, float]] | None:
+    """The screen's form of a function of ``x`` given as a spec, and its numbers
+    (``level`` and those the form ``uses`` of amplitude, position, length;
+    :mod:`core.profile_forms`), or ``None`` when no form of the screen shows it (a table,
+    a formula, a sine with a phase, ...). The spec is not validated here."""
+    return _form_of(spec, "variations")
+
+
+def history_form_of(spec: Any) -> tuple[str, dict[str, float]] | None:
+    """The screen's form of a load history given as a spec, and its numbers (``value``
+    and those the form ``uses`` of second, time), or ``None`` when no form shows it."""
+    return _form_of(spec, "histories")
 
 
 def without_offset(profile: Profile) -> Profile:

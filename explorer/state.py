@@ -20,7 +20,7 @@ from typing import Any
 import param
 
 from core.coating_model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
-from core.profiles import VARIATIONS, variation_of
+from core.profiles import HISTORY_FORMS, VARIATIONS, history_form_of, variation_of
 from core.scene import QUANTITIES
 
 from .creep_view import CODE_CREEP_MODELS, CodeCreepState
@@ -134,21 +134,22 @@ class ProfileState(param.Parameterized):
         m = self.mean * self.scale
         if self.kind == "custom":
             return m if self.custom is None else copy.deepcopy(self.custom)
-        return VARIATIONS[self.kind].spec(m, self._amplitude_si(m), self.position,
-                                          self.length)
+        return VARIATIONS[self.kind].spec({"level": m, "amplitude": self._amplitude_si(m),
+                                           "position": self.position, "length": self.length})
 
     def load_spec(self, spec: Any) -> None:
         """Set the state from an SI spec; anything else is kept as a ``custom`` profile."""
         values: dict[str, Any] = {"kind": "custom", "custom": copy.deepcopy(spec)}
         found = variation_of(spec)
         if found is not None:
-            name, (level, amplitude, position, length) = found
-            uses = VARIATIONS[name].uses
-            amp = self._amplitude_from(level, amplitude) if uses else 0.0
-            if amp is not None:  # None: a percentage of a zero level
-                values = {"kind": name, "custom": None, "mean": level / self.scale}
-                shown = {"amplitude": amp, "position": position, "length": length}
-                values.update({key: shown[key] for key in uses})
+            name, numbers = found
+            level = numbers["level"]
+            amp = self._amplitude_from(level, numbers.get("amplitude", 0.0))
+            if amp is not None or "amplitude" not in numbers:  # None: % of a zero level
+                values = {**numbers, "kind": name, "custom": None, "mean": level / self.scale}
+                del values["level"]
+                if "amplitude" in numbers:
+                    values["amplitude"] = amp
         self.param.update(**values)
 
 
@@ -387,8 +388,7 @@ class BaseState(param.Parameterized):
 class HistoryState(param.Parameterized):
     """The history of one loading quantity, ``t`` in days after loading (display units)."""
 
-    kind = param.Selector(default="constant", objects=["constant", "ramp", "step", "sine",
-                                                       "custom"],
+    kind = param.Selector(default="constant", objects=[*HISTORY_FORMS, "custom"],
                           doc="Shape of the history.")
     value = param.Number(default=0.0, doc="Main level: the constant, the ramp's final "
                                           "value, the value before a step, the sine's mean.")
@@ -404,37 +404,21 @@ class HistoryState(param.Parameterized):
         self.unit, self.scale = QUANTITY_UNITS[quantity]
 
     def to_spec(self) -> float | dict[str, Any]:
-        v, w = self.value * self.scale, self.second * self.scale
-        if self.kind == "ramp":
-            return {"kind": "ramp", "start": w, "end": v, "duration": self.time}
-        if self.kind == "step":
-            return {"kind": "step", "values": [v, w], "breaks": [self.time]}
-        if self.kind == "sine":
-            return {"kind": "sine", "mean": v, "amplitude": w, "wavelength": self.time,
-                    "phase": 0.0}
         if self.kind == "custom" and self.custom is not None:
             return copy.deepcopy(self.custom)
-        return v
+        form = HISTORY_FORMS.get(self.kind, HISTORY_FORMS["constant"])
+        return form.spec({"value": self.value * self.scale, "second": self.second * self.scale,
+                          "time": self.time})
 
     def load_spec(self, spec: Any) -> None:
-        s = self.scale
-        values: dict[str, Any] = {"custom": None}
-        kind = spec.get("kind") if isinstance(spec, dict) else None
-        if _is_number(spec):
-            values.update(kind="constant", value=spec / s)
-        elif kind == "constant" and _is_number(spec.get("value")) and len(spec) == 2:
-            values.update(kind="constant", value=spec["value"] / s)
-        elif kind == "ramp":
-            values.update(kind="ramp", value=spec["end"] / s, second=spec["start"] / s,
-                          time=spec["duration"])
-        elif kind == "step" and len(spec["values"]) == 2 and len(spec["breaks"]) == 1:
-            values.update(kind="step", value=spec["values"][0] / s,
-                          second=spec["values"][1] / s, time=spec["breaks"][0])
-        elif kind == "sine" and spec.get("phase", 0) == 0:
-            values.update(kind="sine", value=spec["mean"] / s, second=spec["amplitude"] / s,
-                          time=spec["wavelength"])
-        else:
-            values.update(kind="custom", custom=copy.deepcopy(spec))
+        values: dict[str, Any] = {"kind": "custom", "custom": copy.deepcopy(spec)}
+        found = history_form_of(spec)
+        if found is not None:
+            name, numbers = found
+            values = {**numbers, "kind": name, "custom": None}
+            for key in ("value", "second"):  # SI to display units; times are days
+                if key in values:
+                    values[key] = values[key] / self.scale
         self.param.update(**values)
 
 

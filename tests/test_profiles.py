@@ -658,25 +658,31 @@ def test_without_offset_changes_a_profile_by_a_constant_only() -> None:
 
 
 def test_each_form_of_the_screen_reads_back_what_it_writes() -> None:
-    from core.profiles import VARIATIONS, variation_of
+    from core.profiles import HISTORY_FORMS, VARIATIONS, history_form_of, variation_of
 
     assert list(VARIATIONS) == ["none", "linear", "step", "patch", "sine", "bump"]
-    for name, variation in VARIATIONS.items():
-        spec = variation.spec(2.0, 0.5, 0.05, 0.1)
-        found = variation_of(spec)
-        assert found is not None and found[0] == name
-        level, amplitude, position, length = found[1]
-        shown = {"amplitude": amplitude, "position": position, "length": length}
-        assert level == pytest.approx(2.0)
-        expected = {"amplitude": 0.5, "position": 0.05, "length": 0.1}
-        assert all(shown[k] == pytest.approx(expected[k]) for k in variation.uses), name
-        profile_from_spec(spec, field="f", variable="x", domain=D)  # a valid spec
+    assert sorted(HISTORY_FORMS) == ["constant", "ramp", "sine", "step"]
+    cases = [(VARIATIONS, variation_of, {"level": 2.0, "amplitude": 0.5, "position": 0.05,
+                                         "length": 0.1}, "level", "x", D),
+             (HISTORY_FORMS, history_form_of, {"value": 2.0, "second": 0.5, "time": 3.0},
+              "value", "t", (0.0, 10.0))]
+    for registry, form_of, numbers, main, variable, domain in cases:
+        for name, form in registry.items():
+            spec = form.spec(numbers)
+            found = form_of(spec)
+            assert found is not None and found[0] == name
+            assert set(found[1]) == {main, *form.uses}, name
+            assert all(found[1][k] == pytest.approx(numbers[k]) for k in found[1]), name
+            profile_from_spec(spec, field="f", variable=variable, domain=domain)  # valid
     # what no form shows stays a custom profile on screen
     for spec in (FAMILY_EXAMPLES["table"], FAMILY_EXAMPLES["expr"], FAMILY_EXAMPLES["ramp"],
                  {"kind": "sine", "mean": 1.0, "amplitude": 1.0, "wavelength": 1.0,
                   "phase": 0.5}, {"kind": "step", "values": [1.0, "a"], "breaks": [0.0]},
-                 {"kind": "nonsense"}, "text", None):
+                 {"kind": "bump", "mean": 1.0}, {"kind": "nonsense"}, "text", None, True):
         assert variation_of(spec) is None
+    for spec in (FAMILY_EXAMPLES["table"], {"kind": "ramp", "start": 1.0, "end": None,
+                                            "duration": 1.0}, {"kind": "step"}, False):
+        assert history_form_of(spec) is None
 
 
 def test_a_bad_variable_name_is_refused_naming_the_field() -> None:
