@@ -86,6 +86,7 @@ from core.profile_base import (  # noqa: F401 (re-exported: core.profiles is the
     profile_key,
 )
 from core.profile_forms import ScreenForm
+from core.validation import refuse_first
 
 # ----------------------------------------------------------------------------- families
 
@@ -426,25 +427,18 @@ def check_range(profile: Profile, *, field: str, domain: tuple[float, float] | N
     with np.errstate(all="ignore"):
         values = profile(points)
     var = profile.variable
-    bad = ~np.isfinite(values)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise ValueError(f"{field}: must be finite, is {values[i]} at {var} = "
-                         f"{_fmt(points[i])}")
+    refuse_first(~np.isfinite(values), lambda i: (
+        f"{field}: must be finite, is {values[i]} at {var} = {_fmt(points[i])}"))
+    rules = []
     if lower is not None:
-        bad = values < lower if lower_inclusive else values <= lower
-        if bad.any():
-            i = int(np.argmax(bad))
-            op = ">=" if lower_inclusive else ">"
-            raise ValueError(f"{field}: must be {op} {_fmt(lower)}, is {_fmt(values[i])} at "
-                             f"{var} = {_fmt(points[i])}")
+        rules.append((values < lower if lower_inclusive else values <= lower,
+                      f"{'>=' if lower_inclusive else '>'} {_fmt(lower)}"))
     if upper is not None:
-        bad = values > upper if upper_inclusive else values >= upper
-        if bad.any():
-            i = int(np.argmax(bad))
-            op = "<=" if upper_inclusive else "<"
-            raise ValueError(f"{field}: must be {op} {_fmt(upper)}, is {_fmt(values[i])} at "
-                             f"{var} = {_fmt(points[i])}")
+        rules.append((values > upper if upper_inclusive else values >= upper,
+                      f"{'<=' if upper_inclusive else '<'} {_fmt(upper)}"))
+    for bad, rule in rules:
+        refuse_first(bad, lambda i, rule=rule: (
+            f"{field}: must be {rule}, is {_fmt(values[i])} at {var} = {_fmt(points[i])}"))
 
 
 

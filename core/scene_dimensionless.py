@@ -27,6 +27,7 @@ import numpy as np
 
 from core.profiles import Profile
 from core.scene_model import _values
+from core.validation import refuse_first
 
 if TYPE_CHECKING:
     from core.scene_model import Scene
@@ -194,13 +195,11 @@ def _check_x_profiles_at(scene: Scene, x: np.ndarray) -> None:
         if upper is not None:
             checks.append((values >= upper, f"must be < {upper:g}"))
         for bad, rule in checks:
-            if bad.any():
-                i = int(np.argmax(bad))
-                raise ValueError(
-                    f"{path}: {rule}, is {values.flat[i]:.6g} at x = {x.flat[i]:.10g} m, "
-                    f"between the points where the scene was checked (a pole or a spike "
-                    "of a formula narrower than the checks): keep it finite and in range "
-                    "on the whole punch")
+            refuse_first(bad, lambda i, path=path, rule=rule, values=values: (
+                f"{path}: {rule}, is {values.flat[i]:.6g} at x = {x.flat[i]:.10g} m, "
+                "between the points where the scene was checked (a pole or a spike of a "
+                "formula narrower than the checks): keep it finite and in range on the "
+                "whole punch"))
 
 
 def _kinematic_load(profile: Profile, scale: float,
