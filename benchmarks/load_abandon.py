@@ -91,8 +91,7 @@ def run_abandon(args: argparse.Namespace, command: str) -> tuple[str, bool]:
                 rows.append((dropped, visits, peak, level, waited))
         finally:
             server.stop()
-        # the server's own end (SIGTERM raised as KeyboardInterrupt) is not a failure
-        log_errors = [e for e in server_tracebacks(log_path) if "_stop_on_sigterm" not in e]
+        log_errors = server_tracebacks(log_path)
     failed = sum(n for (_, visits, *_rest) in rows for way, n in visits.items()
                  if way not in WAYS) + sum(n for way, n in warm.items() if way not in WAYS)
     levels = [r[3] for r in rows]

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve, rsf2csf, schur, solve_triangular
 
+from core.inputs import validate_times
 from core.quadrature import Panels, base_panels, kernel_operator, operator_rows
 from core.statements import QUANTITIES as _QUANTITIES
 from core.statements import STATEMENTS as _STATEMENTS
@@ -173,7 +174,7 @@ def solve_collocation(
     if edge > 1.0:
         raise ValueError(f"edge_width: must be at most 1, got {edge!r}")
     tol = _positive_number(time_tol, "time_tol")
-    times_arr = _check_times(times)
+    times_arr = validate_times(times)  # the checks and limits of solve_dimensionless
     cuts = _check_breakpoints(breakpoints)
     m_fn = _space_function(m, "m")
     g_fn = _space_function(g, "g")
@@ -503,22 +504,6 @@ def _adaptive_grids(system: _System, times: np.ndarray, richardson: bool,
 
 def _positive_number(value: object, name: str) -> float:
     return positive_number(value, name, style=PYTHON_STYLE)
-
-
-def _check_times(times: Sequence[float] | np.ndarray) -> np.ndarray:
-    try:
-        arr = np.atleast_1d(np.asarray(times, dtype=float))
-    except (TypeError, ValueError):
-        raise ValueError("times: must be an array of numbers") from None
-    if arr.ndim != 1 or arr.size == 0:
-        raise ValueError("times: must be a non-empty 1-D array")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError("times: must be finite")
-    if arr[0] < 1.0:
-        raise ValueError(f"times: must start at or after t = 1 (loading), got {arr[0]!r}")
-    if np.any(np.diff(arr) <= 0.0):
-        raise ValueError("times: must be strictly increasing")
-    return arr
 
 
 def _check_breakpoints(breakpoints: Sequence[float]) -> list[float]:

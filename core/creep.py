@@ -50,6 +50,7 @@ from core.code_creep import SPEC_FIELDS as _CODE_SPEC_FIELDS
 from core.code_creep import CodeCreep
 from core.validation import (
     PYTHON_STYLE,
+    bounded_list,
     finite_number,
     nonnegative_number,
     positive_number,
@@ -279,10 +280,7 @@ def _check_arutyunyan(values: Mapping[str, Any], field: str) -> dict[str, float]
 
 def _check_terms(terms: Any, field: str) -> Terms:
     """Prony terms as a tuple of (C_r, A_r, gamma_r) float triples, validated."""
-    if isinstance(terms, (str, bytes)) or not isinstance(terms, (list, tuple)):
-        raise ValueError(f"{field}: must be a list of terms, got {show_python(terms)}")
-    if not 1 <= len(terms) <= MAX_TERMS:
-        raise ValueError(f"{field}: must hold 1 to {MAX_TERMS} terms, got {len(terms)}")
+    terms = bounded_list(terms, field, least=1, most=MAX_TERMS, what="terms", style=PYTHON_STYLE)
     checked = []
     for r, term in enumerate(terms):
         where = f"{field}[{r}]"

@@ -49,6 +49,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from core import limits
+from core.immutable import Immutable
 
 #: Longest accepted formula, in characters.
 MAX_LENGTH = limits.MAX_FORMULA_CHARS
@@ -309,23 +310,23 @@ class _Parser:
         return self.fail(self.describe(tok), tok.pos)
 
     def expr(self) -> _Node:
-        node = self.term()
-        while self.tok.kind == "op" and self.tok.text in ("+", "-"):
-            op = self.advance()
-            self.count(op.pos)
-            right = self.term()
-            text = f"{_wrap(node, _ADD)} {op.text} {_wrap(right, _MUL)}"
-            node = self.apply(_BINARY[op.text], [node, right], text, _ADD, node.pos)
-        return node
+        return self.left_to_right(("+", "-"), self.term, _ADD, _MUL)
 
     def term(self) -> _Node:
-        node = self.unary()
-        while self.tok.kind == "op" and self.tok.text in ("*", "/"):
+        return self.left_to_right(("*", "/"), self.unary, _MUL, _UNARY)
+
+    def left_to_right(self, ops: tuple[str, ...], operand: Callable[[], _Node], level: int,
+                      right_level: int) -> _Node:
+        """Operands joined by the operators ``ops`` of one precedence ``level``, grouped
+        from the left (``a - b - c`` is ``(a - b) - c``); a right operand is wrapped in
+        parentheses below ``right_level``."""
+        node = operand()
+        while self.tok.kind == "op" and self.tok.text in ops:
             op = self.advance()
             self.count(op.pos)
-            right = self.unary()
-            text = f"{_wrap(node, _MUL)} {op.text} {_wrap(right, _UNARY)}"
-            node = self.apply(_BINARY[op.text], [node, right], text, _MUL, node.pos)
+            right = operand()
+            text = f"{_wrap(node, level)} {op.text} {_wrap(right, right_level)}"
+            node = self.apply(_BINARY[op.text], [node, right], text, level, node.pos)
         return node
 
     def unary(self) -> _Node:
@@ -465,7 +466,7 @@ def _run(program: tuple[_Instr, ...], arrays: list[np.ndarray]) -> Any:
     return stack[0]
 
 
-class Expression:
+class Expression(Immutable):
     """A parsed formula: an immutable, vectorized callable of its variables.
 
     Build it with :func:`parse_expression`. ``expression(*arrays)`` takes one array per
@@ -490,12 +491,6 @@ class Expression:
         object.__setattr__(self, "_value", _value)
         object.__setattr__(self, "_switches", _switches)
         object.__setattr__(self, "_live", _live_arrays(_program))
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        raise AttributeError("Expression is immutable")
-
-    def __delattr__(self, name: str) -> None:
-        raise AttributeError("Expression is immutable")
 
     @property
     def text(self) -> str:

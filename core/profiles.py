@@ -35,120 +35,64 @@ Every refusal is a ValueError whose message starts with the full field path, e.g
 ``coating[1].modulus.points: must be strictly increasing in x (row 3)``. List indices in
 paths and in "row"/"entry" are 0-based, as in the JSON file; line numbers of uploaded
 CSV files are 1-based, as an editor shows them.
+
+One registry, :data:`FAMILIES`, holds everything done by family: its fields, how it is
+built (canonical spec, breakpoints, known extremes), the constant part it separates
+exactly (:func:`without_offset`, for the gap) and the forms in which the explorer's
+screen shows a function of ``x`` (:data:`VARIATIONS`, :func:`variation_of`) or a load
+history (:data:`HISTORY_FORMS`, :func:`history_form_of`; the forms themselves are in
+:mod:`core.profile_forms`). The
+:class:`Profile` value and the helpers of single families are in
+:mod:`core.profile_base`, CSV uploads in :mod:`core.profile_csv`; both are re-exported
+here.
 """
 
 from __future__ import annotations
 
 import difflib
-import hashlib
-import json
 import math
-import re
 from collections.abc import Callable, Mapping
-from typing import Any
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from core import limits
-from core.expressions import ALIASES, CONSTANTS, FUNCTIONS, Expression, parse_expression
+from core import profile_forms as forms
+from core.expressions import parse_expression
+from core.profile_base import (  # noqa: F401 (re-exported: core.profiles is the public path)
+    FORMULA_BREAK_SAMPLES,
+    INTERPOLATIONS,
+    MAX_POLYNOMIAL_COEFFICIENTS,
+    MAX_TABLE_BYTES,
+    MAX_TABLE_ROWS,
+    RANGE_SAMPLES,
+    Profile,
+    Spec,
+    _check_domain,
+    _check_variable,
+    _constant,
+    _fmt,
+    _formula_breakpoints,
+    _json_type,
+    _list,
+    _number,
+    _numbers,
+    _positive,
+    _sine_crests,
+    _SlopeOverflow,
+    _strictly_increasing,
+    _table,
+    profile_key,
+)
+from core.profile_forms import ScreenForm
+from core.validation import refuse_first
 
-#: Most rows of a table (and most breaks of a step profile).
-MAX_TABLE_ROWS = limits.MAX_TABLE_ROWS
-#: Most coefficients of a polynomial (degree 15).
-MAX_POLYNOMIAL_COEFFICIENTS = limits.MAX_POLYNOMIAL_COEFFICIENTS
-#: Samples of the uniform part of :func:`check_range`'s grid.
-RANGE_SAMPLES = 4097
-#: Samples used to locate the switching points of a formula (see ``Profile.breakpoints``).
-FORMULA_BREAK_SAMPLES = 2049
-
-KINDS: tuple[str, ...] = ("constant", "linear", "step", "sine", "polynomial", "bump", "ramp",
-                          "table", "expr")
-INTERPOLATIONS: tuple[str, ...] = ("linear", "step", "pchip")
-
-# (required, optional) fields of each kind, besides "kind"
-_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
-    "constant": (("value",), ()),
-    "linear": (("start", "end"), ()),
-    "step": (("values", "breaks"), ()),
-    "sine": (("mean", "amplitude", "wavelength"), ("phase",)),
-    "polynomial": (("coefficients",), ()),
-    "bump": (("mean", "amplitude", "center", "width"), ()),
-    "ramp": (("start", "end", "duration"), ()),
-    "table": (("points",), ("interpolation",)),
-    "expr": (("expr",), ()),
-}
-
-Spec = float | dict[str, Any]
-
-
-# ----------------------------------------------------------------------------- validation
-
-
-def _json_type(value: Any) -> str:
-    """The JSON name of a value's type, for messages read by scene-file authors."""
-    if value is None:
-        return "null"
-    if isinstance(value, (bool, np.bool_)):
-        return "a boolean"
-    if isinstance(value, str):
-        return "a string"
-    if isinstance(value, Mapping):
-        return "an object"
-    if isinstance(value, (list, tuple)):
-        return "a list"
-    if isinstance(value, (int, float, np.integer, np.floating)):
-        return "a number"
-    return f"a {type(value).__name__}"
-
-
-def _fmt(value: float) -> str:
-    return f"{value:.6g}"
-
-
-def _number(value: Any, field: str) -> float:
-    """``value`` as a finite float (``-0.0`` made ``0.0``), or a ValueError naming field."""
-    # true/false in a scene file is a mistake, although Python counts bool as an int
-    if isinstance(value, (bool, np.bool_)) or not isinstance(
-            value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"{field}: must be a number, not {_json_type(value)}")
-    try:
-        x = float(value)
-    except OverflowError:
-        raise ValueError(f"{field}: must be a finite number, is too large") from None
-    if not math.isfinite(x):
-        raise ValueError(f"{field}: must be a finite number, is {x}")
-    return x + 0.0  # -0.0 + 0.0 == +0.0, so equal profiles have equal specs
-
-
-def _positive(value: Any, field: str) -> float:
-    x = _number(value, field)
-    if x <= 0:
-        raise ValueError(f"{field}: must be > 0, is {_fmt(x)}")
-    return x
-
-
-def _list(value: Any, field: str, *, least: int, most: int, what: str = "entries") -> list:
-    if isinstance(value, np.ndarray):
-        value = value.tolist()
-    if not isinstance(value, (list, tuple)):
-        raise ValueError(f"{field}: must be a list, not {_json_type(value)}")
-    if len(value) < least:
-        if least == 1:
-            raise ValueError(f"{field}: must not be empty")
-        raise ValueError(f"{field}: must have at least {least} {what}, has {len(value)}")
-    if len(value) > most:
-        raise ValueError(f"{field}: must have at most {most} {what}, has {len(value)}")
-    return list(value)
-
-
-def _numbers(value: Any, field: str, *, least: int, most: int, what: str = "entries"
-             ) -> list[float]:
-    items = _list(value, field, least=least, most=most, what=what)
-    return [_number(item, f"{field}[{i}]") for i, item in enumerate(items)]
+# ----------------------------------------------------------------------------- families
 
 
 def _check_fields(spec: Mapping[str, Any], kind: str, field: str) -> None:
-    required, optional = _FIELDS[kind]
+    required, optional = FAMILIES[kind].required, FAMILIES[kind].optional
     # "kind" stays allowed in the short form too, so a misspelt "kind" gets its hint
     allowed = set(required) | set(optional) | {"kind"}
     for key in spec:
@@ -167,274 +111,264 @@ def _check_fields(spec: Mapping[str, Any], kind: str, field: str) -> None:
             raise ValueError(f"{field}: missing field {key!r} (required for kind {kind!r})")
 
 
-def _check_domain(domain: Any, field: str) -> tuple[float, float]:
-    if not isinstance(domain, (list, tuple)) or len(domain) != 2:
-        raise ValueError(f"{field}: domain must be a pair (lo, hi), got {domain!r}")
-    lo = _number(domain[0], f"{field}: domain start")
-    hi = _number(domain[1], f"{field}: domain end")
-    if not lo < hi:
-        raise ValueError(f"{field}: domain must have start < end, got ({lo!r}, {hi!r})")
-    return lo, hi
+class _At(NamedTuple):
+    """Where a spec is read: its field path, its variable and the domain ``(lo, hi)``."""
+
+    field: str
+    variable: str
+    domain: tuple[float, float]
+
+    def number(self, spec: Mapping[str, Any], key: str) -> float:
+        return _number(spec[key], f"{self.field}.{key}")
+
+    def positive(self, spec: Mapping[str, Any], key: str) -> float:
+        return _positive(spec[key], f"{self.field}.{key}")
 
 
-def _check_variable(variable: Any) -> str:
-    if (not isinstance(variable, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", variable)
-            or variable in CONSTANTS or variable in FUNCTIONS or variable in ALIASES):
-        raise ValueError(f"variable name {variable!r} is not allowed")
-    return variable
+def _build_constant(spec: Mapping[str, Any], at: _At) -> Profile:
+    return _constant(at.number(spec, "value"), at.variable, at.domain)
 
 
-def _strictly_increasing(values: list[float], field: str, variable: str, what: str) -> None:
-    for i in range(1, len(values)):
-        if not values[i] > values[i - 1]:
-            raise ValueError(f"{field}: must be strictly increasing in {variable} "
-                             f"({what} {i})")
+def _build_linear(spec: Mapping[str, Any], at: _At) -> Profile:
+    start, end = at.number(spec, "start"), at.number(spec, "end")
+    lo, hi = at.domain
+    span = hi - lo
+    # weights that are exactly 1 and 0 at the ends, so y(lo) = start and y(hi) = end
+    return Profile(kind="linear", spec={"kind": "linear", "start": start, "end": end},
+                   variable=at.variable, domain=at.domain,
+                   evaluate=lambda v: start * ((hi - v) / span) + end * ((v - lo) / span))
 
 
-# ----------------------------------------------------------------------------- the profile
+def _build_step(spec: Mapping[str, Any], at: _At) -> Profile:
+    field, (lo, hi) = at.field, at.domain
+    breaks = _numbers(spec["breaks"], f"{field}.breaks", least=0, most=MAX_TABLE_ROWS)
+    values = _numbers(spec["values"], f"{field}.values", least=1, most=MAX_TABLE_ROWS + 1)
+    if len(values) != len(breaks) + 1:
+        raise ValueError(f"{field}.values: must have one entry more than breaks "
+                         f"({len(breaks) + 1}), has {len(values)}")
+    for i, b in enumerate(breaks):
+        if not lo < b < hi:
+            raise ValueError(f"{field}.breaks[{i}]: must lie strictly inside the domain "
+                             f"({_fmt(lo)}, {_fmt(hi)}) of {at.variable}, is {_fmt(b)}")
+    _strictly_increasing(breaks, f"{field}.breaks", at.variable, "entry")
+    b_arr, y_arr = np.array(breaks), np.array(values)
+    return Profile(kind="step", spec={"kind": "step", "values": values, "breaks": breaks},
+                   variable=at.variable, domain=at.domain, breakpoints=tuple(breaks),
+                   evaluate=lambda v: y_arr[np.searchsorted(b_arr, v, side="right")])
 
 
-def _canonical_json(obj: Any) -> str:
-    return json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=False)
+def _build_sine(spec: Mapping[str, Any], at: _At) -> Profile:
+    mean, amplitude = at.number(spec, "mean"), at.number(spec, "amplitude")
+    wavelength = at.positive(spec, "wavelength")
+    phase = _number(spec.get("phase", 0.0), f"{at.field}.phase")
+    k = 2 * math.pi / wavelength
+    return Profile(kind="sine", spec={"kind": "sine", "mean": mean, "amplitude": amplitude,
+                                      "wavelength": wavelength, "phase": phase},
+                   variable=at.variable, domain=at.domain,
+                   extra=_sine_crests(*at.domain, wavelength, phase),
+                   evaluate=lambda v: mean + amplitude * np.sin(k * v + phase))
 
 
-class Profile:
-    """A validated function of one variable: an immutable, vectorized callable.
+def _build_polynomial(spec: Mapping[str, Any], at: _At) -> Profile:
+    lo, hi = at.domain
+    coefficients = _numbers(spec["coefficients"], f"{at.field}.coefficients", least=1,
+                            most=MAX_POLYNOMIAL_COEFFICIENTS, what="coefficients")
+    c = np.array(coefficients)
+    extra: tuple[float, ...] = ()
+    with np.errstate(all="ignore"):  # coefficients near the float limit overflow: NaN
+        derivative = np.polynomial.polynomial.polyder(c)
+    if np.all(np.isfinite(derivative)) and np.any(derivative != 0):
+        try:
+            with np.errstate(all="ignore"):
+                roots = np.polynomial.polynomial.polyroots(np.trim_zeros(derivative, "b"))
+        except np.linalg.LinAlgError:
+            # extreme coefficient ratios overflow the companion matrix; the grid decides
+            roots = np.array([])
+        real = roots.real[np.abs(roots.imag) <= 1e-9 * (1 + np.abs(roots.real))]
+        extra = tuple(float(r) for r in real if lo <= r <= hi)
+    return Profile(kind="polynomial", spec={"kind": "polynomial", "coefficients": coefficients},
+                   variable=at.variable, domain=at.domain, extra=extra,
+                   evaluate=lambda v: np.polynomial.polynomial.polyval(v, c))
 
-    ``profile(values)`` takes an array of positions [m] or times [day] (the unit of the
-    variable) and returns a new float array of the same shape, in the unit of the
-    quantity described; NaN inputs give NaN. Attributes: ``kind``, ``spec`` (canonical
-    JSON-able form), ``breakpoints`` (sorted points strictly inside the domain where the
-    value or its slope may jump), ``variable``, ``domain``. Profiles compare and hash by
-    (spec, variable, domain); :func:`profile_key` gives a stable string key.
+
+def _build_bump(spec: Mapping[str, Any], at: _At) -> Profile:
+    mean, amplitude = at.number(spec, "mean"), at.number(spec, "amplitude")
+    center, width = at.number(spec, "center"), at.positive(spec, "width")
+    return Profile(kind="bump", spec={"kind": "bump", "mean": mean, "amplitude": amplitude,
+                                      "center": center, "width": width},
+                   variable=at.variable, domain=at.domain, extra=(center,),
+                   evaluate=lambda v: mean + amplitude * np.exp(-((v - center) / width) ** 2))
+
+
+def _build_ramp(spec: Mapping[str, Any], at: _At) -> Profile:
+    start, end = at.number(spec, "start"), at.number(spec, "end")
+    duration = at.positive(spec, "duration")
+    lo = at.domain[0]
+    return Profile(kind="ramp", spec={"kind": "ramp", "start": start, "end": end,
+                                      "duration": duration},
+                   variable=at.variable, domain=at.domain, breakpoints=(lo + duration,),
+                   evaluate=lambda v: start + (end - start)
+                   * np.clip((v - lo) / duration, 0.0, 1.0))
+
+
+def _build_table(spec: Mapping[str, Any], at: _At) -> Profile:
+    field, variable = at.field, at.variable
+    rows = _list(spec["points"], f"{field}.points", least=2, most=MAX_TABLE_ROWS, what="rows")
+    points: list[tuple[float, float]] = []
+    for i, row in enumerate(rows):
+        path = f"{field}.points[{i}]"
+        if isinstance(row, np.ndarray):
+            row = row.tolist()
+        if not isinstance(row, (list, tuple)) or len(row) != 2:
+            raise ValueError(f"{path}: must be a pair [{variable}, value], "
+                             f"not {_json_type(row)}"
+                             + (f" of {len(row)}" if isinstance(row, (list, tuple)) else ""))
+        points.append((_number(row[0], f"{path}[0]"), _number(row[1], f"{path}[1]")))
+    _strictly_increasing([p[0] for p in points], f"{field}.points", variable, "row")
+    interpolation = spec.get("interpolation", "linear")
+    if not isinstance(interpolation, str) or interpolation not in INTERPOLATIONS:
+        shown = (repr(interpolation[:40]) if isinstance(interpolation, str)
+                 else _json_type(interpolation))
+        raise ValueError(f"{field}.interpolation: must be one of "
+                         f"{', '.join(INTERPOLATIONS)}, is {shown}")
+    canonical = {"kind": "table", "points": [list(p) for p in points],
+                 "interpolation": interpolation}
+    try:
+        return _table(points, interpolation, variable, at.domain, canonical)
+    except _SlopeOverflow:
+        raise ValueError(f"{field}.points: the slopes between rows overflow a double "
+                         "(rows too close together for 'pchip'); spread them or use "
+                         "'linear'") from None
+
+
+def _build_expr(spec: Mapping[str, Any], at: _At) -> Profile:
+    text = spec["expr"]
+    if not isinstance(text, str):
+        raise ValueError(f"{at.field}.expr: must be a string (a formula in {at.variable}), "
+                         f"not {_json_type(text)}")
+    expression = parse_expression(text, (at.variable,), field=f"{at.field}.expr")
+    breaks = [] if expression.is_constant else _formula_breakpoints(expression, *at.domain)
+    return Profile(kind="expr", spec={"kind": "expr", "expr": expression.text},
+                   variable=at.variable, domain=at.domain, breakpoints=tuple(breaks),
+                   evaluate=expression)
+
+
+# The constant part each family separates exactly (see without_offset): differences of
+# nearby values are exact in floating point, so dropping it loses nothing.
+
+def _offset_none(spec: Spec) -> Spec:
+    return 0.0
+
+
+def _offset_mean(spec: Spec) -> Spec:
+    return {**spec, "mean": 0.0}
+
+
+def _offset_linear(spec: Spec) -> Spec:
+    return {**spec, "start": 0.0, "end": spec["end"] - spec["start"]}
+
+
+def _offset_step(spec: Spec) -> Spec:
+    first = spec["values"][0]
+    return {**spec, "values": [v - first for v in spec["values"]]}
+
+
+def _offset_polynomial(spec: Spec) -> Spec:
+    return {**spec, "coefficients": [0.0, *spec["coefficients"][1:]]}
+
+
+def _offset_table(spec: Spec) -> Spec:
+    first = spec["points"][0][1]
+    return {**spec, "points": [[v, y - first] for v, y in spec["points"]]}
+
+
+@dataclass(frozen=True)
+class Family:
+    """One family of profiles, and everything the program does by family.
+
+    ``kind``: its name in a spec; ``required`` and ``optional``: its fields besides
+    ``kind``; ``build(spec, at)``: the validated :class:`Profile` with its canonical spec,
+    breakpoints and known extremes; ``offset(spec)``: the canonical spec less a constant
+    part that the family separates exactly (``None``: nothing is dropped, as for a
+    formula); ``variations`` and ``histories``: the forms in which the explorer's screen
+    shows it as a function of ``x`` and as a load history (:mod:`core.profile_forms`).
     """
 
-    __slots__ = ("_kind", "_json", "_variable", "_domain", "_breakpoints", "_extra",
-                 "_evaluate", "_key")
-
-    def __init__(self, *, kind: str, spec: Spec, variable: str, domain: tuple[float, float],
-                 evaluate: Callable[[np.ndarray], Any], breakpoints: tuple[float, ...] = (),
-                 extra: tuple[float, ...] = ()) -> None:
-        """Internal: use :func:`profile_from_spec` or :func:`profile_from_csv`."""
-        text = _canonical_json(spec)
-        # a digest rather than the JSON itself: a 10000-row table would double its memory
-        key = hashlib.sha256(_canonical_json(
-            {"spec": spec, "variable": variable, "domain": list(domain)}).encode()).hexdigest()
-        lo, hi = domain
-        inside = sorted({float(b) for b in breakpoints if lo < b < hi})
-        for name, value in (("_kind", kind), ("_json", text), ("_variable", variable),
-                            ("_domain", (float(lo), float(hi))),
-                            ("_breakpoints", tuple(inside)), ("_extra", tuple(extra)),
-                            ("_evaluate", evaluate), ("_key", key)):
-            object.__setattr__(self, name, value)
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        raise AttributeError("Profile is immutable")
-
-    def __delattr__(self, name: str) -> None:
-        raise AttributeError("Profile is immutable")
-
-    @property
-    def kind(self) -> str:
-        """The family: one of :data:`KINDS`."""
-        return self._kind
-
-    @property
-    def spec(self) -> Spec:
-        """Canonical JSON-able form (a new object each time; a float for constants)."""
-        return json.loads(self._json)
-
-    @property
-    def breakpoints(self) -> tuple[float, ...]:
-        """Sorted points strictly inside the domain (unit of the variable) where the value
-        or the slope may be discontinuous."""
-        return self._breakpoints
-
-    def nonsmooth_points(self, lo: float | None = None,
-                         hi: float | None = None) -> tuple[float, ...]:
-        """Sorted points strictly inside ``(lo, hi)`` (default: the domain; unit of the
-        variable) where the value or the slope may jump: step breaks, the ramp's corner,
-        table rows (all for "linear", all but the first for "step", the end rows for
-        "pchip"), the switches of a formula.
-
-        For a load history these are the times the time stepper must land on exactly
-        (``breaks`` of :func:`core.time_integration.solve_degenerate`): a step across a
-        jump loses the method's order and fools its error estimate.
-        """
-        low = self._domain[0] if lo is None else float(lo)
-        high = self._domain[1] if hi is None else float(hi)
-        return tuple(b for b in self._breakpoints if low < b < high)
-
-    @property
-    def variable(self) -> str:
-        """Name of the variable (``"x"`` or ``"t"``)."""
-        return self._variable
-
-    @property
-    def domain(self) -> tuple[float, float]:
-        """The domain ``(lo, hi)`` the spec refers to (unit of the variable)."""
-        return self._domain
-
-    def __call__(self, values: Any) -> np.ndarray:
-        """Values of the profile at ``values`` (unit of the variable); same shape, float."""
-        v = np.asarray(values, dtype=float)
-        with np.errstate(all="ignore"):
-            out = np.array(np.broadcast_to(self._evaluate(v), v.shape), dtype=float)
-        nan = np.isnan(v)
-        if nan.any():
-            out[nan] = np.nan
-        return out
-
-    def sample_points(self, domain: tuple[float, float] | None = None,
-                      samples: int = RANGE_SAMPLES) -> np.ndarray:
-        """Sorted points of ``domain`` (default: the profile's) at which sampling sees the
-        profile's extremes: a uniform grid, both ends, both sides of every breakpoint,
-        and the known interior extremes of the family (bump centre, sine crests,
-        polynomial turning points, table rows). Unit of the variable."""
-        lo, hi = self._domain if domain is None else _check_domain(domain, "sample_points")
-        grid = [np.linspace(lo, hi, max(int(samples), 2))]
-        if self._breakpoints:
-            b = np.asarray(self._breakpoints)
-            grid += [b, np.nextafter(b, -np.inf), np.nextafter(b, np.inf)]
-        if self._extra:
-            grid.append(np.asarray(self._extra))
-        points = np.unique(np.concatenate(grid))
-        return points[(points >= lo) & (points <= hi)]
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Profile):
-            return NotImplemented
-        return self._key == other._key
-
-    def __hash__(self) -> int:
-        return hash(self._key)
-
-    def __repr__(self) -> str:
-        text = self._json if len(self._json) <= 120 else self._json[:117] + "..."
-        return (f"Profile(kind={self._kind!r}, spec={text}, variable={self._variable!r}, "
-                f"domain={self._domain!r})")
-
-    def __reduce__(self) -> tuple[Any, ...]:
-        return (_rebuild, (self.spec, self._variable, self._domain))
+    kind: str
+    required: tuple[str, ...]
+    optional: tuple[str, ...]
+    build: Callable[[Mapping[str, Any], _At], Profile]
+    offset: Callable[[Spec], Spec] | None = None
+    variations: tuple[ScreenForm, ...] = ()
+    histories: tuple[ScreenForm, ...] = ()
 
 
-def _rebuild(spec: Spec, variable: str, domain: tuple[float, float]) -> Profile:
-    return profile_from_spec(spec, field="profile", variable=variable, domain=domain)
+#: The families of profiles, by kind (the registry: fields, building, offsets, screen).
+FAMILIES: Mapping[str, Family] = MappingProxyType({f.kind: f for f in (
+    Family("constant", ("value",), (), _build_constant, _offset_none,
+           (forms.X_NONE,), (forms.T_CONSTANT,)),
+    Family("linear", ("start", "end"), (), _build_linear, _offset_linear, (forms.X_LINEAR,)),
+    Family("step", ("values", "breaks"), (), _build_step, _offset_step,
+           (forms.X_STEP, forms.X_PATCH), (forms.T_STEP,)),
+    Family("sine", ("mean", "amplitude", "wavelength"), ("phase",), _build_sine,
+           _offset_mean, (forms.X_SINE,), (forms.T_SINE,)),
+    Family("polynomial", ("coefficients",), (), _build_polynomial, _offset_polynomial),
+    Family("bump", ("mean", "amplitude", "center", "width"), (), _build_bump, _offset_mean,
+           (forms.X_BUMP,)),
+    Family("ramp", ("start", "end", "duration"), (), _build_ramp, None, (), (forms.T_RAMP,)),
+    Family("table", ("points",), ("interpolation",), _build_table, _offset_table),
+    Family("expr", ("expr",), (), _build_expr),
+)})
+
+#: The kinds of profiles, in the order the module docstring lists them.
+KINDS: tuple[str, ...] = tuple(FAMILIES)
+
+#: The screen's forms of a function of x and of a load history, by name, in the order
+#: the screen lists them.
+VARIATIONS: Mapping[str, ScreenForm] = MappingProxyType(
+    {v.name: v for family in FAMILIES.values() for v in family.variations})
+HISTORY_FORMS: Mapping[str, ScreenForm] = MappingProxyType(
+    {h.name: h for family in FAMILIES.values() for h in family.histories})
 
 
-def profile_key(profile: Profile) -> str:
-    """A stable hex key of a profile: the SHA-256 of the canonical JSON of its spec,
-    variable and domain (same for equal profiles, across processes and runs)."""
-    return profile._key
+def _form_of(spec: Any, which: str) -> tuple[str, dict[str, float]] | None:
+    kind = "constant" if forms.numeric(spec) else (
+        spec.get("kind") if isinstance(spec, Mapping) else None)
+    family = FAMILIES.get(kind) if isinstance(kind, str) else None
+    for form in getattr(family, which, ()):
+        numbers = form.numbers_of(spec)
+        if numbers is not None:
+            return form.name, numbers
+    return None
 
 
-# ----------------------------------------------------------------------------- families
+def variation_of(spec: Any) -> tuple[str, dict[str, float]] | None:
+    """The screen's form of a function of ``x`` given as a spec, and its numbers
+    (``level`` and those the form ``uses`` of amplitude, position, length;
+    :mod:`core.profile_forms`), or ``None`` when no form of the screen shows it (a table,
+    a formula, a sine with a phase, ...). The spec is not validated here."""
+    return _form_of(spec, "variations")
 
 
-def _constant(value: float, variable: str, domain: tuple[float, float]) -> Profile:
-    return Profile(kind="constant", spec=value, variable=variable, domain=domain,
-                   evaluate=lambda v: np.full(v.shape, value))
+def history_form_of(spec: Any) -> tuple[str, dict[str, float]] | None:
+    """The screen's form of a load history given as a spec, and its numbers (``value``
+    and those the form ``uses`` of second, time), or ``None`` when no form shows it."""
+    return _form_of(spec, "histories")
 
 
-def _sine_crests(lo: float, hi: float, wavelength: float, phase: float) -> tuple[float, ...]:
-    # crests and troughs where 2 pi v / L + phi = pi/2 + k pi; beyond the first few the
-    # domain holds full periods and both extremes have been seen already
-    first = (2 * math.pi * lo / wavelength + phase - math.pi / 2) / math.pi
-    if not math.isfinite(first) or abs(first) > 1e15:
-        # crests too dense to place (the values there are noise anyway); the grid decides
-        return ()
-    ks = math.ceil(first) + np.arange(8)
-    with np.errstate(all="ignore"):  # a huge wavelength overflows: such points are dropped
-        v = (math.pi / 2 + ks * math.pi - phase) * wavelength / (2 * math.pi)
-    return tuple(float(p) for p in v if lo <= p <= hi)
+def without_offset(profile: Profile) -> Profile:
+    """The profile less a constant part that its family separates exactly.
 
-
-def _formula_breakpoints(expression: Expression, lo: float, hi: float) -> list[float]:
-    """Where the formula's switching functions change sign (see
-    ``Expression.switching_functions``): zeros at grid points that border a non-zero
-    sample, and sign changes between samples located by bisection."""
-    grid = np.linspace(lo, hi, FORMULA_BREAK_SAMPLES)
-    found: list[float] = []
-    seen: set[str] = set()
-    for g in expression.switching_functions:
-        if g.text in seen:
-            continue
-        seen.add(g.text)
-        values = g(grid)
-        zero = values == 0
-        # a zero run (min(x, x), ...) switches nothing inside, only where it starts or ends
-        border = np.zeros_like(zero)
-        border[1:] |= ~zero[:-1]
-        border[:-1] |= ~zero[1:]
-        found.extend(grid[1:-1][(zero & border)[1:-1]].tolist())
-        s = np.sign(values)
-        change = np.isfinite(values[:-1]) & np.isfinite(values[1:]) & (s[:-1] * s[1:] < 0)
-        index = np.nonzero(change)[0]
-        if index.size == 0:
-            continue
-        a, b = grid[index].copy(), grid[index + 1].copy()
-        sa = s[index]
-        # bisection needs only a sign change, so it also finds jumps of g; it stops when
-        # every bracket is down to adjacent floating-point numbers
-        for _ in range(64):
-            mid = 0.5 * (a + b)
-            open_ = (mid > a) & (mid < b)
-            if not open_.any():
-                break
-            same = np.sign(g(mid)) == sa
-            a = np.where(open_ & same, mid, a)
-            b = np.where(open_ & ~same, mid, b)
-        found.extend(b.tolist())
-    return found
-
-
-class _SlopeOverflow(Exception):
-    """A table's pchip slopes are not finite (caught and named by the caller)."""
-
-
-def _table(points: list[tuple[float, float]], interpolation: str, variable: str,
-           domain: tuple[float, float], spec: dict[str, Any]) -> Profile:
-    xs = np.array([p[0] for p in points])
-    ys = np.array([p[1] for p in points])
-    lo, hi = domain
-    evaluate: Callable[[np.ndarray], Any]
-    if interpolation == "linear":
-        def evaluate(v: np.ndarray) -> Any:
-            return np.interp(v, xs, ys)
-        # the table's own ends are kinks too when inside the domain (held constant beyond)
-        breaks: tuple[float, ...] = tuple(xs.tolist())
-        extra: tuple[float, ...] = ()
-    elif interpolation == "step":
-        def evaluate(v: np.ndarray) -> Any:
-            index = np.clip(np.searchsorted(xs, v, side="right") - 1, 0, len(xs) - 1)
-            return ys[index]
-        breaks = tuple(xs[1:].tolist())
-        extra = ()
-    else:
-        with np.errstate(all="ignore"):
-            try:
-                # imported here: scipy.interpolate is 2/3 of a cold CLI start's imports
-                from scipy.interpolate import PchipInterpolator
-
-                interpolant = PchipInterpolator(xs, ys, extrapolate=False)
-            except ValueError:
-                # SciPy refuses slopes that overflow (rows ~1e-300 apart): refused here
-                # with the field named by the caller
-                raise _SlopeOverflow from None
-        x0, x1 = float(xs[0]), float(xs[-1])
-
-        y0, y1 = float(ys[0]), float(ys[-1])
-
-        def evaluate(v: np.ndarray) -> Any:
-            # the last piece evaluated at its right end is off by rounding; hold exact ends
-            inner = interpolant(np.clip(v, x0, x1))
-            return np.where(v <= x0, y0, np.where(v >= x1, y1, inner))
-        # pchip is C1 between its ends; it is monotone between rows, so its extremes
-        # lie at rows
-        breaks = (x0, x1)
-        extra = tuple(float(p) for p in xs if lo <= p <= hi)
-    return Profile(kind="table", spec=spec, variable=variable, domain=domain,
-                   evaluate=evaluate, breakpoints=breaks, extra=extra)
+    ``constant`` gives 0; ``sine`` and ``bump`` drop ``mean``, ``polynomial`` its
+    constant coefficient, ``linear``, ``step`` and ``table`` their first value (the
+    differences of nearby values are exact in floating point). Other families are kept
+    as they are. Only differences of the result are meaningful.
+    """
+    offset = FAMILIES[profile.kind].offset
+    if offset is None:
+        return profile
+    return profile_from_spec(offset(profile.spec), field="gap", variable=profile.variable,
+                             domain=profile.domain)
 
 
 def profile_from_spec(spec: Any, *, field: str, variable: str = "x",
@@ -446,9 +380,8 @@ def profile_from_spec(spec: Any, *, field: str, variable: str = "x",
     ``step`` breaks must lie strictly inside. Values keep the unit of the quantity.
     Raises ValueError whose message starts with ``field`` (or ``field.sub.path``).
     """
-    variable = _check_variable(variable)
+    variable = _check_variable(variable, field)
     domain = _check_domain(domain, field)
-    lo, hi = domain
     if not isinstance(spec, Mapping):
         if isinstance(spec, (bool, np.bool_)) or not isinstance(
                 spec, (int, float, np.integer, np.floating)):
@@ -456,8 +389,7 @@ def profile_from_spec(spec: Any, *, field: str, variable: str = "x",
                              f"not {_json_type(spec)}")
         return _constant(_number(spec, field), variable, domain)
 
-    short = "kind" not in spec and "expr" in spec
-    if short:
+    if "kind" not in spec and "expr" in spec:
         kind = "expr"
     else:
         if "kind" not in spec:
@@ -466,134 +398,11 @@ def profile_from_spec(spec: Any, *, field: str, variable: str = "x",
         kind = spec["kind"]
         if not isinstance(kind, str):
             raise ValueError(f"{field}.kind: must be a string, not {_json_type(kind)}")
-        if kind not in _FIELDS:
+        if kind not in FAMILIES:
             raise ValueError(f"{field}.kind: unknown kind {kind[:40]!r}; "
                              f"known kinds: {', '.join(KINDS)}")
     _check_fields(spec, kind, field)
-
-    def num(key: str) -> float:
-        return _number(spec[key], f"{field}.{key}")
-
-    if kind == "constant":
-        return _constant(num("value"), variable, domain)
-
-    if kind == "linear":
-        start, end = num("start"), num("end")
-        span = hi - lo
-        # weights that are exactly 1 and 0 at the ends, so y(lo) = start and y(hi) = end
-        return Profile(kind=kind, spec={"kind": kind, "start": start, "end": end},
-                       variable=variable, domain=domain,
-                       evaluate=lambda v: start * ((hi - v) / span) + end * ((v - lo) / span))
-
-    if kind == "step":
-        breaks = _numbers(spec["breaks"], f"{field}.breaks", least=0, most=MAX_TABLE_ROWS)
-        values = _numbers(spec["values"], f"{field}.values", least=1,
-                          most=MAX_TABLE_ROWS + 1)
-        if len(values) != len(breaks) + 1:
-            raise ValueError(f"{field}.values: must have one entry more than breaks "
-                             f"({len(breaks) + 1}), has {len(values)}")
-        for i, b in enumerate(breaks):
-            if not lo < b < hi:
-                raise ValueError(f"{field}.breaks[{i}]: must lie strictly inside the domain "
-                                 f"({_fmt(lo)}, {_fmt(hi)}) of {variable}, is {_fmt(b)}")
-        _strictly_increasing(breaks, f"{field}.breaks", variable, "entry")
-        b_arr, y_arr = np.array(breaks), np.array(values)
-        return Profile(kind=kind, spec={"kind": kind, "values": values, "breaks": breaks},
-                       variable=variable, domain=domain, breakpoints=tuple(breaks),
-                       evaluate=lambda v: y_arr[np.searchsorted(b_arr, v, side="right")])
-
-    if kind == "sine":
-        mean, amplitude = num("mean"), num("amplitude")
-        wavelength = _positive(spec["wavelength"], f"{field}.wavelength")
-        phase = _number(spec.get("phase", 0.0), f"{field}.phase")
-        k = 2 * math.pi / wavelength
-        return Profile(kind=kind, spec={"kind": kind, "mean": mean, "amplitude": amplitude,
-                                        "wavelength": wavelength, "phase": phase},
-                       variable=variable, domain=domain,
-                       extra=_sine_crests(lo, hi, wavelength, phase),
-                       evaluate=lambda v: mean + amplitude * np.sin(k * v + phase))
-
-    if kind == "polynomial":
-        coefficients = _numbers(spec["coefficients"], f"{field}.coefficients", least=1,
-                                most=MAX_POLYNOMIAL_COEFFICIENTS, what="coefficients")
-        c = np.array(coefficients)
-        extra: tuple[float, ...] = ()
-        with np.errstate(all="ignore"):  # coefficients near the float limit overflow: NaN
-            derivative = np.polynomial.polynomial.polyder(c)
-        if np.all(np.isfinite(derivative)) and np.any(derivative != 0):
-            try:
-                with np.errstate(all="ignore"):
-                    roots = np.polynomial.polynomial.polyroots(np.trim_zeros(derivative, "b"))
-            except np.linalg.LinAlgError:
-                # extreme coefficient ratios overflow the companion matrix; the grid decides
-                roots = np.array([])
-            real = roots.real[np.abs(roots.imag) <= 1e-9 * (1 + np.abs(roots.real))]
-            extra = tuple(float(r) for r in real if lo <= r <= hi)
-        return Profile(kind=kind, spec={"kind": kind, "coefficients": coefficients},
-                       variable=variable, domain=domain, extra=extra,
-                       evaluate=lambda v: np.polynomial.polynomial.polyval(v, c))
-
-    if kind == "bump":
-        mean, amplitude, center = num("mean"), num("amplitude"), num("center")
-        width = _positive(spec["width"], f"{field}.width")
-        return Profile(kind=kind, spec={"kind": kind, "mean": mean, "amplitude": amplitude,
-                                        "center": center, "width": width},
-                       variable=variable, domain=domain, extra=(center,),
-                       evaluate=lambda v: mean + amplitude * np.exp(-((v - center) / width)
-                                                                    ** 2))
-
-    if kind == "ramp":
-        start, end = num("start"), num("end")
-        duration = _positive(spec["duration"], f"{field}.duration")
-        return Profile(kind=kind, spec={"kind": kind, "start": start, "end": end,
-                                        "duration": duration},
-                       variable=variable, domain=domain, breakpoints=(lo + duration,),
-                       evaluate=lambda v: start + (end - start)
-                       * np.clip((v - lo) / duration, 0.0, 1.0))
-
-    if kind == "table":
-        rows = _list(spec["points"], f"{field}.points", least=2, most=MAX_TABLE_ROWS,
-                     what="rows")
-        points: list[tuple[float, float]] = []
-        for i, row in enumerate(rows):
-            path = f"{field}.points[{i}]"
-            if isinstance(row, np.ndarray):
-                row = row.tolist()
-            if not isinstance(row, (list, tuple)) or len(row) != 2:
-                raise ValueError(f"{path}: must be a pair [{variable}, value], "
-                                 f"not {_json_type(row)}"
-                                 + (f" of {len(row)}" if isinstance(row, (list, tuple))
-                                    else ""))
-            points.append((_number(row[0], f"{path}[0]"), _number(row[1], f"{path}[1]")))
-        _strictly_increasing([p[0] for p in points], f"{field}.points", variable, "row")
-        interpolation = spec.get("interpolation", "linear")
-        if not isinstance(interpolation, str) or interpolation not in INTERPOLATIONS:
-            shown = (repr(interpolation[:40]) if isinstance(interpolation, str)
-                     else _json_type(interpolation))
-            raise ValueError(f"{field}.interpolation: must be one of "
-                             f"{', '.join(INTERPOLATIONS)}, is {shown}")
-        canonical = {"kind": kind, "points": [list(p) for p in points],
-                     "interpolation": interpolation}
-        try:
-            return _table(points, interpolation, variable, domain, canonical)
-        except _SlopeOverflow:
-            raise ValueError(f"{field}.points: the slopes between rows overflow a double "
-                             "(rows too close together for 'pchip'); spread them or use "
-                             "'linear'") from None
-
-    # kind == "expr"
-    text = spec["expr"]
-    if not isinstance(text, str):
-        raise ValueError(f"{field}.expr: must be a string (a formula in {variable}), "
-                         f"not {_json_type(text)}")
-    expression = parse_expression(text, (variable,), field=f"{field}.expr")
-    if expression.is_constant:
-        breaks_found: list[float] = []
-    else:
-        breaks_found = _formula_breakpoints(expression, lo, hi)
-    return Profile(kind="expr", spec={"kind": "expr", "expr": expression.text},
-                   variable=variable, domain=domain, breakpoints=tuple(breaks_found),
-                   evaluate=expression)
+    return FAMILIES[kind].build(spec, _At(field, variable, domain))
 
 
 # ----------------------------------------------------------------------------- range check
@@ -618,144 +427,26 @@ def check_range(profile: Profile, *, field: str, domain: tuple[float, float] | N
     with np.errstate(all="ignore"):
         values = profile(points)
     var = profile.variable
-    bad = ~np.isfinite(values)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise ValueError(f"{field}: must be finite, is {values[i]} at {var} = "
-                         f"{_fmt(points[i])}")
+    refuse_first(~np.isfinite(values), lambda i: (
+        f"{field}: must be finite, is {values[i]} at {var} = {_fmt(points[i])}"))
+    rules = []
     if lower is not None:
-        bad = values < lower if lower_inclusive else values <= lower
-        if bad.any():
-            i = int(np.argmax(bad))
-            op = ">=" if lower_inclusive else ">"
-            raise ValueError(f"{field}: must be {op} {_fmt(lower)}, is {_fmt(values[i])} at "
-                             f"{var} = {_fmt(points[i])}")
+        rules.append((values < lower if lower_inclusive else values <= lower,
+                      f"{'>=' if lower_inclusive else '>'} {_fmt(lower)}"))
     if upper is not None:
-        bad = values > upper if upper_inclusive else values >= upper
-        if bad.any():
-            i = int(np.argmax(bad))
-            op = "<=" if upper_inclusive else "<"
-            raise ValueError(f"{field}: must be {op} {_fmt(upper)}, is {_fmt(values[i])} at "
-                             f"{var} = {_fmt(points[i])}")
+        rules.append((values > upper if upper_inclusive else values >= upper,
+                      f"{'<=' if upper_inclusive else '<'} {_fmt(upper)}"))
+    for bad, rule in rules:
+        refuse_first(bad, lambda i, rule=rule: (
+            f"{field}: must be {rule}, is {_fmt(values[i])} at {var} = {_fmt(points[i])}"))
 
 
-# ----------------------------------------------------------------------------- CSV upload
 
-# Unambiguous (no nested quantifiers), so matching is linear in the cell length.
-_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+def __getattr__(name: str) -> Any:
+    # profile_from_csv lives in core.profile_csv, which builds on this module: loaded on
+    # first use, so that either module may be imported first
+    if name == "profile_from_csv":
+        from core.profile_csv import profile_from_csv
 
-
-def _split(line: str, separator: str | None) -> list[str]:
-    if separator is None:
-        cells = line.split()
-    else:
-        cells = [c.strip() for c in line.split(separator)]
-        while cells and cells[-1] == "":  # spreadsheets often end rows with a separator
-            cells.pop()
-    if separator == ";":
-        # semicolon files come from locales that write a decimal comma
-        cells = [c.replace(",", ".") for c in cells]
-    return cells
-
-
-def _cell_number(cell: str) -> float | None:
-    if len(cell) > 400 or not _NUMBER.fullmatch(cell):
-        return None
-    return float(cell)
-
-
-#: Largest CSV table accepted for a profile [bytes] (1 MB).
-MAX_TABLE_BYTES = limits.MAX_TABLE_BYTES
-
-
-def profile_from_csv(data: bytes | str, *, field: str, variable: str = "x",
-                     domain: tuple[float, float], interpolation: str = "linear",
-                     max_bytes: int = MAX_TABLE_BYTES, max_rows: int = MAX_TABLE_ROWS,
-                     max_breakpoints: int | None = None) -> Profile:
-    """A table profile from an uploaded CSV file of two numeric columns.
-
-    Columns: the variable (unit of the variable) and the value (unit of the quantity).
-    Cells are separated by commas, semicolons (then a decimal comma is accepted) or
-    white space; one header line is allowed; blank lines are skipped. The result is the
-    ``table`` profile with ``interpolation``. Raises ValueError naming ``field`` and the
-    1-based line for: a file over ``max_bytes`` bytes, over ``max_rows`` data rows, fewer
-    than 2 rows, a wrong number of columns, a cell that is not a number, values not
-    strictly increasing in the variable; and naming the limit for a table with more
-    than ``max_breakpoints`` points inside the domain where its value or slope jumps
-    (default: :data:`core.limits.MAX_BREAKPOINTS` for an x-profile, which the solver
-    allows for a whole scene, so such a table could never be solved; none for ``t``).
-    """
-    if isinstance(data, (bytes, bytearray, memoryview)):
-        raw = bytes(data)
-        if len(raw) > max_bytes:
-            raise ValueError(f"{field}: file is too large ({len(raw)} bytes, at most "
-                             f"{max_bytes})")
-        if b"\x00" in raw:
-            raise ValueError(f"{field}: file is not text (upload a plain CSV file)")
-        try:
-            text = raw.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            # only the header can hold non-ASCII text, and it is not used
-            text = raw.decode("latin-1")
-    elif isinstance(data, str):
-        if len(data) > max_bytes or len(data.encode("utf-8", "replace")) > max_bytes:
-            raise ValueError(f"{field}: file is too large (more than {max_bytes} bytes)")
-        text = data.removeprefix("\ufeff")
-    else:
-        raise ValueError(f"{field}: file content must be bytes or text, not "
-                         f"{_json_type(data)}")
-
-    lines = [(n, line.strip()) for n, line in enumerate(text.splitlines(), start=1)]
-    lines = [(n, line) for n, line in lines if line]
-    if not lines:
-        raise ValueError(f"{field}: file is empty")
-    first = lines[0][1]
-    separator = ";" if ";" in first else "," if "," in first else None
-    first_cells = _split(first, separator)
-    if not first_cells or any(_cell_number(c) is None for c in first_cells):
-        lines = lines[1:]  # a header; later lines must all be data
-        if lines:
-            first = lines[0][1]
-            separator = ";" if ";" in first else "," if "," in first else None
-    if len(lines) > max_rows:
-        raise ValueError(f"{field}: file has too many rows ({len(lines)}, at most "
-                         f"{max_rows})")
-    if len(lines) < 2:
-        raise ValueError(f"{field}: file needs at least 2 data rows, has {len(lines)}")
-
-    points: list[list[float]] = []
-    for n, line in lines:
-        cells = _split(line, separator)
-        row = []
-        for column, cell in enumerate(cells, start=1):
-            value = _cell_number(cell)
-            if value is None:
-                shown = cell if len(cell) <= 40 else cell[:40] + "..."
-                raise ValueError(f"{field}: line {n}, column {column}: {shown!r} is not a "
-                                 "number")
-            if not math.isfinite(value):
-                raise ValueError(f"{field}: line {n}, column {column}: {cell[:40]!r} is out "
-                                 "of range")
-            row.append(value)
-        if len(row) != 2:
-            shown = "white space" if separator is None else repr(separator)
-            raise ValueError(f"{field}: line {n}: expected 2 columns separated by {shown}, "
-                             f"found {len(row)}")
-        if points and not row[0] > points[-1][0]:
-            raise ValueError(f"{field}: {variable} values must be strictly increasing "
-                             f"(line {n}: {_fmt(row[0])} after {_fmt(points[-1][0])})")
-        points.append(row)
-    profile = profile_from_spec({"kind": "table", "points": points,
-                                 "interpolation": interpolation},
-                                field=field, variable=variable, domain=domain)
-    if max_breakpoints is None and variable == "x":
-        max_breakpoints = limits.MAX_BREAKPOINTS
-    jumps = len(profile.breakpoints)
-    if max_breakpoints is not None and jumps > max_breakpoints:
-        raise ValueError(
-            f"{field}: a table of {len(points)} rows with {interpolation!r} interpolation "
-            f"has {jumps} points inside the domain where its value or slope jumps, more "
-            f"than the {max_breakpoints} the solver allows in a whole scene: use at most "
-            f"{max_breakpoints} rows inside the domain, or 'pchip' interpolation (smooth "
-            "between its end rows)")
-    return profile
+        return profile_from_csv
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -48,28 +48,13 @@ from core.projection_levels import (
     _Superposition,
 )
 from core.projection_stages import _discretize, _Inputs, _modes, _validate
-from core.stage_caches import (
-    _BASIS,
-    _CORRECTION,
-    _GALERKIN,
-    _GAP,
-    _MODES,
-    _OPERATOR,
-    _PANELS,
-    _RESPONSE,
-    _SAMPLE_ROWS,
-    _STAGES,
-    STAGE_CACHE_BYTES,
-    set_stage_cache_budget,
-)
+from core.stage_caches import _STAGES, STAGE_CACHE_BYTES, set_stage_cache_budget
 from core.statements import QUANTITIES, statement_number
 
 # Re-exported: modules, tests and benchmarks import these from here since before the split.
 __all__ = ["ContactSolution", "solve_dimensionless", "set_stage_cache_budget",
            "STAGE_CACHE_BYTES", "QUANTITIES", "MODE_LEVELS", "BASIS_CAPS",
-           "DIRECT_LARGEST_BELOW", "ERROR_FLOOR", "SUCCESS_MARGIN", "_validate", "_STAGES",
-           "_PANELS", "_OPERATOR", "_BASIS", "_GALERKIN", "_CORRECTION", "_GAP", "_MODES",
-           "_RESPONSE", "_SAMPLE_ROWS"]
+           "DIRECT_LARGEST_BELOW", "ERROR_FLOOR", "SUCCESS_MARGIN", "_validate", "_STAGES"]
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 

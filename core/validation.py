@@ -19,6 +19,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 #: Integers with more digits are quoted by their first digits and their length, so that a
 #: 4000-digit integer (valid JSON) still gives a one-line message.
 MAX_QUOTED_DIGITS = 40
@@ -122,3 +124,24 @@ def nonnegative_number(value: Any, field: str, *, style: Style = JSON_STYLE) -> 
     if x < 0:
         raise ValueError(f"{field}: must be >= 0, got {style.show(value)}")
     return x
+
+
+def bounded_list(value: Any, field: str, *, least: int, most: int, what: str,
+                 style: Style = JSON_STYLE) -> list | tuple:
+    """``value`` if it is a list (or tuple) of ``least`` to ``most`` entries, else a
+    ValueError starting with ``field`` (``what`` names the entries: "layers", "terms")."""
+    # a string is a sequence to Python, but a list of its characters is never meant
+    if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)):
+        raise ValueError(f"{field}: must be a list of {what}, got {style.show(value)}")
+    if not least <= len(value) <= most:
+        raise ValueError(f"{field}: must hold {least} to {most} {what}, got {len(value)}")
+    return value
+
+
+def refuse_first(bad: Any, message: Callable[[int], str]) -> None:
+    """Raise ``ValueError(message(i))`` for the first (flat) index ``i`` where the boolean
+    array ``bad`` is true; nothing when it is false everywhere. ``message`` names the
+    field and quotes the values at ``i``."""
+    flags = np.asarray(bad, dtype=bool).ravel()
+    if flags.any():
+        raise ValueError(message(int(np.argmax(flags))))

@@ -11,6 +11,7 @@ import os
 import signal
 import socket
 import sys
+from typing import Any
 
 # The solver works on small dense matrices from several threads at once; BLAS threads on
 # top of those only fight for the cores (a cold solve measured 1.5 s instead of 0.09 s on
@@ -113,27 +114,50 @@ def main(argv: list[str] | None = None) -> int:
     print(f"Serving the explorer at http://{args.address}:{args.port}/app", file=sys.stderr,
           flush=True)
     linger_ms = int(args.session_linger * 1000)
-    # SIGTERM (a service manager, a test harness) ends the server like Ctrl+C: the event
-    # loop unwinds and the worker processes are stopped in order.
-    previous = signal.signal(signal.SIGTERM, _stop_on_sigterm)
     try:
-        pn.serve({"app": create_app}, port=args.port, address=args.address, show=args.show,
-                 websocket_origin=origins, title="Coated punch explorer", threaded=False,
-                 liveness=True, start=True, websocket_max_message_size=WEBSOCKET_MAX_BYTES,
-                 unused_session_lifetime_milliseconds=linger_ms,
-                 check_unused_sessions_milliseconds=linger_ms)
+        _serve(pn, {"app": create_app}, port=args.port, address=args.address,
+               show=args.show, websocket_origin=origins, title="Coated punch explorer",
+               liveness=True, websocket_max_message_size=WEBSOCKET_MAX_BYTES,
+               unused_session_lifetime_milliseconds=linger_ms,
+               check_unused_sessions_milliseconds=linger_ms)
     except KeyboardInterrupt:
-        pass
+        pass  # Ctrl+C during the server's set-up
     finally:
-        signal.signal(signal.SIGTERM, previous)
         processes = worker_processes()
         if processes is not None:
             processes.shutdown()
     return 0
 
 
-def _stop_on_sigterm(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt
+def _serve(pn: Any, apps: dict[str, Any], **options: Any) -> None:
+    """Serve ``apps`` with Panel until SIGTERM or SIGINT, then stop the server in order.
+
+    Both signals are handled by the event loop (``add_signal_handler``): the handler runs
+    as one of the loop's callbacks and stops the loop there, and a signal that comes
+    before the loop runs stops it as soon as it starts. A Python handler that raises
+    KeyboardInterrupt instead runs between any two bytecodes of the main thread, also
+    inside a weakref callback or a finaliser, where Python prints the exception
+    ("Exception ignored in ...") and drops it: the server printed a traceback and kept
+    serving until it was killed.
+    """
+    from tornado.ioloop import IOLoop
+
+    io_loop = IOLoop.current()
+    loop = io_loop.asyncio_loop
+    loop.add_signal_handler(signal.SIGTERM, io_loop.stop)
+    try:
+        server = pn.serve(apps, threaded=False, start=False, loop=io_loop, **options)
+        # after pn.serve, which sets a SIGINT handler of its own
+        loop.add_signal_handler(signal.SIGINT, io_loop.stop)
+        try:
+            server.start()
+            io_loop.start()
+        finally:
+            # closes the listening socket and the sessions' connections, stops the callbacks
+            server.stop()
+    finally:
+        for signum in (signal.SIGTERM, signal.SIGINT):
+            loop.remove_signal_handler(signum)
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ from typing import Any
 import param
 
 from core.coating_model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
+from core.profiles import HISTORY_FORMS, VARIATIONS, history_form_of, variation_of
 from core.scene import QUANTITIES
 
 from .creep_view import CODE_CREEP_MODELS, CodeCreepState
@@ -91,7 +92,7 @@ class ProfileState(param.Parameterized):
     """
 
     kind = param.Selector(
-        default="none", objects=["none", "linear", "step", "patch", "sine", "bump", "custom"],
+        default="none", objects=[*VARIATIONS, "custom"],
         doc="Variation across the punch: none, linear (left to right), a step at a "
             "position, a patch (a band of another value), sine, bump, or custom (a table "
             "or formula from a file).")
@@ -131,73 +132,24 @@ class ProfileState(param.Parameterized):
     def to_spec(self) -> float | dict[str, Any]:
         """The profile spec in SI units (a number or a dict of the scene schema)."""
         m = self.mean * self.scale
-        amp = self._amplitude_si(m)
-        if self.kind == "linear":
-            return {"kind": "linear", "start": m - amp, "end": m + amp}
-        if self.kind == "step":
-            return {"kind": "step", "values": [m - amp, m + amp], "breaks": [self.position]}
-        if self.kind == "patch":
-            half = 0.5 * self.length
-            return {"kind": "step", "values": [m, m + amp, m],
-                    "breaks": [self.position - half, self.position + half]}
-        if self.kind == "sine":
-            return {"kind": "sine", "mean": m, "amplitude": amp,
-                    "wavelength": self.length, "phase": 0.0}
-        if self.kind == "bump":
-            return {"kind": "bump", "mean": m, "amplitude": amp,
-                    "center": self.position, "width": self.length}
-        if self.kind == "custom" and self.custom is not None:
-            return copy.deepcopy(self.custom)
-        return m
+        if self.kind == "custom":
+            return m if self.custom is None else copy.deepcopy(self.custom)
+        return VARIATIONS[self.kind].spec({"level": m, "amplitude": self._amplitude_si(m),
+                                           "position": self.position, "length": self.length})
 
     def load_spec(self, spec: Any) -> None:
         """Set the state from an SI spec; anything else is kept as a ``custom`` profile."""
-        s = self.scale
-        values: dict[str, Any] = {"custom": None}
-        kind = spec.get("kind") if isinstance(spec, dict) else None
-        nums = (lambda *keys: all(_is_number(spec.get(k)) for k in keys)) if kind else None
-        steps = spec.get("values", []) if kind == "step" else []
-        breaks = spec.get("breaks", []) if kind == "step" else []
-        parsed: dict[str, Any] | None = None
-        if _is_number(spec):
-            parsed = {"kind": "none", "mean": spec / s}
-        elif kind == "constant" and nums("value") and len(spec) == 2:
-            # the long form of a constant reads back as a plain number, which is the same
-            parsed = {"kind": "none", "mean": spec["value"] / s}
-        elif kind == "linear" and nums("start", "end"):
-            m = 0.5 * (spec["start"] + spec["end"])
-            amp = self._amplitude_from(m, 0.5 * (spec["end"] - spec["start"]))
-            if amp is not None:
-                parsed = {"kind": "linear", "mean": m / s, "amplitude": amp}
-        elif (kind == "step" and len(steps) == 2 and len(breaks) == 1
-              and all(_is_number(v) for v in steps)):
-            m = 0.5 * (steps[0] + steps[1])
-            amp = self._amplitude_from(m, 0.5 * (steps[1] - steps[0]))
-            if amp is not None:
-                parsed = {"kind": "step", "mean": m / s, "amplitude": amp,
-                          "position": breaks[0]}
-        elif (kind == "step" and len(steps) == 3 and len(breaks) == 2
-              and all(_is_number(v) for v in steps) and steps[0] == steps[2]):
-            m = steps[0]
-            amp = self._amplitude_from(m, steps[1] - m)
-            if amp is not None:
-                parsed = {"kind": "patch", "mean": m / s, "amplitude": amp,
-                          "position": 0.5 * (breaks[0] + breaks[1]),
-                          "length": breaks[1] - breaks[0]}
-        elif kind == "sine" and nums("mean", "amplitude", "wavelength") and spec.get(
-                "phase", 0.0) == 0:
-            amp = self._amplitude_from(spec["mean"], spec["amplitude"])
-            if amp is not None:
-                parsed = {"kind": "sine", "mean": spec["mean"] / s, "amplitude": amp,
-                          "length": spec["wavelength"]}
-        elif kind == "bump" and nums("mean", "amplitude", "center", "width"):
-            amp = self._amplitude_from(spec["mean"], spec["amplitude"])
-            if amp is not None:
-                parsed = {"kind": "bump", "mean": spec["mean"] / s, "amplitude": amp,
-                          "position": spec["center"], "length": spec["width"]}
-        if parsed is None:
-            parsed = {"kind": "custom", "custom": copy.deepcopy(spec)}
-        values.update(parsed)
+        values: dict[str, Any] = {"kind": "custom", "custom": copy.deepcopy(spec)}
+        found = variation_of(spec)
+        if found is not None:
+            name, numbers = found
+            level = numbers["level"]
+            amp = self._amplitude_from(level, numbers.get("amplitude", 0.0))
+            if amp is not None or "amplitude" not in numbers:  # None: % of a zero level
+                values = {**numbers, "kind": name, "custom": None, "mean": level / self.scale}
+                del values["level"]
+                if "amplitude" in numbers:
+                    values["amplitude"] = amp
         self.param.update(**values)
 
 
@@ -436,8 +388,7 @@ class BaseState(param.Parameterized):
 class HistoryState(param.Parameterized):
     """The history of one loading quantity, ``t`` in days after loading (display units)."""
 
-    kind = param.Selector(default="constant", objects=["constant", "ramp", "step", "sine",
-                                                       "custom"],
+    kind = param.Selector(default="constant", objects=[*HISTORY_FORMS, "custom"],
                           doc="Shape of the history.")
     value = param.Number(default=0.0, doc="Main level: the constant, the ramp's final "
                                           "value, the value before a step, the sine's mean.")
@@ -453,37 +404,21 @@ class HistoryState(param.Parameterized):
         self.unit, self.scale = QUANTITY_UNITS[quantity]
 
     def to_spec(self) -> float | dict[str, Any]:
-        v, w = self.value * self.scale, self.second * self.scale
-        if self.kind == "ramp":
-            return {"kind": "ramp", "start": w, "end": v, "duration": self.time}
-        if self.kind == "step":
-            return {"kind": "step", "values": [v, w], "breaks": [self.time]}
-        if self.kind == "sine":
-            return {"kind": "sine", "mean": v, "amplitude": w, "wavelength": self.time,
-                    "phase": 0.0}
         if self.kind == "custom" and self.custom is not None:
             return copy.deepcopy(self.custom)
-        return v
+        form = HISTORY_FORMS.get(self.kind, HISTORY_FORMS["constant"])
+        return form.spec({"value": self.value * self.scale, "second": self.second * self.scale,
+                          "time": self.time})
 
     def load_spec(self, spec: Any) -> None:
-        s = self.scale
-        values: dict[str, Any] = {"custom": None}
-        kind = spec.get("kind") if isinstance(spec, dict) else None
-        if _is_number(spec):
-            values.update(kind="constant", value=spec / s)
-        elif kind == "constant" and _is_number(spec.get("value")) and len(spec) == 2:
-            values.update(kind="constant", value=spec["value"] / s)
-        elif kind == "ramp":
-            values.update(kind="ramp", value=spec["end"] / s, second=spec["start"] / s,
-                          time=spec["duration"])
-        elif kind == "step" and len(spec["values"]) == 2 and len(spec["breaks"]) == 1:
-            values.update(kind="step", value=spec["values"][0] / s,
-                          second=spec["values"][1] / s, time=spec["breaks"][0])
-        elif kind == "sine" and spec.get("phase", 0) == 0:
-            values.update(kind="sine", value=spec["mean"] / s, second=spec["amplitude"] / s,
-                          time=spec["wavelength"])
-        else:
-            values.update(kind="custom", custom=copy.deepcopy(spec))
+        values: dict[str, Any] = {"kind": "custom", "custom": copy.deepcopy(spec)}
+        found = history_form_of(spec)
+        if found is not None:
+            name, numbers = found
+            values = {**numbers, "kind": name, "custom": None}
+            for key in ("value", "second"):  # SI to display units; times are days
+                if key in values:
+                    values[key] = values[key] / self.scale
         self.param.update(**values)
 
 

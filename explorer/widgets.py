@@ -16,6 +16,8 @@ from typing import Any
 import panel as pn
 import param
 
+from core.profiles import VARIATIONS
+
 from .state import QUANTITY_RANGES, HistoryState, ProfileState
 
 
@@ -232,15 +234,9 @@ class Binding:
             self._syncing = False
 
 
-PROFILE_KINDS = {
-    "constant": "none",
-    "linear across the punch": "linear",
-    "step at a position": "step",
-    "patch (a band of another value)": "patch",
-    "sine (waviness)": "sine",
-    "bump (local patch)": "bump",
-    "custom (from file)": "custom",
-}
+#: The variations of a function of x offered on screen (label -> name), from core's list.
+PROFILE_KINDS = {**{v.label: v.name for v in VARIATIONS.values()},
+                 "custom (from file)": "custom"}
 
 
 class ProfileEditor:
@@ -295,9 +291,10 @@ class ProfileEditor:
         kind = profile.kind
         custom = kind == "custom" and profile.custom is not None
         if self.variations:
-            self.amplitude.visible = kind in ("linear", "step", "patch", "sine", "bump")
-            self.position.visible = kind in ("step", "patch", "bump")
-            self.length.visible = kind in ("sine", "patch", "bump")
+            uses = VARIATIONS[kind].uses if kind in VARIATIONS else ()
+            self.amplitude.visible = "amplitude" in uses
+            self.position.visible = "position" in uses
+            self.length.visible = "length" in uses
             self.mean.visible = not custom
             note = ("Custom profile from a file (kept as it is). Choose another variation "
                     "to replace it." if custom else "")

@@ -614,3 +614,78 @@ def test_a_pchip_table_whose_slopes_overflow_is_refused_naming_the_field():
             "interpolation": "pchip"}
     with pytest.raises(ValueError, match=r"^punch\.shape\.points: the slopes between rows"):
         profile_from_spec(spec, field="punch.shape", variable="x", domain=(-0.15, 0.25))
+
+
+# ------------------------------------------------------------------------ the registry
+
+#: One spec of each family on D, with a constant part to drop.
+FAMILY_EXAMPLES = {
+    "constant": {"kind": "constant", "value": 2.5},
+    "linear": {"kind": "linear", "start": 1.0, "end": 3.0},
+    "step": {"kind": "step", "values": [1.0, 2.0, 0.5], "breaks": [-0.05, 0.1]},
+    "sine": {"kind": "sine", "mean": 4.0, "amplitude": 1.0, "wavelength": 0.1},
+    "polynomial": {"kind": "polynomial", "coefficients": [5.0, 1.0, -2.0]},
+    "bump": {"kind": "bump", "mean": 3.0, "amplitude": 1.0, "center": 0.05, "width": 0.05},
+    "ramp": {"kind": "ramp", "start": 1.0, "end": 2.0, "duration": 0.1},
+    "table": {"kind": "table", "points": [[-0.1, 7.0], [0.0, 8.0], [0.2, 6.5]]},
+    "expr": {"kind": "expr", "expr": "1 + x**2"},
+}
+
+
+def test_every_family_of_the_registry_is_listed_and_built() -> None:
+    from core.profiles import FAMILIES
+
+    assert tuple(FAMILIES) == KINDS == tuple(FAMILY_EXAMPLES)
+    for kind, spec in FAMILY_EXAMPLES.items():
+        p = profile_from_spec(spec, field="f", variable="x", domain=D)
+        assert p.kind == kind
+        assert profile_from_spec(p.spec, field="f", variable="x", domain=D) == p
+
+
+def test_without_offset_changes_a_profile_by_a_constant_only() -> None:
+    from core.profiles import FAMILIES, without_offset
+
+    for kind, spec in FAMILY_EXAMPLES.items():
+        p = profile_from_spec(spec, field="f", variable="x", domain=D)
+        q = without_offset(p)
+        difference = p(V) - q(V)
+        # rounding of values of size ~5: measured at most 6.7e-16 (linear) here
+        assert np.ptp(difference) <= 1e-14, kind
+        if FAMILIES[kind].offset is None:
+            assert q == p
+        else:
+            assert difference[0] != 0.0, kind  # every example has a constant part
+
+
+def test_each_form_of_the_screen_reads_back_what_it_writes() -> None:
+    from core.profiles import HISTORY_FORMS, VARIATIONS, history_form_of, variation_of
+
+    assert list(VARIATIONS) == ["none", "linear", "step", "patch", "sine", "bump"]
+    assert sorted(HISTORY_FORMS) == ["constant", "ramp", "sine", "step"]
+    cases = [(VARIATIONS, variation_of, {"level": 2.0, "amplitude": 0.5, "position": 0.05,
+                                         "length": 0.1}, "level", "x", D),
+             (HISTORY_FORMS, history_form_of, {"value": 2.0, "second": 0.5, "time": 3.0},
+              "value", "t", (0.0, 10.0))]
+    for registry, form_of, numbers, main, variable, domain in cases:
+        for name, form in registry.items():
+            spec = form.spec(numbers)
+            found = form_of(spec)
+            assert found is not None and found[0] == name
+            assert set(found[1]) == {main, *form.uses}, name
+            assert all(found[1][k] == pytest.approx(numbers[k]) for k in found[1]), name
+            profile_from_spec(spec, field="f", variable=variable, domain=domain)  # valid
+    # what no form shows stays a custom profile on screen
+    for spec in (FAMILY_EXAMPLES["table"], FAMILY_EXAMPLES["expr"], FAMILY_EXAMPLES["ramp"],
+                 {"kind": "sine", "mean": 1.0, "amplitude": 1.0, "wavelength": 1.0,
+                  "phase": 0.5}, {"kind": "step", "values": [1.0, "a"], "breaks": [0.0]},
+                 {"kind": "bump", "mean": 1.0}, {"kind": "nonsense"}, "text", None, True):
+        assert variation_of(spec) is None
+    for spec in (FAMILY_EXAMPLES["table"], {"kind": "ramp", "start": 1.0, "end": None,
+                                            "duration": 1.0}, {"kind": "step"}, False):
+        assert history_form_of(spec) is None
+
+
+def test_a_bad_variable_name_is_refused_naming_the_field() -> None:
+    with pytest.raises(ValueError, match=r"^coating\[0\]\.modulus: the variable name 'sin' "
+                                         r"is not allowed"):
+        profile_from_spec(1.0, field="coating[0].modulus", variable="sin", domain=D)

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-import core.scene as scene_module
+import core.scene_schema as scene_schema
 from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
 from core.cli import main as cli_main
 from core.profiles import profile_from_csv
@@ -417,14 +417,14 @@ def test_older_and_newer_schema_versions_are_migrated_or_explained(monkeypatch) 
         scene_from_dict(edited("schema_version", 1.5))
     # the migration chain: a program reading version 2 brings a version 1 file forward
     # step by step, without changing the caller's dict
-    monkeypatch.setattr(scene_module, "SCHEMA_VERSION", 2)
+    monkeypatch.setattr(scene_schema, "SCHEMA_VERSION", 2)
 
     def one_to_two(d: dict[str, Any]) -> dict[str, Any]:
         out = dict(d)
         out["title"] = out.pop("name")
         return out
 
-    monkeypatch.setitem(scene_module._MIGRATIONS, 1, one_to_two)
+    monkeypatch.setitem(scene_schema._MIGRATIONS, 1, one_to_two)
     old = base_scene()
     new = migrate(old)
     assert new["schema_version"] == 2 and new["title"] == old["name"] and "name" not in new
@@ -618,12 +618,10 @@ def test_a_deeply_nested_link_is_refused() -> None:
 
 
 def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:
-    import panel as pn
-
     import explorer.__main__ as entry
 
-    served: list[dict[str, Any]] = []
-    monkeypatch.setattr(pn, "serve", lambda *a, **k: served.append(k))
+    served: list[dict[str, Any]] = []  # the options pn.serve would be given
+    monkeypatch.setattr(entry, "_serve", lambda pn, apps, **k: served.append(k))
     base = ["--port", "5999", "--warm-up", "none", "--solver-processes", "0"]
     assert entry.main(base) == 0
     assert served[-1]["address"] == "localhost" and served[-1]["websocket_origin"] is None
