@@ -174,7 +174,7 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
         "method": "layered",
         "contact": "full",
         "max_abs_tilt": largest_tilt,
-        "stages": {},
+        "stages": answer.stages,
         "coating_model": "exact layered",
         "layered_model_error": model_error,
     }

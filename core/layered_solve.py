@@ -34,8 +34,10 @@ uses.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.fft import dct
@@ -241,22 +243,33 @@ def _unit_responses(lam: float, matrix: np.ndarray, gap: Gap, breakpoints: Seque
 def _cached_response(half_width: float, layers: Sequence[UniformLayer],
                      base_thickness: float, base_modulus: float, base_poisson: float,
                      gap: Gap, breakpoints: Sequence[float], modes: int,
-                     keys: tuple[str, str]) -> LayeredResponse:
+                     keys: tuple[str, str], built: dict[str, float]) -> LayeredResponse:
     """:func:`layered_response` through the caches of :mod:`core.layered_cache` (``keys``:
-    the stack's and the gap's): a repeat with other loads builds nothing."""
+    the stack's and the gap's): a repeat with other loads builds nothing. Adds the CPU
+    seconds of what it builds to ``built`` (``operator``: the stack's table and Galerkin
+    matrix; ``galerkin``: the unit responses)."""
     stack, gap_id = keys
-    operator_key = (stack, modes)
+
+    def timed(stage: str, compute: Callable[[], Any]) -> Callable[[], Any]:
+        def run() -> Any:
+            start = time.perf_counter()
+            value = compute()
+            built[stage] = built.get(stage, 0.0) + time.perf_counter() - start
+            return value
+        return run
 
     def response() -> LayeredResponse:
-        table, _ = LAYERED_TABLE.get_or_compute(stack, lambda: RegularPartTable(
-            2 * half_width / base_thickness, layers, base_thickness, base_modulus,
-            base_poisson))
-        matrix, _ = LAYERED_OPERATOR.get_or_compute(operator_key, lambda: _operator(
-            half_width, layers, base_thickness, base_modulus, base_poisson, modes, table))
+        table, _ = LAYERED_TABLE.get_or_compute(stack, timed("operator", lambda: (
+            RegularPartTable(2 * half_width / base_thickness, layers, base_thickness,
+                             base_modulus, base_poisson))))
+        matrix, _ = LAYERED_OPERATOR.get_or_compute((stack, modes), timed("operator", lambda: (
+            _operator(half_width, layers, base_thickness, base_modulus, base_poisson, modes,
+                      table))))
         return _unit_responses(half_width / base_thickness, matrix, gap, breakpoints,
                                node_count(half_width, layers, modes))
 
-    return LAYERED_RESPONSE.get_or_compute((stack, modes, gap_id), response)[0]
+    return LAYERED_RESPONSE.get_or_compute((stack, modes, gap_id),
+                                           timed("galerkin", response))[0]
 
 
 @dataclass(frozen=True)
@@ -265,7 +278,8 @@ class LayeredAnswer:
     ``settlement`` delta*, ``tilt`` alpha, ``force`` P*, ``moment`` M*; ``response`` gives
     the pressure; ``error_estimate`` [-] the relative error of the unknowns and of q on
     ``|t| <= 0.9`` (as :func:`core.solver.solve_dimensionless` measures them);
-    ``errors`` per quantity; ``modes``."""
+    ``errors`` per quantity; ``modes``; ``stages``: per stage (``operator``, ``galerkin``,
+    ``solve``) the seconds this call spent and whether it was ``cached``."""
 
     settlement: np.ndarray
     tilt: np.ndarray
@@ -275,6 +289,7 @@ class LayeredAnswer:
     error_estimate: float
     errors: dict[str, float]
     modes: int
+    stages: dict[str, dict[str, float | bool]] = field(default_factory=dict)
 
 
 def _differences(response: LayeredResponse, given: dict[str, np.ndarray],
@@ -325,10 +340,12 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
     keys = (stack_key(half_width, layers, base_thickness, base_modulus, base_poisson),
             gap_key(gap, breakpoints))
     modes = min(default_modes(half_width, layers), max_modes)
+    built: dict[str, float] = {}
+    start = time.perf_counter()
     unknowns = [n for n in _NAMES if n not in given]
     while True:
         response = _cached_response(half_width, layers, base_thickness, base_modulus,
-                                    base_poisson, gap, breakpoints, modes, keys)
+                                    base_poisson, gap, breakpoints, modes, keys, built)
         fine = response.complete(given)
         d1 = _differences(response, given, fine, level=1)
         d0 = _differences(response, given, fine, level=2)
@@ -340,8 +357,16 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
         if estimate <= 0.5 * tol or 2 * modes > max_modes:
             break
         modes *= 2
+    # the galerkin stage's time includes the operator it built: report each once
+    built_galerkin = built.get("galerkin", 0.0) - built.get("operator", 0.0)
+    stages = {"operator": {"seconds": built.get("operator", 0.0),
+                           "cached": "operator" not in built},
+              "galerkin": {"seconds": max(built_galerkin, 0.0),
+                           "cached": "galerkin" not in built},
+              "solve": {"seconds": max(time.perf_counter() - start
+                                       - built.get("galerkin", 0.0), 0.0), "cached": False}}
     return LayeredAnswer(fine["settlement"], fine["tilt"], fine["force"], fine["moment"],
-                         response, float(estimate), errors, modes)
+                         response, float(estimate), errors, modes, stages)
 
 
 @dataclass(frozen=True)

@@ -78,3 +78,14 @@ def test_load_changes_reuse_the_geometry_and_a_geometry_change_builds_again() ->
     again = builds()
     assert again["layered_table"] > now["layered_table"]
     assert again["layered_operator"] > now["layered_operator"]
+
+
+def test_the_stage_report_says_what_a_load_change_redid() -> None:
+    clear_caches()
+    scene = rounded_graded({"tilt": 0.0, "force": 8e5})
+    stages = solve(scene).info["stages"]
+    assert not stages["operator"]["cached"] and not stages["galerkin"]["cached"]
+    scene["loading"]["force"] = 7e5
+    stages = solve(scene).info["stages"]
+    assert stages["operator"]["cached"] and stages["galerkin"]["cached"]
+    assert not stages["solve"]["cached"]
