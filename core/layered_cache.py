@@ -28,20 +28,25 @@ import numpy as np
 from core.cache import StageCache, fingerprint
 from core.layered_kernel import UniformLayer
 
-__all__ = ["LAYERED_OPERATOR", "LAYERED_RESPONSE", "LAYERED_TABLE", "gap_key", "stack_key"]
+__all__ = ["LAYERED_BYTES", "LAYERED_OPERATOR", "LAYERED_RESPONSE", "LAYERED_TABLE", "gap_key",
+           "share_budget", "stack_key"]
 
 _MiB = 2**20
 #: Points on which a callable gap is sampled for its key [-].
 GAP_PROBES = 2049
-#: Stacks' tables kept: one table holds panels x (degree + 1) coefficients, ~0.1-1 MiB.
-LAYERED_TABLE = StageCache("layered_table", max_items=8, max_bytes=64 * _MiB,
+#: Stacks' tables kept: one table holds panels x (degree + 1) coefficients (2 KiB for the
+#: rounded_graded preset, more for a base much thinner than the punch).
+LAYERED_TABLE = StageCache("layered_table", max_items=8, max_bytes=16 * _MiB,
                            sizeof=lambda table: int(table.coefficients.nbytes
                                                     + table.edges.nbytes))
 #: Galerkin matrices: modes^2 doubles, 2 MiB at the most modes (512); a solve that doubles
 #: its modes keeps each level, so a handful per geometry.
-LAYERED_OPERATOR = StageCache("layered_operator", max_items=32, max_bytes=64 * _MiB)
+LAYERED_OPERATOR = StageCache("layered_operator", max_items=32, max_bytes=32 * _MiB)
 #: Unit responses: 3 x modes doubles and two coarser copies, a few tens of KiB each.
-LAYERED_RESPONSE = StageCache("layered_response", max_items=256, max_bytes=16 * _MiB)
+LAYERED_RESPONSE = StageCache("layered_response", max_items=256, max_bytes=8 * _MiB)
+#: The caches above with their default bounds [bytes] (:func:`share_budget`).
+_LAYERED = (LAYERED_TABLE, LAYERED_OPERATOR, LAYERED_RESPONSE)
+LAYERED_BYTES = {cache.name: cache.max_bytes for cache in _LAYERED}
 
 
 def stack_key(half_width: float, layers: Sequence[UniformLayer], base_thickness: float,
@@ -63,3 +68,11 @@ def gap_key(gap: Callable[[np.ndarray], np.ndarray] | float | None,
     probe = np.concatenate([probe, at - 1e-9, at + 1e-9])
     values: Any = np.broadcast_to(np.asarray(gap(probe), dtype=float), probe.shape)
     return fingerprint("layered gap", np.ascontiguousarray(values), bps)
+
+
+def share_budget(total_bytes: int, default_total: int) -> None:
+    """Bound each cache here by ``total_bytes / default_total`` of its default bound [-]
+    (a worker process's share of the machine's budget,
+    :func:`core.stage_caches.set_stage_cache_budget`)."""
+    for cache in _LAYERED:
+        cache.max_bytes = max(1, LAYERED_BYTES[cache.name] * total_bytes // default_total)

@@ -89,3 +89,16 @@ def test_the_stage_report_says_what_a_load_change_redid() -> None:
     stages = solve(scene).info["stages"]
     assert stages["operator"]["cached"] and stages["galerkin"]["cached"]
     assert not stages["solve"]["cached"]
+
+
+def test_a_worker_s_budget_bounds_the_layered_caches_too() -> None:
+    from core.layered_cache import LAYERED_BYTES
+    from core.stage_caches import STAGE_CACHE_BYTES, set_stage_cache_budget
+
+    try:
+        set_stage_cache_budget(STAGE_CACHE_BYTES // 4)
+        for name, cache in STAGES.items():
+            assert cache.max_bytes == LAYERED_BYTES[name] // 4, name
+    finally:
+        set_stage_cache_budget(STAGE_CACHE_BYTES)
+    assert all(cache.max_bytes == LAYERED_BYTES[name] for name, cache in STAGES.items())
