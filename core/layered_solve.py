@@ -34,13 +34,15 @@ uses.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from functools import lru_cache
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.fft import dct
 
+from core.layered_cache import LAYERED_OPERATOR, LAYERED_RESPONSE, LAYERED_TABLE, gap_key, stack_key
 from core.layered_kernel import RegularPartTable, UniformLayer, symbol_at_infinity
 
 __all__ = ["FlatPunchStiffness", "LayeredAnswer", "LayeredResponse", "MAX_MODES",
@@ -205,11 +207,27 @@ def layered_response(half_width: float, layers: Sequence[UniformLayer],
     if half_width <= 0 or not np.isfinite(half_width):
         raise ValueError(f"half_width: must be a finite positive number, got {half_width!r}")
     lam = half_width / base_thickness
-    l_inf = symbol_at_infinity(layers, base_modulus, base_poisson)
     if table is None:
         table = RegularPartTable(2 * lam, layers, base_thickness, base_modulus, base_poisson)
     n_nodes = node_count(half_width, layers, modes)
-    matrix = _galerkin_matrix(lam, l_inf, table, modes, n_nodes)
+    matrix = _operator(half_width, layers, base_thickness, base_modulus, base_poisson,
+                       modes, table)
+    return _unit_responses(lam, matrix, gap, breakpoints, n_nodes)
+
+
+def _operator(half_width: float, layers: Sequence[UniformLayer], base_thickness: float,
+              base_modulus: float, base_poisson: float, modes: int,
+              table: RegularPartTable) -> np.ndarray:
+    """The Galerkin matrix of the stack on ``modes`` modes (:func:`_galerkin_matrix`)."""
+    lam = half_width / base_thickness
+    l_inf = symbol_at_infinity(layers, base_modulus, base_poisson)
+    return _galerkin_matrix(lam, l_inf, table, modes, node_count(half_width, layers, modes))
+
+
+def _unit_responses(lam: float, matrix: np.ndarray, gap: Gap, breakpoints: Sequence[float],
+                    n_nodes: int) -> LayeredResponse:
+    """The responses to the gap, a unit settlement and a unit tilt on ``matrix``."""
+    modes = matrix.shape[0]
     rhs = np.zeros((modes, 3))
     if callable(gap):
         rhs[:, 0] = -np.pi * _gap_moments(gap, breakpoints, modes)
@@ -222,13 +240,46 @@ def layered_response(half_width: float, layers: Sequence[UniformLayer],
         np.linalg.solve(matrix[:n, :n], rhs[:n]) for n in blocks), n_nodes)
 
 
+def _cached_response(half_width: float, layers: Sequence[UniformLayer],
+                     base_thickness: float, base_modulus: float, base_poisson: float,
+                     gap: Gap, breakpoints: Sequence[float], modes: int,
+                     keys: tuple[str, str], built: dict[str, float]) -> LayeredResponse:
+    """:func:`layered_response` through the caches of :mod:`core.layered_cache` (``keys``:
+    the stack's and the gap's): a repeat with other loads builds nothing. Adds the CPU
+    seconds of what it builds to ``built`` (``operator``: the stack's table and Galerkin
+    matrix; ``galerkin``: the unit responses)."""
+    stack, gap_id = keys
+
+    def timed(stage: str, compute: Callable[[], Any]) -> Callable[[], Any]:
+        def run() -> Any:
+            start = time.perf_counter()
+            value = compute()
+            built[stage] = built.get(stage, 0.0) + time.perf_counter() - start
+            return value
+        return run
+
+    def response() -> LayeredResponse:
+        table, _ = LAYERED_TABLE.get_or_compute(stack, timed("operator", lambda: (
+            RegularPartTable(2 * half_width / base_thickness, layers, base_thickness,
+                             base_modulus, base_poisson))))
+        matrix, _ = LAYERED_OPERATOR.get_or_compute((stack, modes), timed("operator", lambda: (
+            _operator(half_width, layers, base_thickness, base_modulus, base_poisson, modes,
+                      table))))
+        return _unit_responses(half_width / base_thickness, matrix, gap, breakpoints,
+                               node_count(half_width, layers, modes))
+
+    return LAYERED_RESPONSE.get_or_compute((stack, modes, gap_id),
+                                           timed("galerkin", response))[0]
+
+
 @dataclass(frozen=True)
 class LayeredAnswer:
     """The answer of :func:`solve_layered` (dimensionless, arrays over the load values):
     ``settlement`` delta*, ``tilt`` alpha, ``force`` P*, ``moment`` M*; ``response`` gives
     the pressure; ``error_estimate`` [-] the relative error of the unknowns and of q on
     ``|t| <= 0.9`` (as :func:`core.solver.solve_dimensionless` measures them);
-    ``errors`` per quantity; ``modes``."""
+    ``errors`` per quantity; ``modes``; ``stages``: per stage (``operator``, ``galerkin``,
+    ``solve``) the seconds this call spent and whether it was ``cached``."""
 
     settlement: np.ndarray
     tilt: np.ndarray
@@ -238,6 +289,7 @@ class LayeredAnswer:
     error_estimate: float
     errors: dict[str, float]
     modes: int
+    stages: dict[str, dict[str, float | bool]] = field(default_factory=dict)
 
 
 def _differences(response: LayeredResponse, given: dict[str, np.ndarray],
@@ -265,14 +317,6 @@ def _differences(response: LayeredResponse, given: dict[str, np.ndarray],
     return out
 
 
-@lru_cache(maxsize=8)
-def _table(largest_s: float, layers: tuple[UniformLayer, ...], base_thickness: float,
-           base_modulus: float, base_poisson: float) -> RegularPartTable:
-    """The stack's regular part, kept for the next solve of the same stack (a load
-    slider's steps: the table is most of a solve's time)."""
-    return RegularPartTable(largest_s, layers, base_thickness, base_modulus, base_poisson)
-
-
 def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickness: float,
                   base_modulus: float, base_poisson: float, given: dict[str, np.ndarray],
                   gap: Gap = None, breakpoints: Sequence[float] = (), *,
@@ -293,13 +337,15 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
     if len(given) != 2 or not set(given) <= set(_NAMES):
         raise ValueError(f"given: must be two of {', '.join(_NAMES)}, got {sorted(given)}")
     given = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in given.items()}
-    lam = half_width / base_thickness
-    table = _table(2 * lam, tuple(layers), base_thickness, base_modulus, base_poisson)
+    keys = (stack_key(half_width, layers, base_thickness, base_modulus, base_poisson),
+            gap_key(gap, breakpoints))
     modes = min(default_modes(half_width, layers), max_modes)
+    built: dict[str, float] = {}
+    start = time.perf_counter()
     unknowns = [n for n in _NAMES if n not in given]
     while True:
-        response = layered_response(half_width, layers, base_thickness, base_modulus,
-                                    base_poisson, gap, breakpoints, modes=modes, table=table)
+        response = _cached_response(half_width, layers, base_thickness, base_modulus,
+                                    base_poisson, gap, breakpoints, modes, keys, built)
         fine = response.complete(given)
         d1 = _differences(response, given, fine, level=1)
         d0 = _differences(response, given, fine, level=2)
@@ -311,8 +357,16 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
         if estimate <= 0.5 * tol or 2 * modes > max_modes:
             break
         modes *= 2
+    # the galerkin stage's time includes the operator it built: report each once
+    built_galerkin = built.get("galerkin", 0.0) - built.get("operator", 0.0)
+    stages = {"operator": {"seconds": built.get("operator", 0.0),
+                           "cached": "operator" not in built},
+              "galerkin": {"seconds": max(built_galerkin, 0.0),
+                           "cached": "galerkin" not in built},
+              "solve": {"seconds": max(time.perf_counter() - start
+                                       - built.get("galerkin", 0.0), 0.0), "cached": False}}
     return LayeredAnswer(fine["settlement"], fine["tilt"], fine["force"], fine["moment"],
-                         response, float(estimate), errors, modes)
+                         response, float(estimate), errors, modes, stages)
 
 
 @dataclass(frozen=True)

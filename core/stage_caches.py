@@ -39,10 +39,13 @@ def set_stage_cache_budget(total_bytes: int) -> None:
     if isinstance(total_bytes, bool) or not (isinstance(total_bytes, int) and total_bytes > 0):
         raise ValueError(f"total_bytes: must be a positive integer, got {total_bytes!r}")
     default_total = sum(_DEFAULT_STAGE_BYTES.values())
+    from core.layered_cache import share_budget
     from core.prepared import PREPARED, PREPARED_BYTES
 
-    # The default engine's prepared geometries take their share in the same proportion.
+    # The default engine's prepared geometries, and the exact layered kernel's operators,
+    # take their share in the same proportion.
     PREPARED.max_bytes = max(1, PREPARED_BYTES * total_bytes // default_total)
+    share_budget(total_bytes, default_total)
     for cache in _STAGES:
         cache.max_bytes = max(1, _DEFAULT_STAGE_BYTES[cache.name] * total_bytes
                               // default_total)

@@ -1,0 +1,78 @@
+"""Bounded caches of the exact layered solve, so a load change re-solves nothing geometric.
+
+:func:`core.layered_solve.solve_layered` builds, per geometry, three things that do not
+depend on the loads, each kept in its own :class:`core.cache.StageCache` (counted, cleared
+by :func:`core.cache.clear_caches`):
+
+- ``layered_table``: the stack's regular part (:class:`core.layered_kernel.RegularPartTable`),
+  keyed by the stack alone (``a / H``, the layers, the base); most of a cold solve;
+- ``layered_operator``: the Galerkin matrix on ``modes`` Chebyshev modes, keyed by the
+  stack and ``modes`` (a gap change reuses it); most of a warm solve before this cache;
+- ``layered_response``: the unit responses (to the gap, a unit settlement, a unit tilt),
+  keyed by the operator's key, the gap's values and its breakpoints.
+
+A load slider's step (settlement, tilt, force, moment) is then the superposition of the
+cached unit responses (:meth:`core.layered_solve.LayeredResponse.complete`).
+
+Gaps are callables: they are recognised by their values on :data:`GAP_PROBES` Chebyshev
+points and on both sides of each breakpoint (as :mod:`core.prepared` does).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from core.cache import StageCache, fingerprint
+from core.layered_kernel import UniformLayer
+
+__all__ = ["LAYERED_BYTES", "LAYERED_OPERATOR", "LAYERED_RESPONSE", "LAYERED_TABLE", "gap_key",
+           "share_budget", "stack_key"]
+
+_MiB = 2**20
+#: Points on which a callable gap is sampled for its key [-].
+GAP_PROBES = 2049
+#: Stacks' tables kept: one table holds panels x (degree + 1) coefficients (2 KiB for the
+#: rounded_graded preset, more for a base much thinner than the punch).
+LAYERED_TABLE = StageCache("layered_table", max_items=8, max_bytes=16 * _MiB,
+                           sizeof=lambda table: int(table.coefficients.nbytes
+                                                    + table.edges.nbytes))
+#: Galerkin matrices: modes^2 doubles, 2 MiB at the most modes (512); a solve that doubles
+#: its modes keeps each level, so a handful per geometry.
+LAYERED_OPERATOR = StageCache("layered_operator", max_items=32, max_bytes=32 * _MiB)
+#: Unit responses: 3 x modes doubles and two coarser copies, a few tens of KiB each.
+LAYERED_RESPONSE = StageCache("layered_response", max_items=256, max_bytes=8 * _MiB)
+#: The caches above with their default bounds [bytes] (:func:`share_budget`).
+_LAYERED = (LAYERED_TABLE, LAYERED_OPERATOR, LAYERED_RESPONSE)
+LAYERED_BYTES = {cache.name: cache.max_bytes for cache in _LAYERED}
+
+
+def stack_key(half_width: float, layers: Sequence[UniformLayer], base_thickness: float,
+              base_modulus: float, base_poisson: float) -> str:
+    """The key of a stack under a punch of half-width a [m]: every number it depends on."""
+    parts = tuple((lay.thickness, lay.modulus, lay.poisson, lay.interface) for lay in layers)
+    return fingerprint("layered stack", float(half_width), parts, float(base_thickness),
+                       float(base_modulus), float(base_poisson))
+
+
+def gap_key(gap: Callable[[np.ndarray], np.ndarray] | float | None,
+            breakpoints: Sequence[float]) -> str:
+    """The key of a gap ``g*(t)`` [-] (a callable, a number or None) with its breakpoints."""
+    bps = tuple(float(b) for b in breakpoints)
+    if not callable(gap):
+        return fingerprint("layered gap", None if gap is None else float(gap), bps)
+    probe = np.cos(np.linspace(0.0, np.pi, GAP_PROBES))
+    at = np.asarray(bps, dtype=float)
+    probe = np.concatenate([probe, at - 1e-9, at + 1e-9])
+    values: Any = np.broadcast_to(np.asarray(gap(probe), dtype=float), probe.shape)
+    return fingerprint("layered gap", np.ascontiguousarray(values), bps)
+
+
+def share_budget(total_bytes: int, default_total: int) -> None:
+    """Bound each cache here by ``total_bytes / default_total`` of its default bound [-]
+    (a worker process's share of the machine's budget,
+    :func:`core.stage_caches.set_stage_cache_budget`)."""
+    for cache in _LAYERED:
+        cache.max_bytes = max(1, LAYERED_BYTES[cache.name] * total_bytes // default_total)

@@ -1,0 +1,104 @@
+"""The exact layered answer is prepared once per geometry: a load change builds nothing."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+
+from core import solve
+from core.cache import clear_caches
+from core.layered_cache import LAYERED_OPERATOR, LAYERED_RESPONSE, LAYERED_TABLE
+
+SCENES = Path(__file__).resolve().parent.parent / "assets" / "scenes"
+STAGES = {"layered_table": LAYERED_TABLE, "layered_operator": LAYERED_OPERATOR,
+          "layered_response": LAYERED_RESPONSE}
+QUANTITIES = ("settlement", "tilt", "force", "moment")
+
+
+def rounded_graded(loading: dict) -> dict:
+    """The crowned punch on three smooth layers over an elastic base, one output time."""
+    d = json.loads((SCENES / "rounded_graded.json").read_text())
+    d["base"]["creep"] = {"model": "elastic", "modulus": 3.4e10}
+    d["times"] = {"end": 1.0, "count": 1}
+    d["loading"] = loading
+    return d
+
+
+def builds() -> dict[str, int]:
+    """Evaluations (builds) of each cache of the layered solve so far."""
+    return {name: cache.evaluations for name, cache in STAGES.items()}
+
+
+def test_load_changes_reuse_the_geometry_and_a_geometry_change_builds_again() -> None:
+    clear_caches()
+    scene = rounded_graded({"tilt": 0.0, "force": 8e5})
+    start = builds()
+    first = solve(scene)
+    assert first.info["coating_model"] == "exact layered"
+    after_first = builds()
+    assert all(after_first[name] > start[name] for name in STAGES)
+
+    # load-only changes, and another statement of the same geometry: nothing is built
+    changed = []
+    for loading in ({"tilt": 0.0, "force": 6e5}, {"tilt": 1e-5, "force": 9e5},
+                    {"settlement": 3e-5, "moment": 2e3}):
+        d = copy.deepcopy(scene)
+        d["loading"] = loading
+        result = solve(d)
+        assert result.info["coating_model"] == "exact layered"
+        assert builds() == after_first, loading
+        changed.append((d, result))
+
+    # the cached answer is the one a cold solve gives: the same arithmetic on the same
+    # unit responses (measured: equal to the last bit; 1e-12 leaves room for BLAS order)
+    clear_caches()
+    for d, result in changed:
+        cold = solve(d)
+        for q in QUANTITIES:
+            np.testing.assert_allclose(getattr(result, q), getattr(cold, q), rtol=1e-12,
+                                       atol=0.0, err_msg=q)
+    after_cold = builds()
+
+    # another punch shape on the same stack: new unit responses, the same operator
+    d = copy.deepcopy(scene)
+    d["punch"]["shape"]["coefficients"] = [0.0, 0.0, 5e-5]
+    solve(d)
+    now = builds()
+    assert now["layered_response"] > after_cold["layered_response"]
+    assert now["layered_operator"] == after_cold["layered_operator"]
+    assert now["layered_table"] == after_cold["layered_table"]
+
+    # another coating: the stack's table and operator are built again
+    d = copy.deepcopy(scene)
+    d["coating"][0]["modulus"] = 5e8
+    solve(d)
+    again = builds()
+    assert again["layered_table"] > now["layered_table"]
+    assert again["layered_operator"] > now["layered_operator"]
+
+
+def test_the_stage_report_says_what_a_load_change_redid() -> None:
+    clear_caches()
+    scene = rounded_graded({"tilt": 0.0, "force": 8e5})
+    stages = solve(scene).info["stages"]
+    assert not stages["operator"]["cached"] and not stages["galerkin"]["cached"]
+    scene["loading"]["force"] = 7e5
+    stages = solve(scene).info["stages"]
+    assert stages["operator"]["cached"] and stages["galerkin"]["cached"]
+    assert not stages["solve"]["cached"]
+
+
+def test_a_worker_s_budget_bounds_the_layered_caches_too() -> None:
+    from core.layered_cache import LAYERED_BYTES
+    from core.stage_caches import STAGE_CACHE_BYTES, set_stage_cache_budget
+
+    try:
+        set_stage_cache_budget(STAGE_CACHE_BYTES // 4)
+        for name, cache in STAGES.items():
+            assert cache.max_bytes == LAYERED_BYTES[name] // 4, name
+    finally:
+        set_stage_cache_budget(STAGE_CACHE_BYTES)
+    assert all(cache.max_bytes == LAYERED_BYTES[name] for name, cache in STAGES.items())
