@@ -1233,6 +1233,10 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
     Returns a :class:`SceneSolution` in SI units (m, rad, N/m, N, Pa; days after loading).
     """
     scene = scene_from_dict(scene)
+    # a load no contact can carry is refused in every contact mode, in the scene's units
+    from core.load_contact import check_loads_touch
+
+    check_loads_touch(scene)
     problem = scene.dimensionless
     with np.errstate(all="ignore"):
         result = SceneSolution(scene, problem, problem.solve())

@@ -74,3 +74,63 @@ def test_reused_operators_give_the_same_answer() -> None:
     assert np.allclose(warm.settlement, cold.settlement, rtol=1e-12, atol=0.0)
     ends = [np.ravel(zones) for zones in (warm.contact_set, cold.contact_set)]
     assert np.allclose(ends[0], ends[1], rtol=1e-12, atol=1e-14)
+
+
+# ------------------------------------------------------- loads no contact can carry
+
+def _elastic(loading: dict, contact: str = "auto") -> dict:
+    scene = _lesson()
+    scene["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
+    scene["times"] = {"end": 1.0, "count": 1}
+    scene["loading"] = loading
+    scene["solver"]["contact"] = contact
+    return scene
+
+
+def _creep(loading: dict, contact: str = "auto") -> dict:
+    scene = _lesson()
+    scene["loading"] = loading
+    scene["solver"]["contact"] = contact
+    return scene
+
+
+@pytest.mark.parametrize("contact", ["auto", "full", "unilateral"])
+@pytest.mark.parametrize("make", [_elastic, _creep])
+def test_a_resultant_outside_the_punch_is_refused_in_every_contact_mode(make, contact):
+    # a = 1 m: e = M/P = 1.125 m and -1.0 m (on the edge) leave no contact
+    for moment, e in ((9.0e5, "1.125"), (-8.0e5, "-1")):
+        with pytest.raises(ValueError, match=(
+                rf"^loading\.moment: the eccentricity e = M/P = {e} m at t = (0|1) days after "
+                r"loading .*\|e\| must be < a = 1 m")):
+            solve(make({"force": 8.0e5, "moment": moment}, contact))
+
+
+@pytest.mark.parametrize("contact", ["auto", "full", "unilateral"])
+@pytest.mark.parametrize("make", [_elastic, _creep])
+def test_a_force_that_does_not_press_is_refused_in_every_contact_mode(make, contact):
+    with pytest.raises(ValueError, match=r"^loading\.force: the punch is pulled away "
+                                         r"\(P = -100000 N/m at t = 0 days after loading\)"):
+        solve(make({"force": -1.0e5, "moment": 0.0}, contact))
+    with pytest.raises(ValueError, match=r"^loading\.force: must be > 0 .*P = 0 N/m"):
+        solve(make({"force": 0.0, "moment": 1.0e5}, contact))
+    # statement "force + tilt": a pulled punch too
+    with pytest.raises(ValueError, match=r"^loading\.force: the punch is pulled away"):
+        solve(make({"force": -1.0e5, "tilt": 0.0}, contact))
+
+
+def test_an_eccentricity_growing_out_of_the_punch_is_refused_at_its_time():
+    # M grows linearly from 0.6 P to 1.2 P over the 1000 days: |e| reaches a = 1 m at
+    # 666.7 days (the first sample at or after it, samples are 1000/1024 days apart)
+    scene = _creep({"force": 8.0e5, "moment": {"expr": "8e5 * (0.6 + 0.6 * t / 1000)"}})
+    with pytest.raises(ValueError, match=r"^loading\.moment: the eccentricity e = M/P = "
+                                         r"1\.000\d* m at t = 66[67]\.\d+ days"):
+        solve(scene)
+
+
+def test_loads_that_touch_are_still_solved():
+    # e = 0.95 m: a sliver of contact under the toe, answered by the unilateral model;
+    # a ramp from nothing (P = M = 0 at t = 0) is allowed
+    near = solve(_elastic({"force": 8.0e5, "moment": 7.6e5}))
+    assert near.info["contact"] == "unilateral" and near.contact_set[0][0][0] > 0.8
+    ramp = _creep({"force": {"expr": "8e5 * min(t / 10, 1)"}, "moment": 0.0}, "full")
+    assert solve(ramp).force[-1] == pytest.approx(8.0e5, rel=1e-6)
