@@ -141,6 +141,11 @@ class StageCache:
             return entry[0]
 
 
+    def values(self) -> list[Any]:
+        """A snapshot of the values held, least recently used first."""
+        with self._lock:
+            return [value for value, _ in self._data.values()]
+
     def clear(self) -> None:
         """Drop every cached value (the counters are kept)."""
         with self._lock:

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from core.cache import StageCache, fingerprint
 from core.collocation import time_grid
 from core.contact_bands import BAND_WIDTHS, band_rule, bands_from_ends
 from core.contact_zones import (
@@ -40,7 +41,7 @@ from core.contact_zones import (
     nodal_active_set,
     zones_from_nodes,
 )
-from core.quadrature import Panels, kernel_operator
+from core.quadrature import KernelOperator, Panels, kernel_operator
 
 #: Nominal steps of the first time grid over [1, t_end] (every output time is a grid
 #: point; each interval between output times gets whole steps).
@@ -58,6 +59,32 @@ LOCATE_EDGE = 0.05
 #: times the largest difference for bands 0.04 and 0.02 wide (against 0.0025; see
 #: tests/test_contact.py), so 2 leaves a margin of 1.5.
 SPACE_FACTOR = 2.0
+
+#: The operators of the stepping's panel rules, keyed by lam and the panel edges (they
+#: depend on nothing else): a load-only change (the explorer's eccentricity slider) meets
+#: the same base and locating rules again, and band rules that share most panels with one
+#: kept here, whose blocks are copied (only the rows and columns of new panels are built).
+_RULE_OPERATORS = StageCache("contact_rule_operator", max_items=12, max_bytes=96 * 2**20)
+
+
+def rule_operator(lam: float, rule: Panels) -> np.ndarray:
+    """The Nystrom matrix of F on the nodes of ``rule`` (read-only, cached; see
+    ``_RULE_OPERATORS``). ``lam`` = a/H (dimensionless)."""
+    key = fingerprint(float(lam), np.asarray(rule.edges, dtype=float))
+
+    def build() -> KernelOperator:
+        # the kept operator of this lam sharing most panels with the rule seeds it
+        best, shared = None, 0
+        for previous in _RULE_OPERATORS.values():
+            if previous.lam == lam:
+                common = np.intersect1d(previous.panels.edges, rule.edges).size
+                if common > shared:
+                    best, shared = previous, common
+        operator = kernel_operator(lam, rule, previous=best)
+        operator.matrix.flags.writeable = False  # shared by every march on this rule
+        return operator
+
+    return _RULE_OPERATORS.get_or_compute(key, build)[0].matrix
 
 
 def _zones(state: NodalState, breakpoints: tuple[float, ...]
@@ -312,7 +339,7 @@ def _in_time(space: Space, inp: Any, base: Panels, first_steps: int, tol: float,
              end_tol: float) -> tuple[dict[str, Any], float, float, dict[str, Any]]:
     """March on halved grids until the time estimate meets tol / 3 (module notes):
     (outputs, their time error, the zone ends' time error, the last march)."""
-    op = kernel_operator(space.lam, base).matrix
+    op = rule_operator(space.lam, base)
     m = space.m(base.nodes)
     g = space.g(base.nodes)
     plain: list[dict[str, Any]] = []
@@ -379,7 +406,7 @@ def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol:
     grid, widths, index = time_grid(check, first_steps, 0)
 
     def march(rule: Panels) -> dict[str, Any]:
-        op = kernel_operator(space.lam, rule).matrix
+        op = rule_operator(space.lam, rule)
         run = _march(space, inp, rule, op, space.m(rule.nodes), space.g(rule.nodes), grid,
                      widths, index)
         return _outputs(run)
@@ -392,7 +419,7 @@ def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol:
         grid_l, widths_l, index_l = time_grid(locate, first_steps, 0)
         coarse = band_rule(space, Resolution(res.width, max(res.edge, LOCATE_EDGE)), [],
                            0.0)
-        op_l = kernel_operator(space.lam, coarse).matrix
+        op_l = rule_operator(space.lam, coarse)
         located = _march(space, inp, coarse, op_l, space.m(coarse.nodes),
                          space.g(coarse.nodes), grid_l, widths_l, index_l)
         bands = bands_from_ends(_outputs(located)["ends"], space.breakpoints)

@@ -21,6 +21,7 @@ one job each,
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping
 from typing import Any
 
@@ -75,12 +76,19 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
 
     Returns a :class:`SceneSolution` in SI units (m, rad, N/m, N, Pa; days after loading).
     """
-    scene = scene_from_dict(scene)
-    problem = scene.dimensionless
     from core.layered_scene import solve_scene_layered  # uniform coating, elastic base
+    from core.load_contact import check_loads_touch
 
+    scene = scene_from_dict(scene)
+    # a load no contact can carry is refused in every contact mode, in the scene's units
+    check_loads_touch(scene)
+    started = time.thread_time()
+    problem = scene.dimensionless
     with np.errstate(all="ignore"):
         answer = solve_scene_layered(scene, problem)
         result = SceneSolution(scene, problem, problem.solve() if answer is None else answer)
+    # CPU time of this thread [s]: what the scene costs, whatever else the machine runs
+    # (info["seconds"] is the solver's wall time)
+    result.info["cpu_seconds"] = time.thread_time() - started
     _check_finite(result)
     return result
