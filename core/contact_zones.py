@@ -71,8 +71,23 @@ class Step:
     given: dict[str, float]
 
 
+class _Resultants:
+    """Force and moment (dimensionless) of a nodal pressure ``q`` on ``panels``."""
+
+    panels: Panels
+    q: np.ndarray
+
+    @property
+    def force(self) -> float:
+        return float(self.panels.weights @ self.q)
+
+    @property
+    def moment(self) -> float:
+        return float((self.panels.weights * self.panels.nodes) @ self.q)
+
+
 @dataclass
-class NodalState:
+class NodalState(_Resultants):
     """A solution on the nodes of ``panels``: pressure ``q`` (0 off contact), the four
     scalars, the contact nodes ``active`` and the Nystrom pressure ``nystrom`` (Q)."""
 
@@ -82,14 +97,6 @@ class NodalState:
     tilt: float
     active: np.ndarray
     nystrom: np.ndarray
-
-    @property
-    def force(self) -> float:
-        return float(self.panels.weights @ self.q)
-
-    @property
-    def moment(self) -> float:
-        return float((self.panels.weights * self.panels.nodes) @ self.q)
 
 
 class NoContact(ValueError):
@@ -262,7 +269,7 @@ class Resolution:
 
 
 @dataclass
-class ZoneSolution:
+class ZoneSolution(_Resultants):
     """The problem solved on given zones: the rule on the contact set, nodal q, the
     scalars, and Q (the Nystrom pressure) at every end."""
 
@@ -273,14 +280,6 @@ class ZoneSolution:
     tilt: float
     end_values: np.ndarray
     q_scale: float
-
-    @property
-    def force(self) -> float:
-        return float(self.panels.weights @ self.q)
-
-    @property
-    def moment(self) -> float:
-        return float((self.panels.weights * self.panels.nodes) @ self.q)
 
 
 def zone_panels(space: Space, ends: Sequence[float], res: Resolution) -> Panels:

@@ -79,10 +79,13 @@ def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
         page.page.locator(".study-png").first.click()
     assert Path(info.value.path()).read_bytes().startswith(b"\x89PNG")
 
-    # a 9 x 9 study over the force and the coating modulus (81 solves), cancelled
+    # the largest study the tab takes, 20 x 20 over the force and the coating modulus
+    # (400 solves, 20 geometries: some seconds; 9 x 9 ended in 2 s, before the test saw it
+    # running), cancelled
     page.page.locator(".study-p2-field select").first.select_option(
         label="coating 1: Young's modulus [MPa]")
-    page.type_into(".study-p1-count", "9")
+    page.type_into(".study-p1-count", "20")
+    page.type_into(".study-p2-count", "20")
     page.page.locator(".study-run button").first.click()
     until(lambda: page.page.evaluate(JS_SHOWN, "running:"), "the study running", 120,
           lambda: status(page))

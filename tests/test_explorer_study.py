@@ -61,8 +61,13 @@ def test_study_from_the_scene_on_screen_equals_a_serial_loop():
             for name, values in expected.items():
                 got = result.outputs[name][i, j]
                 # the same solver on the same scene: measured bitwise equal; 1e-12 of the
-                # output's scale leaves room for stage caches prepared in another order
+                # output's scale leaves room for stage caches prepared in another order.
+                # The tilt of this centred load is round-off (~3e-21 rad): its scale is
+                # the settlement over the half-width, not its own noise.
                 scale = max(np.max(np.abs(values)), 1e-300)
+                if name == "tilt":
+                    scale = max(scale, float(np.max(np.abs(want.settlement)))
+                                / float(scene["punch"]["half_width"]))
                 np.testing.assert_allclose(got / scale, np.asarray(values) / scale,
                                            rtol=0, atol=1e-12, err_msg=name)
             # full contact (q_min > 0 here): the contact width is the punch's width
