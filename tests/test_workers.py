@@ -64,11 +64,17 @@ def test_a_view_solved_in_a_worker_is_the_view_solved_here(processes, small_pres
     scene = small_preset(force_kN=400.0)
     there = processes.run(0, solve_view, scene)
     here = prepare_view(solve(scene), scene)
+    # The same numbers up to round-off: a worker's process-wide quadrature tables were
+    # filled by its own scenes, this process's by every test before (in the whole suite:
+    # settlement 4.2e-16, q 3.2e-15 relative; bitwise equal when run alone).
     for q in QUANTITIES:
-        assert np.array_equal(there.values[q], here.values[q]), q
+        np.testing.assert_allclose(there.values[q], here.values[q], rtol=1e-13, atol=0,
+                                   err_msg=q)
     assert np.array_equal(there.x, here.x) and np.array_equal(there.times, here.times)
-    assert np.array_equal(there.pressure, here.pressure)
-    assert np.array_equal(there.image, here.image)
+    scale = float(np.max(np.abs(here.pressure)))
+    np.testing.assert_allclose(there.pressure, here.pressure, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(there.image, here.image, rtol=0,
+                               atol=1e-13 * float(np.max(np.abs(here.image))))
     assert np.array_equal(there.geometry.shape, here.geometry.shape)
     assert there.flags == here.flags and there.scene == scene
 
