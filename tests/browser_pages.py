@@ -151,3 +151,43 @@ def chromium_context(width: int, height: int, **options):
         yield context
         context.close()
     shutil.rmtree(profile, ignore_errors=True)
+
+
+def page_fixtures(width: int, height: int, **options):
+    """The fixtures ``server``, ``browser_context`` (both per module) and ``page`` (per
+    test) of a browser test module, its window ``width`` x ``height`` [px] and ``options``
+    of the Playwright context (e.g. ``accept_downloads=True``). Use as
+    ``server, browser_context, page = page_fixtures(1400, 900)`` at the module's top."""
+    import pytest
+
+    @pytest.fixture(scope="module", name="server")
+    def server():
+        yield from served_explorer()
+
+    @pytest.fixture(scope="module", name="browser_context")
+    def browser_context():
+        yield from chromium_context(width, height, **options)
+
+    @pytest.fixture(name="page")
+    def page(server: str, browser_context: object):
+        p = Page(browser_context, server)
+        yield p
+        p.close()
+
+    return server, browser_context, page
+
+
+# Width on the page of the view of a named Bokeh model [px] (0 or null: not shown).
+JS_VIEW_WIDTH = """(name) => {
+  const stack = Object.values(Bokeh.index);
+  while (stack.length) {
+    const v = stack.pop();
+    if (v.model && v.model.name === name) return v.el.getBoundingClientRect().width;
+    if (v.child_views) stack.push(...v.child_views);
+    else if (v.renderer_views) stack.push(...v.renderer_views.values());
+  }
+  return null;
+}"""
+# Top [px] of a named figure in the viewport, or null while it is not drawn.
+JS_VIEW_TOP = JS_VIEW_WIDTH.replace("getBoundingClientRect().width",
+                                    "getBoundingClientRect().top")

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -21,26 +20,12 @@ from tests.browser_pages import require_browser  # noqa: E402
 
 require_browser()
 
-from tests.browser_pages import Page, chromium_context, served_explorer  # noqa: E402
+from tests.browser_pages import Page, page_fixtures  # noqa: E402
 
 ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
 
 
-@pytest.fixture(scope="module")
-def server() -> Iterator[str]:
-    yield from served_explorer()
-
-
-@pytest.fixture(scope="module")
-def browser_context() -> Iterator[object]:
-    yield from chromium_context(1500, 1300)
-
-
-@pytest.fixture()
-def page(server: str, browser_context: object) -> Iterator[Page]:
-    p = Page(browser_context, server)
-    yield p
-    p.close()
+server, browser_context, page = page_fixtures(1500, 1300)
 
 
 def test_page_loads_without_errors_and_screenshot(page: Page):

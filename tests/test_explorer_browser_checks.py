@@ -8,7 +8,6 @@ step sends) in Debian's Chromium. Every wait is on a condition in the page.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -21,25 +20,14 @@ require_browser()
 
 from tests.browser_pages import (  # noqa: E402
     JS_SHOWN,
+    JS_VIEW_WIDTH,
     Page,
-    chromium_context,
-    served_explorer,
+    page_fixtures,
     until,
 )
 
 ROOT = Path(__file__).resolve().parent.parent
 
-# The page's Bokeh view of a named figure (its drawn size), found from the roots down.
-JS_VIEW_WIDTH = """(name) => {
-  const stack = Object.values(Bokeh.index);
-  while (stack.length) {
-    const v = stack.pop();
-    if (v.model && v.model.name === name) return v.el.getBoundingClientRect().width;
-    if (v.child_views) stack.push(...v.child_views);
-    else if (v.renderer_views) stack.push(...v.renderer_views.values());
-  }
-  return null;
-}"""
 # Top [px] of a named figure in the viewport, or null while it is not drawn.
 JS_VIEW_TOP = JS_VIEW_WIDTH.replace("getBoundingClientRect().width",
                                     "getBoundingClientRect().top")
@@ -52,21 +40,7 @@ JS_TITLE_WIDTH = """(name) => {
 }"""
 
 
-@pytest.fixture(scope="module")
-def server() -> Iterator[str]:
-    yield from served_explorer()
-
-
-@pytest.fixture(scope="module")
-def browser_context() -> Iterator[object]:
-    yield from chromium_context(1400, 900, accept_downloads=True)
-
-
-@pytest.fixture()
-def page(server: str, browser_context: object) -> Iterator[Page]:
-    p = Page(browser_context, server)
-    yield p
-    p.close()
+server, browser_context, page = page_fixtures(1400, 900, accept_downloads=True)
 
 
 def _wait(page: Page, js: str, arg: object = None, timeout: float = 60_000) -> None:

@@ -5,8 +5,6 @@ Debian's Chromium drives the served explorer; every wait is on a condition in th
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import pytest
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
@@ -15,7 +13,7 @@ from tests.browser_pages import require_browser  # noqa: E402
 
 require_browser()
 
-from tests.browser_pages import Page, chromium_context, served_explorer, until  # noqa: E402
+from tests.browser_pages import Page, page_fixtures, until  # noqa: E402
 
 # Label of a pin's legend entry (a value spec in the page: {value: ...} or plain text).
 JS_LEGEND = """(k) => {
@@ -37,21 +35,7 @@ JS_FRAME_X = """(name) => {
 }"""
 
 
-@pytest.fixture(scope="module")
-def server() -> Iterator[str]:
-    yield from served_explorer()
-
-
-@pytest.fixture(scope="module")
-def browser_context() -> Iterator[object]:
-    yield from chromium_context(1400, 900)
-
-
-@pytest.fixture()
-def page(server: str, browser_context: object) -> Iterator[Page]:
-    p = Page(browser_context, server)
-    yield p
-    p.close()
+server, browser_context, page = page_fixtures(1400, 900)
 
 
 def _pins(page: Page) -> int:

@@ -8,7 +8,6 @@ Every wait is on a condition in the page.
 from __future__ import annotations
 
 import copy
-from collections.abc import Iterator
 
 import pytest
 
@@ -20,9 +19,9 @@ require_browser()
 
 from tests.browser_pages import (  # noqa: E402
     JS_SHOWN,
+    JS_VIEW_WIDTH,
     Page,
-    chromium_context,
-    served_explorer,
+    page_fixtures,
     until,
 )
 
@@ -38,34 +37,9 @@ JS_INSET_SHOWN = """() => {
   return !!fig && fig.visible;
 }"""
 JS_TITLE = "(name) => Bokeh.documents[0].get_model_by_name(name).title.text"
-# Width on the page of the view of a named model [px] (0 or null: not shown).
-JS_VIEW_WIDTH = """(name) => {
-  const stack = Object.values(Bokeh.index);
-  while (stack.length) {
-    const v = stack.pop();
-    if (v.model && v.model.name === name) return v.el.getBoundingClientRect().width;
-    if (v.child_views) stack.push(...v.child_views);
-    else if (v.renderer_views) stack.push(...v.renderer_views.values());
-  }
-  return null;
-}"""
 
 
-@pytest.fixture(scope="module")
-def server() -> Iterator[str]:
-    yield from served_explorer()
-
-
-@pytest.fixture(scope="module")
-def browser_context() -> Iterator[object]:
-    yield from chromium_context(1400, 900)
-
-
-@pytest.fixture()
-def page(server: str, browser_context: object) -> Iterator[Page]:
-    p = Page(browser_context, server)
-    yield p
-    p.close()
+server, browser_context, page = page_fixtures(1400, 900)
 
 
 def _choose(page: Page, key: str) -> None:

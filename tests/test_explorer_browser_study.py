@@ -4,7 +4,6 @@ condition in the page."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -18,8 +17,7 @@ require_browser()
 from tests.browser_pages import (  # noqa: E402
     JS_SHOWN,
     Page,
-    chromium_context,
-    served_explorer,
+    page_fixtures,
     until,
 )
 
@@ -40,21 +38,7 @@ def status(page: Page) -> str:
     return page.pane_text(".study-status")
 
 
-@pytest.fixture(scope="module")
-def server() -> Iterator[str]:
-    yield from served_explorer()
-
-
-@pytest.fixture(scope="module")
-def browser_context() -> Iterator[object]:
-    yield from chromium_context(1400, 900, accept_downloads=True)
-
-
-@pytest.fixture()
-def page(server: str, browser_context: object) -> Iterator[Page]:
-    p = Page(browser_context, server)
-    yield p
-    p.close()
+server, browser_context, page = page_fixtures(1400, 900, accept_downloads=True)
 
 
 def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
