@@ -5,8 +5,11 @@ that points sharing a geometry (every varied field but the loads) are neighbours
 them into batches and runs each batch as one task: inside a task the points run in
 order, so the solver's cached geometric stages (panels, operator, basis, Galerkin
 matrices) are prepared once per geometry and a load-only variation costs a few array
-operations. A point that fails (an invalid scene drawn from a distribution, a solver
-error) is recorded with its message; it never stops the study.
+operations. When only given loads vary (``loading.force``, ``loading.moment``, ...), a
+batch validates the base scene once and builds each point's scene by replacing its loads
+(:func:`core.scene_validation.replace_loads`, the same checks and messages). A point
+that fails (an invalid scene drawn from a distribution, a solver error) is recorded with
+its message; it never stops the study.
 
 Each finished batch is written atomically to a work directory (``parts/batch_NNNNNN.npz``
 next to a ``manifest.json`` naming the study), so a study that was interrupted (a killed
