@@ -34,6 +34,7 @@ uses.
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -199,6 +200,7 @@ class LayeredResponse:
 _CHEBYSHEV_SETS = 16
 _CHEBYSHEV_MOST_VALUES = 2**18
 _chebyshev_kept: dict[tuple[bytes, int], np.ndarray] = {}
+_chebyshev_lock = threading.Lock()
 
 
 def _chebyshev_rows(t: np.ndarray, modes: int) -> np.ndarray:
@@ -208,13 +210,17 @@ def _chebyshev_rows(t: np.ndarray, modes: int) -> np.ndarray:
     if t.ndim != 1 or t.size * modes > _CHEBYSHEV_MOST_VALUES:
         return np.cos(np.outer(np.arccos(np.clip(t, -1, 1)), np.arange(modes)))
     key = (t.tobytes(), modes)
-    rows = _chebyshev_kept.pop(key, None)
-    if rows is None:
-        rows = np.cos(np.outer(np.arccos(np.clip(t, -1, 1)), np.arange(modes)))
-        rows.setflags(write=False)
+    with _chebyshev_lock:  # solves may run in threads (a served explorer, Dask threads)
+        rows = _chebyshev_kept.pop(key, None)
+        if rows is not None:
+            _chebyshev_kept[key] = rows  # now the most recently used
+            return rows
+    rows = np.cos(np.outer(np.arccos(np.clip(t, -1, 1)), np.arange(modes)))
+    rows.setflags(write=False)
+    with _chebyshev_lock:
         while len(_chebyshev_kept) >= _CHEBYSHEV_SETS:
-            _chebyshev_kept.pop(next(iter(_chebyshev_kept)))  # the least recently used
-    _chebyshev_kept[key] = rows
+            del _chebyshev_kept[next(iter(_chebyshev_kept))]  # the least recently used
+        _chebyshev_kept[key] = rows
     return rows
 
 
