@@ -263,9 +263,10 @@ def _check_loads_scalable(scene: Scene, problem: DimensionlessProblem) -> None:
                              "days after loading (the sizes in the scene are too far apart)"))
 
 
-#: Cached properties of a :class:`Scene` that depend on the punch and the coating alone:
-#: a scene with other loads keeps them (:func:`replace_loads`).
-_GEOMETRY_CACHES = ("breakpoints", "_geometry_key", "sample_x", "_gap_parts", "gap_minimum")
+#: Cached properties of a :class:`Scene` that do not depend on the loads: a scene with
+#: other loads keeps those already computed (:func:`replace_loads`).
+_GEOMETRY_CACHES = ("breakpoints", "_geometry_key", "sample_x", "_gap_parts", "gap_minimum",
+                    "sample_extremes")
 
 
 def replace_loads(scene: Scene, loads: Mapping[str, Any]) -> Scene:

@@ -136,9 +136,11 @@ def _load_only_base(base: Mapping[str, Any], paths: Sequence[str]) -> Scene | No
                             and path.split(".", 1)[1] in given for path in paths):
         return None
     try:
-        return scene_from_dict(base)
+        scene = scene_from_dict(base)
     except Exception:  # noqa: BLE001 - each point then reports its own message
         return None
+    scene.sample_extremes  # noqa: B018 - computed once here, kept by every point's scene
+    return scene
 
 
 def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,

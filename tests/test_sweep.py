@@ -263,6 +263,11 @@ def test_replace_loads_equals_the_validated_dict():
     new = replace_loads(base, {"moment": 3e4})
     assert new.key == scene_from_dict(apply_point(study.base, {"loading.moment": 3e4})).key
     assert base.loading["moment"](0.0) != new.loading["moment"](0.0)  # base unchanged
+    # the geometric figures it keeps from the base scene are those of a fresh solve
+    whole = solve(apply_point(study.base, {"loading.moment": 3e4}))
+    base.sample_extremes  # noqa: B018 - computed on the base, then kept by the copy
+    assert solve(replace_loads(base, {"moment": 3e4})).info["dimensional"] \
+        == whole.info["dimensional"]
     with pytest.raises(ValueError, match=r"^loading\.tilt: not one of the scene's given"):
         replace_loads(base, {"tilt": 1e-3})
     with pytest.raises(ValueError, match=r"^loading\.force: must be a finite number"):
