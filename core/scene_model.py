@@ -220,6 +220,20 @@ class Scene:
         return self.gap_variation(x) - self.gap_minimum
 
     @cached_property
+    def sample_extremes(self) -> dict[str, float]:
+        """On :attr:`sample_x`: the range of ``m*`` (-), the largest gap [m] and the largest
+        coating thickness [m]; none depends on the loads, so a scene with other loads
+        (:func:`core.scene_validation.replace_loads`) keeps them."""
+        x = self.sample_x
+        problem = self.dimensionless
+        with np.errstate(all="ignore"):  # as in the solve that reports them
+            m_star = problem.m(x / self.half_width) if callable(problem.m) \
+                else np.full(x.shape, problem.m)
+            return {"m_star_min": float(np.min(m_star)), "m_star_max": float(np.max(m_star)),
+                    "gap_max_m": float(np.max(self.gap(x))),
+                    "coating_thickness_max_m": float(np.max(self.coating_thickness(x)))}
+
+    @cached_property
     def dimensionless(self) -> DimensionlessProblem:
         """The dimensionless problem of this scene (built once; the formulas:
         :mod:`core.scene_dimensionless`)."""

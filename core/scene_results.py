@@ -138,19 +138,17 @@ class SceneSolution:
 
     def _extras(self) -> dict[str, Any]:
         scene, problem = self.scene, self.problem
-        x = scene.sample_x
-        m_star = problem.m(x / scene.half_width) if callable(problem.m) \
-            else np.full(x.shape, problem.m)
+        extremes = scene.sample_extremes
         return {
             "scene_key": scene.key,
             "statement": scene.statement,
             "lam": problem.lam,
             "modulus_at_loading_Pa": problem.modulus_at_loading,
             "age_at_loading_days": problem.age_at_loading,
-            "m_star_min": float(np.min(m_star)),
-            "m_star_max": float(np.max(m_star)),
-            "gap_max_m": float(np.max(scene.gap(x))),
-            "coating_thickness_max_m": float(np.max(scene.coating_thickness(x))),
+            "m_star_min": extremes["m_star_min"],
+            "m_star_max": extremes["m_star_max"],
+            "gap_max_m": extremes["gap_max_m"],
+            "coating_thickness_max_m": extremes["coating_thickness_max_m"],
             "breakpoints_m": list(scene.breakpoints),
             "min_pressure_Pa": float(np.min(self.pressure_on_grid)),
             "max_pressure_Pa": float(np.max(self.pressure_on_grid)),

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
@@ -246,7 +247,13 @@ def _check_solvable(scene: Scene) -> None:
 
             refuse_first(~np.isfinite(g) | (np.abs(g) > schema.MAX_GAP_RATIO), gap_message)
         _check_creep(scene, problem)
-        ts = problem.times
+        _check_loads_scalable(scene, problem)
+
+
+def _check_loads_scalable(scene: Scene, problem: DimensionlessProblem) -> None:
+    """Refuse a load whose dimensionless value leaves double precision."""
+    ts = problem.times
+    with np.errstate(all="ignore"):
         for name, load in problem.loads.items():
             values = np.broadcast_to(load(ts) if callable(load) else load, ts.shape)
             refuse_first(~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE),
@@ -254,6 +261,40 @@ def _check_solvable(scene: Scene) -> None:
                              f"loading.{name}: cannot be scaled by the base modulus and the "
                              f"half-width in double precision at t = {scene.times[i]:.6g} "
                              "days after loading (the sizes in the scene are too far apart)"))
+
+
+#: Cached properties of a :class:`Scene` that do not depend on the loads: a scene with
+#: other loads keeps those already computed (:func:`replace_loads`).
+_GEOMETRY_CACHES = ("breakpoints", "_geometry_key", "sample_x", "_gap_parts", "gap_minimum",
+                    "sample_extremes")
+
+
+def replace_loads(scene: Scene, loads: Mapping[str, Any]) -> Scene:
+    """``scene`` with some of its given loads replaced (``{"force": 2e5}``: quantity ->
+    load spec, in N/m, N, m or rad as in the scene file), validated as
+    :func:`scene_from_dict` validates the scene dict with those loads, with the same
+    messages; only the loads are checked again (the rest was validated with ``scene``).
+    A load the scene does not give is refused (another statement needs a new scene)."""
+    for q in loads:
+        if q not in scene.loading:
+            raise ValueError(f"loading.{q}: not one of the scene's given loads "
+                             f"({', '.join(scene.loading)}); change the statement with a "
+                             "new scene")
+    t_domain = (0.0, float(scene.times[-1]))
+    profiles = dict(scene.loading)
+    data = dict(scene._data)
+    data["loading"] = dict(data["loading"])
+    for q, spec in loads.items():
+        profiles[q] = _profile(spec, f"loading.{q}", "t", t_domain)
+        data["loading"][q] = _jsonable(_spec_of(profiles[q], spec))
+    new = replace(scene, loading=MappingProxyType(profiles), _data=data)
+    for name in _GEOMETRY_CACHES:
+        if name in scene.__dict__:
+            new.__dict__[name] = scene.__dict__[name]
+    with np.errstate(all="ignore"):
+        _check_loads_scalable(new, new.dimensionless)
+    _check_load_rates(new)
+    return new
 
 
 def _check_creep(scene: Scene, problem: DimensionlessProblem) -> None:

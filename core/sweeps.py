@@ -5,8 +5,11 @@ that points sharing a geometry (every varied field but the loads) are neighbours
 them into batches and runs each batch as one task: inside a task the points run in
 order, so the solver's cached geometric stages (panels, operator, basis, Galerkin
 matrices) are prepared once per geometry and a load-only variation costs a few array
-operations. A point that fails (an invalid scene drawn from a distribution, a solver
-error) is recorded with its message; it never stops the study.
+operations. When only given loads vary (``loading.force``, ``loading.moment``, ...), a
+batch validates the base scene once and builds each point's scene by replacing its loads
+(:func:`core.scene_validation.replace_loads`, the same checks and messages). A point
+that fails (an invalid scene drawn from a distribution, a solver error) is recorded with
+its message; it never stops the study.
 
 Each finished batch is written atomically to a work directory (``parts/batch_NNNNNN.npz``
 next to a ``manifest.json`` naming the study), so a study that was interrupted (a killed
@@ -34,7 +37,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from core.scene import FLAG_MESSAGES, atomic_write_text, solve
+from core.scene import FLAG_MESSAGES, Scene, atomic_write_text, scene_from_dict, solve
+from core.scene_validation import replace_loads
 from core.study import OUTPUT_UNITS, Study, apply_point, load_study, point_table
 
 if TYPE_CHECKING:
@@ -123,6 +127,22 @@ def point_outputs(result: Any, outputs: Sequence[str]) -> np.ndarray:
     return np.asarray(rows, dtype=float)
 
 
+def _load_only_base(base: Mapping[str, Any], paths: Sequence[str]) -> Scene | None:
+    """The validated base scene when every varied field is one of its given loads
+    (``loading.force``, ...), else None (each point's scene is then validated whole, as
+    is a base scene that does not validate on its own)."""
+    given = base.get("loading", {})
+    if not paths or not all(path.startswith("loading.") and path.count(".") == 1
+                            and path.split(".", 1)[1] in given for path in paths):
+        return None
+    try:
+        scene = scene_from_dict(base)
+    except Exception:  # noqa: BLE001 - each point then reports its own message
+        return None
+    scene.sample_extremes  # noqa: B018 - computed once here, kept by every point's scene
+    return scene
+
+
 def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
               outputs: Sequence[str], n_times: int) -> dict[str, np.ndarray]:
     """Solve the points of one batch in order (``values[i]`` holds point i's value of each
@@ -135,10 +155,18 @@ def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
     flags = [""] * m
     errors = [""] * m
     seconds = np.zeros(m)
+    validated = _load_only_base(base, paths)
+    loads = [path.split(".", 1)[1] for path in paths]
     for i, row in enumerate(values):
         start = time.perf_counter()
         try:
-            result = solve(apply_point(base, dict(zip(paths, row, strict=True))))
+            if validated is not None:
+                # only the loads change: the base scene was validated once for the batch
+                scene = replace_loads(validated, {q: float(v) for q, v in
+                                                  zip(loads, row, strict=True)})
+            else:
+                scene = apply_point(base, dict(zip(paths, row, strict=True)))
+            result = solve(scene)
             out[i] = point_outputs(result, outputs)
             estimate[i] = float(result.info.get("error_estimate", np.nan))
             flags[i] = ",".join(result.flags)

@@ -102,3 +102,20 @@ def test_a_worker_s_budget_bounds_the_layered_caches_too() -> None:
     finally:
         set_stage_cache_budget(STAGE_CACHE_BYTES)
     assert all(cache.max_bytes == LAYERED_BYTES[name] for name, cache in STAGES.items())
+
+
+def test_kept_chebyshev_rows_are_the_computed_ones_and_bounded():
+    from core import layered_solve as ls
+
+    t = np.cos(np.linspace(0.0, np.pi, 91))
+    direct = np.cos(np.outer(np.arccos(np.clip(t, -1, 1)), np.arange(40)))
+    first = ls._chebyshev_rows(t, 40)
+    assert ls._chebyshev_rows(t.copy(), 40) is first  # equal points: the kept rows
+    np.testing.assert_array_equal(first, direct)  # bit for bit
+    assert not first.flags.writeable
+    for k in range(2 * ls._CHEBYSHEV_SETS):
+        ls._chebyshev_rows(t, 41 + k)
+    assert len(ls._chebyshev_kept) == ls._CHEBYSHEV_SETS
+    big = np.linspace(-1.0, 1.0, ls._CHEBYSHEV_MOST_VALUES // 40 + 1)
+    ls._chebyshev_rows(big, 40)
+    assert all(key[0] != big.tobytes() for key in ls._chebyshev_kept)

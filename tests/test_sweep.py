@@ -215,6 +215,65 @@ def test_serial_run_equals_the_loop_and_batches_follow_geometry():
     assert pairs == sorted(pairs)
 
 
+def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
+    """A batch varying only loads validates the base scene once and replaces the loads of
+    each point: every output, estimate, flag and message equals core.solve's on the
+    point's whole scene dict, lift-off and refused points included."""
+    import core.sweeps as sweeps
+
+    study = study_from_dict(small_study(vary=[
+        {"field": "loading.force", "values": [-1e5, 1e5, 5e5]},
+        {"field": "loading.moment", "values": [0.0, 4e4, 8e4, 2e5]}]))
+    paths = ["loading.force", "loading.moment"]
+    grid = np.array([(f, m) for f in (-1e5, 1e5, 5e5) for m in (0.0, 4e4, 8e4, 2e5)])
+    outputs = list(OUTPUTS)
+
+    def whole_scene(*args):
+        raise AssertionError("a load-only batch must not rebuild each point's scene dict")
+
+    monkeypatch.setattr(sweeps, "apply_point", whole_scene)
+    got = sweeps.run_batch(study.base, paths, grid, outputs, len(study.times))
+    monkeypatch.undo()
+    kinds = {"failed": 0, "unilateral": 0, "full": 0}
+    for i, (force, moment) in enumerate(grid):
+        try:
+            result = solve(apply_point(study.base, {"loading.force": force,
+                                                    "loading.moment": moment}))
+        except ValueError as exc:
+            kinds["failed"] += 1
+            assert got["flags"][i] == "failed"
+            assert got["error"][i] == " ".join(str(exc).split())[:500]
+            assert np.all(np.isnan(got["values"][i]))
+            continue
+        kinds[result.info["contact"]] += 1
+        # the same solver on equal scenes: measured bitwise equal
+        np.testing.assert_array_equal(got["values"][i], sweeps.point_outputs(result, outputs))
+        assert got["error_estimate"][i] == result.info["error_estimate"]
+        assert got["flags"][i] == ",".join(result.flags) and got["error"][i] == ""
+    # pulled (P < 0) and beyond the edge (e = 2 m > a) refused; lift-off at e = 0.8 m
+    assert kinds["failed"] == 5 and kinds["unilateral"] >= 1 and kinds["full"] >= 4
+
+
+def test_replace_loads_equals_the_validated_dict():
+    from core.scene import scene_from_dict
+    from core.scene_validation import replace_loads
+
+    study = study_from_dict(small_study())
+    base = scene_from_dict(study.base)
+    new = replace_loads(base, {"moment": 3e4})
+    assert new.key == scene_from_dict(apply_point(study.base, {"loading.moment": 3e4})).key
+    assert base.loading["moment"](0.0) != new.loading["moment"](0.0)  # base unchanged
+    # the geometric figures it keeps from the base scene are those of a fresh solve
+    whole = solve(apply_point(study.base, {"loading.moment": 3e4}))
+    base.sample_extremes  # noqa: B018 - computed on the base, then kept by the copy
+    assert solve(replace_loads(base, {"moment": 3e4})).info["dimensional"] \
+        == whole.info["dimensional"]
+    with pytest.raises(ValueError, match=r"^loading\.tilt: not one of the scene's given"):
+        replace_loads(base, {"tilt": 1e-3})
+    with pytest.raises(ValueError, match=r"^loading\.force: must be a finite number"):
+        replace_loads(base, {"force": float("nan")})
+
+
 def test_failed_point_is_recorded_and_the_study_goes_on():
     from core.sweeps import sweep
 
