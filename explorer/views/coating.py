@@ -120,7 +120,7 @@ class CoatingCheckView:
 
     def __init__(self, app: ExplorerApp) -> None:
         self.app = app
-        self.button = pn.widgets.Button(name="check the coating model", button_type="default",
+        self.button = pn.widgets.Button(label="check the coating model",
                                         sizing_mode="stretch_width",
                                         css_classes=["coating-check-button"])
         self.progress = pn.indicators.Progress(active=True, visible=False,
