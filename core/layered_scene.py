@@ -51,8 +51,9 @@ __all__ = ["layered_declines", "solve_scene_layered"]
 #: Time samples of the load histories for the largest tilt between output times.
 TILT_SAMPLES = 257
 #: Most cosines the stack's kernel table may take (:func:`core.layered_kernel.table_cost`):
-#: measured 3.1e7 in 0.4 s of CPU (a / H = 20, h = a / 20), 1.4e8 in 5.9 s (a / H = 10,
-#: h = 0.003 a), 1.2e9 in 21.5 s (a / H = 100): beyond, the thin layer answers (~0.1 s).
+#: measured 3.5e6 in 0.06 s of CPU (a / H = 20, h = a / 20), 1.6e7 in 0.32 s (a / H = 10,
+#: h = 0.003 a), 2.2e7 in 0.21 s (a / H = 50, h = a / 20): ~1 s at the bound; beyond, the
+#: thin layer answers (~0.1 s).
 MAX_TABLE_COST = 5e7
 #: A pressure below this share of its largest value is taken as lift-off.
 LIFT_OFF_SHARE = 1e-9
