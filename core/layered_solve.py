@@ -41,14 +41,20 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.fft import dct
+from scipy.fft import dct, next_fast_len
 
 from core.layered_cache import LAYERED_OPERATOR, LAYERED_RESPONSE, LAYERED_TABLE, gap_key, stack_key
-from core.layered_kernel import RegularPartTable, UniformLayer, symbol_at_infinity
+from core.layered_kernel import (
+    _PANEL_DEGREE,
+    COARSE_PANEL_DEGREE,
+    RegularPartTable,
+    UniformLayer,
+    symbol_at_infinity,
+)
 
 __all__ = ["FlatPunchStiffness", "LayeredAnswer", "LayeredResponse", "MAX_MODES",
            "MAX_NODES", "default_modes", "flat_punch_stiffness", "layered_response",
-           "node_count", "solve_layered"]
+           "node_count", "solve_layered", "table_degree"]
 
 #: Chebyshev modes of the pressure per ``sqrt(a / h_min)``: the edge boundary layer of
 #: width ``h`` is ``sqrt(h / a)`` wide in the angle of ``t = cos(theta)``. Measured (smooth,
@@ -67,6 +73,14 @@ NODES_PER_MODE = 4
 #: must resolve h. Measured (bonded, h = 0.008 a, E_c = 0.01 E, crowned punch with a
 #: kink): spacing 0.73 h errs by 3e-7 in the settlement, 0.36 h by 1e-13.
 NODES_PER_THICKNESS = 3 * np.pi
+#: Tolerances at or above this take the coarser quadrature and table below: their error
+#: (<= 2e-10 measured) stays 250x below the ``tol / 2`` a solve aims at.
+COARSE_TOL = 1e-7
+#: Nodes per ``a / h_min`` for ``tol >= COARSE_TOL`` (spacing 0.5 h). Measured against
+#: 6 pi on rounded_graded at tol 1e-6 (135 modes): 3 pi 1.6e-14, 2.4 pi 1.5e-13, 2 pi
+#: 2.1e-11, 1.6 pi 2.7e-9, 1.4 pi 3.0e-8 in force and moment; a soft bonded and a stiff
+#: smooth coating (240-270 modes) are set by the modes there, 3.5e-14 and 1e-16.
+COARSE_NODES_PER_THICKNESS = 2 * np.pi
 #: Most nodes (a 4096^2 table lookup and product, a few seconds): coatings thinner than
 #: ``NODES_PER_THICKNESS a / MAX_NODES`` (2.3e-3 a) are left to the thin-layer model.
 MAX_NODES = 4096
@@ -79,6 +93,8 @@ MAX_RATIO = 0.9
 #: relative, tests/test_layered_kernel.py) and the kernel's ~1e-14; settled answers change
 #: by ~1e-12 between mode counts (a flat punch, h = 0.02 a, H = 4 a: 1.5e-12 in q).
 ERROR_FLOOR = 1e-12
+#: The floor for ``tol >= COARSE_TOL``: the coarser table's 1.1e-10 and quadrature's 2e-11.
+COARSE_ERROR_FLOOR = 2e-10
 #: A gap: ``g*(t)`` [-] as a vectorized callable of ``t`` in [-1, 1], a number, or None.
 Gap = Callable[[np.ndarray], np.ndarray] | float | None
 #: Pressure errors are measured on ``|t| <= PRESSURE_REACH`` (the corner singularities).
@@ -86,12 +102,21 @@ PRESSURE_REACH = 0.9
 _NAMES = ("settlement", "tilt", "force", "moment")
 
 
-def node_count(half_width: float, layers: Sequence[UniformLayer], modes: int) -> int:
+def node_count(half_width: float, layers: Sequence[UniformLayer], modes: int, *,
+               tol: float = 0.0) -> int:
     """Gauss-Chebyshev nodes [-]: ``max(NODES_PER_MODE modes, NODES_PER_THICKNESS a /
-    h_min)``."""
+    h_min)`` (:data:`COARSE_NODES_PER_THICKNESS` for ``tol >= COARSE_TOL``), rounded up
+    to a product of 2, 3 and 5: the Galerkin matrix's DCTs then take half the time
+    (1179 nodes 28 ms, 1200 nodes 13 ms)."""
     thinnest = min([lay.thickness for lay in layers] + [half_width])
-    return max(NODES_PER_MODE * modes,
-               int(np.ceil(NODES_PER_THICKNESS * half_width / thinnest)))
+    per_thickness = COARSE_NODES_PER_THICKNESS if tol >= COARSE_TOL else NODES_PER_THICKNESS
+    return next_fast_len(max(NODES_PER_MODE * modes,
+                             int(np.ceil(per_thickness * half_width / thinnest))), real=True)
+
+
+def table_degree(tol: float) -> int:
+    """The Chebyshev degree [-] of the stack's table for a solve to ``tol`` [-]."""
+    return COARSE_PANEL_DEGREE if tol >= COARSE_TOL else _PANEL_DEGREE
 
 
 def default_modes(half_width: float, layers: Sequence[UniformLayer]) -> int:
@@ -227,32 +252,37 @@ def _chebyshev_rows(t: np.ndarray, modes: int) -> np.ndarray:
 def layered_response(half_width: float, layers: Sequence[UniformLayer],
                      base_thickness: float, base_modulus: float, base_poisson: float,
                      gap: Gap = None, breakpoints: Sequence[float] = (), *, modes: int,
-                     table: RegularPartTable | None = None) -> LayeredResponse:
+                     table: RegularPartTable | None = None,
+                     tol: float = 0.0) -> LayeredResponse:
     """The unit responses of a punch of half-width a [m] on ``layers`` (top first) over the
     base (H [m], E [Pa], nu), with ``modes`` Chebyshev modes.
 
     ``gap``: ``g*(t) = g(a t) / a`` [-] as a vectorized callable of ``t`` in [-1, 1], a
     number or None (flat punch); ``breakpoints`` in ``t`` where it may kink. ``table`` a
     :class:`RegularPartTable` of this stack reaching ``2 a / H`` (built when None).
+    ``tol`` [-]: the accuracy the answer is for (:func:`node_count`, :func:`table_degree`;
+    the finest rules by default).
     """
     if half_width <= 0 or not np.isfinite(half_width):
         raise ValueError(f"half_width: must be a finite positive number, got {half_width!r}")
     lam = half_width / base_thickness
     if table is None:
-        table = RegularPartTable(2 * lam, layers, base_thickness, base_modulus, base_poisson)
-    n_nodes = node_count(half_width, layers, modes)
+        table = RegularPartTable(2 * lam, layers, base_thickness, base_modulus, base_poisson,
+                                 degree=table_degree(tol))
+    n_nodes = node_count(half_width, layers, modes, tol=tol)
     matrix = _operator(half_width, layers, base_thickness, base_modulus, base_poisson,
-                       modes, table)
+                       modes, table, n_nodes)
     return _unit_responses(lam, matrix, gap, breakpoints, n_nodes)
 
 
 def _operator(half_width: float, layers: Sequence[UniformLayer], base_thickness: float,
               base_modulus: float, base_poisson: float, modes: int,
-              table: RegularPartTable) -> np.ndarray:
-    """The Galerkin matrix of the stack on ``modes`` modes (:func:`_galerkin_matrix`)."""
+              table: RegularPartTable, n_nodes: int) -> np.ndarray:
+    """The Galerkin matrix of the stack on ``modes`` modes and ``n_nodes`` nodes
+    (:func:`_galerkin_matrix`)."""
     lam = half_width / base_thickness
     l_inf = symbol_at_infinity(layers, base_modulus, base_poisson)
-    return _galerkin_matrix(lam, l_inf, table, modes, node_count(half_width, layers, modes))
+    return _galerkin_matrix(lam, l_inf, table, modes, n_nodes)
 
 
 def _unit_responses(lam: float, matrix: np.ndarray, gap: Gap, breakpoints: Sequence[float],
@@ -274,12 +304,16 @@ def _unit_responses(lam: float, matrix: np.ndarray, gap: Gap, breakpoints: Seque
 def _cached_response(half_width: float, layers: Sequence[UniformLayer],
                      base_thickness: float, base_modulus: float, base_poisson: float,
                      gap: Gap, breakpoints: Sequence[float], modes: int,
-                     keys: tuple[str, str], built: dict[str, float]) -> LayeredResponse:
+                     keys: tuple[str, str], built: dict[str, float],
+                     tol: float = 0.0) -> LayeredResponse:
     """:func:`layered_response` through the caches of :mod:`core.layered_cache` (``keys``:
     the stack's and the gap's): a repeat with other loads builds nothing. Adds the CPU
     seconds of what it builds to ``built`` (``operator``: the stack's table and Galerkin
-    matrix; ``galerkin``: the unit responses)."""
+    matrix; ``galerkin``: the unit responses). ``tol`` chooses the table's degree and the
+    nodes (:func:`table_degree`, :func:`node_count`), which the keys then carry."""
     stack, gap_id = keys
+    degree = table_degree(tol)
+    n_nodes = node_count(half_width, layers, modes, tol=tol)
 
     def timed(stage: str, compute: Callable[[], Any]) -> Callable[[], Any]:
         def run() -> Any:
@@ -290,16 +324,17 @@ def _cached_response(half_width: float, layers: Sequence[UniformLayer],
         return run
 
     def response() -> LayeredResponse:
-        table, _ = LAYERED_TABLE.get_or_compute(stack, timed("operator", lambda: (
+        table, _ = LAYERED_TABLE.get_or_compute((stack, degree), timed("operator", lambda: (
             RegularPartTable(2 * half_width / base_thickness, layers, base_thickness,
-                             base_modulus, base_poisson))))
-        matrix, _ = LAYERED_OPERATOR.get_or_compute((stack, modes), timed("operator", lambda: (
-            _operator(half_width, layers, base_thickness, base_modulus, base_poisson, modes,
-                      table))))
+                             base_modulus, base_poisson, degree=degree))))
+        matrix, _ = LAYERED_OPERATOR.get_or_compute(
+            (stack, modes, n_nodes), timed("operator", lambda: (
+                _operator(half_width, layers, base_thickness, base_modulus, base_poisson,
+                          modes, table, n_nodes))))
         return _unit_responses(half_width / base_thickness, matrix, gap, breakpoints,
-                               node_count(half_width, layers, modes))
+                               n_nodes)
 
-    return LAYERED_RESPONSE.get_or_compute((stack, modes, gap_id),
+    return LAYERED_RESPONSE.get_or_compute((stack, modes, n_nodes, gap_id),
                                            timed("galerkin", response))[0]
 
 
@@ -362,8 +397,10 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
     below ``tol / 2``. The estimate: ``d1 r / (1 - r)`` from the differences ``d1`` of the
     answer with half the modes and ``d0`` of half against a quarter, ``r = min(d1 / d0,
     MAX_RATIO)`` (the unknowns, and q on ``|t| <= 0.9``, over all the given values), at
-    least :data:`ERROR_FLOOR`. It measures the truncation of the modes; the quadrature is
-    fixed by :func:`node_count`, whose rule was measured to leave ~1e-13.
+    least :data:`ERROR_FLOOR` (:data:`COARSE_ERROR_FLOOR` for ``tol >= COARSE_TOL``). It
+    measures the truncation of the modes; the quadrature (:func:`node_count`) and the
+    stack's table (:func:`table_degree`) were measured to leave ~1e-13, or below 2e-10 for
+    ``tol >= COARSE_TOL``.
     """
     if len(given) != 2 or not set(given) <= set(_NAMES):
         raise ValueError(f"given: must be two of {', '.join(_NAMES)}, got {sorted(given)}")
@@ -371,19 +408,21 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
     keys = (stack_key(half_width, layers, base_thickness, base_modulus, base_poisson),
             gap_key(gap, breakpoints))
     modes = min(default_modes(half_width, layers), max_modes)
+    floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
     built: dict[str, float] = {}
     start = time.perf_counter()
     unknowns = [n for n in _NAMES if n not in given]
     while True:
         response = _cached_response(half_width, layers, base_thickness, base_modulus,
-                                    base_poisson, gap, breakpoints, modes, keys, built)
+                                    base_poisson, gap, breakpoints, modes, keys, built,
+                                    tol=tol)
         fine = response.complete(given)
         d1 = _differences(response, given, fine, level=1)
         d0 = _differences(response, given, fine, level=2)
         errors = {}
         for name in unknowns + ["pressure"]:
             ratio = min(d1[name] / d0[name], MAX_RATIO) if d0[name] > 0 else MAX_RATIO
-            errors[name] = max(d1[name] * ratio / (1 - ratio), ERROR_FLOOR)
+            errors[name] = max(d1[name] * ratio / (1 - ratio), floor)
         estimate = max(errors.values())
         if estimate <= 0.5 * tol or 2 * modes > max_modes:
             break

@@ -270,3 +270,13 @@ def test_mixed_stack_recursion_against_one_linear_system(interfaces):
     # measured <= 1.3e-13 below u = 1 (both lose ~1e-16 / u^2 there: the soft top layer
     # makes the system's rows span 1e2), <= 6.2e-15 above
     assert err[u < 1].max() < 4e-13 and err[u >= 1].max() < 2e-14
+
+
+def test_coarse_table_for_coarser_tolerances():
+    from core.layered_kernel import COARSE_PANEL_DEGREE
+
+    layers = [UniformLayer(0.01, 0.005, 0.45, "bonded")]
+    table = RegularPartTable(2.0, layers, **BASE, degree=COARSE_PANEL_DEGREE)
+    s = np.concatenate([np.geomspace(1e-6, 2.0, 200), np.linspace(0, 2, 201)])
+    # measured 1.1e-10 (the soft bonded layer: L_inf = 166, values down to -894)
+    assert np.abs(table(s) - stack_kernel_regular(s, layers, **BASE)).max() < 3e-10
