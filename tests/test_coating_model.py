@@ -192,3 +192,27 @@ def test_check_compares_in_full_contact_as_the_fe_model():
     copy = elastic_scene(scene_from_dict(d))
     assert copy.contact == "full" and copy.creep.spec["model"] == "elastic"
     assert solve(copy).contact_lost
+
+
+def test_the_error_map_read_from_its_data_file_is_the_measured_one():
+    import hashlib
+
+    from benchmarks.coating_validity import _table_json
+    from core import coating_error_table as table
+
+    parts = [table.THICKNESS_RATIOS, table.MODULUS_RATIOS, table.COATING_POISSON,
+             table.BASE_RATIOS] + [table.ERRORS[i][p] for i in ("smooth", "bonded")
+                                   for p in ("force", "moment")]
+    digest = hashlib.sha256()
+    for values in parts:
+        array = np.ascontiguousarray(np.array(values, dtype=float), dtype="<f8")
+        digest.update(array.tobytes())
+        digest.update(str(array.shape).encode())
+    # the digest of the map as it stood in Python literals (commit 0127960), bit for bit
+    assert digest.hexdigest() == ("574c386ba39263390dc3c33702e6f45f"
+                                  "cddde55e824278f7406a972e87132b0c")
+    # the generator writes the file back unchanged
+    errors = {i: {p: np.array(table.ERRORS[i][p]) for p in ("force", "moment")}
+              for i in ("smooth", "bonded")}
+    path = Path(table.__file__).with_name("coating_error_table.json")
+    assert _table_json(errors) == path.read_text(encoding="utf-8")
