@@ -68,13 +68,18 @@ MIN_MODES = 32
 MAX_MODES = 512
 #: Gauss-Chebyshev nodes of the smooth part per mode.
 NODES_PER_MODE = 4
+#: The same for ``tol >= COARSE_TOL``. Measured at tol 1e-6 against tol 1e-11 with 4 per
+#: mode (force and moment; 135-270 modes): 2 per mode leaves 1.1e-13 (uniform_flat),
+#: 1.4e-11 (rounded_graded: its nodes are set by the thickness), 2.3e-10 (soft bonded,
+#: h = 0.008 a: the coarser table's floor), 2.1e-12 (stiff smooth, H = a / 2).
+COARSE_NODES_PER_MODE = 2
 #: Nodes per ``a / h_min``: the smooth part ``K`` turns from the top coating's logarithm
 #: to the base's over distances ~ h, so the node spacing at the centre (``pi / nodes``)
 #: must resolve h. Measured (bonded, h = 0.008 a, E_c = 0.01 E, crowned punch with a
 #: kink): spacing 0.73 h errs by 3e-7 in the settlement, 0.36 h by 1e-13.
 NODES_PER_THICKNESS = 3 * np.pi
 #: Tolerances at or above this take the coarser quadrature and table below: their error
-#: (<= 2e-10 measured) stays 250x below the ``tol / 2`` a solve aims at.
+#: (<= 2.3e-10 measured) stays 200x below the ``tol / 2`` a solve aims at.
 COARSE_TOL = 1e-7
 #: Nodes per ``a / h_min`` for ``tol >= COARSE_TOL`` (spacing 0.5 h). Measured against
 #: 6 pi on rounded_graded at tol 1e-6 (135 modes): 3 pi 1.6e-14, 2.4 pi 1.5e-13, 2 pi
@@ -93,8 +98,9 @@ MAX_RATIO = 0.9
 #: relative, tests/test_layered_kernel.py) and the kernel's ~1e-14; settled answers change
 #: by ~1e-12 between mode counts (a flat punch, h = 0.02 a, H = 4 a: 1.5e-12 in q).
 ERROR_FLOOR = 1e-12
-#: The floor for ``tol >= COARSE_TOL``: the coarser table's 1.1e-10 and quadrature's 2e-11.
-COARSE_ERROR_FLOOR = 2e-10
+#: The floor for ``tol >= COARSE_TOL``: the coarser table and quadrature, measured to
+#: leave up to 2.3e-10 (:data:`COARSE_NODES_PER_MODE`).
+COARSE_ERROR_FLOOR = 5e-10
 #: A gap: ``g*(t)`` [-] as a vectorized callable of ``t`` in [-1, 1], a number, or None.
 Gap = Callable[[np.ndarray], np.ndarray] | float | None
 #: Pressure errors are measured on ``|t| <= PRESSURE_REACH`` (the corner singularities).
@@ -105,12 +111,14 @@ _NAMES = ("settlement", "tilt", "force", "moment")
 def node_count(half_width: float, layers: Sequence[UniformLayer], modes: int, *,
                tol: float = 0.0) -> int:
     """Gauss-Chebyshev nodes [-]: ``max(NODES_PER_MODE modes, NODES_PER_THICKNESS a /
-    h_min)`` (:data:`COARSE_NODES_PER_THICKNESS` for ``tol >= COARSE_TOL``), rounded up
-    to a product of 2, 3 and 5: the Galerkin matrix's DCTs then take half the time
-    (1179 nodes 28 ms, 1200 nodes 13 ms)."""
+    h_min)`` (:data:`COARSE_NODES_PER_MODE`, :data:`COARSE_NODES_PER_THICKNESS` for ``tol
+    >= COARSE_TOL``), rounded up to a product of 2, 3 and 5: the Galerkin matrix's DCTs
+    then take half the time (1179 nodes 28 ms, 1200 nodes 13 ms)."""
     thinnest = min([lay.thickness for lay in layers] + [half_width])
-    per_thickness = COARSE_NODES_PER_THICKNESS if tol >= COARSE_TOL else NODES_PER_THICKNESS
-    return next_fast_len(max(NODES_PER_MODE * modes,
+    coarse = tol >= COARSE_TOL
+    per_thickness = COARSE_NODES_PER_THICKNESS if coarse else NODES_PER_THICKNESS
+    per_mode = COARSE_NODES_PER_MODE if coarse else NODES_PER_MODE
+    return next_fast_len(max(per_mode * modes,
                              int(np.ceil(per_thickness * half_width / thinnest))), real=True)
 
 
@@ -305,15 +313,21 @@ def _cached_response(half_width: float, layers: Sequence[UniformLayer],
                      base_thickness: float, base_modulus: float, base_poisson: float,
                      gap: Gap, breakpoints: Sequence[float], modes: int,
                      keys: tuple[str, str], built: dict[str, float],
-                     tol: float = 0.0) -> LayeredResponse:
+                     tol: float = 0.0, room: int = 0) -> LayeredResponse:
     """:func:`layered_response` through the caches of :mod:`core.layered_cache` (``keys``:
     the stack's and the gap's): a repeat with other loads builds nothing. Adds the CPU
     seconds of what it builds to ``built`` (``operator``: the stack's table and Galerkin
     matrix; ``galerkin``: the unit responses). ``tol`` chooses the table's degree and the
-    nodes (:func:`table_degree`, :func:`node_count`), which the keys then carry."""
+    nodes (:func:`table_degree`, :func:`node_count`), which the keys then carry.
+
+    The Galerkin matrix is built for ``max(modes, room)`` modes on the nodes those need
+    and its leading block answers: a solve that doubles its modes within ``room`` reuses
+    it (the leading block of the larger matrix is the smaller one, the same DCT rows).
+    """
     stack, gap_id = keys
     degree = table_degree(tol)
-    n_nodes = node_count(half_width, layers, modes, tol=tol)
+    room = max(modes, room)
+    n_nodes = node_count(half_width, layers, room, tol=tol)
 
     def timed(stage: str, compute: Callable[[], Any]) -> Callable[[], Any]:
         def run() -> Any:
@@ -328,13 +342,13 @@ def _cached_response(half_width: float, layers: Sequence[UniformLayer],
             RegularPartTable(2 * half_width / base_thickness, layers, base_thickness,
                              base_modulus, base_poisson, degree=degree))))
         matrix, _ = LAYERED_OPERATOR.get_or_compute(
-            (stack, modes, n_nodes), timed("operator", lambda: (
+            (stack, degree, room, n_nodes), timed("operator", lambda: (
                 _operator(half_width, layers, base_thickness, base_modulus, base_poisson,
-                          modes, table, n_nodes))))
-        return _unit_responses(half_width / base_thickness, matrix, gap, breakpoints,
-                               n_nodes)
+                          room, table, n_nodes))))
+        return _unit_responses(half_width / base_thickness, matrix[:modes, :modes], gap,
+                               breakpoints, n_nodes)
 
-    return LAYERED_RESPONSE.get_or_compute((stack, modes, n_nodes, gap_id),
+    return LAYERED_RESPONSE.get_or_compute((stack, degree, modes, n_nodes, gap_id),
                                            timed("galerkin", response))[0]
 
 
@@ -399,7 +413,7 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
     MAX_RATIO)`` (the unknowns, and q on ``|t| <= 0.9``, over all the given values), at
     least :data:`ERROR_FLOOR` (:data:`COARSE_ERROR_FLOOR` for ``tol >= COARSE_TOL``). It
     measures the truncation of the modes; the quadrature (:func:`node_count`) and the
-    stack's table (:func:`table_degree`) were measured to leave ~1e-13, or below 2e-10 for
+    stack's table (:func:`table_degree`) were measured to leave ~1e-13, or up to 2.3e-10 for
     ``tol >= COARSE_TOL``.
     """
     if len(given) != 2 or not set(given) <= set(_NAMES):
@@ -408,6 +422,10 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
     keys = (stack_key(half_width, layers, base_thickness, base_modulus, base_poisson),
             gap_key(gap, breakpoints))
     modes = min(default_modes(half_width, layers), max_modes)
+    # room for one doubling in the first Galerkin matrix: the default modes often fall
+    # short once (uniform_flat at tol 1e-6: 85 modes, then 170), and the nodes of twice
+    # the modes cost little more when the coating's thickness sets them
+    room = min(2 * modes, max_modes)
     floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
     built: dict[str, float] = {}
     start = time.perf_counter()
@@ -415,7 +433,7 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
     while True:
         response = _cached_response(half_width, layers, base_thickness, base_modulus,
                                     base_poisson, gap, breakpoints, modes, keys, built,
-                                    tol=tol)
+                                    tol=tol, room=room)
         fine = response.complete(given)
         d1 = _differences(response, given, fine, level=1)
         d0 = _differences(response, given, fine, level=2)
