@@ -170,6 +170,8 @@ def stack_symbol(u: ArrayLike, layers: Sequence[UniformLayer], base_thickness: f
 # panel; its end ``u = _TAIL_DECAY / h_min``, where the coating's share ``exp(-2 u h_min)``
 # is below 1e-17; panels of at most ``_PHASE_PER_PANEL`` radians of the cosine ``cos(s u)``.
 _GAUSS_POINTS, _TAIL_DECAY, _PHASE_PER_PANEL = 16, 20.0, 12.0
+# computed once: leggauss's eigenvalue problem was 1/10 of a new stack's table
+_GAUSS_RULE = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
 #: Beyond this u the base's own share ``exp(-2 u)`` is below 1e-17: only the coating's
 #: scale ``H / h`` (and the cosine) limits the panels there.
 _BASE_REACH = 20.0
@@ -204,7 +206,7 @@ def _u_rule(layers: Sequence[UniformLayer], base_thickness: float,
     while edges[-1] < end:
         edges.append(min(end, edges[-1] + min(widest, (_PANEL_GROWTH - 1) * edges[-1])))
     edges_arr = np.array(edges)
-    x, w = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
+    x, w = _GAUSS_RULE
     half = 0.5 * np.diff(edges_arr)
     mid = 0.5 * (edges_arr[1:] + edges_arr[:-1])
     return (mid[:, None] + half[:, None] * x).ravel(), (half[:, None] * w).ravel()

@@ -91,7 +91,9 @@ def layered_declines(scene: Any, problem: Any) -> str | None:
     modes = default_modes(scene.half_width, layers)
     if modes > MAX_MODES or node_count(scene.half_width, layers, modes) > MAX_NODES:
         return "the coating is thinner than the layered solve resolves"
-    if _table_cost(2 * scene.half_width / scene.base_thickness, tuple(layers),
+    # the cost depends on the thicknesses alone: other moduli share the kept value
+    shapes = tuple(UniformLayer(lay.thickness, 1.0, 0.0) for lay in layers)
+    if _table_cost(2 * scene.half_width / scene.base_thickness, shapes,
                    scene.base_thickness) > MAX_TABLE_COST:
         return "the stack's kernel table would take too long (a thin base or coating)"
     if problem.breakpoints:

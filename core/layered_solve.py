@@ -91,6 +91,11 @@ COARSE_NODES_PER_THICKNESS = 2 * np.pi
 MAX_NODES = 4096
 #: Gauss-Legendre points per panel of the gap's moments (panels of ~ pi / modes in angle).
 GAP_POINTS = 12
+_GAP_RULE = np.polynomial.legendre.leggauss(GAP_POINTS)
+#: Gap moments kept per (gap, modes): a new coating under the same punch reuses them
+#: (they were a fifth of a new rounded_graded coating's solve).
+_GAP_MOMENTS_KEPT = 32
+_gap_moments_kept: dict[tuple[str, int], np.ndarray] = {}
 #: Geometric extrapolation of the last two differences uses at most this ratio (a slower
 #: decrease is not trusted: the estimate is then 9x the last difference).
 MAX_RATIO = 0.9
@@ -167,7 +172,7 @@ def _gap_moments(gap: Callable[[np.ndarray], np.ndarray], breakpoints: Sequence[
     count = max(4, modes // 2)
     edges = np.unique(np.concatenate([np.linspace(lo, hi, max(2, int(np.ceil(
         count * (hi - lo) / np.pi)) + 1)) for lo, hi in zip(cuts[:-1], cuts[1:], strict=True)]))
-    x, w = np.polynomial.legendre.leggauss(GAP_POINTS)
+    x, w = _GAP_RULE
     half = 0.5 * np.diff(edges)
     theta = (0.5 * (edges[1:] + edges[:-1])[:, None] + half[:, None] * x).ravel()
     weights = (half[:, None] * w).ravel()
@@ -293,13 +298,33 @@ def _operator(half_width: float, layers: Sequence[UniformLayer], base_thickness:
     return _galerkin_matrix(lam, l_inf, table, modes, n_nodes)
 
 
+def _kept_gap_moments(gap: Callable[[np.ndarray], np.ndarray], breakpoints: Sequence[float],
+                      modes: int, gap_id: str | None) -> np.ndarray:
+    """:func:`_gap_moments`, kept per ``(gap_id, modes)`` when ``gap_id`` is given."""
+    if gap_id is None:
+        return _gap_moments(gap, breakpoints, modes)
+    key = (gap_id, modes)
+    with _chebyshev_lock:
+        kept = _gap_moments_kept.get(key)
+    if kept is not None:
+        return kept
+    moments = _gap_moments(gap, breakpoints, modes)
+    moments.setflags(write=False)
+    with _chebyshev_lock:
+        while len(_gap_moments_kept) >= _GAP_MOMENTS_KEPT:
+            del _gap_moments_kept[next(iter(_gap_moments_kept))]  # the oldest
+        _gap_moments_kept[key] = moments
+    return moments
+
+
 def _unit_responses(lam: float, matrix: np.ndarray, gap: Gap, breakpoints: Sequence[float],
-                    n_nodes: int) -> LayeredResponse:
-    """The responses to the gap, a unit settlement and a unit tilt on ``matrix``."""
+                    n_nodes: int, gap_id: str | None = None) -> LayeredResponse:
+    """The responses to the gap, a unit settlement and a unit tilt on ``matrix``
+    (``gap_id``: the gap's key, to reuse its moments)."""
     modes = matrix.shape[0]
     rhs = np.zeros((modes, 3))
     if callable(gap):
-        rhs[:, 0] = -np.pi * _gap_moments(gap, breakpoints, modes)
+        rhs[:, 0] = -np.pi * _kept_gap_moments(gap, breakpoints, modes, gap_id)
     elif gap:
         rhs[0, 0] = -np.pi * np.pi * float(gap)
     rhs[0, 1] = np.pi * np.pi
@@ -346,7 +371,7 @@ def _cached_response(half_width: float, layers: Sequence[UniformLayer],
                 _operator(half_width, layers, base_thickness, base_modulus, base_poisson,
                           room, table, n_nodes))))
         return _unit_responses(half_width / base_thickness, matrix[:modes, :modes], gap,
-                               breakpoints, n_nodes)
+                               breakpoints, n_nodes, gap_id)
 
     return LAYERED_RESPONSE.get_or_compute((stack, degree, modes, n_nodes, gap_id),
                                            timed("galerkin", response))[0]
