@@ -5,7 +5,7 @@
 
 For ``sum h / 2a = 0.02, 0.05``, ``E_c / E = 0.05, 1, 3``, ``nu_c = 0.3, 0.45``, smooth and
 bonded, ``H = a``, base ``nu = 0.2``: the force per unit settlement and the moment per unit
-tilt of :func:`core.layered_solve.flat_punch_stiffness` (the layered kernel) and of the
+tilt of :func:`core.layered_stiffness.flat_punch_stiffness` (the layered kernel) and of the
 thin-layer model (:func:`benchmarks.coating_validity.fast_stiffness` with the compliance of
 :func:`core.coating_model.layer_compliance`), each as a relative difference from the FE
 model of :mod:`core.fem_check` at mesh level 1; the FE model's own discretisation error is
@@ -24,7 +24,7 @@ from benchmarks.coating_validity import BASE_POISSON, fast_stiffness
 from core.coating_model import layer_compliance
 from core.fem_check import CoatingStrip, Stack, solve_stack
 from core.layered_kernel import UniformLayer
-from core.layered_solve import flat_punch_stiffness
+from core.layered_stiffness import flat_punch_stiffness
 
 THICKNESS_RATIOS = (0.02, 0.05)
 MODULUS_RATIOS = (0.05, 1.0, 3.0)

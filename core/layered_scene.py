@@ -43,8 +43,9 @@ import numpy as np
 
 from core.coating_model import model_error_estimate, tilt_share
 from core.contact_solution import ContactSolution
+from core.layered_galerkin import MAX_MODES, MAX_NODES, default_modes, node_count
 from core.layered_kernel import UniformLayer, table_cost
-from core.layered_solve import MAX_MODES, MAX_NODES, default_modes, node_count, solve_layered
+from core.layered_solve import solve_layered
 
 __all__ = ["layered_declines", "solve_scene_layered"]
 

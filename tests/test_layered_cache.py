@@ -10,7 +10,7 @@ import numpy as np
 
 from core import solve
 from core.cache import clear_caches
-from core.layered_cache import LAYERED_OPERATOR, LAYERED_RESPONSE, LAYERED_TABLE
+from core.layered_cache import GAP_MOMENTS, LAYERED_OPERATOR, LAYERED_RESPONSE, LAYERED_TABLE
 
 SCENES = Path(__file__).resolve().parent.parent / "assets" / "scenes"
 STAGES = {"layered_table": LAYERED_TABLE, "layered_operator": LAYERED_OPERATOR,
@@ -106,6 +106,7 @@ def test_a_worker_s_budget_bounds_the_layered_caches_too() -> None:
 
 def test_kept_chebyshev_rows_are_the_computed_ones_and_bounded():
     from core import layered_solve as ls
+    from core.layered_cache import CHEBYSHEV_ROWS
 
     t = np.cos(np.linspace(0.0, np.pi, 91))
     direct = np.cos(np.outer(np.arccos(np.clip(t, -1, 1)), np.arange(40)))
@@ -113,9 +114,22 @@ def test_kept_chebyshev_rows_are_the_computed_ones_and_bounded():
     assert ls._chebyshev_rows(t.copy(), 40) is first  # equal points: the kept rows
     np.testing.assert_array_equal(first, direct)  # bit for bit
     assert not first.flags.writeable
-    for k in range(2 * ls._CHEBYSHEV_SETS):
+    kept = CHEBYSHEV_ROWS
+    for k in range(2 * kept.max_items):
         ls._chebyshev_rows(t, 41 + k)
-    assert len(ls._chebyshev_kept) == ls._CHEBYSHEV_SETS
+    assert len(kept._kept) == kept.max_items
     big = np.linspace(-1.0, 1.0, ls._CHEBYSHEV_MOST_VALUES // 40 + 1)
     ls._chebyshev_rows(big, 40)
-    assert all(key[0] != big.tobytes() for key in ls._chebyshev_kept)
+    assert all(key[0] != big.tobytes() for key in kept._kept)
+
+
+def test_a_new_coating_under_the_same_punch_reuses_the_gap_moments():
+    clear_caches()
+    scene = rounded_graded({"tilt": 0.0, "force": 8e5})
+    solve(scene)
+    before = dict(GAP_MOMENTS._kept)
+    d = copy.deepcopy(scene)
+    d["coating"][0]["modulus"] = 4e8
+    solve(d)
+    assert GAP_MOMENTS._kept.keys() == before.keys()
+    assert all(GAP_MOMENTS._kept[key] is before[key] for key in before)

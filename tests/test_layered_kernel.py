@@ -17,7 +17,7 @@ from core.layered_kernel import (
     stack_symbol,
     symbol_at_infinity,
 )
-from core.layered_solve import flat_punch_stiffness
+from core.layered_stiffness import flat_punch_stiffness
 
 BASE = dict(base_thickness=1.0, base_modulus=1.0, base_poisson=0.2)
 
