@@ -169,7 +169,7 @@ def stack_symbol(u: ArrayLike, layers: Sequence[UniformLayer], base_thickness: f
 # The u-integral's rule (:func:`_u_rule`, measured there): Gauss-Legendre points per
 # panel; its end ``u = _TAIL_DECAY / h_min``, where the coating's share ``exp(-2 u h_min)``
 # is below 1e-17; panels of at most ``_PHASE_PER_PANEL`` radians of the cosine ``cos(s u)``.
-_GAUSS_POINTS, _TAIL_DECAY, _PHASE_PER_PANEL = 16, 20.0, 12.0
+_GAUSS_POINTS, _TAIL_DECAY, _PHASE_PER_PANEL = 16, 20.0, 16.0
 # computed once: leggauss's eigenvalue problem was 1/10 of a new stack's table
 _GAUSS_RULE = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
 #: Beyond this u the base's own share ``exp(-2 u)`` is below 1e-17: only the coating's
@@ -186,7 +186,7 @@ def _u_rule(layers: Sequence[UniformLayer], base_thickness: float,
 
     Up to ``U = _TAIL_DECAY / min(h_k / H, 1) + _TAIL_DECAY``: panels of width <= 1 (the
     base's scale) up to :data:`_BASE_REACH`, then growing geometrically to half the
-    coating's scale ``H / 2 h_min``; all of width <= ``_PHASE_PER_PANEL / largest_s`` (two
+    coating's scale ``H / 2 h_min``; all of width <= ``_PHASE_PER_PANEL / largest_s`` (2.5
     periods of the cosine per panel). Uniform panels of width 1 all the way cost ``~40 H /
     h`` panels: 12 s of the 12.4 s of a flat-punch solve at ``h = 0.001 H`` before the
     grading.
@@ -194,8 +194,9 @@ def _u_rule(layers: Sequence[UniformLayer], base_thickness: float,
     Measured against a rule of 30 points, phase 2 and twice the reach (four stacks,
     ``h_min / H`` = 0.002 to 0.2, ``E_c / E`` = 0.005 to 30, 300 values of s): panels of 12
     and 16 radians leave <= 1.7e-12 (that reference's own rounding), 24 radians 6e-10, 32
-    radians 5e-6; 12 Gauss points instead of 16 leave 4e-9. Phase 4 with 24 points and
-    twice the reach took 3-8x the nodes for the same 1.7e-12.
+    radians 5e-6; 12 Gauss points instead of 16 leave 4e-9, a reach of 14 / h_min instead
+    of 20 / h_min 2.8e-9 (soft bonded layers). Phase 4 with 24 points and twice the reach
+    took 3-8x the nodes for the same 1.7e-12.
     """
     thinnest = min([lay.thickness / base_thickness for lay in layers] + [1.0])
     end = _TAIL_DECAY / thinnest + _TAIL_DECAY
