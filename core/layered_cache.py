@@ -5,11 +5,14 @@ depend on the loads, each kept in its own :class:`core.cache.StageCache` (counte
 by :func:`core.cache.clear_caches`):
 
 - ``layered_table``: the stack's regular part (:class:`core.layered_kernel.RegularPartTable`),
-  keyed by the stack alone (``a / H``, the layers, the base); most of a cold solve;
-- ``layered_operator``: the Galerkin matrix on ``modes`` Chebyshev modes, keyed by the
-  stack and ``modes`` (a gap change reuses it); most of a warm solve before this cache;
+  keyed by the stack (``a / H``, the layers, the base) and the table's degree; about a
+  third of a new geometry's solve;
+- ``layered_operator``: the Galerkin matrix, keyed by the stack, the table's degree, the
+  modes it holds (room for one doubling) and its nodes (a gap change reuses it); about
+  half of a new geometry's solve;
 - ``layered_response``: the unit responses (to the gap, a unit settlement, a unit tilt),
-  keyed by the operator's key, the gap's values and its breakpoints.
+  keyed by the stack, the degree, the modes, the nodes, the gap's values and its
+  breakpoints.
 
 A load slider's step (settlement, tilt, force, moment) is then the superposition of the
 cached unit responses (:meth:`core.layered_solve.LayeredResponse.complete`).
@@ -41,7 +44,7 @@ LAYERED_TABLE = StageCache("layered_table", max_items=8, max_bytes=16 * _MiB,
                            sizeof=lambda table: int(table.coefficients.nbytes
                                                     + table.edges.nbytes))
 #: Galerkin matrices: modes^2 doubles, 2 MiB at the most modes (512); a solve that doubles
-#: its modes keeps each level, so a handful per geometry.
+#: its modes beyond the first matrix's room keeps each level, so a handful per geometry.
 LAYERED_OPERATOR = StageCache("layered_operator", max_items=32, max_bytes=32 * _MiB)
 #: Unit responses: 3 x modes doubles and two coarser copies, a few tens of KiB each.
 LAYERED_RESPONSE = StageCache("layered_response", max_items=256, max_bytes=8 * _MiB)

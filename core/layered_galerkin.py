@@ -34,7 +34,7 @@ __all__ = ["COARSE_TOL", "MAX_MODES", "MAX_NODES", "default_modes", "galerkin_ma
 MODES_PER_ROOT = 12
 #: Fewest modes.
 MIN_MODES = 32
-#: Most modes (2048 nodes: a 2048^2 table lookup, ~1 s); a thinner coating than
+#: Most modes (up to 2048 nodes: a quarter of 2048^2 table reads); a thinner coating than
 #: ``(MODES_PER_ROOT / MAX_MODES)^2 a`` (5.5e-4 a) would need more from the start.
 MAX_MODES = 512
 #: Gauss-Chebyshev nodes of the smooth part per mode.
