@@ -339,7 +339,9 @@ class RegularPartTable:
         out = np.empty_like(flat)
         # Points grouped by panel, so Clenshaw runs with scalar coefficients: gathering
         # each point's own coefficients took half the time of a Galerkin matrix.
-        order = np.argsort(idx, kind="stable")
+        # (a stable sort of 16-bit integers is a radix sort: 4x faster than of int64)
+        small = np.uint16 if self.centre.size < 2**16 else np.int64
+        order = np.argsort(idx.astype(small), kind="stable")
         ends = np.cumsum(np.bincount(idx, minlength=self.centre.size))
         start = 0
         for panel, end in enumerate(ends):
