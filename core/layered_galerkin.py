@@ -42,7 +42,8 @@ NODES_PER_MODE = 4
 #: The same for ``tol >= COARSE_TOL``. Measured at tol 1e-6 against tol 1e-11 with 4 per
 #: mode (force and moment; 135-270 modes): 2 per mode leaves 1.1e-13 (uniform_flat),
 #: 1.4e-11 (rounded_graded: its nodes are set by the thickness), 2.3e-10 (soft bonded,
-#: h = 0.008 a: the coarser table's floor), 2.1e-12 (stiff smooth, H = a / 2).
+#: h = 0.008 a: the coarser table's floor), 2.1e-12 (stiff smooth, H = a / 2); bases much
+#: thinner than the punch (a / H = 5 to 40, h = 0.2 H to 2 H, bonded): <= 2.2e-10.
 COARSE_NODES_PER_MODE = 2
 #: Nodes per ``a / h_min``: the smooth part ``K`` turns from the top coating's logarithm
 #: to the base's over distances ~ h, so the node spacing at the centre (``pi / nodes``)
