@@ -248,13 +248,16 @@ def sweeps_point_outputs(result, outputs):
     return point_outputs(result, outputs)
 
 
-def test_load_batch_equals_core_solve_on_a_loads_grid():
+@pytest.mark.parametrize("contact", ["auto", "full"])
+def test_load_batch_equals_core_solve_on_a_loads_grid(contact):
     """core.sweep_loads answers the full-contact points of a force x moment grid at once,
-    equal to core.solve point by point; it leaves lift-off and refused points alone."""
+    equal to core.solve point by point; it leaves lift-off (``auto``) and refused points
+    alone; with ``full`` contact it answers the points that lose contact, flagged."""
     from core.scene import scene_from_dict
     from core.sweep_loads import load_batch_applies, solve_load_batch
 
     base = elastic_scene() | {"times": [1.0, 365.0]}
+    base["solver"] = dict(base.get("solver", {}), contact=contact)
     scene = scene_from_dict(base)
     assert load_batch_applies(scene)
     force, moment = (v.ravel() for v in np.meshgrid(np.linspace(1e5, 1e6, 7),
@@ -262,6 +265,7 @@ def test_load_batch_equals_core_solve_on_a_loads_grid():
     outputs = list(OUTPUTS)
     got = solve_load_batch(scene, {"force": force, "moment": moment}, outputs)
     kinds = {"failed": 0, "unilateral": 0, "full": 0}
+    lost = 0
     for i in range(force.size):
         try:
             result = solve(apply_point(base, {"loading.force": force[i],
@@ -277,7 +281,9 @@ def test_load_batch_equals_core_solve_on_a_loads_grid():
         assert got.answered[i]
         assert_batched_equal(got.values[i], got.error_estimate[i], result, outputs)
         assert got.flags[i] == ",".join(result.flags)
-    assert kinds["failed"] >= 1 and kinds["unilateral"] >= 1 and kinds["full"] >= 20
+        lost += "contact_lost" in result.flags
+    assert kinds["failed"] >= 1 and kinds["full"] >= 20
+    assert kinds["unilateral"] >= 1 if contact == "auto" else lost >= 1
 
 
 def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
