@@ -147,43 +147,87 @@ def _load_only_base(base: Mapping[str, Any], paths: Sequence[str]) -> Scene | No
     return scene
 
 
+def _given_load_paths(base: Mapping[str, Any], paths: Sequence[str]) -> list[int]:
+    """The indices of ``paths`` that name one of the base scene's given loads."""
+    given = base.get("loading", {})
+    return [j for j, path in enumerate(paths) if path.startswith("loading.")
+            and path.count(".") == 1 and path.split(".", 1)[1] in given]
+
+
+def _geometry_groups(base: Mapping[str, Any], paths: Sequence[str],
+                     values: np.ndarray) -> list[tuple[Mapping[str, Any] | None, np.ndarray]]:
+    """The batch's points grouped by their values of the fields that are not given loads
+    (in order of first appearance), each with its scene dict but for the loads (None when
+    it cannot be built: its points then report their own messages). Without a given load
+    among ``paths`` every point is its own geometry: one group, no shared scene."""
+    loads = _given_load_paths(base, paths)
+    others = [j for j in range(len(paths)) if j not in loads]
+    if not loads:
+        return [(None, np.arange(len(values)))]
+    if not others:
+        return [(base, np.arange(len(values)))]
+    keys: dict[tuple, list[int]] = {}
+    for i, row in enumerate(values):
+        keys.setdefault(tuple(float(row[j]) for j in others), []).append(i)
+    groups = []
+    for key, rows in keys.items():
+        try:
+            scene = apply_point(base, {paths[j]: v for j, v in zip(others, key, strict=True)})
+        except Exception:  # noqa: BLE001 - each point then reports its own message
+            scene = None
+        groups.append((scene, np.array(rows)))
+    return groups
+
+
 def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
               outputs: Sequence[str], n_times: int) -> dict[str, np.ndarray]:
     """Solve the points of one batch in order (``values[i]`` holds point i's value of each
-    of ``paths``). Returns arrays: ``values`` ``(m, len(outputs), n_times)``,
-    ``error_estimate`` (relative, -), ``flags`` (comma-joined), ``error`` (the message of a
-    failed point, else empty), ``seconds`` (per point)."""
+    of ``paths``). Points that differ only in given loads share one validated scene
+    (:func:`_geometry_groups`); on a scene of the exact layered kernel their full-contact
+    answers come at once (:func:`core.sweep_loads.solve_load_batch`). Returns arrays:
+    ``values`` ``(m, len(outputs), n_times)``, ``error_estimate`` (relative, -), ``flags``
+    (comma-joined), ``error`` (the message of a failed point, else empty), ``seconds``
+    (per point)."""
+    from core.sweep_loads import load_batch_applies, solve_load_batch
+
     m = len(values)
     out = np.full((m, len(outputs), n_times), np.nan)
     estimate = np.full(m, np.nan)
     flags = [""] * m
     errors = [""] * m
     seconds = np.zeros(m)
-    from core.sweep_loads import load_batch_applies, solve_load_batch
-
-    validated = _load_only_base(base, paths)
-    loads = [path.split(".", 1)[1] for path in paths]
+    load_columns = _given_load_paths(base, paths)
+    loads = [paths[j].split(".", 1)[1] for j in load_columns]
+    load_paths = [paths[j] for j in load_columns]
     batched = np.zeros(m, dtype=bool)
-    if validated is not None and m and load_batch_applies(validated):
-        # a linear problem: the whole batch at once, the points it leaves one by one
+    validated: list[Scene | None] = [None] * m
+    for scene_dict, rows in _geometry_groups(base, paths, values):
+        group = None if scene_dict is None else _load_only_base(scene_dict, load_paths)
+        for i in rows:
+            validated[i] = group
+        if group is None or not load_batch_applies(group):
+            continue
+        # a linear problem: the whole group at once, the points it leaves one by one
         start = time.perf_counter()
-        answer = solve_load_batch(validated, {q: values[:, j] for j, q in enumerate(loads)},
-                                  outputs)
-        batched = answer.answered
-        out[batched] = answer.values[batched]
-        estimate[batched] = answer.error_estimate[batched]
-        for i in np.flatnonzero(batched):
-            flags[i] = answer.flags[i]
-        seconds[batched] = (time.perf_counter() - start) / max(int(batched.sum()), 1)
+        answer = solve_load_batch(group, {q: values[rows, j] for q, j in
+                                          zip(loads, load_columns, strict=True)}, outputs)
+        done = rows[answer.answered]
+        batched[done] = True
+        out[done] = answer.values[answer.answered]
+        estimate[done] = answer.error_estimate[answer.answered]
+        for i, k in zip(rows, range(len(rows)), strict=True):
+            if answer.answered[k]:
+                flags[i] = answer.flags[k]
+        seconds[done] = (time.perf_counter() - start) / max(done.size, 1)
     for i, row in enumerate(values):
         if batched[i]:
             continue
         start = time.perf_counter()
         try:
-            if validated is not None:
-                # only the loads change: the base scene was validated once for the batch
-                scene = replace_loads(validated, {q: float(v) for q, v in
-                                                  zip(loads, row, strict=True)})
+            if validated[i] is not None:
+                # only the loads change: the group's scene was validated once
+                scene = replace_loads(validated[i], {q: float(row[j]) for q, j in
+                                                     zip(loads, load_columns, strict=True)})
             else:
                 scene = apply_point(base, dict(zip(paths, row, strict=True)))
             result = solve(scene)

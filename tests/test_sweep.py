@@ -498,3 +498,45 @@ def test_solving_does_not_import_dask():
                          text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_batch_groups_points_sharing_a_geometry(monkeypatch):
+    """Points that differ only in their loads share one validated scene and one load batch
+    per geometry; every answer equals core.solve on the point's whole scene dict, and a
+    geometry that does not validate leaves its points to report their own messages."""
+    import core.sweep_loads as sweep_loads
+    import core.sweeps as sweeps
+
+    study = study_from_dict(small_study())
+    paths = ["coating[0].modulus", "loading.force", "loading.moment"]
+    grid = np.array([(e, f, m) for e in (8e8, -1.0, 4e8) for f in (2e5, 6e5)
+                     for m in (0.0, 1e5, 1.9e5)])
+    calls = []
+    original = sweep_loads.solve_load_batch
+
+    def counted(scene, loads, outputs):
+        calls.append(len(next(iter(loads.values()))))
+        return original(scene, loads, outputs)
+
+    monkeypatch.setattr(sweep_loads, "solve_load_batch", counted)
+    outputs = list(OUTPUTS)
+    got = sweeps.run_batch(study.base, paths, grid, outputs, len(study.times))
+    assert calls == [6, 6]  # the two valid moduli; the negative one is not batched
+    kinds = {"failed": 0, "unilateral": 0, "full": 0}
+    for i, row in enumerate(grid):
+        try:
+            result = solve(apply_point(study.base, dict(zip(paths, row, strict=True))))
+        except ValueError as exc:
+            kinds["failed"] += 1
+            assert got["flags"][i] == "failed"
+            assert got["error"][i] == " ".join(str(exc).split())[:500]
+            continue
+        kinds[result.info["contact"]] += 1
+        if result.info["contact"] == "unilateral":
+            np.testing.assert_array_equal(got["values"][i],
+                                          sweeps.point_outputs(result, outputs))
+        else:
+            assert_batched_equal(got["values"][i], got["error_estimate"][i], result,
+                                 outputs)
+        assert got["flags"][i] == ",".join(result.flags) and got["error"][i] == ""
+    assert kinds["failed"] == 6 and kinds["unilateral"] >= 1 and kinds["full"] >= 6
