@@ -202,7 +202,9 @@ def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
     batched = np.zeros(m, dtype=bool)
     validated: list[Scene | None] = [None] * m
     for scene_dict, rows in _geometry_groups(base, paths, values):
-        group = None if scene_dict is None else _load_only_base(scene_dict, load_paths)
+        if scene_dict is None or (scene_dict is not base and len(rows) < 2):
+            continue  # nothing shared: the point's whole scene is validated on its own
+        group = _load_only_base(scene_dict, load_paths)
         for i in rows:
             validated[i] = group
         if group is None or not load_batch_applies(group):
