@@ -51,7 +51,7 @@ class LoadBatch:
     """The answers of :func:`solve_load_batch` for ``n`` points: ``answered`` (bool, n);
     where answered, ``values`` ``(n, len(outputs), n_times)`` in the units of
     :data:`core.study.OUTPUT_UNITS`, ``error_estimate`` (relative, -) and ``flags``
-    (comma-joined) as :func:`core.sweeps.run_batch` records a solved point."""
+    (comma-joined) as :func:`core.sweep_batch.run_batch` records a solved point."""
 
     answered: np.ndarray
     values: np.ndarray
@@ -131,7 +131,7 @@ def _differences(response: LayeredResponse, given: Mapping[str, np.ndarray],
 
 def _contact_width(x: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Length [m] of the part of ``x`` where ``q >= 0``, linear between points, per column."""
-    from core.sweeps import _contact_width as width
+    from core.sweep_batch import _contact_width as width
 
     return width(x, q)
 

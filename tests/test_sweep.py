@@ -290,6 +290,7 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
     """A batch varying only loads validates the base scene once and replaces the loads of
     each point: every output, estimate, flag and message equals core.solve's on the
     point's whole scene dict, lift-off and refused points included."""
+    import core.sweep_batch as batch
     import core.sweeps as sweeps
 
     study = study_from_dict(small_study(vary=[
@@ -302,7 +303,7 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
     def whole_scene(*args):
         raise AssertionError("a load-only batch must not rebuild each point's scene dict")
 
-    monkeypatch.setattr(sweeps, "apply_point", whole_scene)
+    monkeypatch.setattr(batch, "apply_point", whole_scene)
     got = sweeps.run_batch(study.base, paths, grid, outputs, len(study.times))
     monkeypatch.undo()
     kinds = {"failed": 0, "unilateral": 0, "full": 0}
