@@ -30,7 +30,7 @@ from .results import ResultView
 from .scales import DisplayScales
 from .state import ExplorerState
 from .status import status_html
-from .view_link import read_view_query
+from .view_link import read_study_query, read_view_query
 from .views.base import BaseView
 from .views.busy import BUSY_AFTER_MS, BusyIndicator
 from .views.check import CheckView
@@ -112,6 +112,11 @@ class ExplorerApp(pn.viewable.Viewer):
             self.pins.solve_from_link(pin_scenes)
         if pin_message and not self.notice:
             self.notice = pin_message
+        study_settings, study_message = read_study_query(query or {})
+        if study_settings is not None:
+            self.apply_study_settings(study_settings)
+        if study_message and not self.notice:
+            self.notice = study_message
         # Changes to plain Bokeh models made after the page was generated but before its
         # websocket connects would never reach the browser: hold them until it does.
         self._initializing = True

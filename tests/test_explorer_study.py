@@ -194,3 +194,51 @@ def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
     assert chart.flagged.data["y"][0] < 0  # kPa: the tension the flag is about
     rows = [line for line in result.to_csv().splitlines() if not line.startswith("#")]
     assert rows[-1].endswith('"contact_lost",""')
+
+
+def test_a_link_keeps_the_study_settings():
+    """The Study tab's fields, ranges, spacing, counts and output go into the page's link
+    and a page opened from it shows them again; bad settings are refused, not fatal."""
+    from explorer.app import ExplorerApp
+    from explorer.view_link import read_study_query, study_settings, view_query
+
+    app = ExplorerApp(executor=None)
+    first, second = app.study_first, app.study_second
+    first.field.value = "coating[0].modulus"
+    first.start.value, first.stop.value = 150.0, 1200.0
+    first.count.value, first.spacing.value = 7, "log"
+    second.field.value = "loading.force"
+    second.start.value, second.stop.value = 250.0, 650.0
+    second.count.value, second.spacing.value = 5, "linear"
+    app.study_output.value = "tilt"
+    settings = app.study_settings()
+    assert settings == {"axes": [["coating[0].modulus", 150.0, 1200.0, 7, "log"],
+                                 ["loading.force", 250.0, 650.0, 5, "linear"]],
+                        "output": "tilt"}
+    query = view_query(app.controller.view.scene, 0, 0, [], settings)
+    opened = ExplorerApp(executor=None, query=query)
+    assert opened.study_settings() == settings
+    assert opened.study_second.field.value == "loading.force"
+    assert opened.study_first.spacing.value == "log" and opened.study_first.count.value == 7
+    # one parameter: the second is left out
+    one = {"axes": [["loading.force", 100.0, 900.0, 4, "linear"]], "output": "q_max"}
+    opened = ExplorerApp(executor=None, query=view_query(app.controller.view.scene, 0, 0,
+                                                         [], one))
+    assert opened.study_settings() == one
+    # settings a page never writes: refused with the setting named, the page opens
+    for bad, reason in (({"axes": [], "output": "tilt"}, "study axes"),
+                        ({"axes": [["x", 1.0, float("nan"), 3, "log"]], "output": "tilt"},
+                         "'to' must be a finite number"),
+                        ({"axes": [["x", 1.0, 2.0, 10**6, "log"]], "output": "tilt"},
+                         "points must be an integer"),
+                        ({"axes": [["x", 1.0, 2.0, 3, "cubic"]], "output": "tilt"},
+                         "spacing"),
+                        ({"axes": [["x", 1.0, 2.0, 3, "log"]], "output": "__import__"},
+                         "study output")):
+        with pytest.raises(ValueError, match=reason):
+            study_settings(bad)
+    from explorer.links import encode_scene
+
+    settings, message = read_study_query({"study": encode_scene({"axes": "x"})})
+    assert settings is None and message.startswith("The study settings in the link were "
+                                                   "not used")

@@ -215,10 +215,82 @@ def test_serial_run_equals_the_loop_and_batches_follow_geometry():
     assert pairs == sorted(pairs)
 
 
+#: Batched against one-point answers, relative to the size of each kind of output
+#: (kinematics max(|delta|, a |alpha|), statics max(|P|, |M| / a), pressures max |q|,
+#: widths a): the batch's matrix products round differently. Measured at most 2.0e-15
+#: (q_min) over the 8,224 full-contact points of benchmarks.sweep.loads_study(100).
+BATCH_ROUNDING = 1e-13
+#: The error estimate extrapolates differences of answers near round-off (~1e-13), whose
+#: rounding differs the same way: measured at most 4.7e-7 relative on those points.
+BATCH_ESTIMATE_ROUNDING = 1e-5
+
+
+def assert_batched_equal(values, estimate, result, outputs):
+    """A batched point's outputs and estimate equal one point's solve to rounding."""
+    want = sweeps_point_outputs(result, outputs)
+    a = result.scene.half_width
+    rows = dict(zip(outputs, want, strict=True))
+    kin = max(np.max(np.abs(rows["settlement"])), a * np.max(np.abs(rows["tilt"])))
+    stat = max(np.max(np.abs(rows["force"])), np.max(np.abs(rows["moment"])) / a)
+    q = max(np.max(np.abs(rows["q_max"])), np.max(np.abs(rows["q_min"])))
+    scale = {"settlement": kin, "tilt": kin / a, "force": stat, "moment": stat * a,
+             "q_max": q, "q_min": q, "contact_width": a}
+    for j, name in enumerate(outputs):
+        np.testing.assert_allclose(values[j], want[j], rtol=0,
+                                   atol=BATCH_ROUNDING * scale[name], err_msg=name)
+    np.testing.assert_allclose(estimate, result.info["error_estimate"],
+                               rtol=BATCH_ESTIMATE_ROUNDING)
+
+
+def sweeps_point_outputs(result, outputs):
+    from core.sweeps import point_outputs
+
+    return point_outputs(result, outputs)
+
+
+@pytest.mark.parametrize("contact", ["auto", "full"])
+def test_load_batch_equals_core_solve_on_a_loads_grid(contact):
+    """core.sweep_loads answers the full-contact points of a force x moment grid at once,
+    equal to core.solve point by point; it leaves lift-off (``auto``) and refused points
+    alone; with ``full`` contact it answers the points that lose contact, flagged."""
+    from core.scene import scene_from_dict
+    from core.sweep_loads import load_batch_applies, solve_load_batch
+
+    base = elastic_scene() | {"times": [1.0, 365.0]}
+    base["solver"] = dict(base.get("solver", {}), contact=contact)
+    scene = scene_from_dict(base)
+    assert load_batch_applies(scene)
+    force, moment = (v.ravel() for v in np.meshgrid(np.linspace(1e5, 1e6, 7),
+                                                     np.linspace(0.0, 3e5, 6)))
+    outputs = list(OUTPUTS)
+    got = solve_load_batch(scene, {"force": force, "moment": moment}, outputs)
+    kinds = {"failed": 0, "unilateral": 0, "full": 0}
+    lost = 0
+    for i in range(force.size):
+        try:
+            result = solve(apply_point(base, {"loading.force": force[i],
+                                              "loading.moment": moment[i]}))
+        except ValueError:
+            kinds["failed"] += 1
+            assert not got.answered[i]
+            continue
+        kinds[result.info["contact"]] += 1
+        if result.info["contact"] == "unilateral":
+            assert not got.answered[i]
+            continue
+        assert got.answered[i]
+        assert_batched_equal(got.values[i], got.error_estimate[i], result, outputs)
+        assert got.flags[i] == ",".join(result.flags)
+        lost += "contact_lost" in result.flags
+    assert kinds["failed"] >= 1 and kinds["full"] >= 20
+    assert kinds["unilateral"] >= 1 if contact == "auto" else lost >= 1
+
+
 def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
     """A batch varying only loads validates the base scene once and replaces the loads of
     each point: every output, estimate, flag and message equals core.solve's on the
     point's whole scene dict, lift-off and refused points included."""
+    import core.sweep_batch as batch
     import core.sweeps as sweeps
 
     study = study_from_dict(small_study(vary=[
@@ -231,7 +303,7 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
     def whole_scene(*args):
         raise AssertionError("a load-only batch must not rebuild each point's scene dict")
 
-    monkeypatch.setattr(sweeps, "apply_point", whole_scene)
+    monkeypatch.setattr(batch, "apply_point", whole_scene)
     got = sweeps.run_batch(study.base, paths, grid, outputs, len(study.times))
     monkeypatch.undo()
     kinds = {"failed": 0, "unilateral": 0, "full": 0}
@@ -246,9 +318,14 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
             assert np.all(np.isnan(got["values"][i]))
             continue
         kinds[result.info["contact"]] += 1
-        # the same solver on equal scenes: measured bitwise equal
-        np.testing.assert_array_equal(got["values"][i], sweeps.point_outputs(result, outputs))
-        assert got["error_estimate"][i] == result.info["error_estimate"]
+        if result.info["contact"] == "unilateral":
+            # the same solver on equal scenes: measured bitwise equal
+            np.testing.assert_array_equal(got["values"][i],
+                                          sweeps.point_outputs(result, outputs))
+            assert got["error_estimate"][i] == result.info["error_estimate"]
+        else:  # full contact: the whole batch at once (core.sweep_loads)
+            assert_batched_equal(got["values"][i], got["error_estimate"][i], result,
+                                 outputs)
         assert got["flags"][i] == ",".join(result.flags) and got["error"][i] == ""
     # pulled (P < 0) and beyond the edge (e = 2 m > a) refused; lift-off at e = 0.8 m
     assert kinds["failed"] == 5 and kinds["unilateral"] >= 1 and kinds["full"] >= 4
@@ -422,3 +499,45 @@ def test_solving_does_not_import_dask():
                          text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_batch_groups_points_sharing_a_geometry(monkeypatch):
+    """Points that differ only in their loads share one validated scene and one load batch
+    per geometry; every answer equals core.solve on the point's whole scene dict, and a
+    geometry that does not validate leaves its points to report their own messages."""
+    import core.sweep_loads as sweep_loads
+    import core.sweeps as sweeps
+
+    study = study_from_dict(small_study())
+    paths = ["coating[0].modulus", "loading.force", "loading.moment"]
+    grid = np.array([(e, f, m) for e in (8e8, -1.0, 4e8) for f in (2e5, 6e5)
+                     for m in (0.0, 1e5, 1.9e5)])
+    calls = []
+    original = sweep_loads.solve_load_batch
+
+    def counted(scene, loads, outputs):
+        calls.append(len(next(iter(loads.values()))))
+        return original(scene, loads, outputs)
+
+    monkeypatch.setattr(sweep_loads, "solve_load_batch", counted)
+    outputs = list(OUTPUTS)
+    got = sweeps.run_batch(study.base, paths, grid, outputs, len(study.times))
+    assert calls == [6, 6]  # the two valid moduli; the negative one is not batched
+    kinds = {"failed": 0, "unilateral": 0, "full": 0}
+    for i, row in enumerate(grid):
+        try:
+            result = solve(apply_point(study.base, dict(zip(paths, row, strict=True))))
+        except ValueError as exc:
+            kinds["failed"] += 1
+            assert got["flags"][i] == "failed"
+            assert got["error"][i] == " ".join(str(exc).split())[:500]
+            continue
+        kinds[result.info["contact"]] += 1
+        if result.info["contact"] == "unilateral":
+            np.testing.assert_array_equal(got["values"][i],
+                                          sweeps.point_outputs(result, outputs))
+        else:
+            assert_batched_equal(got["values"][i], got["error_estimate"][i], result,
+                                 outputs)
+        assert got["flags"][i] == ",".join(result.flags) and got["error"][i] == ""
+    assert kinds["failed"] == 6 and kinds["unilateral"] >= 1 and kinds["full"] >= 6

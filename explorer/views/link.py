@@ -1,4 +1,5 @@
-"""The page's address follows the view on screen: scene, time, open tab and pins."""
+"""The page's address follows the view on screen: scene, time, open tab, pins and the
+Study tab's settings."""
 
 from __future__ import annotations
 
@@ -41,7 +42,7 @@ class AddressLink:
             return  # a newer result is coming, and will ask again
         try:
             query = view_query(view.scene, app.time_index, app.sidebar.active,
-                               app.pins.board.scenes())
+                               app.pins.board.scenes(), app.study_settings())
             # the whole query at once: the values are URL-safe already (base64url, digits)
             link = "?" + "&".join(f"{k}={v}" for k, v in query.items() if v)
             if link != self.linked:

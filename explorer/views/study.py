@@ -126,6 +126,13 @@ class StudyView:
         # the fields offered follow each result on screen (a solve, not every slider step)
         app.controller.param.watch(lambda e: self.refresh(getattr(e.new, "scene", None)),
                                    "view")
+        # the settings are part of the page's link (explorer.view_link)
+        self._wanted: dict[str, Any] | None = None
+        for inputs in (self.study_first, self.study_second):
+            for widget in (inputs.field, inputs.start, inputs.stop, inputs.count,
+                           inputs.spacing):
+                widget.param.watch(lambda e: app.link.schedule(), "value")
+        self.study_output.param.watch(lambda e: app.link.schedule(), "value")
         if app.served:
             # a closed page stops its study
             pn.state.on_session_destroyed(lambda ctx: self.study_run.cancel())
@@ -169,6 +176,8 @@ class StudyView:
             else:
                 inputs.field.value = NONE if inputs.optional else next(iter(choices), None)
                 self._on_field(inputs)
+        if self._wanted is not None:
+            self.apply_study_settings(self._wanted)
 
     def _on_field(self, inputs: _AxisInputs) -> None:
         """A new field: its first range around the value on screen."""
@@ -176,6 +185,36 @@ class StudyView:
         inputs.row.visible = choice is not None
         if choice is not None:
             inputs.fill(default_range(choice, getattr(self, "_half_width", 1.0)))
+
+    # -- the link ------------------------------------------------------------------------
+    def study_settings(self) -> dict[str, Any] | None:
+        """The parameters and output typed, as a link keeps them
+        (:func:`explorer.view_link.study_settings`), or None when one is incomplete."""
+        axes = [a for a in (self.study_first.axis(), self.study_second.axis())
+                if a is not None]
+        rows = [[a.key, a.start, a.stop, a.count, a.spacing] for a in axes]
+        if not rows or any(r[1] != r[1] or r[2] != r[2] for r in rows):
+            return None
+        return {"axes": rows, "output": self.study_output.value}
+
+    def apply_study_settings(self, settings: dict[str, Any]) -> None:
+        """Show the settings of a link (checked by :func:`explorer.view_link.
+        study_settings`); a field the scene does not offer yet is set when it does."""
+        self._wanted = settings
+        axes = settings["axes"]
+        if any(axis[0] not in self._choices for axis in axes):
+            return  # the scene on screen has not offered these fields yet
+        self._wanted = None
+        for inputs, axis in zip((self.study_first, self.study_second), axes + [None],
+                                strict=False):
+            if axis is None:
+                inputs.field.value = NONE
+                continue
+            key, start, stop, count, spacing = axis
+            inputs.field.value = key  # fills its default range first
+            inputs.fill(Axis(key, start, stop, count, spacing))
+        if settings["output"] in self.study_output.options.values():
+            self.study_output.value = settings["output"]
 
     # -- running ---------------------------------------------------------------------------
     def start(self) -> bool:

@@ -1,0 +1,172 @@
+"""One batch of a design study: its points solved in order, in one task.
+
+:func:`run_batch` is what a Dask task (or the serial loop) of :func:`core.sweeps.sweep`
+runs. Points that differ only in given loads share one validated scene (the loads
+replaced with :func:`core.scene_validation.replace_loads`: the same checks and
+messages); on a scene the exact layered kernel answers, their full-contact answers come
+at once (:func:`core.sweep_loads.solve_load_batch`). Every other point is solved on its
+own with :func:`core.scene.solve`. A point that fails is recorded with its message.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from core.scene import Scene, scene_from_dict, solve
+from core.scene_validation import replace_loads
+from core.study import apply_point
+
+__all__ = ["point_outputs", "run_batch"]
+
+
+def _contact_width(x: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Length [m] of the part of ``x`` where ``q(x, t) >= 0``, linear between points, per
+    time (``q`` has shape ``(len(x), n_times)``)."""
+    dx = np.diff(x)[:, None]
+    q0, q1 = q[:-1], q[1:]
+    both = (q0 >= 0) & (q1 >= 0)
+    width = np.sum(np.where(both, dx, 0.0), axis=0)
+    cross = (q0 >= 0) != (q1 >= 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = np.where(q0 >= 0, q0, q1) / (np.abs(q0) + np.abs(q1))
+    return width + np.sum(np.where(cross, dx * share, 0.0), axis=0)
+
+
+def point_outputs(result: Any, outputs: Sequence[str]) -> np.ndarray:
+    """The requested outputs of a :class:`core.scene.SceneSolution`, shape
+    ``(len(outputs), n_times)``, in the units of :data:`core.study.OUTPUT_UNITS`.
+
+    ``q_max``/``q_min`` are the extremes of the pressure on the 201-point plotting grid;
+    ``contact_width`` is where the computed pressure is >= 0 (``2a`` under full contact;
+    less when ``contact_lost`` flags the full-contact answer as unphysical).
+    """
+    rows = []
+    q = result.pressure_on_grid if {"q_max", "q_min", "contact_width"} & set(outputs) \
+        else None
+    for name in outputs:
+        if name in ("settlement", "tilt", "force", "moment"):
+            rows.append(getattr(result, name))
+        elif name == "q_max":
+            rows.append(np.max(q, axis=0))
+        elif name == "q_min":
+            rows.append(np.min(q, axis=0))
+        else:
+            rows.append(_contact_width(result.x, q))
+    return np.asarray(rows, dtype=float)
+
+
+def _load_only_base(base: Mapping[str, Any], paths: Sequence[str]) -> Scene | None:
+    """The validated base scene when every varied field is one of its given loads
+    (``loading.force``, ...), else None (each point's scene is then validated whole, as
+    is a base scene that does not validate on its own)."""
+    given = base.get("loading", {})
+    if not paths or not all(path.startswith("loading.") and path.count(".") == 1
+                            and path.split(".", 1)[1] in given for path in paths):
+        return None
+    try:
+        scene = scene_from_dict(base)
+    except Exception:  # noqa: BLE001 - each point then reports its own message
+        return None
+    scene.sample_extremes  # noqa: B018 - computed once here, kept by every point's scene
+    return scene
+
+
+def _given_load_paths(base: Mapping[str, Any], paths: Sequence[str]) -> list[int]:
+    """The indices of ``paths`` that name one of the base scene's given loads."""
+    given = base.get("loading", {})
+    return [j for j, path in enumerate(paths) if path.startswith("loading.")
+            and path.count(".") == 1 and path.split(".", 1)[1] in given]
+
+
+def _geometry_groups(base: Mapping[str, Any], paths: Sequence[str],
+                     values: np.ndarray) -> list[tuple[Mapping[str, Any] | None, np.ndarray]]:
+    """The batch's points grouped by their values of the fields that are not given loads
+    (in order of first appearance), each with its scene dict but for the loads (None when
+    it cannot be built: its points then report their own messages). Without a given load
+    among ``paths`` every point is its own geometry: one group, no shared scene."""
+    loads = _given_load_paths(base, paths)
+    others = [j for j in range(len(paths)) if j not in loads]
+    if not loads:
+        return [(None, np.arange(len(values)))]
+    if not others:
+        return [(base, np.arange(len(values)))]
+    keys: dict[tuple, list[int]] = {}
+    for i, row in enumerate(values):
+        keys.setdefault(tuple(float(row[j]) for j in others), []).append(i)
+    groups = []
+    for key, rows in keys.items():
+        try:
+            scene = apply_point(base, {paths[j]: v for j, v in zip(others, key, strict=True)})
+        except Exception:  # noqa: BLE001 - each point then reports its own message
+            scene = None
+        groups.append((scene, np.array(rows)))
+    return groups
+
+
+def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
+              outputs: Sequence[str], n_times: int) -> dict[str, np.ndarray]:
+    """Solve the points of one batch in order (``values[i]`` holds point i's value of each
+    of ``paths``). Points that differ only in given loads share one validated scene
+    (:func:`_geometry_groups`); on a scene of the exact layered kernel their full-contact
+    answers come at once (:func:`core.sweep_loads.solve_load_batch`). Returns arrays:
+    ``values`` ``(m, len(outputs), n_times)``, ``error_estimate`` (relative, -), ``flags``
+    (comma-joined), ``error`` (the message of a failed point, else empty), ``seconds``
+    (per point)."""
+    from core.sweep_loads import load_batch_applies, solve_load_batch
+
+    m = len(values)
+    out = np.full((m, len(outputs), n_times), np.nan)
+    estimate = np.full(m, np.nan)
+    flags = [""] * m
+    errors = [""] * m
+    seconds = np.zeros(m)
+    load_columns = _given_load_paths(base, paths)
+    loads = [paths[j].split(".", 1)[1] for j in load_columns]
+    load_paths = [paths[j] for j in load_columns]
+    batched = np.zeros(m, dtype=bool)
+    validated: list[Scene | None] = [None] * m
+    for scene_dict, rows in _geometry_groups(base, paths, values):
+        if scene_dict is None or (scene_dict is not base and len(rows) < 2):
+            continue  # nothing shared: the point's whole scene is validated on its own
+        group = _load_only_base(scene_dict, load_paths)
+        for i in rows:
+            validated[i] = group
+        if group is None or not load_batch_applies(group):
+            continue
+        # a linear problem: the whole group at once, the points it leaves one by one
+        start = time.perf_counter()
+        answer = solve_load_batch(group, {q: values[rows, j] for q, j in
+                                          zip(loads, load_columns, strict=True)}, outputs)
+        done = rows[answer.answered]
+        batched[done] = True
+        out[done] = answer.values[answer.answered]
+        estimate[done] = answer.error_estimate[answer.answered]
+        for i, k in zip(rows, range(len(rows)), strict=True):
+            if answer.answered[k]:
+                flags[i] = answer.flags[k]
+        seconds[done] = (time.perf_counter() - start) / max(done.size, 1)
+    for i, row in enumerate(values):
+        if batched[i]:
+            continue
+        start = time.perf_counter()
+        try:
+            if validated[i] is not None:
+                # only the loads change: the group's scene was validated once
+                scene = replace_loads(validated[i], {q: float(row[j]) for q, j in
+                                                     zip(loads, load_columns, strict=True)})
+            else:
+                scene = apply_point(base, dict(zip(paths, row, strict=True)))
+            result = solve(scene)
+            out[i] = point_outputs(result, outputs)
+            estimate[i] = float(result.info.get("error_estimate", np.nan))
+            flags[i] = ",".join(result.flags)
+        except Exception as exc:  # noqa: BLE001 - a failed point is recorded, never fatal
+            errors[i] = (" ".join(str(exc).split()) or type(exc).__name__)[:500]
+            flags[i] = "failed"
+        seconds[i] = time.perf_counter() - start
+    return {"values": out, "error_estimate": estimate, "flags": np.array(flags, dtype=str),
+            "error": np.array(errors, dtype=str), "seconds": seconds}
