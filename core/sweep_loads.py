@@ -27,6 +27,8 @@ import numpy as np
 from core.layered_cache import gap_key, stack_key
 from core.layered_scene import LIFT_OFF_SHARE, _layers, layered_declines
 from core.layered_solve import (
+    COARSE_ERROR_FLOOR,
+    COARSE_TOL,
     ERROR_FLOOR,
     MAX_MODES,
     MAX_RATIO,
@@ -136,15 +138,17 @@ def _contact_width(x: np.ndarray, q: np.ndarray) -> np.ndarray:
     return width(x, q)
 
 
-def _response(scene: Scene, layers: list, modes: int) -> LayeredResponse:
+def _response(scene: Scene, layers: list, modes: int, room: int) -> LayeredResponse:
     """The scene's unit responses on ``modes`` modes, from the caches
-    :func:`core.layered_solve.solve_layered` fills (built once per geometry)."""
+    :func:`core.layered_solve.solve_layered` fills (built once per geometry), with the
+    same rules (chosen by the scene's tol) and the same ``room`` for doubling, so a batch
+    reads the very table and Galerkin matrix one point's solve reads."""
     problem = scene.dimensionless
     a, h, e0, nu = (scene.half_width, scene.base_thickness, problem.modulus_at_loading,
                     scene.base_poisson)
     keys = (stack_key(a, layers, h, e0, nu), gap_key(problem.g, problem.breakpoints))
     return _cached_response(a, layers, h, e0, nu, problem.g, problem.breakpoints, modes,
-                            keys, {})
+                            keys, {}, tol=problem.tol, room=room)
 
 
 @dataclass
@@ -170,11 +174,12 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
     d1 = _differences(response, given, fine, level=1)
     d0 = _differences(response, given, fine, level=2)
     unknowns = [name for name in _NAMES if name not in given]
+    floor = COARSE_ERROR_FLOOR if problem.tol >= COARSE_TOL else ERROR_FLOOR
     errors = {}
     for name in unknowns + ["pressure"]:
         ratio = np.where(d0[name] > 0, np.minimum(d1[name] / np.where(
             d0[name] > 0, d0[name], 1.0), MAX_RATIO), MAX_RATIO)
-        errors[name] = np.maximum(d1[name] * ratio / (1 - ratio), ERROR_FLOOR)
+        errors[name] = np.maximum(d1[name] * ratio / (1 - ratio), floor)
     error = np.max(np.stack(list(errors.values())), axis=0)
     numerical = np.max(np.stack([errors[name] for name in unknowns]), axis=0)
     met = error <= 0.5 * problem.tol
@@ -244,10 +249,11 @@ def solve_load_batch(scene: Scene, loads: Mapping[str, np.ndarray],
     pending = np.flatnonzero(answered)
     answered[:] = False
     modes = min(default_modes(scene.half_width, layers), MAX_MODES)
+    room = min(2 * modes, MAX_MODES)  # as solve_layered reserves it
     with np.errstate(all="ignore"):
         while pending.size:
             last = 2 * modes > MAX_MODES
-            level = _answer_level(scene, _response(scene, layers, modes),
+            level = _answer_level(scene, _response(scene, layers, modes, room),
                                   {name: v[pending] for name, v in given.items()}, outputs,
                                   last)
             for i in np.flatnonzero(level.keep):
