@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from core import limits
+from core.exponential_steps import solve_exponential
 from core.radau import (  # noqa: F401 (RADAU_A, RADAU_C, _radau_step(s): re-exported)
     JUMP_SIDE,
     RADAU_A,
@@ -58,6 +59,10 @@ from core.radau import (  # noqa: F401 (RADAU_A, RADAU_C, _radau_step(s): re-exp
 )
 
 TimeFunction = Callable[[np.ndarray], np.ndarray]
+
+#: The exponential collocation may spend this fraction (1/EXPONENTIAL_SHARE) of the step
+#: limit before the adaptive Radau stepping takes over (a history that oscillates fast).
+EXPONENTIAL_SHARE = 4
 
 #: Step-doubling differences below this are round-off, not truncation error (~100 ulp).
 _ROUNDOFF = 100 * float(np.finfo(float).eps)
@@ -164,7 +169,8 @@ def _scales(problem: ModalProblem, t_end: float) -> tuple[np.ndarray, np.ndarray
 
 
 def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: float,
-                     max_steps: int = limits.MAX_TIME_STEPS, breaks=()) -> VolterraSolution:
+                     max_steps: int = limits.MAX_TIME_STEPS, breaks=(),
+                     method: str = "exponential") -> VolterraSolution:
     """Solve ``problem`` at ``times`` (increasing, >= 1) for a degenerate kernel.
 
     ``kernel`` has ``rates``, ``tau_part(tau)`` and ``exponential_parts(tau)`` (see
@@ -176,7 +182,15 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     every step ends on each of them, and an output time on one reports the value after
     the jump. At most ``max_steps`` steps (accepted and rejected) are taken; then the
     times not reached are NaN and the message says which limit stopped it.
+
+    ``method``: ``"exponential"`` (default) tries the exponential collocation of
+    :mod:`core.exponential_steps` (exact for the kernel's exponentials, steps fixed in
+    advance and refined as a whole) within a share of ``max_steps`` and steps adaptively
+    by Radau IIA when that does not meet ``tol``; ``"radau"`` steps adaptively only (the
+    independent reference of the tests).
     """
+    if method not in ("exponential", "radau"):
+        raise ValueError(f"method: must be 'exponential' or 'radau', got {method!r}")
     times = np.asarray(times, dtype=float)
     jumps = _jumps(breaks, 1.0, float(times[-1]))
     jump_set = set(jumps.tolist())
@@ -209,6 +223,14 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         forcing = problem.r(tt) + (problem.coupling @ vu_out if nk else 0.0)
         return (forcing + vw_out) / problem.d(tt)
 
+    if method == "exponential" and float(times[-1]) > 1.0:
+        fast = solve_exponential(kernel, problem, times, jumps, tol=tol, w_scale=w_scale,
+                                 u_scale=u_scale, max_steps=max_steps // EXPONENTIAL_SHARE)
+        if fast is not None:
+            vw_out[:], vu_out[:], errors, steps = fast
+            part_errors = tuple(float(max(e, 1e-15)) for e in errors)
+            return VolterraSolution(finish(), vw_out, vu_out, max(part_errors), steps, 0,
+                                    True, "ok", part_errors)
     k_out = 0
     while k_out < len(times) and times[k_out] <= 1.0:
         record(k_out, s_modes.sum(axis=1), s_known.sum(axis=1))

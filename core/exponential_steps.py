@@ -1,0 +1,475 @@
+"""Exponential collocation of the modal Volterra equations: exact for the kernel's terms.
+
+The modes of :mod:`core.time_integration` with a kernel
+``K(t, tau) = b(tau) + sum_r a_r(tau) exp(-rate_r (t - tau))`` carry their memory in the
+states ``S_s(t) = int_1^t beta_s(tau) exp(-decay_s (t - tau)) z(tau) dtau`` (``beta_0 = b``,
+``decay_0 = 0``; ``beta_r = a_r``, ``decay_r = rate_r``), and over a step ``[t_n, t_n + h]``
+
+    S_s(t_n + a h) = exp(-decay_s a h) S_s(t_n)
+                     + int_0^{a h} exp(-decay_s (a h - sigma)) beta_s z (t_n + sigma) dsigma
+
+holds exactly. Here ``beta_s z`` is replaced by its cubic interpolant at the four Lobatto
+points of the step (``0, (5 -+ sqrt 5)/10, 1``) and the integral of each cubic against
+the exponential is taken exactly (:func:`_moments`): the method is exact for the
+exponential terms, however stiff, and its error is set by the smoothness of ``beta_s z``
+(the modulus, the loads and the creep response), not by the kernel's rates. At
+``decay_s = 0`` it is Lobatto IIIA collocation (order 6 at the step ends); for
+``decay_s h >> 1`` the stage values tend to the quasi-static answer (no instability).
+
+The value at a step's start is explicit (``d z = r + V w`` with ``V w`` the sum of the
+states there), so a step solves one 3x3 system per mode for its three other points. The
+steps are fixed before the march (graded geometrically in time from the start and from
+every jump of a history, with a bound on their length), so every factor of every step
+(kernel values, histories, exponential weights and the inverses of the 3x3 systems) is
+computed for all steps at once and the march itself is a few array operations a step.
+Output times inside a step are read from its cubic (dense output), all at once.
+
+The error is measured, not modelled: the march is repeated on the grid with every step
+halved, and the estimate is the difference of the two answers at the output times over
+``2**ORDER - 1`` (:data:`ORDER`, the order measured in tests/test_time_integration.py);
+the grid is doubled until it meets ``tol``. :func:`solve_exponential` returns ``None``
+when that takes more than its step budget (a history that oscillates fast): the caller
+then steps adaptively (:mod:`core.radau`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from core.radau import JUMP_SIDE
+
+_S5 = np.sqrt(5.0)
+#: The Lobatto points of a step (fractions of its length).
+NODES = np.array([0.0, (5 - _S5) / 10, (5 + _S5) / 10, 1.0])
+# cubic Lagrange basis in monomials of the fraction u of the step: l_j(u) = sum_k L[j, k] u^k
+_LAGRANGE = np.linalg.inv(np.vander(NODES, 4, increasing=True)).T
+#: Convergence order of the answers at output times used by the error estimate: the
+#: stage order (4) of the collocation; at the step ends it is higher where the kernel's
+#: rates times the step are small (measured in tests/test_time_integration.py).
+ORDER = 4
+#: Below this ``x = decay h`` the moments come from their Taylor series (forward
+#: recursion loses at most a factor 3.4 of accuracy above it); 24 terms leave
+#: 2^24 / 25! < 1e-17 of the series.
+_SERIES_BELOW = 2.0
+_SERIES_TERMS = 24
+#: Powers of the moments: up to the sextic of the dense output (:func:`_output_weights`).
+_POWERS = 7
+# k! / (n + k + 1)!: the Taylor coefficients of mu_k, (terms, 4)
+_SERIES = np.array([[math.factorial(k) / math.factorial(n + k + 1) for k in range(_POWERS)]
+                    for n in range(_SERIES_TERMS)])
+#: Steps per decade of time since the start or a jump, and steps over the whole span,
+#: of the first grid (each refinement doubles both).
+STEPS_PER_DECADE = 3
+SPAN_STEPS = 4
+#: Grid refinements tried before the caller's adaptive stepping takes over.
+MAX_REFINEMENTS = 6
+#: The grid is refined until the estimate is this many times below ``tol``: the error is
+#: measured against the size of the forcing, which exceeds the unknowns by up to the
+#: creep factor, and a fast state's error reaches the outputs through the equation's own
+#: feedback, which the estimate leaves out. Measured on the fast aging Arutyunyan inverse
+#: problem (tests/test_creep.py, tol 1e-10): with 1 the answer (w = 1) was 1.1e-10 off
+#: with an estimate of 2.7e-11 relative to a forcing of 6.9; with 4 it is 1.9e-12 off.
+SAFETY = 4.0
+
+
+def _moments(x: np.ndarray, powers: int = 4) -> np.ndarray:
+    """``mu_k(x) = int_0^1 exp(-x (1 - u)) u^k du`` for k < powers (at most 7), shape
+    x.shape + (powers,).
+
+    Taylor series ``sum_n (-x)^n k! / (n + k + 1)!`` for small x, else the recursion
+    ``mu_0 = (1 - exp(-x))/x``, ``mu_k = (1 - k mu_{k-1}) / x`` (for x >= 2 it loses at
+    most a factor ``6!/2^6 = 11`` of accuracy by k = 6).
+    """
+    x = np.asarray(x, dtype=float)
+    out = np.empty(x.shape + (powers,))
+    small = x < _SERIES_BELOW
+    xs = x[small]
+    if xs.size:
+        # Horner in -x, all four k at once
+        acc = np.broadcast_to(_SERIES[-1, :powers], (xs.size, powers)).copy()
+        neg = -xs[:, None]
+        for row in _SERIES[-2::-1, :powers]:
+            acc *= neg
+            acc += row
+        out[small] = acc
+    xl = x[~small]
+    if xl.size:
+        mu = -np.expm1(-xl) / xl
+        out[~small, 0] = mu
+        for k in range(1, powers):
+            mu = (1.0 - k * mu) / xl
+            out[~small, k] = mu
+    return out
+
+
+def _weights(fraction: np.ndarray, h: np.ndarray, decay: np.ndarray) -> tuple[np.ndarray,
+                                                                                np.ndarray]:
+    """Exponential weights of the step's cubic up to ``fraction`` of the step.
+
+    ``fraction`` (..., A), ``h`` (...,) step lengths, ``decay`` (S,) rates. Returns
+    ``carry = exp(-decay a h)`` (..., S, A) and ``weight`` (..., S, A, 4):
+    ``int_0^{a h} exp(-decay (a h - sigma)) l_j(sigma/h) dsigma``.
+    """
+    ah = fraction * h[..., None]                                  # (..., A)
+    x = decay[:, None] * ah[..., None, :]                         # (..., S, A)
+    mu = _moments(x)                                              # (..., S, A, 4 powers)
+    powers = fraction[..., None, :, None] ** np.arange(1, 5)      # a^(k+1): (..., 1, A, 4)
+    weight = h[..., None, None, None] * ((mu * powers) @ _LAGRANGE.T)  # (..., S, A, 4 nodes)
+    return np.exp(-x), weight
+
+
+def grid(start: float, end: float, jumps: np.ndarray, first_step: float,
+         level: int) -> tuple[np.ndarray, np.ndarray]:
+    """Step ends from ``start`` to ``end`` through every jump, and which start on a jump.
+
+    In each piece ``[a, b]`` between jumps the steps are equal in the smooth, increasing
+    ``sigma(t) = n_dec log10(1 + (t - a)/theta) + n_span (t - a)/span`` with
+    ``n_dec = STEPS_PER_DECADE 2**level``, ``n_span = SPAN_STEPS 2**level`` and ``theta =
+    first_step``: graded geometrically from the piece's start (creep follows log time,
+    and a jump starts a new transient), never longer than about ``span / n_span``. One
+    level more halves every step in ``sigma`` exactly, so the answers of two levels
+    converge like ``h**order`` and their difference estimates the error.
+    """
+    edges = np.concatenate([[start], jumps, [end]])
+    span = end - start
+    n_dec, n_span = STEPS_PER_DECADE * 2**level, SPAN_STEPS * 2**level
+    points = [np.array([start])]
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        theta = min(first_step, b - a)
+        slope = n_dec / np.log(10.0)
+
+        def sigma(t, a=a, theta=theta):
+            return slope * np.log1p((t - a) / theta) + n_span * (t - a) / span
+
+        total = float(sigma(b))
+        n = max(1, int(np.ceil(total)))
+        target = total * np.arange(1, n) / n
+        # invert sigma: start from the log part alone (below sigma's root), then Newton
+        # (sigma is increasing and concave, so Newton from below stays below and converges)
+        t = a + theta * np.expm1(np.minimum(target / slope, np.log1p((b - a) / theta)))
+        t = np.minimum(t, b)
+        for _ in range(50):
+            step = (sigma(t) - target) / (slope / (theta + t - a) + n_span / span)
+            t = t - step
+            if np.all(np.abs(step) <= 1e-15 * np.maximum(1.0, np.abs(t))):
+                break
+        points += [np.sort(t), np.array([b])]
+    ends = np.concatenate(points)
+    jump_start = np.isin(ends[:-1], jumps)
+    return ends, jump_start
+
+
+def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.ndarray,
+                  vu_nodes: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """``z`` at a step's four points as ``constant + sum_j response[:, j] sums[j]``.
+
+    ``d``, ``r`` (B, M, 4) at the points, ``total`` (B, 3, 4) the step's drive of ``V w``
+    at its three later points by ``z`` at its four; ``sums`` (4, M) are the carried
+    states' sums at the points. The first point is explicit (``d z = r + sums``), the
+    three others solve ``(diag(d) - total[:, 1:]) z = r + sums + total[:, 0] z_0`` (by
+    the adjugate: ``d >= 1`` on the diagonal, the step's creep off it); both for all steps
+    at once, so the march only applies them. Returns ``constant`` (B, 4, M) and
+    ``response`` (B, 4, 4, M), modes last (contiguous for the march).
+    """
+    if vu_nodes is not None:
+        r = r + np.einsum("mk,bkj->bmj", coupling, vu_nodes)
+    d = d.transpose(0, 2, 1)                                      # (B, 4, M)
+    r = r.transpose(0, 2, 1)
+    t = total[:, :, :, None]                                      # (B, 3, 4, 1)
+    m = [[(d[:, i + 1] if i == j else 0.0) - t[:, i, j + 1] for j in range(3)]
+         for i in range(3)]
+    adj = [[m[1][1] * m[2][2] - m[1][2] * m[2][1], m[0][2] * m[2][1] - m[0][1] * m[2][2],
+            m[0][1] * m[1][2] - m[0][2] * m[1][1]],
+           [m[1][2] * m[2][0] - m[1][0] * m[2][2], m[0][0] * m[2][2] - m[0][2] * m[2][0],
+            m[0][2] * m[1][0] - m[0][0] * m[1][2]],
+           [m[1][0] * m[2][1] - m[1][1] * m[2][0], m[0][1] * m[2][0] - m[0][0] * m[2][1],
+            m[0][0] * m[1][1] - m[0][1] * m[1][0]]]
+    inv_det = 1.0 / (m[0][0] * adj[0][0] + m[0][1] * adj[1][0] + m[0][2] * adj[2][0])
+    inv_d0 = 1.0 / d[:, 0]                                        # (B, M)
+    n_steps, nm = inv_d0.shape
+    response = np.zeros((n_steps, 4, 4, nm))
+    response[:, 0, 0] = inv_d0
+    for i in range(3):
+        for j in range(3):
+            response[:, i + 1, j + 1] = adj[i][j] * inv_det
+        response[:, i + 1, 0] = inv_d0 * sum(response[:, i + 1, j + 1] * t[:, j, 0]
+                                             for j in range(3))
+    constant = (response * r[:, None, :, :]).sum(axis=2)          # (B, 4, M)
+    return constant, response
+
+
+def _sextic_weights(h: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
+                    step_of: np.ndarray, a: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Weights of the seven points of step ``step_of`` and a neighbour for the integral
+    from the step's start to ``a`` of it (see :func:`_output_weights`).
+
+    Returns ``side`` (T,): +1 the next step, -1 the previous, 0 none (then the step's
+    cubic, its four weights first); ``weight`` (T, S, 7); ``x = decay a h`` (T, S).
+    """
+    n_steps = h.size
+    hn = h[step_of]
+    has_next = (step_of + 1 < n_steps) & ~jump_start[np.minimum(step_of + 1, n_steps - 1)]
+    has_prev = (step_of >= 1) & ~jump_start[step_of]
+    side = np.where(has_next, 1, np.where(has_prev, -1, 0))
+    rho_next = h[np.minimum(step_of + 1, n_steps - 1)] / hn
+    rho_prev = h[np.maximum(step_of - 1, 0)] / hn
+    nodes = np.where(
+        (side == 1)[:, None],
+        np.concatenate([np.broadcast_to(NODES, (a.size, 4)),
+                        1.0 + rho_next[:, None] * NODES[1:]], axis=1),
+        np.concatenate([rho_prev[:, None] * (NODES[:3] - 1.0),
+                        np.broadcast_to(NODES, (a.size, 4))], axis=1))
+    plain = side == 0
+    nodes[plain] = np.linspace(-1.0, 1.0, 7)                      # unused (cubic below)
+    inv_vander = np.linalg.inv(nodes[:, :, None] ** np.arange(7))  # (T, 7 powers, 7 nodes)
+    x = decay[None, :] * (a * hn)[:, None]                        # (T, S)
+    mu = _moments(x, 7) * (a[:, None, None] ** np.arange(1, 8))   # (T, S, 7 powers)
+    weight = hn[:, None, None] * (mu @ inv_vander)                # (T, S, 7 nodes)
+    if np.any(plain):
+        _, cubic = _weights(a[plain, None], hn[plain], decay)
+        weight[plain] = 0.0
+        weight[plain, :, :4] = cubic[:, :, 0, :]
+    return side, weight, x
+
+
+def _output_weights(ends: np.ndarray, jump_start: np.ndarray, beta: np.ndarray,
+                    decay: np.ndarray, t_out: np.ndarray):
+    """How ``V`` at each output time is read from the march (dense output).
+
+    An output at ``t_n + a h`` in step n carries the states from the step's start
+    (``carry`` (T, S)) and integrates the sextic through the seven points of step n and
+    of a neighbouring step (the next, else the previous where a jump separates them; the
+    step's own cubic where both do) against the exponentials (``total`` (T, 7)). The
+    sextic's error is far below the steps' own, so the answers at output times converge
+    like those at the step ends, wherever the outputs fall in the steps (with the cubic
+    they converged erratically, and their difference on two grids was no estimate).
+    Returns ``step_of`` (T,), ``side`` (T,): +1 next, -1 previous, 0 none, and the two.
+    """
+    h = np.diff(ends)
+    step_of = np.clip(np.searchsorted(ends, t_out, side="left") - 1, 0, h.size - 1)
+    a = np.clip((t_out - ends[step_of]) / h[step_of], 0.0, 1.0)
+    side, weight, x = _sextic_weights(h, jump_start, decay, step_of, a)
+    beta7 = _seven(beta.transpose(0, 2, 1), step_of, side)        # (T, 7, S)
+    total = np.einsum("tsj,tjs->tj", weight, beta7)
+    carry = np.exp(-x)
+    before_start = t_out <= ends[0]
+    carry[before_start] = 0.0
+    total[before_start] = 0.0
+    return step_of, side, carry, total
+
+
+def _seven(values: np.ndarray, step_of: np.ndarray, side: np.ndarray) -> np.ndarray:
+    """Values at the four points of each output's step and three of its neighbour, in the
+    order of :func:`_output_weights` (``values`` (B, 4, ...); zeros for no neighbour)."""
+    n_steps = values.shape[0]
+    own = values[step_of]                                         # (T, 4, ...)
+    nxt = values[np.minimum(step_of + 1, n_steps - 1)][:, 1:]
+    prv = values[np.maximum(step_of - 1, 0)][:, :3]
+    shape = (-1,) + (1,) * (values.ndim - 1)
+    after = np.concatenate([own, nxt * (side == 1).reshape(shape)], axis=1)
+    before = np.concatenate([prv, own], axis=1)
+    return np.where((side == -1).reshape(shape), before, after)
+
+
+def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
+                  beta: np.ndarray, end_weight: np.ndarray, values: np.ndarray,
+                  rows: np.ndarray, parts: int, t_out: np.ndarray) -> np.ndarray:
+    """Sum of the steps' local errors at the output times, largest per group (parts,).
+
+    A state that decays fast within a step forgets all but its last steps, so its error
+    at a time is the local error of the steps just before it, which depends on where the
+    time falls in them: two grids may then agree by chance (measured on a stiff aging
+    kernel: 2.1e-9 on the finer grid, 8.9e-10 on the coarser, their difference 1.1e-9).
+    Here each step's error is estimated as the difference of its cubic from the sextic
+    through its points and three of a neighbour (:func:`_sextic_weights`), for every state,
+    and carried to every output time with the state's decay (its absolute value: no
+    cancelling), relative to ``rows`` (the size of each channel, ``values`` (B, 4, C) at
+    the points of the steps).
+    """
+    h = np.diff(ends)
+    n_steps = h.size
+    steps = np.arange(n_steps)
+    side, sextic, _ = _sextic_weights(h, jump_start, decay, steps, np.ones(n_steps))
+    cubic = np.zeros_like(sextic)
+    own_last = side == -1
+    cubic[~own_last, :, :4] = end_weight[~own_last]
+    cubic[own_last, :, 3:] = end_weight[own_last]
+    beta7 = _seven(beta.transpose(0, 2, 1), steps, side)          # (B, 7, S)
+    values7 = _seven(values, steps, side)                         # (B, 7, C)
+    local = ((sextic - cubic) * beta7.transpose(0, 2, 1)) @ values7  # (B, S, C)
+    size = np.abs(local) / rows                                   # (B, S, C)
+    per_part = size.reshape(n_steps, decay.size, parts, -1).max(axis=3)  # (B, S, P)
+    # carried to the step starts: a sum of errors per state, each decaying with its state
+    fade = np.exp(-decay[None, :] * h[:, None])                   # (B, S)
+    carried = np.zeros((n_steps, decay.size, parts))
+    for b in range(1, n_steps):
+        carried[b] = carried[b - 1] * fade[b - 1, :, None] + per_part[b - 1]
+    # and from there to the output times; an output inside a step is read from the
+    # points of that step and of a neighbour (dense output), whose errors are those of
+    # their steps: both added whole
+    step_of = np.clip(np.searchsorted(ends, t_out, side="left") - 1, 0, n_steps - 1)
+    lag = np.maximum(t_out - ends[step_of], 0.0)
+    own = per_part[step_of] + per_part[np.minimum(step_of + 1, n_steps - 1)]
+    at_outputs = np.exp(-decay[None, :] * lag[:, None])[:, :, None] * carried[step_of] + own
+    worst = np.max(at_outputs.sum(axis=1), axis=0, initial=0.0)
+    return worst
+
+
+def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: np.ndarray,
+          times: np.ndarray, rows: tuple[np.ndarray, np.ndarray] | None = None
+          ) -> tuple[np.ndarray, np.ndarray, Callable[[], np.ndarray] | None]:
+    """``V w`` (modes, T) and ``V u`` (known, T) at ``times`` (in ``[ends[0], ends[-1]]``)
+    by exponential collocation on the steps ``ends``.
+
+    ``jump_start`` / ``jump_end`` (steps,) bools: that step starts (ends) where a history
+    jumps, so its first (last) point reads the history after (before) it. With ``rows``
+    (the sizes of the modes and of the known functions) the third answer computes, when
+    called, the sum of the local errors per group of ``problem.parts``
+    (:func:`_local_errors`); else it is None.
+    """
+    from core.radau import _kernel_factors
+
+    h = np.diff(ends)
+    n_steps = h.size
+    at = ends[:-1, None] + h[:, None] * NODES[None, :]            # (B, 4)
+    side = JUMP_SIDE * np.maximum(1.0, np.abs(at))
+    at[:, 0] += np.where(jump_start, side[:, 0], 0.0)
+    at[:, 3] -= np.where(jump_end, side[:, 3], 0.0)
+    flat = at.ravel()
+    beta, decay = _kernel_factors(kernel, flat)                   # (S, 4B), (S,)
+    n_states = decay.size
+    beta = beta.reshape(n_states, n_steps, 4).transpose(1, 0, 2)  # (B, S, 4)
+    carry, weight = _weights(NODES[1:], h, decay)                 # (B,S,3), (B,S,3,4)
+    driven = weight * beta[:, :, None, :]                         # (B, S, 3, 4)
+    total = driven.sum(axis=1)                                    # (B, 3, 4)
+    end_drive = driven[:, :, 2, :].transpose(0, 2, 1).copy()      # (B, 4, S)
+    end_carry = carry[:, :, 2]                                    # (B, S)
+    end_weight = weight[:, :, 2, :]                               # (B, S, 4)
+    # state sums at the step's points: ones for its start, carries for the others
+    reads = np.concatenate([np.ones((n_steps, n_states, 1)), carry], axis=2)  # (B, S, 4)
+
+    t_out = np.asarray(times, dtype=float)
+    step_of, side, out_carry, out_total = _output_weights(ends, jump_start, beta, decay,
+                                                          t_out)
+    order = np.argsort(step_of, kind="stable")
+    bounds = np.searchsorted(step_of[order], np.arange(n_steps + 1))
+
+    def read(fn) -> np.ndarray:
+        return fn(flat).reshape(-1, n_steps, 4).transpose(1, 0, 2)  # (B, channels, 4)
+
+    nm, nk = problem.n_modes, problem.n_known
+    channels: list[tuple[np.ndarray, np.ndarray]] = []
+    vu_out = np.zeros((nk, t_out.size))
+    vu_nodes = None
+    if nk:
+        u = read(problem.u)                                       # (B, K, 4)
+        # V u at the points: the carried states plus the step's own drive
+        vu_nodes = np.zeros_like(u)
+        vu_nodes[:, :, 1:] = u @ total.transpose(0, 2, 1)
+        next_drive = u @ end_drive                                # (B, K, S)
+        s_known = np.zeros((nk, n_states))
+        for b in range(n_steps):
+            vu_nodes[b] += s_known @ reads[b]
+            lo, hi = bounds[b], bounds[b + 1]
+            if hi > lo:
+                idx = order[lo:hi]
+                vu_out[:, idx] = s_known @ out_carry[idx].T
+            s_known = s_known * end_carry[b] + next_drive[b]
+        vu_out += np.einsum("tj,tjk->kt", out_total, _seven(u.transpose(0, 2, 1), step_of,
+                                                            side))
+        if rows is not None:
+            channels.append((u.transpose(0, 2, 1), rows[1]))
+    vw_out = np.zeros((nm, t_out.size))
+    if nm:
+        constant, response = _point_values(read(problem.d), read(problem.r), total,
+                                           problem.coupling, vu_nodes)
+        reads_t = reads.transpose(0, 2, 1).copy()                 # (B, 4, S)
+        drive_t = end_drive.transpose(0, 2, 1).copy()             # (B, S, 4)
+        carry_t = end_carry[:, :, None]                           # (B, S, 1)
+        s_modes = np.zeros((n_states, nm))                        # modes last
+        z_all = np.empty((n_steps, 4, nm))
+        for b in range(n_steps):
+            # z at the step's four points: affine in the state sums there
+            sums = reads_t[b] @ s_modes                           # (4, M)
+            z = z_all[b] = constant[b] + (response[b] * sums[None]).sum(axis=1)
+            lo, hi = bounds[b], bounds[b + 1]
+            if hi > lo:
+                idx = order[lo:hi]
+                vw_out[:, idx] = (out_carry[idx] @ s_modes).T
+            s_modes = s_modes * carry_t[b] + drive_t[b] @ z
+        # the drive of every output by z at its seven points, step by step of the outputs
+        for b in np.unique(step_of):
+            idx = order[bounds[b]:bounds[b + 1]]
+            for sd in (-1, 0, 1):
+                pick = idx[side[idx] == sd]
+                if pick.size:
+                    z7 = (np.concatenate([z_all[b - 1, :3], z_all[b]]) if sd == -1 else
+                          np.concatenate([z_all[b], z_all[b + 1, 1:]]) if sd == 1 else
+                          np.concatenate([z_all[b], np.zeros((3, nm))]))
+                    vw_out[:, pick] += (out_total[pick] @ z7).T
+        if rows is not None:
+            channels.append((z_all, rows[0]))
+
+    def local() -> np.ndarray:
+        return np.max([np.zeros(problem.parts)] + [
+            _local_errors(ends, jump_start, decay, beta, end_weight, values, size,
+                          problem.parts, t_out) for values, size in channels], axis=0)
+
+    return vw_out, vu_out, (local if rows is not None else None)
+
+
+def first_step(kernel, start: float, span: float) -> float:
+    """The length of the first step after a start or a jump: a tenth of the time scale of
+    the fastest transient the kernel can drive (its rate plus its size, as ``d >= 1``),
+    at least ``1e-9 span``."""
+    from core.radau import _kernel_factors
+
+    beta, decay = _kernel_factors(kernel, np.array([start]))
+    fastest = float(np.max(decay + np.abs(beta[:, 0]), initial=0.0))
+    return max(0.1 / fastest, 1e-9 * span) if fastest > 0 else span
+
+
+def solve_exponential(kernel, problem, times: np.ndarray, jumps: np.ndarray, *, tol: float,
+                      w_scale: np.ndarray, u_scale: np.ndarray, max_steps: int):
+    """``V w`` and ``V u`` at ``times`` to ``tol``, or None past ``max_steps`` steps.
+
+    ``w_scale`` (modes,), ``u_scale`` (known,): sizes of the unknowns, for the relative
+    error, measured per group of ``problem.parts``. Returns ``(vw, vu, part_errors,
+    steps)``: the answer of the finest grid marched, the estimate of its error per group
+    and its steps. The estimate is the larger of the difference from the grid of twice
+    longer steps over ``2**ORDER - 1`` (the global error, carried through the march) and
+    the sum of the steps' local errors (:func:`_local_errors`: a fast state's error,
+    which two grids can miss).
+    """
+    start, end = 1.0, float(times[-1])
+    span = end - start
+    theta = first_step(kernel, start, span)
+    parts = problem.parts
+    previous = None
+    used = 0
+    for level in range(MAX_REFINEMENTS + 1):
+        ends, jump_start = grid(start, end, jumps, theta, level)
+        steps = ends.size - 1
+        used += steps
+        if used > max_steps:
+            return None
+        jump_end = np.isin(ends[1:], jumps)
+        vw, vu, local = march(kernel, problem, ends, jump_start, jump_end, times,
+                              rows=None if previous is None else (w_scale, u_scale))
+        if previous is not None:
+            diff = np.concatenate([
+                (np.max(np.abs(vw - previous[0]), axis=1, initial=0.0) / w_scale).reshape(
+                    parts, -1),
+                (np.max(np.abs(vu - previous[1]), axis=1, initial=0.0) / u_scale).reshape(
+                    parts, -1)], axis=1)
+            errors = np.max(diff, axis=1, initial=0.0) / (2**ORDER - 1)
+            if np.max(errors) <= tol / SAFETY:
+                errors = np.maximum(errors, local())
+                if np.max(errors) <= tol / SAFETY:
+                    return vw, vu, errors, steps
+        previous = (vw, vu)
+    return None
