@@ -224,8 +224,13 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         return (forcing + vw_out) / problem.d(tt)
 
     if method == "exponential" and float(times[-1]) > 1.0:
+        def unknowns(vw: np.ndarray, vu: np.ndarray) -> np.ndarray:
+            vw_out[:], vu_out[:] = vw, vu
+            return finish()
+
         fast = solve_exponential(kernel, problem, times, jumps, tol=tol, w_scale=w_scale,
-                                 u_scale=u_scale, max_steps=max_steps // EXPONENTIAL_SHARE)
+                                 u_scale=u_scale, max_steps=max_steps // EXPONENTIAL_SHARE,
+                                 unknowns=unknowns)
         if fast is not None:
             vw_out[:], vu_out[:], errors, steps = fast
             part_errors = tuple(float(max(e, 1e-15)) for e in errors)
