@@ -58,6 +58,8 @@ _SERIES_TERMS = 24
 #: Powers of the moments: up to the sextic of the dense output (:func:`_output_weights`).
 _POWERS = 7
 # k! / (n + k + 1)!: the Taylor coefficients of mu_k, (terms, 4)
+#: (largest x, terms) of the series: 0.02^8 / 9! and 0.3^14 / 15! are below 1e-19
+_SERIES_GROUPS = ((0.02, 8), (0.3, 14), (_SERIES_BELOW, _SERIES_TERMS))
 _SERIES = np.array([[math.factorial(k) / math.factorial(n + k + 1) for k in range(_POWERS)]
                     for n in range(_SERIES_TERMS)])
 #: Steps per decade of time since the start or a jump, and steps over the whole span,
@@ -93,15 +95,21 @@ def _moments(x: np.ndarray, powers: int = 4) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     out = np.empty(x.shape + (powers,))
     small = x < _SERIES_BELOW
-    xs = x[small]
-    if xs.size:
-        # Horner in -x, all four k at once
-        acc = np.broadcast_to(_SERIES[-1, :powers], (xs.size, powers)).copy()
+    # the series in groups by size, each with the terms it needs (x^n / (n + 1)! < 1e-19)
+    lower = -1.0
+    for upper, terms in _SERIES_GROUPS:
+        group = (x > lower) & (x <= upper) & small if lower >= 0 else (x <= upper) & small
+        lower = upper
+        xs = x[group]
+        if not xs.size:
+            continue
+        # Horner in -x, all k at once
+        acc = np.broadcast_to(_SERIES[terms - 1, :powers], (xs.size, powers)).copy()
         neg = -xs[:, None]
-        for row in _SERIES[-2::-1, :powers]:
+        for row in _SERIES[terms - 2::-1, :powers]:
             acc *= neg
             acc += row
-        out[small] = acc
+        out[group] = acc
     xl = x[~small]
     if xl.size:
         mu = -np.expm1(-xl) / xl
@@ -274,13 +282,23 @@ def _seven(values: np.ndarray, step_of: np.ndarray, side: np.ndarray) -> np.ndar
     """Values at the four points of each output's step and three of its neighbour, in the
     order of :func:`_output_weights` (``values`` (B, 4, ...); zeros for no neighbour)."""
     n_steps = values.shape[0]
-    own = values[step_of]                                         # (T, 4, ...)
-    nxt = values[np.minimum(step_of + 1, n_steps - 1)][:, 1:]
-    prv = values[np.maximum(step_of - 1, 0)][:, :3]
-    shape = (-1,) + (1,) * (values.ndim - 1)
-    after = np.concatenate([own, nxt * (side == 1).reshape(shape)], axis=1)
-    before = np.concatenate([prv, own], axis=1)
-    return np.where((side == -1).reshape(shape), before, after)
+    before = (side == -1)[:, None]
+    # step and point of each of the seven slots: own 0..3 then next 1..3, or previous
+    # 0..2 then own 0..3
+    slot_step = np.where(before, step_of[:, None] + _PREVIOUS_STEP, step_of[:, None]
+                         + _NEXT_STEP)
+    slot_point = np.where(before, _PREVIOUS_POINT, _NEXT_POINT)
+    picked = values[np.clip(slot_step, 0, n_steps - 1), slot_point]   # (T, 7, ...)
+    missing = (side == 0)[:, None] & (np.arange(7) >= 4)[None, :]
+    if np.any(missing):
+        picked[missing] = 0.0
+    return picked
+
+
+_NEXT_STEP = np.array([0, 0, 0, 0, 1, 1, 1])
+_NEXT_POINT = np.array([0, 1, 2, 3, 1, 2, 3])
+_PREVIOUS_STEP = np.array([-1, -1, -1, 0, 0, 0, 0])
+_PREVIOUS_POINT = np.array([0, 1, 2, 0, 1, 2, 3])
 
 
 def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
