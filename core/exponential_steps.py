@@ -73,6 +73,9 @@ MIN_LEVEL = 2
 #: and ``(tol / DENSITY_TOL)**(1/6)`` times sparser at a looser one (at most 2x), so
 #: that a loose tol is not met by grids far finer than it needs (three are marched).
 DENSITY_TOL = 3e-8
+#: The point systems of the modes are built for blocks of steps of at most this many
+#: floats (16 a step and mode: 8 MB), so a long march of many modes stays small.
+MAX_BLOCK_ELEMENTS = 2**20
 #: Grid refinements tried before the caller's adaptive stepping takes over.
 MAX_REFINEMENTS = 6
 #: The grid is refined until the estimate is this many times below ``tol``: the error is
@@ -176,6 +179,12 @@ def grid(start: float, end: float, jumps: np.ndarray, first_step: float,
     ends = np.concatenate(points)
     jump_start = np.isin(ends[:-1], jumps)
     return ends, jump_start
+
+
+def _by_step(values: np.ndarray, points: int) -> np.ndarray:
+    """(channels, steps * points) values at the points of consecutive steps, as
+    (steps, channels, points)."""
+    return values.reshape(values.shape[0], -1, points).transpose(1, 0, 2)
 
 
 def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.ndarray,
@@ -387,7 +396,7 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     bounds = np.searchsorted(step_of[order], np.arange(n_steps + 1))
 
     def read(fn) -> np.ndarray:
-        return fn(flat).reshape(-1, n_steps, 4).transpose(1, 0, 2)  # (B, channels, 4)
+        return _by_step(fn(flat), 4)                              # (B, channels, 4)
 
     nm, nk = problem.n_modes, problem.n_known
     channels: list[tuple[np.ndarray, np.ndarray]] = []
@@ -413,17 +422,25 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
             channels.append((u.transpose(0, 2, 1), rows[1]))
     vw_out = np.zeros((nm, t_out.size))
     if nm:
-        constant, response = _point_values(read(problem.d), read(problem.r), total,
-                                           problem.coupling, vu_nodes)
+        # the point systems of a block of steps at a time: (steps, 4, 4, modes) floats
+        block = max(1, MAX_BLOCK_ELEMENTS // (16 * nm))
+        at_steps = flat.reshape(n_steps, 4)
         reads_t = reads.transpose(0, 2, 1).copy()                 # (B, 4, S)
         drive_t = end_drive.transpose(0, 2, 1).copy()             # (B, S, 4)
         carry_t = end_carry[:, :, None]                           # (B, S, 1)
         s_modes = np.zeros((n_states, nm))                        # modes last
         z_all = np.empty((n_steps, 4, nm))
         for b in range(n_steps):
+            if b % block == 0:
+                steps = slice(b, min(n_steps, b + block))
+                times_block = at_steps[steps].ravel()
+                constant, response = _point_values(
+                    _by_step(problem.d(times_block), 4), _by_step(problem.r(times_block), 4),
+                    total[steps], problem.coupling,
+                    None if vu_nodes is None else vu_nodes[steps])
             # z at the step's four points: affine in the state sums there
             sums = reads_t[b] @ s_modes                           # (4, M)
-            z = z_all[b] = constant[b] + (response[b] * sums[None]).sum(axis=1)
+            z = z_all[b] = constant[b % block] + (response[b % block] * sums[None]).sum(axis=1)
             lo, hi = bounds[b], bounds[b + 1]
             if hi > lo:
                 idx = order[lo:hi]

@@ -153,3 +153,17 @@ def test_exponential_collocation_meets_tol_and_its_estimate_is_honest(tol):
     # 9.3e-11 (2.8-14x above) for 43, 140, 681 steps (adaptive Radau IIA: 57, 152, 531)
     assert error <= tol
     assert sol.error_estimate >= error
+
+
+def test_exponential_collocation_in_blocks_of_steps_is_the_same(monkeypatch):
+    """The point systems are built a block of steps at a time (bounded memory): blocks of
+    five steps give the answer of one block (measured identical)."""
+    import core.exponential_steps as steps
+
+    problem = _creep_problem()
+    times = 1.0 + np.geomspace(1e-3, 60.0, 30)
+    whole = solve_degenerate(_STIFF, problem, times, tol=1e-7)
+    monkeypatch.setattr(steps, "MAX_BLOCK_ELEMENTS", 16 * problem.n_modes * 5)
+    blocks = solve_degenerate(_STIFF, problem, times, tol=1e-7)
+    assert blocks.steps == whole.steps
+    np.testing.assert_array_equal(blocks.w, whole.w)
