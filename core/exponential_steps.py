@@ -250,7 +250,10 @@ def _sextic_weights(h: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
                         np.broadcast_to(NODES, (a.size, 4))], axis=1))
     plain = side == 0
     nodes[plain] = np.linspace(-1.0, 1.0, 7)                      # unused (cubic below)
-    inv_vander = np.linalg.inv(nodes[:, :, None] ** np.arange(7))  # (T, 7 powers, 7 nodes)
+    # the nodes depend on the step and the side only: one inverse per such pair
+    _, first, which = np.unique(step_of * 3 + side + 1, return_index=True,
+                                return_inverse=True)
+    inv_vander = np.linalg.inv(nodes[first, :, None] ** np.arange(7))[which.ravel()]
     x = decay[None, :] * (a * hn)[:, None]                        # (T, S)
     mu = _moments(x, 7) * (a[:, None, None] ** np.arange(1, 8))   # (T, S, 7 powers)
     weight = hn[:, None, None] * (mu @ inv_vander)                # (T, S, 7 nodes)
