@@ -10,8 +10,8 @@ states ``S_s(t) = int_1^t beta_s(tau) exp(-decay_s (t - tau)) z(tau) dtau`` (``b
 
 holds exactly. Here ``beta_s z`` is replaced by its cubic interpolant at the four Lobatto
 points of the step (``0, (5 -+ sqrt 5)/10, 1``) and the integral of each cubic against
-the exponential is taken exactly (:func:`_moments`): the method is exact for the
-exponential terms, however stiff, and its error is set by the smoothness of ``beta_s z``
+the exponential is taken exactly (:mod:`core.exponential_weights`): the method is exact
+for the exponential terms, however stiff, and its error is set by the smoothness of ``beta_s z``
 (the modulus, the loads and the creep response), not by the kernel's rates. At
 ``decay_s = 0`` it is Lobatto IIIA collocation (order 6 at the step ends); for
 ``decay_s h >> 1`` the stage values tend to the quasi-static answer (no instability).
@@ -22,46 +22,36 @@ steps are fixed before the march (graded geometrically in time from the start an
 every jump of a history, with a bound on their length), so every factor of every step
 (kernel values, histories, exponential weights and the inverses of the 3x3 systems) is
 computed for all steps at once and the march itself is a few array operations a step.
-Output times inside a step are read from its cubic (dense output), all at once.
+Output times inside a step are read from the sextic through its points and three of a
+neighbouring step (dense output, :mod:`core.exponential_weights`), all at once.
 
-The error is measured, not modelled: the march is repeated on the grid with every step
-halved, and the estimate is the difference of the two answers at the output times over
-``2**ORDER - 1`` (:data:`ORDER`, the order measured in tests/test_time_integration.py);
-the grid is doubled until it meets ``tol``. :func:`solve_exponential` returns ``None``
-when that takes more than its step budget (a history that oscillates fast): the caller
-then steps adaptively (:mod:`core.radau`).
+The error is measured, not modelled: the march is repeated on grids with every step
+halved (at least three), and the estimate is the difference of the last two answers at
+the output times over the convergence factor the grids show, or the sum of the local
+errors of the states that decay within a step, where larger. :func:`solve_exponential`
+returns ``None`` when that takes more than its step budget (a history that oscillates
+fast): the caller then steps adaptively (:mod:`core.radau`).
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 
 import numpy as np
 
+from core.exponential_weights import (
+    NODES,
+    output_weights,
+    seven,
+    sextic_weights,
+    weights,
+)
 from core.radau import JUMP_SIDE
 
-_S5 = np.sqrt(5.0)
-#: The Lobatto points of a step (fractions of its length).
-NODES = np.array([0.0, (5 - _S5) / 10, (5 + _S5) / 10, 1.0])
-# cubic Lagrange basis in monomials of the fraction u of the step: l_j(u) = sum_k L[j, k] u^k
-_LAGRANGE = np.linalg.inv(np.vander(NODES, 4, increasing=True)).T
 #: Convergence order of the answers at output times used by the error estimate: the
 #: stage order (4) of the collocation; at the step ends it is higher where the kernel's
 #: rates times the step are small (measured in tests/test_time_integration.py).
 ORDER = 4
-#: Below this ``x = decay h`` the moments come from their Taylor series (forward
-#: recursion loses at most a factor 3.4 of accuracy above it); 24 terms leave
-#: 2^24 / 25! < 1e-17 of the series.
-_SERIES_BELOW = 2.0
-_SERIES_TERMS = 24
-#: Powers of the moments: up to the sextic of the dense output (:func:`_output_weights`).
-_POWERS = 7
-# k! / (n + k + 1)!: the Taylor coefficients of mu_k, (terms, 4)
-#: (largest x, terms) of the series: 0.02^8 / 9! and 0.3^14 / 15! are below 1e-19
-_SERIES_GROUPS = ((0.02, 8), (0.3, 14), (_SERIES_BELOW, _SERIES_TERMS))
-_SERIES = np.array([[math.factorial(k) / math.factorial(n + k + 1) for k in range(_POWERS)]
-                    for n in range(_SERIES_TERMS)])
 #: Steps per decade of time since the start or a jump, and steps over the whole span,
 #: of the first grid (each refinement doubles both).
 STEPS_PER_DECADE = 3
@@ -78,65 +68,6 @@ DENSITY_TOL = 3e-8
 MAX_BLOCK_ELEMENTS = 2**20
 #: Grid refinements tried before the caller's adaptive stepping takes over.
 MAX_REFINEMENTS = 6
-#: The grid is refined until the estimate is this many times below ``tol``: the error is
-#: measured against the size of the forcing, which exceeds the unknowns by up to the
-#: creep factor, and a fast state's error reaches the outputs through the equation's own
-#: feedback, which the estimate leaves out. Measured on the fast aging Arutyunyan inverse
-#: problem (tests/test_creep.py, tol 1e-10): with 1 the answer (w = 1) was 1.1e-10 off
-#: with an estimate of 2.7e-11 relative to a forcing of 6.9; with 4 it is 1.9e-12 off.
-SAFETY = 1.0
-
-
-def _moments(x: np.ndarray, powers: int = 4) -> np.ndarray:
-    """``mu_k(x) = int_0^1 exp(-x (1 - u)) u^k du`` for k < powers (at most 7), shape
-    x.shape + (powers,).
-
-    Taylor series ``sum_n (-x)^n k! / (n + k + 1)!`` for small x, else the recursion
-    ``mu_0 = (1 - exp(-x))/x``, ``mu_k = (1 - k mu_{k-1}) / x`` (for x >= 2 it loses at
-    most a factor ``6!/2^6 = 11`` of accuracy by k = 6).
-    """
-    x = np.asarray(x, dtype=float)
-    out = np.empty(x.shape + (powers,))
-    small = x < _SERIES_BELOW
-    # the series in groups by size, each with the terms it needs (x^n / (n + 1)! < 1e-19)
-    lower = -1.0
-    for upper, terms in _SERIES_GROUPS:
-        group = (x > lower) & (x <= upper) & small if lower >= 0 else (x <= upper) & small
-        lower = upper
-        xs = x[group]
-        if not xs.size:
-            continue
-        # Horner in -x, all k at once
-        acc = np.broadcast_to(_SERIES[terms - 1, :powers], (xs.size, powers)).copy()
-        neg = -xs[:, None]
-        for row in _SERIES[terms - 2::-1, :powers]:
-            acc *= neg
-            acc += row
-        out[group] = acc
-    xl = x[~small]
-    if xl.size:
-        mu = -np.expm1(-xl) / xl
-        out[~small, 0] = mu
-        for k in range(1, powers):
-            mu = (1.0 - k * mu) / xl
-            out[~small, k] = mu
-    return out
-
-
-def _weights(fraction: np.ndarray, h: np.ndarray, decay: np.ndarray) -> tuple[np.ndarray,
-                                                                                np.ndarray]:
-    """Exponential weights of the step's cubic up to ``fraction`` of the step.
-
-    ``fraction`` (..., A), ``h`` (...,) step lengths, ``decay`` (S,) rates. Returns
-    ``carry = exp(-decay a h)`` (..., S, A) and ``weight`` (..., S, A, 4):
-    ``int_0^{a h} exp(-decay (a h - sigma)) l_j(sigma/h) dsigma``.
-    """
-    ah = fraction * h[..., None]                                  # (..., A)
-    x = decay[:, None] * ah[..., None, :]                         # (..., S, A)
-    mu = _moments(x)                                              # (..., S, A, 4 powers)
-    powers = fraction[..., None, :, None] ** np.arange(1, 5)      # a^(k+1): (..., 1, A, 4)
-    weight = h[..., None, None, None] * ((mu * powers) @ _LAGRANGE.T)  # (..., S, A, 4 nodes)
-    return np.exp(-x), weight
 
 
 def grid(start: float, end: float, jumps: np.ndarray, first_step: float,
@@ -226,92 +157,6 @@ def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.
     return constant, response
 
 
-def _sextic_weights(h: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
-                    step_of: np.ndarray, a: np.ndarray
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Weights of the seven points of step ``step_of`` and a neighbour for the integral
-    from the step's start to ``a`` of it (see :func:`_output_weights`).
-
-    Returns ``side`` (T,): +1 the next step, -1 the previous, 0 none (then the step's
-    cubic, its four weights first); ``weight`` (T, S, 7); ``x = decay a h`` (T, S).
-    """
-    n_steps = h.size
-    hn = h[step_of]
-    has_next = (step_of + 1 < n_steps) & ~jump_start[np.minimum(step_of + 1, n_steps - 1)]
-    has_prev = (step_of >= 1) & ~jump_start[step_of]
-    side = np.where(has_next, 1, np.where(has_prev, -1, 0))
-    rho_next = h[np.minimum(step_of + 1, n_steps - 1)] / hn
-    rho_prev = h[np.maximum(step_of - 1, 0)] / hn
-    nodes = np.where(
-        (side == 1)[:, None],
-        np.concatenate([np.broadcast_to(NODES, (a.size, 4)),
-                        1.0 + rho_next[:, None] * NODES[1:]], axis=1),
-        np.concatenate([rho_prev[:, None] * (NODES[:3] - 1.0),
-                        np.broadcast_to(NODES, (a.size, 4))], axis=1))
-    plain = side == 0
-    nodes[plain] = np.linspace(-1.0, 1.0, 7)                      # unused (cubic below)
-    # the nodes depend on the step and the side only: one inverse per such pair
-    _, first, which = np.unique(step_of * 3 + side + 1, return_index=True,
-                                return_inverse=True)
-    inv_vander = np.linalg.inv(nodes[first, :, None] ** np.arange(7))[which.ravel()]
-    x = decay[None, :] * (a * hn)[:, None]                        # (T, S)
-    mu = _moments(x, 7) * (a[:, None, None] ** np.arange(1, 8))   # (T, S, 7 powers)
-    weight = hn[:, None, None] * (mu @ inv_vander)                # (T, S, 7 nodes)
-    if np.any(plain):
-        _, cubic = _weights(a[plain, None], hn[plain], decay)
-        weight[plain] = 0.0
-        weight[plain, :, :4] = cubic[:, :, 0, :]
-    return side, weight, x
-
-
-def _output_weights(ends: np.ndarray, jump_start: np.ndarray, beta: np.ndarray,
-                    decay: np.ndarray, t_out: np.ndarray):
-    """How ``V`` at each output time is read from the march (dense output).
-
-    An output at ``t_n + a h`` in step n carries the states from the step's start
-    (``carry`` (T, S)) and integrates the sextic through the seven points of step n and
-    of a neighbouring step (the next, else the previous where a jump separates them; the
-    step's own cubic where both do) against the exponentials (``total`` (T, 7)). The
-    sextic's error is far below the steps' own, so the answers at output times converge
-    like those at the step ends, wherever the outputs fall in the steps (with the cubic
-    they converged erratically, and their difference on two grids was no estimate).
-    Returns ``step_of`` (T,), ``side`` (T,): +1 next, -1 previous, 0 none, and the two.
-    """
-    h = np.diff(ends)
-    step_of = np.clip(np.searchsorted(ends, t_out, side="left") - 1, 0, h.size - 1)
-    a = np.clip((t_out - ends[step_of]) / h[step_of], 0.0, 1.0)
-    side, weight, x = _sextic_weights(h, jump_start, decay, step_of, a)
-    beta7 = _seven(beta.transpose(0, 2, 1), step_of, side)        # (T, 7, S)
-    total = np.einsum("tsj,tjs->tj", weight, beta7)
-    carry = np.exp(-x)
-    before_start = t_out <= ends[0]
-    carry[before_start] = 0.0
-    total[before_start] = 0.0
-    return step_of, side, carry, total
-
-
-def _seven(values: np.ndarray, step_of: np.ndarray, side: np.ndarray) -> np.ndarray:
-    """Values at the four points of each output's step and three of its neighbour, in the
-    order of :func:`_output_weights` (``values`` (B, 4, ...); zeros for no neighbour)."""
-    n_steps = values.shape[0]
-    before = (side == -1)[:, None]
-    # step and point of each of the seven slots: own 0..3 then next 1..3, or previous
-    # 0..2 then own 0..3
-    slot_step = np.where(before, step_of[:, None] + _PREVIOUS_STEP, step_of[:, None]
-                         + _NEXT_STEP)
-    slot_point = np.where(before, _PREVIOUS_POINT, _NEXT_POINT)
-    picked = values[np.clip(slot_step, 0, n_steps - 1), slot_point]   # (T, 7, ...)
-    missing = (side == 0)[:, None] & (np.arange(7) >= 4)[None, :]
-    if np.any(missing):
-        picked[missing] = 0.0
-    return picked
-
-
-_NEXT_STEP = np.array([0, 0, 0, 0, 1, 1, 1])
-_NEXT_POINT = np.array([0, 1, 2, 3, 1, 2, 3])
-_PREVIOUS_STEP = np.array([-1, -1, -1, 0, 0, 0, 0])
-_PREVIOUS_POINT = np.array([0, 1, 2, 0, 1, 2, 3])
-
 
 def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
                   beta: np.ndarray, end_weight: np.ndarray, values: np.ndarray,
@@ -323,20 +168,20 @@ def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
     time falls in them: two grids may then agree by chance (measured on a stiff aging
     kernel: 2.1e-9 on the finer grid, 8.9e-10 on the coarser, their difference 1.1e-9).
     Here each step's error is estimated as the difference of its cubic from the sextic
-    through its points and three of a neighbour (:func:`_sextic_weights`), and carried to
+    through its points and three of a neighbour (:func:`sextic_weights`), and carried to
     the output times (its absolute value: no cancelling between steps), relative to
     ``rows`` (the size of each channel, ``values`` (B, 4, C) at the points of the steps).
     """
     h = np.diff(ends)
     n_steps = h.size
     steps = np.arange(n_steps)
-    side, sextic, _ = _sextic_weights(h, jump_start, decay, steps, np.ones(n_steps))
+    side, sextic, _ = sextic_weights(h, jump_start, decay, steps, np.ones(n_steps))
     cubic = np.zeros_like(sextic)
     own_last = side == -1
     cubic[~own_last, :, :4] = end_weight[~own_last]
     cubic[own_last, :, 3:] = end_weight[own_last]
-    beta7 = _seven(beta.transpose(0, 2, 1), steps, side)          # (B, 7, S)
-    values7 = _seven(values, steps, side)                         # (B, 7, C)
+    beta7 = seven(beta.transpose(0, 2, 1), steps, side)          # (B, 7, S)
+    values7 = seven(values, steps, side)                         # (B, 7, C)
     # A state slow over a step (decay h < 1) keeps its errors: they add up smoothly over
     # the steps, and the difference of two grids measures them (measured on the 50-year
     # fib MC2010 preset: that difference over 15 is 1.2-1.4x the true error at every
@@ -383,7 +228,7 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     beta, decay = _kernel_factors(kernel, flat)                   # (S, 4B), (S,)
     n_states = decay.size
     beta = beta.reshape(n_states, n_steps, 4).transpose(1, 0, 2)  # (B, S, 4)
-    carry, weight = _weights(NODES[1:], h, decay)                 # (B,S,3), (B,S,3,4)
+    carry, weight = weights(NODES[1:], h, decay)                 # (B,S,3), (B,S,3,4)
     driven = weight * beta[:, :, None, :]                         # (B, S, 3, 4)
     total = driven.sum(axis=1)                                    # (B, 3, 4)
     end_drive = driven[:, :, 2, :].transpose(0, 2, 1).copy()      # (B, 4, S)
@@ -393,7 +238,7 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     reads = np.concatenate([np.ones((n_steps, n_states, 1)), carry], axis=2)  # (B, S, 4)
 
     t_out = np.asarray(times, dtype=float)
-    step_of, side, out_carry, out_total = _output_weights(ends, jump_start, beta, decay,
+    step_of, side, out_carry, out_total = output_weights(ends, jump_start, beta, decay,
                                                           t_out)
     order = np.argsort(step_of, kind="stable")
     bounds = np.searchsorted(step_of[order], np.arange(n_steps + 1))
@@ -419,7 +264,7 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
                 idx = order[lo:hi]
                 vu_out[:, idx] = s_known @ out_carry[idx].T
             s_known = s_known * end_carry[b] + next_drive[b]
-        vu_out += np.einsum("tj,tjk->kt", out_total, _seven(u.transpose(0, 2, 1), step_of,
+        vu_out += np.einsum("tj,tjk->kt", out_total, seven(u.transpose(0, 2, 1), step_of,
                                                             side))
         if rows is not None:
             channels.append((u.transpose(0, 2, 1), rows[1]))
@@ -534,9 +379,9 @@ def solve_exponential(kernel, problem, times: np.ndarray, jumps: np.ndarray, *, 
                       if last_change is not None else np.full(parts, 2.0**ORDER))
             errors = change / (factor - 1.0)
             last_change = change
-            if level >= MIN_LEVEL and np.max(errors) <= tol / SAFETY:
+            if level >= MIN_LEVEL and np.max(errors) <= tol:
                 errors = np.maximum(errors, local())
-                if np.max(errors) <= tol / SAFETY:
+                if np.max(errors) <= tol:
                     return vw, vu, errors, steps
         previous = (vw, vu)
     return None
