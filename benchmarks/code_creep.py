@@ -24,12 +24,11 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import time
 from pathlib import Path
-from statistics import median
 
 import numpy as np
 
+from benchmarks.creep_goals import timed
 from core.cache import clear_caches
 from core.code_creep import _FORMULAS, MAX_DURATION, RESOLUTION, CodeCreep, clamp_age
 from core.creep import Arutyunyan
@@ -42,18 +41,12 @@ PRESET = Path(__file__).resolve().parents[1] / "assets" / "scenes" / \
 
 
 def _timed(fn, repeats: int, before=None) -> tuple[float, object]:
-    """Median wall time [s] of ``repeats`` runs and the last answer (CPU time in
-    ``_timed.cpu``: on a shared machine it is inflated far less than the wall time)."""
-    seconds, cpu, out = [], [], None
-    for _ in range(repeats):
-        if before is not None:
-            before()
-        start, start_cpu = time.perf_counter(), time.process_time()
-        out = fn()
-        seconds.append(time.perf_counter() - start)
-        cpu.append(time.process_time() - start_cpu)
-    _timed.cpu = median(cpu)
-    return median(seconds), out
+    """Median wall time [s] of ``repeats`` runs after a warm-up and the last answer (CPU
+    time in ``_timed.cpu``: on a shared machine it is inflated far less than the wall
+    time); see :func:`benchmarks.creep_goals.timed`."""
+    cpu_ms, wall_ms, out = timed(fn, repeats, before)
+    _timed.cpu = cpu_ms / 1e3
+    return wall_ms / 1e3, out
 
 
 def _fine_kernel(model: CodeCreep, tau0: float):
@@ -79,8 +72,9 @@ def code_scene(model_name: str, repeats: int) -> dict:
     new_s, result = _timed(lambda: scene_from_dict(data).dimensionless.solve(), repeats,
                            clear_caches)
     new_cpu = _timed.cpu
+    # one more than the runs: the warm-up takes the first
     loads = [dict(data, loading={"force": 6.0e5 * (1 + 0.01 * (k + 1)), "moment": 0.0})
-             for k in range(repeats)]
+             for k in range(repeats + 1)]
     problems = [scene_from_dict(d).dimensionless for d in loads]
     it = iter(problems)
     load_s, _ = _timed(lambda: next(it).solve(), repeats)

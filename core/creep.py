@@ -41,257 +41,35 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from functools import partial
 from typing import Any
 
 import numpy as np
 
 from core.code_creep import SPEC_FIELDS as _CODE_SPEC_FIELDS
 from core.code_creep import CodeCreep
-from core.validation import (
-    PYTHON_STYLE,
-    bounded_list,
-    finite_number,
-    nonnegative_number,
-    positive_number,
-    show_python,
+from core.creep_inputs import (  # noqa: F401 (MAX_RATE, MAX_TERMS: re-exported)
+    MAX_RATE,
+    MAX_TERMS,
+    Terms,
+    _age_at_loading,
+    _check_arutyunyan,
+    _check_exponential,
+    _check_terms,
+    _positive,
 )
-
-#: Largest accepted creep rate [1/day]. Faster creep is instantaneous on any time scale
-#: the model is meant for, and would only make the modal equations needlessly stiff.
-MAX_RATE = 1e6
-
-#: Largest number of Prony terms.
-MAX_TERMS = 12
+from core.creep_kernels import (  # noqa: F401 (the kernels: re-exported)
+    CausalKernel,
+    DegenerateKernel,
+    RelativeModulus,
+    _set,
+    separable_kernel_value,
+)
+from core.validation import show_python
 
 ArrayLike = Any
 
 
-# ----------------------------------------------------------------------------- validation
-
-
-# Models are built from Python as often as from scene files: their messages quote reprs.
-_number = partial(finite_number, style=PYTHON_STYLE)
-_positive = partial(positive_number, style=PYTHON_STYLE)
-_nonnegative = partial(nonnegative_number, style=PYTHON_STYLE)
-
-
-def _creep_coefficient(value: Any, field: str) -> float:
-    x = _number(value, field)
-    if x < 0:
-        raise ValueError(
-            f"{field}: must be >= 0, got {show_python(value)}: a negative value makes the "
-            "compliance decrease in time, which is not creep")
-    return x
-
-
-def _rate(value: Any, field: str) -> float:
-    x = _positive(value, field)
-    if x > MAX_RATE:
-        raise ValueError(f"{field}: must be <= {MAX_RATE:g} per day, got {show_python(value)}")
-    return x
-
-
-def _beta(value: Any, field: str) -> float:
-    x = _number(value, field)
-    if not 0 <= x < 1:
-        raise ValueError(
-            f"{field}: must be >= 0 and < 1 (the modulus at age 0 is "
-            f"modulus_final (1 - beta)), got {show_python(value)}")
-    return x
-
-
-def _age_at_loading(value: Any, field: str) -> float:
-    return _positive(value, field)
-
-
-def _set(obj: Any, **values: Any) -> None:
-    # frozen dataclasses: store the normalized (validated, float) values once
-    for name, value in values.items():
-        object.__setattr__(obj, name, value)
-
-
-# ------------------------------------------------------------------ the degenerate kernel
-
-
-def separable_kernel_value(kernel: Any, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
-    """``K(t, tau) = b(tau) + sum_r a_r(tau) exp(-rate_r (t - tau))`` [-], 0 where ``t < tau``.
-
-    For any kernel with ``rates`` (R,), ``tau_part(tau)`` (b) and ``exponential_parts(tau)``
-    (a_r, shape (R,) + tau.shape): the aging Prony series below and the fitted kernels of
-    :mod:`core.kernel_fit` share this one causal evaluation. ``t`` broadcasts against ``tau``.
-    """
-    t, tau = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(tau, dtype=float))
-    lag = np.maximum(t - tau, 0.0)
-    rates = kernel.rates.reshape((-1,) + (1,) * lag.ndim)
-    value = kernel.tau_part(tau) + np.sum(
-        kernel.exponential_parts(tau) * np.exp(-rates * lag[None]), axis=0)
-    return np.where(t >= tau, value, 0.0)
-
-
-@dataclass(frozen=True)
-class DegenerateKernel:
-    """``K*(t*, tau*) = b(tau*) + sum_r a_r(tau*) exp(-rate_r (t* - tau*))``, aging Prony series.
-
-    The kernel of ``E(age) = modulus_final (1 - beta exp(-alpha age))`` and
-    ``C(t, tau) = sum_r (C_r + A_r/tau)(1 - exp(-gamma_r (t - tau)))`` (``terms`` holds the
-    triples ``(C_r [1/Pa], A_r [day/Pa], gamma_r [1/day])``), expressed in the time
-    ``t* = age / age_at_loading`` [-]. With ``age_at_loading = 1`` it is the kernel in ages
-    [1/day]. Built by the creep models; all methods are vectorized.
-    """
-
-    age_at_loading: float
-    modulus_final: float
-    beta: float
-    alpha: float
-    terms: tuple[tuple[float, float, float], ...]
-
-    def __post_init__(self) -> None:
-        # plain floats and tuples, so that equal kernels compare and hash equal
-        _set(self, age_at_loading=float(self.age_at_loading),
-             modulus_final=float(self.modulus_final), beta=float(self.beta),
-             alpha=float(self.alpha),
-             terms=tuple((float(c), float(a), float(g)) for c, a, g in self.terms))
-
-    @property
-    def rates(self) -> np.ndarray:
-        """Dimensionless decay rates ``gamma_r * age_at_loading``, shape (R,)."""
-        return np.array([g for _, _, g in self.terms], dtype=float) * self.age_at_loading
-
-    @property
-    def key(self) -> tuple:
-        """A tuple of plain numbers that identifies the kernel (for cache keys)."""
-        return ("degenerate", self.age_at_loading, self.modulus_final, self.beta, self.alpha,
-                tuple(self.terms))
-
-    def _age_modulus(self, age: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``E(age)`` [Pa] and ``-E'(age)/E(age)`` [1/day]."""
-        decay = self.beta * np.exp(-self.alpha * age)
-        return self.modulus_final * (1.0 - decay), -self.alpha * decay / (1.0 - decay)
-
-    def tau_part(self, tau: ArrayLike) -> np.ndarray:
-        """``b(tau*)`` [-], the part of the kernel that does not depend on ``t*``; shape of tau."""
-        tau0 = self.age_at_loading
-        age = tau0 * np.asarray(tau, dtype=float)
-        modulus, log_rate = self._age_modulus(age)
-        aging = sum(a for _, a, _ in self.terms)
-        return tau0 * (log_rate - modulus * aging / age**2)
-
-    def exponential_parts(self, tau: ArrayLike) -> np.ndarray:
-        """``a_r(tau*)`` [-], amplitudes of ``exp(-rate_r (t* - tau*))``; shape (R,) + tau.shape."""
-        tau0 = self.age_at_loading
-        age = tau0 * np.asarray(tau, dtype=float)
-        modulus, _ = self._age_modulus(age)
-        coef = np.array(self.terms, dtype=float).reshape((len(self.terms), 3)
-                                                           + (1,) * age.ndim)
-        c, a, g = coef[:, 0], coef[:, 1], coef[:, 2]
-        return tau0 * modulus * (a / age**2 - g * (c + a / age))
-
-    def factors(self, tau: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """``b(tau*)`` and ``a_r(tau*)`` [-] together (:meth:`tau_part`,
-        :meth:`exponential_parts`), the modulus evaluated once."""
-        tau0 = self.age_at_loading
-        age = tau0 * np.asarray(tau, dtype=float)
-        modulus, log_rate = self._age_modulus(age)
-        coef = np.array(self.terms, dtype=float).reshape((len(self.terms), 3)
-                                                           + (1,) * age.ndim)
-        c, a, g = coef[:, 0], coef[:, 1], coef[:, 2]
-        aging = sum(a_r for _, a_r, _ in self.terms)
-        return (tau0 * (log_rate - modulus * aging / age**2),
-                tau0 * modulus * (a / age**2 - g * (c + a / age)))
-
-    def __call__(self, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
-        """``K*(t*, tau*)`` [-], broadcasting ``t`` against ``tau``; 0 where ``t < tau``."""
-        return separable_kernel_value(self, t, tau)
-
-
-@dataclass(frozen=True)
-class RelativeModulus:
-    """``c(t*) = E(tau0 t*) / E(tau0)`` [-] for ``E(age) = E_inf (1 - beta exp(-alpha age))``."""
-
-    age_at_loading: float
-    beta: float
-    alpha: float
-
-    def __call__(self, t: ArrayLike) -> np.ndarray:
-        """The relative modulus at dimensionless times ``t* = age / age_at_loading``."""
-        tau0 = self.age_at_loading
-        t = np.asarray(t, dtype=float)
-        return ((1.0 - self.beta * np.exp(-self.alpha * tau0 * t))
-                / (1.0 - self.beta * np.exp(-self.alpha * tau0)))
-
-
-@dataclass(frozen=True, eq=False)
-class CausalKernel:
-    """A user kernel ``K(t, tau)`` (any units) made causal: 0 where ``t < tau``.
-
-    The wrapped function is only ever evaluated at ``t >= tau`` (``t`` is raised to
-    ``tau`` elsewhere), so a formula such as ``sqrt(t - tau)`` is safe; a non-finite value
-    where the kernel is used is an error.
-    """
-
-    function: Callable[[np.ndarray, np.ndarray], Any]
-    scale: float = 1.0  # K* = scale * K(scale t, scale tau): the age at loading [day]
-
-    def __call__(self, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
-        """``scale * K(scale t, scale tau)``, broadcasting; 0 where ``t < tau``."""
-        t, tau = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(tau, dtype=float))
-        causal = t >= tau
-        with np.errstate(all="ignore"):
-            raw = self.function(self.scale * np.maximum(t, tau), self.scale * tau)
-        value = np.broadcast_to(np.asarray(raw, dtype=float), t.shape)
-        bad = causal & ~np.isfinite(value)
-        if np.any(bad):
-            i = np.argwhere(bad)[0]
-            t_bad, tau_bad = float(t[tuple(i)]), float(tau[tuple(i)])
-            raise ValueError(
-                f"creep kernel: not finite at t = {self.scale * t_bad:g}, "
-                f"tau = {self.scale * tau_bad:g} (ages in days)")
-        return self.scale * np.where(causal, value, 0.0)
-
-    def __eq__(self, other: object) -> bool:
-        return (isinstance(other, CausalKernel) and other.function is self.function
-                and other.scale == self.scale)
-
-    def __hash__(self) -> int:
-        return hash((id(self.function), self.scale))
-
-
 # ----------------------------------------------------------------------------- the models
-
-Terms = tuple[tuple[float, float, float], ...]
-
-
-def _check_exponential(values: Mapping[str, Any], field: str) -> dict[str, float]:
-    return {"modulus": _positive(values["modulus"], f"{field}.modulus"),
-            "compliance": _creep_coefficient(values["compliance"], f"{field}.compliance"),
-            "rate": _rate(values["rate"], f"{field}.rate")}
-
-
-def _check_arutyunyan(values: Mapping[str, Any], field: str) -> dict[str, float]:
-    return {"modulus_final": _positive(values["modulus_final"], f"{field}.modulus_final"),
-            "beta": _beta(values["beta"], f"{field}.beta"),
-            "alpha": _nonnegative(values["alpha"], f"{field}.alpha"),
-            "compliance_final": _creep_coefficient(values["compliance_final"],
-                                                   f"{field}.compliance_final"),
-            "aging": _creep_coefficient(values["aging"], f"{field}.aging"),
-            "rate": _rate(values["rate"], f"{field}.rate")}
-
-
-def _check_terms(terms: Any, field: str) -> Terms:
-    """Prony terms as a tuple of (C_r, A_r, gamma_r) float triples, validated."""
-    terms = bounded_list(terms, field, least=1, most=MAX_TERMS, what="terms", style=PYTHON_STYLE)
-    checked = []
-    for r, term in enumerate(terms):
-        where = f"{field}[{r}]"
-        if isinstance(term, (str, bytes)) or not isinstance(term, (list, tuple)) \
-                or len(term) != 3:
-            raise ValueError(f"{where}: must be a (compliance, aging, rate) triple, "
-                             f"got {show_python(term)}")
-        checked.append((_creep_coefficient(term[0], f"{where}.compliance"),
-                        _creep_coefficient(term[1], f"{where}.aging"),
-                        _rate(term[2], f"{where}.rate")))
-    return tuple(checked)
 
 
 class _AgingSeries:
@@ -351,18 +129,30 @@ class _AgingSeries:
         return DegenerateKernel(tau0, e_inf, beta, alpha, terms)
 
 
+class _ConstantModulus:
+    """What the models with a modulus that does not age share (``instantaneous_modulus``)."""
+
+    instantaneous_modulus: float
+
+    def modulus(self, age: ArrayLike) -> np.ndarray:
+        """Instantaneous modulus ``E(age)`` [Pa] at ages [day] (constant)."""
+        return np.full(np.shape(age), self.instantaneous_modulus)
+
+    def relative_modulus(self, age_at_loading: float, *,
+                         field: str = "age_at_loading") -> float:
+        """``c(t*) = 1.0``: the modulus does not age. ``age_at_loading`` in days."""
+        _age_at_loading(age_at_loading, field)
+        return 1.0
+
+
 @dataclass(frozen=True, init=False)
-class Elastic:
+class Elastic(_ConstantModulus):
     """No creep: constant ``modulus`` [Pa], ``C = 0``, ``K = 0``."""
 
     instantaneous_modulus: float
 
     def __init__(self, modulus: float) -> None:
         _set(self, instantaneous_modulus=_positive(modulus, "Elastic.modulus"))
-
-    def modulus(self, age: ArrayLike) -> np.ndarray:
-        """Instantaneous modulus ``E(age)`` [Pa] at ages [day] (constant)."""
-        return np.full(np.shape(age), self.instantaneous_modulus)
 
     def compliance(self, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
         """Creep function ``C(t, tau) = 0`` [1/Pa] at ages [day]."""
@@ -371,12 +161,6 @@ class Elastic:
     def kernel(self, t: ArrayLike, tau: ArrayLike) -> np.ndarray:
         """Creep kernel ``K(t, tau) = 0`` [1/day] at ages [day]."""
         return np.zeros(np.broadcast_shapes(np.shape(t), np.shape(tau)))
-
-    def relative_modulus(self, age_at_loading: float, *,
-                         field: str = "age_at_loading") -> float:
-        """``c(t*) = 1.0``: the modulus does not age. ``age_at_loading`` in days."""
-        _age_at_loading(age_at_loading, field)
-        return 1.0
 
     def dimensionless_kernel(self, age_at_loading: float, *,
                              field: str = "age_at_loading") -> None:
@@ -476,7 +260,7 @@ class PronySeries(_AgingSeries):
 
 
 @dataclass(frozen=True, init=False, eq=False)
-class UserKernel:
+class UserKernel(_ConstantModulus):
     """Constant ``modulus`` [Pa] and the creep kernel given directly (Python API).
 
     ``kernel`` is a vectorized callable ``K(t, tau)`` [1/day] of ages ``t >= tau`` [day];
@@ -511,16 +295,6 @@ class UserKernel:
     def __hash__(self) -> int:
         return hash((self.instantaneous_modulus,
                      self.expr if self.expr is not None else self.kernel))
-
-    def modulus(self, age: ArrayLike) -> np.ndarray:
-        """Instantaneous modulus ``E(age)`` [Pa] at ages [day] (constant)."""
-        return np.full(np.shape(age), self.instantaneous_modulus)
-
-    def relative_modulus(self, age_at_loading: float, *,
-                         field: str = "age_at_loading") -> float:
-        """``c(t*) = 1.0``: the modulus does not age. ``age_at_loading`` in days."""
-        _age_at_loading(age_at_loading, field)
-        return 1.0
 
     def dimensionless_kernel(self, age_at_loading: float, *,
                              field: str = "age_at_loading") -> CausalKernel:

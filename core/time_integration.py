@@ -14,22 +14,25 @@ The requested times are outputs, not the step: each solver chooses its own steps
 meets ``tol`` at them.
 
 * :func:`solve_degenerate` for ``K(t, tau) = b(tau) + sum_r a_r(tau) exp(-rate_r (t - tau))``
-  (every shipped creep model). ``V f`` is the sum of states ``S_0' = b f`` and
-  ``S_r' = -rate_r S_r + a_r f``, so each mode is a small linear ODE. It is stepped by the
-  3-stage Radau IIA collocation method (order 5, L-stable: a fast, stiff exponential costs
-  nothing extra), all modes at once, O(1) work per mode and step. The known channels are
-  stepped first; the modes then see their stage values (the coupled system is block
-  triangular, so this is the exact Radau step of the whole system). Step sizes come from
-  step-doubling error estimates; a step may spend its share of the time or of the
-  log-time since loading (:data:`LOG_TIME_BUDGET`) or of the steps
-  (:data:`STEP_BUDGET`), whichever is largest. A step, both its halves and the side steps
-  to the output times inside it read the kernel and the histories once (the batched
-  step itself is :mod:`core.radau`).
-* :func:`solve_general` for any vectorized ``K(t, tau)``: product trapezoid rule on grids
-  containing every requested time, halved until the Richardson estimate meets ``tol``
-  (O(steps^2) per mode, as any method for a general kernel must be). The grid's size is
-  checked before it is built (:data:`core.limits.MAX_KERNEL_GRID_POINTS`) and the kernel
-  matrix is evaluated in blocks of rows, so one solve's memory is bounded.
+  (every shipped creep model, every fitted kernel). ``V f`` is the sum of states
+  ``S_0' = b f`` and ``S_r' = -rate_r S_r + a_r f``, so each mode is a small linear ODE.
+  By default it is stepped by exponential collocation (:mod:`core.exponential_steps`:
+  the exponentials integrated exactly, grids fixed in advance and refined as a whole,
+  all steps' factors computed at once); where that would need more than a share of the
+  step limit (:data:`EXPONENTIAL_SHARE`), and with ``method="radau"`` (the reference),
+  by the 3-stage Radau IIA collocation method (order 5, L-stable), all modes at once,
+  O(1) work per mode and step. The known channels are stepped first; the modes then see
+  their stage values (the coupled system is block triangular, so this is the exact Radau
+  step of the whole system). Step sizes come from step-doubling error estimates; a step
+  may spend its share of the time or of the log-time since loading
+  (:data:`LOG_TIME_BUDGET`) or of the steps (:data:`STEP_BUDGET`), whichever is largest.
+  A step, both its halves and the side steps to the output times inside it read the
+  kernel and the histories once (the batched step itself is :mod:`core.radau`).
+* :func:`solve_general` (:mod:`core.product_quadrature`) for any vectorized
+  ``K(t, tau)``: product trapezoid rule on grids containing every requested time, halved
+  until the Richardson estimate meets ``tol``.
+
+The problem and solution types are in :mod:`core.volterra_problem`.
 
 Both accept ``breaks``: times where a given history (a load) jumps or kinks. The steps
 (or grid points) fall exactly on them, and the history is read on the proper side of
@@ -40,14 +43,15 @@ assumes a smooth history, can read far too low.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
-
 import numpy as np
 
 from core import limits
+from core.exponential_steps import solve_exponential
+from core.product_quadrature import (  # noqa: F401 (the general-kernel solver: re-exported)
+    _trapezoid_solve,
+    solve_general,
+)
 from core.radau import (  # noqa: F401 (RADAU_A, RADAU_C, _radau_step(s): re-exported)
-    JUMP_SIDE,
     RADAU_A,
     RADAU_C,
     RADAU_ORDER,
@@ -56,8 +60,18 @@ from core.radau import (  # noqa: F401 (RADAU_A, RADAU_C, _radau_step(s): re-exp
     _radau_steps,
     _stage_values,
 )
+from core.volterra_problem import (  # noqa: F401 (the problem: re-exported)
+    ModalProblem,
+    TimeFunction,
+    VolterraSolution,
+    _after,
+    _jumps,
+    _scales,
+)
 
-TimeFunction = Callable[[np.ndarray], np.ndarray]
+#: The exponential collocation may spend this fraction (1/EXPONENTIAL_SHARE) of the step
+#: limit before the adaptive Radau stepping takes over (a history that oscillates fast).
+EXPONENTIAL_SHARE = 4
 
 #: Step-doubling differences below this are round-off, not truncation error (~100 ulp).
 _ROUNDOFF = 100 * float(np.finfo(float).eps)
@@ -75,96 +89,11 @@ LOG_TIME_BUDGET = 100.0
 #: Measured on the 50-year fib MC2010 preset: 193 -> 147 steps (400: 163, 100: 134); the
 #: stiff exponential's closed form (tests/test_hard_cases.py) held to 4.6e-13.
 STEP_BUDGET = 200
-def _before(t: float) -> float:
-    return t - JUMP_SIDE * max(1.0, abs(t))
-
-
-def _after(t: float) -> float:
-    return t + JUMP_SIDE * max(1.0, abs(t))
-
-
-def _jumps(breaks, start: float, end: float) -> np.ndarray:
-    """Sorted distinct ``breaks`` strictly inside ``(start, end)`` (beyond rounding)."""
-    try:
-        b = np.asarray(list(breaks), dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise ValueError("breaks: must be a sequence of times") from None
-    if not np.all(np.isfinite(b)):
-        raise ValueError("breaks: must be finite times")
-    b = np.unique(b)
-    margin = 4 * JUMP_SIDE
-    return b[(b > start + margin * max(1.0, abs(start)))
-             & (b < end - margin * max(1.0, abs(end)))]
-
-
-@dataclass(frozen=True)
-class ModalProblem:
-    """``d w - V w = r + coupling @ V u`` for ``modes`` unknowns and ``known`` functions u.
-
-    ``d(t)``, ``r(t)`` return arrays (modes, len(t)); ``u(t)`` (known, len(t));
-    ``coupling`` is (modes, known). All dimensionless. ``parts``: the modes and the known
-    functions are that many equal consecutive groups, independent problems stepped
-    together (the same steps for all); their sizes and errors are measured per group.
-    """
-
-    d: TimeFunction
-    r: TimeFunction
-    u: TimeFunction
-    coupling: np.ndarray
-    parts: int = 1
-
-    @property
-    def n_modes(self) -> int:
-        return self.coupling.shape[0]
-
-    @property
-    def n_known(self) -> int:
-        return self.coupling.shape[1]
-
-
-@dataclass(frozen=True)
-class VolterraSolution:
-    """Solution at the output times.
-
-    ``w`` and ``vw`` (= ``V w``) have shape (modes, times); ``vu`` (known, times).
-    ``error_estimate`` estimates the global error of ``w`` relative to ``max|w|`` (and of
-    ``vu`` relative to ``max|u|``); ``steps`` counts accepted steps. ``part_errors``: the
-    estimate of each group of :attr:`ModalProblem.parts`, relative to its own size
-    (``error_estimate`` is their largest).
-    """
-
-    w: np.ndarray
-    vw: np.ndarray
-    vu: np.ndarray
-    error_estimate: float
-    steps: int
-    rejected: int
-    success: bool
-    message: str
-    part_errors: tuple[float, ...] = ()
-
-
-def _scales(problem: ModalProblem, t_end: float) -> tuple[np.ndarray, np.ndarray]:
-    """Sizes of the unknowns and known functions, for a relative error norm."""
-    probe = np.linspace(1.0, t_end, 17)
-    w_scale = np.ones(problem.n_modes)
-    if problem.n_modes:
-        d = problem.d(probe)
-        forcing = problem.r(probe)
-        if problem.n_known:
-            u = problem.u(probe)
-            forcing = np.abs(forcing) + np.abs(problem.coupling) @ np.abs(u)
-        # one size per group of modes (per problem stepped together)
-        size = np.max(np.abs(forcing / d).reshape(problem.parts, -1), axis=1)
-        w_scale = np.repeat(np.where(size > 0, size, 1.0), problem.n_modes // problem.parts)
-    u_scale = np.ones(problem.n_known)
-    if problem.n_known:
-        u_scale = np.maximum(np.max(np.abs(problem.u(probe)), axis=1), 1e-300)
-    return w_scale, u_scale
 
 
 def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: float,
-                     max_steps: int = limits.MAX_TIME_STEPS, breaks=()) -> VolterraSolution:
+                     max_steps: int = limits.MAX_TIME_STEPS, breaks=(),
+                     method: str = "exponential") -> VolterraSolution:
     """Solve ``problem`` at ``times`` (increasing, >= 1) for a degenerate kernel.
 
     ``kernel`` has ``rates``, ``tau_part(tau)`` and ``exponential_parts(tau)`` (see
@@ -176,7 +105,15 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     every step ends on each of them, and an output time on one reports the value after
     the jump. At most ``max_steps`` steps (accepted and rejected) are taken; then the
     times not reached are NaN and the message says which limit stopped it.
+
+    ``method``: ``"exponential"`` (default) tries the exponential collocation of
+    :mod:`core.exponential_steps` (exact for the kernel's exponentials, steps fixed in
+    advance and refined as a whole) within a share of ``max_steps`` and steps adaptively
+    by Radau IIA when that does not meet ``tol``; ``"radau"`` steps adaptively only (the
+    independent reference of the tests).
     """
+    if method not in ("exponential", "radau"):
+        raise ValueError(f"method: must be 'exponential' or 'radau', got {method!r}")
     times = np.asarray(times, dtype=float)
     jumps = _jumps(breaks, 1.0, float(times[-1]))
     jump_set = set(jumps.tolist())
@@ -209,6 +146,22 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
         forcing = problem.r(tt) + (problem.coupling @ vu_out if nk else 0.0)
         return (forcing + vw_out) / problem.d(tt)
 
+    if method == "exponential" and float(times[-1]) > 1.0:
+        def unknowns(vw: np.ndarray, vu: np.ndarray) -> np.ndarray:
+            # w at (at most 65 of) the output times: a size, not the answer
+            pick = np.unique(np.linspace(0, len(times) - 1, min(len(times), 65)).astype(int))
+            tt = times[pick]
+            forcing = problem.r(tt) + (problem.coupling @ vu[:, pick] if nk else 0.0)
+            return (forcing + vw[:, pick]) / problem.d(tt)
+
+        fast = solve_exponential(kernel, problem, times, jumps, tol=tol, w_scale=w_scale,
+                                 u_scale=u_scale, max_steps=max_steps // EXPONENTIAL_SHARE,
+                                 unknowns=unknowns)
+        if fast is not None:
+            vw_out[:], vu_out[:], errors, steps = fast
+            part_errors = tuple(float(max(e, 1e-15)) for e in errors)
+            return VolterraSolution(finish(), vw_out, vu_out, max(part_errors), steps, 0,
+                                    True, "ok", part_errors)
     k_out = 0
     while k_out < len(times) and times[k_out] <= 1.0:
         record(k_out, s_modes.sum(axis=1), s_known.sum(axis=1))
@@ -298,158 +251,3 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     part_errors = tuple(float(max(e, 1e-15)) for e in total_error)
     return VolterraSolution(finish(), vw_out, vu_out, max(part_errors), steps, rejected,
                             True, "ok", part_errors)
-
-
-def _trapezoid_weights(grid: np.ndarray, i: int) -> np.ndarray:
-    """Weights of the trapezoid rule for int_{grid[0]}^{grid[i]} on the nodes 0..i."""
-    h = np.diff(grid[: i + 1])
-    om = np.zeros(i + 1)
-    om[:-1] += h / 2
-    om[1:] += h / 2
-    return om
-
-
-def _kernel_matrix(kernel: Callable, grid: np.ndarray) -> np.ndarray:
-    """``K(grid_i, grid_j)`` for ``j <= i``, 0 above the diagonal.
-
-    Evaluated in blocks of rows of at most :data:`core.limits.KERNEL_BLOCK_ELEMENTS`
-    values (only the columns a block's rows need), so a formula kernel's temporaries
-    stay small whatever the grid.
-    """
-    n = len(grid)
-    kmat = np.zeros((n, n))
-    rows = max(1, limits.KERNEL_BLOCK_ELEMENTS // n)
-    for start in range(0, n, rows):
-        stop = min(n, start + rows)
-        block = np.broadcast_to(np.asarray(kernel(grid[start:stop, None],
-                                                  grid[None, :stop]), dtype=float),
-                                (stop - start, stop))
-        block = np.tril(block, start)
-        if not np.all(np.isfinite(block)):
-            raise ValueError("kernel: returned non-finite values K(t, tau) for "
-                             "1 <= tau <= t")
-        kmat[start:stop, :stop] = block
-    return kmat
-
-
-def _trapezoid_solve(kernel: Callable, problem: ModalProblem, grid: np.ndarray,
-                     at: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Product trapezoid rule on ``grid`` (which starts at 1). Values on the grid.
-
-    ``at``: where ``d``, ``r``, ``u`` are read for each node (``grid``, but just before
-    a jump for the first of the two nodes a jump has).
-    """
-    n = len(grid)
-    kmat = _kernel_matrix(kernel, grid)
-    nm, nk = problem.n_modes, problem.n_known
-    vu = np.zeros((nk, n))
-    if nk:
-        u = problem.u(at)
-        for i in range(1, n):
-            vu[:, i] = u[:, : i + 1] @ (kmat[i, : i + 1] * _trapezoid_weights(grid, i))
-    w = np.zeros((nm, n))
-    vw = np.zeros((nm, n))
-    if nm:
-        d = problem.d(at)
-        r = problem.r(at) + (problem.coupling @ vu if nk else 0.0)
-        w[:, 0] = r[:, 0] / d[:, 0]
-        for i in range(1, n):
-            kw = kmat[i, : i + 1] * _trapezoid_weights(grid, i)
-            hist = w[:, :i] @ kw[:i]
-            w[:, i] = (r[:, i] + hist) / (d[:, i] - kw[i])
-            vw[:, i] = hist + kw[i] * w[:, i]
-    return w, vw, vu
-
-
-def _general_grid(anchors: np.ndarray, sub: np.ndarray,
-                  jumps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The grid (``sub[k]`` equal intervals between consecutive anchors) and where each
-    node reads the histories. A jump is two nodes at the same time: the first reads the
-    value just before it, the second the value from it on; the zero-width interval
-    between them has no weight, so the quadrature of each side stays exact."""
-    grid = np.concatenate([[anchors[0]]] + [
-        np.linspace(a, b, s + 1)[1:] for a, b, s in zip(anchors[:-1], anchors[1:], sub,
-                                                       strict=True)])
-    if not jumps.size:
-        return grid, grid
-    position = np.searchsorted(grid, jumps)
-    grid = np.insert(grid, position, jumps)
-    at = grid.copy()
-    first = position + np.arange(len(position))
-    at[first] = [_before(t) for t in grid[first]]
-    return grid, at
-
-
-def _grid_points(sub: np.ndarray, jumps: np.ndarray) -> int:
-    return 1 + int(sub.sum()) + len(jumps)
-
-
-def solve_general(kernel: Callable, problem: ModalProblem, times: np.ndarray, *, tol: float,
-                  max_points: int = limits.MAX_KERNEL_GRID_POINTS,
-                  breaks=()) -> VolterraSolution:
-    """Same problem as :func:`solve_degenerate` for any vectorized kernel ``K(t, tau)``.
-
-    Trapezoid product quadrature on a grid containing every output time and every
-    ``breaks`` time (where a history jumps or kinks), refined by halving; Richardson
-    extrapolation of the last two grids gives the answer and the difference of the last
-    two extrapolations the error estimate. A grid of more than ``max_points`` is never
-    built: if the first one would be, ``ValueError`` (naming ``times``); else the finest
-    affordable answer is returned, with the estimate of its last two grids when only two
-    fitted (the error of the finer trapezoid answer, an upper bound of the extrapolated
-    one's in practice).
-    """
-    times = np.asarray(times, dtype=float)
-    jumps = _jumps(breaks, 1.0, float(times[-1]))
-    anchors = np.unique(np.concatenate([[1.0], times, jumps]))
-    span = max(anchors[-1] - 1.0, 1e-300)
-    sub = np.maximum(1, np.ceil(np.diff(anchors) / (span / 16)).astype(int))
-    size = _grid_points(sub, jumps)
-    if size > max_points:
-        jump_text = f" and {len(jumps)} jumps of the loads" if len(jumps) else ""
-        raise ValueError(
-            f"times: {len(times)} output times{jump_text} need a time grid of at least "
-            f"{size} points with a general creep kernel (the grid holds every output "
-            f"time), more than the {max_points} allowed: ask for fewer output times")
-    w_scale, u_scale = _scales(problem, float(anchors[-1]))
-
-    def difference(a, b) -> float:
-        err_w = (float(np.max(np.abs(a[0] - b[0]) / w_scale[:, None]))
-                 if problem.n_modes else 0.0)
-        err_u = (float(np.max(np.abs(a[2] - b[2]) / u_scale[:, None]))
-                 if problem.n_known else 0.0)
-        return max(err_w, err_u)
-
-    answers: list[tuple[np.ndarray, ...]] = []
-    extrapolated: list[tuple[np.ndarray, ...]] = []
-    while True:
-        grid, at = _general_grid(anchors, sub, jumps)
-        # the last node at a time: after a jump when an output time is on one
-        idx = np.searchsorted(grid, times, side="right") - 1
-        w, vw, vu = _trapezoid_solve(kernel, problem, grid, at)
-        answers.append((w[:, idx], vw[:, idx], vu[:, idx]))
-        if len(answers) >= 2:
-            # Error c h^2 + d h^4: (4 fine - coarse)/3 removes the h^2 term.
-            extrapolated.append(tuple((4 * c - p) / 3 for c, p in zip(
-                answers[-1], answers[-2], strict=True)))
-        if len(extrapolated) >= 2:
-            # Two extrapolations differ by 15x the finer one's O(h^4) error.
-            est = difference(extrapolated[-1], extrapolated[-2]) / 15
-            if est <= tol:
-                return VolterraSolution(*extrapolated[-1], max(est, 1e-15), len(grid) - 1,
-                                        0, True, "ok")
-        if _grid_points(2 * sub, jumps) <= max_points:
-            sub = sub * 2
-            continue
-        if len(extrapolated) >= 2:
-            best = extrapolated[-1]
-        elif extrapolated:
-            # the fine trapezoid answer's own error: the coarse one's is 4x larger
-            est = difference(answers[-1], answers[-2]) / 3
-            best = extrapolated[-1]
-        else:
-            est, best = np.inf, answers[-1]
-        ok = est <= tol
-        message = "ok" if ok else (
-            f"general-kernel time stepping reached {len(grid)} points (at most "
-            f"{max_points}) with estimated error {est:.1e}")
-        return VolterraSolution(*best, max(est, 1e-15), len(grid) - 1, 0, ok, message)

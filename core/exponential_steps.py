@@ -1,0 +1,387 @@
+"""Exponential collocation of the modal Volterra equations: exact for the kernel's terms.
+
+The modes of :mod:`core.time_integration` with a kernel
+``K(t, tau) = b(tau) + sum_r a_r(tau) exp(-rate_r (t - tau))`` carry their memory in the
+states ``S_s(t) = int_1^t beta_s(tau) exp(-decay_s (t - tau)) z(tau) dtau`` (``beta_0 = b``,
+``decay_0 = 0``; ``beta_r = a_r``, ``decay_r = rate_r``), and over a step ``[t_n, t_n + h]``
+
+    S_s(t_n + a h) = exp(-decay_s a h) S_s(t_n)
+                     + int_0^{a h} exp(-decay_s (a h - sigma)) beta_s z (t_n + sigma) dsigma
+
+holds exactly. Here ``beta_s z`` is replaced by its cubic interpolant at the four Lobatto
+points of the step (``0, (5 -+ sqrt 5)/10, 1``) and the integral of each cubic against
+the exponential is taken exactly (:mod:`core.exponential_weights`): the method is exact
+for the exponential terms, however stiff, and its error is set by the smoothness of ``beta_s z``
+(the modulus, the loads and the creep response), not by the kernel's rates. At
+``decay_s = 0`` it is Lobatto IIIA collocation (order 6 at the step ends); for
+``decay_s h >> 1`` the stage values tend to the quasi-static answer (no instability).
+
+The value at a step's start is explicit (``d z = r + V w`` with ``V w`` the sum of the
+states there), so a step solves one 3x3 system per mode for its three other points. The
+steps are fixed before the march (graded geometrically in time from the start and from
+every jump of a history, with a bound on their length), so every factor of every step
+(kernel values, histories, exponential weights and the inverses of the 3x3 systems) is
+computed for all steps at once and the march itself is a few array operations a step.
+Output times inside a step are read from the sextic through its points and three of a
+neighbouring step (dense output, :mod:`core.exponential_weights`), all at once.
+
+The error is measured, not modelled: the march is repeated on grids with every step
+halved (at least three), and the estimate is the difference of the last two answers at
+the output times over the convergence factor the grids show, or the sum of the local
+errors of the states that decay within a step, where larger. :func:`solve_exponential`
+returns ``None`` when that takes more than its step budget (a history that oscillates
+fast): the caller then steps adaptively (:mod:`core.radau`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from core.exponential_weights import (
+    NODES,
+    output_weights,
+    seven,
+    sextic_weights,
+    weights,
+)
+from core.radau import JUMP_SIDE
+
+#: Convergence order of the answers at output times used by the error estimate: the
+#: stage order (4) of the collocation; at the step ends it is higher where the kernel's
+#: rates times the step are small (measured in tests/test_time_integration.py).
+ORDER = 4
+#: Steps per decade of time since the start or a jump, and steps over the whole span,
+#: of the first grid (each refinement doubles both).
+STEPS_PER_DECADE = 3
+SPAN_STEPS = 4
+#: The first grid whose answer may be taken: three grids give two differences, whose
+#: ratio is the measured convergence factor (see :func:`solve_exponential`).
+MIN_LEVEL = 2
+#: The first grids are as dense as STEPS_PER_DECADE and SPAN_STEPS say at this ``tol``
+#: and ``(tol / DENSITY_TOL)**(1/6)`` times sparser at a looser one (at most 2x), so
+#: that a loose tol is not met by grids far finer than it needs (three are marched).
+DENSITY_TOL = 3e-8
+#: The point systems of the modes are built for blocks of steps of at most this many
+#: floats (16 a step and mode: 8 MB), so a long march of many modes stays small.
+MAX_BLOCK_ELEMENTS = 2**20
+#: Grid refinements tried before the caller's adaptive stepping takes over.
+MAX_REFINEMENTS = 6
+
+
+def grid(start: float, end: float, jumps: np.ndarray, first_step: float,
+         level: int, density: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Step ends from ``start`` to ``end`` through every jump, and which start on a jump.
+
+    In each piece ``[a, b]`` between jumps the steps are equal in the smooth, increasing
+    ``sigma(t) = n_dec log10(1 + (t - a)/theta) + n_span (t - a)/span`` with
+    ``n_dec = density STEPS_PER_DECADE 2**level``, ``n_span = density SPAN_STEPS
+    2**level`` and ``theta = first_step``: graded geometrically from the piece's start
+    (creep follows log time, and a jump starts a new transient), never longer than about
+    ``span / n_span``. One level more halves every step in ``sigma`` exactly, so the
+    answers of two levels converge like ``h**order`` and their difference estimates the
+    error.
+    """
+    edges = np.concatenate([[start], jumps, [end]])
+    span = end - start
+    n_dec, n_span = (density * STEPS_PER_DECADE * 2**level, density * SPAN_STEPS * 2**level)
+    slope = n_dec / np.log(10.0)
+    points = [np.array([start])]
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        theta = min(first_step, b - a)
+
+        def sigma(t, a=a, theta=theta):
+            return slope * np.log1p((t - a) / theta) + n_span * (t - a) / span
+
+        total = float(sigma(b))
+        n = max(1, int(np.ceil(total)))
+        target = total * np.arange(1, n) / n
+        # invert sigma: start from the log part alone (below sigma's root), then Newton
+        # (sigma is increasing and concave, so Newton from below stays below and converges)
+        t = a + theta * np.expm1(np.minimum(target / slope, np.log1p((b - a) / theta)))
+        t = np.minimum(t, b)
+        for _ in range(50):
+            step = (sigma(t) - target) / (slope / (theta + t - a) + n_span / span)
+            t = t - step
+            if np.all(np.abs(step) <= 1e-15 * np.maximum(1.0, np.abs(t))):
+                break
+        points += [np.sort(t), np.array([b])]
+    ends = np.concatenate(points)
+    jump_start = np.isin(ends[:-1], jumps)
+    return ends, jump_start
+
+
+def _by_step(values: np.ndarray, points: int) -> np.ndarray:
+    """(channels, steps * points) values at the points of consecutive steps, as
+    (steps, channels, points)."""
+    return values.reshape(values.shape[0], -1, points).transpose(1, 0, 2)
+
+
+def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.ndarray,
+                  vu_nodes: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """``z`` at a step's four points as ``constant + sum_j response[:, j] sums[j]``.
+
+    ``d``, ``r`` (B, M, 4) at the points, ``total`` (B, 3, 4) the step's drive of ``V w``
+    at its three later points by ``z`` at its four; ``sums`` (4, M) are the carried
+    states' sums at the points. The first point is explicit (``d z = r + sums``), the
+    three others solve ``(diag(d) - total[:, 1:]) z = r + sums + total[:, 0] z_0`` (by
+    the adjugate: ``d >= 1`` on the diagonal, the step's creep off it); both for all steps
+    at once, so the march only applies them. Returns ``constant`` (B, 4, M) and
+    ``response`` (B, 4, 4, M), modes last (contiguous for the march).
+    """
+    if vu_nodes is not None:
+        r = r + np.einsum("mk,bkj->bmj", coupling, vu_nodes)
+    d = d.transpose(0, 2, 1)                                      # (B, 4, M)
+    r = r.transpose(0, 2, 1)
+    t = total[:, :, :, None]                                      # (B, 3, 4, 1)
+    m = [[(d[:, i + 1] if i == j else 0.0) - t[:, i, j + 1] for j in range(3)]
+         for i in range(3)]
+    adj = [[m[1][1] * m[2][2] - m[1][2] * m[2][1], m[0][2] * m[2][1] - m[0][1] * m[2][2],
+            m[0][1] * m[1][2] - m[0][2] * m[1][1]],
+           [m[1][2] * m[2][0] - m[1][0] * m[2][2], m[0][0] * m[2][2] - m[0][2] * m[2][0],
+            m[0][2] * m[1][0] - m[0][0] * m[1][2]],
+           [m[1][0] * m[2][1] - m[1][1] * m[2][0], m[0][1] * m[2][0] - m[0][0] * m[2][1],
+            m[0][0] * m[1][1] - m[0][1] * m[1][0]]]
+    inv_det = 1.0 / (m[0][0] * adj[0][0] + m[0][1] * adj[1][0] + m[0][2] * adj[2][0])
+    inv_d0 = 1.0 / d[:, 0]                                        # (B, M)
+    n_steps, nm = inv_d0.shape
+    response = np.zeros((n_steps, 4, 4, nm))
+    response[:, 0, 0] = inv_d0
+    for i in range(3):
+        for j in range(3):
+            response[:, i + 1, j + 1] = adj[i][j] * inv_det
+        response[:, i + 1, 0] = inv_d0 * sum(response[:, i + 1, j + 1] * t[:, j, 0]
+                                             for j in range(3))
+    constant = (response * r[:, None, :, :]).sum(axis=2)          # (B, 4, M)
+    return constant, response
+
+
+
+def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
+                  beta: np.ndarray, end_weight: np.ndarray, values: np.ndarray,
+                  rows: np.ndarray, parts: int, t_out: np.ndarray) -> np.ndarray:
+    """Sum of the steps' local errors at the output times, largest per group (parts,).
+
+    A state that decays fast within a step forgets all but its last steps, so its error
+    at a time is the local error of the steps just before it, which depends on where the
+    time falls in them: two grids may then agree by chance (measured on a stiff aging
+    kernel: 2.1e-9 on the finer grid, 8.9e-10 on the coarser, their difference 1.1e-9).
+    Here each step's error is estimated as the difference of its cubic from the sextic
+    through its points and three of a neighbour (:func:`sextic_weights`), and carried to
+    the output times (its absolute value: no cancelling between steps), relative to
+    ``rows`` (the size of each channel, ``values`` (B, 4, C) at the points of the steps).
+    """
+    h = np.diff(ends)
+    n_steps = h.size
+    steps = np.arange(n_steps)
+    side, sextic, _ = sextic_weights(h, jump_start, decay, steps, np.ones(n_steps))
+    cubic = np.zeros_like(sextic)
+    own_last = side == -1
+    cubic[~own_last, :, :4] = end_weight[~own_last]
+    cubic[own_last, :, 3:] = end_weight[own_last]
+    beta7 = seven(beta.transpose(0, 2, 1), steps, side)          # (B, 7, S)
+    values7 = seven(values, steps, side)                         # (B, 7, C)
+    # A state slow over a step (decay h < 1) keeps its errors: they add up smoothly over
+    # the steps, and the difference of two grids measures them (measured on the 50-year
+    # fib MC2010 preset: that difference over 15 is 1.2-1.4x the true error at every
+    # level). Only the states that forget within a step are counted here, their errors
+    # summed over the states with their signs (the error of V w, their sum) and each
+    # step's carried on with a decay of exp(-1) a step, the least of those states.
+    fast = (decay[None, :] * h[:, None] >= 1.0)[:, :, None]      # (B, S, 1)
+    drive = np.sum((sextic - cubic) * beta7.transpose(0, 2, 1) * fast, axis=1)  # (B, 7)
+    local = np.abs((drive[:, None, :] @ values7)[:, 0, :]) / rows  # (B, C)
+    per_part = local.reshape(n_steps, parts, -1).max(axis=2)      # (B, P)
+    carried = np.zeros((n_steps, parts))
+    for b in range(1, n_steps):
+        carried[b] = carried[b - 1] * np.exp(-1.0) + per_part[b - 1]
+    # at the output times: an output inside a step is read from the points of that step
+    # and of a neighbour (dense output), whose errors are those of their steps: the larger
+    step_of = np.clip(np.searchsorted(ends, t_out, side="left") - 1, 0, n_steps - 1)
+    at_outputs = carried[step_of] + np.maximum(
+        per_part[step_of], per_part[np.minimum(step_of + 1, n_steps - 1)])
+    worst = np.max(at_outputs, axis=0, initial=0.0)
+    return worst
+
+
+def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: np.ndarray,
+          times: np.ndarray, rows: tuple[np.ndarray, np.ndarray] | None = None
+          ) -> tuple[np.ndarray, np.ndarray, Callable[[], np.ndarray] | None]:
+    """``V w`` (modes, T) and ``V u`` (known, T) at ``times`` (in ``[ends[0], ends[-1]]``)
+    by exponential collocation on the steps ``ends``.
+
+    ``jump_start`` / ``jump_end`` (steps,) bools: that step starts (ends) where a history
+    jumps, so its first (last) point reads the history after (before) it. With ``rows``
+    (the sizes of the modes and of the known functions) the third answer computes, when
+    called, the sum of the local errors per group of ``problem.parts``
+    (:func:`_local_errors`); else it is None.
+    """
+    from core.radau import _kernel_factors
+
+    h = np.diff(ends)
+    n_steps = h.size
+    at = ends[:-1, None] + h[:, None] * NODES[None, :]            # (B, 4)
+    side = JUMP_SIDE * np.maximum(1.0, np.abs(at))
+    at[:, 0] += np.where(jump_start, side[:, 0], 0.0)
+    at[:, 3] -= np.where(jump_end, side[:, 3], 0.0)
+    flat = at.ravel()
+    beta, decay = _kernel_factors(kernel, flat)                   # (S, 4B), (S,)
+    n_states = decay.size
+    beta = beta.reshape(n_states, n_steps, 4).transpose(1, 0, 2)  # (B, S, 4)
+    carry, weight = weights(NODES[1:], h, decay)                 # (B,S,3), (B,S,3,4)
+    driven = weight * beta[:, :, None, :]                         # (B, S, 3, 4)
+    total = driven.sum(axis=1)                                    # (B, 3, 4)
+    end_drive = driven[:, :, 2, :].transpose(0, 2, 1).copy()      # (B, 4, S)
+    end_carry = carry[:, :, 2]                                    # (B, S)
+    end_weight = weight[:, :, 2, :]                               # (B, S, 4)
+    # state sums at the step's points: ones for its start, carries for the others
+    reads = np.concatenate([np.ones((n_steps, n_states, 1)), carry], axis=2)  # (B, S, 4)
+
+    t_out = np.asarray(times, dtype=float)
+    step_of, side, out_carry, out_total = output_weights(ends, jump_start, beta, decay,
+                                                          t_out)
+    order = np.argsort(step_of, kind="stable")
+    bounds = np.searchsorted(step_of[order], np.arange(n_steps + 1))
+
+    def read(fn) -> np.ndarray:
+        return _by_step(fn(flat), 4)                              # (B, channels, 4)
+
+    nm, nk = problem.n_modes, problem.n_known
+    channels: list[tuple[np.ndarray, np.ndarray]] = []
+    vu_out = np.zeros((nk, t_out.size))
+    vu_nodes = None
+    if nk:
+        u = read(problem.u)                                       # (B, K, 4)
+        # V u at the points: the carried states plus the step's own drive
+        vu_nodes = np.zeros_like(u)
+        vu_nodes[:, :, 1:] = u @ total.transpose(0, 2, 1)
+        next_drive = u @ end_drive                                # (B, K, S)
+        s_known = np.zeros((nk, n_states))
+        for b in range(n_steps):
+            vu_nodes[b] += s_known @ reads[b]
+            lo, hi = bounds[b], bounds[b + 1]
+            if hi > lo:
+                idx = order[lo:hi]
+                vu_out[:, idx] = s_known @ out_carry[idx].T
+            s_known = s_known * end_carry[b] + next_drive[b]
+        vu_out += np.einsum("tj,tjk->kt", out_total, seven(u.transpose(0, 2, 1), step_of,
+                                                            side))
+        if rows is not None:
+            channels.append((u.transpose(0, 2, 1), rows[1]))
+    vw_out = np.zeros((nm, t_out.size))
+    if nm:
+        # the point systems of a block of steps at a time: (steps, 4, 4, modes) floats
+        block = max(1, MAX_BLOCK_ELEMENTS // (16 * nm))
+        at_steps = flat.reshape(n_steps, 4)
+        reads_t = reads.transpose(0, 2, 1).copy()                 # (B, 4, S)
+        drive_t = end_drive.transpose(0, 2, 1).copy()             # (B, S, 4)
+        carry_t = end_carry[:, :, None]                           # (B, S, 1)
+        s_modes = np.zeros((n_states, nm))                        # modes last
+        z_all = np.empty((n_steps, 4, nm))
+        for b in range(n_steps):
+            if b % block == 0:
+                steps = slice(b, min(n_steps, b + block))
+                times_block = at_steps[steps].ravel()
+                constant, response = _point_values(
+                    _by_step(problem.d(times_block), 4), _by_step(problem.r(times_block), 4),
+                    total[steps], problem.coupling,
+                    None if vu_nodes is None else vu_nodes[steps])
+            # z at the step's four points: affine in the state sums there
+            sums = reads_t[b] @ s_modes                           # (4, M)
+            z = z_all[b] = constant[b % block] + (response[b % block] * sums[None]).sum(axis=1)
+            lo, hi = bounds[b], bounds[b + 1]
+            if hi > lo:
+                idx = order[lo:hi]
+                vw_out[:, idx] = (out_carry[idx] @ s_modes).T
+            s_modes = s_modes * carry_t[b] + drive_t[b] @ z
+        # the drive of every output by z at its seven points, step by step of the outputs
+        for b in np.unique(step_of):
+            idx = order[bounds[b]:bounds[b + 1]]
+            for sd in (-1, 0, 1):
+                pick = idx[side[idx] == sd]
+                if pick.size:
+                    z7 = (np.concatenate([z_all[b - 1, :3], z_all[b]]) if sd == -1 else
+                          np.concatenate([z_all[b], z_all[b + 1, 1:]]) if sd == 1 else
+                          np.concatenate([z_all[b], np.zeros((3, nm))]))
+                    vw_out[:, pick] += (out_total[pick] @ z7).T
+        if rows is not None:
+            channels.append((z_all, rows[0]))
+
+    def local() -> np.ndarray:
+        return np.max([np.zeros(problem.parts)] + [
+            _local_errors(ends, jump_start, decay, beta, end_weight, values, size,
+                          problem.parts, t_out) for values, size in channels], axis=0)
+
+    return vw_out, vu_out, (local if rows is not None else None)
+
+
+def first_step(kernel, start: float, span: float) -> float:
+    """The length of the first step after a start or a jump: a tenth of the time scale of
+    the fastest transient the kernel can drive (its rate plus its size, as ``d >= 1``),
+    at least ``1e-9 span``."""
+    from core.radau import _kernel_factors
+
+    beta, decay = _kernel_factors(kernel, np.array([start]))
+    fastest = float(np.max(decay + np.abs(beta[:, 0]), initial=0.0))
+    return max(0.1 / fastest, 1e-9 * span) if fastest > 0 else span
+
+
+def solve_exponential(kernel, problem, times: np.ndarray, jumps: np.ndarray, *, tol: float,
+                      w_scale: np.ndarray, u_scale: np.ndarray, max_steps: int,
+                      unknowns: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None):
+    """``V w`` and ``V u`` at ``times`` to ``tol``, or None past ``max_steps`` steps.
+
+    ``w_scale`` (modes,), ``u_scale`` (known,): sizes of the unknowns, for the relative
+    error, measured per group of ``problem.parts``. ``unknowns(vw, vu)``: ``w`` at the
+    times; when given, each group's error is measured against the largest ``|w|`` of the
+    group on the first grid instead (at least a thousandth of ``w_scale``): the forcing
+    behind ``w_scale`` can exceed the unknowns by the creep factor (6.9 measured on the
+    inverse problem of tests/test_creep.py). Returns ``(vw, vu, part_errors,
+    steps)``: the answer of the finest grid marched, the estimate of its error per group
+    and its steps. The estimate is the larger of the difference from the grid of twice
+    longer steps over ``factor - 1`` (the global error, carried through the march), with
+    ``factor`` the ratio of the last two such differences (the convergence as measured,
+    within 2 and 2**7: a coarse first grid, far from the asymptotic rate, made the
+    assumed ``2**ORDER`` 12x pessimistic on tests/test_hard_cases.py's reversing load),
+    and the sum of the steps' local errors (:func:`_local_errors`: a fast state's error,
+    which two grids can miss).
+    """
+    start, end = 1.0, float(times[-1])
+    span = end - start
+    theta = first_step(kernel, start, span)
+    density = float(np.clip((DENSITY_TOL / tol) ** (1 / 6), 0.5, 1.0))
+    parts = problem.parts
+    previous = last_change = None
+    used = 0
+    for level in range(MAX_REFINEMENTS + 1):
+        ends, jump_start = grid(start, end, jumps, theta, level, density)
+        steps = ends.size - 1
+        used += steps
+        if used > max_steps:
+            return None
+        jump_end = np.isin(ends[1:], jumps)
+        vw, vu, local = march(kernel, problem, ends, jump_start, jump_end, times,
+                              rows=(w_scale, u_scale))
+        if previous is None and unknowns is not None and problem.n_modes:
+            size = np.max(np.abs(unknowns(vw, vu)).reshape(parts, -1), axis=1)
+            given = w_scale.reshape(parts, -1)
+            w_scale = np.clip(size[:, None], 1e-3 * given, given).ravel()
+        if previous is not None:
+            diff = np.concatenate([
+                (np.max(np.abs(vw - previous[0]), axis=1, initial=0.0) / w_scale).reshape(
+                    parts, -1),
+                (np.max(np.abs(vu - previous[1]), axis=1, initial=0.0) / u_scale).reshape(
+                    parts, -1)], axis=1)
+            change = np.max(diff, axis=1, initial=0.0)
+            # the ratio of the last two changes is the convergence factor of a step halving
+            # as measured (2**ORDER until there are two), kept within 2 and 2**7
+            factor = (np.clip(last_change / np.maximum(change, 1e-300), 2.0, 2.0**7)
+                      if last_change is not None else np.full(parts, 2.0**ORDER))
+            errors = change / (factor - 1.0)
+            last_change = change
+            if level >= MIN_LEVEL and np.max(errors) <= tol:
+                errors = np.maximum(errors, local())
+                if np.max(errors) <= tol:
+                    return vw, vu, errors, steps
+        previous = (vw, vu)
+    return None
