@@ -529,11 +529,37 @@ def test_contact_argument_and_refusals():
         solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=-1.0)
     with pytest.raises(ValueError, match="^time_steps"):
         solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.0, time_steps=0)
-    # "auto" with a pulling punch: no unilateral answer exists, the flagged full-contact
-    # answer stays (with the reason), rather than an error
-    pulled = solve_dimensionless(1.0, 0.05, 0.0, [1.0], force=-1.0, moment=0.0)
-    assert pulled.info["contact"] == "full" and "contact_lost" in pulled.flags
-    assert pulled.info["unilateral_refused"].startswith("force: must be > 0")
+
+
+@pytest.mark.parametrize("contact", ["full", "unilateral", "auto"])
+def test_loads_leaving_no_contact_are_refused_in_every_contact_mode(contact):
+    """A pulled punch or a resultant outside it has no answer in any contact model: the
+    dimensionless API refuses it naming the load, as the dimensional one does."""
+    def solve(**loads):
+        return solve_dimensionless(1.0, 0.05, 0.0, [1.0, 2.0], contact=contact, **loads)
+
+    with pytest.raises(ValueError, match=r"^force: the punch is pulled away \(P = -1 at"):
+        solve(force=-1.0, moment=0.0)
+    with pytest.raises(ValueError, match=r"^force: the punch is pulled away"):
+        solve(force=-1.0, tilt=0.0)  # a mixed statement: pulled all the same
+    with pytest.raises(ValueError, match=r"^force: must be > 0 .*P = 0 at every time"):
+        solve(force=0.0, moment=0.0)
+    with pytest.raises(ValueError, match=r"^moment: the eccentricity M/P = 1 at t = 1"):
+        solve(force=1.0, moment=1.0)
+    with pytest.raises(ValueError, match=r"^moment: the eccentricity M/P = -1.5 at t = 2"):
+        solve(force=1.0, moment=lambda t: -0.75 * t)
+    with pytest.raises(ValueError, match=r"^moment: M = 0.1 with no force"):
+        solve(force=lambda t: t - 1.0, moment=0.1)
+    # a creeping base remembers the loads between output times: a pull there is refused
+    with pytest.raises(ValueError, match=r"^force: the punch is pulled away \(P = -1 at t = 1\.49"):
+        solve_dimensionless(1.0, 0.05, 0.0, [1.0, 2.0], contact=contact,
+                            kernel=lambda t, tau: 0.1 * np.exp(-(t - tau)),
+                            force=lambda t: np.where(np.abs(t - 1.5) < 0.01, -1.0, 1.0),
+                            moment=0.0)
+    # a given settlement and tilt may leave the punch above the surface: not refused here
+    if contact != "full":
+        lifted = solve(settlement=-1.0, tilt=0.0)
+        assert lifted.contact_set == [[], []]
 
 
 def test_full_contact_result_carries_the_whole_base():
