@@ -31,7 +31,7 @@ import numpy as np
 from core.cache import StageCache, fingerprint
 from core.collocation import time_grid
 from core.contact_bands import BAND_WIDTHS, band_rule, bands_from_ends
-from core.contact_kinks import corrected_ends_state
+from core.contact_kinks import corrected_ends
 from core.contact_zones import (
     ZONE_END_TOL,
     NoContact,
@@ -113,7 +113,7 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
     memory_of = _SeparableMemory(inp.kernel, grid, inner, n_nodes) if _separable(
         inp.kernel) else _HistoryMemory(inp.kernel, grid, inner, n_nodes)
     wanted = {int(i): k for k, i in enumerate(out_index)}
-    states: list[tuple[NodalState, Step, np.ndarray, NodalState]] = [None] * len(out_index)  # type: ignore
+    states: list[tuple[NodalState, Step, np.ndarray, list[float]]] = [None] * len(out_index)  # type: ignore
     active = None
     solver = StepSolver()
     sweeps = 0
@@ -139,9 +139,10 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
         active = state.active
         memory_of.record(n, state.q)
         if n in wanted:
-            ends_state = state if not exact_ends else corrected_ends_state(
-                space, step, state, op, m, g, displacement, solver)
-            states[wanted[n]] = (state, step, memory_density, ends_state)
+            ends = (corrected_ends(space, step, state, op, m, g, displacement,
+                                   memory_density, solver) if exact_ends
+                    else _zones(state, space.breakpoints)[1])
+            states[wanted[n]] = (state, step, memory_density, ends)
     return {"states": states, "sweeps": sweeps, "unsettled": unsettled, "steps": steps - 1,
             "breakpoints": space.breakpoints,
             "factorizations": solver.factorizations,
@@ -228,8 +229,7 @@ class _SeparableMemory:
 def _outputs(run: dict[str, Any]) -> dict[str, Any]:
     """The outputs of one march, with what the pressure needs (all linear in the steps)."""
     states = run["states"]
-    # the ends from the state without the kink defect (core/contact_kinks.py)
-    zones, ends = zip(*(_zones(e, run["breakpoints"]) for _, _, _, e in states), strict=True)
+    ends = [e for _, _, _, e in states]  # without the kink defect (core/contact_kinks.py)
     return {
         "settlement": np.array([s.settlement for s, _, _, _ in states]),
         "tilt": np.array([s.tilt for s, _, _, _ in states]),

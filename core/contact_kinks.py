@@ -12,12 +12,17 @@ interpolant of the nodal ``Q`` cut at its root, ``q = P_Q`` on the contact part.
 integrals there are taken exactly by a Gauss rule of that part alone (with the product
 weights of the log kernel where a node is near), and the difference from the panel's
 rule is a defect of the discrete equation. One solve with the step's kept factors
-(:class:`core.contact_systems.StepSolver`) removes it. Measured on the preset (20 output
-times, two time grids Richardson-extrapolated): against each output time re-solved on
-panels graded toward its end (with the same memory), the ends of 0.04 / 0.02 / 0.005
-band panels were 3.8e-6 / 8.7e-7 / 3.4e-7 off before and 3.8e-7 / 1.9e-7 / 1.5e-8 after.
-What is left is the kinks of past pressures in the creep memory, which this leaves: it
-halves with the band panels.
+(:class:`core.contact_systems.StepSolver`) removes it, and each free end is then the root
+of that solution's Nystrom pressure evaluated by its formula (the panel interpolant of
+the nodal Q errs near the end, see :func:`corrected_ends`).
+
+Measured on the preset (20 output times, two time grids Richardson-extrapolated), with
+0.04 / 0.02 / 0.005 band panels: the nodal ends were 3.8e-6 / 8.7e-7 / 3.4e-7 from the
+solver at tol = 1e-7; the corrected ones are 4.3e-7 / 8.9e-8 / 2.8e-10 from each output
+time re-solved on panels graded toward its end (same memory and time grid). What is left
+is the kinks of past pressures in the creep memory, which this leaves (it falls with
+the band panels). Elastic, on uniform 0.04 panels: 3.7e-8 from the refined ends, where
+the nodal ones were 2.4e-6 off (tests/test_contact.py).
 """
 
 from __future__ import annotations
@@ -25,15 +30,18 @@ from __future__ import annotations
 import numpy as np
 
 from core.contact_systems import StepSolver, bordered_solve
-from core.contact_zones import _BARYCENTRIC, _T, NodalState, Space, Step, zones_from_nodes
+from core.contact_zones import (
+    _BARYCENTRIC,
+    _T,
+    ZONE_END_TOL,
+    NodalState,
+    Space,
+    Step,
+    zones_from_nodes,
+)
 from core.log_moments import legendre_log_moments
 from core.panels import _TO_COEF, _W
 from core.quadrature import NEAR_FIELD, NODES_PER_PANEL, Panels, _rows
-
-#: Passes of the defect correction. The defect moves with the end only to second order
-#: (the ends move by ~4e-6): one pass, the ends then read from the corrected Q.
-PASSES = 1
-
 
 #: Log moments at targets just off a part (1.05 < |z| <= NEAR_FIELD in its coordinate)
 #: by a 64-point Gauss rule: ln|z - t| is analytic within the ellipse through z (rho >=
@@ -44,11 +52,11 @@ _OVER_P = np.polynomial.legendre.legvander(_OVER_T, NODES_PER_PANEL - 1)
 
 
 def _part_rows(lam: float, part: Panels, targets: np.ndarray) -> np.ndarray:
-    """Rows of F (len(targets) x 16) on the one panel ``part``: as
+    """Rows of F (len(targets) x 16 P) on the panels ``part``: as
     :func:`core.quadrature.operator_rows`, its near-field moments computed as above."""
-    z = (targets - part.centers[0]) / part.half_widths[0]
-    near_t = np.nonzero(np.abs(z) <= NEAR_FIELD)[0]
-    zn = z[near_t]
+    z = (targets[:, None] - part.centers[None, :]) / part.half_widths[None, :]
+    near_t, near_s = np.nonzero(np.abs(z) <= NEAR_FIELD)
+    zn = z[near_t, near_s]
     moments = np.empty((zn.size, NODES_PER_PANEL))
     inner = np.abs(zn) <= 1.05
     if inner.any():
@@ -57,10 +65,9 @@ def _part_rows(lam: float, part: Panels, targets: np.ndarray) -> np.ndarray:
         outer = zn[~inner]
         moments[~inner] = (np.log(np.abs(outer[:, None] - _OVER_T[None, :]))
                            * _OVER_W[None, :]) @ _OVER_P
-    h = part.half_widths[0]
+    h = part.half_widths[near_s][:, None]
     log_weights = h * (np.log(h) * _W[None, :] + moments @ _TO_COEF)
-    return _rows(lam, part, targets, np.zeros(1, dtype=np.intp), near_t,
-                 np.zeros(near_t.size, dtype=np.intp), log_weights)
+    return _rows(lam, part, targets, np.arange(part.n_panels), near_t, near_s, log_weights)
 
 
 def _interpolation(center: float, half: float, targets: np.ndarray) -> np.ndarray:
@@ -93,70 +100,127 @@ def _contact_parts(panels: Panels, zones: list[tuple[float, float]], free: list[
     return parts
 
 
-def _defect(space: Space, step: Step, state: NodalState, op: np.ndarray,
-            parts: dict[int, list[tuple[float, float]]]) -> tuple[np.ndarray, float, float]:
+def _defect(space: Space, step: Step, state: NodalState, op: np.ndarray, cut: Panels,
+            values: np.ndarray, parts: dict[int, list[tuple[float, float]]]
+            ) -> tuple[np.ndarray, float, float]:
     """(defect of s F q at the nodes, of the force, of the moment): the exact integrals of
-    the cut interpolant over the contact parts less the panels' Gauss sums."""
+    the cut interpolant (``values`` on the rule ``cut``) less the panels' Gauss sums."""
     panels = state.panels
-    targets = panels.nodes
-    defect = np.zeros(targets.size)
-    force = moment = 0.0
-    for p, pieces in parts.items():
-        cols = slice(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
-        q_nodes = state.q[cols]
-        defect -= op[:, cols] @ q_nodes
-        force -= float(panels.weights[cols] @ q_nodes)
-        moment -= float((panels.weights[cols] * panels.nodes[cols]) @ q_nodes)
-        for lo, hi in pieces:
-            sub = Panels.from_edges(np.array([lo, hi]))
-            values = _interpolation(panels.centers[p], panels.half_widths[p],
-                                    sub.nodes) @ state.nystrom[cols]
-            defect += _part_rows(space.lam, sub, targets) @ values
-            force += float(sub.weights @ values)
-            moment += float((sub.weights * sub.nodes) @ values)
+    cols = np.concatenate([np.arange(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
+                           for p in parts])
+    q_cols = state.q[cols]
+    defect = _part_rows(space.lam, cut, panels.nodes) @ values - op[:, cols] @ q_cols
+    force = float(cut.weights @ values - panels.weights[cols] @ q_cols)
+    moment = float((cut.weights * cut.nodes) @ values
+                   - (panels.weights[cols] * panels.nodes[cols]) @ q_cols)
     return step.scale * defect, force, moment
 
 
-def corrected_ends_state(space: Space, step: Step, state: NodalState, op: np.ndarray,
-                         m: np.ndarray, g: np.ndarray, memory: np.ndarray | None,
-                         solver: StepSolver | None = None) -> NodalState:
-    """The nodal state of a step with the kink defect of its free ends removed.
+def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
+                   m: np.ndarray, g: np.ndarray, memory: np.ndarray | None = None,
+                   memory_density: np.ndarray | None = None,
+                   solver: StepSolver | None = None) -> list[float]:
+    """The zone ends of a step, sorted, two per zone, with the kink defect removed.
 
     ``state`` from :func:`core.contact_zones.nodal_active_set` on the rule whose Nystrom
-    matrix is ``op``; ``m``, ``g`` and ``memory`` (the memory displacement e, or None) at
-    its nodes. The contact nodes are kept; ``q``, settlement, tilt and ``nystrom`` (Q)
-    are those of the corrected equation, for locating the free ends
-    (:func:`core.contact_zones.zones_from_nodes`). Returns ``state`` itself when it has
-    no free end (dimensionless throughout).
+    matrix is ``op``; ``m``, ``g`` at its nodes; ``memory`` the memory displacement e at
+    the nodes and ``memory_density`` the density it is F of (None for an elastic step).
+    The contact nodes are kept and the step solved again with the defect; each free end
+    is then the root of that solution's Nystrom pressure Q(x), evaluated by its formula
+    (the interpolant of the nodal Q errs there: F of the kinked q puts a
+    ``(x - end)^2 ln|x - end|`` term into Q, which 16-point panels read ~1e-4 wrong).
+    Ends at +-1 or at breakpoints are kept (dimensionless throughout).
     """
     if not state.active.any():
-        return state
+        return []
+    ends, pinned, _ = zones_from_nodes(state, space.breakpoints)
+    free = [k for k, p in enumerate(pinned) if not p]
+    if not free:
+        return ends
     panels = state.panels
     x, w = panels.nodes, panels.weights
     idx = np.nonzero(state.active)[0]
-    rhs0 = step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g
+    zones = [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)]
+    parts = _contact_parts(panels, zones, [ends[k] for k in free])
+    cut, values = _cut_rule(panels, state, parts)
+    defect, d_force, d_moment = _defect(space, step, state, op, cut, values, parts)
+    given = dict(step.given)
+    if "force" in given:
+        given["force"] -= d_force
+    if "moment" in given:
+        given["moment"] -= d_moment
+    rhs = step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g - defect
     if memory is not None:
-        rhs0 = rhs0 + memory
-    current = state
-    for _ in range(PASSES):
-        ends, pinned, _ = zones_from_nodes(current, space.breakpoints)
-        free = [e for e, p in zip(ends, pinned, strict=True) if not p]
-        if not free:
-            return state
-        zones = [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)]
-        defect, d_force, d_moment = _defect(space, step, current, op,
-                                            _contact_parts(panels, zones, free))
-        given = dict(step.given)
-        if "force" in given:
-            given["force"] -= d_force
-        if "moment" in given:
-            given["moment"] -= d_moment
-        q_active, delta, alpha = bordered_solve(op, m, x, w, step.c, step.scale, given,
-                                                rhs0 - defect, idx, solver)
-        q = np.zeros(x.size)
-        q[idx] = q_active
-        nystrom = (delta + alpha * x - g + (0.0 if memory is None else memory)
-                   - step.scale * (op @ q) - defect) / (step.c * m)
-        nystrom[idx] = q_active
-        current = NodalState(panels, q, delta, alpha, state.active, nystrom)
-    return current
+        rhs = rhs + memory
+    q_active, delta, alpha = bordered_solve(op, m, x, w, step.c, step.scale, given, rhs,
+                                            idx, solver)
+    q = np.zeros(x.size)
+    q[idx] = q_active
+    # F on the rule and on the cut parts at once; the cut panels' Gauss sums taken off
+    # with the pressure the defect of the solve took them with
+    joined = _join([panels, cut])
+    density = np.concatenate([q, values])
+    for p in parts:
+        cols = slice(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
+        density[cols] -= state.q[cols]
+    density_memory = None if memory_density is None else np.concatenate(
+        [memory_density, np.zeros(values.size)])
+
+    def nystrom(t: np.ndarray) -> np.ndarray:
+        rows = _part_rows(space.lam, joined, t)
+        fq = rows @ density
+        e = 0.0 if density_memory is None else rows @ density_memory
+        return (delta + alpha * t - space.g(t) + e - step.scale * fq) / (step.c * space.m(t))
+
+    # Secant from the interpolant's roots (within ~1e-4 of the true ones).
+    inward = np.array([1.0 if k % 2 == 0 else -1.0 for k in free])
+    a = np.array([ends[k] for k in free])
+    b = a + 1e-6 * inward
+    both = nystrom(np.concatenate([a, b]))
+    fa, fb = both[:a.size], both[a.size:]
+    for _ in range(_SECANT_STEPS):
+        slope = (fb - fa) / (b - a)
+        ok = np.isfinite(slope) & (slope != 0.0)
+        step_x = np.where(ok, -fb / np.where(ok, slope, 1.0), 0.0)
+        a, fa = b, fb
+        b = b + step_x
+        if np.max(np.abs(step_x)) < 1e-3 * ZONE_END_TOL:  # the next step is below 1e-12
+            break
+        fb = nystrom(b)
+    out = list(ends)
+    for j, k in enumerate(free):
+        lo = -1.0 if k == 0 else ends[k - 1]
+        hi = 1.0 if k == len(ends) - 1 else ends[k + 1]
+        # a root that ran off (a degenerate slope) keeps the interpolant's end
+        if lo < b[j] < hi and abs(b[j] - ends[k]) < 2.0 * panels.half_widths.max():
+            out[k] = float(b[j])
+    return out
+
+
+#: Secant steps on the Nystrom pressure at most (quadratic-like convergence from ~1e-4).
+_SECANT_STEPS = 6
+
+
+def _cut_rule(panels: Panels, state: NodalState,
+              parts: dict[int, list[tuple[float, float]]]) -> tuple[Panels, np.ndarray]:
+    """One Gauss panel on every contact part, and there the values of the interpolant of
+    the nodal Q of its panel (the pressure cut at its root)."""
+    pieces = [(p, lo, hi) for p, spans in parts.items() for lo, hi in spans]
+    rule = _join([Panels.from_edges(np.array([lo, hi])) for _, lo, hi in pieces])
+    values = np.concatenate([
+        _interpolation(panels.centers[p], panels.half_widths[p],
+                       rule.nodes[k * NODES_PER_PANEL:(k + 1) * NODES_PER_PANEL])
+        @ state.nystrom[p * NODES_PER_PANEL:(p + 1) * NODES_PER_PANEL]
+        for k, (p, _, _) in enumerate(pieces)]) if pieces else np.zeros(0)
+    return rule, values
+
+
+def _join(rules: list[Panels]) -> Panels:
+    """Panels side by side as one rule (they need not touch; ``edges`` unused)."""
+    if not rules:
+        return Panels(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0))
+    return Panels(np.concatenate([r.edges for r in rules]),
+                  np.concatenate([r.nodes for r in rules]),
+                  np.concatenate([r.weights for r in rules]),
+                  np.concatenate([r.centers for r in rules]),
+                  np.concatenate([r.half_widths for r in rules]))

@@ -641,3 +641,31 @@ def test_lift_off_preset_lifts_off_and_meets_its_tolerance():
     assert result.flags == [], result.flag_messages
     assert all(len(z) == 1 and z[0][0] > -result.scene.half_width
                for z in result.contact_set)
+
+
+@pytest.mark.parametrize("gap, loads", [
+    (0.0, {"force": 1.0, "moment": 0.45}),
+    ("worn", {"force": 0.01, "moment": 0.002}),
+])
+def test_kink_corrected_ends_on_a_fixed_rule(gap, loads):
+    """The ends a creep step reports (core/contact_kinks.py) on a fixed rule of 0.04-wide
+    panels, against the elastic solver's ends refined on graded panels (to ~1e-10):
+    measured 3.7e-8 (footing) and 7.3e-8 (worn patch, two ends) from 2.4e-6 and 1.8e-6
+    where the nodal Q's interpolant changes sign; 1e-6 is the ends' own tolerance."""
+    from core.contact_kinks import corrected_ends
+
+    g = worn_patch if gap == "worn" else constant(gap)
+    ref = solve_unilateral(1.0, 0.05, g, [1.0], tol=1e-10, **loads)
+    ref_ends = [e for zone in ref.contact_set[0] for e in zone if abs(abs(e) - 1.0) > 1e-12]
+    space = Space(1.0, constant(0.05), g, ())
+    step = Step(1.0, 1.0, loads)
+    panels = base_panels(1.0, (), edge_width=1e-2, max_width=0.04)
+    op = kernel_operator(1.0, panels).matrix
+    m, g_nodes = np.full(panels.size, 0.05), g(panels.nodes)
+    state, _, _ = nodal_active_set(panels, op, m, g_nodes, step)
+    ends = [e for e in corrected_ends(space, step, state, op, m, g_nodes)
+            if abs(abs(e) - 1.0) > 1e-12]
+    nodal = [e for e, pinned in zip(*zones_from_nodes(state)[:2], strict=True) if not pinned]
+    assert len(ends) == len(ref_ends) == len(nodal)
+    assert np.max(np.abs(np.subtract(ends, ref_ends))) < 2e-7
+    assert np.max(np.abs(np.subtract(nodal, ref_ends))) > 1e-6  # what it corrects
