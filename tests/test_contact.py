@@ -325,9 +325,11 @@ def test_creep_in_full_contact_agrees_with_the_projection_method():
 
 def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
     # The preset (e = 0.6 m): the zone end moves from -0.306 to -0.349 half-widths over
-    # 1000 days as the base creeps. Two first grids (8 and 16 nominal steps) give ends
-    # 3.6e-6 apart (measured; estimates 5.2e-6 and 9.4e-6); the motion is far larger.
-    # Force by the trapezoid rule on 4001 points: 1.1e-6 off.
+    # 1000 days as the base creeps. At the preset's tol = 1e-4 the ends still have their
+    # own budget, 1e-6: two first grids (8 and 16 nominal steps) must give ends within
+    # the sum of their estimates, each <= 1e-6 (measured: 5.5e-7 apart, estimates 5.1e-7
+    # and 3.3e-7); the motion is far larger. Force by the trapezoid rule on 4001
+    # points: 1.1e-6 off.
     pb = _preset_problem()
     runs = [solve_unilateral(pb.lam, pb.m, pb.g, pb.times, tol=1e-4, time_steps=steps,
                              **_creep_args(pb)) for steps in (8, 16)]
@@ -337,8 +339,9 @@ def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
         assert r.info["contact"] == "unilateral"
     motion = abs(ends[1][-1] - ends[1][0])
     assert motion > 0.03
-    assert np.max(np.abs(ends[0] - ends[1])) < 1e-4
-    assert runs[1].info["zone_end_error"] < 1e-4
+    gap = float(np.max(np.abs(ends[0] - ends[1])))
+    assert all(r.info["zone_end_error"] <= 1e-6 for r in runs), [r.message for r in runs]
+    assert gap <= runs[0].info["zone_end_error"] + runs[1].info["zone_end_error"], gap
     # equilibrium holds at every time (statement 4: P and M are given)
     x = np.linspace(-1.0, 1.0, 4001)
     q = runs[1].pressure(x)
