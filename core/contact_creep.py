@@ -113,7 +113,9 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
     memory_of = _SeparableMemory(inp.kernel, grid, inner, n_nodes) if _separable(
         inp.kernel) else _HistoryMemory(inp.kernel, grid, inner, n_nodes)
     wanted = {int(i): k for k, i in enumerate(out_index)}
-    states: list[tuple[NodalState, Step, np.ndarray, list[float]]] = [None] * len(out_index)  # type: ignore
+    # per output time: the state, its step, the memory density, the ends, the nodal ends
+    states: list[tuple[NodalState, Step, np.ndarray, list[float], list[float]]] = (
+        [None] * len(out_index))  # type: ignore
     active = None
     solver = StepSolver()
     sweeps = 0
@@ -139,10 +141,10 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
         active = state.active
         memory_of.record(n, state.q)
         if n in wanted:
-            ends = (corrected_ends(space, step, state, op, m, g, displacement,
-                                   memory_density, solver) if exact_ends
-                    else _zones(state, space.breakpoints)[1])
-            states[wanted[n]] = (state, step, memory_density, ends)
+            nodal = _zones(state, space.breakpoints)[1]
+            ends = corrected_ends(space, step, state, op, m, g, displacement,
+                                  memory_density, solver) if exact_ends else nodal
+            states[wanted[n]] = (state, step, memory_density, ends, nodal)
     return {"states": states, "sweeps": sweeps, "unsettled": unsettled, "steps": steps - 1,
             "breakpoints": space.breakpoints,
             "factorizations": solver.factorizations,
@@ -229,18 +231,34 @@ class _SeparableMemory:
 def _outputs(run: dict[str, Any]) -> dict[str, Any]:
     """The outputs of one march, with what the pressure needs (all linear in the steps)."""
     states = run["states"]
-    ends = [e for _, _, _, e in states]  # without the kink defect (core/contact_kinks.py)
     return {
-        "settlement": np.array([s.settlement for s, _, _, _ in states]),
-        "tilt": np.array([s.tilt for s, _, _, _ in states]),
-        "force": np.array([s.force for s, _, _, _ in states]),
-        "moment": np.array([s.moment for s, _, _, _ in states]),
-        "ends": [list(e) for e in ends],
+        "settlement": np.array([row[0].settlement for row in states]),
+        "tilt": np.array([row[0].tilt for row in states]),
+        "force": np.array([row[0].force for row in states]),
+        "moment": np.array([row[0].moment for row in states]),
+        # without the kink defect (core/contact_kinks.py) when the march corrected them
+        "ends": [list(row[3]) for row in states],
+        "nodal_ends": [list(row[4]) for row in states],
         # Q(x) = [delta + alpha x - g - F(effective)(x)] / (c m), effective = s q - memory
-        "effective": np.column_stack([step.scale * s.q - memory
-                                      for s, step, memory, _ in states]),
-        "c": np.array([step.c for _, step, _, _ in states]),
+        "effective": np.column_stack([row[1].scale * row[0].q - row[2] for row in states]),
+        "c": np.array([row[1].c for row in states]),
     }
+
+
+def _borrow_corrections(coarse: dict[str, Any], fine: dict[str, Any]) -> None:
+    """Give the uncorrected ends of ``coarse`` the kink corrections of ``fine`` (the same
+    output times on a grid of halved steps), in place.
+
+    The correction is a spatial effect of where an end sits in its panel: between two
+    time grids the ends differ by ~1e-5, which changes it by ~1e-9 (the ends move on the
+    scale of a panel, 0.02), so one set of corrections serves both members of a
+    Richardson pair and the coarser march skips them. Times whose ends differ in number
+    keep theirs (the time estimate then calls the topology unresolved)."""
+    for k, (ends, nodal, exact) in enumerate(zip(coarse["nodal_ends"], fine["nodal_ends"],
+                                                 fine["ends"], strict=True)):
+        if len(ends) == len(nodal) == len(exact):
+            coarse["ends"][k] = [e + (x - n) for e, n, x in zip(ends, nodal, exact,
+                                                                  strict=True)]
 
 
 def _extrapolate(fine: dict[str, Any], coarse: dict[str, Any]) -> dict[str, Any]:
@@ -363,8 +381,11 @@ def _in_time(space: Space, inp: Any, base: Panels, first_steps: int, budget: flo
     time_error = end_shift = np.inf
     for level in range(MAX_HALVINGS + 1):
         grid, widths, index = time_grid(inp.times, first_steps, level)
-        run = _march(space, inp, base, op, m, g, grid, widths, index)
+        # the first grid borrows the kink corrections of the second (_borrow_corrections)
+        run = _march(space, inp, base, op, m, g, grid, widths, index, exact_ends=level > 0)
         plain.append(_outputs(run))
+        if level == 1:
+            _borrow_corrections(plain[0], plain[1])
         if len(plain) >= 2:
             extrapolated.append(_extrapolate(plain[-1], plain[-2]))
         if len(plain) == 2:
