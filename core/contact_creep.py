@@ -249,11 +249,13 @@ def _borrow_corrections(coarse: dict[str, Any], fine: dict[str, Any]) -> None:
     """Give the uncorrected ends of ``coarse`` the kink corrections of ``fine`` (the same
     output times on a grid of halved steps), in place.
 
-    The correction is a spatial effect of where an end sits in its panel: between two
-    time grids the ends differ by ~1e-5, which changes it by ~1e-9 (the ends move on the
-    scale of a panel, 0.02), so one set of corrections serves both members of a
-    Richardson pair and the coarser march skips them. Times whose ends differ in number
-    keep theirs (the time estimate then calls the topology unresolved)."""
+    The correction is a spatial effect of where an end sits in its panel, nearly the
+    same on two time grids: on the 100-time preset with band panels 0.04 / 0.02 the
+    corrections (up to 5.6e-6 / 2.3e-6) differed between the grids of 101 and 202 steps
+    by 1.8e-8 / 2.3e-8, which enters the extrapolated ends divided by 3. So one set
+    serves both members of a Richardson pair and the coarser march skips them. Times
+    whose ends differ in number keep theirs (the time estimate then calls the topology
+    unresolved)."""
     for k, (ends, nodal, exact) in enumerate(zip(coarse["nodal_ends"], fine["nodal_ends"],
                                                  fine["ends"], strict=True)):
         if len(ends) == len(nodal) == len(exact):
