@@ -244,7 +244,8 @@ def main() -> None:
         "asked to max(1e-6, tol): at the preset's tol = 1e-4 they came out ~4e-6 off "
         "(estimate 8.5e-6) in 120 ms of CPU (load 1); they now meet 1e-6 with an honest "
         "estimate, at the cost of band panels 0.02 wide (384 nodes instead of 272) and "
-        "the corrections: the 200 ms goal is missed (see the table). Through "
+        "the corrections (made on the finer grid of a Richardson pair only; the coarser "
+        "borrows them): the 200 ms goal is missed (see the table). Through "
         "`core.solve` the check at t = 1 finds contact lost at loading and the "
         "full-contact stepping is skipped.", ""])
     RESULTS.mkdir(parents=True, exist_ok=True)

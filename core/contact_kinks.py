@@ -101,15 +101,18 @@ def _contact_parts(panels: Panels, zones: list[tuple[float, float]], free: list[
 
 
 def _defect(space: Space, step: Step, state: NodalState, op: np.ndarray, cut: Panels,
-            values: np.ndarray, parts: dict[int, list[tuple[float, float]]]
-            ) -> tuple[np.ndarray, float, float]:
-    """(defect of s F q at the nodes, of the force, of the moment): the exact integrals of
-    the cut interpolant (``values`` on the rule ``cut``) less the panels' Gauss sums."""
+            values: np.ndarray, parts: dict[int, list[tuple[float, float]]],
+            idx: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """(defect of s F q at the nodes ``idx``, 0 elsewhere; of the force; of the moment):
+    the exact integrals of the cut interpolant (``values`` on the rule ``cut``) less the
+    panels' Gauss sums. Only the contact nodes carry the equation, so only they need it."""
     panels = state.panels
     cols = np.concatenate([np.arange(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
                            for p in parts])
     q_cols = state.q[cols]
-    defect = _part_rows(space.lam, cut, panels.nodes) @ values - op[:, cols] @ q_cols
+    defect = np.zeros(panels.size)
+    defect[idx] = (_part_rows(space.lam, cut, panels.nodes[idx]) @ values
+                   - op[np.ix_(idx, cols)] @ q_cols)
     force = float(cut.weights @ values - panels.weights[cols] @ q_cols)
     moment = float((cut.weights * cut.nodes) @ values
                    - (panels.weights[cols] * panels.nodes[cols]) @ q_cols)
@@ -143,7 +146,7 @@ def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
     zones = [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)]
     parts = _contact_parts(panels, zones, [ends[k] for k in free])
     cut, values = _cut_rule(panels, state, parts)
-    defect, d_force, d_moment = _defect(space, step, state, op, cut, values, parts)
+    defect, d_force, d_moment = _defect(space, step, state, op, cut, values, parts, idx)
     given = dict(step.given)
     if "force" in given:
         given["force"] -= d_force
