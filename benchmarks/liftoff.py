@@ -242,7 +242,7 @@ def main() -> None:
         "on the end's panel, one solve with the kept factors, core/contact_kinks.py) and "
         "the end is the root of the corrected Nystrom pressure. Before, the ends were "
         "asked to max(1e-6, tol): at the preset's tol = 1e-4 they came out ~4e-6 off "
-        "(estimate 8.5e-6) in 120 ms of CPU (load 1); they now meet 1e-6 with an honest "
+        "(estimate 8.5e-6) in 124 ms of CPU (load 3.3); they now meet 1e-6 with an honest "
         "estimate, at the cost of band panels 0.02 wide (384 nodes instead of 272) and "
         "the corrections (made on the finer grid of a Richardson pair only; the coarser "
         "borrows them): the 200 ms goal is missed (see the table). Through "
