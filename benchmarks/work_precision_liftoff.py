@@ -43,26 +43,12 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from benchmarks.liftoff import PRESET, RESULTS, constant, nodal_start  # noqa: E402
+from core import contact_zones as cz  # noqa: E402
 from core import scene_from_dict  # noqa: E402
 from core.contact import solve_unilateral  # noqa: E402
-from core.contact_zones import (  # noqa: E402
-    Resolution,
-    Space,
-    Step,
-    nodal_active_set,
-    nystrom_pressure,
-    refine_zone_ends,
-    zones_from_nodes,
-)
-from core.quadrature import base_panels, kernel_operator  # noqa: E402
 
-RESULTS = ROOT / "benchmarks" / "results"
-PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"
 XS = np.linspace(-0.95, 0.95, 381)
-
-
-def constant(value: float):
-    return lambda x: np.full(np.shape(x), float(value))
 
 
 def worn_patch(x):
@@ -95,20 +81,16 @@ ELASTIC = {
 
 
 def elastic_reference(g, loads) -> dict:
-    space = Space(1.0, constant(0.05), g, ())
-    step = Step(1.0, 1.0, loads)
-    panels = base_panels(1.0, (), edge_width=1e-2, max_width=0.25)
-    op = kernel_operator(1.0, panels).matrix
-    state, _, _ = nodal_active_set(panels, op, np.full(panels.size, 0.05), g(panels.nodes),
-                                   step)
-    ends, pinned, slopes = zones_from_nodes(state)
-    res = Resolution(0.5, 1e-2)
+    space = cz.Space(1.0, constant(0.05), g, ())
+    step = cz.Step(1.0, 1.0, loads)
+    _, _, (ends, pinned, slopes) = nodal_start(space, step)
+    res = cz.Resolution(0.5, 1e-2)
     for _ in range(4):
         res = res.finer()
-    refined = refine_zone_ends(space, step, ends, pinned, slopes, res, tol=1e-12,
+    refined = cz.refine_zone_ends(space, step, ends, pinned, slopes, res, tol=1e-12,
                                max_levels=1)
     sol = refined.solution
-    q = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, XS)
+    q = cz.nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, XS)
     inside = np.zeros(XS.size, dtype=bool)
     for k in range(len(sol.ends) // 2):
         inside |= (XS >= sol.ends[2 * k]) & (XS <= sol.ends[2 * k + 1])
@@ -120,15 +102,11 @@ def elastic_reference(g, loads) -> dict:
 
 def nodal_only(g, loads, width: float):
     """The nodal active set on one fixed rule: ends where the nodal Q changes sign."""
-    space = Space(1.0, constant(0.05), g, ())
-    step = Step(1.0, 1.0, loads)
-    panels = base_panels(1.0, (), edge_width=1e-2, max_width=width)
-    op = kernel_operator(1.0, panels).matrix
-    state, _, _ = nodal_active_set(panels, op, np.full(panels.size, 0.05), g(panels.nodes),
-                                   step)
-    ends, _, _ = zones_from_nodes(state)
+    space = cz.Space(1.0, constant(0.05), g, ())
+    step = cz.Step(1.0, 1.0, loads)
+    panels, state, (ends, _, _) = nodal_start(space, step, width)
     zones = [(ends[2 * k], ends[2 * k + 1]) for k in range(len(ends) // 2)]
-    q = nystrom_pressure(space, step, panels, state.q, state.settlement, state.tilt, XS)
+    q = cz.nystrom_pressure(space, step, panels, state.q, state.settlement, state.tilt, XS)
     inside = np.zeros(XS.size, dtype=bool)
     for lo, hi in zones:
         inside |= (XS >= lo) & (XS <= hi)

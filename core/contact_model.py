@@ -24,6 +24,67 @@ def check_contact_model(contact: object) -> str:
     return contact
 
 
+#: Samples of a load history over [1, t_end] under creep, besides the output times (the
+#: base remembers the loads between them): as the dimensional check
+#: (``core.load_contact.LOAD_SAMPLES``).
+LOAD_SAMPLES = 1025
+
+
+def refuse_loads_without_contact(times: Any, kernel: Any, force: Any, moment: Any) -> None:
+    """Refuse a given force or moment no contact can carry, in every contact mode.
+
+    ``force`` (P) and ``moment`` (M) as given to :func:`core.solver.solve_dimensionless`
+    (numbers, callables of t, or None), dimensionless. Raises ``ValueError`` naming
+    ``force`` when P < 0 at some time (the punch is pulled away) or P = 0 at every time
+    (nothing presses it), and ``moment`` when the resultant leaves the punch (|M/P| >= 1
+    half-width, or M != 0 with P = 0). Checked at the output times and, on a creeping
+    base (``kernel`` not None, whose memory holds the loads between them), at
+    ``LOAD_SAMPLES`` times over [1, t_end]. An instant with P = M = 0 (a load taken off)
+    carries nothing and passes. Inputs that fail their own checks are left to the solver.
+    """
+    from core.inputs import as_function, validate_times
+
+    if force is None:
+        return  # statements with a given settlement or tilt: contact may be absent
+    try:
+        t = validate_times(times)
+        force_fn = as_function(force, "force")
+        moment_fn = None if moment is None else as_function(moment, "moment")
+    except ValueError:
+        return  # the solver names the bad argument
+    if kernel is not None and t[-1] > 1.0:
+        t = np.unique(np.concatenate([t, np.linspace(1.0, t[-1], LOAD_SAMPLES)]))
+    p = np.asarray(force_fn(t), dtype=float) * np.ones_like(t)
+    if not np.all(np.isfinite(p)):
+        return
+    pulled = p < 0.0
+    if pulled.any():
+        k = int(np.argmax(pulled))
+        raise ValueError(f"force: the punch is pulled away (P = {p[k]:.6g} at t = {t[k]:.6g});"
+                         " P must be > 0 for the punch to touch the coating, and no contact "
+                         "model answers for a pulled punch")
+    if not (p > 0.0).any():
+        raise ValueError("force: must be > 0 for the punch to touch the coating (P = 0 at "
+                         "every time: nothing presses it)")
+    if moment_fn is None:
+        return
+    mo = np.asarray(moment_fn(t), dtype=float) * np.ones_like(t)
+    if not np.all(np.isfinite(mo)):
+        return
+    pressed = p > 0.0
+    e = np.where(pressed, mo / np.where(pressed, p, 1.0), 0.0)
+    outside = (np.abs(e) >= 1.0) | (~pressed & (mo != 0.0))
+    if outside.any():
+        k = int(np.argmax(outside))
+        if not pressed[k]:
+            reason = f"M = {mo[k]:.6g} with no force (P = 0) at t = {t[k]:.6g}"
+        else:
+            reason = (f"the eccentricity M/P = {e[k]:.6g} at t = {t[k]:.6g} (M = {mo[k]:.6g}, "
+                      f"P = {p[k]:.6g}) is not inside the punch, |M/P| must be < 1 half-width")
+        raise ValueError(f"moment: {reason}: the resultant acts outside the base, so no "
+                         "contact can carry it")
+
+
 def predicted_unilateral(arguments: dict[str, Any]):
     """The unilateral answer when a cheap check shows full contact lost, else None.
 

@@ -58,7 +58,9 @@ def test_a_moment_change_past_lift_off_builds_nothing_geometric(monkeypatch) -> 
     # operators of the base and locating rules, the panels, the gap and the samples are
     # reused.
     assert grown <= {"profiles", "contact_rule_operator"}, grown
-    assert after["contact_rule_operator"] - before["contact_rule_operator"] <= 2
+    # The band rules the spatial check tries (0.04 against 0.02, then 0.02 against 0.01:
+    # the zone ends are held to 1e-6 whatever tol, which takes 0.02 on the lesson).
+    assert after["contact_rule_operator"] - before["contact_rule_operator"] <= 3
     # Operator entries were computed only for panels no kept rule had (those the moved
     # band cut anew); every block between known panels was copied.
     assert built and not set(built) & known, sorted(set(built) & known)

@@ -1,0 +1,231 @@
+"""Zone ends of a creep step without the kink error of the fixed panel rule.
+
+Under creep the contact set is found on the nodes of one fixed panel rule
+(:mod:`core.contact_creep`). At a free zone end the pressure ``q = max(Q, 0)`` has a kink
+inside a panel, and that panel's Gauss rule integrates ``F q`` and the resultants only to
+a low order: on the lift-off preset with 0.04-wide band panels this left the ends ~4e-6
+half-widths off, and only ~0.005-wide panels (8 times the cost) met 1e-6 that way.
+
+The Nystrom pressure ``Q`` itself is smooth across the end (it is ``q`` on the zone and
+``-gap / (c m)`` off it), so on the panel holding an end the pressure is the panel's
+interpolant of the nodal ``Q`` cut at its root, ``q = P_Q`` on the contact part. Its
+integrals there are taken exactly by a Gauss rule of that part alone (with the product
+weights of the log kernel where a node is near), and the difference from the panel's
+rule is a defect of the discrete equation. One solve with the step's kept factors
+(:class:`core.contact_systems.StepSolver`) removes it, and each free end is then the root
+of that solution's Nystrom pressure evaluated by its formula (the panel interpolant of
+the nodal Q errs near the end, see :func:`corrected_ends`).
+
+Measured on the preset (20 output times, two time grids Richardson-extrapolated), with
+0.04 / 0.02 / 0.005 band panels: the nodal ends were 3.8e-6 / 8.7e-7 / 3.4e-7 from the
+solver at tol = 1e-7; the corrected ones are 4.3e-7 / 8.9e-8 / 2.8e-10 from each output
+time re-solved on panels graded toward its end (same memory and time grid). What is left
+is the kinks of past pressures in the creep memory, which this leaves (it falls with
+the band panels). Elastic, on uniform 0.04 panels: 3.7e-8 from the refined ends, where
+the nodal ones were 2.4e-6 off (tests/test_contact.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from core.contact_systems import StepSolver, bordered_solve
+from core.contact_zones import (
+    _BARYCENTRIC,
+    _T,
+    ZONE_END_TOL,
+    NodalState,
+    Space,
+    Step,
+    zones_from_nodes,
+)
+from core.log_moments import legendre_log_moments
+from core.panels import _TO_COEF, _W
+from core.quadrature import NEAR_FIELD, NODES_PER_PANEL, Panels, _rows
+
+#: Log moments at targets just off a part (1.05 < |z| <= NEAR_FIELD in its coordinate)
+#: by a 64-point Gauss rule: ln|z - t| is analytic within the ellipse through z (rho >=
+#: 1.37), so the rule errs like rho^(15 - 128) < 1e-15 against P_15's growth (rows
+#: equal to operator_rows' to 2e-17, measured). The exact moments there need Miller's
+#: backward recurrence (~90 steps): 0.29 ms a call against 0.20 at 224 targets.
+_OVER_T, _OVER_W = np.polynomial.legendre.leggauss(64)
+_OVER_P = np.polynomial.legendre.legvander(_OVER_T, NODES_PER_PANEL - 1)
+
+
+def _part_rows(lam: float, part: Panels, targets: np.ndarray) -> np.ndarray:
+    """Rows of F (len(targets) x 16 P) on the panels ``part``: as
+    :func:`core.quadrature.operator_rows`, its near-field moments computed as above."""
+    z = (targets[:, None] - part.centers[None, :]) / part.half_widths[None, :]
+    near_t, near_s = np.nonzero(np.abs(z) <= NEAR_FIELD)
+    zn = z[near_t, near_s]
+    moments = np.empty((zn.size, NODES_PER_PANEL))
+    inner = np.abs(zn) <= 1.05
+    if inner.any():
+        moments[inner] = legendre_log_moments(zn[inner], NODES_PER_PANEL - 1)
+    if (~inner).any():
+        outer = zn[~inner]
+        moments[~inner] = (np.log(np.abs(outer[:, None] - _OVER_T[None, :]))
+                           * _OVER_W[None, :]) @ _OVER_P
+    h = part.half_widths[near_s][:, None]
+    log_weights = h * (np.log(h) * _W[None, :] + moments @ _TO_COEF)
+    return _rows(lam, part, targets, np.arange(part.n_panels), near_t, near_s, log_weights)
+
+
+def _interpolation(center: float, half: float, targets: np.ndarray) -> np.ndarray:
+    """Rows mapping a panel's 16 nodal values to ``targets`` (its barycentric form)."""
+    d = (targets - center) / half
+    diff = d[:, None] - _T[None, :]
+    rows = np.zeros((targets.size, _T.size))
+    hit = diff == 0.0
+    exact = hit.any(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = _BARYCENTRIC[None, :] / diff
+    rows[~exact] = ratio[~exact] / ratio[~exact].sum(axis=1, keepdims=True)
+    rows[exact] = hit[exact].astype(float)
+    return rows
+
+
+def _contact_parts(panels: Panels, zones: list[tuple[float, float]], free: list[float]
+                   ) -> dict[int, list[tuple[float, float]]]:
+    """For every panel holding a free end: the parts of it inside the zones."""
+    lo_edges = panels.centers - panels.half_widths
+    hi_edges = panels.centers + panels.half_widths
+    parts: dict[int, list[tuple[float, float]]] = {}
+    for end in free:
+        p = int(np.clip(np.searchsorted(hi_edges, end), 0, panels.n_panels - 1))
+        if p in parts:
+            continue
+        a, b = float(lo_edges[p]), float(hi_edges[p])
+        parts[p] = [(max(a, lo), min(b, hi)) for lo, hi in zones
+                    if min(b, hi) > max(a, lo)]
+    return parts
+
+
+def _defect(space: Space, step: Step, state: NodalState, op: np.ndarray, cut: Panels,
+            values: np.ndarray, parts: dict[int, list[tuple[float, float]]],
+            idx: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """(defect of s F q at the nodes ``idx``, 0 elsewhere; of the force; of the moment):
+    the exact integrals of the cut interpolant (``values`` on the rule ``cut``) less the
+    panels' Gauss sums. Only the contact nodes carry the equation, so only they need it."""
+    panels = state.panels
+    cols = np.concatenate([np.arange(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
+                           for p in parts])
+    q_cols = state.q[cols]
+    defect = np.zeros(panels.size)
+    defect[idx] = (_part_rows(space.lam, cut, panels.nodes[idx]) @ values
+                   - op[np.ix_(idx, cols)] @ q_cols)
+    force = float(cut.weights @ values - panels.weights[cols] @ q_cols)
+    moment = float((cut.weights * cut.nodes) @ values
+                   - (panels.weights[cols] * panels.nodes[cols]) @ q_cols)
+    return step.scale * defect, force, moment
+
+
+def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
+                   m: np.ndarray, g: np.ndarray, memory: np.ndarray | None = None,
+                   memory_density: np.ndarray | None = None,
+                   solver: StepSolver | None = None) -> list[float]:
+    """The zone ends of a step, sorted, two per zone, with the kink defect removed.
+
+    ``state`` from :func:`core.contact_zones.nodal_active_set` on the rule whose Nystrom
+    matrix is ``op``; ``m``, ``g`` at its nodes; ``memory`` the memory displacement e at
+    the nodes and ``memory_density`` the density it is F of (None for an elastic step).
+    The contact nodes are kept and the step solved again with the defect; each free end
+    is then the root of that solution's Nystrom pressure Q(x), evaluated by its formula
+    (the interpolant of the nodal Q errs there: F of the kinked q puts a
+    ``(x - end)^2 ln|x - end|`` term into Q, which 16-point panels read ~1e-4 wrong).
+    Ends at +-1 or at breakpoints are kept (dimensionless throughout).
+    """
+    if not state.active.any():
+        return []
+    ends, pinned, _ = zones_from_nodes(state, space.breakpoints)
+    free = [k for k, p in enumerate(pinned) if not p]
+    if not free:
+        return ends
+    panels = state.panels
+    x, w = panels.nodes, panels.weights
+    idx = np.nonzero(state.active)[0]
+    zones = [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)]
+    parts = _contact_parts(panels, zones, [ends[k] for k in free])
+    cut, values = _cut_rule(panels, state, parts)
+    defect, d_force, d_moment = _defect(space, step, state, op, cut, values, parts, idx)
+    given = dict(step.given)
+    if "force" in given:
+        given["force"] -= d_force
+    if "moment" in given:
+        given["moment"] -= d_moment
+    rhs = step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g - defect
+    if memory is not None:
+        rhs = rhs + memory
+    q_active, delta, alpha = bordered_solve(op, m, x, w, step.c, step.scale, given, rhs,
+                                            idx, solver)
+    q = np.zeros(x.size)
+    q[idx] = q_active
+    # F on the rule and on the cut parts at once; the cut panels' Gauss sums taken off
+    # with the pressure the defect of the solve took them with
+    joined = _join([panels, cut])
+    density = np.concatenate([q, values])
+    for p in parts:
+        cols = slice(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
+        density[cols] -= state.q[cols]
+    density_memory = None if memory_density is None else np.concatenate(
+        [memory_density, np.zeros(values.size)])
+
+    def nystrom(t: np.ndarray) -> np.ndarray:
+        rows = _part_rows(space.lam, joined, t)
+        fq = rows @ density
+        e = 0.0 if density_memory is None else rows @ density_memory
+        return (delta + alpha * t - space.g(t) + e - step.scale * fq) / (step.c * space.m(t))
+
+    # Secant from the interpolant's roots (within ~1e-4 of the true ones).
+    inward = np.array([1.0 if k % 2 == 0 else -1.0 for k in free])
+    a = np.array([ends[k] for k in free])
+    b = a + 1e-6 * inward
+    both = nystrom(np.concatenate([a, b]))
+    fa, fb = both[:a.size], both[a.size:]
+    for _ in range(_SECANT_STEPS):
+        slope = (fb - fa) / (b - a)
+        ok = np.isfinite(slope) & (slope != 0.0)
+        step_x = np.where(ok, -fb / np.where(ok, slope, 1.0), 0.0)
+        a, fa = b, fb
+        b = b + step_x
+        # a step below 1e-8 leaves ~1e-14 (the secant converges superlinearly from ~1e-4)
+        if np.max(np.abs(step_x)) < 1e-2 * ZONE_END_TOL:
+            break
+        fb = nystrom(b)
+    out = list(ends)
+    for j, k in enumerate(free):
+        lo = -1.0 if k == 0 else ends[k - 1]
+        hi = 1.0 if k == len(ends) - 1 else ends[k + 1]
+        # a root that ran off (a degenerate slope) keeps the interpolant's end
+        if lo < b[j] < hi and abs(b[j] - ends[k]) < 2.0 * panels.half_widths.max():
+            out[k] = float(b[j])
+    return out
+
+
+#: Secant steps on the Nystrom pressure at most (quadratic-like convergence from ~1e-4).
+_SECANT_STEPS = 6
+
+
+def _cut_rule(panels: Panels, state: NodalState,
+              parts: dict[int, list[tuple[float, float]]]) -> tuple[Panels, np.ndarray]:
+    """One Gauss panel on every contact part, and there the values of the interpolant of
+    the nodal Q of its panel (the pressure cut at its root)."""
+    pieces = [(p, lo, hi) for p, spans in parts.items() for lo, hi in spans]
+    rule = _join([Panels.from_edges(np.array([lo, hi])) for _, lo, hi in pieces])
+    values = np.concatenate([
+        _interpolation(panels.centers[p], panels.half_widths[p],
+                       rule.nodes[k * NODES_PER_PANEL:(k + 1) * NODES_PER_PANEL])
+        @ state.nystrom[p * NODES_PER_PANEL:(p + 1) * NODES_PER_PANEL]
+        for k, (p, _, _) in enumerate(pieces)]) if pieces else np.zeros(0)
+    return rule, values
+
+
+def _join(rules: list[Panels]) -> Panels:
+    """Panels side by side as one rule (they need not touch; ``edges`` unused)."""
+    if not rules:
+        return Panels(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0))
+    return Panels(np.concatenate([r.edges for r in rules]),
+                  np.concatenate([r.nodes for r in rules]),
+                  np.concatenate([r.weights for r in rules]),
+                  np.concatenate([r.centers for r in rules]),
+                  np.concatenate([r.half_widths for r in rules]))
