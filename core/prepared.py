@@ -150,7 +150,7 @@ class PreparedContact:
         """Modal decomposition of a statement (for creep or a modulus varying in time)."""
         with self._lock:
             if given not in self._modal:
-                self._modal[given] = ModalForm(self.grid, given)
+                self._modal[given] = ModalForm(self.grid, given, self.geometry.tol)
                 self.counts["modal"] += 1
             return self._modal[given]
 
