@@ -26,9 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.block_lu import BlockLU
 from core.nystrom import (
     Function,
+    NodalLU,
     NystromGrid,
     build_grid,
     factored_responses,
@@ -122,7 +122,7 @@ class AdaptiveGrid:
     resolved: bool  # the target was met within the panel budget
     rounds: int
     c_ref: float = 1.0  # the relative modulus of ``factor``
-    factor: BlockLU | None = None  # factors of c_ref m + A on ``grid``
+    factor: NodalLU | None = None  # factors of c_ref m + A on ``grid``
     # (c_ref m + A)^-1 [1, x(, -g)] on ``grid``: the statement-1 responses the loop solved
     responses: np.ndarray | None = None
 
@@ -189,7 +189,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
     for _ in range(MAX_ROUNDS):
         rounds += 1
         grid = build_grid(lam, edges, m, g, grid, accuracy)
-        responses, factor = factored_responses(grid, c_ref, with_gap, singular)
+        responses, factor = factored_responses(grid, c_ref, with_gap)
         tails = interior_tails(grid, responses, singular)
         flagged = tails > INTERIOR_SHARE * target
         if not flagged.any():
@@ -208,8 +208,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             resolved = False
             break
         fine = build_grid(lam, fine_edges, m, g, grid, accuracy)
-        fine_responses, fine_factor = factored_responses(fine, c_ref, with_gap, singular,
-                                                         factor)
+        fine_responses, fine_factor = factored_responses(fine, c_ref, with_gap)
         # The coarse answer at the fine nodes: its nodal values where the panel is shared
         # (the Nystrom formula returns them there), the formula at the new nodes only.
         kept_new, kept_old, fresh = shared_panels(grid.panels, fine.panels)
@@ -235,7 +234,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
                 resolved = False
                 break
             grid = build_grid(lam, edges, m, g, grid, accuracy)
-            responses, factor = factored_responses(grid, c_ref, with_gap, singular)
+            responses, factor = factored_responses(grid, c_ref, with_gap)
     estimate = max(estimate, ROUND_OFF)
     return AdaptiveGrid(grid, estimate, resolved and estimate <= target, rounds, c_ref,
                         factor, responses)
