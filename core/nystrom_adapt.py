@@ -74,6 +74,8 @@ KERNEL_SHARE = 1e-4
 COARSEN_FROM = 1e-6
 #: m and g are resolved on the starting panels to this share of the target.
 RESOLVE_SHARE = 0.1
+#: A starting panel may be this much more than GRADING_RATIO times a neighbour's width.
+GROWTH_SLACK = 1.05
 #: Rounds of each refinement loop.
 MAX_ROUNDS = 12
 
@@ -152,7 +154,25 @@ def start_edges(lam: float, breakpoints: Sequence[float], m_min: float,
     # base_panels caps widths at 3/lam' as well: pass the lam' for which that is `widest`.
     panels = base_panels(3.0 / widest, breakpoints, edge_width=edge, max_width=widest,
                          ratio=ratio)
-    return panels.edges
+    return _limit_growth(panels.edges, ratio)
+
+
+def _limit_growth(edges: np.ndarray, ratio: float) -> np.ndarray:
+    """``edges`` with every panel wider than ``ratio`` times a neighbour bisected.
+
+    Where a graded run ends early on a short interval (between a jump and +-1) its last
+    panel can sit next to one 5-6 times wider, where the end behaviour of q is not yet
+    resolved: the interior loop then bisected it after a first solve (measured on the
+    modulus jump and the stepped punch at tol 1e-6: a third grid); bisected here instead.
+    """
+    for _ in range(MAX_ROUNDS):
+        widths = np.diff(edges)
+        narrower = np.minimum(np.append(widths[1:], np.inf), np.append(np.inf, widths[:-1]))
+        wide = widths > ratio * GROWTH_SLACK * narrower
+        if not wide.any():
+            break
+        edges = np.sort(np.concatenate([edges, 0.5 * (edges[:-1] + edges[1:])[wide]]))
+    return edges
 
 
 def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
