@@ -14,7 +14,9 @@ Refinement, in two parts:
   304 -> 240, stepped punch 384 -> 288).
 
 Work of a new scene: the operator of each grid reuses the blocks of the panels it shares
-with the previous one, the coarse answer is evaluated by the formula only at the new
+with the previous one (the kernel being even, a square operator evaluates it on and above
+the diagonal only, and the new columns of a refined one are its new rows transposed
+away from the new panels), the coarse answer is evaluated by the formula only at the new
 nodes, the kernel values are computed to ``KERNEL_SHARE * tol`` (not to rounding), and the
 LU of the last grid serves the bordered solve of the loads (a 2 x 2 Schur complement).
 """
