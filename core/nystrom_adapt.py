@@ -100,21 +100,19 @@ def grade(edges: np.ndarray, singular: np.ndarray, levels: int, split: float = 0
     Each cut is at ``split`` of the remaining width from the point (a panel ending at two
     such points is halved first).
     """
-    new: list[float] = []
-    for a, b in zip(edges[:-1], edges[1:], strict=True):
-        at_a = bool(np.any(np.abs(singular - a) < 1e-14))
-        at_b = bool(np.any(np.abs(singular - b) < 1e-14))
-        steps = split ** np.arange(1, levels + 1)
-        if at_a and at_b:
-            mid = 0.5 * (a + b)
-            new.append(mid)
-            new.extend(a + (mid - a) * steps)
-            new.extend(b - (b - mid) * steps)
-        elif at_a:
-            new.extend(a + (b - a) * steps)
-        elif at_b:
-            new.extend(b - (b - a) * steps)
-    return np.unique(np.concatenate([edges, new]))
+    a, b = edges[:-1], edges[1:]
+    at_a = np.min(np.abs(a[:, None] - singular[None, :]), axis=1) < 1e-14
+    at_b = np.min(np.abs(b[:, None] - singular[None, :]), axis=1) < 1e-14
+    steps = split ** np.arange(1, levels + 1)
+    both = at_a & at_b
+    mid = 0.5 * (a + b)
+    # A panel at two such points is halved, each half cut toward its own end.
+    near_a = np.where(both, mid, b)
+    near_b = np.where(both, mid, a)
+    new = [mid[both],
+           (a[at_a, None] + (near_a[at_a] - a[at_a])[:, None] * steps[None, :]).ravel(),
+           (b[at_b, None] - (b[at_b] - near_b[at_b])[:, None] * steps[None, :]).ravel()]
+    return np.unique(np.concatenate([edges, *new]))
 
 
 @dataclass(frozen=True)
