@@ -115,6 +115,24 @@ def grade(edges: np.ndarray, singular: np.ndarray, levels: int, split: float = 0
     return np.unique(np.concatenate([edges, *new]))
 
 
+def _coarse_rows(coarse: NystromGrid, fine: NystromGrid, kept_new: np.ndarray,
+                 kept_old: np.ndarray, fresh: np.ndarray, accuracy: float) -> np.ndarray:
+    """Rows of the coarse operator at the nodes of the fine grid's ``fresh`` panels.
+
+    On the panels both grids share, these are the fine operator's entries (same target,
+    same source panel, same rule): copied; only the columns of the coarse panels the fine
+    grid split are computed (the rows on all coarse columns cost 0.3-1.1 ms a scene).
+    """
+    fn = panel_nodes(fresh)
+    rows = np.empty((fn.size, coarse.size))
+    rows[:, panel_nodes(kept_old)] = fine.operator[np.ix_(fn, panel_nodes(kept_new))]
+    split = np.setdiff1d(np.arange(coarse.panels.n_panels), kept_old)
+    if split.size:
+        rows[:, panel_nodes(split)] = node_rows(coarse.lam, coarse.panels, fine.panels,
+                                                fresh, split, accuracy)
+    return rows
+
+
 @dataclass(frozen=True)
 class AdaptiveGrid:
     """The grid the adaptive loop settled on and what it measured on it."""
@@ -237,8 +255,8 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
         fn = panel_nodes(fresh)
         coarse_at_fine[fn] = nystrom_values(grid, c_ref, fine.nodes[fn], fine.m[fn],
                                             fine.g[fn], responses, with_gap,
-                                            node_rows(lam, grid.panels, fine.panels, fresh,
-                                                      accuracy=accuracy))
+                                            _coarse_rows(grid, fine, kept_new, kept_old,
+                                                         fresh, accuracy))
         scale = np.max(np.abs(fine_responses), axis=0)
         scale[scale == 0] = 1.0
         difference = float(np.max(np.abs(coarse_at_fine - fine_responses) / scale))
