@@ -77,7 +77,7 @@ class ModalForm:
             raise UnresolvedOperator(
                 f"operator: its modes reach {rounding / np.finfo(float).eps:.1e} (m down "
                 f"to {float(np.min(m)):.1e}, a nearly first-kind equation) and their "
-                f"rounding {rounding:.1e} exceeds tol; the grid does not resolve the problem")
+                f"rounding {rounding:.1e} exceeds 0.1 tol; the grid does not resolve the problem")
         self.to_nodes = s_out[:, None] * q
         self.gap = ms.rotate(-(q.T @ (s_in * grid.g)))
         self.k = len(ms.known)
