@@ -98,13 +98,23 @@ def _near_pairs(panels: Panels, targets: np.ndarray, sources: np.ndarray
                       <= NEAR_FIELD * panels.half_widths[None, sources])
 
 
+#: Absolute error of the log moments per unit of kernel accuracy: an error d in the
+#: moments moves an operator entry by at most h d max_j sum_n |_TO_COEF[n, j]| / pi
+#: (= 4.33 h d / pi), the kernel's accuracy e by e h W_j / pi >= 0.027 e h / pi; this keeps
+#: the first at a third of the second (0.017 / 3).
+_MOMENT_SHARE = 0.017 / 3
+
+
 def _log_weights(panels: Panels, targets: np.ndarray, near_t: np.ndarray,
-                 near_p: np.ndarray) -> np.ndarray:
-    """Product weights of ``ln|x - xi|`` (pairs x 16) for target/panel pairs, one batch."""
+                 near_p: np.ndarray, accuracy: float = FULL_ACCURACY) -> np.ndarray:
+    """Product weights of ``ln|x - xi|`` (pairs x 16) for target/panel pairs, one batch.
+
+    ``accuracy``: the kernel values' absolute accuracy (their moments follow it)."""
     if not near_t.size:
         return np.empty((0, NODES_PER_PANEL))
     c, h = panels.centers[near_p], panels.half_widths[near_p]
-    moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1)
+    moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1,
+                                   _MOMENT_SHARE * accuracy)
     return h[:, None] * (np.log(h)[:, None] * _W[None, :] + moments @ _TO_COEF)
 
 
@@ -129,7 +139,7 @@ def operator_rows(lam: float, panels: Panels, targets: np.ndarray,
     sources = (np.arange(panels.n_panels) if sources is None
                else np.asarray(sources, dtype=np.intp))
     near_t, near_s = _near_pairs(panels, targets, sources)
-    log_weights = _log_weights(panels, targets, near_t, sources[near_s])
+    log_weights = _log_weights(panels, targets, near_t, sources[near_s], accuracy)
     return _rows(lam, panels, targets, sources, near_t, near_s, log_weights, accuracy)
 
 
