@@ -91,19 +91,20 @@ def predicted_unilateral(arguments: dict[str, Any]):
     ``contact="auto"`` would solve full contact over all times and then, finding q < 0,
     solve again with lift-off: under creep the first solve is wasted work (it roughly
     doubled the cost of a 100-time scene). The check solves full contact at the first
-    time only, elastic at the loading instant: from the prepared geometry the default
+    time only, elastic at the loading instant, from the prepared geometry the default
     engine would use (shared with it: a later full solve reuses it; only a pressure the
-    full-contact model itself flags ``contact_lost`` counts), or, for an elastic base
-    whose geometry is not prepared yet, on the nodal rule of the unilateral solver (kept
-    for it; only a clearly lost contact counts, see ``CLEARLY_LOST``). Applies to an
-    elastic base (any first time) and to creep when the first time is t = 1 (at
-    loading the base is elastic); otherwise, or when no unilateral answer exists (loads
-    pulling the punch away) or the check fails on the input, returns None and the caller
-    takes the full-contact path, whose messages and flags then speak.
+    full-contact model itself flags ``contact_lost`` counts). Applies to an elastic base
+    (any first time) and to creep when the first time is t = 1 (at loading the base is
+    elastic); otherwise, or when no unilateral answer exists (loads pulling the punch
+    away) or the check fails on the input, returns None and the caller takes the
+    full-contact path, whose messages and flags then speak. A new elastic geometry is
+    prepared for the check as well: preparing it (3-10 ms on the work-precision scenes at
+    tol 1e-6) is work the full-contact answer needs anyway, where a separate check on
+    the unilateral solver's nodal rule cost 3-14 ms on top of it.
     ``arguments`` are those of :func:`solve_unilateral`.
     """
-    from core.inputs import validate_geometry, validate_time_inputs
-    from core.prepared import PREPARED, _geometry_key, solve_with_prepared
+    from core.inputs import validate_time_inputs
+    from core.prepared import solve_with_prepared
 
     loads = {k: arguments.get(k) for k in ("settlement", "tilt", "force", "moment")}
     breakpoints = arguments.get("breakpoints", ())
@@ -117,26 +118,14 @@ def predicted_unilateral(arguments: dict[str, Any]):
         at = np.array([first])
         values = {k: float(inputs.loads[k](at)[0]) for k in inputs.given}
         c_first = float(inputs.c(at)[0])
-        geometry = validate_geometry(arguments["lam"], arguments["m"], arguments["g"],
-                                     breakpoints, tol)
-        if inputs.kernel is None and PREPARED.get(_geometry_key(geometry)) is None:
-            # A new elastic geometry: preparing it for the check cost more than the
-            # unilateral solve itself; the unilateral solver's own nodal rule (kept for
-            # that solve) decides when contact is clearly lost.
-            seen = _nodal_check(geometry, c_first, values)
-            if seen is None:
-                return None
-            check_info = {"flags": ["contact_lost"], "min_pressure": seen, "seconds": 0.0,
-                          "check": "nodal rule"}
-        else:
-            check = solve_with_prepared(arguments["lam"], arguments["m"], arguments["g"],
-                                        [first], c=c_first, breakpoints=breakpoints,
-                                        tol=tol, check_only=True, **values)
-            if "contact_lost" not in check.info["flags"]:
-                return None
-            check_info = {"flags": list(check.info["flags"]),
-                          "min_pressure": check.info.get("min_pressure"),
-                          "seconds": check.info.get("seconds")}
+        check = solve_with_prepared(arguments["lam"], arguments["m"], arguments["g"],
+                                    [first], c=c_first, breakpoints=breakpoints, tol=tol,
+                                    check_only=True, **values)
+        if "contact_lost" not in check.info["flags"]:
+            return None
+        check_info = {"flags": list(check.info["flags"]),
+                      "min_pressure": check.info.get("min_pressure"),
+                      "seconds": check.info.get("seconds")}
     except ValueError:
         return None
     try:
@@ -146,30 +135,6 @@ def predicted_unilateral(arguments: dict[str, Any]):
     result.info["full_contact"] = {**check_info, "checked_at": first}
     result.info["seconds"] += float(check_info.get("seconds") or 0.0)
     return result
-
-
-#: The nodal check calls contact lost only when q is below this fraction of max q: far
-#: beyond its discretization error (~1e-5 at the edges), so that near the threshold the
-#: full-contact model, whose own flag is exact to its estimate, decides.
-CLEARLY_LOST = 1e-3
-
-
-def _nodal_check(geometry, c: float, loads: dict[str, float]) -> float | None:
-    """Full contact on the unilateral solver's nodal rule: min q / max q when below
-    ``-CLEARLY_LOST``, else None (dimensionless)."""
-    from core.contact import nodal_operator, nodal_resolution
-    from core.contact_zones import Step, _bordered_solve, _given_rhs
-
-    res = nodal_resolution(geometry.lam, geometry.m)
-    panels, op = nodal_operator(geometry.lam, geometry.breakpoints, res)
-    x, w = panels.nodes, panels.weights
-    m, g = geometry.m(x), geometry.g(x)
-    step = Step(c, 1.0, loads)
-    idx = np.arange(x.size)
-    q, _, _ = _bordered_solve(op, m, x, w, step, _given_rhs(step, x, g, None), idx)
-    scale = float(np.max(np.abs(q)))
-    low = float(np.min(q)) / scale if scale > 0.0 else 0.0
-    return low if low < -CLEARLY_LOST else None
 
 
 def with_contact_model(full, contact: str, arguments: dict[str, Any]):

@@ -8,10 +8,29 @@ in the panel's reference coordinate).
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
+from numpy.polynomial import legendre as npleg
 
 #: Points outside [-1.05, 1.05] from which Miller's recurrence runs in bands of |z|.
 _MILLER_BANDS_FROM = 2048
+#: Gauss points of the plain rule that may replace Miller's recurrence for
+#: 1.05 < |z| <= OUTER_RULE_REACH: ln|z - t| P_n(t) is analytic in the Bernstein ellipse
+#: through z (rho >= 1.37), so 72 points leave rho^(15 - 144) < 1e-17 of quadrature error;
+#: what remains is rounding, measured <= 1.4e-14 absolute against the recurrence for
+#: n <= 15 (it grows with ln|z|: 1e-12 at |z| = 870).
+_OUTER_RULE_POINTS = 72
+OUTER_RULE_REACH = 3.0
+#: The rule's error in the moments (absolute), with a margin over the measured 1.4e-14.
+OUTER_RULE_ERROR = 2.5e-14
+
+
+@lru_cache(maxsize=8)
+def _outer_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes (K,) and weights times P_n at the nodes (K, degree + 1) of the outer rule."""
+    t, w = npleg.leggauss(_OUTER_RULE_POINTS)
+    return t, npleg.legvander(t, degree) * w[:, None]
 
 
 def _q_outside(z: np.ndarray, nq: int) -> np.ndarray:
@@ -47,12 +66,15 @@ def _q_outside(z: np.ndarray, nq: int) -> np.ndarray:
     return vals
 
 
-def legendre_log_moments(z: np.ndarray, degree: int) -> np.ndarray:
+def legendre_log_moments(z: np.ndarray, degree: int, rounding: float = 0.0) -> np.ndarray:
     """``M_n(z) = int_{-1}^{1} ln|z - t| P_n(t) dt`` for n = 0..degree (shape (len(z), degree+1)).
 
     Uses Legendre functions of the second kind ``Q_n``: forward recurrence where it is
     stable (|z| <= 1.05) and Miller's backward recurrence outside, where ``Q_n`` is the
     minimal solution and the forward recurrence loses ~2n log10(|z| + sqrt(z^2 - 1)) digits.
+    ``rounding``: the absolute error the caller accepts; at OUTER_RULE_ERROR or above, a
+    few points just outside are integrated by a fixed Gauss rule instead (one small
+    matrix product against Miller's ~90 sequential steps: 0.27 -> 0.03 ms for 150 points).
     """
     z = np.asarray(z, dtype=float)
     ends = np.abs(np.abs(z) - 1.0) < 1e-13
@@ -73,6 +95,13 @@ def legendre_log_moments(z: np.ndarray, degree: int) -> np.ndarray:
             qi[:, n + 1] = ((2 * n + 1) * zi * qi[:, n] - n * qi[:, n - 1]) / (n + 1)
         q[inner] = qi
     outer = ~inner
+    by_rule = None
+    rule = outer & (np.abs(z) <= OUTER_RULE_REACH)
+    if rounding >= OUTER_RULE_ERROR and 0 < rule.sum() <= _MILLER_BANDS_FROM:
+        t, weighted = _outer_rule(degree)
+        by_rule = np.log(np.abs(z[rule, None] - t[None, :])) @ weighted
+        q[rule] = 0.0  # not used: replaced below
+        outer = outer & ~rule
     # Miller's recurrence from an index set by the smallest rho of a group. Many points:
     # in bands of |z|, so that the many well outside a panel do not run the ~90 steps the
     # few just outside need; few points: one group (the steps' overhead dominates).
@@ -97,4 +126,6 @@ def legendre_log_moments(z: np.ndarray, degree: int) -> np.ndarray:
         exact = np.concatenate([[2.0 * np.log(2.0) - 2.0], -2.0 / (n * (n + 1.0))])
         parity = np.where(z[ends, None] < 0, (-1.0) ** np.arange(degree + 1)[None, :], 1.0)
         m[ends] = exact[None, :] * parity
+    if by_rule is not None:
+        m[rule] = by_rule
     return m

@@ -26,10 +26,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.nystrom import NystromGrid
-from core.statements import ModalSystem, modal_system
+from core.statements import ModalSystem, UnresolvedOperator, modal_system
 from core.time_integration import ModalProblem, solve_degenerate, solve_general
 
 Function = Callable[[np.ndarray], np.ndarray]
+
+#: The modes are declined when the rounding of their decomposition, ``eps max|gamma|``
+#: (against ``c + gamma_k >= c``, c ~ 1 at loading), exceeds this share of tol: a coating
+#: that makes the equation first kind (m ~ 3e-15: gamma up to 7e12, rounding 1.6e-3)
+#: gives modes no time stepping can trust; m = 1e-4 gives 2.7e3 (rounding 6e-13).
+MODAL_ROUNDING_SHARE = 0.1
 
 
 @dataclass(frozen=True)
@@ -52,7 +58,9 @@ class ModalAnswer:
 class ModalForm:
     """One statement of the Nystrom equations in decoupled modal coordinates."""
 
-    def __init__(self, grid: NystromGrid, given: frozenset[str]) -> None:
+    def __init__(self, grid: NystromGrid, given: frozenset[str], tol: float = 1e-8) -> None:
+        """``tol``: the relative accuracy the modes serve (see MODAL_ROUNDING_SHARE);
+        raises :class:`core.statements.UnresolvedOperator` when they cannot."""
         w, m, x = grid.panels.weights, grid.m, grid.nodes
         s_in = np.sqrt(w / m)  # row scaling S^-1 W
         s_out = 1.0 / np.sqrt(w * m)  # column scaling S^-1
@@ -63,8 +71,14 @@ class ModalForm:
         galerkin = q.T @ ((s_in[:, None] * grid.operator * s_out[None, :]) @ q)
         self.ms: ModalSystem = modal_system(galerkin, moments, given, grid.size,
                                             symmetric=False)
-        self.to_nodes = s_out[:, None] * q
         ms = self.ms
+        rounding = np.finfo(float).eps * float(np.max(np.abs(ms.gamma), initial=0.0))
+        if rounding > MODAL_ROUNDING_SHARE * tol:
+            raise UnresolvedOperator(
+                f"operator: its modes reach {rounding / np.finfo(float).eps:.1e} (m down "
+                f"to {float(np.min(m)):.1e}, a nearly first-kind equation) and their "
+                f"rounding {rounding:.1e} exceeds 0.1 tol; the grid does not resolve the problem")
+        self.to_nodes = s_out[:, None] * q
         self.gap = ms.rotate(-(q.T @ (s_in * grid.g)))
         self.k = len(ms.known)
         self.constraint_inv = np.linalg.inv(ms.constraint) if self.k else np.zeros((0, 0))

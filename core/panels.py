@@ -191,6 +191,13 @@ def panel_legendre_coefficients(values: np.ndarray) -> np.ndarray:
     return np.einsum("kj,pj...->pk...", _TO_COEF, per_panel)
 
 
+def panel_index(panels: Panels, x: np.ndarray) -> np.ndarray:
+    """Index of the panel holding each point of ``x`` (len(x),); a point on a panel end
+    belongs to the panel on its right (the last end to the last panel)."""
+    x = np.asarray(x, dtype=float)
+    return np.clip(np.searchsorted(panels.edges, x, side="right") - 1, 0, panels.n_panels - 1)
+
+
 def interpolation_weights(panels: Panels, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Panel index (len(x),) and weights (len(x), 16) of the panel-wise interpolant at ``x``.
 
@@ -200,6 +207,6 @@ def interpolation_weights(panels: Panels, x: np.ndarray) -> tuple[np.ndarray, np
     off it.
     """
     x = np.asarray(x, dtype=float)
-    index = np.clip(np.searchsorted(panels.edges, x, side="right") - 1, 0, panels.n_panels - 1)
+    index = panel_index(panels, x)
     t = (x - panels.centers[index]) / panels.half_widths[index]
     return index, npleg.legvander(t, NODES_PER_PANEL - 1) @ _TO_COEF

@@ -41,7 +41,7 @@ from core.nystrom import BorderedSystem, touches
 from core.nystrom_adapt import adapt
 from core.nystrom_result import TimeSide, nystrom_solution
 from core.nystrom_time import ModalAnswer, ModalForm
-from core.panels import interpolation_weights
+from core.panels import panel_index
 from core.prepared_elastic import ElasticUnits, elastic_answer
 
 #: The time stepping aims this many times below its share of tol: its step-doubling
@@ -116,7 +116,7 @@ class PreparedContact:
         # is resolved to the refinement's tail bound, so it is interpolated (the formula at
         # all 405 points cost as much as the operator itself).
         singular = np.array([-1.0, 1.0, *geometry.breakpoints])
-        panel_of = interpolation_weights(self.grid.panels, self.check_x)[0]
+        panel_of = panel_index(self.grid.panels, self.check_x)
         self.check_formula = touches(self.grid.panels, singular)[panel_of]
         self.element_ends = tuple(sorted(set(self.grid.panels.edges[1:-1].tolist())
                                          | set(geometry.breakpoints)))
@@ -150,7 +150,7 @@ class PreparedContact:
         """Modal decomposition of a statement (for creep or a modulus varying in time)."""
         with self._lock:
             if given not in self._modal:
-                self._modal[given] = ModalForm(self.grid, given)
+                self._modal[given] = ModalForm(self.grid, given, self.geometry.tol)
                 self.counts["modal"] += 1
             return self._modal[given]
 

@@ -98,13 +98,23 @@ def _near_pairs(panels: Panels, targets: np.ndarray, sources: np.ndarray
                       <= NEAR_FIELD * panels.half_widths[None, sources])
 
 
+#: Absolute error of the log moments per unit of kernel accuracy: an error d in the
+#: moments moves an operator entry by at most h d max_j sum_n |_TO_COEF[n, j]| / pi
+#: (= 4.33 h d / pi), the kernel's accuracy e by e h W_j / pi >= 0.027 e h / pi; this keeps
+#: the first at a third of the second (0.017 / 3).
+_MOMENT_SHARE = 0.017 / 3
+
+
 def _log_weights(panels: Panels, targets: np.ndarray, near_t: np.ndarray,
-                 near_p: np.ndarray) -> np.ndarray:
-    """Product weights of ``ln|x - xi|`` (pairs x 16) for target/panel pairs, one batch."""
+                 near_p: np.ndarray, accuracy: float = FULL_ACCURACY) -> np.ndarray:
+    """Product weights of ``ln|x - xi|`` (pairs x 16) for target/panel pairs, one batch.
+
+    ``accuracy``: the kernel values' absolute accuracy (their moments follow it)."""
     if not near_t.size:
         return np.empty((0, NODES_PER_PANEL))
     c, h = panels.centers[near_p], panels.half_widths[near_p]
-    moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1)
+    moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1,
+                                   _MOMENT_SHARE * accuracy)
     return h[:, None] * (np.log(h)[:, None] * _W[None, :] + moments @ _TO_COEF)
 
 
@@ -129,7 +139,7 @@ def operator_rows(lam: float, panels: Panels, targets: np.ndarray,
     sources = (np.arange(panels.n_panels) if sources is None
                else np.asarray(sources, dtype=np.intp))
     near_t, near_s = _near_pairs(panels, targets, sources)
-    log_weights = _log_weights(panels, targets, near_t, sources[near_s])
+    log_weights = _log_weights(panels, targets, near_t, sources[near_s], accuracy)
     return _rows(lam, panels, targets, sources, near_t, near_s, log_weights, accuracy)
 
 
@@ -203,19 +213,41 @@ def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
     nodes = panels.nodes[cols_all]
     weights = panels.weights[cols_all] / np.pi
     rows = np.empty((targets.size, nodes.size))
-    step = max(1, _BLOCK_ENTRIES // max(nodes.size, 1))
-    for start in range(0, targets.size, step):
-        block = rows[start:start + step]
-        distance = np.abs(targets[start:start + step, None] - nodes[None, :])
-        distance *= lam
-        block[...] = kernel_block(distance, accuracy)
-        block *= weights[None, :]
+    if targets.size == nodes.size and np.array_equal(targets, nodes):
+        _far_symmetric(lam * nodes, weights, rows, accuracy)
+    else:
+        step = max(1, _BLOCK_ENTRIES // max(nodes.size, 1))
+        for start in range(0, targets.size, step):
+            block = rows[start:start + step]
+            distance = np.abs(targets[start:start + step, None] - nodes[None, :])
+            distance *= lam
+            block[...] = kernel_block(distance, accuracy)
+            block *= weights[None, :]
     if near_t.size:
         cols = near_s[:, None] * NODES_PER_PANEL + _J[None, :]  # positions among sources
         smooth = kernel_regular(lam * np.abs(targets[near_t, None] - nodes[cols]), accuracy)
         smooth -= np.log(lam)
         rows[near_t[:, None], cols] = smooth * weights[cols] - log_weights / np.pi
     return rows
+
+
+def _far_symmetric(scaled: np.ndarray, weights: np.ndarray, rows: np.ndarray,
+                   accuracy: float) -> None:
+    """Far-field rows ``k_pl(|s_i - s_j|) w_j`` of targets equal to the nodes, in place.
+
+    The kernel values are symmetric (``s_i - s_j`` and ``s_j - s_i`` round alike), so each
+    block of rows is evaluated from its diagonal on and mirrored below it: half the kernel
+    evaluations of the square operator.
+    """
+    n = scaled.size
+    step = max(NODES_PER_PANEL, _BLOCK_ENTRIES // max(n, 1))
+    for a in range(0, n, step):
+        b = min(a + step, n)
+        values = np.abs(scaled[a:b, None] - scaled[None, a:])
+        values = kernel_block(values, accuracy)  # K[a:b, a:]
+        rows[a:b, a:] = values * weights[None, a:]
+        if b < n:
+            rows[b:, a:b] = values[:, b - a:].T * weights[None, a:b]
 
 
 def shared_panels(old: Panels, new: Panels) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -263,6 +295,31 @@ def kernel_operator(lam: float, panels: Panels, previous: KernelOperator | None 
     matrix[np.ix_(kn, kn)] = previous.matrix[np.ix_(ko, ko)]
     if fresh.size:
         fn = panel_nodes(fresh)
-        matrix[fn, :] = node_rows(lam, panels, panels, fresh, accuracy=accuracy)
-        matrix[np.ix_(kn, fn)] = node_rows(lam, panels, panels, kept_new, fresh, accuracy)
+        fresh_rows = node_rows(lam, panels, panels, fresh, accuracy=accuracy)
+        matrix[fn, :] = fresh_rows
+        matrix[np.ix_(kn, fn)] = _kept_on_fresh(lam, panels, kept_new, fresh, fresh_rows,
+                                                accuracy)
     return KernelOperator(lam, panels, matrix)
+
+
+def _kept_on_fresh(lam: float, panels: Panels, kept: np.ndarray, fresh: np.ndarray,
+                   fresh_rows: np.ndarray, accuracy: float) -> np.ndarray:
+    """Rows of the kept panels' nodes on the fresh panels' columns (16 kept x 16 fresh).
+
+    Away from the fresh panels these are the fresh rows' far entries transposed (the
+    kernel is even), reweighted from the kept nodes' weights to the fresh ones'; only the
+    kept panels next to a fresh one, where either direction takes product integration,
+    are computed (the kernel evaluations of the refined grid's new columns are saved).
+    """
+    kn, fn = panel_nodes(kept), panel_nodes(fresh)
+    weights = panels.weights / np.pi
+    block = (fresh_rows[:, kn] / weights[None, kn]).T * weights[None, fn]
+    # Near in either direction: |c_P - c_Q| <= NEAR_FIELD h_Q + h_P or NEAR_FIELD h_P + h_Q.
+    gap = np.abs(panels.centers[kept][:, None] - panels.centers[fresh][None, :])
+    reach = (NEAR_FIELD + 1.0) * (panels.half_widths[kept][:, None]
+                                  + panels.half_widths[fresh][None, :])
+    close = np.nonzero(np.any(gap <= reach, axis=1))[0]
+    if close.size:
+        block[panel_nodes(close)] = node_rows(lam, panels, panels, kept[close], fresh,
+                                              accuracy)
+    return block
