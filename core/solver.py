@@ -125,9 +125,13 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     Returns a :class:`ContactSolution` (or, when the unilateral model answered, a
     :class:`core.contact.UnilateralSolution` with the same attributes); ``contact_set``
     and ``info["contact"]`` say which contact model answered. Raises ``ValueError``
-    naming the argument on bad input, and naming ``force`` or ``moment`` in every contact
-    mode when the loads leave no contact (P < 0, P = 0 throughout, |M/P| >= 1:
-    :func:`core.contact_model.refuse_loads_without_contact`).
+    naming the argument on bad input, and naming ``force`` or ``moment`` with ``contact``
+    ``"auto"`` or ``"unilateral"`` when the loads leave no contact (P < 0, P = 0
+    throughout, |M/P| >= 1: :func:`core.contact_model.refuse_loads_without_contact`).
+    ``contact="full"`` asks for the full-contact model itself, a linear equation that
+    holds for any loads (a bonded punch, the model problem of the seed): it answers them
+    with the ``contact_lost`` flag where q < 0, as it answers a given settlement that
+    lifts the punch.
     """
     from core.contact import solve_unilateral
     from core.contact_model import (
@@ -139,7 +143,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
 
     t_start = _time.perf_counter()
     contact = check_contact_model(contact)
-    refuse_loads_without_contact(times, kernel, force, moment)
+    if contact != "full":
+        refuse_loads_without_contact(times, kernel, force, moment)
     method_defaulted = method is None
     if method is None:
         method = "projection" if (n_modes is not None or basis != "graded") else "nystrom"

@@ -540,9 +540,9 @@ def test_contact_argument_and_refusals():
         solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.0, time_steps=0)
 
 
-@pytest.mark.parametrize("contact", ["full", "unilateral", "auto"])
-def test_loads_leaving_no_contact_are_refused_in_every_contact_mode(contact):
-    """A pulled punch or a resultant outside it has no answer in any contact model: the
+@pytest.mark.parametrize("contact", ["unilateral", "auto"])
+def test_loads_leaving_no_contact_are_refused_by_the_contact_models(contact):
+    """A pulled punch or a resultant outside it has no answer in a contact model: the
     dimensionless API refuses it naming the load, as the dimensional one does."""
     def solve(**loads):
         return solve_dimensionless(1.0, 0.05, 0.0, [1.0, 2.0], contact=contact, **loads)
@@ -566,9 +566,17 @@ def test_loads_leaving_no_contact_are_refused_in_every_contact_mode(contact):
                             force=lambda t: np.where(np.abs(t - 1.5) < 0.01, -1.0, 1.0),
                             moment=0.0)
     # a given settlement and tilt may leave the punch above the surface: not refused here
-    if contact != "full":
-        lifted = solve(settlement=-1.0, tilt=0.0)
-        assert lifted.contact_set == [[], []]
+    lifted = solve(settlement=-1.0, tilt=0.0)
+    assert lifted.contact_set == [[], []]
+
+
+def test_the_full_contact_model_answers_any_load_with_its_flag():
+    """contact="full" is the linear full-contact equation (the seed's model problem): a
+    pull or a resultant outside the punch is answered, flagged contact_lost."""
+    for loads in ({"force": -1.0, "moment": 0.0}, {"force": 1.0, "moment": 1.0}):
+        r = solve_dimensionless(1.0, 0.05, 0.0, [1.0, 2.0], contact="full", **loads)
+        assert r.info["contact"] == "full" and "contact_lost" in r.flags
+        assert np.isfinite(r.settlement).all() and np.isfinite(r.tilt).all()
 
 
 def test_full_contact_result_carries_the_whole_base():
