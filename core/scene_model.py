@@ -34,6 +34,10 @@ DENSE_SAMPLES = 4001
 # the samples of one geometry are ~4100 points, 33 kB.
 _SAMPLE_X = StageCache("sample_x", max_items=128, max_bytes=16 * 2**20)
 _GAP_MINIMUM = StageCache("gap_minimum", max_items=256, max_bytes=2**20)
+# Shared likewise: the extremes on the samples (a solve reports them) and the layers'
+# largest moduli (the stiff-coating flag), ~1 ms of each new scene of a known geometry.
+_SAMPLE_EXTREMES = StageCache("sample_extremes", max_items=256, max_bytes=2**20)
+_LAYER_MODULUS_MAX = StageCache("layer_modulus_max", max_items=256, max_bytes=2**20)
 
 
 @dataclass(frozen=True, eq=False)
@@ -210,7 +214,9 @@ class Scene:
         if hi > lo:
             # a smooth minimum can fall between samples: golden-section search on the
             # bracket; any value it finds is a true value of the function, so taking the
-            # smaller one is always safe (also next to a jump)
+            # smaller one is always safe (also next to a jump). (A zoom on uniform grids
+            # of the bracket is ~5x cheaper but walks into a formula's pole between the
+            # samples, which the solver then refuses by a less precise message.)
             best = min(best, golden_minimum(
                 lambda s: float(self.gap_variation(np.array([s]))[0]), float(lo), float(hi)))
         return best
@@ -223,7 +229,14 @@ class Scene:
     def sample_extremes(self) -> dict[str, float]:
         """On :attr:`sample_x`: the range of ``m*`` (-), the largest gap [m] and the largest
         coating thickness [m]; none depends on the loads, so a scene with other loads
-        (:func:`core.scene_validation.replace_loads`) keeps them."""
+        (:func:`core.scene_validation.replace_loads`) keeps them, and scenes of the same
+        geometry and base modulus share them."""
+        # m* = E0 / (2 (1 - nu^2) a) * compliance: the geometry, E0 and nu fix all four
+        key = fingerprint("sample_extremes", self._geometry_key, self.modulus_at_loading(),
+                          self.base_poisson)
+        return dict(_SAMPLE_EXTREMES.get_or_compute(key, self._sample_extremes)[0])
+
+    def _sample_extremes(self) -> dict[str, float]:
         x = self.sample_x
         problem = self.dimensionless
         with np.errstate(all="ignore"):  # as in the solve that reports them
@@ -232,6 +245,13 @@ class Scene:
             return {"m_star_min": float(np.min(m_star)), "m_star_max": float(np.max(m_star)),
                     "gap_max_m": float(np.max(self.gap(x))),
                     "coating_thickness_max_m": float(np.max(self.coating_thickness(x)))}
+
+    @cached_property
+    def layer_modulus_max(self) -> tuple[float, ...]:
+        """The largest modulus [Pa] of each coating layer on :attr:`sample_x` (shared by
+        scenes of the same geometry)."""
+        return _LAYER_MODULUS_MAX.get_or_compute(self._geometry_key, lambda: tuple(
+            float(np.max(_values(layer.modulus, self.sample_x))) for layer in self.coating))[0]
 
     @cached_property
     def dimensionless(self) -> DimensionlessProblem:
@@ -243,5 +263,10 @@ class Scene:
 
 
 def _values(profile: Profile, x: np.ndarray) -> np.ndarray:
-    """A profile's values at ``x`` as a float array of x's shape."""
-    return np.broadcast_to(np.asarray(profile(x), dtype=float), np.shape(x)).astype(float)
+    """A profile's values at ``x`` as a float array of x's shape (a new array)."""
+    out = profile(x)
+    if isinstance(out, np.ndarray) and out.dtype == np.float64 and out.shape == np.shape(x):
+        # a profile's own answer already has x's shape: skip the broadcast (a solve calls
+        # this ~30 times); the copy keeps callers free to write into the result
+        return out.copy()
+    return np.broadcast_to(np.asarray(out, dtype=float), np.shape(x)).astype(float)
