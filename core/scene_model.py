@@ -20,7 +20,7 @@ import numpy as np
 
 from core.cache import StageCache, fingerprint
 from core.coating_model import DEFAULT_INTERFACE, layer_compliance
-from core.golden_section import golden_minimum
+from core.golden_section import golden_minimum_batched
 from core.profiles import Profile, without_offset
 from core.statements import STATEMENTS
 
@@ -214,11 +214,9 @@ class Scene:
         if hi > lo:
             # a smooth minimum can fall between samples: golden-section search on the
             # bracket; any value it finds is a true value of the function, so taking the
-            # smaller one is always safe (also next to a jump). (A zoom on uniform grids
-            # of the bracket is ~5x cheaper but walks into a formula's pole between the
-            # samples, which the solver then refuses by a less precise message.)
-            best = min(best, golden_minimum(
-                lambda s: float(self.gap_variation(np.array([s]))[0]), float(lo), float(hi)))
+            # smaller one is always safe (also next to a jump). Batched: the same points
+            # in 14 calls instead of 62 (1.5-3 ms of a new geometry before).
+            best = min(best, golden_minimum_batched(self.gap_variation, float(lo), float(hi)))
         return best
 
     def gap(self, x: Any) -> np.ndarray:
