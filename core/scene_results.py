@@ -17,7 +17,7 @@ import numpy as np
 
 from core import limits
 from core.cache import StageCache, fingerprint
-from core.coating_model import NEGLIGIBLE_SHARE, model_error_estimate, tilt_share
+from core.coating_model import model_error_estimate, model_error_map, tilt_share
 from core.load_rates import oscillations
 from core.scene_model import Scene
 from core.scene_schema import SCHEMA_VERSION, _jsonable
@@ -74,24 +74,31 @@ def plotting_grid(half_width: float, count: int = PLOT_POINTS) -> np.ndarray:
     return x
 
 
-#: Model-error estimates shared by scenes of the same geometry and base: reading the
-#: measured map costs ~0.7 ms, more than a load change's solve.
-_MODEL_ERRORS = StageCache("scene_model_error", max_items=256, max_bytes=2**20)
+#: The model-error map read on a scene's stack, shared by scenes of the same geometry
+#: and base: reading it costs ~0.7 ms, more than a load change's solve.
+_MODEL_ERROR_MAPS = StageCache("scene_model_error_map", max_items=128, max_bytes=2**20)
 
 
 def _model_error(scene: Scene, share_of_tilt: float) -> dict[str, Any]:
-    """:func:`core.coating_model.model_error_estimate` of ``scene``, remembered.
+    """:func:`core.coating_model.model_error_estimate` of ``scene``, its map remembered.
 
-    The map is read on the geometry, the base modulus at loading and the base thickness;
-    the answer enters only through the weight of the moment part, which is 1 for every
-    share of tilt from :data:`core.coating_model.NEGLIGIBLE_SHARE` up.
+    The map is read on the geometry, the base modulus at loading and the base thickness
+    (:func:`core.coating_model.model_error_map`); the answer enters only through the
+    share of tilt, which weighs the moment part.
     """
-    weight = min(1.0, share_of_tilt / NEGLIGIBLE_SHARE)
-    key = fingerprint("model_error", scene._geometry_key, scene.modulus_at_loading(),
-                      scene.base_thickness, weight)
-    estimate, _ = _MODEL_ERRORS.get_or_compute(
-        key, lambda: model_error_estimate(scene, share_of_tilt))
-    return dict(estimate)
+    key = fingerprint("model_error_map", scene._geometry_key, scene.modulus_at_loading(),
+                      scene.base_thickness)
+    mapped, _ = _MODEL_ERROR_MAPS.get_or_compute(key, lambda: _read_only(model_error_map(scene)))
+    return model_error_estimate(scene, share_of_tilt, mapped)
+
+
+def _read_only(mapped: tuple[np.ndarray, dict[str, np.ndarray]]
+               ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The map's arrays, locked against writes (scenes share them)."""
+    x, parts = mapped
+    for values in (x, *parts.values()):
+        values.setflags(write=False)
+    return x, parts
 
 
 class SceneSolution:
