@@ -56,3 +56,17 @@ def test_a_load_change_gives_the_answer_of_a_fresh_scene(name):
     for field in ("settlement", "tilt", "force", "moment"):
         assert np.array_equal(getattr(shared, field), getattr(fresh, field))
     assert np.array_equal(shared.pressure_on_grid, fresh.pressure_on_grid)
+
+
+@pytest.mark.parametrize("name", ["rounded_graded", "patched_insert", "worn_coating"])
+def test_the_samples_are_the_union_of_every_profiles_samples(name):
+    """Constant profiles are sampled once: the samples are still the union of all."""
+    from core.scene_model import DENSE_SAMPLES
+
+    scene = scene_from_dict(_scene(name))
+    a = scene.half_width
+    profiles = [scene.shape] + [p for layer in scene.coating
+                                for p in (layer.thickness, layer.modulus, layer.poisson)]
+    union = np.unique(np.concatenate([np.linspace(-a, a, DENSE_SAMPLES)] + [
+        p.sample_points((-a, a)) for p in profiles]))
+    assert np.array_equal(scene.sample_x, union)
