@@ -153,7 +153,9 @@ def tilt_share(half_width: float, settlement: Any, tilt: Any) -> float:
     return r / max(d, r) if max(d, r) > 0 else 0.0
 
 
-def model_error_estimate(scene: Any, share_of_tilt: float = 1.0) -> dict[str, Any]:
+def model_error_estimate(scene: Any, share_of_tilt: float = 1.0,
+                         mapped: tuple[np.ndarray, dict[str, np.ndarray]] | None = None
+                         ) -> dict[str, Any]:
     """The coating model's error for a scene, from the measured map.
 
     Reads the map at :data:`ESTIMATE_POINTS` points of ``[-a, a]`` with the local stack:
@@ -166,8 +168,20 @@ def model_error_estimate(scene: Any, share_of_tilt: float = 1.0) -> dict[str, An
     signed, "where_m": x [m] of the largest}``. The moment part (the relative error of the
     moment, or of the tilt) counts fully once ``share_of_tilt`` (:func:`tilt_share` of the
     answer) reaches :data:`NEGLIGIBLE_SHARE`, and fades to nothing below: a centred load
-    has no moment to be wrong about.
+    has no moment to be wrong about. ``mapped``: :func:`model_error_map` of the scene if
+    known (it depends on the scene's geometry and base alone).
     """
+    x, parts = model_error_map(scene) if mapped is None else mapped
+    weight = min(1.0, share_of_tilt / NEGLIGIBLE_SHARE)
+    worst = np.maximum(parts["force_size"], weight * parts["moment_size"])
+    i = int(np.argmax(worst))
+    return {"estimate": float(worst[i]), "force": float(parts["force"][i]),
+            "moment": float(parts["moment"][i]), "where_m": float(x[i])}
+
+
+def model_error_map(scene: Any) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The points x [m] where :func:`model_error_estimate` reads the map, and the map's
+    signed and sized errors there (:func:`mapped_error`)."""
     a = scene.half_width
     x = np.linspace(-a, a, ESTIMATE_POINTS)
     total = np.zeros(x.shape)
@@ -182,13 +196,8 @@ def model_error_estimate(scene: Any, share_of_tilt: float = 1.0) -> dict[str, An
         if getattr(layer, "interface", "smooth") == "bonded":
             interface = "bonded"
     e0 = scene.modulus_at_loading()
-    parts = mapped_error(total / (2 * a), total / softness / e0, poisson / total, interface,
-                         scene.base_thickness / a)
-    weight = min(1.0, share_of_tilt / NEGLIGIBLE_SHARE)
-    worst = np.maximum(parts["force_size"], weight * parts["moment_size"])
-    i = int(np.argmax(worst))
-    return {"estimate": float(worst[i]), "force": float(parts["force"][i]),
-            "moment": float(parts["moment"][i]), "where_m": float(x[i])}
+    return x, mapped_error(total / (2 * a), total / softness / e0, poisson / total,
+                           interface, scene.base_thickness / a)
 
 
 def _values(profile: Any, x: np.ndarray) -> np.ndarray:

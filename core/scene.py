@@ -79,16 +79,17 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
     from core.layered_scene import solve_scene_layered  # uniform coating, elastic base
     from core.load_contact import check_loads_touch
 
+    # CPU time of this thread [s] from the dict to the answer, validation included: what
+    # the scene costs, whatever else the machine runs (info["seconds"] is the solver's
+    # wall time)
+    started = time.thread_time()
     scene = scene_from_dict(scene)
     # a load no contact can carry is refused in every contact mode, in the scene's units
     check_loads_touch(scene)
-    started = time.thread_time()
     problem = scene.dimensionless
     with np.errstate(all="ignore"):
         answer = solve_scene_layered(scene, problem)
         result = SceneSolution(scene, problem, problem.solve() if answer is None else answer)
-    # CPU time of this thread [s]: what the scene costs, whatever else the machine runs
-    # (info["seconds"] is the solver's wall time)
     result.info["cpu_seconds"] = time.thread_time() - started
     _check_finite(result)
     return result

@@ -16,9 +16,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core import limits
-from core.coating_model import model_error_estimate, tilt_share
+from core.cache import StageCache, fingerprint
+from core.coating_model import model_error_estimate, model_error_map, tilt_share
 from core.load_rates import oscillations
-from core.scene_model import Scene, _values
+from core.scene_model import Scene
 from core.scene_schema import SCHEMA_VERSION, _jsonable
 from core.statements import QUANTITIES
 
@@ -73,6 +74,33 @@ def plotting_grid(half_width: float, count: int = PLOT_POINTS) -> np.ndarray:
     return x
 
 
+#: The model-error map read on a scene's stack, shared by scenes of the same geometry
+#: and base: reading it costs ~0.7 ms, more than a load change's solve.
+_MODEL_ERROR_MAPS = StageCache("scene_model_error_map", max_items=128, max_bytes=2**20)
+
+
+def _model_error(scene: Scene, share_of_tilt: float) -> dict[str, Any]:
+    """:func:`core.coating_model.model_error_estimate` of ``scene``, its map remembered.
+
+    The map is read on the geometry, the base modulus at loading and the base thickness
+    (:func:`core.coating_model.model_error_map`); the answer enters only through the
+    share of tilt, which weighs the moment part.
+    """
+    key = fingerprint("model_error_map", scene._geometry_key, scene.modulus_at_loading(),
+                      scene.base_thickness)
+    mapped, _ = _MODEL_ERROR_MAPS.get_or_compute(key, lambda: _read_only(model_error_map(scene)))
+    return model_error_estimate(scene, share_of_tilt, mapped)
+
+
+def _read_only(mapped: tuple[np.ndarray, dict[str, np.ndarray]]
+               ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The map's arrays, locked against writes (scenes share them)."""
+    x, parts = mapped
+    for values in (x, *parts.values()):
+        values.setflags(write=False)
+    return x, parts
+
+
 class SceneSolution:
     """The answer for a scene in SI units (see :func:`solve`).
 
@@ -103,7 +131,7 @@ class SceneSolution:
                             for zones in getattr(solution, "contact_set", [])]
         # the exact layered kernel (core.layered_scene) carries its own estimate
         layered = solution.info.get("layered_model_error")
-        self.model_error = dict(layered) if layered else model_error_estimate(
+        self.model_error = dict(layered) if layered else _model_error(
             scene, tilt_share(a, self.settlement, self.tilt))
         self.flags = self._flags(solution)
         self.flag_messages = {
@@ -119,15 +147,15 @@ class SceneSolution:
     def _flags(self, solution: ContactSolution) -> list[str]:
         scene = self.scene
         flags = [str(f) for f in solution.info.get("flags", [])]
-        x = scene.sample_x
         thin = solution.info.get("coating_model") != "exact layered"
-        if thin and np.max(scene.coating_thickness(x)) / (2 * scene.half_width) \
+        # the extremes on the scene's samples, shared by scenes of the same geometry
+        if thin and scene.sample_extremes["coating_thickness_max_m"] / (2 * scene.half_width) \
                 > THICK_COATING_RATIO:
             flags.append("thick_coating")
         if self.model_error["estimate"] > scene.model_tol:
             flags.append("model_error")
         e0 = self.problem.modulus_at_loading
-        if thin and any(np.max(_values(layer.modulus, x)) > e0 for layer in scene.coating):
+        if thin and any(largest > e0 for largest in scene.layer_modulus_max):
             flags.append("stiff_coating")
         # between the output times too (the default engine samples the load histories)
         largest_tilt = max(float(np.max(np.abs(self.tilt))) if self.tilt.size else 0.0,

@@ -17,6 +17,7 @@ import numpy as np
 
 from core import limits
 from core import scene_schema as schema
+from core.cache import StageCache, fingerprint
 from core.coating_model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
 from core.creep import Elastic, UserKernel, creep_model_from_spec
 from core.load_rates import check_step_limit
@@ -223,6 +224,22 @@ def _check_solvable(scene: Scene) -> None:
     """
     with np.errstate(all="ignore"):
         problem = scene.dimensionless
+        # m* and g on the samples depend on the geometry, E0 and nu alone: a geometry
+        # that passed is not sampled again (a load change)
+        key = fingerprint("solvable", scene._geometry_key, problem.modulus_at_loading,
+                          problem.plane_factor)
+        _SOLVABLE_GEOMETRIES.get_or_compute(key, lambda: _check_coefficients(scene, problem))
+        _check_creep(scene, problem)
+        _check_loads_scalable(scene, problem)
+
+
+#: Geometries (with E0 and nu) whose m* and g passed :func:`_check_coefficients`.
+_SOLVABLE_GEOMETRIES = StageCache("solvable_geometries", max_items=1024, max_bytes=2**20)
+
+
+def _check_coefficients(scene: Scene, problem: DimensionlessProblem) -> bool:
+    """Refuse ``m*`` or ``g`` out of range on the scene's samples; True if they pass."""
+    with np.errstate(all="ignore"):
         a = scene.half_width
         x = scene.sample_x
         xs = x / a
@@ -246,8 +263,7 @@ def _check_solvable(scene: Scene) -> None:
                         f"{schema.MAX_GAP_RATIO:g}): far beyond the shallow contact of this model")
 
             refuse_first(~np.isfinite(g) | (np.abs(g) > schema.MAX_GAP_RATIO), gap_message)
-        _check_creep(scene, problem)
-        _check_loads_scalable(scene, problem)
+    return True
 
 
 def _check_loads_scalable(scene: Scene, problem: DimensionlessProblem) -> None:

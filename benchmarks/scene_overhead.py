@@ -1,0 +1,85 @@
+"""What a dimensional scene solve costs around the solver, preset by preset.
+
+    OPENBLAS_NUM_THREADS=1 python -m benchmarks.scene_overhead [PRESET ...]
+
+For each shipped preset (default: four of them), ``core.solve`` on scene dicts (validation
+included, as the explorer, the CLI and studies call it), eight solves each:
+
+* *new geometry*: the punch half-width 0.01 % wider at each solve (every geometry cache
+  misses: the samples, the gap minimum, the model-error map, the engine's prepared grid);
+* *loads only*: the first given load 0.1 % larger at each solve;
+
+and prints the median CPU time of this process per solve [ms], the median
+``info["cpu_seconds"]`` (the solve's thread CPU time, validation included: what the
+explorer compares with its live-drag bound) and ``info["seconds"]`` (the engine's wall
+time), with the machine's load average: on a shared machine both CPU and wall times grow
+with the load.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+from core.scene import solve
+from explorer.presets import SCENES_DIR
+
+#: The presets measured by default: a creep scene, two thin-coating scenes (smooth and
+#: stepped) and the exact layered one.
+PRESETS = ("uniform_flat", "worn_coating", "patched_insert", "rounded_graded")
+#: Solves per preset and kind (medians are reported).
+SOLVES = 8
+
+
+def _variants(scene: dict, kind: str) -> list[dict]:
+    out = []
+    for i in range(1, SOLVES + 1):
+        new = copy.deepcopy(scene)
+        if kind == "new geometry":
+            new["punch"]["half_width"] = scene["punch"]["half_width"] * (1 + 1e-4 * i)
+        else:
+            quantity = next(iter(new["loading"]))
+            value = new["loading"][quantity]
+            # a zero load (a centred force's moment) gets a tiny one instead
+            new["loading"][quantity] = value * (1 + 1e-3 * i) if value else 1e-9 * i
+        out.append(new)
+    return out
+
+
+def measure(name: str) -> list[tuple[str, float, float, float]]:
+    """``(kind, CPU ms, info cpu_seconds ms, info seconds ms)`` medians for one preset."""
+    scene = json.loads((SCENES_DIR / f"{name}.json").read_text())
+    solve(scene)  # imports and the first build: not measured
+    rows = []
+    for kind in ("new geometry", "loads only"):
+        cpu, cpu_info, wall_info = [], [], []
+        for variant in _variants(scene, kind):
+            started = time.process_time()
+            result = solve(variant)
+            cpu.append(time.process_time() - started)
+            cpu_info.append(result.info["cpu_seconds"])
+            wall_info.append(result.info["seconds"])
+        rows.append((kind, 1e3 * float(np.median(cpu)), 1e3 * float(np.median(cpu_info)),
+                     1e3 * float(np.median(wall_info))))
+    return rows
+
+
+def main(argv: list[str]) -> None:
+    names = argv or list(PRESETS)
+    print(f"load average before: {os.getloadavg()[0]:.2f}")
+    print("| preset | change | CPU per solve [ms] | info cpu_seconds [ms] | "
+          "info seconds [ms] |")
+    print("| --- | --- | --- | --- | --- |")
+    for name in names:
+        for kind, cpu, cpu_info, wall_info in measure(name):
+            print(f"| {name} | {kind} | {cpu:.2f} | {cpu_info:.2f} | {wall_info:.2f} |")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

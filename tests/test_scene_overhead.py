@@ -1,0 +1,72 @@
+"""What a scene solve shares between scenes of the same geometry, and the batched
+golden-section search of the gap minimum (same points as the one-at-a-time search)."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import numpy as np
+import pytest
+
+from core.golden_section import golden_minimum, golden_minimum_batched
+from core.scene import scene_from_dict, solve
+from explorer.presets import SCENES_DIR
+
+
+@pytest.mark.parametrize("depth", [1, 3, 5, 8])
+def test_batched_golden_search_meets_the_same_points(depth):
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        a, b, c = rng.normal(size=3)
+
+        def fn(x, a=a, b=b, c=c):
+            # smooth, several minima, and a jump: every branch of the search is taken
+            return a * np.sin(3 * x + b) + c * x * x + (x > 0.1) * b
+
+        lo, hi = sorted(rng.normal(size=2))
+        one_at_a_time = golden_minimum(lambda s, fn=fn: float(fn(np.array([s]))[0]), lo, hi)
+        # exactly equal: the same points, evaluated elementwise
+        assert golden_minimum_batched(fn, lo, hi, depth=depth) == one_at_a_time
+
+
+def _scene(name: str) -> dict:
+    return json.loads((SCENES_DIR / f"{name}.json").read_text())
+
+
+@pytest.mark.parametrize("name", ["worn_coating", "patched_insert", "uniform_flat"])
+def test_a_load_change_gives_the_answer_of_a_fresh_scene(name):
+    """Results of a scene whose geometry was solved before (shared samples, extremes,
+    model error) equal those computed with nothing shared."""
+    from core.cache import clear_caches
+
+    d = _scene(name)
+    solve(d)
+    other = copy.deepcopy(d)
+    quantity = next(iter(other["loading"]))
+    value = other["loading"][quantity]
+    other["loading"][quantity] = 1.1 * value if value else 1e-9
+    shared = solve(other)
+    clear_caches()
+    fresh = solve(scene_from_dict(other))
+    for key in ("flags", "model_error_estimate", "model_error", "coating_model"):
+        assert shared.info[key] == fresh.info[key]
+    assert shared.info["dimensional"] == fresh.info["dimensional"]
+    # identical inputs to the same engine: identical answers (nothing is tolerated)
+    for field in ("settlement", "tilt", "force", "moment"):
+        assert np.array_equal(getattr(shared, field), getattr(fresh, field))
+    assert np.array_equal(shared.pressure_on_grid, fresh.pressure_on_grid)
+
+
+@pytest.mark.parametrize("name", ["rounded_graded", "patched_insert", "worn_coating"])
+def test_the_samples_are_the_union_of_every_profiles_samples(name):
+    """Constant profiles are sampled once: the samples are still the union of all."""
+    from core.scene_model import DENSE_SAMPLES
+
+    scene = scene_from_dict(_scene(name))
+    a = scene.half_width
+    profiles = [scene.shape] + [p for layer in scene.coating
+                                for p in (layer.thickness, layer.modulus, layer.poisson)]
+    union = np.unique(np.concatenate([np.linspace(-a, a, DENSE_SAMPLES)] + [
+        p.sample_points((-a, a)) for p in profiles]))
+    assert np.array_equal(scene.sample_x, union)
