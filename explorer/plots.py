@@ -29,7 +29,7 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from .bokeh_data import f32, set_data
+from .bokeh_data import MOVING, f32, set_data
 from .classical import bearing_rule_pressure, half_space_pressure
 from .contact_plots import ContactDrawing, FeatureInset
 from .pin_plots import PinLines
@@ -126,10 +126,10 @@ class Figures:
             ("layer", "@layer"), ("thickness", "@h_mm{0.00} mm"), ("E", "@E{0.0} MPa")]))
         self.arrow = Arrow(end=NormalHead(size=12, fill_color="#d62728", line_color="#d62728"),
                            x_start=0, y_start=1, x_end=0, y_end=0.5, line_width=3,
-                           line_color="#d62728", visible=False)
+                           line_color="#d62728", visible=False, level=MOVING)
         p.add_layout(self.arrow)
         self.arrow_label = Label(x=0, y=0, text="", text_font_size="11px",
-                                 text_color="#d62728", x_offset=6)
+                                 text_color="#d62728", x_offset=6, level=MOVING)
         p.add_layout(self.arrow_label)
         self.base_label = Label(x=0, y=0, text="", text_font_size="11px", text_color="#333",
                                 x_offset=4, y_offset=4)
@@ -201,7 +201,7 @@ class Figures:
         self.image_bar = ColorBar(color_mapper=self.image_mapper, title="q [kPa]", width=8)
         p.add_layout(self.image_bar, "right")
         self.image_cursor = Span(location=0, dimension="width", line_color="white",
-                                 line_width=2, line_dash="dashed")
+                                 line_width=2, line_dash="dashed", level=MOVING)
         p.add_layout(self.image_cursor)
         self.image_fig = p
 
@@ -225,10 +225,11 @@ class Figures:
             src = ColumnDataSource({"t": [0.0], "v": [0.0]}, name=f"{q}_source")
             point = ColumnDataSource(_empty("t", "v"), name=f"{q}_point_source")
             line = p.line(x="t", y="v", source=src, line_color=UNKNOWN_COLOR, line_width=2.5)
-            p.scatter(x="t", y="v", source=point, size=8, color="#d62728")
+            p.scatter(x="t", y="v", source=point, size=8, color="#d62728", level=MOVING)
             p.add_tools(HoverTool(renderers=[line], mode="vline", tooltips=[
                 ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
-            cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted")
+            cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted",
+                          level=MOVING)
             p.add_layout(cursor)
             self.history_src[q] = src
             self.history_point_src[q] = point
