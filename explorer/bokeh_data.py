@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from bokeh.models import ColumnDataSource
 
@@ -38,4 +40,49 @@ def set_data(source: ColumnDataSource, data: dict) -> bool:
     if old.keys() == data.keys() and all(_same(old[k], v) for k, v in data.items()):
         return False
     source.data = data
+    return True
+
+
+#: A value axis keeps its range while the data lie inside it and fill at least this
+#: share of it: a load step of a few percent then changes the curve, not the axis (an
+#: axis whose ticks change makes the page lay the figure out again, and an automatic
+#: range refitted in the page was painted twice and sent back to the server).
+KEEP_SHARE = 0.5
+#: Room left on each side of the data when a range is set anew [share of the data span].
+MARGIN_SHARE = 0.1
+#: Data of (nearly) one value are drawn over at least this share of their size (a
+#: constant force of 500 kN/m over 450-550), or over -1 to 1 when that value is zero.
+FLAT_SHARE = 0.2
+
+
+def data_bounds(*arrays: object) -> tuple[float, float] | None:
+    """Smallest and largest finite value of ``arrays`` (None when there is none)."""
+    parts = [np.asarray(a, dtype=float).ravel() for a in arrays]
+    values = np.concatenate(parts) if parts else np.zeros(0)
+    values = values[np.isfinite(values)]
+    if not values.size:
+        return None
+    return float(values.min()), float(values.max())
+
+
+def steady_range(rng: Any, *arrays: object) -> bool:
+    """Fit the value range ``rng`` (a Bokeh ``Range1d``) to ``arrays`` unless it fits
+    them already (see :data:`KEEP_SHARE`); True if it was set. The reset tool returns
+    to the range set last."""
+    bounds = data_bounds(*arrays)
+    if bounds is None:
+        return False
+    lo, hi = bounds
+    size = max(abs(lo), abs(hi))
+    flat = FLAT_SHARE * size if size > 0 else 2.0
+    if hi - lo < flat:
+        mid = 0.5 * (lo + hi)
+        lo, hi = mid - 0.5 * flat, mid + 0.5 * flat
+    start, end = rng.start, rng.end
+    if (start is not None and end is not None and end > start and start <= lo
+            and hi <= end and hi - lo >= KEEP_SHARE * (end - start)):
+        return False
+    pad = MARGIN_SHARE * (hi - lo)
+    start, end = lo - pad, hi + pad
+    rng.update(start=start, end=end, reset_start=start, reset_end=end)
     return True

@@ -29,7 +29,7 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from .bokeh_data import MOVING, f32, set_data
+from .bokeh_data import MOVING, f32, set_data, steady_range
 from .classical import bearing_rule_pressure, half_space_pressure
 from .contact_plots import ContactDrawing, FeatureInset
 from .pin_plots import PinLines
@@ -146,9 +146,10 @@ class Figures:
         self.scene_fig = p
 
     def _build_pressure(self) -> None:
+        # the value axes are set here, not fitted in the page (see steady_range)
         p = figure(height=280, sizing_mode="stretch_width", tools=_TOOLS,
                    title="Contact pressure q(x)", toolbar_location="above",
-                   name="pressure_figure")
+                   name="pressure_figure", y_range=Range1d(0, 1))
         p.toolbar.autohide = True
         p.xaxis.axis_label = "x [m]"
         p.yaxis.axis_label = "q [kPa]"
@@ -217,7 +218,8 @@ class Figures:
             kwargs = {"x_range": shared_x} if shared_x is not None else {}
             p = figure(height=210, sizing_mode="stretch_width", tools=_TOOLS,
                        toolbar_location="above", name=f"{q}_figure",
-                       title=f"{TITLES[q]} {SYMBOLS[q]} [{unit}]", **kwargs)
+                       title=f"{TITLES[q]} {SYMBOLS[q]} [{unit}]", y_range=Range1d(-1, 1),
+                       **kwargs)
             shared_x = p.x_range
             p.toolbar.autohide = True
             p.xaxis.axis_label = "t [days after loading]"
@@ -258,10 +260,29 @@ class Figures:
             self.history_fig[q].title.text = f"{TITLES[q]} {SYMBOLS[q]} [{unit}]: {state}"
         self.pins.show(view, pins, index)
         self.show_time(view, index, pins, pinned_drawn=True)
+        self.fit_axes(view, pins)
 
     def show_pinned(self, view: ResultView, pins: Sequence[Pin], index: int) -> None:
         """Overlay (or clear) the pinned results on the histories and the pressure."""
         self.pins.show(view, pins, index)
+        self.fit_axes(view, pins)
+
+    def fit_axes(self, view: ResultView, pins: Sequence[Pin] = ()) -> None:
+        """Value axes of q(x) and the histories that hold the result at every output
+        time and the pins (kept while they fit, see :func:`steady_range`): playing the
+        times or stepping the load moves the curves, not the axes."""
+        self._pins = tuple(pins)
+        for q in QUANTITIES:
+            steady_range(self.history_fig[q].y_range, view.display(q),
+                         *(pin.view.display(q) for pin in pins))
+        self._fit_pressure(view)
+
+    def _fit_pressure(self, view: ResultView) -> None:
+        size = self.scales.pressure_unit(view)[1]
+        shown = [view.pressure / size, *(pin.view.pressure / size for pin in self._pins)]
+        if self.classical:
+            shown += [self.classic_src.data[k] for k in ("half_space", "bearing_rule")]
+        steady_range(self.q_fig.y_range, *shown)
 
     def show_time(self, view: ResultView, index: int, pins: Sequence[Pin] = (),
                   pinned_drawn: bool = False) -> None:
@@ -313,6 +334,7 @@ class Figures:
         set_data(self.classic_src, {
             "x": f32(x), "half_space": f32(half_space_pressure(x, force, moment, a) / size),
             "bearing_rule": f32(bearing_rule_pressure(x, force, moment, a) / size)})
+        self._fit_pressure(view)
 
     classical = False
 
@@ -433,3 +455,4 @@ class Figures:
 
     _punch_top = 0.0
     _scene_key: str | None = None
+    _pins: tuple[Pin, ...] = ()
