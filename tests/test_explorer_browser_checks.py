@@ -112,7 +112,7 @@ def test_a_flag_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: P
     meta, names, table = parse_csv(Path(info.value.path()).read_text())
     assert "WARNING" in meta and "flag model_error" in meta
     assert names == ["time_day", "settlement_mm", "tilt_mrad", "force_kN_per_m",
-                     "moment_kN_m_per_m"]
+                     "moment_kN_m_per_m", "contact_width_m", "lifted_length_m"]
     assert table[0, 3] == 500  # kN/m: exactly the preset's 5e5 N/m, no round-off tail
     text = Path(info.value.path()).read_text()
     assert "9999999" not in text and "0000001" not in text
