@@ -86,3 +86,29 @@ def steady_range(rng: Any, *arrays: object) -> bool:
     start, end = lo - pad, hi + pad
     rng.update(start=start, end=end, reset_start=start, reset_end=end)
     return True
+
+
+def legend_above(fig: Any, font_size: str | None = None) -> Any:
+    """Move the legend of ``fig`` above its plot, in a compact horizontal row; returns it."""
+    legend = fig.legend[0]
+    legend.orientation = "horizontal"
+    legend.margin = 0
+    legend.padding = 2
+    if font_size is not None:
+        legend.label_text_font_size = font_size
+    fig.add_layout(legend, "above")
+    return legend
+
+
+#: Entries of a legend above a plot laid out in one row up to this many, else in two
+#: columns: at 1024 px the q(x) plot is ~320 px wide and four entries in one row
+#: reached ~250 px past its left edge, over the sidebar.
+ONE_ROW_ENTRIES = 2
+
+
+def wrap_legend(legend: Any) -> None:
+    """One row of the entries shown when few, else two columns (see ONE_ROW_ENTRIES)."""
+    shown = sum(1 for item in legend.items if item.visible)
+    columns = "auto" if shown <= ONE_ROW_ENTRIES else 2
+    if legend.ncols != columns:
+        legend.ncols = columns

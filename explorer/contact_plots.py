@@ -12,7 +12,7 @@ from bokeh.core.properties import value as fixed_label
 from bokeh.models import ColumnDataSource, HoverTool, Label, Range1d, Span
 from bokeh.plotting import figure
 
-from .bokeh_data import MOVING, f32, set_data
+from .bokeh_data import MOVING, f32, legend_above, set_data
 from .contact_zone import contact_widths, contact_zones, lifts_off
 from .results import Geometry, ResultView
 
@@ -91,12 +91,7 @@ class ContactDrawing:
         self.width_cursor = Span(location=0, dimension="height", line_color="#999",
                                  line_dash="dotted", level=MOVING)
         p.add_layout(self.width_cursor)
-        legend = p.legend[0]
-        legend.orientation = "horizontal"
-        legend.label_text_font_size = "11px"
-        legend.margin = 0
-        legend.padding = 2
-        p.add_layout(legend, "above")
+        legend_above(p, "11px")
         self.width_fig = p
         self._widths = np.zeros(1)
 

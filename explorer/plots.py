@@ -29,9 +29,10 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from .bokeh_data import MOVING, f32, set_data, steady_range
+from .bokeh_data import MOVING, f32, legend_above, set_data, steady_range, wrap_legend
 from .classical import bearing_rule_pressure, half_space_pressure
 from .contact_plots import ContactDrawing, FeatureInset
+from .contact_zone import lifts_off
 from .pin_plots import PinLines
 from .pins import Pin
 from .results import ResultView
@@ -51,6 +52,9 @@ GIVEN_COLOR = "#8c8c8c"
 _SLABS = 120
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
+
+#: Font size of the entries of the legends above the plots (normal mode).
+LEGEND_FONT = "11px"
 
 #: Font size of ticks, axis labels and titles in presentation mode (a projector).
 PRESENTATION_FONT = "18px"
@@ -165,22 +169,23 @@ class Figures:
         self.classic_lines = [
             p.line(x="x", y="half_space", source=self.classic_src, line_color="#7f7f7f",
                    line_dash="dotdash", line_width=1.5, visible=False,
-                   legend_label="rigid punch, elastic half-space"),
+                   legend_label="elastic half-space"),
             p.line(x="x", y="bearing_rule", source=self.classic_src, line_color="#2ca02c",
                    line_dash="dotted", line_width=2, visible=False,
-                   legend_label="Winkler / trapezoid rule")]
+                   legend_label="Winkler / trapezoid")]
         line = p.line(x="x", y="q", source=self.q_src, line_color=UNKNOWN_COLOR, line_width=2.5,
                       legend_label="current")
         self.q_hover = HoverTool(renderers=[line], tooltips=[("x", "@x{0.000} m"),
                                                              ("q", "@q{0.000} kPa")],
                                  mode="vline", name="q_hover")
         p.add_tools(self.q_hover)
-        legend = p.legend[0]
-        legend.orientation = "horizontal"
+        # small entries, and only those of lines shown, in two columns when more than two
+        # (see wrap_legend): at 1024 px the plot is ~320 px wide
+        legend = legend_above(p, LEGEND_FONT)
         legend.click_policy = "hide"
-        legend.margin = 0
-        legend.padding = 2
-        p.add_layout(legend, "above")
+        for item in legend.items:
+            if any(r in self.classic_lines for r in item.renderers):
+                item.visible = False
         self.q_fig = p
 
     def _build_image(self) -> None:
@@ -251,6 +256,7 @@ class Figures:
         self.contact.show(view)
         self.scene_fig.title.text = f"Scene: {short(view.scene.get('name', ''))}"
         self._show_image(view)
+        self._label_strips(view)
         for q in QUANTITIES:
             given = q in view.given
             set_data(self.history_src[q], {"t": f32(view.times), "v": f32(view.display(q))})
@@ -295,7 +301,6 @@ class Figures:
         set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
                                 "right": [hi for _, hi in intervals]})
         self.q_fig.title.text = f"Pressure q(x), t = {t:.4g} days"
-        self._label_strips(view)
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
         if not pinned_drawn:
@@ -311,15 +316,25 @@ class Figures:
 
     def _label_strips(self, view: ResultView) -> None:
         label = LIFTED_LABEL if view.info.get("contact") == "unilateral" else LOST_LABEL
+        # listed only for a result with shaded strips at some time
+        shaded = lifts_off(view)
         for item in self.q_fig.legend[0].items:
-            if self.neg_strip in item.renderers and item.label != fixed_label(label):
-                item.label = fixed_label(label)
+            if self.neg_strip in item.renderers:
+                if item.label != fixed_label(label):
+                    item.label = fixed_label(label)
+                if item.visible != shaded:
+                    item.visible = shaded
+        wrap_legend(self.q_fig.legend[0])
 
     def set_classical(self, view: ResultView | None, index: int, shown: bool) -> None:
         """Show or hide the classical answers on the pressure plot."""
         self.classical = shown
         for line in self.classic_lines:
             line.visible = shown
+        for item in self.q_fig.legend[0].items:
+            if any(r in self.classic_lines for r in item.renderers):
+                item.visible = shown
+        wrap_legend(self.q_fig.legend[0])
         if view is not None:
             self._show_classical(view, index)
 
@@ -355,7 +370,7 @@ class Figures:
                 axis.axis_label_text_font_size = label
             fig.toolbar_location = None if on else "above"
         legend = self.q_fig.legend[0]
-        legend.label_text_font_size = "11px" if on else "13px"
+        legend.label_text_font_size = "11px" if on else LEGEND_FONT
         legend.glyph_width = 14 if on else 20
         for q in QUANTITIES:
             self.history_fig[q].height = 170 if on else 210

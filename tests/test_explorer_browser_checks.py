@@ -290,6 +290,47 @@ def test_classical_solutions_undo_and_reset(page: Page):
     assert page.errors == []
 
 
+# The legend above q(x) in its figure's own coordinates [px] (left, right, figure width,
+# number of entries shown), or null before the figure and its legend are drawn.
+JS_Q_LEGEND = """() => {
+  const doc = Bokeh.documents[0];
+  const fig = doc.get_model_by_name('pressure_figure');
+  const view = doc.views_manager.find_one(fig);
+  if (!view) return null;
+  for (const [model, rv] of view.renderer_views) {
+    if (model.type === 'Legend' && rv.bbox && rv.bbox.width > 0)
+      return {left: rv.bbox.left, right: rv.bbox.right, width: view.bbox.width,
+              shown: model.items.filter(i => i.visible).length};
+  }
+  return null;
+}"""
+
+
+def test_the_pressure_legend_stays_inside_its_plot_at_1024px(page: Page):
+    """At 1024 px the q(x) legend reached ~250 px past the plot's left edge, over the
+    sidebar; now only the entries of lines shown are listed, in columns when many."""
+    page.page.set_viewport_size({"width": 1024, "height": 768})
+    _wait(page, "() => window.innerWidth === 1024")
+    _wait(page, f"() => {{ const b = ({JS_Q_LEGEND})(); return b && b.width < 400; }}")
+    # with the classical answers: four entries
+    page.page.locator(".classical-toggle input").first.check()
+    _wait(page, f"() => {{ const b = ({JS_Q_LEGEND})(); return b && b.shown >= 3; }}")
+    # two animation frames after the change, the legend is laid out
+    box = page.page.evaluate(f"""() => new Promise(r => requestAnimationFrame(
+        () => requestAnimationFrame(() => r(({JS_Q_LEGEND})()))))""")
+    assert box["left"] >= 0 and box["right"] <= box["width"], box
+    # and with two pins
+    page.page.get_by_text("Pin this result").first.click()
+    page.type_into(".load-0-value", "650")
+    until(lambda: page.text(".readout-force") == "650", "force 650")
+    page.page.get_by_text("Pin this result").first.click()
+    _wait(page, f"() => {{ const b = ({JS_Q_LEGEND})(); return b && b.shown >= 5; }}")
+    box = page.page.evaluate(f"""() => new Promise(r => requestAnimationFrame(
+        () => requestAnimationFrame(() => r(({JS_Q_LEGEND})()))))""")
+    assert box["left"] >= 0 and box["right"] <= box["width"], box
+    assert page.errors == []
+
+
 def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
                                                    browser_context: object):
     """Feature 4: a copied link reopens the same view, pin included."""
