@@ -16,7 +16,10 @@ explorer's result cache; the core's stage caches work as they do for a user.
 Next to each wall-clock median it reports the page's own work per move: the CPU time of
 the browser's main thread (Chrome's ``ThreadTime`` metric) from the key press to the
 frame that shows the result. On a loaded machine the wall clock waits for other
-processes; the main thread's CPU time does not.
+processes; the main thread's CPU time does not. And where each move's time went: from
+the key press to the page's first message, from there to the new data in the page (the
+server's part: its event loop, the solve in a worker, the redraw, the message), and from
+the data to the frame (the page's part).
 Not part of the test suite. Usage::
 
     python benchmarks/explorer_latency.py [--repeats 9] [--loads 5] [--url URL]
@@ -54,18 +57,32 @@ READY = """() => {
 }"""
 
 # Records, for every change of the pressure plot's data, the time from the last key press
-# to the second animation frame after the change.
+# to the second animation frame after the change, and where that time went: until the
+# page's first message to the server, until the new data arrived (the server's part and
+# the network), and from then to the frame (the page's part).
 INSTRUMENT = """() => {
   const src = Bokeh.documents[0].get_model_by_name('q_source');
   window.__latencies = [];
+  window.__parts = [];
   window.__keyTime = null;
-  document.addEventListener('keydown', e => { window.__keyTime = performance.now(); }, true);
+  let sent = null;
+  document.addEventListener('keydown', e => { window.__keyTime = performance.now();
+                                              sent = null; }, true);
+  const send = WebSocket.prototype.send;
+  WebSocket.prototype.send = function (data) {
+    if (window.__keyTime !== null && sent === null) sent = performance.now();
+    return send.call(this, data);
+  };
   src.change.connect(() => {
     const t0 = window.__keyTime;
     if (t0 === null) return;
     window.__keyTime = null;
-    requestAnimationFrame(() => requestAnimationFrame(
-      () => window.__latencies.push(performance.now() - t0)));
+    const arrived = performance.now(), out = sent === null ? arrived : sent;
+    requestAnimationFrame(() => requestAnimationFrame(() => {
+      const now = performance.now();
+      window.__parts.push([out - t0, arrived - out, now - arrived]);
+      window.__latencies.push(now - t0);
+    }));
   });
 }"""
 
@@ -77,9 +94,11 @@ def _main_thread_seconds(cdp) -> float:
 
 
 def measure_slider(page, tab: str, css: str, presses: int, key: str,
-                   cdp=None, cpu: list[float] | None = None) -> list[float]:
+                   cdp=None, cpu: list[float] | None = None,
+                   parts: list[list[float]] | None = None) -> list[float]:
     """Press ``key`` on a slider's handle ``presses`` times; latency of each [ms] (and
-    the main thread's CPU time of each [ms] into ``cpu``)."""
+    the main thread's CPU time of each [ms] into ``cpu``, and its parts [ms] into
+    ``parts``: key to first message sent, sent to data arrived, arrived to frame)."""
     page.locator(".bk-tab", has_text=tab).first.click()
     handle = page.locator(f"{css} .noUi-handle").first
     handle.focus()
@@ -92,6 +111,8 @@ def measure_slider(page, tab: str, css: str, presses: int, key: str,
         if cdp is not None and cpu is not None:
             cpu.append(1e3 * (_main_thread_seconds(cdp) - busy))
         out.append(page.evaluate("() => window.__latencies[window.__latencies.length - 1]"))
+        if parts is not None:
+            parts.append(page.evaluate("() => window.__parts[window.__parts.length - 1]"))
         time.sleep(0.3)
         status = page.locator(".solve-status").first.inner_text()
         found = re.search(r"Solved in (\d+) ms", status)
@@ -120,6 +141,7 @@ def main() -> None:
     results: dict[str, list[float]] = {}
     solves: dict[str, list[float]] = {}
     cpu: dict[str, list[float]] = {}
+    parts: dict[str, list[list[float]]] = {}
     try:
         with sync_playwright() as p, tempfile.TemporaryDirectory() as profile:
             context = p.chromium.launch_persistent_context(
@@ -148,9 +170,10 @@ def main() -> None:
                                    ("coating thickness", "Coating", ".coating-thickness"),
                                    ("punch half-width", "Punch", ".punch-half-width"),
                                    ("base thickness", "Base", ".base-thickness")):
-                cpu[name] = []
+                cpu[name], parts[name] = [], []
                 results[name], solves[name] = measure_slider(page, tab, css, args.repeats,
-                                                             "ArrowRight", cdp, cpu[name])
+                                                             "ArrowRight", cdp, cpu[name],
+                                                             parts[name])
             context.close()
     finally:
         if server is not None:
@@ -167,9 +190,17 @@ def main() -> None:
         cpu_text = f"{statistics.median(page_cpu):9.0f}" if page_cpu else f"{'':9s}"
         print(f"{name:24s} {statistics.median(values):9.0f} {min(values):9.0f} "
               f"{max(values):9.0f} {goals[name]:7d} {core_text} {cpu_text}  n={len(values)}")
+    print("\nwhere the time of a move went (medians, ms): key press -> first message sent; "
+          "sent -> new data in the page (server, network); data -> frame shown (page)")
+    for name, rows in parts.items():
+        if rows:
+            sent, server_part, page_part = (statistics.median(r[k] for r in rows)
+                                            for k in range(3))
+            print(f"{name:24s} {sent:6.0f} {server_part:9.0f} {page_part:9.0f}")
     if args.json:
         Path(args.json).write_text(json.dumps(
-            {"browser": results, "core_solve": solves, "page_cpu": cpu}, indent=2))
+            {"browser": results, "core_solve": solves, "page_cpu": cpu, "parts": parts},
+            indent=2))
 
 
 if __name__ == "__main__":

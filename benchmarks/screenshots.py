@@ -45,7 +45,7 @@ _READOUT = """([q, v]) => {
 def _pins_shown(page, count: int) -> None:
     page.wait_for_function(
         "(n) => Bokeh.documents[0].get_model_by_name('q_pin_source_' + (n - 1))"
-        ".data.q.length > 1", arg=count, timeout=60_000)
+        "?.data.q.length > 1", arg=count, timeout=60_000)  # a pin's lines come with it
 
 
 def _pin(page, count: int) -> None:

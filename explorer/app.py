@@ -18,7 +18,7 @@ import panel as pn
 import param
 from panel.io.state import set_curdoc
 
-from . import closed_pages, gc_policy
+from . import bokeh_fixes, closed_pages, gc_policy
 from .controller import SolveController, format_error, worker_processes
 from .design import DesignLimits
 from .fidelity_view import FidelityView
@@ -402,6 +402,7 @@ def create_app(**kwargs: Any) -> ExplorerApp:
     kwargs.setdefault("executor", "shared" if served else None)
     if served:
         pn.state.on_session_destroyed(gc_policy.session_ended)
+        bokeh_fixes.install(pn.state.curdoc)
     if "query" not in kwargs:
         kwargs["query"] = _query_from_session()
     app = ExplorerApp(**kwargs)

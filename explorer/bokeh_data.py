@@ -2,8 +2,17 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from bokeh.models import ColumnDataSource
+
+#: Bokeh's render level of what moves with the load or the time but not with the data
+#: (the load's arrow and label, time cursors, the points at the time shown): the page
+#: draws this level on a canvas layer of its own, so moving them repaints that layer
+#: only, not the glyphs, axes and legends of the figure (measured: a load step
+#: repainted the whole scene drawing, ~45 ms of the page's CPU, for the load's label).
+MOVING = "overlay"
 
 
 def f32(values: object) -> np.ndarray:
@@ -32,3 +41,74 @@ def set_data(source: ColumnDataSource, data: dict) -> bool:
         return False
     source.data = data
     return True
+
+
+#: A value axis keeps its range while the data lie inside it and fill at least this
+#: share of it: a load step of a few percent then changes the curve, not the axis (an
+#: axis whose ticks change makes the page lay the figure out again, and an automatic
+#: range refitted in the page was painted twice and sent back to the server).
+KEEP_SHARE = 0.5
+#: Room left on each side of the data when a range is set anew [share of the data span].
+MARGIN_SHARE = 0.1
+#: Data of (nearly) one value are drawn over at least this share of their size (a
+#: constant force of 500 kN/m over 450-550), or over -1 to 1 when that value is zero.
+FLAT_SHARE = 0.2
+
+
+def data_bounds(*arrays: object) -> tuple[float, float] | None:
+    """Smallest and largest finite value of ``arrays`` (None when there is none)."""
+    parts = [np.asarray(a, dtype=float).ravel() for a in arrays]
+    values = np.concatenate(parts) if parts else np.zeros(0)
+    values = values[np.isfinite(values)]
+    if not values.size:
+        return None
+    return float(values.min()), float(values.max())
+
+
+def steady_range(rng: Any, *arrays: object) -> bool:
+    """Fit the value range ``rng`` (a Bokeh ``Range1d``) to ``arrays`` unless it fits
+    them already (see :data:`KEEP_SHARE`); True if it was set. The reset tool returns
+    to the range set last."""
+    bounds = data_bounds(*arrays)
+    if bounds is None:
+        return False
+    lo, hi = bounds
+    size = max(abs(lo), abs(hi))
+    flat = FLAT_SHARE * size if size > 0 else 2.0
+    if hi - lo < flat:
+        mid = 0.5 * (lo + hi)
+        lo, hi = mid - 0.5 * flat, mid + 0.5 * flat
+    start, end = rng.start, rng.end
+    if (start is not None and end is not None and end > start and start <= lo
+            and hi <= end and hi - lo >= KEEP_SHARE * (end - start)):
+        return False
+    pad = MARGIN_SHARE * (hi - lo)
+    start, end = lo - pad, hi + pad
+    rng.update(start=start, end=end, reset_start=start, reset_end=end)
+    return True
+
+
+def legend_above(fig: Any, font_size: str | None = None) -> Any:
+    """Move the legend of ``fig`` above its plot, in a compact horizontal row; returns it."""
+    legend = fig.legend[0]
+    legend.orientation = "horizontal"
+    legend.margin = 0
+    legend.padding = 2
+    if font_size is not None:
+        legend.label_text_font_size = font_size
+    fig.add_layout(legend, "above")
+    return legend
+
+
+#: Entries of a legend above a plot laid out in one row up to this many, else in two
+#: columns: at 1024 px the q(x) plot is ~320 px wide and four entries in one row
+#: reached ~250 px past its left edge, over the sidebar.
+ONE_ROW_ENTRIES = 2
+
+
+def wrap_legend(legend: Any) -> None:
+    """One row of the entries shown when few, else two columns (see ONE_ROW_ENTRIES)."""
+    shown = sum(1 for item in legend.items if item.visible)
+    columns = "auto" if shown <= ONE_ROW_ENTRIES else 2
+    if legend.ncols != columns:
+        legend.ncols = columns

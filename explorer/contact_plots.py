@@ -12,7 +12,7 @@ from bokeh.core.properties import value as fixed_label
 from bokeh.models import ColumnDataSource, HoverTool, Label, Range1d, Span
 from bokeh.plotting import figure
 
-from .bokeh_data import f32, set_data
+from .bokeh_data import MOVING, f32, legend_above, set_data
 from .contact_zone import contact_widths, contact_zones, lifts_off
 from .results import Geometry, ResultView
 
@@ -61,7 +61,8 @@ class ContactDrawing:
         # beside the punch, just above the coating (placed at each time, see show_time)
         self.zone_label = Label(x=0, y=0, text="", text_font_size="11px", y_offset=6,
                                 text_color="#333", background_fill_color="white",
-                                background_fill_alpha=0.7, name="contact_zone_label")
+                                background_fill_alpha=0.7, name="contact_zone_label",
+                                level=MOVING)
         scene_fig.add_layout(self.zone_label)
         self._surface: tuple[np.ndarray, np.ndarray] = (np.array([-1.0, 1.0]), np.zeros(2))
         self._zone_key: tuple | None = None
@@ -85,16 +86,12 @@ class ContactDrawing:
             ("t", "@t{0.0} days"), ("contact width", "@width{0.0000} m"),
             ("lift-off length", "@lifted{0.0000} m")]))
         self.width_point = ColumnDataSource({"t": [], "v": []}, name="contact_width_point")
-        p.scatter(x="t", y="v", source=self.width_point, size=8, color=LIFTED_COLOR)
+        p.scatter(x="t", y="v", source=self.width_point, size=8, color=LIFTED_COLOR,
+                  level=MOVING)
         self.width_cursor = Span(location=0, dimension="height", line_color="#999",
-                                 line_dash="dotted")
+                                 line_dash="dotted", level=MOVING)
         p.add_layout(self.width_cursor)
-        legend = p.legend[0]
-        legend.orientation = "horizontal"
-        legend.label_text_font_size = "11px"
-        legend.margin = 0
-        legend.padding = 2
-        p.add_layout(legend, "above")
+        legend_above(p, "11px")
         self.width_fig = p
         self._widths = np.zeros(1)
 

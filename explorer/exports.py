@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .contact_zone import contact_widths
 from .results import ResultView
 from .state import QUANTITIES, QUANTITY_UNITS
 
@@ -26,6 +27,9 @@ DIGITS = 10
 #: Column names of the histories, in the units the screen shows them in.
 HISTORY_COLUMNS = {"settlement": "settlement_mm", "tilt": "tilt_mrad",
                    "force": "force_kN_per_m", "moment": "moment_kN_m_per_m"}
+#: The contact zone's columns of the histories [m]: the length of the base in contact
+#: and the length lifted off (their sum is the punch width 2a).
+CONTACT_COLUMNS = ("contact_width_m", "lifted_length_m")
 
 
 def project_version() -> str:
@@ -90,14 +94,21 @@ def _header(view: ResultView, what: str, units: Iterable[str]) -> list[str]:
 
 
 def histories_csv(view: ResultView) -> str:
-    """The four histories as CSV, in mm, mrad, kN/m and kN·m/m, time in days."""
+    """The four histories as CSV, in mm, mrad, kN/m and kN·m/m, time in days, and the
+    contact width and the lifted length in m (as the contact width plot shows them)."""
+    width = 2 * view.geometry.half_width
     units = ["time_day: days after loading"]
     units += [f"{HISTORY_COLUMNS[q]}: {QUANTITY_UNITS[q][0]}"
               f"{' (given)' if q in view.given else ' (computed)'}" for q in QUANTITIES]
+    units += [f"{CONTACT_COLUMNS[0]}: m, length of the base in contact (of 2a = "
+              f"{number(width)} m)",
+              f"{CONTACT_COLUMNS[1]}: m, length lifted off (2a - contact width)"]
     lines = _header(view, "histories", units)
     flags = ";".join(view.flags)
-    lines.append(",".join(["time_day", *(HISTORY_COLUMNS[q] for q in QUANTITIES), "flags"]))
-    columns = [view.times, *(view.display(q) for q in QUANTITIES)]
+    lines.append(",".join(["time_day", *(HISTORY_COLUMNS[q] for q in QUANTITIES),
+                           *CONTACT_COLUMNS, "flags"]))
+    contact = contact_widths(view)
+    columns = [view.times, *(view.display(q) for q in QUANTITIES), contact, width - contact]
     for row in zip(*columns, strict=True):
         lines.append(",".join([*(number(v) for v in row), flags]))
     return "\n".join(lines) + "\n"

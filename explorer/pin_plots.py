@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from bokeh.core.properties import value
 from bokeh.models import ColumnDataSource, LegendItem
 
+from .bokeh_data import wrap_legend
 from .pins import MAX_PINS, Pin
 from .results import ResultView
 from .state import QUANTITIES
@@ -99,8 +100,8 @@ class PinLines:
                     data = ({"t": _f32(pin.view.times), "v": _f32(pin.view.display(q))}
                             if shown else {"t": [], "v": []})
                     set_data(self.history_src[q][k], data)
-            # two rows of legend entries with pins: one row was wider than the plot
-            self.figures.q_fig.legend[0].nrows = 2 if pins else "auto"
+            # the entries in columns when there are more than fit one row
+            wrap_legend(self.figures.q_fig.legend[0])
         self.show_time(view, pins, index)
 
     def show_time(self, view: ResultView, pins: Sequence[Pin], index: int) -> None:

@@ -29,9 +29,10 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from .bokeh_data import f32, set_data
+from .bokeh_data import MOVING, f32, legend_above, set_data, steady_range, wrap_legend
 from .classical import bearing_rule_pressure, half_space_pressure
 from .contact_plots import ContactDrawing, FeatureInset
+from .contact_zone import lifts_off
 from .pin_plots import PinLines
 from .pins import Pin
 from .results import ResultView
@@ -51,6 +52,9 @@ GIVEN_COLOR = "#8c8c8c"
 _SLABS = 120
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
+
+#: Font size of the entries of the legends above the plots (normal mode).
+LEGEND_FONT = "11px"
 
 #: Font size of ticks, axis labels and titles in presentation mode (a projector).
 PRESENTATION_FONT = "18px"
@@ -126,10 +130,10 @@ class Figures:
             ("layer", "@layer"), ("thickness", "@h_mm{0.00} mm"), ("E", "@E{0.0} MPa")]))
         self.arrow = Arrow(end=NormalHead(size=12, fill_color="#d62728", line_color="#d62728"),
                            x_start=0, y_start=1, x_end=0, y_end=0.5, line_width=3,
-                           line_color="#d62728", visible=False)
+                           line_color="#d62728", visible=False, level=MOVING)
         p.add_layout(self.arrow)
         self.arrow_label = Label(x=0, y=0, text="", text_font_size="11px",
-                                 text_color="#d62728", x_offset=6)
+                                 text_color="#d62728", x_offset=6, level=MOVING)
         p.add_layout(self.arrow_label)
         self.base_label = Label(x=0, y=0, text="", text_font_size="11px", text_color="#333",
                                 x_offset=4, y_offset=4)
@@ -146,9 +150,10 @@ class Figures:
         self.scene_fig = p
 
     def _build_pressure(self) -> None:
+        # the value axes are set here, not fitted in the page (see steady_range)
         p = figure(height=280, sizing_mode="stretch_width", tools=_TOOLS,
                    title="Contact pressure q(x)", toolbar_location="above",
-                   name="pressure_figure")
+                   name="pressure_figure", y_range=Range1d(0, 1))
         p.toolbar.autohide = True
         p.xaxis.axis_label = "x [m]"
         p.yaxis.axis_label = "q [kPa]"
@@ -164,22 +169,23 @@ class Figures:
         self.classic_lines = [
             p.line(x="x", y="half_space", source=self.classic_src, line_color="#7f7f7f",
                    line_dash="dotdash", line_width=1.5, visible=False,
-                   legend_label="rigid punch, elastic half-space"),
+                   legend_label="elastic half-space"),
             p.line(x="x", y="bearing_rule", source=self.classic_src, line_color="#2ca02c",
                    line_dash="dotted", line_width=2, visible=False,
-                   legend_label="Winkler / trapezoid rule")]
+                   legend_label="Winkler / trapezoid")]
         line = p.line(x="x", y="q", source=self.q_src, line_color=UNKNOWN_COLOR, line_width=2.5,
                       legend_label="current")
         self.q_hover = HoverTool(renderers=[line], tooltips=[("x", "@x{0.000} m"),
                                                              ("q", "@q{0.000} kPa")],
                                  mode="vline", name="q_hover")
         p.add_tools(self.q_hover)
-        legend = p.legend[0]
-        legend.orientation = "horizontal"
+        # small entries, and only those of lines shown, in two columns when more than two
+        # (see wrap_legend): at 1024 px the plot is ~320 px wide
+        legend = legend_above(p, LEGEND_FONT)
         legend.click_policy = "hide"
-        legend.margin = 0
-        legend.padding = 2
-        p.add_layout(legend, "above")
+        for item in legend.items:
+            if any(r in self.classic_lines for r in item.renderers):
+                item.visible = False
         self.q_fig = p
 
     def _build_image(self) -> None:
@@ -201,7 +207,7 @@ class Figures:
         self.image_bar = ColorBar(color_mapper=self.image_mapper, title="q [kPa]", width=8)
         p.add_layout(self.image_bar, "right")
         self.image_cursor = Span(location=0, dimension="width", line_color="white",
-                                 line_width=2, line_dash="dashed")
+                                 line_width=2, line_dash="dashed", level=MOVING)
         p.add_layout(self.image_cursor)
         self.image_fig = p
 
@@ -217,7 +223,8 @@ class Figures:
             kwargs = {"x_range": shared_x} if shared_x is not None else {}
             p = figure(height=210, sizing_mode="stretch_width", tools=_TOOLS,
                        toolbar_location="above", name=f"{q}_figure",
-                       title=f"{TITLES[q]} {SYMBOLS[q]} [{unit}]", **kwargs)
+                       title=f"{TITLES[q]} {SYMBOLS[q]} [{unit}]", y_range=Range1d(-1, 1),
+                       **kwargs)
             shared_x = p.x_range
             p.toolbar.autohide = True
             p.xaxis.axis_label = "t [days after loading]"
@@ -225,10 +232,11 @@ class Figures:
             src = ColumnDataSource({"t": [0.0], "v": [0.0]}, name=f"{q}_source")
             point = ColumnDataSource(_empty("t", "v"), name=f"{q}_point_source")
             line = p.line(x="t", y="v", source=src, line_color=UNKNOWN_COLOR, line_width=2.5)
-            p.scatter(x="t", y="v", source=point, size=8, color="#d62728")
+            p.scatter(x="t", y="v", source=point, size=8, color="#d62728", level=MOVING)
             p.add_tools(HoverTool(renderers=[line], mode="vline", tooltips=[
                 ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
-            cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted")
+            cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted",
+                          level=MOVING)
             p.add_layout(cursor)
             self.history_src[q] = src
             self.history_point_src[q] = point
@@ -248,6 +256,7 @@ class Figures:
         self.contact.show(view)
         self.scene_fig.title.text = f"Scene: {short(view.scene.get('name', ''))}"
         self._show_image(view)
+        self._label_strips(view)
         for q in QUANTITIES:
             given = q in view.given
             set_data(self.history_src[q], {"t": f32(view.times), "v": f32(view.display(q))})
@@ -257,10 +266,29 @@ class Figures:
             self.history_fig[q].title.text = f"{TITLES[q]} {SYMBOLS[q]} [{unit}]: {state}"
         self.pins.show(view, pins, index)
         self.show_time(view, index, pins, pinned_drawn=True)
+        self.fit_axes(view, pins)
 
     def show_pinned(self, view: ResultView, pins: Sequence[Pin], index: int) -> None:
         """Overlay (or clear) the pinned results on the histories and the pressure."""
         self.pins.show(view, pins, index)
+        self.fit_axes(view, pins)
+
+    def fit_axes(self, view: ResultView, pins: Sequence[Pin] = ()) -> None:
+        """Value axes of q(x) and the histories that hold the result at every output
+        time and the pins (kept while they fit, see :func:`steady_range`): playing the
+        times or stepping the load moves the curves, not the axes."""
+        self._pins = tuple(pins)
+        for q in QUANTITIES:
+            steady_range(self.history_fig[q].y_range, view.display(q),
+                         *(pin.view.display(q) for pin in pins))
+        self._fit_pressure(view)
+
+    def _fit_pressure(self, view: ResultView) -> None:
+        size = self.scales.pressure_unit(view)[1]
+        shown = [view.pressure / size, *(pin.view.pressure / size for pin in self._pins)]
+        if self.classical:
+            shown += [self.classic_src.data[k] for k in ("half_space", "bearing_rule")]
+        steady_range(self.q_fig.y_range, *shown)
 
     def show_time(self, view: ResultView, index: int, pins: Sequence[Pin] = (),
                   pinned_drawn: bool = False) -> None:
@@ -273,7 +301,6 @@ class Figures:
         set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
                                 "right": [hi for _, hi in intervals]})
         self.q_fig.title.text = f"Pressure q(x), t = {t:.4g} days"
-        self._label_strips(view)
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
         if not pinned_drawn:
@@ -289,15 +316,25 @@ class Figures:
 
     def _label_strips(self, view: ResultView) -> None:
         label = LIFTED_LABEL if view.info.get("contact") == "unilateral" else LOST_LABEL
+        # listed only for a result with shaded strips at some time
+        shaded = lifts_off(view)
         for item in self.q_fig.legend[0].items:
-            if self.neg_strip in item.renderers and item.label != fixed_label(label):
-                item.label = fixed_label(label)
+            if self.neg_strip in item.renderers:
+                if item.label != fixed_label(label):
+                    item.label = fixed_label(label)
+                if item.visible != shaded:
+                    item.visible = shaded
+        wrap_legend(self.q_fig.legend[0])
 
     def set_classical(self, view: ResultView | None, index: int, shown: bool) -> None:
         """Show or hide the classical answers on the pressure plot."""
         self.classical = shown
         for line in self.classic_lines:
             line.visible = shown
+        for item in self.q_fig.legend[0].items:
+            if any(r in self.classic_lines for r in item.renderers):
+                item.visible = shown
+        wrap_legend(self.q_fig.legend[0])
         if view is not None:
             self._show_classical(view, index)
 
@@ -312,6 +349,7 @@ class Figures:
         set_data(self.classic_src, {
             "x": f32(x), "half_space": f32(half_space_pressure(x, force, moment, a) / size),
             "bearing_rule": f32(bearing_rule_pressure(x, force, moment, a) / size)})
+        self._fit_pressure(view)
 
     classical = False
 
@@ -332,7 +370,7 @@ class Figures:
                 axis.axis_label_text_font_size = label
             fig.toolbar_location = None if on else "above"
         legend = self.q_fig.legend[0]
-        legend.label_text_font_size = "11px" if on else "13px"
+        legend.label_text_font_size = "11px" if on else LEGEND_FONT
         legend.glyph_width = 14 if on else 20
         for q in QUANTITIES:
             self.history_fig[q].height = 170 if on else 210
@@ -432,3 +470,4 @@ class Figures:
 
     _punch_top = 0.0
     _scene_key: str | None = None
+    _pins: tuple[Pin, ...] = ()

@@ -123,26 +123,25 @@ def lifted_intervals(zones: list[tuple[float, float]],
 def negative_intervals(x: np.ndarray, q: np.ndarray) -> list[tuple[float, float]]:
     """Where ``q < 0`` on the grid ``x``, as ``(left, right)`` pairs, the ends placed at
     the zero crossings found by linear interpolation."""
-    neg = np.asarray(q) < 0
-    n = len(x)
+    q = np.asarray(q, dtype=float)
+    neg = q < 0
+    if not neg.any():
+        return []
+    # the runs of negative nodes: where the mask switches on and off
+    switch = np.diff(neg.astype(np.int8))
+    first = np.flatnonzero(switch == 1) + 1
+    last = np.flatnonzero(switch == -1)
+    if neg[0]:
+        first = np.concatenate([[0], first])
+    if neg[-1]:
+        last = np.concatenate([last, [len(q) - 1]])
 
     def crossing(k: int) -> float:  # zero of the chord between k and k + 1
         return float(x[k] - q[k] * (x[k + 1] - x[k]) / (q[k + 1] - q[k]))
 
-    out = []
-    i = 0
-    while i < n:
-        if not neg[i]:
-            i += 1
-            continue
-        j = i
-        while j + 1 < n and neg[j + 1]:
-            j += 1
-        left = float(x[0]) if i == 0 else crossing(i - 1)
-        right = float(x[-1]) if j == n - 1 else crossing(j)
-        out.append((left, right))
-        i = j + 1
-    return out
+    return [(float(x[0]) if i == 0 else crossing(i - 1),
+             float(x[-1]) if j == len(q) - 1 else crossing(j))
+            for i, j in zip(first.tolist(), last.tolist(), strict=True)]
 
 
 def _values(profile: Any, x: np.ndarray) -> np.ndarray:

@@ -112,7 +112,7 @@ def test_a_flag_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: P
     meta, names, table = parse_csv(Path(info.value.path()).read_text())
     assert "WARNING" in meta and "flag model_error" in meta
     assert names == ["time_day", "settlement_mm", "tilt_mrad", "force_kN_per_m",
-                     "moment_kN_m_per_m"]
+                     "moment_kN_m_per_m", "contact_width_m", "lifted_length_m"]
     assert table[0, 3] == 500  # kN/m: exactly the preset's 5e5 N/m, no round-off tail
     text = Path(info.value.path()).read_text()
     assert "9999999" not in text and "0000001" not in text
@@ -202,6 +202,67 @@ def test_units_stay_put_and_a_load_step_sends_only_what_changed(page: Page):
     assert page.errors == []
 
 
+# Counts, per figure, the repaints of its main canvas layer (glyphs, axes, legends), and
+# the messages the page sends back that set a range.
+JS_COUNT_PAINTS = """() => {
+  const doc = Bokeh.documents[0];
+  window.__primary = {};
+  window.__ranges_sent = 0;
+  window.__last_paint = performance.now();
+  for (const m of doc.all_models) {
+    if (!m.name || !m.name.endsWith('_figure')) continue;
+    const v = doc.views_manager.find_one(m);
+    if (!v) continue;
+    const paint = v._paint_primary.bind(v);
+    window.__primary[m.name] = 0;
+    v._paint_primary = (ctx) => {
+      window.__primary[m.name]++;
+      window.__last_paint = performance.now();
+      return paint(ctx);
+    };
+  }
+  const send = WebSocket.prototype.send;
+  WebSocket.prototype.send = function (data) {
+    if (typeof data === 'string' && data.includes('"attr":"start"')) window.__ranges_sent++;
+    return send.call(this, data);
+  };
+}"""
+
+
+def test_a_load_step_repaints_only_the_figures_whose_data_changed(page: Page):
+    """The issue's goal for the load slider: only what changed is sent and redrawn. The
+    drawing (only its load label moves, on its overlay layer), the tilt and the moment
+    (zero throughout) keep their main layer; the others paint it once; no range is sent
+    back to the server; BokehJS no longer rewrites unchanged style sheets."""
+    _wait(page, "() => Bokeh.require('core/dom').InlineStyleSheet.prototype._update"
+          ".__same_text_skipped === true")
+    # the sidebar's last tab is filled a few seconds after the page loads, and the page
+    # is laid out again then: wait for it, and for a second without any repaint
+    _wait(page, "() => [...Bokeh.documents[0].all_models].some(m => m.css_classes && "
+          "m.css_classes.includes('study-run'))")
+    page.page.evaluate(JS_COUNT_PAINTS)
+    handle = page.page.locator(".load-0-value .noUi-handle").first
+    handle.focus()
+    # the first edit also renames the scene in the drawing's title (as changed): count
+    # from the second step on
+    for step in range(2):
+        _wait(page, "() => performance.now() - window.__last_paint > 1000")
+        page.page.evaluate("() => { for (const k in window.__primary) "
+                           "window.__primary[k] = 0; }")
+        force = page.text(".readout-force")
+        handle.press("ArrowRight")
+        until(lambda force=force: page.text(".readout-force") != force, f"step {step + 1}")
+    # two animation frames later, everything of the step is painted
+    painted = page.page.evaluate("""() => new Promise(r => requestAnimationFrame(
+        () => requestAnimationFrame(() => r(window.__primary))))""")
+    assert painted["scene_figure"] == 0, painted
+    assert painted["tilt_figure"] == 0 and painted["moment_figure"] == 0, painted
+    for name in ("pressure_figure", "image_figure", "settlement_figure", "force_figure"):
+        assert painted[name] == 1, painted
+    assert page.page.evaluate("() => window.__ranges_sent") == 0
+    assert page.errors == []
+
+
 def test_an_overlong_name_from_the_page_is_refused(page: Page):
     page.open_tab("Files")
     page.page.locator(".scene-name input").first.wait_for(timeout=30_000)
@@ -287,6 +348,47 @@ def test_classical_solutions_undo_and_reset(page: Page):
     until(lambda: page.text(".readout-force") == "700", "force 700")
     page.page.locator(".reset-button button").first.click()
     until(lambda: page.text(".readout-force") == force, "reset to the preset")
+    assert page.errors == []
+
+
+# The legend above q(x) in its figure's own coordinates [px] (left, right, figure width,
+# number of entries shown), or null before the figure and its legend are drawn.
+JS_Q_LEGEND = """() => {
+  const doc = Bokeh.documents[0];
+  const fig = doc.get_model_by_name('pressure_figure');
+  const view = doc.views_manager.find_one(fig);
+  if (!view) return null;
+  for (const [model, rv] of view.renderer_views) {
+    if (model.type === 'Legend' && rv.bbox && rv.bbox.width > 0)
+      return {left: rv.bbox.left, right: rv.bbox.right, width: view.bbox.width,
+              shown: model.items.filter(i => i.visible).length};
+  }
+  return null;
+}"""
+
+
+def test_the_pressure_legend_stays_inside_its_plot_at_1024px(page: Page):
+    """At 1024 px the q(x) legend reached ~250 px past the plot's left edge, over the
+    sidebar; now only the entries of lines shown are listed, in columns when many."""
+    page.page.set_viewport_size({"width": 1024, "height": 768})
+    _wait(page, "() => window.innerWidth === 1024")
+    _wait(page, f"() => {{ const b = ({JS_Q_LEGEND})(); return b && b.width < 400; }}")
+    # with the classical answers: four entries
+    page.page.locator(".classical-toggle input").first.check()
+    _wait(page, f"() => {{ const b = ({JS_Q_LEGEND})(); return b && b.shown >= 3; }}")
+    # two animation frames after the change, the legend is laid out
+    box = page.page.evaluate(f"""() => new Promise(r => requestAnimationFrame(
+        () => requestAnimationFrame(() => r(({JS_Q_LEGEND})()))))""")
+    assert box["left"] >= 0 and box["right"] <= box["width"], box
+    # and with two pins
+    page.page.get_by_text("Pin this result").first.click()
+    page.type_into(".load-0-value", "650")
+    until(lambda: page.text(".readout-force") == "650", "force 650")
+    page.page.get_by_text("Pin this result").first.click()
+    _wait(page, f"() => {{ const b = ({JS_Q_LEGEND})(); return b && b.shown >= 5; }}")
+    box = page.page.evaluate(f"""() => new Promise(r => requestAnimationFrame(
+        () => requestAnimationFrame(() => r(({JS_Q_LEGEND})()))))""")
+    assert box["left"] >= 0 and box["right"] <= box["width"], box
     assert page.errors == []
 
 

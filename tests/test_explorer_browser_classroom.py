@@ -129,3 +129,24 @@ def test_a_lesson_step_by_step_with_notes_and_pins(page: Page) -> None:
     page.page.locator(".lesson-previous button").first.click()
     until(lambda: page.text(".readout-moment") == "0", "back to step 2")
     assert page.errors == []
+
+
+def test_pin_the_steps_of_the_force_over_a_range(page: Page) -> None:
+    """Feature 3, for teaching: N steps of a load pinned at once, named in the legend."""
+    def fill(css: str, value: str) -> None:
+        box = page.page.locator(f"{css} input").first
+        box.fill(value)
+        box.press("Enter")
+
+    page.page.locator(".pin-steps-button").first.wait_for(timeout=30_000)
+    assert "force P [kN/m]" in page.pane_text(".pin-steps-label")
+    fill(".pin-steps-count", "3")
+    fill(".pin-steps-from", "300")
+    fill(".pin-steps-to", "700")
+    page.page.locator(".pin-steps-button button").first.click()
+    until(lambda: _pins(page) == 3, "three pins")
+    until(lambda: [page.page.evaluate(JS_LEGEND, k) for k in range(3)]
+          == ["P = 300 kN/m", "P = 500 kN/m", "P = 700 kN/m"], "the steps in the legend")
+    # the scene on screen kept its force
+    assert page.text(".readout-force") == "500"
+    assert page.errors == []

@@ -68,7 +68,9 @@ def test_a_flagged_result_leaves_with_its_flag_in_the_units_on_screen():
     assert "model_error" in view.flags
     meta, names, table = parse_csv(histories_csv(view))
     assert names == ["time_day", "settlement_mm", "tilt_mrad", "force_kN_per_m",
-                     "moment_kN_m_per_m"]
+                     "moment_kN_m_per_m", "contact_width_m", "lifted_length_m"]
+    assert meta["unit contact_width_m"].startswith("m, ")
+    assert meta["unit lifted_length_m"].startswith("m, ")
     assert "WARNING" in meta and "solver.model_tol" in meta["flag model_error"]
     assert "see info.message" not in histories_csv(view)
     assert np.all(table[:, 3] == 500.0)  # the preset's 5e5 N/m in kN/m, exactly

@@ -54,3 +54,23 @@ def test_design_check_text_gives_the_lift_off_length() -> None:
     check = design_check(controller.view)
     text = check_html(check)
     assert f"lift-off length {check.full_width - check.contact_width:.4g} m" in text
+
+
+def test_histories_csv_carries_the_contact_width_and_the_lifted_length() -> None:
+    from explorer.contact_zone import contact_widths
+    from explorer.exports import histories_csv, parse_csv
+
+    state = ExplorerState()
+    state.load_scene(json.loads(json.dumps(presets()["eccentric_footing_liftoff"])))
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    view = controller.view
+    meta, names, table = parse_csv(histories_csv(view))
+    assert names[-2:] == ["contact_width_m", "lifted_length_m"]
+    assert meta["unit contact_width_m"].startswith("m, length of the base in contact")
+    a = view.geometry.half_width
+    # the plotted widths, to the 10 significant digits the file writes
+    widths = contact_widths(view)
+    assert widths.min() < 2 * a  # this preset lifts off
+    assert table[:, -2] == pytest.approx(widths, rel=1e-9)
+    assert table[:, -1] == pytest.approx(2 * a - widths, rel=1e-9, abs=1e-9 * a)

@@ -93,3 +93,30 @@ def test_a_link_with_too_many_pins_says_so() -> None:
     query = view_query(scenes[0], 0, 0, scenes)
     _, _, pins, message = read_view_query(query, 7)
     assert pins == [] and f"at most {MAX_PINS}" in message
+
+
+def test_pin_the_steps_of_a_load_over_a_range() -> None:
+    import pytest
+
+    app = ExplorerApp(executor=None)
+    app.pin()
+    pins = app.pins
+    # the first given load of the preset is the force; its steps replace the pins
+    assert "force P [kN/m]" in pins.steps_label.object
+    pins.pin_steps(5, 250.0, 750.0)
+    assert [pin.label for pin in pins.board] == [
+        "P = 250 kN/m", "P = 375 kN/m", "P = 500 kN/m", "P = 625 kN/m", "P = 750 kN/m"]
+    assert [line.visible for line in app.figures.pins.q_lines] == [True] * 5
+    # the scene on screen is unchanged
+    assert app.state.loading.histories["force"].value == 500.0
+    # bad input is refused, naming the field; the pins stay
+    for args, field in (((1, 0.0, 1.0), "steps"), ((MAX_PINS + 1, 0.0, 1.0), "steps"),
+                        ((3, None, 1.0), "from"), ((3, 1.0, float("nan")), "to"),
+                        ((3, 2.0, 2.0), "from and to")):
+        with pytest.raises(ValueError, match=f"^{field}"):
+            pins.pin_steps(*args)
+    assert len(pins.board) == 5
+    pins.step_count.value = 2
+    pins.step_from.value, pins.step_to.value = 100.0, 100.0
+    pins.steps_button.clicks += 1
+    assert app.notice.startswith("Steps not pinned: from and to")

@@ -1,14 +1,19 @@
-"""The pins of a session: pin, remove one, clear, pin every step, and pins from a link."""
+"""The pins of a session: pin, remove one, clear, pin every step, pin the steps of a load
+over a range, and pins from a link."""
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 import panel as pn
 
 from ..controller import SolveController, format_error
-from ..pins import PinBoard
-from ..state import ExplorerState
+from ..pins import MAX_PINS, PinBoard
+from ..state import QUANTITY_UNITS, ExplorerState
+from ..widgets import NAMES
+from .style import html_pane
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp
@@ -32,6 +37,18 @@ class PinsView:
         self.pin_button.on_click(lambda e: self.pin())
         self.unpin_button.on_click(lambda e: self.unpin())
         self.pin_list = pn.Column(margin=0, css_classes=["pin-list"])
+        # "pin 5 steps of the force from A to B": a class sees a load's effect at once
+        self.steps_label = html_pane("", margin=(8, 5, 0, 5), css_classes=["pin-steps-label"])
+        number = {"width": 62, "margin": (0, 3)}
+        self.step_count = pn.widgets.IntInput(label="steps", value=5, start=2, end=MAX_PINS,
+                                              css_classes=["pin-steps-count"], **number)
+        self.step_from = pn.widgets.FloatInput(label="from", css_classes=["pin-steps-from"],
+                                               **number)
+        self.step_to = pn.widgets.FloatInput(label="to", css_classes=["pin-steps-to"],
+                                             **number)
+        self.steps_button = pn.widgets.Button(label="Pin the steps", color="default",
+                                              css_classes=["pin-steps-button"])
+        self.steps_button.on_click(lambda e: self._on_steps())
         # pins of a link, solved off the page's thread: slot -> result (None: refused)
         self._pending: dict[int, ResultView | None] = {}
         self._expected = 0
@@ -40,7 +57,9 @@ class PinsView:
     def content(self) -> pn.Column:
         """The pin buttons and the list of pins (next to the readout)."""
         return pn.Column(self.pin_button, self.every_step, self.unpin_button, self.pin_list,
-                         margin=0)
+                         self.steps_label,
+                         pn.Row(self.step_count, self.step_from, self.step_to, margin=0),
+                         self.steps_button, margin=0)
 
     # -- actions ---------------------------------------------------------------------
     def pin(self) -> None:
@@ -64,11 +83,64 @@ class PinsView:
         if self.every_step.value:
             self.board.add(view)
             self._show_list()
+        self._name_steps()
+
+    def stepped_quantity(self) -> str:
+        """The load the steps change: the first given quantity (the first load slider)."""
+        return self.app.state.loading.given[0]
+
+    def _name_steps(self) -> None:
+        quantity = self.stepped_quantity()
+        text = (f"<span class='pin-steps-name'>Pin steps of {NAMES[quantity]} "
+                f"[{QUANTITY_UNITS[quantity][0]}]:</span>")
+        if self.steps_label.object != text:
+            self.steps_label.object = text
+        if self.step_from.value is None and self.step_to.value is None:
+            # around the value on screen, to start from
+            value = float(self.app.state.loading.histories[quantity].value)
+            self.step_from.value, self.step_to.value = (0.5 * value, 1.5 * value) if value \
+                else (0.0, 1.0)
+
+    def _on_steps(self) -> None:
+        try:
+            self.pin_steps(self.step_count.value, self.step_from.value, self.step_to.value)
+        except ValueError as exc:
+            self.app.notice = f"Steps not pinned: {exc}"
+
+    def pin_steps(self, count: int | None, start: float | None, end: float | None) -> None:
+        """Replace the pins by ``count`` results whose stepped load (see
+        :meth:`stepped_quantity`, display units) goes from ``start`` to ``end`` in equal
+        steps, the rest of the scene as on screen. Solved off the page's thread; the pins
+        appear together. Bad input raises ValueError naming the field."""
+        if count is None or not 2 <= int(count) <= MAX_PINS:
+            raise ValueError(f"steps: between 2 and {MAX_PINS} (one colour each), got "
+                             f"{count}")
+        for field, value in (("from", start), ("to", end)):
+            if value is None or not math.isfinite(float(value)):
+                raise ValueError(f"{field}: a number is needed, got {value}")
+        if float(start) == float(end):
+            raise ValueError(f"from and to: the same value ({start}) gives one result, "
+                             "not steps")
+        quantity = self.stepped_quantity()
+        scene = self.app.state.to_scene()
+        scenes = []
+        for value in np.linspace(float(start), float(end), int(count)):
+            state = ExplorerState()
+            state.load_scene(scene)
+            history = state.loading.histories[quantity]
+            if history.kind == "custom":
+                raise ValueError(f"{NAMES[quantity]}: its history came from a file; "
+                                 "choose a history form to step its level")
+            history.value = float(value)
+            scenes.append(state.to_scene())
+        self.board.clear()
+        self.solve_from_link(scenes, what="A step was not pinned")
 
     # -- pins of a link ----------------------------------------------------------------
-    def solve_from_link(self, scenes: list[dict[str, Any]]) -> None:
+    def solve_from_link(self, scenes: list[dict[str, Any]],
+                        what: str = "A pinned result in the link was not used") -> None:
         """Solve the pinned scenes of a link (off the page's thread), then pin them in
-        the link's order."""
+        the link's order; a scene refused is named in a notice starting with ``what``."""
         from core import scene_from_dict
 
         self._expected = len(scenes)
@@ -78,8 +150,7 @@ class PinsView:
                 scene_from_dict(scene)
                 state.load_scene(scene)
             except ValueError as exc:
-                self.app.notice = (f"A pinned result in the link was not used: "
-                                   f"{format_error(str(exc))}")
+                self.app.notice = f"{what}: {format_error(str(exc))}"
                 self._arrived(slot, None)
                 continue
             controller = SolveController(state, executor=self.app.controller.executor,

@@ -1,0 +1,52 @@
+"""The value axes kept while the data fit, the legends' columns and the page's BokehJS fix."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from bokeh.document import Document
+from bokeh.models import Range1d
+
+from explorer import bokeh_fixes
+from explorer.bokeh_data import KEEP_SHARE, MARGIN_SHARE, steady_range
+
+
+def test_a_value_axis_is_kept_while_the_data_fit_and_refitted_when_not() -> None:
+    rng = Range1d(0, 1)
+    assert steady_range(rng, np.array([200.0, 520.0]))
+    span = 320.0
+    assert (rng.start, rng.end) == pytest.approx((200 - MARGIN_SHARE * span,
+                                                  520 + MARGIN_SHARE * span))
+    # the reset tool returns to it
+    assert (rng.reset_start, rng.reset_end) == (rng.start, rng.end)
+    # a load step of 1 %: the axis stays (no message, no new ticks)
+    assert not steady_range(rng, np.array([202.0, 525.2]))
+    # out of the range: refitted
+    assert steady_range(rng, np.array([200.0, 600.0]))
+    assert rng.end == pytest.approx(600 + MARGIN_SHARE * 400)
+    # the data shrink below half of the range: refitted to them
+    assert steady_range(rng, np.array([0.0, 0.3 * (rng.end - rng.start)]))
+    assert rng.end - rng.start < 1 / KEEP_SHARE * 0.3 * 400 * 1.5
+    # nothing finite: left alone
+    before = (rng.start, rng.end)
+    assert not steady_range(rng, np.array([np.nan]))
+    assert (rng.start, rng.end) == before
+
+
+def test_a_constant_history_gets_room_around_its_value() -> None:
+    rng = Range1d(0, 1)
+    steady_range(rng, np.full(40, 500.0))
+    assert rng.start < 500 < rng.end and rng.end - rng.start == pytest.approx(120.0)
+    # a force step of 1.2 %: kept
+    assert not steady_range(rng, np.full(40, 506.0))
+    zero = Range1d(5, 6)
+    steady_range(zero, np.zeros(40))   # a tilt of zero throughout: -1.2 .. 1.2
+    assert (zero.start, zero.end) == pytest.approx((-1.2, 1.2))
+
+
+def test_the_style_fix_is_sent_with_a_served_document() -> None:
+    doc = Document()
+    assert bokeh_fixes.install(doc)
+    callbacks = doc.callbacks._js_event_callbacks["document_ready"]
+    assert len(callbacks) == 1 and "__same_text_skipped" in callbacks[0].code
+    assert not bokeh_fixes.install(None)
