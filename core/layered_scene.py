@@ -154,8 +154,12 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
     success = answer.error_estimate <= problem.tol
     if not success:
         flags.append("tol_not_met")
-    message = (f"exact layered kernel: estimated error {answer.error_estimate:.1e} "
-               f"{'<=' if success else '>'} tol {problem.tol:.1e} with {answer.modes} modes")
+    if success:
+        message = (f"exact layered kernel: estimated error {answer.error_estimate:.1e} "
+                   f"<= tol {problem.tol:.1e} with {answer.modes} modes")
+    else:  # worded as the other engines word a missed tol
+        message = (f"tol {problem.tol:.1e} not met: the exact layered kernel reached "
+                   f"{answer.modes} modes with estimated error {answer.error_estimate:.1e}")
     q_interior = evaluate(np.cos(theta[1:-1]))
     info = {
         "error_estimate": float(answer.error_estimate),

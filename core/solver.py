@@ -303,9 +303,11 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         if spatial_error * SUCCESS_MARGIN > tol:
             reasons.append(f"the basis reached {chosen.n} modes with estimated error "
                            f"{spatial_error:.1e}")
-        if chosen.time_error * SUCCESS_MARGIN > tol or not chosen.time_success:
+        if not chosen.time_success:
             reasons.append(f"time stepping: {chosen.time_message} (estimated error "
                            f"{chosen.time_error:.1e})")
+        elif chosen.time_error * SUCCESS_MARGIN > tol:
+            reasons.append(f"time stepping: estimated error {chosen.time_error:.1e}")
         if kernel_fit_error * SUCCESS_MARGIN > tol:
             reasons.append(f"the creep kernel's exponential fit has error {kernel_fit_error:.1e}")
         message = (f"tol {tol:.1e} not met (success needs the estimate below tol/"
