@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.contact_systems import StepSolver, bordered_solve
+from core.contact_systems import StepSolver, bordered_change, bordered_solve
 from core.contact_zones import (
     _BARYCENTRIC,
     _T,
@@ -148,16 +148,27 @@ def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
     parts = _contact_parts(panels, zones, [ends[k] for k in free])
     cut, values = _cut_rule(panels, state, parts)
     defect, d_force, d_moment = _defect(space, step, state, op, cut, values, parts, idx)
-    given = dict(step.given)
-    if "force" in given:
-        given["force"] -= d_force
-    if "moment" in given:
-        given["moment"] -= d_moment
-    rhs = step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g - defect
-    if memory is not None:
-        rhs = rhs + memory
-    q_active, delta, alpha = bordered_solve(op, m, x, w, step.c, step.scale, given, rhs,
-                                            idx, solver)
+    if solver is None:
+        given = dict(step.given)
+        if "force" in given:
+            given["force"] -= d_force
+        if "moment" in given:
+            given["moment"] -= d_moment
+        rhs = step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g - defect
+        if memory is not None:
+            rhs = rhs + memory
+        q_active, delta, alpha = bordered_solve(op, m, x, w, step.c, step.scale, given, rhs,
+                                                idx)
+    else:
+        # The system is linear and the state solves it without the defect: only the
+        # change is solved, with the step's kept factors (and its state left for the next
+        # step).
+        change = {name: {"force": -d_force, "moment": -d_moment}.get(name, 0.0)
+                  for name in step.given}
+        dq, d_delta, d_alpha = bordered_change(op, m, x, w, step.c, step.scale, change,
+                                               -defect, idx, solver)
+        q_active = state.q[idx] + dq
+        delta, alpha = state.settlement + d_delta, state.tilt + d_alpha
     q = np.zeros(x.size)
     q[idx] = q_active
     # F on the rule and on the cut parts at once; the cut panels' Gauss sums taken off
