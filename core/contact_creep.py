@@ -31,7 +31,7 @@ import numpy as np
 from core.cache import StageCache, fingerprint
 from core.collocation import time_grid
 from core.contact_bands import BAND_WIDTHS, band_rule, bands_from_ends
-from core.contact_kinks import corrected_ends
+from core.contact_kinks import corrected_roots, kink_corrected
 from core.contact_zones import (
     ZONE_END_TOL,
     NoContact,
@@ -91,14 +91,6 @@ def rule_operator(lam: float, rule: Panels) -> np.ndarray:
     return _RULE_OPERATORS.get_or_compute(key, build)[0].matrix
 
 
-def _zones(state: NodalState, breakpoints: tuple[float, ...]
-           ) -> tuple[list[tuple[float, float]], list[float]]:
-    if not state.active.any():
-        return [], []
-    ends, _, _ = zones_from_nodes(state, breakpoints)
-    return [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)], ends
-
-
 def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.ndarray,
            grid: np.ndarray, widths: np.ndarray, out_index: np.ndarray,
            exact_ends: bool = True) -> dict[str, Any]:
@@ -120,6 +112,7 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
         [None] * len(out_index))  # type: ignore
     active = None
     solver = StepSolver()
+    pending: list[tuple[int, Any]] = []
     sweeps = 0
     unsettled = 0
     for n in range(steps):
@@ -143,10 +136,18 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
         active = state.active
         memory_of.record(n, state.q)
         if n in wanted:
-            nodal = _zones(state, space.breakpoints)[1]
-            ends = corrected_ends(space, step, state, op, m, g, displacement,
-                                  memory_density, solver) if exact_ends else nodal
-            states[wanted[n]] = (state, step, memory_density, ends, nodal)
+            nodal, pinned = ([], []) if not state.active.any() else zones_from_nodes(
+                state, space.breakpoints)[:2]
+            if exact_ends and nodal:
+                # corrected now, with this step's kept factors; roots of all at the end
+                pending.append((wanted[n], kink_corrected(
+                    space, step, state, op, m, g, displacement, memory_density, solver,
+                    nodal=(nodal, pinned))))
+            states[wanted[n]] = (state, step, memory_density, nodal, nodal)
+    if pending:
+        for (k, _), ends in zip(pending, corrected_roots(space, [c for _, c in pending]),
+                                strict=True):
+            states[k] = states[k][:3] + (ends, states[k][4])
     return {"states": states, "sweeps": sweeps, "unsettled": unsettled, "steps": steps - 1,
             "breakpoints": space.breakpoints,
             "factorizations": solver.factorizations,

@@ -27,6 +27,8 @@ the nodal ones were 2.4e-6 off (tests/test_contact.py).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from core.contact_systems import StepSolver, bordered_change, bordered_solve
@@ -133,15 +135,51 @@ def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
     is then the root of that solution's Nystrom pressure Q(x), evaluated by its formula
     (the interpolant of the nodal Q errs there: F of the kinked q puts a
     ``(x - end)^2 ln|x - end|`` term into Q, which 16-point panels read ~1e-4 wrong).
-    Ends at +-1 or at breakpoints are kept (dimensionless throughout).
+    Ends at +-1 or at breakpoints are kept (dimensionless throughout). The two halves,
+    :func:`kink_corrected` and :func:`corrected_roots`, let a march correct every output
+    time as it passes and find all the roots at once at its end.
     """
     if not state.active.any():
         return []
-    ends, pinned, _ = zones_from_nodes(state, space.breakpoints)
+    return corrected_roots(space, [kink_corrected(space, step, state, op, m, g, memory,
+                                                  memory_density, solver)])[0]
+
+
+@dataclass
+class Corrected:
+    """One step's corrected solution, waiting for its roots (:func:`corrected_roots`):
+    the nodal ends and which are free, the density on ``panels`` (the nodal rule) and on
+    ``cut`` (the contact parts of the end panels), the memory density on ``panels``, and
+    the step's scalars."""
+
+    ends: list[float]
+    free: list[int]
+    panels: Panels
+    cut: Panels
+    density: np.ndarray
+    cut_density: np.ndarray
+    memory_density: np.ndarray | None
+    delta: float
+    alpha: float
+    step: Step
+
+
+def kink_corrected(space: Space, step: Step, state: NodalState, op: np.ndarray,
+                   m: np.ndarray, g: np.ndarray, memory: np.ndarray | None = None,
+                   memory_density: np.ndarray | None = None,
+                   solver: StepSolver | None = None,
+                   nodal: tuple[list[float], list[bool]] | None = None) -> Corrected:
+    """The step solved again with the kink defect (see :func:`corrected_ends`, same
+    arguments; ``nodal`` the (ends, pinned) of :func:`zones_from_nodes` if known)."""
+    ends, pinned = nodal if nodal is not None else zones_from_nodes(state,
+                                                                    space.breakpoints)[:2]
+    ends = list(ends)
     free = [k for k, p in enumerate(pinned) if not p]
-    if not free:
-        return ends
     panels = state.panels
+    empty = Panels(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0))
+    if not free:
+        return Corrected(ends, [], panels, empty, state.q, np.zeros(0), None,
+                         state.settlement, state.tilt, step)
     x, w = panels.nodes, panels.weights
     idx = np.nonzero(state.active)[0]
     zones = [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)]
@@ -169,29 +207,56 @@ def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
                                                -defect, idx, solver)
         q_active = state.q[idx] + dq
         delta, alpha = state.settlement + d_delta, state.tilt + d_alpha
-    q = np.zeros(x.size)
-    q[idx] = q_active
-    # F on the rule and on the cut parts at once; the cut panels' Gauss sums taken off
-    # with the pressure the defect of the solve took them with
-    joined = _join([panels, cut])
-    density = np.concatenate([q, values])
+    density = np.zeros(x.size)
+    density[idx] = q_active
+    # the cut panels' Gauss sums taken off with the pressure the defect took them with
     for p in parts:
         cols = slice(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
         density[cols] -= state.q[cols]
-    density_memory = None if memory_density is None else np.concatenate(
-        [memory_density, np.zeros(values.size)])
+    return Corrected(ends, free, panels, cut, density, values, memory_density, delta, alpha,
+                     step)
 
-    def nystrom(t: np.ndarray) -> np.ndarray:
-        rows = _part_rows(space.lam, joined, t)
-        fq = rows @ density
-        e = 0.0 if density_memory is None else rows @ density_memory
-        return (delta + alpha * t - space.g(t) + e - step.scale * fq) / (step.c * space.m(t))
 
-    # Secant from the interpolant's roots (within ~1e-4 of the true ones).
-    inward = np.array([1.0 if k % 2 == 0 else -1.0 for k in free])
-    a = np.array([ends[k] for k in free])
+def corrected_roots(space: Space, steps: list[Corrected]) -> list[list[float]]:
+    """The ends of each of ``steps`` (all on one nodal rule), free ones moved to the roots
+    of their corrected Nystrom pressure Q: a secant from the interpolant's roots (within
+    ~1e-4 of the true ones), all ends of all steps at once (F on the nodal rule and on
+    every cut part evaluated at every end in one go)."""
+    owner = np.array([s for s, c in enumerate(steps) for _ in c.free], dtype=int)
+    out = [list(c.ends) for c in steps]
+    if owner.size == 0:
+        return out
+    panels = steps[0].panels
+    cuts = [c.cut for c in steps]
+    cut_owner = np.concatenate([np.full(c.nodes.size, s) for s, c in enumerate(cuts)])
+    cut_density = np.concatenate([c.cut_density for c in steps])
+    joined_cuts = _join(cuts)
+    density = np.stack([c.density for c in steps])[owner]  # (ends, N)
+    memory = None
+    if any(c.memory_density is not None for c in steps):
+        memory = np.stack([np.zeros(panels.size) if c.memory_density is None
+                           else c.memory_density for c in steps])[owner]
+    delta = np.array([steps[s].delta for s in owner])
+    alpha = np.array([steps[s].alpha for s in owner])
+    scale = np.array([steps[s].step.scale for s in owner])
+    c_val = np.array([steps[s].step.c for s in owner])
+    mine = cut_owner[None, :] == owner[:, None]  # (ends, cut nodes): each end's own cut
+
+    def nystrom(t: np.ndarray, rep: int) -> np.ndarray:
+        base_rows = _part_rows(space.lam, panels, t)
+        cut_rows = _part_rows(space.lam, joined_cuts, t)
+        dens = np.tile(density, (rep, 1))
+        fq = np.einsum("ij,ij->i", base_rows, dens) + (
+            cut_rows * np.tile(mine, (rep, 1))) @ cut_density
+        e = 0.0 if memory is None else np.einsum("ij,ij->i", base_rows,
+                                                 np.tile(memory, (rep, 1)))
+        return ((np.tile(delta, rep) + np.tile(alpha, rep) * t - space.g(t) + e
+                 - np.tile(scale, rep) * fq) / (np.tile(c_val, rep) * space.m(t)))
+
+    inward = np.array([1.0 if k % 2 == 0 else -1.0 for c in steps for k in c.free])
+    a = np.array([c.ends[k] for c in steps for k in c.free])
     b = a + 1e-6 * inward
-    both = nystrom(np.concatenate([a, b]))
+    both = nystrom(np.concatenate([a, b]), 2)
     fa, fb = both[:a.size], both[a.size:]
     for _ in range(_SECANT_STEPS):
         slope = (fb - fa) / (b - a)
@@ -202,14 +267,18 @@ def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
         # a step below 1e-8 leaves ~1e-14 (the secant converges superlinearly from ~1e-4)
         if np.max(np.abs(step_x)) < 1e-2 * ZONE_END_TOL:
             break
-        fb = nystrom(b)
-    out = list(ends)
-    for j, k in enumerate(free):
-        lo = -1.0 if k == 0 else ends[k - 1]
-        hi = 1.0 if k == len(ends) - 1 else ends[k + 1]
-        # a root that ran off (a degenerate slope) keeps the interpolant's end
-        if lo < b[j] < hi and abs(b[j] - ends[k]) < 2.0 * panels.half_widths.max():
-            out[k] = float(b[j])
+        fb = nystrom(b, 1)
+    widest = 2.0 * panels.half_widths.max()
+    j = 0
+    for s, c in enumerate(steps):
+        ends = c.ends
+        for k in c.free:
+            lo = -1.0 if k == 0 else ends[k - 1]
+            hi = 1.0 if k == len(ends) - 1 else ends[k + 1]
+            # a root that ran off (a degenerate slope) keeps the interpolant's end
+            if lo < b[j] < hi and abs(b[j] - ends[k]) < widest:
+                out[s][k] = float(b[j])
+            j += 1
     return out
 
 
