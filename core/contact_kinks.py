@@ -54,11 +54,18 @@ _OVER_T, _OVER_W = np.polynomial.legendre.leggauss(64)
 _OVER_P = np.polynomial.legendre.legvander(_OVER_T, NODES_PER_PANEL - 1)
 
 
-def _part_rows(lam: float, part: Panels, targets: np.ndarray) -> np.ndarray:
+def _part_rows(lam: float, part: Panels, targets: np.ndarray,
+               owners: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Rows of F (len(targets) x 16 P) on the panels ``part``: as
-    :func:`core.quadrature.operator_rows`, its near-field moments computed as above."""
+    :func:`core.quadrature.operator_rows`, its near-field moments computed as above.
+    ``owners`` = (one label per target, one per panel): only the rows of a target's own
+    panels are exact then (the others are left with the far-field rule, for a caller
+    that discards them)."""
     z = (targets[:, None] - part.centers[None, :]) / part.half_widths[None, :]
-    near_t, near_s = np.nonzero(np.abs(z) <= NEAR_FIELD)
+    near = np.abs(z) <= NEAR_FIELD
+    if owners is not None:
+        near &= owners[0][:, None] == owners[1][None, :]
+    near_t, near_s = np.nonzero(near)
     zn = z[near_t, near_s]
     moments = np.empty((zn.size, NODES_PER_PANEL))
     inner = np.abs(zn) <= 1.05
@@ -229,6 +236,7 @@ def corrected_roots(space: Space, steps: list[Corrected]) -> list[list[float]]:
     panels = steps[0].panels
     cuts = [c.cut for c in steps]
     cut_owner = np.concatenate([np.full(c.nodes.size, s) for s, c in enumerate(cuts)])
+    panel_owner = cut_owner[::NODES_PER_PANEL]
     cut_density = np.concatenate([c.cut_density for c in steps])
     joined_cuts = _join(cuts)
     density = np.stack([c.density for c in steps])[owner]  # (ends, N)
@@ -244,7 +252,8 @@ def corrected_roots(space: Space, steps: list[Corrected]) -> list[list[float]]:
 
     def nystrom(t: np.ndarray, rep: int) -> np.ndarray:
         base_rows = _part_rows(space.lam, panels, t)
-        cut_rows = _part_rows(space.lam, joined_cuts, t)
+        # each end needs F of its own step's cut parts only (the rest is masked off)
+        cut_rows = _part_rows(space.lam, joined_cuts, t, (np.tile(owner, rep), panel_owner))
         dens = np.tile(density, (rep, 1))
         fq = np.einsum("ij,ij->i", base_rows, dens) + (
             cut_rows * np.tile(mine, (rep, 1))) @ cut_density
