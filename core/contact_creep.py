@@ -31,7 +31,7 @@ import numpy as np
 from core.cache import StageCache, fingerprint
 from core.collocation import time_grid
 from core.contact_bands import BAND_WIDTHS, band_rule, bands_from_ends
-from core.contact_kinks import corrected_roots, kink_corrected
+from core.contact_kinks import corrected_roots, kinks_corrected
 from core.contact_zones import (
     ZONE_END_TOL,
     NoContact,
@@ -113,6 +113,7 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
     active = None
     solver = StepSolver()
     pending: list[tuple[int, Any]] = []
+    batch: list[tuple[int, tuple]] = []
     sweeps = 0
     unsettled = 0
     for n in range(steps):
@@ -139,11 +140,16 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
             nodal, pinned = ([], []) if not state.active.any() else zones_from_nodes(
                 state, space.breakpoints)[:2]
             if exact_ends and nodal:
-                # corrected now, with this step's kept factors; roots of all at the end
-                pending.append((wanted[n], kink_corrected(
-                    space, step, state, op, m, g, displacement, memory_density, solver,
-                    nodal=(nodal, pinned))))
+                # corrected in batches, each step with its own factors (kept by a
+                # snapshot); the roots of all at the end
+                batch.append((wanted[n], (step, state, displacement, memory_density,
+                                          solver.snapshot(), (nodal, pinned))))
+                if len(batch) == _KINK_BATCH:
+                    pending += _corrected(space, op, m, g, batch)
+                    batch = []
             states[wanted[n]] = (state, step, memory_density, nodal, nodal)
+    if batch:
+        pending += _corrected(space, op, m, g, batch)
     if pending:
         for (k, _), ends in zip(pending, corrected_roots(space, [c for _, c in pending]),
                                 strict=True):
@@ -152,6 +158,18 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
             "breakpoints": space.breakpoints,
             "factorizations": solver.factorizations,
             "back_substitutions": solver.back_substitutions}
+
+
+#: Output times whose kink corrections are made together (one evaluation of F on their
+#: cut parts): each holds its step's LU factors meanwhile (~0.7 MB at 300 contact
+#: nodes), so the batch stays short.
+_KINK_BATCH = 10
+
+
+def _corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
+               batch: list[tuple[int, tuple]]) -> list[tuple[int, Any]]:
+    done = kinks_corrected(space, op, m, g, [row for _, row in batch])
+    return [(k, c) for (k, _), c in zip(batch, done, strict=True)]
 
 
 def _separable(kernel: Any) -> bool:

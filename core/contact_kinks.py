@@ -110,19 +110,19 @@ def _contact_parts(panels: Panels, zones: list[tuple[float, float]], free: list[
     return parts
 
 
-def _defect(space: Space, step: Step, state: NodalState, op: np.ndarray, cut: Panels,
+def _defect(step: Step, state: NodalState, op: np.ndarray, cut: Panels,
             values: np.ndarray, parts: dict[int, list[tuple[float, float]]],
-            idx: np.ndarray) -> tuple[np.ndarray, float, float]:
+            idx: np.ndarray, cut_rows: np.ndarray) -> tuple[np.ndarray, float, float]:
     """(defect of s F q at the nodes ``idx``, 0 elsewhere; of the force; of the moment):
-    the exact integrals of the cut interpolant (``values`` on the rule ``cut``) less the
-    panels' Gauss sums. Only the contact nodes carry the equation, so only they need it."""
+    the exact integrals of the cut interpolant (``values`` on the rule ``cut``, whose
+    rows of F at the nodes ``idx`` are ``cut_rows``) less the panels' Gauss sums. Only
+    the contact nodes carry the equation, so only they need it."""
     panels = state.panels
     cols = np.concatenate([np.arange(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
                            for p in parts])
     q_cols = state.q[cols]
     defect = np.zeros(panels.size)
-    defect[idx] = (_part_rows(space.lam, cut, panels.nodes[idx]) @ values
-                   - op[np.ix_(idx, cols)] @ q_cols)
+    defect[idx] = cut_rows @ values - op[np.ix_(idx, cols)] @ q_cols
     force = float(cut.weights @ values - panels.weights[cols] @ q_cols)
     moment = float((cut.weights * cut.nodes) @ values
                    - (panels.weights[cols] * panels.nodes[cols]) @ q_cols)
@@ -178,50 +178,79 @@ def kink_corrected(space: Space, step: Step, state: NodalState, op: np.ndarray,
                    nodal: tuple[list[float], list[bool]] | None = None) -> Corrected:
     """The step solved again with the kink defect (see :func:`corrected_ends`, same
     arguments; ``nodal`` the (ends, pinned) of :func:`zones_from_nodes` if known)."""
-    ends, pinned = nodal if nodal is not None else zones_from_nodes(state,
-                                                                    space.breakpoints)[:2]
-    ends = list(ends)
-    free = [k for k, p in enumerate(pinned) if not p]
-    panels = state.panels
-    empty = Panels(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0))
-    if not free:
-        return Corrected(ends, [], panels, empty, state.q, np.zeros(0), None,
-                         state.settlement, state.tilt, step)
-    x, w = panels.nodes, panels.weights
-    idx = np.nonzero(state.active)[0]
-    zones = [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)]
-    parts = _contact_parts(panels, zones, [ends[k] for k in free])
-    cut, values = _cut_rule(panels, state, parts)
-    defect, d_force, d_moment = _defect(space, step, state, op, cut, values, parts, idx)
-    if solver is None:
-        given = dict(step.given)
-        if "force" in given:
-            given["force"] -= d_force
-        if "moment" in given:
-            given["moment"] -= d_moment
-        rhs = step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g - defect
-        if memory is not None:
-            rhs = rhs + memory
-        q_active, delta, alpha = bordered_solve(op, m, x, w, step.c, step.scale, given, rhs,
-                                                idx)
-    else:
-        # The system is linear and the state solves it without the defect: only the
-        # change is solved, with the step's kept factors (and its state left for the next
-        # step).
-        change = {name: {"force": -d_force, "moment": -d_moment}.get(name, 0.0)
-                  for name in step.given}
-        dq, d_delta, d_alpha = bordered_change(op, m, x, w, step.c, step.scale, change,
-                                               -defect, idx, solver)
-        q_active = state.q[idx] + dq
-        delta, alpha = state.settlement + d_delta, state.tilt + d_alpha
-    density = np.zeros(x.size)
-    density[idx] = q_active
-    # the cut panels' Gauss sums taken off with the pressure the defect took them with
-    for p in parts:
-        cols = slice(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
-        density[cols] -= state.q[cols]
-    return Corrected(ends, free, panels, cut, density, values, memory_density, delta, alpha,
-                     step)
+    if nodal is None:
+        nodal = tuple(zones_from_nodes(state, space.breakpoints)[:2])  # type: ignore
+    return kinks_corrected(space, op, m, g, [(step, state, memory, memory_density, solver,
+                                              nodal)])[0]
+
+
+def kinks_corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
+                    steps: list[tuple]) -> list[Corrected]:
+    """:func:`kink_corrected` for several steps on one rule at once, each given as
+    (step, state, memory, memory_density, solver, (ends, pinned)): the rows of F of all
+    their cut parts at the rule's nodes come from one evaluation. Each step's
+    ``solver`` must still hold that step's factors (:meth:`StepSolver.snapshot`)."""
+    prepared = []
+    for step, state, memory, memory_density, solver, (ends, pinned) in steps:
+        ends = list(ends)
+        free = [k for k, p in enumerate(pinned) if not p]
+        idx = np.nonzero(state.active)[0]
+        zones = [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)]
+        parts = _contact_parts(state.panels, zones, [ends[k] for k in free]) if free else {}
+        cut, values = _cut_rule(state.panels, state, parts)
+        prepared.append((step, state, memory, memory_density, solver, ends, free, idx,
+                         parts, cut, values))
+    cuts = [row[9] for row in prepared]
+    out: list[Corrected] = []
+    if not any(c.n_panels for c in cuts):
+        return [Corrected(row[5], [], row[1].panels, row[9], row[1].q, np.zeros(0), None,
+                          row[1].settlement, row[1].tilt, row[0]) for row in prepared]
+    panels = prepared[0][1].panels
+    # one evaluation: every node against every step's cut parts (near-field weights only
+    # for each step's own; the other columns are never read)
+    bounds = np.cumsum([0] + [c.nodes.size for c in cuts])
+    rows_all = _part_rows(space.lam, _join(cuts), panels.nodes)
+    for k, (step, state, memory, memory_density, solver, ends, free, idx, parts, cut,
+            values) in enumerate(prepared):
+        if not free:
+            out.append(Corrected(ends, [], panels, cut, state.q, np.zeros(0), None,
+                                 state.settlement, state.tilt, step))
+            continue
+        x, w = panels.nodes, panels.weights
+        cut_rows = rows_all[np.ix_(idx, np.arange(bounds[k], bounds[k + 1]))]
+        defect, d_force, d_moment = _defect(step, state, op, cut, values, parts, idx,
+                                            cut_rows)
+        if solver is None:
+            given = dict(step.given)
+            if "force" in given:
+                given["force"] -= d_force
+            if "moment" in given:
+                given["moment"] -= d_moment
+            rhs = (step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g
+                   - defect)
+            if memory is not None:
+                rhs = rhs + memory
+            q_active, delta, alpha = bordered_solve(op, m, x, w, step.c, step.scale, given,
+                                                    rhs, idx)
+        else:
+            # The system is linear and the state solves it without the defect: only the
+            # change is solved, with the step's kept factors (and its state left for the
+            # next step).
+            change = {name: {"force": -d_force, "moment": -d_moment}.get(name, 0.0)
+                      for name in step.given}
+            dq, d_delta, d_alpha = bordered_change(op, m, x, w, step.c, step.scale, change,
+                                                   -defect, idx, solver)
+            q_active = state.q[idx] + dq
+            delta, alpha = state.settlement + d_delta, state.tilt + d_alpha
+        density = np.zeros(x.size)
+        density[idx] = q_active
+        # the cut panels' Gauss sums taken off with the pressure the defect took them with
+        for p in parts:
+            cols = slice(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
+            density[cols] -= state.q[cols]
+        out.append(Corrected(ends, free, panels, cut, density, values, memory_density,
+                             delta, alpha, step))
+    return out
 
 
 def corrected_roots(space: Space, steps: list[Corrected]) -> list[list[float]]:

@@ -50,6 +50,14 @@ class StepSolver:
             self._last = None
         return self._sub
 
+    def snapshot(self) -> StepSolver:
+        """A solver holding this one's current factors and contact nodes (shared, not
+        copied: a new factorization replaces them here, never changes them), so that a
+        change on this step (:func:`bordered_change`) can be solved after later steps."""
+        kept = StepSolver()
+        kept._key, kept._lu, kept._sub, kept._last = self._key, self._lu, self._sub, self._last
+        return kept
+
     def _back(self, r: np.ndarray) -> np.ndarray:
         # LAPACK directly: the checked wrapper costs more than the O(N^2) solve here.
         x, _ = dgetrs(self._lu[0], self._lu[1], r)
