@@ -12,7 +12,9 @@ nodal active set (warm-started from the step before), on one fixed panel rule, s
 memory of every past pressure lives on the same nodes; that rule has fine panels over the
 bands the free zone ends sweep (:mod:`core.contact_bands`). The zone ends of each output
 time are the roots of the Nystrom pressure's interpolant on those nodes, after the kink
-of the pressure at each end is taken out of the panel rule (:mod:`core.contact_kinks`).
+of the pressure at each end is taken out of the panel rule (:mod:`core.contact_kinks`;
+the corrections of ``_KINK_BATCH`` output times at once, the roots of all after the
+march).
 
 Errors: in time, the grid is halved and the outputs of successive grids extrapolated
 (Richardson, ratio 4.0 of successive differences measured on the lift-off preset even as
