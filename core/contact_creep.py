@@ -12,7 +12,9 @@ nodal active set (warm-started from the step before), on one fixed panel rule, s
 memory of every past pressure lives on the same nodes; that rule has fine panels over the
 bands the free zone ends sweep (:mod:`core.contact_bands`). The zone ends of each output
 time are the roots of the Nystrom pressure's interpolant on those nodes, after the kink
-of the pressure at each end is taken out of the panel rule (:mod:`core.contact_kinks`).
+of the pressure at each end is taken out of the panel rule (:mod:`core.contact_kinks`;
+the corrections of ``_KINK_BATCH`` output times at once, the roots of all after the
+march).
 
 Errors: in time, the grid is halved and the outputs of successive grids extrapolated
 (Richardson, ratio 4.0 of successive differences measured on the lift-off preset even as
@@ -31,7 +33,7 @@ import numpy as np
 from core.cache import StageCache, fingerprint
 from core.collocation import time_grid
 from core.contact_bands import BAND_WIDTHS, band_rule, bands_from_ends
-from core.contact_kinks import corrected_ends
+from core.contact_kinks import corrected_roots, kinks_corrected
 from core.contact_zones import (
     ZONE_END_TOL,
     NoContact,
@@ -91,14 +93,6 @@ def rule_operator(lam: float, rule: Panels) -> np.ndarray:
     return _RULE_OPERATORS.get_or_compute(key, build)[0].matrix
 
 
-def _zones(state: NodalState, breakpoints: tuple[float, ...]
-           ) -> tuple[list[tuple[float, float]], list[float]]:
-    if not state.active.any():
-        return [], []
-    ends, _, _ = zones_from_nodes(state, breakpoints)
-    return [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)], ends
-
-
 def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.ndarray,
            grid: np.ndarray, widths: np.ndarray, out_index: np.ndarray,
            exact_ends: bool = True) -> dict[str, Any]:
@@ -120,6 +114,8 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
         [None] * len(out_index))  # type: ignore
     active = None
     solver = StepSolver()
+    pending: list[tuple[int, Any]] = []
+    batch: list[tuple[int, tuple]] = []
     sweeps = 0
     unsettled = 0
     for n in range(steps):
@@ -143,14 +139,39 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
         active = state.active
         memory_of.record(n, state.q)
         if n in wanted:
-            nodal = _zones(state, space.breakpoints)[1]
-            ends = corrected_ends(space, step, state, op, m, g, displacement,
-                                  memory_density, solver) if exact_ends else nodal
-            states[wanted[n]] = (state, step, memory_density, ends, nodal)
+            nodal, pinned = ([], []) if not state.active.any() else zones_from_nodes(
+                state, space.breakpoints)[:2]
+            if exact_ends and nodal:
+                # corrected in batches, each step with its own factors (kept by a
+                # snapshot); the roots of all at the end
+                batch.append((wanted[n], (step, state, displacement, memory_density,
+                                          solver.snapshot(), (nodal, pinned))))
+                if len(batch) == _KINK_BATCH:
+                    pending += _corrected(space, op, m, g, batch)
+                    batch = []
+            states[wanted[n]] = (state, step, memory_density, nodal, nodal)
+    if batch:
+        pending += _corrected(space, op, m, g, batch)
+    if pending:
+        for (k, _), ends in zip(pending, corrected_roots(space, [c for _, c in pending]),
+                                strict=True):
+            states[k] = states[k][:3] + (ends, states[k][4])
     return {"states": states, "sweeps": sweeps, "unsettled": unsettled, "steps": steps - 1,
             "breakpoints": space.breakpoints,
             "factorizations": solver.factorizations,
             "back_substitutions": solver.back_substitutions}
+
+
+#: Output times whose kink corrections are made together (one evaluation of F on their
+#: cut parts): each holds its step's LU factors meanwhile (~0.7 MB at 300 contact
+#: nodes), so the batch stays short.
+_KINK_BATCH = 10
+
+
+def _corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
+               batch: list[tuple[int, tuple]]) -> list[tuple[int, Any]]:
+    done = kinks_corrected(space, op, m, g, [row for _, row in batch])
+    return [(k, c) for (k, _), c in zip(batch, done, strict=True)]
 
 
 def _separable(kernel: Any) -> bool:

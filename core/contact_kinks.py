@@ -27,9 +27,11 @@ the nodal ones were 2.4e-6 off (tests/test_contact.py).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from core.contact_systems import StepSolver, bordered_solve
+from core.contact_systems import StepSolver, bordered_change, bordered_solve
 from core.contact_zones import (
     _BARYCENTRIC,
     _T,
@@ -52,11 +54,18 @@ _OVER_T, _OVER_W = np.polynomial.legendre.leggauss(64)
 _OVER_P = np.polynomial.legendre.legvander(_OVER_T, NODES_PER_PANEL - 1)
 
 
-def _part_rows(lam: float, part: Panels, targets: np.ndarray) -> np.ndarray:
+def _part_rows(lam: float, part: Panels, targets: np.ndarray,
+               owners: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Rows of F (len(targets) x 16 P) on the panels ``part``: as
-    :func:`core.quadrature.operator_rows`, its near-field moments computed as above."""
+    :func:`core.quadrature.operator_rows`, its near-field moments computed as above.
+    ``owners`` = (one label per target, one per panel): only the rows of a target's own
+    panels are exact then (the others are left with the far-field rule, for a caller
+    that discards them)."""
     z = (targets[:, None] - part.centers[None, :]) / part.half_widths[None, :]
-    near_t, near_s = np.nonzero(np.abs(z) <= NEAR_FIELD)
+    near = np.abs(z) <= NEAR_FIELD
+    if owners is not None:
+        near &= owners[0][:, None] == owners[1][None, :]
+    near_t, near_s = np.nonzero(near)
     zn = z[near_t, near_s]
     moments = np.empty((zn.size, NODES_PER_PANEL))
     inner = np.abs(zn) <= 1.05
@@ -101,19 +110,19 @@ def _contact_parts(panels: Panels, zones: list[tuple[float, float]], free: list[
     return parts
 
 
-def _defect(space: Space, step: Step, state: NodalState, op: np.ndarray, cut: Panels,
+def _defect(step: Step, state: NodalState, op: np.ndarray, cut: Panels,
             values: np.ndarray, parts: dict[int, list[tuple[float, float]]],
-            idx: np.ndarray) -> tuple[np.ndarray, float, float]:
+            idx: np.ndarray, cut_rows: np.ndarray) -> tuple[np.ndarray, float, float]:
     """(defect of s F q at the nodes ``idx``, 0 elsewhere; of the force; of the moment):
-    the exact integrals of the cut interpolant (``values`` on the rule ``cut``) less the
-    panels' Gauss sums. Only the contact nodes carry the equation, so only they need it."""
+    the exact integrals of the cut interpolant (``values`` on the rule ``cut``, whose
+    rows of F at the nodes ``idx`` are ``cut_rows``) less the panels' Gauss sums. Only
+    the contact nodes carry the equation, so only they need it."""
     panels = state.panels
     cols = np.concatenate([np.arange(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
                            for p in parts])
     q_cols = state.q[cols]
     defect = np.zeros(panels.size)
-    defect[idx] = (_part_rows(space.lam, cut, panels.nodes[idx]) @ values
-                   - op[np.ix_(idx, cols)] @ q_cols)
+    defect[idx] = cut_rows @ values - op[np.ix_(idx, cols)] @ q_cols
     force = float(cut.weights @ values - panels.weights[cols] @ q_cols)
     moment = float((cut.weights * cut.nodes) @ values
                    - (panels.weights[cols] * panels.nodes[cols]) @ q_cols)
@@ -133,54 +142,159 @@ def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
     is then the root of that solution's Nystrom pressure Q(x), evaluated by its formula
     (the interpolant of the nodal Q errs there: F of the kinked q puts a
     ``(x - end)^2 ln|x - end|`` term into Q, which 16-point panels read ~1e-4 wrong).
-    Ends at +-1 or at breakpoints are kept (dimensionless throughout).
+    Ends at +-1 or at breakpoints are kept (dimensionless throughout). The two halves,
+    :func:`kink_corrected` and :func:`corrected_roots`, let a march correct every output
+    time as it passes and find all the roots at once at its end.
     """
     if not state.active.any():
         return []
-    ends, pinned, _ = zones_from_nodes(state, space.breakpoints)
-    free = [k for k, p in enumerate(pinned) if not p]
-    if not free:
-        return ends
-    panels = state.panels
-    x, w = panels.nodes, panels.weights
-    idx = np.nonzero(state.active)[0]
-    zones = [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)]
-    parts = _contact_parts(panels, zones, [ends[k] for k in free])
-    cut, values = _cut_rule(panels, state, parts)
-    defect, d_force, d_moment = _defect(space, step, state, op, cut, values, parts, idx)
-    given = dict(step.given)
-    if "force" in given:
-        given["force"] -= d_force
-    if "moment" in given:
-        given["moment"] -= d_moment
-    rhs = step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g - defect
-    if memory is not None:
-        rhs = rhs + memory
-    q_active, delta, alpha = bordered_solve(op, m, x, w, step.c, step.scale, given, rhs,
-                                            idx, solver)
-    q = np.zeros(x.size)
-    q[idx] = q_active
-    # F on the rule and on the cut parts at once; the cut panels' Gauss sums taken off
-    # with the pressure the defect of the solve took them with
-    joined = _join([panels, cut])
-    density = np.concatenate([q, values])
-    for p in parts:
-        cols = slice(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
-        density[cols] -= state.q[cols]
-    density_memory = None if memory_density is None else np.concatenate(
-        [memory_density, np.zeros(values.size)])
+    return corrected_roots(space, [kink_corrected(space, step, state, op, m, g, memory,
+                                                  memory_density, solver)])[0]
 
-    def nystrom(t: np.ndarray) -> np.ndarray:
-        rows = _part_rows(space.lam, joined, t)
-        fq = rows @ density
-        e = 0.0 if density_memory is None else rows @ density_memory
-        return (delta + alpha * t - space.g(t) + e - step.scale * fq) / (step.c * space.m(t))
 
-    # Secant from the interpolant's roots (within ~1e-4 of the true ones).
-    inward = np.array([1.0 if k % 2 == 0 else -1.0 for k in free])
-    a = np.array([ends[k] for k in free])
+@dataclass
+class Corrected:
+    """One step's corrected solution, waiting for its roots (:func:`corrected_roots`):
+    the nodal ends and which are free, the density on ``panels`` (the nodal rule) and on
+    ``cut`` (the contact parts of the end panels), the memory density on ``panels``, and
+    the step's scalars."""
+
+    ends: list[float]
+    free: list[int]
+    panels: Panels
+    cut: Panels
+    density: np.ndarray
+    cut_density: np.ndarray
+    memory_density: np.ndarray | None
+    delta: float
+    alpha: float
+    step: Step
+
+
+def kink_corrected(space: Space, step: Step, state: NodalState, op: np.ndarray,
+                   m: np.ndarray, g: np.ndarray, memory: np.ndarray | None = None,
+                   memory_density: np.ndarray | None = None,
+                   solver: StepSolver | None = None,
+                   nodal: tuple[list[float], list[bool]] | None = None) -> Corrected:
+    """The step solved again with the kink defect (see :func:`corrected_ends`, same
+    arguments; ``nodal`` the (ends, pinned) of :func:`zones_from_nodes` if known)."""
+    if nodal is None:
+        nodal = tuple(zones_from_nodes(state, space.breakpoints)[:2])  # type: ignore
+    return kinks_corrected(space, op, m, g, [(step, state, memory, memory_density, solver,
+                                              nodal)])[0]
+
+
+def kinks_corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
+                    steps: list[tuple]) -> list[Corrected]:
+    """:func:`kink_corrected` for several steps on one rule at once, each given as
+    (step, state, memory, memory_density, solver, (ends, pinned)): the rows of F of all
+    their cut parts at the rule's nodes come from one evaluation. Each step's
+    ``solver`` must still hold that step's factors (:meth:`StepSolver.snapshot`)."""
+    prepared = []
+    for step, state, memory, memory_density, solver, (ends, pinned) in steps:
+        ends = list(ends)
+        free = [k for k, p in enumerate(pinned) if not p]
+        idx = np.nonzero(state.active)[0]
+        zones = [(ends[2 * i], ends[2 * i + 1]) for i in range(len(ends) // 2)]
+        parts = _contact_parts(state.panels, zones, [ends[k] for k in free]) if free else {}
+        cut, values = _cut_rule(state.panels, state, parts)
+        prepared.append((step, state, memory, memory_density, solver, ends, free, idx,
+                         parts, cut, values))
+    cuts = [row[9] for row in prepared]
+    out: list[Corrected] = []
+    if not any(c.n_panels for c in cuts):
+        return [Corrected(row[5], [], row[1].panels, row[9], row[1].q, np.zeros(0), None,
+                          row[1].settlement, row[1].tilt, row[0]) for row in prepared]
+    panels = prepared[0][1].panels
+    # one evaluation: every node against every step's cut parts (near-field weights only
+    # for each step's own; the other columns are never read)
+    bounds = np.cumsum([0] + [c.nodes.size for c in cuts])
+    rows_all = _part_rows(space.lam, _join(cuts), panels.nodes)
+    for k, (step, state, memory, memory_density, solver, ends, free, idx, parts, cut,
+            values) in enumerate(prepared):
+        if not free:
+            out.append(Corrected(ends, [], panels, cut, state.q, np.zeros(0), None,
+                                 state.settlement, state.tilt, step))
+            continue
+        x, w = panels.nodes, panels.weights
+        cut_rows = rows_all[np.ix_(idx, np.arange(bounds[k], bounds[k + 1]))]
+        defect, d_force, d_moment = _defect(step, state, op, cut, values, parts, idx,
+                                            cut_rows)
+        if solver is None:
+            given = dict(step.given)
+            if "force" in given:
+                given["force"] -= d_force
+            if "moment" in given:
+                given["moment"] -= d_moment
+            rhs = (step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g
+                   - defect)
+            if memory is not None:
+                rhs = rhs + memory
+            q_active, delta, alpha = bordered_solve(op, m, x, w, step.c, step.scale, given,
+                                                    rhs, idx)
+        else:
+            # The system is linear and the state solves it without the defect: only the
+            # change is solved, with the step's kept factors (and its state left for the
+            # next step).
+            change = {name: {"force": -d_force, "moment": -d_moment}.get(name, 0.0)
+                      for name in step.given}
+            dq, d_delta, d_alpha = bordered_change(op, m, x, w, step.c, step.scale, change,
+                                                   -defect, idx, solver)
+            q_active = state.q[idx] + dq
+            delta, alpha = state.settlement + d_delta, state.tilt + d_alpha
+        density = np.zeros(x.size)
+        density[idx] = q_active
+        # the cut panels' Gauss sums taken off with the pressure the defect took them with
+        for p in parts:
+            cols = slice(p * NODES_PER_PANEL, (p + 1) * NODES_PER_PANEL)
+            density[cols] -= state.q[cols]
+        out.append(Corrected(ends, free, panels, cut, density, values, memory_density,
+                             delta, alpha, step))
+    return out
+
+
+def corrected_roots(space: Space, steps: list[Corrected]) -> list[list[float]]:
+    """The ends of each of ``steps`` (all on one nodal rule), free ones moved to the roots
+    of their corrected Nystrom pressure Q: a secant from the interpolant's roots (within
+    ~1e-4 of the true ones), all ends of all steps at once (F on the nodal rule and on
+    every cut part evaluated at every end in one go)."""
+    owner = np.array([s for s, c in enumerate(steps) for _ in c.free], dtype=int)
+    out = [list(c.ends) for c in steps]
+    if owner.size == 0:
+        return out
+    panels = steps[0].panels
+    cuts = [c.cut for c in steps]
+    cut_owner = np.concatenate([np.full(c.nodes.size, s) for s, c in enumerate(cuts)])
+    panel_owner = cut_owner[::NODES_PER_PANEL]
+    cut_density = np.concatenate([c.cut_density for c in steps])
+    joined_cuts = _join(cuts)
+    density = np.stack([c.density for c in steps])[owner]  # (ends, N)
+    memory = None
+    if any(c.memory_density is not None for c in steps):
+        memory = np.stack([np.zeros(panels.size) if c.memory_density is None
+                           else c.memory_density for c in steps])[owner]
+    delta = np.array([steps[s].delta for s in owner])
+    alpha = np.array([steps[s].alpha for s in owner])
+    scale = np.array([steps[s].step.scale for s in owner])
+    c_val = np.array([steps[s].step.c for s in owner])
+    mine = cut_owner[None, :] == owner[:, None]  # (ends, cut nodes): each end's own cut
+
+    def nystrom(t: np.ndarray, rep: int) -> np.ndarray:
+        base_rows = _part_rows(space.lam, panels, t)
+        # each end needs F of its own step's cut parts only (the rest is masked off)
+        cut_rows = _part_rows(space.lam, joined_cuts, t, (np.tile(owner, rep), panel_owner))
+        dens = np.tile(density, (rep, 1))
+        fq = np.einsum("ij,ij->i", base_rows, dens) + (
+            cut_rows * np.tile(mine, (rep, 1))) @ cut_density
+        e = 0.0 if memory is None else np.einsum("ij,ij->i", base_rows,
+                                                 np.tile(memory, (rep, 1)))
+        return ((np.tile(delta, rep) + np.tile(alpha, rep) * t - space.g(t) + e
+                 - np.tile(scale, rep) * fq) / (np.tile(c_val, rep) * space.m(t)))
+
+    inward = np.array([1.0 if k % 2 == 0 else -1.0 for c in steps for k in c.free])
+    a = np.array([c.ends[k] for c in steps for k in c.free])
     b = a + 1e-6 * inward
-    both = nystrom(np.concatenate([a, b]))
+    both = nystrom(np.concatenate([a, b]), 2)
     fa, fb = both[:a.size], both[a.size:]
     for _ in range(_SECANT_STEPS):
         slope = (fb - fa) / (b - a)
@@ -191,14 +305,18 @@ def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
         # a step below 1e-8 leaves ~1e-14 (the secant converges superlinearly from ~1e-4)
         if np.max(np.abs(step_x)) < 1e-2 * ZONE_END_TOL:
             break
-        fb = nystrom(b)
-    out = list(ends)
-    for j, k in enumerate(free):
-        lo = -1.0 if k == 0 else ends[k - 1]
-        hi = 1.0 if k == len(ends) - 1 else ends[k + 1]
-        # a root that ran off (a degenerate slope) keeps the interpolant's end
-        if lo < b[j] < hi and abs(b[j] - ends[k]) < 2.0 * panels.half_widths.max():
-            out[k] = float(b[j])
+        fb = nystrom(b, 1)
+    widest = 2.0 * panels.half_widths.max()
+    j = 0
+    for s, c in enumerate(steps):
+        ends = c.ends
+        for k in c.free:
+            lo = -1.0 if k == 0 else ends[k - 1]
+            hi = 1.0 if k == len(ends) - 1 else ends[k + 1]
+            # a root that ran off (a degenerate slope) keeps the interpolant's end
+            if lo < b[j] < hi and abs(b[j] - ends[k]) < widest:
+                out[s][k] = float(b[j])
+            j += 1
     return out
 
 

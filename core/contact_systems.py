@@ -11,7 +11,7 @@ creep step to the next.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from scipy.linalg import lu_factor
@@ -31,6 +31,7 @@ class StepSolver:
     _REFINE_STEPS = 12
     _RESIDUAL = 1e-13
     REFRESH_AFTER = 6
+    CHANGE_RESIDUAL = 1e-9
 
     def __init__(self) -> None:
         self._key: tuple | None = None
@@ -48,6 +49,14 @@ class StepSolver:
             self._lu = None
             self._last = None
         return self._sub
+
+    def snapshot(self) -> StepSolver:
+        """A solver holding this one's current factors and contact nodes (shared, not
+        copied: a new factorization replaces them here, never changes them), so that a
+        change on this step (:func:`bordered_change`) can be solved after later steps."""
+        kept = StepSolver()
+        kept._key, kept._lu, kept._sub, kept._last = self._key, self._lu, self._sub, self._last
+        return kept
 
     def _back(self, r: np.ndarray) -> np.ndarray:
         # LAPACK directly: the checked wrapper costs more than the O(N^2) solve here.
@@ -81,27 +90,45 @@ class StepSolver:
         self._last = self._back(b)
         return self._last
 
+    def solve_change(self, build: Callable[[], np.ndarray],
+                     apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray) -> np.ndarray:
+        """Solve ``A x = b`` for a small change ``b`` of a right-hand side just solved on
+        the same contact nodes: refinement from zero with the kept factors to a residual
+        of ``CHANGE_RESIDUAL`` relative to ``b`` (the change is itself small, so its
+        error enters the total far below ``_RESIDUAL`` of it). The last solution and the
+        factors are left as they were for the next step (new factors are kept only when
+        there were none)."""
+        if self._lu is None:
+            self._lu = lu_factor(build(), check_finite=False)
+            self.factorizations += 1
+        scale = max(float(np.abs(b).max()), 1e-300)
+        x = self._back(b)
+        self.back_substitutions += 1
+        for _ in range(self._REFINE_STEPS):
+            r = b - apply(x)
+            if float(np.abs(r).max()) <= self.CHANGE_RESIDUAL * scale:
+                return x
+            x = x + self._back(r)
+            self.back_substitutions += 1
+        # the kept factors no longer precondition well (c/s drifted): exact ones
+        return np.linalg.solve(build(), b)
 
-def bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, c: float,
-                   scale: float, given: dict[str, float], rhs: np.ndarray, idx: np.ndarray,
-                   solver: StepSolver | None = None) -> tuple[np.ndarray, float, float]:
-    """Solve the equation on the nodes ``idx`` (q = 0 elsewhere) with the given loads.
 
-    Returns (q on idx, settlement, tilt). ``rhs`` = ``delta_g + alpha_g x - g + e`` at all
-    nodes (with the given ones of delta, alpha; 0 for the unknown ones).
-    """
+def _bordered_system(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, c: float,
+                     scale: float, given: Sequence[str], idx: np.ndarray,
+                     solver: StepSolver | None):
+    """(build, apply, key, unknown border names) of the system on ``idx``, divided by
+    ``scale``: see :func:`bordered_solve`."""
     n = idx.size
-    cols, rows, extra = [], [], []
+    cols, rows = [], []
     if "settlement" not in given:
         cols.append(-np.ones(n))
     if "tilt" not in given:
         cols.append(-x[idx])
     if "force" in given:
         rows.append(w[idx])
-        extra.append(given["force"])
     if "moment" in given:
         rows.append(w[idx] * x[idx])
-        extra.append(given["moment"])
     k = len(cols)
     border_cols = np.array(cols).T.reshape(n, k)
     border_rows = np.array(rows).reshape(k, n)
@@ -125,10 +152,41 @@ def bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, 
         top = diagonal * zq + sub @ zq + border_cols @ z[n:]
         return np.concatenate([top, border_rows @ zq])
 
+    return build, apply
+
+
+def bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, c: float,
+                   scale: float, given: dict[str, float], rhs: np.ndarray, idx: np.ndarray,
+                   solver: StepSolver | None = None) -> tuple[np.ndarray, float, float]:
+    """Solve the equation on the nodes ``idx`` (q = 0 elsewhere) with the given loads.
+
+    Returns (q on idx, settlement, tilt). ``rhs`` = ``delta_g + alpha_g x - g + e`` at all
+    nodes (with the given ones of delta, alpha; 0 for the unknown ones).
+    """
+    build, apply = _bordered_system(op, m, x, w, c, scale, tuple(given), idx, solver)
+    extra = [given[name] for name in ("force", "moment") if name in given]
     b = np.concatenate([rhs[idx] / scale, extra])
     sol = np.linalg.solve(build(), b) if solver is None else solver.solve(build, apply, b)
-    sol[n:] *= scale
-    tail = list(sol[n:])
+    return _unpack(sol, idx.size, scale, given)
+
+
+def bordered_change(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, c: float,
+                    scale: float, given: dict[str, float], rhs: np.ndarray,
+                    idx: np.ndarray, solver: StepSolver) -> tuple[np.ndarray, float, float]:
+    """The change of :func:`bordered_solve`'s answer when its ``rhs`` and given loads
+    change by ``rhs`` and ``given`` (the system is linear; given settlement or tilt change
+    by their entries), solved with the kept factors of ``solver`` to a residual of
+    ``StepSolver.CHANGE_RESIDUAL`` of the change, and leaving its state for the next step.
+    Returns (change of q on idx, of the settlement, of the tilt)."""
+    build, apply = _bordered_system(op, m, x, w, c, scale, tuple(given), idx, solver)
+    extra = [given[name] for name in ("force", "moment") if name in given]
+    b = np.concatenate([rhs[idx] / scale, extra])
+    return _unpack(solver.solve_change(build, apply, b), idx.size, scale, given)
+
+
+def _unpack(sol: np.ndarray, n: int, scale: float, given: dict[str, float]
+            ) -> tuple[np.ndarray, float, float]:
+    tail = list(sol[n:] * scale)
     delta = tail.pop(0) if "settlement" not in given else given["settlement"]
     alpha = tail.pop(0) if "tilt" not in given else given["tilt"]
     return sol[:n], float(delta), float(alpha)
