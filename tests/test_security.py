@@ -642,11 +642,7 @@ def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:
 
 @pytest.fixture(scope="module")
 def served() -> Iterator[str]:
-    missing = browser_missing()
-    if missing:
-        if os.environ.get("CI"):  # the test set-up installs both: their absence is a failure
-            pytest.fail(missing, pytrace=False)
-        pytest.skip(missing)
+    require_browser()
     with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as server:
         yield server.url
 

@@ -291,3 +291,23 @@ def test_workers_do_not_outlive_the_server(sig: int, wait_until) -> None:
     finally:
         server.kill()
         server.wait()
+
+
+def test_a_worker_solves_without_importing_the_page_libraries() -> None:
+    # A worker imports this module, core and the state's names (explorer/results.py); Panel
+    # and Bokeh would cost each worker ~1 s and ~100 MB for nothing.
+    script = textwrap.dedent("""
+        import copy, sys
+        import explorer.code_creep_state, explorer.results, explorer.state, explorer.workers
+        from explorer.presets import DEFAULT_PRESET, presets
+
+        scene = copy.deepcopy(presets()[DEFAULT_PRESET])
+        scene["times"] = {"end": 200.0, "count": 4, "spacing": "log"}
+        view = explorer.workers.solve_view(scene)
+        print(len(view.times), sorted(m for m in ("panel", "bokeh") if m in sys.modules))
+    """)
+    env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get(
+        "PYTHONPATH", "")}
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         env=env, timeout=120, check=True).stdout.split()
+    assert out[0] == "4" and out[1:] == ["[]"], out
