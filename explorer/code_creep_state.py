@@ -19,6 +19,7 @@ import numpy as np
 import param
 
 import core
+from core.code_creep import RANGES
 
 #: The design-code creep models offered by name: spec model name -> label on screen.
 CODE_CREEP_MODELS: dict[str, str] = {
@@ -33,6 +34,12 @@ STRENGTH_CLASSES: tuple[str, ...] = (
 PLOT_DURATIONS: np.ndarray = np.geomspace(0.1, 36525.0, 161)
 
 
+def _code_input(name: str, default: float, doc: str) -> param.Number:
+    # the slider's soft range is the range core accepts for the default code (fib MC2010)
+    low, high, _source = RANGES["fib_mc2010"][name]
+    return param.Number(default=default, softbounds=(low, high), doc=doc)
+
+
 class CodeCreepState(param.Parameterized):
     """Inputs of a design-code creep model, in the codes' units."""
 
@@ -41,16 +48,14 @@ class CodeCreepState(param.Parameterized):
     strength_class = param.Selector(default="C30/37", objects=[*STRENGTH_CLASSES, "fcm"],
                                     doc="Strength class, or 'fcm' to give the mean "
                                         "cylinder strength directly.")
-    fcm = param.Number(default=38.0, softbounds=(20.0, 130.0),
-                       doc="Mean cylinder strength f_cm [MPa] (used when the class is 'fcm').")
+    fcm = _code_input("fcm", 38.0, "Mean cylinder strength f_cm [MPa] (used when the class "
+                      "is 'fcm').")
     cement = param.Selector(default="N", objects=["S", "N", "R"],
                             doc="Cement class: S slow, N normal, R rapid hardening.")
-    relative_humidity = param.Number(default=60.0, softbounds=(40.0, 100.0),
-                                     doc="Relative humidity of the ambient air RH [%].")
-    notional_size = param.Number(default=300.0, softbounds=(50.0, 1500.0),
-                                 doc="Notional size h = 2 A_c / u [mm].")
-    temperature = param.Number(default=20.0, softbounds=(5.0, 30.0),
-                               doc="Mean temperature T [deg C].")
+    relative_humidity = _code_input("relative_humidity", 60.0,
+                                    "Relative humidity of the ambient air RH [%].")
+    notional_size = _code_input("notional_size", 300.0, "Notional size h = 2 A_c / u [mm].")
+    temperature = _code_input("temperature", 20.0, "Mean temperature T [deg C].")
 
     def spec(self, model: str | None = None) -> dict[str, Any]:
         """The creep spec (SCENES.md, code units), checked by core; ``model`` replaces
