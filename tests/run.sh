@@ -23,5 +23,5 @@ export CI="${CI:-1}"
 # Small dense matrices: BLAS threads only fight each other on 2 cores (10x slower measured).
 export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}"
 
-
+python -m ruff check core explorer tests benchmarks
 python -m pytest -q "$@"
