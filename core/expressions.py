@@ -70,21 +70,13 @@ def _heaviside(v: Any) -> Any:
     return np.heaviside(v, 1.0)
 
 
+#: Functions of one argument that are numpy's functions of the same name.
+_NUMPY_UNARY = ("sin", "cos", "tan", "exp", "log", "log10", "sqrt", "abs", "tanh", "sinh",
+                "cosh", "arctan", "sign")
+
 #: Functions: name -> (numpy implementation, number of arguments).
 FUNCTIONS: Mapping[str, tuple[Callable[..., Any], int]] = MappingProxyType({
-    "sin": (np.sin, 1),
-    "cos": (np.cos, 1),
-    "tan": (np.tan, 1),
-    "exp": (np.exp, 1),
-    "log": (np.log, 1),
-    "log10": (np.log10, 1),
-    "sqrt": (np.sqrt, 1),
-    "abs": (np.abs, 1),
-    "tanh": (np.tanh, 1),
-    "sinh": (np.sinh, 1),
-    "cosh": (np.cosh, 1),
-    "arctan": (np.arctan, 1),
-    "sign": (np.sign, 1),
+    **{name: (getattr(np, name), 1) for name in _NUMPY_UNARY},
     "heaviside": (_heaviside, 1),
     "min": (np.minimum, 2),
     "max": (np.maximum, 2),

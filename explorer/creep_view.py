@@ -1,10 +1,8 @@
-"""Design-code creep of the base (fib MC2010, Eurocode 2) in engineering units.
+"""Design-code creep of the base (fib MC2010, Eurocode 2) on the page.
 
-``CodeCreepState`` holds the inputs as an engineer reads them off a drawing (strength
-class or mean strength in MPa, cement class, relative humidity in %, notional size in mm,
-temperature in deg C) and turns them into the creep spec of SCENES.md; core validates
-them and every refusal names the field. ``creep_coefficient_data`` and
-``creep_coefficient_figure`` draw phi(t, t0) against the load duration on a log axis, to
+The inputs (``CodeCreepState``) and the plot's columns (``creep_coefficient_data``) live
+in :mod:`explorer.code_creep_state`, free of Panel, and are re-exported here.
+``creep_coefficient_figure`` draws phi(t, t0) against the load duration on a log axis, to
 be compared with the codes' tables and figures (EN 1992-1-1 Figure 3.1, MC2010 5.1.9.4).
 
 ``CodeCreepPanel`` shows the inputs and the plot in the base settings while a code model
@@ -15,93 +13,21 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
 import panel as pn
-import param
 from bokeh.models import ColumnDataSource, HoverTool
 from bokeh.plotting import figure
 
-import core
+from .code_creep_state import (
+    CODE_CREEP_MODELS,
+    PLOT_DURATIONS,
+    STRENGTH_CLASSES,
+    CodeCreepState,
+    creep_coefficient_data,
+)
 
-#: The design-code creep models offered by name: spec model name -> label on screen.
-CODE_CREEP_MODELS: dict[str, str] = {
-    "fib_mc2010": "fib Model Code 2010",
-    "eurocode2": "Eurocode 2 (EN 1992-1-1, Annex B)",
-}
-#: Strength classes offered (EN 1992-1-1 Table 3.1); fcm = fck + 8 MPa in core.
-STRENGTH_CLASSES: tuple[str, ...] = (
-    "C20/25", "C25/30", "C30/37", "C35/45", "C40/50", "C45/55", "C50/60", "C55/67",
-    "C60/75", "C70/85", "C80/95", "C90/105")
-#: Load durations of the plot [day]: 0.1 day to 100 years, log spaced.
-PLOT_DURATIONS: np.ndarray = np.geomspace(0.1, 36525.0, 161)
-
-
-class CodeCreepState(param.Parameterized):
-    """Inputs of a design-code creep model, in the codes' units."""
-
-    code_model = param.Selector(default="fib_mc2010", objects=list(CODE_CREEP_MODELS),
-                                doc="Design code whose creep and aging law is used.")
-    strength_class = param.Selector(default="C30/37", objects=[*STRENGTH_CLASSES, "fcm"],
-                                    doc="Strength class, or 'fcm' to give the mean "
-                                        "cylinder strength directly.")
-    fcm = param.Number(default=38.0, softbounds=(20.0, 130.0),
-                       doc="Mean cylinder strength f_cm [MPa] (used when the class is 'fcm').")
-    cement = param.Selector(default="N", objects=["S", "N", "R"],
-                            doc="Cement class: S slow, N normal, R rapid hardening.")
-    relative_humidity = param.Number(default=60.0, softbounds=(40.0, 100.0),
-                                     doc="Relative humidity of the ambient air RH [%].")
-    notional_size = param.Number(default=300.0, softbounds=(50.0, 1500.0),
-                                 doc="Notional size h = 2 A_c / u [mm].")
-    temperature = param.Number(default=20.0, softbounds=(5.0, 30.0),
-                               doc="Mean temperature T [deg C].")
-
-    def spec(self, model: str | None = None) -> dict[str, Any]:
-        """The creep spec (SCENES.md, code units), checked by core; ``model`` replaces
-        ``code_model`` (the base's creep selector names the code).
-
-        Raises ValueError naming ``base.creep.<field>`` for an input the code does not
-        cover.
-        """
-        out: dict[str, Any] = {"model": model or self.code_model}
-        if self.strength_class == "fcm":
-            out["fcm"] = self.fcm
-        else:
-            out["strength_class"] = self.strength_class
-        out.update(cement=self.cement, relative_humidity=self.relative_humidity,
-                   notional_size=self.notional_size, temperature=self.temperature)
-        # one evaluation validates every field with core's own ranges and messages
-        core.creep_coefficient_curve(out, 28.0, [0.0], field="base.creep")
-        return out
-
-    def load(self, spec: dict[str, Any]) -> None:
-        """Show a code creep spec (as in a scene file) on the inputs."""
-        if spec.get("model") not in CODE_CREEP_MODELS:
-            raise ValueError("base.creep.model: must be one of " + ", ".join(CODE_CREEP_MODELS))
-        values: dict[str, Any] = {"code_model": spec["model"],
-                                  "cement": spec.get("cement", "N"),
-                                  "relative_humidity": spec["relative_humidity"],
-                                  "notional_size": spec["notional_size"],
-                                  "temperature": spec.get("temperature", 20.0)}
-        cls = spec.get("strength_class")
-        if isinstance(cls, str) and cls.replace(" ", "") in STRENGTH_CLASSES:
-            values["strength_class"] = cls.replace(" ", "")
-        elif "fcm" in spec:
-            values.update(strength_class="fcm", fcm=spec["fcm"])
-        else:
-            raise ValueError(f"base.creep.strength_class: {cls!r} is not one of "
-                             + ", ".join(STRENGTH_CLASSES))
-        self.param.update(**values)
-
-
-def creep_coefficient_data(spec: dict[str, Any], age_at_loading: float,
-                           durations: np.ndarray = PLOT_DURATIONS) -> dict[str, list]:
-    """Columns of the creep-coefficient plot: ``duration`` [day], ``phi`` [-].
-
-    ``phi`` is phi(t0 + duration, t0) of the code model ``spec`` for the age at loading
-    t0 [day]; ValueErrors name the field.
-    """
-    phi = core.creep_coefficient_curve(spec, age_at_loading, durations, field="base.creep")
-    return {"duration": [float(d) for d in durations], "phi": [float(p) for p in phi]}
+__all__ = ["CODE_CREEP_MODELS", "PLOT_DURATIONS", "STRENGTH_CLASSES", "CodeCreepPanel",
+           "CodeCreepState", "creep_coefficient_data", "creep_coefficient_figure",
+           "update_creep_figure"]
 
 
 def creep_coefficient_figure() -> tuple[Any, ColumnDataSource]:

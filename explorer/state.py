@@ -23,7 +23,7 @@ from core.coating_model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES,
 from core.profiles import HISTORY_FORMS, VARIATIONS, history_form_of, variation_of
 from core.scene import QUANTITIES
 
-from .creep_view import CODE_CREEP_MODELS, CodeCreepState
+from .code_creep_state import CODE_CREEP_MODELS, CodeCreepState
 
 #: Contact models of ``solver.contact``, as the solver names them ("auto" is the default).
 CONTACT_MODELS = ("auto", "full", "unilateral")

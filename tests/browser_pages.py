@@ -121,15 +121,15 @@ def until(check, what: str, timeout: float = 60.0, describe=None) -> None:
         time.sleep(0.05)
 
 
-def served_explorer():
-    """A served explorer (``python -m explorer``) for a test module: yields its address,
-    then fails on a traceback of the page's code in the server's output."""
-    from benchmarks.serving import ExplorerProcess
-
-    # 180 s: the server solves the default scene once before it answers
-    with ExplorerProcess(ready_timeout=180) as explorer:
-        yield explorer.url
-    output = explorer.output()
+def served_explorer(explorer):
+    """The run's served explorer (``explorer``: the ``explorer_server`` fixture) for a test
+    module: yields its address, then fails on a traceback of the page's code that the
+    server wrote while the module ran."""
+    if explorer.proc.poll() is not None:
+        raise RuntimeError(f"the served explorer has exited:\n{explorer.output()[-3000:]}")
+    start = len(explorer.output())
+    yield explorer.url
+    output = explorer.output()[start:]
     assert not _app_tracebacks(output), output
 
 
@@ -161,8 +161,8 @@ def page_fixtures(width: int, height: int, **options):
     import pytest
 
     @pytest.fixture(scope="module", name="server")
-    def server():
-        yield from served_explorer()
+    def server(explorer_server):
+        yield from served_explorer(explorer_server)
 
     @pytest.fixture(scope="module", name="browser_context")
     def browser_context():
@@ -175,6 +175,24 @@ def page_fixtures(width: int, height: int, **options):
         p.close()
 
     return server, browser_context, page
+
+
+def module_page_fixture(width: int, height: int, **options):
+    """A fixture ``page``: one page of the run's served explorer for a whole test module
+    (its tests build on each other's steps), in a window ``width`` x ``height`` [px] with
+    ``options`` of the Playwright context. Use as ``page = module_page_fixture(1400, 900)``
+    at the module's top."""
+    import pytest
+
+    @pytest.fixture(scope="module", name="page")
+    def page(explorer_server):
+        for url in served_explorer(explorer_server):
+            for context in chromium_context(width, height, **options):
+                shown = Page(context, url)
+                yield shown
+                shown.close()
+
+    return page
 
 
 # Width on the page of the view of a named Bokeh model [px] (0 or null: not shown).

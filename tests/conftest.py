@@ -8,6 +8,15 @@
   returns False when a generous bound runs out (a failure bound, not a measurement).
 - Property tests draw the same examples on every run (hypothesis profile ``suite``,
   derandomized); ``HYPOTHESIS_PROFILE=explore`` draws new ones.
+- One served explorer (:func:`explorer_server`, ``python -m explorer`` in a child
+  process) serves every browser test of a run: each test opens its own page (a session of
+  its own), and each browser module checks the server's output written while it ran
+  (tests/browser_pages.py). Starting a server costs a warm-up solve and its solver
+  processes; once per run instead of once per module.
+- The command line runs in the test's own process (``run_cli`` of tests/cli_runs.py:
+  ``core.cli.main`` with stdout and stderr captured): a child process costs ~1 s of
+  imports each and tests nothing more, except the entry point itself, which a few tests
+  run for real (``run_cli(..., subprocess=True)``).
 - Scenes: the dimensionless benchmark problems come from ``benchmarks/scenes.py`` (one
   definition for the benchmarks and the tests); :func:`small_preset` is a preset of the
   explorer cut to a few output times, for tests that need a quick real solve.
@@ -102,3 +111,15 @@ def small_preset_scene(key: str | None = None, count: int = 6, tol: float = 1e-5
 def small_preset_fixture() -> Callable[..., dict[str, Any]]:
     """:func:`small_preset_scene` for the tests."""
     return small_preset_scene
+
+
+@pytest.fixture(scope="session")
+def explorer_server() -> Iterator[Any]:
+    """The served explorer of the browser tests (``benchmarks.serving.ExplorerProcess``,
+    default options, one BLAS thread): started when a test first asks, stopped at the end
+    of the run."""
+    from benchmarks.serving import ExplorerProcess
+
+    # 180 s: the server solves the default scene once before it answers
+    with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as explorer:
+        yield explorer

@@ -16,6 +16,10 @@ if [ ! -x /usr/bin/chromium ]; then
     fi
 fi
 
+# The set-up above installs Chromium and Playwright: under CI a missing browser fails the
+# run (tests/browser_pages.py: require_browser) instead of skipping the browser tests.
+export CI="${CI:-1}"
+
 # Small dense matrices: BLAS threads only fight each other on 2 cores (10x slower measured).
 export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}"
 

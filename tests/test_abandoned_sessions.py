@@ -83,4 +83,8 @@ def test_dropped_sessions_give_back_their_memory_and_log_no_traceback(server,
                           timeout=90, every=0.5), (before, peak, rss_mib(server.pid))
     output = server.output()
     assert "Traceback" not in output, output[-5000:]
+    # the server restarted itself with the C library's allocator (explorer/__main__.py:
+    # SERVER_ALLOCATOR), which returns the pages around the few objects a session leaves
+    with open(f"/proc/{server.pid}/environ", "rb") as fh:
+        assert b"PYTHONMALLOC=malloc" in fh.read().split(b"\0")
     assert "ERROR" not in output, output[-5000:]

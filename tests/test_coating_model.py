@@ -3,9 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +13,7 @@ from core.coating_check import check_scene
 from core.coating_model import layer_compliance, mapped_error
 from core.fem_check import CoatingStrip, Stack, solve_stack
 from core.scene import scene_from_dict, scene_to_json, solve
+from tests.cli_runs import run_cli
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -170,17 +168,12 @@ def test_estimate_brackets_the_fe_error_of_a_bonded_coating_of_varying_thickness
 def test_cli_check_prints_the_model_error(tmp_path):
     path = tmp_path / "scene.json"
     path.write_text(json.dumps(scene_dict(interface="bonded")))
-    env = dict(os.environ)
-    env["PYTHONPATH"] = str(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
-    proc = subprocess.run([sys.executable, "-m", "core", "check", str(path)], cwd=ROOT,
-                          env=env, capture_output=True, text=True, timeout=300)
+    proc = run_cli("check", path)
     assert proc.returncode == 0, proc.stderr
     assert "model error of the fast answer" in proc.stdout
-    proc = subprocess.run([sys.executable, "-m", "core", "solve", str(path)], cwd=ROOT,
-                          env=env, capture_output=True, text=True, timeout=300)
+    proc = run_cli("solve", path)
     assert "coating model error" in proc.stdout
-    proc = subprocess.run([sys.executable, "-m", "core", "check", str(path), "--time", "5"],
-                          cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    proc = run_cli("check", path, "--time", "5")
     assert proc.returncode == 2 and proc.stderr.startswith("error: --time: must be in")
 
 

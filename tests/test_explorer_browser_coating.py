@@ -6,8 +6,6 @@ Debian's Chromium through Playwright; every wait is on a condition in the page.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import pytest
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
@@ -19,19 +17,11 @@ require_browser()
 from tests.browser_pages import (  # noqa: E402
     JS_SHOWN,
     Page,
-    chromium_context,
-    served_explorer,
+    module_page_fixture,
     until,
 )
 
-
-@pytest.fixture(scope="module")
-def page() -> Iterator[Page]:
-    for url in served_explorer():
-        for context in chromium_context(1400, 900):
-            shown = Page(context, url)
-            yield shown
-            shown.close()
+page = module_page_fixture(1400, 900)
 
 
 def test_check_button_shows_the_measured_model_error_beside_the_estimate(page: Page):

@@ -2,13 +2,7 @@
 
 from __future__ import annotations
 
-import shutil
-import tempfile
-from collections.abc import Iterator
-
 import pytest
-
-from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
@@ -16,29 +10,16 @@ from tests.browser_pages import require_browser  # noqa: E402
 
 require_browser()
 
-import playwright.sync_api as playwright_api  # noqa: E402
-
-from tests.browser_pages import Page, _app_tracebacks  # noqa: E402
+from tests.browser_pages import (  # noqa: E402
+    Page,
+    module_page_fixture,
+)
 
 JS_PHI_COUNT = ("() => Bokeh.documents[0].get_model_by_name('creep_phi_source')"
                 ".data.phi.length")
 
 
-@pytest.fixture(scope="module")
-def page() -> Iterator[Page]:
-    profile = tempfile.mkdtemp(prefix="explorer-chromium-")
-    with ExplorerProcess(ready_timeout=180) as explorer, \
-            playwright_api.sync_playwright() as p:
-        context = p.chromium.launch_persistent_context(
-            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
-            viewport={"width": 1400, "height": 900})
-        page = Page(context, explorer.url)
-        yield page
-        page.close()
-        context.close()
-    shutil.rmtree(profile, ignore_errors=True)
-    output = explorer.output()
-    assert not _app_tracebacks(output), output
+page = module_page_fixture(1400, 900)
 
 
 def test_a_code_model_shows_its_inputs_and_phi_curve_and_names_a_bad_field(page: Page):

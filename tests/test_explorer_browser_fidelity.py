@@ -7,14 +7,10 @@ Debian's Chromium through Playwright; every wait is on a condition in the page o
 from __future__ import annotations
 
 import json
-import shutil
-import tempfile
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess
 from explorer.fidelity_view import CONTACT_LABELS
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
@@ -23,25 +19,12 @@ from tests.browser_pages import require_browser  # noqa: E402
 
 require_browser()
 
-import playwright.sync_api as playwright_api  # noqa: E402
+from tests.browser_pages import (  # noqa: E402
+    Page,
+    module_page_fixture,
+)
 
-from tests.browser_pages import Page, _app_tracebacks  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def page() -> Iterator[Page]:
-    profile = tempfile.mkdtemp(prefix="explorer-chromium-")
-    with ExplorerProcess(ready_timeout=180) as explorer:
-        with playwright_api.sync_playwright() as p:
-            context = p.chromium.launch_persistent_context(
-                profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
-                viewport={"width": 1400, "height": 900}, accept_downloads=True)
-            shown = Page(context, explorer.url)
-            yield shown
-            shown.close()
-            context.close()
-    shutil.rmtree(profile, ignore_errors=True)
-    assert not _app_tracebacks(explorer.output()), explorer.output()
+page = module_page_fixture(1400, 900, accept_downloads=True)
 
 
 def _saved_scene(page: Page) -> dict:

@@ -8,8 +8,6 @@ pass (issue 19, items 5, 6 and the explorer's part of 9); the browser tests in
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from concurrent.futures import Executor, Future
 from dataclasses import replace
 from pathlib import Path
@@ -22,6 +20,7 @@ from explorer.exports import histories_csv, number, parse_csv, pressure_csv
 from explorer.presets import presets
 from explorer.scales import DisplayScales, nice_ceiling
 from explorer.state import MAX_NAME_CHARS, ExplorerState
+from tests.cli_runs import run_cli
 
 PRESETS = presets()
 ROOT = Path(__file__).resolve().parent.parent
@@ -232,8 +231,7 @@ def test_the_command_line_shows_the_solver_message_not_a_pointer(tmp_path):
     scene["solver"] = {"tol": 1e-12}
     path = tmp_path / "scene.json"
     path.write_text(json.dumps(scene))
-    proc = subprocess.run([sys.executable, "-m", "core", "solve", str(path)], cwd=ROOT,
-                          capture_output=True, text=True, timeout=120)
+    proc = run_cli("solve", path)
     assert "warning: tol_not_met" in proc.stderr
     assert "see info.message" not in proc.stderr and "not met" in proc.stderr
 

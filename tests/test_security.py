@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 
 import core.scene_schema as scene_schema
-from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess, browser_missing
+from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS
 from core.cli import main as cli_main
 from core.profiles import profile_from_csv
 from core.scene import (
@@ -40,6 +40,8 @@ from core.scene import (
     solve,
 )
 from explorer.links import MAX_JSON, PREFIX, decode_scene, encode_scene
+from tests.browser_pages import require_browser, served_explorer
+from tests.cli_runs import run_cli
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "assets" / "scenes"
@@ -145,14 +147,7 @@ def test_bad_values_give_one_line_from_the_command_line(tmp_path: Path, capsys, 
     assert message.split(":")[0] in captured.err
 
 
-# ------------------------------------------------------------- the command line, for real
-
-
-def run_cli(*args: str | os.PathLike) -> subprocess.CompletedProcess:
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
-    env["PYTHONPATH"] = str(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
-    return subprocess.run([sys.executable, "-m", "core", *map(str, args)], cwd=ROOT, env=env,
-                          capture_output=True, text=True, timeout=300)
+# ------------------------------------------------- the command line, as a user runs it
 
 
 def assert_refused(proc: subprocess.CompletedProcess, *parts: str) -> None:
@@ -641,14 +636,9 @@ def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:
 
 
 @pytest.fixture(scope="module")
-def served() -> Iterator[str]:
-    missing = browser_missing()
-    if missing:
-        if os.environ.get("CI"):  # the test set-up installs both: their absence is a failure
-            pytest.fail(missing, pytrace=False)
-        pytest.skip(missing)
-    with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as server:
-        yield server.url
+def served(request: pytest.FixtureRequest) -> Iterator[str]:
+    require_browser()
+    yield from served_explorer(request.getfixturevalue("explorer_server"))
 
 
 @pytest.mark.browser

@@ -23,6 +23,7 @@ from core.study import (
     point_table,
     study_from_dict,
 )
+from tests.cli_runs import run_cli
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "assets" / "scenes"
@@ -482,9 +483,7 @@ def test_cli_sweep_on_the_cluster_writes_each_format(loopback_cluster, tmp_path:
     table = pd.read_parquet(tmp_path / "r.parquet").sort_values(["point", "time_day"])
     np.testing.assert_array_equal(table["q_max_Pa"].to_numpy(), ds.q_max.values.reshape(-1))
     ds.close()
-    bad = subprocess.run([sys.executable, "-m", "core", "sweep", "study.json", "--output",
-                          "r.txt"], cwd=tmp_path, env=env, capture_output=True, text=True,
-                         timeout=60)
+    bad = run_cli("sweep", "study.json", "--output", "r.txt", cwd=tmp_path)
     assert bad.returncode == 2
     assert bad.stderr.strip() == ("error: output: unsupported extension '.txt' (use .nc, "
                                   ".csv or .parquet)")

@@ -195,20 +195,33 @@ def test_a_slow_solve_holds_up_another_session_by_the_spill_time_only(processes,
     assert processes.run(0, os.getpid) == pids[0]  # back to its own lane once free
 
 
+def killed_during_a_request(pool: SolverProcesses, kills: int, tmp_path: Path,
+                            wait_until: Any) -> tuple[list[int], list[Any]]:
+    """Start ``pool`` (one lane), hold a request in its worker and kill (SIGKILL) the
+    worker holding it ``kills`` times (1 or 2); returns the killed workers' ids and the
+    request's outcome once answered."""
+    killed = [pool.start()[0]["pid"]]
+    with held_worker(pool, 0, tmp_path, wait_until) as (waiting, outcome):
+        assert wait_until(lambda: pool._lanes[0].busy)
+        os.kill(killed[0], signal.SIGKILL)
+        # the death is noticed at once and the request given to a new worker
+        assert wait_until(lambda: pool.pids() not in ([], killed), timeout=60)
+        if kills == 2:
+            killed.append(pool.pids()[0])
+            os.kill(killed[1], signal.SIGKILL)
+        else:
+            release(tmp_path / "gate-0", wait_until)
+        waiting.join(60)
+    return killed, outcome
+
+
 def test_a_request_whose_worker_is_killed_runs_again_on_a_new_one(tmp_path,
                                                                    wait_until) -> None:
     pool = SolverProcesses(1, 64 * 2**20)
     try:
-        first = pool.start()[0]["pid"]
-        with held_worker(pool, 0, tmp_path, wait_until) as (waiting, outcome):
-            assert wait_until(lambda: pool._lanes[0].busy)
-            os.kill(first, signal.SIGKILL)
-            # the death is noticed at once and the request given to a new worker
-            assert wait_until(lambda: pool.pids() not in ([], [first]), timeout=60)
-            release(tmp_path / "gate-0", wait_until)
-            waiting.join(60)
+        killed, outcome = killed_during_a_request(pool, 1, tmp_path, wait_until)
         assert len(outcome) == 1 and isinstance(outcome[0], int), outcome  # answered
-        assert pool.run(0, os.getpid) not in (first,)
+        assert pool.run(0, os.getpid) not in killed
     finally:
         pool.shutdown()
 
@@ -217,14 +230,7 @@ def test_a_request_whose_worker_dies_twice_is_answered_with_a_message(tmp_path,
                                                                       wait_until) -> None:
     pool = SolverProcesses(1, 64 * 2**20)
     try:
-        first = pool.start()[0]["pid"]
-        with held_worker(pool, 0, tmp_path, wait_until) as (waiting, outcome):
-            assert wait_until(lambda: pool._lanes[0].busy)
-            os.kill(first, signal.SIGKILL)
-            assert wait_until(lambda: pool.pids() not in ([], [first]), timeout=60)
-            second = pool.pids()[0]
-            os.kill(second, signal.SIGKILL)
-            waiting.join(60)
+        (first, second), outcome = killed_during_a_request(pool, 2, tmp_path, wait_until)
         assert len(outcome) == 1 and isinstance(outcome[0], WorkerFailed), outcome
         assert "stopped during this solve twice" in str(outcome[0])
         # killed while idle: nothing was lost, the next request is served by a new worker
@@ -291,3 +297,23 @@ def test_workers_do_not_outlive_the_server(sig: int, wait_until) -> None:
     finally:
         server.kill()
         server.wait()
+
+
+def test_a_worker_solves_without_importing_the_page_libraries() -> None:
+    # A worker imports this module, core and the state's names (explorer/results.py); Panel
+    # and Bokeh would cost each worker ~1 s and ~100 MB for nothing.
+    script = textwrap.dedent("""
+        import copy, sys
+        import explorer.code_creep_state, explorer.results, explorer.state, explorer.workers
+        from explorer.presets import DEFAULT_PRESET, presets
+
+        scene = copy.deepcopy(presets()[DEFAULT_PRESET])
+        scene["times"] = {"end": 200.0, "count": 4, "spacing": "log"}
+        view = explorer.workers.solve_view(scene)
+        print(len(view.times), sorted(m for m in ("panel", "bokeh") if m in sys.modules))
+    """)
+    env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get(
+        "PYTHONPATH", "")}
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         env=env, timeout=120, check=True).stdout.split()
+    assert out[0] == "4" and out[1:] == ["[]"], out
