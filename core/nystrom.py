@@ -121,7 +121,7 @@ def factored_responses(grid: NystromGrid, c: float, with_gap: bool
     once a refinement adds only one panel per graded side (measured on the eight elastic
     work-precision scenes at tol 1e-6: 0.45-4.1 ms per scene split, 0.2-3.4 ms plain).
     """
-    factor = NodalLU(grid.operator, c * grid.m)
+    factor = NodalLU(grid.operator, c * grid.m, grid.kernel_accuracy)
     return factor.solve(_rhs(grid.nodes, grid.g, with_gap)), factor
 
 
@@ -132,9 +132,10 @@ SINGLE_FROM = 200
 #: Refinement steps of a single-precision solve: the correction shrinks by ~cond x 6e-8
 #: per step (1e-4-1e-3 on the work-precision scenes), so three or four reach rounding.
 MAX_REFINEMENTS = 8
-#: A refined solution is final when its last correction is below this share of it.
+#: A refined solution is final when its error (estimated from the last two corrections)
+#: is below this share of it, or below a tenth of the operator's accuracy.
 REFINED = 1e-15
-#: ... and is accepted when that correction is below this share (else double precision).
+#: ... and is accepted when that error is below this share (else double precision).
 ACCEPTED = 1e-11
 
 
@@ -146,8 +147,13 @@ class NodalLU:
     matrix too ill-conditioned for that is factored again in double precision.
     """
 
-    def __init__(self, operator: np.ndarray, diagonal: np.ndarray) -> None:
+    def __init__(self, operator: np.ndarray, diagonal: np.ndarray,
+                 accuracy: float = 0.0) -> None:
+        """``accuracy``: absolute accuracy of the operator's entries (O(0.1-1)); a
+        refined solution goes no further than a tenth of it, relative (the entries'
+        own error moves it more)."""
         self._operator, self._diagonal = operator, diagonal
+        self._goal = max(REFINED, 0.1 * accuracy)
         n = operator.shape[0]
         single = n >= SINGLE_FROM
         matrix = operator.astype(np.float32 if single else float)
@@ -169,19 +175,21 @@ class NodalLU:
         x = lu_solve(self._lu, rhs.astype(np.float32), check_finite=False).astype(float)
         diagonal = self._diagonal if rhs.ndim == 1 else self._diagonal[:, None]
         previous = np.inf
-        change = np.inf
+        left = np.inf  # estimated relative error of x
         for _ in range(MAX_REFINEMENTS):
             residual = rhs - self._operator @ x - diagonal * x
             step = lu_solve(self._lu, residual.astype(np.float32), check_finite=False)
             x += step
             size = np.maximum(np.max(np.abs(x), axis=0), 1e-300)
             change = float(np.max(np.max(np.abs(step), axis=0) / size))
-            # done at rounding, or when the corrections stop shrinking (the residual's
-            # own rounding, ~cond x 1e-16, which a double-precision LU leaves as well)
-            if not change > REFINED or change > 0.25 * previous:
+            # the error left is about the next correction, change^2 / previous; done at
+            # the goal, or when the corrections stop shrinking (the residual's own
+            # rounding, ~cond x 1e-16, which a double-precision LU leaves as well)
+            left = change * min(1.0, change / previous) if previous < np.inf else change
+            if left <= self._goal or change > 0.25 * previous:
                 break
             previous = change
-        if not (np.all(np.isfinite(x)) and change <= ACCEPTED):
+        if not (np.all(np.isfinite(x)) and left <= max(self._goal, ACCEPTED)):
             self._double()  # no contraction: the matrix needs double-precision factors
             return lu_solve(self._lu, rhs, check_finite=False)
         return x
