@@ -32,6 +32,7 @@ import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 
 from core.quadrature import (
+    FRESH_SHARE,
     FULL_ACCURACY,
     NODES_PER_PANEL,
     KernelOperator,
@@ -92,7 +93,7 @@ def build_grid(lam: float, edges: np.ndarray, m: Function, g: Function,
     panels = Panels.from_edges(edges)
     before = (None if previous is None or previous.kernel_accuracy != kernel_accuracy
               else KernelOperator(previous.lam, previous.panels, previous.operator))
-    operator = kernel_operator(lam, panels, before, kernel_accuracy).matrix
+    operator = kernel_operator(lam, panels, before, kernel_accuracy, FRESH_SHARE).matrix
     return NystromGrid(lam, panels, operator, np.asarray(m(panels.nodes), dtype=float),
                        np.asarray(g(panels.nodes), dtype=float), kernel_accuracy)
 
