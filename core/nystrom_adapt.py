@@ -19,6 +19,8 @@ the diagonal only, and the new columns of a refined one are its new rows transpo
 away from the new panels), the coarse answer is evaluated by the formula only at the new
 nodes, the kernel values are computed to ``KERNEL_SHARE * tol`` (not to rounding), and the
 LU of the last grid serves the bordered solve of the loads (a 2 x 2 Schur complement).
+From 200 nodes the LUs are single-precision factors whose solves are refined against the
+double-precision operator (:class:`core.nystrom.NodalLU`).
 """
 
 from __future__ import annotations

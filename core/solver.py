@@ -158,7 +158,9 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                                breakpoints=breakpoints, tol=tol)
         if contact == "unilateral":
             return solve_unilateral(**unilateral_args)
-        if contact == "auto":
+        # On an elastic base with a constant modulus the full-contact answer costs what the
+        # check would (one combination of the prepared unit responses): no check first.
+        if contact == "auto" and (kernel is not None or callable(c)):
             from core.contact_model import predicted_unilateral
 
             predicted = predicted_unilateral(unilateral_args)

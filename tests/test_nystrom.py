@@ -228,3 +228,33 @@ def test_bordered_solve_on_the_refinement_lu_matches_its_own_lu(given):
     for key in b:
         # measured: <= 3e-15 of the largest entry
         assert np.max(np.abs(a[key] - b[key])) <= 1e-12 * np.max(np.abs(b[key]))
+
+
+def test_single_precision_lu_refines_to_the_double_precision_answer():
+    """The refined single-precision solve gives the double-precision LU's answer; a matrix
+    too ill-conditioned for single precision is factored again in double precision."""
+    from scipy.linalg import lu_factor, lu_solve
+
+    from core.nystrom import SINGLE_FROM, NodalLU
+    from core.nystrom_adapt import adapt
+
+    grid = adapt(1.0, jump_m, stepped_g, False, (-0.5, 0.25, 0.3), 1e-6).grid
+    assert grid.size >= SINGLE_FROM
+    rhs = np.column_stack([np.ones(grid.size), grid.nodes, -grid.g])
+    matrix = grid.operator.copy()
+    matrix.flat[::grid.size + 1] += grid.m
+    exact = lu_solve(lu_factor(matrix), rhs)
+    refined = NodalLU(grid.operator, grid.m).solve(rhs)
+    # measured: 2.7e-15 of the largest entry at 528 nodes (the LUs' own rounding)
+    assert np.max(np.abs(refined - exact)) <= 1e-13 * np.max(np.abs(exact))
+    # condition number 1e10: single precision does not contract (6e-8 x 1e10 > 1)
+    rng = np.random.default_rng(3)
+    u, _ = np.linalg.qr(rng.standard_normal((256, 256)))
+    v, _ = np.linalg.qr(rng.standard_normal((256, 256)))
+    hard = (u * np.logspace(0, -10, 256)) @ v.T
+    factor = NodalLU(hard, np.zeros(256))
+    x = factor.solve(rhs[:256, 0])
+    assert not factor._single
+    expected = np.linalg.solve(hard, rhs[:256, 0])
+    # measured 1.2e-7 apart: two double-precision solves at condition 1e10 (~1e10 x 1e-16)
+    assert np.max(np.abs(x - expected)) <= 1e-5 * np.max(np.abs(expected))
