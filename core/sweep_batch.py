@@ -116,6 +116,10 @@ _LOAD_FREE_OUTPUTS = ("contact_width",)
 #: Digits of ``M / (P a)`` that make two points one eccentricity: the scaled answer is then
 #: that of an eccentricity ~1e-12 off, far below any solver tolerance.
 _ECCENTRICITY_DIGITS = 12
+#: Points with ``|M / (P a)|`` above this are solved on their own: at the punch edge the
+#: checks refuse ``|M / P| >= a`` as rounded for each point, so one eccentricity can hold
+#: both a refused point and an answered one.
+_SCALED_ECCENTRICITY_MAX = 1.0 - 1e-6
 
 
 def answers_scale_with_loads(scene: Scene | None) -> bool:
@@ -143,7 +147,10 @@ def _eccentricity_key(scene: Scene, point: Mapping[str, float]) -> tuple[int, fl
     force, moment = loads["force"], loads["moment"]
     if not (np.isfinite(force) and np.isfinite(moment) and force > 0.0):
         return None
-    return id(scene), round(moment / (force * scene.half_width), _ECCENTRICITY_DIGITS)
+    eccentricity = moment / (force * scene.half_width)
+    if abs(eccentricity) > _SCALED_ECCENTRICITY_MAX:
+        return None
+    return id(scene), round(eccentricity, _ECCENTRICITY_DIGITS)
 
 
 def _scaled(answer: tuple[float, np.ndarray, float, list[str], float], force: float,

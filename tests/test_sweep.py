@@ -551,9 +551,10 @@ def test_batch_groups_points_sharing_a_geometry(monkeypatch):
 
 
 #: A point answered by scaling another point of its eccentricity against core.solve on its
-#: own scene, relative to each output's size: measured at most 5.6e-15 (the unilateral
-#: solver rounds differently at another load size); the error estimate, which
-#: extrapolates differences near round-off, 5.3e-8 relative.
+#: own scene, relative to each output's size: measured at most 5.6e-15 on this test's
+#: grid (the unilateral solver rounds differently at another load size; 6.7e-13 at most
+#: over the 10,000 points of benchmarks.sweep.loads_study(100)); the error estimate,
+#: which extrapolates differences near round-off, 5.3e-8 relative here.
 SCALED_ROUNDING = 1e-13
 SCALED_ESTIMATE_ROUNDING = 1e-6
 
