@@ -10,9 +10,11 @@ batch validates the base scene once and builds each point's scene by replacing i
 (:func:`core.scene_validation.replace_loads`, the same checks and messages); when the
 exact layered kernel answers the scene and the loads are constants, the batch's
 full-contact points are answered at once (:func:`core.sweep_loads.solve_load_batch`: the
-problem is linear in the loads) and only the others are solved one by one. A point
-that fails (an invalid scene drawn from a distribution, a solver error) is recorded with
-its message; it never stops the study.
+problem is linear in the loads) and only the others are solved one by one, one per
+eccentricity ``M / P`` on a flat punch over an elastic base (the others of that
+eccentricity scaled from it; batches follow the eccentricity when force and moment both
+vary). A point that fails (an invalid scene drawn from a distribution, a solver error)
+is recorded with its message; it never stops the study.
 
 Each finished batch is written atomically to a work directory (``parts/batch_NNNNNN.npz``
 next to a ``manifest.json`` naming the study), so a study that was interrupted (a killed
