@@ -4,6 +4,7 @@
     python -m benchmarks.sweep --quick      # smaller studies, one repeat (about 2 minutes)
     python -m benchmarks.sweep --chart-only # only the design chart
     python -m benchmarks.sweep --no-chart   # only the measurements (no matplotlib needed)
+    python -m benchmarks.sweep --point-costs  # where the loads study's CPU goes (no Dask)
 
 Measured (``core.sweep`` on a local Dask cluster of single-threaded worker processes on
 127.0.0.1, a fresh cluster for every run so that no worker starts with warm caches; the
@@ -134,6 +135,54 @@ def _cut_points(study: Study, points: int) -> int:
     return max(1, points // per_value) * per_value
 
 
+def point_costs(study: Study, batch: int = 500) -> dict[str, dict[str, float]]:
+    """Where a load-only study's CPU time goes, in this process with no Dask: the points
+    :func:`core.sweep_loads.solve_load_batch` answers at once (in batches of ``batch``)
+    and the points it leaves, each solved by :func:`core.scene.solve` and sorted by the
+    contact model that answered (``refused``: the checks refused the loads). Per kind:
+    the points, their CPU seconds [s] (``time.process_time``) and, for the one-by-one
+    points, the median CPU per point [s]; ``lift-off eccentricities``: the distinct
+    ``M / P`` [m] among the points the unilateral model answered."""
+    from core.scene import solve
+    from core.scene_validation import replace_loads
+    from core.study import point_table
+    from core.sweep_batch import _load_only_base
+    from core.sweep_loads import solve_load_batch
+
+    paths = [p.path for p in study.parameters]
+    loads = [path.split(".", 1)[1] for path in paths]
+    table = point_table(study)
+    scene = _load_only_base(study.base, paths)
+    if scene is None:
+        raise ValueError("study: point_costs needs a study over given loads only")
+    kinds: dict[str, list[float]] = {}
+    batched, batched_cpu, eccentricities = 0, 0.0, set()
+    for lo in range(0, study.n_points, batch):
+        values = {q: np.asarray(table[path][lo:lo + batch], dtype=float)
+                  for q, path in zip(loads, paths, strict=True)}
+        cpu = time.process_time()
+        answer = solve_load_batch(scene, values, study.outputs)
+        batched_cpu += time.process_time() - cpu
+        batched += int(answer.answered.sum())
+        for k in np.flatnonzero(~answer.answered):
+            point = {q: float(v[k]) for q, v in values.items()}
+            cpu = time.process_time()
+            try:
+                result = solve(replace_loads(scene, point))
+                kind = str(result.info.get("contact", "?"))
+            except ValueError:
+                kind = "refused"
+            kinds.setdefault(kind, []).append(time.process_time() - cpu)
+            if kind == "unilateral" and point.get("force"):
+                eccentricities.add(round(point.get("moment", 0.0) / point["force"], 12))
+    out = {"batched": {"points": batched, "cpu": batched_cpu}}
+    for kind, cpu in kinds.items():
+        out[kind] = {"points": len(cpu), "cpu": float(np.sum(cpu)),
+                     "median": float(np.median(cpu))}
+    out["lift-off eccentricities"] = {"points": len(eccentricities)}
+    return out
+
+
 def measure(name: str, study: Study, repeats: int) -> dict[str, Any]:
     runs: dict[int, list[dict[str, float]]] = {2: [], 1: []}
     for w in runs:
@@ -258,12 +307,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small studies, one repeat")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--chart-only", action="store_true")
+    parser.add_argument("--point-costs", action="store_true",
+                        help="only where the loads study's CPU goes, in this process "
+                             "(no Dask, nothing written)")
     parser.add_argument("--no-chart", action="store_true",
                         help="measure only; keep the design chart drawn before (it needs "
                              "matplotlib)")
     args = parser.parse_args(argv)
     # `kill -USR1 PID` prints where a run on a loaded machine is waiting
     faulthandler.register(signal.SIGUSR1)
+    if args.point_costs:
+        print(f"load average {os.getloadavg()[0]:.1f}", flush=True)
+        for kind, cost in point_costs(loads_study(45 if args.quick else 100)).items():
+            print(f"{kind}: {cost}", flush=True)
+        print(f"load average {os.getloadavg()[0]:.1f}")
+        return 0
     out = RESULTS / "quick" if args.quick else RESULTS
     out.mkdir(parents=True, exist_ok=True)
     command = "python -m benchmarks.sweep " + " ".join(argv if argv is not None

@@ -5,7 +5,10 @@ runs. Points that differ only in given loads share one validated scene (the load
 replaced with :func:`core.scene_validation.replace_loads`: the same checks and
 messages); on a scene the exact layered kernel answers, their full-contact answers come
 at once (:func:`core.sweep_loads.solve_load_batch`). Every other point is solved on its
-own with :func:`core.scene.solve`. A point that fails is recorded with its message.
+own with :func:`core.scene.solve`, except that on a flat punch over an elastic base a
+point whose eccentricity ``M / P`` an earlier point of the batch shares is that point's
+answer scaled by the ratio of the forces (:func:`answers_scale_with_loads`). A point that
+fails is recorded with its message.
 """
 
 from __future__ import annotations
@@ -17,10 +20,11 @@ from typing import Any
 import numpy as np
 
 from core.scene import Scene, scene_from_dict, solve
+from core.scene_results import LARGE_TILT
 from core.scene_validation import replace_loads
 from core.study import apply_point
 
-__all__ = ["point_outputs", "run_batch"]
+__all__ = ["answers_scale_with_loads", "point_outputs", "run_batch"]
 
 
 def _contact_width(x: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -107,6 +111,62 @@ def _geometry_groups(base: Mapping[str, Any], paths: Sequence[str],
     return groups
 
 
+#: Outputs that do not scale with the loads on a flat punch (the others are proportional).
+_LOAD_FREE_OUTPUTS = ("contact_width",)
+#: Digits of ``M / (P a)`` that make two points one eccentricity: the scaled answer is then
+#: that of an eccentricity ~1e-12 off, far below any solver tolerance.
+_ECCENTRICITY_DIGITS = 12
+#: Points with ``|M / (P a)|`` above this are solved on their own: at the punch edge the
+#: checks refuse ``|M / P| >= a`` as rounded for each point, so one eccentricity can hold
+#: both a refused point and an answered one.
+_SCALED_ECCENTRICITY_MAX = 1.0 - 1e-6
+
+
+def answers_scale_with_loads(scene: Scene | None) -> bool:
+    """Whether every answer of ``scene`` under other constant loads is proportional to the
+    force at a fixed eccentricity ``M / P``: a flat punch on uniform coatings (no gap) over
+    an elastic base, with exactly a constant force and moment given. The problem (full or
+    unilateral contact) is then homogeneous: loads ``(s P, s M)`` give ``s`` times the
+    settlement, tilt, forces and pressures and the same contact zone."""
+    if scene is None or set(scene.loading) != {"force", "moment"}:
+        return False
+    if not all(getattr(p, "kind", None) == "constant" for p in scene.loading.values()):
+        return False
+    profiles = [scene.shape] + [layer.thickness for layer in scene.coating]
+    if not all(getattr(p, "kind", None) == "constant" for p in profiles):
+        return False
+    return scene.dimensionless.kernel is None
+
+
+def _eccentricity_key(scene: Scene, point: Mapping[str, float]) -> tuple[int, float] | None:
+    """The point's eccentricity on ``scene``, rounded (:data:`_ECCENTRICITY_DIGITS`), with
+    the scene's id; None when the force is not positive or a load is not finite (such
+    points are solved, or refused, on their own)."""
+    loads = {name: point.get(name, float(profile.spec))
+             for name, profile in scene.loading.items()}
+    force, moment = loads["force"], loads["moment"]
+    if not (np.isfinite(force) and np.isfinite(moment) and force > 0.0):
+        return None
+    eccentricity = moment / (force * scene.half_width)
+    if abs(eccentricity) > _SCALED_ECCENTRICITY_MAX:
+        return None
+    return id(scene), round(eccentricity, _ECCENTRICITY_DIGITS)
+
+
+def _scaled(answer: tuple[float, np.ndarray, float, list[str], float], force: float,
+            outputs: Sequence[str]) -> tuple[np.ndarray, float, str]:
+    """Outputs, error estimate and flags of a point with ``force`` [N/m] at the
+    eccentricity of ``answer`` (its force, outputs, estimate, flags, largest |tilt|)."""
+    base_force, values, estimate, flags, tilt = answer
+    ratio = force / base_force
+    scale = np.array([1.0 if name in _LOAD_FREE_OUTPUTS else ratio for name in outputs])
+    # large_tilt is the one flag that depends on the size of the answer
+    kept = [f for f in flags if f != "large_tilt"]
+    if abs(ratio * tilt) > LARGE_TILT:
+        kept.append("large_tilt")
+    return values * scale[:, None], estimate, ",".join(kept)
+
+
 def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
               outputs: Sequence[str], n_times: int) -> dict[str, np.ndarray]:
     """Solve the points of one batch in order (``values[i]`` holds point i's value of each
@@ -149,10 +209,23 @@ def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
             if answer.answered[k]:
                 flags[i] = answer.flags[k]
         seconds[done] = (time.perf_counter() - start) / max(done.size, 1)
+    scaling = {id(g): answers_scale_with_loads(g) for g in validated if g is not None}
+    # per eccentricity, the first solved point's answer (a flat punch, elastic base)
+    solved: dict[tuple[int, float], tuple[float, np.ndarray, float, list[str], float]] = {}
     for i, row in enumerate(values):
         if batched[i]:
             continue
         start = time.perf_counter()
+        key = None
+        if validated[i] is not None and scaling[id(validated[i])]:
+            point = {q: float(row[j]) for q, j in zip(loads, load_columns, strict=True)}
+            key = _eccentricity_key(validated[i], point)
+            if key in solved:
+                out[i], estimate[i], flags[i] = _scaled(
+                    solved[key], point.get("force", float(validated[i].loading["force"].spec)),
+                    outputs)
+                seconds[i] = time.perf_counter() - start
+                continue
         try:
             if validated[i] is not None:
                 # only the loads change: the group's scene was validated once
@@ -164,6 +237,11 @@ def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
             out[i] = point_outputs(result, outputs)
             estimate[i] = float(result.info.get("error_estimate", np.nan))
             flags[i] = ",".join(result.flags)
+            if key is not None:
+                tilt = max(float(np.max(np.abs(result.tilt))) if result.tilt.size else 0.0,
+                           float(result.info.get("max_abs_tilt", 0.0)))
+                solved[key] = (float(scene.loading["force"].spec), out[i].copy(),
+                               estimate[i], list(result.flags), tilt)
         except Exception as exc:  # noqa: BLE001 - a failed point is recorded, never fatal
             errors[i] = (" ".join(str(exc).split()) or type(exc).__name__)[:500]
             flags[i] = "failed"

@@ -10,9 +10,11 @@ batch validates the base scene once and builds each point's scene by replacing i
 (:func:`core.scene_validation.replace_loads`, the same checks and messages); when the
 exact layered kernel answers the scene and the loads are constants, the batch's
 full-contact points are answered at once (:func:`core.sweep_loads.solve_load_batch`: the
-problem is linear in the loads) and only the others are solved one by one. A point
-that fails (an invalid scene drawn from a distribution, a solver error) is recorded with
-its message; it never stops the study.
+problem is linear in the loads) and only the others are solved one by one, one per
+eccentricity ``M / P`` on a flat punch over an elastic base (the others of that
+eccentricity scaled from it; batches follow the eccentricity when force and moment both
+vary). A point that fails (an invalid scene drawn from a distribution, a solver error)
+is recorded with its message; it never stops the study.
 
 Each finished batch is written atomically to a work directory (``parts/batch_NNNNNN.npz``
 next to a ``manifest.json`` naming the study), so a study that was interrupted (a killed
@@ -78,13 +80,29 @@ def plan_batches(study: Study, table: Mapping[str, np.ndarray],
                  batch_points: int) -> list[np.ndarray]:
     """The study's point indices cut into batches of at most ``batch_points``: sorted by
     geometry (the non-load fields) first, then by the loads, so that a geometry's points
-    run together and in order."""
+    run together and in order. When force and moment both vary, the loads are sorted by
+    the eccentricity ``M / P`` first (:func:`batch_plan`), so that points of one
+    eccentricity share a batch (on a flat punch one answer serves them all:
+    :func:`core.sweep_batch.answers_scale_with_loads`)."""
     n = study.n_points
     geometry = [p.path for p in study.parameters if not p.is_load]
     loads = [p.path for p in study.parameters if p.is_load]
-    keys = [table[p] for p in reversed(loads)] + [table[p] for p in reversed(geometry)]
+    keys = [table[p] for p in reversed(loads)]
+    if batch_plan(study) == "eccentricity":
+        force = np.asarray(table["loading.force"], dtype=float)
+        moment = np.asarray(table["loading.moment"], dtype=float)
+        with np.errstate(all="ignore"):
+            keys.append(np.where(force > 0, moment / np.where(force > 0, force, 1.0), np.inf))
+    keys += [table[p] for p in reversed(geometry)]
     order = np.lexsort(keys) if keys else np.arange(n)
     return [order[i:i + batch_points] for i in range(0, n, batch_points)]
+
+
+def batch_plan(study: Study) -> str:
+    """How :func:`plan_batches` orders a geometry's loads: ``"eccentricity"`` when both
+    ``loading.force`` and ``loading.moment`` vary, else ``"lexicographic"``."""
+    paths = {p.path for p in study.parameters}
+    return "eccentricity" if {"loading.force", "loading.moment"} <= paths else "lexicographic"
 
 
 def default_batch_points(n_points: int) -> int:
@@ -109,12 +127,18 @@ class WorkDir:
         self.parts.mkdir(parents=True, exist_ok=True)
         manifest = self.path / "manifest.json"
         want = {"format": _MANIFEST_FORMAT, "study_key": study.key,
-                "n_points": study.n_points, "batch_points": batch_points}
+                "n_points": study.n_points, "batch_points": batch_points,
+                "plan": batch_plan(study)}
         if manifest.exists():
             have = json.loads(manifest.read_text(encoding="utf-8"))
             if have.get("study_key") != study.key:
                 raise ValueError(f"work_dir: {self.path} holds the parts of another study; "
                                  "remove it or choose another directory")
+            # parts cut by another plan hold other points under the same batch numbers
+            if have.get("plan", "lexicographic") != want["plan"]:
+                raise ValueError(f"work_dir: {self.path} holds parts planned in another "
+                                 f"order ({have.get('plan', 'lexicographic')}, now "
+                                 f"{want['plan']}); remove it or choose another directory")
             self.batch_points = int(have["batch_points"])
         else:
             atomic_write_text(manifest, json.dumps(want, indent=1) + "\n")
