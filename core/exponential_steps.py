@@ -197,7 +197,8 @@ def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
         carried[b] = carried[b - 1] * np.exp(-1.0) + per_part[b - 1]
     # at the output times: an output inside a step is read from the points of that step
     # and of a neighbour (dense output), whose errors are those of their steps: the larger
-    step_of = np.clip(np.searchsorted(ends, t_out, side="left") - 1, 0, n_steps - 1)
+    step_of = np.minimum(np.maximum(np.searchsorted(ends, t_out, side="left") - 1, 0),
+                         n_steps - 1)
     at_outputs = carried[step_of] + np.maximum(
         per_part[step_of], per_part[np.minimum(step_of + 1, n_steps - 1)])
     worst = np.max(at_outputs, axis=0, initial=0.0)

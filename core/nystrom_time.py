@@ -85,6 +85,10 @@ class ModalForm:
         r_fk = ms.r_rot[np.ix_(ms.free, ms.known)]
         self.coupling = ms.psi_inv @ r_fk if self.k else np.zeros((len(ms.free), 1))
         self.gap_free = ms.psi_inv @ self.gap[ms.free]
+        # the modal drive of a unit settlement and tilt: a load history then costs an
+        # outer product, not a product with psi^-1 at every time read
+        self.settlement_free = ms.psi_inv @ ms.e0_rot[ms.free]
+        self.tilt_free = ms.psi_inv @ ms.e1_rot[ms.free]
         self.e0 = np.zeros(grid.size)
         self.e1 = np.zeros(grid.size)
         self.e0[0] = np.sqrt(moments[0])
@@ -100,8 +104,12 @@ class ModalForm:
 
     def drive(self, loads: dict[str, np.ndarray], size: int, gap: float = 1.0) -> np.ndarray:
         """Modal drive of the given settlement and tilt and of ``gap`` times the gap (F, T)."""
-        return (self.ms.psi_inv @ self.ms.given_drive(self.ms.free, loads, size)
-                + gap * self.gap_free[:, None])
+        out = np.broadcast_to(gap * self.gap_free[:, None], (self.gap_free.size, size))
+        if "settlement" in loads:
+            out = out + np.outer(self.settlement_free, loads["settlement"])
+        if "tilt" in loads:
+            out = out + np.outer(self.tilt_free, loads["tilt"])
+        return np.array(out)
 
     def finish(self, c_t: np.ndarray, loads: dict[str, np.ndarray], known: np.ndarray,
                z: np.ndarray, vz: np.ndarray, vu: np.ndarray, gap: float = 1.0
@@ -115,7 +123,8 @@ class ModalForm:
             b[ms.known] = known[:k]
         a = ms.to_coefficients(b)
         b_eff = np.zeros_like(b)
-        b_eff[ms.free] = ms.psi @ (z - vz)
+        free_eff = ms.psi @ (z - vz)
+        b_eff[ms.free] = free_eff
         if k:
             b_eff[ms.known] = known[:k] - vu[:k]
         effective = self.to_nodes @ ms.to_coefficients(b_eff)
@@ -124,7 +133,7 @@ class ModalForm:
             # Known rows: c b_K + (I - V)[R_KF b_F + R_KK b_K] = drive_K + unknown drive.
             r_kf = ms.r_rot[np.ix_(ms.known, ms.free)]
             r_kk = ms.r_rot[np.ix_(ms.known, ms.known)]
-            lhs = (c_t[None, :] * known[:k] + r_kf @ (ms.psi @ (z - vz))
+            lhs = (c_t[None, :] * known[:k] + r_kf @ free_eff
                    + r_kk @ (known[:k] - vu[:k]) - gap * self.gap[ms.known][:, None]
                    - self.ms.given_drive(ms.known, loads, size))
             unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
