@@ -241,8 +241,11 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     t_out = np.asarray(times, dtype=float)
     step_of, side, out_carry, out_total = output_weights(ends, jump_start, beta, decay,
                                                           t_out)
+    # the outputs in the order of their steps (already so for increasing times), so that
+    # each step's outputs are one slice of rows
     order = np.argsort(step_of, kind="stable")
     bounds = np.searchsorted(step_of[order], np.arange(n_steps + 1))
+    out_carry_s, out_total_s = out_carry[order], out_total[order]
 
     def read(fn) -> np.ndarray:
         return _by_step(fn(flat), 4)                              # (B, channels, 4)
@@ -262,8 +265,7 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
             vu_nodes[b] += s_known @ reads[b]
             lo, hi = bounds[b], bounds[b + 1]
             if hi > lo:
-                idx = order[lo:hi]
-                vu_out[:, idx] = s_known @ out_carry[idx].T
+                vu_out[:, order[lo:hi]] = s_known @ out_carry_s[lo:hi].T
             s_known = s_known * end_carry[b] + next_drive[b]
         vu_out += np.einsum("tj,tjk->kt", out_total, seven(u.transpose(0, 2, 1), step_of,
                                                             side))
@@ -271,6 +273,8 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
             channels.append((u.transpose(0, 2, 1), rows[1]))
     vw_out = np.zeros((nm, t_out.size))
     if nm:
+        # V w at the outputs, a row per output in the order of their steps
+        vw_rows = np.empty((t_out.size, nm))
         # the point systems of a block of steps at a time: (steps, 4, 4, modes) floats
         block = max(1, MAX_BLOCK_ELEMENTS // (16 * nm))
         at_steps = flat.reshape(n_steps, 4)
@@ -292,19 +296,18 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
             z = z_all[b] = constant[b % block] + (response[b % block] * sums[None]).sum(axis=1)
             lo, hi = bounds[b], bounds[b + 1]
             if hi > lo:
-                idx = order[lo:hi]
-                vw_out[:, idx] = (out_carry[idx] @ s_modes).T
+                vw_rows[lo:hi] = out_carry_s[lo:hi] @ s_modes
             s_modes = s_modes * carry_t[b] + drive_t[b] @ z
         # the drive of every output by z at its seven points, step by step of the outputs
-        for b in np.unique(step_of):
-            idx = order[bounds[b]:bounds[b + 1]]
-            for sd in (-1, 0, 1):
-                pick = idx[side[idx] == sd]
-                if pick.size:
-                    z7 = (np.concatenate([z_all[b - 1, :3], z_all[b]]) if sd == -1 else
-                          np.concatenate([z_all[b], z_all[b + 1, 1:]]) if sd == 1 else
-                          np.concatenate([z_all[b], np.zeros((3, nm))]))
-                    vw_out[:, pick] += (out_total[pick] @ z7).T
+        # (the neighbour read, ``side``, is the same for all outputs of a step)
+        for b in np.flatnonzero(bounds[1:] > bounds[:-1]):
+            lo, hi = bounds[b], bounds[b + 1]
+            sd = side[order[lo]]
+            z7 = (np.concatenate([z_all[b - 1, :3], z_all[b]]) if sd == -1 else
+                  np.concatenate([z_all[b], z_all[b + 1, 1:]]) if sd == 1 else
+                  np.concatenate([z_all[b], np.zeros((3, nm))]))
+            vw_rows[lo:hi] += out_total_s[lo:hi] @ z7
+        vw_out[:, order] = vw_rows.T
         if rows is not None:
             channels.append((z_all, rows[0]))
 

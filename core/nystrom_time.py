@@ -46,13 +46,19 @@ class ModalAnswer:
     equation, for the Nystrom formula between the nodes.
     """
 
-    nodal: np.ndarray
+    nodal_pressures: Callable[[], np.ndarray]
     effective: np.ndarray
     scalars: dict[str, np.ndarray]
     time_error: float
     steps: int
     success: bool
     message: str
+
+    @property
+    def nodal(self) -> np.ndarray:
+        """Nodal pressures (N, T), formed when asked: the answer itself reads ``effective``
+        (an N x N x T product saved on every march with many output times)."""
+        return self.nodal_pressures()
 
 
 class ModalForm:
@@ -113,16 +119,20 @@ class ModalForm:
 
     def finish(self, c_t: np.ndarray, loads: dict[str, np.ndarray], known: np.ndarray,
                z: np.ndarray, vz: np.ndarray, vu: np.ndarray, gap: float = 1.0
-               ) -> tuple[np.ndarray, np.ndarray, dict]:
-        """Nodal pressures, ``q - V q`` at the nodes and the four scalars."""
+               ) -> tuple[Callable[[], np.ndarray], np.ndarray, dict]:
+        """Nodal pressures (formed when called), ``q - V q`` at the nodes and the four
+        scalars."""
         ms, k = self.ms, self.k
         size = c_t.size
-        b = np.zeros((ms.n, size))
-        b[ms.free] = ms.psi @ z
-        if k:
-            b[ms.known] = known[:k]
-        a = ms.to_coefficients(b)
-        b_eff = np.zeros_like(b)
+
+        def nodal() -> np.ndarray:
+            b = np.zeros((ms.n, size))
+            b[ms.free] = ms.psi @ z
+            if k:
+                b[ms.known] = known[:k]
+            return self.to_nodes @ ms.to_coefficients(b)
+
+        b_eff = np.zeros((ms.n, size))
         free_eff = ms.psi @ (z - vz)
         b_eff[ms.free] = free_eff
         if k:
@@ -139,9 +149,17 @@ class ModalForm:
             unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
             for i, name in enumerate(ms.unknown_names):
                 out[name] = unknowns[i]
-        out.setdefault("force", self.e0 @ a)
-        out.setdefault("moment", self.e1 @ a)
-        return self.to_nodes @ a, effective, out
+        if "force" not in out or "moment" not in out:
+            # e0 and e1 are zero past the first two coefficients: their rows of a = T b
+            b2 = np.zeros((2, size))
+            first = ms.free < 2
+            b2[ms.free[first]] = ms.psi[first] @ z
+            if k:
+                b2[ms.known[ms.known < 2]] = known[:k][ms.known < 2]
+            a2 = ms.rotation @ b2
+            out.setdefault("force", self.e0[:2] @ a2)
+            out.setdefault("moment", self.e1[:2] @ a2)
+        return nodal, effective, out
 
     def solve(self, times: np.ndarray, c: Function, kernel, loads: dict[str, Function],
               time_tol: float, gap: float = 1.0, breaks: np.ndarray | None = None
