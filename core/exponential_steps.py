@@ -134,7 +134,7 @@ def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.
     ``response`` (B, 4, 4, M), modes last (contiguous for the march).
     """
     if vu_nodes is not None:
-        r = r + np.einsum("mk,bkj->bmj", coupling, vu_nodes)
+        r = r + coupling @ vu_nodes                               # (B, M, 4)
     d = d.transpose(0, 2, 1)                                      # (B, 4, M)
     r = r.transpose(0, 2, 1)
     t = total[:, :, :, None]                                      # (B, 3, 4, 1)
@@ -156,7 +156,13 @@ def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.
             response[:, i + 1, j + 1] = adj[i][j] * inv_det
         response[:, i + 1, 0] = inv_d0 * sum(response[:, i + 1, j + 1] * t[:, j, 0]
                                              for j in range(3))
-    constant = (response * r[:, None, :, :]).sum(axis=2)          # (B, 4, M)
+    # response times r, point by point (no (B, 4, 4, M) temporary; its first row is
+    # inv_d0 at the first point alone)
+    constant = np.empty((n_steps, 4, nm))                         # (B, 4, M)
+    constant[:, 0] = inv_d0 * r[:, 0]
+    constant[:, 1:] = response[:, 1:, 0] * r[:, None, 0]
+    for j in range(1, 4):
+        constant[:, 1:] += response[:, 1:, j] * r[:, None, j]
     return constant, response
 
 
