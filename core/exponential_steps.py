@@ -131,12 +131,16 @@ def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.
     three others solve ``(diag(d) - total[:, 1:]) z = r + sums + total[:, 0] z_0`` (by
     the adjugate: ``d >= 1`` on the diagonal, the step's creep off it); both for all steps
     at once, so the march only applies them. Returns ``constant`` (B, 4, M) and
-    ``response`` (B, 4, 4, M), modes last (contiguous for the march).
+    ``response`` (B, 4, 4, F), modes last (contiguous for the march).
+
+    ``d`` may hold the first F of the M channels only (B, F, 4), when the M = P F channels
+    are P groups of the same modes with the same ``d`` (the parts of a load stepped
+    together): ``response`` depends on ``d`` alone and is then formed once for all groups.
     """
     if vu_nodes is not None:
         r = r + coupling @ vu_nodes                               # (B, M, 4)
-    d = d.transpose(0, 2, 1)                                      # (B, 4, M)
-    r = r.transpose(0, 2, 1)
+    d = d.transpose(0, 2, 1)                                      # (B, 4, F)
+    r = r.transpose(0, 2, 1)                                      # (B, 4, M)
     t = total[:, :, :, None]                                      # (B, 3, 4, 1)
     m = [[(d[:, i + 1] if i == j else 0.0) - t[:, i, j + 1] for j in range(3)]
          for i in range(3)]
@@ -158,12 +162,13 @@ def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.
                                              for j in range(3))
     # response times r, point by point (no (B, 4, 4, M) temporary; its first row is
     # inv_d0 at the first point alone)
-    constant = np.empty((n_steps, 4, nm))                         # (B, 4, M)
-    constant[:, 0] = inv_d0 * r[:, 0]
-    constant[:, 1:] = response[:, 1:, 0] * r[:, None, 0]
+    r = r.reshape(n_steps, 4, -1, nm)                             # (B, 4, P, F)
+    constant = np.empty(r.shape)
+    constant[:, 0] = inv_d0[:, None] * r[:, 0]
+    constant[:, 1:] = response[:, 1:, 0, None] * r[:, None, 0]
     for j in range(1, 4):
-        constant[:, 1:] += response[:, 1:, j] * r[:, None, j]
-    return constant, response
+        constant[:, 1:] += response[:, 1:, j, None] * r[:, None, j]
+    return constant.reshape(n_steps, 4, -1), response
 
 
 
@@ -296,13 +301,19 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
             if b % block == 0:
                 steps = slice(b, min(n_steps, b + block))
                 times_block = at_steps[steps].ravel()
+                d = _by_step(problem.d(times_block), 4)          # (b, M, 4)
+                # the parts stepped together share the modes and d: one response for all
+                by_part = d.reshape(d.shape[0], problem.parts, -1, 4)
+                shared = problem.parts > 1 and bool(np.all(by_part == by_part[:, :1]))
+                groups = problem.parts if shared else 1
                 constant, response = _point_values(
-                    _by_step(problem.d(times_block), 4), _by_step(problem.r(times_block), 4),
+                    by_part[:, 0] if shared else d, _by_step(problem.r(times_block), 4),
                     total[steps], problem.coupling,
                     None if vu_nodes is None else vu_nodes[steps])
             # z at the step's four points: affine in the state sums there
-            sums = reads_t[b] @ s_modes                           # (4, M)
-            z = z_all[b] = constant[b % block] + (response[b % block] * sums[None]).sum(axis=1)
+            sums = (reads_t[b] @ s_modes).reshape(4, groups, -1)  # (4, P, F)
+            z = z_all[b] = constant[b % block] + (
+                response[b % block][:, :, None, :] * sums[None]).sum(axis=1).reshape(4, nm)
             lo, hi = bounds[b], bounds[b + 1]
             if hi > lo:
                 vw_rows[lo:hi] = out_carry_s[lo:hi] @ s_modes
