@@ -139,7 +139,9 @@ def output_weights(ends: np.ndarray, jump_start: np.ndarray, beta: np.ndarray,
     Returns ``step_of`` (T,), ``side`` (T,): +1 next, -1 previous, 0 none, and the two.
     """
     h = np.diff(ends)
-    step_of = np.clip(np.searchsorted(ends, t_out, side="left") - 1, 0, h.size - 1)
+    # np.minimum / np.maximum: np.clip of integers costs ~7x more (numpy 2)
+    step_of = np.minimum(np.maximum(np.searchsorted(ends, t_out, side="left") - 1, 0),
+                         h.size - 1)
     a = np.clip((t_out - ends[step_of]) / h[step_of], 0.0, 1.0)
     side, weight, x = sextic_weights(h, jump_start, decay, step_of, a)
     beta7 = seven(beta.transpose(0, 2, 1), step_of, side)        # (T, 7, S)
@@ -161,7 +163,7 @@ def seven(values: np.ndarray, step_of: np.ndarray, side: np.ndarray) -> np.ndarr
     slot_step = np.where(before, step_of[:, None] + _PREVIOUS_STEP, step_of[:, None]
                          + _NEXT_STEP)
     slot_point = np.where(before, _PREVIOUS_POINT, _NEXT_POINT)
-    picked = values[np.clip(slot_step, 0, n_steps - 1), slot_point]   # (T, 7, ...)
+    picked = values[np.minimum(np.maximum(slot_step, 0), n_steps - 1), slot_point]  # (T, 7, ...)
     missing = (side == 0)[:, None] & (np.arange(7) >= 4)[None, :]
     if np.any(missing):
         picked[missing] = 0.0

@@ -46,13 +46,19 @@ class ModalAnswer:
     equation, for the Nystrom formula between the nodes.
     """
 
-    nodal: np.ndarray
+    nodal_pressures: Callable[[], np.ndarray]
     effective: np.ndarray
     scalars: dict[str, np.ndarray]
     time_error: float
     steps: int
     success: bool
     message: str
+
+    @property
+    def nodal(self) -> np.ndarray:
+        """Nodal pressures (N, T), formed when asked: the answer itself reads ``effective``
+        (an N x N x T product saved on every march with many output times)."""
+        return self.nodal_pressures()
 
 
 class ModalForm:
@@ -85,6 +91,10 @@ class ModalForm:
         r_fk = ms.r_rot[np.ix_(ms.free, ms.known)]
         self.coupling = ms.psi_inv @ r_fk if self.k else np.zeros((len(ms.free), 1))
         self.gap_free = ms.psi_inv @ self.gap[ms.free]
+        # the modal drive of a unit settlement and tilt: a load history then costs an
+        # outer product, not a product with psi^-1 at every time read
+        self.settlement_free = ms.psi_inv @ ms.e0_rot[ms.free]
+        self.tilt_free = ms.psi_inv @ ms.e1_rot[ms.free]
         self.e0 = np.zeros(grid.size)
         self.e1 = np.zeros(grid.size)
         self.e0[0] = np.sqrt(moments[0])
@@ -100,22 +110,31 @@ class ModalForm:
 
     def drive(self, loads: dict[str, np.ndarray], size: int, gap: float = 1.0) -> np.ndarray:
         """Modal drive of the given settlement and tilt and of ``gap`` times the gap (F, T)."""
-        return (self.ms.psi_inv @ self.ms.given_drive(self.ms.free, loads, size)
-                + gap * self.gap_free[:, None])
+        out = np.broadcast_to(gap * self.gap_free[:, None], (self.gap_free.size, size))
+        if "settlement" in loads:
+            out = out + np.outer(self.settlement_free, loads["settlement"])
+        if "tilt" in loads:
+            out = out + np.outer(self.tilt_free, loads["tilt"])
+        return np.array(out)
 
     def finish(self, c_t: np.ndarray, loads: dict[str, np.ndarray], known: np.ndarray,
                z: np.ndarray, vz: np.ndarray, vu: np.ndarray, gap: float = 1.0
-               ) -> tuple[np.ndarray, np.ndarray, dict]:
-        """Nodal pressures, ``q - V q`` at the nodes and the four scalars."""
+               ) -> tuple[Callable[[], np.ndarray], np.ndarray, dict]:
+        """Nodal pressures (formed when called), ``q - V q`` at the nodes and the four
+        scalars."""
         ms, k = self.ms, self.k
         size = c_t.size
-        b = np.zeros((ms.n, size))
-        b[ms.free] = ms.psi @ z
-        if k:
-            b[ms.known] = known[:k]
-        a = ms.to_coefficients(b)
-        b_eff = np.zeros_like(b)
-        b_eff[ms.free] = ms.psi @ (z - vz)
+
+        def nodal() -> np.ndarray:
+            b = np.zeros((ms.n, size))
+            b[ms.free] = ms.psi @ z
+            if k:
+                b[ms.known] = known[:k]
+            return self.to_nodes @ ms.to_coefficients(b)
+
+        b_eff = np.zeros((ms.n, size))
+        free_eff = ms.psi @ (z - vz)
+        b_eff[ms.free] = free_eff
         if k:
             b_eff[ms.known] = known[:k] - vu[:k]
         effective = self.to_nodes @ ms.to_coefficients(b_eff)
@@ -124,15 +143,23 @@ class ModalForm:
             # Known rows: c b_K + (I - V)[R_KF b_F + R_KK b_K] = drive_K + unknown drive.
             r_kf = ms.r_rot[np.ix_(ms.known, ms.free)]
             r_kk = ms.r_rot[np.ix_(ms.known, ms.known)]
-            lhs = (c_t[None, :] * known[:k] + r_kf @ (ms.psi @ (z - vz))
+            lhs = (c_t[None, :] * known[:k] + r_kf @ free_eff
                    + r_kk @ (known[:k] - vu[:k]) - gap * self.gap[ms.known][:, None]
                    - self.ms.given_drive(ms.known, loads, size))
             unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
             for i, name in enumerate(ms.unknown_names):
                 out[name] = unknowns[i]
-        out.setdefault("force", self.e0 @ a)
-        out.setdefault("moment", self.e1 @ a)
-        return self.to_nodes @ a, effective, out
+        if "force" not in out or "moment" not in out:
+            # e0 and e1 are zero past the first two coefficients: their rows of a = T b
+            b2 = np.zeros((2, size))
+            first = ms.free < 2
+            b2[ms.free[first]] = ms.psi[first] @ z
+            if k:
+                b2[ms.known[ms.known < 2]] = known[:k][ms.known < 2]
+            a2 = ms.rotation @ b2
+            out.setdefault("force", self.e0[:2] @ a2)
+            out.setdefault("moment", self.e1[:2] @ a2)
+        return nodal, effective, out
 
     def solve(self, times: np.ndarray, c: Function, kernel, loads: dict[str, Function],
               time_tol: float, gap: float = 1.0, breaks: np.ndarray | None = None

@@ -150,8 +150,10 @@ def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
         known = np.array([1])
     t = np.eye(n)
     t[:2, :2] = rotation
-    r = r_matrix[:n, :n]
-    r_rot = t.T @ r @ t
+    # T^T R T with T = blockdiag(Q, I): only the first two rows and columns change
+    r_rot = np.array(r_matrix[:n, :n], dtype=float)
+    r_rot[:2, :] = rotation.T @ r_rot[:2, :]
+    r_rot[:, :2] = r_rot[:, :2] @ rotation
     e0_rot = t.T @ e0
     e1_rot = t.T @ e1
     if symmetric:
