@@ -704,12 +704,12 @@ CODE_CREEP = [
     "aging fitted by a sum of exponentials, 200 output times over 50 years, tol 1e-4), "
     "the default engine against the same scene with a finer fit solved at tol 1e-7, in "
     "[code_creep.md](code_creep.md) (`OPENBLAS_NUM_THREADS=1 python -m "
-    "benchmarks.code_creep --repeats 3`). Run E there (load average 5.6, CPU time):", "",
+    "benchmarks.code_creep --repeats 3`). Run F there (load average 3.6, CPU time):", "",
     "| model | new scene, CPU ms | load change, CPU ms | settlement error | estimate "
     "| kernel fit error | steps |",
     "| --- | --- | --- | --- | --- | --- | --- |",
-    "| fib_mc2010 | 79 | 1.8 | 4.8e-07 | 1.7e-05 | 1.5e-05 | 125 |",
-    "| eurocode2 | 49 | 1.6 | 1.5e-06 | 1.2e-05 | 9.3e-06 | 63 |", ""]
+    "| fib_mc2010 | 63 | 1.7 | 4.8e-07 | 1.7e-05 | 1.5e-05 | 125 |",
+    "| eurocode2 | 42 | 1.7 | 1.5e-06 | 1.2e-05 | 9.3e-06 | 63 |", ""]
 
 
 def write_report(results: list[dict[str, Any]], aging100: list[Run], plan: Plan, out: Path,
