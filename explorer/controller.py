@@ -34,6 +34,7 @@ from core.cache import StageCache
 
 from .results import ResultView, prepare_view
 from .state import ExplorerState
+from .trace import mark
 from .workers import SolverProcesses, WorkerFailed, download_text, solution_text, solve_view
 
 log = logging.getLogger(__name__)
@@ -299,6 +300,7 @@ class SolveController(param.Parameterized):
             return f"The solver failed on this scene ({type(exc).__name__}: {exc})."
 
     def _deliver(self, rid: int, outcome: ResultView | str) -> None:
+        mark("delivered", rid=rid)
         if rid < self._shown:
             return
         self._shown = rid

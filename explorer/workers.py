@@ -34,6 +34,7 @@ from concurrent.futures import Future
 from typing import Any
 
 from .results import ResultView, prepare_view
+from .trace import TRACE_FILE, mark
 
 log = logging.getLogger(__name__)
 
@@ -135,16 +136,19 @@ def _serve(connection: multiprocessing.connection.Connection, stage_cache_bytes:
             fn, args = connection.recv()
         except (EOFError, OSError):  # the server closed the pipe (or is gone)
             return
+        start = time.monotonic()
         try:
-            reply: tuple[str, Any] = ("ok", fn(*args))
+            reply: tuple[str, Any, tuple[float, float]] = ("ok", fn(*args), (start, 0.0))
         except BaseException as exc:  # the server raises it in the caller
-            reply = ("error", exc)
+            reply = ("error", exc, (start, 0.0))
+        reply = (reply[0], reply[1], (start, time.monotonic()))  # when it worked [s]
         try:
             connection.send(reply)
         except (BrokenPipeError, EOFError, OSError):
             return
         except Exception as exc:  # a value or exception that does not pickle
-            connection.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}")))
+            connection.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}"),
+                             reply[2]))
 
 
 class _WorkerDied(Exception):
@@ -182,15 +186,20 @@ class _Lane:
             connection.send((fn, args))
         except (EOFError, OSError):  # a broken pipe, or closed by a shutdown
             raise _WorkerDied("before") from None
+        mark("sent", lane=self.index)
         ready = multiprocessing.connection.wait([connection, process.sentinel], timeout)
         if not ready:
             raise TimeoutError
         if connection not in ready:  # only the sentinel: the worker ended
             raise _WorkerDied("during")
         try:
-            kind, value = connection.recv()
+            kind, value, (start, end) = connection.recv()
         except (EOFError, OSError):
             raise _WorkerDied("during") from None
+        if TRACE_FILE is not None:
+            mark("worker_start", start, lane=self.index)
+            mark("worker_end", end, lane=self.index)
+            mark("received", lane=self.index)
         if kind == "error":
             raise value
         return value

@@ -1,0 +1,65 @@
+"""Timestamps of a slider move's way through the server, for the latency benchmark.
+
+Off unless the environment variable ``EXPLORER_TRACE`` names a file: then every mark is
+appended to it as one JSON line ``{"event": ..., "t": seconds, ...}``. The clock is
+``time.monotonic`` (Linux's CLOCK_MONOTONIC, the same in every process), so the worker
+processes' marks line up with the server's.
+
+The marks of one load move, in order: ``ws_in`` (a websocket message from the page read
+by the server), ``revision`` (the widget's change reached the scene state), ``sent`` (the
+request written to the worker's pipe), ``worker_start`` / ``worker_end`` (the solve in
+the worker), ``received`` (the result read back), ``delivered`` (the result handed to the
+page's views on the event loop), ``drawn`` (the figures updated) and ``ws_out`` (a
+message to the page written). ``benchmarks/explorer_latency.py`` pairs them up.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import threading
+import time
+from typing import Any
+
+#: The file the marks go to (None: tracing is off and :func:`mark` costs one test).
+TRACE_FILE: str | None = os.environ.get("EXPLORER_TRACE") or None
+
+_LOCK = threading.Lock()
+
+
+def mark(event: str, t: float | None = None, **fields: Any) -> None:
+    """Note that ``event`` happened now (or at ``t`` [s], ``time.monotonic`` clock)."""
+    if TRACE_FILE is None:
+        return
+    line = json.dumps({"event": event, "t": time.monotonic() if t is None else t, **fields})
+    with _LOCK, open(TRACE_FILE, "a", encoding="utf-8") as fh:
+        fh.write(line + "\n")
+
+
+def install_websocket_marks() -> None:
+    """Mark every websocket message in and out of the Bokeh server (when tracing).
+
+    Panel sends document patches with tornado's ``WebSocketHandler.write_message``
+    itself (``panel.io.document.dispatch_tornado``), so that is what is marked going out.
+    """
+    if TRACE_FILE is None:
+        return
+    from bokeh.server.views.ws import WSHandler
+    from tornado.websocket import WebSocketHandler
+
+    if getattr(WSHandler, "_explorer_traced", False):
+        return
+    on_message, write_message = WSHandler.on_message, WebSocketHandler.write_message
+
+    async def traced_on_message(self: Any, fragment: str | bytes) -> None:
+        mark("ws_in", size=len(fragment))
+        return await on_message(self, fragment)
+
+    def traced_write_message(self: Any, message: Any, binary: bool = False) -> Any:
+        sent = write_message(self, message, binary)
+        mark("ws_out", size=len(message))
+        return sent
+
+    WSHandler.on_message = traced_on_message
+    WebSocketHandler.write_message = traced_write_message
+    WSHandler._explorer_traced = True
