@@ -39,27 +39,27 @@ def mark(event: str, t: float | None = None, **fields: Any) -> None:
 def install_websocket_marks() -> None:
     """Mark every websocket message in and out of the Bokeh server (when tracing).
 
-    Panel sends document patches with tornado's ``WebSocketHandler.write_message``
-    itself (``panel.io.document.dispatch_tornado``), so that is what is marked going out.
+    Panel writes document patches itself (``panel.io.document.dispatch_tornado``: the
+    patch made, serialised and its parts queued on the socket); ``ws_out`` marks its end.
     """
     if TRACE_FILE is None:
         return
+    import panel.io.document as panel_document
     from bokeh.server.views.ws import WSHandler
-    from tornado.websocket import WebSocketHandler
 
     if getattr(WSHandler, "_explorer_traced", False):
         return
-    on_message, write_message = WSHandler.on_message, WebSocketHandler.write_message
+    on_message, dispatch = WSHandler.on_message, panel_document.dispatch_tornado
 
     async def traced_on_message(self: Any, fragment: str | bytes) -> None:
         mark("ws_in", size=len(fragment))
         return await on_message(self, fragment)
 
-    def traced_write_message(self: Any, message: Any, binary: bool = False) -> Any:
-        sent = write_message(self, message, binary)
-        mark("ws_out", size=len(message))
-        return sent
+    def traced_dispatch(*args: Any, **kwargs: Any) -> Any:
+        futures = dispatch(*args, **kwargs)
+        mark("ws_out")
+        return futures
 
     WSHandler.on_message = traced_on_message
-    WebSocketHandler.write_message = traced_write_message
+    panel_document.dispatch_tornado = traced_dispatch
     WSHandler._explorer_traced = True

@@ -102,6 +102,41 @@ def test_downloads_from_a_worker_hold_the_numbers_on_screen(processes, monkeypat
         download_text(view.scene, "to_pickle")
 
 
+def test_a_request_sent_at_once_is_answered_and_frees_its_lane(processes, tmp_path,
+                                                                wait_until) -> None:
+    pids = [info["pid"] for info in processes.run_everywhere(worker_info)]
+    sent = processes.send_now(1, os.getpid)
+    assert sent is not None and processes._lanes[1].busy
+    assert processes.send_now(1, os.getpid) is None  # one request per worker
+    assert processes.result(sent) == pids[1]
+    assert not processes._lanes[1].busy
+    with held_worker(processes, 0, tmp_path, wait_until):
+        assert wait_until(lambda: processes._lanes[0].busy)
+        assert processes.send_now(0, os.getpid) is None  # busy: the caller waits its turn
+
+
+def test_a_session_sends_a_load_step_from_its_own_thread(processes, monkeypatch) -> None:
+    monkeypatch.setattr(controller_module, "_PROCESSES", processes)
+    RESULTS.clear()
+    state = ExplorerState()
+    state.param.update(time_count=5, tol=1e-5)
+    session = SolveController(state, auto=False)  # the shared thread pool waits
+    sent: list[Any] = []
+    send_now = processes.send_now
+    monkeypatch.setattr(processes, "send_now",
+                        lambda *args: sent.append(send_now(*args)) or sent[-1])
+    session.request()
+    assert session.wait(120) and session.error == "", session.error
+    assert len(sent) == 1 and sent[0] is not None  # the worker had it before the thread
+    here = prepare_view(solve(session.view.scene), session.view.scene)
+    np.testing.assert_allclose(session.view.values["settlement"],
+                               here.values["settlement"], rtol=1e-13, atol=0)
+    assert not any(lane.busy for lane in processes._lanes)
+    # the same scene again: known, so nothing is sent
+    session.request()
+    assert session.wait(120) and sent == sent[:1]
+
+
 def test_a_bad_scene_from_a_worker_names_its_field(processes, monkeypatch,
                                                   small_preset) -> None:
     scene = small_preset(force_kN=400.0)
