@@ -144,10 +144,11 @@ def server_steps(trace: Path, since: float, until: float) -> list[dict[str, floa
         for step in STEPS[2:]:
             later = next((k for k in range(at + 1, len(events))
                           if events[k]["event"] == step), None)
-            if step.startswith("worker"):  # stamped by the worker: ordered by time
+            if step.startswith("worker"):  # stamped by the worker, written on receipt;
+                # the worker may start before the server's mark of the sending is made
                 later = next((k for k in range(len(events))
                               if events[k]["event"] == step
-                              and events[k]["t"] >= times["sent"]), None)
+                              and events[k]["t"] >= times["revision"]), None)
             if later is None:
                 break
             times[step] = events[later]["t"]

@@ -232,22 +232,28 @@ class SolveController(param.Parameterized):
         with self._lock:
             self._latest += 1
             rid = self._latest
-        self.requests = rid
         try:
             scene = self.state.to_scene()
         except ValueError as exc:  # a state the screen cannot turn into a scene
+            self.requests = rid
             self._deliver(rid, format_error(str(exc)))
             return rid
         if self._executor is None:
+            self.requests = rid
             self._deliver(rid, self._compute(scene))
             return rid
-        self.busy = True
         with self._lock:
-            if self._running:
+            queued = self._running
+            if queued:
                 self._pending = (rid, scene)
-                return rid
             self._running = True
-        self._executor.submit(self._work, rid, scene, self._send_now(scene))
+        # the worker first: the watchers of ``requests`` and ``busy`` (the status line)
+        # run while it solves
+        sent = None if queued else self._send_now(scene)
+        self.requests = rid
+        self.busy = True
+        if not queued:
+            self._executor.submit(self._work, rid, scene, sent)
         return rid
 
     def _send_now(self, scene: dict[str, Any]) -> SentRequest | None:
