@@ -121,7 +121,7 @@ def measure_slider(page, tab: str, css: str, presses: int, key: str,
 
 
 #: The server's marks of one move (explorer/trace.py), in the order they happen.
-STEPS = ("ws_in", "revision", "sent", "worker_start", "worker_end", "received",
+STEPS = ("ws_in", "widget_event", "revision", "sent", "worker_start", "worker_end", "received",
          "delivered", "drawn", "ws_out")
 
 
@@ -137,11 +137,12 @@ def server_steps(trace: Path, since: float, until: float) -> list[dict[str, floa
         if rev["event"] != "revision":
             continue
         ws_in = [e["t"] for e in events[:i] if e["event"] == "ws_in"]
-        if not ws_in:
+        widget = [e["t"] for e in events[:i] if e["event"] == "widget_event"]
+        if not ws_in or not widget:
             continue
-        times = {"ws_in": ws_in[-1], "revision": rev["t"]}
+        times = {"ws_in": ws_in[-1], "widget_event": widget[-1], "revision": rev["t"]}
         at = i
-        for step in STEPS[2:]:
+        for step in STEPS[3:]:
             later = next((k for k in range(at + 1, len(events))
                           if events[k]["event"] == step), None)
             if step.startswith("worker"):  # stamped by the worker, written on receipt;

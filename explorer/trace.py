@@ -6,7 +6,8 @@ appended to it as one JSON line ``{"event": ..., "t": seconds, ...}``. The clock
 processes' marks line up with the server's.
 
 The marks of one load move, in order: ``ws_in`` (a websocket message from the page read
-by the server), ``revision`` (the widget's change reached the scene state), ``sent`` (the
+by the server), ``widget_event`` (Panel takes up the widget's change on the event
+loop), ``revision`` (the widget's change reached the scene state), ``sent`` (the
 request written to the worker's pipe), ``worker_start`` / ``worker_end`` (the solve in
 the worker), ``received`` (the result read back), ``delivered`` (the result handed to the
 page's views on the event loop), ``drawn`` (the figures updated) and ``ws_out`` (a
@@ -46,10 +47,16 @@ def install_websocket_marks() -> None:
         return
     import panel.io.document as panel_document
     from bokeh.server.views.ws import WSHandler
+    from panel.reactive import Syncable
 
     if getattr(WSHandler, "_explorer_traced", False):
         return
     on_message, dispatch = WSHandler.on_message, panel_document.dispatch_tornado
+    change = Syncable._change_coroutine
+
+    async def traced_change(self: Any, *args: Any, **kwargs: Any) -> None:
+        mark("widget_event")
+        return await change(self, *args, **kwargs)
 
     async def traced_on_message(self: Any, fragment: str | bytes) -> None:
         mark("ws_in", size=len(fragment))
@@ -61,5 +68,6 @@ def install_websocket_marks() -> None:
         return futures
 
     WSHandler.on_message = traced_on_message
+    Syncable._change_coroutine = traced_change
     panel_document.dispatch_tornado = traced_dispatch
     WSHandler._explorer_traced = True
