@@ -121,8 +121,8 @@ def measure_slider(page, tab: str, css: str, presses: int, key: str,
 
 
 #: The server's marks of one move (explorer/trace.py), in the order they happen.
-STEPS = ("ws_in", "widget_event", "revision", "sent", "worker_start", "worker_end", "received",
-         "delivered", "drawn", "ws_out")
+STEPS = ("ws_in", "widget_event", "widget_value", "revision", "sent", "worker_start",
+         "worker_end", "received", "delivered", "drawn", "ws_out")
 
 
 def server_steps(trace: Path, since: float, until: float) -> list[dict[str, float]]:
@@ -138,11 +138,13 @@ def server_steps(trace: Path, since: float, until: float) -> list[dict[str, floa
             continue
         ws_in = [e["t"] for e in events[:i] if e["event"] == "ws_in"]
         widget = [e["t"] for e in events[:i] if e["event"] == "widget_event"]
-        if not ws_in or not widget:
+        value = [e["t"] for e in events[:i] if e["event"] == "widget_value"]
+        if not ws_in or not widget or not value:
             continue
-        times = {"ws_in": ws_in[-1], "widget_event": widget[-1], "revision": rev["t"]}
+        times = {"ws_in": ws_in[-1], "widget_event": widget[-1], "widget_value": value[-1],
+                 "revision": rev["t"]}
         at = i
-        for step in STEPS[3:]:
+        for step in STEPS[4:]:
             later = next((k for k in range(at + 1, len(events))
                           if events[k]["event"] == step), None)
             if step.startswith("worker"):  # stamped by the worker, written on receipt;

@@ -7,7 +7,8 @@ processes' marks line up with the server's.
 
 The marks of one load move, in order: ``ws_in`` (a websocket message from the page read
 by the server), ``widget_event`` (Panel takes up the widget's change on the event
-loop), ``revision`` (the widget's change reached the scene state), ``sent`` (the
+loop), ``widget_value`` (the widget's new value reaches its binding to the state),
+``revision`` (the widget's change reached the scene state), ``sent`` (the
 request written to the worker's pipe), ``worker_start`` / ``worker_end`` (the solve in
 the worker), ``received`` (the result read back), ``delivered`` (the result handed to the
 page's views on the event loop), ``drawn`` (the figures updated) and ``ws_out`` (a

@@ -204,7 +204,10 @@ class _Lane:
     def receive(self, timeout: float) -> Any:
         """The value of the request sent last (see :meth:`call`)."""
         process, connection = self.process, self.connection
-        ready = multiprocessing.connection.wait([connection, process.sentinel], timeout)
+        try:
+            ready = multiprocessing.connection.wait([connection, process.sentinel], timeout)
+        except OSError:  # the pipe closed by a shutdown
+            raise _WorkerDied("during") from None
         if not ready:
             raise TimeoutError
         if connection not in ready:  # only the sentinel: the worker ended

@@ -21,10 +21,10 @@ def test_marks_are_off_unless_a_file_is_named(monkeypatch, tmp_path) -> None:
 def test_a_move_is_paired_from_its_websocket_message_to_its_patch(tmp_path) -> None:
     # one move, 1 ms a step; the worker started before the sending was marked (it is
     # marked once written), and its marks are written when its answer is read
-    order = ["ws_in", "widget_event", "revision", "sent", "received", "delivered",
+    order = ["ws_in", "widget_event", "widget_value", "revision", "sent", "received", "delivered",
              "drawn", "ws_out"]
-    at = {"ws_in": 0, "widget_event": 1, "revision": 2, "sent": 4, "received": 6,
-          "delivered": 7, "drawn": 8, "ws_out": 9}
+    at = {"ws_in": 0, "widget_event": 1, "widget_value": 1.5, "revision": 2, "sent": 4,
+          "received": 6, "delivered": 7, "drawn": 8, "ws_out": 9}
     lines = []
     for event in order:
         lines.append({"event": event, "t": 100 + at[event] / 1e3})
