@@ -278,6 +278,29 @@ def test_a_request_whose_worker_dies_twice_is_answered_with_a_message(tmp_path,
         pool.shutdown()
 
 
+def test_a_request_sent_at_once_whose_worker_is_killed_runs_again(tmp_path,
+                                                                   wait_until) -> None:
+    pool = SolverProcesses(1, 64 * 2**20)
+    try:
+        killed = pool.start()[0]["pid"]
+        gate = tmp_path / "gate-sent"
+        os.mkfifo(gate)
+        sent = pool.send_now(0, os.open, str(gate), os.O_RDONLY)
+        assert sent is not None
+        outcome: list[Any] = []
+        waiting = threading.Thread(target=lambda: outcome.append(pool.result(sent)))
+        waiting.start()
+        os.kill(killed, signal.SIGKILL)
+        # noticed at once, given to a new worker, which waits at the gate in turn
+        assert wait_until(lambda: pool.pids() not in ([], [killed]), timeout=60)
+        release(gate, wait_until)
+        waiting.join(60)
+        assert len(outcome) == 1 and isinstance(outcome[0], int), outcome  # answered
+        assert not pool._lanes[0].busy
+    finally:
+        pool.shutdown()
+
+
 def test_a_stuck_worker_is_stopped_and_replaced(monkeypatch, wait_until) -> None:
     pool = SolverProcesses(1, 64 * 2**20)
     try:
