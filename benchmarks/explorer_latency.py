@@ -120,6 +120,48 @@ def measure_slider(page, tab: str, css: str, presses: int, key: str,
     return out, solves
 
 
+#: The server's marks of one move (explorer/trace.py), in the order they happen.
+STEPS = ("ws_in", "widget_event", "widget_value", "revision", "sent", "worker_start",
+         "worker_end", "received", "delivered", "drawn", "ws_out")
+
+
+def server_steps(trace: Path, since: float, until: float) -> list[dict[str, float]]:
+    """The server's marks of each move between ``since`` and ``until`` [s, monotonic]:
+    for every ``revision`` the websocket message before it and the first of each later
+    step after the one before; a move lacking a step (a result from the cache) is left
+    out. Returns per move the step times [ms] after ``ws_in``."""
+    events = [json.loads(line) for line in trace.read_text().splitlines() if line]
+    events = [e for e in events if since <= e["t"] <= until]
+    moves = []
+    for i, rev in enumerate(events):
+        if rev["event"] != "revision":
+            continue
+        ws_in = [e["t"] for e in events[:i] if e["event"] == "ws_in"]
+        widget = [e["t"] for e in events[:i] if e["event"] == "widget_event"]
+        value = [e["t"] for e in events[:i] if e["event"] == "widget_value"]
+        if not ws_in or not widget or not value:
+            continue
+        times = {"ws_in": ws_in[-1], "widget_event": widget[-1], "widget_value": value[-1],
+                 "revision": rev["t"]}
+        at = i
+        for step in STEPS[4:]:
+            later = next((k for k in range(at + 1, len(events))
+                          if events[k]["event"] == step), None)
+            if step.startswith("worker"):  # stamped by the worker, written on receipt;
+                # the worker may start before the server's mark of the sending is made
+                later = next((k for k in range(len(events))
+                              if events[k]["event"] == step
+                              and events[k]["t"] >= times["revision"]), None)
+            if later is None:
+                break
+            times[step] = events[later]["t"]
+            if not step.startswith("worker"):
+                at = later
+        if len(times) == len(STEPS):
+            moves.append({step: 1e3 * (times[step] - times["ws_in"]) for step in STEPS})
+    return moves
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--url", help="an explorer already running (default: start one)")
@@ -132,8 +174,11 @@ def main() -> None:
 
     server = None
     url = args.url
+    trace = Path(tempfile.mkdtemp()) / "trace.jsonl"
+    windows: dict[str, tuple[float, float]] = {}
     if url is None:
-        server = ExplorerProcess(ready_timeout=300, stop_timeout=20)
+        server = ExplorerProcess(ready_timeout=300, stop_timeout=20,
+                                 env={"EXPLORER_TRACE": str(trace)})
         try:
             url = server.start().url
         except ExplorerStartError as err:
@@ -171,9 +216,11 @@ def main() -> None:
                                    ("punch half-width", "Punch", ".punch-half-width"),
                                    ("base thickness", "Base", ".base-thickness")):
                 cpu[name], parts[name] = [], []
+                since = time.monotonic()
                 results[name], solves[name] = measure_slider(page, tab, css, args.repeats,
                                                              "ArrowRight", cdp, cpu[name],
                                                              parts[name])
+                windows[name] = (since, time.monotonic())
             context.close()
     finally:
         if server is not None:
@@ -197,10 +244,21 @@ def main() -> None:
             sent, server_part, page_part = (statistics.median(r[k] for r in rows)
                                             for k in range(3))
             print(f"{name:24s} {sent:6.0f} {server_part:9.0f} {page_part:9.0f}")
+    steps = {}
+    if trace.exists():
+        print("\ninside the server (medians, ms after the websocket message in; "
+              "explorer/trace.py):")
+        print(f"{'control':24s} " + " ".join(f"{s:>12s}" for s in STEPS[1:]))
+        for name, (since, until) in windows.items():
+            steps[name] = moves = server_steps(trace, since, until)
+            if moves:
+                print(f"{name:24s} " + " ".join(
+                    f"{statistics.median(m[s] for m in moves):12.1f}" for s in STEPS[1:])
+                    + f"  n={len(moves)}")
     if args.json:
         Path(args.json).write_text(json.dumps(
-            {"browser": results, "core_solve": solves, "page_cpu": cpu, "parts": parts},
-            indent=2))
+            {"browser": results, "core_solve": solves, "page_cpu": cpu, "parts": parts,
+             "server_steps": steps}, indent=2))
 
 
 if __name__ == "__main__":

@@ -30,6 +30,7 @@ from .results import ResultView
 from .scales import DisplayScales
 from .state import ExplorerState
 from .status import status_html
+from .trace import install_websocket_marks, mark
 from .view_link import read_study_query, read_view_query
 from .views.base import BaseView
 from .views.busy import BUSY_AFTER_MS, BusyIndicator
@@ -55,6 +56,7 @@ __all__ = ["BADGES", "BUSY_AFTER_MS", "CSS", "FILL_TABS_AFTER_MS", "LINK_EVERY_M
 
 log = logging.getLogger(__name__)
 install_panel_fixes()
+install_websocket_marks()
 
 #: Geometry and material sliders apply each drag step (not only the release) while the
 #: last solve took less than this much CPU time [s]: then a step's answer arrives before
@@ -279,6 +281,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.history.reset()
 
     def _on_revision(self, event: Any) -> None:
+        mark("revision")
         self.history.remember()
         self.controller.request()
 
@@ -344,6 +347,7 @@ class ExplorerApp(pn.viewable.Viewer):
         with pn.io.hold():
             self.results.draw(view, index, new_range=old is None or len(old.times) != n)
             self.files_view.name_files(view)
+            mark("drawn")  # the patch goes out as the hold ends
         self.results.push()
         self.link.schedule()
 

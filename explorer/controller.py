@@ -34,7 +34,15 @@ from core.cache import StageCache
 
 from .results import ResultView, prepare_view
 from .state import ExplorerState
-from .workers import SolverProcesses, WorkerFailed, download_text, solution_text, solve_view
+from .trace import mark
+from .workers import (
+    SentRequest,
+    SolverProcesses,
+    WorkerFailed,
+    download_text,
+    solution_text,
+    solve_view,
+)
 
 log = logging.getLogger(__name__)
 
@@ -224,23 +232,40 @@ class SolveController(param.Parameterized):
         with self._lock:
             self._latest += 1
             rid = self._latest
-        self.requests = rid
         try:
             scene = self.state.to_scene()
         except ValueError as exc:  # a state the screen cannot turn into a scene
+            self.requests = rid
             self._deliver(rid, format_error(str(exc)))
             return rid
         if self._executor is None:
+            self.requests = rid
             self._deliver(rid, self._compute(scene))
             return rid
-        self.busy = True
         with self._lock:
-            if self._running:
+            queued = self._running
+            if queued:
                 self._pending = (rid, scene)
-                return rid
             self._running = True
-        self._executor.submit(self._work, rid, scene)
+        # the worker first: the watchers of ``requests`` and ``busy`` (the status line)
+        # run while it solves
+        sent = None if queued else self._send_now(scene)
+        self.requests = rid
+        self.busy = True
+        if not queued:
+            self._executor.submit(self._work, rid, scene, sent)
         return rid
+
+    def _send_now(self, scene: dict[str, Any]) -> SentRequest | None:
+        # The request goes to this session's worker from the thread that made it (the
+        # event loop) when the worker is free and the result not known already; the
+        # thread of :meth:`_work` then only collects the answer.
+        if self._processes is None:
+            return None
+        key = result_key(scene)
+        if key is None or RESULTS.get(key) is not None:
+            return None
+        return self._processes.send_now(self._lane, solve_view, scene)
 
     def start(self) -> int:
         """First request of a session: shown at once when the result is already known
@@ -267,9 +292,10 @@ class SolveController(param.Parameterized):
         self._deliver(rid, outcome)
         return rid
 
-    def _work(self, rid: int, scene: dict[str, Any]) -> None:
+    def _work(self, rid: int, scene: dict[str, Any], sent: SentRequest | None = None) -> None:
         while True:
-            outcome = self._compute(scene)
+            outcome = self._compute(scene, sent)
+            sent = None
             self._dispatch(lambda rid=rid, outcome=outcome: self._deliver(rid, outcome))
             with self._lock:
                 if self._pending is None:
@@ -278,17 +304,21 @@ class SolveController(param.Parameterized):
                 rid, scene = self._pending
                 self._pending = None
 
-    def _view(self, scene: dict[str, Any]) -> ResultView:
+    def _view(self, scene: dict[str, Any], sent: list[SentRequest]) -> ResultView:
         if self._processes is not None:
+            if sent:
+                return self._processes.result(sent.pop())
             return self._processes.run(self._lane, solve_view, scene)
         return prepare_view(self._solve(scene), scene)
 
-    def _compute(self, scene: dict[str, Any]) -> ResultView | str:
+    def _compute(self, scene: dict[str, Any],
+                 sent: SentRequest | None = None) -> ResultView | str:
         key = result_key(scene) if self._solve is _default_solve else None
+        unread = [sent] if sent is not None else []  # emptied once its answer is read
         try:
             if key is None:
-                return self._view(scene)
-            view, reused = RESULTS.get_or_compute(key, lambda: self._view(scene))
+                return self._view(scene, unread)
+            view, reused = RESULTS.get_or_compute(key, lambda: self._view(scene, unread))
             return replace(view, info={**view.info, "reused": True}) if reused else view
         except ValueError as exc:
             return format_error(str(exc))
@@ -297,8 +327,17 @@ class SolveController(param.Parameterized):
         except Exception as exc:  # the session must survive any failure of a solve
             log.exception("solve failed")
             return f"The solver failed on this scene ({type(exc).__name__}: {exc})."
+        finally:
+            if unread and self._processes is not None:
+                # another session solved the same scene meanwhile: the worker's answer
+                # to this one is read and dropped, which frees the lane
+                try:
+                    self._processes.result(unread.pop())
+                except Exception:
+                    log.debug("dropped answer failed", exc_info=True)
 
     def _deliver(self, rid: int, outcome: ResultView | str) -> None:
+        mark("delivered", rid=rid)
         if rid < self._shown:
             return
         self._shown = rid

@@ -19,6 +19,7 @@ import param
 from core.profiles import VARIATIONS
 
 from .state import QUANTITY_RANGES, HistoryState, ProfileState
+from .trace import mark
 
 
 # Panel holds every change from the browser for 50 ms before handling it, to gather a
@@ -206,6 +207,7 @@ class Binding:
                                            sorted({name for name, _ in self._pairs}))
 
     def _to_target(self, name: str, value: Any) -> None:
+        mark("widget_value")
         if self._syncing or self._target is None or value is None:
             return
         try:

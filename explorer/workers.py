@@ -30,11 +30,11 @@ import os
 import signal
 import threading
 import time
-from concurrent.futures import Future, ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
+from concurrent.futures import Future
 from typing import Any
 
 from .results import ResultView, prepare_view
+from .trace import TRACE_FILE, mark
 
 log = logging.getLogger(__name__)
 
@@ -124,7 +124,46 @@ def worker_info() -> dict[str, int]:
     return {"pid": os.getpid(), "stage_cache_bytes": stage_cache_bytes()}
 
 
+def _serve(connection: multiprocessing.connection.Connection, stage_cache_bytes: int) -> None:
+    # A worker's main loop: one request (fn, args) in, one ("ok", value) or ("error",
+    # exception) out, on its own pipe. No executor between the server and the worker: a
+    # ProcessPoolExecutor hands each request and each result over through two more threads
+    # of the server (its queue feeder and its manager), and on a busy machine every
+    # hand-over waits for a core.
+    _start_worker(stage_cache_bytes)
+    while True:
+        try:
+            fn, args = connection.recv()
+        except (EOFError, OSError):  # the server closed the pipe (or is gone)
+            return
+        start = time.monotonic()
+        try:
+            reply: tuple[str, Any, tuple[float, float]] = ("ok", fn(*args), (start, 0.0))
+        except BaseException as exc:  # the server raises it in the caller
+            reply = ("error", exc, (start, 0.0))
+        reply = (reply[0], reply[1], (start, time.monotonic()))  # when it worked [s]
+        try:
+            connection.send(reply)
+        except (BrokenPipeError, EOFError, OSError):
+            return
+        except Exception as exc:  # a value or exception that does not pickle
+            connection.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}"),
+                             reply[2]))
+
+
+class _WorkerDied(Exception):
+    """The lane's worker process ended (before or during a request)."""
+
+
 # -- the server's side -------------------------------------------------------------------
+class SentRequest:
+    """A request given to a worker by :meth:`SolverProcesses.send_now`, its value not
+    yet collected."""
+
+    def __init__(self, lane: _Lane, fn: Any, args: tuple[Any, ...]) -> None:
+        self.lane, self.fn, self.args = lane, fn, args
+
+
 class _Lane:
     """One worker process, whether it is working, and the requests waiting for it."""
 
@@ -133,21 +172,74 @@ class _Lane:
         self.stage_cache_bytes = stage_cache_bytes
         self.busy = False                         # a request is in the worker
         self.waiting: collections.deque[object] = collections.deque()  # requests, in order
-        self.executor = self._new_executor()
+        self.process, self.connection = self._new_worker()
 
-    def _new_executor(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"),
-                                   initializer=_start_worker,
-                                   initargs=(self.stage_cache_bytes,))
+    def _new_worker(self) -> tuple[Any, multiprocessing.connection.Connection]:
+        context = multiprocessing.get_context("spawn")
+        ours, theirs = context.Pipe(duplex=True)
+        process = context.Process(target=_serve, args=(theirs, self.stage_cache_bytes),
+                                  name=f"solver-{self.index}", daemon=True)
+        process.start()
+        theirs.close()  # the worker's end lives in the worker: its death closes the pipe
+        return process, ours
+
+    def call(self, fn: Any, args: tuple[Any, ...], timeout: float) -> Any:
+        """``fn(*args)`` in the worker; raises :class:`_WorkerDied` if the worker is dead
+        (before or during the request), TimeoutError past ``timeout`` [s], and ``fn``'s
+        own exception. Only the one thread holding the lane calls this."""
+        self.send(fn, args)
+        return self.receive(timeout)
+
+    def send(self, fn: Any, args: tuple[Any, ...]) -> None:
+        """Give ``fn(*args)`` to the worker (:class:`_WorkerDied` if it is dead)."""
+        process, connection = self.process, self.connection
+        if not process.is_alive():
+            raise _WorkerDied("before")
+        try:
+            connection.send((fn, args))
+        except (EOFError, OSError):  # a broken pipe, or closed by a shutdown
+            raise _WorkerDied("before") from None
+        mark("sent", lane=self.index)
+
+    def receive(self, timeout: float) -> Any:
+        """The value of the request sent last (see :meth:`call`)."""
+        process, connection = self.process, self.connection
+        try:
+            ready = multiprocessing.connection.wait([connection, process.sentinel], timeout)
+        except OSError:  # the pipe closed by a shutdown
+            raise _WorkerDied("during") from None
+        if not ready:
+            raise TimeoutError
+        if connection not in ready:  # only the sentinel: the worker ended
+            raise _WorkerDied("during")
+        try:
+            kind, value, (start, end) = connection.recv()
+        except (EOFError, OSError):
+            raise _WorkerDied("during") from None
+        if TRACE_FILE is not None:
+            mark("worker_start", start, lane=self.index)
+            mark("worker_end", end, lane=self.index)
+            mark("received", lane=self.index)
+        if kind == "error":
+            raise value
+        return value
 
     def restart(self) -> None:
         """Stop the worker (whatever it is doing) and start a new one."""
-        old, self.executor = self.executor, self._new_executor()
-        processes = list(getattr(old, "_processes", {}).values())
-        old.shutdown(wait=False, cancel_futures=True)
-        for process in processes:  # a stuck worker would never read the shutdown
-            if process.is_alive():
-                process.kill()
+        old, old_connection = self.process, self.connection
+        self.process, self.connection = self._new_worker()
+        old_connection.close()  # an idle worker reads the end of the pipe and returns
+        if old.is_alive():
+            old.kill()  # a working or stuck one would never read it
+        old.join(5)
+
+    def stop(self) -> None:
+        """Stop the worker: an idle one at once, a working one killed after 5 s."""
+        self.connection.close()
+        self.process.join(5)
+        if self.process.is_alive():
+            self.process.kill()
+            self.process.join(5)
 
 
 class SolverProcesses:
@@ -186,20 +278,62 @@ class SolverProcesses:
         (first come, first served), or, after :data:`SPILL_AFTER_S`, takes any lane that
         is idle with nobody waiting. Exceptions of ``fn`` are raised here. A worker found
         dead before the work was given to it is replaced and the work given to the new
-        one. A worker that dies during the work (noticed at once: the pool watches its
-        processes) is replaced and the work run once more on the new one; if that one
+        one. A worker that dies during the work (noticed at once: the wait watches the
+        process) is replaced and the work run once more on the new one; if that one
         dies too, or the work takes longer than :data:`REQUEST_TIMEOUT_S`, the worker is
         replaced and :class:`WorkerFailed` raised.
         """
-        lane = self._acquire(preferred)
+        return self._finish(self._acquire(preferred), fn, args, sent=False)
+
+    def send_now(self, preferred: int, fn: Any, *args: Any) -> SentRequest | None:
+        """Give ``fn(*args)`` to lane ``preferred`` at once, from the calling thread, if
+        that lane is idle with nobody waiting; None otherwise (then use :meth:`run`).
+
+        A slider step is written to the worker by the event loop that read it, so the
+        worker starts while the loop finishes the step's other work; waiting for a
+        thread to wake and take the lock first cost 5-8 ms a step on a loaded machine.
+        Every request sent must be collected with :meth:`result` (which frees the lane).
+        """
+        with self._cond:
+            lane = self._lanes[preferred % len(self._lanes)]
+            if self._closed or lane.busy or lane.waiting:
+                return None
+            lane.busy = True
         try:
-            retried = False
+            lane.send(fn, args)
+        except _WorkerDied:  # replaced by the request that follows on the usual way
+            with self._cond:
+                lane.busy = False
+                self._cond.notify_all()
+            return None
+        return SentRequest(lane, fn, args)
+
+    def result(self, sent: SentRequest) -> Any:
+        """The value of a request given by :meth:`send_now`, with :meth:`run`'s handling
+        of a worker that dies or gets stuck meanwhile."""
+        return self._finish(sent.lane, sent.fn, sent.args, sent=True)
+
+    def _finish(self, lane: _Lane, fn: Any, args: tuple[Any, ...], sent: bool) -> Any:
+        # ``lane`` is held by this request (busy); ``sent``: fn(*args) is in its worker
+        try:
+            retried, starts = False, 0
             while True:
-                future, executor = self._submit(lane, fn, args)
+                with self._lock:
+                    if self._closed:
+                        raise WorkerFailed("the server is stopping")
                 try:
-                    return future.result(timeout=REQUEST_TIMEOUT_S)
-                except BrokenProcessPool:
-                    self._replace(lane, executor)
+                    if sent:
+                        sent = False
+                        return lane.receive(REQUEST_TIMEOUT_S)
+                    return lane.call(fn, args, REQUEST_TIMEOUT_S)
+                except _WorkerDied as died:
+                    self._replace(lane)
+                    if str(died) == "before":  # died while idle: nothing was lost
+                        starts += 1
+                        if starts > 2:
+                            raise WorkerFailed("the solver process could not be "
+                                               "started") from None
+                        continue
                     if not retried:
                         # killed from outside (or out of memory): once more, not forever
                         retried = True
@@ -210,7 +344,7 @@ class SolverProcesses:
                                        "twice (out of memory?); a new one was started, "
                                        "please try again") from None
                 except TimeoutError:
-                    self._replace(lane, executor)
+                    self._replace(lane)
                     raise WorkerFailed(f"the solve took longer than {REQUEST_TIMEOUT_S:.0f} "
                                        "s and was stopped") from None
         finally:
@@ -242,35 +376,39 @@ class SolverProcesses:
                 own.waiting.remove(ticket)
                 self._cond.notify_all()  # the next in the queue may go now
 
-    def _submit(self, lane: _Lane, fn: Any,
-                args: tuple[Any, ...]) -> tuple[Future[Any], ProcessPoolExecutor]:
-        for _attempt in range(2):
-            with self._lock:
-                if self._closed:
-                    raise WorkerFailed("the server is stopping")
-                executor = lane.executor
-            try:
-                future: Future[Any] = executor.submit(fn, *args)
-            except BrokenProcessPool:  # died while idle: nothing was lost, start anew
-                self._replace(lane, executor)
-                continue
-            return future, executor
-        raise WorkerFailed("the solver process could not be started")
-
-    def _replace(self, lane: _Lane, broken: ProcessPoolExecutor) -> None:
+    def _replace(self, lane: _Lane) -> None:
         with self._lock:
-            # another request on the same lane may have replaced the worker already
-            if not self._closed and lane.executor is broken:
+            if not self._closed:
                 log.warning("restarting solver process %d", lane.index)
                 lane.restart()
 
     def run_everywhere(self, fn: Any, *args: Any) -> list[Any]:
-        """Call ``fn(*args)`` in every worker at once (to start them, or to warm their
-        caches with a scene) and return the values, lane by lane."""
-        with self._lock:
-            executors = [lane.executor for lane in self._lanes]
-        futures = [executor.submit(fn, *args) for executor in executors]
-        return [f.result(timeout=REQUEST_TIMEOUT_S) for f in futures]
+        """Call ``fn(*args)`` in every worker (to start them, or to warm their caches with
+        a scene) and return the values, lane by lane. Each lane is taken in turn, as a
+        request would take it; the workers work at once."""
+        results: list[Future[Any]] = []
+        for lane in self._lanes:
+            done: Future[Any] = Future()
+            thread = threading.Thread(target=self._run_into, args=(lane.index, fn, args, done),
+                                      daemon=True)
+            thread.start()
+            results.append(done)
+        return [f.result() for f in results]
+
+    def _run_into(self, index: int, fn: Any, args: tuple[Any, ...], done: Future[Any]) -> None:
+        own = self._lanes[index]
+        with self._cond:  # this lane and no other, whatever waits
+            while own.busy and not self._closed:
+                self._cond.wait()
+            own.busy = True
+        try:
+            done.set_result(own.call(fn, args, REQUEST_TIMEOUT_S))
+        except BaseException as exc:
+            done.set_exception(exc)
+        finally:
+            with self._cond:
+                own.busy = False
+                self._cond.notify_all()
 
     def start(self) -> list[dict[str, int]]:
         """Start every worker now rather than at the first request; returns
@@ -280,15 +418,13 @@ class SolverProcesses:
     def pids(self) -> list[int]:
         """Process ids of the running workers."""
         with self._lock:
-            return [p.pid for lane in self._lanes
-                    for p in getattr(lane.executor, "_processes", {}).values()
-                    if p.pid is not None]
+            return [lane.process.pid for lane in self._lanes
+                    if lane.process.pid is not None and lane.process.is_alive()]
 
     def shutdown(self) -> None:
         """Stop every worker (requests still waiting get :class:`WorkerFailed`)."""
         with self._cond:
             self._closed = True
             self._cond.notify_all()
-            executors = [lane.executor for lane in self._lanes]
-        for executor in executors:
-            executor.shutdown(wait=True, cancel_futures=True)
+        for lane in self._lanes:
+            lane.stop()

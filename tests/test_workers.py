@@ -102,6 +102,41 @@ def test_downloads_from_a_worker_hold_the_numbers_on_screen(processes, monkeypat
         download_text(view.scene, "to_pickle")
 
 
+def test_a_request_sent_at_once_is_answered_and_frees_its_lane(processes, tmp_path,
+                                                                wait_until) -> None:
+    pids = [info["pid"] for info in processes.run_everywhere(worker_info)]
+    sent = processes.send_now(1, os.getpid)
+    assert sent is not None and processes._lanes[1].busy
+    assert processes.send_now(1, os.getpid) is None  # one request per worker
+    assert processes.result(sent) == pids[1]
+    assert not processes._lanes[1].busy
+    with held_worker(processes, 0, tmp_path, wait_until):
+        assert wait_until(lambda: processes._lanes[0].busy)
+        assert processes.send_now(0, os.getpid) is None  # busy: the caller waits its turn
+
+
+def test_a_session_sends_a_load_step_from_its_own_thread(processes, monkeypatch) -> None:
+    monkeypatch.setattr(controller_module, "_PROCESSES", processes)
+    RESULTS.clear()
+    state = ExplorerState()
+    state.param.update(time_count=5, tol=1e-5)
+    session = SolveController(state, auto=False)  # the shared thread pool waits
+    sent: list[Any] = []
+    send_now = processes.send_now
+    monkeypatch.setattr(processes, "send_now",
+                        lambda *args: sent.append(send_now(*args)) or sent[-1])
+    session.request()
+    assert session.wait(120) and session.error == "", session.error
+    assert len(sent) == 1 and sent[0] is not None  # the worker had it before the thread
+    here = prepare_view(solve(session.view.scene), session.view.scene)
+    np.testing.assert_allclose(session.view.values["settlement"],
+                               here.values["settlement"], rtol=1e-13, atol=0)
+    assert not any(lane.busy for lane in processes._lanes)
+    # the same scene again: known, so nothing is sent
+    session.request()
+    assert session.wait(120) and sent == sent[:1]
+
+
 def test_a_bad_scene_from_a_worker_names_its_field(processes, monkeypatch,
                                                   small_preset) -> None:
     scene = small_preset(force_kN=400.0)
@@ -239,6 +274,29 @@ def test_a_request_whose_worker_dies_twice_is_answered_with_a_message(tmp_path,
         os.kill(third, signal.SIGKILL)
         assert wait_until(lambda: gone(third))
         assert pool.run(0, os.getpid) not in (first, second, third)
+    finally:
+        pool.shutdown()
+
+
+def test_a_request_sent_at_once_whose_worker_is_killed_runs_again(tmp_path,
+                                                                   wait_until) -> None:
+    pool = SolverProcesses(1, 64 * 2**20)
+    try:
+        killed = pool.start()[0]["pid"]
+        gate = tmp_path / "gate-sent"
+        os.mkfifo(gate)
+        sent = pool.send_now(0, os.open, str(gate), os.O_RDONLY)
+        assert sent is not None
+        outcome: list[Any] = []
+        waiting = threading.Thread(target=lambda: outcome.append(pool.result(sent)))
+        waiting.start()
+        os.kill(killed, signal.SIGKILL)
+        # noticed at once, given to a new worker, which waits at the gate in turn
+        assert wait_until(lambda: pool.pids() not in ([], [killed]), timeout=60)
+        release(gate, wait_until)
+        waiting.join(60)
+        assert len(outcome) == 1 and isinstance(outcome[0], int), outcome  # answered
+        assert not pool._lanes[0].busy
     finally:
         pool.shutdown()
 
