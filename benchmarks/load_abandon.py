@@ -25,7 +25,7 @@ from pathlib import Path
 
 from benchmarks.abandon import WAYS, abandon_sessions
 from benchmarks.serving import ExplorerProcess, ExplorerStartError
-from explorer.gc_policy import COLLECT_AFTER_S
+from explorer.gc_policy import COLLECT_AFTER_S, LATE_COLLECT_AFTER_S
 
 #: Visits that load what every page needs once, before the baseline is read.
 WARM_UP_VISITS = 2 * len(WAYS)
@@ -54,9 +54,10 @@ def memory_mib(pid: int) -> tuple[float, float]:
 def discard_wait_s(session_linger: float) -> float:
     """How long after its connection is lost a session is surely discarded and collected
     [s]: Bokeh keeps it ``session_linger`` s, looks for such sessions every
-    ``session_linger`` s (``python -m explorer`` sets both from --session-linger), and
-    the full collection that frees its page comes ``COLLECT_AFTER_S`` later."""
-    return 2 * session_linger + COLLECT_AFTER_S + DISCARD_MARGIN_S
+    ``session_linger`` s (``python -m explorer`` sets both from --session-linger), the
+    full collection that frees its page comes ``COLLECT_AFTER_S`` later, and one more
+    for pages let go late ``LATE_COLLECT_AFTER_S`` after that."""
+    return 2 * session_linger + COLLECT_AFTER_S + LATE_COLLECT_AFTER_S + DISCARD_MARGIN_S
 
 
 def settled_mib(pid: int, session_linger: float) -> tuple[float, float, float]:
@@ -145,9 +146,9 @@ def run_abandon(args: argparse.Namespace, command: str) -> tuple[str, bool]:
         f"of four points of its start ({', '.join(WAYS)}: benchmarks/abandon.py). After "
         f"each round the memory is read once the server has surely discarded the round's "
         f"sessions ({discard_wait_s(args.session_linger):g} s: linger, one check interval, "
-        f"the collection delay, a margin) and {SETTLE_READINGS} readings {SETTLE_PERIOD:g} s "
-        f"apart agree within {SETTLE_MIB:g} MiB; the server's resident memory (RSS) and "
-        f"its solver processes' (summed) are read apart.",
+        f"the two collections' delays, a margin) and {SETTLE_READINGS} readings "
+        f"{SETTLE_PERIOD:g} s apart agree within {SETTLE_MIB:g} MiB; the server's resident "
+        f"memory (RSS) and its solver processes' (summed) are read apart.",
         "",
         f"- Failed visits: **{failed}**; tracebacks in the server log: "
         f"**{len(log_errors)}** (goal 0 each).",

@@ -10,11 +10,13 @@ its level before those visitors, and its log must hold no traceback.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 
 import pytest
 
 from benchmarks.abandon import WAYS, abandon_sessions
+from benchmarks.load_abandon import discard_wait_s
 from benchmarks.serving import ExplorerProcess
 
 pytestmark = pytest.mark.timeout(600)
@@ -31,6 +33,8 @@ ROUND = 16
 #: a fresh-clone run read +62. Without the release of Panel's link registry two rounds
 #: kept +93 MiB (177 -> 270 MiB): pages kept add ~55 MiB a round.
 GROWTH_MIB = 60.0
+#: The server's --session-linger [s].
+LINGER_S = 1.0
 
 
 def rss_mib(pid: int) -> float:
@@ -44,14 +48,16 @@ def rss_mib(pid: int) -> float:
 
 @pytest.fixture(scope="module")
 def server() -> Iterator[ExplorerProcess]:
-    with ExplorerProcess(args=["--solver-processes", "1", "--session-linger", "1"],
+    with ExplorerProcess(args=["--solver-processes", "1", "--session-linger", f"{LINGER_S:g}"],
                          host="127.0.0.1", ready_timeout=300) as process:
         yield process
 
 
 def settled(pid: int, wait_until) -> float:
-    """The server's memory once dropped sessions have been discarded and collected: the
+    """The server's memory once dropped sessions have been discarded and collected: after
+    the time the server needs for that (benchmarks/load_abandon.py: discard_wait_s), the
     level reached when three readings 1 s apart agree within 2 MiB (at most 60 s)."""
+    time.sleep(discard_wait_s(LINGER_S))  # a condition on the server's state, not a bound
     readings: list[float] = []
 
     def steady() -> bool:
