@@ -33,7 +33,7 @@ ROUND = 16
 #: dropped sessions over eight rounds of 25. What the bound must catch: a round whose
 #: pages were kept added ~55 MiB (before the release of Panel's link registry), and pages
 #: frozen until the next round ended held 60-85 MiB (before the second collection of
-#: explorer/gc_policy.py). 20 MiB is 20x the largest growth measured and a third of the
+#: explorer/gc_policy.py). 20 MiB is 20x the largest growth measured and about a third of the
 #: smallest of those.
 GROWTH_MIB = 20.0
 #: The server's --session-linger [s].
