@@ -28,6 +28,16 @@ for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 #: back the free pages around such survivors (``gc_policy`` trims after each collection).
 SERVER_ALLOCATOR = "malloc"
 
+#: How long the server waits for the headers of a request on an open connection [s].
+#: Tornado's default is an hour: every connection (each page's GET and websocket) left a
+#: one-hour timer on the event loop, cancelled when the connection closed but kept in the
+#: loop's queue until its hour was up or the cancelled ones outnumbered the live ones, one
+#: more of the small survivors per dropped session. A minute is ample for a browser to
+#: send a request's headers; an idle keep-alive connection is then closed (the browser
+#: opens another), and a client that sends nothing is dropped within the minute, not the
+#: hour.
+HEADER_TIMEOUT_S = 60.0
+
 
 #: Worker processes by default: the server's own process keeps a core for the pages; two
 #: at least, so that one slow solve cannot hold up every session (measured on 2 cores with
@@ -147,7 +157,8 @@ def main(argv: list[str] | None = None) -> int:
                show=args.show, websocket_origin=origins, title="Coated punch explorer",
                liveness=True, websocket_max_message_size=WEBSOCKET_MAX_BYTES,
                unused_session_lifetime_milliseconds=linger_ms,
-               check_unused_sessions_milliseconds=linger_ms)
+               check_unused_sessions_milliseconds=linger_ms,
+               http_server_kwargs={"idle_connection_timeout": HEADER_TIMEOUT_S})
     except KeyboardInterrupt:
         pass  # Ctrl+C during the server's set-up
     finally:

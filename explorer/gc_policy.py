@@ -18,7 +18,12 @@ hands the freed memory back to the system (``malloc_trim``) and freezes the page
 open again. Until it has run no page is frozen: a freeze then would also freeze the
 closed pages' garbage, out of reach for good (with visitors who leave abruptly, rounds of
 50 dropped sessions grew the server by ~350 MiB each, none of it returned). A page whose
-session has already ended when it completes is not frozen either.
+session has already ended when it completes is not frozen either. A page can still be
+held for a moment after its session's collection (a solve of the page coming back from
+a worker): frozen with the live pages, it would wait for the next session to end. One
+more collection :data:`LATE_COLLECT_AFTER_S` after the first frees it (measured with
+benchmarks/load_test.py --mode abandon: without it, two rounds of 25 in eight left the
+server 60-85 MiB above its level until the next round ended).
 
 Used by served sessions only, on the server's event loop.
 """
@@ -38,6 +43,8 @@ log = logging.getLogger(__name__)
 #: discards the sessions of closed pages in batches (every 17 s by default): one
 #: collection serves a whole batch, and a class closing its tabs costs one pause.
 COLLECT_AFTER_S = 2.0
+#: Delay from that collection to one more, for pages let go just after it [s].
+LATE_COLLECT_AFTER_S = 10.0
 
 _collect_due = False
 
@@ -79,8 +86,24 @@ def session_ended(session_context: Any) -> None:
     except RuntimeError:  # not on an event loop (a script, a test): collect now
         collect_ended_sessions()
         return
-    loop.call_later(COLLECT_AFTER_S, collect_ended_sessions)
+    loop.call_later(COLLECT_AFTER_S, _collect_and_look_again)
     _collect_due = True
+
+
+def _collect_and_look_again() -> None:
+    """The collection for ended sessions, and one more a little later (unless another
+    session ends meanwhile, whose own collection then comes first and looks again)."""
+    collect_ended_sessions()
+    try:
+        loop = asyncio.get_running_loop()
+    except RuntimeError:
+        return
+    loop.call_later(LATE_COLLECT_AFTER_S, _late_collection)
+
+
+def _late_collection() -> None:
+    if not _collect_due:  # a collection already due covers it
+        collect_ended_sessions()
 
 
 def collect_ended_sessions() -> int:
