@@ -94,9 +94,11 @@ def predicted_unilateral(arguments: dict[str, Any]):
     time only, elastic at the loading instant, from the prepared geometry the default
     engine would use (shared with it: a later full solve reuses it; only a pressure the
     full-contact model itself flags ``contact_lost`` counts). Applies to an elastic base
-    (any first time) and to creep when the first time is t = 1 (at loading the base is
-    elastic); otherwise, or when no unilateral answer exists (loads pulling the punch
-    away) or the check fails on the input, returns None and the caller takes the
+    (any first time; :func:`core.solver.solve_dimensionless` does not call it when the
+    modulus is also constant, since the full-contact answer costs what the check costs)
+    and to creep when the first time is t = 1 (at loading the base is elastic);
+    otherwise, or when no unilateral answer exists (loads pulling the punch away) or the
+    check fails on the input, returns None and the caller takes the
     full-contact path, whose messages and flags then speak. A new elastic geometry is
     prepared for the check as well: preparing it (3-10 ms on the work-precision scenes at
     tol 1e-6) is work the full-contact answer needs anyway, where a separate check on
