@@ -86,6 +86,28 @@ def assert_equal_to_serial(ds, study) -> None:
                                    want / np.where(scale > 0, scale, 1.0), rtol=0, atol=1e-12)
 
 
+def each_load_point_against_solve(study, grid, got, same_as_the_point) -> dict[str, int]:
+    """Check a batch's answers ``got`` over the (force, moment) ``grid`` point by point
+    against ``core.solve``: a refused point recorded with its message and no values, a
+    solved one by ``same_as_the_point(i, result)`` and its flags. Returns the count of
+    each kind (failed, unilateral, full)."""
+    kinds = {"failed": 0, "unilateral": 0, "full": 0}
+    for i, (force, moment) in enumerate(grid):
+        try:
+            result = solve(apply_point(study.base, {"loading.force": force,
+                                                    "loading.moment": moment}))
+        except ValueError as exc:
+            kinds["failed"] += 1
+            assert got["flags"][i] == "failed"
+            assert got["error"][i] == " ".join(str(exc).split())[:500]
+            assert np.all(np.isnan(got["values"][i]))
+            continue
+        kinds[result.info["contact"]] += 1
+        same_as_the_point(i, result)
+        assert got["flags"][i] == ",".join(result.flags) and got["error"][i] == ""
+    return kinds
+
+
 # ------------------------------------------------------------------------- validation
 
 
@@ -308,18 +330,7 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
     monkeypatch.setattr(batch, "apply_point", whole_scene)
     got = sweeps.run_batch(study.base, paths, grid, outputs, len(study.times))
     monkeypatch.undo()
-    kinds = {"failed": 0, "unilateral": 0, "full": 0}
-    for i, (force, moment) in enumerate(grid):
-        try:
-            result = solve(apply_point(study.base, {"loading.force": force,
-                                                    "loading.moment": moment}))
-        except ValueError as exc:
-            kinds["failed"] += 1
-            assert got["flags"][i] == "failed"
-            assert got["error"][i] == " ".join(str(exc).split())[:500]
-            assert np.all(np.isnan(got["values"][i]))
-            continue
-        kinds[result.info["contact"]] += 1
+    def same_as_the_point(i, result):
         if result.info["contact"] == "unilateral":
             # the same solver on equal scenes: measured bitwise equal
             np.testing.assert_array_equal(got["values"][i],
@@ -328,7 +339,8 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
         else:  # full contact: the whole batch at once (core.sweep_loads)
             assert_batched_equal(got["values"][i], got["error_estimate"][i], result,
                                  outputs)
-        assert got["flags"][i] == ",".join(result.flags) and got["error"][i] == ""
+
+    kinds = each_load_point_against_solve(study, grid, got, same_as_the_point)
     # pulled (P < 0) and beyond the edge (e = 2 m > a) refused; lift-off at e = 0.8 m
     assert kinds["failed"] == 5 and kinds["unilateral"] >= 1 and kinds["full"] >= 4
 
@@ -581,17 +593,7 @@ def test_points_of_one_eccentricity_are_one_answer_scaled(monkeypatch):
     # three refused, one per eccentricity 0.8, 0.47 and 0.45 m; 300 kN/m at 0.267 m is
     # answered with the load batch
     assert len(solved) == 6
-    kinds = {"failed": 0, "unilateral": 0, "full": 0}
-    for i, (force, moment) in enumerate(grid):
-        try:
-            result = solve(apply_point(study.base, {"loading.force": force,
-                                                    "loading.moment": moment}))
-        except ValueError as exc:
-            kinds["failed"] += 1
-            assert got["flags"][i] == "failed"
-            assert got["error"][i] == " ".join(str(exc).split())[:500]
-            continue
-        kinds[result.info["contact"]] += 1
+    def same_as_the_point(i, result):
         want = batch.point_outputs(result, list(OUTPUTS))
         scale = np.max(np.abs(want), axis=1, keepdims=True)
         scale = np.where(scale > 0, scale, 1.0)
@@ -599,7 +601,8 @@ def test_points_of_one_eccentricity_are_one_answer_scaled(monkeypatch):
                                    atol=SCALED_ROUNDING)
         np.testing.assert_allclose(got["error_estimate"][i], result.info["error_estimate"],
                                    rtol=SCALED_ESTIMATE_ROUNDING)
-        assert got["flags"][i] == ",".join(result.flags) and got["error"][i] == ""
+
+    kinds = each_load_point_against_solve(study, grid, got, same_as_the_point)
     assert kinds == {"failed": 3, "unilateral": 5, "full": 1}
 
 
