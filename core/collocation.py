@@ -44,6 +44,7 @@ from core.collocation_steps import (
     MAX_STEPS,
     CollocationSystem,
     adaptive_grids,
+    finite_values,
     fixed_grids,
     time_grid,
 )
@@ -182,9 +183,9 @@ def solve_collocation(
     tol = _positive_number(time_tol, "time_tol")
     times_arr = validate_times(times)  # the checks and limits of solve_dimensionless
     cuts = _check_breakpoints(breakpoints)
-    m_fn = _space_function(m, "m")
-    g_fn = _space_function(g, "g")
-    c_fn = _time_function(c, "c")
+    m_fn = _function(m, "m")
+    g_fn = _function(g, "g")
+    c_fn = _function(c, "c")
     given = {name: value for name, value in zip(
         _QUANTITIES, (settlement, tilt, force, moment), strict=True) if value is not None}
     key = frozenset(given)
@@ -195,7 +196,7 @@ def solve_collocation(
         raise ValueError("settlement, tilt, force, moment: " + " and ".join(sorted(key))
                          + " is not one of the four statements (settlement+tilt, "
                          "settlement+moment, tilt+force, force+moment)")
-    loads = {name: _time_function(value, name) for name, value in given.items()}
+    loads = {name: _function(value, name) for name, value in given.items()}
     if kernel is not None and not callable(kernel):
         raise ValueError("kernel: must be None or a callable K(t, tau)")
     if time_points is not None:
@@ -266,18 +267,12 @@ def _check_breakpoints(breakpoints: Sequence[float]) -> list[float]:
     return cuts
 
 
-def _space_function(value: object, name: str) -> Callable[[np.ndarray], np.ndarray]:
+def _function(value: object, name: str) -> Callable[[np.ndarray], np.ndarray]:
+    # a callable of x or t as it is, a number as the constant function of that value
     if callable(value):
         return value  # type: ignore[return-value]
     number = _finite_number(value, name)
-    return lambda x: np.full(np.shape(x), number)
-
-
-def _time_function(value: object, name: str) -> Callable[[np.ndarray], np.ndarray]:
-    if callable(value):
-        return value  # type: ignore[return-value]
-    number = _finite_number(value, name)
-    return lambda t: np.full(np.shape(t), number)
+    return lambda points: np.full(np.shape(points), number)
 
 
 def _finite_number(value: object, name: str) -> float:
@@ -286,8 +281,5 @@ def _finite_number(value: object, name: str) -> float:
 
 
 def _eval_space(fn: Callable, x: np.ndarray, name: str) -> np.ndarray:
-    values = np.broadcast_to(np.asarray(fn(x), dtype=float), x.shape)
-    if not np.all(np.isfinite(values)):
-        raise ValueError(f"{name}: values on [-1, 1] must be finite")
-    return np.array(values)
+    return finite_values(fn, x, name, "values on [-1, 1] must be finite")
 

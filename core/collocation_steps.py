@@ -288,12 +288,17 @@ def adaptive_grids(system: CollocationSystem, times: np.ndarray, richardson: boo
         level += 1
 
 
+def finite_values(fn: Callable, points: np.ndarray, name: str, refusal: str) -> np.ndarray:
+    """``fn(points)`` broadcast to the shape of ``points`` (dimensionless x or t), as a new
+    array; a ValueError ``"<name>: <refusal>"`` if any value is not finite."""
+    values = np.broadcast_to(np.asarray(fn(points), dtype=float), points.shape)
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"{name}: {refusal}")
+    return np.array(values)
+
 
 def _eval_time(fn: Callable, t: np.ndarray, name: str) -> np.ndarray:
-    values = np.broadcast_to(np.asarray(fn(t), dtype=float), t.shape)
-    if not np.all(np.isfinite(values)):
-        raise ValueError(f"{name}: values must be finite at every time")
-    return np.array(values)
+    return finite_values(fn, t, name, "values must be finite at every time")
 
 
 def _eval_kernel(kernel: Callable, t: float, tau: np.ndarray) -> np.ndarray:
