@@ -26,274 +26,39 @@ M per unit tilt at H = a: level 0 1.0e-4 / 2.3e-4 (25k unknowns, ~1 s), level 1 
 observed order 3.6-3.7 in the element size (timings on a shared 2-core machine).
 Coated, ``sum h / 2a = 0.02``, ``E_c / E = 0.05``, ``nu_c = 0.45``, H = a: levels 0 and
 1 differ by 4e-5 / 9e-5 (smooth) and 5e-5 / 1.3e-4 (bonded).
+
+This module assembles and solves (:func:`solve_stack`); the inputs and results are in
+:mod:`core.fem_stack`, the mesh in :mod:`core.fem_mesh` (both re-exported here).
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-#: Interfaces of a coating layer with what lies under it.
-INTERFACES = ("smooth", "bonded")
+from core.fem_mesh import (
+    COATING_ROWS,
+    EDGE_SIZE,
+    GROWTH,
+    INTERIOR_SIZE,
+    build_mesh,
+    total_thickness,
+)
+from core.fem_stack import INTERFACES, CoatingStrip, FEResponse, Profile, Stack
+
+__all__ = [
+    "COATING_ROWS", "EDGE_SIZE", "GROWTH", "INTERFACES", "INTERIOR_SIZE",
+    "TRUNCATION_DEPTHS", "CoatingStrip", "FEResponse", "Profile", "Stack", "solve_stack",
+]
+
 #: Lateral extent of the base beyond the punch edge, in base thicknesses (the kernel of
 #: the layer decays like exp(-2.1 x / H); ``--fe-study`` measured the change of the force
 #: against 10 H: 2.5e-4 / 6.2e-4 at 2 H, 4e-8 / 8e-8 at 4 H, 6e-11 / 7e-11 at 6 H for
 #: H = a / H = 4a).
 TRUNCATION_DEPTHS = 6.0
-#: Smallest element next to a punch edge, in half-widths (level 0).
-EDGE_SIZE = 1e-5
-#: Growth of the element size away from a punch edge or breakpoint.
-GROWTH = 1.6
-#: Largest element under the punch, in half-widths (level 0).
-INTERIOR_SIZE = 0.08
-#: Element rows per coating layer (level 0).
-COATING_ROWS = 2
-
-Profile = Callable[[np.ndarray], np.ndarray]
-
-
-@dataclass(frozen=True)
-class CoatingStrip:
-    """One resolved coating layer: ``thickness`` [m], ``modulus`` [Pa], ``poisson`` [-] as
-    vectorized functions of ``x`` [m] on ``[-a, a]``, and its ``interface`` with what lies
-    under it (``"smooth"`` or ``"bonded"``)."""
-
-    thickness: Profile
-    modulus: Profile
-    poisson: Profile
-    interface: str = "smooth"
-
-
-@dataclass(frozen=True)
-class Stack:
-    """The geometry and materials of a check (SI units).
-
-    ``half_width`` a [m]; ``shape`` f(x) [m] of the punch base on ``[-a, a]``; ``coating``
-    top layer first (as in a scene); the base: ``base_thickness`` H [m], ``base_modulus``
-    E [Pa] (elastic, at the chosen time), ``base_poisson`` nu; ``breakpoints`` [m] where a
-    profile may jump (the mesh puts element edges there).
-    """
-
-    half_width: float
-    coating: tuple[CoatingStrip, ...]
-    base_thickness: float
-    base_modulus: float
-    base_poisson: float
-    shape: Profile | None = None
-    breakpoints: tuple[float, ...] = ()
-
-
-@dataclass
-class FEResponse:
-    """The three unit responses of one finite-element solve (SI units).
-
-    ``force_parts``, ``moment_parts``: P [N/m] and M [N] for (the gap alone, a unit
-    settlement [per m], a unit tilt [per rad]); ``pressure_parts`` q [Pa] at the contact
-    nodes ``x_nodes`` [m] (P2 nodes in order: vertex, midpoint, vertex, ...). ``dofs``,
-    ``seconds`` describe the solve.
-    """
-
-    half_width: float
-    x_nodes: np.ndarray
-    pressure_parts: np.ndarray
-    force_parts: np.ndarray
-    moment_parts: np.ndarray
-    dofs: int
-    seconds: float
-    extent: float = field(default=0.0)
-
-    def force_moment(self, settlement: float, tilt: float) -> tuple[float, float]:
-        """P [N/m] and M [N] for a settlement delta [m] and a tilt alpha [rad]."""
-        w = np.array([1.0, settlement, tilt])
-        return float(w @ self.force_parts), float(w @ self.moment_parts)
-
-    def kinematics(self, force: float, moment: float) -> tuple[float, float]:
-        """delta [m] and alpha [rad] that carry P [N/m] and M [N] (statement 4)."""
-        a = np.array([[self.force_parts[1], self.force_parts[2]],
-                      [self.moment_parts[1], self.moment_parts[2]]])
-        rhs = np.array([force - self.force_parts[0], moment - self.moment_parts[0]])
-        delta, alpha = np.linalg.solve(a, rhs)
-        return float(delta), float(alpha)
-
-    def complete(self, given: dict[str, float]) -> dict[str, float]:
-        """All four of settlement, tilt, force, moment from any two of them (SI units)."""
-        known = {k: float(v) for k, v in given.items()}
-        # the four quantities are related by two linear equations in (delta, alpha)
-        rows = {"force": (self.force_parts, 0), "moment": (self.moment_parts, 0)}
-        a_rows, rhs = [], []
-        for name, value in known.items():
-            if name == "settlement":
-                a_rows.append([1.0, 0.0])
-                rhs.append(value)
-            elif name == "tilt":
-                a_rows.append([0.0, 1.0])
-                rhs.append(value)
-            else:
-                parts = rows[name][0]
-                a_rows.append([parts[1], parts[2]])
-                rhs.append(value - parts[0])
-        delta, alpha = np.linalg.solve(np.array(a_rows), np.array(rhs))
-        force, moment = self.force_moment(delta, alpha)
-        return {"settlement": float(delta), "tilt": float(alpha), "force": force,
-                "moment": moment}
-
-    def pressure(self, x: np.ndarray, settlement: float, tilt: float) -> np.ndarray:
-        """q [Pa] at points ``x`` [m] of ``[-a, a]`` (the P2 interpolant of the nodal values)."""
-        values = np.array([1.0, settlement, tilt]) @ self.pressure_parts
-        return _p2_interpolate(self.x_nodes, values, np.asarray(x, dtype=float))
-
-
-def _p2_interpolate(nodes: np.ndarray, values: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Piecewise quadratic through (vertex, midpoint, vertex) triples of ``nodes``."""
-    left = nodes[0:-1:2]
-    seg = np.clip(np.searchsorted(left, x, side="right") - 1, 0, left.size - 1)
-    x0, x1, x2 = nodes[2 * seg], nodes[2 * seg + 1], nodes[2 * seg + 2]
-    v0, v1, v2 = values[2 * seg], values[2 * seg + 1], values[2 * seg + 2]
-    l0 = (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2))
-    l1 = (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2))
-    l2 = (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1))
-    return v0 * l0 + v1 * l1 + v2 * l2
-
-
-# ---------------------------------------------------------------------------- the mesh
-
-
-def _graded(lo: float, hi: float, grade_lo: bool, grade_hi: bool, smallest: float,
-            largest: float) -> np.ndarray:
-    """Points of [lo, hi] (ends included) with sizes growing by GROWTH from ``smallest``
-    at a graded end up to ``largest``."""
-    def from_end(length: float) -> list[float]:
-        d, step, out = 0.0, smallest, []
-        while d + step < length:
-            d += step
-            out.append(d)
-            step = min(step * GROWTH, largest)
-        return out
-
-    length = hi - lo
-    if not grade_lo and not grade_hi:
-        n = max(1, int(np.ceil(length / largest)))
-        return np.linspace(lo, hi, n + 1)
-    if grade_lo and grade_hi:
-        half = 0.5 * length
-        left = [lo + d for d in from_end(half) if d < half - 0.3 * smallest]
-        right = [hi - d for d in from_end(half) if d < half - 0.3 * smallest]
-        pts = [lo] + left + [lo + half] + right[::-1] + [hi]
-        return np.unique(np.array(pts))
-    dist = from_end(length)
-    if grade_lo:
-        pts = [lo] + [lo + d for d in dist] + [hi]
-    else:
-        pts = [lo] + [hi - d for d in dist[::-1]] + [hi]
-    pts = np.array(pts)
-    # a last sliver would be a needle element
-    if pts.size > 2 and pts[-1] - pts[-2] < 0.3 * (pts[-2] - pts[-3] if pts.size > 3 else 1):
-        pts = np.delete(pts, -2 if grade_lo else 1)
-    return pts
-
-
-def _bisect(points: np.ndarray, times: int) -> np.ndarray:
-    for _ in range(times):
-        points = np.sort(np.concatenate([points, 0.5 * (points[1:] + points[:-1])]))
-    return points
-
-
-def _x_grid(stack: Stack, extent: float, level: int) -> np.ndarray:
-    """The x grid in half-widths: graded toward +-1 and the breakpoints."""
-    a = stack.half_width
-    h_scale = stack.base_thickness / a
-    inner = sorted({-1.0, 1.0} | {float(b) / a for b in stack.breakpoints if -a < b < a})
-    total = _total_thickness(stack, a * np.linspace(-1, 1, 201)) / a
-    # outside the punch the coating bends with the base: keep its elements within a few
-    # tens of its thickness long (stretched P2 elements grow too stiff in bending)
-    thickest = float(np.max(total, initial=0.0))
-    outer_size = 0.5 * h_scale if thickest == 0 else \
-        min(0.5 * h_scale, max(INTERIOR_SIZE, 25.0 * thickest))
-    pieces = [_graded(-extent, -1.0, False, True, EDGE_SIZE, outer_size)]
-    for lo, hi in zip(inner[:-1], inner[1:], strict=True):
-        pieces.append(_graded(lo, hi, True, True, EDGE_SIZE, min(INTERIOR_SIZE, h_scale)))
-    pieces.append(_graded(1.0, extent, True, False, EDGE_SIZE, outer_size))
-    return _bisect(np.unique(np.concatenate(pieces)), level)
-
-
-def _total_thickness(stack: Stack, x: np.ndarray) -> np.ndarray:
-    a = stack.half_width
-    xc = np.clip(x, -a, a)
-    total = np.zeros(np.shape(x))
-    for layer in stack.coating:
-        total = total + np.broadcast_to(np.asarray(layer.thickness(xc), dtype=float), xc.shape)
-    return total
-
-
-def _material(layer: CoatingStrip, xs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    e = np.broadcast_to(np.asarray(layer.modulus(xs), dtype=float), xs.shape)
-    nu = np.broadcast_to(np.asarray(layer.poisson(xs), dtype=float), xs.shape)
-    return e, nu
-
-
-def _build_mesh(stack: Stack, extent: float, level: int):
-    """Vertices, triangles, per-triangle Lame parameters, and each region's bottom and top
-    rows (vertex indices in x order). Region 0 is the base, then the coating bottom-up."""
-    a, e_ref = stack.half_width, stack.base_modulus
-    xs = _x_grid(stack, extent, level)
-    nx = xs.size
-    h_base = stack.base_thickness / a
-    rows_base = -_graded(0.0, h_base, True, False, EDGE_SIZE, min(0.5, 0.25 * h_base))[::-1]
-    rows_base = _bisect(np.sort(rows_base), level)
-    fractions = np.linspace(0.0, 1.0, COATING_ROWS * 2**level + 1)
-    points, triangles, lam, mu, rows = [], [], [], [], []
-    offset = 0
-    bottom = np.zeros(nx)
-    xm = np.clip(a * xs, -a, a)
-    layers = list(stack.coating)[::-1]  # bottom-up
-    regions = [(None, rows_base)] + [(layer, fractions) for layer in layers]
-    for number, (layer, ys) in enumerate(regions):
-        if number == len(regions) - 1 and layer is not None:
-            # the punch edge's singularity lies in the top layer: rows geometric toward
-            # its top (sized on its thinnest point)
-            h_min = float(np.min(np.asarray(layer.thickness(xm), dtype=float))) / a
-            ys = 1.0 - _graded(0.0, 1.0, True, False, EDGE_SIZE / h_min,
-                               1.0 / COATING_ROWS)[::-1]
-            ys = _bisect(np.sort(ys), level)
-        if layer is None:
-            yy = ys[:, None] + 0 * xs[None, :]
-        else:
-            h = np.broadcast_to(np.asarray(layer.thickness(xm), dtype=float), xs.shape) / a
-            yy = bottom[None, :] + ys[:, None] * h[None, :]
-        ny = ys.size
-        index = offset + np.arange(ny * nx).reshape(ny, nx)
-        points.append(np.stack([np.broadcast_to(xs, yy.shape).ravel(), yy.ravel()]))
-        i0, i1 = index[:-1, :-1].ravel(), index[:-1, 1:].ravel()
-        i2, i3 = index[1:, :-1].ravel(), index[1:, 1:].ravel()
-        # alternate the diagonals so that no direction is preferred
-        flip = ((np.arange(ny - 1)[:, None] + np.arange(nx - 1)[None, :]) % 2).ravel() == 1
-        t1 = np.where(flip, np.stack([i0, i1, i3]), np.stack([i0, i1, i2]))
-        t2 = np.where(flip, np.stack([i0, i3, i2]), np.stack([i1, i3, i2]))
-        tri = np.concatenate([t1, t2], axis=1)
-        triangles.append(tri)
-        cell_x = np.tile(0.5 * (xs[1:] + xs[:-1]), ny - 1)
-        cell_x = np.concatenate([cell_x, cell_x])
-        if layer is None:
-            e = np.full(cell_x.shape, 1.0)
-            nu = np.full(cell_x.shape, stack.base_poisson)
-        else:
-            e, nu = _material(layer, np.clip(a * cell_x, -a, a))
-            e = e / e_ref
-        lam.append(e * nu / ((1 + nu) * (1 - 2 * nu)))
-        mu.append(e / (2 * (1 + nu)))
-        rows.append((index[0], index[-1]))
-        bottom = yy[-1]
-        offset += ny * nx
-    return (xs, np.concatenate(points, axis=1), np.concatenate(triangles, axis=1),
-            np.concatenate(lam), np.concatenate(mu), rows, layers)
-
-
-# --------------------------------------------------------------------------- the solve
 
 
 def _row_dofs(basis, facet_of: dict, row: np.ndarray, component: int) -> np.ndarray:
@@ -335,7 +100,7 @@ def solve_stack(stack: Stack, *, level: int = 0, extent: float | None = None) ->
                              f"got {layer.interface!r}")
     if extent is None:
         extent = 1.0 + TRUNCATION_DEPTHS * stack.base_thickness / a
-    xs, p, t, lam, mu, rows, layers = _build_mesh(stack, extent, level)
+    xs, p, t, lam, mu, rows, layers = build_mesh(stack, extent, level)
     mesh = MeshTri(p, t.astype(np.int64))
     # MeshTri may reorder a triangle's vertices but keeps the triangles' order
     basis = Basis(mesh, ElementVector(ElementTriP2()), intorder=2)
@@ -389,7 +154,7 @@ def solve_stack(stack: Stack, *, level: int = 0, extent: float | None = None) ->
     dense = np.linspace(-a, a, 4001)
     f_dense = np.zeros(dense.shape) if stack.shape is None else \
         np.broadcast_to(np.asarray(stack.shape(dense), dtype=float), dense.shape)
-    lowest = min(float(np.min(f_dense - _total_thickness(stack, dense))) / a,
+    lowest = min(float(np.min(f_dense - total_thickness(stack, dense))) / a,
                  float(np.min(f - y_top[contact])))
     gap = f - y_top[contact] - lowest
     for i, d in enumerate(top[contact]):

@@ -161,7 +161,7 @@ def test_schur_path_agrees_with_lu_factorizations(monkeypatch):
     # Aging kernel and c(t): a new step matrix every step. By default the solver switches
     # from LU to one Schur form after 16 matrices; forcing LU throughout must agree to
     # round-off (measured 9.4e-15 over all statements, outputs and nodal pressures).
-    import core.collocation as collocation
+    import core.collocation_steps as collocation_steps
 
     def kernel(t, tau):
         return np.where(t >= tau, -0.6 * (1.0 + 1.0 / tau) * np.exp(-1.5 * (t - tau)), 0.0)
@@ -172,7 +172,7 @@ def test_schur_path_agrees_with_lu_factorizations(monkeypatch):
     pairs = (dict(force=1.0, moment=0.1), dict(settlement=0.3, tilt=0.05),
              dict(settlement=0.3, moment=0.1), dict(tilt=0.05, force=1.0))
     schur = [solve_collocation(**common, **given) for given in pairs]
-    monkeypatch.setattr(collocation, "_LU_LIMIT", 10**9)
+    monkeypatch.setattr(collocation_steps, "LU_LIMIT", 10**9)
     lu = [solve_collocation(**common, **given) for given in pairs]
     worst = 0.0
     for a, b in zip(schur, lu, strict=True):
