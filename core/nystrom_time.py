@@ -95,6 +95,14 @@ class ModalForm:
         # outer product, not a product with psi^-1 at every time read
         self.settlement_free = ms.psi_inv @ ms.e0_rot[ms.free]
         self.tilt_free = ms.psi_inv @ ms.e1_rot[ms.free]
+        # nodal values of the modal coordinates (free) and of the known ones, with the
+        # rotation and psi folded in: a history then costs one product with the nodes
+        # instead of psi, the rotation and the nodes in turn (two N x N x T products)
+        rotation = ms.to_coefficients(np.eye(ms.n))
+        self.node_modes = self.to_nodes @ (rotation[:, ms.free] @ ms.psi)
+        self.node_known = self.to_nodes @ rotation[:, ms.known]
+        self.known_modes = (ms.r_rot[np.ix_(ms.known, ms.free)] @ ms.psi if self.k
+                            else np.zeros((0, len(ms.free))))
         self.e0 = np.zeros(grid.size)
         self.e1 = np.zeros(grid.size)
         self.e0[0] = np.sqrt(moments[0])
@@ -126,24 +134,18 @@ class ModalForm:
         size = c_t.size
 
         def nodal() -> np.ndarray:
-            b = np.zeros((ms.n, size))
-            b[ms.free] = ms.psi @ z
-            if k:
-                b[ms.known] = known[:k]
-            return self.to_nodes @ ms.to_coefficients(b)
+            out = self.node_modes @ z
+            return out + self.node_known @ known[:k] if k else out
 
-        b_eff = np.zeros((ms.n, size))
-        free_eff = ms.psi @ (z - vz)
-        b_eff[ms.free] = free_eff
+        z_eff = z - vz
+        effective = self.node_modes @ z_eff
         if k:
-            b_eff[ms.known] = known[:k] - vu[:k]
-        effective = self.to_nodes @ ms.to_coefficients(b_eff)
+            effective += self.node_known @ (known[:k] - vu[:k])
         out = {name: np.asarray(v, dtype=float) for name, v in loads.items()}
         if k:
             # Known rows: c b_K + (I - V)[R_KF b_F + R_KK b_K] = drive_K + unknown drive.
-            r_kf = ms.r_rot[np.ix_(ms.known, ms.free)]
             r_kk = ms.r_rot[np.ix_(ms.known, ms.known)]
-            lhs = (c_t[None, :] * known[:k] + r_kf @ free_eff
+            lhs = (c_t[None, :] * known[:k] + self.known_modes @ z_eff
                    + r_kk @ (known[:k] - vu[:k]) - gap * self.gap[ms.known][:, None]
                    - self.ms.given_drive(ms.known, loads, size))
             unknowns = np.linalg.solve(ms.unknown_rhs, lhs)

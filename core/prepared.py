@@ -41,7 +41,7 @@ from core.nystrom import BorderedSystem, touches
 from core.nystrom_adapt import adapt
 from core.nystrom_result import TimeSide, nystrom_solution
 from core.nystrom_time import ModalAnswer, ModalForm
-from core.panels import panel_index
+from core.panels import NODES_PER_PANEL, interpolation_weights, panel_index
 from core.prepared_elastic import ElasticUnits, elastic_answer
 
 #: The time stepping aims this many times below its share of tol: its step-doubling
@@ -118,6 +118,12 @@ class PreparedContact:
         singular = np.array([-1.0, 1.0, *geometry.breakpoints])
         panel_of = panel_index(self.grid.panels, self.check_x)
         self.check_formula = touches(self.grid.panels, singular)[panel_of]
+        # the interpolation of the other check points, panel by panel: (panel, points,
+        # weights (points, NODES_PER_PANEL))
+        smooth = np.flatnonzero(~self.check_formula)
+        index, weights = interpolation_weights(self.grid.panels, self.check_x[smooth])
+        self._check_interpolation = [(int(p), smooth[index == p], weights[index == p])
+                                     for p in np.unique(index)]
         self.element_ends = tuple(sorted(set(self.grid.panels.edges[1:-1].tolist())
                                          | set(geometry.breakpoints)))
         self._solves = 0
@@ -306,7 +312,6 @@ class PreparedContact:
             parts.append((1.0, (common, "gap"), zero, 1.0))
         weighted_error = 0.0
         q_check = np.zeros((self.check_x.size, times.size))
-        x = self.check_x
         terms: list[tuple[float, ModalAnswer]] = []
         # All parts are stepped in one time march (force and moment together), so they are
         # cached together: the steps depend on every part, and an answer must not depend
@@ -318,14 +323,9 @@ class PreparedContact:
             answers = form.solve_parts(times, inputs.c, kernel,
                                        [(loads, gap) for _, _, loads, gap in parts],
                                        time_tol, breaks)
-            found = []
-            for (_, _, _, gap), response in zip(parts, answers, strict=True):
-                sc = response.scalars
-                drive = (sc["settlement"][None, :] + np.outer(x, sc["tilt"])
-                         - gap * self.geometry.g(x)[:, None])
-                found.append((response, self.nystrom_pressure(x, drive, c_t,
-                                                              response.effective)))
-                self.counts["time_response"] += 1
+            found = [(response, self._check_pressure(response, gap, c_t))
+                     for (_, _, _, gap), response in zip(parts, answers, strict=True)]
+            self.counts["time_response"] += len(found)
             with self._lock:
                 self._responses[joint_key] = found
                 while len(self._responses) > 24:
@@ -348,6 +348,24 @@ class PreparedContact:
         return _Superposed(scalars, effective, q_check, float(weighted_error / size),
                            max(r.steps for _, r in terms), not failed,
                            "; ".join(failed) or terms[0][1].message)
+
+    def _check_pressure(self, response: ModalAnswer, gap: float, c_t: np.ndarray
+                        ) -> np.ndarray:
+        """q of a time-stepped response at the check points (X, T), as the elastic check
+        takes it: the Nystrom formula on panels touching +-1 or a jump, elsewhere the
+        panel interpolant of the nodal q (16 nodes a point instead of all N, and the
+        operator rows at the formula's points only, which the contact check shares)."""
+        x, formula = self.check_x, self.check_formula
+        sc = response.scalars
+        near = x[formula]
+        drive = (sc["settlement"][None, :] + np.outer(near, sc["tilt"])
+                 - gap * self.geometry.g(near)[:, None])
+        check = np.empty((x.size, c_t.size))
+        check[formula] = self.nystrom_pressure(near, drive, c_t, response.effective)
+        nodal = response.nodal.reshape(self.grid.panels.n_panels, NODES_PER_PANEL, -1)
+        for panel, points, weights in self._check_interpolation:
+            check[points] = weights @ nodal[panel]
+        return check
 
     def _history_times(self, times: np.ndarray, kind: str) -> np.ndarray:
         """Output times plus samples between them, where the answer's validity is checked."""
