@@ -42,12 +42,16 @@ MODAL_ROUNDING_SHARE = 0.1
 class ModalAnswer:
     """Nodal pressures (N, T), the four scalars over the times and the time stepping's report.
 
-    ``effective`` holds ``q - V q`` at the nodes (N, T): the density whose ``F`` enters the
-    equation, for the Nystrom formula between the nodes.
+    ``q - V q`` at the nodes (the density whose ``F`` enters the equation, for the Nystrom
+    formula between the nodes) is kept in modal coordinates, ``modal_effective`` = (free
+    (F, T), known (k, T)), with ``to_nodes`` = (free (N, F), known (N, k)): it is formed
+    at the nodes only where asked (:meth:`effective`), and rows of the operator reach it
+    through the modes (:meth:`effective_through`, no N x N x T product).
     """
 
     nodal_pressures: Callable[[], np.ndarray]
-    effective: np.ndarray
+    modal_effective: tuple[np.ndarray, np.ndarray]
+    to_nodes: tuple[np.ndarray, np.ndarray]
     scalars: dict[str, np.ndarray]
     time_error: float
     steps: int
@@ -56,9 +60,22 @@ class ModalAnswer:
 
     @property
     def nodal(self) -> np.ndarray:
-        """Nodal pressures (N, T), formed when asked: the answer itself reads ``effective``
-        (an N x N x T product saved on every march with many output times)."""
+        """Nodal pressures (N, T), formed when asked (an N x N x T product)."""
         return self.nodal_pressures()
+
+    def effective(self, at: np.ndarray | slice = slice(None)) -> np.ndarray:
+        """``q - V q`` at the nodes (N, len(at)) at the columns ``at`` of the times."""
+        return self.effective_through(None, at)
+
+    def effective_through(self, rows: np.ndarray | None, at: np.ndarray | slice = slice(None)
+                          ) -> np.ndarray:
+        """``rows @ (q - V q)`` at the columns ``at`` (len(rows), len(at)); rows (X, N), or
+        None for the nodal values themselves."""
+        (free, known), (node_free, node_known) = self.modal_effective, self.to_nodes
+        if rows is not None:
+            node_free, node_known = rows @ node_free, rows @ node_known
+        out = node_free @ free[:, at]
+        return out + node_known @ known[:, at] if known.shape[0] else out
 
 
 class ModalForm:
@@ -101,6 +118,7 @@ class ModalForm:
         rotation = ms.to_coefficients(np.eye(ms.n))
         self.node_modes = self.to_nodes @ (rotation[:, ms.free] @ ms.psi)
         self.node_known = self.to_nodes @ rotation[:, ms.known]
+        self.nodes = (self.node_modes, self.node_known)
         self.known_modes = (ms.r_rot[np.ix_(ms.known, ms.free)] @ ms.psi if self.k
                             else np.zeros((0, len(ms.free))))
         self.e0 = np.zeros(grid.size)
@@ -127,9 +145,9 @@ class ModalForm:
 
     def finish(self, c_t: np.ndarray, loads: dict[str, np.ndarray], known: np.ndarray,
                z: np.ndarray, vz: np.ndarray, vu: np.ndarray, gap: float = 1.0
-               ) -> tuple[Callable[[], np.ndarray], np.ndarray, dict]:
-        """Nodal pressures (formed when called), ``q - V q`` at the nodes and the four
-        scalars."""
+               ) -> tuple[Callable[[], np.ndarray], tuple[np.ndarray, np.ndarray], dict]:
+        """Nodal pressures (formed when called), ``q - V q`` in modal coordinates (free,
+        known; see :class:`ModalAnswer`) and the four scalars."""
         ms, k = self.ms, self.k
         size = c_t.size
 
@@ -138,15 +156,13 @@ class ModalForm:
             return out + self.node_known @ known[:k] if k else out
 
         z_eff = z - vz
-        effective = self.node_modes @ z_eff
-        if k:
-            effective += self.node_known @ (known[:k] - vu[:k])
+        known_eff = known[:k] - vu[:k]
         out = {name: np.asarray(v, dtype=float) for name, v in loads.items()}
         if k:
             # Known rows: c b_K + (I - V)[R_KF b_F + R_KK b_K] = drive_K + unknown drive.
             r_kk = ms.r_rot[np.ix_(ms.known, ms.known)]
             lhs = (c_t[None, :] * known[:k] + self.known_modes @ z_eff
-                   + r_kk @ (known[:k] - vu[:k]) - gap * self.gap[ms.known][:, None]
+                   + r_kk @ known_eff - gap * self.gap[ms.known][:, None]
                    - self.ms.given_drive(ms.known, loads, size))
             unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
             for i, name in enumerate(ms.unknown_names):
@@ -161,7 +177,7 @@ class ModalForm:
             a2 = ms.rotation @ b2
             out.setdefault("force", self.e0[:2] @ a2)
             out.setdefault("moment", self.e1[:2] @ a2)
-        return nodal, effective, out
+        return nodal, (z_eff, known_eff), out
 
     def solve(self, times: np.ndarray, c: Function, kernel, loads: dict[str, Function],
               time_tol: float, gap: float = 1.0, breaks: np.ndarray | None = None
@@ -194,7 +210,7 @@ class ModalForm:
                     c_t[None, :] + gamma[:, None])
                 nodal, effective, scalars = self.finish(c_t, vals, kn, z, np.zeros_like(z),
                                                         np.zeros_like(kn), gap)
-                answers.append(ModalAnswer(nodal, effective, scalars, 0.0, 0, True,
+                answers.append(ModalAnswer(nodal, effective, self.nodes, scalars, 0.0, 0, True,
                                            "no creep: no time stepping"))
             return answers
         n_parts, n_free, n_known = len(parts), gamma.size, self.coupling.shape[1]
@@ -234,6 +250,7 @@ class ModalForm:
             known_rows = slice(p * n_known, (p + 1) * n_known)
             nodal, effective, scalars = self.finish(c_t, values[p], known[p], sol.w[rows],
                                                     sol.vw[rows], sol.vu[known_rows], gap)
-            answers.append(ModalAnswer(nodal, effective, scalars, float(estimates[p]),
+            answers.append(ModalAnswer(nodal, effective, self.nodes, scalars,
+                                       float(estimates[p]),
                                        int(sol.steps), bool(sol.success), sol.message))
         return answers
