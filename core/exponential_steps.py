@@ -278,13 +278,14 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
         vu_nodes = np.zeros_like(u)
         vu_nodes[:, :, 1:] = u @ total.transpose(0, 2, 1)
         next_drive = u @ end_drive                                # (B, K, S)
-        s_known = np.zeros((nk, n_states))
+        # the known functions' states at each step's start (no solve: a carry and a
+        # drive a step), then read at the points and the outputs all at once
+        s_known = np.zeros((n_steps + 1, nk, n_states))
         for b in range(n_steps):
-            vu_nodes[b] += s_known @ reads[b]
-            lo, hi = bounds[b], bounds[b + 1]
-            if hi > lo:
-                vu_out[:, order[lo:hi]] = s_known @ out_carry_s[lo:hi].T
-            s_known = s_known * end_carry[b] + next_drive[b]
+            np.multiply(s_known[b], end_carry[b], out=s_known[b + 1])
+            s_known[b + 1] += next_drive[b]
+        vu_nodes += s_known[:-1] @ reads
+        vu_out[:, order] = np.einsum("tks,ts->kt", s_known[step_of[order]], out_carry_s)
         vu_out += np.einsum("tj,tjk->kt", out_total, seven(u.transpose(0, 2, 1), step_of,
                                                             side))
         if rows is not None:
@@ -293,44 +294,58 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     if nm:
         # V w at the outputs, a row per output in the order of their steps
         vw_rows = np.empty((t_out.size, nm))
-        # the point systems of a block of steps at a time: (steps, 4, 4, modes) floats
-        block = max(1, MAX_BLOCK_ELEMENTS // (16 * nm))
+        # Over a step the states of a mode move by an affine map, s' = A s + e: z at the
+        # step's points is affine in the state sums there (:func:`_point_values`) and the
+        # states take the step's drive by z. The maps of a block of steps are formed at
+        # once, so the march is one small product a step; z at the points and the
+        # outputs are read afterwards from the states at each step's start.
+        block = max(1, MAX_BLOCK_ELEMENTS // ((16 + n_states**2) * nm))
         at_steps = flat.reshape(n_steps, 4)
         reads_t = reads.transpose(0, 2, 1).copy()                 # (B, 4, S)
         drive_t = end_drive.transpose(0, 2, 1).copy()             # (B, S, 4)
-        carry_t = end_carry[:, :, None]                           # (B, S, 1)
-        s_modes = np.zeros((n_states, nm))                        # modes last
+        states = np.zeros((n_steps + 1, n_states, nm))            # at each step's start
         z_all = np.empty((n_steps, 4, nm))
-        for b in range(n_steps):
-            if b % block == 0:
-                steps = slice(b, min(n_steps, b + block))
-                times_block = at_steps[steps].ravel()
-                d = _by_step(problem.d(times_block), 4)          # (b, M, 4)
-                # the parts stepped together share the modes and d: one response for all
-                by_part = d.reshape(d.shape[0], problem.parts, -1, 4)
-                shared = problem.parts > 1 and bool(np.all(by_part == by_part[:, :1]))
-                groups = problem.parts if shared else 1
-                constant, response = _point_values(
-                    by_part[:, 0] if shared else d, _by_step(problem.r(times_block), 4),
-                    total[steps], problem.coupling,
-                    None if vu_nodes is None else vu_nodes[steps])
-            # z at the step's four points: affine in the state sums there
-            sums = (reads_t[b] @ s_modes).reshape(4, groups, -1)  # (4, P, F)
-            z = z_all[b] = constant[b % block] + (
-                response[b % block][:, :, None, :] * sums[None]).sum(axis=1).reshape(4, nm)
-            lo, hi = bounds[b], bounds[b + 1]
-            if hi > lo:
-                vw_rows[lo:hi] = out_carry_s[lo:hi] @ s_modes
-            s_modes = s_modes * carry_t[b] + drive_t[b] @ z
-        # the drive of every output by z at its seven points, step by step of the outputs
-        # (the neighbour read, ``side``, is the same for all outputs of a step)
+        diagonal = np.arange(n_states)
+        for first in range(0, n_steps, block):
+            steps = slice(first, min(n_steps, first + block))
+            times_block = at_steps[steps].ravel()
+            d = _by_step(problem.d(times_block), 4)              # (b, M, 4)
+            # the parts stepped together share the modes and d: one response for all
+            by_part = d.reshape(d.shape[0], problem.parts, -1, 4)
+            shared = problem.parts > 1 and bool(np.all(by_part == by_part[:, :1]))
+            groups = problem.parts if shared else 1
+            constant, response = _point_values(
+                by_part[:, 0] if shared else d, _by_step(problem.r(times_block), 4),
+                total[steps], problem.coupling,
+                None if vu_nodes is None else vu_nodes[steps])
+            n_block, n_each = response.shape[0], response.shape[-1]
+            drive_b, reads_b = drive_t[steps], reads_t[steps]
+            # A[s, t] = carry_s delta_st + sum_ik drive[s, i] response[i, k] reads[k, t]
+            through = (drive_b @ response.reshape(n_block, 4, -1)).reshape(
+                n_block, n_states, 4, n_each).transpose(0, 1, 3, 2)     # (b, S, F, 4)
+            maps = np.ascontiguousarray(
+                (through @ reads_b[:, None]).transpose(0, 1, 3, 2))      # (b, S, S, F)
+            maps[:, diagonal, diagonal, :] += end_carry[steps][:, :, None]
+            shifts = (drive_b @ constant).reshape(n_block, n_states, groups, n_each)
+            for k in range(n_block):
+                after = states[first + k + 1].reshape(n_states, groups, n_each)
+                np.einsum("stf,tpf->spf", maps[k],
+                          states[first + k].reshape(n_states, groups, n_each), out=after)
+                after += shifts[k]
+            # z at the four points of the block's steps, from the states at their starts
+            sums = (reads_b @ states[steps]).reshape(n_block, 4, groups, n_each)
+            z = constant.reshape(n_block, 4, groups, n_each) + np.einsum(
+                "bikf,bkpf->bipf", response, sums)
+            z_all[steps] = z.reshape(n_block, 4, nm)
+        # the outputs of each step: its carried states and the drive by z at its seven
+        # points (the neighbour read, ``side``, is the same for all outputs of a step)
         for b in np.flatnonzero(bounds[1:] > bounds[:-1]):
             lo, hi = bounds[b], bounds[b + 1]
             sd = side[order[lo]]
             z7 = (np.concatenate([z_all[b - 1, :3], z_all[b]]) if sd == -1 else
                   np.concatenate([z_all[b], z_all[b + 1, 1:]]) if sd == 1 else
                   np.concatenate([z_all[b], np.zeros((3, nm))]))
-            vw_rows[lo:hi] += out_total_s[lo:hi] @ z7
+            vw_rows[lo:hi] = out_carry_s[lo:hi] @ states[b] + out_total_s[lo:hi] @ z7
         if np.array_equal(order, np.arange(order.size)):  # increasing times: as marched
             vw_out = vw_rows.T
         else:
