@@ -69,6 +69,9 @@ DENSITY_TOL = 3e-9
 #: The point systems of the modes are built for blocks of steps of at most this many
 #: floats (16 a step and mode: 8 MB), so a long march of many modes stays small.
 MAX_BLOCK_ELEMENTS = 2**20
+#: Marches of up to this many steps carry their local errors by one matrix product
+#: (512^2 floats, 2 MB), longer ones step by step.
+CARRY_MATRIX_STEPS = 512
 #: Grid refinements tried before the caller's adaptive stepping takes over.
 MAX_REFINEMENTS = 6
 
@@ -209,14 +212,23 @@ def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
     # and of a neighbour (dense output), whose errors are those of their steps: the larger
     step_of = np.minimum(np.maximum(np.searchsorted(ends, t_out, side="left") - 1, 0),
                          n_steps - 1)
+    # carried[b] = sum_{j < b} exp(-(b - 1 - j)) per_part[j], as one product for a march
+    # of up to CARRY_MATRIX_STEPS steps (the loop a step costs more below that)
+    carry = None
+    if n_steps <= CARRY_MATRIX_STEPS:
+        lag = np.subtract.outer(np.arange(n_steps), np.arange(n_steps)) - 1.0
+        carry = np.where(lag >= 0.0, np.exp(-np.maximum(lag, 0.0)), 0.0)
     worst = np.zeros(parts)
     for values, rows in channels:
         values7 = seven(values, steps, side)                     # (B, 7, C)
         local = np.abs((drive[:, None, :] @ values7)[:, 0, :]) / rows  # (B, C)
         per_part = local.reshape(n_steps, parts, -1).max(axis=2)  # (B, P)
-        carried = np.zeros((n_steps, parts))
-        for b in range(1, n_steps):
-            carried[b] = carried[b - 1] * np.exp(-1.0) + per_part[b - 1]
+        if carry is not None:
+            carried = carry @ per_part
+        else:
+            carried = np.zeros((n_steps, parts))
+            for b in range(1, n_steps):
+                carried[b] = carried[b - 1] * np.exp(-1.0) + per_part[b - 1]
         at_outputs = carried[step_of] + np.maximum(
             per_part[step_of], per_part[np.minimum(step_of + 1, n_steps - 1)])
         worst = np.maximum(worst, np.max(at_outputs, axis=0, initial=0.0))

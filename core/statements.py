@@ -161,28 +161,17 @@ def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
         gamma, psi = np.linalg.eigh(r_rot[np.ix_(free, free)])
         psi_inv = psi.T
     else:
-        gamma, psi, psi_inv = _nonsymmetric_modes(r_rot[np.ix_(free, free)])
+        gamma, psi = np.linalg.eig(r_rot[np.ix_(free, free)])
+        scale = float(np.max(np.abs(gamma))) if gamma.size else 1.0
+        if gamma.size and (np.max(np.abs(gamma.imag)) > 1e-8 * scale
+                           or np.min(gamma.real) <= 0):
+            raise UnresolvedOperator("operator: eigenvalues not real and positive; the grid does "
+                             "not resolve the problem")
+        gamma, psi = gamma.real, psi.real
+        psi_inv = np.linalg.inv(psi)
     constraint = np.array([[(e0_rot if name == "force" else e1_rot)[i] for i in known]
                            for name in constraint_names]).reshape(k, k)
     unknown_rhs = np.array([[(e0_rot if name == "settlement" else e1_rot)[i]
                              for name in unknown_names] for i in known]).reshape(k, k)
     return ModalSystem(given, n, rotation, free, known, gamma, psi, r_rot, e0_rot, e1_rot,
                        constraint, constraint_names, unknown_names, unknown_rhs, psi_inv)
-
-
-def _nonsymmetric_modes(block: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(gamma, psi, psi^-1)`` of a free block that is symmetric up to its discretization:
-    the symmetric part's modes refined (:mod:`core.creep_modes`, several times cheaper),
-    else ``eig``. Raises :class:`UnresolvedOperator` unless gamma is real and positive."""
-    from core.creep_modes import near_symmetric_modes
-
-    modes = near_symmetric_modes(block)
-    if modes is None:
-        gamma, psi = np.linalg.eig(block)
-        scale = float(np.max(np.abs(gamma))) if gamma.size else 1.0
-        real = not gamma.size or np.max(np.abs(gamma.imag)) <= 1e-8 * scale
-        modes = (gamma.real, psi.real, np.linalg.inv(psi.real)) if real else None
-    if modes is None or (modes[0].size and np.min(modes[0]) <= 0):
-        raise UnresolvedOperator("operator: eigenvalues not real and positive; the grid does "
-                                 "not resolve the problem")
-    return modes
