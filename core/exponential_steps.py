@@ -39,6 +39,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from core.exponential_modes import by_step, mode_march
 from core.exponential_weights import (
     NODES,
     output_weights,
@@ -116,63 +117,6 @@ def grid(start: float, end: float, jumps: np.ndarray, first_step: float,
     ends = np.concatenate(points)
     jump_start = np.isin(ends[:-1], jumps)
     return ends, jump_start
-
-
-def _by_step(values: np.ndarray, points: int) -> np.ndarray:
-    """(channels, steps * points) values at the points of consecutive steps, as
-    (steps, channels, points)."""
-    return values.reshape(values.shape[0], -1, points).transpose(1, 0, 2)
-
-
-def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.ndarray,
-                  vu_nodes: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """``z`` at a step's four points as ``constant + sum_j response[:, j] sums[j]``.
-
-    ``d``, ``r`` (B, M, 4) at the points, ``total`` (B, 3, 4) the step's drive of ``V w``
-    at its three later points by ``z`` at its four; ``sums`` (4, M) are the carried
-    states' sums at the points. The first point is explicit (``d z = r + sums``), the
-    three others solve ``(diag(d) - total[:, 1:]) z = r + sums + total[:, 0] z_0`` (by
-    the adjugate: ``d >= 1`` on the diagonal, the step's creep off it); both for all steps
-    at once, so the march only applies them. Returns ``constant`` (B, 4, M) and
-    ``response`` (B, 4, 4, F), modes last (contiguous for the march).
-
-    ``d`` may hold the first F of the M channels only (B, F, 4), when the M = P F channels
-    are P groups of the same modes with the same ``d`` (the parts of a load stepped
-    together): ``response`` depends on ``d`` alone and is then formed once for all groups.
-    """
-    if vu_nodes is not None:
-        r = r + coupling @ vu_nodes                               # (B, M, 4)
-    d = d.transpose(0, 2, 1)                                      # (B, 4, F)
-    r = r.transpose(0, 2, 1)                                      # (B, 4, M)
-    t = total[:, :, :, None]                                      # (B, 3, 4, 1)
-    m = [[(d[:, i + 1] if i == j else 0.0) - t[:, i, j + 1] for j in range(3)]
-         for i in range(3)]
-    adj = [[m[1][1] * m[2][2] - m[1][2] * m[2][1], m[0][2] * m[2][1] - m[0][1] * m[2][2],
-            m[0][1] * m[1][2] - m[0][2] * m[1][1]],
-           [m[1][2] * m[2][0] - m[1][0] * m[2][2], m[0][0] * m[2][2] - m[0][2] * m[2][0],
-            m[0][2] * m[1][0] - m[0][0] * m[1][2]],
-           [m[1][0] * m[2][1] - m[1][1] * m[2][0], m[0][1] * m[2][0] - m[0][0] * m[2][1],
-            m[0][0] * m[1][1] - m[0][1] * m[1][0]]]
-    inv_det = 1.0 / (m[0][0] * adj[0][0] + m[0][1] * adj[1][0] + m[0][2] * adj[2][0])
-    inv_d0 = 1.0 / d[:, 0]                                        # (B, M)
-    n_steps, nm = inv_d0.shape
-    response = np.zeros((n_steps, 4, 4, nm))
-    response[:, 0, 0] = inv_d0
-    for i in range(3):
-        for j in range(3):
-            response[:, i + 1, j + 1] = adj[i][j] * inv_det
-        response[:, i + 1, 0] = inv_d0 * sum(response[:, i + 1, j + 1] * t[:, j, 0]
-                                             for j in range(3))
-    # response times r, point by point (no (B, 4, 4, M) temporary; its first row is
-    # inv_d0 at the first point alone)
-    r = r.reshape(n_steps, 4, -1, nm)                             # (B, 4, P, F)
-    constant = np.empty(r.shape)
-    constant[:, 0] = inv_d0[:, None] * r[:, 0]
-    constant[:, 1:] = response[:, 1:, 0, None] * r[:, None, 0]
-    for j in range(1, 4):
-        constant[:, 1:] += response[:, 1:, j, None] * r[:, None, j]
-    return constant.reshape(n_steps, 4, -1), response
-
 
 
 def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
@@ -278,7 +222,7 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     out_carry_s, out_total_s = out_carry[order], out_total[order]
 
     def read(fn) -> np.ndarray:
-        return _by_step(fn(flat), 4)                              # (B, channels, 4)
+        return by_step(fn(flat), 4)                              # (B, channels, 4)
 
     nm, nk = problem.n_modes, problem.n_known
     channels: list[tuple[np.ndarray, np.ndarray]] = []
@@ -306,49 +250,8 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     if nm:
         # V w at the outputs, a row per output in the order of their steps
         vw_rows = np.empty((t_out.size, nm))
-        # Over a step the states of a mode move by an affine map, s' = A s + e: z at the
-        # step's points is affine in the state sums there (:func:`_point_values`) and the
-        # states take the step's drive by z. The maps of a block of steps are formed at
-        # once, so the march is one small product a step; z at the points and the
-        # outputs are read afterwards from the states at each step's start.
-        block = max(1, MAX_BLOCK_ELEMENTS // ((16 + n_states**2) * nm))
-        at_steps = flat.reshape(n_steps, 4)
-        reads_t = reads.transpose(0, 2, 1).copy()                 # (B, 4, S)
-        drive_t = end_drive.transpose(0, 2, 1).copy()             # (B, S, 4)
-        states = np.zeros((n_steps + 1, n_states, nm))            # at each step's start
-        z_all = np.empty((n_steps, 4, nm))
-        diagonal = np.arange(n_states)
-        for first in range(0, n_steps, block):
-            steps = slice(first, min(n_steps, first + block))
-            times_block = at_steps[steps].ravel()
-            d = _by_step(problem.d(times_block), 4)              # (b, M, 4)
-            # the parts stepped together share the modes and d: one response for all
-            by_part = d.reshape(d.shape[0], problem.parts, -1, 4)
-            shared = problem.parts > 1 and bool(np.all(by_part == by_part[:, :1]))
-            groups = problem.parts if shared else 1
-            constant, response = _point_values(
-                by_part[:, 0] if shared else d, _by_step(problem.r(times_block), 4),
-                total[steps], problem.coupling,
-                None if vu_nodes is None else vu_nodes[steps])
-            n_block, n_each = response.shape[0], response.shape[-1]
-            drive_b, reads_b = drive_t[steps], reads_t[steps]
-            # A[s, t] = carry_s delta_st + sum_ik drive[s, i] response[i, k] reads[k, t]
-            through = (drive_b @ response.reshape(n_block, 4, -1)).reshape(
-                n_block, n_states, 4, n_each).transpose(0, 1, 3, 2)     # (b, S, F, 4)
-            maps = np.ascontiguousarray(
-                (through @ reads_b[:, None]).transpose(0, 1, 3, 2))      # (b, S, S, F)
-            maps[:, diagonal, diagonal, :] += end_carry[steps][:, :, None]
-            shifts = (drive_b @ constant).reshape(n_block, n_states, groups, n_each)
-            for k in range(n_block):
-                after = states[first + k + 1].reshape(n_states, groups, n_each)
-                np.einsum("stf,tpf->spf", maps[k],
-                          states[first + k].reshape(n_states, groups, n_each), out=after)
-                after += shifts[k]
-            # z at the four points of the block's steps, from the states at their starts
-            sums = (reads_b @ states[steps]).reshape(n_block, 4, groups, n_each)
-            z = constant.reshape(n_block, 4, groups, n_each) + np.einsum(
-                "bikf,bkpf->bipf", response, sums)
-            z_all[steps] = z.reshape(n_block, 4, nm)
+        states, z_all = mode_march(problem, flat.reshape(n_steps, 4), total, reads,
+                                   end_drive, end_carry, vu_nodes, MAX_BLOCK_ELEMENTS)
         # the outputs of each step: its carried states and the drive by z at its seven
         # points (the neighbour read, ``side``, is the same for all outputs of a step)
         for b in np.flatnonzero(bounds[1:] > bounds[:-1]):
