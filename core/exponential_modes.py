@@ -68,17 +68,13 @@ def point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.n
     response[:, 0, 0] = inv_d0
     for i in range(3):
         for j in range(3):
-            response[:, i + 1, j + 1] = adj[i][j] * inv_det
-        response[:, i + 1, 0] = inv_d0 * sum(response[:, i + 1, j + 1] * t[:, j, 0]
-                                             for j in range(3))
-    # response times r, point by point (no (B, 4, 4, M) temporary; its first row is
-    # inv_d0 at the first point alone)
+            np.multiply(adj[i][j], inv_det, out=response[:, i + 1, j + 1])
+    # the later points' response to the first: through the drive total[:, j, 0] z_0
+    np.multiply(np.einsum("bijf,bj->bif", response[:, 1:, 1:], total[:, :, 0]),
+                inv_d0[:, None, :], out=response[:, 1:, 0])
+    # response times r, point by point (its first row is inv_d0 at the first point alone)
     r = r.reshape(n_steps, 4, -1, nm)                             # (B, 4, P, F)
-    constant = np.empty(r.shape)
-    constant[:, 0] = inv_d0[:, None] * r[:, 0]
-    constant[:, 1:] = response[:, 1:, 0, None] * r[:, None, 0]
-    for j in range(1, 4):
-        constant[:, 1:] += response[:, 1:, j, None] * r[:, None, j]
+    constant = np.einsum("bikf,bkpf->bipf", response, r)
     return constant.reshape(n_steps, 4, -1), response
 
 
