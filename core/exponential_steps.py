@@ -39,6 +39,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from core.exponential_modes import by_step, mode_march
 from core.exponential_weights import (
     NODES,
     output_weights,
@@ -69,6 +70,9 @@ DENSITY_TOL = 3e-9
 #: The point systems of the modes are built for blocks of steps of at most this many
 #: floats (16 a step and mode: 8 MB), so a long march of many modes stays small.
 MAX_BLOCK_ELEMENTS = 2**20
+#: Marches of up to this many steps carry their local errors by one matrix product
+#: (512^2 floats, 2 MB), longer ones step by step.
+CARRY_MATRIX_STEPS = 512
 #: Grid refinements tried before the caller's adaptive stepping takes over.
 MAX_REFINEMENTS = 6
 
@@ -115,66 +119,10 @@ def grid(start: float, end: float, jumps: np.ndarray, first_step: float,
     return ends, jump_start
 
 
-def _by_step(values: np.ndarray, points: int) -> np.ndarray:
-    """(channels, steps * points) values at the points of consecutive steps, as
-    (steps, channels, points)."""
-    return values.reshape(values.shape[0], -1, points).transpose(1, 0, 2)
-
-
-def _point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.ndarray,
-                  vu_nodes: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """``z`` at a step's four points as ``constant + sum_j response[:, j] sums[j]``.
-
-    ``d``, ``r`` (B, M, 4) at the points, ``total`` (B, 3, 4) the step's drive of ``V w``
-    at its three later points by ``z`` at its four; ``sums`` (4, M) are the carried
-    states' sums at the points. The first point is explicit (``d z = r + sums``), the
-    three others solve ``(diag(d) - total[:, 1:]) z = r + sums + total[:, 0] z_0`` (by
-    the adjugate: ``d >= 1`` on the diagonal, the step's creep off it); both for all steps
-    at once, so the march only applies them. Returns ``constant`` (B, 4, M) and
-    ``response`` (B, 4, 4, F), modes last (contiguous for the march).
-
-    ``d`` may hold the first F of the M channels only (B, F, 4), when the M = P F channels
-    are P groups of the same modes with the same ``d`` (the parts of a load stepped
-    together): ``response`` depends on ``d`` alone and is then formed once for all groups.
-    """
-    if vu_nodes is not None:
-        r = r + coupling @ vu_nodes                               # (B, M, 4)
-    d = d.transpose(0, 2, 1)                                      # (B, 4, F)
-    r = r.transpose(0, 2, 1)                                      # (B, 4, M)
-    t = total[:, :, :, None]                                      # (B, 3, 4, 1)
-    m = [[(d[:, i + 1] if i == j else 0.0) - t[:, i, j + 1] for j in range(3)]
-         for i in range(3)]
-    adj = [[m[1][1] * m[2][2] - m[1][2] * m[2][1], m[0][2] * m[2][1] - m[0][1] * m[2][2],
-            m[0][1] * m[1][2] - m[0][2] * m[1][1]],
-           [m[1][2] * m[2][0] - m[1][0] * m[2][2], m[0][0] * m[2][2] - m[0][2] * m[2][0],
-            m[0][2] * m[1][0] - m[0][0] * m[1][2]],
-           [m[1][0] * m[2][1] - m[1][1] * m[2][0], m[0][1] * m[2][0] - m[0][0] * m[2][1],
-            m[0][0] * m[1][1] - m[0][1] * m[1][0]]]
-    inv_det = 1.0 / (m[0][0] * adj[0][0] + m[0][1] * adj[1][0] + m[0][2] * adj[2][0])
-    inv_d0 = 1.0 / d[:, 0]                                        # (B, M)
-    n_steps, nm = inv_d0.shape
-    response = np.zeros((n_steps, 4, 4, nm))
-    response[:, 0, 0] = inv_d0
-    for i in range(3):
-        for j in range(3):
-            response[:, i + 1, j + 1] = adj[i][j] * inv_det
-        response[:, i + 1, 0] = inv_d0 * sum(response[:, i + 1, j + 1] * t[:, j, 0]
-                                             for j in range(3))
-    # response times r, point by point (no (B, 4, 4, M) temporary; its first row is
-    # inv_d0 at the first point alone)
-    r = r.reshape(n_steps, 4, -1, nm)                             # (B, 4, P, F)
-    constant = np.empty(r.shape)
-    constant[:, 0] = inv_d0[:, None] * r[:, 0]
-    constant[:, 1:] = response[:, 1:, 0, None] * r[:, None, 0]
-    for j in range(1, 4):
-        constant[:, 1:] += response[:, 1:, j, None] * r[:, None, j]
-    return constant.reshape(n_steps, 4, -1), response
-
-
-
 def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
-                  beta: np.ndarray, end_weight: np.ndarray, values: np.ndarray,
-                  rows: np.ndarray, parts: int, t_out: np.ndarray) -> np.ndarray:
+                  beta: np.ndarray, end_weight: np.ndarray,
+                  channels: list[tuple[np.ndarray, np.ndarray]], parts: int,
+                  t_out: np.ndarray) -> np.ndarray:
     """Sum of the steps' local errors at the output times, largest per group (parts,).
 
     A state that decays fast within a step forgets all but its last steps, so its error
@@ -184,7 +132,8 @@ def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
     Here each step's error is estimated as the difference of its cubic from the sextic
     through its points and three of a neighbour (:func:`sextic_weights`), and carried to
     the output times (its absolute value: no cancelling between steps), relative to
-    ``rows`` (the size of each channel, ``values`` (B, 4, C) at the points of the steps).
+    ``rows`` (the size of each channel, ``values`` (B, 4, C) at the points of the steps),
+    for each ``(values, rows)`` of ``channels``: the larger.
     """
     h = np.diff(ends)
     n_steps = h.size
@@ -195,7 +144,6 @@ def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
     cubic[~own_last, :, :4] = end_weight[~own_last]
     cubic[own_last, :, 3:] = end_weight[own_last]
     beta7 = seven(beta.transpose(0, 2, 1), steps, side)          # (B, 7, S)
-    values7 = seven(values, steps, side)                         # (B, 7, C)
     # A state slow over a step (decay h < 1) keeps its errors: they add up smoothly over
     # the steps, and the difference of two grids measures them (measured on the 50-year
     # fib MC2010 preset: that difference over 15 is 1.2-1.4x the true error at every
@@ -204,18 +152,30 @@ def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
     # step's carried on with a decay of exp(-1) a step, the least of those states.
     fast = (decay[None, :] * h[:, None] >= 1.0)[:, :, None]      # (B, S, 1)
     drive = np.sum((sextic - cubic) * beta7.transpose(0, 2, 1) * fast, axis=1)  # (B, 7)
-    local = np.abs((drive[:, None, :] @ values7)[:, 0, :]) / rows  # (B, C)
-    per_part = local.reshape(n_steps, parts, -1).max(axis=2)      # (B, P)
-    carried = np.zeros((n_steps, parts))
-    for b in range(1, n_steps):
-        carried[b] = carried[b - 1] * np.exp(-1.0) + per_part[b - 1]
     # at the output times: an output inside a step is read from the points of that step
     # and of a neighbour (dense output), whose errors are those of their steps: the larger
     step_of = np.minimum(np.maximum(np.searchsorted(ends, t_out, side="left") - 1, 0),
                          n_steps - 1)
-    at_outputs = carried[step_of] + np.maximum(
-        per_part[step_of], per_part[np.minimum(step_of + 1, n_steps - 1)])
-    worst = np.max(at_outputs, axis=0, initial=0.0)
+    # carried[b] = sum_{j < b} exp(-(b - 1 - j)) per_part[j], as one product for a march
+    # of up to CARRY_MATRIX_STEPS steps (the loop a step costs more below that)
+    carry = None
+    if n_steps <= CARRY_MATRIX_STEPS:
+        lag = np.subtract.outer(np.arange(n_steps), np.arange(n_steps)) - 1.0
+        carry = np.where(lag >= 0.0, np.exp(-np.maximum(lag, 0.0)), 0.0)
+    worst = np.zeros(parts)
+    for values, rows in channels:
+        values7 = seven(values, steps, side)                     # (B, 7, C)
+        local = np.abs((drive[:, None, :] @ values7)[:, 0, :]) / rows  # (B, C)
+        per_part = local.reshape(n_steps, parts, -1).max(axis=2)  # (B, P)
+        if carry is not None:
+            carried = carry @ per_part
+        else:
+            carried = np.zeros((n_steps, parts))
+            for b in range(1, n_steps):
+                carried[b] = carried[b - 1] * np.exp(-1.0) + per_part[b - 1]
+        at_outputs = carried[step_of] + np.maximum(
+            per_part[step_of], per_part[np.minimum(step_of + 1, n_steps - 1)])
+        worst = np.maximum(worst, np.max(at_outputs, axis=0, initial=0.0))
     return worst
 
 
@@ -262,7 +222,7 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     out_carry_s, out_total_s = out_carry[order], out_total[order]
 
     def read(fn) -> np.ndarray:
-        return _by_step(fn(flat), 4)                              # (B, channels, 4)
+        return by_step(fn(flat), 4)                              # (B, channels, 4)
 
     nm, nk = problem.n_modes, problem.n_known
     channels: list[tuple[np.ndarray, np.ndarray]] = []
@@ -274,13 +234,14 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
         vu_nodes = np.zeros_like(u)
         vu_nodes[:, :, 1:] = u @ total.transpose(0, 2, 1)
         next_drive = u @ end_drive                                # (B, K, S)
-        s_known = np.zeros((nk, n_states))
+        # the known functions' states at each step's start (no solve: a carry and a
+        # drive a step), then read at the points and the outputs all at once
+        s_known = np.zeros((n_steps + 1, nk, n_states))
         for b in range(n_steps):
-            vu_nodes[b] += s_known @ reads[b]
-            lo, hi = bounds[b], bounds[b + 1]
-            if hi > lo:
-                vu_out[:, order[lo:hi]] = s_known @ out_carry_s[lo:hi].T
-            s_known = s_known * end_carry[b] + next_drive[b]
+            np.multiply(s_known[b], end_carry[b], out=s_known[b + 1])
+            s_known[b + 1] += next_drive[b]
+        vu_nodes += s_known[:-1] @ reads
+        vu_out[:, order] = np.einsum("tks,ts->kt", s_known[step_of[order]], out_carry_s)
         vu_out += np.einsum("tj,tjk->kt", out_total, seven(u.transpose(0, 2, 1), step_of,
                                                             side))
         if rows is not None:
@@ -289,54 +250,37 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     if nm:
         # V w at the outputs, a row per output in the order of their steps
         vw_rows = np.empty((t_out.size, nm))
-        # the point systems of a block of steps at a time: (steps, 4, 4, modes) floats
-        block = max(1, MAX_BLOCK_ELEMENTS // (16 * nm))
-        at_steps = flat.reshape(n_steps, 4)
-        reads_t = reads.transpose(0, 2, 1).copy()                 # (B, 4, S)
-        drive_t = end_drive.transpose(0, 2, 1).copy()             # (B, S, 4)
-        carry_t = end_carry[:, :, None]                           # (B, S, 1)
-        s_modes = np.zeros((n_states, nm))                        # modes last
-        z_all = np.empty((n_steps, 4, nm))
-        for b in range(n_steps):
-            if b % block == 0:
-                steps = slice(b, min(n_steps, b + block))
-                times_block = at_steps[steps].ravel()
-                d = _by_step(problem.d(times_block), 4)          # (b, M, 4)
-                # the parts stepped together share the modes and d: one response for all
-                by_part = d.reshape(d.shape[0], problem.parts, -1, 4)
-                shared = problem.parts > 1 and bool(np.all(by_part == by_part[:, :1]))
-                groups = problem.parts if shared else 1
-                constant, response = _point_values(
-                    by_part[:, 0] if shared else d, _by_step(problem.r(times_block), 4),
-                    total[steps], problem.coupling,
-                    None if vu_nodes is None else vu_nodes[steps])
-            # z at the step's four points: affine in the state sums there
-            sums = (reads_t[b] @ s_modes).reshape(4, groups, -1)  # (4, P, F)
-            z = z_all[b] = constant[b % block] + (
-                response[b % block][:, :, None, :] * sums[None]).sum(axis=1).reshape(4, nm)
-            lo, hi = bounds[b], bounds[b + 1]
-            if hi > lo:
-                vw_rows[lo:hi] = out_carry_s[lo:hi] @ s_modes
-            s_modes = s_modes * carry_t[b] + drive_t[b] @ z
-        # the drive of every output by z at its seven points, step by step of the outputs
-        # (the neighbour read, ``side``, is the same for all outputs of a step)
+        states, z_all = mode_march(problem, flat.reshape(n_steps, 4), total, reads,
+                                   end_drive, end_carry, vu_nodes, MAX_BLOCK_ELEMENTS)
+        # the outputs of each step: its carried states and the drive by z at its seven
+        # points (the neighbour read, ``side``, is the same for all outputs of a step)
         for b in np.flatnonzero(bounds[1:] > bounds[:-1]):
             lo, hi = bounds[b], bounds[b + 1]
             sd = side[order[lo]]
             z7 = (np.concatenate([z_all[b - 1, :3], z_all[b]]) if sd == -1 else
                   np.concatenate([z_all[b], z_all[b + 1, 1:]]) if sd == 1 else
                   np.concatenate([z_all[b], np.zeros((3, nm))]))
-            vw_rows[lo:hi] += out_total_s[lo:hi] @ z7
-        vw_out[:, order] = vw_rows.T
+            vw_rows[lo:hi] = out_carry_s[lo:hi] @ states[b] + out_total_s[lo:hi] @ z7
+        if np.array_equal(order, np.arange(order.size)):  # increasing times: as marched
+            vw_out = vw_rows.T
+        else:
+            vw_out[:, order] = vw_rows.T
         if rows is not None:
             channels.append((z_all, rows[0]))
 
     def local() -> np.ndarray:
-        return np.max([np.zeros(problem.parts)] + [
-            _local_errors(ends, jump_start, decay, beta, end_weight, values, size,
-                          problem.parts, t_out) for values, size in channels], axis=0)
+        return _local_errors(ends, jump_start, decay, beta, end_weight, channels,
+                             problem.parts, t_out)
 
     return vw_out, vu_out, (local if rows is not None else None)
+
+
+def _largest_change(new: np.ndarray, old: np.ndarray) -> np.ndarray:
+    """``max |new - old|`` along the times of each channel (channels, T) -> (channels,),
+    with one temporary (the answers at 1000 outputs are 2.4 MB each)."""
+    change = new - old
+    np.abs(change, out=change)
+    return np.max(change, axis=1, initial=0.0)
 
 
 def first_step(kernel, start: float, span: float) -> float:
@@ -392,10 +336,8 @@ def solve_exponential(kernel, problem, times: np.ndarray, jumps: np.ndarray, *, 
             w_scale = np.clip(size[:, None], 1e-3 * given, given).ravel()
         if previous is not None:
             diff = np.concatenate([
-                (np.max(np.abs(vw - previous[0]), axis=1, initial=0.0) / w_scale).reshape(
-                    parts, -1),
-                (np.max(np.abs(vu - previous[1]), axis=1, initial=0.0) / u_scale).reshape(
-                    parts, -1)], axis=1)
+                (_largest_change(vw, previous[0]) / w_scale).reshape(parts, -1),
+                (_largest_change(vu, previous[1]) / u_scale).reshape(parts, -1)], axis=1)
             change = np.max(diff, axis=1, initial=0.0)
             # the ratio of the last two changes is the convergence factor of a step halving
             # as measured (2**ORDER until there are two), kept within 2 and 2**7

@@ -16,6 +16,13 @@ with the gap as a constant drive ``f = -P^T W g``, so :func:`core.statements.mod
 decouples them (its free block diagonalized as it is: the product-integration rows of
 ``A`` are not symmetric, but the operator is similar to a symmetric positive one) and
 :mod:`core.time_integration` steps one scalar Volterra equation per mode.
+
+The free block is ``eig``-decomposed. Its antisymmetric part is ~7e-4 of the whole, so
+``eigh`` of its symmetric part refined by Newton steps of all eigenvectors at once was
+tried and measured (CPU, one thread, the work-precision scenes): 0.6-1.2 ms faster at 142
+modes (4.2-4.3 against 4.8-5.4 ms), 15-55 % slower from 222 modes on (its matrix
+products grow faster than ``eig``), and diverging where eigenvalues cluster (no coating,
+and two creep scenes of the tests), where ``eig`` then had to run after it.
 """
 
 from __future__ import annotations
@@ -42,12 +49,16 @@ MODAL_ROUNDING_SHARE = 0.1
 class ModalAnswer:
     """Nodal pressures (N, T), the four scalars over the times and the time stepping's report.
 
-    ``effective`` holds ``q - V q`` at the nodes (N, T): the density whose ``F`` enters the
-    equation, for the Nystrom formula between the nodes.
+    ``q - V q`` at the nodes (the density whose ``F`` enters the equation, for the Nystrom
+    formula between the nodes) is kept in modal coordinates, ``modal_effective`` = (free
+    (F, T), known (k, T)), with ``to_nodes`` = (free (N, F), known (N, k)): it is formed
+    at the nodes only where asked (:meth:`effective`), and rows of the operator reach it
+    through the modes (:meth:`effective_through`, no N x N x T product).
     """
 
     nodal_pressures: Callable[[], np.ndarray]
-    effective: np.ndarray
+    modal_effective: tuple[np.ndarray, np.ndarray]
+    to_nodes: tuple[np.ndarray, np.ndarray]
     scalars: dict[str, np.ndarray]
     time_error: float
     steps: int
@@ -56,9 +67,22 @@ class ModalAnswer:
 
     @property
     def nodal(self) -> np.ndarray:
-        """Nodal pressures (N, T), formed when asked: the answer itself reads ``effective``
-        (an N x N x T product saved on every march with many output times)."""
+        """Nodal pressures (N, T), formed when asked (an N x N x T product)."""
         return self.nodal_pressures()
+
+    def effective(self, at: np.ndarray | slice = slice(None)) -> np.ndarray:
+        """``q - V q`` at the nodes (N, len(at)) at the columns ``at`` of the times."""
+        return self.effective_through(None, at)
+
+    def effective_through(self, rows: np.ndarray | None, at: np.ndarray | slice = slice(None)
+                          ) -> np.ndarray:
+        """``rows @ (q - V q)`` at the columns ``at`` (len(rows), len(at)); rows (X, N), or
+        None for the nodal values themselves."""
+        (free, known), (node_free, node_known) = self.modal_effective, self.to_nodes
+        if rows is not None:
+            node_free, node_known = rows @ node_free, rows @ node_known
+        out = node_free @ free[:, at]
+        return out + node_known @ known[:, at] if known.shape[0] else out
 
 
 class ModalForm:
@@ -76,7 +100,7 @@ class ModalForm:
         moments = (float(np.sum(w / m)), float(np.sum(w * x / m)), float(np.sum(w * x * x / m)))
         galerkin = q.T @ ((s_in[:, None] * grid.operator * s_out[None, :]) @ q)
         self.ms: ModalSystem = modal_system(galerkin, moments, given, grid.size,
-                                            symmetric=False)
+                                            symmetric=False, inverse=False)
         ms = self.ms
         rounding = np.finfo(float).eps * float(np.max(np.abs(ms.gamma), initial=0.0))
         if rounding > MODAL_ROUNDING_SHARE * tol:
@@ -88,13 +112,23 @@ class ModalForm:
         self.gap = ms.rotate(-(q.T @ (s_in * grid.g)))
         self.k = len(ms.known)
         self.constraint_inv = np.linalg.inv(ms.constraint) if self.k else np.zeros((0, 0))
+        # psi^-1 is needed on these few vectors only: one solve with psi (an LU) instead
+        # of its inverse (0.6 ms at 142 modes). The modal drive of a unit settlement and
+        # tilt: a load history then costs an outer product, not a solve at every time read
         r_fk = ms.r_rot[np.ix_(ms.free, ms.known)]
-        self.coupling = ms.psi_inv @ r_fk if self.k else np.zeros((len(ms.free), 1))
-        self.gap_free = ms.psi_inv @ self.gap[ms.free]
-        # the modal drive of a unit settlement and tilt: a load history then costs an
-        # outer product, not a product with psi^-1 at every time read
-        self.settlement_free = ms.psi_inv @ ms.e0_rot[ms.free]
-        self.tilt_free = ms.psi_inv @ ms.e1_rot[ms.free]
+        drives = np.linalg.solve(ms.psi, np.column_stack(
+            [self.gap[ms.free], ms.e0_rot[ms.free], ms.e1_rot[ms.free], r_fk]))
+        self.gap_free, self.settlement_free, self.tilt_free = drives[:, :3].T.copy()
+        self.coupling = drives[:, 3:] if self.k else np.zeros((len(ms.free), 1))
+        # nodal values of the modal coordinates (free) and of the known ones, with the
+        # rotation and psi folded in: a history then costs one product with the nodes
+        # instead of psi, the rotation and the nodes in turn (two N x N x T products)
+        rotation = ms.to_coefficients(np.eye(ms.n))
+        self.node_modes = self.to_nodes @ (rotation[:, ms.free] @ ms.psi)
+        self.node_known = self.to_nodes @ rotation[:, ms.known]
+        self.nodes = (self.node_modes, self.node_known)
+        self.known_modes = (ms.r_rot[np.ix_(ms.known, ms.free)] @ ms.psi if self.k
+                            else np.zeros((0, len(ms.free))))
         self.e0 = np.zeros(grid.size)
         self.e1 = np.zeros(grid.size)
         self.e0[0] = np.sqrt(moments[0])
@@ -119,32 +153,24 @@ class ModalForm:
 
     def finish(self, c_t: np.ndarray, loads: dict[str, np.ndarray], known: np.ndarray,
                z: np.ndarray, vz: np.ndarray, vu: np.ndarray, gap: float = 1.0
-               ) -> tuple[Callable[[], np.ndarray], np.ndarray, dict]:
-        """Nodal pressures (formed when called), ``q - V q`` at the nodes and the four
-        scalars."""
+               ) -> tuple[Callable[[], np.ndarray], tuple[np.ndarray, np.ndarray], dict]:
+        """Nodal pressures (formed when called), ``q - V q`` in modal coordinates (free,
+        known; see :class:`ModalAnswer`) and the four scalars."""
         ms, k = self.ms, self.k
         size = c_t.size
 
         def nodal() -> np.ndarray:
-            b = np.zeros((ms.n, size))
-            b[ms.free] = ms.psi @ z
-            if k:
-                b[ms.known] = known[:k]
-            return self.to_nodes @ ms.to_coefficients(b)
+            out = self.node_modes @ z
+            return out + self.node_known @ known[:k] if k else out
 
-        b_eff = np.zeros((ms.n, size))
-        free_eff = ms.psi @ (z - vz)
-        b_eff[ms.free] = free_eff
-        if k:
-            b_eff[ms.known] = known[:k] - vu[:k]
-        effective = self.to_nodes @ ms.to_coefficients(b_eff)
+        z_eff = z - vz
+        known_eff = known[:k] - vu[:k]
         out = {name: np.asarray(v, dtype=float) for name, v in loads.items()}
         if k:
             # Known rows: c b_K + (I - V)[R_KF b_F + R_KK b_K] = drive_K + unknown drive.
-            r_kf = ms.r_rot[np.ix_(ms.known, ms.free)]
             r_kk = ms.r_rot[np.ix_(ms.known, ms.known)]
-            lhs = (c_t[None, :] * known[:k] + r_kf @ free_eff
-                   + r_kk @ (known[:k] - vu[:k]) - gap * self.gap[ms.known][:, None]
+            lhs = (c_t[None, :] * known[:k] + self.known_modes @ z_eff
+                   + r_kk @ known_eff - gap * self.gap[ms.known][:, None]
                    - self.ms.given_drive(ms.known, loads, size))
             unknowns = np.linalg.solve(ms.unknown_rhs, lhs)
             for i, name in enumerate(ms.unknown_names):
@@ -159,7 +185,7 @@ class ModalForm:
             a2 = ms.rotation @ b2
             out.setdefault("force", self.e0[:2] @ a2)
             out.setdefault("moment", self.e1[:2] @ a2)
-        return nodal, effective, out
+        return nodal, (z_eff, known_eff), out
 
     def solve(self, times: np.ndarray, c: Function, kernel, loads: dict[str, Function],
               time_tol: float, gap: float = 1.0, breaks: np.ndarray | None = None
@@ -192,7 +218,7 @@ class ModalForm:
                     c_t[None, :] + gamma[:, None])
                 nodal, effective, scalars = self.finish(c_t, vals, kn, z, np.zeros_like(z),
                                                         np.zeros_like(kn), gap)
-                answers.append(ModalAnswer(nodal, effective, scalars, 0.0, 0, True,
+                answers.append(ModalAnswer(nodal, effective, self.nodes, scalars, 0.0, 0, True,
                                            "no creep: no time stepping"))
             return answers
         n_parts, n_free, n_known = len(parts), gamma.size, self.coupling.shape[1]
@@ -232,6 +258,7 @@ class ModalForm:
             known_rows = slice(p * n_known, (p + 1) * n_known)
             nodal, effective, scalars = self.finish(c_t, values[p], known[p], sol.w[rows],
                                                     sol.vw[rows], sol.vu[known_rows], gap)
-            answers.append(ModalAnswer(nodal, effective, scalars, float(estimates[p]),
+            answers.append(ModalAnswer(nodal, effective, self.nodes, scalars,
+                                       float(estimates[p]),
                                        int(sol.steps), bool(sol.success), sol.message))
         return answers

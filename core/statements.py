@@ -85,7 +85,8 @@ class ModalSystem:
     constraint_names: tuple[str, ...]  # which of force, moment each row fixes
     unknown_names: tuple[str, ...]  # which of settlement, tilt the known rows determine
     unknown_rhs: np.ndarray  # (k x k)
-    #: ``psi^-1``: ``psi.T`` for a symmetric ``R``; the inverse for a Nystrom ``R``.
+    #: ``psi^-1``: ``psi.T`` for a symmetric ``R``; the inverse for a Nystrom ``R`` (None
+    #: when not asked for).
     psi_inv: np.ndarray | None = None
 
     def to_coefficients(self, b: np.ndarray) -> np.ndarray:
@@ -113,14 +114,17 @@ class ModalSystem:
 
 
 def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
-                 given: frozenset[str], n: int, *, symmetric: bool = True) -> ModalSystem:
+                 given: frozenset[str], n: int, *, symmetric: bool = True,
+                 inverse: bool = True) -> ModalSystem:
     """Build the decoupled system for a statement at ``n`` functions of the basis.
 
     ``r_matrix`` is the Galerkin matrix ``R`` (at least n x n, symmetric positive definite);
     ``moments`` are ``J_0, J_1, J_2``. With ``symmetric=False`` (the Nystrom matrix, whose
     product-integration rows are not symmetric) the free block is diagonalized as it is,
     ``R_FF = psi diag(gamma) psi^-1``; its eigenvalues are real and positive up to
-    round-off (the operator is similar to a symmetric positive one), else ``ValueError``.
+    round-off (the operator is similar to a symmetric positive one), else ``ValueError``;
+    ``inverse=False`` leaves ``psi_inv`` None (a caller that applies it to a few vectors
+    solves with ``psi`` instead of inverting it).
     """
     statement_number(given)
     j0, j1, j2 = moments
@@ -168,7 +172,7 @@ def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
             raise UnresolvedOperator("operator: eigenvalues not real and positive; the grid does "
                              "not resolve the problem")
         gamma, psi = gamma.real, psi.real
-        psi_inv = np.linalg.inv(psi)
+        psi_inv = np.linalg.inv(psi) if inverse else None
     constraint = np.array([[(e0_rot if name == "force" else e1_rot)[i] for i in known]
                            for name in constraint_names]).reshape(k, k)
     unknown_rhs = np.array([[(e0_rot if name == "settlement" else e1_rot)[i]

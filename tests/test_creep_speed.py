@@ -119,3 +119,20 @@ def test_force_and_moment_parts_in_one_march_equal_separate_marches():
         # each part's error is measured against its own size, as in its march alone:
         # measured equal to 8e-8 (force) and 1.5e-7 (moment) relative, the same 39 steps
         assert abs(both.time_error / alone.time_error - 1.0) < 1e-5
+
+
+def test_creep_validity_samples_keep_the_checked_times_close():
+    """Under creep the samples between outputs are taken only in gaps wider than their
+    spacing: every output is checked, no two checked times are further apart than the
+    spacing (as with all samples), and dense equally spaced outputs need no sample."""
+    from core.prepared import HISTORY_SAMPLES, PreparedContact
+
+    history = PreparedContact._history_times
+    for times in (1.0 + np.linspace(0.0, 35.7, 100), 1.0 + np.geomspace(1e-3, 35.7, 100),
+                  np.array([1.0, 2.0, 50.0]), 1.0 + np.linspace(0.0, 35.7, 30)):
+        checked = history(None, times, "creep")
+        spacing = (times[-1] - times[0]) / (HISTORY_SAMPLES["creep"] - 1)
+        assert np.all(np.isin(times, checked))
+        assert np.max(np.diff(checked)) <= spacing * (1 + 1e-12)
+    dense = 1.0 + np.linspace(0.0, 35.7, 100)
+    np.testing.assert_array_equal(history(None, dense, "creep"), dense)
