@@ -98,7 +98,8 @@ def build_grid(lam: float, edges: np.ndarray, m: Function, g: Function,
                        np.asarray(g(panels.nodes), dtype=float), kernel_accuracy)
 
 
-def _rhs(x: np.ndarray, g: np.ndarray, with_gap: bool) -> np.ndarray:
+def rhs_columns(x: np.ndarray, g: np.ndarray, with_gap: bool) -> np.ndarray:
+    """Right-hand sides ``[1, x(, -g)]`` of the statement-1 responses at ``x`` (len(x), 2|3)."""
     columns = [np.ones(x.size), x] + ([-g] if with_gap else [])
     return np.column_stack(columns)
 
@@ -123,7 +124,7 @@ def factored_responses(grid: NystromGrid, c: float, with_gap: bool
     work-precision scenes at tol 1e-6: 0.45-4.1 ms per scene split, 0.2-3.4 ms plain).
     """
     factor = NodalLU(grid.operator, c * grid.m, grid.kernel_accuracy)
-    return factor.solve(_rhs(grid.nodes, grid.g, with_gap)), factor
+    return factor.solve(rhs_columns(grid.nodes, grid.g, with_gap)), factor
 
 
 #: From this size on the nodal LU is taken in single precision and its solutions refined
@@ -212,7 +213,7 @@ def nystrom_values(grid: NystromGrid, c: float, x: np.ndarray, m_x: np.ndarray,
     ``rows``: the rows of the grid's operator at ``x``, if already known.
     """
     rows = grid.rows(x) if rows is None else rows
-    return (_rhs(x, g_x, with_gap) - rows @ nodal) / (c * m_x[:, None])
+    return (rhs_columns(x, g_x, with_gap) - rows @ nodal) / (c * m_x[:, None])
 
 
 # ------------------------------------------------------------------- bordered solves

@@ -37,8 +37,10 @@ from core.nystrom import (
     build_grid,
     factored_responses,
     nystrom_values,
+    rhs_columns,
     touches,
 )
+from core.nystrom_twogrid import DeferredFactor, TwoGridSolver
 from core.quadrature import (
     NODES_PER_PANEL,
     Panels,
@@ -135,6 +137,23 @@ def _coarse_rows(coarse: NystromGrid, fine: NystromGrid, kept_new: np.ndarray,
     return rows
 
 
+def _fine_responses(coarse: NystromGrid, coarse_factor: NodalLU | DeferredFactor,
+                    fine: NystromGrid, c: float, with_gap: bool,
+                    shared: tuple[np.ndarray, np.ndarray, np.ndarray], guess: np.ndarray
+                    ) -> tuple[np.ndarray, NodalLU | DeferredFactor]:
+    """The statement-1 responses on ``fine`` and its (deferred) factors.
+
+    Solved with the coarse grid's factors (:class:`core.nystrom_twogrid.TwoGridSolver`,
+    from ``guess``, the coarse answer at the fine nodes); the fine grid is factored only
+    if that does not converge, or later if a solve asks for its factors.
+    """
+    solver = TwoGridSolver(coarse, coarse_factor, fine, c, *shared)
+    responses = solver.solve(rhs_columns(fine.nodes, fine.g, with_gap), guess)
+    if responses is None:
+        return factored_responses(fine, c, with_gap)
+    return responses, DeferredFactor(fine, c)
+
+
 @dataclass(frozen=True)
 class AdaptiveGrid:
     """The grid the adaptive loop settled on and what it measured on it."""
@@ -144,7 +163,8 @@ class AdaptiveGrid:
     resolved: bool  # the target was met within the panel budget
     rounds: int
     c_ref: float = 1.0  # the relative modulus of ``factor``
-    factor: NodalLU | None = None  # factors of c_ref m + A on ``grid``
+    # factors of c_ref m + A on ``grid`` (taken at the first solve that needs them)
+    factor: NodalLU | DeferredFactor | None = None
     # (c_ref m + A)^-1 [1, x(, -g)] on ``grid``: the statement-1 responses the loop solved
     responses: np.ndarray | None = None
 
@@ -248,17 +268,19 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             resolved = False
             break
         fine = build_grid(lam, fine_edges, m, g, grid, accuracy)
-        fine_responses, fine_factor = factored_responses(fine, c_ref, with_gap)
         # The coarse answer at the fine nodes: its nodal values where the panel is shared
         # (the Nystrom formula returns them there), the formula at the new nodes only.
         kept_new, kept_old, fresh = shared_panels(grid.panels, fine.panels)
-        coarse_at_fine = np.empty_like(fine_responses)
+        coarse_at_fine = np.empty((fine.size, responses.shape[1]))
         coarse_at_fine[panel_nodes(kept_new)] = responses[panel_nodes(kept_old)]
         fn = panel_nodes(fresh)
         coarse_at_fine[fn] = nystrom_values(grid, c_ref, fine.nodes[fn], fine.m[fn],
                                             fine.g[fn], responses, with_gap,
                                             _coarse_rows(grid, fine, kept_new, kept_old,
                                                          fresh, accuracy))
+        fine_responses, fine_factor = _fine_responses(grid, factor, fine, c_ref, with_gap,
+                                                      (kept_new, kept_old, fresh),
+                                                      coarse_at_fine)
         scale = np.max(np.abs(fine_responses), axis=0)
         scale[scale == 0] = 1.0
         difference = float(np.max(np.abs(coarse_at_fine - fine_responses) / scale))
