@@ -18,8 +18,10 @@ with the previous one (the kernel being even, a square operator evaluates it on 
 the diagonal only, and the new columns of a refined one are its new rows transposed
 away from the new panels), the coarse answer is evaluated by the formula only at the new
 nodes, the kernel values are computed to ``KERNEL_SHARE * tol`` (not to rounding), and the
-LU of the last grid serves the bordered solve of the loads (a 2 x 2 Schur complement).
-From 200 nodes the LUs are single-precision factors whose solves are refined against the
+responses of the last grid serve the bordered solve of the loads (a 2 x 2 Schur
+complement). A refined grid is solved with the factors of the grid it refines (two-grid
+steps, :mod:`core.nystrom_twogrid`) and factored only if a later solve asks for it. From
+200 nodes the LUs are single-precision factors whose solves are refined against the
 double-precision operator (:class:`core.nystrom.NodalLU`).
 """
 
