@@ -183,6 +183,22 @@ class AdaptiveGrid:
     responses: np.ndarray | None = None
 
 
+def _remembering(f: Function) -> Function:
+    """``f`` with its values at the last points asked for kept: the resolution check of the
+    starting panels and the operator of the grid on them ask for the same nodes (one
+    evaluation of a ten-layer m costs ~0.09 ms at 192 nodes, mostly per call)."""
+    last: list = [None, None]
+
+    def remembered(x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        key = x.tobytes()
+        if last[0] != key:
+            last[:] = [key, np.asarray(f(x), dtype=float)]
+        return last[1].copy()
+
+    return remembered
+
+
 def widest_panel(lam: float, target: float) -> float:
     """Widest panel whose Gauss rule integrates the kernel's smooth part to ~target/10.
 
@@ -237,6 +253,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
     ``c_ref`` is the relative modulus the error is measured at (geometry is prepared
     before the times are known; c(1) = 1 in the scenes' scaling).
     """
+    m, g = _remembering(m), _remembering(g)
     probe = np.linspace(-1.0, 1.0, 513)
     m_min = float(np.min(m(probe)))
     with_gap = not g_is_zero
