@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve
+from scipy.linalg.lapack import dgetrs, sgetrs
 
 from core.quadrature import (
     FRESH_SHARE,
@@ -172,9 +173,10 @@ class NodalLU:
     def rough_solve(self, rhs: np.ndarray) -> np.ndarray:
         """The factors' own solve, unrefined (single precision from SINGLE_FROM nodes on:
         ~cond x 6e-8 relative): for a preconditioner, whose steps are refined anyway."""
+        lu, pivots = self._lu  # LAPACK directly: scipy.linalg's checks cost ~10 us a call
         if not self._single:
-            return lu_solve(self._lu, rhs, check_finite=False)
-        return lu_solve(self._lu, rhs.astype(np.float32), check_finite=False).astype(float)
+            return dgetrs(lu, pivots, rhs)[0]
+        return sgetrs(lu, pivots, rhs.astype(np.float32))[0].astype(float)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solution of ``matrix x = rhs`` for right-hand sides (N,) or (N, k)."""
