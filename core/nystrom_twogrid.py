@@ -167,7 +167,7 @@ class TwoGridSolver:
         for run in runs:
             nodes = slice(run[0] * NODES_PER_PANEL, (run[-1] + 1) * NODES_PER_PANEL)
             block = fine.operator[nodes, nodes].copy()
-            block[np.diag_indices_from(block)] += self._diagonal[nodes]
+            block.flat[::block.shape[0] + 1] += self._diagonal[nodes]
             lu, pivots, info = dgetrf(block, overwrite_a=True)
             if info != 0:
                 self.nested = False  # singular block: leave it to the dense factors
