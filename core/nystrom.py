@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve
+from scipy.linalg.lapack import dgetrs, sgetrs
 
 from core.quadrature import (
     FRESH_SHARE,
@@ -98,7 +99,8 @@ def build_grid(lam: float, edges: np.ndarray, m: Function, g: Function,
                        np.asarray(g(panels.nodes), dtype=float), kernel_accuracy)
 
 
-def _rhs(x: np.ndarray, g: np.ndarray, with_gap: bool) -> np.ndarray:
+def rhs_columns(x: np.ndarray, g: np.ndarray, with_gap: bool) -> np.ndarray:
+    """Right-hand sides ``[1, x(, -g)]`` of the statement-1 responses at ``x`` (len(x), 2|3)."""
     columns = [np.ones(x.size), x] + ([-g] if with_gap else [])
     return np.column_stack(columns)
 
@@ -123,7 +125,7 @@ def factored_responses(grid: NystromGrid, c: float, with_gap: bool
     work-precision scenes at tol 1e-6: 0.45-4.1 ms per scene split, 0.2-3.4 ms plain).
     """
     factor = NodalLU(grid.operator, c * grid.m, grid.kernel_accuracy)
-    return factor.solve(_rhs(grid.nodes, grid.g, with_gap)), factor
+    return factor.solve(rhs_columns(grid.nodes, grid.g, with_gap)), factor
 
 
 #: From this size on the nodal LU is taken in single precision and its solutions refined
@@ -167,6 +169,14 @@ class NodalLU:
         matrix.flat[::matrix.shape[0] + 1] += self._diagonal
         self._lu = lu_factor(matrix, overwrite_a=True, check_finite=False)
         self._single = False
+
+    def rough_solve(self, rhs: np.ndarray) -> np.ndarray:
+        """The factors' own solve, unrefined (single precision from SINGLE_FROM nodes on:
+        ~cond x 6e-8 relative): for a preconditioner, whose steps are refined anyway."""
+        lu, pivots = self._lu  # LAPACK directly: scipy.linalg's checks cost ~10 us a call
+        if not self._single:
+            return dgetrs(lu, pivots, rhs)[0]
+        return sgetrs(lu, pivots, rhs.astype(np.float32))[0].astype(float)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solution of ``matrix x = rhs`` for right-hand sides (N,) or (N, k)."""
@@ -212,7 +222,7 @@ def nystrom_values(grid: NystromGrid, c: float, x: np.ndarray, m_x: np.ndarray,
     ``rows``: the rows of the grid's operator at ``x``, if already known.
     """
     rows = grid.rows(x) if rows is None else rows
-    return (_rhs(x, g_x, with_gap) - rows @ nodal) / (c * m_x[:, None])
+    return (rhs_columns(x, g_x, with_gap) - rows @ nodal) / (c * m_x[:, None])
 
 
 # ------------------------------------------------------------------- bordered solves

@@ -18,8 +18,10 @@ with the previous one (the kernel being even, a square operator evaluates it on 
 the diagonal only, and the new columns of a refined one are its new rows transposed
 away from the new panels), the coarse answer is evaluated by the formula only at the new
 nodes, the kernel values are computed to ``KERNEL_SHARE * tol`` (not to rounding), and the
-LU of the last grid serves the bordered solve of the loads (a 2 x 2 Schur complement).
-From 200 nodes the LUs are single-precision factors whose solves are refined against the
+responses of the last grid serve the bordered solve of the loads (a 2 x 2 Schur
+complement). A refined grid is solved with the factors of the grid it refines (two-grid
+steps, :mod:`core.nystrom_twogrid`) and factored only if a later solve asks for it. From
+200 nodes the LUs are single-precision factors whose solves are refined against the
 double-precision operator (:class:`core.nystrom.NodalLU`).
 """
 
@@ -36,9 +38,10 @@ from core.nystrom import (
     NystromGrid,
     build_grid,
     factored_responses,
-    nystrom_values,
+    rhs_columns,
     touches,
 )
+from core.nystrom_twogrid import DeferredFactor, TwoGridSolver
 from core.quadrature import (
     NODES_PER_PANEL,
     Panels,
@@ -82,6 +85,11 @@ RESOLVE_SHARE = 0.1
 GROWTH_SLACK = 1.05
 #: Rounds of each refinement loop.
 MAX_ROUNDS = 12
+#: From this size on a refined grid is solved with the coarser grid's factors
+#: (:mod:`core.nystrom_twogrid`); below it its own dense LU is cheaper (measured, one
+#: thread: 144 nodes 0.15 ms LU against 0.30 ms of steps; 224 nodes 0.46 against 0.38;
+#: 256-416 nodes 0.66-2.3 against 0.46-0.87).
+TWO_GRID_FROM = 200
 
 
 
@@ -117,22 +125,47 @@ def grade(edges: np.ndarray, singular: np.ndarray, levels: int, split: float = 0
     return np.unique(np.concatenate([edges, *new]))
 
 
-def _coarse_rows(coarse: NystromGrid, fine: NystromGrid, kept_new: np.ndarray,
-                 kept_old: np.ndarray, fresh: np.ndarray, accuracy: float) -> np.ndarray:
-    """Rows of the coarse operator at the nodes of the fine grid's ``fresh`` panels.
+def _coarse_operator_at(coarse: NystromGrid, fine: NystromGrid, kept_new: np.ndarray,
+                        kept_old: np.ndarray, fresh: np.ndarray, nodal: np.ndarray,
+                        accuracy: float) -> np.ndarray:
+    """``(F q)`` of the coarse operator at the nodes of the fine grid's ``fresh`` panels,
+    for coarse nodal values ``nodal`` (N0, k).
 
-    On the panels both grids share, these are the fine operator's entries (same target,
-    same source panel, same rule): copied; only the columns of the coarse panels the fine
-    grid split are computed (the rows on all coarse columns cost 0.3-1.1 ms a scene).
+    On the panels both grids share, the coarse rows are the fine operator's entries (same
+    target, same source panel, same rule): its rows times ``nodal`` placed at the shared
+    nodes; only the columns of the coarse panels the fine grid split are computed (the
+    rows on all coarse columns cost 0.3-1.1 ms a scene).
     """
     fn = panel_nodes(fresh)
-    rows = np.empty((fn.size, coarse.size))
-    rows[:, panel_nodes(kept_old)] = fine.operator[np.ix_(fn, panel_nodes(kept_new))]
-    split = np.setdiff1d(np.arange(coarse.panels.n_panels), kept_old)
+    on_fine = np.zeros((fine.size, nodal.shape[1]))
+    on_fine[panel_nodes(kept_new)] = nodal[panel_nodes(kept_old)]
+    out = fine.operator[fn] @ on_fine
+    split = np.ones(coarse.panels.n_panels, dtype=bool)
+    split[kept_old] = False
+    split = np.nonzero(split)[0]
     if split.size:
-        rows[:, panel_nodes(split)] = node_rows(coarse.lam, coarse.panels, fine.panels,
-                                                fresh, split, accuracy)
-    return rows
+        out += node_rows(coarse.lam, coarse.panels, fine.panels, fresh, split,
+                         accuracy) @ nodal[panel_nodes(split)]
+    return out
+
+
+def _fine_responses(coarse: NystromGrid, coarse_factor: NodalLU | DeferredFactor,
+                    fine: NystromGrid, c: float, with_gap: bool,
+                    shared: tuple[np.ndarray, np.ndarray, np.ndarray], guess: np.ndarray
+                    ) -> tuple[np.ndarray, NodalLU | DeferredFactor]:
+    """The statement-1 responses on ``fine`` and its (deferred) factors.
+
+    Solved with the coarse grid's factors (:class:`core.nystrom_twogrid.TwoGridSolver`,
+    from ``guess``, the coarse answer at the fine nodes); the fine grid is factored only
+    if that does not converge, or later if a solve asks for its factors.
+    """
+    if fine.size < TWO_GRID_FROM:
+        return factored_responses(fine, c, with_gap)
+    solver = TwoGridSolver(coarse, coarse_factor, fine, c, *shared)
+    responses = solver.solve(rhs_columns(fine.nodes, fine.g, with_gap), guess)
+    if responses is None:
+        return factored_responses(fine, c, with_gap)
+    return responses, DeferredFactor(fine, c)
 
 
 @dataclass(frozen=True)
@@ -144,9 +177,26 @@ class AdaptiveGrid:
     resolved: bool  # the target was met within the panel budget
     rounds: int
     c_ref: float = 1.0  # the relative modulus of ``factor``
-    factor: NodalLU | None = None  # factors of c_ref m + A on ``grid``
+    # factors of c_ref m + A on ``grid`` (taken at the first solve that needs them)
+    factor: NodalLU | DeferredFactor | None = None
     # (c_ref m + A)^-1 [1, x(, -g)] on ``grid``: the statement-1 responses the loop solved
     responses: np.ndarray | None = None
+
+
+def _remembering(f: Function) -> Function:
+    """``f`` with its values at the last points asked for kept: the resolution check of the
+    starting panels and the operator of the grid on them ask for the same nodes (one
+    evaluation of a ten-layer m costs ~0.09 ms at 192 nodes, mostly per call)."""
+    last: list = [None, None]
+
+    def remembered(x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        key = x.tobytes()
+        if last[0] != key:
+            last[:] = [key, np.asarray(f(x), dtype=float)]
+        return last[1].copy()
+
+    return remembered
 
 
 def widest_panel(lam: float, target: float) -> float:
@@ -203,6 +253,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
     ``c_ref`` is the relative modulus the error is measured at (geometry is prepared
     before the times are known; c(1) = 1 in the scenes' scaling).
     """
+    m, g = _remembering(m), _remembering(g)
     probe = np.linspace(-1.0, 1.0, 513)
     m_min = float(np.min(m(probe)))
     with_gap = not g_is_zero
@@ -248,17 +299,19 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             resolved = False
             break
         fine = build_grid(lam, fine_edges, m, g, grid, accuracy)
-        fine_responses, fine_factor = factored_responses(fine, c_ref, with_gap)
         # The coarse answer at the fine nodes: its nodal values where the panel is shared
         # (the Nystrom formula returns them there), the formula at the new nodes only.
         kept_new, kept_old, fresh = shared_panels(grid.panels, fine.panels)
-        coarse_at_fine = np.empty_like(fine_responses)
+        coarse_at_fine = np.empty((fine.size, responses.shape[1]))
         coarse_at_fine[panel_nodes(kept_new)] = responses[panel_nodes(kept_old)]
         fn = panel_nodes(fresh)
-        coarse_at_fine[fn] = nystrom_values(grid, c_ref, fine.nodes[fn], fine.m[fn],
-                                            fine.g[fn], responses, with_gap,
-                                            _coarse_rows(grid, fine, kept_new, kept_old,
-                                                         fresh, accuracy))
+        applied = _coarse_operator_at(grid, fine, kept_new, kept_old, fresh, responses,
+                                      accuracy)
+        coarse_at_fine[fn] = ((rhs_columns(fine.nodes[fn], fine.g[fn], with_gap) - applied)
+                              / (c_ref * fine.m[fn, None]))
+        fine_responses, fine_factor = _fine_responses(grid, factor, fine, c_ref, with_gap,
+                                                      (kept_new, kept_old, fresh),
+                                                      coarse_at_fine)
         scale = np.max(np.abs(fine_responses), axis=0)
         scale[scale == 0] = 1.0
         difference = float(np.max(np.abs(coarse_at_fine - fine_responses) / scale))
