@@ -1,27 +1,29 @@
-"""Lift-off answers of many eccentricities of one flat punch, interpolated along the zone end.
+"""Lift-off answers of many eccentricities of one flat punch, located along the zone end.
 
 On a flat punch over an elastic base (uniform coating, no gap) the unilateral problem is
 homogeneous in the loads: its answer per unit force depends on the eccentricity
 ``e = M / (P a)`` alone, and with lift-off the contact zone is one interval ``[c, 1]``
 (``e > 0``; ``[-1, c]`` for ``e < 0``). Parametrized by the zone end ``c`` instead of
-``e``, everything is a smooth function of ``c``: on the zone the two unit responses
-(settlement 1 and tilt 1) of the thin-layer model are solved with the Nystrom rule of
-:mod:`core.contact_zones`, and the free-end condition ``Q(c) = 0`` fixes the ratio of tilt
-to settlement; the force and the moment of that combination give ``e(c)``, the settlement
-and tilt per unit force and the Nystrom pressure on the plotting grid per unit force.
+``e``, the answer is a smooth function of ``c``: on the zone the two unit responses
+(settlement 1 and tilt 1) of the thin-layer model are solved on the Nystrom rule of
+:mod:`core.contact_zones` (:func:`core.contact_zones.zone_panels`, the unilateral
+solver's own), and the free-end condition ``Q(c) = 0`` fixes the ratio of tilt to
+settlement; the force and the moment of that combination give ``e(c)``.
 
-:func:`liftoff_family` builds these on Chebyshev-Lobatto points in ``c`` between the zone
-ends of the batch's smallest and largest eccentricity (both solved by
-:func:`core.scene.solve`, which also fixes the topology), inverts ``e(c)`` for every
-other eccentricity, and evaluates the outputs there. The pressure on the grid is
-interpolated before it is cut to the zone and clipped at 0, so ``q_max``, ``q_min`` and
-the contact width are taken per point from its own grid values (never interpolated
-through the kink where the argmax moves). The error of the interpolation is estimated
-per point as the difference to the interpolant of half the degree (the nested points);
-the discretization error of each zone solve as the difference to the next coarser panel
-rule, as :func:`core.contact_zones.refine_zone_ends` estimates it. Points whose estimate
-misses a third of ``tol`` (outputs) or of :data:`core.contact_zones.ZONE_END_TOL` (the
-zone end) after the largest degree are left to :func:`core.scene.solve`.
+:func:`liftoff_family` builds ``e(c)`` on Chebyshev-Lobatto points in ``c`` between the
+zone ends of the batch's smallest and largest eccentricity (both solved by
+:func:`core.scene.solve`, which also fixes the topology), inverts it for every other
+eccentricity (its error estimated per point against the interpolant of half the degree,
+on the nested points) and solves each point once on its zone ``[c*, 1]``: settlement,
+tilt and the pressure on the plotting grid come from that solve, so ``q_max``, ``q_min``
+and the contact width are the point's own grid extremes (nothing is interpolated through
+the kinks of a max over a grid). The discretization error is that of each family point
+against the next coarser panel rule, as :func:`core.contact_zones.refine_zone_ends`
+estimates it. A point is answered only when its zone end is within a third of
+:data:`core.contact_zones.ZONE_END_TOL` (the interpolant's estimate, the discretization's
+and the zone's own miss of ``e`` through ``de/dc``), its outputs within a third of
+``tol``, and its pressure passes the contact set's check; the others are left to
+:func:`core.scene.solve`.
 """
 
 from __future__ import annotations
@@ -41,8 +43,9 @@ from core.scene_results import LARGE_TILT, _model_error, plotting_grid
 
 __all__ = ["FAMILY_MIN_ECCENTRICITIES", "LiftoffAnswer", "liftoff_family"]
 
-#: Distinct eccentricities of one sign below which a family is not built: it costs about
-#: as much as this many one-by-one lift-off solves (9 to 33 zone solves and their checks).
+#: Eccentricities between a family's two ends below which it is not built: its 9 to 33
+#: family points (each with its coarser check) cost about as much as this many
+#: one-by-one lift-off solves.
 FAMILY_MIN_ECCENTRICITIES = 8
 #: Chebyshev-Lobatto degrees tried in turn (nested: each reuses the solves of the one
 #: before; the estimate of degree N is the difference to degree N / 2).
