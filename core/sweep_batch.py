@@ -188,13 +188,16 @@ def _liftoff_families(validated: Sequence[Scene | None],
                       solved: dict[tuple[int, float], tuple]) -> dict[tuple[int, float], float]:
     """Answer the lift-off eccentricities of each scaled geometry of the batch at once
     where there are enough of them (:func:`core.sweep_liftoff.liftoff_family`), filling
-    ``solved``; returns the seconds each answered eccentricity's point is charged."""
+    ``solved``; returns the seconds [s] each point of an answered eccentricity is charged
+    (the family's time over the points it answered)."""
     from core.sweep_liftoff import FAMILY_MIN_ECCENTRICITIES
 
     first: dict[tuple[int, float], int] = {}
+    count: dict[tuple[int, float], int] = {}
     for i, key in enumerate(keys):
-        if key is not None and key not in first:
-            first[key] = i
+        if key is not None:
+            first.setdefault(key, i)
+            count[key] = count.get(key, 0) + 1
     charged: dict[tuple[int, float], float] = {}
     scenes = {id(g): g for g in validated if g is not None}
     for scene_id, scene in scenes.items():
@@ -206,7 +209,9 @@ def _liftoff_families(validated: Sequence[Scene | None],
             start = time.perf_counter()
             rows = {key: values[first[key]] for key in picked}
             done = _one_family(scene, picked, rows, loads, load_columns, outputs, solved)
-            share = (time.perf_counter() - start) / max(len(done), 1)
+            # the family's time shared by every point it answered (a key may hold several)
+            points = sum(count[key] for key in done)
+            share = (time.perf_counter() - start) / max(points, 1)
             charged.update({key: share for key in done})
     return charged
 
