@@ -627,7 +627,7 @@ def test_scaled_answer_flags_a_large_tilt_by_its_own_size():
 #: The lift-off answers of one geometry's batch located along the zone end
 #: (core.sweep_liftoff) against core.solve on each point's scene, relative to each
 #: output's size: measured at most 2.3e-9 over the 1,470 lift-off points of
-#: benchmarks.sweep.loads_study(100) and 3.2e-13 on this test's grid; both
+#: benchmarks.sweep.loads_study(100) and 1.9e-12 on this test's grid; both
 #: solve the same zone to its solver's tolerance (estimates ~1e-8 to 6e-8), so they differ
 #: by their discretizations at zone ends ~1e-10 apart, well below tol = 1e-6.
 LIFTOFF_FAMILY_DIFFERENCE = 1e-8
