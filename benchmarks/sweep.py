@@ -5,6 +5,7 @@
     python -m benchmarks.sweep --chart-only # only the design chart
     python -m benchmarks.sweep --no-chart   # only the measurements (no matplotlib needed)
     python -m benchmarks.sweep --point-costs  # where the loads study's CPU goes (no Dask)
+    python -m benchmarks.sweep --memory 100000 1000000  # peak memory, batches on disk
 
 Measured (``core.sweep`` on a local Dask cluster of single-threaded worker processes on
 127.0.0.1, a fresh cluster for every run so that no worker starts with warm caches; the
@@ -135,19 +136,19 @@ def _cut_points(study: Study, points: int) -> int:
     return max(1, points // per_value) * per_value
 
 
-def point_costs(study: Study, batch: int = 500) -> dict[str, dict[str, float]]:
-    """Where a load-only study's CPU time goes, in this process with no Dask: the points
-    :func:`core.sweep_loads.solve_load_batch` answers at once (in batches of ``batch``)
-    and the points it leaves, each solved by :func:`core.scene.solve` and sorted by the
-    contact model that answered (``refused``: the checks refused the loads). Per kind:
-    the points, their CPU seconds [s] (``time.process_time``) and, for the one-by-one
-    points, the median CPU per point [s]; ``lift-off eccentricities``: the distinct
-    ``M / P`` [m] among the points the unilateral model answered."""
-    from core.scene import solve
-    from core.scene_validation import replace_loads
+def point_costs(study: Study, batch: int | None = None) -> dict[str, dict[str, float]]:
+    """Where a load-only study's CPU time goes, in this process with no Dask, batch by
+    batch as :func:`core.sweeps.sweep` plans them (``batch`` points each, default as the
+    study's default): the points :func:`core.sweep_loads.solve_load_batch` answers at
+    once (``batched``), and the whole of :func:`core.sweep_batch.run_batch`
+    (``run_batch``: the batched points again, the lift-off families of
+    :mod:`core.sweep_liftoff`, the scaled points and the one-point solves, counted in
+    ``one-point solves``). CPU seconds [s] from ``time.process_time``."""
+    import core.sweep_batch as batch_module
     from core.study import point_table
-    from core.sweep_batch import _load_only_base
+    from core.sweep_batch import _load_only_base, run_batch
     from core.sweep_loads import solve_load_batch
+    from core.sweeps import default_batch_points, plan_batches
 
     paths = [p.path for p in study.parameters]
     loads = [path.split(".", 1)[1] for path in paths]
@@ -155,32 +156,91 @@ def point_costs(study: Study, batch: int = 500) -> dict[str, dict[str, float]]:
     scene = _load_only_base(study.base, paths)
     if scene is None:
         raise ValueError("study: point_costs needs a study over given loads only")
-    kinds: dict[str, list[float]] = {}
-    batched, batched_cpu, eccentricities = 0, 0.0, set()
-    for lo in range(0, study.n_points, batch):
-        values = {q: np.asarray(table[path][lo:lo + batch], dtype=float)
-                  for q, path in zip(loads, paths, strict=True)}
+    batches = plan_batches(study, table, batch or default_batch_points(study.n_points))
+    batched, batched_cpu, run_cpu, failed, flagged = 0, 0.0, 0.0, 0, 0
+    solves: list[float] = []
+    one_point = batch_module.solve
+
+    def counted(point_scene):
         cpu = time.process_time()
-        answer = solve_load_batch(scene, values, study.outputs)
-        batched_cpu += time.process_time() - cpu
-        batched += int(answer.answered.sum())
-        for k in np.flatnonzero(~answer.answered):
-            point = {q: float(v[k]) for q, v in values.items()}
+        try:
+            return one_point(point_scene)
+        finally:
+            solves.append(time.process_time() - cpu)
+
+    batch_module.solve = counted
+    try:
+        for index in batches:
+            values = np.stack([np.asarray(table[p])[index] for p in paths], axis=1)
             cpu = time.process_time()
-            try:
-                result = solve(replace_loads(scene, point))
-                kind = str(result.info.get("contact", "?"))
-            except ValueError:
-                kind = "refused"
-            kinds.setdefault(kind, []).append(time.process_time() - cpu)
-            if kind == "unilateral" and point.get("force"):
-                eccentricities.add(round(point.get("moment", 0.0) / point["force"], 12))
-    out = {"batched": {"points": batched, "cpu": batched_cpu}}
-    for kind, cpu in kinds.items():
-        out[kind] = {"points": len(cpu), "cpu": float(np.sum(cpu)),
-                     "median": float(np.median(cpu))}
-    out["lift-off eccentricities"] = {"points": len(eccentricities)}
-    return out
+            answer = solve_load_batch(scene, {q: values[:, j] for j, q in enumerate(loads)},
+                                      study.outputs)
+            batched_cpu += time.process_time() - cpu
+            batched += int(answer.answered.sum())
+            cpu = time.process_time()
+            got = run_batch(study.base, paths, values, study.outputs, len(study.times))
+            run_cpu += time.process_time() - cpu
+            failed += int(np.sum(got["flags"] == "failed"))
+            flagged += int(np.sum((got["flags"] != "") & (got["flags"] != "failed")))
+    finally:
+        batch_module.solve = one_point
+    return {"batched": {"points": batched, "cpu": batched_cpu},
+            "run_batch": {"points": study.n_points, "batches": len(batches), "cpu": run_cpu,
+                          "failed": failed, "flagged": flagged},
+            "one-point solves": {"count": len(solves), "cpu": float(np.sum(solves)),
+                                 "median": float(np.median(solves)) if solves else 0.0}}
+
+
+def full_contact_study(n_force: int, n_moment: int) -> Study:
+    """``n_force`` x ``n_moment`` points over force [N/m] and moment [N] that all keep full
+    contact (eccentricity at most 0.2 m on the 2 m punch): the cheapest points, so the
+    study's size, not its solves, is what a large one measures."""
+    return study_from_dict({
+        "study_version": 1, "name": "full contact loads", "scene": elastic_scene(),
+        "vary": [{"field": "loading.force", "linspace": {"start": 1e5, "stop": 1e6,
+                                                         "count": n_force}},
+                 {"field": "loading.moment", "linspace": {"start": 0.0, "stop": 2e4,
+                                                          "count": n_moment}}]})
+
+
+def _peak_rss_mb() -> float:
+    """Peak resident memory of this process [MB] (Linux reports kB)."""
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def memory_of_study(study: Study, workers: int, work_dir: Path) -> dict[str, float]:
+    """Run ``study`` on a fresh local cluster with its batches streamed to ``work_dir``
+    (no dataset assembled: ``return_dataset=False``); the peak resident memory [MB] of
+    this process (the client and, in a local cluster, the scheduler) and of each worker,
+    the seconds, the workers' CPU [s] and the size of the written parts [MB]."""
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                           host="127.0.0.1", dashboard_address=None,
+                           env={"OPENBLAS_NUM_THREADS": "1"})
+    client = Client(cluster)
+    client.wait_for_workers(workers)
+    try:
+        before = _peak_rss_mb()
+        worker_before = client.run(_peak_rss_mb)
+        cpu_before = client.run(time.process_time)
+        start = time.perf_counter()
+        info = sweep(study, client=client, work_dir=work_dir, return_dataset=False)
+        seconds = time.perf_counter() - start
+        cpu = sum(t - cpu_before.get(w, 0.0) for w, t in client.run(time.process_time).items())
+        workers_peak = client.run(_peak_rss_mb)
+    finally:
+        client.close()
+        cluster.close()
+    parts = sum(f.stat().st_size for f in Path(work_dir).rglob("*") if f.is_file())
+    return {"points": study.n_points, "seconds": seconds, "cpu": cpu,
+            "client_before": before, "client_peak": _peak_rss_mb(),
+            "workers_before": max(worker_before.values()),
+            "workers_peak": max(workers_peak.values()), "parts_mb": parts / 2**20,
+            "batches": info["batches"], "failed": info["points_failed"],
+            "load": os.getloadavg()[0]}
 
 
 def measure(name: str, study: Study, repeats: int) -> dict[str, Any]:
@@ -310,6 +370,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--point-costs", action="store_true",
                         help="only where the loads study's CPU goes, in this process "
                              "(no Dask, nothing written)")
+    parser.add_argument("--memory", type=int, nargs="+", metavar="POINTS",
+                        help="only the peak memory of full-contact load studies of these "
+                             "sizes (squares of 1,000 forces by POINTS / 1,000 moments) "
+                             "on 2 workers, batches streamed to a temporary directory")
     parser.add_argument("--no-chart", action="store_true",
                         help="measure only; keep the design chart drawn before (it needs "
                              "matplotlib)")
@@ -321,6 +385,15 @@ def main(argv: list[str] | None = None) -> int:
         for kind, cost in point_costs(loads_study(45 if args.quick else 100)).items():
             print(f"{kind}: {cost}", flush=True)
         print(f"load average {os.getloadavg()[0]:.1f}")
+        return 0
+    if args.memory:
+        import tempfile
+
+        for points in args.memory:
+            with tempfile.TemporaryDirectory(prefix="study-memory-") as work:
+                study = full_contact_study(1000, max(1, points // 1000))
+                print(f"{study.n_points:,} points: {memory_of_study(study, 2, Path(work))}",
+                      flush=True)
         return 0
     out = RESULTS / "quick" if args.quick else RESULTS
     out.mkdir(parents=True, exist_ok=True)

@@ -422,15 +422,22 @@ def point_table(study: Study) -> dict[str, np.ndarray]:
     """
     grids = [p for p in study.parameters if p.is_grid]
     shape = tuple(len(p.values) for p in grids) + (study.samples,)
-    index = np.indices(shape).reshape(len(shape), -1)
+
+    def spread(values: np.ndarray, axis: int) -> np.ndarray:
+        # each point's value along one axis, without an index array per axis (at 1e6
+        # points those held 8 MB an axis at once, the client's largest share of memory)
+        view = [1] * len(shape)
+        view[axis] = shape[axis]
+        return np.array(np.broadcast_to(values.reshape(view), shape)).reshape(-1)
+
     table: dict[str, np.ndarray] = {}
     for axis, p in enumerate(grids):
-        table[p.path] = np.asarray(p.values, dtype=float)[index[axis]]
+        table[p.path] = spread(np.asarray(p.values, dtype=float), axis)
     rng = np.random.default_rng(study.seed)
     for p in study.parameters:
         if not p.is_grid:
-            table[p.path] = _draws(p, rng, study.samples)[index[-1]]
-    table["sample"] = index[-1].astype(np.int64)
+            table[p.path] = spread(_draws(p, rng, study.samples), len(shape) - 1)
+    table["sample"] = spread(np.arange(study.samples, dtype=np.int64), len(shape) - 1)
     return {p.path: table[p.path] for p in study.parameters} | {"sample": table["sample"]}
 
 

@@ -7,8 +7,11 @@ messages); on a scene the exact layered kernel answers, their full-contact answe
 at once (:func:`core.sweep_loads.solve_load_batch`). Every other point is solved on its
 own with :func:`core.scene.solve`, except that on a flat punch over an elastic base a
 point whose eccentricity ``M / P`` an earlier point of the batch shares is that point's
-answer scaled by the ratio of the forces (:func:`answers_scale_with_loads`). A point that
-fails is recorded with its message.
+answer scaled by the ratio of the forces (:func:`answers_scale_with_loads`), and where a
+geometry's batch holds many lift-off eccentricities of one sign they are answered as one
+family (:func:`core.sweep_liftoff.liftoff_family`: the smallest and the largest solved by
+:func:`core.scene.solve`, the ones between located along the zone end and solved on
+their zones). A point that fails is recorded with its message.
 """
 
 from __future__ import annotations
@@ -167,6 +170,135 @@ def _scaled(answer: tuple[float, np.ndarray, float, list[str], float], force: fl
     return values * scale[:, None], estimate, ",".join(kept)
 
 
+def _kept_answer(result: Any, outputs: Sequence[str]
+                 ) -> tuple[float, np.ndarray, float, list[str], float]:
+    """What a solved point keeps to answer the points of its eccentricity: its force
+    [N/m], outputs, error estimate, flags and largest |tilt| [rad]."""
+    tilt = max(float(np.max(np.abs(result.tilt))) if result.tilt.size else 0.0,
+               float(result.info.get("max_abs_tilt", 0.0)))
+    force = result.scene.loading.get("force")
+    return (float(force.spec) if force is not None else np.nan, point_outputs(result, outputs),
+            float(result.info.get("error_estimate", np.nan)), list(result.flags), tilt)
+
+
+def _liftoff_families(validated: Sequence[Scene | None],
+                      keys: Sequence[tuple[int, float] | None], values: np.ndarray,
+                      loads: Sequence[str], load_columns: Sequence[int],
+                      outputs: Sequence[str],
+                      solved: dict[tuple[int, float], tuple]) -> dict[tuple[int, float], float]:
+    """Answer the lift-off eccentricities of each scaled geometry of the batch at once
+    where there are enough of them (:func:`core.sweep_liftoff.liftoff_family`), filling
+    ``solved``; returns the seconds [s] each point of an answered eccentricity is charged
+    (the family's time over the points it answered)."""
+    from core.sweep_liftoff import FAMILY_MIN_ECCENTRICITIES
+
+    first: dict[tuple[int, float], int] = {}
+    count: dict[tuple[int, float], int] = {}
+    for i, key in enumerate(keys):
+        if key is not None:
+            first.setdefault(key, i)
+            count[key] = count.get(key, 0) + 1
+    charged: dict[tuple[int, float], float] = {}
+    scenes = {id(g): g for g in validated if g is not None}
+    for scene_id, scene in scenes.items():
+        for sign in (1.0, -1.0):
+            picked = sorted((key for key in first if key[0] == scene_id
+                             and key[1] * sign > 0), key=lambda k: abs(k[1]))
+            if len(picked) < FAMILY_MIN_ECCENTRICITIES + 2:
+                continue
+            start = time.perf_counter()
+            rows = {key: values[first[key]] for key in picked}
+            done = _one_family(scene, picked, rows, loads, load_columns, outputs, solved)
+            # the family's time shared by every point it answered (a key may hold several)
+            points = sum(count[key] for key in done)
+            share = (time.perf_counter() - start) / max(points, 1)
+            charged.update({key: share for key in done})
+    return charged
+
+
+#: Points of the smallest eccentricities solved one by one, at most, to find the first
+#: that lifts off (the ones below keep full contact in the thin-layer model's check).
+_FULL_CONTACT_TRIES = 3
+
+
+def _one_family(scene: Scene, picked: list[tuple[int, float]],
+                rows: Mapping[tuple[int, float], np.ndarray], loads: Sequence[str],
+                load_columns: Sequence[int], outputs: Sequence[str],
+                solved: dict[tuple[int, float], tuple]) -> list[tuple[int, float]]:
+    """One sign of eccentricity of one geometry: its smallest and largest eccentricities
+    solved by :func:`core.scene.solve` (they fix the zone ends' range and the topology),
+    the ones between by :func:`core.sweep_liftoff.liftoff_family`. Returns the keys it
+    answered (into ``solved``); any doubt leaves the rest one by one."""
+    from core.sweep_liftoff import family_applies, family_flags, liftoff_family
+    from core.sweep_loads import _dimensionless_loads
+
+    if not family_applies(scene):
+        return []
+    points = [{name: float(rows[key][j]) for name, j in zip(loads, load_columns,
+                                                            strict=True)} for key in picked]
+    both = [{name: p.get(name, float(scene.loading[name].spec)) for name in ("force", "moment")}
+            for p in points]
+    forces = np.array([p["force"] for p in both])
+    a = scene.half_width
+    eccentricity = np.array([p["moment"] for p in both]) / (forces * a)
+    _, plain = _dimensionless_loads(scene, {q: np.array([p[q] for p in both])
+                                            for q in ("force", "moment")}, len(picked))
+    if not plain.all():
+        return []  # a point the checks may refuse: each one then speaks for itself
+    sign = 1.0 if eccentricity[0] > 0 else -1.0
+
+    def one(k: int) -> Any:
+        try:
+            sub = replace_loads(scene, points[k])
+            result = solve(sub)
+        except Exception:  # noqa: BLE001 - the loop solves it again and records it
+            return None
+        solved[picked[k]] = _kept_answer(result, outputs)
+        return result
+
+    def zone_end(result: Any) -> float | None:
+        zones = {tuple(z) for z in result.contact_set}
+        if result.info.get("contact") != "unilateral" or len(zones) != 1:
+            return None
+        (zone,) = zones
+        if len(zone) != 1:
+            return None
+        lo, hi = zone[0]
+        if sign > 0 and hi == a:
+            return lo / a
+        if sign < 0 and lo == -a:
+            return hi / a
+        return None
+
+    low, low_result = None, None
+    for k in range(min(_FULL_CONTACT_TRIES, len(picked) - 2)):
+        low_result = one(k)
+        if low_result is None:
+            return []
+        if low_result.info.get("contact") == "unilateral":
+            low = k
+            break
+    if low is None or len(picked) - low < 3:
+        return []
+    high_result = one(len(picked) - 1)
+    if high_result is None:
+        return []
+    ends = (zone_end(low_result), zone_end(high_result))
+    flags = family_flags(low_result.flags)
+    if None in ends or flags is None or flags != family_flags(high_result.flags):
+        return []
+    middle = slice(low + 1, len(picked) - 1)
+    answers, _ = liftoff_family(scene, eccentricity[middle], forces[middle], ends, outputs,
+                                flags)
+    done = []
+    for key, answer in zip(picked[middle], answers, strict=True):
+        if answer is not None:
+            solved[key] = (answer.force, answer.values, answer.estimate, answer.flags,
+                           answer.tilt)
+            done.append(key)
+    return done
+
+
 def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
               outputs: Sequence[str], n_times: int) -> dict[str, np.ndarray]:
     """Solve the points of one batch in order (``values[i]`` holds point i's value of each
@@ -212,20 +344,25 @@ def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
     scaling = {id(g): answers_scale_with_loads(g) for g in validated if g is not None}
     # per eccentricity, the first solved point's answer (a flat punch, elastic base)
     solved: dict[tuple[int, float], tuple[float, np.ndarray, float, list[str], float]] = {}
+    keys: list[tuple[int, float] | None] = [None] * m
+    for i, row in enumerate(values):
+        if not batched[i] and validated[i] is not None and scaling[id(validated[i])]:
+            point = {q: float(row[j]) for q, j in zip(loads, load_columns, strict=True)}
+            keys[i] = _eccentricity_key(validated[i], point)
+    family_seconds = _liftoff_families(validated, keys, values, loads, load_columns,
+                                       outputs, solved)
     for i, row in enumerate(values):
         if batched[i]:
             continue
         start = time.perf_counter()
-        key = None
-        if validated[i] is not None and scaling[id(validated[i])]:
+        key = keys[i]
+        if key is not None and key in solved:
             point = {q: float(row[j]) for q, j in zip(loads, load_columns, strict=True)}
-            key = _eccentricity_key(validated[i], point)
-            if key in solved:
-                out[i], estimate[i], flags[i] = _scaled(
-                    solved[key], point.get("force", float(validated[i].loading["force"].spec)),
-                    outputs)
-                seconds[i] = time.perf_counter() - start
-                continue
+            out[i], estimate[i], flags[i] = _scaled(
+                solved[key], point.get("force", float(validated[i].loading["force"].spec)),
+                outputs)
+            seconds[i] = time.perf_counter() - start + family_seconds.get(key, 0.0)
+            continue
         try:
             if validated[i] is not None:
                 # only the loads change: the group's scene was validated once
@@ -234,14 +371,10 @@ def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
             else:
                 scene = apply_point(base, dict(zip(paths, row, strict=True)))
             result = solve(scene)
-            out[i] = point_outputs(result, outputs)
-            estimate[i] = float(result.info.get("error_estimate", np.nan))
-            flags[i] = ",".join(result.flags)
+            answer = _kept_answer(result, outputs)
+            out[i], estimate[i], flags[i] = answer[1], answer[2], ",".join(answer[3])
             if key is not None:
-                tilt = max(float(np.max(np.abs(result.tilt))) if result.tilt.size else 0.0,
-                           float(result.info.get("max_abs_tilt", 0.0)))
-                solved[key] = (float(scene.loading["force"].spec), out[i].copy(),
-                               estimate[i], list(result.flags), tilt)
+                solved[key] = answer
         except Exception as exc:  # noqa: BLE001 - a failed point is recorded, never fatal
             errors[i] = (" ".join(str(exc).split()) or type(exc).__name__)[:500]
             flags[i] = "failed"

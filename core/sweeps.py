@@ -13,8 +13,10 @@ full-contact points are answered at once (:func:`core.sweep_loads.solve_load_bat
 problem is linear in the loads) and only the others are solved one by one, one per
 eccentricity ``M / P`` on a flat punch over an elastic base (the others of that
 eccentricity scaled from it; batches follow the eccentricity when force and moment both
-vary). A point that fails (an invalid scene drawn from a distribution, a solver error)
-is recorded with its message; it never stops the study.
+vary), and a batch's many lift-off eccentricities are answered as one family, their zone
+ends located along a Chebyshev interpolant (:mod:`core.sweep_liftoff`). A point that
+fails (an invalid scene drawn from a distribution, a solver error) is recorded with its
+message; it never stops the study.
 
 Each finished batch is written atomically to a work directory (``parts/batch_NNNNNN.npz``
 next to a ``manifest.json`` naming the study), so a study that was interrupted (a killed

@@ -622,3 +622,60 @@ def test_scaled_answer_flags_a_large_tilt_by_its_own_size():
 
     scene = json.loads((SCENES / "uniform_flat.json").read_text())
     assert not answers_scale_with_loads(scene_from_dict(scene))
+
+
+#: The lift-off answers of one geometry's batch located along the zone end
+#: (core.sweep_liftoff) against core.solve on each point's scene, relative to each
+#: output's size: measured at most 2.3e-9 over the 1,470 lift-off points of
+#: benchmarks.sweep.loads_study(100) and 1.9e-12 on this test's grid; both
+#: solve the same zone to its solver's tolerance (estimates ~1e-8 to 6e-8), so they differ
+#: by their discretizations at zone ends ~1e-10 apart, well below tol = 1e-6.
+LIFTOFF_FAMILY_DIFFERENCE = 1e-8
+
+
+def test_liftoff_eccentricities_of_a_batch_are_one_family(monkeypatch):
+    """Many lift-off eccentricities of a flat punch in one batch: the smallest and the
+    largest are solved by core.solve, the others located along the zone end and solved on
+    their zones (core.sweep_liftoff); every point's outputs, flags and messages match
+    core.solve's, and its error estimate stays within a third of tol."""
+    import core.sweep_batch as batch
+
+    study = study_from_dict(small_study(vary=[
+        {"field": "loading.force", "values": [1e5]},
+        {"field": "loading.moment", "values": [0.0]}], times=[365.0]))
+    # 14 lift-off eccentricities 0.46-0.95 m at two forces (not in a ratio of powers of
+    # two), one that keeps full contact (0.2 m) and one refused (1.2 m); then 10 negative
+    # ones -0.5 to -0.9 m (the zone [-a, c], a family of its own)
+    eccentricities = list(np.linspace(0.46, 0.95, 14)) + [0.2, 1.2] + list(
+        np.linspace(-0.9, -0.5, 10))
+    grid = np.array([(f, f * e) for e in eccentricities for f in (1e5, 2.3e5)])
+    solved = []
+    one_point = batch.solve
+    monkeypatch.setattr(batch, "solve", lambda scene: solved.append(1) or one_point(scene))
+    got = batch.run_batch(study.base, ["loading.force", "loading.moment"], grid,
+                          list(OUTPUTS), len(study.times))
+    monkeypatch.undo()
+    # the two ends of each family and the refused point (twice): 6 one-point solves
+    # where one per eccentricity would be 26
+    assert len(solved) == 6
+    # the batch's own points decide its answers: the same again after another batch has
+    # warmed this process's caches (as on a worker that ran other batches before)
+    batch.run_batch(study.base, ["loading.force", "loading.moment"], grid[::3],
+                    list(OUTPUTS), len(study.times))
+    again = batch.run_batch(study.base, ["loading.force", "loading.moment"], grid,
+                            list(OUTPUTS), len(study.times))
+    for name in ("values", "error_estimate", "flags", "error"):
+        np.testing.assert_array_equal(again[name], got[name])
+    worst = []
+
+    def same_as_the_point(i, result):
+        want = batch.point_outputs(result, list(OUTPUTS))
+        scale = np.max(np.abs(want), axis=1, keepdims=True)
+        scale = np.where(scale > 0, scale, 1.0)
+        worst.append(float(np.max(np.abs(got["values"][i] - want) / scale)))
+        assert worst[-1] <= LIFTOFF_FAMILY_DIFFERENCE
+        assert got["error_estimate"][i] <= study.base["solver"]["tol"] / 3
+
+    kinds = each_load_point_against_solve(study, grid, got, same_as_the_point)
+    assert kinds == {"failed": 2, "unilateral": 48, "full": 2}
+    print(f"largest difference to core.solve: {max(worst):.2e}")
