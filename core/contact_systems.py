@@ -18,6 +18,14 @@ from scipy.linalg import lu_factor
 from scipy.linalg.lapack import dgetrs
 
 
+def restrict(op: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """``op`` on the nodes ``idx`` (sorted): a view when they are one run of nodes (one
+    contact zone, the usual case: no copy of the block), a copy otherwise."""
+    if idx.size and int(idx[-1]) - int(idx[0]) + 1 == idx.size:
+        return op[idx[0]:idx[-1] + 1, idx[0]:idx[-1] + 1]
+    return op[np.ix_(idx, idx)]
+
+
 class StepSolver:
     """Solves the bordered systems of one panel rule, keeping the last factorization.
 
@@ -44,7 +52,7 @@ class StepSolver:
     def submatrix(self, op: np.ndarray, idx: np.ndarray, key: tuple) -> np.ndarray:
         """``op`` restricted to the nodes ``idx`` (kept while the contact nodes stay)."""
         if self._key != key or self._sub is None:
-            self._sub = op[np.ix_(idx, idx)]
+            self._sub = restrict(op, idx)
             self._key = key
             self._lu = None
             self._last = None
@@ -133,7 +141,7 @@ def _bordered_system(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray
     border_cols = np.array(cols).T.reshape(n, k)
     border_rows = np.array(rows).reshape(k, n)
     key = (idx.tobytes(), tuple(sorted(given)))
-    sub = op[np.ix_(idx, idx)] if solver is None else solver.submatrix(op, idx, key)
+    sub = restrict(op, idx) if solver is None else solver.submatrix(op, idx, key)
     # Divided by the weight s of F, the system depends on c and s only through c/s (and
     # the border unknowns come out divided by s): kept factors then precondition the
     # next steps up to the change of c/s alone.
