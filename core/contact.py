@@ -38,8 +38,10 @@ from core.contact_zones import (
     nodal_active_set,
     nystrom_pressure,
     refine_zone_ends,
+    zone_kernel_accuracy,
     zones_from_nodes,
 )
+from core.kernel_values import FULL_ACCURACY
 from core.quadrature import Panels, base_panels, kernel_operator
 
 #: The contact models of ``solve_dimensionless(..., contact=...)``.
@@ -97,6 +99,8 @@ class UnilateralSolution(SolveOutcome):
     info: dict[str, Any]
     _space: Space = field(repr=False)
     _snapshots: list[_Snapshot] = field(repr=False)
+    # absolute accuracy of the kernel values in the rows of q(x) (those of the solve)
+    _kernel_accuracy: float = field(default=FULL_ACCURACY, repr=False)
 
     def pressure(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
         """Contact pressure q(x, t) at points of [-1, 1], shape ``(len(x), len(times))``.
@@ -123,7 +127,8 @@ class UnilateralSolution(SolveOutcome):
                 if key not in rows:
                     from core.quadrature import operator_rows
 
-                    rows[key] = operator_rows(self._space.lam, snap.panels, x)
+                    rows[key] = operator_rows(self._space.lam, snap.panels, x,
+                                              accuracy=self._kernel_accuracy)
                 xi = x[inside]
                 fq = rows[key][inside] @ snap.q
                 values = (snap.settlement + snap.tilt * xi - self._space.g(xi)
@@ -285,7 +290,7 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     out["info"]["seconds"] = _time.perf_counter() - started
     return UnilateralSolution(times_arr.copy(), out["settlement"], out["tilt"], out["force"],
                               out["moment"], out["contact_set"], out["info"], space,
-                              out["snapshots"])
+                              out["snapshots"], out.get("kernel_accuracy", FULL_ACCURACY))
 
 
 #: The operator of the nodal rule depends on lam and the panels only (not on m, g or the
@@ -361,6 +366,9 @@ def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
         "min_pressure": 0.0,
     }
     return {
+        # q(x) to the kernel accuracy of the zone operators (the solve's own error is
+        # larger): 201 rows of the study's outputs 2.3 -> 1.6 ms CPU (measured)
+        "kernel_accuracy": zone_kernel_accuracy(tol),
         "settlement": np.array([s.settlement for s in snapshots]),
         "tilt": np.array([s.tilt for s in snapshots]),
         "force": np.array([r[1]["force"] for r in per_time]),

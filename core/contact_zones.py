@@ -348,6 +348,11 @@ def solve_on_zones(space: Space, step: Step, ends: Sequence[float],
     return sol if probes is None else (sol, values[ends_arr.size:])
 
 
+def zone_kernel_accuracy(tol: float) -> float:
+    """Absolute accuracy of the kernel values in the zone operators for ``tol``."""
+    return max(FULL_ACCURACY, 1e-4 * min(tol, ZONE_END_TOL))
+
+
 @dataclass
 class Refined:
     """Result of :func:`refine_zone_ends`: the final solution, the estimated error of the
@@ -387,7 +392,7 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
     # errs by that times int |q|, far below both; the truncated series and the zeros of
     # the decayed kernel save ~6 % of an elastic lift-off solve (12.9 -> 12.1 ms CPU,
     # measured; the ends moved by 6e-14 at tol 1e-6).
-    accuracy = max(FULL_ACCURACY, 1e-4 * min(tol, ZONE_END_TOL))
+    accuracy = zone_kernel_accuracy(tol)
     builds = 0
     # The nodal Q is in units of q; the residual is Q / max q.
     inward = np.array([1.0 if k % 2 == 0 else -1.0 for k in free])
