@@ -408,7 +408,7 @@ def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: 
         sol = refined.solution
     zones = [(float(sol.ends[2 * i]), float(sol.ends[2 * i + 1]))
              for i in range(len(sol.ends) // 2)]
-    verified = _verify(space, step, sol, base, zones)
+    verified = _verify(space, step, sol, base, zones, zone_kernel_accuracy(tol))
     snap = _Snapshot(sol.panels, sol.q, sol.settlement, sol.tilt, step, zones)
     return snap, {"zone_end_error": refined.end_error, "error_estimate": refined.output_error,
                   "verified": verified, "converged": refined.converged,
@@ -440,8 +440,9 @@ def _bad_pins(space: Space, step: Step, sol, pinned: list[bool]) -> list[int]:
     return bad
 
 
-def _verify(space: Space, step: Step, sol, base: Panels, zones) -> bool:
-    """q >= 0 on the zones and the gap open (Q <= 0) at the base nodes off them."""
+def _verify(space: Space, step: Step, sol, base: Panels, zones, accuracy: float) -> bool:
+    """q >= 0 on the zones and the gap open (Q <= 0) at the base nodes off them (the
+    kernel values to ``accuracy``, far below the check's 1e-8 of max q)."""
     scale = sol.q_scale
     if np.min(sol.q) < -1e-8 * scale:
         return False
@@ -452,5 +453,6 @@ def _verify(space: Space, step: Step, sol, base: Panels, zones) -> bool:
     off = x[~inside]
     if off.size == 0:
         return True
-    values = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, off)
+    values = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, off,
+                              accuracy=accuracy)
     return bool(np.max(values) <= 1e-8 * scale)

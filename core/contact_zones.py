@@ -305,14 +305,16 @@ def zone_panels(space: Space, ends: Sequence[float], res: Resolution) -> Panels:
 
 def nystrom_pressure(space: Space, step: Step, panels: Panels, q: np.ndarray, delta: float,
                      alpha: float, targets: np.ndarray, inward: np.ndarray | None = None,
-                     memory_at: Callable[[np.ndarray], np.ndarray] | None = None) -> np.ndarray:
+                     memory_at: Callable[[np.ndarray], np.ndarray] | None = None,
+                     accuracy: float = FULL_ACCURACY) -> np.ndarray:
     """Q at ``targets`` for the nodal pressure ``q`` on ``panels`` (see the module notes).
 
-    ``inward`` (+-1 per target) says from which side m and g are sampled at a jump.
+    ``inward`` (+-1 per target) says from which side m and g are sampled at a jump;
+    ``accuracy`` is the absolute accuracy of the kernel values (default: rounding).
     """
     targets = np.asarray(targets, dtype=float)
     side = targets if inward is None else np.clip(targets + 1e-13 * inward, -1.0, 1.0)
-    fq = operator_rows(space.lam, panels, targets) @ q
+    fq = operator_rows(space.lam, panels, targets, accuracy=accuracy) @ q
     memory = 0.0 if memory_at is None else memory_at(targets)
     return (delta + alpha * targets - space.g(side) + memory - step.scale * fq) / (
         step.c * space.m(side))
