@@ -232,14 +232,11 @@ def zones_from_nodes(state: NodalState, breakpoints: Sequence[float] = ()
     ends: list[float] = []
     pinned: list[bool] = []
     slopes: list[float] = []
-    i = 0
-    while i < n:
-        if not active[i]:
-            i += 1
-            continue
-        j = i
-        while j + 1 < n and active[j + 1]:
-            j += 1
+    # the runs of contact nodes, found at once (a loop over the nodes cost ~0.1 ms per
+    # call, paid at every output time of a creep march)
+    flips = np.flatnonzero(np.diff(np.concatenate([[0], active.astype(np.int8), [0]])))
+    for i, j in zip(flips[0::2], flips[1::2] - 1, strict=True):
+        i, j = int(i), int(j)
         for k, side in ((i, -1), (j, 1)):
             if (k == 0 and side < 0) or (k == n - 1 and side > 0):
                 ends.append(float(side))
@@ -258,7 +255,6 @@ def zones_from_nodes(state: NodalState, breakpoints: Sequence[float] = ()
             pinned.append(False)
             dx = x[lo + 1] - x[lo]
             slopes.append(float((state.nystrom[lo + 1] - state.nystrom[lo]) / dx))
-        i = j + 1
     return ends, pinned, slopes
 
 
