@@ -335,7 +335,8 @@ def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
         key = (float(c_t[k]),) + tuple(sorted(given.items()))
         if key not in results:
             step = Step(float(c_t[k]), 1.0, given)
-            results[key] = _solve_one(space, step, base, op, m_nodes, g_nodes, res, tol)
+            results[key] = _solve_one(space, step, base, op, m_nodes, g_nodes, res, tol,
+                                      nodal_res)
         per_time.append(results[key])
     snapshots = [r[0] for r in per_time]
     end_error = max(r[1]["zone_end_error"] for r in per_time)
@@ -379,10 +380,62 @@ def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
     }
 
 
-def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: np.ndarray,
-               g_nodes: np.ndarray, res: Resolution, tol: float) -> tuple[_Snapshot, dict]:
+def _coarse_start(space: Space, step: Step, base: Panels, nodal_res: Resolution
+                  ) -> np.ndarray | None:
+    """A start of the nodal active set on ``base``: the zones found by the active set
+    on the next coarser rule (from full contact there), as the nodes of ``base`` inside
+    them; None when that rule is not much smaller or finds no contact.
+
+    It depends on the scene and the loads alone. The coarse sweeps cost ~1/5 of the
+    fine ones, and from the coarse zones (ends interpolated between nodes, within a few
+    nodes of the fine ones) the fine set settles in 2-3 sweeps instead of 4-8 from full
+    contact (measured on the eccentric footing, e = 0.45-0.8, lam = 0.3-3)."""
+    coarse_res = nodal_res.coarser()
+    coarse, coarse_op = nodal_operator(space.lam, space.breakpoints, coarse_res)
+    if coarse.size > COARSE_SHARE * base.size:
+        return None
     try:
-        state, _, _ = nodal_active_set(base, op, m_nodes, g_nodes, step)
+        state, _, _ = nodal_active_set(coarse, coarse_op, space.m(coarse.nodes),
+                                       space.g(coarse.nodes), step)
+    except NoContact:
+        return None
+    if not state.active.any():
+        return None
+    ends = zones_from_nodes(state, space.breakpoints)[0]
+    x = base.nodes
+    start = np.zeros(x.size, dtype=bool)
+    for lo, hi in zip(ends[0::2], ends[1::2], strict=True):
+        start |= (x >= lo) & (x <= hi)
+    return start if np.count_nonzero(start) >= 3 else None
+
+
+#: The coarse prediction of :func:`_coarse_start` is made when the coarser rule has at
+#: most this share of the nodes (its sweeps cost ~share^3 of the fine ones; the rule for
+#: the thinnest coatings, m = 1e-3, has 320 against 416).
+COARSE_SHARE = 0.8
+
+
+def _nodal_state(space: Space, step: Step, base: Panels, op: np.ndarray,
+                 m_nodes: np.ndarray, g_nodes: np.ndarray, nodal_res: Resolution | None):
+    """The nodal active set on ``base``, started from :func:`_coarse_start` (a start
+    that does not settle is retried from full contact, which raises NoContact)."""
+    start = None if nodal_res is None else _coarse_start(space, step, base, nodal_res)
+    if start is not None:
+        try:
+            state, _, settled = nodal_active_set(base, op, m_nodes, g_nodes, step,
+                                                 start=start)
+            if settled:
+                return state
+        except NoContact:
+            pass
+    return nodal_active_set(base, op, m_nodes, g_nodes, step)[0]
+
+
+def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: np.ndarray,
+               g_nodes: np.ndarray, res: Resolution, tol: float,
+               nodal_res: Resolution | None = None) -> tuple[_Snapshot, dict]:
+    try:
+        state = _nodal_state(space, step, base, op, m_nodes, g_nodes, nodal_res)
     except NoContact as exc:
         name = "force" if "force" in step.given else "moment" if "moment" in step.given \
             else "settlement"
