@@ -34,7 +34,6 @@ from core.cache import StageCache, fingerprint
 from core.collocation import time_grid
 from core.contact_bands import BAND_WIDTHS, band_rule, bands_from_ends
 from core.contact_kinks import corrected_roots, kinks_corrected
-from core.contact_systems import FactorStore
 from core.contact_zones import (
     ZONE_END_TOL,
     NoContact,
@@ -97,7 +96,7 @@ def rule_operator(lam: float, rule: Panels) -> np.ndarray:
 
 def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.ndarray,
            grid: np.ndarray, widths: np.ndarray, out_index: np.ndarray,
-           exact_ends: bool = True, store: FactorStore | None = None) -> dict[str, Any]:
+           exact_ends: bool = True) -> dict[str, Any]:
     from core.contact import _check_loads
 
     # kink rows with kernel values to 1e-4 of the tighter of tol and the zone-end
@@ -118,7 +117,7 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
     states: list[tuple[NodalState, Step, np.ndarray, list[float], list[float]]] = (
         [None] * len(out_index))  # type: ignore
     active = None
-    solver = StepSolver(store)
+    solver = StepSolver()
     pending: list[tuple[int, Any]] = []
     batch: list[tuple[int, tuple]] = []
     sweeps = 0
@@ -163,7 +162,7 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
             states[k] = states[k][:3] + (ends, states[k][4])
     return {"states": states, "sweeps": sweeps, "unsettled": unsettled, "steps": steps - 1,
             "breakpoints": space.breakpoints,
-            "factorizations": solver.factorizations, "reused_factors": solver.reused,
+            "factorizations": solver.factorizations,
             "back_substitutions": solver.back_substitutions}
 
 
@@ -409,13 +408,10 @@ def _in_time(space: Space, inp: Any, base: Panels, first_steps: int, budget: flo
     plain: list[dict[str, Any]] = []
     extrapolated: list[dict[str, Any]] = []
     time_error = end_shift = np.inf
-    # each grid meets the contact sets of the one before at about the same times
-    store = FactorStore()
     for level in range(MAX_HALVINGS + 1):
         grid, widths, index = time_grid(inp.times, first_steps, level)
         # the first grid borrows the kink corrections of the second (_borrow_corrections)
-        run = _march(space, inp, base, op, m, g, grid, widths, index, exact_ends=level > 0,
-                     store=store)
+        run = _march(space, inp, base, op, m, g, grid, widths, index, exact_ends=level > 0)
         plain.append(_outputs(run))
         if level == 1:
             _borrow_corrections(plain[0], plain[1])

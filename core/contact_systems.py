@@ -6,8 +6,7 @@ On the contact nodes ``idx`` of a panel rule (q = 0 elsewhere) one solve is
 
 with the unknown ones of delta, alpha as border columns and the given ones of P, M as
 border rows (:func:`bordered_solve`). :class:`StepSolver` carries the LU factors from one
-creep step to the next, and (with a :class:`FactorStore`) from one march to the next on
-the same panel rule.
+creep step to the next.
 """
 
 from __future__ import annotations
@@ -27,42 +26,6 @@ def restrict(op: np.ndarray, idx: np.ndarray) -> np.ndarray:
     return op[np.ix_(idx, idx)]
 
 
-class FactorStore:
-    """LU factors by contact nodes (and given loads), shared by the marches of one solve
-    on one panel rule.
-
-    The grids of a Richardson pair step through the same contact sets at about the same
-    times (so at about the same c/s): the finer march takes the coarser one's factors as
-    the preconditioner of its refinement instead of factoring again (on the lift-off
-    preset 48 of 110 factorizations were of a set the other march had factored).
-    Entries are kept up to ``max_bytes``; the oldest go first. It lives in one solve, so
-    the answer depends on the scene alone.
-    """
-
-    def __init__(self, max_bytes: int = 48 * 2**20) -> None:
-        self._items: dict[tuple, tuple] = {}
-        self._bytes = 0
-        self.max_bytes = max_bytes
-
-    def get(self, key: tuple):
-        """The factors kept for ``key``, or None."""
-        return self._items.get(key)
-
-    def put(self, key: tuple, lu: tuple) -> None:
-        """Keep ``lu`` (the output of ``lu_factor``) for ``key``."""
-        size = lu[0].nbytes + lu[1].nbytes
-        old = self._items.pop(key, None)
-        if old is not None:
-            self._bytes -= old[0].nbytes + old[1].nbytes
-        while self._items and self._bytes + size > self.max_bytes:
-            first = next(iter(self._items))
-            gone = self._items.pop(first)
-            self._bytes -= gone[0].nbytes + gone[1].nbytes
-        if size <= self.max_bytes:
-            self._items[key] = lu
-            self._bytes += size
-
-
 class StepSolver:
     """Solves the bordered systems of one panel rule, keeping the last factorization.
 
@@ -70,8 +33,7 @@ class StepSolver:
     set rarely: the kept LU factors of the last matrix with the same contact nodes
     precondition a few steps of iterative refinement (each O(N^2)) instead of a new
     factorization (O(N^3)); a new one is made when the refinement does not converge
-    within ``_REFINE_STEPS`` steps. With a :class:`FactorStore`, new contact nodes
-    first take the factors kept for them there.
+    within ``_REFINE_STEPS`` steps.
     """
 
     _REFINE_STEPS = 12
@@ -81,15 +43,13 @@ class StepSolver:
     #: start the refinement from the line through the last two solutions
     EXTRAPOLATE = True
 
-    def __init__(self, store: FactorStore | None = None) -> None:
-        self._store = store
+    def __init__(self) -> None:
         self._key: tuple | None = None
         self._lu = None
         self._sub: np.ndarray | None = None  # F on the contact nodes of _key
         self._last: np.ndarray | None = None  # the last solution with these factors
         self._prev: np.ndarray | None = None  # the one before it (same contact nodes)
         self.factorizations = 0
-        self.reused = 0
         self.back_substitutions = 0
 
     def submatrix(self, op: np.ndarray, idx: np.ndarray, key: tuple) -> np.ndarray:
@@ -100,16 +60,13 @@ class StepSolver:
             self._lu = None
             self._last = None
             self._prev = None
-            if self._store is not None:
-                self._lu = self._store.get(key)
-                self.reused += self._lu is not None
         return self._sub
 
     def snapshot(self) -> StepSolver:
         """A solver holding this one's current factors and contact nodes (shared, not
         copied: a new factorization replaces them here, never changes them), so that a
         change on this step (:func:`bordered_change`) can be solved after later steps."""
-        kept = StepSolver()  # without the store: it only finishes this step
+        kept = StepSolver()
         kept._key, kept._lu, kept._sub, kept._last = self._key, self._lu, self._sub, self._last
         return kept
 
@@ -156,8 +113,6 @@ class StepSolver:
     def _factor(self, build: Callable[[], np.ndarray]) -> None:
         self._lu = lu_factor(build(), check_finite=False)
         self.factorizations += 1
-        if self._store is not None:
-            self._store.put(self._key, self._lu)
 
     def solve_change(self, build: Callable[[], np.ndarray],
                      apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray) -> np.ndarray:

@@ -754,28 +754,3 @@ def test_coarse_start_settles_on_the_set_found_from_full_contact(gap, loads):
     assert settled and np.array_equal(state.active, full.active)
     assert sweeps < full_sweeps
 
-
-def test_kept_factors_of_another_march_solve_to_the_residual():
-    """A solver taking the factors a store holds for its contact nodes (made at another
-    c/s) refines to the residual of fresh ones: the answers agree with a direct solve
-    to the refinement's residual (measured: q 5.6e-14 to 6.7e-13 of max q, the settlement
-    9e-16 relative; 5e-12 leaves a margin of 7)."""
-    from core.contact_systems import FactorStore, StepSolver, bordered_solve
-
-    panels = base_panels(1.0, (), edge_width=1e-2, max_width=0.25)
-    op = kernel_operator(1.0, panels).matrix
-    x, w = panels.nodes, panels.weights
-    m = np.full(x.size, 0.05)
-    rhs = -0.01 * x ** 2
-    given = {"force": 1.0, "moment": 0.2}
-    idx = np.arange(20, x.size)
-    store = FactorStore()
-    bordered_solve(op, m, x, w, 1.0, 1.0, given, rhs, idx, StepSolver(store))
-    reused = StepSolver(store)
-    for c in (1.005, 1.01, 1.02):  # the later march meets the set at other c/s
-        got = bordered_solve(op, m, x, w, c, 1.0, given, rhs, idx, reused)
-        ref = bordered_solve(op, m, x, w, c, 1.0, given, rhs, idx)
-        scale = np.max(np.abs(ref[0]))
-        assert np.max(np.abs(got[0] - ref[0])) < 5e-12 * scale
-        assert abs(got[1] - ref[1]) < 1e-13 * abs(ref[1])
-    assert reused.reused == 1 and reused.factorizations == 0
