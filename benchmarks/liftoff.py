@@ -108,8 +108,8 @@ def work_precision() -> list[str]:
     lines.append("The last row is the reference (errors 0). `estimate`: the solver's estimate "
                  "of the end error at that rule (against the next coarser rule). The solver "
                  "does not make a last quasi-Newton step on the ends that would move them by "
-                 "less than 1e-7 (it adds its length to the estimate instead), so the finest "
-                 "rows agree to ~1e-10, not to rounding.")
+                 "less than a tenth of the tighter of tol and 1e-6 (it adds its length to the "
+                 "estimate instead).")
     return lines
 
 
@@ -235,7 +235,8 @@ def main() -> None:
         "evaluations and the near-field product weights), which is where the time goes. "
         "The zone operators take kernel values to 1e-4 of the tighter of tol and 1e-6, "
         "not to rounding, and the last quasi-Newton step on the ends is not made when it "
-        "would move them by less than 1e-7 (its length is added to the estimate). The "
+        "would move them by less than a tenth of the tighter of tol and 1e-6 (its length "
+        "is added to the estimate). The "
         "nodal active set starts from the zones the active set finds on the coarser rule "
         "(from full contact there): the fine set then settles in one sweep on most loads, "
         "and the answer depends on the scene and the loads alone, never on what was "
