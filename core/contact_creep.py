@@ -96,7 +96,11 @@ def rule_operator(lam: float, rule: Panels) -> np.ndarray:
 
 def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.ndarray,
            grid: np.ndarray, widths: np.ndarray, out_index: np.ndarray,
-           exact_ends: bool = True) -> dict[str, Any]:
+           exact_ends: bool = True, first: dict[str, Any] | None = None) -> dict[str, Any]:
+    """March over ``grid`` on the rule ``base`` (its Nystrom matrix ``op``, m and g at
+    its nodes). ``first`` (shared by the marches of one solve): the zones of the first
+    step, at loading, recorded by the first march and the start of the first step of
+    the later ones (from full contact it took 4-6 sweeps, each with a new LU)."""
     from core.contact import _check_loads
 
     # kink rows with kernel values to 1e-4 of the tighter of tol and the zone-end
@@ -130,14 +134,19 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
         step = Step(float(c_vals[n]), 1.0 - diag,
                     {name: float(v[n]) for name, v in loads.items()})
         displacement = op @ memory_density
+        start = active
+        if n == 0 and first is not None and "zones" in first:
+            start = _nodes_in(base.nodes, first["zones"])
         try:
-            state, count, settled = nodal_active_set(base, op, m, g, step,
-                                                     memory=displacement, start=active,
-                                                     solver=solver)
+            state, count, settled = _step_state(base, op, m, g, step, displacement, start,
+                                                solver, retry=n == 0)
         except NoContact as exc:
             name = "force" if "force" in step.given else "moment"
             raise ValueError(f"{name}: the loads pull the punch away at t = {grid[n]:g} "
                              f"({exc})") from None
+        if n == 0 and first is not None and "zones" not in first and state.active.any():
+            ends = zones_from_nodes(state, space.breakpoints)[0]
+            first["zones"] = list(zip(ends[0::2], ends[1::2], strict=True))
         sweeps += count
         unsettled += not settled
         active = state.active
@@ -164,6 +173,35 @@ def _march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nd
             "breakpoints": space.breakpoints,
             "factorizations": solver.factorizations,
             "back_substitutions": solver.back_substitutions}
+
+
+def _nodes_in(x: np.ndarray, zones: list[tuple[float, float]]) -> np.ndarray:
+    """The nodes ``x`` inside the ``zones`` (a contact set as a start)."""
+    inside = np.zeros(x.size, dtype=bool)
+    for lo, hi in zones:
+        inside |= (x >= lo) & (x <= hi)
+    return inside
+
+
+def _step_state(base, op: np.ndarray, m: np.ndarray, g: np.ndarray, step: Step,
+                displacement: np.ndarray, start: np.ndarray | None, solver: StepSolver,
+                retry: bool) -> tuple[NodalState, int, bool]:
+    """The nodal active set of one step from ``start``; with ``retry``, a start that
+    does not settle (or leaves no contact) is retried from full contact."""
+    tried = 0
+    if retry and start is not None:
+        try:
+            state, tried, settled = nodal_active_set(base, op, m, g, step,
+                                                     memory=displacement, start=start,
+                                                     solver=solver)
+            if settled:
+                return state, tried, settled
+        except NoContact:
+            pass
+        start = None
+    state, count, settled = nodal_active_set(base, op, m, g, step, memory=displacement,
+                                             start=start, solver=solver)
+    return state, tried + count, settled
 
 
 #: Output times whose kink corrections are made together (one evaluation of F on their
@@ -339,21 +377,23 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     # rest, or at least the other half, for the time grid; likewise tol / 3 of the outputs
     # (success asks the sum of the two parts to meet it).
     end_tol = ZONE_END_TOL
+    # the zones at loading found by the first march start the first step of the others
+    first: dict[str, Any] = {}
     base, space_error, space_shift, band_note = _select_rule(space, inp, res, first_steps,
-                                                             tol, end_tol)
+                                                             tol, end_tol, first=first)
     out, time_error, end_shift, run = _in_time(
         space, inp, base, first_steps, max(tol / 3 - space_error, tol / 6),
-        max(end_tol - space_shift, end_tol / 2))
+        max(end_tol - space_shift, end_tol / 2), first)
     strays = _outside_bands(out["ends"], band_note["bands"], space.breakpoints)
     if strays:
         # An end went where the first march did not see it (between its few times, or as
         # a zone opening late): the bands of every output time, and everything again.
         bands = _merge(band_note["bands"] + bands_from_ends(out["ends"], space.breakpoints))
         base, space_error, space_shift, band_note = _select_rule(
-            space, inp, res, first_steps, tol, end_tol, bands=bands)
+            space, inp, res, first_steps, tol, end_tol, bands=bands, first=first)
         out, time_error, end_shift, run = _in_time(
             space, inp, base, first_steps, max(tol / 3 - space_error, tol / 6),
-            max(end_tol - space_shift, end_tol / 2))
+            max(end_tol - space_shift, end_tol / 2), first)
         strays = _outside_bands(out["ends"], band_note["bands"], space.breakpoints)
     unsettled, sweeps, steps = run["unsettled"], run["sweeps"], run["steps"]
 
@@ -398,7 +438,8 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
 
 
 def _in_time(space: Space, inp: Any, base: Panels, first_steps: int, budget: float,
-             end_budget: float) -> tuple[dict[str, Any], float, float, dict[str, Any]]:
+             end_budget: float, first: dict[str, Any] | None = None
+             ) -> tuple[dict[str, Any], float, float, dict[str, Any]]:
     """March on halved grids until the time estimate meets ``budget`` (what the panel
     rule left of tol / 3) and that of the zone ends ``end_budget`` (module notes):
     (outputs, their time error, the zone ends' time error, the last march)."""
@@ -411,7 +452,8 @@ def _in_time(space: Space, inp: Any, base: Panels, first_steps: int, budget: flo
     for level in range(MAX_HALVINGS + 1):
         grid, widths, index = time_grid(inp.times, first_steps, level)
         # the first grid borrows the kink corrections of the second (_borrow_corrections)
-        run = _march(space, inp, base, op, m, g, grid, widths, index, exact_ends=level > 0)
+        run = _march(space, inp, base, op, m, g, grid, widths, index, exact_ends=level > 0,
+                     first=first)
         plain.append(_outputs(run))
         if level == 1:
             _borrow_corrections(plain[0], plain[1])
@@ -456,7 +498,8 @@ def _check_times(times: np.ndarray, count: int = 0) -> np.ndarray:
 
 
 def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol: float,
-                 end_tol: float, bands: list[tuple[float, float]] | None = None
+                 end_tol: float, bands: list[tuple[float, float]] | None = None,
+                 first: dict[str, Any] | None = None
                  ) -> tuple[Panels, float, float, dict[str, Any]]:
     """The panel rule of the stepping and its spatial error (outputs, zone ends).
 
@@ -474,7 +517,7 @@ def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol:
     def march(rule: Panels) -> dict[str, Any]:
         op = rule_operator(space.lam, rule)
         run = _march(space, inp, rule, op, space.m(rule.nodes), space.g(rule.nodes), grid,
-                     widths, index)
+                     widths, index, first=first)
         return _outputs(run)
 
     # The bands need the ends only to well within their margin: fewer times and a
@@ -487,7 +530,8 @@ def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol:
                            0.0)
         op_l = rule_operator(space.lam, coarse)
         located = _march(space, inp, coarse, op_l, space.m(coarse.nodes),
-                         space.g(coarse.nodes), grid_l, widths_l, index_l, exact_ends=False)
+                         space.g(coarse.nodes), grid_l, widths_l, index_l, exact_ends=False,
+                         first=first)
         bands = bands_from_ends(_outputs(located)["ends"], space.breakpoints)
     # every panel finer: the base width halved, its grading at +-1 and the breakpoints too
     finer = Resolution(res.width / 2.0, res.edge / 2.0)
