@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from core.cache import StageCache
+from core.contact_nodal import nodal_operator, nodal_state
 from core.contact_solution import SolveOutcome
 from core.contact_zones import (
     ZONE_END_TOL,
@@ -35,14 +35,13 @@ from core.contact_zones import (
     Resolution,
     Space,
     Step,
-    nodal_active_set,
     nystrom_pressure,
     refine_zone_ends,
     zone_kernel_accuracy,
     zones_from_nodes,
 )
 from core.kernel_values import FULL_ACCURACY
-from core.quadrature import Panels, base_panels, kernel_operator
+from core.quadrature import Panels
 
 #: The contact models of ``solve_dimensionless(..., contact=...)``.
 CONTACT_MODELS = ("full", "unilateral", "auto")
@@ -293,32 +292,11 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
                               out["snapshots"], out.get("kernel_accuracy", FULL_ACCURACY))
 
 
-#: The operator of the nodal rule depends on lam and the panels only (not on m, g or the
-#: loads): kept, so that moving a load (the explorer's eccentricity slider) rebuilds only
-#: what the zone ends need.
-_NODAL_OPERATORS = StageCache("contact_nodal_operator", max_items=8, max_bytes=64 * 2**20)
-
-
 def nodal_resolution(lam: float, m: Callable[[np.ndarray], np.ndarray]) -> Resolution:
     """The rule of the nodal active set: panels at most ``_NODAL_WIDTH`` (and 3/lam)
     wide, graded to ``_EDGE`` at +-1 and the breakpoints, finer for a thin coating."""
     m_probe = m(np.linspace(-1.0, 1.0, 257))
     return Resolution(min(_NODAL_WIDTH, 3.0 / lam), min(_EDGE, 0.25 * float(np.min(m_probe))))
-
-
-def nodal_operator(lam: float, breakpoints: tuple[float, ...], res: Resolution
-                   ) -> tuple[Panels, np.ndarray]:
-    """The panels of ``res`` on [-1, 1] and the Nystrom matrix of F there (cached)."""
-    key = (float(lam), tuple(float(b) for b in breakpoints), float(res.width),
-           float(res.edge))
-
-    def build() -> tuple[Panels, np.ndarray]:
-        panels = base_panels(lam, breakpoints, edge_width=res.edge, max_width=res.width)
-        matrix = kernel_operator(lam, panels).matrix
-        matrix.flags.writeable = False  # shared by every solve on this rule
-        return panels, matrix
-
-    return _NODAL_OPERATORS.get_or_compute(key, build)[0]
 
 
 def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
@@ -380,62 +358,11 @@ def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
     }
 
 
-def _coarse_start(space: Space, step: Step, base: Panels, nodal_res: Resolution
-                  ) -> np.ndarray | None:
-    """A start of the nodal active set on ``base``: the zones found by the active set
-    on the next coarser rule (from full contact there), as the nodes of ``base`` inside
-    them; None when that rule is not much smaller or finds no contact.
-
-    It depends on the scene and the loads alone. The coarse sweeps cost ~1/5 of the
-    fine ones, and from the coarse zones (ends interpolated between nodes, within a few
-    nodes of the fine ones) the fine set settles in 2-3 sweeps instead of 4-8 from full
-    contact (measured on the eccentric footing, e = 0.45-0.8, lam = 0.3-3)."""
-    coarse_res = nodal_res.coarser()
-    coarse, coarse_op = nodal_operator(space.lam, space.breakpoints, coarse_res)
-    if coarse.size > COARSE_SHARE * base.size:
-        return None
-    try:
-        state, _, _ = nodal_active_set(coarse, coarse_op, space.m(coarse.nodes),
-                                       space.g(coarse.nodes), step)
-    except NoContact:
-        return None
-    if not state.active.any():
-        return None
-    ends = zones_from_nodes(state, space.breakpoints)[0]
-    x = base.nodes
-    start = np.zeros(x.size, dtype=bool)
-    for lo, hi in zip(ends[0::2], ends[1::2], strict=True):
-        start |= (x >= lo) & (x <= hi)
-    return start if np.count_nonzero(start) >= 3 else None
-
-
-#: The coarse prediction of :func:`_coarse_start` is made when the coarser rule has at
-#: most this share of the nodes (its sweeps cost ~share^3 of the fine ones; the rule for
-#: the thinnest coatings, m = 1e-3, has 320 against 416).
-COARSE_SHARE = 0.8
-
-
-def _nodal_state(space: Space, step: Step, base: Panels, op: np.ndarray,
-                 m_nodes: np.ndarray, g_nodes: np.ndarray, nodal_res: Resolution | None):
-    """The nodal active set on ``base``, started from :func:`_coarse_start` (a start
-    that does not settle is retried from full contact, which raises NoContact)."""
-    start = None if nodal_res is None else _coarse_start(space, step, base, nodal_res)
-    if start is not None:
-        try:
-            state, _, settled = nodal_active_set(base, op, m_nodes, g_nodes, step,
-                                                 start=start)
-            if settled:
-                return state
-        except NoContact:
-            pass
-    return nodal_active_set(base, op, m_nodes, g_nodes, step)[0]
-
-
 def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: np.ndarray,
                g_nodes: np.ndarray, res: Resolution, tol: float,
                nodal_res: Resolution | None = None) -> tuple[_Snapshot, dict]:
     try:
-        state = _nodal_state(space, step, base, op, m_nodes, g_nodes, nodal_res)
+        state = nodal_state(space, step, base, op, m_nodes, g_nodes, nodal_res)
     except NoContact as exc:
         name = "force" if "force" in step.given else "moment" if "moment" in step.given \
             else "settlement"

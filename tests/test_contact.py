@@ -739,7 +739,8 @@ def test_elastic_answer_does_not_depend_on_earlier_solves():
 def test_coarse_start_settles_on_the_set_found_from_full_contact(gap, loads):
     """Only the start changes: the settled nodal set is the one found from full contact
     (the discrete problem has one solution), in fewer sweeps on the fine rule."""
-    from core.contact import _coarse_start, nodal_operator, nodal_resolution
+    from core.contact import nodal_resolution
+    from core.contact_nodal import coarse_start, nodal_operator
 
     g = worn_patch if gap == "worn" else constant(gap)
     space = Space(1.0, constant(0.05), g, ())
@@ -748,7 +749,7 @@ def test_coarse_start_settles_on_the_set_found_from_full_contact(gap, loads):
     m, g_nodes = np.full(base.size, 0.05), g(base.nodes)
     step = Step(1.0, 1.0, loads)
     full, full_sweeps, _ = nodal_active_set(base, op, m, g_nodes, step)
-    start = _coarse_start(space, step, base, res)
+    start = coarse_start(space, step, base, res)
     assert start is not None
     state, sweeps, settled = nodal_active_set(base, op, m, g_nodes, step, start=start)
     assert settled and np.array_equal(state.active, full.active)
