@@ -1,7 +1,7 @@
 """Zone ends of a creep step without the kink error of the fixed panel rule.
 
 Under creep the contact set is found on the nodes of one fixed panel rule
-(:mod:`core.contact_creep`). At a free zone end the pressure ``q = max(Q, 0)`` has a kink
+(:mod:`core.contact_march`). At a free zone end the pressure ``q = max(Q, 0)`` has a kink
 inside a panel, and that panel's Gauss rule integrates ``F q`` and the resultants only to
 a low order: on the lift-off preset with 0.04-wide band panels this left the ends ~4e-6
 half-widths off, and only ~0.005-wide panels (8 times the cost) met 1e-6 that way.

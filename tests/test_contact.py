@@ -353,7 +353,7 @@ def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
 def _creep_rule_march(pb, tol, rule_for, level=0):
     """Zone ends and outputs of the creep stepping on the rule ``rule_for(space, res)``."""
     from core.collocation import time_grid
-    from core.contact_creep import _march, _outputs
+    from core.contact_march import march, march_outputs
     from core.solver import _validate
 
     inp = _validate(pb.lam, pb.m, pb.g, pb.times, pb.c, pb.kernel,
@@ -363,8 +363,8 @@ def _creep_rule_march(pb, tol, rule_for, level=0):
     rule = rule_for(space, Resolution(min(0.5, 3.0 / inp.lam), edge))
     grid, widths, index = time_grid(inp.times, 16, level)
     op = kernel_operator(space.lam, rule).matrix
-    out = _outputs(_march(space, inp, rule, op, space.m(rule.nodes), space.g(rule.nodes),
-                          grid, widths, index))
+    out = march_outputs(march(space, inp, rule, op, space.m(rule.nodes), space.g(rule.nodes),
+                              grid, widths, index))
     return np.array([e[0] for e in out["ends"]]), out
 
 
