@@ -109,36 +109,49 @@ class UnilateralSolution(SolveOutcome):
         x = np.atleast_1d(np.asarray(x, dtype=float))
         if x.ndim != 1 or np.any(~np.isfinite(x)) or np.any(np.abs(x) > 1.0):
             raise ValueError("x: pressure is defined on [-1, 1] only")
-        out = np.zeros((x.size, len(self._snapshots)))
-        # Snapshots on one panel rule (every time of a creep solve) share the rows of F
-        # at x: one evaluation of them and one matrix product for all times.
-        rows: dict[int, np.ndarray] = {}
+        count = len(self._snapshots)
+        out = np.zeros((x.size, count))
+        inside = np.zeros((x.size, count), dtype=bool)
+        at_end = np.zeros((x.size, count), dtype=bool)
         for k, snap in enumerate(self._snapshots):
-            inside = np.zeros(x.size, dtype=bool)
-            at_end = np.zeros(x.size, dtype=bool)
             for lo, hi in snap.zones:
-                inside |= (x >= lo) & (x <= hi)
-                at_end |= (x == lo) | (x == hi)
-            if not inside.any():
+                inside[:, k] |= (x >= lo) & (x <= hi)
+                at_end[:, k] |= (x == lo) | (x == hi)
+        # Snapshots on one panel rule (every time of a creep solve) share the rows of F
+        # at x, and m and g at x: one evaluation of them and one matrix product for all
+        # times (per time they cost 2.5 times the rows on the 100-time lift-off preset).
+        rules: dict[int, list[int]] = {}
+        for k, snap in enumerate(self._snapshots):
+            if not inside[:, k].any():
                 continue
             if snap.memory is None:
-                key = id(snap.panels)
-                if key not in rows:
-                    from core.quadrature import operator_rows
+                rules.setdefault(id(snap.panels), []).append(k)
+            else:
+                out[inside[:, k], k] = self._pressure_one(snap, x[inside[:, k]])
+        touched = inside.any(axis=1)
+        xi = x[touched]
+        if rules:
+            m_x = np.broadcast_to(np.asarray(self._space.m(xi), dtype=float), xi.shape)
+            g_x = np.broadcast_to(np.asarray(self._space.g(xi), dtype=float), xi.shape)
+        for times in rules.values():
+            from core.quadrature import operator_rows
 
-                    rows[key] = operator_rows(self._space.lam, snap.panels, x,
-                                              accuracy=self._kernel_accuracy)
-                xi = x[inside]
-                fq = rows[key][inside] @ snap.q
-                values = (snap.settlement + snap.tilt * xi - self._space.g(xi)
-                          - snap.step.scale * fq) / (snap.step.c * self._space.m(xi))
-                out[inside, k] = np.maximum(values, 0.0)
-                # m and g sampled from inside the zone where it ends on a jump of them
-                at_end &= np.isin(x, self._space.breakpoints)
-                if at_end.any():
-                    out[at_end, k] = self._pressure_one(snap, x[at_end])
-                continue
-            out[inside, k] = self._pressure_one(snap, x[inside])
+            snaps = [self._snapshots[k] for k in times]
+            rows = operator_rows(self._space.lam, snaps[0].panels, xi,
+                                 accuracy=self._kernel_accuracy)
+            fq = rows @ np.column_stack([snap.q for snap in snaps])
+            delta, alpha, scale, c = (np.array(v, dtype=float)[None, :] for v in zip(
+                *((snap.settlement, snap.tilt, snap.step.scale, snap.step.c)
+                  for snap in snaps), strict=True))
+            values = (delta + alpha * xi[:, None] - g_x[:, None] - scale * fq) / (
+                c * m_x[:, None])
+            block = np.where(inside[np.ix_(touched, times)], np.maximum(values, 0.0), 0.0)
+            out[np.ix_(touched, times)] = block
+            # m and g sampled from inside the zone where it ends on a jump of them
+            at_break = at_end & np.isin(x, self._space.breakpoints)[:, None]
+            for k, snap in zip(times, snaps, strict=True):
+                if at_break[:, k].any():
+                    out[at_break[:, k], k] = self._pressure_one(snap, x[at_break[:, k]])
         return out
 
     def _pressure_one(self, snap: _Snapshot, xi: np.ndarray) -> np.ndarray:
