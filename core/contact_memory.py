@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 
 
-def pressure_memory(kernel: Any, grid: np.ndarray, inner: np.ndarray, n_nodes: int):
+def pressure_memory(kernel: Any, grid: np.ndarray, inner: np.ndarray, n_nodes: int
+                    ) -> _HistoryMemory | _SeparableMemory:
     """The memory of past pressures on ``grid`` (dimensionless times; ``inner`` the
     trapezoid weights of its points) for ``n_nodes`` nodes: the recursion for a
     degenerate ``kernel``, the trapezoid sum otherwise."""
