@@ -1,7 +1,7 @@
 """Zone ends of a creep step without the kink error of the fixed panel rule.
 
 Under creep the contact set is found on the nodes of one fixed panel rule
-(:mod:`core.contact_creep`). At a free zone end the pressure ``q = max(Q, 0)`` has a kink
+(:mod:`core.contact_march`). At a free zone end the pressure ``q = max(Q, 0)`` has a kink
 inside a panel, and that panel's Gauss rule integrates ``F q`` and the resultants only to
 a low order: on the lift-off preset with 0.04-wide band panels this left the ends ~4e-6
 half-widths off, and only ~0.005-wide panels (8 times the cost) met 1e-6 that way.
@@ -41,6 +41,7 @@ from core.contact_zones import (
     Step,
     zones_from_nodes,
 )
+from core.kernel_values import FULL_ACCURACY
 from core.log_moments import legendre_log_moments
 from core.panels import _TO_COEF, _W
 from core.quadrature import NEAR_FIELD, NODES_PER_PANEL, Panels, _rows
@@ -55,12 +56,13 @@ _OVER_P = np.polynomial.legendre.legvander(_OVER_T, NODES_PER_PANEL - 1)
 
 
 def _part_rows(lam: float, part: Panels, targets: np.ndarray,
-               owners: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+               owners: tuple[np.ndarray, np.ndarray] | None = None,
+               accuracy: float = FULL_ACCURACY) -> np.ndarray:
     """Rows of F (len(targets) x 16 P) on the panels ``part``: as
     :func:`core.quadrature.operator_rows`, its near-field moments computed as above.
     ``owners`` = (one label per target, one per panel): only the rows of a target's own
     panels are exact then (the others are left with the far-field rule, for a caller
-    that discards them)."""
+    that discards them). ``accuracy``: absolute accuracy of the kernel values."""
     z = (targets[:, None] - part.centers[None, :]) / part.half_widths[None, :]
     near = np.abs(z) <= NEAR_FIELD
     if owners is not None:
@@ -77,7 +79,8 @@ def _part_rows(lam: float, part: Panels, targets: np.ndarray,
                            * _OVER_W[None, :]) @ _OVER_P
     h = part.half_widths[near_s][:, None]
     log_weights = h * (np.log(h) * _W[None, :] + moments @ _TO_COEF)
-    return _rows(lam, part, targets, np.arange(part.n_panels), near_t, near_s, log_weights)
+    return _rows(lam, part, targets, np.arange(part.n_panels), near_t, near_s, log_weights,
+                 accuracy)
 
 
 def _interpolation(center: float, half: float, targets: np.ndarray) -> np.ndarray:
@@ -185,11 +188,12 @@ def kink_corrected(space: Space, step: Step, state: NodalState, op: np.ndarray,
 
 
 def kinks_corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
-                    steps: list[tuple]) -> list[Corrected]:
+                    steps: list[tuple], accuracy: float = FULL_ACCURACY) -> list[Corrected]:
     """:func:`kink_corrected` for several steps on one rule at once, each given as
     (step, state, memory, memory_density, solver, (ends, pinned)): the rows of F of all
     their cut parts at the rule's nodes come from one evaluation. Each step's
-    ``solver`` must still hold that step's factors (:meth:`StepSolver.snapshot`)."""
+    ``solver`` must still hold that step's factors (:meth:`StepSolver.snapshot`).
+    ``accuracy``: absolute accuracy of the kernel values in those rows."""
     prepared = []
     for step, state, memory, memory_density, solver, (ends, pinned) in steps:
         ends = list(ends)
@@ -209,7 +213,7 @@ def kinks_corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
     # one evaluation: every node against every step's cut parts (near-field weights only
     # for each step's own; the other columns are never read)
     bounds = np.cumsum([0] + [c.nodes.size for c in cuts])
-    rows_all = _part_rows(space.lam, _join(cuts), panels.nodes)
+    rows_all = _part_rows(space.lam, _join(cuts), panels.nodes, accuracy=accuracy)
     for k, (step, state, memory, memory_density, solver, ends, free, idx, parts, cut,
             values) in enumerate(prepared):
         if not free:
@@ -253,11 +257,13 @@ def kinks_corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
     return out
 
 
-def corrected_roots(space: Space, steps: list[Corrected]) -> list[list[float]]:
+def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL_ACCURACY
+                    ) -> list[list[float]]:
     """The ends of each of ``steps`` (all on one nodal rule), free ones moved to the roots
     of their corrected Nystrom pressure Q: a secant from the interpolant's roots (within
     ~1e-4 of the true ones), all ends of all steps at once (F on the nodal rule and on
-    every cut part evaluated at every end in one go)."""
+    every cut part evaluated at every end in one go; the kernel values to ``accuracy``,
+    absolute)."""
     owner = np.array([s for s, c in enumerate(steps) for _ in c.free], dtype=int)
     out = [list(c.ends) for c in steps]
     if owner.size == 0:
@@ -280,9 +286,10 @@ def corrected_roots(space: Space, steps: list[Corrected]) -> list[list[float]]:
     mine = cut_owner[None, :] == owner[:, None]  # (ends, cut nodes): each end's own cut
 
     def nystrom(t: np.ndarray, rep: int) -> np.ndarray:
-        base_rows = _part_rows(space.lam, panels, t)
+        base_rows = _part_rows(space.lam, panels, t, accuracy=accuracy)
         # each end needs F of its own step's cut parts only (the rest is masked off)
-        cut_rows = _part_rows(space.lam, joined_cuts, t, (np.tile(owner, rep), panel_owner))
+        cut_rows = _part_rows(space.lam, joined_cuts, t, (np.tile(owner, rep), panel_owner),
+                              accuracy)
         dens = np.tile(density, (rep, 1))
         fq = np.einsum("ij,ij->i", base_rows, dens) + (
             cut_rows * np.tile(mine, (rep, 1))) @ cut_density

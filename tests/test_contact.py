@@ -353,7 +353,7 @@ def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
 def _creep_rule_march(pb, tol, rule_for, level=0):
     """Zone ends and outputs of the creep stepping on the rule ``rule_for(space, res)``."""
     from core.collocation import time_grid
-    from core.contact_creep import _march, _outputs
+    from core.contact_march import march, march_outputs
     from core.solver import _validate
 
     inp = _validate(pb.lam, pb.m, pb.g, pb.times, pb.c, pb.kernel,
@@ -363,8 +363,8 @@ def _creep_rule_march(pb, tol, rule_for, level=0):
     rule = rule_for(space, Resolution(min(0.5, 3.0 / inp.lam), edge))
     grid, widths, index = time_grid(inp.times, 16, level)
     op = kernel_operator(space.lam, rule).matrix
-    out = _outputs(_march(space, inp, rule, op, space.m(rule.nodes), space.g(rule.nodes),
-                          grid, widths, index))
+    out = march_outputs(march(space, inp, rule, op, space.m(rule.nodes), space.g(rule.nodes),
+                              grid, widths, index))
     return np.array([e[0] for e in out["ends"]]), out
 
 
@@ -718,3 +718,40 @@ def test_kink_corrections_batched_with_kept_factors_equal_the_exact_solve(gap, l
     for a, b in zip(batched, plain, strict=True):
         assert len(a) == len(b)
         assert np.max(np.abs(np.subtract(a, b))) < 5e-11, (a, b)
+
+
+def test_elastic_answer_does_not_depend_on_earlier_solves():
+    """The nodal active set starts from the zones of the coarser rule, found from full
+    contact there: a scene's digits are the same whatever was solved before it."""
+    args = dict(force=1.0, moment=0.45, tol=1e-6)
+    first = solve_unilateral(1.0, 0.05, 0.0, [1.0], **args)
+    for moment in (0.6, 0.3, 0.8):  # other loads on the same geometry
+        solve_unilateral(1.0, 0.05, 0.0, [1.0], force=1.0, moment=moment, tol=1e-6)
+    solve_unilateral(1.0, 0.05, worn_patch, [1.0], force=0.01, moment=0.0)
+    again = solve_unilateral(1.0, 0.05, 0.0, [1.0], **args)
+    assert again.contact_set == first.contact_set
+    assert again.settlement[0] == first.settlement[0] and again.tilt[0] == first.tilt[0]
+
+
+@pytest.mark.parametrize("gap, loads", [
+    (0.0, {"force": 1.0, "moment": 0.6}), (0.0, {"force": 1.0, "moment": 0.8}),
+    ("worn", {"force": 0.01, "moment": 0.0}), ("worn", {"force": 0.01, "moment": 0.002})])
+def test_coarse_start_settles_on_the_set_found_from_full_contact(gap, loads):
+    """Only the start changes: the settled nodal set is the one found from full contact
+    (the discrete problem has one solution), in fewer sweeps on the fine rule."""
+    from core.contact import nodal_resolution
+    from core.contact_nodal import coarse_start, nodal_operator
+
+    g = worn_patch if gap == "worn" else constant(gap)
+    space = Space(1.0, constant(0.05), g, ())
+    res = nodal_resolution(1.0, constant(0.05))
+    base, op = nodal_operator(1.0, (), res)
+    m, g_nodes = np.full(base.size, 0.05), g(base.nodes)
+    step = Step(1.0, 1.0, loads)
+    full, full_sweeps, _ = nodal_active_set(base, op, m, g_nodes, step)
+    start = coarse_start(space, step, base, res)
+    assert start is not None
+    state, sweeps, settled = nodal_active_set(base, op, m, g_nodes, step, start=start)
+    assert settled and np.array_equal(state.active, full.active)
+    assert sweeps < full_sweeps
+

@@ -32,7 +32,7 @@ def _panel_set(panels) -> set[tuple[float, float]]:
 
 
 def test_a_moment_change_past_lift_off_builds_nothing_geometric(monkeypatch) -> None:
-    from core.contact_creep import _RULE_OPERATORS
+    from core.contact_march import _RULE_OPERATORS
 
     solve(_lesson())          # caches warm, as in the explorer after the lesson's first solve
     known = set().union(*(_panel_set(op.panels) for op in _RULE_OPERATORS.values()))
@@ -67,7 +67,7 @@ def test_a_moment_change_past_lift_off_builds_nothing_geometric(monkeypatch) -> 
 
 
 def test_reused_operators_give_the_same_answer() -> None:
-    from core.contact_creep import _RULE_OPERATORS
+    from core.contact_march import _RULE_OPERATORS
 
     warm = solve(_lesson(moment=5.0e5))
     _RULE_OPERATORS.clear()
