@@ -104,7 +104,7 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     Richardson-extrapolated outputs of two successive pairs of grids agree to ``tol``/3
     (their difference / 7 is the estimate) or ``MAX_HALVINGS`` is reached.
     """
-    from core.contact import _Snapshot
+    from core.contact_result import _Snapshot
 
     times = inp.times
     tol = inp.tol

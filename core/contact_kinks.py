@@ -31,16 +31,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from core.contact_active_set import _BARYCENTRIC, _T, NodalState, zones_from_nodes
+from core.contact_step import Space, Step
 from core.contact_systems import StepSolver, bordered_change, bordered_solve
-from core.contact_zones import (
-    _BARYCENTRIC,
-    _T,
-    ZONE_END_TOL,
-    NodalState,
-    Space,
-    Step,
-    zones_from_nodes,
-)
+from core.contact_zones import ZONE_END_TOL
 from core.kernel_values import FULL_ACCURACY
 from core.log_moments import legendre_log_moments
 from core.panels import _TO_COEF, _W
@@ -138,7 +132,7 @@ def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
                    solver: StepSolver | None = None) -> list[float]:
     """The zone ends of a step, sorted, two per zone, with the kink defect removed.
 
-    ``state`` from :func:`core.contact_zones.nodal_active_set` on the rule whose Nystrom
+    ``state`` from :func:`core.contact_active_set.nodal_active_set` on the rule whose Nystrom
     matrix is ``op``; ``m``, ``g`` at its nodes; ``memory`` the memory displacement e at
     the nodes and ``memory_density`` the density it is F of (None for an elastic step).
     The contact nodes are kept and the step solved again with the defect; each free end

@@ -20,18 +20,12 @@ from typing import Any
 import numpy as np
 
 from core.cache import StageCache, fingerprint
+from core.contact_active_set import NoContact, NodalState, nodal_active_set, zones_from_nodes
 from core.contact_kinks import corrected_roots, kinks_corrected
 from core.contact_memory import pressure_memory
-from core.contact_zones import (
-    NoContact,
-    NodalState,
-    Space,
-    Step,
-    StepSolver,
-    nodal_active_set,
-    zone_kernel_accuracy,
-    zones_from_nodes,
-)
+from core.contact_step import Space, Step
+from core.contact_systems import StepSolver
+from core.contact_zones import zone_kernel_accuracy
 from core.quadrature import KernelOperator, Panels, kernel_operator
 
 #: The operators of the stepping's panel rules, keyed by lam and the panel edges (they

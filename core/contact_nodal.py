@@ -11,15 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from core.cache import StageCache
-from core.contact_zones import (
-    NoContact,
-    NodalState,
-    Resolution,
-    Space,
-    Step,
-    nodal_active_set,
-    zones_from_nodes,
-)
+from core.contact_active_set import NoContact, NodalState, nodal_active_set, zones_from_nodes
+from core.contact_step import Space, Step
+from core.contact_zones import Resolution
 from core.quadrature import Panels, base_panels, kernel_operator
 
 #: The operator of the nodal rule depends on lam and the panels only (not on m, g or the

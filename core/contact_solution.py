@@ -13,7 +13,7 @@ from core.basis import Basis
 
 class SolveOutcome:
     """How a solve went, read from its ``info`` dict: shared by the result types of both
-    contact models (:class:`ContactSolution`, :class:`core.contact.UnilateralSolution`)."""
+    contact models (:class:`ContactSolution`, :class:`core.contact_result.UnilateralSolution`)."""
 
     info: dict[str, Any]
 

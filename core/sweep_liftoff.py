@@ -35,8 +35,14 @@ from typing import Any
 
 import numpy as np
 
-from core.contact import _EDGE, _WIDTH
-from core.contact_zones import ZONE_END_TOL, Resolution, Space, zone_panels
+from core.contact_zones import (
+    ZONE_EDGE_WIDTH,
+    ZONE_END_TOL,
+    ZONE_PANEL_WIDTH,
+    Resolution,
+    Space,
+    zone_panels,
+)
 from core.quadrature import kernel_operator, operator_rows
 from core.scene_model import Scene
 from core.scene_results import LARGE_TILT, _model_error, plotting_grid
@@ -216,7 +222,8 @@ def liftoff_family(scene: Scene, eccentricities: np.ndarray, forces: np.ndarray,
     c_rel = float(np.asarray(_callable(problem.c)(np.asarray(problem.times)))[0])
     pressure_scale = problem.modulus_after_loading(times) / problem.plane_factor
     m_probe = m_fn(np.linspace(-1.0, 1.0, 257))
-    res = Resolution(min(_WIDTH, 3.0 / problem.lam), min(_EDGE, 0.25 * float(np.min(m_probe))))
+    res = Resolution(min(ZONE_PANEL_WIDTH, 3.0 / problem.lam),
+                     min(ZONE_EDGE_WIDTH, 0.25 * float(np.min(m_probe))))
     x = plotting_grid(a)
     x_rel = np.clip(x / a, -1.0, 1.0)
     tol = problem.tol
