@@ -30,7 +30,10 @@ OUTER_RULE_ERROR = 2.5e-14
 def _outer_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
     """Nodes (K,) and weights times P_n at the nodes (K, degree + 1) of the outer rule."""
     t, w = npleg.leggauss(_OUTER_RULE_POINTS)
-    return t, npleg.legvander(t, degree) * w[:, None]
+    weighted = npleg.legvander(t, degree) * w[:, None]
+    for shared in (t, weighted):  # cached: every caller gets these very arrays
+        shared.setflags(write=False)
+    return t, weighted
 
 
 def _q_outside(z: np.ndarray, nq: int) -> np.ndarray:
