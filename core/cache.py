@@ -6,7 +6,11 @@ on exactly those inputs, bounded both in items and in bytes, and counts how ofte
 stage was really evaluated, so tests can prove that a load slider never recomputes the
 kernel matrix or the basis.
 
-Keys are built with :func:`fingerprint`, which hashes numpy arrays by content.
+Keys are built with :func:`fingerprint`, which hashes numpy arrays by content (an object
+with no content to hash goes in a key as :class:`SameObject`, never as its ``id()``). A
+value is shared by every caller that gets it: its arrays are made read-only when it is
+stored (:func:`freeze`), so a caller writing into one raises instead of changing the
+answers of the next.
 """
 
 from __future__ import annotations
