@@ -47,19 +47,20 @@ def _q_outside(z: np.ndarray, nq: int, own_start: bool = False) -> np.ndarray:
     # Start index so that rho^-2(start - n) < 1e-18 for every needed n.
     starts = nq + np.ceil(18 * np.log(10) / (2 * np.log(rho))).astype(int) + 5
     start = int(starts.max())
-    first = int(starts.min()) if own_start else start
+    # points that start later than the first ones: (re)started at their own index
+    begins = ({int(s): np.nonzero(starts == s)[0] for s in np.unique(starts) if s < start}
+              if own_start else {})
     qa = np.zeros(zo.size)
     qb = np.full(zo.size, 1e-280)
     vals = np.empty((zo.size, nq))
     for n in range(start, 0, -1):
+        if n in begins:
+            qa[begins[n]] = 0.0
+            qb[begins[n]] = 1e-280
         # (n) Q_{n-1} = (2n+1) z Q_n - (n+1) Q_{n+1}, in place: qa becomes Q_{n-1}
         qa *= -(n + 1) / n
         qa += ((2 * n + 1) / n) * zo * qb
         qa, qb = qb, qa
-        if n > first:  # points whose own start is below n: back to the starting values
-            waiting = starts < n
-            qa[waiting] = 0.0
-            qb[waiting] = 1e-280
         if n - 1 < nq:
             vals[:, n - 1] = qb
         # Rescale every 4th step: 4 steps grow |Q| by less than (3 |z| + 3)^4, far below
