@@ -62,6 +62,18 @@ def test_prepared_rows_are_read_only():
     assert not _written(rows)
 
 
+def test_fitted_kernel_values_are_read_only():
+    """The fit is cached (its arrays shared) and so are its amplitudes at the last ages
+    asked for (every caller at those ages gets views of the same arrays)."""
+    from core.creep import ExponentialCreep
+    from core.kernel_fit import fit_kernel
+
+    law = ExponentialCreep(modulus=3e10, compliance=6e-11, rate=0.05).dimensionless_kernel(28.0)
+    fitted = fit_kernel(lambda t, s: law(t, s), end=10.0)
+    tau = np.array([1.0, 2.0, 5.0])
+    assert not any(_written(a) for a in (fitted.thetas, fitted.coef, *fitted.amplitudes(tau)))
+
+
 def test_fingerprint_separates_what_differs():
     from core.cache import fingerprint
 
