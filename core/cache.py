@@ -6,7 +6,11 @@ on exactly those inputs, bounded both in items and in bytes, and counts how ofte
 stage was really evaluated, so tests can prove that a load slider never recomputes the
 kernel matrix or the basis.
 
-Keys are built with :func:`fingerprint`, which hashes numpy arrays by content.
+Keys are built with :func:`fingerprint`, which hashes numpy arrays by content (an object
+with no content to hash goes in a key as :class:`SameObject`, never as its ``id()``). A
+value is shared by every caller that gets it: its arrays are made read-only when it is
+stored (:func:`freeze`), so a caller writing into one raises instead of changing the
+answers of the next.
 """
 
 from __future__ import annotations
@@ -53,6 +57,49 @@ def fingerprint(*parts: Any) -> str:
     for part in parts:
         feed(part)
     return h.hexdigest()
+
+
+class SameObject:
+    """A cache key part equal only to one for the very same object (compared with ``is``).
+
+    For values with no content to hash (a plain callable): unlike ``id(obj)``, it holds
+    the object, so while the key is kept no other object can take over its id.
+    """
+
+    __slots__ = ("obj",)
+
+    def __init__(self, obj: Any) -> None:
+        self.obj = obj
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, SameObject) and other.obj is self.obj
+
+    def __hash__(self) -> int:
+        return id(self.obj)
+
+
+def freeze(value: T, depth: int = 0) -> T:
+    """Make the numpy arrays of a cached value read-only, in place; returns ``value``.
+
+    Looks into tuples, lists, dict values and dataclass fields (as :func:`_nbytes` does).
+    A cached value is shared by every later caller: one that wrote into it (``+=``, a
+    slice assignment, a LAPACK call with ``overwrite_a``) would change the answer of the
+    next, so such a write raises instead.
+    """
+    if depth > 4:
+        return value
+    if isinstance(value, np.ndarray):
+        value.setflags(write=False)
+    elif isinstance(value, (tuple, list)):
+        for item in value:
+            freeze(item, depth + 1)
+    elif isinstance(value, dict):
+        for item in value.values():
+            freeze(item, depth + 1)
+    elif is_dataclass(value) and not isinstance(value, type):
+        for f in fields(value):
+            freeze(getattr(value, f.name, None), depth + 1)
+    return value
 
 
 def _nbytes(obj: Any, depth: int = 0) -> int:
@@ -116,6 +163,7 @@ class StageCache:
                 self._in_flight.pop(key, None)
             event.set()
             raise
+        freeze(value)  # shared from now on: a caller's in-place write must not change it
         # measured outside the lock: sizing a large value takes milliseconds
         size = self._sizeof(value)
         with self._lock:

@@ -64,6 +64,8 @@ class FittedKernel:
         if memo is not None and memo[0] == token:
             return memo[1]
         result = self._amplitudes(tau)
+        for part in result:  # handed to every caller asking at the same tau: never written
+            part.setflags(write=False)
         object.__setattr__(self, "_last", (token, result))
         return result
 

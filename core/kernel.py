@@ -237,6 +237,8 @@ def _build_table(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 _POLES = _poles(_N_POLES)
 _EVEN = _build_even_polynomial(_POLES)
 _TABLE, _SCALES = _build_table(_POLES)
+for _shared in (_POLES, _EVEN, _TABLE, _SCALES):  # read by every evaluation: never written
+    _shared.setflags(write=False)
 
 
 def _even_part(s: np.ndarray) -> np.ndarray:

@@ -25,7 +25,9 @@ KERNEL_DECAY = 2.10619611524533
 def _even_chebyshev() -> np.ndarray:
     """Chebyshev coefficients in y = s^2/2 - 1 of ``k_reg`` on |s| <= 2 (degree 24)."""
     y = np.cos(np.pi * (np.arange(25) + 0.5) / 25)
-    return npcheb.chebfit(y, plane_kernel_regular(np.sqrt(2.0 * (y + 1.0))), 24)
+    coef = npcheb.chebfit(y, plane_kernel_regular(np.sqrt(2.0 * (y + 1.0))), 24)
+    coef.setflags(write=False)  # cached: every caller gets this very array
+    return coef
 
 
 @lru_cache(maxsize=64)
@@ -39,7 +41,9 @@ def _even_coefficients(accuracy: float) -> np.ndarray:
     cheb = _even_chebyshev()
     tail = np.cumsum(np.abs(cheb[::-1]))[::-1]  # tail[k] = sum_{j >= k} |c_j|
     degree = int(np.argmax(np.append(tail, 0.0) <= 0.5 * accuracy)) - 1
-    return npcheb.cheb2poly(cheb[:max(degree, 1) + 1])
+    coef = npcheb.cheb2poly(cheb[:max(degree, 1) + 1])
+    coef.setflags(write=False)  # cached: every caller gets this very array
+    return coef
 
 
 def kernel_regular(s: np.ndarray, accuracy: float) -> np.ndarray:

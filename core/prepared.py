@@ -205,6 +205,7 @@ class PreparedContact:
     def _rows_locked(self, key: bytes, x: np.ndarray) -> np.ndarray:
         if key not in self._rows:
             self._rows[key] = self.grid.rows(x)
+            self._rows[key].setflags(write=False)  # returned to every later caller
             self.counts["rows"] += 1
             while sum(r.nbytes for r in self._rows.values()) > ROWS_BYTES and len(
                     self._rows) > 1:
@@ -311,13 +312,19 @@ class PreparedContact:
         together, keyed by the times, c, the kernel and the shapes. A load slider changes
         an amplitude, so it costs a few array operations instead of a time integration.
         """
-        from core.cache import fingerprint
+        from core.cache import SameObject, fingerprint
 
         c_t = inputs.c(times)
+        # A kernel without a content key is known by identity: the cache key then holds
+        # the kernel itself, so its id cannot pass to another kernel while the response
+        # is kept (keyed by id() alone, a kernel freed and replaced by another at the
+        # same address handed the new one the old one's response).
+        content = getattr(kernel, "key", None)
+        identity = SameObject(kernel) if content is None and kernel is not None else None
         try:
-            kernel_key = fingerprint(getattr(kernel, "key", None) or id(kernel))
+            kernel_key = fingerprint(content)
         except TypeError:  # a key of objects the fingerprint does not know: the instance
-            kernel_key = fingerprint(id(kernel))
+            kernel_key, identity = fingerprint(None), SameObject(kernel)
         common = fingerprint("modal", tuple(sorted(inputs.given)), times, c_t, kernel_key,
                              time_tol, breaks)
         zero = {name: (lambda tt: np.zeros(np.shape(tt))) for name in inputs.loads}
@@ -340,7 +347,7 @@ class PreparedContact:
         # All parts are stepped in one time march (force and moment together), so they are
         # cached together: the steps depend on every part, and an answer must not depend
         # on which parts happened to be cached before.
-        joint_key = tuple(key for _, key, _, _ in parts)
+        joint_key = (identity, *(key for _, key, _, _ in parts))
         with self._lock:
             found = self._responses.get(joint_key)
         if found is None:

@@ -176,10 +176,18 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
     if missing:
         keys_array = np.array(missing)  # (missing, 2): ratio, offset
         z = keys_array[:, 1:] + keys_array[:, :1] * _T[None, :]  # (missing, 16)
-        moments = legendre_log_moments(z.ravel(), NODES_PER_PANEL - 1) @ _TO_COEF
-        moments = moments.reshape(len(missing), NODES_PER_PANEL, NODES_PER_PANEL)
-        new = {key: (np.abs(zk) <= NEAR_FIELD, table)
-               for key, zk, table in zip(missing, z, moments, strict=True)}
+        # Each table a function of its key alone, not of the keys missing with it (else
+        # the operator's last bits depend on what earlier solves cached): moments with
+        # Miller's recurrence from each point's own start, and one 16 x 16 product per
+        # key (a product of all rows at once rounds a row differently by batch size).
+        moments = legendre_log_moments(z.ravel(), NODES_PER_PANEL - 1, own_start=True)
+        moments = moments.reshape(len(missing), NODES_PER_PANEL, NODES_PER_PANEL) @ _TO_COEF
+        near_all = np.abs(z) <= NEAR_FIELD
+        # Shared by later calls (and threads): read-only, so an in-place write raises.
+        moments.setflags(write=False)
+        near_all.setflags(write=False)
+        new = {key: (near, table)
+               for key, near, table in zip(missing, near_all, moments, strict=True)}
         found.update(new)
         if len(_PAIR_TABLES) + len(new) > _PAIR_TABLES_MAX:
             _PAIR_TABLES.clear()

@@ -68,6 +68,28 @@ def test_node_rows_from_reference_tables_match_operator_rows():
     assert np.max(np.abs(tables - batched)) <= 3e-14
 
 
+def test_operator_does_not_depend_on_what_the_tables_held_before():
+    """The same grid's operator, bit for bit, whether the reference tables of panel pairs
+    start empty or hold the pairs of other grids (computed in other batches). Before,
+    a table's last bits depended on the keys computed with it (Miller's recurrence started
+    where the batch's nearest point needed, the product rounded by batch size): the
+    operator differed by 1.7e-16, enough for the modal form to meet a complex pair."""
+    from core import quadrature
+    from core.nystrom_adapt import grade
+    from core.quadrature import Panels, kernel_operator
+
+    coarse = _graded(1.0, (), 2e-4)
+    fine = Panels.from_edges(grade(coarse.edges, np.array([-1.0, 1.0]), 2))
+    other = _graded(1.0, (0.3,), 1e-3)
+    quadrature._PAIR_TABLES.clear()
+    alone = kernel_operator(1.0, fine).matrix
+    quadrature._PAIR_TABLES.clear()
+    kernel_operator(1.0, other)  # a few of its pairs recur on ``fine``, in other batches
+    kernel_operator(1.0, coarse)
+    after_others = kernel_operator(1.0, fine).matrix
+    assert np.array_equal(alone, after_others)
+
+
 @pytest.mark.parametrize("accuracy", [1e-6, 1e-9, 1e-12])
 def test_kernel_values_meet_the_asked_accuracy(accuracy):
     """The truncated series and the zeros beyond the envelope stay within ``accuracy``."""

@@ -1,0 +1,134 @@
+"""Caches hand out values that cannot be changed, under keys that cannot collide.
+
+A cached value is shared by every later caller: a write into it (``+=``, a slice
+assignment, an in-place LAPACK call) would change the next caller's answer, an
+order-dependent wrong answer. So every cache returns read-only arrays. And a key must
+name its inputs: one built from ``id()`` of an object that is gone matches the next
+object given that address.
+"""
+
+from __future__ import annotations
+
+import gc
+
+import numpy as np
+import pytest
+
+
+def _written(array: np.ndarray) -> bool:
+    """Whether an in-place write into ``array`` goes through."""
+    try:
+        array.flat[0] += 0.0
+    except ValueError:
+        return False
+    return True
+
+
+def test_stage_cache_values_are_read_only():
+    from core.cache import StageCache
+
+    cache = StageCache("test_read_only_values", max_items=4)
+    value, _ = cache.get_or_compute("k", lambda: (np.ones(3), {"a": np.zeros(2)}))
+    again, was_cached = cache.get_or_compute("k", lambda: None)
+    assert was_cached and again is value
+    assert not _written(value[0]) and not _written(value[1]["a"])
+
+
+def test_pair_tables_are_read_only():
+    from core import quadrature
+    from core.quadrature import Panels, node_rows
+
+    panels = Panels.from_edges(np.array([-1.0, -0.25, 0.0, 0.5, 1.0]))
+    node_rows(1.0, panels, panels, np.arange(panels.n_panels))
+    assert quadrature._PAIR_TABLES
+    for near, table in quadrature._PAIR_TABLES.values():
+        assert not _written(near) and not _written(table)
+
+
+def test_module_tables_are_read_only():
+    from core import kernel, kernel_values, log_moments
+
+    shared = [kernel._EVEN, kernel._TABLE, kernel._SCALES, kernel._POLES,
+              kernel_values._even_chebyshev(), kernel_values._even_coefficients(1e-8),
+              *log_moments._outer_rule(15)]
+    assert not any(_written(a) for a in shared)
+
+
+def test_prepared_rows_are_read_only():
+    from core.prepared import prepare
+
+    prepared = prepare(1.0, 0.05, 0.0, tol=1e-6)
+    rows = prepared.rows(np.linspace(-0.9, 0.9, 5))
+    assert not _written(rows)
+
+
+def test_fitted_kernel_values_are_read_only():
+    """The fit is cached (its arrays shared) and so are its amplitudes at the last ages
+    asked for (every caller at those ages gets views of the same arrays)."""
+    from core.creep import ExponentialCreep
+    from core.kernel_fit import fit_kernel
+
+    law = ExponentialCreep(modulus=3e10, compliance=6e-11, rate=0.05).dimensionless_kernel(28.0)
+    fitted = fit_kernel(lambda t, s: law(t, s), end=10.0)
+    tau = np.array([1.0, 2.0, 5.0])
+    assert not any(_written(a) for a in (fitted.thetas, fitted.coef, *fitted.amplitudes(tau)))
+
+
+def test_fingerprint_separates_what_differs():
+    from core.cache import fingerprint
+
+    distinct = [1, 1.0, "1", "1.0", True, None, (1, 2), (12,), ("1", "2"), ("12",),
+                np.arange(4.0), np.arange(4.0).reshape(2, 2), np.arange(4),
+                0.1, float(np.nextafter(0.1, 1.0)), -0.0, 0.0]
+    keys = [fingerprint(v) for v in distinct]
+    assert len(set(keys)) == len(keys)
+    # the same content gives the same key, whatever object holds it
+    assert fingerprint(np.arange(4.0)) == fingerprint(np.arange(4.0).copy())
+
+
+def test_same_object_key_holds_its_object():
+    """The id of an object kept in a key is not given to another while the key lives."""
+    from core.cache import SameObject
+
+    keys = []
+    for k in range(50):
+        keys.append(SameObject(lambda t, s, k=k: k))
+        gc.collect()
+    assert len({id(key.obj) for key in keys}) == 50
+    assert len(set(keys)) == 50
+    assert keys[3] == SameObject(keys[3].obj)
+
+
+def test_unkeyed_kernel_response_is_not_reused_for_another(monkeypatch):
+    """Two plain-callable creep kernels solved one after the other on one prepared
+    geometry: the second gets its own answer, even when it has the first one's id (as a
+    kernel does that takes over the address of one freed before). Keyed by ``id()``, the
+    second kernel was given the first one's response."""
+    import core.prepared
+    from core.prepared import prepare
+
+    # tol 1e-10: no sum-of-exponentials fit is within the budget, so the kernels are
+    # stepped as they are and known by identity only
+    prepared = prepare(1.0, 0.05, 0.0, tol=1e-10)
+    from core.creep import ExponentialCreep
+
+    # two creep laws, each hidden in a plain callable (no key to tell them apart)
+    laws = [ExponentialCreep(modulus=3e10, compliance=c, rate=0.05).dimensionless_kernel(28.0)
+            for c in (3e-11, 6e-11)]
+    kernels = [lambda t, s, law=law: law(t, s) for law in laws]
+
+    def settlement(kernel) -> float:
+        return float(prepared.solve([1.0, 2.0], kernel=kernel, force=1.0,
+                                    moment=0.1).settlement[-1])
+
+    alone = []
+    for kernel in kernels:
+        prepared._responses.clear()
+        alone.append(settlement(kernel))
+    prepared._responses.clear()
+    # every object the module asks the id of has the same one: an address reused
+    monkeypatch.setattr(core.prepared, "id", lambda obj: 1, raising=False)
+    in_turn = [settlement(kernel) for kernel in kernels]
+    assert alone[0] != pytest.approx(alone[1], rel=1e-3)
+    # measured: equal to the last digit (the same time march)
+    assert in_turn == pytest.approx(alone, rel=1e-12)
