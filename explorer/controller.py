@@ -32,6 +32,7 @@ import param
 
 from core.cache import StageCache
 
+from .answer_wait import when_answered
 from .results import ResultView, prepare_view
 from .state import ExplorerState
 from .trace import mark
@@ -188,6 +189,17 @@ def format_error(message: str) -> str:
     return f"{words} ({path.strip()}):{reason}"
 
 
+def _failure_text(exc: Exception) -> str:
+    """What the page says of a solve that raised ``exc``."""
+    if isinstance(exc, ValueError):  # the core's message, naming the field
+        return format_error(str(exc))
+    if isinstance(exc, WorkerFailed):
+        return f"The solver failed on this scene: {exc}."
+    # the session must survive any failure of a solve
+    log.error("solve failed", exc_info=exc)
+    return f"The solver failed on this scene ({type(exc).__name__}: {exc})."
+
+
 class SolveController(param.Parameterized):
     """Turns state changes into solves and solves into a displayed :class:`ResultView`."""
 
@@ -253,8 +265,45 @@ class SolveController(param.Parameterized):
         self.requests = rid
         self.busy = True
         if not queued:
-            self._executor.submit(self._work, rid, scene, sent)
+            self._wait(rid, scene, sent)
         return rid
+
+    def _wait(self, rid: int, scene: dict[str, Any], sent: SentRequest | None) -> None:
+        # A request written to the worker by the event loop is awaited by that loop
+        # (explorer/answer_wait.py); anything else by a thread of the pool.
+        if sent is None or not when_answered(
+                sent, lambda: self._answered(rid, scene, sent),
+                lambda: self._executor.submit(self._work, rid, scene, sent)):
+            self._executor.submit(self._work, rid, scene, sent)
+
+    def _answered(self, rid: int, scene: dict[str, Any], sent: SentRequest) -> None:
+        # on the event loop, the answer in the pipe: read, shown, and the next request
+        # (if one came meanwhile) sent
+        outcome = self._collect(scene, sent)
+        self._dispatch(lambda: self._deliver(rid, outcome))
+        with self._lock:
+            if self._pending is None:
+                self._running = False
+                return
+            rid, scene = self._pending
+            self._pending = None
+        self._wait(rid, scene, self._send_now(scene))
+
+    def _collect(self, scene: dict[str, Any], sent: SentRequest) -> ResultView | str:
+        # The answer of ``sent`` (there to read), kept in RESULTS by a thread of the pool:
+        # the cache may wait for another session's solve of the same scene, which the
+        # event loop must not.
+        try:
+            view = self._processes.result(sent)
+        except Exception as exc:
+            return _failure_text(exc)
+        key = result_key(scene)
+        cached = RESULTS.get(key) if key is not None else None
+        if cached is not None:
+            return replace(cached, info={**cached.info, "reused": True})
+        if key is not None:
+            self._executor.submit(RESULTS.get_or_compute, key, lambda: view)
+        return view
 
     def _send_now(self, scene: dict[str, Any]) -> SentRequest | None:
         # The request goes to this session's worker from the thread that made it (the
@@ -320,13 +369,8 @@ class SolveController(param.Parameterized):
                 return self._view(scene, unread)
             view, reused = RESULTS.get_or_compute(key, lambda: self._view(scene, unread))
             return replace(view, info={**view.info, "reused": True}) if reused else view
-        except ValueError as exc:
-            return format_error(str(exc))
-        except WorkerFailed as exc:
-            return f"The solver failed on this scene: {exc}."
-        except Exception as exc:  # the session must survive any failure of a solve
-            log.exception("solve failed")
-            return f"The solver failed on this scene ({type(exc).__name__}: {exc})."
+        except Exception as exc:
+            return _failure_text(exc)
         finally:
             if unread and self._processes is not None:
                 # another session solved the same scene meanwhile: the worker's answer
