@@ -18,7 +18,7 @@ import panel as pn
 import param
 from panel.io.state import set_curdoc
 
-from . import bokeh_fixes, closed_pages, gc_policy
+from . import bokeh_fixes, closed_pages, gc_policy, idle_painter
 from .controller import SolveController, format_error, worker_processes
 from .design import DesignLimits
 from .fidelity_view import FidelityView
@@ -407,6 +407,7 @@ def create_app(**kwargs: Any) -> ExplorerApp:
     if served:
         pn.state.on_session_destroyed(gc_policy.session_ended)
         bokeh_fixes.install(pn.state.curdoc)
+        idle_painter.install(pn.state.curdoc)
     if "query" not in kwargs:
         kwargs["query"] = _query_from_session()
     app = ExplorerApp(**kwargs)

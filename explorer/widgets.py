@@ -18,6 +18,7 @@ import param
 
 from core.profiles import VARIATIONS
 
+from .idle_painter import WAKE_JS
 from .state import QUANTITY_RANGES, HistoryState, ProfileState
 from .trace import mark
 
@@ -119,7 +120,7 @@ class BoundedUpload(pn.viewable.Viewer):
         # page to remove its files (a new dropper in its place broke the old one's
         # preview script, still drawing the file it had just sent).
         self._clears = pn.widgets.IntInput(value=0, visible=False)
-        self._clears.jscallback(value="""
+        self._clears.jscallback(value=WAKE_JS + """
             const view = Bokeh.index.find_one(box);
             if (view && view._file_pond) { view._file_pond.removeFiles(); }""",
                                 args={"box": self._box})
