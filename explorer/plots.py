@@ -32,7 +32,7 @@ from .pin_plots import PinLines
 from .pins import Pin
 from .results import ResultView
 from .scales import DisplayScales
-from .scene_plot import _TOOLS, SceneDrawing, _empty
+from .scene_plot import TOOLS, SceneDrawing, empty_columns
 from .state import QUANTITIES, QUANTITY_UNITS
 
 SYMBOLS = {"settlement": "δ", "tilt": "α", "force": "P", "moment": "M"}
@@ -86,7 +86,7 @@ class Figures:
     # -- construction ----------------------------------------------------------------
     def _build_pressure(self) -> None:
         # the value axes are set here, not fitted in the page (see steady_range)
-        p = figure(height=280, sizing_mode="stretch_width", tools=_TOOLS,
+        p = figure(height=280, sizing_mode="stretch_width", tools=TOOLS,
                    title="Contact pressure q(x)", toolbar_location="above",
                    name="pressure_figure", y_range=Range1d(0, 1))
         p.toolbar.autohide = True
@@ -94,12 +94,12 @@ class Figures:
         p.yaxis.axis_label = "q [kPa]"
         # one point until the first result, so the auto ranges have something to fit
         self.q_src = ColumnDataSource({"x": [0.0], "q": [0.0]}, name="q_source")
-        self.neg_src = ColumnDataSource(_empty("left", "right"), name="negative_source")
+        self.neg_src = ColumnDataSource(empty_columns("left", "right"), name="negative_source")
         self.neg_strip = p.vstrip(x0="left", x1="right", source=self.neg_src,
                                   fill_color="#d62728", fill_alpha=0.18, line_color=None,
                                   legend_label=LOST_LABEL)
         p.add_layout(Span(location=0, dimension="width", line_color="#555", line_width=1))
-        self.classic_src = ColumnDataSource(_empty("x", "half_space", "bearing_rule"),
+        self.classic_src = ColumnDataSource(empty_columns("x", "half_space", "bearing_rule"),
                                             name="classical_source")
         self.classic_lines = [
             p.line(x="x", y="half_space", source=self.classic_src, line_color="#7f7f7f",
@@ -124,7 +124,7 @@ class Figures:
         self.q_fig = p
 
     def _build_image(self) -> None:
-        p = figure(height=280, sizing_mode="stretch_width", tools=_TOOLS,
+        p = figure(height=280, sizing_mode="stretch_width", tools=TOOLS,
                    title="q(x, t)", toolbar_location="above", name="image_figure",
                    x_range=Range1d(-1, 1), y_range=Range1d(0, 1))
         p.toolbar.autohide = True
@@ -132,7 +132,7 @@ class Figures:
         p.yaxis.axis_label = "t [days after loading]"
         self.image_mapper = LinearColorMapper(palette=Viridis256, low=0, high=1,
                                               name="image_mapper")
-        self.image_src = ColumnDataSource(_empty("image", "x", "y", "dw", "dh"),
+        self.image_src = ColumnDataSource(empty_columns("image", "x", "y", "dw", "dh"),
                                           name="image_source")
         image = p.image(image="image", x="x", y="y", dw="dw", dh="dh", source=self.image_src,
                         color_mapper=self.image_mapper)
@@ -156,7 +156,7 @@ class Figures:
         for q in QUANTITIES:
             unit = QUANTITY_UNITS[q][0]
             kwargs = {"x_range": shared_x} if shared_x is not None else {}
-            p = figure(height=210, sizing_mode="stretch_width", tools=_TOOLS,
+            p = figure(height=210, sizing_mode="stretch_width", tools=TOOLS,
                        toolbar_location="above", name=f"{q}_figure",
                        title=f"{TITLES[q]} {SYMBOLS[q]} [{unit}]", y_range=Range1d(-1, 1),
                        **kwargs)
@@ -165,7 +165,7 @@ class Figures:
             p.xaxis.axis_label = "t [days after loading]"
             p.yaxis.axis_label = f"{SYMBOLS[q]} [{unit}]"
             src = ColumnDataSource({"t": [0.0], "v": [0.0]}, name=f"{q}_source")
-            point = ColumnDataSource(_empty("t", "v"), name=f"{q}_point_source")
+            point = ColumnDataSource(empty_columns("t", "v"), name=f"{q}_point_source")
             line = p.line(x="t", y="v", source=src, line_color=UNKNOWN_COLOR, line_width=2.5)
             p.scatter(x="t", y="v", source=point, size=8, color="#d62728", level=MOVING)
             p.add_tools(HoverTool(renderers=[line], mode="vline", tooltips=[

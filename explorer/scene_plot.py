@@ -30,7 +30,8 @@ from .results import ResultView
 # Number of slabs each coating layer is drawn with (its colour follows E(x)).
 _SLABS = 120
 
-_TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
+#: The tools of every figure of the explorer.
+TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
 
 def _nice(value: float) -> float:
@@ -44,7 +45,8 @@ def _nice(value: float) -> float:
     return float(power)
 
 
-def _empty(*columns: str) -> dict[str, list]:
+def empty_columns(*columns: str) -> dict[str, list]:
+    """The data of an empty ColumnDataSource with ``columns``."""
     return {c: [] for c in columns}
 
 
@@ -53,19 +55,19 @@ class SceneDrawing:
 
     def __init__(self, modulus_mapper: LogColorMapper) -> None:
         self.modulus_mapper = modulus_mapper
-        p = figure(height=300, sizing_mode="stretch_width", tools=_TOOLS,
+        p = figure(height=300, sizing_mode="stretch_width", tools=TOOLS,
                    x_range=Range1d(-1.5, 1.5), y_range=Range1d(-1.5, 1.0),
                    title="Scene", toolbar_location="above", name="scene_figure")
         p.toolbar.autohide = True
         p.xaxis.axis_label = "x [m]"
         p.yaxis.axis_label = "y [m] (exaggerated)"
-        self.base_src = ColumnDataSource(_empty("left", "right", "bottom", "top", "E"),
+        self.base_src = ColumnDataSource(empty_columns("left", "right", "bottom", "top", "E"),
                                          name="base_source")
         self.layer_src = ColumnDataSource(
-            _empty("left", "right", "bottom", "top", "E", "layer", "h_mm"),
+            empty_columns("left", "right", "bottom", "top", "E", "layer", "h_mm"),
             name="layer_source")
-        self.punch_src = ColumnDataSource(_empty("x", "y"), name="punch_source")
-        self.cut_src = ColumnDataSource(_empty("x", "y"), name="cut_source")
+        self.punch_src = ColumnDataSource(empty_columns("x", "y"), name="punch_source")
+        self.cut_src = ColumnDataSource(empty_columns("x", "y"), name="cut_source")
         fill = {"field": "E", "transform": self.modulus_mapper}
         p.quad(left="left", right="right", bottom="bottom", top="top", source=self.base_src,
                fill_color=fill, line_color=None, fill_alpha=0.55)
