@@ -125,17 +125,21 @@ STEPS = ("ws_in", "widget_event", "widget_value", "revision", "sent", "worker_st
          "worker_end", "received", "delivered", "drawn", "ws_out")
 
 
-def server_steps(trace: Path, since: float, until: float) -> list[dict[str, float]]:
+def server_steps(trace: Path, since: float, until: float,
+                 cpu: list[float] | None = None) -> list[dict[str, float]]:
     """The server's marks of each move between ``since`` and ``until`` [s, monotonic]:
     for every ``revision`` the websocket message before it and the first of each later
     step after the one before; a move lacking a step (a result from the cache) is left
-    out. Returns per move the step times [ms] after ``ws_in``."""
+    out. Returns per move the step times [ms] after ``ws_in`` (and appends to ``cpu`` the
+    server process's CPU time [ms] from ``ws_in`` to ``ws_out`` of each move, where the
+    marks carry it)."""
     events = [json.loads(line) for line in trace.read_text().splitlines() if line]
     events = [e for e in events if since <= e["t"] <= until]
     moves = []
     for i, rev in enumerate(events):
         if rev["event"] != "revision":
             continue
+        ws_in_cpu = [e.get("cpu") for e in events[:i] if e["event"] == "ws_in"]
         ws_in = [e["t"] for e in events[:i] if e["event"] == "ws_in"]
         widget = [e["t"] for e in events[:i] if e["event"] == "widget_event"]
         value = [e["t"] for e in events[:i] if e["event"] == "widget_value"]
@@ -159,6 +163,9 @@ def server_steps(trace: Path, since: float, until: float) -> list[dict[str, floa
                 at = later
         if len(times) == len(STEPS):
             moves.append({step: 1e3 * (times[step] - times["ws_in"]) for step in STEPS})
+            out_cpu = events[at].get("cpu")
+            if cpu is not None and out_cpu is not None and ws_in_cpu[-1] is not None:
+                cpu.append(1e3 * (out_cpu - ws_in_cpu[-1]))
     return moves
 
 
@@ -244,21 +251,27 @@ def main() -> None:
             sent, server_part, page_part = (statistics.median(r[k] for r in rows)
                                             for k in range(3))
             print(f"{name:24s} {sent:6.0f} {server_part:9.0f} {page_part:9.0f}")
-    steps = {}
+    steps: dict[str, list[dict[str, float]]] = {}
+    server_cpu: dict[str, list[float]] = {}
     if trace.exists():
         print("\ninside the server (medians, ms after the websocket message in; "
               "explorer/trace.py):")
-        print(f"{'control':24s} " + " ".join(f"{s:>12s}" for s in STEPS[1:]))
+        print(f"{'control':24s} " + " ".join(f"{s:>12s}" for s in STEPS[1:])
+              + f" {'server CPU':>11s}")
         for name, (since, until) in windows.items():
-            steps[name] = moves = server_steps(trace, since, until)
+            server_cpu[name] = used = []
+            steps[name] = moves = server_steps(trace, since, until, used)
             if moves:
+                cpu_text = f"{statistics.median(used):11.1f}" if used else f"{'':11s}"
                 print(f"{name:24s} " + " ".join(
                     f"{statistics.median(m[s] for m in moves):12.1f}" for s in STEPS[1:])
-                    + f"  n={len(moves)}")
+                    + f" {cpu_text}  n={len(moves)}")
+        print("(server CPU: the server process's CPU time from the websocket message in "
+              "to the patch written, all its threads; the solve runs in a worker)")
     if args.json:
         Path(args.json).write_text(json.dumps(
             {"browser": results, "core_solve": solves, "page_cpu": cpu, "parts": parts,
-             "server_steps": steps}, indent=2))
+             "server_steps": steps, "server_cpu": server_cpu}, indent=2))
 
 
 if __name__ == "__main__":

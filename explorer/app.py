@@ -18,8 +18,8 @@ import panel as pn
 import param
 from panel.io.state import set_curdoc
 
-from . import bokeh_fixes, closed_pages, gc_policy
-from .controller import SolveController, format_error, worker_processes
+from . import bokeh_fixes, closed_pages, gc_policy, idle_painter
+from .controller import SolveController, format_error
 from .design import DesignLimits
 from .fidelity_view import FidelityView
 from .links import decode_scene
@@ -48,7 +48,7 @@ from .views.study import StudyView
 from .views.style import CSS, html_pane
 from .views.tabs import FILL_TABS_AFTER_MS, DeferredTabs
 from .views.times import TimesView
-from .workers import solve_view
+from .warm_up import warm_up
 
 __all__ = ["BADGES", "BUSY_AFTER_MS", "CSS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS",
            "ExplorerApp", "SIDEBAR_VIEWS", "badges_html", "create_app", "readout_html",
@@ -368,22 +368,6 @@ class ExplorerApp(pn.viewable.Viewer):
         self.link.schedule()
 
 
-def warm_up(keys: tuple[str, ...] = (DEFAULT_PRESET,)) -> None:
-    """Solve some presets now, so that the first visitors find them in the caches."""
-    available = presets()
-    for key in keys:
-        scene = available.get(key)
-        if scene is None:
-            continue
-        state = ExplorerState()
-        state.load_scene(scene)
-        SolveController(state, executor=None, auto=False).solve_now()
-        processes = worker_processes()
-        if processes is not None and processes.lanes > 1:
-            # the first solve warmed one worker; the others get the same caches
-            processes.run_everywhere(solve_view, state.to_scene())
-
-
 def _query_from_session() -> dict[str, str]:
     """The page's query arguments (first value of each, as text)."""
     out: dict[str, str] = {}
@@ -407,6 +391,7 @@ def create_app(**kwargs: Any) -> ExplorerApp:
     if served:
         pn.state.on_session_destroyed(gc_policy.session_ended)
         bokeh_fixes.install(pn.state.curdoc)
+        idle_painter.install(pn.state.curdoc)
     if "query" not in kwargs:
         kwargs["query"] = _query_from_session()
     app = ExplorerApp(**kwargs)

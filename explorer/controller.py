@@ -19,19 +19,17 @@ passes one that schedules on its Bokeh document); the default applies them at on
 
 from __future__ import annotations
 
-import json
 import logging
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from concurrent.futures import Executor, Future, ThreadPoolExecutor
-from dataclasses import fields, is_dataclass, replace
+from dataclasses import replace
 from typing import Any
 
-import numpy as np
 import param
 
-from core.cache import StageCache
-
+from .answer_wait import when_answered
+from .result_cache import RESULTS, approx_bytes, result_key
 from .results import ResultView, prepare_view
 from .state import ExplorerState
 from .trace import mark
@@ -43,6 +41,9 @@ from .workers import (
     solution_text,
     solve_view,
 )
+
+__all__ = ["RESULTS", "SolveController", "approx_bytes", "describe_field", "format_error",
+           "result_key", "shared_pool", "use_worker_processes", "worker_processes"]
 
 log = logging.getLogger(__name__)
 
@@ -100,55 +101,6 @@ def worker_processes() -> SolverProcesses | None:
     return _PROCESSES
 
 
-def approx_bytes(obj: Any, _seen: set[int] | None = None, _depth: int = 0) -> int:
-    """Memory held by a result [bytes], approximately: numpy arrays (each buffer once),
-    text, and the containers and objects of ``core`` and ``explorer`` that hold them."""
-    seen = set() if _seen is None else _seen
-    if id(obj) in seen or _depth > 8:
-        return 0
-    seen.add(id(obj))
-    if isinstance(obj, np.ndarray):
-        base = obj
-        while isinstance(base.base, np.ndarray):
-            base = base.base
-        if base is not obj:
-            return approx_bytes(base, seen, _depth)
-        return int(obj.nbytes)
-    if isinstance(obj, (str, bytes)):
-        return len(obj) + 50
-    if isinstance(obj, Mapping):
-        return 100 + sum(approx_bytes(k, seen, _depth + 1) + approx_bytes(v, seen, _depth + 1)
-                         for k, v in obj.items())
-    if isinstance(obj, (list, tuple)):
-        # a table row of a scene: a list of two floats, 24 bytes each plus the list
-        return 56 + sum(8 + approx_bytes(v, seen, _depth + 1) for v in obj)
-    if is_dataclass(obj) and not isinstance(obj, type):
-        return 64 + sum(approx_bytes(getattr(obj, f.name, None), seen, _depth + 1)
-                        for f in fields(obj))
-    module = type(obj).__module__ or ""
-    if hasattr(obj, "__dict__") and module.split(".")[0] in ("core", "explorer"):
-        return 64 + sum(approx_bytes(v, seen, _depth + 1) for v in vars(obj).values())
-    return 24
-
-
-def result_key(scene: dict[str, Any]) -> str | None:
-    """The key of a scene in :data:`RESULTS` (its canonical JSON), None if not JSON."""
-    try:
-        return json.dumps(scene, sort_keys=True, separators=(",", ":"), allow_nan=False)
-    except (TypeError, ValueError):
-        return None
-
-
-#: Process-wide cache of prepared results, keyed by :func:`result_key`: a new session
-#: opening a preset, or a slider going back to an earlier value, then costs nothing, and
-#: sessions asking for the same scene at once solve it once. Views are never modified
-#: after they are made, so sessions share them. One view of 2000 output times measured
-#: 4.5 MB (tracemalloc), 4.75 MB by :func:`approx_bytes`; the byte bound keeps the
-#: server (with the solver's own 512 MiB of stage caches) under 1 GiB.
-RESULTS = StageCache("explorer_results", max_items=24, max_bytes=96 * 2**20,
-                     sizeof=approx_bytes)
-
-
 #: Translation of the first part of a core field path into words on screen.
 _FIELD_WORDS = {
     "punch": "Punch",
@@ -186,6 +138,17 @@ def format_error(message: str) -> str:
     if words == path.strip():
         return message
     return f"{words} ({path.strip()}):{reason}"
+
+
+def _failure_text(exc: Exception) -> str:
+    """What the page says of a solve that raised ``exc``."""
+    if isinstance(exc, ValueError):  # the core's message, naming the field
+        return format_error(str(exc))
+    if isinstance(exc, WorkerFailed):
+        return f"The solver failed on this scene: {exc}."
+    # the session must survive any failure of a solve
+    log.error("solve failed", exc_info=exc)
+    return f"The solver failed on this scene ({type(exc).__name__}: {exc})."
 
 
 class SolveController(param.Parameterized):
@@ -253,8 +216,45 @@ class SolveController(param.Parameterized):
         self.requests = rid
         self.busy = True
         if not queued:
-            self._executor.submit(self._work, rid, scene, sent)
+            self._wait(rid, scene, sent)
         return rid
+
+    def _wait(self, rid: int, scene: dict[str, Any], sent: SentRequest | None) -> None:
+        # A request written to the worker by the event loop is awaited by that loop
+        # (explorer/answer_wait.py); anything else by a thread of the pool.
+        if sent is None or not when_answered(
+                sent, lambda: self._answered(rid, scene, sent),
+                lambda: self._executor.submit(self._work, rid, scene, sent)):
+            self._executor.submit(self._work, rid, scene, sent)
+
+    def _answered(self, rid: int, scene: dict[str, Any], sent: SentRequest) -> None:
+        # on the event loop, the answer in the pipe: read, shown, and the next request
+        # (if one came meanwhile) sent
+        outcome = self._collect(scene, sent)
+        self._dispatch(lambda: self._deliver(rid, outcome))
+        with self._lock:
+            if self._pending is None:
+                self._running = False
+                return
+            rid, scene = self._pending
+            self._pending = None
+        self._wait(rid, scene, self._send_now(scene))
+
+    def _collect(self, scene: dict[str, Any], sent: SentRequest) -> ResultView | str:
+        # The answer of ``sent`` (there to read), kept in RESULTS by a thread of the pool:
+        # the cache may wait for another session's solve of the same scene, which the
+        # event loop must not.
+        try:
+            view = self._processes.result(sent)
+        except Exception as exc:
+            return _failure_text(exc)
+        key = result_key(scene)
+        cached = RESULTS.get(key) if key is not None else None
+        if cached is not None:
+            return replace(cached, info={**cached.info, "reused": True})
+        if key is not None:
+            self._executor.submit(RESULTS.get_or_compute, key, lambda: view)
+        return view
 
     def _send_now(self, scene: dict[str, Any]) -> SentRequest | None:
         # The request goes to this session's worker from the thread that made it (the
@@ -320,13 +320,8 @@ class SolveController(param.Parameterized):
                 return self._view(scene, unread)
             view, reused = RESULTS.get_or_compute(key, lambda: self._view(scene, unread))
             return replace(view, info={**view.info, "reused": True}) if reused else view
-        except ValueError as exc:
-            return format_error(str(exc))
-        except WorkerFailed as exc:
-            return f"The solver failed on this scene: {exc}."
-        except Exception as exc:  # the session must survive any failure of a solve
-            log.exception("solve failed")
-            return f"The solver failed on this scene ({type(exc).__name__}: {exc})."
+        except Exception as exc:
+            return _failure_text(exc)
         finally:
             if unread and self._processes is not None:
                 # another session solved the same scene meanwhile: the worker's answer

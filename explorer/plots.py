@@ -9,20 +9,15 @@ the user's zoom. Nothing here imports Panel.
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Sequence
 
-import numpy as np
 from bokeh.core.properties import value as fixed_label
 from bokeh.models import (
-    Arrow,
     ColorBar,
     ColumnDataSource,
     HoverTool,
-    Label,
     LinearColorMapper,
     LogColorMapper,
-    NormalHead,
     Range1d,
     Span,
 )
@@ -37,6 +32,7 @@ from .pin_plots import PinLines
 from .pins import Pin
 from .results import ResultView
 from .scales import DisplayScales
+from .scene_plot import TOOLS, SceneDrawing, empty_columns
 from .state import QUANTITIES, QUANTITY_UNITS
 
 SYMBOLS = {"settlement": "δ", "tilt": "α", "force": "P", "moment": "M"}
@@ -47,11 +43,6 @@ UNKNOWN_COLOR = "#1f77b4"
 LOST_LABEL = "q < 0 (contact lost)"
 LIFTED_LABEL = "lifted off (q = 0)"
 GIVEN_COLOR = "#8c8c8c"
-
-# Number of slabs each coating layer is drawn with (its colour follows E(x)).
-_SLABS = 120
-
-_TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
 #: Font size of the entries of the legends above the plots (normal mode).
 LEGEND_FONT = "11px"
@@ -70,28 +61,17 @@ def short(text: str, limit: int = TITLE_CHARS) -> str:
     return text if len(text) <= limit else text[: limit - 1].rstrip() + "…"
 
 
-def _nice(value: float) -> float:
-    """The largest of 1, 2, 5 times a power of ten not above ``value`` (at least 1)."""
-    if not np.isfinite(value) or value <= 1:
-        return 1.0
-    power = 10 ** math.floor(math.log10(value))
-    for step in (5, 2, 1):
-        if step * power <= value:
-            return float(step * power)
-    return float(power)
-
-
-def _empty(*columns: str) -> dict[str, list]:
-    return {c: [] for c in columns}
-
-
 class Figures:
     """All figures of one session and the sources behind them."""
 
     def __init__(self, scales: DisplayScales | None = None) -> None:
         self.scales = scales or DisplayScales()
         self.modulus_mapper = LogColorMapper(palette=Viridis256, low=1.0, high=1e5)
-        self._build_scene()
+        self.drawing = SceneDrawing(self.modulus_mapper)
+        self.scene_fig = self.drawing.fig
+        # the drawing's sources, by the names they had here
+        self.base_src, self.layer_src = self.drawing.base_src, self.drawing.layer_src
+        self.punch_src = self.drawing.punch_src
         self._build_pressure()
         self._build_image()
         self._build_histories()
@@ -104,54 +84,9 @@ class Figures:
         self.pins = PinLines(self)
 
     # -- construction ----------------------------------------------------------------
-    def _build_scene(self) -> None:
-        p = figure(height=300, sizing_mode="stretch_width", tools=_TOOLS,
-                   x_range=Range1d(-1.5, 1.5), y_range=Range1d(-1.5, 1.0),
-                   title="Scene", toolbar_location="above", name="scene_figure")
-        p.toolbar.autohide = True
-        p.xaxis.axis_label = "x [m]"
-        p.yaxis.axis_label = "y [m] (exaggerated)"
-        self.base_src = ColumnDataSource(_empty("left", "right", "bottom", "top", "E"),
-                                         name="base_source")
-        self.layer_src = ColumnDataSource(
-            _empty("left", "right", "bottom", "top", "E", "layer", "h_mm"),
-            name="layer_source")
-        self.punch_src = ColumnDataSource(_empty("x", "y"), name="punch_source")
-        self.cut_src = ColumnDataSource(_empty("x", "y"), name="cut_source")
-        fill = {"field": "E", "transform": self.modulus_mapper}
-        p.quad(left="left", right="right", bottom="bottom", top="top", source=self.base_src,
-               fill_color=fill, line_color=None, fill_alpha=0.55)
-        layers = p.quad(left="left", right="right", bottom="bottom", top="top",
-                        source=self.layer_src, fill_color=fill, line_color=fill)
-        p.patch(x="x", y="y", source=self.punch_src, fill_color="#b0b7c3", line_color="#333",
-                line_width=1.5)
-        p.line(x="x", y="y", source=self.cut_src, line_dash="dashed", line_color="#333")
-        p.add_tools(HoverTool(renderers=[layers], tooltips=[
-            ("layer", "@layer"), ("thickness", "@h_mm{0.00} mm"), ("E", "@E{0.0} MPa")]))
-        self.arrow = Arrow(end=NormalHead(size=12, fill_color="#d62728", line_color="#d62728"),
-                           x_start=0, y_start=1, x_end=0, y_end=0.5, line_width=3,
-                           line_color="#d62728", visible=False, level=MOVING)
-        p.add_layout(self.arrow)
-        self.arrow_label = Label(x=0, y=0, text="", text_font_size="11px",
-                                 text_color="#d62728", x_offset=6, level=MOVING)
-        p.add_layout(self.arrow_label)
-        self.base_label = Label(x=0, y=0, text="", text_font_size="11px", text_color="#333",
-                                x_offset=4, y_offset=4)
-        p.add_layout(self.base_label)
-        # the vertical exaggeration, inside the plot: in the title it made the title too
-        # long for a 1024 px screen
-        self.scale_label = Label(x=4, y=4, x_units="screen", y_units="screen", text="",
-                                 text_font_size="11px", text_color="#555",
-                                 background_fill_color="white", background_fill_alpha=0.7,
-                                 name="scale_label")
-        p.add_layout(self.scale_label)
-        p.add_layout(ColorBar(color_mapper=self.modulus_mapper, title="E [MPa]", width=8),
-                     "right")
-        self.scene_fig = p
-
     def _build_pressure(self) -> None:
         # the value axes are set here, not fitted in the page (see steady_range)
-        p = figure(height=280, sizing_mode="stretch_width", tools=_TOOLS,
+        p = figure(height=280, sizing_mode="stretch_width", tools=TOOLS,
                    title="Contact pressure q(x)", toolbar_location="above",
                    name="pressure_figure", y_range=Range1d(0, 1))
         p.toolbar.autohide = True
@@ -159,12 +94,12 @@ class Figures:
         p.yaxis.axis_label = "q [kPa]"
         # one point until the first result, so the auto ranges have something to fit
         self.q_src = ColumnDataSource({"x": [0.0], "q": [0.0]}, name="q_source")
-        self.neg_src = ColumnDataSource(_empty("left", "right"), name="negative_source")
+        self.neg_src = ColumnDataSource(empty_columns("left", "right"), name="negative_source")
         self.neg_strip = p.vstrip(x0="left", x1="right", source=self.neg_src,
                                   fill_color="#d62728", fill_alpha=0.18, line_color=None,
                                   legend_label=LOST_LABEL)
         p.add_layout(Span(location=0, dimension="width", line_color="#555", line_width=1))
-        self.classic_src = ColumnDataSource(_empty("x", "half_space", "bearing_rule"),
+        self.classic_src = ColumnDataSource(empty_columns("x", "half_space", "bearing_rule"),
                                             name="classical_source")
         self.classic_lines = [
             p.line(x="x", y="half_space", source=self.classic_src, line_color="#7f7f7f",
@@ -189,7 +124,7 @@ class Figures:
         self.q_fig = p
 
     def _build_image(self) -> None:
-        p = figure(height=280, sizing_mode="stretch_width", tools=_TOOLS,
+        p = figure(height=280, sizing_mode="stretch_width", tools=TOOLS,
                    title="q(x, t)", toolbar_location="above", name="image_figure",
                    x_range=Range1d(-1, 1), y_range=Range1d(0, 1))
         p.toolbar.autohide = True
@@ -197,7 +132,7 @@ class Figures:
         p.yaxis.axis_label = "t [days after loading]"
         self.image_mapper = LinearColorMapper(palette=Viridis256, low=0, high=1,
                                               name="image_mapper")
-        self.image_src = ColumnDataSource(_empty("image", "x", "y", "dw", "dh"),
+        self.image_src = ColumnDataSource(empty_columns("image", "x", "y", "dw", "dh"),
                                           name="image_source")
         image = p.image(image="image", x="x", y="y", dw="dw", dh="dh", source=self.image_src,
                         color_mapper=self.image_mapper)
@@ -221,7 +156,7 @@ class Figures:
         for q in QUANTITIES:
             unit = QUANTITY_UNITS[q][0]
             kwargs = {"x_range": shared_x} if shared_x is not None else {}
-            p = figure(height=210, sizing_mode="stretch_width", tools=_TOOLS,
+            p = figure(height=210, sizing_mode="stretch_width", tools=TOOLS,
                        toolbar_location="above", name=f"{q}_figure",
                        title=f"{TITLES[q]} {SYMBOLS[q]} [{unit}]", y_range=Range1d(-1, 1),
                        **kwargs)
@@ -230,7 +165,7 @@ class Figures:
             p.xaxis.axis_label = "t [days after loading]"
             p.yaxis.axis_label = f"{SYMBOLS[q]} [{unit}]"
             src = ColumnDataSource({"t": [0.0], "v": [0.0]}, name=f"{q}_source")
-            point = ColumnDataSource(_empty("t", "v"), name=f"{q}_point_source")
+            point = ColumnDataSource(empty_columns("t", "v"), name=f"{q}_point_source")
             line = p.line(x="t", y="v", source=src, line_color=UNKNOWN_COLOR, line_width=2.5)
             p.scatter(x="t", y="v", source=point, size=8, color="#d62728", level=MOVING)
             p.add_tools(HoverTool(renderers=[line], mode="vline", tooltips=[
@@ -250,7 +185,7 @@ class Figures:
         key = json.dumps([view.scene.get(k) for k in ("punch", "coating", "base")],
                          sort_keys=True, default=str)
         if key != self._scene_key:
-            self._show_scene(view)
+            self.drawing.show(view, self.contact)
             self.inset.show(view.geometry)
             self._scene_key = key
         self.contact.show(view)
@@ -311,7 +246,7 @@ class Figures:
             self.history_cursor[name].location = t
             set_data(self.history_point_src[name],
                      {"t": [t], "v": [float(view.display(name)[index])]})
-        self._show_arrow(view, index)
+        self.drawing.show_arrow(view, index)
         self.contact.show_time(view, index)
 
     def _label_strips(self, view: ResultView) -> None:
@@ -378,75 +313,6 @@ class Figures:
         self.contact_fig.height = 170 if on else 210
         self.q_fig.height = self.image_fig.height = 240 if on else 280
 
-    def _show_arrow(self, view: ResultView, index: int) -> None:
-        g = view.geometry
-        force = float(view.values["force"][index])
-        moment = float(view.values["moment"][index])
-        top = self._punch_top
-        if force > 0 and np.isfinite(moment):
-            e = moment / force
-            inside = abs(e) <= 1.45 * g.half_width
-            xe = float(np.clip(e, -1.45 * g.half_width, 1.45 * g.half_width))
-            self.arrow.update(x_start=xe, x_end=xe, y_start=top + 0.45 * g.half_width,
-                              y_end=top + 0.02 * g.half_width, visible=True)
-            where = f"e = M/P = {e:.3g} m" + ("" if inside else " (off the drawing)")
-            self.arrow_label.update(x=xe, y=top + 0.3 * g.half_width,
-                                    text=f"P = {force / 1e3:.4g} kN/m, {where}")
-        else:
-            self.arrow.visible = False
-            self.arrow_label.update(x=-g.half_width, y=top + 0.3 * g.half_width,
-                                    text=f"P = {force / 1e3:.4g} kN/m (no compressive load)")
-
-    def _show_scene(self, view: ResultView) -> None:
-        g = view.geometry
-        a = g.half_width
-        depth = min(g.base_thickness, 1.2 * a)
-        total = np.sum(g.thickness, axis=0)
-        t_max = float(np.max(total)) if total.size else 0.0
-        scale = _nice(0.15 * depth / t_max) if t_max > 0 else 1.0
-        # slabs: boundaries and values at the centres, interpolated from the fine grid
-        edges = np.linspace(-a, a, _SLABS + 1)
-        centres = 0.5 * (edges[1:] + edges[:-1])
-        bottom = np.zeros(_SLABS)
-        cols: dict[str, list] = {k: [] for k in ("left", "right", "bottom", "top", "E",
-                                                 "layer", "h_mm")}
-        # layer 1 is drawn on top, in contact with the punch
-        for k in reversed(range(len(g.thickness))):
-            h = np.interp(centres, g.x, g.thickness[k])
-            e = np.interp(centres, g.x, g.modulus[k])
-            top = bottom + scale * h
-            cols["left"].extend(edges[:-1])
-            cols["right"].extend(edges[1:])
-            cols["bottom"].extend(bottom)
-            cols["top"].extend(top)
-            cols["E"].extend(e / 1e6)
-            cols["layer"].extend([k + 1] * _SLABS)
-            cols["h_mm"].extend(h * 1e3)
-            bottom = top
-        self.layer_src.data = cols
-        self.base_src.data = {"left": [-1.5 * a], "right": [1.5 * a], "bottom": [-depth],
-                              "top": [0.0], "E": [g.base_modulus / 1e6]}
-        if g.base_thickness > depth:
-            self.cut_src.data = {"x": [-1.5 * a, 1.5 * a], "y": [-depth, -depth]}
-            self.base_label.update(x=-1.5 * a, y=-depth,
-                                   text=f"base continues to H = {g.base_thickness:.3g} m")
-        else:
-            self.cut_src.data = {"x": [], "y": []}
-            self.base_label.update(x=-1.5 * a, y=-depth,
-                                   text=f"base H = {g.base_thickness:.3g} m on rigid ground")
-        lift = float(np.min(g.shape - total))
-        bottom_y = scale * (g.shape - lift)
-        punch_top = float(np.max(bottom_y)) + 0.35 * a
-        self._punch_top = punch_top
-        self.contact.set_surface(g.x, scale * total)
-        self.punch_src.data = {"x": np.concatenate([g.x, [a, -a]]),
-                               "y": np.concatenate([bottom_y, [punch_top, punch_top]])}
-        self.scene_fig.x_range.update(start=-1.55 * a, end=1.55 * a)
-        self.scene_fig.y_range.update(start=-1.08 * depth, end=punch_top + 0.55 * a)
-        note = f"coating and punch profile drawn ×{scale:g} vertically" if scale > 1 else \
-            "drawn to scale"
-        self.scale_label.text = note
-
     def _show_image(self, view: ResultView) -> None:
         unit, size = self.scales.pressure_unit(view)
         a = view.geometry.half_width
@@ -468,6 +334,5 @@ class Figures:
         self.image_fig.x_range.update(start=-a, end=a)
         self.image_fig.y_range.update(start=t0, end=t0 + span)
 
-    _punch_top = 0.0
     _scene_key: str | None = None
     _pins: tuple[Pin, ...] = ()

@@ -1,7 +1,8 @@
 """Timestamps of a slider move's way through the server, for the latency benchmark.
 
 Off unless the environment variable ``EXPLORER_TRACE`` names a file: then every mark is
-appended to it as one JSON line ``{"event": ..., "t": seconds, ...}``. The clock is
+appended to it as one JSON line ``{"event": ..., "t": seconds, "cpu": seconds, ...}``
+(``cpu``: the CPU time of the process that wrote it, all its threads). The clock is
 ``time.monotonic`` (Linux's CLOCK_MONOTONIC, the same in every process), so the worker
 processes' marks line up with the server's.
 
@@ -33,7 +34,10 @@ def mark(event: str, t: float | None = None, **fields: Any) -> None:
     """Note that ``event`` happened now (or at ``t`` [s], ``time.monotonic`` clock)."""
     if TRACE_FILE is None:
         return
-    line = json.dumps({"event": event, "t": time.monotonic() if t is None else t, **fields})
+    # with the CPU time of this process so far [s]: the server's own work of a move, which
+    # the machine's load does not stretch as it stretches the wall clock
+    line = json.dumps({"event": event, "t": time.monotonic() if t is None else t,
+                       "cpu": time.process_time(), **fields})
     with _LOCK, open(TRACE_FILE, "a", encoding="utf-8") as fh:
         fh.write(line + "\n")
 

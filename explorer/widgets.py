@@ -10,7 +10,7 @@ layer or whichever two loads are given.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from typing import Any
 
 import panel as pn
@@ -20,6 +20,11 @@ from core.profiles import VARIATIONS
 
 from .state import QUANTITY_RANGES, HistoryState, ProfileState
 from .trace import mark
+from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
+
+__all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
+           "EditableIntSlider", "EditableSlider", "HistoryEditor", "ProfileEditor", "fine_slider",
+           "slider"]
 
 
 # Panel holds every change from the browser for 50 ms before handling it, to gather a
@@ -56,68 +61,35 @@ class EditableSlider(pn.widgets.EditableFloatSlider):
     _slider_widget = PromptFloatSlider
     _input_widget = PromptFloatInput
 
+    def watch_drag_first(self, callback: Callable[[Any], None]) -> None:
+        """Call ``callback(value)`` [the slider's value] at each move of the slider,
+        before the composite's own watchers bring its value and text box in line.
+
+        A load step reached the explorer's binding only after those (~7 ms on a loaded
+        server, as long as the solve); called first, the solve starts at once and the
+        text box follows while the worker solves. The composite's own watcher is taken
+        off and put back after ``callback``: watchers of the same precedence run in the
+        order they were added.
+        """
+        inner = self._slider
+        inner.param.watch(lambda event: callback(event.new), "value")
+        own = [w for w in inner.param.watchers.get("value", {}).get("value", [])
+               if getattr(w.fn, "__func__", None) is _SYNC_VALUE]
+        for watcher in own:
+            inner.param.unwatch(watcher)
+            inner.param.watch(watcher.fn, watcher.parameter_names, onlychanged=watcher.onlychanged,
+                              queued=watcher.queued, precedence=watcher.precedence)
+
+
+#: The composite slider's own watcher of its parts (re-ordered by ``watch_drag_first``).
+_SYNC_VALUE = pn.widgets.EditableFloatSlider._sync_value
+
 
 class EditableIntSlider(pn.widgets.EditableIntSlider):
     """An EditableIntSlider made of prompt parts."""
 
     _slider_widget = PromptIntSlider
     _input_widget = PromptIntInput
-
-
-#: Longest file name kept from an upload [characters] (it is echoed into messages).
-MAX_FILENAME_CHARS = 120
-#: Size of the pieces an upload is sent in [bytes]: well below the server's limit of one
-#: websocket message (``WEBSOCKET_MAX_BYTES`` in explorer/__main__.py).
-UPLOAD_CHUNK_BYTES = 256 * 1024
-
-
-class BoundedUpload(pn.viewable.Viewer):
-    """A one-file upload that refuses a file over ``max_bytes`` in the browser, before
-    sending it. ``filename`` and ``value`` (the file's bytes) follow the last file.
-
-    A plain FileInput sends the whole file in one websocket message: a file over the
-    server's message limit (20 MB) closed the session's connection and left a dead page
-    (measured with 25 MB). The dropper checks the size in the page and sends in chunks.
-    """
-
-    filename = param.String(default="", doc="Name of the last file.")
-    value = param.Bytes(default=None, allow_None=True, doc="Contents of the last file.")
-
-    def __init__(self, accept: Sequence[str], max_bytes: int, **params: Any) -> None:
-        super().__init__(**params)
-        self.max_bytes = max_bytes
-        # chunks well below the server's websocket message limit (explorer/__main__.py)
-        self._box = pn.widgets.FileDropper(
-            accepted_filetypes=list(accept), multiple=False,
-            max_file_size=f"{max(1, max_bytes // 1000)}KB", chunk_size=UPLOAD_CHUNK_BYTES,
-            sizing_mode="stretch_width", height=90, css_classes=["file-dropper"])
-        self._box.param.watch(self._on_drop, "value")
-        # The dropper has no way to be emptied from the server: a hidden counter asks the
-        # page to remove its files (a new dropper in its place broke the old one's
-        # preview script, still drawing the file it had just sent).
-        self._clears = pn.widgets.IntInput(value=0, visible=False)
-        self._clears.jscallback(value="""
-            const view = Bokeh.index.find_one(box);
-            if (view && view._file_pond) { view._file_pond.removeFiles(); }""",
-                                args={"box": self._box})
-        self._holder = pn.Column(self._box, self._clears, sizing_mode="stretch_width",
-                                 margin=0)
-
-    def clear(self) -> None:
-        """Empty the box on the page, ready for the next file (``filename`` and ``value``
-        keep the last file): a refused file no longer shows "Upload complete", and the
-        next file needs no click on the first one's x."""
-        self._clears.value += 1
-
-    def _on_drop(self, event: Any) -> None:
-        for name, data in (event.new or {}).items():
-            raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
-            # the same file again is a new request (e.g. after fixing the scene on screen)
-            self.param.update(filename=str(name)[:MAX_FILENAME_CHARS], value=None)
-            self.value = raw
-
-    def __panel__(self) -> pn.viewable.Viewable:
-        return self._holder
 
 
 def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
@@ -167,6 +139,7 @@ class Binding:
         self._target: param.Parameterized | None = None
         self._watcher: Any = None
         self._syncing = False
+        self._leading: str | None = None  # a slider the state follows ahead of its widget
         self._on_reject = on_reject
 
     @property
@@ -181,12 +154,25 @@ class Binding:
         before it reaches the state; the widget then shows the state's value again."""
         event = "value" if live or "value_throttled" not in widget.param else "value_throttled"
         widget.param.watch(lambda e, name=name: self._to_target(name, e.new), event)
+        if live and isinstance(widget, EditableSlider):
+            # a drag step reaches the state before the text box follows (the watcher
+            # above then finds the state at the value already: no second change)
+            widget.watch_drag_first(lambda value, name=name: self._lead(name, value))
         if event == "value_throttled" and self._live_when is not None:
             widget.param.watch(lambda e, name=name: self._drag_step(name, e.new), "value")
         if check is not None:
             self._checks[name] = check
         self._pairs.append((name, widget))
         return widget
+
+    def _lead(self, name: str, value: Any) -> None:
+        # the slider moved ahead of its composite: the state follows it now, and the
+        # composite brings itself in line afterwards (not from here, as an echo)
+        self._leading = name
+        try:
+            self._to_target(name, value)
+        finally:
+            self._leading = None
 
     def _drag_step(self, name: str, value: Any) -> None:
         if self._live_when is not None and self._live_when():
@@ -230,7 +216,8 @@ class Binding:
         try:
             for event in events:
                 for name, widget in self._pairs:
-                    if name == event.name and widget.value != event.new:
+                    if (name == event.name and name != self._leading
+                            and widget.value != event.new):
                         _set_widget(widget, event.new)
         finally:
             self._syncing = False

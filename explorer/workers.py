@@ -17,7 +17,8 @@ millisecond (~250 kB). The core's solution object stays in the worker; the downl
 the shown scene again (:func:`download_text`): the solver is deterministic, so the file
 holds the numbers on screen, and with the stage caches warm that costs 5-11 ms.
 
-Nothing here imports Panel; the workers import only ``core`` and :mod:`explorer.results`.
+What runs in a worker is in :mod:`explorer.worker_side`. Nothing here imports Panel; the
+workers import only ``core`` and :mod:`explorer.results`.
 """
 
 from __future__ import annotations
@@ -26,21 +27,26 @@ import collections
 import logging
 import multiprocessing
 import multiprocessing.connection
-import os
-import signal
 import threading
 import time
 from concurrent.futures import Future
 from typing import Any
 
-from .results import ResultView, prepare_view
 from .trace import TRACE_FILE, mark
+from .worker_side import (
+    DOWNLOADS,
+    download_text,
+    serve,
+    solution_text,
+    solve_view,
+    worker_info,
+)
+
+__all__ = ["DOWNLOADS", "REQUEST_TIMEOUT_S", "SPILL_AFTER_S", "SentRequest",
+           "SolverProcesses", "WorkerFailed", "download_text", "solution_text",
+           "solve_view", "worker_info"]
 
 log = logging.getLogger(__name__)
-
-#: What :func:`download_text` can produce: the histories as CSV, q(x, t) as CSV, and the
-#: whole solution as JSON (the methods of ``core.SceneSolution`` of the same names).
-DOWNLOADS = ("to_csv", "pressure_csv", "to_json")
 
 #: A request waits this long for its session's lane [s] before it takes any idle one.
 #: Its own lane holds the stage caches of its session's scene (a force step costs ~10 ms
@@ -62,95 +68,6 @@ class WorkerFailed(RuntimeError):
 
 
 # -- what runs in a worker ---------------------------------------------------------------
-def _watch_parent() -> None:
-    # Killed without a chance to stop its workers (SIGKILL, a crash), the server would
-    # leave them behind, waiting for work forever.
-    parent = multiprocessing.parent_process()
-    if parent is None:
-        return
-    multiprocessing.connection.wait([parent.sentinel])
-    os._exit(0)
-
-
-def _start_worker(stage_cache_bytes: int) -> None:
-    # Ctrl+C in the terminal reaches the whole process group: the server stops its
-    # workers itself, and a worker's traceback would only clutter the terminal.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    from core import solver
-
-    solver.set_stage_cache_budget(stage_cache_bytes)
-    threading.Thread(target=_watch_parent, name="watch-parent", daemon=True).start()
-
-
-def solve_view(scene: dict[str, Any]) -> ResultView:
-    """Solve ``scene`` (a scene dict) and prepare what the explorer draws.
-
-    Runs in a worker. An invalid scene raises the core's ValueError, which names the field.
-    """
-    from core import solve
-
-    return prepare_view(solve(scene), scene)
-
-
-def download_text(scene: dict[str, Any], kind: str,
-                  info: dict[str, Any] | None = None) -> str:
-    """The file ``kind`` (one of :data:`DOWNLOADS`) of the solution of ``scene``: the
-    histories as CSV (time [day], settlement [m], tilt [rad], force [N/m], moment [N]),
-    q(x, t) as CSV [Pa], or the whole solution as JSON.
-
-    ``info``: the solve report of the result on screen (``ResultView.info``), written into
-    the JSON in place of the new solve's (whose timings and cache hits differ; its numbers
-    do not).
-    """
-    from core import solve
-
-    return solution_text(solve(scene), kind, info)
-
-
-def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None) -> str:
-    """``solution.to_csv()``, ``.pressure_csv()`` or ``.to_json()`` (``kind``), with the
-    solve report ``info`` in the JSON if given (see :func:`download_text`)."""
-    if kind not in DOWNLOADS:
-        raise ValueError(f"kind: unknown download {kind!r}; known: {', '.join(DOWNLOADS)}")
-    if info is not None and kind == "to_json":
-        solution.info = {k: v for k, v in info.items() if k != "reused"}
-    return getattr(solution, kind)()
-
-
-def worker_info() -> dict[str, int]:
-    """The worker's process id and the bound of its solver stage caches [bytes]."""
-    from core.stage_budget import stage_cache_bytes
-
-    return {"pid": os.getpid(), "stage_cache_bytes": stage_cache_bytes()}
-
-
-def _serve(connection: multiprocessing.connection.Connection, stage_cache_bytes: int) -> None:
-    # A worker's main loop: one request (fn, args) in, one ("ok", value) or ("error",
-    # exception) out, on its own pipe. No executor between the server and the worker: a
-    # ProcessPoolExecutor hands each request and each result over through two more threads
-    # of the server (its queue feeder and its manager), and on a busy machine every
-    # hand-over waits for a core.
-    _start_worker(stage_cache_bytes)
-    while True:
-        try:
-            fn, args = connection.recv()
-        except (EOFError, OSError):  # the server closed the pipe (or is gone)
-            return
-        start = time.monotonic()
-        try:
-            reply: tuple[str, Any, tuple[float, float]] = ("ok", fn(*args), (start, 0.0))
-        except BaseException as exc:  # the server raises it in the caller
-            reply = ("error", exc, (start, 0.0))
-        reply = (reply[0], reply[1], (start, time.monotonic()))  # when it worked [s]
-        try:
-            connection.send(reply)
-        except (BrokenPipeError, EOFError, OSError):
-            return
-        except Exception as exc:  # a value or exception that does not pickle
-            connection.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}"),
-                             reply[2]))
-
-
 class _WorkerDied(Exception):
     """The lane's worker process ended (before or during a request)."""
 
@@ -177,7 +94,7 @@ class _Lane:
     def _new_worker(self) -> tuple[Any, multiprocessing.connection.Connection]:
         context = multiprocessing.get_context("spawn")
         ours, theirs = context.Pipe(duplex=True)
-        process = context.Process(target=_serve, args=(theirs, self.stage_cache_bytes),
+        process = context.Process(target=serve, args=(theirs, self.stage_cache_bytes),
                                   name=f"solver-{self.index}", daemon=True)
         process.start()
         theirs.close()  # the worker's end lives in the worker: its death closes the pipe

@@ -1,0 +1,74 @@
+"""An idle page costs no frames; the file dropper still works after the page was idle.
+
+The dropper's frame loop (FilePond) ran at 60 frames a second for as long as the page
+was open, ~9 % of a core of the browser on an idle page; it is now held while nothing
+happens (explorer/idle_painter.py). Checked in Debian's Chromium: no frames are asked for
+on an idle page, and a file chosen long after the last click (no event on the page but
+the file input's own) is still taken up and loaded.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import pytest
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
+
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
+
+from explorer.idle_painter import AWAKE_MS  # noqa: E402
+from tests.browser_pages import Page, page_fixtures  # noqa: E402
+
+server, browser_context, page = page_fixtures(1400, 900)
+
+ROOT = Path(__file__).resolve().parent.parent
+
+def _painter_runs(page: Page, ms: int) -> int:
+    """Frames FilePond's loop ran during ``ms`` [ms]."""
+    return page.page.evaluate("""(ms) => new Promise(resolve => {
+      const painter = window.__explorerPainter;
+      let runs = 0;
+      const writers = window.__framePainter ? window.__framePainter.writers : [];
+      const count = () => { runs += 1; };
+      writers.push(count);
+      setTimeout(() => { writers.splice(writers.indexOf(count), 1); resolve(runs); }, ms);
+      if (!painter) resolve(-1);
+    })""", ms)
+
+
+def _wait_asleep(page: Page, timeout: float = 90.0) -> None:
+    deadline = time.monotonic() + timeout
+    while page.page.evaluate("() => window.__explorerPainter.awake()"):
+        assert time.monotonic() < deadline, "the dropper's loop never went to sleep"
+        time.sleep(0.25)
+
+
+def test_an_idle_page_holds_the_droppers_loop_and_a_late_file_still_loads(page: Page):
+    page.open_tab("Files")
+    upload = page.page.locator("input[type=file]").last
+    upload.wait_for(state="attached", timeout=30_000)
+    # awake after the click on the tab: the loop runs (the dropper draws itself)
+    assert _painter_runs(page, 500) > 5
+    # idle: once the page has filled its other tabs in the background (a few seconds
+    # after loading: changes from the server wake the loop too), no more frames of the
+    # dropper, for longer than the wake
+    _wait_asleep(page)
+    assert _painter_runs(page, AWAKE_MS + 500) == 0
+    # a file chosen now (as after a long look through the file dialog): only the file
+    # input's own events happen on the page, and the dropper takes it up all the same
+    scene = json.loads((ROOT / "assets" / "scenes" / "stepped_punch.json").read_text())
+    scene["name"] = "chosen while idle"
+    upload.set_input_files(files=[{"name": "scene.json", "mimeType": "application/json",
+                                   "buffer": json.dumps(scene).encode()}])
+    page.page.wait_for_function(
+        "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text"
+        ".includes('chosen while idle')", timeout=60_000)
+    # and after it, idle again
+    _wait_asleep(page)
+    assert _painter_runs(page, 1500) == 0
+    assert page.errors == []
