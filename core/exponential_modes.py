@@ -80,7 +80,8 @@ def point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray, coupling: np.n
 
 def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarray,
                end_drive: np.ndarray, end_carry: np.ndarray, vu_nodes: np.ndarray | None,
-               block_elements: int) -> tuple[np.ndarray, np.ndarray]:
+               block_elements: int, restart: np.ndarray | None = None
+               ) -> tuple[np.ndarray, np.ndarray]:
     """States at each step's start (B + 1, S, M) and ``z`` at each step's points (B, 4, M).
 
     ``at_steps`` (B, 4) the times of the points; ``total`` (B, 3, 4) the step's drive of
@@ -88,7 +89,9 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
     weights at the points (ones at the start); ``end_drive`` (B, 4, S), ``end_carry``
     (B, S) how the states reach the step's end; ``vu_nodes`` (B, K, 4) ``V u`` at the
     points or None; the point systems are formed for blocks of steps of at most
-    ``block_elements`` floats. Dimensionless throughout.
+    ``block_elements`` floats; ``restart`` (B,) bools: the states after that step start
+    again from zero (the steps of several grids marched in one pass), None: never.
+    Dimensionless throughout.
     """
     n_steps, n_states = end_carry.shape
     nm = problem.n_modes
@@ -100,6 +103,8 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
     states = np.zeros((n_steps + 1, n_states, nm))
     z_all = np.empty((n_steps, 4, nm))
     diagonal = np.arange(n_states)
+    if restart is None:
+        restart = np.zeros(n_steps, dtype=bool)
     for first in range(0, n_steps, block):
         steps = slice(first, min(n_steps, first + block))
         times_block = at_steps[steps].ravel()
@@ -120,6 +125,8 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
                 sums = (reads_b[k] @ states[b]).reshape(4, groups, n_each)
                 z = z_all[b] = constant[k] + np.einsum(
                     "ikf,kpf->ipf", response[k], sums).reshape(4, nm)
+                if restart[b]:
+                    continue
                 np.multiply(states[b], end_carry[b][:, None], out=states[b + 1])
                 states[b + 1] += drive_b[k] @ z
             continue
@@ -130,6 +137,8 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
         maps[:, diagonal, diagonal, :] += end_carry[steps][:, :, None]
         shifts = (drive_b @ constant).reshape(n_block, n_states, groups, n_each)
         for k in range(n_block):
+            if restart[first + k]:
+                continue
             after = states[first + k + 1].reshape(n_states, groups, n_each)
             np.einsum("stf,tpf->spf", maps[k],
                       states[first + k].reshape(n_states, groups, n_each), out=after)
