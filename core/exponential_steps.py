@@ -26,9 +26,10 @@ Output times inside a step are read from the sextic through its points and three
 neighbouring step (dense output, :mod:`core.exponential_weights`), all at once.
 
 The error is measured, not modelled: the march is repeated on grids with every step
-halved (at least three), and the estimate is the difference of the last two answers at
-the output times over the convergence factor the grids show, or the sum of the local
-errors of the states that decay within a step, where larger. :func:`solve_exponential`
+halved (at least three, marched in one pass: :func:`march_grids`), and the estimate is
+the difference of the last two answers at the output times over the convergence factor
+the grids show, or the sum of the local errors of the states that decay within a step,
+where larger. :func:`solve_exponential`
 returns ``None`` when that takes more than its step budget (a history that oscillates
 fast): the caller then steps adaptively (:mod:`core.radau`).
 """
