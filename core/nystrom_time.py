@@ -266,24 +266,35 @@ class ModalForm:
             return answers
         n_parts, n_free, n_known = len(parts), gamma.size, self.coupling.shape[1]
         memo: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        single = self.coupling / gamma[:, None]
+        # the drives over gamma, once: each history is then one product and a few
+        # outer products written into its rows (no (F, T) temporaries a part)
+        per_gamma = {"gap": self.gap_free / gamma, "settlement": self.settlement_free / gamma,
+                     "tilt": self.tilt_free / gamma}
 
         def evaluate(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             key = tt.tobytes()
             if key not in memo:
                 memo.clear()
                 d = 1.0 + c(tt)[None, :] / gamma[:, None]
-                rs, us = [], []
-                for loads, gap in parts:
+                r = np.empty((n_parts * n_free, tt.size))
+                us = []
+                for p, (loads, gap) in enumerate(parts):
                     ld = {name: fn(tt) for name, fn in loads.items()}
                     u = self.known(ld, tt.size)
-                    rs.append((self.drive(ld, tt.size, gap) - self.coupling @ u)
-                              / gamma[:, None])
+                    rows = r[p * n_free:(p + 1) * n_free]
+                    # (drive - coupling u) / gamma
+                    np.matmul(-single, u, out=rows)
+                    if gap:
+                        rows += gap * per_gamma["gap"][:, None]
+                    for name in ("settlement", "tilt"):
+                        if name in ld:
+                            rows += np.multiply.outer(per_gamma[name], ld[name])
                     us.append(u)
-                memo[key] = (np.tile(d, (n_parts, 1)) if n_parts > 1 else d,
-                             np.concatenate(rs), np.concatenate(us))
+                memo[key] = (np.tile(d, (n_parts, 1)) if n_parts > 1 else d, r,
+                             np.concatenate(us))
             return memo[key]
 
-        single = self.coupling / gamma[:, None]
         problem = ModalProblem(d=lambda tt: evaluate(tt)[0], r=lambda tt: evaluate(tt)[1],
                                u=lambda tt: evaluate(tt)[2],
                                coupling=(np.kron(np.eye(n_parts), single) if n_parts > 1
