@@ -26,9 +26,10 @@ Output times inside a step are read from the sextic through its points and three
 neighbouring step (dense output, :mod:`core.exponential_weights`), all at once.
 
 The error is measured, not modelled: the march is repeated on grids with every step
-halved (at least three), and the estimate is the difference of the last two answers at
-the output times over the convergence factor the grids show, or the sum of the local
-errors of the states that decay within a step, where larger. :func:`solve_exponential`
+halved (at least three, marched in one pass: :func:`march_grids`), and the estimate is
+the difference of the last two answers at the output times over the convergence factor
+the grids show, or the sum of the local errors of the states that decay within a step,
+where larger. :func:`solve_exponential`
 returns ``None`` when that takes more than its step budget (a history that oscillates
 fast): the caller then steps adaptively (:mod:`core.radau`).
 """
@@ -42,7 +43,8 @@ import numpy as np
 from core.exponential_modes import by_step, mode_march
 from core.exponential_weights import (
     NODES,
-    output_weights,
+    output_steps,
+    output_weights_at,
     seven,
     sextic_weights,
     weights,
@@ -179,9 +181,12 @@ def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
     return worst
 
 
+Grid = tuple[np.ndarray, np.ndarray, np.ndarray]
+March = tuple[np.ndarray, np.ndarray, Callable[..., np.ndarray] | None]
+
+
 def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: np.ndarray,
-          times: np.ndarray, rows: tuple[np.ndarray, np.ndarray] | None = None
-          ) -> tuple[np.ndarray, np.ndarray, Callable[[], np.ndarray] | None]:
+          times: np.ndarray, rows: tuple[np.ndarray, np.ndarray] | None = None) -> March:
     """``V w`` (modes, T) and ``V u`` (known, T) at ``times`` (in ``[ends[0], ends[-1]]``)
     by exponential collocation on the steps ``ends``.
 
@@ -189,13 +194,36 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     jumps, so its first (last) point reads the history after (before) it. With ``rows``
     (the sizes of the modes and of the known functions) the third answer computes, when
     called, the sum of the local errors per group of ``problem.parts``
-    (:func:`_local_errors`); else it is None.
+    (:func:`_local_errors`; its optional argument, sizes measured after the march,
+    replaces ``rows``); else it is None.
+    """
+    return march_grids(kernel, problem, [(ends, jump_start, jump_end)], times, rows)[0]
+
+
+def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
+                rows: tuple[np.ndarray, np.ndarray] | None = None) -> list[March]:
+    """:func:`march` on each of ``grids`` (``(ends, jump_start, jump_end)``), in one pass.
+
+    The steps of all grids are laid one after the other and every factor (kernel values,
+    histories, weights, point systems, output weights) is formed for all of them at once;
+    only the march itself restarts from zero states at each grid's first step. The
+    answers are those of separate marches (a few fixed costs a call, ~0.9 ms of CPU
+    measured on the aging scene, are paid once).
     """
     from core.radau import _kernel_factors
 
-    h = np.diff(ends)
+    ends_of = [np.asarray(g[0], dtype=float) for g in grids]
+    counts = np.array([e.size - 1 for e in ends_of])
+    first = np.concatenate([[0], np.cumsum(counts)])               # first step of each grid
+    h = np.concatenate([np.diff(e) for e in ends_of])
     n_steps = h.size
-    at = ends[:-1, None] + h[:, None] * NODES[None, :]            # (B, 4)
+    restart = np.zeros(n_steps + 1, dtype=bool)                    # states start at zero
+    restart[first] = True
+    jump_start = np.concatenate([np.asarray(g[1], dtype=bool) for g in grids])
+    jump_end = np.concatenate([np.asarray(g[2], dtype=bool) for g in grids])
+    # no neighbour across a jump or into another grid (dense output, local errors)
+    apart = jump_start | restart[:-1]
+    at = np.concatenate([e[:-1] for e in ends_of])[:, None] + h[:, None] * NODES[None, :]
     side = JUMP_SIDE * np.maximum(1.0, np.abs(at))
     at[:, 0] += np.where(jump_start, side[:, 0], 0.0)
     at[:, 3] -= np.where(jump_end, side[:, 3], 0.0)
@@ -212,12 +240,19 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     # state sums at the step's points: ones for its start, carries for the others
     reads = np.concatenate([np.ones((n_steps, n_states, 1)), carry], axis=2)  # (B, S, 4)
 
+    # the outputs of every grid, one grid after the other (G T outputs)
     t_out = np.asarray(times, dtype=float)
-    step_of, side, out_carry, out_total = output_weights(ends, jump_start, beta, decay,
-                                                          t_out)
+    n_out = t_out.size
+    placed = [output_steps(e, t_out) for e in ends_of]
+    step_of = np.concatenate([s + f for (s, _), f in zip(placed, first[:-1], strict=True)])
+    a = np.concatenate([a for _, a in placed])
+    before_start = np.concatenate([t_out <= e[0] for e in ends_of])
+    side, out_carry, out_total = output_weights_at(h, apart, beta, decay, step_of, a,
+                                                   before_start)
     # the outputs in the order of their steps (already so for increasing times), so that
     # each step's outputs are one slice of rows
     order = np.argsort(step_of, kind="stable")
+    in_order = bool(np.array_equal(order, np.arange(order.size)))
     bounds = np.searchsorted(step_of[order], np.arange(n_steps + 1))
     out_carry_s, out_total_s = out_carry[order], out_total[order]
 
@@ -225,8 +260,8 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
         return by_step(fn(flat), 4)                              # (B, channels, 4)
 
     nm, nk = problem.n_modes, problem.n_known
-    channels: list[tuple[np.ndarray, np.ndarray]] = []
-    vu_out = np.zeros((nk, t_out.size))
+    channels: list[tuple[np.ndarray, int]] = []                  # (values, which size)
+    vu_out = np.zeros((nk, step_of.size))
     vu_nodes = None
     if nk:
         u = read(problem.u)                                       # (B, K, 4)
@@ -235,23 +270,26 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
         vu_nodes[:, :, 1:] = u @ total.transpose(0, 2, 1)
         next_drive = u @ end_drive                                # (B, K, S)
         # the known functions' states at each step's start (no solve: a carry and a
-        # drive a step), then read at the points and the outputs all at once
+        # drive a step; zero at each grid's start), then read at the points and the
+        # outputs all at once
         s_known = np.zeros((n_steps + 1, nk, n_states))
         for b in range(n_steps):
-            np.multiply(s_known[b], end_carry[b], out=s_known[b + 1])
-            s_known[b + 1] += next_drive[b]
+            if not restart[b + 1]:
+                np.multiply(s_known[b], end_carry[b], out=s_known[b + 1])
+                s_known[b + 1] += next_drive[b]
         vu_nodes += s_known[:-1] @ reads
         vu_out[:, order] = np.einsum("tks,ts->kt", s_known[step_of[order]], out_carry_s)
         vu_out += np.einsum("tj,tjk->kt", out_total, seven(u.transpose(0, 2, 1), step_of,
                                                             side))
         if rows is not None:
-            channels.append((u.transpose(0, 2, 1), rows[1]))
-    vw_out = np.zeros((nm, t_out.size))
+            channels.append((u.transpose(0, 2, 1), 1))
+    vw_out = np.zeros((nm, step_of.size))
     if nm:
         # V w at the outputs, a row per output in the order of their steps
-        vw_rows = np.empty((t_out.size, nm))
+        vw_rows = np.empty((step_of.size, nm))
         states, z_all = mode_march(problem, flat.reshape(n_steps, 4), total, reads,
-                                   end_drive, end_carry, vu_nodes, MAX_BLOCK_ELEMENTS)
+                                   end_drive, end_carry, vu_nodes, MAX_BLOCK_ELEMENTS,
+                                   restart[1:])
         # the outputs of each step: its carried states and the drive by z at its seven
         # points (the neighbour read, ``side``, is the same for all outputs of a step)
         for b in np.flatnonzero(bounds[1:] > bounds[:-1]):
@@ -261,18 +299,29 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
                   np.concatenate([z_all[b], z_all[b + 1, 1:]]) if sd == 1 else
                   np.concatenate([z_all[b], np.zeros((3, nm))]))
             vw_rows[lo:hi] = out_carry_s[lo:hi] @ states[b] + out_total_s[lo:hi] @ z7
-        if np.array_equal(order, np.arange(order.size)):  # increasing times: as marched
+        if in_order:  # increasing times: as marched
             vw_out = vw_rows.T
         else:
             vw_out[:, order] = vw_rows.T
         if rows is not None:
-            channels.append((z_all, rows[0]))
+            channels.append((z_all, 0))
 
-    def local() -> np.ndarray:
-        return _local_errors(ends, jump_start, decay, beta, end_weight, channels,
-                             problem.parts, t_out)
+    def answer(g: int) -> March:
+        steps = slice(first[g], first[g + 1])
+        columns = slice(g * n_out, (g + 1) * n_out)
 
-    return vw_out, vu_out, (local if rows is not None else None)
+        def local(sizes: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+            # ``sizes`` replace ``rows`` (sizes measured after the march)
+            sizes = rows if sizes is None else sizes
+            return _local_errors(ends_of[g], jump_start[steps], decay, beta[steps],
+                                 end_weight[steps],
+                                 [(values[steps], sizes[which]) for values, which in channels],
+                                 problem.parts, t_out)
+
+        return (vw_out[:, columns], vu_out[:, columns],
+                local if rows is not None else None)
+
+    return [answer(g) for g in range(len(grids))]
 
 
 def _largest_change(new: np.ndarray, old: np.ndarray) -> np.ndarray:
@@ -321,15 +370,23 @@ def solve_exponential(kernel, problem, times: np.ndarray, jumps: np.ndarray, *, 
     parts = problem.parts
     previous = last_change = None
     used = 0
+    marched: list[tuple[int, March]] = []
     for level in range(MAX_REFINEMENTS + 1):
-        ends, jump_start = grid(start, end, jumps, theta, level, density)
-        steps = ends.size - 1
-        used += steps
-        if used > max_steps:
-            return None
-        jump_end = np.isin(ends[1:], jumps)
-        vw, vu, local = march(kernel, problem, ends, jump_start, jump_end, times,
-                              rows=(w_scale, u_scale))
+        if not marched:
+            # the first MIN_LEVEL + 1 grids (none of which can be taken alone) in one
+            # pass, their fixed costs once; the refinements after them one at a time
+            levels = range(level, MIN_LEVEL + 1) if level < MIN_LEVEL else [level]
+            grids = []
+            for lev in levels:
+                ends, jump_start = grid(start, end, jumps, theta, lev, density)
+                grids.append((ends, jump_start, np.isin(ends[1:], jumps)))
+            used += sum(g[0].size - 1 for g in grids)
+            if used > max_steps:
+                return None
+            marched = [(g[0].size - 1, answer) for g, answer in zip(
+                grids, march_grids(kernel, problem, grids, times, rows=(w_scale, u_scale)),
+                strict=True)]
+        steps, (vw, vu, local) = marched.pop(0)
         if previous is None and unknowns is not None and problem.n_modes:
             size = np.max(np.abs(unknowns(vw, vu)).reshape(parts, -1), axis=1)
             given = w_scale.reshape(parts, -1)
@@ -346,7 +403,8 @@ def solve_exponential(kernel, problem, times: np.ndarray, jumps: np.ndarray, *, 
             errors = change / (factor - 1.0)
             last_change = change
             if level >= MIN_LEVEL and np.max(errors) <= tol:
-                errors = np.maximum(errors, local())
+                # the local errors against the sizes as measured on the first grid
+                errors = np.maximum(errors, local((w_scale, u_scale)))
                 if np.max(errors) <= tol:
                     return vw, vu, errors, steps
         previous = (vw, vu)

@@ -139,18 +139,38 @@ def output_weights(ends: np.ndarray, jump_start: np.ndarray, beta: np.ndarray,
     Returns ``step_of`` (T,), ``side`` (T,): +1 next, -1 previous, 0 none, and the two.
     """
     h = np.diff(ends)
+    step_of, a = output_steps(ends, t_out)
+    side, carry, total = output_weights_at(h, jump_start, beta, decay, step_of, a,
+                                           t_out <= ends[0])
+    return step_of, side, carry, total
+
+
+def output_steps(ends: np.ndarray, t_out: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The step of each output time (T,) and its fraction ``a`` of that step (T,)."""
+    h = np.diff(ends)
     # np.minimum / np.maximum: np.clip of integers costs ~7x more (numpy 2)
     step_of = np.minimum(np.maximum(np.searchsorted(ends, t_out, side="left") - 1, 0),
                          h.size - 1)
-    a = np.clip((t_out - ends[step_of]) / h[step_of], 0.0, 1.0)
-    side, weight, x = sextic_weights(h, jump_start, decay, step_of, a)
+    return step_of, np.clip((t_out - ends[step_of]) / h[step_of], 0.0, 1.0)
+
+
+def output_weights_at(h: np.ndarray, apart: np.ndarray, beta: np.ndarray, decay: np.ndarray,
+                      step_of: np.ndarray, a: np.ndarray, before_start: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`output_weights` for outputs already placed in their steps (``step_of``, ``a``).
+
+    ``h`` (B,) may hold the steps of several grids one after the other: ``apart`` (B,)
+    marks the steps that take no neighbour before them (a jump, or the first step of a
+    grid); ``before_start`` (T,) the outputs at or before their grid's start (no memory).
+    Returns ``side``, ``carry`` (T, S) and ``total`` (T, 7).
+    """
+    side, weight, x = sextic_weights(h, apart, decay, step_of, a)
     beta7 = seven(beta.transpose(0, 2, 1), step_of, side)        # (T, 7, S)
     total = np.einsum("tsj,tjs->tj", weight, beta7)
     carry = np.exp(-x)
-    before_start = t_out <= ends[0]
     carry[before_start] = 0.0
     total[before_start] = 0.0
-    return step_of, side, carry, total
+    return side, carry, total
 
 
 def seven(values: np.ndarray, step_of: np.ndarray, side: np.ndarray) -> np.ndarray:

@@ -85,6 +85,43 @@ class ModalAnswer:
         return out + node_known @ known[:, at] if known.shape[0] else out
 
 
+class _Basis:
+    """The orthonormal basis ``Q`` (N x N) whose first two columns span those of ``first``
+    (N, 2), kept as its two Householder reflectors ``Q = H_0 H_1 S`` (``S`` the signs that
+    make R's diagonal positive), so products with it cost O(N^2)."""
+
+    def __init__(self, first: np.ndarray) -> None:
+        h, tau = np.linalg.qr(first, mode="raw")   # reflectors in LAPACK's (2, N) layout
+        n = first.shape[0]
+        self.v = np.zeros((2, n))
+        self.tau = tau
+        for i in range(2):
+            self.v[i, i] = 1.0
+            self.v[i, i + 1:] = h[i, i + 1:]
+        self.signs = np.sign(np.diag(h[:2, :2]))  # R's diagonal (R = h.T's upper triangle)
+
+    def _reflect(self, i: int, y: np.ndarray) -> np.ndarray:
+        """``H_i y`` (N, ...) for the reflector ``H_i = I - tau_i v_i v_i^T``."""
+        v = self.v[i]
+        return y - self.tau[i] * np.multiply.outer(v, v @ y)
+
+    def times(self, y: np.ndarray) -> np.ndarray:
+        """``Q y`` for ``y`` (N, ...)."""
+        y = np.array(y, dtype=float)
+        y[:2] *= self.signs.reshape((2,) + (1,) * (y.ndim - 1))
+        return self._reflect(0, self._reflect(1, y))
+
+    def transposed_times(self, y: np.ndarray) -> np.ndarray:
+        """``Q^T y`` for ``y`` (N, ...)."""
+        out = self._reflect(1, self._reflect(0, y))
+        out[:2] *= self.signs.reshape((2,) + (1,) * (out.ndim - 1))
+        return out
+
+    def times_right(self, y: np.ndarray) -> np.ndarray:
+        """``y Q`` for ``y`` (X, N)."""
+        return self.transposed_times(y.T).T
+
+
 class ModalForm:
     """One statement of the Nystrom equations in decoupled modal coordinates."""
 
@@ -94,11 +131,13 @@ class ModalForm:
         w, m, x = grid.panels.weights, grid.m, grid.nodes
         s_in = np.sqrt(w / m)  # row scaling S^-1 W
         s_out = 1.0 / np.sqrt(w * m)  # column scaling S^-1
-        first = np.column_stack([s_in, s_in * x])
-        q, r = np.linalg.qr(first, mode="complete")
-        q[:, :2] *= np.sign(np.diag(r[:2, :2]))[None, :]
+        # the basis Q: two Householder reflectors (the QR of the first two vectors), the
+        # signs of its first two columns those of R's diagonal; applied as reflections
+        # (rank-one updates, O(N^2)) instead of formed and multiplied (two N^3 products)
+        basis = _Basis(np.column_stack([s_in, s_in * x]))
         moments = (float(np.sum(w / m)), float(np.sum(w * x / m)), float(np.sum(w * x * x / m)))
-        galerkin = q.T @ ((s_in[:, None] * grid.operator * s_out[None, :]) @ q)
+        galerkin = basis.transposed_times(
+            basis.times_right(s_in[:, None] * grid.operator * s_out[None, :]))
         self.ms: ModalSystem = modal_system(galerkin, moments, given, grid.size,
                                             symmetric=False, inverse=False)
         ms = self.ms
@@ -108,8 +147,7 @@ class ModalForm:
                 f"operator: its modes reach {rounding / np.finfo(float).eps:.1e} (m down "
                 f"to {float(np.min(m)):.1e}, a nearly first-kind equation) and their "
                 f"rounding {rounding:.1e} exceeds 0.1 tol; the grid does not resolve the problem")
-        self.to_nodes = s_out[:, None] * q
-        self.gap = ms.rotate(-(q.T @ (s_in * grid.g)))
+        self.gap = ms.rotate(-basis.transposed_times(s_in * grid.g))
         self.k = len(ms.known)
         self.constraint_inv = np.linalg.inv(ms.constraint) if self.k else np.zeros((0, 0))
         # psi^-1 is needed on these few vectors only: one solve with psi (an LU) instead
@@ -123,9 +161,14 @@ class ModalForm:
         # nodal values of the modal coordinates (free) and of the known ones, with the
         # rotation and psi folded in: a history then costs one product with the nodes
         # instead of psi, the rotation and the nodes in turn (two N x N x T products)
-        rotation = ms.to_coefficients(np.eye(ms.n))
-        self.node_modes = self.to_nodes @ (rotation[:, ms.free] @ ms.psi)
-        self.node_known = self.to_nodes @ rotation[:, ms.known]
+        # T (identity but for its first 2 x 2 block) applied to psi and to the known
+        # columns, then Q and the column scaling: O(N F) besides the reflections
+        modes = np.zeros((ms.n, ms.free.size))
+        modes[ms.free] = ms.psi
+        self.node_modes = s_out[:, None] * basis.times(ms.to_coefficients(modes))
+        known_cols = np.zeros((ms.n, ms.known.size))
+        known_cols[ms.known, np.arange(ms.known.size)] = 1.0
+        self.node_known = s_out[:, None] * basis.times(ms.to_coefficients(known_cols))
         self.nodes = (self.node_modes, self.node_known)
         self.known_modes = (ms.r_rot[np.ix_(ms.known, ms.free)] @ ms.psi if self.k
                             else np.zeros((0, len(ms.free))))
@@ -223,24 +266,35 @@ class ModalForm:
             return answers
         n_parts, n_free, n_known = len(parts), gamma.size, self.coupling.shape[1]
         memo: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        single = self.coupling / gamma[:, None]
+        # the drives over gamma, once: each history is then one product and a few
+        # outer products written into its rows (no (F, T) temporaries a part)
+        per_gamma = {"gap": self.gap_free / gamma, "settlement": self.settlement_free / gamma,
+                     "tilt": self.tilt_free / gamma}
 
         def evaluate(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             key = tt.tobytes()
             if key not in memo:
                 memo.clear()
                 d = 1.0 + c(tt)[None, :] / gamma[:, None]
-                rs, us = [], []
-                for loads, gap in parts:
+                r = np.empty((n_parts * n_free, tt.size))
+                us = []
+                for p, (loads, gap) in enumerate(parts):
                     ld = {name: fn(tt) for name, fn in loads.items()}
                     u = self.known(ld, tt.size)
-                    rs.append((self.drive(ld, tt.size, gap) - self.coupling @ u)
-                              / gamma[:, None])
+                    rows = r[p * n_free:(p + 1) * n_free]
+                    # (drive - coupling u) / gamma
+                    np.matmul(-single, u, out=rows)
+                    if gap:
+                        rows += gap * per_gamma["gap"][:, None]
+                    for name in ("settlement", "tilt"):
+                        if name in ld:
+                            rows += np.multiply.outer(per_gamma[name], ld[name])
                     us.append(u)
-                memo[key] = (np.tile(d, (n_parts, 1)) if n_parts > 1 else d,
-                             np.concatenate(rs), np.concatenate(us))
+                memo[key] = (np.tile(d, (n_parts, 1)) if n_parts > 1 else d, r,
+                             np.concatenate(us))
             return memo[key]
 
-        single = self.coupling / gamma[:, None]
         problem = ModalProblem(d=lambda tt: evaluate(tt)[0], r=lambda tt: evaluate(tt)[1],
                                u=lambda tt: evaluate(tt)[2],
                                coupling=(np.kron(np.eye(n_parts), single) if n_parts > 1
