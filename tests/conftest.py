@@ -3,7 +3,8 @@
 - No state leaks between tests: mpmath's working precision is restored after every test
   (a test that needs more digits uses ``mpmath.workdps``), and stage evaluations are
   counted from a fixture that starts from empty stage caches (:func:`stage_evaluations`),
-  so a count does not depend on which tests ran before.
+  so a count does not depend on which tests ran before; a test that looks at what the
+  caches hold asks for :func:`cold_caches`.
 - Tests wait on conditions, never on the clock: :func:`wait_until` polls a condition and
   returns False when a generous bound runs out (a failure bound, not a measurement).
 - Property tests draw the same examples on every run (hypothesis profile ``suite``,
@@ -69,15 +70,20 @@ def _mpmath_precision_restored() -> Iterator[None]:
 
 
 @pytest.fixture
-def stage_evaluations() -> Callable[[], dict[str, int]]:
-    """Evaluations of each solver stage since the test began, from empty stage caches.
-
-    The caches are process-wide; emptied here, a test's counts are those of its own
-    solves, whatever ran before it.
-    """
-    from core.cache import clear_caches, stage_counts
+def cold_caches() -> None:
+    """Empty stage caches when the test begins: the caches are process-wide, so what a test
+    then finds cached is what its own solves put there, whatever ran before it."""
+    from core.cache import clear_caches
 
     clear_caches()
+
+
+@pytest.fixture
+def stage_evaluations(cold_caches: None) -> Callable[[], dict[str, int]]:
+    """Evaluations of each solver stage since the test began, from empty stage caches
+    (:func:`cold_caches`): a test's counts are those of its own solves."""
+    from core.cache import stage_counts
+
     start = stage_counts()
 
     def since_start() -> dict[str, int]:

@@ -31,7 +31,8 @@ def _panel_set(panels) -> set[tuple[float, float]]:
     return set(zip(edges[:-1], edges[1:], strict=True))
 
 
-def test_a_moment_change_past_lift_off_builds_nothing_geometric(monkeypatch) -> None:
+def test_a_moment_change_past_lift_off_builds_nothing_geometric(monkeypatch,
+                                                              cold_caches) -> None:
     from core.contact_march import _RULE_OPERATORS
 
     solve(_lesson())          # caches warm, as in the explorer after the lesson's first solve

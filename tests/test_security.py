@@ -219,6 +219,7 @@ def test_many_jumps_are_refused_before_the_solver_sees_them() -> None:
     # the same rows interpolated smoothly have two breakpoints (the end rows): solved
     smooth = edited("punch.shape", {"kind": "table", "points": rows,
                                     "interpolation": "pchip"})
+    smooth["times"]["count"] = 1  # accepted and solved is the point: 3 s of CPU, not 12
     assert np.all(np.isfinite(solve(smooth).settlement))
     steps = {"kind": "step", "values": [1e8 * (2 + (-1) ** k) for k in range(10_001)],
              "breaks": list(np.linspace(-0.999, 0.999, 10_000))}
