@@ -87,13 +87,21 @@ def test_several_pins_named_in_the_legend_removed_one_by_one_and_linked(
 
 def test_pin_every_step_keeps_the_steps_of_a_slider(page: Page) -> None:
     page.page.locator(".pin-every-step input").first.check()
+
+    def seen() -> str:  # what the page shows, for a failure's message
+        checked = page.page.locator(".pin-every-step input").first.is_checked()
+        return (f"readout force {page.text('.readout-force')}, {_pins(page)} pins, "
+                f"box checked {checked}, legend {page.page.evaluate(JS_LEGEND, 1)!r}")
+
     # each step is pinned when its result arrives: wait for that pin before the next step
     # (a step typed while the previous one is still solving may be skipped, as a dragged
     # slider skips values; the readout alone can show a step before its pin is drawn)
     for count, force in enumerate(("600", "700", "800"), start=1):
         page.type_into(".load-0-value", force)
-        until(lambda force=force: page.text(".readout-force") == force, f"force {force}")
-        until(lambda count=count: _pins(page) == count, f"step {count} pinned")
+        until(lambda force=force: page.text(".readout-force") == force, f"force {force}",
+              describe=seen)
+        until(lambda count=count: _pins(page) == count, f"step {count} pinned",
+              describe=seen)
     assert page.page.evaluate(JS_LEGEND, 2) == "P = 800 kN/m"
     assert page.errors == []
 
