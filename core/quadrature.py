@@ -328,24 +328,28 @@ def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
             block[...] = kernel_block(distance, accuracy)
             block *= weights[None, :]
     if near_t.size:
-        cols = near_s[:, None] * NODES_PER_PANEL + _J[None, :]  # positions among sources
-        offset = np.abs(targets[near_t, None] - nodes[cols])  # |x - xi|
+        # (target, source panel) blocks of 16 through a view: whole rows of 16 gathered and
+        # scattered, not 16 index pairs each
+        by_pair = rows.reshape(targets.size, sources.size, NODES_PER_PANEL)
+        near_w = weights.reshape(-1, NODES_PER_PANEL)[near_s]
+        offset = np.abs(targets[near_t, None] - nodes.reshape(-1, NODES_PER_PANEL)[near_s])
         if accuracy > FULL_ACCURACY:
             # k_reg(lam d) - ln lam = k_pl(lam d) + ln d: the far value just computed plus a
             # log, instead of the series again (~15x cheaper per entry); the sum errs by
             # ~|ln d| x 1e-16 (and by the decayed k_pl, below the accuracy, where those are
             # zeros). d = 0 (a target on a node) takes k_reg(0) - ln lam.
             with np.errstate(divide="ignore", invalid="ignore"):
-                near = rows[near_t[:, None], cols] + np.log(offset) * weights[cols]
+                near = by_pair[near_t, near_s] + np.log(offset) * near_w
             on_node = offset == 0.0
             if on_node.any():
                 at_zero = kernel_regular(np.zeros(1), accuracy)[0] - np.log(lam)
-                near[on_node] = at_zero * np.broadcast_to(weights[cols], near.shape)[on_node]
-            rows[near_t[:, None], cols] = near - log_weights / np.pi
+                near[on_node] = at_zero * near_w[on_node]
+            near -= log_weights / np.pi
+            by_pair[near_t, near_s] = near
         else:
             smooth = kernel_regular(lam * offset, accuracy)
             smooth -= np.log(lam)
-            rows[near_t[:, None], cols] = smooth * weights[cols] - log_weights / np.pi
+            by_pair[near_t, near_s] = smooth * near_w - log_weights / np.pi
     return rows
 
 
