@@ -36,6 +36,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from core import pair_tables
 from core.kernel_values import FULL_ACCURACY, kernel_block, kernel_regular
 from core.log_moments import legendre_log_moments
 from core.panels import (  # re-exported: the grid is part of this module's interface
@@ -172,76 +173,71 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
     ratio, offset = np.round(raw_ratio, 12), np.round(raw_offset, 12)
     # The distinct keys (a few on graded panels) by one np.unique of ratio + i offset.
     unique, inverse = np.unique(ratio + 1j * offset, return_inverse=True)
-    keys = list(zip(unique.real.tolist(), unique.imag.tolist(), strict=True))
-    # Looked up into a local dict first: another thread may empty the shared one.
-    found = {k: _PAIR_TABLES.get(k) for k in keys}
-    missing = [k for k, v in found.items() if v is None]
-    if missing:
-        new = _pair_tables(np.array(missing))
-        found.update(new)
-        if len(_PAIR_TABLES) + len(new) > _PAIR_TABLES_MAX:
-            _PAIR_TABLES.clear()
-        _PAIR_TABLES.update(new)
-    tables = [found[k] for k in keys]
-    near = np.array([t[0] for t in tables])[inverse.ravel()]  # (pairs, 16 target nodes)
-    which, node = np.nonzero(near)
-    u = inverse.ravel()[which]
-    h = sh[pair_s[which]]
+    store, rows_of_keys = pair_tables.lookup(
+        list(zip(unique.real.tolist(), unique.imag.tolist(), strict=True)), NEAR_FIELD)
+    inverse = inverse.ravel()
+    table_of_pair = rows_of_keys[inverse]
+    which, node = np.nonzero(store.near[table_of_pair])  # near (pair, target node)
+    u = table_of_pair[which]
     near_t = pair_t[which] * NODES_PER_PANEL + node
     if accuracy > FULL_ACCURACY:
-        return _near_from_tables(lam, panels, targets, sources, tables, is_self=unique == 1.0,
-                                 u=u, node=node, near_t=near_t, near_s=pair_s[which],
+        return _near_from_tables(lam, panels, targets, sources, store,
+                                 own=(unique == 1.0)[inverse[which]], u=u, node=node,
+                                 near_t=near_t, near_s=pair_s[which],
                                  shift=(raw_offset - offset)[which]
                                  + (raw_ratio - ratio)[which] * _T[node], accuracy=accuracy)
-    reference = np.array([t[1] for t in tables])[u, node]  # (near pairs, 16)
-    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + reference)
+    h = sh[pair_s[which]]
+    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + store.reference[u, node])
     return _rows(lam, panels, targets, sources, near_t, pair_s[which], log_weights,
                  accuracy)
 
 
-#: Share of the kernel accuracy left to the first-order term of a key's rounding (below
-#: it the term is skipped: at accuracy >= ~1e-11 it always is).
-_SHIFT_SHARE = 1e-3
+#: Share of the kernel accuracy (relative to an entry's weight / pi, as the kernel values'
+#: own error) left to the tables' approximations: the first-order term of a key's
+#: rounding is skipped, and the tables' distances stand for the nodes' own, below it.
+_TABLE_SHARE = 1e-2
 
 
 def _near_from_tables(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
-                      tables: list, *, is_self: np.ndarray, u: np.ndarray, node: np.ndarray,
+                      store: pair_tables.PairTables, *, own: np.ndarray, u: np.ndarray,
+                      node: np.ndarray,
                       near_t: np.ndarray, near_s: np.ndarray, shift: np.ndarray,
                       accuracy: float) -> np.ndarray:
     """:func:`node_rows` at a loose kernel accuracy: the far values everywhere, then on the
     near entries ``+ h/pi (W_j ln|z - t_j| - R)`` from the tables (the log of each entry's
     distance and the log weights cancel ``ln h``; no log is taken per entry).
 
-    ``u``: each near row's table; ``node``: its target node; ``shift``: the target's offset
-    from the table's (the key's rounding, <= 5e-13), put back to first order where it
-    could reach ``_SHIFT_SHARE`` of the accuracy; ``is_self``: tables of a panel on itself
-    (a target on a node, where the far value is -ln 0 and k_reg(0) - ln(lam h) is used).
+    ``u``: each near row's table in ``store``; ``node``: its target node; ``shift``: the
+    target's offset from the table's (the key's rounding, <= 5e-13), put back to first
+    order where it could reach ``_TABLE_SHARE`` of the accuracy; ``own``: rows of a panel
+    on itself (a target on a node, where the far value is -ln 0 and k_reg(0) - ln(lam h)
+    is used).
     """
     rows = _rows(lam, panels, targets, sources, near_t[:0], near_s[:0],
                  np.empty((0, NODES_PER_PANEL)), accuracy)
     by_pair = rows.reshape(targets.size, sources.size, NODES_PER_PANEL)
     h = panels.half_widths[sources[near_s]]
-    correction = np.array([t[2] for t in tables])[u, node]
-    slope = np.array([t[4] for t in tables])[u, node]  # max_j |D| of each row
+    correction = store.correction[u, node]
+    steepest = store.steepest[u, node]  # 1 / the row's smallest |z - t_j|
     # The entries' distances are the nodes' (rounded to ~_NODE_ROUNDING), the tables' are
-    # exact: ln differs by _NODE_ROUNDING |D| / (h W_j). Rows where that could reach the
-    # accuracy's share (a target within ~1e-4 h of a node, or panels ~1e-12 wide) take
-    # the log of their own distances instead.
-    exact = ((_NODE_ROUNDING / np.pi) * slope > _SHIFT_SHARE * accuracy) | (
-        _NODE_ROUNDING * slope > 0.01 * _W.min() * h)
+    # exact: ln differs by _NODE_ROUNDING / (h |z - t_j|), relative. Rows where that could
+    # reach the tables' share of the accuracy (a target within ~1e-5 h of a node, or
+    # panels narrower than ~1e-4) take the log of their own distances instead.
+    exact = _NODE_ROUNDING * steepest > min(_TABLE_SHARE * accuracy, 1e-3) * h
     if exact.any():
-        _exact_near(lam, panels, targets, sources, tables, by_pair, u[exact], node[exact],
-                    near_t[exact], near_s[exact], h[exact], accuracy)
+        _exact_near(lam, panels, targets, sources, store.reference[u[exact], node[exact]],
+                    by_pair, near_t[exact], near_s[exact], h[exact], accuracy)
         keep = ~exact
         u, node, near_t, near_s = u[keep], node[keep], near_t[keep], near_s[keep]
-        h, shift, slope, correction = h[keep], shift[keep], slope[keep], correction[keep]
-    reach = np.abs(shift) * slope * h / np.pi
-    far_off = np.nonzero(reach > _SHIFT_SHARE * accuracy)[0]
+        own = own[keep]
+        h, shift, steepest, correction = h[keep], shift[keep], steepest[keep], correction[keep]
+    # the key's rounding moves ln by shift / (z - t_j): put back where it could matter
+    far_off = np.nonzero(np.abs(shift) * steepest > _TABLE_SHARE * accuracy)[0]
     if far_off.size:
         correction[far_off] += (shift[far_off, None]
-                                * np.array([t[3] for t in tables])[u[far_off], node[far_off]])
+                                * store.slope[u[far_off], node[far_off]])
     correction *= (h / np.pi)[:, None]
-    own = np.nonzero(is_self[u])[0]
+    own = np.nonzero(own)[0]
     if own.size:
         at_zero = kernel_regular(np.zeros(1), accuracy)[0] - np.log(lam)
         column = node[own]
@@ -257,15 +253,14 @@ _NODE_ROUNDING = 2 * np.finfo(float).eps
 
 
 def _exact_near(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
-                tables: list, by_pair: np.ndarray, u: np.ndarray, node: np.ndarray,
-                near_t: np.ndarray, near_s: np.ndarray, h: np.ndarray, accuracy: float
-                ) -> None:
+                reference: np.ndarray, by_pair: np.ndarray, near_t: np.ndarray,
+                near_s: np.ndarray, h: np.ndarray, accuracy: float) -> None:
     """Near rows of :func:`_near_from_tables` from their own distances (as :func:`_rows`
-    does), written into ``by_pair`` (targets, sources, 16) in place."""
+    does), written into ``by_pair`` (targets, sources, 16) in place; ``reference``: their
+    rows of the tables' product weights."""
     src = sources[near_s][:, None] * NODES_PER_PANEL + _J[None, :]
     offset = np.abs(targets[near_t][:, None] - panels.nodes[src])
     weights = panels.weights[src] / np.pi
-    reference = np.array([t[1] for t in tables])[u, node]
     log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + reference)
     with np.errstate(divide="ignore", invalid="ignore"):
         near = by_pair[near_t, near_s] + np.log(offset) * weights
@@ -275,34 +270,6 @@ def _exact_near(lam: float, panels: Panels, targets: np.ndarray, sources: np.nda
         near[on_node] = at_zero * weights[on_node]
     by_pair[near_t, near_s] = near - log_weights / np.pi
 
-
-def _pair_tables(keys: np.ndarray) -> dict[tuple[float, float], tuple[np.ndarray, ...]]:
-    """Tables of :func:`node_rows` for (ratio, offset) keys (K, 2): near mask (16,), the
-    product weights ``R = M(z) @ _TO_COEF`` (16 x 16), ``C = W_j ln|z_i - t_j| - R`` and
-    ``D = W_j / (z_i - t_j)`` (both 0 on a node, where C = -R) and ``max_j |D|`` (16,), z
-    the target nodes in the source panel's coordinate."""
-    z = keys[:, 1:] + keys[:, :1] * _T[None, :]  # (K, 16)
-    moments = legendre_log_moments(z.ravel(), NODES_PER_PANEL - 1) @ _TO_COEF
-    moments = moments.reshape(len(keys), NODES_PER_PANEL, NODES_PER_PANEL)
-    apart = z[:, :, None] - _T[None, None, :]
-    on_node = apart == 0.0
-    apart[on_node] = 1.0
-    log_term = np.where(on_node, 0.0, _W * np.log(np.abs(apart)))
-    slope = np.where(on_node, 0.0, _W / apart)
-    correction = log_term - moments
-    steepest = np.max(np.abs(slope), axis=2)  # (K, 16): per target node
-    out = {}
-    for key, zk, table, c, d, top in zip(map(tuple, keys.tolist()), z, moments, correction,
-                                          slope, steepest, strict=True):
-        out[key] = (np.abs(zk) <= NEAR_FIELD, table, c, d, top)
-    return out
-
-
-#: Reference tables of :func:`node_rows`, keyed by (half-width ratio, centre offset) of a
-#: (target, source) panel pair rounded to 1e-12 (moments move by ~1e-12 of their size):
-#: see :func:`_pair_tables`. Emptied when it holds more.
-_PAIR_TABLES: dict[tuple[float, float], tuple[np.ndarray, ...]] = {}
-_PAIR_TABLES_MAX = 4096
 
 
 def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
