@@ -195,7 +195,7 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
 #: Share of the kernel accuracy (relative to an entry's weight / pi, as the kernel values'
 #: own error) left to the tables' approximations: the first-order term of a key's
 #: rounding is skipped, and the tables' distances stand for the nodes' own, below it.
-_TABLE_SHARE = 1e-2
+_TABLE_SHARE = 0.1
 
 
 def _near_from_tables(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,

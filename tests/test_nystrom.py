@@ -347,6 +347,6 @@ def test_operator_from_pair_tables_matches_its_own_distances(accuracy):
                            accuracy=accuracy)
         own = operator_rows(1.0, sources, targets.nodes, accuracy=accuracy)
         # measured: <= 6.8e-14 at 1e-6 (a key's rounding, 5e-13 at most, left out below
-        # 1e-2 of the accuracy relative to the weight), <= 1.6e-15 at 1e-10
+        # 0.1 of the accuracy relative to the weight), <= 1.6e-15 at 1e-10
         assert np.all(np.isfinite(tabled))
         assert np.max(np.abs(tabled - own)) <= 1e-13
