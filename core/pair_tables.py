@@ -11,7 +11,9 @@ the source panel's coordinate (z the target nodes there, t_j and W_j the Gauss r
 * ``slope`` (16, 16): ``W_j / (z_i - t_j)`` (0 on a node) and ``steepest`` (16,): the
   largest ``1 / |z_i - t_j|`` of each target node (nodes excepted).
 
-The tables of all keys seen are kept stacked in arrays, so that one call gathers the
+:func:`add_near` turns the far values of an operator's rows into its near entries with
+them, at the loose kernel accuracy of a target tol. The tables of all keys seen are kept
+stacked in arrays, so that one call gathers the
 rows it needs with one index instead of stacking a list of small arrays (~0.03 ms a
 call, 3-4 calls a new scene). Rows are only appended (under a lock); a reader keeps the
 store it started with, so a store replaced meanwhile (grown, or emptied at MAX_KEYS)
@@ -25,8 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from core.kernel_values import kernel_regular
 from core.log_moments import legendre_log_moments
-from core.panels import _T, _TO_COEF, _W, NODES_PER_PANEL
+from core.panels import _T, _TO_COEF, _W, NODES_PER_PANEL, Panels
 
 #: Keys kept; the store is emptied when a new one would pass it (4096 keys hold ~25 MB).
 MAX_KEYS = 4096
@@ -114,6 +117,83 @@ def _add(missing: list[tuple[float, float]], near_field: float) -> PairTables:
             store.index[key] = size + i
         _STORE = store
         return store
+
+
+#: Share of the kernel accuracy (relative to an entry's weight / pi, as the kernel values'
+#: own error) left to the tables' approximations: the first-order term of a key's
+#: rounding is skipped, and the tables' distances stand for the nodes' own, below it.
+_TABLE_SHARE = 0.1
+
+
+def add_near(rows: np.ndarray, lam: float, panels: Panels, targets: np.ndarray,
+             sources: np.ndarray, store: PairTables, *, own: np.ndarray, u: np.ndarray,
+             node: np.ndarray, near_t: np.ndarray, near_s: np.ndarray, shift: np.ndarray,
+             accuracy: float) -> None:
+    """The near entries of operator rows at panel nodes, at a loose kernel accuracy, in
+    place: ``rows`` (targets x 16 len(sources)) holds the far values everywhere (kernel
+    values to ``accuracy``, :func:`core.kernel_values.kernel_block`); the near entries add
+    ``h/pi (W_j ln|z - t_j| - R)`` from the tables (the log of each entry's distance and
+    the product weights cancel ``ln h``; no log is taken per entry).
+
+    ``u``: each near row's table in ``store``; ``node``: its target node; ``shift``: the
+    target's offset from the table's (the key's rounding, <= 5e-13), put back to first
+    order where it could reach ``_TABLE_SHARE`` of the accuracy; ``own``: rows of a panel
+    on itself (a target on a node, where the far value is -ln 0 and k_reg(0) - ln(lam h)
+    is used).
+    """
+    by_pair = rows.reshape(targets.size, sources.size, NODES_PER_PANEL)
+    h = panels.half_widths[sources[near_s]]
+    correction = store.correction[u, node]
+    steepest = store.steepest[u, node]  # 1 / the row's smallest |z - t_j|
+    # The entries' distances are the nodes' (rounded to ~_NODE_ROUNDING), the tables' are
+    # exact: ln differs by _NODE_ROUNDING / (h |z - t_j|), relative. Rows where that could
+    # reach the tables' share of the accuracy (a target within ~1e-5 h of a node, or
+    # panels narrower than ~1e-4) take the log of their own distances instead.
+    exact = _NODE_ROUNDING * steepest > min(_TABLE_SHARE * accuracy, 1e-3) * h
+    if exact.any():
+        _exact_near(lam, panels, targets, sources, store.reference[u[exact], node[exact]],
+                    by_pair, near_t[exact], near_s[exact], h[exact], accuracy)
+        keep = ~exact
+        u, node, near_t, near_s = u[keep], node[keep], near_t[keep], near_s[keep]
+        own = own[keep]
+        h, shift, steepest, correction = h[keep], shift[keep], steepest[keep], correction[keep]
+    # the key's rounding moves ln by shift / (z - t_j): put back where it could matter
+    far_off = np.nonzero(np.abs(shift) * steepest > _TABLE_SHARE * accuracy)[0]
+    if far_off.size:
+        correction[far_off] += (shift[far_off, None]
+                                * store.slope[u[far_off], node[far_off]])
+    correction *= (h / np.pi)[:, None]
+    own = np.nonzero(own)[0]
+    if own.size:
+        at_zero = kernel_regular(np.zeros(1), accuracy)[0] - np.log(lam)
+        column = node[own]
+        weight = panels.weights[sources[near_s[own]] * NODES_PER_PANEL + column] / np.pi
+        by_pair[near_t[own], near_s[own], column] = 0.0  # was -ln 0
+        correction[own, column] += weight * (at_zero - np.log(h[own]))
+    by_pair[near_t, near_s] += correction
+
+
+#: Rounding of two node abscissae in [-1, 1] (2 ulp of 1): their distance errs by this.
+_NODE_ROUNDING = 2 * np.finfo(float).eps
+
+
+def _exact_near(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
+                reference: np.ndarray, by_pair: np.ndarray, near_t: np.ndarray,
+                near_s: np.ndarray, h: np.ndarray, accuracy: float) -> None:
+    """Near rows of :func:`add_near` from their own distances (as
+    :func:`core.quadrature.operator_rows` does), written into ``by_pair`` (targets,
+    sources, 16) in place; ``reference``: their rows of the tables' product weights."""
+    src = sources[near_s][:, None] * NODES_PER_PANEL + np.arange(NODES_PER_PANEL)[None, :]
+    offset = np.abs(targets[near_t][:, None] - panels.nodes[src])
+    weights = panels.weights[src] / np.pi
+    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + reference)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        near = by_pair[near_t, near_s] + np.log(offset) * weights
+    on_node = offset == 0.0
+    if on_node.any():
+        at_zero = kernel_regular(np.zeros(1), accuracy)[0] - np.log(lam)
+        near[on_node] = at_zero * weights[on_node]
+    by_pair[near_t, near_s] = near - log_weights / np.pi
 
 
 def clear() -> None:

@@ -181,95 +181,19 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
     u = table_of_pair[which]
     near_t = pair_t[which] * NODES_PER_PANEL + node
     if accuracy > FULL_ACCURACY:
-        return _near_from_tables(lam, panels, targets, sources, store,
-                                 own=(unique == 1.0)[inverse[which]], u=u, node=node,
-                                 near_t=near_t, near_s=pair_s[which],
-                                 shift=(raw_offset - offset)[which]
-                                 + (raw_ratio - ratio)[which] * _T[node], accuracy=accuracy)
+        # the far values everywhere, then the near entries from the tables
+        rows = _rows(lam, panels, targets, sources, near_t[:0], near_t[:0],
+                     np.empty((0, NODES_PER_PANEL)), accuracy)
+        pair_tables.add_near(rows, lam, panels, targets, sources, store,
+                             own=(unique == 1.0)[inverse[which]], u=u, node=node,
+                             near_t=near_t, near_s=pair_s[which],
+                             shift=(raw_offset - offset)[which]
+                             + (raw_ratio - ratio)[which] * _T[node], accuracy=accuracy)
+        return rows
     h = sh[pair_s[which]]
     log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + store.reference[u, node])
     return _rows(lam, panels, targets, sources, near_t, pair_s[which], log_weights,
                  accuracy)
-
-
-#: Share of the kernel accuracy (relative to an entry's weight / pi, as the kernel values'
-#: own error) left to the tables' approximations: the first-order term of a key's
-#: rounding is skipped, and the tables' distances stand for the nodes' own, below it.
-_TABLE_SHARE = 0.1
-
-
-def _near_from_tables(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
-                      store: pair_tables.PairTables, *, own: np.ndarray, u: np.ndarray,
-                      node: np.ndarray,
-                      near_t: np.ndarray, near_s: np.ndarray, shift: np.ndarray,
-                      accuracy: float) -> np.ndarray:
-    """:func:`node_rows` at a loose kernel accuracy: the far values everywhere, then on the
-    near entries ``+ h/pi (W_j ln|z - t_j| - R)`` from the tables (the log of each entry's
-    distance and the log weights cancel ``ln h``; no log is taken per entry).
-
-    ``u``: each near row's table in ``store``; ``node``: its target node; ``shift``: the
-    target's offset from the table's (the key's rounding, <= 5e-13), put back to first
-    order where it could reach ``_TABLE_SHARE`` of the accuracy; ``own``: rows of a panel
-    on itself (a target on a node, where the far value is -ln 0 and k_reg(0) - ln(lam h)
-    is used).
-    """
-    rows = _rows(lam, panels, targets, sources, near_t[:0], near_s[:0],
-                 np.empty((0, NODES_PER_PANEL)), accuracy)
-    by_pair = rows.reshape(targets.size, sources.size, NODES_PER_PANEL)
-    h = panels.half_widths[sources[near_s]]
-    correction = store.correction[u, node]
-    steepest = store.steepest[u, node]  # 1 / the row's smallest |z - t_j|
-    # The entries' distances are the nodes' (rounded to ~_NODE_ROUNDING), the tables' are
-    # exact: ln differs by _NODE_ROUNDING / (h |z - t_j|), relative. Rows where that could
-    # reach the tables' share of the accuracy (a target within ~1e-5 h of a node, or
-    # panels narrower than ~1e-4) take the log of their own distances instead.
-    exact = _NODE_ROUNDING * steepest > min(_TABLE_SHARE * accuracy, 1e-3) * h
-    if exact.any():
-        _exact_near(lam, panels, targets, sources, store.reference[u[exact], node[exact]],
-                    by_pair, near_t[exact], near_s[exact], h[exact], accuracy)
-        keep = ~exact
-        u, node, near_t, near_s = u[keep], node[keep], near_t[keep], near_s[keep]
-        own = own[keep]
-        h, shift, steepest, correction = h[keep], shift[keep], steepest[keep], correction[keep]
-    # the key's rounding moves ln by shift / (z - t_j): put back where it could matter
-    far_off = np.nonzero(np.abs(shift) * steepest > _TABLE_SHARE * accuracy)[0]
-    if far_off.size:
-        correction[far_off] += (shift[far_off, None]
-                                * store.slope[u[far_off], node[far_off]])
-    correction *= (h / np.pi)[:, None]
-    own = np.nonzero(own)[0]
-    if own.size:
-        at_zero = kernel_regular(np.zeros(1), accuracy)[0] - np.log(lam)
-        column = node[own]
-        weight = panels.weights[sources[near_s[own]] * NODES_PER_PANEL + column] / np.pi
-        by_pair[near_t[own], near_s[own], column] = 0.0  # was -ln 0
-        correction[own, column] += weight * (at_zero - np.log(h[own]))
-    by_pair[near_t, near_s] += correction
-    return rows
-
-
-#: Rounding of two node abscissae in [-1, 1] (2 ulp of 1): their distance errs by this.
-_NODE_ROUNDING = 2 * np.finfo(float).eps
-
-
-def _exact_near(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
-                reference: np.ndarray, by_pair: np.ndarray, near_t: np.ndarray,
-                near_s: np.ndarray, h: np.ndarray, accuracy: float) -> None:
-    """Near rows of :func:`_near_from_tables` from their own distances (as :func:`_rows`
-    does), written into ``by_pair`` (targets, sources, 16) in place; ``reference``: their
-    rows of the tables' product weights."""
-    src = sources[near_s][:, None] * NODES_PER_PANEL + _J[None, :]
-    offset = np.abs(targets[near_t][:, None] - panels.nodes[src])
-    weights = panels.weights[src] / np.pi
-    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + reference)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        near = by_pair[near_t, near_s] + np.log(offset) * weights
-    on_node = offset == 0.0
-    if on_node.any():
-        at_zero = kernel_regular(np.zeros(1), accuracy)[0] - np.log(lam)
-        near[on_node] = at_zero * weights[on_node]
-    by_pair[near_t, near_s] = near - log_weights / np.pi
-
 
 
 def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
