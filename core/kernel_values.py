@@ -53,8 +53,10 @@ def kernel_regular(s: np.ndarray, accuracy: float) -> np.ndarray:
     coef = _even_coefficients(accuracy)
     y = 0.5 * s * s
     y -= 1.0
-    out = np.full_like(y, coef[-1])
-    for c in coef[-2::-1]:
+    # Horner, its first step (c_n y + c_(n-1)) without filling an array with c_n
+    out = y * coef[-1]
+    out += coef[-2]
+    for c in coef[-3::-1]:
         out *= y
         out += c
     return out

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from core.inputs import TimeInputs
+from core.panels import NODES_PER_PANEL
 from core.statements import QUANTITIES
 
 #: Probe times per block when the extremes of q over the check points are sought: a block
@@ -91,7 +92,11 @@ class ElasticUnits:
             prepared = self._prepared
             x, formula = prepared.check_x, prepared.check_formula
             check = np.empty((x.size, self.nodal.shape[1]))
-            check[~formula] = prepared.grid.interpolate(x[~formula], self.nodal)
+            # the prepared geometry's interpolation weights, panel by panel (forming them
+            # again here cost ~0.07 ms a new scene)
+            nodal = self.nodal.reshape(prepared.grid.panels.n_panels, NODES_PER_PANEL, -1)
+            for panel, points, weights in prepared._check_interpolation:
+                check[points] = weights @ nodal[panel]
             check[formula] = self.pressure(x[formula])
             self._check = check
         return self._check

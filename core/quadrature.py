@@ -36,6 +36,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from core import pair_tables
 from core.kernel_values import FULL_ACCURACY, kernel_block, kernel_regular
 from core.log_moments import legendre_log_moments
 from core.panels import (  # re-exported: the grid is part of this module's interface
@@ -167,47 +168,32 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
     if not pair_t.size:
         return _rows(lam, panels, targets, sources, pair_t, pair_s, np.empty((0, 16)),
                      accuracy)
-    ratio = np.round(th[pair_t] / sh[pair_s], 12)
-    offset = np.round((tc[pair_t] - sc[pair_s]) / sh[pair_s], 12)
-    keys = list(zip(ratio.tolist(), offset.tolist(), strict=True))
-    # Looked up into a local dict first: another thread may empty the shared one.
-    found = {k: _PAIR_TABLES.get(k) for k in dict.fromkeys(keys)}
-    missing = [k for k, v in found.items() if v is None]
-    if missing:
-        keys_array = np.array(missing)  # (missing, 2): ratio, offset
-        z = keys_array[:, 1:] + keys_array[:, :1] * _T[None, :]  # (missing, 16)
-        # Each table a function of its key alone, not of the keys missing with it (else
-        # the operator's last bits depend on what earlier solves cached): moments with
-        # Miller's recurrence from each point's own start, and one 16 x 16 product per
-        # key (a product of all rows at once rounds a row differently by batch size).
-        moments = legendre_log_moments(z.ravel(), NODES_PER_PANEL - 1, own_start=True)
-        moments = moments.reshape(len(missing), NODES_PER_PANEL, NODES_PER_PANEL) @ _TO_COEF
-        near_all = np.abs(z) <= NEAR_FIELD
-        # Shared by later calls (and threads): read-only, so an in-place write raises.
-        moments.setflags(write=False)
-        near_all.setflags(write=False)
-        new = {key: (near, table)
-               for key, near, table in zip(missing, near_all, moments, strict=True)}
-        found.update(new)
-        if len(_PAIR_TABLES) + len(new) > _PAIR_TABLES_MAX:
-            _PAIR_TABLES.clear()
-        _PAIR_TABLES.update(new)
-    tables = [found[k] for k in keys]
-    near = np.array([t[0] for t in tables])  # (pairs, 16 target nodes)
-    which, node = np.nonzero(near)
-    reference = np.array([t[1] for t in tables])[which, node]  # (near pairs, 16)
-    h = sh[pair_s[which]]
-    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + reference)
+    raw_ratio = th[pair_t] / sh[pair_s]
+    raw_offset = (tc[pair_t] - sc[pair_s]) / sh[pair_s]
+    ratio, offset = np.round(raw_ratio, 12), np.round(raw_offset, 12)
+    # The distinct keys (a few on graded panels) by one np.unique of ratio + i offset.
+    unique, inverse = np.unique(ratio + 1j * offset, return_inverse=True)
+    store, rows_of_keys = pair_tables.lookup(
+        list(zip(unique.real.tolist(), unique.imag.tolist(), strict=True)), NEAR_FIELD)
+    inverse = inverse.ravel()
+    table_of_pair = rows_of_keys[inverse]
+    which, node = np.nonzero(store.near[table_of_pair])  # near (pair, target node)
+    u = table_of_pair[which]
     near_t = pair_t[which] * NODES_PER_PANEL + node
+    if accuracy > FULL_ACCURACY:
+        # the far values everywhere, then the near entries from the tables
+        rows = _rows(lam, panels, targets, sources, near_t[:0], near_t[:0],
+                     np.empty((0, NODES_PER_PANEL)), accuracy)
+        pair_tables.add_near(rows, lam, panels, targets, sources, store,
+                             own=(unique == 1.0)[inverse[which]], u=u, node=node,
+                             near_t=near_t, near_s=pair_s[which],
+                             shift=(raw_offset - offset)[which]
+                             + (raw_ratio - ratio)[which] * _T[node], accuracy=accuracy)
+        return rows
+    h = sh[pair_s[which]]
+    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + store.reference[u, node])
     return _rows(lam, panels, targets, sources, near_t, pair_s[which], log_weights,
                  accuracy)
-
-
-#: Reference tables of :func:`node_rows`, keyed by (half-width ratio, centre offset) of a
-#: (target, source) panel pair rounded to 1e-12 (moments move by ~1e-12 of their size):
-#: near mask (16,) and ``M(z) @ _TO_COEF`` (16 x 16). Emptied when it holds more.
-_PAIR_TABLES: dict[tuple[float, float], tuple[np.ndarray, np.ndarray]] = {}
-_PAIR_TABLES_MAX = 4096
 
 
 def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
@@ -233,24 +219,28 @@ def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
             block[...] = kernel_block(distance, accuracy)
             block *= weights[None, :]
     if near_t.size:
-        cols = near_s[:, None] * NODES_PER_PANEL + _J[None, :]  # positions among sources
-        offset = np.abs(targets[near_t, None] - nodes[cols])  # |x - xi|
+        # (target, source panel) blocks of 16 through a view: whole rows of 16 gathered and
+        # scattered, not 16 index pairs each
+        by_pair = rows.reshape(targets.size, sources.size, NODES_PER_PANEL)
+        near_w = weights.reshape(-1, NODES_PER_PANEL)[near_s]
+        offset = np.abs(targets[near_t, None] - nodes.reshape(-1, NODES_PER_PANEL)[near_s])
         if accuracy > FULL_ACCURACY:
             # k_reg(lam d) - ln lam = k_pl(lam d) + ln d: the far value just computed plus a
             # log, instead of the series again (~15x cheaper per entry); the sum errs by
             # ~|ln d| x 1e-16 (and by the decayed k_pl, below the accuracy, where those are
             # zeros). d = 0 (a target on a node) takes k_reg(0) - ln lam.
             with np.errstate(divide="ignore", invalid="ignore"):
-                near = rows[near_t[:, None], cols] + np.log(offset) * weights[cols]
+                near = by_pair[near_t, near_s] + np.log(offset) * near_w
             on_node = offset == 0.0
             if on_node.any():
                 at_zero = kernel_regular(np.zeros(1), accuracy)[0] - np.log(lam)
-                near[on_node] = at_zero * np.broadcast_to(weights[cols], near.shape)[on_node]
-            rows[near_t[:, None], cols] = near - log_weights / np.pi
+                near[on_node] = at_zero * near_w[on_node]
+            near -= log_weights / np.pi
+            by_pair[near_t, near_s] = near
         else:
             smooth = kernel_regular(lam * offset, accuracy)
             smooth -= np.log(lam)
-            rows[near_t[:, None], cols] = smooth * weights[cols] - log_weights / np.pi
+            by_pair[near_t, near_s] = smooth * near_w - log_weights / np.pi
     return rows
 
 

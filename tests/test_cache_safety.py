@@ -35,14 +35,15 @@ def test_stage_cache_values_are_read_only():
 
 
 def test_pair_tables_are_read_only():
-    from core import quadrature
+    from core import pair_tables
     from core.quadrature import Panels, node_rows
 
     panels = Panels.from_edges(np.array([-1.0, -0.25, 0.0, 0.5, 1.0]))
     node_rows(1.0, panels, panels, np.arange(panels.n_panels))
-    assert quadrature._PAIR_TABLES
-    for near, table in quadrature._PAIR_TABLES.values():
-        assert not _written(near) and not _written(table)
+    store = pair_tables.stored()
+    assert store.index
+    for name in ("near", "reference", "correction", "slope", "steepest"):
+        assert not _written(getattr(store, name))
 
 
 def test_module_tables_are_read_only():

@@ -42,12 +42,12 @@ def test_creep_at_loading_equals_the_elastic_answer_from_empty_tables():
     """At t = 1 the base has not crept: the creep answer is the elastic one. On this grid
     (624 nodes) the eigensolver met such a pair when the reference tables of the
     quadrature started empty (a fresh process): 0.0904 instead of 0.2416."""
-    from core import quadrature
+    from core import pair_tables
     from core.creep import ExponentialCreep
     from core.inputs import validate_geometry
     from core.prepared import PreparedContact
 
-    quadrature._PAIR_TABLES.clear()  # the state in which the pair appeared
+    pair_tables.clear()  # the state in which the pair appeared
     law = ExponentialCreep(modulus=3e10, compliance=3e-11, rate=0.05).dimensionless_kernel(28.0)
     prepared = PreparedContact(validate_geometry(1.0, 0.05, 0.0, (), 1e-10))
     elastic = prepared.solve([1.0], force=1.0, moment=0.1).settlement[0]

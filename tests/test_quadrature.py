@@ -74,16 +74,16 @@ def test_operator_does_not_depend_on_what_the_tables_held_before():
     a table's last bits depended on the keys computed with it (Miller's recurrence started
     where the batch's nearest point needed, the product rounded by batch size): the
     operator differed by 1.7e-16, enough for the modal form to meet a complex pair."""
-    from core import quadrature
+    from core import pair_tables
     from core.nystrom_adapt import grade
     from core.quadrature import Panels, kernel_operator
 
     coarse = _graded(1.0, (), 2e-4)
     fine = Panels.from_edges(grade(coarse.edges, np.array([-1.0, 1.0]), 2))
     other = _graded(1.0, (0.3,), 1e-3)
-    quadrature._PAIR_TABLES.clear()
+    pair_tables.clear()
     alone = kernel_operator(1.0, fine).matrix
-    quadrature._PAIR_TABLES.clear()
+    pair_tables.clear()
     kernel_operator(1.0, other)  # a few of its pairs recur on ``fine``, in other batches
     kernel_operator(1.0, coarse)
     after_others = kernel_operator(1.0, fine).matrix
