@@ -145,18 +145,20 @@ def point_costs(study: Study, batch: int | None = None) -> dict[str, dict[str, f
     :mod:`core.sweep_liftoff`, the scaled points and the one-point solves, counted in
     ``one-point solves``). CPU seconds [s] from ``time.process_time``."""
     import core.sweep_batch as batch_module
-    from core.study import point_table
+    from core.study import StudyPoints
     from core.sweep_batch import _load_only_base, run_batch
     from core.sweep_loads import solve_load_batch
-    from core.sweeps import default_batch_points, plan_batches
+    from core.sweep_plan import BatchPlan
+    from core.sweeps import default_batch_points
 
     paths = [p.path for p in study.parameters]
     loads = [path.split(".", 1)[1] for path in paths]
-    table = point_table(study)
+    points = StudyPoints(study)
     scene = _load_only_base(study.base, paths)
     if scene is None:
         raise ValueError("study: point_costs needs a study over given loads only")
-    batches = plan_batches(study, table, batch or default_batch_points(study.n_points))
+    plan = BatchPlan(study, batch or default_batch_points(study.n_points), points)
+    batches = (plan.batch(k) for k in range(plan.n_batches))
     batched, batched_cpu, run_cpu, failed, flagged = 0, 0.0, 0.0, 0, 0
     solves: list[float] = []
     one_point = batch_module.solve
@@ -171,7 +173,8 @@ def point_costs(study: Study, batch: int | None = None) -> dict[str, dict[str, f
     batch_module.solve = counted
     try:
         for index in batches:
-            values = np.stack([np.asarray(table[p])[index] for p in paths], axis=1)
+            point = points(index)
+            values = np.stack([point[p] for p in paths], axis=1)
             cpu = time.process_time()
             answer = solve_load_batch(scene, {q: values[:, j] for j, q in enumerate(loads)},
                                       study.outputs)

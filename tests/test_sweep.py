@@ -220,7 +220,8 @@ def test_contact_width_of_a_pressure_linear_in_x():
 
 
 def test_serial_run_equals_the_loop_and_batches_follow_geometry():
-    from core.sweeps import plan_batches, sweep
+    from core.sweep_plan import BatchPlan
+    from core.sweeps import sweep
 
     study = study_from_dict(small_study())
     ds = sweep(study, client="serial", batch_points=4)
@@ -231,7 +232,8 @@ def test_serial_run_equals_the_loop_and_batches_follow_geometry():
     # a geometry's points are neighbours; inside it, force and moment both varying, the
     # loads in order of eccentricity M / P, then force, then moment
     table = point_table(study)
-    order = np.concatenate(plan_batches(study, table, 4))
+    plan = BatchPlan(study, 4)
+    order = np.concatenate([plan.batch(k) for k in range(plan.n_batches)])
     moduli = table["coating[0].modulus"][order]
     assert np.count_nonzero(np.diff(moduli)) == 1
     force, moment = table["loading.force"][order][:6], table["loading.moment"][order][:6]
