@@ -27,6 +27,7 @@ Output: ``benchmarks/results/sweep.md`` and ``benchmarks/results/sweep_design_ch
 from __future__ import annotations
 
 import argparse
+import contextlib
 import faulthandler
 import json
 import os
@@ -36,6 +37,7 @@ import statistics
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -213,20 +215,55 @@ def _peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def memory_of_study(study: Study, workers: int, work_dir: Path) -> dict[str, float]:
-    """Run ``study`` on a fresh local cluster with its batches streamed to ``work_dir``
-    (no dataset assembled: ``return_dataset=False``); the peak resident memory [MB] of
-    this process (the client and, in a local cluster, the scheduler) and of each worker,
-    the seconds, the workers' CPU [s] and the size of the written parts [MB]."""
-    from distributed import Client, LocalCluster
+@contextlib.contextmanager
+def separate_cluster(workers: int) -> Iterator[str]:
+    """A ``dask scheduler`` and ``workers`` single-threaded ``dask worker`` processes on
+    127.0.0.1, each its own program (so that the client's, the scheduler's and each
+    worker's memory are measured apart); yields the scheduler's address."""
+    import tempfile
 
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           host="127.0.0.1", dashboard_address=None,
-                           env={"OPENBLAS_NUM_THREADS": "1"})
-    client = Client(cluster)
-    client.wait_for_workers(workers)
-    try:
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+               PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    with tempfile.TemporaryDirectory(prefix="study-cluster-") as where:
+        file = Path(where) / "scheduler.json"
+        common = ["--scheduler-file", str(file), "--no-dashboard"]
+        procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler",
+                                   "--host", "127.0.0.1", "--port", "0", *common],
+                                  cwd=where, env=env, stdout=subprocess.DEVNULL,
+                                  stderr=subprocess.DEVNULL)]
+        try:
+            deadline = time.monotonic() + 120
+            while not file.exists() and time.monotonic() < deadline:
+                time.sleep(0.1)
+            procs += [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker",
+                                        "--no-nanny", "--nthreads", "1", "--host",
+                                        "127.0.0.1", *common], cwd=where, env=env,
+                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                      for _ in range(workers)]
+            yield json.loads(file.read_text())["address"]
+        finally:
+            for proc in reversed(procs):
+                proc.terminate()
+            for proc in procs:
+                try:
+                    proc.wait(timeout=30)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    proc.wait(timeout=30)
+
+
+def memory_of_study(study: Study, workers: int, work_dir: Path) -> dict[str, float]:
+    """Run ``study`` on a fresh cluster of separate processes (:func:`separate_cluster`)
+    with its batches streamed to ``work_dir`` (no dataset assembled:
+    ``return_dataset=False``); the peak resident memory [MB] of this process (the client
+    alone), of the scheduler and of the larger worker, the seconds, the workers' CPU [s]
+    and the size of the written parts [MB]."""
+    from distributed import Client
+
+    with separate_cluster(workers) as address, Client(address, timeout=120) as client:
+        client.wait_for_workers(workers, timeout=120)
         before = _peak_rss_mb()
+        scheduler_before = client.run_on_scheduler(_peak_rss_mb)
         worker_before = client.run(_peak_rss_mb)
         cpu_before = client.run(time.process_time)
         start = time.perf_counter()
@@ -234,12 +271,12 @@ def memory_of_study(study: Study, workers: int, work_dir: Path) -> dict[str, flo
         seconds = time.perf_counter() - start
         cpu = sum(t - cpu_before.get(w, 0.0) for w, t in client.run(time.process_time).items())
         workers_peak = client.run(_peak_rss_mb)
-    finally:
-        client.close()
-        cluster.close()
+        scheduler_peak = client.run_on_scheduler(_peak_rss_mb)
+        client_peak = _peak_rss_mb()
     parts = sum(f.stat().st_size for f in Path(work_dir).rglob("*") if f.is_file())
     return {"points": study.n_points, "seconds": seconds, "cpu": cpu,
-            "client_before": before, "client_peak": _peak_rss_mb(),
+            "client_before": before, "client_peak": client_peak,
+            "scheduler_before": scheduler_before, "scheduler_peak": scheduler_peak,
             "workers_before": max(worker_before.values()),
             "workers_peak": max(workers_peak.values()), "parts_mb": parts / 2**20,
             "batches": info["batches"], "failed": info["points_failed"],

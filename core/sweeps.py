@@ -157,7 +157,7 @@ class WorkDir:
 
 def _resolve_client(client: Any, scheduler: str | None) -> tuple[Any, Callable[[], None]]:
     """A distributed client and a function that releases what was started here."""
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     if client is not None:
         return client, lambda: None
@@ -167,17 +167,11 @@ def _resolve_client(client: Any, scheduler: str | None) -> tuple[Any, Callable[[
     if address:
         own = Client(address)
         return own, own.close
-    # one single-threaded worker process per core; BLAS threads would only compete
-    cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1,
-                           processes=True, host="127.0.0.1", dashboard_address=None,
-                           env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-                                "MKL_NUM_THREADS": "1"})
-    own = Client(cluster)
+    # workers warmed as the cluster starts: imports and shared tables are not paid on
+    # each worker's first batch (see core.sweep_warm)
+    from core.sweep_warm import start_local_cluster
 
-    def close() -> None:
-        own.close()
-        cluster.close()
-    return own, close
+    return start_local_cluster()
 
 
 def _run_serial(todo: list[int], plan: BatchPlan, job: Callable) -> Iterator[tuple]:

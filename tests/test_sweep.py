@@ -510,6 +510,26 @@ def test_cli_sweep_on_the_cluster_writes_each_format(loopback_cluster, tmp_path:
                                   ".csv or .parquet)")
 
 
+def test_workers_are_warmed_by_a_plugin_and_the_warming_batches_solve(loopback_cluster):
+    from distributed import Client
+
+    from core.sweep_batch import run_batch
+    from core.sweep_warm import WARM_LOADS, WARM_SCENE, warm_worker, warm_workers
+
+    # the warming batch goes through the load paths: full contact, lift-off and scaled
+    got = run_batch(WARM_SCENE, ["loading.force", "loading.moment"], WARM_LOADS,
+                    ("settlement", "q_min"), 1)
+    assert not np.any(got["flags"] == "failed")
+    q_min = got["values"][:, 1, 0]
+    assert np.all(q_min[:3] > 0) and np.all(q_min[3:] == 0)  # full contact, then lift-off
+    np.testing.assert_allclose(got["values"][4], 2 * got["values"][3], rtol=1e-12)
+    assert warm_worker() > 0
+    with Client(loopback_cluster, timeout=60) as client:
+        warm_workers(client)
+        cpu = client.run(lambda dask_worker: dask_worker.coated_punch_warm_cpu)
+    assert len(cpu) == 2 and all(t > 0 for t in cpu.values())
+
+
 def test_solving_does_not_import_dask():
     code = ("import sys, core, core.cli; core.cli.main(['solve', "
             f"{str(SCENES / 'uniform_flat.json')!r}]); core.solve; core.load_study; "
