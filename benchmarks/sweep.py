@@ -6,10 +6,11 @@
     python -m benchmarks.sweep --no-chart   # only the measurements (no matplotlib needed)
     python -m benchmarks.sweep --point-costs  # where the loads study's CPU goes (no Dask)
     python -m benchmarks.sweep --memory 100000 1000000  # peak memory, batches on disk
+    python -m benchmarks.sweep --loads-runs --repeats 3  # the loads study on 2 / 1 workers
 
 Measured (``core.sweep`` on a local Dask cluster of single-threaded worker processes on
-127.0.0.1, a fresh cluster for every run so that no worker starts with warm caches; the
-cluster's start is timed separately):
+127.0.0.1, a fresh cluster for every run so that no worker starts with the study's caches;
+the cluster's start, its workers' warming included, is timed separately):
 
 * 10,000 elastic points over two loads (force x moment, 100 x 100, one output time):
   goal <= 10 s on 2 workers;
@@ -81,19 +82,20 @@ def modulus_study(n: int) -> Study:
                                                               "count": n}}]})
 
 
-def on_fresh_cluster(study: Study, workers: int) -> dict[str, float]:
-    """Run ``study`` on a new local cluster of ``workers`` processes; seconds of the start
-    and of the study, and the points that failed."""
-    from distributed import Client, LocalCluster
+def on_fresh_cluster(study: Study, workers: int, warm: bool = True) -> dict[str, float]:
+    """Run ``study`` on a new local cluster of ``workers`` processes started as
+    :func:`core.sweep` starts its own (:func:`core.sweep_warm.start_local_cluster`, the
+    workers warmed unless ``warm`` is false: that is counted in the start); seconds of the
+    start and of the study, the workers' CPU in the study and in the warming [s], and the
+    points that failed."""
+    from core.sweep_warm import start_local_cluster
 
     start = time.perf_counter()
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           host="127.0.0.1", dashboard_address=None,
-                           env={"OPENBLAS_NUM_THREADS": "1"})
-    client = Client(cluster)
-    client.wait_for_workers(workers)
+    client, close = start_local_cluster(workers, warm=warm)
     started = time.perf_counter() - start
     try:
+        warm_cpu = sum(client.run(
+            lambda dask_worker: getattr(dask_worker, "coated_punch_warm_cpu", 0.0)).values())
         cpu_before = client.run(time.process_time)
         start = time.perf_counter()
         info = sweep(study, client=client, return_dataset=False)
@@ -103,10 +105,9 @@ def on_fresh_cluster(study: Study, workers: int) -> dict[str, float]:
         cpu_after = client.run(time.process_time)
         cpu = sum(cpu_after[w] - cpu_before.get(w, 0.0) for w in cpu_after)
     finally:
-        client.close()
-        cluster.close()
-    return {"start": started, "seconds": seconds, "cpu": cpu, "load": os.getloadavg()[0],
-            "failed": info["points_failed"],
+        close()
+    return {"start": started, "seconds": seconds, "cpu": cpu, "warm_cpu": warm_cpu,
+            "load": os.getloadavg()[0], "failed": info["points_failed"],
             "flagged": info["points_flagged"], "batches": info["batches"]}
 
 
@@ -364,8 +365,9 @@ def report(results: list[dict[str, Any]], chart: dict[str, Any] | None, command:
     lines = ["# Design studies on Dask: measured", "",
              f"Command: `{command}`  ", f"Machine: {environment()}.", "",
              "Each run starts a fresh local cluster (single-threaded worker processes on "
-             "127.0.0.1; its start is not counted) so that no worker begins with warm "
-             f"solver caches; median of {repeats} run(s). Measured with today's default "
+             "127.0.0.1; its start, the workers' warming included, is not counted) so that "
+             "no worker begins with the study's caches; median of "
+             f"{repeats} run(s). Measured with today's default "
              "solver engine (projection): a faster engine is being introduced, so the "
              "absolute times will change; the batching and the speed-up are what this "
              "measures.", "",
@@ -414,6 +416,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="only the peak memory of full-contact load studies of these "
                              "sizes (squares of 1,000 forces by POINTS / 1,000 moments) "
                              "on 2 workers, batches streamed to a temporary directory")
+    parser.add_argument("--loads-runs", action="store_true",
+                        help="only the 10,000-point loads study on fresh warmed clusters of "
+                             "2 then 1 workers, --repeats times each, and once cold")
     parser.add_argument("--no-chart", action="store_true",
                         help="measure only; keep the design chart drawn before (it needs "
                              "matplotlib)")
@@ -425,6 +430,15 @@ def main(argv: list[str] | None = None) -> int:
         for kind, cost in point_costs(loads_study(45 if args.quick else 100)).items():
             print(f"{kind}: {cost}", flush=True)
         print(f"load average {os.getloadavg()[0]:.1f}")
+        return 0
+    if args.loads_runs:
+        study = loads_study(100)
+        for _ in range(args.repeats):
+            for w in (2, 1):
+                print(f"{w} worker(s), warmed: {on_fresh_cluster(study, w)}", flush=True)
+        for w in (2, 1):
+            print(f"{w} worker(s), cold: {on_fresh_cluster(study, w, warm=False)}",
+                  flush=True)
         return 0
     if args.memory:
         import tempfile
