@@ -61,8 +61,12 @@ class WarmStudyWorker(WorkerPlugin):
     name = "coated-punch-study-warm"
 
     def setup(self, worker: Any) -> None:
-        """Warm the worker (:func:`warm_worker`)."""
-        worker.coated_punch_warm_cpu = warm_worker()
+        """Warm the worker (:func:`warm_worker`); a failure is kept as the worker's
+        ``coated_punch_warm_error``, never stopping it: warming only saves time."""
+        try:
+            worker.coated_punch_warm_cpu = warm_worker()
+        except Exception as exc:  # noqa: BLE001 - the study's own batches report errors
+            worker.coated_punch_warm_error = f"{type(exc).__name__}: {exc}"[:500]
 
 
 def warm_workers(client: Any) -> None:

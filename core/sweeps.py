@@ -18,6 +18,10 @@ ends located along a Chebyshev interpolant (:mod:`core.sweep_liftoff`). A point 
 fails (an invalid scene drawn from a distribution, a solver error) is recorded with its
 message; it never stops the study.
 
+The points and the batches are made batch by batch from the study's description
+(:class:`core.study.StudyPoints`, :class:`core.sweep_plan.BatchPlan`): the client holds no
+array over all the points, whatever the study's size.
+
 Each finished batch is written atomically to a work directory (``parts/batch_NNNNNN.npz``
 next to a ``manifest.json`` naming the study), so a study that was interrupted (a killed
 process, a lost worker) resumes from what was written, and the results stream to disk
@@ -261,9 +265,10 @@ def sweep(study: Study | Mapping[str, Any] | str | os.PathLike, client: Any = No
     ``distributed.Client``; ``"serial"`` runs in this process without Dask; ``None``
     connects to ``scheduler`` (``tcp://HOST:PORT``) or to the Dask config's
     ``scheduler-address``, else starts a local cluster (one single-threaded worker process
-    per core) for the study. ``work_dir`` keeps the finished batches (default: a
-    temporary directory, removed at the end); with the same ``work_dir`` an interrupted
-    study resumes and recomputes nothing already written. ``output`` (``.nc``, ``.csv``,
+    per core, warmed before the study: :mod:`core.sweep_warm`) for the study. ``work_dir``
+    keeps the finished batches (default: a temporary directory, removed at the end); with
+    the same ``work_dir`` an interrupted study resumes and recomputes nothing already
+    written. ``output`` (``.nc``, ``.csv``,
     ``.parquet``) is written at the end. ``progress``: ``True`` draws a bar on stderr; a
     callable gets ``(points done, points in all)`` after every batch and cancels the study
     by returning ``False`` (raising :class:`StudyInterrupted`). With ``return_dataset``

@@ -530,6 +530,19 @@ def test_workers_are_warmed_by_a_plugin_and_the_warming_batches_solve(loopback_c
     assert len(cpu) == 2 and all(t > 0 for t in cpu.values())
 
 
+def test_a_failed_warming_leaves_the_worker_running(monkeypatch):
+    pytest.importorskip("distributed")
+    import core.sweep_warm as warm
+
+    def broken() -> float:
+        raise RuntimeError("no tables today")
+
+    monkeypatch.setattr(warm, "warm_worker", broken)
+    worker = type("Worker", (), {})()
+    warm.WarmStudyWorker().setup(worker)
+    assert worker.coated_punch_warm_error == "RuntimeError: no tables today"
+
+
 def test_solving_does_not_import_dask():
     code = ("import sys, core, core.cli; core.cli.main(['solve', "
             f"{str(SCENES / 'uniform_flat.json')!r}]); core.solve; core.load_study; "
