@@ -6,10 +6,11 @@
     python -m benchmarks.sweep --no-chart   # only the measurements (no matplotlib needed)
     python -m benchmarks.sweep --point-costs  # where the loads study's CPU goes (no Dask)
     python -m benchmarks.sweep --memory 100000 1000000  # peak memory, batches on disk
+    python -m benchmarks.sweep --loads-runs --repeats 3  # the loads study on 2 / 1 workers
 
 Measured (``core.sweep`` on a local Dask cluster of single-threaded worker processes on
-127.0.0.1, a fresh cluster for every run so that no worker starts with warm caches; the
-cluster's start is timed separately):
+127.0.0.1, a fresh cluster for every run so that no worker starts with the study's caches;
+the cluster's start, its workers' warming included, is timed separately):
 
 * 10,000 elastic points over two loads (force x moment, 100 x 100, one output time):
   goal <= 10 s on 2 workers;
@@ -27,6 +28,7 @@ Output: ``benchmarks/results/sweep.md`` and ``benchmarks/results/sweep_design_ch
 from __future__ import annotations
 
 import argparse
+import contextlib
 import faulthandler
 import json
 import os
@@ -36,6 +38,7 @@ import statistics
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -79,19 +82,20 @@ def modulus_study(n: int) -> Study:
                                                               "count": n}}]})
 
 
-def on_fresh_cluster(study: Study, workers: int) -> dict[str, float]:
-    """Run ``study`` on a new local cluster of ``workers`` processes; seconds of the start
-    and of the study, and the points that failed."""
-    from distributed import Client, LocalCluster
+def on_fresh_cluster(study: Study, workers: int, warm: bool = True) -> dict[str, float]:
+    """Run ``study`` on a new local cluster of ``workers`` processes started as
+    :func:`core.sweep` starts its own (:func:`core.sweep_warm.start_local_cluster`, the
+    workers warmed unless ``warm`` is false: that is counted in the start); seconds of the
+    start and of the study, the workers' CPU in the study and in the warming [s], and the
+    points that failed."""
+    from core.sweep_warm import start_local_cluster
 
     start = time.perf_counter()
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           host="127.0.0.1", dashboard_address=None,
-                           env={"OPENBLAS_NUM_THREADS": "1"})
-    client = Client(cluster)
-    client.wait_for_workers(workers)
+    client, close = start_local_cluster(workers, warm=warm)
     started = time.perf_counter() - start
     try:
+        warm_cpu = sum(client.run(
+            lambda dask_worker: getattr(dask_worker, "coated_punch_warm_cpu", 0.0)).values())
         cpu_before = client.run(time.process_time)
         start = time.perf_counter()
         info = sweep(study, client=client, return_dataset=False)
@@ -101,10 +105,9 @@ def on_fresh_cluster(study: Study, workers: int) -> dict[str, float]:
         cpu_after = client.run(time.process_time)
         cpu = sum(cpu_after[w] - cpu_before.get(w, 0.0) for w in cpu_after)
     finally:
-        client.close()
-        cluster.close()
-    return {"start": started, "seconds": seconds, "cpu": cpu, "load": os.getloadavg()[0],
-            "failed": info["points_failed"],
+        close()
+    return {"start": started, "seconds": seconds, "cpu": cpu, "warm_cpu": warm_cpu,
+            "load": os.getloadavg()[0], "failed": info["points_failed"],
             "flagged": info["points_flagged"], "batches": info["batches"]}
 
 
@@ -145,18 +148,20 @@ def point_costs(study: Study, batch: int | None = None) -> dict[str, dict[str, f
     :mod:`core.sweep_liftoff`, the scaled points and the one-point solves, counted in
     ``one-point solves``). CPU seconds [s] from ``time.process_time``."""
     import core.sweep_batch as batch_module
-    from core.study import point_table
+    from core.study import StudyPoints
     from core.sweep_batch import _load_only_base, run_batch
     from core.sweep_loads import solve_load_batch
-    from core.sweeps import default_batch_points, plan_batches
+    from core.sweep_plan import BatchPlan
+    from core.sweeps import default_batch_points
 
     paths = [p.path for p in study.parameters]
     loads = [path.split(".", 1)[1] for path in paths]
-    table = point_table(study)
+    points = StudyPoints(study)
     scene = _load_only_base(study.base, paths)
     if scene is None:
         raise ValueError("study: point_costs needs a study over given loads only")
-    batches = plan_batches(study, table, batch or default_batch_points(study.n_points))
+    plan = BatchPlan(study, batch or default_batch_points(study.n_points), points)
+    batches = (plan.batch(k) for k in range(plan.n_batches))
     batched, batched_cpu, run_cpu, failed, flagged = 0, 0.0, 0.0, 0, 0
     solves: list[float] = []
     one_point = batch_module.solve
@@ -171,7 +176,8 @@ def point_costs(study: Study, batch: int | None = None) -> dict[str, dict[str, f
     batch_module.solve = counted
     try:
         for index in batches:
-            values = np.stack([np.asarray(table[p])[index] for p in paths], axis=1)
+            point = points(index)
+            values = np.stack([point[p] for p in paths], axis=1)
             cpu = time.process_time()
             answer = solve_load_batch(scene, {q: values[:, j] for j, q in enumerate(loads)},
                                       study.outputs)
@@ -210,20 +216,55 @@ def _peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def memory_of_study(study: Study, workers: int, work_dir: Path) -> dict[str, float]:
-    """Run ``study`` on a fresh local cluster with its batches streamed to ``work_dir``
-    (no dataset assembled: ``return_dataset=False``); the peak resident memory [MB] of
-    this process (the client and, in a local cluster, the scheduler) and of each worker,
-    the seconds, the workers' CPU [s] and the size of the written parts [MB]."""
-    from distributed import Client, LocalCluster
+@contextlib.contextmanager
+def separate_cluster(workers: int) -> Iterator[str]:
+    """A ``dask scheduler`` and ``workers`` single-threaded ``dask worker`` processes on
+    127.0.0.1, each its own program (so that the client's, the scheduler's and each
+    worker's memory are measured apart); yields the scheduler's address."""
+    import tempfile
 
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           host="127.0.0.1", dashboard_address=None,
-                           env={"OPENBLAS_NUM_THREADS": "1"})
-    client = Client(cluster)
-    client.wait_for_workers(workers)
-    try:
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+               PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    with tempfile.TemporaryDirectory(prefix="study-cluster-") as where:
+        file = Path(where) / "scheduler.json"
+        common = ["--scheduler-file", str(file), "--no-dashboard"]
+        procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler",
+                                   "--host", "127.0.0.1", "--port", "0", *common],
+                                  cwd=where, env=env, stdout=subprocess.DEVNULL,
+                                  stderr=subprocess.DEVNULL)]
+        try:
+            deadline = time.monotonic() + 120
+            while not file.exists() and time.monotonic() < deadline:
+                time.sleep(0.1)
+            procs += [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker",
+                                        "--no-nanny", "--nthreads", "1", "--host",
+                                        "127.0.0.1", *common], cwd=where, env=env,
+                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                      for _ in range(workers)]
+            yield json.loads(file.read_text())["address"]
+        finally:
+            for proc in reversed(procs):
+                proc.terminate()
+            for proc in procs:
+                try:
+                    proc.wait(timeout=30)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    proc.wait(timeout=30)
+
+
+def memory_of_study(study: Study, workers: int, work_dir: Path) -> dict[str, float]:
+    """Run ``study`` on a fresh cluster of separate processes (:func:`separate_cluster`)
+    with its batches streamed to ``work_dir`` (no dataset assembled:
+    ``return_dataset=False``); the peak resident memory [MB] of this process (the client
+    alone), of the scheduler and of the larger worker, the seconds, the workers' CPU [s]
+    and the size of the written parts [MB]."""
+    from distributed import Client
+
+    with separate_cluster(workers) as address, Client(address, timeout=120) as client:
+        client.wait_for_workers(workers, timeout=120)
         before = _peak_rss_mb()
+        scheduler_before = client.run_on_scheduler(_peak_rss_mb)
         worker_before = client.run(_peak_rss_mb)
         cpu_before = client.run(time.process_time)
         start = time.perf_counter()
@@ -231,12 +272,12 @@ def memory_of_study(study: Study, workers: int, work_dir: Path) -> dict[str, flo
         seconds = time.perf_counter() - start
         cpu = sum(t - cpu_before.get(w, 0.0) for w, t in client.run(time.process_time).items())
         workers_peak = client.run(_peak_rss_mb)
-    finally:
-        client.close()
-        cluster.close()
+        scheduler_peak = client.run_on_scheduler(_peak_rss_mb)
+        client_peak = _peak_rss_mb()
     parts = sum(f.stat().st_size for f in Path(work_dir).rglob("*") if f.is_file())
     return {"points": study.n_points, "seconds": seconds, "cpu": cpu,
-            "client_before": before, "client_peak": _peak_rss_mb(),
+            "client_before": before, "client_peak": client_peak,
+            "scheduler_before": scheduler_before, "scheduler_peak": scheduler_peak,
             "workers_before": max(worker_before.values()),
             "workers_peak": max(workers_peak.values()), "parts_mb": parts / 2**20,
             "batches": info["batches"], "failed": info["points_failed"],
@@ -324,8 +365,9 @@ def report(results: list[dict[str, Any]], chart: dict[str, Any] | None, command:
     lines = ["# Design studies on Dask: measured", "",
              f"Command: `{command}`  ", f"Machine: {environment()}.", "",
              "Each run starts a fresh local cluster (single-threaded worker processes on "
-             "127.0.0.1; its start is not counted) so that no worker begins with warm "
-             f"solver caches; median of {repeats} run(s). Measured with today's default "
+             "127.0.0.1; its start, the workers' warming included, is not counted) so that "
+             "no worker begins with the study's caches; median of "
+             f"{repeats} run(s). Measured with today's default "
              "solver engine (projection): a faster engine is being introduced, so the "
              "absolute times will change; the batching and the speed-up are what this "
              "measures.", "",
@@ -374,6 +416,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="only the peak memory of full-contact load studies of these "
                              "sizes (squares of 1,000 forces by POINTS / 1,000 moments) "
                              "on 2 workers, batches streamed to a temporary directory")
+    parser.add_argument("--loads-runs", action="store_true",
+                        help="only the 10,000-point loads study on fresh warmed clusters of "
+                             "2 then 1 workers, --repeats times each, and once cold")
     parser.add_argument("--no-chart", action="store_true",
                         help="measure only; keep the design chart drawn before (it needs "
                              "matplotlib)")
@@ -385,6 +430,15 @@ def main(argv: list[str] | None = None) -> int:
         for kind, cost in point_costs(loads_study(45 if args.quick else 100)).items():
             print(f"{kind}: {cost}", flush=True)
         print(f"load average {os.getloadavg()[0]:.1f}")
+        return 0
+    if args.loads_runs:
+        study = loads_study(100)
+        for _ in range(args.repeats):
+            for w in (2, 1):
+                print(f"{w} worker(s), warmed: {on_fresh_cluster(study, w)}", flush=True)
+        for w in (2, 1):
+            print(f"{w} worker(s), cold: {on_fresh_cluster(study, w, warm=False)}",
+                  flush=True)
         return 0
     if args.memory:
         import tempfile

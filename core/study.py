@@ -9,7 +9,8 @@ present every grid point gets the same ``samples`` draws (common random numbers)
 percentile along a grid axis compares like with like.
 
 Everything here is pure: :func:`study_from_dict` validates (a ``ValueError`` whose message
-starts with the field), :func:`point_table` expands a study into its points and
+starts with the field), :func:`point_table` expands a study into its points,
+:class:`StudyPoints` makes any of them on demand, and
 :func:`apply_point` makes the scene dict of one point. Running a study is
 :mod:`core.sweep`'s job.
 """
@@ -37,6 +38,7 @@ from core.scene import (
     read_scene_json,
     scene_from_dict,
 )
+from core.sweep_points import DRAW_BLOCK, StudyPoints, point_table  # noqa: F401
 from core.validation import finite_number, positive_number, show_value
 
 #: The study format version this program reads and writes.
@@ -401,44 +403,6 @@ def load_study(path: str | os.PathLike) -> Study:
 
 
 # ------------------------------------------------------------------------- expansion
-
-
-def _draws(p: Parameter, rng: np.random.Generator, n: int) -> np.ndarray:
-    args = dict(p.args)
-    if p.kind == "normal":
-        return rng.normal(args["mean"], args["std"], n)
-    if p.kind == "lognormal":
-        return args["median"] * np.exp(rng.normal(0.0, args["sigma"], n))
-    return rng.uniform(args["low"], args["high"], n)
-
-
-def point_table(study: Study) -> dict[str, np.ndarray]:
-    """Every point's value of every varied field: ``path -> array`` of length
-    :attr:`Study.n_points`, plus ``"sample"`` (the draw's index, 0 for a pure grid).
-
-    Order: grid axes in the order of the study (the last fastest), the samples innermost.
-    Draws come from ``numpy.random.default_rng(seed)``, one stream per distribution in the
-    order of the study, so the same study always gives the same points.
-    """
-    grids = [p for p in study.parameters if p.is_grid]
-    shape = tuple(len(p.values) for p in grids) + (study.samples,)
-
-    def spread(values: np.ndarray, axis: int) -> np.ndarray:
-        # each point's value along one axis, without an index array per axis (at 1e6
-        # points those held 8 MB an axis at once, the client's largest share of memory)
-        view = [1] * len(shape)
-        view[axis] = shape[axis]
-        return np.array(np.broadcast_to(values.reshape(view), shape)).reshape(-1)
-
-    table: dict[str, np.ndarray] = {}
-    for axis, p in enumerate(grids):
-        table[p.path] = spread(np.asarray(p.values, dtype=float), axis)
-    rng = np.random.default_rng(study.seed)
-    for p in study.parameters:
-        if not p.is_grid:
-            table[p.path] = spread(_draws(p, rng, study.samples), len(shape) - 1)
-    table["sample"] = spread(np.arange(study.samples, dtype=np.int64), len(shape) - 1)
-    return {p.path: table[p.path] for p in study.parameters} | {"sample": table["sample"]}
 
 
 def point_values(table: Mapping[str, np.ndarray], i: int,

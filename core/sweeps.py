@@ -18,6 +18,10 @@ ends located along a Chebyshev interpolant (:mod:`core.sweep_liftoff`). A point 
 fails (an invalid scene drawn from a distribution, a solver error) is recorded with its
 message; it never stops the study.
 
+The points and the batches are made batch by batch from the study's description
+(:class:`core.study.StudyPoints`, :class:`core.sweep_plan.BatchPlan`): the client holds no
+array over all the points, whatever the study's size.
+
 Each finished batch is written atomically to a work directory (``parts/batch_NNNNNN.npz``
 next to a ``manifest.json`` naming the study), so a study that was interrupted (a killed
 process, a lost worker) resumes from what was written, and the results stream to disk
@@ -45,8 +49,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.scene import FLAG_MESSAGES, atomic_write_text
-from core.study import OUTPUT_UNITS, Study, load_study, point_table
+from core.study import OUTPUT_UNITS, Study, StudyPoints, load_study, point_table
 from core.sweep_batch import _contact_width, point_outputs, run_batch  # noqa: F401
+from core.sweep_plan import PLAN_ORDER, BatchPlan, batch_plan
 
 if TYPE_CHECKING:
     import xarray
@@ -78,35 +83,6 @@ class StudyInterrupted(RuntimeError):
 # ------------------------------------------------------------------------- planning
 
 
-def plan_batches(study: Study, table: Mapping[str, np.ndarray],
-                 batch_points: int) -> list[np.ndarray]:
-    """The study's point indices cut into batches of at most ``batch_points``: sorted by
-    geometry (the non-load fields) first, then by the loads, so that a geometry's points
-    run together and in order. When force and moment both vary, the loads are sorted by
-    the eccentricity ``M / P`` first (:func:`batch_plan`), so that points of one
-    eccentricity share a batch (on a flat punch one answer serves them all:
-    :func:`core.sweep_batch.answers_scale_with_loads`)."""
-    n = study.n_points
-    geometry = [p.path for p in study.parameters if not p.is_load]
-    loads = [p.path for p in study.parameters if p.is_load]
-    keys = [table[p] for p in reversed(loads)]
-    if batch_plan(study) == "eccentricity":
-        force = np.asarray(table["loading.force"], dtype=float)
-        moment = np.asarray(table["loading.moment"], dtype=float)
-        with np.errstate(all="ignore"):
-            keys.append(np.where(force > 0, moment / np.where(force > 0, force, 1.0), np.inf))
-    keys += [table[p] for p in reversed(geometry)]
-    order = np.lexsort(keys) if keys else np.arange(n)
-    return [order[i:i + batch_points] for i in range(0, n, batch_points)]
-
-
-def batch_plan(study: Study) -> str:
-    """How :func:`plan_batches` orders a geometry's loads: ``"eccentricity"`` when both
-    ``loading.force`` and ``loading.moment`` vary, else ``"lexicographic"``."""
-    paths = {p.path for p in study.parameters}
-    return "eccentricity" if {"loading.force", "loading.moment"} <= paths else "lexicographic"
-
-
 def default_batch_points(n_points: int) -> int:
     """Points per batch for a study of ``n_points``: about :data:`TARGET_BATCHES` batches."""
     return max(1, min(MAX_BATCH_POINTS, math.ceil(n_points / TARGET_BATCHES)))
@@ -130,17 +106,23 @@ class WorkDir:
         manifest = self.path / "manifest.json"
         want = {"format": _MANIFEST_FORMAT, "study_key": study.key,
                 "n_points": study.n_points, "batch_points": batch_points,
-                "plan": batch_plan(study)}
+                "plan": batch_plan(study), "order": PLAN_ORDER}
         if manifest.exists():
             have = json.loads(manifest.read_text(encoding="utf-8"))
             if have.get("study_key") != study.key:
                 raise ValueError(f"work_dir: {self.path} holds the parts of another study; "
                                  "remove it or choose another directory")
             # parts cut by another plan hold other points under the same batch numbers
-            if have.get("plan", "lexicographic") != want["plan"]:
+            # (parts written before the order was named are in it when a sort of all
+            # the points gave the same order)
+            order = have.get("order") or ("" if not BatchPlan(
+                study, int(have["batch_points"])).same_as_whole_sort else PLAN_ORDER)
+            if have.get("plan", "lexicographic") != want["plan"] or order != PLAN_ORDER:
                 raise ValueError(f"work_dir: {self.path} holds parts planned in another "
-                                 f"order ({have.get('plan', 'lexicographic')}, now "
-                                 f"{want['plan']}); remove it or choose another directory")
+                                 f"order ({have.get('plan', 'lexicographic')}, "
+                                 f"{order or 'one sort of all the points'}; now "
+                                 f"{want['plan']}, {PLAN_ORDER}); remove it or choose "
+                                 "another directory")
             self.batch_points = int(have["batch_points"])
         else:
             atomic_write_text(manifest, json.dumps(want, indent=1) + "\n")
@@ -179,7 +161,7 @@ class WorkDir:
 
 def _resolve_client(client: Any, scheduler: str | None) -> tuple[Any, Callable[[], None]]:
     """A distributed client and a function that releases what was started here."""
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     if client is not None:
         return client, lambda: None
@@ -189,25 +171,20 @@ def _resolve_client(client: Any, scheduler: str | None) -> tuple[Any, Callable[[
     if address:
         own = Client(address)
         return own, own.close
-    # one single-threaded worker process per core; BLAS threads would only compete
-    cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1,
-                           processes=True, host="127.0.0.1", dashboard_address=None,
-                           env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-                                "MKL_NUM_THREADS": "1"})
-    own = Client(cluster)
+    # workers warmed as the cluster starts: imports and shared tables are not paid on
+    # each worker's first batch (see core.sweep_warm)
+    from core.sweep_warm import start_local_cluster
 
-    def close() -> None:
-        own.close()
-        cluster.close()
-    return own, close
+    return start_local_cluster()
 
 
-def _run_serial(todo: list[tuple[int, np.ndarray]], job: Callable) -> Iterator[tuple]:
-    for k, index in todo:
+def _run_serial(todo: list[int], plan: BatchPlan, job: Callable) -> Iterator[tuple]:
+    for k in todo:
+        index = plan.batch(k)
         yield k, index, job(index), None
 
 
-def _run_dask(todo: list[tuple[int, np.ndarray]], job_args: Callable, client: Any,
+def _run_dask(todo: list[int], plan: BatchPlan, job_args: Callable, client: Any,
               key: str) -> Iterator[tuple]:
     from distributed import as_completed
 
@@ -219,9 +196,10 @@ def _run_dask(todo: list[tuple[int, np.ndarray]], job_args: Callable, client: An
     meta: dict[str, tuple[int, np.ndarray]] = {}
 
     def submit_next() -> None:
-        item = next(pending, None)
-        if item is not None:
-            k, index = item
+        k = next(pending, None)
+        if k is not None:
+            item = k, plan.batch(k)
+            index = item[1]
             fut = client.submit(_run_shared, shared, job_args.values(index),
                                 key=f"study-{key[:12]}-batch-{k}", pure=False, retries=1)
             meta[fut.key] = item
@@ -248,14 +226,15 @@ def _run_shared(shared: Mapping[str, Any], values: np.ndarray) -> dict[str, np.n
 class _Job:
     """What every batch of one study needs, and its point values."""
 
-    def __init__(self, study: Study, table: Mapping[str, np.ndarray]) -> None:
+    def __init__(self, study: Study, points: StudyPoints) -> None:
         self.paths = [p.path for p in study.parameters]
         self.shared = {"base": study.base, "paths": self.paths, "outputs": study.outputs,
                        "n_times": len(study.times)}
-        self.table = table
+        self.points = points
 
     def values(self, index: np.ndarray) -> np.ndarray:
-        return np.stack([self.table[p][index] for p in self.paths], axis=1)
+        point = self.points(index)
+        return np.stack([point[p] for p in self.paths], axis=1)
 
     def __call__(self, index: np.ndarray) -> dict[str, np.ndarray]:
         return _run_shared(self.shared, self.values(index))
@@ -286,9 +265,10 @@ def sweep(study: Study | Mapping[str, Any] | str | os.PathLike, client: Any = No
     ``distributed.Client``; ``"serial"`` runs in this process without Dask; ``None``
     connects to ``scheduler`` (``tcp://HOST:PORT``) or to the Dask config's
     ``scheduler-address``, else starts a local cluster (one single-threaded worker process
-    per core) for the study. ``work_dir`` keeps the finished batches (default: a
-    temporary directory, removed at the end); with the same ``work_dir`` an interrupted
-    study resumes and recomputes nothing already written. ``output`` (``.nc``, ``.csv``,
+    per core, warmed before the study: :mod:`core.sweep_warm`) for the study. ``work_dir``
+    keeps the finished batches (default: a temporary directory, removed at the end); with
+    the same ``work_dir`` an interrupted study resumes and recomputes nothing already
+    written. ``output`` (``.nc``, ``.csv``,
     ``.parquet``) is written at the end. ``progress``: ``True`` draws a bar on stderr; a
     callable gets ``(points done, points in all)`` after every batch and cancels the study
     by returning ``False`` (raising :class:`StudyInterrupted`). With ``return_dataset``
@@ -307,21 +287,23 @@ def sweep(study: Study | Mapping[str, Any] | str | os.PathLike, client: Any = No
         parts = WorkDir(work_dir or scratch, study,
                         batch_points or default_batch_points(study.n_points),
                         durable=work_dir is not None)
-        table = point_table(study)
-        batches = plan_batches(study, table, parts.batch_points)
-        job = _Job(study, table)
-        todo = [(k, index) for k, index in enumerate(batches) if not parts.done(k)]
-        reused = len(batches) - len(todo)
-        done = sum(len(batches[k]) for k in range(len(batches)) if parts.done(k))
+        # the points and batches are made batch by batch from the study: the client's
+        # memory does not grow with the study (a 1e6-point index was ~32 MB)
+        points = StudyPoints(study)
+        plan = BatchPlan(study, parts.batch_points, points)
+        job = _Job(study, points)
+        todo = [k for k in range(plan.n_batches) if not parts.done(k)]
+        reused = plan.n_batches - len(todo)
+        done = sum(plan.size(k) for k in range(plan.n_batches) if parts.done(k))
         started = time.monotonic()
         lost: dict[int, str] = {}
         release: Callable[[], None] = lambda: None  # noqa: E731
         try:
             if isinstance(client, str) and client == "serial":
-                results = _run_serial(todo, job)
+                results = _run_serial(todo, plan, job)
             else:
                 client, release = _resolve_client(client, scheduler)
-                results = _run_dask(todo, job, client, study.key)
+                results = _run_dask(todo, plan, job, client, study.key)
             for k, index, arrays, failure in results:
                 if arrays is None:
                     lost[k] = failure
@@ -335,14 +317,14 @@ def sweep(study: Study | Mapping[str, Any] | str | os.PathLike, client: Any = No
                                            f"{study.n_points} points")
         finally:
             release()
-        info = {"batches": len(batches), "batches_reused": reused,
+        info = {"batches": plan.n_batches, "batches_reused": reused,
                 "batches_computed": len(todo) - len(lost), "batches_lost": len(lost),
-                "seconds": time.monotonic() - started} | _counts(parts, len(batches))
+                "seconds": time.monotonic() - started} | _counts(parts, plan.n_batches)
         if output is not None:
-            write_output(study, table, parts, batches, lost, Path(output), info)
+            write_output(study, parts, plan, lost, Path(output), info)
         if not return_dataset:
             return info
-        return study_dataset(study, table, parts, batches, lost, info)
+        return study_dataset(study, parts, plan, lost, info)
 
 
 # ----------------------------------------------------------------------------- results
@@ -373,15 +355,15 @@ def _variable_name(path: str) -> str:
                     if part)
 
 
-def _gather(study: Study, parts: WorkDir, batches: list[np.ndarray],
+def _gather(study: Study, parts: WorkDir, plan: BatchPlan,
             lost: Mapping[int, str]) -> dict[str, np.ndarray]:
     n, n_out, n_t = study.n_points, len(study.outputs), len(study.times)
     data = {"values": np.full((n, n_out, n_t), np.nan), "error_estimate": np.full(n, np.nan),
             "seconds": np.zeros(n), "flags": np.full(n, "failed", dtype=object),
             "error": np.full(n, "not computed", dtype=object)}
-    for k, index in enumerate(batches):
+    for k in range(plan.n_batches):
         if k in lost or not parts.done(k):
-            data["error"][index] = f"not computed: {lost.get(k, 'batch missing')}"
+            data["error"][plan.batch(k)] = f"not computed: {lost.get(k, 'batch missing')}"
             continue
         arrays = parts.read(k)
         for name in data:
@@ -389,8 +371,7 @@ def _gather(study: Study, parts: WorkDir, batches: list[np.ndarray],
     return data
 
 
-def study_dataset(study: Study, table: Mapping[str, np.ndarray], parts: WorkDir,
-                  batches: list[np.ndarray], lost: Mapping[int, str],
+def study_dataset(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[int, str],
                   info: Mapping[str, Any]) -> xarray.Dataset:
     """The results as an ``xarray.Dataset``: dims ``point`` and ``time`` [day after
     loading]; one coordinate per varied field (named like ``coating_0_modulus``, the field
@@ -399,7 +380,8 @@ def study_dataset(study: Study, table: Mapping[str, np.ndarray], parts: WorkDir,
     ``flag_<name>`` (bool), ``failed`` (bool), ``error`` (message), ``solve_seconds``."""
     import xarray as xr
 
-    data = _gather(study, parts, batches, lost)
+    data = _gather(study, parts, plan, lost)
+    table = point_table(study)  # the dataset holds every point anyway
     coords: dict[str, Any] = {"point": np.arange(study.n_points),
                               "time": ("time", np.asarray(study.times),
                                        {"units": "day", "long_name": "time after loading"})}
@@ -434,14 +416,15 @@ def study_dataset(study: Study, table: Mapping[str, np.ndarray], parts: WorkDir,
     return xr.Dataset(variables, coords=coords, attrs=attrs)
 
 
-def _long_rows(study: Study, table: Mapping[str, np.ndarray], index: np.ndarray,
+def _long_rows(study: Study, points: StudyPoints, index: np.ndarray,
                arrays: Mapping[str, np.ndarray] | None, lost: str | None) -> dict[str, Any]:
     """One batch in long form: a row per (point, time)."""
     n_t = len(study.times)
     rows: dict[str, Any] = {"point": np.repeat(index, n_t)}
+    point = points(index)
     for p in study.parameters:
-        rows[_variable_name(p.path)] = np.repeat(table[p.path][index], n_t)
-    rows["sample"] = np.repeat(table["sample"][index], n_t)
+        rows[_variable_name(p.path)] = np.repeat(point[p.path], n_t)
+    rows["sample"] = np.repeat(point["sample"], n_t)
     rows["time_day"] = np.tile(np.asarray(study.times), len(index))
     for j, name in enumerate(study.outputs):
         unit = OUTPUT_UNITS[name].replace("/", "_per_")
@@ -457,9 +440,8 @@ def _long_rows(study: Study, table: Mapping[str, np.ndarray], index: np.ndarray,
     return rows
 
 
-def write_output(study: Study, table: Mapping[str, np.ndarray], parts: WorkDir,
-                 batches: list[np.ndarray], lost: Mapping[int, str], path: Path,
-                 info: Mapping[str, Any]) -> None:
+def write_output(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[int, str],
+                 path: Path, info: Mapping[str, Any]) -> None:
     """Write the results to ``path`` atomically: ``.nc`` the dataset of
     :func:`study_dataset`; ``.csv``/``.parquet`` one row per point and time (columns
     ``point``, the varied fields, ``sample``, ``time_day``, each output with its unit,
@@ -470,10 +452,10 @@ def write_output(study: Study, table: Mapping[str, np.ndarray], parts: WorkDir,
     os.close(fd)
     try:
         if suffix == ".nc":
-            ds = study_dataset(study, table, parts, batches, lost, info)
+            ds = study_dataset(study, parts, plan, lost, info)
             ds.to_netcdf(tmp, engine="scipy")
         else:
-            _write_long(study, table, parts, batches, lost, Path(tmp), suffix)
+            _write_long(study, parts, plan, lost, Path(tmp), suffix)
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     except BaseException:
@@ -481,16 +463,15 @@ def write_output(study: Study, table: Mapping[str, np.ndarray], parts: WorkDir,
         raise
 
 
-def _write_long(study: Study, table: Mapping[str, np.ndarray], parts: WorkDir,
-                batches: list[np.ndarray], lost: Mapping[int, str], tmp: Path,
-                suffix: str) -> None:
+def _write_long(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[int, str],
+                tmp: Path, suffix: str) -> None:
     writer = None
+    points = StudyPoints(study)
     with open(tmp, "w" if suffix == ".csv" else "wb") as fh:
-        for k, index in enumerate(batches):
+        for k in range(plan.n_batches):
             arrays = parts.read(k) if parts.done(k) and k not in lost else None
-            if arrays is not None:
-                index = arrays["index"]
-            rows = _long_rows(study, table, index, arrays, lost.get(k, "batch missing"))
+            index = plan.batch(k) if arrays is None else arrays["index"]
+            rows = _long_rows(study, points, index, arrays, lost.get(k, "batch missing"))
             if suffix == ".csv":
                 if k == 0:
                     fh.write(",".join(rows) + "\n")

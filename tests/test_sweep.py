@@ -220,7 +220,8 @@ def test_contact_width_of_a_pressure_linear_in_x():
 
 
 def test_serial_run_equals_the_loop_and_batches_follow_geometry():
-    from core.sweeps import plan_batches, sweep
+    from core.sweep_plan import BatchPlan
+    from core.sweeps import sweep
 
     study = study_from_dict(small_study())
     ds = sweep(study, client="serial", batch_points=4)
@@ -231,7 +232,8 @@ def test_serial_run_equals_the_loop_and_batches_follow_geometry():
     # a geometry's points are neighbours; inside it, force and moment both varying, the
     # loads in order of eccentricity M / P, then force, then moment
     table = point_table(study)
-    order = np.concatenate(plan_batches(study, table, 4))
+    plan = BatchPlan(study, 4)
+    order = np.concatenate([plan.batch(k) for k in range(plan.n_batches)])
     moduli = table["coating[0].modulus"][order]
     assert np.count_nonzero(np.diff(moduli)) == 1
     force, moment = table["loading.force"][order][:6], table["loading.moment"][order][:6]
@@ -506,6 +508,39 @@ def test_cli_sweep_on_the_cluster_writes_each_format(loopback_cluster, tmp_path:
     assert bad.returncode == 2
     assert bad.stderr.strip() == ("error: output: unsupported extension '.txt' (use .nc, "
                                   ".csv or .parquet)")
+
+
+def test_workers_are_warmed_by_a_plugin_and_the_warming_batches_solve(loopback_cluster):
+    from distributed import Client
+
+    from core.sweep_batch import run_batch
+    from core.sweep_warm import WARM_LOADS, WARM_SCENE, warm_worker, warm_workers
+
+    # the warming batch goes through the load paths: full contact, lift-off and scaled
+    got = run_batch(WARM_SCENE, ["loading.force", "loading.moment"], WARM_LOADS,
+                    ("settlement", "q_min"), 1)
+    assert not np.any(got["flags"] == "failed")
+    q_min = got["values"][:, 1, 0]
+    assert np.all(q_min[:3] > 0) and np.all(q_min[3:] == 0)  # full contact, then lift-off
+    np.testing.assert_allclose(got["values"][4], 2 * got["values"][3], rtol=1e-12)
+    assert warm_worker() > 0
+    with Client(loopback_cluster, timeout=60) as client:
+        warm_workers(client)
+        cpu = client.run(lambda dask_worker: dask_worker.coated_punch_warm_cpu)
+    assert len(cpu) == 2 and all(t > 0 for t in cpu.values())
+
+
+def test_a_failed_warming_leaves_the_worker_running(monkeypatch):
+    pytest.importorskip("distributed")
+    import core.sweep_warm as warm
+
+    def broken() -> float:
+        raise RuntimeError("no tables today")
+
+    monkeypatch.setattr(warm, "warm_worker", broken)
+    worker = type("Worker", (), {})()
+    warm.WarmStudyWorker().setup(worker)
+    assert worker.coated_punch_warm_error == "RuntimeError: no tables today"
 
 
 def test_solving_does_not_import_dask():
