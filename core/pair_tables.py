@@ -214,10 +214,3 @@ def _exact_near(lam: float, panels: Panels, targets: np.ndarray, sources: np.nda
         at_zero = kernel_regular(np.zeros(1), accuracy)[0] - np.log(lam)
         near[on_node] = at_zero * weights[on_node]
     by_pair[near_t, near_s] = near - log_weights / np.pi
-
-
-def clear() -> None:
-    """Forget every table (tests; the store refills on use)."""
-    global _STORE
-    with _LOCK:
-        _STORE = PairTables.empty(_FIRST_CAPACITY)
