@@ -107,20 +107,24 @@ def lookup(keys: list[tuple[float, float]], near_field: float
     store = _STORE
     rows = [store.index.get(k) for k in keys]
     if None in rows:
-        store = _add([k for k, r in zip(keys, rows, strict=True) if r is None], near_field)
+        store = _add(keys, near_field)
         rows = [store.index[k] for k in keys]
     return store, np.array(rows, dtype=np.intp)
 
 
-def _add(missing: list[tuple[float, float]], near_field: float) -> PairTables:
+def _add(keys: list[tuple[float, float]], near_field: float) -> PairTables:
+    """A store holding every one of ``keys`` (the current one, added to, or a new one)."""
     global _STORE
     with _LOCK:
-        store = _STORE
-        missing = [k for k in dict.fromkeys(missing) if k not in store.index]
+        store = _STORE  # perhaps not the one the caller looked in: all keys are checked
+        wanted = list(dict.fromkeys(keys))
+        missing = [k for k in wanted if k not in store.index]
         if not missing:
             return store
         size = len(store.index)
         if size + len(missing) > MAX_KEYS:
+            # emptied: the keys the old store held must come into the new one as well
+            missing = wanted
             store, size = PairTables.empty(max(_FIRST_CAPACITY, len(missing))), 0
         if size + len(missing) > store.near.shape[0]:
             store = store.grown(max(2 * store.near.shape[0], size + len(missing)))

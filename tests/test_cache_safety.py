@@ -133,3 +133,23 @@ def test_unkeyed_kernel_response_is_not_reused_for_another(monkeypatch):
     assert alone[0] != pytest.approx(alone[1], rel=1e-3)
     # measured: equal to the last digit (the same time march)
     assert in_turn == pytest.approx(alone, rel=1e-12)
+
+
+def test_pair_tables_emptied_when_full_still_answer_every_key(monkeypatch):
+    """When a call's new keys would pass the store's limit, the store is emptied: the
+    call's keys the old store held must then come into the new one too (else KeyError)."""
+    from core import pair_tables
+    from core.quadrature import Panels, node_rows
+
+    first = Panels.from_edges(np.array([-1.0, -0.5, 0.0, 0.5, 1.0]))
+    second = Panels.from_edges(np.array([-1.0, -0.75, -0.5, 0.0, 0.25, 0.5, 1.0]))
+    pair_tables.clear()
+    alone = node_rows(1.0, second, second, np.arange(second.n_panels))
+    pair_tables.clear()
+    node_rows(1.0, first, first, np.arange(first.n_panels))
+    held = len(pair_tables.stored().index)
+    # room for what the first grid left and one more: the second grid's keys pass it
+    monkeypatch.setattr(pair_tables, "MAX_KEYS", held + 1)
+    again = node_rows(1.0, second, second, np.arange(second.n_panels))
+    assert np.array_equal(alone, again)
+    pair_tables.clear()
