@@ -34,6 +34,8 @@ class PinsView:
         # six): a class moves a slider step by step, and the steps stay on the plots
         self.every_step = pn.widgets.Checkbox(label="pin every step",
                                               css_classes=["pin-every-step"])
+        # the result on screen is the first step: pinned when the box is ticked
+        self.every_step.param.watch(lambda e: e.new and self.pin(), "value")
         self.pin_button.on_click(lambda e: self.pin())
         self.unpin_button.on_click(lambda e: self.unpin())
         self.pin_list = pn.Column(margin=0, css_classes=["pin-list"])
