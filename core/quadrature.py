@@ -225,18 +225,10 @@ def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
         near_w = weights.reshape(-1, NODES_PER_PANEL)[near_s]
         offset = np.abs(targets[near_t, None] - nodes.reshape(-1, NODES_PER_PANEL)[near_s])
         if accuracy > FULL_ACCURACY:
-            # k_reg(lam d) - ln lam = k_pl(lam d) + ln d: the far value just computed plus a
-            # log, instead of the series again (~15x cheaper per entry); the sum errs by
-            # ~|ln d| x 1e-16 (and by the decayed k_pl, below the accuracy, where those are
-            # zeros). d = 0 (a target on a node) takes k_reg(0) - ln lam.
-            with np.errstate(divide="ignore", invalid="ignore"):
-                near = by_pair[near_t, near_s] + np.log(offset) * near_w
-            on_node = offset == 0.0
-            if on_node.any():
-                at_zero = kernel_regular(np.zeros(1), accuracy)[0] - np.log(lam)
-                near[on_node] = at_zero * near_w[on_node]
-            near -= log_weights / np.pi
-            by_pair[near_t, near_s] = near
+            # the far value just computed plus a log (pair_tables.near_from_far)
+            near = pair_tables.near_from_far(by_pair[near_t, near_s], offset, near_w, lam,
+                                             accuracy)
+            by_pair[near_t, near_s] = near - log_weights / np.pi
         else:
             smooth = kernel_regular(lam * offset, accuracy)
             smooth -= np.log(lam)
