@@ -230,6 +230,16 @@ def test_a_slow_solve_holds_up_another_session_by_the_spill_time_only(processes,
     assert processes.run(0, os.getpid) == pids[0]  # back to its own lane once free
 
 
+def at_the_gate(pid: int) -> bool:
+    """Whether process ``pid`` waits in open(2) of a FIFO with no writer yet (the gate of
+    :func:`held_worker`): the kernel's wait channel names the wait (Linux)."""
+    try:
+        with open(f"/proc/{pid}/wchan") as wchan:
+            return wchan.read().strip() == "wait_for_partner"
+    except OSError:
+        return False
+
+
 def killed_during_a_request(pool: SolverProcesses, kills: int, tmp_path: Path,
                             wait_until: Any) -> tuple[list[int], list[Any]]:
     """Start ``pool`` (one lane), hold a request in its worker and kill (SIGKILL) the
@@ -243,6 +253,10 @@ def killed_during_a_request(pool: SolverProcesses, kills: int, tmp_path: Path,
         assert wait_until(lambda: pool.pids() not in ([], killed), timeout=60)
         if kills == 2:
             killed.append(pool.pids()[0])
+            # killed only once it holds the request again (a worker killed before the
+            # request reaches it died idle: the request then runs on the next one, as a
+            # fresh-clone run met)
+            assert wait_until(lambda: at_the_gate(killed[1]), timeout=60)
             os.kill(killed[1], signal.SIGKILL)
         else:
             release(tmp_path / "gate-0", wait_until)
