@@ -248,14 +248,16 @@ def killed_during_a_request(pool: SolverProcesses, kills: int, tmp_path: Path,
     killed = [pool.start()[0]["pid"]]
     with held_worker(pool, 0, tmp_path, wait_until) as (waiting, outcome):
         assert wait_until(lambda: pool._lanes[0].busy)
+        # the lane is busy before the request is written: killed once the worker holds it
+        # (else it died idle, and nothing was lost: the request runs on the next worker)
+        assert wait_until(lambda: at_the_gate(killed[0]), timeout=60)
         os.kill(killed[0], signal.SIGKILL)
         # the death is noticed at once and the request given to a new worker
         assert wait_until(lambda: pool.pids() not in ([], killed), timeout=60)
         if kills == 2:
             killed.append(pool.pids()[0])
-            # killed only once it holds the request again (a worker killed before the
-            # request reaches it died idle: the request then runs on the next one, as a
-            # fresh-clone run met)
+            # the same for the new worker (two fresh-clone runs met a kill before the
+            # request had reached the worker: answered on a third one, not refused)
             assert wait_until(lambda: at_the_gate(killed[1]), timeout=60)
             os.kill(killed[1], signal.SIGKILL)
         else:
