@@ -232,13 +232,17 @@ class SolveController(param.Parameterized):
         # (if one came meanwhile) sent
         outcome = self._collect(scene, sent)
         self._dispatch(lambda: self._deliver(rid, outcome))
+        pending = self._take_pending()
+        if pending is not None:
+            self._wait(*pending, self._send_now(pending[1]))
+
+    def _take_pending(self) -> tuple[int, dict[str, Any]] | None:
+        # the request that came while one ran (the newest), or None: then nothing runs
         with self._lock:
-            if self._pending is None:
+            pending, self._pending = self._pending, None
+            if pending is None:
                 self._running = False
-                return
-            rid, scene = self._pending
-            self._pending = None
-        self._wait(rid, scene, self._send_now(scene))
+            return pending
 
     def _collect(self, scene: dict[str, Any], sent: SentRequest) -> ResultView | str:
         # The answer of ``sent`` (there to read), kept in RESULTS by a thread of the pool:
@@ -297,12 +301,10 @@ class SolveController(param.Parameterized):
             outcome = self._compute(scene, sent)
             sent = None
             self._dispatch(lambda rid=rid, outcome=outcome: self._deliver(rid, outcome))
-            with self._lock:
-                if self._pending is None:
-                    self._running = False
-                    return
-                rid, scene = self._pending
-                self._pending = None
+            pending = self._take_pending()
+            if pending is None:
+                return
+            rid, scene = pending
 
     def _view(self, scene: dict[str, Any], sent: list[SentRequest]) -> ResultView:
         if self._processes is not None:
