@@ -30,10 +30,10 @@ import numpy as np
 
 from benchmarks.creep_goals import timed
 from core.cache import clear_caches
-from core.code_creep import _FORMULAS, MAX_DURATION, RESOLUTION, CodeCreep, clamp_age
-from core.creep import Arutyunyan
-from core.kernel_fit import fit_compliance
-from core.scene import scene_from_dict
+from core.creep.design_codes import _FORMULAS, MAX_DURATION, RESOLUTION, CodeCreep, clamp_age
+from core.creep.kernel_fit import fit_compliance
+from core.creep.models import Arutyunyan
+from core.scene.pipeline import scene_from_dict
 from core.solver import solve_dimensionless
 
 PRESET = Path(__file__).resolve().parents[1] / "assets" / "scenes" / \
@@ -104,8 +104,8 @@ def plain_callable(repeats: int, count: int) -> dict:
     reference = solve_dimensionless(0.5, 0.05, 0.0, times, kernel=exact,
                                     **dict(args, tol=1e-9))
     size = float(np.max(np.abs(reference.settlement)))
-    import core.prepared as prepared
-    import core.solver as solver
+    import core.engines.nystrom.prepared as prepared
+    import core.engines.projection.solve as solver
 
     def plain(t: np.ndarray, s: np.ndarray) -> np.ndarray:
         return exact(t, s)

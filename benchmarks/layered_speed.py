@@ -4,7 +4,7 @@
                                                  # benchmarks/results/layered_speed.md
 
 A geometry or material change of a uniform coating builds the stack's kernel table and
-Galerkin matrix again (:mod:`core.layered_cache`); a load change reuses them. Measured here,
+Galerkin matrix again (:mod:`core.engines.layered.cache`); a load change reuses them. Measured here,
 in this process, each solve a new geometry (``core.solve`` on a scene dict, validation
 included):
 
@@ -19,7 +19,7 @@ included):
   (:func:`benchmarks.sweep.modulus_study`) on a fresh local Dask cluster of 2 workers
   (:func:`benchmarks.sweep.on_fresh_cluster`): wall seconds and the workers' CPU seconds;
 * the price: settlement, tilt, force and moment of the default tolerance (1e-6, the
-  coarser rules of :mod:`core.layered_galerkin`) against tol 1e-12 (the finest), over the
+  coarser rules of :mod:`core.engines.layered.galerkin`) against tol 1e-12 (the finest), over the
   same slider steps.
 
 CPU times are of this process (``time.process_time``); the machine's load average is

@@ -2,7 +2,7 @@
 
     python benchmarks/liftoff.py           # writes benchmarks/results/liftoff.md (~1-2 min)
 
-1. Work-precision of the elastic unilateral solver (core.contact_zones) on a partial-
+1. Work-precision of the elastic unilateral solver (core.contact.zones) on a partial-
    contact scene (lam = 1, m = 0.05, P = 1, M = 0.45: the edge x = -1 lifts off): the
    zone end, settlement, tilt and q at interior points on successively finer rules
    (root-find on each, ``max_levels=1``), against the finest; the time of each solve.
@@ -34,8 +34,8 @@ if str(ROOT) not in sys.path:
 from core import contact_zones as cz  # noqa: E402
 from core import scene_from_dict, solve, solve_dimensionless  # noqa: E402
 from core.cache import clear_caches  # noqa: E402
-from core.contact import solve_unilateral  # noqa: E402
-from core.quadrature import base_panels, kernel_operator  # noqa: E402
+from core.contact.unilateral import solve_unilateral  # noqa: E402
+from core.discretize.quadrature import base_panels, kernel_operator  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"
@@ -251,7 +251,7 @@ def main() -> None:
         "budget, 1e-6 half-widths whatever tol is (issue 13): at every output time the "
         "kink of q at each free end is taken out of the panel rule (a defect correction "
         "on the end's panel, one solve of the change with the step's kept factors, "
-        "core/contact_kinks.py) and the end is the root of the corrected Nystrom "
+        "core/contact/kinks.py) and the end is the root of the corrected Nystrom "
         "pressure. That first cost 424 ms of CPU (load 2.4; 124 ms when the ends were "
         "asked only to max(1e-6, tol) and came out ~4e-6 off). Profiled (cProfile, CPU), "
         "then cut without touching what the ends achieve (the same ends and estimates to "

@@ -2,9 +2,9 @@
 
     python -m benchmarks.liftoff_family [n_side]     # default 100: 10,000 points (~1 min CPU)
 
-Runs :func:`core.sweep_batch.run_batch` over the batches of
+Runs :func:`core.study.batch.run_batch` over the batches of
 ``benchmarks.sweep.loads_study(n_side)`` as the study plans them (its lift-off points
-answered as one family per eccentricity side, :mod:`core.sweep_liftoff`), then
+answered as one family per eccentricity side, :mod:`core.study.liftoff`), then
 ``core.solve`` on each point's scene, and prints per contact model the largest difference
 of each output relative to that output's size at the point, whether the refused points
 carry the same messages and no values, whether the flags are equal, and the largest
@@ -22,9 +22,9 @@ import numpy as np
 
 from benchmarks.sweep import loads_study
 from core import solve
-from core.study import Study, apply_point, point_table
-from core.sweep_batch import point_outputs, run_batch
-from core.sweeps import default_batch_points, plan_batches
+from core.study.batch import point_outputs, run_batch
+from core.study.definition import Study, apply_point, point_table
+from core.study.run import default_batch_points, plan_batches
 
 
 def compare(study: Study) -> dict[str, Any]:

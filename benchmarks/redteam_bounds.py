@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 _CHILD = """
 import json, resource, sys, time
 sys.path.insert(0, {root!r})
-from core.scene import scene_from_dict, solve
+from core.scene.pipeline import scene_from_dict, solve
 d = json.loads({scene!r})
 t0 = time.perf_counter()
 try:

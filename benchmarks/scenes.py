@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from core.creep import Arutyunyan
+from core.creep.models import Arutyunyan
 
 Function = Callable[[np.ndarray], np.ndarray]
 Load = float | Function

@@ -53,7 +53,7 @@ if str(ROOT) not in sys.path:
 
 from benchmarks.scenes import Scene, creep_times, suite  # noqa: E402
 from core.cache import clear_caches  # noqa: E402
-from core.collocation import solve_collocation  # noqa: E402
+from core.engines.collocation.solve import solve_collocation  # noqa: E402
 from core.solver import solve_dimensionless  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
@@ -786,9 +786,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=None, help="output folder")
     args = parser.parse_args(argv)
     try:
-        import core.kernel  # noqa: F401
+        import core.kernel.plane  # noqa: F401
     except ImportError:
-        print("core/kernel.py is missing: the figures must be made with the real kernel",
+        print("core/kernel/plane.py is missing: the figures must be made with the real kernel",
               file=sys.stderr)
         return 2
     out = args.out or (RESULTS / "quick" if args.quick else RESULTS)

@@ -1,10 +1,10 @@
 """The command line: ``python -m core solve SCENE.json``, ``python -m core validate SCENE.json``
 and ``python -m core sweep STUDY.json --output RESULT.nc`` (a design study, see
-:mod:`core.sweeps`) and ``python -m core check SCENE.json`` (the coating model against
+:mod:`core.study.run`) and ``python -m core check SCENE.json`` (the coating model against
 resolved finite elements).
 
 ``solve`` writes the solution to ``--output`` (``.json``: everything, see
-:meth:`core.scene.SceneSolution.to_dict`, with the contact set per time; ``.csv``: the
+:meth:`core.scene.pipeline.SceneSolution.to_dict`, with the contact set per time; ``.csv``: the
 histories of settlement, tilt, force and moment, and the contact zones when the punch
 lifts off) and optionally the pressure ``q(x, t)`` to ``--pressure-csv``; without
 ``--output`` it prints a short summary. ``validate`` only checks the scene file.
@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import NoReturn
 
 from core.files import same_file, writable_target
-from core.scene import (
+from core.scene.pipeline import (
     QUANTITIES,
     Scene,
     SceneSolution,
@@ -165,8 +165,8 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
     # imported here: a plain solve must not load Dask
-    from core.study import load_study
-    from core.sweeps import check_output, sweep
+    from core.study.definition import load_study
+    from core.study.run import check_output, sweep
 
     output = Path(args.output)
     try:
@@ -199,7 +199,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from core.coating_check import check_scene
+    from core.scene.coating_check import check_scene
 
     scene = _read(args.scene)
     end = float(scene.times[-1])

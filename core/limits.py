@@ -15,7 +15,7 @@ from __future__ import annotations
 
 # ----------------------------------------------------------------------------- text
 
-#: Largest scene file read by ``core.scene.load_scene`` [bytes].
+#: Largest scene file read by ``core.scene.pipeline.load_scene`` [bytes].
 MAX_SCENE_BYTES = 1_000_000
 #: Longest scene name [characters]: a title, shown in a page title and file names.
 MAX_NAME_CHARS = 200
@@ -85,7 +85,7 @@ MAX_KERNEL_GRID_POINTS = 4_097
 KERNEL_BLOCK_ELEMENTS = MAX_FORMULA_ELEMENTS // 64
 #: Most steps (accepted and rejected) of the degenerate-kernel time stepper per solve.
 #: A load that varies faster than this many steps can follow is refused up front
-#: (``core.load_rates``).
+#: (``core.scene.load_rates``).
 MAX_TIME_STEPS = 20_000
 
 # ----------------------------------------------------------------------------- results

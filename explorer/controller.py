@@ -79,12 +79,12 @@ def use_worker_processes(lanes: int, stage_cache_bytes: int | None = None) -> So
     """Solve in ``lanes`` worker processes from now on (all sessions of this process).
 
     ``stage_cache_bytes`` [bytes] bounds the solver's stage caches of each worker; the
-    default divides the solver's budget (``core.solver.STAGE_CACHE_BYTES``) among them,
+    default divides the solver's budget (``core.STAGE_CACHE_BYTES``) among them,
     so the memory the caches may hold does not grow with the number of workers. Sessions
     created before the call keep solving where they did.
     """
     global _PROCESSES
-    from core.solver import STAGE_CACHE_BYTES
+    from core import STAGE_CACHE_BYTES
 
     if stage_cache_bytes is None:
         stage_cache_bytes = STAGE_CACHE_BYTES // max(1, lanes)

@@ -13,8 +13,8 @@ from typing import Any
 
 import param
 
-from core.profiles import HISTORY_FORMS, history_form_of
-from core.scene import QUANTITIES
+from core.profiles.build import HISTORY_FORMS, history_form_of
+from core.scene.pipeline import QUANTITIES
 
 #: The four statements (which two quantities are given), as shown on screen.
 STATEMENTS: dict[str, tuple[str, str]] = {

@@ -22,7 +22,7 @@ STAGE_WORDS = {
     "modes": "the creep modes",
     "mode_selection": "the choice of modes",
     "time": "the time history",
-    # the default engine's stages (core/prepared.py)
+    # the default engine's stages (core/engines/nystrom/prepared.py)
     "grid": "the grid and the foundation's response",
     "bordered": "the contact equations",
     "modal": "the creep modes",

@@ -1,6 +1,6 @@
 """The explorer's design studies: one or two fields of the scene on screen over a range.
 
-A study of the Study tab is a :class:`core.study.Study` built from the scene on screen:
+A study of the Study tab is a :class:`core.study.definition.Study` built from the scene on screen:
 :func:`study_choices` lists the fields worth varying (with their units on screen),
 :func:`plan_study` checks the ranges the user typed and builds the study (a ``ValueError``
 naming the field of the tab, e.g. ``parameter 2, points: ...``), and a
@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from core.study import Study, numeric_fields, study_from_dict
+from core.study.definition import Study, numeric_fields, study_from_dict
 
 #: Most points of a study started from the page (grid product). The page is served to
 #: untrusted users on a shared machine: a point differing only in its loads costs a few
@@ -234,7 +234,7 @@ def _tab_message(message: str, choices: Sequence[Choice]) -> str:
 
 @dataclass
 class StudyResult:
-    """The answers of a study on its grid (SI units, see ``core.study.OUTPUT_UNITS``):
+    """The answers of a study on its grid (SI units, see ``core.study.definition.OUTPUT_UNITS``):
     ``outputs[name]`` of shape ``grid + (len(times),)``, ``flags`` (comma-joined, or
     ``failed``) and ``errors`` (a failed point's message) of the grid's shape."""
 
@@ -247,7 +247,7 @@ class StudyResult:
 
     @classmethod
     def from_arrays(cls, planned: PlannedStudy, arrays: Mapping[str, Any]) -> StudyResult:
-        """Put the per-point arrays of a run (point order of ``core.study.point_table``:
+        """Put the per-point arrays of a run (point order of ``core.study.definition.point_table``:
         the last parameter fastest) on the grid."""
         shape = planned.shape
         outputs = {name: np.asarray(arrays[name], dtype=float).reshape(shape + (-1,))

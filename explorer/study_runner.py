@@ -52,9 +52,9 @@ PROGRESS_EVERY_S = 0.1
 #: Modules the fork server imports once, so that a study's process starts warm: the
 #: solver's modules and scipy's parts it uses cost ~1 s of CPU to import (measured), which
 #: every study would pay again.
-_PRELOAD = ["core.sweeps", "core.scene", "core.study", "core.solver", "core.nystrom",
-            "core.prepared", "core.projection", "core.contact", "core.contact_zones",
-            "core.kernel_fit", "core.time_integration", "core.nystrom_time", "scipy.linalg",
+_PRELOAD = ["core.study.run", "core.scene.pipeline", "core.study.definition", "core.solver", "core.engines.nystrom.bordered",
+            "core.engines.nystrom.prepared", "core.engines.projection.matrices", "core.contact.unilateral", "core.contact.zones",
+            "core.creep.kernel_fit", "core.time.integration", "core.engines.nystrom.modal", "scipy.linalg",
             "scipy.interpolate", "scipy.optimize", "scipy.special", "scipy.sparse",
             "scipy.fft", "xarray", "explorer.study_runner"]
 
@@ -84,7 +84,7 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl+C is the server's to handle
-    from core.sweeps import sweep
+    from core.study.run import sweep
 
     def progress(done: int, total: int) -> bool:
         out.put(("progress", done, total))

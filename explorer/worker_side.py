@@ -38,9 +38,9 @@ def _start_worker(stage_cache_bytes: int) -> None:
     # Ctrl+C in the terminal reaches the whole process group: the server stops its
     # workers itself, and a worker's traceback would only clutter the terminal.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    from core import solver
+    from core import set_stage_cache_budget
 
-    solver.set_stage_cache_budget(stage_cache_bytes)
+    set_stage_cache_budget(stage_cache_bytes)
     threading.Thread(target=_watch_parent, name="watch-parent", daemon=True).start()
 
 
@@ -81,7 +81,7 @@ def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None) 
 
 def worker_info() -> dict[str, int]:
     """The worker's process id and the bound of its solver stage caches [bytes]."""
-    from core.stage_budget import stage_cache_bytes
+    from core import stage_cache_bytes
 
     return {"pid": os.getpid(), "stage_cache_bytes": stage_cache_bytes()}
 

@@ -1,4 +1,4 @@
-"""The orthonormal bases of :mod:`core.basis` and the panel tools they rely on.
+"""The orthonormal bases of :mod:`core.discretize.basis` and the panel tools they rely on.
 
 Every tolerance below is a measured error with a margin; the measured value is quoted.
 The convergence checks solve statement 4 (force and moment given) on an elastic base with
@@ -14,15 +14,15 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import pytest
 
-from core.basis import GRADED_DEPTH, GRADED_RATIO, Basis, build_basis, graded_cuts
-from core.galerkin import galerkin_correction
-from core.projection import galerkin_matrix
-from core.quadrature import (
+from core.discretize.basis import GRADED_DEPTH, GRADED_RATIO, Basis, build_basis, graded_cuts
+from core.discretize.galerkin import galerkin_correction
+from core.discretize.quadrature import (
     Panels,
     base_panels,
     kernel_operator,
     operator_rows,
 )
+from core.engines.projection.matrices import galerkin_matrix
 
 #: Interior points where the pressure is compared (as the solver does: |x| <= 0.95 and
 #: more than 0.02 from a jump).

@@ -35,8 +35,8 @@ def test_stage_cache_values_are_read_only():
 
 
 def test_pair_tables_are_read_only():
-    from core import pair_tables
-    from core.quadrature import Panels, node_rows
+    from core.discretize import pair_tables
+    from core.discretize.quadrature import Panels, node_rows
 
     panels = Panels.from_edges(np.array([-1.0, -0.25, 0.0, 0.5, 1.0]))
     node_rows(1.0, panels, panels, np.arange(panels.n_panels))
@@ -47,16 +47,16 @@ def test_pair_tables_are_read_only():
 
 
 def test_module_tables_are_read_only():
-    from core import kernel, kernel_values, log_moments
+    from core.kernel import log_moments, plane, values
 
-    shared = [kernel._EVEN, kernel._TABLE, kernel._SCALES, kernel._POLES,
-              kernel_values._even_chebyshev(), kernel_values._even_coefficients(1e-8),
+    shared = [plane._EVEN, plane._TABLE, plane._SCALES, plane._POLES,
+              values._even_chebyshev(), values._even_coefficients(1e-8),
               *log_moments._outer_rule(15)]
     assert not any(_written(a) for a in shared)
 
 
 def test_prepared_rows_are_read_only():
-    from core.prepared import prepare
+    from core.engines.nystrom.prepared import prepare
 
     prepared = prepare(1.0, 0.05, 0.0, tol=1e-6)
     rows = prepared.rows(np.linspace(-0.9, 0.9, 5))
@@ -66,8 +66,8 @@ def test_prepared_rows_are_read_only():
 def test_fitted_kernel_values_are_read_only():
     """The fit is cached (its arrays shared) and so are its amplitudes at the last ages
     asked for (every caller at those ages gets views of the same arrays)."""
-    from core.creep import ExponentialCreep
-    from core.kernel_fit import fit_kernel
+    from core.creep.kernel_fit import fit_kernel
+    from core.creep.models import ExponentialCreep
 
     law = ExponentialCreep(modulus=3e10, compliance=6e-11, rate=0.05).dimensionless_kernel(28.0)
     fitted = fit_kernel(lambda t, s: law(t, s), end=10.0)
@@ -105,13 +105,13 @@ def test_unkeyed_kernel_response_is_not_reused_for_another(monkeypatch):
     geometry: the second gets its own answer, even when it has the first one's id (as a
     kernel does that takes over the address of one freed before). Keyed by ``id()``, the
     second kernel was given the first one's response."""
-    import core.prepared
-    from core.prepared import prepare
+    import core.engines.nystrom.prepared
+    from core.engines.nystrom.prepared import prepare
 
     # tol 1e-10: no sum-of-exponentials fit is within the budget, so the kernels are
     # stepped as they are and known by identity only
     prepared = prepare(1.0, 0.05, 0.0, tol=1e-10)
-    from core.creep import ExponentialCreep
+    from core.creep.models import ExponentialCreep
 
     # two creep laws, each hidden in a plain callable (no key to tell them apart)
     laws = [ExponentialCreep(modulus=3e10, compliance=c, rate=0.05).dimensionless_kernel(28.0)
@@ -128,7 +128,7 @@ def test_unkeyed_kernel_response_is_not_reused_for_another(monkeypatch):
         alone.append(settlement(kernel))
     prepared._responses.clear()
     # every object the module asks the id of has the same one: an address reused
-    monkeypatch.setattr(core.prepared, "id", lambda obj: 1, raising=False)
+    monkeypatch.setattr(core.engines.nystrom.prepared, "id", lambda obj: 1, raising=False)
     in_turn = [settlement(kernel) for kernel in kernels]
     assert alone[0] != pytest.approx(alone[1], rel=1e-3)
     # measured: equal to the last digit (the same time march)
@@ -138,8 +138,8 @@ def test_unkeyed_kernel_response_is_not_reused_for_another(monkeypatch):
 def test_pair_tables_emptied_when_full_still_answer_every_key(monkeypatch):
     """When a call's new keys would pass the store's limit, the store is emptied: the
     call's keys the old store held must then come into the new one too (else KeyError)."""
-    from core import pair_tables
-    from core.quadrature import Panels, node_rows
+    from core.discretize import pair_tables
+    from core.discretize.quadrature import Panels, node_rows
 
     first = Panels.from_edges(np.array([-1.0, -0.5, 0.0, 0.5, 1.0]))
     second = Panels.from_edges(np.array([-1.0, -0.75, -0.5, 0.0, 0.25, 0.5, 1.0]))

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from core import solve_dimensionless
-from core.coating_check import check_scene
-from core.coating_model import layer_compliance, mapped_error
-from core.fem_check import CoatingStrip, Stack, solve_stack
-from core.scene import scene_from_dict, scene_to_json, solve
+from core.coating.fem_check import CoatingStrip, Stack, solve_stack
+from core.coating.model import layer_compliance, mapped_error
+from core.scene.coating_check import check_scene
+from core.scene.pipeline import scene_from_dict, scene_to_json, solve
 from tests.cli_runs import run_cli
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -178,7 +178,7 @@ def test_cli_check_prints_the_model_error(tmp_path):
 
 
 def test_check_compares_in_full_contact_as_the_fe_model():
-    from core.coating_check import elastic_scene
+    from core.scene.coating_check import elastic_scene
 
     d = creeping_scene_dict()
     d["loading"] = {"force": 5e5, "moment": 4e5}  # e = 0.8 a: the scene's answer lifts off
@@ -191,8 +191,7 @@ def test_the_error_map_read_from_its_data_file_is_the_measured_one():
     import hashlib
 
     from benchmarks.coating_validity import _table_json
-    from core import coating_error_table as table
-
+    from core.coating import error_table as table
     parts = [table.THICKNESS_RATIOS, table.MODULUS_RATIOS, table.COATING_POISSON,
              table.BASE_RATIOS] + [table.ERRORS[i][p] for i in ("smooth", "bonded")
                                    for p in ("force", "moment")]

@@ -1,5 +1,5 @@
-"""Creep of concrete by the design codes (core/code_creep.py) and fitted kernels
-(core/kernel_fit.py).
+"""Creep of concrete by the design codes (core/creep/design_codes.py) and fitted kernels
+(core/creep/kernel_fit.py).
 
 Hand values follow fib Model Code 2010 (2013) and EN 1992-1-1:2004, equation numbers in
 the comments. Tolerances are set from measured errors (written next to them).
@@ -14,12 +14,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.code_creep import RESOLUTION, CodeCreep, creep_coefficient_curve
-from core.creep import Arutyunyan, creep_model_from_spec
-from core.kernel_fit import fit_kernel, nonpositive_violation
-from core.scene import scene_from_dict, solve
+from core.creep.design_codes import RESOLUTION, CodeCreep, creep_coefficient_curve
+from core.creep.kernel_fit import fit_kernel, nonpositive_violation
+from core.creep.models import Arutyunyan, creep_model_from_spec
+from core.scene.pipeline import scene_from_dict, solve
 from core.solver import solve_dimensionless
-from core.time_integration import ModalProblem, _trapezoid_solve, solve_degenerate
+from core.time.integration import ModalProblem, _trapezoid_solve, solve_degenerate
 
 ROOT = Path(__file__).resolve().parents[1]
 C30 = {"strength_class": "C30/37", "cement": "N", "relative_humidity": 60.0,

@@ -1,4 +1,4 @@
-"""The Nystrom collocation solver (core.collocation): convergence, limits, creep oracle.
+"""The Nystrom collocation solver (core.engines.collocation.solve): convergence, limits, creep oracle.
 
 Every tolerance below is set from a measured error, quoted next to it (measured with
 the double-precision kernel; margins of 2-10x leave room for other BLAS builds).
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from scipy.linalg import expm, solve
 
-from core.collocation import collocation_panels, solve_collocation, time_grid
-from core.kernel import plane_kernel_regular
-from core.quadrature import kernel_operator
+from core.discretize.quadrature import kernel_operator
+from core.engines.collocation.solve import collocation_panels, solve_collocation, time_grid
+from core.kernel.plane import plane_kernel_regular
 
 X_CHECK = np.linspace(-1.0, 1.0, 401)
 
@@ -161,7 +161,7 @@ def test_schur_path_agrees_with_lu_factorizations(monkeypatch):
     # Aging kernel and c(t): a new step matrix every step. By default the solver switches
     # from LU to one Schur form after 16 matrices; forcing LU throughout must agree to
     # round-off (measured 9.4e-15 over all statements, outputs and nodal pressures).
-    import core.collocation_steps as collocation_steps
+    import core.engines.collocation.steps as collocation_steps
 
     def kernel(t, tau):
         return np.where(t >= tau, -0.6 * (1.0 + 1.0 / tau) * np.exp(-1.5 * (t - tau)), 0.0)

@@ -233,12 +233,11 @@ def test_all_shared_caches_together_stay_under_the_memory_budget() -> None:
     """The solver's stage caches within STAGE_CACHE_BYTES, and with the explorer's result
     cache under 640 MiB: the server measured ~130 MiB idle and ~7 MiB per session
     (benchmarks/results/load_test.md), so 20 sessions stay under 1 GiB."""
-    from core import stage_caches
+    from core.budget import STAGE_CACHE_BYTES
+    from core.engines.projection import PROJECTION_CACHES
 
-    stages = [stage_caches._PANELS, stage_caches._OPERATOR, stage_caches._BASIS,
-              stage_caches._GALERKIN, stage_caches._CORRECTION, stage_caches._GAP,
-              stage_caches._MODES, stage_caches._RESPONSE, stage_caches._SAMPLE_ROWS]
-    budget = stage_caches.STAGE_CACHE_BYTES
+    stages = list(PROJECTION_CACHES)
+    budget = STAGE_CACHE_BYTES
     assert sum(c.max_bytes for c in stages) <= budget <= 512 * 2**20
     assert budget + RESULTS.max_bytes <= 640 * 2**20
 

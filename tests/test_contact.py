@@ -1,4 +1,4 @@
-"""Unilateral contact (core.contact): limits, a second method, refinement, creep, the API.
+"""Unilateral contact (core.contact.unilateral): limits, a second method, refinement, creep, the API.
 
 Every tolerance is a measured error with a margin; the measured value is quoted next to
 it (double-precision kernel, OPENBLAS_NUM_THREADS=1).
@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 
 from core import scene_from_dict, solve, solve_dimensionless
-from core.contact import (
+from core.contact.unilateral import (
     FULL_CONTACT,
     contact_set_from_pressure,
     solve_unilateral,
 )
-from core.contact_zones import (
+from core.contact.zones import (
     Resolution,
     Space,
     Step,
@@ -29,7 +29,7 @@ from core.contact_zones import (
     solve_on_zones,
     zones_from_nodes,
 )
-from core.quadrature import base_panels, kernel_operator
+from core.discretize.quadrature import base_panels, kernel_operator
 
 ROOT = Path(__file__).resolve().parent.parent
 PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"
@@ -352,11 +352,11 @@ def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
 
 def _creep_rule_march(pb, tol, rule_for, level=0):
     """Zone ends and outputs of the creep stepping on the rule ``rule_for(space, res)``."""
-    from core.collocation import time_grid
-    from core.contact_march import march, march_outputs
-    from core.solver import _validate
+    from core.contact.march import march, march_outputs
+    from core.engines.collocation.solve import time_grid
+    from core.engines.projection.stages import validate_inputs
 
-    inp = _validate(pb.lam, pb.m, pb.g, pb.times, pb.c, pb.kernel,
+    inp = validate_inputs(pb.lam, pb.m, pb.g, pb.times, pb.c, pb.kernel,
                     {"settlement": None, "tilt": None, **pb.loads}, pb.breakpoints, tol)
     space = Space(inp.lam, inp.m, inp.g, inp.breakpoints)
     edge = min(1e-2, 0.25 * float(np.min(inp.m(np.linspace(-1.0, 1.0, 257)))))
@@ -369,7 +369,7 @@ def _creep_rule_march(pb, tol, rule_for, level=0):
 
 
 def test_band_rule_covers_the_bands_finely_and_keeps_the_breaks():
-    from core.contact_bands import band_rule, bands_from_ends
+    from core.contact.bands import band_rule, bands_from_ends
 
     space = Space(1.0, constant(0.05), constant(0.0), (-0.5, 0.3))
     res = Resolution(0.5, 1e-2)
@@ -398,13 +398,13 @@ def test_creep_zone_ends_converge_over_the_band_and_the_space_estimate_holds():
     # The preset at 5 output times, one time grid: the free end on rules with panels
     # 0.04, 0.02, 0.01 wide over the band it sweeps, against 0.0025. Measured largest
     # errors over the times 1.4e-7, 5.9e-8, 1.8e-8 with the kink correction
-    # (core/contact_kinks.py), 2.2e-6, 6.0e-7, 3.4e-7 where the nodal Q changes sign;
+    # (core/contact/kinks.py), 2.2e-6, 6.0e-7, 3.4e-7 where the nodal Q changes sign;
     # largest differences from the rule with halved panels 1.9e-7 (w = 0.04) and 4.5e-8
     # (0.02), which SPACE_FACTOR = 2 turns into estimates 3.8e-7 and 9.0e-8 above the
     # errors (1.5 times the worst ratio). Panels 0.125 wide everywhere (the former fixed
     # rule): 6.9e-5 off.
-    from core.contact_bands import band_rule, bands_from_ends
-    from core.contact_creep import SPACE_FACTOR
+    from core.contact.bands import band_rule, bands_from_ends
+    from core.contact.creep import SPACE_FACTOR
 
     pb = _preset_problem()
     first, _ = _creep_rule_march(pb, 1e-6, lambda sp, res: band_rule(sp, res, [], 0.0))
@@ -665,11 +665,11 @@ def test_lift_off_preset_lifts_off_and_meets_its_tolerance():
     ("worn", {"force": 0.01, "moment": 0.002}),
 ])
 def test_kink_corrected_ends_on_a_fixed_rule(gap, loads):
-    """The ends a creep step reports (core/contact_kinks.py) on a fixed rule of 0.04-wide
+    """The ends a creep step reports (core/contact/kinks.py) on a fixed rule of 0.04-wide
     panels, against the elastic solver's ends refined on graded panels (to ~1e-10):
     measured 3.7e-8 (footing) and 7.3e-8 (worn patch, two ends) from 2.4e-6 and 1.8e-6
     where the nodal Q's interpolant changes sign; 1e-6 is the ends' own tolerance."""
-    from core.contact_kinks import corrected_ends
+    from core.contact.kinks import corrected_ends
 
     g = worn_patch if gap == "worn" else constant(gap)
     ref = solve_unilateral(1.0, 0.05, g, [1.0], tol=1e-10, **loads)
@@ -698,8 +698,8 @@ def test_kink_corrections_batched_with_kept_factors_equal_the_exact_solve(gap, l
     (the corrected system solved anew, one step at a time): the change is refined to
     1e-9 of itself, so the ends agree far below their 1e-6 (measured: at most 6.7e-16
     on the footing, 4.7e-12 on the worn patch; 5e-11 leaves a margin of 10)."""
-    from core.contact_kinks import corrected_ends, corrected_roots, kinks_corrected
-    from core.contact_systems import StepSolver
+    from core.contact.kinks import corrected_ends, corrected_roots, kinks_corrected
+    from core.contact.systems import StepSolver
 
     g = worn_patch if gap == "worn" else constant(gap)
     space = Space(1.0, constant(0.05), g, ())
@@ -739,8 +739,8 @@ def test_elastic_answer_does_not_depend_on_earlier_solves():
 def test_coarse_start_settles_on_the_set_found_from_full_contact(gap, loads):
     """Only the start changes: the settled nodal set is the one found from full contact
     (the discrete problem has one solution), in fewer sweeps on the fine rule."""
-    from core.contact import nodal_resolution
-    from core.contact_nodal import coarse_start, nodal_operator
+    from core.contact.nodal import coarse_start, nodal_operator
+    from core.contact.unilateral import nodal_resolution
 
     g = worn_patch if gap == "worn" else constant(gap)
     space = Space(1.0, constant(0.05), g, ())

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from core.creep import (
+from core.creep.models import (
     KNOWN_MODELS,
     Arutyunyan,
     CausalKernel,
@@ -23,9 +23,9 @@ from core.creep import (
     UserKernel,
     creep_model_from_spec,
 )
-from core.time_integration import ModalProblem, solve_degenerate
+from core.time.integration import ModalProblem, solve_degenerate
 
-HAVE_EXPRESSIONS = importlib.util.find_spec("core.expressions") is not None
+HAVE_EXPRESSIONS = importlib.util.find_spec("core.profiles.expressions") is not None
 
 # Concrete-like parameters: E ~ 30 GPa, creep coefficient phi = E C of order 1-3, rates of
 # a week to a year, aging term A/tau comparable to C_inf at an age of a month.
@@ -309,7 +309,7 @@ def test_constant_stress_oracle_in_ages(name, model, e_ref, c_ref):
 
 @pytest.mark.parametrize(("name", "model", "e_ref", "c_ref"), SERIES_CASES, ids=SERIES_IDS)
 def test_kernel_drives_the_degenerate_volterra_solver(name, model, e_ref, c_ref):
-    """The kernel through core.time_integration: V(1/c) by the ODE states, and the inverse
+    """The kernel through core.time.integration: V(1/c) by the ODE states, and the inverse
     problem (creep strain given, constant stress recovered)."""
     tau0 = 28.0
     kern = model.dimensionless_kernel(tau0)
@@ -405,7 +405,7 @@ def test_spec_matches_python_api_and_defaults():
     assert isinstance(prony.spec["modulus"], float)
 
 
-@pytest.mark.skipif(not HAVE_EXPRESSIONS, reason="core.expressions not written yet")
+@pytest.mark.skipif(not HAVE_EXPRESSIONS, reason="core.profiles.expressions not written yet")
 def test_kernel_spec_round_trip():
     spec = {"model": "kernel", "modulus": 30e9, "expr": "-0.003 * exp(-0.05 * (t - tau))"}
     model = creep_model_from_spec(spec)
@@ -418,7 +418,7 @@ def test_kernel_spec_round_trip():
     assert float(model.kernel(30.0, 40.0)) == 0.0
 
 
-@pytest.mark.skipif(not HAVE_EXPRESSIONS, reason="core.expressions not written yet")
+@pytest.mark.skipif(not HAVE_EXPRESSIONS, reason="core.profiles.expressions not written yet")
 @pytest.mark.parametrize("text", ["t +* 2", "x + t", "__import__('os')"])
 def test_kernel_formula_errors_name_the_field(text):
     with pytest.raises(ValueError, match=r"^base\.creep\.expr: "):

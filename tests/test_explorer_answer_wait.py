@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import explorer.controller as controller_module
-from core import solve, solver
+from core import budget, solve
 from explorer.answer_wait import when_answered
 from explorer.controller import RESULTS, SolveController
 from explorer.results import prepare_view
@@ -30,7 +30,7 @@ pytestmark = pytest.mark.timeout(300)
 
 @pytest.fixture(scope="module")
 def processes() -> Iterator[SolverProcesses]:
-    pool = SolverProcesses(1, solver.STAGE_CACHE_BYTES // 4)
+    pool = SolverProcesses(1, budget.STAGE_CACHE_BYTES // 4)
     pool.start()
     yield pool
     pool.shutdown()

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from core import solve
-from core.study import apply_point
+from core.study.definition import apply_point
 from explorer.presets import presets
 from explorer.state import ExplorerState
 from explorer.study import (

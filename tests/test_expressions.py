@@ -13,8 +13,8 @@ import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-import core.expressions as ex
-from core.expressions import (
+import core.profiles.expressions as ex
+from core.profiles.expressions import (
     MAX_DEPTH,
     MAX_LENGTH,
     MAX_NODES,
@@ -441,10 +441,10 @@ def test_the_whitelist_is_read_only() -> None:
 
 
 def test_the_modules_never_use_pythons_compiler() -> None:
-    import core.expression_parser
-    import core.expression_tables
+    import core.profiles.parser
+    import core.profiles.whitelist
 
-    for module in (ex, core.expression_parser, core.expression_tables):
+    for module in (ex, core.profiles.parser, core.profiles.whitelist):
         source = open(module.__file__, encoding="utf-8").read()
         for word in ("eval(", "exec(", "compile(", "import ast", "literal_eval",
                      "__import__"):

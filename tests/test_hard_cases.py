@@ -31,10 +31,10 @@ import numpy as np
 import pytest
 
 from benchmarks.scenes import CONCRETE, TEN_LAYERS, jump_m, rough_g, smooth_m, stepped_g
-from core.basis import build_basis, graded_cuts
-from core.collocation import solve_collocation
-from core.creep import ExponentialCreep
-from core.quadrature import base_panels
+from core.creep.models import ExponentialCreep
+from core.discretize.basis import build_basis, graded_cuts
+from core.discretize.quadrature import base_panels
+from core.engines.collocation.solve import solve_collocation
 from core.solver import solve_dimensionless as _solve_dimensionless
 
 

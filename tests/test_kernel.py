@@ -1,7 +1,7 @@
 """Tests of the layer kernel k_pl(s) and its regular part k_pl(s) + ln|s|.
 
 The reference values are 30-digit mpmath computations by two formulas independent of the
-tables in core.kernel: the exact split
+tables in core.kernel.plane: the exact split
 
     k_pl(s) = ln(1 + 1/s^2)/2 + int_0^inf [L(u) - 1 + exp(-u)]/u cos(s u) du
 
@@ -20,7 +20,7 @@ import mpmath as mp
 import numpy as np
 from scipy import integrate
 
-from core.kernel import (
+from core.kernel.plane import (
     KERNEL_INTEGRAL,
     KERNEL_REGULAR_AT_ZERO,
     SWITCH,

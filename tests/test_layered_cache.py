@@ -10,7 +10,12 @@ import numpy as np
 
 from core import solve
 from core.cache import clear_caches
-from core.layered_cache import GAP_MOMENTS, LAYERED_OPERATOR, LAYERED_RESPONSE, LAYERED_TABLE
+from core.engines.layered.cache import (
+    GAP_MOMENTS,
+    LAYERED_OPERATOR,
+    LAYERED_RESPONSE,
+    LAYERED_TABLE,
+)
 
 SCENES = Path(__file__).resolve().parent.parent / "assets" / "scenes"
 STAGES = {"layered_table": LAYERED_TABLE, "layered_operator": LAYERED_OPERATOR,
@@ -92,8 +97,8 @@ def test_the_stage_report_says_what_a_load_change_redid() -> None:
 
 
 def test_a_worker_s_budget_bounds_the_layered_caches_too() -> None:
-    from core.layered_cache import LAYERED_BYTES
-    from core.stage_caches import STAGE_CACHE_BYTES, set_stage_cache_budget
+    from core.engines.layered.cache import LAYERED_BYTES
+    from core.budget import STAGE_CACHE_BYTES, set_stage_cache_budget
 
     try:
         set_stage_cache_budget(STAGE_CACHE_BYTES // 4)
@@ -105,8 +110,8 @@ def test_a_worker_s_budget_bounds_the_layered_caches_too() -> None:
 
 
 def test_kept_chebyshev_rows_are_the_computed_ones_and_bounded():
-    from core import layered_solve as ls
-    from core.layered_cache import CHEBYSHEV_ROWS
+    from core.engines.layered import solve as ls
+    from core.engines.layered.cache import CHEBYSHEV_ROWS
 
     t = np.cos(np.linspace(0.0, np.pi, 91))
     direct = np.cos(np.outer(np.arccos(np.clip(t, -1, 1)), np.arange(40)))

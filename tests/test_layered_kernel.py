@@ -7,9 +7,9 @@ import mpmath as mp
 import numpy as np
 import pytest
 
-from core.coating_model import layer_compliance
-from core.kernel import plane_kernel
-from core.layered_kernel import (
+from core.coating.model import layer_compliance
+from core.engines.layered.stiffness import flat_punch_stiffness
+from core.kernel.layered import (
     RegularPartTable,
     UniformLayer,
     stack_kernel,
@@ -17,7 +17,7 @@ from core.layered_kernel import (
     stack_symbol,
     symbol_at_infinity,
 )
-from core.layered_stiffness import flat_punch_stiffness
+from core.kernel.plane import plane_kernel
 
 BASE = dict(base_thickness=1.0, base_modulus=1.0, base_poisson=0.2)
 
@@ -33,7 +33,7 @@ def test_no_coating_is_the_base_symbol_and_kernel():
     err = np.abs(stack_symbol(u, [], **BASE) / base_symbol(u) - 1)
     assert err[0] < 5e-14 and err[1:].max() < 5e-15
     s = np.array([0.01, 0.1, 0.5, 1.0, 2.0, 5.0])
-    # measured <= 6.7e-16 against core.kernel (itself checked against mpmath)
+    # measured <= 6.7e-16 against core.kernel.plane (itself checked against mpmath)
     assert np.abs(stack_kernel(s, [], **BASE) - plane_kernel(s)).max() < 3e-15
 
 
@@ -89,7 +89,7 @@ def test_thin_bonded_soft_coating_adds_the_constrained_compliance():
 
 def _mp_symbol_one_layer(u, layer, nu_b=0.2):
     """L_stack(u) of one smooth or bonded layer on the base (H = E = 1) in mpmath: the
-    displacement / stress formulas of core/layered_kernel.py written out again with
+    displacement / stress formulas of core/kernel/layered.py written out again with
     unscaled exponentials (the working precision absorbs the conditioning)."""
     def face(z, h, nu, mu):
         # columns: f = exp(-kz), g = exp(-kz), f = exp(kz), g = exp(kz); rows U, W, S, T
@@ -183,7 +183,7 @@ def test_regular_part_table_matches_direct_evaluation():
 
 
 def test_flat_punch_converges_and_agrees_with_the_fe_model():
-    from core.fem_check import CoatingStrip, Stack, solve_stack
+    from core.coating.fem_check import CoatingStrip, Stack, solve_stack
 
     layer = UniformLayer(0.04, 0.05, 0.45, "bonded")
     a = flat_punch_stiffness(1.0, [layer], **BASE, modes=32)
@@ -196,7 +196,7 @@ def test_flat_punch_converges_and_agrees_with_the_fe_model():
                          lambda x: np.full(np.shape(x), 0.45), "bonded")
     fe = solve_stack(Stack(1.0, (strip,), 1.0, 1.0, 0.2), level=0)
     # measured -5.9e-5 / -1.4e-4: FE level 0's own error (1.0e-4 / 2.3e-4 uncoated,
-    # core/fem_check.py); the thin-layer model errs by -29 % / -36 % here
+    # core/coating/fem_check.py); the thin-layer model errs by -29 % / -36 % here
     assert b.force_per_settlement / fe.force_parts[1] - 1 == pytest.approx(0, abs=3e-4)
     assert b.moment_per_tilt / fe.moment_parts[2] - 1 == pytest.approx(0, abs=5e-4)
 
@@ -222,8 +222,8 @@ def test_results_say_which_coating_model_answered(small_preset):
 def _system_symbol(u, layers, nu_b=0.2):
     """L_stack(u) (H = E = 1) from one linear system of all the layers' coefficients per
     wavenumber: the boundary and interface conditions written out row by row, with the
-    bounded basis of :func:`core.layered_kernel._face` (a second, independent assembly)."""
-    from core.layered_kernel import _face
+    bounded basis of :func:`core.kernel.layered._face` (a second, independent assembly)."""
+    from core.kernel.layered import _face
 
     k = np.asarray(u, dtype=float)
     mu_b = 1 / (2 * (1 + nu_b))
@@ -273,7 +273,7 @@ def test_mixed_stack_recursion_against_one_linear_system(interfaces):
 
 
 def test_coarse_table_for_coarser_tolerances():
-    from core.layered_kernel import COARSE_PANEL_DEGREE
+    from core.kernel.layered import COARSE_PANEL_DEGREE
 
     layers = [UniformLayer(0.01, 0.005, 0.45, "bonded")]
     table = RegularPartTable(2.0, layers, **BASE, degree=COARSE_PANEL_DEGREE)

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from core import solve
-from core.layered_kernel import UniformLayer
-from core.layered_solve import solve_layered
+from core.engines.layered.solve import solve_layered
+from core.kernel.layered import UniformLayer
 
 SCENES = Path(__file__).resolve().parent.parent / "assets" / "scenes"
 
@@ -35,7 +35,7 @@ def elastic_scene(name: str, loading: dict, base_thickness: float | None = None,
 # then q on |x| <= 0.9 a): 4.1e-5 / 9.3e-5, 3.0e-3 (first), 3.7e-5 / 8.4e-5, 3.3e-3
 # (second), 6.8e-5 / 2.8e-5, 2.0e-3 (third); at FE level 1 they fall to 3.4e-6 / 8.0e-6,
 # 6.4e-4; 3.1e-6 / 7.4e-6, 7.2e-4; 6.5e-6 / 2.5e-6, 4.5e-4: the FE model's own
-# discretization error (1.0e-4 / 2.3e-4 at level 0 uncoated, core/fem_check.py), not the
+# discretization error (1.0e-4 / 2.3e-4 at level 0 uncoated, core/coating/fem_check.py), not the
 # kernel's. The thin-layer model errs by 1.5-1.7 % on these scenes.
 FE_CASES = [
     ("uniform_flat", {"force": 5e5, "moment": 5e4}, 1.0, "bonded"),
@@ -47,7 +47,7 @@ FE_CASES = [
 @pytest.mark.parametrize(("name", "loading", "base_thickness", "interface"), FE_CASES)
 def test_uniform_coating_answer_agrees_with_the_fe_model(name, loading, base_thickness,
                                                          interface):
-    from core.coating_check import check_scene
+    from core.scene.coating_check import check_scene
 
     d = elastic_scene(name, loading, base_thickness, interface)
     result = solve(d)
@@ -141,7 +141,7 @@ def test_a_default_tolerance_takes_the_coarser_rules_and_keeps_its_accuracy(modu
     assert coarse.info["coating_model"] == fine.info["coating_model"] == "exact layered"
     assert coarse.info["n_nodes"] < fine.info["n_nodes"]
     # measured 1.4e-11 (3e8) and 6.3e-12 (3e9) against the finest rules; the coarser
-    # rules' own error is up to 2.3e-10 (core/layered_solve.py)
+    # rules' own error is up to 2.3e-10 (core/engines/layered/solve.py)
     for q in ("force", "moment"):
         change = np.max(np.abs(getattr(coarse, q) / getattr(fine, q) - 1))
         assert change <= 1e-9, (q, change)

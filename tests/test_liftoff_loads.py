@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import core.quadrature as quadrature
+import core.discretize.quadrature as quadrature
 from core.cache import cache_report
-from core.scene import solve
+from core.scene.pipeline import solve
 
 LESSON = Path(__file__).resolve().parents[1] / "assets/scenes/eccentric_footing_liftoff.json"
 
@@ -33,7 +33,7 @@ def _panel_set(panels) -> set[tuple[float, float]]:
 
 def test_a_moment_change_past_lift_off_builds_nothing_geometric(monkeypatch,
                                                               cold_caches) -> None:
-    from core.contact_march import _RULE_OPERATORS
+    from core.contact.march import _RULE_OPERATORS
 
     solve(_lesson())          # caches warm, as in the explorer after the lesson's first solve
     known = set().union(*(_panel_set(op.panels) for op in _RULE_OPERATORS.values()))
@@ -68,7 +68,7 @@ def test_a_moment_change_past_lift_off_builds_nothing_geometric(monkeypatch,
 
 
 def test_reused_operators_give_the_same_answer() -> None:
-    from core.contact_march import _RULE_OPERATORS
+    from core.contact.march import _RULE_OPERATORS
 
     warm = solve(_lesson(moment=5.0e5))
     _RULE_OPERATORS.clear()

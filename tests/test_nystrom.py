@@ -1,4 +1,4 @@
-"""The default engine (direct graded-panel Nystrom, core/nystrom.py, core/prepared.py).
+"""The default engine (direct graded-panel Nystrom, core/engines/nystrom/bordered.py, core/engines/nystrom/prepared.py).
 
 Accuracy is measured as the engine claims it: q on the whole of [-1, 1] (3001 Chebyshev
 points, both ends and both sides of every jump) relative to max|q|, and delta, alpha, P,
@@ -17,7 +17,7 @@ import pytest
 
 import core
 from benchmarks.scenes import jump_m, smooth_m, stepped_g, tiny_m
-from core.creep import Arutyunyan
+from core.creep.models import Arutyunyan
 from core.solver import solve_dimensionless
 
 SCENES = {
@@ -218,8 +218,8 @@ def test_first_kind_creep_scene_falls_back_to_the_projection():
                                    frozenset({"settlement", "moment"})])
 def test_bordered_solve_on_the_refinement_lu_matches_its_own_lu(given):
     """The 2 x 2 Schur complement on the refinement's LU gives the bordered LU's answer."""
-    from core.nystrom import BorderedSystem
-    from core.nystrom_adapt import adapt
+    from core.engines.nystrom.adapt import adapt
+    from core.engines.nystrom.bordered import BorderedSystem
 
     adaptive = adapt(1.0, jump_m, stepped_g, False, (-0.5, 0.25, 0.3), 1e-6)
     schur = BorderedSystem(adaptive.grid, adaptive.c_ref, given, adaptive.factor)
@@ -235,8 +235,8 @@ def test_single_precision_lu_refines_to_the_double_precision_answer():
     too ill-conditioned for single precision is factored again in double precision."""
     from scipy.linalg import lu_factor, lu_solve
 
-    from core.nystrom import SINGLE_FROM, NodalLU
-    from core.nystrom_adapt import adapt
+    from core.engines.nystrom.adapt import adapt
+    from core.engines.nystrom.bordered import SINGLE_FROM, NodalLU
 
     grid = adapt(1.0, jump_m, stepped_g, False, (-0.5, 0.25, 0.3), 1e-6).grid
     assert grid.size >= SINGLE_FROM
@@ -266,9 +266,9 @@ def test_refined_grid_solved_by_two_grid_matches_its_dense_solve(name):
     solve's; the refined grid itself is factored only when a solve asks for it."""
     from scipy.linalg import lu_factor, lu_solve
 
-    from core.inputs import as_function
-    from core.nystrom_adapt import adapt
-    from core.nystrom_twogrid import DeferredFactor
+    from core.engines.nystrom.adapt import adapt
+    from core.engines.nystrom.twogrid import DeferredFactor
+    from core.problem.inputs import as_function
 
     s = SCENES[name]
     m, g = as_function(s["m"], "m"), as_function(s["g"], "g")
@@ -295,8 +295,8 @@ def test_operator_at_a_loose_kernel_accuracy_stays_within_it(lam, accuracy):
     far values plus a log, far pairs on the panel pairs above the diagonal), every entry
     is the full-accuracy one to within ``accuracy`` times its weight / pi, at the nodes
     and between them."""
-    from core.nystrom_adapt import start_edges
-    from core.quadrature import Panels, node_rows, operator_rows
+    from core.discretize.quadrature import Panels, node_rows, operator_rows
+    from core.engines.nystrom.adapt import start_edges
 
     panels = Panels.from_edges(start_edges(lam, (0.3,), 0.01, 1e-9, 2.0))
     every = np.arange(panels.n_panels)
@@ -314,8 +314,8 @@ def test_operator_at_a_loose_kernel_accuracy_stays_within_it(lam, accuracy):
 def test_mirror_pairs_of_a_symmetric_grid_give_the_evaluated_operator(monkeypatch):
     """On panels symmetric about 0 the far blocks copied from their mirror images equal
     the evaluated ones (to the rounding of the node positions)."""
-    import core.quadrature as quadrature
-    from core.nystrom_adapt import start_edges
+    import core.discretize.quadrature as quadrature
+    from core.engines.nystrom.adapt import start_edges
 
     panels = quadrature.Panels.from_edges(start_edges(1.0, (), 1e-3, 1e-9, 2.0))
     assert panels.n_panels >= quadrature.MIRROR_FROM
@@ -333,9 +333,9 @@ def test_operator_from_pair_tables_matches_its_own_distances(accuracy):
     tables (ln|z - t_j| of the key, no log per entry); they equal the rows formed from the
     nodes' own distances, on a grid, across a refinement (both ways) and on panels ~4e-11
     wide (where the tables' distances would not do and the nodes' own are taken)."""
-    from core import pair_tables
-    from core.nystrom_adapt import grade, start_edges
-    from core.quadrature import Panels, node_rows, operator_rows
+    from core.discretize import pair_tables
+    from core.discretize.quadrature import Panels, node_rows, operator_rows
+    from core.engines.nystrom.adapt import grade, start_edges
 
     pair_tables.clear()
     singular = np.array([-1.0, 1.0, 0.3])

@@ -1,4 +1,4 @@
-"""Elastic answers at many output times (core/prepared_elastic.py).
+"""Elastic answers at many output times (core/engines/nystrom/elastic.py).
 
 The answer at every output time is a combination of cached unit responses; the extremes of
 q that decide ``contact_lost`` are sought over the check points block by block. Both must
@@ -12,8 +12,8 @@ import pytest
 
 import core
 from benchmarks.scenes import jump_m
-from core.prepared import HISTORY_SAMPLES
-from core.prepared_elastic import CHECK_BLOCK
+from core.engines.nystrom.elastic import CHECK_BLOCK
+from core.engines.nystrom.prepared import HISTORY_SAMPLES
 
 
 def force(t: np.ndarray) -> np.ndarray:

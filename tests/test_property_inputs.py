@@ -26,7 +26,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from core.scene import parse_scene_json, scene_from_dict, solve
+from core.scene.pipeline import parse_scene_json, scene_from_dict, solve
 from explorer.controller import SolveController
 from explorer.state import QUANTITIES, STATEMENTS, ExplorerState
 

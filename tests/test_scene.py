@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
-from core.creep import creep_model_from_spec
-from core.scene import (
+from core.creep.models import creep_model_from_spec
+from core.scene.pipeline import (
     MAX_SCENE_BYTES,
     Scene,
     SceneSolution,
@@ -119,7 +119,7 @@ def test_shipped_scene_solves_in_full_contact(path: Path):
     # defects 3e-10 - 2e-9 of the force against estimates of ~1e-8).
     if result.info["coating_model"] == "exact layered":
         # q is singular like 1 / sqrt(a - |x|) at the corners and held within half the top
-        # layer of them (core/layered_scene.py): P = pi c_0, M = pi c_1 / 2 by
+        # layer of them (core/engines/layered/answer.py): P = pi c_0, M = pi c_1 / 2 by
         # construction, checked against the FE model in tests/test_layered_scene.py
         return
     force, moment = _integrals(result)

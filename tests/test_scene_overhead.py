@@ -9,8 +9,8 @@ import json
 import numpy as np
 import pytest
 
-from core.golden_section import golden_minimum, golden_minimum_batched
-from core.scene import scene_from_dict, solve
+from core.scene.golden_section import golden_minimum, golden_minimum_batched
+from core.scene.pipeline import scene_from_dict, solve
 from explorer.presets import SCENES_DIR
 
 
@@ -61,7 +61,7 @@ def test_a_load_change_gives_the_answer_of_a_fresh_scene(name):
 @pytest.mark.parametrize("name", ["rounded_graded", "patched_insert", "worn_coating"])
 def test_the_samples_are_the_union_of_every_profiles_samples(name):
     """Constant profiles are sampled once: the samples are still the union of all."""
-    from core.scene_model import DENSE_SAMPLES
+    from core.scene.model import DENSE_SAMPLES
 
     scene = scene_from_dict(_scene(name))
     a = scene.half_width

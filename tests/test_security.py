@@ -25,11 +25,11 @@ from typing import Any
 import numpy as np
 import pytest
 
-import core.scene_schema as scene_schema
+import core.scene.schema as scene_schema
 from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS
 from core.cli import main as cli_main
-from core.profiles import profile_from_csv
-from core.scene import (
+from core.profiles.build import profile_from_csv
+from core.scene.pipeline import (
     MAX_BREAKPOINTS,
     MAX_SCENE_BYTES,
     load_scene,
@@ -379,7 +379,7 @@ def test_a_process_killed_during_a_save_leaves_the_old_file_intact(tmp_path: Pat
     script = textwrap.dedent(f"""
         import json, os, sys
         sys.path.insert(0, {str(ROOT)!r})
-        from core.scene import save_scene
+        from core.scene.pipeline import save_scene
         scene = json.loads({json.dumps(json.dumps(edited("name", "the new scene")))})
         os.replace = lambda src, dst: os._exit(9)
         save_scene(scene, {str(path)!r})

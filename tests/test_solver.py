@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from core.basis import graded_cuts
-from core.quadrature import base_panels, kernel_operator, operator_rows
+from core.discretize.basis import graded_cuts
+from core.discretize.quadrature import base_panels, kernel_operator, operator_rows
 from core.solver import solve_dimensionless
 
 
@@ -221,7 +221,7 @@ def _ode_oracle(lam, m, amp, rate, p, mom, times, max_width=0.1):
 
 
 def test_creep_against_ode_oracle():
-    from core.creep import ExponentialCreep
+    from core.creep.models import ExponentialCreep
 
     model = ExponentialCreep(modulus=3e10, compliance=6e-11, rate=0.05)
     kernel = model.dimensionless_kernel(28.0)
@@ -239,7 +239,7 @@ def test_creep_against_ode_oracle():
 
 
 def test_general_kernel_path_matches_degenerate():
-    from core.creep import ExponentialCreep
+    from core.creep.models import ExponentialCreep
 
     kernel = ExponentialCreep(modulus=3e10, compliance=6e-11, rate=0.05).dimensionless_kernel(28)
     times = np.array([1.0, 2.0, 5.0])

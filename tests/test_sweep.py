@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.scene import solve
-from core.study import (
+from core.scene.pipeline import solve
+from core.study.definition import (
     MAX_STUDY_POINTS,
     apply_point,
     load_study,
@@ -211,7 +211,7 @@ def test_fields_a_study_can_vary_and_a_smaller_limit():
 
 
 def test_contact_width_of_a_pressure_linear_in_x():
-    from core.sweeps import _contact_width
+    from core.study.run import _contact_width
 
     x = -np.cos(np.linspace(0, np.pi, 201))  # uneven, like the plotting grid
     q = np.stack([x - 0.5, 1 + 0 * x, -1 - x * 0, 0.3 - x], axis=1)
@@ -220,8 +220,8 @@ def test_contact_width_of_a_pressure_linear_in_x():
 
 
 def test_serial_run_equals_the_loop_and_batches_follow_geometry():
-    from core.sweep_plan import BatchPlan
-    from core.sweeps import sweep
+    from core.study.plan import BatchPlan
+    from core.study.run import sweep
 
     study = study_from_dict(small_study())
     ds = sweep(study, client="serial", batch_points=4)
@@ -269,18 +269,18 @@ def assert_batched_equal(values, estimate, result, outputs):
 
 
 def sweeps_point_outputs(result, outputs):
-    from core.sweeps import point_outputs
+    from core.study.run import point_outputs
 
     return point_outputs(result, outputs)
 
 
 @pytest.mark.parametrize("contact", ["auto", "full"])
 def test_load_batch_equals_core_solve_on_a_loads_grid(contact):
-    """core.sweep_loads answers the full-contact points of a force x moment grid at once,
+    """core.study.loads answers the full-contact points of a force x moment grid at once,
     equal to core.solve point by point; it leaves lift-off (``auto``) and refused points
     alone; with ``full`` contact it answers the points that lose contact, flagged."""
-    from core.scene import scene_from_dict
-    from core.sweep_loads import load_batch_applies, solve_load_batch
+    from core.scene.pipeline import scene_from_dict
+    from core.study.loads import load_batch_applies, solve_load_batch
 
     base = elastic_scene() | {"times": [1.0, 365.0]}
     base["solver"] = dict(base.get("solver", {}), contact=contact)
@@ -316,8 +316,8 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
     """A batch varying only loads validates the base scene once and replaces the loads of
     each point: every output, estimate, flag and message equals core.solve's on the
     point's whole scene dict, lift-off and refused points included."""
-    import core.sweep_batch as batch
-    import core.sweeps as sweeps
+    import core.study.batch as batch
+    import core.study.run as sweeps
 
     study = study_from_dict(small_study(vary=[
         {"field": "loading.force", "values": [-1e5, 1e5, 5e5]},
@@ -338,7 +338,7 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
             np.testing.assert_array_equal(got["values"][i],
                                           sweeps.point_outputs(result, outputs))
             assert got["error_estimate"][i] == result.info["error_estimate"]
-        else:  # full contact: the whole batch at once (core.sweep_loads)
+        else:  # full contact: the whole batch at once (core.study.loads)
             assert_batched_equal(got["values"][i], got["error_estimate"][i], result,
                                  outputs)
 
@@ -348,8 +348,8 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
 
 
 def test_replace_loads_equals_the_validated_dict():
-    from core.scene import scene_from_dict
-    from core.scene_validation import replace_loads
+    from core.scene.pipeline import scene_from_dict
+    from core.scene.validate import replace_loads
 
     study = study_from_dict(small_study())
     base = scene_from_dict(study.base)
@@ -368,7 +368,7 @@ def test_replace_loads_equals_the_validated_dict():
 
 
 def test_failed_point_is_recorded_and_the_study_goes_on():
-    from core.sweeps import sweep
+    from core.study.run import sweep
 
     spec = small_study(vary=[{"field": "base.poisson", "normal": {"mean": 0.3, "std": 0.15}}],
                        samples=12, seed=3)
@@ -386,7 +386,7 @@ def test_failed_point_is_recorded_and_the_study_goes_on():
 
 
 def test_interrupted_study_resumes_without_recomputing(tmp_path: Path):
-    from core.sweeps import StudyInterrupted, sweep
+    from core.study.run import StudyInterrupted, sweep
 
     study = study_from_dict(small_study())
     work = tmp_path / "parts"
@@ -468,7 +468,7 @@ def loopback_cluster(tmp_path_factory):
 def test_study_on_a_separately_started_cluster_equals_a_serial_loop(loopback_cluster):
     from distributed import Client
 
-    from core.sweeps import sweep
+    from core.study.run import sweep
 
     study = study_from_dict(small_study())
     with Client(loopback_cluster, timeout=60) as client:
@@ -482,7 +482,7 @@ def test_cli_sweep_on_the_cluster_writes_each_format(loopback_cluster, tmp_path:
     import pandas as pd
     import xarray as xr
 
-    from core.sweeps import sweep
+    from core.study.run import sweep
 
     (tmp_path / "study.json").write_text(json.dumps(small_study()))
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
@@ -513,8 +513,8 @@ def test_cli_sweep_on_the_cluster_writes_each_format(loopback_cluster, tmp_path:
 def test_workers_are_warmed_by_a_plugin_and_the_warming_batches_solve(loopback_cluster):
     from distributed import Client
 
-    from core.sweep_batch import run_batch
-    from core.sweep_warm import WARM_LOADS, WARM_SCENE, warm_worker, warm_workers
+    from core.study.batch import run_batch
+    from core.study.warm import WARM_LOADS, WARM_SCENE, warm_worker, warm_workers
 
     # the warming batch goes through the load paths: full contact, lift-off and scaled
     got = run_batch(WARM_SCENE, ["loading.force", "loading.moment"], WARM_LOADS,
@@ -532,7 +532,7 @@ def test_workers_are_warmed_by_a_plugin_and_the_warming_batches_solve(loopback_c
 
 def test_a_failed_warming_leaves_the_worker_running(monkeypatch):
     pytest.importorskip("distributed")
-    import core.sweep_warm as warm
+    import core.study.warm as warm
 
     def broken() -> float:
         raise RuntimeError("no tables today")
@@ -558,8 +558,8 @@ def test_batch_groups_points_sharing_a_geometry(monkeypatch):
     """Points that differ only in their loads share one validated scene and one load batch
     per geometry; every answer equals core.solve on the point's whole scene dict, and a
     geometry that does not validate leaves its points to report their own messages."""
-    import core.sweep_loads as sweep_loads
-    import core.sweeps as sweeps
+    import core.study.loads as sweep_loads
+    import core.study.run as sweeps
 
     study = study_from_dict(small_study())
     paths = ["coating[0].modulus", "loading.force", "loading.moment"]
@@ -610,7 +610,7 @@ def test_points_of_one_eccentricity_are_one_answer_scaled(monkeypatch):
     fixed eccentricity: a batch solves one point per eccentricity that the load batch
     leaves (lift-off here) and scales it for the others; outputs, estimates and flags
     equal core.solve's on each point's scene."""
-    import core.sweep_batch as batch
+    import core.study.batch as batch
 
     study = study_from_dict(small_study(vary=[
         {"field": "loading.force", "values": [1e5]},
@@ -642,8 +642,8 @@ def test_points_of_one_eccentricity_are_one_answer_scaled(monkeypatch):
 
 
 def test_scaled_answer_flags_a_large_tilt_by_its_own_size():
-    from core.scene_results import LARGE_TILT
-    from core.sweep_batch import _scaled
+    from core.scene.results import LARGE_TILT
+    from core.study.batch import _scaled
 
     answer = (1e5, np.array([[1.0], [2.0]]), 1e-9, ["contact_lost", "large_tilt"],
               0.8 * LARGE_TILT)
@@ -652,15 +652,15 @@ def test_scaled_answer_flags_a_large_tilt_by_its_own_size():
     assert estimate == 1e-9 and flags == "contact_lost,large_tilt"
     assert _scaled(answer, 1e5, ["tilt"])[2] == "contact_lost"
     # a creeping base (the preset as shipped) is not taken as one that scales here
-    from core.scene import scene_from_dict
-    from core.sweep_batch import answers_scale_with_loads
+    from core.scene.pipeline import scene_from_dict
+    from core.study.batch import answers_scale_with_loads
 
     scene = json.loads((SCENES / "uniform_flat.json").read_text())
     assert not answers_scale_with_loads(scene_from_dict(scene))
 
 
 #: The lift-off answers of one geometry's batch located along the zone end
-#: (core.sweep_liftoff) against core.solve on each point's scene, relative to each
+#: (core.study.liftoff) against core.solve on each point's scene, relative to each
 #: output's size: measured at most 2.3e-9 over the 1,470 lift-off points of
 #: benchmarks.sweep.loads_study(100) and 1.9e-12 on this test's grid; both
 #: solve the same zone to its solver's tolerance (estimates ~1e-8 to 6e-8), so they differ
@@ -671,9 +671,9 @@ LIFTOFF_FAMILY_DIFFERENCE = 1e-8
 def test_liftoff_eccentricities_of_a_batch_are_one_family(monkeypatch):
     """Many lift-off eccentricities of a flat punch in one batch: the smallest and the
     largest are solved by core.solve, the others located along the zone end and solved on
-    their zones (core.sweep_liftoff); every point's outputs, flags and messages match
+    their zones (core.study.liftoff); every point's outputs, flags and messages match
     core.solve's, and its error estimate stays within a third of tol."""
-    import core.sweep_batch as batch
+    import core.study.batch as batch
 
     study = study_from_dict(small_study(vary=[
         {"field": "loading.force", "values": [1e5]},

@@ -1,5 +1,5 @@
 """The points and batches of a study made batch by batch from its description
-(core.study.StudyPoints, core.sweep_plan.BatchPlan): the same points as the whole table,
+(core.study.definition.StudyPoints, core.study.plan.BatchPlan): the same points as the whole table,
 the same order as a sort of all of them where the loads fit a window, bounded memory."""
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import core.sweep_plan as sweep_plan
-from core.study import DRAW_BLOCK, StudyPoints, point_table, study_from_dict
-from core.sweep_plan import BatchPlan
+import core.study.plan as sweep_plan
+from core.study.definition import DRAW_BLOCK, StudyPoints, point_table, study_from_dict
+from core.study.plan import BatchPlan
 from tests.test_sweep import elastic_scene, small_study
 
 
@@ -125,7 +125,7 @@ def test_plan_of_a_million_points_holds_no_per_point_array():
 
 def test_parts_written_before_the_order_was_named_resume_when_it_is_the_same(
         tmp_path: Path):
-    from core.sweeps import sweep
+    from core.study.run import sweep
 
     study = study_from_dict(small_study())
     work = tmp_path / "parts"

@@ -1,6 +1,6 @@
 """The Radau IIA step of the modal Volterra equations against the plain stage system.
 
-:func:`core.time_integration._radau_step` eliminates the kernel's states (they couple
+:func:`core.time.integration._radau_step` eliminates the kernel's states (they couple
 only through their sum) and solves one 3x3 system per mode. The reference here builds
 the whole stage system of each mode, ``I - h (A (x) J_j)`` of size 3 * states, and
 solves it densely: the textbook form of the method, an independent second computation.
@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from core.creep import DegenerateKernel
-from core.time_integration import RADAU_A, RADAU_C, ModalProblem, _radau_step, solve_degenerate
+from core.creep.models import DegenerateKernel
+from core.time.integration import RADAU_A, RADAU_C, ModalProblem, _radau_step, solve_degenerate
 
 
 def _reference_step(kernel, problem, t0, h, s_modes, s_known):
@@ -119,7 +119,7 @@ _STIFF = DegenerateKernel(age_at_loading=28.0, modulus_final=3e10, beta=0.4, alp
 def test_exponential_collocation_converges_at_high_order():
     """True error against a tight adaptive Radau IIA reference (an independent method) on
     grids of 2x, 4x, 8x the steps: the order in the step count is the method's."""
-    from core.exponential_steps import first_step, grid, march
+    from core.time.exponential import first_step, grid, march
 
     problem = _creep_problem()
     times = 1.0 + np.geomspace(1e-3, 60.0, 30)
@@ -156,12 +156,12 @@ def test_exponential_collocation_meets_tol_and_its_estimate_is_honest(tol):
 
 
 def test_modes_marched_by_affine_maps_or_step_by_step_agree(monkeypatch):
-    """The two ways of marching the modes (:mod:`core.exponential_modes`: an affine map of
+    """The two ways of marching the modes (:mod:`core.time.exponential_modes`: an affine map of
     the states a step for few states, z formed on the way for many) give the same answer
     (4 states here; both forced in turn, five grids marched). Measured: 2.5e-16 of
     max|V w| and 3.6e-16 of max|w| apart (the order of the sums alone differs), so 1e-13
     holds it with room for other BLAS builds."""
-    import core.exponential_modes as modes
+    import core.time.exponential_modes as modes
 
     problem = _creep_problem()
     times = 1.0 + np.geomspace(1e-3, 60.0, 30)
@@ -178,7 +178,7 @@ def test_modes_marched_by_affine_maps_or_step_by_step_agree(monkeypatch):
 def test_exponential_collocation_in_blocks_of_steps_is_the_same(monkeypatch):
     """The point systems are built a block of steps at a time (bounded memory): blocks of
     five steps give the answer of one block (measured identical)."""
-    import core.exponential_steps as steps
+    import core.time.exponential as steps
 
     problem = _creep_problem()
     times = 1.0 + np.geomspace(1e-3, 60.0, 30)
@@ -191,12 +191,12 @@ def test_exponential_collocation_in_blocks_of_steps_is_the_same(monkeypatch):
 
 @pytest.mark.parametrize("affine_states", [100, 0])
 def test_grids_marched_in_one_pass_are_marched_apart(monkeypatch, affine_states):
-    """Several grids marched in one pass (:func:`core.exponential_steps.march_grids`: the
+    """Several grids marched in one pass (:func:`core.time.exponential.march_grids`: the
     states restart at each grid's first step, no neighbour read across grids) give each
     grid's own march, with a jump inside, both ways of marching the modes, and the local
     errors of each grid. Measured identical (the same operations on the same numbers)."""
-    import core.exponential_modes as modes
-    from core.exponential_steps import first_step, grid, march, march_grids
+    import core.time.exponential_modes as modes
+    from core.time.exponential import first_step, grid, march, march_grids
 
     monkeypatch.setattr(modes, "AFFINE_STATES", affine_states)
     problem = _creep_problem()

@@ -25,8 +25,8 @@ import pytest
 
 import explorer.controller as controller_module
 import explorer.workers as workers
-from core import solve, solver
-from core.stage_budget import stage_cache_bounds
+from core import budget, solve
+from core.budget import stage_cache_bounds
 from explorer.controller import RESULTS, SolveController
 from explorer.results import prepare_view
 from explorer.state import QUANTITIES, ExplorerState
@@ -45,7 +45,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 @pytest.fixture(scope="module")
 def processes() -> Iterator[SolverProcesses]:
-    pool = SolverProcesses(2, solver.STAGE_CACHE_BYTES // 2)
+    pool = SolverProcesses(2, budget.STAGE_CACHE_BYTES // 2)
     pool.start()
     yield pool
     pool.shutdown()
@@ -155,7 +155,7 @@ def test_a_bad_scene_from_a_worker_names_its_field(processes, monkeypatch,
 
 
 def test_each_worker_holds_its_share_of_the_stage_cache_budget(processes) -> None:
-    share = solver.STAGE_CACHE_BYTES // 2
+    share = budget.STAGE_CACHE_BYTES // 2
     infos = processes.run_everywhere(worker_info)
     assert len({info["pid"] for info in infos}) == 2 and os.getpid() not in \
         {info["pid"] for info in infos}
@@ -166,13 +166,13 @@ def test_each_worker_holds_its_share_of_the_stage_cache_budget(processes) -> Non
 def test_the_stage_cache_budget_is_shared_in_proportion() -> None:
     default = stage_cache_bounds()
     try:
-        solver.set_stage_cache_budget(solver.STAGE_CACHE_BYTES // 4)
+        budget.set_stage_cache_budget(budget.STAGE_CACHE_BYTES // 4)
         assert stage_cache_bounds() == {name: size // 4 for name, size in default.items()}
         for bad in (0, -1, 1.5, "1", True):
             with pytest.raises(ValueError, match="total_bytes"):
-                solver.set_stage_cache_budget(bad)
+                budget.set_stage_cache_budget(bad)
     finally:
-        solver.set_stage_cache_budget(solver.STAGE_CACHE_BYTES)
+        budget.set_stage_cache_budget(budget.STAGE_CACHE_BYTES)
     assert stage_cache_bounds() == default
 
 

@@ -1,0 +1,194 @@
+"""One time march of unilateral contact under creep on a fixed panel rule.
+
+At step ``n`` of a time grid the memory of the past pressures (:mod:`core.contact.memory`)
+turns the problem into the elastic one of :mod:`core.contact.zones` with
+``scale = 1 - w_n`` on the current pressure and the memory displacement
+``e = F (memory of q_0 .. q_{n-1})``. The contact set is found at every step by the nodal
+active set (warm-started from the step before), on one panel rule, so the memory of every
+past pressure lives on the same nodes. The zone ends of each output time are the roots of
+the Nystrom pressure's interpolant on those nodes, after the kink of the pressure at each
+end is taken out of the panel rule (:mod:`core.contact.kinks`; the corrections of
+``_KINK_BATCH`` output times at once, the roots of all after the march). The error
+control over rules and grids is :mod:`core.contact.creep`'s.
+"""
+
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from core.cache import StageCache, fingerprint
+from core.contact.active_set import NoContact, NodalState, nodal_active_set, zones_from_nodes
+from core.contact.kinks import corrected_roots, kinks_corrected
+from core.contact.memory import pressure_memory
+from core.contact.step import Space, Step
+from core.contact.systems import StepSolver
+from core.contact.zones import zone_kernel_accuracy
+from core.discretize.quadrature import KernelOperator, Panels, kernel_operator
+
+#: The operators of the stepping's panel rules, keyed by lam and the panel edges (they
+#: depend on nothing else): a load-only change (the explorer's eccentricity slider) meets
+#: the same base and locating rules again, and band rules that share most panels with one
+#: kept here, whose blocks are copied (only the rows and columns of new panels are built).
+_RULE_OPERATORS = StageCache("contact_rule_operator", max_items=12, max_bytes=96 * 2**20)
+
+
+def rule_operator(lam: float, rule: Panels) -> np.ndarray:
+    """The Nystrom matrix of F on the nodes of ``rule`` (read-only, cached; see
+    ``_RULE_OPERATORS``). ``lam`` = a/H (dimensionless)."""
+    key = fingerprint(float(lam), np.asarray(rule.edges, dtype=float))
+
+    def build() -> KernelOperator:
+        # the kept operator of this lam sharing most panels with the rule seeds it
+        best, shared = None, 0
+        for previous in _RULE_OPERATORS.values():
+            if previous.lam == lam:
+                common = np.intersect1d(previous.panels.edges, rule.edges).size
+                if common > shared:
+                    best, shared = previous, common
+        operator = kernel_operator(lam, rule, previous=best)
+        operator.matrix.flags.writeable = False  # shared by every march on this rule
+        return operator
+
+    return _RULE_OPERATORS.get_or_compute(key, build)[0].matrix
+
+
+def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.ndarray,
+           grid: np.ndarray, widths: np.ndarray, out_index: np.ndarray,
+           exact_ends: bool = True, first: dict[str, Any] | None = None) -> dict[str, Any]:
+    """March over ``grid`` on the rule ``base`` (its Nystrom matrix ``op``, m and g at
+    its nodes). ``first`` (shared by the marches of one solve): the zones of the first
+    step, at loading, recorded by the first march and the start of the first step of
+    the later ones (from full contact it took 4-6 sweeps, each with a new LU)."""
+    from core.contact.unilateral import _check_loads
+
+    # kink rows with kernel values to 1e-4 of the tighter of tol and the zone-end
+    # tolerance (as the elastic zone operators): ~15 % less kernel work per correction
+    accuracy = zone_kernel_accuracy(inp.tol)
+    n_nodes = base.size
+    steps = grid.size
+    c_vals = inp.c(grid)
+    loads = {name: np.asarray(fn(grid), dtype=float) for name, fn in inp.loads.items()}
+    _check_loads(inp.given, loads, grid)
+    inner = np.zeros(steps)
+    inner[:-1] += 0.5 * widths
+    inner[1:] += 0.5 * widths
+    memory_of = pressure_memory(inp.kernel, grid, inner, n_nodes)
+    wanted = {int(i): k for k, i in enumerate(out_index)}
+    # per output time: the state, its step, the memory density, the ends, the nodal ends
+    states: list[tuple[NodalState, Step, np.ndarray, list[float], list[float]]] = (
+        [None] * len(out_index))  # type: ignore
+    active = None
+    solver = StepSolver()
+    pending: list[tuple[int, Any]] = []
+    batch: list[tuple[int, tuple]] = []
+    sweeps = 0
+    unsettled = 0
+    for n in range(steps):
+        memory_density = np.zeros(n_nodes)
+        diag = 0.0
+        if n > 0:
+            memory_density, diag = memory_of.at(n)
+        step = Step(float(c_vals[n]), 1.0 - diag,
+                    {name: float(v[n]) for name, v in loads.items()})
+        displacement = op @ memory_density
+        start = active
+        if n == 0 and first is not None and "zones" in first:
+            start = _nodes_in(base.nodes, first["zones"])
+        try:
+            state, count, settled = _step_state(base, op, m, g, step, displacement, start,
+                                                solver, retry=n == 0)
+        except NoContact as exc:
+            name = "force" if "force" in step.given else "moment"
+            raise ValueError(f"{name}: the loads pull the punch away at t = {grid[n]:g} "
+                             f"({exc})") from None
+        if n == 0 and first is not None and "zones" not in first and state.active.any():
+            ends = zones_from_nodes(state, space.breakpoints)[0]
+            first["zones"] = list(zip(ends[0::2], ends[1::2], strict=True))
+        sweeps += count
+        unsettled += not settled
+        active = state.active
+        memory_of.record(n, state.q)
+        if n in wanted:
+            nodal, pinned = ([], []) if not state.active.any() else zones_from_nodes(
+                state, space.breakpoints)[:2]
+            if exact_ends and nodal:
+                # corrected in batches, each step with its own factors (kept by a
+                # snapshot); the roots of all at the end
+                batch.append((wanted[n], (step, state, displacement, memory_density,
+                                          solver.snapshot(), (nodal, pinned))))
+                if len(batch) == _KINK_BATCH:
+                    pending += _corrected(space, op, m, g, batch, accuracy)
+                    batch = []
+            states[wanted[n]] = (state, step, memory_density, nodal, nodal)
+    if batch:
+        pending += _corrected(space, op, m, g, batch, accuracy)
+    if pending:
+        roots = corrected_roots(space, [c for _, c in pending], accuracy)
+        for (k, _), ends in zip(pending, roots, strict=True):
+            states[k] = states[k][:3] + (ends, states[k][4])
+    return {"states": states, "sweeps": sweeps, "unsettled": unsettled, "steps": steps - 1,
+            "breakpoints": space.breakpoints,
+            "factorizations": solver.factorizations,
+            "back_substitutions": solver.back_substitutions}
+
+
+def _nodes_in(x: np.ndarray, zones: list[tuple[float, float]]) -> np.ndarray:
+    """The nodes ``x`` inside the ``zones`` (a contact set as a start)."""
+    inside = np.zeros(x.size, dtype=bool)
+    for lo, hi in zones:
+        inside |= (x >= lo) & (x <= hi)
+    return inside
+
+
+def _step_state(base, op: np.ndarray, m: np.ndarray, g: np.ndarray, step: Step,
+                displacement: np.ndarray, start: np.ndarray | None, solver: StepSolver,
+                retry: bool) -> tuple[NodalState, int, bool]:
+    """The nodal active set of one step from ``start``; with ``retry``, a start that
+    does not settle (or leaves no contact) is retried from full contact."""
+    tried = 0
+    if retry and start is not None:
+        try:
+            state, tried, settled = nodal_active_set(base, op, m, g, step,
+                                                     memory=displacement, start=start,
+                                                     solver=solver)
+            if settled:
+                return state, tried, settled
+        except NoContact:
+            pass
+        start = None
+    state, count, settled = nodal_active_set(base, op, m, g, step, memory=displacement,
+                                             start=start, solver=solver)
+    return state, tried + count, settled
+
+
+#: Output times whose kink corrections are made together (one evaluation of F on their
+#: cut parts): each holds its step's LU factors meanwhile (~0.7 MB at 300 contact
+#: nodes), so the batch stays short.
+_KINK_BATCH = 10
+
+
+def _corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
+               batch: list[tuple[int, tuple]], accuracy: float) -> list[tuple[int, Any]]:
+    done = kinks_corrected(space, op, m, g, [row for _, row in batch], accuracy)
+    return [(k, c) for (k, _), c in zip(batch, done, strict=True)]
+
+
+def march_outputs(run: dict[str, Any]) -> dict[str, Any]:
+    """The outputs of one march, with what the pressure needs (all linear in the steps)."""
+    states = run["states"]
+    return {
+        "settlement": np.array([row[0].settlement for row in states]),
+        "tilt": np.array([row[0].tilt for row in states]),
+        "force": np.array([row[0].force for row in states]),
+        "moment": np.array([row[0].moment for row in states]),
+        # without the kink defect (core/contact/kinks.py) when the march corrected them
+        "ends": [list(row[3]) for row in states],
+        "nodal_ends": [list(row[4]) for row in states],
+        # Q(x) = [delta + alpha x - g - F(effective)(x)] / (c m), effective = s q - memory
+        "effective": np.column_stack([row[1].scale * row[0].q - row[2] for row in states]),
+        "c": np.array([row[1].c for row in states]),
+    }
+

@@ -1,0 +1,100 @@
+"""The unilateral problem at one time: its data and the Nystrom pressure.
+
+At one time the unilateral problem (model notes, dimensionless) reads: find ``q >= 0`` and
+the contact set ``S`` with
+
+    c m q + s F q = delta + alpha x - g + e(x)   on S   (q > 0: the surfaces touch)
+    h(x) = s F q - (delta + alpha x - g + e(x)) >= 0   off S   (q = 0: the gap is open)
+
+and the two given ones of ``delta, alpha, P = int q, M = int x q``. ``s`` weighs the current
+pressure (1 elastic; ``1 - K(t, t) dt/2`` in an implicit creep step) and ``e(x)`` is the
+displacement of the creep memory (0 elastic). Both conditions are one continuous function,
+the *Nystrom pressure*
+
+    Q(x) = [delta + alpha x - g(x) + e(x) - s F q (x)] / (c m(x)),
+
+which equals ``q`` on S and ``-h / (c m)`` off it: S is where ``Q > 0``, and at a free end
+of a zone ``Q`` passes through zero (``q`` is continuous and vanishes there: ``h >= 0`` just
+outside forces ``q(end) <= 0``, ``q >= 0`` just inside forces ``>= 0``).
+
+:func:`nystrom_pressure` evaluates Q; :func:`_bordered_solve` solves the equation on the
+contact nodes with the two given ones of the four scalars. The nodal active set
+(:mod:`core.contact.active_set`) and the zone ends (:mod:`core.contact.zones`) are built on
+them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from core.contact.systems import StepSolver, bordered_solve
+from core.discretize.quadrature import Panels, operator_rows
+from core.kernel.values import FULL_ACCURACY
+
+
+@dataclass(frozen=True)
+class Space:
+    """The scene's functions of x: ``lam`` = a/H, coating compliance ``m`` and gap ``g``
+    (vectorized callables on [-1, 1]), and ``breakpoints`` where m or g may jump."""
+
+    lam: float
+    m: Callable[[np.ndarray], np.ndarray]
+    g: Callable[[np.ndarray], np.ndarray]
+    breakpoints: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class Step:
+    """One time's data: relative modulus ``c``, weight ``scale`` of F on the current
+    pressure, and the two given ones of settlement, tilt, force, moment (dimensionless)."""
+
+    c: float
+    scale: float
+    given: dict[str, float]
+
+
+class _Resultants:
+    """Force and moment (dimensionless) of a nodal pressure ``q`` on ``panels``."""
+
+    panels: Panels
+    q: np.ndarray
+
+    @property
+    def force(self) -> float:
+        return float(self.panels.weights @ self.q)
+
+    @property
+    def moment(self) -> float:
+        return float((self.panels.weights * self.panels.nodes) @ self.q)
+
+
+def _bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, step: Step,
+                    rhs: np.ndarray, idx: np.ndarray,
+                    solver: StepSolver | None = None) -> tuple[np.ndarray, float, float]:
+    """:func:`core.contact.systems.bordered_solve` for one :class:`Step`."""
+    return bordered_solve(op, m, x, w, step.c, step.scale, step.given, rhs, idx, solver)
+
+
+def _given_rhs(step: Step, x: np.ndarray, g: np.ndarray, memory: np.ndarray | None) -> np.ndarray:
+    rhs = step.given.get("settlement", 0.0) + step.given.get("tilt", 0.0) * x - g
+    return rhs if memory is None else rhs + memory
+
+
+def nystrom_pressure(space: Space, step: Step, panels: Panels, q: np.ndarray, delta: float,
+                     alpha: float, targets: np.ndarray, inward: np.ndarray | None = None,
+                     memory_at: Callable[[np.ndarray], np.ndarray] | None = None,
+                     accuracy: float = FULL_ACCURACY) -> np.ndarray:
+    """Q at ``targets`` for the nodal pressure ``q`` on ``panels`` (see the module notes).
+
+    ``inward`` (+-1 per target) says from which side m and g are sampled at a jump;
+    ``accuracy`` is the absolute accuracy of the kernel values (default: rounding).
+    """
+    targets = np.asarray(targets, dtype=float)
+    side = targets if inward is None else np.clip(targets + 1e-13 * inward, -1.0, 1.0)
+    fq = operator_rows(space.lam, panels, targets, accuracy=accuracy) @ q
+    memory = 0.0 if memory_at is None else memory_at(targets)
+    return (delta + alpha * targets - space.g(side) + memory - step.scale * fq) / (
+        step.c * space.m(side))

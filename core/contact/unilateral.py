@@ -1,0 +1,138 @@
+"""Unilateral contact: the punch may lift off, and the contact set is part of the answer.
+
+:func:`solve_unilateral` solves the dimensionless problem of ``core/README.md`` with
+``q >= 0`` and an unknown contact set ``S(t)`` in [-1, 1] (may have several pieces):
+
+    c m q + (I - V) F q = delta + alpha x - g   on S(t),  q > 0 there,
+    (I - V) F q >= delta + alpha x - g          off S(t), q = 0 there (the gap is open),
+    int q dx = P,  int x q dx = M               (two of delta, alpha, P, M given).
+
+Elastic base (``kernel=None``): each time is solved on its own
+(:mod:`core.contact.elastic`), the zone ends located to ``ZONE_END_TOL`` by
+:mod:`core.contact.zones`. Creep: implicit stepping with the active
+set found at every step, on a rule refined where the zone ends travel
+(:mod:`core.contact.creep`, :mod:`core.contact.bands`).
+
+The answer is a :class:`UnilateralSolution` (:mod:`core.contact.result`, which also holds
+:func:`contact_set_from_pressure`: sampled pressures of any engine into contact sets);
+:mod:`core.contact.switch` holds the ``contact=`` switch of
+:func:`core.solver.solve_dimensionless`.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from core.contact.elastic import _solve_elastic
+from core.contact.result import (  # noqa: F401  (importable from here as before)
+    UnilateralSolution,
+    _Snapshot,
+    contact_set_from_pressure,
+)
+from core.contact.zones import (
+    NODAL_PANEL_WIDTH,
+    ZONE_EDGE_WIDTH,
+    ZONE_PANEL_WIDTH,
+    Resolution,
+    Space,
+)
+from core.kernel.values import FULL_ACCURACY
+
+#: The contact models of ``solve_dimensionless(..., contact=...)``.
+CONTACT_MODELS = ("full", "unilateral", "auto")
+#: The contact set of full contact.
+FULL_CONTACT: list[tuple[float, float]] = [(-1.0, 1.0)]
+#: The base of the fixed rule of creep steps: panels at most this wide, graded to this
+#: width at +-1 and the breakpoints (finer for a thin coating); the bands the zone ends
+#: sweep get finer panels (core/contact/bands.py: outside them 0.5 and 0.0625 gave the
+#: same ends to 1e-14 on the lift-off preset).
+_CREEP_WIDTH = 0.5
+_CREEP_EDGE = 1e-2
+
+Scalar = float | Callable[[np.ndarray], np.ndarray]
+
+
+
+def _check_loads(statement_given: frozenset[str], loads: dict[str, np.ndarray],
+                 times: np.ndarray) -> None:
+    """Refuse loads that pull the punch away (no contact can carry them)."""
+    if "force" in loads:
+        bad = loads["force"] <= 0.0
+        if bad.any():
+            t = times[int(np.argmax(bad))]
+            raise ValueError(f"force: must be > 0 for the punch to touch (a punch pulled away "
+                             f"has no contact), got {loads['force'][bad][0]:.6g} at t = {t:g}")
+        if "moment" in loads:
+            e = loads["moment"] / loads["force"]
+            bad = np.abs(e) >= 1.0
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise ValueError(f"moment: the eccentricity M/P = {e[k]:.6g} at t = "
+                                 f"{times[k]:g} puts the load outside the punch (|M/P| must "
+                                 "be < 1 half-width): no contact can carry it")
+
+
+def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | np.ndarray,
+                     *, c: Scalar = 1.0, kernel: Callable | None = None,
+                     settlement: Scalar | None = None, tilt: Scalar | None = None,
+                     force: Scalar | None = None, moment: Scalar | None = None,
+                     breakpoints: Sequence[float] = (), tol: float = 1e-8,
+                     time_steps: int | None = None) -> UnilateralSolution:
+    """Solve the dimensionless problem with unilateral contact (the punch may lift off).
+
+    Arguments as :func:`core.solver.solve_dimensionless` (all dimensionless): ``lam`` =
+    a/H; ``m(x) > 0`` coating compliance; ``g(x)`` gap; ``times`` >= 1 increasing; ``c(t)``
+    relative modulus; ``kernel`` K(t, tau) of V or None (elastic); exactly two of
+    ``settlement`` (delta), ``tilt`` (alpha), ``force`` (P), ``moment`` (M); ``breakpoints``
+    where m or g may jump; ``tol`` for delta, alpha, P, M (relative, as in the solver).
+    ``time_steps``: nominal steps of the first creep grid over ``[1, times[-1]]`` (default
+    ``core.contact.creep.FIRST_STEPS``; the grid is then halved until ``tol`` is met).
+
+    Returns a :class:`UnilateralSolution` whose ``contact_set`` gives the contact zones
+    at each time (free ends located to ``ZONE_END_TOL`` half-widths on an elastic base).
+    Raises ``ValueError`` naming the argument on bad input and naming the load when the
+    loads pull the punch away (``force <= 0`` in statement 4 or 3, ``|moment/force| >= 1``).
+    """
+    from core.engines.projection.stages import validate_inputs  # one source of truth for the input rules
+
+    started = _time.perf_counter()
+    if time_steps is not None and (isinstance(time_steps, bool) or not isinstance(
+            time_steps, (int, np.integer)) or not 1 <= time_steps <= 4096):
+        raise ValueError(f"time_steps: must be an integer in [1, 4096], got {time_steps!r}")
+    inp = validate_inputs(lam, m, g, times, c, kernel,
+                    {"settlement": settlement, "tilt": tilt, "force": force,
+                     "moment": moment}, breakpoints, tol)
+    times_arr = inp.times
+    c_t = inp.c(times_arr)
+    loads = {name: np.asarray(fn(times_arr), dtype=float) for name, fn in inp.loads.items()}
+    _check_loads(inp.given, loads, times_arr)
+    space = Space(inp.lam, inp.m, inp.g, inp.breakpoints)
+    m_probe = inp.m(np.linspace(-1.0, 1.0, 257))
+    res = Resolution(min(ZONE_PANEL_WIDTH, 3.0 / inp.lam),
+                     min(ZONE_EDGE_WIDTH, 0.25 * float(np.min(m_probe))))
+    nodal_res = nodal_resolution(inp.lam, inp.m)
+    if inp.kernel is None:
+        out = _solve_elastic(space, c_t, loads, times_arr, nodal_res, res, inp.tol)
+    else:
+        from core.contact.creep import solve_creep
+
+        creep_res = Resolution(min(_CREEP_WIDTH, 3.0 / inp.lam), max(res.edge, min(
+            _CREEP_EDGE, 0.25 * float(np.min(m_probe)))))
+        out = solve_creep(space, inp, c_t, loads, creep_res,
+                          **({} if time_steps is None else {"first_steps": time_steps}))
+    out["info"]["seconds"] = _time.perf_counter() - started
+    return UnilateralSolution(times_arr.copy(), out["settlement"], out["tilt"], out["force"],
+                              out["moment"], out["contact_set"], out["info"], space,
+                              out["snapshots"], out.get("kernel_accuracy", FULL_ACCURACY))
+
+
+def nodal_resolution(lam: float, m: Callable[[np.ndarray], np.ndarray]) -> Resolution:
+    """The rule of the nodal active set: panels at most ``NODAL_PANEL_WIDTH`` (and 3/lam)
+    wide, graded to ``ZONE_EDGE_WIDTH`` at +-1 and the breakpoints, finer for a thin
+    coating."""
+    m_probe = m(np.linspace(-1.0, 1.0, 257))
+    return Resolution(min(NODAL_PANEL_WIDTH, 3.0 / lam),
+                      min(ZONE_EDGE_WIDTH, 0.25 * float(np.min(m_probe))))

@@ -1,0 +1,215 @@
+"""Creep and aging of concrete as the design codes specify them.
+
+Two models, with their inputs in the units of the codes (MPa, %, mm, days, deg C):
+``"fib_mc2010"``, fib Model Code for Concrete Structures 2010 (subclause 5.1.9.4 for
+creep, 5.1.9.3 / 5.1.7.2 for the development of the modulus), and ``"eurocode2"``,
+EN 1992-1-1:2004 (Annex B.1 for creep, 3.1.2 / 3.1.3 for the modulus). Their equations,
+clause by clause, are in :mod:`core.creep.code_formulas`, the validation of their inputs in
+:mod:`core.creep.code_inputs`; the public names of both are re-exported here.
+
+The creep function of the model notes is ``C(t, tau) = phi(t, tau)/E_ref`` and the
+kernel ``K(t, tau) = E(tau) d/dtau [1/E(tau) + C(t, tau)]`` (<= 0 for a creeping
+material; core/creep/models.py). The derivative in ``tau`` is not taken of the code formulas
+directly: the compliance is fitted by a Dirichlet series whose amplitudes are smooth in
+the age (:mod:`core.creep.kernel_fit`) and the kernel follows from the fit exactly. Its error
+(``fit_error``) enters the solver's error estimate.
+
+Inputs outside the ranges the codes cover are refused with a ValueError naming the field
+and the range (see ``RANGES``); nothing is clipped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from core import limits
+from core.creep.code_formulas import (
+    _FORMULAS,
+    _modulus_log_slope,
+    clamp_age,
+    ec2_creep_coefficient,
+    ec2_modulus,
+    mc2010_creep_coefficient,
+    mc2010_modulus,
+)
+from core.creep.code_inputs import (
+    CEMENT_CLASSES,
+    DELTA_F,
+    RANGES,
+    CodeInputs,
+    _in_range,
+    check_inputs,
+    mean_strength,
+)
+from core.validation import show_python
+
+__all__ = [
+    "CEMENT_CLASSES", "DELTA_F", "K_SIGN_SLACK", "MAX_DURATION", "RANGES", "RESOLUTION",
+    "SPEC_FIELDS", "CodeCreep", "CodeInputs", "RelativeCodeModulus", "check_inputs",
+    "clamp_age", "creep_coefficient_curve", "ec2_creep_coefficient", "ec2_modulus",
+    "mc2010_creep_coefficient", "mc2010_modulus", "mean_strength",
+]
+
+#: Longest load duration the kernel is fitted for [day] (100 years).
+MAX_DURATION = 36525.0
+#: Shortest load duration the kernel's fit error covers [day] (a minute and a half).
+RESOLUTION = 1e-3
+#: Largest positive value of the fitted kernel, relative to its largest magnitude, that is
+#: taken as rounding (measured ~1e-15 on the corners of the input ranges).
+K_SIGN_SLACK = 1e9
+
+
+@dataclass(frozen=True)
+class RelativeCodeModulus:
+    """``c(t*) = E(tau0 t*) / E(tau0)`` [-] of a code model, ``t* = age / tau0``."""
+
+    inputs: CodeInputs
+    age_at_loading: float
+
+    def __call__(self, t: Any) -> np.ndarray:
+        """The relative modulus at dimensionless times ``t*``."""
+        modulus = _FORMULAS[self.inputs.model][0]
+        tau0 = self.age_at_loading
+        return modulus(self.inputs, tau0 * np.asarray(t, dtype=float)) / self._at_loading
+
+    @property
+    def _at_loading(self) -> float:
+        value = self.__dict__.get("_e0")
+        if value is None:
+            value = float(_FORMULAS[self.inputs.model][0](self.inputs, self.age_at_loading))
+            object.__setattr__(self, "_e0", value)
+        return value
+
+    def log_slope(self, t: Any) -> np.ndarray:
+        """``c'(t*)/c(t*)`` [-]."""
+        tau0 = self.age_at_loading
+        return tau0 * _modulus_log_slope(self.inputs, tau0 * np.asarray(t, dtype=float))
+
+
+class CodeCreep:
+    """Creep and aging of concrete by a design code (``"fib_mc2010"`` or ``"eurocode2"``).
+
+    ``modulus(age)`` [Pa], ``creep_coefficient(t, t0)`` [-] and ``compliance(t, tau)``
+    (the creep function ``C = phi/E_ref`` [1/Pa], ``E_ref`` the 28-day modulus) follow
+    the code's equations (:mod:`core.creep.code_formulas`); ``dimensionless_kernel`` is the
+    kernel of the model notes fitted by :func:`core.creep.kernel_fit.fit_compliance` (its
+    ``fit_error`` enters the solver's estimate).
+    """
+
+    def __init__(self, model: str, spec: dict, field: str = "base.creep") -> None:
+        if model not in _FORMULAS:
+            raise ValueError(f"{field}.model: unknown code model {model!r}; known: "
+                             + ", ".join(sorted(_FORMULAS)))
+        self.name = model
+        self.inputs = check_inputs(model, spec, field)
+        self._reference = float(_FORMULAS[model][0](self.inputs, 28.0))
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, CodeCreep) and other.inputs == self.inputs
+
+    def __hash__(self) -> int:
+        return hash(self.inputs)
+
+    def __repr__(self) -> str:
+        return f"CodeCreep({self.spec!r})"
+
+    def modulus(self, age: Any) -> np.ndarray:
+        """Instantaneous modulus ``E(age)`` [Pa] at ages [day]."""
+        return 1e6 * _FORMULAS[self.name][0](self.inputs, np.asarray(age, dtype=float))
+
+    def creep_coefficient(self, t: Any, t0: Any) -> np.ndarray:
+        """The code's creep coefficient ``phi(t, t0)`` [-] at ages ``t >= t0`` [day]."""
+        return _FORMULAS[self.name][1](self.inputs, t, t0)
+
+    def compliance(self, t: Any, tau: Any) -> np.ndarray:
+        """Creep function ``C(t, tau) = phi(t, tau)/E(28)`` [1/Pa] at ages [day]; 0 for t < tau."""
+        return self.creep_coefficient(t, tau) / (1e6 * self._reference)
+
+    def _age_at_loading(self, value: Any, field: str) -> float:
+        return _in_range(value, self.name, "age_at_loading", field)
+
+    def relative_modulus(self, age_at_loading: float, *,
+                         field: str = "age_at_loading") -> RelativeCodeModulus:
+        """``c(t*) = E(tau0 t*) / E(tau0)`` [-]; ``age_at_loading`` tau0 [day]."""
+        return RelativeCodeModulus(self.inputs, self._age_at_loading(age_at_loading, field))
+
+    def dimensionless_kernel(self, age_at_loading: float, *,
+                             field: str = "age_at_loading"):
+        """``K*(t*, tau*)`` [-] fitted on ages ``tau0`` to ``tau0 + MAX_DURATION`` days.
+
+        Returns a :class:`core.creep.kernel_fit.FittedKernel` (``fit_error``, ``rates``, ...).
+        Raises ValueError if the fitted kernel is positive anywhere (it must creep).
+        """
+        from core.creep.kernel_fit import fit_compliance, nonpositive_violation
+
+        tau0 = self._age_at_loading(age_at_loading, field)
+        inputs = self.inputs
+        c = RelativeCodeModulus(inputs, tau0)
+        e0 = float(_FORMULAS[self.name][0](inputs, tau0))
+        scale = e0 / self._reference
+
+        def creep(t: np.ndarray, tau: np.ndarray) -> np.ndarray:
+            return scale * _FORMULAS[inputs.model][1](inputs, tau0 * t, tau0 * tau)
+
+        fitted = fit_compliance(creep, end=1.0 + MAX_DURATION / tau0,
+                                resolution=RESOLUTION / tau0, modulus=c,
+                                log_slope=c.log_slope, breaks=(clamp_age(inputs) / tau0,),
+                                key=(inputs, tau0))
+        violation = nonpositive_violation(fitted)
+        if violation > K_SIGN_SLACK:
+            raise ValueError(f"{field}: the fitted creep kernel is positive somewhere "
+                             f"({violation:.2g} of its largest magnitude); the base would "
+                             "not creep")
+        return fitted
+
+    def kernel(self, t: Any, tau: Any) -> np.ndarray:
+        """``K(t, tau)`` [1/day] at ages [day] >= 1 (the fitted kernel with tau0 = 1 day)."""
+        return self.dimensionless_kernel(1.0)(t, tau)
+
+    @property
+    def spec(self) -> dict:
+        """JSON-able description, inverse of ``creep_model_from_spec`` (code units)."""
+        inp = self.inputs
+        out: dict[str, Any] = {"model": self.name}
+        if inp.strength_class is not None:
+            out["strength_class"] = inp.strength_class
+        else:
+            out["fcm"] = inp.fcm
+        out.update(cement=inp.cement, relative_humidity=inp.relative_humidity,
+                   notional_size=inp.notional_size, temperature=inp.temperature)
+        return out
+
+
+#: Spec fields of the code models: (required, optional).
+SPEC_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    name: (("relative_humidity", "notional_size"),
+           ("fcm", "strength_class", "cement", "temperature")) for name in _FORMULAS}
+
+
+def creep_coefficient_curve(spec: dict, age_at_loading: float, durations: Any, *,
+                            field: str = "creep") -> np.ndarray:
+    """``phi(t0 + d, t0)`` [-] of a code model at load durations ``d`` [day] (for plots).
+
+    ``spec`` is a ``{"model": "fib_mc2010" | "eurocode2", ...}`` creep spec (SCENES.md),
+    ``age_at_loading`` t0 [day]. Durations must be >= 0 and at most ``MAX_DURATION``.
+    """
+    # a list or object as the model name is unhashable: test its type before the lookup
+    if not isinstance(spec, dict) or not isinstance(spec.get("model"), str) \
+            or spec["model"] not in _FORMULAS:
+        raise ValueError(f"{field}.model: must be one of " + ", ".join(sorted(_FORMULAS)))
+    model = CodeCreep(spec["model"], spec, field)
+    t0 = model._age_at_loading(age_at_loading, "age_at_loading")
+    try:
+        d = np.asarray(durations, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError("durations: must be a number or an array of numbers [day], got "
+                         f"{show_python(durations)[:60]}") from None
+    if d.size > limits.MAX_CURVE_POINTS:
+        raise ValueError(f"durations: at most {limits.MAX_CURVE_POINTS:,} values, got "
+                         f"{d.size:,}")
+    if not np.all(np.isfinite(d)) or np.any(d < 0) or np.any(d > MAX_DURATION):
+        raise ValueError(f"durations: must be finite, in [0, {MAX_DURATION:g}] days")
+    return model.creep_coefficient(t0 + d, t0)

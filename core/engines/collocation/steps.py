@@ -1,0 +1,309 @@
+"""Time stepping of the collocation cross-check (:mod:`core.engines.collocation.solve`).
+
+One scene on one panel rule (:class:`CollocationSystem`) is marched through a time grid
+by the trapezoid rule, one bordered linear system per step (LU factorizations while the
+step matrices are few, then one Schur form and O(N^2) per step); :func:`time_grid` builds
+grids containing every requested time, and :func:`fixed_grids` and
+:func:`adaptive_grids` combine grids h and h/2 by Richardson extrapolation with an
+estimate of the relative error in time. All quantities dimensionless.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import lu_factor, lu_solve, rsf2csf, schur, solve_triangular
+
+from core.discretize.quadrature import Panels
+
+#: Coarsest nominal grid of the automatic time refinement, and the finest allowed.
+FIRST_STEPS = 16
+MAX_STEPS = 8192
+#: LU factorizations of distinct step matrices before switching to the Schur form, which
+#: costs about 30 LU factorizations once and then O(N^2) per step (measured, N = 560).
+LU_LIMIT = 16
+
+
+@dataclass(frozen=True)
+class GridResult:
+    """Outputs at the requested times of one time grid; linear in the solution, so grids
+    can be combined."""
+
+    delta: np.ndarray
+    alpha: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    c: np.ndarray
+    effective: np.ndarray  # (N, T): q - V q at the nodes
+    nodal: np.ndarray  # (N, T): q at the nodes
+
+    def combine(self, coarse: GridResult) -> GridResult:
+        """Richardson extrapolation ``(4 self - coarse) / 3`` (self on the halved grid)."""
+        def mix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+            return (4.0 * a - b) / 3.0
+        return GridResult(mix(self.delta, coarse.delta), mix(self.alpha, coarse.alpha),
+                       mix(self.force, coarse.force), mix(self.moment, coarse.moment),
+                       self.c, mix(self.effective, coarse.effective),
+                       mix(self.nodal, coarse.nodal))
+
+    def distance(self, other: GridResult) -> float:
+        """Largest relative difference over all outputs (each group on its own scale)."""
+        def rel(pairs: list[tuple[np.ndarray, np.ndarray]]) -> float:
+            scale = max(float(np.max(np.abs(a))) for a, _ in pairs) or 1.0
+            return max(float(np.max(np.abs(a - b))) for a, b in pairs) / scale
+        return max(rel([(self.delta, other.delta), (self.alpha, other.alpha)]),
+                   rel([(self.force, other.force), (self.moment, other.moment)]),
+                   rel([(self.nodal, other.nodal)]))
+
+
+class CollocationSystem:
+    """One scene on one panel rule; :meth:`march` solves it on a given time grid."""
+
+    def __init__(self, panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarray,
+                 given: frozenset[str], loads: dict, c_fn: Callable, kernel: Callable | None):
+        self.panels = panels
+        self.op = op
+        self.m = m
+        self.g = g
+        self.given = given
+        self.loads = loads
+        self.c_fn = c_fn
+        self.kernel = kernel
+        n = panels.size
+        x = panels.nodes
+        self.unknown_delta = "settlement" not in given
+        self.unknown_alpha = "tilt" not in given
+        # Border of the augmented system: columns of the unknown ones of delta, alpha, and
+        # the equilibrium rows of the given ones of P, M.
+        cols = []
+        if self.unknown_delta:
+            cols.append(-np.ones(n))
+        if self.unknown_alpha:
+            cols.append(-x)
+        rows = []
+        if "force" in given:
+            rows.append(panels.weights)
+        if "moment" in given:
+            rows.append(panels.weights * x)
+        self.k = len(cols)
+        self.border_cols = np.array(cols).T.reshape(n, self.k)
+        self.border_rows = np.array(rows).reshape(self.k, n)
+        self._lu: dict[tuple[float, float], tuple] = {}
+        self._n_factorized = 0
+        self._schur: tuple | None = None
+
+    def _matrix(self, c_n: float, scale: float) -> np.ndarray:
+        n = self.panels.size
+        big = np.zeros((n + self.k, n + self.k))
+        big[:n, :n] = scale * self.op
+        big[np.arange(n), np.arange(n)] += c_n * self.m
+        big[:n, n:] = self.border_cols
+        big[n:, :n] = self.border_rows
+        return big
+
+    def solve(self, c_n: float, scale: float, rhs: np.ndarray) -> np.ndarray:
+        """Solve the bordered step system with block ``c_n diag(m) + scale F``.
+
+        A few distinct matrices (an elastic base, a non-aging kernel on a uniform grid) are
+        LU-factorized and kept. Once more than ``LU_LIMIT`` have been needed (aging: the
+        diagonal trapezoid weight or ``c`` changes every step) a real Schur form of
+        ``E = D^-1/2 F D^-1/2`` (D = diag(m)) is computed once, and every later step costs
+        O(N^2): ``c D + s F = s D^1/2 U (T + (c/s) I) U^T D^1/2`` with T triangular. E is
+        similar to the positive operator F/m, so ``T + (c/s) I`` is well conditioned for
+        ``c/s > 0``; the border (k <= 2 unknowns) is eliminated with its k x k complement.
+        """
+        key = (c_n, scale)
+        lu = self._lu.get(key)
+        if lu is None and (self._n_factorized < LU_LIMIT or scale <= 0.0):
+            lu = lu_factor(self._matrix(c_n, scale), check_finite=False)
+            self._n_factorized += 1
+            if len(self._lu) >= 4:
+                self._lu.pop(next(iter(self._lu)))
+            self._lu[key] = lu
+        if lu is not None:
+            return lu_solve(lu, rhs, check_finite=False)
+        if self._schur is None:
+            root = np.sqrt(self.m)
+            tri, vecs = schur(self.op / root[:, None] / root[None, :], output="real")
+            if np.any(np.diag(tri, -1) != 0.0):
+                # Complex eigenvalue pairs leave 2 x 2 blocks: go to the complex form.
+                tri, vecs = rsf2csf(tri, vecs)
+            self._schur = (tri.copy(), np.diag(tri).copy(), vecs,
+                           np.ascontiguousarray(vecs.conj().T), root)
+        shifted, diagonal, vecs, vecs_h, root = self._schur
+        # Only the diagonal of the triangular factor depends on the step.
+        np.fill_diagonal(shifted, diagonal + c_n / scale)
+
+        def inverse(v: np.ndarray) -> np.ndarray:
+            y = solve_triangular(shifted, vecs_h @ (v / root[:, None]), check_finite=False)
+            return np.real(vecs @ y) / root[:, None] / scale
+
+        if self.k == 0:
+            return inverse(rhs[:, None])[:, 0]
+        n = self.panels.size
+        y = inverse(np.column_stack([rhs[:n], self.border_cols]))
+        complement = self.border_rows @ y[:, 1:]
+        u = np.linalg.solve(complement, self.border_rows @ y[:, 0] - rhs[n:])
+        return np.concatenate([y[:, 0] - y[:, 1:] @ u, u])
+
+    def march(self, grid: np.ndarray, widths: np.ndarray, out_index: np.ndarray) -> GridResult:
+        """Step through ``grid`` (step lengths ``widths``); record outputs at ``out_index``."""
+        panels = self.panels
+        n_nodes = panels.size
+        x = panels.nodes
+        steps = len(grid)
+        c_vals = _eval_time(self.c_fn, grid, "c")
+        if np.any(c_vals <= 0.0):
+            raise ValueError("c: the relative modulus must be > 0 at every time")
+        load = {name: _eval_time(fn, grid, name) for name, fn in self.loads.items()}
+        zero = np.zeros(steps)
+        delta_given = load.get("settlement", zero)
+        alpha_given = load.get("tilt", zero)
+
+        memory = self.kernel is not None
+        if memory:
+            # Trapezoid weight of node j in int_{t_0}^{t_n} for every j < n.
+            inner = np.zeros(steps)
+            inner[:-1] += 0.5 * widths
+            inner[1:] += 0.5 * widths
+            history = np.zeros((n_nodes, steps))
+
+        wanted = {int(i): k for k, i in enumerate(out_index)}
+        n_out = len(out_index)
+        out = {name: np.zeros(n_out) for name in ("delta", "alpha", "force", "moment", "c")}
+        effective = np.zeros((n_nodes, n_out))
+        nodal = np.zeros((n_nodes, n_out))
+
+        for n in range(steps):
+            vq_past = np.zeros(n_nodes)
+            diag_weight = 0.0
+            if memory and n > 0:
+                kvals = _eval_kernel(self.kernel, grid[n], grid[: n + 1])
+                vq_past = history[:, :n] @ (inner[:n] * kvals[:n])
+                diag_weight = 0.5 * widths[n - 1] * kvals[n]
+            rhs = np.empty(n_nodes + self.k)
+            rhs[:n_nodes] = delta_given[n] + alpha_given[n] * x - self.g + self.op @ vq_past
+            extra = [load[name][n] for name in ("force", "moment") if name in self.given]
+            rhs[n_nodes:] = extra
+            sol = self.solve(c_vals[n], 1.0 - diag_weight, rhs)
+            q = sol[:n_nodes]
+            if memory:
+                history[:, n] = q
+            if n in wanted:
+                k = wanted[n]
+                tail = list(sol[n_nodes:])
+                d = tail.pop(0) if self.unknown_delta else delta_given[n]
+                a = tail.pop(0) if self.unknown_alpha else alpha_given[n]
+                out["delta"][k] = d
+                out["alpha"][k] = a
+                out["force"][k] = load["force"][n] if "force" in load else panels.weights @ q
+                out["moment"][k] = (load["moment"][n] if "moment" in load
+                                    else (panels.weights * x) @ q)
+                out["c"][k] = c_vals[n]
+                effective[:, k] = q * (1.0 - diag_weight) - vq_past
+                nodal[:, k] = q
+        return GridResult(out["delta"], out["alpha"], out["force"], out["moment"], out["c"],
+                       effective, nodal)
+
+
+def time_grid(times: np.ndarray, steps: int,
+              refine: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A grid on ``[1, times[-1]]`` containing every requested time (dimensionless t).
+
+    The nominal step is ``(times[-1] - 1) / steps``; each interval between consecutive
+    requested times (and from 1 to the first) is split into equal steps no longer than
+    that, and then every step is halved ``refine`` times. Halving the steps of a fixed
+    grid (rather than recounting for ``2 steps``, which need not halve every interval's
+    step) keeps the trapezoid error expansion in even powers of one step, which is what
+    Richardson extrapolation needs. Returns the grid (G,), the step lengths (G-1,),
+    exactly equal within an interval, and the grid index of each requested time.
+    """
+    times = np.asarray(times, dtype=float)
+    h = (times[-1] - 1.0) / steps
+    points = [1.0]
+    widths: list[float] = []
+    index = []
+    start = 1.0
+    for t in times:
+        length = float(t) - start
+        if length > 0.0:
+            count = max(1, math.ceil(length / h - 1e-9)) * 2**refine
+            points.extend(start + length * np.arange(1, count + 1) / count)
+            points[-1] = float(t)
+            # One width per interval, not np.diff of the points: equal widths keep the
+            # step matrix bit-identical, so its factorization is reused.
+            widths.extend([length / count] * count)
+        index.append(len(points) - 1)
+        start = float(t)
+    return np.array(points), np.array(widths), np.array(index)
+
+
+def fixed_grids(system: CollocationSystem, times: np.ndarray, steps: int,
+                richardson: bool) -> tuple[GridResult, float, int]:
+    """Solve on ``steps`` nominal steps, and with ``richardson`` on the halved grid too.
+
+    Returns the result (extrapolated when ``richardson``), its estimated relative error
+    in time (NaN for one grid) and the number of steps of the finest grid.
+    """
+    grid, widths, index = time_grid(times, steps)
+    coarse = system.march(grid, widths, index)
+    fine_grid, fine_widths, fine_index = time_grid(times, steps, 1)
+    fine = system.march(fine_grid, fine_widths, fine_index) if richardson else None
+    if fine is None:
+        return coarse, float("nan"), len(grid) - 1
+    # |x_{h/2} - x_h| / 3 estimates the error of x_{h/2}; the extrapolated value is
+    # better still, so this is a safe (pessimistic) figure.
+    return fine.combine(coarse), fine.distance(coarse) / 3.0, len(fine_grid) - 1
+
+
+def adaptive_grids(system: CollocationSystem, times: np.ndarray, richardson: bool,
+                    tol: float) -> tuple[GridResult, float, int, bool]:
+    """Double the grid until the estimated relative error in time is below ``tol``."""
+    level = 0
+    plain: list[GridResult] = []
+    extrapolated: list[GridResult] = []
+    while True:
+        grid, widths, index = time_grid(times, FIRST_STEPS, level)
+        plain.append(system.march(grid, widths, index))
+        n_steps = len(grid) - 1
+        error = float("inf")
+        if richardson:
+            if len(plain) >= 2:
+                extrapolated.append(plain[-1].combine(plain[-2]))
+            best = extrapolated[-1] if extrapolated else plain[-1]
+            if len(extrapolated) >= 2:
+                # Order 4: the newer extrapolation is ~16 times closer than the older one.
+                error = extrapolated[-1].distance(extrapolated[-2]) / 15.0
+        else:
+            best = plain[-1]
+            if len(plain) >= 2:
+                error = plain[-1].distance(plain[-2]) / 3.0
+        if error <= tol:
+            return best, error, n_steps, True
+        if 2 * n_steps > MAX_STEPS:
+            return best, error, n_steps, False
+        level += 1
+
+
+def finite_values(fn: Callable, points: np.ndarray, name: str, refusal: str) -> np.ndarray:
+    """``fn(points)`` broadcast to the shape of ``points`` (dimensionless x or t), as a new
+    array; a ValueError ``"<name>: <refusal>"`` if any value is not finite."""
+    values = np.broadcast_to(np.asarray(fn(points), dtype=float), points.shape)
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"{name}: {refusal}")
+    return np.array(values)
+
+
+def _eval_time(fn: Callable, t: np.ndarray, name: str) -> np.ndarray:
+    return finite_values(fn, t, name, "values must be finite at every time")
+
+
+def _eval_kernel(kernel: Callable, t: float, tau: np.ndarray) -> np.ndarray:
+    values = np.broadcast_to(np.asarray(kernel(np.full(tau.shape, t), tau), dtype=float),
+                             tau.shape)
+    if not np.all(np.isfinite(values)):
+        raise ValueError(f"kernel: K(t, tau) must be finite; it is not at t = {t!r}")
+    return values

@@ -1,0 +1,192 @@
+"""The default answer for a uniform coating on an elastic base: the exact layered kernel.
+
+When every coating layer has constant thickness, modulus and Poisson ratio, the base is
+elastic (``{"model": "elastic"}``: no creep, no aging) and the punch shape is smooth,
+:func:`core.scene.pipeline.solve` answers with :func:`core.engines.layered.solve.solve_layered` (the plane
+-strain response of the whole stack, smooth or bonded interfaces) instead of the thin
+(Winkler) layer: ``info["coating_model"] = "exact layered"``. The exact kernel solves the
+same continuum problem as the resolved finite-element model of :mod:`core.coating.fem_check`, so
+the model error it leaves is its own numerical error: ``info["model_error_estimate"]`` is
+that estimate for the unknowns (``benchmarks/layered_kernel.py`` measures it against FE).
+
+Where it does not apply the thin-layer model answers, with its measured error
+(:mod:`core.coating.model`); :func:`layered_declines` says why:
+
+- a creeping or aging base: the coating does not creep, so the stack's response is not
+  the elastic one scaled by ``E(t)``; the thin-layer model with the map's error (read at
+  the modulus at loading) answers;
+- a coating that varies along ``x``;
+- a punch shape with breakpoints: a jump (a step on an elastic solid has an infinite
+  force in full contact: the thin layer's finite answer is the model's) or a kink (the
+  pressure is log-singular there and the series converges slowly);
+- a coating layer thinner than ``NODES_PER_THICKNESS a / MAX_NODES`` (2.3e-3 a), which
+  would need more quadrature nodes than the cap (the thin-layer error is smallest there),
+  or a stack whose kernel table would cost more than :data:`MAX_TABLE_COST` cosines
+  (a base much thinner than the punch, ``a / H`` above ~10-20, under a thin coating);
+- ``contact = "unilateral"``, or ``"auto"`` when the pressure comes out negative (lift-off:
+  the unilateral solver of the thin-layer model answers).
+
+Pressure: the top coating is an elastic solid at the punch corners, so ``q`` is singular
+like ``1 / sqrt(a - |x|)`` there (not finite as in the thin-layer model).
+``pressure(x)`` reports it on ``|x| <= a - h_1 / 2`` (``h_1`` the top layer's thickness)
+and holds that value beyond: within half a layer of the corner the singular field is the
+punch corner's, not the coating's.
+"""
+
+from __future__ import annotations
+
+import time
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+
+from core.coating.model import model_error_estimate, tilt_share
+from core.engines.layered.galerkin import MAX_MODES, MAX_NODES, default_modes, node_count
+from core.engines.layered.solve import solve_layered
+from core.kernel.layered import UniformLayer, table_cost
+from core.problem.result import ContactSolution
+
+__all__ = ["layered_declines", "solve_scene_layered"]
+
+#: Time samples of the load histories for the largest tilt between output times.
+TILT_SAMPLES = 257
+#: Most cosines the stack's kernel table may take (:func:`core.kernel.layered.table_cost`):
+#: measured 3.5e6 in 0.06 s of CPU (a / H = 20, h = a / 20), 1.6e7 in 0.32 s (a / H = 10,
+#: h = 0.003 a), 2.2e7 in 0.21 s (a / H = 50, h = a / 20): ~1 s at the bound; beyond, the
+#: thin layer answers (~0.1 s).
+MAX_TABLE_COST = 5e7
+#: A pressure below this share of its largest value is taken as lift-off.
+LIFT_OFF_SHARE = 1e-9
+
+
+@lru_cache(maxsize=64)
+def _table_cost(largest_s: float, layers: tuple[UniformLayer, ...],
+                base_thickness: float) -> float:
+    """:func:`core.kernel.layered.table_cost`, kept per stack: ~20 ms of a warm solve."""
+    return table_cost(largest_s, layers, base_thickness)
+
+
+def _constant(profile: Any) -> float:
+    return float(np.asarray(profile(np.zeros(1)), dtype=float).ravel()[0])
+
+
+def _layers(scene: Any) -> list[UniformLayer]:
+    return [UniformLayer(_constant(layer.thickness), _constant(layer.modulus),
+                         _constant(layer.poisson), layer.interface)
+            for layer in scene.coating]
+
+
+def layered_declines(scene: Any, problem: Any) -> str | None:
+    """Why the exact layered kernel does not answer this scene (None when it does)."""
+    if not scene.coating:
+        return "no coating"
+    if problem.kernel is not None or callable(problem.c) or problem.c != 1.0:
+        return "the base creeps or ages"
+    if scene.contact not in ("auto", "full"):
+        return "unilateral contact"
+    if not all(getattr(p, "kind", None) == "constant" for layer in scene.coating
+               for p in (layer.thickness, layer.modulus, layer.poisson)):
+        return "the coating varies along x"
+    layers = _layers(scene)
+    modes = default_modes(scene.half_width, layers)
+    if modes > MAX_MODES or node_count(scene.half_width, layers, modes) > MAX_NODES:
+        return "the coating is thinner than the layered solve resolves"
+    # the cost depends on the thicknesses alone: other moduli share the kept value
+    shapes = tuple(UniformLayer(lay.thickness, 1.0, 0.0) for lay in layers)
+    if _table_cost(2 * scene.half_width / scene.base_thickness, shapes,
+                   scene.base_thickness) > MAX_TABLE_COST:
+        return "the stack's kernel table would take too long (a thin base or coating)"
+    if problem.breakpoints:
+        # a jump has an infinite force in full contact, a kink a log-singular pressure
+        # (the Chebyshev series converges like 1/n there: 1 % in q with 340 modes)
+        return "the punch shape has breakpoints"
+    return None
+
+
+def _load_values(problem: Any, times: np.ndarray) -> dict[str, np.ndarray]:
+    out = {}
+    for name, load in problem.loads.items():
+        values = load(times) if callable(load) else load
+        out[name] = np.broadcast_to(np.asarray(values, dtype=float), times.shape).copy()
+    return out
+
+
+def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
+    """The scene's answer with the exact layered kernel (dimensionless, like
+    :meth:`core.scene.pipeline.DimensionlessProblem.solve`), or None where it does not apply
+    (:func:`layered_declines`) or, with ``contact = "auto"``, where the punch lifts off."""
+    if layered_declines(scene, problem) is not None:
+        return None
+    start = time.perf_counter()
+    layers = _layers(scene)
+    a = scene.half_width
+    times = np.asarray(problem.times, dtype=float)
+    answer = solve_layered(a, layers, scene.base_thickness, problem.modulus_at_loading,
+                           scene.base_poisson, _load_values(problem, times),
+                           gap=problem.g, breakpoints=problem.breakpoints, tol=problem.tol)
+    response = answer.response
+    # the sign of q is that of sqrt(1 - t^2) q, finite at the corners
+    theta = np.linspace(0.0, np.pi, 8 * answer.modes + 1)
+    regular = response.regular_part(np.cos(theta), answer.settlement, answer.tilt)
+    scale = max(float(np.max(np.abs(regular))), 1e-300)
+    lost = float(np.min(regular)) < -max(answer.error_estimate, LIFT_OFF_SHARE) * scale
+    if lost and scene.contact == "auto":
+        return None
+    dense = np.linspace(times[0], times[-1], TILT_SAMPLES)
+    largest_tilt = float(np.max(np.abs(response.complete(_load_values(problem, dense))["tilt"])))
+    edge = 1.0 - 0.5 * layers[0].thickness / a
+
+    def evaluate(x: np.ndarray) -> np.ndarray:
+        t = np.clip(x, -edge, edge)
+        return response.regular_part(t, answer.settlement, answer.tilt) \
+            / np.sqrt(1.0 - t * t)[:, None]
+
+    unknowns = [n for n in ("settlement", "tilt", "force", "moment") if n not in problem.loads]
+    numerical = max(answer.errors[n] for n in unknowns)
+    thin = model_error_estimate(scene, tilt_share(a, a * answer.settlement, answer.tilt))
+    model_error = {"estimate": float(numerical),
+                   "force": float(answer.errors.get("force", numerical)),
+                   "moment": float(answer.errors.get("moment", numerical)),
+                   "where_m": 0.0, "model": "exact layered",
+                   "thin_layer_estimate": thin["estimate"]}
+    flags = ["contact_lost"] if lost else []
+    success = answer.error_estimate <= problem.tol
+    if not success:
+        flags.append("tol_not_met")
+    if success:
+        message = (f"exact layered kernel: estimated error {answer.error_estimate:.1e} "
+                   f"<= tol {problem.tol:.1e} with {answer.modes} modes")
+    else:  # worded as the other engines word a missed tol
+        message = (f"tol {problem.tol:.1e} not met: the exact layered kernel reached "
+                   f"{answer.modes} modes with estimated error {answer.error_estimate:.1e}")
+    q_interior = evaluate(np.cos(theta[1:-1]))
+    info = {
+        "error_estimate": float(answer.error_estimate),
+        "spatial_error_estimate": float(answer.error_estimate),
+        "time_error_estimate": 0.0,
+        "kernel_fit_error": 0.0,
+        "seconds": time.perf_counter() - start,
+        "flags": flags,
+        "success": bool(success),
+        "message": message,
+        "n_modes": int(answer.modes),
+        "n_steps": 0,
+        "n_nodes": int(response.nodes),
+        "statement": scene.statement,
+        "given": sorted(problem.loads),
+        "min_pressure": float(np.min(q_interior)),
+        "max_pressure": float(np.max(np.abs(q_interior))),
+        "basis": "chebyshev",
+        "element_ends": [],
+        "method": "layered",
+        "contact": "full",
+        "max_abs_tilt": largest_tilt,
+        "stages": answer.stages,
+        "coating_model": "exact layered",
+        "layered_model_error": model_error,
+    }
+    return ContactSolution(times.copy(), answer.settlement, answer.tilt, answer.force,
+                           answer.moment, info, None, np.zeros((0, times.size)),
+                           np.ones(times.size), None, None, _evaluate=evaluate,
+                           contact_set=[[(-1.0, 1.0)] for _ in times])

@@ -1,0 +1,116 @@
+"""The model error of a scene's fast answer, against the resolved finite-element model.
+
+:func:`check_scene` builds the resolved model of :mod:`core.coating.fem_check` for a scene's
+geometry (punch shape, every coating layer with its profiles and interface, the base) with
+the base elastic at the modulus of a chosen time, solves the scene's statement there with
+the same two given values, and compares the fast answer of the same elastic problem: the
+coating model that answers the scene itself (the exact layered kernel for a uniform
+coating on an elastic base, else the thin layer, :mod:`core.engines.layered.answer`). With an
+aging, creeping base this measures the thin-layer model's error at that modulus; creep
+itself is not part of the check.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from core.coating.fem_check import CoatingStrip, Stack, solve_stack
+from core.coating.model import NEGLIGIBLE_SHARE
+from core.engines.layered.answer import layered_declines
+from core.scene.pipeline import QUANTITIES, Scene, SceneSolution, scene_from_dict, solve
+
+#: Pressure errors are measured on |x| <= this fraction of a (the edge singularities of
+#: both answers are not comparable pointwise).
+PRESSURE_REACH = 0.9
+
+
+def fe_stack(scene: Scene, time: float = 0.0) -> Stack:
+    """The :class:`core.coating.fem_check.Stack` of a scene, the base elastic at ``E(tau0 + time)``
+    (``time`` in days after loading)."""
+    modulus = float(np.asarray(scene.creep.modulus(scene.age_at_loading + time), dtype=float))
+    return Stack(
+        half_width=scene.half_width,
+        coating=tuple(CoatingStrip(layer.thickness, layer.modulus, layer.poisson,
+                                   layer.interface) for layer in scene.coating),
+        base_thickness=scene.base_thickness, base_modulus=modulus,
+        base_poisson=scene.base_poisson, shape=scene.shape, breakpoints=scene.breakpoints)
+
+
+def elastic_scene(scene: Scene, time: float = 0.0) -> Scene:
+    """The scene with its base elastic at ``E(tau0 + time)``, its two given loads held
+    at their values at ``time`` [days after loading], in full contact (as the FE model)."""
+    d = scene.to_dict()
+    modulus = float(np.asarray(scene.creep.modulus(scene.age_at_loading + time), dtype=float))
+    d["base"]["creep"] = {"model": "elastic", "modulus": modulus}
+    d["loading"] = {name: float(np.asarray(profile(np.array([time])), dtype=float).ravel()[0])
+                    for name, profile in scene.loading.items()}
+    d["times"] = [1.0]
+    # the FE model ties the punch to the surface: the fast model is compared in full
+    # contact too (a lifting punch would compare two contact models, not two coatings)
+    d["solver"]["contact"] = "full"
+    return scene_from_dict(d)
+
+
+def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
+                level: int = 0) -> dict[str, Any]:
+    """Model error of the fast answer against the resolved FE model at one time.
+
+    ``time`` [days after loading] picks the base modulus and the given loads; ``level`` is
+    the FE mesh level (:func:`core.coating.fem_check.solve_stack`: 0 gives P to ~2e-4). Returns
+    ``{"fast": {...}, "fe": {...}}`` (settlement [m], tilt [rad], force [N/m], moment [N]),
+    ``"errors"``: signed relative errors of the four against the FE answer (each relative to
+    its own FE value, or to 1e-3 of its pair's scale ``max(|delta|, a |alpha|)``, ``max(|P|,
+    |M| / a)`` if that is larger: a centred load has no moment) and of
+    the pressure (largest difference on ``|x| <= 0.9 a`` over the largest FE pressure
+    there), ``"model_error"``: the largest error of the two unknowns, ``"estimate"``: the
+    map's estimate that results carry, ``"fe_seconds"``, ``"fe_dofs"``.
+    """
+    scene = scene_from_dict(scene)
+    if not np.isfinite(time) or not 0.0 <= time <= float(scene.times[-1]):
+        raise ValueError(f"time: must be in [0, {float(scene.times[-1]):g}] days after "
+                         f"loading, got {time!r}")
+    elastic = elastic_scene(scene, time)
+    if layered_declines(scene, scene.dimensionless) is None:
+        fast = solve(elastic)  # the exact layered kernel answers the scene itself
+    else:
+        # the scene's own answer is the thin layer's (a creeping base, a varying coating):
+        # check that model at this modulus, not the exact kernel its elastic copy would get
+        problem = elastic.dimensionless
+        with np.errstate(all="ignore"):
+            fast = SceneSolution(elastic, problem, problem.solve())
+    fe = solve_stack(fe_stack(scene, time), level=level)
+    given = {name: float(getattr(fast, name)[0]) for name in scene.loading}
+    exact = fe.complete(given)
+    quick = {name: float(getattr(fast, name)[0]) for name in QUANTITIES}
+    a = scene.half_width
+    kin = max(abs(exact["settlement"]), a * abs(exact["tilt"]))
+    stat = max(abs(exact["force"]), abs(exact["moment"]) / a)
+    scales = {"settlement": kin, "tilt": kin / a, "force": stat, "moment": stat * a}
+    # each relative to itself (as the map measures them), unless it is tiny against its
+    # pair (a moment of a centred load): then relative to the pair's scale
+    errors = {}
+    for name in QUANTITIES:
+        scale = max(abs(exact[name]), NEGLIGIBLE_SHARE * scales[name])
+        errors[name] = (quick[name] - exact[name]) / scale if scale > 0 else 0.0
+    x = np.linspace(-PRESSURE_REACH * a, PRESSURE_REACH * a, 181)
+    q_fe = fe.pressure(x, exact["settlement"], exact["tilt"])
+    q_fast = fast.pressure(x)[:, 0]
+    q_scale = float(np.max(np.abs(q_fe)))
+    errors["pressure"] = float(np.max(np.abs(q_fast - q_fe)) / q_scale) if q_scale > 0 else 0.0
+    unknowns = [name for name in QUANTITIES if name not in scene.loading]
+    return {
+        "time_day": float(time),
+        "fast": quick,
+        "fe": exact,
+        "errors": errors,
+        "model_error": max(abs(errors[name]) for name in unknowns),
+        "estimate": fast.info["model_error_estimate"],
+        "coating_model": fast.info["coating_model"],
+        "given": sorted(scene.loading),
+        "contact_lost": fast.contact_lost,
+        "fe_seconds": fe.seconds,
+        "fe_dofs": fe.dofs,
+    }

@@ -1,0 +1,84 @@
+"""Scene files: strict JSON reading, loading, canonical writing (format: core/SCENES.md).
+
+The scene itself (its fields and their validation) is :mod:`core.scene.pipeline`, which
+re-exports everything here; ``from core.scene.pipeline import load_scene`` stays the public path.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+from core import limits
+from core.files import atomic_write_text, read_regular_file
+
+if TYPE_CHECKING:
+    from core.scene.pipeline import Scene
+
+
+def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"duplicate field {key!r} in one JSON object")
+        out[key] = value
+    return out
+
+
+def _parse_int(text: str) -> int | float:
+    # no double holds more than 309 digits; Python's int() of a few thousand digits raises
+    # an error about its own limits, so such a number becomes inf, refused by its field
+    return int(text) if len(text) <= 400 else (-math.inf if text[0] == "-" else math.inf)
+
+
+def read_scene_json(text: str, source: str = "scene") -> Any:
+    """The JSON value of a scene file's text, read strictly: a field repeated in one
+    object, a nesting too deep or a number beyond any double is refused (``ValueError``
+    naming ``source``). The value is not yet validated as a scene."""
+    try:
+        return json.loads(text, object_pairs_hook=_no_duplicates, parse_int=_parse_int)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{source}: not valid JSON ({exc.msg} at line {exc.lineno}, "
+                         f"column {exc.colno})") from None
+    except ValueError as exc:
+        raise ValueError(f"{source}: {exc}") from None
+    except RecursionError:
+        raise ValueError(f"{source}: not valid JSON (nested too deeply)") from None
+
+
+def parse_scene_json(text: str, source: str = "scene") -> Scene:
+    """Parse and validate the JSON text of a scene; errors name ``source`` or the field."""
+    from core.scene.pipeline import scene_from_dict
+
+    return scene_from_dict(read_scene_json(text, source))
+
+
+def load_scene(path: str | os.PathLike) -> Scene:
+    """Read and validate a scene file (JSON, UTF-8, at most 1 MB).
+
+    Raises ``ValueError`` (message starting with the file path or the field path) for a
+    file that is too large, not a regular file (a named pipe is refused, not waited on),
+    not JSON or not a valid scene, ``OSError`` if it cannot be read.
+    """
+    raw = read_regular_file(path, limits.MAX_SCENE_BYTES)
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file in UTF-8 (a scene file is JSON)") from None
+    return parse_scene_json(text, str(path))
+
+
+def scene_to_json(scene: Scene | Mapping[str, Any]) -> str:
+    """The canonical JSON text of a scene (validated first when given as a dict)."""
+    from core.scene.pipeline import scene_from_dict
+
+    scene = scene_from_dict(scene)
+    return json.dumps(scene.to_dict(), indent=2, allow_nan=False) + "\n"
+
+
+def save_scene(scene: Scene | Mapping[str, Any], path: str | os.PathLike) -> None:
+    """Write a scene as JSON to ``path`` atomically (a dict is validated first)."""
+    atomic_write_text(path, scene_to_json(scene))

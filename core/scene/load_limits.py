@@ -1,0 +1,86 @@
+"""Loads no contact can carry, refused before solving and named in the scene's units.
+
+A punch pressed by a force ``P`` [N/m] and a moment ``M`` [N·m/m] touches the coating
+only while ``P > 0`` and the resultant acts inside the base, ``|e| = |M / P| < a``: the
+pressure is never negative, so its resultant lies within the contact zone, itself within
+``[-a, a]``. Otherwise no contact model has an answer: the full-contact one would need a
+tensile pressure, the unilateral one has no zone left. Every contact mode refuses such a
+load, with the field to change, the value and the time in days after loading (the
+dimensionless solver would otherwise name ``t* = 1`` and half-widths).
+
+An instant where both ``P`` and ``M`` are zero (a ramp starting from nothing, a load
+taken off) carries nothing and is allowed; a load that is zero at every time is not.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from core.scene.pipeline import Scene
+
+#: Samples of a load history between 0 and the last output time, besides the output
+#: times and the points where the history kinks or jumps: a pull shorter than end/1024
+#: is left to the solver's own check on its time grid.
+LOAD_SAMPLES = 1025
+
+
+def _sample_days(scene: Scene) -> np.ndarray:
+    end = float(scene.times[-1])
+    days = [np.asarray(scene.times, dtype=float), np.linspace(0.0, end, LOAD_SAMPLES)]
+    for profile in scene.loading.values():
+        if hasattr(profile, "nonsmooth_points"):
+            kinks = np.asarray(list(profile.nonsmooth_points(0.0, end)), dtype=float)
+            # both sides of a jump
+            days.append(np.clip(np.concatenate([kinks, kinks * (1 - 1e-12) - 1e-12,
+                                                kinks * (1 + 1e-12) + 1e-12]), 0.0, end))
+    return np.unique(np.concatenate(days))
+
+
+def check_loads_touch(scene: Scene) -> None:
+    """Refuse a given force that pulls the punch away (``P < 0``, or ``P = 0`` at every
+    time) or a given moment that puts the resultant outside the punch (``|M/P| >= a``,
+    or ``M != 0`` with ``P = 0``), with a ``ValueError`` naming ``loading.force`` or
+    ``loading.moment``, the value [N/m, N·m/m, m] and the time [days after loading].
+
+    Scenes whose force is not given (settlement or tilt given) are not checked here.
+    """
+    if "force" not in scene.loading:
+        return
+    days = _sample_days(scene)
+    force = np.asarray(scene.loading["force"](days), dtype=float) * np.ones_like(days)
+    if not np.all(np.isfinite(force)):
+        return  # the scene's own checks name a non-finite load
+    pulled = force < 0.0
+    if pulled.any():
+        k = int(np.argmax(pulled))
+        raise ValueError(
+            f"loading.force: the punch is pulled away (P = {force[k]:.6g} N/m at t = "
+            f"{days[k]:.6g} days after loading); P must be > 0 for the punch to touch the "
+            "coating, and no contact model answers for a pulled punch")
+    if not (force > 0.0).any():
+        raise ValueError("loading.force: must be > 0 for the punch to touch the coating "
+                         "(P = 0 N/m at every time: nothing presses it)")
+    if "moment" not in scene.loading:
+        return
+    moment = np.asarray(scene.loading["moment"](days), dtype=float) * np.ones_like(days)
+    if not np.all(np.isfinite(moment)):
+        return
+    a = scene.half_width
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e = np.where(force > 0.0, moment / np.where(force > 0.0, force, 1.0), 0.0)
+    unloaded_moment = (force == 0.0) & (moment != 0.0)
+    outside = (np.abs(e) >= a) | unloaded_moment
+    if outside.any():
+        k = int(np.argmax(outside))
+        if unloaded_moment[k]:
+            reason = (f"M = {moment[k]:.6g} N·m/m with no force (P = 0 N/m) at t = "
+                      f"{days[k]:.6g} days after loading")
+        else:
+            reason = (f"the eccentricity e = M/P = {e[k]:.6g} m at t = {days[k]:.6g} days "
+                      f"after loading (M = {moment[k]:.6g} N·m/m, P = {force[k]:.6g} N/m) "
+                      f"is not inside the punch, |e| must be < a = {a:.6g} m")
+        raise ValueError(f"loading.moment: {reason}: the resultant acts outside the base, "
+                         "so no contact can carry it")

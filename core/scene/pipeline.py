@@ -1,0 +1,95 @@
+"""The dimensional scene: one physical problem in SI units with time in days, and its solve.
+
+A *scene* describes the punch, the coating layers, the aging base, the loading and the
+output times (the schema is documented in ``core/SCENES.md``). :func:`scene_from_dict`
+validates a JSON-like dict and builds a :class:`Scene`; :func:`solve` converts it to the
+dimensionless problem of :func:`core.solver.solve_dimensionless` and the answer back to a
+:class:`SceneSolution` in SI units.
+
+This module is the public path to the scene: it re-exports what the modules below hold,
+one job each,
+
+- :mod:`core.scene.schema`: schema version and migrations, accepted ranges, validators of
+  single fields;
+- :mod:`core.scene.validate`: :func:`scene_from_dict` and the checks of a whole scene;
+- :mod:`core.scene.model`: the validated :class:`Scene` and what follows from it alone;
+- :mod:`core.scene.dimensionless`: the conversion to the dimensionless problem (its
+  formulas are in that module's docstring);
+- :mod:`core.scene.results`: :class:`SceneSolution` and its JSON and CSV forms;
+- :mod:`core.scene.files`: reading and writing scene files.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+# re-exported: ``from core.scene.pipeline import ...`` is the public path for every name below
+from core.files import atomic_write_text, read_regular_file  # noqa: F401
+from core.problem.statements import QUANTITIES, STATEMENTS  # noqa: F401
+from core.scene.dimensionless import DimensionlessProblem, to_dimensionless  # noqa: F401
+from core.scene.files import (  # noqa: F401
+    load_scene,
+    parse_scene_json,
+    read_scene_json,
+    save_scene,
+    scene_to_json,
+)
+from core.scene.model import DENSE_SAMPLES, Layer, Scene  # noqa: F401
+from core.scene.results import (  # noqa: F401
+    FLAG_MESSAGES,
+    LARGE_TILT,
+    PLOT_POINTS,
+    THICK_COATING_RATIO,
+    UNITS,
+    SceneSolution,
+    _check_finite,
+    plotting_grid,
+)
+from core.scene.schema import (  # noqa: F401
+    _MIGRATIONS,
+    DEFAULT_TOL,
+    LAM_RANGE,
+    M_STAR_RANGE,
+    MAX_BREAKPOINTS,
+    MAX_CREEP_COEFFICIENT,
+    MAX_GAP_RATIO,
+    MAX_LAYERS,
+    MAX_SCENE_BYTES,
+    MAX_TIMES,
+    SCHEMA_VERSION,
+    TOL_RANGE,
+    _check_fields,
+    _integer,
+    _jsonable,
+    _text,
+    migrate,
+)
+from core.scene.validate import scene_from_dict
+
+
+def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
+    """Solve a scene (a :class:`Scene` or a scene dict, validated first).
+
+    Returns a :class:`SceneSolution` in SI units (m, rad, N/m, N, Pa; days after loading).
+    """
+    from core.engines.layered.answer import solve_scene_layered  # uniform coating, elastic base
+    from core.scene.load_limits import check_loads_touch
+
+    # CPU time of this thread [s] from the dict to the answer, validation included: what
+    # the scene costs, whatever else the machine runs (info["seconds"] is the solver's
+    # wall time)
+    started = time.thread_time()
+    scene = scene_from_dict(scene)
+    # a load no contact can carry is refused in every contact mode, in the scene's units
+    check_loads_touch(scene)
+    problem = scene.dimensionless
+    with np.errstate(all="ignore"):
+        answer = solve_scene_layered(scene, problem)
+        result = SceneSolution(scene, problem, problem.solve() if answer is None else answer)
+    result.info["cpu_seconds"] = time.thread_time() - started
+    _check_finite(result)
+    return result

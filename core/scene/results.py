@@ -1,0 +1,307 @@
+"""The answer for a scene in SI units (:class:`SceneSolution`) and its serialisation:
+JSON (``to_dict``/``to_json``), CSV of the histories and of the pressure, the flags
+that make an answer doubtful and the last check that it is finite.
+
+:func:`core.scene.pipeline.solve` builds a :class:`SceneSolution` from the dimensionless answer
+(the conversion back: :mod:`core.scene.dimensionless`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from core import limits
+from core.cache import StageCache, fingerprint
+from core.coating.model import model_error_estimate, model_error_map, tilt_share
+from core.problem.statements import QUANTITIES
+from core.scene.load_rates import oscillations
+from core.scene.model import Scene
+from core.scene.schema import SCHEMA_VERSION, _jsonable
+
+if TYPE_CHECKING:
+    from core.scene.dimensionless import DimensionlessProblem
+    from core.solver import ContactSolution
+
+#: The thin-coating model is doubtful where sum h_k exceeds this fraction of 2a.
+THICK_COATING_RATIO = 0.1
+#: Tilts beyond this many radians are not small.
+LARGE_TILT = 0.01
+#: Points of the default plotting grid :attr:`SceneSolution.x`.
+PLOT_POINTS = 201
+
+#: One-line explanations of the flags a solution may carry.
+FLAG_MESSAGES: dict[str, str] = {
+    "contact_lost": "The computed pressure is negative somewhere: part of the punch base "
+                    "lifts off, so this full-contact answer is not physical.",
+    "thick_coating": f"The coating is thicker than {THICK_COATING_RATIO:g} of the punch width "
+                     "somewhere: the thin (Winkler) coating model is doubtful.",
+    "stiff_coating": "A coating layer is stiffer than the base at loading somewhere: the "
+                     "thin-coating model assumes soft coatings.",
+    "large_tilt": f"The tilt exceeds {LARGE_TILT:g} rad: the small-angle assumption is "
+                  "doubtful.",
+    "model_error": "The estimated error of the thin-coating model (info.model_error_estimate, "
+                   "from measurements against a resolved finite-element model) exceeds "
+                   "solver.model_tol: check the coating model (python -m core check).",
+    "tol_not_met": "The solver could not reach the requested tolerance: see info.message.",
+    "unresolved_input": "A profile has features finer than the quadrature resolves: "
+                        "see info.message.",
+    "contact_set_unverified": "The unilateral contact set failed its final check (q < 0 "
+                              "on it, or the surfaces overlap off it): see info.message.",
+}
+
+UNITS: dict[str, str] = {
+    "times": "day (after loading)",
+    "settlement": "m",
+    "tilt": "rad",
+    "force": "N/m",
+    "moment": "N",
+    "x": "m (from the punch centre)",
+    "pressure": "Pa (rows: x, columns: times)",
+}
+
+
+def plotting_grid(half_width: float, count: int = PLOT_POINTS) -> np.ndarray:
+    """``count`` points of ``[-a, a]`` [m], clustered toward the edges (Chebyshev-Lobatto)."""
+    x = -half_width * np.cos(np.pi * np.arange(count) / (count - 1))
+    x[0], x[-1] = -half_width, half_width
+    if count % 2:
+        x[count // 2] = 0.0
+    return x
+
+
+#: The model-error map read on a scene's stack, shared by scenes of the same geometry
+#: and base: reading it costs ~0.7 ms, more than a load change's solve.
+_MODEL_ERROR_MAPS = StageCache("scene_model_error_map", max_items=128, max_bytes=2**20)
+
+
+def _model_error(scene: Scene, share_of_tilt: float) -> dict[str, Any]:
+    """:func:`core.coating.model.model_error_estimate` of ``scene``, its map remembered.
+
+    The map is read on the geometry, the base modulus at loading and the base thickness
+    (:func:`core.coating.model.model_error_map`); the answer enters only through the
+    share of tilt, which weighs the moment part.
+    """
+    key = fingerprint("model_error_map", scene._geometry_key, scene.modulus_at_loading(),
+                      scene.base_thickness)
+    mapped, _ = _MODEL_ERROR_MAPS.get_or_compute(key, lambda: _read_only(model_error_map(scene)))
+    return model_error_estimate(scene, share_of_tilt, mapped)
+
+
+def _read_only(mapped: tuple[np.ndarray, dict[str, np.ndarray]]
+               ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The map's arrays, locked against writes (scenes share them)."""
+    x, parts = mapped
+    for values in (x, *parts.values()):
+        values.setflags(write=False)
+    return x, parts
+
+
+class SceneSolution:
+    """The answer for a scene in SI units (see :func:`solve`).
+
+    ``times`` [day after loading], ``settlement`` [m], ``tilt`` [rad], ``force`` [N/m],
+    ``moment`` [N] are arrays over ``times``; ``pressure(x)`` gives q [Pa] at points
+    ``x`` [m] of ``[-a, a]``; ``x`` is a default plotting grid [m]; ``flags`` names what
+    makes the answer doubtful or unphysical (``flag_messages`` explains each).
+    ``contact_set[k]`` lists the ``(start, end)`` intervals [m] where q > 0 at ``times[k]``
+    (``[(-a, a)]`` in full contact); ``info["contact"]`` names the contact model that
+    answered (``"full"`` or ``"unilateral"``).
+    """
+
+    def __init__(self, scene: Scene, problem: DimensionlessProblem,
+                 solution: ContactSolution) -> None:
+        self.scene = scene
+        self.problem = problem
+        self.dimensionless = solution
+        a = scene.half_width
+        self.times = np.array(scene.times, dtype=float)
+        modulus = problem.modulus_after_loading(self.times)
+        self._pressure_scale = modulus / problem.plane_factor
+        self.settlement = a * np.asarray(solution.settlement, dtype=float)
+        self.tilt = np.asarray(solution.tilt, dtype=float).copy()
+        self.force = np.asarray(solution.force, dtype=float) * self._pressure_scale * a
+        self.moment = np.asarray(solution.moment, dtype=float) * self._pressure_scale * a * a
+        self.x = plotting_grid(a)
+        self.contact_set = [[(a * lo, a * hi) for lo, hi in zones]
+                            for zones in getattr(solution, "contact_set", [])]
+        # the exact layered kernel (core.engines.layered.answer) carries its own estimate
+        layered = solution.info.get("layered_model_error")
+        self.model_error = dict(layered) if layered else _model_error(
+            scene, tilt_share(a, self.settlement, self.tilt))
+        self.flags = self._flags(solution)
+        self.flag_messages = {
+            name: FLAG_MESSAGES.get(name, f"{name}: {solution.info.get('message', '')}")
+            for name in self.flags}
+        self.info = dict(solution.info)
+        self.info["flags"] = list(self.flags)
+        self.info["model_error_estimate"] = self.model_error["estimate"]
+        self.info["coating_model"] = solution.info.get("coating_model", "thin layer")
+        self.info["model_error"] = dict(self.model_error)
+        self.info["dimensional"] = self._extras()
+
+    def _flags(self, solution: ContactSolution) -> list[str]:
+        scene = self.scene
+        flags = [str(f) for f in solution.info.get("flags", [])]
+        thin = solution.info.get("coating_model") != "exact layered"
+        # the extremes on the scene's samples, shared by scenes of the same geometry
+        if thin and scene.sample_extremes["coating_thickness_max_m"] / (2 * scene.half_width) \
+                > THICK_COATING_RATIO:
+            flags.append("thick_coating")
+        if self.model_error["estimate"] > scene.model_tol:
+            flags.append("model_error")
+        e0 = self.problem.modulus_at_loading
+        if thin and any(largest > e0 for largest in scene.layer_modulus_max):
+            flags.append("stiff_coating")
+        # between the output times too (the default engine samples the load histories)
+        largest_tilt = max(float(np.max(np.abs(self.tilt))) if self.tilt.size else 0.0,
+                           float(solution.info.get("max_abs_tilt", 0.0)))
+        if largest_tilt > LARGE_TILT:
+            flags.append("large_tilt")
+        return list(dict.fromkeys(flags))
+
+    def _extras(self) -> dict[str, Any]:
+        scene, problem = self.scene, self.problem
+        extremes = scene.sample_extremes
+        return {
+            "scene_key": scene.key,
+            "statement": scene.statement,
+            "lam": problem.lam,
+            "modulus_at_loading_Pa": problem.modulus_at_loading,
+            "age_at_loading_days": problem.age_at_loading,
+            "m_star_min": extremes["m_star_min"],
+            "m_star_max": extremes["m_star_max"],
+            "gap_max_m": extremes["gap_max_m"],
+            "coating_thickness_max_m": extremes["coating_thickness_max_m"],
+            "breakpoints_m": list(scene.breakpoints),
+            "min_pressure_Pa": float(np.min(self.pressure_on_grid)),
+            "max_pressure_Pa": float(np.max(self.pressure_on_grid)),
+        }
+
+    @property
+    def contact_lost(self) -> bool:
+        """Whether the pressure is negative somewhere (the answer is then not physical)."""
+        return "contact_lost" in self.flags
+
+    def pressure(self, x: Any) -> np.ndarray:
+        """Contact pressure q [Pa] at points ``x`` [m] of ``[-a, a]``, shape (len(x), len(times)).
+
+        Points outside ``[-a, a]`` are refused (ValueError), and so are more points than
+        :data:`core.limits.MAX_PRESSURE_VALUES` values allow (checked before any work).
+        """
+        a = self.scene.half_width
+        xs = np.atleast_1d(np.asarray(x, dtype=float))
+        if xs.size * self.times.size > limits.MAX_PRESSURE_VALUES:
+            raise ValueError(
+                f"x: {xs.size} points at {self.times.size} times are more than the "
+                f"{limits.MAX_PRESSURE_VALUES} pressure values one call may compute; ask "
+                "for fewer points (or in several calls)")
+        if np.any(~np.isfinite(xs)) or np.any(np.abs(xs) > a * (1 + 1e-12)):
+            raise ValueError(f"x: the pressure is defined on [-a, a] = [{-a:g}, {a:g}] m only")
+        # x = +-a can land a rounding error outside [-1, 1] after the division
+        q_star = self.dimensionless.pressure(np.clip(xs / a, -1.0, 1.0))
+        return q_star * self._pressure_scale[None, :]
+
+    @cached_property
+    def pressure_on_grid(self) -> np.ndarray:
+        """``pressure(x)`` on the plotting grid, shape (201, len(times)) [Pa]."""
+        return self.pressure(self.x)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-able dict: the scene, the histories, q on ``x`` at every time, info, flags.
+
+        Units are listed under ``units``; non-finite numbers become ``null``.
+        """
+        return _jsonable({
+            "format": "coated-punch solution",
+            "schema_version": SCHEMA_VERSION,
+            "scene": self.scene.to_dict(),
+            "units": UNITS,
+            "times": self.times,
+            "settlement": self.settlement,
+            "tilt": self.tilt,
+            "force": self.force,
+            "moment": self.moment,
+            "x": self.x,
+            "pressure": self.pressure_on_grid,
+            "flags": self.flags,
+            "flag_messages": self.flag_messages,
+            "contact_set": [[list(zone) for zone in zones] for zones in self.contact_set],
+            "info": self.info,
+        })
+
+    def to_json(self) -> str:
+        """:meth:`to_dict` as compact JSON text."""
+        return json.dumps(self.to_dict(), separators=(",", ":"), allow_nan=False)
+
+    def to_csv(self) -> str:
+        """The histories as CSV: time [day], settlement [m], tilt [rad], force [N/m], moment [N].
+
+        When the unilateral contact model answered, the contact set follows: the contact
+        length [m] and the ends of each zone [m] (``zone1_start_m, zone1_end_m, ...``,
+        ``nan`` where a time has fewer zones).
+        """
+        header = "time_day,settlement_m,tilt_rad,force_N_per_m,moment_N"
+        zones = max((len(z) for z in self.contact_set), default=0)
+        unilateral = self.info.get("contact") == "unilateral"
+        if unilateral:
+            header += ",contact_length_m" + "".join(
+                f",zone{k + 1}_start_m,zone{k + 1}_end_m" for k in range(zones))
+        lines = [header]
+        for k, row in enumerate(zip(self.times, self.settlement, self.tilt, self.force,
+                                    self.moment, strict=True)):
+            values = [float(v) for v in row]
+            if unilateral:
+                current = self.contact_set[k]
+                values.append(sum(hi - lo for lo, hi in current))
+                for j in range(zones):
+                    values.extend(current[j] if j < len(current) else (math.nan, math.nan))
+            lines.append(",".join(repr(float(v)) for v in values))
+        return "\n".join(lines) + "\n"
+
+    def pressure_csv(self, x: Any = None) -> str:
+        """q(x, t) as CSV in long form: time [day], x [m], pressure [Pa] (default x: ``.x``)."""
+        xs = self.x if x is None else np.atleast_1d(np.asarray(x, dtype=float))
+        q = self.pressure_on_grid if x is None else self.pressure(xs)
+        lines = ["time_day,x_m,pressure_Pa"]
+        for j, t in enumerate(self.times):
+            tt = repr(float(t))
+            lines.extend(f"{tt},{float(xi)!r},{float(qi)!r}" for xi, qi in zip(xs, q[:, j],
+                                                                               strict=True))
+        return "\n".join(lines) + "\n"
+
+
+def _check_finite(result: SceneSolution) -> None:
+    """Refuse an answer with a non-finite value: the last guard of the promise that a
+    result never holds NaN or infinity (the checks of :func:`scene_from_dict` catch the
+    known causes first, with the field to change)."""
+    parts = [(q, getattr(result, q)) for q in QUANTITIES]
+    parts.append(("pressure", result.pressure_on_grid))
+    for name, values in parts:
+        bad = ~np.isfinite(np.asarray(values, dtype=float))
+        if bad.any():
+            j = int(np.argwhere(bad)[0][-1])  # the time index (last axis)
+            message = str(result.info.get("message", ""))
+            if "stopped at its limit" in message:
+                # the stepper gave up, which says nothing of double precision
+                raise ValueError(f"{_fastest_load(result.scene)}: the time stepping could "
+                                 "not follow the loads: "
+                                 + message.split("time stepping: ", 1)[-1])
+            raise ValueError(
+                f"scene: the computed {name} is not finite at t = {result.times[j]:.6g} days "
+                "after loading: the sizes in this scene (moduli, loads, lengths) are too far "
+                "apart for double precision")
+
+
+def _fastest_load(scene: Scene) -> str:
+    """The field of the load that oscillates most over the solved times (``loading``
+    when none oscillates)."""
+    end = float(scene.times[-1])
+    counts = {q: oscillations(p, 0.0, end) + len(p.breakpoints)
+              for q, p in scene.loading.items()}
+    name = max(counts, key=lambda q: counts[q])
+    return f"loading.{name}" if counts[name] > 0 else "loading"

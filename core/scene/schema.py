@@ -1,0 +1,254 @@
+"""The scene schema: its version and migrations, the accepted ranges of its fields, and
+the validators of single fields (objects, integers, texts, output times, profiles).
+
+:func:`core.scene.pipeline.scene_from_dict` (built in :mod:`core.scene.validate`) checks a whole
+scene with these; every refusal is a ``ValueError`` whose message starts with the path of
+the field (``coating[1].modulus: ...``). The schema itself is documented in
+``core/SCENES.md``.
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import json
+import math
+import numbers
+import re
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from core import limits
+from core.cache import StageCache, fingerprint
+from core.profiles.build import Profile, check_range, profile_from_spec
+from core.validation import finite_number, positive_number, show_value
+
+#: The schema version this program writes and reads.
+SCHEMA_VERSION = 1
+#: Largest scene file accepted by :func:`core.scene.pipeline.load_scene` [bytes].
+MAX_SCENE_BYTES = limits.MAX_SCENE_BYTES
+#: Number of coating layers accepted.
+MAX_LAYERS = 10
+#: Largest number of output times.
+MAX_TIMES = limits.MAX_SCENE_TIMES
+#: Accepted range of the solver's relative tolerance, and its default.
+TOL_RANGE = (1e-12, 1e-2)
+DEFAULT_TOL = 1e-6
+#: Most points of (-a, a) where a profile may jump or kink (see
+#: ``core.scene.validate._check_breakpoints``).
+MAX_BREAKPOINTS = limits.MAX_BREAKPOINTS
+#: Accepted range of the dimensionless coating compliance m*: physical coatings are far
+#: inside it; the solver was measured finite for 1e-100 to 1e100.
+M_STAR_RANGE = (1e-30, 1e30)
+#: Largest accepted gap between punch and coating surface, in half-widths a.
+MAX_GAP_RATIO = 1e3
+#: Accepted range of a / H (the limits and their measured cost: core/limits.py).
+LAM_RANGE = (limits.MIN_LAM, limits.MAX_SCENE_LAM)
+#: Largest accepted creep coefficient E(tau0) C(t_end, tau0) (concrete: 1 to 5). The
+#: time stepping was measured at 1.9 s for 1000 (tol 1e-8), 32 s for 1e4 (tol 1e-8) and
+#: 13 s for 9e7 (tol 1e-3), the last two stopping at the step limit.
+MAX_CREEP_COEFFICIENT = 1e3
+
+#: Migrations from older schema versions: version -> function returning the next version.
+#: Version 1 is the first; there is nothing to migrate yet.
+_MIGRATIONS: dict[int, Callable[[dict], dict]] = {}
+
+# Shared between scenes (a slider step makes a new scene and changes one field), keyed on
+# exactly what it depends on. A validated profile holds its spec and a closure (a
+# 10000-row table ~0.5 MB).
+_PROFILES = StageCache("profiles", max_items=512, max_bytes=32 * 2**20)
+
+
+# --------------------------------------------------------------------- small validators
+
+
+def _join(parent: str, key: str) -> str:
+    return f"{parent}.{key}" if parent else key
+
+
+def _check_fields(obj: Any, path: str, required: Sequence[str],
+                  optional: Sequence[str] = ()) -> Mapping[str, Any]:
+    """``obj`` as a mapping with exactly the allowed fields, or a ValueError."""
+    where = path or "scene"
+    if not isinstance(obj, Mapping):
+        raise ValueError(f"{where}: must be an object, got {show_value(obj)}")
+    allowed = list(required) + list(optional)
+    for key in obj:
+        if key not in allowed:
+            hint = difflib.get_close_matches(str(key), allowed, n=1)
+            extra = f" (did you mean '{hint[0]}'?)" if hint else \
+                f" (allowed: {', '.join(allowed)})"
+            raise ValueError(f"{where}: unknown field {str(key)[:40]!r}{extra}")
+    for key in required:
+        if key not in obj:
+            raise ValueError(f"{_join(path, key)}: required field is missing")
+    return obj
+
+
+def _poisson(value: Any, path: str) -> float:
+    x = finite_number(value, path)
+    if not -1.0 < x < 0.5:
+        raise ValueError(f"{path}: must be in (-1, 0.5), got {show_value(value)}")
+    return x
+
+
+def _integer(value: Any, path: str, lo: int, hi: int) -> int:
+    x = finite_number(value, path)
+    if not x.is_integer():
+        raise ValueError(f"{path}: must be an integer, got {show_value(value)}")
+    if not lo <= x <= hi:
+        raise ValueError(f"{path}: must be an integer from {lo} to {hi}, got {int(x)}")
+    return int(x)
+
+
+def _text(value: Any, path: str, *, allow_empty: bool, most: int) -> str:
+    if not isinstance(value, str):
+        raise ValueError(f"{path}: must be a string, got {show_value(value)}")
+    # checked first: a text field is echoed into titles, links and file names
+    if len(value) > most:
+        raise ValueError(f"{path}: must be at most {most} characters, has {len(value)}")
+    if not allow_empty and not value.strip():
+        raise ValueError(f"{path}: must not be empty")
+    return value
+
+
+def _jsonable(obj: Any) -> Any:
+    """A deep copy of ``obj`` with numpy and tuple values turned into plain JSON types."""
+    if isinstance(obj, Mapping):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, numbers.Integral):
+        return int(obj)
+    if isinstance(obj, numbers.Real):
+        x = float(obj)
+        # JSON has no NaN or infinity; null marks a value that could not be computed
+        return x if math.isfinite(x) else None
+    return copy.deepcopy(obj)
+
+
+# ------------------------------------------------------------------------ schema versions
+
+
+def migrate(d: Mapping[str, Any]) -> dict[str, Any]:
+    """Bring a scene dict of an older schema version to :data:`SCHEMA_VERSION`.
+
+    Returns a new dict (the input is not modified). Version 1 is the first version of the
+    schema, so today this only checks ``schema_version``; later versions will register
+    one step per version in ``_MIGRATIONS``.
+    """
+    if not isinstance(d, Mapping):
+        raise ValueError(f"scene: must be a JSON object, got {show_value(d)}")
+    if "schema_version" not in d:
+        raise ValueError(f"schema_version: required field is missing (this program reads "
+                         f"{SCHEMA_VERSION})")
+    raw = d["schema_version"]
+    if isinstance(raw, bool) or not isinstance(raw, numbers.Real):
+        raise ValueError(f"schema_version: must be an integer, got {show_value(raw)}")
+    if isinstance(raw, numbers.Integral):
+        version = int(raw)  # float() of a huge integer would overflow
+    elif not math.isfinite(float(raw)) or not float(raw).is_integer():
+        raise ValueError(f"schema_version: must be an integer, got {show_value(raw)}")
+    else:
+        version = int(raw)
+    if version > SCHEMA_VERSION:
+        raise ValueError(f"schema_version: unsupported version {version} "
+                         f"(this program reads {SCHEMA_VERSION})")
+    if version < 1:
+        raise ValueError(f"schema_version: version {version} does not exist (the first "
+                         f"version of the schema is 1; this program reads {SCHEMA_VERSION})")
+    out = dict(d)
+    while version < SCHEMA_VERSION:
+        out = _MIGRATIONS[version](out)
+        version += 1
+        out["schema_version"] = version
+    return out
+
+
+# ------------------------------------------------------------------ profiles and times
+
+
+def _profile(spec: Any, path: str, variable: str, domain: tuple[float, float], *,
+             lower: float | None = None, upper: float | None = None) -> Profile:
+    """Build a profile and check that its values lie in the open range (lower, upper).
+
+    Profiles are immutable, so a validated one is shared by every scene that has it: a
+    slider step changes one field, and checking every profile again on thousands of
+    points was as costly as the solve itself (measured under 20 sessions)."""
+    try:
+        key = fingerprint("profile", json.dumps(spec, sort_keys=True, separators=(",", ":"),
+                                                allow_nan=False),
+                          path, variable, domain, lower, upper)
+    except (TypeError, ValueError):  # not plain JSON: validated without the memo
+        return _checked_profile(spec, path, variable, domain, lower, upper)
+    return _PROFILES.get_or_compute(
+        key, lambda: _checked_profile(spec, path, variable, domain, lower, upper))[0]
+
+
+def _checked_profile(spec: Any, path: str, variable: str, domain: tuple[float, float],
+                     lower: float | None, upper: float | None) -> Profile:
+    profile = profile_from_spec(spec, field=path, variable=variable, domain=domain)
+    try:
+        check_range(profile, field=path, domain=domain, lower=lower, upper=upper)
+    except ValueError as exc:
+        message = str(exc)
+        # the position is in metres (x) or days after loading (t): say so
+        unit = " m" if variable == "x" else " days after loading"
+        if re.search(rf" at {variable} = \S+$", message):
+            message += unit
+        raise ValueError(message) from None
+    return profile
+
+
+def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
+    """The output times [day after loading] and their canonical spec."""
+    if isinstance(spec, Mapping):
+        _check_fields(spec, path, ("end", "count"), ("spacing",))
+        end = positive_number(spec["end"], f"{path}.end")
+        count = _integer(spec["count"], f"{path}.count", 1, MAX_TIMES)
+        spacing = spec.get("spacing", "linear")
+        if spacing not in ("linear", "log"):
+            raise ValueError(f"{path}.spacing: must be 'linear' or 'log', "
+                             f"got {show_value(spacing)}")
+        if count == 1:
+            times = np.array([end])
+        elif spacing == "linear":
+            times = np.linspace(0.0, end, count)
+        else:
+            # the instant of loading, then count - 1 times geometrically spaced over the
+            # last three decades before ``end`` (creep is fastest just after loading)
+            times = np.concatenate([[0.0], np.geomspace(end * 1e-3, end, count - 1)])
+        times[-1] = end
+        return times, {"end": end, "count": count, "spacing": spacing}
+    if isinstance(spec, (list, tuple)):
+        if not 1 <= len(spec) <= MAX_TIMES:
+            raise ValueError(f"{path}: must list 1 to {MAX_TIMES} times, got {len(spec)}")
+        values = []
+        for i, value in enumerate(spec):
+            t = finite_number(value, f"{path}[{i}]")
+            if t < 0:
+                raise ValueError(f"{path}[{i}]: must be >= 0 days after loading (times before "
+                                 f"loading are not part of the problem), got {show_value(value)}")
+            if values and t <= values[-1]:
+                raise ValueError(f"{path}[{i}]: times must increase, got {show_value(value)} after "
+                                 f"{show_value(values[-1])}")
+            values.append(t)
+        if values[-1] <= 0:
+            raise ValueError(f"{path}: the last time must be > 0 days after loading (the "
+                             "loads are functions of time on [0, last time])")
+        return np.array(values), values
+    raise ValueError(f"{path}: must be an object {{end, count, spacing}} or a list of days "
+                     f"after loading, got {show_value(spec)}")
+
+
+def _spec_of(profile: Profile, given: Any) -> Any:
+    """The canonical spec of a profile (its ``spec`` when it has one, else what was given)."""
+    spec = getattr(profile, "spec", None)
+    return given if spec is None else spec
+

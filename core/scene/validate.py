@@ -1,0 +1,373 @@
+"""Validation of a whole scene: :func:`scene_from_dict` checks a scene dict field by
+field (the validators: :mod:`core.scene.schema`) and builds a :class:`Scene`, then
+refuses the combinations the solver cannot handle in bounded work or in double
+precision (too many breakpoints, an extreme coating compliance or gap, loads faster than
+the time stepping, creep beyond real materials), naming the field to change.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import replace
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from core import limits
+from core.cache import StageCache, fingerprint
+from core.coating.model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
+from core.creep.models import Elastic, UserKernel, creep_model_from_spec
+from core.problem.statements import QUANTITIES, STATEMENTS
+from core.profiles.build import Profile
+from core.scene import schema
+from core.scene.load_rates import check_step_limit
+from core.scene.model import Layer, Scene, _values
+from core.scene.schema import (
+    _check_fields,
+    _jsonable,
+    _poisson,
+    _profile,
+    _spec_of,
+    _text,
+    _times,
+    migrate,
+)
+from core.validation import (
+    MAX_MAGNITUDE,
+    NumberTooLarge,
+    bounded_list,
+    finite_number,
+    positive_number,
+    refuse_first,
+    show_value,
+)
+
+if TYPE_CHECKING:
+    from core.scene.dimensionless import DimensionlessProblem
+
+
+def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
+    """Validate a scene dict (schema in ``core/SCENES.md``) and build a :class:`Scene`.
+
+    Units: SI (m, Pa, N/m, N, rad), times in days. Every field is checked; a problem
+    raises ``ValueError`` whose message starts with the full path of the field, e.g.
+    ``coating[1].modulus: must be > 0, ...``. A :class:`Scene` is returned unchanged.
+    """
+    if isinstance(d, Scene):
+        return d
+    d = migrate(d)
+    _check_fields(d, "", ("schema_version", "name", "punch", "coating", "base", "loading",
+                          "times"), ("description", "solver"))
+    name = _text(d["name"], "name", allow_empty=False, most=limits.MAX_NAME_CHARS)
+    description = _text(d.get("description", ""), "description", allow_empty=True,
+                        most=limits.MAX_DESCRIPTION_CHARS)
+
+    punch = _check_fields(d["punch"], "punch", ("half_width",), ("shape",))
+    a = positive_number(punch["half_width"], "punch.half_width")
+    x_domain = (-a, a)
+    shape_spec = punch.get("shape", 0.0)
+    shape = _profile(shape_spec, "punch.shape", "x", x_domain)
+
+    layers_spec = bounded_list(d["coating"], "coating", least=1, most=schema.MAX_LAYERS,
+                               what="layers")
+    layers = []
+    for k, spec in enumerate(layers_spec):
+        path = f"coating[{k}]"
+        _check_fields(spec, path, ("thickness", "modulus", "poisson"), ("interface",))
+        interface = spec.get("interface", DEFAULT_INTERFACE)
+        if interface not in INTERFACES:
+            raise ValueError(f"{path}.interface: must be 'smooth' or 'bonded', got "
+                             f"{show_value(interface)}")
+        layers.append(Layer(
+            thickness=_profile(spec["thickness"], f"{path}.thickness", "x", x_domain,
+                               lower=0.0),
+            modulus=_profile(spec["modulus"], f"{path}.modulus", "x", x_domain, lower=0.0),
+            poisson=_profile(spec["poisson"], f"{path}.poisson", "x", x_domain, lower=-1.0,
+                             upper=0.5),
+            interface=interface,
+        ))
+
+    base = _check_fields(d["base"], "base", ("thickness", "poisson", "age_at_loading", "creep"))
+    h_base = positive_number(base["thickness"], "base.thickness")
+    nu = _poisson(base["poisson"], "base.poisson")
+    tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
+    try:
+        creep = creep_model_from_spec(base["creep"], field="base.creep")
+    except NumberTooLarge:
+        raise  # a ValueError that names the parameter (base.creep.modulus)
+    except OverflowError:
+        # an overflow in a creep computation, with no parameter to name
+        raise ValueError("base.creep: a number is too large for a double (must be a finite "
+                         "number)") from None
+    lam_lo, lam_hi = schema.LAM_RANGE
+    if not math.isfinite(a / h_base) or not lam_lo <= a / h_base <= lam_hi:
+        raise ValueError(f"base.thickness: the ratio punch.half_width / base.thickness must be "
+                         f"in [{lam_lo:g}, {lam_hi:g}], got {a / h_base:.6g}")
+
+    times, times_spec = _times(d["times"], "times")
+
+    loading = d["loading"]
+    _check_fields(loading, "loading", (), QUANTITIES)
+    given = frozenset(loading)
+    if len(given) != 2:
+        raise ValueError("loading: exactly two of settlement, tilt, force, moment are needed, "
+                         "got " + (", ".join(q for q in QUANTITIES if q in given) or "none"))
+    if given not in STATEMENTS:
+        raise ValueError("loading: " + " and ".join(q for q in QUANTITIES if q in given)
+                         + " is not one of the four statements (settlement+tilt, "
+                         "settlement+moment, tilt+force, force+moment)")
+    t_domain = (0.0, float(times[-1]))
+    loads = {q: _profile(loading[q], f"loading.{q}", "t", t_domain)
+             for q in QUANTITIES if q in given}
+    # the solver's time is the age over tau0: times closer than its rounding would merge
+    ages = (tau0 + times) / tau0
+    if np.any(np.diff(ages) <= 0):
+        i = int(np.argmax(np.diff(ages) <= 0)) + 1
+        raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
+                         f"an age at loading of {tau0:g} days")
+
+    solver = _check_fields(d.get("solver", {}), "solver", (), ("tol", "contact", "model_tol"))
+    tol = finite_number(solver.get("tol", schema.DEFAULT_TOL), "solver.tol")
+    tol_lo, tol_hi = schema.TOL_RANGE
+    if not tol_lo <= tol <= tol_hi:
+        raise ValueError(f"solver.tol: must be in [{tol_lo:g}, {tol_hi:g}], "
+                         f"got {show_value(tol)}")
+    contact = solver.get("contact", "auto")
+    if contact != "auto":
+        from core.contact.unilateral import (
+            CONTACT_MODELS,  # the solver's list (loaded only when asked)
+        )
+
+        if not isinstance(contact, str) or contact not in CONTACT_MODELS:
+            raise ValueError(f"solver.contact: must be one of {', '.join(CONTACT_MODELS)}, "
+                             f"got {show_value(contact)}")
+    model_tol = finite_number(solver.get("model_tol", DEFAULT_MODEL_TOL), "solver.model_tol")
+    if not MODEL_TOL_RANGE[0] <= model_tol <= MODEL_TOL_RANGE[1]:
+        raise ValueError(f"solver.model_tol: must be in [{MODEL_TOL_RANGE[0]:g}, "
+                         f"{MODEL_TOL_RANGE[1]:g}], got {show_value(model_tol)}")
+
+    data = {
+        "schema_version": schema.SCHEMA_VERSION,
+        "name": name,
+        "description": description,
+        "punch": {"half_width": a, "shape": _jsonable(_spec_of(shape, shape_spec))},
+        "coating": [{"thickness": _jsonable(_spec_of(layer.thickness, s["thickness"])),
+                     "modulus": _jsonable(_spec_of(layer.modulus, s["modulus"])),
+                     "poisson": _jsonable(_spec_of(layer.poisson, s["poisson"])),
+                     "interface": layer.interface}
+                    for layer, s in zip(layers, layers_spec, strict=True)],
+        "base": {"thickness": h_base, "poisson": nu, "age_at_loading": tau0,
+                 "creep": _jsonable(creep.spec)},
+        "loading": {q: _jsonable(_spec_of(loads[q], loading[q])) for q in loads},
+        "times": _jsonable(times_spec),
+        # the default contact model is left out, so existing scenes keep their keys
+        "solver": ({"tol": tol, "model_tol": model_tol} if contact == "auto" else
+                   {"tol": tol, "model_tol": model_tol, "contact": contact}),
+    }
+    times.setflags(write=False)
+    scene = Scene(name, description, a, shape, tuple(layers), h_base, nu, tau0, creep,
+                  MappingProxyType(loads), times, tol, data, contact)
+    _check_breakpoints(scene)
+    _check_solvable(scene)
+    _check_load_rates(scene)
+    return scene
+
+
+def _check_load_rates(scene: Scene) -> None:
+    """Refuse a load that varies faster than the time stepping can follow (an elastic
+    base has no time stepping; a formula kernel's grid has its own point limit)."""
+    if isinstance(scene.creep, Elastic):
+        return
+    general = isinstance(scene.creep, UserKernel)
+    check_step_limit({f"loading.{q}": p for q, p in scene.loading.items()}, 0.0,
+                     float(scene.times[-1]), scene.tol,
+                     limits.MAX_KERNEL_GRID_POINTS if general else limits.MAX_TIME_STEPS,
+                     "the time grid's limit" if general else "the time stepping's limit")
+
+
+def _x_profiles(scene: Scene) -> list[tuple[str, Profile]]:
+    """The x-profiles of a scene with their field paths."""
+    return [("punch.shape", scene.shape)] + [
+        (f"coating[{k}].{name}", getattr(layer, name))
+        for k, layer in enumerate(scene.coating) for name in ("thickness", "modulus", "poisson")]
+
+
+def _check_breakpoints(scene: Scene) -> None:
+    """Refuse more jumps and kinks across the punch than the solver can afford.
+
+    Each breakpoint adds a graded cluster of quadrature panels (about 140 nodes), and the
+    kernel operator is dense in the nodes: 16 breakpoints measured 2448 nodes, 1.9 s and
+    360 MB for one solve, 40 breakpoints 9 s and 1.7 GB, a 10000-row table asked for a
+    15 TiB matrix. A served explorer must not let one scene take the machine.
+    """
+    count = len(scene.breakpoints)
+    if count <= schema.MAX_BREAKPOINTS:
+        return
+    a = scene.half_width
+    path, most = max(((p, sum(1 for b in prof.breakpoints if -a < b < a))
+                      for p, prof in _x_profiles(scene)), key=lambda item: item[1])
+    raise ValueError(
+        f"{path}: has {most} points where its value or slope jumps (table rows, step "
+        f"breaks or formula switches), {count} in the whole scene, more than the "
+        f"{schema.MAX_BREAKPOINTS} the solver allows: use fewer rows or breaks, a 'pchip' table "
+        "(smooth between its end rows) or a smooth formula")
+
+
+def _check_solvable(scene: Scene) -> None:
+    """Refuse a scene whose dimensionless problem leaves double precision or the range the
+    solver handles, naming the field to change.
+
+    Every value may pass its own check (a coating modulus of 1e300 Pa is > 0) while the
+    combination is not computable: ``m*`` underflows, a load over ``E a`` overflows, an
+    aging term ``A / age^2`` is infinite at a tiny age at loading. Such scenes are far from
+    physical sizes; refusing them here keeps NaN out of results and bounds the work.
+    """
+    with np.errstate(all="ignore"):
+        problem = scene.dimensionless
+        # m* and g on the samples depend on the geometry, E0 and nu alone: a geometry
+        # that passed is not sampled again (a load change)
+        key = fingerprint("solvable", scene._geometry_key, problem.modulus_at_loading,
+                          problem.plane_factor)
+        _SOLVABLE_GEOMETRIES.get_or_compute(key, lambda: _check_coefficients(scene, problem))
+        _check_creep(scene, problem)
+        _check_loads_scalable(scene, problem)
+
+
+#: Geometries (with E0 and nu) whose m* and g passed :func:`_check_coefficients`.
+_SOLVABLE_GEOMETRIES = StageCache("solvable_geometries", max_items=1024, max_bytes=2**20)
+
+
+def _check_coefficients(scene: Scene, problem: DimensionlessProblem) -> bool:
+    """Refuse ``m*`` or ``g`` out of range on the scene's samples; True if they pass."""
+    with np.errstate(all="ignore"):
+        a = scene.half_width
+        x = scene.sample_x
+        xs = x / a
+        m = np.broadcast_to(problem.m(xs) if callable(problem.m) else problem.m, xs.shape)
+        lo, hi = schema.M_STAR_RANGE
+        refuse_first(~np.isfinite(m) | (m < lo) | (m > hi), lambda i: (
+            f"coating: the coating compliance relative to the base, m* = E0 sum_k (1 - "
+            f"nu_k^2) h_k / E_k / (2 (1 - nu^2) a), is {m[i]:.3g} at x = {x[i]:.6g} m, "
+            f"outside [{lo:g}, {hi:g}]: the layers are too stiff or soft, thin or thick "
+            "against the base to be solved in double precision"))
+        if callable(problem.g):
+            g = problem.g(xs)
+
+            def gap_message(i: int) -> str:
+                # the field to change: the punch or the coating, whichever varies more
+                f_range = float(np.ptp(_values(scene.shape, x)))
+                h_range = float(np.ptp(scene.coating_thickness(x)))
+                where = "punch.shape" if not f_range < h_range else "coating"
+                return (f"{where}: the gap between the punch base and the coating surface "
+                        f"is {g[i]:.3g} half-widths at x = {x[i]:.6g} m (at most "
+                        f"{schema.MAX_GAP_RATIO:g}): far beyond the shallow contact of this model")
+
+            refuse_first(~np.isfinite(g) | (np.abs(g) > schema.MAX_GAP_RATIO), gap_message)
+    return True
+
+
+def _check_loads_scalable(scene: Scene, problem: DimensionlessProblem) -> None:
+    """Refuse a load whose dimensionless value leaves double precision."""
+    ts = problem.times
+    with np.errstate(all="ignore"):
+        for name, load in problem.loads.items():
+            values = np.broadcast_to(load(ts) if callable(load) else load, ts.shape)
+            refuse_first(~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE),
+                         lambda i, name=name: (
+                             f"loading.{name}: cannot be scaled by the base modulus and the "
+                             f"half-width in double precision at t = {scene.times[i]:.6g} "
+                             "days after loading (the sizes in the scene are too far apart)"))
+
+
+#: Cached properties of a :class:`Scene` that do not depend on the loads: a scene with
+#: other loads keeps those already computed (:func:`replace_loads`).
+_GEOMETRY_CACHES = ("breakpoints", "_geometry_key", "sample_x", "_gap_parts", "gap_minimum",
+                    "sample_extremes")
+
+
+def replace_loads(scene: Scene, loads: Mapping[str, Any]) -> Scene:
+    """``scene`` with some of its given loads replaced (``{"force": 2e5}``: quantity ->
+    load spec, in N/m, N, m or rad as in the scene file), validated as
+    :func:`scene_from_dict` validates the scene dict with those loads, with the same
+    messages; only the loads are checked again (the rest was validated with ``scene``).
+    A load the scene does not give is refused (another statement needs a new scene)."""
+    for q in loads:
+        if q not in scene.loading:
+            raise ValueError(f"loading.{q}: not one of the scene's given loads "
+                             f"({', '.join(scene.loading)}); change the statement with a "
+                             "new scene")
+    t_domain = (0.0, float(scene.times[-1]))
+    profiles = dict(scene.loading)
+    data = dict(scene._data)
+    data["loading"] = dict(data["loading"])
+    for q, spec in loads.items():
+        profiles[q] = _profile(spec, f"loading.{q}", "t", t_domain)
+        data["loading"][q] = _jsonable(_spec_of(profiles[q], spec))
+    new = replace(scene, loading=MappingProxyType(profiles), _data=data)
+    for name in _GEOMETRY_CACHES:
+        if name in scene.__dict__:
+            new.__dict__[name] = scene.__dict__[name]
+    with np.errstate(all="ignore"):
+        _check_loads_scalable(new, new.dimensionless)
+    _check_load_rates(new)
+    return new
+
+
+def _check_creep(scene: Scene, problem: DimensionlessProblem) -> None:
+    """The relative modulus and the creep kernel at the ages of the solve: finite, and for
+    a kernel given as a formula, never positive (a positive ``K`` makes the compliance
+    decrease in time)."""
+    tau0 = scene.age_at_loading
+    ts = problem.times
+    c = np.broadcast_to(problem.c(ts) if callable(problem.c) else problem.c, ts.shape)
+    refuse_first(~np.isfinite(c) | (c <= 0), lambda i: (
+        f"base.creep: the modulus E(age) / E(age at loading) is {c[i]:.3g} at the age "
+        f"{tau0 * ts[i]:.6g} days: the creep parameters or base.age_at_loading are "
+        "too extreme for double precision"))
+    kernel = problem.kernel
+    if kernel is None:
+        return
+    # the output times and a few between, all pairs t >= tau
+    grid = np.unique(np.concatenate([ts[np.linspace(0, ts.size - 1, min(ts.size, 17))
+                                        .round().astype(int)],
+                                     np.linspace(ts[0], ts[-1], 17)]))
+    t_star, tau_star = np.meshgrid(grid, grid, indexing="ij")
+    keep = t_star >= tau_star
+    t_star, tau_star = t_star[keep], tau_star[keep]
+    try:
+        k = np.asarray(kernel(t_star, tau_star), dtype=float)
+    except ValueError as exc:  # a formula kernel refuses its own non-finite values
+        where = "base.creep.expr" if isinstance(scene.creep, UserKernel) else "base.creep"
+        raise ValueError(f"{where}: {exc}") from None
+    refuse_first(~np.isfinite(k), lambda i: (
+        f"base.creep: the creep kernel K(t, tau) is {k[i]} at the ages t = "
+        f"{tau0 * t_star[i]:.6g}, tau = {tau0 * tau_star[i]:.6g} days: the creep "
+        "parameters or base.age_at_loading are too extreme for double precision"))
+    user = isinstance(scene.creep, UserKernel)
+    if user:
+        # the shipped models are <= 0 by their coefficient checks; a formula is checked
+        # on samples, with room for rounding of a kernel that is 0 somewhere
+        scale = float(np.max(np.abs(k))) if k.size else 0.0
+        refuse_first(k > 1e-9 * scale, lambda i: (
+            f"base.creep.expr: K(t, tau) must be <= 0 (the base creeps), is "
+            f"{k[i] / tau0:.3g} per day at the ages t = {tau0 * t_star[i]:.6g}, tau = "
+            f"{tau0 * tau_star[i]:.6g} days: a positive kernel makes the compliance "
+            "decrease in time"))
+        # creep strain per elastic strain under a unit stress held from loading:
+        # -int_1^t* K*(t*, s) ds, on points graded toward s = t* where a fast kernel lives
+        u = np.concatenate([[0.0], np.geomspace(1e-12, 1.0, 400)])
+        s = ts[-1] - (ts[-1] - ts[0]) * u
+        line = np.asarray(kernel(np.full(s.shape, ts[-1]), s), dtype=float)
+        phi = float(np.sum(0.5 * (line[1:] + line[:-1]) * (s[:-1] - s[1:])))
+        phi = -phi
+    else:
+        phi = float(scene.modulus_at_loading()
+                    * np.asarray(scene.creep.compliance(tau0 * ts[-1], tau0), dtype=float))
+    if not phi <= schema.MAX_CREEP_COEFFICIENT:
+        raise ValueError(
+            f"{'base.creep.expr' if user else 'base.creep'}: the creep coefficient (creep "
+            "strain over elastic strain under a stress held from loading to the last output "
+            f"time) is {phi:.3g}, more than {schema.MAX_CREEP_COEFFICIENT:g}: far beyond real "
+            "materials, and beyond what the time stepping can follow in reasonable time")

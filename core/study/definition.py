@@ -1,0 +1,411 @@
+"""Design studies: one base scene and the scene fields to vary (grids or distributions).
+
+A *study* (format in ``core/SCENES.md``, "Study files") names a base scene, the numeric
+scene fields to vary by their path (``coating[0].modulus``, ``loading.moment``,
+``base.age_at_loading``), each as a grid (``values``, ``linspace``, ``logspace``) or a
+distribution (``normal``, ``lognormal``, ``uniform``, drawn with ``seed``), the outputs
+wanted and the output times. Grids combine as a Cartesian product; when a distribution is
+present every grid point gets the same ``samples`` draws (common random numbers), so a
+percentile along a grid axis compares like with like.
+
+Everything here is pure: :func:`study_from_dict` validates (a ``ValueError`` whose message
+starts with the field), :func:`point_table` expands a study into its points,
+:class:`StudyPoints` makes any of them on demand, and
+:func:`apply_point` makes the scene dict of one point. Running a study is
+:mod:`core.sweep`'s job.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import math
+import os
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from core.scene.pipeline import (
+    MAX_SCENE_BYTES,
+    _check_fields,
+    _integer,
+    load_scene,
+    read_scene_json,
+    scene_from_dict,
+)
+from core.study.points import DRAW_BLOCK, StudyPoints, point_table  # noqa: F401
+from core.validation import finite_number, positive_number, show_value
+
+#: The study format version this program reads and writes.
+STUDY_VERSION = 1
+#: Most points in one study (grid product times samples): each point is one solve and a
+#: row of the result; 1e6 points of one output time are ~100 MB of results on disk.
+MAX_STUDY_POINTS = 1_000_000
+#: Most fields varied in one study (each is an axis of the result).
+MAX_PARAMETERS = 8
+#: Outputs a study can ask for, with their units; flags, error estimates and the failure
+#: message of every point are always recorded.
+OUTPUT_UNITS: dict[str, str] = {
+    "settlement": "m",
+    "tilt": "rad",
+    "force": "N/m",
+    "moment": "N",
+    "q_max": "Pa",
+    "q_min": "Pa",
+    "contact_width": "m",
+}
+GRID_KINDS = ("values", "linspace", "logspace")
+DISTRIBUTIONS = ("normal", "lognormal", "uniform")
+# whole subtrees a study may not vary: the output times are the study's own axis
+_FIXED_ROOTS = ("schema_version", "name", "description", "times")
+_PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d{1,4}\])*)")
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One varied field: ``path`` in the scene dict and either grid ``values`` or a
+    ``distribution`` (``kind`` in :data:`DISTRIBUTIONS`, ``args`` its parameters)."""
+
+    path: str
+    kind: str
+    values: tuple[float, ...] = ()
+    args: tuple[tuple[str, float], ...] = ()
+
+    @property
+    def is_grid(self) -> bool:
+        """Whether this parameter is a grid axis (else a distribution sampled per point)."""
+        return self.kind in GRID_KINDS
+
+    @property
+    def is_load(self) -> bool:
+        """Whether the field is a load: points differing only in loads share the solver's
+        prepared geometry (operator, basis, Galerkin matrices)."""
+        return self.path.startswith("loading.")
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated study: ``base`` is the canonical scene dict (its ``times`` set to the
+    study's), ``times`` the output times [day after loading]."""
+
+    name: str
+    base: dict
+    parameters: tuple[Parameter, ...]
+    samples: int
+    seed: int
+    outputs: tuple[str, ...]
+    times: tuple[float, ...]
+
+    @property
+    def grid_shape(self) -> tuple[int, ...]:
+        """Lengths of the grid axes, in the order of the study file."""
+        return tuple(len(p.values) for p in self.parameters if p.is_grid)
+
+    @property
+    def n_points(self) -> int:
+        """Number of points: the product of the grid lengths times the samples."""
+        return math.prod(self.grid_shape) * self.samples
+
+    @property
+    def key(self) -> str:
+        """A content hash (hex) of everything that defines the points and their results."""
+        data = {"base": self.base, "parameters": [vars(p) for p in self.parameters],
+                "samples": self.samples, "seed": self.seed, "outputs": self.outputs,
+                "times": self.times}
+        text = json.dumps(data, sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()
+
+
+# ---------------------------------------------------------------------------- paths
+
+
+def parse_path(path: Any, field: str = "field") -> tuple[str | int, ...]:
+    """``"coating[0].modulus"`` as ``("coating", 0, "modulus")``; ValueError naming ``field``."""
+    if not isinstance(path, str) or not path or len(path) > 200:
+        raise ValueError(f"{field}: must be a field path such as 'coating[0].modulus', got "
+                         f"{show_value(path)}")
+    parts: list[str | int] = []
+    for piece in path.split("."):
+        match = _PATH_PART.fullmatch(piece)
+        if match is None:
+            raise ValueError(f"{field}: {path!r} is not a field path (names joined by '.', "
+                             "list items as [k], e.g. 'coating[0].modulus')")
+        parts.append(match.group(1))
+        parts.extend(int(k) for k in re.findall(r"\[(\d+)\]", match.group(2)))
+    return tuple(parts)
+
+
+def get_field(scene: Mapping[str, Any], path: str) -> Any:
+    """The value at ``path`` in a scene dict; ValueError naming the path if it is absent."""
+    node: Any = scene
+    for part in parse_path(path):
+        if isinstance(part, int):
+            if not isinstance(node, list) or part >= len(node):
+                raise ValueError(f"{path}: no such field in the scene (no item [{part}])")
+        elif not isinstance(node, Mapping) or part not in node:
+            raise ValueError(f"{path}: no such field in the scene (no {part!r})")
+        node = node[part]
+    return node
+
+
+def apply_point(scene: Mapping[str, Any], values: Mapping[str, float]) -> dict[str, Any]:
+    """A copy of the scene dict with each ``path -> value`` of ``values`` set (not validated)."""
+    out = copy.deepcopy(dict(scene))
+    for path, value in values.items():
+        parts = parse_path(path)
+        get_field(out, path)  # the whole path must exist
+        node: Any = out
+        for part in parts[:-1]:
+            node = node[part]
+        node[parts[-1]] = float(value)
+    return out
+
+
+# ------------------------------------------------------------------------ validation
+
+
+def _count(value: Any, field: str) -> int:
+    return _integer(value, field, 1, MAX_STUDY_POINTS)
+
+
+def _grid(kind: str, spec: Any, field: str) -> tuple[float, ...]:
+    if kind == "values":
+        if not isinstance(spec, (list, tuple)) or not spec:
+            raise ValueError(f"{field}: must be a non-empty list of numbers, got "
+                             f"{show_value(spec)}")
+        if len(spec) > MAX_STUDY_POINTS:
+            raise ValueError(f"{field}: at most {MAX_STUDY_POINTS} values, got {len(spec)}")
+        return tuple(finite_number(v, f"{field}[{i}]") for i, v in enumerate(spec))
+    _check_fields(spec, field, ("start", "stop", "count"))
+    count = _count(spec["count"], f"{field}.count")
+    if kind == "linspace":
+        lo = finite_number(spec["start"], f"{field}.start")
+        hi = finite_number(spec["stop"], f"{field}.stop")
+        grid = np.linspace(lo, hi, count)
+    else:
+        lo = positive_number(spec["start"], f"{field}.start")
+        hi = positive_number(spec["stop"], f"{field}.stop")
+        grid = np.geomspace(lo, hi, count)
+    if count > 1 and lo == hi:
+        raise ValueError(f"{field}.stop: equals start ({show_value(lo)}): {count} equal "
+                         "points would repeat one solve")
+    return tuple(float(v) for v in grid)
+
+
+def _distribution(kind: str, spec: Any, field: str) -> tuple[tuple[str, float], ...]:
+    if kind == "normal":
+        _check_fields(spec, field, ("mean", "std"))
+        mean = finite_number(spec["mean"], f"{field}.mean")
+        std = positive_number(spec["std"], f"{field}.std")
+        return (("mean", mean), ("std", std))
+    if kind == "lognormal":
+        _check_fields(spec, field, ("median", "sigma"))
+        median = positive_number(spec["median"], f"{field}.median")
+        sigma = positive_number(spec["sigma"], f"{field}.sigma")
+        if sigma > 5:
+            raise ValueError(f"{field}.sigma: must be at most 5 (the spread of log values), "
+                             f"got {show_value(sigma)}")
+        return (("median", median), ("sigma", sigma))
+    _check_fields(spec, field, ("low", "high"))
+    low = finite_number(spec["low"], f"{field}.low")
+    high = finite_number(spec["high"], f"{field}.high")
+    if not high > low:
+        raise ValueError(f"{field}.high: must be greater than low ({show_value(low)}), got "
+                         f"{show_value(high)}")
+    return (("low", low), ("high", high))
+
+
+def _parameter(spec: Any, field: str, base: Mapping[str, Any]) -> Parameter:
+    kinds = GRID_KINDS + DISTRIBUTIONS
+    _check_fields(spec, field, ("field",), kinds)
+    given = [k for k in kinds if k in spec]
+    if len(given) != 1:
+        raise ValueError(f"{field}: give exactly one of {', '.join(kinds)}, got "
+                         + (", ".join(given) or "none"))
+    kind = given[0]
+    path = spec["field"]
+    parts = parse_path(path, f"{field}.field")
+    if parts[0] in _FIXED_ROOTS:
+        raise ValueError(f"{field}.field: {path!r} cannot be varied (the output times are "
+                         "the study's 'times'; names and versions are not numbers)")
+    try:
+        current = get_field(base, path)
+    except ValueError as exc:
+        raise ValueError(f"{field}.field: {exc}") from None
+    if isinstance(current, bool) or not isinstance(current, (int, float)):
+        raise ValueError(f"{field}.field: {path!r} holds {show_value(current)} in the base "
+                         "scene, not a number; vary a number inside it (for a profile "
+                         "object, e.g. '.value' or '.start')")
+    if kind in GRID_KINDS:
+        return Parameter(path, kind, values=_grid(kind, spec[kind], f"{field}.{kind}"))
+    return Parameter(path, kind, args=_distribution(kind, spec[kind], f"{field}.{kind}"))
+
+
+def _extremes(p: Parameter) -> list[tuple[str, float]]:
+    """Values of ``p`` whose scene must be valid: the grid's ends, a distribution's centre
+    (a normal or lognormal draw may still leave the valid range: that point fails alone)."""
+    if p.is_grid:
+        i_lo, i_hi = int(np.argmin(p.values)), int(np.argmax(p.values))
+        return [(f"{p.kind}", p.values[i_lo]), (f"{p.kind}", p.values[i_hi])]
+    args = dict(p.args)
+    if p.kind == "uniform":
+        return [(f"{p.kind}.low", args["low"]), (f"{p.kind}.high", args["high"])]
+    centre = "mean" if p.kind == "normal" else "median"
+    return [(f"{p.kind}.{centre}", args[centre])]
+
+
+def _read_json_file(path: Path, what: str) -> Any:
+    size = path.stat().st_size
+    if size > MAX_SCENE_BYTES:
+        raise ValueError(f"{path}: file is {size} bytes, over the limit of {MAX_SCENE_BYTES} "
+                         f"bytes for a {what} file")
+    with path.open("rb") as fh:
+        raw = fh.read(MAX_SCENE_BYTES + 1)
+    if len(raw) > MAX_SCENE_BYTES:
+        raise ValueError(f"{path}: file is over the limit of {MAX_SCENE_BYTES} bytes")
+    try:
+        return read_scene_json(raw.decode("utf-8-sig"), str(path))
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file in UTF-8") from None
+
+
+def _base_scene(spec: Any, base_dir: Path | None) -> dict[str, Any]:
+    if isinstance(spec, str):
+        if base_dir is None:
+            raise ValueError("scene: a scene file path needs the study's directory (use "
+                             "load_study, or give the scene inline)")
+        path = Path(spec) if os.path.isabs(spec) else base_dir / spec
+        try:
+            return load_scene(path).to_dict()
+        except ValueError as exc:
+            raise ValueError(f"scene: {exc}") from None
+        except OSError as exc:
+            raise ValueError(f"scene: cannot read {spec!r} ({exc.strerror or exc})") from None
+    if not isinstance(spec, Mapping):
+        raise ValueError(f"scene: must be a scene object or the path of a scene file, got "
+                         f"{show_value(spec)}")
+    try:
+        return scene_from_dict(spec).to_dict()
+    except ValueError as exc:
+        raise ValueError(f"scene: {exc}") from None
+
+
+def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = None, *,
+                    max_points: int = MAX_STUDY_POINTS) -> Study:
+    """Validate a study dict (format in ``core/SCENES.md``) and build a :class:`Study`.
+
+    ``base_dir`` resolves a relative ``scene`` path. Every problem raises ``ValueError``
+    whose message starts with the field (``vary[1].linspace.count: ...``); the base scene's
+    own problems are prefixed ``scene:``. The scene at each end of every grid (and at the
+    centre of every distribution) must be valid; the number of points is at most
+    ``max_points`` (default and upper bound :data:`MAX_STUDY_POINTS`; a server offering
+    studies to untrusted users passes a smaller one).
+    """
+    max_points = min(int(max_points), MAX_STUDY_POINTS)
+    try:
+        _check_fields(d, "", ("study_version", "name", "scene", "vary"),
+                      ("description", "samples", "seed", "outputs", "times"))
+    except ValueError as exc:
+        # the scene checker names the top level "scene", which in a study is the field
+        # holding the base scene: a stray study field must not be blamed on it
+        msg = str(exc)
+        if msg.startswith("scene: "):
+            raise ValueError("study: " + msg[len("scene: "):]) from None
+        raise
+    _integer(d["study_version"], "study_version", STUDY_VERSION, STUDY_VERSION)
+    name = d["name"]
+    if not isinstance(name, str) or not name.strip():
+        raise ValueError(f"name: must be a non-empty string, got {show_value(name)}")
+    base = _base_scene(d["scene"], None if base_dir is None else Path(base_dir))
+    if "times" in d:
+        base["times"] = d["times"]
+        try:
+            base = scene_from_dict(base).to_dict()
+        except ValueError as exc:
+            msg = str(exc)
+            raise ValueError(msg if msg.startswith("times") else f"times: {msg}") from None
+    times = tuple(float(t) for t in scene_from_dict(base).times)
+
+    vary = d["vary"]
+    if not isinstance(vary, (list, tuple)) or not 1 <= len(vary) <= MAX_PARAMETERS:
+        raise ValueError(f"vary: must be a list of 1 to {MAX_PARAMETERS} fields to vary, got "
+                         + (f"{len(vary)}" if isinstance(vary, (list, tuple))
+                            else show_value(vary)))
+    params = tuple(_parameter(spec, f"vary[{i}]", base) for i, spec in enumerate(vary))
+    seen: dict[str, int] = {}
+    for i, p in enumerate(params):
+        if p.path in seen:
+            raise ValueError(f"vary[{i}].field: {p.path!r} is already varied by "
+                             f"vary[{seen[p.path]}]")
+        seen[p.path] = i
+
+    random = any(not p.is_grid for p in params)
+    if random and "samples" not in d:
+        raise ValueError("samples: required when a field follows a distribution")
+    if not random and "samples" in d:
+        raise ValueError("samples: only for distributions (every field here is a grid)")
+    samples = _count(d["samples"], "samples") if random else 1
+    seed = _integer(d.get("seed", 0), "seed", 0, 2**63 - 1)
+
+    outputs_spec = d.get("outputs", list(OUTPUT_UNITS))
+    if not isinstance(outputs_spec, (list, tuple)) or not outputs_spec:
+        raise ValueError(f"outputs: must be a non-empty list of {', '.join(OUTPUT_UNITS)}")
+    for i, o in enumerate(outputs_spec):
+        # a list or object in the list is unhashable: test the type before the lookup
+        if not isinstance(o, str) or o not in OUTPUT_UNITS:
+            raise ValueError(f"outputs[{i}]: unknown output {show_value(o)} (known: "
+                             f"{', '.join(OUTPUT_UNITS)})")
+    outputs = tuple(dict.fromkeys(outputs_spec))
+
+    n = math.prod(len(p.values) for p in params if p.is_grid) * samples
+    if n > max_points:
+        raise ValueError(f"vary: the study has {n:,} points (grid sizes times samples), more "
+                         f"than the limit of {max_points:,}")
+
+    for i, p in enumerate(params):
+        for where, value in _extremes(p):
+            try:
+                scene_from_dict(apply_point(base, {p.path: value}))
+            except ValueError as exc:
+                raise ValueError(f"vary[{i}].{where}: the scene is invalid at {p.path} = "
+                                 f"{value:.6g} ({exc})") from None
+    return Study(name.strip(), base, params, samples, seed, outputs, times)
+
+
+def numeric_fields(scene: Mapping[str, Any], prefix: str = "") -> list[tuple[str, float]]:
+    """Every field of a scene dict that a study can vary, with its current value: the
+    numbers outside ``times`` and the schema fields, as ``(path, value)`` in document
+    order (``[("punch.half_width", 1.0), ("coating[0].thickness", 0.02), ...]``)."""
+    out: list[tuple[str, float]] = []
+    items = scene.items() if isinstance(scene, Mapping) else enumerate(scene)
+    for key, value in items:
+        path = (f"{prefix}[{key}]" if isinstance(key, int)
+                else f"{prefix}.{key}" if prefix else str(key))
+        if not prefix and key in _FIXED_ROOTS:
+            continue
+        if isinstance(value, (Mapping, list)):
+            out.extend(numeric_fields(value, path))
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            out.append((path, float(value)))
+    return out
+
+
+def load_study(path: str | os.PathLike) -> Study:
+    """Read and validate a study file (JSON, at most 1 MB); a relative ``scene`` path is
+    taken from the study file's directory."""
+    path = Path(path)
+    return study_from_dict(_read_json_file(path, "study"), base_dir=path.parent)
+
+
+# ------------------------------------------------------------------------- expansion
+
+
+def point_values(table: Mapping[str, np.ndarray], i: int,
+                 paths: Sequence[str]) -> dict[str, float]:
+    """The field values of point ``i`` of a :func:`point_table`."""
+    return {path: float(table[path][i]) for path in paths}
