@@ -8,7 +8,7 @@
     python -m benchmarks.coating_validity --variable   # bonded, varying thickness
 
 ``--table`` solves, for a flat punch with a uniform coating, the fast model (with the
-compliance of :func:`core.coating.model.layer_compliance`) and the FE model of
+compliance of :func:`core.coating.layer_compliance`) and the FE model of
 :mod:`core.coating.fem_check` (level 0) for a unit settlement and a unit tilt, over the grid below,
 and writes the signed relative errors of the force and the moment to
 ``core/coating/error_table.py`` (the map behind ``info["model_error_estimate"]``) and a
@@ -26,8 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from core import solve_dimensionless
-from core.coating.fem_check import CoatingStrip, Stack, solve_stack
-from core.coating.model import INTERFACES, layer_compliance
+from core.coating import INTERFACES, CoatingStrip, Stack, layer_compliance, solve_stack
 
 THICKNESS_RATIOS = (0.002, 0.005, 0.02, 0.05, 0.1)
 MODULUS_RATIOS = (0.005, 0.05, 0.3, 1.0, 3.0)
@@ -107,7 +106,7 @@ def table(keep: bool = False) -> None:
 
 
 def _table_json(errors: dict) -> str:
-    """The map as the text of ``core/coating_error_table.json``: the axes, then per
+    """The map as the text of ``core/coating/error_table.json``: the axes, then per
     interface and part one line per (sum h / 2a, E_c / E) holding its nu_c x H / a values
     (rounded to 5 decimals; JSON keeps each float's repr, so values read back exactly)."""
     head = {"about": ("Measured error of the thin-coating model against the resolved FE "
@@ -133,9 +132,9 @@ def _table_json(errors: dict) -> str:
 
 
 def _write_module(errors: dict) -> None:
-    """Write the map to ``core/coating_error_table.json`` (read by
+    """Write the map to ``core/coating/error_table.json`` (read by
     :mod:`core.coating.error_table` at import)."""
-    (ROOT / "core" / "coating_error_table.json").write_text(_table_json(errors))
+    (ROOT / "core" / "coating" / "error_table.json").write_text(_table_json(errors))
 
 
 def _write_markdown(errors: dict, seconds: float, keep: bool = False) -> None:
@@ -203,7 +202,7 @@ def fe_study() -> None:
 def _elastic_copy(d: dict) -> dict:
     """The scene with its base elastic at the modulus at loading (the exact layered kernel
     then answers a uniform coating)."""
-    from core.scene.pipeline import scene_from_dict
+    from core.scene import scene_from_dict
 
     out = dict(d)
     out["base"] = dict(d["base"])
@@ -216,8 +215,7 @@ def presets() -> None:
     """The FE check on every preset scene: model error against the carried estimate, for
     the scene as it is and for its copy on an elastic base (where a uniform coating is
     answered by the exact layered kernel)."""
-    from core.scene.coating_check import check_scene
-    from core.scene.pipeline import load_scene
+    from core.scene import check_scene, load_scene
 
     lines = ["| scene | interface | statement | model | FE model error | estimate | ratio | "
              "elastic copy: model | FE difference | estimate | FE s |",
@@ -308,7 +306,7 @@ VARIABLE_SCENES = (
 def variable() -> None:
     """The estimate against the FE check (levels 0 and 1) on bonded coatings of varying
     thickness."""
-    from core.scene.coating_check import check_scene
+    from core.scene import check_scene
 
     lines = ["| scene | FE level 0 error | FE level 1 error | estimate | ratio (level 1) | "
              "FE s |", "| --- | --- | --- | --- | --- | --- |"]
@@ -346,8 +344,7 @@ AGING_PRESETS = ("eccentric_creep", "young_concrete_50_years")
 def aging() -> None:
     """The thin-layer answer of an aging base checked at loading and at the last output
     time: the FE model with the base elastic at E(t) against the fast model at E(t)."""
-    from core.scene.coating_check import check_scene
-    from core.scene.pipeline import load_scene
+    from core.scene import check_scene, load_scene
 
     lines = ["| scene | interface | time [day] | E(t) / E(tau0) | FE model error | "
              "estimate (at loading) | FE s |", "| --- | --- | --- | --- | --- | --- | --- |"]

@@ -30,10 +30,11 @@ import numpy as np
 
 from benchmarks.creep_goals import timed
 from core.cache import clear_caches
-from core.creep.design_codes import _FORMULAS, MAX_DURATION, RESOLUTION, CodeCreep, clamp_age
+from core.creep.code_formulas import _FORMULAS, clamp_age
+from core.creep.design_codes import MAX_DURATION, RESOLUTION, CodeCreep
 from core.creep.kernel_fit import fit_compliance
 from core.creep.models import Arutyunyan
-from core.scene.pipeline import scene_from_dict
+from core.scene import scene_from_dict
 from core.solver import solve_dimensionless
 
 PRESET = Path(__file__).resolve().parents[1] / "assets" / "scenes" / \

@@ -30,7 +30,7 @@ import numpy as np
 import core
 from benchmarks.scenes import creep_times, suite
 from core.cache import clear_caches
-from core.scene.pipeline import scene_from_dict
+from core.scene import scene_from_dict
 from core.solver import solve_dimensionless
 
 PRESET = Path(__file__).resolve().parents[1] / "assets" / "scenes" / \

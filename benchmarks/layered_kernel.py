@@ -5,9 +5,9 @@
 
 For ``sum h / 2a = 0.02, 0.05``, ``E_c / E = 0.05, 1, 3``, ``nu_c = 0.3, 0.45``, smooth and
 bonded, ``H = a``, base ``nu = 0.2``: the force per unit settlement and the moment per unit
-tilt of :func:`core.engines.layered.stiffness.flat_punch_stiffness` (the layered kernel) and of the
+tilt of :func:`core.engines.layered.flat_punch_stiffness` (the layered kernel) and of the
 thin-layer model (:func:`benchmarks.coating_validity.fast_stiffness` with the compliance of
-:func:`core.coating.model.layer_compliance`), each as a relative difference from the FE
+:func:`core.coating.layer_compliance`), each as a relative difference from the FE
 model of :mod:`core.coating.fem_check` at mesh level 1; the FE model's own discretisation error is
 shown as the difference of its levels 0 and 1.
 """
@@ -21,10 +21,9 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.coating_validity import BASE_POISSON, fast_stiffness
-from core.coating.fem_check import CoatingStrip, Stack, solve_stack
-from core.coating.model import layer_compliance
+from core.coating import CoatingStrip, Stack, layer_compliance, solve_stack
 from core.engines.layered.stiffness import flat_punch_stiffness
-from core.kernel.layered import UniformLayer
+from core.kernel import UniformLayer
 
 THICKNESS_RATIOS = (0.02, 0.05)
 MODULUS_RATIOS = (0.05, 1.0, 3.0)

@@ -34,8 +34,8 @@ if str(ROOT) not in sys.path:
 from core import contact_zones as cz  # noqa: E402
 from core import scene_from_dict, solve, solve_dimensionless  # noqa: E402
 from core.cache import clear_caches  # noqa: E402
-from core.contact.unilateral import solve_unilateral  # noqa: E402
-from core.discretize.quadrature import base_panels, kernel_operator  # noqa: E402
+from core.contact import solve_unilateral  # noqa: E402
+from core.discretize import base_panels, kernel_operator  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"

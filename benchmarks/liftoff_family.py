@@ -2,7 +2,7 @@
 
     python -m benchmarks.liftoff_family [n_side]     # default 100: 10,000 points (~1 min CPU)
 
-Runs :func:`core.study.batch.run_batch` over the batches of
+Runs :func:`core.study.run_batch` over the batches of
 ``benchmarks.sweep.loads_study(n_side)`` as the study plans them (its lift-off points
 answered as one family per eccentricity side, :mod:`core.study.liftoff`), then
 ``core.solve`` on each point's scene, and prints per contact model the largest difference
@@ -22,8 +22,10 @@ import numpy as np
 
 from benchmarks.sweep import loads_study
 from core import solve
+from core.study import Study
 from core.study.batch import point_outputs, run_batch
-from core.study.definition import Study, apply_point, point_table
+from core.study.definition import apply_point
+from core.study.points import point_table
 from core.study.run import default_batch_points, plan_batches
 
 

@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-from core.scene.pipeline import solve
+from core.scene import solve
 from explorer.presets import SCENES_DIR
 
 #: The presets measured by default: a creep scene, two thin-coating scenes (smooth and

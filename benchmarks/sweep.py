@@ -48,8 +48,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from core.study.definition import Study, study_from_dict  # noqa: E402
-from core.study.run import sweep  # noqa: E402
+from core.study import Study, study_from_dict, sweep  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 DESIGN_STUDY = ROOT / "assets" / "studies" / "eccentric_design.json"
@@ -84,7 +83,7 @@ def modulus_study(n: int) -> Study:
 
 def on_fresh_cluster(study: Study, workers: int, warm: bool = True) -> dict[str, float]:
     """Run ``study`` on a new local cluster of ``workers`` processes started as
-    :func:`core.sweep` starts its own (:func:`core.study.warm.start_local_cluster`, the
+    :func:`core.sweep` starts its own (:func:`core.study.start_local_cluster`, the
     workers warmed unless ``warm`` is false: that is counted in the start); seconds of the
     start and of the study, the workers' CPU in the study and in the warming [s], and the
     points that failed."""
@@ -141,17 +140,17 @@ def _cut_points(study: Study, points: int) -> int:
 
 def point_costs(study: Study, batch: int | None = None) -> dict[str, dict[str, float]]:
     """Where a load-only study's CPU time goes, in this process with no Dask, batch by
-    batch as :func:`core.study.run.sweep` plans them (``batch`` points each, default as the
-    study's default): the points :func:`core.study.loads.solve_load_batch` answers at
-    once (``batched``), and the whole of :func:`core.study.batch.run_batch`
+    batch as :func:`core.study.sweep` plans them (``batch`` points each, default as the
+    study's default): the points :func:`core.study.solve_load_batch` answers at
+    once (``batched``), and the whole of :func:`core.study.run_batch`
     (``run_batch``: the batched points again, the lift-off families of
     :mod:`core.study.liftoff`, the scaled points and the one-point solves, counted in
     ``one-point solves``). CPU seconds [s] from ``time.process_time``."""
     import core.study.batch as batch_module
     from core.study.batch import _load_only_base, run_batch
-    from core.study.definition import StudyPoints
     from core.study.loads import solve_load_batch
     from core.study.plan import BatchPlan
+    from core.study.points import StudyPoints
     from core.study.run import default_batch_points
 
     paths = [p.path for p in study.parameters]

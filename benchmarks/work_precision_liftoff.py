@@ -3,7 +3,7 @@
     OPENBLAS_NUM_THREADS=1 python benchmarks/work_precision_liftoff.py
     # writes benchmarks/results/work_precision_liftoff.md (~2 min)
 
-Three scenes past lift-off (dimensionless, core.contact.unilateral.solve_unilateral):
+Three scenes past lift-off (dimensionless, core.contact.solve_unilateral):
 
 * eccentric footing, elastic: lam = 1, m = 0.05, P = 1, M = 0.45 (e = 0.45, the edge
   x = -1 lifts off: one free end);
@@ -46,7 +46,7 @@ if str(ROOT) not in sys.path:
 from benchmarks.liftoff import PRESET, RESULTS, constant, nodal_start  # noqa: E402
 from core import contact_zones as cz  # noqa: E402
 from core import scene_from_dict  # noqa: E402
-from core.contact.unilateral import solve_unilateral  # noqa: E402
+from core.contact import solve_unilateral  # noqa: E402
 
 XS = np.linspace(-0.95, 0.95, 381)
 

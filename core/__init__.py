@@ -1,17 +1,22 @@
 """coated-punch: contact of a rigid punch on a coated, aging viscoelastic layer.
 
-The public entry points are loaded on first use, so that importing one submodule (say
-:mod:`core.kernel.plane`) does not load the whole pipeline:
+The public entry points, loaded on first use (importing one subpackage, say
+:mod:`core.kernel`, does not load the whole pipeline):
 
-- :func:`solve_dimensionless`, :class:`ContactSolution` (:mod:`core.solver`): the
-  dimensionless problem;
-- :func:`prepare` (:mod:`core.engines.nystrom.prepared`): prepare a geometry once, ``.solve(...)`` the
-  loads many times;
+- :func:`solve_dimensionless` (:mod:`core.solver`), :class:`ContactSolution`
+  (:mod:`core.problem`): the dimensionless problem, answered by one of the engines;
+- :func:`prepare` (:mod:`core.engines.nystrom`): prepare a geometry once, then
+  ``.solve(...)`` the loads many times;
 - :func:`solve`, :class:`Scene`, :class:`SceneSolution`, :func:`scene_from_dict`,
-  :func:`load_scene`, :func:`save_scene` (:mod:`core.scene.pipeline`): dimensional scenes in SI
+  :func:`load_scene`, :func:`save_scene` (:mod:`core.scene`): dimensional scenes in SI
   units with time in days;
-- :func:`sweep` (:mod:`core.study.run`), :func:`load_study`, :func:`study_from_dict`
-  (:mod:`core.study.definition`): design studies (parameter sweeps, Monte Carlo) run on Dask.
+- :func:`sweep`, :func:`load_study`, :func:`study_from_dict` (:mod:`core.study`): design
+  studies (parameter sweeps, Monte Carlo) run on Dask;
+- :func:`creep_coefficient_curve` (:mod:`core.creep`): the design codes' creep laws;
+- :data:`STAGE_CACHE_BYTES`, :func:`set_stage_cache_budget`, :func:`stage_cache_bytes`
+  (:mod:`core.budget`): the memory the solver's caches may hold.
+
+``core/README.md`` maps the subpackages.
 """
 
 from __future__ import annotations
@@ -21,43 +26,36 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from core.budget import STAGE_CACHE_BYTES, set_stage_cache_budget, stage_cache_bytes
-    from core.creep.design_codes import creep_coefficient_curve
-    from core.engines.nystrom.prepared import prepare
-    from core.scene.pipeline import (
-        Scene,
-        SceneSolution,
-        load_scene,
-        save_scene,
-        scene_from_dict,
-        solve,
-    )
-    from core.solver import ContactSolution, solve_dimensionless
-    from core.study.definition import load_study, study_from_dict
-    from core.study.run import sweep
+    from core.creep import creep_coefficient_curve
+    from core.engines.nystrom import prepare
+    from core.problem import ContactSolution
+    from core.scene import Scene, SceneSolution, load_scene, save_scene, scene_from_dict, solve
+    from core.solver import solve_dimensionless
+    from core.study import load_study, study_from_dict, sweep
 
 _EXPORTS: dict[str, str] = {
     "solve_dimensionless": "core.solver",
-    "prepare": "core.engines.nystrom.prepared",
-    "ContactSolution": "core.solver",
-    "solve": "core.scene.pipeline",
-    "Scene": "core.scene.pipeline",
-    "SceneSolution": "core.scene.pipeline",
-    "scene_from_dict": "core.scene.pipeline",
-    "load_scene": "core.scene.pipeline",
-    "save_scene": "core.scene.pipeline",
-    "creep_coefficient_curve": "core.creep.design_codes",
-    "sweep": "core.study.run",
+    "ContactSolution": "core.problem",
+    "prepare": "core.engines.nystrom",
+    "solve": "core.scene",
+    "Scene": "core.scene",
+    "SceneSolution": "core.scene",
+    "scene_from_dict": "core.scene",
+    "load_scene": "core.scene",
+    "save_scene": "core.scene",
+    "creep_coefficient_curve": "core.creep",
+    "sweep": "core.study",
+    "load_study": "core.study",
+    "study_from_dict": "core.study",
     "STAGE_CACHE_BYTES": "core.budget",
     "set_stage_cache_budget": "core.budget",
     "stage_cache_bytes": "core.budget",
-    "load_study": "core.study.definition",
-    "study_from_dict": "core.study.definition",
 }
 
 __all__ = [
     "solve_dimensionless",
-    "prepare",
     "ContactSolution",
+    "prepare",
     "solve",
     "Scene",
     "SceneSolution",

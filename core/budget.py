@@ -24,9 +24,9 @@ def set_stage_cache_budget(total_bytes: int) -> None:
         raise ValueError(f"total_bytes: must be a positive integer, got {total_bytes!r}")
     # Imported here: the exact layered kernel's module loads scipy.fft, which a scene
     # without uniform layers never needs.
-    from core.engines.layered.cache import share_budget
-    from core.engines.nystrom.prepared import PREPARED, PREPARED_BYTES
-    from core.engines.projection.caches import DEFAULT_STAGE_BYTES, PROJECTION_CACHES
+    from core.engines.layered import share_budget
+    from core.engines.nystrom import PREPARED, PREPARED_BYTES
+    from core.engines.projection import DEFAULT_STAGE_BYTES, PROJECTION_CACHES
 
     default_total = sum(DEFAULT_STAGE_BYTES.values())
     # The default engine's prepared geometries, and the exact layered kernel's operators,
@@ -40,7 +40,7 @@ def set_stage_cache_budget(total_bytes: int) -> None:
 
 def stage_cache_bounds() -> dict[str, int]:
     """Each projection stage cache's name and its current bound on held memory [bytes]."""
-    from core.engines.projection.caches import PROJECTION_CACHES
+    from core.engines.projection import PROJECTION_CACHES
 
     return {cache.name: cache.max_bytes for cache in PROJECTION_CACHES}
 

@@ -4,7 +4,7 @@ and ``python -m core sweep STUDY.json --output RESULT.nc`` (a design study, see
 resolved finite elements).
 
 ``solve`` writes the solution to ``--output`` (``.json``: everything, see
-:meth:`core.scene.pipeline.SceneSolution.to_dict`, with the contact set per time; ``.csv``: the
+:meth:`core.scene.SceneSolution.to_dict`, with the contact set per time; ``.csv``: the
 histories of settlement, tilt, force and moment, and the contact zones when the punch
 lifts off) and optionally the pressure ``q(x, t)`` to ``--pressure-csv``; without
 ``--output`` it prints a short summary. ``validate`` only checks the scene file.
@@ -31,15 +31,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
-from core.files import same_file, writable_target
-from core.scene.pipeline import (
-    QUANTITIES,
-    Scene,
-    SceneSolution,
-    atomic_write_text,
-    load_scene,
-    solve,
-)
+from core.files import atomic_write_text, same_file, writable_target
+from core.problem import QUANTITIES
+from core.scene import Scene, SceneSolution, load_scene, solve
 
 EXIT_OK = 0
 EXIT_SOLVER_FAILED = 1
@@ -165,8 +159,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
     # imported here: a plain solve must not load Dask
-    from core.study.definition import load_study
-    from core.study.run import check_output, sweep
+    from core.study import check_output, load_study, sweep
 
     output = Path(args.output)
     try:
@@ -199,7 +192,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from core.scene.coating_check import check_scene
+    from core.scene import check_scene
 
     scene = _read(args.scene)
     end = float(scene.times[-1])

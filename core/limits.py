@@ -15,7 +15,7 @@ from __future__ import annotations
 
 # ----------------------------------------------------------------------------- text
 
-#: Largest scene file read by ``core.scene.pipeline.load_scene`` [bytes].
+#: Largest scene file read by ``core.scene.load_scene`` [bytes].
 MAX_SCENE_BYTES = 1_000_000
 #: Longest scene name [characters]: a title, shown in a page title and file names.
 MAX_NAME_CHARS = 200

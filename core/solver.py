@@ -16,9 +16,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from core.engines.projection.solve import solve_projection
-from core.engines.projection.stages import validate_inputs
-from core.problem.result import ContactSolution
+from core.engines.projection import solve_projection, validate_inputs
+from core.problem import ContactSolution
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
@@ -51,10 +50,10 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
             (the seed's basis).
         n_modes: a fixed number of basis functions (for studies); default adaptive.
         method: "nystrom" (the default: a direct solve on graded panels, adaptively
-            refined, :mod:`core.engines.nystrom.prepared`) or "projection" (the seed's series; the default
-            when ``basis`` or ``n_modes`` is given, which only it uses).
+            refined, :mod:`core.engines.nystrom`) or "projection" (the seed's series; the
+            default when ``basis`` or ``n_modes`` is given, which only it uses).
         contact: "full" (q may come out negative: flag ``contact_lost``), "unilateral"
-            (q >= 0 with an unknown contact set, :func:`core.contact.unilateral.solve_unilateral`) or
+            (q >= 0 with an unknown contact set, :func:`core.contact.solve_unilateral`) or
             "auto" (full contact first, unilateral only when it is lost).
         time_breaks: times where a given load history jumps or kinks; the default engine's
             time steps land on them (a step across a jump loses the order and fools the
@@ -65,19 +64,19 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     and ``info["contact"]`` say which contact model answered. Raises ``ValueError``
     naming the argument on bad input, and naming ``force`` or ``moment`` with ``contact``
     ``"auto"`` or ``"unilateral"`` when the loads leave no contact (P < 0, P = 0
-    throughout, |M/P| >= 1: :func:`core.contact.switch.refuse_loads_without_contact`).
+    throughout, |M/P| >= 1: :func:`core.contact.refuse_loads_without_contact`).
     ``contact="full"`` asks for the full-contact model itself, a linear equation that
     holds for any loads (a bonded punch, the model problem of the seed): it answers them
     with the ``contact_lost`` flag where q < 0, as it answers a given settlement that
     lifts the punch.
     """
-    from core.contact.switch import (
+    from core.contact import (
         check_contact_model,
         refuse_loads_without_contact,
+        solve_unilateral,
         with_contact_model,
     )
-    from core.contact.unilateral import solve_unilateral
-    from core.problem.statements import UnresolvedOperator
+    from core.problem import UnresolvedOperator
 
     contact = check_contact_model(contact)
     if contact != "full":
@@ -88,7 +87,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     if method not in ("nystrom", "projection"):
         raise ValueError(f"method: must be 'nystrom' or 'projection', got {method!r}")
     if method == "nystrom":
-        from core.engines.nystrom.prepared import solve_with_prepared
+        from core.engines.nystrom import solve_with_prepared
 
         unilateral_args = dict(lam=lam, m=m, g=g, times=times, c=c, kernel=kernel,
                                settlement=settlement, tilt=tilt, force=force, moment=moment,
@@ -98,7 +97,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         # On an elastic base with a constant modulus the full-contact answer costs what the
         # check would (one combination of the prepared unit responses): no check first.
         if contact == "auto" and (kernel is not None or callable(c)):
-            from core.contact.switch import predicted_unilateral
+            from core.contact import predicted_unilateral
 
             predicted = predicted_unilateral(unilateral_args)
             if predicted is not None:

@@ -1,6 +1,6 @@
 """Checks of single numbers given by a user, with messages that start with the field.
 
-The scene loader (:mod:`core.scene.pipeline`) and the creep models (:mod:`core.creep.models`) refuse the
+The scene loader (:mod:`core.scene`) and the creep models (:mod:`core.creep`) refuse the
 same values: anything that is not a real number (strings, ``null``/``None``, lists,
 objects), booleans, NaN, infinities and integers too large for a double. They word the
 refusal for different readers, so each check takes a :class:`Style`:

@@ -19,7 +19,7 @@ import numpy as np
 import param
 
 import core
-from core.creep.design_codes import RANGES
+from core.creep import RANGES
 
 #: The design-code creep models offered by name: spec model name -> label on screen.
 CODE_CREEP_MODELS: dict[str, str] = {

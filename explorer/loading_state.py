@@ -13,8 +13,8 @@ from typing import Any
 
 import param
 
-from core.profiles.build import HISTORY_FORMS, history_form_of
-from core.scene.pipeline import QUANTITIES
+from core.problem import QUANTITIES
+from core.profiles import HISTORY_FORMS, history_form_of
 
 #: The four statements (which two quantities are given), as shown on screen.
 STATEMENTS: dict[str, tuple[str, str]] = {

@@ -16,8 +16,8 @@ from typing import Any
 
 import param
 
-from core.coating.model import DEFAULT_INTERFACE, INTERFACES
-from core.profiles.build import VARIATIONS, variation_of
+from core.coating import DEFAULT_INTERFACE, INTERFACES
+from core.profiles import VARIATIONS, variation_of
 
 from .code_creep_state import CODE_CREEP_MODELS, CodeCreepState
 

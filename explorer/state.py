@@ -22,8 +22,8 @@ from typing import Any
 
 import param
 
-from core.coating.model import DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
-from core.scene.pipeline import QUANTITIES
+from core.coating import DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
+from core.problem import QUANTITIES
 
 from .loading_state import (
     QUANTITY_RANGES,

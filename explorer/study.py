@@ -1,6 +1,6 @@
 """The explorer's design studies: one or two fields of the scene on screen over a range.
 
-A study of the Study tab is a :class:`core.study.definition.Study` built from the scene on screen:
+A study of the Study tab is a :class:`core.study.Study` built from the scene on screen:
 :func:`study_choices` lists the fields worth varying (with their units on screen),
 :func:`plan_study` checks the ranges the user typed and builds the study (a ``ValueError``
 naming the field of the tab, e.g. ``parameter 2, points: ...``), and a
@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from core.study.definition import Study, numeric_fields, study_from_dict
+from core.study import Study, numeric_fields, study_from_dict
 
 #: Most points of a study started from the page (grid product). The page is served to
 #: untrusted users on a shared machine: a point differing only in its loads costs a few

@@ -52,9 +52,8 @@ PROGRESS_EVERY_S = 0.1
 #: Modules the fork server imports once, so that a study's process starts warm: the
 #: solver's modules and scipy's parts it uses cost ~1 s of CPU to import (measured), which
 #: every study would pay again.
-_PRELOAD = ["core.study.run", "core.scene.pipeline", "core.study.definition", "core.solver", "core.engines.nystrom.bordered",
-            "core.engines.nystrom.prepared", "core.engines.projection.matrices", "core.contact.unilateral", "core.contact.zones",
-            "core.creep.kernel_fit", "core.time.integration", "core.engines.nystrom.modal", "scipy.linalg",
+_PRELOAD = ["core.study", "core.scene", "core.solver", "core.engines.nystrom",
+            "core.engines.projection", "core.contact", "core.creep", "core.time", "scipy.linalg",
             "scipy.interpolate", "scipy.optimize", "scipy.special", "scipy.sparse",
             "scipy.fft", "xarray", "explorer.study_runner"]
 
@@ -84,7 +83,7 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl+C is the server's to handle
-    from core.study.run import sweep
+    from core.study import sweep
 
     def progress(done: int, total: int) -> bool:
         out.put(("progress", done, total))

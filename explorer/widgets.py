@@ -16,7 +16,7 @@ from typing import Any
 import panel as pn
 import param
 
-from core.profiles.build import VARIATIONS
+from core.profiles import VARIATIONS
 
 from .state import QUANTITY_RANGES, HistoryState, ProfileState
 from .trace import mark

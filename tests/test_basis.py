@@ -14,14 +14,17 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import pytest
 
-from core.discretize.basis import GRADED_DEPTH, GRADED_RATIO, Basis, build_basis, graded_cuts
-from core.discretize.galerkin import galerkin_correction
-from core.discretize.quadrature import (
+from core.discretize import (
+    Basis,
     Panels,
     base_panels,
+    build_basis,
+    galerkin_correction,
+    graded_cuts,
     kernel_operator,
     operator_rows,
 )
+from core.discretize.graded_basis import GRADED_DEPTH, GRADED_RATIO
 from core.engines.projection.matrices import galerkin_matrix
 
 #: Interior points where the pressure is compared (as the solver does: |x| <= 0.95 and

@@ -35,8 +35,7 @@ def test_stage_cache_values_are_read_only():
 
 
 def test_pair_tables_are_read_only():
-    from core.discretize import pair_tables
-    from core.discretize.quadrature import Panels, node_rows
+    from core.discretize import Panels, node_rows, pair_tables
 
     panels = Panels.from_edges(np.array([-1.0, -0.25, 0.0, 0.5, 1.0]))
     node_rows(1.0, panels, panels, np.arange(panels.n_panels))
@@ -56,7 +55,7 @@ def test_module_tables_are_read_only():
 
 
 def test_prepared_rows_are_read_only():
-    from core.engines.nystrom.prepared import prepare
+    from core.engines.nystrom import prepare
 
     prepared = prepare(1.0, 0.05, 0.0, tol=1e-6)
     rows = prepared.rows(np.linspace(-0.9, 0.9, 5))
@@ -106,7 +105,7 @@ def test_unkeyed_kernel_response_is_not_reused_for_another(monkeypatch):
     kernel does that takes over the address of one freed before). Keyed by ``id()``, the
     second kernel was given the first one's response."""
     import core.engines.nystrom.prepared
-    from core.engines.nystrom.prepared import prepare
+    from core.engines.nystrom import prepare
 
     # tol 1e-10: no sum-of-exponentials fit is within the budget, so the kernels are
     # stepped as they are and known by identity only
@@ -138,8 +137,7 @@ def test_unkeyed_kernel_response_is_not_reused_for_another(monkeypatch):
 def test_pair_tables_emptied_when_full_still_answer_every_key(monkeypatch):
     """When a call's new keys would pass the store's limit, the store is emptied: the
     call's keys the old store held must then come into the new one too (else KeyError)."""
-    from core.discretize import pair_tables
-    from core.discretize.quadrature import Panels, node_rows
+    from core.discretize import Panels, node_rows, pair_tables
 
     first = Panels.from_edges(np.array([-1.0, -0.5, 0.0, 0.5, 1.0]))
     second = Panels.from_edges(np.array([-1.0, -0.75, -0.5, 0.0, 0.25, 0.5, 1.0]))

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from core.scene.pipeline import MAX_SCENE_BYTES
+from core.scene import MAX_SCENE_BYTES
 from tests.cli_runs import run_cli
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from core import solve_dimensionless
-from core.coating.fem_check import CoatingStrip, Stack, solve_stack
-from core.coating.model import layer_compliance, mapped_error
-from core.scene.coating_check import check_scene
-from core.scene.pipeline import scene_from_dict, scene_to_json, solve
+from core.coating import CoatingStrip, Stack, layer_compliance, solve_stack
+from core.coating.model import mapped_error
+from core.scene import check_scene, scene_from_dict, solve
+from core.scene.files import scene_to_json
 from tests.cli_runs import run_cli
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -206,5 +206,5 @@ def test_the_error_map_read_from_its_data_file_is_the_measured_one():
     # the generator writes the file back unchanged
     errors = {i: {p: np.array(table.ERRORS[i][p]) for p in ("force", "moment")}
               for i in ("smooth", "bonded")}
-    path = Path(table.__file__).with_name("coating_error_table.json")
+    path = Path(table.__file__).with_name("error_table.json")
     assert _table_json(errors) == path.read_text(encoding="utf-8")

@@ -14,12 +14,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.creep.design_codes import RESOLUTION, CodeCreep, creep_coefficient_curve
+from core.creep import creep_coefficient_curve, creep_model_from_spec
+from core.creep.design_codes import RESOLUTION, CodeCreep
 from core.creep.kernel_fit import fit_kernel, nonpositive_violation
-from core.creep.models import Arutyunyan, creep_model_from_spec
-from core.scene.pipeline import scene_from_dict, solve
+from core.creep.models import Arutyunyan
+from core.scene import scene_from_dict, solve
 from core.solver import solve_dimensionless
-from core.time.integration import ModalProblem, _trapezoid_solve, solve_degenerate
+from core.time import ModalProblem, solve_degenerate
+from core.time.product_quadrature import _trapezoid_solve
 
 ROOT = Path(__file__).resolve().parents[1]
 C30 = {"strength_class": "C30/37", "cement": "N", "relative_humidity": 60.0,

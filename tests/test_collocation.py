@@ -1,4 +1,4 @@
-"""The Nystrom collocation solver (core.engines.collocation.solve): convergence, limits, creep oracle.
+"""The Nystrom collocation solver (core.engines.collocation): convergence, limits, creep oracle.
 
 Every tolerance below is set from a measured error, quoted next to it (measured with
 the double-precision kernel; margins of 2-10x leave room for other BLAS builds).
@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 from scipy.linalg import expm, solve
 
-from core.discretize.quadrature import kernel_operator
-from core.engines.collocation.solve import collocation_panels, solve_collocation, time_grid
+from core.discretize import kernel_operator
+from core.engines.collocation import time_grid
+from core.engines.collocation.solve import collocation_panels, solve_collocation
 from core.kernel.plane import plane_kernel_regular
 
 X_CHECK = np.linspace(-1.0, 1.0, 401)

@@ -1,4 +1,4 @@
-"""Unilateral contact (core.contact.unilateral): limits, a second method, refinement, creep, the API.
+"""Unilateral contact (core.contact): limits, a second method, refinement, creep, the API.
 
 Every tolerance is a measured error with a margin; the measured value is quoted next to
 it (double-precision kernel, OPENBLAS_NUM_THREADS=1).
@@ -15,21 +15,13 @@ import numpy as np
 import pytest
 
 from core import scene_from_dict, solve, solve_dimensionless
-from core.contact.unilateral import (
-    FULL_CONTACT,
-    contact_set_from_pressure,
-    solve_unilateral,
-)
-from core.contact.zones import (
-    Resolution,
-    Space,
-    Step,
-    nodal_active_set,
-    refine_zone_ends,
-    solve_on_zones,
-    zones_from_nodes,
-)
-from core.discretize.quadrature import base_panels, kernel_operator
+from core.contact import Resolution, Space, solve_unilateral
+from core.contact.active_set import nodal_active_set, zones_from_nodes
+from core.contact.result import contact_set_from_pressure
+from core.contact.step import Step
+from core.contact.unilateral import FULL_CONTACT
+from core.contact.zones import refine_zone_ends, solve_on_zones
+from core.discretize import base_panels, kernel_operator
 
 ROOT = Path(__file__).resolve().parent.parent
 PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"
@@ -352,9 +344,10 @@ def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
 
 def _creep_rule_march(pb, tol, rule_for, level=0):
     """Zone ends and outputs of the creep stepping on the rule ``rule_for(space, res)``."""
-    from core.contact.march import march, march_outputs
-    from core.engines.collocation.solve import time_grid
-    from core.engines.projection.stages import validate_inputs
+    from core.contact import march
+    from core.contact.march import march_outputs
+    from core.engines.collocation import time_grid
+    from core.engines.projection import validate_inputs
 
     inp = validate_inputs(pb.lam, pb.m, pb.g, pb.times, pb.c, pb.kernel,
                     {"settlement": None, "tilt": None, **pb.loads}, pb.breakpoints, tol)

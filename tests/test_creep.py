@@ -11,19 +11,10 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from core.creep.models import (
-    KNOWN_MODELS,
-    Arutyunyan,
-    CausalKernel,
-    DegenerateKernel,
-    Elastic,
-    ExponentialCreep,
-    PronySeries,
-    RelativeModulus,
-    UserKernel,
-    creep_model_from_spec,
-)
-from core.time.integration import ModalProblem, solve_degenerate
+from core.creep import Elastic, UserKernel, creep_model_from_spec
+from core.creep.kernels import CausalKernel, DegenerateKernel, RelativeModulus
+from core.creep.models import KNOWN_MODELS, Arutyunyan, ExponentialCreep, PronySeries
+from core.time import ModalProblem, solve_degenerate
 
 HAVE_EXPRESSIONS = importlib.util.find_spec("core.profiles.expressions") is not None
 

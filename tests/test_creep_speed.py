@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from core.cache import clear_caches
-from core.scene.pipeline import scene_from_dict
+from core.scene import scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -39,7 +39,7 @@ def test_a_load_change_of_an_aging_scene_does_not_step_in_time_again():
 
 
 def _problem(modes: int, known: int):
-    from core.time.integration import ModalProblem
+    from core.time import ModalProblem
 
     rng = np.random.default_rng(11)
     gamma = rng.uniform(0.01, 50.0, modes)
@@ -51,8 +51,8 @@ def _problem(modes: int, known: int):
 
 
 def test_batched_steps_equal_single_steps():
-    from core.creep.models import DegenerateKernel
-    from core.time.integration import _radau_step, _radau_steps
+    from core.creep.kernels import DegenerateKernel
+    from core.time.radau import _radau_step, _radau_steps
 
     kernel = DegenerateKernel(age_at_loading=28.0, modulus_final=3e10, beta=0.4, alpha=0.05,
                               terms=((1e-11, 3e-10, 0.02), (5e-12, 0.0, 30.0)))
@@ -72,8 +72,8 @@ def test_batched_steps_equal_single_steps():
 def test_outputs_inside_steps_are_the_answer_at_their_times():
     """An output time inside a step is a side step from the step's start; asking for it
     alone (a run whose last step ends on it) gives the same answer to the time tol."""
-    from core.creep.models import DegenerateKernel
-    from core.time.integration import solve_degenerate
+    from core.creep.kernels import DegenerateKernel
+    from core.time import solve_degenerate
 
     kernel = DegenerateKernel(age_at_loading=28.0, modulus_final=3e10, beta=0.4, alpha=0.05,
                               terms=((1e-11, 3e-10, 0.02), (5e-12, 0.0, 30.0)))

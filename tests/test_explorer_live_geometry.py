@@ -22,7 +22,7 @@ def _app():
 
 
 def test_the_scene_solve_counts_its_validation_in_its_cpu_time() -> None:
-    from core.scene.pipeline import solve
+    from core.scene import solve
 
     info = solve(json.loads(json.dumps(presets()[KEY]))).info
     assert isinstance(info["cpu_seconds"], float) and info["cpu_seconds"] > 0.0

@@ -14,14 +14,10 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 import core.profiles.expressions as ex
-from core.profiles.expressions import (
-    MAX_DEPTH,
-    MAX_LENGTH,
-    MAX_NODES,
-    Expression,
-    ExpressionError,
-    parse_expression,
-)
+from core.profiles import parse_expression
+from core.profiles.expressions import Expression
+from core.profiles.parser import ExpressionError
+from core.profiles.whitelist import MAX_DEPTH, MAX_LENGTH, MAX_NODES
 
 X = np.linspace(-2.0, 2.0, 41)
 

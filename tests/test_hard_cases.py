@@ -32,8 +32,7 @@ import pytest
 
 from benchmarks.scenes import CONCRETE, TEN_LAYERS, jump_m, rough_g, smooth_m, stepped_g
 from core.creep.models import ExponentialCreep
-from core.discretize.basis import build_basis, graded_cuts
-from core.discretize.quadrature import base_panels
+from core.discretize import base_panels, build_basis, graded_cuts
 from core.engines.collocation.solve import solve_collocation
 from core.solver import solve_dimensionless as _solve_dimensionless
 

@@ -97,8 +97,8 @@ def test_the_stage_report_says_what_a_load_change_redid() -> None:
 
 
 def test_a_worker_s_budget_bounds_the_layered_caches_too() -> None:
-    from core.engines.layered.cache import LAYERED_BYTES
     from core.budget import STAGE_CACHE_BYTES, set_stage_cache_budget
+    from core.engines.layered.cache import LAYERED_BYTES
 
     try:
         set_stage_cache_budget(STAGE_CACHE_BYTES // 4)

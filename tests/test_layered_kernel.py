@@ -7,16 +7,10 @@ import mpmath as mp
 import numpy as np
 import pytest
 
-from core.coating.model import layer_compliance
+from core.coating import layer_compliance
 from core.engines.layered.stiffness import flat_punch_stiffness
-from core.kernel.layered import (
-    RegularPartTable,
-    UniformLayer,
-    stack_kernel,
-    stack_kernel_regular,
-    stack_symbol,
-    symbol_at_infinity,
-)
+from core.kernel import RegularPartTable, UniformLayer, symbol_at_infinity
+from core.kernel.layered import stack_kernel, stack_kernel_regular, stack_symbol
 from core.kernel.plane import plane_kernel
 
 BASE = dict(base_thickness=1.0, base_modulus=1.0, base_poisson=0.2)
@@ -183,7 +177,7 @@ def test_regular_part_table_matches_direct_evaluation():
 
 
 def test_flat_punch_converges_and_agrees_with_the_fe_model():
-    from core.coating.fem_check import CoatingStrip, Stack, solve_stack
+    from core.coating import CoatingStrip, Stack, solve_stack
 
     layer = UniformLayer(0.04, 0.05, 0.45, "bonded")
     a = flat_punch_stiffness(1.0, [layer], **BASE, modes=32)
@@ -273,7 +267,7 @@ def test_mixed_stack_recursion_against_one_linear_system(interfaces):
 
 
 def test_coarse_table_for_coarser_tolerances():
-    from core.kernel.layered import COARSE_PANEL_DEGREE
+    from core.kernel import COARSE_PANEL_DEGREE
 
     layers = [UniformLayer(0.01, 0.005, 0.45, "bonded")]
     table = RegularPartTable(2.0, layers, **BASE, degree=COARSE_PANEL_DEGREE)

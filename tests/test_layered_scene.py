@@ -11,7 +11,7 @@ import pytest
 
 from core import solve
 from core.engines.layered.solve import solve_layered
-from core.kernel.layered import UniformLayer
+from core.kernel import UniformLayer
 
 SCENES = Path(__file__).resolve().parent.parent / "assets" / "scenes"
 
@@ -47,7 +47,7 @@ FE_CASES = [
 @pytest.mark.parametrize(("name", "loading", "base_thickness", "interface"), FE_CASES)
 def test_uniform_coating_answer_agrees_with_the_fe_model(name, loading, base_thickness,
                                                          interface):
-    from core.scene.coating_check import check_scene
+    from core.scene import check_scene
 
     d = elastic_scene(name, loading, base_thickness, interface)
     result = solve(d)

@@ -10,7 +10,7 @@ import pytest
 
 import core.discretize.quadrature as quadrature
 from core.cache import cache_report
-from core.scene.pipeline import solve
+from core.scene import solve
 
 LESSON = Path(__file__).resolve().parents[1] / "assets/scenes/eccentric_footing_liftoff.json"
 

@@ -14,7 +14,7 @@ import numpy as np
 
 
 def test_a_complex_pair_of_rounding_size_gives_well_conditioned_modes():
-    from core.problem.statements import modal_system
+    from core.problem import modal_system
 
     rng = np.random.default_rng(7)
     n = 12
@@ -45,7 +45,7 @@ def test_creep_at_loading_equals_the_elastic_answer_from_empty_tables():
     from core.creep.models import ExponentialCreep
     from core.discretize import pair_tables
     from core.engines.nystrom.prepared import PreparedContact
-    from core.problem.inputs import validate_geometry
+    from core.problem import validate_geometry
 
     pair_tables.clear()  # the state in which the pair appeared
     law = ExponentialCreep(modulus=3e10, compliance=3e-11, rate=0.05).dimensionless_kernel(28.0)

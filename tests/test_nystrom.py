@@ -1,4 +1,5 @@
-"""The default engine (direct graded-panel Nystrom, core/engines/nystrom/bordered.py, core/engines/nystrom/prepared.py).
+"""The default engine (direct graded-panel Nystrom, core/engines/nystrom).
+
 
 Accuracy is measured as the engine claims it: q on the whole of [-1, 1] (3001 Chebyshev
 points, both ends and both sides of every jump) relative to max|q|, and delta, alpha, P,
@@ -218,7 +219,7 @@ def test_first_kind_creep_scene_falls_back_to_the_projection():
                                    frozenset({"settlement", "moment"})])
 def test_bordered_solve_on_the_refinement_lu_matches_its_own_lu(given):
     """The 2 x 2 Schur complement on the refinement's LU gives the bordered LU's answer."""
-    from core.engines.nystrom.adapt import adapt
+    from core.engines.nystrom import adapt
     from core.engines.nystrom.bordered import BorderedSystem
 
     adaptive = adapt(1.0, jump_m, stepped_g, False, (-0.5, 0.25, 0.3), 1e-6)
@@ -235,7 +236,7 @@ def test_single_precision_lu_refines_to_the_double_precision_answer():
     too ill-conditioned for single precision is factored again in double precision."""
     from scipy.linalg import lu_factor, lu_solve
 
-    from core.engines.nystrom.adapt import adapt
+    from core.engines.nystrom import adapt
     from core.engines.nystrom.bordered import SINGLE_FROM, NodalLU
 
     grid = adapt(1.0, jump_m, stepped_g, False, (-0.5, 0.25, 0.3), 1e-6).grid
@@ -266,9 +267,9 @@ def test_refined_grid_solved_by_two_grid_matches_its_dense_solve(name):
     solve's; the refined grid itself is factored only when a solve asks for it."""
     from scipy.linalg import lu_factor, lu_solve
 
-    from core.engines.nystrom.adapt import adapt
+    from core.engines.nystrom import adapt
     from core.engines.nystrom.twogrid import DeferredFactor
-    from core.problem.inputs import as_function
+    from core.problem import as_function
 
     s = SCENES[name]
     m, g = as_function(s["m"], "m"), as_function(s["g"], "g")
@@ -295,7 +296,7 @@ def test_operator_at_a_loose_kernel_accuracy_stays_within_it(lam, accuracy):
     far values plus a log, far pairs on the panel pairs above the diagonal), every entry
     is the full-accuracy one to within ``accuracy`` times its weight / pi, at the nodes
     and between them."""
-    from core.discretize.quadrature import Panels, node_rows, operator_rows
+    from core.discretize import Panels, node_rows, operator_rows
     from core.engines.nystrom.adapt import start_edges
 
     panels = Panels.from_edges(start_edges(lam, (0.3,), 0.01, 1e-9, 2.0))
@@ -333,8 +334,7 @@ def test_operator_from_pair_tables_matches_its_own_distances(accuracy):
     tables (ln|z - t_j| of the key, no log per entry); they equal the rows formed from the
     nodes' own distances, on a grid, across a refinement (both ways) and on panels ~4e-11
     wide (where the tables' distances would not do and the nodes' own are taken)."""
-    from core.discretize import pair_tables
-    from core.discretize.quadrature import Panels, node_rows, operator_rows
+    from core.discretize import Panels, node_rows, operator_rows, pair_tables
     from core.engines.nystrom.adapt import grade, start_edges
 
     pair_tables.clear()

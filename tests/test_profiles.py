@@ -15,16 +15,9 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from scipy.interpolate import PchipInterpolator
 
-from core.profiles.build import (
-    INTERPOLATIONS,
-    KINDS,
-    MAX_TABLE_ROWS,
-    Profile,
-    check_range,
-    profile_from_csv,
-    profile_from_spec,
-    profile_key,
-)
+from core.profiles import Profile, check_range, profile_from_csv, profile_from_spec
+from core.profiles.base import INTERPOLATIONS, MAX_TABLE_ROWS, profile_key
+from core.profiles.build import KINDS
 
 D = (-0.15, 0.25)
 LO, HI = D
@@ -201,7 +194,7 @@ def test_profile_key_is_stable_across_processes() -> None:
     spec = {"kind": "table", "points": POINTS, "interpolation": "pchip"}
     key = profile_key(make(spec))
     assert len(key) == 64 and all(c in "0123456789abcdef" for c in key)
-    code = ("from core.profiles.build import profile_from_spec, profile_key; "
+    code = ("from core.profiles import profile_from_spec, profile_key; "
             f"print(profile_key(profile_from_spec({spec!r}, field='f', domain={D!r})))")
     env = dict(os.environ, PYTHONHASHSEED="12345")
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -643,7 +636,8 @@ def test_every_family_of_the_registry_is_listed_and_built() -> None:
 
 
 def test_without_offset_changes_a_profile_by_a_constant_only() -> None:
-    from core.profiles.build import FAMILIES, without_offset
+    from core.profiles import without_offset
+    from core.profiles.build import FAMILIES
 
     for kind, spec in FAMILY_EXAMPLES.items():
         p = profile_from_spec(spec, field="f", variable="x", domain=D)
@@ -658,7 +652,7 @@ def test_without_offset_changes_a_profile_by_a_constant_only() -> None:
 
 
 def test_each_form_of_the_screen_reads_back_what_it_writes() -> None:
-    from core.profiles.build import HISTORY_FORMS, VARIATIONS, history_form_of, variation_of
+    from core.profiles import HISTORY_FORMS, VARIATIONS, history_form_of, variation_of
 
     assert list(VARIATIONS) == ["none", "linear", "step", "patch", "sine", "bump"]
     assert sorted(HISTORY_FORMS) == ["constant", "ramp", "sine", "step"]

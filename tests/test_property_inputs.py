@@ -26,7 +26,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from core.scene.pipeline import parse_scene_json, scene_from_dict, solve
+from core.scene import scene_from_dict, solve
+from core.scene.files import parse_scene_json
 from explorer.controller import SolveController
 from explorer.state import QUANTITIES, STATEMENTS, ExplorerState
 

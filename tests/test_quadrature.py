@@ -6,7 +6,7 @@ import mpmath
 import numpy as np
 import pytest
 
-from core.discretize.quadrature import legendre_log_moments
+from core.kernel import legendre_log_moments
 
 
 @pytest.mark.parametrize("z", [-1.0, 1.0])
@@ -35,7 +35,7 @@ def test_log_moments_match_mpmath(z):
 
 
 def _graded(lam: float, breakpoints: tuple[float, ...], edge: float):
-    from core.discretize.quadrature import base_panels
+    from core.discretize import base_panels
 
     return base_panels(lam, breakpoints, edge_width=edge, max_width=min(0.5, 3.0 / lam),
                        ratio=4.0)
@@ -44,7 +44,7 @@ def _graded(lam: float, breakpoints: tuple[float, ...], edge: float):
 @pytest.mark.parametrize(("lam", "breakpoints"), [(1.0, (0.3,)), (50.0, ()), (0.05, (-0.5,))])
 def test_operator_reused_on_a_refined_grid_equals_a_new_one(lam, breakpoints):
     """Blocks of shared panels are copied, the rest computed: the same matrix exactly."""
-    from core.discretize.quadrature import Panels, kernel_operator
+    from core.discretize import Panels, kernel_operator
     from core.engines.nystrom.adapt import grade
 
     coarse = _graded(lam, breakpoints, 1e-3)
@@ -57,7 +57,7 @@ def test_operator_reused_on_a_refined_grid_equals_a_new_one(lam, breakpoints):
 
 def test_node_rows_from_reference_tables_match_operator_rows():
     """The tables of reference panel pairs give the batched moments' numbers."""
-    from core.discretize.quadrature import Panels, node_rows, operator_rows
+    from core.discretize import Panels, node_rows, operator_rows
     from core.engines.nystrom.adapt import grade
 
     coarse = _graded(1.0, (0.3,), 1e-3)
@@ -74,8 +74,7 @@ def test_operator_does_not_depend_on_what_the_tables_held_before():
     a table's last bits depended on the keys computed with it (Miller's recurrence started
     where the batch's nearest point needed, the product rounded by batch size): the
     operator differed by 1.7e-16, enough for the modal form to meet a complex pair."""
-    from core.discretize import pair_tables
-    from core.discretize.quadrature import Panels, kernel_operator
+    from core.discretize import Panels, kernel_operator, pair_tables
     from core.engines.nystrom.adapt import grade
 
     coarse = _graded(1.0, (), 2e-4)
@@ -93,8 +92,8 @@ def test_operator_does_not_depend_on_what_the_tables_held_before():
 @pytest.mark.parametrize("accuracy", [1e-6, 1e-9, 1e-12])
 def test_kernel_values_meet_the_asked_accuracy(accuracy):
     """The truncated series and the zeros beyond the envelope stay within ``accuracy``."""
+    from core.kernel import kernel_block
     from core.kernel.plane import plane_kernel
-    from core.kernel.values import kernel_block
 
     s = np.linspace(1e-6, 40.0, 400_001)
     error = np.max(np.abs(kernel_block(s.copy(), accuracy) - plane_kernel(s)))

@@ -20,7 +20,7 @@ import pytest
 
 from core import limits
 from core.cli import main
-from core.scene.pipeline import load_scene, save_scene, scene_from_dict
+from core.scene import load_scene, save_scene, scene_from_dict
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "assets" / "scenes"
@@ -158,7 +158,7 @@ class _ExponentialKernel:
 
 
 def _one_mode(load, d: float = 2.0):
-    from core.time.integration import ModalProblem
+    from core.time import ModalProblem
     return ModalProblem(d=lambda t: np.full((1, np.size(t)), d),
                         r=lambda t: np.asarray(load(np.asarray(t, float)), float)[None, :],
                         u=lambda t: np.zeros((0, np.size(t))), coupling=np.zeros((1, 0)))
@@ -183,7 +183,7 @@ def _exact_step_response(times, t_break, d, amplitude, rate, before=1.0, after=3
 
 def test_general_kernel_grid_is_checked_before_it_is_built():
     """5000 output times used to ask for a 20001-point grid (a 3.2 GB matrix)."""
-    from core.time.integration import solve_general
+    from core.time import solve_general
     kernel = _ExponentialKernel(0.5, 1.0)
     times = np.linspace(1.0, 3.0, 5000)
     with pytest.raises(ValueError, match=r"^times: 5000 output times need .* more than "
@@ -195,7 +195,7 @@ def test_general_kernel_grid_is_checked_before_it_is_built():
 def test_general_kernel_grid_stays_within_its_limit():
     """2000 output times: grids of 2001 and 4001 points; the next (8001) is never built,
     and the kernel matrix is evaluated in blocks within the formula budget."""
-    from core.time.integration import solve_general
+    from core.time import solve_general
     kernel = _ExponentialKernel(0.5, 1.0)
     times = np.linspace(1.0, 3.0, 2000)
     sol = solve_general(kernel, _one_mode(lambda t: np.ones_like(t)), times, tol=1e-12)
@@ -209,7 +209,7 @@ def test_general_kernel_grid_stays_within_its_limit():
 
 
 def test_formula_temporaries_are_bounded():
-    from core.profiles.expressions import parse_expression
+    from core.profiles import parse_expression
     expr = parse_expression("t - (tau - (t - (tau - (t - tau))))", ("t", "tau"))
     n = 3000  # 9e6 points times the formula's live arrays: over the budget
     with pytest.raises(ValueError, match="evaluate it in blocks"):
@@ -269,7 +269,7 @@ def _step_load(t):
 
 @pytest.mark.parametrize("tol", [1e-6, 1e-8])
 def test_steps_stop_at_a_jump_of_the_load(tol: float):
-    from core.time.integration import solve_degenerate
+    from core.time import solve_degenerate
     times = np.sort(np.concatenate([np.linspace(1.0, 1.0 + 365 / 28, 40), [_JUMP]]))
     exact = _exact_step_response(times, _JUMP, 2.0, 0.5, _RATE)
     kernel = _ExponentialKernel(0.5, _RATE)
@@ -283,7 +283,7 @@ def test_steps_stop_at_a_jump_of_the_load(tol: float):
 
 
 def test_general_kernel_grid_holds_the_jumps():
-    from core.time.integration import solve_general
+    from core.time import solve_general
     times = np.sort(np.concatenate([np.linspace(1.0, 1.0 + 365 / 28, 40), [_JUMP]]))
     exact = _exact_step_response(times, _JUMP, 2.0, 0.5, _RATE)
     kernel = _ExponentialKernel(0.5, _RATE)
@@ -330,12 +330,12 @@ def test_the_step_limit_is_named_when_it_is_hit(monkeypatch):
 
     import core.engines.nystrom.modal
     import core.engines.projection.levels
-    from core.time.integration import solve_degenerate
+    from core.time import solve_degenerate
     # the projection's time stage and the default engine's
     for engine in (core.engines.projection.levels, core.engines.nystrom.modal):
         monkeypatch.setattr(engine, "solve_degenerate",
                             functools.partial(solve_degenerate, max_steps=40))
-    from core.scene.pipeline import solve
+    from core.scene import solve
     with pytest.raises(ValueError, match=r"^loading\.force: the time stepping could not "
                                          r"follow the loads: .*limit of 40 steps.*vary "
                                          "faster") as info:
@@ -347,7 +347,7 @@ def test_the_step_limit_is_named_when_it_is_hit(monkeypatch):
 
 
 def test_profiles_expose_their_jumps_and_kinks():
-    from core.profiles.build import profile_from_spec
+    from core.profiles import profile_from_spec
 
     def history(spec):
         return profile_from_spec(spec, field="loading.force", variable="t",
@@ -372,7 +372,7 @@ def test_profiles_expose_their_jumps_and_kinks():
 
 def test_a_formula_pole_between_check_samples_names_the_scene_field():
     """Was refused as "m: must be > 0" (the solver's internal name)."""
-    from core.scene.pipeline import solve
+    from core.scene import solve
     d = elastic_dict()
     d["coating"][0]["thickness"] = {"expr": "0.02 + 1e-7/(x - 0.123456789)"}
     scene = scene_from_dict(d)  # the 4097 check samples miss the pole
@@ -384,7 +384,7 @@ def test_a_formula_pole_between_check_samples_names_the_scene_field():
 def test_an_uploaded_shape_table_beyond_the_solver_limit_is_refused_on_upload():
     """A 40-row shape table was accepted by the upload (10,000 rows allowed) and then
     always refused when the scene was built (16 kinks at most in a scene)."""
-    from core.profiles.build import profile_from_csv
+    from core.profiles import profile_from_csv
     rows = "x,f\n" + "".join(f"{-1 + 2 * k / 39:.6f},{1e-4 * (k % 2)}\n" for k in range(40))
     with pytest.raises(ValueError, match=rf"^punch\.shape: a table of 40 rows with 'linear' "
                                          rf".* more than the {limits.MAX_BREAKPOINTS} .*"
@@ -401,7 +401,7 @@ def test_an_uploaded_shape_table_beyond_the_solver_limit_is_refused_on_upload():
 
 
 def test_output_times_and_pressure_points_are_bounded(monkeypatch):
-    from core.scene.pipeline import solve
+    from core.scene import solve
     from core.solver import solve_dimensionless
     times = 1.0 + np.arange(limits.MAX_SOLVER_TIMES + 1) * 1e-3
     with pytest.raises(ValueError, match=rf"^times: at most {limits.MAX_SOLVER_TIMES}"):

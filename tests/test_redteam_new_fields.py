@@ -3,7 +3,7 @@ the field, never another exception, and no work before the check.
 
 Covers ``solver.contact``, ``solver.model_tol``, ``coating[k].interface``, the code creep
 models (``base.creep`` with ``fib_mc2010``/``eurocode2`` and
-:func:`core.creep_coefficient_curve`) and study files (:func:`core.study.definition.study_from_dict`).
+:func:`core.creep_coefficient_curve`) and study files (:func:`core.study.study_from_dict`).
 """
 
 from __future__ import annotations
@@ -16,9 +16,10 @@ from typing import Any
 import pytest
 
 from core import limits
-from core.creep.design_codes import creep_coefficient_curve
-from core.scene.pipeline import scene_from_dict
-from core.study.definition import MAX_STUDY_POINTS, study_from_dict
+from core.creep import creep_coefficient_curve
+from core.scene import scene_from_dict
+from core.study import study_from_dict
+from core.study.definition import MAX_STUDY_POINTS
 from tests.conftest import small_preset_scene
 
 #: Values no number, string or choice field should take without a clear refusal.

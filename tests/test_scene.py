@@ -15,18 +15,18 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
-from core.creep.models import creep_model_from_spec
-from core.scene.pipeline import (
+from core.creep import creep_model_from_spec
+from core.scene import (
     MAX_SCENE_BYTES,
     Scene,
     SceneSolution,
     load_scene,
-    migrate,
     plotting_grid,
     save_scene,
     scene_from_dict,
     solve,
 )
+from core.scene.schema import migrate
 
 SCENES_DIR = Path(__file__).resolve().parent.parent / "assets" / "scenes"
 SCENE_FILES = sorted(SCENES_DIR.glob("*.json"))

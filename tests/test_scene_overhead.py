@@ -9,8 +9,8 @@ import json
 import numpy as np
 import pytest
 
+from core.scene import scene_from_dict, solve
 from core.scene.golden_section import golden_minimum, golden_minimum_batched
-from core.scene.pipeline import scene_from_dict, solve
 from explorer.presets import SCENES_DIR
 
 

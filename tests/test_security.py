@@ -28,17 +28,10 @@ import pytest
 import core.scene.schema as scene_schema
 from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS
 from core.cli import main as cli_main
-from core.profiles.build import profile_from_csv
-from core.scene.pipeline import (
-    MAX_BREAKPOINTS,
-    MAX_SCENE_BYTES,
-    load_scene,
-    migrate,
-    parse_scene_json,
-    save_scene,
-    scene_from_dict,
-    solve,
-)
+from core.profiles import profile_from_csv
+from core.scene import MAX_SCENE_BYTES, load_scene, save_scene, scene_from_dict, solve
+from core.scene.files import parse_scene_json
+from core.scene.schema import MAX_BREAKPOINTS, migrate
 from explorer.links import MAX_JSON, PREFIX, decode_scene, encode_scene
 from tests.browser_pages import require_browser, served_explorer
 from tests.cli_runs import run_cli
@@ -379,7 +372,7 @@ def test_a_process_killed_during_a_save_leaves_the_old_file_intact(tmp_path: Pat
     script = textwrap.dedent(f"""
         import json, os, sys
         sys.path.insert(0, {str(ROOT)!r})
-        from core.scene.pipeline import save_scene
+        from core.scene import save_scene
         scene = json.loads({json.dumps(json.dumps(edited("name", "the new scene")))})
         os.replace = lambda src, dst: os._exit(9)
         save_scene(scene, {str(path)!r})

@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from core.discretize.basis import graded_cuts
-from core.discretize.quadrature import base_panels, kernel_operator, operator_rows
+from core.discretize import base_panels, graded_cuts, kernel_operator, operator_rows
 from core.solver import solve_dimensionless
 
 

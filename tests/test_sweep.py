@@ -13,16 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.scene.pipeline import solve
-from core.study.definition import (
-    MAX_STUDY_POINTS,
-    apply_point,
-    load_study,
-    numeric_fields,
-    parse_path,
-    point_table,
-    study_from_dict,
-)
+from core.scene import solve
+from core.study import load_study, numeric_fields, study_from_dict
+from core.study.definition import MAX_STUDY_POINTS, apply_point, parse_path
+from core.study.points import point_table
 from tests.cli_runs import run_cli
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -211,7 +205,7 @@ def test_fields_a_study_can_vary_and_a_smaller_limit():
 
 
 def test_contact_width_of_a_pressure_linear_in_x():
-    from core.study.run import _contact_width
+    from core.study.batch import _contact_width
 
     x = -np.cos(np.linspace(0, np.pi, 201))  # uneven, like the plotting grid
     q = np.stack([x - 0.5, 1 + 0 * x, -1 - x * 0, 0.3 - x], axis=1)
@@ -220,8 +214,8 @@ def test_contact_width_of_a_pressure_linear_in_x():
 
 
 def test_serial_run_equals_the_loop_and_batches_follow_geometry():
+    from core.study import sweep
     from core.study.plan import BatchPlan
-    from core.study.run import sweep
 
     study = study_from_dict(small_study())
     ds = sweep(study, client="serial", batch_points=4)
@@ -269,7 +263,7 @@ def assert_batched_equal(values, estimate, result, outputs):
 
 
 def sweeps_point_outputs(result, outputs):
-    from core.study.run import point_outputs
+    from core.study.batch import point_outputs
 
     return point_outputs(result, outputs)
 
@@ -279,7 +273,7 @@ def test_load_batch_equals_core_solve_on_a_loads_grid(contact):
     """core.study.loads answers the full-contact points of a force x moment grid at once,
     equal to core.solve point by point; it leaves lift-off (``auto``) and refused points
     alone; with ``full`` contact it answers the points that lose contact, flagged."""
-    from core.scene.pipeline import scene_from_dict
+    from core.scene import scene_from_dict
     from core.study.loads import load_batch_applies, solve_load_batch
 
     base = elastic_scene() | {"times": [1.0, 365.0]}
@@ -317,7 +311,7 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
     each point: every output, estimate, flag and message equals core.solve's on the
     point's whole scene dict, lift-off and refused points included."""
     import core.study.batch as batch
-    import core.study.run as sweeps
+    import core.study.batch as sweeps
 
     study = study_from_dict(small_study(vary=[
         {"field": "loading.force", "values": [-1e5, 1e5, 5e5]},
@@ -348,8 +342,7 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
 
 
 def test_replace_loads_equals_the_validated_dict():
-    from core.scene.pipeline import scene_from_dict
-    from core.scene.validate import replace_loads
+    from core.scene import replace_loads, scene_from_dict
 
     study = study_from_dict(small_study())
     base = scene_from_dict(study.base)
@@ -368,7 +361,7 @@ def test_replace_loads_equals_the_validated_dict():
 
 
 def test_failed_point_is_recorded_and_the_study_goes_on():
-    from core.study.run import sweep
+    from core.study import sweep
 
     spec = small_study(vary=[{"field": "base.poisson", "normal": {"mean": 0.3, "std": 0.15}}],
                        samples=12, seed=3)
@@ -386,7 +379,8 @@ def test_failed_point_is_recorded_and_the_study_goes_on():
 
 
 def test_interrupted_study_resumes_without_recomputing(tmp_path: Path):
-    from core.study.run import StudyInterrupted, sweep
+    from core.study import sweep
+    from core.study.run import StudyInterrupted
 
     study = study_from_dict(small_study())
     work = tmp_path / "parts"
@@ -468,7 +462,7 @@ def loopback_cluster(tmp_path_factory):
 def test_study_on_a_separately_started_cluster_equals_a_serial_loop(loopback_cluster):
     from distributed import Client
 
-    from core.study.run import sweep
+    from core.study import sweep
 
     study = study_from_dict(small_study())
     with Client(loopback_cluster, timeout=60) as client:
@@ -482,7 +476,7 @@ def test_cli_sweep_on_the_cluster_writes_each_format(loopback_cluster, tmp_path:
     import pandas as pd
     import xarray as xr
 
-    from core.study.run import sweep
+    from core.study import sweep
 
     (tmp_path / "study.json").write_text(json.dumps(small_study()))
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
@@ -558,8 +552,8 @@ def test_batch_groups_points_sharing_a_geometry(monkeypatch):
     """Points that differ only in their loads share one validated scene and one load batch
     per geometry; every answer equals core.solve on the point's whole scene dict, and a
     geometry that does not validate leaves its points to report their own messages."""
+    import core.study.batch as sweeps
     import core.study.loads as sweep_loads
-    import core.study.run as sweeps
 
     study = study_from_dict(small_study())
     paths = ["coating[0].modulus", "loading.force", "loading.moment"]
@@ -642,7 +636,7 @@ def test_points_of_one_eccentricity_are_one_answer_scaled(monkeypatch):
 
 
 def test_scaled_answer_flags_a_large_tilt_by_its_own_size():
-    from core.scene.results import LARGE_TILT
+    from core.scene import LARGE_TILT
     from core.study.batch import _scaled
 
     answer = (1e5, np.array([[1.0], [2.0]]), 1e-9, ["contact_lost", "large_tilt"],
@@ -652,7 +646,7 @@ def test_scaled_answer_flags_a_large_tilt_by_its_own_size():
     assert estimate == 1e-9 and flags == "contact_lost,large_tilt"
     assert _scaled(answer, 1e5, ["tilt"])[2] == "contact_lost"
     # a creeping base (the preset as shipped) is not taken as one that scales here
-    from core.scene.pipeline import scene_from_dict
+    from core.scene import scene_from_dict
     from core.study.batch import answers_scale_with_loads
 
     scene = json.loads((SCENES / "uniform_flat.json").read_text())

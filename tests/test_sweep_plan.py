@@ -1,5 +1,5 @@
 """The points and batches of a study made batch by batch from its description
-(core.study.definition.StudyPoints, core.study.plan.BatchPlan): the same points as the whole table,
+(core.study.definition.StudyPoints, core.study.BatchPlan): the same points as the whole table,
 the same order as a sort of all of them where the loads fit a window, bounded memory."""
 
 from __future__ import annotations
@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 import core.study.plan as sweep_plan
-from core.study.definition import DRAW_BLOCK, StudyPoints, point_table, study_from_dict
+from core.study import study_from_dict
 from core.study.plan import BatchPlan
+from core.study.points import DRAW_BLOCK, StudyPoints, point_table
 from tests.test_sweep import elastic_scene, small_study
 
 
@@ -125,7 +126,7 @@ def test_plan_of_a_million_points_holds_no_per_point_array():
 
 def test_parts_written_before_the_order_was_named_resume_when_it_is_the_same(
         tmp_path: Path):
-    from core.study.run import sweep
+    from core.study import sweep
 
     study = study_from_dict(small_study())
     work = tmp_path / "parts"

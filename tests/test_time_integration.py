@@ -11,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from core.creep.models import DegenerateKernel
-from core.time.integration import RADAU_A, RADAU_C, ModalProblem, _radau_step, solve_degenerate
+from core.creep.kernels import DegenerateKernel
+from core.time import ModalProblem, solve_degenerate
+from core.time.radau import RADAU_A, RADAU_C, _radau_step
 
 
 def _reference_step(kernel, problem, t0, h, s_modes, s_known):
@@ -191,7 +192,7 @@ def test_exponential_collocation_in_blocks_of_steps_is_the_same(monkeypatch):
 
 @pytest.mark.parametrize("affine_states", [100, 0])
 def test_grids_marched_in_one_pass_are_marched_apart(monkeypatch, affine_states):
-    """Several grids marched in one pass (:func:`core.time.exponential.march_grids`: the
+    """Several grids marched in one pass (:func:`core.time.march_grids`: the
     states restart at each grid's first step, no neighbour read across grids) give each
     grid's own march, with a jump inside, both ways of marching the modes, and the local
     errors of each grid. Measured identical (the same operations on the same numbers)."""

@@ -1,6 +1,6 @@
 """Measured error of the thin-coating model against the resolved FE model.
 
-The map lives in ``coating_error_table.json`` beside this module, written by ``python -m
+The map lives in ``error_table.json`` beside this module, written by ``python -m
 benchmarks.coating_validity --table`` (do not edit it by hand): signed relative errors
 (fast - FE) / FE of the force per settlement and the moment per tilt, flat punch,
 uniform coating, base Poisson ratio 0.2, FE level 0 (its own error ~2e-4). Axes: sum h /

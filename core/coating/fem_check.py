@@ -36,8 +36,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from core.coating.fem_mesh import (
     COATING_ROWS,
@@ -90,6 +88,9 @@ def solve_stack(stack: Stack, *, level: int = 0, extent: float | None = None) ->
     of the truncated base in half-widths (default ``1 + TRUNCATION_DEPTHS H / a``).
     Returns an :class:`FEResponse` in SI units.
     """
+    # Imported here: scipy.sparse costs ~0.07 s at start-up, which no other path needs.
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
     from skfem import Basis, ElementTriP2, ElementVector, MeshTri, asm
 
     start = time.perf_counter()
@@ -185,6 +186,9 @@ def solve_stack(stack: Stack, *, level: int = 0, extent: float | None = None) ->
 def _recover_pressure(xc: np.ndarray, nodal_forces: np.ndarray) -> np.ndarray:
     """Nodal values of the P2 pressure whose consistent nodal forces are ``nodal_forces``
     (the L2 projection of the contact traction onto the boundary's P2 space)."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
+
     nseg = (xc.size - 1) // 2
     local = np.array([[4.0, 2.0, -1.0], [2.0, 16.0, 2.0], [-1.0, 2.0, 4.0]]) / 30.0
     rows, cols, vals = [], [], []

@@ -14,18 +14,14 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.polynomial import legendre as npleg
 
 from core.contact.step import Step, _bordered_solve, _given_rhs, _Resultants
 from core.contact.systems import StepSolver
-from core.discretize.quadrature import NODES_PER_PANEL, Panels
+from core.discretize import BARYCENTRIC_WEIGHTS, GAUSS_NODES, NODES_PER_PANEL, Panels
 
 #: Sweeps of the nodal active set before it is declared cycling.
 MAX_SWEEPS = 60
 
-_T, _W = npleg.leggauss(NODES_PER_PANEL)
-# Barycentric weights of the Gauss-Legendre nodes: (-1)^j sqrt((1 - t_j^2) w_j).
-_BARYCENTRIC = (-1.0) ** np.arange(NODES_PER_PANEL) * np.sqrt((1.0 - _T**2) * _W)
 
 
 @dataclass
@@ -106,11 +102,11 @@ def _crossing(panels: Panels, values: np.ndarray, i: int) -> float:
 
     def f(xx: float) -> float:
         # barycentric form of the panel's interpolant: O(16), stable (Gauss nodes)
-        d = (xx - c) / h - _T
+        d = (xx - c) / h - GAUSS_NODES
         hit = np.nonzero(d == 0.0)[0]
         if hit.size:
             return float(local[hit[0]])
-        ratio = _BARYCENTRIC / d
+        ratio = BARYCENTRIC_WEIGHTS / d
         return float(ratio @ local / ratio.sum())
 
     # the interpolant takes the nodal values at the nodes

@@ -20,8 +20,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from core.contact.zones import Resolution, Space
-from core.discretize.quadrature import Panels, base_panels
+from core.contact.step import Space
+from core.contact.zones import Resolution
+from core.discretize import Panels, base_panels
 
 #: Widths of the band panels tried in turn (each checked against half of it). With the
 #: kink correction of the ends (core/contact/kinks.py) 0.04 left the preset's ends 3.2e-7

@@ -22,9 +22,10 @@ import numpy as np
 
 from core.contact.bands import BAND_WIDTHS, band_rule, bands_from_ends
 from core.contact.march import march, march_outputs, rule_operator
-from core.contact.zones import ZONE_END_TOL, Resolution, Space, Step
-from core.discretize.quadrature import Panels
-from core.engines.collocation.solve import time_grid
+from core.contact.step import Space, Step
+from core.contact.zones import ZONE_END_TOL, Resolution
+from core.discretize import Panels
+from core.engines.collocation import time_grid
 
 #: Nominal steps of the first time grid over [1, t_end] (every output time is a grid
 #: point; each interval between output times gets whole steps).

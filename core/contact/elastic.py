@@ -1,7 +1,7 @@
 """Lift-off on an elastic base: every output time solved on its own.
 
 At each time the nodal active set (:mod:`core.contact.nodal`) gives the zones to within a
-node, their free ends are then located exactly (:func:`core.contact.zones.refine_zone_ends`),
+node, their free ends are then located exactly (:func:`core.contact.refine_zone_ends`),
 ends pinned at +-1 or a breakpoint are checked to be corners indeed, and the answer is
 checked against the contact conditions on the nodal rule.
 """
@@ -12,20 +12,12 @@ from typing import Any
 
 import numpy as np
 
+from core.contact.active_set import NoContact, zones_from_nodes
 from core.contact.nodal import nodal_operator, nodal_state
 from core.contact.result import _Snapshot
-from core.contact.zones import (
-    ZONE_END_TOL,
-    NoContact,
-    Resolution,
-    Space,
-    Step,
-    nystrom_pressure,
-    refine_zone_ends,
-    zone_kernel_accuracy,
-    zones_from_nodes,
-)
-from core.discretize.quadrature import Panels
+from core.contact.step import Space, Step, nystrom_pressure
+from core.contact.zones import ZONE_END_TOL, Resolution, refine_zone_ends, zone_kernel_accuracy
+from core.discretize import Panels
 
 
 def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],

@@ -12,7 +12,7 @@ interpolant of the nodal ``Q`` cut at its root, ``q = P_Q`` on the contact part.
 integrals there are taken exactly by a Gauss rule of that part alone (with the product
 weights of the log kernel where a node is near), and the difference from the panel's
 rule is a defect of the discrete equation. One solve with the step's kept factors
-(:class:`core.contact.systems.StepSolver`) removes it, and each free end is then the root
+(:class:`core.contact.StepSolver`) removes it, and each free end is then the root
 of that solution's Nystrom pressure evaluated by its formula (the panel interpolant of
 the nodal Q errs near the end, see :func:`corrected_ends`).
 
@@ -31,14 +31,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.contact.active_set import _BARYCENTRIC, _T, NodalState, zones_from_nodes
+from core.contact.active_set import NodalState, zones_from_nodes
 from core.contact.step import Space, Step
 from core.contact.systems import StepSolver, bordered_change, bordered_solve
 from core.contact.zones import ZONE_END_TOL
-from core.discretize.panels import _TO_COEF, _W
-from core.discretize.quadrature import NEAR_FIELD, NODES_PER_PANEL, Panels, _rows
-from core.kernel.log_moments import legendre_log_moments
-from core.kernel.values import FULL_ACCURACY
+from core.discretize import (
+    BARYCENTRIC_WEIGHTS,
+    GAUSS_NODES,
+    GAUSS_WEIGHTS,
+    NEAR_FIELD,
+    NODES_PER_PANEL,
+    VALUES_TO_LEGENDRE,
+    Panels,
+    operator_rows_from_pairs,
+)
+from core.kernel import FULL_ACCURACY, legendre_log_moments
 
 #: Log moments at targets just off a part (1.05 < |z| <= NEAR_FIELD in its coordinate)
 #: by a 64-point Gauss rule: ln|z - t| is analytic within the ellipse through z (rho >=
@@ -53,7 +60,7 @@ def _part_rows(lam: float, part: Panels, targets: np.ndarray,
                owners: tuple[np.ndarray, np.ndarray] | None = None,
                accuracy: float = FULL_ACCURACY) -> np.ndarray:
     """Rows of F (len(targets) x 16 P) on the panels ``part``: as
-    :func:`core.discretize.quadrature.operator_rows`, its near-field moments computed as above.
+    :func:`core.discretize.operator_rows`, its near-field moments computed as above.
     ``owners`` = (one label per target, one per panel): only the rows of a target's own
     panels are exact then (the others are left with the far-field rule, for a caller
     that discards them). ``accuracy``: absolute accuracy of the kernel values."""
@@ -72,20 +79,20 @@ def _part_rows(lam: float, part: Panels, targets: np.ndarray,
         moments[~inner] = (np.log(np.abs(outer[:, None] - _OVER_T[None, :]))
                            * _OVER_W[None, :]) @ _OVER_P
     h = part.half_widths[near_s][:, None]
-    log_weights = h * (np.log(h) * _W[None, :] + moments @ _TO_COEF)
-    return _rows(lam, part, targets, np.arange(part.n_panels), near_t, near_s, log_weights,
-                 accuracy)
+    log_weights = h * (np.log(h) * GAUSS_WEIGHTS[None, :] + moments @ VALUES_TO_LEGENDRE)
+    return operator_rows_from_pairs(lam, part, targets, np.arange(part.n_panels), near_t,
+                                    near_s, log_weights, accuracy)
 
 
 def _interpolation(center: float, half: float, targets: np.ndarray) -> np.ndarray:
     """Rows mapping a panel's 16 nodal values to ``targets`` (its barycentric form)."""
     d = (targets - center) / half
-    diff = d[:, None] - _T[None, :]
-    rows = np.zeros((targets.size, _T.size))
+    diff = d[:, None] - GAUSS_NODES[None, :]
+    rows = np.zeros((targets.size, GAUSS_NODES.size))
     hit = diff == 0.0
     exact = hit.any(axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = _BARYCENTRIC[None, :] / diff
+        ratio = BARYCENTRIC_WEIGHTS[None, :] / diff
     rows[~exact] = ratio[~exact] / ratio[~exact].sum(axis=1, keepdims=True)
     rows[exact] = hit[exact].astype(float)
     return rows
@@ -132,7 +139,7 @@ def corrected_ends(space: Space, step: Step, state: NodalState, op: np.ndarray,
                    solver: StepSolver | None = None) -> list[float]:
     """The zone ends of a step, sorted, two per zone, with the kink defect removed.
 
-    ``state`` from :func:`core.contact.active_set.nodal_active_set` on the rule whose Nystrom
+    ``state`` from :func:`core.contact.nodal_active_set` on the rule whose Nystrom
     matrix is ``op``; ``m``, ``g`` at its nodes; ``memory`` the memory displacement e at
     the nodes and ``memory_density`` the density it is F of (None for an elastic step).
     The contact nodes are kept and the step solved again with the defect; each free end

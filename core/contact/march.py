@@ -26,7 +26,7 @@ from core.contact.memory import pressure_memory
 from core.contact.step import Space, Step
 from core.contact.systems import StepSolver
 from core.contact.zones import zone_kernel_accuracy
-from core.discretize.quadrature import KernelOperator, Panels, kernel_operator
+from core.discretize import KernelOperator, Panels, kernel_operator
 
 #: The operators of the stepping's panel rules, keyed by lam and the panel edges (they
 #: depend on nothing else): a load-only change (the explorer's eccentricity slider) meets

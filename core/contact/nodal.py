@@ -14,7 +14,7 @@ from core.cache import StageCache
 from core.contact.active_set import NoContact, NodalState, nodal_active_set, zones_from_nodes
 from core.contact.step import Space, Step
 from core.contact.zones import Resolution
-from core.discretize.quadrature import Panels, base_panels, kernel_operator
+from core.discretize import Panels, base_panels, kernel_operator
 
 #: The operator of the nodal rule depends on lam and the panels only (not on m, g or the
 #: loads): kept, so that moving a load (the explorer's eccentricity slider) rebuilds only

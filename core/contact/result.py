@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 
 from core.contact.step import Space, Step, nystrom_pressure
-from core.discretize.quadrature import Panels
-from core.kernel.values import FULL_ACCURACY
-from core.problem.result import SolveOutcome
+from core.discretize import Panels
+from core.kernel import FULL_ACCURACY
+from core.problem import SolveOutcome
 
 
 @dataclass(frozen=True)
@@ -88,7 +88,7 @@ class UnilateralSolution(SolveOutcome):
             m_x = np.broadcast_to(np.asarray(self._space.m(xi), dtype=float), xi.shape)
             g_x = np.broadcast_to(np.asarray(self._space.g(xi), dtype=float), xi.shape)
         for times in rules.values():
-            from core.discretize.quadrature import operator_rows
+            from core.discretize import operator_rows
 
             snaps = [self._snapshots[k] for k in times]
             rows = operator_rows(self._space.lam, snaps[0].panels, xi,
@@ -111,7 +111,7 @@ class UnilateralSolution(SolveOutcome):
     def _pressure_one(self, snap: _Snapshot, xi: np.ndarray) -> np.ndarray:
         memory_at = None
         if snap.memory is not None:
-            from core.discretize.quadrature import operator_rows
+            from core.discretize import operator_rows
 
             def memory_at(t, _v=snap.memory, _p=snap.panels):
                 return operator_rows(self._space.lam, _p, t) @ _v

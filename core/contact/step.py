@@ -31,8 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.contact.systems import StepSolver, bordered_solve
-from core.discretize.quadrature import Panels, operator_rows
-from core.kernel.values import FULL_ACCURACY
+from core.discretize import Panels, operator_rows
+from core.kernel import FULL_ACCURACY
 
 
 @dataclass(frozen=True)

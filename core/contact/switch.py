@@ -1,7 +1,7 @@
 """The ``contact=`` switch of :func:`core.solver.solve_dimensionless`.
 
 ``"full"`` answers with the full-contact model (q may come out negative: flag
-``contact_lost``), ``"unilateral"`` with :func:`core.contact.unilateral.solve_unilateral`, ``"auto"``
+``contact_lost``), ``"unilateral"`` with :func:`core.contact.solve_unilateral`, ``"auto"``
 with full contact unless it is lost (then unilateral). :func:`predicted_unilateral` is
 the cheap check that lets ``"auto"`` skip a full-contact solve that would be thrown away.
 """
@@ -42,7 +42,7 @@ def refuse_loads_without_contact(times: Any, kernel: Any, force: Any, moment: An
     ``LOAD_SAMPLES`` times over [1, t_end]. An instant with P = M = 0 (a load taken off)
     carries nothing and passes. Inputs that fail their own checks are left to the solver.
     """
-    from core.problem.inputs import as_function, validate_times
+    from core.problem import as_function, validate_times
 
     if force is None:
         return  # statements with a given settlement or tilt: contact may be absent
@@ -105,8 +105,8 @@ def predicted_unilateral(arguments: dict[str, Any]):
     the unilateral solver's nodal rule cost 3-14 ms on top of it.
     ``arguments`` are those of :func:`solve_unilateral`.
     """
-    from core.engines.nystrom.prepared import solve_with_prepared
-    from core.problem.inputs import validate_time_inputs
+    from core.engines.nystrom import solve_with_prepared
+    from core.problem import validate_time_inputs
 
     loads = {k: arguments.get(k) for k in ("settlement", "tilt", "force", "moment")}
     breakpoints = arguments.get("breakpoints", ())

@@ -27,19 +27,10 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from core.contact.elastic import _solve_elastic
-from core.contact.result import (  # noqa: F401  (importable from here as before)
-    UnilateralSolution,
-    _Snapshot,
-    contact_set_from_pressure,
-)
-from core.contact.zones import (
-    NODAL_PANEL_WIDTH,
-    ZONE_EDGE_WIDTH,
-    ZONE_PANEL_WIDTH,
-    Resolution,
-    Space,
-)
-from core.kernel.values import FULL_ACCURACY
+from core.contact.result import UnilateralSolution
+from core.contact.step import Space
+from core.contact.zones import NODAL_PANEL_WIDTH, ZONE_EDGE_WIDTH, ZONE_PANEL_WIDTH, Resolution
+from core.kernel import FULL_ACCURACY
 
 #: The contact models of ``solve_dimensionless(..., contact=...)``.
 CONTACT_MODELS = ("full", "unilateral", "auto")
@@ -96,7 +87,7 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     Raises ``ValueError`` naming the argument on bad input and naming the load when the
     loads pull the punch away (``force <= 0`` in statement 4 or 3, ``|moment/force| >= 1``).
     """
-    from core.engines.projection.stages import validate_inputs  # one source of truth for the input rules
+    from core.engines.projection import validate_inputs
 
     started = _time.perf_counter()
     if time_steps is not None and (isinstance(time_steps, bool) or not isinstance(

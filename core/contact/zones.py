@@ -15,16 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.contact.active_set import (  # noqa: F401  (importable from here as before)
-    _BARYCENTRIC,
-    _T,
-    MAX_SWEEPS,
-    NoContact,
-    NodalState,
-    nodal_active_set,
-    zones_from_nodes,
-)
-from core.contact.step import (  # noqa: F401  (importable from here as before)
+from core.contact.step import (
     Space,
     Step,
     _bordered_solve,
@@ -32,9 +23,8 @@ from core.contact.step import (  # noqa: F401  (importable from here as before)
     _Resultants,
     nystrom_pressure,
 )
-from core.contact.systems import StepSolver  # noqa: F401  (importable from here as before)
-from core.discretize.quadrature import NODES_PER_PANEL, Panels, base_panels, kernel_operator
-from core.kernel.values import FULL_ACCURACY
+from core.discretize import NODES_PER_PANEL, Panels, base_panels, kernel_operator
+from core.kernel import FULL_ACCURACY
 
 #: Accuracy aimed at for every free zone end [half-widths] (issue 13).
 ZONE_END_TOL = 1e-6

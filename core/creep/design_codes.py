@@ -95,7 +95,7 @@ class CodeCreep:
     ``modulus(age)`` [Pa], ``creep_coefficient(t, t0)`` [-] and ``compliance(t, tau)``
     (the creep function ``C = phi/E_ref`` [1/Pa], ``E_ref`` the 28-day modulus) follow
     the code's equations (:mod:`core.creep.code_formulas`); ``dimensionless_kernel`` is the
-    kernel of the model notes fitted by :func:`core.creep.kernel_fit.fit_compliance` (its
+    kernel of the model notes fitted by :func:`core.creep.fit_compliance` (its
     ``fit_error`` enters the solver's estimate).
     """
 

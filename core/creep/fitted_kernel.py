@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
-from core.creep.models import separable_kernel_value
+from core.creep.kernels import separable_kernel_value
 
 ArrayLike = Any
 

@@ -47,9 +47,7 @@ import numpy as np
 
 from core.creep.design_codes import SPEC_FIELDS as _CODE_SPEC_FIELDS
 from core.creep.design_codes import CodeCreep
-from core.creep.inputs import (  # noqa: F401 (MAX_RATE, MAX_TERMS: re-exported)
-    MAX_RATE,
-    MAX_TERMS,
+from core.creep.inputs import (
     Terms,
     _age_at_loading,
     _check_arutyunyan,
@@ -57,13 +55,7 @@ from core.creep.inputs import (  # noqa: F401 (MAX_RATE, MAX_TERMS: re-exported)
     _check_terms,
     _positive,
 )
-from core.creep.kernels import (  # noqa: F401 (the kernels: re-exported)
-    CausalKernel,
-    DegenerateKernel,
-    RelativeModulus,
-    _set,
-    separable_kernel_value,
-)
+from core.creep.kernels import CausalKernel, DegenerateKernel, RelativeModulus, _set
 from core.validation import show_python
 
 ArrayLike = Any
@@ -403,7 +395,7 @@ def creep_model_from_spec(spec: dict, *, field: str = "base.creep") -> CreepMode
     if not isinstance(text, str) or not text.strip():
         raise ValueError(f"{field}.expr: must be a formula in t and tau, got {show_python(text)}")
     # imported here so that the rest of the module does not depend on the parser
-    from core.profiles.expressions import parse_expression
+    from core.profiles import parse_expression
 
     expression = parse_expression(text, variables=("t", "tau"), field=f"{field}.expr")
     return UserKernel(modulus, expression, expr=text)

@@ -1,1 +1,59 @@
 """core.discretize."""
+
+from __future__ import annotations
+
+from core.discretize.basis import build_basis
+from core.discretize.basis_pieces import Basis
+from core.discretize.galerkin import galerkin_correction
+from core.discretize.graded_basis import graded_cuts
+from core.discretize.panels import (
+    BARYCENTRIC_WEIGHTS,
+    GAUSS_NODES,
+    GAUSS_WEIGHTS,
+    NODES_PER_PANEL,
+    VALUES_TO_LEGENDRE,
+    Panels,
+    base_panels,
+    interpolation_weights,
+    panel_index,
+    panel_legendre_coefficients,
+    refine_to_resolve,
+)
+from core.discretize.quadrature import (
+    FRESH_SHARE,
+    NEAR_FIELD,
+    KernelOperator,
+    kernel_operator,
+    node_rows,
+    operator_rows,
+    operator_rows_from_pairs,
+    panel_nodes,
+    shared_panels,
+)
+
+__all__ = [
+    "BARYCENTRIC_WEIGHTS",
+    "base_panels",
+    "Basis",
+    "build_basis",
+    "FRESH_SHARE",
+    "galerkin_correction",
+    "GAUSS_NODES",
+    "GAUSS_WEIGHTS",
+    "graded_cuts",
+    "interpolation_weights",
+    "kernel_operator",
+    "KernelOperator",
+    "NEAR_FIELD",
+    "node_rows",
+    "NODES_PER_PANEL",
+    "operator_rows",
+    "operator_rows_from_pairs",
+    "panel_index",
+    "panel_legendre_coefficients",
+    "panel_nodes",
+    "Panels",
+    "refine_to_resolve",
+    "shared_panels",
+    "VALUES_TO_LEGENDRE",
+]

@@ -25,7 +25,7 @@ Three bases are offered:
              pressure 2.5e-5 / 4e-8 / 2e-10 at 64 / 128 / 192 functions, against
              8.8e-5 / 7.9e-6 / 1.4e-6 for ``global``). Its functions have kinks at the
              element ends, so the Galerkin form needs
-             :func:`core.discretize.galerkin.galerkin_correction` on panels broken at the ends.
+             :func:`core.discretize.galerkin_correction` on panels broken at the ends.
 
 Functions are ordered so that the first ``n`` of a basis are the best ``n`` to keep
 (degree scaled by the interval length), hence the bases are nested and truncation to
@@ -55,7 +55,7 @@ from core.discretize.graded_basis import (
     graded_basis,
     graded_cuts,
 )
-from core.discretize.quadrature import Panels
+from core.discretize.panels import Panels
 
 __all__ = [
     "AMPLITUDE_POWER", "GRADED_DEPTH", "GRADED_MAX_DEGREE", "GRADED_MAX_LAYERS",

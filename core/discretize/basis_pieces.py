@@ -3,7 +3,8 @@
 Orthonormal polynomials on one interval by the discretized Stieltjes procedure
 (:class:`Recurrence`, :func:`stieltjes`), the :class:`Basis` value that joins them into
 one basis on [-1, 1], and its orthonormality check. The bases themselves are built by
-:mod:`core.discretize.basis` (global and piecewise) and :mod:`core.discretize.graded_basis` (hp-graded).
+:mod:`core.discretize.basis` (global and piecewise) and
+:mod:`core.discretize.graded_basis` (hp-graded).
 """
 
 from __future__ import annotations

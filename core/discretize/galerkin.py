@@ -3,8 +3,8 @@
 The Galerkin form ``int v F u`` is the rule's sum ``sum_i w_i v(x_i) (F u)(x_i)`` of
 :mod:`core.discretize.quadrature`, exact in the inner integral only. :func:`galerkin_correction`
 makes the outer one exact as well for panel-wise polynomials of degree <= 15, which a
-basis with kinks or jumps at panel ends (``"graded"`` in :mod:`core.discretize.basis`) needs; with it
-no panel grading is needed at all. The Nystrom engine does not use it.
+basis with kinks or jumps at panel ends (``"graded"`` in :mod:`core.discretize.basis`)
+needs; with it no panel grading is needed at all. The Nystrom engine does not use it.
 """
 
 from __future__ import annotations
@@ -12,8 +12,14 @@ from __future__ import annotations
 import numpy as np
 from numpy.polynomial import legendre as npleg
 
-from core.discretize.panels import _T, _TO_COEF, _W, NODES_PER_PANEL, Panels
-from core.kernel.log_moments import legendre_log_moments
+from core.discretize.panels import (
+    GAUSS_NODES,
+    GAUSS_WEIGHTS,
+    NODES_PER_PANEL,
+    VALUES_TO_LEGENDRE,
+    Panels,
+)
+from core.kernel import legendre_log_moments
 
 #: Dyadic levels of the outer rule of :func:`galerkin_correction` toward a singular end:
 #: the last piece, 2^-24 of the panel, holds ~1e-17 of an ``s ln s`` integrand.
@@ -33,8 +39,8 @@ def _outer_rule(left: bool, right: bool) -> tuple[np.ndarray, np.ndarray]:
         segments = [(min(p, q), max(p, q)) for p, q in zip(pts[:-1], pts[1:], strict=True)]
     lo = np.array([s[0] for s in segments])
     hi = np.array([s[1] for s in segments])
-    nodes = (0.5 * (lo + hi)[:, None] + 0.5 * (hi - lo)[:, None] * _T[None, :]).ravel()
-    weights = (0.5 * (hi - lo)[:, None] * _W[None, :]).ravel()
+    nodes = (0.5 * (lo + hi)[:, None] + 0.5 * (hi - lo)[:, None] * GAUSS_NODES[None, :]).ravel()
+    weights = (0.5 * (hi - lo)[:, None] * GAUSS_WEIGHTS[None, :]).ravel()
     return nodes, weights
 
 
@@ -77,15 +83,15 @@ def galerkin_correction(panels: Panels, *, reach: float = 1.0) -> np.ndarray:
         inner = h[q, None, None] * moments
         inner[:, :, 0] += (2.0 * h[q] * np.log(h[q]))[:, None]
         exact_coef = h[p, None, None] * np.einsum("ka,pkb->pab", vander[kind], inner)
-        exact = np.einsum("ai,pab,bj->pij", _TO_COEF, exact_coef, _TO_COEF)
+        exact = np.einsum("ai,pab,bj->pij", VALUES_TO_LEGENDRE, exact_coef, VALUES_TO_LEGENDRE)
         # What diag(w) F holds there: the target panel's Gauss rule times the exact inner
         # integral (log_product_weights, batched over the pairs).
         x_t = panels.nodes.reshape(-1, NODES_PER_PANEL)[p]
         z_t = (x_t - c[q, None]) / h[q, None]
         m_t = legendre_log_moments(z_t.ravel(), NODES_PER_PANEL - 1).reshape(
             len(p), NODES_PER_PANEL, NODES_PER_PANEL)
-        inner_t = h[q, None, None] * (np.log(h[q])[:, None, None] * _W[None, None, :]
-                                      + m_t @ _TO_COEF)
+        inner_t = h[q, None, None] * (np.log(h[q])[:, None, None] * GAUSS_WEIGHTS[None, None, :]
+                                      + m_t @ VALUES_TO_LEGENDRE)
         approx = panels.weights.reshape(-1, NODES_PER_PANEL)[p][:, :, None] * inner_t
         block = -(exact - approx) / np.pi
         for k in range(len(p)):

@@ -1,4 +1,4 @@
-"""The hp-graded basis (``kind="graded"`` of :func:`core.discretize.basis.build_basis`).
+"""The hp-graded basis (``kind="graded"`` of :func:`core.discretize.build_basis`).
 
 Continuous piecewise polynomials on a mesh graded geometrically toward +-1 and every
 breakpoint (:func:`graded_cuts`), with degrees growing away from them; the candidate
@@ -15,7 +15,7 @@ import numpy as np
 from numpy.polynomial import legendre as npleg
 
 from core.discretize.basis_pieces import Basis, Recurrence, orthonormality_error, stieltjes
-from core.discretize.quadrature import Panels
+from core.discretize.panels import Panels
 
 #: Ratio of consecutive element widths toward a singular point (hp-FEM's sigma). The
 #: classic 0.15-0.2 minimizes the count for the energy norm; the interior pressure needs

@@ -6,7 +6,7 @@ few such pairs recur. Each pair's key (ratio, offset), rounded to 1e-12, has tab
 the source panel's coordinate (z the target nodes there, t_j and W_j the Gauss rule):
 
 * ``near`` (16,): the target nodes within NEAR_FIELD of the source centre;
-* ``reference`` (16, 16): the product weights ``R = M(z) @ _TO_COEF`` of ln|z - t|;
+* ``reference`` (16, 16): the product weights ``R = M(z) @ VALUES_TO_LEGENDRE`` of ln|z - t|;
 * ``correction`` (16, 16): ``W_j ln|z_i - t_j| - R`` (``-R`` on a node, z_i = t_j);
 * ``slope`` (16, 16): ``W_j / (z_i - t_j)`` (0 on a node) and ``steepest`` (16,): the
   largest ``1 / |z_i - t_j|`` of each target node (nodes excepted).
@@ -27,9 +27,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.discretize.panels import _T, _TO_COEF, _W, NODES_PER_PANEL, Panels
-from core.kernel.log_moments import legendre_log_moments
-from core.kernel.values import kernel_regular
+from core.discretize.panels import (
+    GAUSS_NODES,
+    GAUSS_WEIGHTS,
+    NODES_PER_PANEL,
+    VALUES_TO_LEGENDRE,
+    Panels,
+)
+from core.kernel import kernel_regular, legendre_log_moments
 
 #: Keys kept; the store is emptied when a new one would pass it (4096 keys hold ~25 MB).
 MAX_KEYS = 4096
@@ -85,18 +90,18 @@ def stored() -> PairTables:
 def tables_of(keys: np.ndarray, near_field: float) -> tuple[np.ndarray, ...]:
     """The tables of (ratio, offset) keys (K, 2): near, reference, correction, slope,
     steepest (each with a leading K axis)."""
-    z = keys[:, 1:] + keys[:, :1] * _T[None, :]  # (K, 16)
+    z = keys[:, 1:] + keys[:, :1] * GAUSS_NODES[None, :]  # (K, 16)
     # Each table a function of its key alone, not of the keys missing with it (else the
     # operator's last bits depend on what earlier solves cached): moments with Miller's
     # recurrence from each point's own start, and one 16 x 16 product per key (a product
     # of all rows at once rounds a row differently by batch size).
     moments = legendre_log_moments(z.ravel(), NODES_PER_PANEL - 1, own_start=True)
-    moments = moments.reshape(len(keys), NODES_PER_PANEL, NODES_PER_PANEL) @ _TO_COEF
-    apart = z[:, :, None] - _T[None, None, :]
+    moments = moments.reshape(len(keys), NODES_PER_PANEL, NODES_PER_PANEL) @ VALUES_TO_LEGENDRE
+    apart = z[:, :, None] - GAUSS_NODES[None, None, :]
     on_node = apart == 0.0
     apart[on_node] = 1.0
-    correction = np.where(on_node, 0.0, _W * np.log(np.abs(apart))) - moments
-    slope = np.where(on_node, 0.0, _W / apart)
+    correction = np.where(on_node, 0.0, GAUSS_WEIGHTS * np.log(np.abs(apart))) - moments
+    slope = np.where(on_node, 0.0, GAUSS_WEIGHTS / apart)
     return (np.abs(z) <= near_field, moments, correction, slope,
             np.max(np.where(on_node, 0.0, 1.0 / np.abs(apart)), axis=2))
 
@@ -155,7 +160,7 @@ def add_near(rows: np.ndarray, lam: float, panels: Panels, targets: np.ndarray,
              accuracy: float) -> None:
     """The near entries of operator rows at panel nodes, at a loose kernel accuracy, in
     place: ``rows`` (targets x 16 len(sources)) holds the far values everywhere (kernel
-    values to ``accuracy``, :func:`core.kernel.values.kernel_block`); the near entries add
+    values to ``accuracy``, :func:`core.kernel.kernel_block`); the near entries add
     ``h/pi (W_j ln|z - t_j| - R)`` from the tables (the log of each entry's distance and
     the product weights cancel ``ln h``; no log is taken per entry).
 
@@ -205,12 +210,12 @@ def _exact_near(lam: float, panels: Panels, targets: np.ndarray, sources: np.nda
                 reference: np.ndarray, by_pair: np.ndarray, near_t: np.ndarray,
                 near_s: np.ndarray, h: np.ndarray, accuracy: float) -> None:
     """Near rows of :func:`add_near` from their own distances (as
-    :func:`core.discretize.quadrature.operator_rows` does), written into ``by_pair`` (targets,
+    :func:`core.discretize.operator_rows` does), written into ``by_pair`` (targets,
     sources, 16) in place; ``reference``: their rows of the tables' product weights."""
     src = sources[near_s][:, None] * NODES_PER_PANEL + np.arange(NODES_PER_PANEL)[None, :]
     offset = np.abs(targets[near_t][:, None] - panels.nodes[src])
     weights = panels.weights[src] / np.pi
-    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + reference)
+    log_weights = h[:, None] * (np.log(h)[:, None] * GAUSS_WEIGHTS[None, :] + reference)
     near = near_from_far(by_pair[near_t, near_s], offset, weights, lam, accuracy)
     by_pair[near_t, near_s] = near - log_weights / np.pi
 

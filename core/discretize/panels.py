@@ -17,12 +17,16 @@ import numpy as np
 from numpy.polynomial import legendre as npleg
 
 NODES_PER_PANEL = 16
-_T, _W = npleg.leggauss(NODES_PER_PANEL)
-# Values P_n(t_j), n < 16, and the interpolation matrix nodes -> Legendre coefficients.
-_P = npleg.legvander(_T, NODES_PER_PANEL - 1)  # (16 nodes, 16 degrees)
-_TO_COEF = (_P * _W[:, None]).T * (np.arange(NODES_PER_PANEL) + 0.5)[:, None]  # (deg, node)
+#: Gauss-Legendre nodes and weights of one panel's rule on [-1, 1].
+GAUSS_NODES, GAUSS_WEIGHTS = npleg.leggauss(NODES_PER_PANEL)
+# Values P_n(t_j), n < 16, of the Legendre polynomials at the nodes.
+_P = npleg.legvander(GAUSS_NODES, NODES_PER_PANEL - 1)  # (16 nodes, 16 degrees)
+#: The matrix from values at the nodes to Legendre coefficients, shape (degree, node).
+VALUES_TO_LEGENDRE = ((_P * GAUSS_WEIGHTS[:, None]).T
+                      * (np.arange(NODES_PER_PANEL) + 0.5)[:, None])
 #: Barycentric weights of the Gauss-Legendre nodes: (-1)^j sqrt((1 - t_j^2) w_j).
-_BARYCENTRIC = (-1.0) ** np.arange(NODES_PER_PANEL) * np.sqrt((1.0 - _T**2) * _W)
+BARYCENTRIC_WEIGHTS = ((-1.0) ** np.arange(NODES_PER_PANEL)
+                       * np.sqrt((1.0 - GAUSS_NODES**2) * GAUSS_WEIGHTS))
 
 
 @dataclass(frozen=True)
@@ -52,8 +56,8 @@ class Panels:
         edges = np.asarray(edges, dtype=float)
         centers = 0.5 * (edges[1:] + edges[:-1])
         half = 0.5 * (edges[1:] - edges[:-1])
-        nodes = (centers[:, None] + half[:, None] * _T[None, :]).ravel()
-        weights = (half[:, None] * _W[None, :]).ravel()
+        nodes = (centers[:, None] + half[:, None] * GAUSS_NODES[None, :]).ravel()
+        weights = (half[:, None] * GAUSS_WEIGHTS[None, :]).ravel()
         return cls(edges, nodes, weights, centers, half)
 
     def integrate(self, values: np.ndarray) -> np.ndarray:
@@ -108,7 +112,7 @@ def base_panels(lam: float, breakpoints: Sequence[float] = (), *,
     piecewise basis, see :func:`core.discretize.basis.graded_cuts`). Basis functions have kinks or
     jumps there, hence ``F(p/m)`` has ``(x - c)^k ln|x - c|`` terms that the plain Gauss
     rule integrates poorly on the neighbouring panels. Either correct the Galerkin form by
-    :func:`core.discretize.galerkin.galerkin_correction` (exact at every panel end: then no grading is
+    :func:`core.discretize.galerkin_correction` (exact at every panel end: then no grading is
     needed at all, ``edge_width=None``), or grade the panels toward soft cuts to ``soft_width``
     (measured: ~1e-3 absolute was needed, tripling the node count). Between cuts, grading
     toward ``+-1`` or a breakpoint only happens on intervals wider than ``8 edge_width``: a
@@ -169,7 +173,7 @@ def refine_to_resolve(panels: Panels, functions: Sequence[Callable[[np.ndarray],
         for f in functions:
             values = np.asarray(f(current.nodes), dtype=float).reshape(current.n_panels, -1)
             scale = float(np.max(np.abs(values))) or 1.0
-            coef = values @ _TO_COEF.T  # (panels, degrees)
+            coef = values @ VALUES_TO_LEGENDRE.T  # (panels, degrees)
             tail = np.max(np.abs(coef[:, -3:]), axis=1)
             bad |= tail > rel_tol * scale
         bad &= 2 * current.half_widths > 2 * min_width
@@ -190,7 +194,7 @@ def panel_legendre_coefficients(values: np.ndarray) -> np.ndarray:
     """
     values = np.asarray(values, dtype=float)
     per_panel = values.reshape((-1, NODES_PER_PANEL) + values.shape[1:])
-    return np.einsum("kj,pj...->pk...", _TO_COEF, per_panel)
+    return np.einsum("kj,pj...->pk...", VALUES_TO_LEGENDRE, per_panel)
 
 
 def panel_index(panels: Panels, x: np.ndarray) -> np.ndarray:
@@ -213,10 +217,10 @@ def interpolation_weights(panels: Panels, x: np.ndarray) -> tuple[np.ndarray, np
     t = (x - panels.centers[index]) / panels.half_widths[index]
     # Barycentric form (stable on Gauss-Legendre nodes; 3-4x cheaper than the Legendre
     # Vandermonde times the coefficient map, the same weights to ~1e-15).
-    difference = t[:, None] - _T[None, :]
+    difference = t[:, None] - GAUSS_NODES[None, :]
     on_node = difference == 0.0
     with np.errstate(divide="ignore", invalid="ignore"):
-        terms = _BARYCENTRIC[None, :] / difference
+        terms = BARYCENTRIC_WEIGHTS[None, :] / difference
     hit = on_node.any(axis=1)
     if hit.any():
         terms[hit] = on_node[hit]

@@ -26,7 +26,7 @@ re-exported here.
 
 The Galerkin form ``int v F u`` of the projection method is the rule's sum
 ``sum_i w_i v(x_i) (F u)(x_i)``, exact in the inner integral only;
-:func:`core.discretize.galerkin.galerkin_correction` makes the outer one exact as well.
+:func:`core.discretize.galerkin_correction` makes the outer one exact as well.
 """
 
 from __future__ import annotations
@@ -37,19 +37,18 @@ from functools import lru_cache
 import numpy as np
 
 from core.discretize import pair_tables
-from core.discretize.panels import (  # re-exported: the grid is part of this module's interface
-    _T,
-    _TO_COEF,
-    _W,
+from core.discretize.panels import (
+    GAUSS_NODES,
+    GAUSS_WEIGHTS,
     NODES_PER_PANEL,
+    VALUES_TO_LEGENDRE,
     Panels,
     base_panels,
     interpolation_weights,
     panel_legendre_coefficients,
     refine_to_resolve,
 )
-from core.kernel.log_moments import legendre_log_moments
-from core.kernel.values import FULL_ACCURACY, kernel_block, kernel_regular
+from core.kernel import FULL_ACCURACY, kernel_block, kernel_regular, legendre_log_moments
 
 __all__ = ["NODES_PER_PANEL", "NEAR_FIELD", "Panels", "KernelOperator", "base_panels",
            "refine_to_resolve", "log_product_weights", "operator_rows", "node_rows",
@@ -73,7 +72,7 @@ def log_product_weights(center: float, half_width: float, targets: np.ndarray) -
     z = (np.asarray(targets, dtype=float) - center) / half_width
     moments = legendre_log_moments(z, NODES_PER_PANEL - 1)  # (targets, deg)
     # On a node itself (z = t_j) the forward recurrence is exact; no special case needed.
-    return half_width * (np.log(half_width) * _W[None, :] + moments @ _TO_COEF)
+    return half_width * (np.log(half_width) * GAUSS_WEIGHTS[None, :] + moments @ VALUES_TO_LEGENDRE)
 
 
 @dataclass(frozen=True)
@@ -101,7 +100,7 @@ def _near_pairs(panels: Panels, targets: np.ndarray, sources: np.ndarray
 
 
 #: Absolute error of the log moments per unit of kernel accuracy: an error d in the
-#: moments moves an operator entry by at most h d max_j sum_n |_TO_COEF[n, j]| / pi
+#: moments moves an operator entry by at most h d max_j sum_n |VALUES_TO_LEGENDRE[n, j]| / pi
 #: (= 4.33 h d / pi), the kernel's accuracy e by e h W_j / pi >= 0.027 e h / pi; this keeps
 #: the first at a third of the second (0.017 / 3).
 _MOMENT_SHARE = 0.017 / 3
@@ -117,7 +116,7 @@ def _log_weights(panels: Panels, targets: np.ndarray, near_t: np.ndarray,
     c, h = panels.centers[near_p], panels.half_widths[near_p]
     moments = legendre_log_moments((targets[near_t] - c) / h, NODES_PER_PANEL - 1,
                                    _MOMENT_SHARE * accuracy)
-    return h[:, None] * (np.log(h)[:, None] * _W[None, :] + moments @ _TO_COEF)
+    return h[:, None] * (np.log(h)[:, None] * GAUSS_WEIGHTS[None, :] + moments @ VALUES_TO_LEGENDRE)
 
 
 #: Target rows per block of :func:`operator_rows`: rows x nodes about this many entries,
@@ -142,7 +141,8 @@ def operator_rows(lam: float, panels: Panels, targets: np.ndarray,
                else np.asarray(sources, dtype=np.intp))
     near_t, near_s = _near_pairs(panels, targets, sources)
     log_weights = _log_weights(panels, targets, near_t, sources[near_s], accuracy)
-    return _rows(lam, panels, targets, sources, near_t, near_s, log_weights, accuracy)
+    return operator_rows_from_pairs(lam, panels, targets, sources, near_t, near_s, log_weights,
+                                    accuracy)
 
 
 def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: np.ndarray,
@@ -166,8 +166,8 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
     pair_t, pair_s = np.nonzero(np.abs(tc[:, None] - sc[None, :])
                                 <= NEAR_FIELD * sh[None, :] + th[:, None])
     if not pair_t.size:
-        return _rows(lam, panels, targets, sources, pair_t, pair_s, np.empty((0, 16)),
-                     accuracy)
+        return operator_rows_from_pairs(lam, panels, targets, sources, pair_t, pair_s,
+                                        np.empty((0, 16)), accuracy)
     raw_ratio = th[pair_t] / sh[pair_s]
     raw_offset = (tc[pair_t] - sc[pair_s]) / sh[pair_s]
     ratio, offset = np.round(raw_ratio, 12), np.round(raw_offset, 12)
@@ -182,27 +182,28 @@ def node_rows(lam: float, panels: Panels, target_panels: Panels, target_index: n
     near_t = pair_t[which] * NODES_PER_PANEL + node
     if accuracy > FULL_ACCURACY:
         # the far values everywhere, then the near entries from the tables
-        rows = _rows(lam, panels, targets, sources, near_t[:0], near_t[:0],
+        rows = operator_rows_from_pairs(lam, panels, targets, sources, near_t[:0], near_t[:0],
                      np.empty((0, NODES_PER_PANEL)), accuracy)
         pair_tables.add_near(rows, lam, panels, targets, sources, store,
                              own=(unique == 1.0)[inverse[which]], u=u, node=node,
                              near_t=near_t, near_s=pair_s[which],
                              shift=(raw_offset - offset)[which]
-                             + (raw_ratio - ratio)[which] * _T[node], accuracy=accuracy)
+                             + (raw_ratio - ratio)[which] * GAUSS_NODES[node], accuracy=accuracy)
         return rows
     h = sh[pair_s[which]]
-    log_weights = h[:, None] * (np.log(h)[:, None] * _W[None, :] + store.reference[u, node])
-    return _rows(lam, panels, targets, sources, near_t, pair_s[which], log_weights,
-                 accuracy)
+    log_weights = h[:, None] * (np.log(h)[:, None] * GAUSS_WEIGHTS[None, :]
+                                + store.reference[u, node])
+    return operator_rows_from_pairs(lam, panels, targets, sources, near_t, pair_s[which],
+                                    log_weights, accuracy)
 
 
-def _rows(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
+def operator_rows_from_pairs(lam: float, panels: Panels, targets: np.ndarray, sources: np.ndarray,
           near_t: np.ndarray, near_s: np.ndarray, log_weights: np.ndarray,
           accuracy: float = FULL_ACCURACY) -> np.ndarray:
     """Operator rows given the near (target, source position) pairs and their log weights.
 
     ``accuracy``: absolute accuracy of the kernel values (see
-    :func:`core.kernel.values.kernel_block`).
+    :func:`core.kernel.kernel_block`).
     """
     cols_all = (sources[:, None] * NODES_PER_PANEL + _J[None, :]).ravel()
     nodes = panels.nodes[cols_all]

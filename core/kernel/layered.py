@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from core.coating.model import INTERFACES
+from core.coating import INTERFACES
 
 __all__ = ["COARSE_PANEL_DEGREE", "RegularPartTable", "UniformLayer", "stack_kernel",
            "stack_kernel_regular", "stack_symbol", "symbol_at_infinity", "table_cost"]
@@ -261,7 +261,7 @@ def stack_kernel(s: ArrayLike, layers: Sequence[UniformLayer], base_thickness: f
 
 #: Chebyshev degree of the interpolant of the regular part on each panel of s: 24 leaves
 #: ~1e-14 relative (tests/test_layered_kernel.py), what a solve to tol 1e-12 needs.
-_PANEL_DEGREE = 24
+PANEL_DEGREE = 24
 #: The degree a solve to a tol of 1e-7 or above takes (:mod:`core.engines.layered.solve`): measured
 #: against direct evaluation on 4,000 values of s for four stacks (h_min / H = 0.004 to
 #: 0.2, E_c / E = 0.005 to 30, a / H up to 10): <= 1.1e-10 (the table's values are O(1) to
@@ -298,7 +298,7 @@ def table_cost(largest_s: float, layers: Sequence[UniformLayer],
         low = 0.25 * top if top > 8.0 * thinnest else -1.0
         band = remaining & (tops > low)
         remaining &= ~band
-        count = np.count_nonzero(band) * (_PANEL_DEGREE + 1)
+        count = np.count_nonzero(band) * (PANEL_DEGREE + 1)
         cost += count * _u_rule(layers, base_thickness, top)[0].size
         top = low
 
@@ -310,13 +310,13 @@ class RegularPartTable:
 
     Panels of s: ``[0, h_min / 2H]``, then doubling up to :data:`_PANEL_WIDTH` (the part
     varies on the coating's scale near 0 and on the base's beyond), each with a Chebyshev
-    interpolant of degree ``degree`` (:data:`_PANEL_DEGREE`, or
+    interpolant of degree ``degree`` (:data:`PANEL_DEGREE`, or
     :data:`COARSE_PANEL_DEGREE` for a coarser tolerance) of :func:`stack_kernel_regular`.
     """
 
     def __init__(self, largest_s: float, layers: Sequence[UniformLayer],
                  base_thickness: float, base_modulus: float, base_poisson: float, *,
-                 degree: int = _PANEL_DEGREE) -> None:
+                 degree: int = PANEL_DEGREE) -> None:
         self.edges = _table_edges(largest_s, layers, base_thickness)
         self.degree = int(degree)
         n = self.degree + 1

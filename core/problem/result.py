@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from core.discretize.basis import Basis
+from core.discretize import Basis
 
 
 class SolveOutcome:

@@ -19,7 +19,8 @@ import numpy as np
 
 from core import limits
 from core.immutable import Immutable
-from core.profiles.expressions import ALIASES, CONSTANTS, FUNCTIONS, Expression
+from core.profiles.expressions import Expression
+from core.profiles.whitelist import ALIASES, CONSTANTS, FUNCTIONS
 
 #: Most rows of a table (and most breaks of a step profile).
 MAX_TABLE_ROWS = limits.MAX_TABLE_ROWS
@@ -190,7 +191,7 @@ class Profile(Immutable):
         "pchip"), the switches of a formula.
 
         For a load history these are the times the time stepper must land on exactly
-        (``breaks`` of :func:`core.time.integration.solve_degenerate`): a step across a
+        (``breaks`` of :func:`core.time.solve_degenerate`): a step across a
         jump loses the method's order and fools its error estimate.
         """
         low = self._domain[0] if lo is None else float(lo)
@@ -251,7 +252,7 @@ class Profile(Immutable):
 
 
 def _rebuild(spec: Spec, variable: str, domain: tuple[float, float]) -> Profile:
-    from core.profiles.build import profile_from_spec  # the registry builds on this module
+    from core.profiles.build import profile_from_spec
 
     return profile_from_spec(spec, field="profile", variable=variable, domain=domain)
 

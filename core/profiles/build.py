@@ -58,12 +58,7 @@ from typing import Any
 import numpy as np
 
 from core.profiles import forms
-from core.profiles.base import (  # noqa: F401 (re-exported: core.profiles.build is the public path)
-    FORMULA_BREAK_SAMPLES,
-    INTERPOLATIONS,
-    MAX_POLYNOMIAL_COEFFICIENTS,
-    MAX_TABLE_BYTES,
-    MAX_TABLE_ROWS,
+from core.profiles.base import (
     RANGE_SAMPLES,
     Profile,
     Spec,
@@ -73,7 +68,6 @@ from core.profiles.base import (  # noqa: F401 (re-exported: core.profiles.build
     _fmt,
     _json_type,
     _number,
-    profile_key,
 )
 from core.profiles.families import (
     _At,

@@ -49,13 +49,7 @@ import numpy as np
 
 from core import limits
 from core.immutable import Immutable
-from core.profiles.parser import (
-    NAME_CHARS,
-    NAME_START,
-    ExpressionError,
-    Instruction,
-    read_formula,
-)
+from core.profiles.parser import NAME_CHARS, NAME_START, ExpressionError, Instruction, read_formula
 from core.profiles.whitelist import (
     ALIASES,
     CONSTANTS,

@@ -1,10 +1,10 @@
 """The builders of the profile families, and the constant part each one separates.
 
 One ``_build_<kind>`` per family reads a spec's fields at a place :class:`_At` (field
-path, variable, domain) and returns the validated :class:`~core.profiles.base.Profile`
+path, variable, domain) and returns the validated :class:`~core.profiles.Profile`
 with its canonical spec, breakpoints and known extremes; one ``_offset_<kind>`` gives
 the canonical spec less its exactly separable constant part. The registry that joins
-them, :data:`core.profiles.build.FAMILIES`, and the public entry points are in
+them, :data:`core.profiles.FAMILIES`, and the public entry points are in
 :mod:`core.profiles.build`.
 """
 

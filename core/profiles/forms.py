@@ -5,8 +5,8 @@ A function of ``x`` is shown as a ``level`` and a variation about it of size
 form has them; a load history as a ``value``, a ``second`` value and a ``time`` [days].
 Values are in the unit of the quantity. Each form builds the canonical spec from its
 numbers and reads them back from a spec of its own form. Which forms show which family
-is part of the registry of families (:data:`core.profiles.build.FAMILIES`); nothing here
-validates a spec (:func:`core.profiles.build.profile_from_spec` does).
+is part of the registry of families (:data:`core.profiles.FAMILIES`); nothing here
+validates a spec (:func:`core.profiles.profile_from_spec` does).
 """
 
 from __future__ import annotations

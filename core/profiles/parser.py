@@ -4,7 +4,7 @@ Reads a formula's text, one token at a time in a single linear pass, into a
 :class:`FormulaNode`: its normal form, the stack program that evaluates it, its folded
 value when it has no variables, and the arguments of its switching functions. The grammar
 and the rules of the normal form are in :mod:`core.profiles.expressions`, which builds the public
-:class:`~core.profiles.expressions.Expression` from the node; the whitelist is
+:class:`~core.profiles.Expression` from the node; the whitelist is
 :mod:`core.profiles.whitelist`.
 """
 

@@ -1,5 +1,5 @@
 """Profiles from uploaded CSV files: two numeric columns read strictly into a ``table``
-profile (:func:`core.profiles.build.profile_from_spec`), with limits on size, rows and jumps.
+profile (:func:`core.profiles.profile_from_spec`), with limits on size, rows and jumps.
 
 ``from core.profiles.build import profile_from_csv`` stays the public path.
 """
@@ -114,7 +114,7 @@ def profile_from_csv(data: bytes | str, *, field: str, variable: str = "x",
             raise ValueError(f"{field}: {variable} values must be strictly increasing "
                              f"(line {n}: {_fmt(row[0])} after {_fmt(points[-1][0])})")
         points.append(row)
-    from core.profiles.build import profile_from_spec  # the registry (it loads this module)
+    from core.profiles.build import profile_from_spec
 
     profile = profile_from_spec({"kind": "table", "points": points,
                                  "interpolation": interpolation},

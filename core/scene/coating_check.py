@@ -17,10 +17,13 @@ from typing import Any
 
 import numpy as np
 
-from core.coating.fem_check import CoatingStrip, Stack, solve_stack
-from core.coating.model import NEGLIGIBLE_SHARE
-from core.engines.layered.answer import layered_declines
-from core.scene.pipeline import QUANTITIES, Scene, SceneSolution, scene_from_dict, solve
+from core.coating import NEGLIGIBLE_SHARE, CoatingStrip, Stack, solve_stack
+from core.engines.layered import layered_declines
+from core.problem import QUANTITIES
+from core.scene.model import Scene
+from core.scene.pipeline import solve
+from core.scene.results import SceneSolution
+from core.scene.validate import scene_from_dict
 
 #: Pressure errors are measured on |x| <= this fraction of a (the edge singularities of
 #: both answers are not comparable pointwise).
@@ -59,7 +62,7 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
     """Model error of the fast answer against the resolved FE model at one time.
 
     ``time`` [days after loading] picks the base modulus and the given loads; ``level`` is
-    the FE mesh level (:func:`core.coating.fem_check.solve_stack`: 0 gives P to ~2e-4). Returns
+    the FE mesh level (:func:`core.coating.solve_stack`: 0 gives P to ~2e-4). Returns
     ``{"fast": {...}, "fe": {...}}`` (settlement [m], tilt [rad], force [N/m], moment [N]),
     ``"errors"``: signed relative errors of the four against the FE answer (each relative to
     its own FE value, or to 1e-3 of its pair's scale ``max(|delta|, a |alpha|)``, ``max(|P|,

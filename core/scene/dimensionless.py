@@ -1,4 +1,4 @@
-"""The dimensionless problem of a scene: the conversion of a :class:`core.scene.pipeline.Scene`
+"""The dimensionless problem of a scene: the conversion of a :class:`core.scene.Scene`
 to the arguments of :func:`core.solver.solve_dimensionless` (model notes, "Dimensionless
 problem"), and the reference values that convert the answer back.
 
@@ -26,13 +26,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.cache import StageCache, fingerprint
-from core.profiles.build import Profile
-from core.scene.model import _values
+from core.profiles import Profile
+from core.scene.model import profile_values
 from core.validation import refuse_first
 
 if TYPE_CHECKING:
+    from core.problem import ContactSolution
     from core.scene.model import Scene
-    from core.solver import ContactSolution
 
 
 #: Values of ``m*`` and ``g*`` at the points the solver asks for, shared by scenes of the
@@ -166,7 +166,7 @@ def to_dimensionless(scene: Scene) -> DimensionlessProblem:
         if name in ("settlement", "tilt"):
             scale = 1.0 / a if name == "settlement" else 1.0
             if _is_constant(profile):
-                loads[name] = float(scale * _values(profile, np.zeros(1))[0])
+                loads[name] = float(scale * profile_values(profile, np.zeros(1))[0])
             else:
                 loads[name] = _kinematic_load(profile, scale, days)
         else:
@@ -174,7 +174,8 @@ def to_dimensionless(scene: Scene) -> DimensionlessProblem:
             # products give inf, which the checks of scene_from_dict report
             a_power = a if name == "force" else a * a
             if _is_constant(profile) and not aging:
-                loads[name] = float(plane * _values(profile, np.zeros(1))[0] / (e0 * a_power))
+                loads[name] = float(plane * profile_values(profile, np.zeros(1))[0]
+                                    / (e0 * a_power))
             else:
                 loads[name] = _static_load(profile, plane / a_power, days, modulus, tau0)
 
@@ -216,7 +217,7 @@ def _check_x_profiles_at(scene: Scene, x: np.ndarray) -> None:
         (f"coating[{k}].{name}", getattr(layer, name), bounds)
         for k, layer in enumerate(scene.coating) for name, bounds in _LAYER_BOUNDS.items()]
     for path, profile, (lower, upper) in candidates:
-        values = _values(profile, x)
+        values = profile_values(profile, x)
         checks = [(~np.isfinite(values), "must be finite")]
         if lower is not None:
             checks.append((values <= lower, f"must be > {lower:g}"))
@@ -234,7 +235,7 @@ def _kinematic_load(profile: Profile, scale: float,
                     days: Callable[[np.ndarray], np.ndarray]) -> Callable:
     def load(ts: np.ndarray) -> np.ndarray:
         t = days(ts)
-        return scale * _values(profile, t)
+        return scale * profile_values(profile, t)
     return load
 
 
@@ -242,5 +243,5 @@ def _static_load(profile: Profile, scale: float, days: Callable[[np.ndarray], np
                  modulus: Callable[[Any], np.ndarray], tau0: float) -> Callable:
     def load(ts: np.ndarray) -> np.ndarray:
         t = days(ts)
-        return scale * _values(profile, t) / modulus(tau0 + t)
+        return scale * profile_values(profile, t) / modulus(tau0 + t)
     return load

@@ -16,7 +16,7 @@ from core import limits
 from core.files import atomic_write_text, read_regular_file
 
 if TYPE_CHECKING:
-    from core.scene.pipeline import Scene
+    from core.scene.model import Scene
 
 
 def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
@@ -51,7 +51,7 @@ def read_scene_json(text: str, source: str = "scene") -> Any:
 
 def parse_scene_json(text: str, source: str = "scene") -> Scene:
     """Parse and validate the JSON text of a scene; errors name ``source`` or the field."""
-    from core.scene.pipeline import scene_from_dict
+    from core.scene.validate import scene_from_dict
 
     return scene_from_dict(read_scene_json(text, source))
 
@@ -73,7 +73,7 @@ def load_scene(path: str | os.PathLike) -> Scene:
 
 def scene_to_json(scene: Scene | Mapping[str, Any]) -> str:
     """The canonical JSON text of a scene (validated first when given as a dict)."""
-    from core.scene.pipeline import scene_from_dict
+    from core.scene.validate import scene_from_dict
 
     scene = scene_from_dict(scene)
     return json.dumps(scene.to_dict(), indent=2, allow_nan=False) + "\n"

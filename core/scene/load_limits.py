@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from core.scene.pipeline import Scene
+    from core.scene.model import Scene
 
 #: Samples of a load history between 0 and the last output time, besides the output
 #: times and the points where the history kinks or jumps: a pull shorter than end/1024

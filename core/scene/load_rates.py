@@ -8,7 +8,7 @@ nothing to show. :func:`check_step_limit` refuses such a load *before* solving, 
 the field, from a lower bound of the steps its history needs.
 
 Steps per period of a sine force on the uniform preset (``benchmarks``-style runs of
-``core.scene.pipeline.solve``, wavelength 5 days over 365 days): 3.8 at tol 1e-2, 9.5 at 1e-4,
+``core.scene.solve``, wavelength 5 days over 365 days): 3.8 at tol 1e-2, 9.5 at 1e-4,
 23.3 at 1e-6, 48.7 at 1e-8; the same per period for wavelengths 1 to 20 days. That is
 ``3.8 (1e-2 / tol)^0.185`` for that relative amplitude (0.29). A smaller oscillation is
 cheaper: the step count falls about as ``amplitude^(1/6)``, so a full-amplitude sine needs
@@ -22,7 +22,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from core.profiles.build import Profile
+from core.profiles import Profile
 
 #: Steps per period of a full-amplitude oscillation at tol 1e-2 (measured 4.7, about
 #: 2/3 of it for a lower bound) and their growth with 1/tol (measured exponent 0.185

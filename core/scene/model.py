@@ -1,7 +1,7 @@
 """The validated scene: its fields and what follows from them alone (statement,
 breakpoints, sample points, coating compliance and thickness, the gap).
 
-A :class:`Scene` is built by :func:`core.scene.pipeline.scene_from_dict` (which checks every
+A :class:`Scene` is built by :func:`core.scene.scene_from_dict` (which checks every
 field, :mod:`core.scene.validate`); its dimensionless problem comes from
 :mod:`core.scene.dimensionless`. Lengths in metres, moduli in pascals, times in days.
 """
@@ -19,9 +19,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.cache import StageCache, fingerprint
-from core.coating.model import DEFAULT_INTERFACE, layer_compliance
-from core.problem.statements import STATEMENTS
-from core.profiles.build import Profile, without_offset
+from core.coating import DEFAULT_INTERFACE, layer_compliance
+from core.problem import STATEMENTS
+from core.profiles import Profile, without_offset
 from core.scene.golden_section import golden_minimum_batched
 
 if TYPE_CHECKING:
@@ -53,8 +53,8 @@ class Layer:
 
 @dataclass(frozen=True, eq=False)
 class Scene:
-    """A validated scene (build it with :func:`core.scene.pipeline.scene_from_dict` or
-    :func:`core.scene.pipeline.load_scene`).
+    """A validated scene (build it with :func:`core.scene.scene_from_dict` or
+    :func:`core.scene.load_scene`).
 
     Lengths in metres, moduli in pascals, times in days. ``shape`` and the layer
     profiles are functions of ``x`` [m] on ``[-a, a]``; the loads are functions of the time
@@ -169,9 +169,9 @@ class Scene:
         x = np.asarray(x, dtype=float)
         total = np.zeros(x.shape)
         for layer in self.coating:
-            total = total + layer_compliance(_values(layer.thickness, x),
-                                             _values(layer.modulus, x),
-                                             _values(layer.poisson, x), layer.interface)
+            total = total + layer_compliance(profile_values(layer.thickness, x),
+                                             profile_values(layer.modulus, x),
+                                             profile_values(layer.poisson, x), layer.interface)
         return total
 
     def coating_thickness(self, x: Any) -> np.ndarray:
@@ -179,13 +179,13 @@ class Scene:
         x = np.asarray(x, dtype=float)
         total = np.zeros(x.shape)
         for layer in self.coating:
-            total = total + _values(layer.thickness, x)
+            total = total + profile_values(layer.thickness, x)
         return total
 
     @cached_property
     def _gap_parts(self) -> tuple[Profile, ...]:
         """``f`` and the ``h_k`` less their constant parts
-        (:func:`core.profiles.build.without_offset`)."""
+        (:func:`core.profiles.without_offset`)."""
         return (without_offset(self.shape),) + tuple(
             without_offset(layer.thickness) for layer in self.coating)
 
@@ -199,9 +199,9 @@ class Scene:
         """
         x = np.asarray(x, dtype=float)
         shape, *layers = self._gap_parts
-        total = _values(shape, x)
+        total = profile_values(shape, x)
         for part in layers:
-            total = total - _values(part, x)
+            total = total - profile_values(part, x)
         return total
 
     @cached_property
@@ -235,7 +235,7 @@ class Scene:
     def sample_extremes(self) -> dict[str, float]:
         """On :attr:`sample_x`: the range of ``m*`` (-), the largest gap [m] and the largest
         coating thickness [m]; none depends on the loads, so a scene with other loads
-        (:func:`core.scene.validate.replace_loads`) keeps them, and scenes of the same
+        (:func:`core.scene.replace_loads`) keeps them, and scenes of the same
         geometry and base modulus share them."""
         # m* = E0 / (2 (1 - nu^2) a) * compliance: the geometry, E0 and nu fix all four
         key = fingerprint("sample_extremes", self._geometry_key, self.modulus_at_loading(),
@@ -257,18 +257,19 @@ class Scene:
         """The largest modulus [Pa] of each coating layer on :attr:`sample_x` (shared by
         scenes of the same geometry)."""
         return _LAYER_MODULUS_MAX.get_or_compute(self._geometry_key, lambda: tuple(
-            float(np.max(_values(layer.modulus, self.sample_x))) for layer in self.coating))[0]
+            float(np.max(profile_values(layer.modulus, self.sample_x)))
+            for layer in self.coating))[0]
 
     @cached_property
     def dimensionless(self) -> DimensionlessProblem:
         """The dimensionless problem of this scene (built once; the formulas:
         :mod:`core.scene.dimensionless`)."""
-        from core.scene.dimensionless import to_dimensionless  # it builds on this module
+        from core.scene.dimensionless import to_dimensionless
 
         return to_dimensionless(self)
 
 
-def _values(profile: Profile, x: np.ndarray) -> np.ndarray:
+def profile_values(profile: Profile, x: np.ndarray) -> np.ndarray:
     """A profile's values at ``x`` as a float array of x's shape (a new array)."""
     out = profile(x)
     if isinstance(out, np.ndarray) and out.dtype == np.float64 and out.shape == np.shape(x):

@@ -28,46 +28,8 @@ from typing import Any
 import numpy as np
 
 # re-exported: ``from core.scene.pipeline import ...`` is the public path for every name below
-from core.files import atomic_write_text, read_regular_file  # noqa: F401
-from core.problem.statements import QUANTITIES, STATEMENTS  # noqa: F401
-from core.scene.dimensionless import DimensionlessProblem, to_dimensionless  # noqa: F401
-from core.scene.files import (  # noqa: F401
-    load_scene,
-    parse_scene_json,
-    read_scene_json,
-    save_scene,
-    scene_to_json,
-)
-from core.scene.model import DENSE_SAMPLES, Layer, Scene  # noqa: F401
-from core.scene.results import (  # noqa: F401
-    FLAG_MESSAGES,
-    LARGE_TILT,
-    PLOT_POINTS,
-    THICK_COATING_RATIO,
-    UNITS,
-    SceneSolution,
-    _check_finite,
-    plotting_grid,
-)
-from core.scene.schema import (  # noqa: F401
-    _MIGRATIONS,
-    DEFAULT_TOL,
-    LAM_RANGE,
-    M_STAR_RANGE,
-    MAX_BREAKPOINTS,
-    MAX_CREEP_COEFFICIENT,
-    MAX_GAP_RATIO,
-    MAX_LAYERS,
-    MAX_SCENE_BYTES,
-    MAX_TIMES,
-    SCHEMA_VERSION,
-    TOL_RANGE,
-    _check_fields,
-    _integer,
-    _jsonable,
-    _text,
-    migrate,
-)
+from core.scene.model import Scene
+from core.scene.results import SceneSolution, _check_finite
 from core.scene.validate import scene_from_dict
 
 
@@ -76,7 +38,7 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
 
     Returns a :class:`SceneSolution` in SI units (m, rad, N/m, N, Pa; days after loading).
     """
-    from core.engines.layered.answer import solve_scene_layered  # uniform coating, elastic base
+    from core.engines.layered import solve_scene_layered
     from core.scene.load_limits import check_loads_touch
 
     # CPU time of this thread [s] from the dict to the answer, validation included: what

@@ -2,7 +2,7 @@
 JSON (``to_dict``/``to_json``), CSV of the histories and of the pressure, the flags
 that make an answer doubtful and the last check that it is finite.
 
-:func:`core.scene.pipeline.solve` builds a :class:`SceneSolution` from the dimensionless answer
+:func:`core.scene.solve` builds a :class:`SceneSolution` from the dimensionless answer
 (the conversion back: :mod:`core.scene.dimensionless`).
 """
 
@@ -17,15 +17,15 @@ import numpy as np
 
 from core import limits
 from core.cache import StageCache, fingerprint
-from core.coating.model import model_error_estimate, model_error_map, tilt_share
-from core.problem.statements import QUANTITIES
+from core.coating import model_error_estimate, model_error_map, tilt_share
+from core.problem import QUANTITIES
 from core.scene.load_rates import oscillations
 from core.scene.model import Scene
 from core.scene.schema import SCHEMA_VERSION, _jsonable
 
 if TYPE_CHECKING:
+    from core.problem import ContactSolution
     from core.scene.dimensionless import DimensionlessProblem
-    from core.solver import ContactSolution
 
 #: The thin-coating model is doubtful where sum h_k exceeds this fraction of 2a.
 THICK_COATING_RATIO = 0.1
@@ -79,11 +79,11 @@ def plotting_grid(half_width: float, count: int = PLOT_POINTS) -> np.ndarray:
 _MODEL_ERROR_MAPS = StageCache("scene_model_error_map", max_items=128, max_bytes=2**20)
 
 
-def _model_error(scene: Scene, share_of_tilt: float) -> dict[str, Any]:
-    """:func:`core.coating.model.model_error_estimate` of ``scene``, its map remembered.
+def scene_model_error(scene: Scene, share_of_tilt: float) -> dict[str, Any]:
+    """:func:`core.coating.model_error_estimate` of ``scene``, its map remembered.
 
     The map is read on the geometry, the base modulus at loading and the base thickness
-    (:func:`core.coating.model.model_error_map`); the answer enters only through the
+    (:func:`core.coating.model_error_map`); the answer enters only through the
     share of tilt, which weighs the moment part.
     """
     key = fingerprint("model_error_map", scene._geometry_key, scene.modulus_at_loading(),
@@ -131,7 +131,7 @@ class SceneSolution:
                             for zones in getattr(solution, "contact_set", [])]
         # the exact layered kernel (core.engines.layered.answer) carries its own estimate
         layered = solution.info.get("layered_model_error")
-        self.model_error = dict(layered) if layered else _model_error(
+        self.model_error = dict(layered) if layered else scene_model_error(
             scene, tilt_share(a, self.settlement, self.tilt))
         self.flags = self._flags(solution)
         self.flag_messages = {

@@ -1,7 +1,7 @@
 """The scene schema: its version and migrations, the accepted ranges of its fields, and
 the validators of single fields (objects, integers, texts, output times, profiles).
 
-:func:`core.scene.pipeline.scene_from_dict` (built in :mod:`core.scene.validate`) checks a whole
+:func:`core.scene.scene_from_dict` (built in :mod:`core.scene.validate`) checks a whole
 scene with these; every refusal is a ``ValueError`` whose message starts with the path of
 the field (``coating[1].modulus: ...``). The schema itself is documented in
 ``core/SCENES.md``.
@@ -22,12 +22,12 @@ import numpy as np
 
 from core import limits
 from core.cache import StageCache, fingerprint
-from core.profiles.build import Profile, check_range, profile_from_spec
+from core.profiles import Profile, check_range, profile_from_spec
 from core.validation import finite_number, positive_number, show_value
 
 #: The schema version this program writes and reads.
 SCHEMA_VERSION = 1
-#: Largest scene file accepted by :func:`core.scene.pipeline.load_scene` [bytes].
+#: Largest scene file accepted by :func:`core.scene.load_scene` [bytes].
 MAX_SCENE_BYTES = limits.MAX_SCENE_BYTES
 #: Number of coating layers accepted.
 MAX_LAYERS = 10
@@ -68,7 +68,7 @@ def _join(parent: str, key: str) -> str:
     return f"{parent}.{key}" if parent else key
 
 
-def _check_fields(obj: Any, path: str, required: Sequence[str],
+def check_fields(obj: Any, path: str, required: Sequence[str],
                   optional: Sequence[str] = ()) -> Mapping[str, Any]:
     """``obj`` as a mapping with exactly the allowed fields, or a ValueError."""
     where = path or "scene"
@@ -94,7 +94,7 @@ def _poisson(value: Any, path: str) -> float:
     return x
 
 
-def _integer(value: Any, path: str, lo: int, hi: int) -> int:
+def integer_in_range(value: Any, path: str, lo: int, hi: int) -> int:
     x = finite_number(value, path)
     if not x.is_integer():
         raise ValueError(f"{path}: must be an integer, got {show_value(value)}")
@@ -209,9 +209,9 @@ def _checked_profile(spec: Any, path: str, variable: str, domain: tuple[float, f
 def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
     """The output times [day after loading] and their canonical spec."""
     if isinstance(spec, Mapping):
-        _check_fields(spec, path, ("end", "count"), ("spacing",))
+        check_fields(spec, path, ("end", "count"), ("spacing",))
         end = positive_number(spec["end"], f"{path}.end")
-        count = _integer(spec["count"], f"{path}.count", 1, MAX_TIMES)
+        count = integer_in_range(spec["count"], f"{path}.count", 1, MAX_TIMES)
         spacing = spec.get("spacing", "linear")
         if spacing not in ("linear", "log"):
             raise ValueError(f"{path}.spacing: must be 'linear' or 'log', "

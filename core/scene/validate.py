@@ -17,21 +17,21 @@ import numpy as np
 
 from core import limits
 from core.cache import StageCache, fingerprint
-from core.coating.model import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
-from core.creep.models import Elastic, UserKernel, creep_model_from_spec
-from core.problem.statements import QUANTITIES, STATEMENTS
-from core.profiles.build import Profile
+from core.coating import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
+from core.creep import Elastic, UserKernel, creep_model_from_spec
+from core.problem import QUANTITIES, STATEMENTS
+from core.profiles import Profile
 from core.scene import schema
 from core.scene.load_rates import check_step_limit
-from core.scene.model import Layer, Scene, _values
+from core.scene.model import Layer, Scene, profile_values
 from core.scene.schema import (
-    _check_fields,
     _jsonable,
     _poisson,
     _profile,
     _spec_of,
     _text,
     _times,
+    check_fields,
     migrate,
 )
 from core.validation import (
@@ -58,13 +58,13 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     if isinstance(d, Scene):
         return d
     d = migrate(d)
-    _check_fields(d, "", ("schema_version", "name", "punch", "coating", "base", "loading",
+    check_fields(d, "", ("schema_version", "name", "punch", "coating", "base", "loading",
                           "times"), ("description", "solver"))
     name = _text(d["name"], "name", allow_empty=False, most=limits.MAX_NAME_CHARS)
     description = _text(d.get("description", ""), "description", allow_empty=True,
                         most=limits.MAX_DESCRIPTION_CHARS)
 
-    punch = _check_fields(d["punch"], "punch", ("half_width",), ("shape",))
+    punch = check_fields(d["punch"], "punch", ("half_width",), ("shape",))
     a = positive_number(punch["half_width"], "punch.half_width")
     x_domain = (-a, a)
     shape_spec = punch.get("shape", 0.0)
@@ -75,7 +75,7 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     layers = []
     for k, spec in enumerate(layers_spec):
         path = f"coating[{k}]"
-        _check_fields(spec, path, ("thickness", "modulus", "poisson"), ("interface",))
+        check_fields(spec, path, ("thickness", "modulus", "poisson"), ("interface",))
         interface = spec.get("interface", DEFAULT_INTERFACE)
         if interface not in INTERFACES:
             raise ValueError(f"{path}.interface: must be 'smooth' or 'bonded', got "
@@ -89,7 +89,7 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
             interface=interface,
         ))
 
-    base = _check_fields(d["base"], "base", ("thickness", "poisson", "age_at_loading", "creep"))
+    base = check_fields(d["base"], "base", ("thickness", "poisson", "age_at_loading", "creep"))
     h_base = positive_number(base["thickness"], "base.thickness")
     nu = _poisson(base["poisson"], "base.poisson")
     tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
@@ -109,7 +109,7 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     times, times_spec = _times(d["times"], "times")
 
     loading = d["loading"]
-    _check_fields(loading, "loading", (), QUANTITIES)
+    check_fields(loading, "loading", (), QUANTITIES)
     given = frozenset(loading)
     if len(given) != 2:
         raise ValueError("loading: exactly two of settlement, tilt, force, moment are needed, "
@@ -128,7 +128,7 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
                          f"an age at loading of {tau0:g} days")
 
-    solver = _check_fields(d.get("solver", {}), "solver", (), ("tol", "contact", "model_tol"))
+    solver = check_fields(d.get("solver", {}), "solver", (), ("tol", "contact", "model_tol"))
     tol = finite_number(solver.get("tol", schema.DEFAULT_TOL), "solver.tol")
     tol_lo, tol_hi = schema.TOL_RANGE
     if not tol_lo <= tol <= tol_hi:
@@ -136,9 +136,7 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
                          f"got {show_value(tol)}")
     contact = solver.get("contact", "auto")
     if contact != "auto":
-        from core.contact.unilateral import (
-            CONTACT_MODELS,  # the solver's list (loaded only when asked)
-        )
+        from core.contact import CONTACT_MODELS
 
         if not isinstance(contact, str) or contact not in CONTACT_MODELS:
             raise ValueError(f"solver.contact: must be one of {', '.join(CONTACT_MODELS)}, "
@@ -257,7 +255,7 @@ def _check_coefficients(scene: Scene, problem: DimensionlessProblem) -> bool:
 
             def gap_message(i: int) -> str:
                 # the field to change: the punch or the coating, whichever varies more
-                f_range = float(np.ptp(_values(scene.shape, x)))
+                f_range = float(np.ptp(profile_values(scene.shape, x)))
                 h_range = float(np.ptp(scene.coating_thickness(x)))
                 where = "punch.shape" if not f_range < h_range else "coating"
                 return (f"{where}: the gap between the punch base and the coating surface "

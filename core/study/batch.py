@@ -1,16 +1,16 @@
 """One batch of a design study: its points solved in order, in one task.
 
-:func:`run_batch` is what a Dask task (or the serial loop) of :func:`core.study.run.sweep`
+:func:`run_batch` is what a Dask task (or the serial loop) of :func:`core.study.sweep`
 runs. Points that differ only in given loads share one validated scene (the loads
-replaced with :func:`core.scene.validate.replace_loads`: the same checks and
+replaced with :func:`core.scene.replace_loads`: the same checks and
 messages); on a scene the exact layered kernel answers, their full-contact answers come
-at once (:func:`core.study.loads.solve_load_batch`). Every other point is solved on its
-own with :func:`core.scene.pipeline.solve`, except that on a flat punch over an elastic base a
+at once (:func:`core.study.solve_load_batch`). Every other point is solved on its
+own with :func:`core.scene.solve`, except that on a flat punch over an elastic base a
 point whose eccentricity ``M / P`` an earlier point of the batch shares is that point's
 answer scaled by the ratio of the forces (:func:`answers_scale_with_loads`), and where a
 geometry's batch holds many lift-off eccentricities of one sign they are answered as one
 family (:func:`core.study.liftoff.liftoff_family`: the smallest and the largest solved by
-:func:`core.scene.pipeline.solve`, the ones between located along the zone end and solved on
+:func:`core.scene.solve`, the ones between located along the zone end and solved on
 their zones). A point that fails is recorded with its message.
 """
 
@@ -22,9 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from core.scene.pipeline import Scene, scene_from_dict, solve
-from core.scene.results import LARGE_TILT
-from core.scene.validate import replace_loads
+from core.scene import LARGE_TILT, Scene, replace_loads, scene_from_dict, solve
 from core.study.definition import apply_point
 
 __all__ = ["answers_scale_with_loads", "point_outputs", "run_batch"]
@@ -44,7 +42,7 @@ def _contact_width(x: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 
 def point_outputs(result: Any, outputs: Sequence[str]) -> np.ndarray:
-    """The requested outputs of a :class:`core.scene.pipeline.SceneSolution`, shape
+    """The requested outputs of a :class:`core.scene.SceneSolution`, shape
     ``(len(outputs), n_times)``, in the units of :data:`core.study.definition.OUTPUT_UNITS`.
 
     ``q_max``/``q_min`` are the extremes of the pressure on the 201-point plotting grid;
@@ -226,7 +224,7 @@ def _one_family(scene: Scene, picked: list[tuple[int, float]],
                 load_columns: Sequence[int], outputs: Sequence[str],
                 solved: dict[tuple[int, float], tuple]) -> list[tuple[int, float]]:
     """One sign of eccentricity of one geometry: its smallest and largest eccentricities
-    solved by :func:`core.scene.pipeline.solve` (they fix the zone ends' range and the topology),
+    solved by :func:`core.scene.solve` (they fix the zone ends' range and the topology),
     the ones between by :func:`core.study.liftoff.liftoff_family`. Returns the keys it
     answered (into ``solved``); any doubt leaves the rest one by one."""
     from core.study.liftoff import family_applies, family_flags, liftoff_family
@@ -304,7 +302,7 @@ def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
     """Solve the points of one batch in order (``values[i]`` holds point i's value of each
     of ``paths``). Points that differ only in given loads share one validated scene
     (:func:`_geometry_groups`); on a scene of the exact layered kernel their full-contact
-    answers come at once (:func:`core.study.loads.solve_load_batch`). Returns arrays:
+    answers come at once (:func:`core.study.solve_load_batch`). Returns arrays:
     ``values`` ``(m, len(outputs), n_times)``, ``error_estimate`` (relative, -), ``flags``
     (comma-joined), ``error`` (the message of a failed point, else empty), ``seconds``
     (per point)."""

@@ -30,15 +30,14 @@ from typing import Any
 
 import numpy as np
 
-from core.scene.pipeline import (
+from core.scene import (
     MAX_SCENE_BYTES,
-    _check_fields,
-    _integer,
+    check_fields,
+    integer_in_range,
     load_scene,
     read_scene_json,
     scene_from_dict,
 )
-from core.study.points import DRAW_BLOCK, StudyPoints, point_table  # noqa: F401
 from core.validation import finite_number, positive_number, show_value
 
 #: The study format version this program reads and writes.
@@ -170,7 +169,7 @@ def apply_point(scene: Mapping[str, Any], values: Mapping[str, float]) -> dict[s
 
 
 def _count(value: Any, field: str) -> int:
-    return _integer(value, field, 1, MAX_STUDY_POINTS)
+    return integer_in_range(value, field, 1, MAX_STUDY_POINTS)
 
 
 def _grid(kind: str, spec: Any, field: str) -> tuple[float, ...]:
@@ -181,7 +180,7 @@ def _grid(kind: str, spec: Any, field: str) -> tuple[float, ...]:
         if len(spec) > MAX_STUDY_POINTS:
             raise ValueError(f"{field}: at most {MAX_STUDY_POINTS} values, got {len(spec)}")
         return tuple(finite_number(v, f"{field}[{i}]") for i, v in enumerate(spec))
-    _check_fields(spec, field, ("start", "stop", "count"))
+    check_fields(spec, field, ("start", "stop", "count"))
     count = _count(spec["count"], f"{field}.count")
     if kind == "linspace":
         lo = finite_number(spec["start"], f"{field}.start")
@@ -199,19 +198,19 @@ def _grid(kind: str, spec: Any, field: str) -> tuple[float, ...]:
 
 def _distribution(kind: str, spec: Any, field: str) -> tuple[tuple[str, float], ...]:
     if kind == "normal":
-        _check_fields(spec, field, ("mean", "std"))
+        check_fields(spec, field, ("mean", "std"))
         mean = finite_number(spec["mean"], f"{field}.mean")
         std = positive_number(spec["std"], f"{field}.std")
         return (("mean", mean), ("std", std))
     if kind == "lognormal":
-        _check_fields(spec, field, ("median", "sigma"))
+        check_fields(spec, field, ("median", "sigma"))
         median = positive_number(spec["median"], f"{field}.median")
         sigma = positive_number(spec["sigma"], f"{field}.sigma")
         if sigma > 5:
             raise ValueError(f"{field}.sigma: must be at most 5 (the spread of log values), "
                              f"got {show_value(sigma)}")
         return (("median", median), ("sigma", sigma))
-    _check_fields(spec, field, ("low", "high"))
+    check_fields(spec, field, ("low", "high"))
     low = finite_number(spec["low"], f"{field}.low")
     high = finite_number(spec["high"], f"{field}.high")
     if not high > low:
@@ -222,7 +221,7 @@ def _distribution(kind: str, spec: Any, field: str) -> tuple[tuple[str, float], 
 
 def _parameter(spec: Any, field: str, base: Mapping[str, Any]) -> Parameter:
     kinds = GRID_KINDS + DISTRIBUTIONS
-    _check_fields(spec, field, ("field",), kinds)
+    check_fields(spec, field, ("field",), kinds)
     given = [k for k in kinds if k in spec]
     if len(given) != 1:
         raise ValueError(f"{field}: give exactly one of {', '.join(kinds)}, got "
@@ -308,7 +307,7 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     """
     max_points = min(int(max_points), MAX_STUDY_POINTS)
     try:
-        _check_fields(d, "", ("study_version", "name", "scene", "vary"),
+        check_fields(d, "", ("study_version", "name", "scene", "vary"),
                       ("description", "samples", "seed", "outputs", "times"))
     except ValueError as exc:
         # the scene checker names the top level "scene", which in a study is the field
@@ -317,7 +316,7 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
         if msg.startswith("scene: "):
             raise ValueError("study: " + msg[len("scene: "):]) from None
         raise
-    _integer(d["study_version"], "study_version", STUDY_VERSION, STUDY_VERSION)
+    integer_in_range(d["study_version"], "study_version", STUDY_VERSION, STUDY_VERSION)
     name = d["name"]
     if not isinstance(name, str) or not name.strip():
         raise ValueError(f"name: must be a non-empty string, got {show_value(name)}")
@@ -350,7 +349,7 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     if not random and "samples" in d:
         raise ValueError("samples: only for distributions (every field here is a grid)")
     samples = _count(d["samples"], "samples") if random else 1
-    seed = _integer(d.get("seed", 0), "seed", 0, 2**63 - 1)
+    seed = integer_in_range(d.get("seed", 0), "seed", 0, 2**63 - 1)
 
     outputs_spec = d.get("outputs", list(OUTPUT_UNITS))
     if not isinstance(outputs_spec, (list, tuple)) or not outputs_spec:

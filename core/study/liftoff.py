@@ -6,24 +6,24 @@ homogeneous in the loads: its answer per unit force depends on the eccentricity
 (``e > 0``; ``[-1, c]`` for ``e < 0``). Parametrized by the zone end ``c`` instead of
 ``e``, the answer is a smooth function of ``c``: on the zone the two unit responses
 (settlement 1 and tilt 1) of the thin-layer model are solved on the Nystrom rule of
-:mod:`core.contact.zones` (:func:`core.contact.zones.zone_panels`, the unilateral
+:mod:`core.contact.zones` (:func:`core.contact.zone_panels`, the unilateral
 solver's own), and the free-end condition ``Q(c) = 0`` fixes the ratio of tilt to
 settlement; the force and the moment of that combination give ``e(c)``.
 
 :func:`liftoff_family` builds ``e(c)`` on Chebyshev-Lobatto points in ``c`` between the
 zone ends of the batch's smallest and largest eccentricity (both solved by
-:func:`core.scene.pipeline.solve`, which also fixes the topology), inverts it for every other
+:func:`core.scene.solve`, which also fixes the topology), inverts it for every other
 eccentricity (its error estimated per point against the interpolant of half the degree,
 on the nested points) and solves each point once on its zone ``[c*, 1]``: settlement,
 tilt and the pressure on the plotting grid come from that solve, so ``q_max``, ``q_min``
 and the contact width are the point's own grid extremes (nothing is interpolated through
 the kinks of a max over a grid). The discretization error is that of each family point
-against the next coarser panel rule, as :func:`core.contact.zones.refine_zone_ends`
+against the next coarser panel rule, as :func:`core.contact.refine_zone_ends`
 estimates it. A point is answered only when its zone end is within a third of
-:data:`core.contact.zones.ZONE_END_TOL` (the interpolant's estimate, the discretization's
+:data:`core.contact.ZONE_END_TOL` (the interpolant's estimate, the discretization's
 and the zone's own miss of ``e`` through ``de/dc``), its outputs within a third of
 ``tol``, and its pressure passes the contact set's check; the others are left to
-:func:`core.scene.pipeline.solve`.
+:func:`core.scene.solve`.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from core.contact.zones import (
+from core.contact import (
     ZONE_EDGE_WIDTH,
     ZONE_END_TOL,
     ZONE_PANEL_WIDTH,
@@ -43,9 +43,8 @@ from core.contact.zones import (
     Space,
     zone_panels,
 )
-from core.discretize.quadrature import kernel_operator, operator_rows
-from core.scene.model import Scene
-from core.scene.results import LARGE_TILT, _model_error, plotting_grid
+from core.discretize import kernel_operator, operator_rows
+from core.scene import LARGE_TILT, Scene, plotting_grid, scene_model_error
 
 __all__ = ["FAMILY_MIN_ECCENTRICITIES", "LiftoffAnswer", "liftoff_family"]
 
@@ -78,7 +77,7 @@ _SOLVE_ACCURACY = 1e-12
 class LiftoffAnswer:
     """One eccentricity's answer at the force ``force`` [N/m]: ``values`` (outputs x
     times, units of :data:`core.study.definition.OUTPUT_UNITS`), ``estimate`` (relative, -),
-    ``flags`` and the largest |tilt| [rad], as :func:`core.study.batch.run_batch` keeps a
+    ``flags`` and the largest |tilt| [rad], as :func:`core.study.run_batch` keeps a
     solved point to scale it."""
 
     force: float
@@ -201,12 +200,12 @@ def liftoff_family(scene: Scene, eccentricities: np.ndarray, forces: np.ndarray,
                    flags: Sequence[str]) -> tuple[list[LiftoffAnswer | None], dict[str, Any]]:
     """Answers of ``scene`` at the dimensionless eccentricities ``eccentricities``
     (``M / (P a)``, all of one sign, strictly between those of two points
-    :func:`core.scene.pipeline.solve` answered with lift-off, whose zone ends ``ends`` [-] are
+    :func:`core.scene.solve` answered with lift-off, whose zone ends ``ends`` [-] are
     the free ends at the smallest and the largest ``|e|``) under the forces ``forces``
     [N/m] (one point per eccentricity), for ``outputs`` of
     :data:`core.study.definition.OUTPUT_UNITS`. ``flags`` are the geometry's flags of those two
     answers (the contact-model ones and ``large_tilt``/``model_error`` excluded: they are
-    decided per point here). Requires :func:`core.study.batch.answers_scale_with_loads`
+    decided per point here). Requires :func:`core.study.answers_scale_with_loads`
     and a modulus constant over the scene's times.
 
     Returns one :class:`LiftoffAnswer` per eccentricity, None where the estimate misses
@@ -309,8 +308,8 @@ def _point_values(problem: Any, a: float, force: float, e: float, settlement: fl
                   tilt: float, q: np.ndarray, x: np.ndarray, pressure_scale: np.ndarray,
                   outputs: Sequence[str]) -> tuple[np.ndarray, SimpleNamespace]:
     """The outputs of one point (``q`` the pressure per unit force on the grid ``x``) as
-    :func:`core.study.batch.point_outputs` takes them from a
-    :class:`core.scene.pipeline.SceneSolution`, and that point's histories."""
+    :func:`core.study.point_outputs` takes them from a
+    :class:`core.scene.SceneSolution`, and that point's histories."""
     from core.study.batch import point_outputs
 
     p_star = _dimensionless_force(problem, force, a)
@@ -324,14 +323,14 @@ def _point_values(problem: Any, a: float, force: float, e: float, settlement: fl
 
 def _answer(scene: Scene, point: tuple[np.ndarray, SimpleNamespace], force: float,
             flags: Sequence[str], estimate: float) -> LiftoffAnswer:
-    """The point's answer with its flags, as :class:`core.scene.pipeline.SceneSolution` sets them."""
-    from core.coating.model import tilt_share
+    """The point's answer with its flags, as :class:`core.scene.SceneSolution` sets them."""
+    from core.coating import tilt_share
 
     values, result = point
     a = scene.half_width
     point_flags = list(flags)
     share = tilt_share(a, result.settlement, result.tilt)
-    if _model_error(scene, share)["estimate"] > scene.model_tol:
+    if scene_model_error(scene, share)["estimate"] > scene.model_tol:
         point_flags.append("model_error")
     largest = float(np.max(np.abs(result.tilt)))
     if largest > LARGE_TILT:
@@ -342,7 +341,7 @@ def _answer(scene: Scene, point: tuple[np.ndarray, SimpleNamespace], force: floa
 
 
 def family_flags(result_flags: Sequence[str]) -> list[str] | None:
-    """The geometry's flags of a lift-off answer of :func:`core.scene.pipeline.solve` that hold for
+    """The geometry's flags of a lift-off answer of :func:`core.scene.solve` that hold for
     every eccentricity of the family, or None when its flags say the one-point solver
     missed its tolerance or its check (the family is then not built)."""
     if {"tol_not_met", "contact_set_unverified", "contact_lost"} & set(result_flags):

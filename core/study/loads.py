@@ -3,14 +3,14 @@
 On an elastic base under a uniform coating the exact layered kernel answers
 (:mod:`core.engines.layered.answer`), and the problem is linear: the pressure is the gap's response
 plus a settlement times the unit-settlement response plus a tilt times the unit-tilt
-response (:class:`core.engines.layered.solve.LayeredResponse`). A batch of constant loads is then
+response (:class:`core.engines.layered.LayeredResponse`). A batch of constant loads is then
 a batch of 2 x 2 solves and matrix products: the unknowns, the error estimate of
-:func:`core.engines.layered.solve.solve_layered`, the lift-off test of
-:func:`core.engines.layered.answer.solve_scene_layered`, the flags of
-:class:`core.scene.pipeline.SceneSolution` and the pressure on its plotting grid, for every point
-at once, as :func:`core.scene.pipeline.solve` computes them for one point.
+:func:`core.engines.layered.solve_layered`, the lift-off test of
+:func:`core.engines.layered.solve_scene_layered`, the flags of
+:class:`core.scene.SceneSolution` and the pressure on its plotting grid, for every point
+at once, as :func:`core.scene.solve` computes them for one point.
 
-A point this path does not answer the same way is left to :func:`core.scene.pipeline.solve`
+A point this path does not answer the same way is left to :func:`core.scene.solve`
 (``answered`` false): a load that the scene's checks would refuse (non-finite, a pulled
 punch, a resultant outside the base, beyond double precision), an estimate that would
 need more modes than the default, a pressure that comes out negative when the contact
@@ -24,23 +24,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.engines.layered.answer import LIFT_OFF_SHARE, _layers, layered_declines
-from core.engines.layered.cache import gap_key, stack_key
-from core.engines.layered.solve import (
+from core.engines.layered import (
     COARSE_ERROR_FLOOR,
     COARSE_TOL,
     ERROR_FLOOR,
+    LIFT_OFF_SHARE,
     MAX_MODES,
     MAX_RATIO,
     PRESSURE_REACH,
     LayeredResponse,
-    _cached_response,
+    cached_response,
     default_modes,
+    gap_key,
+    layered_declines,
+    stack_key,
+    uniform_layers,
 )
-from core.scene.model import Scene, _values
-from core.scene.results import LARGE_TILT, plotting_grid
-from core.scene.validate import MAX_MAGNITUDE
+from core.scene import LARGE_TILT, Scene, plotting_grid, profile_values
 from core.study.definition import OUTPUT_UNITS
+from core.validation import MAX_MAGNITUDE
 
 __all__ = ["LoadBatch", "load_batch_applies", "solve_load_batch"]
 
@@ -53,7 +55,7 @@ class LoadBatch:
     """The answers of :func:`solve_load_batch` for ``n`` points: ``answered`` (bool, n);
     where answered, ``values`` ``(n, len(outputs), n_times)`` in the units of
     :data:`core.study.definition.OUTPUT_UNITS`, ``error_estimate`` (relative, -) and ``flags``
-    (comma-joined) as :func:`core.study.batch.run_batch` records a solved point."""
+    (comma-joined) as :func:`core.study.run_batch` records a solved point."""
 
     answered: np.ndarray
     values: np.ndarray
@@ -86,7 +88,7 @@ def _dimensionless_loads(scene: Scene, loads: Mapping[str, np.ndarray],
             if name in loads:
                 value = np.asarray(loads[name], dtype=float).reshape(n)
             else:
-                value = np.full(n, _values(profile, np.zeros(1))[0])
+                value = np.full(n, profile_values(profile, np.zeros(1))[0])
             dimensional[name] = value
             if name in _KINEMATIC:
                 scale = 1.0 / a if name == "settlement" else 1.0
@@ -109,7 +111,7 @@ def _dimensionless_loads(scene: Scene, loads: Mapping[str, np.ndarray],
 def _differences(response: LayeredResponse, given: Mapping[str, np.ndarray],
                  fine: Mapping[str, np.ndarray], level: int) -> dict[str, np.ndarray]:
     """Per point (column), the relative differences of levels ``level`` and ``level - 1``
-    as :func:`core.engines.layered.solve.solve_layered` measures them over one point's times."""
+    as :func:`core.engines.layered.solve_layered` measures them over one point's times."""
     other = response.complete(dict(given), level=level)
     better = response.complete(dict(given), level=level - 1)
     kin = np.maximum(np.abs(fine["settlement"]), np.abs(fine["tilt"]))
@@ -140,14 +142,14 @@ def _contact_width(x: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 def _response(scene: Scene, layers: list, modes: int, room: int) -> LayeredResponse:
     """The scene's unit responses on ``modes`` modes, from the caches
-    :func:`core.engines.layered.solve.solve_layered` fills (built once per geometry), with the
+    :func:`core.engines.layered.solve_layered` fills (built once per geometry), with the
     same rules (chosen by the scene's tol) and the same ``room`` for doubling, so a batch
     reads the very table and Galerkin matrix one point's solve reads."""
     problem = scene.dimensionless
     a, h, e0, nu = (scene.half_width, scene.base_thickness, problem.modulus_at_loading,
                     scene.base_poisson)
     keys = (stack_key(a, layers, h, e0, nu), gap_key(problem.g, problem.breakpoints))
-    return _cached_response(a, layers, h, e0, nu, problem.g, problem.breakpoints, modes,
+    return cached_response(a, layers, h, e0, nu, problem.g, problem.breakpoints, modes,
                             keys, {}, tol=problem.tol, room=room)
 
 
@@ -195,7 +197,7 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
         keep &= ~lost
     # the pressure on the plotting grid, as the solution's evaluate gives it
     x = plotting_grid(a)
-    edge = 1.0 - 0.5 * _layers(scene)[0].thickness / a
+    edge = 1.0 - 0.5 * uniform_layers(scene)[0].thickness / a
     t = np.clip(np.clip(x / a, -1.0, 1.0), -edge, edge)
     q_star = response.regular_part(t, fine["settlement"], fine["tilt"]) \
         / np.sqrt(1.0 - t * t)[:, None]
@@ -234,7 +236,7 @@ def solve_load_batch(scene: Scene, loads: Mapping[str, np.ndarray],
     the ``outputs`` of :data:`core.study.definition.OUTPUT_UNITS` at the scene's times. Requires
     :func:`load_batch_applies`. Points not ``answered`` must be solved one by one.
 
-    The modes grow as :func:`core.engines.layered.solve.solve_layered` grows them for one point:
+    The modes grow as :func:`core.engines.layered.solve_layered` grows them for one point:
     from :func:`core.engines.layered.solve.default_modes`, doubled for the points whose estimate
     is still above ``tol / 2``, up to :data:`core.engines.layered.solve.MAX_MODES`."""
     unknown = [name for name in outputs if name not in OUTPUT_UNITS]
@@ -245,7 +247,7 @@ def solve_load_batch(scene: Scene, loads: Mapping[str, np.ndarray],
     values = np.full((n, len(outputs), len(scene.times)), np.nan)
     estimate = np.full(n, np.nan)
     flags = [""] * n
-    layers = _layers(scene)
+    layers = uniform_layers(scene)
     pending = np.flatnonzero(answered)
     answered[:] = False
     modes = min(default_modes(scene.half_width, layers), MAX_MODES)

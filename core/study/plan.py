@@ -1,4 +1,4 @@
-"""The order in which :func:`core.study.run.sweep` runs a study's points, and its batches,
+"""The order in which :func:`core.study.sweep` runs a study's points, and its batches,
 made batch by batch from the study's description: no array over all the points is held.
 
 Points sharing a geometry (every varied field but the loads) are neighbours, so that the
@@ -19,7 +19,8 @@ import math
 
 import numpy as np
 
-from core.study.definition import DRAW_BLOCK, Study, StudyPoints
+from core.study.definition import Study
+from core.study.points import DRAW_BLOCK, StudyPoints
 
 #: Most points of one geometry sorted together by eccentricity: bounds the client's
 #: memory of planning whatever the study's size (at the peak, a batch straddling two

@@ -1,4 +1,4 @@
-"""The points of a design study (:class:`core.study.definition.Study`) from its description: all of
+"""The points of a design study (:class:`core.study.Study`) from its description: all of
 them as a table (:func:`point_table`) or any of them on demand (:class:`StudyPoints`), both
 re-exported by :mod:`core.study.definition`.
 

@@ -7,9 +7,9 @@ order, so the solver's cached geometric stages (panels, operator, basis, Galerki
 matrices) are prepared once per geometry and a load-only variation costs a few array
 operations. When only given loads vary (``loading.force``, ``loading.moment``, ...), a
 batch validates the base scene once and builds each point's scene by replacing its loads
-(:func:`core.scene.validate.replace_loads`, the same checks and messages); when the
+(:func:`core.scene.replace_loads`, the same checks and messages); when the
 exact layered kernel answers the scene and the loads are constants, the batch's
-full-contact points are answered at once (:func:`core.study.loads.solve_load_batch`: the
+full-contact points are answered at once (:func:`core.study.solve_load_batch`: the
 problem is linear in the loads) and only the others are solved one by one, one per
 eccentricity ``M / P`` on a flat punch over an elastic base (the others of that
 eccentricity scaled from it; batches follow the eccentricity when force and moment both
@@ -19,7 +19,7 @@ fails (an invalid scene drawn from a distribution, a solver error) is recorded w
 message; it never stops the study.
 
 The points and the batches are made batch by batch from the study's description
-(:class:`core.study.definition.StudyPoints`, :class:`core.study.plan.BatchPlan`): the client holds no
+(:class:`core.study.definition.StudyPoints`, :class:`core.study.BatchPlan`): the client holds no
 array over all the points, whatever the study's size.
 
 Each finished batch is written atomically to a work directory (``parts/batch_NNNNNN.npz``
@@ -48,10 +48,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from core.scene.pipeline import FLAG_MESSAGES, atomic_write_text
-from core.study.batch import _contact_width, point_outputs, run_batch  # noqa: F401
-from core.study.definition import OUTPUT_UNITS, Study, StudyPoints, load_study, point_table
+from core.files import atomic_write_text
+from core.scene import FLAG_MESSAGES
+from core.study.batch import run_batch
+from core.study.definition import OUTPUT_UNITS, Study, load_study
 from core.study.plan import PLAN_ORDER, BatchPlan, batch_plan
+from core.study.points import StudyPoints, point_table
 
 if TYPE_CHECKING:
     import xarray

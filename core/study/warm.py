@@ -7,7 +7,7 @@ scene of its own (a flat punch on a coating over an elastic base: a few load poi
 and out of full contact, and a coating modulus), whose geometry no study shares, so no
 study's own results are prepared ahead. :class:`WarmStudyWorker` runs it on every worker
 of a cluster, those joining later included; :func:`start_local_cluster` starts the local
-cluster :func:`core.study.run.sweep` uses, warmed, so that the warming counts in the
+cluster :func:`core.study.sweep` uses, warmed, so that the warming counts in the
 cluster's start. This module imports Dask's ``distributed``: :mod:`core.study.run` imports
 it only when a cluster is used.
 """

@@ -47,27 +47,8 @@ import numpy as np
 
 from core import limits
 from core.time.exponential import solve_exponential
-from core.time.product_quadrature import (  # noqa: F401 (the general-kernel solver: re-exported)
-    _trapezoid_solve,
-    solve_general,
-)
-from core.time.radau import (  # noqa: F401 (RADAU_A, RADAU_C, _radau_step(s): re-exported)
-    RADAU_A,
-    RADAU_C,
-    RADAU_ORDER,
-    _advance,
-    _radau_step,
-    _radau_steps,
-    _stage_values,
-)
-from core.time.volterra import (  # noqa: F401 (the problem: re-exported)
-    ModalProblem,
-    TimeFunction,
-    VolterraSolution,
-    _after,
-    _jumps,
-    _scales,
-)
+from core.time.radau import RADAU_ORDER, _advance, _stage_values
+from core.time.volterra import ModalProblem, VolterraSolution, _after, _jumps, _scales
 
 #: The exponential collocation may spend this fraction (1/EXPONENTIAL_SHARE) of the step
 #: limit before the adaptive Radau stepping takes over (a history that oscillates fast).

@@ -88,7 +88,7 @@ class CoatingView:
 
 
 def check_report_html(report: dict[str, Any]) -> str:
-    """The FE check's report (:func:`core.scene.coating_check.check_scene`) as HTML: the model
+    """The FE check's report (:func:`core.scene.check_scene`) as HTML: the model
     error of the fast answer beside its estimate, and a row per quantity."""
     errors = report["errors"]
     given = report.get("given", ())
@@ -113,7 +113,7 @@ def check_report_html(report: dict[str, Any]) -> str:
 
 
 class CoatingCheckView:
-    """The "check the coating model" button: runs :func:`core.scene.coating_check.check_scene`
+    """The "check the coating model" button: runs :func:`core.scene.check_scene`
     on the scene on screen where the session's solves run (a worker process, or a thread
     of the solver pool; never the page's event loop), shows a progress bar meanwhile and
     the report when it is done."""
@@ -163,7 +163,7 @@ class CoatingCheckView:
 
 def _check(scene: dict[str, Any]) -> dict[str, Any] | str:
     """The check's report, or why there is none (runs off the event loop)."""
-    from core.scene.coating_check import check_scene
+    from core.scene import check_scene
 
     from ..controller import worker_processes
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
-from core.scene.pipeline import MAX_SCENE_BYTES
+from core.scene import MAX_SCENE_BYTES
 
 from .. import exports
 from ..report import report_html
@@ -95,7 +95,7 @@ class FilesView:
             self.load_file.clear()
 
     def _read_scene_file(self, data: bytes) -> None:
-        from core.scene.pipeline import read_scene_json
+        from core.scene import read_scene_json
 
         app = self.app
         # the same limit as the command line: a browser may send up to the websocket's

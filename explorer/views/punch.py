@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
-from core.profiles.build import MAX_TABLE_BYTES
+from core.profiles import MAX_TABLE_BYTES
 
 from ..controller import format_error
 from ..widgets import Binding, BoundedUpload, fine_slider, slider
@@ -95,7 +95,7 @@ class PunchView:
         data = event.new
         if not data:
             return
-        from core.profiles.build import profile_from_csv
+        from core.profiles import profile_from_csv
 
         app = self.app
         a = app.state.punch.half_width

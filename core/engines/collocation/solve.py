@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from core.discretize.quadrature import Panels, base_panels, kernel_operator, operator_rows
+from core.discretize import Panels, base_panels, kernel_operator, operator_rows
 from core.engines.collocation.steps import (
     MAX_STEPS,
     CollocationSystem,
@@ -49,9 +49,9 @@ from core.engines.collocation.steps import (
     fixed_grids,
     time_grid,
 )
-from core.problem.inputs import validate_times
-from core.problem.statements import QUANTITIES as _QUANTITIES
-from core.problem.statements import STATEMENTS as _STATEMENTS
+from core.problem import QUANTITIES as _QUANTITIES
+from core.problem import STATEMENTS as _STATEMENTS
+from core.problem import validate_times
 from core.validation import PYTHON_STYLE, finite_number, positive_number
 
 TimeInput = float | Callable[[np.ndarray], np.ndarray]

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve, rsf2csf, schur, solve_triangular
 
-from core.discretize.quadrature import Panels
+from core.discretize import Panels
 
 #: Coarsest nominal grid of the automatic time refinement, and the finest allowed.
 FIRST_STEPS = 16

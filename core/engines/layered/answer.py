@@ -2,7 +2,7 @@
 
 When every coating layer has constant thickness, modulus and Poisson ratio, the base is
 elastic (``{"model": "elastic"}``: no creep, no aging) and the punch shape is smooth,
-:func:`core.scene.pipeline.solve` answers with :func:`core.engines.layered.solve.solve_layered` (the plane
+:func:`core.scene.solve` answers with :func:`core.engines.layered.solve_layered` (the plane
 -strain response of the whole stack, smooth or bonded interfaces) instead of the thin
 (Winkler) layer: ``info["coating_model"] = "exact layered"``. The exact kernel solves the
 same continuum problem as the resolved finite-element model of :mod:`core.coating.fem_check`, so
@@ -41,17 +41,17 @@ from typing import Any
 
 import numpy as np
 
-from core.coating.model import model_error_estimate, tilt_share
+from core.coating import model_error_estimate, tilt_share
 from core.engines.layered.galerkin import MAX_MODES, MAX_NODES, default_modes, node_count
 from core.engines.layered.solve import solve_layered
-from core.kernel.layered import UniformLayer, table_cost
-from core.problem.result import ContactSolution
+from core.kernel import UniformLayer, table_cost
+from core.problem import ContactSolution
 
 __all__ = ["layered_declines", "solve_scene_layered"]
 
 #: Time samples of the load histories for the largest tilt between output times.
 TILT_SAMPLES = 257
-#: Most cosines the stack's kernel table may take (:func:`core.kernel.layered.table_cost`):
+#: Most cosines the stack's kernel table may take (:func:`core.kernel.table_cost`):
 #: measured 3.5e6 in 0.06 s of CPU (a / H = 20, h = a / 20), 1.6e7 in 0.32 s (a / H = 10,
 #: h = 0.003 a), 2.2e7 in 0.21 s (a / H = 50, h = a / 20): ~1 s at the bound; beyond, the
 #: thin layer answers (~0.1 s).
@@ -63,7 +63,7 @@ LIFT_OFF_SHARE = 1e-9
 @lru_cache(maxsize=64)
 def _table_cost(largest_s: float, layers: tuple[UniformLayer, ...],
                 base_thickness: float) -> float:
-    """:func:`core.kernel.layered.table_cost`, kept per stack: ~20 ms of a warm solve."""
+    """:func:`core.kernel.table_cost`, kept per stack: ~20 ms of a warm solve."""
     return table_cost(largest_s, layers, base_thickness)
 
 
@@ -71,7 +71,7 @@ def _constant(profile: Any) -> float:
     return float(np.asarray(profile(np.zeros(1)), dtype=float).ravel()[0])
 
 
-def _layers(scene: Any) -> list[UniformLayer]:
+def uniform_layers(scene: Any) -> list[UniformLayer]:
     return [UniformLayer(_constant(layer.thickness), _constant(layer.modulus),
                          _constant(layer.poisson), layer.interface)
             for layer in scene.coating]
@@ -88,7 +88,7 @@ def layered_declines(scene: Any, problem: Any) -> str | None:
     if not all(getattr(p, "kind", None) == "constant" for layer in scene.coating
                for p in (layer.thickness, layer.modulus, layer.poisson)):
         return "the coating varies along x"
-    layers = _layers(scene)
+    layers = uniform_layers(scene)
     modes = default_modes(scene.half_width, layers)
     if modes > MAX_MODES or node_count(scene.half_width, layers, modes) > MAX_NODES:
         return "the coating is thinner than the layered solve resolves"
@@ -119,7 +119,7 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
     if layered_declines(scene, problem) is not None:
         return None
     start = time.perf_counter()
-    layers = _layers(scene)
+    layers = uniform_layers(scene)
     a = scene.half_width
     times = np.asarray(problem.times, dtype=float)
     answer = solve_layered(a, layers, scene.base_thickness, problem.modulus_at_loading,

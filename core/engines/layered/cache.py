@@ -1,10 +1,10 @@
 """Bounded caches of the exact layered solve, so a load change re-solves nothing geometric.
 
-:func:`core.engines.layered.solve.solve_layered` builds, per geometry, three things that do not
+:func:`core.engines.layered.solve_layered` builds, per geometry, three things that do not
 depend on the loads, each kept in its own :class:`core.cache.StageCache` (counted, cleared
 by :func:`core.cache.clear_caches`):
 
-- ``layered_table``: the stack's regular part (:class:`core.kernel.layered.RegularPartTable`),
+- ``layered_table``: the stack's regular part (:class:`core.kernel.RegularPartTable`),
   keyed by the stack (``a / H``, the layers, the base) and the table's degree; about a
   third of a new geometry's solve;
 - ``layered_operator``: the Galerkin matrix, keyed by the stack, the table's degree, the
@@ -15,7 +15,7 @@ by :func:`core.cache.clear_caches`):
   breakpoints.
 
 A load slider's step (settlement, tilt, force, moment) is then the superposition of the
-cached unit responses (:meth:`core.engines.layered.solve.LayeredResponse.complete`).
+cached unit responses (:meth:`core.engines.layered.LayeredResponse.complete`).
 
 Gaps are callables: they are recognised by their values on :data:`GAP_PROBES` Chebyshev
 points and on both sides of each breakpoint (as :mod:`core.engines.nystrom.prepared` does).
@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from core.cache import StageCache, fingerprint
-from core.kernel.layered import UniformLayer
+from core.kernel import UniformLayer
 
 __all__ = ["CHEBYSHEV_ROWS", "GAP_MOMENTS", "KeptValues", "LAYERED_BYTES", "LAYERED_OPERATOR",
            "LAYERED_RESPONSE", "LAYERED_TABLE", "gap_key", "share_budget", "stack_key"]

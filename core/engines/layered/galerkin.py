@@ -4,7 +4,7 @@ The pressure ``q*(t) = sum_n c_n T_n(t) / sqrt(1 - t^2)`` (n < modes) on the sta
 ``k_stack(lam (t - s)) = -L_inf ln|t - s| + K(t - s)`` (:mod:`core.engines.layered.solve`): the
 logarithmic part's Galerkin matrix is diagonal, the smooth part's comes from ``K`` on
 Gauss-Chebyshev nodes through two DCTs (:func:`galerkin_matrix`), ``K`` read from the
-stack's table (:class:`core.kernel.layered.RegularPartTable`). How many modes and nodes,
+stack's table (:class:`core.kernel.RegularPartTable`). How many modes and nodes,
 and the table's degree, follow from the coating's thinnest layer and the tolerance
 (:func:`default_modes`, :func:`node_count`, :func:`table_degree`): tolerances of
 :data:`COARSE_TOL` and above take coarser rules, measured to leave <= 2.3e-10.
@@ -17,12 +17,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from scipy.fft import dct, next_fast_len
 
-from core.kernel.layered import (
-    _PANEL_DEGREE,
-    COARSE_PANEL_DEGREE,
-    RegularPartTable,
-    UniformLayer,
-)
+from core.kernel import COARSE_PANEL_DEGREE, PANEL_DEGREE, RegularPartTable, UniformLayer
 
 __all__ = ["COARSE_TOL", "MAX_MODES", "MAX_NODES", "default_modes", "galerkin_matrix",
            "gap_moments", "node_count", "table_degree"]
@@ -82,7 +77,7 @@ def node_count(half_width: float, layers: Sequence[UniformLayer], modes: int, *,
 
 def table_degree(tol: float) -> int:
     """The Chebyshev degree [-] of the stack's table for a solve to ``tol`` [-]."""
-    return COARSE_PANEL_DEGREE if tol >= COARSE_TOL else _PANEL_DEGREE
+    return COARSE_PANEL_DEGREE if tol >= COARSE_TOL else PANEL_DEGREE
 
 
 def default_modes(half_width: float, layers: Sequence[UniformLayer]) -> int:

@@ -27,7 +27,7 @@ M`` then give the other two (the four statements). The error estimate compares t
 with the one of half the modes on the same nodes (the leading block of the same system)
 and extrapolates the two last differences geometrically (:func:`solve_layered`).
 
-:func:`core.engines.layered.stiffness.flat_punch_stiffness` is the flat-punch special case in SI
+:func:`core.engines.layered.flat_punch_stiffness` is the flat-punch special case in SI
 units (force per unit settlement, moment per unit tilt), which the FE comparison
 (``benchmarks/layered_kernel.py``) uses.
 """
@@ -60,7 +60,7 @@ from core.engines.layered.galerkin import (
     node_count,
     table_degree,
 )
-from core.kernel.layered import RegularPartTable, UniformLayer, symbol_at_infinity
+from core.kernel import RegularPartTable, UniformLayer, symbol_at_infinity
 
 __all__ = ["LayeredAnswer", "LayeredResponse", "MAX_MODES", "MAX_NODES", "default_modes",
            "layered_response", "node_count", "solve_layered", "table_degree"]
@@ -134,7 +134,7 @@ class LayeredResponse:
 
 
 #: The most values (points x modes) of a point set whose Chebyshev rows are kept (2 MiB;
-#: :data:`core.engines.layered.cache.CHEBYSHEV_ROWS`).
+#: :data:`core.engines.layered.CHEBYSHEV_ROWS`).
 _CHEBYSHEV_MOST_VALUES = 2**18
 
 
@@ -206,7 +206,7 @@ def _unit_responses(lam: float, matrix: np.ndarray, gap: Gap, breakpoints: Seque
         np.linalg.solve(matrix[:n, :n], rhs[:n]) for n in blocks), n_nodes)
 
 
-def _cached_response(half_width: float, layers: Sequence[UniformLayer],
+def cached_response(half_width: float, layers: Sequence[UniformLayer],
                      base_thickness: float, base_modulus: float, base_poisson: float,
                      gap: Gap, breakpoints: Sequence[float], modes: int,
                      keys: tuple[str, str], built: dict[str, float],
@@ -328,7 +328,7 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
     start = time.perf_counter()
     unknowns = [n for n in _NAMES if n not in given]
     while True:
-        response = _cached_response(half_width, layers, base_thickness, base_modulus,
+        response = cached_response(half_width, layers, base_thickness, base_modulus,
                                     base_poisson, gap, breakpoints, modes, keys, built,
                                     tol=tol, room=room)
         fine = response.complete(given)

@@ -9,8 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.engines.layered.solve import default_modes, layered_response
-from core.kernel.layered import UniformLayer
+from core.engines.layered.galerkin import default_modes
+from core.engines.layered.solve import layered_response
+from core.kernel import UniformLayer
 
 __all__ = ["FlatPunchStiffness", "flat_punch_stiffness"]
 

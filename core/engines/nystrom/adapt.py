@@ -1,4 +1,5 @@
-"""Adaptive refinement of the Nystrom grid and its error estimate (:mod:`core.engines.nystrom.bordered`).
+"""Adaptive refinement of the Nystrom grid (:mod:`core.engines.nystrom.bordered`) and its
+error estimate.
 
 Refinement, in two parts:
 - away from ``+-1`` and the jumps q is analytic: a panel whose last three Legendre
@@ -22,7 +23,7 @@ responses of the last grid serve the bordered solve of the loads (a 2 x 2 Schur
 complement). A refined grid is solved with the factors of the grid it refines (two-grid
 steps, :mod:`core.engines.nystrom.twogrid`) and factored only if a later solve asks for it. From
 200 nodes the LUs are single-precision factors whose solves are refined against the
-double-precision operator (:class:`core.engines.nystrom.bordered.NodalLU`).
+double-precision operator (:class:`core.engines.nystrom.NodalLU`).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.discretize.quadrature import (
+from core.discretize import (
     NODES_PER_PANEL,
     Panels,
     base_panels,

@@ -32,9 +32,8 @@ import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 from scipy.linalg.lapack import dgetrs, sgetrs
 
-from core.discretize.quadrature import (
+from core.discretize import (
     FRESH_SHARE,
-    FULL_ACCURACY,
     NODES_PER_PANEL,
     KernelOperator,
     Panels,
@@ -42,6 +41,7 @@ from core.discretize.quadrature import (
     kernel_operator,
     operator_rows,
 )
+from core.kernel import FULL_ACCURACY
 
 Function = Callable[[np.ndarray], np.ndarray]
 

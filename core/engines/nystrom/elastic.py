@@ -18,9 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from core.discretize.panels import NODES_PER_PANEL
-from core.problem.inputs import TimeInputs
-from core.problem.statements import QUANTITIES
+from core.discretize import NODES_PER_PANEL
+from core.problem import QUANTITIES, TimeInputs
 
 #: Probe times per block when the extremes of q over the check points are sought: a block
 #: of (405 check points x 512 times) is 1.6 MB, so it stays in the cache between the
@@ -36,7 +35,7 @@ class ElasticUnits:
     Column ``k`` of every array is the response to the ``k``-th given load (sorted by name)
     = 1 with the other load 0 and no gap, and the last column the response to the gap
     alone. ``nodal`` (N, 3) holds nodal pressures, ``unknowns`` (2, 3) the two quantities
-    that are not given (in the order of :data:`core.problem.statements.QUANTITIES`).
+    that are not given (in the order of :data:`core.problem.QUANTITIES`).
     """
 
     def __init__(self, prepared: Any, given: frozenset[str], c0: float) -> None:
@@ -86,7 +85,7 @@ class ElasticUnits:
         """Unit-response pressures at the prepared check points (X, 3), cached.
 
         Where the formula is needed (panels touching +-1 or a jump) it is used; elsewhere
-        the panel interpolant (see :class:`core.engines.nystrom.prepared.PreparedContact`).
+        the panel interpolant (see :class:`core.engines.nystrom.PreparedContact`).
         """
         if self._check is None:
             prepared = self._prepared

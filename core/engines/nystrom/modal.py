@@ -12,7 +12,7 @@ into exactly the seed's Galerkin rows,
 
     c a_i + (I - V) sum_j R_ij a_j = delta e0_i + alpha e1_i + f_i,   R = P^T W A P,
 
-with the gap as a constant drive ``f = -P^T W g``, so :func:`core.problem.statements.modal_system`
+with the gap as a constant drive ``f = -P^T W g``, so :func:`core.problem.modal_system`
 decouples them (its free block diagonalized as it is: the product-integration rows of
 ``A`` are not symmetric, but the operator is similar to a symmetric positive one) and
 :mod:`core.time.integration` steps one scalar Volterra equation per mode.
@@ -33,8 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.engines.nystrom.bordered import NystromGrid
-from core.problem.statements import ModalSystem, UnresolvedOperator, modal_system
-from core.time.integration import ModalProblem, solve_degenerate, solve_general
+from core.problem import ModalSystem, UnresolvedOperator, modal_system
+from core.time import ModalProblem, solve_degenerate, solve_general
 
 Function = Callable[[np.ndarray], np.ndarray]
 
@@ -127,7 +127,7 @@ class ModalForm:
 
     def __init__(self, grid: NystromGrid, given: frozenset[str], tol: float = 1e-8) -> None:
         """``tol``: the relative accuracy the modes serve (see MODAL_ROUNDING_SHARE);
-        raises :class:`core.problem.statements.UnresolvedOperator` when they cannot."""
+        raises :class:`core.problem.UnresolvedOperator` when they cannot."""
         w, m, x = grid.panels.weights, grid.m, grid.nodes
         s_in = np.sqrt(w / m)  # row scaling S^-1 W
         s_out = 1.0 / np.sqrt(w * m)  # column scaling S^-1

@@ -4,8 +4,8 @@
     sol = prepared.solve(times, force=P, moment=M, c=..., kernel=...)  # loads: cheap
 
 :func:`prepare` validates the geometry, grades and refines the panels until the pressure
-is resolved to ``tol`` (:mod:`core.engines.nystrom.adapt`) and keeps the grid. Everything a solve needs
-beyond that is built on first use and kept on the object, keyed by exactly what it
+is resolved to ``tol`` (:mod:`core.engines.nystrom.adapt`) and keeps the grid. Everything a
+solve needs beyond that is built on first use and kept on the object, keyed by exactly what it
 depends on:
 
 ==============  ==================================  =========================================
@@ -34,21 +34,21 @@ from typing import Any
 import numpy as np
 
 from core.cache import StageCache
-from core.creep.kernel_fit import stepping_kernel
-from core.discretize.panels import NODES_PER_PANEL, interpolation_weights, panel_index
+from core.creep import stepping_kernel
+from core.discretize import NODES_PER_PANEL, interpolation_weights, panel_index
 from core.engines.nystrom.adapt import adapt
 from core.engines.nystrom.bordered import BorderedSystem, touches
 from core.engines.nystrom.elastic import ElasticUnits, elastic_answer
 from core.engines.nystrom.modal import ModalAnswer, ModalForm
 from core.engines.nystrom.result import TimeSide, nystrom_solution
-from core.problem.inputs import (
+from core.problem import (
+    ContactSolution,
     Geometry,
     Scalar,
     TimeInputs,
     validate_geometry,
     validate_time_inputs,
 )
-from core.problem.result import ContactSolution
 
 #: The time stepping aims this many times below its share of tol: its step-doubling
 #: estimate read up to ~20x the true error on decaying creep (see core/solver.py).
@@ -115,7 +115,8 @@ def _check_points(breakpoints: Sequence[float]) -> np.ndarray:
 class PreparedContact:
     """The geometry of one problem, discretized once (see the module notes).
 
-    Attributes: ``geometry`` (validated inputs), ``grid`` (:class:`core.engines.nystrom.bordered.NystromGrid`),
+    Attributes: ``geometry`` (validated inputs), ``grid``
+    (:class:`core.engines.nystrom.bordered.NystromGrid`),
     ``spatial_error`` (estimated relative error of q), ``resolved``, ``counts``
     (evaluations of each cached member), ``seconds`` (time spent preparing).
     """
@@ -252,7 +253,7 @@ class PreparedContact:
 
     def solve_validated(self, inputs: TimeInputs, time_breaks: Sequence[float] = (),
                         *, check_only: bool = False) -> ContactSolution:
-        """:meth:`solve` for inputs already checked by :func:`core.problem.inputs.validate_time_inputs`.
+        """:meth:`solve` for inputs already checked by :func:`core.problem.validate_time_inputs`.
 
         ``time_breaks``: times where a given history jumps or kinks (dimensionless).
         ``check_only``: a preliminary solve (the contact check of ``contact="auto"``) that

@@ -1,7 +1,7 @@
 """The result object of a prepared (Nystrom) solve: success, message, flags and timings.
 
-Kept apart from :mod:`core.engines.nystrom.prepared`, which computes the answer; this module only judges
-it against ``tol`` and packs it like the other engines do (``ContactSolution`` with an
+Kept apart from :mod:`core.engines.nystrom.prepared`, which computes the answer; this module
+only judges it against ``tol`` and packs it like the other engines do (``ContactSolution`` with an
 ``info`` dict in the spirit of scipy's ``OdeResult``).
 """
 
@@ -13,9 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from core.problem.inputs import TimeInputs
-from core.problem.result import ContactSolution
-from core.problem.statements import QUANTITIES, statement_number
+from core.problem import QUANTITIES, ContactSolution, TimeInputs, statement_number
 
 
 @dataclass(frozen=True)
@@ -34,7 +32,7 @@ def nystrom_solution(prepared: Any, inputs: TimeInputs, scalars: dict[str, np.nd
                      q_extremes: tuple[float, float], time_side: TimeSide, seconds: float,
                      built: dict[str, int], max_abs_tilt: float, first_solve: bool
                      ) -> ContactSolution:
-    """Pack the answer of ``prepared.solve`` (a :class:`core.engines.nystrom.prepared.PreparedContact`).
+    """Pack the answer of ``prepared.solve`` (a :class:`core.engines.nystrom.PreparedContact`).
 
     ``q_extremes``: (min q, max |q|) over the check points and probe times; ``seconds``:
     time of this solve [s]; ``built``: cached members this solve built.

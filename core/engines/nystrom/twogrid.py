@@ -1,6 +1,6 @@
 """The refined grid's equations solved with the factors of the grid it refines (two-grid).
 
-The grading loop of :func:`core.engines.nystrom.adapt.adapt` solves on a grid and on its
+The grading loop of :func:`core.engines.nystrom.adapt` solves on a grid and on its
 refinement toward +-1 and the jumps, which splits the few panels there and keeps every
 other one. The refined grid's nodal matrix ``M1 = c m + A1`` then needs no factors of its
 own: one step of
@@ -29,8 +29,14 @@ import numpy as np
 from numpy.polynomial import legendre as npleg
 from scipy.linalg.lapack import dgetrf, dgetrs
 
-from core.discretize.panels import _T, _TO_COEF, Panels, panel_index
-from core.discretize.quadrature import NODES_PER_PANEL, panel_nodes
+from core.discretize import (
+    GAUSS_NODES,
+    NODES_PER_PANEL,
+    VALUES_TO_LEGENDRE,
+    Panels,
+    panel_index,
+    panel_nodes,
+)
 from core.engines.nystrom.bordered import REFINED, NodalLU, NystromGrid
 
 #: Steps before giving up (two suffice on every scene measured; the rest is a margin).
@@ -40,7 +46,7 @@ CONTRACTION = 0.1
 
 
 class DeferredFactor:
-    """Factors of ``c m + A`` on a grid (:class:`core.engines.nystrom.bordered.NodalLU`), taken at the first
+    """Factors of ``c m + A`` on a grid (:class:`core.engines.nystrom.NodalLU`), taken at the first
     solve: a grid solved by :class:`TwoGridSolver` needs none unless a later solve asks."""
 
     def __init__(self, grid: NystromGrid, c: float) -> None:
@@ -65,7 +71,7 @@ class DeferredFactor:
         return self._factors().solve(rhs)
 
     def rough_solve(self, rhs: np.ndarray) -> np.ndarray:
-        """:meth:`core.engines.nystrom.bordered.NodalLU.rough_solve` of the factors."""
+        """:meth:`core.engines.nystrom.NodalLU.rough_solve` of the factors."""
         return self._factors().rough_solve(rhs)
 
 
@@ -97,7 +103,7 @@ def _weights(key: tuple, compute) -> np.ndarray:
 
 def _to_piece(ratio: float, offset: float) -> np.ndarray:
     """Values at a piece's 16 nodes of the whole panel's interpolant (16 x 16)."""
-    return _interpolant_at(offset + ratio * _T)
+    return _interpolant_at(offset + ratio * GAUSS_NODES)
 
 
 def _to_whole(pieces: tuple[tuple[float, float], ...]) -> np.ndarray:
@@ -106,9 +112,9 @@ def _to_whole(pieces: tuple[tuple[float, float], ...]) -> np.ndarray:
     out = np.zeros((NODES_PER_PANEL, NODES_PER_PANEL * len(pieces)))
     taken = np.zeros(NODES_PER_PANEL, dtype=bool)
     for k, (ratio, offset) in enumerate(pieces):
-        inside = (np.abs(_T - offset) <= ratio * (1.0 + 1e-14)) & ~taken
+        inside = (np.abs(GAUSS_NODES - offset) <= ratio * (1.0 + 1e-14)) & ~taken
         taken |= inside
-        local = (_T[inside] - offset) / ratio
+        local = (GAUSS_NODES[inside] - offset) / ratio
         out[np.ix_(inside, np.arange(k * NODES_PER_PANEL, (k + 1) * NODES_PER_PANEL))] = (
             _interpolant_at(local))
     return out
@@ -116,13 +122,13 @@ def _to_whole(pieces: tuple[tuple[float, float], ...]) -> np.ndarray:
 
 def _interpolant_at(t: np.ndarray) -> np.ndarray:
     """Weights (len(t), 16) of the interpolant through the 16 Gauss nodes at ``t`` in [-1, 1]."""
-    return npleg.legvander(t, NODES_PER_PANEL - 1) @ _TO_COEF
+    return npleg.legvander(t, NODES_PER_PANEL - 1) @ VALUES_TO_LEGENDRE
 
 
 class TwoGridSolver:
     """Solves ``(c m + A1) x = b`` on ``fine`` with the factors of ``c m + A0`` on ``coarse``.
 
-    ``kept_new``, ``kept_old``, ``fresh``: :func:`core.discretize.quadrature.shared_panels` of the two
+    ``kept_new``, ``kept_old``, ``fresh``: :func:`core.discretize.shared_panels` of the two
     grids. The coarse panels must be unions of fine ones (the refinements of
     :mod:`core.engines.nystrom.adapt` only cut panels); :meth:`solve` returns ``None`` otherwise.
     """
@@ -201,7 +207,7 @@ class TwoGridSolver:
         ``None`` if the steps do not contract (then factor the matrix instead).
 
         Stops when the error left (estimated from the last two corrections, as
-        :class:`core.engines.nystrom.bordered.NodalLU` does) is below a tenth of the operator's accuracy,
+        :class:`core.engines.nystrom.NodalLU` does) is below a tenth of the operator's accuracy,
         relative to the solution.
         """
         if not self.nested:

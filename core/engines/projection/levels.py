@@ -15,8 +15,8 @@ from core.cache import fingerprint
 from core.engines.projection.caches import _RESPONSE
 from core.engines.projection.matrices import GapTerms
 from core.engines.projection.stages import _Discretization, _Inputs
-from core.problem.statements import QUANTITIES, ModalSystem
-from core.time.integration import ModalProblem, solve_degenerate, solve_general
+from core.problem import QUANTITIES, ModalSystem
+from core.time import ModalProblem, solve_degenerate, solve_general
 
 # ---------------------------------------------------------------------- time stage
 

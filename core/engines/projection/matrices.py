@@ -17,8 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.discretize.basis import Basis
-from core.discretize.quadrature import KernelOperator
+from core.discretize import Basis, KernelOperator
 
 
 @dataclass(frozen=True)
@@ -34,7 +33,7 @@ def galerkin_matrix(operator: KernelOperator, basis: Basis, m_values: np.ndarray
                     correction: np.ndarray | None = None) -> np.ndarray:
     """``R`` (n x n) for all functions of ``basis`` (dimensionless).
 
-    ``correction``: :func:`core.discretize.galerkin.galerkin_correction` of the operator's panels,
+    ``correction``: :func:`core.discretize.galerkin_correction` of the operator's panels,
     needed by a basis with kinks or jumps at panel ends (the ``"graded"`` basis).
     """
     phi = basis.values / m_values[:, None]

@@ -43,8 +43,7 @@ from core.engines.projection.levels import (
     _Superposition,
 )
 from core.engines.projection.stages import _discretize, _Inputs, _modes
-from core.problem.result import ContactSolution
-from core.problem.statements import statement_number
+from core.problem import ContactSolution, statement_number
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
@@ -65,8 +64,8 @@ SUCCESS_MARGIN = 3.0
 
 
 def _fast_kernel(inp: _Inputs) -> tuple[_Inputs, float]:
-    """The kernel to step with, and the error of its fit (see core.creep.kernel_fit.stepping_kernel)."""
-    from core.creep.kernel_fit import stepping_kernel
+    """The kernel to step with, and the error of its fit (see core.creep.stepping_kernel)."""
+    from core.creep import stepping_kernel
 
     kernel, fit_error = stepping_kernel(inp.kernel, float(inp.times[-1]),
                                         0.5 * inp.tol / SUCCESS_MARGIN)

@@ -14,12 +14,14 @@ from typing import Any
 import numpy as np
 
 from core.cache import StageCache, fingerprint
-from core.discretize.basis import Basis, build_basis, graded_cuts
-from core.discretize.galerkin import galerkin_correction
-from core.discretize.quadrature import (
+from core.discretize import (
+    Basis,
     KernelOperator,
     Panels,
     base_panels,
+    build_basis,
+    galerkin_correction,
+    graded_cuts,
     kernel_operator,
     operator_rows,
     refine_to_resolve,
@@ -35,8 +37,13 @@ from core.engines.projection.caches import (
     _SAMPLE_ROWS,
 )
 from core.engines.projection.matrices import GapTerms, galerkin_matrix, gap_terms
-from core.problem.inputs import check_values, validate_geometry, validate_time_inputs
-from core.problem.statements import ModalSystem, modal_system
+from core.problem import (
+    ModalSystem,
+    check_values,
+    modal_system,
+    validate_geometry,
+    validate_time_inputs,
+)
 
 # ---------------------------------------------------------------------- validation
 
