@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 import core
-from benchmarks.scenes import suite
+from tests.support.scenes import suite
 
 PRESETS = Path(__file__).resolve().parent.parent / "assets" / "scenes"
 X = np.linspace(-1.0, 1.0, 41)

@@ -5,7 +5,7 @@ Run from the repository root:
     OPENBLAS_NUM_THREADS=1 python -m benchmarks.creep_goals [--repeats 5]
 
 The same solves as the creep goals of ``benchmarks/engines.py`` (the ``aging_creep``
-scene of :mod:`benchmarks.scenes` with 100 and 1000 output times over 1000 days, tol
+scene of :mod:`tests.support.scenes` with 100 and 1000 output times over 1000 days, tol
 1e-6: a new scene with every cache cleared, then only the loads changed on a prepared
 geometry) and the 50-year preset ``assets/scenes/young_concrete_50_years.json`` with
 both design-code models (a new scene, and a load change rebuilt from the scene dict).
@@ -28,10 +28,10 @@ from typing import Any
 import numpy as np
 
 import core
-from benchmarks.scenes import creep_times, suite
 from core.cache import clear_caches
 from core.scene import scene_from_dict
 from core.solver import solve_dimensionless
+from tests.support.scenes import creep_times, suite
 
 PRESET = Path(__file__).resolve().parents[1] / "assets" / "scenes" / \
     "young_concrete_50_years.json"

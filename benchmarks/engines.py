@@ -3,7 +3,7 @@
     python benchmarks/engines.py            # all scenes, report in benchmarks/results/
     python benchmarks/engines.py --quick    # three scenes, fewer repeats
 
-For each scene of :mod:`benchmarks.scenes`: the default engine (``method="nystrom"``) and
+For each scene of :mod:`tests.support.scenes`: the default engine (``method="nystrom"``) and
 the seed's projection (``method="projection"``), each swept over ``tol``. The error is the
 largest of delta, alpha (relative to max(|delta|, |alpha|)), P, M (relative to
 max(|P|, |M|)) and q relative to max|q| on 2001 points of the whole of [-1, 1] (both ends,
@@ -46,9 +46,9 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 import core  # noqa: E402
-from benchmarks.scenes import Scene, creep_times, suite  # noqa: E402
 from core.cache import clear_caches  # noqa: E402
 from core.solver import solve_dimensionless  # noqa: E402
+from tests.support.scenes import Scene, creep_times, suite  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 TOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9)

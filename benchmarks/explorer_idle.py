@@ -31,13 +31,13 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.explorer_latency import READY  # noqa: E402
-from benchmarks.serving import (  # noqa: E402
+from explorer.views.tabs import FILL_TABS_AFTER_MS  # noqa: E402
+from tests.support.serving import (  # noqa: E402
     CHROMIUM,
     CHROMIUM_ARGS,
     ExplorerProcess,
     ExplorerStartError,
 )
-from explorer.views.tabs import FILL_TABS_AFTER_MS  # noqa: E402
 
 
 def _browser_processes() -> list[psutil.Process]:

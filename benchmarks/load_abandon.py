@@ -2,7 +2,7 @@
 
 Starts ``python -m explorer`` on 127.0.0.1, drops a few sessions to load what every page
 needs once, then drops ``--dropped`` more in rounds of ``--round`` (the four ways of
-:mod:`benchmarks.abandon`, in equal shares). After each round it first waits as long as
+:mod:`tests.support.abandon`, in equal shares). After each round it first waits as long as
 the server needs to discard the round's sessions (the linger, one check interval of the
 same length, the collection delay of :mod:`explorer.gc_policy` and a margin), then until
 the memory settles, and records the server's resident memory and its solver processes'
@@ -23,9 +23,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from benchmarks.abandon import WAYS, abandon_sessions
-from benchmarks.serving import ExplorerProcess, ExplorerStartError
-from explorer.gc_policy import COLLECT_AFTER_S, LATE_COLLECT_AFTER_S
+from tests.support.abandon import WAYS, abandon_sessions, discard_wait_s
+from tests.support.serving import ExplorerProcess, ExplorerStartError
 
 #: Visits that load what every page needs once, before the baseline is read.
 WARM_UP_VISITS = 2 * len(WAYS)
@@ -34,9 +33,6 @@ WARM_UP_VISITS = 2 * len(WAYS)
 SETTLE_MIB = 1.0
 SETTLE_PERIOD = 1.0
 SETTLE_READINGS = 4
-#: Added to the time the server needs to discard a round's sessions [s] (a loaded
-#: machine runs its timers late).
-DISCARD_MARGIN_S = 3.0
 #: Longest wait for the memory to settle after a round [s].
 SETTLE_LIMIT = 90.0
 
@@ -49,15 +45,6 @@ def memory_mib(pid: int) -> tuple[float, float]:
     server = rss_bytes(pid) or 0
     workers = sum(r for r in (rss_bytes(p) for p in process_tree(pid)[1:]) if r is not None)
     return server / 2**20, workers / 2**20
-
-
-def discard_wait_s(session_linger: float) -> float:
-    """How long after its connection is lost a session is surely discarded and collected
-    [s]: Bokeh keeps it ``session_linger`` s, looks for such sessions every
-    ``session_linger`` s (``python -m explorer`` sets both from --session-linger), the
-    full collection that frees its page comes ``COLLECT_AFTER_S`` later, and one more
-    for pages let go late ``LATE_COLLECT_AFTER_S`` after that."""
-    return 2 * session_linger + COLLECT_AFTER_S + LATE_COLLECT_AFTER_S + DISCARD_MARGIN_S
 
 
 def settled_mib(pid: int, session_linger: float) -> tuple[float, float, float]:
@@ -143,7 +130,7 @@ def run_abandon(args: argparse.Namespace, command: str) -> tuple[str, bool]:
         "",
         f"Visits: {WARM_UP_VISITS} to warm up, then {args.dropped} in rounds of "
         f"{args.round}, {args.at_once} at a time, each dropped by a connection reset at one "
-        f"of four points of its start ({', '.join(WAYS)}: benchmarks/abandon.py). After "
+        f"of four points of its start ({', '.join(WAYS)}: tests/support/abandon.py). After "
         f"each round the memory is read once the server has surely discarded the round's "
         f"sessions ({discard_wait_s(args.session_linger):g} s: linger, one check interval, "
         f"the two collections' delays, a margin) and {SETTLE_READINGS} readings "

@@ -57,8 +57,8 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from benchmarks.serving import CHROMIUM, ExplorerProcess, ExplorerStartError  # noqa: E402
-from benchmarks.serving import CHROMIUM_ARGS as BROWSER_ARGS  # noqa: E402
+from tests.support.serving import CHROMIUM, ExplorerProcess, ExplorerStartError  # noqa: E402
+from tests.support.serving import CHROMIUM_ARGS as BROWSER_ARGS  # noqa: E402
 
 CHROMIUM_ARGS = [*BROWSER_ARGS,
                  # pages of one browser compete for its renderers: none may be throttled

@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess  # noqa: E402
+from tests.support.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess  # noqa: E402
 
 READY = """() => {
   const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];

@@ -3,7 +3,7 @@
     python benchmarks/work_precision.py            # full report (about 17 minutes)
     python benchmarks/work_precision.py --quick    # reduced sweeps (about 30 s)
 
-For every scene of :mod:`benchmarks.scenes`: the error against a tight reference on the
+For every scene of :mod:`tests.support.scenes`: the error against a tight reference on the
 x axis, the run time on the y axis (log-log), one curve per method swept over its
 resolution:
 
@@ -51,10 +51,10 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from benchmarks.scenes import Scene, creep_times, suite  # noqa: E402
 from core.cache import clear_caches  # noqa: E402
 from core.engines.collocation.solve import solve_collocation  # noqa: E402
 from core.solver import solve_dimensionless  # noqa: E402
+from tests.support.scenes import Scene, creep_times, suite  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 #: Accuracy at which methods are compared (the goals are stated at it).

@@ -14,7 +14,7 @@ def require_browser() -> None:
     under CI (where the test set-up installs both) their absence fails instead."""
     import pytest
 
-    from benchmarks.serving import browser_missing
+    from tests.support.serving import browser_missing
 
     missing = browser_missing()
     if missing:
@@ -141,7 +141,7 @@ def chromium_context(width: int, height: int, **options):
 
     import playwright.sync_api as playwright_api
 
-    from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS
+    from tests.support.serving import CHROMIUM, CHROMIUM_ARGS
 
     profile = tempfile.mkdtemp(prefix="explorer-chromium-")
     with playwright_api.sync_playwright() as p:

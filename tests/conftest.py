@@ -18,7 +18,7 @@
   ``core.cli.main`` with stdout and stderr captured): a child process costs ~1 s of
   imports each and tests nothing more, except the entry point itself, which a few tests
   run for real (``run_cli(..., subprocess=True)``).
-- Scenes: the dimensionless benchmark problems come from ``benchmarks/scenes.py`` (one
+- Scenes: the dimensionless benchmark problems come from ``tests/support/scenes.py`` (one
   definition for the benchmarks and the tests); :func:`small_preset` is a preset of the
   explorer cut to a few output times, for tests that need a quick real solve.
 """
@@ -35,7 +35,7 @@ import mpmath
 import pytest
 from hypothesis import settings
 
-from benchmarks import scenes as benchmark_scenes
+from tests.support import scenes as benchmark_scenes
 
 # The suite draws the same examples on every run, so it cannot flake on a rare draw;
 # HYPOTHESIS_PROFILE=explore draws new ones when digging by hand.
@@ -94,7 +94,7 @@ def stage_evaluations(cold_caches: None) -> Callable[[], dict[str, int]]:
 
 @pytest.fixture(scope="session")
 def scenes() -> Any:
-    """The benchmark problems' module (``benchmarks/scenes.py``): ``smooth_m``,
+    """The benchmark problems' module (``tests/support/scenes.py``): ``smooth_m``,
     ``jump_m``, ``stepped_g``, ``CONCRETE``, ``suite()`` ..."""
     return benchmark_scenes
 
@@ -121,10 +121,10 @@ def small_preset_fixture() -> Callable[..., dict[str, Any]]:
 
 @pytest.fixture(scope="session")
 def explorer_server() -> Iterator[Any]:
-    """The served explorer of the browser tests (``benchmarks.serving.ExplorerProcess``,
+    """The served explorer of the browser tests (``tests.support.serving.ExplorerProcess``,
     default options, one BLAS thread): started when a test first asks, stopped at the end
     of the run."""
-    from benchmarks.serving import ExplorerProcess
+    from tests.support.serving import ExplorerProcess
 
     # 180 s: the server solves the default scene once before it answers
     with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as explorer:

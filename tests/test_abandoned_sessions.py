@@ -2,7 +2,7 @@
 
 A real server (``python -m explorer``, one worker process, sessions kept 1 s after their
 connection is lost instead of 15 s). Sessions are opened and dropped at every point of
-their start (benchmarks/abandon.py: the page asked for and dropped, the websocket
+their start (tests/support/abandon.py: the page asked for and dropped, the websocket
 dropped after its first message, after asking for the document, and a moment after the
 page reported itself ready). Afterwards the server's resident memory must come back to
 its level before those visitors, and its log must hold no traceback.
@@ -15,9 +15,8 @@ from collections.abc import Iterator
 
 import pytest
 
-from benchmarks.abandon import WAYS, abandon_sessions
-from benchmarks.load_abandon import discard_wait_s
-from benchmarks.serving import ExplorerProcess
+from tests.support.abandon import WAYS, abandon_sessions, discard_wait_s
+from tests.support.serving import ExplorerProcess
 
 pytestmark = pytest.mark.timeout(600)
 
@@ -63,7 +62,7 @@ def server() -> Iterator[ExplorerProcess]:
 
 def settled(pid: int, wait_until) -> float:
     """The server's memory once dropped sessions have been discarded and collected: after
-    the time the server needs for that (benchmarks/load_abandon.py: discard_wait_s), the
+    the time the server needs for that (tests/support/abandon.py: discard_wait_s), the
     level reached when three readings 1 s apart agree within 2 MiB (at most 60 s)."""
     time.sleep(discard_wait_s(LINGER_S))  # a condition on the server's state, not a bound
     readings: list[float] = []

@@ -190,8 +190,8 @@ def test_check_compares_in_full_contact_as_the_fe_model():
 def test_the_error_map_read_from_its_data_file_is_the_measured_one():
     import hashlib
 
-    from benchmarks.coating_validity import _table_json
     from core.coating import error_table as table
+    from tests.support.coating_table import table_json
     parts = [table.THICKNESS_RATIOS, table.MODULUS_RATIOS, table.COATING_POISSON,
              table.BASE_RATIOS] + [table.ERRORS[i][p] for i in ("smooth", "bonded")
                                    for p in ("force", "moment")]
@@ -207,4 +207,4 @@ def test_the_error_map_read_from_its_data_file_is_the_measured_one():
     errors = {i: {p: np.array(table.ERRORS[i][p]) for p in ("force", "moment")}
               for i in ("smooth", "bonded")}
     path = Path(table.__file__).with_name("error_table.json")
-    assert _table_json(errors) == path.read_text(encoding="utf-8")
+    assert table_json(errors) == path.read_text(encoding="utf-8")

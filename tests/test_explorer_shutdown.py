@@ -17,7 +17,7 @@ import urllib.request
 
 import pytest
 
-from benchmarks.serving import ExplorerProcess
+from tests.support.serving import ExplorerProcess
 
 pytestmark = pytest.mark.timeout(600)
 

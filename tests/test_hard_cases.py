@@ -30,11 +30,11 @@ from typing import Any
 import numpy as np
 import pytest
 
-from benchmarks.scenes import CONCRETE, TEN_LAYERS, jump_m, rough_g, smooth_m, stepped_g
 from core.creep.models import ExponentialCreep
 from core.discretize import base_panels, build_basis, graded_cuts
 from core.engines.collocation.solve import solve_collocation
 from core.solver import solve_dimensionless as _solve_dimensionless
+from tests.support.scenes import CONCRETE, TEN_LAYERS, jump_m, rough_g, smooth_m, stepped_g
 
 
 def solve_dimensionless(*args: Any, **kwargs: Any):
@@ -42,7 +42,7 @@ def solve_dimensionless(*args: Any, **kwargs: Any):
     return _solve_dimensionless(*args, method="projection", **kwargs)
 
 # ------------------------------------------------------------------------------ cases
-# The coatings, gaps and creep of the benchmark suite (benchmarks/scenes.py); the ten
+# The coatings, gaps and creep of the benchmark suite (tests/support/scenes.py); the ten
 # layers here are scaled to a mean m of 0.13 (the benchmark's: 0.08).
 
 

@@ -5,7 +5,7 @@ Accuracy is measured as the engine claims it: q on the whole of [-1, 1] (3001 Ch
 points, both ends and both sides of every jump) relative to max|q|, and delta, alpha, P,
 M relative to their scales, against (a) the same engine at tol 1e-10 (convergence under
 refinement) and (b) the independent projection method at tol 1e-10 on interior points.
-The measured values quoted in the comments come from benchmarks/scenes.py's scenes on
+The measured values quoted in the comments come from tests/support/scenes.py's scenes on
 this version (errors/estimates 0.11-0.38 at tol 1e-4, 1e-6, 1e-8).
 """
 
@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 
 import core
-from benchmarks.scenes import jump_m, smooth_m, stepped_g, tiny_m
 from core.creep.models import Arutyunyan
 from core.solver import solve_dimensionless
+from tests.support.scenes import jump_m, smooth_m, stepped_g, tiny_m
 
 SCENES = {
     "smooth": dict(lam=1.0, m=smooth_m, g=0.0, breakpoints=()),

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import core
-from benchmarks.scenes import jump_m
 from core.engines.nystrom.elastic import CHECK_BLOCK
 from core.engines.nystrom.prepared import HISTORY_SAMPLES
+from tests.support.scenes import jump_m
 
 
 def force(t: np.ndarray) -> np.ndarray:

@@ -26,7 +26,6 @@ import numpy as np
 import pytest
 
 import core.scene.schema as scene_schema
-from benchmarks.serving import CHROMIUM, CHROMIUM_ARGS
 from core.cli import main as cli_main
 from core.profiles import profile_from_csv
 from core.scene import MAX_SCENE_BYTES, load_scene, save_scene, scene_from_dict, solve
@@ -35,6 +34,7 @@ from core.scene.schema import MAX_BREAKPOINTS, migrate
 from explorer.links import MAX_JSON, PREFIX, decode_scene, encode_scene
 from tests.browser_pages import require_browser, served_explorer
 from tests.cli_runs import run_cli
+from tests.support.serving import CHROMIUM, CHROMIUM_ARGS
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "assets" / "scenes"

@@ -1,12 +1,12 @@
 """The server's marks of a slider move (explorer/trace.py) and how the latency benchmark
-pairs them up (benchmarks/explorer_latency.py)."""
+pairs them up (tests/support/trace_steps.py, for benchmarks/explorer_latency.py)."""
 
 from __future__ import annotations
 
 import json
 
 import explorer.trace as trace
-from benchmarks.explorer_latency import STEPS, server_steps
+from tests.support.trace_steps import STEPS, server_steps
 
 
 def test_marks_are_off_unless_a_file_is_named(monkeypatch, tmp_path) -> None:

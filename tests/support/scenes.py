@@ -214,7 +214,7 @@ def suite() -> list[Scene]:
               1.0, tiny_m, 0.0, eccentric),
         Scene("ten_layers", "Ten layers",
               "lam = 1, m = s sum_k (1 - nu_k^2) h_k(x)/E_k(x) over ten layers "
-              "(benchmarks/scenes.py: TEN_LAYERS; mean m = 0.08), g = 0, P = 1, M = 0.1, "
+              "(tests/support/scenes.py: TEN_LAYERS; mean m = 0.08), g = 0, P = 1, M = 0.1, "
               "elastic",
               1.0, ten_layer_m, 0.0, eccentric, smooth=True),
         Scene("aging_creep", "Aging creep, 1000 days, 500 output times",

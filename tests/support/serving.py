@@ -37,7 +37,7 @@ CHROMIUM_ARGS = ("--headless=new", "--no-sandbox", "--disable-gpu",
 
 # The directory holding the `explorer` and `core` packages (the repository root in a
 # checkout): the child must import the same code as its parent, wherever it was started.
-_PACKAGE_PARENT = Path(__file__).resolve().parent.parent
+_PACKAGE_PARENT = Path(__file__).resolve().parents[2]
 
 # Lines of the server's output quoted when it fails to start: enough for a traceback.
 _TAIL_LINES = 60

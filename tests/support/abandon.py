@@ -12,7 +12,8 @@ connection reset (no closing handshake, as when a laptop lid shuts or a process 
   rendered, so the page fills its tabs and solves) and the connection is dropped a moment
   later, at a random point of that work.
 
-Used by ``benchmarks/load_test.py --mode abandon`` and by tests/test_abandoned_sessions.py.
+Used by ``benchmarks/load_test.py --mode abandon`` and by
+tests/explorer/test_abandoned_sessions.py.
 Loopback only; the number of visits is bounded by the caller. Speaks the Bokeh websocket
 protocol directly (tornado's client), so a visit costs the client almost nothing.
 """
@@ -27,7 +28,21 @@ import struct
 from collections import Counter
 from typing import Any
 
+from explorer.gc_policy import COLLECT_AFTER_S, LATE_COLLECT_AFTER_S
+
 WAYS = ("get", "ack", "pull", "loaded")
+#: Added to the time the server needs to discard a round's sessions [s] (a loaded
+#: machine runs its timers late).
+DISCARD_MARGIN_S = 3.0
+
+
+def discard_wait_s(session_linger: float) -> float:
+    """How long after its connection is lost a session is surely discarded and collected
+    [s]: Bokeh keeps it ``session_linger`` s, looks for such sessions every
+    ``session_linger`` s (``python -m explorer`` sets both from --session-linger), the
+    full collection that frees its page comes ``COLLECT_AFTER_S`` later, and one more
+    for pages let go late ``LATE_COLLECT_AFTER_S`` after that."""
+    return 2 * session_linger + COLLECT_AFTER_S + LATE_COLLECT_AFTER_S + DISCARD_MARGIN_S
 
 
 def _linger_zero(sock: Any) -> None:
