@@ -2,7 +2,7 @@
 # Installs everything the test suite needs, then runs the whole suite.
 # Usage (from the repository root):  bash tests/run.sh [pytest args]
 # Without arguments the whole suite runs in two halves at once (see below); with arguments
-# one pytest run gets them (e.g. bash tests/run.sh tests/test_scene.py -x).
+# one pytest run gets them (e.g. bash tests/run.sh tests/scene/test_scene.py -x).
 # SKIP_SETUP=1 skips the installation (an environment already set up).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -23,7 +23,7 @@ from explorer.state import MAX_NAME_CHARS, ExplorerState
 from tests.cli_runs import run_cli
 
 PRESETS = presets()
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def solved(key: str = "uniform_flat", **solver: float):

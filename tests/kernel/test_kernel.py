@@ -8,7 +8,7 @@ tables in core.kernel.plane: the exact split
 by quadrature for s < 1, and the residue series over the poles of L (roots of
 sinh z + z = 0 found by mpmath.findroot) for s >= 1. They agree to 1e-40 at s = 0.6, 1
 and 1.5 (40-digit working precision).
-Regenerate the stored table with ``python tests/test_kernel.py`` (package installed, as
+Regenerate the stored table with ``python tests/kernel/test_kernel.py`` (package installed, as
 ``tests/run.sh`` does, or ``PYTHONPATH=.``).
 """
 
@@ -79,7 +79,7 @@ def mp_kernel(s: float, dps: int = 30) -> mp.mpf:
 
 
 # Reference values: (s, k_pl(s)) with s exact as a double and k_pl to 25 digits, from
-# mp_kernel(s, 30) (run ``python tests/test_kernel.py``, about 20 s). Points: near 0, the
+# mp_kernel(s, 30) (run ``python tests/kernel/test_kernel.py``, about 20 s). Points: near 0, the
 # switch point SWITCH = 2 and its neighbours, a centre and an end of a table interval
 # (2.0625, 2.125), the first zero, the check values of the model notes, and the tail up to
 # the last normal doubles.

@@ -28,7 +28,7 @@ from core.scene import (
 )
 from core.scene.schema import migrate
 
-SCENES_DIR = Path(__file__).resolve().parent.parent / "assets" / "scenes"
+SCENES_DIR = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 SCENE_FILES = sorted(SCENES_DIR.glob("*.json"))
 
 
@@ -73,7 +73,7 @@ DELETE = object()
 
 
 #: The preset that teaches lift-off: it is meant to leave full contact
-#: (tests/test_contact.py checks it).
+#: (tests/contact/test_contact.py checks it).
 LIFT_OFF_PRESET = "eccentric_footing_liftoff.json"
 
 
@@ -120,7 +120,7 @@ def test_shipped_scene_solves_in_full_contact(path: Path):
     if result.info["coating_model"] == "exact layered":
         # q is singular like 1 / sqrt(a - |x|) at the corners and held within half the top
         # layer of them (core/engines/layered/answer.py): P = pi c_0, M = pi c_1 / 2 by
-        # construction, checked against the FE model in tests/test_layered_scene.py
+        # construction, checked against the FE model in tests/engines/test_layered_scene.py
         return
     force, moment = _integrals(result)
     a = result.scene.half_width
@@ -273,7 +273,7 @@ def test_dimensional_round_trip_elastic():
     d["loading"] = {"force": 4e5, "moment": 3e4}
     scene = scene_from_dict(d)
     # the thin-layer path (solve() answers a uniform coating on an elastic base with the
-    # exact layered kernel, tests/test_layered_scene.py)
+    # exact layered kernel, tests/engines/test_layered_scene.py)
     result = SceneSolution(scene, scene.dimensionless, scene.dimensionless.solve())
     assert solve(scene).info["coating_model"] == "exact layered"
     # the same solver on the same numbers up to rounding: measured 1.7e-15 relative

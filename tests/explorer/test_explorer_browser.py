@@ -188,7 +188,7 @@ def test_an_oversized_upload_is_refused_in_the_page_and_a_scene_file_loads(page:
     upload.set_input_files(files=[{"name": "big.json", "mimeType": "application/json",
                                    "buffer": b"{" + b" " * (5 * 2**20) + b"}"}])
     page.page.get_by_text("File is too large").first.wait_for(timeout=30_000)
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     scene = json.loads((root / "assets" / "scenes" / "stepped_punch.json").read_text())
     scene["name"] = "uploaded in the browser"
     settlement = page.text(".readout-settlement")

@@ -15,7 +15,7 @@ from core.scene import check_scene, scene_from_dict, solve
 from core.scene.files import scene_to_json
 from tests.cli_runs import run_cli
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def constant(value: float):

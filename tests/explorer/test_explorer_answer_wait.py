@@ -108,7 +108,7 @@ def test_a_worker_that_ends_while_the_loop_waits_goes_the_threads_way() -> None:
 
         asyncio.run(wait())
         # the thread's way (SolverProcesses.result) replaces the worker and runs the
-        # request again: tests/test_workers.py
+        # request again: tests/explorer/test_workers.py
         assert outcome == ["other"]
     finally:
         pool.shutdown()

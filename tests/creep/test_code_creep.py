@@ -23,7 +23,7 @@ from core.solver import solve_dimensionless
 from core.time import ModalProblem, solve_degenerate
 from core.time.product_quadrature import _trapezoid_solve
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 C30 = {"strength_class": "C30/37", "cement": "N", "relative_humidity": 60.0,
        "notional_size": 300.0}
 #: t_T / t at 20 deg C (MC2010 5.1-85, EN 1992-1-1 B.10)

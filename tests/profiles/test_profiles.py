@@ -198,7 +198,7 @@ def test_profile_key_is_stable_across_processes() -> None:
             "from core.profiles.base import profile_key; "
             f"print(profile_key(profile_from_spec({spec!r}, field='f', domain={D!r})))")
     env = dict(os.environ, PYTHONHASHSEED="12345")
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          env=env, cwd=root, check=True).stdout.strip()
     assert out == key

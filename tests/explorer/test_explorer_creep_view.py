@@ -73,7 +73,7 @@ def test_base_state_offers_the_code_models_and_round_trips_the_preset():
     from explorer.state import CREEP_MODELS, ExplorerState
 
     assert {"fib_mc2010", "eurocode2"} <= set(CREEP_MODELS)
-    scene = json.loads((Path(__file__).resolve().parent.parent
+    scene = json.loads((Path(__file__).resolve().parents[2]
                         / "assets/scenes/young_concrete_50_years.json").read_text())
     state = ExplorerState()
     state._load(scene)

@@ -12,7 +12,7 @@ import core.discretize.quadrature as quadrature
 from core.cache import cache_report
 from core.scene import solve
 
-LESSON = Path(__file__).resolve().parents[1] / "assets/scenes/eccentric_footing_liftoff.json"
+LESSON = Path(__file__).resolve().parents[2] / "assets/scenes/eccentric_footing_liftoff.json"
 
 
 def _lesson(moment: float | None = None) -> dict:

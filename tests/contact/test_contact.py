@@ -23,7 +23,7 @@ from core.contact.unilateral import FULL_CONTACT
 from core.contact.zones import refine_zone_ends, solve_on_zones
 from core.discretize import base_panels, kernel_operator
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"
 
 

@@ -26,7 +26,7 @@ from tests.browser_pages import (  # noqa: E402
     until,
 )
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 # Top [px] of a named figure in the viewport, or null while it is not drawn.
 JS_VIEW_TOP = JS_VIEW_WIDTH.replace("getBoundingClientRect().width",

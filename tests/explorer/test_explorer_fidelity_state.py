@@ -17,7 +17,7 @@ from core import scene_from_dict
 from explorer.links import decode_scene, encode_scene
 from explorer.state import ExplorerState
 
-LIFTOFF = Path(__file__).resolve().parents[1] / "assets/scenes/eccentric_footing_liftoff.json"
+LIFTOFF = Path(__file__).resolve().parents[2] / "assets/scenes/eccentric_footing_liftoff.json"
 
 
 def _scene() -> dict:

@@ -19,7 +19,7 @@ from core.study.definition import MAX_STUDY_POINTS, apply_point, parse_path
 from core.study.points import point_table
 from tests.cli_runs import run_cli
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "assets" / "scenes"
 OUTPUTS = ("settlement", "tilt", "force", "moment", "q_max", "q_min", "contact_width")
 

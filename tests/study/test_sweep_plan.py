@@ -15,7 +15,7 @@ import core.study.plan as sweep_plan
 from core.study import study_from_dict
 from core.study.plan import BatchPlan
 from core.study.points import DRAW_BLOCK, StudyPoints, point_table
-from tests.test_sweep import elastic_scene, small_study
+from tests.study.test_sweep import elastic_scene, small_study
 
 
 def loads_grid(n_force: int, n_moment: int, **extra) -> dict:

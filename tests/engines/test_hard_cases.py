@@ -38,7 +38,7 @@ from tests.support.scenes import CONCRETE, TEN_LAYERS, jump_m, rough_g, smooth_m
 
 
 def solve_dimensionless(*args: Any, **kwargs: Any):
-    """The projection method (this file checks it; tests/test_nystrom.py the default)."""
+    """The projection method (this file checks it; tests/engines/test_nystrom.py the default)."""
     return _solve_dimensionless(*args, method="projection", **kwargs)
 
 # ------------------------------------------------------------------------------ cases

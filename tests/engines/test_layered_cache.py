@@ -17,7 +17,7 @@ from core.engines.layered.cache import (
     LAYERED_TABLE,
 )
 
-SCENES = Path(__file__).resolve().parent.parent / "assets" / "scenes"
+SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 STAGES = {"layered_table": LAYERED_TABLE, "layered_operator": LAYERED_OPERATOR,
           "layered_response": LAYERED_RESPONSE}
 QUANTITIES = ("settlement", "tilt", "force", "moment")

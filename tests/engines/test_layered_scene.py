@@ -13,7 +13,7 @@ from core import solve
 from core.engines.layered.solve import solve_layered
 from core.kernel import UniformLayer
 
-SCENES = Path(__file__).resolve().parent.parent / "assets" / "scenes"
+SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 
 
 def elastic_scene(name: str, loading: dict, base_thickness: float | None = None,

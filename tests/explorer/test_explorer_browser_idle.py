@@ -26,7 +26,7 @@ from tests.browser_pages import Page, page_fixtures  # noqa: E402
 
 server, browser_context, page = page_fixtures(1400, 900)
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 def _painter_runs(page: Page, ms: int) -> int:
     """Frames FilePond's loop ran during ``ms`` [ms]."""

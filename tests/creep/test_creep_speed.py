@@ -14,7 +14,7 @@ import numpy as np
 from core.cache import clear_caches
 from core.scene import scene_from_dict
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _young_concrete(force: float) -> dict:
