@@ -20,15 +20,21 @@
   run for real (``run_cli(..., subprocess=True)``).
 - Scenes: the dimensionless benchmark problems come from ``tests/support/scenes.py`` (one
   definition for the benchmarks and the tests); :func:`small_preset` is a preset of the
-  explorer cut to a few output times, for tests that need a quick real solve.
+  explorer cut to a few output times, for tests that need a quick real solve. Scene dicts
+  written by hand start from here too (imported from ``tests.conftest``): a scene file
+  (:func:`scene_file`), the small scenes the refusal tests share (:func:`base_scene`,
+  :func:`elastic_dict`) and a field set or removed by its dotted path (:func:`edited`).
 """
 
 from __future__ import annotations
 
 import copy
+import json
+import math
 import os
 import time
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import mpmath
@@ -117,6 +123,63 @@ def small_preset_scene(key: str | None = None, count: int = 6, tol: float = 1e-5
 def small_preset_fixture() -> Callable[..., dict[str, Any]]:
     """:func:`small_preset_scene` for the tests."""
     return small_preset_scene
+
+
+SCENES_DIR = Path(__file__).resolve().parent.parent / "assets" / "scenes"
+
+
+def scene_file(name: str) -> dict[str, Any]:
+    """The scene file ``assets/scenes/<name>.json`` as a new dict."""
+    return json.loads((SCENES_DIR / f"{name}.json").read_text())
+
+
+def base_scene() -> dict[str, Any]:
+    """A small valid scene (few output times: its solves stay quick)."""
+    scene = scene_file("uniform_flat")
+    scene["times"] = {"end": 100.0, "count": 3, "spacing": "linear"}
+    scene["solver"] = {"tol": 1e-3}
+    return scene
+
+
+def elastic_dict(**changes: Any) -> dict[str, Any]:
+    """The uniform preset on an elastic base, few times: a solve of ~0.1 s."""
+    d = scene_file("uniform_flat")
+    d["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
+    d["times"] = {"end": 10.0, "count": 3}
+    d.update(changes)
+    return d
+
+
+#: The value :func:`edited` reads as "remove the field".
+DELETE = object()
+
+
+def edited(path: str, value: Any, scene: dict[str, Any] | None = None) -> dict[str, Any]:
+    """``scene`` (default :func:`base_scene`) with the field at dotted ``path`` set to
+    ``value``, or removed when ``value`` is :data:`DELETE`."""
+    scene = base_scene() if scene is None else scene
+    *parents, last = path.replace("[", ".").replace("]", "").split(".")
+    target: Any = scene
+    for key in parents:
+        target = target[int(key)] if key.isdigit() else target[key]
+    if value is DELETE:
+        del target[last]
+    elif last.isdigit():
+        target[int(last)] = value
+    else:
+        target[last] = value
+    return scene
+
+
+def write_scene(path: Path, d: dict[str, Any] | None = None) -> Path:
+    """``d`` (default :func:`elastic_dict`) written as a scene file at ``path``."""
+    path.write_text(json.dumps(d or elastic_dict()))
+    return path
+
+
+#: Values no number, string or choice field should take without a clear refusal.
+ODD = [math.nan, math.inf, -math.inf, "x", None, True, [[1]], {"a": 1}, 10**400,
+       "__import__('os').system('true')", 1e308]
 
 
 @pytest.fixture(scope="session")

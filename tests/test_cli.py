@@ -8,11 +8,15 @@ import json
 import os
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import pytest
 
+from core.cli import main as cli_main
 from core.scene import MAX_SCENE_BYTES
 from tests.cli_runs import run_cli
+from tests.conftest import DELETE, base_scene, edited
+from tests.scene.test_scene_refusals import BAD_VALUES
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "assets" / "scenes"
@@ -144,3 +148,69 @@ def test_bad_arguments(tmp_path: Path):
     assert_one_line_error(run("frobnicate"), "python -m core: argument")
     assert_one_line_error(run("solve", SCENES / "uniform_flat.json", "-o", tmp_path / "r.txt"),
                           "--output: unsupported extension '.txt'")
+
+
+@pytest.mark.parametrize(("path", "value", "message"), BAD_VALUES[::3],
+                         ids=[f"{p}={v!r}"[:50] for p, v, _ in BAD_VALUES[::3]])
+def test_bad_values_give_one_line_from_the_command_line(tmp_path: Path, capsys, path: str,
+                                                        value: Any, message: str) -> None:
+    file = tmp_path / "scene.json"
+    file.write_text(json.dumps(edited(path, value)))
+    assert cli_main(["solve", str(file)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.count("\n") == 1 and captured.err.startswith("error: "), captured.err
+    assert message.split(":")[0] in captured.err
+
+
+def assert_refused(proc: subprocess.CompletedProcess, *parts: str) -> None:
+    assert proc.returncode == 2, (proc.returncode, proc.stderr)
+    assert "Traceback" not in proc.stderr and proc.stdout == ""
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), proc.stderr
+    for part in parts:
+        assert part in lines[0], lines[0]
+
+
+def test_cli_refuses_a_file_of_100_mb_before_reading_it(tmp_path: Path) -> None:
+    big = tmp_path / "huge.json"
+    with big.open("wb") as fh:  # sparse: no disk space is used
+        fh.truncate(100 * 2**20)
+    proc = run_cli("solve", big, "--output", tmp_path / "out.json")
+    assert_refused(proc, "huge.json: file is 104857600 bytes, over the limit of 1000000")
+    assert not (tmp_path / "out.json").exists()
+
+
+@pytest.mark.parametrize(("content", "parts"), [
+    (b"this is not JSON {", ("not valid JSON",)),
+    (b"\xff\xfe\x00\x01", ("not a text file in UTF-8",)),
+    (b"[" * 200_000 + b"]" * 200_000, ("not valid JSON (nested too deeply)",)),
+    (json.dumps(edited("punch.colour", "red")).encode(), ("punch: unknown field 'colour'",)),
+    (json.dumps(edited("loading", {"force": 1.0})).encode(),
+     ("loading: exactly two of settlement, tilt, force, moment",)),
+    (json.dumps(edited("base.thickness", DELETE)).encode(),
+     ("base.thickness: required field is missing",)),
+    (json.dumps(edited("schema_version", 7)).encode(),
+     ("schema_version: unsupported version 7 (this program reads 1)",)),
+    # a 5000-digit integer is valid JSON; Python's int() refuses it with advice about
+    # sys.set_int_max_str_digits, which is no message for a user
+    (json.dumps(base_scene()).replace('"half_width": 1.0', '"half_width": ' + "9" * 5000)
+     .encode(), ("punch.half_width: must be a finite number",)),
+], ids=["not-json", "binary", "nested", "unknown-field", "one-load", "missing-field",
+        "wrong-version", "5000-digits"])
+def test_cli_answers_broken_files_with_one_line(tmp_path: Path, content: bytes,
+                                                parts: tuple[str, ...]) -> None:
+    file = tmp_path / "scene.json"
+    file.write_bytes(content)
+    assert_refused(run_cli("validate", file), *parts)
+
+
+def test_cli_never_prints_a_traceback(monkeypatch, capsys) -> None:
+    """An unexpected exception (a bug) still gives one line and a non-zero exit code."""
+    def broken(path: str) -> None:
+        raise TypeError("something unforeseen")
+
+    monkeypatch.setattr("core.cli.load_scene", broken)
+    assert cli_main(["validate", "whatever.json"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("error: internal error (TypeError: "), err

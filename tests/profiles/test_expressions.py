@@ -557,3 +557,12 @@ def test_generated_formulas_match_numpy(formula: tuple[str, Callable]) -> None:
     # same ufuncs in the same order: bitwise equal (see CASES)
     np.testing.assert_array_equal(e(x), expected)
     assert parse_expression(e.text) == e
+
+
+def test_formula_temporaries_are_bounded():
+    from core.profiles import parse_expression
+    expr = parse_expression("t - (tau - (t - (tau - (t - tau))))", ("t", "tau"))
+    n = 3000  # 9e6 points times the formula's live arrays: over the budget
+    with pytest.raises(ValueError, match="evaluate it in blocks"):
+        expr(np.ones((n, 1)), np.ones((1, n)))
+    assert expr(np.ones((100, 1)), np.ones((1, 100))).shape == (100, 100)

@@ -15,9 +15,12 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from scipy.interpolate import PchipInterpolator
 
+from core import limits
 from core.profiles import Profile, check_range, profile_from_csv, profile_from_spec
 from core.profiles.base import INTERPOLATIONS, MAX_TABLE_ROWS, profile_key
 from core.profiles.build import KINDS
+from core.scene import scene_from_dict
+from tests.conftest import elastic_dict
 
 D = (-0.15, 0.25)
 LO, HI = D
@@ -684,3 +687,69 @@ def test_a_bad_variable_name_is_refused_naming_the_field() -> None:
     with pytest.raises(ValueError, match=r"^coating\[0\]\.modulus: the variable name 'sin' "
                                          r"is not allowed"):
         profile_from_spec(1.0, field="coating[0].modulus", variable="sin", domain=D)
+
+
+def test_profiles_expose_their_jumps_and_kinks():
+    from core.profiles import profile_from_spec
+
+    def history(spec):
+        return profile_from_spec(spec, field="loading.force", variable="t",
+                                 domain=(0.0, 365.0))
+
+    step = history({"kind": "step", "values": [1.0, 3.0], "breaks": [3.3]})
+    assert step.nonsmooth_points() == (3.3,)
+    assert step.nonsmooth_points(4.0, 365.0) == ()
+    assert history({"kind": "ramp", "start": 0, "end": 1, "duration": 7}
+                   ).nonsmooth_points() == (7.0,)
+    table = history({"kind": "table", "points": [[0, 0], [2, 1], [5, 1]],
+                     "interpolation": "step"})
+    assert table.nonsmooth_points() == (2.0, 5.0)
+    assert history({"expr": "1 + heaviside(t - 10)"}).nonsmooth_points() == \
+        pytest.approx((10.0,), abs=1e-9)
+    assert history({"kind": "sine", "mean": 1, "amplitude": 1, "wavelength": 9}
+                   ).nonsmooth_points() == ()
+
+
+def test_an_uploaded_shape_table_beyond_the_solver_limit_is_refused_on_upload():
+    """A 40-row shape table was accepted by the upload (10,000 rows allowed) and then
+    always refused when the scene was built (16 kinks at most in a scene)."""
+    from core.profiles import profile_from_csv
+    rows = "x,f\n" + "".join(f"{-1 + 2 * k / 39:.6f},{1e-4 * (k % 2)}\n" for k in range(40))
+    with pytest.raises(ValueError, match=rf"^punch\.shape: a table of 40 rows with 'linear' "
+                                         rf".* more than the {limits.MAX_BREAKPOINTS} .*"
+                                         "'pchip'"):
+        profile_from_csv(rows, field="punch.shape", variable="x", domain=(-1.0, 1.0))
+    smooth = profile_from_csv(rows, field="punch.shape", variable="x", domain=(-1.0, 1.0),
+                              interpolation="pchip")
+    d = elastic_dict()
+    d["punch"]["shape"] = smooth.spec
+    scene_from_dict(d)  # the solver's limit agrees: accepted
+    # a load history in time has no such limit
+    history = "t,f\n" + "".join(f"{k},{k % 2}\n" for k in range(40))
+    profile_from_csv(history, field="loading.force", variable="t", domain=(0.0, 50.0))
+
+
+def test_uploaded_tables_have_limits_and_clear_errors() -> None:
+    domain = (-1.0, 1.0)
+
+    def refused(data: bytes | str, match: str, **kwargs: Any) -> None:
+        with pytest.raises(ValueError, match=match):
+            profile_from_csv(data, field="punch.shape", domain=domain, **kwargs)
+
+    refused(b"x,f\n" + b"0,0\n" * 300_000, r"^punch\.shape: file is too large \(1200004 bytes")
+    rows = "".join(f"{k / 20000},{k}\n" for k in range(10_001))
+    refused(rows, r"^punch\.shape: file has too many rows \(10001, at most 10000\)")
+    refused(b"x,f\n0.1,1\n", r"^punch\.shape: file needs at least 2 data rows, has 1")
+    refused(b"x,f\n0.1,1\n0.2,=cmd|' /C calc'!A0\n", r"^punch\.shape: line 3, column 2: "
+                                                   r"\"=cmd\|' /C calc'!A0\" is not a number")
+    refused(b"x,f\n0.2,1\n0.1,2\n", r"^punch\.shape: x values must be strictly increasing "
+                                    r"\(line 3: 0\.1 after 0\.2\)")
+    refused(b"x,f\n0.1,1\n0.2,nan\n", r"line 3, column 2: 'nan' is not a number")
+    refused(b"x,f\n0.1,1\n0.2,1e999\n", r"line 3, column 2: '1e999' is out of range")
+    refused(b"x,f\n0.1,1,3\n0.2,1,4\n", r"line 2: expected 2 columns")
+    refused(b"\x00\x01binary", r"file is not text")
+    refused(b"", r"file is empty")
+    # a header with markup is skipped, not echoed
+    table = profile_from_csv(b"<img src=x onerror=alert(1)>,f\n-0.5,0\n0.5,1e-5\n",
+                             field="punch.shape", domain=domain)
+    assert table.spec["points"] == [[-0.5, 0.0], [0.5, 1e-5]]

@@ -1,0 +1,208 @@
+"""A scene that would take the shared server's memory or minutes of solving is refused
+before any work, naming the field to change: text fields, output times, jumps and kinks,
+extreme sizes, loads faster than the time stepping, nested kernel formulas; and a solve
+never answers NaN."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from core import limits
+from core.scene import load_scene, scene_from_dict, solve
+from core.scene.schema import MAX_BREAKPOINTS
+from tests.conftest import edited, elastic_dict, scene_file, write_scene
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize("field, limit", [("name", limits.MAX_NAME_CHARS),
+                                          ("description", limits.MAX_DESCRIPTION_CHARS)])
+def test_text_fields_are_bounded(field: str, limit: int, tmp_path: Path):
+    scene_from_dict(elastic_dict(**{field: "x" * limit}))
+    long = elastic_dict(**{field: "x" * 15_000_000})
+    with pytest.raises(ValueError, match=rf"^{field}: .*at most {limit} characters"):
+        scene_from_dict(long)
+    # the same refusal from a file and from the JSON text of a link
+    with pytest.raises(ValueError, match=rf"^{field}: "):
+        load_scene(write_scene(tmp_path / "long.json", elastic_dict(**{field: "y" * (
+            limit + 1)})))
+
+
+GUARD = """
+import resource, sys, time, json
+resource.setrlimit(resource.RLIMIT_AS, ({limit_mib} * 2**20,) * 2)
+sys.path.insert(0, {root!r})
+from core.scene.pipeline import scene_from_dict, solve
+d = json.loads({scene!r})
+t0 = time.perf_counter()
+try:
+    result = solve(scene_from_dict(d))
+    print(json.dumps({{"solved": True, "message": result.info["message"],
+                      "flags": result.flags}}))
+except ValueError as exc:
+    print(json.dumps({{"solved": False, "message": str(exc)}}))
+"""
+
+
+def _nested_kernel_scene() -> dict:
+    e = "exp(-0.03*(t-tau))"
+    for k in range(8):
+        e = f"(0.5+0.5*{e})*(1+0*(t-tau+{k}))"
+    d = scene_file("uniform_flat")
+    d["base"]["creep"] = {"model": "kernel", "modulus": 3e10, "expr": f"-0.01*{e}"}
+    d["times"] = {"end": 365.0, "count": 2000}
+    return d
+
+
+def test_small_scene_with_a_nested_kernel_formula_is_bounded():
+    """A 1.1 kB scene (a nested kernel formula, 2000 output times) took 2.6 GB here
+    (9.5 GiB in the report): it must now solve within 1.2 GiB of address space."""
+    script = GUARD.format(limit_mib=1200, root=str(ROOT),
+                          scene=json.dumps(_nested_kernel_scene()))
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    outcome = json.loads(proc.stdout.splitlines()[-1])
+    assert outcome["solved"], outcome
+
+
+def _sine_force(wavelength: float) -> dict:
+    d = scene_file("uniform_flat")  # exponential creep: the O(1)-per-step stepper
+    d["loading"]["force"] = {"kind": "sine", "mean": 5e5, "amplitude": 2e5,
+                             "wavelength": wavelength}
+    return d
+
+
+def test_a_load_faster_than_the_step_limit_is_refused_before_solving():
+    """A sine force of period 0.05 day over a year (7300 periods) ran into the step limit
+    after a minute and was then blamed on double precision."""
+    with pytest.raises(ValueError, match=r"^loading\.force\.wavelength: the load varies "
+                                         r"faster than the time stepping can follow: "
+                                         r"about 7\.3e\+03 oscillations"):
+        scene_from_dict(_sine_force(0.05))
+    d = _sine_force(0.05)
+    d["loading"]["force"] = {"expr": "5e5 + 2e5 * sin(2 * pi * t / 0.05)"}
+    with pytest.raises(ValueError, match=r"^loading\.force: the load varies faster"):
+        scene_from_dict(d)
+    # a period of a day needs 8500 steps at tol 1e-6 (measured): accepted
+    scene_from_dict(_sine_force(1.0))
+    # an elastic base has no time stepping
+    elastic = _sine_force(0.05)
+    elastic["base"]["creep"] = {"model": "elastic", "modulus": 3e10}
+    scene_from_dict(elastic)
+
+
+def test_the_step_limit_is_named_when_it_is_hit(monkeypatch):
+    """The stepper's own limit, when hit, is reported as such with the load's field."""
+    import functools
+
+    import core.engines.nystrom.modal
+    import core.engines.projection.levels
+    from core.time import solve_degenerate
+    # the projection's time stage and the default engine's
+    for engine in (core.engines.projection.levels, core.engines.nystrom.modal):
+        monkeypatch.setattr(engine, "solve_degenerate",
+                            functools.partial(solve_degenerate, max_steps=40))
+    from core.scene import solve
+    with pytest.raises(ValueError, match=r"^loading\.force: the time stepping could not "
+                                         r"follow the loads: .*limit of 40 steps.*vary "
+                                         "faster") as info:
+        solve(scene_from_dict(_sine_force(10.0)))
+    assert "double precision" not in str(info.value)
+
+
+def test_output_times_and_pressure_points_are_bounded(monkeypatch):
+    from core.scene import solve
+    from core.solver import solve_dimensionless
+    times = 1.0 + np.arange(limits.MAX_SOLVER_TIMES + 1) * 1e-3
+    with pytest.raises(ValueError, match=rf"^times: at most {limits.MAX_SOLVER_TIMES}"):
+        solve_dimensionless(1.0, 0.05, 0.0, times, force=1.0, moment=0.0)
+    result = solve(elastic_dict())
+    monkeypatch.setattr(limits, "MAX_PRESSURE_VALUES", 3000)  # the check, not the work
+    points = limits.MAX_PRESSURE_VALUES // result.times.size + 1
+    with pytest.raises(ValueError, match=r"^x: .* more than the"):
+        result.pressure(np.zeros(points))
+    assert result.pressure(np.zeros(points - 1)).shape == (points - 1, result.times.size)
+
+
+def test_many_jumps_are_refused_before_the_solver_sees_them() -> None:
+    """Each jump or kink adds a graded cluster of panels to a dense operator: a 50-row
+    linear shape table took 15 s and 2.4 GB and ended in an obscure error; a 10000-row
+    table asked for a 15 TiB matrix. A served explorer must refuse them at once."""
+    x = np.linspace(-1.0, 1.0, 50)
+    rows = [[float(v), float(1e-5 * (1 + np.sin(20 * v)))] for v in x]
+    scene = edited("punch.shape", {"kind": "table", "points": rows})
+    with pytest.raises(ValueError, match=r"^punch\.shape: has 48 points where its value or "
+                                         r"slope jumps .* more than the 16 "):
+        scene_from_dict(scene)
+    # the same rows interpolated smoothly have two breakpoints (the end rows): solved
+    smooth = edited("punch.shape", {"kind": "table", "points": rows,
+                                    "interpolation": "pchip"})
+    smooth["times"]["count"] = 1  # accepted and solved is the point: 3 s of CPU, not 12
+    assert np.all(np.isfinite(solve(smooth).settlement))
+    steps = {"kind": "step", "values": [1e8 * (2 + (-1) ** k) for k in range(10_001)],
+             "breaks": list(np.linspace(-0.999, 0.999, 10_000))}
+    with pytest.raises(ValueError, match=r"^coating\[0\]\.modulus: has 10000 points"):
+        scene_from_dict(edited("coating[0].modulus", steps))
+    switches = {"expr": "0.01 * (1.5 + 0.5 * sign(sin(300 * x)))"}
+    with pytest.raises(ValueError, match=r"^coating\[0\]\.thickness: has \d+ points"):
+        scene_from_dict(edited("coating[0].thickness", switches))
+    # jumps spread over several profiles count together
+    a_few = {"kind": "step", "values": [0.01] * 10, "breaks": list(np.linspace(-0.9, 0.9, 9))}
+    scene = edited("coating[0].thickness", a_few)
+    scene = edited("coating[0].modulus", {"kind": "step", "values": [5e8] * 10,
+                                          "breaks": list(np.linspace(-0.85, 0.95, 9))}, scene)
+    assert MAX_BREAKPOINTS == 16
+    with pytest.raises(ValueError, match=r"18 in the whole scene"):
+        scene_from_dict(scene)
+
+
+@pytest.mark.parametrize(("path", "value", "message"), [
+    # a / H = 1000 measured 27 s and 5.5 GB; the solver itself accepts up to 1e4
+    ("base.thickness", 1e-3, "base.thickness: the ratio punch.half_width / base.thickness "
+                             "must be in [0.0001, 100], got 1000"),
+    # a creep coefficient of 9e7 ran the time stepping to its step limit (13 s)
+    ("base.creep.compliance", 3e-3, "base.creep: the creep coefficient"),
+    ("base.creep", {"model": "kernel", "modulus": 3e10, "expr": "-2e4 * exp(-0.05 * (t - tau))"},
+     "base.creep.expr: the creep coefficient"),
+    # a coating modulus of 1e300 Pa ran 29 s and returned NaN
+    ("coating[0].modulus", 1e300, "coating: the coating compliance relative to the base, m* ="),
+    ("coating[0].modulus", 1e-300, "coating: the coating compliance relative to the base"),
+    # a punch shape of 1e300 m gave an infinite pressure
+    ("punch.shape", {"kind": "polynomial", "coefficients": [0, 1e300]},
+     "punch.shape: the gap between the punch base and the coating surface is"),
+    # a tiny age at loading makes the aging term A / age^2 infinite
+    ("base.age_at_loading", 1e-300, "base.creep: the creep kernel K(t, tau) is"),
+    # 1e200 m squared overflowed Python's float power (OverflowError, a traceback)
+    ("punch.half_width", 1e200, "base.thickness: the ratio"),
+])
+def test_extreme_sizes_are_refused_with_the_field_to_change(path: str, value: Any,
+                                                            message: str) -> None:
+    with pytest.raises(ValueError) as info:
+        solve(edited(path, value))
+    assert str(info.value).startswith(message), str(info.value)
+
+
+def test_a_solution_never_holds_nan(monkeypatch) -> None:
+    """The last guard: were the solver to answer NaN, solve() refuses the answer."""
+    from core import solver
+
+    real = solver.solve_dimensionless
+
+    def poisoned(*args: Any, **kwargs: Any) -> Any:
+        solution = real(*args, **kwargs)
+        solution.settlement[-1] = np.nan
+        return solution
+
+    monkeypatch.setattr(solver, "solve_dimensionless", poisoned)
+    with pytest.raises(ValueError, match=r"^scene: the computed settlement is not finite at "
+                                         r"t = 100 days"):
+        solve(edited("loading.force", 4.1e5))
