@@ -16,7 +16,7 @@ from core.cli import main
 from core.scene import load_scene, save_scene
 from tests.conftest import write_scene
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_cli_refuses_to_overwrite_its_input(tmp_path: Path, capsys):

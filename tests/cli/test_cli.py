@@ -18,7 +18,7 @@ from tests.cli_runs import run_cli
 from tests.conftest import DELETE, base_scene, edited
 from tests.scene.test_scene_refusals import BAD_VALUES
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "assets" / "scenes"
 
 
