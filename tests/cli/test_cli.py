@@ -15,7 +15,7 @@ import pytest
 from core.cli import main as cli_main
 from core.scene import MAX_SCENE_BYTES
 from tests.cli_runs import run_cli
-from tests.conftest import DELETE, base_scene, edited
+from tests.conftest import DELETE, base_scene, edited, scene_file
 from tests.scene.test_scene_refusals import BAD_VALUES
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -27,7 +27,7 @@ def run(*args: str | os.PathLike, cwd: Path = ROOT) -> subprocess.CompletedProce
 
 
 def scene_dict() -> dict:
-    return json.loads((SCENES / "uniform_flat.json").read_text())
+    return scene_file("uniform_flat")
 
 
 def assert_one_line_error(proc: subprocess.CompletedProcess, starts: str) -> None:

@@ -14,8 +14,7 @@ from core.coating.model import mapped_error
 from core.scene import check_scene, scene_from_dict, solve
 from core.scene.files import scene_to_json
 from tests.cli_runs import run_cli
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.conftest import scene_file
 
 
 def constant(value: float):
@@ -23,7 +22,7 @@ def constant(value: float):
 
 
 def scene_dict(**coating) -> dict:
-    d = json.loads((ROOT / "assets" / "scenes" / "uniform_flat.json").read_text())
+    d = scene_file("uniform_flat")
     d["coating"] = [{"thickness": 0.02, "modulus": 3e9, "poisson": 0.3, **coating}]
     d["base"]["creep"] = {"model": "elastic", "modulus": 3e10}
     d["base"]["thickness"] = 1.0
@@ -100,8 +99,7 @@ def test_scene_interface_and_model_tol_are_validated_and_saved():
 def creeping_scene_dict(**coating) -> dict:
     """:func:`scene_dict` on the creeping base of the preset: the thin layer answers."""
     d = scene_dict(**coating)
-    d["base"]["creep"] = json.loads((ROOT / "assets" / "scenes" / "uniform_flat.json")
-                                    .read_text())["base"]["creep"]
+    d["base"]["creep"] = scene_file("uniform_flat")["base"]["creep"]
     return d
 
 
@@ -137,7 +135,7 @@ def test_check_confirms_the_estimate_within_a_factor_3(interface):
 
 
 def worn_bonded() -> dict:
-    d = json.loads((ROOT / "assets" / "scenes" / "worn_coating.json").read_text())
+    d = scene_file("worn_coating")
     d["coating"][0]["interface"] = "bonded"
     return d
 

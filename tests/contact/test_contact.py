@@ -22,9 +22,7 @@ from core.contact.step import Step
 from core.contact.unilateral import FULL_CONTACT
 from core.contact.zones import refine_zone_ends, solve_on_zones
 from core.discretize import base_panels, kernel_operator
-
-ROOT = Path(__file__).resolve().parents[2]
-PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"
+from tests.conftest import scene_file
 
 
 def worn_patch(x):
@@ -287,7 +285,7 @@ def test_zone_end_converges_under_refinement_and_the_estimate_holds():
 
 
 def _preset_problem(**changes):
-    scene = json.loads(PRESET.read_text())
+    scene = scene_file("eccentric_footing_liftoff")
     scene["times"] = {"end": 1000.0, "count": 5, "spacing": "log"}
     for key, value in changes.items():
         scene["loading"][key] = value
@@ -439,7 +437,7 @@ def test_creep_zone_opening_late_gets_its_band():
     # first, lift-off later, the free end travelling from -1 inward. Every free end at
     # every output time must lie in a finely paneled band (else the spatial estimate
     # would not hold there and the run is flagged).
-    scene = json.loads(PRESET.read_text())
+    scene = scene_file("eccentric_footing_liftoff")
     scene["times"] = {"end": 1000.0, "count": 12, "spacing": "log"}
     pb = scene_from_dict(scene).dimensionless
     force = pb.loads["force"]
@@ -595,7 +593,7 @@ def test_contact_set_from_pressure():
 
 
 def _elastic_preset(contact: str | None = None) -> dict:
-    scene = json.loads(PRESET.read_text())
+    scene = scene_file("eccentric_footing_liftoff")
     scene["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
     scene["times"] = [0.0, 10.0]
     if contact is not None:
@@ -643,7 +641,7 @@ def test_cli_writes_the_contact_set(tmp_path: Path):
 
 
 def test_lift_off_preset_lifts_off_and_meets_its_tolerance():
-    scene = copy.deepcopy(json.loads(PRESET.read_text()))
+    scene = copy.deepcopy(scene_file("eccentric_footing_liftoff"))
     scene["times"] = {"end": 1000.0, "count": 5, "spacing": "log"}
     result = solve(scene)
     assert result.info["contact"] == "unilateral"

@@ -2,21 +2,17 @@
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 import core.discretize.quadrature as quadrature
 from core.cache import cache_report
 from core.scene import solve
-
-LESSON = Path(__file__).resolve().parents[2] / "assets/scenes/eccentric_footing_liftoff.json"
+from tests.conftest import scene_file
 
 
 def _lesson(moment: float | None = None) -> dict:
-    scene = json.loads(LESSON.read_text())
+    scene = scene_file("eccentric_footing_liftoff")
     if moment is not None:
         scene["loading"]["moment"] = moment
     return scene

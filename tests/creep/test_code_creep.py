@@ -7,9 +7,7 @@ the comments. Tolerances are set from measured errors (written next to them).
 
 from __future__ import annotations
 
-import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,8 +20,8 @@ from core.scene import scene_from_dict, solve
 from core.solver import solve_dimensionless
 from core.time import ModalProblem, solve_degenerate
 from core.time.product_quadrature import _trapezoid_solve
+from tests.conftest import scene_file
 
-ROOT = Path(__file__).resolve().parents[2]
 C30 = {"strength_class": "C30/37", "cement": "N", "relative_humidity": 60.0,
        "notional_size": 300.0}
 #: t_T / t at 20 deg C (MC2010 5.1-85, EN 1992-1-1 B.10)
@@ -230,7 +228,7 @@ def test_plain_callable_kernel_is_stepped_through_its_fit():
 
 
 def test_preset_scene_solves_with_the_fit_error_in_its_estimate():
-    data = json.loads((ROOT / "assets/scenes/young_concrete_50_years.json").read_text())
+    data = scene_file("young_concrete_50_years")
     scene = scene_from_dict(data)
     assert scene.times.size == 200 and scene.times[-1] == pytest.approx(50 * 365.25)
     result = solve(scene)
@@ -264,7 +262,7 @@ def test_bad_inputs_are_named(change, field):
 
 
 def test_ages_outside_the_range_are_named():
-    data = json.loads((ROOT / "assets/scenes/young_concrete_50_years.json").read_text())
+    data = scene_file("young_concrete_50_years")
     data["base"]["age_at_loading"] = 0.5
     with pytest.raises(ValueError, match=r"^base\.age_at_loading: must be in \[1, 3650\]"):
         scene_from_dict(data)

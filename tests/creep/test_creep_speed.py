@@ -6,19 +6,15 @@ again (the prepared object's build counts) and that the answers agree.
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import numpy as np
 
 from core.cache import clear_caches
 from core.scene import scene_from_dict
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.conftest import scene_file
 
 
 def _young_concrete(force: float) -> dict:
-    data = json.loads((ROOT / "assets/scenes/young_concrete_50_years.json").read_text())
+    data = scene_file("young_concrete_50_years")
     # one year and 24 outputs keep the test short; the path is the one of 50 years
     data["times"] = {"end": 365.25, "count": 24, "spacing": "log"}
     data["loading"] = {"force": force, "moment": 0.0}

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import copy
-import json
-from pathlib import Path
 
 import numpy as np
 
@@ -16,8 +14,8 @@ from core.engines.layered.cache import (
     LAYERED_RESPONSE,
     LAYERED_TABLE,
 )
+from tests.conftest import scene_file
 
-SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 STAGES = {"layered_table": LAYERED_TABLE, "layered_operator": LAYERED_OPERATOR,
           "layered_response": LAYERED_RESPONSE}
 QUANTITIES = ("settlement", "tilt", "force", "moment")
@@ -25,7 +23,7 @@ QUANTITIES = ("settlement", "tilt", "force", "moment")
 
 def rounded_graded(loading: dict) -> dict:
     """The crowned punch on three smooth layers over an elastic base, one output time."""
-    d = json.loads((SCENES / "rounded_graded.json").read_text())
+    d = scene_file("rounded_graded")
     d["base"]["creep"] = {"model": "elastic", "modulus": 3.4e10}
     d["times"] = {"end": 1.0, "count": 1}
     d["loading"] = loading

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import copy
-import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,14 +10,13 @@ import pytest
 from core import solve
 from core.engines.layered.solve import solve_layered
 from core.kernel import UniformLayer
-
-SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
+from tests.conftest import scene_file
 
 
 def elastic_scene(name: str, loading: dict, base_thickness: float | None = None,
                   interface: str | None = None) -> dict:
     """A preset with an elastic base (E = 30 GPa), two output times and ``loading``."""
-    d = json.loads((SCENES / f"{name}.json").read_text())
+    d = scene_file(name)
     d["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
     d["times"] = {"end": 10.0, "count": 2, "spacing": "linear"}
     d["loading"] = loading
@@ -110,8 +107,7 @@ def test_where_the_exact_kernel_does_not_apply_the_thin_layer_answers(change):
     name = {"step": "stepped_punch", "varying": "worn_coating"}.get(change, "uniform_flat")
     d = elastic_scene(name, {"force": 5e5, "moment": 0.0})
     if change == "creep":
-        d["base"]["creep"] = json.loads((SCENES / "uniform_flat.json").read_text())[
-            "base"]["creep"]
+        d["base"]["creep"] = scene_file("uniform_flat")["base"]["creep"]
     if change == "unilateral":
         d["solver"]["contact"] = "unilateral"
     if change == "thin_base":  # a / H = 100: the kernel table would take ~20 s

@@ -27,8 +27,8 @@ from core.scene import (
     solve,
 )
 from core.scene.schema import migrate
+from tests.conftest import DELETE, SCENES_DIR, edited, scene_file
 
-SCENES_DIR = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 SCENE_FILES = sorted(SCENES_DIR.glob("*.json"))
 
 
@@ -51,22 +51,7 @@ def base_dict() -> dict:
 def edit(path: str, value, d: dict | None = None) -> dict:
     """A copy of ``d`` (default :func:`base_dict`) with the field at a dotted path set;
     ``value = DELETE`` removes it."""
-    d = copy.deepcopy(base_dict() if d is None else d)
-    keys = path.replace("[", ".").replace("]", "").split(".")
-    target = d
-    for key in keys[:-1]:
-        target = target[int(key)] if isinstance(target, list) else target[key]
-    last = keys[-1]
-    if value is DELETE:
-        del target[last]
-    elif isinstance(target, list):
-        target[int(last)] = value
-    else:
-        target[last] = value
-    return d
-
-
-DELETE = object()
+    return edited(path, value, copy.deepcopy(base_dict() if d is None else d))
 
 
 # ------------------------------------------------------------------------ shipped scenes
@@ -224,7 +209,7 @@ def test_gap_keeps_its_own_accuracy_on_a_thick_coating():
 
 
 def test_aging_loads_use_the_modulus_at_each_time():
-    d = json.loads((SCENES_DIR / "eccentric_creep.json").read_text())
+    d = scene_file("eccentric_creep")
     scene = scene_from_dict(d)
     p = scene.dimensionless
     tau0 = 28.0
@@ -296,7 +281,7 @@ def test_dimensional_round_trip_aging():
     """The eccentric scene on aging concrete against a hand conversion."""
     from core.solver import solve_dimensionless
 
-    d = json.loads((SCENES_DIR / "eccentric_creep.json").read_text())
+    d = scene_file("eccentric_creep")
     d["times"] = [0.0, 10.0, 100.0, 1000.0]
     result = solve(d)
     tau0, a, h_base, nu = 28.0, 1.0, 6.0, 0.2
@@ -330,7 +315,7 @@ def test_dimensional_round_trip_aging():
 def test_similarity_scaling_all_lengths():
     """Scaling every length by s (loads P by s, M by s^2) leaves q and alpha unchanged and
     scales delta by s: the dimensionless problem is the same."""
-    d = json.loads((SCENES_DIR / "stepped_punch.json").read_text())
+    d = scene_file("stepped_punch")
     d["loading"] = {"force": 6e5, "moment": 5e4}
     d["times"] = [0.0, 30.0, 365.0]
     s = 2.5
@@ -428,7 +413,7 @@ def test_a_load_change_reuses_every_cached_stage():
     """The conversion builds equal callables for equal scenes, so the prepared geometry
     (recognised by sampled values) is reused when only the loads change: nothing geometric
     and no factorization is built again (counted on the prepared object)."""
-    d = json.loads((SCENES_DIR / "patched_insert.json").read_text())
+    d = scene_file("patched_insert")
     d["times"] = [0.0, 100.0]
     first = solve(d)
     d["loading"]["settlement"] = 4e-5

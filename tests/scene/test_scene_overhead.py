@@ -4,14 +4,13 @@ golden-section search of the gap minimum (same points as the one-at-a-time searc
 from __future__ import annotations
 
 import copy
-import json
 
 import numpy as np
 import pytest
 
 from core.scene import scene_from_dict, solve
 from core.scene.golden_section import golden_minimum, golden_minimum_batched
-from explorer.presets import SCENES_DIR
+from tests.conftest import scene_file
 
 
 @pytest.mark.parametrize("depth", [1, 3, 5, 8])
@@ -30,17 +29,13 @@ def test_batched_golden_search_meets_the_same_points(depth):
         assert golden_minimum_batched(fn, lo, hi, depth=depth) == one_at_a_time
 
 
-def _scene(name: str) -> dict:
-    return json.loads((SCENES_DIR / f"{name}.json").read_text())
-
-
 @pytest.mark.parametrize("name", ["worn_coating", "patched_insert", "uniform_flat"])
 def test_a_load_change_gives_the_answer_of_a_fresh_scene(name):
     """Results of a scene whose geometry was solved before (shared samples, extremes,
     model error) equal those computed with nothing shared."""
     from core.cache import clear_caches
 
-    d = _scene(name)
+    d = scene_file(name)
     solve(d)
     other = copy.deepcopy(d)
     quantity = next(iter(other["loading"]))
@@ -63,7 +58,7 @@ def test_the_samples_are_the_union_of_every_profiles_samples(name):
     """Constant profiles are sampled once: the samples are still the union of all."""
     from core.scene.model import DENSE_SAMPLES
 
-    scene = scene_from_dict(_scene(name))
+    scene = scene_from_dict(scene_file(name))
     a = scene.half_width
     profiles = [scene.shape] + [p for layer in scene.coating
                                 for p in (layer.thickness, layer.modulus, layer.poisson)]

@@ -18,6 +18,7 @@ from core.study import load_study, numeric_fields, study_from_dict
 from core.study.definition import MAX_STUDY_POINTS, apply_point, parse_path
 from core.study.points import point_table
 from tests.cli_runs import run_cli
+from tests.conftest import scene_file
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "assets" / "scenes"
@@ -25,7 +26,7 @@ OUTPUTS = ("settlement", "tilt", "force", "moment", "q_max", "q_min", "contact_w
 
 
 def elastic_scene() -> dict:
-    scene = json.loads((SCENES / "uniform_flat.json").read_text())
+    scene = scene_file("uniform_flat")
     scene["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
     return scene
 
@@ -649,7 +650,7 @@ def test_scaled_answer_flags_a_large_tilt_by_its_own_size():
     from core.scene import scene_from_dict
     from core.study.batch import answers_scale_with_loads
 
-    scene = json.loads((SCENES / "uniform_flat.json").read_text())
+    scene = scene_file("uniform_flat")
     assert not answers_scale_with_loads(scene_from_dict(scene))
 
 
