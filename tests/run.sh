@@ -4,6 +4,11 @@
 # Without arguments the whole suite runs in two halves at once (see below); with arguments
 # one pytest run gets them (e.g. bash tests/run.sh tests/scene/test_scene.py -x).
 # SKIP_SETUP=1 skips the installation (an environment already set up).
+#
+# This script runs every test. For a quick loop while working, the unit tests alone (the
+# markers, described in pyproject.toml, set apart what needs a browser, long-running
+# servers and processes, or seconds per check), from the repository root:
+#     OPENBLAS_NUM_THREADS=1 python -m pytest -m "not browser and not soak and not slow"
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -29,6 +34,7 @@ export CI="${CI:-1}"
 export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}"
 
 python -m ruff check core explorer tests benchmarks
+lint-imports
 
 if [ "$#" -gt 0 ]; then
     exec python -m pytest -q "$@"
@@ -40,7 +46,8 @@ fi
 # shared with other work: 15.4 min (load average 2 -> 7, 355 s of CPU) where one pytest
 # took 20.6 min (load 1 -> 9, 439 s of CPU, before tests were made cheaper). The halves
 # share nothing: each has its own temporary directory, pytest cache and served explorers
-# (a free port each).
+# (a free port each). The soak and slow tests run in the second half: the browser half is
+# the longer one.
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
 python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
     >"$work/browser.log" 2>&1 &

@@ -86,6 +86,7 @@ def test_fingerprint_separates_what_differs():
     assert fingerprint(np.arange(4.0)) == fingerprint(np.arange(4.0).copy())
 
 
+@pytest.mark.slow
 def test_same_object_key_holds_its_object():
     """The id of an object kept in a key is not given to another while the key lives."""
     from core.cache import SameObject

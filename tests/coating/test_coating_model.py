@@ -31,6 +31,7 @@ def scene_dict(**coating) -> dict:
     return d
 
 
+@pytest.mark.slow
 def test_fe_matches_the_kernel_solution_of_the_uncoated_layer():
     stack = Stack(1.0, (), 1.0, 1.0, 0.3)
     fe = solve_stack(stack, level=0)
@@ -47,6 +48,7 @@ def test_fe_matches_the_kernel_solution_of_the_uncoated_layer():
     assert abs(fe.force_parts[2]) < 1e-10 * fe.force_parts[1]
 
 
+@pytest.mark.slow
 def test_bonded_layer_of_the_base_material_is_a_thicker_base():
     h = 0.1
     same = CoatingStrip(constant(h), constant(1.0), constant(0.3), "bonded")
@@ -58,6 +60,7 @@ def test_bonded_layer_of_the_base_material_is_a_thicker_base():
     assert coated.moment_parts[2] / thicker.moment_parts[2] - 1 == pytest.approx(0, abs=2.5e-4)
 
 
+@pytest.mark.slow
 def test_fe_statements_agree():
     layer = CoatingStrip(constant(0.02), constant(0.1), constant(0.3), "smooth")
     fe = solve_stack(Stack(1.0, (layer,), 1.0, 1.0, 0.2), level=0)
@@ -126,6 +129,7 @@ def test_map_scales_with_thickness_outside_its_range():
     assert thinner == pytest.approx(0.5 * inside)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("interface", ["smooth", "bonded"])
 def test_check_confirms_the_estimate_within_a_factor_3(interface):
     report = check_scene(creeping_scene_dict(interface=interface))
@@ -153,6 +157,7 @@ def tapered_bonded() -> dict:
             "loading": {"force": 6.0e5, "moment": 0.0}, "times": [1.0]}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scene", [worn_bonded, tapered_bonded])
 def test_estimate_brackets_the_fe_error_of_a_bonded_coating_of_varying_thickness(scene):
     # FE level 0 (level 1 moves these errors by < 0.01 percentage points, `python -m
@@ -163,6 +168,7 @@ def test_estimate_brackets_the_fe_error_of_a_bonded_coating_of_varying_thickness
     assert report["estimate"] / 3 <= report["model_error"] <= 3 * report["estimate"]
 
 
+@pytest.mark.slow
 def test_cli_check_prints_the_model_error(tmp_path):
     path = tmp_path / "scene.json"
     path.write_text(json.dumps(scene_dict(interface="bonded")))

@@ -415,6 +415,7 @@ def test_creep_zone_ends_converge_over_the_band_and_the_space_estimate_holds():
         assert errors[k] <= estimate, (w, errors[k], estimate)
 
 
+@pytest.mark.slow
 def test_creep_zone_ends_to_1e_6_at_two_time_resolutions():
     # tol = 1e-6 asks the zone ends for 1e-6 too: the band panels are refined to meet it
     # and two first time grids (8 and 16 nominal steps) must agree within the sum of

@@ -41,6 +41,7 @@ FE_CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("name", "loading", "base_thickness", "interface"), FE_CASES)
 def test_uniform_coating_answer_agrees_with_the_fe_model(name, loading, base_thickness,
                                                          interface):

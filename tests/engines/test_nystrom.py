@@ -189,6 +189,7 @@ def test_a_force_step_in_time_is_stepped_exactly_with_its_break():
     assert error <= sol.info["error_estimate"] <= 1e-6
 
 
+@pytest.mark.slow
 def test_first_kind_creep_scene_falls_back_to_the_projection():
     """A scene the property test found: a 100 m footing on a 4 m base (lam = 25) under a
     coating 1e12 times stiffer than concrete (m ~ 3e-15, a first-kind equation) with creep.

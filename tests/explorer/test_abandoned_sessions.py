@@ -18,7 +18,7 @@ import pytest
 from tests.support.abandon import WAYS, abandon_sessions, discard_wait_s
 from tests.support.serving import ExplorerProcess
 
-pytestmark = pytest.mark.timeout(600)
+pytestmark = [pytest.mark.soak, pytest.mark.timeout(600)]
 
 #: Sessions dropped per round. A page held ~3.4 MiB of the server at its peak (50
 #: dropped sessions: 234 -> 403 MiB before they were given back), so a round that kept

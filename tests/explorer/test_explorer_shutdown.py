@@ -19,7 +19,7 @@ import pytest
 
 from tests.support.serving import ExplorerProcess
 
-pytestmark = pytest.mark.timeout(600)
+pytestmark = [pytest.mark.soak, pytest.mark.timeout(600)]
 
 #: Servers stopped per signal.
 ROUNDS = 2

@@ -266,6 +266,7 @@ def killed_during_a_request(pool: SolverProcesses, kills: int, tmp_path: Path,
     return killed, outcome
 
 
+@pytest.mark.soak
 def test_a_request_whose_worker_is_killed_runs_again_on_a_new_one(tmp_path,
                                                                    wait_until) -> None:
     pool = SolverProcesses(1, 64 * 2**20)
@@ -277,6 +278,7 @@ def test_a_request_whose_worker_is_killed_runs_again_on_a_new_one(tmp_path,
         pool.shutdown()
 
 
+@pytest.mark.soak
 def test_a_request_whose_worker_dies_twice_is_answered_with_a_message(tmp_path,
                                                                       wait_until) -> None:
     pool = SolverProcesses(1, 64 * 2**20)
@@ -294,6 +296,7 @@ def test_a_request_whose_worker_dies_twice_is_answered_with_a_message(tmp_path,
         pool.shutdown()
 
 
+@pytest.mark.soak
 def test_a_request_sent_at_once_whose_worker_is_killed_runs_again(tmp_path,
                                                                    wait_until) -> None:
     pool = SolverProcesses(1, 64 * 2**20)
@@ -317,6 +320,7 @@ def test_a_request_sent_at_once_whose_worker_is_killed_runs_again(tmp_path,
         pool.shutdown()
 
 
+@pytest.mark.soak
 def test_a_stuck_worker_is_stopped_and_replaced(monkeypatch, wait_until) -> None:
     pool = SolverProcesses(1, 64 * 2**20)
     try:
@@ -333,6 +337,7 @@ def test_a_stuck_worker_is_stopped_and_replaced(monkeypatch, wait_until) -> None
         pool.shutdown()
 
 
+@pytest.mark.soak
 def test_after_shutdown_requests_are_refused_and_workers_are_gone(wait_until) -> None:
     pool = SolverProcesses(2, 64 * 2**20)
     pids = [info["pid"] for info in pool.start()]
@@ -342,6 +347,7 @@ def test_after_shutdown_requests_are_refused_and_workers_are_gone(wait_until) ->
         pool.run(0, os.getpid)
 
 
+@pytest.mark.soak
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT])
 def test_workers_do_not_outlive_the_server(sig: int, wait_until) -> None:
     # SIGINT is handled as the served explorer handles it (explorer/__main__.py): a flag

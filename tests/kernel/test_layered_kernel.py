@@ -176,6 +176,7 @@ def test_regular_part_table_matches_direct_evaluation():
     assert np.abs(table(s) - stack_kernel_regular(s, layers, **BASE)).max() < 1e-14
 
 
+@pytest.mark.slow
 def test_flat_punch_converges_and_agrees_with_the_fe_model():
     from core.coating import CoatingStrip, Stack, solve_stack
 

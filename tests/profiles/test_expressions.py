@@ -472,6 +472,7 @@ def _check_outcome(text: str) -> None:
     np.testing.assert_array_equal(again(np.array([-1.5, 0.5])), e(np.array([-1.5, 0.5])))
 
 
+@pytest.mark.slow
 @settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.text(max_size=120))
 def test_random_text_is_parsed_or_refused(text: str) -> None:
@@ -483,6 +484,7 @@ GOOD_TOKENS = ["x", "2", "0.5", "1e-3", "pi", "+", "-", "*", "/", "**", "(", ")"
                "min(x, ", "abs(", "exp(-"]
 
 
+@pytest.mark.slow
 @settings(max_examples=600, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.one_of(st.lists(st.sampled_from(TOKENS), max_size=40),
                  st.lists(st.sampled_from(GOOD_TOKENS), max_size=30)).map("".join))
@@ -538,6 +540,7 @@ def _formulas() -> st.SearchStrategy[tuple[str, Callable[[np.ndarray], object]]]
     return st.recursive(leaves, extend, max_leaves=6)
 
 
+@pytest.mark.slow
 @settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(_formulas())
 def test_generated_formulas_match_numpy(formula: tuple[str, Callable]) -> None:

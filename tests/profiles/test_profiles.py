@@ -537,6 +537,7 @@ json_like = st.recursive(
     max_leaves=12)
 
 
+@pytest.mark.slow
 @settings(max_examples=600, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.one_of(near_specs(), json_like),
        st.sampled_from([("x", (-0.15, 0.25)), ("t", (0.0, 30.0))]))
@@ -590,6 +591,7 @@ def near_csv(draw: st.DrawFn) -> str:
     return "\n".join(lines)
 
 
+@pytest.mark.slow
 @settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.one_of(csv_text, csv_text.map(lambda s: s.encode("utf-8")), st.binary(max_size=64),
                  near_csv()))

@@ -292,6 +292,7 @@ def _json_text(scene: dict[str, Any]) -> str | None:
 # ------------------------------------------------------------------------- scene dicts
 
 
+@pytest.mark.slow
 def test_generated_bad_scenes_are_refused_or_solved() -> None:
     outcomes: Counter[str] = Counter()
 
@@ -395,6 +396,7 @@ def _target(state: ExplorerState, owner: str) -> Any:
     return state.loading.histories[owner.split(".")[1]]
 
 
+@pytest.mark.slow
 def test_generated_widget_values_are_refused_or_solved() -> None:
     outcomes: Counter[str] = Counter()
 

@@ -62,6 +62,7 @@ def _nested_kernel_scene() -> dict:
     return d
 
 
+@pytest.mark.slow
 def test_small_scene_with_a_nested_kernel_formula_is_bounded():
     """A 1.1 kB scene (a nested kernel formula, 2000 output times) took 2.6 GB here
     (9.5 GiB in the report): it must now solve within 1.2 GiB of address space."""
@@ -133,6 +134,7 @@ def test_output_times_and_pressure_points_are_bounded(monkeypatch):
     assert result.pressure(np.zeros(points - 1)).shape == (points - 1, result.times.size)
 
 
+@pytest.mark.slow
 def test_many_jumps_are_refused_before_the_solver_sees_them() -> None:
     """Each jump or kink adds a graded cluster of panels to a dense operator: a 50-row
     linear shape table took 15 s and 2.4 GB and ended in an obscure error; a 10000-row

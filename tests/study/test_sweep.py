@@ -460,6 +460,7 @@ def loopback_cluster(tmp_path_factory):
                 proc.wait(timeout=20)
 
 
+@pytest.mark.slow
 def test_study_on_a_separately_started_cluster_equals_a_serial_loop(loopback_cluster):
     from distributed import Client
 
@@ -473,6 +474,7 @@ def test_study_on_a_separately_started_cluster_equals_a_serial_loop(loopback_clu
     assert_equal_to_serial(ds, study)
 
 
+@pytest.mark.slow
 def test_cli_sweep_on_the_cluster_writes_each_format(loopback_cluster, tmp_path: Path):
     import pandas as pd
     import xarray as xr
@@ -663,6 +665,7 @@ def test_scaled_answer_flags_a_large_tilt_by_its_own_size():
 LIFTOFF_FAMILY_DIFFERENCE = 1e-8
 
 
+@pytest.mark.slow
 def test_liftoff_eccentricities_of_a_batch_are_one_family(monkeypatch):
     """Many lift-off eccentricities of a flat punch in one batch: the smallest and the
     largest are solved by core.solve, the others located along the zone end and solved on

@@ -140,6 +140,7 @@ def test_exponential_collocation_converges_at_high_order():
     assert order >= 3.8, (steps, errors)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("tol", [1e-5, 1e-7, 1e-9])
 def test_exponential_collocation_meets_tol_and_its_estimate_is_honest(tol):
     problem = _creep_problem()
