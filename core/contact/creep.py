@@ -22,6 +22,7 @@ import numpy as np
 
 from core.contact.bands import BAND_WIDTHS, band_rule, bands_from_ends
 from core.contact.march import march, march_outputs, rule_operator
+from core.contact.result import _Snapshot
 from core.contact.step import Space, Step
 from core.contact.zones import ZONE_END_TOL, Resolution
 from core.discretize import Panels
@@ -105,8 +106,6 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     Richardson-extrapolated outputs of two successive pairs of grids agree to ``tol``/3
     (their difference / 7 is the estimate) or ``MAX_HALVINGS`` is reached.
     """
-    from core.contact.result import _Snapshot
-
     times = inp.times
     tol = inp.tol
     # The zone ends have their own budget whatever tol is (issue 13): half of it for the
