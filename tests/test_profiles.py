@@ -194,7 +194,8 @@ def test_profile_key_is_stable_across_processes() -> None:
     spec = {"kind": "table", "points": POINTS, "interpolation": "pchip"}
     key = profile_key(make(spec))
     assert len(key) == 64 and all(c in "0123456789abcdef" for c in key)
-    code = ("from core.profiles import profile_from_spec; from core.profiles.base import profile_key; "
+    code = ("from core.profiles import profile_from_spec; "
+            "from core.profiles.base import profile_key; "
             f"print(profile_key(profile_from_spec({spec!r}, field='f', domain={D!r})))")
     env = dict(os.environ, PYTHONHASHSEED="12345")
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
