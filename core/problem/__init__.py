@@ -12,7 +12,7 @@ from core.problem.inputs import (
     validate_time_inputs,
     validate_times,
 )
-from core.problem.result import ContactSolution, SolveOutcome
+from core.problem.result import INFO_KEYS, ContactSolution, SolveOutcome, accepts
 from core.problem.statements import (
     QUANTITIES,
     STATEMENTS,
@@ -23,10 +23,12 @@ from core.problem.statements import (
 )
 
 __all__ = [
+    "accepts",
     "as_function",
     "check_values",
     "ContactSolution",
     "Geometry",
+    "INFO_KEYS",
     "modal_system",
     "ModalSystem",
     "QUANTITIES",

@@ -43,7 +43,7 @@ from core.engines.projection.levels import (
     _Superposition,
 )
 from core.engines.projection.stages import _discretize, _Inputs, _modes
-from core.problem import ContactSolution, statement_number
+from core.problem import ContactSolution, accepts, statement_number
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
@@ -172,7 +172,7 @@ def solve_projection(inp: _Inputs, basis: str = "graded",
     stages["time"] = {"seconds": _time.perf_counter() - t_time, "cached": time_cached}
 
     error_estimate = float(spatial_error + chosen.time_error + kernel_fit_error)
-    success = error_estimate * SUCCESS_MARGIN <= tol and chosen.time_success
+    success = accepts(error_estimate, tol, SUCCESS_MARGIN) and chosen.time_success
     if not disc.resolved:
         flags.append("unresolved_input")
     if not success:
