@@ -219,7 +219,7 @@ def test_first_kind_creep_scene_falls_back_to_the_projection():
                                    frozenset({"settlement", "moment"})])
 def test_bordered_solve_on_the_refinement_lu_matches_its_own_lu(given):
     """The 2 x 2 Schur complement on the refinement's LU gives the bordered LU's answer."""
-    from core.engines.nystrom import adapt
+    from core.engines.nystrom.adapt import adapt
     from core.engines.nystrom.bordered import BorderedSystem
 
     adaptive = adapt(1.0, jump_m, stepped_g, False, (-0.5, 0.25, 0.3), 1e-6)
@@ -236,7 +236,7 @@ def test_single_precision_lu_refines_to_the_double_precision_answer():
     too ill-conditioned for single precision is factored again in double precision."""
     from scipy.linalg import lu_factor, lu_solve
 
-    from core.engines.nystrom import adapt
+    from core.engines.nystrom.adapt import adapt
     from core.engines.nystrom.bordered import SINGLE_FROM, NodalLU
 
     grid = adapt(1.0, jump_m, stepped_g, False, (-0.5, 0.25, 0.3), 1e-6).grid
@@ -267,7 +267,7 @@ def test_refined_grid_solved_by_two_grid_matches_its_dense_solve(name):
     solve's; the refined grid itself is factored only when a solve asks for it."""
     from scipy.linalg import lu_factor, lu_solve
 
-    from core.engines.nystrom import adapt
+    from core.engines.nystrom.adapt import adapt
     from core.engines.nystrom.twogrid import DeferredFactor
     from core.problem import as_function
 

@@ -476,6 +476,12 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
     geometry = validate_geometry(lam, m, g, breakpoints, tol)
     inputs = validate_time_inputs(times, c, kernel, {"settlement": settlement, "tilt": tilt,
                                                      "force": force, "moment": moment})
+    return prepared_for(geometry).solve_validated(inputs, time_breaks, check_only=check_only)
+
+
+def prepared_for(geometry: Geometry) -> PreparedContact:
+    """The prepared form of a validated geometry: from :data:`PREPARED` when a geometry of
+    the same values was prepared before, else prepared now and kept there."""
     prepared, _ = PREPARED.get_or_compute(_geometry_key(geometry),
                                           lambda: PreparedContact(geometry))
-    return prepared.solve_validated(inputs, time_breaks, check_only=check_only)
+    return prepared
