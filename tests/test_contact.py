@@ -344,8 +344,7 @@ def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
 
 def _creep_rule_march(pb, tol, rule_for, level=0):
     """Zone ends and outputs of the creep stepping on the rule ``rule_for(space, res)``."""
-    from core.contact import march
-    from core.contact.march import march_outputs
+    from core.contact.march import march, march_outputs
     from core.engines.collocation import time_grid
     from core.engines.projection import validate_inputs
 

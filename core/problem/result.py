@@ -42,7 +42,7 @@ key                        meaning
 ========================== ===================================================================
 
 :func:`core.solver.solve_dimensionless` adds ``contact`` (``"full"``; the unilateral model's
-answer, :class:`core.contact.UnilateralSolution`, has an ``info`` of its own) and, when
+answer, :class:`core.contact.result.UnilateralSolution`, has an ``info`` of its own) and, when
 the default engine declined and the next one answered, ``fallback`` (why).
 
 Engine-specific keys: nystrom ``n_panels``, ``prepare_seconds`` (the geometry's
