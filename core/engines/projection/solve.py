@@ -213,6 +213,7 @@ def solve_projection(inp: _Inputs, basis: str = "graded",
         message += ("; m or g has features finer than the quadrature could resolve "
                     "(declare jumps in breakpoints)")
     info = {
+        "method": "projection",
         "error_estimate": error_estimate,
         "spatial_error_estimate": float(spatial_error),
         "time_error_estimate": float(chosen.time_error),
