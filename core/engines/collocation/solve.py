@@ -27,8 +27,11 @@ Cost: one LU factorization per distinct step matrix while there are few (elastic
 non-aging kernel), else one Schur form and O(N^2) per step; plus O(N * steps) per step for
 the memory term, so O(N * steps^2) in total. Meant for cross-checks, not for speed.
 
-This module holds the solution, the input checks and :func:`solve_collocation`; the time
-stepping is :mod:`core.engines.collocation.steps` (``time_grid`` is re-exported here).
+This module holds the solution type, the input checks and :func:`solve_collocation`, made
+of the two steps the registered engine (:mod:`core.engines.collocation.engine`) takes too:
+:func:`prepare_collocation` (panels and operator) and :func:`solve_prepared` (the time
+stepping, the judgement of its estimate, the answer); the time stepping itself is
+:mod:`core.engines.collocation.steps` (``time_grid`` is re-exported here).
 """
 
 from __future__ import annotations
