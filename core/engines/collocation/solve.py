@@ -31,7 +31,7 @@ This module holds the solution type, the input checks and :func:`solve_collocati
 of the two steps the registered engine (:mod:`core.engines.collocation.engine`) takes too:
 :func:`prepare_collocation` (panels and operator) and :func:`solve_prepared` (the time
 stepping, the judgement of its estimate, the answer); the time stepping itself is
-:mod:`core.engines.collocation.steps` (``time_grid`` is re-exported here).
+:mod:`core.engines.collocation.steps`.
 """
 
 from __future__ import annotations
@@ -50,7 +50,6 @@ from core.engines.collocation.steps import (
     adaptive_grids,
     finite_values,
     fixed_grids,
-    time_grid,
 )
 from core.problem import QUANTITIES as _QUANTITIES
 from core.problem import STATEMENTS as _STATEMENTS
@@ -66,8 +65,7 @@ DEFAULT_TIME_TOL = 1e-6
 SUCCESS_MARGIN = 1.0
 
 __all__ = ["DEFAULT_TIME_TOL", "CollocationGeometry", "CollocationSolution", "TimeInput",
-           "collocation_panels", "prepare_collocation", "solve_collocation", "solve_prepared",
-           "time_grid"]
+           "collocation_panels", "prepare_collocation", "solve_collocation", "solve_prepared"]
 
 
 class CollocationSolution(ContactSolution):
