@@ -1,7 +1,7 @@
 """A live browser explorer of the coated-punch contact problem (Panel).
 
 ``create_app()`` builds one session; ``python -m explorer`` serves it. The state classes
-in :mod:`explorer.state` turn widget values into the scene dicts of ``core`` and can be
+in :mod:`explorer.model.state` turn widget values into the scene dicts of ``core`` and can be
 used without a server.
 """
 
@@ -19,11 +19,11 @@ def __getattr__(name: str) -> Any:
 
         return getattr(app, name)
     if name == "ExplorerState":
-        from .state import ExplorerState
+        from .model import ExplorerState
 
         return ExplorerState
     if name == "SolveController":
-        from .controller import SolveController
+        from .solving import SolveController
 
         return SolveController
     raise AttributeError(f"module 'explorer' has no attribute {name!r}")

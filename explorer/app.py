@@ -2,7 +2,7 @@
 
 ``create_app()`` builds one :class:`ExplorerApp` per browser session (serve the factory,
 not an instance). The page calls only the public API of ``core`` (through the
-controller); every number the user sets lives in :class:`~explorer.state.ExplorerState`.
+controller); every number the user sets lives in :class:`~explorer.model.state.ExplorerState`.
 The widgets live in the views of :mod:`explorer.views`, one per sidebar tab and one for
 the results; ``SIDEBAR_VIEWS`` is the one place where the tabs are assembled.
 """
@@ -18,44 +18,56 @@ import panel as pn
 import param
 from panel.io.state import set_curdoc
 
-from . import bokeh_fixes, closed_pages, gc_policy, idle_painter
-from .controller import SolveController, format_error
-from .design import DesignLimits
-from .fidelity_view import FidelityView
-from .links import decode_scene
-from .panel_fixes import install as install_panel_fixes
+from core import scene_from_dict
+
+from .fixes import bokeh_fixes, closed_pages, gc_policy, idle_painter, panel_fixes
+from .model import (
+    DEFAULT_PRESET,
+    DesignLimits,
+    DisplayScales,
+    ExplorerState,
+    ResultView,
+    decode_scene,
+    presets,
+    read_study_query,
+    read_view_query,
+)
 from .plots import Figures
-from .presets import DEFAULT_PRESET, presets
-from .results import ResultView
-from .scales import DisplayScales
-from .state import ExplorerState
-from .status import status_html
-from .trace import install_websocket_marks, mark
-from .view_link import read_study_query, read_view_query
-from .views.base import BaseView
-from .views.busy import BUSY_AFTER_MS, BusyIndicator
-from .views.check import CheckView
-from .views.coating import CoatingView
-from .views.files import FilesView
-from .views.history import SceneHistory
-from .views.lessons import LessonsView
-from .views.link import LINK_EVERY_MS, AddressLink
-from .views.pins import PinsView
-from .views.punch import PunchView
-from .views.results import BADGES, ResultsView, badges_html, readout_html
-from .views.scene import SceneView
-from .views.study import StudyView
-from .views.style import CSS, html_pane
-from .views.tabs import FILL_TABS_AFTER_MS, DeferredTabs
-from .views.times import TimesView
-from .warm_up import warm_up
+from .solving import SolveController, format_error, install_websocket_marks, mark, warm_up
+from .views import (
+    BADGES,
+    BUSY_AFTER_MS,
+    CSS,
+    FILL_TABS_AFTER_MS,
+    LINK_EVERY_MS,
+    AddressLink,
+    BaseView,
+    BusyIndicator,
+    CheckView,
+    CoatingView,
+    DeferredTabs,
+    FidelityView,
+    FilesView,
+    LessonsView,
+    PinsView,
+    PunchView,
+    ResultsView,
+    SceneHistory,
+    SceneView,
+    StudyView,
+    TimesView,
+    badges_html,
+    html_pane,
+    readout_html,
+    status_html,
+)
 
 __all__ = ["BADGES", "BUSY_AFTER_MS", "CSS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS",
            "ExplorerApp", "SIDEBAR_VIEWS", "badges_html", "create_app", "readout_html",
            "warm_up"]
 
 log = logging.getLogger(__name__)
-install_panel_fixes()
+panel_fixes.install()
 install_websocket_marks()
 
 #: Geometry and material sliders apply each drag step (not only the release) while the
@@ -187,8 +199,6 @@ class ExplorerApp(pn.viewable.Viewer):
             callback()
 
     def _initial_scene(self, scene: dict[str, Any] | None, query: dict[str, str]) -> None:
-        from core import scene_from_dict
-
         default = self.presets.get(DEFAULT_PRESET) or next(iter(self.presets.values()), None)
         chosen = scene
         if chosen is None and query.get("scene"):
@@ -287,8 +297,6 @@ class ExplorerApp(pn.viewable.Viewer):
 
     def load_scene(self, scene: dict[str, Any]) -> bool:
         """Validate a scene dict with the core and show it; False (and a notice) if bad."""
-        from core import scene_from_dict
-
         try:
             scene_from_dict(scene)
             self.state.load_scene(scene)

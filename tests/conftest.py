@@ -103,7 +103,7 @@ def small_preset_scene(key: str | None = None, count: int = 6, tol: float = 1e-5
                        force_kN: float | None = None) -> dict[str, Any]:
     """A preset of the explorer (the default one if ``key`` is None) with ``count`` output
     times over 200 days, tolerance ``tol`` and, if given, a constant force [kN/m]."""
-    from explorer.presets import DEFAULT_PRESET, presets
+    from explorer.model import DEFAULT_PRESET, presets
 
     scene = copy.deepcopy(presets()[key or DEFAULT_PRESET])
     scene["times"] = {"end": 200.0, "count": count, "spacing": "log"}

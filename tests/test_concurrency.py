@@ -22,9 +22,8 @@ import pytest
 
 from core import scene_from_dict, solve
 from core.cache import _REGISTRY, _REGISTRY_LOCK, StageCache, cache_report, clear_caches
-from explorer.controller import RESULTS, SolveController, approx_bytes
-from explorer.presets import presets
-from explorer.state import ExplorerState
+from explorer.model import ExplorerState, presets
+from explorer.solving import RESULTS, SolveController, approx_bytes
 
 pytestmark = pytest.mark.timeout(600)
 
@@ -340,7 +339,7 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
         assert shown is app.controller.view
 
         def check_downloads_match(view: Any) -> None:
-            from explorer.exports import parse_csv
+            from explorer.files import parse_csv
 
             # the CSV holds the plotted numbers in the units on screen (mm, kN/m), to
             # 10 significant digits; the JSON the solver's SI numbers in full
@@ -372,7 +371,7 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
         assert started.wait(60)
         assert app.controller.busy and app._drawn is shown
         check_downloads_match(shown)
-        from explorer.exports import parse_csv
+        from explorer.files import parse_csv
 
         assert parse_csv(app._csv_file().getvalue())[2][0, 3] == old_force / 1e3
         gate.set()

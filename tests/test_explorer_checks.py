@@ -15,11 +15,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from explorer.controller import SolveController
-from explorer.exports import histories_csv, number, parse_csv, pressure_csv
-from explorer.presets import presets
-from explorer.scales import DisplayScales, nice_ceiling
-from explorer.state import MAX_NAME_CHARS, ExplorerState
+from explorer.files import histories_csv, number, parse_csv, pressure_csv
+from explorer.model import MAX_NAME_CHARS, ExplorerState, presets
+from explorer.model.scales import DisplayScales, nice_ceiling
+from explorer.solving import SolveController
 from tests.cli_runs import run_cli
 
 PRESETS = presets()
@@ -193,7 +192,7 @@ class _Never(Executor):
 
 def test_a_slow_first_solve_says_so_and_a_failure_claims_no_last_result():
     from explorer.app import ExplorerApp
-    from explorer.workers import WorkerFailed
+    from explorer.solving import WorkerFailed
 
     slow = json.loads(json.dumps(PRESETS["eccentric_creep"]))
     slow["times"] = {"end": 1000.0, "count": 77, "spacing": "log"}  # in no cache
@@ -238,7 +237,7 @@ def test_the_command_line_shows_the_solver_message_not_a_pointer(tmp_path):
 
 # ------------------------------------------------------------------ design check, report
 def test_the_design_check_finds_the_extremes_and_judges_the_limits():
-    from explorer.design import DesignLimits, design_check
+    from explorer.model import DesignLimits, design_check
 
     _, controller = solved("eccentric_creep")
     view = controller.view
@@ -259,8 +258,7 @@ def test_the_design_check_finds_the_extremes_and_judges_the_limits():
 
 
 def test_the_report_holds_inputs_plots_flags_accuracy_and_version():
-    from explorer.exports import project_version
-    from explorer.report import report_html
+    from explorer.files import project_version, report_html
 
     _, controller = solved_flagged()
     text = report_html(controller.view)
@@ -270,7 +268,7 @@ def test_the_report_holds_inputs_plots_flags_accuracy_and_version():
 
 
 def test_the_status_speaks_plainly_and_keeps_the_numbers_in_details():
-    from explorer.status import status_html
+    from explorer.views import status_html
 
     state, controller = solved()
     text = status_html(controller.view, False)
@@ -307,7 +305,7 @@ def test_classical_solutions_carry_the_force_and_moment():
     for the rule, measured 5e-11)."""
     from numpy.polynomial.chebyshev import chebgauss
 
-    from explorer.classical import EDGE_CAP, bearing_rule_pressure, half_space_pressure
+    from explorer.plots.classical import EDGE_CAP, bearing_rule_pressure, half_space_pressure
 
     a, force = 1.2, 5e5
     x = np.linspace(-a, a, 200_001)

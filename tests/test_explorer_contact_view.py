@@ -9,12 +9,16 @@ from functools import cache
 import numpy as np
 import pytest
 
-from explorer.contact_zone import contact_text, contact_widths, contact_zones
-from explorer.controller import SolveController
+from explorer.model import (
+    ExplorerState,
+    ResultView,
+    contact_text,
+    contact_widths,
+    contact_zones,
+    presets,
+)
 from explorer.plots import Figures
-from explorer.presets import presets
-from explorer.results import ResultView
-from explorer.state import ExplorerState
+from explorer.solving import SolveController
 
 
 @cache
@@ -91,7 +95,7 @@ def test_in_full_contact_the_width_plot_says_so() -> None:
 
 
 def test_the_readout_names_the_contact_zone() -> None:
-    from explorer.views.results import readout_html
+    from explorer.views import readout_html
 
     view = _solved("eccentric_footing_liftoff")
     text = readout_html(view, 0, ())
@@ -145,7 +149,7 @@ def test_a_load_step_in_full_contact_resends_nothing_of_the_contact() -> None:
 def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
     from bokeh.core.properties import value
 
-    from explorer.views.results import badges_html
+    from explorer.views import badges_html
 
     view = _solved("eccentric_footing_liftoff")
     badges = badges_html(view, "pressure")
@@ -161,7 +165,7 @@ def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
 
 
 def test_the_report_carries_the_contact_zone_and_its_history() -> None:
-    from explorer.report import report_html
+    from explorer.files import report_html
 
     text = report_html(_solved("eccentric_footing_liftoff"), index=0)
     assert "At t = 0 days: contact 1.306 m of 2 m (65 %)" in text

@@ -10,7 +10,7 @@ import re
 import numpy as np
 import pytest
 
-from explorer.presets import presets
+from explorer.model import presets
 
 KEY = "eccentric_footing_liftoff"
 
@@ -24,7 +24,7 @@ def _app(key: str = KEY):
 
 
 def _control(app):
-    from explorer.views.scene import SceneView
+    from explorer.views import SceneView
 
     return next(v for v in app.views if isinstance(v, SceneView)).eccentric_load
 

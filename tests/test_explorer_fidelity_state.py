@@ -14,8 +14,7 @@ from pathlib import Path
 import pytest
 
 from core import scene_from_dict
-from explorer.links import decode_scene, encode_scene
-from explorer.state import ExplorerState
+from explorer.model import ExplorerState, decode_scene, encode_scene
 
 LIFTOFF = Path(__file__).resolve().parents[1] / "assets/scenes/eccentric_footing_liftoff.json"
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import core
-from explorer.lessons import LESSONS, lessons, step_scene
+from explorer.model.lessons import LESSONS, lessons, step_scene
 
 LESSON = {lesson.key: lesson for lesson in LESSONS}
 

@@ -9,7 +9,7 @@ from dataclasses import replace
 import param
 import pytest
 
-from explorer.presets import presets
+from explorer.model import presets
 
 KEY = "eccentric_footing_liftoff"
 
@@ -23,7 +23,7 @@ def _app():
 
 
 def _control(app):
-    from explorer.views.scene import SceneView
+    from explorer.views import SceneView
 
     return next(v for v in app.views if isinstance(v, SceneView)).eccentric_load
 

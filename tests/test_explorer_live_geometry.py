@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import pytest
 
-from explorer.presets import presets
+from explorer.model import presets
 
 KEY = "rounded_graded"
 

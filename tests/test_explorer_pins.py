@@ -5,9 +5,8 @@ from __future__ import annotations
 import copy
 
 from explorer.app import ExplorerApp
-from explorer.pins import MAX_PINS, pin_labels
-from explorer.presets import presets
-from explorer.view_link import read_view_query, view_query
+from explorer.model import presets, read_view_query, view_query
+from explorer.model.pins import MAX_PINS, pin_labels
 
 
 def _scene(**loading: float) -> dict:

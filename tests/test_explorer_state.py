@@ -19,17 +19,18 @@ import param
 import pytest
 
 from core import scene_from_dict, solve
-from explorer.controller import SolveController, describe_field, format_error
-from explorer.links import decode_scene, encode_scene
-from explorer.presets import presets
-from explorer.results import negative_intervals
-from explorer.state import (
+from explorer.model import (
     CREEP_MODELS,
     QUANTITIES,
     STATEMENTS,
     ExplorerState,
     ProfileState,
+    decode_scene,
+    encode_scene,
+    presets,
 )
+from explorer.model.results import negative_intervals
+from explorer.solving import SolveController, describe_field, format_error
 
 PRESETS = presets()
 

@@ -12,9 +12,9 @@ import pytest
 
 from core import solve
 from core.study.definition import apply_point
-from explorer.presets import presets
-from explorer.state import ExplorerState
-from explorer.study import (
+from explorer.files import study_csv
+from explorer.model import ExplorerState, presets
+from explorer.model.study import (
     ECCENTRICITY,
     MAX_POINTS,
     OUTPUTS,
@@ -22,7 +22,7 @@ from explorer.study import (
     plan_study,
     study_choices,
 )
-from explorer.study_runner import StudyRun
+from explorer.solving import StudyRun
 
 
 def screen_scene(times=(1.0, 365.0)) -> dict:
@@ -177,7 +177,7 @@ def test_the_tab_draws_the_chart_and_writes_the_files():
 
 
 def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
-    from explorer.study_plots import DesignChart
+    from explorer.plots import DesignChart
 
     scene = screen_scene()
     scene["solver"]["contact"] = "full"  # the full-contact answer, flagged when q < 0
@@ -192,7 +192,7 @@ def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
     chart.draw(result, "q_min", 1)
     np.testing.assert_allclose(chart.flagged.data["x"], [0.6])
     assert chart.flagged.data["y"][0] < 0  # kPa: the tension the flag is about
-    rows = [line for line in result.to_csv().splitlines() if not line.startswith("#")]
+    rows = [line for line in study_csv(result).splitlines() if not line.startswith("#")]
     assert rows[-1].endswith('"contact_lost",""')
 
 
@@ -200,7 +200,7 @@ def test_a_link_keeps_the_study_settings():
     """The Study tab's fields, ranges, spacing, counts and output go into the page's link
     and a page opened from it shows them again; bad settings are refused, not fatal."""
     from explorer.app import ExplorerApp
-    from explorer.view_link import read_study_query, study_settings, view_query
+    from explorer.model.view_link import read_study_query, study_settings, view_query
 
     app = ExplorerApp(executor=None)
     first, second = app.study_first, app.study_second
@@ -237,7 +237,7 @@ def test_a_link_keeps_the_study_settings():
                          "study output")):
         with pytest.raises(ValueError, match=reason):
             study_settings(bad)
-    from explorer.links import encode_scene
+    from explorer.model import encode_scene
 
     settings, message = read_study_query({"study": encode_scene({"axes": "x"})})
     assert settings is None and message.startswith("The study settings in the link were "

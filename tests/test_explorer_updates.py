@@ -15,7 +15,7 @@ import pytest
 from bokeh.models import ColumnDataSource
 
 from explorer.app import BUSY_AFTER_MS, LINK_EVERY_MS, ExplorerApp
-from explorer.plots import set_data
+from explorer.plots.bokeh_data import set_data
 
 
 def test_set_data_skips_equal_numbers_and_sends_changes() -> None:
@@ -135,7 +135,7 @@ class _Location:
 
 
 def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
-    from explorer.links import decode_scene
+    from explorer.model import decode_scene
 
     app, timers = served_app
     location = _Location(app)
@@ -167,7 +167,7 @@ def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
 
 
 def test_a_message_left_queued_by_a_finished_write_task_is_still_sent() -> None:
-    """The state Panel's write queue can be left in (see explorer/panel_fixes.py): a
+    """The state Panel's write queue can be left in (see explorer/fixes/panel_fixes.py): a
     message queued and no write flag. Seen under load as a slider step whose plots never
     arrived; the guard sends it."""
     import asyncio
@@ -175,7 +175,7 @@ def test_a_message_left_queued_by_a_finished_write_task_is_still_sent() -> None:
     from bokeh.document import Document
     from panel.io import document as pdoc
 
-    from explorer.panel_fixes import install
+    from explorer.fixes.panel_fixes import install
 
     assert install()
 
@@ -211,7 +211,7 @@ def test_a_complete_page_is_frozen_out_of_the_collectors_reach(served_app, monke
     session ends so that its cycles are still freed."""
     import gc
 
-    from explorer import gc_policy
+    from explorer.fixes import gc_policy
 
     app, timers = served_app
     frozen: list[int] = []
@@ -246,7 +246,7 @@ def test_a_page_completed_after_its_session_ended_is_not_frozen() -> None:
     server by ~350 MiB each, none returned)."""
     import gc
 
-    from explorer import gc_policy
+    from explorer.fixes import gc_policy
 
     class Ended:
         destroyed = True

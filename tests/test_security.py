@@ -32,7 +32,7 @@ from core.profiles import profile_from_csv
 from core.scene import MAX_SCENE_BYTES, load_scene, save_scene, scene_from_dict, solve
 from core.scene.files import parse_scene_json
 from core.scene.schema import MAX_BREAKPOINTS, migrate
-from explorer.links import MAX_JSON, PREFIX, decode_scene, encode_scene
+from explorer.model.links import MAX_JSON, PREFIX, decode_scene, encode_scene
 from tests.browser_pages import require_browser, served_explorer
 from tests.cli_runs import run_cli
 

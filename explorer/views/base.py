@@ -6,10 +6,10 @@ from typing import TYPE_CHECKING
 
 import panel as pn
 
-from ..creep_view import CODE_CREEP_MODELS, CodeCreepPanel
-from ..state import CREEP_MODELS
-from ..widgets import Binding, fine_slider, slider
+from ..model import CODE_CREEP_MODELS, CREEP_MODELS
+from .creep import CodeCreepPanel
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
+from .widgets import Binding, fine_slider, slider
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING, Any
 
 import param
 
-from ..status import status_html
+from .status import status_html
 from .style import html_pane
 
 if TYPE_CHECKING:

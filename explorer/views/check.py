@@ -13,7 +13,7 @@ if TYPE_CHECKING:
 
 
 class CheckView:
-    """Inputs of the session's :class:`~explorer.design.DesignLimits` and of e = M/P."""
+    """Inputs of the session's :class:`~explorer.model.design.DesignLimits` and of e = M/P."""
 
     title = "Check"
 

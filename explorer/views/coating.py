@@ -8,9 +8,12 @@ from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
-from ..state import SCREEN_LAYERS
-from ..widgets import ProfileEditor, PromptIntSlider
+from core.scene import check_scene
+
+from ..model import SCREEN_LAYERS
+from ..solving import worker_processes
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
+from .widgets import ProfileEditor, PromptIntSlider
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp
@@ -163,10 +166,6 @@ class CoatingCheckView:
 
 def _check(scene: dict[str, Any]) -> dict[str, Any] | str:
     """The check's report, or why there is none (runs off the event loop)."""
-    from core.scene import check_scene
-
-    from ..controller import worker_processes
-
     try:
         processes = worker_processes()
         if processes is not None:

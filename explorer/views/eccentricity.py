@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
-from ..widgets import _set_widget, slider
 from .style import NOTE_STYLE, html_pane
+from .widgets import _set_widget, slider
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp

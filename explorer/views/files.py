@@ -10,14 +10,12 @@ from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
-from core.scene import MAX_SCENE_BYTES
+from core.scene import MAX_SCENE_BYTES, read_scene_json
 
-from .. import exports
-from ..report import report_html
-from ..results import ResultView
-from ..state import MAX_DESCRIPTION_CHARS, MAX_NAME_CHARS, check_text
-from ..widgets import Binding, BoundedUpload
+from ..files import exports, report_html
+from ..model import MAX_DESCRIPTION_CHARS, MAX_NAME_CHARS, ResultView, check_text
 from .style import TAB_COLUMN, html_pane, slug
+from .widgets import Binding, BoundedUpload
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp
@@ -95,8 +93,6 @@ class FilesView:
             self.load_file.clear()
 
     def _read_scene_file(self, data: bytes) -> None:
-        from core.scene import read_scene_json
-
         app = self.app
         # the same limit as the command line: a browser may send up to the websocket's
         # message size, and parsing costs memory and time on the shared server

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ..undo import UndoStack
+from ..model import UndoStack
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import panel as pn
 
-from ..lessons import Lesson, lessons, step_scene
+from ..model import Lesson, lessons, step_scene
 from .style import TAB_COLUMN, html_pane
 
 if TYPE_CHECKING:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import logging
 from typing import TYPE_CHECKING
 
-from ..view_link import view_query
+from ..model import view_query
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp

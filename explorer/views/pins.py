@@ -9,15 +9,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import panel as pn
 
-from ..controller import SolveController, format_error
-from ..pins import MAX_PINS, PinBoard
-from ..state import QUANTITY_UNITS, ExplorerState
-from ..widgets import NAMES
+from core import scene_from_dict
+
+from ..model import MAX_PINS, QUANTITY_UNITS, ExplorerState, PinBoard
+from ..plots import PIN_COLORS
+from ..solving import SolveController, format_error
 from .style import html_pane
+from .widgets import NAMES
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp
-    from ..results import ResultView
+    from ..model import ResultView
 
 
 class PinsView:
@@ -143,8 +145,6 @@ class PinsView:
                         what: str = "A pinned result in the link was not used") -> None:
         """Solve the pinned scenes of a link (off the page's thread), then pin them in
         the link's order; a scene refused is named in a notice starting with ``what``."""
-        from core import scene_from_dict
-
         self._expected = len(scenes)
         for slot, scene in enumerate(scenes):
             state = ExplorerState()
@@ -192,8 +192,6 @@ class PinsView:
 
     def _show_list(self) -> None:
         """One remove button per pin, coloured and named as in the legend."""
-        from ..pin_plots import PIN_COLORS
-
         self.unpin_button.disabled = not self.board.pins
         buttons = []
         for k, pin in enumerate(self.board.pins):

@@ -7,11 +7,11 @@ from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
-from core.profiles import MAX_TABLE_BYTES
+from core.profiles import MAX_TABLE_BYTES, profile_from_csv
 
-from ..controller import format_error
-from ..widgets import Binding, BoundedUpload, fine_slider, slider
+from ..solving import format_error
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
+from .widgets import Binding, BoundedUpload, fine_slider, slider
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp
@@ -95,8 +95,6 @@ class PunchView:
         data = event.new
         if not data:
             return
-        from core.profiles import profile_from_csv
-
         app = self.app
         a = app.state.punch.half_width
         try:

@@ -9,19 +9,23 @@ from typing import TYPE_CHECKING, Any
 import panel as pn
 import param
 
-from .. import exports
-from ..contact_zone import contact_text, lifts_off
-from ..design import check_html, design_check
-from ..pin_plots import PIN_COLORS
-from ..pins import Pin
-from ..results import ResultView
-from ..state import QUANTITIES, QUANTITY_UNITS
-from ..status import status_html
-from ..time_axis import LogTime
-from ..widgets import NAMES
+from ..files import exports
+from ..model import (
+    QUANTITIES,
+    QUANTITY_UNITS,
+    Pin,
+    ResultView,
+    check_html,
+    contact_text,
+    design_check,
+    lifts_off,
+)
+from ..plots import PIN_COLORS, LogTime
 from .busy import BusySpinner
 from .contact import ContactPanes
+from .status import status_html
 from .style import html_pane
+from .widgets import NAMES
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp

@@ -6,11 +6,10 @@ from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
-from ..presets import preset_label
-from ..state import STATEMENTS
-from ..widgets import NAMES, HistoryEditor
+from ..model import STATEMENTS, preset_label
 from .eccentricity import EccentricityControl
 from .style import TAB_COLUMN, html_pane
+from .widgets import NAMES, HistoryEditor
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp

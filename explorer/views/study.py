@@ -1,10 +1,10 @@
 """The Study tab: a design chart over one or two fields of the scene on screen.
 
-The user picks the fields (loads, coating, base, punch: :func:`explorer.study.
+The user picks the fields (loads, coating, base, punch: :func:`explorer.model.study.
 study_choices`), their ranges and the output; Run builds the study from the scene on
-screen (:func:`explorer.study.plan_study`, refused with a message naming the field) and
-runs it off the page's event loop (:class:`explorer.study_runner.StudyRun`, a process of
-its own, cancellable). The chart (:class:`explorer.study_plots.DesignChart`) shows the
+screen (:func:`explorer.model.study.plan_study`, refused with a message naming the field) and
+runs it off the page's event loop (:class:`explorer.solving.study_runner.StudyRun`, a process of
+its own, cancellable). The chart (:class:`explorer.plots.study.DesignChart`) shows the
 output at a chosen time; it downloads as CSV (every output at every time) and PNG.
 """
 
@@ -16,18 +16,10 @@ from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
-from ..study import (
-    MAX_POINTS,
-    OUTPUTS,
-    SPACINGS,
-    Axis,
-    default_range,
-    plan_study,
-    study_choices,
-)
-from ..study_plots import DesignChart, flag_note
-from ..study_png import design_chart_png
-from ..study_runner import StudyRun
+from ..files import study_csv
+from ..model import MAX_POINTS, OUTPUTS, SPACINGS, Axis, default_range, plan_study, study_choices
+from ..plots import DesignChart, design_chart_png, flag_note
+from ..solving import StudyRun
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
 
 if TYPE_CHECKING:
@@ -126,7 +118,7 @@ class StudyView:
         # the fields offered follow each result on screen (a solve, not every slider step)
         app.controller.param.watch(lambda e: self.refresh(getattr(e.new, "scene", None)),
                                    "view")
-        # the settings are part of the page's link (explorer.view_link)
+        # the settings are part of the page's link (explorer.model.view_link)
         self._wanted: dict[str, Any] | None = None
         for inputs in (self.study_first, self.study_second):
             for widget in (inputs.field, inputs.start, inputs.stop, inputs.count,
@@ -189,7 +181,7 @@ class StudyView:
     # -- the link ------------------------------------------------------------------------
     def study_settings(self) -> dict[str, Any] | None:
         """The parameters and output typed, as a link keeps them
-        (:func:`explorer.view_link.study_settings`), or None when one is incomplete."""
+        (:func:`explorer.model.view_link.study_settings`), or None when one is incomplete."""
         axes = [a for a in (self.study_first.axis(), self.study_second.axis())
                 if a is not None]
         rows = [[a.key, a.start, a.stop, a.count, a.spacing] for a in axes]
@@ -198,7 +190,7 @@ class StudyView:
         return {"axes": rows, "output": self.study_output.value}
 
     def apply_study_settings(self, settings: dict[str, Any]) -> None:
-        """Show the settings of a link (checked by :func:`explorer.view_link.
+        """Show the settings of a link (checked by :func:`explorer.model.view_link.
         study_settings`); a field the scene does not offer yet is set when it does."""
         self._wanted = settings
         axes = settings["axes"]
@@ -277,7 +269,7 @@ class StudyView:
     # -- files -----------------------------------------------------------------------------
     def _csv(self) -> io.StringIO:
         result = self.study_run.result
-        return io.StringIO(result.to_csv() if result is not None else "")
+        return io.StringIO(study_csv(result) if result is not None else "")
 
     def _png(self) -> io.BytesIO:
         result = self.study_run.result

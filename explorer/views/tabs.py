@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING, Any
 
 import panel as pn
 
-from .. import gc_policy
+from ..fixes import gc_policy
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp

@@ -6,8 +6,8 @@ from typing import TYPE_CHECKING
 
 import panel as pn
 
-from ..widgets import Binding, EditableIntSlider, slider
 from .style import TAB_COLUMN
+from .widgets import Binding, EditableIntSlider, slider
 
 if TYPE_CHECKING:
     from ..app import ExplorerApp
