@@ -117,10 +117,10 @@ def main(argv: list[str] | None = None) -> int:
         _restart_with_server_allocator()
     import panel as pn
 
-    from explorer.app import create_app, warm_up
+    from explorer.app import create_app
     from explorer.fixes import closed_pages
     from explorer.model import ORDER
-    from explorer.solving import shared_pool, use_worker_processes, worker_processes
+    from explorer.solving import shared_pool, use_worker_processes, warm_up, worker_processes
 
     if args.solver_processes < 0 or args.solver_threads < 1:
         print("--solver-processes must be 0 or more and --solver-threads 1 or more",

@@ -134,13 +134,12 @@ def test_cancel_stops_the_study_process():
     assert again.status == "done", again.message
 
 
-def test_the_tab_draws_the_chart_and_writes_the_files():
-    from explorer.app import create_app
-    from explorer.views.study import NONE, StudyView
+def test_the_tab_draws_the_chart_and_writes_the_files(explorer_app):
+    from explorer.views.study import NONE
 
     state_scene = screen_scene()
-    app = create_app(scene=state_scene)
-    tab = next(v for v in app.views if isinstance(v, StudyView))
+    app = explorer_app(scene=state_scene)
+    tab = app.study_tab
     assert tab.study_first.field.value == "loading.force"
     assert tab.study_second.field.value == NONE
     tab.study_first.fill(Axis("loading.force", 300.0, 700.0, 3))
@@ -196,35 +195,35 @@ def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
     assert rows[-1].endswith('"contact_lost",""')
 
 
-def test_a_link_keeps_the_study_settings():
+def test_a_link_keeps_the_study_settings(explorer_app):
     """The Study tab's fields, ranges, spacing, counts and output go into the page's link
     and a page opened from it shows them again; bad settings are refused, not fatal."""
-    from explorer.app import ExplorerApp
     from explorer.model.view_link import read_study_query, study_settings, view_query
 
-    app = ExplorerApp(executor=None)
-    first, second = app.study_first, app.study_second
+    app = explorer_app()
+    first, second = app.study_tab.study_first, app.study_tab.study_second
     first.field.value = "coating[0].modulus"
     first.start.value, first.stop.value = 150.0, 1200.0
     first.count.value, first.spacing.value = 7, "log"
     second.field.value = "loading.force"
     second.start.value, second.stop.value = 250.0, 650.0
     second.count.value, second.spacing.value = 5, "linear"
-    app.study_output.value = "tilt"
-    settings = app.study_settings()
+    app.study_tab.study_output.value = "tilt"
+    settings = app.study_tab.study_settings()
     assert settings == {"axes": [["coating[0].modulus", 150.0, 1200.0, 7, "log"],
                                  ["loading.force", 250.0, 650.0, 5, "linear"]],
                         "output": "tilt"}
     query = view_query(app.controller.view.scene, 0, 0, [], settings)
-    opened = ExplorerApp(executor=None, query=query)
-    assert opened.study_settings() == settings
-    assert opened.study_second.field.value == "loading.force"
-    assert opened.study_first.spacing.value == "log" and opened.study_first.count.value == 7
+    opened = explorer_app(query=query)
+    assert opened.study_tab.study_settings() == settings
+    assert opened.study_tab.study_second.field.value == "loading.force"
+    first = opened.study_tab.study_first
+    assert first.spacing.value == "log" and first.count.value == 7
     # one parameter: the second is left out
     one = {"axes": [["loading.force", 100.0, 900.0, 4, "linear"]], "output": "q_max"}
-    opened = ExplorerApp(executor=None, query=view_query(app.controller.view.scene, 0, 0,
+    opened = explorer_app(query=view_query(app.controller.view.scene, 0, 0,
                                                          [], one))
-    assert opened.study_settings() == one
+    assert opened.study_tab.study_settings() == one
     # settings a page never writes: refused with the setting named, the page opens
     for bad, reason in (({"axes": [], "output": "tilt"}, "study axes"),
                         ({"axes": [["x", 1.0, float("nan"), 3, "log"]], "output": "tilt"},

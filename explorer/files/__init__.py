@@ -5,6 +5,7 @@
 """
 
 from .exports import (
+    flag_message,
     histories_csv,
     number,
     parse_csv,
@@ -14,5 +15,5 @@ from .exports import (
 )
 from .report import report_html
 
-__all__ = ["histories_csv", "number", "parse_csv", "pressure_csv", "project_version",
-           "report_html", "study_csv"]
+__all__ = ["flag_message", "histories_csv", "number", "parse_csv", "pressure_csv",
+           "project_version", "report_html", "study_csv"]

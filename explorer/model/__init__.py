@@ -13,7 +13,8 @@ prepared where it is solved), and the state can be used without a server.
 - ``pins``: pinned results, named after what differs between them.
 - ``presets``, ``lessons``: the preset scenes, and lessons built from them.
 - ``links``, ``view_link``: the scene, and what else a link keeps, in the page's address.
-- ``undo``: the scenes shown, for undo and reset.
+- ``undo``, ``history``: the scenes shown, for undo and reset.
+- ``screen``: what the page shows now (the result, the output time, a notice).
 - ``study``: the Study tab's design studies, planned from the scene on screen.
 """
 
@@ -26,6 +27,7 @@ from .code_creep_state import (
 )
 from .contact_zone import contact_text, contact_widths, contact_zones, lifts_off
 from .design import DesignLimits, check_html, design_check
+from .history import SceneHistory
 from .lessons import Lesson, lessons, step_scene
 from .links import decode_scene, encode_scene
 from .loading_state import QUANTITIES, QUANTITY_RANGES, QUANTITY_UNITS, STATEMENTS, HistoryState
@@ -44,6 +46,7 @@ from .scene_parts import (
     ProfileState,
     check_text,
 )
+from .screen import Screen
 from .state import MODEL_TOL_RANGE, ExplorerState
 from .study import (
     MAX_POINTS,
@@ -59,16 +62,15 @@ from .study import (
 from .undo import UndoStack
 from .view_link import read_study_query, read_view_query, view_query
 
-__all__ = [
-    "CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
-    "MAX_DESCRIPTION_CHARS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS", "MODEL_TOL_RANGE",
-    "ORDER", "OUTPUTS", "PLOT_DURATIONS", "QUANTITIES", "QUANTITY_RANGES", "QUANTITY_UNITS",
-    "SCENES_DIR", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES", "Axis",
-    "CodeCreepState", "DesignLimits", "DisplayScales", "ExplorerState", "Geometry",
-    "HistoryState", "LayerState", "Lesson", "Pin", "PinBoard", "PlannedStudy",
-    "ProfileState", "ResultView", "StudyResult", "UndoStack", "check_html", "check_text",
-    "contact_text", "contact_widths", "contact_zones", "creep_coefficient_data",
-    "decode_scene", "default_range", "design_check", "encode_scene", "lessons", "lifts_off",
-    "plan_study", "prepare_view", "preset_label", "presets", "read_study_query",
-    "read_view_query", "step_scene", "study_choices", "view_query",
-]
+__all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
+           "MAX_DESCRIPTION_CHARS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS", "MODEL_TOL_RANGE",
+           "ORDER", "OUTPUTS", "PLOT_DURATIONS", "QUANTITIES", "QUANTITY_RANGES", "QUANTITY_UNITS",
+           "SCENES_DIR", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES", "Axis",
+           "CodeCreepState", "DesignLimits", "DisplayScales", "ExplorerState", "Geometry",
+           "HistoryState", "LayerState", "Lesson", "Pin", "PinBoard", "PlannedStudy",
+           "ProfileState", "ResultView", "SceneHistory", "Screen", "StudyResult", "UndoStack",
+           "check_html", "check_text", "contact_text", "contact_widths", "contact_zones",
+           "creep_coefficient_data", "decode_scene", "default_range", "design_check",
+           "encode_scene", "lessons", "lifts_off", "plan_study", "prepare_view", "preset_label",
+           "presets", "read_study_query", "read_view_query", "step_scene", "study_choices",
+           "view_query"]

@@ -30,6 +30,5 @@ from .warm_up import warm_up
 from .workers import SolverProcesses, WorkerFailed, solve_view
 
 __all__ = ["RESULTS", "SolveController", "SolverProcesses", "StudyRun", "WorkerFailed",
-           "approx_bytes", "describe_field", "format_error", "install_websocket_marks",
-           "mark", "shared_pool", "solve_view", "use_worker_processes", "warm_up",
-           "worker_processes"]
+           "approx_bytes", "describe_field", "format_error", "install_websocket_marks", "mark",
+           "shared_pool", "solve_view", "use_worker_processes", "warm_up", "worker_processes"]

@@ -356,6 +356,17 @@ class SolveController(param.Parameterized):
             return self._processes.run(self._lane, download_text, view.scene, kind, view.info)
         return solution_text(self._solve(view.scene), kind, view.info)
 
+    def solved_within(self, seconds: float) -> bool:
+        """Whether the result kept took less than ``seconds`` [s] of CPU time to solve
+        (what the scene costs: on a shared server its wall time swings with the others'
+        work); False before the first result."""
+        view = self.view
+        if view is None:
+            return False
+        # a result kept from before the CPU time was recorded has its wall time only
+        spent = view.info.get("cpu_seconds", view.info.get("seconds"))
+        return isinstance(spent, (int, float)) and spent < seconds
+
     def download_later(self, view: ResultView, kind: str) -> Future[str]:
         """:meth:`download` off the calling thread: a future of the text, done when the
         worker has answered (at once where solves run in the caller). The server's event

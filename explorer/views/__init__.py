@@ -1,8 +1,9 @@
 """The views of the explorer page: one small view per sidebar tab, one for the results, and
 the widgets they are made of.
 
-Each view builds its widgets over the model objects it is given and knows how to refresh
-them; :mod:`explorer.app` builds the views and assembles the page from them in one place.
+Each view is given the model objects it reads and edits (the state, the screen, the
+controller, ...), never the whole session; it builds its widgets over them and knows how
+to refresh them. :mod:`explorer.app` builds the views and assembles the page from them.
 
 - Sidebar tabs: ``scene`` (presets, undo, the loading, with the slider of
   ``eccentricity``), ``punch``, ``coating`` (with the coating-model check), ``base`` (with
@@ -11,8 +12,9 @@ them; :mod:`explorer.app` builds the views and assembles the page from them in o
 - The results column: ``results`` (messages, plots, player, readout, design check),
   ``contact`` (the contact figures' slots), ``pins`` (pin, remove, pin every step, pins
   of a link), ``busy`` (the busy indicator), ``status`` (the status line in words).
-- The page: ``tabs`` (tabs filled when first opened), ``link`` (the address follows the
-  view), ``history`` (undo, reset), ``style`` (the page's CSS and HTML panes).
+- The page: ``loop`` (the session's document and event loop), ``tabs`` (tabs filled when
+  first opened), ``link`` (the address follows the view), ``style`` (the page's CSS and
+  HTML panes).
 - Widgets: ``widgets`` (widgets bound both ways to the state), ``upload`` (a one-file
   upload box).
 """
@@ -23,9 +25,9 @@ from .check import CheckView
 from .coating import CoatingView
 from .fidelity import CONTACT_LABELS, FidelityView
 from .files import FilesView
-from .history import SceneHistory
 from .lessons import LessonsView
 from .link import LINK_EVERY_MS, AddressLink
+from .loop import PageLoop
 from .pins import PinsView
 from .punch import PunchView
 from .results import BADGES, ResultsView, badges_html, readout_html
@@ -37,7 +39,7 @@ from .tabs import FILL_TABS_AFTER_MS, DeferredTabs
 from .times import TimesView
 
 __all__ = ["BADGES", "BUSY_AFTER_MS", "CONTACT_LABELS", "CSS", "FILL_TABS_AFTER_MS",
-           "LINK_EVERY_MS", "AddressLink", "BaseView", "BusyIndicator", "CheckView",
-           "CoatingView", "DeferredTabs", "FidelityView", "FilesView", "LessonsView",
-           "PinsView", "PunchView", "ResultsView", "SceneHistory", "SceneView", "StudyView",
-           "TimesView", "badges_html", "html_pane", "readout_html", "status_html"]
+           "LINK_EVERY_MS", "AddressLink", "BaseView", "BusyIndicator", "CheckView", "CoatingView",
+           "DeferredTabs", "FidelityView", "FilesView", "LessonsView", "PageLoop", "PinsView",
+           "PunchView", "ResultsView", "SceneView", "StudyView", "TimesView", "badges_html",
+           "html_pane", "readout_html", "status_html"]

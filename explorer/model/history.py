@@ -2,19 +2,22 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-from ..model import UndoStack
+import param
 
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from .state import ExplorerState
+from .undo import UndoStack
 
 
-class SceneHistory:
+class SceneHistory(param.Parameterized):
     """Remembers each scene shown, to go back one change or to the scene as loaded."""
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
+    can_undo = param.Boolean(default=False, doc="Whether there is a change to undo.")
+
+    def __init__(self, state: ExplorerState, **params: Any) -> None:
+        super().__init__(**params)
+        self.state = state
         self.stack = UndoStack()
         self._undoing = False
         #: the scene as it was loaded (the preset, the file, the link)
@@ -22,15 +25,13 @@ class SceneHistory:
 
     def remember(self) -> None:
         """Keep the scene now in the state (a change happened)."""
-        app = self.app
         if self._undoing:
             return
         try:
-            self.stack.push(app.state.to_scene())
+            self.stack.push(self.state.to_scene())
         except ValueError:
             return  # a state that is no scene (its message comes with the solve)
-        if app._views:
-            app.undo_button.disabled = not self.stack.can_undo
+        self.can_undo = self.stack.can_undo
 
     def undo(self) -> None:
         """Go back to the scene before the last change."""
@@ -39,12 +40,12 @@ class SceneHistory:
             return
         self._undoing = True
         try:
-            self.app.state.load_scene(scene)
+            self.state.load_scene(scene)
         finally:
             self._undoing = False
-        self.app.undo_button.disabled = not self.stack.can_undo
+        self.can_undo = self.stack.can_undo
 
     def reset(self) -> None:
         """Back to the scene as it was loaded (the preset, the file, the link)."""
         if self.loaded is not None:
-            self.app.state.load_scene(self.loaded)
+            self.state.load_scene(self.loaded)
