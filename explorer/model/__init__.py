@@ -20,7 +20,6 @@ prepared where it is solved), and the state can be used without a server.
 
 from .code_creep_state import (
     CODE_CREEP_MODELS,
-    PLOT_DURATIONS,
     STRENGTH_CLASSES,
     CodeCreepState,
     creep_coefficient_data,
@@ -59,18 +58,16 @@ from .study import (
     plan_study,
     study_choices,
 )
-from .undo import UndoStack
 from .view_link import read_study_query, read_view_query, view_query
 
 __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
            "MAX_DESCRIPTION_CHARS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS", "MODEL_TOL_RANGE",
-           "ORDER", "OUTPUTS", "PLOT_DURATIONS", "QUANTITIES", "QUANTITY_RANGES", "QUANTITY_UNITS",
-           "SCENES_DIR", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES", "Axis",
-           "CodeCreepState", "DesignLimits", "DisplayScales", "ExplorerState", "Geometry",
-           "HistoryState", "LayerState", "Lesson", "Pin", "PinBoard", "PlannedStudy",
-           "ProfileState", "ResultView", "SceneHistory", "Screen", "StudyResult", "UndoStack",
-           "check_html", "check_text", "contact_text", "contact_widths", "contact_zones",
-           "creep_coefficient_data", "decode_scene", "default_range", "design_check",
-           "encode_scene", "lessons", "lifts_off", "plan_study", "prepare_view", "preset_label",
-           "presets", "read_study_query", "read_view_query", "step_scene", "study_choices",
-           "view_query"]
+           "ORDER", "OUTPUTS", "QUANTITIES", "QUANTITY_RANGES", "QUANTITY_UNITS", "SCENES_DIR",
+           "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES", "Axis", "CodeCreepState",
+           "DesignLimits", "DisplayScales", "ExplorerState", "Geometry", "HistoryState",
+           "LayerState", "Lesson", "Pin", "PinBoard", "PlannedStudy", "ProfileState", "ResultView",
+           "SceneHistory", "Screen", "StudyResult", "check_html", "check_text", "contact_text",
+           "contact_widths", "contact_zones", "creep_coefficient_data", "decode_scene",
+           "default_range", "design_check", "encode_scene", "lessons", "lifts_off", "plan_study",
+           "prepare_view", "preset_label", "presets", "read_study_query", "read_view_query",
+           "step_scene", "study_choices", "view_query"]

@@ -27,8 +27,8 @@ from .controller import (
 from .study_runner import StudyRun
 from .trace import install_websocket_marks, mark
 from .warm_up import warm_up
-from .workers import SolverProcesses, WorkerFailed, solve_view
+from .workers import SolverProcesses, WorkerFailed
 
 __all__ = ["RESULTS", "SolveController", "SolverProcesses", "StudyRun", "WorkerFailed",
            "approx_bytes", "describe_field", "format_error", "install_websocket_marks", "mark",
-           "shared_pool", "solve_view", "use_worker_processes", "warm_up", "worker_processes"]
+           "shared_pool", "use_worker_processes", "warm_up", "worker_processes"]

@@ -20,7 +20,7 @@ to refresh them. :mod:`explorer.app` builds the views and assembles the page fro
 """
 
 from .base import BaseView
-from .busy import BUSY_AFTER_MS, BusyIndicator
+from .busy import BUSY_AFTER_MS
 from .check import CheckView
 from .coating import CoatingView
 from .fidelity import CONTACT_LABELS, FidelityView
@@ -30,16 +30,15 @@ from .link import LINK_EVERY_MS, AddressLink
 from .loop import PageLoop
 from .pins import PinsView
 from .punch import PunchView
-from .results import BADGES, ResultsView, badges_html, readout_html
+from .results import ResultsView, badges_html, readout_html
 from .scene import SceneView
 from .status import status_html
 from .study import StudyView
-from .style import CSS, html_pane
+from .style import html_pane
 from .tabs import FILL_TABS_AFTER_MS, DeferredTabs
 from .times import TimesView
 
-__all__ = ["BADGES", "BUSY_AFTER_MS", "CONTACT_LABELS", "CSS", "FILL_TABS_AFTER_MS",
-           "LINK_EVERY_MS", "AddressLink", "BaseView", "BusyIndicator", "CheckView", "CoatingView",
-           "DeferredTabs", "FidelityView", "FilesView", "LessonsView", "PageLoop", "PinsView",
-           "PunchView", "ResultsView", "SceneView", "StudyView", "TimesView", "badges_html",
-           "html_pane", "readout_html", "status_html"]
+__all__ = ["BUSY_AFTER_MS", "CONTACT_LABELS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS", "AddressLink",
+           "BaseView", "CheckView", "CoatingView", "DeferredTabs", "FidelityView", "FilesView",
+           "LessonsView", "PageLoop", "PinsView", "PunchView", "ResultsView", "SceneView",
+           "StudyView", "TimesView", "badges_html", "html_pane", "readout_html", "status_html"]

@@ -36,10 +36,10 @@ class CoatingView:
                  controller: SolveController, loop: PageLoop,
                  live_when: Callable[[], bool]) -> None:
         """``fidelity``: its interface selector edits the layer chosen here;
-        ``controller`` and ``loop``: where the coating-model check runs and reports."""
+        ``controller`` and ``loop``: where the coating-model check runs and reports;
+        ``live_when``: whether a slider applies each drag step (else its release)."""
         self.state = s = state
         self.fidelity = fidelity
-        live = live_when
         self.n_layers = PromptIntSlider(label="number of layers", start=1, end=SCREEN_LAYERS,
                                         value=min(s.n_layers, SCREEN_LAYERS),
                                         sizing_mode="stretch_width")
@@ -50,11 +50,11 @@ class CoatingView:
         self.layer.param.watch(lambda *e: self.bind_layer(), "value")
         self.thickness_editor = ProfileEditor("thickness", "mm", 0.5, 50.0, 0.1, "0[.]00",
                                               amplitude=("µm", -1000.0, 1000.0, 0.5),
-                                              css="coating-thickness", live_when=live)
+                                              css="coating-thickness", live_when=live_when)
         self.modulus_editor = ProfileEditor("Young's modulus", "MPa", 1.0, 10000.0, 1.0,
-                                            "0[.]0", live_when=live)
+                                            "0[.]0", live_when=live_when)
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
-                                            variations=False, live_when=live)
+                                            variations=False, live_when=live_when)
         self.layer_note = html_pane("", styles=NOTE_STYLE)
         self.check = CoatingCheckView(state, controller, loop)
         s.param.watch(lambda *e: self.refresh(), "n_layers")
