@@ -37,7 +37,7 @@ from benchmarks.serving import (  # noqa: E402
     ExplorerProcess,
     ExplorerStartError,
 )
-from explorer.views.tabs import FILL_TABS_AFTER_MS  # noqa: E402
+from explorer.views import FILL_TABS_AFTER_MS  # noqa: E402
 
 
 def _browser_processes() -> list[psutil.Process]:

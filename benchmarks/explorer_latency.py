@@ -46,7 +46,7 @@ from benchmarks.serving import (  # noqa: E402
     ExplorerProcess,
     ExplorerStartError,
 )
-from explorer.views.tabs import FILL_TABS_AFTER_MS  # noqa: E402
+from explorer.views import FILL_TABS_AFTER_MS  # noqa: E402
 
 READY = """() => {
   const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];
@@ -120,7 +120,7 @@ def measure_slider(page, tab: str, css: str, presses: int, key: str,
     return out, solves
 
 
-#: The server's marks of one move (explorer/trace.py), in the order they happen.
+#: The server's marks of one move (explorer/solving/trace.py), in the order they happen.
 STEPS = ("ws_in", "widget_event", "widget_value", "revision", "sent", "worker_start",
          "worker_end", "received", "delivered", "drawn", "ws_out")
 
@@ -255,7 +255,7 @@ def main() -> None:
     server_cpu: dict[str, list[float]] = {}
     if trace.exists():
         print("\ninside the server (medians, ms after the websocket message in; "
-              "explorer/trace.py):")
+              "explorer/solving/trace.py):")
         print(f"{'control':24s} " + " ".join(f"{s:>12s}" for s in STEPS[1:])
               + f" {'server CPU':>11s}")
         for name, (since, until) in windows.items():

@@ -11,7 +11,7 @@ import pytest
 
 from core.scene import scene_from_dict, solve
 from core.scene.golden_section import golden_minimum, golden_minimum_batched
-from explorer.presets import SCENES_DIR
+from explorer.model import SCENES_DIR
 
 
 @pytest.mark.parametrize("depth", [1, 3, 5, 8])
