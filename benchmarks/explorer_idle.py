@@ -31,7 +31,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.explorer_latency import READY  # noqa: E402
-from explorer.views.tabs import FILL_TABS_AFTER_MS  # noqa: E402
+from explorer.views import FILL_TABS_AFTER_MS  # noqa: E402
 from tests.support.serving import (  # noqa: E402
     CHROMIUM,
     CHROMIUM_ARGS,

@@ -40,7 +40,7 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from explorer.views.tabs import FILL_TABS_AFTER_MS  # noqa: E402
+from explorer.views import FILL_TABS_AFTER_MS  # noqa: E402
 from tests.support.serving import (  # noqa: E402
     CHROMIUM,
     CHROMIUM_ARGS,
@@ -207,7 +207,7 @@ def main() -> None:
     server_cpu: dict[str, list[float]] = {}
     if trace.exists():
         print("\ninside the server (medians, ms after the websocket message in; "
-              "explorer/trace.py):")
+              "explorer/solving/trace.py):")
         print(f"{'control':24s} " + " ".join(f"{s:>12s}" for s in STEPS[1:])
               + f" {'server CPU':>11s}")
         for name, (since, until) in windows.items():

@@ -31,10 +31,12 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from core import contact_zones as cz  # noqa: E402
 from core import scene_from_dict, solve, solve_dimensionless  # noqa: E402
 from core.cache import clear_caches  # noqa: E402
 from core.contact import solve_unilateral  # noqa: E402
+from core.contact.active_set import nodal_active_set, zones_from_nodes  # noqa: E402
+from core.contact.step import Space, Step, nystrom_pressure  # noqa: E402
+from core.contact.zones import Resolution, refine_zone_ends, solve_on_zones  # noqa: E402
 from core.discretize import base_panels, kernel_operator  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
@@ -45,14 +47,14 @@ def constant(value: float):
     return lambda x: np.full(np.shape(x), float(value))
 
 
-def nodal_start(space: cz.Space, step: cz.Step, max_width: float = 0.25):
+def nodal_start(space: Space, step: Step, max_width: float = 0.25):
     """The nodal active set on a fixed rule (panels <= ``max_width``, graded to 1e-2 at
     +-1): (panels, state, (ends, pinned, slopes)), where the root-finds start."""
     panels = base_panels(space.lam, space.breakpoints, edge_width=1e-2, max_width=max_width)
     op = kernel_operator(space.lam, panels).matrix
-    state, _, _ = cz.nodal_active_set(panels, op, space.m(panels.nodes), space.g(panels.nodes),
+    state, _, _ = nodal_active_set(panels, op, space.m(panels.nodes), space.g(panels.nodes),
                                    step)
-    return panels, state, cz.zones_from_nodes(state, space.breakpoints)
+    return panels, state, zones_from_nodes(state, space.breakpoints)
 
 
 def median_time(fn, repeats: int = 5) -> float:
@@ -73,22 +75,22 @@ def median_times(fn, repeats: int = 5) -> tuple[float, float]:
 
 
 def work_precision() -> list[str]:
-    space = cz.Space(1.0, constant(0.05), constant(0.0), ())
-    step = cz.Step(1.0, 1.0, {"force": 1.0, "moment": 0.45})
+    space = Space(1.0, constant(0.05), constant(0.0), ())
+    step = Step(1.0, 1.0, {"force": 1.0, "moment": 0.45})
     _, _, (ends, pinned, slopes) = nodal_start(space, step)
-    levels = [cz.Resolution(1.0, 1e-1)]
+    levels = [Resolution(1.0, 1e-1)]
     for _ in range(5):
         levels.append(levels[-1].finer())
     x_check = np.linspace(-0.75, 0.95, 35)
     runs = []
     for res in levels:
         def run(res=res):
-            return cz.refine_zone_ends(space, step, ends, pinned, slopes, res, tol=1e-8,
+            return refine_zone_ends(space, step, ends, pinned, slopes, res, tol=1e-8,
                                     max_levels=1)
         seconds = median_time(run, repeats=3)
         refined = run()
         sol = refined.solution
-        q = cz.nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt,
+        q = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt,
                              x_check)
         runs.append((res, sol, q, refined, seconds))
     ref = runs[-1]
@@ -114,11 +116,11 @@ def work_precision() -> list[str]:
 
 
 def threshold(lam: float, m: float) -> float:
-    space = cz.Space(lam, constant(m), constant(0.0), ())
-    res = cz.Resolution(min(0.25, 3.0 / lam), min(1e-3, m / 4))
-    q_force = cz.solve_on_zones(space, cz.Step(1.0, 1.0, {"force": 1.0, "moment": 0.0}),
+    space = Space(lam, constant(m), constant(0.0), ())
+    res = Resolution(min(0.25, 3.0 / lam), min(1e-3, m / 4))
+    q_force = solve_on_zones(space, Step(1.0, 1.0, {"force": 1.0, "moment": 0.0}),
                              [-1.0, 1.0], res).end_values[0]
-    q_moment = cz.solve_on_zones(space, cz.Step(1.0, 1.0, {"force": 0.0, "moment": 1.0}),
+    q_moment = solve_on_zones(space, Step(1.0, 1.0, {"force": 0.0, "moment": 1.0}),
                               [-1.0, 1.0], res).end_values[0]
     return float(-q_force / q_moment)
 

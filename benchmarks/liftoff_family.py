@@ -23,10 +23,12 @@ import numpy as np
 from benchmarks.sweep import loads_study
 from core import solve
 from core.study import Study
-from core.study.batch import point_outputs, run_batch
+from core.study.batch import run_batch
 from core.study.definition import apply_point
+from core.study.outputs import point_outputs
+from core.study.plan import BatchPlan
 from core.study.points import point_table
-from core.study.run import default_batch_points, plan_batches
+from core.study.run import default_batch_points
 
 
 def compare(study: Study) -> dict[str, Any]:
@@ -41,7 +43,8 @@ def compare(study: Study) -> dict[str, Any]:
     table = point_table(study)
     paths = [p.path for p in study.parameters]
     outputs = list(study.outputs)
-    batches = plan_batches(study, table, default_batch_points(study.n_points))
+    plan = BatchPlan(study, default_batch_points(study.n_points))
+    batches = [plan.batch(k) for k in range(plan.n_batches)]
     worst = {"unilateral": np.zeros(len(outputs)), "full": np.zeros(len(outputs))}
     out: dict[str, Any] = {"kinds": {"failed": 0, "unilateral": 0, "full": 0},
                            "worst": worst, "bad_failures": 0, "bad_flags": 0, "flagged": 0,

@@ -4,7 +4,7 @@ Starts ``python -m explorer`` on 127.0.0.1, drops a few sessions to load what ev
 needs once, then drops ``--dropped`` more in rounds of ``--round`` (the four ways of
 :mod:`tests.support.abandon`, in equal shares). After each round it first waits as long as
 the server needs to discard the round's sessions (the linger, one check interval of the
-same length, the collection delay of :mod:`explorer.gc_policy` and a margin), then until
+same length, the collection delay of :mod:`explorer.fixes.gc_policy` and a margin), then until
 the memory settles, and records the server's resident memory and its solver processes'
 apart: the server's own is what dropped pages could keep; the workers' grows as their
 bounded stage caches fill with the scenes the "loaded" visits solved. A server that gave

@@ -27,7 +27,7 @@ import time
 import numpy as np
 
 from core.scene import solve
-from explorer.presets import SCENES_DIR
+from explorer.model import SCENES_DIR
 
 #: The presets measured by default: a creep scene, two thin-coating scenes (smooth and
 #: stepped) and the exact layered one.

@@ -44,9 +44,10 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.liftoff import PRESET, RESULTS, constant, nodal_start  # noqa: E402
-from core import contact_zones as cz  # noqa: E402
 from core import scene_from_dict  # noqa: E402
 from core.contact import solve_unilateral  # noqa: E402
+from core.contact.step import Space, Step, nystrom_pressure  # noqa: E402
+from core.contact.zones import Resolution, refine_zone_ends  # noqa: E402
 
 XS = np.linspace(-0.95, 0.95, 381)
 
@@ -81,16 +82,16 @@ ELASTIC = {
 
 
 def elastic_reference(g, loads) -> dict:
-    space = cz.Space(1.0, constant(0.05), g, ())
-    step = cz.Step(1.0, 1.0, loads)
+    space = Space(1.0, constant(0.05), g, ())
+    step = Step(1.0, 1.0, loads)
     _, _, (ends, pinned, slopes) = nodal_start(space, step)
-    res = cz.Resolution(0.5, 1e-2)
+    res = Resolution(0.5, 1e-2)
     for _ in range(4):
         res = res.finer()
-    refined = cz.refine_zone_ends(space, step, ends, pinned, slopes, res, tol=1e-12,
+    refined = refine_zone_ends(space, step, ends, pinned, slopes, res, tol=1e-12,
                                max_levels=1)
     sol = refined.solution
-    q = cz.nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, XS)
+    q = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, XS)
     inside = np.zeros(XS.size, dtype=bool)
     for k in range(len(sol.ends) // 2):
         inside |= (XS >= sol.ends[2 * k]) & (XS <= sol.ends[2 * k + 1])
@@ -102,11 +103,11 @@ def elastic_reference(g, loads) -> dict:
 
 def nodal_only(g, loads, width: float):
     """The nodal active set on one fixed rule: ends where the nodal Q changes sign."""
-    space = cz.Space(1.0, constant(0.05), g, ())
-    step = cz.Step(1.0, 1.0, loads)
+    space = Space(1.0, constant(0.05), g, ())
+    step = Step(1.0, 1.0, loads)
     panels, state, (ends, _, _) = nodal_start(space, step, width)
     zones = [(ends[2 * k], ends[2 * k + 1]) for k in range(len(ends) // 2)]
-    q = cz.nystrom_pressure(space, step, panels, state.q, state.settlement, state.tilt, XS)
+    q = nystrom_pressure(space, step, panels, state.q, state.settlement, state.tilt, XS)
     inside = np.zeros(XS.size, dtype=bool)
     for lo, hi in zones:
         inside |= (XS >= lo) & (XS <= hi)

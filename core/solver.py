@@ -5,21 +5,43 @@ The dimensionless problem (model notes; the seed's (9)-(12)):
     c(t) m(x) q(x,t) + (I - V) F q = delta(t) + alpha(t) x - g(x),   -1 <= x <= 1,  t >= 1,
     int q dx = P(t),   int x q dx = M(t).
 
-The default engine is :mod:`core.engines.nystrom`; the seed's projection method is
-:mod:`core.engines.projection`; the contact model (full, unilateral, auto) is
-:mod:`core.contact`.
+:func:`solve_dimensionless` checks the common arguments, picks the engine(s) of
+:data:`core.engines.ENGINES` (the default :mod:`core.engines.nystrom`, the seed's
+:mod:`core.engines.projection`, the cross-check :mod:`core.engines.collocation`), asks them
+in turn until one answers, and applies the contact model (:mod:`core.contact`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
-from core.engines.projection import solve_projection, validate_inputs
-from core.problem import ContactSolution
+from core.contact import (
+    check_contact_model,
+    predicted_unilateral,
+    refuse_loads_without_contact,
+    solve_unilateral,
+    with_contact_model,
+)
+from core.engines import DEFAULT_METHOD, DEFAULT_ORDER, Engine, engine_options, get_engine
+from core.problem import (
+    ContactSolution,
+    Geometry,
+    TimeInputs,
+    UnresolvedOperator,
+    validate_geometry,
+    validate_time_inputs,
+)
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
+
+#: Engine options that stay keywords of the common signature, so calls written before the
+#: registry keep working, with the value of each that asks nothing of an engine: an engine
+#: that does not take one accepts that value (it is what its own answer assumes) and
+#: refuses any other.
+SIGNATURE_OPTIONS: dict[str, Any] = {"basis": "graded", "n_modes": None, "time_breaks": ()}
 
 
 def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | np.ndarray,
@@ -29,105 +51,153 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                         breakpoints: Sequence[float] = (), tol: float = 1e-8,
                         basis: str = "graded", n_modes: int | None = None,
                         method: str | None = None, contact: str = "auto",
-                        time_breaks: Sequence[float] = ()) -> ContactSolution:
-    """Solve the dimensionless contact problem (Nystrom by default, or the seed's projection).
+                        time_breaks: Sequence[float] = (), **options: Any) -> ContactSolution:
+    """Solve the dimensionless contact problem of a rigid punch on the coated base.
 
-    Parameters (all dimensionless):
-        lam: a/H, half-width over base thickness (> 0).
-        m: coating compliance m(x) > 0 on [-1, 1] (number or vectorized callable).
-        g: gap g(x) (number or vectorized callable); may jump at ``breakpoints``.
-        times: output times, increasing, the first >= 1 (t = 1 is the moment of loading).
-        c: relative base modulus c(t) = E(t)/E0 > 0 (number or callable of t).
-        kernel: None (elastic base) or the creep kernel K(t, tau) of ``V``; a
-            :class:`core.creep.models.DegenerateKernel` is stepped in O(1) per mode and step.
-        settlement, tilt, force, moment: exactly two, numbers or callables of t
-            (delta, alpha, P, M).
-        breakpoints: points of (-1, 1) where m or g may jump.
-        tol: relative accuracy target for delta, alpha (relative to max(|delta|, |alpha|)),
-            P, M (relative to max(|P|, |M|)) and q (relative to max|q| over interior points).
-        basis: "graded" (default: continuous piecewise polynomials on meshes graded toward
-            the edges and jumps), "piecewise" (polynomials between breakpoints) or "global"
-            (the seed's basis).
-        n_modes: a fixed number of basis functions (for studies); default adaptive.
-        method: "nystrom" (the default: a direct solve on graded panels, adaptively
-            refined, :mod:`core.engines.nystrom`) or "projection" (the seed's series; the
-            default when ``basis`` or ``n_modes`` is given, which only it uses).
-        contact: "full" (q may come out negative: flag ``contact_lost``), "unilateral"
-            (q >= 0 with an unknown contact set, :func:`core.contact.solve_unilateral`) or
-            "auto" (full contact first, unilateral only when it is lost).
-        time_breaks: times where a given load history jumps or kinks; the default engine's
-            time steps land on them (a step across a jump loses the order and fools the
-            step-doubling estimate).
+    Parameters
+    ----------
+    lam : float
+        ``a/H``, the punch's half-width over the base's thickness (> 0).
+    m : float or callable
+        Coating compliance ``m(x) > 0`` on [-1, 1] (vectorized callable of ``x = X/a``).
+    g : float or callable
+        Gap ``g(x)`` between punch and coating; may jump at ``breakpoints``.
+    times : array_like
+        Output times ``t = (age - tau0) / tau0 + 1``, increasing, the first >= 1
+        (``t = 1`` is the moment of loading).
+    c : float or callable, optional
+        Relative base modulus ``c(t) = E(t)/E0 > 0``.
+    kernel : callable or None, optional
+        None (elastic base) or the creep kernel ``K(t, tau)`` of the Volterra operator
+        ``V`` (vectorized); a :class:`core.creep.models.DegenerateKernel` is stepped in
+        O(1) per mode and step.
+    settlement, tilt, force, moment : float or callable, optional
+        Exactly two of ``delta``, ``alpha``, ``P``, ``M`` (numbers or callables of t):
+        one of the four statements; the other two are solved for.
+    breakpoints : sequence of float, optional
+        Points of (-1, 1) where ``m`` or ``g`` may jump.
+    tol : float, optional
+        Relative accuracy target of delta, alpha (relative to ``max(|delta|, |alpha|)``),
+        P, M (relative to ``max(|P|, |M|)``) and q (relative to ``max|q|``).
+    method : str or None, optional
+        The engine, a name of :data:`core.engines.ENGINES`: ``"nystrom"`` (the default:
+        direct solve on graded panels, adaptively refined), ``"projection"`` (the seed's
+        series; the default when ``n_modes`` is given or ``basis`` is not ``"graded"``)
+        or ``"collocation"`` (a cross-check on fixed panels). With ``method`` defaulted,
+        an engine that declines the problem (:class:`core.problem.UnresolvedOperator`)
+        hands it to the next of :data:`core.engines.DEFAULT_ORDER`, and
+        ``info["fallback"]`` says so.
+    contact : {"auto", "full", "unilateral"}, optional
+        ``"full"``: the full-contact model, a linear equation that holds for any loads
+        (a bonded punch; q may come out negative: flag ``contact_lost``);
+        ``"unilateral"``: q >= 0 with an unknown contact set
+        (:func:`core.contact.solve_unilateral`, which answers whatever the engine);
+        ``"auto"``: full contact first, unilateral only when it is lost.
+    basis, n_modes, time_breaks : optional
+        Engine options kept as keywords (see ``**options``): the projection's basis
+        (``"graded"``, ``"piecewise"``, ``"global"``) and fixed mode count, the Nystrom
+        engine's times where a given load history jumps or kinks (its steps land on
+        them). An engine that does not take one accepts its default value only.
+    **options
+        Options of the chosen engine only (its ``prepare_options`` and
+        ``solve_options``, documented with its ``prepare`` and ``solve``), e.g. the
+        collocation's ``panels_per_unit``, ``edge_width``, ``time_points``.
 
-    Returns a :class:`ContactSolution` (or, when the unilateral model answered, a
-    :class:`core.contact.unilateral.UnilateralSolution` with the same attributes); ``contact_set``
-    and ``info["contact"]`` say which contact model answered. Raises ``ValueError``
-    naming the argument on bad input, and naming ``force`` or ``moment`` with ``contact``
-    ``"auto"`` or ``"unilateral"`` when the loads leave no contact (P < 0, P = 0
-    throughout, |M/P| >= 1: :func:`core.contact.refuse_loads_without_contact`).
-    ``contact="full"`` asks for the full-contact model itself, a linear equation that
-    holds for any loads (a bonded punch, the model problem of the seed): it answers them
-    with the ``contact_lost`` flag where q < 0, as it answers a given settlement that
-    lifts the punch.
+    Returns
+    -------
+    ContactSolution
+        With ``info`` as documented in :mod:`core.problem.result` (``method``,
+        ``success``, ``error_estimate``, ...) and ``info["contact"]``; when the unilateral
+        model answered, a :class:`core.contact.result.UnilateralSolution` with the same
+        attributes, its ``contact_set`` the contact zones per time.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument on bad input: ``method`` for an unknown engine, an option the
+        chosen engine does not take, and ``force`` or ``moment`` with ``contact``
+        ``"auto"`` or ``"unilateral"`` when the loads leave no contact (P < 0, P = 0
+        throughout, |M/P| >= 1: :func:`core.contact.refuse_loads_without_contact`).
     """
-    from core.contact import (
-        check_contact_model,
-        refuse_loads_without_contact,
-        solve_unilateral,
-        with_contact_model,
-    )
-    from core.problem import UnresolvedOperator
-
     contact = check_contact_model(contact)
     if contact != "full":
         refuse_loads_without_contact(times, kernel, force, moment)
-    method_defaulted = method is None
-    if method is None:
-        method = "projection" if (n_modes is not None or basis != "graded") else "nystrom"
-    if method not in ("nystrom", "projection"):
-        raise ValueError(f"method: must be 'nystrom' or 'projection', got {method!r}")
-    if method == "nystrom":
-        from core.engines.nystrom import solve_with_prepared
-
-        unilateral_args = dict(lam=lam, m=m, g=g, times=times, c=c, kernel=kernel,
-                               settlement=settlement, tilt=tilt, force=force, moment=moment,
-                               breakpoints=breakpoints, tol=tol)
-        if contact == "unilateral":
-            return solve_unilateral(**unilateral_args)
-        # On an elastic base with a constant modulus the full-contact answer costs what the
-        # check would (one combination of the prepared unit responses): no check first.
-        if contact == "auto" and (kernel is not None or callable(c)):
-            from core.contact import predicted_unilateral
-
-            predicted = predicted_unilateral(unilateral_args)
-            if predicted is not None:
-                return predicted
-        try:
-            full = solve_with_prepared(lam, m, g, times, c=c, kernel=kernel,
-                                       settlement=settlement, tilt=tilt, force=force,
-                                       moment=moment, breakpoints=breakpoints, tol=tol,
-                                       time_breaks=time_breaks)
-        except UnresolvedOperator as exc:
-            if not method_defaulted:
-                raise
-            # the symmetric Galerkin projection steps such a scene (positive definite by
-            # construction); say which engine answered and why
-            full = solve_dimensionless(lam, m, g, times, c=c, kernel=kernel,
-                                       settlement=settlement, tilt=tilt, force=force,
-                                       moment=moment, breakpoints=breakpoints, tol=tol,
-                                       method="projection", contact="full",
-                                       time_breaks=time_breaks)
-            full.info["method"] = "projection"
-            full.info["fallback"] = f"default engine declined ({exc}); projection answered"
-            return with_contact_model(full, contact, unilateral_args)
-        return with_contact_model(full, contact, unilateral_args)
-    inp = validate_inputs(lam, m, g, times, c, kernel,
-                          {"settlement": settlement, "tilt": tilt, "force": force,
-                           "moment": moment}, breakpoints, tol)
+    engines = _engines(method, basis, n_modes)
+    asked = _asked_options(engines[0], {"basis": basis, "n_modes": n_modes,
+                                        "time_breaks": time_breaks}, options)
+    loads = {"settlement": settlement, "tilt": tilt, "force": force, "moment": moment}
     unilateral_args = dict(lam=lam, m=m, g=g, times=times, c=c, kernel=kernel,
-                           settlement=settlement, tilt=tilt, force=force, moment=moment,
-                           breakpoints=breakpoints, tol=tol)
+                           breakpoints=breakpoints, tol=tol, **loads)
+    geometry = validate_geometry(lam, m, g, breakpoints, tol)
+    inputs = validate_time_inputs(times, c, kernel, loads)
     if contact == "unilateral":
         return solve_unilateral(**unilateral_args)
-    full = solve_projection(inp, basis, n_modes)
+    # The check runs on the Nystrom engine's prepared geometry, which its full answer then
+    # reuses. On an elastic base with a constant modulus that answer costs what the check
+    # would (one combination of the prepared unit responses): no check first.
+    if (contact == "auto" and engines[0].name == "nystrom"
+            and (kernel is not None or callable(c))):
+        predicted = predicted_unilateral(unilateral_args)
+        if predicted is not None:
+            return predicted
+    full = _first_answer(engines, geometry, inputs, asked)
     return with_contact_model(full, contact, unilateral_args)
+
+
+def _engines(method: object, basis: object, n_modes: object) -> list[Engine]:
+    """The engine asked for, or with ``method`` defaulted those of ``DEFAULT_ORDER`` from
+    the default one on (the projection when ``n_modes`` or a basis other than the
+    graded one asks for it: the other engines have neither)."""
+    if method is not None:
+        return [get_engine(method)]
+    first = "projection" if (n_modes is not None or basis != "graded") else DEFAULT_METHOD
+    return [get_engine(name) for name in DEFAULT_ORDER[DEFAULT_ORDER.index(first):]]
+
+
+def _asks_nothing(value: Any, default: Any) -> bool:
+    if default is None:
+        return value is None
+    if isinstance(default, str):
+        return isinstance(value, str) and value == default
+    return np.size(value) == 0  # an empty sequence of times
+
+
+def _asked_options(engine: Engine, signature: dict[str, Any], options: dict[str, Any]
+                   ) -> dict[str, Any]:
+    """The options for ``engine``: every one it takes, and no other unless it is a keyword
+    of the common signature at the value that asks nothing (ValueError names it)."""
+    taken = engine.prepare_options + engine.solve_options
+    asked = {name: value for name, value in signature.items()
+             if name in taken or not _asks_nothing(value, SIGNATURE_OPTIONS[name])}
+    asked.update(options)
+    engine_options(engine, asked)  # refuses what the engine does not take
+    return asked
+
+
+def _first_answer(engines: list[Engine], geometry: Geometry, inputs: TimeInputs,
+                  asked: dict[str, Any]) -> ContactSolution:
+    """The full-contact answer of the first engine that does not decline.
+
+    The options were asked of the first engine; a later one gets those it takes (the
+    default engine's ``time_breaks`` mean nothing to the projection's adaptive steps).
+    """
+    declined: UnresolvedOperator | None = None
+    for engine in engines:
+        taken = engine.prepare_options + engine.solve_options
+        prepare_options, solve_options = engine_options(
+            engine, {k: v for k, v in asked.items() if k in taken})
+        try:
+            full = engine.solve(engine.prepare(geometry, **prepare_options), inputs,
+                                **solve_options)
+        except UnresolvedOperator as exc:
+            if engine is engines[-1]:
+                raise
+            declined = declined or exc
+            continue
+        if declined is not None:
+            # say which engine answered and why
+            full.info["method"] = engine.name
+            full.info["fallback"] = (f"default engine declined ({declined}); "
+                                     f"{engine.name} answered")
+        return full
+    raise AssertionError("unreachable: the last engine answers or raises")

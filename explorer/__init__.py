@@ -1,29 +1,22 @@
 """A live browser explorer of the coated-punch contact problem (Panel).
 
-``create_app()`` builds one session; ``python -m explorer`` serves it. The state classes
-in :mod:`explorer.state` turn widget values into the scene dicts of ``core`` and can be
-used without a server.
+``create_app()`` builds one session; ``python -m explorer`` serves it. ``README.md`` here
+maps the subpackages: ``model`` (the state and the result on screen, without Panel),
+``solving``, ``plots``, ``files``, ``views``, ``fixes``.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["create_app", "ExplorerApp", "ExplorerState", "SolveController"]
+__all__ = ["ExplorerApp", "create_app"]
 
 
 def __getattr__(name: str) -> Any:
-    # Panel is imported only when the page itself is wanted, not for the state classes.
+    # Panel is imported only when the page itself is wanted: the solver workers and the
+    # study processes import explorer.model and explorer.solving, and nothing else.
     if name in ("create_app", "ExplorerApp"):
         from . import app
 
         return getattr(app, name)
-    if name == "ExplorerState":
-        from .state import ExplorerState
-
-        return ExplorerState
-    if name == "SolveController":
-        from .controller import SolveController
-
-        return SolveController
     raise AttributeError(f"module 'explorer' has no attribute {name!r}")

@@ -51,7 +51,7 @@ WAITING_THREADS = 64
 
 
 #: Largest message the server accepts from a page [bytes]. Uploads arrive in chunks of
-#: 256 KiB (explorer/widgets.py) and every other message is small: a larger one (a
+#: 256 KiB (explorer/views/widgets.py) and every other message is small: a larger one (a
 #: 15-million-character scene name held 380 MiB of the server's memory) closes that
 #: page's connection instead of being read.
 WEBSOCKET_MAX_BYTES = 4 * 2**20
@@ -117,10 +117,10 @@ def main(argv: list[str] | None = None) -> int:
         _restart_with_server_allocator()
     import panel as pn
 
-    from explorer import closed_pages
-    from explorer.app import create_app, warm_up
-    from explorer.controller import shared_pool, use_worker_processes, worker_processes
-    from explorer.presets import ORDER
+    from explorer.app import create_app
+    from explorer.fixes import closed_pages
+    from explorer.model import ORDER
+    from explorer.solving import shared_pool, use_worker_processes, warm_up, worker_processes
 
     if args.solver_processes < 0 or args.solver_threads < 1:
         print("--solver-processes must be 0 or more and --solver-threads 1 or more",

@@ -1,10 +1,12 @@
-"""The explorer page: a thin Panel view over the state, the solve controller and the plots.
+"""The explorer page: one session's model objects, its views, and the page made of them.
 
 ``create_app()`` builds one :class:`ExplorerApp` per browser session (serve the factory,
 not an instance). The page calls only the public API of ``core`` (through the
-controller); every number the user sets lives in :class:`~explorer.state.ExplorerState`.
-The widgets live in the views of :mod:`explorer.views`, one per sidebar tab and one for
-the results; ``SIDEBAR_VIEWS`` is the one place where the tabs are assembled.
+controller); every number the user sets lives in :class:`~explorer.model.ExplorerState`.
+The session owns the model objects (state, screen, history, scales, limits), the solve
+controller and the figures; each view is given those it needs
+(:meth:`ExplorerApp._build_sidebar` is the one place where the sidebar's tabs are made),
+and the session ties what happens in one to the others.
 """
 
 from __future__ import annotations
@@ -15,47 +17,49 @@ from collections.abc import Callable
 from typing import Any
 
 import panel as pn
-import param
-from panel.io.state import set_curdoc
 
-from . import bokeh_fixes, closed_pages, gc_policy, idle_painter
-from .controller import SolveController, format_error
-from .design import DesignLimits
-from .fidelity_view import FidelityView
-from .links import decode_scene
-from .panel_fixes import install as install_panel_fixes
+from core import scene_from_dict
+
+from .fixes import bokeh_fixes, closed_pages, gc_policy, idle_painter, panel_fixes
+from .model import (
+    DEFAULT_PRESET,
+    DesignLimits,
+    DisplayScales,
+    ExplorerState,
+    SceneHistory,
+    Screen,
+    decode_scene,
+    presets,
+    read_study_query,
+    read_view_query,
+)
 from .plots import Figures
-from .presets import DEFAULT_PRESET, presets
-from .results import ResultView
-from .scales import DisplayScales
-from .state import ExplorerState
-from .status import status_html
-from .trace import install_websocket_marks, mark
-from .view_link import read_study_query, read_view_query
-from .views.base import BaseView
-from .views.busy import BUSY_AFTER_MS, BusyIndicator
-from .views.check import CheckView
-from .views.coating import CoatingView
-from .views.files import FilesView
-from .views.history import SceneHistory
-from .views.lessons import LessonsView
-from .views.link import LINK_EVERY_MS, AddressLink
-from .views.pins import PinsView
-from .views.punch import PunchView
-from .views.results import BADGES, ResultsView, badges_html, readout_html
-from .views.scene import SceneView
-from .views.study import StudyView
-from .views.style import CSS, html_pane
-from .views.tabs import FILL_TABS_AFTER_MS, DeferredTabs
-from .views.times import TimesView
-from .warm_up import warm_up
+from .solving import SolveController, format_error, install_websocket_marks, mark
+from .views import (
+    FILL_TABS_AFTER_MS,
+    AddressLink,
+    BaseView,
+    CheckView,
+    CoatingView,
+    DeferredTabs,
+    FidelityView,
+    FilesView,
+    LessonsView,
+    PageLoop,
+    PinsView,
+    PunchView,
+    ResultsView,
+    SceneView,
+    StudyView,
+    TimesView,
+    html_pane,
+    status_html,
+)
 
-__all__ = ["BADGES", "BUSY_AFTER_MS", "CSS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS",
-           "ExplorerApp", "SIDEBAR_VIEWS", "badges_html", "create_app", "readout_html",
-           "warm_up"]
+__all__ = ["ExplorerApp", "LIVE_SOLVE_S", "create_app"]
 
 log = logging.getLogger(__name__)
-install_panel_fixes()
+panel_fixes.install()
 install_websocket_marks()
 
 #: Geometry and material sliders apply each drag step (not only the release) while the
@@ -67,48 +71,37 @@ install_websocket_marks()
 #: newest request.
 LIVE_SOLVE_S = 0.030
 
-#: The sidebar's tabs, in their order on the page: each a view class taking the session
-#: (with a ``title`` and a ``content()`` column). A new tab is one more entry here; the
-#: index of a tab is part of the page's links (``view_link``), so append, do not insert.
-SIDEBAR_VIEWS: tuple[type, ...] = (SceneView, PunchView, CoatingView, BaseView, TimesView,
-                                   CheckView, FilesView, LessonsView, StudyView)
-#: Names the views share; never looked up on the session (see ExplorerApp.__getattr__).
-_VIEW_COMMON = frozenset({"app", "title", "content", "refresh"})
-
 
 class ExplorerApp(pn.viewable.Viewer):
-    """One session of the explorer: widgets, plots, status, files and the link."""
-
-    notice = param.String(default="", doc="A problem with a file or a link (not a solve).")
-    time_index = param.Integer(default=0, doc="Index of the output time shown.")
+    """One session of the explorer: its model objects, views and page."""
 
     def __init__(self, scene: dict[str, Any] | None = None, *,
                  query: dict[str, str] | None = None,
                  solve: Callable[[dict[str, Any]], Any] | None = None,
                  executor: Any = "shared", **params: Any) -> None:
         super().__init__(**params)
-        self._doc = pn.state.curdoc
-        self._location = pn.state.location if self.served else None
+        self.loop = PageLoop(pn.state.curdoc)
         self.state = ExplorerState()
+        self.screen = Screen()
         self.controller = SolveController(self.state, solve=solve, executor=executor,
-                                          dispatch=self._dispatch, auto=False)
+                                          dispatch=self.loop.dispatch, auto=False)
         self.presets = presets()
         self.scales = DisplayScales()
         self.limits = DesignLimits()
-        self.history = SceneHistory(self)
+        self.history = SceneHistory(self.state)
         self.figures = Figures(self.scales)
-        self._drawn: ResultView | None = None
-        self.busy = BusyIndicator(self)
-        self._views: list[Any] = []
         self._initial_scene(scene, query or {})
-        self.link = AddressLink(self)
-        self.pins = PinsView(self)
-        self.results = ResultsView(self)
+        self.link = AddressLink(self.screen, self.controller, self.loop,
+                                pn.state.location if self.loop.served else None,
+                                self._view_parts)
+        self.pins = PinsView(self.state, self.screen, self.controller, self.loop,
+                             on_change=self._on_pins)
+        self.results = ResultsView(self.screen, self.controller, self.loop, self.figures,
+                                   self.limits, self.pins, self.link)
         # model fidelity (layer interface, contact model, coating-model tolerance): one
         # view whose widgets sit in the Coating and Time tabs
-        self.fidelity = FidelityView(self.state, self.reject)
-        self.views = [view(self) for view in SIDEBAR_VIEWS]
-        self._views = [self.results, self.pins, *self.views]
+        self.fidelity = FidelityView(self.state, self.screen.reject)
+        self.views = self._build_sidebar()
         self._layout = self._build_layout()
         self._wanted_index, tab, pin_scenes, pin_message = read_view_query(
             query or {}, len(self.sidebar))
@@ -117,23 +110,23 @@ class ExplorerApp(pn.viewable.Viewer):
             self.sidebar.active = tab
         if pin_scenes:
             self.pins.solve_from_link(pin_scenes)
-        if pin_message and not self.notice:
-            self.notice = pin_message
+        if pin_message and not self.screen.notice:
+            self.screen.notice = pin_message
         study_settings, study_message = read_study_query(query or {})
         if study_settings is not None:
-            self.apply_study_settings(study_settings)
-        if study_message and not self.notice:
-            self.notice = study_message
+            self.study_tab.apply_study_settings(study_settings)
+        if study_message and not self.screen.notice:
+            self.screen.notice = study_message
         # Changes to plain Bokeh models made after the page was generated but before its
         # websocket connects would never reach the browser: hold them until it does.
         self._initializing = True
-        self._connected = not self.served
-        if self.served:
+        self._connected = not self.loop.served
+        if self.loop.served:
             pn.state.onload(self._on_load)
         self.controller.param.watch(self._on_view, "view")
-        self.controller.param.watch(self.busy.on_status, ["error", "busy"])
-        self.param.watch(self._on_time, "time_index")
-        self.param.watch(self._on_notice, "notice")
+        self.controller.param.watch(self.results.on_status, ["error", "busy"])
+        self.screen.param.watch(self._on_time, "time_index")
+        self.screen.param.watch(self._on_notice, "notice")
         self.state.param.watch(self._on_revision, "revision")
         # A known answer (a preset solved at start-up) is shown before the page is sent;
         # anything else is solved in the background while the page loads.
@@ -145,50 +138,32 @@ class ExplorerApp(pn.viewable.Viewer):
             self.results.status.object = status_html(None, True)
         self._initializing = False
 
-    def __getattr__(self, name: str) -> Any:
-        """The widgets and file callbacks of the views, by the names they had on the
-        session before the page was split into views (``app.load_file``, ``app.alert``)."""
-        views = self.__dict__.get("_views") or ()
-        if not name.startswith("__") and name not in _VIEW_COMMON:
-            for view in views:
-                if name in vars(view) or name in type(view).__dict__:
-                    return getattr(view, name)
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+    def _build_sidebar(self) -> list[Any]:
+        """The sidebar's tabs, in their order on the page (each view with a ``title`` and
+        a ``content()`` column). The index of a tab is part of the page's links
+        (``explorer.model.view_link``): a new tab is appended, never inserted."""
+        state, screen, controller, loop = self.state, self.screen, self.controller, self.loop
+        live = self.fast_solves
+        self.scene_tab = SceneView(state, self.presets, self.preset_key, self.history,
+                                   self.load_scene, controller, screen.reject)
+        self.punch_tab = PunchView(state, screen, live)
+        self.coating_tab = CoatingView(state, self.fidelity, controller, loop, live)
+        self.base_tab = BaseView(state, screen.reject, live)
+        self.times_tab = TimesView(state, self.fidelity, screen.reject, live)
+        self.check_tab = CheckView(state, self.limits, screen)
+        self.files_tab = FilesView(state, screen, controller, self.scales, self.limits,
+                                   self._load_file, self.results.show_download_error)
+        self.lessons_tab = LessonsView(self.pins, self.results.log_time, self.load_scene)
+        self.study_tab = StudyView(state, controller, loop, self.link.schedule)
+        return [self.scene_tab, self.punch_tab, self.coating_tab, self.base_tab,
+                self.times_tab, self.check_tab, self.files_tab, self.lessons_tab,
+                self.study_tab]
 
     def page_parts(self) -> list[Any]:
         """Every viewable of the page: the layout and the sidebar tabs not filled yet."""
         return [self._layout, *self.tabs.parts()]
 
-    @property
-    def busy_shown(self) -> bool:
-        """Whether the page shows the busy indicator now."""
-        return self.busy.shown
-
-    # -- plumbing --------------------------------------------------------------------
-    @property
-    def _served(self) -> bool:
-        return bool(self._doc is not None and self._doc.session_context)
-
-    @property
-    def served(self) -> bool:
-        """Whether this session is a served page (not a notebook or a script)."""
-        return self._served
-
-    def shown(self) -> ResultView | None:
-        """The result on screen (the downloads, the check and the report hold it)."""
-        return self._drawn
-
-    def _dispatch(self, callback: Callable[[], None]) -> None:
-        """Run ``callback`` (from a solver thread) on this session's event loop, or at
-        once where there is none (a notebook, a script)."""
-        if self.served:
-            self._later(callback, 0)
-        else:
-            callback()
-
     def _initial_scene(self, scene: dict[str, Any] | None, query: dict[str, str]) -> None:
-        from core import scene_from_dict
-
         default = self.presets.get(DEFAULT_PRESET) or next(iter(self.presets.values()), None)
         chosen = scene
         if chosen is None and query.get("scene"):
@@ -196,21 +171,22 @@ class ExplorerApp(pn.viewable.Viewer):
                 chosen = decode_scene(query["scene"])
                 scene_from_dict(chosen)
             except ValueError as exc:
-                self.notice = (f"The scene in the link was not used: {format_error(str(exc))}"
-                               ". Showing the default scene instead.")
+                self.screen.notice = (f"The scene in the link was not used: "
+                                      f"{format_error(str(exc))}. Showing the default scene "
+                                      "instead.")
                 chosen = None
         if chosen is None and query.get("preset"):
             chosen = self.presets.get(query["preset"])
             if chosen is None:
-                self.notice = (f"Unknown preset {query['preset'][:40]!r} in the link; "
-                               "showing the default scene.")
+                self.screen.notice = (f"Unknown preset {query['preset'][:40]!r} in the link; "
+                                      "showing the default scene.")
         chosen = chosen or default
         if chosen is not None:
             try:
                 self.state.load_scene(chosen)
                 self.history.loaded = chosen
             except ValueError as exc:
-                self.notice = f"The scene could not be shown: {exc}"
+                self.screen.notice = f"The scene could not be shown: {exc}"
         self.history.remember()
         self.preset_key = next((k for k, s in self.presets.items() if s == chosen), None)
 
@@ -218,25 +194,20 @@ class ExplorerApp(pn.viewable.Viewer):
         default = self.presets.get(DEFAULT_PRESET)
         if default is None:
             return
-        self.notice = (f"The scene could not be solved ({self.controller.error}); showing "
-                       "the default scene instead.")
+        self.screen.notice = (f"The scene could not be solved ({self.controller.error}); "
+                              "showing the default scene instead.")
         self.scales.reset()
         self.state.load_scene(default)
         self.controller.solve_now()
 
     def fast_solves(self) -> bool:
         """Whether the last solve was quick enough for sliders to apply every drag step."""
-        view = self.controller.view
-        if view is None:
-            return False
-        # CPU time of the whole solve (see LIVE_SOLVE_S); a result kept from before it
-        # was recorded has its wall time only
-        seconds = view.info.get("cpu_seconds", view.info.get("seconds"))
-        return isinstance(seconds, (int, float)) and seconds < LIVE_SOLVE_S
+        return self.controller.solved_within(LIVE_SOLVE_S)
 
     # -- layout ----------------------------------------------------------------------
     def _build_layout(self) -> pn.viewable.Viewable:
-        self.tabs = DeferredTabs(self, [(view.title, view.content()) for view in self.views])
+        self.tabs = DeferredTabs(self.loop,
+                                 [(view.title, view.content()) for view in self.views])
         sidebar = self.tabs.sidebar
         sidebar.param.watch(lambda e: self.link.schedule(), "active")
         self.sidebar = sidebar
@@ -268,18 +239,6 @@ class ExplorerApp(pn.viewable.Viewer):
         return self._layout
 
     # -- events ----------------------------------------------------------------------
-    def reject(self, message: str) -> None:
-        """Say on the page that a value typed or dragged was refused, and why."""
-        self.notice = f"Value not accepted: {message}"
-
-    def undo(self) -> None:
-        """Go back to the scene before the last change."""
-        self.history.undo()
-
-    def reset(self) -> None:
-        """Back to the scene as it was loaded (the preset, the file, the link)."""
-        self.history.reset()
-
     def _on_revision(self, event: Any) -> None:
         mark("revision")
         self.history.remember()
@@ -287,77 +246,69 @@ class ExplorerApp(pn.viewable.Viewer):
 
     def load_scene(self, scene: dict[str, Any]) -> bool:
         """Validate a scene dict with the core and show it; False (and a notice) if bad."""
-        from core import scene_from_dict
-
         try:
             scene_from_dict(scene)
             self.state.load_scene(scene)
         except ValueError as exc:
-            self.notice = f"The scene was not loaded: {format_error(str(exc))}"
+            self.screen.notice = f"The scene was not loaded: {format_error(str(exc))}"
             return False
         self.scales.reset()
         self.history.loaded = scene
-        self.notice = ""
+        self.screen.notice = ""
         return True
+
+    def _load_file(self, scene: dict[str, Any]) -> bool:
+        """A scene read from a file: shown as a scene of its own, no preset chosen."""
+        if not self.load_scene(scene):
+            return False
+        self.scene_tab.forget_preset()
+        return True
+
+    def _view_parts(self) -> tuple[int, list[dict[str, Any]], dict[str, Any] | None]:
+        """What a link keeps besides the scene and the time: the open tab, the pinned
+        scenes and the Study tab's settings."""
+        return self.sidebar.active, self.pins.board.scenes(), self.study_tab.study_settings()
+
+    def _on_pins(self) -> None:
+        self.results.show_pins()
+        self.link.schedule()
 
     def _on_notice(self, event: Any) -> None:
         # notices echo user text (file names, field names, formulas, links): the alert
         # renders Markdown, which passes raw HTML through, so the text is escaped
-        self.notice_alert.object = html.escape(self.notice)
-        self.notice_alert.visible = bool(self.notice)
+        notice = self.screen.notice
+        self.results.notice_alert.object = html.escape(notice)
+        self.results.notice_alert.visible = bool(notice)
 
     def _on_load(self) -> None:
         self._connected = True
-        if self.controller.view is not None and self.controller.view is not self._drawn:
+        if self.controller.view is not None and self.controller.view is not self.screen.drawn:
             self._on_view(None)
-        self._later(self.tabs.fill_idle, FILL_TABS_AFTER_MS)
-
-    def _later(self, callback: Callable[[], None], delay_ms: float) -> None:
-        """Run ``callback`` on this session's event loop after ``delay_ms`` [ms]."""
-        doc = self._doc
-        if doc is None or not doc.session_context:
-            return
-
-        def run() -> None:
-            with set_curdoc(doc):
-                callback()
-
-        try:
-            if delay_ms > 0:
-                doc.add_timeout_callback(run, delay_ms)
-            else:
-                doc.add_next_tick_callback(run)
-        except Exception:  # the session was closed meanwhile (a result, a timer)
-            log.debug("callback dropped: session gone")
+        self.loop.later(self.tabs.fill_idle, FILL_TABS_AFTER_MS)
 
     def _on_view(self, event: Any) -> None:
         view = self.controller.view
         if view is None or not (self._connected or self._initializing):
             return
         n = len(view.times)
-        old = self._drawn
+        old = self.screen.drawn
         if old is None and self._wanted_index is not None:
             index = min(self._wanted_index, n - 1)  # the time the link was made at
         elif old is None or len(old.times) != n:
             index = n - 1
         else:
-            index = min(self.time_index, n - 1)
-        self._drawn = view
+            index = min(self.screen.time_index, n - 1)
+        self.screen.drawn = view
         self.pins.on_result(view)
         with pn.io.hold():
             self.results.draw(view, index, new_range=old is None or len(old.times) != n)
-            self.files_view.name_files(view)
+            self.files_tab.name_files(view)
             mark("drawn")  # the patch goes out as the hold ends
         self.results.push()
         self.link.schedule()
 
-    @property
-    def files_view(self) -> FilesView:
-        """The Files tab (it names the downloads after the scene on screen)."""
-        return next(v for v in self.views if isinstance(v, FilesView))
-
     def _on_time(self, event: Any) -> None:
-        view = self._drawn
+        view = self.screen.drawn
         if view is None:
             return
         index = min(max(int(event.new), 0), len(view.times) - 1)

@@ -24,6 +24,9 @@
   written by hand start from here too (imported from ``tests.conftest``): a scene file
   (:func:`scene_file`), the small scenes the refusal tests share (:func:`base_scene`,
   :func:`elastic_dict`) and a field set or removed by its dotted path (:func:`edited`).
+- Explorer sessions without a server are built by one builder, :func:`explorer_app`
+  (``explorer_app()``, ``explorer_app("worn_coating", solved=True)``): a session as a
+  script or a notebook runs it, solving in the test's own thread.
 """
 
 from __future__ import annotations
@@ -109,7 +112,7 @@ def small_preset_scene(key: str | None = None, count: int = 6, tol: float = 1e-5
                        force_kN: float | None = None) -> dict[str, Any]:
     """A preset of the explorer (the default one if ``key`` is None) with ``count`` output
     times over 200 days, tolerance ``tol`` and, if given, a constant force [kN/m]."""
-    from explorer.presets import DEFAULT_PRESET, presets
+    from explorer.model import DEFAULT_PRESET, presets
 
     scene = copy.deepcopy(presets()[key or DEFAULT_PRESET])
     scene["times"] = {"end": 200.0, "count": count, "spacing": "log"}
@@ -192,3 +195,29 @@ def explorer_server() -> Iterator[Any]:
     # 180 s: the server solves the default scene once before it answers
     with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as explorer:
         yield explorer
+
+
+def build_explorer_app(preset: str | None = None, *, solved: bool = False,
+                       **kwargs: Any) -> Any:
+    """An explorer session without a server (``explorer.app.ExplorerApp``).
+
+    ``preset``: the preset it starts from (default: the default scene, or ``scene=``);
+    ``solved``: wait for its first result and check that the scene was solved. Solves run
+    in the calling thread (``executor=None``) unless ``executor`` is given; the other
+    keywords go to ``ExplorerApp`` (``scene``, ``query``, ``solve``)."""
+    from explorer.app import ExplorerApp
+    from explorer.model import presets
+
+    kwargs.setdefault("executor", None)
+    if preset is not None:
+        kwargs["scene"] = presets()[preset]  # a copy of its own
+    app = ExplorerApp(**kwargs)
+    if solved:
+        assert app.controller.wait(120) and app.controller.error == "", app.controller.error
+    return app
+
+
+@pytest.fixture(name="explorer_app")
+def explorer_app_fixture() -> Callable[..., Any]:
+    """:func:`build_explorer_app` for the tests."""
+    return build_explorer_app

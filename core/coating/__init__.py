@@ -1,4 +1,12 @@
-"""core.coating."""
+"""The thin coating model: compliance per interface, its error, and a finite-element check.
+
+- ``model.py``: the coating compliance ``m(x)`` of a stack of layers (smooth or bonded
+  interfaces) and the model-error estimate read from the measured map;
+- ``error_table.py`` (and ``error_table.json``): that map, measured against the FE check;
+- ``fem_check.py``, ``fem_stack.py``, ``fem_mesh.py``: plane-strain P2 finite elements of
+  the punch on the resolved coating layers and the base (scikit-fem), the independent
+  check of the thin-coating model.
+"""
 
 from __future__ import annotations
 

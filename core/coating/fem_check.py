@@ -28,7 +28,7 @@ Coated, ``sum h / 2a = 0.02``, ``E_c / E = 0.05``, ``nu_c = 0.45``, H = a: level
 1 differ by 4e-5 / 9e-5 (smooth) and 5e-5 / 1.3e-4 (bonded).
 
 This module assembles and solves (:func:`solve_stack`); the inputs and results are in
-:mod:`core.coating.fem_stack`, the mesh in :mod:`core.coating.fem_mesh` (both re-exported here).
+:mod:`core.coating.fem_stack`, the mesh in :mod:`core.coating.fem_mesh`.
 """
 
 from __future__ import annotations
@@ -38,19 +38,10 @@ import time
 import numpy as np
 
 from core.coating.fem_mesh import (
-    COATING_ROWS,
-    EDGE_SIZE,
-    GROWTH,
-    INTERIOR_SIZE,
     build_mesh,
     total_thickness,
 )
-from core.coating.fem_stack import INTERFACES, CoatingStrip, FEResponse, Profile, Stack
-
-__all__ = [
-    "COATING_ROWS", "EDGE_SIZE", "GROWTH", "INTERFACES", "INTERIOR_SIZE",
-    "TRUNCATION_DEPTHS", "CoatingStrip", "FEResponse", "Profile", "Stack", "solve_stack",
-]
+from core.coating.fem_stack import INTERFACES, FEResponse, Stack
 
 #: Lateral extent of the base beyond the punch edge, in base thicknesses (the kernel of
 #: the layer decays like exp(-2.1 x / H); ``--fe-study`` measured the change of the force

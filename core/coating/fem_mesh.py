@@ -3,7 +3,7 @@
 The ``x`` grid is geometric toward the punch edges and the coating's breakpoints
 (:func:`x_grid`), the base rows geometric toward its top, and every coating layer has its
 own rows (:func:`build_mesh`); lengths in half-widths, moduli relative to the base's.
-Used by :func:`core.coating.solve_stack`, which re-exports the constants.
+Used by :func:`core.coating.solve_stack`.
 """
 
 from __future__ import annotations

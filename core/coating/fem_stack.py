@@ -2,7 +2,7 @@
 
 :class:`CoatingStrip` and :class:`Stack` describe the punch, the resolved coating layers
 and the base in SI units; :class:`FEResponse` holds the three unit responses of one solve
-and completes any statement from them. :mod:`core.coating.fem_check` re-exports these names.
+and completes any statement from them.
 """
 
 from __future__ import annotations

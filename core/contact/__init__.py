@@ -1,4 +1,20 @@
-"""core.contact.unilateral."""
+"""Unilateral contact: the punch may lift off, and the contact set is an unknown.
+
+``solve_unilateral`` (``unilateral.py``) answers ``contact="unilateral"``; ``switch.py``
+holds the ``contact=`` switch of ``solve_dimensionless`` (full, unilateral, auto) and the
+cheap check that lets ``auto`` skip a full-contact solve.
+
+- ``active_set.py``: the nodal active set (primal-dual sweeps on a fixed panel rule) and
+  the zones it finds; ``nodal.py``: its operator and start from the next coarser rule;
+- ``zones.py``: zone ends as roots of the Nystrom pressure on panels graded toward them,
+  with the error estimate against a coarser rule;
+- ``step.py``: the problem at one time; ``systems.py``: the bordered systems;
+- ``elastic.py``: lift-off on an elastic base, each time on its own;
+- ``creep.py``, ``march.py``, ``memory.py``, ``bands.py``, ``kinks.py``: lift-off under
+  creep (error control, one march on a fixed rule, the memory of past pressures, the
+  bands the zone ends sweep, kink-corrected zone ends);
+- ``result.py``: ``UnilateralSolution`` and ``contact_set_from_pressure``.
+"""
 
 from __future__ import annotations
 

@@ -22,10 +22,12 @@ import numpy as np
 
 from core.contact.bands import BAND_WIDTHS, band_rule, bands_from_ends
 from core.contact.march import march, march_outputs, rule_operator
+from core.contact.result import UNILATERAL_MARGIN, _Snapshot
 from core.contact.step import Space, Step
 from core.contact.zones import ZONE_END_TOL, Resolution
 from core.discretize import Panels
 from core.engines.collocation import time_grid
+from core.problem import accepts
 
 #: Nominal steps of the first time grid over [1, t_end] (every output time is a grid
 #: point; each interval between output times gets whole steps).
@@ -105,8 +107,6 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     Richardson-extrapolated outputs of two successive pairs of grids agree to ``tol``/3
     (their difference / 7 is the estimate) or ``MAX_HALVINGS`` is reached.
     """
-    from core.contact.result import _Snapshot
-
     times = inp.times
     tol = inp.tol
     # The zone ends have their own budget whatever tol is (issue 13): half of it for the
@@ -119,7 +119,7 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     base, space_error, space_shift, band_note = _select_rule(space, inp, res, first_steps,
                                                              tol, end_tol, first=first)
     out, time_error, end_shift, run = _in_time(
-        space, inp, base, first_steps, max(tol / 3 - space_error, tol / 6),
+        space, inp, base, first_steps, max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
         max(end_tol - space_shift, end_tol / 2), first)
     strays = _outside_bands(out["ends"], band_note["bands"], space.breakpoints)
     if strays:
@@ -129,15 +129,15 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
         base, space_error, space_shift, band_note = _select_rule(
             space, inp, res, first_steps, tol, end_tol, bands=bands, first=first)
         out, time_error, end_shift, run = _in_time(
-            space, inp, base, first_steps, max(tol / 3 - space_error, tol / 6),
+            space, inp, base, first_steps, max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
             max(end_tol - space_shift, end_tol / 2), first)
         strays = _outside_bands(out["ends"], band_note["bands"], space.breakpoints)
     unsettled, sweeps, steps = run["unsettled"], run["sweeps"], run["steps"]
 
     error = float(time_error + space_error)
     end_error = float(end_shift + space_shift)
-    success = (error * 3.0 <= tol and end_error <= end_tol and unsettled == 0
-               and not strays)
+    success = (accepts(error, tol, UNILATERAL_MARGIN) and end_error <= end_tol
+               and unsettled == 0 and not strays)
     flags = [] if success else ["tol_not_met"]
     message = (f"unilateral contact under creep: {steps} steps, estimated error "
                f"{error:.1e} (time {time_error:.1e}, space {space_error:.1e}), zone ends to "

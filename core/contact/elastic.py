@@ -14,10 +14,11 @@ import numpy as np
 
 from core.contact.active_set import NoContact, zones_from_nodes
 from core.contact.nodal import nodal_operator, nodal_state
-from core.contact.result import _Snapshot
+from core.contact.result import UNILATERAL_MARGIN, _Snapshot
 from core.contact.step import Space, Step, nystrom_pressure
 from core.contact.zones import ZONE_END_TOL, Resolution, refine_zone_ends, zone_kernel_accuracy
 from core.discretize import Panels
+from core.problem import accepts
 
 
 def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
@@ -42,7 +43,8 @@ def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
     error = max(r[1]["error_estimate"] for r in per_time)
     verified = all(r[1]["verified"] for r in per_time)
     converged = all(r[1]["converged"] for r in per_time)
-    success = error * 3.0 <= tol and end_error <= ZONE_END_TOL and verified and converged
+    success = (accepts(error, tol, UNILATERAL_MARGIN) and end_error <= ZONE_END_TOL
+               and verified and converged)
     flags = [] if success else ["tol_not_met"]
     if not verified:
         flags.append("contact_set_unverified")

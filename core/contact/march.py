@@ -23,7 +23,7 @@ from core.cache import StageCache, fingerprint
 from core.contact.active_set import NoContact, NodalState, nodal_active_set, zones_from_nodes
 from core.contact.kinks import corrected_roots, kinks_corrected
 from core.contact.memory import pressure_memory
-from core.contact.step import Space, Step
+from core.contact.step import Space, Step, check_loads
 from core.contact.systems import StepSolver
 from core.contact.zones import zone_kernel_accuracy
 from core.discretize import KernelOperator, Panels, kernel_operator
@@ -62,8 +62,6 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
     its nodes). ``first`` (shared by the marches of one solve): the zones of the first
     step, at loading, recorded by the first march and the start of the first step of
     the later ones (from full contact it took 4-6 sweeps, each with a new LU)."""
-    from core.contact.unilateral import _check_loads
-
     # kink rows with kernel values to 1e-4 of the tighter of tol and the zone-end
     # tolerance (as the elastic zone operators): ~15 % less kernel work per correction
     accuracy = zone_kernel_accuracy(inp.tol)
@@ -71,7 +69,7 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
     steps = grid.size
     c_vals = inp.c(grid)
     loads = {name: np.asarray(fn(grid), dtype=float) for name, fn in inp.loads.items()}
-    _check_loads(inp.given, loads, grid)
+    check_loads(inp.given, loads, grid)
     inner = np.zeros(steps)
     inner[:-1] += 0.5 * widths
     inner[1:] += 0.5 * widths

@@ -18,6 +18,10 @@ from core.discretize import Panels
 from core.kernel import FULL_ACCURACY
 from core.problem import SolveOutcome
 
+#: The unilateral solvers' ``success_margin`` (:func:`core.problem.accepts`): their
+#: Richardson and coarser-rule estimates can read up to ~3x low, as the projection's do.
+UNILATERAL_MARGIN = 3.0
+
 
 @dataclass(frozen=True)
 class _Snapshot:

@@ -98,3 +98,22 @@ def nystrom_pressure(space: Space, step: Step, panels: Panels, q: np.ndarray, de
     memory = 0.0 if memory_at is None else memory_at(targets)
     return (delta + alpha * targets - space.g(side) + memory - step.scale * fq) / (
         step.c * space.m(side))
+
+
+def check_loads(statement_given: frozenset[str], loads: dict[str, np.ndarray],
+                times: np.ndarray) -> None:
+    """Refuse loads that pull the punch away (no contact can carry them)."""
+    if "force" in loads:
+        bad = loads["force"] <= 0.0
+        if bad.any():
+            t = times[int(np.argmax(bad))]
+            raise ValueError(f"force: must be > 0 for the punch to touch (a punch pulled away "
+                             f"has no contact), got {loads['force'][bad][0]:.6g} at t = {t:g}")
+        if "moment" in loads:
+            e = loads["moment"] / loads["force"]
+            bad = np.abs(e) >= 1.0
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise ValueError(f"moment: the eccentricity M/P = {e[k]:.6g} at t = "
+                                 f"{times[k]:g} puts the load outside the punch (|M/P| must "
+                                 "be < 1 half-width): no contact can carry it")

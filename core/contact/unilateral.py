@@ -1,6 +1,6 @@
 """Unilateral contact: the punch may lift off, and the contact set is part of the answer.
 
-:func:`solve_unilateral` solves the dimensionless problem of ``core/README.md`` with
+:func:`solve_unilateral` solves the dimensionless problem of ``docs/method.md`` with
 ``q >= 0`` and an unknown contact set ``S(t)`` in [-1, 1] (may have several pieces):
 
     c m q + (I - V) F q = delta + alpha x - g   on S(t),  q > 0 there,
@@ -28,7 +28,7 @@ import numpy as np
 
 from core.contact.elastic import _solve_elastic
 from core.contact.result import UnilateralSolution
-from core.contact.step import Space
+from core.contact.step import Space, check_loads
 from core.contact.zones import NODAL_PANEL_WIDTH, ZONE_EDGE_WIDTH, ZONE_PANEL_WIDTH, Resolution
 from core.kernel import FULL_ACCURACY
 
@@ -45,25 +45,6 @@ _CREEP_EDGE = 1e-2
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
-
-
-def _check_loads(statement_given: frozenset[str], loads: dict[str, np.ndarray],
-                 times: np.ndarray) -> None:
-    """Refuse loads that pull the punch away (no contact can carry them)."""
-    if "force" in loads:
-        bad = loads["force"] <= 0.0
-        if bad.any():
-            t = times[int(np.argmax(bad))]
-            raise ValueError(f"force: must be > 0 for the punch to touch (a punch pulled away "
-                             f"has no contact), got {loads['force'][bad][0]:.6g} at t = {t:g}")
-        if "moment" in loads:
-            e = loads["moment"] / loads["force"]
-            bad = np.abs(e) >= 1.0
-            if bad.any():
-                k = int(np.argmax(bad))
-                raise ValueError(f"moment: the eccentricity M/P = {e[k]:.6g} at t = "
-                                 f"{times[k]:g} puts the load outside the punch (|M/P| must "
-                                 "be < 1 half-width): no contact can carry it")
 
 
 def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | np.ndarray,
@@ -99,7 +80,7 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     times_arr = inp.times
     c_t = inp.c(times_arr)
     loads = {name: np.asarray(fn(times_arr), dtype=float) for name, fn in inp.loads.items()}
-    _check_loads(inp.given, loads, times_arr)
+    check_loads(inp.given, loads, times_arr)
     space = Space(inp.lam, inp.m, inp.g, inp.breakpoints)
     m_probe = inp.m(np.linspace(-1.0, 1.0, 257))
     res = Resolution(min(ZONE_PANEL_WIDTH, 3.0 / inp.lam),

@@ -5,7 +5,7 @@ Two stages: (1) the nodal active set (:mod:`core.contact.active_set`) gives the 
 and ends to within a node; (2) each free end is then located as the root of
 ``Q(end) = 0`` of the problem solved on the contact set alone, with panels broken at and
 graded toward the current end estimates (quasi-Newton on the ends), and checked against
-a finer rule (this module). The names of both stages stay importable from here.
+a finer rule (this module).
 """
 
 from __future__ import annotations

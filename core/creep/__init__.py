@@ -1,4 +1,16 @@
-"""core.creep.models."""
+"""Creep and aging of the base, and the kernels the solver steps with.
+
+- ``models.py``: the creep models (elastic, exponential, Arutyunyan aging, Prony series,
+  user kernel) giving ``E(age)``, ``C(t, tau)`` and the kernel ``K(t, tau)``, and
+  ``creep_model_from_spec`` for scene files;
+- ``kernels.py``: those kernels in the solver's time (``DegenerateKernel``: sums of
+  exponentials, stepped in O(1) per mode and step);
+- ``inputs.py``: the checked inputs of the models (messages naming the field);
+- ``design_codes.py``, ``code_formulas.py``, ``code_inputs.py``: fib Model Code 2010 and
+  EN 1992-1-1 Annex B creep, clause by clause, and ``creep_coefficient_curve``;
+- ``kernel_fit.py``, ``fitted_kernel.py``: any kernel fitted by a sum of exponentials,
+  with its measured ``fit_error`` (``stepping_kernel``).
+"""
 
 from __future__ import annotations
 

@@ -49,7 +49,7 @@ s = 0.38, 0.25, 0.20 (Table 5.1-9, 3.1.2(6)). The strength is the mean cylinder
 strength ``fcm`` [MPa] or a class ``"C30/37"`` (fcm = fck + 8 MPa, 5.1-1 and Table 3.1).
 
 The inputs are validated by :mod:`core.creep.code_inputs`; :mod:`core.creep.design_codes` builds the
-creep model and its fitted kernel on these functions and re-exports them.
+creep model and its fitted kernel on these functions.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ Strength (``fcm`` [MPa] or a class ``"C30/37"``), cement class, relative humidit
 notional size [mm] and temperature [deg C], each checked against the range its code covers
 (:data:`RANGES`, with the clause the bound comes from) and gathered in :class:`CodeInputs`.
 Inputs outside the ranges are refused with a ValueError naming the field and the range;
-nothing is clipped. :mod:`core.creep.design_codes` re-exports these names.
+nothing is clipped.
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ Two models, with their inputs in the units of the codes (MPa, %, mm, days, deg C
 creep, 5.1.9.3 / 5.1.7.2 for the development of the modulus), and ``"eurocode2"``,
 EN 1992-1-1:2004 (Annex B.1 for creep, 3.1.2 / 3.1.3 for the modulus). Their equations,
 clause by clause, are in :mod:`core.creep.code_formulas`, the validation of their inputs in
-:mod:`core.creep.code_inputs`; the public names of both are re-exported here.
+:mod:`core.creep.code_inputs`.
 
 The creep function of the model notes is ``C(t, tau) = phi(t, tau)/E_ref`` and the
 kernel ``K(t, tau) = E(tau) d/dtau [1/E(tau) + C(t, tau)]`` (<= 0 for a creeping
@@ -30,28 +30,13 @@ from core.creep.code_formulas import (
     _FORMULAS,
     _modulus_log_slope,
     clamp_age,
-    ec2_creep_coefficient,
-    ec2_modulus,
-    mc2010_creep_coefficient,
-    mc2010_modulus,
 )
 from core.creep.code_inputs import (
-    CEMENT_CLASSES,
-    DELTA_F,
-    RANGES,
     CodeInputs,
     _in_range,
     check_inputs,
-    mean_strength,
 )
 from core.validation import show_python
-
-__all__ = [
-    "CEMENT_CLASSES", "DELTA_F", "K_SIGN_SLACK", "MAX_DURATION", "RANGES", "RESOLUTION",
-    "SPEC_FIELDS", "CodeCreep", "CodeInputs", "RelativeCodeModulus", "check_inputs",
-    "clamp_age", "creep_coefficient_curve", "ec2_creep_coefficient", "ec2_modulus",
-    "mc2010_creep_coefficient", "mc2010_modulus", "mean_strength",
-]
 
 #: Longest load duration the kernel is fitted for [day] (100 years).
 MAX_DURATION = 36525.0

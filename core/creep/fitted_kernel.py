@@ -4,7 +4,7 @@
 tau))`` and the compliance it stands for from Chebyshev coefficients of the amplitudes in
 ``ln tau``; :func:`integrated_kernel` is the graded quadrature of ``-int_tau^t K(t, u)
 du`` (the creep part of the compliance of a general kernel). How the coefficients are
-fitted, and their error, is in :mod:`core.creep.kernel_fit`, which re-exports these names.
+fitted, and their error, is in :mod:`core.creep.kernel_fit`.
 """
 
 from __future__ import annotations

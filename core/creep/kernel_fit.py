@@ -46,7 +46,7 @@ A general kernel ``K(t, tau)`` (a plain callable) is fitted the same way, with `
 and ``J(t, tau) = 1 - int_tau^t K(t, u) du`` computed by Gauss-Legendre quadrature on
 panels graded toward ``u = t`` (where a weakly singular kernel lives).
 Fits are cached on their inputs. The fitted value, :class:`FittedKernel`, and the
-quadrature :func:`integrated_kernel` are in :mod:`core.creep.fitted_kernel` (re-exported here).
+quadrature :func:`integrated_kernel` are in :mod:`core.creep.fitted_kernel`.
 """
 
 from __future__ import annotations
@@ -58,13 +58,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
 from core.cache import StageCache, fingerprint
-from core.creep.fitted_kernel import ArrayLike, FittedKernel, integrated_kernel
-
-__all__ = [
-    "AGE_NODES", "PER_DECADE", "RIDGE", "THETA_BELOW_RESOLUTION", "ArrayLike", "FittedKernel",
-    "fit_compliance", "fit_kernel", "integrated_kernel", "nonpositive_violation",
-    "stepping_kernel",
-]
+from core.creep.fitted_kernel import FittedKernel, integrated_kernel
 
 #: Retardation times per decade of duration (measured on the fib MC2010 compliance:
 #: 2 a decade 7.5e-5, 3 a decade 1.6e-5, 4 a decade 1.6e-5 relative error).

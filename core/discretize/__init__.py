@@ -1,4 +1,16 @@
-"""core.discretize."""
+"""Space discretization: panels, product-integration quadrature and bases on [-1, 1].
+
+- ``panels.py``: composite Gauss-Legendre panels graded toward ``x = +-1`` and jumps, the
+  panel rule (``GAUSS_NODES``, ``GAUSS_WEIGHTS``) and the panel-wise interpolant;
+- ``quadrature.py``: product-integration weights exact for the log singularity and the
+  discrete operator ``F`` on panels (``kernel_operator``, ``operator_rows``);
+- ``pair_tables.py``: reference tables of near panel pairs (near entries with no log per
+  entry);
+- ``basis.py``, ``basis_pieces.py``, ``graded_basis.py``: orthonormal bases for the
+  weight ``1/m`` (the seed's global polynomials, piecewise, and the default graded one);
+- ``galerkin.py``: the Galerkin correction that makes the projection exact for panel-wise
+  polynomials.
+"""
 
 from __future__ import annotations
 

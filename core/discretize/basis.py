@@ -33,7 +33,7 @@ Functions are ordered so that the first ``n`` of a basis are the best ``n`` to k
 
 This module builds the global and piecewise bases (:func:`build_basis`); the recurrences
 and the :class:`Basis` value are in :mod:`core.discretize.basis_pieces`, the graded basis and its
-mesh in :mod:`core.discretize.graded_basis`; their public names are re-exported here.
+mesh in :mod:`core.discretize.graded_basis`.
 """
 
 from __future__ import annotations
@@ -44,24 +44,9 @@ import numpy as np
 
 from core.discretize.basis_pieces import Basis, Recurrence, orthonormality_error, stieltjes
 from core.discretize.graded_basis import (
-    AMPLITUDE_POWER,
-    GRADED_DEPTH,
-    GRADED_MAX_DEGREE,
-    GRADED_MAX_LAYERS,
-    GRADED_OUTER,
-    GRADED_RATIO,
-    RHO_POWER,
-    TOUCHING_DECAY,
     graded_basis,
-    graded_cuts,
 )
 from core.discretize.panels import Panels
-
-__all__ = [
-    "AMPLITUDE_POWER", "GRADED_DEPTH", "GRADED_MAX_DEGREE", "GRADED_MAX_LAYERS",
-    "GRADED_OUTER", "GRADED_RATIO", "RHO_POWER", "TOUCHING_DECAY", "Basis", "Recurrence",
-    "build_basis", "graded_cuts", "stieltjes",
-]
 
 
 def build_basis(panels: Panels, m_values: np.ndarray, count: int, *,

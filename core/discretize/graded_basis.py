@@ -4,7 +4,6 @@ Continuous piecewise polynomials on a mesh graded geometrically toward +-1 and e
 breakpoint (:func:`graded_cuts`), with degrees growing away from them; the candidate
 functions are ranked by an a-priori error model (the constants below, tuned on seven test
 scenes) and orthonormalized in that order, so truncation is taking the first columns.
-:mod:`core.discretize.basis` re-exports the public names.
 """
 
 from __future__ import annotations

@@ -21,8 +21,7 @@ refined grid copies the blocks of the panels it shares with the coarser one
 than rounding (a truncated series, and exact zeros where the kernel has decayed below it).
 
 The panels themselves (breaks at every jump of ``m`` or ``g``, grading toward those points
-and ``x = +-1``, refinement, interpolation) are in :mod:`core.discretize.panels`; their names are
-re-exported here.
+and ``x = +-1``, refinement, interpolation) are in :mod:`core.discretize.panels`.
 
 The Galerkin form ``int v F u`` of the projection method is the rule's sum
 ``sum_i w_i v(x_i) (F u)(x_i)``, exact in the inner integral only;
@@ -43,17 +42,8 @@ from core.discretize.panels import (
     NODES_PER_PANEL,
     VALUES_TO_LEGENDRE,
     Panels,
-    base_panels,
-    interpolation_weights,
-    panel_legendre_coefficients,
-    refine_to_resolve,
 )
 from core.kernel import FULL_ACCURACY, kernel_block, kernel_regular, legendre_log_moments
-
-__all__ = ["NODES_PER_PANEL", "NEAR_FIELD", "Panels", "KernelOperator", "base_panels",
-           "refine_to_resolve", "log_product_weights", "operator_rows", "node_rows",
-           "shared_panels", "panel_nodes", "kernel_operator", "panel_legendre_coefficients",
-           "interpolation_weights", "legendre_log_moments"]
 
 _J = np.arange(NODES_PER_PANEL)
 

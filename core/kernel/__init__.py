@@ -1,4 +1,13 @@
-"""core.kernel.plane."""
+"""The kernels of the integral equation: the layer kernel and the exact stack kernel.
+
+- ``plane.py``: the plane-strain kernel ``k_pl(s)`` of a layer on a rigid frictionless
+  base (the seed's ``L(u)/u``) to rounding, and its regular part ``k_pl(s) + ln|s|``;
+- ``values.py``: the same kernel to a chosen accuracy (``kernel_block``), as the engines
+  evaluate it;
+- ``log_moments.py``: the Legendre moments of ``ln|z - t|`` used by product integration;
+- ``layered.py``: the exact plane-strain kernel of uniform coating layers (smooth or
+  bonded) on the base.
+"""
 
 from __future__ import annotations
 

@@ -1,4 +1,57 @@
-"""The result type of :func:`core.solver.solve_dimensionless` (full contact)."""
+"""The result type of every engine: :class:`ContactSolution`, its ``info`` schema, and the
+one acceptance rule :func:`accepts`.
+
+Every engine of :mod:`core.engines` answers the full-contact problem with a
+:class:`ContactSolution` whose ``info`` dict (in the spirit of SciPy's ``OdeResult``)
+holds at least the keys of :data:`INFO_KEYS`:
+
+========================== ===================================================================
+key                        meaning
+========================== ===================================================================
+``method``                 the engine that answered: ``"nystrom"``, ``"projection"``,
+                           ``"collocation"``, ``"layered"``
+``success``                whether the answer meets ``tol``: :func:`accepts` of
+                           ``error_estimate`` with the engine's margin, and the engine's own
+                           conditions (input resolved, time stepping finished)
+``message``                one line saying how the solve went (why ``tol`` was missed)
+``flags``                  validity flags: ``tol_not_met``, ``contact_lost`` (q < 0
+                           somewhere), ``unresolved_input`` (m or g finer than the grid)
+``error_estimate``         estimated relative error of delta, alpha (relative to
+                           ``max(|delta|, |alpha|)``), P, M (to ``max(|P|, |M|)``) and q (to
+                           ``max|q|``): the parts below added (a part the engine does not
+                           estimate is NaN and left out)
+``spatial_error_estimate`` its part from the discretization in x
+``time_error_estimate``    its part from the time stepping (0 on an elastic base)
+``kernel_fit_error``       its part from the creep kernel's sum-of-exponentials fit (the
+                           Nystrom engine counts it in the time part)
+``seconds``                wall time of the solve [s]
+``n_modes``                unknowns in x: basis functions, or nodes for a nodal engine
+``n_nodes``                quadrature or collocation nodes in x
+``n_steps``                time steps (0 or the number of times on an elastic base)
+``statement``              1-4, which two of delta, alpha, P, M were given
+                           (:data:`core.problem.STATEMENTS`)
+``given``                  the names of those two, sorted
+``min_pressure``           least q over the engine's check points and times (< 0: lift-off)
+``max_pressure``           largest |q| there (the scale of ``contact_lost``)
+``basis``                  how q is represented in x (``"nystrom"``, the projection's basis
+                           kind, ``"collocation"``, ``"chebyshev"``)
+``element_ends``           points of (-1, 1) where q may kink or jump (panel or element
+                           ends, breakpoints)
+``stages``                 ``{stage: {"seconds": s, "cached": bool}}``: what the solve built
+                           and what it found cached
+========================== ===================================================================
+
+:func:`core.solver.solve_dimensionless` adds ``contact`` (``"full"``; the unilateral model's
+answer, :class:`core.contact.result.UnilateralSolution`, has an ``info`` of its own) and, when
+the default engine declined and the next one answered, ``fallback`` (why).
+
+Engine-specific keys: nystrom ``n_panels``, ``prepare_seconds`` (the geometry's
+preparation, done once), ``max_abs_tilt`` (largest |alpha| between the output times too),
+``builds`` (how often each cached member was built); projection ``orthonormality_error``;
+collocation ``richardson``, ``nodes`` and ``nodal_pressure`` (arrays: the collocation
+solution itself); layered (a scene-level engine, :mod:`core.engines.layered`)
+``max_abs_tilt``, ``coating_model``, ``layered_model_error``.
+"""
 
 from __future__ import annotations
 
@@ -9,6 +62,24 @@ from typing import Any
 import numpy as np
 
 from core.discretize import Basis
+
+#: The ``info`` keys every engine's answer carries (see the module notes).
+INFO_KEYS = ("method", "success", "message", "flags", "error_estimate",
+             "spatial_error_estimate", "time_error_estimate", "kernel_fit_error", "seconds",
+             "n_modes", "n_nodes", "n_steps", "statement", "given", "min_pressure",
+             "max_pressure", "basis", "element_ends", "stages")
+
+
+def accepts(error_estimate: float, tol: float, margin: float = 1.0) -> bool:
+    """The one acceptance rule of every engine: ``margin * error_estimate <= tol``.
+
+    ``error_estimate`` and ``tol`` are relative errors (``info["error_estimate"]`` and the
+    requested ``tol``); ``margin`` >= 1 is the engine's ``success_margin``: how far its
+    estimate may read low (1 for an estimate that bounds the error, 3 for the projection's
+    extrapolated level differences, which read up to ~3x low). A NaN estimate (none
+    made) is never accepted.
+    """
+    return bool(error_estimate * margin <= tol)
 
 
 class SolveOutcome:
@@ -36,14 +107,16 @@ class SolveOutcome:
 
 @dataclass(frozen=True)
 class ContactSolution(SolveOutcome):
-    """The answer of :func:`solve_dimensionless` (all quantities dimensionless).
+    """The answer of every engine, full contact (all quantities dimensionless).
 
     ``times`` (T,), ``settlement`` (delta), ``tilt`` (alpha), ``force`` (P), ``moment`` (M)
     as arrays over ``times``; ``pressure(x)`` gives q at points of [-1, 1] (shape
-    ``(len(x), T)``); ``info`` holds ``error_estimate`` (relative, see the module notes),
-    ``seconds``, ``flags``, ``message``, ``success``, ``n_modes``, ``n_steps``, ``stages``,
-    ``contact`` (``"full"``). ``contact_set`` holds, per time, the intervals of x where
-    q > 0: ``[(-1.0, 1.0)]`` (full contact is assumed).
+    ``(len(x), T)``); ``info`` holds the keys of :data:`INFO_KEYS` (the module notes
+    give their meaning) and the engine's own. ``contact_set`` holds, per time, the
+    intervals of x where q > 0: ``[(-1.0, 1.0)]`` (full contact is assumed).
+
+    A projection answer evaluates q from its basis and coefficients; a nodal engine
+    (Nystrom, collocation, layered) passes ``_evaluate`` instead.
     """
 
     times: np.ndarray

@@ -1,8 +1,20 @@
-"""core.profiles.build."""
+"""Functions of x or t given by a user: numbers, tables, parametric families, formulas.
+
+Every coating, punch and load input is a :class:`Profile`, an immutable value with a
+stable key (``profile_key``) that the stage caches use.
+
+- ``build.py``: ``profile_from_spec`` and ``FAMILIES``, the one registry of the families
+  (fields, building, the constant part, the screen's forms ``VARIATIONS``);
+- ``base.py``: the ``Profile`` value and the helpers of single families;
+- ``families.py``: the builders of the families; ``forms.py``: the screen's forms;
+- ``tables.py``: profiles from uploaded CSV tables (``profile_from_csv``);
+- ``expressions.py``, ``parser.py``, ``whitelist.py``: the formula parser (tokenizer and
+  recursive descent over a whitelist of constants and functions; never ``eval``).
+"""
 
 from __future__ import annotations
 
-from core.profiles.base import MAX_TABLE_BYTES, Profile
+from core.profiles.base import MAX_TABLE_BYTES, Profile, profile_values
 from core.profiles.build import (
     HISTORY_FORMS,
     VARIATIONS,
@@ -24,6 +36,7 @@ __all__ = [
     "Profile",
     "profile_from_csv",
     "profile_from_spec",
+    "profile_values",
     "variation_of",
     "VARIATIONS",
     "without_offset",

@@ -3,7 +3,7 @@ entries, and the evaluation helpers of the families that need more than a line (
 crests, formula switches, tables).
 
 The families themselves (their fields, how each is built, its offset, the screen's
-forms) are the registry of :mod:`core.profiles.build`, the public path for every name here.
+forms) are the registry of :mod:`core.profiles.build`.
 """
 
 from __future__ import annotations
@@ -247,14 +247,15 @@ class Profile(Immutable):
         return (f"Profile(kind={self._kind!r}, spec={text}, variable={self._variable!r}, "
                 f"domain={self._domain!r})")
 
-    def __reduce__(self) -> tuple[Any, ...]:
-        return (_rebuild, (self.spec, self._variable, self._domain))
 
-
-def _rebuild(spec: Spec, variable: str, domain: tuple[float, float]) -> Profile:
-    from core.profiles.build import profile_from_spec
-
-    return profile_from_spec(spec, field="profile", variable=variable, domain=domain)
+def profile_values(profile: Profile, x: np.ndarray) -> np.ndarray:
+    """A profile's values at ``x`` as a float array of x's shape (a new array)."""
+    out = profile(x)
+    if isinstance(out, np.ndarray) and out.dtype == np.float64 and out.shape == np.shape(x):
+        # a profile's own answer already has x's shape: skip the broadcast (a solve calls
+        # this ~30 times); the copy keeps callers free to write into the result
+        return out.copy()
+    return np.broadcast_to(np.asarray(out, dtype=float), np.shape(x)).astype(float)
 
 
 def profile_key(profile: Profile) -> str:

@@ -44,11 +44,12 @@ history (:data:`HISTORY_FORMS`, :func:`history_form_of`; the forms themselves ar
 :mod:`core.profiles.forms`). The
 :class:`Profile` value and the helpers of single families are in
 :mod:`core.profiles.base`, the builders of the families in :mod:`core.profiles.families`,
-CSV uploads in :mod:`core.profiles.tables`; the public names are re-exported here.
+CSV uploads in :mod:`core.profiles.tables`.
 """
 
 from __future__ import annotations
 
+import copyreg
 import difflib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -272,12 +273,15 @@ def check_range(profile: Profile, *, field: str, domain: tuple[float, float] | N
             f"{field}: must be {rule}, is {_fmt(values[i])} at {var} = {_fmt(points[i])}"))
 
 
+def _rebuild(spec: Any, variable: str, domain: tuple[float, float]) -> Profile:
+    return profile_from_spec(spec, field="profile", variable=variable, domain=domain)
 
-def __getattr__(name: str) -> Any:
-    # profile_from_csv lives in core.profiles.tables, which builds on this module: loaded on
-    # first use, so that either module may be imported first
-    if name == "profile_from_csv":
-        from core.profiles.tables import profile_from_csv
 
-        return profile_from_csv
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+def _reduce(profile: Profile) -> tuple[Any, ...]:
+    # A profile travels to worker processes as its spec and is built again there, through
+    # the same checks. Registered here rather than as Profile.__reduce__ so that the
+    # module of the value does not import its builder (which imports it).
+    return (_rebuild, (profile.spec, profile.variable, profile.domain))
+
+
+copyreg.pickle(Profile, _reduce)

@@ -6,7 +6,7 @@ untrusted users, so the text is read by the hand-written tokenizer and recursive
 parser of :mod:`core.profiles.parser`; Python's compiler, ``eval``, ``exec`` and
 ``ast`` are never involved. This module holds the parsed :class:`Expression` (its
 evaluation as a stack program) and :func:`parse_expression`; the whitelist is
-:mod:`core.profiles.whitelist`; the public names of both are re-exported here.
+:mod:`core.profiles.whitelist`.
 
 Grammar (highest precedence last, as in Python)::
 
@@ -54,16 +54,8 @@ from core.profiles.whitelist import (
     ALIASES,
     CONSTANTS,
     FUNCTIONS,
-    MAX_CONSTANT_EXPONENT,
-    MAX_DEPTH,
     MAX_LENGTH,
-    MAX_NODES,
 )
-
-__all__ = [
-    "ALIASES", "CONSTANTS", "FUNCTIONS", "MAX_CONSTANT_EXPONENT", "MAX_DEPTH", "MAX_LENGTH",
-    "MAX_NODES", "Expression", "ExpressionError", "parse_expression",
-]
 
 
 def _live_arrays(program: tuple[Instruction, ...]) -> int:

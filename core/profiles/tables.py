@@ -11,6 +11,7 @@ import re
 
 from core import limits
 from core.profiles.base import MAX_TABLE_BYTES, MAX_TABLE_ROWS, Profile, _fmt, _json_type
+from core.profiles.build import profile_from_spec
 
 # Unambiguous (no nested quantifiers), so matching is linear in the cell length.
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
@@ -114,8 +115,6 @@ def profile_from_csv(data: bytes | str, *, field: str, variable: str = "x",
             raise ValueError(f"{field}: {variable} values must be strictly increasing "
                              f"(line {n}: {_fmt(row[0])} after {_fmt(points[-1][0])})")
         points.append(row)
-    from core.profiles.build import profile_from_spec
-
     profile = profile_from_spec({"kind": "table", "points": points,
                                  "interpolation": interpolation},
                                 field=field, variable=variable, domain=domain)

@@ -3,7 +3,7 @@
 Everything a formula may name or do is listed here, as read-only tables, so no other code
 can widen the whitelist at run time. The tokenizer and parser are in
 :mod:`core.profiles.parser`; the parsed value and its evaluation in
-:mod:`core.profiles.expressions`, which re-exports these names.
+:mod:`core.profiles.expressions`.
 """
 
 from __future__ import annotations

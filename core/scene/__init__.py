@@ -1,10 +1,25 @@
-"""core.scene.pipeline."""
+"""Dimensional scenes: the SI-unit problem a user writes, solved through the dimensionless one.
+
+``solve(scene)`` (``pipeline.py``) checks a scene, converts it, picks the engine and
+returns a ``SceneSolution``.
+
+- ``schema.py``: the schema version and migrations, accepted ranges, field validators;
+- ``validate.py``: ``scene_from_dict``, a whole scene checked field by field;
+- ``model.py``: the validated ``Scene`` and ``Layer`` and what follows from them alone;
+- ``dimensionless.py``: ``to_dimensionless``, the scene as the dimensionless problem;
+- ``results.py``: ``SceneSolution``, the answer in SI units with its flags, JSON and CSV;
+- ``files.py``: ``load_scene``, ``save_scene`` (strict JSON, atomic writes);
+- ``load_limits.py``, ``load_rates.py``: loads no contact can carry, and the steps a
+  load history forces, refused before any solve;
+- ``coating_check.py``: a scene's fast answer against the finite-element check;
+- ``golden_section.py``: the least gap between punch and coating.
+"""
 
 from __future__ import annotations
 
 from core.scene.coating_check import check_scene
 from core.scene.files import load_scene, read_scene_json, save_scene
-from core.scene.model import Scene, profile_values
+from core.scene.model import Scene
 from core.scene.pipeline import solve
 from core.scene.results import (
     FLAG_MESSAGES,
@@ -25,7 +40,6 @@ __all__ = [
     "load_scene",
     "MAX_SCENE_BYTES",
     "plotting_grid",
-    "profile_values",
     "read_scene_json",
     "replace_loads",
     "save_scene",

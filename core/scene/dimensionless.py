@@ -26,8 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.cache import StageCache, fingerprint
-from core.profiles import Profile
-from core.scene.model import profile_values
+from core.profiles import Profile, profile_values
 from core.validation import refuse_first
 
 if TYPE_CHECKING:

@@ -1,7 +1,7 @@
 """Scene files: strict JSON reading, loading, canonical writing (format: core/SCENES.md).
 
-The scene itself (its fields and their validation) is :mod:`core.scene.pipeline`, which
-re-exports everything here; ``from core.scene.pipeline import load_scene`` stays the public path.
+The scene's fields and their validation are :mod:`core.scene.validate`; the public path
+of these names is :mod:`core.scene`.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from core import limits
 from core.files import atomic_write_text, read_regular_file
+from core.scene.validate import scene_from_dict
 
 if TYPE_CHECKING:
     from core.scene.model import Scene
@@ -51,8 +52,6 @@ def read_scene_json(text: str, source: str = "scene") -> Any:
 
 def parse_scene_json(text: str, source: str = "scene") -> Scene:
     """Parse and validate the JSON text of a scene; errors name ``source`` or the field."""
-    from core.scene.validate import scene_from_dict
-
     return scene_from_dict(read_scene_json(text, source))
 
 
@@ -73,8 +72,6 @@ def load_scene(path: str | os.PathLike) -> Scene:
 
 def scene_to_json(scene: Scene | Mapping[str, Any]) -> str:
     """The canonical JSON text of a scene (validated first when given as a dict)."""
-    from core.scene.validate import scene_from_dict
-
     scene = scene_from_dict(scene)
     return json.dumps(scene.to_dict(), indent=2, allow_nan=False) + "\n"
 

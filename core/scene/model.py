@@ -14,18 +14,16 @@ import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from core.cache import StageCache, fingerprint
 from core.coating import DEFAULT_INTERFACE, layer_compliance
 from core.problem import STATEMENTS
-from core.profiles import Profile, without_offset
+from core.profiles import Profile, profile_values, without_offset
+from core.scene.dimensionless import DimensionlessProblem, to_dimensionless
 from core.scene.golden_section import golden_minimum_batched
-
-if TYPE_CHECKING:
-    from core.scene.dimensionless import DimensionlessProblem
 
 #: Uniform samples of [-a, a] for the gap minimum and the coating checks (on top of each
 #: profile's own sample points).
@@ -264,16 +262,4 @@ class Scene:
     def dimensionless(self) -> DimensionlessProblem:
         """The dimensionless problem of this scene (built once; the formulas:
         :mod:`core.scene.dimensionless`)."""
-        from core.scene.dimensionless import to_dimensionless
-
         return to_dimensionless(self)
-
-
-def profile_values(profile: Profile, x: np.ndarray) -> np.ndarray:
-    """A profile's values at ``x`` as a float array of x's shape (a new array)."""
-    out = profile(x)
-    if isinstance(out, np.ndarray) and out.dtype == np.float64 and out.shape == np.shape(x):
-        # a profile's own answer already has x's shape: skip the broadcast (a solve calls
-        # this ~30 times); the copy keeps callers free to write into the result
-        return out.copy()
-    return np.broadcast_to(np.asarray(out, dtype=float), np.shape(x)).astype(float)

@@ -6,17 +6,8 @@ validates a JSON-like dict and builds a :class:`Scene`; :func:`solve` converts i
 dimensionless problem of :func:`core.solver.solve_dimensionless` and the answer back to a
 :class:`SceneSolution` in SI units.
 
-This module is the public path to the scene: it re-exports what the modules below hold,
-one job each,
-
-- :mod:`core.scene.schema`: schema version and migrations, accepted ranges, validators of
-  single fields;
-- :mod:`core.scene.validate`: :func:`scene_from_dict` and the checks of a whole scene;
-- :mod:`core.scene.model`: the validated :class:`Scene` and what follows from it alone;
-- :mod:`core.scene.dimensionless`: the conversion to the dimensionless problem (its
-  formulas are in that module's docstring);
-- :mod:`core.scene.results`: :class:`SceneSolution` and its JSON and CSV forms;
-- :mod:`core.scene.files`: reading and writing scene files.
+The modules of :mod:`core.scene` say what each holds; :mod:`core.scene` is the public
+path of their names.
 """
 
 from __future__ import annotations
@@ -27,7 +18,8 @@ from typing import Any
 
 import numpy as np
 
-# re-exported: ``from core.scene.pipeline import ...`` is the public path for every name below
+from core.engines.layered import solve_scene_layered
+from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
 from core.scene.results import SceneSolution, _check_finite
 from core.scene.validate import scene_from_dict
@@ -38,9 +30,6 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
 
     Returns a :class:`SceneSolution` in SI units (m, rad, N/m, N, Pa; days after loading).
     """
-    from core.engines.layered import solve_scene_layered
-    from core.scene.load_limits import check_loads_touch
-
     # CPU time of this thread [s] from the dict to the answer, validation included: what
     # the scene costs, whatever else the machine runs (info["seconds"] is the solver's
     # wall time)

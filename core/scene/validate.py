@@ -20,10 +20,10 @@ from core.cache import StageCache, fingerprint
 from core.coating import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
 from core.creep import Elastic, UserKernel, creep_model_from_spec
 from core.problem import QUANTITIES, STATEMENTS
-from core.profiles import Profile
+from core.profiles import Profile, profile_values
 from core.scene import schema
 from core.scene.load_rates import check_step_limit
-from core.scene.model import Layer, Scene, profile_values
+from core.scene.model import Layer, Scene
 from core.scene.schema import (
     _jsonable,
     _poisson,

@@ -1,4 +1,16 @@
-"""core.study.definition."""
+"""Design studies: a base scene and fields to vary, solved in batches on Dask.
+
+``sweep(study)`` (``run.py``) runs a study, resumable from its work directory, and
+returns an xarray Dataset (netCDF, CSV, parquet).
+
+- ``definition.py``: the study file (grids, distributions), validated, and its points;
+- ``points.py``: the points, generated per batch; ``plan.py``: batches sorted by geometry;
+- ``batch.py``: one batch of points (geometry shared, loads varied);
+- ``loads.py``: a batch whose points differ only in their loads, as one combination of
+  unit responses;
+- ``liftoff.py``: a batch of lift-off eccentricities as one family;
+- ``warm.py``: warming Dask workers when a study's cluster starts.
+"""
 
 from __future__ import annotations
 

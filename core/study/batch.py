@@ -24,44 +24,16 @@ import numpy as np
 
 from core.scene import LARGE_TILT, Scene, replace_loads, scene_from_dict, solve
 from core.study.definition import apply_point
+from core.study.liftoff import (
+    FAMILY_MIN_ECCENTRICITIES,
+    family_applies,
+    family_flags,
+    liftoff_family,
+)
+from core.study.loads import _dimensionless_loads, load_batch_applies, solve_load_batch
+from core.study.outputs import point_outputs
 
-__all__ = ["answers_scale_with_loads", "point_outputs", "run_batch"]
-
-
-def _contact_width(x: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Length [m] of the part of ``x`` where ``q(x, t) >= 0``, linear between points, per
-    time (``q`` has shape ``(len(x), n_times)``)."""
-    dx = np.diff(x)[:, None]
-    q0, q1 = q[:-1], q[1:]
-    both = (q0 >= 0) & (q1 >= 0)
-    width = np.sum(np.where(both, dx, 0.0), axis=0)
-    cross = (q0 >= 0) != (q1 >= 0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        share = np.where(q0 >= 0, q0, q1) / (np.abs(q0) + np.abs(q1))
-    return width + np.sum(np.where(cross, dx * share, 0.0), axis=0)
-
-
-def point_outputs(result: Any, outputs: Sequence[str]) -> np.ndarray:
-    """The requested outputs of a :class:`core.scene.SceneSolution`, shape
-    ``(len(outputs), n_times)``, in the units of :data:`core.study.definition.OUTPUT_UNITS`.
-
-    ``q_max``/``q_min`` are the extremes of the pressure on the 201-point plotting grid;
-    ``contact_width`` is where the computed pressure is >= 0 (``2a`` under full contact;
-    less when ``contact_lost`` flags the full-contact answer as unphysical).
-    """
-    rows = []
-    q = result.pressure_on_grid if {"q_max", "q_min", "contact_width"} & set(outputs) \
-        else None
-    for name in outputs:
-        if name in ("settlement", "tilt", "force", "moment"):
-            rows.append(getattr(result, name))
-        elif name == "q_max":
-            rows.append(np.max(q, axis=0))
-        elif name == "q_min":
-            rows.append(np.min(q, axis=0))
-        else:
-            rows.append(_contact_width(result.x, q))
-    return np.asarray(rows, dtype=float)
+__all__ = ["answers_scale_with_loads", "run_batch"]
 
 
 def _load_only_base(base: Mapping[str, Any], paths: Sequence[str]) -> Scene | None:
@@ -188,7 +160,6 @@ def _liftoff_families(validated: Sequence[Scene | None],
     where there are enough of them (:func:`core.study.liftoff.liftoff_family`), filling
     ``solved``; returns the seconds [s] each point of an answered eccentricity is charged
     (the family's time over the points it answered)."""
-    from core.study.liftoff import FAMILY_MIN_ECCENTRICITIES
 
     first: dict[tuple[int, float], int] = {}
     count: dict[tuple[int, float], int] = {}
@@ -227,8 +198,6 @@ def _one_family(scene: Scene, picked: list[tuple[int, float]],
     solved by :func:`core.scene.solve` (they fix the zone ends' range and the topology),
     the ones between by :func:`core.study.liftoff.liftoff_family`. Returns the keys it
     answered (into ``solved``); any doubt leaves the rest one by one."""
-    from core.study.liftoff import family_applies, family_flags, liftoff_family
-    from core.study.loads import _dimensionless_loads
 
     if not family_applies(scene):
         return []
@@ -306,7 +275,6 @@ def run_batch(base: Mapping[str, Any], paths: Sequence[str], values: np.ndarray,
     ``values`` ``(m, len(outputs), n_times)``, ``error_estimate`` (relative, -), ``flags``
     (comma-joined), ``error`` (the message of a failed point, else empty), ``seconds``
     (per point)."""
-    from core.study.loads import load_batch_applies, solve_load_batch
 
     m = len(values)
     out = np.full((m, len(outputs), n_times), np.nan)

@@ -45,6 +45,7 @@ from core.contact import (
 )
 from core.discretize import kernel_operator, operator_rows
 from core.scene import LARGE_TILT, Scene, plotting_grid, scene_model_error
+from core.study.outputs import point_outputs
 
 __all__ = ["FAMILY_MIN_ECCENTRICITIES", "LiftoffAnswer", "liftoff_family"]
 
@@ -310,8 +311,6 @@ def _point_values(problem: Any, a: float, force: float, e: float, settlement: fl
     """The outputs of one point (``q`` the pressure per unit force on the grid ``x``) as
     :func:`core.study.point_outputs` takes them from a
     :class:`core.scene.SceneSolution`, and that point's histories."""
-    from core.study.batch import point_outputs
-
     p_star = _dimensionless_force(problem, force, a)
     n = pressure_scale.size
     result = SimpleNamespace(

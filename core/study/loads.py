@@ -40,8 +40,10 @@ from core.engines.layered import (
     stack_key,
     uniform_layers,
 )
-from core.scene import LARGE_TILT, Scene, plotting_grid, profile_values
+from core.profiles import profile_values
+from core.scene import LARGE_TILT, Scene, plotting_grid
 from core.study.definition import OUTPUT_UNITS
+from core.study.outputs import contact_width
 from core.validation import MAX_MAGNITUDE
 
 __all__ = ["LoadBatch", "load_batch_applies", "solve_load_batch"]
@@ -133,13 +135,6 @@ def _differences(response: LayeredResponse, given: Mapping[str, np.ndarray],
     return out
 
 
-def _contact_width(x: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Length [m] of the part of ``x`` where ``q >= 0``, linear between points, per column."""
-    from core.study.batch import _contact_width as width
-
-    return width(x, q)
-
-
 def _response(scene: Scene, layers: list, modes: int, room: int) -> LayeredResponse:
     """The scene's unit responses on ``modes`` modes, from the caches
     :func:`core.engines.layered.solve_layered` fills (built once per geometry), with the
@@ -220,7 +215,7 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
             elif name == "q_min":
                 rows[:, j, k] = np.min(q, axis=0)
             else:
-                rows[:, j, k] = _contact_width(x, q)
+                rows[:, j, k] = contact_width(x, q)
         keep &= np.all(np.isfinite(q), axis=0)
     # core.scene.pipeline._check_finite refuses a non-finite answer with its message
     keep &= np.all(np.isfinite(rows), axis=(1, 2))

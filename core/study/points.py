@@ -1,6 +1,5 @@
 """The points of a design study (:class:`core.study.Study`) from its description: all of
-them as a table (:func:`point_table`) or any of them on demand (:class:`StudyPoints`), both
-re-exported by :mod:`core.study.definition`.
+them as a table (:func:`point_table`) or any of them on demand (:class:`StudyPoints`).
 
 Order: grid axes in the order of the study (the last fastest), the samples innermost.
 """

@@ -1,4 +1,16 @@
-"""core.time."""
+"""Time stepping of the modal Volterra equations of a creeping base.
+
+``integration.py`` holds ``solve_degenerate`` (kernels that are sums of exponentials)
+and ``solve_general`` (any kernel); the steppers behind them:
+
+- ``exponential.py``, ``exponential_weights.py``, ``exponential_modes.py``: exponential
+  collocation for kernels that are sums of exponentials (the default; error from three
+  grids);
+- ``radau.py``: adaptive Radau IIA, the fallback and the reference;
+- ``product_quadrature.py``: a general kernel by the product trapezoid rule with
+  Richardson extrapolation;
+- ``volterra.py``: the problem and solution types the steppers share.
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,44 @@
-"""The views of the explorer page: one small view per sidebar tab and one for the results.
+"""The views of the explorer page: one small view per sidebar tab, one for the results, and
+the widgets they are made of.
 
-Each view builds its widgets over the session's state objects and knows how to refresh
-them; :mod:`explorer.app` assembles the page from them in one place (``SIDEBAR_VIEWS``).
+Each view is given the model objects it reads and edits (the state, the screen, the
+controller, ...), never the whole session; it builds its widgets over them and knows how
+to refresh them. :mod:`explorer.app` builds the views and assembles the page from them.
+
+- Sidebar tabs: ``scene`` (presets, undo, the loading, with the slider of
+  ``eccentricity``), ``punch``, ``coating`` (with the coating-model check), ``base`` (with
+  ``creep``, the design codes' creep), ``times``, ``check``, ``files``, ``lessons``,
+  ``study``; ``fidelity``: the model-fidelity widgets of the Coating and Time tabs.
+- The results column: ``results`` (messages, plots, player, readout, design check),
+  ``contact`` (the contact figures' slots), ``pins`` (pin, remove, pin every step, pins
+  of a link), ``busy`` (the busy indicator), ``status`` (the status line in words).
+- The page: ``loop`` (the session's document and event loop), ``tabs`` (tabs filled when
+  first opened), ``link`` (the address follows the view), ``style`` (the page's CSS and
+  HTML panes).
+- Widgets: ``widgets`` (widgets bound both ways to the state), ``upload`` (a one-file
+  upload box).
 """
+
+from .base import BaseView
+from .busy import BUSY_AFTER_MS
+from .check import CheckView
+from .coating import CoatingView
+from .fidelity import CONTACT_LABELS, FidelityView
+from .files import FilesView
+from .lessons import LessonsView
+from .link import LINK_EVERY_MS, AddressLink
+from .loop import PageLoop
+from .pins import PinsView
+from .punch import PunchView
+from .results import ResultsView, badges_html, readout_html
+from .scene import SceneView
+from .status import status_html
+from .study import StudyView
+from .style import html_pane
+from .tabs import FILL_TABS_AFTER_MS, DeferredTabs
+from .times import TimesView
+
+__all__ = ["BUSY_AFTER_MS", "CONTACT_LABELS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS", "AddressLink",
+           "BaseView", "CheckView", "CoatingView", "DeferredTabs", "FidelityView", "FilesView",
+           "LessonsView", "PageLoop", "PinsView", "PunchView", "ResultsView", "SceneView",
+           "StudyView", "TimesView", "badges_html", "html_pane", "readout_html", "status_html"]

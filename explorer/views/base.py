@@ -2,17 +2,14 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Callable
 
 import panel as pn
 
-from ..creep_view import CODE_CREEP_MODELS, CodeCreepPanel
-from ..state import CREEP_MODELS
-from ..widgets import Binding, fine_slider, slider
+from ..model import CODE_CREEP_MODELS, CREEP_MODELS, ExplorerState
+from .creep import CodeCreepPanel
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from .widgets import Binding, fine_slider, slider
 
 
 class BaseView:
@@ -20,10 +17,12 @@ class BaseView:
 
     title = "Base"
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
-        s = app.state
-        self.base = Binding(app.reject, live_when=app.fast_solves)
+    def __init__(self, state: ExplorerState, reject: Callable[[str], None],
+                 live_when: Callable[[], bool]) -> None:
+        """``reject``: says why a value was refused; ``live_when``: whether a slider applies
+        each drag step (else its release)."""
+        self.state = s = state
+        self.base = Binding(reject, live_when=live_when)
         bb = self.base
         self.base_thickness = bb.add("thickness", slider("thickness H [m]", 0.1, 20.0, 0.05,
                                                          "0[.]00", css_classes=["base-thickness"]))
@@ -48,7 +47,7 @@ class BaseView:
         bb.bind(s.base)
         s.base.param.watch(lambda *e: self.refresh(), ["creep_model", "custom"])
         # design-code creep (fib MC2010, Eurocode 2): inputs and phi(t, t0) plot
-        self.code_creep = CodeCreepPanel(s.base, Binding(app.reject))
+        self.code_creep = CodeCreepPanel(s.base, Binding(reject))
         self.refresh()
 
     def content(self) -> pn.Column:
@@ -60,7 +59,7 @@ class BaseView:
 
     def refresh(self) -> None:
         """Show the parameters of the chosen creep model only."""
-        base = self.app.state.base
+        base = self.state.base
         model = base.creep_model
         creeps = model in ("exponential", "arutyunyan")
         self.compliance.visible = self.rate.visible = creeps

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import param
 
-from ..status import status_html
+from ..solving import SolveController
+from .loop import PageLoop
+from .status import status_html
 from .style import html_pane
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
 
 #: A solve shows the busy indicator only once it has run this long [ms]. A slider step
 #: is solved in 10-50 ms: its new plots are the feedback, and switching the indicator on
@@ -48,30 +47,31 @@ class BusySpinner(param.Parameterized):
 
 
 class BusyIndicator:
-    """Follows the controller's ``busy`` and ``error`` for the page's spinner and status."""
+    """Follows the controller's ``busy`` for the page's spinner and status line."""
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
+    def __init__(self, controller: SolveController, loop: PageLoop, spinner: BusySpinner,
+                 status: Any) -> None:
+        """``status``: the pane of the status line (it says when a solve is running)."""
+        self.controller = controller
+        self.loop = loop
+        self.spinner = spinner
+        self.status = status
         self.shown = False
         self._due = False
 
-    def on_status(self, *events: object) -> None:
-        """The controller started or finished a solve, or refused a scene."""
-        app = self.app
-        controller = app.controller
-        app.results.show_error(controller.error, controller.view is not None)
-        if not controller.busy:
+    def follow(self, busy: bool) -> None:
+        """The controller started (``busy``) or finished a solve."""
+        if not busy:
             self.show(False)
-            app.link.schedule()  # a link skipped while busy, if no newer result came
-        elif not app.served:  # no event loop to wait on: show it at once
+        elif not self.loop.served:  # no event loop to wait on: show it at once
             self.show(True)
         elif not (self.shown or self._due):
             self._due = True
-            app._later(self._timeout, BUSY_AFTER_MS)
+            self.loop.later(self._timeout, BUSY_AFTER_MS)
 
     def _timeout(self) -> None:
         self._due = False
-        if self.app.controller.busy:
+        if self.controller.busy:
             self.show(True)
 
     def show(self, busy: bool) -> None:
@@ -79,6 +79,5 @@ class BusyIndicator:
         if busy == self.shown:
             return
         self.shown = busy
-        results = self.app.results
-        results.spinner.value = busy
-        results.status.object = status_html(self.app.controller.view, busy)
+        self.spinner.value = busy
+        self.status.object = status_html(self.controller.view, busy)

@@ -2,23 +2,24 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import panel as pn
 
+from ..model import DesignLimits, ExplorerState, Screen
 from .style import TAB_COLUMN, html_pane
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
 
 
 class CheckView:
-    """Inputs of the session's :class:`~explorer.design.DesignLimits` and of e = M/P."""
+    """Inputs of the session's :class:`~explorer.model.design.DesignLimits` and of e = M/P."""
 
     title = "Check"
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
+    def __init__(self, state: ExplorerState, limits: DesignLimits, screen: Screen) -> None:
+        """``limits``: set here; ``screen``: where a refused eccentricity is said."""
+        self.state = state
+        self.limits = limits
+        self.screen = screen
         self.allowable_pressure = self._limit("allowable bearing pressure [kPa]",
                                               "allowable_pressure", "limit-pressure")
         self.settlement_limit = self._limit("settlement limit [mm]", "settlement_limit",
@@ -32,7 +33,7 @@ class CheckView:
     def _limit(self, label: str, name: str, css: str) -> pn.widgets.FloatInput:
         box = pn.widgets.FloatInput(label=label, value=None, start=0,
                                     sizing_mode="stretch_width", css_classes=[css])
-        box.param.watch(lambda e: setattr(self.app.limits, name, e.new), "value")
+        box.param.watch(lambda e: setattr(self.limits, name, e.new), "value")
         return box
 
     def content(self) -> pn.Column:
@@ -46,13 +47,13 @@ class CheckView:
     def _on_eccentricity(self, event: Any) -> None:
         """Set the moment so that M = e P (force and moment given, constant force)."""
         e = event.new
-        loading = self.app.state.loading
+        loading = self.state.loading
         if e is None:
             return
         force = loading.histories["force"]
         if loading.given != ("force", "moment") or force.kind != "constant":
-            self.app.notice = ("Value not accepted: the eccentricity sets the moment when "
-                               "force and moment are given and the force is constant.")
+            self.screen.reject("the eccentricity sets the moment when force and moment are "
+                               "given and the force is constant.")
             return
         moment = loading.histories["moment"]
         moment.param.update(kind="constant", value=float(e) * force.value)

@@ -4,16 +4,19 @@
 from __future__ import annotations
 
 import logging
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
 import panel as pn
 
-from ..state import SCREEN_LAYERS
-from ..widgets import ProfileEditor, PromptIntSlider
-from .style import NOTE_STYLE, TAB_COLUMN, html_pane
+from core.scene import check_scene
 
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from ..model import SCREEN_LAYERS, ExplorerState
+from ..solving import SolveController, worker_processes
+from .fidelity import FidelityView
+from .loop import PageLoop
+from .style import NOTE_STYLE, TAB_COLUMN, html_pane
+from .widgets import ProfileEditor, PromptIntSlider
 
 log = logging.getLogger(__name__)
 
@@ -29,10 +32,14 @@ class CoatingView:
 
     title = "Coating"
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
-        s = app.state
-        live = app.fast_solves
+    def __init__(self, state: ExplorerState, fidelity: FidelityView,
+                 controller: SolveController, loop: PageLoop,
+                 live_when: Callable[[], bool]) -> None:
+        """``fidelity``: its interface selector edits the layer chosen here;
+        ``controller`` and ``loop``: where the coating-model check runs and reports;
+        ``live_when``: whether a slider applies each drag step (else its release)."""
+        self.state = s = state
+        self.fidelity = fidelity
         self.n_layers = PromptIntSlider(label="number of layers", start=1, end=SCREEN_LAYERS,
                                         value=min(s.n_layers, SCREEN_LAYERS),
                                         sizing_mode="stretch_width")
@@ -43,13 +50,13 @@ class CoatingView:
         self.layer.param.watch(lambda *e: self.bind_layer(), "value")
         self.thickness_editor = ProfileEditor("thickness", "mm", 0.5, 50.0, 0.1, "0[.]00",
                                               amplitude=("µm", -1000.0, 1000.0, 0.5),
-                                              css="coating-thickness", live_when=live)
+                                              css="coating-thickness", live_when=live_when)
         self.modulus_editor = ProfileEditor("Young's modulus", "MPa", 1.0, 10000.0, 1.0,
-                                            "0[.]0", live_when=live)
+                                            "0[.]0", live_when=live_when)
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
-                                            variations=False, live_when=live)
+                                            variations=False, live_when=live_when)
         self.layer_note = html_pane("", styles=NOTE_STYLE)
-        self.check = CoatingCheckView(app)
+        self.check = CoatingCheckView(state, controller, loop)
         s.param.watch(lambda *e: self.refresh(), "n_layers")
         self.refresh()
 
@@ -60,11 +67,11 @@ class CoatingView:
                       "a slider.</small>"),
             self.n_layers, self.layer, self.layer_note, self.thickness_editor.panel,
             self.modulus_editor.panel, self.poisson_editor.panel,
-            self.app.fidelity.interface_panel, self.check.panel, **TAB_COLUMN)
+            self.fidelity.interface_panel, self.check.panel, **TAB_COLUMN)
 
     def refresh(self) -> None:
         """Offer one button per layer on screen; say so when the scene has more."""
-        n = self.app.state.n_layers
+        n = self.state.n_layers
         shown = min(n, SCREEN_LAYERS)
         options = [str(k + 1) for k in range(shown)]
         if self.layer.value not in options:
@@ -78,13 +85,13 @@ class CoatingView:
 
     def bind_layer(self) -> None:
         """Point the editors at the layer chosen."""
-        state = self.app.state
+        state = self.state
         layer = state.layers[int(self.layer.value) - 1]
         a = state.punch.half_width
         self.thickness_editor.bind(layer.thickness, a)
         self.modulus_editor.bind(layer.modulus, a)
         self.poisson_editor.bind(layer.poisson, a)
-        self.app.fidelity.bind_layer(layer)
+        self.fidelity.bind_layer(layer)
 
 
 def check_report_html(report: dict[str, Any]) -> str:
@@ -118,8 +125,11 @@ class CoatingCheckView:
     of the solver pool; never the page's event loop), shows a progress bar meanwhile and
     the report when it is done."""
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
+    def __init__(self, state: ExplorerState, controller: SolveController,
+                 loop: PageLoop) -> None:
+        self.state = state
+        self.controller = controller
+        self.loop = loop
         self.button = pn.widgets.Button(label="check the coating model",
                                         sizing_mode="stretch_width",
                                         css_classes=["coating-check-button"])
@@ -137,21 +147,21 @@ class CoatingCheckView:
     def run(self) -> None:
         """Start the check of the current scene (the outcome arrives by :meth:`show`)."""
         try:
-            scene = self.app.state.to_scene()
+            scene = self.state.to_scene()
         except ValueError as exc:
             self.result.object = f"<span class='cp-msg'>Not checked: {exc}</span>"
             return
         self.button.disabled = True
         self.progress.visible = True
         self.result.object = "<small>Solving the resolved model…</small>"
-        executor = self.app.controller.executor
+        executor = self.controller.executor
         if executor is None:
             self.show(_check(scene))
         else:
             executor.submit(lambda: self._finish(_check(scene)))
 
     def _finish(self, outcome: dict[str, Any] | str) -> None:
-        self.app._dispatch(lambda: self.show(outcome))
+        self.loop.dispatch(lambda: self.show(outcome))
 
     def show(self, outcome: dict[str, Any] | str) -> None:
         """Show a report (dict) or a message (str) and make the button ready again."""
@@ -163,10 +173,6 @@ class CoatingCheckView:
 
 def _check(scene: dict[str, Any]) -> dict[str, Any] | str:
     """The check's report, or why there is none (runs off the event loop)."""
-    from core.scene import check_scene
-
-    from ..controller import worker_processes
-
     try:
         processes = worker_processes()
         if processes is not None:

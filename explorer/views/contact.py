@@ -12,9 +12,8 @@ from typing import Any
 
 import panel as pn
 
-from ..contact_zone import lifts_off
+from ..model import ResultView, lifts_off
 from ..plots import Figures
-from ..results import ResultView
 
 
 class ContactPanes:

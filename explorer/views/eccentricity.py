@@ -7,19 +7,19 @@ the e of the scene on screen whatever set it (a preset, a file, the moment's own
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
 import panel as pn
 
-from ..widgets import _set_widget, slider
+from ..model import ExplorerState
+from ..solving import SolveController
 from .style import NOTE_STYLE, html_pane
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from .widgets import _set_widget, slider
 
 #: Drag steps of the slider are applied at once while the last solve took less than this
 #: [s] of CPU time; slower, the moment is set on release. The speed goal of a lift-off
-#: scene under creep (issue 13: 100 output times in 200 ms) is what keeps this slider
+#: scene under creep (100 output times in 200 ms) is what keeps this slider
 #: live; the solver keeps one pending request, so a step taking longer than a frame is
 #: not lost. CPU, not wall time: on the shared 2-core machine at load 4-8, moment steps
 #: of the eccentric-footing lesson took 115-150 ms CPU but 150-310 ms wall, so on wall
@@ -39,25 +39,30 @@ NOT_APPLICABLE = ("The eccentricity sets the moment when force and moment are gi
 class EccentricityControl:
     """A slider of e = M/P [m] bound to the loading of the session's state."""
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
+    def __init__(self, state: ExplorerState, controller: SolveController,
+                 reject: Callable[[str], None]) -> None:
+        """``controller``: its last solve's time decides whether drag steps apply;
+        ``reject``: says why a value was refused."""
+        self.state = state
+        self.controller = controller
+        self.reject = reject
         self.slider = slider("eccentricity e = M/P [m] (sets the moment)", -1.0, 1.0, 0.01,
                              "0[.]000", css_classes=["eccentricity-slider"])
         self.note = html_pane("", styles=NOTE_STYLE, visible=False)
         self._syncing = False
         self.slider.param.watch(self._on_drag, "value")
         self.slider.param.watch(self._on_release, "value_throttled")
-        loading = app.state.loading
+        loading = state.loading
         for q in ("force", "moment"):
             loading.histories[q].param.watch(self.refresh, ["kind", "value"])
         loading.param.watch(self.refresh, "statement")
-        app.state.punch.param.watch(self.refresh, "half_width")
+        state.punch.param.watch(self.refresh, "half_width")
         self.panel = pn.Column(self.slider, self.note, sizing_mode="stretch_width", margin=0)
         self.refresh()
 
     def applicable(self) -> bool:
         """Whether the slider can set the moment (constant force P > 0 and M given)."""
-        loading = self.app.state.loading
+        loading = self.state.loading
         force = loading.histories["force"]
         return (loading.given == ("force", "moment") and force.kind == "constant"
                 and force.value > 0)
@@ -66,12 +71,12 @@ class EccentricityControl:
         """e = M/P [m] of the state (the moment's main level), None when not defined."""
         if not self.applicable():
             return None
-        loading = self.app.state.loading
+        loading = self.state.loading
         return loading.histories["moment"].value / loading.histories["force"].value
 
     def refresh(self, *events: Any) -> None:
         """Follow the state: the range (the half-width), the value, enabled or not."""
-        a = self.app.state.punch.half_width
+        a = self.state.punch.half_width
         self.slider.param.update(start=-SLIDER_SPAN * a, end=SLIDER_SPAN * a)
         e = self.eccentricity()
         # not applicable: the note says why, without a dead slider taking the room
@@ -89,28 +94,20 @@ class EccentricityControl:
                 self._syncing = False
 
     def _on_drag(self, event: Any) -> None:
-        if self._fast():
+        if self.controller.solved_within(LIVE_SOLVE_S):
             self.apply(event.new)
 
     def _on_release(self, event: Any) -> None:
         self.apply(event.new)
-
-    def _fast(self) -> bool:
-        view = self.app.controller.view
-        if view is None:
-            return False
-        # a result kept from before the CPU time was recorded has its wall time only
-        seconds = view.info.get("cpu_seconds", view.info.get("seconds"))
-        return isinstance(seconds, (int, float)) and seconds < LIVE_SOLVE_S
 
     def apply(self, e: float | None) -> None:
         """Set the moment M = e P [kN·m/m] (constant) for the eccentricity ``e`` [m]."""
         if self._syncing or e is None:
             return
         if not self.applicable():
-            self.app.reject(NOT_APPLICABLE)
+            self.reject(NOT_APPLICABLE)
             return
-        loading = self.app.state.loading
+        loading = self.state.loading
         moment = loading.histories["moment"]
         value = float(e) * loading.histories["force"].value
         if moment.kind != "constant" or moment.value != value:

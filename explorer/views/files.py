@@ -6,21 +6,27 @@ import asyncio
 import html
 import io
 import json
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
 import panel as pn
 
-from core.scene import MAX_SCENE_BYTES
+from core.scene import MAX_SCENE_BYTES, read_scene_json
 
-from .. import exports
-from ..report import report_html
-from ..results import ResultView
-from ..state import MAX_DESCRIPTION_CHARS, MAX_NAME_CHARS, check_text
-from ..widgets import Binding, BoundedUpload
+from ..files import histories_csv, pressure_csv, report_html
+from ..model import (
+    MAX_DESCRIPTION_CHARS,
+    MAX_NAME_CHARS,
+    DesignLimits,
+    DisplayScales,
+    ExplorerState,
+    ResultView,
+    Screen,
+    check_text,
+)
+from ..solving import SolveController
 from .style import TAB_COLUMN, html_pane, slug
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from .widgets import Binding, BoundedUpload
 
 
 class FilesView:
@@ -28,10 +34,23 @@ class FilesView:
 
     title = "Files"
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
-        s = app.state
-        self.naming = Binding(app.reject, live_when=app.fast_solves)
+    def __init__(self, state: ExplorerState, screen: Screen, controller: SolveController,
+                 scales: DisplayScales, limits: DesignLimits,
+                 load_scene: Callable[[dict[str, Any]], bool],
+                 show_error: Callable[[str], None]) -> None:
+        """``screen``: the result the downloads hold, and where a refused file is said;
+        ``controller``: solves the JSON download again; ``scales`` and ``limits``: the
+        units and the design check of the files; ``load_scene``: shows a scene read from
+        a file (False if refused); ``show_error``: says on the page why a download
+        failed."""
+        self.state = s = state
+        self.screen = screen
+        self.controller = controller
+        self.scales = scales
+        self.limits = limits
+        self.load_scene = load_scene
+        self.show_error = show_error
+        self.naming = Binding(screen.reject)
         self.scene_name = self.naming.add("scene_name", pn.widgets.TextInput(
             label="scene name", sizing_mode="stretch_width", max_length=MAX_NAME_CHARS,
             css_classes=["scene-name"]),
@@ -95,14 +114,12 @@ class FilesView:
             self.load_file.clear()
 
     def _read_scene_file(self, data: bytes) -> None:
-        from core.scene import read_scene_json
-
-        app = self.app
+        screen = self.screen
         # the same limit as the command line: a browser may send up to the websocket's
         # message size, and parsing costs memory and time on the shared server
         if len(data) > MAX_SCENE_BYTES:
-            app.notice = (f"The file {self.load_file.filename!r} is too large ({len(data)} "
-                          f"bytes; a scene file has at most {MAX_SCENE_BYTES})")
+            screen.notice = (f"The file {self.load_file.filename!r} is too large ({len(data)} "
+                             f"bytes; a scene file has at most {MAX_SCENE_BYTES})")
             return
         name = self.load_file.filename or "the file"
         try:
@@ -110,56 +127,53 @@ class FilesView:
             # read as the command line reads it: a repeated field is refused, not dropped
             scene = read_scene_json(text, repr(name))
         except UnicodeDecodeError:
-            app.notice = f"The file {name!r} is not text in UTF-8 (a scene file is JSON)."
+            screen.notice = f"The file {name!r} is not text in UTF-8 (a scene file is JSON)."
             return
         except ValueError as exc:
-            app.notice = f"The file {exc}"
+            screen.notice = f"The file {exc}"
             return
         if not isinstance(scene, dict):
-            app.notice = "The file does not hold a scene (a JSON object)."
+            screen.notice = "The file does not hold a scene (a JSON object)."
             return
-        if app.load_scene(scene):
-            app.preset.value = ""
+        self.load_scene(scene)
 
     # -- downloads -------------------------------------------------------------------
     def _scene_file(self) -> io.StringIO:
-        view = self.app.shown()
-        scene = view.scene if view is not None else self.app.state.to_scene()
+        view = self.screen.shown()
+        scene = view.scene if view is not None else self.state.to_scene()
         return io.StringIO(json.dumps(scene, indent=2) + "\n")
 
     async def _download(self, kind: str, empty: str) -> io.StringIO:
         # awaited, not waited for: the worker's answer must not hold the event loop, and
         # with it every page of the server
-        view = self.app.shown()
+        view = self.screen.shown()
         if view is None:
             return io.StringIO(empty)
         try:
             return io.StringIO(await asyncio.wrap_future(
-                self.app.controller.download_later(view, kind)))
+                self.controller.download_later(view, kind)))
         except Exception as exc:
             # no file is better than a wrong one; say why on the page
-            alert = self.app.alert
-            alert.object = f"**Download failed:** {html.escape(str(exc))}"
-            alert.visible = True
+            self.show_error(f"**Download failed:** {html.escape(str(exc))}")
             raise
 
     def _csv_file(self) -> io.StringIO:
-        view = self.app.shown()
-        return io.StringIO(exports.histories_csv(view) if view is not None else "")
+        view = self.screen.shown()
+        return io.StringIO(histories_csv(view) if view is not None else "")
 
     def _pressure_file(self) -> io.StringIO:
-        view = self.app.shown()
+        view = self.screen.shown()
         if view is None:
             return io.StringIO("")
-        return io.StringIO(exports.pressure_csv(view, self.app.scales.pressure_unit(view)))
+        return io.StringIO(pressure_csv(view, self.scales.pressure_unit(view)))
 
     async def _json_file(self) -> io.StringIO:
         return await self._download("to_json", "{}")
 
     def _report_file(self) -> io.StringIO:
-        view = self.app.shown()
+        view = self.screen.shown()
         if view is None:
             return io.StringIO("")
-        index = min(self.app.time_index, len(view.times) - 1)
-        return io.StringIO(report_html(view, self.app.limits, index,
-                                       self.app.scales.pressure_unit(view)))
+        index = min(self.screen.time_index, len(view.times) - 1)
+        return io.StringIO(report_html(view, self.limits, index,
+                                       self.scales.pressure_unit(view)))

@@ -3,15 +3,14 @@
 from __future__ import annotations
 
 import html
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import Any
 
 import panel as pn
 
-from ..lessons import Lesson, lessons, step_scene
+from ..model import Lesson, lessons, step_scene
+from .pins import PinsView
 from .style import TAB_COLUMN, html_pane
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
 
 
 class LessonsView:
@@ -19,8 +18,13 @@ class LessonsView:
 
     title = "Lessons"
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
+    def __init__(self, pins: PinsView, log_time: pn.widgets.Checkbox,
+                 load_scene: Callable[[dict[str, Any]], bool]) -> None:
+        """``pins``: a step left stays pinned; ``log_time``: the histories' log time
+        axis, which a step may switch; ``load_scene``: shows a step's scene."""
+        self.pins = pins
+        self.log_time = log_time
+        self.load_scene = load_scene
         self.lessons = lessons()
         self.lesson: Lesson | None = None
         self.step = 0
@@ -53,7 +57,7 @@ class LessonsView:
         if self.lesson is None:
             self.previous_button.disabled = self.next_button.disabled = True
             return
-        self.app.pins.unpin()
+        self.pins.unpin()
         self.go(0, pin=False)
 
     def go(self, index: int, pin: bool = True) -> None:
@@ -62,12 +66,12 @@ class LessonsView:
         if lesson is None or not 0 <= index < len(lesson.steps):
             return
         if pin and lesson.pin_steps and index > self.step:
-            self.app.pins.pin()
+            self.pins.pin()
         step = lesson.steps[index]
         self.step = index
         if step.log_time is not None:
-            self.app.results.log_time.value = step.log_time
-        self.app.load_scene(step_scene(lesson, index))
+            self.log_time.value = step.log_time
+        self.load_scene(step_scene(lesson, index))
         self.previous_button.disabled = index == 0
         self.next_button.disabled = index == len(lesson.steps) - 1
         self.lesson_note.object = (

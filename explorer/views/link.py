@@ -4,12 +4,14 @@ Study tab's settings."""
 from __future__ import annotations
 
 import logging
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import Any
 
-from ..view_link import view_query
+import panel as pn
 
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from ..model import Screen, view_query
+from ..solving import SolveController
+from .loop import PageLoop
 
 log = logging.getLogger(__name__)
 
@@ -21,32 +23,45 @@ LINK_EVERY_MS = 1000
 class AddressLink:
     """Writes a link that reproduces the view into the page's address bar, calmly."""
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
+    def __init__(self, screen: Screen, controller: SolveController, loop: PageLoop,
+                 location: Any, view_parts: Callable[[], tuple[int, list[Any], Any]]) -> None:
+        """``screen``: the result and time on screen; ``controller``: a link waits while a
+        newer result is coming; ``location``: the page's address (None: not served, no
+        link); ``view_parts``: the open tab, the pinned scenes and the Study tab's
+        settings, asked when the link is written."""
+        self.screen = screen
+        self.controller = controller
+        self.loop = loop
+        self.location = location
+        self.view_parts = view_parts
         self._due = False
         self.linked = ""
+        # The address bar is written by the page itself when this hidden box changes:
+        # Panel's location model delayed an update until the next one (its push waits
+        # for the document's first idle signal, which a replaced view never sees).
+        self.address = pn.widgets.TextInput(value="", visible=False)
+        self.address.jscallback(value="if (cb_obj.value) { window.history.replaceState("
+                                      "null, '', cb_obj.value) }")
 
     def schedule(self) -> None:
         """Update the address within :data:`LINK_EVERY_MS` (one update per interval)."""
-        app = self.app
-        if app._location is not None and app.shown() is not None and not self._due:
+        if self.location is not None and self.screen.shown() is not None and not self._due:
             self._due = True
-            app._later(self.update, LINK_EVERY_MS)
+            self.loop.later(self.update, LINK_EVERY_MS)
 
     def update(self) -> None:
         """Put the view on screen into the page's address (a link that reproduces it)."""
         self._due = False
-        app = self.app
-        view = app.shown()
-        if view is None or app._location is None or app.controller.busy:
+        view = self.screen.shown()
+        if view is None or self.location is None or self.controller.busy:
             return  # a newer result is coming, and will ask again
         try:
-            query = view_query(view.scene, app.time_index, app.sidebar.active,
-                               app.pins.board.scenes(), app.study_settings())
+            tab, pins, study = self.view_parts()
+            query = view_query(view.scene, self.screen.time_index, tab, pins, study)
             # the whole query at once: the values are URL-safe already (base64url, digits)
             link = "?" + "&".join(f"{k}={v}" for k, v in query.items() if v)
             if link != self.linked:
-                app.results._address.value = link
+                self.address.value = link
                 self.linked = link
         except Exception:  # the link is a convenience; the page must not fail for it
             log.exception("could not update the link")

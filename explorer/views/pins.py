@@ -4,27 +4,35 @@ over a range, and pins from a link."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import panel as pn
 
-from ..controller import SolveController, format_error
-from ..pins import MAX_PINS, PinBoard
-from ..state import QUANTITY_UNITS, ExplorerState
-from ..widgets import NAMES
-from .style import html_pane
+from core import scene_from_dict
 
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
-    from ..results import ResultView
+from ..model import MAX_PINS, QUANTITY_UNITS, ExplorerState, PinBoard, ResultView, Screen
+from ..plots import PIN_COLORS
+from ..solving import SolveController, format_error
+from .loop import PageLoop
+from .style import html_pane
+from .widgets import NAMES
 
 
 class PinsView:
     """Results kept on the plots for comparison, each named after what differs."""
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
+    def __init__(self, state: ExplorerState, screen: Screen, controller: SolveController,
+                 loop: PageLoop, on_change: Callable[[], None]) -> None:
+        """``screen``: the result a pin keeps, and where a refused pin is said;
+        ``controller`` and ``loop``: where the pins of a link are solved; ``on_change``:
+        called when the pins changed (the page draws them)."""
+        self.state = state
+        self.screen = screen
+        self.controller = controller
+        self.loop = loop
+        self.on_change = on_change
         self.board = PinBoard()
         self.pin_button = pn.widgets.Button(label="Pin this result", color="default",
                                             css_classes=["pin-button"])
@@ -66,7 +74,7 @@ class PinsView:
     # -- actions ---------------------------------------------------------------------
     def pin(self) -> None:
         """Keep the result on screen for comparison with the next ones."""
-        view = self.app.shown()
+        view = self.screen.shown()
         if view is not None and self.board.add(view):
             self.redraw()
 
@@ -89,7 +97,7 @@ class PinsView:
 
     def stepped_quantity(self) -> str:
         """The load the steps change: the first given quantity (the first load slider)."""
-        return self.app.state.loading.given[0]
+        return self.state.loading.given[0]
 
     def _name_steps(self) -> None:
         quantity = self.stepped_quantity()
@@ -99,7 +107,7 @@ class PinsView:
             self.steps_label.object = text
         if self.step_from.value is None and self.step_to.value is None:
             # around the value on screen, to start from
-            value = float(self.app.state.loading.histories[quantity].value)
+            value = float(self.state.loading.histories[quantity].value)
             self.step_from.value, self.step_to.value = (0.5 * value, 1.5 * value) if value \
                 else (0.0, 1.0)
 
@@ -107,7 +115,7 @@ class PinsView:
         try:
             self.pin_steps(self.step_count.value, self.step_from.value, self.step_to.value)
         except ValueError as exc:
-            self.app.notice = f"Steps not pinned: {exc}"
+            self.screen.notice = f"Steps not pinned: {exc}"
 
     def pin_steps(self, count: int | None, start: float | None, end: float | None) -> None:
         """Replace the pins by ``count`` results whose stepped load (see
@@ -124,7 +132,7 @@ class PinsView:
             raise ValueError(f"from and to: the same value ({start}) gives one result, "
                              "not steps")
         quantity = self.stepped_quantity()
-        scene = self.app.state.to_scene()
+        scene = self.state.to_scene()
         scenes = []
         for value in np.linspace(float(start), float(end), int(count)):
             state = ExplorerState()
@@ -143,8 +151,6 @@ class PinsView:
                         what: str = "A pinned result in the link was not used") -> None:
         """Solve the pinned scenes of a link (off the page's thread), then pin them in
         the link's order; a scene refused is named in a notice starting with ``what``."""
-        from core import scene_from_dict
-
         self._expected = len(scenes)
         for slot, scene in enumerate(scenes):
             state = ExplorerState()
@@ -152,11 +158,11 @@ class PinsView:
                 scene_from_dict(scene)
                 state.load_scene(scene)
             except ValueError as exc:
-                self.app.notice = f"{what}: {format_error(str(exc))}"
+                self.screen.notice = f"{what}: {format_error(str(exc))}"
                 self._arrived(slot, None)
                 continue
-            controller = SolveController(state, executor=self.app.controller.executor,
-                                         dispatch=self.app._dispatch, auto=False)
+            controller = SolveController(state, executor=self.controller.executor,
+                                         dispatch=self.loop.dispatch, auto=False)
             controller.param.watch(lambda e, slot=slot: self._arrived(slot, e.new), "view")
             controller.param.watch(lambda e, slot=slot: e.new and self._arrived(slot, None),
                                    "error")
@@ -177,23 +183,12 @@ class PinsView:
 
     # -- drawing -----------------------------------------------------------------------
     def redraw(self) -> None:
-        """Draw the pins on the figures, the readout and the list; update the link."""
-        app = self.app
+        """Show the list of pins, then let the page draw them."""
         self._show_list()
-        view = app.shown()
-        if view is not None:
-            with pn.io.hold():
-                app.figures.show_pinned(view, self.board.pins, app.time_index)
-                if app.results.time_axis.on:
-                    app.results.time_axis.fit()
-                app.results.show_time_texts(view, app.time_index)
-            app.results.push()
-        app.link.schedule()
+        self.on_change()
 
     def _show_list(self) -> None:
         """One remove button per pin, coloured and named as in the legend."""
-        from ..pin_plots import PIN_COLORS
-
         self.unpin_button.disabled = not self.board.pins
         buttons = []
         for k, pin in enumerate(self.board.pins):

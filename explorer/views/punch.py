@@ -3,18 +3,17 @@
 from __future__ import annotations
 
 import html
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
 import panel as pn
 
-from core.profiles import MAX_TABLE_BYTES
+from core.profiles import MAX_TABLE_BYTES, profile_from_csv
 
-from ..controller import format_error
-from ..widgets import Binding, BoundedUpload, fine_slider, slider
+from ..model import ExplorerState, Screen
+from ..solving import format_error
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from .widgets import Binding, BoundedUpload, fine_slider, slider
 
 SHAPES = {
     "flat": "flat", "crowned (parabolic, radius R)": "parabolic",
@@ -28,10 +27,13 @@ class PunchView:
 
     title = "Punch"
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
-        s = app.state
-        self.punch = Binding(app.reject, live_when=app.fast_solves)
+    def __init__(self, state: ExplorerState, screen: Screen,
+                 live_when: Callable[[], bool]) -> None:
+        """``screen``: where a refused value or shape table is said; ``live_when``: whether
+        a slider applies each drag step (else its release)."""
+        self.state = s = state
+        self.screen = screen
+        self.punch = Binding(screen.reject, live_when=live_when)
         pb = self.punch
         self.half_width = pb.add("half_width", slider("half-width a [m]", 0.1, 5.0, 0.01,
                                                       css_classes=["punch-half-width"]))
@@ -73,7 +75,7 @@ class PunchView:
 
     def refresh(self) -> None:
         """Show the sliders of the chosen shape only."""
-        p = self.app.state.punch
+        p = self.state.punch
         a = p.half_width
         self.step_position.param.update(start=-a, end=a)
         shape = p.shape
@@ -95,18 +97,15 @@ class PunchView:
         data = event.new
         if not data:
             return
-        from core.profiles import profile_from_csv
-
-        app = self.app
-        a = app.state.punch.half_width
+        a = self.state.punch.half_width
         try:
             profile = profile_from_csv(data, field="punch.shape", variable="x",
                                        domain=(-a, a))
         except ValueError as exc:
-            app.notice = f"The shape table was not used: {format_error(str(exc))}"
+            self.screen.notice = f"The shape table was not used: {format_error(str(exc))}"
             return
         finally:
             self.shape_file.clear()
-        app.notice = ""
-        app.state.punch.param.update(custom=profile.spec, shape="custom",
-                                     custom_label=self.shape_file.filename or "a CSV file")
+        self.screen.notice = ""
+        self.state.punch.param.update(custom=profile.spec, shape="custom",
+                                      custom_label=self.shape_file.filename or "a CSV file")

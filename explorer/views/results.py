@@ -4,27 +4,34 @@ from __future__ import annotations
 
 import html
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import panel as pn
 import param
 
-from .. import exports
-from ..contact_zone import contact_text, lifts_off
-from ..design import check_html, design_check
-from ..pin_plots import PIN_COLORS
-from ..pins import Pin
-from ..results import ResultView
-from ..state import QUANTITIES, QUANTITY_UNITS
-from ..status import status_html
-from ..time_axis import LogTime
-from ..widgets import NAMES
-from .busy import BusySpinner
+from ..files import flag_message
+from ..model import (
+    QUANTITIES,
+    QUANTITY_UNITS,
+    DesignLimits,
+    Pin,
+    ResultView,
+    Screen,
+    check_html,
+    contact_text,
+    design_check,
+    lifts_off,
+)
+from ..plots import PIN_COLORS, Figures, LogTime
+from ..solving import SolveController
+from .busy import BusyIndicator, BusySpinner
 from .contact import ContactPanes
+from .link import AddressLink
+from .loop import PageLoop
+from .pins import PinsView
+from .status import status_html
 from .style import html_pane
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from .widgets import NAMES
 
 #: Which validity flags are shown next to which plot.
 BADGES: dict[str, dict[str, tuple[str, str]]] = {
@@ -57,7 +64,7 @@ def badges_html(view: ResultView | None, group: str) -> str:
         if lifted and flag == "contact_lost":
             continue
         if flag in view.flags:
-            message = html.escape(exports.flag_message(view, flag))
+            message = html.escape(flag_message(view, flag))
             parts.append(f'<span class="cp-badge cp-bad flag-{flag}" title="{message}">'
                          f"⚠ {bad}</span><span class='cp-msg'>{message}</span>")
         elif good:
@@ -102,16 +109,29 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
 class ResultsView:
     """The page's main column: what the result on screen is, and how far to trust it."""
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
+    def __init__(self, screen: Screen, controller: SolveController, loop: PageLoop,
+                 figures: Figures, limits: DesignLimits, pins: PinsView,
+                 link: AddressLink) -> None:
+        """``screen``: the result and time shown, and the notice; ``controller``: its
+        refusals and busy spells are shown here; ``figures``: the plots of the column;
+        ``limits``: the design check's; ``pins``: their buttons sit by the readout, their
+        results on the plots; ``link``: its hidden address box is part of the column."""
+        self.screen = screen
+        self.controller = controller
+        self.loop = loop
+        self.figures = figures
+        self.limits = limits
+        self.pins = pins
+        self.link = link
         self.alert = pn.pane.Alert("", alert_type="danger", visible=False,
                                    sizing_mode="stretch_width", css_classes=["solve-error"])
-        self.notice_alert = pn.pane.Alert(html.escape(app.notice), alert_type="warning",
-                                          visible=bool(app.notice),
+        self.notice_alert = pn.pane.Alert(html.escape(screen.notice), alert_type="warning",
+                                          visible=bool(screen.notice),
                                           sizing_mode="stretch_width",
                                           css_classes=["notice"])
         self.spinner = BusySpinner()
         self.status = html_pane("", sizing_mode="stretch_width", margin=(5, 5))
+        self.busy = BusyIndicator(controller, loop, self.spinner, self.status)
         badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
         self.scene_badges = html_pane("", **badge)
         self.pressure_badges = html_pane("", **badge)
@@ -122,12 +142,6 @@ class ResultsView:
         self.time_label = html_pane("", margin=(12, 10))
         self.readout = html_pane("", sizing_mode="stretch_width")
         self.design = html_pane("", sizing_mode="stretch_width", css_classes=["design-pane"])
-        # The address bar is written by the page itself when this hidden box changes:
-        # Panel's location model delayed an update until the next one (its push waits
-        # for the document's first idle signal, which a replaced view never sees).
-        self._address = pn.widgets.TextInput(value="", visible=False)
-        self._address.jscallback(value="if (cb_obj.value) { window.history.replaceState("
-                                       "null, '', cb_obj.value) }")
         self.classical = pn.widgets.Checkbox(label="classical solutions on q(x)",
                                              css_classes=["classical-toggle"])
         self.classical.param.watch(self._on_classical, "value")
@@ -135,10 +149,10 @@ class ResultsView:
         self.log_time = pn.widgets.Checkbox(label="log time axis", css_classes=["log-time"],
                                             margin=(5, 10))
         self.log_time.param.watch(self._on_log_time, "value")
-        self.time_axis = LogTime([app.figures.history_fig[q] for q in QUANTITIES])
-        app.limits.param.watch(lambda *e: self.show_design(), list(
-            n for n in app.limits.param if n != "name"))
-        f = app.figures
+        self.time_axis = LogTime([figures.history_fig[q] for q in QUANTITIES])
+        limits.param.watch(lambda *e: self.show_design(), list(
+            n for n in limits.param if n != "name"))
+        f = figures
         bokeh = {"sizing_mode": "stretch_width", "margin": (0, 5)}
         self._bokeh_panes = [pn.pane.Bokeh(fig, **bokeh) for fig in (
             f.scene_fig, f.q_fig, f.image_fig, *(f.history_fig[q] for q in QUANTITIES))]
@@ -148,7 +162,7 @@ class ResultsView:
         """The main column of the page."""
         scene_pane, q_pane, image_pane, *history_panes = self._bokeh_panes
         return pn.Column(
-            self._address,
+            self.link.address,
             self.notice_alert,
             self.alert,
             pn.Row(self.spinner.pane, self.status, sizing_mode="stretch_width"),
@@ -158,7 +172,7 @@ class ResultsView:
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
-            pn.Row(self.readout, pn.Column(self.app.pins.content(), self.classical),
+            pn.Row(self.readout, pn.Column(self.pins.content(), self.classical),
                    sizing_mode="stretch_width"),
             self.design,
             pn.Row(self.history_badges, self.log_time, sizing_mode="stretch_width"),
@@ -169,17 +183,16 @@ class ResultsView:
 
     def draw(self, view: ResultView, index: int, new_range: bool) -> None:
         """Show a new result at output time ``index`` (call inside ``pn.io.hold()``)."""
-        app = self.app
-        app.figures.show(view, index, app.pins.board.pins)
+        self.figures.show(view, index, self.pins.board.pins)
         self.contact_panes.update(view)
         if new_range:
             self._replace_player(max(len(view.times) - 1, 1), index)
         else:
             self.player.value = index
-        with param.discard_events(app):
-            app.time_index = index
+        with param.discard_events(self.screen):
+            self.screen.time_index = index
         self.show_time_texts(view, index)
-        self.status.object = status_html(view, app.busy_shown)
+        self.status.object = status_html(view, self.busy.shown)
         self.scene_badges.object = badges_html(view, "scene")
         self.pressure_badges.object = badges_html(view, "pressure")
         self.history_badges.object = badges_html(view, "history")
@@ -192,12 +205,38 @@ class ResultsView:
         """The time label and the readout at output time ``index``."""
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{float(view.times[index]):.4g} days</span>")
-        self.readout.object = readout_html(view, index, self.app.pins.board.pins)
+        self.readout.object = readout_html(view, index, self.pins.board.pins)
 
     def show_design(self) -> None:
         """The design check of the result on screen against the session's limits."""
-        view = self.app.shown()
-        self.design.object = check_html(design_check(view, self.app.limits)) if view else ""
+        view = self.screen.shown()
+        self.design.object = check_html(design_check(view, self.limits)) if view else ""
+
+    def show_pins(self) -> None:
+        """Draw the pins on the figures and in the readout (they changed)."""
+        view = self.screen.shown()
+        if view is None:
+            return
+        index = self.screen.time_index
+        with pn.io.hold():
+            self.figures.show_pinned(view, self.pins.board.pins, index)
+            if self.time_axis.on:
+                self.time_axis.fit()
+            self.show_time_texts(view, index)
+        self.push()
+
+    def on_status(self, *events: object) -> None:
+        """The controller started or finished a solve, or refused a scene."""
+        controller = self.controller
+        self.show_error(controller.error, controller.view is not None)
+        self.busy.follow(controller.busy)
+        if not controller.busy:
+            self.link.schedule()  # a link skipped while busy, if no newer result came
+
+    def show_download_error(self, text: str) -> None:
+        """Say why a download failed (Markdown, user text escaped)."""
+        self.alert.object = text
+        self.alert.visible = True
 
     def show_error(self, error: str, has_view: bool) -> None:
         """The solver's refusal (empty: none), and what the plots show meanwhile."""
@@ -214,9 +253,9 @@ class ResultsView:
             pane.styles = {"font-size": size} if on else {}
 
     def _on_classical(self, event: Any) -> None:
-        app = self.app
         with pn.io.hold():
-            app.figures.set_classical(app.shown(), app.time_index, bool(event.new))
+            self.figures.set_classical(self.screen.shown(), self.screen.time_index,
+                                       bool(event.new))
         self.push()
 
     def _on_log_time(self, event: Any) -> None:
@@ -229,7 +268,7 @@ class ResultsView:
                                    loop_policy="once", show_loop_controls=False,
                                    sizing_mode="stretch_width", show_value=False,
                                    css_classes=["time-player"])
-        player.param.watch(lambda e: setattr(self.app, "time_index", int(e.new)), "value")
+        player.param.watch(lambda e: setattr(self.screen, "time_index", int(e.new)), "value")
         return player
 
     def _replace_player(self, end: int, value: int) -> None:
@@ -241,5 +280,5 @@ class ResultsView:
 
     def push(self) -> None:
         """In a notebook, plain Bokeh models changed in place must be pushed by hand."""
-        if not self.app.served and self._bokeh_panes:
+        if not self.loop.served and self._bokeh_panes:
             pn.io.push_notebook(*self._bokeh_panes)

@@ -2,18 +2,16 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
 import panel as pn
 
-from ..presets import preset_label
-from ..state import STATEMENTS
-from ..widgets import NAMES, HistoryEditor
+from ..model import STATEMENTS, ExplorerState, SceneHistory, preset_label
+from ..solving import SolveController
 from .eccentricity import EccentricityControl
 from .style import TAB_COLUMN, html_pane
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from .widgets import NAMES, HistoryEditor
 
 
 class SceneView:
@@ -21,24 +19,34 @@ class SceneView:
 
     title = "Scene"
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
-        s = app.state
+    def __init__(self, state: ExplorerState, presets: dict[str, dict[str, Any]],
+                 preset_key: str | None, history: SceneHistory,
+                 load_scene: Callable[[dict[str, Any]], bool], controller: SolveController,
+                 reject: Callable[[str], None]) -> None:
+        """``presets``: key -> scene, offered in this order; ``preset_key``: the preset on
+        screen (None: another scene); ``history``: undo and reset; ``load_scene``: shows
+        a preset chosen; ``controller`` and ``reject``: for the eccentricity slider."""
+        self.state = s = state
+        self.presets = presets
+        self.history = history
+        self.load_scene = load_scene
         options = {"(custom scene)": ""}
-        options.update({preset_label(k, v): k for k, v in app.presets.items()})
+        options.update({preset_label(k, v): k for k, v in presets.items()})
         self.preset = pn.widgets.Select(label="Preset scene", options=options,
-                                        value=app.preset_key or "",
+                                        value=preset_key or "",
                                         sizing_mode="stretch_width",
                                         css_classes=["preset-select"])
         self.preset_description = pn.pane.Markdown(self._preset_text(), margin=(0, 10),
                                                    styles={"font-size": "13px"})
         self.preset.param.watch(self._on_preset, "value")
-        self.undo_button = pn.widgets.Button(label="↶ Undo", disabled=True,
+        self.undo_button = pn.widgets.Button(label="↶ Undo", disabled=not history.can_undo,
                                              css_classes=["undo-button"])
-        self.undo_button.on_click(lambda e: app.undo())
+        self.undo_button.on_click(lambda e: history.undo())
+        history.param.watch(lambda e: setattr(self.undo_button, "disabled", not e.new),
+                            "can_undo")
         self.reset_button = pn.widgets.Button(label="Reset to the loaded scene",
                                               css_classes=["reset-button"])
-        self.reset_button.on_click(lambda e: app.reset())
+        self.reset_button.on_click(lambda e: history.reset())
 
         self.statement = pn.widgets.Select(label="statement (which two are given)",
                                            options=list(STATEMENTS), value=s.loading.statement,
@@ -48,7 +56,7 @@ class SceneView:
         s.loading.param.watch(self.refresh, "statement")
         self.history_editors = (HistoryEditor("load-0"), HistoryEditor("load-1"))
         self.unknowns_note = html_pane("", styles={"font-size": "13px"})
-        self.eccentric_load = EccentricityControl(app)
+        self.eccentric_load = EccentricityControl(state, controller, reject)
         self.refresh()
 
     def content(self) -> pn.Column:
@@ -62,7 +70,7 @@ class SceneView:
 
     def _preset_text(self) -> str:
         key = getattr(self, "preset", None) and self.preset.value
-        scene = self.app.presets.get(key) if key else None
+        scene = self.presets.get(key) if key else None
         if scene is None:
             return "Your own scene: start from a preset, a file or a link."
         return str(scene.get("description", ""))
@@ -70,16 +78,20 @@ class SceneView:
     def _on_preset(self, event: Any) -> None:
         key = event.new
         self.preset_description.object = self._preset_text()
-        if not key or key not in self.app.presets:
+        if not key or key not in self.presets:
             return
-        self.app.load_scene(self.app.presets[key])
+        self.load_scene(self.presets[key])
+
+    def forget_preset(self) -> None:
+        """Show no preset as chosen (a scene from a file is a scene of its own)."""
+        self.preset.value = ""
 
     def refresh(self, *events: Any) -> None:
         """Point the history editors at the two given quantities; name the unknowns."""
-        loading = self.app.state.loading
+        loading = self.state.loading
         if self.statement.value != loading.statement:
             self.statement.value = loading.statement
         for editor, q in zip(self.history_editors, loading.given, strict=True):
-            editor.bind(loading.histories[q], self.app.state.time_end)
+            editor.bind(loading.histories[q], self.state.time_end)
         unknowns = " and ".join(NAMES[q] for q in loading.unknowns)
         self.unknowns_note.object = f"Computed: <b>{unknowns}</b> (and the pressure)."

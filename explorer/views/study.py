@@ -1,10 +1,10 @@
 """The Study tab: a design chart over one or two fields of the scene on screen.
 
-The user picks the fields (loads, coating, base, punch: :func:`explorer.study.
+The user picks the fields (loads, coating, base, punch: :func:`explorer.model.study.
 study_choices`), their ranges and the output; Run builds the study from the scene on
-screen (:func:`explorer.study.plan_study`, refused with a message naming the field) and
-runs it off the page's event loop (:class:`explorer.study_runner.StudyRun`, a process of
-its own, cancellable). The chart (:class:`explorer.study_plots.DesignChart`) shows the
+screen (:func:`explorer.model.study.plan_study`, refused with a message naming the field) and
+runs it off the page's event loop (:class:`explorer.solving.study_runner.StudyRun`, a process of
+its own, cancellable). The chart (:class:`explorer.plots.study.DesignChart`) shows the
 output at a chosen time; it downloads as CSV (every output at every time) and PNG.
 """
 
@@ -12,26 +12,26 @@ from __future__ import annotations
 
 import html
 import io
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
 import panel as pn
 
-from ..study import (
+from ..files import study_csv
+from ..model import (
     MAX_POINTS,
     OUTPUTS,
     SPACINGS,
     Axis,
+    ExplorerState,
     default_range,
     plan_study,
     study_choices,
 )
-from ..study_plots import DesignChart, flag_note
-from ..study_png import design_chart_png
-from ..study_runner import StudyRun
+from ..plots import DesignChart, design_chart_png, flag_note
+from ..solving import SolveController, StudyRun
+from .loop import PageLoop
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
 
 #: The second parameter's choice for "no second parameter".
 NONE = "(none: a line over parameter 1)"
@@ -80,9 +80,14 @@ class StudyView:
 
     title = "Study"
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
-        self.study_run = StudyRun(dispatch=app._dispatch)
+    def __init__(self, state: ExplorerState, controller: SolveController, loop: PageLoop,
+                 on_settings: Callable[[], None]) -> None:
+        """``state``: the scene a study is built around; ``controller``: the fields offered
+        follow its results; ``loop``: where the study's progress is shown;
+        ``on_settings``: called when the fields or the output change (the link keeps
+        them)."""
+        self.state = state
+        self.study_run = StudyRun(dispatch=loop.dispatch)
         self._choices: dict[str, Any] = {}
         self.study_first = _AxisInputs(1, optional=False)
         self.study_second = _AxisInputs(2, optional=True)
@@ -124,16 +129,16 @@ class StudyView:
         self.study_run.param.watch(self._on_run, ["status", "done", "total", "message"])
         self.study_run.param.watch(self._on_result, "result")
         # the fields offered follow each result on screen (a solve, not every slider step)
-        app.controller.param.watch(lambda e: self.refresh(getattr(e.new, "scene", None)),
-                                   "view")
-        # the settings are part of the page's link (explorer.view_link)
+        controller.param.watch(lambda e: self.refresh(getattr(e.new, "scene", None)),
+                               "view")
+        # the settings are part of the page's link (explorer.model.view_link)
         self._wanted: dict[str, Any] | None = None
         for inputs in (self.study_first, self.study_second):
             for widget in (inputs.field, inputs.start, inputs.stop, inputs.count,
                            inputs.spacing):
-                widget.param.watch(lambda e: app.link.schedule(), "value")
-        self.study_output.param.watch(lambda e: app.link.schedule(), "value")
-        if app.served:
+                widget.param.watch(lambda e: on_settings(), "value")
+        self.study_output.param.watch(lambda e: on_settings(), "value")
+        if loop.served:
             # a closed page stops its study
             pn.state.on_session_destroyed(lambda ctx: self.study_run.cancel())
         self.refresh()
@@ -158,7 +163,7 @@ class StudyView:
         fields chosen when they are still there."""
         if scene is None:
             try:
-                scene = self.app.state.to_scene()
+                scene = self.state.to_scene()
             except ValueError:
                 return  # not a scene now; its message comes with the solve
         choices = {c.key: c for c in study_choices(scene)}
@@ -189,7 +194,7 @@ class StudyView:
     # -- the link ------------------------------------------------------------------------
     def study_settings(self) -> dict[str, Any] | None:
         """The parameters and output typed, as a link keeps them
-        (:func:`explorer.view_link.study_settings`), or None when one is incomplete."""
+        (:func:`explorer.model.view_link.study_settings`), or None when one is incomplete."""
         axes = [a for a in (self.study_first.axis(), self.study_second.axis())
                 if a is not None]
         rows = [[a.key, a.start, a.stop, a.count, a.spacing] for a in axes]
@@ -198,7 +203,7 @@ class StudyView:
         return {"axes": rows, "output": self.study_output.value}
 
     def apply_study_settings(self, settings: dict[str, Any]) -> None:
-        """Show the settings of a link (checked by :func:`explorer.view_link.
+        """Show the settings of a link (checked by :func:`explorer.model.view_link.
         study_settings`); a field the scene does not offer yet is set when it does."""
         self._wanted = settings
         axes = settings["axes"]
@@ -225,7 +230,7 @@ class StudyView:
         axes = [a for a in (self.study_first.axis(), self.study_second.axis())
                 if a is not None]
         try:
-            planned = plan_study(self.app.state.to_scene(), axes)
+            planned = plan_study(self.state.to_scene(), axes)
         except ValueError as exc:
             self._say(f"Not run: {exc}", bad=True)
             return False
@@ -277,7 +282,7 @@ class StudyView:
     # -- files -----------------------------------------------------------------------------
     def _csv(self) -> io.StringIO:
         result = self.study_run.result
-        return io.StringIO(result.to_csv() if result is not None else "")
+        return io.StringIO(study_csv(result) if result is not None else "")
 
     def _png(self) -> io.BytesIO:
         result = self.study_run.result

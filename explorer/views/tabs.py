@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import panel as pn
 
-from .. import gc_policy
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from ..fixes import gc_policy
+from .loop import PageLoop
 
 #: Time after a page connects before the sidebar tabs not yet opened are filled in the
 #: background [ms]: after the first paint and a first look (see DeferredTabs.fill_idle).
@@ -27,11 +25,11 @@ class DeferredTabs:
     Panel's dynamic tabs would rebuild a tab at every switch: measured 110 ms of server
     time each, which made 20 sessions 8x slower."""
 
-    def __init__(self, app: ExplorerApp, tabs: list[tuple[str, pn.Column]]) -> None:
-        self.app = app
+    def __init__(self, loop: PageLoop, tabs: list[tuple[str, pn.Column]]) -> None:
+        self.loop = loop
         self.deferred: dict[int, tuple[pn.Column, list[Any]]] = {}
         for k, (_title, content) in enumerate(tabs):
-            if k and app.served:
+            if k and loop.served:
                 self.deferred[k] = (content, list(content.objects))
                 content.objects = []
         # the tab titles wrap onto a second line: in one line the last tabs were out of
@@ -57,11 +55,11 @@ class DeferredTabs:
         Under load the server can miss a tab click (measured once in ~600 first openings
         with 20 sessions: the client showed the tab, the server never heard of it), and
         the tab stayed empty; filled in the background it cannot."""
-        app = self.app
+        loop = self.loop
         if self.deferred:
             self.fill(min(self.deferred))
         if self.deferred:
-            app._later(self.fill_idle, 0)
-        elif app.served:
+            loop.later(self.fill_idle, 0)
+        elif loop.served:
             # the page is complete; it lives as long as the session
-            gc_policy.page_built(getattr(app._doc, "session_context", None))
+            gc_policy.page_built(getattr(loop.doc, "session_context", None))

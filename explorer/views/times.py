@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Callable
 
 import panel as pn
 
-from ..widgets import Binding, EditableIntSlider, slider
+from ..model import ExplorerState
+from .fidelity import FidelityView
 from .style import TAB_COLUMN
-
-if TYPE_CHECKING:
-    from ..app import ExplorerApp
+from .widgets import Binding, EditableIntSlider, slider
 
 SPACINGS = {"linear": "linear", "log": "log"}
 
@@ -20,10 +19,12 @@ class TimesView:
 
     title = "Time"
 
-    def __init__(self, app: ExplorerApp) -> None:
-        self.app = app
-        s = app.state
-        self.global_binding = Binding(app.reject, live_when=app.fast_solves)
+    def __init__(self, state: ExplorerState, fidelity: FidelityView,
+                 reject: Callable[[str], None], live_when: Callable[[], bool]) -> None:
+        """``fidelity``: its solver settings sit under the accuracy target."""
+        self.state = s = state
+        self.fidelity = fidelity
+        self.global_binding = Binding(reject, live_when=live_when)
         gb = self.global_binding
         self.time_end = gb.add("time_end", slider("time span [days after loading]", 1.0,
                                                   3650.0, 1.0, "0[.]0"))
@@ -42,11 +43,11 @@ class TimesView:
     def content(self) -> pn.Column:
         """The tab's column."""
         return pn.Column(self.time_end, self.time_count, self.time_spacing, self.tol,
-                         self.app.fidelity.solver_panel, **TAB_COLUMN)
+                         self.fidelity.solver_panel, **TAB_COLUMN)
 
     def refresh(self) -> None:
         """Offer the tolerances the state allows; show the one set."""
-        options = {f"{v:g}": v for v in self.app.state.param.tol.objects}
+        options = {f"{v:g}": v for v in self.state.param.tol.objects}
         if options != self.tol.options:
             self.tol.options = options
-        self.tol.value = self.app.state.tol
+        self.tol.value = self.state.tol

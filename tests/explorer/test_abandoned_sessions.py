@@ -32,7 +32,7 @@ ROUND = 16
 #: benchmarks/load_test.py --mode abandon drifted +0.6 MiB per 100 dropped sessions over
 #: eight rounds of 25. What the bound must catch: a round whose pages were kept added
 #: ~55 MiB (before the release of Panel's link registry) and pages frozen until the next
-#: round ended held 60-85 MiB (before the second collection of explorer/gc_policy.py).
+#: round ended held 60-85 MiB (before the second collection of explorer/fixes/gc_policy.py).
 #: 20 MiB is 20x the largest growth measured and about a third of the smallest of those,
 #: so one round after the baseline tells such a leak from noise; a second round (16 more
 #: visits, 40-50 s of the suite at load 6-7) only doubled the reach for leaks of 10-20 MiB

@@ -22,9 +22,8 @@ import pytest
 
 from core import scene_from_dict, solve
 from core.cache import _REGISTRY, _REGISTRY_LOCK, StageCache, cache_report, clear_caches
-from explorer.controller import RESULTS, SolveController, approx_bytes
-from explorer.presets import presets
-from explorer.state import ExplorerState
+from explorer.model import ExplorerState, presets
+from explorer.solving import RESULTS, SolveController, approx_bytes
 
 pytestmark = pytest.mark.timeout(600)
 
@@ -318,8 +317,7 @@ def test_many_sessions_on_the_shared_pool_each_get_their_own_answer() -> None:
         pool.shutdown(wait=True)
 
 
-def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> None:
-    from explorer.app import ExplorerApp
+def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved(explorer_app) -> None:
 
     gate = threading.Event()
     started = threading.Event()
@@ -334,20 +332,20 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
     pool = ThreadPoolExecutor(max_workers=2)
     try:
         scene = small(PRESETS["uniform_flat"], count=5)
-        app = ExplorerApp(scene=scene, solve=gated, executor=pool)
+        app = explorer_app(scene=scene, solve=gated, executor=pool)
         assert app.controller.wait(120) and app.controller.view is not None
-        shown = app._drawn
+        shown = app.screen.drawn
         assert shown is app.controller.view
 
         def check_downloads_match(view: Any) -> None:
-            from explorer.exports import parse_csv
+            from explorer.files import parse_csv
 
             # the CSV holds the plotted numbers in the units on screen (mm, kN/m), to
             # 10 significant digits; the JSON the solver's SI numbers in full
-            _, names, table = parse_csv(app._csv_file().getvalue())
+            _, names, table = parse_csv(app.files_tab._csv_file().getvalue())
             assert names[:4] == ["time_day", "settlement_mm", "tilt_mrad", "force_kN_per_m"]
-            result = json.loads(asyncio.run(app._json_file()).getvalue())
-            saved = json.loads(app._scene_file().getvalue())
+            result = json.loads(asyncio.run(app.files_tab._json_file()).getvalue())
+            saved = json.loads(app.files_tab._scene_file().getvalue())
             assert saved == view.scene
             assert scene_from_dict(saved) == scene_from_dict(result["scene"])
             np.testing.assert_allclose(table[:, 0], result["times"], rtol=1e-9)
@@ -357,12 +355,12 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
             shown_mm = np.asarray(app.figures.history_src["settlement"].data["v"])
             # the plot holds float32 (7 digits), the file 10 digits of the same number
             np.testing.assert_allclose(table[:, 1], shown_mm, rtol=1e-7, atol=0)
-            index = app.time_index
+            index = app.screen.time_index
             unit = view.pressure_unit[1]
             q_file = np.asarray(result["pressure"])[:, index]
             np.testing.assert_allclose(q_file / unit, app.figures.q_src.data["q"],
                                        rtol=1e-7, atol=0)  # float32 on screen
-            _, _, long = parse_csv(app._pressure_file().getvalue())
+            _, _, long = parse_csv(app.files_tab._pressure_file().getvalue())
             assert len(long) == len(result["times"]) * len(result["x"])
 
         check_downloads_match(shown)
@@ -370,16 +368,16 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved() -> No
         # a load change: the new solve starts and waits behind the gate
         app.state.loading.histories["force"].value = 650.0
         assert started.wait(60)
-        assert app.controller.busy and app._drawn is shown
+        assert app.controller.busy and app.screen.drawn is shown
         check_downloads_match(shown)
-        from explorer.exports import parse_csv
+        from explorer.files import parse_csv
 
-        assert parse_csv(app._csv_file().getvalue())[2][0, 3] == old_force / 1e3
+        assert parse_csv(app.files_tab._csv_file().getvalue())[2][0, 3] == old_force / 1e3
         gate.set()
         assert app.controller.wait(120)
-        assert app._drawn is app.controller.view and app._drawn is not shown
-        check_downloads_match(app._drawn)
-        assert parse_csv(app._csv_file().getvalue())[2][0, 3] == pytest.approx(650.0,
+        assert app.screen.drawn is app.controller.view and app.screen.drawn is not shown
+        check_downloads_match(app.screen.drawn)
+        assert parse_csv(app.files_tab._csv_file().getvalue())[2][0, 3] == pytest.approx(650.0,
                                                                               rel=1e-12)
     finally:
         gate.set()

@@ -1,4 +1,4 @@
-"""A worker's answer awaited on the server's event loop (explorer/answer_wait.py).
+"""A worker's answer awaited on the server's event loop (explorer/solving/answer_wait.py).
 
 A load step written to the worker by the event loop is read back by that loop when the
 answer is in the pipe, with no thread in between; a worker that ends while the loop
@@ -17,13 +17,11 @@ from typing import Any
 import numpy as np
 import pytest
 
-import explorer.controller as controller_module
+import explorer.solving.controller as controller_module
 from core import budget, solve
-from explorer.answer_wait import when_answered
-from explorer.controller import RESULTS, SolveController
-from explorer.results import prepare_view
-from explorer.state import ExplorerState
-from explorer.workers import SolverProcesses
+from explorer.model import ExplorerState, prepare_view
+from explorer.solving import RESULTS, SolveController, SolverProcesses
+from explorer.solving.answer_wait import when_answered
 
 pytestmark = pytest.mark.timeout(300)
 

@@ -7,8 +7,8 @@ import pytest
 from bokeh.document import Document
 from bokeh.models import Range1d
 
-from explorer import bokeh_fixes
-from explorer.bokeh_data import KEEP_SHARE, MARGIN_SHARE, steady_range
+from explorer.fixes import bokeh_fixes
+from explorer.plots.bokeh_data import KEEP_SHARE, MARGIN_SHARE, steady_range
 
 
 def test_a_value_axis_is_kept_while_the_data_fit_and_refitted_when_not() -> None:

@@ -119,8 +119,8 @@ def test_a_bad_link_shows_a_message_and_the_default_scene(server: str, browser_c
 
 
 def test_pin_link_and_downloads_match_the_screen(server: str, browser_context, page: Page):
-    from explorer.exports import parse_csv
-    from explorer.links import decode_scene
+    from explorer.files import parse_csv
+    from explorer.model import decode_scene
 
     settlement = page.text(".readout-settlement")
     page.page.get_by_text("Pin this result").first.click()

@@ -48,7 +48,7 @@ def _wait(page: Page, js: str, arg: object = None, timeout: float = 60_000) -> N
 
 
 def _choose_preset(page: Page, key: str, title_part: str) -> None:
-    from explorer.presets import preset_label, presets
+    from explorer.model import preset_label, presets
 
     label = preset_label(key, presets()[key])
     page.page.locator(".preset-select select").first.select_option(label=label)
@@ -80,7 +80,7 @@ def test_time_slider_range_follows_a_preset_switch(page: Page):
 
 
 def test_a_flag_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: Page):
-    from explorer.exports import parse_csv
+    from explorer.files import parse_csv
 
     page.page.set_viewport_size({"width": 1024, "height": 768})
     _wait(page, "() => window.innerWidth === 1024")
@@ -320,7 +320,7 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     with page.page.expect_download(timeout=60_000) as info:
         page.page.get_by_text("Printable report (HTML)").first.click()
     text = Path(info.value.path()).read_text()
-    from explorer.exports import project_version
+    from explorer.files import project_version
 
     assert "Design check" in text and "all set limits hold" in text
     assert project_version() in text and "estimated relative error" in text

@@ -61,7 +61,7 @@ def test_several_pins_named_in_the_legend_removed_one_by_one_and_linked(
     def linked_pins() -> int:
         from urllib.parse import parse_qsl, urlsplit
 
-        from explorer.view_link import read_view_query
+        from explorer.model import read_view_query
 
         query = dict(parse_qsl(urlsplit(href()).query))
         return len(read_view_query(query, 99)[2]) if query.get("pin") else 0

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from explorer.fidelity_view import CONTACT_LABELS
+from explorer.views import CONTACT_LABELS
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
@@ -57,7 +57,7 @@ def test_fidelity_fields_set_on_the_page_reach_the_saved_scene(page: Page):
 
 
 def test_liftoff_preset_shades_the_lifted_heel_on_the_page(page: Page):
-    from explorer.presets import preset_label, presets
+    from explorer.model import preset_label, presets
 
     key = "eccentric_footing_liftoff"
     page.open_tab("Scene")

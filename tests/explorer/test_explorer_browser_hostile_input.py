@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from explorer.links import encode_scene
+from explorer.model.links import encode_scene
 from tests.browser_pages import require_browser, served_explorer
 from tests.conftest import base_scene
 from tests.support.serving import CHROMIUM, CHROMIUM_ARGS

@@ -2,7 +2,7 @@
 
 The dropper's frame loop (FilePond) ran at 60 frames a second for as long as the page
 was open, ~9 % of a core of the browser on an idle page; it is now held while nothing
-happens (explorer/idle_painter.py). Checked in Debian's Chromium: no frames are asked for
+happens (explorer/fixes/idle_painter.py). Checked in Debian's Chromium: no frames are asked for
 on an idle page, and a file chosen long after the last click (no event on the page but
 the file input's own) is still taken up and loaded.
 """
@@ -21,7 +21,7 @@ from tests.browser_pages import require_browser  # noqa: E402
 
 require_browser()
 
-from explorer.idle_painter import AWAKE_MS  # noqa: E402
+from explorer.fixes.idle_painter import AWAKE_MS  # noqa: E402
 from tests.browser_pages import Page, page_fixtures  # noqa: E402
 
 server, browser_context, page = page_fixtures(1400, 900)

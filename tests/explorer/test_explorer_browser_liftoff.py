@@ -43,7 +43,7 @@ server, browser_context, page = page_fixtures(1400, 900)
 
 
 def _choose(page: Page, key: str) -> None:
-    from explorer.presets import preset_label, presets
+    from explorer.model import preset_label, presets
 
     page.page.locator(".preset-select select").first.select_option(
         label=preset_label(key, presets()[key]))
@@ -57,7 +57,7 @@ def _solved(e: float):
     """The preset solved here with the force at ``e`` [m] (the server's solver is the same
     deterministic code)."""
     from core import solve
-    from explorer.presets import presets
+    from explorer.model import presets
 
     scene = copy.deepcopy(presets()[KEY])
     scene["loading"]["moment"] = e * scene["loading"]["force"]

@@ -15,11 +15,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from explorer.controller import SolveController
-from explorer.exports import histories_csv, number, parse_csv, pressure_csv
-from explorer.presets import presets
-from explorer.scales import DisplayScales, nice_ceiling
-from explorer.state import MAX_NAME_CHARS, ExplorerState
+from explorer.files import histories_csv, number, parse_csv, pressure_csv
+from explorer.model import MAX_NAME_CHARS, ExplorerState, presets
+from explorer.model.scales import DisplayScales, nice_ceiling
+from explorer.solving import SolveController
 from tests.cli_runs import run_cli
 
 PRESETS = presets()
@@ -145,25 +144,23 @@ def test_a_changed_preset_is_renamed_and_a_typed_name_is_kept():
     assert state.scene_name == "mine"
 
 
-def test_overlong_text_is_refused_from_files_links_and_the_page():
-    from explorer.app import ExplorerApp
+def test_overlong_text_is_refused_from_files_links_and_the_page(explorer_app):
 
     state = ExplorerState()
     scene = json.loads(json.dumps(PRESETS["uniform_flat"]))
     scene["name"] = "x" * (MAX_NAME_CHARS + 1)
     with pytest.raises(ValueError, match="name: at most 200 characters, got 201"):
         state.load_scene(scene)
-    app = ExplorerApp(executor=None)
+    app = explorer_app()
     before = app.state.scene_name
-    app.scene_name.value = "y" * 100_000
-    assert app.state.scene_name == before and app.scene_name.value == before
-    assert "at most 200 characters" in app.notice and "yyyy" not in app.notice
-    app.description.value = "z" * 5000
-    assert "at most 4000 characters" in app.notice
+    app.files_tab.scene_name.value = "y" * 100_000
+    assert app.state.scene_name == before and app.files_tab.scene_name.value == before
+    assert "at most 200 characters" in app.screen.notice and "yyyy" not in app.screen.notice
+    app.files_tab.description.value = "z" * 5000
+    assert "at most 4000 characters" in app.screen.notice
 
 
-def test_other_creep_model_without_a_file_is_never_solved_as_elastic():
-    from explorer.app import ExplorerApp
+def test_other_creep_model_without_a_file_is_never_solved_as_elastic(explorer_app):
 
     state, controller = solved("eccentric_creep")
     shown = controller.view
@@ -171,15 +168,15 @@ def test_other_creep_model_without_a_file_is_never_solved_as_elastic():
     controller.request()
     assert "base.creep" in controller.error and "from a scene file" in controller.error
     assert controller.view is shown
-    app = ExplorerApp(executor=None)
-    assert "other model (from file)" not in app.creep_model.options
+    app = explorer_app()
+    assert "other model (from file)" not in app.base_tab.creep_model.options
     scene = json.loads(json.dumps(PRESETS["eccentric_creep"]))
     creep = scene["base"]["creep"]
     scene["base"]["creep"] = {"model": "prony", "modulus": creep["modulus_final"],
                               "terms": [{"compliance": 1e-11, "rate": 0.03}]}
-    assert app.load_scene(scene), app.notice  # a model the screen does not offer ...
+    assert app.load_scene(scene), app.screen.notice  # a model the screen does not offer ...
     assert app.state.base.creep_model == "custom"  # ... is kept and offered by name
-    assert "other model (from file)" in app.creep_model.options
+    assert "other model (from file)" in app.base_tab.creep_model.options
     assert app.controller.view.scene["base"]["creep"]["model"] == "prony"
 
 
@@ -191,23 +188,22 @@ class _Never(Executor):
         return Future()
 
 
-def test_a_slow_first_solve_says_so_and_a_failure_claims_no_last_result():
-    from explorer.app import ExplorerApp
-    from explorer.workers import WorkerFailed
+def test_a_slow_first_solve_says_so_and_a_failure_claims_no_last_result(explorer_app):
+    from explorer.solving import WorkerFailed
 
     slow = json.loads(json.dumps(PRESETS["eccentric_creep"]))
     slow["times"] = {"end": 1000.0, "count": 77, "spacing": "log"}  # in no cache
-    app = ExplorerApp(scene=slow, executor=_Never())
-    assert app.controller.view is None and "first time" in app.status.object
+    app = explorer_app(scene=slow, executor=_Never())
+    assert app.controller.view is None and "first time" in app.results.status.object
 
     def lost(scene):
         raise WorkerFailed("the worker process died")
 
-    app = ExplorerApp(scene=slow, executor=None, solve=lost)
-    assert app.controller.view is None or app.notice  # the default scene may stand in
+    app = explorer_app(scene=slow, solve=lost)
+    assert app.controller.view is None or app.screen.notice  # the default scene may stand in
     if app.controller.view is None:
-        assert "last good result" not in app.alert.object
-        assert "no result to show yet" in app.alert.object
+        assert "last good result" not in app.results.alert.object
+        assert "no result to show yet" in app.results.alert.object
 
 
 def test_the_eccentric_creep_preset_says_what_its_curve_does():
@@ -238,7 +234,7 @@ def test_the_command_line_shows_the_solver_message_not_a_pointer(tmp_path):
 
 # ------------------------------------------------------------------ design check, report
 def test_the_design_check_finds_the_extremes_and_judges_the_limits():
-    from explorer.design import DesignLimits, design_check
+    from explorer.model import DesignLimits, design_check
 
     _, controller = solved("eccentric_creep")
     view = controller.view
@@ -259,8 +255,7 @@ def test_the_design_check_finds_the_extremes_and_judges_the_limits():
 
 
 def test_the_report_holds_inputs_plots_flags_accuracy_and_version():
-    from explorer.exports import project_version
-    from explorer.report import report_html
+    from explorer.files import project_version, report_html
 
     _, controller = solved_flagged()
     text = report_html(controller.view)
@@ -270,7 +265,7 @@ def test_the_report_holds_inputs_plots_flags_accuracy_and_version():
 
 
 def test_the_status_speaks_plainly_and_keeps_the_numbers_in_details():
-    from explorer.status import status_html
+    from explorer.views import status_html
 
     state, controller = solved()
     text = status_html(controller.view, False)
@@ -281,22 +276,21 @@ def test_the_status_speaks_plainly_and_keeps_the_numbers_in_details():
 
 
 # ------------------------------------------------------------------ undo, reset, classical
-def test_undo_and_reset_return_to_earlier_scenes():
-    from explorer.app import ExplorerApp
+def test_undo_and_reset_return_to_earlier_scenes(explorer_app):
 
-    app = ExplorerApp(executor=None)
+    app = explorer_app()
     start = app.state.to_scene()
-    assert app.undo_button.disabled
+    assert app.scene_tab.undo_button.disabled
     app.state.loading.histories["force"].value = 600.0
     app.state.punch.half_width = 1.1
-    assert not app.undo_button.disabled
-    app.undo()
+    assert not app.scene_tab.undo_button.disabled
+    app.history.undo()
     assert app.state.punch.half_width == 1.0
     assert app.state.loading.histories["force"].value == 600.0
-    app.undo()
+    app.history.undo()
     assert app.state.to_scene()["loading"] == start["loading"]
     app.state.punch.half_width = 1.4
-    app.reset()
+    app.history.reset()
     assert app.state.to_scene() == start
     assert app.controller.view.scene == start
 
@@ -307,7 +301,7 @@ def test_classical_solutions_carry_the_force_and_moment():
     for the rule, measured 5e-11)."""
     from numpy.polynomial.chebyshev import chebgauss
 
-    from explorer.classical import EDGE_CAP, bearing_rule_pressure, half_space_pressure
+    from explorer.plots.classical import EDGE_CAP, bearing_rule_pressure, half_space_pressure
 
     a, force = 1.2, 5e5
     x = np.linspace(-a, a, 200_001)

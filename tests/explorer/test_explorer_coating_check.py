@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-from explorer.app import ExplorerApp
-from explorer.views.coating import CoatingView, check_report_html
+from explorer.views.coating import check_report_html
 
 
 class _Held:
@@ -16,15 +15,13 @@ class _Held:
         self.work.append((fn, args))
 
 
-def _check_view(app: ExplorerApp):
-    return next(v for v in app.views if isinstance(v, CoatingView)).check
 
 
-def test_the_check_runs_off_the_page_and_shows_the_model_error_beside_its_estimate():
+def test_the_check_runs_off_the_page_and_shows_the_model_error_beside_its_estimate(explorer_app):
     held = _Held()
-    app = ExplorerApp(executor=None)
+    app = explorer_app()
     app.controller._executor = held  # the check goes where the session's solves go
-    check = _check_view(app)
+    check = app.coating_tab.check
     check.run()
     # while the FE model solves, the page shows progress and the button waits
     assert len(held.work) == 1 and check.progress.visible and check.button.disabled

@@ -9,12 +9,16 @@ from functools import cache
 import numpy as np
 import pytest
 
-from explorer.contact_zone import contact_text, contact_widths, contact_zones
-from explorer.controller import SolveController
+from explorer.model import (
+    ExplorerState,
+    ResultView,
+    contact_text,
+    contact_widths,
+    contact_zones,
+    presets,
+)
 from explorer.plots import Figures
-from explorer.presets import presets
-from explorer.results import ResultView
-from explorer.state import ExplorerState
+from explorer.solving import SolveController
 
 
 @cache
@@ -91,7 +95,7 @@ def test_in_full_contact_the_width_plot_says_so() -> None:
 
 
 def test_the_readout_names_the_contact_zone() -> None:
-    from explorer.views.results import readout_html
+    from explorer.views import readout_html
 
     view = _solved("eccentric_footing_liftoff")
     text = readout_html(view, 0, ())
@@ -125,10 +129,9 @@ def test_no_inset_without_small_features() -> None:
     assert not figures.inset_fig.visible
 
 
-def test_a_load_step_in_full_contact_resends_nothing_of_the_contact() -> None:
-    from explorer.app import ExplorerApp
+def test_a_load_step_in_full_contact_resends_nothing_of_the_contact(explorer_app) -> None:
 
-    app = ExplorerApp(executor=None)
+    app = explorer_app()
     sent = [0]
     contact = app.figures.contact
     for source in (contact.zone_src, contact.lifted_src, contact.width_src,
@@ -139,13 +142,13 @@ def test_a_load_step_in_full_contact_resends_nothing_of_the_contact() -> None:
     assert app.controller.wait(60) and app.controller.error == ""
     assert sent[0] == 0
     # a force step changes the histories: the width plot's point moves, its data stays
-    assert app.figures.contact.width_point.data["t"] == [float(app.shown().times[-1])]
+    assert app.figures.contact.width_point.data["t"] == [float(app.screen.shown().times[-1])]
 
 
 def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
     from bokeh.core.properties import value
 
-    from explorer.views.results import badges_html
+    from explorer.views import badges_html
 
     view = _solved("eccentric_footing_liftoff")
     badges = badges_html(view, "pressure")
@@ -161,7 +164,7 @@ def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
 
 
 def test_the_report_carries_the_contact_zone_and_its_history() -> None:
-    from explorer.report import report_html
+    from explorer.files import report_html
 
     text = report_html(_solved("eccentric_footing_liftoff"), index=0)
     assert "At t = 0 days: contact 1.306 m of 2 m (65 %)" in text
@@ -193,10 +196,9 @@ def test_the_full_contact_model_marks_its_pull_zone_not_a_gap() -> None:
     assert "q < 0 (contact lost)" in contact_text(view, 0)
 
 
-def test_the_contact_figures_join_the_page_only_when_a_result_needs_them() -> None:
-    from explorer.app import ExplorerApp
+def test_the_contact_figures_join_the_page_only_when_a_result_needs_them(explorer_app) -> None:
 
-    app = ExplorerApp(executor=None)          # the default scene: full contact, flat
+    app = explorer_app()          # the default scene: full contact, flat
     slots = app.results.contact_panes
     assert not slots.width_slot.visible and slots.width_slot.objects == []
     assert not slots.inset_slot.visible and slots.inset_slot.objects == []

@@ -1,16 +1,13 @@
-"""The design-code creep inputs and the phi(t, t0) plot of the explorer (explorer/creep_view.py)."""
+"""The design-code creep inputs and the phi(t, t0) plot of the explorer
+(explorer/model/code_creep_state.py, explorer/views/creep.py)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from explorer.creep_view import (
-    CodeCreepState,
-    creep_coefficient_data,
-    creep_coefficient_figure,
-    update_creep_figure,
-)
+from explorer.model import CodeCreepState, creep_coefficient_data
+from explorer.views.creep import creep_coefficient_figure, update_creep_figure
 
 
 def _ec2_phi(fcm: float, rh: float, h0: float, t0: float, d: float, temp: float = 20.0) -> float:
@@ -70,7 +67,7 @@ def test_base_state_offers_the_code_models_and_round_trips_the_preset():
     import json
     from pathlib import Path
 
-    from explorer.state import CREEP_MODELS, ExplorerState
+    from explorer.model import CREEP_MODELS, ExplorerState
 
     assert {"fib_mc2010", "eurocode2"} <= set(CREEP_MODELS)
     scene = json.loads((Path(__file__).resolve().parents[2]

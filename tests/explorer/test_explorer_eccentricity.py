@@ -4,34 +4,19 @@ the preset's text says what the solver computes."""
 from __future__ import annotations
 
 import copy
-import json
 import re
 
 import numpy as np
 import pytest
 
-from explorer.presets import presets
+from explorer.model import presets
 
 KEY = "eccentric_footing_liftoff"
 
 
-def _app(key: str = KEY):
-    from explorer.app import ExplorerApp
-
-    app = ExplorerApp(scene=json.loads(json.dumps(presets()[key])), executor=None)
-    assert app.controller.wait(120) and app.controller.error == "", app.controller.error
-    return app
-
-
-def _control(app):
-    from explorer.views.scene import SceneView
-
-    return next(v for v in app.views if isinstance(v, SceneView)).eccentric_load
-
-
-def test_the_slider_shows_the_preset_eccentricity_and_moves_the_zone() -> None:
-    app = _app()
-    control = _control(app)
+def test_the_slider_shows_the_preset_eccentricity_and_moves_the_zone(explorer_app) -> None:
+    app = explorer_app(KEY, solved=True)
+    control = app.scene_tab.eccentric_load
     assert control.slider.value == pytest.approx(0.6, rel=1e-12)   # 480 / 800 kN
     assert (control.slider.start, control.slider.end) == (-0.9, 0.9)  # 0.9 a, a = 1 m
     before = app.figures.contact.zone_src.data["xs"][0][0]
@@ -39,7 +24,7 @@ def test_the_slider_shows_the_preset_eccentricity_and_moves_the_zone() -> None:
     assert app.controller.wait(120) and app.controller.error == ""
     moment = app.state.loading.histories["moment"]
     assert (moment.kind, moment.value) == ("constant", pytest.approx(640.0, rel=1e-12))
-    view = app.shown()
+    view = app.screen.shown()
     assert view.values["moment"][-1] / view.values["force"][-1] == pytest.approx(0.8)
     after = app.figures.contact.zone_src.data["xs"][0][0]
     assert after == view.contact_set[-1][0][0] > before   # the zone shrank toward the toe
@@ -49,29 +34,29 @@ def test_the_slider_shows_the_preset_eccentricity_and_moves_the_zone() -> None:
     assert [(x[0], x[-1]) for x in app.figures.contact.zone_src.data["xs"]] == [(-1.0, 1.0)]
 
 
-def test_the_slider_follows_the_moment_set_elsewhere() -> None:
-    app = _app("uniform_flat")
-    control = _control(app)
+def test_the_slider_follows_the_moment_set_elsewhere(explorer_app) -> None:
+    app = explorer_app("uniform_flat", solved=True)
+    control = app.scene_tab.eccentric_load
     loading = app.state.loading
     loading.histories["moment"].value = 0.25 * loading.histories["force"].value
     assert control.slider.value == pytest.approx(0.25)
     assert not control.slider.disabled
 
 
-def test_the_slider_is_off_when_it_cannot_set_the_moment() -> None:
-    app = _app("uniform_flat")
-    control = _control(app)
+def test_the_slider_is_off_when_it_cannot_set_the_moment(explorer_app) -> None:
+    app = explorer_app("uniform_flat", solved=True)
+    control = app.scene_tab.eccentric_load
     app.state.loading.statement = "settlement + tilt given"
     assert control.slider.disabled and not control.slider.visible and control.note.visible
     control.apply(0.3)
-    assert "force and moment are given" in app.notice
+    assert "force and moment are given" in app.screen.notice
 
 
-def test_drag_steps_apply_at_once_only_while_solves_are_fast(monkeypatch) -> None:
+def test_drag_steps_apply_at_once_only_while_solves_are_fast(monkeypatch, explorer_app) -> None:
     from explorer.views import eccentricity
 
-    app = _app()
-    control = _control(app)
+    app = explorer_app(KEY, solved=True)
+    control = app.scene_tab.eccentric_load
     monkeypatch.setitem(app.controller.view.info, "cpu_seconds", 2 * eccentricity.LIVE_SOLVE_S)
     control.slider.value = 0.7            # a drag step, slow solves: wait for the release
     assert app.state.loading.histories["moment"].value == pytest.approx(480.0)

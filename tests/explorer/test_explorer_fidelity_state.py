@@ -14,8 +14,7 @@ from pathlib import Path
 import pytest
 
 from core import scene_from_dict
-from explorer.links import decode_scene, encode_scene
-from explorer.state import ExplorerState
+from explorer.model import ExplorerState, decode_scene, encode_scene
 
 LIFTOFF = Path(__file__).resolve().parents[2] / "assets/scenes/eccentric_footing_liftoff.json"
 
@@ -67,10 +66,9 @@ def test_a_change_of_a_fidelity_field_is_a_scene_change(change) -> None:
     scene_from_dict(state.to_scene())
 
 
-def test_widgets_edit_and_show_the_fidelity_fields() -> None:
-    from explorer.app import ExplorerApp
+def test_widgets_edit_and_show_the_fidelity_fields(explorer_app) -> None:
 
-    app = ExplorerApp(executor=None)
+    app = explorer_app()
     view = app.fidelity
     view.interface.value = "bonded"
     assert app.state.layers[0].interface == "bonded"

@@ -12,17 +12,11 @@ import numpy as np
 import pytest
 
 from core.scene import MAX_SCENE_BYTES
-from explorer.links import MAX_JSON, PREFIX, decode_scene, encode_scene
+from explorer.model.links import MAX_JSON, PREFIX, decode_scene, encode_scene
 from tests.conftest import base_scene, edited
 
 XSS = ['<script>window.__xss = 1</script>', '<img src=x onerror="window.__xss=1">',
        "<img src=x onerror=alert(1)>"]
-
-
-def _explorer_app(**kwargs: Any) -> Any:
-    from explorer.app import ExplorerApp
-
-    return ExplorerApp(executor=None, **kwargs)
 
 
 def _rendered_markup(app: Any) -> list[str]:
@@ -32,7 +26,7 @@ def _rendered_markup(app: Any) -> list[str]:
     texts = []
     for pane in app._layout.select(pn.pane.Markdown) + app._layout.select(pn.pane.HTML):
         texts.append(str(pane.object))
-    texts += [str(app.notice_alert.object), str(app.alert.object)]
+    texts += [str(app.results.notice_alert.object), str(app.results.alert.object)]
     return texts
 
 
@@ -43,124 +37,127 @@ def assert_inert(app: Any) -> None:
         assert "onerror=" not in lowered or "&lt;" in lowered, text
 
 
-def test_markup_in_a_link_is_shown_as_text() -> None:
+def test_markup_in_a_link_is_shown_as_text(explorer_app) -> None:
     scene = base_scene()
     scene["name"] = XSS[0]
     scene["description"] = XSS[1]
     scene["punch"][XSS[2]] = 1.0
-    app = _explorer_app(query={"scene": encode_scene(scene)})
-    assert "unknown field" in app.notice and "default scene" in app.notice
-    assert "&lt;img src=x onerror=alert(1)&gt;" in app.notice_alert.object
+    app = explorer_app(query={"scene": encode_scene(scene)})
+    assert "unknown field" in app.screen.notice and "default scene" in app.screen.notice
+    assert "&lt;img src=x onerror=alert(1)&gt;" in app.results.notice_alert.object
     assert_inert(app)
-    app = _explorer_app(query={"preset": XSS[1]})
-    assert "Unknown preset" in app.notice
+    app = explorer_app(query={"preset": XSS[1]})
+    assert "Unknown preset" in app.screen.notice
     assert_inert(app)
 
 
-def test_markup_in_scene_files_and_fields_is_shown_as_text() -> None:
-    app = _explorer_app()
+def test_markup_in_scene_files_and_fields_is_shown_as_text(explorer_app) -> None:
+    app = explorer_app()
     good = base_scene()
     good["name"] = XSS[0]
     good["description"] = XSS[1]
-    app.load_file.filename = "scene.json"
-    app.load_file.value = json.dumps(good).encode()
-    assert app.notice == "" and app.state.scene_name == XSS[0]
-    assert "<" not in app.save_scene.filename and "/" not in app.save_scene.filename
+    app.files_tab.load_file.filename = "scene.json"
+    app.files_tab.load_file.value = json.dumps(good).encode()
+    assert app.screen.notice == "" and app.state.scene_name == XSS[0]
+    saved = app.files_tab.save_scene.filename
+    assert "<" not in saved and "/" not in saved
     assert_inert(app)
     # the core echoes these texts in its messages
     for bad in (edited("base.creep", {"model": XSS[1], "modulus": 3e10}),
                 edited("punch.shape", {"expr": "sin(x) + " + XSS[2]}),
                 edited("punch.shape", {"kind": XSS[0]}),
                 edited("loading.force", {"kind": "table", XSS[2]: 1})):
-        app.load_file.filename = XSS[1] + ".json"
-        app.load_file.value = json.dumps(bad).encode()
-        assert app.notice.startswith("The scene was not loaded"), app.notice
+        app.files_tab.load_file.filename = XSS[1] + ".json"
+        app.files_tab.load_file.value = json.dumps(bad).encode()
+        assert app.screen.notice.startswith("The scene was not loaded"), app.screen.notice
         assert_inert(app)
-    app.load_file.value = b"{" + XSS[2].encode()
-    assert "not valid JSON" in app.notice
+    app.files_tab.load_file.value = b"{" + XSS[2].encode()
+    assert "not valid JSON" in app.screen.notice
     assert_inert(app)
     # a value typed into the name field
-    app.scene_name.value = XSS[0]
+    app.files_tab.scene_name.value = XSS[0]
     assert_inert(app)
 
 
-def test_markup_in_an_uploaded_table_is_shown_as_text() -> None:
-    app = _explorer_app()
-    app.shape_file.filename = XSS[1] + ".csv"
-    app.shape_file.value = ("x,f\n-0.5,0\n0," + XSS[2] + "\n").encode()
-    assert app.notice.startswith("The shape table was not used: Punch, shape (punch.shape): "
-                                 "line 3, column 2:"), app.notice
+def test_markup_in_an_uploaded_table_is_shown_as_text(explorer_app) -> None:
+    app = explorer_app()
+    app.punch_tab.shape_file.filename = XSS[1] + ".csv"
+    app.punch_tab.shape_file.value = ("x,f\n-0.5,0\n0," + XSS[2] + "\n").encode()
+    assert app.screen.notice.startswith("The shape table was not used: Punch, shape (punch.shape): "
+                                 "line 3, column 2:"), app.screen.notice
     assert_inert(app)
-    app.shape_file.value = b"x,f\n-0.5,0.00002\n0,0\n0.5,0.00001\n"
-    assert app.state.punch.shape == "custom" and app.notice == ""
-    assert "&lt;img" in app.shape_note.object
+    app.punch_tab.shape_file.value = b"x,f\n-0.5,0.00002\n0,0\n0.5,0.00001\n"
+    assert app.state.punch.shape == "custom" and app.screen.notice == ""
+    assert "&lt;img" in app.punch_tab.shape_note.object
     assert_inert(app)
 
 
-def test_markup_in_a_solver_message_is_shown_as_text() -> None:
+def test_markup_in_a_solver_message_is_shown_as_text(explorer_app) -> None:
     """A valid file whose creep formula fails at solve time: the alert escapes it."""
-    app = _explorer_app()
+    app = explorer_app()
     shown = app.controller.view
     app.state.base.param.update(creep_model="custom", custom={
         "model": "kernel", "modulus": 3e10, "expr": "0.01 * exp(-(t - tau))"})
-    assert app.alert.visible and "base.creep.expr" in app.alert.object
+    assert app.results.alert.visible and "base.creep.expr" in app.results.alert.object
     assert app.controller.view is shown
     app.controller.param.update(error="solve: " + XSS[1])
     assert_inert(app)
 
 
-def test_uploads_over_the_limits_are_refused_with_a_notice() -> None:
-    app = _explorer_app()
+def test_uploads_over_the_limits_are_refused_with_a_notice(explorer_app) -> None:
+    app = explorer_app()
     shown = app.controller.view
-    app.load_file.filename = "big.json"
-    app.load_file.value = b" " * (MAX_SCENE_BYTES + 1)
-    assert "too large" in app.notice and str(MAX_SCENE_BYTES) in app.notice
-    app.load_file.filename = "deep.json"
-    app.load_file.value = b"[" * 100_000 + b"]" * 100_000
-    assert "nested too deeply" in app.notice
-    app.shape_file.filename = "big.csv"
-    app.shape_file.value = b"x,f\n" + b"0.0,0.0\n" * 200_000
-    assert "punch.shape" in app.notice and "too large" in app.notice
-    app.shape_file.filename = "rows.csv"
-    app.shape_file.value = "".join(f"{k / 20000 - 0.25},0\n" for k in range(10_001)).encode()
-    assert "too many rows" in app.notice
+    app.files_tab.load_file.filename = "big.json"
+    app.files_tab.load_file.value = b" " * (MAX_SCENE_BYTES + 1)
+    assert "too large" in app.screen.notice and str(MAX_SCENE_BYTES) in app.screen.notice
+    app.files_tab.load_file.filename = "deep.json"
+    app.files_tab.load_file.value = b"[" * 100_000 + b"]" * 100_000
+    assert "nested too deeply" in app.screen.notice
+    app.punch_tab.shape_file.filename = "big.csv"
+    app.punch_tab.shape_file.value = b"x,f\n" + b"0.0,0.0\n" * 200_000
+    assert "punch.shape" in app.screen.notice and "too large" in app.screen.notice
+    app.punch_tab.shape_file.filename = "rows.csv"
+    rows = "".join(f"{k / 20000 - 0.25},0\n" for k in range(10_001))
+    app.punch_tab.shape_file.value = rows.encode()
+    assert "too many rows" in app.screen.notice
     assert app.controller.view is shown and app.controller.error == ""
 
 
-def test_an_uploaded_scene_is_read_as_strictly_as_the_command_line_reads_it() -> None:
+def test_an_uploaded_scene_is_read_as_strictly_as_the_command_line_reads_it(explorer_app) -> None:
     """A field given twice is refused (json.loads would silently keep the second), as are
     text that is not UTF-8 and numbers beyond any double; the result on screen stays."""
-    app = _explorer_app()
+    app = explorer_app()
     shown = app.controller.view
     text = json.dumps(base_scene())
-    app.load_file.filename = "twice.json"
-    app.load_file.value = text.replace('"name":', '"name": "first", "name":', 1).encode()
-    assert app.notice == "The file 'twice.json': duplicate field 'name' in one JSON object"
-    app.load_file.filename = "latin1.json"
-    app.load_file.value = b'{"name": "caf\xe9"}'  # Latin-1
-    assert "not text in UTF-8" in app.notice
-    app.load_file.filename = "huge.json"
-    app.load_file.value = text.replace('"schema_version": 1', '"schema_version": ' + "9" * 500,
-                                       1).encode()
-    assert app.notice.startswith("The scene was not loaded"), app.notice
+    app.files_tab.load_file.filename = "twice.json"
+    app.files_tab.load_file.value = text.replace('"name":', '"name": "first", "name":', 1).encode()
+    assert app.screen.notice == "The file 'twice.json': duplicate field 'name' in one JSON object"
+    app.files_tab.load_file.filename = "latin1.json"
+    app.files_tab.load_file.value = b'{"name": "caf\xe9"}'  # Latin-1
+    assert "not text in UTF-8" in app.screen.notice
+    app.files_tab.load_file.filename = "huge.json"
+    app.files_tab.load_file.value = text.replace(
+        '"schema_version": 1', '"schema_version": ' + "9" * 500, 1).encode()
+    assert app.screen.notice.startswith("The scene was not loaded"), app.screen.notice
     assert app.controller.view is shown and app.controller.error == ""
 
 
-def test_an_uploaded_table_with_too_many_rows_for_the_solver_keeps_the_last_result() -> None:
-    app = _explorer_app()
+def test_an_uploaded_table_with_too_many_rows_for_the_solver_keeps_the_last_result(
+        explorer_app) -> None:
+    app = explorer_app()
     shown = app.controller.view
     rows = "".join(f"{x:.4f},{1e-5 * (1 + np.sin(20 * x)):.3e}\n"
                    for x in np.linspace(-0.9, 0.9, 40))
-    app.shape_file.filename = "measured.csv"
-    app.shape_file.value = ("x,f\n" + rows).encode()
+    app.punch_tab.shape_file.filename = "measured.csv"
+    app.punch_tab.shape_file.value = ("x,f\n" + rows).encode()
     # every row of a linear table is a kink, the end rows too (the held value begins):
     # more than the solver allows, so the upload itself is refused, naming the limit
     assert app.state.punch.shape == "flat"
-    assert "(punch.shape): a table of 40 rows" in app.notice and "16" in app.notice
+    assert "(punch.shape): a table of 40 rows" in app.screen.notice and "16" in app.screen.notice
     assert app.controller.view is shown
 
 
-def test_a_deeply_nested_link_is_refused() -> None:
+def test_a_deeply_nested_link_is_refused(explorer_app) -> None:
     import base64
     import zlib
 
@@ -169,8 +166,8 @@ def test_a_deeply_nested_link_is_refused() -> None:
     link = PREFIX + base64.urlsafe_b64encode(zlib.compress(raw, 9)).decode().rstrip("=")
     with pytest.raises(ValueError, match="nested too deeply"):
         decode_scene(link)
-    app = _explorer_app(query={"scene": link})
-    assert "nested too deeply" in app.notice and app.controller.view is not None
+    app = explorer_app(query={"scene": link})
+    assert "nested too deeply" in app.screen.notice and app.controller.view is not None
 
 
 def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import core
-from explorer.lessons import LESSONS, lessons, step_scene
+from explorer.model.lessons import LESSONS, lessons, step_scene
 
 LESSON = {lesson.key: lesson for lesson in LESSONS}
 
@@ -102,11 +102,10 @@ def test_the_creep_lesson_says_what_the_solver_finds() -> None:
     assert _rounds_to(settlement[0], "0.049") and np.ptp(settlement) < 1e-12
 
 
-def test_a_lesson_goes_step_by_step_and_pins_each_step() -> None:
-    from explorer.app import ExplorerApp
+def test_a_lesson_goes_step_by_step_and_pins_each_step(explorer_app) -> None:
 
-    app = ExplorerApp(executor=None)
-    view = next(v for v in app.views if v.title == "Lessons")
+    app = explorer_app()
+    view = app.lessons_tab
     view.lesson_select.value = "load_and_tilt"
     assert app.controller.wait(60)
     assert "Step 1 of 4" in view.lesson_note.object and view.previous_button.disabled
@@ -117,7 +116,7 @@ def test_a_lesson_goes_step_by_step_and_pins_each_step() -> None:
     assert [pin.label for pin in app.pins.board] == ["P = 500 kN/m, e = 0 m",
                                                       "P = 1000 kN/m, e = 0 m",
                                                       "P = 1000 kN/m, e = 0.2 m"]
-    assert float(app.readout.object.split("readout-moment'>")[1].split("<")[0]) == 300
+    assert float(app.results.readout.object.split("readout-moment'>")[1].split("<")[0]) == 300
     view.previous_button.clicks += 1
     assert app.controller.wait(60)
     assert "Step 3 of 4" in view.lesson_note.object

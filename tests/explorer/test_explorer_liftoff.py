@@ -7,11 +7,9 @@ import json
 
 import pytest
 
-from explorer.controller import SolveController
-from explorer.design import design_check
-from explorer.presets import presets
-from explorer.results import lifted_intervals
-from explorer.state import ExplorerState
+from explorer.model import ExplorerState, design_check, presets
+from explorer.model.results import lifted_intervals
+from explorer.solving import SolveController
 
 
 @pytest.mark.parametrize(("zones", "lifted"), [
@@ -45,7 +43,7 @@ def test_liftoff_preset_shows_its_contact_zone() -> None:
 
 
 def test_design_check_text_gives_the_lift_off_length() -> None:
-    from explorer.design import check_html
+    from explorer.model import check_html
 
     state = ExplorerState()
     state.load_scene(json.loads(json.dumps(presets()["eccentric_footing_liftoff"])))
@@ -57,8 +55,8 @@ def test_design_check_text_gives_the_lift_off_length() -> None:
 
 
 def test_histories_csv_carries_the_contact_width_and_the_lifted_length() -> None:
-    from explorer.contact_zone import contact_widths
-    from explorer.exports import histories_csv, parse_csv
+    from explorer.files import histories_csv, parse_csv
+    from explorer.model import contact_widths
 
     state = ExplorerState()
     state.load_scene(json.loads(json.dumps(presets()["eccentric_footing_liftoff"])))

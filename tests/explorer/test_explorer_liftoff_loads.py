@@ -3,36 +3,19 @@ can carry is refused with the last good result kept; the slider is live on a fas
 
 from __future__ import annotations
 
-import json
 from dataclasses import replace
 
 import param
 import pytest
 
-from explorer.presets import presets
-
 KEY = "eccentric_footing_liftoff"
 
 
-def _app():
-    from explorer.app import ExplorerApp
-
-    app = ExplorerApp(scene=json.loads(json.dumps(presets()[KEY])), executor=None)
-    assert app.controller.wait(120) and app.controller.error == "", app.controller.error
-    return app
-
-
-def _control(app):
-    from explorer.views.scene import SceneView
-
-    return next(v for v in app.views if isinstance(v, SceneView)).eccentric_load
-
-
-def test_a_resultant_outside_the_punch_is_refused_and_the_last_result_stays() -> None:
-    app = _app()
+def test_a_resultant_outside_the_punch_is_refused_and_the_last_result_stays(explorer_app) -> None:
+    app = explorer_app(KEY, solved=True)
     shown = app.controller.view
     # e = 1.1 m typed into the box (the slider stops at 0.9 a): no contact can carry it
-    _control(app).apply(1.1)
+    app.scene_tab.eccentric_load.apply(1.1)
     assert app.controller.wait(120)
     error = app.controller.error
     assert error.startswith("Loading, moment (loading.moment): the eccentricity e = M/P "
@@ -40,23 +23,24 @@ def test_a_resultant_outside_the_punch_is_refused_and_the_last_result_stays() ->
     assert "|e| must be < a = 1 m" in error
     assert app.controller.view is shown            # the last good result stays on screen
     # back inside the punch: solved again, the message gone
-    _control(app).apply(0.7)
+    app.scene_tab.eccentric_load.apply(0.7)
     assert app.controller.wait(120) and app.controller.error == ""
     assert app.controller.view is not shown
 
 
-def test_the_solve_reports_its_cpu_time() -> None:
-    app = _app()
+def test_the_solve_reports_its_cpu_time(explorer_app) -> None:
+    app = explorer_app(KEY, solved=True)
     info = app.controller.view.info
     assert isinstance(info["cpu_seconds"], float) and info["cpu_seconds"] > 0.0
 
 
 @pytest.mark.parametrize(("cpu", "live"), [(0.15, True), (0.25, False)])
-def test_the_slider_is_live_when_the_solve_is_fast_in_cpu_time(cpu: float, live: bool):
+def test_the_slider_is_live_when_the_solve_is_fast_in_cpu_time(cpu: float, live: bool,
+                                                                explorer_app):
     from explorer.views.eccentricity import LIVE_SOLVE_S
 
-    app = _app()
-    control = _control(app)
+    app = explorer_app(KEY, solved=True)
+    control = app.scene_tab.eccentric_load
     moment = app.state.loading.histories["moment"]
     before = moment.value
     # the wall time of a loaded machine (0.3 s) does not decide, the solve's CPU time does

@@ -8,17 +8,9 @@ from dataclasses import replace
 
 import pytest
 
-from explorer.presets import presets
+from explorer.model import presets
 
 KEY = "rounded_graded"
-
-
-def _app():
-    from explorer.app import ExplorerApp
-
-    app = ExplorerApp(scene=json.loads(json.dumps(presets()[KEY])), executor=None)
-    assert app.controller.wait(120) and app.controller.error == "", app.controller.error
-    return app
 
 
 def test_the_scene_solve_counts_its_validation_in_its_cpu_time() -> None:
@@ -31,10 +23,11 @@ def test_the_scene_solve_counts_its_validation_in_its_cpu_time() -> None:
 @pytest.mark.parametrize(("cpu", "wall", "live"),
                          [(0.020, 0.060, True), (0.040, 0.020, False), (None, 0.020, True),
                           (None, 0.060, False)])
-def test_geometry_sliders_are_live_when_the_solve_is_fast_in_cpu_time(cpu, wall, live):
+def test_geometry_sliders_are_live_when_the_solve_is_fast_in_cpu_time(cpu, wall, live,
+                                                                       explorer_app):
     from explorer.app import LIVE_SOLVE_S
 
-    app = _app()
+    app = explorer_app(KEY, solved=True)
     view = app.controller.view
     info = {k: v for k, v in view.info.items() if k != "cpu_seconds"}
     if cpu is not None:
@@ -45,6 +38,6 @@ def test_geometry_sliders_are_live_when_the_solve_is_fast_in_cpu_time(cpu, wall,
     assert app.fast_solves() == live
     # a drag step of the base thickness (no release): applied only when live
     before = app.state.base.thickness
-    app.base_thickness.value = 2.5
+    app.base_tab.base_thickness.value = 2.5
     assert app.controller.wait(120)
     assert app.state.base.thickness == pytest.approx(2.5 if live else before)

@@ -4,10 +4,8 @@ from __future__ import annotations
 
 import copy
 
-from explorer.app import ExplorerApp
-from explorer.pins import MAX_PINS, pin_labels
-from explorer.presets import presets
-from explorer.view_link import read_view_query, view_query
+from explorer.model import presets, read_view_query, view_query
+from explorer.model.pins import MAX_PINS, pin_labels
 
 
 def _scene(**loading: float) -> dict:
@@ -32,14 +30,14 @@ def test_pins_are_named_after_what_differs() -> None:
     assert pin_labels([base, renamed]) == ["1: Uniform coating, flat punch", "2: other"]
 
 
-def test_pins_compare_several_results_and_go_one_by_one() -> None:
-    app = ExplorerApp(executor=None)
+def test_pins_compare_several_results_and_go_one_by_one(explorer_app) -> None:
+    app = explorer_app()
     force = app.state.loading.histories["force"]
     for value in (500.0, 600.0, 700.0):
         force.value = value
         assert app.controller.wait(60)
-        app.pin()
-    app.pin()  # the same result again: not pinned twice
+        app.pins.pin()
+    app.pins.pin()  # the same result again: not pinned twice
     board = app.pins.board
     assert [pin.label for pin in board] == ["P = 500 kN/m", "P = 600 kN/m", "P = 700 kN/m"]
     lines = app.figures.pins
@@ -47,22 +45,22 @@ def test_pins_compare_several_results_and_go_one_by_one() -> None:
     assert [line.visible for line in lines.q_lines] == [True, True, True]
     assert [getattr(item.label, "value", item.label) for item in lines.legend_items[:3]] == [
         "P = 500 kN/m", "P = 600 kN/m", "P = 700 kN/m"]
-    assert app.readout.object.count("pinned-settlement") == 3
+    assert app.results.readout.object.count("pinned-settlement") == 3
     # the settlement is linear in the force (elastic coating, linear creep): the
     # readout's change against the 500 kN/m pin is +40 %
-    assert "+40.00 %" in app.readout.object
+    assert "+40.00 %" in app.results.readout.object
     assert [b.label for b in app.pins.pin_list.objects] == [
         "✕ P = 500 kN/m", "✕ P = 600 kN/m", "✕ P = 700 kN/m"]
     app.pins.pin_list.objects[1].clicks += 1   # remove the middle one
     assert [pin.label for pin in board] == ["P = 500 kN/m", "P = 700 kN/m"]
     assert not lines.q_lines[2].visible and len(lines.q_src[2].data["q"]) == 0
-    app.unpin()
+    app.pins.unpin()
     assert len(board) == 0 and app.pins.unpin_button.disabled
-    assert "pinned-settlement" not in app.readout.object
+    assert "pinned-settlement" not in app.results.readout.object
 
 
-def test_pin_every_step_keeps_the_last_steps() -> None:
-    app = ExplorerApp(executor=None)
+def test_pin_every_step_keeps_the_last_steps(explorer_app) -> None:
+    app = explorer_app()
     app.pins.every_step.value = True
     moment = app.state.loading.histories["moment"]
     for step in range(MAX_PINS + 2):
@@ -74,7 +72,7 @@ def test_pin_every_step_keeps_the_last_steps() -> None:
     assert labels[0] == "e = 0.2 m" and labels[-1] == "e = 0.7 m"
 
 
-def test_a_link_keeps_several_pins() -> None:
+def test_a_link_keeps_several_pins(explorer_app) -> None:
     scenes = [_scene(moment=m) for m in (0.0, 1e5, 2e5)]
     query = view_query(scenes[0], 4, 2, scenes)
     # three scenes that differ in one number deflate to little more than one
@@ -84,7 +82,7 @@ def test_a_link_keeps_several_pins() -> None:
     one = view_query(scenes[0], 0, 0, scenes[:1])
     assert read_view_query(one, 7)[2] == scenes[:1]
     assert view_query(scenes[0], 0, 0, [])["pin"] == ""
-    app = ExplorerApp(executor=None, query={k: v for k, v in query.items()})
+    app = explorer_app(query={k: v for k, v in query.items()})
     assert [pin.label for pin in app.pins.board] == ["e = 0 m", "e = 0.2 m", "e = 0.4 m"]
 
 
@@ -95,11 +93,11 @@ def test_a_link_with_too_many_pins_says_so() -> None:
     assert pins == [] and f"at most {MAX_PINS}" in message
 
 
-def test_pin_the_steps_of_a_load_over_a_range() -> None:
+def test_pin_the_steps_of_a_load_over_a_range(explorer_app) -> None:
     import pytest
 
-    app = ExplorerApp(executor=None)
-    app.pin()
+    app = explorer_app()
+    app.pins.pin()
     pins = app.pins
     # the first given load of the preset is the force; its steps replace the pins
     assert "force P [kN/m]" in pins.steps_label.object
@@ -119,4 +117,4 @@ def test_pin_the_steps_of_a_load_over_a_range() -> None:
     pins.step_count.value = 2
     pins.step_from.value, pins.step_to.value = 100.0, 100.0
     pins.steps_button.clicks += 1
-    assert app.notice.startswith("Steps not pinned: from and to")
+    assert app.screen.notice.startswith("Steps not pinned: from and to")

@@ -19,17 +19,18 @@ import param
 import pytest
 
 from core import scene_from_dict, solve
-from explorer.controller import SolveController, describe_field, format_error
-from explorer.links import decode_scene, encode_scene
-from explorer.presets import presets
-from explorer.results import negative_intervals
-from explorer.state import (
+from explorer.model import (
     CREEP_MODELS,
     QUANTITIES,
     STATEMENTS,
     ExplorerState,
     ProfileState,
+    decode_scene,
+    encode_scene,
+    presets,
 )
+from explorer.model.results import negative_intervals
+from explorer.solving import SolveController, describe_field, format_error
 
 PRESETS = presets()
 
@@ -425,23 +426,22 @@ def test_link_bombs_and_non_objects_are_refused():
         decode_scene(pack(b"{nope"))
 
 
-def test_app_uses_a_good_link_and_falls_back_on_a_bad_one():
-    from explorer.app import ExplorerApp
+def test_app_uses_a_good_link_and_falls_back_on_a_bad_one(explorer_app):
 
     scene = json.loads(json.dumps(PRESETS["worn_coating"]))
-    app = ExplorerApp(query={"scene": encode_scene(scene)}, executor=None)
-    assert app.notice == ""
+    app = explorer_app(query={"scene": encode_scene(scene)})
+    assert app.screen.notice == ""
     assert app.state.scene_name == scene["name"]
     assert app.controller.view is not None
 
     scene["coating"][0]["modulus"] = -1.0
-    app = ExplorerApp(query={"scene": encode_scene(scene)}, executor=None)
-    assert "coating[0].modulus" in app.notice and "default" in app.notice
+    app = explorer_app(query={"scene": encode_scene(scene)})
+    assert "coating[0].modulus" in app.screen.notice and "default" in app.screen.notice
     assert app.state.scene_name == PRESETS["uniform_flat"]["name"]
     assert app.controller.view is not None and app.controller.error == ""
 
-    app = ExplorerApp(query={"scene": "1.garbage!"}, executor=None)
-    assert "link" in app.notice and app.controller.view is not None
+    app = explorer_app(query={"scene": "1.garbage!"})
+    assert "link" in app.screen.notice and app.controller.view is not None
 
 
 def release(widget, value):
@@ -451,39 +451,38 @@ def release(widget, value):
         widget.value_throttled = value
 
 
-def test_app_widgets_follow_and_drive_the_state(monkeypatch):
+def test_app_widgets_follow_and_drive_the_state(monkeypatch, explorer_app):
     from explorer import app as app_module
-    from explorer.app import ExplorerApp
 
     # solves slower than the live threshold: geometry sliders apply on release only
     monkeypatch.setattr(app_module, "LIVE_SOLVE_S", 0.0)
-    app = ExplorerApp(executor=None)
-    app.preset.value = "patched_insert"
+    app = explorer_app()
+    app.scene_tab.preset.value = "patched_insert"
     assert app.state.loading.statement == "settlement + tilt given"
-    assert app.statement.value == "settlement + tilt given"
+    assert app.scene_tab.statement.value == "settlement + tilt given"
     assert app.controller.view.scene["name"] == PRESETS["patched_insert"]["name"]
-    assert "Given settlement" in app.history_editors[0].title.object
+    assert "Given settlement" in app.scene_tab.history_editors[0].title.object
     # a load slider writes while dragging (value), a geometry slider on release
-    editor = app.history_editors[0]
+    editor = app.scene_tab.history_editors[0]
     editor.value.value = 0.06
     assert app.state.loading.histories["settlement"].value == pytest.approx(0.06)
-    app.base_thickness.value = 3.5
+    app.base_tab.base_thickness.value = 3.5
     assert app.state.base.thickness != 3.5
-    release(app.base_thickness, 3.5)
+    release(app.base_tab.base_thickness, 3.5)
     assert app.state.base.thickness == pytest.approx(3.5)
     # solves faster than the threshold (the last one measured): every drag step applies
     monkeypatch.setattr(app_module, "LIVE_SOLVE_S", float("inf"))
-    app.base_thickness.value = 3.6
+    app.base_tab.base_thickness.value = 3.6
     assert app.state.base.thickness == pytest.approx(3.6)
     # bad input: message in the alert, plots keep the last good result
     view = app.controller.view
-    release(app.thickness_editor.mean, -1.0)
-    assert app.alert.visible and "coating[0].thickness" in app.alert.object
+    release(app.coating_tab.thickness_editor.mean, -1.0)
+    assert app.results.alert.visible and "coating[0].thickness" in app.results.alert.object
     assert app.controller.view is view
     # downloads hold what is on screen
-    assert app._scene_file().getvalue().strip().startswith("{")
-    assert json.loads(app._scene_file().getvalue()) == view.scene
-    csv = app._csv_file().getvalue()
+    assert app.files_tab._scene_file().getvalue().strip().startswith("{")
+    assert json.loads(app.files_tab._scene_file().getvalue()) == view.scene
+    csv = app.files_tab._csv_file().getvalue()
     assert csv.startswith("# coated-punch explorer") and "\ntime_day,settlement_mm," in csv
 
 
@@ -511,29 +510,28 @@ def test_time_is_quick_to_scrub():
     assert controller.solves == solves
 
 
-def test_scene_files_load_and_bad_files_explain_themselves():
-    from explorer.app import ExplorerApp
+def test_scene_files_load_and_bad_files_explain_themselves(explorer_app):
 
-    app = ExplorerApp(executor=None)
+    app = explorer_app()
     scene = PRESETS["rounded_graded"]
-    app.load_file.filename = "rounded.json"
-    app.load_file.value = json.dumps(scene).encode()
-    assert app.notice == ""
-    assert app.state.n_layers == 3 and app.layer.options == ["1", "2", "3"]
+    app.files_tab.load_file.filename = "rounded.json"
+    app.files_tab.load_file.value = json.dumps(scene).encode()
+    assert app.screen.notice == ""
+    assert app.state.n_layers == 3 and app.coating_tab.layer.options == ["1", "2", "3"]
     assert app.controller.view.scene["name"] == scene["name"]
     shown = app.controller.view
 
-    app.load_file.value = b"{not json"
-    assert "not valid JSON" in app.notice
+    app.files_tab.load_file.value = b"{not json"
+    assert "not valid JSON" in app.screen.notice
     bad = json.loads(json.dumps(scene))
     bad["base"]["thickness"] = -1
-    app.load_file.value = json.dumps(bad).encode()
-    assert "base.thickness" in app.notice
+    app.files_tab.load_file.value = json.dumps(bad).encode()
+    assert "base.thickness" in app.screen.notice
     assert app.controller.view is shown and app.state.n_layers == 3
 
-    app.shape_file.filename = "shape.csv"
-    app.shape_file.value = b"x,f\n-0.5,0.00002\n0,0\n0.5,0.00001\n"
+    app.punch_tab.shape_file.filename = "shape.csv"
+    app.punch_tab.shape_file.value = b"x,f\n-0.5,0.00002\n0,0\n0.5,0.00001\n"
     assert app.state.punch.shape == "custom" and app.controller.error == ""
-    assert "shape.csv" in app.shape_note.object
-    app.shape_file.value = b"x,f\n-0.5,abc\n0,0\n"
-    assert "punch.shape" in app.notice and "line 2" in app.notice
+    assert "shape.csv" in app.punch_tab.shape_note.object
+    app.punch_tab.shape_file.value = b"x,f\n-0.5,abc\n0,0\n"
+    assert "punch.shape" in app.screen.notice and "line 2" in app.screen.notice

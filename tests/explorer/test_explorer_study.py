@@ -12,9 +12,9 @@ import pytest
 
 from core import solve
 from core.study.definition import apply_point
-from explorer.presets import presets
-from explorer.state import ExplorerState
-from explorer.study import (
+from explorer.files import study_csv
+from explorer.model import ExplorerState, presets
+from explorer.model.study import (
     ECCENTRICITY,
     MAX_POINTS,
     OUTPUTS,
@@ -22,7 +22,7 @@ from explorer.study import (
     plan_study,
     study_choices,
 )
-from explorer.study_runner import StudyRun
+from explorer.solving import StudyRun
 
 
 def screen_scene(times=(1.0, 365.0)) -> dict:
@@ -134,13 +134,12 @@ def test_cancel_stops_the_study_process():
     assert again.status == "done", again.message
 
 
-def test_the_tab_draws_the_chart_and_writes_the_files():
-    from explorer.app import create_app
-    from explorer.views.study import NONE, StudyView
+def test_the_tab_draws_the_chart_and_writes_the_files(explorer_app):
+    from explorer.views.study import NONE
 
     state_scene = screen_scene()
-    app = create_app(scene=state_scene)
-    tab = next(v for v in app.views if isinstance(v, StudyView))
+    app = explorer_app(scene=state_scene)
+    tab = app.study_tab
     assert tab.study_first.field.value == "loading.force"
     assert tab.study_second.field.value == NONE
     tab.study_first.fill(Axis("loading.force", 300.0, 700.0, 3))
@@ -177,7 +176,7 @@ def test_the_tab_draws_the_chart_and_writes_the_files():
 
 
 def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
-    from explorer.study_plots import DesignChart
+    from explorer.plots import DesignChart
 
     scene = screen_scene()
     scene["solver"]["contact"] = "full"  # the full-contact answer, flagged when q < 0
@@ -192,39 +191,39 @@ def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
     chart.draw(result, "q_min", 1)
     np.testing.assert_allclose(chart.flagged.data["x"], [0.6])
     assert chart.flagged.data["y"][0] < 0  # kPa: the tension the flag is about
-    rows = [line for line in result.to_csv().splitlines() if not line.startswith("#")]
+    rows = [line for line in study_csv(result).splitlines() if not line.startswith("#")]
     assert rows[-1].endswith('"contact_lost",""')
 
 
-def test_a_link_keeps_the_study_settings():
+def test_a_link_keeps_the_study_settings(explorer_app):
     """The Study tab's fields, ranges, spacing, counts and output go into the page's link
     and a page opened from it shows them again; bad settings are refused, not fatal."""
-    from explorer.app import ExplorerApp
-    from explorer.view_link import read_study_query, study_settings, view_query
+    from explorer.model.view_link import read_study_query, study_settings, view_query
 
-    app = ExplorerApp(executor=None)
-    first, second = app.study_first, app.study_second
+    app = explorer_app()
+    first, second = app.study_tab.study_first, app.study_tab.study_second
     first.field.value = "coating[0].modulus"
     first.start.value, first.stop.value = 150.0, 1200.0
     first.count.value, first.spacing.value = 7, "log"
     second.field.value = "loading.force"
     second.start.value, second.stop.value = 250.0, 650.0
     second.count.value, second.spacing.value = 5, "linear"
-    app.study_output.value = "tilt"
-    settings = app.study_settings()
+    app.study_tab.study_output.value = "tilt"
+    settings = app.study_tab.study_settings()
     assert settings == {"axes": [["coating[0].modulus", 150.0, 1200.0, 7, "log"],
                                  ["loading.force", 250.0, 650.0, 5, "linear"]],
                         "output": "tilt"}
     query = view_query(app.controller.view.scene, 0, 0, [], settings)
-    opened = ExplorerApp(executor=None, query=query)
-    assert opened.study_settings() == settings
-    assert opened.study_second.field.value == "loading.force"
-    assert opened.study_first.spacing.value == "log" and opened.study_first.count.value == 7
+    opened = explorer_app(query=query)
+    assert opened.study_tab.study_settings() == settings
+    assert opened.study_tab.study_second.field.value == "loading.force"
+    first = opened.study_tab.study_first
+    assert first.spacing.value == "log" and first.count.value == 7
     # one parameter: the second is left out
     one = {"axes": [["loading.force", 100.0, 900.0, 4, "linear"]], "output": "q_max"}
-    opened = ExplorerApp(executor=None, query=view_query(app.controller.view.scene, 0, 0,
+    opened = explorer_app(query=view_query(app.controller.view.scene, 0, 0,
                                                          [], one))
-    assert opened.study_settings() == one
+    assert opened.study_tab.study_settings() == one
     # settings a page never writes: refused with the setting named, the page opens
     for bad, reason in (({"axes": [], "output": "tilt"}, "study axes"),
                         ({"axes": [["x", 1.0, float("nan"), 3, "log"]], "output": "tilt"},
@@ -237,7 +236,7 @@ def test_a_link_keeps_the_study_settings():
                          "study output")):
         with pytest.raises(ValueError, match=reason):
             study_settings(bad)
-    from explorer.links import encode_scene
+    from explorer.model import encode_scene
 
     settings, message = read_study_query({"study": encode_scene({"axes": "x"})})
     assert settings is None and message.startswith("The study settings in the link were "

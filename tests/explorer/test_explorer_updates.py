@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 from bokeh.models import ColumnDataSource
 
-from explorer.app import BUSY_AFTER_MS, LINK_EVERY_MS, ExplorerApp
-from explorer.plots import set_data
+from explorer.app import ExplorerApp
+from explorer.plots.bokeh_data import set_data
+from explorer.views import BUSY_AFTER_MS, LINK_EVERY_MS, PageLoop
 
 
 def test_set_data_skips_equal_numbers_and_sends_changes() -> None:
@@ -47,8 +48,8 @@ def _count_changes(app: ExplorerApp) -> dict[str, list[int]]:
     return counts
 
 
-def test_a_load_step_resends_only_the_data_that_changed() -> None:
-    app = ExplorerApp(executor=None)
+def test_a_load_step_resends_only_the_data_that_changed(explorer_app) -> None:
+    app = explorer_app()
     assert set(app.state.to_scene()["loading"]) == {"force", "moment"}  # P = 500 kN/m, M = 0
     counts = _count_changes(app)
     force = app.state.loading.histories["force"]
@@ -62,7 +63,7 @@ def test_a_load_step_resends_only_the_data_that_changed() -> None:
         assert sent[name] == 0, name
     assert app.figures.pins.q_src == []
     # pinning makes the pin's lines; a load step then leaves the pinned curves alone
-    app.pin()
+    app.pins.pin()
     counts = _count_changes(app)
     force.value = force.value * 1.1
     assert app.controller.wait(60) and app.controller.error == ""
@@ -88,11 +89,11 @@ class _Timers:
 
 
 @pytest.fixture
-def served_app(monkeypatch: pytest.MonkeyPatch) -> tuple[ExplorerApp, _Timers]:
-    app = ExplorerApp(executor=None)
+def served_app(monkeypatch: pytest.MonkeyPatch, explorer_app) -> tuple[ExplorerApp, _Timers]:
+    app = explorer_app()
     timers = _Timers()
-    monkeypatch.setattr(ExplorerApp, "_served", property(lambda self: True))
-    monkeypatch.setattr(app, "_later", timers)
+    monkeypatch.setattr(PageLoop, "served", property(lambda self: True))
+    monkeypatch.setattr(app.loop, "later", timers)
     return app, timers
 
 
@@ -100,26 +101,26 @@ def test_the_busy_indicator_waits_for_a_slow_solve(served_app) -> None:
     app, timers = served_app
     # a quick solve: over before the indicator is due, never shown
     app.controller.busy = True
-    assert not app.spinner.value and "Solving" not in app.status.object
+    assert not app.results.spinner.value and "Solving" not in app.results.status.object
     app.controller.busy = False
     assert timers.run() == [BUSY_AFTER_MS]
-    assert not app.spinner.value
+    assert not app.results.spinner.value
     # a slow one: shown when due, gone with the result
     app.controller.busy = True
     app.controller.busy = False
     app.controller.busy = True          # one timer for the whole busy spell
     assert timers.run() == [BUSY_AFTER_MS]
-    assert app.spinner.value and "Solving the newest change" in app.status.object
+    assert app.results.spinner.value and "Solving the newest change" in app.results.status.object
     app.controller.busy = False
-    assert not app.spinner.value and "Solving" not in app.status.object
+    assert not app.results.spinner.value and "Solving" not in app.results.status.object
 
 
-def test_the_busy_indicator_shows_at_once_outside_a_server() -> None:
-    app = ExplorerApp(executor=None)
+def test_the_busy_indicator_shows_at_once_outside_a_server(explorer_app) -> None:
+    app = explorer_app()
     app.controller.busy = True
-    assert app.spinner.value
+    assert app.results.spinner.value
     app.controller.busy = False
-    assert not app.spinner.value
+    assert not app.results.spinner.value
 
 
 class _Location:
@@ -127,7 +128,7 @@ class _Location:
 
     def __init__(self, app) -> None:
         self.calls: list[str] = []
-        app._address.param.watch(self._record, "value")
+        app.link.address.param.watch(self._record, "value")
 
     def _record(self, event) -> None:
         query = dict(part.split("=", 1) for part in event.new.lstrip("?").split("&"))
@@ -135,11 +136,11 @@ class _Location:
 
 
 def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
-    from explorer.links import decode_scene
+    from explorer.model import decode_scene
 
     app, timers = served_app
     location = _Location(app)
-    app._location = location
+    app.link.location = location
     force = app.state.loading.histories["force"]
     for value in (510.0, 520.0, 530.0):   # a drag: three results, one link
         force.value = value
@@ -147,7 +148,7 @@ def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
     assert location.calls == []
     assert timers.run() == [LINK_EVERY_MS]
     assert len(location.calls) == 1
-    assert decode_scene(location.calls[0]) == app._drawn.scene
+    assert decode_scene(location.calls[0]) == app.screen.drawn.scene
     assert decode_scene(location.calls[0])["loading"]["force"] == 530e3
     # nothing new on screen: the address is not written again
     app._on_view(None)
@@ -167,7 +168,7 @@ def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
 
 
 def test_a_message_left_queued_by_a_finished_write_task_is_still_sent() -> None:
-    """The state Panel's write queue can be left in (see explorer/panel_fixes.py): a
+    """The state Panel's write queue can be left in (see explorer/fixes/panel_fixes.py): a
     message queued and no write flag. Seen under load as a slider step whose plots never
     arrived; the guard sends it."""
     import asyncio
@@ -175,7 +176,7 @@ def test_a_message_left_queued_by_a_finished_write_task_is_still_sent() -> None:
     from bokeh.document import Document
     from panel.io import document as pdoc
 
-    from explorer.panel_fixes import install
+    from explorer.fixes.panel_fixes import install
 
     assert install()
 
@@ -211,7 +212,7 @@ def test_a_complete_page_is_frozen_out_of_the_collectors_reach(served_app, monke
     session ends so that its cycles are still freed."""
     import gc
 
-    from explorer import gc_policy
+    from explorer.fixes import gc_policy
 
     app, timers = served_app
     frozen: list[int] = []
@@ -246,7 +247,7 @@ def test_a_page_completed_after_its_session_ended_is_not_frozen() -> None:
     server by ~350 MiB each, none returned)."""
     import gc
 
-    from explorer import gc_policy
+    from explorer.fixes import gc_policy
 
     class Ended:
         destroyed = True
@@ -259,8 +260,8 @@ def test_a_page_completed_after_its_session_ended_is_not_frozen() -> None:
         gc.unfreeze()
 
 
-def test_one_output_time_draws_q_x_t_as_a_band_around_it() -> None:
-    app = ExplorerApp(executor=None)
+def test_one_output_time_draws_q_x_t_as_a_band_around_it(explorer_app) -> None:
+    app = explorer_app()
     app.state.time_count = 1
     assert app.controller.wait(60) and app.controller.error == ""
     (t,) = app.controller.view.times

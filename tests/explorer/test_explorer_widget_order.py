@@ -1,12 +1,12 @@
 """A load slider's move reaches the state before the slider's text box follows it
-(explorer/widgets.py, ``EditableSlider.watch_drag_first``), and every way of setting the
+(explorer/views/widgets.py, ``EditableSlider.watch_drag_first``), and every way of setting the
 value still ends with the state, the slider and the text box agreeing."""
 
 from __future__ import annotations
 
 import param
 
-from explorer.widgets import Binding, slider
+from explorer.views.widgets import Binding, slider
 
 
 class _Target(param.Parameterized):

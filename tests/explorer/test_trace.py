@@ -1,11 +1,11 @@
-"""The server's marks of a slider move (explorer/trace.py) and how the latency benchmark
-pairs them up (tests/support/trace_steps.py, for benchmarks/explorer_latency.py)."""
+"""The server's marks of a slider move (explorer/solving/trace.py) and how the latency
+benchmark pairs them up (tests/support/trace_steps.py, for benchmarks/explorer_latency.py)."""
 
 from __future__ import annotations
 
 import json
 
-import explorer.trace as trace
+import explorer.solving.trace as trace
 from tests.support.trace_steps import STEPS, server_steps
 
 

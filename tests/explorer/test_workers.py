@@ -1,4 +1,4 @@
-"""Solving in worker processes (explorer/workers.py), as ``python -m explorer`` does.
+"""Solving in worker processes (explorer/solving/workers.py), as ``python -m explorer`` does.
 
 A worker must give the view a solve here gives, bit for bit, and downloads that hold the
 numbers on screen. A slow solve holds up other sessions by ``SPILL_AFTER_S`` at most; a
@@ -23,14 +23,13 @@ from typing import Any
 import numpy as np
 import pytest
 
-import explorer.controller as controller_module
-import explorer.workers as workers
+import explorer.solving.controller as controller_module
+import explorer.solving.workers as workers
 from core import budget, solve
 from core.budget import stage_cache_bounds
-from explorer.controller import RESULTS, SolveController
-from explorer.results import prepare_view
-from explorer.state import QUANTITIES, ExplorerState
-from explorer.workers import (
+from explorer.model import QUANTITIES, ExplorerState, prepare_view
+from explorer.solving import RESULTS, SolveController
+from explorer.solving.workers import (
     SolverProcesses,
     WorkerFailed,
     download_text,
@@ -355,7 +354,7 @@ def test_workers_do_not_outlive_the_server(sig: int, wait_until) -> None:
     # callback, be printed and dropped, and leave the script asleep (1 in 3 clean runs).
     script = textwrap.dedent("""
         import signal, sys, threading
-        from explorer.controller import use_worker_processes
+        from explorer.solving.controller import use_worker_processes
 
         if __name__ == "__main__":
             stop = threading.Event()
@@ -380,16 +379,16 @@ def test_workers_do_not_outlive_the_server(sig: int, wait_until) -> None:
 
 
 def test_a_worker_solves_without_importing_the_page_libraries() -> None:
-    # A worker imports this module, core and the state's names (explorer/results.py); Panel
-    # and Bokeh would cost each worker ~1 s and ~100 MB for nothing.
+    # A worker imports the solving and model packages and core (explorer/model/results.py);
+    # Panel and Bokeh would cost each worker ~1 s and ~100 MB for nothing.
     script = textwrap.dedent("""
         import copy, sys
-        import explorer.code_creep_state, explorer.results, explorer.state, explorer.workers
-        from explorer.presets import DEFAULT_PRESET, presets
+        import explorer.model, explorer.solving.workers
+        from explorer.model import DEFAULT_PRESET, presets
 
         scene = copy.deepcopy(presets()[DEFAULT_PRESET])
         scene["times"] = {"end": 200.0, "count": 4, "spacing": "log"}
-        view = explorer.workers.solve_view(scene)
+        view = explorer.solving.workers.solve_view(scene)
         print(len(view.times), sorted(m for m in ("panel", "bokeh") if m in sys.modules))
     """)
     env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get(

@@ -28,8 +28,8 @@ from hypothesis import strategies as st
 
 from core.scene import scene_from_dict, solve
 from core.scene.files import parse_scene_json
-from explorer.controller import SolveController
-from explorer.state import QUANTITIES, STATEMENTS, ExplorerState
+from explorer.model import QUANTITIES, STATEMENTS, ExplorerState
+from explorer.solving import SolveController
 
 pytestmark = pytest.mark.timeout(600)
 

@@ -206,7 +206,7 @@ def test_fields_a_study_can_vary_and_a_smaller_limit():
 
 
 def test_contact_width_of_a_pressure_linear_in_x():
-    from core.study.batch import _contact_width
+    from core.study.outputs import contact_width as _contact_width
 
     x = -np.cos(np.linspace(0, np.pi, 201))  # uneven, like the plotting grid
     q = np.stack([x - 0.5, 1 + 0 * x, -1 - x * 0, 0.3 - x], axis=1)
@@ -264,7 +264,7 @@ def assert_batched_equal(values, estimate, result, outputs):
 
 
 def sweeps_point_outputs(result, outputs):
-    from core.study.batch import point_outputs
+    from core.study.outputs import point_outputs
 
     return point_outputs(result, outputs)
 
@@ -331,7 +331,7 @@ def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
         if result.info["contact"] == "unilateral":
             # the same solver on equal scenes: measured bitwise equal
             np.testing.assert_array_equal(got["values"][i],
-                                          sweeps.point_outputs(result, outputs))
+                                          sweeps_point_outputs(result, outputs))
             assert got["error_estimate"][i] == result.info["error_estimate"]
         else:  # full contact: the whole batch at once (core.study.loads)
             assert_batched_equal(got["values"][i], got["error_estimate"][i], result,
@@ -569,7 +569,7 @@ def test_batch_groups_points_sharing_a_geometry(monkeypatch):
         calls.append(len(next(iter(loads.values()))))
         return original(scene, loads, outputs)
 
-    monkeypatch.setattr(sweep_loads, "solve_load_batch", counted)
+    monkeypatch.setattr(sweeps, "solve_load_batch", counted)
     outputs = list(OUTPUTS)
     got = sweeps.run_batch(study.base, paths, grid, outputs, len(study.times))
     assert calls == [6, 6]  # the two valid moduli; the negative one is not batched
@@ -585,7 +585,7 @@ def test_batch_groups_points_sharing_a_geometry(monkeypatch):
         kinds[result.info["contact"]] += 1
         if result.info["contact"] == "unilateral":
             np.testing.assert_array_equal(got["values"][i],
-                                          sweeps.point_outputs(result, outputs))
+                                          sweeps_point_outputs(result, outputs))
         else:
             assert_batched_equal(got["values"][i], got["error_estimate"][i], result,
                                  outputs)
@@ -626,7 +626,7 @@ def test_points_of_one_eccentricity_are_one_answer_scaled(monkeypatch):
     # answered with the load batch
     assert len(solved) == 6
     def same_as_the_point(i, result):
-        want = batch.point_outputs(result, list(OUTPUTS))
+        want = sweeps_point_outputs(result, list(OUTPUTS))
         scale = np.max(np.abs(want), axis=1, keepdims=True)
         scale = np.where(scale > 0, scale, 1.0)
         np.testing.assert_allclose(got["values"][i] / scale, want / scale, rtol=0,
@@ -702,7 +702,7 @@ def test_liftoff_eccentricities_of_a_batch_are_one_family(monkeypatch):
     worst = []
 
     def same_as_the_point(i, result):
-        want = batch.point_outputs(result, list(OUTPUTS))
+        want = sweeps_point_outputs(result, list(OUTPUTS))
         scale = np.max(np.abs(want), axis=1, keepdims=True)
         scale = np.where(scale > 0, scale, 1.0)
         worst.append(float(np.max(np.abs(got["values"][i] - want) / scale)))

@@ -28,7 +28,7 @@ import struct
 from collections import Counter
 from typing import Any
 
-from explorer.gc_policy import COLLECT_AFTER_S, LATE_COLLECT_AFTER_S
+from explorer.fixes.gc_policy import COLLECT_AFTER_S, LATE_COLLECT_AFTER_S
 
 WAYS = ("get", "ack", "pull", "loaded")
 #: Added to the time the server needs to discard a round's sessions [s] (a loaded

@@ -1,6 +1,6 @@
 """The scene suite of the work-precision benchmark (all quantities dimensionless).
 
-Every scene is one instance of the dimensionless problem of ``core/README.md``:
+Every scene is one instance of the dimensionless problem of ``docs/method.md``:
 
     c(t) m(x) q + (I - V) F q = delta + alpha x - g(x),   int q = P,   int x q = M,
 

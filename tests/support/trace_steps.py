@@ -1,4 +1,4 @@
-"""A slider move's way through the server, from the marks of explorer/trace.py.
+"""A slider move's way through the server, from the marks of explorer/solving/trace.py.
 
 ``benchmarks/explorer_latency.py`` splits each move's latency into these steps; a test
 checks the pairing on a trace written by hand.
@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-#: The server's marks of one move (explorer/trace.py), in the order they happen.
+#: The server's marks of one move (explorer/solving/trace.py), in the order they happen.
 STEPS = ("ws_in", "widget_event", "widget_value", "revision", "sent", "worker_start",
          "worker_end", "received", "delivered", "drawn", "ws_out")
 

@@ -27,8 +27,11 @@ Cost: one LU factorization per distinct step matrix while there are few (elastic
 non-aging kernel), else one Schur form and O(N^2) per step; plus O(N * steps) per step for
 the memory term, so O(N * steps^2) in total. Meant for cross-checks, not for speed.
 
-This module holds the solution, the input checks and :func:`solve_collocation`; the time
-stepping is :mod:`core.engines.collocation.steps` (``time_grid`` is re-exported here).
+This module holds the solution type, the input checks and :func:`solve_collocation`, made
+of the two steps the registered engine (:mod:`core.engines.collocation.engine`) takes too:
+:func:`prepare_collocation` (panels and operator) and :func:`solve_prepared` (the time
+stepping, the judgement of its estimate, the answer); the time stepping itself is
+:mod:`core.engines.collocation.steps`.
 """
 
 from __future__ import annotations
@@ -47,77 +50,63 @@ from core.engines.collocation.steps import (
     adaptive_grids,
     finite_values,
     fixed_grids,
-    time_grid,
 )
 from core.problem import QUANTITIES as _QUANTITIES
 from core.problem import STATEMENTS as _STATEMENTS
-from core.problem import validate_times
+from core.problem import ContactSolution, accepts, validate_times
 from core.validation import PYTHON_STYLE, finite_number, positive_number
 
 TimeInput = float | Callable[[np.ndarray], np.ndarray]
 
 #: Default relative accuracy aimed at in time when ``time_points`` is not given.
 DEFAULT_TIME_TOL = 1e-6
+#: Margin of :func:`core.problem.accepts`: the estimate in time (the distance of two
+#: Richardson levels over 15, or of two grids over 3) is taken as it stands.
+SUCCESS_MARGIN = 1.0
 
-__all__ = ["DEFAULT_TIME_TOL", "CollocationSolution", "TimeInput", "collocation_panels",
-           "solve_collocation", "time_grid"]
+__all__ = ["DEFAULT_TIME_TOL", "CollocationGeometry", "CollocationSolution", "TimeInput",
+           "collocation_panels", "prepare_collocation", "solve_collocation", "solve_prepared"]
 
 
-@dataclass(frozen=True)
-class CollocationSolution:
-    """Result of :func:`solve_collocation`, all quantities dimensionless.
+class CollocationSolution(ContactSolution):
+    """The :class:`core.problem.ContactSolution` of the collocation engine.
 
-    ``times`` (T,); ``settlement`` (delta), ``tilt`` (alpha), ``force`` (P) and ``moment``
-    (M) are arrays over ``times``. ``pressure(x)`` gives ``q`` of shape (len(x), T).
-    ``info`` holds ``n_nodes``, ``n_steps`` (steps of the finest time grid, or the number
-    of times for an elastic base), ``seconds`` (wall clock), ``statement`` (1-4),
-    ``richardson``, ``error_estimate`` (estimated relative error of the time
-    discretization: 0 for an elastic base, NaN for one fixed grid without Richardson)
-    and ``message``. ``nodes`` and ``nodal_pressure`` expose the collocation solution.
+    Its ``info`` holds the keys every engine sets (:data:`core.problem.INFO_KEYS`) and
+    ``richardson``, ``nodes`` and ``nodal_pressure`` (the collocation solution itself,
+    arrays); this class only reads the last two as attributes. ``error_estimate`` is the
+    estimated relative error of the time discretization (0 for an elastic base, NaN for
+    one fixed grid without Richardson): the spatial error is not estimated
+    (``spatial_error_estimate`` NaN), its panels being fixed by ``panels_per_unit`` and
+    ``edge_width`` (a cross-check: refine them to see it).
     """
-
-    times: np.ndarray
-    settlement: np.ndarray
-    tilt: np.ndarray
-    force: np.ndarray
-    moment: np.ndarray
-    info: dict
-    panels: Panels = field(repr=False)
-    # Pieces of the Nystrom formula at the output times: c(t), and the density whose F
-    # gives (I - V) F q, i.e. q(t) - V q(t), at the nodes (N, T).
-    _lam: float = field(repr=False)
-    _m: Callable[[np.ndarray], np.ndarray] = field(repr=False)
-    _g: Callable[[np.ndarray], np.ndarray] = field(repr=False)
-    _c: np.ndarray = field(repr=False)
-    _effective: np.ndarray = field(repr=False)
-    _nodal: np.ndarray = field(repr=False)
 
     @property
     def nodes(self) -> np.ndarray:
         """Collocation nodes in [-1, 1] (dimensionless x), shape (N,)."""
-        return self.panels.nodes
+        return self.info["nodes"]
 
     @property
     def nodal_pressure(self) -> np.ndarray:
         """Dimensionless pressure at the collocation nodes, shape (N, len(times))."""
-        return self._nodal
+        return self.info["nodal_pressure"]
 
-    def pressure(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Dimensionless pressure ``q(x, t)`` at points ``x`` in [-1, 1], shape (len(x), T).
 
-        Nystrom interpolation: exact at the nodes, and between them as accurate as the
-        nodal solution (divided by ``c m(x)``, so relative accuracy degrades as m -> 0).
-        """
-        x = np.atleast_1d(np.asarray(x, dtype=float))
-        if x.ndim != 1:
-            raise ValueError("x: must be a scalar or a 1-D array of points")
-        if not np.all(np.isfinite(x)) or np.any(np.abs(x) > 1.0):
-            raise ValueError("x: points must be finite and lie in [-1, 1]")
-        m = _eval_space(self._m, x, "m")
-        g = _eval_space(self._g, x, "g")
-        fq = operator_rows(self._lam, self.panels, x) @ self._effective
-        rhs = self.settlement[None, :] + self.tilt[None, :] * x[:, None] - g[:, None] - fq
-        return rhs / (m[:, None] * self._c[None, :])
+@dataclass(frozen=True)
+class CollocationGeometry:
+    """The spatial side of a collocation solve (dimensionless): the panel rule, the
+    discrete operator ``F`` on it (N x N), ``m`` and ``g`` at its nodes, and ``tol``, the
+    relative accuracy the time grid aims at (the panels are fixed)."""
+
+    lam: float
+    m: Callable[[np.ndarray], np.ndarray]
+    g: Callable[[np.ndarray], np.ndarray]
+    panels: Panels
+    operator: np.ndarray = field(repr=False)
+    m_nodes: np.ndarray = field(repr=False)
+    g_nodes: np.ndarray = field(repr=False)
+    breakpoints: tuple[float, ...]
+    tol: float
+    seconds: float  # time of the preparation [s]
 
 
 def collocation_panels(lam: float, breakpoints: Sequence[float] = (), *,
@@ -176,10 +165,7 @@ def solve_collocation(
     """
     started = time.perf_counter()
     lam = _positive_number(lam, "lam")
-    ppu = _positive_number(panels_per_unit, "panels_per_unit")
-    edge = _positive_number(edge_width, "edge_width")
-    if edge > 1.0:
-        raise ValueError(f"edge_width: must be at most 1, got {edge!r}")
+    ppu, edge = check_resolution(panels_per_unit, edge_width)
     tol = _positive_number(time_tol, "time_tol")
     times_arr = validate_times(times)  # the checks and limits of solve_dimensionless
     cuts = _check_breakpoints(breakpoints)
@@ -199,56 +185,146 @@ def solve_collocation(
     loads = {name: _function(value, name) for name, value in given.items()}
     if kernel is not None and not callable(kernel):
         raise ValueError("kernel: must be None or a callable K(t, tau)")
-    if time_points is not None:
-        if isinstance(time_points, bool) or not isinstance(time_points, (int, np.integer)) \
-                or time_points < 1:
-            raise ValueError(f"time_points: must be a positive integer, got {time_points!r}")
-    if richardson is None:
-        richardson = kernel is not None
+    check_time_points(time_points)
 
-    panels = collocation_panels(lam, cuts, panels_per_unit=ppu, edge_width=edge)
+    prepared = prepare_collocation(lam, m_fn, g_fn, cuts, ppu, edge, tol, started=started)
+    return solve_prepared(prepared, times_arr, c_fn, kernel, loads, time_points, richardson,
+                          tol_name="time_tol")
+
+
+def prepare_collocation(lam: float, m: Callable[[np.ndarray], np.ndarray],
+                        g: Callable[[np.ndarray], np.ndarray], breakpoints: Sequence[float],
+                        panels_per_unit: float, edge_width: float, tol: float, *,
+                        started: float | None = None) -> CollocationGeometry:
+    """The panel rule of :func:`collocation_panels` and the operator on it, for checked
+    arguments (``started``: the clock [s] the preparation counts from, default now)."""
+    started = time.perf_counter() if started is None else started
+    panels = collocation_panels(lam, breakpoints, panels_per_unit=panels_per_unit,
+                                edge_width=edge_width)
     x = panels.nodes
-    m_nodes = _eval_space(m_fn, x, "m")
+    m_nodes = _eval_space(m, x, "m")
     if np.any(m_nodes <= 0.0):
         raise ValueError("m: the coating compliance must be > 0 on [-1, 1]")
-    g_nodes = _eval_space(g_fn, x, "g")
+    g_nodes = _eval_space(g, x, "g")
     op = kernel_operator(lam, panels).matrix
-    system = CollocationSystem(panels, op, m_nodes, g_nodes, key, loads, c_fn, kernel)
+    return CollocationGeometry(lam, m, g, panels, op, m_nodes, g_nodes, tuple(breakpoints),
+                               tol, time.perf_counter() - started)
 
-    span = times_arr[-1] - 1.0
-    message = "ok"
+
+def solve_prepared(prepared: CollocationGeometry, times: np.ndarray,
+                   c: Callable[[np.ndarray], np.ndarray], kernel: Callable | None,
+                   loads: dict[str, Callable[[np.ndarray], np.ndarray]],
+                   time_points: int | None, richardson: bool | None, *,
+                   tol_name: str = "tol") -> CollocationSolution:
+    """March the prepared rule through ``times`` for checked arguments: ``loads`` the two
+    given histories by name, ``time_points`` a fixed grid (None: grids doubled until the
+    estimate meets ``prepared.tol``, named ``tol_name`` in the message)."""
+    started = time.perf_counter()
+    tol = prepared.tol
+    panels = prepared.panels
+    key = frozenset(loads)
+    if richardson is None:
+        richardson = kernel is not None
+    system = CollocationSystem(panels, prepared.operator, prepared.m_nodes, prepared.g_nodes,
+                               key, loads, c, kernel)
+
+    span = times[-1] - 1.0
+    limited = False
     if kernel is None or span <= 0.0:
         # No memory: every requested time is an independent elastic problem.
-        result = system.march(times_arr, np.diff(times_arr), np.arange(len(times_arr)))
-        n_steps = len(times_arr)
+        result = system.march(times, np.diff(times), np.arange(len(times)))
+        n_steps = len(times)
         error = 0.0
         richardson = False
     elif time_points is not None:
-        result, error, n_steps = fixed_grids(system, times_arr, int(time_points), richardson)
+        result, error, n_steps = fixed_grids(system, times, int(time_points), richardson)
     else:
-        result, error, n_steps, met = adaptive_grids(system, times_arr, richardson, tol)
-        if not met:
-            message = (f"time grid limit of {MAX_STEPS} steps reached; estimated relative "
-                       f"error {error:.1e} is above time_tol = {tol:.1e}")
+        result, error, n_steps, met = adaptive_grids(system, times, richardson, tol)
+        limited = not met
 
+    success = accepts(error, tol, SUCCESS_MARGIN)
+    if success:
+        message = "ok"
+    elif limited:
+        message = (f"time grid limit of {MAX_STEPS} steps reached; estimated relative "
+                   f"error {error:.1e} is above {tol_name} = {tol:.1e}")
+    elif math.isnan(error):
+        message = ("no error estimate: one fixed time grid without Richardson "
+                   "extrapolation")
+    else:
+        message = f"estimated relative error {error:.1e} is above {tol_name} = {tol:.1e}"
+    flags = [] if success else ["tol_not_met"]
+    q_scale = max(float(np.max(np.abs(result.nodal))), 1e-300)
+    min_q = float(np.min(result.nodal))
+    # as the other engines judge lift-off: below minus the estimate, relative to max|q|
+    if min_q < -max(error if math.isfinite(error) else 0.0, 1e-12) * q_scale:
+        flags.append("contact_lost")
+    seconds = time.perf_counter() - started
     info = {
+        "method": "collocation",
+        "error_estimate": float(error),
+        "spatial_error_estimate": math.nan,
+        "time_error_estimate": float(error),
+        "kernel_fit_error": 0.0,  # the kernel is used as it is, not fitted
+        "seconds": prepared.seconds + seconds,
+        "flags": flags,
+        "success": success,
+        "message": message,
+        "n_modes": panels.size,
         "n_nodes": panels.size,
         "n_steps": n_steps,
-        "seconds": time.perf_counter() - started,
         "statement": _STATEMENTS[key],
+        "given": sorted(key),
+        # over the nodes and the output times
+        "min_pressure": min_q,
+        "max_pressure": q_scale,
+        "basis": "collocation",
+        "element_ends": sorted(set(panels.edges[1:-1].tolist()) | set(prepared.breakpoints)),
+        "stages": {"panels": {"seconds": prepared.seconds, "cached": False},
+                   "solve": {"seconds": seconds, "cached": False}},
         "richardson": bool(richardson),
-        "error_estimate": float(error),
-        "message": message,
+        "nodes": panels.nodes,
+        "nodal_pressure": result.nodal,
     }
-    return CollocationSolution(
-        times=times_arr, settlement=result.delta, tilt=result.alpha, force=result.force,
-        moment=result.moment, info=info, panels=panels, _lam=lam, _m=m_fn, _g=g_fn,
-        _c=result.c, _effective=result.effective, _nodal=result.nodal)
+    lam, m, g = prepared.lam, prepared.m, prepared.g
+    c_out, effective = result.c, result.effective
+    settlement, tilt = result.delta, result.alpha
+
+    def pressure(x: np.ndarray) -> np.ndarray:
+        # the Nystrom formula: exact at the nodes, and between them as accurate as the
+        # nodal solution (divided by c m(x), so relative accuracy degrades as m -> 0)
+        if x.ndim != 1:
+            raise ValueError("x: must be a scalar or a 1-D array of points")
+        m_x = _eval_space(m, x, "m")
+        g_x = _eval_space(g, x, "g")
+        fq = operator_rows(lam, panels, x) @ effective
+        rhs = settlement[None, :] + tilt[None, :] * x[:, None] - g_x[:, None] - fq
+        return rhs / (m_x[:, None] * c_out[None, :])
+
+    return CollocationSolution(times, settlement, tilt, result.force, result.moment, info,
+                               None, np.zeros((0, times.size)), c_out, m, g, pressure)
 
 
 
 # ---------------------------------------------------------------------------------------
 # Input checking
+
+
+def check_resolution(panels_per_unit: object, edge_width: object) -> tuple[float, float]:
+    """``panels_per_unit`` and ``edge_width`` checked (``ValueError`` naming a bad one)."""
+    ppu = _positive_number(panels_per_unit, "panels_per_unit")
+    edge = _positive_number(edge_width, "edge_width")
+    if edge > 1.0:
+        raise ValueError(f"edge_width: must be at most 1, got {edge!r}")
+    return ppu, edge
+
+
+def check_time_points(time_points: object) -> None:
+    """Refuse a ``time_points`` that is not None or a positive integer, naming it."""
+    if time_points is not None:
+        if isinstance(time_points, bool) or not isinstance(time_points, (int, np.integer)) \
+                or time_points < 1:
+            raise ValueError(f"time_points: must be a positive integer, got {time_points!r}")
 
 
 def _positive_number(value: object, name: str) -> float:

@@ -1,4 +1,21 @@
-"""core.engines.layered."""
+"""The exact layered kernel: uniform coating layers on an elastic base (a scene-level engine).
+
+It needs the stack itself (each layer's thickness, modulus, Poisson ratio and interface,
+the base's thickness and Poisson ratio), which the dimensionless problem has collapsed into
+the thin-layer compliance ``m(x)``: so it is not in :data:`core.engines.ENGINES`, and
+:func:`core.scene.solve` asks it first with the scene (:func:`solve_scene_layered`, None
+where :func:`layered_declines`). Its answer is a :class:`core.problem.ContactSolution`
+with the common ``info`` keys and :func:`core.problem.accepts` (margin 1).
+
+- :mod:`~core.engines.layered.answer`: :func:`solve_scene_layered`, when it applies, the
+  answer packed;
+- :mod:`~core.engines.layered.solve`: :func:`solve_layered` (Chebyshev-Galerkin on the
+  stack's kernel) and **the error estimate**: the answers with half and a quarter of the
+  modes, their differences extrapolated geometrically;
+- :mod:`~core.engines.layered.galerkin`: modes, nodes and the Galerkin matrix;
+- :mod:`~core.engines.layered.cache`: the bounded caches of tables, operators and
+  responses; :mod:`~core.engines.layered.stiffness`: flat-punch stiffnesses in SI units.
+"""
 
 from __future__ import annotations
 

@@ -53,7 +53,6 @@ from core.engines.layered.cache import (
 from core.engines.layered.galerkin import (
     COARSE_TOL,
     MAX_MODES,
-    MAX_NODES,
     default_modes,
     galerkin_matrix,
     gap_moments,
@@ -62,8 +61,7 @@ from core.engines.layered.galerkin import (
 )
 from core.kernel import RegularPartTable, UniformLayer, symbol_at_infinity
 
-__all__ = ["LayeredAnswer", "LayeredResponse", "MAX_MODES", "MAX_NODES", "default_modes",
-           "layered_response", "node_count", "solve_layered", "table_degree"]
+__all__ = ["LayeredAnswer", "LayeredResponse", "layered_response", "solve_layered"]
 
 #: Geometric extrapolation of the last two differences uses at most this ratio (a slower
 #: decrease is not trusted: the estimate is then 9x the last difference).

@@ -51,7 +51,8 @@ from core.problem import (
 )
 
 #: The time stepping aims this many times below its share of tol: its step-doubling
-#: estimate read up to ~20x the true error on decaying creep (see core/solver.py).
+#: estimate read up to ~20x the true error on decaying creep (as the projection's, see
+#: core/engines/projection/solve.py).
 TIME_SHARE = 30.0
 #: Points (Chebyshev, plus both sides of every jump) where q >= 0 is checked.
 CHECK_POINTS = 401
@@ -434,8 +435,9 @@ def prepare(lam: float, m: Scalar, g: Scalar, *, breakpoints: Sequence[float] = 
 
     ``lam = a/H``; ``m(x) > 0`` the coating compliance; ``g(x) >= 0`` the gap; jumps of m
     or g declared in ``breakpoints``; ``tol`` the relative accuracy target of delta,
-    alpha, P, M and of q on the whole of [-1, 1]. Only ``method="nystrom"`` has a prepared
-    form; ``solve_dimensionless(method="projection")`` runs the seed's method.
+    alpha, P, M and of q on the whole of [-1, 1]. This is the Nystrom engine's prepared
+    form (``method="nystrom"`` only); the engines of :data:`core.engines.ENGINES` all
+    ``prepare`` a validated geometry the same way.
     """
     if method != "nystrom":
         raise ValueError(f"method: prepare supports 'nystrom' only, got {method!r}")
@@ -466,7 +468,7 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
                         moment: Scalar | None = None, breakpoints: Sequence[float] = (),
                         tol: float = 1e-8, time_breaks: Sequence[float] = (),
                         check_only: bool = False) -> ContactSolution:
-    """``solve_dimensionless(method="nystrom")``: prepare (or reuse) the geometry, then solve.
+    """The Nystrom engine on raw arguments: validate, prepare (or reuse) the geometry, solve.
 
     ``check_only``: see :meth:`PreparedContact.solve_validated`.
 
@@ -476,6 +478,12 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
     geometry = validate_geometry(lam, m, g, breakpoints, tol)
     inputs = validate_time_inputs(times, c, kernel, {"settlement": settlement, "tilt": tilt,
                                                      "force": force, "moment": moment})
+    return prepared_for(geometry).solve_validated(inputs, time_breaks, check_only=check_only)
+
+
+def prepared_for(geometry: Geometry) -> PreparedContact:
+    """The prepared form of a validated geometry: from :data:`PREPARED` when a geometry of
+    the same values was prepared before, else prepared now and kept there."""
     prepared, _ = PREPARED.get_or_compute(_geometry_key(geometry),
                                           lambda: PreparedContact(geometry))
-    return prepared.solve_validated(inputs, time_breaks, check_only=check_only)
+    return prepared

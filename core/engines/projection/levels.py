@@ -1,7 +1,8 @@
 """The projection engine's time stage: mode levels, superposition of loads, error estimates.
 
 Solves the modal Volterra equations for a chosen mode count (:mod:`core.time.integration`)
-and compares consecutive levels for the spatial error estimate (:mod:`core.solver`).
+and compares consecutive levels for the spatial error estimate (used by
+:mod:`core.engines.projection.solve`).
 """
 
 from __future__ import annotations

@@ -32,6 +32,7 @@ from __future__ import annotations
 import time as _time
 from collections.abc import Callable
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -43,7 +44,7 @@ from core.engines.projection.levels import (
     _Superposition,
 )
 from core.engines.projection.stages import _discretize, _Inputs, _modes
-from core.problem import ContactSolution, statement_number
+from core.problem import ContactSolution, accepts, statement_number
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
@@ -73,6 +74,15 @@ def _fast_kernel(inp: _Inputs) -> tuple[_Inputs, float]:
 
 
 
+def check_options(basis: Any, n_modes: Any) -> None:
+    """Refuse a ``basis`` or ``n_modes`` the projection does not know, naming it."""
+    if basis not in ("piecewise", "global", "graded"):
+        raise ValueError(f"basis: must be 'piecewise', 'global' or 'graded', got {basis!r}")
+    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int)
+                                or not 2 <= n_modes <= BASIS_CAPS[-1]):
+        raise ValueError(f"n_modes: must be an integer in [2, {BASIS_CAPS[-1]}], got {n_modes}")
+
+
 def solve_projection(inp: _Inputs, basis: str = "graded",
                      n_modes: int | None = None) -> ContactSolution:
     """Solve validated inputs (:func:`validate_inputs`) by the projection method.
@@ -82,12 +92,8 @@ def solve_projection(inp: _Inputs, basis: str = "graded",
     """
     t_start = _time.perf_counter()
     tol = inp.tol
-    if basis not in ("piecewise", "global", "graded"):
-        raise ValueError(f"basis: must be 'piecewise', 'global' or 'graded', got {basis!r}")
+    check_options(basis, n_modes)
     inp, kernel_fit_error = _fast_kernel(inp)
-    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int)
-                                or not 2 <= n_modes <= BASIS_CAPS[-1]):
-        raise ValueError(f"n_modes: must be an integer in [2, {BASIS_CAPS[-1]}], got {n_modes}")
     stages: dict[str, dict] = {}
     times_arr = inp.times
     c_t = inp.c(times_arr)
@@ -172,7 +178,7 @@ def solve_projection(inp: _Inputs, basis: str = "graded",
     stages["time"] = {"seconds": _time.perf_counter() - t_time, "cached": time_cached}
 
     error_estimate = float(spatial_error + chosen.time_error + kernel_fit_error)
-    success = error_estimate * SUCCESS_MARGIN <= tol and chosen.time_success
+    success = accepts(error_estimate, tol, SUCCESS_MARGIN) and chosen.time_success
     if not disc.resolved:
         flags.append("unresolved_input")
     if not success:
@@ -207,6 +213,7 @@ def solve_projection(inp: _Inputs, basis: str = "graded",
         message += ("; m or g has features finer than the quadrature could resolve "
                     "(declare jumps in breakpoints)")
     info = {
+        "method": "projection",
         "error_estimate": error_estimate,
         "spatial_error_estimate": float(spatial_error),
         "time_error_estimate": float(chosen.time_error),

@@ -1,7 +1,8 @@
 """Validation and the cached spatial stages of the projection engine.
 
 Panels, operator, basis, Galerkin rows, gap terms and modes (see the stage table of
-:mod:`core.solver`), each cached in :mod:`core.engines.projection.caches` on exactly its inputs.
+:mod:`core.engines.projection.solve`), each cached in :mod:`core.engines.projection.caches`
+on exactly its inputs.
 """
 
 from __future__ import annotations
@@ -38,7 +39,9 @@ from core.engines.projection.caches import (
 )
 from core.engines.projection.matrices import GapTerms, galerkin_matrix, gap_terms
 from core.problem import (
+    Geometry,
     ModalSystem,
+    TimeInputs,
     check_values,
     modal_system,
     validate_geometry,
@@ -65,8 +68,14 @@ class _Inputs:
 
 
 def validate_inputs(lam, m, g, times, c, kernel, loads, breakpoints, tol) -> _Inputs:
-    geometry = validate_geometry(lam, m, g, breakpoints, tol)
-    timing = validate_time_inputs(times, c, kernel, loads)
+    """The inputs of the dimensionless problem checked (as ``solve_dimensionless`` checks
+    them) and joined in the form the projection's stages take."""
+    return joined_inputs(validate_geometry(lam, m, g, breakpoints, tol),
+                         validate_time_inputs(times, c, kernel, loads))
+
+
+def joined_inputs(geometry: Geometry, timing: TimeInputs) -> _Inputs:
+    """A validated geometry and time side in the form the projection's stages take."""
     return _Inputs(geometry.lam, geometry.m, geometry.g, geometry.g_is_zero, timing.times,
                    timing.c, timing.c_is_constant, timing.kernel, timing.loads, timing.given,
                    geometry.breakpoints, geometry.tol)

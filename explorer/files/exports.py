@@ -1,0 +1,200 @@
+"""The CSV files of the explorer: the numbers on screen, in the units on screen.
+
+The result's files (histories, q(x, t)) are written from the
+:class:`~explorer.model.results.ResultView` that is drawn, so a file holds exactly what
+the plots show (no second solve, no worker needed). Each starts with ``#`` lines saying
+what was solved, how accurately, which validity flags were raised and in which units the
+columns are, so a flagged result never leaves unmarked (``pandas.read_csv(path,
+comment="#")`` reads the table). A study's file (:func:`study_csv`) holds every output
+at every time of every point. Numbers are written with
+:data:`DIGITS` significant digits: more than any accuracy target the solver offers
+(1e-8), without the binary round-off tails of ``repr`` (``799999.9999999999``).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable
+from importlib import metadata
+from typing import Any
+
+import numpy as np
+
+from ..model import OUTPUTS, QUANTITIES, QUANTITY_UNITS, ResultView, StudyResult, contact_widths
+
+#: Significant digits of every number in a CSV file.
+DIGITS = 10
+
+#: Column names of the histories, in the units the screen shows them in.
+HISTORY_COLUMNS = {"settlement": "settlement_mm", "tilt": "tilt_mrad",
+                   "force": "force_kN_per_m", "moment": "moment_kN_m_per_m"}
+#: The contact zone's columns of the histories [m]: the length of the base in contact
+#: and the length lifted off (their sum is the punch width 2a).
+CONTACT_COLUMNS = ("contact_width_m", "lifted_length_m")
+
+
+def project_version() -> str:
+    """The installed version of the project ('unknown' outside an installation)."""
+    try:
+        return metadata.version("coated-punch")
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+def number(value: float) -> str:
+    """``value`` with :data:`DIGITS` significant digits ('-0' written as '0')."""
+    text = f"{float(value):.{DIGITS}g}"
+    return "0" if text == "-0" else text
+
+
+def accuracy_statement(view: ResultView) -> str:
+    """What the solver says of its own accuracy for this result, in one sentence."""
+    info = view.info
+    tol = float(view.scene.get("solver", {}).get("tol", 1e-6))
+    err = info.get("error_estimate")
+    err_text = f"{float(err):.1e}" if isinstance(err, (int, float)) else "not available"
+    met = "met" if "tol_not_met" not in view.flags else "NOT met"
+    return (f"estimated relative error {err_text}, target {tol:g} ({met}); "
+            f"{info.get('n_modes', '?')} modes, {info.get('n_steps', '?')} time steps")
+
+
+def flag_lines(view: ResultView) -> list[str]:
+    """One line per raised flag with its explanation (the solver's message filled in)."""
+    return [f"{flag}: {flag_message(view, flag)}" for flag in view.flags]
+
+
+def flag_message(view: ResultView, flag: str) -> str:
+    """The explanation of ``flag``; the core's pointer to its report is replaced by the
+    report's own text, which the page and the files show."""
+    text = view.flag_messages.get(flag, flag)
+    detail = str(view.info.get("message", "")).strip()
+    if "see info.message" in text:
+        text = text.replace("see info.message", detail or "no further detail").rstrip(".")
+        text += "."
+    return text
+
+
+def _header(view: ResultView, what: str, units: Iterable[str]) -> list[str]:
+    scene = view.scene
+    given = ", ".join(view.given)
+    lines = [
+        f"# coated-punch explorer {project_version()}: {what}",
+        f"# scene: {scene.get('name', '')}",
+        f"# given: {given}; computed: {', '.join(view.unknowns)} (and the pressure)",
+        f"# accuracy: {accuracy_statement(view)}",
+    ]
+    flags = flag_lines(view)
+    if flags:
+        lines.append("# WARNING: this result is flagged; the model cannot fully stand "
+                     "behind it")
+        lines.extend(f"# flag {line}" for line in flags)
+    else:
+        lines.append("# flags: none")
+    lines.extend(f"# unit {u}" for u in units)
+    return lines
+
+
+def histories_csv(view: ResultView) -> str:
+    """The four histories as CSV, in mm, mrad, kN/m and kN·m/m, time in days, and the
+    contact width and the lifted length in m (as the contact width plot shows them)."""
+    width = 2 * view.geometry.half_width
+    units = ["time_day: days after loading"]
+    units += [f"{HISTORY_COLUMNS[q]}: {QUANTITY_UNITS[q][0]}"
+              f"{' (given)' if q in view.given else ' (computed)'}" for q in QUANTITIES]
+    units += [f"{CONTACT_COLUMNS[0]}: m, length of the base in contact (of 2a = "
+              f"{number(width)} m)",
+              f"{CONTACT_COLUMNS[1]}: m, length lifted off (2a - contact width)"]
+    lines = _header(view, "histories", units)
+    flags = ";".join(view.flags)
+    lines.append(",".join(["time_day", *(HISTORY_COLUMNS[q] for q in QUANTITIES),
+                           *CONTACT_COLUMNS, "flags"]))
+    contact = contact_widths(view)
+    columns = [view.times, *(view.display(q) for q in QUANTITIES), contact, width - contact]
+    for row in zip(*columns, strict=True):
+        lines.append(",".join([*(number(v) for v in row), flags]))
+    return "\n".join(lines) + "\n"
+
+
+def pressure_csv(view: ResultView, unit: tuple[str, float] | None = None) -> str:
+    """q(x, t) as CSV in long form (time, x, q), on the grid of the plotted line.
+
+    ``unit``: the pressure unit on screen and its size in Pa (default: the result's own).
+    A row whose pressure is negative beyond the error band is marked ``lift_off``.
+    """
+    name, size = unit or view.pressure_unit
+    column = f"q_{name}"
+    lines = _header(view, "contact pressure q(x, t)", [
+        "time_day: days after loading", "x_m: m from the punch centre",
+        f"{column}: {name} (compression positive)"])
+    lines.append(f"time_day,x_m,{column},flags")
+    band = view.lift_off_band()
+    q = view.pressure
+    for j, t in enumerate(view.times):
+        tt = number(t)
+        for xi, qi in zip(view.x, q[:, j], strict=True):
+            mark = "lift_off" if qi < -band else ""
+            lines.append(f"{tt},{number(xi)},{number(qi / size)},{mark}")
+    return "\n".join(lines) + "\n"
+
+
+def parse_csv(text: str) -> tuple[dict[str, str], list[str], np.ndarray]:
+    """Read a file of this module back: header lines, column names and the numbers
+    (the text ``flags`` column dropped). For tests and scripts."""
+    meta: dict[str, str] = {}
+    rows: list[list[float]] = []
+    names: list[str] = []
+    for line in text.splitlines():
+        if line.startswith("#"):
+            key, _, value = line[1:].strip().partition(": ")
+            meta[key] = value
+        elif not names:
+            names = line.split(",")[:-1]
+        elif line:
+            rows.append([float(v) for v in line.split(",")[: len(names)]])
+    return meta, names, np.array(rows, dtype=float)
+
+
+def describe(view: ResultView) -> dict[str, Any]:
+    """The metadata of a result as a dict (report and tests)."""
+    return {"version": project_version(), "scene": view.scene.get("name", ""),
+            "accuracy": accuracy_statement(view), "flags": flag_lines(view)}
+
+
+def study_csv(result: StudyResult) -> str:
+    """A design study as CSV: ``#`` lines saying what was varied, then one row per point
+    and output time (the parameters and outputs in the units on screen, ``flags`` and
+    ``error`` of the point)."""
+    planned = result.planned
+    base = planned.study.base
+    lines = [f"# coated-punch {project_version()}: design study around the scene "
+             f"{str(base.get('name', ''))[:200]!r}",
+             f"# {planned.study.n_points} points, "
+             f"{int(result.failed.sum())} failed, {int(result.flagged.sum())} flagged "
+             "(see the flags column: a flagged answer is outside the model's validity)"]
+    for c, v in zip(planned.choices, planned.values, strict=True):
+        lines.append(f"# varied: {c.label} [{c.unit}] from {number(v[0])} to "
+                     f"{number(v[-1])}, {len(v)} values")
+    header = [_study_column(c.label, c.unit) for c in planned.choices] + ["time_day"]
+    header += [_study_column(name, unit) for name, (_, unit, _) in OUTPUTS.items()]
+    lines.append(",".join(header + ["flags", "error"]))
+    grids = np.meshgrid(*planned.values, indexing="ij")
+    for index in np.ndindex(planned.shape):
+        params = [number(float(g[index])) for g in grids]
+        flags = '"' + result.flags[index] + '"'
+        error = '"' + str(result.errors[index]).replace('"', '""') + '"'
+        for k, t in enumerate(result.times):
+            row = params + [number(float(t))]
+            for name, (_, _, factor) in OUTPUTS.items():
+                value = float(result.outputs[name][index + (k,)])
+                row.append(number(value * factor) if math.isfinite(value) else "")
+            lines.append(",".join(row + [flags, error]))
+    return "\n".join(lines) + "\n"
+
+
+def _study_column(label: str, unit: str) -> str:
+    """A CSV column name: ``coating 1: Young's modulus`` [MPa] -> ``coating_1_young_s_
+    modulus_MPa``."""
+    name = re.sub(r"[^A-Za-z0-9]+", "_", label.split("=")[0]).strip("_").lower()
+    unit = {"kN·m/m": "kN_m_per_m", "kN/m": "kN_per_m", "-": "1"}.get(unit, unit)
+    return f"{name}_{unit}"

@@ -1,0 +1,16 @@
+"""Panel, Bokeh and Python's collector adjusted for a server holding many pages.
+
+Each module is one fix, with the versions it was checked with and why it is needed; each
+is used through its module (``panel_fixes.install()``), so a test can replace one part.
+
+- ``panel_fixes``: messages Panel queues for a page and then never sends.
+- ``bokeh_fixes``: style sheets BokehJS rewrites with the same text.
+- ``idle_painter``: the file dropper's frame loop, paused while nothing happens.
+- ``closed_pages``: pages closed abruptly (a debug line, not a traceback) and Panel's
+  link registry released when a session ends.
+- ``gc_policy``: the garbage collector kept off complete pages, and given them back.
+"""
+
+from . import bokeh_fixes, closed_pages, gc_policy, idle_painter, panel_fixes
+
+__all__ = ["bokeh_fixes", "closed_pages", "gc_policy", "idle_painter", "panel_fixes"]

@@ -1,0 +1,73 @@
+"""The explorer's model: what the user sets and what the page shows, in numbers and words.
+
+Nothing here imports Panel or Bokeh: the solver workers import this package (a result is
+prepared where it is solved), and the state can be used without a server.
+
+- ``state``: :class:`ExplorerState`, the scene on screen in display units, and its parts:
+  ``scene_parts`` (punch, coating layers, base), ``loading_state`` (which two quantities
+  are given, and their histories), ``code_creep_state`` (design-code creep inputs).
+- ``results``: :class:`ResultView`, a solution turned into the arrays the plots show.
+- ``contact_zone``: the contact zone of a result in numbers.
+- ``design``: the design check against the limits the user sets.
+- ``scales``: one pressure unit and colour range per scene family.
+- ``pins``: pinned results, named after what differs between them.
+- ``presets``, ``lessons``: the preset scenes, and lessons built from them.
+- ``links``, ``view_link``: the scene, and what else a link keeps, in the page's address.
+- ``undo``, ``history``: the scenes shown, for undo and reset.
+- ``screen``: what the page shows now (the result, the output time, a notice).
+- ``study``: the Study tab's design studies, planned from the scene on screen.
+"""
+
+from .code_creep_state import (
+    CODE_CREEP_MODELS,
+    STRENGTH_CLASSES,
+    CodeCreepState,
+    creep_coefficient_data,
+)
+from .contact_zone import contact_text, contact_widths, contact_zones, lifts_off
+from .design import DesignLimits, check_html, design_check
+from .history import SceneHistory
+from .lessons import Lesson, lessons, step_scene
+from .links import decode_scene, encode_scene
+from .loading_state import QUANTITIES, QUANTITY_RANGES, QUANTITY_UNITS, STATEMENTS, HistoryState
+from .pins import MAX_PINS, Pin, PinBoard
+from .presets import DEFAULT_PRESET, ORDER, SCENES_DIR, preset_label, presets
+from .results import Geometry, ResultView, prepare_view
+from .scales import DisplayScales
+from .scene_parts import (
+    CONTACT_MODELS,
+    CREEP_MODELS,
+    INTERFACES,
+    MAX_DESCRIPTION_CHARS,
+    MAX_NAME_CHARS,
+    SCREEN_LAYERS,
+    LayerState,
+    ProfileState,
+    check_text,
+)
+from .screen import Screen
+from .state import MODEL_TOL_RANGE, ExplorerState
+from .study import (
+    MAX_POINTS,
+    OUTPUTS,
+    SPACINGS,
+    Axis,
+    PlannedStudy,
+    StudyResult,
+    default_range,
+    plan_study,
+    study_choices,
+)
+from .view_link import read_study_query, read_view_query, view_query
+
+__all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
+           "MAX_DESCRIPTION_CHARS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS", "MODEL_TOL_RANGE",
+           "ORDER", "OUTPUTS", "QUANTITIES", "QUANTITY_RANGES", "QUANTITY_UNITS", "SCENES_DIR",
+           "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES", "Axis", "CodeCreepState",
+           "DesignLimits", "DisplayScales", "ExplorerState", "Geometry", "HistoryState",
+           "LayerState", "Lesson", "Pin", "PinBoard", "PlannedStudy", "ProfileState", "ResultView",
+           "SceneHistory", "Screen", "StudyResult", "check_html", "check_text", "contact_text",
+           "contact_widths", "contact_zones", "creep_coefficient_data", "decode_scene",
+           "default_range", "design_check", "encode_scene", "lessons", "lifts_off", "plan_study",
+           "prepare_view", "preset_label", "presets", "read_study_query", "read_view_query",
+           "step_scene", "study_choices", "view_query"]

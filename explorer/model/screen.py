@@ -1,0 +1,28 @@
+"""What the page shows now: the result drawn, the output time shown, and a notice."""
+
+from __future__ import annotations
+
+import param
+
+from .results import ResultView
+
+
+class Screen(param.Parameterized):
+    """The session's screen, shared by its views: the result on screen (what downloads,
+    the check, the report and the link hold), the output time shown, and a notice."""
+
+    notice = param.String(default="", doc="A problem with a file or a link (not a solve).")
+    time_index = param.Integer(default=0, doc="Index of the output time shown.")
+
+    def __init__(self, **params: object) -> None:
+        super().__init__(**params)
+        #: the result drawn (None until the first one); set by the page as it draws
+        self.drawn: ResultView | None = None
+
+    def shown(self) -> ResultView | None:
+        """The result on screen."""
+        return self.drawn
+
+    def reject(self, message: str) -> None:
+        """Say on the page that a value typed or dragged was refused, and why."""
+        self.notice = f"Value not accepted: {message}"

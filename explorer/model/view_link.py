@@ -1,0 +1,118 @@
+"""What a link keeps besides the scene: the output time shown, the open tab, the pins,
+the Study tab's settings.
+
+``?scene=…&t=12&tab=3&pin=…&study=…``: ``t`` is the index of the output time, ``tab`` the
+index of the open sidebar tab, ``pin`` the pinned results' scenes (encoded as the scene
+is, see :mod:`explorer.model.links`: one pin as its scene, several as ``{"pins": [scene,
+...]}``, which deflates to little more than one scene since pins differ in a few fields;
+the pins are solved again when the link is opened), ``study`` the Study tab's parameters
+(field, from, to, points, spacing of each) and output, encoded the same way (see
+:func:`study_settings`; the study is not run when the link is opened). Anything odd is
+ignored with a message, never fatal: the scene is what matters. No Panel import.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .links import decode_scene, encode_scene
+from .pins import MAX_PINS
+from .study import MAX_POINTS, OUTPUTS, SPACINGS
+
+#: Largest output-time index a link may ask for (the scene schema's limit is lower).
+MAX_INDEX = 100_000
+
+
+#: Longest field key of a study parameter in a link (the page's keys are ~25 characters).
+MAX_STUDY_KEY = 100
+#: Most parameters of the Study tab.
+MAX_STUDY_AXES = 2
+
+
+def view_query(scene: dict[str, Any], time_index: int, tab: int,
+               pins: list[dict[str, Any]],
+               study: dict[str, Any] | None = None) -> dict[str, str]:
+    """The query arguments of a link to this view (``pins``: the pinned scenes; ``study``:
+    the Study tab's settings, :func:`study_settings`)."""
+    query = {"scene": encode_scene(scene), "t": str(int(time_index)), "tab": str(int(tab))}
+    if len(pins) == 1:
+        query["pin"] = encode_scene(pins[0])
+    else:
+        query["pin"] = encode_scene({"pins": list(pins)}) if pins else ""
+    query["study"] = encode_scene(study_settings(study)) if study else ""
+    return query
+
+
+def study_settings(settings: Any) -> dict[str, Any]:
+    """The Study tab's settings checked: ``{"axes": [[key, from, to, points, spacing],
+    ...], "output": key}`` (one or two axes; from and to in the units on screen, finite;
+    points an integer in [2, MAX_POINTS]; spacing one of ``SPACINGS``; output one of
+    ``OUTPUTS``). Raises ValueError naming the setting and the reason."""
+    if not isinstance(settings, dict):
+        raise ValueError("the study settings are not a JSON object")
+    axes = settings.get("axes")
+    if not isinstance(axes, list) or not 1 <= len(axes) <= MAX_STUDY_AXES:
+        raise ValueError(f"study axes: must be a list of 1 to {MAX_STUDY_AXES} parameters")
+    checked = []
+    for n, axis in enumerate(axes, start=1):
+        if not isinstance(axis, list) or len(axis) != 5:
+            raise ValueError(f"study parameter {n}: must be [field, from, to, points, "
+                             "spacing]")
+        key, start, stop, count, spacing = axis
+        if not isinstance(key, str) or not 0 < len(key) <= MAX_STUDY_KEY:
+            raise ValueError(f"study parameter {n}: the field must be a text of 1 to "
+                             f"{MAX_STUDY_KEY} characters")
+        for name, value in (("from", start), ("to", stop)):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                    or value != value or abs(value) == float("inf"):
+                raise ValueError(f"study parameter {n}: '{name}' must be a finite number")
+        if isinstance(count, bool) or not isinstance(count, int) \
+                or not 2 <= count <= MAX_POINTS:
+            raise ValueError(f"study parameter {n}: points must be an integer in "
+                             f"[2, {MAX_POINTS}]")
+        if spacing not in SPACINGS:
+            raise ValueError(f"study parameter {n}: spacing must be one of "
+                             f"{', '.join(SPACINGS)}")
+        checked.append([key, float(start), float(stop), int(count), spacing])
+    output = settings.get("output")
+    if output not in OUTPUTS:
+        raise ValueError(f"study output: must be one of {', '.join(OUTPUTS)}")
+    return {"axes": checked, "output": output}
+
+
+def read_study_query(query: dict[str, str]) -> tuple[dict[str, Any] | None, str]:
+    """(the Study tab's settings or None, message) from a link's query arguments."""
+    if not query.get("study"):
+        return None, ""
+    try:
+        return study_settings(decode_scene(query["study"])), ""
+    except ValueError as exc:
+        return None, f"The study settings in the link were not used: {exc}."
+
+
+def _index(text: str | None, limit: int) -> int | None:
+    if not text or len(text) > 6 or not text.isdigit():
+        return None
+    value = int(text)
+    return value if value <= limit else None
+
+
+def read_view_query(query: dict[str, str], tabs: int) -> tuple[int | None, int | None,
+                                                                list[dict[str, Any]], str]:
+    """(time index, tab index, pinned scenes, message) from a link's query arguments."""
+    message = ""
+    time_index = _index(query.get("t"), MAX_INDEX)
+    tab = _index(query.get("tab"), tabs - 1)
+    pins: list[dict[str, Any]] = []
+    if query.get("pin"):
+        try:
+            decoded = decode_scene(query["pin"])
+            pins = decoded["pins"] if "pins" in decoded else [decoded]
+            if not isinstance(pins, list) or not all(isinstance(p, dict) for p in pins):
+                raise ValueError("the pins in the link are not a list of scenes")
+            if len(pins) > MAX_PINS:
+                raise ValueError(f"the link has {len(pins)} pins, at most {MAX_PINS}")
+        except ValueError as exc:
+            pins = []
+            message = f"The pinned results in the link were not used: {exc}."
+    return time_index, tab, pins, message

@@ -1,0 +1,334 @@
+"""Bokeh figures of the explorer, built once and updated in place.
+
+Every figure is created once per session; a new result or a new time only replaces the
+``data`` of ``ColumnDataSource`` objects and a few properties (titles, axis labels,
+span locations). Rebuilding figures would cost a full re-render in the browser and lose
+the user's zoom. Nothing here imports Panel.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+
+from bokeh.core.properties import value as fixed_label
+from bokeh.models import (
+    ColorBar,
+    ColumnDataSource,
+    HoverTool,
+    LinearColorMapper,
+    LogColorMapper,
+    Range1d,
+    Span,
+)
+from bokeh.palettes import Viridis256
+from bokeh.plotting import figure
+
+from ..model import QUANTITIES, QUANTITY_UNITS, DisplayScales, Pin, ResultView, lifts_off
+from .bokeh_data import MOVING, f32, legend_above, set_data, steady_range, wrap_legend
+from .classical import bearing_rule_pressure, half_space_pressure
+from .contact import ContactDrawing, FeatureInset
+from .pins import PinLines
+from .scene import TOOLS, SceneDrawing, empty_columns
+
+SYMBOLS = {"settlement": "δ", "tilt": "α", "force": "P", "moment": "M"}
+TITLES = {"settlement": "Settlement", "tilt": "Tilt", "force": "Force", "moment": "Moment"}
+UNKNOWN_COLOR = "#1f77b4"
+#: What the shaded strips of q(x) are: negative pressure of the full-contact model, or
+#: the parts a unilateral solve lifted off (q = 0 there).
+LOST_LABEL = "q < 0 (contact lost)"
+LIFTED_LABEL = "lifted off (q = 0)"
+GIVEN_COLOR = "#8c8c8c"
+
+#: Font size of the entries of the legends above the plots (normal mode).
+LEGEND_FONT = "11px"
+
+#: Font size of ticks, axis labels and titles in presentation mode (a projector).
+PRESENTATION_FONT = "18px"
+
+#: Longest scene name shown in the drawing's title [characters]: a Bokeh title does not
+#: wrap, and at 1024 px a longer one was cut off.
+TITLE_CHARS = 40
+
+
+def short(text: str, limit: int = TITLE_CHARS) -> str:
+    """``text`` cut to ``limit`` characters with an ellipsis."""
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 1].rstrip() + "…"
+
+
+class Figures:
+    """All figures of one session and the sources behind them."""
+
+    def __init__(self, scales: DisplayScales | None = None) -> None:
+        self.scales = scales or DisplayScales()
+        self.modulus_mapper = LogColorMapper(palette=Viridis256, low=1.0, high=1e5)
+        self.drawing = SceneDrawing(self.modulus_mapper)
+        self.scene_fig = self.drawing.fig
+        # the drawing's sources, by the names they had here
+        self.base_src, self.layer_src = self.drawing.base_src, self.drawing.layer_src
+        self.punch_src = self.drawing.punch_src
+        self._build_pressure()
+        self._build_image()
+        self._build_histories()
+        # the contact zone under the punch, the width history (its time axis shared with
+        # the other histories) and the inset of small features
+        self.contact = ContactDrawing(self.scene_fig, self.history_fig["settlement"].x_range)
+        self.contact_fig = self.contact.width_fig
+        self.inset = FeatureInset()
+        self.inset_fig = self.inset.fig
+        self.pins = PinLines(self.q_fig, self.history_fig, self.scales)
+
+    # -- construction ----------------------------------------------------------------
+    def _build_pressure(self) -> None:
+        # the value axes are set here, not fitted in the page (see steady_range)
+        p = figure(height=280, sizing_mode="stretch_width", tools=TOOLS,
+                   title="Contact pressure q(x)", toolbar_location="above",
+                   name="pressure_figure", y_range=Range1d(0, 1))
+        p.toolbar.autohide = True
+        p.xaxis.axis_label = "x [m]"
+        p.yaxis.axis_label = "q [kPa]"
+        # one point until the first result, so the auto ranges have something to fit
+        self.q_src = ColumnDataSource({"x": [0.0], "q": [0.0]}, name="q_source")
+        self.neg_src = ColumnDataSource(empty_columns("left", "right"), name="negative_source")
+        self.neg_strip = p.vstrip(x0="left", x1="right", source=self.neg_src,
+                                  fill_color="#d62728", fill_alpha=0.18, line_color=None,
+                                  legend_label=LOST_LABEL)
+        p.add_layout(Span(location=0, dimension="width", line_color="#555", line_width=1))
+        self.classic_src = ColumnDataSource(empty_columns("x", "half_space", "bearing_rule"),
+                                            name="classical_source")
+        self.classic_lines = [
+            p.line(x="x", y="half_space", source=self.classic_src, line_color="#7f7f7f",
+                   line_dash="dotdash", line_width=1.5, visible=False,
+                   legend_label="elastic half-space"),
+            p.line(x="x", y="bearing_rule", source=self.classic_src, line_color="#2ca02c",
+                   line_dash="dotted", line_width=2, visible=False,
+                   legend_label="Winkler / trapezoid")]
+        line = p.line(x="x", y="q", source=self.q_src, line_color=UNKNOWN_COLOR, line_width=2.5,
+                      legend_label="current")
+        self.q_hover = HoverTool(renderers=[line], tooltips=[("x", "@x{0.000} m"),
+                                                             ("q", "@q{0.000} kPa")],
+                                 mode="vline", name="q_hover")
+        p.add_tools(self.q_hover)
+        # small entries, and only those of lines shown, in two columns when more than two
+        # (see wrap_legend): at 1024 px the plot is ~320 px wide
+        legend = legend_above(p, LEGEND_FONT)
+        legend.click_policy = "hide"
+        for item in legend.items:
+            if any(r in self.classic_lines for r in item.renderers):
+                item.visible = False
+        self.q_fig = p
+
+    def _build_image(self) -> None:
+        p = figure(height=280, sizing_mode="stretch_width", tools=TOOLS,
+                   title="q(x, t)", toolbar_location="above", name="image_figure",
+                   x_range=Range1d(-1, 1), y_range=Range1d(0, 1))
+        p.toolbar.autohide = True
+        p.xaxis.axis_label = "x [m]"
+        p.yaxis.axis_label = "t [days after loading]"
+        self.image_mapper = LinearColorMapper(palette=Viridis256, low=0, high=1,
+                                              name="image_mapper")
+        self.image_src = ColumnDataSource(empty_columns("image", "x", "y", "dw", "dh"),
+                                          name="image_source")
+        image = p.image(image="image", x="x", y="y", dw="dw", dh="dh", source=self.image_src,
+                        color_mapper=self.image_mapper)
+        self.image_hover = HoverTool(renderers=[image], name="image_hover", tooltips=[
+            ("x", "$x{0.000} m"), ("t", "$y{0.0} days"), ("q", "@image{0.000} kPa")])
+        p.add_tools(self.image_hover)
+        self.image_bar = ColorBar(color_mapper=self.image_mapper, title="q [kPa]", width=8)
+        p.add_layout(self.image_bar, "right")
+        self.image_cursor = Span(location=0, dimension="width", line_color="white",
+                                 line_width=2, line_dash="dashed", level=MOVING)
+        p.add_layout(self.image_cursor)
+        self.image_fig = p
+
+    def _build_histories(self) -> None:
+        self.history_src: dict[str, ColumnDataSource] = {}
+        self.history_point_src: dict[str, ColumnDataSource] = {}
+        self.history_fig = {}
+        self.history_line = {}
+        self.history_cursor = {}
+        shared_x = None
+        for q in QUANTITIES:
+            unit = QUANTITY_UNITS[q][0]
+            kwargs = {"x_range": shared_x} if shared_x is not None else {}
+            p = figure(height=210, sizing_mode="stretch_width", tools=TOOLS,
+                       toolbar_location="above", name=f"{q}_figure",
+                       title=f"{TITLES[q]} {SYMBOLS[q]} [{unit}]", y_range=Range1d(-1, 1),
+                       **kwargs)
+            shared_x = p.x_range
+            p.toolbar.autohide = True
+            p.xaxis.axis_label = "t [days after loading]"
+            p.yaxis.axis_label = f"{SYMBOLS[q]} [{unit}]"
+            src = ColumnDataSource({"t": [0.0], "v": [0.0]}, name=f"{q}_source")
+            point = ColumnDataSource(empty_columns("t", "v"), name=f"{q}_point_source")
+            line = p.line(x="t", y="v", source=src, line_color=UNKNOWN_COLOR, line_width=2.5)
+            p.scatter(x="t", y="v", source=point, size=8, color="#d62728", level=MOVING)
+            p.add_tools(HoverTool(renderers=[line], mode="vline", tooltips=[
+                ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
+            cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted",
+                          level=MOVING)
+            p.add_layout(cursor)
+            self.history_src[q] = src
+            self.history_point_src[q] = point
+            self.history_fig[q], self.history_line[q] = p, line
+            self.history_cursor[q] = cursor
+
+    # -- updates ---------------------------------------------------------------------
+    def show(self, view: ResultView, index: int, pins: Sequence[Pin] = ()) -> None:
+        """Draw a new result (call inside ``pn.io.hold`` to send one message)."""
+        # A change of the loads leaves the drawing as it is: do not send it again.
+        key = json.dumps([view.scene.get(k) for k in ("punch", "coating", "base")],
+                         sort_keys=True, default=str)
+        if key != self._scene_key:
+            self.drawing.show(view, self.contact)
+            self.inset.show(view.geometry)
+            self._scene_key = key
+        self.contact.show(view)
+        self.scene_fig.title.text = f"Scene: {short(view.scene.get('name', ''))}"
+        self._show_image(view)
+        self._label_strips(view)
+        for q in QUANTITIES:
+            given = q in view.given
+            set_data(self.history_src[q], {"t": f32(view.times), "v": f32(view.display(q))})
+            self.history_line[q].glyph.line_color = GIVEN_COLOR if given else UNKNOWN_COLOR
+            state = "given" if given else "computed"
+            unit = QUANTITY_UNITS[q][0]
+            self.history_fig[q].title.text = f"{TITLES[q]} {SYMBOLS[q]} [{unit}]: {state}"
+        self.pins.show(view, pins, index)
+        self.show_time(view, index, pins, pinned_drawn=True)
+        self.fit_axes(view, pins)
+
+    def show_pinned(self, view: ResultView, pins: Sequence[Pin], index: int) -> None:
+        """Overlay (or clear) the pinned results on the histories and the pressure."""
+        self.pins.show(view, pins, index)
+        self.fit_axes(view, pins)
+
+    def fit_axes(self, view: ResultView, pins: Sequence[Pin] = ()) -> None:
+        """Value axes of q(x) and the histories that hold the result at every output
+        time and the pins (kept while they fit, see :func:`steady_range`): playing the
+        times or stepping the load moves the curves, not the axes."""
+        self._pins = tuple(pins)
+        for q in QUANTITIES:
+            steady_range(self.history_fig[q].y_range, view.display(q),
+                         *(pin.view.display(q) for pin in pins))
+        self._fit_pressure(view)
+
+    def _fit_pressure(self, view: ResultView) -> None:
+        size = self.scales.pressure_unit(view)[1]
+        shown = [view.pressure / size, *(pin.view.pressure / size for pin in self._pins)]
+        if self.classical:
+            shown += [self.classic_src.data[k] for k in ("half_space", "bearing_rule")]
+        steady_range(self.q_fig.y_range, *shown)
+
+    def show_time(self, view: ResultView, index: int, pins: Sequence[Pin] = (),
+                  pinned_drawn: bool = False) -> None:
+        """Move every time cursor to output ``index`` (no solve)."""
+        unit, size = self.scales.pressure_unit(view)
+        t = float(view.times[index])
+        q = view.pressure[:, index]
+        set_data(self.q_src, {"x": f32(view.x), "q": f32(q / size)})
+        intervals = view.negative_intervals(index)
+        set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
+                                "right": [hi for _, hi in intervals]})
+        self.q_fig.title.text = f"Pressure q(x), t = {t:.4g} days"
+        self.q_fig.yaxis.axis_label = f"q [{unit}]"
+        self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
+        if not pinned_drawn:
+            self.pins.show_time(view, pins, index)
+        self._show_classical(view, index)
+        self.image_cursor.location = t
+        for name in QUANTITIES:
+            self.history_cursor[name].location = t
+            set_data(self.history_point_src[name],
+                     {"t": [t], "v": [float(view.display(name)[index])]})
+        self.drawing.show_arrow(view, index)
+        self.contact.show_time(view, index)
+
+    def _label_strips(self, view: ResultView) -> None:
+        label = LIFTED_LABEL if view.info.get("contact") == "unilateral" else LOST_LABEL
+        # listed only for a result with shaded strips at some time
+        shaded = lifts_off(view)
+        for item in self.q_fig.legend[0].items:
+            if self.neg_strip in item.renderers:
+                if item.label != fixed_label(label):
+                    item.label = fixed_label(label)
+                if item.visible != shaded:
+                    item.visible = shaded
+        wrap_legend(self.q_fig.legend[0])
+
+    def set_classical(self, view: ResultView | None, index: int, shown: bool) -> None:
+        """Show or hide the classical answers on the pressure plot."""
+        self.classical = shown
+        for line in self.classic_lines:
+            line.visible = shown
+        for item in self.q_fig.legend[0].items:
+            if any(r in self.classic_lines for r in item.renderers):
+                item.visible = shown
+        wrap_legend(self.q_fig.legend[0])
+        if view is not None:
+            self._show_classical(view, index)
+
+    def _show_classical(self, view: ResultView, index: int) -> None:
+        if not self.classical:
+            return
+        size = self.scales.pressure_unit(view)[1]
+        a = view.geometry.half_width
+        force = float(view.values["force"][index])
+        moment = float(view.values["moment"][index])
+        x = view.x
+        set_data(self.classic_src, {
+            "x": f32(x), "half_space": f32(half_space_pressure(x, force, moment, a) / size),
+            "bearing_rule": f32(bearing_rule_pressure(x, force, moment, a) / size)})
+        self._fit_pressure(view)
+
+    classical = False
+
+    def all_figures(self) -> list:
+        """Every figure of the session."""
+        return [self.scene_fig, self.q_fig, self.image_fig,
+                *(self.history_fig[q] for q in QUANTITIES), self.contact_fig, self.inset_fig]
+
+    def set_presentation(self, on: bool) -> None:
+        """Fonts a projector shows from the back of a room (ticks and labels of
+        :data:`PRESENTATION_FONT`), or the normal ones."""
+        tick, label, title = ((PRESENTATION_FONT, PRESENTATION_FONT, PRESENTATION_FONT)
+                              if on else ("11px", "13px", "13px"))
+        for fig in self.all_figures():
+            fig.title.text_font_size = title
+            for axis in (*fig.xaxis, *fig.yaxis):
+                axis.major_label_text_font_size = tick
+                axis.axis_label_text_font_size = label
+            fig.toolbar_location = None if on else "above"
+        legend = self.q_fig.legend[0]
+        legend.label_text_font_size = "11px" if on else LEGEND_FONT
+        legend.glyph_width = 14 if on else 20
+        for q in QUANTITIES:
+            self.history_fig[q].height = 170 if on else 210
+        self.scene_fig.height = self.inset_fig.height = 240 if on else 300
+        self.contact_fig.height = 170 if on else 210
+        self.q_fig.height = self.image_fig.height = 240 if on else 280
+
+    def _show_image(self, view: ResultView) -> None:
+        unit, size = self.scales.pressure_unit(view)
+        a = view.geometry.half_width
+        t0, t1 = float(view.times[0]), float(view.times[-1])
+        span = t1 - t0
+        if not span > 0:
+            # one output time: a band around it, so that the axis reads that time (a
+            # zero-height image gave ticks like 10.000000001)
+            span = max(0.1 * abs(t0), 1.0)
+            t0 -= span / 2
+        img = f32(view.image / size)
+        set_data(self.image_src, {"image": [img], "x": [-a], "y": [t0], "dw": [2 * a],
+                                  "dh": [span]})
+        lo, hi = self.scales.image_range(view)
+        self.image_mapper.update(low=lo, high=hi)
+        self.image_bar.title = f"q [{unit}]"
+        self.image_hover.tooltips = [("x", "$x{0.000} m"), ("t", "$y{0.0} days"),
+                                     ("q", f"@image{{0.000}} {unit}")]
+        self.image_fig.x_range.update(start=-a, end=a)
+        self.image_fig.y_range.update(start=t0, end=t0 + span)
+
+    _scene_key: str | None = None
+    _pins: tuple[Pin, ...] = ()

@@ -1,0 +1,34 @@
+"""Solving off the page's thread: a change of the state becomes a ``core.solve``, and its
+answer comes back to the page.
+
+Nothing here imports Panel or Bokeh when imported (the solver workers import it too).
+
+- ``controller``: :class:`SolveController`, one per session: requests, coalescing, stale
+  results, error messages; where solves run (threads or worker processes).
+- ``workers``: :class:`SolverProcesses`, the worker processes of a served explorer, and
+  ``worker_side``, what runs inside them.
+- ``answer_wait``: a worker's answer awaited on the server's event loop.
+- ``result_cache``: the process-wide cache of prepared results.
+- ``warm_up``: presets solved before the first visitor comes.
+- ``study_runner``: :class:`StudyRun`, a design study in a process of its own.
+- ``trace``: timestamps of a slider move's way through the server (latency benchmark).
+"""
+
+from .controller import (
+    RESULTS,
+    SolveController,
+    approx_bytes,
+    describe_field,
+    format_error,
+    shared_pool,
+    use_worker_processes,
+    worker_processes,
+)
+from .study_runner import StudyRun
+from .trace import install_websocket_marks, mark
+from .warm_up import warm_up
+from .workers import SolverProcesses, WorkerFailed
+
+__all__ = ["RESULTS", "SolveController", "SolverProcesses", "StudyRun", "WorkerFailed",
+           "approx_bytes", "describe_field", "format_error", "install_websocket_marks", "mark",
+           "shared_pool", "use_worker_processes", "warm_up", "worker_processes"]

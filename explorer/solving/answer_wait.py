@@ -1,0 +1,74 @@
+"""Waiting for a worker's answer on the server's event loop, not on a thread.
+
+A load step's request is written to the session's worker by the event loop that read the
+step (:meth:`explorer.solving.workers.SolverProcesses.send_now`). Its answer used to be awaited
+by a thread of a pool, blocked on the worker's pipe: when the answer came, the operating
+system had to wake that thread, the thread had to get Python's lock from the busy event
+loop, and then hand the result back to the loop: 3-5 ms a step on a loaded server (the
+solve itself takes ~1 ms). Here the event loop watches the pipe itself
+(``add_reader``) and reads the answer when it is there.
+
+Only the plain case is taken here: the answer arrives within :data:`LOOP_WAIT_S`. A
+worker that ends, or an answer that takes longer, goes back to the thread's way
+(:meth:`explorer.solving.workers.SolverProcesses.result`), which replaces the worker, runs the
+request again or gives up after the time limit.
+
+Nothing here imports Panel.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Callable
+
+from .workers import SentRequest
+
+#: The event loop waits this long for an answer [s] before a thread takes the wait over
+#: (a slow solve, or a stuck worker: the thread applies the time limit).
+LOOP_WAIT_S = 2.0
+
+
+def when_answered(sent: SentRequest, on_answer: Callable[[], None],
+                  on_other: Callable[[], None]) -> bool:
+    """Call ``on_answer()`` on the running event loop once the answer to ``sent`` is in
+    its worker's pipe (reading it then does not block), or ``on_other()`` if the worker
+    ends first or no answer came within :data:`LOOP_WAIT_S`. Exactly one of them is
+    called, once.
+
+    Returns False (and calls neither) when the calling thread runs no event loop.
+    """
+    try:
+        loop = asyncio.get_running_loop()
+    except RuntimeError:
+        return False
+    lane = sent.lane
+    connection, sentinel = lane.connection, lane.process.sentinel
+    fds = (connection.fileno(), sentinel)
+    done = False
+
+    def finish() -> None:
+        nonlocal done
+        if done:
+            return
+        done = True
+        timer.cancel()
+        for fd in fds:
+            loop.remove_reader(fd)
+        try:
+            # a pipe whose worker ended reads as ready too (its end): the thread's way
+            # tells the two apart and replaces the worker
+            answered = connection.poll(0) and lane.process.is_alive()
+        except (OSError, EOFError, ValueError):  # the pipe closed (a shutdown)
+            answered = False
+        (on_answer if answered else on_other)()
+
+    timer = loop.call_later(LOOP_WAIT_S, finish)
+    try:
+        for fd in fds:
+            loop.add_reader(fd, finish)
+    except (OSError, ValueError, NotImplementedError):  # a closed pipe; a loop without
+        timer.cancel()                                   # readers
+        for fd in fds:
+            loop.remove_reader(fd)
+        return False
+    return True

@@ -1,0 +1,390 @@
+"""Solving off the UI thread: requests, coalescing, stale results and error messages.
+
+A :class:`SolveController` watches an :class:`~explorer.model.state.ExplorerState`. Every
+change asks for a solve. At most one solve per session runs at a time; requests made
+meanwhile collapse into one pending request (the newest), so a slider dragged through
+twenty values costs a handful of solves, not twenty. An outcome is shown only if no
+newer outcome has been shown already, so a slow old solve can never overwrite a newer
+answer. A rejected scene sets ``error`` (the core's message, naming the field) and leaves
+``view`` (the last good result) on screen.
+
+Where solves run: on the thread that waits for them (a shared thread pool, or the caller),
+or, once :func:`use_worker_processes` has started them, in worker processes
+(:mod:`explorer.solving.workers`), the thread then only waiting. ``python -m explorer`` uses
+worker processes, so that the server's own process keeps its time for the pages.
+
+Nothing here imports Panel: ``dispatch`` is how outcomes get back to the UI (the app
+passes one that schedules on its Bokeh document); the default applies them at once.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from concurrent.futures import Executor, Future, ThreadPoolExecutor
+from dataclasses import replace
+from typing import Any
+
+import param
+
+from core import STAGE_CACHE_BYTES, solve
+
+from ..model import ExplorerState, ResultView, prepare_view
+from .answer_wait import when_answered
+from .result_cache import RESULTS, approx_bytes, result_key
+from .trace import mark
+from .workers import (
+    SentRequest,
+    SolverProcesses,
+    WorkerFailed,
+    download_text,
+    solution_text,
+    solve_view,
+)
+
+__all__ = ["RESULTS", "SolveController", "approx_bytes", "describe_field", "format_error",
+           "result_key", "shared_pool", "use_worker_processes", "worker_processes"]
+
+log = logging.getLogger(__name__)
+
+# Shared by all sessions. Solving in this process: solves are numpy-heavy and release the
+# GIL only in part, so a few threads suffice and bound the load a crowd of sessions can put
+# on the machine. With worker processes, the threads only wait for the workers, one per
+# session with a request out at most; the server then sizes the pool for its sessions.
+_POOL: ThreadPoolExecutor | None = None
+_POOL_LOCK = threading.Lock()
+
+
+def shared_pool(max_workers: int = 4) -> ThreadPoolExecutor:
+    """The process-wide thread pool the explorer solves on."""
+    global _POOL
+    with _POOL_LOCK:
+        if _POOL is None:
+            _POOL = ThreadPoolExecutor(max_workers=max_workers, thread_name_prefix="solve")
+        return _POOL
+
+
+def _default_solve(scene: dict[str, Any]) -> Any:
+    return solve(scene)
+
+
+#: The worker processes the explorer solves in, once :func:`use_worker_processes` has
+#: started them (``python -m explorer`` does); None: solves run on the threads that ask.
+_PROCESSES: SolverProcesses | None = None
+
+
+def use_worker_processes(lanes: int, stage_cache_bytes: int | None = None) -> SolverProcesses:
+    """Solve in ``lanes`` worker processes from now on (all sessions of this process).
+
+    ``stage_cache_bytes`` [bytes] bounds the solver's stage caches of each worker; the
+    default divides the solver's budget (``core.STAGE_CACHE_BYTES``) among them,
+    so the memory the caches may hold does not grow with the number of workers. Sessions
+    created before the call keep solving where they did.
+    """
+    global _PROCESSES
+    if stage_cache_bytes is None:
+        stage_cache_bytes = STAGE_CACHE_BYTES // max(1, lanes)
+    processes = SolverProcesses(lanes, stage_cache_bytes)
+    processes.start()
+    old, _PROCESSES = _PROCESSES, processes
+    if old is not None:
+        old.shutdown()
+    return processes
+
+
+def worker_processes() -> SolverProcesses | None:
+    """The worker processes in use (None when solves run in this process)."""
+    return _PROCESSES
+
+
+#: Translation of the first part of a core field path into words on screen.
+_FIELD_WORDS = {
+    "punch": "Punch",
+    "coating": "Coating",
+    "base": "Base",
+    "loading": "Loading",
+    "times": "Time span",
+    "solver": "Solver",
+}
+
+
+def describe_field(path: str) -> str:
+    """A field path of the core (``coating[1].thickness``) in words (``Coating layer 2,
+    thickness``); unknown paths come back unchanged."""
+    head, _, rest = path.partition(".")
+    if head.startswith("coating[") and head.endswith("]"):
+        try:
+            index = int(head[len("coating["):-1])
+        except ValueError:
+            return path
+        words = f"Coating layer {index + 1}"
+    elif head in _FIELD_WORDS:
+        words = _FIELD_WORDS[head]
+    else:
+        return path
+    return f"{words}, {rest.replace('.', ', ').replace('_', ' ')}" if rest else words
+
+
+def format_error(message: str) -> str:
+    """The core's ``"field.path: reason"`` message with the field also named in words."""
+    path, sep, reason = message.partition(":")
+    if not sep or " " in path.strip():
+        return message
+    words = describe_field(path.strip())
+    if words == path.strip():
+        return message
+    return f"{words} ({path.strip()}):{reason}"
+
+
+def _failure_text(exc: Exception) -> str:
+    """What the page says of a solve that raised ``exc``."""
+    if isinstance(exc, ValueError):  # the core's message, naming the field
+        return format_error(str(exc))
+    if isinstance(exc, WorkerFailed):
+        return f"The solver failed on this scene: {exc}."
+    # the session must survive any failure of a solve
+    log.error("solve failed", exc_info=exc)
+    return f"The solver failed on this scene ({type(exc).__name__}: {exc})."
+
+
+class SolveController(param.Parameterized):
+    """Turns state changes into solves and solves into a displayed :class:`ResultView`."""
+
+    view = param.ClassSelector(class_=ResultView, default=None, allow_None=True,
+                               doc="The result on screen (the last good one).")
+    error = param.String(default="", doc="Why the newest request was not solved ('' if ok).")
+    busy = param.Boolean(default=False, doc="A newer request than the one shown is running.")
+    requests = param.Integer(default=0, doc="Requests made.")
+    solves = param.Integer(default=0, doc="Outcomes delivered (results and errors).")
+
+    def __init__(self, state: ExplorerState,
+                 solve: Callable[[dict[str, Any]], Any] | None = None,
+                 executor: Executor | None | str = "shared",
+                 dispatch: Callable[[Callable[[], None]], None] | None = None,
+                 auto: bool = True, **params: Any) -> None:
+        """``executor``: ``"shared"`` (the process pool), an Executor, or None to solve
+        synchronously in the caller (tests, scripts). ``auto``: solve on every change."""
+        super().__init__(**params)
+        self.state = state
+        self._solve = solve or _default_solve
+        self._executor = shared_pool() if executor == "shared" else executor
+        # the lane of the worker processes this session prefers (its stage caches are there)
+        self._processes = _PROCESSES if solve is None else None
+        self._lane = self._processes.assign() if self._processes is not None else 0
+        self._dispatch = dispatch or (lambda callback: callback())
+        self._lock = threading.Lock()
+        self._latest = 0          # id of the newest request
+        self._shown = 0           # id of the newest outcome shown
+        self._running = False
+        self._pending: tuple[int, dict[str, Any]] | None = None
+        if auto:
+            state.param.watch(lambda event: self.request(), "revision")
+
+    @property
+    def executor(self) -> Executor | None:
+        """Where this controller's solves run (None: in the caller)."""
+        return self._executor
+
+    # -- requests --------------------------------------------------------------------
+    def request(self) -> int:
+        """Ask for a solve of the current state; returns the request id."""
+        with self._lock:
+            self._latest += 1
+            rid = self._latest
+        try:
+            scene = self.state.to_scene()
+        except ValueError as exc:  # a state the screen cannot turn into a scene
+            self.requests = rid
+            self._deliver(rid, format_error(str(exc)))
+            return rid
+        if self._executor is None:
+            self.requests = rid
+            self._deliver(rid, self._compute(scene))
+            return rid
+        with self._lock:
+            queued = self._running
+            if queued:
+                self._pending = (rid, scene)
+            self._running = True
+        # the worker first: the watchers of ``requests`` and ``busy`` (the status line)
+        # run while it solves
+        sent = None if queued else self._send_now(scene)
+        self.requests = rid
+        self.busy = True
+        if not queued:
+            self._wait(rid, scene, sent)
+        return rid
+
+    def _wait(self, rid: int, scene: dict[str, Any], sent: SentRequest | None) -> None:
+        # A request written to the worker by the event loop is awaited by that loop
+        # (explorer/solving/answer_wait.py); anything else by a thread of the pool.
+        if sent is None or not when_answered(
+                sent, lambda: self._answered(rid, scene, sent),
+                lambda: self._executor.submit(self._work, rid, scene, sent)):
+            self._executor.submit(self._work, rid, scene, sent)
+
+    def _answered(self, rid: int, scene: dict[str, Any], sent: SentRequest) -> None:
+        # on the event loop, the answer in the pipe: read, shown, and the next request
+        # (if one came meanwhile) sent
+        outcome = self._collect(scene, sent)
+        self._dispatch(lambda: self._deliver(rid, outcome))
+        pending = self._take_pending()
+        if pending is not None:
+            self._wait(*pending, self._send_now(pending[1]))
+
+    def _take_pending(self) -> tuple[int, dict[str, Any]] | None:
+        # the request that came while one ran (the newest), or None: then nothing runs
+        with self._lock:
+            pending, self._pending = self._pending, None
+            if pending is None:
+                self._running = False
+            return pending
+
+    def _collect(self, scene: dict[str, Any], sent: SentRequest) -> ResultView | str:
+        # The answer of ``sent`` (there to read), kept in RESULTS by a thread of the pool:
+        # the cache may wait for another session's solve of the same scene, which the
+        # event loop must not.
+        try:
+            view = self._processes.result(sent)
+        except Exception as exc:
+            return _failure_text(exc)
+        key = result_key(scene)
+        cached = RESULTS.get(key) if key is not None else None
+        if cached is not None:
+            return replace(cached, info={**cached.info, "reused": True})
+        if key is not None:
+            self._executor.submit(RESULTS.get_or_compute, key, lambda: view)
+        return view
+
+    def _send_now(self, scene: dict[str, Any]) -> SentRequest | None:
+        # The request goes to this session's worker from the thread that made it (the
+        # event loop) when the worker is free and the result not known already; the
+        # thread of :meth:`_work` then only collects the answer.
+        if self._processes is None:
+            return None
+        key = result_key(scene)
+        if key is None or RESULTS.get(key) is not None:
+            return None
+        return self._processes.send_now(self._lane, solve_view, scene)
+
+    def start(self) -> int:
+        """First request of a session: shown at once when the result is already known
+        (the page then arrives with its plots), else solved in the background."""
+        try:
+            scene = self.state.to_scene()
+        except ValueError:
+            return self.solve_now()  # delivers the message
+        if self._executor is None or (self._solve is _default_solve
+                                      and RESULTS.get(result_key(scene)) is not None):
+            return self.solve_now()
+        return self.request()
+
+    def solve_now(self) -> int:
+        """Solve the current state in the caller and show the outcome (first paint)."""
+        with self._lock:
+            self._latest += 1
+            rid = self._latest
+        self.requests = rid
+        try:
+            outcome: ResultView | str = self._compute(self.state.to_scene())
+        except ValueError as exc:
+            outcome = format_error(str(exc))
+        self._deliver(rid, outcome)
+        return rid
+
+    def _work(self, rid: int, scene: dict[str, Any], sent: SentRequest | None = None) -> None:
+        while True:
+            outcome = self._compute(scene, sent)
+            sent = None
+            self._dispatch(lambda rid=rid, outcome=outcome: self._deliver(rid, outcome))
+            pending = self._take_pending()
+            if pending is None:
+                return
+            rid, scene = pending
+
+    def _view(self, scene: dict[str, Any], sent: list[SentRequest]) -> ResultView:
+        if self._processes is not None:
+            if sent:
+                return self._processes.result(sent.pop())
+            return self._processes.run(self._lane, solve_view, scene)
+        return prepare_view(self._solve(scene), scene)
+
+    def _compute(self, scene: dict[str, Any],
+                 sent: SentRequest | None = None) -> ResultView | str:
+        key = result_key(scene) if self._solve is _default_solve else None
+        unread = [sent] if sent is not None else []  # emptied once its answer is read
+        try:
+            if key is None:
+                return self._view(scene, unread)
+            view, reused = RESULTS.get_or_compute(key, lambda: self._view(scene, unread))
+            return replace(view, info={**view.info, "reused": True}) if reused else view
+        except Exception as exc:
+            return _failure_text(exc)
+        finally:
+            if unread and self._processes is not None:
+                # another session solved the same scene meanwhile: the worker's answer
+                # to this one is read and dropped, which frees the lane
+                try:
+                    self._processes.result(unread.pop())
+                except Exception:
+                    log.debug("dropped answer failed", exc_info=True)
+
+    def _deliver(self, rid: int, outcome: ResultView | str) -> None:
+        mark("delivered", rid=rid)
+        if rid < self._shown:
+            return
+        self._shown = rid
+        with self._lock:
+            latest = self._latest
+        if isinstance(outcome, str):
+            self.param.update(error=outcome, busy=rid < latest, solves=self.solves + 1)
+        else:
+            self.param.update(view=outcome, error="", busy=rid < latest,
+                              solves=self.solves + 1)
+
+    def download(self, view: ResultView, kind: str) -> str:
+        """The text of a download of ``view``: ``"to_csv"`` (the histories),
+        ``"pressure_csv"`` (q(x, t)) or ``"to_json"`` (everything), in SI units.
+
+        The shown scene is solved again (where this session's solves run, with its
+        caches warm): the solver is deterministic, so the file holds the numbers on screen;
+        the JSON's solve report is the one of the result on screen.
+        """
+        if self._processes is not None:
+            return self._processes.run(self._lane, download_text, view.scene, kind, view.info)
+        return solution_text(self._solve(view.scene), kind, view.info)
+
+    def solved_within(self, seconds: float) -> bool:
+        """Whether the result kept took less than ``seconds`` [s] of CPU time to solve
+        (what the scene costs: on a shared server its wall time swings with the others'
+        work); False before the first result."""
+        view = self.view
+        if view is None:
+            return False
+        # a result kept from before the CPU time was recorded has its wall time only
+        spent = view.info.get("cpu_seconds", view.info.get("seconds"))
+        return isinstance(spent, (int, float)) and spent < seconds
+
+    def download_later(self, view: ResultView, kind: str) -> Future[str]:
+        """:meth:`download` off the calling thread: a future of the text, done when the
+        worker has answered (at once where solves run in the caller). The server's event
+        loop awaits it (``asyncio.wrap_future``) and keeps serving every page meanwhile."""
+        if self._executor is None:
+            done: Future[str] = Future()
+            try:
+                done.set_result(self.download(view, kind))
+            except Exception as exc:
+                done.set_exception(exc)
+            return done
+        return self._executor.submit(self.download, view, kind)
+
+    def wait(self, timeout: float = 60.0) -> bool:
+        """Block until the newest request has been delivered (for scripts and tests)."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self._shown >= self._latest and not self._running:
+                return True
+            time.sleep(0.005)
+        return False

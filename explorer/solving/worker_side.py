@@ -1,0 +1,107 @@
+"""What runs in a solver worker process (started by :mod:`explorer.solving.workers`).
+
+A worker's main loop (:func:`serve`) takes one request ``(fn, args)`` at a time from its
+pipe and answers ``("ok", value, (start, end))`` or ``("error", exception, (start,
+end))``; the functions the server asks for are here: :func:`solve_view`,
+:func:`download_text`, :func:`worker_info`. Nothing here imports Panel: the workers
+import only ``core`` and :mod:`explorer.results`.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import multiprocessing.connection
+import os
+import signal
+import threading
+import time
+from typing import Any
+
+from core import set_stage_cache_budget, solve, stage_cache_bytes
+
+from ..model import ResultView, prepare_view
+
+#: What :func:`download_text` can produce: the histories as CSV, q(x, t) as CSV, and the
+#: whole solution as JSON (the methods of ``core.SceneSolution`` of the same names).
+DOWNLOADS = ("to_csv", "pressure_csv", "to_json")
+
+
+def _watch_parent() -> None:
+    # Killed without a chance to stop its workers (SIGKILL, a crash), the server would
+    # leave them behind, waiting for work forever.
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+    multiprocessing.connection.wait([parent.sentinel])
+    os._exit(0)
+
+
+def _start_worker(stage_cache_bytes: int) -> None:
+    # Ctrl+C in the terminal reaches the whole process group: the server stops its
+    # workers itself, and a worker's traceback would only clutter the terminal.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    set_stage_cache_budget(stage_cache_bytes)
+    threading.Thread(target=_watch_parent, name="watch-parent", daemon=True).start()
+
+
+def solve_view(scene: dict[str, Any]) -> ResultView:
+    """Solve ``scene`` (a scene dict) and prepare what the explorer draws.
+
+    Runs in a worker. An invalid scene raises the core's ValueError, which names the field.
+    """
+    return prepare_view(solve(scene), scene)
+
+
+def download_text(scene: dict[str, Any], kind: str,
+                  info: dict[str, Any] | None = None) -> str:
+    """The file ``kind`` (one of :data:`DOWNLOADS`) of the solution of ``scene``: the
+    histories as CSV (time [day], settlement [m], tilt [rad], force [N/m], moment [N]),
+    q(x, t) as CSV [Pa], or the whole solution as JSON.
+
+    ``info``: the solve report of the result on screen (``ResultView.info``), written into
+    the JSON in place of the new solve's (whose timings and cache hits differ; its numbers
+    do not).
+    """
+    return solution_text(solve(scene), kind, info)
+
+
+def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None) -> str:
+    """``solution.to_csv()``, ``.pressure_csv()`` or ``.to_json()`` (``kind``), with the
+    solve report ``info`` in the JSON if given (see :func:`download_text`)."""
+    if kind not in DOWNLOADS:
+        raise ValueError(f"kind: unknown download {kind!r}; known: {', '.join(DOWNLOADS)}")
+    if info is not None and kind == "to_json":
+        solution.info = {k: v for k, v in info.items() if k != "reused"}
+    return getattr(solution, kind)()
+
+
+def worker_info() -> dict[str, int]:
+    """The worker's process id and the bound of its solver stage caches [bytes]."""
+    return {"pid": os.getpid(), "stage_cache_bytes": stage_cache_bytes()}
+
+
+def serve(connection: multiprocessing.connection.Connection, stage_cache_bytes: int) -> None:
+    # A worker's main loop: one request (fn, args) in, one ("ok", value) or ("error",
+    # exception) out, on its own pipe. No executor between the server and the worker: a
+    # ProcessPoolExecutor hands each request and each result over through two more threads
+    # of the server (its queue feeder and its manager), and on a busy machine every
+    # hand-over waits for a core.
+    _start_worker(stage_cache_bytes)
+    while True:
+        try:
+            fn, args = connection.recv()
+        except (EOFError, OSError):  # the server closed the pipe (or is gone)
+            return
+        start = time.monotonic()
+        try:
+            reply: tuple[str, Any, tuple[float, float]] = ("ok", fn(*args), (start, 0.0))
+        except BaseException as exc:  # the server raises it in the caller
+            reply = ("error", exc, (start, 0.0))
+        reply = (reply[0], reply[1], (start, time.monotonic()))  # when it worked [s]
+        try:
+            connection.send(reply)
+        except (BrokenPipeError, EOFError, OSError):
+            return
+        except Exception as exc:  # a value or exception that does not pickle
+            connection.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}"),
+                             reply[2]))

@@ -1,0 +1,378 @@
+"""Widgets bound to the state classes, in both directions, with no feedback loops.
+
+The state (``explorer.model.state``) is the single source of truth: a widget writes into it
+(on every drag step for loads, on release for everything costly) and follows it when
+it changes from Python (a preset, a file, a link). A :class:`Binding` can be re-pointed
+at another object of the same class, so one set of widgets edits the selected coating
+layer or whichever two loads are given.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import panel as pn
+import param
+
+from core.profiles import VARIATIONS
+
+from ..model import QUANTITY_RANGES, HistoryState, ProfileState
+from ..solving import mark
+from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
+
+__all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
+           "EditableIntSlider", "EditableSlider", "HistoryEditor", "ProfileEditor", "fine_slider",
+           "slider"]
+
+
+# Panel holds every change from the browser for 50 ms before handling it, to gather a
+# burst into one event. The explorer gathers bursts itself (a solve runs at most once at
+# a time and the newest request waits), so here the wait is only latency: measured 50 of
+# the 140 ms from a load slider step to the new pressure data on the server's side.
+class PromptFloatSlider(pn.widgets.FloatSlider):
+    """A FloatSlider whose browser changes are handled at once (no 50 ms debounce)."""
+
+    _debounce = 0
+
+
+class PromptFloatInput(pn.widgets.FloatInput):
+    """A FloatInput whose browser changes are handled at once (no 50 ms debounce)."""
+
+    _debounce = 0
+
+
+class PromptIntSlider(pn.widgets.IntSlider):
+    """An IntSlider whose browser changes are handled at once (no 50 ms debounce)."""
+
+    _debounce = 0
+
+
+class PromptIntInput(pn.widgets.IntInput):
+    """An IntInput whose browser changes are handled at once (no 50 ms debounce)."""
+
+    _debounce = 0
+
+
+class EditableSlider(pn.widgets.EditableFloatSlider):
+    """An EditableFloatSlider made of prompt parts."""
+
+    _slider_widget = PromptFloatSlider
+    _input_widget = PromptFloatInput
+
+    def watch_drag_first(self, callback: Callable[[Any], None]) -> None:
+        """Call ``callback(value)`` [the slider's value] at each move of the slider,
+        before the composite's own watchers bring its value and text box in line.
+
+        A load step reached the explorer's binding only after those (~7 ms on a loaded
+        server, as long as the solve); called first, the solve starts at once and the
+        text box follows while the worker solves. The composite's own watcher is taken
+        off and put back after ``callback``: watchers of the same precedence run in the
+        order they were added.
+        """
+        inner = self._slider
+        inner.param.watch(lambda event: callback(event.new), "value")
+        own = [w for w in inner.param.watchers.get("value", {}).get("value", [])
+               if getattr(w.fn, "__func__", None) is _SYNC_VALUE]
+        for watcher in own:
+            inner.param.unwatch(watcher)
+            inner.param.watch(watcher.fn, watcher.parameter_names, onlychanged=watcher.onlychanged,
+                              queued=watcher.queued, precedence=watcher.precedence)
+
+
+#: The composite slider's own watcher of its parts (re-ordered by ``watch_drag_first``).
+_SYNC_VALUE = pn.widgets.EditableFloatSlider._sync_value
+
+
+class EditableIntSlider(pn.widgets.EditableIntSlider):
+    """An EditableIntSlider made of prompt parts."""
+
+    _slider_widget = PromptIntSlider
+    _input_widget = PromptIntInput
+
+
+def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
+           **kwargs: Any) -> pn.widgets.EditableFloatSlider:
+    """A float slider with an input box (any value can be typed; the core validates it)."""
+    return EditableSlider(label=label, start=start, end=end, step=step, format=fmt,
+                          sizing_mode="stretch_width", **kwargs)
+
+
+def fine_slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
+                **kwargs: Any) -> pn.widgets.FloatSlider:
+    """A plain slider for secondary parameters (a quarter of the cost of an editable one
+    to build and to render, which adds up over a page of them)."""
+    return PromptFloatSlider(label=label, start=start, end=end, step=step, format=fmt,
+                             sizing_mode="stretch_width", **kwargs)
+
+
+def _set_widget(widget: pn.widgets.Widget, value: Any) -> None:
+    """Show ``value`` in ``widget`` as if the user had set it, throttled value included."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
+        start, end = getattr(widget, "start", None), getattr(widget, "end", None)
+        if start is not None and value < start:
+            widget.start = value
+        if end is not None and value > end:
+            widget.end = value
+    widget.value = value
+    # Setting ``value`` from Python leaves ``value_throttled`` stale (holoviz/panel#2675):
+    # the next release at that old value would then send no event at all. The inner
+    # widgets of a composite slider carry their own copy.
+    for part in (widget, getattr(widget, "_slider", None), getattr(widget, "_value_edit", None)):
+        if part is not None and "value_throttled" in part.param:
+            with param.edit_constant(part):
+                part.param.update(value_throttled=value)
+
+
+class Binding:
+    """Widgets editing parameters of one Parameterized at a time (re-bindable)."""
+
+    def __init__(self, on_reject: Callable[[str], None] | None = None,
+                 live_when: Callable[[], bool] | None = None) -> None:
+        """``live_when``: asked at each drag step of a slider that updates on release;
+        when it answers True the step is applied at once (a fast solver makes every
+        slider live)."""
+        self._pairs: list[tuple[str, pn.widgets.Widget]] = []
+        self._checks: dict[str, Callable[[Any], Any]] = {}
+        self._live_when = live_when
+        self._target: param.Parameterized | None = None
+        self._watcher: Any = None
+        self._syncing = False
+        self._leading: str | None = None  # a slider the state follows ahead of its widget
+        self._on_reject = on_reject
+
+    @property
+    def target(self) -> param.Parameterized | None:
+        return self._target
+
+    def add(self, name: str, widget: pn.widgets.Widget, live: bool = False,
+            check: Callable[[Any], Any] | None = None) -> Any:
+        """Edit parameter ``name`` with ``widget``; ``live`` updates while dragging,
+        otherwise on release (``value_throttled``) where the widget has it, and while
+        dragging too when ``live_when`` says so. ``check`` refuses a value (ValueError)
+        before it reaches the state; the widget then shows the state's value again."""
+        event = "value" if live or "value_throttled" not in widget.param else "value_throttled"
+        widget.param.watch(lambda e, name=name: self._to_target(name, e.new), event)
+        if live and isinstance(widget, EditableSlider):
+            # a drag step reaches the state before the text box follows (the watcher
+            # above then finds the state at the value already: no second change)
+            widget.watch_drag_first(lambda value, name=name: self._lead(name, value))
+        if event == "value_throttled" and self._live_when is not None:
+            widget.param.watch(lambda e, name=name: self._drag_step(name, e.new), "value")
+        if check is not None:
+            self._checks[name] = check
+        self._pairs.append((name, widget))
+        return widget
+
+    def _lead(self, name: str, value: Any) -> None:
+        # the slider moved ahead of its composite: the state follows it now, and the
+        # composite brings itself in line afterwards (not from here, as an echo)
+        self._leading = name
+        try:
+            self._to_target(name, value)
+        finally:
+            self._leading = None
+
+    def _drag_step(self, name: str, value: Any) -> None:
+        if self._live_when is not None and self._live_when():
+            self._to_target(name, value)
+
+    def bind(self, target: param.Parameterized) -> None:
+        """Point every widget at ``target`` and show its values."""
+        if self._target is not None and self._watcher is not None:
+            self._target.param.unwatch(self._watcher)
+        self._target = target
+        self._syncing = True
+        try:
+            for name, widget in self._pairs:
+                _set_widget(widget, getattr(target, name))
+        finally:
+            self._syncing = False
+        self._watcher = target.param.watch(self._from_target,
+                                           sorted({name for name, _ in self._pairs}))
+
+    def _to_target(self, name: str, value: Any) -> None:
+        mark("widget_value")
+        if self._syncing or self._target is None or value is None:
+            return
+        try:
+            if name in self._checks:
+                self._checks[name](value)
+            setattr(self._target, name, value)
+        except ValueError as exc:  # a type the parameter refuses outright
+            if self._on_reject is not None:
+                self._on_reject(str(exc))
+            self._syncing = True
+            try:
+                for other, widget in self._pairs:
+                    if other == name:
+                        _set_widget(widget, getattr(self._target, name))
+            finally:
+                self._syncing = False
+
+    def _from_target(self, *events: param.parameterized.Event) -> None:
+        self._syncing = True
+        try:
+            for event in events:
+                for name, widget in self._pairs:
+                    if (name == event.name and name != self._leading
+                            and widget.value != event.new):
+                        _set_widget(widget, event.new)
+        finally:
+            self._syncing = False
+
+
+#: The variations of a function of x offered on screen (label -> name), from core's list.
+PROFILE_KINDS = {**{v.label: v.name for v in VARIATIONS.values()},
+                 "custom (from file)": "custom"}
+
+
+class ProfileEditor:
+    """Level, variation kind and its parameters for one :class:`ProfileState`."""
+
+    def __init__(self, label: str, unit: str, start: float, end: float, step: float,
+                 fmt: str = "0[.]00", variations: bool = True,
+                 amplitude: tuple[str, float, float, float] = ("%", -90.0, 500.0, 1.0),
+                 css: str = "", live_when: Callable[[], bool] | None = None) -> None:
+        """``amplitude``: unit of the variation ('%' of the level, or an absolute unit),
+        its slider range and step. Without ``variations`` only the level is offered.
+        ``live_when``: see :class:`Binding`."""
+        self.binding = Binding(live_when=live_when)
+        self.variations = variations
+        self.mean = self.binding.add("mean", slider(f"{label} [{unit}]", start, end, step, fmt,
+                                                    css_classes=[css] if css else []))
+        self.note = pn.pane.HTML("", margin=(0, 10), visible=False,
+                                 styles={"font-size": "12px", "color": "#666"})
+        widgets: list[Any] = [self.mean]
+        if variations:
+            self.kind = self.binding.add("kind", pn.widgets.Select(
+                label=f"{label}: variation across the punch", options=PROFILE_KINDS,
+                sizing_mode="stretch_width"))
+            a_unit, a_lo, a_hi, a_step = amplitude
+            a_label = f"{a_unit} of the level" if a_unit == "%" else a_unit
+            self.amplitude = self.binding.add("amplitude", fine_slider(
+                f"variation A [{a_label}]", a_lo, a_hi, a_step, "0[.]0"))
+            self.position = self.binding.add("position", fine_slider(
+                "step position / patch or bump centre [m]", -1.0, 1.0, 0.01))
+            self.length = self.binding.add("length", fine_slider(
+                "wavelength / patch or bump width [m]", 0.02, 2.0, 0.01))
+            widgets += [self.kind, self.amplitude, self.position, self.length]
+        self.panel = pn.Column(*widgets, self.note, sizing_mode="stretch_width", margin=0)
+        self._watched: ProfileState | None = None
+        self._watcher: Any = None
+
+    def bind(self, profile: ProfileState, half_width: float) -> None:
+        if self.variations:
+            self.position.param.update(start=-half_width, end=half_width)
+            self.length.end = max(self.length.end, 2 * half_width)
+        self.binding.bind(profile)
+        if self._watched is not None and self._watcher is not None:
+            self._watched.param.unwatch(self._watcher)
+        self._watched = profile
+        self._watcher = profile.param.watch(lambda *e: self.refresh(), ["kind", "custom"])
+        self.refresh()
+
+    def refresh(self) -> None:
+        profile = self.binding.target
+        if profile is None:
+            return
+        kind = profile.kind
+        custom = kind == "custom" and profile.custom is not None
+        if self.variations:
+            uses = VARIATIONS[kind].uses if kind in VARIATIONS else ()
+            self.amplitude.visible = "amplitude" in uses
+            self.position.visible = "position" in uses
+            self.length.visible = "length" in uses
+            self.mean.visible = not custom
+            note = ("Custom profile from a file (kept as it is). Choose another variation "
+                    "to replace it." if custom else "")
+        elif custom:
+            note = "Varies across the punch (from a file); the level above is not used."
+        elif kind != "none":
+            note = "Varies across the punch (from a file) about the level above."
+        else:
+            note = ""
+        self.note.object = note
+        self.note.visible = bool(note)
+
+
+HISTORY_KINDS = {"constant": "constant", "ramp": "ramp", "step": "step", "sine": "sine",
+                 "custom (from file)": "custom"}
+
+_VALUE_LABELS = {"constant": "{q}", "ramp": "{q} at the end of the ramp",
+                 "step": "{q} before the step", "sine": "mean {q}", "custom": "{q}"}
+_SECOND_LABELS = {"ramp": "{q} at loading (ramp start)", "step": "{q} after the step",
+                  "sine": "amplitude of {q}"}
+_TIME_LABELS = {"ramp": "ramp duration [days]", "step": "time of the step [days]",
+                "sine": "period [days]"}
+NAMES = {"settlement": "settlement δ", "tilt": "tilt α", "force": "force P",
+         "moment": "moment M"}
+
+
+def _fit(widget: pn.widgets.Widget, value: float, default: tuple[float, float]) -> None:
+    """Slider range: the default one, widened to keep ``value`` well inside."""
+    lo, hi = default
+    if value > hi or value < lo:
+        span = 2 * abs(value) if value else 1.0
+        lo, hi = min(lo, -span if lo < 0 else 0.0, value), max(hi, span, value)
+    widget.param.update(start=lo, end=hi)
+
+
+class HistoryEditor:
+    """Shape and parameters of the history of one given quantity (live while dragging)."""
+
+    def __init__(self, css: str = "") -> None:
+        self.binding = Binding()
+        self.title = pn.pane.HTML("", margin=(8, 10, 0, 10))
+        self.kind = self.binding.add("kind", pn.widgets.Select(
+            label="history", options=HISTORY_KINDS, sizing_mode="stretch_width"))
+        self.value = self.binding.add("value", slider("value", 0.0, 1.0, 0.001, "0[.]0000",
+                                                      css_classes=[f"{css}-value"] if css
+                                                      else []), live=True)
+        self.second = self.binding.add("second", fine_slider("second", 0.0, 1.0, 0.001,
+                                                        "0[.]0000"), live=True)
+        self.time = self.binding.add("time", fine_slider("time [days]", 0.1, 365.0, 0.1, "0[.]0"),
+                                     live=True)
+        self.note = pn.pane.HTML("", margin=(0, 10), styles={"font-size": "12px",
+                                                              "color": "#666"})
+        self.panel = pn.Column(self.title, self.kind, self.value, self.second, self.time,
+                               self.note, sizing_mode="stretch_width", margin=0)
+        self._watched: HistoryState | None = None
+        self._watcher: Any = None
+
+    def bind(self, history: HistoryState, time_end: float) -> None:
+        q = history.quantity
+        lo, hi = QUANTITY_RANGES[q]
+        step = (hi - lo) / 1000
+        self.value.step = self.second.step = step
+        _fit(self.value, history.value, (lo, hi))
+        _fit(self.second, history.second, (min(lo, -hi) if q in ("tilt", "moment") else lo, hi))
+        self.time.end = max(time_end, history.time)
+        self.binding.bind(history)
+        if self._watched is not None and self._watcher is not None:
+            self._watched.param.unwatch(self._watcher)
+        self._watched = history
+        self._watcher = history.param.watch(lambda *e: self.refresh(), ["kind", "custom"])
+        self.refresh()
+
+    def refresh(self) -> None:
+        history = self._watched
+        if history is None:
+            return
+        q = history.quantity
+        name = NAMES[q]
+        unit = history.unit
+        kind = history.kind
+        self.title.object = f"<b>Given {name} [{unit}]</b>"
+        self.value.label = _VALUE_LABELS[kind].format(q=name) + f" [{unit}]"
+        self.second.visible = kind in _SECOND_LABELS
+        self.time.visible = kind in _TIME_LABELS
+        if kind in _SECOND_LABELS:
+            self.second.label = _SECOND_LABELS[kind].format(q=name) + f" [{unit}]"
+            self.time.label = _TIME_LABELS[kind]
+        custom = kind == "custom" and history.custom is not None
+        self.value.visible = not custom
+        self.note.object = ("Custom history from a file (kept as it is). Choose another "
+                            "shape to replace it." if custom else "")
+        self.note.visible = custom
