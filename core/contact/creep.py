@@ -43,7 +43,7 @@ LOCATE_EDGE = 0.05
 #: fell irregularly with the band panels (it depends on where the ends sit among the
 #: nodes): on the preset, with the kink correction of the ends, the largest end error
 #: over the output times was 0.73 and 1.31 times the largest difference for bands 0.04
-#: and 0.02 wide (against 0.0025; see tests/test_contact.py), and 0.86 to 0.97 times the
+#: and 0.02 wide (against 0.0025; see tests/contact/test_contact.py), and 0.86 to 0.97 times the
 #: difference the check takes (against a rule with every panel halved, 100 output
 #: times), so 2 leaves a margin of 1.5.
 SPACE_FACTOR = 2.0

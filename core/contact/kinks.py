@@ -22,7 +22,7 @@ solver at tol = 1e-7; the corrected ones are 4.3e-7 / 8.9e-8 / 2.8e-10 from each
 time re-solved on panels graded toward its end (same memory and time grid). What is left
 is the kinks of past pressures in the creep memory, which this leaves (it falls with
 the band panels). Elastic, on uniform 0.04 panels: 3.7e-8 from the refined ends, where
-the nodal ones were 2.4e-6 off (tests/test_contact.py).
+the nodal ones were 2.4e-6 off (tests/contact/test_contact.py).
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ system of the boundary and interface conditions (``4 (N + 1)`` unknowns) has no
 per wavenumber (batched); ``L_stack = 2 mu_b k W / (2 (1 - nu))`` at the surface for unit
 pressure, ``mu_b`` the base's shear modulus.
 
-Limits (tests in ``tests/test_layered_kernel.py``): no coating gives ``L`` exactly;
+Limits (tests in ``tests/kernel/test_layered_kernel.py``): no coating gives ``L`` exactly;
 ``L_stack -> L_inf = (1 - nu_1^2) E / ((1 - nu^2) E_1)`` as ``u -> inf`` (the top coating as a
 half-space); for ``u h << 1`` a coating adds to ``L`` the thin-layer term ``u c_k E /
 (2 (1 - nu^2) H)`` with the Winkler compliance ``c_k`` of :func:`core.coating.model.
@@ -260,7 +260,7 @@ def stack_kernel(s: ArrayLike, layers: Sequence[UniformLayer], base_thickness: f
 
 
 #: Chebyshev degree of the interpolant of the regular part on each panel of s: 24 leaves
-#: ~1e-14 relative (tests/test_layered_kernel.py), what a solve to tol 1e-12 needs.
+#: ~1e-14 relative (tests/kernel/test_layered_kernel.py), what a solve to tol 1e-12 needs.
 PANEL_DEGREE = 24
 #: The degree a solve to a tol of 1e-7 or above takes (:mod:`core.engines.layered.solve`): measured
 #: against direct evaluation on 4,000 values of s for four stacks (h_min / H = 0.004 to

@@ -46,7 +46,7 @@ extended precision, about 10 ms), so that an evaluation is a few Horner steps:
   the rounding of its argument).
 * ``|s| >= 354.25``: ``|k_pl|`` is below half the smallest subnormal double; 0 is returned.
 
-Measured against mpmath (30 digits; references as in ``tests/test_kernel.py``) on 14,300
+Measured against mpmath (30 digits; references as in ``tests/kernel/test_kernel.py``) on 14,300
 points of [0, 354.3]: for ``|s| < 2`` the error of ``k_pl`` is <= 2.7e-16 max(1, |k_pl|)
 (near 0 that is the rounding of ``ln s``; <= 1.6e-16 absolute on [1, 2]) and that of
 ``k_reg`` <= 1.9e-16; for ``|s| >= 2`` the error of ``k_pl`` is <= 2.6e-16 of the envelope

@@ -53,7 +53,7 @@ from core.time.radau import JUMP_SIDE
 
 #: Convergence order of the answers at output times used by the error estimate: the
 #: stage order (4) of the collocation; at the step ends it is higher where the kernel's
-#: rates times the step are small (measured in tests/test_time_integration.py).
+#: rates times the step are small (measured in tests/time/test_time_integration.py).
 ORDER = 4
 #: Steps per decade of time since the start or a jump, and steps over the whole span,
 #: of the first grid (each refinement doubles both).
@@ -353,13 +353,13 @@ def solve_exponential(kernel, problem, times: np.ndarray, jumps: np.ndarray, *, 
     times; when given, each group's error is measured against the largest ``|w|`` of the
     group on the first grid instead (at least a thousandth of ``w_scale``): the forcing
     behind ``w_scale`` can exceed the unknowns by the creep factor (6.9 measured on the
-    inverse problem of tests/test_creep.py). Returns ``(vw, vu, part_errors,
+    inverse problem of tests/creep/test_creep.py). Returns ``(vw, vu, part_errors,
     steps)``: the answer of the finest grid marched, the estimate of its error per group
     and its steps. The estimate is the larger of the difference from the grid of twice
     longer steps over ``factor - 1`` (the global error, carried through the march), with
     ``factor`` the ratio of the last two such differences (the convergence as measured,
     within 2 and 2**7: a coarse first grid, far from the asymptotic rate, made the
-    assumed ``2**ORDER`` 12x pessimistic on tests/test_hard_cases.py's reversing load),
+    assumed ``2**ORDER`` 12x pessimistic on tests/engines/test_hard_cases.py's reversing load),
     and the sum of the steps' local errors (:func:`_local_errors`: a fast state's error,
     which two grids can miss).
     """

@@ -61,14 +61,14 @@ _ROUNDOFF = 100 * float(np.finfo(float).eps)
 #: ``h / (t - 1 + h)`` adds up to at most ``1 + ln(1e10)``, about 24, so this share adds at
 #: most a quarter budget to the share of the time (``h / span``, adding up to 1). Measured:
 #: 408 -> 193 steps on the 50-year fib MC2010 preset; 25 (148 steps) let a stiff
-#: exponential's transient (tests/test_hard_cases.py) leave 2.6e-11 at 28 relaxation
+#: exponential's transient (tests/engines/test_hard_cases.py) leave 2.6e-11 at 28 relaxation
 #: times, where its closed form holds to 7e-13 (100: 3.7e-13).
 LOG_TIME_BUDGET = 100.0
 #: Each of the first STEP_BUDGET steps may spend at least 1/STEP_BUDGET of the error
 #: budget (so this share adds at most one budget): the optimum for the sum of local errors
 #: is an equal error per step, which a run of a few hundred steps then nearly has.
 #: Measured on the 50-year fib MC2010 preset: 193 -> 147 steps (400: 163, 100: 134); the
-#: stiff exponential's closed form (tests/test_hard_cases.py) held to 4.6e-13.
+#: stiff exponential's closed form (tests/engines/test_hard_cases.py) held to 4.6e-13.
 STEP_BUDGET = 200
 
 

@@ -222,7 +222,7 @@ def _solve_stages(d: np.ndarray, total: np.ndarray, rhs: np.ndarray) -> np.ndarr
     ``d``, ``rhs`` (B, modes, 3), ``total`` (B, 3, 3). Cramer's rule over the arrays, which
     avoids a LAPACK call per system: the systems are well conditioned (``d >= 1`` on the
     diagonal, ``total`` the creep of one step), checked against the full stage system in
-    tests/test_time_integration.py.
+    tests/time/test_time_integration.py.
     """
     t = total[:, None]                                       # (B, 1, 3, 3)
     m00, m11, m22 = d[..., 0] - t[..., 0, 0], d[..., 1] - t[..., 1, 1], d[..., 2] - t[..., 2, 2]

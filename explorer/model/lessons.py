@@ -3,7 +3,7 @@
 A lesson is a preset and a sequence of steps; each step sets a few fields of the scene
 (dotted paths of the scene dict, SI units, as the scene files write them) and shows a
 short note. The steps add up: step k is the preset with the changes of steps 1..k. The
-numbers in the notes are the solver's, checked by ``tests/test_explorer_lessons.py``
+numbers in the notes are the solver's, checked by ``tests/explorer/test_explorer_lessons.py``
 (rounded as written). No Panel import.
 """
 

@@ -50,7 +50,7 @@ SPILL_AFTER_S = 0.25
 #: The served explorer's time limit per solve [s] (listed with the scene limits in
 #: core/SCENES.md). A request has its worker to itself, so this is the solve's own time.
 #: The slowest of 10,000 generated valid scenes solved in 0.7 s
-#: (tests/test_property_inputs.py); past the limit the
+#: (tests/scene/test_property_inputs.py); past the limit the
 #: scene is taken to be beyond what the explorer is for (or the worker to be stuck): the
 #: worker is stopped and replaced, and the session told.
 REQUEST_TIMEOUT_S = 60.0

@@ -67,7 +67,7 @@ __all__ = ["LayeredAnswer", "LayeredResponse", "layered_response", "solve_layere
 #: decrease is not trusted: the estimate is then 9x the last difference).
 MAX_RATIO = 0.9
 #: Floor of the error estimate [-]: the symbol's conditioning at small u (~1e-16 / u^2
-#: relative, tests/test_layered_kernel.py) and the kernel's ~1e-14; settled answers change
+#: relative, tests/kernel/test_layered_kernel.py) and the kernel's ~1e-14; settled answers change
 #: by ~1e-12 between mode counts (a flat punch, h = 0.02 a, H = 4 a: 1.5e-12 in q).
 ERROR_FLOOR = 1e-12
 #: The floor for ``tol >= COARSE_TOL``: the coarser table and quadrature, measured to

@@ -9,7 +9,7 @@ from __future__ import annotations
 from core.cache import StageCache
 
 # Bytes per stage sum to STAGE_CACHE_BYTES (512 MiB), sized from the largest items
-# measured on the hard cases of benchmarks/scenes.py: operator and correction ~9 MiB,
+# measured on the hard cases of tests/support/scenes.py: operator and correction ~9 MiB,
 # basis ~8 MiB, all modes of a scene ~3 MiB, responses ~5 MiB.
 _MiB = 2**20
 _PANELS = StageCache("panels", max_items=32, max_bytes=8 * _MiB)

@@ -308,7 +308,7 @@ def _extrapolated_error(diffs: list[float]) -> float:
     is about d_k rho/(1 - rho) (a geometric tail); rho is kept in [0.05, 0.9] so neither a
     lucky cancellation nor a stall makes the estimate absurd. The graded basis converges
     in steps, so this reads up to ~3x low or ~6x high (measured on the hard cases of
-    tests/test_hard_cases.py); ``SUCCESS_MARGIN`` keeps a claim of success honest.
+    tests/engines/test_hard_cases.py); ``SUCCESS_MARGIN`` keeps a claim of success honest.
     """
     if len(diffs) < 2:
         return diffs[-1] if diffs else np.inf

@@ -56,7 +56,7 @@ BASIS_CAPS = (128, 256)
 #: 128-256 functions for 1e-8 on q, so a first try at 128 would be wasted work).
 DIRECT_LARGEST_BELOW = 1e-7
 #: Quadrature and round-off floor of the relative error (measured: ~1e-13 on the scenes
-#: of the test suite; see tests/test_solver.py).
+#: of the test suite; see tests/solver/test_solver.py).
 ERROR_FLOOR = 2e-13
 #: Success is claimed only when the error estimate is this many times below tol: the
 #: estimate itself can read ~3x low (see _extrapolated_error).

@@ -1,7 +1,7 @@
-"""Time and peak memory of the red-team scenes (issue 19), each solved in a fresh process.
+"""Time and peak memory of the costliest scenes a user can write, each solved in a fresh process.
 
-    python benchmarks/redteam_bounds.py              # all cases
-    python benchmarks/redteam_bounds.py nested simple
+    python benchmarks/costly_scenes.py              # all cases
+    python benchmarks/costly_scenes.py nested simple
 
 Cases: ``nested`` (a creep kernel as a nested formula, 2000 output times, tol 1e-6),
 ``simple`` (a plain kernel formula, 2000 output times, tol 1e-2), ``sine-0.5`` and
