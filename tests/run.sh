@@ -34,7 +34,9 @@ export CI="${CI:-1}"
 export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}"
 
 python -m ruff check core explorer tests benchmarks
-lint-imports
+# The import contracts of pyproject.toml (through python: a new console script may not be
+# on PATH until a shell rehashes).
+python -c 'import sys; from importlinter.cli import lint_imports_command; sys.exit(lint_imports_command())'
 
 if [ "$#" -gt 0 ]; then
     exec python -m pytest -q "$@"
