@@ -227,8 +227,7 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     """Cancel the solves the explorer tests left queued on the shared pool.
 
     The pool's threads are joined when the interpreter exits, so the queued solves of
-    sessions the tests dropped would otherwise run first (measured: ~19 s after the last
-    unit test).
+    sessions the tests dropped would otherwise all run before the process ends.
     """
     import sys
 
