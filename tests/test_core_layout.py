@@ -86,8 +86,8 @@ def test_parts_import_each_other_only_through_their_apis() -> None:
 
 
 def test_the_public_names_the_readmes_use_resolve() -> None:
-    """``core.solve``, ``from core import solve_dimensionless``, ... in the README, the guide and the
-    scene guide stay working through every move of the code."""
+    """``core.solve``, ``from core import solve_dimensionless``, ... in the README, the
+    guide and the scene guide stay working through every move of the code."""
     import importlib
 
     core = importlib.import_module("core")
