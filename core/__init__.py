@@ -24,6 +24,10 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
+#: The package's version: the one source of truth (``pyproject.toml`` reads it from here),
+#: recorded in every file the tool writes.
+__version__ = "0.2.0"
+
 if TYPE_CHECKING:
     from core.budget import STAGE_CACHE_BYTES, set_stage_cache_budget, stage_cache_bytes
     from core.creep import creep_coefficient_curve
@@ -53,6 +57,7 @@ _EXPORTS: dict[str, str] = {
 }
 
 __all__ = [
+    "__version__",
     "solve_dimensionless",
     "ContactSolution",
     "prepare",

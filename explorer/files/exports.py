@@ -16,10 +16,11 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterable
-from importlib import metadata
 from typing import Any
 
 import numpy as np
+
+import core
 
 from ..model import OUTPUTS, QUANTITIES, QUANTITY_UNITS, ResultView, StudyResult, contact_widths
 
@@ -35,11 +36,8 @@ CONTACT_COLUMNS = ("contact_width_m", "lifted_length_m")
 
 
 def project_version() -> str:
-    """The installed version of the project ('unknown' outside an installation)."""
-    try:
-        return metadata.version("coated-punch")
-    except metadata.PackageNotFoundError:
-        return "unknown"
+    """The project's version (``core.__version__``)."""
+    return core.__version__
 
 
 def number(value: float) -> str:
