@@ -22,7 +22,7 @@ import numpy as np
 import core
 from tests.support.scenes import suite
 
-PRESETS = Path(__file__).resolve().parent.parent / "assets" / "scenes"
+PRESETS = Path(__file__).resolve().parent.parent / "core" / "presets" / "scenes"
 X = np.linspace(-1.0, 1.0, 41)
 
 

@@ -197,7 +197,7 @@ def presets() -> None:
              "elastic copy: model | FE difference | estimate | FE s |",
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     within, total = 0, 0
-    for path in sorted((ROOT / "assets" / "scenes").glob("*.json")):
+    for path in sorted((ROOT / "core" / "presets" / "scenes").glob("*.json")):
         scene = load_scene(path)
         for interface in INTERFACES:
             d = scene.to_dict()
@@ -325,7 +325,7 @@ def aging() -> None:
     lines = ["| scene | interface | time [day] | E(t) / E(tau0) | FE model error | "
              "estimate (at loading) | FE s |", "| --- | --- | --- | --- | --- | --- | --- |"]
     for name in AGING_PRESETS:
-        scene = load_scene(ROOT / "assets" / "scenes" / f"{name}.json")
+        scene = load_scene(ROOT / "core" / "presets" / "scenes" / f"{name}.json")
         e0 = scene.modulus_at_loading()
         for interface in INTERFACES:
             d = scene.to_dict()

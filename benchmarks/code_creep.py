@@ -4,7 +4,7 @@ Run from the repository root:
 
     OPENBLAS_NUM_THREADS=1 python -m benchmarks.code_creep [--repeats 5]
 
-Reports, for the preset ``assets/scenes/young_concrete_50_years.json`` (fib MC2010 and
+Reports, for the preset ``core/presets/scenes/young_concrete_50_years.json`` (fib MC2010 and
 EN 1992-1-1, 200 output times over 50 years, tol 1e-4):
 
 * the kernel fit alone (cold, median), a new scene (caches cleared: fit, geometry and
@@ -37,7 +37,7 @@ from core.creep.models import Arutyunyan
 from core.scene import scene_from_dict
 from core.solver import solve_dimensionless
 
-PRESET = Path(__file__).resolve().parents[1] / "assets" / "scenes" / \
+PRESET = Path(__file__).resolve().parents[1] / "core" / "presets" / "scenes" / \
     "young_concrete_50_years.json"
 
 

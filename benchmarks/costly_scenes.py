@@ -38,7 +38,7 @@ print(json.dumps([seconds, peak, outcome]))
 
 
 def _scene(case: str) -> dict:
-    d = json.loads((ROOT / "assets" / "scenes" / "uniform_flat.json").read_text())
+    d = json.loads((ROOT / "core" / "presets" / "scenes" / "uniform_flat.json").read_text())
     if case in ("nested", "simple"):
         expr = "-0.01*exp(-0.03*(t-tau))"
         if case == "nested":

@@ -7,7 +7,7 @@ Run from the repository root:
 The same solves as the creep goals of ``benchmarks/engines.py`` (the ``aging_creep``
 scene of :mod:`tests.support.scenes` with 100 and 1000 output times over 1000 days, tol
 1e-6: a new scene with every cache cleared, then only the loads changed on a prepared
-geometry) and the 50-year preset ``assets/scenes/young_concrete_50_years.json`` with
+geometry) and the 50-year preset ``core/presets/scenes/young_concrete_50_years.json`` with
 both design-code models (a new scene, and a load change rebuilt from the scene dict).
 Medians of ``--repeats`` runs after a warm-up. On a shared machine the wall time is
 inflated by other work far more than the CPU time of this process, so both are printed
@@ -33,7 +33,7 @@ from core.scene import scene_from_dict
 from core.solver import solve_dimensionless
 from tests.support.scenes import creep_times, suite
 
-PRESET = Path(__file__).resolve().parents[1] / "assets" / "scenes" / \
+PRESET = Path(__file__).resolve().parents[1] / "core" / "presets" / "scenes" / \
     "young_concrete_50_years.json"
 
 

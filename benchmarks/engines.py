@@ -193,7 +193,7 @@ def goals(repeats: int) -> dict[str, float]:
     out["elastic_10000_times_ms"] = warm * 1e3
     out["elastic_10000_times_cpu_ms"] = warm_cpu * 1e3
     cold_cli, cold_cli_cpu = [], []
-    scene_file = ROOT / "assets" / "scenes" / "uniform_flat.json"
+    scene_file = ROOT / "core" / "presets" / "scenes" / "uniform_flat.json"
     for _ in range(max(3, repeats // 2)):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()

@@ -47,7 +47,7 @@ QUANTITIES = ("settlement", "tilt", "force", "moment")
 
 def rounded_graded() -> dict[str, Any]:
     """The preset as shipped (an elastic base)."""
-    return json.loads((ROOT / "assets" / "scenes" / "rounded_graded.json").read_text())
+    return json.loads((ROOT / "core" / "presets" / "scenes" / "rounded_graded.json").read_text())
 
 
 def _step(d: dict[str, Any], name: str, k: int) -> dict[str, Any]:

@@ -40,7 +40,7 @@ from core.contact.zones import Resolution, refine_zone_ends, solve_on_zones  # n
 from core.discretize import base_panels, kernel_operator  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
-PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"
+PRESET = ROOT / "core" / "presets" / "scenes" / "eccentric_footing_liftoff.json"
 
 
 def constant(value: float):

@@ -17,7 +17,7 @@ the cluster's start, its workers' warming included, is timed separately):
 * 1,000 points over the coating modulus (a new geometry per point): goal <= 30 s;
 * the same two studies on 1 worker (speed-up 1 vs 2 workers), and a serial loop in this
   process on a tenth of the points (the cost of a point without Dask);
-* the design chart of ``assets/studies/eccentric_design.json`` (settlement and tilt 50
+* the design chart of ``core/presets/studies/eccentric_design.json`` (settlement and tilt 50
   years after loading over the eccentricity and the coating modulus, the region where the
   full-contact answer loses contact hatched).
 
@@ -51,13 +51,13 @@ if str(ROOT) not in sys.path:
 from core.study import Study, study_from_dict, sweep  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
-DESIGN_STUDY = ROOT / "assets" / "studies" / "eccentric_design.json"
+DESIGN_STUDY = ROOT / "core" / "presets" / "studies" / "eccentric_design.json"
 GOALS = {"loads": 10.0, "modulus": 30.0}
 
 
 def elastic_scene() -> dict[str, Any]:
     """The uniform-coating preset on an elastic base, one output time (a year)."""
-    scene = json.loads((ROOT / "assets" / "scenes" / "uniform_flat.json").read_text())
+    scene = json.loads((ROOT / "core" / "presets" / "scenes" / "uniform_flat.json").read_text())
     scene["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
     scene["times"] = [365.0]
     return scene

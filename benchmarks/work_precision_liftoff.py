@@ -9,7 +9,7 @@ Three scenes past lift-off (dimensionless, core.contact.solve_unilateral):
   x = -1 lifts off: one free end);
 * worn patch, elastic: the same coating with a gap bump 0.01 exp(-(x/0.2)^2) in the
   middle, P = 0.01, M = 0.002 (contact in two pieces: two free ends between them);
-* eccentric footing under creep: the lift-off preset (assets/scenes/
+* eccentric footing under creep: the lift-off preset (core/presets/scenes/
   eccentric_footing_liftoff.json) with 20 log-spaced output times over 1000 days.
 
 Elastic curves: the solver swept over ``tol`` (zone ends refined as roots of Q(end) = 0 on

@@ -7,11 +7,14 @@ localhost only and opens no browser.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import os
 import signal
 import socket
 import sys
 from typing import Any
+
+import core
 
 # The solver works on small dense matrices from several threads at once; BLAS threads on
 # top of those only fight for the cores (a cold solve measured 1.5 s instead of 0.09 s on
@@ -57,12 +60,18 @@ WAITING_THREADS = 64
 WEBSOCKET_MAX_BYTES = 4 * 2**20
 
 
+#: What the page needs beyond the solver (the ``explorer`` extra of the package).
+EXPLORER_PACKAGES = ("panel", "bokeh", "param", "tornado", "holoviews", "distributed", "xarray")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="python -m explorer",
+        prog="coated-punch-explorer",
         description="Serve the coated-punch explorer. Open http://localhost:PORT/app "
                     "(/ redirects there). Add ?preset=NAME to start from a preset scene; "
                     "the address bar always holds a link to the scene on screen.")
+    parser.add_argument("--version", action="version",
+                        version=f"coated-punch {core.__version__}")
     parser.add_argument("--port", type=int, default=5006,
                         help="port to listen on (default 5006)")
     parser.add_argument("--address", default="localhost",
@@ -113,6 +122,11 @@ def main(argv: list[str] | None = None) -> int:
     (``argv`` None), the program first starts itself again with the server's memory
     allocator (:data:`SERVER_ALLOCATOR`)."""
     args = build_parser().parse_args(argv)
+    missing = [name for name in EXPLORER_PACKAGES if importlib.util.find_spec(name) is None]
+    if missing:
+        print(f"The explorer needs {', '.join(missing)}, not installed here: "
+              "pip install 'coated-punch[explorer]'", file=sys.stderr)
+        return 2
     if argv is None:
         _restart_with_server_allocator()
     import panel as pn

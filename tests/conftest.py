@@ -128,11 +128,11 @@ def small_preset_fixture() -> Callable[..., dict[str, Any]]:
     return small_preset_scene
 
 
-SCENES_DIR = Path(__file__).resolve().parent.parent / "assets" / "scenes"
+SCENES_DIR = Path(__file__).resolve().parent.parent / "core" / "presets" / "scenes"
 
 
 def scene_file(name: str) -> dict[str, Any]:
-    """The scene file ``assets/scenes/<name>.json`` as a new dict."""
+    """The scene file ``core/presets/scenes/<name>.json`` as a new dict."""
     return json.loads((SCENES_DIR / f"{name}.json").read_text())
 
 

@@ -42,6 +42,7 @@ from core.coating.fem_mesh import (
     total_thickness,
 )
 from core.coating.fem_stack import INTERFACES, FEResponse, Stack
+from core.optional import import_optional
 
 #: Lateral extent of the base beyond the punch edge, in base thicknesses (the kernel of
 #: the layer decays like exp(-2.1 x / H); ``--fe-study`` measured the change of the force
@@ -82,6 +83,8 @@ def solve_stack(stack: Stack, *, level: int = 0, extent: float | None = None) ->
     # Imported here: scipy.sparse costs ~0.07 s at start-up, which no other path needs.
     import scipy.sparse as sp
     from scipy.sparse.linalg import splu
+
+    import_optional("skfem", "the finite-element check of the coating model")
     from skfem import Basis, ElementTriP2, ElementVector, MeshTri, asm
 
     start = time.perf_counter()

@@ -49,6 +49,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.files import atomic_write_text
+from core.optional import import_optional
 from core.scene import FLAG_MESSAGES
 from core.study.batch import run_batch
 from core.study.definition import OUTPUT_UNITS, Study, load_study
@@ -163,12 +164,11 @@ class WorkDir:
 
 def _resolve_client(client: Any, scheduler: str | None) -> tuple[Any, Callable[[], None]]:
     """A distributed client and a function that releases what was started here."""
-    from distributed import Client
+    Client = import_optional("distributed", "a study on Dask").Client  # noqa: N806
 
     if client is not None:
         return client, lambda: None
-    import dask
-
+    dask = import_optional("dask", "a study on Dask")
     address = scheduler or dask.config.get("scheduler-address", None)
     if address:
         own = Client(address)
@@ -380,8 +380,7 @@ def study_dataset(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[i
     path in its ``field`` attribute) and ``sample``; variables: each output over (point,
     time) with ``units``, ``error_estimate`` (relative), ``flags`` (comma-joined),
     ``flag_<name>`` (bool), ``failed`` (bool), ``error`` (message), ``solve_seconds``."""
-    import xarray as xr
-
+    xr = import_optional("xarray", "a study's dataset")
     data = _gather(study, parts, plan, lost)
     table = point_table(study)  # the dataset holds every point anyway
     coords: dict[str, Any] = {"point": np.arange(study.n_points),
@@ -480,8 +479,8 @@ def _write_long(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[int
                 columns = [_csv_column(v) for v in rows.values()]
                 fh.writelines(",".join(r) + "\n" for r in zip(*columns, strict=True))
             else:
-                import pyarrow as pa
-                import pyarrow.parquet as pq
+                pa = import_optional("pyarrow", "a study's Parquet table")
+                pq = import_optional("pyarrow.parquet", "a study's Parquet table")
 
                 batch = pa.table(rows)
                 if writer is None:

@@ -31,7 +31,7 @@ from .lessons import Lesson, lessons, step_scene
 from .links import decode_scene, encode_scene
 from .loading_state import QUANTITIES, QUANTITY_RANGES, QUANTITY_UNITS, STATEMENTS, HistoryState
 from .pins import MAX_PINS, Pin, PinBoard
-from .presets import DEFAULT_PRESET, ORDER, SCENES_DIR, preset_label, presets
+from .presets import DEFAULT_PRESET, ORDER, preset_label, presets
 from .results import Geometry, ResultView, prepare_view
 from .scales import DisplayScales
 from .scene_parts import (
@@ -62,7 +62,7 @@ from .view_link import read_study_query, read_view_query, view_query
 
 __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
            "MAX_DESCRIPTION_CHARS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS", "MODEL_TOL_RANGE",
-           "ORDER", "OUTPUTS", "QUANTITIES", "QUANTITY_RANGES", "QUANTITY_UNITS", "SCENES_DIR",
+           "ORDER", "OUTPUTS", "QUANTITIES", "QUANTITY_RANGES", "QUANTITY_UNITS",
            "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES", "Axis", "CodeCreepState",
            "DesignLimits", "DisplayScales", "ExplorerState", "Geometry", "HistoryState",
            "LayerState", "Lesson", "Pin", "PinBoard", "PlannedStudy", "ProfileState", "ResultView",

@@ -19,7 +19,7 @@ from tests.conftest import DELETE, base_scene, edited, scene_file
 from tests.scene.test_scene_refusals import BAD_VALUES
 
 ROOT = Path(__file__).resolve().parents[2]
-SCENES = ROOT / "assets" / "scenes"
+SCENES = ROOT / "core" / "presets" / "scenes"
 
 
 def run(*args: str | os.PathLike, cwd: Path = ROOT) -> subprocess.CompletedProcess:

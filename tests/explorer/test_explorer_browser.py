@@ -189,7 +189,7 @@ def test_an_oversized_upload_is_refused_in_the_page_and_a_scene_file_loads(page:
                                    "buffer": b"{" + b" " * (5 * 2**20) + b"}"}])
     page.page.get_by_text("File is too large").first.wait_for(timeout=30_000)
     root = Path(__file__).resolve().parents[2]
-    scene = json.loads((root / "assets" / "scenes" / "stepped_punch.json").read_text())
+    scene = json.loads((root / "core" / "presets" / "scenes" / "stepped_punch.json").read_text())
     scene["name"] = "uploaded in the browser"
     settlement = page.text(".readout-settlement")
     upload.set_input_files(files=[{"name": "scene.json", "mimeType": "application/json",

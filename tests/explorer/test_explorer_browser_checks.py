@@ -464,7 +464,7 @@ def test_a_refused_scene_file_leaves_the_box_ready_for_the_next(page: Page):
     page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000)
     until(lambda: "broken.json" in page.pane_text(".notice"), "the refusal of broken.json")
     until(lambda: not _upload_complete_shown(page), "the box emptied after the refusal")
-    scene = json.loads((ROOT / "assets" / "scenes" / "stepped_punch.json").read_text())
+    scene = json.loads((ROOT / "core" / "presets" / "scenes" / "stepped_punch.json").read_text())
     scene["name"] = "second file"
     upload = page.page.locator("input[type=file]").last
     upload.wait_for(state="attached", timeout=30_000)

@@ -61,7 +61,7 @@ def test_an_idle_page_holds_the_droppers_loop_and_a_late_file_still_loads(page: 
     assert _painter_runs(page, AWAKE_MS + 500) == 0
     # a file chosen now (as after a long look through the file dialog): only the file
     # input's own events happen on the page, and the dropper takes it up all the same
-    scene = json.loads((ROOT / "assets" / "scenes" / "stepped_punch.json").read_text())
+    scene = json.loads((ROOT / "core" / "presets" / "scenes" / "stepped_punch.json").read_text())
     scene["name"] = "chosen while idle"
     upload.set_input_files(files=[{"name": "scene.json", "mimeType": "application/json",
                                    "buffer": json.dumps(scene).encode()}])

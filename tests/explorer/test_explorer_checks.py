@@ -221,7 +221,7 @@ def test_the_eccentric_creep_preset_says_what_its_curve_does():
 
 
 def test_the_command_line_shows_the_solver_message_not_a_pointer(tmp_path):
-    scene = json.loads((ROOT / "assets" / "scenes" / "rounded_graded.json").read_text())
+    scene = json.loads((ROOT / "core" / "presets" / "scenes" / "rounded_graded.json").read_text())
     # below what the exact layered kernel reaches at its most modes (measured 9.0e-12 at
     # 270 modes; the aging presets' time stepping now meets 1e-12)
     scene["solver"] = {"tol": 1e-12}

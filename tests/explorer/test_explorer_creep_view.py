@@ -71,7 +71,7 @@ def test_base_state_offers_the_code_models_and_round_trips_the_preset():
 
     assert {"fib_mc2010", "eurocode2"} <= set(CREEP_MODELS)
     scene = json.loads((Path(__file__).resolve().parents[2]
-                        / "assets/scenes/young_concrete_50_years.json").read_text())
+                        / "core/presets/scenes/young_concrete_50_years.json").read_text())
     state = ExplorerState()
     state._load(scene)
     assert state.base.creep_model == "fib_mc2010"  # by name, not as "other model"

@@ -16,7 +16,7 @@ import pytest
 from core import scene_from_dict
 from explorer.model import ExplorerState, decode_scene, encode_scene
 
-LIFTOFF = Path(__file__).resolve().parents[2] / "assets/scenes/eccentric_footing_liftoff.json"
+LIFTOFF = Path(__file__).resolve().parents[2] / "core/presets/scenes/eccentric_footing_liftoff.json"
 
 
 def _scene() -> dict:

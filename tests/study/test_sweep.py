@@ -21,7 +21,7 @@ from tests.cli_runs import run_cli
 from tests.conftest import scene_file
 
 ROOT = Path(__file__).resolve().parents[2]
-SCENES = ROOT / "assets" / "scenes"
+SCENES = ROOT / "core" / "presets" / "scenes"
 OUTPUTS = ("settlement", "tilt", "force", "moment", "q_max", "q_min", "contact_width")
 
 

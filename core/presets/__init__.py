@@ -1,0 +1,93 @@
+"""The preset scenes and studies shipped with the package.
+
+The files are package data (``core/presets/scenes/*.json`` and
+``core/presets/studies/*.json``), read through :mod:`importlib.resources`, so an installed
+wheel finds them wherever it is started from. The explorer offers the scenes as its
+presets and builds its lessons from them; the command line reads them by name
+(``coated-punch solve preset:worn_coating``).
+
+The names are the file stems (``uniform_flat``, ``worn_coating``, ...).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from contextlib import AbstractContextManager, contextmanager
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+__all__ = ["PRESET_PREFIX", "preset_names", "preset_path", "read_preset", "read_study",
+           "study_names", "study_path"]
+
+#: How a command-line argument names a shipped scene or study instead of a file.
+PRESET_PREFIX = "preset:"
+
+
+def _folder(kind: str) -> Any:
+    return resources.files(__name__).joinpath(kind)
+
+
+@cache
+def _names(kind: str) -> tuple[str, ...]:
+    return tuple(sorted(item.name[:-5] for item in _folder(kind).iterdir()
+                        if item.name.endswith(".json")))
+
+
+def preset_names() -> tuple[str, ...]:
+    """The names of the shipped preset scenes, sorted."""
+    return _names("scenes")
+
+
+def study_names() -> tuple[str, ...]:
+    """The names of the shipped studies, sorted."""
+    return _names("studies")
+
+
+def _read(kind: str, name: str) -> dict[str, Any]:
+    known = _names(kind)
+    if name not in known:
+        raise KeyError(f"no shipped {kind[:-1]} named {name!r}; known: {', '.join(known)}")
+    data = json.loads(_folder(kind).joinpath(f"{name}.json").read_text(encoding="utf-8"))
+    if not isinstance(data, dict):
+        raise ValueError(f"the shipped {kind[:-1]} {name!r} is not a JSON object")
+    return data
+
+
+def read_preset(name: str) -> dict[str, Any]:
+    """The preset scene ``name`` as a fresh scene dict (format: ``core/SCENES.md``).
+
+    Raises
+    ------
+    KeyError
+        If no preset has that name (the message lists the known ones).
+    """
+    return _read("scenes", name)
+
+
+def read_study(name: str) -> dict[str, Any]:
+    """The shipped study ``name`` as a fresh study dict; its ``scene`` is a path relative
+    to :func:`study_path` ``(name)``'s folder."""
+    return _read("studies", name)
+
+
+@contextmanager
+def _as_path(kind: str, name: str) -> Iterator[Path]:
+    if name not in _names(kind):
+        raise KeyError(f"no shipped {kind[:-1]} named {name!r}; "
+                       f"known: {', '.join(_names(kind))}")
+    with resources.as_file(_folder(kind).joinpath(f"{name}.json")) as path:
+        yield path
+
+
+def preset_path(name: str) -> AbstractContextManager[Path]:
+    """A context manager giving a file-system path of the preset scene ``name``."""
+    return _as_path("scenes", name)
+
+
+def study_path(name: str) -> AbstractContextManager[Path]:
+    """A context manager giving a file-system path of the shipped study ``name`` (its
+    ``scene`` path resolves beside it)."""
+    return _as_path("studies", name)
