@@ -105,20 +105,25 @@ class ExplorerProcess:
         killing it (SIGKILL). Default 10 s.
     cwd:
         Working directory of the child; ``None``: the directory holding the package.
+    program:
+        The program to run instead of ``python -m explorer``, e.g. an installed
+        ``coated-punch-explorer`` script. It runs the code it was installed with:
+        ``PYTHONPATH`` is removed from its environment, not prefixed.
     """
 
     def __init__(self, args: Sequence[str] = (), *, host: str = "localhost",
                  port: int | None = None, env: Mapping[str, str] | None = None,
                  log: str | os.PathLike[str] | None = None, ready_timeout: float = 180.0,
                  stop_timeout: float = 10.0, cwd: str | os.PathLike[str] | None = None,
-                 ) -> None:
+                 program: Sequence[str] | None = None) -> None:
         self.host = host
         self.port = free_port("127.0.0.1" if host == "localhost" else host) \
             if port is None else port
         self.url = f"http://{host}:{self.port}"
         self.ready_timeout = ready_timeout
         self.stop_timeout = stop_timeout
-        self.command = [sys.executable, "-m", "explorer", "--port", str(self.port)]
+        self._installed = program is not None
+        self.command = [*(program or (sys.executable, "-m", "explorer")), "--port", str(self.port)]
         if host != "localhost":
             self.command += ["--address", host,
                              "--allow-websocket-origin", f"{host}:{self.port}"]
@@ -147,8 +152,11 @@ class ExplorerProcess:
             raise RuntimeError("the explorer server has already been started")
         env = dict(os.environ)
         env.update(self._env)
-        env["PYTHONPATH"] = os.pathsep.join(
-            filter(None, [str(_PACKAGE_PARENT), env.get("PYTHONPATH")]))
+        if self._installed:
+            env.pop("PYTHONPATH", None)
+        else:
+            env["PYTHONPATH"] = os.pathsep.join(
+                filter(None, [str(_PACKAGE_PARENT), env.get("PYTHONPATH")]))
         if self.log_path is None:
             fd, name = tempfile.mkstemp(prefix="explorer-server-", suffix=".log")
             self.log_path = Path(name)
