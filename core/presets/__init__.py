@@ -12,6 +12,7 @@ The names are the file stems (``uniform_flat``, ``worn_coating``, ...).
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Iterator
 from contextlib import AbstractContextManager, contextmanager
 from functools import cache
@@ -20,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 __all__ = ["PRESET_PREFIX", "preset_names", "preset_path", "read_preset", "read_study",
-           "study_names", "study_path"]
+           "shipped_file", "study_names", "study_path"]
 
 #: How a command-line argument names a shipped scene or study instead of a file.
 PRESET_PREFIX = "preset:"
@@ -71,6 +72,25 @@ def read_study(name: str) -> dict[str, Any]:
     """The shipped study ``name`` as a fresh study dict; its ``scene`` is a path relative
     to :func:`study_path` ``(name)``'s folder."""
     return _read("studies", name)
+
+
+def shipped_file(path: str | os.PathLike, kind: str) -> str | os.PathLike:
+    """``path`` itself, or for ``"preset:NAME"`` the file-system path of the shipped
+    ``kind`` (``"scenes"`` or ``"studies"``) of that name.
+
+    Raises
+    ------
+    ValueError
+        If nothing of that name is shipped (the message lists what is).
+    """
+    if not (isinstance(path, str) and path.startswith(PRESET_PREFIX)):
+        return path
+    name = path[len(PRESET_PREFIX):]
+    if name not in _names(kind):
+        raise ValueError(f"{path}: no shipped {kind[:-1]} of that name; "
+                       f"known: {', '.join(_names(kind))}")
+    # an installed package is a folder of files (a wheel unpacks; a zipped one would not do)
+    return Path(str(_folder(kind).joinpath(f"{name}.json")))
 
 
 @contextmanager

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from core import limits
 from core.files import atomic_write_text, read_regular_file
+from core.presets import shipped_file
 from core.scene.validate import scene_from_dict
 
 if TYPE_CHECKING:
@@ -56,12 +57,14 @@ def parse_scene_json(text: str, source: str = "scene") -> Scene:
 
 
 def load_scene(path: str | os.PathLike) -> Scene:
-    """Read and validate a scene file (JSON, UTF-8, at most 1 MB).
+    """Read and validate a scene file (JSON, UTF-8, at most 1 MB); ``"preset:NAME"`` reads
+    the shipped preset of that name (:mod:`core.presets`).
 
     Raises ``ValueError`` (message starting with the file path or the field path) for a
     file that is too large, not a regular file (a named pipe is refused, not waited on),
     not JSON or not a valid scene, ``OSError`` if it cannot be read.
     """
+    path = shipped_file(path, "scenes")
     raw = read_regular_file(path, limits.MAX_SCENE_BYTES)
     try:
         text = raw.decode("utf-8-sig")

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from core.presets import shipped_file
 from core.scene import (
     MAX_SCENE_BYTES,
     check_fields,
@@ -396,8 +397,9 @@ def numeric_fields(scene: Mapping[str, Any], prefix: str = "") -> list[tuple[str
 
 def load_study(path: str | os.PathLike) -> Study:
     """Read and validate a study file (JSON, at most 1 MB); a relative ``scene`` path is
-    taken from the study file's directory."""
-    path = Path(path)
+    taken from the study file's directory. ``"preset:NAME"`` reads the shipped study of
+    that name (:mod:`core.presets`)."""
+    path = Path(shipped_file(path, "studies"))
     return study_from_dict(_read_json_file(path, "study"), base_dir=path.parent)
 
 

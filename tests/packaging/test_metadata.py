@@ -175,3 +175,12 @@ def test_every_scene_is_json_an_editor_reads():
     for name in preset_names():
         path = ROOT / "core" / "presets" / "scenes" / f"{name}.json"
         assert isinstance(json.loads(path.read_text()), dict)
+
+
+def test_a_shipped_scene_or_study_is_named_preset_colon_name():
+    assert core.load_scene("preset:worn_coating").to_dict() \
+        == core.scene_from_dict(read_preset("worn_coating")).to_dict()
+    assert core.load_study("preset:eccentric_design").n_points > 0
+    with pytest.raises(ValueError, match="preset:nope: no shipped scene of that name; known: "
+                                         "eccentric_creep"):
+        core.load_scene("preset:nope")
