@@ -16,7 +16,7 @@ from types import ModuleType
 EXTRA_OF: dict[str, str] = {
     "dask": "studies",
     "distributed": "studies",
-    "pyarrow": "studies",
+    "pyarrow": "parquet",
     "xarray": "data",
     "pandas": "data",
     "skfem": "fem",
