@@ -86,7 +86,13 @@ def same_file(first: str | os.PathLike, second: str | os.PathLike) -> bool:
 
 
 def atomic_write_text(path: str | os.PathLike, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path`` atomically, under the rules of this module.
+    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` atomically
+    (:func:`atomic_write_bytes`)."""
+    atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically, under the rules of this module.
 
     A temporary file in the target's directory is flushed to disk, then renamed over the
     target; an existing target keeps its mode. Raises ValueError (see
@@ -96,8 +102,8 @@ def atomic_write_text(path: str | os.PathLike, text: str) -> None:
     directory = target.parent if str(target.parent) else Path(".")
     fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{target.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
         # mkstemp creates the file readable by its owner only; keep an existing file's

@@ -1,0 +1,71 @@
+"""The report as one self-contained HTML file: the sections, the plots of
+:meth:`SceneSolution.plot` rendered by Bokeh with its library inline (the file opens and
+prints with no network), and the scene file itself."""
+
+from __future__ import annotations
+
+import html
+
+from core.optional import import_optional
+from core.report.content import Section, scene_json, sections
+from core.scene import SceneSolution
+
+CSS = """
+body {font-family: Helvetica, Arial, sans-serif; font-size: 12px; margin: 18px; color: #222;
+      max-width: 1100px;}
+h1 {font-size: 18px; margin: 0 0 4px 0;} h2 {font-size: 14px; margin: 16px 0 4px 0;}
+table {border-collapse: collapse;} td {padding: 2px 8px; border-bottom: 1px solid #ddd;
+text-align: left; vertical-align: top;} td:first-child {white-space: nowrap;}
+.bad {color: #9b1c1c; font-weight: bold;} .good {color: #1d6b2c;}
+pre {font-size: 10px; white-space: pre-wrap; word-break: break-all;}
+@media print {body {margin: 8mm;} .report-plots {page-break-inside: avoid;}}
+"""
+
+
+def _section(section: Section) -> str:
+    tone = f" class='{section.tone}'" if section.tone else ""
+    slug = "report-" + section.title.lower().replace(" ", "-")
+    parts = [f"<section class='{slug}'><h2>{html.escape(section.title)}</h2>"]
+    if section.lead:
+        parts.append(f"<p{tone}>{html.escape(section.lead)}</p>")
+    if section.rows:
+        parts.append("<table>" + "".join(
+            f"<tr><td>{html.escape(label)}</td><td>{html.escape(value)}</td></tr>"
+            for label, value in section.rows) + "</table>")
+    parts.extend(f"<p>{html.escape(note)}</p>" for note in section.notes)
+    return "".join(parts) + "</section>"
+
+
+def _plots(result: SceneSolution) -> tuple[str, str]:
+    """The plots as (scripts for the page head, the body's markup)."""
+    hv = import_optional("holoviews", "the report's plots")
+    embed = import_optional("bokeh.embed", "the report's plots")
+    resources = import_optional("bokeh.resources", "the report's plots")
+    model = hv.render(result.plot(), backend="bokeh")
+    script, div = embed.components(model)
+    return resources.INLINE.render() + script, div
+
+
+def report_html(result: SceneSolution) -> str:
+    """The report of ``result`` as a complete HTML document (text).
+
+    Parameters
+    ----------
+    result : SceneSolution
+        A solved scene; its limits (if the scene sets any) are checked in the report.
+
+    Returns
+    -------
+    str
+        The document: validity, design check, key results with units, accuracy, the
+        plots of q(x, t), settlement and tilt, and the scene file.
+    """
+    head, plots = _plots(result)
+    title = html.escape(str(result.scene.name or "scene"))
+    body = "".join(_section(s) for s in sections(result))
+    return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+            f"<title>Report: {title}</title><style>{CSS}</style>{head}</head><body>"
+            f"<h1>Coated punch: {title}</h1>{body}"
+            f"<section class='report-plots'><h2>Plots</h2>{plots}</section>"
+            f"<section class='report-scene'><h2>Scene file</h2>"
+            f"<pre>{html.escape(scene_json(result))}</pre></section></body></html>")

@@ -1,0 +1,90 @@
+"""The report as a PDF: the same sections as the HTML report on A4 pages, and the plots
+of :meth:`SceneSolution.plot` rendered by HoloViews' Matplotlib backend."""
+
+from __future__ import annotations
+
+import io
+import os
+import textwrap
+
+from core.optional import import_optional
+from core.report.content import scene_json, sections
+from core.scene import SceneSolution
+
+#: A4 portrait [inch].
+PAGE = (8.27, 11.69)
+#: Lines of text on a page, and characters on a line, at the font size used.
+LINES_PER_PAGE = 62
+CHARACTERS_PER_LINE = 100
+COLOURS = {"bad": "#9b1c1c", "good": "#1d6b2c", "": "#222222"}
+
+
+def _text_lines(result: SceneSolution) -> list[tuple[str, str, bool]]:
+    """(text, tone, bold) lines of the report's sections."""
+    lines: list[tuple[str, str, bool]] = [
+        (f"Coated punch: {result.scene.name or 'scene'}", "", True), ("", "", False)]
+    for section in sections(result):
+        lines.append((section.title, "", True))
+        if section.lead:
+            lines.extend((t, section.tone, False)
+                         for t in textwrap.wrap(section.lead, CHARACTERS_PER_LINE))
+        for label, value in section.rows:
+            wrapped = textwrap.wrap(f"{label}: {value}", CHARACTERS_PER_LINE,
+                                    subsequent_indent="    ")
+            lines.extend((t, "", False) for t in wrapped)
+        lines.append(("", "", False))
+    return lines
+
+
+def _text_pages(pdf, plt, lines: list[tuple[str, str, bool]], size: float = 8.5) -> None:
+    for start in range(0, len(lines), LINES_PER_PAGE):
+        figure = plt.figure(figsize=PAGE)
+        for k, (text, tone, bold) in enumerate(lines[start:start + LINES_PER_PAGE]):
+            figure.text(0.07, 0.95 - k * 0.9 / LINES_PER_PAGE, text, fontsize=size,
+                        color=COLOURS.get(tone, "#222222"), family="DejaVu Sans",
+                        weight="bold" if bold else "normal", va="top")
+        pdf.savefig(figure)
+        plt.close(figure)
+
+
+def report_pdf(result: SceneSolution) -> bytes:
+    """The report of ``result`` as PDF bytes (the sections, the plots, the scene file).
+
+    Raises
+    ------
+    MissingDependency
+        Without Matplotlib or HoloViews (the ``report`` extra).
+    """
+    hv = import_optional("holoviews", "the PDF report")
+    import_optional("matplotlib", "the PDF report")
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import holoviews.plotting.mpl  # noqa: F401  (registers the Matplotlib backend)
+    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    buffer = io.BytesIO()
+    with PdfPages(buffer, metadata={"Title": f"Report: {result.scene.name or 'scene'}",
+                                    "Creator": "coated-punch"}) as pdf:
+        _text_pages(pdf, plt, _text_lines(result))
+        figure = hv.render(result.plot(), backend="matplotlib")
+        figure.set_size_inches(PAGE[0], PAGE[0] * 0.75)
+        pdf.savefig(figure, bbox_inches="tight")
+        plt.close(figure)
+        scene = [(line, "", False) for raw in scene_json(result).splitlines()
+                 for line in (textwrap.wrap(raw, CHARACTERS_PER_LINE + 20,
+                                            subsequent_indent="      ") or [""])]
+        _text_pages(pdf, plt, [("Scene file", "", True), *scene], size=6.5)
+    return buffer.getvalue()
+
+
+def write_report(result: SceneSolution, path: str | os.PathLike) -> None:
+    """Write the report of ``result`` to ``path``: PDF for a ``.pdf`` name, else HTML."""
+    from core.files import atomic_write_bytes, atomic_write_text
+    from core.report.html import report_html
+
+    if str(path).lower().endswith(".pdf"):
+        atomic_write_bytes(path, report_pdf(result))
+    else:
+        atomic_write_text(path, report_html(result))
