@@ -24,9 +24,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-#: The package's version: the one source of truth (``pyproject.toml`` reads it from here),
-#: recorded in every file the tool writes.
-__version__ = "0.2.0"
+from core.version import __version__
 
 if TYPE_CHECKING:
     from core.budget import STAGE_CACHE_BYTES, set_stage_cache_budget, stage_cache_bytes

@@ -36,7 +36,8 @@ class _Snapshot:
     memory: np.ndarray | None = None  # creep memory density at the nodes (F of it is e(x))
 
 
-@dataclass(frozen=True)
+# repr=False: the short repr of SolveOutcome, not every array and snapshot
+@dataclass(frozen=True, repr=False)
 class UnilateralSolution(SolveOutcome):
     """The answer of :func:`solve_unilateral` (dimensionless, like ``ContactSolution``).
 

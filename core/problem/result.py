@@ -104,8 +104,23 @@ class SolveOutcome:
         ``unresolved_input`` (full) or ``contact_set_unverified`` (unilateral)."""
         return list(self.info["flags"])
 
+    def __repr__(self) -> str:
+        """One line: the engine, the output times, the last values of delta, alpha, P, M
+        (dimensionless), the error estimate and the flags (the arrays would fill pages)."""
+        times = getattr(self, "times", ())
+        engine = self.info.get("method") or f"{self.info.get('contact', '')} contact"
+        last = ", ".join(f"{name} {float(getattr(self, name)[-1]):.6g}"
+                         for name in ("settlement", "tilt", "force", "moment")) \
+            if len(times) else "no times"
+        t_end = f" to t = {float(times[-1]):.6g}" if len(times) else ""
+        return (f"<{type(self).__name__} {engine}, dimensionless: {len(times)} times{t_end}; "
+                f"{last}; "
+                f"error estimate {float(self.info.get('error_estimate', float('nan'))):.2g}"
+                f"; flags: {', '.join(self.flags) or 'none'}>")
 
-@dataclass(frozen=True)
+
+# repr=False: the short repr of SolveOutcome, not every array and the whole info
+@dataclass(frozen=True, repr=False)
 class ContactSolution(SolveOutcome):
     """The answer of every engine, full contact (all quantities dimensionless).
 

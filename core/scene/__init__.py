@@ -8,6 +8,8 @@ returns a ``SceneSolution``.
 - ``model.py``: the validated ``Scene`` and ``Layer`` and what follows from them alone;
 - ``dimensionless.py``: ``to_dimensionless``, the scene as the dimensionless problem;
 - ``results.py``: ``SceneSolution``, the answer in SI units with its flags, JSON and CSV;
+- ``display.py``: its repr and HTML table, its metadata, ``to_xarray``/``to_dataframe``;
+- ``plotting.py``: its HoloViews plot (the one module of core that imports HoloViews);
 - ``files.py``: ``load_scene``, ``save_scene`` (strict JSON, atomic writes);
 - ``load_limits.py``, ``load_rates.py``: loads no contact can carry, and the steps a
   load history forces, refused before any solve;

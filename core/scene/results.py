@@ -21,9 +21,17 @@ from core.coating import model_error_estimate, model_error_map, tilt_share
 from core.problem import QUANTITIES
 from core.scene.load_rates import oscillations
 from core.scene.model import Scene
+from core.scene.display import HISTORIES, html_summary, package_version, text_summary
+from core.scene.display import to_dataframe as _to_dataframe
+from core.scene.display import to_xarray as _to_xarray
 from core.scene.schema import SCHEMA_VERSION, _jsonable
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import pandas
+    import xarray
+
     from core.problem import ContactSolution
     from core.scene.dimensionless import DimensionlessProblem
 
@@ -56,10 +64,7 @@ FLAG_MESSAGES: dict[str, str] = {
 
 UNITS: dict[str, str] = {
     "times": "day (after loading)",
-    "settlement": "m",
-    "tilt": "rad",
-    "force": "N/m",
-    "moment": "N",
+    **{name: unit for name, (unit, _, _) in HISTORIES.items()},
     "x": "m (from the punch centre)",
     "pressure": "Pa (rows: x, columns: times)",
 }
@@ -218,6 +223,7 @@ class SceneSolution:
         """
         return _jsonable({
             "format": "coated-punch solution",
+            "version": package_version(),
             "schema_version": SCHEMA_VERSION,
             "scene": self.scene.to_dict(),
             "units": UNITS,
@@ -233,6 +239,42 @@ class SceneSolution:
             "contact_set": [[list(zone) for zone in zones] for zones in self.contact_set],
             "info": self.info,
         })
+
+    def __repr__(self) -> str:
+        """A few lines: the scene, the figures at the last time with units, the error
+        estimates, the flags and the engine."""
+        return text_summary(self)
+
+    def _repr_html_(self) -> str:
+        """The summary of ``repr`` as an HTML table, flags in red with their messages."""
+        return html_summary(self)
+
+    def to_xarray(self) -> xarray.Dataset:
+        """An ``xarray.Dataset`` over ``time`` [day] and ``x`` [m]: ``pressure`` q(x, t)
+        [Pa] on :attr:`x`, ``settlement`` [m], ``tilt`` [rad], ``force`` [N/m], ``moment``
+        [N], ``contact_width`` [m]; units and long names in the variables' attributes; the
+        package version, the scene (canonical JSON), the solver settings (JSON), the flags
+        and the error estimates in the dataset's. Needs xarray (``ImportError`` naming
+        the extra to install otherwise)."""
+        return _to_xarray(self)
+
+    def to_dataframe(self) -> pandas.DataFrame:
+        """The histories as a ``pandas.DataFrame`` indexed by ``time`` [day]: columns
+        ``settlement`` [m], ``tilt`` [rad], ``force`` [N/m], ``moment`` [N],
+        ``contact_width`` [m]; ``attrs`` hold the dataset attributes of :meth:`to_xarray`
+        and ``units``. Needs pandas."""
+        return _to_dataframe(self)
+
+    def plot(self, count: int | None = None,
+             times: Sequence[float] | None = None) -> Any:
+        """A ``holoviews.Layout``: q(x) [kPa or MPa] at ``count`` output times (default
+        :data:`core.scene.plotting.PLOT_CURVES`) or at those nearest to ``times`` [day],
+        coloured by time; settlement delta [mm] and tilt alpha [mrad] over time; the flags
+        in the title, lift-off in the pressure plot's title and shaded. Options are set
+        for the Bokeh backend (:mod:`core.scene.plotting`)."""
+        from core.scene.plotting import PLOT_CURVES, plot_solution
+
+        return plot_solution(self, PLOT_CURVES if count is None else count, times)
 
     def to_json(self) -> str:
         """:meth:`to_dict` as compact JSON text."""

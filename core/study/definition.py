@@ -120,6 +120,28 @@ class Study:
         text = json.dumps(data, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()
 
+    def to_dict(self) -> dict[str, Any]:
+        """The study as a study file's dict (format in ``core/SCENES.md``): the base scene
+        inline (its ``times`` are the study's), each grid as it was given (a
+        ``linspace``/``logspace`` by its ends and count), each distribution with its
+        parameters. :func:`study_from_dict` of it gives a study with the same :attr:`key`."""
+        vary: list[dict[str, Any]] = []
+        for p in self.parameters:
+            if p.kind == "values":
+                spec: Any = list(p.values)
+            elif p.is_grid:
+                # linspace and geomspace return their ends exactly: the grid is rebuilt
+                spec = {"start": p.values[0], "stop": p.values[-1], "count": len(p.values)}
+            else:
+                spec = dict(p.args)
+            vary.append({"field": p.path, p.kind: spec})
+        d: dict[str, Any] = {"study_version": STUDY_VERSION, "name": self.name,
+                             "scene": copy.deepcopy(self.base), "vary": vary}
+        if any(not p.is_grid for p in self.parameters):
+            d["samples"] = self.samples
+        d |= {"seed": self.seed, "outputs": list(self.outputs)}
+        return d
+
 
 # ---------------------------------------------------------------------------- paths
 

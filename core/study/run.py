@@ -26,7 +26,9 @@ Each finished batch is written atomically to a work directory (``parts/batch_NNN
 next to a ``manifest.json`` naming the study), so a study that was interrupted (a killed
 process, a lost worker) resumes from what was written, and the results stream to disk
 rather than into memory. The result is an ``xarray.Dataset`` over ``point`` and ``time``
-with units in its attributes (see :func:`study_dataset`); ``.csv`` and ``.parquet``
+with units in its attributes (see :func:`study_dataset`) and the package version, the
+study, the base scene and the solver settings in the dataset's (:func:`study_metadata`,
+also in a parquet file's metadata); ``.csv`` and ``.parquet``
 outputs are written batch by batch in long form, ``.nc`` (netCDF 3, scipy engine) from
 the assembled dataset.
 
@@ -55,6 +57,7 @@ from core.study.batch import run_batch
 from core.study.definition import OUTPUT_UNITS, Study, load_study
 from core.study.plan import PLAN_ORDER, BatchPlan, batch_plan
 from core.study.points import StudyPoints, point_table
+from core.version import __version__
 
 if TYPE_CHECKING:
     import xarray
@@ -409,12 +412,23 @@ def study_dataset(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[i
                            {"long_name": "the point has no result (see error)"})
     variables["error"] = ("point", data["error"].astype(str))
     variables["solve_seconds"] = ("point", data["seconds"], {"units": "s"})
-    attrs = {"study": study.name, "study_key": study.key,
+    return xr.Dataset(variables, coords=coords, attrs=study_metadata(study, info))
+
+
+def study_metadata(study: Study, info: Mapping[str, Any]) -> dict[str, Any]:
+    """What every result file of a study records besides its values: the package version,
+    the study (name, key, its definition as JSON: :meth:`Study.to_dict`), the base scene
+    and its solver settings (JSON), the grid's shape, the samples and seed, and ``info``
+    (batches, points failed, seconds). Every value is a string or a number (netCDF
+    attributes)."""
+    attrs = {"format": "coated-punch study", "version": __version__,
+             "study": study.name, "study_key": study.key,
+             "study_definition": json.dumps(study.to_dict(), separators=(",", ":")),
              "base_scene": json.dumps(study.base, separators=(",", ":")),
+             "solver_settings": json.dumps(study.base.get("solver", {}), sort_keys=True),
              "grid_shape": json.dumps(list(study.grid_shape)),
              "samples": study.samples, "seed": study.seed}
-    attrs |= {k: v for k, v in info.items()}
-    return xr.Dataset(variables, coords=coords, attrs=attrs)
+    return attrs | dict(info)
 
 
 def _long_rows(study: Study, points: StudyPoints, index: np.ndarray,
@@ -456,7 +470,8 @@ def write_output(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[in
             ds = study_dataset(study, parts, plan, lost, info)
             ds.to_netcdf(tmp, engine="scipy")
         else:
-            _write_long(study, parts, plan, lost, Path(tmp), suffix)
+            _write_long(study, parts, plan, lost, Path(tmp), suffix,
+                        study_metadata(study, info))
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     except BaseException:
@@ -465,8 +480,12 @@ def write_output(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[in
 
 
 def _write_long(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[int, str],
-                tmp: Path, suffix: str) -> None:
+                tmp: Path, suffix: str, attrs: Mapping[str, Any]) -> None:
     writer = None
+    # parquet keeps the attributes in its schema: under their own key, and under the one
+    # pandas reads back into DataFrame.attrs (pandas.read_parquet)
+    text = json.dumps(dict(attrs), allow_nan=True)
+    metadata = {"coated_punch": text, "PANDAS_ATTRS": text}
     points = StudyPoints(study)
     with open(tmp, "w" if suffix == ".csv" else "wb") as fh:
         for k in range(plan.n_batches):
@@ -482,7 +501,7 @@ def _write_long(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[int
                 pa = import_optional("pyarrow", "a study's Parquet table")
                 pq = import_optional("pyarrow.parquet", "a study's Parquet table")
 
-                batch = pa.table(rows)
+                batch = pa.table(rows).replace_schema_metadata(metadata)
                 if writer is None:
                     writer = pq.ParquetWriter(fh, batch.schema)
                 writer.write_table(batch)

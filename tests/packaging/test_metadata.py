@@ -156,7 +156,8 @@ def test_the_version_has_one_source():
     assert metadata.version("coated-punch") == core.__version__
     citation = (ROOT / "CITATION.cff").read_text()
     assert f'version: "{core.__version__}"' in citation
-    assert PYPROJECT["tool"]["setuptools"]["dynamic"]["version"] == {"attr": "core.__version__"}
+    version = PYPROJECT["tool"]["setuptools"]["dynamic"]["version"]
+    assert version == {"attr": "core.version.__version__"}
 
 
 def test_license_and_metadata():

@@ -1,0 +1,257 @@
+"""A :class:`~core.scene.SceneSolution` for people and for data tools: its key figures as
+text (``repr``) and as an HTML table (notebooks), its metadata (the package version, the
+scene, the solver settings, flags and error estimates) and its arrays as an
+``xarray.Dataset`` or a ``pandas.DataFrame``.
+
+xarray and pandas are imported only by :func:`to_xarray` and :func:`to_dataframe`: a
+missing one raises ``ImportError`` naming the extra to install.
+"""
+
+from __future__ import annotations
+
+import html
+import importlib
+import json
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from core.scene.files import scene_to_json
+from core.scene.schema import SCHEMA_VERSION, _jsonable
+
+# the package root only, for its version: its imports of the upper layers are for type
+# checkers (the layers contract ignores this import)
+from core.version import __version__
+
+if TYPE_CHECKING:
+    import pandas
+    import xarray
+
+    from core.scene.results import SceneSolution
+
+#: The pip extra that brings xarray and pandas.
+DATA_EXTRA = "coated-punch[data]"
+#: A contact set narrower than ``(1 - LIFT_OFF_SHARE) * 2a`` is reported as lift-off: a
+#: unilateral answer in full contact holds ``[(-a, a)]`` exactly (measured on the lift-off
+#: preset at e = 0.41 m, back in full contact by 1000 days), so this only absorbs rounding.
+LIFT_OFF_SHARE = 1e-9
+
+#: The histories over time: (unit, long name, the paper's symbol).
+HISTORIES: dict[str, tuple[str, str, str]] = {
+    "settlement": ("m", "settlement of the punch centre", "delta"),
+    "tilt": ("rad", "tilt of the punch", "alpha"),
+    "force": ("N/m", "force per unit length", "P"),
+    "moment": ("N", "moment per unit length (N m/m)", "M"),
+}
+#: The figures of the summary: (attribute, factor from SI, unit shown).
+SHOWN: tuple[tuple[str, float, str], ...] = (
+    ("settlement", 1e3, "mm"),
+    ("tilt", 1e3, "mrad"),
+    ("force", 1e-3, "kN/m"),
+    ("moment", 1e-3, "kN m/m"),
+)
+
+
+def optional_import(name: str, purpose: str, extra: str = DATA_EXTRA) -> Any:
+    """Import ``name`` or raise ``ImportError`` saying what needs it and how to install it."""
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:
+        raise ImportError(f"{purpose} needs {name}, which is not installed: "
+                          f'pip install "{extra}"') from exc
+
+
+def package_version() -> str:
+    """The package's version (``core.__version__``), recorded in every file written."""
+    return __version__
+
+
+def _number(value: float) -> str:
+    return f"{value:.4g}" if math.isfinite(value) else str(value)
+
+
+def contact_width(result: SceneSolution) -> np.ndarray | None:
+    """Length of the contact set [m] at every output time (None if the answer has none)."""
+    if len(result.contact_set) != len(result.times):
+        return None
+    return np.array([sum(hi - lo for lo, hi in zones) for zones in result.contact_set])
+
+
+def lifts_off(result: SceneSolution, k: int = -1) -> bool:
+    """Whether the contact set at ``times[k]`` is narrower than the punch base."""
+    widths = contact_width(result)
+    full = 2 * result.scene.half_width
+    return widths is not None and bool(widths[k] < (1 - LIFT_OFF_SHARE) * full)
+
+
+def zones_text(result: SceneSolution, k: int = -1) -> str:
+    """The contact zones at ``times[k]`` as ``[lo, hi]`` in metres."""
+    return ", ".join(f"[{_number(lo)}, {_number(hi)}]" for lo, hi in result.contact_set[k])
+
+
+def engine_text(result: SceneSolution) -> str:
+    """The engine, the contact model and the coating model that answered."""
+    info = result.info
+    contact = str(info.get("contact", "full"))
+    parts = ([f"{info['method']} engine", f"{contact} contact"] if "method" in info
+             else [f"{contact} contact solver"])
+    parts.append(f"{info.get('coating_model', 'thin layer')} coating model")
+    if info.get("fallback"):
+        parts.append(f"fallback: {info['fallback']}")
+    return ", ".join(parts)
+
+
+def error_text(result: SceneSolution) -> str:
+    """The numerical and the coating-model error estimates with their tolerances."""
+    numerical = float(result.info.get("error_estimate", math.nan))
+    return (f"{numerical:.2g} numerical (tol {result.scene.tol:.2g}), "
+            f"{result.model_error['estimate']:.2g} coating model "
+            f"(model_tol {result.scene.model_tol:.2g})")
+
+
+def headline(result: SceneSolution) -> str:
+    """The scene's name, its statement and its output times."""
+    scene, times = result.scene, result.times
+    given = ", ".join(sorted(scene.given))
+    span = (f"{_number(times[0])} to {_number(times[-1])}" if len(times) > 1
+            else _number(times[0]))
+    return (f"'{scene.name}': statement {scene.statement} ({given} given), {len(times)} "
+            f"output time{'s' * (len(times) != 1)}, {span} days after loading")
+
+
+def key_figures(result: SceneSolution) -> list[tuple[str, str]]:
+    """The figures at the last output time as ``(name, value with unit)``."""
+    rows = [(name, f"{_number(float(getattr(result, name)[-1]) * factor)} {unit}")
+            for name, factor, unit in SHOWN]
+    q_max = float(np.max(result.pressure_on_grid[:, -1]))
+    rows.append(("max pressure", f"{_number(q_max * 1e-6)} MPa"))
+    if lifts_off(result):
+        width = float(contact_width(result)[-1])
+        rows.append(("contact width", f"{_number(width)} m of 2a = "
+                     f"{_number(2 * result.scene.half_width)} m (lift-off; contact on "
+                     f"{zones_text(result)} m)"))
+    return rows
+
+
+def text_summary(result: SceneSolution) -> str:
+    """The readable ``repr``: a few lines of key figures, errors, flags and engine."""
+    figures = key_figures(result)
+    at_last = ", ".join(f"{name} {value}" for name, value in figures
+                        if name != "contact width")
+    lines = [f"SceneSolution {headline(result)}",
+             f"  at t = {_number(result.times[-1])} days: {at_last}"]
+    lines += [f"  {name} {value}" for name, value in figures if name == "contact width"]
+    lines.append(f"  estimated error: {error_text(result)}")
+    lines.append("  flags: " + (", ".join(result.flags) or "none"))
+    lines.append(f"  engine: {engine_text(result)}")
+    return "\n".join(lines)
+
+
+#: The colour of a flag in the HTML summary.
+FLAG_COLOUR = "#c00000"
+
+
+def html_summary(result: SceneSolution) -> str:
+    """The key figures, errors, flags (in red, with their messages) and engine as an HTML
+    table; every text from the scene or the solver is escaped."""
+    e = html.escape
+
+    def row(name: str, value_html: str) -> str:
+        return (f'<tr><th style="text-align:left">{e(name)}</th>'
+                f'<td style="text-align:left">{value_html}</td></tr>')
+
+    rows = [f'<tr><th colspan="2" style="text-align:left">at t = '
+            f"{e(_number(result.times[-1]))} days after loading</th></tr>"]
+    rows += [row(name, e(value)) for name, value in key_figures(result)]
+    rows.append(row("estimated error", e(error_text(result))))
+    if result.flags:
+        flags = "<br>".join(
+            f'<span style="color:{FLAG_COLOUR}"><b>{e(name)}</b>: '
+            f"{e(result.flag_messages.get(name, ''))}</span>" for name in result.flags)
+    else:
+        flags = "none"
+    rows.append(row("flags", flags))
+    rows.append(row("engine", e(engine_text(result))))
+    return ('<div class="coated-punch-solution"><table>'
+            f'<caption style="text-align:left"><b>SceneSolution</b> {e(headline(result))}'
+            "</caption>" + "".join(rows) + "</table></div>")
+
+
+# ------------------------------------------------------------------------------ metadata
+
+
+def solver_settings(result: SceneSolution) -> dict[str, Any]:
+    """The scene's ``solver`` section and what the solver chose: the engine, the contact
+    and coating models, the sizes of its discretization."""
+    settings: dict[str, Any] = dict(result.scene.to_dict().get("solver", {}))
+    info = result.info
+    for name in ("method", "contact", "coating_model", "basis", "n_modes", "n_nodes",
+                 "n_panels", "n_steps", "fallback"):
+        if name in info:
+            settings[name] = info[name]
+    return _jsonable(settings)
+
+
+def metadata(result: SceneSolution) -> dict[str, Any]:
+    """What a file of ``result`` records besides its arrays: the package version, the scene
+    (canonical JSON, as scene files hold it), the solver settings (JSON), the flags and the
+    error estimates. Every value is a string or a number (netCDF attributes)."""
+    info = result.info
+    return {
+        "format": "coated-punch solution",
+        "version": package_version(),
+        "schema_version": SCHEMA_VERSION,
+        "scene_name": result.scene.name,
+        "scene_key": result.scene.key,
+        "scene": scene_to_json(result.scene),
+        "solver_settings": json.dumps(solver_settings(result), sort_keys=True),
+        "statement": int(result.scene.statement),
+        "given": ",".join(sorted(result.scene.given)),
+        "flags": ",".join(result.flags),
+        "flag_messages": json.dumps(result.flag_messages),
+        "error_estimate": float(info.get("error_estimate", math.nan)),
+        "model_error_estimate": float(result.model_error["estimate"]),
+        "model_error": json.dumps(_jsonable(result.model_error), sort_keys=True),
+        "success": int(bool(info.get("success", False))),
+        "message": str(info.get("message", "")),
+    }
+
+
+def to_xarray(result: SceneSolution) -> xarray.Dataset:
+    """``result`` as an ``xarray.Dataset`` over ``time`` [day] and ``x`` [m]: the pressure
+    q(x, t) [Pa], the histories, the contact width [m] when the answer has contact sets;
+    units and long names in each variable's attributes, :func:`metadata` in the dataset's."""
+    xr = optional_import("xarray", "SceneSolution.to_xarray")
+    coords = {"time": ("time", result.times.copy(),
+                       {"units": "day", "long_name": "time after loading"}),
+              "x": ("x", result.x.copy(),
+                    {"units": "m", "long_name": "distance from the punch centre"})}
+    variables: dict[str, Any] = {
+        "pressure": (("x", "time"), result.pressure_on_grid.copy(),
+                     {"units": "Pa", "long_name": "contact pressure", "symbol": "q"})}
+    for name, (unit, long_name, symbol) in HISTORIES.items():
+        variables[name] = ("time", np.array(getattr(result, name)),
+                           {"units": unit, "long_name": long_name, "symbol": symbol})
+    widths = contact_width(result)
+    if widths is not None:
+        variables["contact_width"] = ("time", widths,
+                                      {"units": "m", "long_name": "length of the contact set"})
+    return xr.Dataset(variables, coords=coords, attrs=metadata(result))
+
+
+def to_dataframe(result: SceneSolution) -> pandas.DataFrame:
+    """The histories as a ``pandas.DataFrame`` indexed by ``time`` [day]: settlement [m],
+    tilt [rad], force [N/m], moment [N] (and contact_width [m]); ``attrs`` hold
+    :func:`metadata` and ``units`` (column to unit)."""
+    pd = optional_import("pandas", "SceneSolution.to_dataframe")
+    columns = {name: np.array(getattr(result, name)) for name in HISTORIES}
+    units = {name: unit for name, (unit, _, _) in HISTORIES.items()}
+    widths = contact_width(result)
+    if widths is not None:
+        columns["contact_width"] = widths
+        units["contact_width"] = "m"
+    frame = pd.DataFrame(columns, index=pd.Index(result.times.copy(), name="time"))
+    frame.attrs.update(metadata(result))
+    frame.attrs["units"] = {"time": "day", **units}
+    return frame

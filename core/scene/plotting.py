@@ -1,0 +1,134 @@
+"""Plots of a :class:`~core.scene.SceneSolution` with HoloViews: the contact pressure q(x)
+at several times coloured by time, the settlement and the tilt over time, flags and
+lift-off in the titles.
+
+The only module of :mod:`core` that imports HoloViews, and only when a plot is asked for
+(``import core`` stays free of it). The plots carry options of the Bokeh backend, which
+is registered here if no ``hv.extension`` did it.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from core.scene.display import lifts_off, optional_import, zones_text
+
+if TYPE_CHECKING:
+    import holoviews
+
+    from core.scene.results import SceneSolution
+
+#: q(x) curves drawn when no times are asked for.
+PLOT_CURVES = 6
+#: Units of the pressure axis, the first that the largest |q| reaches: (unit, Pa in it).
+PRESSURE_UNITS: tuple[tuple[str, float], ...] = (("MPa", 1e6), ("kPa", 1e3), ("Pa", 1.0))
+#: The colour map of the q(x) curves, early to late (its palest end is left out: on a
+#: white page the latest curve must stay visible).
+TIME_COLOURS = "viridis"
+#: Size of each plot of the layout [screen pixels]; the pressure's is wider for its legend.
+PLOT_WIDTH, PLOT_HEIGHT, PRESSURE_WIDTH = 400, 300, 580
+#: The titles of the plots (the paper's symbols).
+TITLES = {"pressure": "contact pressure q(x, t)", "settlement": "settlement δ(t)",
+          "tilt": "tilt α(t)"}
+#: The shade of the parts of the base that lift off at the last time.
+LIFT_OFF_COLOUR = "#d9d9d9"
+
+
+def _holoviews() -> Any:
+    """HoloViews with its Bokeh backend registered (no notebook output, unlike
+    ``hv.extension``, and the current backend is left as it was)."""
+    hv = optional_import("holoviews", "SceneSolution.plot", extra="coated-punch")
+    if "bokeh" not in hv.Store.renderers:
+        importlib.import_module("holoviews.plotting.bokeh")
+    return hv
+
+
+def pressure_unit(q_max: float) -> tuple[str, float]:
+    """The unit of the pressure axis for pressures up to ``q_max`` [Pa], and its size [Pa]."""
+    for unit, size in PRESSURE_UNITS:
+        if abs(q_max) >= size:
+            return unit, size
+    return PRESSURE_UNITS[-1]
+
+
+def shown_times(times: np.ndarray, count: int = PLOT_CURVES,
+                wanted: Sequence[float] | None = None) -> np.ndarray:
+    """Indices of the output times to draw: the ones nearest to ``wanted`` [day], else
+    ``count`` spread evenly over the indices (the first and the last among them)."""
+    if wanted is not None:
+        picked = [int(np.argmin(np.abs(times - float(t)))) for t in wanted]
+    else:
+        picked = np.linspace(0, len(times) - 1, max(1, min(count, len(times)))).round()
+    return np.unique(np.asarray(picked, dtype=int))
+
+
+def _days(t: float) -> str:
+    return f"t = {t:.4g} d"
+
+
+def _lift_off_spans(hv: Any, result: SceneSolution) -> list[Any]:
+    """Shaded spans where the base lifts off at the last time."""
+    a = result.scene.half_width
+    ends = [-a] + [e for zone in result.contact_set[-1] for e in zone] + [a]
+    return [hv.VSpan(lo, hi).opts(color=LIFT_OFF_COLOUR, alpha=0.5, backend="bokeh")
+            for lo, hi in zip(ends[::2], ends[1::2], strict=True) if hi > lo]
+
+
+def pressure_overlay(result: SceneSolution, count: int = PLOT_CURVES,
+                     times: Sequence[float] | None = None) -> holoviews.Overlay:
+    """q(x) [kPa or MPa] against x [m] at some of the output times, coloured by time."""
+    hv = _holoviews()
+    from holoviews.plotting.util import process_cmap
+
+    picked = shown_times(result.times, count, times)
+    q = result.pressure_on_grid[:, picked]
+    unit, size = pressure_unit(float(np.max(np.abs(q))) if q.size else 0.0)
+    colours = process_cmap(TIME_COLOURS, len(picked) + 1)[:len(picked)]
+    x_dim = hv.Dimension("x", label="x", unit="m")
+    q_dim = hv.Dimension("q", label="q", unit=unit)
+    curves = [hv.Curve((result.x, q[:, j] / size), kdims=[x_dim], vdims=[q_dim],
+                       label=_days(result.times[k]))
+              .opts(color=colours[j], tools=["hover"], backend="bokeh")
+              for j, k in enumerate(picked)]
+    title = TITLES["pressure"]
+    spans: list[Any] = []
+    if lifts_off(result):
+        title += f"; lift-off at {_days(result.times[-1])}: contact on {zones_text(result)} m"
+        spans = _lift_off_spans(hv, result)
+    if result.contact_lost:
+        title += "; contact lost (q < 0: not physical)"
+    # the axes are labelled here: the spans' own dimensions (x, y) would name them
+    return hv.Overlay(curves + spans).opts(
+        title=title, xlabel=x_dim.pprint_label, ylabel=q_dim.pprint_label,
+        width=PRESSURE_WIDTH, height=PLOT_HEIGHT, legend_position="right", backend="bokeh")
+
+
+def history_curve(result: SceneSolution, name: str, factor: float,
+                  unit: str) -> holoviews.Curve:
+    """``name`` (an attribute of ``result`` over time) times ``factor``, in ``unit``."""
+    hv = _holoviews()
+    t_dim = hv.Dimension("time", label="t", unit="day")
+    v_dim = hv.Dimension(name, label=name, unit=unit)
+    values = np.asarray(getattr(result, name)) * factor
+    return hv.Curve((result.times, values), kdims=[t_dim], vdims=[v_dim]).opts(
+        title=TITLES[name], width=PLOT_WIDTH, height=PLOT_HEIGHT, tools=["hover"],
+        backend="bokeh")
+
+
+def plot_solution(result: SceneSolution, count: int = PLOT_CURVES,
+                  times: Sequence[float] | None = None) -> holoviews.Layout:
+    """A HoloViews layout of ``result``: q(x) at ``count`` output times (or those nearest
+    to ``times`` [day]) coloured by time, the settlement [mm] and the tilt [mrad] over
+    time; the flags in the layout's title, lift-off in the pressure's."""
+    hv = _holoviews()
+    layout = hv.Layout([pressure_overlay(result, count, times),
+                        history_curve(result, "settlement", 1e3, "mm"),
+                        history_curve(result, "tilt", 1e3, "mrad")]).cols(3)
+    title = result.scene.name
+    if result.flags:
+        title += ": flags " + ", ".join(result.flags)
+    return layout.opts(title=title, backend="bokeh")
