@@ -19,11 +19,11 @@ from core import limits
 from core.cache import StageCache, fingerprint
 from core.coating import model_error_estimate, model_error_map, tilt_share
 from core.problem import QUANTITIES
-from core.scene.load_rates import oscillations
-from core.scene.model import Scene
 from core.scene.display import HISTORIES, html_summary, package_version, text_summary
 from core.scene.display import to_dataframe as _to_dataframe
 from core.scene.display import to_xarray as _to_xarray
+from core.scene.load_rates import oscillations
+from core.scene.model import Scene
 from core.scene.schema import SCHEMA_VERSION, _jsonable
 
 if TYPE_CHECKING:
