@@ -24,7 +24,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from core.version import __version__
+from core.version import VERSION as __version__
 
 if TYPE_CHECKING:
     from core.budget import STAGE_CACHE_BYTES, set_stage_cache_budget, stage_cache_bytes

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from core.scene import SceneSolution
-from core.version import __version__
+from core.version import VERSION
 
 
 @dataclass(frozen=True)
@@ -101,7 +101,7 @@ def sections(result: SceneSolution) -> list[Section]:
         ("statement", f"{scene.statement}: " + " and ".join(
             q for q in ("settlement", "tilt", "force", "moment") if q in scene.given)
             + " given"),
-        ("made by", f"coated-punch {__version__}, {stamp}"),
+        ("made by", f"coated-punch {VERSION}, {stamp}"),
         ("units", "SI; plane strain, per metre out of plane; t in days after loading; "
                   "compression positive"),
     ])]

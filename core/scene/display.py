@@ -22,7 +22,7 @@ from core.scene.schema import SCHEMA_VERSION, _jsonable
 
 # the package root only, for its version: its imports of the upper layers are for type
 # checkers (the layers contract ignores this import)
-from core.version import __version__
+from core.version import VERSION
 
 if TYPE_CHECKING:
     import pandas
@@ -64,7 +64,7 @@ def optional_import(name: str, purpose: str, extra: str = DATA_EXTRA) -> Any:
 
 def package_version() -> str:
     """The package's version (``core.__version__``), recorded in every file written."""
-    return __version__
+    return VERSION
 
 
 def _number(value: float) -> str:

@@ -57,7 +57,7 @@ from core.study.batch import run_batch
 from core.study.definition import OUTPUT_UNITS, Study, load_study
 from core.study.plan import PLAN_ORDER, BatchPlan, batch_plan
 from core.study.points import StudyPoints, point_table
-from core.version import __version__
+from core.version import VERSION
 
 if TYPE_CHECKING:
     import xarray
@@ -421,7 +421,7 @@ def study_metadata(study: Study, info: Mapping[str, Any]) -> dict[str, Any]:
     and its solver settings (JSON), the grid's shape, the samples and seed, and ``info``
     (batches, points failed, seconds). Every value is a string or a number (netCDF
     attributes)."""
-    attrs = {"format": "coated-punch study", "version": __version__,
+    attrs = {"format": "coated-punch study", "version": VERSION,
              "study": study.name, "study_key": study.key,
              "study_definition": json.dumps(study.to_dict(), separators=(",", ":")),
              "base_scene": json.dumps(study.base, separators=(",", ":")),

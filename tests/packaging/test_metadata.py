@@ -157,7 +157,7 @@ def test_the_version_has_one_source():
     citation = (ROOT / "CITATION.cff").read_text()
     assert f'version: "{core.__version__}"' in citation
     version = PYPROJECT["tool"]["setuptools"]["dynamic"]["version"]
-    assert version == {"attr": "core.version.__version__"}
+    assert version == {"attr": "core.version.VERSION"}
 
 
 def test_license_and_metadata():

@@ -14,7 +14,7 @@ nbclient = pytest.importorskip("nbclient")
 pytest.importorskip("ipykernel")
 
 ROOT = Path(__file__).resolve().parents[2]
-PRESET = ROOT / "assets" / "scenes" / "eccentric_footing_liftoff.json"
+PRESET = ROOT / "core" / "presets" / "scenes" / "eccentric_footing_liftoff.json"
 #: The libraries that only the data and plot methods load.
 LATE = ("holoviews", "xarray", "bokeh")
 
