@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from core.scene import SceneSolution
+from core.scene import SceneSolution, engine_text
 from core.version import VERSION
 
 
@@ -74,10 +74,11 @@ def accuracy_rows(result: SceneSolution) -> list[tuple[str, str]]:
         ("numerical error (estimated, relative)",
          (f"{float(error):.1e}" if isinstance(error, (int, float)) else "not available")
          + target),
-        ("coating model", f"{info.get('coating_model', 'thin layer')}"),
         ("coating model error (estimated, relative)",
-         f"{float(result.model_error['estimate']):.1e}"),
-        ("engine", f"{info.get('method', '?')}, contact model {info.get('contact', 'full')}"),
+         f"{float(result.model_error['estimate']):.1e} (flagged above "
+         f"{result.scene.model_tol:g})"),
+        ("solved by", engine_text(result)),
+        ("solver's message", str(info.get("message", ""))),
     ]
 
 

@@ -41,7 +41,8 @@ def _plots(result: SceneSolution) -> tuple[str, str]:
     hv = import_optional("holoviews", "the report's plots")
     embed = import_optional("bokeh.embed", "the report's plots")
     resources = import_optional("bokeh.resources", "the report's plots")
-    model = hv.render(result.plot(), backend="bokeh")
+    # two plots a row: the three side by side are wider than a printed page
+    model = hv.render(result.plot().cols(2), backend="bokeh")
     script, div = embed.components(model)
     return resources.INLINE.render() + script, div
 

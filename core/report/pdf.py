@@ -9,7 +9,7 @@ import textwrap
 
 from core.optional import import_optional
 from core.report.content import scene_json, sections
-from core.scene import SceneSolution
+from core.scene import LIFT_OFF_COLOUR, SceneSolution
 
 #: A4 portrait [inch].
 PAGE = (8.27, 11.69)
@@ -17,6 +17,8 @@ PAGE = (8.27, 11.69)
 LINES_PER_PAGE = 62
 CHARACTERS_PER_LINE = 100
 COLOURS = {"bad": "#9b1c1c", "good": "#1d6b2c", "": "#222222"}
+#: The titles of the three plots of :meth:`SceneSolution.plot`, in its order.
+PLOT_TITLES = ("contact pressure q(x, t) (grey: lifted off)", "settlement δ(t)", "tilt α(t)")
 
 
 def _text_lines(result: SceneSolution) -> list[tuple[str, str, bool]]:
@@ -68,8 +70,14 @@ def report_pdf(result: SceneSolution) -> bytes:
     with PdfPages(buffer, metadata={"Title": f"Report: {result.scene.name or 'scene'}",
                                     "Creator": "coated-punch"}) as pdf:
         _text_pages(pdf, plt, _text_lines(result))
-        figure = hv.render(result.plot(), backend="matplotlib")
-        figure.set_size_inches(PAGE[0], PAGE[0] * 0.75)
+        layout = result.plot().cols(2).opts(fig_inches=PAGE[0] - 1.5, sublabel_format="",
+                                            backend="matplotlib")
+        layout = layout.map(lambda span: span.opts(facecolor=LIFT_OFF_COLOUR, alpha=0.5,
+                                                   backend="matplotlib"), hv.VSpan)
+        figure = hv.render(layout, backend="matplotlib")
+        # the plots' titles are Bokeh options; the same words here
+        for axes, title in zip(figure.axes, PLOT_TITLES, strict=False):
+            axes.set_title(title, fontsize=10)
         pdf.savefig(figure, bbox_inches="tight")
         plt.close(figure)
         scene = [(line, "", False) for raw in scene_json(result).splitlines()

@@ -20,9 +20,11 @@ returns a ``SceneSolution``.
 from __future__ import annotations
 
 from core.scene.coating_check import check_scene
+from core.scene.display import engine_text
 from core.scene.files import load_scene, read_scene_json, save_scene
 from core.scene.model import Scene
 from core.scene.pipeline import solve
+from core.scene.plotting import LIFT_OFF_COLOUR
 from core.scene.results import (
     FLAG_MESSAGES,
     LARGE_TILT,
@@ -34,6 +36,8 @@ from core.scene.schema import MAX_SCENE_BYTES, check_fields, integer_in_range
 from core.scene.validate import replace_loads, scene_from_dict
 
 __all__ = [
+    "LIFT_OFF_COLOUR",
+    "engine_text",
     "check_fields",
     "check_scene",
     "FLAG_MESSAGES",
