@@ -9,8 +9,13 @@ returns a ``SceneSolution``.
 - ``dimensionless.py``: ``to_dimensionless``, the scene as the dimensionless problem;
 - ``results.py``: ``SceneSolution``, the answer in SI units with its flags, JSON and CSV;
 - ``files.py``: ``load_scene``, ``save_scene`` (strict JSON, atomic writes);
+- ``records.py``: what every file of an answer records (version, scene, solver settings);
 - ``load_limits.py``, ``load_rates.py``: loads no contact can carry, and the steps a
   load history forces, refused before any solve;
+- ``design.py``: the design check (``DesignLimits``, ``check_design``): the largest
+  pressure, settlement and tilt against the scene's ``limits``;
+- ``json_schema.py``: the JSON Schema of scene files, made from the tables of
+  ``schema.py`` and shipped in ``schemas/``;
 - ``coating_check.py``: a scene's fast answer against the finite-element check;
 - ``golden_section.py``: the least gap between punch and coating.
 """
@@ -18,9 +23,28 @@ returns a ``SceneSolution``.
 from __future__ import annotations
 
 from core.scene.coating_check import check_scene
+from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
 from core.scene.files import load_scene, read_scene_json, save_scene
+from core.scene.json_schema import DIALECT as JSON_SCHEMA_DIALECT
+from core.scene.json_schema import (
+    SCHEMA_FILES,
+    SCHEMA_IDS,
+    load_json_schema,
+    scene_definitions,
+    scene_json_schema,
+    scene_root,
+    schema_errors,
+    schema_text,
+)
 from core.scene.model import Scene
 from core.scene.pipeline import solve
+from core.scene.records import (
+    provenance,
+    provenance_lines,
+    solution_document,
+    solution_json,
+    solver_settings,
+)
 from core.scene.results import (
     FLAG_MESSAGES,
     LARGE_TILT,
@@ -28,24 +52,51 @@ from core.scene.results import (
     plotting_grid,
     scene_model_error,
 )
-from core.scene.schema import MAX_SCENE_BYTES, check_fields, integer_in_range
+from core.scene.schema import (
+    MAX_SCENE_BYTES,
+    SCHEMA_KEY,
+    check_fields,
+    integer_in_range,
+    migrate,
+)
 from core.scene.validate import replace_loads, scene_from_dict
 
 __all__ = [
+    "check_design",
     "check_fields",
     "check_scene",
+    "design_check",
+    "DesignCheck",
+    "DesignLimits",
     "FLAG_MESSAGES",
     "integer_in_range",
+    "JSON_SCHEMA_DIALECT",
+    "load_json_schema",
     "LARGE_TILT",
+    "LimitCheck",
     "load_scene",
     "MAX_SCENE_BYTES",
+    "migrate",
     "plotting_grid",
+    "provenance",
+    "provenance_lines",
     "read_scene_json",
     "replace_loads",
     "save_scene",
     "Scene",
+    "scene_definitions",
     "scene_from_dict",
+    "scene_json_schema",
+    "scene_root",
+    "SCHEMA_FILES",
+    "SCHEMA_IDS",
+    "SCHEMA_KEY",
+    "schema_errors",
+    "schema_text",
     "scene_model_error",
     "SceneSolution",
+    "solution_document",
+    "solution_json",
     "solve",
+    "solver_settings",
 ]

@@ -19,6 +19,7 @@ from core import limits
 from core.cache import StageCache, fingerprint
 from core.coating import model_error_estimate, model_error_map, tilt_share
 from core.problem import QUANTITIES
+from core.scene.design import DesignCheck, DesignLimits, design_check
 from core.scene.load_rates import oscillations
 from core.scene.model import Scene
 from core.scene.schema import SCHEMA_VERSION, _jsonable
@@ -232,6 +233,7 @@ class SceneSolution:
             "flag_messages": self.flag_messages,
             "contact_set": [[list(zone) for zone in zones] for zones in self.contact_set],
             "info": self.info,
+            "design_check": None if (check := self.design_check()) is None else check.to_dict(),
         })
 
     def to_json(self) -> str:
@@ -273,6 +275,15 @@ class SceneSolution:
             lines.extend(f"{tt},{float(xi)!r},{float(qi)!r}" for xi, qi in zip(xs, q[:, j],
                                                                                strict=True))
         return "\n".join(lines) + "\n"
+
+    def design_check(self, limits: DesignLimits | None = None) -> DesignCheck | None:
+        """The design check over the whole history (:func:`core.scene.design.design_check`)
+        against ``limits`` [Pa, m, rad] (default: the scene's ``limits``); None when
+        neither gives a limit."""
+        limits = limits if limits is not None else self.scene.limits
+        if limits is None or limits.empty:
+            return None
+        return design_check(self, limits)
 
 
 def _check_finite(result: SceneSolution) -> None:

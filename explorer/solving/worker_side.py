@@ -18,6 +18,7 @@ import time
 from typing import Any
 
 from core import set_stage_cache_budget, solve, stage_cache_bytes
+from core.scene import solution_json
 
 from ..model import ResultView, prepare_view
 
@@ -66,12 +67,16 @@ def download_text(scene: dict[str, Any], kind: str,
 
 
 def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None) -> str:
-    """``solution.to_csv()``, ``.pressure_csv()`` or ``.to_json()`` (``kind``), with the
+    """``solution.to_csv()``, ``.pressure_csv()`` or the JSON of everything with the
+    version and solver settings (:func:`core.scene.solution_json`) (``kind``), with the
     solve report ``info`` in the JSON if given (see :func:`download_text`)."""
     if kind not in DOWNLOADS:
         raise ValueError(f"kind: unknown download {kind!r}; known: {', '.join(DOWNLOADS)}")
     if info is not None and kind == "to_json":
         solution.info = {k: v for k, v in info.items() if k != "reused"}
+    if kind == "to_json":
+        # the version and the solver settings beside the scene, as the command line writes
+        return solution_json(solution)
     return getattr(solution, kind)()
 
 

@@ -27,6 +27,7 @@ import explorer.solving.controller as controller_module
 import explorer.solving.workers as workers
 from core import budget, solve
 from core.budget import stage_cache_bounds
+from core.scene import solution_json
 from explorer.model import QUANTITIES, ExplorerState, prepare_view
 from explorer.solving import RESULTS, SolveController
 from explorer.solving.workers import (
@@ -93,7 +94,8 @@ def test_downloads_from_a_worker_hold_the_numbers_on_screen(processes, monkeypat
     # the numbers of a new solve, the solve report of the one on screen
     assert here.info != view.info  # timings and cache hits differ
     here.info = view.info
-    assert session.download(view, "to_json") == here.to_json()
+    # the JSON of the command line: the solution with the version and solver settings
+    assert session.download(view, "to_json") == solution_json(here)
     rows = np.loadtxt(session.download(view, "to_csv").splitlines(), delimiter=",",
                       skiprows=1)
     assert np.array_equal(rows[:, 1], view.values["settlement"])
