@@ -95,7 +95,10 @@ def _rule(name: str, kind: str, unit: str, description: str, **rest: Any) -> Fie
     return FieldRule(name, kind, unit, description, **rest)
 
 
-_POISSON = {"low": -1.0, "high": 0.5, "low_open": True, "high_open": True}
+#: Accepted range of a Poisson ratio, both ends open (a stable isotropic solid).
+POISSON_RANGE = (-1.0, 0.5)
+_POISSON = {"low": POISSON_RANGE[0], "high": POISSON_RANGE[1], "low_open": True,
+            "high_open": True}
 
 #: The fields of each object of a scene file, by the object's path (``"coating[k]"`` for
 #: every layer): names, whether required, units, ranges and meaning.
@@ -234,8 +237,9 @@ def check_fields(obj: Any, path: str, required: Sequence[str],
 
 def _poisson(value: Any, path: str) -> float:
     x = finite_number(value, path)
-    if not -1.0 < x < 0.5:
-        raise ValueError(f"{path}: must be in (-1, 0.5), got {show_value(value)}")
+    lo, hi = POISSON_RANGE
+    if not lo < x < hi:
+        raise ValueError(f"{path}: must be in ({lo:g}, {hi:g}), got {show_value(value)}")
     return x
 
 

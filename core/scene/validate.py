@@ -91,8 +91,8 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
             thickness=_profile(spec["thickness"], f"{path}.thickness", "x", x_domain,
                                lower=0.0),
             modulus=_profile(spec["modulus"], f"{path}.modulus", "x", x_domain, lower=0.0),
-            poisson=_profile(spec["poisson"], f"{path}.poisson", "x", x_domain, lower=-1.0,
-                             upper=0.5),
+            poisson=_profile(spec["poisson"], f"{path}.poisson", "x", x_domain,
+                             lower=schema.POISSON_RANGE[0], upper=schema.POISSON_RANGE[1]),
             interface=interface,
         ))
 

@@ -13,7 +13,9 @@ Nothing here imports Panel.
 from __future__ import annotations
 
 import html
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import param
@@ -101,6 +103,20 @@ def core_limits(limits: DesignLimits | None) -> CoreLimits:
         value = getattr(limits, name)
         values[name] = None if value is None else value * _SCREEN_UNITS[quantity][1]
     return CoreLimits(**values)
+
+
+def screen_limits(spec: Mapping[str, Any] | None) -> dict[str, float | None]:
+    """A scene file's ``limits`` (Pa, m, rad; assumed valid) as the Check tab's values
+    (kPa, mm, mrad); a limit the file leaves out is None."""
+    spec = spec or {}
+    return {name: None if spec.get(name) is None
+            else float(spec[name]) / _SCREEN_UNITS[quantity][1]
+            for name, quantity in _LIMITS}
+
+
+def scene_limits(limits: DesignLimits | None) -> dict[str, float]:
+    """The session's limits as a scene file's ``limits`` (Pa, m, rad; only those set)."""
+    return core_limits(limits).to_dict()
 
 
 def _on_screen(line: LimitCheck, limits: DesignLimits | None) -> Check:

@@ -362,3 +362,27 @@ def test_classical_solutions_carry_the_force_and_moment():
     np.testing.assert_allclose(q_root[inner], closed[inner], rtol=1e-12)
     assert np.sum(w * closed) * a / a == pytest.approx(force, rel=1e-14)
     assert np.max(half_space_pressure(x, force, moment, a)) <= EDGE_CAP * force / (2 * a)
+
+
+def test_a_scene_files_limits_fill_the_check_tab_and_a_saved_scene_keeps_them(explorer_app):
+    app = explorer_app("eccentric_creep", solved=True)
+    scene = json.loads(json.dumps(PRESETS["eccentric_creep"]))
+    scene["limits"] = {"allowable_pressure": 2.5e5, "tilt_limit": 2e-3}
+    assert app.load_scene(scene)
+    limits = app.limits  # the Check tab's, in kPa, mm, mrad
+    assert limits.allowable_pressure == pytest.approx(250.0, rel=1e-15)
+    assert limits.tilt_limit == pytest.approx(2.0, rel=1e-15)
+    assert limits.settlement_limit is None
+    assert app.check_tab.allowable_pressure.value == limits.allowable_pressure
+    # a scene without limits leaves those typed
+    assert app.load_scene(json.loads(json.dumps(PRESETS["uniform_flat"])))
+    assert limits.tilt_limit == pytest.approx(2.0, rel=1e-15)
+    app.check_tab.settlement_limit.value = 12.0  # mm
+    app.controller.solve_now()
+    saved = json.loads(app.files_tab._scene_file().getvalue())
+    assert saved["limits"] == pytest.approx({"allowable_pressure": 2.5e5,
+                                             "settlement_limit": 0.012, "tilt_limit": 2e-3},
+                                            rel=1e-15)
+    for name in ("allowable_pressure", "settlement_limit", "tilt_limit"):
+        getattr(app.check_tab, name).value = None
+    assert "limits" not in json.loads(app.files_tab._scene_file().getvalue())
