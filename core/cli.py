@@ -1,13 +1,19 @@
-"""The command line: ``python -m core solve SCENE.json``, ``python -m core validate SCENE.json``
-and ``python -m core sweep STUDY.json --output RESULT.nc`` (a design study, see
-:mod:`core.study.run`) and ``python -m core check SCENE.json`` (the coating model against
-resolved finite elements).
+"""The command line: ``python -m core solve SCENE.json``, ``python -m core validate FILE``
+(a scene or a study file), ``python -m core sweep STUDY.json --output RESULT.nc`` (a
+design study, see :mod:`core.study.run`), ``python -m core check SCENE.json`` (the
+coating model against resolved finite elements) and ``python -m core schema scene|study``
+(the JSON Schema of the files); ``python -m core --version``.
 
 ``solve`` writes the solution to ``--output`` (``.json``: everything, see
-:meth:`core.scene.SceneSolution.to_dict`, with the contact set per time; ``.csv``: the
-histories of settlement, tilt, force and moment, and the contact zones when the punch
-lifts off) and optionally the pressure ``q(x, t)`` to ``--pressure-csv``; without
-``--output`` it prints a short summary. ``validate`` only checks the scene file.
+:meth:`core.scene.SceneSolution.to_dict`, with the contact set per time and the design
+check; ``.csv``: the histories of settlement, tilt, force and moment, and the contact
+zones when the punch lifts off) and optionally the pressure ``q(x, t)`` to
+``--pressure-csv``; without ``--output`` it prints a short summary. Every file records
+the program's version, the scene and the solver settings (:mod:`core.scene.records`:
+top-level keys of the JSON, ``# key: value`` lines before a CSV table). ``-`` as the
+scene reads it from standard input, ``-`` as an output writes it to standard output
+(``--format`` chooses JSON or CSV, default JSON). ``validate`` checks a file against its
+JSON Schema, then validates it fully; every problem is one line naming the field.
 
 Files: an output may not be the scene file itself, two outputs may not name one file,
 and an existing output must be a regular, writable file (a read-only file is refused,
@@ -16,10 +22,13 @@ stays). The scene file must be a regular file (a named pipe is refused at once).
 this is checked before solving (see :mod:`core.files`).
 
 Exit codes: 0 success, 1 the solver failed (or an internal error), 2 bad input (an
-unreadable, oversized or invalid scene file, or bad arguments). Every error is one line
+unreadable, oversized or invalid file, or bad arguments), and with ``solve --strict``: 3
+a limit of the design check is exceeded, 4 the answer carries a validity flag (4 wins
+when both hold: a flagged answer's check cannot be trusted). Every error is one line
 ``error: <field>: <reason>`` on stderr; validity flags of a solution (for instance
-``contact_lost``) are reported as ``warning: <flag>: <explanation>`` lines on stderr with
-exit code 0.
+``contact_lost``) and exceeded limits are reported as ``warning: <flag>: <explanation>``
+and ``warning: design_check: <line>`` lines on stderr, with exit code 0 unless
+``--strict``.
 """
 
 from __future__ import annotations
@@ -29,15 +38,39 @@ import shutil
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, NoReturn
 
-from core.files import atomic_write_text, same_file, writable_target
+from core.files import atomic_write_text, read_regular_file, same_file, writable_target
 from core.problem import QUANTITIES
-from core.scene import Scene, SceneSolution, load_scene, solve
+from core.scene import (
+    MAX_SCENE_BYTES,
+    SCHEMA_FILES,
+    Scene,
+    SceneSolution,
+    load_json_schema,
+    load_scene,
+    migrate,
+    provenance_lines,
+    read_scene_json,
+    scene_from_dict,
+    scene_json_schema,
+    schema_errors,
+    schema_text,
+    solve,
+)
+from core.version import VERSION
 
 EXIT_OK = 0
 EXIT_SOLVER_FAILED = 1
 EXIT_BAD_INPUT = 2
+#: ``solve --strict``: a limit of the design check is exceeded.
+EXIT_DESIGN_FAILED = 3
+#: ``solve --strict``: the answer carries a validity flag (wins over a failed check).
+EXIT_FLAGGED = 4
+#: The name standing for standard input (a scene) or standard output (a file written).
+STDIO = "-"
+#: How standard input is named in messages.
+STDIN_NAME = "<stdin>"
 
 _UNITS = {"settlement": "m", "tilt": "rad", "force": "N/m", "moment": "N"}
 
@@ -57,8 +90,24 @@ def _one_line(text: str) -> str:
     return " ".join(str(text).split())
 
 
+def _stdin_text() -> str:
+    """Standard input as text, at most a scene file's size."""
+    stream = getattr(sys.stdin, "buffer", None)
+    raw = stream.read(MAX_SCENE_BYTES + 1) if stream is not None else \
+        sys.stdin.read(MAX_SCENE_BYTES + 1).encode("utf-8")
+    if len(raw) > MAX_SCENE_BYTES:
+        raise _InputError(f"{STDIN_NAME}: over the limit of {MAX_SCENE_BYTES} bytes for a "
+                          "scene file")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise _InputError(f"{STDIN_NAME}: not text in UTF-8 (a scene file is JSON)") from None
+
+
 def _read(path: str) -> Scene:
     try:
+        if path == STDIO:
+            return scene_from_dict(read_scene_json(_stdin_text(), STDIN_NAME))
         return load_scene(path)
     except ValueError as exc:
         raise _InputError(str(exc)) from None
@@ -68,12 +117,37 @@ def _read(path: str) -> Scene:
         raise _InputError(f"{path}: {exc.strerror or exc}") from None
 
 
+def _read_document(path: str) -> Any:
+    """The JSON value of a file (or of standard input), read strictly, not validated."""
+    if path == STDIO:
+        return read_scene_json(_stdin_text(), STDIN_NAME)
+    try:
+        raw = read_regular_file(path, MAX_SCENE_BYTES)
+    except ValueError as exc:
+        raise _InputError(str(exc)) from None
+    except IsADirectoryError:
+        raise _InputError(f"{path}: is a directory, not a scene file") from None
+    except OSError as exc:
+        raise _InputError(f"{path}: {exc.strerror or exc}") from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise _InputError(f"{path}: not a text file in UTF-8 (a scene file is JSON)") from None
+    try:
+        return read_scene_json(text, path)
+    except ValueError as exc:
+        raise _InputError(str(exc)) from None
+
+
 def _check_outputs(scene: str, outputs: Sequence[tuple[str, Path | None]]) -> None:
     """Refuse, before solving, an output that is the scene file itself, two outputs to
     one file, and an output that may not be replaced (read-only, not a regular file)."""
     given = [(option, path) for option, path in outputs if path is not None]
+    if sum(str(path) == STDIO for _, path in given) > 1:
+        raise _InputError(f"{given[-1][0]}: only one output may be '-' (standard output)")
+    given = [(option, path) for option, path in given if str(path) != STDIO]
     for i, (option, path) in enumerate(given):
-        if same_file(path, scene):
+        if scene != STDIO and same_file(path, scene):
             raise _InputError(f"{option}: {path} is the scene file being solved; it is not "
                               "overwritten (choose another file)")
         for earlier, other in given[:i]:
@@ -87,6 +161,10 @@ def _check_outputs(scene: str, outputs: Sequence[tuple[str, Path | None]]) -> No
 
 
 def _write(path: Path, text: str) -> None:
+    if str(path) == STDIO:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        return
     try:
         atomic_write_text(path, text)
     except ValueError as exc:
@@ -120,20 +198,98 @@ def _summary(result: SceneSolution) -> str:
         lines.append(f"coating model error ({result.info.get('coating_model')}, estimate): "
                      f"{100 * estimate:.2g} % (solver.model_tol "
                      f"{100 * result.scene.model_tol:g} %)")
+    check = result.design_check()
+    if check is not None:
+        lines.append(f"design check (whole history): "
+                     f"{'pass' if check.passed else 'FAIL'}")
+        lines.extend(f"  {line.describe()}" for line in check.checks)
     return "\n".join(lines)
 
 
+def _csv_head(result: SceneSolution, what: str) -> str:
+    """The ``#`` lines before a CSV table of ``result``: what it is, the version, the
+    scene, the solver settings, the answer's accuracy and flags."""
+    info = result.info
+    estimate = info.get("error_estimate")
+    lines = [f"# coated-punch {VERSION}: {what}",
+             f"# scene: {_one_line(result.scene.name)}",
+             *provenance_lines(result.scene),
+             f"# answered: contact {info.get('contact', 'full')}, coating model "
+             f"{info.get('coating_model', '')}, estimated relative error "
+             + (f"{float(estimate):.1e}" if isinstance(estimate, (int, float)) else "n/a")]
+    lines.append("# flags: " + (", ".join(result.flags) or "none"))
+    check = result.design_check()
+    if check is not None:
+        lines.append(f"# design_check: {'pass' if check.passed else 'FAIL'}; "
+                     + "; ".join(line.describe() for line in check.checks))
+    return "\n".join(lines) + "\n"
+
+
 def _cmd_validate(args: argparse.Namespace) -> int:
-    scene = _read(args.scene)
-    print(f"ok: {_describe(scene)}")
+    data = _read_document(args.file)
+    study = isinstance(data, dict) and "study_version" in data
+    if not study:
+        try:
+            # an older schema version is brought to the current one before its schema
+            data = migrate(data)
+        except ValueError as exc:
+            raise _InputError(str(exc)) from None
+    kind = "study" if study else "scene"
+    problems = schema_errors(data, load_json_schema(kind), root=kind)
+    if problems:
+        # each problem is one line; the full validation's messages follow once they are gone
+        for line in problems:
+            print(f"error: {_one_line(line)}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    try:
+        if study:
+            from core.study import study_from_dict
+
+            base = Path.cwd() if args.file == STDIO else Path(args.file).resolve().parent
+            checked = study_from_dict(data, base_dir=base)
+            print(f"ok: study {checked.name!r}: {checked.n_points} points, "
+                  f"{len(checked.parameters)} varied field(s)")
+        else:
+            print(f"ok: {_describe(scene_from_dict(data))}")
+    except ValueError as exc:
+        raise _InputError(str(exc)) from None
+    return EXIT_OK
+
+
+def _output_format(option: str, path: Path | None, given: str | None) -> str | None:
+    """``json`` or ``csv`` for an output: ``--format``, else the file's extension."""
+    if path is None:
+        return None
+    if given is not None:
+        return given
+    if str(path) == STDIO:
+        return "json"
+    suffix = path.suffix.lower()
+    if suffix not in (".json", ".csv"):
+        raise _InputError(f"{option}: unsupported extension {path.suffix!r} "
+                          "(use .json or .csv, or --format)")
+    return suffix[1:]
+
+
+def _strict_verdict(result: SceneSolution) -> int:
+    """The exit code of ``solve --strict`` for ``result``, its reasons on stderr."""
+    check = result.design_check()
+    failed = check is not None and check.passed is False
+    if result.flags:
+        print(f"error: strict: the answer is flagged ({', '.join(result.flags)}); "
+              f"exit code {EXIT_FLAGGED}", file=sys.stderr)
+        return EXIT_FLAGGED
+    if failed:
+        names = ", ".join(line.limit_name or line.quantity for line in check.failures)
+        print(f"error: strict: the design check failed ({names}); exit code "
+              f"{EXIT_DESIGN_FAILED}", file=sys.stderr)
+        return EXIT_DESIGN_FAILED
     return EXIT_OK
 
 
 def _cmd_solve(args: argparse.Namespace) -> int:
     output = Path(args.output) if args.output else None
-    if output is not None and output.suffix.lower() not in (".json", ".csv"):
-        raise _InputError(f"--output: unsupported extension {output.suffix!r} "
-                          "(use .json or .csv)")
+    fmt = _output_format("--output", output, args.format)
     pressure_out = Path(args.pressure_csv) if args.pressure_csv else None
     _check_outputs(args.scene, [("--output", output), ("--pressure-csv", pressure_out)])
     scene = _read(args.scene)
@@ -146,14 +302,30 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         return EXIT_SOLVER_FAILED
     if output is None:
         print(_summary(result))
-    elif output.suffix.lower() == ".json":
+    elif fmt == "json":
         _write(output, result.to_json() + "\n")
     else:
-        _write(output, result.to_csv())
+        _write(output, _csv_head(result, "histories (python -m core solve)")
+               + result.to_csv())
     if pressure_out is not None:
-        _write(pressure_out, result.pressure_csv())
+        _write(pressure_out, _csv_head(result, "contact pressure q(x, t) (python -m core "
+                                               "solve)") + result.pressure_csv())
     for name in result.flags:
         print(f"warning: {name}: {_one_line(result.flag_messages[name].replace('see info.message', result.info.get('message', '')))}", file=sys.stderr)  # noqa: E501
+    check = result.design_check()
+    for line in check.failures if check is not None else ():
+        print(f"warning: design_check: {_one_line(line.describe())}", file=sys.stderr)
+    return _strict_verdict(result) if args.strict else EXIT_OK
+
+
+def _cmd_schema(args: argparse.Namespace) -> int:
+    if args.kind == "study":
+        from core.study import study_json_schema
+
+        schema = study_json_schema()
+    else:
+        schema = scene_json_schema()
+    sys.stdout.write(schema_text(schema))
     return EXIT_OK
 
 
@@ -229,22 +401,37 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m core",
                      description="Contact of a rigid punch on a coated, aging viscoelastic "
                                  "layer (scene files: see core/SCENES.md).")
-    sub = parser.add_subparsers(dest="command", metavar="{solve,validate,sweep,check}",
+    parser.add_argument("--version", action="version", version=f"coated-punch {VERSION}")
+    sub = parser.add_subparsers(dest="command",
+                                metavar="{solve,validate,sweep,check,schema}",
                                 parser_class=_Parser)
     sub.required = True
     p_solve = sub.add_parser("solve", help="solve a scene and write the result")
-    p_solve.add_argument("scene", help="scene file (JSON)")
+    p_solve.add_argument("scene", help="scene file (JSON); '-' reads standard input")
     p_solve.add_argument("--output", "-o", metavar="PATH",
                          help="result file: .json (everything) or .csv (histories of "
-                              "settlement [m], tilt [rad], force [N/m], moment [N]); "
-                              "default: print a summary")
+                              "settlement [m], tilt [rad], force [N/m], moment [N]); '-' "
+                              "writes to standard output; default: print a summary")
+    p_solve.add_argument("--format", choices=("json", "csv"),
+                         help="format of --output (default: from its extension; JSON "
+                              "for '-')")
     p_solve.add_argument("--pressure-csv", metavar="PATH",
                          help="also write the pressure q(x, t) [Pa] as CSV (time [day], "
-                              "x [m], pressure [Pa])")
+                              "x [m], pressure [Pa]); '-' writes to standard output")
+    p_solve.add_argument("--strict", action="store_true",
+                         help=f"exit with {EXIT_DESIGN_FAILED} when a limit of the scene's "
+                              f"design check is exceeded, {EXIT_FLAGGED} when the answer "
+                              "carries a validity flag (the reason on stderr)")
     p_solve.set_defaults(run=_cmd_solve)
-    p_validate = sub.add_parser("validate", help="check a scene file")
-    p_validate.add_argument("scene", help="scene file (JSON)")
+    p_validate = sub.add_parser("validate", help="check a scene or study file against its "
+                                                 "JSON Schema, then fully")
+    p_validate.add_argument("file", help="scene or study file (JSON); '-' reads standard "
+                                         "input")
     p_validate.set_defaults(run=_cmd_validate)
+    p_schema = sub.add_parser("schema", help="print the JSON Schema of scene or study files")
+    p_schema.add_argument("kind", nargs="?", choices=tuple(SCHEMA_FILES), default="scene",
+                          help="which files (default: scene)")
+    p_schema.set_defaults(run=_cmd_schema)
     p_sweep = sub.add_parser("sweep", help="run a design study (core/SCENES.md, "
                                            "'Study files') on Dask")
     p_sweep.add_argument("study", help="study file (JSON)")

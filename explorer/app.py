@@ -255,6 +255,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.scales.reset()
         self.history.loaded = scene
         self.screen.notice = ""
+        self.check_tab.show_limits(scene.get("limits"))
         return True
 
     def _load_file(self, scene: dict[str, Any]) -> bool:

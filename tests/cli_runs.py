@@ -14,9 +14,10 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def run_cli(*args: str | os.PathLike, cwd: str | os.PathLike | None = None,
-            subprocess: bool = False, timeout: float = 300.0) -> child_process.CompletedProcess:
-    """``python -m core ARGS`` run in ``cwd`` (default: the repository root): its exit code
-    and the text it wrote to stdout and stderr.
+            subprocess: bool = False, timeout: float = 300.0,
+            stdin: str | bytes = b"") -> child_process.CompletedProcess:
+    """``python -m core ARGS`` run in ``cwd`` (default: the repository root), ``stdin`` on
+    its standard input: its exit code and the text it wrote to stdout and stderr.
 
     By default ``core.cli.main`` runs in this process, its output captured; with
     ``subprocess=True`` a child process runs the real entry point (one BLAS thread;
@@ -24,17 +25,22 @@ def run_cli(*args: str | os.PathLike, cwd: str | os.PathLike | None = None,
     """
     argv = [str(a) for a in args]
     where = Path(cwd) if cwd is not None else ROOT
+    data = stdin.encode("utf-8") if isinstance(stdin, str) else stdin
     if subprocess:
         env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
         env["PYTHONPATH"] = str(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
-        return child_process.run([sys.executable, "-m", "core", *argv], cwd=where, env=env,
-                                 capture_output=True, text=True, timeout=timeout)
+        done = child_process.run([sys.executable, "-m", "core", *argv], cwd=where, env=env,
+                                 capture_output=True, input=data, timeout=timeout)
+        return child_process.CompletedProcess(done.args, done.returncode,
+                                              done.stdout.decode("utf-8"),
+                                              done.stderr.decode("utf-8"))
     from core.cli import main
 
     out, err = io.StringIO(), io.StringIO()
-    here = Path.cwd()
+    here, given = Path.cwd(), sys.stdin
     try:
         os.chdir(where)
+        sys.stdin = io.TextIOWrapper(io.BytesIO(data), encoding="utf-8")
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
                 code = main(argv)
@@ -42,5 +48,6 @@ def run_cli(*args: str | os.PathLike, cwd: str | os.PathLike | None = None,
                 code = exc.code if isinstance(exc.code, int) else 1
     finally:
         os.chdir(here)
+        sys.stdin = given
     return child_process.CompletedProcess(["python", "-m", "core", *argv], code,
                                           out.getvalue(), err.getvalue())

@@ -14,16 +14,33 @@
 
 from __future__ import annotations
 
-from core.creep.code_inputs import RANGES
+from core.creep.code_inputs import CEMENT_CLASSES, RANGES, STRENGTH_CLASS
+from core.creep.design_codes import SPEC_FIELDS as CODE_SPEC_FIELDS
 from core.creep.design_codes import creep_coefficient_curve
+from core.creep.inputs import MAX_RATE, MAX_TERMS
 from core.creep.kernel_fit import stepping_kernel
-from core.creep.models import Elastic, UserKernel, creep_model_from_spec
+from core.creep.models import (
+    KNOWN_MODELS,
+    SPEC_FIELDS,
+    TERM_FIELDS,
+    Elastic,
+    UserKernel,
+    creep_model_from_spec,
+)
 
 __all__ = [
+    "CEMENT_CLASSES",
+    "CODE_SPEC_FIELDS",
     "creep_coefficient_curve",
     "creep_model_from_spec",
     "Elastic",
+    "KNOWN_MODELS",
+    "MAX_RATE",
+    "MAX_TERMS",
     "RANGES",
+    "SPEC_FIELDS",
     "stepping_kernel",
+    "STRENGTH_CLASS",
+    "TERM_FIELDS",
     "UserKernel",
 ]

@@ -42,7 +42,8 @@ RANGES: dict[str, dict[str, tuple[float, float, str]]] = {
     },
 }
 
-_STRENGTH_CLASS = re.compile(r"^\s*C\s*(\d{2,3})\s*/\s*(\d{2,3})\s*$")
+#: A strength class, "C<fck>/<fck,cube>" (MPa).
+STRENGTH_CLASS = re.compile(r"^\s*C\s*(\d{2,3})\s*/\s*(\d{2,3})\s*$")
 
 
 def _in_range(value: Any, model: str, name: str, field: str) -> float:
@@ -61,7 +62,7 @@ def mean_strength(fcm: Any, strength_class: Any, model: str, field: str) -> floa
                          "and strength_class (e.g. 'C30/37')")
     if fcm is not None:
         return _in_range(fcm, model, "fcm", f"{field}.fcm")
-    match = _STRENGTH_CLASS.match(strength_class) if isinstance(strength_class, str) else None
+    match = STRENGTH_CLASS.match(strength_class) if isinstance(strength_class, str) else None
     if match is None:
         raise ValueError(f"{field}.strength_class: must look like 'C30/37' (cylinder/cube "
                          f"strength in MPa), got {show_python(strength_class)}")

@@ -312,8 +312,9 @@ class UserKernel(_ConstantModulus):
 
 CreepModel = Elastic | ExponentialCreep | Arutyunyan | PronySeries | UserKernel | CodeCreep
 
-#: Spec fields of each model: (required, optional).
-_SPEC_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+#: Spec fields of each model: (required, optional) (the JSON Schema of scene files is
+#: made from this table too, :mod:`core.scene.json_schema`).
+SPEC_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "arutyunyan": (("modulus_final", "beta", "alpha", "compliance_final", "aging", "rate"),
                    ()),
     "elastic": (("modulus",), ()),
@@ -322,8 +323,9 @@ _SPEC_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "prony": (("modulus", "terms"), ()),
     **_CODE_SPEC_FIELDS,
 }
-KNOWN_MODELS: tuple[str, ...] = tuple(sorted(_SPEC_FIELDS))
-_TERM_FIELDS = (("compliance", "rate"), ("aging",))
+KNOWN_MODELS: tuple[str, ...] = tuple(sorted(SPEC_FIELDS))
+#: Fields of a Prony term: (required, optional).
+TERM_FIELDS = (("compliance", "rate"), ("aging",))
 
 
 def _check_keys(spec: Mapping[str, Any], fields: tuple[tuple[str, ...], tuple[str, ...]],
@@ -363,9 +365,9 @@ def creep_model_from_spec(spec: dict, *, field: str = "base.creep") -> CreepMode
     if "model" not in spec:
         raise ValueError(f"{field}.model: missing; known models: {known}")
     name = spec["model"]
-    if not isinstance(name, str) or name not in _SPEC_FIELDS:
+    if not isinstance(name, str) or name not in SPEC_FIELDS:
         raise ValueError(f"{field}.model: unknown model {name!r}; known models: {known}")
-    _check_keys(spec, _SPEC_FIELDS[name], field, f"model {name!r}", ignore=("model",))
+    _check_keys(spec, SPEC_FIELDS[name], field, f"model {name!r}", ignore=("model",))
 
     if name in _CODE_SPEC_FIELDS:
         return CodeCreep(name, dict(spec), field)
@@ -386,7 +388,7 @@ def creep_model_from_spec(spec: dict, *, field: str = "base.creep") -> CreepMode
             if not isinstance(term, Mapping):
                 raise ValueError(f"{where}: must be an object with compliance, aging, rate; "
                                  f"got {show_python(term)}")
-            _check_keys(term, _TERM_FIELDS, where, "a Prony term")
+            _check_keys(term, TERM_FIELDS, where, "a Prony term")
             triples.append((term["compliance"], term.get("aging", 0.0), term["rate"]))
         return PronySeries(modulus, _check_terms(triples, f"{field}.terms"))
     # name == "kernel"

@@ -14,9 +14,18 @@ stable key (``profile_key``) that the stage caches use.
 
 from __future__ import annotations
 
-from core.profiles.base import MAX_TABLE_BYTES, Profile, profile_values
+from core.profiles.base import (
+    INTERPOLATIONS,
+    MAX_POLYNOMIAL_COEFFICIENTS,
+    MAX_TABLE_BYTES,
+    MAX_TABLE_ROWS,
+    Profile,
+    profile_values,
+)
 from core.profiles.build import (
+    FAMILIES,
     HISTORY_FORMS,
+    KINDS,
     VARIATIONS,
     check_range,
     history_form_of,
@@ -29,9 +38,14 @@ from core.profiles.tables import profile_from_csv
 
 __all__ = [
     "check_range",
+    "FAMILIES",
     "history_form_of",
     "HISTORY_FORMS",
+    "INTERPOLATIONS",
+    "KINDS",
+    "MAX_POLYNOMIAL_COEFFICIENTS",
     "MAX_TABLE_BYTES",
+    "MAX_TABLE_ROWS",
     "parse_expression",
     "Profile",
     "profile_from_csv",

@@ -11,8 +11,13 @@ returns a ``SceneSolution``.
 - ``display.py``: its repr and HTML table, its metadata, ``to_xarray``/``to_dataframe``;
 - ``plotting.py``: its HoloViews plot (the one module of core that imports HoloViews);
 - ``files.py``: ``load_scene``, ``save_scene`` (strict JSON, atomic writes);
+- ``records.py``: what every file of an answer records (version, scene, solver settings);
 - ``load_limits.py``, ``load_rates.py``: loads no contact can carry, and the steps a
   load history forces, refused before any solve;
+- ``design.py``: the design check (``DesignLimits``, ``check_design``): the largest
+  pressure, settlement and tilt against the scene's ``limits``;
+- ``json_schema.py``: the JSON Schema of scene files, made from the tables of
+  ``schema.py`` and shipped in ``schemas/``;
 - ``coating_check.py``: a scene's fast answer against the finite-element check;
 - ``golden_section.py``: the least gap between punch and coating.
 """
@@ -20,11 +25,28 @@ returns a ``SceneSolution``.
 from __future__ import annotations
 
 from core.scene.coating_check import check_scene
+from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
 from core.scene.display import engine_text
 from core.scene.files import load_scene, read_scene_json, save_scene
+from core.scene.json_schema import DIALECT as JSON_SCHEMA_DIALECT
+from core.scene.json_schema import (
+    SCHEMA_FILES,
+    SCHEMA_IDS,
+    load_json_schema,
+    scene_definitions,
+    scene_json_schema,
+    scene_root,
+    schema_errors,
+    schema_text,
+)
 from core.scene.model import Scene
 from core.scene.pipeline import solve
 from core.scene.plotting import LIFT_OFF_COLOUR
+from core.scene.records import (
+    provenance,
+    provenance_lines,
+    solver_settings,
+)
 from core.scene.results import (
     FLAG_MESSAGES,
     LARGE_TILT,
@@ -32,26 +54,51 @@ from core.scene.results import (
     plotting_grid,
     scene_model_error,
 )
-from core.scene.schema import MAX_SCENE_BYTES, check_fields, integer_in_range
+from core.scene.schema import (
+    MAX_SCENE_BYTES,
+    SCHEMA_KEY,
+    check_fields,
+    integer_in_range,
+    migrate,
+)
 from core.scene.validate import replace_loads, scene_from_dict
 
 __all__ = [
     "LIFT_OFF_COLOUR",
     "engine_text",
+    "check_design",
     "check_fields",
     "check_scene",
+    "design_check",
+    "DesignCheck",
+    "DesignLimits",
     "FLAG_MESSAGES",
     "integer_in_range",
+    "JSON_SCHEMA_DIALECT",
+    "load_json_schema",
     "LARGE_TILT",
+    "LimitCheck",
     "load_scene",
     "MAX_SCENE_BYTES",
+    "migrate",
     "plotting_grid",
+    "provenance",
+    "provenance_lines",
     "read_scene_json",
     "replace_loads",
     "save_scene",
     "Scene",
+    "scene_definitions",
     "scene_from_dict",
+    "scene_json_schema",
+    "scene_root",
+    "SCHEMA_FILES",
+    "SCHEMA_IDS",
+    "SCHEMA_KEY",
+    "schema_errors",
+    "schema_text",
     "scene_model_error",
     "SceneSolution",
     "solve",
+    "solver_settings",
 ]

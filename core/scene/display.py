@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.scene.files import scene_to_json
+from core.scene.records import solver_settings as scene_solver_settings
 from core.scene.schema import SCHEMA_VERSION, _jsonable
 
 # the package root only, for its version: its imports of the upper layers are for type
@@ -60,11 +61,6 @@ def optional_import(name: str, purpose: str, extra: str = DATA_EXTRA) -> Any:
     except ImportError as exc:
         raise ImportError(f"{purpose} needs {name}, which is not installed: "
                           f'pip install "{extra}"') from exc
-
-
-def package_version() -> str:
-    """The package's version (``core.__version__``), recorded in every file written."""
-    return VERSION
 
 
 def _number(value: float) -> str:
@@ -184,7 +180,7 @@ def html_summary(result: SceneSolution) -> str:
 def solver_settings(result: SceneSolution) -> dict[str, Any]:
     """The scene's ``solver`` section and what the solver chose: the engine, the contact
     and coating models, the sizes of its discretization."""
-    settings: dict[str, Any] = dict(result.scene.to_dict().get("solver", {}))
+    settings: dict[str, Any] = scene_solver_settings(result.scene)
     info = result.info
     for name in ("method", "contact", "coating_model", "basis", "n_modes", "n_nodes",
                  "n_panels", "n_steps", "fallback"):
@@ -200,7 +196,7 @@ def metadata(result: SceneSolution) -> dict[str, Any]:
     info = result.info
     return {
         "format": "coated-punch solution",
-        "version": package_version(),
+        "version": VERSION,
         "schema_version": SCHEMA_VERSION,
         "scene_name": result.scene.name,
         "scene_key": result.scene.key,

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 from core import limits
 from core.files import atomic_write_text, read_regular_file
 from core.presets import shipped_file
+from core.scene.schema import SCHEMA_KEY
 from core.scene.validate import scene_from_dict
 
 if TYPE_CHECKING:
@@ -73,12 +74,23 @@ def load_scene(path: str | os.PathLike) -> Scene:
     return parse_scene_json(text, str(path))
 
 
-def scene_to_json(scene: Scene | Mapping[str, Any]) -> str:
-    """The canonical JSON text of a scene (validated first when given as a dict)."""
+def scene_to_json(scene: Scene | Mapping[str, Any], schema: str | None = None) -> str:
+    """The canonical JSON text of a scene (validated first when given as a dict);
+    ``schema``: a ``"$schema"`` to write first (the file's JSON Schema, for editors)."""
     scene = scene_from_dict(scene)
-    return json.dumps(scene.to_dict(), indent=2, allow_nan=False) + "\n"
+    data = scene.to_dict()
+    if schema is not None:
+        if not isinstance(schema, str):
+            raise ValueError(f"{SCHEMA_KEY}: must be a string, got {type(schema).__name__}")
+        data = {SCHEMA_KEY: schema, **data}
+    return json.dumps(data, indent=2, allow_nan=False) + "\n"
 
 
-def save_scene(scene: Scene | Mapping[str, Any], path: str | os.PathLike) -> None:
-    """Write a scene as JSON to ``path`` atomically (a dict is validated first)."""
-    atomic_write_text(path, scene_to_json(scene))
+def save_scene(scene: Scene | Mapping[str, Any], path: str | os.PathLike,
+               schema: str | None = None) -> None:
+    """Write a scene as JSON to ``path`` atomically (a dict is validated first).
+
+    ``schema``: a ``"$schema"`` to write first, naming the file's JSON Schema for an
+    editor (e.g. the relative path of ``scene.schema.json``, see core/SCENES.md); the
+    program ignores it when reading."""
+    atomic_write_text(path, scene_to_json(scene, schema))

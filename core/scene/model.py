@@ -22,6 +22,7 @@ from core.cache import StageCache, fingerprint
 from core.coating import DEFAULT_INTERFACE, layer_compliance
 from core.problem import STATEMENTS
 from core.profiles import Profile, profile_values, without_offset
+from core.scene.design import DesignLimits
 from core.scene.dimensionless import DimensionlessProblem, to_dimensionless
 from core.scene.golden_section import golden_minimum_batched
 
@@ -75,6 +76,8 @@ class Scene:
     _data: dict = field(repr=False)
     #: Contact model: "auto" (full contact unless it is lost), "full" or "unilateral".
     contact: str = "auto"
+    #: Limits of the design check (the file's ``limits``; None: none given).
+    limits: DesignLimits | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The canonical JSON-able dict of the scene (schema version 1, defaults filled in)."""

@@ -19,12 +19,15 @@ from core import limits
 from core.cache import StageCache, fingerprint
 from core.coating import model_error_estimate, model_error_map, tilt_share
 from core.problem import QUANTITIES
-from core.scene.display import HISTORIES, html_summary, package_version, text_summary
+from core.scene.design import DesignCheck, DesignLimits, design_check
+from core.scene.display import HISTORIES, html_summary, solver_settings, text_summary
 from core.scene.display import to_dataframe as _to_dataframe
 from core.scene.display import to_xarray as _to_xarray
 from core.scene.load_rates import oscillations
 from core.scene.model import Scene
+from core.scene.records import PROGRAM
 from core.scene.schema import SCHEMA_VERSION, _jsonable
+from core.version import VERSION
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -223,7 +226,9 @@ class SceneSolution:
         """
         return _jsonable({
             "format": "coated-punch solution",
-            "version": package_version(),
+            "program": PROGRAM,
+            "version": VERSION,
+            "solver": solver_settings(self),
             "schema_version": SCHEMA_VERSION,
             "scene": self.scene.to_dict(),
             "units": UNITS,
@@ -238,6 +243,7 @@ class SceneSolution:
             "flag_messages": self.flag_messages,
             "contact_set": [[list(zone) for zone in zones] for zones in self.contact_set],
             "info": self.info,
+            "design_check": None if (check := self.design_check()) is None else check.to_dict(),
         })
 
     def __repr__(self) -> str:
@@ -315,6 +321,15 @@ class SceneSolution:
             lines.extend(f"{tt},{float(xi)!r},{float(qi)!r}" for xi, qi in zip(xs, q[:, j],
                                                                                strict=True))
         return "\n".join(lines) + "\n"
+
+    def design_check(self, limits: DesignLimits | None = None) -> DesignCheck | None:
+        """The design check over the whole history (:func:`core.scene.design.design_check`)
+        against ``limits`` [Pa, m, rad] (default: the scene's ``limits``); None when
+        neither gives a limit."""
+        limits = limits if limits is not None else self.scene.limits
+        if limits is None or limits.empty:
+            return None
+        return design_check(self, limits)
 
 
 def _check_finite(result: SceneSolution) -> None:

@@ -16,12 +16,17 @@ import math
 import numbers
 import re
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
 from core import limits
 from core.cache import StageCache, fingerprint
+from core.coating import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
+from core.contact import CONTACT_MODELS
+from core.problem import QUANTITIES
 from core.profiles import Profile, check_range, profile_from_spec
 from core.validation import finite_number, positive_number, show_value
 
@@ -50,6 +55,149 @@ LAM_RANGE = (limits.MIN_LAM, limits.MAX_SCENE_LAM)
 #: time stepping was measured at 1.9 s for 1000 (tol 1e-8), 32 s for 1e4 (tol 1e-8) and
 #: 13 s for 9e7 (tol 1e-3), the last two stopping at the step limit.
 MAX_CREEP_COEFFICIENT = 1e3
+
+#: The key a scene or study file may carry to name its JSON Schema (any string; ignored
+#: by the validation, see core/SCENES.md "JSON Schema").
+SCHEMA_KEY = "$schema"
+
+
+@dataclass(frozen=True)
+class FieldRule:
+    """One field of an object of a scene file: the table :data:`FIELDS` holds them all.
+
+    ``kind`` says what the value is: ``"number"``, ``"integer"``, ``"text"``,
+    ``"choice"`` (one of ``choices``), ``"x_profile"`` (a function of x [m] on [-a, a]),
+    ``"t_profile"`` (a function of t [day after loading]), ``"object"`` (the object of
+    that name in :data:`FIELDS`), ``"layers"`` (a list of ``"coating[k]"`` objects),
+    ``"times"`` or ``"creep"`` (see core/SCENES.md). ``low``/``high`` bound a number
+    (or every value of a profile), exclusive where ``low_open``/``high_open``; ``least``
+    and ``most`` bound a text's length or a list's entries. The validator
+    (:func:`core.scene.scene_from_dict`) and the JSON Schema
+    (:mod:`core.scene.json_schema`) both read this table.
+    """
+
+    name: str
+    kind: str
+    unit: str
+    description: str
+    required: bool = True
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+    choices: tuple[str, ...] = ()
+    least: int | None = None
+    most: int | None = None
+    default: Any = None
+
+
+def _rule(name: str, kind: str, unit: str, description: str, **rest: Any) -> FieldRule:
+    return FieldRule(name, kind, unit, description, **rest)
+
+
+#: Accepted range of a Poisson ratio, both ends open (a stable isotropic solid).
+POISSON_RANGE = (-1.0, 0.5)
+_POISSON = {"low": POISSON_RANGE[0], "high": POISSON_RANGE[1], "low_open": True,
+            "high_open": True}
+
+#: The fields of each object of a scene file, by the object's path (``"coating[k]"`` for
+#: every layer): names, whether required, units, ranges and meaning.
+FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
+    "scene": (
+        _rule("schema_version", "integer", "-", f"Version of the scene schema: "
+              f"{SCHEMA_VERSION}.", low=SCHEMA_VERSION, high=SCHEMA_VERSION),
+        _rule("name", "text", "-", "Name of the scene (not empty).", least=1,
+              most=limits.MAX_NAME_CHARS),
+        _rule("description", "text", "-", "Teaching text shown in the explorer.",
+              required=False, most=limits.MAX_DESCRIPTION_CHARS, default=""),
+        _rule("punch", "object", "-", "The rigid punch."),
+        _rule("coating", "layers", "-", f"Coating layers, top (under the punch) first, 1 to "
+              f"{MAX_LAYERS}.", least=1, most=MAX_LAYERS),
+        _rule("base", "object", "-", "The aging viscoelastic base layer."),
+        _rule("loading", "object", "-", "Exactly two of settlement [m], tilt [rad], force "
+              "[N/m], moment [N], each a function of t [day after loading], forming one of "
+              "the four statements."),
+        _rule("times", "times", "day", "Output times after loading: {end, count, spacing} "
+              f"or a list of 1 to {MAX_TIMES} increasing days after loading."),
+        _rule("solver", "object", "-", "Solver settings.", required=False),
+        _rule("limits", "object", "-", "Limits of the design check (each optional; a limit "
+              "left out is not checked).", required=False),
+    ),
+    "punch": (
+        _rule("half_width", "number", "m", "Half-width a of the punch.", low=0.0,
+              low_open=True),
+        _rule("shape", "x_profile", "m", "Height f(x) of the punch base above its lowest "
+              "point, x [m] from the centre on [-a, a] (0: a flat punch).", required=False,
+              default=0.0),
+    ),
+    "coating[k]": (
+        _rule("thickness", "x_profile", "m", "Thickness h_k(x) of the layer, > 0.", low=0.0,
+              low_open=True),
+        _rule("modulus", "x_profile", "Pa", "Young's modulus E_k(x) of the layer, > 0.",
+              low=0.0, low_open=True),
+        _rule("poisson", "x_profile", "-", "Poisson ratio nu_k(x) of the layer, in (-1, 0.5).",
+              **_POISSON),
+        _rule("interface", "choice", "-", "How the layer is joined to what lies under it.",
+              required=False, choices=INTERFACES, default=DEFAULT_INTERFACE),
+    ),
+    "base": (
+        _rule("thickness", "number", "m", f"Thickness H of the base (a/H in [{LAM_RANGE[0]:g}, "
+              f"{LAM_RANGE[1]:g}]).", low=0.0, low_open=True),
+        _rule("poisson", "number", "-", "Poisson ratio nu of the base, in (-1, 0.5).",
+              **_POISSON),
+        _rule("age_at_loading", "number", "day", "Age tau0 of the base when the load is "
+              "applied (the base is made at age 0).", low=0.0, low_open=True),
+        _rule("creep", "creep", "-", "Creep model of the base (core/SCENES.md, 'Creep "
+              "models')."),
+    ),
+    "loading": tuple(
+        _rule(q, "t_profile", unit, f"Given {q} [{unit}], a function of t [day after "
+              "loading].", required=False)
+        for q, unit in zip(QUANTITIES, ("m", "rad", "N/m", "N"), strict=True)),
+    "times": (
+        _rule("end", "number", "day", "Last output time after loading.", low=0.0,
+              low_open=True),
+        _rule("count", "integer", "-", "Number of output times.", low=1, high=MAX_TIMES),
+        _rule("spacing", "choice", "-", "linear: equally spaced from 0; log: 0, then "
+              "geometrically spaced over the last three decades.", required=False,
+              choices=("linear", "log"), default="linear"),
+    ),
+    "solver": (
+        _rule("tol", "number", "-", "Relative tolerance of the solver.", required=False,
+              low=TOL_RANGE[0], high=TOL_RANGE[1], default=DEFAULT_TOL),
+        _rule("contact", "choice", "-", "Contact model: auto (full contact unless it is "
+              "lost), full or unilateral.", required=False,
+              choices=("auto", *(c for c in CONTACT_MODELS if c != "auto")), default="auto"),
+        _rule("model_tol", "number", "-", "Coating-model error a result may carry "
+              "unflagged (flag model_error).", required=False, low=MODEL_TOL_RANGE[0],
+              high=MODEL_TOL_RANGE[1], default=DEFAULT_MODEL_TOL),
+    ),
+    "limits": (
+        _rule("allowable_pressure", "number", "Pa", "Allowable bearing pressure: the "
+              "largest contact pressure q over x and the whole history must not exceed it.",
+              required=False, low=0.0),
+        _rule("settlement_limit", "number", "m", "Largest settlement allowed (its "
+              "magnitude, over the whole history).", required=False, low=0.0),
+        _rule("tilt_limit", "number", "rad", "Largest tilt allowed, either way (its "
+              "magnitude, over the whole history).", required=False, low=0.0),
+    ),
+})
+
+
+def required_fields(obj: str) -> tuple[str, ...]:
+    """The required fields of the object ``obj`` of :data:`FIELDS` (``"punch"``, ...)."""
+    return tuple(r.name for r in FIELDS[obj] if r.required)
+
+
+def optional_fields(obj: str) -> tuple[str, ...]:
+    """The optional fields of the object ``obj`` of :data:`FIELDS`."""
+    return tuple(r.name for r in FIELDS[obj] if not r.required)
+
+
+def field_rule(obj: str, name: str) -> FieldRule:
+    """The rule of field ``name`` of the object ``obj`` of :data:`FIELDS`."""
+    return next(r for r in FIELDS[obj] if r.name == name)
+
 
 #: Migrations from older schema versions: version -> function returning the next version.
 #: Version 1 is the first; there is nothing to migrate yet.
@@ -89,8 +237,9 @@ def check_fields(obj: Any, path: str, required: Sequence[str],
 
 def _poisson(value: Any, path: str) -> float:
     x = finite_number(value, path)
-    if not -1.0 < x < 0.5:
-        raise ValueError(f"{path}: must be in (-1, 0.5), got {show_value(value)}")
+    lo, hi = POISSON_RANGE
+    if not lo < x < hi:
+        raise ValueError(f"{path}: must be in ({lo:g}, {hi:g}), got {show_value(value)}")
     return x
 
 

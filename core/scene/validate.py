@@ -22,6 +22,7 @@ from core.creep import Elastic, UserKernel, creep_model_from_spec
 from core.problem import QUANTITIES, STATEMENTS
 from core.profiles import Profile, profile_values
 from core.scene import schema
+from core.scene.design import DesignLimits
 from core.scene.load_rates import check_step_limit
 from core.scene.model import Layer, Scene
 from core.scene.schema import (
@@ -58,13 +59,18 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     if isinstance(d, Scene):
         return d
     d = migrate(d)
-    check_fields(d, "", ("schema_version", "name", "punch", "coating", "base", "loading",
-                          "times"), ("description", "solver"))
+    check_fields(d, "", schema.required_fields("scene"),
+                 (*schema.optional_fields("scene"), schema.SCHEMA_KEY))
+    if schema.SCHEMA_KEY in d:
+        # names the file's JSON Schema for editors; not part of the scene
+        _text(d[schema.SCHEMA_KEY], schema.SCHEMA_KEY, allow_empty=True,
+              most=limits.MAX_DESCRIPTION_CHARS)
     name = _text(d["name"], "name", allow_empty=False, most=limits.MAX_NAME_CHARS)
     description = _text(d.get("description", ""), "description", allow_empty=True,
                         most=limits.MAX_DESCRIPTION_CHARS)
 
-    punch = check_fields(d["punch"], "punch", ("half_width",), ("shape",))
+    punch = check_fields(d["punch"], "punch", schema.required_fields("punch"),
+                         schema.optional_fields("punch"))
     a = positive_number(punch["half_width"], "punch.half_width")
     x_domain = (-a, a)
     shape_spec = punch.get("shape", 0.0)
@@ -75,7 +81,8 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     layers = []
     for k, spec in enumerate(layers_spec):
         path = f"coating[{k}]"
-        check_fields(spec, path, ("thickness", "modulus", "poisson"), ("interface",))
+        check_fields(spec, path, schema.required_fields("coating[k]"),
+                     schema.optional_fields("coating[k]"))
         interface = spec.get("interface", DEFAULT_INTERFACE)
         if interface not in INTERFACES:
             raise ValueError(f"{path}.interface: must be 'smooth' or 'bonded', got "
@@ -84,12 +91,12 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
             thickness=_profile(spec["thickness"], f"{path}.thickness", "x", x_domain,
                                lower=0.0),
             modulus=_profile(spec["modulus"], f"{path}.modulus", "x", x_domain, lower=0.0),
-            poisson=_profile(spec["poisson"], f"{path}.poisson", "x", x_domain, lower=-1.0,
-                             upper=0.5),
+            poisson=_profile(spec["poisson"], f"{path}.poisson", "x", x_domain,
+                             lower=schema.POISSON_RANGE[0], upper=schema.POISSON_RANGE[1]),
             interface=interface,
         ))
 
-    base = check_fields(d["base"], "base", ("thickness", "poisson", "age_at_loading", "creep"))
+    base = check_fields(d["base"], "base", schema.required_fields("base"))
     h_base = positive_number(base["thickness"], "base.thickness")
     nu = _poisson(base["poisson"], "base.poisson")
     tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
@@ -109,7 +116,7 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     times, times_spec = _times(d["times"], "times")
 
     loading = d["loading"]
-    check_fields(loading, "loading", (), QUANTITIES)
+    check_fields(loading, "loading", (), schema.optional_fields("loading"))
     given = frozenset(loading)
     if len(given) != 2:
         raise ValueError("loading: exactly two of settlement, tilt, force, moment are needed, "
@@ -128,7 +135,7 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
                          f"an age at loading of {tau0:g} days")
 
-    solver = check_fields(d.get("solver", {}), "solver", (), ("tol", "contact", "model_tol"))
+    solver = check_fields(d.get("solver", {}), "solver", (), schema.optional_fields("solver"))
     tol = finite_number(solver.get("tol", schema.DEFAULT_TOL), "solver.tol")
     tol_lo, tol_hi = schema.TOL_RANGE
     if not tol_lo <= tol <= tol_hi:
@@ -145,6 +152,9 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     if not MODEL_TOL_RANGE[0] <= model_tol <= MODEL_TOL_RANGE[1]:
         raise ValueError(f"solver.model_tol: must be in [{MODEL_TOL_RANGE[0]:g}, "
                          f"{MODEL_TOL_RANGE[1]:g}], got {show_value(model_tol)}")
+
+    design = DesignLimits.from_dict(check_fields(d.get("limits", {}), "limits", (),
+                                                 schema.optional_fields("limits")))
 
     data = {
         "schema_version": schema.SCHEMA_VERSION,
@@ -164,9 +174,13 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
         "solver": ({"tol": tol, "model_tol": model_tol} if contact == "auto" else
                    {"tol": tol, "model_tol": model_tol, "contact": contact}),
     }
+    if not design.empty:
+        # a scene without limits keeps its keys (and its key)
+        data["limits"] = design.to_dict()
     times.setflags(write=False)
     scene = Scene(name, description, a, shape, tuple(layers), h_base, nu, tau0, creep,
-                  MappingProxyType(loads), times, tol, data, contact)
+                  MappingProxyType(loads), times, tol, data, contact,
+                  None if design.empty else design)
     _check_breakpoints(scene)
     _check_solvable(scene)
     _check_load_rates(scene)

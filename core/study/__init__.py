@@ -9,12 +9,14 @@ returns an xarray Dataset (netCDF, CSV, parquet).
 - ``loads.py``: a batch whose points differ only in their loads, as one combination of
   unit responses;
 - ``liftoff.py``: a batch of lift-off eccentricities as one family;
-- ``warm.py``: warming Dask workers when a study's cluster starts.
+- ``warm.py``: warming Dask workers when a study's cluster starts;
+- ``json_schema.py``: the JSON Schema of study files (``study_json_schema``).
 """
 
 from __future__ import annotations
 
 from core.study.definition import Study, load_study, numeric_fields, study_from_dict
+from core.study.json_schema import study_json_schema
 from core.study.run import check_output, sweep
 
 __all__ = [
@@ -23,5 +25,6 @@ __all__ = [
     "numeric_fields",
     "Study",
     "study_from_dict",
+    "study_json_schema",
     "sweep",
 ]

@@ -33,6 +33,7 @@ import numpy as np
 from core.presets import shipped_file
 from core.scene import (
     MAX_SCENE_BYTES,
+    SCHEMA_KEY,
     check_fields,
     integer_in_range,
     load_scene,
@@ -61,9 +62,11 @@ OUTPUT_UNITS: dict[str, str] = {
 }
 GRID_KINDS = ("values", "linspace", "logspace")
 DISTRIBUTIONS = ("normal", "lognormal", "uniform")
-# whole subtrees a study may not vary: the output times are the study's own axis
-_FIXED_ROOTS = ("schema_version", "name", "description", "times")
-_PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d{1,4}\])*)")
+#: Whole subtrees a study may not vary: the output times are the study's own axis, and
+#: the design-check limits do not change an answer.
+FIXED_ROOTS = ("schema_version", "name", "description", "times", "limits")
+#: One part of a field path: a name and its list items (``coating[0]``).
+PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d{1,4}\])*)")
 
 
 @dataclass(frozen=True)
@@ -153,7 +156,7 @@ def parse_path(path: Any, field: str = "field") -> tuple[str | int, ...]:
                          f"{show_value(path)}")
     parts: list[str | int] = []
     for piece in path.split("."):
-        match = _PATH_PART.fullmatch(piece)
+        match = PATH_PART.fullmatch(piece)
         if match is None:
             raise ValueError(f"{field}: {path!r} is not a field path (names joined by '.', "
                              "list items as [k], e.g. 'coating[0].modulus')")
@@ -252,9 +255,10 @@ def _parameter(spec: Any, field: str, base: Mapping[str, Any]) -> Parameter:
     kind = given[0]
     path = spec["field"]
     parts = parse_path(path, f"{field}.field")
-    if parts[0] in _FIXED_ROOTS:
+    if parts[0] in FIXED_ROOTS:
         raise ValueError(f"{field}.field: {path!r} cannot be varied (the output times are "
-                         "the study's 'times'; names and versions are not numbers)")
+                         "the study's 'times'; names and versions are not numbers; limits "
+                         "do not change an answer)")
     try:
         current = get_field(base, path)
     except ValueError as exc:
@@ -331,7 +335,7 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     max_points = min(int(max_points), MAX_STUDY_POINTS)
     try:
         check_fields(d, "", ("study_version", "name", "scene", "vary"),
-                      ("description", "samples", "seed", "outputs", "times"))
+                      ("description", "samples", "seed", "outputs", "times", SCHEMA_KEY))
     except ValueError as exc:
         # the scene checker names the top level "scene", which in a study is the field
         # holding the base scene: a stray study field must not be blamed on it
@@ -343,6 +347,9 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     name = d["name"]
     if not isinstance(name, str) or not name.strip():
         raise ValueError(f"name: must be a non-empty string, got {show_value(name)}")
+    for key in ("description", SCHEMA_KEY):
+        if key in d and not isinstance(d[key], str):
+            raise ValueError(f"{key}: must be a string, got {show_value(d[key])}")
     base = _base_scene(d["scene"], None if base_dir is None else Path(base_dir))
     if "times" in d:
         base["times"] = d["times"]
@@ -408,7 +415,7 @@ def numeric_fields(scene: Mapping[str, Any], prefix: str = "") -> list[tuple[str
     for key, value in items:
         path = (f"{prefix}[{key}]" if isinstance(key, int)
                 else f"{prefix}.{key}" if prefix else str(key))
-        if not prefix and key in _FIXED_ROOTS:
+        if not prefix and key in FIXED_ROOTS:
             continue
         if isinstance(value, (Mapping, list)):
             out.extend(numeric_fields(value, path))

@@ -3,8 +3,10 @@
 The result's files (histories, q(x, t)) are written from the
 :class:`~explorer.model.results.ResultView` that is drawn, so a file holds exactly what
 the plots show (no second solve, no worker needed). Each starts with ``#`` lines saying
-what was solved, how accurately, which validity flags were raised and in which units the
-columns are, so a flagged result never leaves unmarked (``pandas.read_csv(path,
+what was solved (the version, the whole scene as one line of JSON, the solver settings:
+:func:`core.scene.provenance_lines`, as the command line writes them), how accurately,
+which validity flags were raised and in which units the columns are, so a flagged result
+never leaves unmarked (``pandas.read_csv(path,
 comment="#")`` reads the table). A study's file (:func:`study_csv`) holds every output
 at every time of every point. Numbers are written with
 :data:`DIGITS` significant digits: more than any accuracy target the solver offers
@@ -21,6 +23,7 @@ from typing import Any
 import numpy as np
 
 import core
+from core.scene import provenance_lines
 
 from ..model import OUTPUTS, QUANTITIES, QUANTITY_UNITS, ResultView, StudyResult, contact_widths
 
@@ -79,6 +82,8 @@ def _header(view: ResultView, what: str, units: Iterable[str]) -> list[str]:
     lines = [
         f"# coated-punch explorer {project_version()}: {what}",
         f"# scene: {scene.get('name', '')}",
+        # the version, the whole scene and the solver settings, as the command line writes
+        *provenance_lines(scene),
         f"# given: {given}; computed: {', '.join(view.unknowns)} (and the pressure)",
         f"# accuracy: {accuracy_statement(view)}",
     ]
@@ -167,6 +172,7 @@ def study_csv(result: StudyResult) -> str:
     base = planned.study.base
     lines = [f"# coated-punch {project_version()}: design study around the scene "
              f"{str(base.get('name', ''))[:200]!r}",
+             *provenance_lines(base),
              f"# {planned.study.n_points} points, "
              f"{int(result.failed.sum())} failed, {int(result.flagged.sum())} flagged "
              "(see the flags column: a flagged answer is outside the model's validity)"]

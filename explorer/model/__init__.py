@@ -25,7 +25,13 @@ from .code_creep_state import (
     creep_coefficient_data,
 )
 from .contact_zone import contact_text, contact_widths, contact_zones, lifts_off
-from .design import DesignLimits, check_html, design_check
+from .design import (
+    DesignLimits,
+    check_html,
+    design_check,
+    scene_limits,
+    screen_limits,
+)
 from .history import SceneHistory
 from .lessons import Lesson, lessons, step_scene
 from .links import decode_scene, encode_scene
@@ -70,4 +76,4 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "contact_widths", "contact_zones", "creep_coefficient_data", "decode_scene",
            "default_range", "design_check", "encode_scene", "lessons", "lifts_off", "plan_study",
            "prepare_view", "preset_label", "presets", "read_study_query", "read_view_query",
-           "step_scene", "study_choices", "view_query"]
+           "scene_limits", "screen_limits", "step_scene", "study_choices", "view_query"]

@@ -4,18 +4,27 @@
 and smallest contact pressure over the whole history and where and when they occur, the
 width in contact (the part not lifting off beyond the solver's error band), the
 eccentricity ``e = M/P``, and the largest settlement and tilt, each compared with a limit
-the user sets (:class:`DesignLimits`). Nothing here imports Panel.
+the user sets (:class:`DesignLimits`). The check itself is the core's
+(:func:`core.scene.check_design`, the one the command line and scene files' ``limits``
+use); this module holds the screen's units and the limits as the Check tab sets them.
+Nothing here imports Panel.
 """
 
 from __future__ import annotations
 
 import html
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import param
 
+from core.scene import DesignLimits as CoreLimits
+from core.scene import LimitCheck, check_design
+
 from .results import ResultView
+from .state import QUANTITY_UNITS
 
 
 class DesignLimits(param.Parameterized):
@@ -31,19 +40,22 @@ class DesignLimits(param.Parameterized):
 
 @dataclass
 class Check:
-    """One line of the check: a value, its limit (None: not set) and the verdict."""
+    """One line of the check: a value, its limit (None: not set) and the verdict
+    (``passed``, from the core's check; None: no limit)."""
 
     name: str
     value: float
     unit: str
     where: str
     limit: float | None = None
+    passed: bool | None = None
 
     @property
     def verdict(self) -> str:
         if self.limit is None:
             return "no limit set"
-        return "pass" if abs(self.value) <= self.limit else "FAIL"
+        passed = self.passed if self.passed is not None else abs(self.value) <= self.limit
+        return "pass" if passed else "FAIL"
 
 
 @dataclass
@@ -66,40 +78,71 @@ class DesignCheck:
         return all(v == "pass" for v in verdicts)
 
 
+#: The screen's unit of each quantity of the core's check: (unit, its size in SI).
+_SCREEN_UNITS: dict[str, tuple[str, float]] = {
+    "q_max": ("kPa", 1e3), "q_min": ("kPa", 1e3),
+    "settlement": QUANTITY_UNITS["settlement"], "tilt": QUANTITY_UNITS["tilt"]}
+
+
+#: The session's limits: (field of :class:`DesignLimits`, quantity it bounds).
+_LIMITS = (("allowable_pressure", "q_max"), ("settlement_limit", "settlement"),
+           ("tilt_limit", "tilt"))
+
+
 def _contact_width(view: ResultView, index: int) -> float:
     lifted = sum(hi - lo for lo, hi in view.negative_intervals(index))
     return float(2 * view.geometry.half_width - lifted)
 
 
+def core_limits(limits: DesignLimits | None) -> CoreLimits:
+    """The session's limits (kPa, mm, mrad) as the core's (Pa, m, rad)."""
+    if limits is None:
+        return CoreLimits()
+    values = {}
+    for name, quantity in _LIMITS:
+        value = getattr(limits, name)
+        values[name] = None if value is None else value * _SCREEN_UNITS[quantity][1]
+    return CoreLimits(**values)
+
+
+def screen_limits(spec: Mapping[str, Any] | None) -> dict[str, float | None]:
+    """A scene file's ``limits`` (Pa, m, rad; assumed valid) as the Check tab's values
+    (kPa, mm, mrad); a limit the file leaves out is None."""
+    spec = spec or {}
+    return {name: None if spec.get(name) is None
+            else float(spec[name]) / _SCREEN_UNITS[quantity][1]
+            for name, quantity in _LIMITS}
+
+
+def scene_limits(limits: DesignLimits | None) -> dict[str, float]:
+    """The session's limits as a scene file's ``limits`` (Pa, m, rad; only those set)."""
+    return core_limits(limits).to_dict()
+
+
+def _on_screen(line: LimitCheck, limits: DesignLimits | None) -> Check:
+    """A line of the core's check in the screen's units, with the limit as typed."""
+    unit, size = _SCREEN_UNITS[line.quantity]
+    where = f"t = {line.time:.4g} days"
+    if line.x is not None:
+        where = f"x = {line.x:.3g} m, " + where
+    typed = None if limits is None or line.limit_name is None \
+        else getattr(limits, line.limit_name)
+    return Check(line.label, line.value / size, unit, where, typed, line.passed)
+
+
 def design_check(view: ResultView, limits: DesignLimits | None = None) -> DesignCheck:
-    """The design check of ``view`` over its whole history, against ``limits``."""
-    limits = limits or DesignLimits()
-    q = view.pressure / 1e3  # kPa
-    i_max = np.unravel_index(int(np.nanargmax(q)), q.shape)
-    i_min = np.unravel_index(int(np.nanargmin(q)), q.shape)
-
-    def at(i: tuple[int, ...]) -> str:
-        return f"x = {view.x[i[0]]:.3g} m, t = {view.times[i[1]]:.4g} days"
-
+    """The design check of ``view`` over its whole history, against ``limits``: the
+    core's check (:func:`core.scene.check_design`) in the screen's units, with the
+    contact width and the eccentricity the screen shows beside it."""
+    verdict = check_design(view.times, view.x, view.pressure, view.values["settlement"],
+                           view.values["tilt"], core_limits(limits))
     widths = [_contact_width(view, j) for j in range(len(view.times))]
     j_narrow = int(np.argmin(widths))
     force = float(view.values["force"][-1])
     moment = float(view.values["moment"][-1])
-    settlement = view.display("settlement")
-    tilt = view.display("tilt")
-    k_d = int(np.argmax(np.abs(settlement)))
-    k_t = int(np.argmax(np.abs(tilt)))
-    q_max = Check("largest contact pressure q_max", float(q[i_max]), "kPa", at(i_max),
-                  limits.allowable_pressure)
-    q_min = Check("smallest contact pressure q_min", float(q[i_min]), "kPa", at(i_min))
-    checks = [
-        q_max,
-        Check("largest settlement", float(settlement[k_d]), "mm",
-              f"t = {view.times[k_d]:.4g} days", limits.settlement_limit),
-        Check("largest tilt", float(tilt[k_t]), "mrad", f"t = {view.times[k_t]:.4g} days",
-              limits.tilt_limit),
-    ]
-    return DesignCheck(q_max=q_max, q_min=q_min, contact_width=widths[j_narrow],
+    checks = [_on_screen(line, limits) for line in verdict.checks]
+    return DesignCheck(q_max=checks[0], q_min=_on_screen(verdict.q_min, limits),
+                       contact_width=widths[j_narrow],
                        full_width=2 * view.geometry.half_width,
                        eccentricity=moment / force if force > 0 else None, checks=checks)
 

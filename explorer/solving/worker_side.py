@@ -66,12 +66,16 @@ def download_text(scene: dict[str, Any], kind: str,
 
 
 def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None) -> str:
-    """``solution.to_csv()``, ``.pressure_csv()`` or ``.to_json()`` (``kind``), with the
+    """``solution.to_csv()``, ``.pressure_csv()`` or the JSON of everything with the
+    version and solver settings (:meth:`core.scene.SceneSolution.to_json`) (``kind``), with the
     solve report ``info`` in the JSON if given (see :func:`download_text`)."""
     if kind not in DOWNLOADS:
         raise ValueError(f"kind: unknown download {kind!r}; known: {', '.join(DOWNLOADS)}")
     if info is not None and kind == "to_json":
         solution.info = {k: v for k, v in info.items() if k != "reused"}
+    if kind == "to_json":
+        # the version and the solver settings beside the scene, as the command line writes
+        return solution.to_json()
     return getattr(solution, kind)()
 
 

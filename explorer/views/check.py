@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import panel as pn
 
-from ..model import DesignLimits, ExplorerState, Screen
+from ..model import DesignLimits, ExplorerState, Screen, screen_limits
 from .style import TAB_COLUMN, html_pane
 
 
@@ -30,6 +31,14 @@ class CheckView:
             sizing_mode="stretch_width", css_classes=["eccentricity-input"])
         self.eccentricity.param.watch(self._on_eccentricity, "value")
 
+    def show_limits(self, spec: Mapping[str, Any] | None) -> None:
+        """Fill the limits from a scene file's ``limits`` (Pa, m, rad), when it has some;
+        a scene without limits leaves those typed here."""
+        if not spec:
+            return
+        for name, value in screen_limits(spec).items():
+            getattr(self, name).value = value
+
     def _limit(self, label: str, name: str, css: str) -> pn.widgets.FloatInput:
         box = pn.widgets.FloatInput(label=label, value=None, start=0,
                                     sizing_mode="stretch_width", css_classes=[css])
@@ -40,7 +49,8 @@ class CheckView:
         """The tab's column."""
         return pn.Column(
             html_pane("<small>Limits of the design check (leave empty: not checked). "
-                      "The check covers the whole history.</small>"),
+                      "The check covers the whole history. A scene file's limits fill "
+                      "them, and a saved scene keeps them.</small>"),
             self.allowable_pressure, self.settlement_limit, self.tilt_limit,
             self.eccentricity, **TAB_COLUMN)
 

@@ -23,6 +23,7 @@ from ..model import (
     ResultView,
     Screen,
     check_text,
+    scene_limits,
 )
 from ..solving import SolveController
 from .style import TAB_COLUMN, html_pane, slug
@@ -140,7 +141,13 @@ class FilesView:
     # -- downloads -------------------------------------------------------------------
     def _scene_file(self) -> io.StringIO:
         view = self.screen.shown()
-        scene = view.scene if view is not None else self.state.to_scene()
+        scene = dict(view.scene if view is not None else self.state.to_scene())
+        # the limits typed in the Check tab, as the command line checks them (Pa, m, rad)
+        limits = scene_limits(self.limits)
+        if limits:
+            scene["limits"] = limits
+        else:
+            scene.pop("limits", None)
         return io.StringIO(json.dumps(scene, indent=2) + "\n")
 
     async def _download(self, kind: str, empty: str) -> io.StringIO:

@@ -64,13 +64,15 @@ def test_solve_to_csv_with_pressure(tmp_path: Path):
     pressure = tmp_path / "q.csv"
     proc = run("solve", SCENES / "patched_insert.json", "-o", out, "--pressure-csv", pressure)
     assert proc.returncode == 0, proc.stderr
-    rows = list(csv.reader(io.StringIO(out.read_text())))
+    rows = list(csv.reader(line for line in io.StringIO(out.read_text())
+                           if not line.startswith("#")))
     assert rows[0] == ["time_day", "settlement_m", "tilt_rad", "force_N_per_m", "moment_N"]
     assert len(rows) == 1 + 50
     assert all(float(r[1]) == 5e-5 for r in rows[1:])  # the given settlement
     forces = [float(r[3]) for r in rows[1:]]
     assert forces[-1] < forces[0]  # relaxation under a held settlement
-    qrows = list(csv.reader(io.StringIO(pressure.read_text())))
+    qrows = list(csv.reader(line for line in io.StringIO(pressure.read_text())
+                            if not line.startswith("#")))
     assert qrows[0] == ["time_day", "x_m", "pressure_Pa"]
     assert len(qrows) == 1 + 50 * 201
     assert all(float(r[2]) > 0 for r in qrows[1:])
@@ -211,6 +213,6 @@ def test_cli_never_prints_a_traceback(monkeypatch, capsys) -> None:
         raise TypeError("something unforeseen")
 
     monkeypatch.setattr("core.cli.load_scene", broken)
-    assert cli_main(["validate", "whatever.json"]) == 1
+    assert cli_main(["solve", "whatever.json"]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("error: internal error (TypeError: "), err

@@ -67,7 +67,8 @@ def test_cli_writes_through_a_symlink(tmp_path: Path):
     link.symlink_to(target)
     assert main(["solve", str(scene), "--output", str(link)]) == 0
     assert link.is_symlink()  # still a link, not replaced by a regular file
-    assert target.read_text().startswith("time_day,")
+    assert target.read_text().startswith("# coated-punch ")
+    assert "\ntime_day," in target.read_text()
 
 
 def test_cli_refuses_non_regular_files(tmp_path: Path):

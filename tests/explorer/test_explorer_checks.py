@@ -254,6 +254,49 @@ def test_the_design_check_finds_the_extremes_and_judges_the_limits():
     assert design_check(view, limits).passed is False
 
 
+def test_the_explorers_check_is_the_cores():
+    """The Check tab's limits (kPa, mm, mrad) judged by the core's check of the same
+    answer with the same limits in SI, as a scene file's limits are."""
+    from core import solve
+    from core.scene import DesignLimits as CoreLimits
+    from explorer.model import DesignLimits, design_check
+
+    _, controller = solved("eccentric_creep")
+    view = controller.view
+    screen = design_check(view)
+    limits = DesignLimits(allowable_pressure=screen.q_max.value * 0.99,
+                          settlement_limit=abs(screen.checks[1].value) * 1.01,
+                          tilt_limit=abs(screen.checks[2].value) * 0.99)
+    mine = design_check(view, limits)
+    verdict = solve(view.scene).design_check(CoreLimits(
+        allowable_pressure=limits.allowable_pressure * 1e3,
+        settlement_limit=limits.settlement_limit * 1e-3, tilt_limit=limits.tilt_limit * 1e-3))
+    assert [c.verdict for c in mine.checks] == ["FAIL", "pass", "FAIL"]
+    assert [c.passed for c in verdict.checks] == [False, True, False]
+    for shown, line, size in zip(mine.checks, verdict.checks, (1e3, 1e-3, 1e-3), strict=True):
+        assert shown.name == line.label
+        # the same solve: the same numbers, in the screen's units
+        assert shown.value == pytest.approx(line.value / size, rel=1e-12)
+
+
+def test_the_explorers_files_record_version_scene_and_solver_settings():
+    import core
+    from core.scene import scene_from_dict
+
+    _, controller = solved("eccentric_creep")
+    view = controller.view
+    canonical = scene_from_dict(view.scene).to_dict()
+    for text in (histories_csv(view), pressure_csv(view)):
+        meta, _, _ = parse_csv(text)
+        assert meta["version"] == core.__version__
+        assert json.loads(meta["scene_json"]) == canonical
+        assert json.loads(meta["solver"]) == {"tol": canonical["solver"]["tol"],
+                                              "model_tol": 0.02, "contact": "auto"}
+    data = json.loads(controller.download(view, "to_json"))
+    assert data["version"] == core.__version__ and data["scene"] == canonical
+    assert data["solver"]["contact"] == "auto"
+
+
 def test_the_report_holds_inputs_plots_flags_accuracy_and_version():
     from explorer.files import project_version, report_html
 
@@ -319,3 +362,27 @@ def test_classical_solutions_carry_the_force_and_moment():
     np.testing.assert_allclose(q_root[inner], closed[inner], rtol=1e-12)
     assert np.sum(w * closed) * a / a == pytest.approx(force, rel=1e-14)
     assert np.max(half_space_pressure(x, force, moment, a)) <= EDGE_CAP * force / (2 * a)
+
+
+def test_a_scene_files_limits_fill_the_check_tab_and_a_saved_scene_keeps_them(explorer_app):
+    app = explorer_app("eccentric_creep", solved=True)
+    scene = json.loads(json.dumps(PRESETS["eccentric_creep"]))
+    scene["limits"] = {"allowable_pressure": 2.5e5, "tilt_limit": 2e-3}
+    assert app.load_scene(scene)
+    limits = app.limits  # the Check tab's, in kPa, mm, mrad
+    assert limits.allowable_pressure == pytest.approx(250.0, rel=1e-15)
+    assert limits.tilt_limit == pytest.approx(2.0, rel=1e-15)
+    assert limits.settlement_limit is None
+    assert app.check_tab.allowable_pressure.value == limits.allowable_pressure
+    # a scene without limits leaves those typed
+    assert app.load_scene(json.loads(json.dumps(PRESETS["uniform_flat"])))
+    assert limits.tilt_limit == pytest.approx(2.0, rel=1e-15)
+    app.check_tab.settlement_limit.value = 12.0  # mm
+    app.controller.solve_now()
+    saved = json.loads(app.files_tab._scene_file().getvalue())
+    assert saved["limits"] == pytest.approx({"allowable_pressure": 2.5e5,
+                                             "settlement_limit": 0.012, "tilt_limit": 2e-3},
+                                            rel=1e-15)
+    for name in ("allowable_pressure", "settlement_limit", "tilt_limit"):
+        getattr(app.check_tab, name).value = None
+    assert "limits" not in json.loads(app.files_tab._scene_file().getvalue())

@@ -5,11 +5,13 @@ study's process, and the chart, CSV and PNG hold the result."""
 from __future__ import annotations
 
 import copy
+import json
 import time
 
 import numpy as np
 import pytest
 
+import core
 from core import solve
 from core.study.definition import apply_point
 from explorer.files import study_csv
@@ -193,6 +195,12 @@ def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
     assert chart.flagged.data["y"][0] < 0  # kPa: the tension the flag is about
     rows = [line for line in study_csv(result).splitlines() if not line.startswith("#")]
     assert rows[-1].endswith('"contact_lost",""')
+    # the file records the version, the base scene and its solver settings
+    meta = dict(line[2:].split(": ", 1) for line in study_csv(result).splitlines()
+                if line.startswith("# ") and ": " in line)
+    assert meta["version"] == core.__version__
+    assert json.loads(meta["scene_json"])["solver"]["contact"] == "full"
+    assert json.loads(meta["solver"])["contact"] == "full"
 
 
 def test_a_link_keeps_the_study_settings(explorer_app):

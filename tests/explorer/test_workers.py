@@ -93,6 +93,7 @@ def test_downloads_from_a_worker_hold_the_numbers_on_screen(processes, monkeypat
     # the numbers of a new solve, the solve report of the one on screen
     assert here.info != view.info  # timings and cache hits differ
     here.info = view.info
+    # the JSON of the command line: the solution with the version and solver settings
     assert session.download(view, "to_json") == here.to_json()
     rows = np.loadtxt(session.download(view, "to_csv").splitlines(), delimiter=",",
                       skiprows=1)

@@ -1,0 +1,210 @@
+"""The design check: the largest contact pressure, settlement and tilt of an answer over
+its whole history, each against a limit, with where and when the extreme occurs.
+
+The limits (:class:`DesignLimits`, SI units) come from the ``limits`` section of a scene
+file or from the caller; :func:`check_design` judges plain arrays, so the explorer (which
+draws arrays, not a :class:`~core.scene.SceneSolution`), the command line and the JSON
+output share one check; :func:`design_check` reads a solution. A limit holds when the
+magnitude of the extreme is at most the limit; a limit left out is not checked.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from core.validation import finite_number, show_value
+
+#: The limit checks in order: (field of :class:`DesignLimits`, quantity, unit, label).
+CHECKS: tuple[tuple[str, str, str, str], ...] = (
+    ("allowable_pressure", "q_max", "Pa", "largest contact pressure q_max"),
+    ("settlement_limit", "settlement", "m", "largest settlement"),
+    ("tilt_limit", "tilt", "rad", "largest tilt"),
+)
+
+
+@dataclass(frozen=True)
+class DesignLimits:
+    """What the design must not exceed (``None``: not checked).
+
+    ``allowable_pressure`` [Pa]: the largest contact pressure q over x and time;
+    ``settlement_limit`` [m]: the largest settlement delta (magnitude);
+    ``tilt_limit`` [rad]: the largest tilt alpha, either way. Each finite and >= 0.
+    """
+
+    allowable_pressure: float | None = None
+    settlement_limit: float | None = None
+    tilt_limit: float | None = None
+
+    def __post_init__(self) -> None:
+        for name, _, _, _ in CHECKS:
+            value = getattr(self, name)
+            if value is None:
+                continue
+            x = finite_number(value, f"limits.{name}")
+            if x < 0:
+                raise ValueError(f"limits.{name}: must be >= 0, got {show_value(value)}")
+            object.__setattr__(self, name, x)
+
+    @classmethod
+    def from_dict(cls, spec: Mapping[str, Any]) -> DesignLimits:
+        """The limits of a scene file's ``limits`` object (fields as in :data:`CHECKS`)."""
+        return cls(**{name: spec.get(name) for name, _, _, _ in CHECKS})
+
+    def to_dict(self) -> dict[str, float]:
+        """The limits that are set, as a scene file's ``limits`` object."""
+        return {name: getattr(self, name) for name, _, _, _ in CHECKS
+                if getattr(self, name) is not None}
+
+    @property
+    def empty(self) -> bool:
+        """Whether no limit is set."""
+        return not self.to_dict()
+
+
+@dataclass(frozen=True)
+class LimitCheck:
+    """One line of the check: the extreme ``value`` of ``quantity`` [``unit``] at ``time``
+    [day after loading] (and ``x`` [m] for the pressure), against ``limit`` (None: not
+    set, or ``limit_name`` None for a value reported without a limit)."""
+
+    limit_name: str | None
+    quantity: str
+    label: str
+    value: float
+    unit: str
+    time: float
+    x: float | None = None
+    limit: float | None = None
+
+    @property
+    def utilisation(self) -> float | None:
+        """``|value| / limit`` [-] (above 1: the limit is exceeded); None without a limit."""
+        if self.limit is None:
+            return None
+        if self.limit == 0:
+            return 0.0 if self.value == 0 else math.inf
+        return abs(self.value) / self.limit
+
+    @property
+    def passed(self) -> bool | None:
+        """Whether ``|value| <= limit``; None without a limit."""
+        if self.limit is None:
+            return None
+        return bool(abs(self.value) <= self.limit)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-able dict of the line (non-finite numbers as None)."""
+        def plain(v: float | None) -> float | None:
+            return None if v is None or not math.isfinite(v) else float(v)
+
+        return {"quantity": self.quantity, "limit_name": self.limit_name,
+                "label": self.label, "unit": self.unit, "value": plain(self.value),
+                "limit": plain(self.limit), "utilisation": plain(self.utilisation),
+                "passed": self.passed, "time_day": plain(self.time), "x_m": plain(self.x)}
+
+    def describe(self) -> str:
+        """One line for a terminal: value, limit, utilisation, verdict, where."""
+        where = f"t = {self.time:.6g} days" + ("" if self.x is None else
+                                                f", x = {self.x:.6g} m")
+        text = f"{self.label} {self.value:.6g} {self.unit} at {where}"
+        if self.limit is None:
+            return text + ", no limit set"
+        verdict = "pass" if self.passed else "FAIL"
+        return (f"{text}; limit {self.limit:.6g} {self.unit}, utilisation "
+                f"{self.utilisation:.3g}: {verdict}")
+
+
+@dataclass(frozen=True)
+class DesignCheck:
+    """The design check of one answer: ``checks`` (largest pressure, settlement and tilt,
+    in the order of :data:`CHECKS`) and ``q_min``, the smallest pressure (no limit)."""
+
+    checks: tuple[LimitCheck, ...]
+    q_min: LimitCheck
+
+    @property
+    def passed(self) -> bool | None:
+        """True: every set limit holds; False: one is exceeded; None: no limit is set."""
+        verdicts = [c.passed for c in self.checks if c.passed is not None]
+        if not verdicts:
+            return None
+        return all(verdicts)
+
+    @property
+    def failures(self) -> tuple[LimitCheck, ...]:
+        """The checks whose limit is exceeded."""
+        return tuple(c for c in self.checks if c.passed is False)
+
+    def check(self, quantity: str) -> LimitCheck:
+        """The line of ``quantity`` (``"q_max"``, ``"settlement"``, ``"tilt"``, ``"q_min"``)."""
+        for c in (*self.checks, self.q_min):
+            if c.quantity == quantity:
+                return c
+        raise KeyError(quantity)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-able dict: ``passed`` and one entry per line (``checks``, ``q_min``)."""
+        return {"passed": self.passed, "checks": [c.to_dict() for c in self.checks],
+                "q_min": self.q_min.to_dict()}
+
+
+def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
+                 limits: DesignLimits | None = None) -> DesignCheck:
+    """The design check of an answer given as arrays.
+
+    Parameters
+    ----------
+    times : array, shape (n,)
+        Output times [day after loading].
+    x : array, shape (m,)
+        Points of [-a, a] [m] where ``pressure`` is given.
+    pressure : array, shape (m, n)
+        Contact pressure q [Pa] (compression positive) at ``x`` and ``times``.
+    settlement, tilt : arrays, shape (n,)
+        Settlement delta [m] and tilt alpha [rad] at ``times``.
+    limits : DesignLimits, optional
+        The limits (default: none set; the extremes are still found).
+
+    Returns
+    -------
+    DesignCheck
+        The largest pressure, settlement and tilt (by magnitude for the last two, with
+        their sign), where and when they occur, against the limits; the smallest pressure.
+    """
+    limits = limits or DesignLimits()
+    times = np.asarray(times, dtype=float)
+    x = np.asarray(x, dtype=float)
+    q = np.asarray(pressure, dtype=float)
+    i_max = np.unravel_index(int(np.nanargmax(q)), q.shape)
+    i_min = np.unravel_index(int(np.nanargmin(q)), q.shape)
+    histories = {"settlement": np.asarray(settlement, dtype=float),
+                 "tilt": np.asarray(tilt, dtype=float)}
+    lines = []
+    for name, quantity, unit, label in CHECKS:
+        limit = getattr(limits, name)
+        if quantity == "q_max":
+            lines.append(LimitCheck(name, quantity, label, float(q[i_max]), unit,
+                                    float(times[i_max[1]]), float(x[i_max[0]]), limit))
+            continue
+        values = histories[quantity]
+        k = int(np.nanargmax(np.abs(values)))
+        lines.append(LimitCheck(name, quantity, label, float(values[k]), unit,
+                                float(times[k]), None, limit))
+    q_min = LimitCheck(None, "q_min", "smallest contact pressure q_min", float(q[i_min]),
+                       "Pa", float(times[i_min[1]]), float(x[i_min[0]]))
+    return DesignCheck(tuple(lines), q_min)
+
+
+def design_check(result: Any, limits: DesignLimits | None = None) -> DesignCheck:
+    """The design check of a :class:`~core.scene.SceneSolution` over its whole history:
+    the pressure on its plotting grid ``x`` [m] at every output time, its settlement and
+    tilt histories, against ``limits`` (default: the scene's ``limits``, else none)."""
+    if limits is None:
+        limits = getattr(result.scene, "limits", None)
+    return check_design(result.times, result.x, result.pressure_on_grid, result.settlement,
+                        result.tilt, limits)

@@ -1,0 +1,103 @@
+"""The design check in the core: limits in the scene file, the check of an answer's
+largest pressure, settlement and tilt, and its verdict in the JSON of a solution."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.scene import (
+    DesignLimits,
+    check_design,
+    load_scene,
+    save_scene,
+    scene_from_dict,
+    solve,
+)
+from core.study import study_from_dict
+from tests.conftest import base_scene, edited, scene_file
+
+
+def test_limits_are_read_written_and_left_out_when_absent(tmp_path: Path) -> None:
+    plain = scene_from_dict(base_scene())
+    assert plain.limits is None and "limits" not in plain.to_dict()
+    # an empty section is no limit: the scene keeps its canonical form and key
+    assert scene_from_dict(edited("limits", {})) == plain
+    scene = scene_from_dict(edited("limits", {"tilt_limit": 2e-3, "allowable_pressure": 3e5}))
+    assert scene.limits == DesignLimits(allowable_pressure=3e5, tilt_limit=2e-3)
+    assert scene.to_dict()["limits"] == {"allowable_pressure": 3e5, "tilt_limit": 2e-3}
+    assert scene != plain  # another file, though the same answer
+    file = tmp_path / "scene.json"
+    save_scene(scene, file)
+    assert load_scene(file) == scene
+
+
+@pytest.mark.parametrize(("limits", "message"), [
+    ({"allowable_pressure": -1.0}, "limits.allowable_pressure: must be >= 0, got -1"),
+    ({"settlement_limit": True}, "limits.settlement_limit: must be a number, got true"),
+    ({"tilt_limit": float("nan")}, "limits.tilt_limit: must be a finite number"),
+    ({"settlement": 0.01}, "limits: unknown field 'settlement' (did you mean "
+                           "'settlement_limit'?)"),
+    ([1.0], "limits: must be an object"),
+])
+def test_bad_limits_are_refused_naming_the_field(limits: object, message: str) -> None:
+    with pytest.raises(ValueError) as info:
+        scene_from_dict(edited("limits", limits))
+    assert str(info.value).startswith(message), str(info.value)
+
+
+def test_the_check_finds_the_extremes_where_and_when() -> None:
+    times = np.array([0.0, 10.0, 100.0])
+    x = np.array([-1.0, 0.0, 1.0])
+    pressure = np.array([[1.0, 2.0, 3.0], [4.0, 9.0, 5.0], [-1.0, 0.5, 0.0]]) * 1e5
+    settlement = np.array([0.001, 0.004, 0.003])
+    tilt = np.array([1e-4, -3e-4, 2e-4])  # the largest is the negative one
+    limits = DesignLimits(allowable_pressure=9e5, settlement_limit=0.002)
+    check = check_design(times, x, pressure, settlement, tilt, limits)
+    q_max, delta, alpha = check.checks
+    assert (q_max.value, q_max.x, q_max.time) == (9e5, 0.0, 10.0)
+    assert q_max.passed is True and q_max.utilisation == 1.0  # at the limit: it holds
+    assert (delta.value, delta.time, delta.x) == (0.004, 10.0, None)
+    assert delta.passed is False and delta.utilisation == pytest.approx(2.0, rel=1e-15)
+    assert (alpha.value, alpha.time, alpha.limit, alpha.passed) == (-3e-4, 10.0, None, None)
+    assert check.q_min.value == -1e5 and (check.q_min.x, check.q_min.time) == (1.0, 0.0)
+    assert check.passed is False and check.failures == (delta,)
+    assert check.check("tilt") is alpha
+    data = check.to_dict()
+    assert data["passed"] is False and data["checks"][1]["utilisation"] == pytest.approx(2.0)
+    assert json.loads(json.dumps(data)) == data
+    none = check_design(times, x, pressure, settlement, tilt)
+    assert none.passed is None and none.failures == ()
+    zero = check_design(times, x, pressure, settlement, tilt, DesignLimits(tilt_limit=0.0))
+    assert zero.check("tilt").utilisation == math.inf and zero.passed is False
+
+
+def test_a_solution_checks_its_scenes_limits() -> None:
+    scene = scene_file("eccentric_creep")
+    scene["times"] = {"end": 100.0, "count": 4}
+    plain = solve(scene)
+    assert plain.design_check() is None and plain.to_dict()["design_check"] is None
+    q_max = float(np.max(plain.pressure_on_grid))
+    tilt = float(np.max(np.abs(plain.tilt)))
+    scene["limits"] = {"allowable_pressure": 1.01 * q_max, "tilt_limit": 0.99 * tilt}
+    result = solve(scene)
+    check = result.design_check()
+    assert check.check("q_max").value == q_max and check.check("q_max").passed
+    assert check.check("tilt").passed is False and check.passed is False
+    assert check.check("settlement").limit is None
+    assert result.to_dict()["design_check"] == check.to_dict()
+    # other limits given in Python win over the scene's
+    assert result.design_check(DesignLimits(tilt_limit=2 * tilt)).passed is True
+
+
+def test_a_study_does_not_vary_the_limits() -> None:
+    scene = edited("limits", {"tilt_limit": 1e-3})
+    study = {"study_version": 1, "name": "limits", "scene": scene,
+             "vary": [{"field": "limits.tilt_limit", "values": [1e-3, 2e-3]}]}
+    with pytest.raises(ValueError, match=r"^vary\[0\]\.field: 'limits\.tilt_limit' cannot be "
+                                         r"varied .*limits do not change an answer"):
+        study_from_dict(study)
