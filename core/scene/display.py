@@ -178,14 +178,17 @@ def html_summary(result: SceneSolution) -> str:
 
 
 def solver_settings(result: SceneSolution) -> dict[str, Any]:
-    """The scene's ``solver`` section and what the solver chose: the engine, the contact
-    and coating models, the sizes of its discretization."""
+    """The scene's ``solver`` settings (defaults filled in) and what the solver chose: the
+    engine (``method``), the contact model that answered (``contact_model``: the
+    setting ``contact`` may be ``"auto"``), the coating model, its discretization."""
     settings: dict[str, Any] = scene_solver_settings(result.scene)
     info = result.info
-    for name in ("method", "contact", "coating_model", "basis", "n_modes", "n_nodes",
-                 "n_panels", "n_steps", "fallback"):
+    chosen = {"method": "method", "contact": "contact_model", "coating_model": "coating_model",
+              "basis": "basis", "n_modes": "n_modes", "n_nodes": "n_nodes",
+              "n_panels": "n_panels", "n_steps": "n_steps", "fallback": "fallback"}
+    for name, key in chosen.items():
         if name in info:
-            settings[name] = info[name]
+            settings[key] = info[name]
     return _jsonable(settings)
 
 

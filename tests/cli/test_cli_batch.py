@@ -70,7 +70,9 @@ def test_solve_from_stdin_to_stdout_records_version_scene_and_settings() -> None
     data = json.loads(proc.stdout)
     assert list(data)[:4] == ["format", "program", "version", "solver"]
     assert data["version"] == core.__version__ and data["program"] == "coated-punch"
-    assert data["solver"] == {"tol": 1e-6, "model_tol": 0.02, "contact": "auto"}
+    settings = {"tol": 1e-6, "model_tol": 0.02, "contact": "auto"}
+    assert {k: data["solver"][k] for k in settings} == settings
+    assert data["solver"]["contact_model"] == "full" and data["solver"]["method"] == "nystrom"
     assert data["scene"] == scene_from_dict(scene).to_dict()
     assert data["design_check"]["passed"] is True
     assert len(data["times"]) == 4

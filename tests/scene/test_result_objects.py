@@ -130,7 +130,7 @@ def test_to_xarray_dims_units_and_metadata(lift_off: SceneSolution) -> None:
     assert scene_from_dict(json.loads(attrs["scene"])) == lift_off.scene
     settings = json.loads(attrs["solver_settings"])
     assert settings["tol"] == 1e-4 and settings["model_tol"] == 0.02
-    assert settings["contact"] == "unilateral"
+    assert settings["contact"] == "auto" and settings["contact_model"] == "unilateral"
     assert attrs["flags"] == "" and attrs["error_estimate"] == lift_off.info["error_estimate"]
     assert attrs["model_error_estimate"] == lift_off.model_error["estimate"]
 
