@@ -10,7 +10,9 @@ No figure on these pages is typed by hand:
   its own estimate at each ``tol``, per scene;
 - ``.. reference-agreement::`` (``work_precision.json``): how far the independent
   reference answers of the work-precision scenes agree with the cross-check;
-- ``.. engine-goals::`` (``engines.json``): the speed goals' measured figures.
+- ``.. engine-goals::`` (``engines.json``): the speed goals' measured figures;
+- ``.. report-section:: FILE.md`` with the heading as content: one section of a report,
+  shown where it is needed (its text as the report has it; for Markdown pages).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import Any
 
 from docutils import nodes
 from docutils.parsers.rst import directives
+from docutils.statemachine import StringList
 from sphinx.application import Sphinx
 from sphinx.util.docutils import SphinxDirective
 
@@ -212,23 +215,24 @@ def _metadata_of(path: Path) -> dict[str, str]:
 
 
 class EngineAccuracy(_ResultsDirective):
+    """Per scene and ``tol``: the measured error / the estimate (a failed solve marked)."""
+
     default_file = "engines.json"
 
     def run(self) -> list[nodes.Node]:
         data = self.load()
+        tols = sorted({run["tol"] for scene in data["scenes"] for run in scene["runs"]
+                       if run["method"] == "nystrom"}, reverse=True)
         rows = []
         for scene in data["scenes"]:
+            cells = dict.fromkeys(tols, "-")
             for run in scene["runs"]:
-                if run["method"] != "nystrom":
-                    continue
-                error, estimate = run["error"], run["estimate"]
-                ratio = "-" if not error else f"{estimate / error:.2g}"
-                rows.append([scene["title"], f"{run['tol']:.0e}", _sci(error),
-                             _sci(run.get("interior_error")), _sci(estimate), ratio,
-                             "yes" if run["success"] else "no"])
-        headers = ["scene", "tol", "measured error", "interior q error", "estimate",
-                   "estimate / error", "success"]
-        return [self.source_note(), _table(headers, rows)]
+                if run["method"] == "nystrom":
+                    mark = "" if run["success"] else " (failed)"
+                    cells[run["tol"]] = f"{_sci(run['error'])} / {_sci(run['estimate'])}{mark}"
+            rows.append([scene["title"]] + [cells[tol] for tol in tols])
+        headers = ["scene"] + [f"tol {tol:.0e}" for tol in tols]
+        return [self.source_note(), _table(headers, rows, widths=[3] + [2] * len(tols))]
 
 
 class ReferenceAgreement(_ResultsDirective):
@@ -289,6 +293,39 @@ class ReportIndex(SphinxDirective):
         return [_table(headers, rows, widths=[3, 5, 2, 2, 2, 6])]
 
 
+class ReportSection(SphinxDirective):
+    required_arguments = 1
+    has_content = True
+
+    def run(self) -> list[nodes.Node]:
+        path = RESULTS / self.arguments[0]
+        self.env.note_dependency(str(path))
+        text = path.read_text(encoding="utf-8")
+        heading = " ".join(self.content).strip()
+        lines = text.splitlines()
+        start = level = None
+        for i, line in enumerate(lines):
+            m = _HEADING.match(line)
+            if m and m.group(2).strip() == heading:
+                start, level = i + 1, len(m.group(1))
+                break
+        if start is None or level is None:
+            raise self.error(f"{self.arguments[0]} has no heading {heading!r}")
+        end = len(lines)
+        for i in range(start, len(lines)):
+            m = _HEADING.match(lines[i])
+            if m and len(m.group(1)) <= level:
+                end = i
+                break
+        note = nodes.paragraph()
+        note += nodes.Text("From ")
+        note += _page_link(self.env.docname, path.stem, f"benchmarks/results/{path.name}")
+        note += nodes.Text(f", section \u201c{heading}\u201d:")
+        container = nodes.container(classes=["report-section"])
+        self.state.nested_parse(StringList(lines[start:end], str(path)), 0, container)
+        return [note, container]
+
+
 def _page_link(from_doc: str, stem: str, text: str) -> nodes.Node:
     from sphinx.addnodes import pending_xref
 
@@ -305,4 +342,5 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.add_directive("engine-accuracy", EngineAccuracy)
     app.add_directive("reference-agreement", ReferenceAgreement)
     app.add_directive("engine-goals", EngineGoals)
+    app.add_directive("report-section", ReportSection)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
