@@ -117,7 +117,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         Naming the argument on bad input: ``method`` for an unknown engine, an option the
         chosen engine does not take, and ``force`` or ``moment`` with ``contact``
         ``"auto"`` or ``"unilateral"`` when the loads leave no contact (P < 0, P = 0
-        throughout, |M/P| >= 1: :func:`core.contact.refuse_loads_without_contact`).
+        throughout, ``|M/P| >= 1``: :func:`core.contact.refuse_loads_without_contact`).
     """
     contact = check_contact_model(contact)
     if contact != "full":

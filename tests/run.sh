@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Installs everything the test suite needs, then runs the whole suite.
+# Installs everything the test suite needs, then runs the whole suite and builds the
+# documentation.
 # Usage (from the repository root):  bash tests/run.sh [pytest args]
-# Without arguments the whole suite runs in two halves at once (see below); with arguments
-# one pytest run gets them (e.g. bash tests/run.sh tests/scene/test_scene.py -x).
+# Without arguments the whole suite runs in two halves at once and the documentation is
+# built beside them (see below); with arguments one pytest run gets them (e.g.
+# bash tests/run.sh tests/scene/test_scene.py -x) and the documentation is not built.
 # SKIP_SETUP=1 skips the installation (an environment already set up).
 #
 # This script runs every test. For a quick loop while working, the unit tests alone (the
@@ -13,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 if [ "${SKIP_SETUP:-0}" != "1" ]; then
-    python -m pip install --quiet --disable-pip-version-check -e ".[test]"
+    python -m pip install --quiet --disable-pip-version-check -e ".[test,docs]"
 
     # The browser tests drive Debian's Chromium (a browser download by the test tool
     # itself does not work on these machines).
@@ -54,15 +56,41 @@ work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
 python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
     >"$work/browser.log" 2>&1 &
 browser_pid=$!
-# (kill fails once the half has ended: no status of its own may reach the exit code)
-trap 'kill "$browser_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
+
+# The documentation (docs/, Sphinx): built here so that it cannot rot. Warnings are errors
+# (-W), so a renamed API, a broken docstring, a moved report or link, or a gallery example
+# that no longer runs fails the run. Always from an empty build directory: an incremental
+# build would not repeat the warnings of pages it skips. It runs beside the two halves
+# (~30 s of one core; measured in docs/conf.py's docstring). The pages stay in
+# DOCS_BUILD_DIR (default ${TMPDIR:-/tmp}/coated-punch-docs, outside the source tree):
+# open index.html there.
+docs_dir="${DOCS_BUILD_DIR:-${TMPDIR:-/tmp}/coated-punch-docs}"
+build_docs() {
+    local start=$SECONDS
+    # only a former build is removed (Sphinx leaves .buildinfo in it)
+    if [ -e "$docs_dir" ] && [ ! -f "$docs_dir/.buildinfo" ]; then
+        echo "DOCS_BUILD_DIR=$docs_dir exists and is not a Sphinx build: not removing it"
+        return 1
+    fi
+    rm -rf "$docs_dir"
+    python -m sphinx -W --keep-going -q -b html docs "$docs_dir" &&
+        echo "built in $((SECONDS - start)) s: $docs_dir/index.html"
+}
+build_docs >"$work/docs.log" 2>&1 &
+docs_pid=$!
+# (kill fails once a job has ended: no status of its own may reach the exit code)
+trap 'kill "$browser_pid" "$docs_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
 set +e
 python -m pytest -q -m "not browser" --basetemp "$work/rest" -o cache_dir=.pytest_cache/rest
 rest=$?
 wait "$browser_pid"
 browser=$?
+wait "$docs_pid"
+docs=$?
 set -e
+echo "---- documentation (sphinx -W) ----"
+cat "$work/docs.log"
 echo "---- browser tests (pytest -m browser) ----"
 cat "$work/browser.log"
-echo "---- exit codes: rest $rest, browser $browser ----"
-[ "$rest" -eq 0 ] && [ "$browser" -eq 0 ]
+echo "---- exit codes: rest $rest, browser $browser, docs $docs ----"
+[ "$rest" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$docs" -eq 0 ]

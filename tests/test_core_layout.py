@@ -87,12 +87,16 @@ def test_parts_import_each_other_only_through_their_apis() -> None:
 
 def test_the_public_names_the_readmes_use_resolve() -> None:
     """``core.solve``, ``from core import solve_dimensionless``, ... in the README, the
-    guide and the scene guide stay working through every move of the code."""
+    scene guide, the documentation's pages and its gallery stay working through every
+    move of the code."""
     import importlib
 
     core = importlib.import_module("core")
-    text = "".join((CORE.parent / name).read_text(encoding="utf-8")
-                   for name in ("README.md", "core/SCENES.md", "docs/guide.md"))
+    root = CORE.parent
+    sources = [root / "README.md", root / "core/SCENES.md", *sorted(root.glob("docs/*.md")),
+               *sorted(root.glob("docs/guides/*.md")), *sorted(root.glob("docs/examples/*.py"))]
+    assert root / "docs/guide.md" in sources
+    text = "".join(path.read_text(encoding="utf-8") for path in sources)
     names = set(re.findall(r"\bcore\.([a-z_]\w*)\(", text))
     for line in re.findall(r"from core import ([\w, ]+)", text):
         names |= {n.strip() for n in line.split(",")}
