@@ -1,8 +1,10 @@
-"""The command line: ``python -m core solve SCENE.json``, ``python -m core validate FILE``
-(a scene or a study file), ``python -m core sweep STUDY.json --output RESULT.nc`` (a
-design study, see :mod:`core.study.run`), ``python -m core check SCENE.json`` (the
-coating model against resolved finite elements) and ``python -m core schema scene|study``
-(the JSON Schema of the files); ``python -m core --version``.
+"""The command line ``coated-punch`` (also ``python -m core``): ``solve SCENE.json``,
+``validate FILE`` (a scene or a study file), ``report SCENE.json -o REPORT.pdf`` (the
+printable report, HTML or PDF: :mod:`core.report`), ``sweep STUDY.json --output
+RESULT.nc`` (a design study, see :mod:`core.study.run`), ``check SCENE.json`` (the
+coating model against resolved finite elements) and ``schema scene|study`` (the JSON
+Schema of the files); ``--version``. A scene or study argument may name a shipped one as
+``preset:NAME`` (:mod:`core.presets`).
 
 ``solve`` writes the solution to ``--output`` (``.json``: everything, see
 :meth:`core.scene.SceneSolution.to_dict`, with the contact set per time and the design
@@ -40,7 +42,15 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from core.files import atomic_write_text, read_regular_file, same_file, writable_target
+from core.files import (
+    atomic_write_bytes,
+    atomic_write_text,
+    read_regular_file,
+    same_file,
+    writable_target,
+)
+from core.optional import MissingDependency
+from core.presets import preset_names
 from core.problem import QUANTITIES
 from core.scene import (
     MAX_SCENE_BYTES,
@@ -318,6 +328,42 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     return _strict_verdict(result) if args.strict else EXIT_OK
 
 
+def _cmd_report(args: argparse.Namespace) -> int:
+    output = Path(args.output)
+    stdout = str(output) == STDIO
+    fmt = args.format or ("pdf" if output.suffix.lower() == ".pdf" else "html")
+    if not stdout and output.suffix.lower() not in (".html", ".htm", ".pdf"):
+        raise _InputError(f"--output: {output}: a report is .html or .pdf")
+    _check_outputs(args.scene, [("--output", output)])
+    scene = _read(args.scene)
+    try:
+        result = solve(scene)
+    except (ArithmeticError, ValueError, RuntimeError, MemoryError,
+            NotImplementedError) as exc:
+        print(f"error: solve: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_SOLVER_FAILED
+    # imported here: the report loads HoloViews and Bokeh (or Matplotlib), ~2 s
+    from core.report import report_html, report_pdf
+
+    if fmt == "pdf":
+        data = report_pdf(result)
+        if stdout:
+            sys.stdout.buffer.write(data)
+            sys.stdout.flush()
+        else:
+            try:
+                atomic_write_bytes(output, data)
+            except ValueError as exc:
+                raise _InputError(str(exc)) from None
+            except OSError as exc:
+                raise _InputError(f"{output}: cannot write ({exc.strerror or exc})") from None
+    else:
+        _write(output, report_html(result))
+    for name in result.flags:
+        print(f"warning: {name}: {_one_line(result.flag_messages[name])}", file=sys.stderr)
+    return _strict_verdict(result) if args.strict else EXIT_OK
+
+
 def _cmd_schema(args: argparse.Namespace) -> int:
     if args.kind == "study":
         from core.study import study_json_schema
@@ -396,18 +442,27 @@ def _cmd_check(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+#: Where the file formats are documented: ``SCENES.md``, shipped in the package.
+FORMAT_DOC = str(Path(__file__).resolve().parent / "SCENES.md")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``python -m core``."""
-    parser = _Parser(prog="python -m core",
+    parser = _Parser(prog="coated-punch",
                      description="Contact of a rigid punch on a coated, aging viscoelastic "
-                                 "layer (scene files: see core/SCENES.md).")
+                                 "layer. A scene is a JSON file, '-' (standard input) or "
+                                 "preset:NAME, one of the shipped presets ("
+                                 + ", ".join(preset_names()) + ").",
+                     epilog=f"The file formats: {FORMAT_DOC} (installed with the package); "
+                            "'coated-punch schema scene' prints the JSON Schema.")
     parser.add_argument("--version", action="version", version=f"coated-punch {VERSION}")
     sub = parser.add_subparsers(dest="command",
-                                metavar="{solve,validate,sweep,check,schema}",
+                                metavar="{solve,validate,report,sweep,check,schema}",
                                 parser_class=_Parser)
     sub.required = True
     p_solve = sub.add_parser("solve", help="solve a scene and write the result")
-    p_solve.add_argument("scene", help="scene file (JSON); '-' reads standard input")
+    p_solve.add_argument("scene", help="scene file (JSON), '-' (standard input) or "
+                                       "preset:NAME")
     p_solve.add_argument("--output", "-o", metavar="PATH",
                          help="result file: .json (everything) or .csv (histories of "
                               "settlement [m], tilt [rad], force [N/m], moment [N]); '-' "
@@ -428,13 +483,27 @@ def build_parser() -> argparse.ArgumentParser:
     p_validate.add_argument("file", help="scene or study file (JSON); '-' reads standard "
                                          "input")
     p_validate.set_defaults(run=_cmd_validate)
+    p_report = sub.add_parser("report", help="solve a scene and write the printable report "
+                                             "(HTML or PDF)")
+    p_report.add_argument("scene", help="scene file (JSON), '-' (standard input) or "
+                                        "preset:NAME")
+    p_report.add_argument("--output", "-o", metavar="PATH", required=True,
+                          help="report file: .html (self-contained, Bokeh plots) or .pdf; "
+                               "'-' writes to standard output (--format, default html)")
+    p_report.add_argument("--format", choices=("html", "pdf"),
+                          help="format of --output (default: from its extension)")
+    p_report.add_argument("--strict", action="store_true",
+                          help=f"exit with {EXIT_DESIGN_FAILED} when a limit is exceeded, "
+                               f"{EXIT_FLAGGED} when the answer is flagged (the report is "
+                               "written all the same)")
+    p_report.set_defaults(run=_cmd_report)
     p_schema = sub.add_parser("schema", help="print the JSON Schema of scene or study files")
     p_schema.add_argument("kind", nargs="?", choices=tuple(SCHEMA_FILES), default="scene",
                           help="which files (default: scene)")
     p_schema.set_defaults(run=_cmd_schema)
-    p_sweep = sub.add_parser("sweep", help="run a design study (core/SCENES.md, "
-                                           "'Study files') on Dask")
-    p_sweep.add_argument("study", help="study file (JSON)")
+    p_sweep = sub.add_parser("sweep", help="run a design study (format: 'Study files' in "
+                                           "the file formats) on Dask")
+    p_sweep.add_argument("study", help="study file (JSON) or preset:NAME")
     p_sweep.add_argument("--output", "-o", metavar="PATH", required=True,
                          help="result file: .nc (xarray dataset), .csv or .parquet (a row "
                               "per point and time)")
@@ -452,7 +521,7 @@ def build_parser() -> argparse.ArgumentParser:
     p_sweep.set_defaults(run=_cmd_sweep)
     p_check = sub.add_parser("check", help="model error of the fast answer against a "
                                            "resolved finite-element model of the coating")
-    p_check.add_argument("scene", help="scene file (JSON)")
+    p_check.add_argument("scene", help="scene file (JSON) or preset:NAME")
     p_check.add_argument("--time", type=float, default=0.0, metavar="DAYS",
                          help="days after loading: base modulus and given loads (default 0)")
     p_check.add_argument("--level", type=int, choices=(0, 1), default=0,
@@ -469,6 +538,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except _InputError as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except MissingDependency as exc:
+        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_SOLVER_FAILED
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130

@@ -82,13 +82,25 @@ def accuracy_rows(result: SceneSolution) -> list[tuple[str, str]]:
     ]
 
 
-def design_rows(result: SceneSolution) -> Section | None:
+def _check_line(line: Any) -> str:
+    """A design-check line without its label: value, where, limit, utilisation, verdict."""
+    where = f"t = {_number(line.time)} d" + ("" if line.x is None else
+                                              f", x = {_number(line.x)} m")
+    text = f"{_number(line.value)} {line.unit} at {where}"
+    if line.limit is None:
+        return text + "; no limit set"
+    verdict = "pass" if line.passed else "FAIL"
+    return (f"{text}; limit {_number(line.limit)} {line.unit}, utilisation "
+            f"{line.utilisation:.3g}: {verdict}")
+
+
+def design_section(result: SceneSolution) -> Section | None:
     """The design check against the scene's limits, or None when the scene sets none."""
     check = result.design_check()
     if check is None:
         return None
-    rows = [(item.name, item.describe()) for item in check.items]
-    failed = not check.passed
+    rows = [(line.label, _check_line(line)) for line in (*check.checks, check.q_min)]
+    failed = check.passed is False
     return Section("Design check", "A limit is exceeded." if failed else
                    "Every limit the scene sets holds.", rows, tone="bad" if failed else "good")
 
@@ -114,7 +126,7 @@ def sections(result: SceneSolution) -> list[Section]:
     else:
         out.append(Section("Validity", "No validity flag: the model stands behind this "
                            "result.", tone="good"))
-    design = design_rows(result)
+    design = design_section(result)
     if design is not None:
         out.append(design)
     out.append(Section("Results", rows=key_numbers(result)))

@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import os
 import textwrap
+import warnings
 
 from core.optional import import_optional
 from core.report.content import scene_json, sections
@@ -72,9 +73,13 @@ def report_pdf(result: SceneSolution) -> bytes:
         _text_pages(pdf, plt, _text_lines(result))
         layout = result.plot().cols(2).opts(fig_inches=PAGE[0] - 1.5, sublabel_format="",
                                             backend="matplotlib")
-        layout = layout.map(lambda span: span.opts(facecolor=LIFT_OFF_COLOUR, alpha=0.5,
-                                                   backend="matplotlib"), hv.VSpan)
-        figure = hv.render(layout, backend="matplotlib")
+        layout = layout.map(lambda span: span.opts(
+            facecolor=LIFT_OFF_COLOUR, alpha=0.5, backend="matplotlib"), hv.VSpan)
+        with warnings.catch_warnings():
+            # once the same layout was drawn by Bokeh (the HTML report), HoloViews hands
+            # Matplotlib's span a colour beside its face colour; the face colour wins
+            warnings.filterwarnings("ignore", message="Setting the 'color' property")
+            figure = hv.render(layout, backend="matplotlib")
         # the plots' titles are Bokeh options; the same words here
         for axes, title in zip(figure.axes, PLOT_TITLES, strict=False):
             axes.set_title(title, fontsize=10)

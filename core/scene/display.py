@@ -10,13 +10,13 @@ missing one raises ``ImportError`` naming the extra to install.
 from __future__ import annotations
 
 import html
-import importlib
 import json
 import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from core.optional import import_optional
 from core.scene.files import scene_to_json
 from core.scene.records import solver_settings as scene_solver_settings
 from core.scene.schema import SCHEMA_VERSION, _jsonable
@@ -31,8 +31,6 @@ if TYPE_CHECKING:
 
     from core.scene.results import SceneSolution
 
-#: The pip extra that brings xarray and pandas.
-DATA_EXTRA = "coated-punch[data]"
 #: A contact set narrower than ``(1 - LIFT_OFF_SHARE) * 2a`` is reported as lift-off: a
 #: unilateral answer in full contact holds ``[(-a, a)]`` exactly (measured on the lift-off
 #: preset at e = 0.41 m, back in full contact by 1000 days), so this only absorbs rounding.
@@ -52,15 +50,6 @@ SHOWN: tuple[tuple[str, float, str], ...] = (
     ("force", 1e-3, "kN/m"),
     ("moment", 1e-3, "kN m/m"),
 )
-
-
-def optional_import(name: str, purpose: str, extra: str = DATA_EXTRA) -> Any:
-    """Import ``name`` or raise ``ImportError`` saying what needs it and how to install it."""
-    try:
-        return importlib.import_module(name)
-    except ImportError as exc:
-        raise ImportError(f"{purpose} needs {name}, which is not installed: "
-                          f'pip install "{extra}"') from exc
 
 
 def _number(value: float) -> str:
@@ -221,7 +210,7 @@ def to_xarray(result: SceneSolution) -> xarray.Dataset:
     """``result`` as an ``xarray.Dataset`` over ``time`` [day] and ``x`` [m]: the pressure
     q(x, t) [Pa], the histories, the contact width [m] when the answer has contact sets;
     units and long names in each variable's attributes, :func:`metadata` in the dataset's."""
-    xr = optional_import("xarray", "SceneSolution.to_xarray")
+    xr = import_optional("xarray", "SceneSolution.to_xarray")
     coords = {"time": ("time", result.times.copy(),
                        {"units": "day", "long_name": "time after loading"}),
               "x": ("x", result.x.copy(),
@@ -243,7 +232,7 @@ def to_dataframe(result: SceneSolution) -> pandas.DataFrame:
     """The histories as a ``pandas.DataFrame`` indexed by ``time`` [day]: settlement [m],
     tilt [rad], force [N/m], moment [N] (and contact_width [m]); ``attrs`` hold
     :func:`metadata` and ``units`` (column to unit)."""
-    pd = optional_import("pandas", "SceneSolution.to_dataframe")
+    pd = import_optional("pandas", "SceneSolution.to_dataframe")
     columns = {name: np.array(getattr(result, name)) for name in HISTORIES}
     units = {name: unit for name, (unit, _, _) in HISTORIES.items()}
     widths = contact_width(result)

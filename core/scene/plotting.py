@@ -15,7 +15,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from core.scene.display import lifts_off, optional_import, zones_text
+from core.optional import import_optional
+from core.scene.display import lifts_off, zones_text
 
 if TYPE_CHECKING:
     import holoviews
@@ -41,7 +42,7 @@ LIFT_OFF_COLOUR = "#d9d9d9"
 def _holoviews() -> Any:
     """HoloViews with its Bokeh backend registered (no notebook output, unlike
     ``hv.extension``, and the current backend is left as it was)."""
-    hv = optional_import("holoviews", "SceneSolution.plot", extra="coated-punch")
+    hv = import_optional("holoviews", "SceneSolution.plot")
     if "bokeh" not in hv.Store.renderers:
         importlib.import_module("holoviews.plotting.bokeh")
     return hv

@@ -146,8 +146,8 @@ def test_missing_file(tmp_path: Path):
 
 def test_bad_arguments(tmp_path: Path):
     assert_one_line_error(run_cli("solve", subprocess=True),
-                          "python -m core solve: the following arguments")
-    assert_one_line_error(run("frobnicate"), "python -m core: argument")
+                          "coated-punch solve: the following arguments")
+    assert_one_line_error(run("frobnicate"), "coated-punch: argument")
     assert_one_line_error(run("solve", SCENES / "uniform_flat.json", "-o", tmp_path / "r.txt"),
                           "--output: unsupported extension '.txt'")
 

@@ -167,8 +167,8 @@ def test_a_missing_data_library_names_the_extra(full: SceneSolution,
                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "xarray", None)
     monkeypatch.setitem(sys.modules, "pandas", None)
-    with pytest.raises(ImportError, match=r'to_xarray needs xarray.*pip install '
-                                          r'"coated-punch\[data\]"'):
+    with pytest.raises(ImportError, match=r"to_xarray needs xarray.*pip install "
+                                          r"'coated-punch\[data\]'"):
         full.to_xarray()
     with pytest.raises(ImportError, match=r"to_dataframe needs pandas"):
         full.to_dataframe()
