@@ -29,6 +29,9 @@ EXTRA_OF: dict[str, str] = {
 DISTRIBUTION_OF: dict[str, str] = {"skfem": "scikit-fem"}
 
 
+__all__ = ["DISTRIBUTION_OF", "EXTRA_OF", "MissingDependency", "import_optional"]
+
+
 class MissingDependency(ImportError):
     """An optional package a feature needs is not installed."""
 

@@ -31,6 +31,9 @@ PACKAGES = (
     "core.coating",
     "core.engines",
     "core.problem",
+    "core.report",
+    "core.presets",
+    "core.optional",
     "core",
 )
 OUT_DIR = Path("api") / "packages"

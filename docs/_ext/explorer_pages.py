@@ -1,6 +1,6 @@
 """The teacher's lists, read from the files the explorer reads: no copy to go stale.
 
-- ``.. preset-list::``: the explorer's preset scenes (``assets/scenes/``) in its order,
+- ``.. preset-list::``: the explorer's preset scenes (``core/presets/scenes/``) in its order,
   each with its key (for ``/app?preset=KEY``), name and description;
 - ``.. lesson-list::``: the explorer's lessons, step by step, with the notes the class
   sees (their numbers are the solver's, checked by the tests).
@@ -15,7 +15,8 @@ from docutils import nodes
 from sphinx.application import Sphinx
 from sphinx.util.docutils import SphinxDirective
 
-SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
+ROOT = Path(__file__).resolve().parents[2]
+SCENES = ROOT / "core" / "presets" / "scenes"
 
 
 class PresetList(SphinxDirective):
@@ -45,7 +46,7 @@ class LessonList(SphinxDirective):
     def run(self) -> list[nodes.Node]:
         from explorer.model import lessons
 
-        self.env.note_dependency(str(SCENES.parents[1] / "explorer" / "model" / "lessons.py"))
+        self.env.note_dependency(str(ROOT / "explorer" / "model" / "lessons.py"))
         out: list[nodes.Node] = []
         for lesson in lessons().values():
             head = nodes.paragraph()

@@ -8,16 +8,13 @@ concrete creeps and, still young, hardens: fastest in the first weeks, which a l
 time axis shows best.
 """
 
-import json
-from pathlib import Path
 
 import matplotlib.pyplot as plt
 
 import core
+from core.presets import read_preset
 
-SCENES = Path(core.__file__).resolve().parents[1] / "assets" / "scenes"
-
-spec = json.loads((SCENES / "young_concrete_50_years.json").read_text())
+spec = read_preset("young_concrete_50_years")
 creeping = core.solve(core.scene_from_dict(spec))
 print(creeping.scene.name, "| flags:", creeping.flags,
       "| error estimate:", f"{creeping.info['error_estimate']:.1e}")

@@ -8,16 +8,13 @@ the unilateral problem (q >= 0, an unknown contact zone) instead. As the concret
 creeps, the zone in contact grows and the peak under the toe rises.
 """
 
-from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 
 import core
 
-SCENES = Path(core.__file__).resolve().parents[1] / "assets" / "scenes"
-
-result = core.solve(core.load_scene(SCENES / "eccentric_footing_liftoff.json"))
+result = core.solve(core.load_scene("preset:eccentric_footing_liftoff"))
 print("contact model:", result.info["contact"], "| flags:", result.flags)
 for k in (0, len(result.times) - 1):
     (start, end), = result.contact_set[k]

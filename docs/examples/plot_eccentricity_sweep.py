@@ -9,17 +9,14 @@ the whole base is in contact, and faster once the heel lifts off; the width in c
 falls from the full 2 m.
 """
 
-import json
-from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 
 import core
+from core.presets import read_preset
 
-SCENES = Path(core.__file__).resolve().parents[1] / "assets" / "scenes"
-
-spec = json.loads((SCENES / "eccentric_footing_liftoff.json").read_text())
+spec = read_preset("eccentric_footing_liftoff")
 spec["times"] = {"end": 1.0, "count": 1, "spacing": "linear"}  # the first day only
 force = spec["loading"]["force"]  # [N/m]
 

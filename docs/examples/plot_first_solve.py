@@ -7,16 +7,14 @@ with its error estimate and validity flags, and draw the contact pressure q(x) [
 under the punch at loading and at the last output time.
 """
 
-from pathlib import Path
 
 import matplotlib.pyplot as plt
 
 import core
 
 # the preset scenes of the checkout this core comes from
-SCENES = Path(core.__file__).resolve().parents[1] / "assets" / "scenes"
 
-scene = core.load_scene(SCENES / "uniform_flat.json")
+scene = core.load_scene("preset:uniform_flat")
 result = core.solve(scene)
 
 print(f"settlement at loading {result.settlement[0] * 1e3:.4f} mm, "

@@ -10,16 +10,14 @@ step is drawn for comparison.
 """
 
 import json
-from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 
 import core
+from core.presets import read_preset
 
-SCENES = Path(core.__file__).resolve().parents[1] / "assets" / "scenes"
-
-spec = json.loads((SCENES / "stepped_punch.json").read_text())
+spec = read_preset("stepped_punch")
 print("punch shape:", json.dumps(spec["punch"]["shape"]))
 stepped = core.solve(core.scene_from_dict(spec))
 flat = core.solve(core.scene_from_dict({**spec, "punch": {**spec["punch"], "shape": 0.0}}))
