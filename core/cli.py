@@ -50,7 +50,7 @@ from core.files import (
     writable_target,
 )
 from core.optional import MissingDependency
-from core.presets import preset_names
+from core.presets import PRESET_PREFIX, preset_names, shipped_file, study_names
 from core.problem import QUANTITIES
 from core.scene import (
     MAX_SCENE_BYTES,
@@ -235,7 +235,19 @@ def _csv_head(result: SceneSolution, what: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _shipped_scene_or_study(path: str) -> str:
+    """The file of ``preset:NAME``, a shipped scene or else a shipped study."""
+    if not path.startswith(PRESET_PREFIX):
+        return path
+    kind = "studies" if path[len(PRESET_PREFIX):] in study_names() else "scenes"
+    try:
+        return str(shipped_file(path, kind))
+    except ValueError as exc:
+        raise _InputError(str(exc)) from None
+
+
 def _cmd_validate(args: argparse.Namespace) -> int:
+    args.file = _shipped_scene_or_study(args.file)
     data = _read_document(args.file)
     study = isinstance(data, dict) and "study_version" in data
     if not study:
@@ -480,8 +492,8 @@ def build_parser() -> argparse.ArgumentParser:
     p_solve.set_defaults(run=_cmd_solve)
     p_validate = sub.add_parser("validate", help="check a scene or study file against its "
                                                  "JSON Schema, then fully")
-    p_validate.add_argument("file", help="scene or study file (JSON); '-' reads standard "
-                                         "input")
+    p_validate.add_argument("file", help="scene or study file (JSON), '-' (standard "
+                                         "input) or preset:NAME")
     p_validate.set_defaults(run=_cmd_validate)
     p_report = sub.add_parser("report", help="solve a scene and write the printable report "
                                              "(HTML or PDF)")

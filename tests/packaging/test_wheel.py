@@ -12,6 +12,7 @@ against the imports in ``test_metadata.py``.
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -73,7 +74,9 @@ def test_the_wheel_carries_the_data_the_code_reads(installed):
         assert f"core/presets/scenes/{name}.json" in names
     for name in study_names():
         assert f"core/presets/studies/{name}.json" in names
-    assert {"core/SCENES.md", "core/coating/error_table.json", "core/py.typed"} <= names
+    assert {"core/SCENES.md", "core/coating/error_table.json", "core/py.typed",
+            "core/scene/schemas/scene.schema.json",
+            "core/scene/schemas/study.schema.json"} <= names
     assert any(n.endswith(".dist-info/licenses/LICENSE") for n in names)
     meta = zipfile.ZipFile(installed["wheel"]).read(
         next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
@@ -89,8 +92,16 @@ def test_the_installed_package_runs_outside_the_checkout(installed):
     assert all(line.startswith(str(installed["venv"])) for line in where.split()), where
     import core
 
-    assert _run(bin_ / "coated-punch-explorer", "--version", cwd=away).strip() \
-        == f"coated-punch {core.__version__}"
+    for script in ("coated-punch", "coated-punch-explorer"):
+        assert _run(bin_ / script, "--version", cwd=away).strip() \
+            == f"coated-punch {core.__version__}"
+    # the format document the help names is installed, and a preset solves by its name
+    usage = "".join(_run(bin_ / "coated-punch", "--help", cwd=away).split())  # unwrapped
+    assert f"{installed['venv']}/lib/" in usage and "/site-packages/core/SCENES.md" in usage
+    solved = json.loads(_run(bin_ / "coated-punch", "solve", "preset:uniform_flat", "-o", "-",
+                             cwd=away))
+    assert solved["version"] == core.__version__
+    assert _run(bin_ / "coated-punch", "validate", "preset:worn_coating", cwd=away)
     script = ("import core; from core.presets import preset_names, read_preset; "
               "print(len(preset_names())); "
               "print(core.solve(read_preset('worn_coating')).settlement[-1])")
