@@ -431,6 +431,10 @@ def study_metadata(study: Study, info: Mapping[str, Any]) -> dict[str, Any]:
     return attrs | dict(info)
 
 
+def _one_line(value: Any) -> str:
+    return " ".join(str(value).split())
+
+
 def _long_rows(study: Study, points: StudyPoints, index: np.ndarray,
                arrays: Mapping[str, np.ndarray] | None, lost: str | None) -> dict[str, Any]:
     """One batch in long form: a row per (point, time)."""
@@ -494,6 +498,10 @@ def _write_long(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[int
             rows = _long_rows(study, points, index, arrays, lost.get(k, "batch missing"))
             if suffix == ".csv":
                 if k == 0:
+                    # what made the table, as the other CSV files of the tool say it
+                    # (``# key: value``; pandas.read_csv(path, comment="#") skips them)
+                    fh.writelines(f"# {key}: {_one_line(value)}\n"
+                                  for key, value in attrs.items())
                     fh.write(",".join(rows) + "\n")
                 columns = [_csv_column(v) for v in rows.values()]
                 fh.writelines(",".join(r) + "\n" for r in zip(*columns, strict=True))

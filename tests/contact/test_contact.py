@@ -637,7 +637,9 @@ def test_cli_writes_the_contact_set(tmp_path: Path):
     assert len(data["contact_set"]) == 2 and len(data["contact_set"][0]) == 1
     csv = tmp_path / "out.csv"
     assert main(["solve", str(scene_path), "--output", str(csv)]) == 0
-    rows = np.loadtxt(csv.read_text().splitlines(), delimiter=",", skiprows=1)
+    # the table after the "# key: value" lines of what made it, and its header
+    table = [line for line in csv.read_text().splitlines() if not line.startswith("#")]
+    rows = np.loadtxt(table, delimiter=",", skiprows=1)
     assert rows.shape == (2, 8)
 
 

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import core
 from core.scene import solve
 from core.study import load_study, numeric_fields, study_from_dict
 from core.study.definition import MAX_STUDY_POINTS, apply_point, parse_path
@@ -494,7 +495,12 @@ def test_cli_sweep_on_the_cluster_writes_each_format(loopback_cluster, tmp_path:
               return_dataset=False)
     ds = xr.open_dataset(tmp_path / "r.nc", engine="scipy")
     assert ds.settlement.attrs["units"] == "m"
-    rows = pd.read_csv(tmp_path / "r.csv").sort_values(["point", "time_day"])
+    head = [line for line in (tmp_path / "r.csv").read_text().splitlines()
+            if line.startswith("# ")]
+    assert f"# version: {core.__version__}" in head
+    assert any(line.startswith("# base_scene: {") for line in head)
+    assert any(line.startswith("# study_definition: {") for line in head)
+    rows = pd.read_csv(tmp_path / "r.csv", comment="#").sort_values(["point", "time_day"])
     assert len(rows) == 12 * 2
     np.testing.assert_array_equal(rows["settlement_m"].to_numpy(),
                                   ds.settlement.values.reshape(-1))
