@@ -309,18 +309,25 @@ def _strict_verdict(result: SceneSolution) -> int:
     return EXIT_OK
 
 
+def _solve(path: str) -> SceneSolution | None:
+    """The answer for the scene at ``path``; None (the reason on stderr) when the solver
+    cannot answer a valid scene, which is not the user's input error."""
+    scene = _read(path)
+    try:
+        return solve(scene)
+    except (ArithmeticError, ValueError, RuntimeError, MemoryError,
+            NotImplementedError) as exc:
+        print(f"error: solve: {_one_line(exc)}", file=sys.stderr)
+        return None
+
+
 def _cmd_solve(args: argparse.Namespace) -> int:
     output = Path(args.output) if args.output else None
     fmt = _output_format("--output", output, args.format)
     pressure_out = Path(args.pressure_csv) if args.pressure_csv else None
     _check_outputs(args.scene, [("--output", output), ("--pressure-csv", pressure_out)])
-    scene = _read(args.scene)
-    try:
-        result = solve(scene)
-    except (ArithmeticError, ValueError, RuntimeError, MemoryError,
-            NotImplementedError) as exc:
-        # a valid scene the solver cannot handle: not the user's input error
-        print(f"error: solve: {_one_line(exc)}", file=sys.stderr)
+    result = _solve(args.scene)
+    if result is None:
         return EXIT_SOLVER_FAILED
     if output is None:
         print(_summary(result))
@@ -347,12 +354,8 @@ def _cmd_report(args: argparse.Namespace) -> int:
     if not stdout and output.suffix.lower() not in (".html", ".htm", ".pdf"):
         raise _InputError(f"--output: {output}: a report is .html or .pdf")
     _check_outputs(args.scene, [("--output", output)])
-    scene = _read(args.scene)
-    try:
-        result = solve(scene)
-    except (ArithmeticError, ValueError, RuntimeError, MemoryError,
-            NotImplementedError) as exc:
-        print(f"error: solve: {_one_line(exc)}", file=sys.stderr)
+    result = _solve(args.scene)
+    if result is None:
         return EXIT_SOLVER_FAILED
     # imported here: the report loads HoloViews and Bokeh (or Matplotlib), ~2 s
     from core.report import report_html, report_pdf

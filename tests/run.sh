@@ -35,7 +35,7 @@ export CI="${CI:-1}"
 # Small dense matrices: BLAS threads only fight each other on 2 cores (10x slower measured).
 export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}"
 
-python -m ruff check core explorer tests benchmarks
+python -m ruff check core explorer tests benchmarks docs
 # The import contracts of pyproject.toml (through python: a new console script may not be
 # on PATH until a shell rehashes).
 python -c 'import sys; from importlinter.cli import lint_imports_command; sys.exit(lint_imports_command())'

@@ -82,24 +82,12 @@ def accuracy_rows(result: SceneSolution) -> list[tuple[str, str]]:
     ]
 
 
-def _check_line(line: Any) -> str:
-    """A design-check line without its label: value, where, limit, utilisation, verdict."""
-    where = f"t = {_number(line.time)} d" + ("" if line.x is None else
-                                              f", x = {_number(line.x)} m")
-    text = f"{_number(line.value)} {line.unit} at {where}"
-    if line.limit is None:
-        return text + "; no limit set"
-    verdict = "pass" if line.passed else "FAIL"
-    return (f"{text}; limit {_number(line.limit)} {line.unit}, utilisation "
-            f"{line.utilisation:.3g}: {verdict}")
-
-
 def design_section(result: SceneSolution) -> Section | None:
     """The design check against the scene's limits, or None when the scene sets none."""
     check = result.design_check()
     if check is None:
         return None
-    rows = [(line.label, _check_line(line)) for line in (*check.checks, check.q_min)]
+    rows = [(line.label, line.verdict_text()) for line in (*check.checks, check.q_min)]
     failed = check.passed is False
     return Section("Design check", "A limit is exceeded." if failed else
                    "Every limit the scene sets holds.", rows, tone="bad" if failed else "good")

@@ -108,10 +108,14 @@ class LimitCheck:
                 "passed": self.passed, "time_day": plain(self.time), "x_m": plain(self.x)}
 
     def describe(self) -> str:
-        """One line for a terminal: value, limit, utilisation, verdict, where."""
+        """One line for a terminal: the label, then :meth:`verdict_text`."""
+        return f"{self.label} {self.verdict_text()}"
+
+    def verdict_text(self) -> str:
+        """Value, where, limit, utilisation and verdict (the report's table cell)."""
         where = f"t = {self.time:.6g} days" + ("" if self.x is None else
                                                 f", x = {self.x:.6g} m")
-        text = f"{self.label} {self.value:.6g} {self.unit} at {where}"
+        text = f"{self.value:.6g} {self.unit} at {where}"
         if self.limit is None:
             return text + ", no limit set"
         verdict = "pass" if self.passed else "FAIL"

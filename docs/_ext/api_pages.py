@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from generated_pages import write_if_changed
 from sphinx.application import Sphinx
 from sphinx.pycode import ModuleAnalyzer
 from sphinx.util import logging
@@ -124,19 +125,13 @@ def _page(package: str, homes: dict[str, str]) -> str:
     return "\n".join(lines)
 
 
-def _write_if_changed(path: Path, text: str) -> None:
-    """Unchanged pages keep their time stamps, so an incremental build skips them."""
-    if path.exists() and path.read_text(encoding="utf-8") == text:
-        return
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text, encoding="utf-8")
 
 
 def generate(app: Sphinx) -> None:
     out = Path(app.srcdir) / OUT_DIR
     homes = _homes()
     for package in PACKAGES:
-        _write_if_changed(out / f"{package}.rst", _page(package, homes))
+        write_if_changed(out / f"{package}.rst", _page(package, homes))
     # a fresh environment listed its documents before these pages were written
     app.env.find_files(app.config, app.builder)
 

@@ -25,6 +25,7 @@ from typing import Any
 from docutils import nodes
 from docutils.parsers.rst import directives
 from docutils.statemachine import StringList
+from generated_pages import write_if_changed
 from sphinx.application import Sphinx
 from sphinx.util.docutils import SphinxDirective
 
@@ -122,12 +123,6 @@ def _cell(value: str) -> str:
         else value.replace("|", "\\|")
 
 
-def _write_if_changed(path: Path, text: str) -> None:
-    if path.exists() and path.read_text(encoding="utf-8") == text:
-        return
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text, encoding="utf-8")
-
 
 def generate(app: Sphinx) -> None:
     out = Path(app.srcdir) / OUT_DIR
@@ -136,7 +131,7 @@ def generate(app: Sphinx) -> None:
         if old.stem not in wanted:
             old.unlink()
     for path in sorted(RESULTS.glob("*.md")):
-        _write_if_changed(out / f"{path.stem}.md", _report_page(path))
+        write_if_changed(out / f"{path.stem}.md", _report_page(path))
     app.env.find_files(app.config, app.builder)
 
 
