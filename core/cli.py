@@ -42,6 +42,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
+import numpy as np
+
 from core.files import (
     atomic_write_bytes,
     atomic_write_text,
@@ -202,7 +204,12 @@ def _summary(result: SceneSolution) -> str:
         for i in rows:
             zones = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in result.contact_set[i])
             lines.append(f"contact at {result.times[i]:g} days: {zones or 'none'} m")
+    q = result.pressure_on_grid
+    i, k = np.unravel_index(int(np.argmax(q)), q.shape)
+    lines.append(f"largest contact pressure q: {q[i, k]:.6g} Pa at x = {result.x[i]:.6g} m, "
+                 f"t = {result.times[k]:.6g} days")
     lines.append(str(result.info.get("message", "")))
+    lines.append(f"flags: {', '.join(result.flags) if result.flags else 'none'}")
     estimate = result.info.get("model_error_estimate")
     if estimate is not None:
         lines.append(f"coating model error ({result.info.get('coating_model')}, estimate): "

@@ -12,6 +12,7 @@ from typing import Any
 
 import pytest
 
+import core
 from core.cli import main as cli_main
 from core.scene import MAX_SCENE_BYTES
 from tests.cli_runs import run_cli
@@ -82,6 +83,10 @@ def test_solve_without_output_prints_a_summary():
     proc = run("solve", SCENES / "rounded_graded.json")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.startswith("solved 'Rounded punch on a graded coating'")
+    result = core.solve(core.load_scene(SCENES / "rounded_graded.json"))
+    peak = result.pressure_on_grid.max()
+    assert f"largest contact pressure q: {peak:.6g} Pa at x = " in proc.stdout
+    assert "flags: none" in proc.stdout
 
 
 def test_validate():
