@@ -346,8 +346,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="three scenes, fewer repeats")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--scenes", nargs="*", default=None)
-    parser.add_argument("--out", type=Path, default=RESULTS)
+    parser.add_argument("--out", type=Path, default=RESULTS, metavar="DIR",
+                        help="folder of the report (engines.md, engines.json and the "
+                             "figures; default benchmarks/results)")
     args = parser.parse_args(argv)
+    if args.out.suffix or (args.out.exists() and not args.out.is_dir()):
+        parser.error(f"--out: {args.out} names a file; give the folder the report's files "
+                     "go to (engines.md, engines.json, the figures)")
     scenes = [s for s in suite() if not s.creeping]
     if args.scenes:
         scenes = [s for s in scenes if s.key in args.scenes]

@@ -1,0 +1,18 @@
+"""The benchmark commands refuse what would write their results in the wrong place."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from benchmarks import engines
+
+
+def test_engines_out_is_a_folder_not_a_file_name(tmp_path: Path, capsys):
+    target = tmp_path / "X.md"
+    with pytest.raises(SystemExit) as stop:
+        engines.main(["--out", str(target)])
+    assert stop.value.code == 2
+    assert "--out: " in capsys.readouterr().err
+    assert not target.exists()  # no folder named like a file
