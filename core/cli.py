@@ -365,10 +365,14 @@ def _cmd_report(args: argparse.Namespace) -> int:
     if result is None:
         return EXIT_SOLVER_FAILED
     # imported here: the report loads HoloViews and Bokeh (or Matplotlib), ~2 s
-    from core.report import report_html, report_pdf
+    from core.report import output_index, report_html, report_pdf
 
+    try:
+        output_index(result, args.time)
+    except ValueError as exc:
+        raise _InputError(f"--{exc}") from None
     if fmt == "pdf":
-        data = report_pdf(result)
+        data = report_pdf(result, args.time)
         if stdout:
             sys.stdout.buffer.write(data)
             sys.stdout.flush()
@@ -380,7 +384,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
             except OSError as exc:
                 raise _InputError(f"{output}: cannot write ({exc.strerror or exc})") from None
     else:
-        _write(output, report_html(result))
+        _write(output, report_html(result, args.time))
     for name in result.flags:
         print(f"warning: {name}: {_one_line(result.flag_messages[name])}", file=sys.stderr)
     return _strict_verdict(result) if args.strict else EXIT_OK
@@ -514,6 +518,10 @@ def build_parser() -> argparse.ArgumentParser:
                                "'-' writes to standard output (--format, default html)")
     p_report.add_argument("--format", choices=("html", "pdf"),
                           help="format of --output (default: from its extension)")
+    p_report.add_argument("--time", type=float, metavar="DAYS",
+                          help="days after loading: the report describes the contact at "
+                               "the output time nearest to it and draws its q(x) (default: "
+                               "the last output time)")
     p_report.add_argument("--strict", action="store_true",
                           help=f"exit with {EXIT_DESIGN_FAILED} when a limit is exceeded, "
                                f"{EXIT_FLAGGED} when the answer is flagged (the report is "

@@ -10,7 +10,10 @@ from typing import Any
 
 import numpy as np
 
-from core.scene import SceneSolution, engine_text
+from core.report.contact import contact_text, lift_off_times, output_index
+from core.report.inputs import SHOWN_UNITS, input_rows
+from core.report.inputs import number as _number
+from core.scene import SceneSolution, contact_width, engine_text
 from core.version import VERSION
 
 
@@ -29,34 +32,49 @@ class Section:
     tone: str = ""
 
 
-def _number(value: float, digits: int = 4) -> str:
-    return f"{value:.{digits}g}" if np.isfinite(value) else "not finite"
-
-
 def _at(times: np.ndarray, values: np.ndarray, pick: str) -> tuple[float, float]:
     """The largest (by magnitude) value of a history and its time [day]."""
     k = int(np.argmax(np.abs(values))) if pick == "abs" else int(np.argmax(values))
     return float(values[k]), float(times[k])
 
 
-def key_numbers(result: SceneSolution) -> list[tuple[str, str]]:
-    """The results in the units an engineer reads: largest over the history, with when."""
+def _shown(value: float, si_unit: str) -> str:
+    """``value`` [``si_unit``] in the unit the report shows it in (:data:`SHOWN_UNITS`)."""
+    unit, size = SHOWN_UNITS[si_unit]
+    return f"{_number(value / size)} {unit}"
+
+
+def key_numbers(result: SceneSolution, time: float | None = None) -> list[tuple[str, str]]:
+    """The results in the units an engineer reads: largest over the history, with when;
+    the contact at ``time`` [day] (default: the last output time) and, when the punch
+    lifts off, when it does and the smallest contact width."""
     t = result.times
     q = result.pressure_on_grid
     k_max = np.unravel_index(int(np.argmax(q)), q.shape)
     settlement, t_s = _at(t, result.settlement, "abs")
     tilt, t_a = _at(t, result.tilt, "abs")
     rows = [
-        ("largest settlement δ", f"{_number(settlement * 1e3)} mm at t = {_number(t_s)} d"),
-        ("largest tilt α", f"{_number(tilt * 1e3)} mrad at t = {_number(t_a)} d"),
-        ("largest contact pressure q", f"{_number(q[k_max] / 1e3)} kPa at x = "
+        ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {_number(t_s)} d"),
+        ("largest tilt α", f"{_shown(tilt, 'rad')} at t = {_number(t_a)} d"),
+        ("largest contact pressure q", f"{_shown(q[k_max], 'Pa')} at x = "
                                        f"{_number(result.x[k_max[0]])} m, t = "
                                        f"{_number(t[k_max[1]])} d"),
-        ("force P at the last time", f"{_number(result.force[-1] / 1e3)} kN/m"),
-        ("moment M at the last time", f"{_number(result.moment[-1] / 1e3)} kN·m/m"),
+        ("force P at the last time", _shown(result.force[-1], "N/m")),
+        ("moment M at the last time", _shown(result.moment[-1], "N")),
     ]
-    if result.info.get("contact") == "unilateral" and result.contact_set:
-        width = [sum(hi - lo for lo, hi in zones) for zones in result.contact_set]
+    force = float(result.force[-1])
+    if force != 0 and np.isfinite(force):
+        rows.append(("eccentricity e = M/P at the last time",
+                     f"{_number(float(result.moment[-1]) / force)} m"))
+    k = output_index(result, time)
+    rows.append((f"contact at t = {_number(t[k])} d", contact_text(result, k)))
+    lifted = lift_off_times(result)
+    if lifted.size:
+        rows.append(("lift-off", f"at {lifted.size} of {len(t)} output times, first at "
+                                 f"t = {_number(t[lifted[0]])} d, last at "
+                                 f"t = {_number(t[lifted[-1]])} d (contact width plotted)"))
+    width = contact_width(result)
+    if result.info.get("contact") == "unilateral" and width is not None:
         k = int(np.argmin(width))
         rows.append(("smallest contact width", f"{_number(width[k])} m of "
                                                f"{_number(2 * result.scene.half_width)} m at "
@@ -78,8 +96,30 @@ def accuracy_rows(result: SceneSolution) -> list[tuple[str, str]]:
          f"{float(result.model_error['estimate']):.1e} (flagged above "
          f"{result.scene.model_tol:g})"),
         ("solved by", engine_text(result)),
+        ("discretization", _discretization(info)),
         ("solver's message", str(info.get("message", ""))),
     ]
+
+
+def _discretization(info: dict[str, Any]) -> str:
+    """The sizes the solver chose (modes, nodes, panels, time steps), as it reported them."""
+    sizes = [f"{info[key]} {word}" for key, word in (
+        ("n_modes", "modes"), ("n_nodes", "nodes"), ("n_panels", "panels"),
+        ("n_steps", "time steps")) if isinstance(info.get(key), (int, float))]
+    return ", ".join(sizes) or "not reported"
+
+
+def _check_line(line: Any) -> str:
+    """A design-check line without its label: value, where, limit, utilisation, verdict,
+    in the units of the results (kPa, mm, mrad)."""
+    where = f"t = {_number(line.time)} d" + ("" if line.x is None else
+                                              f", x = {_number(line.x)} m")
+    text = f"{_shown(line.value, line.unit)} at {where}"
+    if line.limit is None:
+        return text + "; no limit set"
+    verdict = "pass" if line.passed else "FAIL"
+    return (f"{text}; limit {_shown(line.limit, line.unit)}, utilisation "
+            f"{line.utilisation:.3g}: {verdict}")
 
 
 def design_section(result: SceneSolution) -> Section | None:
@@ -87,14 +127,21 @@ def design_section(result: SceneSolution) -> Section | None:
     check = result.design_check()
     if check is None:
         return None
-    rows = [(line.label, line.verdict_text()) for line in (*check.checks, check.q_min)]
+    rows = [(line.label, _check_line(line)) for line in (*check.checks, check.q_min)]
     failed = check.passed is False
     return Section("Design check", "A limit is exceeded." if failed else
                    "Every limit the scene sets holds.", rows, tone="bad" if failed else "good")
 
 
-def sections(result: SceneSolution) -> list[Section]:
-    """The report's sections, in order."""
+def sections(result: SceneSolution, time: float | None = None) -> list[Section]:
+    """The report's sections, in order; ``time`` [day after loading]: the output time
+    nearest to it is the one whose contact the results describe (default: the last).
+
+    Raises
+    ------
+    ValueError
+        When ``time`` is not within the output times (naming ``time``).
+    """
     scene = result.scene
     stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     out = [Section("About", rows=[
@@ -103,8 +150,10 @@ def sections(result: SceneSolution) -> list[Section]:
             q for q in ("settlement", "tilt", "force", "moment") if q in scene.given)
             + " given"),
         ("made by", f"coated-punch {VERSION}, {stamp}"),
-        ("units", "SI; plane strain, per metre out of plane; t in days after loading; "
-                  "compression positive"),
+        ("units", "plane strain, per metre out of plane; x in m from the punch centre; "
+                  "t in days after loading; pressure in kPa, compression positive; "
+                  "settlement mm, tilt mrad, force kN/m, moment kN·m/m; the scene file "
+                  "in SI"),
     ])]
     if result.flags:
         out.append(Section("Validity", "This result is flagged: the model cannot fully "
@@ -117,8 +166,9 @@ def sections(result: SceneSolution) -> list[Section]:
     design = design_section(result)
     if design is not None:
         out.append(design)
-    out.append(Section("Results", rows=key_numbers(result)))
+    out.append(Section("Results", rows=key_numbers(result, time)))
     out.append(Section("Accuracy", rows=accuracy_rows(result)))
+    out.append(Section("Inputs", rows=input_rows(scene)))
     return out
 
 
@@ -127,7 +177,7 @@ def scene_json(result: SceneSolution) -> str:
     return json.dumps(result.scene.to_dict(), indent=1, allow_nan=False)
 
 
-def describe(result: SceneSolution) -> dict[str, Any]:
+def describe(result: SceneSolution, time: float | None = None) -> dict[str, Any]:
     """The report's text as one JSON-able dict (what the tests read)."""
     return {s.title: {"lead": s.lead, "rows": dict(s.rows), "tone": s.tone}
-            for s in sections(result)}
+            for s in sections(result, time)}

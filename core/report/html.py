@@ -1,6 +1,6 @@
-"""The report as one self-contained HTML file: the sections, the plots of
-:meth:`SceneSolution.plot` rendered by Bokeh with its library inline (the file opens and
-prints with no network), and the scene file itself."""
+"""The report as one self-contained HTML file: the sections, the plots
+(:func:`core.report.plots.report_layout`) rendered by Bokeh with its library inline (the
+file opens and prints with no network), and the scene file itself."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import html
 
 from core.optional import import_optional
 from core.report.content import Section, scene_json, sections
+from core.report.plots import report_layout
 from core.scene import SceneSolution
 
 CSS = """
@@ -36,37 +37,49 @@ def _section(section: Section) -> str:
     return "".join(parts) + "</section>"
 
 
-def _plots(result: SceneSolution) -> tuple[str, str]:
+def _plots(result: SceneSolution, time: float | None) -> tuple[str, str]:
     """The plots as (scripts for the page head, the body's markup)."""
     hv = import_optional("holoviews", "the report's plots")
     embed = import_optional("bokeh.embed", "the report's plots")
     resources = import_optional("bokeh.resources", "the report's plots")
-    # two plots a row: the three side by side are wider than a printed page
-    model = hv.render(result.plot().cols(2), backend="bokeh")
-    script, div = embed.components(model)
+    layout, _ = report_layout(result, time)
+    script, div = embed.components(hv.render(layout, backend="bokeh"))
     return resources.INLINE.render() + script, div
 
 
-def report_html(result: SceneSolution) -> str:
+def report_html(result: SceneSolution, time: float | None = None) -> str:
     """The report of ``result`` as a complete HTML document (text).
 
     Parameters
     ----------
     result : SceneSolution
         A solved scene; its limits (if the scene sets any) are checked in the report.
+    time : float, optional
+        A time t [day after loading] the reader chose: the contact at the output time
+        nearest to it is described, and its q(x) drawn (default: the last output time).
 
     Returns
     -------
     str
         The document: validity, design check, key results with units, accuracy, the
-        plots of q(x, t), settlement and tilt, and the scene file.
+        inputs, the plots of q(x, t), settlement and tilt (and of the contact width when
+        the punch lifts off, of the punch base and the coating where they vary), and the
+        scene file.
+
+    Raises
+    ------
+    ValueError
+        When ``time`` is not within the output times.
+    MissingDependency
+        Without HoloViews or Bokeh (the ``report`` extra).
     """
-    head, plots = _plots(result)
+    text = sections(result, time)
+    head, plots = _plots(result, time)
     title = html.escape(str(result.scene.name or "scene"))
-    body = "".join(_section(s) for s in sections(result))
+    body = "".join(_section(s) for s in text)
     return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
             f"<title>Report: {title}</title><style>{CSS}</style>{head}</head><body>"
             f"<h1>Coated punch: {title}</h1>{body}"
             f"<section class='report-plots'><h2>Plots</h2>{plots}</section>"
-            f"<section class='report-scene'><h2>Scene file</h2>"
+            f"<section class='report-scene'><h2>Scene file (SI units)</h2>"
             f"<pre>{html.escape(scene_json(result))}</pre></section></body></html>")

@@ -1,5 +1,6 @@
-"""The report as a PDF: the same sections as the HTML report on A4 pages, and the plots
-of :meth:`SceneSolution.plot` rendered by HoloViews' Matplotlib backend."""
+"""The report as a PDF: the same sections as the HTML report on A4 pages, and the same
+plots (:func:`core.report.plots.report_layout`) rendered by HoloViews' Matplotlib
+backend."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ import warnings
 
 from core.optional import import_optional
 from core.report.content import scene_json, sections
-from core.scene import LIFT_OFF_COLOUR, SceneSolution
+from core.report.plots import matplotlib_layout, report_layout
+from core.scene import SceneSolution
 
 #: A4 portrait [inch].
 PAGE = (8.27, 11.69)
@@ -18,15 +20,14 @@ PAGE = (8.27, 11.69)
 LINES_PER_PAGE = 62
 CHARACTERS_PER_LINE = 100
 COLOURS = {"bad": "#9b1c1c", "good": "#1d6b2c", "": "#222222"}
-#: The titles of the three plots of :meth:`SceneSolution.plot`, in its order.
-PLOT_TITLES = ("contact pressure q(x, t) (grey: lifted off)", "settlement δ(t)", "tilt α(t)")
 
 
-def _text_lines(result: SceneSolution) -> list[tuple[str, str, bool]]:
+def _text_lines(result: SceneSolution,
+                time: float | None) -> list[tuple[str, str, bool]]:
     """(text, tone, bold) lines of the report's sections."""
     lines: list[tuple[str, str, bool]] = [
         (f"Coated punch: {result.scene.name or 'scene'}", "", True), ("", "", False)]
-    for section in sections(result):
+    for section in sections(result, time):
         lines.append((section.title, "", True))
         if section.lead:
             lines.extend((t, section.tone, False)
@@ -50,11 +51,15 @@ def _text_pages(pdf, plt, lines: list[tuple[str, str, bool]], size: float = 8.5)
         plt.close(figure)
 
 
-def report_pdf(result: SceneSolution) -> bytes:
+def report_pdf(result: SceneSolution, time: float | None = None) -> bytes:
     """The report of ``result`` as PDF bytes (the sections, the plots, the scene file).
+
+    ``time`` [day after loading]: as for :func:`core.report.report_html`.
 
     Raises
     ------
+    ValueError
+        When ``time`` is not within the output times.
     MissingDependency
         Without Matplotlib or HoloViews (the ``report`` extra).
     """
@@ -67,37 +72,40 @@ def report_pdf(result: SceneSolution) -> bytes:
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_pdf import PdfPages
 
+    lines = _text_lines(result, time)
+    layout, titles = report_layout(result, time)
     buffer = io.BytesIO()
     with PdfPages(buffer, metadata={"Title": f"Report: {result.scene.name or 'scene'}",
                                     "Creator": "coated-punch"}) as pdf:
-        _text_pages(pdf, plt, _text_lines(result))
-        layout = result.plot().cols(2).opts(fig_inches=PAGE[0] - 1.5, sublabel_format="",
-                                            backend="matplotlib")
-        layout = layout.map(lambda span: span.opts(
-            facecolor=LIFT_OFF_COLOUR, alpha=0.5, backend="matplotlib"), hv.VSpan)
+        _text_pages(pdf, plt, lines)
+        layout = matplotlib_layout(layout.opts(fig_inches=PAGE[0] - 1.5, sublabel_format="",
+                                               backend="matplotlib"))
         with warnings.catch_warnings():
-            # once the same layout was drawn by Bokeh (the HTML report), HoloViews hands
-            # Matplotlib's span a colour beside its face colour; the face colour wins
+            # HoloViews hands Matplotlib's span a colour beside its face colour, and the
+            # colour wins (the face colour alone came out blue once Bokeh had drawn the
+            # same layout): both are the shade (matplotlib_layout)
             warnings.filterwarnings("ignore", message="Setting the 'color' property")
             figure = hv.render(layout, backend="matplotlib")
         # the plots' titles are Bokeh options; the same words here
-        for axes, title in zip(figure.axes, PLOT_TITLES, strict=False):
+        for axes, title in zip(figure.axes, titles, strict=False):
             axes.set_title(title, fontsize=10)
         pdf.savefig(figure, bbox_inches="tight")
         plt.close(figure)
         scene = [(line, "", False) for raw in scene_json(result).splitlines()
                  for line in (textwrap.wrap(raw, CHARACTERS_PER_LINE + 20,
                                             subsequent_indent="      ") or [""])]
-        _text_pages(pdf, plt, [("Scene file", "", True), *scene], size=6.5)
+        _text_pages(pdf, plt, [("Scene file (SI units)", "", True), *scene], size=6.5)
     return buffer.getvalue()
 
 
-def write_report(result: SceneSolution, path: str | os.PathLike) -> None:
-    """Write the report of ``result`` to ``path``: PDF for a ``.pdf`` name, else HTML."""
+def write_report(result: SceneSolution, path: str | os.PathLike,
+                 time: float | None = None) -> None:
+    """Write the report of ``result`` to ``path``: PDF for a ``.pdf`` name, else HTML
+    (``time`` [day after loading]: as for :func:`core.report.report_html`)."""
     from core.files import atomic_write_bytes, atomic_write_text
     from core.report.html import report_html
 
     if str(path).lower().endswith(".pdf"):
-        atomic_write_bytes(path, report_pdf(result))
+        atomic_write_bytes(path, report_pdf(result, time))
     else:
-        atomic_write_text(path, report_html(result))
+        atomic_write_text(path, report_html(result, time))

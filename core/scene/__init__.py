@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from core.scene.coating_check import check_scene
 from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
-from core.scene.display import engine_text
+from core.scene.display import LIFT_OFF_SHARE, contact_width, engine_text, lifts_off
 from core.scene.files import load_scene, read_scene_json, save_scene
 from core.scene.json_schema import DIALECT as JSON_SCHEMA_DIALECT
 from core.scene.json_schema import (
@@ -41,7 +41,7 @@ from core.scene.json_schema import (
 )
 from core.scene.model import Scene
 from core.scene.pipeline import solve
-from core.scene.plotting import LIFT_OFF_COLOUR
+from core.scene.plotting import LIFT_OFF_COLOUR, shown_times
 from core.scene.records import (
     provenance,
     provenance_lines,
@@ -65,6 +65,8 @@ from core.scene.validate import replace_loads, scene_from_dict
 
 __all__ = [
     "LIFT_OFF_COLOUR",
+    "LIFT_OFF_SHARE",
+    "contact_width",
     "engine_text",
     "check_design",
     "check_fields",
@@ -78,6 +80,7 @@ __all__ = [
     "load_json_schema",
     "LARGE_TILT",
     "LimitCheck",
+    "lifts_off",
     "load_scene",
     "MAX_SCENE_BYTES",
     "migrate",
@@ -99,6 +102,7 @@ __all__ = [
     "schema_text",
     "scene_model_error",
     "SceneSolution",
+    "shown_times",
     "solve",
     "solver_settings",
 ]

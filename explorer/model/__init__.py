@@ -30,6 +30,7 @@ from .design import (
     check_html,
     design_check,
     scene_limits,
+    scene_with_limits,
     screen_limits,
 )
 from .history import SceneHistory
@@ -76,4 +77,5 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "contact_widths", "contact_zones", "creep_coefficient_data", "decode_scene",
            "default_range", "design_check", "encode_scene", "lessons", "lifts_off", "plan_study",
            "prepare_view", "preset_label", "presets", "read_study_query", "read_view_query",
-           "scene_limits", "screen_limits", "step_scene", "study_choices", "view_query"]
+           "scene_limits", "scene_with_limits", "screen_limits", "step_scene", "study_choices",
+           "view_query"]

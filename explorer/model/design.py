@@ -119,6 +119,16 @@ def scene_limits(limits: DesignLimits | None) -> dict[str, float]:
     return core_limits(limits).to_dict()
 
 
+def scene_with_limits(scene: dict[str, Any], limits: DesignLimits | None) -> dict[str, Any]:
+    """``scene`` (a scene dict, not changed) with the session's limits as its ``limits``,
+    as the command line checks them (Pa, m, rad); without a limit set, without any."""
+    out = {key: value for key, value in scene.items() if key != "limits"}
+    checked = scene_limits(limits)
+    if checked:
+        out["limits"] = checked
+    return out
+
+
 def _on_screen(line: LimitCheck, limits: DesignLimits | None) -> Check:
     """A line of the core's check in the screen's units, with the limit as typed."""
     unit, size = _SCREEN_UNITS[line.quantity]

@@ -31,7 +31,7 @@ import param
 
 from core import STAGE_CACHE_BYTES, solve
 
-from ..model import ExplorerState, ResultView, prepare_view
+from ..model import DesignLimits, ExplorerState, ResultView, prepare_view, scene_with_limits
 from .answer_wait import when_answered
 from .result_cache import RESULTS, approx_bytes, result_key
 from .trace import mark
@@ -344,17 +344,24 @@ class SolveController(param.Parameterized):
             self.param.update(view=outcome, error="", busy=rid < latest,
                               solves=self.solves + 1)
 
-    def download(self, view: ResultView, kind: str) -> str:
-        """The text of a download of ``view``: ``"to_csv"`` (the histories),
-        ``"pressure_csv"`` (q(x, t)) or ``"to_json"`` (everything), in SI units.
+    def download(self, view: ResultView, kind: str, limits: DesignLimits | None = None,
+                 shown_time: float | None = None) -> str | bytes:
+        """The file of a download of ``view``: ``"to_csv"`` (the histories),
+        ``"pressure_csv"`` (q(x, t)) or ``"to_json"`` (everything), in SI units, or the
+        printable report, ``"report_html"`` (text) or ``"report_pdf"`` (bytes).
 
         The shown scene is solved again (where this session's solves run, with its
         caches warm): the solver is deterministic, so the file holds the numbers on screen;
-        the JSON's solve report is the one of the result on screen.
+        the JSON's and the report's solve report is the one of the result on screen.
+        ``limits``: the Check tab's, put into the scene in place of its own (the report's
+        design check); ``shown_time`` [day after loading]: the time on screen, whose
+        contact the report describes.
         """
+        scene = view.scene if limits is None else scene_with_limits(view.scene, limits)
         if self._processes is not None:
-            return self._processes.run(self._lane, download_text, view.scene, kind, view.info)
-        return solution_text(self._solve(view.scene), kind, view.info)
+            return self._processes.run(self._lane, download_text, scene, kind, view.info,
+                                       shown_time)
+        return solution_text(self._solve(scene), kind, view.info, shown_time)
 
     def solved_within(self, seconds: float) -> bool:
         """Whether the result kept took less than ``seconds`` [s] of CPU time to solve
@@ -367,18 +374,19 @@ class SolveController(param.Parameterized):
         spent = view.info.get("cpu_seconds", view.info.get("seconds"))
         return isinstance(spent, (int, float)) and spent < seconds
 
-    def download_later(self, view: ResultView, kind: str) -> Future[str]:
-        """:meth:`download` off the calling thread: a future of the text, done when the
+    def download_later(self, view: ResultView, kind: str, limits: DesignLimits | None = None,
+                       shown_time: float | None = None) -> Future[str | bytes]:
+        """:meth:`download` off the calling thread: a future of the file, done when the
         worker has answered (at once where solves run in the caller). The server's event
         loop awaits it (``asyncio.wrap_future``) and keeps serving every page meanwhile."""
         if self._executor is None:
-            done: Future[str] = Future()
+            done: Future[str | bytes] = Future()
             try:
-                done.set_result(self.download(view, kind))
+                done.set_result(self.download(view, kind, limits, shown_time))
             except Exception as exc:
                 done.set_exception(exc)
             return done
-        return self._executor.submit(self.download, view, kind)
+        return self._executor.submit(self.download, view, kind, limits, shown_time)
 
     def wait(self, timeout: float = 60.0) -> bool:
         """Block until the newest request has been delivered (for scripts and tests)."""

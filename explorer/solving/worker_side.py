@@ -3,8 +3,10 @@
 A worker's main loop (:func:`serve`) takes one request ``(fn, args)`` at a time from its
 pipe and answers ``("ok", value, (start, end))`` or ``("error", exception, (start,
 end))``; the functions the server asks for are here: :func:`solve_view`,
-:func:`download_text`, :func:`worker_info`. Nothing here imports Panel: the workers
-import only ``core`` and :mod:`explorer.results`.
+:func:`download_text` (the downloads, the printable report among them),
+:func:`worker_info`. Nothing here imports Panel: the workers import only ``core`` and
+:mod:`explorer.results` (a report loads HoloViews, Bokeh and Matplotlib in the worker
+that builds it, when it does).
 """
 
 from __future__ import annotations
@@ -17,13 +19,17 @@ import threading
 import time
 from typing import Any
 
+import core.report
 from core import set_stage_cache_budget, solve, stage_cache_bytes
 
 from ..model import ResultView, prepare_view
 
 #: What :func:`download_text` can produce: the histories as CSV, q(x, t) as CSV, and the
-#: whole solution as JSON (the methods of ``core.SceneSolution`` of the same names).
-DOWNLOADS = ("to_csv", "pressure_csv", "to_json")
+#: whole solution as JSON (the methods of ``core.SceneSolution`` of the same names), and
+#: the printable report as HTML (text) or PDF (bytes) (the functions of ``core.report``).
+DOWNLOADS = ("to_csv", "pressure_csv", "to_json", "report_html", "report_pdf")
+#: The printable reports among :data:`DOWNLOADS`.
+REPORTS = ("report_html", "report_pdf")
 
 
 def _watch_parent() -> None:
@@ -52,30 +58,38 @@ def solve_view(scene: dict[str, Any]) -> ResultView:
     return prepare_view(solve(scene), scene)
 
 
-def download_text(scene: dict[str, Any], kind: str,
-                  info: dict[str, Any] | None = None) -> str:
+def download_text(scene: dict[str, Any], kind: str, info: dict[str, Any] | None = None,
+                  shown_time: float | None = None) -> str | bytes:
     """The file ``kind`` (one of :data:`DOWNLOADS`) of the solution of ``scene``: the
     histories as CSV (time [day], settlement [m], tilt [rad], force [N/m], moment [N]),
-    q(x, t) as CSV [Pa], or the whole solution as JSON.
+    q(x, t) as CSV [Pa], the whole solution as JSON, or the printable report (HTML text,
+    PDF bytes) checked against the scene's ``limits``.
 
     ``info``: the solve report of the result on screen (``ResultView.info``), written into
-    the JSON in place of the new solve's (whose timings and cache hits differ; its numbers
-    do not).
+    the JSON and the report in place of the new solve's (whose timings and cache hits
+    differ; its numbers do not). ``shown_time`` [day after loading]: the time on screen,
+    whose contact the report describes.
     """
-    return solution_text(solve(scene), kind, info)
+    return solution_text(solve(scene), kind, info, shown_time)
 
 
-def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None) -> str:
-    """``solution.to_csv()``, ``.pressure_csv()`` or the JSON of everything with the
-    version and solver settings (:meth:`core.scene.SceneSolution.to_json`) (``kind``), with the
-    solve report ``info`` in the JSON if given (see :func:`download_text`)."""
+def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None,
+                  shown_time: float | None = None) -> str | bytes:
+    """``solution.to_csv()``, ``.pressure_csv()``, the JSON of everything with the version
+    and solver settings (:meth:`core.scene.SceneSolution.to_json`) or the report
+    (:func:`core.report.report_html`, :func:`core.report.report_pdf` at ``shown_time``)
+    (``kind``), with the solve report ``info`` in the JSON and the report if given (see
+    :func:`download_text`)."""
     if kind not in DOWNLOADS:
         raise ValueError(f"kind: unknown download {kind!r}; known: {', '.join(DOWNLOADS)}")
-    if info is not None and kind == "to_json":
+    if info is not None and kind in ("to_json", *REPORTS):
         solution.info = {k: v for k, v in info.items() if k != "reused"}
     if kind == "to_json":
         # the version and the solver settings beside the scene, as the command line writes
         return solution.to_json()
+    if kind in REPORTS:
+        # the command line's report; HoloViews, Bokeh and Matplotlib load with the first
+        return getattr(core.report, kind)(solution, shown_time)
     return getattr(solution, kind)()
 
 

@@ -13,7 +13,7 @@ import panel as pn
 
 from core.scene import MAX_SCENE_BYTES, read_scene_json
 
-from ..files import histories_csv, pressure_csv, report_html
+from ..files import histories_csv, pressure_csv
 from ..model import (
     MAX_DESCRIPTION_CHARS,
     MAX_NAME_CHARS,
@@ -23,7 +23,7 @@ from ..model import (
     ResultView,
     Screen,
     check_text,
-    scene_limits,
+    scene_with_limits,
 )
 from ..solving import SolveController
 from .style import TAB_COLUMN, html_pane, slug
@@ -40,10 +40,11 @@ class FilesView:
                  load_scene: Callable[[dict[str, Any]], bool],
                  show_error: Callable[[str], None]) -> None:
         """``screen``: the result the downloads hold, and where a refused file is said;
-        ``controller``: solves the JSON download again; ``scales`` and ``limits``: the
-        units and the design check of the files; ``load_scene``: shows a scene read from
-        a file (False if refused); ``show_error``: says on the page why a download
-        failed."""
+        ``controller``: solves the JSON download and the reports again (in the worker
+        that solves this session's scenes); ``scales`` and ``limits``: the units of the
+        CSV files and the design check of the saved scene and the reports; ``load_scene``:
+        shows a scene read from a file (False if refused); ``show_error``: says on the
+        page why a download failed."""
         self.state = s = state
         self.screen = screen
         self.controller = controller
@@ -75,9 +76,14 @@ class FilesView:
                                                          filename="pressure.csv",
                                                          label="Results: q(x, t) (CSV)",
                                                          **stretch)
+        # the command line's report (core.report), built in the worker: the plots are
+        # Bokeh's and Matplotlib's, and the file records version, scene and settings
         self.report_download = pn.widgets.FileDownload(
             callback=self._report_file, filename="report.html", color="primary",
             label="Printable report (HTML)", css_classes=["report-download"], **stretch)
+        self.pdf_report_download = pn.widgets.FileDownload(
+            callback=self._pdf_report_file, filename="report.pdf",
+            label="Printable report (PDF)", css_classes=["report-pdf-download"], **stretch)
         self.json_download = pn.widgets.FileDownload(callback=self._json_file,
                                                      filename="results.json",
                                                      label="Results: everything (JSON)",
@@ -86,7 +92,8 @@ class FilesView:
     def content(self) -> pn.Column:
         """The tab's column."""
         return pn.Column(
-            self.report_download, self.scene_name, self.description, self.save_scene,
+            self.report_download, self.pdf_report_download, self.scene_name,
+            self.description, self.save_scene,
             html_pane("<small>Load a scene (the JSON the command line reads):</small>"),
             self.load_file, self.csv_download, self.pressure_download, self.json_download,
             html_pane("<small>Downloads hold the result on screen. The address bar holds "
@@ -100,6 +107,7 @@ class FilesView:
         self.pressure_download.filename = f"{stem}_pressure.csv"
         self.json_download.filename = f"{stem}_results.json"
         self.report_download.filename = f"{stem}_report.html"
+        self.pdf_report_download.filename = f"{stem}_report.pdf"
 
     # -- loading ---------------------------------------------------------------------
     def _on_scene_file(self, event: Any) -> None:
@@ -141,24 +149,26 @@ class FilesView:
     # -- downloads -------------------------------------------------------------------
     def _scene_file(self) -> io.StringIO:
         view = self.screen.shown()
-        scene = dict(view.scene if view is not None else self.state.to_scene())
+        scene = view.scene if view is not None else self.state.to_scene()
         # the limits typed in the Check tab, as the command line checks them (Pa, m, rad)
-        limits = scene_limits(self.limits)
-        if limits:
-            scene["limits"] = limits
-        else:
-            scene.pop("limits", None)
-        return io.StringIO(json.dumps(scene, indent=2) + "\n")
+        return io.StringIO(json.dumps(scene_with_limits(scene, self.limits), indent=2) + "\n")
 
-    async def _download(self, kind: str, empty: str) -> io.StringIO:
-        # awaited, not waited for: the worker's answer must not hold the event loop, and
-        # with it every page of the server
+    async def _fetch(self, kind: str, report: bool = False) -> str | bytes | None:
+        """The file ``kind`` of the result on screen from the worker (None without one);
+        a report is checked against the Check tab's limits and describes the time on
+        screen."""
         view = self.screen.shown()
         if view is None:
-            return io.StringIO(empty)
+            return None
+        options: dict[str, Any] = {}
+        if report:
+            index = min(self.screen.time_index, len(view.times) - 1)
+            options = {"limits": self.limits, "shown_time": float(view.times[index])}
+        # awaited, not waited for: the worker's answer must not hold the event loop, and
+        # with it every page of the server
         try:
-            return io.StringIO(await asyncio.wrap_future(
-                self.controller.download_later(view, kind)))
+            return await asyncio.wrap_future(
+                self.controller.download_later(view, kind, **options))
         except Exception as exc:
             # no file is better than a wrong one; say why on the page
             self.show_error(f"**Download failed:** {html.escape(str(exc))}")
@@ -175,12 +185,13 @@ class FilesView:
         return io.StringIO(pressure_csv(view, self.scales.pressure_unit(view)))
 
     async def _json_file(self) -> io.StringIO:
-        return await self._download("to_json", "{}")
+        text = await self._fetch("to_json")
+        return io.StringIO("{}" if text is None else str(text))
 
-    def _report_file(self) -> io.StringIO:
-        view = self.screen.shown()
-        if view is None:
-            return io.StringIO("")
-        index = min(self.screen.time_index, len(view.times) - 1)
-        return io.StringIO(report_html(view, self.limits, index,
-                                       self.scales.pressure_unit(view)))
+    async def _report_file(self) -> io.StringIO:
+        text = await self._fetch("report_html", report=True)
+        return io.StringIO("" if text is None else str(text))
+
+    async def _pdf_report_file(self) -> io.BytesIO:
+        data = await self._fetch("report_pdf", report=True)
+        return io.BytesIO(data if isinstance(data, bytes) else b"")

@@ -315,16 +315,27 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     ecc.press("Enter")
     until(lambda: page.text(".readout-moment") == "100", "M = 0.2 m x 500 kN/m")
     until(lambda: "e = M/P = 0.2 m" in page.text(".design-check"), "e in the check")
-    # the report holds the check, the flags' verdict, the accuracy and the version
+    # the report (the command line's) holds the check against the limit typed, the
+    # flags' verdict, the accuracy, the inputs on screen and the version
+    import core
+
     page.open_tab("Files")
     with page.page.expect_download(timeout=60_000) as info:
         page.page.get_by_text("Printable report (HTML)").first.click()
     text = Path(info.value.path()).read_text()
-    from explorer.files import project_version
-
-    assert "Design check" in text and "all set limits hold" in text
-    assert project_version() in text and "estimated relative error" in text
-    assert text.count("<svg") == 7
+    assert info.value.suggested_filename.endswith("_report.html")
+    assert "<h2>Design check</h2>" in text and "Every limit the scene sets holds." in text
+    assert "; limit 1e+05 kPa, utilisation" in text  # the 100000 kPa typed
+    assert f"coated-punch {core.__version__}, " in text and "No validity flag" in text
+    assert "numerical error (estimated, relative)" in text
+    assert "<td>moment M (given)</td><td>100 kN·m/m</td>" in text  # from e = 0.2 m typed
+    assert "<td>eccentricity e = M/P at the last time</td><td>0.2 m</td>" in text
+    # Bokeh's plots, their library inline; nothing drawn by hand
+    assert "Bokeh.embed" in text and "<svg" not in text.split("</head><body>")[1]
+    with page.page.expect_download(timeout=60_000) as info:
+        page.page.get_by_text("Printable report (PDF)").first.click()
+    assert Path(info.value.path()).read_bytes().startswith(b"%PDF-")
+    assert info.value.suggested_filename.endswith("_report.pdf")
     assert page.errors == []
 
 

@@ -297,14 +297,40 @@ def test_the_explorers_files_record_version_scene_and_solver_settings():
     assert data["solver"]["contact"] == "auto"
 
 
-def test_the_report_holds_inputs_plots_flags_accuracy_and_version():
-    from explorer.files import project_version, report_html
+def test_the_report_holds_inputs_plots_flags_accuracy_and_version(explorer_app):
+    """The Files tab's reports are the command line's (core.report), made from the scene
+    on screen with the Check tab's limits, as the user downloads them."""
+    import asyncio
+    import html
+    import re
 
-    _, controller = solved_flagged()
-    text = report_html(controller.view)
-    assert text.startswith("<!DOCTYPE html>") and text.count("<svg") == 7
-    assert "model_error" in text and project_version() in text
-    assert "Design check" in text and "Inputs" in text and "<script" not in text
+    import core
+    import core.report
+
+    app = explorer_app(scene=thick_coating_scene(), solved=True)
+    assert "model_error" in app.controller.view.flags
+    app.check_tab.allowable_pressure.value = 100.0  # kPa: the flat preset reaches ~500
+    files = app.files_tab
+    text = asyncio.run(files._report_file()).getvalue()
+    assert text.startswith("<!DOCTYPE html>") and text.endswith("</html>")
+    # Bokeh's plots (its library inline in the head), none drawn by hand in the body
+    assert "Bokeh.embed" in text and "<svg" not in text.split("</head><body>")[1]
+    assert f"coated-punch {core.__version__}, " in text
+    assert "<td>model_error</td>" in text and "class='bad'>This result is flagged" in text
+    assert "class='bad'>A limit is exceeded." in text and "limit 100 kPa" in text
+    assert "<h2>Inputs</h2>" in text and "<td>coating layer 1</td><td>h = 200 mm, E = " in text
+    assert "<td>contact at t = 365 d</td>" in text  # the time on screen: the last
+    assert "&quot;allowable_pressure&quot;: 100000.0" in text  # the scene file, with it
+    assert "solver settings</td><td>tol 1e-06, model_tol 0.02, contact auto" in text
+    # the command line's report of the saved scene says the same, row by row
+    saved = core.solve(json.loads(files._scene_file().getvalue()))
+    for section in core.report.sections(saved, 365.0):
+        for label, value in section.rows:
+            if label != "made by":  # its minute may differ
+                assert f"<td>{html.escape(label)}</td><td>{html.escape(value)}</td>" in text
+    data = asyncio.run(files._pdf_report_file()).getvalue()
+    assert data.startswith(b"%PDF-") and len(re.findall(rb"/Type\s*/Page\b", data)) >= 3
+    assert files.pdf_report_download.filename.endswith("_report.pdf")
 
 
 def test_the_status_speaks_plainly_and_keeps_the_numbers_in_details():

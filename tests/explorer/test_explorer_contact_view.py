@@ -163,14 +163,29 @@ def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
     assert labels == [value("lifted off (gap open)")]
 
 
-def test_the_report_carries_the_contact_zone_and_its_history() -> None:
-    from explorer.files import report_html
+@pytest.mark.slow
+def test_the_report_carries_the_contact_zone_and_its_history(explorer_app) -> None:
+    """The downloaded report says the contact at the time on screen, as the readout does,
+    and plots the contact width over time when the punch lifts off."""
+    import asyncio
 
-    text = report_html(_solved("eccentric_footing_liftoff"), index=0)
-    assert "At t = 0 days: contact 1.306 m of 2 m (65 %)" in text
-    assert "report-contact" in text and "lift-off length" in text
-    flat = report_html(_solved("uniform_flat"))
-    assert "full contact: the whole width" in flat and "report-contact'" not in flat
+    app = explorer_app("eccentric_footing_liftoff", solved=True)
+    app.screen.time_index = 0  # the time slider at its start
+    text = asyncio.run(app.files_tab._report_file()).getvalue()
+    said = contact_text(app.screen.shown(), 0)
+    assert said.startswith("contact 1.306 m of 2 m (65 %), lifted 0.694 m")
+    assert f"<td>contact at t = 0 d</td><td>{said}</td>" in text  # the readout's words
+    assert "<td>lift-off</td><td>at 20 of 20 output times" in text
+    assert "contact width and lifted length (2a = 2 m)" in text  # the plot's title
+    app.screen.time_index = 11  # 46.42 d of the preset's log-spaced times
+    text = asyncio.run(app.files_tab._report_file()).getvalue()
+    said = contact_text(app.screen.shown(), 11)
+    assert said.startswith("contact 1.339 m of 2 m (67 %)")  # the zone grows with creep
+    assert f"<td>contact at t = 46.42 d</td><td>{said}</td>" in text
+    flat = explorer_app("uniform_flat", solved=True)
+    text = asyncio.run(flat.files_tab._report_file()).getvalue()
+    assert "full contact: the whole width 2a = 2 m touches" in text
+    assert "contact width and lifted length" not in text and "<td>lift-off</td>" not in text
 
 
 def test_the_full_contact_model_marks_its_pull_zone_not_a_gap() -> None:

@@ -27,7 +27,7 @@ import explorer.solving.controller as controller_module
 import explorer.solving.workers as workers
 from core import budget, solve
 from core.budget import stage_cache_bounds
-from explorer.model import QUANTITIES, ExplorerState, prepare_view
+from explorer.model import QUANTITIES, DesignLimits, ExplorerState, prepare_view
 from explorer.solving import RESULTS, SolveController
 from explorer.solving.workers import (
     SolverProcesses,
@@ -100,6 +100,13 @@ def test_downloads_from_a_worker_hold_the_numbers_on_screen(processes, monkeypat
     assert np.array_equal(rows[:, 1], view.values["settlement"])
     with pytest.raises(ValueError, match="kind: unknown download"):
         download_text(view.scene, "to_pickle")
+    # the printable reports, the command line's, built in the worker: checked against the
+    # Check tab's limits (mm here), describing the time on screen
+    report = session.download(view, "report_html", DesignLimits(settlement_limit=1e-3),
+                              float(view.times[0]))
+    assert report.startswith("<!DOCTYPE html>") and "<td>contact at t = 0 d</td>" in report
+    assert "A limit is exceeded." in report and "; limit 0.001 mm, utilisation" in report
+    assert session.download(view, "report_pdf").startswith(b"%PDF-")
 
 
 def test_a_request_sent_at_once_is_answered_and_frees_its_lane(processes, tmp_path,
@@ -381,7 +388,8 @@ def test_workers_do_not_outlive_the_server(sig: int, wait_until) -> None:
 
 def test_a_worker_solves_without_importing_the_page_libraries() -> None:
     # A worker imports the solving and model packages and core (explorer/model/results.py);
-    # Panel and Bokeh would cost each worker ~1 s and ~100 MB for nothing.
+    # Panel and Bokeh would cost each worker ~1 s and ~100 MB for nothing (the plotting
+    # libraries load only in a worker asked for a printable report).
     script = textwrap.dedent("""
         import copy, sys
         import explorer.model, explorer.solving.workers
@@ -390,7 +398,8 @@ def test_a_worker_solves_without_importing_the_page_libraries() -> None:
         scene = copy.deepcopy(presets()[DEFAULT_PRESET])
         scene["times"] = {"end": 200.0, "count": 4, "spacing": "log"}
         view = explorer.solving.workers.solve_view(scene)
-        print(len(view.times), sorted(m for m in ("panel", "bokeh") if m in sys.modules))
+        print(len(view.times), sorted(m for m in ("panel", "bokeh", "holoviews", "matplotlib")
+                                      if m in sys.modules))
     """)
     env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get(
         "PYTHONPATH", "")}

@@ -1,6 +1,8 @@
 """The printable report: what it says (validity, design check, results with units,
-accuracy, the scene), its real plots (Bokeh in the HTML, Matplotlib in the PDF), the
-command line's ``report``, and the message when the report's packages are missing."""
+accuracy, the inputs in engineering units, the contact at a chosen time, the scene), its
+real plots (Bokeh in the HTML, Matplotlib in the PDF: q(x, t), settlement, tilt, the
+contact width when the punch lifts off, the geometry where it varies), the command line's
+``report``, and the message when the report's packages are missing."""
 
 from __future__ import annotations
 
@@ -12,7 +14,8 @@ import pytest
 import core
 from core.optional import MissingDependency
 from core.presets import read_preset
-from core.report import report_html, report_pdf, sections
+from core.report import output_index, report_html, report_pdf, sections
+from core.scene import scene_from_dict
 from tests.cli_runs import run_cli
 
 pytest.importorskip("holoviews")
@@ -27,13 +30,21 @@ def checked() -> core.SceneSolution:
     return core.solve(scene)
 
 
+def rows(result: core.SceneSolution, title: str, time: float | None = None) -> dict:
+    """The rows of the section ``title`` of the report of ``result``."""
+    return next(dict(s.rows) for s in sections(result, time) if s.title == title)
+
+
 def test_the_sections_say_validity_check_results_and_accuracy(checked):
     titles = [s.title for s in sections(checked)]
-    assert titles == ["About", "Validity", "Design check", "Results", "Accuracy"]
+    assert titles == ["About", "Validity", "Design check", "Results", "Accuracy", "Inputs"]
     design = dict(sections(checked)[2].rows)
     assert sections(checked)[2].tone == "bad"
     assert design["largest contact pressure q_max"].endswith("FAIL")
     assert design["largest settlement"].endswith(": pass")
+    # in the units of the results: the limits of the fixture, 1.5e6 Pa and 0.01 m
+    assert "; limit 1500 kPa, utilisation 1.31: FAIL" in design["largest contact pressure q_max"]
+    assert "; limit 10 mm, utilisation" in design["largest settlement"]
     about = dict(sections(checked)[0].rows)
     assert about["made by"].startswith(f"coated-punch {core.__version__}, ")
     assert about["statement"] == "4: force and moment given"
@@ -41,6 +52,85 @@ def test_the_sections_say_validity_check_results_and_accuracy(checked):
     assert "smallest contact width" in results  # the punch lifts off
     assert re.fullmatch(r"[0-9.]+ kPa at x = 1 m, t = [0-9.]+ d",
                         results["largest contact pressure q"])
+    assert results["eccentricity e = M/P at the last time"] == "0.6 m"  # 480 / 800 kN
+    accuracy = rows(checked, "Accuracy")
+    assert re.fullmatch(r"\d+ nodes, \d+ time steps", accuracy["discretization"])
+
+
+def test_the_inputs_are_listed_in_engineering_units(checked):
+    inputs = rows(checked, "Inputs")
+    assert inputs["punch"] == "half-width a = 1 m (width 2a = 2 m); base flat"
+    assert inputs["coating layer 1"] == "h = 15 mm, E = 400 MPa, ν = 0.35, smooth interface"
+    assert inputs["base"] == ("H = 6 m, ν = 0.2, age at loading τ0 = 28 d, modulus at "
+                              "loading E(τ0) = 23.52 GPa")
+    assert inputs["base creep"] == ("aging creep (Arutyunyan): E∞ = 30 GPa; β = 0.5; α = "
+                                    "0.03 1/day; C∞ = 0.009 1/GPa; A = 0.48 day/GPa; γ = "
+                                    "0.03 1/day")
+    assert inputs["force P (given)"] == "800 kN/m"
+    assert inputs["moment M (given)"] == "480 kN·m/m"
+    assert inputs["output times"] == "20 output times, 0 to 1000 d after loading (log spacing)"
+    assert inputs["solver settings"] == "tol 0.0001, model_tol 0.02, contact auto"
+
+
+@pytest.mark.parametrize(("preset", "label", "text"), [
+    ("stepped_punch", "punch", "base f(x) = 0 to 0.015 mm (step profile) above its lowest "
+                               "point"),
+    ("patched_insert", "coating layer 1", "E = 500 to 3000 MPa (step profile)"),
+    ("worn_coating", "coating layer 1", "h = 19.98 to 20 mm (bump profile)"),
+    ("rounded_graded", "coating layer 1 (under the punch)", "h = 4 mm, E = 300 MPa"),
+    ("young_concrete_50_years", "base creep", "fib Model Code 2010: strength class C30/37; "
+                                              "cement N; RH = 60 %; h0 = 300 mm; T = 20 °C"),
+    ("patched_insert", "base creep", "Prony series: E = 32 GPa; term 1: C = 0.01 1/GPa, "
+                                     "A = 0 day/GPa, γ = 0.1 1/day; term 2:"),
+    ("stepped_punch", "settlement δ (given)", "0.08 mm"),
+    ("rounded_graded", "output times", "1 output time, 1 d after loading"),
+])
+def test_profiles_and_creep_models_are_said_in_their_units(preset, label, text):
+    from core.report.inputs import input_rows
+
+    listed = dict(input_rows(scene_from_dict(read_preset(preset))))
+    assert text in listed[label]
+
+
+def test_a_varying_load_is_given_by_its_range_and_kind():
+    from core.report.inputs import input_rows
+
+    scene = read_preset("uniform_flat")
+    scene["loading"]["force"] = {"kind": "ramp", "start": 0.0, "end": 5e5, "duration": 10.0}
+    listed = dict(input_rows(scene_from_dict(scene)))
+    assert listed["force P (given)"] == "0 to 500 kN/m (ramp profile)"
+
+
+def test_the_contact_at_a_chosen_time_and_when_the_punch_lifts_off(checked):
+    results = rows(checked, "Results", time=0.0)
+    # the preset's description: at e = 0.6 m only 1.31 m of the 2 m carry the load
+    assert results["contact at t = 0 d"] == ("contact 1.306 m of 2 m (65 %), lifted 0.694 m: "
+                                             "x = -1 to -0.306 m (unilateral contact)")
+    assert results["lift-off"].startswith("at 20 of 20 output times, first at t = 0 d")
+    # the nearest output time: 46.42 d for 50 d (log spacing to 1000 d)
+    assert "contact at t = 46.42 d" in rows(checked, "Results", time=50)
+    assert "contact at t = 1000 d" in rows(checked, "Results")  # the last by default
+    assert output_index(checked, 1000.4) == 19
+    for bad, reason in ((-3.0, "outside the output times, 0 to 1000 d"),
+                        (2000.0, "outside the output times"), (float("nan"), "not a finite"),
+                        ("7", "not a finite")):
+        with pytest.raises(ValueError, match=f"^time: .*{reason}"):
+            sections(checked, time=bad)
+
+
+def test_full_contact_is_said_and_a_lost_contact_named_not_physical():
+    flat = rows(core.solve(read_preset("uniform_flat")), "Results")
+    assert flat["contact at t = 365 d"] == "full contact: the whole width 2a = 2 m touches"
+    assert "lift-off" not in flat and "smallest contact width" not in flat
+    scene = read_preset("eccentric_footing_liftoff")
+    scene["solver"]["contact"] = "full"
+    lost = core.solve(scene)
+    assert "contact_lost" in lost.flags
+    text = rows(lost, "Results", time=0)["contact at t = 0 d"]
+    # where the full-contact pressure is negative: 0.37 m of the heel (measured; the
+    # unilateral answer lifts 0.69 m)
+    assert text.startswith("contact 1.628 m of 2 m (81 %), q < 0 (contact lost, not "
+                           "physical) 0.372 m: x = -1 to -0.628 m (full-contact model)")
 
 
 def test_no_design_section_without_limits():
@@ -49,12 +139,23 @@ def test_no_design_section_without_limits():
 
 
 def test_the_html_report_embeds_bokeh_plots_and_the_scene(checked):
-    text = report_html(checked)
+    text = report_html(checked, time=100)
     assert text.startswith("<!DOCTYPE html>") and text.endswith("</html>")
     assert "Bokeh.embed" in text or "embed_items" in text  # the plots are Bokeh's
     assert "https://" not in text.split("<body>")[0].split("<script")[0]
     assert "class='bad'>A limit is exceeded." in text
     assert "&quot;allowable_pressure&quot;: 1500000.0" in text  # the scene file, escaped
+    # the plot of the contact over time, and the chosen time among the q(x) curves
+    assert "contact width and lifted length (2a = 2 m)" in text
+    assert '"t = 100 d"' in text and "<td>contact at t = 100 d</td>" in text
+    assert "<h2>Inputs</h2>" in text and "punch base f(x)" not in text  # a flat punch
+
+
+def test_the_geometry_is_drawn_where_it_varies_and_no_lift_off_plot_in_full_contact():
+    text = report_html(core.solve(read_preset("stepped_punch")))
+    assert "punch base f(x) above its lowest point [mm]" in text
+    assert "coating thickness, all layers" not in text  # a uniform coating
+    assert "contact width and lifted length" not in text  # in full contact
 
 
 def test_the_html_report_escapes_the_scene_name():
@@ -66,9 +167,10 @@ def test_the_html_report_escapes_the_scene_name():
 
 
 def test_the_pdf_report_has_text_plot_and_scene_pages(checked):
-    data = report_pdf(checked)
+    data = report_pdf(checked, time=0)
     assert data.startswith(b"%PDF-")
-    # text, plots, scene file: three pages for this scene (measured)
+    # text (with the inputs), plots (four, the contact width's among them), scene file:
+    # three pages for this scene (measured)
     assert len(re.findall(rb"/Type\s*/Page\b", data)) == 3
 
 
@@ -88,6 +190,16 @@ def test_the_command_line_writes_both_and_is_strict(tmp_path):
     assert strict.returncode == 3, strict.stderr
     assert "design check failed (settlement_limit)" in strict.stderr
     assert html_path.exists()  # written all the same
+
+
+def test_the_command_line_describes_the_contact_at_the_time_asked_for(tmp_path):
+    path = tmp_path / "r.html"
+    done = run_cli("report", "preset:eccentric_footing_liftoff", "-o", path, "--time", "0")
+    assert done.returncode == 0, done.stderr
+    assert "<td>contact at t = 0 d</td><td>contact 1.306 m of 2 m (65 %)" in path.read_text()
+    late = run_cli("report", "preset:eccentric_footing_liftoff", "-o", path, "--time", "5000")
+    assert late.returncode == 2
+    assert "--time: 5000 d is outside the output times, 0 to 1000 d" in late.stderr
 
 
 def test_a_missing_plotting_package_is_named_with_its_extra(monkeypatch, checked):

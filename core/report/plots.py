@@ -1,0 +1,137 @@
+"""The report's plots, one HoloViews layout for both printers: those of
+:meth:`SceneSolution.plot` (q(x) at a few times and at the time the reader chose,
+settlement and tilt over time), the contact width and the lifted length over time when
+the punch lifts off, and the punch base and the coating thickness over x when they vary.
+
+Options are set for the Bokeh backend, as :mod:`core.scene.plotting` sets them (the HTML
+report); :func:`matplotlib_layout` restyles the layout for the PDF. HoloViews is imported
+when a plot is made, never with :mod:`core.report`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from core.optional import import_optional
+from core.report.contact import lift_off_times, output_index
+from core.report.inputs import LAYER_FIELDS, SHAPE_UNIT
+from core.scene import LIFT_OFF_COLOUR, SceneSolution, contact_width, shown_times
+
+#: The curves of the contact plot: (label, colour), the part in contact dark blue and the
+#: part lifted off red, as the explorer draws them.
+CONTACT_CURVES = (("contact width", "#08306b"), ("lifted length", "#d62728"))
+#: The geometry plots: (name of the plotted value, title, colour).
+GEOMETRY_PLOTS = (("punch_base", "punch base f(x) above its lowest point", "#333333"),
+                  ("coating_thickness", "coating thickness, all layers", "#2b7bb9"))
+#: Size of a plot of the report [screen pixels] (those of SceneSolution.plot are 400 x 300).
+PLOT_WIDTH, PLOT_HEIGHT = 400, 300
+#: The titles of the three plots of :meth:`SceneSolution.plot` in the PDF, in its order
+#: (their Bokeh titles are options Matplotlib does not read).
+PLOT_TITLES = ("contact pressure q(x, t) (grey: lifted off)", "settlement δ(t)", "tilt α(t)")
+#: Points of the geometry plots over [-a, a], besides both sides of every breakpoint.
+GEOMETRY_POINTS = 801
+
+
+def _holoviews() -> Any:
+    hv = import_optional("holoviews", "the report's plots")
+    import_optional("bokeh", "the report's plots")
+    import_optional("holoviews.plotting.bokeh", "the report's plots")  # the backend's options
+    return hv
+
+
+def contact_overlay(result: SceneSolution) -> Any:
+    """The contact width and the lifted length [m] over time (their sum is 2a)."""
+    hv = _holoviews()
+    width = contact_width(result)
+    full = 2 * result.scene.half_width
+    t_dim = hv.Dimension("time", label="t", unit="day")
+    length = hv.Dimension("length", label="length", unit="m")
+    curves = [hv.Curve((result.times, values), kdims=[t_dim], vdims=[length], label=label)
+              .opts(color=colour, tools=["hover"], backend="bokeh")
+              for (label, colour), values in zip(CONTACT_CURVES, (width, full - width),
+                                                 strict=True)]
+    return hv.Overlay(curves).opts(
+        title=contact_title(result), width=PLOT_WIDTH, height=PLOT_HEIGHT,
+        legend_position="right", backend="bokeh")
+
+
+def contact_title(result: SceneSolution) -> str:
+    """The contact plot's title."""
+    return f"contact width and lifted length (2a = {2 * result.scene.half_width:g} m)"
+
+
+def _geometry_x(result: SceneSolution) -> np.ndarray:
+    a = result.scene.half_width
+    # both sides of a jump of a profile (a step of the punch base, a coating patch)
+    sides = [p + s * 1e-9 * a for p in result.scene.breakpoints for s in (-1.0, 1.0)]
+    return np.clip(np.union1d(np.linspace(-a, a, GEOMETRY_POINTS), sides), -a, a)
+
+
+def geometry_curves(result: SceneSolution) -> list[tuple[str, Any]]:
+    """(title, curve) of the punch base f(x) [mm] and of the coating thickness of all
+    layers [mm] over x [m], each only where it varies (a flat base and a uniform coating
+    are said in the inputs)."""
+    hv = _holoviews()
+    scene = result.scene
+    x = _geometry_x(result)
+
+    def values(profile: Any) -> np.ndarray:
+        return np.broadcast_to(np.asarray(profile(x), dtype=float), x.shape)
+
+    _, shape_unit, shape_size = SHAPE_UNIT
+    _, unit, size = LAYER_FIELDS["thickness"]
+    heights = {"punch_base": (values(scene.shape) / shape_size, shape_unit),
+               "coating_thickness": (sum(values(layer.thickness) for layer in scene.coating)
+                                     / size, unit)}
+    x_dim = hv.Dimension("x", label="x", unit="m")
+    out = []
+    for name, title, colour in GEOMETRY_PLOTS:
+        height, unit = heights[name]
+        if np.ptp(height) == 0:
+            continue
+        title = f"{title} [{unit}]"
+        y_dim = hv.Dimension(name, label=name.replace("_", " "), unit=unit)
+        out.append((title, hv.Curve((x, height), kdims=[x_dim], vdims=[y_dim]).opts(
+            title=title, color=colour, width=PLOT_WIDTH, height=PLOT_HEIGHT,
+            tools=["hover"], backend="bokeh")))
+    return out
+
+
+def report_layout(result: SceneSolution, time: float | None = None) -> tuple[Any, list[str]]:
+    """The report's plots as one ``holoviews.Layout`` (two a row, for a printed page) and
+    their titles in order (what the PDF writes over them).
+
+    ``time`` [day after loading]: its output time is drawn among the q(x) curves.
+    """
+    _holoviews()
+    k = output_index(result, time)
+    picked = shown_times(result.times)
+    wanted = [float(result.times[j]) for j in sorted({*picked.tolist(), k})]
+    layout = result.plot(times=wanted)
+    extra: list[tuple[str, Any]] = []
+    if lift_off_times(result).size:
+        extra.append((contact_title(result), contact_overlay(result)))
+    extra.extend(geometry_curves(result))
+    titles = [*PLOT_TITLES, *(title for title, _ in extra)]
+    # a clone keeps the layout's title (the scene and its flags)
+    return layout.clone([*layout, *(element for _, element in extra)]).cols(2), titles
+
+
+def matplotlib_layout(layout: Any) -> Any:
+    """``layout`` styled for HoloViews' Matplotlib backend (registered by the caller): the
+    lift-off shading, the contact and the geometry curves in the colours of the HTML
+    report."""
+    hv = _holoviews()
+    by_label = dict(CONTACT_CURVES)
+    by_value = {name: colour for name, _, colour in GEOMETRY_PLOTS}
+
+    def colour(curve: Any) -> str | None:
+        return by_label.get(curve.label) or by_value.get(curve.vdims[0].name)
+
+    layout = layout.map(lambda span: span.opts(
+        color=LIFT_OFF_COLOUR, facecolor=LIFT_OFF_COLOUR, alpha=0.5, backend="matplotlib"),
+        hv.VSpan)
+    return layout.map(lambda curve: curve.opts(color=colour(curve), backend="matplotlib"),
+                      lambda item: isinstance(item, hv.Curve) and colour(item) is not None)
