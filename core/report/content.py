@@ -56,7 +56,7 @@ def key_numbers(result: SceneSolution) -> list[tuple[str, str]]:
         ("moment M at the last time", f"{_number(result.moment[-1] / 1e3)} kN·m/m"),
     ]
     if result.info.get("contact") == "unilateral" and result.contact_set:
-        width = [sum(hi - lo for lo, hi in zones) for zones in result.contact_set]
+        width = result.contact_width
         k = int(np.argmin(width))
         rows.append(("smallest contact width", f"{_number(width[k])} m of "
                                                f"{_number(2 * result.scene.half_width)} m at "

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.optional import import_optional
+from core.scene.contact_zone import lifts_off as contact_lifts_off
 from core.scene.files import scene_to_json
 from core.scene.records import solver_settings as scene_solver_settings
 from core.scene.schema import SCHEMA_VERSION, _jsonable
@@ -30,11 +31,6 @@ if TYPE_CHECKING:
     import xarray
 
     from core.scene.results import SceneSolution
-
-#: A contact set narrower than ``(1 - LIFT_OFF_SHARE) * 2a`` is reported as lift-off: a
-#: unilateral answer in full contact holds ``[(-a, a)]`` exactly (measured on the lift-off
-#: preset at e = 0.41 m, back in full contact by 1000 days), so this only absorbs rounding.
-LIFT_OFF_SHARE = 1e-9
 
 #: The histories over time: (unit, long name, the paper's symbol).
 HISTORIES: dict[str, tuple[str, str, str]] = {
@@ -57,17 +53,19 @@ def _number(value: float) -> str:
 
 
 def contact_width(result: SceneSolution) -> np.ndarray | None:
-    """Length of the contact set [m] at every output time (None if the answer has none)."""
+    """:attr:`SceneSolution.contact_width` [m] at every output time (None if the answer
+    has no contact set)."""
     if len(result.contact_set) != len(result.times):
         return None
-    return np.array([sum(hi - lo for lo, hi in zones) for zones in result.contact_set])
+    return result.contact_width
 
 
 def lifts_off(result: SceneSolution, k: int = -1) -> bool:
-    """Whether the contact set at ``times[k]`` is narrower than the punch base."""
-    widths = contact_width(result)
-    full = 2 * result.scene.half_width
-    return widths is not None and bool(widths[k] < (1 - LIFT_OFF_SHARE) * full)
+    """Whether the contact set at ``times[k]`` is narrower than the punch base
+    (:func:`core.scene.contact_zone.lifts_off`)."""
+    if len(result.contact_set) != len(result.times):
+        return False
+    return bool(contact_lifts_off(result.contact_set, result.scene.half_width)[k])
 
 
 def zones_text(result: SceneSolution, k: int = -1) -> str:
