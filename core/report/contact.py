@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.scene import LIFT_OFF_SHARE, SceneSolution, contact_width, lifts_off
+from core.scene import LIFT_OFF_SHARE, SceneSolution, known_contact_width, lifts_off_at
 
 
 def output_index(result: SceneSolution, time: float | None) -> int:
@@ -47,7 +47,7 @@ def lifted_parts(result: SceneSolution, k: int) -> list[tuple[float, float]]:
     a = result.scene.half_width
     if result.contact_lost:
         return _negative_parts(result, k)
-    if not lifts_off(result, k):
+    if not lifts_off_at(result, k):
         return []
     parts, edge = [], -a
     for lo, hi in sorted(result.contact_set[k]):
@@ -104,6 +104,6 @@ def contact_text(result: SceneSolution, k: int) -> str:
 def lift_off_times(result: SceneSolution) -> np.ndarray:
     """Indices of the output times at which the unilateral contact model lifts part of the
     base off (empty for the full-contact model and in full contact)."""
-    if contact_width(result) is None or result.info.get("contact") != "unilateral":
+    if known_contact_width(result) is None or result.info.get("contact") != "unilateral":
         return np.zeros(0, dtype=int)
-    return np.array([k for k in range(len(result.times)) if lifts_off(result, k)], dtype=int)
+    return np.array([k for k in range(len(result.times)) if lifts_off_at(result, k)], dtype=int)

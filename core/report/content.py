@@ -13,7 +13,7 @@ import numpy as np
 from core.report.contact import contact_text, lift_off_times, output_index
 from core.report.inputs import SHOWN_UNITS, input_rows
 from core.report.inputs import number as _number
-from core.scene import SceneSolution, contact_width, engine_text
+from core.scene import SceneSolution, engine_text
 from core.version import VERSION
 
 
@@ -73,8 +73,8 @@ def key_numbers(result: SceneSolution, time: float | None = None) -> list[tuple[
         rows.append(("lift-off", f"at {lifted.size} of {len(t)} output times, first at "
                                  f"t = {_number(t[lifted[0]])} d, last at "
                                  f"t = {_number(t[lifted[-1]])} d (contact width plotted)"))
-    width = contact_width(result)
-    if result.info.get("contact") == "unilateral" and width is not None:
+    if result.info.get("contact") == "unilateral" and result.contact_set:
+        width = result.contact_width
         k = int(np.argmin(width))
         rows.append(("smallest contact width", f"{_number(width[k])} m of "
                                                f"{_number(2 * result.scene.half_width)} m at "

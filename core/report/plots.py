@@ -17,7 +17,7 @@ import numpy as np
 from core.optional import import_optional
 from core.report.contact import lift_off_times, output_index
 from core.report.inputs import LAYER_FIELDS, SHAPE_UNIT
-from core.scene import LIFT_OFF_COLOUR, SceneSolution, contact_width, shown_times
+from core.scene import LIFT_OFF_COLOUR, SceneSolution, known_contact_width, shown_times
 
 #: The curves of the contact plot: (label, colour), the part in contact dark blue and the
 #: part lifted off red, as the explorer draws them.
@@ -44,7 +44,7 @@ def _holoviews() -> Any:
 def contact_overlay(result: SceneSolution) -> Any:
     """The contact width and the lifted length [m] over time (their sum is 2a)."""
     hv = _holoviews()
-    width = contact_width(result)
+    width = known_contact_width(result)
     full = 2 * result.scene.half_width
     t_dim = hv.Dimension("time", label="t", unit="day")
     length = hv.Dimension("length", label="length", unit="m")

@@ -8,6 +8,8 @@ returns a ``SceneSolution``.
 - ``model.py``: the validated ``Scene`` and ``Layer`` and what follows from them alone;
 - ``dimensionless.py``: ``to_dimensionless``, the scene as the dimensionless problem;
 - ``results.py``: ``SceneSolution``, the answer in SI units with its flags, JSON and CSV;
+- ``contact_zone.py``: ``contact_width``, ``lift_off_length``, ``lifts_off`` of a
+  contact set: the one definition every output of the contact width uses;
 - ``display.py``: its repr and HTML table, its metadata, ``to_xarray``/``to_dataframe``;
 - ``plotting.py``: its HoloViews plot (the one module of core that imports HoloViews);
 - ``files.py``: ``load_scene``, ``save_scene`` (strict JSON, atomic writes);
@@ -25,8 +27,9 @@ returns a ``SceneSolution``.
 from __future__ import annotations
 
 from core.scene.coating_check import check_scene
+from core.scene.contact_zone import LIFT_OFF_SHARE, contact_width, lift_off_length, lifts_off
 from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
-from core.scene.display import LIFT_OFF_SHARE, contact_width, engine_text, lifts_off
+from core.scene.display import engine_text, known_contact_width, lifts_off_at
 from core.scene.files import load_scene, read_scene_json, save_scene
 from core.scene.json_schema import DIALECT as JSON_SCHEMA_DIALECT
 from core.scene.json_schema import (
@@ -66,11 +69,13 @@ from core.scene.validate import replace_loads, scene_from_dict
 __all__ = [
     "LIFT_OFF_COLOUR",
     "LIFT_OFF_SHARE",
-    "contact_width",
     "engine_text",
+    "known_contact_width",
+    "lifts_off_at",
     "check_design",
     "check_fields",
     "check_scene",
+    "contact_width",
     "design_check",
     "DesignCheck",
     "DesignLimits",
@@ -80,6 +85,7 @@ __all__ = [
     "load_json_schema",
     "LARGE_TILT",
     "LimitCheck",
+    "lift_off_length",
     "lifts_off",
     "load_scene",
     "MAX_SCENE_BYTES",

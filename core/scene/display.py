@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.optional import import_optional
+from core.scene.contact_zone import lifts_off as contact_lifts_off
 from core.scene.files import scene_to_json
 from core.scene.records import solver_settings as scene_solver_settings
 from core.scene.schema import SCHEMA_VERSION, _jsonable
@@ -30,11 +31,6 @@ if TYPE_CHECKING:
     import xarray
 
     from core.scene.results import SceneSolution
-
-#: A contact set narrower than ``(1 - LIFT_OFF_SHARE) * 2a`` is reported as lift-off: a
-#: unilateral answer in full contact holds ``[(-a, a)]`` exactly (measured on the lift-off
-#: preset at e = 0.41 m, back in full contact by 1000 days), so this only absorbs rounding.
-LIFT_OFF_SHARE = 1e-9
 
 #: The histories over time: (unit, long name, the paper's symbol).
 HISTORIES: dict[str, tuple[str, str, str]] = {
@@ -56,18 +52,20 @@ def _number(value: float) -> str:
     return f"{value:.4g}" if math.isfinite(value) else str(value)
 
 
-def contact_width(result: SceneSolution) -> np.ndarray | None:
-    """Length of the contact set [m] at every output time (None if the answer has none)."""
+def known_contact_width(result: SceneSolution) -> np.ndarray | None:
+    """:attr:`SceneSolution.contact_width` [m] at every output time (None if the answer
+    has no contact set)."""
     if len(result.contact_set) != len(result.times):
         return None
-    return np.array([sum(hi - lo for lo, hi in zones) for zones in result.contact_set])
+    return result.contact_width
 
 
-def lifts_off(result: SceneSolution, k: int = -1) -> bool:
-    """Whether the contact set at ``times[k]`` is narrower than the punch base."""
-    widths = contact_width(result)
-    full = 2 * result.scene.half_width
-    return widths is not None and bool(widths[k] < (1 - LIFT_OFF_SHARE) * full)
+def lifts_off_at(result: SceneSolution, k: int = -1) -> bool:
+    """Whether the contact set at ``times[k]`` is narrower than the punch base
+    (:func:`core.scene.contact_zone.lifts_off`)."""
+    if len(result.contact_set) != len(result.times):
+        return False
+    return bool(contact_lifts_off(result.contact_set, result.scene.half_width)[k])
 
 
 def zones_text(result: SceneSolution, k: int = -1) -> str:
@@ -111,8 +109,8 @@ def key_figures(result: SceneSolution) -> list[tuple[str, str]]:
             for name, factor, unit in SHOWN]
     q_max = float(np.max(result.pressure_on_grid[:, -1]))
     rows.append(("max pressure", f"{_number(q_max * 1e-6)} MPa"))
-    if lifts_off(result):
-        width = float(contact_width(result)[-1])
+    if lifts_off_at(result):
+        width = float(result.contact_width[-1])
         rows.append(("contact width", f"{_number(width)} m of 2a = "
                      f"{_number(2 * result.scene.half_width)} m (lift-off; contact on "
                      f"{zones_text(result)} m)"))
@@ -221,7 +219,7 @@ def to_xarray(result: SceneSolution) -> xarray.Dataset:
     for name, (unit, long_name, symbol) in HISTORIES.items():
         variables[name] = ("time", np.array(getattr(result, name)),
                            {"units": unit, "long_name": long_name, "symbol": symbol})
-    widths = contact_width(result)
+    widths = known_contact_width(result)
     if widths is not None:
         variables["contact_width"] = ("time", widths,
                                       {"units": "m", "long_name": "length of the contact set"})
@@ -235,7 +233,7 @@ def to_dataframe(result: SceneSolution) -> pandas.DataFrame:
     pd = import_optional("pandas", "SceneSolution.to_dataframe")
     columns = {name: np.array(getattr(result, name)) for name in HISTORIES}
     units = {name: unit for name, (unit, _, _) in HISTORIES.items()}
-    widths = contact_width(result)
+    widths = known_contact_width(result)
     if widths is not None:
         columns["contact_width"] = widths
         units["contact_width"] = "m"

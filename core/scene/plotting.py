@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.optional import import_optional
-from core.scene.display import lifts_off, zones_text
+from core.scene.display import lifts_off_at, zones_text
 
 if TYPE_CHECKING:
     import holoviews
@@ -97,7 +97,7 @@ def pressure_overlay(result: SceneSolution, count: int = PLOT_CURVES,
               for j, k in enumerate(picked)]
     title = TITLES["pressure"]
     spans: list[Any] = []
-    if lifts_off(result):
+    if lifts_off_at(result):
         title += f"; lift-off at {_days(result.times[-1])}: contact on {zones_text(result)} m"
         spans = _lift_off_spans(hv, result)
     if result.contact_lost:

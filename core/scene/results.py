@@ -19,6 +19,7 @@ from core import limits
 from core.cache import StageCache, fingerprint
 from core.coating import model_error_estimate, model_error_map, tilt_share
 from core.problem import QUANTITIES
+from core.scene.contact_zone import contact_width, lift_off_length
 from core.scene.design import DesignCheck, DesignLimits, design_check
 from core.scene.display import HISTORIES, html_summary, solver_settings, text_summary
 from core.scene.display import to_dataframe as _to_dataframe
@@ -118,7 +119,8 @@ class SceneSolution:
     makes the answer doubtful or unphysical (``flag_messages`` explains each).
     ``contact_set[k]`` lists the ``(start, end)`` intervals [m] where q > 0 at ``times[k]``
     (``[(-a, a)]`` in full contact); ``info["contact"]`` names the contact model that
-    answered (``"full"`` or ``"unilateral"``).
+    answered (``"full"`` or ``"unilateral"``); :attr:`contact_width` and
+    :attr:`lift_off_length` [m] are its lengths (:mod:`core.scene.contact_zone`).
     """
 
     def __init__(self, scene: Scene, problem: DimensionlessProblem,
@@ -194,6 +196,19 @@ class SceneSolution:
     def contact_lost(self) -> bool:
         """Whether the pressure is negative somewhere (the answer is then not physical)."""
         return "contact_lost" in self.flags
+
+    @property
+    def contact_width(self) -> np.ndarray:
+        """The contact width [m] at each output time: the length of :attr:`contact_set`
+        (``2a`` for a full-contact answer, ``contact_lost`` or not; see
+        :func:`core.scene.contact_width`)."""
+        return contact_width(self.contact_set, self.scene.half_width)
+
+    @property
+    def lift_off_length(self) -> np.ndarray:
+        """The length of the base lifted off [m] at each output time: ``2a`` less
+        :attr:`contact_width` (:func:`core.scene.lift_off_length`)."""
+        return lift_off_length(self.contact_set, self.scene.half_width)
 
     def pressure(self, x: Any) -> np.ndarray:
         """Contact pressure q [Pa] at points ``x`` [m] of ``[-a, a]``, shape (len(x), len(times)).
@@ -296,6 +311,7 @@ class SceneSolution:
         header = "time_day,settlement_m,tilt_rad,force_N_per_m,moment_N"
         zones = max((len(z) for z in self.contact_set), default=0)
         unilateral = self.info.get("contact") == "unilateral"
+        widths = self.contact_width
         if unilateral:
             header += ",contact_length_m" + "".join(
                 f",zone{k + 1}_start_m,zone{k + 1}_end_m" for k in range(zones))
@@ -305,7 +321,7 @@ class SceneSolution:
             values = [float(v) for v in row]
             if unilateral:
                 current = self.contact_set[k]
-                values.append(sum(hi - lo for lo, hi in current))
+                values.append(widths[k])
                 for j in range(zones):
                     values.extend(current[j] if j < len(current) else (math.nan, math.nan))
             lines.append(",".join(repr(float(v)) for v in values))

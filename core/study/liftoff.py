@@ -15,15 +15,15 @@ zone ends of the batch's smallest and largest eccentricity (both solved by
 :func:`core.scene.solve`, which also fixes the topology), inverts it for every other
 eccentricity (its error estimated per point against the interpolant of half the degree,
 on the nested points) and solves each point once on its zone ``[c*, 1]``: settlement,
-tilt and the pressure on the plotting grid come from that solve, so ``q_max``, ``q_min``
-and the contact width are the point's own grid extremes (nothing is interpolated through
-the kinks of a max over a grid). The discretization error is that of each family point
-against the next coarser panel rule, as :func:`core.contact.refine_zone_ends`
-estimates it. A point is answered only when its zone end is within a third of
-:data:`core.contact.ZONE_END_TOL` (the interpolant's estimate, the discretization's
-and the zone's own miss of ``e`` through ``de/dc``), its outputs within a third of
-``tol``, and its pressure passes the contact set's check; the others are left to
-:func:`core.scene.solve`.
+tilt and the pressure on the plotting grid come from that solve, so ``q_max`` and ``q_min``
+are the point's own grid extremes (nothing is interpolated through the kinks of a max over
+a grid), and the contact width is its zone's length. The discretization error is that of
+each family point against the next coarser panel rule, as
+:func:`core.contact.refine_zone_ends` estimates it. A point is answered only when its
+zone end is within a third of :data:`core.contact.ZONE_END_TOL` (the interpolant's
+estimate, the discretization's and the zone's own miss of ``e`` through ``de/dc``), its
+outputs within a third of ``tol``, and its pressure passes the contact set's check; the
+others are left to :func:`core.scene.solve`.
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ from core.contact import (
     zone_panels,
 )
 from core.discretize import kernel_operator, operator_rows
-from core.scene import LARGE_TILT, Scene, plotting_grid, scene_model_error
+from core.scene import LARGE_TILT, Scene, contact_width, plotting_grid, scene_model_error
 from core.study.outputs import point_outputs
 
 __all__ = ["FAMILY_MIN_ECCENTRICITIES", "LiftoffAnswer", "liftoff_family"]
@@ -292,7 +292,9 @@ def _solved_point(space: Space, c_rel: float, end: float, side: int, res: Resolu
     if np.any(grid[inside] < -scale) or np.any(grid[~inside] > scale):
         return None
     q = np.where(inside, np.maximum(grid, 0.0), 0.0)
-    point = _point_values(problem, scene.half_width, force, e, settlement, tilt, q, x,
+    a = scene.half_width
+    zone = (a * end, a) if side > 0 else (-a, a * end)  # as SceneSolution scales its zones
+    point = _point_values(problem, a, force, e, settlement, tilt, q, x, zone,
                           pressure_scale, outputs)
     # the discretization's estimate and the change of the outputs over the eccentricity
     # the zone misses (per unit force they move by about their own size over e)
@@ -306,14 +308,16 @@ def _dimensionless_force(problem: Any, force: float, a: float) -> float:
 
 
 def _point_values(problem: Any, a: float, force: float, e: float, settlement: float,
-                  tilt: float, q: np.ndarray, x: np.ndarray, pressure_scale: np.ndarray,
+                  tilt: float, q: np.ndarray, x: np.ndarray, zone: tuple[float, float],
+                  pressure_scale: np.ndarray,
                   outputs: Sequence[str]) -> tuple[np.ndarray, SimpleNamespace]:
-    """The outputs of one point (``q`` the pressure per unit force on the grid ``x``) as
-    :func:`core.study.point_outputs` takes them from a
-    :class:`core.scene.SceneSolution`, and that point's histories."""
+    """The outputs of one point (``q`` the pressure per unit force on the grid ``x``,
+    ``zone`` its contact zone [m] at every time) as :func:`core.study.point_outputs` takes
+    them from a :class:`core.scene.SceneSolution`, and that point's histories."""
     p_star = _dimensionless_force(problem, force, a)
     n = pressure_scale.size
     result = SimpleNamespace(
+        contact_width=contact_width([[zone]] * n, a),
         settlement=np.full(n, a * settlement * p_star), tilt=np.full(n, tilt * p_star),
         force=p_star * pressure_scale * a, moment=e * p_star * pressure_scale * a * a,
         x=x, pressure_on_grid=(p_star * q)[:, None] * pressure_scale[None, :])

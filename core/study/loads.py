@@ -41,9 +41,8 @@ from core.engines.layered import (
     uniform_layers,
 )
 from core.profiles import profile_values
-from core.scene import LARGE_TILT, Scene, plotting_grid
+from core.scene import LARGE_TILT, Scene, contact_width, plotting_grid
 from core.study.definition import OUTPUT_UNITS
-from core.study.outputs import contact_width
 from core.validation import MAX_MAGNITUDE
 
 __all__ = ["LoadBatch", "load_batch_applies", "solve_load_batch"]
@@ -202,6 +201,8 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
                    "force": fine["force"][:, None] * pressure_scale * a,
                    "moment": fine["moment"][:, None] * pressure_scale * a * a}
     n = len(error)
+    # every point here is a full-contact answer: its contact set is the whole base
+    width = contact_width([[(-a, a)]], a)[0]
     rows = np.empty((n, len(outputs), times.size))
     for k in range(times.size):
         q = q_star * pressure_scale[k]
@@ -215,7 +216,7 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
             elif name == "q_min":
                 rows[:, j, k] = np.min(q, axis=0)
             else:
-                rows[:, j, k] = contact_width(x, q)
+                rows[:, j, k] = width
         keep &= np.all(np.isfinite(q), axis=0)
     # core.scene.pipeline._check_finite refuses a non-finite answer with its message
     keep &= np.all(np.isfinite(rows), axis=(1, 2))

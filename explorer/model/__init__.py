@@ -24,7 +24,14 @@ from .code_creep_state import (
     CodeCreepState,
     creep_coefficient_data,
 )
-from .contact_zone import contact_text, contact_widths, contact_zones, lifts_off
+from .contact_zone import (
+    contact_text,
+    contact_widths,
+    contact_zones,
+    lift_off_lengths,
+    lifts_off,
+    lifts_or_pulls,
+)
 from .design import (
     DesignLimits,
     check_html,
@@ -75,7 +82,8 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "LayerState", "Lesson", "Pin", "PinBoard", "PlannedStudy", "ProfileState", "ResultView",
            "SceneHistory", "Screen", "StudyResult", "check_html", "check_text", "contact_text",
            "contact_widths", "contact_zones", "creep_coefficient_data", "decode_scene",
-           "default_range", "design_check", "encode_scene", "lessons", "lifts_off", "plan_study",
+           "default_range", "design_check", "encode_scene", "lessons", "lift_off_lengths",
+           "lifts_off", "lifts_or_pulls", "plan_study",
            "prepare_view", "preset_label", "presets", "read_study_query", "read_view_query",
            "scene_limits", "scene_with_limits", "screen_limits", "step_scene", "study_choices",
            "view_query"]

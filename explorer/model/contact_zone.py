@@ -1,35 +1,62 @@
 """The contact zone of a result in numbers: where the base touches, how wide, how much lifts.
 
-A unilateral solve reports its contact set per output time (``ResultView.contact_set``);
-a full-contact solve that lost contact reports negative pressure instead, and
-:meth:`~explorer.model.results.ResultView.negative_intervals` turns either into the lifted
-parts. Everything here follows that one rule, so the drawing, the width plot, the
-readout and the design check never disagree. Nothing here imports Panel or Bokeh.
+The contact width and the lift-off length are the core's (:func:`core.scene.contact_width`,
+:func:`core.scene.lift_off_length`): the lengths of the contact set the solver reported
+(``ResultView.contact_set``), so the width plot, the readout, the design check, the files
+and a study's ``contact_width`` never disagree. A full-contact answer keeps the whole base
+in contact (width ``2a``) even when it lost contact; where it pulls (q < 0 beyond the
+error band) is drawn and named apart, as
+:meth:`~explorer.model.results.ResultView.negative_intervals` gives it (the lifted parts of
+a unilateral answer, or those pulling parts). Nothing here imports Panel or Bokeh.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from core.scene import contact_width, lift_off_length
+from core.scene import lifts_off as core_lifts_off
+
 from .results import ResultView, lifted_intervals
 
 
+def _contact_set(view: ResultView) -> list[list[tuple[float, float]]]:
+    """The view's contact set, one entry per output time; a solution that reports none
+    answered with the full-contact model: the whole base at every time."""
+    if len(view.contact_set) == len(view.times):
+        return view.contact_set
+    a = view.geometry.half_width
+    return [[(-a, a)] for _ in view.times]
+
+
 def contact_zones(view: ResultView, index: int) -> list[tuple[float, float]]:
-    """Intervals of ``x`` [m] in contact at output ``index`` (the whole ``[-a, a]`` in full
-    contact): the complement of the lifted parts."""
+    """Intervals of ``x`` [m] drawn in contact at output ``index`` (the whole ``[-a, a]``
+    in full contact): the complement of the parts drawn lifted off or pulling."""
     a = view.geometry.half_width
     return lifted_intervals(view.negative_intervals(index), a)
 
 
 def contact_widths(view: ResultView) -> np.ndarray:
-    """Total length in contact [m] at each output time (``2a`` in full contact)."""
-    a = view.geometry.half_width
-    return np.array([2 * a - sum(hi - lo for lo, hi in view.negative_intervals(j))
-                     for j in range(len(view.times))], dtype=float)
+    """The contact width [m] at each output time (``2a`` in full contact), the core's
+    :func:`core.scene.contact_width` of the view's contact set."""
+    return contact_width(_contact_set(view), view.geometry.half_width)
+
+
+def lift_off_lengths(view: ResultView) -> np.ndarray:
+    """The length of the base lifted off [m] at each output time (0 in full contact), the
+    core's :func:`core.scene.lift_off_length`."""
+    return lift_off_length(_contact_set(view), view.geometry.half_width)
 
 
 def lifts_off(view: ResultView) -> bool:
-    """Whether some part of the base is lifted off at some output time."""
+    """Whether the contact set is narrower than the base at some output time (the core's
+    :func:`core.scene.lifts_off`)."""
+    return bool(np.any(core_lifts_off(_contact_set(view), view.geometry.half_width)))
+
+
+def lifts_or_pulls(view: ResultView) -> bool:
+    """Whether some part of the base is drawn lifted off or pulling (q < 0 of a
+    full-contact answer that lost contact) at some output time."""
     return any(view.negative_intervals(j) for j in range(len(view.times)))
 
 
@@ -49,15 +76,19 @@ def _fmt_m(value: float) -> str:
 
 def contact_text(view: ResultView, index: int) -> str:
     """The contact at output ``index`` in plain words, lengths in m, e.g. "contact
-    1.306 m of 2 m (65 %), lifted 0.694 m: x = -1 to -0.306 m (unilateral contact)"."""
+    1.306 m of 2 m (65 %), lifted 0.694 m: x = -1 to -0.306 m (unilateral contact)", or
+    for a full-contact answer that pulls "contact 2 m of 2 m, as the full-contact model
+    assumes; q < 0 (contact lost) on 0.372 m: x = -1 to -0.628 m (not physical)"."""
     a = view.geometry.half_width
-    lifted = view.negative_intervals(index)
     full = 2 * a
-    if not lifted:
-        return f"full contact: the whole width 2a = {_fmt_m(full)} m touches"
-    width = full - sum(hi - lo for lo, hi in lifted)
-    where = ", ".join(f"x = {_fmt_m(lo)} to {_fmt_m(hi)} m" for lo, hi in lifted)
-    kind = ("lifted" if view.info.get("contact") == "unilateral"
-            else "q < 0 (contact lost)")
-    return (f"contact {_fmt_m(width)} m of {_fmt_m(full)} m ({100 * width / full:.0f} %), "
-            f"{kind} {_fmt_m(full - width)} m: {where} ({model_name(view)})")
+    off = view.negative_intervals(index)
+    where = ", ".join(f"x = {_fmt_m(lo)} to {_fmt_m(hi)} m" for lo, hi in off)
+    width = float(contact_widths(view)[index])
+    if core_lifts_off(_contact_set(view)[index:index + 1], a)[0]:
+        return (f"contact {_fmt_m(width)} m of {_fmt_m(full)} m ({100 * width / full:.0f} %), "
+                f"lifted {_fmt_m(full - width)} m: {where} ({model_name(view)})")
+    if off:
+        pulled = sum(hi - lo for lo, hi in off)
+        return (f"contact {_fmt_m(width)} m of {_fmt_m(full)} m, as the {model_name(view)} "
+                f"assumes; q < 0 (contact lost) on {_fmt_m(pulled)} m: {where} (not physical)")
+    return f"full contact: the whole width 2a = {_fmt_m(full)} m touches"

@@ -2,9 +2,10 @@
 
 :func:`design_check` reads a :class:`~explorer.model.results.ResultView` (no solve): the largest
 and smallest contact pressure over the whole history and where and when they occur, the
-width in contact (the part not lifting off beyond the solver's error band), the
-eccentricity ``e = M/P``, and the largest settlement and tilt, each compared with a limit
-the user sets (:class:`DesignLimits`). The check itself is the core's
+smallest contact width (the core's, :func:`core.scene.contact_width`: ``2a`` for a
+full-contact answer, even one that lost contact), the eccentricity ``e = M/P``, and the
+largest settlement and tilt, each compared with a limit the user sets
+(:class:`DesignLimits`). The check itself is the core's
 (:func:`core.scene.check_design`, the one the command line and scene files' ``limits``
 use); this module holds the screen's units and the limits as the Check tab sets them.
 Nothing here imports Panel.
@@ -23,6 +24,7 @@ import param
 from core.scene import DesignLimits as CoreLimits
 from core.scene import LimitCheck, check_design
 
+from .contact_zone import contact_widths
 from .results import ResultView
 from .state import QUANTITY_UNITS
 
@@ -89,11 +91,6 @@ _LIMITS = (("allowable_pressure", "q_max"), ("settlement_limit", "settlement"),
            ("tilt_limit", "tilt"))
 
 
-def _contact_width(view: ResultView, index: int) -> float:
-    lifted = sum(hi - lo for lo, hi in view.negative_intervals(index))
-    return float(2 * view.geometry.half_width - lifted)
-
-
 def core_limits(limits: DesignLimits | None) -> CoreLimits:
     """The session's limits (kPa, mm, mrad) as the core's (Pa, m, rad)."""
     if limits is None:
@@ -146,13 +143,13 @@ def design_check(view: ResultView, limits: DesignLimits | None = None) -> Design
     contact width and the eccentricity the screen shows beside it."""
     verdict = check_design(view.times, view.x, view.pressure, view.values["settlement"],
                            view.values["tilt"], core_limits(limits))
-    widths = [_contact_width(view, j) for j in range(len(view.times))]
+    widths = contact_widths(view)
     j_narrow = int(np.argmin(widths))
     force = float(view.values["force"][-1])
     moment = float(view.values["moment"][-1])
     checks = [_on_screen(line, limits) for line in verdict.checks]
     return DesignCheck(q_max=checks[0], q_min=_on_screen(verdict.q_min, limits),
-                       contact_width=widths[j_narrow],
+                       contact_width=float(widths[j_narrow]),
                        full_width=2 * view.geometry.half_width,
                        eccentricity=moment / force if force > 0 else None, checks=checks)
 

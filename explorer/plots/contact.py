@@ -12,7 +12,15 @@ from bokeh.core.properties import value as fixed_label
 from bokeh.models import ColumnDataSource, HoverTool, Label, Range1d, Span
 from bokeh.plotting import figure
 
-from ..model import Geometry, ResultView, contact_widths, contact_zones, lifts_off
+from ..model import (
+    Geometry,
+    ResultView,
+    contact_widths,
+    contact_zones,
+    lift_off_lengths,
+    lifts_off,
+    lifts_or_pulls,
+)
 from .bokeh_data import MOVING, f32, legend_above, set_data
 
 # navy: apart from the viridis colours of the coating it lies on; red as the lifted
@@ -104,20 +112,22 @@ class ContactDrawing:
         widths = contact_widths(view)
         self._widths = widths
         set_data(self.width_src, {"t": f32(view.times), "width": f32(widths),
-                                  "lifted": f32(2 * a - widths)})
+                                  "lifted": f32(lift_off_lengths(view))})
         self.width_fig.y_range.start = 0.0
         self.width_fig.y_range.end = 2.1 * a
         label = fixed_label(GAP_LABEL if view.info.get("contact") == "unilateral"
                             else PULL_LABEL)
-        lifting = lifts_off(view)
+        dashed = lifts_or_pulls(view)
         for item in self.scene_legend.items:
             if self.lifted_line in item.renderers:
                 if item.label != label:
                     item.label = label
-                item.visible = lifting  # listed only when some time has a lifted part
+                item.visible = dashed  # listed only when some time has a dashed part
         # short titles: at 1024 px this figure is ~300 px wide
         if lifts_off(view):
             self.width_fig.title.text = "Contact width [m]: lift-off"
+        elif dashed:  # the full-contact model's width is 2a, though it pulls somewhere
+            self.width_fig.title.text = "Contact width [m]: full-contact model, q < 0"
         else:
             self.width_fig.title.text = "Contact width [m]: full contact"
 
@@ -138,8 +148,12 @@ class ContactDrawing:
         t = float(view.times[index])
         width = float(self._widths[index]) if index < len(self._widths) else 2 * a
         self.zone_label.update(x=-1.52 * a, y=float(np.max(y)))
-        self.zone_label.text = (f"contact {width:.3f} m of {2 * a:.3g} m at t = {t:.4g} days"
-                                if lifted else f"full contact at t = {t:.4g} days")
+        if width < 2 * a and lifted:
+            self.zone_label.text = f"contact {width:.3f} m of {2 * a:.3g} m at t = {t:.4g} days"
+        elif lifted:
+            self.zone_label.text = f"full-contact model, q < 0 at t = {t:.4g} days"
+        else:
+            self.zone_label.text = f"full contact at t = {t:.4g} days"
         self.width_cursor.location = t
         set_data(self.width_point, {"t": [t], "v": [width]})
 

@@ -24,7 +24,7 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from ..model import QUANTITIES, QUANTITY_UNITS, DisplayScales, Pin, ResultView, lifts_off
+from ..model import QUANTITIES, QUANTITY_UNITS, DisplayScales, Pin, ResultView, lifts_or_pulls
 from .bokeh_data import MOVING, f32, legend_above, set_data, steady_range, wrap_legend
 from .classical import bearing_rule_pressure, half_space_pressure
 from .contact import ContactDrawing, FeatureInset
@@ -248,7 +248,7 @@ class Figures:
     def _label_strips(self, view: ResultView) -> None:
         label = LIFTED_LABEL if view.info.get("contact") == "unilateral" else LOST_LABEL
         # listed only for a result with shaded strips at some time
-        shaded = lifts_off(view)
+        shaded = lifts_or_pulls(view)
         for item in self.q_fig.legend[0].items:
             if self.neg_strip in item.renderers:
                 if item.label != fixed_label(label):

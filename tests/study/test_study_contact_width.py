@@ -1,0 +1,84 @@
+"""A study's ``contact_width`` is the length of each point's contact set, as
+``SceneSolution.contact_width`` gives it (:func:`core.scene.contact_width`), through the
+Python API and the command line: the lift-off preset at M = 480 kN m/m touches on
+[-0.3486, 1] m at 1000 days, 1.3486 m of its 2 m, not the 2 m where q >= 0 (q = 0 on the
+lifted heel). A full-contact answer keeps the whole width, flagged or not."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.scene import solve
+from core.study import study_from_dict
+from core.study.definition import apply_point
+from tests.cli_runs import run_cli
+from tests.conftest import scene_file
+
+#: The preset's moment, and none (full contact) [N m/m].
+MOMENTS = [4.8e5, 0.0]
+#: The lift-off preset's contact width at 1000 days [m], to the 5e-5 m of its digits.
+LAST_WIDTH = 1.3486
+
+
+def liftoff_study(contact: str | None = None) -> dict:
+    scene = scene_file("eccentric_footing_liftoff")
+    if contact is not None:
+        scene["solver"]["contact"] = contact
+    return {"study_version": 1, "name": "contact width", "scene": scene,
+            "vary": [{"field": "loading.moment", "values": MOMENTS}],
+            "outputs": ["q_min", "contact_width"]}
+
+
+def solved(study: dict) -> list:
+    return [solve(apply_point(study["scene"], {"loading.moment": m})) for m in MOMENTS]
+
+
+def test_a_study_records_the_width_of_the_contact_set() -> None:
+    pytest.importorskip("xarray")
+    from core.study import sweep
+
+    study = liftoff_study()
+    ds = sweep(study_from_dict(study), client="serial")
+    for i, result in enumerate(solved(study)):
+        # the same solver on the same scene: measured bitwise equal
+        np.testing.assert_array_equal(ds.contact_width.values[i], result.contact_width)
+    lifted, full = ds.contact_width.values
+    assert lifted[-1] == pytest.approx(LAST_WIDTH, abs=5e-5)
+    assert ds.q_min.values[0, -1] == 0.0  # the lifted heel carries q = 0 ...
+    assert np.all(lifted < 2.0)            # ... and is not in contact
+    np.testing.assert_array_equal(full, 2.0)
+
+
+def test_a_full_contact_study_keeps_the_whole_width_where_it_pulls() -> None:
+    pytest.importorskip("xarray")
+    from core.study import sweep
+
+    ds = sweep(study_from_dict(liftoff_study("full")), client="serial")
+    assert ds.flag_contact_lost.values.tolist() == [True, False]
+    assert np.all(ds.q_min.values[0] < 0)
+    np.testing.assert_array_equal(ds.contact_width.values, 2.0)
+
+
+def test_the_command_line_sweep_writes_the_width_of_the_contact_set(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``python -m core sweep`` in this process, its Dask cluster replaced by the serial
+    runner (the cluster itself: tests/study/test_sweep.py)."""
+    pd = pytest.importorskip("pandas")
+    import core.study
+
+    study = liftoff_study()
+    (tmp_path / "study.json").write_text(json.dumps(study))
+    run_sweep = core.study.sweep
+    monkeypatch.setattr(core.study, "sweep",
+                        lambda *args, **kwargs: run_sweep(*args, client="serial", **kwargs))
+    done = run_cli("sweep", "study.json", "--output", "r.csv", "--quiet", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    rows = pd.read_csv(tmp_path / "r.csv", comment="#").sort_values(["point", "time_day"])
+    widths = rows["contact_width_m"].to_numpy().reshape(len(MOMENTS), -1)
+    for i, result in enumerate(solved(study)):
+        np.testing.assert_array_equal(widths[i], result.contact_width)
+    assert widths[0, -1] == pytest.approx(LAST_WIDTH, abs=5e-5)
