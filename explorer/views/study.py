@@ -250,7 +250,14 @@ class StudyView:
         self.study_progress.visible = busy
         self.study_progress.max = max(run.total, 1)
         self.study_progress.value = min(run.done, max(run.total, 1))
-        self._say(run.message, bad=run.status == "failed")
+        if run.status == "done" and run.result is not None:
+            # the same words whichever of the run's and the result's events comes last
+            self._say(self._done_text(run.result))
+        else:
+            self._say(run.message, bad=run.status == "failed")
+
+    def _done_text(self, result: Any) -> str:
+        return f"Done: {self.study_run.message}. Marks: {flag_note(result)}."
 
     def _on_result(self, event: Any) -> None:
         result = event.new
@@ -273,7 +280,7 @@ class StudyView:
         self.study_csv.filename = f"{stem}_study.csv"
         self.study_png.filename = f"{stem}_study.png"
         self.study_csv.disabled = self.study_png.disabled = False
-        self._say(f"Done: {self.study_run.message}. Marks: {flag_note(result)}.")
+        self._say(self._done_text(result))
 
     def _redraw(self) -> None:
         if self.study_charts is not None and self.study_time.value is not None:
