@@ -48,8 +48,15 @@ LOAD_SAMPLES = 2001
 
 
 def number(value: float, digits: int = 4) -> str:
-    """``value`` with ``digits`` significant digits ("not finite" for NaN and infinity)."""
-    return f"{value:.{digits}g}" if np.isfinite(value) else "not finite"
+    """``value`` with ``digits`` significant digits ("not finite" for NaN and infinity),
+    without an exponent from 0.001 to a million (50 years read "18260 d", not
+    "1.826e+04 d")."""
+    if not np.isfinite(value):
+        return "not finite"
+    if value == 0 or 1e-3 <= abs(value) < 1e6:
+        return np.format_float_positional(float(value), precision=digits, unique=False,
+                                          fractional=False, trim="-")
+    return f"{value:.{digits}g}"
 
 
 def _with_unit(value: float, unit: str) -> str:

@@ -206,3 +206,10 @@ def test_a_missing_plotting_package_is_named_with_its_extra(monkeypatch, checked
     monkeypatch.setitem(sys.modules, "matplotlib", None)
     with pytest.raises(MissingDependency, match=r"coated-punch\[report\]"):
         report_pdf(checked)
+
+
+def test_long_times_read_without_an_exponent():
+    result = core.solve(read_preset("young_concrete_50_years"))
+    assert result.times[-1] > 1e4  # 50 years of days
+    text = "".join(f"{label} {value}" for s in sections(result) for label, value in s.rows)
+    assert "e+04" not in text and f"{round(result.times[-1], -1):.0f} d" in text
