@@ -325,7 +325,7 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     text = Path(info.value.path()).read_text()
     assert info.value.suggested_filename.endswith("_report.html")
     assert "<h2>Design check</h2>" in text and "Every limit the scene sets holds." in text
-    assert "; limit 1e+05 kPa, utilisation" in text  # the 100000 kPa typed
+    assert "; limit 100000 kPa, utilisation" in text  # the 100000 kPa typed
     assert f"coated-punch {core.__version__}, " in text and "No validity flag" in text
     assert "numerical error (estimated, relative)" in text
     assert "<td>moment M (given)</td><td>100 kN·m/m</td>" in text  # from e = 0.2 m typed
