@@ -36,9 +36,10 @@ and ``warning: design_check: <line>`` lines on stderr, with exit code 0 unless
 from __future__ import annotations
 
 import argparse
+import contextlib
 import shutil
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -116,31 +117,33 @@ def _stdin_text() -> str:
         raise _InputError(f"{STDIN_NAME}: not text in UTF-8 (a scene file is JSON)") from None
 
 
-def _read(path: str) -> Scene:
+@contextlib.contextmanager
+def _input_errors(path: str) -> Iterator[None]:
+    """A file that cannot be read, or does not hold a valid scene, is the user's input
+    error: one line naming the file (exit code 2)."""
     try:
-        if path == STDIO:
-            return scene_from_dict(read_scene_json(_stdin_text(), STDIN_NAME))
-        return load_scene(path)
+        yield
     except ValueError as exc:
         raise _InputError(str(exc)) from None
     except IsADirectoryError:
         raise _InputError(f"{path}: is a directory, not a scene file") from None
     except OSError as exc:
         raise _InputError(f"{path}: {exc.strerror or exc}") from None
+
+
+def _read(path: str) -> Scene:
+    with _input_errors(path):
+        if path == STDIO:
+            return scene_from_dict(read_scene_json(_stdin_text(), STDIN_NAME))
+        return load_scene(path)
 
 
 def _read_document(path: str) -> Any:
     """The JSON value of a file (or of standard input), read strictly, not validated."""
     if path == STDIO:
         return read_scene_json(_stdin_text(), STDIN_NAME)
-    try:
+    with _input_errors(path):
         raw = read_regular_file(path, MAX_SCENE_BYTES)
-    except ValueError as exc:
-        raise _InputError(str(exc)) from None
-    except IsADirectoryError:
-        raise _InputError(f"{path}: is a directory, not a scene file") from None
-    except OSError as exc:
-        raise _InputError(f"{path}: {exc.strerror or exc}") from None
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
