@@ -84,6 +84,8 @@ EXIT_FLAGGED = 4
 STDIO = "-"
 #: How standard input is named in messages.
 STDIN_NAME = "<stdin>"
+#: FE mesh level of ``check`` by default and of ``report --fe-check`` (0: ~1 s, P to ~2e-4).
+FE_CHECK_LEVEL = 0
 
 _UNITS = {"settlement": "m", "tilt": "rad", "force": "N/m", "moment": "N"}
 
@@ -303,12 +305,14 @@ def _output_format(option: str, path: Path | None, given: str | None) -> str | N
     return suffix[1:]
 
 
-def _strict_verdict(result: SceneSolution) -> int:
-    """The exit code of ``solve --strict`` for ``result``, its reasons on stderr."""
+def _strict_verdict(result: SceneSolution, flags: Sequence[str] | None = None) -> int:
+    """The exit code of ``solve --strict`` for ``result``, its reasons on stderr
+    (``flags``: the result's flags as the best evidence has them, default its own)."""
     check = result.design_check()
     failed = check is not None and check.passed is False
-    if result.flags:
-        print(f"error: strict: the answer is flagged ({', '.join(result.flags)}); "
+    flags = result.flags if flags is None else list(flags)
+    if flags:
+        print(f"error: strict: the answer is flagged ({', '.join(flags)}); "
               f"exit code {EXIT_FLAGGED}", file=sys.stderr)
         return EXIT_FLAGGED
     if failed:
@@ -374,8 +378,17 @@ def _cmd_report(args: argparse.Namespace) -> int:
         output_index(result, args.time)
     except ValueError as exc:
         raise _InputError(f"--{exc}") from None
+    fe_check = None
+    if args.fe_check:
+        from core.scene import check_scene
+
+        try:
+            fe_check = check_scene(result.scene, 0.0, level=FE_CHECK_LEVEL)
+        except (ArithmeticError, ValueError, RuntimeError, MemoryError) as exc:
+            print(f"error: check: {_one_line(exc)}", file=sys.stderr)
+            return EXIT_SOLVER_FAILED
     if fmt == "pdf":
-        data = report_pdf(result, args.time)
+        data = report_pdf(result, args.time, check=fe_check)
         if stdout:
             sys.stdout.buffer.write(data)
             sys.stdout.flush()
@@ -387,10 +400,19 @@ def _cmd_report(args: argparse.Namespace) -> int:
             except OSError as exc:
                 raise _InputError(f"{output}: cannot write ({exc.strerror or exc})") from None
     else:
-        _write(output, report_html(result, args.time))
-    for name in result.flags:
-        print(f"warning: {name}: {_one_line(result.flag_messages[name])}", file=sys.stderr)
-    return _strict_verdict(result) if args.strict else EXIT_OK
+        _write(output, report_html(result, args.time, check=fe_check))
+    from core.scene import flags_with_evidence, model_error_evidence
+
+    evidence = model_error_evidence(result.scene, result.model_error["estimate"], fe_check)
+    flags = flags_with_evidence(result.flags, evidence)
+    messages = {**result.flag_messages, "model_error": evidence["message"]}
+    if fe_check is not None:
+        print(f"coating model error: {100 * evidence['error']:.2f} % measured by the FE "
+              f"check at loading, {100 * evidence['estimate']:.2g} % estimated "
+              f"(solver.model_tol {100 * evidence['model_tol']:g} %)", file=sys.stderr)
+    for name in flags:
+        print(f"warning: {name}: {_one_line(messages[name])}", file=sys.stderr)
+    return _strict_verdict(result, flags) if args.strict else EXIT_OK
 
 
 def _cmd_schema(args: argparse.Namespace) -> int:
@@ -529,6 +551,11 @@ def build_parser() -> argparse.ArgumentParser:
                           help=f"exit with {EXIT_DESIGN_FAILED} when a limit is exceeded, "
                                f"{EXIT_FLAGGED} when the answer is flagged (the report is "
                                "written all the same)")
+    p_report.add_argument("--fe-check", action="store_true",
+                          help="also run the finite-element check of the coating model at "
+                               "loading (as 'check', ~1 s) and report its measured error "
+                               "next to the estimate; the measurement decides the "
+                               "model_error flag")
     p_report.set_defaults(run=_cmd_report)
     p_schema = sub.add_parser("schema", help="print the JSON Schema of scene or study files")
     p_schema.add_argument("kind", nargs="?", choices=tuple(SCHEMA_FILES), default="scene",
@@ -557,7 +584,7 @@ def build_parser() -> argparse.ArgumentParser:
     p_check.add_argument("scene", help="scene file (JSON) or preset:NAME")
     p_check.add_argument("--time", type=float, default=0.0, metavar="DAYS",
                          help="days after loading: base modulus and given loads (default 0)")
-    p_check.add_argument("--level", type=int, choices=(0, 1), default=0,
+    p_check.add_argument("--level", type=int, choices=(0, 1), default=FE_CHECK_LEVEL,
                          help="FE mesh level: 0 (~1 s, force to ~2e-4) or 1 (~10 s, ~2e-5)")
     p_check.set_defaults(run=_cmd_check)
     return parser

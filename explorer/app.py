@@ -147,7 +147,8 @@ class ExplorerApp(pn.viewable.Viewer):
         self.scene_tab = SceneView(state, self.presets, self.preset_key, self.history,
                                    self.load_scene, controller, screen.reject)
         self.punch_tab = PunchView(state, screen, live)
-        self.coating_tab = CoatingView(state, self.fidelity, controller, loop, live)
+        self.coating_tab = CoatingView(state, self.fidelity, controller, loop, live,
+                                       screen)
         self.base_tab = BaseView(state, screen.reject, live)
         self.times_tab = TimesView(state, self.fidelity, screen.reject, live)
         self.check_tab = CheckView(state, self.limits, screen)

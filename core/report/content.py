@@ -4,6 +4,7 @@ with a check, as plain text rows (the HTML and PDF writers only lay them out).""
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from typing import Any
@@ -13,7 +14,7 @@ import numpy as np
 from core.report.contact import contact_text, lift_off_times, output_index
 from core.report.inputs import SHOWN_UNITS, input_rows
 from core.report.inputs import number as _number
-from core.scene import SceneSolution, engine_text
+from core.scene import SceneSolution, engine_text, flags_with_evidence, model_error_evidence
 from core.version import VERSION
 
 
@@ -82,9 +83,20 @@ def key_numbers(result: SceneSolution, time: float | None = None) -> list[tuple[
     return rows
 
 
-def accuracy_rows(result: SceneSolution) -> list[tuple[str, str]]:
-    """The numerical error estimate against its target, and the coating model's error."""
+def model_evidence(result: SceneSolution,
+                   check: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """:func:`core.scene.model_error_evidence` of ``result``: the FE check's measurement
+    when ``check`` was made for its scene, else the result's estimate."""
+    return model_error_evidence(result.scene, float(result.model_error["estimate"]), check)
+
+
+def accuracy_rows(result: SceneSolution,
+                  check: Mapping[str, Any] | None = None) -> list[tuple[str, str]]:
+    """The numerical error estimate against its target, and the coating model's error
+    (measured by ``check``, a :func:`core.scene.check_scene` report of the scene, next
+    to the estimate when it applies)."""
     info = result.info
+    evidence = model_evidence(result, check)
     error = info.get("error_estimate")
     target = f" (target {result.scene.tol:g}: " + (
         "NOT met)" if "tol_not_met" in result.flags else "met)")
@@ -92,9 +104,16 @@ def accuracy_rows(result: SceneSolution) -> list[tuple[str, str]]:
         ("numerical error (estimated, relative)",
          (f"{float(error):.1e}" if isinstance(error, (int, float)) else "not available")
          + target),
+        *([(f"coating model error ({evidence['label']}, relative)",
+            f"{evidence['measured']:.1e} at t = {_number(evidence['time_day'])} d "
+            f"(flagged above {result.scene.model_tol:g}: "
+            + ("FLAGGED)" if evidence["flagged"] else "within)"))]
+          if evidence["source"] == "measured" else []),
         ("coating model error (estimated, relative)",
          f"{float(result.model_error['estimate']):.1e} (flagged above "
-         f"{result.scene.model_tol:g})"),
+         f"{result.scene.model_tol:g})"
+         + ("; the FE check's measurement above overrides it"
+            if evidence["source"] == "measured" else "")),
         ("solved by", engine_text(result)),
         ("discretization", _discretization(info)),
         ("solver's message", str(info.get("message", ""))),
@@ -133,9 +152,12 @@ def design_section(result: SceneSolution) -> Section | None:
                    "Every limit the scene sets holds.", rows, tone="bad" if failed else "good")
 
 
-def sections(result: SceneSolution, time: float | None = None) -> list[Section]:
+def sections(result: SceneSolution, time: float | None = None,
+             check: Mapping[str, Any] | None = None) -> list[Section]:
     """The report's sections, in order; ``time`` [day after loading]: the output time
-    nearest to it is the one whose contact the results describe (default: the last).
+    nearest to it is the one whose contact the results describe (default: the last);
+    ``check``: a :func:`core.scene.check_scene` report; made for this scene, its measured
+    coating-model error overrides the estimate (the ``model_error`` flag, the accuracy).
 
     Raises
     ------
@@ -155,10 +177,13 @@ def sections(result: SceneSolution, time: float | None = None) -> list[Section]:
                   "settlement mm, tilt mrad, force kN/m, moment kN·m/m; the scene file "
                   "in SI"),
     ])]
-    if result.flags:
+    evidence = model_evidence(result, check)
+    flags = flags_with_evidence(result.flags, evidence)
+    messages = {**result.flag_messages, "model_error": evidence["message"]}
+    if flags:
         out.append(Section("Validity", "This result is flagged: the model cannot fully "
                            "stand behind it.",
-                           [(name, result.flag_messages[name]) for name in result.flags],
+                           [(name, messages[name]) for name in flags],
                            tone="bad"))
     else:
         out.append(Section("Validity", "No validity flag: the model stands behind this "
@@ -167,7 +192,7 @@ def sections(result: SceneSolution, time: float | None = None) -> list[Section]:
     if design is not None:
         out.append(design)
     out.append(Section("Results", rows=key_numbers(result, time)))
-    out.append(Section("Accuracy", rows=accuracy_rows(result)))
+    out.append(Section("Accuracy", rows=accuracy_rows(result, check)))
     out.append(Section("Inputs", rows=input_rows(scene)))
     return out
 
@@ -177,7 +202,8 @@ def scene_json(result: SceneSolution) -> str:
     return json.dumps(result.scene.to_dict(), indent=1, allow_nan=False)
 
 
-def describe(result: SceneSolution, time: float | None = None) -> dict[str, Any]:
+def describe(result: SceneSolution, time: float | None = None,
+             check: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The report's text as one JSON-able dict (what the tests read)."""
     return {s.title: {"lead": s.lead, "rows": dict(s.rows), "tone": s.tone}
-            for s in sections(result, time)}
+            for s in sections(result, time, check)}

@@ -5,6 +5,8 @@ file opens and prints with no network), and the scene file itself."""
 from __future__ import annotations
 
 import html
+from collections.abc import Mapping
+from typing import Any
 
 from core.optional import import_optional
 from core.report.content import Section, scene_json, sections
@@ -47,7 +49,8 @@ def _plots(result: SceneSolution, time: float | None) -> tuple[str, str]:
     return resources.INLINE.render() + script, div
 
 
-def report_html(result: SceneSolution, time: float | None = None) -> str:
+def report_html(result: SceneSolution, time: float | None = None,
+                check: Mapping[str, Any] | None = None) -> str:
     """The report of ``result`` as a complete HTML document (text).
 
     Parameters
@@ -57,6 +60,10 @@ def report_html(result: SceneSolution, time: float | None = None) -> str:
     time : float, optional
         A time t [day after loading] the reader chose: the contact at the output time
         nearest to it is described, and its q(x) drawn (default: the last output time).
+    check : mapping, optional
+        A report of :func:`core.scene.check_scene`: made for this scene, its measured
+        coating-model error is reported next to the estimate and overrides it (the
+        ``model_error`` flag); a check of another scene is ignored.
 
     Returns
     -------
@@ -73,7 +80,7 @@ def report_html(result: SceneSolution, time: float | None = None) -> str:
     MissingDependency
         Without HoloViews or Bokeh (the ``report`` extra).
     """
-    text = sections(result, time)
+    text = sections(result, time, check)
     head, plots = _plots(result, time)
     title = html.escape(str(result.scene.name or "scene"))
     body = "".join(_section(s) for s in text)

@@ -8,6 +8,8 @@ import io
 import os
 import textwrap
 import warnings
+from collections.abc import Mapping
+from typing import Any
 
 from core.optional import import_optional
 from core.report.content import scene_json, sections
@@ -22,12 +24,12 @@ CHARACTERS_PER_LINE = 100
 COLOURS = {"bad": "#9b1c1c", "good": "#1d6b2c", "": "#222222"}
 
 
-def _text_lines(result: SceneSolution,
-                time: float | None) -> list[tuple[str, str, bool]]:
+def _text_lines(result: SceneSolution, time: float | None,
+                check: Mapping[str, Any] | None = None) -> list[tuple[str, str, bool]]:
     """(text, tone, bold) lines of the report's sections."""
     lines: list[tuple[str, str, bool]] = [
         (f"Coated punch: {result.scene.name or 'scene'}", "", True), ("", "", False)]
-    for section in sections(result, time):
+    for section in sections(result, time, check):
         lines.append((section.title, "", True))
         if section.lead:
             lines.extend((t, section.tone, False)
@@ -51,10 +53,12 @@ def _text_pages(pdf, plt, lines: list[tuple[str, str, bool]], size: float = 8.5)
         plt.close(figure)
 
 
-def report_pdf(result: SceneSolution, time: float | None = None) -> bytes:
+def report_pdf(result: SceneSolution, time: float | None = None,
+               check: Mapping[str, Any] | None = None) -> bytes:
     """The report of ``result`` as PDF bytes (the sections, the plots, the scene file).
 
-    ``time`` [day after loading]: as for :func:`core.report.report_html`.
+    ``time`` [day after loading], ``check`` (a :func:`core.scene.check_scene` report): as
+    for :func:`core.report.report_html`.
 
     Raises
     ------
@@ -72,7 +76,7 @@ def report_pdf(result: SceneSolution, time: float | None = None) -> bytes:
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_pdf import PdfPages
 
-    lines = _text_lines(result, time)
+    lines = _text_lines(result, time, check)
     layout, titles = report_layout(result, time)
     buffer = io.BytesIO()
     with PdfPages(buffer, metadata={"Title": f"Report: {result.scene.name or 'scene'}",
@@ -99,13 +103,13 @@ def report_pdf(result: SceneSolution, time: float | None = None) -> bytes:
 
 
 def write_report(result: SceneSolution, path: str | os.PathLike,
-                 time: float | None = None) -> None:
+                 time: float | None = None, check: Mapping[str, Any] | None = None) -> None:
     """Write the report of ``result`` to ``path``: PDF for a ``.pdf`` name, else HTML
-    (``time`` [day after loading]: as for :func:`core.report.report_html`)."""
+    (``time`` [day after loading], ``check``: as for :func:`core.report.report_html`)."""
     from core.files import atomic_write_bytes, atomic_write_text
     from core.report.html import report_html
 
     if str(path).lower().endswith(".pdf"):
-        atomic_write_bytes(path, report_pdf(result, time))
+        atomic_write_bytes(path, report_pdf(result, time, check))
     else:
-        atomic_write_text(path, report_html(result, time))
+        atomic_write_text(path, report_html(result, time, check))

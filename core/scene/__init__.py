@@ -21,6 +21,8 @@ returns a ``SceneSolution``.
 - ``json_schema.py``: the JSON Schema of scene files, made from the tables of
   ``schema.py`` and shipped in ``schemas/``;
 - ``coating_check.py``: a scene's fast answer against the finite-element check;
+- ``evidence.py``: ``model_error_evidence``, the coating model's error every output shows
+  (the FE check's measurement once run on the scene, else the estimate);
 - ``golden_section.py``: the least gap between punch and coating.
 """
 
@@ -30,6 +32,7 @@ from core.scene.coating_check import check_scene
 from core.scene.contact_zone import LIFT_OFF_SHARE, contact_width, lift_off_length, lifts_off
 from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
 from core.scene.display import engine_text, known_contact_width, lifts_off_at
+from core.scene.evidence import checked_key, flags_with_evidence, model_error_evidence
 from core.scene.files import load_scene, read_scene_json, save_scene
 from core.scene.json_schema import DIALECT as JSON_SCHEMA_DIALECT
 from core.scene.json_schema import (
@@ -75,6 +78,9 @@ __all__ = [
     "check_design",
     "check_fields",
     "check_scene",
+    "checked_key",
+    "flags_with_evidence",
+    "model_error_evidence",
     "contact_width",
     "design_check",
     "DesignCheck",

@@ -20,6 +20,7 @@ import numpy as np
 from core.coating import NEGLIGIBLE_SHARE, CoatingStrip, Stack, solve_stack
 from core.engines.layered import layered_declines
 from core.problem import QUANTITIES
+from core.scene.evidence import checked_key
 from core.scene.model import Scene
 from core.scene.pipeline import solve
 from core.scene.results import SceneSolution
@@ -69,7 +70,8 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
     |M| / a)`` if that is larger: a centred load has no moment) and of
     the pressure (largest difference on ``|x| <= 0.9 a`` over the largest FE pressure
     there), ``"model_error"``: the largest error of the two unknowns, ``"estimate"``: the
-    map's estimate that results carry, ``"fe_seconds"``, ``"fe_dofs"``.
+    map's estimate that results carry, ``"scene_key"``: :func:`core.scene.checked_key` of
+    the scene (which results the measurement applies to), ``"fe_seconds"``, ``"fe_dofs"``.
     """
     scene = scene_from_dict(scene)
     if not np.isfinite(time) or not 0.0 <= time <= float(scene.times[-1]):
@@ -114,6 +116,7 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
         "coating_model": fast.info["coating_model"],
         "given": sorted(scene.loading),
         "contact_lost": fast.contact_lost,
+        "scene_key": checked_key(scene),
         "fe_seconds": fe.seconds,
         "fe_dofs": fe.dofs,
     }

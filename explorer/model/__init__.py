@@ -46,7 +46,7 @@ from .links import decode_scene, encode_scene
 from .loading_state import QUANTITIES, QUANTITY_RANGES, QUANTITY_UNITS, STATEMENTS, HistoryState
 from .pins import MAX_PINS, Pin, PinBoard
 from .presets import DEFAULT_PRESET, ORDER, preset_label, presets
-from .results import Geometry, ResultView, prepare_view
+from .results import Geometry, ResultView, model_evidence, prepare_view, shown_flags
 from .scales import DisplayScales
 from .scene_parts import (
     CONTACT_MODELS,
@@ -83,7 +83,8 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "SceneHistory", "Screen", "StudyResult", "check_html", "check_text", "contact_text",
            "contact_widths", "contact_zones", "creep_coefficient_data", "decode_scene",
            "default_range", "design_check", "encode_scene", "lessons", "lift_off_lengths",
-           "lifts_off", "lifts_or_pulls", "plan_study",
+           "lifts_off", "lifts_or_pulls", "model_evidence", "plan_study",
            "prepare_view", "preset_label", "presets", "read_study_query", "read_view_query",
+           "shown_flags",
            "scene_limits", "scene_with_limits", "screen_limits", "step_scene", "study_choices",
            "view_query"]

@@ -7,6 +7,7 @@ only slices arrays that already exist.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -14,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from core import scene_from_dict
+from core.scene import flags_with_evidence, model_error_evidence
 
 from .state import QUANTITIES, QUANTITY_UNITS
 
@@ -105,6 +107,22 @@ class ResultView:
         if not np.isfinite(band):
             return []
         return negative_intervals(self.x, self.pressure[:, index] + band)
+
+
+def model_evidence(view: ResultView,
+                   check: Mapping[str, Any] | None = None) -> dict[str, Any] | None:
+    """The coating model's error to show for ``view`` (:func:`core.scene.model_error_evidence`):
+    the FE check's measurement when ``check`` was made for its scene, else the estimate the
+    result carries; None for a result that carries none."""
+    estimate = view.info.get("model_error_estimate")
+    if not isinstance(estimate, (int, float)):
+        return None
+    return model_error_evidence(view.scene, float(estimate), check)
+
+
+def shown_flags(view: ResultView, evidence: Mapping[str, Any] | None) -> list[str]:
+    """The result's flags with ``model_error`` as the best evidence has it."""
+    return list(view.flags) if evidence is None else flags_with_evidence(view.flags, evidence)
 
 
 def lifted_intervals(zones: list[tuple[float, float]],

@@ -9,10 +9,15 @@ from .results import ResultView
 
 class Screen(param.Parameterized):
     """The session's screen, shared by its views: the result on screen (what downloads,
-    the check, the report and the link hold), the output time shown, and a notice."""
+    the check, the report and the link hold), the output time shown, a notice, and the
+    latest FE check of the coating model."""
 
     notice = param.String(default="", doc="A problem with a file or a link (not a solve).")
     time_index = param.Integer(default=0, doc="Index of the output time shown.")
+    model_check = param.Dict(default=None, allow_None=True, doc=(
+        "The latest FE check of the coating model (core.scene.check_scene's report): "
+        "where it was made for the scene on screen, its measured error is the one the "
+        "badges, the status and the report speak of (core.scene.model_error_evidence)."))
 
     def __init__(self, **params: object) -> None:
         super().__init__(**params)

@@ -345,7 +345,8 @@ class SolveController(param.Parameterized):
                               solves=self.solves + 1)
 
     def download(self, view: ResultView, kind: str, limits: DesignLimits | None = None,
-                 shown_time: float | None = None) -> str | bytes:
+                 shown_time: float | None = None,
+                 check: dict[str, Any] | None = None) -> str | bytes:
         """The file of a download of ``view``: ``"to_csv"`` (the histories),
         ``"pressure_csv"`` (q(x, t)) or ``"to_json"`` (everything), in SI units, or the
         printable report, ``"report_html"`` (text) or ``"report_pdf"`` (bytes).
@@ -355,13 +356,14 @@ class SolveController(param.Parameterized):
         the JSON's and the report's solve report is the one of the result on screen.
         ``limits``: the Check tab's, put into the scene in place of its own (the report's
         design check); ``shown_time`` [day after loading]: the time on screen, whose
-        contact the report describes.
+        contact the report describes; ``check``: the FE check of the coating model
+        (:func:`core.scene.check_scene`), reported where it was made for this scene.
         """
         scene = view.scene if limits is None else scene_with_limits(view.scene, limits)
         if self._processes is not None:
             return self._processes.run(self._lane, download_text, scene, kind, view.info,
-                                       shown_time)
-        return solution_text(self._solve(scene), kind, view.info, shown_time)
+                                       shown_time, check)
+        return solution_text(self._solve(scene), kind, view.info, shown_time, check)
 
     def solved_within(self, seconds: float) -> bool:
         """Whether the result kept took less than ``seconds`` [s] of CPU time to solve
@@ -375,18 +377,19 @@ class SolveController(param.Parameterized):
         return isinstance(spent, (int, float)) and spent < seconds
 
     def download_later(self, view: ResultView, kind: str, limits: DesignLimits | None = None,
-                       shown_time: float | None = None) -> Future[str | bytes]:
+                       shown_time: float | None = None,
+                       check: dict[str, Any] | None = None) -> Future[str | bytes]:
         """:meth:`download` off the calling thread: a future of the file, done when the
         worker has answered (at once where solves run in the caller). The server's event
         loop awaits it (``asyncio.wrap_future``) and keeps serving every page meanwhile."""
         if self._executor is None:
             done: Future[str | bytes] = Future()
             try:
-                done.set_result(self.download(view, kind, limits, shown_time))
+                done.set_result(self.download(view, kind, limits, shown_time, check))
             except Exception as exc:
                 done.set_exception(exc)
             return done
-        return self._executor.submit(self.download, view, kind, limits, shown_time)
+        return self._executor.submit(self.download, view, kind, limits, shown_time, check)
 
     def wait(self, timeout: float = 60.0) -> bool:
         """Block until the newest request has been delivered (for scripts and tests)."""

@@ -59,7 +59,8 @@ def solve_view(scene: dict[str, Any]) -> ResultView:
 
 
 def download_text(scene: dict[str, Any], kind: str, info: dict[str, Any] | None = None,
-                  shown_time: float | None = None) -> str | bytes:
+                  shown_time: float | None = None,
+                  check: dict[str, Any] | None = None) -> str | bytes:
     """The file ``kind`` (one of :data:`DOWNLOADS`) of the solution of ``scene``: the
     histories as CSV (time [day], settlement [m], tilt [rad], force [N/m], moment [N]),
     q(x, t) as CSV [Pa], the whole solution as JSON, or the printable report (HTML text,
@@ -68,13 +69,16 @@ def download_text(scene: dict[str, Any], kind: str, info: dict[str, Any] | None 
     ``info``: the solve report of the result on screen (``ResultView.info``), written into
     the JSON and the report in place of the new solve's (whose timings and cache hits
     differ; its numbers do not). ``shown_time`` [day after loading]: the time on screen,
-    whose contact the report describes.
+    whose contact the report describes. ``check``: the FE check of the coating model
+    (:func:`core.scene.check_scene`), whose measurement the report gives when it was made
+    for ``scene``.
     """
-    return solution_text(solve(scene), kind, info, shown_time)
+    return solution_text(solve(scene), kind, info, shown_time, check)
 
 
 def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None,
-                  shown_time: float | None = None) -> str | bytes:
+                  shown_time: float | None = None,
+                  check: dict[str, Any] | None = None) -> str | bytes:
     """``solution.to_csv()``, ``.pressure_csv()``, the JSON of everything with the version
     and solver settings (:meth:`core.scene.SceneSolution.to_json`) or the report
     (:func:`core.report.report_html`, :func:`core.report.report_pdf` at ``shown_time``)
@@ -89,7 +93,7 @@ def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None,
         return solution.to_json()
     if kind in REPORTS:
         # the command line's report; HoloViews, Bokeh and Matplotlib load with the first
-        return getattr(core.report, kind)(solution, shown_time)
+        return getattr(core.report, kind)(solution, shown_time, check=check)
     return getattr(solution, kind)()
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import param
@@ -50,9 +51,12 @@ class BusyIndicator:
     """Follows the controller's ``busy`` for the page's spinner and status line."""
 
     def __init__(self, controller: SolveController, loop: PageLoop, spinner: BusySpinner,
-                 status: Any) -> None:
-        """``status``: the pane of the status line (it says when a solve is running)."""
+                 status: Any, evidence: Callable[[Any], Any] | None = None) -> None:
+        """``status``: the pane of the status line (it says when a solve is running);
+        ``evidence``: the coating model's error to state for a result
+        (:meth:`explorer.views.ResultsView.evidence`), none by default."""
         self.controller = controller
+        self.evidence = evidence if evidence is not None else (lambda view: None)
         self.loop = loop
         self.spinner = spinner
         self.status = status
@@ -80,4 +84,5 @@ class BusyIndicator:
             return
         self.shown = busy
         self.spinner.value = busy
-        self.status.object = status_html(self.controller.view, busy)
+        view = self.controller.view
+        self.status.object = status_html(view, busy, self.evidence(view))

@@ -11,7 +11,7 @@ import panel as pn
 
 from core.scene import check_scene
 
-from ..model import SCREEN_LAYERS, ExplorerState
+from ..model import SCREEN_LAYERS, ExplorerState, Screen
 from ..solving import SolveController, worker_processes
 from .fidelity import FidelityView
 from .loop import PageLoop
@@ -34,10 +34,11 @@ class CoatingView:
 
     def __init__(self, state: ExplorerState, fidelity: FidelityView,
                  controller: SolveController, loop: PageLoop,
-                 live_when: Callable[[], bool]) -> None:
+                 live_when: Callable[[], bool], screen: Screen | None = None) -> None:
         """``fidelity``: its interface selector edits the layer chosen here;
         ``controller`` and ``loop``: where the coating-model check runs and reports;
-        ``live_when``: whether a slider applies each drag step (else its release)."""
+        ``live_when``: whether a slider applies each drag step (else its release);
+        ``screen``: where the check's report is put for the badges, status and report."""
         self.state = s = state
         self.fidelity = fidelity
         self.n_layers = PromptIntSlider(label="number of layers", start=1, end=SCREEN_LAYERS,
@@ -56,7 +57,7 @@ class CoatingView:
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
                                             variations=False, live_when=live_when)
         self.layer_note = html_pane("", styles=NOTE_STYLE)
-        self.check = CoatingCheckView(state, controller, loop)
+        self.check = CoatingCheckView(state, controller, loop, screen)
         s.param.watch(lambda *e: self.refresh(), "n_layers")
         self.refresh()
 
@@ -126,8 +127,12 @@ class CoatingCheckView:
     the report when it is done."""
 
     def __init__(self, state: ExplorerState, controller: SolveController,
-                 loop: PageLoop) -> None:
+                 loop: PageLoop, screen: Screen | None = None) -> None:
+        """``screen``: its ``model_check`` receives each report, so that the badges, the
+        status and the report download speak of the measured error of the scene it was
+        made for (the estimate of any other)."""
         self.state = state
+        self.screen = screen
         self.controller = controller
         self.loop = loop
         self.button = pn.widgets.Button(label="check the coating model",
@@ -169,6 +174,8 @@ class CoatingCheckView:
         self.button.disabled = False
         self.result.object = (check_report_html(outcome) if isinstance(outcome, dict)
                               else f"<span class='cp-msg'>{outcome}</span>")
+        if isinstance(outcome, dict) and self.screen is not None:
+            self.screen.model_check = outcome
 
 
 def _check(scene: dict[str, Any]) -> dict[str, Any] | str:

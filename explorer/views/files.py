@@ -155,15 +155,18 @@ class FilesView:
 
     async def _fetch(self, kind: str, report: bool = False) -> str | bytes | None:
         """The file ``kind`` of the result on screen from the worker (None without one);
-        a report is checked against the Check tab's limits and describes the time on
-        screen."""
+        a report is checked against the Check tab's limits, describes the time on screen
+        and gives the coating model's error the FE check measured, if it was run on it."""
         view = self.screen.shown()
         if view is None:
             return None
         options: dict[str, Any] = {}
         if report:
             index = min(self.screen.time_index, len(view.times) - 1)
-            options = {"limits": self.limits, "shown_time": float(view.times[index])}
+            # the FE check's measurement, where it was made for this scene (the report
+            # itself decides: core.scene.model_error_evidence)
+            options = {"limits": self.limits, "shown_time": float(view.times[index]),
+                       "check": self.screen.model_check}
         # awaited, not waited for: the worker's answer must not hold the event loop, and
         # with it every page of the server
         try:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import html
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import panel as pn
@@ -21,6 +21,8 @@ from ..model import (
     contact_text,
     design_check,
     lifts_off,
+    model_evidence,
+    shown_flags,
 )
 from ..plots import PIN_COLORS, Figures, LogTime
 from ..solving import SolveController
@@ -51,10 +53,15 @@ def _fmt(value: float) -> str:
     return f"{value:.5g}" if abs(value) < 1e5 else f"{value:.4e}"
 
 
-def badges_html(view: ResultView | None, group: str) -> str:
-    """Validity badges of one plot group (flag names as CSS classes, messages as tooltips)."""
+def badges_html(view: ResultView | None, group: str,
+                evidence: Mapping[str, Any] | None = None) -> str:
+    """Validity badges of one plot group (flag names as CSS classes, messages as tooltips).
+
+    ``evidence``: :func:`explorer.model.model_evidence` of ``view``; the ``model_error``
+    badge says what it rests on (the FE check's measurement, else the estimate)."""
     if view is None:
         return ""
+    flags = shown_flags(view, evidence)
     parts = []
     lifted = group == "pressure" and lifts_off(view) and "contact_lost" not in view.flags
     if lifted:  # a unilateral solve: no q < 0, and no full contact either
@@ -63,8 +70,14 @@ def badges_html(view: ResultView | None, group: str) -> str:
     for flag, (bad, good) in BADGES[group].items():
         if lifted and flag == "contact_lost":
             continue
-        if flag in view.flags:
-            message = html.escape(flag_message(view, flag))
+        text = flag_message(view, flag)
+        if flag == "model_error" and evidence is not None:
+            # a badge of the model's error says whether it was measured or estimated
+            bad, good = (f"{word} ({evidence['label']} "
+                         f"{100 * evidence['error']:.3g} %)" for word in (bad, good))
+            text = evidence["message"]
+        if flag in flags:
+            message = html.escape(text)
             parts.append(f'<span class="cp-badge cp-bad flag-{flag}" title="{message}">'
                          f"⚠ {bad}</span><span class='cp-msg'>{message}</span>")
         elif good:
@@ -131,7 +144,10 @@ class ResultsView:
                                           css_classes=["notice"])
         self.spinner = BusySpinner()
         self.status = html_pane("", sizing_mode="stretch_width", margin=(5, 5))
-        self.busy = BusyIndicator(controller, loop, self.spinner, self.status)
+        self._evidence: tuple[tuple[int, int], dict[str, Any] | None] = ((0, 0), None)
+        self.busy = BusyIndicator(controller, loop, self.spinner, self.status,
+                                  evidence=self.evidence)
+        screen.param.watch(lambda *e: self.show_model_check(), "model_check")
         badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
         self.scene_badges = html_pane("", **badge)
         self.pressure_badges = html_pane("", **badge)
@@ -192,14 +208,35 @@ class ResultsView:
         with param.discard_events(self.screen):
             self.screen.time_index = index
         self.show_time_texts(view, index)
-        self.status.object = status_html(view, self.busy.shown)
-        self.scene_badges.object = badges_html(view, "scene")
+        self.status.object = status_html(view, self.busy.shown, self.evidence(view))
+        self.scene_badges.object = badges_html(view, "scene", self.evidence(view))
         self.pressure_badges.object = badges_html(view, "pressure")
         self.history_badges.object = badges_html(view, "history")
         self.status_badges.object = badges_html(view, "status")
         if self.time_axis.on:
             self.time_axis.fit()
         self.show_design()
+
+    def evidence(self, view: ResultView | None) -> dict[str, Any] | None:
+        """The coating model's error to show for ``view``: measured by the Coating tab's
+        FE check when it was run on this scene, else estimated (remembered per result
+        and check: the key of a scene is a validation away)."""
+        if view is None:
+            return None
+        check = self.screen.model_check
+        key = (id(view), id(check))
+        if self._evidence[0] != key:
+            self._evidence = (key, model_evidence(view, check))
+        return self._evidence[1]
+
+    def show_model_check(self) -> None:
+        """A new FE check: the status and the badges of the result on screen say what it
+        measured (or the estimate still, when it was run on another scene)."""
+        view = self.screen.shown()
+        if view is None:
+            return
+        self.status.object = status_html(view, self.busy.shown, self.evidence(view))
+        self.scene_badges.object = badges_html(view, "scene", self.evidence(view))
 
     def show_time_texts(self, view: ResultView, index: int) -> None:
         """The time label and the readout at output time ``index``."""

@@ -8,6 +8,8 @@ native ``<details>`` element (no round trip to the server). Nothing here imports
 from __future__ import annotations
 
 import html
+from collections.abc import Mapping
+from typing import Any
 
 from ..model import ResultView
 
@@ -75,14 +77,30 @@ def details_text(view: ResultView) -> str:
             f"solver: {info.get('message', '')}")
 
 
-def status_html(view: ResultView | None, busy: bool) -> str:
-    """The status line (plain words) and its details (the solver's numbers)."""
+def model_error_text(evidence: Mapping[str, Any]) -> str:
+    """The coating model's error in words: measured by the FE check, or estimated."""
+    side = "above" if evidence["flagged"] else "within"
+    return (f"Coating model error {100 * evidence['error']:.3g} % ({evidence['label']}), "
+            f"{side} solver.model_tol {100 * evidence['model_tol']:g} %.")
+
+
+def status_html(view: ResultView | None, busy: bool,
+                evidence: Mapping[str, Any] | None = None) -> str:
+    """The status line (plain words) and its details (the solver's numbers); ``evidence``
+    (:func:`explorer.model.model_evidence`): the coating model's error it states."""
     if view is None:
         return ("<span class='cp-status solve-status first-solve'>Solving this scene for the "
                 "first time… the plots appear when it is done.</span>") if busy else ""
     text = plain_status(view)
     if busy:
         text = "Solving the newest change… showing the previous result. " + text
-    return (f"<span class='cp-status solve-status'>{html.escape(text)}</span> "
+    if evidence is not None:
+        tone = " model-flagged" if evidence["flagged"] else ""
+        text_model = html.escape(model_error_text(evidence))
+        model = (f" <span class='cp-status model-evidence model-{evidence['source']}{tone}'>"
+                 f"{text_model}</span>")
+    else:
+        model = ""
+    return (f"<span class='cp-status solve-status'>{html.escape(text)}</span>{model} "
             f"<details class='cp-status solve-details'><summary>details</summary>"
             f"{html.escape(details_text(view))}</details>")

@@ -1,0 +1,48 @@
+"""The model-error badge on the page after the Coating tab's FE check: on a scene whose
+estimate (1.56 %) under-reads the measured error (3.58 %), the badge turns from "within
+solver.model_tol (estimated)" to "above solver.model_tol (measured by the FE check)".
+
+Debian's Chromium through Playwright; every wait is on a condition in the page.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
+
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
+
+from explorer.model.links import encode_scene  # noqa: E402
+from tests.browser_pages import (  # noqa: E402
+    Page,
+    chromium_context,
+    served_explorer,
+)
+from tests.support.under_read import under_read_scene  # noqa: E402
+
+
+@pytest.fixture(scope="module", name="page")
+def page_fixture(explorer_server):
+    for url in served_explorer(explorer_server):
+        for context in chromium_context(1400, 900):
+            shown = Page(context, url, f"/app?scene={encode_scene(under_read_scene())}")
+            yield shown
+            shown.close()
+
+
+def test_the_badge_follows_the_fe_check(page: Page):
+    ok = page.page.locator(".ok-model_error").first
+    ok.wait_for(timeout=120_000)
+    assert "(estimated 1.56 %)" in ok.inner_text()
+    page.open_tab("Coating")
+    page.page.locator(".coating-check-button button").first.click()
+    flag = page.page.locator(".flag-model_error").first
+    flag.wait_for(timeout=180_000)
+    assert "above solver.model_tol (measured by the FE check 3.58 %)" in flag.inner_text()
+    assert page.page.locator(".ok-model_error").count() == 0
+    status = page.page.locator(".model-evidence").first
+    assert "3.58 % (measured by the FE check), above" in status.inner_text()
+    assert page.errors == []

@@ -1,0 +1,98 @@
+"""The report speaks of the coating model's error from the best evidence: the FE
+check's measurement when it was made for the scene, else the estimate."""
+
+from __future__ import annotations
+
+import pytest
+
+import core
+from core.report import report_html
+from core.report.content import describe
+from core.scene import check_scene, checked_key, model_error_evidence
+from tests.cli_runs import run_cli
+from tests.support.under_read import ESTIMATE, MEASURED, under_read_scene
+
+pytest.importorskip("holoviews")
+
+MEASURED_ROW = "coating model error (measured by the FE check, relative)"
+ESTIMATED_ROW = "coating model error (estimated, relative)"
+
+
+@pytest.fixture(scope="module")
+def result() -> core.SceneSolution:
+    return core.solve(under_read_scene())
+
+
+def _check(scene: dict, error: float) -> dict:
+    """What check_scene reports, as far as the evidence reads it."""
+    return {"scene_key": checked_key(scene), "model_error": error, "time_day": 0.0}
+
+
+def test_the_estimate_alone_passes_this_scene(result):
+    assert result.model_error["estimate"] == pytest.approx(ESTIMATE, abs=1e-4)
+    assert "model_error" not in result.flags
+    text = describe(result)
+    assert "model_error" not in text["Validity"]["rows"]
+    assert MEASURED_ROW not in text["Accuracy"]["rows"]
+
+
+def test_a_measurement_of_the_scene_overrides_the_estimate(result):
+    text = describe(result, check=_check(under_read_scene(), MEASURED))
+    validity = text["Validity"]
+    assert validity["tone"] == "bad"
+    assert "3.58 %" in validity["rows"]["model_error"]
+    assert "measured by the FE check" in validity["rows"]["model_error"]
+    rows = text["Accuracy"]["rows"]
+    assert rows[MEASURED_ROW].startswith("3.6e-02") and "FLAGGED" in rows[MEASURED_ROW]
+    assert rows[ESTIMATED_ROW].startswith("1.6e-02")  # next to it, not replaced
+
+
+def test_a_measurement_within_the_tolerance_lowers_an_estimated_flag(result):
+    scene = under_read_scene()
+    scene["solver"] = {"model_tol": 0.01}  # the estimate 1.56 % is now flagged
+    strict = core.solve(scene)
+    assert "model_error" in strict.flags
+    text = describe(strict, check=_check(scene, 0.005))
+    assert "model_error" not in text["Validity"]["rows"]
+    assert "within" in text["Accuracy"]["rows"][MEASURED_ROW]
+
+
+def test_a_measurement_of_another_scene_is_ignored(result):
+    other = under_read_scene()
+    other["loading"]["moment"] = 0.0  # another eccentricity: another model error
+    evidence = model_error_evidence(result.scene, ESTIMATE, _check(other, MEASURED))
+    assert evidence["source"] == "estimated" and not evidence["flagged"]
+    assert MEASURED_ROW not in describe(result, check=_check(other, MEASURED))["Accuracy"]["rows"]
+
+
+def test_the_output_times_and_solver_settings_do_not_void_a_measurement():
+    scene = under_read_scene()
+    changed = under_read_scene()
+    changed["times"] = [1.0, 10.0]
+    changed["solver"] = {"tol": 1e-5, "model_tol": 0.03}
+    changed["name"] = "renamed"
+    assert checked_key(scene) == checked_key(changed)
+
+
+@pytest.mark.slow
+def test_the_report_carries_the_real_check(result):
+    check = check_scene(result.scene, 0.0, level=0)
+    assert check["model_error"] == pytest.approx(MEASURED, abs=1e-3)
+    text = report_html(result, check=check)
+    assert MEASURED_ROW in text and "3.58 %" in text
+
+
+@pytest.mark.slow
+def test_the_command_line_report_runs_the_check(tmp_path):
+    path = tmp_path / "scene.json"
+    core.save_scene(under_read_scene(), path)
+    plain = run_cli("report", path, "-o", tmp_path / "plain.html")
+    assert plain.returncode == 0 and "model_error" not in plain.stderr
+    done = run_cli("report", path, "-o", tmp_path / "checked.html", "--fe-check")
+    assert done.returncode == 0, done.stderr
+    assert "3.58 % measured by the FE check" in done.stderr
+    assert "warning: model_error" in done.stderr
+    assert MEASURED_ROW in (tmp_path / "checked.html").read_text()
+    strict = run_cli("report", path, "-o", tmp_path / "strict.html", "--fe-check",
+                     "--strict")
+    assert strict.returncode == 4 and "model_error" in strict.stderr
