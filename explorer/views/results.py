@@ -19,6 +19,7 @@ from ..model import (
     Screen,
     check_html,
     contact_text,
+    days_text,
     design_check,
     lifts_off,
 )
@@ -101,7 +102,7 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
     force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
     ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
     contact = html.escape(contact_text(view, index))
-    return (f"<div class='readout'><b>At t = {t:.4g} days after loading</b> · {ecc}"
+    return (f"<div class='readout'><b>At t = {days_text(t)} after loading</b> · {ecc}"
             f"<table class='cp-readout'>{''.join(rows)}</table>"
             f"<div class='contact-readout'>{contact}</div></div>")
 
@@ -204,7 +205,7 @@ class ResultsView:
     def show_time_texts(self, view: ResultView, index: int) -> None:
         """The time label and the readout at output time ``index``."""
         self.time_label.object = (f"<span class='time-label'>t = "
-                                  f"{float(view.times[index]):.4g} days</span>")
+                                  f"{days_text(float(view.times[index]))}</span>")
         self.readout.object = readout_html(view, index, self.pins.board.pins)
 
     def show_design(self) -> None:
