@@ -30,8 +30,8 @@ from .contact import ContactPanes
 from .link import AddressLink
 from .loop import PageLoop
 from .pins import PinsView
-from .status import status_html
-from .style import html_pane
+from .status import held_text, status_html
+from .style import NOTE_STYLE, html_pane
 from .widgets import NAMES
 
 #: Which validity flags are shown next to which plot.
@@ -133,6 +133,9 @@ class ResultsView:
         self.spinner = BusySpinner()
         self.status = html_pane("", sizing_mode="stretch_width", margin=(5, 5))
         self.busy = BusyIndicator(controller, loop, self.spinner, self.status)
+        # said while a slider is dragged that only its release applies (slow solves)
+        self.held = html_pane("", visible=False, css_classes=["drag-held"],
+                              styles=NOTE_STYLE, margin=(0, 10))
         badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
         self.scene_badges = html_pane("", **badge)
         self.pressure_badges = html_pane("", **badge)
@@ -167,6 +170,7 @@ class ResultsView:
             self.notice_alert,
             self.alert,
             pn.Row(self.spinner.pane, self.status, sizing_mode="stretch_width"),
+            self.held,
             self.status_badges,
             self.scene_badges,
             pn.Row(scene_pane, self.contact_panes.inset_slot, sizing_mode="stretch_width"),
@@ -233,6 +237,16 @@ class ResultsView:
         self.busy.follow(controller.busy)
         if not controller.busy:
             self.link.schedule()  # a link skipped while busy, if no newer result came
+
+    def say_held(self, held: bool, cpu_seconds: float | None = None) -> None:
+        """Say (``held``) or stop saying that a dragged slider waits for its release, the
+        last solve having taken ``cpu_seconds`` [s] of CPU time (None: not known)."""
+        if not held:
+            if self.held.visible:
+                self.held.object, self.held.visible = "", False
+            return
+        self.held.object = held_text(cpu_seconds)
+        self.held.visible = True
 
     def show_download_error(self, text: str) -> None:
         """Say why a download failed (Markdown, user text escaped)."""

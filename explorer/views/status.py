@@ -92,6 +92,14 @@ def details_text(view: ResultView) -> str:
     return " · ".join(p for p in pieces if p) or "the solver reported no details"
 
 
+def held_text(cpu_seconds: float | None) -> str:
+    """What the page says while a dragged slider waits for its release: the plots show
+    the last result; ``cpu_seconds`` [s]: what that result cost (None: not known)."""
+    took = "" if cpu_seconds is None else f" (the last one took {_duration(cpu_seconds)})"
+    return (f"Solves are too slow to follow a dragged slider{took}: the plots show the "
+            "last result and update when you release it.")
+
+
 def status_html(view: ResultView | None, busy: bool) -> str:
     """The status line (plain words) and its details (the solver's numbers)."""
     if view is None:
