@@ -1,6 +1,6 @@
 """A slow scene in a real browser: the eccentricity slider says while it is dragged that
-the plots wait for the release, and the times of a 50-year history read in days and
-years (never 1.826e+04).
+the plots wait for the release, the times of a 50-year history read in days and years
+(never 1.826e+04), and the status line claims nothing the solver did not report.
 
 Every wait is on a condition in the page.
 """
@@ -45,6 +45,10 @@ def test_a_slow_drag_says_it_waits_and_long_times_read_in_years(server: str, pag
     assert "e+" not in page.text(".time-label")
     assert page.page.evaluate(JS_SHOWN, "At t = 18260 days (50.0 years) after loading")
     assert not page.page.evaluate(JS_SHOWN, LAG)
+    # the lift-off engine reports no stages nor modes: the status line claims neither
+    assert page.page.evaluate(JS_SHOWN, "unilateral contact under creep")   # its details
+    assert not page.page.evaluate(JS_SHOWN, "computed afresh")
+    assert not page.page.evaluate(JS_SHOWN, "? modes")
     # a drag of the handle, held: the box follows, the plots do not, and the page says so
     handle = page.page.locator(".eccentricity-slider .noUi-handle").first
     box = handle.bounding_box()
