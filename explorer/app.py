@@ -143,7 +143,7 @@ class ExplorerApp(pn.viewable.Viewer):
         a ``content()`` column). The index of a tab is part of the page's links
         (``explorer.model.view_link``): a new tab is appended, never inserted."""
         state, screen, controller, loop = self.state, self.screen, self.controller, self.loop
-        live = self.fast_solves
+        live = self._drag_step_applies
         self.scene_tab = SceneView(state, self.presets, self.preset_key, self.history,
                                    self.load_scene, controller, screen.reject)
         self.punch_tab = PunchView(state, screen, live)
@@ -205,6 +205,16 @@ class ExplorerApp(pn.viewable.Viewer):
         """Whether the last solve was quick enough for sliders to apply every drag step."""
         return self.controller.solved_within(LIVE_SOLVE_S)
 
+    def _drag_step_applies(self) -> bool:
+        """At a drag step of a slider that otherwise waits for its release: whether the
+        step applies now (:meth:`fast_solves`); when not, the page says so."""
+        fast = self.fast_solves()
+        view = self.controller.view
+        spent = None if view is None else view.info.get("cpu_seconds", view.info.get("seconds"))
+        self.results.say_held(not fast, float(spent) if isinstance(spent, (int, float))
+                              else None)
+        return fast
+
     # -- layout ----------------------------------------------------------------------
     def _build_layout(self) -> pn.viewable.Viewable:
         self.tabs = DeferredTabs(self.loop,
@@ -242,6 +252,7 @@ class ExplorerApp(pn.viewable.Viewer):
     # -- events ----------------------------------------------------------------------
     def _on_revision(self, event: Any) -> None:
         mark("revision")
+        self.results.say_held(False)   # a release applied: the plots follow now
         self.history.remember()
         self.controller.request()
 
@@ -302,6 +313,7 @@ class ExplorerApp(pn.viewable.Viewer):
             index = min(self.screen.time_index, n - 1)
         self.screen.drawn = view
         self.pins.on_result(view)
+        self.results.say_held(False)
         with pn.io.hold():
             self.results.draw(view, index, new_range=old is None or len(old.times) != n)
             self.files_tab.name_files(view)

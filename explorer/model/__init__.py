@@ -15,6 +15,7 @@ prepared where it is solved), and the state can be used without a server.
 - ``links``, ``view_link``: the scene, and what else a link keeps, in the page's address.
 - ``undo``, ``history``: the scenes shown, for undo and reset.
 - ``screen``: what the page shows now (the result, the output time, a notice).
+- ``time_text``: times after loading in words, without an exponent.
 - ``study``: the Study tab's design studies, planned from the scene on screen.
 """
 
@@ -44,7 +45,7 @@ from .history import SceneHistory
 from .lessons import Lesson, lessons, step_scene
 from .links import decode_scene, encode_scene
 from .loading_state import QUANTITIES, QUANTITY_RANGES, QUANTITY_UNITS, STATEMENTS, HistoryState
-from .pins import MAX_PINS, Pin, PinBoard
+from .pins import MAX_PINS, Pin, PinBoard, eccentricity
 from .presets import DEFAULT_PRESET, ORDER, preset_label, presets
 from .results import Geometry, ResultView, model_evidence, prepare_view, shown_flags
 from .scales import DisplayScales
@@ -72,6 +73,7 @@ from .study import (
     plan_study,
     study_choices,
 )
+from .time_text import days_text, plain_number
 from .view_link import read_study_query, read_view_query, view_query
 
 __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
@@ -81,9 +83,10 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "DesignLimits", "DisplayScales", "ExplorerState", "Geometry", "HistoryState",
            "LayerState", "Lesson", "Pin", "PinBoard", "PlannedStudy", "ProfileState", "ResultView",
            "SceneHistory", "Screen", "StudyResult", "check_html", "check_text", "contact_text",
-           "contact_widths", "contact_zones", "creep_coefficient_data", "decode_scene",
-           "default_range", "design_check", "encode_scene", "lessons", "lift_off_lengths",
-           "lifts_off", "lifts_or_pulls", "model_evidence", "plan_study",
+           "contact_widths", "contact_zones", "creep_coefficient_data", "days_text", "decode_scene",
+           "default_range", "design_check", "eccentricity", "encode_scene", "lessons",
+           "lift_off_lengths", "lifts_off", "lifts_or_pulls", "model_evidence", "plain_number",
+           "plan_study",
            "prepare_view", "preset_label", "presets", "read_study_query", "read_view_query",
            "shown_flags",
            "scene_limits", "scene_with_limits", "screen_limits", "step_scene", "study_choices",

@@ -27,6 +27,7 @@ from core.scene import LimitCheck, check_design
 from .contact_zone import contact_widths
 from .results import ResultView
 from .state import QUANTITY_UNITS
+from .time_text import days_text
 
 
 class DesignLimits(param.Parameterized):
@@ -129,7 +130,7 @@ def scene_with_limits(scene: dict[str, Any], limits: DesignLimits | None) -> dic
 def _on_screen(line: LimitCheck, limits: DesignLimits | None) -> Check:
     """A line of the core's check in the screen's units, with the limit as typed."""
     unit, size = _SCREEN_UNITS[line.quantity]
-    where = f"t = {line.time:.4g} days"
+    where = f"t = {days_text(line.time)}"
     if line.x is not None:
         where = f"x = {line.x:.3g} m, " + where
     typed = None if limits is None or line.limit_name is None \

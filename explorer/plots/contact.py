@@ -17,6 +17,7 @@ from ..model import (
     ResultView,
     contact_widths,
     contact_zones,
+    days_text,
     lift_off_lengths,
     lifts_off,
     lifts_or_pulls,
@@ -149,11 +150,11 @@ class ContactDrawing:
         width = float(self._widths[index]) if index < len(self._widths) else 2 * a
         self.zone_label.update(x=-1.52 * a, y=float(np.max(y)))
         if width < 2 * a and lifted:
-            self.zone_label.text = f"contact {width:.3f} m of {2 * a:.3g} m at t = {t:.4g} days"
+            self.zone_label.text = f"contact {width:.3f} m of {2 * a:.3g} m at t = {days_text(t)}"
         elif lifted:
-            self.zone_label.text = f"full-contact model, q < 0 at t = {t:.4g} days"
+            self.zone_label.text = f"full-contact model, q < 0 at t = {days_text(t)}"
         else:
-            self.zone_label.text = f"full contact at t = {t:.4g} days"
+            self.zone_label.text = f"full contact at t = {days_text(t)}"
         self.width_cursor.location = t
         set_data(self.width_point, {"t": [t], "v": [width]})
 

@@ -24,7 +24,15 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from ..model import QUANTITIES, QUANTITY_UNITS, DisplayScales, Pin, ResultView, lifts_or_pulls
+from ..model import (
+    QUANTITIES,
+    QUANTITY_UNITS,
+    DisplayScales,
+    Pin,
+    ResultView,
+    days_text,
+    lifts_or_pulls,
+)
 from .bokeh_data import MOVING, f32, legend_above, set_data, steady_range, wrap_legend
 from .classical import bearing_rule_pressure, half_space_pressure
 from .contact import ContactDrawing, FeatureInset
@@ -231,7 +239,7 @@ class Figures:
         intervals = view.negative_intervals(index)
         set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
                                 "right": [hi for _, hi in intervals]})
-        self.q_fig.title.text = f"Pressure q(x), t = {t:.4g} days"
+        self.q_fig.title.text = f"Pressure q(x), t = {days_text(t)}"
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
         if not pinned_drawn:

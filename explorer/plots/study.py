@@ -22,7 +22,7 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from ..model import OUTPUTS, StudyResult
+from ..model import OUTPUTS, StudyResult, days_text
 
 #: Most tick labels along a heat map's axis.
 MAX_TICKS = 7
@@ -38,7 +38,7 @@ def fmt(value: float) -> str:
 def chart_title(result: StudyResult, output: str, time_index: int) -> str:
     """``settlement [mm] at t = 365 days``."""
     name, unit, _ = OUTPUTS[output]
-    return f"{name} [{unit}] at t = {fmt(float(result.times[time_index]))} days"
+    return f"{name} [{unit}] at t = {days_text(float(result.times[time_index]))}"
 
 
 def flag_note(result: StudyResult) -> str:

@@ -3,6 +3,8 @@
 Moving the force off the centre is how a design engineer meets lift-off: the slider sets
 the moment M = e P of a constant force P (statement "force + moment given") and shows
 the e of the scene on screen whatever set it (a preset, a file, the moment's own slider).
+When solves are too slow to follow the handle, a note under the slider says so while it
+is dragged, with the e the plots still show, until the release sets the new one.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from typing import Any
 
 import panel as pn
 
-from ..model import ExplorerState
+from ..model import ExplorerState, eccentricity
 from ..solving import SolveController
 from .style import NOTE_STYLE, html_pane
 from .widgets import _set_widget, slider
@@ -36,6 +38,18 @@ NOT_APPLICABLE = ("The eccentricity sets the moment when force and moment are gi
                   "the force is a constant above zero.")
 
 
+def lag_text(dragged: float, shown: float | None, cpu_seconds: float | None) -> str:
+    """What the page says while the handle is at ``dragged`` [m] and the plots still show
+    the result solved at e = ``shown`` [m] (None: not known), solved in ``cpu_seconds``
+    [s] of CPU time (None: not known)."""
+    took = ("" if cpu_seconds is None
+            else f" (the last one took {1e3 * cpu_seconds:.0f} ms)")
+    showing = ("the previous result" if shown is None
+               else f"the result at e = {shown:.3f} m")
+    return (f"Solves are too slow to follow the handle{took}: the plots show {showing} "
+            f"and update to e = {dragged:.3f} m when you release it.")
+
+
 class EccentricityControl:
     """A slider of e = M/P [m] bound to the loading of the session's state."""
 
@@ -49,6 +63,9 @@ class EccentricityControl:
         self.slider = slider("eccentricity e = M/P [m] (sets the moment)", -1.0, 1.0, 0.01,
                              "0[.]000", css_classes=["eccentricity-slider"])
         self.note = html_pane("", styles=NOTE_STYLE, visible=False)
+        # said while a drag step waits for the release (the plots lag behind the box)
+        self.lag = html_pane("", styles=NOTE_STYLE, visible=False,
+                             css_classes=["eccentricity-lag"])
         self._syncing = False
         self.slider.param.watch(self._on_drag, "value")
         self.slider.param.watch(self._on_release, "value_throttled")
@@ -57,7 +74,10 @@ class EccentricityControl:
             loading.histories[q].param.watch(self.refresh, ["kind", "value"])
         loading.param.watch(self.refresh, "statement")
         state.punch.param.watch(self.refresh, "half_width")
-        self.panel = pn.Column(self.slider, self.note, sizing_mode="stretch_width", margin=0)
+        # a result arriving mid-drag changes what the plots show: the note follows it
+        controller.param.watch(self._on_result, "view")
+        self.panel = pn.Column(self.slider, self.lag, self.note, sizing_mode="stretch_width",
+                               margin=0)
         self.refresh()
 
     def applicable(self) -> bool:
@@ -84,6 +104,8 @@ class EccentricityControl:
         self.slider.visible = e is not None
         self.note.object = "" if e is not None else NOT_APPLICABLE
         self.note.visible = e is None
+        if e is None:
+            self.say_lag(None)
         # the value the slider already shows is left alone: a round trip through M = e P
         # differs in the last digit, and resending it would jerk the handle mid-drag
         if e is not None and abs(e - (self.slider.value or 0.0)) > 1e-9 * max(a, 1.0):
@@ -94,11 +116,43 @@ class EccentricityControl:
                 self._syncing = False
 
     def _on_drag(self, event: Any) -> None:
+        if self._syncing:
+            return
         if self.controller.solved_within(LIVE_SOLVE_S):
+            self.say_lag(None)
             self.apply(event.new)
+        else:
+            self.say_lag(event.new)
 
     def _on_release(self, event: Any) -> None:
+        self.say_lag(None)
         self.apply(event.new)
+
+    def _on_result(self, event: Any) -> None:
+        if self.lag.visible:
+            self.say_lag(self.slider.value)
+
+    def solved_eccentricity(self) -> float | None:
+        """e = M/P [m] of the result on screen (the last one solved), None when it has
+        no constant force above zero or before the first result."""
+        view = self.controller.view
+        return None if view is None else eccentricity(view.scene)
+
+    def say_lag(self, dragged: float | None) -> None:
+        """Say that the plots lag behind the handle at ``dragged`` [m] (None: they do
+        not: the note goes). A handle back at the e on screen needs no release."""
+        shown = self.solved_eccentricity()
+        a = self.state.punch.half_width
+        if (dragged is None or not self.applicable()
+                or (shown is not None and abs(dragged - shown) <= 1e-9 * max(a, 1.0))):
+            self.lag.object, self.lag.visible = "", False
+            return
+        view = self.controller.view
+        spent = None if view is None else view.info.get("cpu_seconds",
+                                                        view.info.get("seconds"))
+        self.lag.object = lag_text(float(dragged), shown,
+                                   float(spent) if isinstance(spent, (int, float)) else None)
+        self.lag.visible = True
 
     def apply(self, e: float | None) -> None:
         """Set the moment M = e P [kN·m/m] (constant) for the eccentricity ``e`` [m]."""

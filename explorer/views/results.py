@@ -19,6 +19,7 @@ from ..model import (
     Screen,
     check_html,
     contact_text,
+    days_text,
     design_check,
     lifts_off,
     model_evidence,
@@ -31,8 +32,8 @@ from .contact import ContactPanes
 from .link import AddressLink
 from .loop import PageLoop
 from .pins import PinsView
-from .status import status_html
-from .style import html_pane
+from .status import held_text, status_html
+from .style import NOTE_STYLE, html_pane
 from .widgets import NAMES
 
 #: Which validity flags are shown next to which plot.
@@ -114,7 +115,7 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
     force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
     ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
     contact = html.escape(contact_text(view, index))
-    return (f"<div class='readout'><b>At t = {t:.4g} days after loading</b> · {ecc}"
+    return (f"<div class='readout'><b>At t = {days_text(t)} after loading</b> · {ecc}"
             f"<table class='cp-readout'>{''.join(rows)}</table>"
             f"<div class='contact-readout'>{contact}</div></div>")
 
@@ -148,6 +149,9 @@ class ResultsView:
         self.busy = BusyIndicator(controller, loop, self.spinner, self.status,
                                   evidence=self.evidence)
         screen.param.watch(lambda *e: self.show_model_check(), "model_check")
+        # said while a slider is dragged that only its release applies (slow solves)
+        self.held = html_pane("", visible=False, css_classes=["drag-held"],
+                              styles=NOTE_STYLE, margin=(0, 10))
         badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
         self.scene_badges = html_pane("", **badge)
         self.pressure_badges = html_pane("", **badge)
@@ -182,6 +186,7 @@ class ResultsView:
             self.notice_alert,
             self.alert,
             pn.Row(self.spinner.pane, self.status, sizing_mode="stretch_width"),
+            self.held,
             self.status_badges,
             self.scene_badges,
             pn.Row(scene_pane, self.contact_panes.inset_slot, sizing_mode="stretch_width"),
@@ -241,7 +246,7 @@ class ResultsView:
     def show_time_texts(self, view: ResultView, index: int) -> None:
         """The time label and the readout at output time ``index``."""
         self.time_label.object = (f"<span class='time-label'>t = "
-                                  f"{float(view.times[index]):.4g} days</span>")
+                                  f"{days_text(float(view.times[index]))}</span>")
         self.readout.object = readout_html(view, index, self.pins.board.pins)
 
     def show_design(self) -> None:
@@ -269,6 +274,16 @@ class ResultsView:
         self.busy.follow(controller.busy)
         if not controller.busy:
             self.link.schedule()  # a link skipped while busy, if no newer result came
+
+    def say_held(self, held: bool, cpu_seconds: float | None = None) -> None:
+        """Say (``held``) or stop saying that a dragged slider waits for its release, the
+        last solve having taken ``cpu_seconds`` [s] of CPU time (None: not known)."""
+        if not held:
+            if self.held.visible:
+                self.held.object, self.held.visible = "", False
+            return
+        self.held.object = held_text(cpu_seconds)
+        self.held.visible = True
 
     def show_download_error(self, text: str) -> None:
         """Say why a download failed (Markdown, user text escaped)."""

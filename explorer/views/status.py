@@ -8,6 +8,7 @@ native ``<details>`` element (no round trip to the server). Nothing here imports
 from __future__ import annotations
 
 import html
+import numbers
 from collections.abc import Mapping
 from typing import Any
 
@@ -39,21 +40,33 @@ def _seconds(value: object) -> float:
     return float(value) if isinstance(value, (int, float)) else 0.0
 
 
+def _duration(seconds: float) -> str:
+    """A solve's wall time [s] in words: "240 ms", "under 1 ms", "3.2 s"."""
+    if seconds < 1e-3:
+        return "under 1 ms"
+    return f"{1e3 * seconds:.0f} ms" if seconds < 10 else f"{seconds:.1f} s"
+
+
 def plain_status(view: ResultView) -> str:
     """One or two sentences: how long, what was recomputed, how accurate."""
     info = view.info
     stages = info.get("stages", {}) or {}
     redone = [STAGE_WORDS.get(n, n) for n, s in stages.items() if not s.get("cached")]
-    ms = 1e3 * _seconds(info.get("seconds"))
+    seconds = info.get("seconds")
+    took = (f"Solved in {_duration(float(seconds))}" if isinstance(seconds, (int, float))
+            else "Solved")
     if info.get("reused"):
         what = "Shown at once: this exact scene was solved before"
-    elif not stages or len(redone) == len(stages):
-        what = f"Solved in {ms:.0f} ms, everything computed afresh"
+    elif not stages:
+        # the engine says nothing of what it reused: claim nothing either way
+        what = took
+    elif len(redone) == len(stages):
+        what = f"{took}, everything computed afresh"
     elif set(redone) <= LOAD_STAGES:
-        what = (f"Solved in {ms:.0f} ms: only the response to the loads was recomputed "
+        what = (f"{took}: only the response to the loads was recomputed "
                 "(the geometry and materials were unchanged)")
     else:
-        what = (f"Solved in {ms:.0f} ms: recomputed {', '.join(redone) or 'nothing'}; "
+        what = (f"{took}: recomputed {', '.join(redone) or 'nothing'}; "
                 "the rest reused")
     tol = float(view.scene.get("solver", {}).get("tol", 1e-6))
     err = info.get("error_estimate")
@@ -67,14 +80,26 @@ def plain_status(view: ResultView) -> str:
 
 
 def details_text(view: ResultView) -> str:
-    """The solver's own report: time per stage, cache use, modes, steps, message."""
+    """The solver's own report: time per stage, cache use, modes, steps, message; what
+    the solver did not report is left out (not written as "?")."""
     info = view.info
     stages = info.get("stages", {}) or {}
     parts = [f"{name} {1e3 * _seconds(s.get('seconds')):.1f} ms"
              + (" (cached)" if s.get("cached") else "") for name, s in stages.items()]
-    return (f"stages: {', '.join(parts) or 'none reported'} · {info.get('n_modes', '?')} "
-            f"modes, {info.get('n_steps', '?')} time steps · "
-            f"solver: {info.get('message', '')}")
+    counts = [f"{info[key]} {word}" for key, word in (("n_modes", "modes"),
+                                                       ("n_steps", "time steps"))
+              if isinstance(info.get(key), numbers.Integral)]
+    pieces = [f"stages: {', '.join(parts)}" if parts else "",
+              ", ".join(counts), f"solver: {info['message']}" if info.get("message") else ""]
+    return " · ".join(p for p in pieces if p) or "the solver reported no details"
+
+
+def held_text(cpu_seconds: float | None) -> str:
+    """What the page says while a dragged slider waits for its release: the plots show
+    the last result; ``cpu_seconds`` [s]: what that result cost (None: not known)."""
+    took = "" if cpu_seconds is None else f" (the last one took {_duration(cpu_seconds)})"
+    return (f"Solves are too slow to follow a dragged slider{took}: the plots show the "
+            "last result and update when you release it.")
 
 
 def model_error_text(evidence: Mapping[str, Any]) -> str:

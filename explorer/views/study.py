@@ -24,6 +24,7 @@ from ..model import (
     SPACINGS,
     Axis,
     ExplorerState,
+    days_text,
     default_range,
     plan_study,
     study_choices,
@@ -263,7 +264,7 @@ class StudyView:
         result = event.new
         if result is None:
             return
-        times = {f"{t:.6g} days": k for k, t in enumerate(result.times)}
+        times = {days_text(t, 6): k for k, t in enumerate(result.times)}
         self.study_time.options = times
         self.study_time.value = len(result.times) - 1
         if self.study_charts is None:

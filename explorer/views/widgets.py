@@ -175,7 +175,10 @@ class Binding:
             self._leading = None
 
     def _drag_step(self, name: str, value: Any) -> None:
-        if self._live_when is not None and self._live_when():
+        # a value shown from the state (``bind``, a preset) is no drag: nothing to ask
+        if self._syncing or self._live_when is None:
+            return
+        if self._live_when():
             self._to_target(name, value)
 
     def bind(self, target: param.Parameterized) -> None:

@@ -7,6 +7,7 @@ import copy
 import re
 
 import numpy as np
+import param
 import pytest
 
 from explorer.model import presets
@@ -108,3 +109,47 @@ def test_the_lesson_is_true_to_the_numbers() -> None:
     # the eccentric-creep preset (same footing and concrete) names the same threshold
     assert "beyond about 0.40 m" in presets()["eccentric_creep"]["description"]
     assert re.search(r"e = M/P = 0\.6 m", text)
+
+
+def test_a_drag_step_that_waits_for_the_release_says_so(monkeypatch, explorer_app) -> None:
+    """Slow solves: the box follows the handle but the plots do not; the note under the
+    slider says so, with the e the plots still show, and goes on release."""
+    from explorer.views import eccentricity
+
+    app = explorer_app(KEY, solved=True)
+    control = app.scene_tab.eccentric_load
+    assert not control.lag.visible
+    monkeypatch.setitem(app.controller.view.info, "cpu_seconds", 2 * eccentricity.LIVE_SOLVE_S)
+    control.slider.value = 0.72           # a drag step the solver cannot follow
+    assert app.state.loading.histories["moment"].value == pytest.approx(480.0)
+    assert control.lag.visible
+    note = control.lag.object
+    assert "the result at e = 0.600 m" in note and "e = 0.720 m when you release" in note
+    assert "400 ms" in note               # the cost that keeps the slider from following
+    control.slider.value = 0.6            # back where the plots are: nothing to wait for
+    assert not control.lag.visible
+    control.slider.value = 0.72
+    assert control.lag.visible
+    with param.edit_constant(control.slider):     # the release (set by the browser)
+        control.slider.value_throttled = 0.72
+    assert not control.lag.visible
+    assert app.state.loading.histories["moment"].value == pytest.approx(576.0)
+
+
+def test_live_drag_steps_need_no_note(monkeypatch, explorer_app) -> None:
+    from explorer.views import eccentricity
+
+    app = explorer_app(KEY, solved=True)
+    control = app.scene_tab.eccentric_load
+    monkeypatch.setitem(app.controller.view.info, "cpu_seconds", 0.5 * eccentricity.LIVE_SOLVE_S)
+    control.slider.value = 0.65
+    assert not control.lag.visible
+    assert app.state.loading.histories["moment"].value == pytest.approx(520.0)
+
+
+def test_the_lag_note_names_what_is_known() -> None:
+    from explorer.views.eccentricity import lag_text
+
+    assert lag_text(0.72, None, None) == (
+        "Solves are too slow to follow the handle: the plots show the previous result "
+        "and update to e = 0.720 m when you release it.")

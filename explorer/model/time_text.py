@@ -1,0 +1,37 @@
+"""Times after loading as the page writes them: positional digits, never an exponent.
+
+A history over decades reaches 18262.5 days; ``f"{t:.4g}"`` wrote that "1.826e+04", which
+an engineer has to decode. Here it reads "18260 days (50.0 years)": four significant
+digits written out (the report's numbers do the same, ``core.report``), and the years
+beside the days once the span is long enough for years to be the natural reading.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: [day] per year (the Julian year: 50 years of loading are 18262.5 days).
+DAYS_PER_YEAR = 365.25
+
+#: From this time on [day] the years are written beside the days: below two years the
+#: days are the natural reading (28 days, 365 days), beyond it the years.
+YEARS_FROM_DAYS = 2 * DAYS_PER_YEAR
+
+
+def plain_number(value: float, digits: int = 4) -> str:
+    """``value`` with ``digits`` significant digits, without an exponent from 0.001 to a
+    million ("18260", "0.5", "1000"); beyond, and for NaN or infinity, as Python writes it."""
+    if math.isfinite(value) and (value == 0 or 1e-3 <= abs(value) < 1e6):
+        return np.format_float_positional(float(value), precision=digits, unique=False,
+                                          fractional=False, trim="-")
+    return f"{value:.{digits}g}"
+
+
+def days_text(t: float, digits: int = 4) -> str:
+    """A time ``t`` [day] after loading in words: "28 days", "18260 days (50.0 years)"."""
+    text = f"{plain_number(t, digits)} days"
+    if math.isfinite(t) and abs(t) >= YEARS_FROM_DAYS:
+        text += f" ({t / DAYS_PER_YEAR:.1f} years)"
+    return text

@@ -1,0 +1,47 @@
+"""The status line and its details say what the solver reported, and nothing it did not:
+no "everything computed afresh" without stage timings, no "? modes"."""
+
+from __future__ import annotations
+
+import types
+
+import numpy as np
+
+from explorer.views.status import details_text, plain_status
+
+
+def _view(info: dict) -> types.SimpleNamespace:
+    # the two fields the status reads: the solve report and the result's flags
+    return types.SimpleNamespace(info=info, flags=[], scene={"solver": {"tol": 1e-4}})
+
+
+def test_without_stage_timings_no_claim_of_what_was_recomputed() -> None:
+    # the lift-off engine reports no stages (eccentric_footing_liftoff: info has none)
+    text = plain_status(_view({"seconds": 0.0012, "error_estimate": 7e-7}))
+    assert text.startswith("Solved in 1 ms;"), text
+    assert "afresh" not in text and "recomputed" not in text
+
+
+def test_stage_timings_all_fresh_say_so() -> None:
+    stages = {"grid": {"seconds": 0.007, "cached": False},
+              "solve": {"seconds": 0.017, "cached": False}}
+    text = plain_status(_view({"seconds": 0.024, "stages": stages, "error_estimate": 1e-7}))
+    assert text.startswith("Solved in 24 ms, everything computed afresh;"), text
+
+
+def test_times_below_a_millisecond_and_unknown_times() -> None:
+    stages = {"grid": {"seconds": 0.007, "cached": True},
+              "solve": {"seconds": 0.0004, "cached": False}}
+    assert plain_status(_view({"seconds": 0.0004, "stages": stages})).startswith(
+        "Solved in under 1 ms: only the response to the loads")
+    assert plain_status(_view({})).startswith("Solved; no accuracy estimate")
+
+
+def test_details_leave_out_what_the_solver_did_not_report() -> None:
+    text = details_text(_view({"n_steps": 124, "message": "unilateral contact"}))
+    assert "?" not in text and "modes" not in text
+    assert text == "124 time steps · solver: unilateral contact"
+    full = details_text(_view({"n_modes": np.int64(128), "n_steps": 32, "message": "ok",
+                               "stages": {"solve": {"seconds": 0.0004, "cached": False}}}))
+    assert full == "stages: solve 0.4 ms · 128 modes, 32 time steps · solver: ok"
+    assert details_text(_view({})) == "the solver reported no details"

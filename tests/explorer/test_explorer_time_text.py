@@ -1,0 +1,41 @@
+"""Times after loading on the page: written out, never in e+04 notation."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+
+from explorer.model import days_text, plain_number
+
+
+@pytest.mark.parametrize(("days", "text"), [
+    (0.0, "0 days"), (14.7, "14.7 days"), (28.0, "28 days"), (365.0, "365 days"),
+    (1000.0, "1000 days (2.7 years)"), (18262.5, "18260 days (50.0 years)"),
+    (0.0004, "0.0004 days"),
+])
+def test_days_are_written_out(days: float, text: str) -> None:
+    assert days_text(days) == text
+
+
+def test_plain_numbers_keep_the_exponent_only_beyond_a_million() -> None:
+    assert plain_number(123456.7) == "123500"
+    assert plain_number(0.30000000000000004) == "0.3"
+    assert plain_number(2.5e7) == "2.5e+07"
+
+
+def test_a_fifty_year_history_reads_in_days_and_years(explorer_app) -> None:
+    from explorer.model import presets
+
+    scene = copy.deepcopy(presets()["eccentric_footing_liftoff"])
+    scene["times"]["end"] = 18262.5       # 50 years
+    app = explorer_app(scene=scene, solved=True)
+    view = app.screen.shown()
+    last = len(view.times) - 1
+    app.results.show_time_texts(view, last)
+    assert "t = 18260 days (50.0 years)" in app.results.time_label.object
+    assert "At t = 18260 days (50.0 years) after loading" in app.results.readout.object
+    assert "e+" not in app.results.time_label.object + app.results.readout.object
+    app.figures.show_time(view, last)
+    assert app.figures.q_fig.title.text == "Pressure q(x), t = 18260 days (50.0 years)"
+    assert "e+" not in app.figures.contact.zone_label.text
