@@ -56,8 +56,12 @@ def accuracy_statement(view: ResultView) -> str:
     err = info.get("error_estimate")
     err_text = f"{float(err):.1e}" if isinstance(err, (int, float)) else "not available"
     met = "met" if "tol_not_met" not in view.flags else "NOT met"
-    return (f"estimated relative error {err_text}, target {tol:g} ({met}); "
-            f"{info.get('n_modes', '?')} modes, {info.get('n_steps', '?')} time steps")
+    # what the solver did not report is left out, not written as "?"
+    counts = [f"{info[key]} {word}" for key, word in (("n_modes", "modes"),
+                                                       ("n_steps", "time steps"))
+              if isinstance(info.get(key), int)]
+    return (f"estimated relative error {err_text}, target {tol:g} ({met})"
+            + (f"; {', '.join(counts)}" if counts else ""))
 
 
 def flag_lines(view: ResultView) -> list[str]:

@@ -45,3 +45,14 @@ def test_details_leave_out_what_the_solver_did_not_report() -> None:
                                "stages": {"solve": {"seconds": 0.0004, "cached": False}}}))
     assert full == "stages: solve 0.4 ms · 128 modes, 32 time steps · solver: ok"
     assert details_text(_view({})) == "the solver reported no details"
+
+
+def test_the_files_accuracy_line_leaves_out_what_the_solver_did_not_report():
+    from explorer.files.exports import accuracy_statement
+
+    view = types.SimpleNamespace(info={"error_estimate": 2e-7, "n_steps": 12}, flags=[],
+                           scene={"solver": {"tol": 1e-6}})
+    assert accuracy_statement(view) == ("estimated relative error 2.0e-07, target 1e-06 "
+                                        "(met); 12 time steps")
+    view.info = {}
+    assert "?" not in accuracy_statement(view)
