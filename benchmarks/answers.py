@@ -28,6 +28,9 @@ X = np.linspace(-1.0, 1.0, 41)
 
 #: Keys of ``info`` that measure the run (times, cache hits), not the answer.
 RUN_KEYS = ("seconds", "cached", "builds", "stages")
+#: Top-level keys of a solution's JSON that record what made the file (the program, its
+#: version, the solver's settings), not the answer: a new version changes them alone.
+RECORD_KEYS = ("program", "version", "solver")
 
 
 def _answer_only(value: Any) -> Any:
@@ -80,7 +83,10 @@ def _presets(out: dict[str, np.ndarray]) -> None:
                 scene = core.scene_from_dict(data)
             key = f"preset.{path.stem}.{tol}"
             result = core.solve(scene)
-            out[f"{key}.json"] = np.asarray(json.dumps(_answer_only(json.loads(result.to_json()))))
+            document = json.loads(result.to_json())
+            for name in RECORD_KEYS:
+                document.pop(name, None)
+            out[f"{key}.json"] = np.asarray(json.dumps(_answer_only(document)))
             out[f"{key}.csv"] = np.asarray(result.to_csv())
             out[f"{key}.q"] = np.asarray(result.pressure_on_grid, dtype=float)
 
