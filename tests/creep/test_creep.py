@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 
@@ -15,8 +14,6 @@ from core.creep import Elastic, UserKernel, creep_model_from_spec
 from core.creep.kernels import CausalKernel, DegenerateKernel, RelativeModulus
 from core.creep.models import KNOWN_MODELS, Arutyunyan, ExponentialCreep, PronySeries
 from core.time import ModalProblem, solve_degenerate
-
-HAVE_EXPRESSIONS = importlib.util.find_spec("core.profiles.expressions") is not None
 
 # Concrete-like parameters: E ~ 30 GPa, creep coefficient phi = E C of order 1-3, rates of
 # a week to a year, aging term A/tau comparable to C_inf at an age of a month.
@@ -396,7 +393,6 @@ def test_spec_matches_python_api_and_defaults():
     assert isinstance(prony.spec["modulus"], float)
 
 
-@pytest.mark.skipif(not HAVE_EXPRESSIONS, reason="core.profiles.expressions not written yet")
 def test_kernel_spec_round_trip():
     spec = {"model": "kernel", "modulus": 30e9, "expr": "-0.003 * exp(-0.05 * (t - tau))"}
     model = creep_model_from_spec(spec)
@@ -409,7 +405,6 @@ def test_kernel_spec_round_trip():
     assert float(model.kernel(30.0, 40.0)) == 0.0
 
 
-@pytest.mark.skipif(not HAVE_EXPRESSIONS, reason="core.profiles.expressions not written yet")
 @pytest.mark.parametrize("text", ["t +* 2", "x + t", "__import__('os')"])
 def test_kernel_formula_errors_name_the_field(text):
     with pytest.raises(ValueError, match=r"^base\.creep\.expr: "):

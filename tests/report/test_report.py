@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 import sys
 
+import holoviews  # noqa: F401  (installed by the test set-up)
 import pytest
 
 import core
@@ -17,8 +18,6 @@ from core.presets import read_preset
 from core.report import output_index, report_html, report_pdf, sections
 from core.scene import scene_from_dict
 from tests.cli_runs import run_cli
-
-pytest.importorskip("holoviews")
 
 
 @pytest.fixture(scope="module")

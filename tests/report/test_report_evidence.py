@@ -3,6 +3,7 @@ check's measurement when it was made for the scene, else the estimate."""
 
 from __future__ import annotations
 
+import holoviews  # noqa: F401  (installed by the test set-up)
 import pytest
 
 import core
@@ -11,8 +12,6 @@ from core.report.content import describe
 from core.scene import check_scene, checked_key, model_error_evidence
 from tests.cli_runs import run_cli
 from tests.support.under_read import ESTIMATE, MEASURED, under_read_scene
-
-pytest.importorskip("holoviews")
 
 MEASURED_ROW = "coating model error (measured by the FE check, relative)"
 ESTIMATED_ROW = "coating model error (estimated, relative)"

@@ -38,7 +38,8 @@ def solved(study: dict) -> list:
 
 
 def test_a_study_records_the_width_of_the_contact_set() -> None:
-    pytest.importorskip("xarray")
+    import xarray  # noqa: F401  (installed by the test set-up)
+
     from core.study import sweep
 
     study = liftoff_study()
@@ -54,7 +55,8 @@ def test_a_study_records_the_width_of_the_contact_set() -> None:
 
 
 def test_a_full_contact_study_keeps_the_whole_width_where_it_pulls() -> None:
-    pytest.importorskip("xarray")
+    import xarray  # noqa: F401  (installed by the test set-up)
+
     from core.study import sweep
 
     ds = sweep(study_from_dict(liftoff_study("full")), client="serial")
@@ -67,7 +69,8 @@ def test_the_command_line_sweep_writes_the_width_of_the_contact_set(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """``python -m core sweep`` in this process, its Dask cluster replaced by the serial
     runner (the cluster itself: tests/study/test_sweep.py)."""
-    pd = pytest.importorskip("pandas")
+    import pandas as pd
+
     import core.study
 
     study = liftoff_study()

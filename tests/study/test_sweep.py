@@ -404,7 +404,7 @@ def loopback_cluster(tmp_path_factory):
     """A ``dask scheduler`` and two single-threaded ``dask worker`` processes on 127.0.0.1,
     started as separate programs, as a user would start a cluster (without nannies: they
     only slow the shutdown here)."""
-    pytest.importorskip("distributed")
+    import distributed  # noqa: F401  (installed by the test set-up)
     where = tmp_path_factory.mktemp("cluster")
     scheduler_file = where / "scheduler.json"
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1",
@@ -519,7 +519,8 @@ def test_workers_are_warmed_by_a_plugin_and_the_warming_batches_solve(loopback_c
 
 
 def test_a_failed_warming_leaves_the_worker_running(monkeypatch):
-    pytest.importorskip("distributed")
+    import distributed  # noqa: F401  (installed by the test set-up)
+
     import core.study.warm as warm
 
     def broken() -> float:
