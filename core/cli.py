@@ -60,9 +60,12 @@ from core.scene import (
     SCHEMA_FILES,
     Scene,
     SceneSolution,
+    check_scene,
+    flags_with_evidence,
     load_json_schema,
     load_scene,
     migrate,
+    model_error_evidence,
     provenance_lines,
     read_scene_json,
     scene_from_dict,
@@ -177,13 +180,20 @@ def _check_outputs(scene: str, outputs: Sequence[tuple[str, Path | None]]) -> No
             raise _InputError(f"{option}: {exc}") from None
 
 
-def _write(path: Path, text: str) -> None:
+def _write(path: Path, content: str | bytes) -> None:
+    """Write text or bytes to ``path`` atomically, or to standard output for ``-``."""
     if str(path) == STDIO:
-        sys.stdout.write(text)
+        if isinstance(content, bytes):
+            sys.stdout.buffer.write(content)
+        else:
+            sys.stdout.write(content)
         sys.stdout.flush()
         return
     try:
-        atomic_write_text(path, text)
+        if isinstance(content, bytes):
+            atomic_write_bytes(path, content)
+        else:
+            atomic_write_text(path, content)
     except ValueError as exc:
         raise _InputError(str(exc)) from None
     except OSError as exc:
@@ -380,29 +390,15 @@ def _cmd_report(args: argparse.Namespace) -> int:
         raise _InputError(f"--{exc}") from None
     fe_check = None
     if args.fe_check:
-        from core.scene import check_scene
-
         try:
             fe_check = check_scene(result.scene, 0.0, level=FE_CHECK_LEVEL)
         except (ArithmeticError, ValueError, RuntimeError, MemoryError) as exc:
             print(f"error: check: {_one_line(exc)}", file=sys.stderr)
             return EXIT_SOLVER_FAILED
     if fmt == "pdf":
-        data = report_pdf(result, args.time, check=fe_check)
-        if stdout:
-            sys.stdout.buffer.write(data)
-            sys.stdout.flush()
-        else:
-            try:
-                atomic_write_bytes(output, data)
-            except ValueError as exc:
-                raise _InputError(str(exc)) from None
-            except OSError as exc:
-                raise _InputError(f"{output}: cannot write ({exc.strerror or exc})") from None
+        _write(output, report_pdf(result, args.time, check=fe_check))
     else:
         _write(output, report_html(result, args.time, check=fe_check))
-    from core.scene import flags_with_evidence, model_error_evidence
-
     evidence = model_error_evidence(result.scene, result.model_error["estimate"], fe_check)
     flags = flags_with_evidence(result.flags, evidence)
     messages = {**result.flag_messages, "model_error": evidence["message"]}
@@ -461,8 +457,6 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from core.scene import check_scene
-
     scene = _read(args.scene)
     end = float(scene.times[-1])
     if not 0.0 <= args.time <= end:  # also refuses nan

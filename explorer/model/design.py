@@ -57,8 +57,7 @@ class Check:
     def verdict(self) -> str:
         if self.limit is None:
             return "no limit set"
-        passed = self.passed if self.passed is not None else abs(self.value) <= self.limit
-        return "pass" if passed else "FAIL"
+        return "pass" if self.passed else "FAIL"
 
 
 @dataclass
