@@ -19,7 +19,7 @@ import numpy as np
 from core.optional import import_optional
 from core.scene.contact_zone import lifts_off as contact_lifts_off
 from core.scene.files import scene_to_json
-from core.scene.records import solver_settings as scene_solver_settings
+from core.scene.records import solver_settings
 from core.scene.schema import SCHEMA_VERSION, _jsonable
 
 # the package root only, for its version: its imports of the upper layers are for type
@@ -164,11 +164,11 @@ def html_summary(result: SceneSolution) -> str:
 # ------------------------------------------------------------------------------ metadata
 
 
-def solver_settings(result: SceneSolution) -> dict[str, Any]:
+def answered_settings(result: SceneSolution) -> dict[str, Any]:
     """The scene's ``solver`` settings (defaults filled in) and what the solver chose: the
     engine (``method``), the contact model that answered (``contact_model``: the
     setting ``contact`` may be ``"auto"``), the coating model, its discretization."""
-    settings: dict[str, Any] = scene_solver_settings(result.scene)
+    settings: dict[str, Any] = solver_settings(result.scene)
     info = result.info
     chosen = {"method": "method", "contact": "contact_model", "coating_model": "coating_model",
               "basis": "basis", "n_modes": "n_modes", "n_nodes": "n_nodes",
@@ -191,7 +191,7 @@ def metadata(result: SceneSolution) -> dict[str, Any]:
         "scene_name": result.scene.name,
         "scene_key": result.scene.key,
         "scene": scene_to_json(result.scene),
-        "solver_settings": json.dumps(solver_settings(result), sort_keys=True),
+        "solver_settings": json.dumps(answered_settings(result), sort_keys=True),
         "statement": int(result.scene.statement),
         "given": ",".join(sorted(result.scene.given)),
         "flags": ",".join(result.flags),

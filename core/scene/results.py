@@ -21,7 +21,7 @@ from core.coating import model_error_estimate, model_error_map, tilt_share
 from core.problem import QUANTITIES
 from core.scene.contact_zone import contact_width, lift_off_length
 from core.scene.design import DesignCheck, DesignLimits, design_check
-from core.scene.display import HISTORIES, html_summary, solver_settings, text_summary
+from core.scene.display import HISTORIES, answered_settings, html_summary, text_summary
 from core.scene.display import to_dataframe as _to_dataframe
 from core.scene.display import to_xarray as _to_xarray
 from core.scene.load_rates import oscillations
@@ -243,7 +243,7 @@ class SceneSolution:
             "format": "coated-punch solution",
             "program": PROGRAM,
             "version": VERSION,
-            "solver": solver_settings(self),
+            "solver": answered_settings(self),
             "schema_version": SCHEMA_VERSION,
             "scene": self.scene.to_dict(),
             "units": UNITS,
