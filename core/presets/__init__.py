@@ -13,15 +13,13 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterator
-from contextlib import AbstractContextManager, contextmanager
 from functools import cache
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-__all__ = ["PRESET_PREFIX", "preset_names", "preset_path", "read_preset", "read_study",
-           "shipped_file", "study_names", "study_path"]
+__all__ = ["PRESET_PREFIX", "preset_names", "read_preset", "read_study", "shipped_file",
+           "study_names"]
 
 #: How a command-line argument names a shipped scene or study instead of a file.
 PRESET_PREFIX = "preset:"
@@ -47,10 +45,14 @@ def study_names() -> tuple[str, ...]:
     return _names("studies")
 
 
+def _known(kind: str) -> str:
+    """The shipped names of ``kind``, as the refusal of another name lists them."""
+    return f"known: {', '.join(_names(kind))}"
+
+
 def _read(kind: str, name: str) -> dict[str, Any]:
-    known = _names(kind)
-    if name not in known:
-        raise KeyError(f"no shipped {kind[:-1]} named {name!r}; known: {', '.join(known)}")
+    if name not in _names(kind):
+        raise KeyError(f"no shipped {kind[:-1]} named {name!r}; {_known(kind)}")
     data = json.loads(_folder(kind).joinpath(f"{name}.json").read_text(encoding="utf-8"))
     if not isinstance(data, dict):
         raise ValueError(f"the shipped {kind[:-1]} {name!r} is not a JSON object")
@@ -70,7 +72,7 @@ def read_preset(name: str) -> dict[str, Any]:
 
 def read_study(name: str) -> dict[str, Any]:
     """The shipped study ``name`` as a fresh study dict; its ``scene`` is a path relative
-    to :func:`study_path` ``(name)``'s folder."""
+    to the study's file (``shipped_file("preset:NAME", "studies")``)."""
     return _read("studies", name)
 
 
@@ -87,27 +89,6 @@ def shipped_file(path: str | os.PathLike, kind: str) -> str | os.PathLike:
         return path
     name = path[len(PRESET_PREFIX):]
     if name not in _names(kind):
-        raise ValueError(f"{path}: no shipped {kind[:-1]} of that name; "
-                       f"known: {', '.join(_names(kind))}")
+        raise ValueError(f"{path}: no shipped {kind[:-1]} of that name; {_known(kind)}")
     # an installed package is a folder of files (a wheel unpacks; a zipped one would not do)
     return Path(str(_folder(kind).joinpath(f"{name}.json")))
-
-
-@contextmanager
-def _as_path(kind: str, name: str) -> Iterator[Path]:
-    if name not in _names(kind):
-        raise KeyError(f"no shipped {kind[:-1]} named {name!r}; "
-                       f"known: {', '.join(_names(kind))}")
-    with resources.as_file(_folder(kind).joinpath(f"{name}.json")) as path:
-        yield path
-
-
-def preset_path(name: str) -> AbstractContextManager[Path]:
-    """A context manager giving a file-system path of the preset scene ``name``."""
-    return _as_path("scenes", name)
-
-
-def study_path(name: str) -> AbstractContextManager[Path]:
-    """A context manager giving a file-system path of the shipped study ``name`` (its
-    ``scene`` path resolves beside it)."""
-    return _as_path("studies", name)
