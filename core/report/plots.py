@@ -14,10 +14,15 @@ from typing import Any
 
 import numpy as np
 
-from core.optional import import_optional
 from core.report.contact import lift_off_times, output_index
 from core.report.inputs import LAYER_FIELDS, SHAPE_UNIT
-from core.scene import LIFT_OFF_COLOUR, SceneSolution, known_contact_width, shown_times
+from core.scene import (
+    LIFT_OFF_COLOUR,
+    SceneSolution,
+    holoviews_for_bokeh,
+    known_contact_width,
+    shown_times,
+)
 
 #: The curves of the contact plot: (label, colour), the part in contact dark blue and the
 #: part lifted off red, as the explorer draws them.
@@ -34,16 +39,9 @@ PLOT_TITLES = ("contact pressure q(x, t) (grey: lifted off)", "settlement δ(t)"
 GEOMETRY_POINTS = 801
 
 
-def _holoviews() -> Any:
-    hv = import_optional("holoviews", "the report's plots")
-    import_optional("bokeh", "the report's plots")
-    import_optional("holoviews.plotting.bokeh", "the report's plots")  # the backend's options
-    return hv
-
-
 def contact_overlay(result: SceneSolution) -> Any:
     """The contact width and the lifted length [m] over time (their sum is 2a)."""
-    hv = _holoviews()
+    hv = holoviews_for_bokeh("the report's plots")
     width = known_contact_width(result)
     full = 2 * result.scene.half_width
     t_dim = hv.Dimension("time", label="t", unit="day")
@@ -73,7 +71,7 @@ def geometry_curves(result: SceneSolution) -> list[tuple[str, Any]]:
     """(title, curve) of the punch base f(x) [mm] and of the coating thickness of all
     layers [mm] over x [m], each only where it varies (a flat base and a uniform coating
     are said in the inputs)."""
-    hv = _holoviews()
+    hv = holoviews_for_bokeh("the report's plots")
     scene = result.scene
     x = _geometry_x(result)
 
@@ -105,7 +103,7 @@ def report_layout(result: SceneSolution, time: float | None = None) -> tuple[Any
 
     ``time`` [day after loading]: its output time is drawn among the q(x) curves.
     """
-    _holoviews()
+    holoviews_for_bokeh("the report's plots")
     k = output_index(result, time)
     picked = shown_times(result.times)
     wanted = [float(result.times[j]) for j in sorted({*picked.tolist(), k})]
@@ -123,7 +121,7 @@ def matplotlib_layout(layout: Any) -> Any:
     """``layout`` styled for HoloViews' Matplotlib backend (registered by the caller): the
     lift-off shading, the contact and the geometry curves in the colours of the HTML
     report."""
-    hv = _holoviews()
+    hv = holoviews_for_bokeh("the report's plots")
     by_label = dict(CONTACT_CURVES)
     by_value = {name: colour for name, _, colour in GEOMETRY_PLOTS}
 

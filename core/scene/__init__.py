@@ -11,7 +11,7 @@ returns a ``SceneSolution``.
 - ``contact_zone.py``: ``contact_width``, ``lift_off_length``, ``lifts_off`` of a
   contact set: the one definition every output of the contact width uses;
 - ``display.py``: its repr and HTML table, its metadata, ``to_xarray``/``to_dataframe``;
-- ``plotting.py``: its HoloViews plot (the one module of core that imports HoloViews);
+- ``plotting.py``: its HoloViews plot (HoloViews is imported here and by core.report only, on use);
 - ``files.py``: ``load_scene``, ``save_scene`` (strict JSON, atomic writes);
 - ``records.py``: what every file of an answer records (version, scene, solver settings);
 - ``load_limits.py``, ``load_rates.py``: loads no contact can carry, and the steps a
@@ -47,7 +47,7 @@ from core.scene.json_schema import (
 )
 from core.scene.model import Scene
 from core.scene.pipeline import solve
-from core.scene.plotting import LIFT_OFF_COLOUR, shown_times
+from core.scene.plotting import LIFT_OFF_COLOUR, holoviews_for_bokeh, shown_times
 from core.scene.records import (
     provenance,
     provenance_lines,
@@ -73,6 +73,7 @@ __all__ = [
     "LIFT_OFF_COLOUR",
     "LIFT_OFF_SHARE",
     "engine_text",
+    "holoviews_for_bokeh",
     "known_contact_width",
     "lifts_off_at",
     "check_design",

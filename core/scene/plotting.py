@@ -39,10 +39,12 @@ TITLES = {"pressure": "contact pressure q(x, t)", "settlement": "settlement δ(t
 LIFT_OFF_COLOUR = "#d9d9d9"
 
 
-def _holoviews() -> Any:
+def holoviews_for_bokeh(feature: str = "SceneSolution.plot") -> Any:
     """HoloViews with its Bokeh backend registered (no notebook output, unlike
-    ``hv.extension``, and the current backend is left as it was)."""
-    hv = import_optional("holoviews", "SceneSolution.plot")
+    ``hv.extension``, and the current backend is left as it was); ``feature`` names what
+    needs them in the error when either is missing."""
+    hv = import_optional("holoviews", feature)
+    import_optional("bokeh", feature)
     if "bokeh" not in hv.Store.renderers:
         importlib.import_module("holoviews.plotting.bokeh")
     return hv
@@ -82,7 +84,7 @@ def _lift_off_spans(hv: Any, result: SceneSolution) -> list[Any]:
 def pressure_overlay(result: SceneSolution, count: int = PLOT_CURVES,
                      times: Sequence[float] | None = None) -> holoviews.Overlay:
     """q(x) [kPa or MPa] against x [m] at some of the output times, coloured by time."""
-    hv = _holoviews()
+    hv = holoviews_for_bokeh()
     from holoviews.plotting.util import process_cmap
 
     picked = shown_times(result.times, count, times)
@@ -111,7 +113,7 @@ def pressure_overlay(result: SceneSolution, count: int = PLOT_CURVES,
 def history_curve(result: SceneSolution, name: str, factor: float,
                   unit: str) -> holoviews.Curve:
     """``name`` (an attribute of ``result`` over time) times ``factor``, in ``unit``."""
-    hv = _holoviews()
+    hv = holoviews_for_bokeh()
     t_dim = hv.Dimension("time", label="t", unit="day")
     v_dim = hv.Dimension(name, label=name, unit=unit)
     values = np.asarray(getattr(result, name)) * factor
@@ -125,7 +127,7 @@ def plot_solution(result: SceneSolution, count: int = PLOT_CURVES,
     """A HoloViews layout of ``result``: q(x) at ``count`` output times (or those nearest
     to ``times`` [day]) coloured by time, the settlement [mm] and the tilt [mrad] over
     time; the flags in the layout's title, lift-off in the pressure's."""
-    hv = _holoviews()
+    hv = holoviews_for_bokeh()
     layout = hv.Layout([pressure_overlay(result, count, times),
                         history_curve(result, "settlement", 1e3, "mm"),
                         history_curve(result, "tilt", 1e3, "mrad")]).cols(3)
