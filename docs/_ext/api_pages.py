@@ -125,6 +125,13 @@ def _page(package: str, homes: dict[str, str]) -> str:
     return "\n".join(lines)
 
 
+def _remove_stale_stubs(folder: Path) -> None:
+    """Autosummary's pages of names a package no longer exports: left in the source tree
+    from an earlier build, they would fail this one (autodoc cannot import them)."""
+    for stub in folder.glob("*.rst") if folder.exists() else []:
+        package, _, name = stub.stem.rpartition(".")
+        if package not in PACKAGES or name not in importlib.import_module(package).__all__:
+            stub.unlink()
 
 
 def generate(app: Sphinx) -> None:
@@ -132,6 +139,7 @@ def generate(app: Sphinx) -> None:
     homes = _homes()
     for package in PACKAGES:
         write_if_changed(out / f"{package}.rst", _page(package, homes))
+    _remove_stale_stubs(out / "generated")
     # a fresh environment listed its documents before these pages were written
     app.env.find_files(app.config, app.builder)
 
