@@ -19,7 +19,6 @@ with the load.
 from __future__ import annotations
 
 import copy
-import json
 import os
 import sys
 import time
@@ -27,7 +26,7 @@ import time
 import numpy as np
 
 from core.scene import solve
-from explorer.model import SCENES_DIR
+from core.presets import read_preset
 
 #: The presets measured by default: a creep scene, two thin-coating scenes (smooth and
 #: stepped) and the exact layered one.
@@ -53,7 +52,7 @@ def _variants(scene: dict, kind: str) -> list[dict]:
 
 def measure(name: str) -> list[tuple[str, float, float, float]]:
     """``(kind, CPU ms, info cpu_seconds ms, info seconds ms)`` medians for one preset."""
-    scene = json.loads((SCENES_DIR / f"{name}.json").read_text())
+    scene = read_preset(name)
     solve(scene)  # imports and the first build: not measured
     rows = []
     for kind in ("new geometry", "loads only"):
