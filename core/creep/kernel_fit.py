@@ -245,6 +245,18 @@ def nonpositive_violation(fitted: FittedKernel, samples: int = 41) -> float:
     The ages are geometric in ``tau`` and the lags geometric from the resolution to the
     end, so both the fast and the slow terms are seen.
     """
+    if fitted.key is None:
+        return _nonpositive_violation(fitted, samples)
+    # a scene's kernel is checked at every solve (a load slider): once per fit
+    return _VIOLATIONS.get_or_compute((fitted.key, samples),
+                                      lambda: _nonpositive_violation(fitted, samples))[0]
+
+
+#: :func:`nonpositive_violation` of the fits met so far, by their keys.
+_VIOLATIONS = StageCache("kernel_sign", max_items=64, max_bytes=2**16, sizeof=lambda _: 8)
+
+
+def _nonpositive_violation(fitted: FittedKernel, samples: int) -> float:
     _, ages = _age_nodes(1.0, fitted.end, samples)
     ages = np.unique(np.concatenate([ages, fitted.edges]))
     lags = np.concatenate([[0.0], np.geomspace(fitted.resolution, fitted.end - 1.0, samples)])

@@ -7,6 +7,7 @@ the time stepping, creep beyond real materials), naming the field to change.
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping
 from dataclasses import replace
@@ -59,6 +60,37 @@ def scene_from_dict(d: Mapping[str, Any] | Scene) -> Scene:
     if isinstance(d, Scene):
         return d
     d = migrate(d)
+    # a dict equal to one validated before but for its load values (a load slider, a
+    # study over a load) is checked as a load change: its geometry, base and times are
+    # not sampled and checked again
+    key = _key_without_loads(d)
+    loading = d.get("loading")
+    if key is not None and isinstance(loading, Mapping):
+        known = _VALIDATED.get(key)
+        if known is not None and set(loading) == set(known.loading):
+            return replace_loads(known, loading)
+    scene = _validated(d)
+    if key is not None:
+        _VALIDATED.get_or_compute(key, lambda: scene)
+    return scene
+
+
+#: Scenes validated by :func:`scene_from_dict`, by :func:`_key_without_loads` of their dict.
+_VALIDATED = StageCache("validated_scenes", max_items=32, max_bytes=64 * 2**20)
+
+
+def _key_without_loads(d: Mapping[str, Any]) -> str | None:
+    """The canonical JSON of a (migrated) scene dict without its ``loading``, or None if
+    the dict is not plain JSON (numpy scalars, callables: such a dict is not memoised)."""
+    try:
+        return json.dumps({k: v for k, v in d.items() if k != "loading"}, sort_keys=True,
+                          separators=(",", ":"))
+    except (TypeError, ValueError, RecursionError):
+        return None
+
+
+def _validated(d: dict[str, Any]) -> Scene:
+    """:func:`scene_from_dict`'s checks of every field of the migrated dict ``d``."""
     check_fields(d, "", schema.required_fields("scene"),
                  (*schema.optional_fields("scene"), schema.SCHEMA_KEY))
     if schema.SCHEMA_KEY in d:

@@ -10,7 +10,7 @@ import pytest
 
 from core.scene import scene_from_dict, solve
 from core.scene.golden_section import golden_minimum, golden_minimum_batched
-from tests.conftest import scene_file
+from tests.conftest import edited, scene_file
 
 
 @pytest.mark.parametrize("depth", [1, 3, 5, 8])
@@ -65,3 +65,52 @@ def test_the_samples_are_the_union_of_every_profiles_samples(name):
     union = np.unique(np.concatenate([np.linspace(-a, a, DENSE_SAMPLES)] + [
         p.sample_points((-a, a)) for p in profiles]))
     assert np.array_equal(scene.sample_x, union)
+
+
+def test_a_scene_dict_with_new_loads_is_validated_as_a_load_change(stage_evaluations):
+    """A scene dict equal to one validated before but for its load values (a load slider,
+    a study over a load) is checked as a load change: its geometry, base and times are not
+    validated again, and a geometry change is."""
+    d = scene_file("uniform_flat")
+    scene_from_dict(d)
+    assert stage_evaluations().get("validated_scenes") == 1
+    for factor in (1.1, 1.2, 0.5):
+        scene_from_dict(edited("loading.force", factor * d["loading"]["force"], d))
+    assert stage_evaluations().get("validated_scenes") == 1
+    scene_from_dict(edited("punch.half_width", 1.01 * d["punch"]["half_width"], d))
+    assert stage_evaluations().get("validated_scenes") == 2
+
+
+@pytest.mark.parametrize(("path", "value"), [
+    ("loading.force", -1e30),
+    ("loading.force", "x * "),
+    ("loading.force", [[0, 1], [0, 2]]),
+    ("loading.force", None),
+])
+def test_a_bad_load_after_a_good_scene_is_refused_as_in_a_fresh_one(path, value):
+    """The load-change path refuses a bad load with the words of a full validation."""
+    from core.cache import clear_caches
+
+    d = scene_file("uniform_flat")
+    scene_from_dict(d)  # remembered: the bad dict below differs in a load only
+    bad = edited(path, value, d)
+    with pytest.raises(ValueError) as shared:
+        solve(bad)
+    clear_caches()
+    with pytest.raises(ValueError) as fresh:
+        solve(bad)
+    assert str(shared.value) == str(fresh.value)
+    assert str(shared.value).startswith(path)
+
+
+def test_other_given_loads_are_validated_in_full():
+    """Loads naming other quantities (another statement) take the full validation."""
+    d = scene_file("uniform_flat")
+    scene_from_dict(d)
+    other = copy.deepcopy(d)
+    other["loading"] = {"settlement": 0.001, "tilt": 0.0}
+    scene = scene_from_dict(other)
+    assert set(scene.loading) == {"settlement", "tilt"}
+    other["loading"] = {"settlement": 0.001}
+    with pytest.raises(ValueError, match="^loading: exactly two"):
+        scene_from_dict(other)
