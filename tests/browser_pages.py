@@ -22,6 +22,24 @@ def require_browser() -> None:
             pytest.fail(missing, pytrace=False)
         pytest.skip(missing, allow_module_level=True)
 
+
+#: The most a wait on the page is stretched on a busy machine (see :func:`patience`).
+MOST_PATIENCE = 5.0
+
+
+def patience() -> float:
+    """How many times longer than on a quiet machine the page may take now: the load
+    average per core, from 1 to :data:`MOST_PATIENCE`.
+
+    Every wait of these tests is on a condition of the page, so a longer limit costs
+    nothing where the page is quick; on a shared machine at load ~10 (2 cores) a page
+    load took 30 s and a study's last message came over 60 s after its chart, where a
+    quiet machine takes 2-5 s.
+    """
+    per_core = os.getloadavg()[0] / (os.cpu_count() or 1)
+    return min(MOST_PATIENCE, max(1.0, per_core))
+
+
 # JavaScript helpers run in the page.
 JS_DOC = "() => (window.Bokeh && Bokeh.documents && Bokeh.documents[0]) || null"
 JS_READY = """() => {
@@ -53,8 +71,8 @@ class Page:
         self.errors: list[str] = []
         self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
         self.page.on("pageerror", lambda e: self.errors.append(str(e)))
-        self.page.goto(url + path)
-        self.page.wait_for_function(JS_READY, timeout=60_000)
+        self.page.goto(url + path, timeout=30_000 * patience())
+        self.page.wait_for_function(JS_READY, timeout=60_000 * patience())
 
     def q(self) -> list[float]:
         return self.page.evaluate(JS_Q)
@@ -71,7 +89,7 @@ class Page:
             "e => (e.shadowRoot || e).textContent")
 
     def wait_text_change(self, selector: str, old: str, timeout: float = 60.0) -> str:
-        deadline = time.monotonic() + timeout
+        deadline = time.monotonic() + timeout * patience()
         while time.monotonic() < deadline:
             new = self.text(selector)
             if new != old:
@@ -111,8 +129,10 @@ JS_SHOWN = """(text) => {
 
 
 def until(check, what: str, timeout: float = 60.0, describe=None) -> None:
-    """Poll ``check`` (a look at the page) until it holds; fail after ``timeout`` [s]
-    (saying what ``describe()``, if given, sees on the page then)."""
+    """Poll ``check`` (a look at the page) until it holds; fail after ``timeout`` [s] on a
+    quiet machine, stretched by :func:`patience` on a busy one (saying what
+    ``describe()``, if given, sees on the page then)."""
+    timeout *= patience()
     deadline = time.monotonic() + timeout
     while not check():
         if time.monotonic() > deadline:
@@ -148,6 +168,8 @@ def chromium_context(width: int, height: int, **options):
         context = p.chromium.launch_persistent_context(
             profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
             viewport={"width": width, "height": height}, **options)
+        # Playwright's own waits (a click, a download) get the same patience
+        context.set_default_timeout(30_000 * patience())
         yield context
         context.close()
     shutil.rmtree(profile, ignore_errors=True)

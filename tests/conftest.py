@@ -55,8 +55,11 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "suite"))
 
 def wait_until(condition: Callable[[], Any], timeout: float = 30.0,
                every: float = 0.02) -> bool:
-    """True as soon as ``condition()`` is true; False if it is not within ``timeout`` [s]."""
-    deadline = time.monotonic() + timeout
+    """True as soon as ``condition()`` is true; False if it is not within ``timeout`` [s]
+    (on a quiet machine; stretched on a busy one: :func:`tests.browser_pages.patience`)."""
+    from tests.browser_pages import patience
+
+    deadline = time.monotonic() + timeout * patience()
     while True:
         if condition():
             return True

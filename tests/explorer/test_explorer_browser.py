@@ -16,7 +16,7 @@ import pytest
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
-from tests.browser_pages import require_browser  # noqa: E402
+from tests.browser_pages import patience, require_browser  # noqa: E402
 
 require_browser()
 
@@ -68,7 +68,7 @@ def test_moving_a_load_slider_changes_settlement_and_pressure(page: Page):
     page.page.wait_for_function(
         "(old) => { const q = Bokeh.documents[0].get_model_by_name('q_source').data.q;"
         " return q.length > 0 && Math.abs(q[Math.floor(q.length / 2)] -"
-        " old[Math.floor(old.length / 2)]) > 1e-9; }", arg=q_before, timeout=60_000)
+        " old[Math.floor(old.length / 2)]) > 1e-9; }", arg=q_before, timeout=60_000 * patience())
     assert page.errors == []
 
 
@@ -78,7 +78,7 @@ def test_switching_the_statement_changes_the_unknowns(page: Page):
         "settlement + tilt given")
     page.page.wait_for_function(
         "() => Bokeh.documents[0].get_model_by_name('force_figure').title.text"
-        ".endsWith('computed')", timeout=60_000)
+        ".endsWith('computed')", timeout=60_000 * patience())
     assert page.title("moment_figure").endswith("computed")
     assert page.title("settlement_figure").endswith("given")
     assert page.title("tilt_figure").endswith("given")
@@ -93,14 +93,14 @@ def test_a_bad_value_shows_its_message_and_keeps_the_plots(page: Page):
     page.open_tab("Coating")
     page.type_into(".coating-thickness", "-2")
     alert = page.page.locator(".solve-error").first
-    alert.wait_for(state="visible", timeout=60_000)
+    alert.wait_for(state="visible", timeout=60_000 * patience())
     message = page.pane_text(".solve-error")
     assert "coating[0].thickness" in message and "must be > 0" in message
     assert page.q() == q_before
     assert page.text(".readout-settlement") == settlement
     # the session keeps working
     page.type_into(".coating-thickness", "15")
-    alert.wait_for(state="hidden", timeout=60_000)
+    alert.wait_for(state="hidden", timeout=60_000 * patience())
     page.wait_text_change(".readout-settlement", settlement)
     assert "Traceback" not in page.page.content()
     assert page.errors == []
@@ -110,7 +110,7 @@ def test_a_bad_link_shows_a_message_and_the_default_scene(server: str, browser_c
     p = Page(browser_context, server, "/app?scene=1.not-a-scene")
     try:
         notice = p.page.locator(".notice").first
-        notice.wait_for(state="visible", timeout=30_000)
+        notice.wait_for(state="visible", timeout=30_000 * patience())
         text = p.pane_text(".notice")
         assert "link" in text and "default scene" in text
         assert len(p.q()) > 100
@@ -124,7 +124,7 @@ def test_pin_link_and_downloads_match_the_screen(server: str, browser_context, p
 
     settlement = page.text(".readout-settlement")
     page.page.get_by_text("Pin this result").first.click()
-    page.page.locator(".pinned-settlement").first.wait_for(timeout=30_000)
+    page.page.locator(".pinned-settlement").first.wait_for(timeout=30_000 * patience())
     assert page.page.evaluate(
         "() => Bokeh.documents[0].get_model_by_name('q_pin_source_0').data.q.length") > 1
 
@@ -150,11 +150,11 @@ def test_pin_link_and_downloads_match_the_screen(server: str, browser_context, p
 
     # downloads hold the same scene and result
     page.open_tab("Files")
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.get_by_text("Save scene (JSON)").first.click()
     saved = json.loads(Path(info.value.path()).read_text())
     assert saved == scene
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.get_by_text("Results: histories (CSV)").first.click()
     meta, names, table = parse_csv(Path(info.value.path()).read_text())
     assert names[:3] == ["time_day", "settlement_mm", "tilt_mrad"]
@@ -181,13 +181,13 @@ def test_an_oversized_upload_is_refused_in_the_page_and_a_scene_file_loads(page:
     page.page.on("console", lambda m: "Lost websocket" in m.text and disconnected.append(m.text))
     page.open_tab("Files")
     upload = page.page.locator("input[type=file]").last
-    upload.wait_for(state="attached", timeout=30_000)
+    upload.wait_for(state="attached", timeout=30_000 * patience())
     # 5 MiB: over the limit of a scene file (1 MB) and over the largest websocket message
     # the server reads (4 MiB, explorer/__main__.py), which a file sent in one message
     # would exceed and lose the page's connection (25 MiB cost 20 s more to hand over)
     upload.set_input_files(files=[{"name": "big.json", "mimeType": "application/json",
                                    "buffer": b"{" + b" " * (5 * 2**20) + b"}"}])
-    page.page.get_by_text("File is too large").first.wait_for(timeout=30_000)
+    page.page.get_by_text("File is too large").first.wait_for(timeout=30_000 * patience())
     root = Path(__file__).resolve().parents[2]
     scene = json.loads((root / "core" / "presets" / "scenes" / "stepped_punch.json").read_text())
     scene["name"] = "uploaded in the browser"
@@ -197,5 +197,5 @@ def test_an_oversized_upload_is_refused_in_the_page_and_a_scene_file_loads(page:
     page.wait_text_change(".readout-settlement", settlement)
     page.page.wait_for_function(
         "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text"
-        ".includes('uploaded in the browser')", timeout=30_000)
+        ".includes('uploaded in the browser')", timeout=30_000 * patience())
     assert disconnected == [] and page.errors == []

@@ -23,6 +23,7 @@ from tests.browser_pages import (  # noqa: E402
     JS_VIEW_WIDTH,
     Page,
     page_fixtures,
+    patience,
     until,
 )
 
@@ -86,12 +87,12 @@ def test_a_flag_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: P
     _wait(page, "() => window.innerWidth === 1024")
     scene_top = page.page.locator(".bk-panel-models-layout-Column").first.bounding_box()
     status = page.page.locator(".solve-status").first
-    status.wait_for(timeout=30_000)
+    status.wait_for(timeout=30_000 * patience())
     before_top = _figure_top(page)
     # a 200 mm coating on the 2 m footing: the coating model errs by ~3.4 % (flagged)
     page.open_tab("Coating")
     page.type_into(".coating-thickness", "200")
-    page.page.locator(".flag-model_error").first.wait_for(timeout=60_000)
+    page.page.locator(".flag-model_error").first.wait_for(timeout=60_000 * patience())
     # the status keeps the width of the main column; the plots hardly move
     width = status.bounding_box()["width"]
     assert width > 400, width
@@ -107,7 +108,7 @@ def test_a_flag_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: P
         page.page.evaluate(JS_VIEW_WIDTH, "scene_figure") - 60
     # the flagged result's CSV carries the flag and the units on screen
     page.open_tab("Files")
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.get_by_text("Results: histories (CSV)").first.click()
     meta, names, table = parse_csv(Path(info.value.path()).read_text())
     assert "WARNING" in meta and "flag model_error" in meta
@@ -116,7 +117,7 @@ def test_a_flag_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: P
     assert table[0, 3] == 500  # kN/m: exactly the preset's 5e5 N/m, no round-off tail
     text = Path(info.value.path()).read_text()
     assert "9999999" not in text and "0000001" not in text
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.get_by_text("Results: q(x, t) (CSV)").first.click()
     meta, names, table = parse_csv(Path(info.value.path()).read_text())
     assert names == ["time_day", "x_m", "q_kPa"] and "flag model_error" in meta
@@ -143,17 +144,17 @@ def test_a_changed_scene_is_saved_under_its_own_name_and_description(page: Page)
     until(lambda: page.text(".readout-force") == "650", "force 650")
     page.open_tab("Files")
     name = page.page.locator(".scene-name input").first
-    name.wait_for(timeout=30_000)
+    name.wait_for(timeout=30_000 * patience())
     until(lambda: name.input_value().endswith("(modified)"), "the name '... (modified)'")
     area = page.page.locator(".scene-description textarea").first
     area.fill("Strip footing B-12, checked for 650 kN/m")
     area.blur()
     page.page.wait_for_function(
         "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text"
-        ".includes('(modified)')", timeout=60_000)
+        ".includes('(modified)')", timeout=60_000 * patience())
     saved = None
     for _ in range(50):  # the description reaches the server on blur: read until it has
-        with page.page.expect_download(timeout=60_000) as info:
+        with page.page.expect_download(timeout=60_000 * patience()) as info:
             page.page.get_by_text("Save scene (JSON)").first.click()
         saved = json.loads(Path(info.value.path()).read_text())
         if saved["description"].startswith("Strip footing"):
@@ -265,7 +266,7 @@ def test_a_load_step_repaints_only_the_figures_whose_data_changed(page: Page):
 
 def test_an_overlong_name_from_the_page_is_refused(page: Page):
     page.open_tab("Files")
-    page.page.locator(".scene-name input").first.wait_for(timeout=30_000)
+    page.page.locator(".scene-name input").first.wait_for(timeout=30_000 * patience())
     # bypass the input's own length limit, as a crafted message would
     page.page.evaluate("""() => {
       const doc = Bokeh.documents[0];
@@ -273,7 +274,7 @@ def test_an_overlong_name_from_the_page_is_refused(page: Page):
         if (m.css_classes && m.css_classes.includes('scene-name')) m.value = 'x'.repeat(5000);
       }
     }""")
-    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000)
+    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000 * patience())
     assert "at most 200 characters" in page.pane_text(".notice")
     assert "xxxxxxxxxx" not in page.page.evaluate(
         "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text")
@@ -283,7 +284,7 @@ def test_an_overlong_name_from_the_page_is_refused(page: Page):
 def test_the_creep_model_from_a_file_is_offered_only_with_one(page: Page):
     page.open_tab("Base")
     select = page.page.locator(".creep-select select").first
-    select.wait_for(timeout=30_000)
+    select.wait_for(timeout=30_000 * patience())
     options = select.evaluate("s => [...s.options].map(o => o.textContent)")
     assert "other model (from file)" not in options
     assert "aging creep (Arutyunyan)" in options
@@ -302,7 +303,7 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     until(lambda: "no limits set" in page.text(".design-check"), "the design check")
     page.open_tab("Check")
     box = page.page.locator(".limit-pressure input").first
-    box.wait_for(timeout=30_000)
+    box.wait_for(timeout=30_000 * patience())
     box.fill("1")  # kPa: any footing fails this
     box.press("Enter")
     until(lambda: "a limit is exceeded" in page.text(".design-check"), "FAIL")
@@ -320,7 +321,7 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     import core
 
     page.open_tab("Files")
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.get_by_text("Printable report (HTML)").first.click()
     text = Path(info.value.path()).read_text()
     assert info.value.suggested_filename.endswith("_report.html")
@@ -332,7 +333,7 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     assert "<td>eccentricity e = M/P at the last time</td><td>0.2 m</td>" in text
     # Bokeh's plots, their library inline; nothing drawn by hand
     assert "Bokeh.embed" in text and "<svg" not in text.split("</head><body>")[1]
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.get_by_text("Printable report (PDF)").first.click()
     assert Path(info.value.path()).read_bytes().startswith(b"%PDF-")
     assert info.value.suggested_filename.endswith("_report.pdf")
@@ -407,7 +408,7 @@ def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
                                                    browser_context: object):
     """Feature 4: a copied link reopens the same view, pin included."""
     page.page.get_by_text("Pin this result").first.click()
-    page.page.locator(".pinned-settlement").first.wait_for(timeout=30_000)
+    page.page.locator(".pinned-settlement").first.wait_for(timeout=30_000 * patience())
     page.type_into(".load-0-value", "650")
     until(lambda: page.text(".readout-force") == "650", "force 650")
     page.page.locator(".time-player input[type=range]").first.fill("5")
@@ -424,11 +425,11 @@ def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
     other = Page(browser_context, server, "/app?" + href().split("?", 1)[1])
     try:
         until(lambda: other.text(".time-label") == label, "the same time")
-        other.page.locator(".pinned-settlement").first.wait_for(timeout=60_000)
+        other.page.locator(".pinned-settlement").first.wait_for(timeout=60_000 * patience())
         until(lambda: other.text(".pinned-settlement") == pinned, "the same pin")
         assert other.text(".readout-force") == "650"
         other.page.locator(".creep-select select").first.wait_for(state="visible",
-                                                                 timeout=30_000)
+                                                                 timeout=30_000 * patience())
         assert other.errors == []
     finally:
         other.close()
@@ -469,19 +470,19 @@ def test_a_refused_scene_file_leaves_the_box_ready_for_the_next(page: Page):
     file could be dropped only after finding the x of the first."""
     page.open_tab("Files")
     upload = page.page.locator("input[type=file]").last
-    upload.wait_for(state="attached", timeout=30_000)
+    upload.wait_for(state="attached", timeout=30_000 * patience())
     upload.set_input_files(files=[{"name": "broken.json", "mimeType": "application/json",
                                    "buffer": b'{"name": "x", "punch": '}])
-    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000)
+    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000 * patience())
     until(lambda: "broken.json" in page.pane_text(".notice"), "the refusal of broken.json")
     until(lambda: not _upload_complete_shown(page), "the box emptied after the refusal")
     scene = json.loads((ROOT / "core" / "presets" / "scenes" / "stepped_punch.json").read_text())
     scene["name"] = "second file"
     upload = page.page.locator("input[type=file]").last
-    upload.wait_for(state="attached", timeout=30_000)
+    upload.wait_for(state="attached", timeout=30_000 * patience())
     upload.set_input_files(files=[{"name": "scene.json", "mimeType": "application/json",
                                    "buffer": json.dumps(scene).encode()}])
     _wait(page, "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text"
-          ".includes('second file')", timeout=30_000)
+          ".includes('second file')", timeout=30_000 * patience())
     until(lambda: not _upload_complete_shown(page), "the box emptied after the accepted file")
     assert page.errors == []

@@ -9,7 +9,7 @@ import pytest
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
-from tests.browser_pages import require_browser  # noqa: E402
+from tests.browser_pages import patience, require_browser  # noqa: E402
 
 require_browser()
 
@@ -131,7 +131,7 @@ def test_a_lesson_step_by_step_with_notes_and_pins(page: Page) -> None:
     """Feature 5: a lesson from a preset, next and previous, a note at each step."""
     page.open_tab("Lessons")
     select = page.page.locator(".lesson-select select").first
-    select.wait_for(state="visible", timeout=30_000)
+    select.wait_for(state="visible", timeout=30_000 * patience())
     select.select_option(label="Force, eccentricity and tilt")
     until(lambda: "Step 1 of 4" in page.pane_text(".lesson-note"), "step 1")
     page.page.locator(".lesson-next button").first.click()
@@ -153,7 +153,7 @@ def test_pin_the_steps_of_the_force_over_a_range(page: Page) -> None:
         box.fill(value)
         box.press("Enter")
 
-    page.page.locator(".pin-steps-button").first.wait_for(timeout=30_000)
+    page.page.locator(".pin-steps-button").first.wait_for(timeout=30_000 * patience())
     assert "force P [kN/m]" in page.pane_text(".pin-steps-label")
     fill(".pin-steps-count", "3")
     fill(".pin-steps-from", "300")

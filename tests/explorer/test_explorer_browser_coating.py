@@ -18,6 +18,7 @@ from tests.browser_pages import (  # noqa: E402
     JS_SHOWN,
     Page,
     module_page_fixture,
+    patience,
     until,
 )
 
@@ -32,7 +33,7 @@ def test_check_button_shows_the_measured_model_error_beside_the_estimate(page: P
     bar = page.page.locator(".coating-check-progress").first
     until(lambda: bar.is_visible() or page.page.evaluate(JS_SHOWN, "model error: measured"),
           "the check's progress bar", timeout=60)
-    page.page.wait_for_function(JS_SHOWN, arg="model error: measured", timeout=180_000)
+    page.page.wait_for_function(JS_SHOWN, arg="model error: measured", timeout=180_000 * patience())
     for text in ("estimated", "settlement [mm]", "pressure", "Coating model: thin layer"):
         assert page.page.evaluate(JS_SHOWN, text), text
     assert button.is_enabled()

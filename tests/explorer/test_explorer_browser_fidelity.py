@@ -22,13 +22,14 @@ require_browser()
 from tests.browser_pages import (  # noqa: E402
     Page,
     module_page_fixture,
+    patience,
 )
 
 page = module_page_fixture(1400, 900, accept_downloads=True)
 
 
 def _saved_scene(page: Page) -> dict:
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.get_by_text("Save scene (JSON)").first.click()
     return json.loads(Path(info.value.path()).read_text())
 
@@ -68,7 +69,7 @@ def test_liftoff_preset_shades_the_lifted_heel_on_the_page(page: Page):
         """() => {
           const s = Bokeh.documents[0].get_model_by_name('negative_source');
           return s.data.left.length === 1 && s.data.right[0] > s.data.left[0];
-        }""", timeout=120_000)
+        }""", timeout=120_000 * patience())
     left = page.page.evaluate(
         "() => Bokeh.documents[0].get_model_by_name('negative_source').data.left[0]")
     assert left == pytest.approx(-1.0)   # the base's edge x = -a (a = 1 m in the preset)

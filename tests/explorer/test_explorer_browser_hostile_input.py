@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from explorer.model.links import encode_scene
-from tests.browser_pages import require_browser, served_explorer
+from tests.browser_pages import patience, require_browser, served_explorer
 from tests.conftest import base_scene
 from tests.support.serving import CHROMIUM, CHROMIUM_ARGS
 
@@ -42,7 +42,7 @@ def test_markup_in_a_link_and_an_upload_does_not_run_in_the_browser(served: str,
             page.on("dialog", lambda d: (dialogs.append(d.message), d.dismiss()))
             page.goto(f"{served}/app?scene={encode_scene(scene)}")
             notice = page.locator(".notice").first
-            notice.wait_for(state="visible", timeout=60_000)
+            notice.wait_for(state="visible", timeout=60_000 * patience())
             text = notice.evaluate("e => (e.shadowRoot || e).textContent")
             assert '<img src=x onerror="window.__xss=1">' in text
             assert notice.evaluate("e => (e.shadowRoot || e).querySelectorAll('img, script')"

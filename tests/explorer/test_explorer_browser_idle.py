@@ -17,7 +17,7 @@ import pytest
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
-from tests.browser_pages import require_browser  # noqa: E402
+from tests.browser_pages import patience, require_browser  # noqa: E402
 
 require_browser()
 
@@ -51,7 +51,7 @@ def _wait_asleep(page: Page, timeout: float = 90.0) -> None:
 def test_an_idle_page_holds_the_droppers_loop_and_a_late_file_still_loads(page: Page):
     page.open_tab("Files")
     upload = page.page.locator("input[type=file]").last
-    upload.wait_for(state="attached", timeout=30_000)
+    upload.wait_for(state="attached", timeout=30_000 * patience())
     # awake after the click on the tab: the loop runs (the dropper draws itself)
     assert _painter_runs(page, 500) > 5
     # idle: once the page has filled its other tabs in the background (a few seconds
@@ -67,7 +67,7 @@ def test_an_idle_page_holds_the_droppers_loop_and_a_late_file_still_loads(page: 
                                    "buffer": json.dumps(scene).encode()}])
     page.page.wait_for_function(
         "() => Bokeh.documents[0].get_model_by_name('scene_figure').title.text"
-        ".includes('chosen while idle')", timeout=60_000)
+        ".includes('chosen while idle')", timeout=60_000 * patience())
     # and after it, idle again
     _wait_asleep(page)
     assert _painter_runs(page, 1500) == 0

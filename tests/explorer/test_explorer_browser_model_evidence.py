@@ -19,6 +19,7 @@ from explorer.model.links import encode_scene  # noqa: E402
 from tests.browser_pages import (  # noqa: E402
     Page,
     chromium_context,
+    patience,
     served_explorer,
 )
 from tests.support.under_read import under_read_scene  # noqa: E402
@@ -35,12 +36,12 @@ def page_fixture(explorer_server):
 
 def test_the_badge_follows_the_fe_check(page: Page):
     ok = page.page.locator(".ok-model_error").first
-    ok.wait_for(timeout=120_000)
+    ok.wait_for(timeout=120_000 * patience())
     assert "(estimated 1.56 %)" in ok.inner_text()
     page.open_tab("Coating")
     page.page.locator(".coating-check-button button").first.click()
     flag = page.page.locator(".flag-model_error").first
-    flag.wait_for(timeout=180_000)
+    flag.wait_for(timeout=180_000 * patience())
     assert "above solver.model_tol (measured by the FE check 3.58 %)" in flag.inner_text()
     assert page.page.locator(".ok-model_error").count() == 0
     status = page.page.locator(".model-evidence").first

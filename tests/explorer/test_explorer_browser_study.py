@@ -18,6 +18,7 @@ from tests.browser_pages import (  # noqa: E402
     JS_SHOWN,
     Page,
     page_fixtures,
+    patience,
     until,
 )
 
@@ -43,7 +44,7 @@ server, browser_context, page = page_fixtures(1400, 900, accept_downloads=True)
 
 def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
     page.open_tab("Study")
-    page.page.locator(".study-run button").first.wait_for(timeout=60_000)
+    page.page.locator(".study-run button").first.wait_for(timeout=60_000 * patience())
     # parameter 1: the force (the default), 3 points from 250 to 750 kN/m
     page.type_into(".study-p1-count", "3")
     page.page.locator(".study-run button").first.click()
@@ -52,14 +53,15 @@ def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
           240, lambda: status(page))
     y = page.page.evaluate(JS_STUDY_Y)
     assert all(v > 0 for v in y) and y[0] < y[1] < y[2]  # settlement grows with the force
-    until(lambda: page.page.evaluate(JS_SHOWN, "Done: 3 points"), "the study's summary")
+    until(lambda: page.page.evaluate(JS_SHOWN, "Done: 3 points"), "the study's summary", 60,
+          lambda: status(page))
 
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.locator(".study-csv").first.click()
     text = Path(info.value.path()).read_text()
     rows = [line for line in text.splitlines() if not line.startswith("#")]
     assert rows[0].startswith("loading_force_p_kN_per_m,time_day,settlement_mm")
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.locator(".study-png").first.click()
     assert Path(info.value.path()).read_bytes().startswith(b"\x89PNG")
 

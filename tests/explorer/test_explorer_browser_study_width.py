@@ -20,6 +20,7 @@ from tests.browser_pages import (  # noqa: E402
     JS_SHOWN,
     Page,
     page_fixtures,
+    patience,
     until,
 )
 
@@ -41,7 +42,7 @@ def test_the_study_csv_holds_the_width_the_readout_gives(page: Page):
     until(lambda: page.page.evaluate(JS_SHOWN, "contact 1.349 m of 2 m"), "the readout",
           timeout=120)
     page.open_tab("Study")
-    page.page.locator(".study-run button").first.wait_for(timeout=60_000)
+    page.page.locator(".study-run button").first.wait_for(timeout=60_000 * patience())
     page.page.locator(".study-p1-field select").first.select_option(
         label="loading: eccentricity e = M/P [m]")
     page.type_into(".study-p1-from", "0.6")
@@ -50,7 +51,7 @@ def test_the_study_csv_holds_the_width_the_readout_gives(page: Page):
     page.page.locator(".study-run button").first.click()
     until(lambda: len(page.page.evaluate(JS_STUDY_Y) or []) == 2, "the chart of 2 points",
           240, lambda: page.pane_text(".study-status"))
-    with page.page.expect_download(timeout=60_000) as info:
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
         page.page.locator(".study-csv").first.click()
     lines = [line for line in Path(info.value.path()).read_text().splitlines()
              if not line.startswith("#")]

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.browser_pages import JS_READY, chromium_context, require_browser
+from tests.browser_pages import JS_READY, chromium_context, patience, require_browser
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
@@ -127,16 +127,17 @@ def test_the_installed_explorer_shows_every_preset_and_lesson(installed):
         for context in chromium_context(1400, 900):
             page = context.new_page()
             page.goto(server.url + "/app?preset=worn_coating")
-            page.wait_for_function(JS_READY, timeout=120_000)
+            page.wait_for_function(JS_READY, timeout=120_000 * patience())
             shown = page.locator(".preset-select select option").all_inner_texts()
             assert [s.strip() for s in shown if s.strip() in expected_presets] \
                 == expected_presets, shown
             # the link's preset is the scene on screen
             page.wait_for_function("() => Bokeh.documents[0].get_model_by_name("
-                                   "'scene_figure').title.text.includes('Worn')", timeout=60_000)
+                                   "'scene_figure').title.text.includes('Worn')",
+                                   timeout=60_000 * patience())
             page.locator(".bk-tab", has_text="Lessons").first.click()
             select = page.locator(".lesson-select select").first
-            select.wait_for(state="visible", timeout=30_000)
+            select.wait_for(state="visible", timeout=30_000 * patience())
             options = [s.strip() for s in select.locator("option").all_inner_texts()]
             assert [o for o in options if o in expected_lessons] == expected_lessons, options
             page.close()
