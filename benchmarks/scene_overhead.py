@@ -25,8 +25,8 @@ import time
 
 import numpy as np
 
-from core.scene import solve
 from core.presets import read_preset
+from core.scene import solve
 
 #: The presets measured by default: a creep scene, two thin-coating scenes (smooth and
 #: stepped) and the exact layered one.
