@@ -60,7 +60,6 @@ from core.scene import (
     SCHEMA_FILES,
     Scene,
     SceneSolution,
-    check_scene,
     flags_with_evidence,
     load_json_schema,
     load_scene,
@@ -390,6 +389,8 @@ def _cmd_report(args: argparse.Namespace) -> int:
         raise _InputError(f"--{exc}") from None
     fe_check = None
     if args.fe_check:
+        from core.scene import check_scene  # here for start-up speed: the FE modules
+
         try:
             fe_check = check_scene(result.scene, 0.0, level=FE_CHECK_LEVEL)
         except (ArithmeticError, ValueError, RuntimeError, MemoryError) as exc:
@@ -462,6 +463,9 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if not 0.0 <= args.time <= end:  # also refuses nan
         raise _InputError(f"--time: must be in [0, {end:g}] days after loading (the scene's "
                           f"output times), got {args.time:g}")
+    # imported here: a command that checks nothing starts without the FE modules
+    from core.scene import check_scene
+
     try:
         report = check_scene(scene, args.time, level=args.level)
     except (ArithmeticError, ValueError, RuntimeError, MemoryError) as exc:

@@ -10,8 +10,9 @@
 
 from __future__ import annotations
 
-from core.coating.fem_check import solve_stack
-from core.coating.fem_stack import CoatingStrip, Stack
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from core.coating.model import (
     DEFAULT_INTERFACE,
     DEFAULT_MODEL_TOL,
@@ -23,6 +24,18 @@ from core.coating.model import (
     model_error_map,
     tilt_share,
 )
+
+if TYPE_CHECKING:
+    from core.coating.fem_check import solve_stack
+    from core.coating.fem_stack import CoatingStrip, Stack
+
+# The finite-element check, loaded on first use: a scene's solve needs the thin coating
+# model only, and the command line starts faster without the FE modules.
+_LAZY: dict[str, str] = {
+    "solve_stack": "core.coating.fem_check",
+    "CoatingStrip": "core.coating.fem_stack",
+    "Stack": "core.coating.fem_stack",
+}
 
 __all__ = [
     "CoatingStrip",
@@ -38,3 +51,16 @@ __all__ = [
     "Stack",
     "tilt_share",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'core.coating' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later lookups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + __all__)

@@ -28,7 +28,9 @@ returns a ``SceneSolution``.
 
 from __future__ import annotations
 
-from core.scene.coating_check import check_scene
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from core.scene.contact_zone import LIFT_OFF_SHARE, contact_width, lift_off_length, lifts_off
 from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
 from core.scene.display import engine_text, known_contact_width, lifts_off_at
@@ -68,6 +70,13 @@ from core.scene.schema import (
     migrate,
 )
 from core.scene.validate import replace_loads, scene_from_dict
+
+if TYPE_CHECKING:
+    from core.scene.coating_check import check_scene
+
+# The finite-element check (and its FE modules), loaded on first use: a solve never
+# needs it, and the command line starts faster without it.
+_LAZY: dict[str, str] = {"check_scene": "core.scene.coating_check"}
 
 __all__ = [
     "LIFT_OFF_COLOUR",
@@ -119,3 +128,16 @@ __all__ = [
     "solve",
     "solver_settings",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'core.scene' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later lookups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + __all__)

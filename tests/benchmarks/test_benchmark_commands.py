@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks import engines
+from benchmarks import cold_start, engines
 
 
 def test_engines_out_is_a_folder_not_a_file_name(tmp_path: Path, capsys):
@@ -16,3 +16,13 @@ def test_engines_out_is_a_folder_not_a_file_name(tmp_path: Path, capsys):
     assert stop.value.code == 2
     assert "--out: " in capsys.readouterr().err
     assert not target.exists()  # no folder named like a file
+
+
+def test_cold_start_out_is_a_folder_not_a_file_name(tmp_path: Path, capsys):
+    target = tmp_path / "cold_start.md"
+    target.write_text("kept\n")
+    with pytest.raises(SystemExit) as stop:
+        cold_start.main(["--out", str(target)])
+    assert stop.value.code == 2
+    assert "--out: " in capsys.readouterr().err
+    assert target.read_text() == "kept\n"  # refused before any run

@@ -15,7 +15,6 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from scipy.fft import dct, next_fast_len
 
 from core.kernel import COARSE_PANEL_DEGREE, PANEL_DEGREE, RegularPartTable, UniformLayer
 
@@ -67,6 +66,10 @@ def node_count(half_width: float, layers: Sequence[UniformLayer], modes: int, *,
     >= COARSE_TOL``), rounded up to twice a product of 2, 3 and 5: the Galerkin matrix
     transforms each half of the nodes (:func:`galerkin_matrix`), and DCTs of such lengths
     take half the time of others (1179 nodes 28 ms, 1200 nodes 13 ms)."""
+    # imported here: a scene the layered kernel declines never loads scipy.fft (and
+    # scipy.special behind it), a tenth of the command line's start-up
+    from scipy.fft import next_fast_len
+
     thinnest = min([lay.thickness for lay in layers] + [half_width])
     coarse = tol >= COARSE_TOL
     per_thickness = COARSE_NODES_PER_THICKNESS if coarse else NODES_PER_THICKNESS
@@ -90,6 +93,8 @@ def galerkin_matrix(lam: float, l_inf: float, table: RegularPartTable, modes: in
                     n_nodes: int) -> np.ndarray:
     """``pi`` times the Galerkin matrix of ``(1/pi) int k_stack(lam (t - s)) . ds`` on
     ``T_n / sqrt(1 - t^2)``, n < modes, with ``n_nodes`` (even) Gauss-Chebyshev nodes."""
+    from scipy.fft import dct  # here for start-up speed (see node_count)
+
     if n_nodes % 2:
         raise ValueError(f"n_nodes: must be even, got {n_nodes}")
     q = n_nodes // 2
