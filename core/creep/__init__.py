@@ -15,8 +15,15 @@
 from __future__ import annotations
 
 from core.creep.code_inputs import CEMENT_CLASSES, RANGES, STRENGTH_CLASS
+from core.creep.design_codes import (
+    DEFAULT_TOL_LADDER,
+    FIT_ERROR_SHARE,
+    CodeCreep,
+    creep_coefficient_curve,
+    default_tolerance,
+    fit_advice,
+)
 from core.creep.design_codes import SPEC_FIELDS as CODE_SPEC_FIELDS
-from core.creep.design_codes import creep_coefficient_curve
 from core.creep.inputs import MAX_RATE, MAX_TERMS
 from core.creep.kernel_fit import stepping_kernel
 from core.creep.models import (
@@ -31,8 +38,13 @@ from core.creep.models import (
 __all__ = [
     "CEMENT_CLASSES",
     "CODE_SPEC_FIELDS",
+    "CodeCreep",
     "creep_coefficient_curve",
     "creep_model_from_spec",
+    "default_tolerance",
+    "DEFAULT_TOL_LADDER",
+    "FIT_ERROR_SHARE",
+    "fit_advice",
     "Elastic",
     "KNOWN_MODELS",
     "MAX_RATE",

@@ -69,7 +69,7 @@ from core.scene.schema import (
     integer_in_range,
     migrate,
 )
-from core.scene.validate import replace_loads, scene_from_dict
+from core.scene.validate import default_tol, replace_loads, scene_from_dict
 
 if TYPE_CHECKING:
     from core.scene.coating_check import check_scene
@@ -79,6 +79,7 @@ if TYPE_CHECKING:
 _LAZY: dict[str, str] = {"check_scene": "core.scene.coating_check"}
 
 __all__ = [
+    "default_tol",
     "LIFT_OFF_COLOUR",
     "LIFT_OFF_SHARE",
     "engine_text",

@@ -163,7 +163,9 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
               choices=("linear", "log"), default="linear"),
     ),
     "solver": (
-        _rule("tol", "number", "-", "Relative tolerance of the solver.", required=False,
+        _rule("tol", "number", "-", "Relative tolerance of the solver (default 1e-6; with "
+              "a design code's creep law the smallest of 1e-6, 1e-5, 1e-4, 1e-3 that its "
+              "fit by exponentials can meet).", required=False,
               low=TOL_RANGE[0], high=TOL_RANGE[1], default=DEFAULT_TOL),
         _rule("contact", "choice", "-", "Contact model: auto (full contact unless it is "
               "lost), full or unilateral.", required=False,

@@ -19,7 +19,7 @@ import numpy as np
 from core import limits
 from core.cache import StageCache, fingerprint
 from core.coating import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
-from core.creep import Elastic, UserKernel, creep_model_from_spec
+from core.creep import CodeCreep, Elastic, UserKernel, creep_model_from_spec, default_tolerance
 from core.problem import QUANTITIES, STATEMENTS
 from core.profiles import Profile, profile_values
 from core.scene import schema
@@ -168,7 +168,8 @@ def _validated(d: dict[str, Any]) -> Scene:
                          f"an age at loading of {tau0:g} days")
 
     solver = check_fields(d.get("solver", {}), "solver", (), schema.optional_fields("solver"))
-    tol = finite_number(solver.get("tol", schema.DEFAULT_TOL), "solver.tol")
+    tol = finite_number(solver["tol"] if "tol" in solver else default_tol(creep, tau0),
+                        "solver.tol")
     tol_lo, tol_hi = schema.TOL_RANGE
     if not tol_lo <= tol <= tol_hi:
         raise ValueError(f"solver.tol: must be in [{tol_lo:g}, {tol_hi:g}], "
@@ -217,6 +218,22 @@ def _validated(d: dict[str, Any]) -> Scene:
     _check_solvable(scene)
     _check_load_rates(scene)
     return scene
+
+
+def default_tol(creep: Any, age_at_loading: float) -> float:
+    """The solver tolerance [-] of a scene that leaves ``solver.tol`` out.
+
+    1e-6 (:data:`core.scene.schema.DEFAULT_TOL`), except with a design code's creep law
+    (fib MC2010, Eurocode 2): the smallest of 1e-6, 1e-5, 1e-4, 1e-3 that its fit by
+    exponentials can meet at this age at loading [day]
+    (:func:`core.creep.default_tolerance`). ``creep``: the base's creep model, or its
+    spec as in a scene file (``base.creep``).
+    """
+    if isinstance(creep, Mapping):
+        creep = creep_model_from_spec(dict(creep), field="base.creep")
+    if isinstance(creep, CodeCreep):
+        return default_tolerance(creep, age_at_loading, field="base.age_at_loading")
+    return schema.DEFAULT_TOL
 
 
 def _check_load_rates(scene: Scene) -> None:

@@ -25,7 +25,9 @@ import param
 
 from core.coating import DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
 from core.problem import QUANTITIES
+from core.scene import default_tol
 
+from .code_creep_state import CODE_CREEP_MODELS
 from .loading_state import QUANTITY_RANGES, QUANTITY_UNITS, STATEMENTS, HistoryState, LoadingState
 from .scene_parts import (
     _RTOL,
@@ -80,6 +82,9 @@ class ExplorerState(param.Parameterized):
         bounds=(100.0 * MODEL_TOL_RANGE[0], 100.0 * MODEL_TOL_RANGE[1]),
         doc="Coating-model error a result may carry unflagged (solver.model_tol) [%].")
     revision = param.Integer(default=0, doc="Counts changes of the scene.")
+    tol_note = param.String(
+        default="", doc="Why the accuracy target was raised (a design code's creep law "
+                        "allows no finer one); empty otherwise.")
 
     def __init__(self, **params: Any) -> None:
         super().__init__(**params)
@@ -92,6 +97,10 @@ class ExplorerState(param.Parameterized):
         self._loaded_name: str | None = None
         self._batch = 0
         self._dirty = False
+        # before the change tracking: the scene of a switch to a code carries its target
+        self.base.param.watch(self._on_creep_law, ["creep_model", "age_at_loading"])
+        self._raising_tol = False
+        self.param.watch(self._on_tol, ["tol"])
         watched = [self.punch, self.base, self.base.code, self.loading,
                    *self.loading.histories.values(),
                    *(p for layer in self.layers for p in layer.profiles)]
@@ -103,6 +112,39 @@ class ExplorerState(param.Parameterized):
                                            "time_end", "time_count", "time_spacing", "tol",
                                            "time_list", "contact", "model_tol_percent"])
         self.param.watch(self._on_times, ["time_end", "time_count", "time_spacing"])
+
+    # -- the accuracy a creep law allows ----------------------------------------------
+    def _on_creep_law(self, *events: param.parameterized.Event) -> None:
+        """Raise the accuracy target to one a design code's creep law can meet (the
+        default a scene file without ``solver.tol`` gets, :func:`core.scene.default_tol`),
+        and say so; a loaded scene keeps its own target."""
+        if self._batch:
+            return
+        base = self.base
+        if base.creep_model not in CODE_CREEP_MODELS:
+            self.tol_note = ""
+            return
+        try:
+            allowed = default_tol(base.creep_dict(), base.age_at_loading)
+        except ValueError:
+            return  # an input out of range: the solve names it
+        if self.tol >= allowed:
+            return
+        if allowed not in self.param.tol.objects:
+            self.param.tol.objects = sorted({*self.param.tol.objects, allowed}, reverse=True)
+        self.tol_note = (f"Accuracy target raised from {self.tol:g} to {allowed:g}: "
+                         f"the {CODE_CREEP_MODELS[base.creep_model]} creep law is fitted "
+                         "by exponentials no closer at this age at loading, so a finer target "
+                         "would be flagged as not met.")
+        self._raising_tol = True
+        try:
+            self.tol = allowed
+        finally:
+            self._raising_tol = False
+
+    def _on_tol(self, *events: param.parameterized.Event) -> None:
+        if not self._raising_tol:
+            self.tol_note = ""  # the user's own choice (or a loaded scene's) stands
 
     # -- change tracking -------------------------------------------------------------
     def _on_change(self, *events: param.parameterized.Event) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import html
 from collections.abc import Callable
 
 import panel as pn
@@ -46,6 +47,7 @@ class BaseView:
         self.creep_note = html_pane("", styles=NOTE_STYLE)
         bb.bind(s.base)
         s.base.param.watch(lambda *e: self.refresh(), ["creep_model", "custom"])
+        s.param.watch(lambda *e: self.refresh(), ["tol_note"])
         # design-code creep (fib MC2010, Eurocode 2): inputs and phi(t, t0) plot
         self.code_creep = CodeCreepPanel(s.base, Binding(reject))
         self.refresh()
@@ -73,6 +75,9 @@ class BaseView:
                    if k != "custom" or base.custom is not None}
         if offered != self.creep_model.options:
             self.creep_model.options = offered
-        self.creep_note.object = ("A creep model from a file (kept as it is); choose another "
-                                  "model to replace it." if model == "custom" else "")
-        self.creep_note.visible = model == "custom"
+        if model == "custom":
+            note = "A creep model from a file (kept as it is); choose another model to replace it."
+        else:
+            note = self.state.tol_note  # a design code's law raised the accuracy target
+        self.creep_note.object = html.escape(note)
+        self.creep_note.visible = bool(note)

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import html
 from collections.abc import Callable
 
 import panel as pn
 
 from ..model import ExplorerState
 from .fidelity import FidelityView
-from .style import TAB_COLUMN
+from .style import NOTE_STYLE, TAB_COLUMN, html_pane
 from .widgets import Binding, EditableIntSlider, slider
 
 SPACINGS = {"linear": "linear", "log": "log"}
@@ -36,14 +37,16 @@ class TimesView:
             label="accuracy target (relative)",
             options={f"{v:g}": v for v in s.param.tol.objects},
             sizing_mode="stretch_width", css_classes=["tol-select"]))
+        # why the target was raised (a design code's creep law), under the target
+        self.tol_note = html_pane("", styles=NOTE_STYLE, css_classes=["tol-note"])
         gb.bind(s)
-        s.param.watch(lambda *e: self.refresh(), "tol")
+        s.param.watch(lambda *e: self.refresh(), ["tol", "tol_note"])
         self.refresh()
 
     def content(self) -> pn.Column:
         """The tab's column."""
         return pn.Column(self.time_end, self.time_count, self.time_spacing, self.tol,
-                         self.fidelity.solver_panel, **TAB_COLUMN)
+                         self.tol_note, self.fidelity.solver_panel, **TAB_COLUMN)
 
     def refresh(self) -> None:
         """Offer the tolerances the state allows; show the one set."""
@@ -51,3 +54,5 @@ class TimesView:
         if options != self.tol.options:
             self.tol.options = options
         self.tol.value = self.state.tol
+        self.tol_note.object = html.escape(self.state.tol_note)
+        self.tol_note.visible = bool(self.state.tol_note)

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from core.creep import FIT_ERROR_SHARE, fit_advice
 from core.problem import QUANTITIES, ContactSolution, TimeInputs, accepts, statement_number
 
 #: Margin of :func:`core.problem.accepts`: the estimate (the two-grid difference of
@@ -71,7 +72,9 @@ def nystrom_solution(prepared: Any, inputs: TimeInputs, scalars: dict[str, np.nd
         elif time_error > tol:
             # the stepping finished; its estimate holds the creep kernel's fit as well
             reasons.append(f"time stepping: estimated error {time_error:.1e}, of which the "
-                           f"creep kernel's exponential fit {time_side.fit_error:.1e}")
+                           f"creep kernel's exponential fit {time_side.fit_error:.1e}"
+                           + (f" ({fit_advice(time_side.fit_error)})"
+                              if FIT_ERROR_SHARE * time_side.fit_error > tol else ""))
         message = f"tol {tol:.1e} not met: " + "; ".join(reasons or ["see the estimate"])
     counts = prepared.counts
     info = {

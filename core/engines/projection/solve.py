@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from core.creep import fit_advice
 from core.engines.projection.levels import (
     _difference,
     _extrapolated_error,
@@ -206,7 +207,8 @@ def solve_projection(inp: _Inputs, basis: str = "graded",
         elif chosen.time_error * SUCCESS_MARGIN > tol:
             reasons.append(f"time stepping: estimated error {chosen.time_error:.1e}")
         if kernel_fit_error * SUCCESS_MARGIN > tol:
-            reasons.append(f"the creep kernel's exponential fit has error {kernel_fit_error:.1e}")
+            reasons.append(f"the creep kernel's exponential fit has error {kernel_fit_error:.1e} "
+                           f"({fit_advice(kernel_fit_error)})")
         message = (f"tol {tol:.1e} not met (success needs the estimate below tol/"
                    f"{SUCCESS_MARGIN:g}): " + "; ".join(reasons))
     if not disc.resolved:
