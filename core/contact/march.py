@@ -27,6 +27,7 @@ from core.contact.step import Space, Step, check_loads
 from core.contact.systems import StepSolver
 from core.contact.zones import zone_kernel_accuracy
 from core.discretize import KernelOperator, Panels, kernel_operator
+from core.work import check_work
 
 #: The operators of the stepping's panel rules, keyed by lam and the panel edges (they
 #: depend on nothing else): a load-only change (the explorer's eccentricity slider) meets
@@ -85,6 +86,7 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
     sweeps = 0
     unsettled = 0
     for n in range(steps):
+        check_work("following the contact zones under creep step by step")
         memory_density = np.zeros(n_nodes)
         diag = 0.0
         if n > 0:

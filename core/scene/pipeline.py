@@ -23,6 +23,7 @@ from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
 from core.scene.results import SceneSolution, _check_finite
 from core.scene.validate import scene_from_dict
+from core.work import WorkLimitExceeded, work_bound
 
 
 def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
@@ -38,9 +39,24 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
     # a load no contact can carry is refused in every contact mode, in the scene's units
     check_loads_touch(scene)
     problem = scene.dimensionless
-    with np.errstate(all="ignore"):
-        answer = solve_scene_layered(scene, problem)
-        result = SceneSolution(scene, problem, problem.solve() if answer is None else answer)
+    try:
+        with np.errstate(all="ignore"), work_bound():
+            answer = solve_scene_layered(scene, problem)
+            result = SceneSolution(scene, problem,
+                                   problem.solve() if answer is None else answer)
+    except WorkLimitExceeded as exc:
+        raise ValueError(_costly(scene, exc)) from None
     result.info["cpu_seconds"] = time.thread_time() - started
     _check_finite(result)
     return result
+
+
+def _costly(scene: Scene, exc: WorkLimitExceeded) -> str:
+    """The message of a solve stopped at its work bound, naming the field to change: a
+    load that varies in time (the usual cause: lift-off under creep follows it step by
+    step), else the tolerance."""
+    varying = [q for q, profile in scene.loading.items()
+               if getattr(profile, "kind", None) != "constant"]
+    field = f"loading.{varying[0]}" if varying else "solver.tol"
+    return (f"{field}: {exc}; a smoother or shorter history of the loads, fewer or earlier output times, a looser solver.tol, or "
+            "solver.contact 'full' costs less")

@@ -50,6 +50,7 @@ from core.time.exponential_weights import (
     weights,
 )
 from core.time.radau import JUMP_SIDE
+from core.work import check_work
 
 #: Convergence order of the answers at output times used by the error estimate: the
 #: stage order (4) of the collocation; at the step ends it is higher where the kernel's
@@ -372,6 +373,7 @@ def solve_exponential(kernel, problem, times: np.ndarray, jumps: np.ndarray, *, 
     used = 0
     marched: list[tuple[int, March]] = []
     for level in range(MAX_REFINEMENTS + 1):
+        check_work("refining the time steps of the creep")
         if not marched:
             # the first MIN_LEVEL + 1 grids (none of which can be taken alone) in one
             # pass, their fixed costs once; the refinements after them one at a time

@@ -49,6 +49,7 @@ from core import limits
 from core.time.exponential import solve_exponential
 from core.time.radau import RADAU_ORDER, _advance, _stage_values
 from core.time.volterra import ModalProblem, VolterraSolution, _after, _jumps, _scales
+from core.work import check_work
 
 #: The exponential collocation may spend this fraction (1/EXPONENTIAL_SHARE) of the step
 #: limit before the adaptive Radau stepping takes over (a history that oscillates fast).
@@ -154,6 +155,7 @@ def solve_degenerate(kernel, problem: ModalProblem, times: np.ndarray, *, tol: f
     t_final = float(times[-1])
     j_next = 0
     while k_out < len(times):
+        check_work("stepping the creep in time")
         if steps + rejected > max_steps:
             # No answer is better than a wrong one: the times not reached are NaN.
             w_out = finish()

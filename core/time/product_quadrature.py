@@ -16,6 +16,7 @@ import numpy as np
 
 from core import limits
 from core.time.volterra import ModalProblem, VolterraSolution, _before, _jumps, _scales
+from core.work import check_work
 
 
 def _trapezoid_weights(grid: np.ndarray, i: int) -> np.ndarray:
@@ -140,6 +141,7 @@ def solve_general(kernel: Callable, problem: ModalProblem, times: np.ndarray, *,
     answers: list[tuple[np.ndarray, ...]] = []
     extrapolated: list[tuple[np.ndarray, ...]] = []
     while True:
+        check_work("refining the time grid of the creep kernel")
         grid, at = _general_grid(anchors, sub, jumps)
         # the last node at a time: after a jump when an output time is on one
         idx = np.searchsorted(grid, times, side="right") - 1

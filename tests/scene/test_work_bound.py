@@ -1,0 +1,68 @@
+"""Every solve runs under a bound on its CPU time (core.work, core.limits), also where its
+cost cannot be predicted: lift-off under creep driven by a time-varying tilt ran 600 s."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+from core.limits import MAX_SOLVE_CPU_SECONDS
+from core.scene import solve
+from core.work import WorkLimitExceeded, check_work, work_bound
+from tests.conftest import scene_file
+
+
+def _sine_tilt_on_creep() -> dict:
+    """Statement 3 (tilt and force given), the tilt a sine in time, on the creeping base
+    of uniform_flat: the heel lifts off and on, followed step by step (measured: over 600
+    s of CPU before this bound; the bound below stops it after about 1 s)."""
+    d = scene_file("uniform_flat")
+    d["loading"] = {"tilt": {"kind": "sine", "mean": 0.0, "amplitude": 1e-4,
+                             "wavelength": 100.0, "phase": 0.0},
+                    "force": 500000.0}
+    return d
+
+
+def test_a_solve_past_its_bound_stops_and_names_the_costly_field():
+    with work_bound(1.0), pytest.raises(ValueError) as refused:
+        solve(_sine_tilt_on_creep())
+    message = str(refused.value)
+    assert message.startswith("loading.tilt: the solve was stopped after 1 s of CPU time")
+    assert "following the contact zones under creep" in message
+
+
+def test_the_default_bound_is_the_limit_of_one_solve():
+    assert MAX_SOLVE_CPU_SECONDS == 60.0
+    d = _sine_tilt_on_creep()
+    d["loading"]["tilt"]["amplitude"] = 1e-5  # stays in contact: 0.1 s
+    with work_bound(None):  # no bound of its own: the default one of solve holds
+        assert solve(d).info["contact"] == "full"
+
+
+def test_the_bound_changes_no_answer():
+    d = scene_file("eccentric_creep")
+    free = solve(d)
+    with work_bound(MAX_SOLVE_CPU_SECONDS):
+        bounded = solve(d)
+    for name in ("settlement", "tilt", "force", "moment"):
+        assert np.array_equal(getattr(free, name), getattr(bounded, name))
+
+
+def test_nested_bounds_keep_the_tighter_and_threads_their_own():
+    check_work("nothing")  # no bound: nothing happens
+    with work_bound(0.0):
+        with work_bound(100.0), pytest.raises(WorkLimitExceeded, match="spinning"):
+            while True:
+                check_work("spinning")
+        seen = []
+
+        def other_thread() -> None:
+            check_work("another solve")  # not bounded by this thread's bound
+            seen.append(True)
+
+        thread = threading.Thread(target=other_thread)
+        thread.start()
+        thread.join()
+        assert seen == [True]
