@@ -3,8 +3,10 @@
 A *scene family* is what the user loaded (a preset, a file, a link) and every edit made
 to it since. Within a family the pressure keeps one unit (kPa or MPa, chosen from the
 first result) and the q(x, t) image keeps one colour scale, widened (to a round number)
-only when a result falls outside it: so that dragging a slider changes the colours, not
-the meaning of the colours, and a peak crossing 1 MPa does not relabel every axis.
+when a result falls outside it: so that dragging a slider changes the colours, not the
+meaning of the colours, and a peak crossing 1 MPa does not relabel every axis. A result
+that fills less than :data:`SHRINK_BELOW` of the scale (a much softer change after a
+stiff one) gets its own scale again: a map drawn in one colour says nothing.
 Nothing here imports Panel or Bokeh.
 """
 
@@ -28,6 +30,13 @@ def nice_ceiling(value: float) -> float:
     return 10.0 * power
 
 
+#: The q(x, t) colour scale is narrowed to the result's own when the result spans less
+#: than this share of it (its largest |q| against the scale's): a round-number step of
+#: the scale (1, 2, 2.5, 5) is at most 2x, so a drag that wanders within a factor of 2.5
+#: keeps its colours.
+SHRINK_BELOW = 0.4
+
+
 class DisplayScales:
     """The pressure unit and the q(x, t) colour range of the current scene family."""
 
@@ -47,7 +56,9 @@ class DisplayScales:
 
     def image_range(self, view: ResultView) -> tuple[float, float]:
         """Colour range of q(x, t) [display unit]: round numbers that cover every result
-        of the family seen so far (zero included, so that lift-off reads at a glance)."""
+        of the family seen so far (zero included, so that lift-off reads at a glance),
+        narrowed to this result's own when it spans less than :data:`SHRINK_BELOW` of
+        them."""
         size = self.pressure_unit(view)[1]
         img = view.image
         lo = float(np.nanmin(img)) / size if img.size else 0.0
@@ -55,6 +66,9 @@ class DisplayScales:
         lo = -nice_ceiling(-lo) if lo < 0 else 0.0
         hi = nice_ceiling(hi) if hi > 0 else 1.0
         if self._range is not None:
-            lo, hi = min(lo, self._range[0]), max(hi, self._range[1])
+            old_lo, old_hi = self._range
+            extent = max(abs(lo), hi)
+            if extent >= SHRINK_BELOW * max(abs(old_lo), old_hi):
+                lo, hi = min(lo, old_lo), max(hi, old_hi)
         self._range = (lo, hi)
         return self._range

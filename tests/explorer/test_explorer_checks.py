@@ -88,7 +88,7 @@ def test_an_unflagged_result_says_so():
 
 
 # ------------------------------------------------------------------ units and colours
-def test_one_pressure_unit_and_a_widening_colour_scale_per_scene_family():
+def test_one_pressure_unit_and_a_colour_scale_that_follows_the_results():
     assert [nice_ceiling(v) for v in (0.7, 1.0, 1.3, 2.2, 3.0, 7.0, 420.0)] == \
         [1.0, 1.0, 2.0, 2.5, 5.0, 10.0, 500.0]
     state, controller = solved()
@@ -101,7 +101,11 @@ def test_one_pressure_unit_and_a_widening_colour_scale_per_scene_family():
     assert scales.pressure_unit(high) == ("kPa", 1e3)    # ... within the family it stays
     widened = scales.image_range(high)
     assert widened[1] > first[1]
-    assert scales.image_range(low) == widened           # never shrinks back
+    # a result within SHRINK_BELOW of the scale keeps it (a drag keeps its colours) ...
+    near = replace(low, pressure=low.pressure * 12, image=low.image * 12)
+    assert scales.image_range(near) == widened
+    # ... a much softer one (1/20 of the scale) gets its own again: one colour says nothing
+    assert scales.image_range(low) == first
     scales.reset()
     assert scales.pressure_unit(high) == ("MPa", 1e6)
 
