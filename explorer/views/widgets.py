@@ -9,6 +9,7 @@ layer or whichever two loads are given.
 
 from __future__ import annotations
 
+import html
 import math
 from collections.abc import Callable
 from typing import Any
@@ -16,7 +17,7 @@ from typing import Any
 import panel as pn
 import param
 
-from core.profiles import VARIATIONS
+from core.profiles import MAX_TABLE_BYTES, VARIATIONS, profile_from_csv
 
 from ..model import QUANTITY_RANGES, HistoryState, ProfileState
 from ..solving import mark
@@ -311,6 +312,8 @@ _TIME_LABELS = {"ramp": "ramp duration [days]", "step": "time of the step [days]
                 "sine": "period [days]"}
 NAMES = {"settlement": "settlement δ", "tilt": "tilt α", "force": "force P",
          "moment": "moment M"}
+#: The units of a history table (SI, as in a scene file).
+SI_UNITS = {"settlement": "m", "tilt": "rad", "force": "N/m", "moment": "N m/m"}
 
 
 def _fit(widget: pn.widgets.Widget, value: float, default: tuple[float, float]) -> None:
@@ -343,6 +346,12 @@ class HistoryEditor:
                                self.note, sizing_mode="stretch_width", margin=0)
         self._watched: HistoryState | None = None
         self._watcher: Any = None
+        self._time_end = 365.0
+        # the table upload of "custom (from file)", made when that kind is first chosen
+        # (a file box costs the first page; most scenes never use one)
+        self.upload: BoundedUpload | None = None
+        self.upload_help = pn.pane.HTML("", margin=(0, 10), visible=False,
+                                        styles={"font-size": "12px", "color": "#666"})
 
     def bind(self, history: HistoryState, time_end: float) -> None:
         q = history.quantity
@@ -352,6 +361,7 @@ class HistoryEditor:
         _fit(self.value, history.value, (lo, hi))
         _fit(self.second, history.second, (min(lo, -hi) if q in ("tilt", "moment") else lo, hi))
         self.time.end = max(time_end, history.time)
+        self._time_end = time_end
         self.binding.bind(history)
         if self._watched is not None and self._watcher is not None:
             self._watched.param.unwatch(self._watcher)
@@ -376,6 +386,39 @@ class HistoryEditor:
             self.time.label = _TIME_LABELS[kind]
         custom = kind == "custom" and history.custom is not None
         self.value.visible = not custom
-        self.note.object = ("Custom history from a file (kept as it is). Choose another "
-                            "shape to replace it." if custom else "")
-        self.note.visible = custom
+        self._say("Custom history from a file (kept as it is). Upload another table below, "
+                  "or choose another shape to replace it." if custom else "")
+        if kind == "custom" and self.upload is None:
+            self.upload = BoundedUpload(accept=(".csv", ".txt"), max_bytes=MAX_TABLE_BYTES)
+            self.upload.param.watch(self._on_table, "value")
+            self.panel.extend([self.upload_help, self.upload])
+        self.upload_help.object = (
+            f"Upload a history table: CSV with two columns, t [days after loading] and "
+            f"{name} [{SI_UNITS[q]}] (SI units), linear between its rows."
+            if kind == "custom" else "")
+        self.upload_help.visible = kind == "custom"
+        if self.upload is not None:
+            self.upload.visible = kind == "custom"
+
+    def _say(self, text: str, bad: bool = False) -> None:
+        color = "#9b1c1c" if bad else "#666"
+        self.note.styles = {"font-size": "12px", "color": color}
+        self.note.object = html.escape(text)
+        self.note.visible = bool(text)
+
+    def _on_table(self, event: Any) -> None:
+        data, history = event.new, self._watched
+        if not data or history is None or self.upload is None:
+            return
+        q = history.quantity
+        try:
+            profile = profile_from_csv(data, field=f"loading.{q}", variable="t",
+                                       domain=(0.0, self._time_end))
+        except ValueError as exc:
+            self._say(f"The table was not used: {exc}", bad=True)
+            return
+        finally:
+            self.upload.clear()
+        history.param.update(custom=profile.spec, kind="custom")
+        self._say(f"Custom history from {self.upload.filename or 'a CSV file'}. Upload "
+                  "another table, or choose another shape to replace it.")
