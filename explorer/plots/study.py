@@ -147,6 +147,8 @@ class DesignChart:
             x = planned.values[0]
             self.source.data = {"x": x, "y": z, "flags": list(flags)}
             self.flagged.data = {"x": x[mark], "y": z[mark]}
+            # the legend names the red crosses only when there are some
+            self.shown.legend.visible = bool(np.any(mark))
             self.shown.yaxis.axis_label = f"{name} [{unit}]"
             return
         n1, n2 = planned.shape

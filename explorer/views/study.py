@@ -109,7 +109,7 @@ class StudyView:
         # the figures are built at the first result: three Bokeh figures cost ~70 ms of
         # the server's CPU (measured), a seventh of a new session, for a tab few open
         self.study_charts: DesignChart | None = None
-        self._chart_panes: list[pn.pane.Bokeh] = []
+        self._chart_pane: pn.pane.Bokeh | None = None
         self._chart_box = pn.Column(
             html_pane("<small><i>Run a study to see its design chart here.</i></small>"),
             **stretch)
@@ -269,14 +269,15 @@ class StudyView:
         self.study_time.value = len(result.times) - 1
         if self.study_charts is None:
             self.study_charts = DesignChart()
-            self._chart_panes = [pn.pane.Bokeh(fig, visible=False,
-                                               sizing_mode="stretch_width")
-                                 for fig in self.study_charts.figures]
-            self._chart_box.objects = self._chart_panes
         shown = self.study_charts.draw(result, self.study_output.value,
                                        self.study_time.value)
-        for pane in self._chart_panes:
-            pane.visible = pane.object is shown
+        # one figure of the three on the page, in one pane (three panes toggled by their
+        # "visible" showed all three, the heat map empty, in Chromium)
+        if self._chart_pane is None:
+            self._chart_pane = pn.pane.Bokeh(shown, sizing_mode="stretch_width")
+            self._chart_box.objects = [self._chart_pane]
+        elif self._chart_pane.object is not shown:
+            self._chart_pane.object = shown
         stem = slug(str(result.planned.study.base.get("name", "scene"))[:60])
         self.study_csv.filename = f"{stem}_study.csv"
         self.study_png.filename = f"{stem}_study.png"

@@ -155,6 +155,10 @@ def test_the_tab_draws_the_chart_and_writes_the_files(explorer_app):
     assert tab.study_run.status == "done", tab.study_run.message
     data = tab.study_charts.source.data
     np.testing.assert_allclose(data["x"], [300.0, 500.0, 700.0])
+    # one chart on the page: the linear line; the log line and the heat map hidden
+    assert tab._chart_box.objects == [tab._chart_pane]
+    assert tab._chart_pane.object is tab.study_charts.lines["linear"]
+    assert not tab.study_charts.shown.legend.visible  # no flagged point, no "flagged" key
     result = tab.study_run.result
     np.testing.assert_allclose(data["y"], result.outputs["settlement"][:, -1] * 1e3)
     tab.study_output.value = "q_max"
@@ -192,6 +196,7 @@ def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
     chart = DesignChart()
     chart.draw(result, "q_min", 1)
     np.testing.assert_allclose(chart.flagged.data["x"], [0.6])
+    assert chart.shown.legend.visible  # the red cross is named
     assert chart.flagged.data["y"][0] < 0  # kPa: the tension the flag is about
     rows = [line for line in study_csv(result).splitlines() if not line.startswith("#")]
     assert rows[-1].endswith('"contact_lost",""')
