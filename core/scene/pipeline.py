@@ -22,6 +22,7 @@ from core.engines.layered import solve_scene_layered
 from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
 from core.scene.results import SceneSolution, _check_finite
+from core.scene.uncoated import lift_off_refusal
 from core.scene.validate import scene_from_dict
 
 
@@ -40,6 +41,9 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
     problem = scene.dimensionless
     with np.errstate(all="ignore"):
         answer = solve_scene_layered(scene, problem)
+        if answer is None and not scene.coating:
+            # the thin layer has no bare limit (m = 0): only a lift-off gets here
+            raise ValueError(lift_off_refusal(scene))
         result = SceneSolution(scene, problem, problem.solve() if answer is None else answer)
     result.info["cpu_seconds"] = time.thread_time() - started
     _check_finite(result)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from core.engines.layered.answer import (
     LIFT_OFF_SHARE,
+    NO_COATING,
     layered_declines,
     solve_scene_layered,
     uniform_layers,
@@ -48,6 +49,7 @@ __all__ = [
     "LIFT_OFF_SHARE",
     "MAX_MODES",
     "MAX_RATIO",
+    "NO_COATING",
     "PRESSURE_REACH",
     "share_budget",
     "solve_scene_layered",

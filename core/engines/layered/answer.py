@@ -9,6 +9,11 @@ same continuum problem as the resolved finite-element model of :mod:`core.coatin
 the model error it leaves is its own numerical error: ``info["model_error_estimate"]`` is
 that estimate for the unknowns (``benchmarks/layered_kernel.py`` measures it against FE).
 
+With no coating layers at all the stack's kernel is the base's own (``k_stack = k_pl``,
+``L_inf = 1``): the same path solves the bare layer exactly, and its coating-model error
+is 0 (``info["coating_model"] = NO_COATING``). :func:`core.scene.scene_from_dict` refuses
+a bare scene this path declines (the thin-layer model has no bare limit: ``m = 0``).
+
 Where it does not apply the thin-layer model answers, with its measured error
 (:mod:`core.coating.model`); :func:`layered_declines` says why:
 
@@ -60,6 +65,13 @@ MAX_TABLE_COST = 5e7
 #: of the Chebyshev modes over the whole tail (:func:`core.engines.layered.solve_layered`)
 #: and is taken as it stands.
 SUCCESS_MARGIN = 1.0
+#: Without coating ``pressure(x)`` is reported on ``|x| <= a (1 - BARE_CORNER)`` and held
+#: beyond: q is infinite at the corners, and there it is 22x its value at the centre
+#: (flat punch, ``1 / sqrt(2 BARE_CORNER)``), which a plot of the punch width still shows.
+BARE_CORNER = 1e-3
+#: ``info["coating_model"]`` of a scene without coating layers (its coating-model error
+#: is 0: there is no coating to model).
+NO_COATING = "none (no coating)"
 #: A pressure below this share of its largest value is taken as lift-off.
 LIFT_OFF_SHARE = 1e-9
 
@@ -83,8 +95,6 @@ def uniform_layers(scene: Any) -> list[UniformLayer]:
 
 def layered_declines(scene: Any, problem: Any) -> str | None:
     """Why the exact layered kernel does not answer this scene (None when it does)."""
-    if not scene.coating:
-        return "no coating"
     if problem.kernel is not None or callable(problem.c) or problem.c != 1.0:
         return "the base creeps or ages"
     if scene.contact not in ("auto", "full"):
@@ -94,7 +104,8 @@ def layered_declines(scene: Any, problem: Any) -> str | None:
         return "the coating varies along x"
     layers = uniform_layers(scene)
     modes = default_modes(scene.half_width, layers)
-    if modes > MAX_MODES or node_count(scene.half_width, layers, modes) > MAX_NODES:
+    if modes > MAX_MODES or node_count(
+            scene.half_width, layers, modes, base_thickness=scene.base_thickness) > MAX_NODES:
         return "the coating is thinner than the layered solve resolves"
     # the cost depends on the thicknesses alone: other moduli share the kept value
     shapes = tuple(UniformLayer(lay.thickness, 1.0, 0.0) for lay in layers)
@@ -139,7 +150,7 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
         return None
     dense = np.linspace(times[0], times[-1], TILT_SAMPLES)
     largest_tilt = float(np.max(np.abs(response.complete(_load_values(problem, dense))["tilt"])))
-    edge = 1.0 - 0.5 * layers[0].thickness / a
+    edge = 1.0 - 0.5 * layers[0].thickness / a if layers else 1.0 - BARE_CORNER
 
     def evaluate(x: np.ndarray) -> np.ndarray:
         t = np.clip(x, -edge, edge)
@@ -148,12 +159,18 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
 
     unknowns = [n for n in ("settlement", "tilt", "force", "moment") if n not in problem.loads]
     numerical = max(answer.errors[n] for n in unknowns)
-    thin = model_error_estimate(scene, tilt_share(a, a * answer.settlement, answer.tilt))
-    model_error = {"estimate": float(numerical),
-                   "force": float(answer.errors.get("force", numerical)),
-                   "moment": float(answer.errors.get("moment", numerical)),
-                   "where_m": 0.0, "model": "exact layered",
-                   "thin_layer_estimate": thin["estimate"]}
+    if layers:
+        thin = model_error_estimate(scene, tilt_share(a, a * answer.settlement, answer.tilt))
+        model_error = {"estimate": float(numerical),
+                       "force": float(answer.errors.get("force", numerical)),
+                       "moment": float(answer.errors.get("moment", numerical)),
+                       "where_m": 0.0, "model": "exact layered",
+                       "thin_layer_estimate": thin["estimate"]}
+    else:
+        # no coating, no coating model: the base's own kernel is the whole problem, and
+        # the numerical estimate above is the only error
+        model_error = {"estimate": 0.0, "force": 0.0, "moment": 0.0, "where_m": 0.0,
+                       "model": NO_COATING, "thin_layer_estimate": 0.0}
     flags = ["contact_lost"] if lost else []
     success = accepts(answer.error_estimate, problem.tol, SUCCESS_MARGIN)
     if not success:
@@ -187,7 +204,7 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
         "contact": "full",
         "max_abs_tilt": largest_tilt,
         "stages": answer.stages,
-        "coating_model": "exact layered",
+        "coating_model": "exact layered" if layers else NO_COATING,
         "layered_model_error": model_error,
     }
     return ContactSolution(times.copy(), answer.settlement, answer.tilt, answer.force,
