@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from core.engines.layered.stiffness import flat_punch_stiffness
 from core.engines.layered.solve import solve_layered
+from core.engines.layered.stiffness import flat_punch_stiffness
 from core.kernel import FULL_ACCURACY, UniformLayer, kernel_regular
 
 #: The settlement coefficient ``pi theta delta / P`` of a flat punch on a layer of
