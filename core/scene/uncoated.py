@@ -3,8 +3,9 @@
 With ``coating: []`` the compliance ``m*`` is 0 and the thin-layer model has nothing to
 stand on (its projection divides by ``m``); the exact layered kernel
 (:mod:`core.engines.layered.answer`) with an empty stack is the base's own kernel and
-solves the bare layer exactly, inverse square-root corners included. It answers an
-elastic base in full contact under a smooth punch; :func:`check_uncoated` refuses the
+solves the bare layer exactly, inverse square-root corners included (a creeping or aging
+base by scalar Volterra equations in time, :mod:`core.engines.layered.bare_creep`). It
+answers full contact under a smooth punch; :func:`check_uncoated` refuses the
 rest when the scene is read, naming the field and the reason, and
 :func:`lift_off_refusal` words the refusal of a punch that lifts off (known only once
 solved).
@@ -14,14 +15,13 @@ from __future__ import annotations
 
 from typing import Any
 
-from core.creep import Elastic
-from core.engines.layered import layered_declines
+from core.engines.layered import bare_creep_declines
 
 __all__ = ["check_uncoated", "lift_off_refusal", "UNCOATED_SCOPE"]
 
 #: What a scene without coating layers is solved for, as its refusals say it.
-UNCOATED_SCOPE = ("a scene with no coating layers is solved for an elastic base in full "
-                  "contact under a punch shape without jumps or kinks only, for now")
+UNCOATED_SCOPE = ("a scene with no coating layers is solved in full contact under a punch "
+                  "shape without jumps or kinks only, for now")
 
 
 def check_uncoated(scene: Any) -> None:
@@ -29,11 +29,6 @@ def check_uncoated(scene: Any) -> None:
     answer (ValueError naming the field); nothing for a coated scene or one it answers."""
     if scene.coating:
         return
-    if not isinstance(scene.creep, Elastic):
-        raise ValueError(
-            f"base.creep: {UNCOATED_SCOPE}; got the creep model "
-            f"{scene.creep.spec.get('model')!r}: use {{\"model\": \"elastic\", \"modulus\": "
-            "...}, or add a coating layer")
     if scene.contact == "unilateral":
         raise ValueError(f"solver.contact: {UNCOATED_SCOPE}; got 'unilateral': use 'auto' "
                          "or 'full', or add a coating layer")
@@ -43,7 +38,7 @@ def check_uncoated(scene: Any) -> None:
             f"{', '.join(f'{b:.6g}' for b in scene.breakpoints[:3])} m (on a bare elastic base a "
             "jump carries an infinite force in full contact, a kink a log-singular pressure):"
             " use a smooth shape, or add a coating layer")
-    reason = layered_declines(scene, scene.dimensionless)
+    reason = bare_creep_declines(scene, scene.dimensionless)
     if reason is not None:
         # the stack's table grows like (a / H)^2: past ~88 its cost bound declines
         field = "base.thickness" if "table" in reason else "coating"

@@ -30,8 +30,8 @@ CHECK_ROWS = (("settlement", "mm", 1e3), ("tilt", "mrad", 1e3), ("force", "kN/m"
 #: What the tab says with no coating layer (the scope of core's bare-base answer).
 BARE_NOTE = ("<small>No coating: the punch presses the bare base, whose pressure rises "
              "without bound at the punch edges (like 1 / &radic;(distance to the edge)). "
-             "Solved for an elastic base in full contact under a smooth punch; add a layer "
-             "to see what a coating does.</small>")
+             "Solved in full contact under a smooth punch; add a layer to see what a "
+             "coating does.</small>")
 
 
 class CoatingView:

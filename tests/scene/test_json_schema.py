@@ -192,7 +192,6 @@ MORE_BAD: list[tuple[str, Any, str, bool]] = [
                               "breaks": [-0.85 + 0.1 * k for k in range(17)]},
      "coating[0].thickness", False),                               # 16 breakpoints
     ("times", [0.0, 0.0], "times[1]", False),                      # increasing
-    ("coating", [], "base.creep", False),                 # no coating on a creeping base
     ("base.creep", {"model": "fib_mc2010", "strength_class": "C150/170",
                     "relative_humidity": 60, "notional_size": 300},
      "base.creep.strength_class", False),                          # fck + 8 in range

@@ -22,6 +22,7 @@ from __future__ import annotations
 from core.engines.layered.answer import (
     LIFT_OFF_SHARE,
     NO_COATING,
+    bare_creep_declines,
     layered_declines,
     solve_scene_layered,
     uniform_layers,
@@ -38,6 +39,7 @@ from core.engines.layered.solve import (
 )
 
 __all__ = [
+    "bare_creep_declines",
     "cached_response",
     "COARSE_ERROR_FLOOR",
     "COARSE_TOL",
