@@ -23,6 +23,7 @@ from core.engines.layered.answer import (
     LIFT_OFF_SHARE,
     NO_COATING,
     bare_creep_declines,
+    corner_reach,
     layered_declines,
     solve_scene_layered,
     uniform_layers,
@@ -41,6 +42,7 @@ from core.engines.layered.solve import (
 __all__ = [
     "bare_creep_declines",
     "cached_response",
+    "corner_reach",
     "COARSE_ERROR_FLOOR",
     "COARSE_TOL",
     "default_modes",

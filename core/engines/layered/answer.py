@@ -43,6 +43,7 @@ punch corner's, not the coating's.
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from functools import lru_cache
 from typing import Any
 
@@ -55,7 +56,7 @@ from core.engines.layered.solve import solve_layered
 from core.kernel import UniformLayer, table_cost
 from core.problem import ContactSolution, accepts
 
-__all__ = ["bare_creep_declines", "layered_declines", "solve_scene_layered"]
+__all__ = ["bare_creep_declines", "corner_reach", "layered_declines", "solve_scene_layered"]
 
 #: Time samples of the load histories for the largest tilt between output times.
 TILT_SAMPLES = 257
@@ -135,6 +136,14 @@ def bare_creep_declines(scene: Any, problem: Any) -> str | None:
     return None
 
 
+def corner_reach(layers: Sequence[UniformLayer], half_width: float) -> float:
+    """``|t|`` [-] up to which ``pressure(x)`` is reported (held beyond): half the top
+    layer's thickness from the corner, ``BARE_CORNER`` without coating."""
+    if not layers:
+        return 1.0 - BARE_CORNER
+    return 1.0 - 0.5 * layers[0].thickness / half_width
+
+
 def _load_values(problem: Any, times: np.ndarray) -> dict[str, np.ndarray]:
     out = {}
     for name, load in problem.loads.items():
@@ -189,7 +198,7 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
             response.complete(_load_values(problem, dense))["tilt"])))
     else:  # the output times' (the stepping reports there)
         largest_tilt = float(np.max(np.abs(tilt)))
-    edge = 1.0 - 0.5 * layers[0].thickness / a if layers else 1.0 - BARE_CORNER
+    edge = corner_reach(layers, a)
 
     def evaluate(x: np.ndarray) -> np.ndarray:
         t = np.clip(x, -edge, edge)
