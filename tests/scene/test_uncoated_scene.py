@@ -223,3 +223,14 @@ def test_a_creeping_bare_result_reads_and_checks():
 
     check = check_scene(creeping({"force": 5e5, "moment": 5e4}), 10.0, level=0)
     assert check["coating_model"] == NO_COATING and abs(check["errors"]["settlement"]) < 3e-4
+
+
+def test_the_report_of_a_bare_scene_says_there_is_no_coating():
+    from core.report.content import accuracy_rows
+    from core.report.inputs import input_rows
+
+    result = solve(bare())
+    assert ("coating", "none: the punch on the bare base") in input_rows(result.scene)
+    rows = dict(accuracy_rows(result))
+    assert rows["coating model error (estimated, relative)"].startswith("0: no coating")
+    assert rows["solved by"].endswith("no coating")
