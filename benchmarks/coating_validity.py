@@ -199,6 +199,8 @@ def presets() -> None:
     within, total = 0, 0
     for path in sorted((ROOT / "core" / "presets" / "scenes").glob("*.json")):
         scene = load_scene(path)
+        if not scene.coating:
+            continue  # no coating, no coating model to check (bare_layer)
         for interface in INTERFACES:
             d = scene.to_dict()
             for layer in d["coating"]:

@@ -32,7 +32,8 @@ class WorkLimitExceeded(RuntimeError):
 
     def __init__(self, seconds: float, doing: str) -> None:
         super().__init__(f"the solve was stopped after {seconds:g} s of CPU time (the bound "
-                         f"of one solve, core.limits.MAX_SOLVE_CPU_SECONDS by default) while {doing}")
+                         "of one solve, core.limits.MAX_SOLVE_CPU_SECONDS by default) while "
+                         f"{doing}")
         self.seconds = seconds
         self.doing = doing
 

@@ -110,6 +110,7 @@ def accuracy_rows(result: SceneSolution,
             + ("FLAGGED)" if evidence["flagged"] else "within)"))]
           if evidence["source"] == "measured" else []),
         ("coating model error (estimated, relative)",
+         "0: no coating, no coating model" if not result.scene.coating else
          f"{float(result.model_error['estimate']):.1e} (flagged above "
          f"{result.scene.model_tol:g})"
          + ("; the FE check's measurement above overrides it"

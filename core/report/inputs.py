@@ -125,6 +125,8 @@ def input_rows(scene: Scene) -> list[tuple[str, str]]:
         where = " (under the punch)" if k == 1 and len(scene.coating) > 1 else ""
         rows.append((f"coating layer {k}{where}",
                      ", ".join(parts) + f", {layer.interface} interface"))
+    if not scene.coating:
+        rows.append(("coating", "none: the punch on the bare base"))
     rows.append(("base", f"H = {number(scene.base_thickness)} m, ν = "
                          f"{number(scene.base_poisson)}, age at loading τ0 = "
                          f"{number(scene.age_at_loading)} d, modulus at loading E(τ0) = "

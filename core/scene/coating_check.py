@@ -78,8 +78,9 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
         raise ValueError(f"time: must be in [0, {float(scene.times[-1]):g}] days after "
                          f"loading, got {time!r}")
     elastic = elastic_scene(scene, time)
-    if layered_declines(scene, scene.dimensionless) is None:
-        fast = solve(elastic)  # the exact layered kernel answers the scene itself
+    if not scene.coating or layered_declines(scene, scene.dimensionless) is None:
+        # the exact layered kernel answers the scene itself (a bare base, creeping or not)
+        fast = solve(elastic)
     else:
         # the scene's own answer is the thin layer's (a creeping base, a varying coating):
         # check that model at this modulus, not the exact kernel its elastic copy would get

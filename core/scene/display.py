@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from core.engines.layered import NO_COATING
 from core.optional import import_optional
 from core.scene.contact_zone import lifts_off as contact_lifts_off
 from core.scene.files import scene_to_json
@@ -79,7 +80,8 @@ def engine_text(result: SceneSolution) -> str:
     contact = str(info.get("contact", "full"))
     parts = ([f"{info['method']} engine", f"{contact} contact"] if "method" in info
              else [f"{contact} contact solver"])
-    parts.append(f"{info.get('coating_model', 'thin layer')} coating model")
+    model = str(info.get("coating_model", "thin layer"))
+    parts.append("no coating" if model == NO_COATING else f"{model} coating model")
     if info.get("fallback"):
         parts.append(f"fallback: {info['fallback']}")
     return ", ".join(parts)
@@ -88,6 +90,9 @@ def engine_text(result: SceneSolution) -> str:
 def error_text(result: SceneSolution) -> str:
     """The numerical and the coating-model error estimates with their tolerances."""
     numerical = float(result.info.get("error_estimate", math.nan))
+    if result.info.get("coating_model") == NO_COATING:
+        return (f"{numerical:.2g} numerical (tol {result.scene.tol:.2g}), 0 coating model "
+                "(no coating)")
     return (f"{numerical:.2g} numerical (tol {result.scene.tol:.2g}), "
             f"{result.model_error['estimate']:.2g} coating model "
             f"(model_tol {result.scene.model_tol:.2g})")

@@ -22,6 +22,7 @@ from core.engines.layered import solve_scene_layered
 from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
 from core.scene.results import SceneSolution, _check_finite
+from core.scene.uncoated import lift_off_refusal
 from core.scene.validate import scene_from_dict
 from core.work import WorkLimitExceeded, work_bound
 
@@ -42,6 +43,9 @@ def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
     try:
         with np.errstate(all="ignore"), work_bound():
             answer = solve_scene_layered(scene, problem)
+            if answer is None and not scene.coating:
+                # the thin layer has no bare limit (m = 0): only a lift-off gets here
+                raise ValueError(lift_off_refusal(scene))
             result = SceneSolution(scene, problem,
                                    problem.solve() if answer is None else answer)
     except WorkLimitExceeded as exc:
@@ -58,5 +62,5 @@ def _costly(scene: Scene, exc: WorkLimitExceeded) -> str:
     varying = [q for q, profile in scene.loading.items()
                if getattr(profile, "kind", None) != "constant"]
     field = f"loading.{varying[0]}" if varying else "solver.tol"
-    return (f"{field}: {exc}; a smoother or shorter history of the loads, fewer or earlier output times, a looser solver.tol, or "
-            "solver.contact 'full' costs less")
+    return (f"{field}: {exc}; a smoother or shorter history of the loads, fewer or "
+            "earlier output times, a looser solver.tol, or solver.contact 'full' costs less")

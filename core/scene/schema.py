@@ -111,8 +111,9 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
         _rule("description", "text", "-", "Teaching text shown in the explorer.",
               required=False, most=limits.MAX_DESCRIPTION_CHARS, default=""),
         _rule("punch", "object", "-", "The rigid punch."),
-        _rule("coating", "layers", "-", f"Coating layers, top (under the punch) first, 1 to "
-              f"{MAX_LAYERS}.", least=1, most=MAX_LAYERS),
+        _rule("coating", "layers", "-", f"Coating layers, top (under the punch) first, 0 to "
+              f"{MAX_LAYERS} (none: the punch on the bare base, in full contact).", least=0,
+              most=MAX_LAYERS),
         _rule("base", "object", "-", "The aging viscoelastic base layer."),
         _rule("loading", "object", "-", "Exactly two of settlement [m], tilt [rad], force "
               "[N/m], moment [N], each a function of t [day after loading], forming one of "

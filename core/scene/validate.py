@@ -36,6 +36,7 @@ from core.scene.schema import (
     check_fields,
     migrate,
 )
+from core.scene.uncoated import check_uncoated
 from core.validation import (
     MAX_MAGNITUDE,
     NumberTooLarge,
@@ -108,7 +109,7 @@ def _validated(d: dict[str, Any]) -> Scene:
     shape_spec = punch.get("shape", 0.0)
     shape = _profile(shape_spec, "punch.shape", "x", x_domain)
 
-    layers_spec = bounded_list(d["coating"], "coating", least=1, most=schema.MAX_LAYERS,
+    layers_spec = bounded_list(d["coating"], "coating", least=0, most=schema.MAX_LAYERS,
                                what="layers")
     layers = []
     for k, spec in enumerate(layers_spec):
@@ -216,6 +217,7 @@ def _validated(d: dict[str, Any]) -> Scene:
                   None if design.empty else design)
     _check_breakpoints(scene)
     _check_solvable(scene)
+    check_uncoated(scene)
     _check_load_rates(scene)
     return scene
 
@@ -308,7 +310,8 @@ def _check_coefficients(scene: Scene, problem: DimensionlessProblem) -> bool:
         xs = x / a
         m = np.broadcast_to(problem.m(xs) if callable(problem.m) else problem.m, xs.shape)
         lo, hi = schema.M_STAR_RANGE
-        refuse_first(~np.isfinite(m) | (m < lo) | (m > hi), lambda i: (
+        # no coating: m* = 0 exactly, which the exact layered kernel solves
+        refuse_first(bool(scene.coating) & (~np.isfinite(m) | (m < lo) | (m > hi)), lambda i: (
             f"coating: the coating compliance relative to the base, m* = E0 sum_k (1 - "
             f"nu_k^2) h_k / E_k / (2 (1 - nu^2) a), is {m[i]:.3g} at x = {x[i]:.6g} m, "
             f"outside [{lo:g}, {hi:g}]: the layers are too stiff or soft, thin or thick "

@@ -34,6 +34,7 @@ from core.engines.layered import (
     PRESSURE_REACH,
     LayeredResponse,
     cached_response,
+    corner_reach,
     default_modes,
     gap_key,
     layered_declines,
@@ -191,7 +192,7 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
         keep &= ~lost
     # the pressure on the plotting grid, as the solution's evaluate gives it
     x = plotting_grid(a)
-    edge = 1.0 - 0.5 * uniform_layers(scene)[0].thickness / a
+    edge = corner_reach(uniform_layers(scene), a)
     t = np.clip(np.clip(x / a, -1.0, 1.0), -edge, edge)
     q_star = response.regular_part(t, fine["settlement"], fine["tilt"]) \
         / np.sqrt(1.0 - t * t)[:, None]
@@ -257,7 +258,8 @@ def solve_load_batch(scene: Scene, loads: Mapping[str, np.ndarray],
             for i in np.flatnonzero(level.keep):
                 point = pending[i]
                 point_flags = ["contact_lost"] if level.lost[i] else []
-                if level.numerical[i] > scene.model_tol:
+                # the numerical estimate stands for the coating model's (0 without one)
+                if scene.coating and level.numerical[i] > scene.model_tol:
                     point_flags.append("model_error")
                 if abs(level.tilt[i]) > LARGE_TILT:
                     point_flags.append("large_tilt")

@@ -82,6 +82,27 @@ LESSONS: tuple[Lesson, ...] = (
                  {"base.creep": {"model": "elastic", "modulus": 3.0e10}}),
         ),
     ),
+    Lesson(
+        key="coating_edges",
+        title="What a coating does to the edge pressure",
+        preset="bare_layer",
+        steps=(
+            Step("A flat punch, 2 m wide, presses a bare 1 m concrete slab with 500 kN/m "
+                 "(0.25 MPa on average). The pressure is lowest in the middle, 0.20 MPa, "
+                 "and rises without bound toward the edges: 0.31 MPa 10 cm from an edge, "
+                 "0.86 MPa 1 cm from it, infinite at the edge itself. The punch settles "
+                 "0.0068 mm."),
+            Step("Put a 20 mm polymer coating (800 MPa) under the punch: 1 cm from the "
+                 "edge the pressure falls from 0.86 to 0.34 MPa, and the middle carries "
+                 "more, 0.23 MPa. The soft coating is squeezed: the settlement nearly "
+                 "doubles, 0.0127 mm.",
+                 {"coating.0": {"thickness": 0.02, "modulus": 8.0e8, "poisson": 0.3}}),
+            Step("A thicker, softer coating (50 mm, 200 MPa) spreads the load almost "
+                 "evenly, 0.24 to 0.25 MPa across the whole punch: it acts like a bed of "
+                 "springs. The settlement is now 0.064 mm, mostly the coating's.",
+                 {"coating.0.thickness": 0.05, "coating.0.modulus": 2.0e8}),
+        ),
+    ),
 )
 
 
@@ -97,7 +118,9 @@ def _set(scene: dict[str, Any], path: str, value: Any) -> None:
     for key in keys[:-1]:
         node = node[int(key)] if isinstance(node, list) else node[key]
     last = keys[-1]
-    if isinstance(node, list):
+    if isinstance(node, list) and int(last) == len(node):
+        node.append(copy.deepcopy(value))  # "coating.0" on a bare scene adds its layer
+    elif isinstance(node, list):
         node[int(last)] = copy.deepcopy(value)
     else:
         node[last] = copy.deepcopy(value)

@@ -61,8 +61,8 @@ class ExplorerState(param.Parameterized):
 
     scene_name = param.String(default="custom scene", doc="Name of the scene.")
     description = param.String(default="", doc="Description of the scene.")
-    n_layers = param.Integer(default=1, bounds=(1, MAX_LAYERS), softbounds=(1, SCREEN_LAYERS),
-                             doc="Number of coating layers.")
+    n_layers = param.Integer(default=1, bounds=(0, MAX_LAYERS), softbounds=(0, SCREEN_LAYERS),
+                             doc="Number of coating layers (0: the punch on the bare base).")
     time_end = param.Number(default=365.0, softbounds=(1.0, 3650.0),
                             doc="End of the time span [days after loading].")
     time_count = param.Integer(default=40, softbounds=(2, 200),
@@ -218,8 +218,8 @@ class ExplorerState(param.Parameterized):
         check_text("name", scene.get("name", ""), MAX_NAME_CHARS)
         check_text("description", scene.get("description", ""), MAX_DESCRIPTION_CHARS)
         layers = scene["coating"]
-        if not 1 <= len(layers) <= MAX_LAYERS:
-            raise ValueError(f"coating: between 1 and {MAX_LAYERS} layers are supported, "
+        if not 0 <= len(layers) <= MAX_LAYERS:
+            raise ValueError(f"coating: between 0 and {MAX_LAYERS} layers are supported, "
                              f"got {len(layers)}")
         snapshot = self.to_scene()
         self._batch += 1

@@ -125,7 +125,7 @@ class SceneDrawing:
         g = view.geometry
         a = g.half_width
         depth = min(g.base_thickness, 1.2 * a)
-        total = np.sum(g.thickness, axis=0)
+        total = np.sum(g.thickness, axis=0) if len(g.thickness) else np.zeros_like(g.x)
         t_max = float(np.max(total)) if total.size else 0.0
         scale = _nice(0.15 * depth / t_max) if t_max > 0 else 1.0
         # slabs: boundaries and values at the centres, interpolated from the fine grid

@@ -27,6 +27,13 @@ CHECK_ROWS = (("settlement", "mm", 1e3), ("tilt", "mrad", 1e3), ("force", "kN/m"
               ("moment", "kN·m/m", 1e-3))
 
 
+#: What the tab says with no coating layer (the scope of core's bare-base answer).
+BARE_NOTE = ("<small>No coating: the punch presses the bare base, whose pressure rises "
+             "without bound at the punch edges (like 1 / &radic;(distance to the edge)). "
+             "Solved in full contact under a smooth punch; add a layer to see what a "
+             "coating does.</small>")
+
+
 class CoatingView:
     """Widgets of ``state.layers``: thickness h(x), modulus E(x), Poisson ratio of each."""
 
@@ -41,7 +48,7 @@ class CoatingView:
         ``screen``: where the check's report is put for the badges, status and report."""
         self.state = s = state
         self.fidelity = fidelity
-        self.n_layers = PromptIntSlider(label="number of layers", start=1, end=SCREEN_LAYERS,
+        self.n_layers = PromptIntSlider(label="number of layers", start=0, end=SCREEN_LAYERS,
                                         value=min(s.n_layers, SCREEN_LAYERS),
                                         sizing_mode="stretch_width")
         self.n_layers.param.watch(lambda e: setattr(s, "n_layers", e.new), "value_throttled")
@@ -57,6 +64,7 @@ class CoatingView:
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
                                             variations=False, live_when=live_when)
         self.layer_note = html_pane("", styles=NOTE_STYLE)
+        self.bare_note = html_pane(BARE_NOTE, styles=NOTE_STYLE, css_classes=["bare-note"])
         self.check = CoatingCheckView(state, controller, loop, screen)
         s.param.watch(lambda *e: self.refresh(), "n_layers")
         self.refresh()
@@ -66,27 +74,44 @@ class CoatingView:
         return pn.Column(
             html_pane("<small>Layer 1 touches the punch. Changes apply when you release "
                       "a slider.</small>"),
-            self.n_layers, self.layer, self.layer_note, self.thickness_editor.panel,
+            self.n_layers, self.bare_note, self.layer, self.layer_note,
+            self.thickness_editor.panel,
             self.modulus_editor.panel, self.poisson_editor.panel,
             self.fidelity.interface_panel, self.check.panel, **TAB_COLUMN)
 
     def refresh(self) -> None:
-        """Offer one button per layer on screen; say so when the scene has more."""
+        """Offer one button per layer on screen; say so when the scene has more; with no
+        layer, hide the layer's editors and say what is solved."""
         n = self.state.n_layers
         shown = min(n, SCREEN_LAYERS)
+        self.n_layers.value = shown
+        bare = shown == 0
+        self.bare_note.visible = bare
+        for part in self.layer_parts:
+            part.visible = not bare
+        if bare:
+            self.layer_note.visible = False
+            return
         options = [str(k + 1) for k in range(shown)]
         if self.layer.value not in options:
             self.layer.value = options[-1]
         self.layer.options = options
-        self.n_layers.value = shown
         self.layer_note.object = (f"This scene has {n} layers; the screen edits the first "
                                   f"{SCREEN_LAYERS}." if n > SCREEN_LAYERS else "")
         self.layer_note.visible = bool(self.layer_note.object)
         self.bind_layer()
 
+    @property
+    def layer_parts(self) -> tuple[Any, ...]:
+        """The widgets of the layer being edited (hidden when there is none)."""
+        return (self.layer, self.thickness_editor.panel, self.modulus_editor.panel,
+                self.poisson_editor.panel, self.fidelity.interface_panel, self.check.panel)
+
     def bind_layer(self) -> None:
         """Point the editors at the layer chosen."""
         state = self.state
+        if state.n_layers == 0:
+            return
         layer = state.layers[int(self.layer.value) - 1]
         a = state.punch.half_width
         self.thickness_editor.bind(layer.thickness, a)

@@ -124,3 +124,24 @@ def test_a_lesson_goes_step_by_step_and_pins_each_step(explorer_app) -> None:
     view.lesson_select.value = "creep"
     assert app.controller.wait(60)
     assert app.results.log_time.value and len(app.pins.board) == 0
+
+
+def test_the_coating_edges_lesson_says_what_the_solver_finds() -> None:
+    bare, thin, thick = (_solved("coating_edges", k) for k in range(3))
+    assert bare.scene.coating == () and len(thin.scene.coating) == 1
+    x = np.array([0.0, 0.9, 0.99])  # the middle, 10 cm and 1 cm from the edge (a = 1 m)
+
+    def mpa(solution) -> np.ndarray:
+        return np.asarray(solution.pressure(x))[:, 0] / 1e6
+
+    q0, q1 = mpa(bare), mpa(thin)
+    # step 1: 0.20 MPa in the middle, 0.31 and 0.86 MPa near the edge, 0.0068 mm
+    assert [f"{v:.2f}" for v in q0] == ["0.20", "0.31", "0.86"]
+    assert _rounds_to(_mm(bare, 0), "0.0068")
+    # step 2: 1 cm from the edge 0.34 MPa, 0.23 MPa in the middle, 0.0127 mm
+    assert f"{q1[2]:.2f}" == "0.34" and f"{q1[0]:.2f}" == "0.23"
+    assert _rounds_to(_mm(thin, 0), "0.0127")
+    # step 3: 0.24 to 0.25 MPa over the punch (as drawn: the plotting grid), 0.064 mm
+    grid = np.asarray(thick.pressure_on_grid)[:, 0] / 1e6
+    assert f"{grid.min():.2f}" == "0.24" and f"{grid.max():.2f}" == "0.25"
+    assert _rounds_to(_mm(thick, 0), "0.064")

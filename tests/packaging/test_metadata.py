@@ -148,7 +148,7 @@ def test_the_shipped_presets_and_studies_are_valid():
         core.scene_from_dict(read_preset(name))
     for name in study_names():
         assert read_study(name)["scene"].startswith("../scenes/")
-    with pytest.raises(KeyError, match="known: eccentric_creep"):
+    with pytest.raises(KeyError, match="known: bare_layer, eccentric_creep"):
         read_preset("no_such_preset")
 
 
@@ -183,5 +183,5 @@ def test_a_shipped_scene_or_study_is_named_preset_colon_name():
         == core.scene_from_dict(read_preset("worn_coating")).to_dict()
     assert core.load_study("preset:eccentric_design").n_points > 0
     with pytest.raises(ValueError, match="preset:nope: no shipped scene of that name; known: "
-                                         "eccentric_creep"):
+                                         "bare_layer, eccentric_creep"):
         core.load_scene("preset:nope")

@@ -142,7 +142,6 @@ MORE_BAD: list[tuple[str, Any, str, bool]] = [
     ("coating[0].thickness", "0.01", "coating[0].thickness", True),
     ("coating[0].modulus", {"kind": "table", "points": [[0, 1e9], [1, 2e9, 3]]},
      "coating[0].modulus", True),
-    ("coating", [], "coating", True),
     ("loading", {"force": 5e5}, "loading", True),
     ("loading", {"force": 5e5, "settlement": 0.01}, "loading", True),
     ("loading", {"tilt": 0.0, "moment": 0.0}, "loading", True),

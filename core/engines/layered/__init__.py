@@ -21,6 +21,9 @@ from __future__ import annotations
 
 from core.engines.layered.answer import (
     LIFT_OFF_SHARE,
+    NO_COATING,
+    bare_creep_declines,
+    corner_reach,
     layered_declines,
     solve_scene_layered,
     uniform_layers,
@@ -37,7 +40,9 @@ from core.engines.layered.solve import (
 )
 
 __all__ = [
+    "bare_creep_declines",
     "cached_response",
+    "corner_reach",
     "COARSE_ERROR_FLOOR",
     "COARSE_TOL",
     "default_modes",
@@ -48,6 +53,7 @@ __all__ = [
     "LIFT_OFF_SHARE",
     "MAX_MODES",
     "MAX_RATIO",
+    "NO_COATING",
     "PRESSURE_REACH",
     "share_budget",
     "solve_scene_layered",

@@ -9,12 +9,19 @@ same continuum problem as the resolved finite-element model of :mod:`core.coatin
 the model error it leaves is its own numerical error: ``info["model_error_estimate"]`` is
 that estimate for the unknowns (``benchmarks/layered_kernel.py`` measures it against FE).
 
+With no coating layers at all the stack's kernel is the base's own (``k_stack = k_pl``,
+``L_inf = 1``): the same path solves the bare layer exactly, creeping or aging base
+included (:mod:`core.engines.layered.bare_creep`), and its coating-model error is 0
+(``info["coating_model"] = NO_COATING``). :func:`core.scene.scene_from_dict` refuses
+a bare scene this path declines (the thin-layer model has no bare limit: ``m = 0``).
+
 Where it does not apply the thin-layer model answers, with its measured error
 (:mod:`core.coating.model`); :func:`layered_declines` says why:
 
-- a creeping or aging base: the coating does not creep, so the stack's response is not
-  the elastic one scaled by ``E(t)``; the thin-layer model with the map's error (read at
-  the modulus at loading) answers;
+- a creeping or aging base under a coating: the coating does not creep, so the stack's
+  response is not the elastic one scaled by ``E(t)``; the thin-layer model with the map's
+  error (read at the modulus at loading) answers (without coating it is: the bare base
+  creeps by scalar Volterra equations, :mod:`core.engines.layered.bare_creep`);
 - a coating that varies along ``x``;
 - a punch shape with breakpoints: a jump (a step on an elastic solid has an infinite
   force in full contact: the thin layer's finite answer is the model's) or a kink (the
@@ -36,18 +43,20 @@ punch corner's, not the coating's.
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from functools import lru_cache
 from typing import Any
 
 import numpy as np
 
 from core.coating import model_error_estimate, tilt_share
+from core.engines.layered.bare_creep import solve_bare_creep
 from core.engines.layered.galerkin import MAX_MODES, MAX_NODES, default_modes, node_count
 from core.engines.layered.solve import solve_layered
 from core.kernel import UniformLayer, table_cost
 from core.problem import ContactSolution, accepts
 
-__all__ = ["layered_declines", "solve_scene_layered"]
+__all__ = ["bare_creep_declines", "corner_reach", "layered_declines", "solve_scene_layered"]
 
 #: Time samples of the load histories for the largest tilt between output times.
 TILT_SAMPLES = 257
@@ -60,6 +69,13 @@ MAX_TABLE_COST = 5e7
 #: of the Chebyshev modes over the whole tail (:func:`core.engines.layered.solve_layered`)
 #: and is taken as it stands.
 SUCCESS_MARGIN = 1.0
+#: Without coating ``pressure(x)`` is reported on ``|x| <= a (1 - BARE_CORNER)`` and held
+#: beyond: q is infinite at the corners, and there it is 22x its value at the centre
+#: (flat punch, ``1 / sqrt(2 BARE_CORNER)``), which a plot of the punch width still shows.
+BARE_CORNER = 1e-3
+#: ``info["coating_model"]`` of a scene without coating layers (its coating-model error
+#: is 0: there is no coating to model).
+NO_COATING = "none (no coating)"
 #: A pressure below this share of its largest value is taken as lift-off.
 LIFT_OFF_SHARE = 1e-9
 
@@ -82,10 +98,21 @@ def uniform_layers(scene: Any) -> list[UniformLayer]:
 
 
 def layered_declines(scene: Any, problem: Any) -> str | None:
-    """Why the exact layered kernel does not answer this scene (None when it does)."""
-    if not scene.coating:
-        return "no coating"
+    """Why the exact layered kernel does not answer this scene as an elastic one (None
+    when it does; a bare creeping base is answered by :func:`solve_scene_layered` too, see
+    :func:`bare_creep_declines`)."""
     if problem.kernel is not None or callable(problem.c) or problem.c != 1.0:
+        return "the base creeps or ages"
+    return bare_creep_declines(scene, problem)
+
+
+def bare_creep_declines(scene: Any, problem: Any) -> str | None:
+    """:func:`layered_declines` but for the base's creep and aging: why the layered path
+    does not answer a scene whatever its base (None when it does). Without coating the
+    creep is scalar Volterra equations over elastic unit responses
+    (:mod:`core.engines.layered.bare_creep`)."""
+    if scene.coating and (problem.kernel is not None or callable(problem.c)
+                          or problem.c != 1.0):
         return "the base creeps or ages"
     if scene.contact not in ("auto", "full"):
         return "unilateral contact"
@@ -94,7 +121,8 @@ def layered_declines(scene: Any, problem: Any) -> str | None:
         return "the coating varies along x"
     layers = uniform_layers(scene)
     modes = default_modes(scene.half_width, layers)
-    if modes > MAX_MODES or node_count(scene.half_width, layers, modes) > MAX_NODES:
+    if modes > MAX_MODES or node_count(
+            scene.half_width, layers, modes, base_thickness=scene.base_thickness) > MAX_NODES:
         return "the coating is thinner than the layered solve resolves"
     # the cost depends on the thicknesses alone: other moduli share the kept value
     shapes = tuple(UniformLayer(lay.thickness, 1.0, 0.0) for lay in layers)
@@ -106,6 +134,14 @@ def layered_declines(scene: Any, problem: Any) -> str | None:
         # (the Chebyshev series converges like 1/n there: 1 % in q with 340 modes)
         return "the punch shape has breakpoints"
     return None
+
+
+def corner_reach(layers: Sequence[UniformLayer], half_width: float) -> float:
+    """``|t|`` [-] up to which ``pressure(x)`` is reported (held beyond): half the top
+    layer's thickness from the corner, ``BARE_CORNER`` without coating."""
+    if not layers:
+        return 1.0 - BARE_CORNER
+    return 1.0 - 0.5 * layers[0].thickness / half_width
 
 
 def _load_values(problem: Any, times: np.ndarray) -> dict[str, np.ndarray]:
@@ -120,62 +156,95 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
     """The scene's answer with the exact layered kernel (dimensionless, like
     :meth:`core.scene.pipeline.DimensionlessProblem.solve`), or None where it does not apply
     (:func:`layered_declines`) or, with ``contact = "auto"``, where the punch lifts off."""
-    if layered_declines(scene, problem) is not None:
+    if bare_creep_declines(scene, problem) is not None:
         return None
     start = time.perf_counter()
     layers = uniform_layers(scene)
     a = scene.half_width
     times = np.asarray(problem.times, dtype=float)
+    creeping = problem.kernel is not None  # bare: the coating term c m q is 0
+    # creeping: the unit responses of a unit settlement and a unit tilt, measured as such
+    given = {"settlement": np.array([1.0, 0.0]), "tilt": np.array([0.0, 1.0])} \
+        if creeping else _load_values(problem, times)
     answer = solve_layered(a, layers, scene.base_thickness, problem.modulus_at_loading,
-                           scene.base_poisson, _load_values(problem, times),
+                           scene.base_poisson, given,
                            gap=problem.g, breakpoints=problem.breakpoints, tol=problem.tol)
     response = answer.response
+    history = solve_bare_creep(response, problem, times, problem.tol) if creeping else None
+    if history is None:
+        settlement, tilt, force, moment = (answer.settlement, answer.tilt, answer.force,
+                                           answer.moment)
+
+        def regular_part(t: np.ndarray) -> np.ndarray:
+            return response.regular_part(t, answer.settlement, answer.tilt)
+    else:
+        settlement, tilt, force, moment = (history.settlement, history.tilt,
+                                           history.force, history.moment)
+
+        def regular_part(t: np.ndarray) -> np.ndarray:
+            return history.regular_part(response, t)
+    time_error = 0.0 if history is None else history.time_error
+    error_estimate = answer.error_estimate + time_error
     # the sign of q is that of sqrt(1 - t^2) q, finite at the corners
     theta = np.linspace(0.0, np.pi, 8 * answer.modes + 1)
-    regular = response.regular_part(np.cos(theta), answer.settlement, answer.tilt)
+    regular = regular_part(np.cos(theta))
     scale = max(float(np.max(np.abs(regular))), 1e-300)
-    lost = float(np.min(regular)) < -max(answer.error_estimate, LIFT_OFF_SHARE) * scale
+    lost = float(np.min(regular)) < -max(error_estimate, LIFT_OFF_SHARE) * scale
     if lost and scene.contact == "auto":
         return None
-    dense = np.linspace(times[0], times[-1], TILT_SAMPLES)
-    largest_tilt = float(np.max(np.abs(response.complete(_load_values(problem, dense))["tilt"])))
-    edge = 1.0 - 0.5 * layers[0].thickness / a
+    if history is None:
+        dense = np.linspace(times[0], times[-1], TILT_SAMPLES)
+        largest_tilt = float(np.max(np.abs(
+            response.complete(_load_values(problem, dense))["tilt"])))
+    else:  # the output times' (the stepping reports there)
+        largest_tilt = float(np.max(np.abs(tilt)))
+    edge = corner_reach(layers, a)
 
     def evaluate(x: np.ndarray) -> np.ndarray:
         t = np.clip(x, -edge, edge)
-        return response.regular_part(t, answer.settlement, answer.tilt) \
-            / np.sqrt(1.0 - t * t)[:, None]
+        return regular_part(t) / np.sqrt(1.0 - t * t)[:, None]
 
     unknowns = [n for n in ("settlement", "tilt", "force", "moment") if n not in problem.loads]
-    numerical = max(answer.errors[n] for n in unknowns)
-    thin = model_error_estimate(scene, tilt_share(a, a * answer.settlement, answer.tilt))
-    model_error = {"estimate": float(numerical),
-                   "force": float(answer.errors.get("force", numerical)),
-                   "moment": float(answer.errors.get("moment", numerical)),
-                   "where_m": 0.0, "model": "exact layered",
-                   "thin_layer_estimate": thin["estimate"]}
+    numerical = error_estimate if history is not None else max(answer.errors[n]
+                                                               for n in unknowns)
+    if layers:
+        thin = model_error_estimate(scene, tilt_share(a, a * answer.settlement, answer.tilt))
+        model_error = {"estimate": float(numerical),
+                       "force": float(answer.errors.get("force", numerical)),
+                       "moment": float(answer.errors.get("moment", numerical)),
+                       "where_m": 0.0, "model": "exact layered",
+                       "thin_layer_estimate": thin["estimate"]}
+    else:
+        # no coating, no coating model: the base's own kernel is the whole problem, and
+        # the numerical estimate above is the only error
+        model_error = {"estimate": 0.0, "force": 0.0, "moment": 0.0, "where_m": 0.0,
+                       "model": NO_COATING, "thin_layer_estimate": 0.0}
     flags = ["contact_lost"] if lost else []
-    success = accepts(answer.error_estimate, problem.tol, SUCCESS_MARGIN)
+    success = accepts(error_estimate, problem.tol, SUCCESS_MARGIN) and (
+        history is None or history.success)
     if not success:
         flags.append("tol_not_met")
     if success:
-        message = (f"exact layered kernel: estimated error {answer.error_estimate:.1e} "
+        message = (f"exact layered kernel: estimated error {error_estimate:.1e} "
                    f"<= tol {problem.tol:.1e} with {answer.modes} modes")
     else:  # worded as the other engines word a missed tol
         message = (f"tol {problem.tol:.1e} not met: the exact layered kernel reached "
                    f"{answer.modes} modes with estimated error {answer.error_estimate:.1e}")
+        if history is not None:
+            message += (f"; time stepping: {history.message} (estimated error "
+                        f"{history.time_error:.1e})")
     q_interior = evaluate(np.cos(theta[1:-1]))
     info = {
-        "error_estimate": float(answer.error_estimate),
+        "error_estimate": float(error_estimate),
         "spatial_error_estimate": float(answer.error_estimate),
-        "time_error_estimate": 0.0,
-        "kernel_fit_error": 0.0,
+        "time_error_estimate": float(time_error),
+        "kernel_fit_error": 0.0 if history is None else history.fit_error,
         "seconds": time.perf_counter() - start,
         "flags": flags,
         "success": bool(success),
         "message": message,
         "n_modes": int(answer.modes),
-        "n_steps": 0,
+        "n_steps": 0 if history is None else history.steps,
         "n_nodes": int(response.nodes),
         "statement": scene.statement,
         "given": sorted(problem.loads),
@@ -187,10 +256,9 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
         "contact": "full",
         "max_abs_tilt": largest_tilt,
         "stages": answer.stages,
-        "coating_model": "exact layered",
+        "coating_model": "exact layered" if layers else NO_COATING,
         "layered_model_error": model_error,
     }
-    return ContactSolution(times.copy(), answer.settlement, answer.tilt, answer.force,
-                           answer.moment, info, None, np.zeros((0, times.size)),
-                           np.ones(times.size), None, None, _evaluate=evaluate,
-                           contact_set=[[(-1.0, 1.0)] for _ in times])
+    return ContactSolution(times.copy(), settlement, tilt, force, moment, info, None,
+                           np.zeros((0, times.size)), np.ones(times.size), None, None,
+                           _evaluate=evaluate, contact_set=[[(-1.0, 1.0)] for _ in times])

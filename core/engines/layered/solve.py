@@ -169,7 +169,7 @@ def layered_response(half_width: float, layers: Sequence[UniformLayer],
     if table is None:
         table = RegularPartTable(2 * lam, layers, base_thickness, base_modulus, base_poisson,
                                  degree=table_degree(tol))
-    n_nodes = node_count(half_width, layers, modes, tol=tol)
+    n_nodes = node_count(half_width, layers, modes, tol=tol, base_thickness=base_thickness)
     matrix = _operator(half_width, layers, base_thickness, base_modulus, base_poisson,
                        modes, table, n_nodes)
     return _unit_responses(lam, matrix, gap, breakpoints, n_nodes)
@@ -222,7 +222,7 @@ def cached_response(half_width: float, layers: Sequence[UniformLayer],
     stack, gap_id = keys
     degree = table_degree(tol)
     room = max(modes, room)
-    n_nodes = node_count(half_width, layers, room, tol=tol)
+    n_nodes = node_count(half_width, layers, room, tol=tol, base_thickness=base_thickness)
 
     def timed(stage: str, compute: Callable[[], Any]) -> Callable[[], Any]:
         def run() -> Any:
