@@ -242,7 +242,6 @@ class ExplorerApp(pn.viewable.Viewer):
         with pn.io.hold():
             self.figures.set_presentation(on)
             self.header.visible = not on
-            self.sidebar.width = 300 if on else 370
             self.results.set_presentation(on)
         self.results.push()
 

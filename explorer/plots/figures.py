@@ -52,6 +52,8 @@ GIVEN_COLOR = "#8c8c8c"
 LEGEND_FONT = "11px"
 
 #: Font size of ticks, axis labels and titles in presentation mode (a projector).
+#: Ticks an axis aims at in presentation mode (Bokeh's default is 6).
+PRESENTATION_TICKS = 4
 PRESENTATION_FONT = "18px"
 
 #: Longest scene name shown in the drawing's title [characters]: a Bokeh title does not
@@ -307,6 +309,9 @@ class Figures:
             for axis in (*fig.xaxis, *fig.yaxis):
                 axis.major_label_text_font_size = tick
                 axis.axis_label_text_font_size = label
+                # ticks of 18 px on a 240 px plot: fewer of them, or they touch
+                if hasattr(axis.ticker, "desired_num_ticks"):
+                    axis.ticker.desired_num_ticks = PRESENTATION_TICKS if on else 6
             fig.toolbar_location = None if on else "above"
         legend = self.q_fig.legend[0]
         legend.label_text_font_size = "11px" if on else LEGEND_FONT

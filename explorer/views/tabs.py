@@ -12,6 +12,10 @@ from .loop import PageLoop
 #: Time after a page connects before the sidebar tabs not yet opened are filled in the
 #: background [ms]: after the first paint and a first look (see DeferredTabs.fill_idle).
 FILL_TABS_AFTER_MS = 3000
+#: Width of the sidebar [px], the same in presentation mode: a width changed on a page
+#: left the tabs' widgets at their old width, running over the plots (at 1024 px: the
+#: description through the scene's axis label, the readout's heading cut).
+SIDEBAR_WIDTH = 340
 #: Style of the sidebar's tab titles: several lines when they do not fit one.
 WRAP_TITLES = (".bk-header, .bk-headers-wrapper, .bk-headers {flex-wrap: wrap; "
                "overflow: visible; height: auto;}")
@@ -34,7 +38,7 @@ class DeferredTabs:
                 content.objects = []
         # the tab titles wrap onto a second line: in one line the last tabs were out of
         # reach at 1024 px (presentation mode) and behind the first ones' width at 1400
-        self.sidebar = pn.Tabs(*tabs, dynamic=False, width=370, margin=(0, 10, 0, 0),
+        self.sidebar = pn.Tabs(*tabs, dynamic=False, width=SIDEBAR_WIDTH, margin=(0, 10, 0, 0),
                                css_classes=["sidebar-tabs"], stylesheets=[WRAP_TITLES])
         self.sidebar.param.watch(lambda e: self.fill(e.new), "active")
 
