@@ -7,6 +7,7 @@ session's scenes are solved (:mod:`explorer.solving`).
 """
 
 from .exports import (
+    MAX_PAGE_DOWNLOAD_BYTES,
     flag_message,
     histories_csv,
     number,
@@ -16,5 +17,5 @@ from .exports import (
     study_csv,
 )
 
-__all__ = ["flag_message", "histories_csv", "number", "parse_csv", "pressure_csv",
-           "project_version", "study_csv"]
+__all__ = ["flag_message", "histories_csv", "MAX_PAGE_DOWNLOAD_BYTES", "number", "parse_csv",
+           "pressure_csv", "project_version", "study_csv"]

@@ -29,6 +29,11 @@ from ..model import OUTPUTS, QUANTITIES, QUANTITY_UNITS, ResultView, StudyResult
 
 #: Significant digits of every number in a CSV file.
 DIGITS = 10
+#: Largest file a page is sent for download [bytes]: it travels base64 in one websocket
+#: message that the server's event loop encodes and writes, so its size is time the loop
+#: (every page's) does nothing else: a 75 MB study CSV held it 11.7 s. Larger studies run
+#: with ``coated-punch sweep``, which writes files of any size.
+MAX_PAGE_DOWNLOAD_BYTES = 16 * 2**20
 
 #: Column names of the histories, in the units the screen shows them in.
 HISTORY_COLUMNS = {"settlement": "settlement_mm", "tilt": "tilt_mrad",

@@ -10,14 +10,16 @@ output at a chosen time; it downloads as CSV (every output at every time) and PN
 
 from __future__ import annotations
 
+import asyncio
 import html
 import io
+import threading
 from collections.abc import Callable
 from typing import Any
 
 import panel as pn
 
-from ..files import study_csv
+from ..files import MAX_PAGE_DOWNLOAD_BYTES, study_csv
 from ..model import (
     MAX_POINTS,
     OUTPUTS,
@@ -88,7 +90,11 @@ class StudyView:
         ``on_settings``: called when the fields or the output change (the link keeps
         them)."""
         self.state = state
+        self.loop = loop
         self.study_run = StudyRun(dispatch=loop.dispatch)
+        # the CSV of the last result, built off the event loop when the result comes
+        # (a 400-point study over 2000 output times is ~75 MB: 12 s of the loop's time)
+        self._csv_data: bytes | None = None
         self._choices: dict[str, Any] = {}
         self.study_first = _AxisInputs(1, optional=False)
         self.study_second = _AxisInputs(2, optional=True)
@@ -281,7 +287,8 @@ class StudyView:
         stem = slug(str(result.planned.study.base.get("name", "scene"))[:60])
         self.study_csv.filename = f"{stem}_study.csv"
         self.study_png.filename = f"{stem}_study.png"
-        self.study_csv.disabled = self.study_png.disabled = False
+        self.study_png.disabled = False
+        self._prepare_csv(result)
         self._say(self._done_text(result))
 
     def _redraw(self) -> None:
@@ -289,16 +296,50 @@ class StudyView:
             self.study_charts.show(self.study_output.value, int(self.study_time.value))
 
     # -- files -----------------------------------------------------------------------------
-    def _csv(self) -> io.StringIO:
-        result = self.study_run.result
-        return io.StringIO(study_csv(result) if result is not None else "")
+    def _prepare_csv(self, result: Any) -> None:
+        """Build the result's CSV on a thread of its own (at once without a served page)
+        and offer it when it is no larger than :data:`MAX_PAGE_DOWNLOAD_BYTES`."""
+        self._csv_data = None
+        self.study_csv.disabled = True
+        self.study_csv.label = "Study data (CSV): preparing"
 
-    def _png(self) -> io.BytesIO:
+        def build() -> None:
+            data = study_csv(result).encode("utf-8")
+            self.loop.dispatch(lambda: self._offer_csv(result, data))
+
+        if self.loop.served:
+            threading.Thread(target=build, name="study-csv", daemon=True).start()
+        else:
+            build()
+
+    def _offer_csv(self, result: Any, data: bytes) -> None:
+        if self.study_run.result is not result:
+            return  # a newer result came meanwhile
+        if len(data) > MAX_PAGE_DOWNLOAD_BYTES:
+            self._csv_data = None
+            self.study_csv.disabled = True
+            self.study_csv.label = (f"Study data (CSV): {len(data) / 2**20:.0f} MiB, more "
+                                    "than the page sends")
+            self._say(f"{self._done_text(result)} The study's CSV is "
+                      f"{len(data) / 2**20:.0f} MiB, more than the page sends "
+                      f"({MAX_PAGE_DOWNLOAD_BYTES / 2**20:.0f} MiB): choose fewer output "
+                      "times (Time tab) or points, or run the study with `coated-punch "
+                      "sweep`, which writes files of any size.")
+            return
+        self._csv_data = data
+        self.study_csv.label = "Study data (CSV)"
+        self.study_csv.disabled = False
+
+    def _csv(self) -> io.BytesIO:
+        return io.BytesIO(self._csv_data or b"")
+
+    async def _png(self) -> io.BytesIO:
         result = self.study_run.result
         if result is None:
             return io.BytesIO(b"")
-        return io.BytesIO(design_chart_png(result, self.study_output.value,
-                                           int(self.study_time.value or 0)))
+        output, index = self.study_output.value, int(self.study_time.value or 0)
+        # drawn off the event loop (Matplotlib: ~0.3 s), which other pages share
+        return io.BytesIO(await asyncio.to_thread(design_chart_png, result, output, index))
 
 
 def stretch_row() -> dict[str, Any]:

@@ -342,7 +342,7 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved(explore
 
             # the CSV holds the plotted numbers in the units on screen (mm, kN/m), to
             # 10 significant digits; the JSON the solver's SI numbers in full
-            _, names, table = parse_csv(app.files_tab._csv_file().getvalue())
+            _, names, table = parse_csv(asyncio.run(app.files_tab._csv_file()).getvalue())
             assert names[:4] == ["time_day", "settlement_mm", "tilt_mrad", "force_kN_per_m"]
             result = json.loads(asyncio.run(app.files_tab._json_file()).getvalue())
             saved = json.loads(app.files_tab._scene_file().getvalue())
@@ -360,7 +360,7 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved(explore
             q_file = np.asarray(result["pressure"])[:, index]
             np.testing.assert_allclose(q_file / unit, app.figures.q_src.data["q"],
                                        rtol=1e-7, atol=0)  # float32 on screen
-            _, _, long = parse_csv(app.files_tab._pressure_file().getvalue())
+            _, _, long = parse_csv(asyncio.run(app.files_tab._pressure_file()).getvalue())
             assert len(long) == len(result["times"]) * len(result["x"])
 
         check_downloads_match(shown)
@@ -372,13 +372,14 @@ def test_downloads_hold_the_result_on_screen_while_a_newer_one_is_solved(explore
         check_downloads_match(shown)
         from explorer.files import parse_csv
 
-        assert parse_csv(app.files_tab._csv_file().getvalue())[2][0, 3] == old_force / 1e3
+        table = parse_csv(asyncio.run(app.files_tab._csv_file()).getvalue())[2]
+        assert table[0, 3] == old_force / 1e3
         gate.set()
         assert app.controller.wait(120)
         assert app.screen.drawn is app.controller.view and app.screen.drawn is not shown
         check_downloads_match(app.screen.drawn)
-        assert parse_csv(app.files_tab._csv_file().getvalue())[2][0, 3] == pytest.approx(650.0,
-                                                                              rel=1e-12)
+        table = parse_csv(asyncio.run(app.files_tab._csv_file()).getvalue())[2]
+        assert table[0, 3] == pytest.approx(650.0, rel=1e-12)
     finally:
         gate.set()
         pool.shutdown(wait=True)

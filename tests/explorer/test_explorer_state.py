@@ -7,6 +7,7 @@ result; a change of the load re-solves without re-evaluating any geometric stage
 
 from __future__ import annotations
 
+import asyncio
 import json
 import math
 import threading
@@ -482,7 +483,7 @@ def test_app_widgets_follow_and_drive_the_state(monkeypatch, explorer_app):
     # downloads hold what is on screen
     assert app.files_tab._scene_file().getvalue().strip().startswith("{")
     assert json.loads(app.files_tab._scene_file().getvalue()) == view.scene
-    csv = app.files_tab._csv_file().getvalue()
+    csv = asyncio.run(app.files_tab._csv_file()).getvalue()
     assert csv.startswith("# coated-punch explorer") and "\ntime_day,settlement_mm," in csv
 
 

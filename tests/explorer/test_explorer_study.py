@@ -4,6 +4,7 @@ study's process, and the chart, CSV and PNG hold the result."""
 
 from __future__ import annotations
 
+import asyncio
 import copy
 import json
 import time
@@ -165,11 +166,19 @@ def test_the_tab_draws_the_chart_and_writes_the_files(explorer_app):
     np.testing.assert_allclose(tab.study_charts.source.data["y"],
                                result.outputs["q_max"][:, -1] * 1e-3)
     assert "kPa" in tab.study_charts.shown.yaxis.axis_label
-    csv = tab._csv().getvalue().splitlines()
+    csv = tab._csv().getvalue().decode("utf-8").splitlines()
     header = next(line for line in csv if not line.startswith("#"))
     assert header.startswith("loading_force_p_kN_per_m,time_day,settlement_mm")
     assert len([line for line in csv if not line.startswith("#")]) == 1 + 3 * 2
-    png = tab._png().getvalue()
+    # a CSV over what the page sends is not offered, and the tab says what to do instead
+    from explorer.files import MAX_PAGE_DOWNLOAD_BYTES
+
+    data = tab._csv_data
+    tab._offer_csv(result, b"x" * (MAX_PAGE_DOWNLOAD_BYTES + 1))
+    assert tab.study_csv.disabled and "more than the page sends" in tab.study_csv.label
+    assert "coated-punch sweep" in tab.study_status.object
+    tab._offer_csv(result, data)
+    png = asyncio.run(tab._png()).getvalue()
     assert png.startswith(b"\x89PNG\r\n\x1a\n") and len(png) > 5000
     assert not tab.study_csv.disabled and not tab.study_png.disabled
     assert set(OUTPUTS) <= set(result.outputs)
