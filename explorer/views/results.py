@@ -326,9 +326,19 @@ class ResultsView:
     def _replace_player(self, end: int, value: int) -> None:
         """A new player for a new number of output times: the page's player redraws its
         range only when its value changes, so a new range with the same value (or a value
-        arriving before the range) left the old range on screen."""
-        self.player = self._new_player(end, value)
-        self.player_box.objects = [self.player]
+        arriving before the range) left the old range on screen.
+
+        The new player starts at 0 and is moved to ``value`` a moment later: the page's
+        range input took the value before its maximum, so a value above the input's default
+        maximum (100) was clamped to it and the handle sat mid-track (a 200-time scene from
+        a file: the label said the last time, the handle 100 of 199)."""
+        self.player = player = self._new_player(end, 0 if self.loop.served else value)
+        self.player_box.objects = [player]
+        if self.loop.served and value:
+            def move() -> None:
+                if self.player is player:
+                    player.value = value
+            self.loop.later(move, 0)
 
     def push(self) -> None:
         """In a notebook, plain Bokeh models changed in place must be pushed by hand."""

@@ -63,7 +63,8 @@ def _player_range(page: Page) -> dict:
 
 
 def test_time_slider_range_follows_a_preset_switch(page: Page):
-    """40 output times, then a preset with 60: the slider must reach the 60th."""
+    """40 output times, then a preset with 60, then one with 200: the slider must reach
+    the last of them, its handle where its label is."""
     assert _player_range(page)["max"] == "39"
     _choose_preset(page, "eccentric_creep", "Eccentric")
     until(lambda: _player_range(page)["max"] == "59", "the slider reaching 59")
@@ -77,6 +78,12 @@ def test_time_slider_range_follows_a_preset_switch(page: Page):
     # the preset's text says what its curve shows (it levels off; not "for years")
     assert page.page.evaluate(JS_SHOWN, "level off after about 250 days")
     assert not page.page.evaluate(JS_SHOWN, "keep growing for years")
+    # 200 output times: the handle at the last one, where its label is (the range input
+    # took the value before its maximum and clamped it to its default 100: mid-track)
+    _choose_preset(page, "young_concrete_50_years", "50 years")
+    until(lambda: _player_range(page) == {"min": "0", "max": "199", "value": "199"},
+          "the slider at the last of 200 times", 60, lambda: _player_range(page))
+    assert "50.0 years" in page.text(".time-label")
     assert page.errors == []
 
 
