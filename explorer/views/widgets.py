@@ -33,9 +33,12 @@ __all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload
 # a time and the newest request waits), so here the wait is only latency: measured 50 of
 # the 140 ms from a load slider step to the new pressure data on the server's side.
 class PromptFloatSlider(pn.widgets.FloatSlider):
-    """A FloatSlider whose browser changes are handled at once (no 50 ms debounce)."""
+    """A FloatSlider whose browser changes are handled at once (no 50 ms debounce), and
+    without the tooltip over its handle: the label shows the value, and a tooltip left on
+    screen after a drag (a tab switched, the slider hidden) covered the label above."""
 
     _debounce = 0
+    tooltips = param.Boolean(default=False, doc="Whether the handle shows its value.")
 
 
 class PromptFloatInput(pn.widgets.FloatInput):
@@ -45,9 +48,11 @@ class PromptFloatInput(pn.widgets.FloatInput):
 
 
 class PromptIntSlider(pn.widgets.IntSlider):
-    """An IntSlider whose browser changes are handled at once (no 50 ms debounce)."""
+    """An IntSlider whose browser changes are handled at once (no 50 ms debounce), without
+    the tooltip over its handle (see :class:`PromptFloatSlider`)."""
 
     _debounce = 0
+    tooltips = param.Boolean(default=False, doc="Whether the handle shows its value.")
 
 
 class PromptIntInput(pn.widgets.IntInput):
@@ -61,6 +66,8 @@ class EditableSlider(pn.widgets.EditableFloatSlider):
 
     _slider_widget = PromptFloatSlider
     _input_widget = PromptFloatInput
+    tooltips = param.Boolean(default=False, doc="Whether the handle shows its value (the "
+                             "text box does).")
 
     def watch_drag_first(self, callback: Callable[[Any], None]) -> None:
         """Call ``callback(value)`` [the slider's value] at each move of the slider,
@@ -91,6 +98,8 @@ class EditableIntSlider(pn.widgets.EditableIntSlider):
 
     _slider_widget = PromptIntSlider
     _input_widget = PromptIntInput
+    tooltips = param.Boolean(default=False, doc="Whether the handle shows its value (the "
+                             "text box does).")
 
 
 def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
