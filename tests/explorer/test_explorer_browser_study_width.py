@@ -51,8 +51,11 @@ def test_the_study_csv_holds_the_width_the_readout_gives(page: Page):
     page.page.locator(".study-run button").first.click()
     until(lambda: len(page.page.evaluate(JS_STUDY_Y) or []) == 2, "the chart of 2 points",
           240, lambda: page.pane_text(".study-status"))
+    # the CSV is written on a thread when the result comes: its button is offered then
+    csv_button = page.page.locator(".study-csv button").first
+    until(lambda: csv_button.is_enabled(), "the study's CSV offered")
     with page.page.expect_download(timeout=60_000 * patience()) as info:
-        page.page.locator(".study-csv").first.click()
+        csv_button.click()
     lines = [line for line in Path(info.value.path()).read_text().splitlines()
              if not line.startswith("#")]
     header, *rows = csv.reader(lines)
