@@ -149,3 +149,22 @@ def _modulus_log_slope(inp: CodeInputs, age: np.ndarray) -> np.ndarray:
 
 _FORMULAS = {"fib_mc2010": (mc2010_modulus, mc2010_creep_coefficient),
              "eurocode2": (ec2_modulus, ec2_creep_coefficient)}
+
+
+def mc2010_reference_modulus(inp: CodeInputs) -> float:
+    """``E_ci`` [MPa], the modulus at 28 days that divides ``phi`` in ``J`` (MC2010 5.1-21,
+    5.1-61): not adjusted for temperature. (``mc2010_modulus(inp, 28)`` is: 0.99988
+    ``E_ci`` at 20 C, 0.946 at 5 C and 1.025 at 30 C; dividing by it made the creep part
+    of ``J`` up to 5.7 % larger than the code's text.)"""
+    return 21500.0 * (inp.fcm / 10.0) ** (1.0 / 3.0)
+
+
+def ec2_reference_modulus(inp: CodeInputs) -> float:
+    """``E_c`` [MPa], the tangent modulus at 28 days that divides ``phi`` in ``J``
+    (EN 1992-1-1 3.1.4(2), 3.1.3): ``1.05 E_cm``."""
+    return float(ec2_modulus(inp, 28.0))
+
+
+#: The modulus dividing the creep coefficient in each code's compliance [MPa].
+_REFERENCE_MODULUS = {"fib_mc2010": mc2010_reference_modulus,
+                      "eurocode2": ec2_reference_modulus}

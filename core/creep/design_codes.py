@@ -28,6 +28,7 @@ import numpy as np
 from core import limits
 from core.creep.code_formulas import (
     _FORMULAS,
+    _REFERENCE_MODULUS,
     _modulus_log_slope,
     clamp_age,
 )
@@ -121,7 +122,7 @@ class CodeCreep:
                              + ", ".join(sorted(_FORMULAS)))
         self.name = model
         self.inputs = check_inputs(model, spec, field)
-        self._reference = float(_FORMULAS[model][0](self.inputs, 28.0))
+        self._reference = float(_REFERENCE_MODULUS[model](self.inputs))
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, CodeCreep) and other.inputs == self.inputs
