@@ -32,8 +32,8 @@ when both hold: a flagged answer's check cannot be trusted); ``calibrate --stric
 exits with 4 when the fit carries a warning (``warning: calibrate: ...`` lines on
 stderr: a field not identifiable, a bound reached, the solver's error near the noise).
 Every error is one line ``error: <field>: <reason>`` on stderr; validity flags of a
-solution (for instance ``contact_lost``) and exceeded limits are reported as ``warning: <flag>: <explanation>``
-and ``warning: design_check: <line>`` lines on stderr, with exit code 0 unless
+solution (for instance ``contact_lost``) and exceeded limits are reported as
+``warning: <flag>: <explanation>`` and ``warning: design_check: <line>`` lines on stderr, with exit code 0 unless
 ``--strict``.
 """
 
