@@ -33,8 +33,8 @@ exits with 4 when the fit carries a warning (``warning: calibrate: ...`` lines o
 stderr: a field not identifiable, a bound reached, the solver's error near the noise).
 Every error is one line ``error: <field>: <reason>`` on stderr; validity flags of a
 solution (for instance ``contact_lost``) and exceeded limits are reported as
-``warning: <flag>: <explanation>`` and ``warning: design_check: <line>`` lines on stderr, with exit code 0 unless
-``--strict``.
+``warning: <flag>: <explanation>`` and ``warning: design_check: <line>`` lines on
+stderr, with exit code 0 unless ``--strict``.
 """
 
 from __future__ import annotations
