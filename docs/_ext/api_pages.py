@@ -27,6 +27,7 @@ logger = logging.getLogger(__name__)
 PACKAGES = (
     "core.scene",
     "core.study",
+    "core.calibrate",
     "core.creep",
     "core.profiles",
     "core.coating",
