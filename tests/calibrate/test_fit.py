@@ -82,6 +82,15 @@ def test_result_serialises_with_units_and_forecasts_a_band() -> None:
     json.dumps(band.to_dict(), allow_nan=False)
 
 
+def test_core_calibrate_is_the_function_even_once_the_package_is_imported() -> None:
+    import core.calibrate as package
+
+    readings = {"time": TIMES.tolist(), "settlement": _exact().settlement.tolist()}
+    fit = core.calibrate(SCENE, readings, fit=["loading.force"])
+    assert callable(package) and package.calibrate.__module__ == "core.calibrate.fit"
+    assert fit.values["loading.force"] == pytest.approx(2e5, rel=1e-6)
+
+
 def test_a_degenerate_pair_is_not_identifiable() -> None:
     # the thin coating enters through h / E alone: the readings fix the ratio only
     scene = dict(SCENE, times=TIMES.tolist())
