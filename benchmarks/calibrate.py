@@ -8,7 +8,7 @@ truth, :data:`FITS` times; the first fit of a case also prepares the geometry an
 reported apart. Cases:
 
 * *exponential creep, 3 fields*: ``base.creep.compliance``, ``base.creep.rate`` and
-  ``loading.force`` of the footing of ``tests/calibrate/test_fit.py`` (eccentric load on
+  ``loading.force`` of the footing of ``tests/back_analysis/test_fit.py`` (eccentric load on
   a layer with exponential creep), 30 settlements over a year with 1e-5 m noise;
 * *young concrete, 2 fields*: ``base.creep.relative_humidity`` and
   ``base.age_at_loading`` of the preset ``young_concrete_50_years`` (fib Model Code
@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from core.calibrate import calibrate
+from core.back_analysis import calibrate
 from core.presets import read_preset
 from core.scene import solve
 from core.study import apply_point

@@ -1,6 +1,6 @@
 """The command line ``coated-punch`` (also ``python -m core``): ``solve SCENE.json``,
 ``validate FILE`` (a scene or a study file), ``calibrate SCENE.json READINGS.csv --fit
-PATH`` (fit scene fields to measured settlements and tilts: :mod:`core.calibrate`),
+PATH`` (fit scene fields to measured settlements and tilts: :mod:`core.back_analysis`),
 ``report SCENE.json -o REPORT.pdf`` (the
 printable report, HTML or PDF: :mod:`core.report`), ``sweep STUDY.json --output
 RESULT.nc`` (a design study, see :mod:`core.study.run`), ``check SCENE.json`` (the
@@ -484,7 +484,7 @@ def _bounds(specs: Sequence[str], fit: Sequence[str]) -> dict[str, tuple[float |
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
     # imported here: the other commands do not load SciPy's optimiser
-    from core.calibrate import calibrate, read_readings, readings_from_text
+    from core.back_analysis import calibrate, read_readings, readings_from_text
 
     if args.scene == STDIO and args.readings == STDIO:
         raise _InputError("readings: the scene already reads standard input; give the "

@@ -27,7 +27,7 @@ logger = logging.getLogger(__name__)
 PACKAGES = (
     "core.scene",
     "core.study",
-    "core.calibrate",
+    "core.back_analysis",
     "core.creep",
     "core.profiles",
     "core.coating",
@@ -68,16 +68,6 @@ def _definition_docs(package: str, name: str, obj: Any) -> list[str]:
     return []
 
 
-def _exported(module: Any, name: str) -> Any:
-    """The object ``module`` exports as ``name``: a package that is callable as its own
-    function (``core.calibrate``, set on ``core`` once the package is imported) stands
-    for that function."""
-    obj = getattr(module, name)
-    if inspect.ismodule(obj) and callable(obj) and hasattr(obj, name):
-        return getattr(obj, name)
-    return obj
-
-
 def _homes() -> dict[str, str]:
     home: dict[str, str] = {}
     for package in PACKAGES:
@@ -85,7 +75,7 @@ def _homes() -> dict[str, str]:
         for name in module.__all__:
             if name.startswith("__"):
                 continue
-            obj = _exported(module, name)
+            obj = getattr(module, name)
             key = f"{getattr(obj, '__module__', package)}.{name}" if _kind(obj) != "data" \
                 else f"{package}.{name}"
             home.setdefault(key, package)
@@ -103,7 +93,7 @@ def _page(package: str, homes: dict[str, str]) -> str:
     for name in module.__all__:
         if name.startswith("__"):
             continue
-        obj = _exported(module, name)
+        obj = getattr(module, name)
         kind = _kind(obj)
         key = f"{getattr(obj, '__module__', package)}.{name}" if kind != "data" \
             else f"{package}.{name}"

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 
 import core
-from core.calibrate import readings_csv
+from core.back_analysis import readings_csv
 from core.cli import EXIT_BAD_INPUT, EXIT_FLAGGED, EXIT_OK
-from tests.calibrate.test_fit import SCENE, SETTLEMENT_STD, TIMES
+from tests.back_analysis.test_fit import SCENE, SETTLEMENT_STD, TIMES
 from tests.cli_runs import run_cli
 
 

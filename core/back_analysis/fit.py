@@ -6,7 +6,7 @@ deviations given, ``sigma_i`` is the reading's and the covariance of the fitted
 coordinates is ``(J^T J)^-1``; without them every reading of the one series weighs the
 same and the covariance is ``s^2 (J^T J)^-1`` with ``s^2 = chi^2 / (n - p)``, the
 scatter about the fit (the noise estimated from the residuals). ``J`` is the Jacobian of
-the weighted residuals by forward differences (:mod:`core.calibrate.model`).
+the weighted residuals by forward differences (:mod:`core.back_analysis.model`).
 """
 
 from __future__ import annotations
@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from core.calibrate.model import FD_STEP, FIT_SOLVER_TOL, Field, Model, fitted_fields
-from core.calibrate.readings import Readings, as_readings
-from core.calibrate.result import Calibration
+from core.back_analysis.model import FD_STEP, FIT_SOLVER_TOL, Field, Model, fitted_fields
+from core.back_analysis.readings import Readings, as_readings
+from core.back_analysis.result import Calibration
 from core.limits import MAX_FIT_SOLVES
 from core.scene import Scene, scene_from_dict
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import core
-from core.calibrate import Calibration, calibrate
+from core.back_analysis import Calibration, calibrate
 from core.limits import MAX_FIT_PARAMETERS
 from core.study import apply_point
 
@@ -82,12 +82,13 @@ def test_result_serialises_with_units_and_forecasts_a_band() -> None:
     json.dumps(band.to_dict(), allow_nan=False)
 
 
-def test_core_calibrate_is_the_function_even_once_the_package_is_imported() -> None:
-    import core.calibrate as package
+def test_core_calibrate_is_the_function_once_its_package_is_imported() -> None:
+    import core.back_analysis as package
 
     readings = {"time": TIMES.tolist(), "settlement": _exact().settlement.tolist()}
     fit = core.calibrate(SCENE, readings, fit=["loading.force"])
-    assert callable(package) and package.calibrate.__module__ == "core.calibrate.fit"
+    assert core.calibrate is package.calibrate
+    assert package.calibrate.__module__ == "core.back_analysis.fit"
     assert fit.values["loading.force"] == pytest.approx(2e5, rel=1e-6)
 
 

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from core.calibrate import read_readings, readings_csv, readings_from_csv, readings_from_mapping
+from core.back_analysis import read_readings, readings_csv, readings_from_csv, readings_from_mapping
 from core.limits import MAX_READINGS
 
 

@@ -19,13 +19,9 @@ and ``.summary()``.
 
 from __future__ import annotations
 
-import sys
-import types
-from typing import Any
-
-from core.calibrate.fit import MAX_CONDITION, MAX_SOLVER_ERROR_TO_NOISE, calibrate
-from core.calibrate.model import FD_STEP, FIT_SOLVER_TOL
-from core.calibrate.readings import (
+from core.back_analysis.fit import MAX_CONDITION, MAX_SOLVER_ERROR_TO_NOISE, calibrate
+from core.back_analysis.model import FD_STEP, FIT_SOLVER_TOL
+from core.back_analysis.readings import (
     Readings,
     read_readings,
     readings_csv,
@@ -33,7 +29,7 @@ from core.calibrate.readings import (
     readings_from_mapping,
     readings_from_text,
 )
-from core.calibrate.result import BAND_LEVEL, Calibration, Forecast
+from core.back_analysis.result import BAND_LEVEL, Calibration, Forecast
 
 __all__ = [
     "BAND_LEVEL",
@@ -51,16 +47,3 @@ __all__ = [
     "readings_from_mapping",
     "readings_from_text",
 ]
-
-
-class _CallableModule(types.ModuleType):
-    """This package, callable as :func:`calibrate`: ``core.calibrate`` is both the
-    package and the top-level function, and once the package is imported Python sets the
-    attribute ``core.calibrate`` to it, so ``core.calibrate(scene, ...)`` must work on
-    the package as well."""
-
-    def __call__(self, *args: Any, **kwargs: Any) -> Calibration:
-        return calibrate(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule

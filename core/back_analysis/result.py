@@ -12,12 +12,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from core.calibrate.readings import SERIES_UNITS, Readings
+from core.back_analysis.readings import SERIES_UNITS, Readings
 from core.scene import Scene, SceneSolution, provenance, scene_from_dict
 from core.study import apply_point
 
 if TYPE_CHECKING:
-    from core.calibrate.model import Field, Model
+    from core.back_analysis.model import Field, Model
 
 #: The default confidence level of a forecast's band.
 BAND_LEVEL = 0.95
@@ -73,7 +73,7 @@ class Forecast:
 
 @dataclass(frozen=True, eq=False)
 class Calibration:
-    """The answer of :func:`core.calibrate.calibrate`.
+    """The answer of :func:`core.back_analysis.calibrate`.
 
     ``values``, ``standard_errors`` (dicts by path, in each field's unit, the standard
     error of a log-fitted field by the delta method ``value * se(log value)``),
@@ -211,7 +211,7 @@ class Calibration:
             Values, standard deviations (delta method) and the band; one solve plus one
             per fitted field.
         """
-        from core.calibrate.model import Model
+        from core.back_analysis.model import Model
 
         if not 0 < float(level) < 1:
             raise ValueError(f"level: must be in (0, 1), got {level!r}")
