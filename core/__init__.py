@@ -12,6 +12,8 @@ The public entry points, loaded on first use (importing one subpackage, say
   units with time in days;
 - :func:`sweep`, :func:`load_study`, :func:`study_from_dict` (:mod:`core.study`): design
   studies (parameter sweeps, Monte Carlo) run on Dask;
+- :func:`calibrate` (:mod:`core.back_analysis`): back-analysis, scene fields fitted to
+  measured settlements and tilts with their standard errors and a forecast band;
 - :func:`creep_coefficient_curve` (:mod:`core.creep`): the design codes' creep laws;
 - :data:`STAGE_CACHE_BYTES`, :func:`set_stage_cache_budget`, :func:`stage_cache_bytes`
   (:mod:`core.budget`): the memory the solver's caches may hold.
@@ -27,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 from core.version import VERSION as __version__
 
 if TYPE_CHECKING:
+    from core.back_analysis import calibrate
     from core.budget import STAGE_CACHE_BYTES, set_stage_cache_budget, stage_cache_bytes
     from core.creep import creep_coefficient_curve
     from core.engines.nystrom import prepare
@@ -49,6 +52,7 @@ _EXPORTS: dict[str, str] = {
     "sweep": "core.study",
     "load_study": "core.study",
     "study_from_dict": "core.study",
+    "calibrate": "core.back_analysis",
     "STAGE_CACHE_BYTES": "core.budget",
     "set_stage_cache_budget": "core.budget",
     "stage_cache_bytes": "core.budget",
@@ -69,6 +73,7 @@ __all__ = [
     "sweep",
     "load_study",
     "study_from_dict",
+    "calibrate",
     "STAGE_CACHE_BYTES",
     "set_stage_cache_budget",
     "stage_cache_bytes",

@@ -1,5 +1,7 @@
 """The command line ``coated-punch`` (also ``python -m core``): ``solve SCENE.json``,
-``validate FILE`` (a scene or a study file), ``report SCENE.json -o REPORT.pdf`` (the
+``validate FILE`` (a scene or a study file), ``calibrate SCENE.json READINGS.csv --fit
+PATH`` (fit scene fields to measured settlements and tilts: :mod:`core.back_analysis`),
+``report SCENE.json -o REPORT.pdf`` (the
 printable report, HTML or PDF: :mod:`core.report`), ``sweep STUDY.json --output
 RESULT.nc`` (a design study, see :mod:`core.study.run`), ``check SCENE.json`` (the
 coating model against resolved finite elements) and ``schema scene|study`` (the JSON
@@ -26,17 +28,20 @@ this is checked before solving (see :mod:`core.files`).
 Exit codes: 0 success, 1 the solver failed (or an internal error), 2 bad input (an
 unreadable, oversized or invalid file, or bad arguments), and with ``solve --strict``: 3
 a limit of the design check is exceeded, 4 the answer carries a validity flag (4 wins
-when both hold: a flagged answer's check cannot be trusted). Every error is one line
-``error: <field>: <reason>`` on stderr; validity flags of a solution (for instance
-``contact_lost``) and exceeded limits are reported as ``warning: <flag>: <explanation>``
-and ``warning: design_check: <line>`` lines on stderr, with exit code 0 unless
-``--strict``.
+when both hold: a flagged answer's check cannot be trusted); ``calibrate --strict``
+exits with 4 when the fit carries a warning (``warning: calibrate: ...`` lines on
+stderr: a field not identifiable, a bound reached, the solver's error near the noise).
+Every error is one line ``error: <field>: <reason>`` on stderr; validity flags of a
+solution (for instance ``contact_lost``) and exceeded limits are reported as
+``warning: <flag>: <explanation>`` and ``warning: design_check: <line>`` lines on
+stderr, with exit code 0 unless ``--strict``.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import shutil
 import sys
 from collections.abc import Iterator, Sequence
@@ -457,6 +462,82 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _bounds(specs: Sequence[str], fit: Sequence[str]) -> dict[str, tuple[float | None,
+                                                                         float | None]]:
+    """``--bound PATH=LOW,HIGH`` options as a mapping (an empty end is no bound)."""
+    out: dict[str, tuple[float | None, float | None]] = {}
+    for spec in specs:
+        path, sep, pair = spec.partition("=")
+        ends = pair.split(",")
+        if not sep or len(ends) != 2:
+            raise _InputError(f"--bound: {spec!r} is not PATH=LOW,HIGH (either end may be "
+                              "empty)")
+        try:
+            lo, hi = (float(e) if e.strip() else None for e in ends)
+        except ValueError:
+            raise _InputError(f"--bound: {spec!r}: the ends must be numbers") from None
+        if path.strip() not in fit:
+            raise _InputError(f"--bound: {path.strip()!r} is not one of the --fit fields")
+        out[path.strip()] = (lo, hi)
+    return out
+
+
+def _cmd_calibrate(args: argparse.Namespace) -> int:
+    # imported here: the other commands do not load SciPy's optimiser
+    from core.back_analysis import calibrate, read_readings, readings_from_text
+
+    if args.scene == STDIO and args.readings == STDIO:
+        raise _InputError("readings: the scene already reads standard input; give the "
+                          "readings as a file")
+    output = Path(args.output) if args.output else None
+    _check_outputs(args.scene, [("--output", output)])
+    if output is not None and str(output) != STDIO and args.readings != STDIO \
+            and same_file(output, args.readings):
+        raise _InputError(f"--output: {output} is the readings file; it is not "
+                          "overwritten (choose another file)")
+    scene = _read(args.scene)
+    with _input_errors(args.readings):
+        readings = readings_from_text(_stdin_text(), STDIN_NAME) \
+            if args.readings == STDIO else read_readings(args.readings)
+    bounds = _bounds(args.bound or [], args.fit)
+    try:
+        fit = calibrate(scene, readings, fit=args.fit, bounds=bounds)
+        forecast = fit.forecast({"end": args.forecast, "count": args.forecast_count,
+                                 "spacing": "log"}) if args.forecast else None
+    except ValueError as exc:
+        message = str(exc)
+        if message.startswith(("fit", "bounds", "measurements", "scene", "settlement",
+                               "tilt", "time", "times")):
+            raise _InputError(message) from None
+        print(f"error: calibrate: {_one_line(message)}", file=sys.stderr)
+        return EXIT_SOLVER_FAILED
+    except (ArithmeticError, RuntimeError, MemoryError, NotImplementedError) as exc:
+        print(f"error: calibrate: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_SOLVER_FAILED
+    summary = fit.summary()
+    if forecast is not None:
+        lower, upper = forecast.band("settlement")
+        summary += (f"\nforecast at {forecast.times[-1]:g} days: settlement "
+                    f"{forecast.settlement[-1]:.6g} m, {100 * forecast.level:g} % band "
+                    f"[{lower[-1]:.6g}, {upper[-1]:.6g}] m (from the fitted fields' "
+                    "uncertainty)")
+    if output is None or str(output) != STDIO:
+        print("\n".join(line for line in summary.splitlines()
+                        if not line.startswith("warning: ")))
+    if output is not None:
+        data = fit.to_dict()
+        if forecast is not None:
+            data["forecast"] = forecast.to_dict()
+        _write(output, json.dumps(data, indent=1, allow_nan=False) + "\n")
+    for warning in fit.warnings:
+        print(f"warning: calibrate: {_one_line(warning)}", file=sys.stderr)
+    if args.strict and fit.warnings:
+        print(f"error: strict: the fit carries {len(fit.warnings)} warning(s); exit code "
+              f"{EXIT_FLAGGED}", file=sys.stderr)
+        return EXIT_FLAGGED
+    return EXIT_OK
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     scene = _read(args.scene)
     end = float(scene.times[-1])
@@ -506,7 +587,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "'coated-punch schema scene' prints the JSON Schema.")
     parser.add_argument("--version", action="version", version=f"coated-punch {VERSION}")
     sub = parser.add_subparsers(dest="command",
-                                metavar="{solve,validate,report,sweep,check,schema}",
+                                metavar="{solve,validate,report,sweep,calibrate,check,schema}",
                                 parser_class=_Parser)
     sub.required = True
     p_solve = sub.add_parser("solve", help="solve a scene and write the result")
@@ -577,6 +658,33 @@ def build_parser() -> argparse.ArgumentParser:
                               "each)")
     p_sweep.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     p_sweep.set_defaults(run=_cmd_sweep)
+    p_cal = sub.add_parser("calibrate", help="fit scene fields to measured settlements and "
+                                             "tilts (back-analysis) and forecast them")
+    p_cal.add_argument("scene", help="scene file (JSON), '-' (standard input) or "
+                                     "preset:NAME; its values start the fit")
+    p_cal.add_argument("readings", help="readings file: CSV (time [day], settlement [m], "
+                                        "tilt [rad], optional *_std columns, units in the "
+                                        "header) or JSON; '-' reads standard input")
+    p_cal.add_argument("--fit", action="append", required=True, metavar="PATH",
+                       help="a scene field to fit, by its path (coating[0].modulus, "
+                            "base.creep.relative_humidity, base.age_at_loading, ...); "
+                            "repeat for more")
+    p_cal.add_argument("--bound", action="append", metavar="PATH=LOW,HIGH",
+                       help="bounds of a fitted field in its unit (an empty end is none)")
+    p_cal.add_argument("--forecast", type=float, metavar="DAYS",
+                       help="also forecast the settlement and tilt to this many days after "
+                            "loading with a 95 %% band (written with --output)")
+    p_cal.add_argument("--forecast-count", type=int, default=100, metavar="N",
+                       help="log-spaced times of the forecast (default 100)")
+    p_cal.add_argument("--output", "-o", metavar="PATH",
+                       help="write the fit as JSON (fields, standard errors, correlation, "
+                            "residuals, the fitted scene, the forecast); '-' writes to "
+                            "standard output")
+    p_cal.add_argument("--strict", action="store_true",
+                       help=f"exit with {EXIT_FLAGGED} when the fit carries a warning (a "
+                            "field not identifiable, a bound reached, the solver's error "
+                            "near the noise)")
+    p_cal.set_defaults(run=_cmd_calibrate)
     p_check = sub.add_parser("check", help="model error of the fast answer against a "
                                            "resolved finite-element model of the coating")
     p_check.add_argument("scene", help="scene file (JSON) or preset:NAME")

@@ -103,3 +103,19 @@ MAX_PRESSURE_VALUES = 4_000_000
 #: The slowest of 10,000 generated valid scenes took 0.7 s, the presets with 2000 output
 #: times at most 11 s; a creep lift-off driven by a sine tilt ran 600 s without it.
 MAX_SOLVE_CPU_SECONDS = 60.0
+
+# ----------------------------------------------------------------------------- back-analysis
+
+#: Most readings of one back-analysis (``core.calibrate``): every reading time is an
+#: output time of each solve of the fit, so a scene's output times bound it.
+MAX_READINGS = MAX_SCENE_TIMES
+#: Largest readings file (CSV or JSON) [bytes]: 2000 rows of five numbers are ~100 kB.
+MAX_READINGS_BYTES = 1_000_000
+#: Most scene fields fitted at once: every iteration of the fit solves the scene once per
+#: fitted field (the finite-difference Jacobian), and a record of settlements and tilts
+#: rarely determines more than a few; a study varies at most as many.
+MAX_FIT_PARAMETERS = 8
+#: Most solves of one fit (its iterations times the fitted fields plus one, and the
+#: Jacobian at the answer). Each solve is bounded by :data:`MAX_SOLVE_CPU_SECONDS`; a fit
+#: of three fields to 30 readings of the shipped young-concrete scene takes ~20 solves.
+MAX_FIT_SOLVES = 400

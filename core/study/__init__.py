@@ -15,14 +15,31 @@ returns an xarray Dataset (netCDF, CSV, parquet).
 
 from __future__ import annotations
 
-from core.study.definition import Study, load_study, numeric_fields, study_from_dict
+from core.study.definition import (
+    FIELD_UNITS,
+    FIXED_ROOTS,
+    Study,
+    apply_point,
+    field_unit,
+    get_field,
+    load_study,
+    numeric_fields,
+    parse_path,
+    study_from_dict,
+)
 from core.study.json_schema import study_json_schema
 from core.study.run import check_output, sweep
 
 __all__ = [
+    "apply_point",
     "check_output",
+    "FIELD_UNITS",
+    "field_unit",
+    "FIXED_ROOTS",
+    "get_field",
     "load_study",
     "numeric_fields",
+    "parse_path",
     "Study",
     "study_from_dict",
     "study_json_schema",

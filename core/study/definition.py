@@ -65,6 +65,15 @@ DISTRIBUTIONS = ("normal", "lognormal", "uniform")
 #: Whole subtrees a study may not vary: the output times are the study's own axis, and
 #: the design-check limits do not change an answer.
 FIXED_ROOTS = ("schema_version", "name", "description", "times", "limits")
+#: Units of the numeric scene fields, by the last name of their path (the units of a
+#: varied or fitted field; the design codes' creep inputs are in the codes' units).
+FIELD_UNITS: dict[str, str] = {
+    "half_width": "m", "thickness": "m", "modulus": "Pa", "modulus_final": "Pa",
+    "poisson": "1", "age_at_loading": "day", "force": "N/m", "moment": "N",
+    "settlement": "m", "tilt": "rad", "tol": "1", "rate": "1/day", "compliance": "1/Pa",
+    "compliance_final": "1/Pa", "aging": "day/Pa", "relative_humidity": "%",
+    "notional_size": "mm", "temperature": "degC",
+}
 #: One part of a field path: a name and its list items (``coating[0]``).
 PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d{1,4}\])*)")
 
@@ -176,6 +185,12 @@ def get_field(scene: Mapping[str, Any], path: str) -> Any:
             raise ValueError(f"{path}: no such field in the scene (no {part!r})")
         node = node[part]
     return node
+
+
+def field_unit(path: str) -> str:
+    """The unit of the scene field at ``path`` (:data:`FIELD_UNITS`; "" when unknown)."""
+    last = path.rsplit(".", 1)[-1].split("[", 1)[0]
+    return FIELD_UNITS.get(last, "")
 
 
 def apply_point(scene: Mapping[str, Any], values: Mapping[str, float]) -> dict[str, Any]:

@@ -54,7 +54,7 @@ from core.files import atomic_write_text
 from core.optional import import_optional
 from core.scene import FLAG_MESSAGES
 from core.study.batch import run_batch
-from core.study.definition import OUTPUT_UNITS, Study, load_study
+from core.study.definition import OUTPUT_UNITS, Study, field_unit, load_study
 from core.study.plan import PLAN_ORDER, BatchPlan, batch_plan
 from core.study.points import StudyPoints, point_table
 from core.version import VERSION
@@ -74,12 +74,6 @@ BATCHES_IN_FLIGHT_PER_THREAD = 3
 #: Known flags, each recorded as a boolean per point.
 FLAG_NAMES = tuple(FLAG_MESSAGES)
 _MANIFEST_FORMAT = "coated-punch study parts"
-# units of the varied fields, by the last name of their path
-_FIELD_UNITS = {"half_width": "m", "thickness": "m", "modulus": "Pa", "modulus_final": "Pa",
-                "poisson": "1", "age_at_loading": "day", "force": "N/m", "moment": "N",
-                "settlement": "m", "tilt": "rad", "tol": "1", "rate": "1/day",
-                "compliance": "1/Pa", "compliance_final": "1/Pa", "aging": "day/Pa"}
-
 
 class StudyInterrupted(RuntimeError):
     """A study stopped before its end (cancelled); what was finished is in the work
@@ -390,10 +384,9 @@ def study_dataset(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[i
                               "time": ("time", np.asarray(study.times),
                                        {"units": "day", "long_name": "time after loading"})}
     for p in study.parameters:
-        last = p.path.rsplit(".", 1)[-1]
         coords[_variable_name(p.path)] = ("point", table[p.path],
                                           {"field": p.path, "kind": p.kind,
-                                           "units": _FIELD_UNITS.get(last, "")})
+                                           "units": field_unit(p.path)})
     coords["sample"] = ("point", table["sample"], {"long_name": "index of the random draw"})
     variables: dict[str, Any] = {}
     for j, name in enumerate(study.outputs):

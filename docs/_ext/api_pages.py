@@ -27,6 +27,7 @@ logger = logging.getLogger(__name__)
 PACKAGES = (
     "core.scene",
     "core.study",
+    "core.back_analysis",
     "core.creep",
     "core.profiles",
     "core.coating",

@@ -1,0 +1,329 @@
+"""The fit: weighted nonlinear least squares of the scene's settlements and tilts to the
+readings, and the uncertainty of the fitted fields from the Jacobian.
+
+The residual of reading ``i`` is ``(model_i - reading_i) / sigma_i``. With standard
+deviations given, ``sigma_i`` is the reading's and the covariance of the fitted
+coordinates is ``(J^T J)^-1``; without them every reading of the one series weighs the
+same and the covariance is ``s^2 (J^T J)^-1`` with ``s^2 = chi^2 / (n - p)``, the
+scatter about the fit (the noise estimated from the residuals). ``J`` is the Jacobian of
+the weighted residuals by forward differences (:mod:`core.back_analysis.model`).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from core.back_analysis.model import FD_STEP, FIT_SOLVER_TOL, Field, Model, fitted_fields
+from core.back_analysis.readings import Readings, as_readings
+from core.back_analysis.result import Calibration
+from core.limits import MAX_FIT_SOLVES
+from core.scene import Scene, scene_from_dict
+
+#: A fit whose normalised Jacobian has a condition number above this does not determine
+#: every field: along the weakest direction the readings pin a combination ~1000 times
+#: less well than along the strongest (a correlation of 0.999998 between two fields). An
+#: exactly degenerate pair (coating thickness and modulus, whose ratio alone matters)
+#: measures ~1e4 and more, set by the finite differences' own error.
+MAX_CONDITION = 1e3
+#: Pairs more correlated than this are named in a warning, even when identifiable.
+STRONG_CORRELATION = 0.99
+#: The solver's error must be this far below the noise (as a fraction of the smallest
+#: standard deviation, or of the scatter about the fit), or the fit says so.
+MAX_SOLVER_ERROR_TO_NOISE = 0.1
+#: A coordinate this close to a bound (in the fit's coordinates) is at the bound.
+BOUND_CLOSENESS = 1e-6
+#: Residual vector of a point whose scene is invalid: large, so that the trust region
+#: shrinks away from it, finite, so that the least-squares solver goes on.
+_INVALID_RESIDUAL = 1e8
+#: Stopping tolerances of the least-squares solver on the fit's coordinates (relative)
+#: and on the cost: a change of 1e-8 in a log coordinate is 1e-8 of the field, far below
+#: any standard error a record of readings gives.
+X_TOL = 1e-8
+F_TOL = 1e-10
+
+
+def _working_scene(scene: Scene | Mapping[str, Any], readings: Readings) -> tuple[dict, dict]:
+    """The canonical scene dict and the dict solved by the fit: the readings' times as
+    output times and the solver tolerance at most :data:`FIT_SOLVER_TOL`."""
+    try:
+        base = scene_from_dict(scene).to_dict()
+    except ValueError as exc:
+        raise ValueError(f"scene: {exc}") from None
+    work = dict(base)
+    work["times"] = [float(t) for t in readings.time]
+    solver = dict(work.get("solver", {}))
+    solver["tol"] = min(float(solver.get("tol", FIT_SOLVER_TOL)), FIT_SOLVER_TOL)
+    work["solver"] = solver
+    try:
+        scene_from_dict(work)
+    except ValueError as exc:
+        raise ValueError(f"measurements: the scene cannot be solved at the reading times "
+                         f"({exc})") from None
+    return base, work
+
+
+def _weights(readings: Readings) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+    """The readings stacked as the model's values are (``mask`` picks those given), their
+    ``sigma`` and whether those are the readings' standard deviations."""
+    series = readings.series
+    given = readings.has_std
+    if len(series) > 1 and not given:
+        missing = next(f"{name}_std" for name in series
+                       if getattr(readings, f"{name}_std") is None)
+        raise ValueError(f"{missing}: required when both settlements and tilts are fitted "
+                         "(without standard deviations the weight of metres against "
+                         "radians is unknown)")
+    y = np.concatenate([getattr(readings, name) for name in series])
+    mask = np.isfinite(y)
+    if given:
+        sigma = np.concatenate([getattr(readings, f"{name}_std") for name in series])
+    else:
+        # one series, equal weights: the scale cancels in s^2 (J^T J)^-1; the largest
+        # reading keeps the residuals of order one for the solver's tolerances
+        scale = float(np.max(np.abs(y[mask]))) or 1.0
+        sigma = np.full(y.shape, scale)
+    return y, mask, sigma, given
+
+
+def calibrate(scene: Scene | Mapping[str, Any],
+              measurements: Readings | Mapping[str, Any] | str | os.PathLike,
+              fit: Sequence[str], bounds: Mapping[str, Sequence[float | None]] | None = None,
+              ) -> Calibration:
+    """Fit scene fields to measured settlements and tilts (back-analysis).
+
+    Parameters
+    ----------
+    scene : Scene or dict
+        The scene; its values of the fitted fields are the start of the fit.
+    measurements : str, path, mapping or Readings
+        A readings file (CSV or JSON, format in ``core/SCENES.md``) or a mapping with
+        ``time`` [day after loading] and ``settlement`` [m] and/or ``tilt`` [rad] (lists),
+        optionally ``settlement_std`` [m] / ``tilt_std`` [rad] (lists or one number).
+    fit : list of str
+        The scene paths of the fitted fields (``coating[0].modulus``,
+        ``base.creep.relative_humidity``, ``base.age_at_loading``, ``loading.force``...).
+    bounds : dict, optional
+        ``path -> (low, high)`` in the field's unit, either end None for none. A field
+        positive at the start and not allowed below zero is fitted by its logarithm.
+
+    Returns
+    -------
+    Calibration
+        ``.values`` and ``.standard_errors`` (dicts by path), ``.correlation``, the
+        residuals, ``chi2_per_dof``, ``.warnings``, ``.scene`` (the fitted scene) and
+        ``.forecast(times)``.
+
+    Raises
+    ------
+    ValueError
+        For bad input, naming the field (``fit[0]: ...``, ``readings.csv: line 4, column
+        tilt: ...``), or when the scene cannot be solved at the start.
+    """
+    started = time.perf_counter()
+    readings = as_readings(measurements)
+    base, work = _working_scene(scene, readings)
+    fields = fitted_fields(base, fit, bounds)
+    y, mask, sigma, std_given = _weights(readings)
+    n, p = int(mask.sum()), len(fields)
+    if n <= p:
+        raise ValueError(f"measurements: {n} reading(s) cannot determine {p} field(s); give "
+                         "more readings than fitted fields")
+    model = Model(work, fields, readings.series)
+    x0 = np.array([f.to_x(f.start) for f in fields])
+    lo = np.array([f.x_bounds[0] for f in fields])
+    hi = np.array([f.x_bounds[1] for f in fields])
+    try:
+        f_start = model.values(x0)
+    except ValueError as exc:
+        raise ValueError(f"scene: cannot be solved at the start of the fit ({exc})") from None
+
+    def residuals(x: np.ndarray) -> np.ndarray:
+        try:
+            values = model.values(x)
+        except ValueError:
+            return np.full(n, _INVALID_RESIDUAL)
+        return ((values - y) / sigma)[mask]
+
+    def jacobian(x: np.ndarray) -> np.ndarray:
+        centre = model.values(x)
+        return model.jacobian(x, centre)[mask] / sigma[mask, None]
+
+    # each evaluation of the residuals is a solve and each Jacobian p more
+    max_nfev = max(1, MAX_FIT_SOLVES // (p + 1))
+    answer = least_squares(residuals, x0, jac=jacobian, bounds=(lo, hi), method="trf",
+                           x_scale=1.0, xtol=X_TOL, ftol=F_TOL, gtol=F_TOL,
+                           max_nfev=max_nfev)
+    x = answer.x
+    solution = model.solve(x)
+    values_fit = model.values(x)
+    J = jacobian(x)
+    r = ((values_fit - y) / sigma)[mask]
+    chi2 = float(r @ r)
+    dof = n - p
+    s2 = 1.0 if std_given else chi2 / dof
+    warnings: list[str] = []
+    if not answer.success:
+        warnings.append(f"the least-squares solver stopped without converging "
+                        f"({answer.message})")
+    cov_x, condition = _covariance(J, s2)
+    warnings += _identifiability(fields, cov_x, condition, x, lo, hi)
+    ratio = _solver_error_to_noise(solution, readings, sigma, mask, math.sqrt(s2))
+    if ratio > MAX_SOLVER_ERROR_TO_NOISE:
+        warnings.append(f"the solver's error estimate is {ratio:.2g} of the noise (more "
+                        f"than {MAX_SOLVER_ERROR_TO_NOISE:g}): the standard errors reflect "
+                        "the solver as much as the readings (tighten solver.tol, or the "
+                        "readings fit the model to within its numerical error)")
+    if std_given and dof > 0:
+        warnings += _chi2_check(chi2, dof)
+    h = model.steps(x)
+    unresolved = _step_check(fields, J * sigma[mask, None] * h, solution, readings, mask,
+                             float(work["solver"]["tol"]))
+    warnings += unresolved
+    unidentified = tuple(f.path for f in fields
+                         if any(w.startswith(f.path + ":") or
+                                (w.startswith("not identifiable") and f.path in w)
+                                for w in warnings))
+    residual = values_fit - y
+    return Calibration(
+        fields=fields, x=x, cov_x=cov_x, readings=readings, base=base, work=work,
+        predicted=_split(values_fit, readings), residuals=_split(
+            np.where(mask, residual, np.nan), readings),
+        start_residuals=_split(np.where(mask, f_start - y, np.nan), readings),
+        chi2=chi2, dof=dof, std_given=std_given, noise_scale=math.sqrt(s2),
+        condition=condition, solver_error_to_noise=ratio, warnings=tuple(warnings),
+        unidentified=unidentified,
+        solves=model.solves, seconds=time.perf_counter() - started,
+        iterations=int(answer.nfev), status=str(answer.message), model=model,
+        sigma=sigma,
+    )
+
+
+def _split(vector: np.ndarray, readings: Readings) -> dict[str, np.ndarray]:
+    """A stacked vector as one array per series."""
+    m = readings.time.size
+    return {name: vector[k * m:(k + 1) * m] for k, name in enumerate(readings.series)}
+
+
+def _covariance(J: np.ndarray, s2: float) -> tuple[np.ndarray, float]:
+    """``s^2 (J^T J)^-1`` by the singular values of J (a pseudo-inverse where J is
+    singular: the covariance is then as large as the finite differences allow), and the
+    condition number of J with its columns scaled to unit length."""
+    norms = np.linalg.norm(J, axis=0)
+    safe = np.where(norms > 0, norms, 1.0)
+    _, sv, vt = np.linalg.svd(J / safe, full_matrices=False)
+    condition = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+    tiny = sv[0] * np.finfo(float).eps * max(J.shape)
+    inv = np.where(sv > tiny, 1.0 / np.where(sv > tiny, sv, 1.0) ** 2, np.inf)
+    with np.errstate(invalid="ignore"):
+        cov_n = (vt.T * np.where(np.isfinite(inv), inv, 1.0 / tiny ** 2)) @ vt
+    cov = s2 * cov_n / np.outer(safe, safe)
+    cov[:, norms == 0] = np.inf
+    cov[norms == 0, :] = np.inf
+    return cov, condition
+
+
+def _identifiability(fields: Sequence[Field], cov: np.ndarray, condition: float,
+                     x: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> list[str]:
+    """Warnings of fields the readings do not determine."""
+    out = []
+    if not condition <= MAX_CONDITION:
+        se = np.sqrt(np.abs(np.diag(cov)))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            corr = cov / np.outer(se, se)
+        names = [f.path for f in fields]
+        worst = [names[j] for j in range(len(fields))
+                 if not np.isfinite(se[j])
+                 or any(abs(corr[j, k]) > STRONG_CORRELATION for k in range(len(fields))
+                        if k != j)]
+        which = ", ".join(worst or names)
+        out.append(f"not identifiable: the readings determine only a combination of "
+                   f"{which} (condition number {condition:.3g} of the scaled Jacobian, "
+                   f"above {MAX_CONDITION:g}); fix all but one of them, or add readings "
+                   "that separate them")
+    else:
+        se = np.sqrt(np.diag(cov))
+        corr = cov / np.outer(se, se)
+        for j in range(len(fields)):
+            for k in range(j + 1, len(fields)):
+                if abs(corr[j, k]) > STRONG_CORRELATION:
+                    out.append(f"{fields[j].path} and {fields[k].path} are strongly "
+                               f"correlated ({corr[j, k]:+.4f}): their standard errors "
+                               "hold only jointly")
+    for j, f in enumerate(fields):
+        for end, name in ((lo[j], "lower"), (hi[j], "upper")):
+            if math.isfinite(end) and abs(x[j] - end) <= BOUND_CLOSENESS * (1 + abs(end)):
+                out.append(f"{f.path}: ended at its {name} bound "
+                           f"({f.bounds[0 if name == 'lower' else 1]:.6g} {f.unit}): the "
+                           "readings push it beyond, so it is not identified within the "
+                           "bounds and its standard error does not hold")
+        if f.log and math.sqrt(abs(cov[j, j])) > 1.0:
+            out.append(f"{f.path}: poorly determined (its standard error exceeds a factor "
+                       "e = 2.7 either way)")
+    return out
+
+
+def _solver_error_to_noise(solution: Any, readings: Readings, sigma: np.ndarray,
+                           mask: np.ndarray, noise_scale: float) -> float:
+    """The solver's estimated error of each series [its unit] over the smallest noise
+    of that series (the standard deviations times the scatter factor), the larger."""
+    estimate = float(solution.info.get("error_estimate") or 0.0)
+    m = readings.time.size
+    ratio = 0.0
+    for k, name in enumerate(readings.series):
+        part = slice(k * m, (k + 1) * m)
+        size = float(np.max(np.abs(getattr(solution, name))))
+        noise = float(np.min(sigma[part][mask[part]])) * noise_scale
+        if noise == 0:
+            return math.inf
+        ratio = max(ratio, estimate * size / noise)
+    return ratio
+
+
+def _chi2_check(chi2: float, dof: int) -> list[str]:
+    """A warning when the scatter about the fit does not match the stated deviations
+    (chi^2 outside its two-sided 99.9 % range for ``dof`` degrees of freedom)."""
+    from scipy.stats import chi2 as chi2_dist
+
+    low, high = chi2_dist.ppf([0.0005, 0.9995], dof)
+    if low <= chi2 <= high:
+        return []
+    side = "larger" if chi2 > high else "smaller"
+    return [f"chi^2/dof = {chi2 / dof:.3g}: the scatter about the fit is {side} than the "
+            f"stated standard deviations allow (99.9 % range {low / dof:.3g} to "
+            f"{high / dof:.3g}); the model misses the readings, or the deviations are "
+            "wrong"]
+
+
+def _step_check(fields: Sequence[Field], changes: np.ndarray, solution: Any,
+                readings: Readings, mask: np.ndarray, tol: float) -> list[str]:
+    """Warnings of fields whose finite-difference step changes no reading by more than
+    100 times the solver's tolerance ``tol`` (relative): their derivative would be mostly
+    the solver's error (``changes``: the step's change of each given reading, in SI
+    units). The error estimate itself is no measure here: on the design codes' creep it
+    is the exponential fit of the creep kernel, ~1e-5, an error that moves smoothly with
+    the fields (the derivatives of the shipped young-concrete scene agree to 1e-5 for
+    steps from 1e-4 to 1e-6)."""
+    m = readings.time.size
+    parts, offset = [], 0
+    for k, name in enumerate(readings.series):
+        count = int(mask[k * m:(k + 1) * m].sum())
+        size = float(np.max(np.abs(getattr(solution, name))))
+        parts.append((offset, offset + count, size))
+        offset += count
+    out = []
+    for j, f in enumerate(fields):
+        if not any(np.max(np.abs(changes[a:b, j]), initial=0.0) > 100 * tol * size
+                   for a, b, size in parts):
+            out.append(f"{f.path}: a step of {FD_STEP:g} in its "
+                       f"{'logarithm' if f.log else 'value over its scale'} changes no "
+                       "reading by more than 100 times the solver's tolerance: the "
+                       "readings hardly depend on it, or its derivative is the solver's "
+                       "error")
+    return out

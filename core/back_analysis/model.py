@@ -1,0 +1,221 @@
+"""The fitted fields and the scene's answer as a function of them.
+
+:class:`Fitted` maps each fitted scene field to the coordinate the fit moves (its
+logarithm for a positive field, else the value over a scale); :class:`Model` solves the
+working scene at a point of those coordinates and returns the settlements and tilts at
+the reading times, with forward-difference derivatives. Every solve goes through
+:func:`core.scene.solve`, whose stage caches keep the prepared geometry: a point that
+changes only loads or creep parameters re-uses the quadrature, the operator and its
+modes, and pays for the time stepping alone.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from core.limits import MAX_FIT_PARAMETERS
+from core.scene import Scene, SceneSolution, replace_loads, scene_from_dict, solve
+from core.study import FIXED_ROOTS, apply_point, field_unit, get_field, parse_path
+from core.validation import finite_number, show_value
+
+#: Step of the forward differences in the fit's coordinates: 1e-3 of the logarithm is a
+#: 0.1 % change of a positive field. The settlement then moves by ~1e-4..1e-3 of itself,
+#: three orders above the working tolerance :data:`FIT_SOLVER_TOL`, so the solver's
+#: error is ~1e-3 of a derivative; a larger step costs accuracy in the curvature term
+#: (relative error of the derivative about half the step).
+FD_STEP = 1e-3
+#: The solver tolerance of the fit's solves (the scene's own when tighter): the error
+#: estimate of the shipped young-concrete scene stays ~1.6e-5 (the creep kernel's fit)
+#: and its answers move by 1e-9 relative between tol 1e-4 and 1e-8, so the solves'
+#: error is far below any derivative the steps above measure.
+FIT_SOLVER_TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class Field:
+    """One fitted scene field: its ``path``, ``start`` value, whether the fit moves its
+    logarithm (``log``) or its value over ``scale``, and its ``bounds`` (values)."""
+
+    path: str
+    start: float
+    log: bool
+    scale: float
+    bounds: tuple[float, float]
+    unit: str
+
+    def to_x(self, value: float) -> float:
+        """The fit's coordinate of ``value``."""
+        return math.log(value) if self.log else value / self.scale
+
+    def to_value(self, x: float) -> float:
+        """The field's value at coordinate ``x``."""
+        return math.exp(x) if self.log else x * self.scale
+
+    @property
+    def x_bounds(self) -> tuple[float, float]:
+        """The bounds in the fit's coordinate (a log field's bound 0 is -inf)."""
+        lo, hi = self.bounds
+        if self.log:
+            return (math.log(lo) if lo > 0 else -math.inf,
+                    math.log(hi) if math.isfinite(hi) else math.inf)
+        return (lo / self.scale, hi / self.scale)
+
+
+def _bound_pair(spec: Any, field: str) -> tuple[float, float]:
+    if isinstance(spec, (str, bytes, Mapping)) or not isinstance(spec, Sequence) \
+            or len(spec) != 2:
+        raise ValueError(f"{field}: must be a pair (low, high), either may be None, got "
+                         f"{show_value(spec)}")
+    lo = -math.inf if spec[0] is None else finite_number(spec[0], f"{field}[0]")
+    hi = math.inf if spec[1] is None else finite_number(spec[1], f"{field}[1]")
+    if not hi > lo:
+        raise ValueError(f"{field}: high ({show_value(hi)}) must exceed low "
+                         f"({show_value(lo)})")
+    return lo, hi
+
+
+def fitted_fields(base: Mapping[str, Any], fit: Any, bounds: Any) -> tuple[Field, ...]:
+    """The fitted fields of the scene dict ``base`` (canonical form): ``fit`` their
+    paths, ``bounds`` an optional mapping ``path -> (low, high)``. A field positive at
+    the start and not allowed below zero is fitted by its logarithm. ValueError naming
+    ``fit[i]`` or ``bounds[path]``."""
+    if isinstance(fit, str):
+        fit = [fit]
+    if not isinstance(fit, (list, tuple)) or not 1 <= len(fit) <= MAX_FIT_PARAMETERS:
+        raise ValueError(f"fit: must be a list of 1 to {MAX_FIT_PARAMETERS} scene field "
+                         "paths (e.g. ['coating[0].modulus']), got "
+                         + (str(len(fit)) if isinstance(fit, (list, tuple))
+                            else show_value(fit)))
+    bounds = {} if bounds is None else bounds
+    if not isinstance(bounds, Mapping):
+        raise ValueError(f"bounds: must map a fitted path to (low, high), got "
+                         f"{show_value(bounds)}")
+    for path in bounds:
+        if path not in fit:
+            raise ValueError(f"bounds[{path}]: not one of the fitted fields "
+                             f"({', '.join(map(str, fit))})")
+    fields = []
+    for i, path in enumerate(fit):
+        parts = parse_path(path, f"fit[{i}]")
+        if parts[0] in FIXED_ROOTS:
+            raise ValueError(f"fit[{i}]: {path!r} cannot be fitted (not a number of the "
+                             "model: output times, names and design limits)")
+        if path in fit[:i]:
+            raise ValueError(f"fit[{i}]: {path!r} is fitted twice")
+        try:
+            start = get_field(base, path)
+        except ValueError as exc:
+            raise ValueError(f"fit[{i}]: {exc}") from None
+        if isinstance(start, bool) or not isinstance(start, (int, float)):
+            raise ValueError(f"fit[{i}]: {path!r} holds {show_value(start)} in the scene, "
+                             "not a number; fit a number inside it (for a profile object, "
+                             "e.g. '.value')")
+        start = float(start)
+        lo, hi = _bound_pair(bounds[path], f"bounds[{path}]") if path in bounds \
+            else (-math.inf, math.inf)
+        if not lo <= start <= hi:
+            raise ValueError(f"bounds[{path}]: the scene's value {start:.6g} (the start "
+                             f"of the fit) is outside [{lo:.6g}, {hi:.6g}]")
+        log = start > 0 and (lo >= 0 or path not in bounds)
+        if log:
+            lo = max(lo, 0.0)
+            if start == lo:
+                raise ValueError(f"bounds[{path}]: the start {start:.6g} is at the lower "
+                                 "bound; start inside the bounds")
+            scale = 1.0
+        elif start != 0:
+            scale = abs(start)
+        elif math.isfinite(hi - lo):
+            scale = (hi - lo) / 2
+        else:
+            raise ValueError(f"bounds[{path}]: the start is 0, which gives the field no "
+                             "scale; give finite bounds (low, high)")
+        fields.append(Field(path, start, log, scale, (lo, hi), field_unit(path)))
+    return tuple(fields)
+
+
+class Model:
+    """The readings the working scene predicts as a function of the fit's coordinates.
+
+    ``work`` is the scene dict solved (its times are those asked for), ``fields`` the
+    fitted fields. :meth:`solve` answers one point (a :class:`SceneSolution`);
+    :meth:`values` the settlements and tilts (``series``) stacked in one vector;
+    :meth:`jacobian` their forward differences. ``solves`` counts the solves.
+    """
+
+    def __init__(self, work: Mapping[str, Any], fields: Sequence[Field],
+                 series: Sequence[str]) -> None:
+        self.work = dict(work)
+        self.fields = tuple(fields)
+        self.series = tuple(series)
+        self.solves = 0
+        self._cache: dict[tuple[float, ...], SceneSolution] = {}
+        given = set(work.get("loading", {}))
+        loads = [f.path.split(".", 1)[1] for f in fields
+                 if f.path.startswith("loading.") and f.path.count(".") == 1]
+        # a fit of given loads alone re-uses one validated scene (only the loads are
+        # checked again), as a study's load batch does
+        self._load_names = loads if len(loads) == len(fields) and set(loads) <= given \
+            else None
+        self._scene: Scene | None = None
+
+    def values_at(self, x: Sequence[float]) -> dict[str, float]:
+        """The field values at coordinates ``x``."""
+        return {f.path: f.to_value(float(v)) for f, v in zip(self.fields, x, strict=True)}
+
+    def scene_dict(self, x: Sequence[float]) -> dict[str, Any]:
+        """The working scene dict at ``x``."""
+        return apply_point(self.work, self.values_at(x))
+
+    def solve(self, x: Sequence[float]) -> SceneSolution:
+        """The answer at ``x`` (the last few are kept: the fit asks twice for a point)."""
+        key = tuple(float(v) for v in x)
+        if key in self._cache:
+            return self._cache[key]
+        if self._load_names is not None:
+            if self._scene is None:
+                self._scene = scene_from_dict(self.work)
+            values = self.values_at(x)
+            scene = replace_loads(self._scene, {name: values[f"loading.{name}"]
+                                                for name in self._load_names})
+        else:
+            scene = scene_from_dict(self.scene_dict(x))
+        result = solve(scene)
+        self.solves += 1
+        if len(self._cache) >= 2 * len(self.fields) + 4:
+            self._cache.pop(next(iter(self._cache)))
+        self._cache[key] = result
+        return result
+
+    def values(self, x: Sequence[float]) -> np.ndarray:
+        """The settlements [m] then the tilts [rad] at every output time, stacked."""
+        result = self.solve(x)
+        return np.concatenate([np.asarray(getattr(result, name), dtype=float)
+                               for name in self.series])
+
+    def steps(self, x: Sequence[float]) -> np.ndarray:
+        """The signed forward-difference step of each coordinate at ``x``: backward where
+        a forward step would cross the upper bound."""
+        h = np.full(len(self.fields), FD_STEP)
+        for j, f in enumerate(self.fields):
+            if x[j] + h[j] > f.x_bounds[1]:
+                h[j] = -h[j]
+        return h
+
+    def jacobian(self, x: Sequence[float], centre: np.ndarray | None = None) -> np.ndarray:
+        """The forward differences of :meth:`values` at ``x``, a column per field
+        (``centre``: the values at ``x`` when known)."""
+        x = np.asarray(x, dtype=float)
+        f0 = self.values(x) if centre is None else centre
+        h = self.steps(x)
+        columns = []
+        for j in range(len(x)):
+            xj = x.copy()
+            xj[j] += h[j]
+            columns.append((self.values(xj) - f0) / h[j])
+        return np.column_stack(columns)

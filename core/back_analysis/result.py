@@ -1,0 +1,313 @@
+"""The answer of a back-analysis (:class:`Calibration`) and its forecast with a band
+(:class:`Forecast`), each with a JSON-able ``to_dict()`` carrying units and a short text
+summary."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from core.back_analysis.readings import SERIES_UNITS, Readings
+from core.scene import Scene, SceneSolution, provenance, scene_from_dict
+from core.study import apply_point
+
+if TYPE_CHECKING:
+    from core.back_analysis.model import Field, Model
+
+#: The default confidence level of a forecast's band.
+BAND_LEVEL = 0.95
+
+
+def _jsonable_array(values: np.ndarray) -> list[float | None]:
+    return [None if not math.isfinite(v) else float(v) for v in np.asarray(values, float)]
+
+
+@dataclass(frozen=True, eq=False)
+class Forecast:
+    """The fitted scene's settlement [m] and tilt [rad] at ``times`` [day after loading]
+    with their standard deviations from the fitted fields' covariance (linearised: the
+    delta method, the gradient by the fit's finite differences) and the band
+    ``value -/+ z std`` of confidence ``level`` (normal quantile ``z``). The band is the
+    uncertainty of the fitted fields alone: not the model's error nor the scatter of
+    future readings."""
+
+    times: np.ndarray
+    settlement: np.ndarray
+    tilt: np.ndarray
+    settlement_std: np.ndarray
+    tilt_std: np.ndarray
+    level: float
+    solution: SceneSolution = field(repr=False)
+
+    @property
+    def z(self) -> float:
+        """The normal quantile of the band's two-sided ``level``."""
+        from scipy.stats import norm
+
+        return float(norm.ppf(0.5 + self.level / 2))
+
+    def band(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """The lower and upper edge of the band of ``settlement`` or ``tilt``."""
+        value, std = getattr(self, name), getattr(self, f"{name}_std")
+        return value - self.z * std, value + self.z * std
+
+    def to_dict(self) -> dict[str, Any]:
+        """The forecast as JSON-able lists with units."""
+        out: dict[str, Any] = {"times": self.times.tolist(), "level": self.level}
+        for name in SERIES_UNITS:
+            lower, upper = self.band(name)
+            out |= {name: _jsonable_array(getattr(self, name)),
+                    f"{name}_std": _jsonable_array(getattr(self, f"{name}_std")),
+                    f"{name}_lower": _jsonable_array(lower),
+                    f"{name}_upper": _jsonable_array(upper)}
+        out["units"] = {"times": "day (after loading)",
+                        **{f"{name}{suffix}": unit for name, unit in SERIES_UNITS.items()
+                           for suffix in ("", "_std", "_lower", "_upper")}}
+        return out
+
+
+@dataclass(frozen=True, eq=False)
+class Calibration:
+    """The answer of :func:`core.back_analysis.calibrate`.
+
+    ``values``, ``standard_errors`` (dicts by path, in each field's unit, the standard
+    error of a log-fitted field by the delta method ``value * se(log value)``),
+    ``correlation`` (rows and columns in the order of ``paths``), ``residuals`` (model
+    minus reading per series, NaN where a row has none), ``chi2``, ``dof`` and
+    ``chi2_per_dof``, ``warnings`` (not identifiable, a bound reached, the solver's error
+    near the noise, ...), ``scene`` (the fitted scene, with the original output times)
+    and :meth:`forecast`. ``std_given`` says which covariance: ``(J^T J)^-1`` with the
+    readings' standard deviations, else ``s^2 (J^T J)^-1`` with ``s^2 = chi^2 / dof``.
+    """
+
+    fields: tuple[Field, ...]
+    x: np.ndarray
+    cov_x: np.ndarray
+    readings: Readings
+    base: dict
+    work: dict
+    predicted: dict[str, np.ndarray]
+    residuals: dict[str, np.ndarray]
+    start_residuals: dict[str, np.ndarray]
+    chi2: float
+    dof: int
+    std_given: bool
+    noise_scale: float
+    condition: float
+    solver_error_to_noise: float
+    warnings: tuple[str, ...]
+    unidentified: tuple[str, ...]
+    solves: int
+    seconds: float
+    iterations: int
+    status: str
+    model: Model = field(repr=False)
+    sigma: np.ndarray = field(repr=False)
+
+    @property
+    def paths(self) -> tuple[str, ...]:
+        """The fitted fields' paths, in the order given."""
+        return tuple(f.path for f in self.fields)
+
+    @property
+    def values(self) -> dict[str, float]:
+        """The fitted values by path, in each field's unit."""
+        return self.model.values_at(self.x)
+
+    @property
+    def start(self) -> dict[str, float]:
+        """The scene's values of the fitted fields (the start of the fit)."""
+        return {f.path: f.start for f in self.fields}
+
+    @property
+    def units(self) -> dict[str, str]:
+        """The unit of each fitted field ("" when the field has none recorded)."""
+        return {f.path: f.unit for f in self.fields}
+
+    @cached_property
+    def _derivative(self) -> np.ndarray:
+        """d value / d coordinate of each field at the answer."""
+        return np.array([f.to_value(v) if f.log else f.scale
+                         for f, v in zip(self.fields, self.x, strict=True)])
+
+    @cached_property
+    def covariance(self) -> np.ndarray:
+        """The covariance of the fitted values (linearised) [unit_i * unit_j]."""
+        d = self._derivative
+        return self.cov_x * np.outer(d, d)
+
+    @property
+    def standard_errors(self) -> dict[str, float]:
+        """The standard error of each fitted value by path, in the field's unit."""
+        se = np.sqrt(np.abs(np.diag(self.covariance)))
+        return {f.path: float(s) for f, s in zip(self.fields, se, strict=True)}
+
+    @property
+    def correlation(self) -> np.ndarray:
+        """The correlation of the fitted values (the order of :attr:`paths`)."""
+        se = np.sqrt(np.abs(np.diag(self.cov_x)))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            corr = self.cov_x / np.outer(se, se)
+        np.fill_diagonal(corr, 1.0)
+        return corr
+
+    @property
+    def chi2_per_dof(self) -> float:
+        """chi^2 over the degrees of freedom (readings minus fitted fields): near 1 when
+        the stated standard deviations match the scatter; the squared scatter in units of
+        the largest reading when no deviations are given."""
+        return self.chi2 / self.dof
+
+    @property
+    def identifiable(self) -> bool:
+        """Whether the readings determine every field: none is in :attr:`unidentified`
+        (a combination of fields not identifiable, a bound reached, a standard error
+        beyond a factor e, no resolved influence on the readings)."""
+        return not self.unidentified
+
+    @property
+    def noise(self) -> dict[str, float]:
+        """The noise the standard errors assume: per series, the standard deviation of
+        a reading [its unit] (the median of those given, or the scatter about the fit)."""
+        out = {}
+        m = self.readings.time.size
+        for k, name in enumerate(self.readings.series):
+            sigma = self.sigma[k * m:(k + 1) * m]
+            given = np.isfinite(getattr(self.readings, name))
+            out[name] = float(np.median(sigma[given])) * self.noise_scale
+        return out
+
+    @cached_property
+    def scene(self) -> Scene:
+        """The fitted scene: the scene given, the fitted values set (its own times and
+        solver settings)."""
+        return scene_from_dict(apply_point(self.base, self.values))
+
+    @property
+    def solution(self) -> SceneSolution:
+        """The fitted scene's answer at the reading times (the fit's solver tolerance)."""
+        return self.model.solve(self.x)
+
+    def forecast(self, times: Sequence[float] | np.ndarray | Mapping[str, Any],
+                 level: float = BAND_LEVEL) -> Forecast:
+        """The fitted scene's settlement and tilt at ``times`` with a band.
+
+        Parameters
+        ----------
+        times : list of float or dict
+            Days after loading (strictly increasing, >= 0), or a scene's ``times``
+            object (``{"end": 18262.5, "count": 100, "spacing": "log"}``).
+        level : float
+            Confidence of the band, in (0, 1).
+
+        Returns
+        -------
+        Forecast
+            Values, standard deviations (delta method) and the band; one solve plus one
+            per fitted field.
+        """
+        from core.back_analysis.model import Model
+
+        if not 0 < float(level) < 1:
+            raise ValueError(f"level: must be in (0, 1), got {level!r}")
+        if not isinstance(times, Mapping):
+            times = [float(t) for t in np.asarray(times, dtype=float).ravel()]
+        work = dict(self.work)
+        work["times"] = times
+        try:
+            scene_from_dict(work)
+        except ValueError as exc:
+            msg = str(exc)
+            raise ValueError(msg if msg.startswith("times") else f"times: {msg}") from None
+        model = Model(work, self.fields, tuple(SERIES_UNITS))
+        centre = model.values(self.x)
+        gradient = model.jacobian(self.x, centre)
+        var = np.einsum("ij,jk,ik->i", gradient, self.cov_x, gradient)
+        std = np.sqrt(np.maximum(var, 0.0))
+        solution = model.solve(self.x)
+        m = solution.times.size
+        return Forecast(np.asarray(solution.times, dtype=float), centre[:m], centre[m:],
+                        std[:m], std[m:], float(level), solution)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fit as JSON-able data with units: the fields (start, value, standard
+        error, bounds, unit), the correlation, the readings with the fitted values and
+        residuals, the goodness of fit, the warnings, the fitted scene and the
+        provenance (program version, scene, solver settings)."""
+        se = self.standard_errors
+        fields = [{"path": f.path, "unit": f.unit, "start": f.start,
+                   "value": self.values[f.path], "standard_error": se[f.path],
+                   "bounds": [f.bounds[0] if math.isfinite(f.bounds[0]) else None,
+                              f.bounds[1] if math.isfinite(f.bounds[1]) else None],
+                   "fitted_as": "log" if f.log else "linear"} for f in self.fields]
+        readings = self.readings.to_dict()
+        for name in self.readings.series:
+            readings[f"{name}_fitted"] = _jsonable_array(self.predicted[name])
+            readings[f"{name}_residual"] = _jsonable_array(self.residuals[name])
+            readings["units"] |= {f"{name}_fitted": SERIES_UNITS[name],
+                                  f"{name}_residual": SERIES_UNITS[name]}
+        corr = self.correlation
+        return {
+            **provenance(self.scene),
+            "fields": fields,
+            "correlation": [[None if not math.isfinite(v) else float(v) for v in row]
+                            for row in corr],
+            "goodness_of_fit": {
+                "chi2": self.chi2, "dof": self.dof, "chi2_per_dof": self.chi2_per_dof,
+                "covariance": "(J^T J)^-1, the readings' standard deviations"
+                if self.std_given else "s^2 (J^T J)^-1, s^2 = chi2/dof (noise estimated "
+                                       "from the residuals)",
+                "noise": self.noise,
+                "condition_number": self.condition if math.isfinite(self.condition)
+                else None,
+                "solver_error_to_noise": self.solver_error_to_noise
+                if math.isfinite(self.solver_error_to_noise) else None,
+                "identifiable": self.identifiable,
+                "unidentified": list(self.unidentified),
+            },
+            "readings": readings,
+            "warnings": list(self.warnings),
+            "work": {"solves": self.solves, "seconds": self.seconds,
+                     "evaluations": self.iterations, "status": self.status,
+                     "solver_tol": self.work["solver"]["tol"]},
+            "fitted_scene": self.scene.to_dict(),
+        }
+
+    def summary(self) -> str:
+        """A short text summary: each field's value and standard error, the goodness of
+        fit and the warnings."""
+        se = self.standard_errors
+        width = max(len(p) for p in self.paths)
+        n = self.readings.count
+        lines = [f"fitted {len(self.fields)} field(s) to {n} reading(s) "
+                 f"({', '.join(self.readings.series)}) in {self.solves} solves, "
+                 f"{self.seconds:.2f} s"]
+        for f in self.fields:
+            value = self.values[f.path]
+            rel = se[f.path] / abs(value) if value else math.inf
+            lines.append(f"  {f.path:<{width}} = {value:.6g} +/- {se[f.path]:.2g} "
+                         f"{f.unit}".rstrip() + f"  ({100 * rel:.2g} %, start "
+                         f"{f.start:.6g})")
+        if len(self.fields) > 1:
+            corr = self.correlation
+            pairs = [f"{self.paths[j]} ~ {self.paths[k]}: {corr[j, k]:+.3f}"
+                     for j in range(len(self.fields)) for k in range(j + 1, len(self.fields))]
+            lines.append("correlations: " + "; ".join(pairs))
+        noise = ", ".join(f"{name} {v:.3g} {SERIES_UNITS[name]}"
+                          for name, v in self.noise.items())
+        lines.append(f"chi^2/dof = {self.chi2_per_dof:.3g} ({self.dof} dof); noise "
+                     f"{'given' if self.std_given else 'estimated from the residuals'}: "
+                     f"{noise}; solver error / noise = {self.solver_error_to_noise:.2g}")
+        for name in self.readings.series:
+            rms = float(np.sqrt(np.nanmean(self.residuals[name] ** 2)))
+            lines.append(f"rms residual of {name}: {rms:.3g} {SERIES_UNITS[name]}")
+        lines.extend(f"warning: {w}" for w in self.warnings)
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.summary()

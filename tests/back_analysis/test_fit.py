@@ -1,0 +1,157 @@
+"""The back-analysis: exact readings give the exact fields, a degenerate pair is reported
+as not identifiable, and the stated standard errors hold in ~95 % of noise draws."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import core
+from core.back_analysis import Calibration, calibrate
+from core.limits import MAX_FIT_PARAMETERS
+from core.study import apply_point
+
+#: A footing on a creeping layer (exponential creep, eccentric load): its solves take
+#: ~15 ms once the geometry is prepared, so a fit of three fields takes ~0.3 s.
+SCENE = {
+    "schema_version": 1, "name": "Footing on a creeping layer",
+    "punch": {"half_width": 1.0, "shape": 0.0},
+    "coating": [{"thickness": 0.02, "modulus": 2e8, "poisson": 0.3}],
+    "base": {"thickness": 4.0, "poisson": 0.3, "age_at_loading": 28.0,
+             "creep": {"model": "exponential", "modulus": 3e8, "compliance": 3e-9,
+                       "rate": 0.02}},
+    "loading": {"force": 2e5, "moment": 2e4},
+    "times": {"end": 3650.0, "count": 50},
+    "solver": {"tol": 1e-6},
+}
+TRUTH = {"base.creep.compliance": 3e-9, "base.creep.rate": 0.02, "loading.force": 2e5}
+TIMES = np.linspace(365 / 30, 365, 30)
+#: Noise of the synthetic readings: ~1 % of the settlement (1.3 mm) and of the tilt.
+SETTLEMENT_STD = 1e-5
+TILT_STD = 1e-6
+
+
+def _exact() -> core.SceneSolution:
+    scene = apply_point(SCENE, TRUTH)
+    scene["times"] = TIMES.tolist()
+    return core.solve(scene)
+
+
+def test_exact_readings_give_the_exact_fields() -> None:
+    exact = _exact()
+    start = apply_point(SCENE, {path: 1.3 * v for path, v in TRUTH.items()})
+    fit = calibrate(start, {"time": TIMES.tolist(), "settlement": exact.settlement.tolist()},
+                    fit=list(TRUTH))
+    assert isinstance(fit, Calibration)
+    # measured: relative errors below 1e-11 (the readings are the working scene's
+    # answers, so only the least-squares tolerance X_TOL = 1e-8 bounds them)
+    for path, value in TRUTH.items():
+        assert fit.values[path] == pytest.approx(value, rel=1e-7)
+    # the residuals are at the solver's level: the fit says its errors are the solver's
+    assert any("solver's error estimate" in w for w in fit.warnings)
+    assert fit.scene.to_dict()["base"]["creep"]["rate"] == pytest.approx(0.02, rel=1e-7)
+    assert fit.scene.to_dict()["times"]["end"] == 3650.0  # the scene's own times
+
+
+def test_result_serialises_with_units_and_forecasts_a_band() -> None:
+    exact = _exact()
+    rng = np.random.default_rng(7)
+    readings = {"time": TIMES.tolist(),
+                "settlement": (exact.settlement
+                               + SETTLEMENT_STD * rng.standard_normal(TIMES.size)).tolist(),
+                "settlement_std": SETTLEMENT_STD,
+                "tilt": (exact.tilt + TILT_STD * rng.standard_normal(TIMES.size)).tolist(),
+                "tilt_std": TILT_STD}
+    fit = calibrate(SCENE, readings, fit=["base.creep.compliance", "base.creep.rate"],
+                    bounds={"base.creep.rate": (1e-3, 1.0)})
+    assert fit.identifiable and fit.std_given
+    d = json.loads(json.dumps(fit.to_dict(), allow_nan=False))
+    assert d["fields"][1]["unit"] == "1/day" and d["fields"][1]["bounds"] == [1e-3, 1.0]
+    assert d["readings"]["units"]["tilt_residual"] == "rad"
+    assert set(fit.standard_errors) == set(fit.values) == set(fit.paths)
+    assert fit.correlation.shape == (2, 2)
+    assert "base.creep.rate" in fit.summary()
+    band = fit.forecast([0.0, 365.0, 3650.0])
+    assert band.times.tolist() == [0.0, 365.0, 3650.0]
+    lower, upper = band.band("settlement")
+    assert np.all(lower <= band.settlement) and np.all(band.settlement <= upper)
+    # the creep at ten years is extrapolated: its band is wider than at loading
+    assert band.settlement_std[-1] > band.settlement_std[0]
+    json.dumps(band.to_dict(), allow_nan=False)
+
+
+def test_core_calibrate_is_the_function_once_its_package_is_imported() -> None:
+    import core.back_analysis as package
+
+    readings = {"time": TIMES.tolist(), "settlement": _exact().settlement.tolist()}
+    fit = core.calibrate(SCENE, readings, fit=["loading.force"])
+    assert core.calibrate is package.calibrate
+    assert package.calibrate.__module__ == "core.back_analysis.fit"
+    assert fit.values["loading.force"] == pytest.approx(2e5, rel=1e-6)
+
+
+def test_a_degenerate_pair_is_not_identifiable() -> None:
+    # the thin coating enters through h / E alone: the readings fix the ratio only
+    scene = dict(SCENE, times=TIMES.tolist())
+    exact = core.solve(scene)
+    start = apply_point(SCENE, {"coating[0].modulus": 3e8})
+    fit = calibrate(start, {"time": TIMES.tolist(), "settlement": exact.settlement.tolist()},
+                    fit=["coating[0].thickness", "coating[0].modulus"])
+    assert not fit.identifiable
+    assert any(w.startswith("not identifiable") for w in fit.warnings), fit.warnings
+    assert set(fit.unidentified) == {"coating[0].thickness", "coating[0].modulus"}
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"fit": ["coating[3].modulus"]}, "fit[0]: coating[3].modulus: no such field"),
+    ({"fit": ["name"]}, "fit[0]: 'name' cannot be fitted"),
+    ({"fit": ["base.creep.model"]}, "fit[0]: 'base.creep.model' holds 'exponential'"),
+    ({"fit": ["loading.force", "loading.force"]}, "fit[1]: 'loading.force' is fitted twice"),
+    ({"fit": ["loading.force"] * (MAX_FIT_PARAMETERS + 1)}, "fit: must be a list of 1 to 8"),
+    ({"fit": ["loading.force"], "bounds": {"loading.force": (3e5, 4e5)}},
+     "bounds[loading.force]: the scene's value 200000 (the start of the fit) is outside"),
+    ({"fit": ["loading.force"], "bounds": {"loading.moment": (0, 1)}},
+     "bounds[loading.moment]: not one of the fitted fields"),
+    ({"fit": ["loading.force"], "bounds": {"loading.force": (5, 1)}},
+     "bounds[loading.force]: high (1) must exceed low (5)"),
+])
+def test_bad_fits_are_named(kwargs: dict, message: str) -> None:
+    readings = {"time": [10.0, 20.0, 30.0], "settlement": [1e-3, 1.1e-3, 1.2e-3]}
+    with pytest.raises(ValueError) as info:
+        calibrate(SCENE, readings, **kwargs)
+    assert str(info.value).startswith(message), str(info.value)
+
+
+def test_both_series_need_their_deviations() -> None:
+    with pytest.raises(ValueError, match="^tilt_std: required when both"):
+        calibrate(SCENE, {"time": [1.0, 2.0, 3.0], "settlement": [1e-3] * 3,
+                          "settlement_std": 1e-4, "tilt": [1e-4] * 3}, fit=["loading.force"])
+
+
+@pytest.mark.slow
+def test_standard_errors_cover_the_truth_in_95_percent_of_draws() -> None:
+    # 200 noise draws of settlements and tilts with stated deviations; each fit starts at
+    # the truth (what is tested is the spread of the answers, not the way there). A
+    # nominal 95 % interval covers in 95 % +/- 1.5 % (binomial, 200 draws): the accepted
+    # [90 %, 99 %] is -3.2 and +2.6 of those. Measured: 0.98 and 0.95 (37 s wall on the
+    # shared machine).
+    exact = _exact()
+    rng = np.random.default_rng(20261129)
+    paths = ["base.creep.compliance", "base.creep.rate"]
+    hits = np.zeros(len(paths))
+    draws = 200
+    for _ in range(draws):
+        readings = {
+            "time": TIMES.tolist(),
+            "settlement": (exact.settlement
+                           + SETTLEMENT_STD * rng.standard_normal(TIMES.size)).tolist(),
+            "settlement_std": SETTLEMENT_STD,
+            "tilt": (exact.tilt + TILT_STD * rng.standard_normal(TIMES.size)).tolist(),
+            "tilt_std": TILT_STD}
+        fit = calibrate(SCENE, readings, fit=paths)
+        for j, path in enumerate(paths):
+            hits[j] += abs(fit.values[path] - TRUTH[path]) <= 1.96 * fit.standard_errors[path]
+    coverage = hits / draws
+    assert np.all((0.90 <= coverage) & (coverage <= 0.99)), coverage

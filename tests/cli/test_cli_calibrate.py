@@ -1,0 +1,74 @@
+"""``python -m core calibrate``: a fit written as JSON with its forecast, one-line errors
+naming the row and column of a bad reading, and ``--strict`` on a warning."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+import core
+from core.back_analysis import readings_csv
+from core.cli import EXIT_BAD_INPUT, EXIT_FLAGGED, EXIT_OK
+from tests.back_analysis.test_fit import SCENE, SETTLEMENT_STD, TIMES
+from tests.cli_runs import run_cli
+
+
+def _files(tmp_path: Path, noise: float = SETTLEMENT_STD) -> tuple[Path, Path]:
+    scene = tmp_path / "scene.json"
+    scene.write_text(json.dumps(SCENE))
+    exact = core.solve(dict(SCENE, times=TIMES.tolist()))
+    rng = np.random.default_rng(3)
+    readings = tmp_path / "readings.csv"
+    readings.write_text(readings_csv({
+        "time": TIMES.tolist(),
+        "settlement": (exact.settlement + noise * rng.standard_normal(TIMES.size)).tolist(),
+        "settlement_std": [noise] * TIMES.size}))
+    return scene, readings
+
+
+def test_calibrate_writes_the_fit_and_its_forecast(tmp_path: Path) -> None:
+    scene, readings = _files(tmp_path)
+    out = tmp_path / "fit.json"
+    proc = run_cli("calibrate", scene, readings, "--fit", "base.creep.compliance",
+                   "--fit", "base.creep.rate", "--bound", "base.creep.rate=1e-3,",
+                   "--forecast", "3650", "--forecast-count", "20", "--output", out,
+                   cwd=tmp_path)
+    assert proc.returncode == EXIT_OK, proc.stderr
+    assert "base.creep.rate" in proc.stdout and "chi^2/dof" in proc.stdout
+    d = json.loads(out.read_text())
+    assert [f["path"] for f in d["fields"]] == ["base.creep.compliance", "base.creep.rate"]
+    assert d["fields"][1]["bounds"] == [1e-3, None]
+    assert len(d["forecast"]["times"]) == 20 and d["forecast"]["units"]["settlement"] == "m"
+    assert d["fitted_scene"]["base"]["creep"]["rate"] == d["fields"][1]["value"]
+
+
+def test_a_bad_reading_is_one_line_naming_row_and_column(tmp_path: Path) -> None:
+    scene, readings = _files(tmp_path)
+    lines = readings.read_text().splitlines()
+    lines[3], lines[4] = lines[4], lines[3]
+    readings.write_text("\n".join(lines) + "\n")
+    proc = run_cli("calibrate", scene, readings, "--fit", "loading.force", cwd=tmp_path)
+    assert proc.returncode == EXIT_BAD_INPUT
+    assert proc.stderr.startswith(f"error: {readings}: line 5, column time:"), proc.stderr
+    assert len(proc.stderr.splitlines()) == 1
+
+
+def test_bad_fit_and_bound_arguments(tmp_path: Path) -> None:
+    scene, readings = _files(tmp_path)
+    proc = run_cli("calibrate", scene, readings, "--fit", "coating[2].modulus", cwd=tmp_path)
+    assert proc.returncode == EXIT_BAD_INPUT
+    assert proc.stderr.startswith("error: fit[0]: coating[2].modulus: no such field")
+    proc = run_cli("calibrate", scene, readings, "--fit", "loading.force", "--bound",
+                   "loading.moment=0,1", cwd=tmp_path)
+    assert proc.returncode == EXIT_BAD_INPUT
+    assert proc.stderr.startswith("error: --bound: 'loading.moment' is not one of the")
+
+
+def test_strict_fails_on_a_warning(tmp_path: Path) -> None:
+    scene, readings = _files(tmp_path)
+    proc = run_cli("calibrate", scene, readings, "--fit", "coating[0].thickness", "--fit",
+                   "coating[0].modulus", "--strict", "--output", tmp_path / "f.json", cwd=tmp_path)
+    assert proc.returncode == EXIT_FLAGGED, proc.stderr
+    assert "warning: calibrate: not identifiable" in proc.stderr
