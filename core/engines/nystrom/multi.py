@@ -1,0 +1,315 @@
+"""Several rigid punches on one foundation: the default engine's grids, coupled.
+
+Design (dimensionless, elastic base, full contact):
+
+- **Lengths.** Each punch ``p`` keeps its own scaling, that of a single punch of its
+  half-width ``a_p`` (:mod:`core.scene.dimensionless`): ``x*_p = (x - e_p) / a_p``,
+  ``lam_p = a_p / H``, ``delta*_p = delta_p / a_p``, ``P*_p = 2 (1 - nu^2) P_p / (E a_p)``,
+  ``M*_p = 2 (1 - nu^2) M_p / (E a_p^2)`` with ``e_p`` its centre. The dimensionless
+  pressure ``q* = 2 (1 - nu^2) q / E`` does not depend on ``a_p``, so it is one field over
+  all zones. The common length between punches is the base thickness ``H``: punch ``p``
+  covers ``[E_p - lam_p, E_p + lam_p]`` with ``E_p = e_p / H``.
+- **Equations.** Divided by ``a_p``, the surface displacement on zone ``p`` reads
+
+      c m_p q_p + F_p q_p + sum_{r != p} (lam_r / lam_p) F_r q_r (x_r)
+          = delta_p + alpha_p x - g_p(x),     x_r = (E_p + lam_p x - E_r) / lam_r,
+
+  where ``F_r`` is punch ``r``'s own operator ``int k_pl(lam_r (x - xi)) q(xi) dxi / pi``
+  evaluated at the points ``x_r`` of zone ``p`` written in ``r``'s coordinates (outside
+  ``[-1, 1]``), and ``int q_p = P_p``, ``int x q_p = M_p`` on each zone.
+- **Grids.** Each punch has the graded, adaptively refined grid of a single punch of
+  its own geometry (:func:`core.engines.nystrom.prepared_for`, cached: two identical
+  punches share one), so each self block is exactly the single-punch operator.
+- **Coupling blocks.** Rows of ``F_r`` at the nodes of zone ``p`` mapped into ``r``'s
+  coordinates (:meth:`PreparedContact.rows`, i.e. :func:`core.discretize.operator_rows`):
+  between disjoint intervals the kernel is smooth and the 16-point Gauss rule of the
+  source panel is used, except where a target lies within ``NEAR_FIELD`` half-widths of a
+  source panel (two punches close against their panel sizes), where the engine's product
+  integration of the log part takes over. A block whose zones are further apart than
+  :data:`NEGLIGIBLE_GAP` base thicknesses is left out: ``k_pl(s)`` decays like
+  ``exp(-2.106 s)`` (model notes), ``|k_pl(s)| < 2 exp(-2.106 s)`` for ``s >= 5`` (measured
+  on 5-40 by quadrature of the kernel: at most 1.4 exp(-2.106 s)), below 1e-16 beyond 18.
+- **Bordered system.** Unknowns ``[q_1 .. q_n; two scalars per punch]``; rows: the nodal
+  equations of every zone, then force and moment balance of every punch. It is factored
+  once per (statements, ``c``) and solved for a unit value of each given load of each
+  punch and for the gaps together: loads that change in time, or a load change, are a
+  combination of those columns (one small matrix product).
+- **Between the nodes** q comes from the equation itself (the Nystrom formula) with the
+  coupling rows at the points asked for: exact in ``m`` and ``g`` at jumps, as for one punch.
+- **Error estimate.** Each punch's grid carries the two-grid estimate of its own
+  adaptive refinement (``spatial_error``); the coupling adds to zone ``p`` a drive that is
+  smooth on it (analytic where the zones are apart), which the grid's interior panels
+  resolve like the ``1, x`` drives the estimate was made with. The estimate of a punch is
+  its grid's; the scene's the largest. The tests measure it against refined answers.
+
+Creep, a modulus varying in time and lift-off are not coupled here (refused by the
+scene, :mod:`core.scene.punches`).
+"""
+
+from __future__ import annotations
+
+import threading
+import time as _time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import lu_factor, lu_solve
+
+from core.cache import StageCache, fingerprint
+from core.engines.nystrom.prepared import (
+    HISTORY_SAMPLES,
+    PreparedContact,
+    geometry_key,
+    prepared_for,
+)
+from core.engines.nystrom.result import TimeSide, nystrom_solution
+from core.problem import QUANTITIES, ContactSolution, Geometry, TimeInputs
+
+#: Zones further apart than this many base thicknesses are not coupled (see the notes:
+#: 2 exp(-2.106 * 18) = 1.1e-16).
+NEGLIGIBLE_GAP = 18.0
+
+
+@dataclass(frozen=True)
+class PunchGeometry:
+    """One punch of a coupled problem: its own validated ``geometry`` (``lam = a/H``,
+    ``m``, ``g``, jumps and ``tol`` in its coordinates ``x* = (x - e)/a``) and its centre
+    ``center = e / H`` (base thicknesses)."""
+
+    geometry: Geometry
+    center: float
+
+    @property
+    def span(self) -> tuple[float, float]:
+        """The zone in base thicknesses, ``(E - lam, E + lam)``."""
+        lam = self.geometry.lam
+        return (self.center - lam, self.center + lam)
+
+
+def coupled_x(source: PunchGeometry, target: PunchGeometry, x: np.ndarray) -> np.ndarray:
+    """Points ``x`` of ``target``'s coordinates written in ``source``'s."""
+    return (target.center + target.geometry.lam * x - source.center) / source.geometry.lam
+
+
+class CoupledPunches:
+    """The coupled discretization of several punches (see the module notes).
+
+    ``punches``: the punches in the order of the answer; ``prepared``: each one's grid
+    (:class:`PreparedContact`); ``blocks[p][r]``: the coupling block (N_p, N_r) of ``r``
+    on ``p``'s nodes, or None when negligible.
+    """
+
+    def __init__(self, punches: Sequence[PunchGeometry]) -> None:
+        t0 = _time.perf_counter()
+        self.punches = tuple(punches)
+        self.prepared: tuple[PreparedContact, ...] = tuple(
+            prepared_for(p.geometry) for p in self.punches)
+        self.sizes = [pc.grid.size for pc in self.prepared]
+        self.offsets = np.concatenate([[0], np.cumsum(self.sizes)]).astype(int)
+        n = len(self.punches)
+        self.blocks: list[list[np.ndarray | None]] = [[None] * n for _ in range(n)]
+        for p in range(n):
+            for r in range(n):
+                if p != r and self.coupled(p, r):
+                    self.blocks[p][r] = self.coupling_rows(p, r, self.prepared[p].grid.nodes)
+        self._systems: dict[tuple, tuple[tuple, np.ndarray, list[str]]] = {}
+        self._lock = threading.Lock()
+        self.seconds = _time.perf_counter() - t0
+
+    def coupled(self, p: int, r: int) -> bool:
+        """Whether zones ``p`` and ``r`` are close enough to act on each other."""
+        (lo_p, hi_p), (lo_r, hi_r) = self.punches[p].span, self.punches[r].span
+        return max(lo_p, lo_r) - min(hi_p, hi_r) < NEGLIGIBLE_GAP
+
+    def coupling_rows(self, p: int, r: int, x: np.ndarray) -> np.ndarray:
+        """``(lam_r / lam_p) F_r`` at points ``x`` of zone ``p`` (len(x), N_r)."""
+        source, target = self.punches[r], self.punches[p]
+        mapped = np.ascontiguousarray(coupled_x(source, target, np.asarray(x, dtype=float)))
+        scale = source.geometry.lam / target.geometry.lam
+        return scale * self.prepared[r].rows(mapped)
+
+    @property
+    def nbytes(self) -> int:
+        """Memory of the coupling blocks and the factored systems [bytes] (the grids are
+        counted by :data:`core.engines.nystrom.PREPARED`)."""
+        blocks = sum(b.nbytes for row in self.blocks for b in row if b is not None)
+        return int(blocks + sum(lu[0].nbytes + units.nbytes
+                                for lu, units, _ in self._systems.values()))
+
+    @property
+    def size(self) -> int:
+        """Nodes of all zones."""
+        return int(self.offsets[-1])
+
+    # ------------------------------------------------------------------ bordered
+
+    def _system(self, givens: tuple[frozenset[str], ...], c: float
+                ) -> tuple[tuple, np.ndarray, list[str]]:
+        """LU of the bordered matrix and its unit responses (nodes + 2 n, K): columns named
+        ``"p:quantity"`` for every given load of every punch, then ``"gap"``."""
+        key = (givens, c)
+        with self._lock:
+            found = self._systems.get(key)
+        if found is not None:
+            return found
+        n_p = len(self.punches)
+        n = self.size
+        total = n + 2 * n_p
+        matrix = np.zeros((total, total))
+        names: list[str] = []
+        rhs_columns: list[np.ndarray] = []
+        gap = np.zeros(total)
+        for p, prepared in enumerate(self.prepared):
+            grid = prepared.grid
+            lo, hi = self.offsets[p], self.offsets[p + 1]
+            block = matrix[lo:hi, lo:hi]
+            block[...] = grid.operator
+            block.flat[::hi - lo + 1] += c * grid.m
+            for r in range(n_p):
+                coupling = self.blocks[p][r]
+                if coupling is not None:
+                    matrix[lo:hi, self.offsets[r]:self.offsets[r + 1]] = coupling
+            force_row, moment_row = n + 2 * p, n + 2 * p + 1
+            matrix[force_row, lo:hi] = grid.panels.weights
+            matrix[moment_row, lo:hi] = grid.panels.weights * grid.nodes
+            unknown = [q for q in QUANTITIES if q not in givens[p]]
+            for k, name in enumerate(unknown):
+                column = n + 2 * p + k
+                if name == "settlement":
+                    matrix[lo:hi, column] = -1.0
+                elif name == "tilt":
+                    matrix[lo:hi, column] = -grid.nodes
+                else:
+                    matrix[force_row if name == "force" else moment_row, column] = -1.0
+            for name in sorted(givens[p]):
+                column = np.zeros(total)
+                if name == "settlement":
+                    column[lo:hi] = 1.0
+                elif name == "tilt":
+                    column[lo:hi] = grid.nodes
+                else:
+                    column[force_row if name == "force" else moment_row] = 1.0
+                names.append(f"{p}:{name}")
+                rhs_columns.append(column)
+            gap[lo:hi] = -grid.g
+        names.append("gap")
+        rhs_columns.append(gap)
+        lu = lu_factor(matrix, overwrite_a=True, check_finite=False)
+        units = lu_solve(lu, np.column_stack(rhs_columns), check_finite=False)
+        found = (lu, units, names)
+        with self._lock:
+            self._systems[key] = found
+            while len(self._systems) > 8:
+                self._systems.pop(next(iter(self._systems)))
+        return found
+
+    # --------------------------------------------------------------------- solve
+
+    def solve(self, inputs: Sequence[TimeInputs]) -> list[ContactSolution]:
+        """The full-contact elastic answer of every punch (dimensionless, each in its own
+        scaling), in the order of the punches.
+
+        ``inputs``: each punch's validated time side; all share the times and a constant
+        ``c`` and have no creep kernel (refused otherwise, ValueError).
+        """
+        t0 = _time.perf_counter()
+        if len(inputs) != len(self.punches):
+            raise ValueError(f"inputs: {len(inputs)} time sides for {len(self.punches)} punches")
+        times = inputs[0].times
+        c_values = set()
+        for k, one in enumerate(inputs):
+            if one.kernel is not None or not one.c_is_constant:
+                raise ValueError(f"punches[{k}]: several punches are coupled on an elastic "
+                                 "base of constant modulus only")
+            if not np.array_equal(one.times, times):
+                raise ValueError(f"punches[{k}]: all punches share the output times")
+            c_values.add(float(one.c(times[:1])[0]))
+        if len(c_values) != 1:
+            raise ValueError("punches: all punches stand on one base (one modulus)")
+        c = c_values.pop()
+        givens = tuple(one.given for one in inputs)
+        _, units, names = self._system(givens, c)
+        # loads at the output times and at samples between them (q >= 0 is checked there)
+        probe = (times if times.size == 1 else
+                 np.union1d(times, np.linspace(times[0], times[-1], HISTORY_SAMPLES["elastic"])))
+        weights = np.ones((len(names), probe.size))
+        for k, name in enumerate(names[:-1]):
+            p, quantity = name.split(":")
+            weights[k] = np.broadcast_to(inputs[int(p)].loads[quantity](probe), probe.shape)
+        solved = units @ weights  # (nodes + 2 n, probe)
+        at = np.searchsorted(probe, times)
+        n = self.size
+        answers = []
+        for p, prepared in enumerate(self.prepared):
+            lo, hi = self.offsets[p], self.offsets[p + 1]
+            scalars: dict[str, np.ndarray] = {}
+            unknown = [q for q in QUANTITIES if q not in givens[p]]
+            for k, name in enumerate(unknown):
+                scalars[name] = solved[n + 2 * p + k]
+            for name in givens[p]:
+                scalars[name] = np.broadcast_to(inputs[p].loads[name](probe),
+                                                probe.shape).astype(float)
+            nodal = solved[lo:hi]
+            check = self._pressure(p, prepared.check_x, nodal, solved, scalars, c)
+            q_extremes = (float(check.min()), float(np.max(np.abs(check))))
+            nodal_out = solved[:n, at]
+            out = {k: v[at] for k, v in scalars.items()}
+            pressure = self._pressure_function(p, nodal_out, out, c)
+            built = dict(prepared.counts)
+            solution = nystrom_solution(
+                prepared, inputs[p], out, pressure, q_extremes,
+                TimeSide(message="elastic base, several punches"),
+                _time.perf_counter() - t0, {k: 0 for k in built},
+                float(np.max(np.abs(scalars["tilt"]))), False)
+            solution.info["punches"] = len(self.punches)
+            solution.info["coupling_seconds"] = self.seconds
+            solution.contact_set.extend([[(-1.0, 1.0)] for _ in range(times.size)])
+            answers.append(solution)
+        return answers
+
+    def _pressure(self, p: int, x: np.ndarray, nodal: np.ndarray, solved: np.ndarray,
+                  scalars: dict[str, np.ndarray], c: float) -> np.ndarray:
+        """q on zone ``p`` at points ``x`` (its coordinates) by the Nystrom formula, shape
+        (len(x), T); ``solved`` holds the nodal q of all zones (rows) at the T times."""
+        prepared = self.prepared[p]
+        x = np.ascontiguousarray(x, dtype=float)
+        applied = prepared.rows(x) @ nodal
+        for r in range(len(self.punches)):
+            if r != p and self.coupled(p, r):
+                applied += (self.coupling_rows(p, r, x)
+                            @ solved[self.offsets[r]:self.offsets[r + 1]])
+        drive = (scalars["settlement"][None, :] + np.outer(x, scalars["tilt"])
+                 - prepared.geometry.g(x)[:, None])
+        return (drive - applied) / (c * prepared.geometry.m(x)[:, None])
+
+    def _pressure_function(self, p: int, nodal_all: np.ndarray,
+                           scalars: dict[str, np.ndarray], c: float):  # noqa: ANN202
+        lo, hi = self.offsets[p], self.offsets[p + 1]
+
+        def pressure(x: np.ndarray) -> np.ndarray:
+            return self._pressure(p, x, nodal_all[lo:hi], nodal_all, scalars, c)
+
+        return pressure
+
+
+#: Coupled discretizations kept for a later solve of the same punches (a load change):
+#: LRU by the punches' geometries and centres.
+COUPLED = StageCache("coupled_punches", max_items=8, max_bytes=256 * 2**20,
+                     sizeof=lambda coupled: coupled.nbytes)
+
+
+def coupled_for(punches: Sequence[PunchGeometry]) -> CoupledPunches:
+    """The coupled discretization of ``punches``: from :data:`COUPLED` when the same
+    geometries at the same centres were coupled before, else built now and kept."""
+    key = fingerprint("coupled", *[(geometry_key(p.geometry), p.center) for p in punches])
+    coupled, _ = COUPLED.get_or_compute(key, lambda: CoupledPunches(punches))
+    return coupled
+
+
+def solve_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeInputs]
+                  ) -> list[ContactSolution]:
+    """The coupled full-contact answer of several punches on an elastic base (see the
+    module notes); one :class:`core.problem.ContactSolution` per punch, in its own
+    scaling (``x* = (x - e)/a``)."""
+    return coupled_for(punches).solve(inputs)
