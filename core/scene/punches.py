@@ -88,14 +88,14 @@ def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:
 
     if isinstance(d, PunchesScene):
         return d
+    for name in ("punch", "loading"):
+        if isinstance(d, Mapping) and name in d:
+            raise ValueError(f"{name}: give either punch and loading (one punch) or punches, "
+                             "not both")
     d = schema.check_fields(d, "", tuple(n for n in schema.required_fields("scene")
                                           if n not in ("punch", "loading")) + ("punches",),
                             tuple(n for n in schema.optional_fields("scene") if n != "punches")
                             + (schema.SCHEMA_KEY,))
-    for name in ("punch", "loading"):
-        if name in d:
-            raise ValueError(f"{name}: give either punch and loading (one punch) or punches, "
-                             "not both")
     punches = bounded_list(d["punches"], "punches", least=1, most=limits.MAX_PUNCHES,
                            what="punches")
     scenes, centers = [], []
