@@ -34,8 +34,12 @@ Design (dimensionless, elastic base, full contact):
   once per (statements, ``c``) and solved for a unit value of each given load of each
   punch and for the gaps together: loads that change in time, or a load change, are a
   combination of those columns (one small matrix product).
-- **Between the nodes** q comes from the equation itself (the Nystrom formula) with the
-  coupling rows at the points asked for: exact in ``m`` and ``g`` at jumps, as for one punch.
+- **Between the nodes** q comes from the equation itself (the Nystrom formula), exact in
+  ``m`` and ``g`` at jumps as for one punch; the other zones' part of ``F q`` is smooth on
+  the zone and is interpolated on its panels from the nodes (the rows of every other
+  zone at every point asked for cost as much as the rest of the solve). The check of
+  ``q >= 0`` takes the formula on panels ending at +-1 or a jump and the panel
+  interpolant elsewhere, as the single punch's check does.
 - **Error estimate.** Each punch's grid carries the two-grid estimate of its own
   adaptive refinement (``spatial_error``); the coupling adds to zone ``p`` a drive that is
   smooth on it (analytic where the zones are apart), which the grid's interior panels
@@ -250,12 +254,12 @@ class CoupledPunches:
             for name in givens[p]:
                 scalars[name] = np.broadcast_to(inputs[p].loads[name](probe),
                                                 probe.shape).astype(float)
-            nodal = solved[lo:hi]
-            check = self._pressure(p, prepared.check_x, nodal, solved, scalars, c)
+            coupling = self._coupling_at_nodes(p, solved[:n])
+            check = self._pressure(p, prepared.check_x, solved[lo:hi], coupling, scalars, c,
+                                   prepared.check_formula)
             q_extremes = (float(check.min()), float(np.max(np.abs(check))))
-            nodal_out = solved[:n, at]
             out = {k: v[at] for k, v in scalars.items()}
-            pressure = self._pressure_function(p, nodal_out, out, c)
+            pressure = self._pressure_function(p, solved[lo:hi, at], coupling[:, at], out, c)
             built = dict(prepared.counts)
             solution = nystrom_solution(
                 prepared, inputs[p], out, pressure, q_extremes,
@@ -268,27 +272,46 @@ class CoupledPunches:
             answers.append(solution)
         return answers
 
-    def _pressure(self, p: int, x: np.ndarray, nodal: np.ndarray, solved: np.ndarray,
-                  scalars: dict[str, np.ndarray], c: float) -> np.ndarray:
-        """q on zone ``p`` at points ``x`` (its coordinates) by the Nystrom formula, shape
-        (len(x), T); ``solved`` holds the nodal q of all zones (rows) at the T times."""
-        prepared = self.prepared[p]
-        x = np.ascontiguousarray(x, dtype=float)
-        applied = prepared.rows(x) @ nodal
-        for r in range(len(self.punches)):
-            if r != p and self.coupled(p, r):
-                applied += (self.coupling_rows(p, r, x)
-                            @ solved[self.offsets[r]:self.offsets[r + 1]])
-        drive = (scalars["settlement"][None, :] + np.outer(x, scalars["tilt"])
-                 - prepared.geometry.g(x)[:, None])
-        return (drive - applied) / (c * prepared.geometry.m(x)[:, None])
+    def _coupling_at_nodes(self, p: int, solved: np.ndarray) -> np.ndarray:
+        """The other zones' part of ``F q`` at zone ``p``'s nodes (N_p, T); ``solved``
+        holds the nodal q of all zones (rows) at the T times."""
+        out = np.zeros((self.sizes[p], solved.shape[1]))
+        for r, block in enumerate(self.blocks[p]):
+            if block is not None:
+                out += block @ solved[self.offsets[r]:self.offsets[r + 1]]
+        return out
 
-    def _pressure_function(self, p: int, nodal_all: np.ndarray,
+    def _pressure(self, p: int, x: np.ndarray, nodal: np.ndarray, coupling: np.ndarray,
+                  scalars: dict[str, np.ndarray], c: float,
+                  formula: np.ndarray | None = None) -> np.ndarray:
+        """q on zone ``p`` at points ``x`` (its coordinates), shape (len(x), T).
+
+        The Nystrom formula with the zone's own rows; the other zones' part of ``F q``
+        (``coupling``, at the nodes) is smooth on the zone and taken from its panel
+        interpolant (rows of every other zone at every point cost as much as the rest of
+        the solve). ``formula``: where the formula is needed (None: everywhere); elsewhere
+        q is interpolated from the nodes as the single-punch check does.
+        """
+        prepared = self.prepared[p]
+        grid = prepared.grid
+        x = np.ascontiguousarray(x, dtype=float)
+        out = np.empty((x.size, nodal.shape[1]))
+        near = np.ones(x.size, dtype=bool) if formula is None else formula
+        xs = np.ascontiguousarray(x[near])
+        if xs.size:
+            applied = prepared.rows(xs) @ nodal + grid.interpolate(xs, coupling)
+            drive = (scalars["settlement"][None, :] + np.outer(xs, scalars["tilt"])
+                     - prepared.geometry.g(xs)[:, None])
+            out[near] = (drive - applied) / (c * prepared.geometry.m(xs)[:, None])
+        if not near.all():
+            out[~near] = grid.interpolate(x[~near], nodal)
+        return out
+
+    def _pressure_function(self, p: int, nodal: np.ndarray, coupling: np.ndarray,
                            scalars: dict[str, np.ndarray], c: float):  # noqa: ANN202
-        lo, hi = self.offsets[p], self.offsets[p + 1]
 
         def pressure(x: np.ndarray) -> np.ndarray:
-            return self._pressure(p, x, nodal_all[lo:hi], nodal_all, scalars, c)
+            return self._pressure(p, x, nodal, coupling, scalars, c)
 
         return pressure
 
