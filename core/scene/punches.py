@@ -8,9 +8,9 @@ so every field keeps its rules; a refusal names it as ``punches[k].<field>``.
 
 One punch is the single-punch scene at its centre, answered by :func:`core.scene.solve`
 (every base, contact model and engine). Several punches are coupled by the default engine
-(:mod:`core.engines.nystrom.multi`) with the thin-layer coating model, on an elastic base
-in full contact; what is not coupled yet (creep or aging, a coating that varies along x,
-unilateral contact) is refused with a ValueError naming the field and the reason.
+(:mod:`core.engines.nystrom.multi`) with the thin-layer coating model, in full contact (on
+an elastic, aging or creeping base); what is not coupled yet (a coating that varies along
+x, unilateral contact) is refused with a ValueError naming the field and the reason.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from core.scene.results import SceneSolution
 from core.validation import bounded_list, finite_number
 
 #: What the coupled solve does not answer yet, named in its refusals.
-COUPLED_SCOPE = "several punches are solved on an elastic base in full contact for now"
+COUPLED_SCOPE = "several punches are solved in full contact for now"
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,11 +138,6 @@ def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:
 def _check_coupled(scene: PunchesScene) -> None:
     """Refuse what the coupled solve does not answer yet, naming the field."""
     first = scene.scenes[0]
-    problem = first.dimensionless
-    if problem.kernel is not None or callable(problem.c):
-        raise ValueError(f"base.creep: {COUPLED_SCOPE} (this base "
-                         + ("creeps" if problem.kernel is not None else "ages")
-                         + "; give {'model': 'elastic', 'modulus': ...} or one punch)")
     if first.contact == "unilateral":
         raise ValueError(f"solver.contact: {COUPLED_SCOPE} (give 'auto' or 'full'; a lost "
                          "contact is flagged contact_lost)")
@@ -231,7 +226,8 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
                                                {q: problem.loads.get(q) for q in
                                                 ("settlement", "tilt", "force", "moment")}))
         with np.errstate(all="ignore"):
-            answers = solve_punches(geometries, inputs)
+            answers = solve_punches(geometries, inputs,
+                                    scene.scenes[0].dimensionless.time_breaks)
         punches = [PunchSolution(sub, center, answer) for sub, center, answer
                    in zip(scene.scenes, scene.centers, answers, strict=True)]
         for p in punches:

@@ -46,8 +46,10 @@ Design (dimensionless, elastic base, full contact):
   resolve like the ``1, x`` drives the estimate was made with. The estimate of a punch is
   its grid's; the scene's the largest. The tests measure it against refined answers.
 
-Creep, a modulus varying in time and lift-off are not coupled here (refused by the
-scene, :mod:`core.scene.punches`).
+Creep and a modulus varying in time: the same coupled operator in modal form
+(:mod:`core.engines.nystrom.multi_modal`), stepped by :mod:`core.time`; the time
+stepping's estimate is added to the punches' spatial ones. Lift-off is not coupled here
+(refused by the scene, :mod:`core.scene.punches`).
 """
 
 from __future__ import annotations
@@ -56,13 +58,17 @@ import threading
 import time as _time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 
 from core.cache import StageCache, fingerprint
+from core.creep import stepping_kernel
+from core.engines.nystrom.multi_modal import CoupledModalForm
 from core.engines.nystrom.prepared import (
     HISTORY_SAMPLES,
+    TIME_SHARE,
     PreparedContact,
     geometry_key,
     prepared_for,
@@ -117,7 +123,8 @@ class CoupledPunches:
             for r in range(n):
                 if p != r and self.coupled(p, r):
                     self.blocks[p][r] = self.coupling_rows(p, r, self.prepared[p].grid.nodes)
-        self._systems: dict[tuple, tuple[tuple, np.ndarray, list[str]]] = {}
+        # bordered systems (LU, unit responses, names) and modal forms, by statements
+        self._systems: dict[tuple, Any] = {}
         self._lock = threading.Lock()
         self.seconds = _time.perf_counter() - t0
 
@@ -138,8 +145,11 @@ class CoupledPunches:
         """Memory of the coupling blocks and the factored systems [bytes] (the grids are
         counted by :data:`core.engines.nystrom.PREPARED`)."""
         blocks = sum(b.nbytes for row in self.blocks for b in row if b is not None)
-        return int(blocks + sum(lu[0].nbytes + units.nbytes
-                                for lu, units, _ in self._systems.values()))
+        systems = sum(entry[0][0].nbytes + entry[1].nbytes
+                      for key, entry in self._systems.items() if key[0] != "modal")
+        modal = sum(3 * entry.q.nbytes for key, entry in self._systems.items()
+                    if key[0] == "modal")
+        return int(blocks + systems + modal)
 
     @property
     def size(self) -> int:
@@ -210,60 +220,82 @@ class CoupledPunches:
 
     # --------------------------------------------------------------------- solve
 
-    def solve(self, inputs: Sequence[TimeInputs]) -> list[ContactSolution]:
-        """The full-contact elastic answer of every punch (dimensionless, each in its own
-        scaling), in the order of the punches.
+    def solve(self, inputs: Sequence[TimeInputs], time_breaks: Sequence[float] = ()
+              ) -> list[ContactSolution]:
+        """The full-contact answer of every punch (dimensionless, each in its own scaling),
+        in the order of the punches.
 
-        ``inputs``: each punch's validated time side; all share the times and a constant
-        ``c`` and have no creep kernel (refused otherwise, ValueError).
+        ``inputs``: each punch's validated time side; all share the times, ``c`` and the
+        creep kernel (one base). An elastic base of constant modulus is answered by the
+        bordered system's unit responses, creep or a varying modulus in modal form
+        (:mod:`core.engines.nystrom.multi_modal`). ``time_breaks``: times where a given
+        history jumps or kinks.
         """
         t0 = _time.perf_counter()
         if len(inputs) != len(self.punches):
             raise ValueError(f"inputs: {len(inputs)} time sides for {len(self.punches)} punches")
-        times = inputs[0].times
-        c_values = set()
+        first = inputs[0]
+        times = first.times
         for k, one in enumerate(inputs):
-            if one.kernel is not None or not one.c_is_constant:
-                raise ValueError(f"punches[{k}]: several punches are coupled on an elastic "
-                                 "base of constant modulus only")
             if not np.array_equal(one.times, times):
                 raise ValueError(f"punches[{k}]: all punches share the output times")
-            c_values.add(float(one.c(times[:1])[0]))
-        if len(c_values) != 1:
-            raise ValueError("punches: all punches stand on one base (one modulus)")
-        c = c_values.pop()
+            if (one.kernel is None) != (first.kernel is None) or (
+                    one.c_is_constant != first.c_is_constant):
+                raise ValueError(f"punches[{k}]: all punches stand on one base")
         givens = tuple(one.given for one in inputs)
-        _, units, names = self._system(givens, c)
-        # loads at the output times and at samples between them (q >= 0 is checked there)
-        probe = (times if times.size == 1 else
-                 np.union1d(times, np.linspace(times[0], times[-1], HISTORY_SAMPLES["elastic"])))
-        weights = np.ones((len(names), probe.size))
-        for k, name in enumerate(names[:-1]):
-            p, quantity = name.split(":")
-            weights[k] = np.broadcast_to(inputs[int(p)].loads[quantity](probe), probe.shape)
-        solved = units @ weights  # (nodes + 2 n, probe)
-        at = np.searchsorted(probe, times)
         n = self.size
+        if first.kernel is None and first.c_is_constant:
+            c = float(first.c(times[:1])[0])
+            _, units, names = self._system(givens, c)
+            # loads at the output times and samples between them (q >= 0 is checked there)
+            probe = (times if times.size == 1 else np.union1d(
+                times, np.linspace(times[0], times[-1], HISTORY_SAMPLES["elastic"])))
+            weights = np.ones((len(names), probe.size))
+            for k, name in enumerate(names[:-1]):
+                p, quantity = name.split(":")
+                weights[k] = np.broadcast_to(inputs[int(p)].loads[quantity](probe),
+                                             probe.shape)
+            solved = units @ weights  # (nodes + 2 n, probe)
+            nodal = effective = solved[:n]
+            scalars_all = []
+            for p in range(len(self.punches)):
+                scalars: dict[str, np.ndarray] = {}
+                unknown = [q for q in QUANTITIES if q not in givens[p]]
+                for k, name in enumerate(unknown):
+                    scalars[name] = solved[n + 2 * p + k]
+                for name in givens[p]:
+                    scalars[name] = np.broadcast_to(inputs[p].loads[name](probe),
+                                                    probe.shape).astype(float)
+                scalars_all.append(scalars)
+            c_probe = np.full(probe.size, c)
+            time_side = TimeSide(message="elastic base, several punches")
+        else:
+            probe = (times if times.size == 1 else np.union1d(
+                times, np.linspace(times[0], times[-1], HISTORY_SAMPLES["creep"])))
+            tol = min(pc.geometry.tol for pc in self.prepared)
+            kernel, fit_error = stepping_kernel(first.kernel, float(times[-1]), 0.5 * tol)
+            breaks = [b for b in time_breaks if times[0] < b < times[-1]]
+            answer = self.modal(givens, tol).solve(inputs, probe, first.c, kernel,
+                                                   tol / TIME_SHARE, breaks)
+            nodal, effective, scalars_all = answer.nodal, answer.effective, answer.scalars
+            c_probe = np.asarray(first.c(probe), dtype=float)
+            time_side = TimeSide(answer.time_error + fit_error, answer.steps, answer.success,
+                                 answer.message, fit_error)
+        at = np.searchsorted(probe, times)
         answers = []
         for p, prepared in enumerate(self.prepared):
             lo, hi = self.offsets[p], self.offsets[p + 1]
-            scalars: dict[str, np.ndarray] = {}
-            unknown = [q for q in QUANTITIES if q not in givens[p]]
-            for k, name in enumerate(unknown):
-                scalars[name] = solved[n + 2 * p + k]
-            for name in givens[p]:
-                scalars[name] = np.broadcast_to(inputs[p].loads[name](probe),
-                                                probe.shape).astype(float)
-            coupling = self._coupling_at_nodes(p, solved[:n])
-            check = self._pressure(p, prepared.check_x, solved[lo:hi], coupling, scalars, c,
-                                   prepared.check_formula)
+            scalars = scalars_all[p]
+            coupling = self._coupling_at_nodes(p, effective)
+            check = self._pressure(p, prepared.check_x, nodal[lo:hi], effective[lo:hi],
+                                   coupling, scalars, c_probe, prepared.check_formula)
             q_extremes = (float(check.min()), float(np.max(np.abs(check))))
             out = {k: v[at] for k, v in scalars.items()}
-            pressure = self._pressure_function(p, solved[lo:hi, at], coupling[:, at], out, c)
+            pressure = self._pressure_function(p, nodal[lo:hi, at], effective[lo:hi, at],
+                                               coupling[:, at], out, c_probe[at])
             built = dict(prepared.counts)
             solution = nystrom_solution(
-                prepared, inputs[p], out, pressure, q_extremes,
-                TimeSide(message="elastic base, several punches"),
+                prepared, inputs[p], out, pressure, q_extremes, time_side,
                 _time.perf_counter() - t0, {k: 0 for k in built},
                 float(np.max(np.abs(scalars["tilt"]))), False)
             solution.info["punches"] = len(self.punches)
@@ -272,25 +304,50 @@ class CoupledPunches:
             answers.append(solution)
         return answers
 
+    def modal(self, givens: tuple[frozenset[str], ...], tol: float) -> CoupledModalForm:
+        """The modal form of the coupled equations for the punches' statements (cached)."""
+        key = ("modal", givens, tol)
+        with self._lock:
+            found = self._systems.get(key)
+        if found is None:
+            n = self.size
+            operator = np.zeros((n, n))
+            for p, prepared in enumerate(self.prepared):
+                lo, hi = self.offsets[p], self.offsets[p + 1]
+                operator[lo:hi, lo:hi] = prepared.grid.operator
+                for r, block in enumerate(self.blocks[p]):
+                    if block is not None:
+                        operator[lo:hi, self.offsets[r]:self.offsets[r + 1]] = block
+            grids = [pc.grid for pc in self.prepared]
+            found = CoupledModalForm(
+                operator, np.concatenate([g.m for g in grids]),
+                np.concatenate([g.panels.weights for g in grids]),
+                np.concatenate([g.nodes for g in grids]),
+                np.concatenate([g.g for g in grids]), self.offsets, givens, tol)
+            with self._lock:
+                self._systems[key] = found
+        return found
+
     def _coupling_at_nodes(self, p: int, solved: np.ndarray) -> np.ndarray:
         """The other zones' part of ``F q`` at zone ``p``'s nodes (N_p, T); ``solved``
-        holds the nodal q of all zones (rows) at the T times."""
+        holds the nodal q (or q - V q) of all zones (rows) at the T times."""
         out = np.zeros((self.sizes[p], solved.shape[1]))
         for r, block in enumerate(self.blocks[p]):
             if block is not None:
                 out += block @ solved[self.offsets[r]:self.offsets[r + 1]]
         return out
 
-    def _pressure(self, p: int, x: np.ndarray, nodal: np.ndarray, coupling: np.ndarray,
-                  scalars: dict[str, np.ndarray], c: float,
+    def _pressure(self, p: int, x: np.ndarray, nodal: np.ndarray, effective: np.ndarray,
+                  coupling: np.ndarray, scalars: dict[str, np.ndarray], c: np.ndarray,
                   formula: np.ndarray | None = None) -> np.ndarray:
         """q on zone ``p`` at points ``x`` (its coordinates), shape (len(x), T).
 
-        The Nystrom formula with the zone's own rows; the other zones' part of ``F q``
-        (``coupling``, at the nodes) is smooth on the zone and taken from its panel
-        interpolant (rows of every other zone at every point cost as much as the rest of
-        the solve). ``formula``: where the formula is needed (None: everywhere); elsewhere
-        q is interpolated from the nodes as the single-punch check does.
+        The Nystrom formula ``q = [delta + alpha x - g - F (q - V q)] / (c m)`` with the
+        zone's own rows; the other zones' part of ``F (q - V q)`` (``coupling``, at the
+        nodes) is smooth on the zone and taken from its panel interpolant (rows of every
+        other zone at every point cost as much as the rest of the solve). ``formula``:
+        where the formula is needed (None: everywhere); elsewhere q is interpolated from
+        the nodes as the single-punch check does. ``c`` (T,): c at the times.
         """
         prepared = self.prepared[p]
         grid = prepared.grid
@@ -299,19 +356,20 @@ class CoupledPunches:
         near = np.ones(x.size, dtype=bool) if formula is None else formula
         xs = np.ascontiguousarray(x[near])
         if xs.size:
-            applied = prepared.rows(xs) @ nodal + grid.interpolate(xs, coupling)
+            applied = prepared.rows(xs) @ effective + grid.interpolate(xs, coupling)
             drive = (scalars["settlement"][None, :] + np.outer(xs, scalars["tilt"])
                      - prepared.geometry.g(xs)[:, None])
-            out[near] = (drive - applied) / (c * prepared.geometry.m(xs)[:, None])
+            out[near] = (drive - applied) / (prepared.geometry.m(xs)[:, None] * c[None, :])
         if not near.all():
             out[~near] = grid.interpolate(x[~near], nodal)
         return out
 
-    def _pressure_function(self, p: int, nodal: np.ndarray, coupling: np.ndarray,
-                           scalars: dict[str, np.ndarray], c: float):  # noqa: ANN202
+    def _pressure_function(self, p: int, nodal: np.ndarray, effective: np.ndarray,
+                           coupling: np.ndarray, scalars: dict[str, np.ndarray],
+                           c: np.ndarray):  # noqa: ANN202
 
         def pressure(x: np.ndarray) -> np.ndarray:
-            return self._pressure(p, x, nodal, coupling, scalars, c)
+            return self._pressure(p, x, nodal, effective, coupling, scalars, c)
 
         return pressure
 
@@ -330,9 +388,9 @@ def coupled_for(punches: Sequence[PunchGeometry]) -> CoupledPunches:
     return coupled
 
 
-def solve_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeInputs]
-                  ) -> list[ContactSolution]:
-    """The coupled full-contact answer of several punches on an elastic base (see the
-    module notes); one :class:`core.problem.ContactSolution` per punch, in its own
-    scaling (``x* = (x - e)/a``)."""
-    return coupled_for(punches).solve(inputs)
+def solve_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeInputs],
+                  time_breaks: Sequence[float] = ()) -> list[ContactSolution]:
+    """The coupled full-contact answer of several punches on one base (see the module
+    notes); one :class:`core.problem.ContactSolution` per punch, in its own scaling
+    (``x* = (x - e)/a``)."""
+    return coupled_for(punches).solve(inputs, time_breaks)
