@@ -9,8 +9,10 @@ so every field keeps its rules; a refusal names it as ``punches[k].<field>``.
 One punch is the single-punch scene at its centre, answered by :func:`core.scene.solve`
 (every base, contact model and engine). Several punches are coupled by the default engine
 (:mod:`core.engines.nystrom.multi`) with the thin-layer coating model, in full contact (on
-an elastic, aging or creeping base); what is not coupled yet (a coating that varies along
-x, unilateral contact) is refused with a ValueError naming the field and the reason.
+an elastic, aging or creeping base). The coating's profiles are functions of the global x
+along the whole surface (checked over the punches' span); each punch sees them from its
+centre. What is not coupled yet (unilateral contact) is refused with a ValueError naming
+the field and the reason.
 """
 
 from __future__ import annotations
@@ -24,8 +26,10 @@ from typing import Any
 import numpy as np
 
 from core import limits
+from core.coating import DEFAULT_INTERFACE
 from core.engines.nystrom import PunchGeometry, solve_punches
 from core.problem import validate_geometry, validate_time_inputs
+from core.profiles import shifted
 from core.scene import schema
 from core.scene.model import Scene
 from core.scene.results import SceneSolution
@@ -100,6 +104,9 @@ def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:
                            what="punches")
     scenes, centers = [], []
     common = {k: v for k, v in d.items() if k not in ("punches", schema.SCHEMA_KEY)}
+    # a coating that varies along x is read in the global x (below); each punch's own
+    # checks see it at its centre meanwhile
+    uniform = len(punches) == 1 or _uniform(common["coating"])
     for k, spec in enumerate(punches):
         path = f"punches[{k}]"
         schema.check_fields(spec, path, schema.required_fields("punches[k]"),
@@ -108,6 +115,8 @@ def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:
         single = dict(common, punch={"half_width": spec["half_width"],
                                      "shape": spec.get("shape", 0.0)},
                       loading=spec["loading"])
+        if not uniform:
+            single["coating"] = _at_centre(common["coating"], center)
         try:
             scenes.append(scene_from_dict(single))
         except ValueError as exc:
@@ -122,17 +131,90 @@ def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:
                 f"punches: punches[{i}] and punches[{j}] overlap or touch ([{spans[i][0]:g}, "
                 f"{spans[i][1]:g}] m and [{spans[j][0]:g}, {spans[j][1]:g}] m): move a centre "
                 "or narrow a punch so that a gap remains between them")
-    if len(scenes) > 1:
-        for k, layer in enumerate(scenes[0].coating):
-            for name in ("thickness", "modulus", "poisson"):
-                if getattr(getattr(layer, name), "kind", None) != "constant":
-                    raise ValueError(
-                        f"coating[{k}].{name}: {COUPLED_SCOPE}, under a coating uniform "
-                        "along x (give a number)")
+    if len(scenes) > 1 and not _uniform(common["coating"]):
+        scenes = _along_x(common, scenes, centers, spans)
     data = {k: v for k, v in scenes[0].to_dict().items() if k not in ("punch", "loading")}
     data["punches"] = [{"center": c, **s.to_dict()["punch"], "loading": s.to_dict()["loading"]}
                        for c, s in zip(centers, scenes, strict=True)]
     return PunchesScene(tuple(scenes), tuple(centers), data)
+
+
+def _uniform(coating: Any) -> bool:
+    """Whether every profile of a coating spec is a number or a constant (as given)."""
+    if not isinstance(coating, list):
+        return True  # refused by the single-punch checks, naming the field
+    for layer in coating:
+        if not isinstance(layer, Mapping):
+            return True
+        for name in ("thickness", "modulus", "poisson"):
+            spec = layer.get(name)
+            if isinstance(spec, Mapping) and spec.get("kind") != "constant":
+                return False
+    return True
+
+
+def _at_centre(coating: list, center: float) -> list:
+    """A coating spec with every varying profile replaced by a valid constant (1: the
+    single-punch checks of the other fields run on it; the coating itself is read in the
+    global x by :func:`_along_x`)."""
+    out = []
+    for layer in coating:
+        layer = dict(layer)
+        for name, value in (("thickness", 0.01), ("modulus", 1e9), ("poisson", 0.3)):
+            if isinstance(layer.get(name), Mapping) and layer[name].get("kind") != "constant":
+                layer[name] = value
+        out.append(layer)
+    return out
+
+
+def _along_x(common: Mapping[str, Any], scenes: list[Scene], centers: list[float],
+             spans: list[tuple[float, float]]) -> list[Scene]:
+    """The punches' scenes under a coating that varies along x: its profiles are read in
+    the global x over the punches' span (checked there, refusals naming
+    ``coating[k].<field>``) and each punch sees them from its centre."""
+    from dataclasses import replace
+
+    from core.scene.validate import (
+        _check_breakpoints,
+        _check_load_rates,
+        _check_solvable,
+        check_uncoated,
+    )
+
+    domain = (min(lo for lo, _ in spans), max(hi for _, hi in spans))
+    bounds = {"thickness": {"lower": 0.0}, "modulus": {"lower": 0.0},
+              "poisson": {"lower": schema.POISSON_RANGE[0], "upper": schema.POISSON_RANGE[1]}}
+    layers = []
+    for k, spec in enumerate(common["coating"]):
+        layers.append({name: schema._profile(spec[name], f"coating[{k}].{name}", "x", domain,
+                                             **bounds[name])
+                       for name in ("thickness", "modulus", "poisson")})
+    coating_data = [{name: schema._jsonable(schema._spec_of(layer[name], spec[name]))
+                     for name in ("thickness", "modulus", "poisson")}
+                    | {"interface": spec.get("interface", DEFAULT_INTERFACE)}
+                    for layer, spec in zip(layers, common["coating"], strict=True)]
+    out = []
+    for k, (scene, center) in enumerate(zip(scenes, centers, strict=True)):
+        a = scene.half_width
+        local = tuple(
+            replace(old, **{name: shifted(layer[name], center, (-a, a))
+                            for name in ("thickness", "modulus", "poisson")})
+            for old, layer in zip(scene.coating, layers, strict=True))
+        data = scene.to_dict()
+        # the centre keys the geometry's caches: two punches alike but for their place
+        # see different stretches of the coating
+        data["punch"]["center"] = center
+        data["coating"] = coating_data
+        moved = replace(scene, coating=local, _data=data)
+        try:
+            _check_breakpoints(moved)
+            _check_solvable(moved)
+            check_uncoated(moved)
+            _check_load_rates(moved)
+        except ValueError as exc:
+            raise ValueError(_renamed(str(exc), k)) from None
+        out.append(moved)
+    return out
 
 
 def _check_coupled(scene: PunchesScene) -> None:

@@ -165,6 +165,47 @@ def test_a_lost_contact_is_flagged_on_its_punch() -> None:
     assert result.flags == ["punches[0].contact_lost"]
 
 
+# --------------------------------------------------------- a coating varying along x
+
+
+def test_the_coating_is_read_in_the_global_x() -> None:
+    d = _pair(60.0)
+    d["coating"][0]["thickness"] = {"expr": "0.02 + 0.0002*x"}
+    d["coating"][0]["modulus"] = {"expr": "8e8*(1 + 0.002*x)"}
+    result = core.solve(d)
+    for k, punch in enumerate(d["punches"]):
+        c = punch["center"]
+        alone = _base()
+        alone["punch"] = {"half_width": punch["half_width"], "shape": punch.get("shape", 0.0)}
+        alone["loading"] = punch["loading"]
+        alone["coating"][0]["thickness"] = {"expr": f"0.02 + 0.0002*(x + {c!r})"}
+        alone["coating"][0]["modulus"] = {"expr": f"8e8*(1 + 0.002*(x + {c!r}))"}
+        scene = core.scene_from_dict(alone)
+        single = SceneSolution(scene, scene.dimensionless, scene.dimensionless.solve())
+        x = np.linspace(-1.0, 1.0, 21) * punch["half_width"]
+        # measured: 1.5e-15 (scalars), 2.5e-14 (q)
+        for q in QUANTITIES:
+            assert _relative(getattr(result.punches[k], q), getattr(single, q)) < 1e-9, q
+        assert _relative(result.punches[k].pressure(x), single.pressure(x)) < 1e-9
+    # the file keeps the profile of the global x
+    assert result.scene.to_dict()["coating"][0]["thickness"] == {"kind": "expr",
+                                                                 "expr": "0.02 + 2e-4 * x"}
+
+
+def test_a_close_pair_on_a_varying_coating_converges_within_its_estimate() -> None:
+    def pair(tol: float) -> Any:
+        d = _pair(0.05, tol=tol)
+        d["coating"][0]["thickness"] = {"kind": "linear", "start": 0.015, "end": 0.03}
+        return core.solve(d)
+
+    reference, result = pair(1e-10), pair(1e-4)
+    for mine, best in zip(result.punches, reference.punches, strict=True):
+        x = mine.scene.half_width * np.concatenate([np.linspace(-1.0, 1.0, 401),
+                                                    [-1 + 1e-6, 1 - 1e-6]])
+        # measured: 4.5e-8 and 8.0e-9 against estimates 1.6e-7 and 3.3e-8
+        assert _relative(mine.pressure(x), best.pressure(x)) <= mine.info["error_estimate"]
+
+
 # ---------------------------------------------------------------------------- creep
 
 CREEP = {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11, "rate": 0.05}
@@ -250,8 +291,8 @@ def test_overlapping_punches_are_refused_naming_both() -> None:
     (lambda d: d["solver"].update(contact="unilateral"),
      r"solver\.contact: several punches are solved in full contact for now"),
     (lambda d: d["coating"][0].update(thickness={"kind": "linear", "start": 0.02,
-                                                 "end": 0.03}),
-     r"coating\[0\]\.thickness: several punches are solved .* uniform along x"),
+                                                 "end": -0.03}),
+     r"coating\[0\]\.thickness: must be > 0, is -[\d.e-]+ at x = 0\.48\d* m"),
     (lambda d: d.update(punch={"half_width": 1.0}),
      r"punch: give either punch and loading \(one punch\) or punches"),
     (lambda d: d["punches"][1]["loading"].update(settlement=0.001),
