@@ -56,6 +56,7 @@ from core.scene.punches import (
     PunchesScene,
     PunchesSolution,
     PunchSolution,
+    has_punches,
     punches_from_dict,
 )
 from core.scene.records import (
@@ -118,6 +119,7 @@ __all__ = [
     "plotting_grid",
     "provenance",
     "provenance_lines",
+    "has_punches",
     "PunchesScene",
     "PunchesSolution",
     "punches_from_dict",

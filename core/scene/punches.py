@@ -18,6 +18,7 @@ the field and the reason.
 from __future__ import annotations
 
 import copy
+import json
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -55,6 +56,11 @@ class PunchesScene:
     def to_dict(self) -> dict[str, Any]:
         """The canonical JSON-able dict of the scene."""
         return copy.deepcopy(self.data)
+
+    @property
+    def name(self) -> str:
+        """The scene's name."""
+        return str(self.data["name"])
 
     @property
     def times(self) -> np.ndarray:
@@ -279,6 +285,10 @@ class PunchesSolution:
         return {"scene": self.scene.to_dict(), "times": self.times.tolist(),
                 "info": dict(self.info),
                 "punches": [dict(p.to_dict(), center=p.center) for p in self.punches]}
+
+    def to_json(self) -> str:
+        """:meth:`to_dict` as compact JSON text."""
+        return json.dumps(self.to_dict(), separators=(",", ":"), allow_nan=False)
 
     def __repr__(self) -> str:
         return (f"PunchesSolution({len(self.punches)} punches, {self.times.size} times, "
