@@ -324,6 +324,15 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
                    in zip(scene.scenes, scene.centers, answers, strict=True)]
         for p in punches:
             p.info["coating_model"] = "thin layer"
+        lost = [k for k, p in enumerate(punches) if "contact_lost" in p.flags]
+        if lost and scene.scenes[0].contact == "auto":
+            k = lost[0]
+            raise ValueError(
+                f"solver.contact: punches[{k}] loses contact (q < 0 under it in full "
+                f"contact, down to {punches[k].info['min_pressure']:.3g} of q*) and lift-off "
+                "under several punches is not solved yet: give solver.contact 'full' for the "
+                "full-contact answer flagged contact_lost, or loads that keep every punch "
+                "pressed")
     result = PunchesSolution(scene, punches)
     result.info["cpu_seconds"] = time.thread_time() - started
     return result
