@@ -4,7 +4,8 @@
 
 The uniform preset on an elastic base at tol 1e-6. *One punch*: the punch alone by the
 same model (thin layer, default engine: ``scene.dimensionless.solve()``), its half-width
-0.01 % wider at each solve so that every cache misses. *Two punches*: ``core.solve`` of
+0.01 % wider at each solve so that every cache misses (*loads only*: its force changed).
+*Two punches*: ``core.solve`` of
 two punches 1 m apart (the second 0.6 times as wide, so the two grids differ, or the same
 width, so they share one), both half-widths changed at each solve; *loads only*: the two
 punches' forces changed. Medians of the CPU time of this process per solve [ms], with
@@ -38,9 +39,10 @@ def _scene() -> dict:
     return d
 
 
-def _single(i: int) -> None:
+def _single(i: int, force_step: float = 0.0, geometry_step: float = 1e-4) -> None:
     d = _scene()
-    d["punch"]["half_width"] *= 1 + 1e-4 * i
+    d["punch"]["half_width"] *= 1 + geometry_step * i
+    d["loading"]["force"] *= 1 + force_step * i
     scene = scene_from_dict(d)
     SceneSolution(scene, scene.dimensionless, scene.dimensionless.solve())
 
@@ -71,6 +73,8 @@ def main(argv: list[str]) -> None:
     rows = [("one punch (a = 1 m), new geometry", _median_ms(_single)),
             ("two punches (a = 1, 0.6 m), new geometry", _median_ms(lambda i: _pair(i, 0.6))),
             ("two punches (a = 1, 1 m), new geometry", _median_ms(lambda i: _pair(i, 1.0))),
+            ("one punch (a = 1 m), loads only",
+             _median_ms(lambda i: _single(1000, force_step=1e-3 * i, geometry_step=0.0))),
             ("two punches (a = 1, 0.6 m), loads only",
              _median_ms(lambda i: _pair(1000, 0.6, force_step=1e-3 * i, geometry_step=0.0)))]
     single = rows[0][1]
