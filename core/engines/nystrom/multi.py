@@ -68,6 +68,7 @@ from core.creep import stepping_kernel
 from core.engines.nystrom.multi_modal import CoupledModalForm
 from core.engines.nystrom.prepared import (
     HISTORY_SAMPLES,
+    PREPARED,
     TIME_SHARE,
     PreparedContact,
     geometry_key,
@@ -110,11 +111,15 @@ class CoupledPunches:
     on ``p``'s nodes, or None when negligible.
     """
 
-    def __init__(self, punches: Sequence[PunchGeometry]) -> None:
+    def __init__(self, punches: Sequence[PunchGeometry],
+                 prepared: Sequence[PreparedContact] | None = None) -> None:
+        """``prepared``: each punch's prepared grid, if known (else found or built by
+        :func:`core.engines.nystrom.prepared_for`)."""
         t0 = _time.perf_counter()
         self.punches = tuple(punches)
         self.prepared: tuple[PreparedContact, ...] = tuple(
-            prepared_for(p.geometry) for p in self.punches)
+            prepared if prepared is not None else
+            (prepared_for(p.geometry) for p in self.punches))
         self.sizes = [pc.grid.size for pc in self.prepared]
         self.offsets = np.concatenate([[0], np.cumsum(self.sizes)]).astype(int)
         n = len(self.punches)
@@ -145,7 +150,7 @@ class CoupledPunches:
         """Memory of the coupling blocks and the factored systems [bytes] (the grids are
         counted by :data:`core.engines.nystrom.PREPARED`)."""
         blocks = sum(b.nbytes for row in self.blocks for b in row if b is not None)
-        systems = sum(entry[0][0].nbytes + entry[1].nbytes
+        systems = sum(entry[0][0].nbytes + entry[1].nbytes + sum(c.nbytes for c in entry[3])
                       for key, entry in self._systems.items() if key[0] != "modal")
         modal = sum(3 * entry.q.nbytes for key, entry in self._systems.items()
                     if key[0] == "modal")
@@ -211,7 +216,21 @@ class CoupledPunches:
         rhs_columns.append(gap)
         lu = lu_factor(matrix, overwrite_a=True, check_finite=False)
         units = lu_solve(lu, np.column_stack(rhs_columns), check_finite=False)
-        found = (lu, units, names)
+        # q of each unit response at each punch's check points (X_p, K): a load change then
+        # checks q >= 0 with one small matrix product per punch
+        gap_weight = np.array([1.0 if name == "gap" else 0.0 for name in names])
+        checks = []
+        for p, prepared in enumerate(self.prepared):
+            lo, hi = self.offsets[p], self.offsets[p + 1]
+            unknown = [q for q in QUANTITIES if q not in givens[p]]
+            scalars = {q: units[n + 2 * p + unknown.index(q)] if q in unknown else
+                       np.array([1.0 if name == f"{p}:{q}" else 0.0 for name in names])
+                       for q in ("settlement", "tilt")}
+            checks.append(self._pressure(
+                p, prepared.check_x, units[lo:hi], units[lo:hi],
+                self._coupling_at_nodes(p, units[:n]), scalars, np.full(len(names), c),
+                prepared.check_formula, gap_weight))
+        found = (lu, units, names, checks)
         with self._lock:
             self._systems[key] = found
             while len(self._systems) > 8:
@@ -246,7 +265,7 @@ class CoupledPunches:
         n = self.size
         if first.kernel is None and first.c_is_constant:
             c = float(first.c(times[:1])[0])
-            _, units, names = self._system(givens, c)
+            _, units, names, unit_checks = self._system(givens, c)
             # loads at the output times and samples between them (q >= 0 is checked there)
             probe = (times if times.size == 1 else np.union1d(
                 times, np.linspace(times[0], times[-1], HISTORY_SAMPLES["elastic"])))
@@ -257,6 +276,7 @@ class CoupledPunches:
                                              probe.shape)
             solved = units @ weights  # (nodes + 2 n, probe)
             nodal = effective = solved[:n]
+            checks = [check @ weights for check in unit_checks]
             scalars_all = []
             for p in range(len(self.punches)):
                 scalars: dict[str, np.ndarray] = {}
@@ -281,18 +301,21 @@ class CoupledPunches:
             c_probe = np.asarray(first.c(probe), dtype=float)
             time_side = TimeSide(answer.time_error + fit_error, answer.steps, answer.success,
                                  answer.message, fit_error)
+            checks = [self._pressure(p, pc.check_x, nodal[self.offsets[p]:self.offsets[p + 1]],
+                                     effective[self.offsets[p]:self.offsets[p + 1]],
+                                     self._coupling_at_nodes(p, effective), scalars_all[p],
+                                     c_probe, pc.check_formula)
+                      for p, pc in enumerate(self.prepared)]
         at = np.searchsorted(probe, times)
         answers = []
         for p, prepared in enumerate(self.prepared):
             lo, hi = self.offsets[p], self.offsets[p + 1]
             scalars = scalars_all[p]
-            coupling = self._coupling_at_nodes(p, effective)
-            check = self._pressure(p, prepared.check_x, nodal[lo:hi], effective[lo:hi],
-                                   coupling, scalars, c_probe, prepared.check_formula)
-            q_extremes = (float(check.min()), float(np.max(np.abs(check))))
+            coupling = self._coupling_at_nodes(p, effective[:, at])
+            q_extremes = (float(checks[p].min()), float(np.max(np.abs(checks[p]))))
             out = {k: v[at] for k, v in scalars.items()}
             pressure = self._pressure_function(p, nodal[lo:hi, at], effective[lo:hi, at],
-                                               coupling[:, at], out, c_probe[at])
+                                               coupling, out, c_probe[at])
             built = dict(prepared.counts)
             solution = nystrom_solution(
                 prepared, inputs[p], out, pressure, q_extremes, time_side,
@@ -339,7 +362,8 @@ class CoupledPunches:
 
     def _pressure(self, p: int, x: np.ndarray, nodal: np.ndarray, effective: np.ndarray,
                   coupling: np.ndarray, scalars: dict[str, np.ndarray], c: np.ndarray,
-                  formula: np.ndarray | None = None) -> np.ndarray:
+                  formula: np.ndarray | None = None, gap: np.ndarray | None = None
+                  ) -> np.ndarray:
         """q on zone ``p`` at points ``x`` (its coordinates), shape (len(x), T).
 
         The Nystrom formula ``q = [delta + alpha x - g - F (q - V q)] / (c m)`` with the
@@ -347,7 +371,8 @@ class CoupledPunches:
         nodes) is smooth on the zone and taken from its panel interpolant (rows of every
         other zone at every point cost as much as the rest of the solve). ``formula``:
         where the formula is needed (None: everywhere); elsewhere q is interpolated from
-        the nodes as the single-punch check does. ``c`` (T,): c at the times.
+        the nodes as the single-punch check does. ``c`` (T,): c at the times; ``gap``
+        (T,): the gap's weight in each column (default 1).
         """
         prepared = self.prepared[p]
         grid = prepared.grid
@@ -357,8 +382,9 @@ class CoupledPunches:
         xs = np.ascontiguousarray(x[near])
         if xs.size:
             applied = prepared.rows(xs) @ effective + grid.interpolate(xs, coupling)
+            g_x = prepared.geometry.g(xs)[:, None]
             drive = (scalars["settlement"][None, :] + np.outer(xs, scalars["tilt"])
-                     - prepared.geometry.g(xs)[:, None])
+                     - (g_x if gap is None else g_x * gap[None, :]))
             out[near] = (drive - applied) / (prepared.geometry.m(xs)[:, None] * c[None, :])
         if not near.all():
             out[~near] = grid.interpolate(x[~near], nodal)
@@ -383,8 +409,15 @@ COUPLED = StageCache("coupled_punches", max_items=8, max_bytes=256 * 2**20,
 def coupled_for(punches: Sequence[PunchGeometry]) -> CoupledPunches:
     """The coupled discretization of ``punches``: from :data:`COUPLED` when the same
     geometries at the same centres were coupled before, else built now and kept."""
-    key = fingerprint("coupled", *[(geometry_key(p.geometry), p.center) for p in punches])
-    coupled, _ = COUPLED.get_or_compute(key, lambda: CoupledPunches(punches))
+    keys = [geometry_key(p.geometry) for p in punches]
+
+    def build() -> CoupledPunches:
+        prepared = [PREPARED.get_or_compute(k, lambda p=p: PreparedContact(p.geometry))[0]
+                    for k, p in zip(keys, punches, strict=True)]
+        return CoupledPunches(punches, prepared)
+
+    key = fingerprint("coupled", *[(k, p.center) for k, p in zip(keys, punches, strict=True)])
+    coupled, _ = COUPLED.get_or_compute(key, build)
     return coupled
 
 
