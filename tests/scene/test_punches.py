@@ -341,3 +341,17 @@ def test_the_json_schema_takes_either_form() -> None:
     both = _pair(0.5)
     both["punch"] = {"half_width": 1.0}
     assert schema_errors(both, schema)
+
+
+def test_three_punches_in_a_row() -> None:
+    d = _base()
+    load = {"force": 4e5, "moment": 0.0}
+    d["punches"] = [{"center": c, "half_width": 0.5, "loading": dict(load)}
+                    for c in (-1.3, 0.0, 1.3)]
+    left, middle, right = core.solve(d).punches
+    np.testing.assert_allclose(left.settlement, right.settlement, rtol=1e-12)
+    np.testing.assert_allclose(left.tilt, -right.tilt, rtol=1e-10)
+    # measured: 1.7e-20 rad against 8.4e-6 rad at the sides
+    assert np.max(np.abs(middle.tilt)) < 1e-10 * np.max(np.abs(left.tilt))
+    # the middle one has a neighbour on each side: it settles most
+    assert np.all(middle.settlement > left.settlement)
