@@ -63,14 +63,18 @@ from core.problem import QUANTITIES
 from core.scene import (
     MAX_SCENE_BYTES,
     SCHEMA_FILES,
+    PunchesScene,
+    PunchesSolution,
     Scene,
     SceneSolution,
     flags_with_evidence,
+    has_punches,
     load_json_schema,
     load_scene,
     migrate,
     model_error_evidence,
     provenance_lines,
+    punches_from_dict,
     read_scene_json,
     scene_from_dict,
     scene_json_schema,
@@ -140,10 +144,11 @@ def _input_errors(path: str) -> Iterator[None]:
         raise _InputError(f"{path}: {exc.strerror or exc}") from None
 
 
-def _read(path: str) -> Scene:
+def _read(path: str) -> Scene | PunchesScene:
     with _input_errors(path):
         if path == STDIO:
-            return scene_from_dict(read_scene_json(_stdin_text(), STDIN_NAME))
+            data = read_scene_json(_stdin_text(), STDIN_NAME)
+            return punches_from_dict(data) if has_punches(data) else scene_from_dict(data)
         return load_scene(path)
 
 
@@ -204,11 +209,40 @@ def _write(path: Path, content: str | bytes) -> None:
         raise _InputError(f"{path}: cannot write ({exc.strerror or exc})") from None
 
 
-def _describe(scene: Scene) -> str:
+def _describe(scene: Scene | PunchesScene) -> str:
+    if isinstance(scene, PunchesScene):
+        first = scene.scenes[0]
+        return (f"{scene.name!r}: {len(scene.scenes)} punches (statements "
+                f"{', '.join(str(s.statement) for s in scene.scenes)}), "
+                f"{len(first.coating)} coating layer(s), {first.times.size} time(s) up to "
+                f"{first.times[-1]:g} days after loading")
     given = " and ".join(q for q in QUANTITIES if q in scene.loading)
     return (f"{scene.name!r}: statement {scene.statement} ({given} given), "
             f"{len(scene.coating)} coating layer(s), {scene.times.size} time(s) up to "
             f"{scene.times[-1]:g} days after loading")
+
+
+def _punches_summary(result: PunchesSolution) -> str:
+    """The summary of a scene of several punches: each punch's histories at the first and
+    last times, its largest pressure, estimate and flags."""
+    lines = [f"solved {_describe(result.scene)}"]
+    rows = sorted({0, result.times.size - 1})
+    for k, punch in enumerate(result.punches):
+        lines.append(f"punches[{k}] at x = {punch.center:g} m (half-width "
+                     f"{punch.scene.half_width:g} m, statement {punch.scene.statement}):")
+        lines.append(f"{'time_day':>12} " + " ".join(f"{f'{q}_{_UNITS[q]}':>16}"
+                                                     for q in QUANTITIES))
+        for i in rows:
+            values = [getattr(punch, q)[i] for q in QUANTITIES]
+            lines.append(f"{result.times[i]:12.6g} " + " ".join(f"{v:16.8g}" for v in values))
+        q = punch.pressure_on_grid
+        i, t = np.unravel_index(int(np.argmax(q)), q.shape)
+        lines.append(f"  largest contact pressure q: {q[i, t]:.6g} Pa at x = "
+                     f"{punch.center + punch.x[i]:.6g} m, t = {result.times[t]:.6g} days")
+        lines.append(f"  {punch.info.get('message', '')}")
+        lines.append(f"  flags: {', '.join(punch.flags) if punch.flags else 'none'}")
+    lines.append(f"coating model: {result.info.get('coating_model')}")
+    return "\n".join(lines)
 
 
 def _summary(result: SceneSolution) -> str:
@@ -298,7 +332,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
             print(f"ok: study {checked.name!r}: {checked.n_points} points, "
                   f"{len(checked.parameters)} varied field(s)")
         else:
-            print(f"ok: {_describe(scene_from_dict(data))}")
+            print(f"ok: {_describe(punches_from_dict(data) if has_punches(data) else scene_from_dict(data))}")  # noqa: E501
     except ValueError as exc:
         raise _InputError(str(exc)) from None
     return EXIT_OK
@@ -337,7 +371,7 @@ def _strict_verdict(result: SceneSolution, flags: Sequence[str] | None = None) -
     return EXIT_OK
 
 
-def _solve(path: str) -> SceneSolution | None:
+def _solve(path: str) -> SceneSolution | PunchesSolution | None:
     """The answer for the scene at ``path``; None (the reason on stderr) when the solver
     cannot answer a valid scene, which is not the user's input error."""
     scene = _read(path)
@@ -357,6 +391,8 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     result = _solve(args.scene)
     if result is None:
         return EXIT_SOLVER_FAILED
+    if isinstance(result, PunchesSolution):
+        return _solved_punches(args, result, output, fmt, pressure_out)
     if output is None:
         print(_summary(result))
     elif fmt == "json":
@@ -375,6 +411,27 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     return _strict_verdict(result) if args.strict else EXIT_OK
 
 
+def _solved_punches(args: argparse.Namespace, result: PunchesSolution, output: Path | None,
+                    fmt: str | None, pressure_out: Path | None) -> int:
+    """``solve`` of a scene of several punches: the summary, or the answer as JSON."""
+    if fmt == "csv" or pressure_out is not None:
+        raise _InputError(f"{'--output' if fmt == 'csv' else '--pressure-csv'}: a scene of "
+                          "several punches is written as JSON (--output answer.json) for now")
+    if output is None:
+        print(_punches_summary(result))
+    else:
+        _write(output, result.to_json() + "\n")
+    for k, punch in enumerate(result.punches):
+        for name in punch.flags:
+            print(f"warning: punches[{k}].{name}: {_one_line(punch.flag_messages[name])}",
+                  file=sys.stderr)
+    if args.strict and result.flags:
+        print(f"error: strict: the answer is flagged ({', '.join(result.flags)}); "
+              f"exit code {EXIT_FLAGGED}", file=sys.stderr)
+        return EXIT_FLAGGED
+    return EXIT_OK
+
+
 def _cmd_report(args: argparse.Namespace) -> int:
     output = Path(args.output)
     stdout = str(output) == STDIO
@@ -385,6 +442,9 @@ def _cmd_report(args: argparse.Namespace) -> int:
     result = _solve(args.scene)
     if result is None:
         return EXIT_SOLVER_FAILED
+    if isinstance(result, PunchesSolution):
+        raise _InputError(f"{args.scene}: a report of several punches is not written yet; "
+                          "use python -m core solve (its summary or --output answer.json)")
     # imported here: the report loads HoloViews and Bokeh (or Matplotlib), ~2 s
     from core.report import output_index, report_html, report_pdf
 

@@ -49,6 +49,9 @@ MAX_POLYNOMIAL_COEFFICIENTS = 16
 #: scene: each adds ~140 quadrature nodes to a dense operator (16: 2448 nodes, 1.9 s,
 #: 360 MB; 40: 9 s, 1.7 GB).
 MAX_BREAKPOINTS = 16
+#: Most punches of one scene (``punches``): the coupled system is dense over all their
+#: nodes (8 punches of ~300 nodes: a 2400^2 LU, ~0.4 s and 46 MB).
+MAX_PUNCHES = 8
 
 # ----------------------------------------------------------------------------- geometry
 

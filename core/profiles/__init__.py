@@ -21,6 +21,7 @@ from core.profiles.base import (
     MAX_TABLE_ROWS,
     Profile,
     profile_values,
+    shifted,
 )
 from core.profiles.build import (
     FAMILIES,
@@ -51,6 +52,7 @@ __all__ = [
     "profile_from_csv",
     "profile_from_spec",
     "profile_values",
+    "shifted",
     "variation_of",
     "VARIATIONS",
     "without_offset",

@@ -258,6 +258,24 @@ def profile_values(profile: Profile, x: np.ndarray) -> np.ndarray:
     return np.broadcast_to(np.asarray(out, dtype=float), np.shape(x)).astype(float)
 
 
+def shifted(profile: Profile, by: float, domain: tuple[float, float]) -> Profile:
+    """``profile`` read from a point ``by`` further on: ``shifted(p, c, d)(x) = p(x + c)``
+    on ``domain`` (unit of the variable), its breakpoints and known extremes moved with it.
+
+    A profile of the global x [m] seen from a punch centred at ``c``. Its kind is
+    ``"shifted"`` and its spec names the profile and the shift; it is built here only (a
+    spec of that kind is not read back: it is no family of :data:`KINDS`).
+    """
+    by = float(by)
+    spec = {"kind": "shifted", "profile": profile.spec, "by": by,
+            "domain": list(profile.domain)}
+    return Profile(kind="shifted", spec=spec, variable=profile.variable,
+                   domain=(float(domain[0]), float(domain[1])),
+                   evaluate=lambda v: profile(v + by),
+                   breakpoints=tuple(b - by for b in profile.breakpoints),
+                   extra=tuple(e - by for e in profile._extra))
+
+
 def profile_key(profile: Profile) -> str:
     """A stable hex key of a profile: the SHA-256 of the canonical JSON of its spec,
     variable and domain (same for equal profiles, across processes and runs)."""

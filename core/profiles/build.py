@@ -196,7 +196,8 @@ def without_offset(profile: Profile) -> Profile:
     differences of nearby values are exact in floating point). Other families are kept
     as they are. Only differences of the result are meaningful.
     """
-    offset = FAMILIES[profile.kind].offset
+    family = FAMILIES.get(profile.kind)  # a shifted profile is no family: kept
+    offset = None if family is None else family.offset
     if offset is None:
         return profile
     return profile_from_spec(offset(profile.spec), field="gap", variable=profile.variable,

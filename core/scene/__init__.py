@@ -7,6 +7,8 @@ returns a ``SceneSolution``.
 - ``validate.py``: ``scene_from_dict``, a whole scene checked field by field;
 - ``model.py``: the validated ``Scene`` and ``Layer`` and what follows from them alone;
 - ``dimensionless.py``: ``to_dimensionless``, the scene as the dimensionless problem;
+- ``punches.py``: several punches on one foundation (``punches``): ``punches_from_dict``,
+  ``PunchesScene``, ``PunchesSolution`` (one ``PunchSolution`` per punch);
 - ``results.py``: ``SceneSolution``, the answer in SI units with its flags, JSON and CSV;
 - ``contact_zone.py``: ``contact_width``, ``lift_off_length``, ``lifts_off`` of a
   contact set: the one definition every output of the contact width uses;
@@ -50,6 +52,13 @@ from core.scene.json_schema import (
 from core.scene.model import Scene
 from core.scene.pipeline import solve
 from core.scene.plotting import LIFT_OFF_COLOUR, holoviews_for_bokeh, shown_times
+from core.scene.punches import (
+    PunchesScene,
+    PunchesSolution,
+    PunchSolution,
+    has_punches,
+    punches_from_dict,
+)
 from core.scene.records import (
     provenance,
     provenance_lines,
@@ -110,6 +119,11 @@ __all__ = [
     "plotting_grid",
     "provenance",
     "provenance_lines",
+    "has_punches",
+    "PunchesScene",
+    "PunchesSolution",
+    "punches_from_dict",
+    "PunchSolution",
     "read_scene_json",
     "replace_loads",
     "save_scene",

@@ -20,6 +20,7 @@ from core.scene.validate import scene_from_dict
 
 if TYPE_CHECKING:
     from core.scene.model import Scene
+    from core.scene.punches import PunchesScene
 
 
 def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
@@ -52,12 +53,17 @@ def read_scene_json(text: str, source: str = "scene") -> Any:
         raise ValueError(f"{source}: not valid JSON (nested too deeply)") from None
 
 
-def parse_scene_json(text: str, source: str = "scene") -> Scene:
-    """Parse and validate the JSON text of a scene; errors name ``source`` or the field."""
-    return scene_from_dict(read_scene_json(text, source))
+def parse_scene_json(text: str, source: str = "scene") -> Scene | PunchesScene:
+    """Parse and validate the JSON text of a scene; errors name ``source`` or the field.
+    A scene of several punches (``punches``) gives a :class:`core.scene.PunchesScene`."""
+    # imported here: the punches' module imports the results, which import this one
+    from core.scene.punches import has_punches, punches_from_dict
+
+    data = read_scene_json(text, source)
+    return punches_from_dict(data) if has_punches(data) else scene_from_dict(data)
 
 
-def load_scene(path: str | os.PathLike) -> Scene:
+def load_scene(path: str | os.PathLike) -> Scene | PunchesScene:
     """Read and validate a scene file (JSON, UTF-8, at most 1 MB); ``"preset:NAME"`` reads
     the shipped preset of that name (:mod:`core.presets`).
 

@@ -182,6 +182,9 @@ def _field(rule: FieldRule) -> dict[str, Any]:
     elif rule.kind == "layers":
         out = {"type": "array", "items": {"$ref": "#/$defs/layer"},
                "minItems": rule.least, "maxItems": rule.most}
+    elif rule.kind == "punches":
+        out = {"type": "array", "items": {"$ref": "#/$defs/placed_punch"},
+               "minItems": rule.least, "maxItems": rule.most}
     elif rule.kind in ("times", "creep"):
         out = {"$ref": f"#/$defs/{rule.kind}"}
     else:  # a kind the table gained without a schema here
@@ -302,6 +305,7 @@ def scene_definitions() -> dict[str, Any]:
     """The ``$defs`` of the scene schema (the study schema embeds them)."""
     return {
         "punch": _object("punch", "The rigid punch."),
+        "placed_punch": _object("punches[k]", "One punch of several, at its centre."),
         "layer": _object("coating[k]", "One coating layer; profiles of x [m] on [-a, a]."),
         "base": _base(),
         "loading": _loading(),
@@ -322,6 +326,11 @@ def scene_root() -> dict[str, Any]:
                             "(m, Pa, N/m, N, rad), times in days.",
                    {SCHEMA_KEY: {"type": "string", "description": "The JSON Schema of the "
                                  "file (ignored by the program)."}})
+    # one punch (punch and loading) or several (punches), not both
+    root["required"] = [name for name in root["required"] if name not in ("punch", "loading")]
+    root["oneOf"] = [{"required": ["punch", "loading"], "not": {"required": ["punches"]}},
+                     {"required": ["punches"], "not": {"anyOf": [{"required": ["punch"]},
+                                                                  {"required": ["loading"]}]}}]
     return root
 
 

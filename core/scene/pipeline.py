@@ -21,17 +21,22 @@ import numpy as np
 from core.engines.layered import solve_scene_layered
 from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
+from core.scene.punches import PunchesScene, PunchesSolution, has_punches, solve_punches_scene
 from core.scene.results import SceneSolution, _check_finite
 from core.scene.uncoated import lift_off_refusal
 from core.scene.validate import scene_from_dict
 from core.work import WorkLimitExceeded, work_bound
 
 
-def solve(scene: Scene | Mapping[str, Any]) -> SceneSolution:
+def solve(scene: Scene | PunchesScene | Mapping[str, Any]) -> SceneSolution | PunchesSolution:
     """Solve a scene (a :class:`Scene` or a scene dict, validated first).
 
-    Returns a :class:`SceneSolution` in SI units (m, rad, N/m, N, Pa; days after loading).
+    Returns a :class:`SceneSolution` in SI units (m, rad, N/m, N, Pa; days after loading);
+    a scene of several punches (``punches``, :mod:`core.scene.punches`) a
+    :class:`core.scene.PunchesSolution`.
     """
+    if has_punches(scene):
+        return solve_punches_scene(scene)
     # CPU time of this thread [s] from the dict to the answer, validation included: what
     # the scene costs, whatever else the machine runs (info["seconds"] is the solver's
     # wall time)

@@ -69,7 +69,8 @@ class FieldRule:
     ``"choice"`` (one of ``choices``), ``"x_profile"`` (a function of x [m] on [-a, a]),
     ``"t_profile"`` (a function of t [day after loading]), ``"object"`` (the object of
     that name in :data:`FIELDS`), ``"layers"`` (a list of ``"coating[k]"`` objects),
-    ``"times"`` or ``"creep"`` (see core/SCENES.md). ``low``/``high`` bound a number
+    ``"times"``, ``"creep"`` or ``"punches"`` (a list of ``"punches[k]"`` objects; see
+    core/SCENES.md). ``low``/``high`` bound a number
     (or every value of a profile), exclusive where ``low_open``/``high_open``; ``least``
     and ``most`` bound a text's length or a list's entries. The validator
     (:func:`core.scene.scene_from_dict`) and the JSON Schema
@@ -110,7 +111,8 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
               most=limits.MAX_NAME_CHARS),
         _rule("description", "text", "-", "Teaching text shown in the explorer.",
               required=False, most=limits.MAX_DESCRIPTION_CHARS, default=""),
-        _rule("punch", "object", "-", "The rigid punch."),
+        _rule("punch", "object", "-", "The rigid punch (or give punches instead of punch "
+              "and loading)."),
         _rule("coating", "layers", "-", f"Coating layers, top (under the punch) first, 0 to "
               f"{MAX_LAYERS} (none: the punch on the bare base, in full contact).", least=0,
               most=MAX_LAYERS),
@@ -123,6 +125,22 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
         _rule("solver", "object", "-", "Solver settings.", required=False),
         _rule("limits", "object", "-", "Limits of the design check (each optional; a limit "
               "left out is not checked).", required=False),
+        _rule("punches", "punches", "-", f"Several rigid punches on the one foundation, 1 to "
+              f"{limits.MAX_PUNCHES}, each with its centre, half-width, shape and loading "
+              "(instead of punch and loading; core/SCENES.md 'Several punches').",
+              required=False, least=1, most=limits.MAX_PUNCHES),
+    ),
+    "punches[k]": (
+        _rule("center", "number", "m", "Position of the punch's centre along the surface "
+              "(the zones of two punches must not overlap or touch)."),
+        _rule("half_width", "number", "m", "Half-width a of the punch.", low=0.0,
+              low_open=True),
+        _rule("shape", "x_profile", "m", "Height f(x) of the punch base above its lowest "
+              "point, x [m] from its own centre on [-a, a] (0: a flat punch).",
+              required=False, default=0.0),
+        _rule("loading", "object", "-", "This punch's loading: exactly two of settlement "
+              "[m], tilt [rad], force [N/m], moment [N] (about its own centre), each a "
+              "function of t [day after loading]."),
     ),
     "punch": (
         _rule("half_width", "number", "m", "Half-width a of the punch.", low=0.0,

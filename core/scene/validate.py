@@ -92,6 +92,9 @@ def _key_without_loads(d: Mapping[str, Any]) -> str | None:
 
 def _validated(d: dict[str, Any]) -> Scene:
     """:func:`scene_from_dict`'s checks of every field of the migrated dict ``d``."""
+    if "punches" in d:
+        raise ValueError("punches: a scene of several punches is read by "
+                         "core.scene.punches_from_dict (core.solve takes either form)")
     check_fields(d, "", schema.required_fields("scene"),
                  (*schema.optional_fields("scene"), schema.SCHEMA_KEY))
     if schema.SCHEMA_KEY in d:

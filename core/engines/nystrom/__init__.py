@@ -15,6 +15,8 @@
 - :mod:`~core.engines.nystrom.elastic`: the elastic answer from cached unit responses;
   :mod:`~core.engines.nystrom.modal`: the modal form for creep or a modulus varying in
   time, stepped by :mod:`core.time.integration`, whose estimate is the time part;
+- :mod:`~core.engines.nystrom.multi`: several punches on one foundation, each on its own
+  grid, coupled through the base (:func:`solve_punches`, :class:`PunchGeometry`);
 - :mod:`~core.engines.nystrom.result`: the two parts added into
   ``info["error_estimate"]``, judged against ``tol`` (margin 1) and packed.
 """
@@ -22,6 +24,13 @@
 from __future__ import annotations
 
 from core.engines.nystrom.engine import NYSTROM, NystromEngine
+from core.engines.nystrom.multi import (
+    COUPLED,
+    CoupledPunches,
+    PunchGeometry,
+    coupled_for,
+    solve_punches,
+)
 from core.engines.nystrom.prepared import (
     PREPARED,
     PREPARED_BYTES,
@@ -32,6 +41,11 @@ from core.engines.nystrom.prepared import (
 )
 
 __all__ = [
+    "COUPLED",
+    "coupled_for",
+    "CoupledPunches",
+    "PunchGeometry",
+    "solve_punches",
     "NYSTROM",
     "NystromEngine",
     "prepare",

@@ -452,7 +452,9 @@ PREPARED = StageCache("prepared", max_items=32, max_bytes=PREPARED_BYTES,
                       sizeof=lambda prepared: prepared.nbytes)
 
 
-def _geometry_key(geometry: Geometry) -> str:
+def geometry_key(geometry: Geometry) -> str:
+    """The key of a validated geometry in :data:`PREPARED` (its values on 2049 Chebyshev
+    points and both sides of each jump)."""
     from core.cache import fingerprint
 
     probe = np.cos(np.linspace(0.0, np.pi, 2049))
@@ -484,6 +486,6 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
 def prepared_for(geometry: Geometry) -> PreparedContact:
     """The prepared form of a validated geometry: from :data:`PREPARED` when a geometry of
     the same values was prepared before, else prepared now and kept there."""
-    prepared, _ = PREPARED.get_or_compute(_geometry_key(geometry),
+    prepared, _ = PREPARED.get_or_compute(geometry_key(geometry),
                                           lambda: PreparedContact(geometry))
     return prepared

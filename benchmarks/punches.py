@@ -1,0 +1,100 @@
+"""What a scene of two punches costs against one punch of the same resolution.
+
+    OPENBLAS_NUM_THREADS=1 python -m benchmarks.punches [--no-write]
+
+The uniform preset on an elastic base at tol 1e-6. *One punch*: the punch alone by the
+same model (thin layer, default engine: ``scene.dimensionless.solve()``), its half-width
+0.01 % wider at each solve so that every cache misses (*loads only*: its force changed).
+*Two punches*: ``core.solve`` of
+two punches 1 m apart (the second 0.6 times as wide, so the two grids differ, or the same
+width, so they share one), both half-widths changed at each solve; *loads only*: the two
+punches' forces changed. Medians of the CPU time of this process per solve [ms], with
+the machine's load average; written to ``benchmarks/results/punches.md`` unless
+``--no-write``.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+import core
+from core.presets import read_preset
+from core.scene import SceneSolution, scene_from_dict
+
+SOLVES = 8
+
+
+def _scene() -> dict:
+    d = read_preset("uniform_flat")
+    d["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
+    d["times"] = {"end": 10.0, "count": 3}
+    d["solver"] = {"tol": 1e-6}
+    return d
+
+
+def _single(i: int, force_step: float = 0.0, geometry_step: float = 1e-4) -> None:
+    d = _scene()
+    d["punch"]["half_width"] *= 1 + geometry_step * i
+    d["loading"]["force"] *= 1 + force_step * i
+    scene = scene_from_dict(d)
+    SceneSolution(scene, scene.dimensionless, scene.dimensionless.solve())
+
+
+def _pair(i: int, ratio: float, force_step: float = 0.0, geometry_step: float = 1e-4) -> None:
+    d = _scene()
+    del d["punch"], d["loading"]
+    a0, a1 = 1.0 * (1 + geometry_step * i), ratio * (1 + geometry_step * i)
+    d["punches"] = [
+        {"center": 0.0, "half_width": a0,
+         "loading": {"force": 5e5 * (1 + force_step * i), "moment": 0.0}},
+        {"center": a0 + 1.0 + a1, "half_width": a1,
+         "loading": {"force": 3e5 * (1 + force_step * i), "moment": 0.0}}]
+    core.solve(d)
+
+
+def _median_ms(run) -> float:  # noqa: ANN001
+    times = []
+    for i in range(1, SOLVES + 1):
+        start = time.process_time()
+        run(i)
+        times.append(time.process_time() - start)
+    return 1e3 * float(np.median(times))
+
+
+def main(argv: list[str]) -> None:
+    _single(0), _pair(0, 0.6)  # imports and first builds: not measured
+    rows = [("one punch (a = 1 m), new geometry", _median_ms(_single)),
+            ("two punches (a = 1, 0.6 m), new geometry", _median_ms(lambda i: _pair(i, 0.6))),
+            ("two punches (a = 1, 1 m), new geometry", _median_ms(lambda i: _pair(i, 1.0))),
+            ("one punch (a = 1 m), loads only",
+             _median_ms(lambda i: _single(1000, force_step=1e-3 * i, geometry_step=0.0))),
+            ("two punches (a = 1, 0.6 m), loads only",
+             _median_ms(lambda i: _pair(1000, 0.6, force_step=1e-3 * i, geometry_step=0.0)))]
+    single = rows[0][1]
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True, check=False).stdout.strip()
+    load = os.getloadavg()
+    lines = ["# Two punches against one", "",
+             f"commit {commit}, {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC, load average "
+             f"{load[0]:.2f} {load[1]:.2f} {load[2]:.2f}, OPENBLAS_NUM_THREADS="
+             f"{os.environ.get('OPENBLAS_NUM_THREADS', 'unset')}; uniform preset, elastic "
+             "base, tol 1e-6, 3 output times; median CPU time of "
+             f"{SOLVES} solves (`python -m benchmarks.punches`).", "",
+             "| solve | CPU [ms] | against one punch |", "| --- | --- | --- |"]
+    lines += [f"| {name} | {ms:.1f} | {ms / single:.2f}x |" for name, ms in rows]
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if "--no-write" not in argv:
+        out = Path(__file__).resolve().parent / "results" / "punches.md"
+        out.write_text(text, encoding="utf-8")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

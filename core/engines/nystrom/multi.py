@@ -1,0 +1,501 @@
+"""Several rigid punches on one foundation: the default engine's grids, coupled.
+
+Design (dimensionless, elastic base, full contact):
+
+- **Lengths.** Each punch ``p`` keeps its own scaling, that of a single punch of its
+  half-width ``a_p`` (:mod:`core.scene.dimensionless`): ``x*_p = (x - e_p) / a_p``,
+  ``lam_p = a_p / H``, ``delta*_p = delta_p / a_p``, ``P*_p = 2 (1 - nu^2) P_p / (E a_p)``,
+  ``M*_p = 2 (1 - nu^2) M_p / (E a_p^2)`` with ``e_p`` its centre. The dimensionless
+  pressure ``q* = 2 (1 - nu^2) q / E`` does not depend on ``a_p``, so it is one field over
+  all zones. The common length between punches is the base thickness ``H``: punch ``p``
+  covers ``[E_p - lam_p, E_p + lam_p]`` with ``E_p = e_p / H``.
+- **Equations.** Divided by ``a_p``, the surface displacement on zone ``p`` reads
+
+      c m_p q_p + F_p q_p + sum_{r != p} (lam_r / lam_p) F_r q_r (x_r)
+          = delta_p + alpha_p x - g_p(x),     x_r = (E_p + lam_p x - E_r) / lam_r,
+
+  where ``F_r`` is punch ``r``'s own operator ``int k_pl(lam_r (x - xi)) q(xi) dxi / pi``
+  evaluated at the points ``x_r`` of zone ``p`` written in ``r``'s coordinates (outside
+  ``[-1, 1]``), and ``int q_p = P_p``, ``int x q_p = M_p`` on each zone.
+- **Grids.** Each punch has the graded, adaptively refined grid of a single punch of
+  its own geometry (:func:`core.engines.nystrom.prepared_for`, cached: two identical
+  punches share one), so each self block is exactly the single-punch operator. Where a
+  neighbour is closer to an end than that end's panel is wide, the neighbour's edge
+  pressure makes the drive on this zone vary on the scale of the gap: the end is graded
+  further (``h -> h/4`` a level, :class:`ZoneGrid`) until its panel is no wider than the
+  gap (measured on a pair 1e-4 to 1e-2 half-widths apart: without it the error of q grew
+  to 1.1e-6 at a gap of 1e-3 and 5e-5 at 1e-4 under an estimate of 1e-7; with it 2.6e-8
+  at tol 1e-6 and 1.8e-9 at tol 1e-8, against a reference graded twenty times finer).
+- **Coupling blocks.** Rows of ``F_r`` at the nodes of zone ``p`` mapped into ``r``'s
+  coordinates (:meth:`PreparedContact.rows`, i.e. :func:`core.discretize.operator_rows`):
+  between disjoint intervals the kernel is smooth and the 16-point Gauss rule of the
+  source panel is used, except where a target lies within ``NEAR_FIELD`` half-widths of a
+  source panel (two punches close against their panel sizes), where the engine's product
+  integration of the log part takes over. A block whose zones are further apart than
+  :data:`NEGLIGIBLE_GAP` base thicknesses is left out: ``k_pl(s)`` decays like
+  ``exp(-2.106 s)`` (model notes), ``|k_pl(s)| < 2 exp(-2.106 s)`` for ``s >= 5`` (measured
+  on 5-40 by quadrature of the kernel: at most 1.4 exp(-2.106 s)), below 1e-16 beyond 18.
+- **Bordered system.** Unknowns ``[q_1 .. q_n; two scalars per punch]``; rows: the nodal
+  equations of every zone, then force and moment balance of every punch. It is factored
+  once per (statements, ``c``) and solved for a unit value of each given load of each
+  punch and for the gaps together: loads that change in time, or a load change, are a
+  combination of those columns (one small matrix product).
+- **Between the nodes** q comes from the equation itself (the Nystrom formula), exact in
+  ``m`` and ``g`` at jumps as for one punch; the other zones' part of ``F q`` is smooth on
+  the zone and is interpolated on its panels from the nodes (the rows of every other
+  zone at every point asked for cost as much as the rest of the solve). The check of
+  ``q >= 0`` takes the formula on panels ending at +-1 or a jump and the panel
+  interpolant elsewhere, as the single punch's check does.
+- **Error estimate.** Each punch's grid carries the two-grid estimate of its own
+  adaptive refinement (``spatial_error``); the coupling adds to zone ``p`` a drive that is
+  smooth on it (analytic where the zones are apart), which the grid's interior panels
+  resolve like the ``1, x`` drives the estimate was made with. The estimate of a punch is
+  its grid's; the scene's the largest. The tests measure it against refined answers.
+
+Creep and a modulus varying in time: the same coupled operator in modal form
+(:mod:`core.engines.nystrom.multi_modal`), stepped by :mod:`core.time`; the time
+stepping's estimate is added to the punches' spatial ones. Lift-off is not coupled here
+(refused by the scene, :mod:`core.scene.punches`).
+"""
+
+from __future__ import annotations
+
+import threading
+import time as _time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.linalg import lu_factor, lu_solve
+
+from core.cache import StageCache, fingerprint
+from core.creep import stepping_kernel
+from core.discretize import panel_index
+from core.engines.nystrom.adapt import LEVEL_SPLIT, MAX_PANELS, grade
+from core.engines.nystrom.bordered import build_grid, touches
+from core.engines.nystrom.multi_modal import CoupledModalForm
+from core.engines.nystrom.prepared import (
+    HISTORY_SAMPLES,
+    PREPARED,
+    TIME_SHARE,
+    PreparedContact,
+    geometry_key,
+    prepared_for,
+)
+from core.engines.nystrom.result import TimeSide, nystrom_solution
+from core.problem import QUANTITIES, ContactSolution, Geometry, TimeInputs
+
+#: Zones further apart than this many base thicknesses are not coupled (see the notes:
+#: 2 exp(-2.106 * 18) = 1.1e-16).
+NEGLIGIBLE_GAP = 18.0
+
+
+#: An end of a zone is graded further while its panel is wider than this many times the
+#: gap to the neighbour it faces (see :meth:`CoupledPunches._facing_refined`).
+CLOSE_SHARE = 1.0
+#: Most extra levels of grading toward a facing end (each cuts the width by 4).
+MAX_FACING_LEVELS = 20
+
+
+class ZoneGrid:
+    """A punch's prepared grid refined on its own edges (see ``_facing_refined``), with the
+    members of :class:`PreparedContact` the coupled solve uses."""
+
+    def __init__(self, prepared: PreparedContact, edges: np.ndarray) -> None:
+        geometry = self.geometry = prepared.geometry
+        self.grid = build_grid(geometry.lam, edges, geometry.m, geometry.g, prepared.grid,
+                               prepared.grid.kernel_accuracy)
+        self.spatial_error, self.resolved = prepared.spatial_error, prepared.resolved
+        self.counts, self.seconds = prepared.counts, prepared.seconds
+        self.check_x = prepared.check_x
+        singular = np.array([-1.0, 1.0, *geometry.breakpoints])
+        self.check_formula = touches(self.grid.panels, singular)[
+            panel_index(self.grid.panels, self.check_x)]
+        self.element_ends = tuple(sorted(set(self.grid.panels.edges[1:-1].tolist())
+                                         | set(geometry.breakpoints)))
+        self._rows: dict[bytes, np.ndarray] = {}
+        self._lock = threading.Lock()
+
+    def rows(self, x: np.ndarray) -> np.ndarray:
+        """Rows of the zone's operator at points ``x`` (len(x), N), cached by the points."""
+        key = x.tobytes()
+        with self._lock:
+            found = self._rows.get(key)
+        if found is None:
+            found = self.grid.rows(x)
+            with self._lock:
+                self._rows[key] = found
+                while len(self._rows) > 8:
+                    self._rows.pop(next(iter(self._rows)))
+        return found
+
+
+@dataclass(frozen=True)
+class PunchGeometry:
+    """One punch of a coupled problem: its own validated ``geometry`` (``lam = a/H``,
+    ``m``, ``g``, jumps and ``tol`` in its coordinates ``x* = (x - e)/a``) and its centre
+    ``center = e / H`` (base thicknesses)."""
+
+    geometry: Geometry
+    center: float
+
+    @property
+    def span(self) -> tuple[float, float]:
+        """The zone in base thicknesses, ``(E - lam, E + lam)``."""
+        lam = self.geometry.lam
+        return (self.center - lam, self.center + lam)
+
+
+def coupled_x(source: PunchGeometry, target: PunchGeometry, x: np.ndarray) -> np.ndarray:
+    """Points ``x`` of ``target``'s coordinates written in ``source``'s."""
+    return (target.center + target.geometry.lam * x - source.center) / source.geometry.lam
+
+
+class CoupledPunches:
+    """The coupled discretization of several punches (see the module notes).
+
+    ``punches``: the punches in the order of the answer; ``prepared``: each one's grid
+    (:class:`PreparedContact`); ``blocks[p][r]``: the coupling block (N_p, N_r) of ``r``
+    on ``p``'s nodes, or None when negligible.
+    """
+
+    def __init__(self, punches: Sequence[PunchGeometry],
+                 prepared: Sequence[PreparedContact] | None = None) -> None:
+        """``prepared``: each punch's prepared grid, if known (else found or built by
+        :func:`core.engines.nystrom.prepared_for`)."""
+        t0 = _time.perf_counter()
+        self.punches = tuple(punches)
+        found = tuple(prepared if prepared is not None else
+                      (prepared_for(p.geometry) for p in self.punches))
+        self.prepared: tuple[PreparedContact | ZoneGrid, ...] = tuple(
+            self._facing_refined(p, pc) for p, pc in enumerate(found))
+        self.sizes = [pc.grid.size for pc in self.prepared]
+        self.offsets = np.concatenate([[0], np.cumsum(self.sizes)]).astype(int)
+        n = len(self.punches)
+        self.blocks: list[list[np.ndarray | None]] = [[None] * n for _ in range(n)]
+        for p in range(n):
+            for r in range(n):
+                if p != r and self.coupled(p, r):
+                    self.blocks[p][r] = self.coupling_rows(p, r, self.prepared[p].grid.nodes)
+        # bordered systems (LU, unit responses, names) and modal forms, by statements
+        self._systems: dict[tuple, Any] = {}
+        self._lock = threading.Lock()
+        self.seconds = _time.perf_counter() - t0
+
+    def _facing_refined(self, p: int, prepared: PreparedContact
+                        ) -> PreparedContact | ZoneGrid:
+        """Punch ``p``'s grid, graded further toward an end that faces a neighbour closer
+        than :data:`CLOSE_SHARE` times the end panel's width (the neighbour's pressure makes
+        the drive on this zone vary on the scale of the gap there)."""
+        lo_p, hi_p = self.punches[p].span
+        lam = self.punches[p].geometry.lam
+        left = min((lo_p - hi for r, (lo, hi) in enumerate(q.span for q in self.punches)
+                    if r != p and hi <= lo_p), default=np.inf) / lam
+        right = min((lo - hi_p for r, (lo, hi) in enumerate(q.span for q in self.punches)
+                     if r != p and lo >= hi_p), default=np.inf) / lam
+        edges = prepared.grid.panels.edges
+        levels = 0
+        for end, gap in ((-1.0, left), (1.0, right)):
+            for _ in range(MAX_FACING_LEVELS):
+                width = edges[1] - edges[0] if end < 0 else edges[-1] - edges[-2]
+                if width <= gap / CLOSE_SHARE or len(edges) - 1 >= MAX_PANELS:
+                    break
+                edges = grade(edges, np.array([end]), 1, LEVEL_SPLIT)
+                levels += 1
+        return prepared if not levels else ZoneGrid(prepared, edges)
+
+    def coupled(self, p: int, r: int) -> bool:
+        """Whether zones ``p`` and ``r`` are close enough to act on each other."""
+        (lo_p, hi_p), (lo_r, hi_r) = self.punches[p].span, self.punches[r].span
+        return max(lo_p, lo_r) - min(hi_p, hi_r) < NEGLIGIBLE_GAP
+
+    def coupling_rows(self, p: int, r: int, x: np.ndarray) -> np.ndarray:
+        """``(lam_r / lam_p) F_r`` at points ``x`` of zone ``p`` (len(x), N_r)."""
+        source, target = self.punches[r], self.punches[p]
+        mapped = np.ascontiguousarray(coupled_x(source, target, np.asarray(x, dtype=float)))
+        scale = source.geometry.lam / target.geometry.lam
+        return scale * self.prepared[r].rows(mapped)
+
+    @property
+    def nbytes(self) -> int:
+        """Memory of the coupling blocks and the factored systems [bytes] (the grids are
+        counted by :data:`core.engines.nystrom.PREPARED`)."""
+        blocks = sum(b.nbytes for row in self.blocks for b in row if b is not None)
+        systems = sum(entry[0][0].nbytes + entry[1].nbytes + sum(c.nbytes for c in entry[3])
+                      for key, entry in self._systems.items() if key[0] != "modal")
+        modal = sum(3 * entry.q.nbytes for key, entry in self._systems.items()
+                    if key[0] == "modal")
+        return int(blocks + systems + modal)
+
+    @property
+    def size(self) -> int:
+        """Nodes of all zones."""
+        return int(self.offsets[-1])
+
+    # ------------------------------------------------------------------ bordered
+
+    def _system(self, givens: tuple[frozenset[str], ...], c: float
+                ) -> tuple[tuple, np.ndarray, list[str]]:
+        """LU of the bordered matrix and its unit responses (nodes + 2 n, K): columns named
+        ``"p:quantity"`` for every given load of every punch, then ``"gap"``."""
+        key = (givens, c)
+        with self._lock:
+            found = self._systems.get(key)
+        if found is not None:
+            return found
+        n_p = len(self.punches)
+        n = self.size
+        total = n + 2 * n_p
+        matrix = np.zeros((total, total))
+        names: list[str] = []
+        rhs_columns: list[np.ndarray] = []
+        gap = np.zeros(total)
+        for p, prepared in enumerate(self.prepared):
+            grid = prepared.grid
+            lo, hi = self.offsets[p], self.offsets[p + 1]
+            block = matrix[lo:hi, lo:hi]
+            block[...] = grid.operator
+            block.flat[::hi - lo + 1] += c * grid.m
+            for r in range(n_p):
+                coupling = self.blocks[p][r]
+                if coupling is not None:
+                    matrix[lo:hi, self.offsets[r]:self.offsets[r + 1]] = coupling
+            force_row, moment_row = n + 2 * p, n + 2 * p + 1
+            matrix[force_row, lo:hi] = grid.panels.weights
+            matrix[moment_row, lo:hi] = grid.panels.weights * grid.nodes
+            unknown = [q for q in QUANTITIES if q not in givens[p]]
+            for k, name in enumerate(unknown):
+                column = n + 2 * p + k
+                if name == "settlement":
+                    matrix[lo:hi, column] = -1.0
+                elif name == "tilt":
+                    matrix[lo:hi, column] = -grid.nodes
+                else:
+                    matrix[force_row if name == "force" else moment_row, column] = -1.0
+            for name in sorted(givens[p]):
+                column = np.zeros(total)
+                if name == "settlement":
+                    column[lo:hi] = 1.0
+                elif name == "tilt":
+                    column[lo:hi] = grid.nodes
+                else:
+                    column[force_row if name == "force" else moment_row] = 1.0
+                names.append(f"{p}:{name}")
+                rhs_columns.append(column)
+            gap[lo:hi] = -grid.g
+        names.append("gap")
+        rhs_columns.append(gap)
+        lu = lu_factor(matrix, overwrite_a=True, check_finite=False)
+        units = lu_solve(lu, np.column_stack(rhs_columns), check_finite=False)
+        # q of each unit response at each punch's check points (X_p, K): a load change then
+        # checks q >= 0 with one small matrix product per punch
+        gap_weight = np.array([1.0 if name == "gap" else 0.0 for name in names])
+        checks = []
+        for p, prepared in enumerate(self.prepared):
+            lo, hi = self.offsets[p], self.offsets[p + 1]
+            unknown = [q for q in QUANTITIES if q not in givens[p]]
+            scalars = {q: units[n + 2 * p + unknown.index(q)] if q in unknown else
+                       np.array([1.0 if name == f"{p}:{q}" else 0.0 for name in names])
+                       for q in ("settlement", "tilt")}
+            checks.append(self._pressure(
+                p, prepared.check_x, units[lo:hi], units[lo:hi],
+                self._coupling_at_nodes(p, units[:n]), scalars, np.full(len(names), c),
+                prepared.check_formula, gap_weight))
+        found = (lu, units, names, checks)
+        with self._lock:
+            self._systems[key] = found
+            while len(self._systems) > 8:
+                self._systems.pop(next(iter(self._systems)))
+        return found
+
+    # --------------------------------------------------------------------- solve
+
+    def solve(self, inputs: Sequence[TimeInputs], time_breaks: Sequence[float] = ()
+              ) -> list[ContactSolution]:
+        """The full-contact answer of every punch (dimensionless, each in its own scaling),
+        in the order of the punches.
+
+        ``inputs``: each punch's validated time side; all share the times, ``c`` and the
+        creep kernel (one base). An elastic base of constant modulus is answered by the
+        bordered system's unit responses, creep or a varying modulus in modal form
+        (:mod:`core.engines.nystrom.multi_modal`). ``time_breaks``: times where a given
+        history jumps or kinks.
+        """
+        t0 = _time.perf_counter()
+        if len(inputs) != len(self.punches):
+            raise ValueError(f"inputs: {len(inputs)} time sides for {len(self.punches)} punches")
+        first = inputs[0]
+        times = first.times
+        for k, one in enumerate(inputs):
+            if not np.array_equal(one.times, times):
+                raise ValueError(f"punches[{k}]: all punches share the output times")
+            if (one.kernel is None) != (first.kernel is None) or (
+                    one.c_is_constant != first.c_is_constant):
+                raise ValueError(f"punches[{k}]: all punches stand on one base")
+        givens = tuple(one.given for one in inputs)
+        n = self.size
+        if first.kernel is None and first.c_is_constant:
+            c = float(first.c(times[:1])[0])
+            _, units, names, unit_checks = self._system(givens, c)
+            # loads at the output times and samples between them (q >= 0 is checked there)
+            probe = (times if times.size == 1 else np.union1d(
+                times, np.linspace(times[0], times[-1], HISTORY_SAMPLES["elastic"])))
+            weights = np.ones((len(names), probe.size))
+            for k, name in enumerate(names[:-1]):
+                p, quantity = name.split(":")
+                weights[k] = np.broadcast_to(inputs[int(p)].loads[quantity](probe),
+                                             probe.shape)
+            solved = units @ weights  # (nodes + 2 n, probe)
+            nodal = effective = solved[:n]
+            checks = [check @ weights for check in unit_checks]
+            scalars_all = []
+            for p in range(len(self.punches)):
+                scalars: dict[str, np.ndarray] = {}
+                unknown = [q for q in QUANTITIES if q not in givens[p]]
+                for k, name in enumerate(unknown):
+                    scalars[name] = solved[n + 2 * p + k]
+                for name in givens[p]:
+                    scalars[name] = np.broadcast_to(inputs[p].loads[name](probe),
+                                                    probe.shape).astype(float)
+                scalars_all.append(scalars)
+            c_probe = np.full(probe.size, c)
+            time_side = TimeSide(message="elastic base, several punches")
+        else:
+            probe = (times if times.size == 1 else np.union1d(
+                times, np.linspace(times[0], times[-1], HISTORY_SAMPLES["creep"])))
+            tol = min(pc.geometry.tol for pc in self.prepared)
+            kernel, fit_error = stepping_kernel(first.kernel, float(times[-1]), 0.5 * tol)
+            breaks = [b for b in time_breaks if times[0] < b < times[-1]]
+            answer = self.modal(givens, tol).solve(inputs, probe, first.c, kernel,
+                                                   tol / TIME_SHARE, breaks)
+            nodal, effective, scalars_all = answer.nodal, answer.effective, answer.scalars
+            c_probe = np.asarray(first.c(probe), dtype=float)
+            time_side = TimeSide(answer.time_error + fit_error, answer.steps, answer.success,
+                                 answer.message, fit_error)
+            checks = [self._pressure(p, pc.check_x, nodal[self.offsets[p]:self.offsets[p + 1]],
+                                     effective[self.offsets[p]:self.offsets[p + 1]],
+                                     self._coupling_at_nodes(p, effective), scalars_all[p],
+                                     c_probe, pc.check_formula)
+                      for p, pc in enumerate(self.prepared)]
+        at = np.searchsorted(probe, times)
+        answers = []
+        for p, prepared in enumerate(self.prepared):
+            lo, hi = self.offsets[p], self.offsets[p + 1]
+            scalars = scalars_all[p]
+            coupling = self._coupling_at_nodes(p, effective[:, at])
+            q_extremes = (float(checks[p].min()), float(np.max(np.abs(checks[p]))))
+            out = {k: v[at] for k, v in scalars.items()}
+            pressure = self._pressure_function(p, nodal[lo:hi, at], effective[lo:hi, at],
+                                               coupling, out, c_probe[at])
+            built = dict(prepared.counts)
+            solution = nystrom_solution(
+                prepared, inputs[p], out, pressure, q_extremes, time_side,
+                _time.perf_counter() - t0, {k: 0 for k in built},
+                float(np.max(np.abs(scalars["tilt"]))), False)
+            solution.info["punches"] = len(self.punches)
+            solution.info["coupling_seconds"] = self.seconds
+            solution.contact_set.extend([[(-1.0, 1.0)] for _ in range(times.size)])
+            answers.append(solution)
+        return answers
+
+    def modal(self, givens: tuple[frozenset[str], ...], tol: float) -> CoupledModalForm:
+        """The modal form of the coupled equations for the punches' statements (cached)."""
+        key = ("modal", givens, tol)
+        with self._lock:
+            found = self._systems.get(key)
+        if found is None:
+            n = self.size
+            operator = np.zeros((n, n))
+            for p, prepared in enumerate(self.prepared):
+                lo, hi = self.offsets[p], self.offsets[p + 1]
+                operator[lo:hi, lo:hi] = prepared.grid.operator
+                for r, block in enumerate(self.blocks[p]):
+                    if block is not None:
+                        operator[lo:hi, self.offsets[r]:self.offsets[r + 1]] = block
+            grids = [pc.grid for pc in self.prepared]
+            found = CoupledModalForm(
+                operator, np.concatenate([g.m for g in grids]),
+                np.concatenate([g.panels.weights for g in grids]),
+                np.concatenate([g.nodes for g in grids]),
+                np.concatenate([g.g for g in grids]), self.offsets, givens, tol)
+            with self._lock:
+                self._systems[key] = found
+        return found
+
+    def _coupling_at_nodes(self, p: int, solved: np.ndarray) -> np.ndarray:
+        """The other zones' part of ``F q`` at zone ``p``'s nodes (N_p, T); ``solved``
+        holds the nodal q (or q - V q) of all zones (rows) at the T times."""
+        out = np.zeros((self.sizes[p], solved.shape[1]))
+        for r, block in enumerate(self.blocks[p]):
+            if block is not None:
+                out += block @ solved[self.offsets[r]:self.offsets[r + 1]]
+        return out
+
+    def _pressure(self, p: int, x: np.ndarray, nodal: np.ndarray, effective: np.ndarray,
+                  coupling: np.ndarray, scalars: dict[str, np.ndarray], c: np.ndarray,
+                  formula: np.ndarray | None = None, gap: np.ndarray | None = None
+                  ) -> np.ndarray:
+        """q on zone ``p`` at points ``x`` (its coordinates), shape (len(x), T).
+
+        The Nystrom formula ``q = [delta + alpha x - g - F (q - V q)] / (c m)`` with the
+        zone's own rows; the other zones' part of ``F (q - V q)`` (``coupling``, at the
+        nodes) is smooth on the zone and taken from its panel interpolant (rows of every
+        other zone at every point cost as much as the rest of the solve). ``formula``:
+        where the formula is needed (None: everywhere); elsewhere q is interpolated from
+        the nodes as the single-punch check does. ``c`` (T,): c at the times; ``gap``
+        (T,): the gap's weight in each column (default 1).
+        """
+        prepared = self.prepared[p]
+        grid = prepared.grid
+        x = np.ascontiguousarray(x, dtype=float)
+        out = np.empty((x.size, nodal.shape[1]))
+        near = np.ones(x.size, dtype=bool) if formula is None else formula
+        xs = np.ascontiguousarray(x[near])
+        if xs.size:
+            applied = prepared.rows(xs) @ effective + grid.interpolate(xs, coupling)
+            g_x = prepared.geometry.g(xs)[:, None]
+            drive = (scalars["settlement"][None, :] + np.outer(xs, scalars["tilt"])
+                     - (g_x if gap is None else g_x * gap[None, :]))
+            out[near] = (drive - applied) / (prepared.geometry.m(xs)[:, None] * c[None, :])
+        if not near.all():
+            out[~near] = grid.interpolate(x[~near], nodal)
+        return out
+
+    def _pressure_function(self, p: int, nodal: np.ndarray, effective: np.ndarray,
+                           coupling: np.ndarray, scalars: dict[str, np.ndarray],
+                           c: np.ndarray):  # noqa: ANN202
+
+        def pressure(x: np.ndarray) -> np.ndarray:
+            return self._pressure(p, x, nodal, effective, coupling, scalars, c)
+
+        return pressure
+
+
+#: Coupled discretizations kept for a later solve of the same punches (a load change):
+#: LRU by the punches' geometries and centres.
+COUPLED = StageCache("coupled_punches", max_items=8, max_bytes=256 * 2**20,
+                     sizeof=lambda coupled: coupled.nbytes)
+
+
+def coupled_for(punches: Sequence[PunchGeometry]) -> CoupledPunches:
+    """The coupled discretization of ``punches``: from :data:`COUPLED` when the same
+    geometries at the same centres were coupled before, else built now and kept."""
+    keys = [geometry_key(p.geometry) for p in punches]
+
+    def build() -> CoupledPunches:
+        prepared = [PREPARED.get_or_compute(k, lambda p=p: PreparedContact(p.geometry))[0]
+                    for k, p in zip(keys, punches, strict=True)]
+        return CoupledPunches(punches, prepared)
+
+    key = fingerprint("coupled", *[(k, p.center) for k, p in zip(keys, punches, strict=True)])
+    coupled, _ = COUPLED.get_or_compute(key, build)
+    return coupled
+
+
+def solve_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeInputs],
+                  time_breaks: Sequence[float] = ()) -> list[ContactSolution]:
+    """The coupled full-contact answer of several punches on one base (see the module
+    notes); one :class:`core.problem.ContactSolution` per punch, in its own scaling
+    (``x* = (x - e)/a``)."""
+    return coupled_for(punches).solve(inputs, time_breaks)

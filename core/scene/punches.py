@@ -1,0 +1,338 @@
+"""Several punches on one foundation: the ``punches`` form of a scene, and its answer.
+
+A scene with ``punches`` (a list of ``{center, half_width, shape, loading}``) instead of
+``punch`` and ``loading`` puts several rigid punches on one coated base; they act on each
+other through the base (core/SCENES.md, "Several punches"). Each punch is checked as the
+single-punch scene it would be at its own centre (same coating, base, times and solver),
+so every field keeps its rules; a refusal names it as ``punches[k].<field>``.
+
+One punch is the single-punch scene at its centre, answered by :func:`core.scene.solve`
+(every base, contact model and engine). Several punches are coupled by the default engine
+(:mod:`core.engines.nystrom.multi`) with the thin-layer coating model, in full contact (on
+an elastic, aging or creeping base). The coating's profiles are functions of the global x
+along the whole surface (checked over the punches' span); each punch sees them from its
+centre. What is not coupled yet (unilateral contact) is refused with a ValueError naming
+the field and the reason.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from core import limits
+from core.coating import DEFAULT_INTERFACE
+from core.engines.nystrom import PunchGeometry, solve_punches
+from core.problem import validate_geometry, validate_time_inputs
+from core.profiles import shifted
+from core.scene import schema
+from core.scene.model import Scene
+from core.scene.results import SceneSolution
+from core.validation import bounded_list, finite_number
+
+#: What the coupled solve does not answer yet, named in its refusals.
+COUPLED_SCOPE = "several punches are solved in full contact for now"
+
+
+@dataclass(frozen=True, eq=False)
+class PunchesScene:
+    """A validated scene of several punches (build it with :func:`punches_from_dict`).
+
+    ``scenes[k]`` is punch ``k`` as a single-punch :class:`core.scene.Scene` in its own
+    coordinates (``x - centers[k]`` [m]); ``centers`` [m] the punch centres in the global
+    x; ``data`` the canonical dict.
+    """
+
+    scenes: tuple[Scene, ...]
+    centers: tuple[float, ...]
+    data: dict
+
+    def to_dict(self) -> dict[str, Any]:
+        """The canonical JSON-able dict of the scene."""
+        return copy.deepcopy(self.data)
+
+    @property
+    def name(self) -> str:
+        """The scene's name."""
+        return str(self.data["name"])
+
+    @property
+    def times(self) -> np.ndarray:
+        """The output times [day after loading]."""
+        return self.scenes[0].times
+
+    @property
+    def spans(self) -> list[tuple[float, float]]:
+        """The zone ``(center - a, center + a)`` [m] of every punch, in order."""
+        return [(c - s.half_width, c + s.half_width)
+                for c, s in zip(self.centers, self.scenes, strict=True)]
+
+
+def has_punches(d: Any) -> bool:
+    """Whether ``d`` is a scene of the ``punches`` form (a dict or a :class:`PunchesScene`)."""
+    return isinstance(d, PunchesScene) or (isinstance(d, Mapping) and "punches" in d)
+
+
+def _renamed(message: str, k: int) -> str:
+    """A refusal of the single-punch scene of punch ``k`` in the words of the file."""
+    for prefix in ("punch.", "loading"):
+        if message.startswith(prefix):
+            rest = message[len("punch."):] if prefix == "punch." else message
+            return f"punches[{k}].{rest}"
+    return message.replace("punch.half_width", f"punches[{k}].half_width")
+
+
+def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:
+    """Check a scene dict of the ``punches`` form and build a :class:`PunchesScene`.
+
+    Raises ValueError naming the field: ``punch`` or ``loading`` given as well, a punch
+    field out of range, two punches that overlap or touch (both named).
+    """
+    from core.scene.validate import scene_from_dict
+
+    if isinstance(d, PunchesScene):
+        return d
+    for name in ("punch", "loading"):
+        if isinstance(d, Mapping) and name in d:
+            raise ValueError(f"{name}: give either punch and loading (one punch) or punches, "
+                             "not both")
+    d = schema.check_fields(d, "", tuple(n for n in schema.required_fields("scene")
+                                          if n not in ("punch", "loading")) + ("punches",),
+                            tuple(n for n in schema.optional_fields("scene") if n != "punches")
+                            + (schema.SCHEMA_KEY,))
+    punches = bounded_list(d["punches"], "punches", least=1, most=limits.MAX_PUNCHES,
+                           what="punches")
+    scenes, centers = [], []
+    common = {k: v for k, v in d.items() if k not in ("punches", schema.SCHEMA_KEY)}
+    # a coating that varies along x is read in the global x (below); each punch's own
+    # checks see it at its centre meanwhile
+    uniform = len(punches) == 1 or _uniform(common["coating"])
+    for k, spec in enumerate(punches):
+        path = f"punches[{k}]"
+        schema.check_fields(spec, path, schema.required_fields("punches[k]"),
+                            schema.optional_fields("punches[k]"))
+        center = finite_number(spec["center"], f"{path}.center")
+        single = dict(common, punch={"half_width": spec["half_width"],
+                                     "shape": spec.get("shape", 0.0)},
+                      loading=spec["loading"])
+        if not uniform:
+            single["coating"] = _at_centre(common["coating"], center)
+        try:
+            scenes.append(scene_from_dict(single))
+        except ValueError as exc:
+            raise ValueError(_renamed(str(exc), k)) from None
+        centers.append(center)
+    spans = [(c - s.half_width, c + s.half_width) for c, s in zip(centers, scenes, strict=True)]
+    order = sorted(range(len(spans)), key=lambda k: spans[k][0])
+    for left, right in zip(order, order[1:], strict=False):
+        if spans[right][0] <= spans[left][1]:
+            i, j = sorted((left, right))
+            raise ValueError(
+                f"punches: punches[{i}] and punches[{j}] overlap or touch ([{spans[i][0]:g}, "
+                f"{spans[i][1]:g}] m and [{spans[j][0]:g}, {spans[j][1]:g}] m): move a centre "
+                "or narrow a punch so that a gap remains between them")
+    if len(scenes) > 1 and not _uniform(common["coating"]):
+        scenes = _along_x(common, scenes, centers, spans)
+    data = {k: v for k, v in scenes[0].to_dict().items() if k not in ("punch", "loading")}
+    data["punches"] = [{"center": c, **s.to_dict()["punch"], "loading": s.to_dict()["loading"]}
+                       for c, s in zip(centers, scenes, strict=True)]
+    return PunchesScene(tuple(scenes), tuple(centers), data)
+
+
+def _uniform(coating: Any) -> bool:
+    """Whether every profile of a coating spec is a number or a constant (as given)."""
+    if not isinstance(coating, list):
+        return True  # refused by the single-punch checks, naming the field
+    for layer in coating:
+        if not isinstance(layer, Mapping):
+            return True
+        for name in ("thickness", "modulus", "poisson"):
+            spec = layer.get(name)
+            if isinstance(spec, Mapping) and spec.get("kind") != "constant":
+                return False
+    return True
+
+
+def _at_centre(coating: list, center: float) -> list:
+    """A coating spec with every varying profile replaced by a valid constant (1: the
+    single-punch checks of the other fields run on it; the coating itself is read in the
+    global x by :func:`_along_x`)."""
+    out = []
+    for layer in coating:
+        layer = dict(layer)
+        for name, value in (("thickness", 0.01), ("modulus", 1e9), ("poisson", 0.3)):
+            if isinstance(layer.get(name), Mapping) and layer[name].get("kind") != "constant":
+                layer[name] = value
+        out.append(layer)
+    return out
+
+
+def _along_x(common: Mapping[str, Any], scenes: list[Scene], centers: list[float],
+             spans: list[tuple[float, float]]) -> list[Scene]:
+    """The punches' scenes under a coating that varies along x: its profiles are read in
+    the global x over the punches' span (checked there, refusals naming
+    ``coating[k].<field>``) and each punch sees them from its centre."""
+    from dataclasses import replace
+
+    from core.scene.validate import (
+        _check_breakpoints,
+        _check_load_rates,
+        _check_solvable,
+        check_uncoated,
+    )
+
+    domain = (min(lo for lo, _ in spans), max(hi for _, hi in spans))
+    bounds = {"thickness": {"lower": 0.0}, "modulus": {"lower": 0.0},
+              "poisson": {"lower": schema.POISSON_RANGE[0], "upper": schema.POISSON_RANGE[1]}}
+    layers = []
+    for k, spec in enumerate(common["coating"]):
+        layers.append({name: schema._profile(spec[name], f"coating[{k}].{name}", "x", domain,
+                                             **bounds[name])
+                       for name in ("thickness", "modulus", "poisson")})
+    coating_data = [{name: schema._jsonable(schema._spec_of(layer[name], spec[name]))
+                     for name in ("thickness", "modulus", "poisson")}
+                    | {"interface": spec.get("interface", DEFAULT_INTERFACE)}
+                    for layer, spec in zip(layers, common["coating"], strict=True)]
+    out = []
+    for k, (scene, center) in enumerate(zip(scenes, centers, strict=True)):
+        a = scene.half_width
+        local = tuple(
+            replace(old, **{name: shifted(layer[name], center, (-a, a))
+                            for name in ("thickness", "modulus", "poisson")})
+            for old, layer in zip(scene.coating, layers, strict=True))
+        data = scene.to_dict()
+        # the centre keys the geometry's caches: two punches alike but for their place
+        # see different stretches of the coating
+        data["punch"]["center"] = center
+        data["coating"] = coating_data
+        moved = replace(scene, coating=local, _data=data)
+        try:
+            _check_breakpoints(moved)
+            _check_solvable(moved)
+            check_uncoated(moved)
+            _check_load_rates(moved)
+        except ValueError as exc:
+            raise ValueError(_renamed(str(exc), k)) from None
+        out.append(moved)
+    return out
+
+
+def _check_coupled(scene: PunchesScene) -> None:
+    """Refuse what the coupled solve does not answer yet, naming the field."""
+    first = scene.scenes[0]
+    if first.contact == "unilateral":
+        raise ValueError(f"solver.contact: {COUPLED_SCOPE} (give 'auto' or 'full'; a lost "
+                         "contact is flagged contact_lost)")
+
+
+class PunchSolution(SceneSolution):
+    """The answer of one punch of several, in SI units: a :class:`SceneSolution` of the
+    punch's own scene (``pressure(x)`` and the plotting grid ``x`` in its coordinates,
+    ``x - center``), plus ``center`` [m] and ``contact_set`` in the global x [m]; the
+    moment is about the punch's own centre (it does work with the tilt)."""
+
+    def __init__(self, scene: Scene, center: float, solution: Any) -> None:
+        super().__init__(scene, scene.dimensionless, solution)
+        self.center = float(center)
+        self.contact_set = [[(self.center + lo, self.center + hi) for lo, hi in zones]
+                            for zones in self.contact_set]
+
+    def pressure_at(self, x: Any) -> np.ndarray:
+        """q [Pa] at points ``x`` [m] of the global x on this punch, (len(x), len(times))."""
+        return self.pressure(np.asarray(x, dtype=float) - self.center)
+
+    @property
+    def contact_width(self) -> np.ndarray:
+        """The contact width [m] at each output time."""
+        return np.array([sum(hi - lo for lo, hi in zones) for zones in self.contact_set])
+
+    @property
+    def lift_off_length(self) -> np.ndarray:
+        """The length of the base lifted off [m] at each output time."""
+        return 2.0 * self.scene.half_width - self.contact_width
+
+
+class PunchesSolution:
+    """The answer for a scene of several punches (see :func:`solve_punches_scene`).
+
+    ``punches[k]`` (:class:`PunchSolution`) holds punch ``k``'s ``settlement`` [m],
+    ``tilt`` [rad], ``force`` [N/m], ``moment`` [N] over ``times`` [day after loading]
+    and its ``contact_set`` in the global x; ``flags`` are the punches' flags, each
+    named ``punches[k].<flag>``; ``info["error_estimate"]`` is the largest of theirs.
+    """
+
+    def __init__(self, scene: PunchesScene, punches: list[PunchSolution]) -> None:
+        self.scene = scene
+        self.punches = punches
+        self.times = np.array(scene.times, dtype=float)
+        self.flags = [f"punches[{k}].{flag}" for k, p in enumerate(punches) for flag in p.flags]
+        self.info: dict[str, Any] = {
+            "punches": len(punches),
+            "error_estimate": max(float(p.info["error_estimate"]) for p in punches),
+            "success": all(bool(p.info["success"]) for p in punches),
+            "flags": list(self.flags),
+            "coating_model": punches[0].info.get("coating_model", "thin layer"),
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-able dict: the scene, and each punch's answer (its ``to_dict``)."""
+        return {"scene": self.scene.to_dict(), "times": self.times.tolist(),
+                "info": dict(self.info),
+                "punches": [dict(p.to_dict(), center=p.center) for p in self.punches]}
+
+    def to_json(self) -> str:
+        """:meth:`to_dict` as compact JSON text."""
+        return json.dumps(self.to_dict(), separators=(",", ":"), allow_nan=False)
+
+    def __repr__(self) -> str:
+        return (f"PunchesSolution({len(self.punches)} punches, {self.times.size} times, "
+                f"flags={self.flags})")
+
+
+def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolution:
+    """Solve a scene of the ``punches`` form (validated first); see the module notes."""
+    from core.scene.pipeline import solve
+
+    started = time.thread_time()
+    scene = punches_from_dict(scene)
+    if len(scene.scenes) == 1:
+        single = solve(scene.scenes[0])
+        solution = single.dimensionless
+        punches = [PunchSolution(scene.scenes[0], scene.centers[0], solution)]
+    else:
+        _check_coupled(scene)
+        geometries, inputs = [], []
+        for sub, center in zip(scene.scenes, scene.centers, strict=True):
+            problem = sub.dimensionless
+            geometries.append(PunchGeometry(
+                validate_geometry(problem.lam, problem.m, problem.g, problem.breakpoints,
+                                  problem.tol),
+                center / sub.base_thickness))
+            inputs.append(validate_time_inputs(problem.times, problem.c, problem.kernel,
+                                               {q: problem.loads.get(q) for q in
+                                                ("settlement", "tilt", "force", "moment")}))
+        with np.errstate(all="ignore"):
+            answers = solve_punches(geometries, inputs,
+                                    scene.scenes[0].dimensionless.time_breaks)
+        punches = [PunchSolution(sub, center, answer) for sub, center, answer
+                   in zip(scene.scenes, scene.centers, answers, strict=True)]
+        for p in punches:
+            p.info["coating_model"] = "thin layer"
+        lost = [k for k, p in enumerate(punches) if "contact_lost" in p.flags]
+        if lost and scene.scenes[0].contact == "auto":
+            k = lost[0]
+            raise ValueError(
+                f"solver.contact: punches[{k}] loses contact (q < 0 under it in full "
+                f"contact, down to {punches[k].info['min_pressure']:.3g} of q*) and lift-off "
+                "under several punches is not solved yet: give solver.contact 'full' for the "
+                "full-contact answer flagged contact_lost, or loads that keep every punch "
+                "pressed")
+    result = PunchesSolution(scene, punches)
+    result.info["cpu_seconds"] = time.thread_time() - started
+    return result
