@@ -36,7 +36,13 @@ def solve(scene: Scene | PunchesScene | Mapping[str, Any]) -> SceneSolution | Pu
     :class:`core.scene.PunchesSolution`.
     """
     if has_punches(scene):
-        return solve_punches_scene(scene)
+        try:
+            with work_bound():
+                return solve_punches_scene(scene)
+        except WorkLimitExceeded as exc:
+            # the time stepping of the coupled modes is what can run long
+            raise ValueError(f"punches: {exc}; fewer or earlier output times, or a looser "
+                             "solver.tol, costs less") from None
     # CPU time of this thread [s] from the dict to the answer, validation included: what
     # the scene costs, whatever else the machine runs (info["seconds"] is the solver's
     # wall time)
