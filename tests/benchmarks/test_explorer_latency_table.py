@@ -50,7 +50,7 @@ def test_unknown_preset_is_refused_by_name(capsys):
 
 def test_quick_takes_fewer_steps_unless_told(tmp_path: Path, capsys):
     args = bench.parse_args(["--quick"])
-    assert (args.repeats, args.loads) == (5, 3)
+    assert (args.repeats, args.loads) == (3, 2)
     assert bench.parse_args(["--quick", "--repeats", "7"]).repeats == 7
     assert (bench.parse_args([]).repeats, bench.parse_args([]).loads) == (9, 5)
     with pytest.raises(SystemExit):
