@@ -268,6 +268,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--quick", action="store_true",
                         help="fewer steps and page loads: all presets in ~6 min on 2 cores")
     parser.add_argument("--json", help="also write the numbers to this file")
+    parser.add_argument("--from-json", metavar="FILE",
+                        help="write the Markdown table from the --json of a run, no browser")
     parser.add_argument("--markdown", default=str(RESULTS),
                         help=f"the table's Markdown file (default {RESULTS.relative_to(ROOT)})")
     args = parser.parse_args(argv)
@@ -310,7 +312,9 @@ def markdown_report(rows: list[dict], switches: dict[str, float | None],
         "of the range) on the slider's handle -> the second animation frame after the "
         "pressure plot's data changed (p50, p95 over the steps). Drag: mouse down on the "
         f"handle, {DRAG_MOVES} moves of {DRAG_PX} px {1e3 * DRAG_PAUSE_S:.0f} ms apart, "
-        "mouse up; *live* when the pressure plot updated during the drag. Page CPU: "
+        "mouse up; *live* when the pressure plot updated during the drag; *drag took*: "
+        "mouse down to up in the page, longer than ~1 s when the page was too busy to "
+        "take the moves at once. Page CPU: "
         "median CPU time of the page's main thread per key step. Solve: median of the "
         "server's \"Solved in N ms\". Times in ms.",
         "",
@@ -331,14 +335,14 @@ def markdown_report(rows: list[dict], switches: dict[str, float | None],
     lines += [
         "",
         "| preset | slider | key p50 | key p95 | goal | page CPU | solve | drag | "
-        "updates during drag | after release | last after release | n |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "updates during drag | after release | last after release | drag took | n |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for r in rows:
         name = r["slider"] + (f" ({r['label']})" if r.get("label") else "")
         if r.get("hidden"):
             lines.append(f"| {r['preset']} | {name} | hidden on this preset "
-                         "| | | | | | | | | |")
+                         "| | | | | | | | | | |")
             continue
         keys = r["key_ms"]
         p95 = percentile(keys, 95)
@@ -353,12 +357,47 @@ def markdown_report(rows: list[dict], switches: dict[str, float | None],
             f"| {r['preset']} | {name} | {_fmt(percentile(keys, 50))} | {_fmt(p95)} | "
             f"{goal:.0f}{mark} | {_fmt(percentile(r['page_cpu'], 50))} | "
             f"{_fmt(percentile(r['solve_ms'], 50))} | {live} | {drag.get('during', '')} | "
-            f"{drag.get('after', '')} | {last_text} | {len(keys)} |")
+            f"{drag.get('after', '')} | {last_text} | {_fmt(drag.get('drag_ms'))} | "
+            f"{len(keys)} |")
+    lines += ["", "Per preset: the worst key step p95, the sliders whose drag is live, and "
+              "the latest update after a release.", "",
+              "| preset | switch | worst key p95 | live | on release | latest after release |",
+              "| --- | --- | --- | --- | --- | --- |"]
+    for preset, summary in preset_summary(rows, switches).items():
+        lines.append(f"| {preset} | {summary['switch']} | {summary['worst_p95']} | "
+                     f"{summary['live']} | {summary['release']} | {summary['latest']} |")
     notes = [r for r in rows if r.get("note")]
     if notes:
         lines += ["", "Notes:", ""]
         lines += [f"- {r['preset']}, {r['slider']}: {r['note']}" for r in notes]
     return "\n".join(lines) + "\n"
+
+
+def preset_summary(rows: list[dict], switches: dict[str, float | None]
+                   ) -> dict[str, dict[str, str]]:
+    """Per preset, as text: its switch time [ms], the slider with the worst key step p95
+    [ms], the sliders live on a drag and those that wait for the release, and the latest
+    update after a release [ms] (with its slider)."""
+    out: dict[str, dict[str, str]] = {}
+    for preset in dict.fromkeys([*switches, *(r["preset"] for r in rows)]):
+        mine = [r for r in rows if r["preset"] == preset and not r.get("hidden")]
+        worst = max(mine, key=lambda r: _nan_low(percentile(r["key_ms"], 95)), default=None)
+        dragged = [r for r in mine if r.get("drag")]
+        latest = max(dragged, key=lambda r: r["drag"]["last_after_ms"], default=None)
+        ms = switches.get(preset)
+        out[preset] = {
+            "switch": "on the page already" if ms is None else _fmt(ms),
+            "worst_p95": "" if worst is None else
+            f"{_fmt(percentile(worst['key_ms'], 95))} ({worst['slider']})",
+            "live": ", ".join(r["slider"] for r in dragged if r["drag"]["during"] > 0),
+            "release": ", ".join(r["slider"] for r in dragged if r["drag"]["during"] == 0),
+            "latest": "" if latest is None else
+            f"{_fmt(latest['drag']['last_after_ms'])} ({latest['slider']})"}
+    return out
+
+
+def _nan_low(value: float) -> float:
+    return -math.inf if math.isnan(value) else value
 
 
 def _find_handle(page, kind: SliderKind):
@@ -487,6 +526,12 @@ def _load_average() -> str:
 
 def main(argv: list[str] | None = None) -> None:
     args = parse_args(argv)
+    if args.from_json:
+        # the table again from a run's numbers (e.g. after a change of its layout)
+        data = json.loads(Path(args.from_json).read_text())
+        Path(args.markdown).write_text(markdown_report(
+            data["rows"], data["preset_switch"], data["first_page"], data["meta"]))
+        return
     from playwright.sync_api import sync_playwright
 
     from explorer.model.presets import preset_label, presets

@@ -88,16 +88,38 @@ def test_markdown_table_marks_goals_live_and_hidden_sliders():
     assert "| worn_coating | 620 | 500 **missed** |" in lines
     # p95 of 60..95: 95 - 0.2 * 5 = 94; live: 19 frames during the drag
     assert ("| uniform_flat | load (force) | 80 | 94 | 100 ok | 50 | 20 | live | 19 | 1 "
-            "| 40 ok | 5 |") in lines
+            "| 40 ok | 1000 | 5 |") in lines
     assert ("| uniform_flat | base thickness | 170 | 356 | 100 **missed** | 50 | 20 | "
-            "release | 0 | 1 | 350 **missed** | 5 |") in lines
+            "release | 0 | 1 | 350 **missed** | 1000 | 5 |") in lines
     assert any(line.startswith("| uniform_flat | punch shape | hidden on this preset")
                for line in lines)
+    # the summary per preset: worst p95, live and release sliders, latest update
+    assert ("| uniform_flat | on the page already | 356 (base thickness) | load | "
+            "base thickness | 350 (base thickness) |") in lines
+    assert "| worn_coating | 620 |  |  |  |  |" in lines
     # every table row has as many cells as its header
-    for table_header in ("| preset | switch |", "| preset | slider |"):
+    for table_header in ("| preset | switch |", "| preset | slider |",
+                         "| preset | switch | worst"):
         start = next(k for k, line in enumerate(lines) if line.startswith(table_header))
         width = lines[start].count("|")
         block = [line for line in lines[start:] if line.startswith("|")]
         block = block[:next((k for k, line in enumerate(block[1:], 1)
                              if line.startswith("| preset")), len(block))]
         assert all(line.count("|") == width for line in block)
+
+
+def test_the_table_is_written_again_from_a_runs_json(tmp_path: Path):
+    import json
+
+    rows = [_row("uniform_flat", "load", [60.0, 70.0],
+                 {"during": 19, "after": 1, "last_after_ms": 40.0, "drag_ms": 1000.0},
+                 goal="load", label="force")]
+    meta = {"commit": "abc1234", "date": "2026-11-29 04:00 UTC", "load_before": "1.00",
+            "load_after": "2.00", "command": "python -m benchmarks.explorer_latency"}
+    data = tmp_path / "run.json"
+    data.write_text(json.dumps({"meta": meta, "first_page": [1500.0],
+                                "preset_switch": {"uniform_flat": None}, "rows": rows}))
+    out = tmp_path / "table.md"
+    bench.main(["--from-json", str(data), "--markdown", str(out)])
+    assert out.read_text() == bench.markdown_report(rows, {"uniform_flat": None}, [1500.0],
+                                                    meta)
