@@ -120,6 +120,11 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
             f"<div class='contact-readout'>{contact}</div></div>")
 
 
+
+#: Delay before a held drag is said on a served page [ms]: longer than from a key press's
+#: step to its release (the same event), shorter than a drag's first steps.
+HELD_AFTER_MS = 200
+
 class ResultsView:
     """The page's main column: what the result on screen is, and how far to trust it."""
 
@@ -150,6 +155,7 @@ class ResultsView:
                                   evidence=self.evidence)
         screen.param.watch(lambda *e: self.show_model_check(), "model_check")
         # said while a slider is dragged that only its release applies (slow solves)
+        self._held_wanted = False
         self.held = html_pane("", visible=False, css_classes=["drag-held"],
                               styles=NOTE_STYLE, margin=(0, 10))
         badge = {"margin": (0, 5), "sizing_mode": "stretch_width"}
@@ -277,13 +283,28 @@ class ResultsView:
 
     def say_held(self, held: bool, cpu_seconds: float | None = None) -> None:
         """Say (``held``) or stop saying that a dragged slider waits for its release, the
-        last solve having taken ``cpu_seconds`` [s] of CPU time (None: not known)."""
+        last solve having taken ``cpu_seconds`` [s] of CPU time (None: not known).
+
+        On a served page the note comes :data:`HELD_AFTER_MS` after the step, if no
+        release came meanwhile: a key press on such a slider is a step and its release at
+        once, and the note shown and hidden at each press cost the page 400-600 ms of
+        relayout a press (benchmarks/results/explorer_latency_presets.md)."""
+        self._held_wanted = held
         if not held:
             if self.held.visible:
                 self.held.object, self.held.visible = "", False
             return
-        self.held.object = held_text(cpu_seconds)
-        self.held.visible = True
+        text = held_text(cpu_seconds)
+
+        def show() -> None:
+            if self._held_wanted:
+                self.held.object = text
+                self.held.visible = True
+
+        if self.loop.served:
+            self.loop.later(show, HELD_AFTER_MS)
+        else:
+            show()
 
     def show_download_error(self, text: str) -> None:
         """Say why a download failed (Markdown, user text escaped)."""
