@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import html
 import logging
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -26,6 +27,7 @@ from .model import (
     DesignLimits,
     DisplayScales,
     ExplorerState,
+    ResultView,
     SceneHistory,
     Screen,
     decode_scene,
@@ -70,6 +72,10 @@ install_websocket_marks()
 #: late costs no backlog: the controller runs one solve at a time and keeps only the
 #: newest request.
 LIVE_SOLVE_S = 0.030
+#: Shortest time between two results drawn on a served page [ms]: the page takes ~45-65
+#: ms of its CPU to show one (benchmarks/results/explorer_latency.md), so a faster stream
+#: of results only queues up in front of it (12 fps at most: a drag stays live).
+DRAW_EVERY_MS = 80.0
 
 
 class ExplorerApp(pn.viewable.Viewer):
@@ -120,6 +126,8 @@ class ExplorerApp(pn.viewable.Viewer):
         # Changes to plain Bokeh models made after the page was generated but before its
         # websocket connects would never reach the browser: hold them until it does.
         self._initializing = True
+        self._last_draw = float("-inf")  # when a result was last drawn (time.monotonic)
+        self._draw_due = False  # a later draw of the newest result is scheduled
         self._connected = not self.loop.served
         if self.loop.served:
             pn.state.onload(self._on_load)
@@ -302,6 +310,27 @@ class ExplorerApp(pn.viewable.Viewer):
         view = self.controller.view
         if view is None or not (self._connected or self._initializing):
             return
+        if self.loop.served:
+            # results drawn at most every DRAW_EVERY_MS, the newest when the time comes: a
+            # drag solved 20 steps a second, each patch took the page ~65 ms of its CPU,
+            # and the queued patches kept coming 1.5 s after the release
+            wait = self._last_draw + DRAW_EVERY_MS / 1000.0 - time.monotonic()
+            if wait > 0:
+                if not self._draw_due:
+                    self._draw_due = True
+                    self.loop.later(self._draw_due_view, 1000.0 * wait)
+                return
+        self._draw(view)
+
+    def _draw_due_view(self) -> None:
+        """The newest result, when the interval after the last draw is over."""
+        self._draw_due = False
+        view = self.controller.view
+        if view is not None and view is not self.screen.drawn:
+            self._draw(view)
+
+    def _draw(self, view: ResultView) -> None:
+        self._last_draw = time.monotonic()
         n = len(view.times)
         old = self.screen.drawn
         if old is None and self._wanted_index is not None:

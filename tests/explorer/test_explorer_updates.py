@@ -135,9 +135,31 @@ class _Location:
         self.calls.append(query["scene"])
 
 
-def test_the_link_follows_the_screen_at_most_once_a_second(served_app) -> None:
+def test_results_reach_a_served_page_at_most_every_draw_interval(served_app) -> None:
+    """A drag's results: the first drawn at once, the newest when the interval is over,
+    the ones between never (they only queued in front of the page)."""
+    from explorer.app import DRAW_EVERY_MS
+
+    app, timers = served_app
+    drawn: list[float] = []
+    app.results.draw = lambda view, *args, **kwargs: drawn.append(
+        view.values["force"][0] / 1e3)  # kN/m
+    app._last_draw = float("-inf")  # the first result was drawn just now: a while ago
+    force = app.state.loading.histories["force"]
+    for value in (510.0, 520.0, 530.0):
+        force.value = value
+        assert app.controller.wait(60)
+    assert drawn == [510.0]
+    delays = [d for d in timers.run() if d <= DRAW_EVERY_MS]
+    assert len(delays) == 1 and drawn == [510.0, 530.0]
+    assert app.screen.drawn is app.controller.view
+
+
+def test_the_link_follows_the_screen_at_most_once_a_second(served_app, monkeypatch) -> None:
+    from explorer import app as page
     from explorer.model import decode_scene
 
+    monkeypatch.setattr(page, "DRAW_EVERY_MS", 0.0)  # every result drawn: the link's part
     app, timers = served_app
     location = _Location(app)
     app.link.location = location
