@@ -87,7 +87,9 @@ class FitView:
                       "<code>time [day], settlement [mm], settlement_std, tilt [urad], "
                       "tilt_std</code>, times in days after loading, a unit in brackets "
                       "per column, an empty cell for no reading.</small>"),
-            self.upload, self.readings_status, *self.fields, self.fit_button,
+            pn.Column(self.upload, css_classes=["fit-upload"], sizing_mode="stretch_width",
+                      margin=0),
+            self.readings_status, *self.fields, self.fit_button,
             self.fit_status, self.fit_table, self.apply_button,
             html_pane(f"<small>The band on the histories is the fitted scene's "
                       f"{100 * BAND_LEVEL:.0f} % band from the fields' uncertainty only, "
