@@ -12,6 +12,7 @@ import pytest
 import core
 from core.presets import read_preset
 from core.report import report_html, report_pdf, sections, write_report
+from tests.cli_runs import run_cli
 
 #: Reading times [day after loading] within the preset's output times.
 TIMES = [5.0, 10.0, 20.0, 40.0, 80.0, 160.0, 300.0]
@@ -61,3 +62,18 @@ def test_the_html_draws_the_readings_and_the_pdf_prints_the_section(fitted, tmp_
     assert pdf.startswith(b"%PDF")
     write_report(result, tmp_path / "fit.html", calibration=calibration)
     assert "Back-analysis" in (tmp_path / "fit.html").read_text()
+
+
+def test_the_command_line_writes_the_report_of_a_fit(tmp_path):
+    readings = tmp_path / "levelling.csv"
+    readings.write_text("time [day], settlement [mm]\n5, 0.0280\n10, 0.0309\n20, 0.0348\n"
+                        "40, 0.0385\n80, 0.0406\n160, 0.0408\n300, 0.0408\n")
+    report = tmp_path / "fit.html"
+    done = run_cli("calibrate", "preset:uniform_flat", readings, "--fit",
+                   "coating[0].modulus", "--report", report)
+    assert done.returncode == 0, done.stderr
+    page = report.read_text()
+    assert "report-back-analysis" in page and "coating[0].modulus" in page
+    bad = run_cli("calibrate", "preset:uniform_flat", readings, "--fit",
+                  "coating[0].modulus", "--report", tmp_path / "fit.txt")
+    assert bad.returncode == 2 and "--report: " in bad.stderr
