@@ -550,7 +550,10 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         raise _InputError("readings: the scene already reads standard input; give the "
                           "readings as a file")
     output = Path(args.output) if args.output else None
-    _check_outputs(args.scene, [("--output", output)])
+    report = Path(args.report) if args.report else None
+    if report is not None and report.suffix.lower() not in (".html", ".htm", ".pdf"):
+        raise _InputError(f"--report: {report}: a report is .html or .pdf")
+    _check_outputs(args.scene, [("--output", output), ("--report", report)])
     if output is not None and str(output) != STDIO and args.readings != STDIO \
             and same_file(output, args.readings):
         raise _InputError(f"--output: {output} is the readings file; it is not "
@@ -589,6 +592,17 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         if forecast is not None:
             data["forecast"] = forecast.to_dict()
         _write(output, json.dumps(data, indent=1, allow_nan=False) + "\n")
+    if report is not None:
+        # imported here: the report loads HoloViews and Bokeh (or Matplotlib), ~2 s
+        from core.report import report_html, report_pdf
+
+        try:
+            fitted = solve(fit.scene)
+        except (ArithmeticError, ValueError, RuntimeError, MemoryError) as exc:
+            print(f"error: calibrate: the fitted scene: {_one_line(exc)}", file=sys.stderr)
+            return EXIT_SOLVER_FAILED
+        _write(report, report_pdf(fitted, calibration=fit)
+               if report.suffix.lower() == ".pdf" else report_html(fitted, calibration=fit))
     for warning in fit.warnings:
         print(f"warning: calibrate: {_one_line(warning)}", file=sys.stderr)
     if args.strict and fit.warnings:
@@ -740,6 +754,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="write the fit as JSON (fields, standard errors, correlation, "
                             "residuals, the fitted scene, the forecast); '-' writes to "
                             "standard output")
+    p_cal.add_argument("--report", metavar="FILE",
+                       help="also write the printable report of the fitted scene with the "
+                            "back-analysis (.html or .pdf)")
     p_cal.add_argument("--strict", action="store_true",
                        help=f"exit with {EXIT_FLAGGED} when the fit carries a warning (a "
                             "field not identifiable, a bound reached, the solver's error "

@@ -153,12 +153,55 @@ def design_section(result: SceneSolution) -> Section | None:
                    "Every limit the scene sets holds.", rows, tone="bad" if failed else "good")
 
 
+def calibration_section(calibration: Any) -> Section:
+    """The back-analysis: the readings fitted, each fitted value with its standard error
+    (in the field's unit), the correlations, chi^2/dof and the fit's warnings.
+
+    ``calibration`` is a :class:`core.back_analysis.Calibration` (read by its attributes:
+    the report sits below the back-analysis in core's layers)."""
+    readings = calibration.readings
+    values, errors, units = (calibration.values, calibration.standard_errors,
+                             calibration.units)
+    series = ", ".join(f"{name} [{SERIES_SI[name]}]" for name in readings.series)
+    rows = [("readings", f"{readings.count} ({series}), t = {_number(float(readings.time[0]))}"
+                         f" to {_number(float(readings.time[-1]))} d"
+                         + (", with standard deviations" if calibration.std_given else ""))]
+    for path in calibration.paths:
+        unit = f" {units[path]}" if units[path] else ""
+        rows.append((path, f"{_number(values[path], 6)} ± {_number(errors[path], 2)}{unit}"
+                           f" (start {_number(calibration.start[path], 6)}{unit})"))
+    corr = calibration.correlation
+    paths = calibration.paths
+    for j in range(len(paths)):
+        for k in range(j + 1, len(paths)):
+            value = float(corr[j, k])
+            rows.append((f"correlation {paths[j]} ~ {paths[k]}",
+                         f"{value:+.3f}" if np.isfinite(value) else "not finite"))
+    rows.append(("χ²/dof", f"{calibration.chi2_per_dof:.3g} ({calibration.dof} dof); "
+                           + ("the readings' standard deviations" if calibration.std_given
+                              else "noise estimated from the scatter about the fit")))
+    warned = bool(calibration.warnings)
+    lead = (f"{len(paths)} field(s) fitted to the readings (weighted least squares; "
+            "standard errors from the linearised covariance)."
+            + (" The fit warns: its values may not be determined." if warned else ""))
+    return Section("Back-analysis", lead, rows,
+                   notes=[f"warning: {w}" for w in calibration.warnings],
+                   tone="bad" if warned else "")
+
+
+#: The SI units of the series of readings.
+SERIES_SI = {"settlement": "m", "tilt": "rad"}
+
+
 def sections(result: SceneSolution, time: float | None = None,
-             check: Mapping[str, Any] | None = None) -> list[Section]:
+             check: Mapping[str, Any] | None = None,
+             calibration: Any = None) -> list[Section]:
     """The report's sections, in order; ``time`` [day after loading]: the output time
     nearest to it is the one whose contact the results describe (default: the last);
     ``check``: a :func:`core.scene.check_scene` report; made for this scene, its measured
-    coating-model error overrides the estimate (the ``model_error`` flag, the accuracy).
+    coating-model error overrides the estimate (the ``model_error`` flag, the accuracy);
+    ``calibration``: a :class:`core.back_analysis.Calibration` of the scene, reported in
+    a section "Back-analysis" after the results.
 
     Raises
     ------
@@ -193,6 +236,8 @@ def sections(result: SceneSolution, time: float | None = None,
     if design is not None:
         out.append(design)
     out.append(Section("Results", rows=key_numbers(result, time)))
+    if calibration is not None:
+        out.append(calibration_section(calibration))
     out.append(Section("Accuracy", rows=accuracy_rows(result, check)))
     out.append(Section("Inputs", rows=input_rows(scene)))
     return out
@@ -204,7 +249,8 @@ def scene_json(result: SceneSolution) -> str:
 
 
 def describe(result: SceneSolution, time: float | None = None,
-             check: Mapping[str, Any] | None = None) -> dict[str, Any]:
+             check: Mapping[str, Any] | None = None,
+             calibration: Any = None) -> dict[str, Any]:
     """The report's text as one JSON-able dict (what the tests read)."""
     return {s.title: {"lead": s.lead, "rows": dict(s.rows), "tone": s.tone}
-            for s in sections(result, time, check)}
+            for s in sections(result, time, check, calibration)}

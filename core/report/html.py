@@ -10,7 +10,7 @@ from typing import Any
 
 from core.optional import import_optional
 from core.report.content import Section, scene_json, sections
-from core.report.plots import report_layout
+from core.report.plots import readings_overlay, report_layout
 from core.scene import SceneSolution
 
 CSS = """
@@ -39,18 +39,23 @@ def _section(section: Section) -> str:
     return "".join(parts) + "</section>"
 
 
-def _plots(result: SceneSolution, time: float | None) -> tuple[str, str]:
-    """The plots as (scripts for the page head, the body's markup)."""
+def _plots(result: SceneSolution, time: float | None,
+           calibration: Any = None) -> tuple[str, str, str]:
+    """The plots as (scripts for the page head, the body's markup, the markup of the
+    readings over the settlement history: empty without ``calibration``)."""
     hv = import_optional("holoviews", "the report's plots")
     embed = import_optional("bokeh.embed", "the report's plots")
     resources = import_optional("bokeh.resources", "the report's plots")
     layout, _ = report_layout(result, time)
-    script, div = embed.components(hv.render(layout, backend="bokeh"))
-    return resources.INLINE.render() + script, div
+    models = [hv.render(layout, backend="bokeh")]
+    if calibration is not None and calibration.readings.settlement is not None:
+        models.append(hv.render(readings_overlay(result, calibration), backend="bokeh"))
+    script, divs = embed.components(models)
+    return resources.INLINE.render() + script, divs[0], "".join(divs[1:])
 
 
 def report_html(result: SceneSolution, time: float | None = None,
-                check: Mapping[str, Any] | None = None) -> str:
+                check: Mapping[str, Any] | None = None, calibration: Any = None) -> str:
     """The report of ``result`` as a complete HTML document (text).
 
     Parameters
@@ -64,6 +69,11 @@ def report_html(result: SceneSolution, time: float | None = None,
         A report of :func:`core.scene.check_scene`: made for this scene, its measured
         coating-model error is reported next to the estimate and overrides it (the
         ``model_error`` flag); a check of another scene is ignored.
+    calibration : Calibration, optional
+        A back-analysis (:func:`core.calibrate`) whose fitted scene ``result`` solves: a
+        section "Back-analysis" (the readings, the fitted values with their standard
+        errors, correlations, chi^2/dof, warnings) and the settlement readings drawn over
+        the settlement history.
 
     Returns
     -------
@@ -80,10 +90,11 @@ def report_html(result: SceneSolution, time: float | None = None,
     MissingDependency
         Without HoloViews or Bokeh (the ``report`` extra).
     """
-    text = sections(result, time, check)
-    head, plots = _plots(result, time)
+    text = sections(result, time, check, calibration)
+    head, plots, fit_plot = _plots(result, time, calibration)
     title = html.escape(str(result.scene.name or "scene"))
-    body = "".join(_section(s) for s in text)
+    body = "".join(_section(s) + (f"<div class='report-readings'>{fit_plot}</div>"
+                                  if s.title == "Back-analysis" else "") for s in text)
     return (f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
             f"<title>Report: {title}</title><style>{CSS}</style>{head}</head><body>"
             f"<h1>Coated punch: {title}</h1>{body}"

@@ -25,11 +25,12 @@ COLOURS = {"bad": "#9b1c1c", "good": "#1d6b2c", "": "#222222"}
 
 
 def _text_lines(result: SceneSolution, time: float | None,
-                check: Mapping[str, Any] | None = None) -> list[tuple[str, str, bool]]:
+                check: Mapping[str, Any] | None = None,
+                calibration: Any = None) -> list[tuple[str, str, bool]]:
     """(text, tone, bold) lines of the report's sections."""
     lines: list[tuple[str, str, bool]] = [
         (f"Coated punch: {result.scene.name or 'scene'}", "", True), ("", "", False)]
-    for section in sections(result, time, check):
+    for section in sections(result, time, check, calibration):
         lines.append((section.title, "", True))
         if section.lead:
             lines.extend((t, section.tone, False)
@@ -38,6 +39,9 @@ def _text_lines(result: SceneSolution, time: float | None,
             wrapped = textwrap.wrap(f"{label}: {value}", CHARACTERS_PER_LINE,
                                     subsequent_indent="    ")
             lines.extend((t, "", False) for t in wrapped)
+        for note in section.notes:
+            lines.extend((t, section.tone, False)
+                         for t in textwrap.wrap(note, CHARACTERS_PER_LINE))
         lines.append(("", "", False))
     return lines
 
@@ -54,11 +58,12 @@ def _text_pages(pdf, plt, lines: list[tuple[str, str, bool]], size: float = 8.5)
 
 
 def report_pdf(result: SceneSolution, time: float | None = None,
-               check: Mapping[str, Any] | None = None) -> bytes:
+               check: Mapping[str, Any] | None = None, calibration: Any = None) -> bytes:
     """The report of ``result`` as PDF bytes (the sections, the plots, the scene file).
 
-    ``time`` [day after loading], ``check`` (a :func:`core.scene.check_scene` report): as
-    for :func:`core.report.report_html`.
+    ``time`` [day after loading], ``check`` (a :func:`core.scene.check_scene` report),
+    ``calibration`` (a :class:`core.back_analysis.Calibration`): as for
+    :func:`core.report.report_html`.
 
     Raises
     ------
@@ -76,7 +81,7 @@ def report_pdf(result: SceneSolution, time: float | None = None,
     import matplotlib.pyplot as plt
     from matplotlib.backends.backend_pdf import PdfPages
 
-    lines = _text_lines(result, time, check)
+    lines = _text_lines(result, time, check, calibration)
     layout, titles = report_layout(result, time)
     buffer = io.BytesIO()
     with PdfPages(buffer, metadata={"Title": f"Report: {result.scene.name or 'scene'}",
@@ -103,13 +108,15 @@ def report_pdf(result: SceneSolution, time: float | None = None,
 
 
 def write_report(result: SceneSolution, path: str | os.PathLike,
-                 time: float | None = None, check: Mapping[str, Any] | None = None) -> None:
+                 time: float | None = None, check: Mapping[str, Any] | None = None,
+                 calibration: Any = None) -> None:
     """Write the report of ``result`` to ``path``: PDF for a ``.pdf`` name, else HTML
-    (``time`` [day after loading], ``check``: as for :func:`core.report.report_html`)."""
+    (``time`` [day after loading], ``check``, ``calibration``: as for
+    :func:`core.report.report_html`)."""
     from core.files import atomic_write_bytes, atomic_write_text
     from core.report.html import report_html
 
     if str(path).lower().endswith(".pdf"):
-        atomic_write_bytes(path, report_pdf(result, time, check))
+        atomic_write_bytes(path, report_pdf(result, time, check, calibration))
     else:
-        atomic_write_text(path, report_html(result, time, check))
+        atomic_write_text(path, report_html(result, time, check, calibration))

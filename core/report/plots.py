@@ -133,3 +133,26 @@ def matplotlib_layout(layout: Any) -> Any:
         hv.VSpan)
     return layout.map(lambda curve: curve.opts(color=colour(curve), backend="matplotlib"),
                       lambda item: isinstance(item, hv.Curve) and colour(item) is not None)
+
+
+def readings_overlay(result: SceneSolution, calibration: Any) -> Any:
+    """The settlement history of ``result`` [mm] with the settlement readings of
+    ``calibration`` (a :class:`core.back_analysis.Calibration`) as points, error bars of
+    one standard deviation where given (HoloViews, Bokeh options)."""
+    hv = holoviews_for_bokeh()
+    readings = calibration.readings
+    given = np.isfinite(readings.settlement)
+    t = readings.time[given]
+    v = readings.settlement[given] * 1e3
+    curve = hv.Curve((result.times, result.settlement * 1e3), "t [days after loading]",
+                     "settlement δ [mm]", label="fitted scene").opts(color="#1f77b4")
+    points = hv.Scatter((t, v), "t [days after loading]", "settlement δ [mm]",
+                        label="readings").opts(color="#111111", size=6)
+    parts = [curve, points]
+    if readings.settlement_std is not None:
+        std = readings.settlement_std[given] * 1e3
+        parts.append(hv.ErrorBars((t, v, std), "t [days after loading]",
+                                  ["settlement δ [mm]", "std"]).opts(color="#111111"))
+    return hv.Overlay(parts).opts(title="settlement δ(t): readings and the fitted scene",
+                                  width=PLOT_WIDTH + 200, height=PLOT_HEIGHT,
+                                  legend_position="top_left")

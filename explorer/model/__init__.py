@@ -17,6 +17,7 @@ prepared where it is solved), and the state can be used without a server.
 - ``screen``: what the page shows now (the result, the output time, a notice).
 - ``time_text``: times after loading in words, without an exponent.
 - ``study``: the Study tab's design studies, planned from the scene on screen.
+- ``fit``: the Fit tab's back-analysis: readings, the fields fitted, the outcome shown.
 """
 
 from .code_creep_state import (
@@ -40,6 +41,17 @@ from .design import (
     scene_limits,
     scene_with_limits,
     screen_limits,
+)
+from .fit import (
+    MAX_FIT_FIELDS,
+    FitOutcome,
+    fit_choices,
+    forecast_columns,
+    plan_fit,
+    read_upload,
+    readings_columns,
+    readings_note,
+    run_fit,
 )
 from .history import SceneHistory
 from .lessons import Lesson, lessons, step_scene
@@ -77,17 +89,17 @@ from .time_text import days_text, plain_number
 from .view_link import read_study_query, read_view_query, view_query
 
 __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
-           "MAX_DESCRIPTION_CHARS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS", "MODEL_TOL_RANGE",
-           "ORDER", "OUTPUTS", "QUANTITIES", "QUANTITY_RANGES", "QUANTITY_UNITS",
-           "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES", "Axis", "CodeCreepState",
-           "DesignLimits", "DisplayScales", "ExplorerState", "Geometry", "HistoryState",
-           "LayerState", "Lesson", "Pin", "PinBoard", "PlannedStudy", "ProfileState", "ResultView",
-           "SceneHistory", "Screen", "StudyResult", "check_html", "check_text", "contact_text",
-           "contact_widths", "contact_zones", "creep_coefficient_data", "days_text", "decode_scene",
-           "default_range", "design_check", "eccentricity", "encode_scene", "lessons",
-           "lift_off_lengths", "lifts_off", "lifts_or_pulls", "model_evidence", "plain_number",
-           "plan_study",
-           "prepare_view", "preset_label", "presets", "read_study_query", "read_view_query",
-           "shown_flags",
-           "scene_limits", "scene_with_limits", "screen_limits", "step_scene", "study_choices",
-           "view_query"]
+           "MAX_DESCRIPTION_CHARS", "MAX_FIT_FIELDS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS",
+           "MODEL_TOL_RANGE", "ORDER", "OUTPUTS", "QUANTITIES", "QUANTITY_RANGES",
+           "QUANTITY_UNITS", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES",
+           "Axis", "CodeCreepState", "DesignLimits", "DisplayScales", "ExplorerState",
+           "FitOutcome", "Geometry", "HistoryState", "LayerState", "Lesson", "Pin", "PinBoard",
+           "PlannedStudy", "ProfileState", "ResultView", "SceneHistory", "Screen", "StudyResult",
+           "check_html", "check_text", "contact_text", "contact_widths", "contact_zones",
+           "creep_coefficient_data", "days_text", "decode_scene", "default_range",
+           "design_check", "eccentricity", "encode_scene", "fit_choices", "forecast_columns",
+           "lessons", "lift_off_lengths", "lifts_off", "lifts_or_pulls", "model_evidence",
+           "plain_number", "plan_fit", "plan_study", "read_upload", "readings_columns",
+           "readings_note", "run_fit", "prepare_view", "preset_label", "presets",
+           "read_study_query", "read_view_query", "shown_flags", "scene_limits",
+           "scene_with_limits", "screen_limits", "step_scene", "study_choices", "view_query"]

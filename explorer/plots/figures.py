@@ -20,6 +20,7 @@ from bokeh.models import (
     LogColorMapper,
     Range1d,
     Span,
+    Whisker,
 )
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
@@ -47,6 +48,11 @@ UNKNOWN_COLOR = "#1f77b4"
 LOST_LABEL = "q < 0 (contact lost)"
 LIFTED_LABEL = "lifted off (q = 0)"
 GIVEN_COLOR = "#8c8c8c"
+#: The readings of a back-analysis (Fit tab) and the fitted scene's forecast band.
+READINGS_COLOR = "#111111"
+FORECAST_COLOR = "#ff7f0e"
+#: The histories the readings of a back-analysis are drawn on.
+READ_SERIES = ("settlement", "tilt")
 
 #: Font size of the entries of the legends above the plots (normal mode).
 LEGEND_FONT = "11px"
@@ -153,6 +159,8 @@ class Figures:
         self.image_fig = p
 
     def _build_histories(self) -> None:
+        self.readings_src: dict[str, ColumnDataSource] = {}
+        self.forecast_src: dict[str, ColumnDataSource] = {}
         self.history_src: dict[str, ColumnDataSource] = {}
         self.history_point_src: dict[str, ColumnDataSource] = {}
         self.history_fig = {}
@@ -179,12 +187,58 @@ class Figures:
             cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted",
                           level=MOVING)
             p.add_layout(cursor)
+            if q in READ_SERIES:
+                self._build_readings(p, q, unit)
             self.history_src[q] = src
             self.history_point_src[q] = point
             self.history_fig[q], self.history_line[q] = p, line
             self.history_cursor[q] = cursor
 
+    def _build_readings(self, p: figure, q: str, unit: str) -> None:
+        """The readings of a fit (points with one-standard-deviation bars) and the fitted
+        scene's forecast with its band, on the history of ``q``; empty until a fit."""
+        band = ColumnDataSource(empty_columns("t", "v", "lower", "upper"),
+                                name=f"forecast_{q}")
+        p.varea(x="t", y1="lower", y2="upper", source=band, fill_color=FORECAST_COLOR,
+                fill_alpha=0.25)
+        p.line(x="t", y="v", source=band, line_color=FORECAST_COLOR, line_width=1.5,
+               line_dash="dashed")
+        src = ColumnDataSource(empty_columns("t", "v", "lower", "upper"),
+                               name=f"readings_{q}")
+        marks = p.scatter(x="t", y="v", source=src, size=6, color=READINGS_COLOR,
+                          marker="circle_x", fill_alpha=0.0)
+        p.add_layout(Whisker(base="t", lower="lower", upper="upper", source=src,
+                             dimension="height", line_color=READINGS_COLOR,
+                             upper_head=None, lower_head=None))
+        p.add_tools(HoverTool(renderers=[marks], tooltips=[
+            ("reading at t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
+        self.readings_src[q] = src
+        self.forecast_src[q] = band
+
     # -- updates ---------------------------------------------------------------------
+    def show_readings(self, columns: dict[str, dict[str, list[float]]]) -> None:
+        """Draw the readings of a fit (:func:`explorer.model.readings_columns`, display
+        units) on the settlement and tilt histories; empty lists clear them."""
+        for q in READ_SERIES:
+            set_data(self.readings_src[q], {k: f32(v) for k, v in columns[q].items()})
+        self._fit_extra()
+
+    def show_forecast(self, columns: dict[str, dict[str, list[float]]]) -> None:
+        """Draw the fitted scene's forecast and its band
+        (:func:`explorer.model.forecast_columns`, display units); empty lists clear it."""
+        for q in READ_SERIES:
+            set_data(self.forecast_src[q], {k: f32(v) for k, v in columns[q].items()})
+        self._fit_extra()
+
+    def _fit_extra(self) -> None:
+        """Value axes of the histories that also hold the readings and the band."""
+        for q in READ_SERIES:
+            extra = [self.readings_src[q].data.get(k, []) for k in ("lower", "upper")]
+            extra += [self.forecast_src[q].data.get(k, []) for k in ("lower", "upper")]
+            shown = [self.history_src[q].data.get("v", []), *extra,
+                     *(pin.view.display(q) for pin in self._pins)]
+            steady_range(self.history_fig[q].y_range, *shown)
+
     def show(self, view: ResultView, index: int, pins: Sequence[Pin] = ()) -> None:
         """Draw a new result (call inside ``pn.io.hold`` to send one message)."""
         # A change of the loads leaves the drawing as it is: do not send it again.
@@ -220,8 +274,11 @@ class Figures:
         times or stepping the load moves the curves, not the axes."""
         self._pins = tuple(pins)
         for q in QUANTITIES:
+            extra = [] if q not in READ_SERIES else [
+                src.data.get(k, []) for src in (self.readings_src[q], self.forecast_src[q])
+                for k in ("lower", "upper")]
             steady_range(self.history_fig[q].y_range, view.display(q),
-                         *(pin.view.display(q) for pin in pins))
+                         *(pin.view.display(q) for pin in pins), *extra)
         self._fit_pressure(view)
 
     def _fit_pressure(self, view: ResultView) -> None:

@@ -10,6 +10,7 @@ Nothing here imports Panel or Bokeh when imported (the solver workers import it 
 - ``answer_wait``: a worker's answer awaited on the server's event loop.
 - ``result_cache``: the process-wide cache of prepared results.
 - ``warm_up``: presets solved before the first visitor comes.
+- ``fit_runner``: :class:`FitRun`, a fit of the Fit tab on a thread of its own.
 - ``study_runner``: :class:`StudyRun`, a design study in a process of its own.
 - ``trace``: timestamps of a slider move's way through the server (latency benchmark).
 """
@@ -24,11 +25,12 @@ from .controller import (
     use_worker_processes,
     worker_processes,
 )
+from .fit_runner import FitRun
 from .study_runner import StudyRun
 from .trace import install_websocket_marks, mark
 from .warm_up import warm_up
 from .workers import SolverProcesses, WorkerFailed
 
-__all__ = ["RESULTS", "SolveController", "SolverProcesses", "StudyRun", "WorkerFailed",
+__all__ = ["RESULTS", "FitRun", "SolveController", "SolverProcesses", "StudyRun", "WorkerFailed",
            "approx_bytes", "describe_field", "format_error", "install_websocket_marks", "mark",
            "shared_pool", "use_worker_processes", "warm_up", "worker_processes"]

@@ -8,7 +8,8 @@ to refresh them. :mod:`explorer.app` builds the views and assembles the page fro
 - Sidebar tabs: ``scene`` (presets, undo, the loading, with the slider of
   ``eccentricity``), ``punch``, ``coating`` (with the coating-model check), ``base`` (with
   ``creep``, the design codes' creep), ``times``, ``check``, ``files``, ``lessons``,
-  ``study``; ``fidelity``: the model-fidelity widgets of the Coating and Time tabs.
+  ``study``, ``fit`` (back-analysis from readings); ``fidelity``: the model-fidelity
+  widgets of the Coating and Time tabs.
 - The results column: ``results`` (messages, plots, player, readout, design check),
   ``contact`` (the contact figures' slots), ``pins`` (pin, remove, pin every step, pins
   of a link), ``busy`` (the busy indicator), ``status`` (the status line in words).
@@ -25,6 +26,7 @@ from .check import CheckView
 from .coating import CoatingView
 from .fidelity import CONTACT_LABELS, FidelityView
 from .files import FilesView
+from .fit import FitView
 from .lessons import LessonsView
 from .link import LINK_EVERY_MS, AddressLink
 from .loop import PageLoop
@@ -38,7 +40,8 @@ from .style import html_pane
 from .tabs import FILL_TABS_AFTER_MS, DeferredTabs
 from .times import TimesView
 
-__all__ = ["BUSY_AFTER_MS", "CONTACT_LABELS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS", "AddressLink",
-           "BaseView", "CheckView", "CoatingView", "DeferredTabs", "FidelityView", "FilesView",
-           "LessonsView", "PageLoop", "PinsView", "PunchView", "ResultsView", "SceneView",
-           "StudyView", "TimesView", "badges_html", "html_pane", "readout_html", "status_html"]
+__all__ = ["BUSY_AFTER_MS", "CONTACT_LABELS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS",
+           "AddressLink", "BaseView", "CheckView", "CoatingView", "DeferredTabs", "FidelityView",
+           "FilesView", "FitView", "LessonsView", "PageLoop", "PinsView", "PunchView",
+           "ResultsView", "SceneView", "StudyView", "TimesView", "badges_html", "html_pane",
+           "readout_html", "status_html"]

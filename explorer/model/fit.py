@@ -1,0 +1,188 @@
+"""The Fit tab's back-analysis: readings uploaded, scene fields fitted to them.
+
+:func:`read_upload` reads a readings file (``core.back_analysis.readings_from_text``:
+a ``ValueError`` naming the line and the column), :func:`fit_choices` lists the fields
+the tab offers (the Study tab's, :func:`explorer.model.study.study_choices`, without the
+derived eccentricity: a fit sets scene fields), :func:`plan_fit` checks the fields chosen
+and :func:`run_fit` fits them with ``core.calibrate`` and forecasts the fitted scene over
+the scene's output times. The rest turns readings, fit and forecast into the numbers the
+page shows, in display units (mm, mrad, the fields' units on screen).
+
+Nothing here imports Panel (the fit runs on a thread of the server).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from core.back_analysis import Calibration, Forecast, Readings, calibrate, readings_from_text
+from core.limits import MAX_READINGS_BYTES
+
+from .loading_state import QUANTITY_UNITS
+from .study import ECCENTRICITY, Choice, study_choices
+from .time_text import plain_number
+
+#: Most fields one fit of the page fits: each costs one more solve per step of the fit
+#: (its finite-difference column) and three already take up to ~6 s (measured on the
+#: default preset's creeping base).
+MAX_FIT_FIELDS = 3
+#: The series a readings file holds, as the page draws them.
+SERIES = ("settlement", "tilt")
+
+
+def read_upload(data: bytes, filename: str) -> Readings:
+    """The readings of an uploaded file (CSV or JSON, ``core/SCENES.md``, "Readings
+    files"). Raises ValueError naming the file, the line and the column."""
+    name = filename or "readings"
+    if len(data) > MAX_READINGS_BYTES:
+        raise ValueError(f"{name}: {len(data):,} bytes, more than a readings file may hold "
+                         f"({MAX_READINGS_BYTES:,})")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise ValueError(f"{name}: not a text file in UTF-8 (readings are CSV or JSON)") \
+            from None
+    return readings_from_text(text, name)
+
+
+def fit_choices(scene: Mapping[str, Any]) -> list[Choice]:
+    """The fields of ``scene`` the tab can fit (the Study tab's fields, scene paths)."""
+    return [c for c in study_choices(scene) if c.key != ECCENTRICITY]
+
+
+def plan_fit(scene: Mapping[str, Any], keys: Sequence[str | None]) -> list[Choice]:
+    """The fields chosen (``None`` entries left out), checked: one to
+    :data:`MAX_FIT_FIELDS`, each a field of ``scene`` the tab offers, none twice.
+    Raises ValueError naming the tab's field (``field 2: ...``)."""
+    offered = {c.key: c for c in fit_choices(scene)}
+    chosen: list[Choice] = []
+    for i, key in enumerate(keys):
+        if key is None:
+            continue
+        where = f"field {i + 1}"
+        if key not in offered:
+            raise ValueError(f"{where}: {key!r} is not a field of this scene the tab can fit")
+        if any(c.key == key for c in chosen):
+            raise ValueError(f"{where}: chosen twice; choose another field or none")
+        chosen.append(offered[key])
+    if not chosen:
+        raise ValueError("field 1: choose a field to fit")
+    if len(chosen) > MAX_FIT_FIELDS:
+        raise ValueError(f"field {MAX_FIT_FIELDS + 1}: at most {MAX_FIT_FIELDS} fields")
+    return chosen
+
+
+@dataclass(frozen=True)
+class FitOutcome:
+    """A fit of the page: the core's :class:`~core.back_analysis.Calibration`, the
+    forecast of the fitted scene over the scene's output times (None when it could not
+    be made: ``forecast_error`` says why), the fields as the tab names them, and the
+    wall time of fit and forecast [s]."""
+
+    calibration: Calibration
+    forecast: Forecast | None
+    choices: tuple[Choice, ...]
+    seconds: float
+    forecast_error: str = ""
+
+    def rows(self) -> list[tuple[str, str, str, str]]:
+        """(field, fitted value, standard error, unit) of each field, in the units on
+        screen."""
+        values, errors = self.calibration.values, self.calibration.standard_errors
+        out = []
+        for c in self.choices:
+            value, se = values[c.key] / c.scale, errors[c.key] / c.scale
+            out.append((c.label, plain_number(value, 4), _error_text(se), c.unit))
+        return out
+
+    def correlations(self) -> list[tuple[str, str, float]]:
+        """(field, field, correlation of their fitted values) of each pair."""
+        corr = self.calibration.correlation
+        n = len(self.choices)
+        return [(self.choices[j].label, self.choices[k].label, float(corr[j, k]))
+                for j in range(n) for k in range(j + 1, n)]
+
+    def fitted_scene(self) -> dict[str, Any]:
+        """The scene with the fitted values (the scene's own output times)."""
+        return self.calibration.scene.to_dict()
+
+
+def _error_text(se: float) -> str:
+    """A standard error with two significant digits ('unbounded' when infinite)."""
+    if not math.isfinite(se):
+        return "unbounded"
+    return f"{se:.2g}"
+
+
+def run_fit(scene: Mapping[str, Any], readings: Readings, keys: Sequence[str | None]
+            ) -> FitOutcome:
+    """Fit the fields ``keys`` of ``scene`` (the scene dict on screen) to ``readings``
+    and forecast the fitted scene over the scene's output times with its band.
+
+    Raises ValueError (the tab's or the core's message, naming the field) when the fit
+    cannot be made."""
+    choices = plan_fit(scene, keys)
+    started = time.perf_counter()
+    calibration = calibrate(dict(scene), readings, fit=[c.key for c in choices])
+    try:
+        forecast, error = calibration.forecast(scene["times"]), ""
+    except ValueError as exc:  # the fitted scene is refused at the scene's times
+        forecast, error = None, str(exc)
+    return FitOutcome(calibration, forecast, tuple(choices),
+                      time.perf_counter() - started, error)
+
+
+def readings_columns(readings: Readings | None) -> dict[str, dict[str, list[float]]]:
+    """Per series (settlement, tilt): the rows with a reading as ``t`` [day], ``v`` and
+    the error bar ``lower``/``upper`` (one standard deviation, ``v`` without one) in the
+    display unit (mm, mrad). Empty lists for a series the readings do not hold."""
+    out: dict[str, dict[str, list[float]]] = {}
+    for name in SERIES:
+        values = None if readings is None else getattr(readings, name)
+        if values is None:
+            out[name] = {"t": [], "v": [], "lower": [], "upper": []}
+            continue
+        size = QUANTITY_UNITS[name][1]
+        given = np.isfinite(values)
+        std = getattr(readings, f"{name}_std")
+        spread = np.zeros_like(values) if std is None else np.nan_to_num(std)
+        v = values[given] / size
+        s = spread[given] / size
+        out[name] = {"t": readings.time[given].tolist(), "v": v.tolist(),
+                     "lower": (v - s).tolist(), "upper": (v + s).tolist()}
+    return out
+
+
+def forecast_columns(forecast: Forecast | None) -> dict[str, dict[str, list[float]]]:
+    """Per series: the forecast ``v`` and its band ``lower``/``upper`` at ``t`` [day] in
+    the display unit (empty lists without a forecast)."""
+    out: dict[str, dict[str, list[float]]] = {}
+    for name in SERIES:
+        if forecast is None:
+            out[name] = {"t": [], "v": [], "lower": [], "upper": []}
+            continue
+        size = QUANTITY_UNITS[name][1]
+        lower, upper = forecast.band(name)
+        out[name] = {"t": forecast.times.tolist(),
+                     "v": (getattr(forecast, name) / size).tolist(),
+                     "lower": (lower / size).tolist(), "upper": (upper / size).tolist()}
+    return out
+
+
+def readings_note(readings: Readings) -> str:
+    """What a readings file holds, in words."""
+    parts = []
+    for name in readings.series:
+        n = int(np.isfinite(getattr(readings, name)).sum())
+        std = " with standard deviations" if getattr(readings, f"{name}_std") is not None \
+            else ""
+        parts.append(f"{n} {name} reading{'s' if n != 1 else ''}{std}")
+    t = readings.time
+    return (f"{' and '.join(parts)} from t = {plain_number(float(t[0]), 4)} to "
+            f"{plain_number(float(t[-1]), 4)} days after loading")

@@ -1,0 +1,232 @@
+"""The Fit tab: back-analysis of the scene on screen from measured readings.
+
+The user uploads a readings file (settlements and/or tilts over time, ``core/SCENES.md``,
+"Readings files"); the readings are drawn on the settlement and tilt histories. Fit fits
+up to three fields of the scene (the Study tab's fields) with ``core.calibrate`` off the
+page's event loop (:class:`explorer.solving.FitRun`); the tab then shows the fitted values
+with their standard errors, chi^2/dof, the correlations and the warnings, and the
+histories the forecast of the fitted scene with its band. "Apply fitted values" shows the
+fitted scene.
+"""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import panel as pn
+
+from core.back_analysis import BAND_LEVEL, Readings
+from core.limits import MAX_READINGS_BYTES
+
+from ..model import (
+    MAX_FIT_FIELDS,
+    ExplorerState,
+    FitOutcome,
+    fit_choices,
+    forecast_columns,
+    read_upload,
+    readings_columns,
+    readings_note,
+)
+from ..plots import Figures
+from ..solving import FitRun, SolveController
+from .loop import PageLoop
+from .style import NOTE_STYLE, TAB_COLUMN, html_pane
+from .upload import BoundedUpload
+
+#: The choice of "no field" for the second and third field.
+NONE = "(none)"
+
+
+class FitView:
+    """Upload, fields, Fit button and the fitted values of the session's back-analysis."""
+
+    title = "Fit"
+
+    def __init__(self, state: ExplorerState, controller: SolveController, loop: PageLoop,
+                 figures: Figures, load_scene: Callable[[dict[str, Any]], bool]) -> None:
+        """``state``: the scene fitted; ``controller``: the fields offered follow its
+        results; ``loop``: where the fit's answer is shown; ``figures``: the histories the
+        readings and the forecast are drawn on; ``load_scene``: shows the fitted scene."""
+        self.state = state
+        self.figures = figures
+        self.load_scene = load_scene
+        self.readings: Readings | None = None
+        self.fit_run = FitRun(dispatch=loop.dispatch)
+        self.background = loop.served
+        stretch = {"sizing_mode": "stretch_width"}
+        self.upload = BoundedUpload([".csv", ".json", ".txt"], MAX_READINGS_BYTES)
+        self.upload.param.watch(self._on_upload, "value")
+        self.readings_status = html_pane("<small><i>No readings yet.</i></small>",
+                                         css_classes=["fit-readings"], **stretch)
+        self.fields = [pn.widgets.Select(label=f"field {k + 1} to fit",
+                                         css_classes=[f"fit-field-{k + 1}"], **stretch)
+                       for k in range(MAX_FIT_FIELDS)]
+        self.fit_button = pn.widgets.Button(label="Fit", color="primary", disabled=True,
+                                            css_classes=["fit-run"], **stretch)
+        self.fit_button.on_click(lambda e: self.start())
+        self.fit_status = html_pane("", css_classes=["fit-status"], **stretch)
+        self.fit_table = html_pane("", css_classes=["fit-table"], **stretch)
+        self.apply_button = pn.widgets.Button(label="Apply fitted values", disabled=True,
+                                              css_classes=["fit-apply"], **stretch)
+        self.apply_button.on_click(lambda e: self.apply())
+        self.fit_run.param.watch(self._on_run, ["status", "message"])
+        self.fit_run.param.watch(self._on_outcome, "outcome")
+        self._choices: dict[str, Any] = {}
+        controller.param.watch(lambda e: self.refresh(getattr(e.new, "scene", None)), "view")
+        self.refresh()
+
+    def content(self) -> pn.Column:
+        """The tab's column."""
+        return pn.Column(
+            html_pane("<small>Back-analysis: fit fields of the scene on screen to measured "
+                      "settlements and tilts. Upload a readings file (CSV or JSON): "
+                      "<code>time [day], settlement [mm], settlement_std, tilt [urad], "
+                      "tilt_std</code>, times in days after loading, a unit in brackets "
+                      "per column, an empty cell for no reading.</small>"),
+            pn.Column(self.upload, css_classes=["fit-upload"], sizing_mode="stretch_width",
+                      margin=0),
+            self.readings_status, *self.fields, self.fit_button,
+            self.fit_status, self.fit_table, self.apply_button,
+            html_pane(f"<small>The band on the histories is the fitted scene's "
+                      f"{100 * BAND_LEVEL:.0f} % band from the fields' uncertainty only, "
+                      "not the model's error. Every step of a fit is a full solve at the "
+                      "readings' times.</small>", styles=NOTE_STYLE),
+            **TAB_COLUMN)
+
+    # -- choices ---------------------------------------------------------------------------
+    def refresh(self, scene: dict[str, Any] | None = None) -> None:
+        """Offer the fields of ``scene`` (default: the state's), keeping those chosen."""
+        if scene is None:
+            try:
+                scene = self.state.to_scene()
+            except ValueError:
+                return
+        choices = {c.key: c for c in fit_choices(scene)}
+        if list(choices) == list(self._choices):
+            self._choices = choices
+            return
+        self._choices = choices
+        options = {c.title: c.key for c in choices.values()}
+        for k, select in enumerate(self.fields):
+            keep = select.value
+            select.options = (options if k == 0 else {NONE: NONE} | options)
+            if keep in select.options.values():
+                select.value = keep
+            else:
+                select.value = next(iter(choices), None) if k == 0 else NONE
+
+    def chosen(self) -> list[str | None]:
+        """The fields chosen (None: no field)."""
+        return [None if s.value in (None, NONE) else s.value for s in self.fields]
+
+    # -- readings --------------------------------------------------------------------------
+    def _on_upload(self, event: Any) -> None:
+        data = event.new
+        if data is None:
+            return
+        name = self.upload.filename or "readings"
+        try:
+            readings = read_upload(data, name)
+        except ValueError as exc:
+            self.upload.clear()
+            self._readings_text(f"The readings were not used: {exc}", bad=True)
+            return
+        self.show_readings(readings)
+
+    def show_readings(self, readings: Readings) -> None:
+        """Use ``readings`` (the last fit's values and band are cleared)."""
+        self.readings = readings
+        self.figures.show_readings(readings_columns(readings))
+        self.figures.show_forecast(forecast_columns(None))
+        self.fit_table.object = ""
+        self.apply_button.disabled = True
+        self._readings_text(f"{readings.source}: {readings_note(readings)}.")
+        self.fit_button.disabled = self.fit_run.running
+
+    def _readings_text(self, text: str, bad: bool = False) -> None:
+        color = "#9b1c1c" if bad else "#333"
+        self.readings_status.object = (f"<div class='fit-readings-message' style='font-size:"
+                                       f"13px;color:{color}'>{html.escape(text)}</div>")
+
+    # -- fitting ---------------------------------------------------------------------------
+    def start(self) -> bool:
+        """Fit the fields chosen of the scene on screen to the readings; False (and the
+        reason on the page) when it cannot start."""
+        if self.fit_run.running:
+            return False
+        if self.readings is None:
+            self._say("Not fitted: upload a readings file first.", bad=True)
+            return False
+        try:
+            scene = self.state.to_scene()
+        except ValueError as exc:
+            self._say(f"Not fitted: {exc}", bad=True)
+            return False
+        self.fit_button.disabled = True
+        self.fit_run.start(scene, self.readings, self.chosen(), background=self.background)
+        return True
+
+    def _say(self, text: str, bad: bool = False) -> None:
+        color = "#9b1c1c" if bad else "#333"
+        self.fit_status.object = (f"<div class='fit-message' style='font-size:13px;"
+                                  f"color:{color}'>{html.escape(text)}</div>")
+
+    def _on_run(self, *events: Any) -> None:
+        run = self.fit_run
+        self.fit_button.disabled = run.status == "running" or self.readings is None
+        if run.status == "running":
+            self._say("Fitting: every step is a full solve (seconds)...")
+        elif run.status == "failed":
+            self._say(f"Not fitted: {run.message}", bad=True)
+        elif run.status == "done":
+            self._say(f"Done: {run.message}.")
+
+    def _on_outcome(self, event: Any) -> None:
+        outcome = event.new
+        if outcome is None:
+            return
+        self.fit_table.object = outcome_html(outcome)
+        self.figures.show_forecast(forecast_columns(outcome.forecast))
+        self.apply_button.disabled = False
+        self.fit_button.disabled = self.readings is None
+
+    def apply(self) -> bool:
+        """Show the last fit's fitted scene; False when there is none or it is refused."""
+        outcome = self.fit_run.outcome
+        if outcome is None:
+            return False
+        return self.load_scene(outcome.fitted_scene())
+
+
+def outcome_html(outcome: FitOutcome) -> str:
+    """The fitted values ± standard errors, chi^2/dof, the correlations and the warnings
+    of a fit, as the tab's HTML (user text escaped)."""
+    c = outcome.calibration
+    rows = "".join(
+        f"<tr class='fit-row'><td>{html.escape(label)}</td><td>{html.escape(value)} ± "
+        f"{html.escape(se)} {html.escape(unit)}</td></tr>"
+        for label, value, se, unit in outcome.rows())
+    noise = ("the readings' standard deviations" if c.std_given
+             else "the noise estimated from the scatter about the fit")
+    parts = [f"<table class='fit-values' style='font-size:13px'>"
+             f"<tr><th>field</th><th>fitted value ± standard error</th></tr>{rows}</table>",
+             f"<div style='font-size:12px'>{c.readings.count} readings, "
+             f"χ²/dof = {c.chi2_per_dof:.3g} ({c.dof} dof); standard errors from "
+             f"{noise}.</div>"]
+    pairs = outcome.correlations()
+    if pairs:
+        parts.append("<div style='font-size:12px'>correlations: " + "; ".join(
+            f"{html.escape(a)} ~ {html.escape(b)}: "
+            f"{'n/a' if not np.isfinite(r) else f'{r:+.3f}'}" for a, b, r in pairs)
+            + "</div>")
+    for warning in c.warnings:
+        parts.append(f"<div class='fit-warning' style='font-size:12px;color:#9b1c1c'>"
+                     f"warning: {html.escape(warning)}</div>")
+    if outcome.forecast_error:
+        parts.append(f"<div class='fit-warning' style='font-size:12px;color:#9b1c1c'>no "
+                     f"forecast: {html.escape(outcome.forecast_error)}</div>")
+    return "".join(parts)

@@ -1,0 +1,74 @@
+"""The Fit tab in a real browser (Debian's Chromium): a readings file made from a solved
+scene is uploaded and drawn on the settlement history, Fit runs the back-analysis and the
+tab shows the fitted value with its standard error, the histories the forecast band.
+Every wait is on a condition in the page."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(600)]
+
+from tests.browser_pages import require_browser  # noqa: E402
+
+require_browser()
+
+from core import solve  # noqa: E402
+from core.back_analysis import readings_csv  # noqa: E402
+from explorer.model import DEFAULT_PRESET, presets  # noqa: E402
+from tests.browser_pages import Page, page_fixtures, patience, until  # noqa: E402
+
+# The values of a named source of the page (null when it is not on the page).
+JS_VALUES = """([name, column]) => {
+  const src = Bokeh.documents[0].get_model_by_name(name);
+  return src && src.data[column] ? Array.from(src.data[column]) : null;
+}"""
+#: Reading times [day after loading] within the default scene's output times.
+TIMES = [5.0, 10.0, 20.0, 40.0, 80.0, 160.0, 300.0]
+
+
+def _readings() -> bytes:
+    """Settlements of the page's default scene with its coating 1.5 times as stiff, a
+    deterministic scatter of 0.5 %."""
+    scene = presets()[DEFAULT_PRESET]
+    scene["times"] = TIMES
+    scene["coating"][0]["modulus"] *= 1.5
+    scatter = 1 + 0.005 * np.array([1, -1, 0.5, -0.5, 1, -1, 0.0])
+    result = solve(scene)
+    return readings_csv({"time": TIMES, "settlement": list(result.settlement * scatter)}
+                        ).encode()
+
+
+def values(page: Page, name: str, column: str = "v") -> list[float]:
+    return page.page.evaluate(JS_VALUES, [name, column]) or []
+
+
+server, browser_context, page = page_fixtures(1400, 900)
+
+
+def test_readings_are_uploaded_drawn_and_fitted(page: Page):
+    page.open_tab("Fit")
+    upload = page.page.locator(".fit-upload input[type=file]").first
+    upload.wait_for(state="attached", timeout=60_000 * patience())
+    upload.set_input_files(files=[{"name": "levelling.csv", "mimeType": "text/csv",
+                                   "buffer": _readings()}])
+    until(lambda: len(values(page, "readings_settlement")) == 7,
+          "the readings on the settlement figure", 60,
+          lambda: page.pane_text(".fit-readings"))
+    assert "7 settlement readings" in page.pane_text(".fit-readings")
+    page.page.locator(".fit-field-1 select").first.select_option(
+        label="coating 1: Young's modulus [MPa]")
+    run = page.page.locator(".fit-run button").first
+    until(lambda: run.is_enabled(), "the Fit button enabled")
+    run.click()
+    until(lambda: "±" in page.pane_text(".fit-table"), "the fitted values", 240,
+          lambda: page.pane_text(".fit-status"))
+    table = page.pane_text(".fit-table")
+    assert "coating 1: Young's modulus" in table and "MPa" in table and "χ²/dof" in table
+    assert "Done: fitted" in page.pane_text(".fit-status")
+    until(lambda: len(values(page, "forecast_settlement", "upper")) > 0, "the forecast band")
+    lower = values(page, "forecast_settlement", "lower")
+    upper = values(page, "forecast_settlement", "upper")
+    assert all(lo <= hi for lo, hi in zip(lower, upper, strict=True))
+    assert page.errors == []
