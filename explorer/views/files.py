@@ -67,7 +67,8 @@ class FilesView:
                                                   filename="scene.json",
                                                   label="Save scene (JSON)", color="primary",
                                                   **stretch)
-        self.load_file = BoundedUpload(accept=(".json",), max_bytes=MAX_SCENE_BYTES)
+        self.load_file = BoundedUpload(accept=(".json",), max_bytes=MAX_SCENE_BYTES,
+                                       css="scene-upload")
         self.load_file.param.watch(self._on_scene_file, "value")
         self.csv_download = pn.widgets.FileDownload(callback=self._csv_file,
                                                     filename="results.csv",

@@ -29,14 +29,17 @@ class BoundedUpload(pn.viewable.Viewer):
     filename = param.String(default="", doc="Name of the last file.")
     value = param.Bytes(default=None, allow_None=True, doc="Contents of the last file.")
 
-    def __init__(self, accept: Sequence[str], max_bytes: int, **params: Any) -> None:
+    def __init__(self, accept: Sequence[str], max_bytes: int, css: str = "",
+                 **params: Any) -> None:
+        """``css``: a class of the box besides ``file-dropper`` (which box a test uses)."""
         super().__init__(**params)
         self.max_bytes = max_bytes
         # chunks well below the server's websocket message limit (explorer/__main__.py)
         self._box = pn.widgets.FileDropper(
             accepted_filetypes=list(accept), multiple=False,
             max_file_size=f"{max(1, max_bytes // 1000)}KB", chunk_size=UPLOAD_CHUNK_BYTES,
-            sizing_mode="stretch_width", height=90, css_classes=["file-dropper"])
+            sizing_mode="stretch_width", height=90,
+            css_classes=["file-dropper", css] if css else ["file-dropper"])
         self._box.param.watch(self._on_drop, "value")
         # The dropper has no way to be emptied from the server: a hidden counter asks the
         # page to remove its files (a new dropper in its place broke the old one's

@@ -180,7 +180,7 @@ def test_an_oversized_upload_is_refused_in_the_page_and_a_scene_file_loads(page:
     disconnected: list[str] = []
     page.page.on("console", lambda m: "Lost websocket" in m.text and disconnected.append(m.text))
     page.open_tab("Files")
-    upload = page.page.locator("input[type=file]").last
+    upload = page.page.locator(".scene-upload input[type=file]").first
     upload.wait_for(state="attached", timeout=30_000 * patience())
     # 5 MiB: over the limit of a scene file (1 MB) and over the largest websocket message
     # the server reads (4 MiB, explorer/__main__.py), which a file sent in one message

@@ -479,7 +479,7 @@ def test_a_refused_scene_file_leaves_the_box_ready_for_the_next(page: Page):
     """A refused file showed a green "Upload complete" beside the refusal, and a second
     file could be dropped only after finding the x of the first."""
     page.open_tab("Files")
-    upload = page.page.locator("input[type=file]").last
+    upload = page.page.locator(".scene-upload input[type=file]").first
     upload.wait_for(state="attached", timeout=30_000 * patience())
     upload.set_input_files(files=[{"name": "broken.json", "mimeType": "application/json",
                                    "buffer": b'{"name": "x", "punch": '}])
@@ -488,7 +488,7 @@ def test_a_refused_scene_file_leaves_the_box_ready_for_the_next(page: Page):
     until(lambda: not _upload_complete_shown(page), "the box emptied after the refusal")
     scene = json.loads((ROOT / "core" / "presets" / "scenes" / "stepped_punch.json").read_text())
     scene["name"] = "second file"
-    upload = page.page.locator("input[type=file]").last
+    upload = page.page.locator(".scene-upload input[type=file]").first
     upload.wait_for(state="attached", timeout=30_000 * patience())
     upload.set_input_files(files=[{"name": "scene.json", "mimeType": "application/json",
                                    "buffer": json.dumps(scene).encode()}])

@@ -50,13 +50,15 @@ def _wait_asleep(page: Page, timeout: float = 90.0) -> None:
 
 def test_an_idle_page_holds_the_droppers_loop_and_a_late_file_still_loads(page: Page):
     page.open_tab("Files")
-    upload = page.page.locator("input[type=file]").last
+    upload = page.page.locator(".scene-upload input[type=file]").first
     upload.wait_for(state="attached", timeout=30_000 * patience())
     # awake after the click on the tab: the loop runs (the dropper draws itself)
     assert _painter_runs(page, 500) > 5
     # idle: once the page has filled its other tabs in the background (a few seconds
     # after loading: changes from the server wake the loop too), no more frames of the
-    # dropper, for longer than the wake
+    # dropper, for longer than the wake. The last tab's box on the page: all are filled.
+    page.page.locator(".fit-upload input[type=file]").first.wait_for(
+        state="attached", timeout=60_000 * patience())
     _wait_asleep(page)
     assert _painter_runs(page, AWAKE_MS + 500) == 0
     # a file chosen now (as after a long look through the file dialog): only the file
