@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from core.problem import ContactSolution
     from core.scene.dimensionless import DimensionlessProblem
 
-#: The thin-coating model is doubtful where sum h_k exceeds this fraction of 2a.
+#: The thin-coating model is doubtful where sum h_k reaches this fraction of 2a.
 THICK_COATING_RATIO = 0.1
 #: Tilts beyond this many radians are not small.
 LARGE_TILT = 0.01
@@ -50,7 +50,7 @@ PLOT_POINTS = 201
 FLAG_MESSAGES: dict[str, str] = {
     "contact_lost": "The computed pressure is negative somewhere: part of the punch base "
                     "lifts off, so this full-contact answer is not physical.",
-    "thick_coating": f"The coating is thicker than {THICK_COATING_RATIO:g} of the punch width "
+    "thick_coating": f"The coating is {THICK_COATING_RATIO:g} of the punch width or thicker "
                      "somewhere: the thin (Winkler) coating model is doubtful.",
     "stiff_coating": "A coating layer is stiffer than the base at loading somewhere: the "
                      "thin-coating model assumes soft coatings.",
@@ -160,7 +160,7 @@ class SceneSolution:
         thin = solution.info.get("coating_model") != "exact layered"
         # the extremes on the scene's samples, shared by scenes of the same geometry
         if thin and scene.sample_extremes["coating_thickness_max_m"] / (2 * scene.half_width) \
-                > THICK_COATING_RATIO:
+                >= THICK_COATING_RATIO:
             flags.append("thick_coating")
         if self.model_error["estimate"] > scene.model_tol:
             flags.append("model_error")

@@ -628,3 +628,12 @@ def test_scene_types():
     assert scene.statement == 4 and scene.given == {"force", "moment"}
     assert math.isclose(scene.modulus_at_loading(), 3e10)
     assert not scene.times.flags.writeable
+
+
+@pytest.mark.parametrize(("thickness", "flagged"), [(0.2, True), (0.1998, False)])
+def test_a_coating_of_a_tenth_of_the_width_is_thick(thickness, flagged):
+    """``thick_coating`` from sum h / 2a = 0.1 on (a users' report: not raised at exactly
+    0.1), on the thin layer's answer (a creeping base)."""
+    d = scene_file("uniform_flat")  # a = 1 m, one layer
+    d["coating"][0]["thickness"] = thickness
+    assert ("thick_coating" in solve(d).flags) is flagged
