@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import logging
+import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -22,6 +23,12 @@ log = logging.getLogger(__name__)
 
 #: FE mesh level of the check (0, the coarsest: ~1-3 s of one core; P and M to ~2e-4).
 CHECK_LEVEL = 0
+#: FE coating checks running at once in one server: one took the server's processes from
+#: 0.3 to 3.3 GiB, so several pages pressing the button at once were bounded by nothing
+#: but the machine. A check waits for the one before it, at most CHECK_WAIT_S [s].
+MAX_RUNNING_CHECKS = 1
+CHECK_WAIT_S = 300.0
+_CHECKS = threading.BoundedSemaphore(MAX_RUNNING_CHECKS)
 #: Rows of the check's table: quantity, unit shown, factor from SI.
 CHECK_ROWS = (("settlement", "mm", 1e3), ("tilt", "mrad", 1e3), ("force", "kN/m", 1e-3),
               ("moment", "kN·m/m", 1e-3))
@@ -184,11 +191,20 @@ class CoatingCheckView:
         self.button.disabled = True
         self.progress.visible = True
         self.result.object = "<small>Solving the resolved model…</small>"
-        executor = self.controller.executor
-        if executor is None:
+        if self.controller.executor is None:
             self.show(_check(scene))
-        else:
-            executor.submit(lambda: self._finish(_check(scene)))
+            return
+
+        def work() -> None:
+            # a thread of its own, not the solver pool's: it may wait for another
+            # page's check, and the pool's threads serve every page's slider solves
+            self._finish(_check(scene, lambda: self.loop.dispatch(self._say_waiting)))
+
+        start_in_background(work)
+
+    def _say_waiting(self) -> None:
+        self.result.object = ("<small>Waiting for another page's coating check to finish "
+                              "(one runs at a time on this server)…</small>")
 
     def _finish(self, outcome: dict[str, Any] | str) -> None:
         self.loop.dispatch(lambda: self.show(outcome))
@@ -203,8 +219,22 @@ class CoatingCheckView:
             self.screen.model_check = outcome
 
 
-def _check(scene: dict[str, Any]) -> dict[str, Any] | str:
-    """The check's report, or why there is none (runs off the event loop)."""
+def start_in_background(work: Callable[[], None]) -> None:
+    """Run ``work`` on a thread of its own (a check may wait for another page's)."""
+    threading.Thread(target=work, name="coating-check", daemon=True).start()
+
+
+def _check(scene: dict[str, Any], waiting: Callable[[], None] | None = None
+           ) -> dict[str, Any] | str:
+    """The check's report, or why there is none (runs off the event loop): one check at a
+    time on the server (:data:`MAX_RUNNING_CHECKS`), ``waiting()`` called when it has to
+    wait for another, at most :data:`CHECK_WAIT_S`."""
+    if not _CHECKS.acquire(blocking=False):
+        if waiting is not None:
+            waiting()
+        if not _CHECKS.acquire(timeout=CHECK_WAIT_S):
+            return (f"Not checked: other pages' coating checks kept the server busy for "
+                    f"{CHECK_WAIT_S:.0f} s; try again later.")
     try:
         processes = worker_processes()
         if processes is not None:
@@ -215,3 +245,5 @@ def _check(scene: dict[str, Any]) -> dict[str, Any] | str:
     except Exception as exc:  # the session must survive a failed check
         log.exception("coating check failed")
         return f"The check failed ({type(exc).__name__}: {exc})."
+    finally:
+        _CHECKS.release()
