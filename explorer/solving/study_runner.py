@@ -127,10 +127,6 @@ class StudyRun(param.Parameterized):
                  **params: Any) -> None:
         super().__init__(**params)
         self._dispatch = dispatch or (lambda callback: callback())
-        # numbers of the updates sent from the study's thread and of the last applied
-        self._order = threading.Lock()
-        self._sent = 0
-        self._applied = 0
         self._cancel = threading.Event()
         self._thread: threading.Thread | None = None
         self.process: Any = None
@@ -163,20 +159,7 @@ class StudyRun(param.Parameterized):
         return not self.running
 
     def _set(self, **values: Any) -> None:
-        """Apply ``values`` on the page's loop, in the order they were set: a progress
-        line dispatched before the result could run after it (the page then read "Done:
-        running: 3 of 3 points"), so an update older than one applied is dropped."""
-        with self._order:
-            self._sent += 1
-            number = self._sent
-
-        def apply() -> None:
-            if number < self._applied:
-                return
-            self._applied = number
-            self.param.update(**values)
-
-        self._dispatch(apply)
+        self._dispatch(lambda: self.param.update(**values))
 
     def _work(self, planned: PlannedStudy, cancel: threading.Event) -> None:
         if not _SLOTS.acquire(blocking=False):

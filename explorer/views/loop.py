@@ -4,6 +4,8 @@ where outcomes computed on other threads are brought back to the page."""
 from __future__ import annotations
 
 import logging
+import threading
+from collections import deque
 from collections.abc import Callable
 from typing import Any
 
@@ -17,6 +19,10 @@ class PageLoop:
 
     def __init__(self, doc: Any) -> None:
         self.doc = doc
+        # callbacks dispatched from other threads, run in the order they were dispatched
+        self._queued: deque[Callable[[], None]] = deque()
+        self._lock = threading.Lock()
+        self._draining = False
 
     @property
     def served(self) -> bool:
@@ -42,9 +48,31 @@ class PageLoop:
             log.debug("callback dropped: session gone")
 
     def dispatch(self, callback: Callable[[], None]) -> None:
-        """Run ``callback`` (from a solver thread) on this session's event loop, or at
-        once where there is none (a notebook, a script)."""
-        if self.served:
-            self.later(callback, 0)
-        else:
+        """Run ``callback`` (from a solver thread) on this session's event loop, after
+        every callback dispatched before it, or at once where there is none (a notebook,
+        a script).
+
+        The callbacks wait in one queue that a single callback on the loop empties: each
+        scheduled on its own, a study's last progress line once ran after its result
+        (the page read "Done: running: 3 of 3 points")."""
+        if not self.served:
             callback()
+            return
+        with self._lock:
+            self._queued.append(callback)
+            if self._draining:
+                return
+            self._draining = True
+        self.later(self._drain, 0)
+
+    def _drain(self) -> None:
+        while True:
+            with self._lock:
+                if not self._queued:
+                    self._draining = False
+                    return
+                callback = self._queued.popleft()
+            try:
+                callback()
+            except Exception:  # the others still run, the page goes on
+                log.exception("a callback from another thread failed")

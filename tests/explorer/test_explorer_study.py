@@ -263,18 +263,3 @@ def test_a_link_keeps_the_study_settings(explorer_app):
     settings, message = read_study_query({"study": encode_scene({"axes": "x"})})
     assert settings is None and message.startswith("The study settings in the link were "
                                                    "not used")
-
-
-def test_the_runs_updates_apply_in_the_order_they_were_set():
-    """Updates from the study's thread reach the page's loop as callbacks; one that runs
-    after a newer one (the last progress line after the result) is dropped, so the page
-    never reads "Done: running: 3 of 3 points" (seen on a loaded machine)."""
-    from explorer.solving import StudyRun
-
-    queued: list = []
-    run = StudyRun(dispatch=queued.append)
-    run._set(done=3, message="running: 3 of 3 points")
-    run._set(status="done", done=3, message="3 points in 1.0 s")
-    for callback in reversed(queued):  # the loop ran them the other way round
-        callback()
-    assert run.status == "done" and run.message == "3 points in 1.0 s"
