@@ -9,7 +9,9 @@ bare ``ModuleNotFoundError`` from deep inside the feature.
 from __future__ import annotations
 
 import importlib
+from collections.abc import Callable, Mapping
 from types import ModuleType
+from typing import Any
 
 #: The pip extra of ``coated-punch`` that installs each optional module (the one source;
 #: ``pyproject.toml`` declares the extras, and a test checks the two agree).
@@ -63,3 +65,26 @@ def import_optional(module: str, feature: str) -> ModuleType:
         raise MissingDependency(
             f"{feature} needs {package}, which is not installed: "
             f"pip install 'coated-punch[{extra}]'") from error
+
+
+def lazy_exports(package: str, exports: Mapping[str, str], namespace: dict[str, Any]
+                 ) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
+    """A package's ``__getattr__`` and ``__dir__`` (PEP 562) for names loaded on first use.
+
+    ``exports`` maps each such name to the module that defines it; ``namespace`` is the
+    package's ``globals()``, where a name loaded once is kept (later lookups skip
+    ``__getattr__``). Used where importing a module up front would slow every start (the
+    command line) for a feature few calls need.
+    """
+    def __getattr__(name: str) -> Any:
+        module = exports.get(name)
+        if module is None:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}")
+        value = getattr(importlib.import_module(module), name)
+        namespace[name] = value
+        return value
+
+    def __dir__() -> list[str]:
+        return sorted(set(namespace) | set(namespace.get("__all__", ())))
+
+    return __getattr__, __dir__

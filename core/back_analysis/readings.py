@@ -23,7 +23,7 @@ import numpy as np
 
 from core.files import read_regular_file
 from core.limits import MAX_READINGS, MAX_READINGS_BYTES
-from core.validation import show_value
+from core.validation import finite_number, show_value
 
 #: The series a readings file may hold, with their SI units.
 SERIES_UNITS: dict[str, str] = {"settlement": "m", "tilt": "rad"}
@@ -176,19 +176,7 @@ def _check_values(columns: Mapping[str, list[float | None]], where: Any) -> Read
 
 def _number(value: Any, field: str) -> float | None:
     """A reading's number (None: no reading); a ValueError naming ``field`` otherwise."""
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer,
-                                                         np.floating)):
-        raise ValueError(f"{field}: must be a number, got {show_value(value)}")
-    try:
-        x = float(value)
-    except OverflowError:
-        raise ValueError(f"{field}: must be a finite number, got an integer too large for "
-                         "a double") from None
-    if not math.isfinite(x):
-        raise ValueError(f"{field}: must be a finite number, got {show_value(value)}")
-    return x
+    return None if value is None else finite_number(value, field)
 
 
 # --------------------------------------------------------------------------- mapping

@@ -10,8 +10,7 @@
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from core.coating.model import (
     DEFAULT_INTERFACE,
@@ -24,6 +23,7 @@ from core.coating.model import (
     model_error_map,
     tilt_share,
 )
+from core.optional import lazy_exports
 
 if TYPE_CHECKING:
     from core.coating.fem_check import solve_stack
@@ -53,14 +53,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'core.coating' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value  # later lookups skip this function
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(list(globals()) + __all__)
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY, globals())

@@ -30,9 +30,9 @@ returns a ``SceneSolution``.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from core.optional import lazy_exports
 from core.scene.contact_zone import LIFT_OFF_SHARE, contact_width, lift_off_length, lifts_off
 from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
 from core.scene.display import engine_text, known_contact_width, lifts_off_at
@@ -145,14 +145,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'core.scene' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value  # later lookups skip this function
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(list(globals()) + __all__)
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY, globals())
