@@ -36,6 +36,7 @@ from core.back_analysis import calibrate
 from core.presets import read_preset
 from core.scene import solve
 from core.study import apply_point
+from tests.support.creeping_footing import creeping_footing
 
 #: Fits per case after the first (medians are reported).
 FITS = 5
@@ -43,16 +44,7 @@ FITS = 5
 GOAL_SECONDS = 2.0
 RESULTS = Path(__file__).resolve().parent / "results" / "calibrate.md"
 
-CREEPING = {
-    "schema_version": 1, "name": "Footing on a creeping layer",
-    "punch": {"half_width": 1.0, "shape": 0.0},
-    "coating": [{"thickness": 0.02, "modulus": 2e8, "poisson": 0.3}],
-    "base": {"thickness": 4.0, "poisson": 0.3, "age_at_loading": 28.0,
-             "creep": {"model": "exponential", "modulus": 3e8, "compliance": 3e-9,
-                       "rate": 0.02}},
-    "loading": {"force": 2e5, "moment": 2e4},
-    "times": {"end": 3650.0, "count": 50}, "solver": {"tol": 1e-6},
-}
+CREEPING = creeping_footing()
 
 
 def _cases() -> list[tuple[str, dict, dict, dict, np.ndarray, float]]:

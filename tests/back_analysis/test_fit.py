@@ -12,20 +12,10 @@ import core
 from core.back_analysis import Calibration, calibrate
 from core.limits import MAX_FIT_PARAMETERS
 from core.study import apply_point
+from tests.support.creeping_footing import creeping_footing
 
-#: A footing on a creeping layer (exponential creep, eccentric load): its solves take
-#: ~15 ms once the geometry is prepared, so a fit of three fields takes ~0.3 s.
-SCENE = {
-    "schema_version": 1, "name": "Footing on a creeping layer",
-    "punch": {"half_width": 1.0, "shape": 0.0},
-    "coating": [{"thickness": 0.02, "modulus": 2e8, "poisson": 0.3}],
-    "base": {"thickness": 4.0, "poisson": 0.3, "age_at_loading": 28.0,
-             "creep": {"model": "exponential", "modulus": 3e8, "compliance": 3e-9,
-                       "rate": 0.02}},
-    "loading": {"force": 2e5, "moment": 2e4},
-    "times": {"end": 3650.0, "count": 50},
-    "solver": {"tol": 1e-6},
-}
+#: The scene fitted (tests/support/creeping_footing.py).
+SCENE = creeping_footing()
 TRUTH = {"base.creep.compliance": 3e-9, "base.creep.rate": 0.02, "loading.force": 2e5}
 TIMES = np.linspace(365 / 30, 365, 30)
 #: Noise of the synthetic readings: ~1 % of the settlement (1.3 mm) and of the tilt.
