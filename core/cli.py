@@ -360,15 +360,17 @@ def _strict_verdict(result: SceneSolution, flags: Sequence[str] | None = None) -
     failed = check is not None and check.passed is False
     flags = result.flags if flags is None else list(flags)
     if flags:
-        print(f"error: strict: the answer is flagged ({', '.join(flags)}); "
-              f"exit code {EXIT_FLAGGED}", file=sys.stderr)
-        return EXIT_FLAGGED
+        return _strict_exit(f"the answer is flagged ({', '.join(flags)})", EXIT_FLAGGED)
     if failed:
         names = ", ".join(line.limit_name or line.quantity for line in check.failures)
-        print(f"error: strict: the design check failed ({names}); exit code "
-              f"{EXIT_DESIGN_FAILED}", file=sys.stderr)
-        return EXIT_DESIGN_FAILED
+        return _strict_exit(f"the design check failed ({names})", EXIT_DESIGN_FAILED)
     return EXIT_OK
+
+
+def _strict_exit(reason: str, code: int) -> int:
+    """``code``, after saying on stderr why ``--strict`` gives it."""
+    print(f"error: strict: {reason}; exit code {code}", file=sys.stderr)
+    return code
 
 
 def _solve(path: str) -> SceneSolution | PunchesSolution | None:
@@ -426,9 +428,8 @@ def _solved_punches(args: argparse.Namespace, result: PunchesSolution, output: P
             print(f"warning: punches[{k}].{name}: {_one_line(punch.flag_messages[name])}",
                   file=sys.stderr)
     if args.strict and result.flags:
-        print(f"error: strict: the answer is flagged ({', '.join(result.flags)}); "
-              f"exit code {EXIT_FLAGGED}", file=sys.stderr)
-        return EXIT_FLAGGED
+        return _strict_exit(f"the answer is flagged ({', '.join(result.flags)})",
+                            EXIT_FLAGGED)
     return EXIT_OK
 
 
@@ -606,9 +607,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     for warning in fit.warnings:
         print(f"warning: calibrate: {_one_line(warning)}", file=sys.stderr)
     if args.strict and fit.warnings:
-        print(f"error: strict: the fit carries {len(fit.warnings)} warning(s); exit code "
-              f"{EXIT_FLAGGED}", file=sys.stderr)
-        return EXIT_FLAGGED
+        return _strict_exit(f"the fit carries {len(fit.warnings)} warning(s)", EXIT_FLAGGED)
     return EXIT_OK
 
 

@@ -132,14 +132,7 @@ def _discretization(info: dict[str, Any]) -> str:
 def _check_line(line: Any) -> str:
     """A design-check line without its label: value, where, limit, utilisation, verdict,
     in the units of the results (kPa, mm, mrad)."""
-    where = f"t = {_number(line.time)} d" + ("" if line.x is None else
-                                              f", x = {_number(line.x)} m")
-    text = f"{_shown(line.value, line.unit)} at {where}"
-    if line.limit is None:
-        return text + "; no limit set"
-    verdict = "pass" if line.passed else "FAIL"
-    return (f"{text}; limit {_shown(line.limit, line.unit)}, utilisation "
-            f"{line.utilisation:.3g}: {verdict}")
+    return line.verdict_text(number=_number, shown=_shown, day="d")
 
 
 def design_section(result: SceneSolution) -> Section | None:

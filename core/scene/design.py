@@ -11,7 +11,7 @@ magnitude of the extreme is at most the limit; a limit left out is not checked.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -26,6 +26,10 @@ CHECKS: tuple[tuple[str, str, str, str], ...] = (
     ("tilt_limit", "tilt", "rad", "largest tilt"),
 )
 
+
+
+def _six_digits(value: float) -> str:
+    return f"{value:.6g}"
 
 @dataclass(frozen=True)
 class DesignLimits:
@@ -111,15 +115,24 @@ class LimitCheck:
         """One line for a terminal: the label, then :meth:`verdict_text`."""
         return f"{self.label} {self.verdict_text()}"
 
-    def verdict_text(self) -> str:
-        """Value, where, limit, utilisation and verdict (the report's table cell)."""
-        where = f"t = {self.time:.6g} days" + ("" if self.x is None else
-                                                f", x = {self.x:.6g} m")
-        text = f"{self.value:.6g} {self.unit} at {where}"
+    def verdict_text(self, number: Callable[[float], str] = _six_digits,
+                     shown: Callable[[float, str], str] | None = None,
+                     day: str = "days") -> str:
+        """Value, where, limit, utilisation and verdict (the report's table cell).
+
+        ``number`` writes a time [day] or a position [m], ``shown`` a value and its unit
+        (default: in the check's SI unit, by ``number``), ``day`` is the unit of time
+        written."""
+        if shown is None:
+            def shown(value: float, unit: str) -> str:
+                return f"{number(value)} {unit}"
+        where = f"t = {number(self.time)} {day}" + ("" if self.x is None else
+                                                     f", x = {number(self.x)} m")
+        text = f"{shown(self.value, self.unit)} at {where}"
         if self.limit is None:
-            return text + ", no limit set"
+            return text + "; no limit set"
         verdict = "pass" if self.passed else "FAIL"
-        return (f"{text}; limit {self.limit:.6g} {self.unit}, utilisation "
+        return (f"{text}; limit {shown(self.limit, self.unit)}, utilisation "
                 f"{self.utilisation:.3g}: {verdict}")
 
 
