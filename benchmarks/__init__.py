@@ -1,1 +1,34 @@
-"""Benchmarks of the coated-punch solvers (work-precision diagrams, see work_precision.py)."""
+"""Benchmarks of the coated-punch solvers and the explorer (speed against error), each
+writing its report under ``benchmarks/results/`` with the commit, the date and the load.
+
+:func:`tree_commit` and :func:`run_lines` are what the reports say of how they were made.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import subprocess
+from datetime import datetime
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def tree_commit() -> str:
+    """The short hash of this tree's commit, ``+`` when it has uncommitted changes."""
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                          capture_output=True, text=True).stdout.strip() or "unknown"
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                           cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    return head + ("+" if dirty else "")
+
+
+def run_lines(started: datetime, load_before: float, load_after: float,
+              load_note: str = "") -> list[str]:
+    """A report's lines on its run: the commit, the date [UTC] and the machine, and the
+    load average before and after (``load_note``: what the load means for its figures)."""
+    return [f"- commit {tree_commit()}, {started:%Y-%m-%d %H:%M} UTC, {platform.machine()}, "
+            f"{os.cpu_count()} cores, Python {platform.python_version()}",
+            f"- load average {load_before:.2f} before, {load_after:.2f} after"
+            + (f" ({load_note})" if load_note else "")]

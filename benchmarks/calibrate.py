@@ -23,8 +23,6 @@ the load average.
 from __future__ import annotations
 
 import os
-import platform
-import subprocess
 import sys
 import time
 from datetime import datetime, timezone
@@ -32,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks import run_lines
 from core.back_analysis import calibrate
 from core.presets import read_preset
 from core.scene import solve
@@ -98,14 +97,10 @@ def main() -> None:
                      f"{per:.3f} |")
         print(lines[-1], flush=True)
     load_after = os.getloadavg()[0]
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True, cwd=RESULTS.parent).stdout.strip()
     text = "\n".join([
         "# What a back-analysis costs", "",
         "    OPENBLAS_NUM_THREADS=1 python -m benchmarks.calibrate", "",
-        f"- commit {commit}, {started:%Y-%m-%d %H:%M} UTC, {platform.machine()}, "
-        f"{os.cpu_count()} cores, Python {platform.python_version()}",
-        f"- load average {load_before:.2f} before, {load_after:.2f} after",
+        *run_lines(started, load_before, load_after),
         f"- wall time per fit: the first (geometry prepared) and the median of the next "
         f"{FITS} (new noise draws); goal of a three-field fit to 30 readings: "
         f"{GOAL_SECONDS:g} s", "",

@@ -34,6 +34,8 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from benchmarks import tree_commit
+
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results"
 #: Cold runs of each command (medians and minima are reported).
@@ -105,15 +107,6 @@ def measure(runs: int, source: bool) -> tuple[list[tuple[str, float, float, floa
     return rows, load_start, load_end
 
 
-def commit() -> str:
-    """The short hash of this tree's commit, ``+`` when it has uncommitted changes."""
-    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
-                          capture_output=True, text=True).stdout.strip() or "unknown"
-    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
-                           cwd=ROOT, capture_output=True, text=True).stdout.strip()
-    return head + ("+" if dirty else "")
-
-
 def report(rows: list[tuple[str, float, float, float]], load: tuple[float, float],
            runs: int, source: bool, command: str) -> str:
     """The Markdown page of one measurement."""
@@ -121,7 +114,7 @@ def report(rows: list[tuple[str, float, float, float]], load: tuple[float, float
     bytecode = ("compiling every module from source (`--source`)" if source else
                 "from cached bytecode, as an installed package runs")
     lines = ["# The command line from a cold process", "",
-             f"Made by `{command}` at commit {commit()}, {date}, on a {os.cpu_count()}-core "
+             f"Made by `{command}` at commit {tree_commit()}, {date}, on a {os.cpu_count()}-core "
              f"machine; load average (1 min) {load[0]:.2f} at the start, {load[1]:.2f} at "
              f"the end (a shared machine inflates wall times; user CPU much less). "
              f"{runs} runs of each command, interleaved, {bytecode}. The goal: "

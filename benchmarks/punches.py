@@ -16,7 +16,6 @@ the machine's load average; written to ``benchmarks/results/punches.md`` unless
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
 import time
 from datetime import datetime, timezone
@@ -25,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import core
+from benchmarks import tree_commit
 from core.presets import read_preset
 from core.scene import SceneSolution, scene_from_dict
 
@@ -78,8 +78,7 @@ def main(argv: list[str]) -> None:
             ("two punches (a = 1, 0.6 m), loads only",
              _median_ms(lambda i: _pair(1000, 0.6, force_step=1e-3 * i, geometry_step=0.0)))]
     single = rows[0][1]
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True, check=False).stdout.strip()
+    commit = tree_commit()
     load = os.getloadavg()
     lines = ["# Two punches against one", "",
              f"commit {commit}, {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC, load average "

@@ -21,8 +21,6 @@ from __future__ import annotations
 
 import copy
 import os
-import platform
-import subprocess
 import sys
 import time
 from datetime import datetime, timezone
@@ -30,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks import run_lines
 from core.presets import preset_names, read_preset
 from core.scene import solve
 
@@ -90,15 +89,11 @@ def main(argv: list[str]) -> None:
                          f"{wall_info:.2f} |")
             print(lines[-1], flush=True)
     load_after = os.getloadavg()[0]
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True, cwd=RESULTS.parent).stdout.strip()
     text = "\n".join([
         "# What a scene solve costs around the engine", "",
         "    OPENBLAS_NUM_THREADS=1 python -m benchmarks.scene_overhead", "",
-        f"- commit {commit}, {started:%Y-%m-%d %H:%M} UTC, {platform.machine()}, "
-        f"{os.cpu_count()} cores, Python {platform.python_version()}",
-        f"- load average {load_before:.2f} before, {load_after:.2f} after (CPU times move "
-        "little with the load; the engine's wall time does)",
+        *run_lines(started, load_before, load_after,
+                   "CPU times move little with the load; the engine's wall time does"),
         f"- medians of {SOLVES} solves per preset and kind; \"new geometry\": the punch "
         "half-width 0.01 % wider each solve (every geometry cache misses); \"loads only\": "
         "the first given load 0.1 % larger each solve", "",
