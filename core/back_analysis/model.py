@@ -20,7 +20,7 @@ import numpy as np
 
 from core.limits import MAX_FIT_PARAMETERS
 from core.scene import Scene, SceneSolution, replace_loads, scene_from_dict, solve
-from core.study import FIXED_ROOTS, apply_point, field_unit, get_field, parse_path
+from core.study import apply_point, field_unit, number_at
 from core.validation import finite_number, show_value
 
 #: Step of the forward differences in the fit's coordinates: 1e-3 of the logarithm is a
@@ -101,21 +101,10 @@ def fitted_fields(base: Mapping[str, Any], fit: Any, bounds: Any) -> tuple[Field
                              f"({', '.join(map(str, fit))})")
     fields = []
     for i, path in enumerate(fit):
-        parts = parse_path(path, f"fit[{i}]")
-        if parts[0] in FIXED_ROOTS:
-            raise ValueError(f"fit[{i}]: {path!r} cannot be fitted (not a number of the "
-                             "model: output times, names and design limits)")
+        start = number_at(base, path, f"fit[{i}]", "fitted",
+                          "the output times are the readings' times")
         if path in fit[:i]:
             raise ValueError(f"fit[{i}]: {path!r} is fitted twice")
-        try:
-            start = get_field(base, path)
-        except ValueError as exc:
-            raise ValueError(f"fit[{i}]: {exc}") from None
-        if isinstance(start, bool) or not isinstance(start, (int, float)):
-            raise ValueError(f"fit[{i}]: {path!r} holds {show_value(start)} in the scene, "
-                             "not a number; fit a number inside it (for a profile object, "
-                             "e.g. '.value')")
-        start = float(start)
         lo, hi = _bound_pair(bounds[path], f"bounds[{path}]") if path in bounds \
             else (-math.inf, math.inf)
         if not lo <= start <= hi:

@@ -260,6 +260,27 @@ def _distribution(kind: str, spec: Any, field: str) -> tuple[tuple[str, float], 
     return (("low", low), ("high", high))
 
 
+def number_at(scene: Mapping[str, Any], path: Any, field: str, use: str,
+              note: str = "") -> float:
+    """The number at ``path`` of a scene dict that a study may vary or a fit may fit
+    (``use``: "varied", "fitted"), else a ValueError starting with ``field``; ``note``:
+    a hint of the caller's for a fixed field (say where else it is set)."""
+    parts = parse_path(path, field)
+    if parts[0] in FIXED_ROOTS:
+        raise ValueError(f"{field}: {path!r} cannot be {use} (names and versions are not "
+                         "numbers, design limits do not change an answer"
+                         + (f"; {note})" if note else ")"))
+    try:
+        value = get_field(scene, path)
+    except ValueError as exc:
+        raise ValueError(f"{field}: {exc}") from None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{field}: {path!r} holds {show_value(value)} in the scene, not a "
+                         "number; choose a number inside it (for a profile object, e.g. "
+                         "'.value' or '.start')")
+    return float(value)
+
+
 def _parameter(spec: Any, field: str, base: Mapping[str, Any]) -> Parameter:
     kinds = GRID_KINDS + DISTRIBUTIONS
     check_fields(spec, field, ("field",), kinds)
@@ -269,19 +290,8 @@ def _parameter(spec: Any, field: str, base: Mapping[str, Any]) -> Parameter:
                          + (", ".join(given) or "none"))
     kind = given[0]
     path = spec["field"]
-    parts = parse_path(path, f"{field}.field")
-    if parts[0] in FIXED_ROOTS:
-        raise ValueError(f"{field}.field: {path!r} cannot be varied (the output times are "
-                         "the study's 'times'; names and versions are not numbers; limits "
-                         "do not change an answer)")
-    try:
-        current = get_field(base, path)
-    except ValueError as exc:
-        raise ValueError(f"{field}.field: {exc}") from None
-    if isinstance(current, bool) or not isinstance(current, (int, float)):
-        raise ValueError(f"{field}.field: {path!r} holds {show_value(current)} in the base "
-                         "scene, not a number; vary a number inside it (for a profile "
-                         "object, e.g. '.value' or '.start')")
+    number_at(base, path, f"{field}.field", "varied",
+              "the output times are the study's 'times'")
     if kind in GRID_KINDS:
         return Parameter(path, kind, values=_grid(kind, spec[kind], f"{field}.{kind}"))
     return Parameter(path, kind, args=_distribution(kind, spec[kind], f"{field}.{kind}"))
