@@ -165,7 +165,7 @@ class ExplorerApp(pn.viewable.Viewer):
                                    self._load_file, self.results.show_download_error)
         self.lessons_tab = LessonsView(self.pins, self.results.log_time, self.load_scene)
         self.study_tab = StudyView(state, controller, loop, self.link.schedule)
-        self.fit_tab = FitView(state, controller, loop, self.figures, self.load_scene)
+        self.fit_tab = FitView(state, controller, loop, self.figures, self.load_scene, screen)
         return [self.scene_tab, self.punch_tab, self.coating_tab, self.base_tab,
                 self.times_tab, self.check_tab, self.files_tab, self.lessons_tab,
                 self.study_tab, self.fit_tab]

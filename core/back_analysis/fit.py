@@ -249,7 +249,10 @@ def _identifiability(fields: Sequence[Field], cov: np.ndarray, condition: float,
                    "that separate them")
     else:
         se = np.sqrt(np.diag(cov))
-        corr = cov / np.outer(se, se)
+        # readings the scene meets exactly leave no scatter (se = 0): no correlation to
+        # speak of, and no warning
+        with np.errstate(invalid="ignore", divide="ignore"):
+            corr = cov / np.outer(se, se)
         for j in range(len(fields)):
             for k in range(j + 1, len(fields)):
                 if abs(corr[j, k]) > STRONG_CORRELATION:

@@ -153,6 +153,14 @@ class Model:
             else None
         self._scene: Scene | None = None
 
+    def __getstate__(self) -> dict[str, Any]:
+        # the answers kept and the validated scene are caches (and a Scene holds
+        # read-only mappings, which do not pickle): a copy sent to another process
+        # (the explorer's report is written in a worker) solves again where it needs to
+        state = self.__dict__.copy()
+        state.update(_cache={}, _scene=None)
+        return state
+
     def values_at(self, x: Sequence[float]) -> dict[str, float]:
         """The field values at coordinates ``x``."""
         return {f.path: f.to_value(float(v)) for f, v in zip(self.fields, x, strict=True)}

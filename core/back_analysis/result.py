@@ -109,6 +109,13 @@ class Calibration:
     model: Model = field(repr=False)
     sigma: np.ndarray = field(repr=False)
 
+    def __getstate__(self) -> dict[str, Any]:
+        # the cached fitted Scene holds read-only mappings, which do not pickle; it is
+        # made again from ``base`` and the values on first use
+        state = self.__dict__.copy()
+        state.pop("scene", None)
+        return state
+
     @property
     def paths(self) -> tuple[str, ...]:
         """The fitted fields' paths, in the order given."""

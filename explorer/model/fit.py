@@ -13,6 +13,7 @@ Nothing here imports Panel (the fit runs on a thread of the server).
 
 from __future__ import annotations
 
+import json
 import math
 import time
 from collections.abc import Mapping, Sequence
@@ -23,6 +24,8 @@ import numpy as np
 
 from core.back_analysis import Calibration, Forecast, Readings, calibrate, readings_from_text
 from core.limits import MAX_READINGS_BYTES
+from core.scene import scene_from_dict
+from core.study import apply_point, number_at
 
 from .loading_state import QUANTITY_UNITS
 from .study import ECCENTRICITY, Choice, study_choices
@@ -111,6 +114,34 @@ class FitOutcome:
     def fitted_scene(self) -> dict[str, Any]:
         """The scene with the fitted values (the scene's own output times)."""
         return self.calibration.scene.to_dict()
+
+    def describes(self, scene: Mapping[str, Any]) -> bool:
+        """Whether ``scene`` (a scene dict on screen) is this fit's fitted scene: the
+        fitted values in its fields (to a relative 1e-9: a slider's unit conversion
+        rounds in the last digits) and, those set back to the start, the scene fitted.
+        A report of any other scene must not carry the fit."""
+        calibration = self.calibration
+        try:
+            for path, value in calibration.values.items():
+                if not math.isclose(number_at(scene, path, "fit", "fitted"), value,
+                                    rel_tol=FITTED_SCENE_RTOL):
+                    return False
+            restored = _canonical(apply_point(dict(scene), calibration.start))
+            fitted = _canonical(calibration.base)
+        except ValueError:  # a field fitted is not in the scene, or the scene is refused
+            return False
+        return restored == fitted
+
+
+#: How close a field on screen must be to its fitted value to be that value (relative).
+FITTED_SCENE_RTOL = 1e-9
+
+
+def _canonical(scene: Mapping[str, Any]) -> str:
+    """A scene as the core reads it (defaults filled in: the page leaves some out), as
+    sorted JSON, its name left out (a name does not change an answer)."""
+    data = scene_from_dict(dict(scene)).to_dict()
+    return json.dumps({k: v for k, v in data.items() if k != "name"}, sort_keys=True)
 
 
 def _error_text(se: float) -> str:

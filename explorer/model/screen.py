@@ -9,8 +9,8 @@ from .results import ResultView
 
 class Screen(param.Parameterized):
     """The session's screen, shared by its views: the result on screen (what downloads,
-    the check, the report and the link hold), the output time shown, a notice, and the
-    latest FE check of the coating model."""
+    the check, the report and the link hold), the output time shown, a notice, the
+    latest FE check of the coating model and the latest fit."""
 
     notice = param.String(default="", doc="A problem with a file or a link (not a solve).")
     time_index = param.Integer(default=0, doc="Index of the output time shown.")
@@ -18,6 +18,10 @@ class Screen(param.Parameterized):
         "The latest FE check of the coating model (core.scene.check_scene's report): "
         "where it was made for the scene on screen, its measured error is the one the "
         "badges, the status and the report speak of (core.scene.model_error_evidence)."))
+
+    fit = param.Parameter(default=None, doc=(
+        "The latest back-analysis of the Fit tab (a FitOutcome): while its fitted scene is "
+        "the one on screen, the printable report carries it."))
 
     def __init__(self, **params: object) -> None:
         super().__init__(**params)

@@ -25,7 +25,7 @@ import time
 from collections.abc import Callable
 from concurrent.futures import Executor, Future, ThreadPoolExecutor
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import param
 
@@ -43,6 +43,9 @@ from .workers import (
     solution_text,
     solve_view,
 )
+
+if TYPE_CHECKING:
+    from core.back_analysis import Calibration
 
 __all__ = ["RESULTS", "SolveController", "approx_bytes", "describe_field", "format_error",
            "result_key", "shared_pool", "use_worker_processes", "worker_processes"]
@@ -346,7 +349,8 @@ class SolveController(param.Parameterized):
 
     def download(self, view: ResultView, kind: str, limits: DesignLimits | None = None,
                  shown_time: float | None = None,
-                 check: dict[str, Any] | None = None) -> str | bytes:
+                 check: dict[str, Any] | None = None,
+                 calibration: Calibration | None = None) -> str | bytes:
         """The file of a download of ``view``: ``"to_csv"`` (the histories),
         ``"pressure_csv"`` (q(x, t)) or ``"to_json"`` (everything), in SI units, or the
         printable report, ``"report_html"`` (text) or ``"report_pdf"`` (bytes).
@@ -357,13 +361,16 @@ class SolveController(param.Parameterized):
         ``limits``: the Check tab's, put into the scene in place of its own (the report's
         design check); ``shown_time`` [day after loading]: the time on screen, whose
         contact the report describes; ``check``: the FE check of the coating model
-        (:func:`core.scene.check_scene`), reported where it was made for this scene.
+        (:func:`core.scene.check_scene`), reported where it was made for this scene;
+        ``calibration``: the back-analysis whose fitted scene is on screen (the report's
+        section "Back-analysis").
         """
         scene = view.scene if limits is None else scene_with_limits(view.scene, limits)
         if self._processes is not None:
             return self._processes.run(self._lane, download_text, scene, kind, view.info,
-                                       shown_time, check)
-        return solution_text(self._solve(scene), kind, view.info, shown_time, check)
+                                       shown_time, check, calibration)
+        return solution_text(self._solve(scene), kind, view.info, shown_time, check,
+                             calibration)
 
     def solved_within(self, seconds: float) -> bool:
         """Whether the result kept took less than ``seconds`` [s] of CPU time to solve
@@ -378,18 +385,21 @@ class SolveController(param.Parameterized):
 
     def download_later(self, view: ResultView, kind: str, limits: DesignLimits | None = None,
                        shown_time: float | None = None,
-                       check: dict[str, Any] | None = None) -> Future[str | bytes]:
+                       check: dict[str, Any] | None = None,
+                       calibration: Calibration | None = None) -> Future[str | bytes]:
         """:meth:`download` off the calling thread: a future of the file, done when the
         worker has answered (at once where solves run in the caller). The server's event
         loop awaits it (``asyncio.wrap_future``) and keeps serving every page meanwhile."""
         if self._executor is None:
             done: Future[str | bytes] = Future()
             try:
-                done.set_result(self.download(view, kind, limits, shown_time, check))
+                done.set_result(self.download(view, kind, limits, shown_time, check,
+                                              calibration))
             except Exception as exc:
                 done.set_exception(exc)
             return done
-        return self._executor.submit(self.download, view, kind, limits, shown_time, check)
+        return self._executor.submit(self.download, view, kind, limits, shown_time, check,
+                                     calibration)
 
     def wait(self, timeout: float = 60.0) -> bool:
         """Block until the newest request has been delivered (for scripts and tests)."""

@@ -17,12 +17,15 @@ import os
 import signal
 import threading
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import core.report
 from core import set_stage_cache_budget, solve, stage_cache_bytes
 
 from ..model import ResultView, prepare_view
+
+if TYPE_CHECKING:
+    from core.back_analysis import Calibration
 
 #: What :func:`download_text` can produce: the histories as CSV, q(x, t) as CSV, and the
 #: whole solution as JSON (the methods of ``core.SceneSolution`` of the same names), and
@@ -60,7 +63,8 @@ def solve_view(scene: dict[str, Any]) -> ResultView:
 
 def download_text(scene: dict[str, Any], kind: str, info: dict[str, Any] | None = None,
                   shown_time: float | None = None,
-                  check: dict[str, Any] | None = None) -> str | bytes:
+                  check: dict[str, Any] | None = None,
+                  calibration: Calibration | None = None) -> str | bytes:
     """The file ``kind`` (one of :data:`DOWNLOADS`) of the solution of ``scene``: the
     histories as CSV (time [day], settlement [m], tilt [rad], force [N/m], moment [N]),
     q(x, t) as CSV [Pa], the whole solution as JSON, or the printable report (HTML text,
@@ -71,14 +75,16 @@ def download_text(scene: dict[str, Any], kind: str, info: dict[str, Any] | None 
     differ; its numbers do not). ``shown_time`` [day after loading]: the time on screen,
     whose contact the report describes. ``check``: the FE check of the coating model
     (:func:`core.scene.check_scene`), whose measurement the report gives when it was made
-    for ``scene``.
+    for ``scene``. ``calibration``: the back-analysis whose fitted scene ``scene`` is,
+    reported in a section of its own.
     """
-    return solution_text(solve(scene), kind, info, shown_time, check)
+    return solution_text(solve(scene), kind, info, shown_time, check, calibration)
 
 
 def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None,
                   shown_time: float | None = None,
-                  check: dict[str, Any] | None = None) -> str | bytes:
+                  check: dict[str, Any] | None = None,
+                  calibration: Calibration | None = None) -> str | bytes:
     """``solution.to_csv()``, ``.pressure_csv()``, the JSON of everything with the version
     and solver settings (:meth:`core.scene.SceneSolution.to_json`) or the report
     (:func:`core.report.report_html`, :func:`core.report.report_pdf` at ``shown_time``)
@@ -93,7 +99,8 @@ def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None,
         return solution.to_json()
     if kind in REPORTS:
         # the command line's report; HoloViews, Bokeh and Matplotlib load with the first
-        return getattr(core.report, kind)(solution, shown_time, check=check)
+        return getattr(core.report, kind)(solution, shown_time, check=check,
+                                          calibration=calibration)
     return getattr(solution, kind)()
 
 

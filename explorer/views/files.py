@@ -166,8 +166,12 @@ class FilesView:
             index = min(self.screen.time_index, len(view.times) - 1)
             # the FE check's measurement, where it was made for this scene (the report
             # itself decides: core.scene.model_error_evidence)
+            fit = self.screen.fit
             options = {"limits": self.limits, "shown_time": float(view.times[index]),
-                       "check": self.screen.model_check}
+                       "check": self.screen.model_check,
+                       # the fit, while the scene on screen is its fitted scene
+                       "calibration": fit.calibration
+                       if fit is not None and fit.describes(view.scene) else None}
         # awaited, not waited for: the worker's answer must not hold the event loop, and
         # with it every page of the server
         try:

@@ -25,6 +25,7 @@ from ..model import (
     MAX_FIT_FIELDS,
     ExplorerState,
     FitOutcome,
+    Screen,
     fit_choices,
     forecast_columns,
     read_upload,
@@ -47,11 +48,15 @@ class FitView:
     title = "Fit"
 
     def __init__(self, state: ExplorerState, controller: SolveController, loop: PageLoop,
-                 figures: Figures, load_scene: Callable[[dict[str, Any]], bool]) -> None:
+                 figures: Figures, load_scene: Callable[[dict[str, Any]], bool],
+                 screen: Screen | None = None) -> None:
         """``state``: the scene fitted; ``controller``: the fields offered follow its
         results; ``loop``: where the fit's answer is shown; ``figures``: the histories the
-        readings and the forecast are drawn on; ``load_scene``: shows the fitted scene."""
+        readings and the forecast are drawn on; ``load_scene``: shows the fitted scene;
+        ``screen``: receives each fit (the report carries it while its fitted scene is on
+        screen)."""
         self.state = state
+        self.screen = screen
         self.figures = figures
         self.load_scene = load_scene
         self.readings: Readings | None = None
@@ -94,7 +99,8 @@ class FitView:
             html_pane(f"<small>The band on the histories is the fitted scene's "
                       f"{100 * BAND_LEVEL:.0f} % band from the fields' uncertainty only, "
                       "not the model's error. Every step of a fit is a full solve at the "
-                      "readings' times.</small>", styles=NOTE_STYLE),
+                      "readings' times. Once the fitted values are applied, the printable "
+                      "report (Files tab) carries the fit.</small>", styles=NOTE_STYLE),
             **TAB_COLUMN)
 
     # -- choices ---------------------------------------------------------------------------
@@ -190,6 +196,8 @@ class FitView:
         if outcome is None:
             return
         self.fit_table.object = outcome_html(outcome)
+        if self.screen is not None:
+            self.screen.fit = outcome
         self.figures.show_forecast(forecast_columns(outcome.forecast))
         self.apply_button.disabled = False
         self.fit_button.disabled = self.readings is None

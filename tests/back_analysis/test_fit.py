@@ -145,3 +145,20 @@ def test_standard_errors_cover_the_truth_in_95_percent_of_draws() -> None:
             hits[j] += abs(fit.values[path] - TRUTH[path]) <= 1.96 * fit.standard_errors[path]
     coverage = hits / draws
     assert np.all((0.90 <= coverage) & (coverage <= 0.99)), coverage
+
+
+def test_a_fit_pickles_and_its_copy_answers_the_same() -> None:
+    """The explorer writes a report with the fit in a worker process: the fit is sent
+    there by pickle, its caches (answers, validated scenes) left behind."""
+    import pickle
+
+    exact = _exact()
+    fit = calibrate(SCENE, {"time": TIMES.tolist(), "settlement": exact.settlement.tolist()},
+                    fit=["base.creep.rate"])
+    fit.scene  # noqa: B018 - a cached Scene must not stop the pickle
+    fit.solution  # noqa: B018
+    copy = pickle.loads(pickle.dumps(fit))
+    assert copy.values == fit.values and copy.standard_errors == fit.standard_errors
+    assert copy.scene.to_dict() == fit.scene.to_dict()
+    np.testing.assert_array_equal(copy.forecast([1.0, 3650.0]).settlement,
+                                  fit.forecast([1.0, 3650.0]).settlement)

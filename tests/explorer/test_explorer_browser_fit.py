@@ -5,6 +5,8 @@ Every wait is on a condition in the page."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -71,4 +73,23 @@ def test_readings_are_uploaded_drawn_and_fitted(page: Page):
     lower = values(page, "forecast_settlement", "lower")
     upper = values(page, "forecast_settlement", "upper")
     assert all(lo <= hi for lo, hi in zip(lower, upper, strict=True))
+    # applied, the fitted scene is solved by the server's workers, and the report they
+    # write of it carries the fit (sent to them by pickle)
+    page.page.locator(".fit-apply button").first.click()
+    page.open_tab("Files")
+
+    def report() -> str:
+        with page.page.expect_download(timeout=60_000 * patience()) as info:
+            page.page.get_by_text("Printable report (HTML)").first.click()
+        return Path(info.value.path()).read_text()
+
+    text = ""
+
+    def fitted_report() -> bool:
+        nonlocal text
+        text = report()
+        return "<h2>Back-analysis</h2>" in text
+
+    until(fitted_report, "the report of the applied fit", 120)
+    assert "coating[0].modulus" in text and "7 (settlement [m])" in text
     assert page.errors == []

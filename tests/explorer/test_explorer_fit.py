@@ -4,6 +4,8 @@ forecast band, the fitted scene applied. The page runs the fit inline without a 
 
 from __future__ import annotations
 
+import asyncio
+
 import numpy as np
 import pytest
 
@@ -59,6 +61,37 @@ def test_readings_are_drawn_fitted_and_the_fitted_scene_applied(explorer_app):
     assert not tab.apply_button.disabled
     assert tab.apply()
     assert app.state.to_scene()["coating"][0]["modulus"] == pytest.approx(value, rel=1e-9)
+
+
+def test_the_report_carries_the_fit_while_its_fitted_scene_is_shown(explorer_app):
+    """Fitted and applied, the printable report has the section "Back-analysis" (the
+    fitted value, the readings drawn over the settlement); before Apply, and once
+    another value moves, the scene on screen is not the fitted one and the report says
+    nothing of the fit."""
+    app = explorer_app(solved=True)
+    tab = app.fit_tab
+    tab.upload.param.update(filename="levelling.csv",
+                            value=_readings_text(app.state.to_scene()).encode())
+    tab.fields[0].value = "coating[0].modulus"
+    assert tab.start() and tab.fit_run.status == "done", tab.fit_run.message
+    assert app.screen.fit is tab.fit_run.outcome
+
+    def report() -> str:
+        return asyncio.run(app.files_tab._report_file()).getvalue()
+
+    assert "Back-analysis" not in report()  # the scene fitted, not the fitted one
+    assert tab.apply()
+    app.controller.wait()
+    text = report()
+    fitted = tab.fit_run.outcome.calibration.values["coating[0].modulus"]
+    assert "Back-analysis" in text and "coating[0].modulus" in text
+    assert f"{fitted:.6g}"[:5] in text
+    assert "7 (settlement [m])" in text
+    pdf = asyncio.run(app.files_tab._pdf_report_file()).getvalue()
+    assert pdf.startswith(b"%PDF")
+    app.state.loading.histories["force"].value *= 1.1
+    app.controller.wait()
+    assert "Back-analysis" not in report()
 
 
 def test_a_bad_readings_file_is_refused_naming_line_and_column(explorer_app):
