@@ -39,6 +39,11 @@ STRONG_CORRELATION = 0.99
 MAX_SOLVER_ERROR_TO_NOISE = 0.1
 #: A coordinate this close to a bound (in the fit's coordinates) is at the bound.
 BOUND_CLOSENESS = 1e-6
+#: How far beyond the answer (in the fit's coordinates: relative for a log-fitted field)
+#: the scene is checked for the edge of its accepted values: the trust region stops
+#: within ~1e-6 of such an edge (it sees only the large residual beyond it), and an
+#: interior answer 1e-4 from an edge is determined by the readings.
+EDGE_PROBE = 1e-4
 #: Residual vector of a point whose scene is invalid: large, so that the trust region
 #: shrinks away from it, finite, so that the least-squares solver goes on.
 _INVALID_RESIDUAL = 1e8
@@ -174,6 +179,7 @@ def calibrate(scene: Scene | Mapping[str, Any],
                         f"({answer.message})")
     cov_x, condition = _covariance(J, s2)
     warnings += _identifiability(fields, cov_x, condition, x, lo, hi)
+    warnings += _edge_check(model, x, lo, hi)
     ratio = _solver_error_to_noise(solution, readings, sigma, mask, math.sqrt(s2))
     if ratio > MAX_SOLVER_ERROR_TO_NOISE:
         warnings.append(f"the solver's error estimate is {ratio:.2g} of the noise (more "
@@ -203,6 +209,27 @@ def calibrate(scene: Scene | Mapping[str, Any],
         iterations=int(answer.nfev), status=str(answer.message), model=model,
         sigma=sigma,
     )
+
+
+def _edge_check(model: Model, x: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> list[str]:
+    """A warning for each field whose answer sits at the edge of the values the scene
+    accepts (its rules, not the fit's bounds: a relative humidity of fib MC2010 below
+    40 %, say): the readings push it beyond, so it is not determined there."""
+    out = []
+    for j, f in enumerate(model.fields):
+        for sign in (-1.0, 1.0):
+            probe = x.copy()
+            probe[j] += sign * EDGE_PROBE
+            if not lo[j] <= probe[j] <= hi[j]:
+                continue
+            try:
+                scene_from_dict(model.scene_dict(probe))
+            except ValueError as exc:
+                out.append(f"{f.path}: ended at the edge of the values the scene accepts "
+                           f"({exc}): the readings push it beyond, so it is not "
+                           "identified and its standard error does not hold")
+                break
+    return out
 
 
 def _split(vector: np.ndarray, readings: Readings) -> dict[str, np.ndarray]:

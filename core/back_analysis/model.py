@@ -212,7 +212,22 @@ class Model:
         h = self.steps(x)
         columns = []
         for j in range(len(x)):
-            xj = x.copy()
-            xj[j] += h[j]
-            columns.append((self.values(xj) - f0) / h[j])
+            columns.append(self._difference(x, f0, j, h[j]))
         return np.column_stack(columns)
+
+    def _difference(self, x: np.ndarray, f0: np.ndarray, j: int, h: float) -> np.ndarray:
+        """The one-sided difference of :meth:`values` along coordinate ``j``: the other
+        side where the scene refuses the step's point (the answer sits at the edge of
+        the values it accepts, a Poisson ratio near 0.5 say)."""
+        refusal = None
+        for step in (h, -h):
+            xj = x.copy()
+            xj[j] += step
+            if not self.fields[j].x_bounds[0] <= xj[j] <= self.fields[j].x_bounds[1]:
+                continue
+            try:
+                return (self.values(xj) - f0) / step
+            except ValueError as exc:
+                refusal = exc
+        raise ValueError(f"fit: {self.fields[j].path}: no difference step on either side "
+                         f"is a scene the solver accepts ({refusal})")

@@ -162,3 +162,20 @@ def test_a_fit_pickles_and_its_copy_answers_the_same() -> None:
     assert copy.scene.to_dict() == fit.scene.to_dict()
     np.testing.assert_array_equal(copy.forecast([1.0, 3650.0]).settlement,
                                   fit.forecast([1.0, 3650.0]).settlement)
+
+
+def test_a_fit_pushed_to_the_edge_of_the_accepted_values_says_so() -> None:
+    """Readings of half the force, fitted by the base's Poisson ratio alone: the stiffest
+    base the scene accepts (nu -> 0.5) is still too soft, so the fit ends at the edge of
+    the accepted values. Its difference steps turn back there (they once crashed with
+    the scene's refusal), and the answer is flagged as not identified although no bound
+    was given."""
+    times = np.linspace(365 / 30, 365, 30)
+    half = apply_point(SCENE, {"loading.force": 0.5 * SCENE["loading"]["force"]})
+    settled = core.solve(half | {"times": times.tolist()}).settlement
+    fit = calibrate(SCENE, {"time": times.tolist(), "settlement": settled.tolist()},
+                    fit=["base.poisson"])
+    assert fit.values["base.poisson"] == pytest.approx(0.5, abs=1e-3)
+    assert fit.unidentified == ("base.poisson",) and not fit.identifiable
+    assert any("edge of the values the scene accepts" in w and "must be in (-1, 0.5)" in w
+               for w in fit.warnings)
