@@ -10,7 +10,7 @@ import panel as pn
 from ..model import CODE_CREEP_MODELS, CREEP_MODELS, ExplorerState
 from .creep import CodeCreepPanel
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-from .widgets import Binding, fine_slider, slider
+from .widgets import Binding, slider
 
 
 class BaseView:
@@ -33,14 +33,14 @@ class BaseView:
         self.creep_model = bb.add("creep_model", pn.widgets.Select(
             label="creep model", options={v: k for k, v in CREEP_MODELS.items()},
             sizing_mode="stretch_width", css_classes=["creep-select"]))
-        self.compliance = bb.add("compliance", fine_slider("final creep compliance C∞ [1/GPa]",
+        self.compliance = bb.add("compliance", slider("final creep compliance C∞ [1/GPa]",
                                                            0.0, 0.1, 0.0005, "0[.]0000"))
-        self.rate = bb.add("rate", fine_slider("creep rate γ [1/day]", 0.001, 1.0, 0.001,
+        self.rate = bb.add("rate", slider("creep rate γ [1/day]", 0.001, 1.0, 0.001,
                                                "0[.]000"))
-        self.beta = bb.add("beta", fine_slider("modulus aging β [-]", 0.0, 0.95, 0.01))
-        self.alpha = bb.add("alpha", fine_slider("modulus aging rate α [1/day]", 0.001, 1.0,
+        self.beta = bb.add("beta", slider("modulus aging β [-]", 0.0, 0.95, 0.01))
+        self.alpha = bb.add("alpha", slider("modulus aging rate α [1/day]", 0.001, 1.0,
                                                  0.001))
-        self.aging = bb.add("aging", fine_slider("aging creep A [day/GPa]", 0.0, 5.0, 0.01,
+        self.aging = bb.add("aging", slider("aging creep A [day/GPa]", 0.0, 5.0, 0.01,
                                                  "0[.]00"))
         self.age = bb.add("age_at_loading", slider("age at loading τ₀ [days]", 1.0, 3650.0,
                                                    1.0, "0[.]0"))

@@ -67,7 +67,8 @@ class CoatingView:
                                               amplitude=("µm", -1000.0, 1000.0, 0.5),
                                               css="coating-thickness", live_when=live_when)
         self.modulus_editor = ProfileEditor("Young's modulus", "MPa", 1.0, 10000.0, 1.0,
-                                            "0[.]0", live_when=live_when)
+                                            "0[.]0", css="coating-modulus",
+                                            live_when=live_when)
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
                                             variations=False, live_when=live_when)
         self.layer_note = html_pane("", styles=NOTE_STYLE)

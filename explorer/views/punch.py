@@ -13,7 +13,7 @@ from core.profiles import MAX_TABLE_BYTES, profile_from_csv
 from ..model import ExplorerState, Screen
 from ..solving import format_error
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-from .widgets import Binding, BoundedUpload, fine_slider, slider
+from .widgets import Binding, BoundedUpload, slider
 
 SHAPES = {
     "flat": "flat", "crowned (parabolic, radius R)": "parabolic",
@@ -39,20 +39,20 @@ class PunchView:
                                                       css_classes=["punch-half-width"]))
         self.shape = pb.add("shape", pn.widgets.Select(label="base shape", options=SHAPES,
                                                        sizing_mode="stretch_width"))
-        self.radius = pb.add("radius", fine_slider("crown radius R [km]", 1.0, 500.0, 0.5,
-                                                   "0[.]0"))
-        self.slope = pb.add("slope", fine_slider("slope of each face [µrad]", 0.0, 200.0,
+        self.radius = pb.add("radius", slider("crown radius R [km]", 1.0, 500.0, 0.5,
+                                              "0[.]0", css_classes=["punch-crown-radius"]))
+        self.slope = pb.add("slope", slider("slope of each face [µrad]", 0.0, 200.0,
                                                  0.5, "0[.]0"))
-        self.step_height = pb.add("step_height", fine_slider(
+        self.step_height = pb.add("step_height", slider(
             "step height [µm] (right part raised)", -100.0, 100.0, 0.5, "0[.]0"))
-        self.step_position = pb.add("step_position", fine_slider(
+        self.step_position = pb.add("step_position", slider(
             "step position x [m]", -1.0, 1.0, 0.01))
-        self.land_height = pb.add("land_height", fine_slider(
+        self.land_height = pb.add("land_height", slider(
             "land height [µm] (middle protrudes)", 0.0, 100.0, 0.5, "0[.]0"))
-        self.land_width = pb.add("land_width", fine_slider("land width [m]", 0.05, 2.0, 0.01))
-        self.wave_amplitude = pb.add("wave_amplitude", fine_slider(
+        self.land_width = pb.add("land_width", slider("land width [m]", 0.05, 2.0, 0.01))
+        self.wave_amplitude = pb.add("wave_amplitude", slider(
             "wave amplitude [µm]", 0.0, 50.0, 0.1, "0[.]0"))
-        self.wave_length = pb.add("wave_length", fine_slider("wavelength [m]", 0.02, 5.0,
+        self.wave_length = pb.add("wave_length", slider("wavelength [m]", 0.02, 5.0,
                                                              0.01))
         self.shape_file = BoundedUpload(accept=(".csv", ".txt"), max_bytes=MAX_TABLE_BYTES)
         self.shape_file.param.watch(self._on_shape_file, "value")

@@ -24,7 +24,7 @@ from ..solving import mark
 from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
 
 __all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
-           "EditableIntSlider", "EditableSlider", "HistoryEditor", "ProfileEditor", "fine_slider",
+           "EditableIntSlider", "EditableSlider", "HistoryEditor", "ProfileEditor",
            "slider"]
 
 
@@ -107,14 +107,6 @@ def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]00
     """A float slider with an input box (any value can be typed; the core validates it)."""
     return EditableSlider(label=label, start=start, end=end, step=step, format=fmt,
                           sizing_mode="stretch_width", **kwargs)
-
-
-def fine_slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
-                **kwargs: Any) -> pn.widgets.FloatSlider:
-    """A plain slider for secondary parameters (a quarter of the cost of an editable one
-    to build and to render, which adds up over a page of them)."""
-    return PromptFloatSlider(label=label, start=start, end=end, step=step, format=fmt,
-                             sizing_mode="stretch_width", **kwargs)
 
 
 def _set_widget(widget: pn.widgets.Widget, value: Any) -> None:
@@ -264,12 +256,15 @@ class ProfileEditor:
                 sizing_mode="stretch_width"))
             a_unit, a_lo, a_hi, a_step = amplitude
             a_label = f"{a_unit} of the level" if a_unit == "%" else a_unit
-            self.amplitude = self.binding.add("amplitude", fine_slider(
-                f"variation A [{a_label}]", a_lo, a_hi, a_step, "0[.]0"))
-            self.position = self.binding.add("position", fine_slider(
-                "step position / patch or bump centre [m]", -1.0, 1.0, 0.01))
-            self.length = self.binding.add("length", fine_slider(
-                "wavelength / patch or bump width [m]", 0.02, 2.0, 0.01))
+            self.amplitude = self.binding.add("amplitude", slider(
+                f"variation A [{a_label}]", a_lo, a_hi, a_step, "0[.]0",
+                css_classes=[f"{css}-amplitude"] if css else []))
+            self.position = self.binding.add("position", slider(
+                "step position / patch or bump centre [m]", -1.0, 1.0, 0.01,
+                css_classes=[f"{css}-position"] if css else []))
+            self.length = self.binding.add("length", slider(
+                "wavelength / patch or bump width [m]", 0.02, 2.0, 0.01,
+                css_classes=[f"{css}-length"] if css else []))
             widgets += [self.kind, self.amplitude, self.position, self.length]
         self.panel = pn.Column(*widgets, self.note, sizing_mode="stretch_width", margin=0)
         self._watched: ProfileState | None = None
@@ -345,9 +340,9 @@ class HistoryEditor:
         self.value = self.binding.add("value", slider("value", 0.0, 1.0, 0.001, "0[.]0000",
                                                       css_classes=[f"{css}-value"] if css
                                                       else []), live=True)
-        self.second = self.binding.add("second", fine_slider("second", 0.0, 1.0, 0.001,
+        self.second = self.binding.add("second", slider("second", 0.0, 1.0, 0.001,
                                                         "0[.]0000"), live=True)
-        self.time = self.binding.add("time", fine_slider("time [days]", 0.1, 365.0, 0.1, "0[.]0"),
+        self.time = self.binding.add("time", slider("time [days]", 0.1, 365.0, 0.1, "0[.]0"),
                                      live=True)
         self.note = pn.pane.HTML("", margin=(0, 10), styles={"font-size": "12px",
                                                               "color": "#666"})
