@@ -11,10 +11,12 @@ steps would wait), and stopping one means killing that worker and its warm cache
 
 A thread of the server only waits: it reads the progress the process sends (after every
 batch), hands it to the page through ``dispatch`` and ends the process when the study is
-cancelled (the process is terminated: the work really stops), took longer than
-:data:`STUDY_TIMEOUT_S`, or the session closed. At most :data:`MAX_RUNNING_STUDIES` run
-at once in a server; a study started meanwhile waits (and can be cancelled while it
-waits).
+cancelled (the process is terminated: the work really stops), ran longer than
+:data:`STUDY_TIMEOUT_S`, or the session closed. The server's studies share its study core
+in turns (:mod:`explorer.solving.fair_share`): a few have a process at once and run one
+at a time, a turn each, the others paused; more wait, first come first served (and can
+be cancelled while they wait). A study's process is bounded in memory
+(:data:`STUDY_MEMORY_BYTES`, its solver caches by :data:`STUDY_CACHE_BYTES`).
 
 Nothing here imports Panel.
 """
@@ -34,19 +36,26 @@ from typing import Any
 
 import param
 
+from core import set_stage_cache_budget
 from core.study import sweep
 
 from ..model import PlannedStudy, StudyResult
+from .fair_share import SHARE, StudyShare, resume
 
 log = logging.getLogger(__name__)
 
-#: Studies running at once in one server: each takes a core while it runs, and the
-#: machine also serves every page's slider solves.
-MAX_RUNNING_STUDIES = 1
-#: A study of the page is stopped after this long [s]: :data:`explorer.model.study.MAX_POINTS`
-#: points at the slowest valid scene's 0.7 s per point are ~280 s of CPU, and a loaded
-#: machine stretches that.
+#: A study of the page is stopped after running this long [s] (its paused turns not
+#: counted): :data:`explorer.model.study.MAX_POINTS` points at the slowest valid scene's
+#: 0.7 s per point are ~280 s of CPU, and a loaded machine stretches that.
 STUDY_TIMEOUT_S = 600.0
+#: The address space a study's process may take [bytes] (POSIX ``RLIMIT_AS``): the
+#: process starts at ~0.55 GiB of it (numpy, scipy and the solver, measured), its solver
+#: caches take at most :data:`STUDY_CACHE_BYTES` and its answers a few MB; past it the
+#: study fails saying so, where a study once took the server's processes to 5.8 GiB.
+STUDY_MEMORY_BYTES = 2 * 1024**3
+#: The solver's stage caches in a study's process [bytes] (``core.set_stage_cache_budget``):
+#: a study's points share one geometry per batch at most, so the caches need hold little.
+STUDY_CACHE_BYTES = 256 * 1024**2
 #: Batches per study: the progress bar moves (and a cancelled study is noticed) once per
 #: batch; a batch also costs a small file write.
 PROGRESS_STEPS = 50
@@ -60,7 +69,6 @@ _PRELOAD = ["core.study", "core.scene", "core.solver", "core.engines.nystrom",
             "scipy.interpolate", "scipy.optimize", "scipy.special", "scipy.sparse",
             "scipy.fft", "xarray", "explorer.solving.study_runner"]
 
-_SLOTS = threading.BoundedSemaphore(MAX_RUNNING_STUDIES)
 _CONTEXT: Any = None
 _CONTEXT_LOCK = threading.Lock()
 
@@ -84,6 +92,8 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
     """Run the study and put ``("progress", done, total)`` after every batch, then
     ``("done", arrays)`` or ``("error", message)`` on ``out``."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl+C is the server's to handle
+    _bound_memory(STUDY_MEMORY_BYTES)
+    set_stage_cache_budget(STUDY_CACHE_BYTES)
 
     def progress(done: int, total: int) -> bool:
         out.put(("progress", done, total))
@@ -104,8 +114,24 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
         arrays["seconds"] = time.perf_counter() - start
         arrays["cpu_seconds"] = time.process_time() - cpu
         out.put(("done", arrays))
+    except MemoryError:
+        out.put(("error", f"the study needed more than its {STUDY_MEMORY_BYTES / 1024**3:g} "
+                          "GiB of memory; use fewer points or output times (or run it "
+                          "with coated-punch sweep)"))
     except Exception as exc:  # noqa: BLE001 - reported to the page, never raised there
         out.put(("error", f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:500]))
+
+
+def _bound_memory(limit: int) -> None:
+    """Bound this process's address space to ``limit`` [bytes] where the system can."""
+    try:
+        import resource
+    except ImportError:  # Windows: no such bound
+        return
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    if hard != resource.RLIM_INFINITY:
+        limit = min(limit, hard)
+    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
 
 
 # -- the server's side ---------------------------------------------------------------------
@@ -124,9 +150,11 @@ class StudyRun(param.Parameterized):
     result = param.Parameter(default=None, doc="The last StudyResult.")
 
     def __init__(self, dispatch: Callable[[Callable[[], None]], None] | None = None,
-                 **params: Any) -> None:
+                 share: StudyShare | None = None, **params: Any) -> None:
+        """``share``: the studies this one takes turns with (default: the server's)."""
         super().__init__(**params)
         self._dispatch = dispatch or (lambda callback: callback())
+        self._share = SHARE if share is None else share
         self._cancel = threading.Event()
         self._thread: threading.Thread | None = None
         self.process: Any = None
@@ -162,22 +190,25 @@ class StudyRun(param.Parameterized):
         self._dispatch(lambda: self.param.update(**values))
 
     def _work(self, planned: PlannedStudy, cancel: threading.Event) -> None:
-        if not _SLOTS.acquire(blocking=False):
-            self._set(message="waiting for another study (of this or another page) to "
-                              "finish")
-            while not _SLOTS.acquire(timeout=0.2):
-                if cancel.is_set():
-                    self._set(status="cancelled", message="cancelled before it started")
-                    return
+        ticket = object()  # this run's place in the server's turns
+
+        def waiting(ahead: int) -> None:
+            self._set(message=f"waiting: {ahead} {'study' if ahead == 1 else 'studies'} "
+                              "(of this or other pages) ahead, the server runs "
+                              f"{self._share.processes} in turns")
+
+        if not self._share.enter(ticket, cancel.is_set, waiting):
+            self._set(status="cancelled", message="cancelled before it started")
+            return
         try:
-            self._run(planned, cancel)
+            self._run(planned, cancel, ticket)
         except Exception as exc:  # noqa: BLE001 - the page says so; the server goes on
             log.exception("study failed")
             self._set(status="failed", message=f"the study could not run: {exc}")
         finally:
-            _SLOTS.release()
+            self._share.leave(ticket)
 
-    def _run(self, planned: PlannedStudy, cancel: threading.Event) -> None:
+    def _run(self, planned: PlannedStudy, cancel: threading.Event, ticket: object) -> None:
         n = planned.study.n_points
         ctx = _context()
         out = ctx.Queue()
@@ -187,16 +218,30 @@ class StudyRun(param.Parameterized):
         self.process = process
         started = time.monotonic()
         process.start()
+        self._share.attach(ticket, process.pid)
         self._set(status="running", message=f"running: 0 of {n} points")
         sent = 0.0
         outcome: tuple[str, Any] | None = None
+        # the running time (paused turns left out) is what the timeout bounds
+        ran, last, paused, done = 0.0, started, False, 0
         try:
             while outcome is None:
+                now = time.monotonic()
+                if not paused:
+                    ran += now - last
+                last = now
+                if self._share.runs(ticket) == paused:
+                    paused = not paused
+                    others = self._share.sharing() - 1
+                    self._set(message=(
+                        f"paused while {others} other {'study' if others == 1 else 'studies'}"
+                        f" take{'s' if others == 1 else ''} a turn: {done} of {n} points"
+                        if paused else f"running: {done} of {n} points"))
                 if cancel.is_set():
                     outcome = ("cancelled", None)
                     break
-                if time.monotonic() - started > STUDY_TIMEOUT_S:
-                    outcome = ("failed", f"the study took longer than {STUDY_TIMEOUT_S:.0f} "
+                if ran > STUDY_TIMEOUT_S:
+                    outcome = ("failed", f"the study ran longer than {STUDY_TIMEOUT_S:.0f} "
                                "s and was stopped; use fewer points")
                     break
                 try:
@@ -206,7 +251,7 @@ class StudyRun(param.Parameterized):
                         outcome = ("failed", "the study's process stopped (out of memory?)")
                     continue
                 if item[0] == "progress":
-                    now = time.monotonic()
+                    now, done = time.monotonic(), int(item[1])
                     if now - sent >= PROGRESS_EVERY_S or item[1] >= item[2]:
                         sent = now
                         self._set(done=int(item[1]),
@@ -235,8 +280,13 @@ class StudyRun(param.Parameterized):
 
 
 def _stop(process: Any) -> None:
-    """End ``process`` if it still runs: terminate, then kill."""
+    """End ``process`` if it still runs: terminate, then kill (a paused process is
+    resumed first: it takes no signal but a kill while stopped)."""
     if process.is_alive():
+        try:
+            resume(process.pid)
+        except OSError:
+            pass
         process.terminate()
         process.join(2.0)
     if process.is_alive():

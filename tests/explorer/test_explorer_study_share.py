@@ -1,0 +1,152 @@
+"""The server's studies take turns (explorer/solving/fair_share.py): a study started while
+another runs no longer waits for it to end, only one runs at any moment (the others
+paused), the queue beyond the processes allowed is first come first served, a cancelled
+waiting study leaves the queue, and a study's process is bounded in memory.
+
+The turns themselves are checked with a clock of the test's own; the real studies with
+real processes (paused by SIGSTOP, which Windows lacks)."""
+
+from __future__ import annotations
+
+import copy
+import threading
+import time
+
+import pytest
+
+from explorer.model import ExplorerState, presets
+from explorer.model.study import Axis, plan_study
+from explorer.solving import StudyRun
+from explorer.solving.fair_share import CAN_PAUSE, StudyShare
+from explorer.solving.study_runner import STUDY_MEMORY_BYTES
+
+
+class Clock:
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_turns_go_round_the_ring_and_the_queue_is_first_come() -> None:
+    clock = Clock()
+    share = StudyShare(processes=2, running=1, turn_s=1.0, pausable=True, clock=clock)
+    never = lambda: False  # noqa: E731
+    assert share.enter("a", never) and share.enter("b", never)
+    assert share.runs("a") and not share.runs("b")
+    clock.now = 0.5
+    assert share.runs("a") and not share.runs("b")  # within a's turn
+    clock.now = 1.0
+    assert not share.runs("a") and share.runs("b")  # b's turn
+    clock.now = 2.0
+    assert share.runs("a") and not share.runs("b")
+    # a third study waits for a process, then gets a's place when a ends
+    entered = threading.Event()
+    told: list[int] = []
+    third = threading.Thread(target=lambda: share.enter("c", never, told.append, 0.01)
+                             and entered.set())
+    third.start()
+    time.sleep(0.1)
+    assert not entered.is_set() and told == [2]  # two studies ahead of it
+    share.leave("a")
+    third.join(5)
+    assert entered.is_set() and share.sharing() == 2
+    assert share.runs("b") and not share.runs("c")  # b's turn began when a left
+
+
+def test_a_cancelled_waiting_study_leaves_the_queue() -> None:
+    share = StudyShare(processes=1, pausable=True)
+    assert share.enter("a", lambda: False)
+    assert not share.enter("b", lambda: True, poll_s=0.01)  # cancelled while waiting
+    share.leave("a")
+    assert share.enter("c", lambda: False)  # not behind the cancelled b
+    assert share.runs("c")
+
+
+def test_without_pausing_one_study_has_a_process_at_a_time() -> None:
+    share = StudyShare(processes=3, pausable=False)
+    assert share.processes == 1 and share.running == 1
+
+
+def _scene() -> dict:
+    scene = copy.deepcopy(presets()["uniform_flat"])
+    scene["times"] = [1.0, 30.0, 365.0]
+    state = ExplorerState()
+    state.load_scene(scene)
+    return state.to_scene()
+
+
+@pytest.mark.skipif(not CAN_PAUSE, reason="processes cannot be paused here")
+def test_two_pages_studies_run_in_turns_and_both_finish() -> None:
+    """The second page's study starts while the first runs (it once waited for the end),
+    at no moment do both processes run, and both give their whole answer."""
+    share = StudyShare(processes=2, running=1, turn_s=0.3)
+    scene = _scene()
+    # 40 coating moduli: each a new geometry, a few seconds of work (measured 3-6 s)
+    long = plan_study(scene, [Axis("coating[0].modulus", 50.0, 5000.0, 40, "log")])
+    short = plan_study(scene, [Axis("loading.force", 300.0, 600.0, 3)])
+    first, second = StudyRun(share=share), StudyRun(share=share)
+    first.start(long)
+    deadline = time.monotonic() + 120
+    while first.process is None or first.done == 0:
+        assert time.monotonic() < deadline, first.message
+        time.sleep(0.02)
+    second.start(short)
+    both_running = paused_first = 0
+    seen_second_alive_with_first = False
+    while first.running or second.running:
+        assert time.monotonic() < deadline + 300, (first.message, second.message)
+        states = [_state(run.process) for run in (first, second)]
+        if states[0] is not None and states[1] is not None:
+            seen_second_alive_with_first = True
+            both_running += states == ["R", "R"]
+            paused_first += states[0] == "T"
+        time.sleep(0.01)
+    assert first.status == second.status == "done", (first.message, second.message)
+    assert seen_second_alive_with_first  # the short study did not wait for the long one
+    # a process reads "R" a moment after its pause (the signal is asynchronous): a few
+    # samples of the ~1000 taken, never a whole turn
+    assert both_running <= 5, both_running
+    assert paused_first > 0  # the long study gave the short one turns
+    assert first.result.outputs["settlement"].shape[0] == 40
+    assert second.result.outputs["settlement"].shape[0] == 3
+
+
+def _state(process) -> str | None:
+    """'R' for a running process, 'T' for a paused one, None when it is gone."""
+    if process is None or not process.is_alive():
+        return None
+    try:
+        with open(f"/proc/{process.pid}/stat") as f:
+            state = f.read().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return None
+    return "T" if state in ("T", "t") else "R"
+
+
+def test_a_study_process_is_bounded_in_memory() -> None:
+    """The study's process has an address-space limit (POSIX), so a study can no longer
+    take the server's machine (one took 5.8 GiB)."""
+    import multiprocessing
+
+    resource = pytest.importorskip("resource")
+    from explorer.solving.study_runner import _bound_memory
+
+    ctx = multiprocessing.get_context("fork")
+    out = ctx.Queue()
+
+    def child() -> None:
+        _bound_memory(STUDY_MEMORY_BYTES)
+        limit = resource.getrlimit(resource.RLIMIT_AS)[0]
+        try:
+            bytearray(STUDY_MEMORY_BYTES)  # beyond what is left below the bound
+            out.put((limit, "allocated"))
+        except MemoryError:
+            out.put((limit, "refused"))
+
+    process = ctx.Process(target=child)
+    process.start()
+    limit, what = out.get(timeout=60)
+    process.join(10)
+    assert limit == STUDY_MEMORY_BYTES and what == "refused"
