@@ -15,8 +15,9 @@ generalized over the block system:
 1. the nodal active set on every punch's nodal rule at once: one bordered system over all
    contact nodes (the coupled operator, two border unknowns and rows per punch), the
    primal-dual sweeps of :func:`core.contact.active_set.nodal_active_set` over all
-   nodes; each punch's zones and ends to within a node by
-   :func:`core.contact.active_set.zones_from_nodes`;
+   nodes, started from each punch's zones alone on its coarser rule
+   (:func:`core.contact.nodal.coarse_start`); each punch's zones and ends to within a
+   node by :func:`core.contact.active_set.zones_from_nodes`;
 2. the free ends of all punches located together by
    :func:`core.contact.zones.refine_ends` (one quasi-Newton on all ends, the error
    estimate against the next coarser rule of every punch at once): :class:`CoupledEnds`
@@ -48,7 +49,7 @@ import numpy as np
 
 from core.contact.active_set import MAX_SWEEPS, NoContact, NodalState, zones_from_nodes
 from core.contact.elastic import _bad_pins, _verify
-from core.contact.nodal import nodal_operator
+from core.contact.nodal import coarse_start, nodal_operator
 from core.contact.result import UNILATERAL_MARGIN, UnilateralSolution, _Snapshot
 from core.contact.step import Space, Step, check_loads, nystrom_pressure
 from core.contact.unilateral import nodal_resolution, zone_resolution
@@ -286,13 +287,37 @@ def _given_rhs_all(steps: Sequence[Step], owner: np.ndarray, x: np.ndarray,
     return delta[owner] + alpha[owner] * x - g
 
 
+def coupled_state(base: CoupledBase, rules: Sequence[Panels], op: np.ndarray,
+                  steps: Sequence[Step], nodal_res: Sequence[Resolution]
+                  ) -> list[NodalState]:
+    """The coupled nodal active set (:func:`coupled_active_set`), started from each
+    punch's zones alone on its next coarser rule (:func:`core.contact.nodal.coarse_start`,
+    full contact where it has none): they depend on the scene and the loads alone, and
+    the coupling moves them little. A start that does not settle is retried from full
+    contact, which raises :class:`NoContact` when the loads leave a punch none."""
+    starts = [coarse_start(space, step, rule, res) for space, step, rule, res
+              in zip(base.spaces, steps, rules, nodal_res, strict=True)]
+    if any(start is not None for start in starts):
+        start = np.concatenate([np.ones(rule.size, dtype=bool) if one is None else one
+                                for one, rule in zip(starts, rules, strict=True)])
+        try:
+            states, settled = coupled_active_set(base, rules, op, steps, start)
+            if settled:
+                return states
+        except NoContact:
+            pass
+    return coupled_active_set(base, rules, op, steps)[0]
+
+
 def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarray,
-                       steps: Sequence[Step]) -> list[NodalState]:
+                       steps: Sequence[Step], start: np.ndarray | None = None
+                       ) -> tuple[list[NodalState], bool]:
     """The primal-dual active set of :func:`core.contact.active_set.nodal_active_set` on
     the nodes of every punch's ``rules`` at once (``op`` their coupled operator), from
-    full contact. Returns each punch's :class:`NodalState`. Raises :class:`NoContact`
-    (its message naming ``punches[k]``) when a punch with a given force or moment keeps
-    no node in contact, or fewer than three."""
+    the contact nodes ``start`` (default: all). Returns each punch's
+    :class:`NodalState` and whether the set settled. Raises :class:`NoContact` (its
+    message naming ``punches[k]``) when a punch with a given force or moment keeps no
+    node in contact, or fewer than three."""
     sizes = [r.size for r in rules]
     owner = np.repeat(np.arange(len(rules)), sizes)
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
@@ -303,8 +328,9 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
     rhs = _given_rhs_all(steps, owner, x, g)
     c, scale = steps[0].c, steps[0].scale
     givens = [s.given for s in steps]
-    active = np.ones(x.size, dtype=bool)
+    active = np.ones(x.size, dtype=bool) if start is None else start.copy()
     seen: set[bytes] = set()
+    settled = False
     q = np.zeros(x.size)
     delta = np.array([s.get("settlement", 0.0) for s in givens])
     alpha = np.array([s.get("tilt", 0.0) for s in givens])
@@ -326,6 +352,7 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
         nystrom[idx] = q[idx]
         new = nystrom > 0.0
         if np.array_equal(new, active):
+            settled = True
             break
         if new.tobytes() in seen:
             break
@@ -333,13 +360,14 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
         active = new
     return [NodalState(rules[p], q[lo:hi], float(delta[p]), float(alpha[p]), active[lo:hi],
                        nystrom[lo:hi])
-            for p, (lo, hi) in enumerate(zip(offsets[:-1], offsets[1:], strict=True))]
+            for p, (lo, hi) in enumerate(zip(offsets[:-1], offsets[1:], strict=True))], settled
 
 
 def _solve_one(base: CoupledBase, steps: Sequence[Step], rules: Sequence[Panels],
-               op: np.ndarray, res: Resolutions, tol: float) -> dict[str, Any]:
+               op: np.ndarray, nodal_res: Sequence[Resolution], res: Resolutions, tol: float
+               ) -> dict[str, Any]:
     """Every punch's zones at one time (see the module notes)."""
-    states = coupled_active_set(base, rules, op, steps)
+    states = coupled_state(base, rules, op, steps, nodal_res)
     ends, pinned, slopes, counts = [], [], [], []
     for space, state in zip(base.spaces, states, strict=True):
         e, p, s = zones_from_nodes(state, space.breakpoints) if state.active.any() else \
@@ -426,8 +454,9 @@ def solve_unilateral_punches(punches: Sequence[PunchGeometry], inputs: Sequence[
     c_t = np.broadcast_to(np.asarray(inputs[0].c(times), dtype=float), times.shape)
     tol = min(p.geometry.tol for p in base.punches)
     res = Resolutions(tuple(zone_resolution(s.lam, s.m) for s in base.spaces))
-    rules = [nodal_operator(s.lam, s.breakpoints, nodal_resolution(s.lam, s.m))
-             for s in base.spaces]
+    nodal_res = [nodal_resolution(s.lam, s.m) for s in base.spaces]
+    rules = [nodal_operator(s.lam, s.breakpoints, r) for s, r in zip(base.spaces, nodal_res,
+                                                                       strict=True)]
     op = base.operator([r[0] for r in rules], [r[1] for r in rules])
     results: dict[tuple, dict[str, Any]] = {}
     per_time = []
@@ -437,7 +466,8 @@ def solve_unilateral_punches(punches: Sequence[PunchGeometry], inputs: Sequence[
         if key not in results:
             steps = [Step(float(c_t[k]), 1.0, g) for g in givens]
             try:
-                results[key] = _solve_one(base, steps, [r[0] for r in rules], op, res, tol)
+                results[key] = _solve_one(base, steps, [r[0] for r in rules], op, nodal_res,
+                                          res, tol)
             except NoContact as exc:
                 raise ValueError(f"{exc}: the loads pull the punch away") from None
         per_time.append(results[key])
