@@ -156,6 +156,25 @@ def test_unilateral_contact_that_holds_meets_full_contact() -> None:
             assert errors[q] <= best.info["error_estimate"] + mine.info["error_estimate"]
 
 
+def test_a_punch_held_above_the_depressed_surface_carries_nothing() -> None:
+    """A punch held at zero settlement and tilt beside a pressed one: the neighbour's
+    pressure lowers the surface under it, so it touches nowhere."""
+    d = _pair(0.2, loads=(LIFTING, {"settlement": 0.0, "tilt": 0.0}))
+    d["solver"]["contact"] = "unilateral"
+    result = core.solve(d)
+    held = result.punches[1]
+    assert result.info["success"] and held.contact_set == [[], [], []]
+    np.testing.assert_array_equal(held.force, 0.0)
+    np.testing.assert_array_equal(held.pressure(np.linspace(-0.6, 0.6, 7)), 0.0)
+    # lowered a little, it touches away from the neighbour only (the surface is lowest
+    # next to it): measured on [1.76, 2.4] m of [1.2, 2.4] m
+    d["punches"][1]["loading"]["settlement"] = 1e-5
+    touching = core.solve(d).punches[1]
+    lo, hi = touching.contact_set[0][0]
+    assert len(touching.contact_set[0]) == 1
+    assert lo > 1.2 + 0.25 * 1.2 and hi == pytest.approx(2.4)
+
+
 def test_one_punch_pulled_away_is_refused_naming_it() -> None:
     d = _pair(0.5, loads=(LIFTING, {"force": -1e5, "moment": 0.0}))
     d["solver"]["contact"] = "unilateral"
