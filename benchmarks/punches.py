@@ -8,9 +8,10 @@ same model (thin layer, default engine: ``scene.dimensionless.solve()``), its ha
 *Two punches*: ``core.solve`` of
 two punches 1 m apart (the second 0.6 times as wide, so the two grids differ, or the same
 width, so they share one), both half-widths changed at each solve; *loads only*: the two
-punches' forces changed. Medians of the CPU time of this process per solve [ms], with
-the machine's load average; written to ``benchmarks/results/punches.md`` unless
-``--no-write``.
+punches' forces changed. *Lift-off*: the first punch (and the punch alone) under a moment
+that lifts its heel off, contact ``"unilateral"``. Medians of the CPU time of this process
+per solve [ms], with the machine's load average; written to
+``benchmarks/results/punches.md`` unless ``--no-write``.
 """
 
 from __future__ import annotations
@@ -39,23 +40,34 @@ def _scene() -> dict:
     return d
 
 
-def _single(i: int, force_step: float = 0.0, geometry_step: float = 1e-4) -> None:
+#: The moment [N] that lifts the first punch's heel off (e = 0.4 a) in the lift-off rows.
+LIFTING_MOMENT = 2e5
+
+
+def _single(i: int, force_step: float = 0.0, geometry_step: float = 1e-4,
+            moment: float = 0.0) -> None:
     d = _scene()
     d["punch"]["half_width"] *= 1 + geometry_step * i
     d["loading"]["force"] *= 1 + force_step * i
+    d["loading"]["moment"] = moment
+    if moment:
+        d["solver"]["contact"] = "unilateral"
     scene = scene_from_dict(d)
     SceneSolution(scene, scene.dimensionless, scene.dimensionless.solve())
 
 
-def _pair(i: int, ratio: float, force_step: float = 0.0, geometry_step: float = 1e-4) -> None:
+def _pair(i: int, ratio: float, force_step: float = 0.0, geometry_step: float = 1e-4,
+          moment: float = 0.0) -> None:
     d = _scene()
     del d["punch"], d["loading"]
     a0, a1 = 1.0 * (1 + geometry_step * i), ratio * (1 + geometry_step * i)
     d["punches"] = [
         {"center": 0.0, "half_width": a0,
-         "loading": {"force": 5e5 * (1 + force_step * i), "moment": 0.0}},
+         "loading": {"force": 5e5 * (1 + force_step * i), "moment": moment}},
         {"center": a0 + 1.0 + a1, "half_width": a1,
          "loading": {"force": 3e5 * (1 + force_step * i), "moment": 0.0}}]
+    if moment:
+        d["solver"]["contact"] = "unilateral"
     core.solve(d)
 
 
@@ -78,6 +90,11 @@ def main(argv: list[str]) -> None:
             ("two punches (a = 1, 0.6 m), loads only",
              _median_ms(lambda i: _pair(1000, 0.6, force_step=1e-3 * i, geometry_step=0.0)))]
     single = rows[0][1]
+    # lift-off (contact "unilateral"), against one punch lifting off alike
+    lifting = [("one punch (a = 1 m), lift-off, new geometry",
+                _median_ms(lambda i: _single(i, moment=LIFTING_MOMENT))),
+               ("two punches (a = 1, 0.6 m), the first lifting off, new geometry",
+                _median_ms(lambda i: _pair(i, 0.6, moment=LIFTING_MOMENT)))]
     commit = tree_commit()
     load = os.getloadavg()
     lines = ["# Two punches against one", "",
@@ -88,6 +105,10 @@ def main(argv: list[str]) -> None:
              f"{SOLVES} solves (`python -m benchmarks.punches`).", "",
              "| solve | CPU [ms] | against one punch |", "| --- | --- | --- |"]
     lines += [f"| {name} | {ms:.1f} | {ms / single:.2f}x |" for name, ms in rows]
+    lines += ["", "Lift-off (`solver.contact` \"unilateral\", the moment "
+              f"{LIFTING_MOMENT:g} N on the first punch, e = 0.4 a):", "",
+              "| solve | CPU [ms] | against one punch lifting off |", "| --- | --- | --- |"]
+    lines += [f"| {name} | {ms:.1f} | {ms / lifting[0][1]:.2f}x |" for name, ms in lifting]
     text = "\n".join(lines) + "\n"
     print(text)
     if "--no-write" not in argv:

@@ -13,11 +13,14 @@ cheap check that lets ``auto`` skip a full-contact solve.
 - ``creep.py``, ``march.py``, ``memory.py``, ``bands.py``, ``kinks.py``: lift-off under
   creep (error control, one march on a fixed rule, the memory of past pressures, the
   bands the zone ends sweep, kink-corrected zone ends);
-- ``result.py``: ``UnilateralSolution`` and ``contact_set_from_pressure``.
+- ``result.py``: ``UnilateralSolution`` and ``contact_set_from_pressure``;
+- ``coupled.py``: lift-off of several punches on one elastic base
+  (``solve_unilateral_punches``), the single punch's machinery over their block system.
 """
 
 from __future__ import annotations
 
+from core.contact.coupled import solve_unilateral_punches
 from core.contact.step import Space
 from core.contact.switch import (
     check_contact_model,
@@ -41,6 +44,7 @@ __all__ = [
     "refuse_loads_without_contact",
     "Resolution",
     "solve_unilateral",
+    "solve_unilateral_punches",
     "Space",
     "with_contact_model",
     "ZONE_EDGE_WIDTH",

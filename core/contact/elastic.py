@@ -8,6 +8,7 @@ checked against the contact conditions on the nodal rule.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -118,12 +119,14 @@ def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: 
                   "builds": refined.builds, "force": sol.force, "moment": sol.moment}
 
 
-def _bad_pins(space: Space, step: Step, sol, pinned: list[bool]) -> list[int]:
+def _bad_pins(space: Space, step: Step, sol, pinned: list[bool],
+              memory_at: Callable[[np.ndarray], np.ndarray] | None = None) -> list[int]:
     """Pinned ends that are free ends in fact.
 
     At +-1 or a breakpoint the zone may end with q > 0 (a corner of the punch); it must
     not end with Q < 0 inside (the zone is shorter: a free end within a node of it) nor
     with Q > 0 just outside (the surfaces would overlap there: the zone is longer).
+    ``memory_at``: the displacement e(x) the rest of the base adds (other punches).
     """
     bad = []
     scale = 1e-9 * sol.q_scale
@@ -137,15 +140,18 @@ def _bad_pins(space: Space, step: Step, sol, pinned: list[bool]) -> list[int]:
         if abs(end) < 1.0:
             outward = -1.0 if k % 2 == 0 else 1.0
             outside = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement,
-                                       sol.tilt, np.array([end]), np.array([outward]))[0]
+                                       sol.tilt, np.array([end]), np.array([outward]),
+                                       memory_at)[0]
             if outside > scale:
                 bad.append(k)
     return bad
 
 
-def _verify(space: Space, step: Step, sol, base: Panels, zones, accuracy: float) -> bool:
+def _verify(space: Space, step: Step, sol, base: Panels, zones, accuracy: float,
+            memory_at: Callable[[np.ndarray], np.ndarray] | None = None) -> bool:
     """q >= 0 on the zones and the gap open (Q <= 0) at the base nodes off them (the
-    kernel values to ``accuracy``, far below the check's 1e-8 of max q)."""
+    kernel values to ``accuracy``, far below the check's 1e-8 of max q); ``memory_at``
+    as in :func:`_bad_pins`."""
     scale = sol.q_scale
     if np.min(sol.q) < -1e-8 * scale:
         return False
@@ -157,5 +163,5 @@ def _verify(space: Space, step: Step, sol, base: Panels, zones, accuracy: float)
     if off.size == 0:
         return True
     values = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, off,
-                              accuracy=accuracy)
+                              memory_at=memory_at, accuracy=accuracy)
     return bool(np.max(values) <= 1e-8 * scale)

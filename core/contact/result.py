@@ -7,7 +7,7 @@ pressures of any engine into contact sets.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -34,6 +34,8 @@ class _Snapshot:
     step: Step
     zones: list[tuple[float, float]]
     memory: np.ndarray | None = None  # creep memory density at the nodes (F of it is e(x))
+    # the displacement e(x) the other punches on the base add (core.contact.coupled)
+    coupling: Callable[[np.ndarray], np.ndarray] | None = None
 
 
 # repr=False: the short repr of SolveOutcome, not every array and snapshot
@@ -83,7 +85,7 @@ class UnilateralSolution(SolveOutcome):
         for k, snap in enumerate(self._snapshots):
             if not inside[:, k].any():
                 continue
-            if snap.memory is None:
+            if snap.memory is None and snap.coupling is None:
                 rules.setdefault(id(snap.panels), []).append(k)
             else:
                 out[inside[:, k], k] = self._pressure_one(snap, x[inside[:, k]])
@@ -114,7 +116,8 @@ class UnilateralSolution(SolveOutcome):
         return out
 
     def _pressure_one(self, snap: _Snapshot, xi: np.ndarray) -> np.ndarray:
-        memory_at = None
+        memory_at = snap.coupling
+        accuracy = FULL_ACCURACY if snap.coupling is None else self._kernel_accuracy
         if snap.memory is not None:
             from core.discretize import operator_rows
 
@@ -126,7 +129,8 @@ class UnilateralSolution(SolveOutcome):
             inward[xi == lo] = 1.0
             inward[xi == hi] = -1.0
         values = nystrom_pressure(self._space, snap.step, snap.panels, snap.q,
-                                  snap.settlement, snap.tilt, xi, inward, memory_at)
+                                  snap.settlement, snap.tilt, xi, inward, memory_at,
+                                  accuracy=accuracy)
         return np.maximum(values, 0.0)
 
 

@@ -83,8 +83,7 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     check_loads(inp.given, loads, times_arr)
     space = Space(inp.lam, inp.m, inp.g, inp.breakpoints)
     m_probe = inp.m(np.linspace(-1.0, 1.0, 257))
-    res = Resolution(min(ZONE_PANEL_WIDTH, 3.0 / inp.lam),
-                     min(ZONE_EDGE_WIDTH, 0.25 * float(np.min(m_probe))))
+    res = zone_resolution(inp.lam, inp.m)
     nodal_res = nodal_resolution(inp.lam, inp.m)
     if inp.kernel is None:
         out = _solve_elastic(space, c_t, loads, times_arr, nodal_res, res, inp.tol)
@@ -99,6 +98,15 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     return UnilateralSolution(times_arr.copy(), out["settlement"], out["tilt"], out["force"],
                               out["moment"], out["contact_set"], out["info"], space,
                               out["snapshots"], out.get("kernel_accuracy", FULL_ACCURACY))
+
+
+def zone_resolution(lam: float, m: Callable[[np.ndarray], np.ndarray]) -> Resolution:
+    """The first rule of the zone ends: panels at most ``ZONE_PANEL_WIDTH`` (and 3/lam)
+    wide, graded to ``ZONE_EDGE_WIDTH`` at +-1, the breakpoints and the ends, finer for a
+    thin coating (its boundary layer is ~m wide)."""
+    m_probe = m(np.linspace(-1.0, 1.0, 257))
+    return Resolution(min(ZONE_PANEL_WIDTH, 3.0 / lam),
+                      min(ZONE_EDGE_WIDTH, 0.25 * float(np.min(m_probe))))
 
 
 def nodal_resolution(lam: float, m: Callable[[np.ndarray], np.ndarray]) -> Resolution:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -162,42 +163,100 @@ def _walls(ends: list[float], pinned: list[bool], k: int) -> tuple[float, float]
     return lo, hi
 
 
+def output_error(sol: ZoneSolution, fine: ZoneSolution) -> float:
+    """The change of delta, alpha (relative to the larger of them) and P, M (to the larger
+    of them) from the coarser rule's ``fine`` to ``sol``: the estimate of the outputs."""
+    kin = max(abs(sol.settlement), abs(sol.tilt), 1e-300)
+    dyn = max(abs(sol.force), abs(sol.moment), 1e-300)
+    return max(abs(sol.settlement - fine.settlement) / kin,
+               abs(sol.tilt - fine.tilt) / kin,
+               abs(sol.force - fine.force) / dyn,
+               abs(sol.moment - fine.moment) / dyn)
+
+
+class OnePunch:
+    """The zone ends of one punch at one time, as :func:`refine_ends` asks for them.
+
+    An end problem answers ``solve(ends, res, probes)`` (a solution whose ``end_values``
+    hold Q at the ends, and Q at ``probes``), ``scale(sol)`` (the q that makes Q at the
+    ends relative: a number, or one per end), ``walls(ends, k)`` (how far end ``k`` may
+    move), ``edge(res)`` (the end grading of ``res``: a number, or one per end) and
+    ``output_error(sol, fine)``; ``res`` has ``finer()`` and ``coarser()``. Several
+    punches on one base answer the same questions for all their ends at once
+    (:mod:`core.contact.coupled`).
+    """
+
+    def __init__(self, space: Space, step: Step, accuracy: float) -> None:
+        self.space, self.step, self.accuracy = space, step, accuracy
+
+    def solve(self, ends: Sequence[float], res: Resolution, probes: np.ndarray | None = None
+              ) -> tuple[ZoneSolution, np.ndarray] | ZoneSolution:
+        return solve_on_zones(self.space, self.step, ends, res, probes=probes,
+                              accuracy=self.accuracy)
+
+    @staticmethod
+    def scale(sol: ZoneSolution) -> float:
+        return sol.q_scale
+
+    @staticmethod
+    def walls(ends: list[float], k: int) -> tuple[float, float]:
+        return _walls(ends, [], k)
+
+    @staticmethod
+    def edge(res: Resolution) -> float:
+        return res.edge
+
+    @staticmethod
+    def output_error(sol: ZoneSolution, fine: ZoneSolution) -> float:
+        return output_error(sol, fine)
+
+
 def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[bool],
                      slopes: list[float], res: Resolution, *, tol: float,
                      max_levels: int = MAX_LEVELS) -> Refined:
-    """Locate every free end as the root of ``Q(end) = 0`` and estimate the error.
-
-    Quasi-Newton (Broyden) on the free ends, starting from the Jacobian ``diag(dQ/dx)``
-    of the nodal estimate. At each resolution the converged ends are compared with the
-    next coarser rule (the shift ``-J^-1 dQ`` it would give them, and the change of the
-    outputs): that difference is the error estimate, an overestimate by the convergence
-    ratio of a level (measured ~16 for the ends), and a coarser check costs a quarter of
-    a finer one. The resolution is refined until both meet ``ZONE_END_TOL`` and ``tol``
-    (a third of each), at most ``max_levels`` times.
-    """
-    ends = list(ends)
-    pinned = list(pinned)
-    free = [k for k, p in enumerate(pinned) if not p]
+    """Locate every free end as the root of ``Q(end) = 0`` and estimate the error
+    (:func:`refine_ends` for one punch)."""
     # Kernel values to 1e-4 of the tighter of tol and the zone-end tolerance: F q then
     # errs by that times int |q|, far below both; the truncated series and the zeros of
     # the decayed kernel save ~6 % of an elastic lift-off solve (12.9 -> 12.1 ms CPU,
     # measured; the ends moved by 6e-14 at tol 1e-6).
-    accuracy = zone_kernel_accuracy(tol)
+    problem = OnePunch(space, step, zone_kernel_accuracy(tol))
+    return refine_ends(problem, ends, pinned, slopes, res, tol=tol, max_levels=max_levels)
+
+
+def refine_ends(problem: Any, ends: list[float], pinned: list[bool], slopes: list[float],
+                res: Any, *, tol: float, max_levels: int = MAX_LEVELS) -> Refined:
+    """Locate every free end as the root of ``Q(end) = 0`` and estimate the error.
+
+    ``problem``: the end problem (:class:`OnePunch` says what it answers), ``res`` its
+    resolution. Quasi-Newton (Broyden) on the free ends, starting from the Jacobian
+    ``diag(dQ/dx)`` of the nodal estimate. At each resolution the converged ends are
+    compared with the next coarser rule (the shift ``-J^-1 dQ`` it would give them, and
+    the change of the outputs): that difference is the error estimate, an overestimate by
+    the convergence ratio of a level (measured ~16 for the ends), and a coarser check
+    costs a quarter of a finer one. The resolution is refined until both meet
+    ``ZONE_END_TOL`` and ``tol`` (a third of each), at most ``max_levels`` times.
+    """
+    ends = list(ends)
+    pinned = list(pinned)
+    free = [k for k, p in enumerate(pinned) if not p]
     builds = 0
     # The nodal Q is in units of q; the residual is Q / max q.
     inward = np.array([1.0 if k % 2 == 0 else -1.0 for k in free])
     ends_free = np.array([ends[k] for k in free])
-    probe = ends_free + inward * 1e-3 * res.edge
-    sol, q_in = solve_on_zones(space, step, ends, res, probes=probe, accuracy=accuracy)
+    probe = ends_free + inward * 1e-3 * _at(problem.edge(res), free)
+    sol, q_in = problem.solve(ends, res, probes=probe)
     builds += 1
-    jac = np.diag([s / sol.q_scale if s != 0.0 else 1.0 for s in
-                   (slopes[k] for k in free)]) if free else np.zeros((0, 0))
+    scale = _at(problem.scale(sol), free)
+    jac = np.diag([s / sc if s != 0.0 else 1.0 for s, sc in
+                   zip((slopes[k] for k in free), np.broadcast_to(scale, (len(free),)),
+                       strict=True)]) if free else np.zeros((0, 0))
     if free:
         # Near the root, moving an end changes the answer little (q vanishes there), so
         # dQ(end)/d(end) is about the slope of Q in x at the end: taken from this solution
         # (a step into the zone) it beats the nodal difference, and the first quasi-Newton
         # step lands far closer (one solve fewer, measured).
-        slope = (q_in - sol.end_values[free]) / (probe - ends_free) / sol.q_scale
+        slope = (q_in - sol.end_values[free]) / (probe - ends_free) / scale
         if np.all(np.isfinite(slope)) and np.all(slope * inward > 0.0):
             jac = np.diag(slope)
     converged = not free
@@ -207,7 +266,7 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
     for _ in range(max_levels):
         level += 1
         if free:
-            r = sol.end_values[free] / sol.q_scale
+            r = sol.end_values[free] / _at(problem.scale(sol), free)
             converged = False
             unmade = 0.0
             for _ in range(MAX_END_ITERATIONS):
@@ -226,12 +285,12 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
                     # the punch's edge is approached geometrically (a fixed margin of
                     # 1e-3 of the span held it 2e-3 away, just past the lift-off
                     # threshold).
-                    lo, hi = _walls(ends, pinned, k)
+                    lo, hi = problem.walls(ends, k)
                     trial[k] = float(np.clip(ends[k] + move[j], ends[k] - 0.9 * (ends[k] - lo),
                                              ends[k] + 0.9 * (hi - ends[k])))
-                new = solve_on_zones(space, step, trial, res, accuracy=accuracy)
+                new = problem.solve(trial, res)
                 builds += 1
-                r_new = new.end_values[free] / new.q_scale
+                r_new = new.end_values[free] / _at(problem.scale(new), free)
                 ds = np.array([trial[k] - ends[k] for k in free])
                 if np.dot(ds, ds) > 0.0:
                     jac = jac + np.outer(r_new - r - jac @ ds, ds) / np.dot(ds, ds)
@@ -249,10 +308,10 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
                     converged = True
                     unmade = ahead
                     break
-        fine = solve_on_zones(space, step, ends, res.coarser(), accuracy=accuracy)
+        fine = problem.solve(ends, res.coarser())
         builds += 1
         if free:
-            r_fine = fine.end_values[free] / fine.q_scale
+            r_fine = fine.end_values[free] / _at(problem.scale(fine), free)
             try:
                 shift = -np.linalg.solve(jac, r_fine)
             except np.linalg.LinAlgError:
@@ -260,17 +319,17 @@ def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[b
             end_error = float(np.max(np.abs(shift))) + unmade
         else:
             end_error = 0.0
-        kin = max(abs(sol.settlement), abs(sol.tilt), 1e-300)
-        dyn = max(abs(sol.force), abs(sol.moment), 1e-300)
-        output_error = max(abs(sol.settlement - fine.settlement) / kin,
-                           abs(sol.tilt - fine.tilt) / kin,
-                           abs(sol.force - fine.force) / dyn,
-                           abs(sol.moment - fine.moment) / dyn)
+        output_error = problem.output_error(sol, fine)
         if end_error <= ZONE_END_TOL / 3 and output_error <= tol / 3:
             break
         if level == max_levels:
             break
         res = res.finer()
-        sol = solve_on_zones(space, step, ends, res, accuracy=accuracy)
+        sol = problem.solve(ends, res)
         builds += 1
     return Refined(sol, end_error, output_error, builds, level, converged)
+
+
+def _at(values: float | np.ndarray, free: list[int]) -> float | np.ndarray:
+    """A number as it stands, or the entries of the free ends of one value per end."""
+    return values if np.ndim(values) == 0 else np.asarray(values)[free]

@@ -20,11 +20,19 @@ from core.kernel.layered import (
     table_cost,
 )
 from core.kernel.log_moments import legendre_log_moments
-from core.kernel.values import FULL_ACCURACY, kernel_block, kernel_regular
+from core.kernel.values import (
+    FULL_ACCURACY,
+    KERNEL_DECAY,
+    KERNEL_ENVELOPE,
+    kernel_block,
+    kernel_regular,
+)
 
 __all__ = [
     "COARSE_PANEL_DEGREE",
     "FULL_ACCURACY",
+    "KERNEL_DECAY",
+    "KERNEL_ENVELOPE",
     "kernel_block",
     "kernel_regular",
     "legendre_log_moments",

@@ -9,10 +9,13 @@ so every field keeps its rules; a refusal names it as ``punches[k].<field>``.
 One punch is the single-punch scene at its centre, answered by :func:`core.scene.solve`
 (every base, contact model and engine). Several punches are coupled by the default engine
 (:mod:`core.engines.nystrom.multi`) with the thin-layer coating model, in full contact (on
-an elastic, aging or creeping base). The coating's profiles are functions of the global x
-along the whole surface (checked over the punches' span); each punch sees them from its
-centre. What is not coupled yet (unilateral contact) is refused with a ValueError naming
-the field and the reason.
+an elastic, aging or creeping base); on an elastic base they may lift off
+(:func:`core.contact.solve_unilateral_punches`: ``solver.contact`` ``"unilateral"``, or
+``"auto"`` when full contact is lost under some punch; then every punch's contact set is
+an unknown). The coating's profiles are functions of the global x along the whole surface
+(checked over the punches' span); each punch sees them from its centre. What is not
+coupled yet (lift-off under creep) is refused with a ValueError naming the field and the
+reason.
 """
 
 from __future__ import annotations
@@ -28,8 +31,9 @@ import numpy as np
 
 from core import limits
 from core.coating import DEFAULT_INTERFACE
+from core.contact import solve_unilateral_punches
 from core.engines.nystrom import PunchGeometry, solve_punches
-from core.problem import validate_geometry, validate_time_inputs
+from core.problem import TimeInputs, validate_geometry, validate_time_inputs
 from core.profiles import shifted
 from core.scene import schema
 from core.scene.model import Scene
@@ -37,7 +41,7 @@ from core.scene.results import SceneSolution
 from core.validation import bounded_list, finite_number
 
 #: What the coupled solve does not answer yet, named in its refusals.
-COUPLED_SCOPE = "several punches are solved in full contact for now"
+COUPLED_SCOPE = "lift-off of several punches is solved on an elastic base for now"
 
 
 @dataclass(frozen=True, eq=False)
@@ -226,9 +230,30 @@ def _along_x(common: Mapping[str, Any], scenes: list[Scene], centers: list[float
 def _check_coupled(scene: PunchesScene) -> None:
     """Refuse what the coupled solve does not answer yet, naming the field."""
     first = scene.scenes[0]
-    if first.contact == "unilateral":
-        raise ValueError(f"solver.contact: {COUPLED_SCOPE} (give 'auto' or 'full'; a lost "
-                         "contact is flagged contact_lost)")
+    if first.contact == "unilateral" and first.dimensionless.kernel is not None:
+        raise ValueError(f"solver.contact: {COUPLED_SCOPE}, and the base creeps (give 'full' "
+                         "for the full-contact answer, a lost contact flagged contact_lost "
+                         "on its punch)")
+
+
+def _check_touch(scene: PunchesScene) -> None:
+    """Refuse, naming ``punches[k].loading.<field>``, loads no contact can carry (the
+    single punch's :func:`core.scene.load_limits.check_loads_touch`, punch by punch): a
+    lift-off answer needs every punch pressed."""
+    from core.scene.load_limits import check_loads_touch
+
+    for k, sub in enumerate(scene.scenes):
+        try:
+            check_loads_touch(sub)
+        except ValueError as exc:
+            raise ValueError(_renamed(str(exc), k)) from None
+
+
+def _lift_off(scene: PunchesScene, geometries: list[PunchGeometry],
+              inputs: list[TimeInputs]) -> list[Any]:
+    """Every punch's answer with lift-off (:func:`core.contact.solve_unilateral_punches`)."""
+    _check_touch(scene)
+    return solve_unilateral_punches(geometries, inputs)
 
 
 class PunchSolution(SceneSolution):
@@ -317,22 +342,36 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
             inputs.append(validate_time_inputs(problem.times, problem.c, problem.kernel,
                                                {q: problem.loads.get(q) for q in
                                                 ("settlement", "tilt", "force", "moment")}))
+        first = scene.scenes[0]
         with np.errstate(all="ignore"):
-            answers = solve_punches(geometries, inputs,
-                                    scene.scenes[0].dimensionless.time_breaks)
+            if first.contact == "unilateral":
+                answers = _lift_off(scene, geometries, inputs)
+            else:
+                answers = solve_punches(geometries, inputs, first.dimensionless.time_breaks)
+                for answer in answers:
+                    answer.info["contact"] = "full"
+                lost = [k for k, a in enumerate(answers) if "contact_lost" in a.info["flags"]]
+                if lost and first.contact == "auto":
+                    if first.dimensionless.kernel is not None:
+                        k = lost[0]
+                        raise ValueError(
+                            f"solver.contact: punches[{k}] loses contact (q < 0 under it in "
+                            f"full contact, down to {answers[k].info['min_pressure']:.3g} of "
+                            f"q*) and {COUPLED_SCOPE}: give solver.contact 'full' for the "
+                            "full-contact answer flagged contact_lost, or loads that keep "
+                            "every punch pressed")
+                    full = answers
+                    answers = _lift_off(scene, geometries, inputs)
+                    for answer, before in zip(answers, full, strict=True):
+                        # what the full-contact model said, as for one punch
+                        answer.info["full_contact"] = {
+                            "flags": list(before.info["flags"]),
+                            "min_pressure": before.info.get("min_pressure"),
+                            "seconds": before.info.get("seconds")}
         punches = [PunchSolution(sub, center, answer) for sub, center, answer
                    in zip(scene.scenes, scene.centers, answers, strict=True)]
         for p in punches:
             p.info["coating_model"] = "thin layer"
-        lost = [k for k, p in enumerate(punches) if "contact_lost" in p.flags]
-        if lost and scene.scenes[0].contact == "auto":
-            k = lost[0]
-            raise ValueError(
-                f"solver.contact: punches[{k}] loses contact (q < 0 under it in full "
-                f"contact, down to {punches[k].info['min_pressure']:.3g} of q*) and lift-off "
-                "under several punches is not solved yet: give solver.contact 'full' for the "
-                "full-contact answer flagged contact_lost, or loads that keep every punch "
-                "pressed")
     result = PunchesSolution(scene, punches)
     result.info["cpu_seconds"] = time.thread_time() - started
     return result

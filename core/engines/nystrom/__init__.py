@@ -29,6 +29,8 @@ from core.engines.nystrom.multi import (
     CoupledPunches,
     PunchGeometry,
     coupled_for,
+    coupled_x,
+    interacting,
     solve_punches,
 )
 from core.engines.nystrom.prepared import (
@@ -43,7 +45,9 @@ from core.engines.nystrom.prepared import (
 __all__ = [
     "COUPLED",
     "coupled_for",
+    "coupled_x",
     "CoupledPunches",
+    "interacting",
     "PunchGeometry",
     "solve_punches",
     "NYSTROM",

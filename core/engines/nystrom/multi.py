@@ -54,8 +54,9 @@ Design (dimensionless, elastic base, full contact):
 
 Creep and a modulus varying in time: the same coupled operator in modal form
 (:mod:`core.engines.nystrom.multi_modal`), stepped by :mod:`core.time`; the time
-stepping's estimate is added to the punches' spatial ones. Lift-off is not coupled here
-(refused by the scene, :mod:`core.scene.punches`).
+stepping's estimate is added to the punches' spatial ones. Lift-off is not solved here:
+:mod:`core.contact.coupled` runs the single punch's lift-off machinery over the punches
+(elastic base), with the same scaling, coupling and :func:`interacting` pairs.
 """
 
 from __future__ import annotations
@@ -152,6 +153,13 @@ def coupled_x(source: PunchGeometry, target: PunchGeometry, x: np.ndarray) -> np
     return (target.center + target.geometry.lam * x - source.center) / source.geometry.lam
 
 
+def interacting(a: PunchGeometry, b: PunchGeometry) -> bool:
+    """Whether the zones of ``a`` and ``b`` are close enough to act on each other (closer
+    than :data:`NEGLIGIBLE_GAP` base thicknesses)."""
+    (lo_a, hi_a), (lo_b, hi_b) = a.span, b.span
+    return max(lo_a, lo_b) - min(hi_a, hi_b) < NEGLIGIBLE_GAP
+
+
 class CoupledPunches:
     """The coupled discretization of several punches (see the module notes).
 
@@ -207,8 +215,7 @@ class CoupledPunches:
 
     def coupled(self, p: int, r: int) -> bool:
         """Whether zones ``p`` and ``r`` are close enough to act on each other."""
-        (lo_p, hi_p), (lo_r, hi_r) = self.punches[p].span, self.punches[r].span
-        return max(lo_p, lo_r) - min(hi_p, hi_r) < NEGLIGIBLE_GAP
+        return interacting(self.punches[p], self.punches[r])
 
     def coupling_rows(self, p: int, r: int, x: np.ndarray) -> np.ndarray:
         """``(lam_r / lam_p) F_r`` at points ``x`` of zone ``p`` (len(x), N_r)."""
