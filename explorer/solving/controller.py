@@ -147,6 +147,8 @@ def _failure_text(exc: Exception) -> str:
         return format_error(str(exc))
     if isinstance(exc, WorkerFailed):
         return f"The solver failed on this scene: {exc}."
+    if isinstance(exc, MemoryError) and str(exc):  # a worker's bound, said in words
+        return f"The solver stopped: {exc}."
     # the session must survive any failure of a solve
     log.error("solve failed", exc_info=exc)
     return f"The solver failed on this scene ({type(exc).__name__}: {exc})."

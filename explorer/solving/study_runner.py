@@ -16,7 +16,8 @@ cancelled (the process is terminated: the work really stops), ran longer than
 in turns (:mod:`explorer.solving.fair_share`): a few have a process at once and run one
 at a time, a turn each, the others paused; more wait, first come first served (and can
 be cancelled while they wait). A study's process is bounded in memory
-(:data:`STUDY_MEMORY_BYTES`, its solver caches by :data:`STUDY_CACHE_BYTES`).
+(:data:`explorer.solving.memory_bound.STUDY_MEMORY_BYTES`, its solver caches by
+:data:`STUDY_CACHE_BYTES`).
 
 Nothing here imports Panel.
 """
@@ -41,6 +42,7 @@ from core.study import sweep
 
 from ..model import PlannedStudy, StudyResult
 from .fair_share import SHARE, StudyShare, resume
+from .memory_bound import STUDY_MEMORY_BYTES, bound_memory, out_of_memory
 
 log = logging.getLogger(__name__)
 
@@ -48,11 +50,6 @@ log = logging.getLogger(__name__)
 #: counted): :data:`explorer.model.study.MAX_POINTS` points at the slowest valid scene's
 #: 0.7 s per point are ~280 s of CPU, and a loaded machine stretches that.
 STUDY_TIMEOUT_S = 600.0
-#: The address space a study's process may take [bytes] (POSIX ``RLIMIT_AS``): the
-#: process starts at ~0.55 GiB of it (numpy, scipy and the solver, measured), its solver
-#: caches take at most :data:`STUDY_CACHE_BYTES` and its answers a few MB; past it the
-#: study fails saying so, where a study once took the server's processes to 5.8 GiB.
-STUDY_MEMORY_BYTES = 2 * 1024**3
 #: The solver's stage caches in a study's process [bytes] (``core.set_stage_cache_budget``):
 #: a study's points share one geometry per batch at most, so the caches need hold little.
 STUDY_CACHE_BYTES = 256 * 1024**2
@@ -92,7 +89,7 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
     """Run the study and put ``("progress", done, total)`` after every batch, then
     ``("done", arrays)`` or ``("error", message)`` on ``out``."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl+C is the server's to handle
-    _bound_memory(STUDY_MEMORY_BYTES)
+    bound_memory(STUDY_MEMORY_BYTES)
     set_stage_cache_budget(STUDY_CACHE_BYTES)
 
     def progress(done: int, total: int) -> bool:
@@ -115,23 +112,11 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
         arrays["cpu_seconds"] = time.process_time() - cpu
         out.put(("done", arrays))
     except MemoryError:
-        out.put(("error", f"the study needed more than its {STUDY_MEMORY_BYTES / 1024**3:g} "
-                          "GiB of memory; use fewer points or output times (or run it "
-                          "with coated-punch sweep)"))
+        out.put(("error", out_of_memory("the study", STUDY_MEMORY_BYTES,
+                                        "use fewer points or output times (or run it with "
+                                        "coated-punch sweep)")))
     except Exception as exc:  # noqa: BLE001 - reported to the page, never raised there
         out.put(("error", f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:500]))
-
-
-def _bound_memory(limit: int) -> None:
-    """Bound this process's address space to ``limit`` [bytes] where the system can."""
-    try:
-        import resource
-    except ImportError:  # Windows: no such bound
-        return
-    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
-    if hard != resource.RLIM_INFINITY:
-        limit = min(limit, hard)
-    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
 
 
 # -- the server's side ---------------------------------------------------------------------

@@ -23,6 +23,7 @@ import core.report
 from core import set_stage_cache_budget, solve, stage_cache_bytes
 
 from ..model import ResultView, prepare_view
+from .memory_bound import WORKER_MEMORY_BYTES, bound_memory, out_of_memory
 
 if TYPE_CHECKING:
     from core.back_analysis import Calibration
@@ -49,6 +50,7 @@ def _start_worker(stage_cache_bytes: int) -> None:
     # Ctrl+C in the terminal reaches the whole process group: the server stops its
     # workers itself, and a worker's traceback would only clutter the terminal.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    bound_memory(WORKER_MEMORY_BYTES)
     set_stage_cache_budget(stage_cache_bytes)
     threading.Thread(target=_watch_parent, name="watch-parent", daemon=True).start()
 
@@ -124,6 +126,10 @@ def serve(connection: multiprocessing.connection.Connection, stage_cache_bytes: 
         start = time.monotonic()
         try:
             reply: tuple[str, Any, tuple[float, float]] = ("ok", fn(*args), (start, 0.0))
+        except MemoryError:  # the bound of this worker, said in words
+            reply = ("error", MemoryError(out_of_memory(
+                "this solve", WORKER_MEMORY_BYTES, "fewer output times (times.count) or a "
+                "looser solver.tol need less")), (start, 0.0))
         except BaseException as exc:  # the server raises it in the caller
             reply = ("error", exc, (start, 0.0))
         reply = (reply[0], reply[1], (start, time.monotonic()))  # when it worked [s]

@@ -1,7 +1,8 @@
 """The server's studies take turns (explorer/solving/fair_share.py): a study started while
 another runs no longer waits for it to end, only one runs at any moment (the others
 paused), the queue beyond the processes allowed is first come first served, a cancelled
-waiting study leaves the queue, and a study's process is bounded in memory.
+waiting study leaves the queue, and a study's process and a solver worker are bounded in
+memory (explorer/solving/memory_bound.py).
 
 The turns themselves are checked with a clock of the test's own; the real studies with
 real processes (paused by SIGSTOP, which Windows lacks)."""
@@ -18,7 +19,13 @@ from explorer.model import ExplorerState, presets
 from explorer.model.study import Axis, plan_study
 from explorer.solving import StudyRun
 from explorer.solving.fair_share import CAN_PAUSE, StudyShare
-from explorer.solving.study_runner import STUDY_MEMORY_BYTES
+from explorer.solving.memory_bound import (
+    STUDY_MEMORY_BYTES,
+    WORKER_MEMORY_BYTES,
+    address_space_bound,
+    bound_memory,
+)
+from explorer.solving.workers import SolverProcesses
 
 
 class Clock:
@@ -131,16 +138,15 @@ def test_a_study_process_is_bounded_in_memory() -> None:
     import multiprocessing
 
     resource = pytest.importorskip("resource")
-    from explorer.solving.study_runner import _bound_memory
 
     ctx = multiprocessing.get_context("fork")
     out = ctx.Queue()
 
     def child() -> None:
-        _bound_memory(STUDY_MEMORY_BYTES)
+        bound_memory(STUDY_MEMORY_BYTES)
         limit = resource.getrlimit(resource.RLIMIT_AS)[0]
         try:
-            bytearray(STUDY_MEMORY_BYTES)  # beyond what is left below the bound
+            bytearray(limit)  # beyond what is left below the bound
             out.put((limit, "allocated"))
         except MemoryError:
             out.put((limit, "refused"))
@@ -149,4 +155,25 @@ def test_a_study_process_is_bounded_in_memory() -> None:
     process.start()
     limit, what = out.get(timeout=60)
     process.join(10)
-    assert limit == STUDY_MEMORY_BYTES and what == "refused"
+    assert limit == address_space_bound(STUDY_MEMORY_BYTES) and what == "refused"
+
+
+def allocate(n: int) -> int:
+    """Take ``n`` bytes (run in a solver worker)."""
+    return len(bytearray(n))
+
+
+def test_a_solver_worker_is_bounded_in_memory_and_says_so() -> None:
+    """A request that needs more than a worker's bound fails in words the page shows,
+    and the worker goes on serving."""
+    pytest.importorskip("resource")
+    from explorer.solving.controller import _failure_text
+
+    processes = SolverProcesses(1, 64 * 1024**2)
+    try:
+        with pytest.raises(MemoryError, match="this solve needed more than") as info:
+            processes.run(0, allocate, address_space_bound(WORKER_MEMORY_BYTES))
+        assert "times.count" in _failure_text(info.value)
+        assert processes.run(0, allocate, 1000) == 1000
+    finally:
+        processes.shutdown()
