@@ -12,7 +12,9 @@ Schema of the files); ``--version``. A scene or study argument may name a shippe
 :meth:`core.scene.SceneSolution.to_dict`, with the contact set per time and the design
 check; ``.csv``: the histories of settlement, tilt, force and moment, and the contact
 zones when the punch lifts off) and optionally the pressure ``q(x, t)`` to
-``--pressure-csv``; without ``--output`` it prints a short summary. Every file records
+``--pressure-csv``; without ``--output`` it prints a short summary. A scene of several
+punches is written the same way, every punch in one file (columns ``punches[k].*``, q
+over the whole surface in the global x), its design check and flags per punch. Every file records
 the program's version, the scene and the solver settings (:mod:`core.scene.records`:
 top-level keys of the JSON, ``# key: value`` lines before a CSV table). ``-`` as the
 scene reads it from standard input, ``-`` as an output writes it to standard output

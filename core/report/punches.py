@@ -48,8 +48,9 @@ HISTORIES = (("settlement", "δ", "m"), ("tilt", "α", "rad"), ("force", "P", "N
 #: Rows of a punch's inputs that are its own (the rest, when alike for every punch, is
 #: said once): its base and its loads.
 OWN_INPUTS = ("punch", "(given)")
-#: Width of the q(x) plot over the surface [screen pixels]: two plots' width.
-SURFACE_WIDTH = 2 * PLOT_WIDTH + 100
+#: Width of a plot of several punches [screen pixels]: a plot of one punch's and its
+#: legend beside it (times, or punches); two a row fit the page.
+WIDTH = PLOT_WIDTH + 120
 
 
 def refuse_single_punch_options(check: Mapping[str, Any] | None, calibration: Any) -> None:
@@ -146,7 +147,7 @@ def punches_sections(result: PunchesSolution, time: float | None = None) -> list
                            tone="bad" if failed else "good"))
     for k, punch in enumerate(punches):
         view = local_view(punch)
-        rows = [(f"at t = {_number(t)} d", _at_time(punch, k_t)),
+        rows = [("zone", _zone(punch)), (f"at t = {_number(t)} d", _at_time(punch, k_t)),
                 *key_numbers(view, time, origin=punch.center),
                 ("flags", ", ".join(punch.flags) or "none")]
         out.append(Section(f"Results: {_name(k, punch)}", rows=rows,
@@ -210,15 +211,18 @@ def surface_overlay(result: PunchesSolution, time: float | None = None) -> Any:
                  for i, (j, (x, q)) in enumerate(zip(picked, curves, strict=True))]
     return hv.Overlay(elements).opts(
         title=surface_title(result), xlabel=x_dim.pprint_label, ylabel=q_dim.pprint_label,
-        width=SURFACE_WIDTH, height=PLOT_HEIGHT, legend_position="right", backend="bokeh")
+        width=WIDTH, height=PLOT_HEIGHT, legend_position="right", backend="bokeh")
 
 
 def surface_title(result: PunchesSolution) -> str:
-    """The title of the q(x) plot over the surface: the punches' zones."""
-    zones = ", ".join(f"punches[{k}] {_number(p.center - p.scene.half_width)} to "
-                      f"{_number(p.center + p.scene.half_width)} m"
-                      for k, p in enumerate(result.punches))
-    return f"contact pressure q(x, t) over the surface (zones shaded: {zones})"
+    """The title of the q(x) plot over the surface (the zones are in each punch's
+    results)."""
+    return f"contact pressure q(x, t), {len(result.punches)} punches (zones shaded)"
+
+
+def _zone(punch: PunchSolution) -> str:
+    a = punch.scene.half_width
+    return f"x = {_number(punch.center - a)} to {_number(punch.center + a)} m (shaded in q(x))"
 
 
 def history_overlay(result: PunchesSolution, name: str, symbol: str, si_unit: str) -> Any:
@@ -232,7 +236,7 @@ def history_overlay(result: PunchesSolution, name: str, symbol: str, si_unit: st
               .opts(color=PUNCH_COLOURS[k % len(PUNCH_COLOURS)], tools=["hover"],
                     backend="bokeh")
               for k, p in enumerate(result.punches)]
-    return hv.Overlay(curves).opts(title=f"{name} {symbol}(t)", width=PLOT_WIDTH,
+    return hv.Overlay(curves).opts(title=f"{name} {symbol}(t)", width=WIDTH,
                                    height=PLOT_HEIGHT, legend_position="right",
                                    backend="bokeh")
 

@@ -116,8 +116,8 @@ def test_the_fe_check_and_a_back_analysis_are_refused(pair: PunchesSolution) -> 
 def test_the_html_draws_the_surface_and_a_line_per_punch(pair: PunchesSolution) -> None:
     text = report_html(pair, time=30)
     assert text.startswith("<!DOCTYPE html>") and text.endswith("</html>")
-    assert ("contact pressure q(x, t) over the surface (zones shaded: punches[0] -2.5 to "
-            "-0.5 m, punches[1] 0.9 to 2.1 m)") in text
+    assert "contact pressure q(x, t), 2 punches (zones shaded)" in text
+    assert "<td>zone</td><td>x = 0.9 to 2.1 m (shaded in q(x))</td>" in text
     j = int(np.argmin(np.abs(pair.times - 30)))
     assert f'"t = {core.report.inputs.number(pair.times[j])} d"' in text  # the chosen time
     # the plots' titles (Bokeh's JSON escapes the Greek letters)
