@@ -3,9 +3,10 @@
     python benchmarks/work_precision.py            # full report (about 17 minutes)
     python benchmarks/work_precision.py --quick    # reduced sweeps (about 30 s)
 
-For every scene of :mod:`tests.support.scenes`: the error against a tight reference on the
-x axis, the run time on the y axis (log-log), one curve per method swept over its
-resolution:
+For every scene of :mod:`tests.support.scenes`, and two punches on one base
+(:mod:`benchmarks.work_precision_punches`, ``core.solve`` over ``solver.tol``): the error
+against a tight reference on the x axis, the run time on the y axis (log-log), one curve
+per method swept over its resolution:
 
 * projection over the number of modes (fixed ``n_modes``), one curve per basis kind the
   solver accepts (global, piecewise and graded when present), and over ``tol`` (adaptive);
@@ -51,6 +52,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from benchmarks import work_precision_punches as punches  # noqa: E402
 from core.cache import clear_caches  # noqa: E402
 from core.engines.collocation.solve import solve_collocation  # noqa: E402
 from core.solver import solve_dimensionless  # noqa: E402
@@ -379,6 +381,42 @@ def sweep_scene(scene: Scene, plan: Plan, log: Callable[[str], None]) -> dict[st
     return {"scene": scene, "reference": ref, "runs": runs}
 
 
+def two_punch_result(plan: Plan, log: Callable[[str], None]) -> dict[str, Any]:
+    """The two-punch entry (:mod:`benchmarks.work_precision_punches`): ``core.solve`` over
+    ``solver.tol`` against the scene at the tightest tol, cold and warm."""
+    import core
+
+    t0 = time.perf_counter()
+    best = core.solve(punches.scene(punches.REFERENCE_TOL))
+    seconds = time.perf_counter() - t0
+    nodes = " + ".join(str(p.info["n_nodes"]) for p in best.punches)
+    how = (f"core.solve at tol={punches.REFERENCE_TOL:.0e}: {nodes} nodes, estimate "
+           f"{best.info['error_estimate']:.1e}, {seconds:.1f} s")
+    check = core.solve(punches.scene(punches.CHECK_TOL))
+    # no second method solves several punches: the check is the engine's own convergence
+    ref = Reference(best, how, [(f"core.solve at tol={punches.CHECK_TOL:.0e} "
+                                 "(self-convergence)", punches.errors(check, best))], seconds)
+    log(f"[{punches.KEY}] reference: {how}; tol={punches.CHECK_TOL:.0e} agrees to "
+        f"{ref.agreement_max:.1e}")
+    runs = []
+    for tol in punches.QUICK_TOLS if plan.quick else punches.TOLS:
+        result, cold, repeats = timed(lambda tol=tol: core.solve(punches.scene(tol)),
+                                      plan.timing, before=lambda _k: clear_caches())
+        core.solve(punches.scene(tol))  # fill the caches for this scene
+        counter = iter(range(1, 10**6))
+        _, warm, _ = timed(lambda tol=tol, counter=counter: core.solve(
+            punches.scene(tol, 1.0 + 1e-3 * next(counter))), plan.timing)
+        run = Run(punches.KEY, punches.CURVE, f"tol={tol:.0e}", punches.errors(result, best),
+                  cold, warm, repeats,
+                  n_nodes=sum(int(p.info["n_nodes"]) for p in result.punches),
+                  estimate=float(result.info["error_estimate"]),
+                  success=bool(result.info["success"]), flags=list(result.flags))
+        log(f"  {run.curve:<34} {run.setting:<38} err {run.error:8.1e}  "
+            f"cold {cold * 1e3:9.2f} ms  warm {warm * 1e3:9.2f} ms")
+        runs.append(run)
+    return {"scene": punches.PunchesEntry(), "reference": ref, "runs": runs}
+
+
 # ----------------------------------------------------------------------------- goals
 
 
@@ -680,7 +718,11 @@ def summary_table(results: list[dict[str, Any]]) -> list[str]:
             f"{min(r.error for r in proj):.1e} | {fmt_ms(bpc.cold) if bpc else 'not reached'} | "
             f"{fmt_ms(bpw.warm) if bpw else 'not reached'} | "
             f"{min(r.error for r in coll):.1e} | {fmt_ms(bcc.cold) if bcc else 'not reached'} | "
-            f"{'-' if ratio is None else f'{ratio:.1f}x ({level})'} |")
+            f"{'-' if ratio is None else f'{ratio:.1f}x ({level})'} |" if coll else
+            # no collocation solver of several punches
+            f"| {res['scene'].key} | {res['reference'].agreement_max:.1e} | "
+            f"{min(r.error for r in proj):.1e} | {fmt_ms(bpc.cold) if bpc else 'not reached'} | "
+            f"{fmt_ms(bpw.warm) if bpw else 'not reached'} | - | - | - |")
     lines.append("")
     return lines
 
@@ -809,15 +851,16 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{time.perf_counter() - started:7.1f}s {text}", flush=True)
 
     scenes = suite()
+    with_punches = not args.scenes or punches.KEY in args.scenes
     if args.scenes:
-        unknown = set(args.scenes) - {s.key for s in scenes}
+        unknown = set(args.scenes) - {s.key for s in scenes} - {punches.KEY}
         if unknown:
             parser.error(f"unknown scenes: {', '.join(sorted(unknown))}")
         scenes = [s for s in scenes if s.key in args.scenes]
     if args.quick:
         scenes = [quick_scene(s) for s in scenes]
     log(f"basis kinds: {', '.join(plan.kinds)} (default {plan.default}); "
-        f"{len(scenes)} scenes")
+        f"{len(scenes) + with_punches} scenes")
     results = []
     aging100: list[Run] = []
     for scene in scenes:
@@ -826,6 +869,10 @@ def main(argv: list[str] | None = None) -> int:
         plot_scene(res, out / f"{scene.key}.png")
         if scene.key == "aging_creep":
             aging100 = aging_100_runs(scene, res["reference"], plan, log)
+    if with_punches:
+        res = two_punch_result(plan, log)
+        results.append(res)
+        plot_scene(res, out / f"{punches.KEY}.png")
     command = "python benchmarks/work_precision.py" + "".join(
         " " + shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv))
     elapsed = time.perf_counter() - started

@@ -12,7 +12,9 @@ Schema of the files); ``--version``. A scene or study argument may name a shippe
 :meth:`core.scene.SceneSolution.to_dict`, with the contact set per time and the design
 check; ``.csv``: the histories of settlement, tilt, force and moment, and the contact
 zones when the punch lifts off) and optionally the pressure ``q(x, t)`` to
-``--pressure-csv``; without ``--output`` it prints a short summary. Every file records
+``--pressure-csv``; without ``--output`` it prints a short summary. A scene of several
+punches is written the same way, every punch in one file (columns ``punches[k].*``, q
+over the whole surface in the global x), its design check and flags per punch. Every file records
 the program's version, the scene and the solver settings (:mod:`core.scene.records`:
 top-level keys of the JSON, ``# key: value`` lines before a CSV table). ``-`` as the
 scene reads it from standard input, ``-`` as an output writes it to standard output
@@ -227,6 +229,7 @@ def _punches_summary(result: PunchesSolution) -> str:
     last times, its largest pressure, estimate and flags."""
     lines = [f"solved {_describe(result.scene)}"]
     rows = sorted({0, result.times.size - 1})
+    checks = result.design_checks()
     for k, punch in enumerate(result.punches):
         lines.append(f"punches[{k}] at x = {punch.center:g} m (half-width "
                      f"{punch.scene.half_width:g} m, statement {punch.scene.statement}):")
@@ -241,6 +244,10 @@ def _punches_summary(result: PunchesSolution) -> str:
                      f"{punch.center + punch.x[i]:.6g} m, t = {result.times[t]:.6g} days")
         lines.append(f"  {punch.info.get('message', '')}")
         lines.append(f"  flags: {', '.join(punch.flags) if punch.flags else 'none'}")
+        if checks[k] is not None:
+            lines.append(f"  design check (whole history): "
+                         f"{'pass' if checks[k].passed else 'FAIL'}")
+            lines.extend(f"    {line.describe()}" for line in checks[k].checks)
     lines.append(f"coating model: {result.info.get('coating_model')}")
     return "\n".join(lines)
 
@@ -276,22 +283,28 @@ def _summary(result: SceneSolution) -> str:
     return "\n".join(lines)
 
 
-def _csv_head(result: SceneSolution, what: str) -> str:
+def _csv_head(result: SceneSolution | PunchesSolution, what: str) -> str:
     """The ``#`` lines before a CSV table of ``result``: what it is, the version, the
-    scene, the solver settings, the answer's accuracy and flags."""
+    scene, the solver settings, the answer's accuracy and flags (and design checks: one
+    per punch of several)."""
     info = result.info
     estimate = info.get("error_estimate")
+    several = isinstance(result, PunchesSolution)
+    contact = ", ".join(sorted({str(p.info.get("contact", "full")) for p in result.punches})) \
+        if several else info.get("contact", "full")
     lines = [f"# coated-punch {VERSION}: {what}",
              f"# scene: {_one_line(result.scene.name)}",
              *provenance_lines(result.scene),
-             f"# answered: contact {info.get('contact', 'full')}, coating model "
+             f"# answered: contact {contact}, coating model "
              f"{info.get('coating_model', '')}, estimated relative error "
              + (f"{float(estimate):.1e}" if isinstance(estimate, (int, float)) else "n/a")]
     lines.append("# flags: " + (", ".join(result.flags) or "none"))
-    check = result.design_check()
-    if check is not None:
-        lines.append(f"# design_check: {'pass' if check.passed else 'FAIL'}; "
-                     + "; ".join(line.describe() for line in check.checks))
+    checks = [(f"punches[{k}] ", c) for k, c in enumerate(result.design_checks())] \
+        if several else [("", result.design_check())]
+    for who, check in checks:
+        if check is not None:
+            lines.append(f"# {who}design_check: {'pass' if check.passed else 'FAIL'}; "
+                         + "; ".join(line.describe() for line in check.checks))
     return "\n".join(lines) + "\n"
 
 
@@ -415,21 +428,48 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
 def _solved_punches(args: argparse.Namespace, result: PunchesSolution, output: Path | None,
                     fmt: str | None, pressure_out: Path | None) -> int:
-    """``solve`` of a scene of several punches: the summary, or the answer as JSON."""
-    if fmt == "csv" or pressure_out is not None:
-        raise _InputError(f"{'--output' if fmt == 'csv' else '--pressure-csv'}: a scene of "
-                          "several punches is written as JSON (--output answer.json) for now")
+    """``solve`` of a scene of several punches: the summary, or the answer as JSON or
+    CSV (the histories of every punch), and q over the whole surface."""
     if output is None:
         print(_punches_summary(result))
-    else:
+    elif fmt == "json":
         _write(output, result.to_json() + "\n")
-    for k, punch in enumerate(result.punches):
+    else:
+        _write(output, _csv_head(result, "histories of every punch (python -m core solve)")
+               + result.to_csv())
+    if pressure_out is not None:
+        _write(pressure_out, _csv_head(result, "contact pressure q(x, t) over the surface, "
+                                               "x global (python -m core solve)")
+               + result.pressure_csv())
+    _punches_warnings(result)
+    return _punches_strict(result) if args.strict else EXIT_OK
+
+
+def _punches_warnings(result: PunchesSolution) -> None:
+    """The flags and the exceeded limits of every punch as ``warning: punches[k].<flag>:
+    ...`` and ``warning: punches[k].design_check: ...`` lines on stderr."""
+    for k, (punch, check) in enumerate(zip(result.punches, result.design_checks(),
+                                           strict=True)):
         for name in punch.flags:
             print(f"warning: punches[{k}].{name}: {_one_line(punch.flag_messages[name])}",
                   file=sys.stderr)
-    if args.strict and result.flags:
+        for line in check.failures if check is not None else ():
+            print(f"warning: punches[{k}].design_check: {_one_line(line.describe())}",
+                  file=sys.stderr)
+
+
+def _punches_strict(result: PunchesSolution) -> int:
+    """The exit code of ``--strict`` for several punches, as :func:`_strict_verdict`: a
+    flag of any punch, else a limit any punch exceeds."""
+    if result.flags:
         return _strict_exit(f"the answer is flagged ({', '.join(result.flags)})",
                             EXIT_FLAGGED)
+    checks = list(enumerate(result.design_checks()))
+    failed = [f"punches[{k}].{line.limit_name or line.quantity}" for k, check in checks
+              if check is not None for line in check.failures]
+    if failed:
+        return _strict_exit(f"the design check failed ({', '.join(failed)})",
+                            EXIT_DESIGN_FAILED)
     return EXIT_OK
 
 
@@ -443,9 +483,6 @@ def _cmd_report(args: argparse.Namespace) -> int:
     result = _solve(args.scene)
     if result is None:
         return EXIT_SOLVER_FAILED
-    if isinstance(result, PunchesSolution):
-        raise _InputError(f"{args.scene}: a report of several punches is not written yet; "
-                          "use python -m core solve (its summary or --output answer.json)")
     # imported here: the report loads HoloViews and Bokeh (or Matplotlib), ~2 s
     from core.report import output_index, report_html, report_pdf
 
@@ -453,6 +490,14 @@ def _cmd_report(args: argparse.Namespace) -> int:
         output_index(result, args.time)
     except ValueError as exc:
         raise _InputError(f"--{exc}") from None
+    if isinstance(result, PunchesSolution):
+        if args.fe_check:
+            raise _InputError("--fe-check: the finite-element check is of one punch; run "
+                              "it on each punch's own scene")
+        _write(output, report_pdf(result, args.time) if fmt == "pdf"
+               else report_html(result, args.time))
+        _punches_warnings(result)
+        return _punches_strict(result) if args.strict else EXIT_OK
     fe_check = None
     if args.fe_check:
         from core.scene import check_scene  # here for start-up speed: the FE modules

@@ -8,7 +8,10 @@
 
 What it says is in ``content`` (the sections), ``inputs`` (the scene's inputs in
 engineering units) and ``contact`` (the contact zone at a chosen time, lift-off); its
-plots are one HoloViews layout (``plots``) that ``html`` and ``pdf`` print. Every
+plots are one HoloViews layout (``plots``) that ``html`` and ``pdf`` print. A scene of
+several punches (:class:`core.scene.PunchesSolution`) is reported by the same functions,
+its sections and plots made in ``punches`` (a results section per punch, q(x) over the
+whole surface, the histories with a line per punch). Every
 function takes an optional ``time`` [day after loading]: the output time nearest to it is
 the one whose contact the report describes and whose q(x) it draws (default: the last).
 

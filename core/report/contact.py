@@ -84,15 +84,17 @@ def _runs_below_zero(x: np.ndarray, q: np.ndarray) -> list[tuple[float, float]]:
             for i, j in zip(starts.tolist(), ends.tolist(), strict=True)]
 
 
-def contact_text(result: SceneSolution, k: int) -> str:
+def contact_text(result: SceneSolution, k: int, origin: float = 0.0) -> str:
     """The contact at ``times[k]`` in plain words, lengths in m, e.g. "contact 1.306 m of
-    2 m (65 %), lifted 0.694 m: x = -1 to -0.306 m (unilateral contact)"."""
+    2 m (65 %), lifted 0.694 m: x = -1 to -0.306 m (unilateral contact)"; positions are
+    ``origin + x`` [m] (a punch of several: its centre, so that they read in the global x)."""
     full = 2 * result.scene.half_width
     parts = lifted_parts(result, k)
     if not parts:
         return f"full contact: the whole width 2a = {_metres(full)} m touches"
     width = full - sum(hi - lo for lo, hi in parts)
-    where = ", ".join(f"x = {_metres(lo)} to {_metres(hi)} m" for lo, hi in parts)
+    where = ", ".join(f"x = {_metres(origin + lo)} to {_metres(origin + hi)} m"
+                      for lo, hi in parts)
     if result.contact_lost:
         return (f"contact {_metres(width)} m of {_metres(full)} m "
                 f"({100 * width / full:.0f} %), q < 0 (contact lost, not physical) "

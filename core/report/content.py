@@ -14,7 +14,13 @@ import numpy as np
 from core.report.contact import contact_text, lift_off_times, output_index
 from core.report.inputs import SHOWN_UNITS, input_rows
 from core.report.inputs import number as _number
-from core.scene import SceneSolution, engine_text, flags_with_evidence, model_error_evidence
+from core.scene import (
+    PunchesSolution,
+    SceneSolution,
+    engine_text,
+    flags_with_evidence,
+    model_error_evidence,
+)
 from core.version import VERSION
 
 
@@ -45,10 +51,12 @@ def _shown(value: float, si_unit: str) -> str:
     return f"{_number(value / size)} {unit}"
 
 
-def key_numbers(result: SceneSolution, time: float | None = None) -> list[tuple[str, str]]:
+def key_numbers(result: SceneSolution, time: float | None = None,
+                origin: float = 0.0) -> list[tuple[str, str]]:
     """The results in the units an engineer reads: largest over the history, with when;
     the contact at ``time`` [day] (default: the last output time) and, when the punch
-    lifts off, when it does and the smallest contact width."""
+    lifts off, when it does and the smallest contact width. Positions are ``origin + x``
+    [m] (``x`` from the punch's centre; a punch of several: ``origin`` its centre)."""
     t = result.times
     q = result.pressure_on_grid
     k_max = np.unravel_index(int(np.argmax(q)), q.shape)
@@ -58,7 +66,7 @@ def key_numbers(result: SceneSolution, time: float | None = None) -> list[tuple[
         ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {_number(t_s)} d"),
         ("largest tilt α", f"{_shown(tilt, 'rad')} at t = {_number(t_a)} d"),
         ("largest contact pressure q", f"{_shown(q[k_max], 'Pa')} at x = "
-                                       f"{_number(result.x[k_max[0]])} m, t = "
+                                       f"{_number(origin + result.x[k_max[0]])} m, t = "
                                        f"{_number(t[k_max[1]])} d"),
         ("force P at the last time", _shown(result.force[-1], "N/m")),
         ("moment M at the last time", _shown(result.moment[-1], "N")),
@@ -68,7 +76,7 @@ def key_numbers(result: SceneSolution, time: float | None = None) -> list[tuple[
         rows.append(("eccentricity e = M/P at the last time",
                      f"{_number(float(result.moment[-1]) / force)} m"))
     k = output_index(result, time)
-    rows.append((f"contact at t = {_number(t[k])} d", contact_text(result, k)))
+    rows.append((f"contact at t = {_number(t[k])} d", contact_text(result, k, origin)))
     lifted = lift_off_times(result)
     if lifted.size:
         rows.append(("lift-off", f"at {lifted.size} of {len(t)} output times, first at "
@@ -186,7 +194,7 @@ def calibration_section(calibration: Any) -> Section:
 SERIES_SI = {"settlement": "m", "tilt": "rad"}
 
 
-def sections(result: SceneSolution, time: float | None = None,
+def sections(result: SceneSolution | PunchesSolution, time: float | None = None,
              check: Mapping[str, Any] | None = None,
              calibration: Any = None) -> list[Section]:
     """The report's sections, in order; ``time`` [day after loading]: the output time
@@ -194,13 +202,23 @@ def sections(result: SceneSolution, time: float | None = None,
     ``check``: a :func:`core.scene.check_scene` report; made for this scene, its measured
     coating-model error overrides the estimate (the ``model_error`` flag, the accuracy);
     ``calibration``: a :class:`core.back_analysis.Calibration` of the scene, reported in
-    a section "Back-analysis" after the results.
+    a section "Back-analysis" after the results. Of several punches
+    (:class:`core.scene.PunchesSolution`): :func:`core.report.punches.punches_sections`
+    (a results section per punch; ``check`` and ``calibration`` are of one punch and
+    refused).
 
     Raises
     ------
     ValueError
-        When ``time`` is not within the output times (naming ``time``).
+        When ``time`` is not within the output times (naming ``time``); ``check`` or
+        ``calibration`` given with several punches.
     """
+    if isinstance(result, PunchesSolution):
+        # here, not at the top: the report of several punches builds on this module
+        from core.report.punches import punches_sections, refuse_single_punch_options
+
+        refuse_single_punch_options(check, calibration)
+        return punches_sections(result, time)
     scene = result.scene
     stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     out = [Section("About", rows=[

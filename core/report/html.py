@@ -11,7 +11,7 @@ from typing import Any
 from core.optional import import_optional
 from core.report.content import Section, scene_json, sections
 from core.report.plots import readings_overlay, report_layout
-from core.scene import SceneSolution
+from core.scene import PunchesSolution, SceneSolution
 
 CSS = """
 body {font-family: Helvetica, Arial, sans-serif; font-size: 12px; margin: 18px; color: #222;
@@ -39,7 +39,7 @@ def _section(section: Section) -> str:
     return "".join(parts) + "</section>"
 
 
-def _plots(result: SceneSolution, time: float | None,
+def _plots(result: SceneSolution | PunchesSolution, time: float | None,
            calibration: Any = None) -> tuple[str, str, str]:
     """The plots as (scripts for the page head, the body's markup, the markup of the
     readings over the settlement history: empty without ``calibration``)."""
@@ -54,14 +54,15 @@ def _plots(result: SceneSolution, time: float | None,
     return resources.INLINE.render() + script, divs[0], "".join(divs[1:])
 
 
-def report_html(result: SceneSolution, time: float | None = None,
+def report_html(result: SceneSolution | PunchesSolution, time: float | None = None,
                 check: Mapping[str, Any] | None = None, calibration: Any = None) -> str:
     """The report of ``result`` as a complete HTML document (text).
 
     Parameters
     ----------
-    result : SceneSolution
-        A solved scene; its limits (if the scene sets any) are checked in the report.
+    result : SceneSolution or PunchesSolution
+        A solved scene; its limits (if the scene sets any) are checked in the report (of
+        several punches: under each punch, :mod:`core.report.punches`).
     time : float, optional
         A time t [day after loading] the reader chose: the contact at the output time
         nearest to it is described, and its q(x) drawn (default: the last output time).

@@ -14,7 +14,7 @@ from typing import Any
 from core.optional import import_optional
 from core.report.content import scene_json, sections
 from core.report.plots import matplotlib_layout, report_layout
-from core.scene import SceneSolution
+from core.scene import PunchesSolution, SceneSolution
 
 #: A4 portrait [inch].
 PAGE = (8.27, 11.69)
@@ -24,7 +24,7 @@ CHARACTERS_PER_LINE = 100
 COLOURS = {"bad": "#9b1c1c", "good": "#1d6b2c", "": "#222222"}
 
 
-def _text_lines(result: SceneSolution, time: float | None,
+def _text_lines(result: SceneSolution | PunchesSolution, time: float | None,
                 check: Mapping[str, Any] | None = None,
                 calibration: Any = None) -> list[tuple[str, str, bool]]:
     """(text, tone, bold) lines of the report's sections."""
@@ -57,7 +57,7 @@ def _text_pages(pdf, plt, lines: list[tuple[str, str, bool]], size: float = 8.5)
         plt.close(figure)
 
 
-def report_pdf(result: SceneSolution, time: float | None = None,
+def report_pdf(result: SceneSolution | PunchesSolution, time: float | None = None,
                check: Mapping[str, Any] | None = None, calibration: Any = None) -> bytes:
     """The report of ``result`` as PDF bytes (the sections, the plots, the scene file).
 
@@ -107,7 +107,7 @@ def report_pdf(result: SceneSolution, time: float | None = None,
     return buffer.getvalue()
 
 
-def write_report(result: SceneSolution, path: str | os.PathLike,
+def write_report(result: SceneSolution | PunchesSolution, path: str | os.PathLike,
                  time: float | None = None, check: Mapping[str, Any] | None = None,
                  calibration: Any = None) -> None:
     """Write the report of ``result`` to ``path``: PDF for a ``.pdf`` name, else HTML

@@ -18,6 +18,7 @@ from core.report.contact import lift_off_times, output_index
 from core.report.inputs import LAYER_FIELDS, SHAPE_UNIT
 from core.scene import (
     LIFT_OFF_COLOUR,
+    PunchesSolution,
     SceneSolution,
     holoviews_for_bokeh,
     known_contact_width,
@@ -37,6 +38,12 @@ PLOT_WIDTH, PLOT_HEIGHT = 400, 300
 PLOT_TITLES = ("contact pressure q(x, t) (grey: lifted off)", "settlement δ(t)", "tilt α(t)")
 #: Points of the geometry plots over [-a, a], besides both sides of every breakpoint.
 GEOMETRY_POINTS = 801
+#: The colours of the punches of several, in order (a line per punch in the histories).
+PUNCH_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2",
+                 "#17becf", "#7f7f7f")
+#: The shade of a punch's zone in the q(x) plot over the surface of several punches, and
+#: the group that tells its spans from the lift-off shade.
+ZONE_COLOUR, ZONE_GROUP = "#c6dbef", "Zone"
 
 
 def contact_overlay(result: SceneSolution) -> Any:
@@ -97,12 +104,19 @@ def geometry_curves(result: SceneSolution) -> list[tuple[str, Any]]:
     return out
 
 
-def report_layout(result: SceneSolution, time: float | None = None) -> tuple[Any, list[str]]:
+def report_layout(result: SceneSolution | PunchesSolution,
+                  time: float | None = None) -> tuple[Any, list[str]]:
     """The report's plots as one ``holoviews.Layout`` (two a row, for a printed page) and
     their titles in order (what the PDF writes over them).
 
-    ``time`` [day after loading]: its output time is drawn among the q(x) curves.
+    ``time`` [day after loading]: its output time is drawn among the q(x) curves. Of
+    several punches: :func:`core.report.punches.punches_layout`.
     """
+    if isinstance(result, PunchesSolution):
+        # here, not at the top: the punches' plots build on this module
+        from core.report.punches import punches_layout
+
+        return punches_layout(result, time)
     holoviews_for_bokeh("the report's plots")
     k = output_index(result, time)
     picked = shown_times(result.times)
@@ -119,18 +133,28 @@ def report_layout(result: SceneSolution, time: float | None = None) -> tuple[Any
 
 def matplotlib_layout(layout: Any) -> Any:
     """``layout`` styled for HoloViews' Matplotlib backend (registered by the caller): the
-    lift-off shading, the contact and the geometry curves in the colours of the HTML
-    report."""
+    lift-off shading and the zones of several punches, the contact and the geometry
+    curves and a punch's line of several in the colours of the HTML report."""
     hv = holoviews_for_bokeh("the report's plots")
-    by_label = dict(CONTACT_CURVES)
+    by_label = dict(CONTACT_CURVES) | {f"punches[{k}]": colour
+                                       for k, colour in enumerate(PUNCH_COLOURS)}
     by_value = {name: colour for name, _, colour in GEOMETRY_PLOTS}
 
     def colour(curve: Any) -> str | None:
         return by_label.get(curve.label) or by_value.get(curve.vdims[0].name)
 
-    layout = layout.map(lambda span: span.opts(
-        color=LIFT_OFF_COLOUR, facecolor=LIFT_OFF_COLOUR, alpha=0.5, backend="matplotlib"),
-        hv.VSpan)
+    def shade(span: Any) -> Any:
+        tone = ZONE_COLOUR if span.group == ZONE_GROUP else LIFT_OFF_COLOUR
+        return span.opts(color=tone, facecolor=tone, alpha=0.5, backend="matplotlib")
+
+    def labels(overlay: Any) -> Any:
+        # an overlay's axis labels are Bokeh options (its first element, a span, would
+        # name them x and y): the same words here
+        given = overlay.opts.get("plot", backend="bokeh").kwargs
+        named = {k: given[k] for k in ("xlabel", "ylabel") if k in given}
+        return overlay.opts(**named, backend="matplotlib") if named else overlay
+
+    layout = layout.map(labels, hv.Overlay).map(shade, hv.VSpan)
     return layout.map(lambda curve: curve.opts(color=colour(curve), backend="matplotlib"),
                       lambda item: isinstance(item, hv.Curve) and colour(item) is not None)
 

@@ -51,7 +51,13 @@ from core.scene.json_schema import (
 )
 from core.scene.model import Scene
 from core.scene.pipeline import solve
-from core.scene.plotting import LIFT_OFF_COLOUR, holoviews_for_bokeh, shown_times
+from core.scene.plotting import (
+    LIFT_OFF_COLOUR,
+    holoviews_for_bokeh,
+    pressure_unit,
+    shown_times,
+    time_colours,
+)
 from core.scene.punches import (
     PunchesScene,
     PunchesSolution,
@@ -117,6 +123,7 @@ __all__ = [
     "MAX_SCENE_BYTES",
     "migrate",
     "plotting_grid",
+    "pressure_unit",
     "provenance",
     "provenance_lines",
     "has_punches",
@@ -135,6 +142,7 @@ __all__ = [
     "SCHEMA_FILES",
     "SCHEMA_IDS",
     "SCHEMA_KEY",
+    "time_colours",
     "schema_errors",
     "schema_text",
     "scene_model_error",

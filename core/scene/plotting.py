@@ -58,6 +58,14 @@ def pressure_unit(q_max: float) -> tuple[str, float]:
     return PRESSURE_UNITS[-1]
 
 
+def time_colours(count: int) -> list[str]:
+    """The colours of ``count`` q(x) curves, early to late (:data:`TIME_COLOURS` without
+    its palest end)."""
+    from holoviews.plotting.util import process_cmap
+
+    return process_cmap(TIME_COLOURS, count + 1)[:count]
+
+
 def shown_times(times: np.ndarray, count: int = PLOT_CURVES,
                 wanted: Sequence[float] | None = None) -> np.ndarray:
     """Indices of the output times to draw: the ones nearest to ``wanted`` [day], else
@@ -85,12 +93,10 @@ def pressure_overlay(result: SceneSolution, count: int = PLOT_CURVES,
                      times: Sequence[float] | None = None) -> holoviews.Overlay:
     """q(x) [kPa or MPa] against x [m] at some of the output times, coloured by time."""
     hv = holoviews_for_bokeh()
-    from holoviews.plotting.util import process_cmap
-
     picked = shown_times(result.times, count, times)
     q = result.pressure_on_grid[:, picked]
     unit, size = pressure_unit(float(np.max(np.abs(q))) if q.size else 0.0)
-    colours = process_cmap(TIME_COLOURS, len(picked) + 1)[:len(picked)]
+    colours = time_colours(len(picked))
     x_dim = hv.Dimension("x", label="x", unit="m")
     q_dim = hv.Dimension("q", label="q", unit=unit)
     curves = [hv.Curve((result.x, q[:, j] / size), kdims=[x_dim], vdims=[q_dim],

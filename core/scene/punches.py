@@ -35,7 +35,8 @@ from core.contact import solve_unilateral_punches
 from core.engines.nystrom import PunchGeometry, solve_punches
 from core.problem import TimeInputs, validate_geometry, validate_time_inputs
 from core.profiles import shifted
-from core.scene import schema
+from core.scene import punches_output, schema
+from core.scene.design import DesignCheck, DesignLimits
 from core.scene.model import Scene
 from core.scene.results import SceneSolution
 from core.validation import bounded_list, finite_number
@@ -314,6 +315,40 @@ class PunchesSolution:
     def to_json(self) -> str:
         """:meth:`to_dict` as compact JSON text."""
         return json.dumps(self.to_dict(), separators=(",", ":"), allow_nan=False)
+
+    def to_csv(self) -> str:
+        """The histories of every punch as CSV: ``time_day``, then ``punches[k].settlement_m``,
+        ``punches[k].tilt_rad``, ``punches[k].force_N_per_m``, ``punches[k].moment_N`` for
+        each punch in order (:func:`core.scene.punches_output.histories_csv`)."""
+        return punches_output.histories_csv(self)
+
+    def pressure(self, x: Any) -> np.ndarray:
+        """Contact pressure q [Pa] at points ``x`` [m] of the global x, shape (len(x),
+        len(times)): each punch's q on its zone, 0 on the free surface between them."""
+        return punches_output.surface_pressure(self, x)
+
+    @property
+    def x(self) -> np.ndarray:
+        """The plotting points of the whole surface [m, global x]: every punch's grid about
+        its centre, punches in order along x (the free surface between them left out)."""
+        return punches_output.surface_x(self)
+
+    @property
+    def pressure_on_grid(self) -> np.ndarray:
+        """q [Pa] at :attr:`x`, shape (len(x), len(times))."""
+        return punches_output.surface_pressure_on_grid(self)
+
+    def pressure_csv(self, x: Any = None) -> str:
+        """q(x, t) over the whole surface as CSV in long form: ``time_day``, ``x_m`` (the
+        global x), ``pressure_Pa``; by default on :attr:`x` (rows on the contact zones
+        only: q = 0 between the punches), else at the points ``x`` [m]."""
+        return punches_output.pressure_csv(self, x)
+
+    def design_checks(self, limits: DesignLimits | None = None) -> list[DesignCheck | None]:
+        """The design check of every punch, in order, over the whole history against
+        ``limits`` [Pa, m, rad] (default: the scene's ``limits``), positions in the global
+        x [m]; None for each when neither gives a limit."""
+        return punches_output.design_checks(self, limits)
 
     def __repr__(self) -> str:
         return (f"PunchesSolution({len(self.punches)} punches, {self.times.size} times, "

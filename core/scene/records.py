@@ -18,28 +18,40 @@ from core.version import VERSION
 
 if TYPE_CHECKING:
     from core.scene.model import Scene
+    from core.scene.punches import PunchesScene
 
 #: The program's name in the files it writes.
 PROGRAM = "coated-punch"
 
 
-def solver_settings(scene: Scene | Mapping[str, Any]) -> dict[str, Any]:
+def _validated(scene: Scene | PunchesScene | Mapping[str, Any]) -> Scene | PunchesScene:
+    """``scene`` validated, of either form (one punch, or ``punches``)."""
+    # here, not at the top: core.scene.punches builds on the results, which import this
+    from core.scene.punches import has_punches, punches_from_dict
+
+    return punches_from_dict(scene) if has_punches(scene) else scene_from_dict(scene)
+
+
+def solver_settings(scene: Scene | PunchesScene | Mapping[str, Any]) -> dict[str, Any]:
     """The solver settings of a scene, defaults filled in: ``tol`` and ``model_tol`` [-],
-    ``contact`` (``"auto"``, ``"full"`` or ``"unilateral"``)."""
-    scene = scene_from_dict(scene)
-    return {"tol": scene.tol, "model_tol": scene.model_tol, "contact": scene.contact}
+    ``contact`` (``"auto"``, ``"full"`` or ``"unilateral"``); of several punches, the
+    settings they share."""
+    scene = _validated(scene)
+    # the punches of one scene share its solver section
+    first = scene.scenes[0] if hasattr(scene, "scenes") else scene
+    return {"tol": first.tol, "model_tol": first.model_tol, "contact": first.contact}
 
 
-def provenance(scene: Scene | Mapping[str, Any]) -> dict[str, Any]:
+def provenance(scene: Scene | PunchesScene | Mapping[str, Any]) -> dict[str, Any]:
     """``program``, ``version`` (``core.__version__``) and ``solver`` (the settings) of a
     file written for ``scene``."""
     return {"program": PROGRAM, "version": VERSION, "solver": solver_settings(scene)}
 
 
-def provenance_lines(scene: Scene | Mapping[str, Any]) -> list[str]:
+def provenance_lines(scene: Scene | PunchesScene | Mapping[str, Any]) -> list[str]:
     """The ``#`` lines of a CSV file written for ``scene``: ``version``, ``scene_json``
     (the canonical scene, one line of JSON) and ``solver`` (the settings, JSON)."""
-    scene = scene_from_dict(scene)
+    scene = _validated(scene)
     compact = {"separators": (",", ":"), "allow_nan": False}
     return [f"# version: {VERSION}",
             f"# scene_json: {json.dumps(scene.to_dict(), **compact)}",

@@ -308,23 +308,10 @@ class SceneSolution:
         length [m] and the ends of each zone [m] (``zone1_start_m, zone1_end_m, ...``,
         ``nan`` where a time has fewer zones).
         """
-        header = "time_day,settlement_m,tilt_rad,force_N_per_m,moment_N"
-        zones = max((len(z) for z in self.contact_set), default=0)
-        unilateral = self.info.get("contact") == "unilateral"
-        widths = self.contact_width
-        if unilateral:
-            header += ",contact_length_m" + "".join(
-                f",zone{k + 1}_start_m,zone{k + 1}_end_m" for k in range(zones))
-        lines = [header]
-        for k, row in enumerate(zip(self.times, self.settlement, self.tilt, self.force,
-                                    self.moment, strict=True)):
-            values = [float(v) for v in row]
-            if unilateral:
-                current = self.contact_set[k]
-                values.append(widths[k])
-                for j in range(zones):
-                    values.extend(current[j] if j < len(current) else (math.nan, math.nan))
-            lines.append(",".join(repr(float(v)) for v in values))
+        names, columns = history_columns(self)
+        lines = ["time_day," + ",".join(names)]
+        lines.extend(",".join(repr(float(v)) for v in (t, *row))
+                     for t, row in zip(self.times, zip(*columns, strict=True), strict=True))
         return "\n".join(lines) + "\n"
 
     def pressure_csv(self, x: Any = None) -> str:
@@ -346,6 +333,31 @@ class SceneSolution:
         if limits is None or limits.empty:
             return None
         return design_check(self, limits)
+
+
+def history_columns(result: SceneSolution, prefix: str = ""
+                    ) -> tuple[list[str], list[list[float]]]:
+    """The columns of :meth:`SceneSolution.to_csv` after the time: their names (each
+    starting with ``prefix``) and their values over ``result.times``.
+
+    Settlement [m], tilt [rad], force [N/m], moment [N]; when the unilateral contact model
+    answered, the contact length [m] and the ends of each zone [m] (``zone1_start_m``,
+    ``zone1_end_m``, ...; ``nan`` where a time has fewer zones), in the coordinates of
+    ``result.contact_set``.
+    """
+    names = [f"{prefix}{name}" for name in
+             ("settlement_m", "tilt_rad", "force_N_per_m", "moment_N")]
+    columns = [[float(v) for v in getattr(result, q)] for q in QUANTITIES]
+    if result.info.get("contact") == "unilateral":
+        zones = max((len(z) for z in result.contact_set), default=0)
+        names.append(f"{prefix}contact_length_m")
+        columns.append([float(w) for w in result.contact_width])
+        for j in range(zones):
+            names += [f"{prefix}zone{j + 1}_start_m", f"{prefix}zone{j + 1}_end_m"]
+            for end in range(2):
+                columns.append([float(zones_k[j][end]) if j < len(zones_k) else math.nan
+                                for zones_k in result.contact_set])
+    return names, columns
 
 
 def _check_finite(result: SceneSolution) -> None:

@@ -22,7 +22,14 @@ from typing import Any
 
 import numpy as np
 
-from core.scene import LARGE_TILT, Scene, replace_loads, scene_from_dict, solve
+from core.scene import (
+    LARGE_TILT,
+    PunchesSolution,
+    Scene,
+    replace_loads,
+    scene_from_dict,
+    solve,
+)
 from core.study.definition import apply_point
 from core.study.liftoff import (
     FAMILY_MIN_ECCENTRICITIES,
@@ -143,7 +150,11 @@ def _scaled(answer: tuple[float, np.ndarray, float, list[str], float], force: fl
 def _kept_answer(result: Any, outputs: Sequence[str]
                  ) -> tuple[float, np.ndarray, float, list[str], float]:
     """What a solved point keeps to answer the points of its eccentricity: its force
-    [N/m], outputs, error estimate, flags and largest |tilt| [rad]."""
+    [N/m], outputs, error estimate, flags and largest |tilt| [rad] (of several punches,
+    whose points are never scaled, NaN for the force and the tilt)."""
+    if isinstance(result, PunchesSolution):
+        return (np.nan, point_outputs(result, outputs),
+                float(result.info.get("error_estimate", np.nan)), list(result.flags), np.nan)
     tilt = max(float(np.max(np.abs(result.tilt))) if result.tilt.size else 0.0,
                float(result.info.get("max_abs_tilt", 0.0)))
     force = result.scene.loading.get("force")

@@ -34,9 +34,13 @@ from core.presets import shipped_file
 from core.scene import (
     MAX_SCENE_BYTES,
     SCHEMA_KEY,
+    PunchesScene,
+    Scene,
     check_fields,
+    has_punches,
     integer_in_range,
     load_scene,
+    punches_from_dict,
     read_scene_json,
     scene_from_dict,
 )
@@ -60,6 +64,8 @@ OUTPUT_UNITS: dict[str, str] = {
     "q_min": "Pa",
     "contact_width": "m",
 }
+#: An output of one punch of several: ``punches[k].<output>`` (k as the scene file's).
+PUNCH_OUTPUT = re.compile(r"punches\[(\d{1,4})\]\.([a-z_]+)")
 GRID_KINDS = ("values", "linspace", "logspace")
 DISTRIBUTIONS = ("normal", "lognormal", "uniform")
 #: Whole subtrees a study may not vary: the output times are the study's own axis, and
@@ -68,7 +74,7 @@ FIXED_ROOTS = ("schema_version", "name", "description", "times", "limits")
 #: Units of the numeric scene fields, by the last name of their path (the units of a
 #: varied or fitted field; the design codes' creep inputs are in the codes' units).
 FIELD_UNITS: dict[str, str] = {
-    "half_width": "m", "thickness": "m", "modulus": "Pa", "modulus_final": "Pa",
+    "half_width": "m", "center": "m", "thickness": "m", "modulus": "Pa", "modulus_final": "Pa",
     "poisson": "1", "age_at_loading": "day", "force": "N/m", "moment": "N",
     "settlement": "m", "tilt": "rad", "tol": "1", "rate": "1/day", "compliance": "1/Pa",
     "compliance_final": "1/Pa", "aging": "day/Pa", "relative_humidity": "%",
@@ -185,6 +191,13 @@ def get_field(scene: Mapping[str, Any], path: str) -> Any:
             raise ValueError(f"{path}: no such field in the scene (no {part!r})")
         node = node[part]
     return node
+
+
+def output_unit(name: str) -> str:
+    """The unit of a study output: one of :data:`OUTPUT_UNITS`, or of one punch of several
+    (``punches[1].tilt``: rad)."""
+    match = PUNCH_OUTPUT.fullmatch(name)
+    return OUTPUT_UNITS[match[2] if match else name]
 
 
 def field_unit(path: str) -> str:
@@ -325,6 +338,12 @@ def _read_json_file(path: Path, what: str) -> Any:
         raise ValueError(f"{path}: not a text file in UTF-8") from None
 
 
+def validated_scene(d: Mapping[str, Any]) -> Scene | PunchesScene:
+    """A scene dict of either form validated: one punch (:func:`core.scene.scene_from_dict`)
+    or several (``punches``: :func:`core.scene.punches_from_dict`)."""
+    return punches_from_dict(d) if has_punches(d) else scene_from_dict(d)
+
+
 def _base_scene(spec: Any, base_dir: Path | None) -> dict[str, Any]:
     if isinstance(spec, str):
         if base_dir is None:
@@ -341,7 +360,7 @@ def _base_scene(spec: Any, base_dir: Path | None) -> dict[str, Any]:
         raise ValueError(f"scene: must be a scene object or the path of a scene file, got "
                          f"{show_value(spec)}")
     try:
-        return scene_from_dict(spec).to_dict()
+        return validated_scene(spec).to_dict()
     except ValueError as exc:
         raise ValueError(f"scene: {exc}") from None
 
@@ -379,11 +398,11 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     if "times" in d:
         base["times"] = d["times"]
         try:
-            base = scene_from_dict(base).to_dict()
+            base = validated_scene(base).to_dict()
         except ValueError as exc:
             msg = str(exc)
             raise ValueError(msg if msg.startswith("times") else f"times: {msg}") from None
-    times = tuple(float(t) for t in scene_from_dict(base).times)
+    times = tuple(float(t) for t in validated_scene(base).times)
 
     vary = d["vary"]
     if not isinstance(vary, (list, tuple)) or not 1 <= len(vary) <= MAX_PARAMETERS:
@@ -406,15 +425,7 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     samples = _count(d["samples"], "samples") if random else 1
     seed = integer_in_range(d.get("seed", 0), "seed", 0, 2**63 - 1)
 
-    outputs_spec = d.get("outputs", list(OUTPUT_UNITS))
-    if not isinstance(outputs_spec, (list, tuple)) or not outputs_spec:
-        raise ValueError(f"outputs: must be a non-empty list of {', '.join(OUTPUT_UNITS)}")
-    for i, o in enumerate(outputs_spec):
-        # a list or object in the list is unhashable: test the type before the lookup
-        if not isinstance(o, str) or o not in OUTPUT_UNITS:
-            raise ValueError(f"outputs[{i}]: unknown output {show_value(o)} (known: "
-                             f"{', '.join(OUTPUT_UNITS)})")
-    outputs = tuple(dict.fromkeys(outputs_spec))
+    outputs = _outputs(d.get("outputs", list(OUTPUT_UNITS)), base)
 
     n = math.prod(len(p.values) for p in params if p.is_grid) * samples
     if n > max_points:
@@ -424,11 +435,40 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     for i, p in enumerate(params):
         for where, value in _extremes(p):
             try:
-                scene_from_dict(apply_point(base, {p.path: value}))
+                validated_scene(apply_point(base, {p.path: value}))
             except ValueError as exc:
                 raise ValueError(f"vary[{i}].{where}: the scene is invalid at {p.path} = "
                                  f"{value:.6g} ({exc})") from None
     return Study(name.strip(), base, params, samples, seed, outputs, times)
+
+
+def _outputs(spec: Any, base: Mapping[str, Any]) -> tuple[str, ...]:
+    """The outputs a study records, checked (ValueError naming ``outputs[i]``). Of a base
+    scene of several punches, every output is one punch's, ``punches[k].<output>``: a
+    plain name stands for it under every punch; the order is by punch, then as given."""
+    if not isinstance(spec, (list, tuple)) or not spec:
+        raise ValueError(f"outputs: must be a non-empty list of {', '.join(OUTPUT_UNITS)}")
+    count = len(base["punches"]) if has_punches(base) else 0
+    wanted: list[tuple[int | None, str]] = []
+    for i, o in enumerate(spec):
+        # a list or object in the list is unhashable: test the type before the lookup
+        match = PUNCH_OUTPUT.fullmatch(o) if isinstance(o, str) else None
+        name = match[2] if match else o
+        if not isinstance(name, str) or name not in OUTPUT_UNITS:
+            raise ValueError(f"outputs[{i}]: unknown output {show_value(o)} (known: "
+                             f"{', '.join(OUTPUT_UNITS)}"
+                             + (", each also as punches[k].<output>)" if count else ")"))
+        if match and not count:
+            raise ValueError(f"outputs[{i}]: {o!r} is an output of one punch of several; the "
+                             "base scene has one punch (give the plain name)")
+        if match and int(match[1]) >= count:
+            raise ValueError(f"outputs[{i}]: {o!r}: the base scene has {count} punches "
+                             f"(punches[0] to punches[{count - 1}])")
+        wanted.append((int(match[1]) if match else None, name))
+    if not count:
+        return tuple(dict.fromkeys(name for _, name in wanted))
+    return tuple(dict.fromkeys(f"punches[{k}].{name}" for k in range(count)
+                               for which, name in wanted if which in (None, k)))
 
 
 def numeric_fields(scene: Mapping[str, Any], prefix: str = "") -> list[tuple[str, float]]:

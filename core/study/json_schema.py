@@ -29,6 +29,7 @@ from core.study.definition import (
     MAX_STUDY_POINTS,
     OUTPUT_UNITS,
     PATH_PART,
+    PUNCH_OUTPUT,
     STUDY_VERSION,
 )
 
@@ -122,10 +123,16 @@ def study_json_schema() -> dict[str, Any]:
             "seed": {"type": "integer", "minimum": 0, "maximum": 2**63 - 1, "default": 0,
                      "description": "Seed of the draws."},
             "outputs": {"type": "array", "minItems": 1,
-                        "items": {"enum": list(OUTPUT_UNITS)},
+                        "items": {"anyOf": [
+                            {"enum": list(OUTPUT_UNITS)},
+                            {"type": "string", "pattern": "^" + PUNCH_OUTPUT.pattern.replace(
+                                "[a-z_]+", "|".join(OUTPUT_UNITS)) + "$"}]},
                         "description": "Outputs to record (default all): "
                                        + ", ".join(f"{k} [{u}]"
-                                                   for k, u in OUTPUT_UNITS.items()) + "."},
+                                                   for k, u in OUTPUT_UNITS.items())
+                                       + "; of a scene of several punches, each under "
+                                         "every punch, or one punch's as "
+                                         "punches[k].<output>."},
             "times": {"$ref": "#/$defs/times",
                       "description": "Output times replacing the base scene's [day after "
                                      "loading]."},

@@ -54,7 +54,7 @@ from core.files import atomic_write_text
 from core.optional import import_optional
 from core.scene import FLAG_MESSAGES
 from core.study.batch import run_batch
-from core.study.definition import OUTPUT_UNITS, Study, field_unit, load_study
+from core.study.definition import Study, field_unit, load_study, output_unit
 from core.study.plan import PLAN_ORDER, BatchPlan, batch_plan
 from core.study.points import StudyPoints, point_table
 from core.version import VERSION
@@ -375,8 +375,10 @@ def study_dataset(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[i
     """The results as an ``xarray.Dataset``: dims ``point`` and ``time`` [day after
     loading]; one coordinate per varied field (named like ``coating_0_modulus``, the field
     path in its ``field`` attribute) and ``sample``; variables: each output over (point,
-    time) with ``units``, ``error_estimate`` (relative), ``flags`` (comma-joined),
-    ``flag_<name>`` (bool), ``failed`` (bool), ``error`` (message), ``solve_seconds``."""
+    time) with ``units`` (a punch's of several named like ``punches_1_tilt``, the output
+    in its ``output`` attribute), ``error_estimate`` (relative), ``flags``
+    (comma-joined), ``flag_<name>`` (bool: of any punch), ``failed`` (bool), ``error``
+    (message), ``solve_seconds``."""
     xr = import_optional("xarray", "a study's dataset")
     data = _gather(study, parts, plan, lost)
     table = point_table(study)  # the dataset holds every point anyway
@@ -390,10 +392,13 @@ def study_dataset(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[i
     coords["sample"] = ("point", table["sample"], {"long_name": "index of the random draw"})
     variables: dict[str, Any] = {}
     for j, name in enumerate(study.outputs):
-        variables[name] = (("point", "time"), data["values"][:, j, :],
-                           {"units": OUTPUT_UNITS[name]})
+        attrs = {"units": output_unit(name)}
+        if _variable_name(name) != name:
+            attrs["output"] = name  # a punch's of several: punches[1].tilt
+        variables[_variable_name(name)] = (("point", "time"), data["values"][:, j, :], attrs)
     flags = data["flags"].astype(str)
-    split = [set(f.split(",")) for f in flags]
+    # a punch's flag of several (punches[1].large_tilt) counts as the flag
+    split = [{f.rsplit(".", 1)[-1] for f in flag.split(",")} for flag in flags]
     variables["error_estimate"] = ("point", data["error_estimate"],
                                    {"units": "1", "long_name": "solver's relative error "
                                                                "estimate"})
@@ -439,10 +444,10 @@ def _long_rows(study: Study, points: StudyPoints, index: np.ndarray,
     rows["sample"] = np.repeat(point["sample"], n_t)
     rows["time_day"] = np.tile(np.asarray(study.times), len(index))
     for j, name in enumerate(study.outputs):
-        unit = OUTPUT_UNITS[name].replace("/", "_per_")
+        unit = output_unit(name).replace("/", "_per_")
         values = np.full((len(index), n_t), np.nan) if arrays is None \
             else arrays["values"][:, j, :]
-        rows[f"{name}_{unit}"] = values.reshape(-1)
+        rows[f"{_variable_name(name)}_{unit}"] = values.reshape(-1)
     estimate = np.full(len(index), np.nan) if arrays is None else arrays["error_estimate"]
     flags = np.full(len(index), "failed") if arrays is None else arrays["flags"]
     error = np.full(len(index), f"not computed: {lost}") if arrays is None else arrays["error"]

@@ -1,0 +1,121 @@
+"""The files of an answer for several punches (:class:`core.scene.PunchesSolution`): the
+histories of every punch as CSV, and the contact pressure q over the whole surface.
+
+The columns follow :meth:`core.scene.SceneSolution.to_csv`, each named by the punch's
+path in the scene file (``punches[1].tilt_rad``); the pressure is written as
+:meth:`core.scene.SceneSolution.pressure_csv` writes it (long form, ``time_day, x_m,
+pressure_Pa``), with ``x`` the global x [m]: on each punch's own plotting grid, punches
+in order along x. Between the punches the surface is free (q = 0) and no row is written
+there: a row is a point of a contact zone.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from core import limits
+from core.scene.design import DesignCheck, DesignLimits, check_design
+from core.scene.results import history_columns
+
+if TYPE_CHECKING:
+    from core.scene.punches import PunchesSolution
+
+#: How far past a punch's edge [share of its half-width] a point still counts as on the
+#: punch: the rounding of ``center + x`` at ``x = +-a`` (as :meth:`SceneSolution.pressure`).
+EDGE_ROUNDING = 1e-12
+
+
+def in_order(result: PunchesSolution) -> list[int]:
+    """The punches' indices in order of their centres along x."""
+    return sorted(range(len(result.punches)), key=lambda k: result.punches[k].center)
+
+
+def surface_x(result: PunchesSolution) -> np.ndarray:
+    """The plotting points of the whole surface [m, global x]: every punch's grid
+    (:attr:`SceneSolution.x`) about its centre, punches in order along x."""
+    return np.concatenate([result.punches[k].center + result.punches[k].x
+                           for k in in_order(result)])
+
+
+def surface_pressure_on_grid(result: PunchesSolution) -> np.ndarray:
+    """q [Pa] at :func:`surface_x`, shape ``(len(x), len(times))``: each punch's
+    ``pressure_on_grid``, in the same order."""
+    return np.concatenate([result.punches[k].pressure_on_grid for k in in_order(result)])
+
+
+def surface_pressure(result: PunchesSolution, x: Any) -> np.ndarray:
+    """Contact pressure q [Pa] at points ``x`` [m] of the global x, shape
+    ``(len(x), len(times))``: each punch's q on its zone ``[center - a, center + a]``,
+    0 elsewhere (the free surface carries no pressure).
+
+    Raises ValueError naming ``x``: a point that is not finite, or more points than
+    :data:`core.limits.MAX_PRESSURE_VALUES` values allow (checked before any work).
+    """
+    xs = np.atleast_1d(np.asarray(x, dtype=float))
+    times = result.times.size
+    if xs.size * times > limits.MAX_PRESSURE_VALUES:
+        raise ValueError(
+            f"x: {xs.size} points at {times} times are more than the "
+            f"{limits.MAX_PRESSURE_VALUES} pressure values one call may compute; ask for "
+            "fewer points (or in several calls)")
+    if xs.ndim != 1 or np.any(~np.isfinite(xs)):
+        raise ValueError("x: must be finite numbers (positions along the surface, m)")
+    q = np.zeros((xs.size, times))
+    for punch in result.punches:
+        a = punch.scene.half_width
+        on = np.abs(xs - punch.center) <= a * (1 + EDGE_ROUNDING)
+        if on.any():
+            q[on] = punch.pressure_at(xs[on])
+    return q
+
+
+def histories_csv(result: PunchesSolution) -> str:
+    """The histories of every punch as CSV: ``time_day``, then for each punch ``k`` in
+    the scene's order ``punches[k].settlement_m``, ``punches[k].tilt_rad``,
+    ``punches[k].force_N_per_m``, ``punches[k].moment_N`` (and, where the unilateral
+    contact model answered that punch, its contact length and zone ends in the global x,
+    ``punches[k].zone1_start_m``, ...), as :meth:`SceneSolution.to_csv`."""
+    names: list[str] = []
+    columns: list[list[float]] = []
+    for k, punch in enumerate(result.punches):
+        more_names, more_columns = history_columns(punch, f"punches[{k}].")
+        names += more_names
+        columns += more_columns
+    lines = ["time_day," + ",".join(names)]
+    lines.extend(",".join(repr(float(v)) for v in (t, *row))
+                 for t, row in zip(result.times, zip(*columns, strict=True), strict=True))
+    return "\n".join(lines) + "\n"
+
+
+def pressure_csv(result: PunchesSolution, x: Any = None) -> str:
+    """q(x, t) over the whole surface as CSV in long form: ``time_day``, ``x_m`` (global
+    x), ``pressure_Pa``; by default on :func:`surface_x` (the contact zones only), else at
+    the points ``x`` [m] (0 off the punches: :func:`surface_pressure`)."""
+    if x is None:
+        xs, q = surface_x(result), surface_pressure_on_grid(result)
+    else:
+        xs = np.atleast_1d(np.asarray(x, dtype=float))
+        q = surface_pressure(result, xs)
+    lines = ["time_day,x_m,pressure_Pa"]
+    for j, t in enumerate(result.times):
+        tt = repr(float(t))
+        lines.extend(f"{tt},{float(xi)!r},{float(qi)!r}"
+                     for xi, qi in zip(xs, q[:, j], strict=True))
+    return "\n".join(lines) + "\n"
+
+
+def design_checks(result: PunchesSolution, limits: DesignLimits | None = None
+                  ) -> list[DesignCheck | None]:
+    """The design check of every punch over the whole history (as
+    :meth:`SceneSolution.design_check`, positions in the global x [m]) against ``limits``
+    (default: the scene's ``limits``, which every punch shares); None for each when
+    neither sets a limit."""
+    out: list[DesignCheck | None] = []
+    for punch in result.punches:
+        given = limits if limits is not None else punch.scene.limits
+        out.append(None if given is None or given.empty else check_design(
+            punch.times, punch.center + punch.x, punch.pressure_on_grid, punch.settlement,
+            punch.tilt, given))
+    return out

@@ -1,0 +1,122 @@
+"""The files of an answer for several punches (core/scene/punches_output.py): the CSV of
+every punch's histories, q over the whole surface (as CSV and as ``pressure(x)``) and the
+design check of each punch in the global x."""
+
+from __future__ import annotations
+
+import csv
+import io
+from typing import Any
+
+import numpy as np
+import pytest
+
+import core
+from core import limits
+from core.scene import PunchesSolution
+from core.scene.punches_output import EDGE_ROUNDING
+from tests.conftest import scene_file
+
+
+def _pair(**extra: Any) -> dict[str, Any]:
+    """Two punches 1.9 m apart on an elastic base: a wide one under a force and a moment,
+    a narrow one held level under a force."""
+    d = scene_file("uniform_flat")
+    d["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
+    d["times"] = {"end": 10.0, "count": 3}
+    del d["punch"], d["loading"]
+    d["punches"] = [
+        {"center": -1.5, "half_width": 1.0, "loading": {"force": 5e5, "moment": 2e4}},
+        {"center": 1.5, "half_width": 0.6, "loading": {"tilt": 0, "force": 3e5}}]
+    return d | extra
+
+
+@pytest.fixture(scope="module")
+def pair() -> PunchesSolution:
+    return core.solve(_pair())
+
+
+def _table(text: str) -> list[dict[str, str]]:
+    return list(csv.DictReader(io.StringIO(text)))
+
+
+def test_the_histories_of_every_punch_in_one_table(pair: PunchesSolution) -> None:
+    rows = _table(pair.to_csv())
+    header = list(rows[0])
+    assert header == ["time_day"] + [f"punches[{k}].{name}" for k in range(2) for name in
+                                     ("settlement_m", "tilt_rad", "force_N_per_m",
+                                      "moment_N")]
+    assert [float(r["time_day"]) for r in rows] == pair.times.tolist()
+    units = {"settlement": "m", "tilt": "rad", "force": "N_per_m", "moment": "N"}
+    for k, punch in enumerate(pair.punches):
+        for name, unit in units.items():
+            # repr() of a float reads back to the same float: equal, not close
+            assert [float(r[f"punches[{k}].{name}_{unit}"]) for r in rows] == \
+                getattr(punch, name).tolist()
+
+
+def test_one_punch_writes_the_single_punch_file_under_its_path() -> None:
+    d = _pair()
+    d["punches"] = d["punches"][:1]
+    one = core.solve(d)
+    single = core.solve(one.scene.scenes[0])
+    head, *rows = one.to_csv().splitlines()
+    single_head, *single_rows = single.to_csv().splitlines()
+    assert head == "time_day," + ",".join(f"punches[0].{name}"
+                                          for name in single_head.split(",")[1:])
+    assert rows == single_rows
+
+
+def test_the_pressure_over_the_surface_is_every_punch_on_its_zone(
+        pair: PunchesSolution) -> None:
+    rows = _table(pair.pressure_csv())
+    assert list(rows[0]) == ["time_day", "x_m", "pressure_Pa"]
+    n_x = sum(p.x.size for p in pair.punches)
+    assert len(rows) == n_x * pair.times.size
+    first = [r for r in rows if float(r["time_day"]) == pair.times[0]]
+    x = np.array([float(r["x_m"]) for r in first])
+    q = np.array([float(r["pressure_Pa"]) for r in first])
+    assert np.all(np.diff(x) > 0)  # one curve along the surface, punches in order
+    np.testing.assert_array_equal(x, pair.x)
+    for punch in pair.punches:
+        a, c = punch.scene.half_width, punch.center
+        # the edge c + a less c is a rounding above a (the slack of pressure(x))
+        on = np.abs(x - c) <= a * (1 + EDGE_ROUNDING)
+        # every row is on a zone: the free surface between the punches is not written
+        assert on.sum() == punch.x.size
+        np.testing.assert_array_equal(q[on], punch.pressure_on_grid[:, 0])
+    assert not np.any((x > -0.5) & (x < 0.9))  # the gap between the zones
+
+
+def test_pressure_is_zero_on_the_free_surface_and_the_punch_on_its_zone(
+        pair: PunchesSolution) -> None:
+    x = np.array([-3.0, -2.5, -1.5, -0.5, 0.0, 0.9, 1.5, 2.1, 5.0])
+    q = pair.pressure(x)
+    assert q.shape == (x.size, pair.times.size)
+    off = np.array([True, False, False, False, True, False, False, False, True])
+    assert np.all(q[off] == 0.0)
+    np.testing.assert_array_equal(q[1:4], pair.punches[0].pressure_at(x[1:4]))
+    np.testing.assert_array_equal(q[5:8], pair.punches[1].pressure_at(x[5:8]))
+    text = pair.pressure_csv(x)
+    assert len(_table(text)) == x.size * pair.times.size
+
+
+def test_pressure_refuses_what_it_cannot_answer(pair: PunchesSolution) -> None:
+    with pytest.raises(ValueError, match=r"^x: must be finite"):
+        pair.pressure([0.0, np.nan])
+    too_many = limits.MAX_PRESSURE_VALUES // pair.times.size + 1
+    with pytest.raises(ValueError, match=r"^x: .* more than"):
+        pair.pressure(np.zeros(too_many))
+
+
+def test_the_design_check_of_each_punch_is_in_the_global_x() -> None:
+    result = core.solve(_pair(limits={"allowable_pressure": 4.0e5}))
+    checks = result.design_checks()
+    assert len(checks) == 2
+    for punch, check in zip(result.punches, checks, strict=True):
+        single = punch.design_check()  # the same check, x from the punch's centre
+        assert check.check("q_max").value == single.check("q_max").value
+        assert check.check("q_max").x == punch.center + single.check("q_max").x
+        assert abs(check.check("q_max").x - punch.center) <= \
+            punch.scene.half_width * (1 + EDGE_ROUNDING)
+    assert core.solve(_pair()).design_checks() == [None, None]
