@@ -18,7 +18,7 @@ import numpy as np
 
 from core.engines.layered import NO_COATING
 from core.optional import import_optional
-from core.scene.contact_zone import lifts_off as contact_lifts_off
+from core.scene.contact_zone import LIFT_OFF_SHARE
 from core.scene.files import scene_to_json
 from core.scene.records import solver_settings
 from core.scene.schema import SCHEMA_VERSION, _jsonable
@@ -66,7 +66,9 @@ def lifts_off_at(result: SceneSolution, k: int = -1) -> bool:
     (:func:`core.scene.contact_zone.lifts_off`)."""
     if len(result.contact_set) != len(result.times):
         return False
-    return bool(contact_lifts_off(result.contact_set, result.scene.half_width)[k])
+    # the result's own length lifted off: a punch of several measures its zones from its
+    # own centre, not from x = 0
+    return bool(result.lift_off_length[k] > LIFT_OFF_SHARE * 2.0 * result.scene.half_width)
 
 
 def zones_text(result: SceneSolution, k: int = -1) -> str:

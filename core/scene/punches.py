@@ -36,6 +36,7 @@ from core.engines.nystrom import PunchGeometry, solve_punches
 from core.problem import TimeInputs, validate_geometry, validate_time_inputs
 from core.profiles import shifted
 from core.scene import punches_output, schema
+from core.scene.contact_zone import contact_width, lift_off_length
 from core.scene.design import DesignCheck, DesignLimits
 from core.scene.model import Scene
 from core.scene.results import SceneSolution
@@ -274,14 +275,22 @@ class PunchSolution(SceneSolution):
         return self.pressure(np.asarray(x, dtype=float) - self.center)
 
     @property
+    def local_contact_set(self) -> list[list[tuple[float, float]]]:
+        """:attr:`contact_set` in the punch's own coordinates ``x - center`` [m]."""
+        return [[(lo - self.center, hi - self.center) for lo, hi in zones]
+                for zones in self.contact_set]
+
+    @property
     def contact_width(self) -> np.ndarray:
-        """The contact width [m] at each output time."""
-        return np.array([sum(hi - lo for lo, hi in zones) for zones in self.contact_set])
+        """The contact width [m] at each output time (:func:`core.scene.contact_width`,
+        the one definition, on the punch's own coordinates)."""
+        return contact_width(self.local_contact_set, self.scene.half_width)
 
     @property
     def lift_off_length(self) -> np.ndarray:
-        """The length of the base lifted off [m] at each output time."""
-        return 2.0 * self.scene.half_width - self.contact_width
+        """The length of the base lifted off [m] at each output time
+        (:func:`core.scene.lift_off_length`)."""
+        return lift_off_length(self.local_contact_set, self.scene.half_width)
 
 
 class PunchesSolution:

@@ -194,3 +194,24 @@ def test_lift_off_under_creep_is_refused_naming_the_contact_model() -> None:
     with pytest.raises(ValueError, match=r"solver\.contact: lift-off of several punches is "
                                          r"solved on an elastic base for now"):
         core.solve(d)
+
+
+def test_a_punch_off_the_centre_measures_its_zones_from_its_own_centre() -> None:
+    """The contact width, the length lifted off and "lifts off" of punch 1 (centred at
+    x = 2.1 m) come from its zones taken about its own centre, by the one definition
+    (core.scene.contact_width): from x = 0 a full-contact punch there read as lifted."""
+    from core.scene import contact_width, lifts_off_at
+
+    lifting = core.solve(_pair(0.5, loads=(LIFTING, {"force": 3e5, "moment": -1e5})))
+    pressed = core.solve(_pair(0.5, loads=(LIFTING, {"force": 3e5, "moment": 0.0})))
+    for result in (lifting, pressed):
+        punch = result.punches[1]
+        a = punch.scene.half_width
+        assert punch.center == 2.1
+        ends = [[(lo - punch.center, hi - punch.center) for lo, hi in zones]
+                for zones in punch.contact_set]
+        np.testing.assert_array_equal(punch.contact_width, contact_width(ends, a))
+        np.testing.assert_array_equal(punch.lift_off_length, 2 * a - punch.contact_width)
+    assert lifts_off_at(lifting.punches[1]) and lifting.punches[1].lift_off_length[-1] > 0.1
+    assert not lifts_off_at(pressed.punches[1])
+    assert pressed.punches[1].contact_width[-1] == pytest.approx(1.2, abs=1e-12)
