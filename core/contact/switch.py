@@ -146,8 +146,9 @@ def with_contact_model(full, contact: str, arguments: dict[str, Any]):
     whole base at every time and ``info["contact"] = "full"``. ``"auto"`` when the
     full-contact pressure is negative somewhere (flag ``contact_lost``): the unilateral
     answer, whose ``info["full_contact"]`` keeps what the full-contact model said; if the
-    loads pull the punch away (no unilateral answer exists), the flagged full-contact
-    answer with ``info["unilateral_refused"]`` giving the reason.
+    loads pull the punch away or its contact shrinks to a point (no unilateral answer),
+    the flagged full-contact answer with ``info["unilateral_refused"]`` giving the reason
+    and ``info["success"]`` False.
     ``arguments`` are those of :func:`solve_unilateral`.
     """
     if contact == "auto" and "contact_lost" in full.info.get("flags", []):
@@ -159,6 +160,9 @@ def with_contact_model(full, contact: str, arguments: dict[str, Any]):
             full.info["contact"] = "full"
             full.info["unilateral_refused"] = str(exc)
             full.info["message"] += f"; unilateral contact refused: {exc}"
+            # the punch lifts off, so the full-contact answer is not this scene's, however
+            # well it meets tol: never a success
+            full.info["success"] = False
             return replace(full, contact_set=[list(FULL_CONTACT) for _ in full.times])
         result.info["full_contact"] = {
             "flags": list(full.info["flags"]),

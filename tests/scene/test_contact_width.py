@@ -86,3 +86,20 @@ def test_a_full_contact_answer_that_pulls_keeps_the_whole_width(pulled: SceneSol
     np.testing.assert_array_equal(pulled.lift_off_length, 0.0)
     np.testing.assert_array_equal(pulled.to_xarray().contact_width.values, 2 * a)
     assert "contact width" not in repr(pulled)  # nothing lifts off
+
+
+def test_a_contact_shrinking_to_a_point_is_never_a_success() -> None:
+    """The lift-off preset at e = 0.9999 a: the unilateral solver finds the contact
+    shrinking to a point and refuses; the full-contact answer that is left (q < 0, the
+    flag contact_lost) is not this scene's answer, so it is no success, and says why.
+    (It was a success: its estimate, 1e-7, met tol.)"""
+    from core.presets import read_preset
+
+    scene = read_preset("eccentric_footing_liftoff")
+    scene["loading"] = {"force": 8e5, "moment": 8e5 * 0.9999}
+    scene["solver"] = {"tol": 1e-6}
+    result = solve(scene)
+    assert result.info["contact"] == "full" and "contact_lost" in result.flags
+    assert result.info["success"] is False
+    assert "shrinks to a point" in result.info["unilateral_refused"]
+    assert "unilateral contact refused" in result.info["message"]
