@@ -80,9 +80,17 @@ class RelativeCodeModulus:
 DEFAULT_TOL_LADDER = (1e-6, 1e-5, 1e-4, 1e-3)
 #: The default tolerance is at least this many times the error of the creep law's fit by
 #: exponentials (which the time stepping's estimate carries): the stepping's own error
-#: then has the other half. Measured fits (fib MC2010, 50 years, RH 40-100 %): 4e-7 at
-#: 365 days of age at loading, 3e-6 at 28, 1.6e-5 at 7, 2.2e-4 at 1 day (RH 40 %).
+#: then has the other half (the fits of :data:`FIT_LEVELS`).
 FIT_ERROR_SHARE = 2.0
+#: The fits of a code's compliance by exponentials, coarsest first: (retardation times a
+#: decade, Chebyshev nodes in ln age, the largest reported fit error measured). Measured
+#: over fib MC2010 and Eurocode 2 for C20/25 (cement S, RH 40 %, h0 1000 mm, 5 C), C30/37
+#: (N, 60 %, 300 mm, 20 C), C50/60 (R, 90 %, 100 mm) and C90/105 (R, 100 %, 50 mm, 30 C),
+#: ages at loading 1 to 3650 days, 100 years of duration: 1.84e-6, 2.98e-8 and 2.93e-9.
+#: A solve takes the coarsest whose error, times :data:`FIT_ERROR_SHARE`, is within its
+#: tolerance: 35 terms from tol 1e-5 on, 46 to 1e-7, 57 below (the time stepping's cost
+#: per step grows with the terms; a fit costs ~0.1 s once per law and age).
+FIT_LEVELS = ((3, 40, 1.9e-6), (4, 48, 3e-8), (5, 64, 3e-9))
 
 
 def default_tolerance(model: CodeCreep, age_at_loading: float,
@@ -90,9 +98,9 @@ def default_tolerance(model: CodeCreep, age_at_loading: float,
     """The solver tolerance [-] a scene with this code's creep law meets by default.
 
     The smallest of :data:`DEFAULT_TOL_LADDER` that is at least :data:`FIT_ERROR_SHARE`
-    times the error of the law's fit by exponentials at this age at loading [day] (the
-    coarsest when none is): the former default, 1e-6, was below the fit's error (1.6e-5
-    at 7 days) and so never met.
+    times the error of the law's finest fit by exponentials at this age at loading [day]
+    (the coarsest when none is): 1e-6 for every law measured (:data:`FIT_LEVELS`). (The
+    fits once stopped at 1.6e-5 at 7 days, and a scene by a code then defaulted to 1e-4.)
     """
     fit_error = float(model.dimensionless_kernel(age_at_loading, field=field).fit_error)
     wanted = FIT_ERROR_SHARE * fit_error
@@ -154,10 +162,13 @@ class CodeCreep:
         return RelativeCodeModulus(self.inputs, self._age_at_loading(age_at_loading, field))
 
     def dimensionless_kernel(self, age_at_loading: float, *,
-                             field: str = "age_at_loading"):
+                             field: str = "age_at_loading", tol: float | None = None):
         """``K*(t*, tau*)`` [-] fitted on ages ``tau0`` to ``tau0 + MAX_DURATION`` days.
 
-        Returns a :class:`core.creep.kernel_fit.FittedKernel` (``fit_error``, ``rates``, ...).
+        ``tol``: the solver tolerance the kernel serves; the coarsest fit of
+        :data:`FIT_LEVELS` whose error is within ``tol / FIT_ERROR_SHARE`` (a finer one if
+        its measured error is not), the finest without one. Returns a
+        :class:`core.creep.kernel_fit.FittedKernel` (``fit_error``, ``rates``, ...).
         Raises ValueError if the fitted kernel is positive anywhere (it must creep).
         """
         from core.creep.kernel_fit import fit_compliance, nonpositive_violation
@@ -171,10 +182,21 @@ class CodeCreep:
         def creep(t: np.ndarray, tau: np.ndarray) -> np.ndarray:
             return scale * _FORMULAS[inputs.model][1](inputs, tau0 * t, tau0 * tau)
 
-        fitted = fit_compliance(creep, end=1.0 + MAX_DURATION / tau0,
-                                resolution=RESOLUTION / tau0, modulus=c,
-                                log_slope=c.log_slope, breaks=(clamp_age(inputs) / tau0,),
-                                key=(inputs, tau0))
+        if tol is None:
+            candidates = FIT_LEVELS[-1:]
+        else:
+            first = next((k for k, level in enumerate(FIT_LEVELS)
+                          if FIT_ERROR_SHARE * level[2] <= tol), len(FIT_LEVELS) - 1)
+            candidates = FIT_LEVELS[first:]
+        for per_decade, age_nodes, _ in candidates:
+            fitted = fit_compliance(creep, end=1.0 + MAX_DURATION / tau0,
+                                    resolution=RESOLUTION / tau0, modulus=c,
+                                    log_slope=c.log_slope,
+                                    breaks=(clamp_age(inputs) / tau0,), key=(inputs, tau0),
+                                    per_decade=per_decade, age_nodes=age_nodes)
+            # a law outside the measured set may need a finer fit than predicted
+            if tol is None or FIT_ERROR_SHARE * fitted.fit_error <= tol:
+                break
         violation = nonpositive_violation(fitted)
         if violation > K_SIGN_SLACK:
             raise ValueError(f"{field}: the fitted creep kernel is positive somewhere "

@@ -109,10 +109,12 @@ class _AgingSeries:
         return RelativeModulus(tau0, beta, alpha)
 
     def dimensionless_kernel(self, age_at_loading: float, *,
-                             field: str = "age_at_loading") -> DegenerateKernel:
+                             field: str = "age_at_loading",
+                             tol: float | None = None) -> DegenerateKernel:
         """``K*(t*, tau*) = tau0 K(tau0 t*, tau0 tau*)`` [-] in degenerate (exponential) form.
 
-        ``age_at_loading`` is ``tau0`` [day], ``t* = age / tau0``.
+        ``age_at_loading`` is ``tau0`` [day], ``t* = age / tau0``; ``tol`` (the solver's)
+        is not needed: the form is exact.
         """
         return self._degenerate(_age_at_loading(age_at_loading, field))
 
@@ -155,8 +157,10 @@ class Elastic(_ConstantModulus):
         return np.zeros(np.broadcast_shapes(np.shape(t), np.shape(tau)))
 
     def dimensionless_kernel(self, age_at_loading: float, *,
-                             field: str = "age_at_loading") -> None:
-        """``None``: there is no creep operator. ``age_at_loading`` in days."""
+                             field: str = "age_at_loading",
+                             tol: float | None = None) -> None:
+        """``None``: there is no creep operator. ``age_at_loading`` in days (``tol``
+        unused)."""
         _age_at_loading(age_at_loading, field)
         return None
 
@@ -289,10 +293,12 @@ class UserKernel(_ConstantModulus):
                      self.expr if self.expr is not None else self.kernel))
 
     def dimensionless_kernel(self, age_at_loading: float, *,
-                             field: str = "age_at_loading") -> CausalKernel:
+                             field: str = "age_at_loading",
+                             tol: float | None = None) -> CausalKernel:
         """``K*(t*, tau*) = tau0 K(tau0 t*, tau0 tau*)`` [-] as a general (causal) callable.
 
-        ``age_at_loading`` is ``tau0`` [day], ``t* = age / tau0``.
+        ``age_at_loading`` is ``tau0`` [day], ``t* = age / tau0``; ``tol`` unused (the
+        time stepping fits the callable itself, within its own budget).
         """
         tau0 = _age_at_loading(age_at_loading, field)
         return CausalKernel(self.kernel.function, tau0)

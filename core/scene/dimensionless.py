@@ -188,7 +188,7 @@ def to_dimensionless(scene: Scene) -> DimensionlessProblem:
         m=m_value,
         g=g_value,
         c=c_value,
-        kernel=creep.dimensionless_kernel(tau0, field="base.age_at_loading"),
+        kernel=creep.dimensionless_kernel(tau0, field="base.age_at_loading", tol=scene.tol),
         loads=loads,
         times=times_star,
         breakpoints=tuple(b / a for b in scene.breakpoints),

@@ -137,9 +137,10 @@ def test_fitted_compliance_within_its_reported_error(name):
     e0 = model.modulus(tau0)
     exact = e0 * (1 / model.modulus(tau0 * tau) + model.compliance(tau0 * t, tau0 * tau))
     error = np.max(np.abs(kernel.compliance(t, tau) - exact) / exact)
-    # measured 9.4e-6 (MC2010) and 7.9e-6 (EC2) against reported 1.5e-5 and 9.3e-6
+    # the finest fit: measured 2.1e-9 (MC2010) and 2.7e-10 (EC2) against reported 2.6e-9
+    # and 3.2e-10 (200,000 random pairs: at most 0.87 of the reported error)
     assert error <= kernel.fit_error
-    assert kernel.fit_error < 3e-5
+    assert kernel.fit_error < 3e-9  # core.creep.design_codes.FIT_LEVELS
     # the kernel is the exact derivative of the fitted compliance (K = e dJ/dtau)
     s = np.array([1.5, 30.0, 400.0])
     tt = np.array([2.0, 100.0, 2000.0])
@@ -305,3 +306,27 @@ def test_spec_round_trip_and_plot_curve():
     assert np.allclose(creep_coefficient_curve(spec, 28.0, d),
                        [ec2_phi_by_hand(28 + x, 28, 38.0, 60.0, 300.0, 0.0) if x else 0.0
                         for x in d], rtol=1e-13)
+
+
+@pytest.mark.parametrize("name", ["fib_mc2010", "eurocode2"])
+@pytest.mark.parametrize("tol", [1e-6, 1e-8])
+def test_a_bare_base_settles_as_the_codes_own_compliance(name, tol):
+    """An independent reference: on the bare base (no coating) creep and space commute,
+    so under a constant force the settlement is the elastic one at loading times
+    ``E(t0) J(t, t0)``, with ``J`` from the code's formulas (not from the fit). Over 50
+    years the answer meets tol 1e-6 and 1e-8, within its estimate (measured: MC2010
+    5.2e-9 and 9.2e-11, EC2 1.5e-8 and 1.5e-10, against estimates 3.4e-8, 2.7e-9,
+    2.6e-8, 3.4e-10; with the fit of the time, 1.6e-5, neither was met)."""
+    data = scene_file("young_concrete_50_years")
+    data["coating"] = []
+    data["base"]["creep"]["model"] = name
+    data["times"] = {"end": 18262.5, "count": 12, "spacing": "log"}
+    data["solver"] = {"tol": tol}
+    result = solve(data)
+    assert result.info["success"] and not result.flags, result.info["message"]
+    model = CodeCreep(name, {k: v for k, v in data["base"]["creep"].items() if k != "model"})
+    tau0 = data["base"]["age_at_loading"]
+    exact = model.modulus(tau0) * (1 / model.modulus(tau0)
+                                   + model.compliance(tau0 + result.times, tau0))
+    error = np.max(np.abs(result.settlement / result.settlement[0] - exact) / exact)
+    assert error <= result.info["error_estimate"] <= tol
