@@ -11,7 +11,9 @@ Nothing here imports Panel or Bokeh when imported (the solver workers import it 
 - ``result_cache``: the process-wide cache of prepared results.
 - ``warm_up``: presets solved before the first visitor comes.
 - ``fit_runner``: :class:`FitRun`, a fit of the Fit tab on a thread of its own.
-- ``study_runner``: :class:`StudyRun`, a design study in a process of its own.
+- ``study_runner``: :class:`StudyRun`, a design study in a process of its own;
+  ``fair_share``: the turns the server's studies take (:class:`StudyShare`).
+- ``memory_bound``: the address-space bounds of the worker and study processes.
 - ``trace``: timestamps of a slider move's way through the server (latency benchmark).
 """
 
