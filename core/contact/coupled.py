@@ -53,6 +53,7 @@ from core.contact.elastic import _bad_pins, _verify
 from core.contact.nodal import coarse_start, nodal_operator
 from core.contact.result import UNILATERAL_MARGIN, UnilateralSolution, _Snapshot
 from core.contact.step import Space, Step, check_loads, nystrom_pressure
+from core.contact.systems import StepSolver
 from core.contact.unilateral import nodal_resolution, zone_resolution
 from core.contact.zones import (
     MAX_LEVELS,
@@ -152,14 +153,20 @@ class CoupledBase:
 def coupled_bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray,
                            owner: np.ndarray, step_c: float, scale: float,
                            givens: Sequence[dict[str, float]], rhs: np.ndarray,
-                           idx: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                           idx: np.ndarray, solver: StepSolver | None = None
+                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`core.contact.systems.bordered_solve` over several punches: the equation on
     the nodes ``idx`` of all punches (``owner`` the punch of every node, ``op`` the
     coupled operator), and per punch the unknown ones of its settlement and tilt as
     border columns on its nodes and its given force and moment as border rows.
+    ``solver``: a :class:`core.contact.systems.StepSolver` keeping the factors from one
+    creep step to the next (None: a direct solve).
 
     Returns (q on idx, settlement and tilt of every punch).
     """
+    if solver is not None:
+        return _kept_factors_solve(op, m, x, w, owner, step_c, scale, givens, rhs, idx,
+                                   solver)
     n = idx.size
     own = owner[idx]
     xi, wi = x[idx], w[idx]
@@ -185,11 +192,63 @@ def coupled_bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.n
         a[n:, :n] = np.array(rows)
     b = np.concatenate([rhs[idx] / scale, values])
     sol = np.linalg.solve(a, b)
+    return _unpack_all(sol, n, scale, givens, names)
+
+
+def _unpack_all(sol: np.ndarray, n: int, scale: float, givens: Sequence[dict[str, float]],
+                names: Sequence[tuple[int, str]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     delta = np.array([given.get("settlement", 0.0) for given in givens])
     alpha = np.array([given.get("tilt", 0.0) for given in givens])
     for (p, name), value in zip(names, sol[n:] * scale, strict=True):
         (delta if name == "settlement" else alpha)[p] = value
     return sol[:n], delta, alpha
+
+
+def _kept_factors_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray,
+                        owner: np.ndarray, step_c: float, scale: float,
+                        givens: Sequence[dict[str, float]], rhs: np.ndarray, idx: np.ndarray,
+                        solver: StepSolver) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`coupled_bordered_solve` by the kept factors of ``solver`` (the system of
+    :func:`core.contact.systems.bordered_solve`, divided by ``scale`` likewise: the
+    factors of one step precondition the next up to the change of c/s)."""
+    n = idx.size
+    own = owner[idx]
+    xi, wi = x[idx], w[idx]
+    cols, names, rows, values = [], [], [], []
+    for p, given in enumerate(givens):
+        on = (own == p).astype(float)
+        if "settlement" not in given:
+            cols.append(-on)
+            names.append((p, "settlement"))
+        if "tilt" not in given:
+            cols.append(-xi * on)
+            names.append((p, "tilt"))
+        for name, weight in (("force", wi), ("moment", wi * xi)):
+            if name in given:
+                rows.append(weight * on)
+                values.append(given[name])
+    k = len(cols)
+    border_cols = np.array(cols).T.reshape(n, k)
+    border_rows = np.array(rows).reshape(k, n)
+    key = (idx.tobytes(), tuple(tuple(sorted(given)) for given in givens))
+    sub = solver.submatrix(op, idx, key)
+    diagonal = (step_c / scale) * m[idx]
+
+    def build() -> np.ndarray:
+        a = np.zeros((n + k, n + k))
+        a[:n, :n] = sub
+        a[np.arange(n), np.arange(n)] += diagonal
+        a[:n, n:] = border_cols
+        a[n:, :n] = border_rows
+        return a
+
+    def apply(z: np.ndarray) -> np.ndarray:
+        zq = z[:n]
+        return np.concatenate([diagonal * zq + sub @ zq + border_cols @ z[n:],
+                               border_rows @ zq])
+
+    b = np.concatenate([rhs[idx] / scale, values])
+    return _unpack_all(solver.solve(build, apply, b), n, scale, givens, names)
 
 
 @dataclass
@@ -319,14 +378,16 @@ def coupled_state(base: CoupledBase, rules: Sequence[Panels], op: np.ndarray,
 
 
 def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarray,
-                       steps: Sequence[Step], start: np.ndarray | None = None
+                       steps: Sequence[Step], start: np.ndarray | None = None,
+                       memory: np.ndarray | None = None, solver: StepSolver | None = None
                        ) -> tuple[list[NodalState], bool]:
     """The primal-dual active set of :func:`core.contact.active_set.nodal_active_set` on
     the nodes of every punch's ``rules`` at once (``op`` their coupled operator), from
-    the contact nodes ``start`` (default: all). Returns each punch's
-    :class:`NodalState` and whether the set settled. Raises :class:`NoContact` (its
-    message naming ``punches[k]``) when a punch with a given force or moment keeps no
-    node in contact, or fewer than three."""
+    the contact nodes ``start`` (default: all). ``memory``: the displacement e of a
+    creep step's memory at all nodes (None: elastic); ``solver`` keeps the factors
+    between steps. Returns each punch's :class:`NodalState` and whether the set
+    settled. Raises :class:`NoContact` (its message naming ``punches[k]``) when a punch
+    with a given force or moment keeps no node in contact, or fewer than three."""
     sizes = [r.size for r in rules]
     owner = np.repeat(np.arange(len(rules)), sizes)
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
@@ -335,6 +396,8 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
     m = np.concatenate([s.m(r.nodes) for s, r in zip(base.spaces, rules, strict=True)])
     g = np.concatenate([s.g(r.nodes) for s, r in zip(base.spaces, rules, strict=True)])
     rhs = _given_rhs_all(steps, owner, x, g)
+    if memory is not None:
+        rhs = rhs + memory
     c, scale = steps[0].c, steps[0].scale
     givens = [s.given for s in steps]
     active = np.ones(x.size, dtype=bool) if start is None else start.copy()
@@ -355,8 +418,12 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
         q = np.zeros(x.size)
         if idx.size:
             q[idx], delta, alpha = coupled_bordered_solve(op, m, x, w, owner, c, scale,
-                                                          givens, rhs, idx)
-        nystrom = (delta[owner] + alpha[owner] * x - g - scale * (op @ q)) / (c * m)
+                                                          givens, rhs, idx, solver)
+        if memory is None:
+            nystrom = (delta[owner] + alpha[owner] * x - g - scale * (op @ q)) / (c * m)
+        else:
+            nystrom = (delta[owner] + alpha[owner] * x - g + memory - scale * (op @ q)) / (
+                c * m)
         # Keep the contact nodes the equation solved exactly (rounding must not flip them).
         nystrom[idx] = q[idx]
         new = nystrom > 0.0
