@@ -42,6 +42,7 @@ from core.contact.active_set import NoContact, NodalState, zones_from_nodes
 from core.contact.bands import band_rule, bands_from_ends
 from core.contact.coupled import (
     CoupledBase,
+    CoupledStepSolver,
     Resolutions,
     _given_rhs_all,
     coupled_active_set,
@@ -61,7 +62,6 @@ from core.contact.kinks import Corrected, _contact_parts, _cut_rule, _part_rows,
 from core.contact.march import creep_memory, nodes_in, rule_operator
 from core.contact.result import UNILATERAL_MARGIN, UnilateralSolution, _Snapshot
 from core.contact.step import Step, check_loads
-from core.contact.systems import StepSolver
 from core.contact.unilateral import creep_resolution
 from core.contact.zones import ZONE_END_TOL, Resolution, zone_kernel_accuracy
 from core.discretize import NODES_PER_PANEL, Panels
@@ -192,7 +192,7 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
     wanted = {int(i): k for k, i in enumerate(out_index)}
     outputs: list[tuple] = [None] * len(out_index)  # type: ignore
     active = None
-    solver = StepSolver()
+    solver = CoupledStepSolver()
     unsettled = 0
     for n in range(steps):
         check_work("following the contact zones of several punches under creep step by step")
@@ -230,7 +230,7 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
             corrected = None
             if exact_ends and any(ends for ends, _ in nodal):
                 corrected = _corrected(base, system, step_data, states, displacement,
-                                       memory_density, nodal, accuracy)
+                                       memory_density, nodal, accuracy, solver)
             outputs[wanted[n]] = (states, step_data, memory_density, nodal, corrected)
     # each punch's free ends, the roots of its corrected Q, all output times at once
     ends = [[list(nodal[p][0]) for p in range(len(base.punches))]
@@ -243,11 +243,12 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
             for (k, _), found in zip(batch, roots, strict=True):
                 ends[k][p] = found
     return {"outputs": outputs, "ends": ends, "unsettled": unsettled, "steps": steps - 1,
-            "system": system, "factorizations": solver.factorizations}
+            "system": system, "factorizations": solver.factorizations,
+            "iterations": solver.iterations, "direct_solves": solver.direct}
 
 
 def _step_states(base: CoupledBase, system: CoupledRules, steps: Sequence[Step],
-                 displacement: np.ndarray, start: np.ndarray | None, solver: StepSolver,
+                 displacement: np.ndarray, start: np.ndarray | None, solver: CoupledStepSolver,
                  retry: bool) -> tuple[list[NodalState], bool]:
     """The coupled nodal active set of one step from ``start``; with ``retry``, a start
     that does not settle (or leaves a punch no contact) is retried from full contact (as
@@ -268,7 +269,7 @@ def _step_states(base: CoupledBase, system: CoupledRules, steps: Sequence[Step],
 def _corrected(base: CoupledBase, system: CoupledRules, steps: Sequence[Step],
                states: Sequence[NodalState], displacement: np.ndarray,
                memory_density: np.ndarray, nodal: Sequence[tuple[list[float], list[bool]]],
-               accuracy: float) -> list[Corrected]:
+               accuracy: float, solver: CoupledStepSolver) -> list[Corrected]:
     """Every punch's step solved again without the kink defect of its free ends
     (:func:`core.contact.kinks.kinks_corrected` over the coupled system): each punch's
     :class:`core.contact.kinks.Corrected`, its ``coupling`` the displacement its
@@ -311,7 +312,8 @@ def _corrected(base: CoupledBase, system: CoupledRules, steps: Sequence[Step],
     idx = np.nonzero(active)[0]
     q_new = np.zeros(x.size)
     q_new[idx], delta, alpha = coupled_bordered_solve(system.op, system.m, x, w, system.owner,
-                                                      steps[0].c, scale, givens, rhs, idx)
+                                                      steps[0].c, scale, givens, rhs, idx,
+                                                      solver)
     densities = []
     for p, (state, parts) in enumerate(zip(states, parts_of, strict=True)):
         density = q_new[system.part(p)].copy()

@@ -40,9 +40,6 @@ from core.scene.model import Scene
 from core.scene.results import SceneSolution
 from core.validation import bounded_list, finite_number
 
-#: What the coupled solve does not answer yet, named in its refusals.
-COUPLED_SCOPE = "lift-off of several punches is solved on an elastic base for now"
-
 
 @dataclass(frozen=True, eq=False)
 class PunchesScene:
