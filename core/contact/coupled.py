@@ -36,7 +36,8 @@ ends together.
 
 Zones further apart than :data:`core.engines.nystrom.multi.NEGLIGIBLE_GAP` base
 thicknesses are not coupled (:func:`core.engines.nystrom.interacting`), as in full
-contact. Under creep lift-off of several punches is not solved (the scene refuses it).
+contact. Under creep :mod:`core.contact.coupled_creep` marches the punches over this
+module's coupled active set and operator.
 """
 
 from __future__ import annotations

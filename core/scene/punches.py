@@ -9,13 +9,15 @@ so every field keeps its rules; a refusal names it as ``punches[k].<field>``.
 One punch is the single-punch scene at its centre, answered by :func:`core.scene.solve`
 (every base, contact model and engine). Several punches are coupled by the default engine
 (:mod:`core.engines.nystrom.multi`) with the thin-layer coating model, in full contact (on
-an elastic, aging or creeping base); on an elastic base they may lift off
-(:func:`core.contact.solve_unilateral_punches`: ``solver.contact`` ``"unilateral"``, or
-``"auto"`` when full contact is lost under some punch; then every punch's contact set is
-an unknown). The coating's profiles are functions of the global x along the whole surface
-(checked over the punches' span); each punch sees them from its centre. What is not
-coupled yet (lift-off under creep) is refused with a ValueError naming the field and the
-reason.
+an elastic, aging or creeping base); they may lift off (``solver.contact``
+``"unilateral"``, or ``"auto"`` when full contact is lost under some punch; then every
+punch's contact set is an unknown): on an elastic base by
+:func:`core.contact.solve_unilateral_punches`, each time on its own, on a creeping or
+aging one by :func:`core.contact.solve_creep_punches`, one march in time over all
+punches. Lift-off needs every punch pressed (a pulled punch is refused naming
+``punches[k].loading.<field>``). The coating's profiles are functions of the global x
+along the whole surface (checked over the punches' span); each punch sees them from its
+centre.
 """
 
 from __future__ import annotations
