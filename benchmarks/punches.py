@@ -9,8 +9,10 @@ same model (thin layer, default engine: ``scene.dimensionless.solve()``), its ha
 two punches 1 m apart (the second 0.6 times as wide, so the two grids differ, or the same
 width, so they share one), both half-widths changed at each solve; *loads only*: the two
 punches' forces changed. *Lift-off*: the first punch (and the punch alone) under a moment
-that lifts its heel off, contact ``"unilateral"``. Medians of the CPU time of this process
-per solve [ms], with the machine's load average; written to
+that lifts its heel off, contact ``"unilateral"``; *under creep*: the same on a creeping
+base (exponential creep, 6 output times over a year, ``CREEP_SOLVES`` solves each) under
+``CREEP_LIFTING_MOMENT``. Medians
+of the CPU time of this process per solve [ms], with the machine's load average; written to
 ``benchmarks/results/punches.md`` unless ``--no-write``.
 """
 
@@ -30,12 +32,20 @@ from core.presets import read_preset
 from core.scene import SceneSolution, scene_from_dict
 
 SOLVES = 8
+#: Solves of each creep lift-off row (a second or more each).
+CREEP_SOLVES = 3
+#: The moment [N] of the creep lift-off rows (e = 0.6 a): the punch alone lifts its heel
+#: off under it from the first time (measured: zone from -0.313 to -0.369 over the year).
+CREEP_LIFTING_MOMENT = 3e5
+#: The creeping base of the creep lift-off rows (as tests/scene/test_punches.py's).
+CREEP = {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11, "rate": 0.05}
 
 
-def _scene() -> dict:
+def _scene(creep: bool = False) -> dict:
     d = read_preset("uniform_flat")
-    d["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
-    d["times"] = {"end": 10.0, "count": 3}
+    d["base"]["creep"] = dict(CREEP) if creep else {"model": "elastic", "modulus": 3.0e10}
+    d["times"] = ({"end": 365.0, "count": 6, "spacing": "log"} if creep
+                  else {"end": 10.0, "count": 3})
     d["solver"] = {"tol": 1e-6}
     return d
 
@@ -45,8 +55,8 @@ LIFTING_MOMENT = 2e5
 
 
 def _single(i: int, force_step: float = 0.0, geometry_step: float = 1e-4,
-            moment: float = 0.0) -> None:
-    d = _scene()
+            moment: float = 0.0, creep: bool = False) -> None:
+    d = _scene(creep)
     d["punch"]["half_width"] *= 1 + geometry_step * i
     d["loading"]["force"] *= 1 + force_step * i
     d["loading"]["moment"] = moment
@@ -57,8 +67,8 @@ def _single(i: int, force_step: float = 0.0, geometry_step: float = 1e-4,
 
 
 def _pair(i: int, ratio: float, force_step: float = 0.0, geometry_step: float = 1e-4,
-          moment: float = 0.0) -> None:
-    d = _scene()
+          moment: float = 0.0, creep: bool = False) -> None:
+    d = _scene(creep)
     del d["punch"], d["loading"]
     a0, a1 = 1.0 * (1 + geometry_step * i), ratio * (1 + geometry_step * i)
     d["punches"] = [
@@ -71,9 +81,9 @@ def _pair(i: int, ratio: float, force_step: float = 0.0, geometry_step: float = 
     core.solve(d)
 
 
-def _median_ms(run) -> float:  # noqa: ANN001
+def _median_ms(run, solves: int = SOLVES) -> float:  # noqa: ANN001
     times = []
-    for i in range(1, SOLVES + 1):
+    for i in range(1, solves + 1):
         start = time.process_time()
         run(i)
         times.append(time.process_time() - start)
@@ -95,6 +105,12 @@ def main(argv: list[str]) -> None:
                 _median_ms(lambda i: _single(i, moment=LIFTING_MOMENT))),
                ("two punches (a = 1, 0.6 m), the first lifting off, new geometry",
                 _median_ms(lambda i: _pair(i, 0.6, moment=LIFTING_MOMENT)))]
+    creeping = [("one punch (a = 1 m), lift-off under creep, new geometry",
+                 _median_ms(lambda i: _single(i, moment=CREEP_LIFTING_MOMENT, creep=True),
+                            CREEP_SOLVES)),
+                ("two punches (a = 1, 0.6 m), the first lifting off under creep, new geometry",
+                 _median_ms(lambda i: _pair(i, 0.6, moment=CREEP_LIFTING_MOMENT, creep=True),
+                            CREEP_SOLVES))]
     commit = tree_commit()
     load = os.getloadavg()
     lines = ["# Two punches against one", "",
@@ -109,6 +125,11 @@ def main(argv: list[str]) -> None:
               f"{LIFTING_MOMENT:g} N on the first punch, e = 0.4 a):", "",
               "| solve | CPU [ms] | against one punch lifting off |", "| --- | --- | --- |"]
     lines += [f"| {name} | {ms:.1f} | {ms / lifting[0][1]:.2f}x |" for name, ms in lifting]
+    lines += ["", "Lift-off under creep (exponential creep, 6 output times over a year, the "
+              f"moment {CREEP_LIFTING_MOMENT:g} N on the first punch, e = 0.6 a; median of "
+              f"{CREEP_SOLVES} solves):", "",
+              "| solve | CPU [ms] | against one punch lifting off |", "| --- | --- | --- |"]
+    lines += [f"| {name} | {ms:.1f} | {ms / creeping[0][1]:.2f}x |" for name, ms in creeping]
     text = "\n".join(lines) + "\n"
     print(text)
     if "--no-write" not in argv:

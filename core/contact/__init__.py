@@ -15,12 +15,15 @@ cheap check that lets ``auto`` skip a full-contact solve.
   bands the zone ends sweep, kink-corrected zone ends);
 - ``result.py``: ``UnilateralSolution`` and ``contact_set_from_pressure``;
 - ``coupled.py``: lift-off of several punches on one elastic base
-  (``solve_unilateral_punches``), the single punch's machinery over their block system.
+  (``solve_unilateral_punches``), the single punch's machinery over their block system;
+  ``coupled_creep.py``: on a creeping base (``solve_creep_punches``), the single punch's
+  creep march over it, one memory for all punches.
 """
 
 from __future__ import annotations
 
 from core.contact.coupled import solve_unilateral_punches
+from core.contact.coupled_creep import solve_creep_punches
 from core.contact.step import Space
 from core.contact.switch import (
     check_contact_model,
@@ -43,6 +46,7 @@ __all__ = [
     "predicted_unilateral",
     "refuse_loads_without_contact",
     "Resolution",
+    "solve_creep_punches",
     "solve_unilateral",
     "solve_unilateral_punches",
     "Space",

@@ -109,33 +109,11 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     """
     times = inp.times
     tol = inp.tol
-    # The zone ends have their own budget whatever tol is (issue 13): half of it for the
-    # panel rule (core/contact/kinks.py takes the kinks at the ends out of its error), the
-    # rest, or at least the other half, for the time grid; likewise tol / 3 of the outputs
-    # (success asks the sum of the two parts to meet it).
     end_tol = ZONE_END_TOL
-    # the zones at loading found by the first march start the first step of the others
-    first: dict[str, Any] = {}
-    base, space_error, space_shift, band_note = _select_rule(space, inp, res, first_steps,
-                                                             tol, end_tol, first=first)
-    out, time_error, end_shift, run = _in_time(
-        space, inp, base, first_steps, max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
-        max(end_tol - space_shift, end_tol / 2), first)
-    strays = _outside_bands(out["ends"], band_note["bands"], space.breakpoints)
-    if strays:
-        # An end went where the first march did not see it (between its few times, or as
-        # a zone opening late): the bands of every output time, and everything again.
-        bands = _merge(band_note["bands"] + bands_from_ends(out["ends"], space.breakpoints))
-        base, space_error, space_shift, band_note = _select_rule(
-            space, inp, res, first_steps, tol, end_tol, bands=bands, first=first)
-        out, time_error, end_shift, run = _in_time(
-            space, inp, base, first_steps, max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
-            max(end_tol - space_shift, end_tol / 2), first)
-        strays = _outside_bands(out["ends"], band_note["bands"], space.breakpoints)
+    (base, out, run, band_note, strays, error, end_error, time_error,
+     space_error) = controlled_march(OnePunchMarches(space, inp), times, tol, res,
+                                     first_steps)
     unsettled, sweeps, steps = run["unsettled"], run["sweeps"], run["steps"]
-
-    error = float(time_error + space_error)
-    end_error = float(end_shift + space_shift)
     success = (accepts(error, tol, UNILATERAL_MARGIN) and end_error <= end_tol
                and unsettled == 0 and not strays)
     flags = [] if success else ["tol_not_met"]
@@ -174,37 +152,118 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
             "info": info}
 
 
-def _in_time(space: Space, inp: Any, base: Panels, first_steps: int, budget: float,
+class OnePunchMarches:
+    """What the error control (:func:`controlled_march`) asks of the marches of one
+    punch: its panel rules, a march on one of them, and the comparison of two marches'
+    outputs. Several punches on one base answer the same for all of them at once
+    (:class:`core.contact.coupled_creep.CoupledMarches`)."""
+
+    def __init__(self, space: Space, inp: Any) -> None:
+        self.space, self.inp = space, inp
+
+    def rule(self, res: Resolution, bands: list[tuple[float, float]], width: float) -> Panels:
+        return band_rule(self.space, res, bands, width)
+
+    @staticmethod
+    def halved(res: Resolution) -> Resolution:
+        """The base width halved, and its grading at +-1 and the breakpoints too."""
+        return Resolution(res.width / 2.0, res.edge / 2.0)
+
+    def locating(self, res: Resolution) -> Panels:
+        """The rule of the march that locates the bands (graded only to ``LOCATE_EDGE``)."""
+        return band_rule(self.space, Resolution(res.width, max(res.edge, LOCATE_EDGE)), [],
+                         0.0)
+
+    def run(self, rule: Panels, grid: np.ndarray, widths: np.ndarray, index: np.ndarray,
+            exact_ends: bool = True, first: dict[str, Any] | None = None
+            ) -> tuple[dict[str, Any], dict[str, Any]]:
+        """(outputs, the march) of a march on ``rule``."""
+        space = self.space
+        op = rule_operator(space.lam, rule)
+        run = march(space, self.inp, rule, op, space.m(rule.nodes), space.g(rule.nodes),
+                    grid, widths, index, exact_ends=exact_ends, first=first)
+        return march_outputs(run), run
+
+    distance = staticmethod(_distance)
+    extrapolate = staticmethod(_extrapolate)
+    borrow = staticmethod(_borrow_corrections)
+
+    def bands(self, out: dict[str, Any], bands: list[tuple[float, float]] | None = None
+              ) -> list[tuple[float, float]]:
+        """The bands the free ends of ``out`` sweep (merged with ``bands`` if given)."""
+        found = bands_from_ends(out["ends"], self.space.breakpoints)
+        return found if bands is None else _merge(bands + found)
+
+    def strays(self, out: dict[str, Any], bands: list[tuple[float, float]]) -> int:
+        return _outside_bands(out["ends"], bands, self.space.breakpoints)
+
+
+def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
+                     first_steps: int) -> tuple:
+    """The panel rule and time grids of the marches of ``marches`` (module notes), with
+    their estimates: (rule, extrapolated outputs, last march, band note, output times
+    with an end outside the bands, error of the outputs, of the zone ends, the time and
+    space parts of the former)."""
+    # The zone ends have their own budget whatever tol is (issue 13): half of it for the
+    # panel rule (core/contact/kinks.py takes the kinks at the ends out of its error), the
+    # rest, or at least the other half, for the time grid; likewise tol / 3 of the outputs
+    # (success asks the sum of the two parts to meet it).
+    end_tol = ZONE_END_TOL
+    # the zones at loading found by the first march start the first step of the others
+    first: dict[str, Any] = {}
+    base, space_error, space_shift, band_note = _select_rule(marches, times, res,
+                                                             first_steps, tol, end_tol,
+                                                             first=first)
+    out, time_error, end_shift, run = _in_time(
+        marches, times, base, first_steps,
+        max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
+        max(end_tol - space_shift, end_tol / 2), first)
+    strays = marches.strays(out, band_note["bands"])
+    if strays:
+        # An end went where the first march did not see it (between its few times, or as
+        # a zone opening late): the bands of every output time, and everything again.
+        bands = marches.bands(out, band_note["bands"])
+        base, space_error, space_shift, band_note = _select_rule(
+            marches, times, res, first_steps, tol, end_tol, bands=bands, first=first)
+        out, time_error, end_shift, run = _in_time(
+            marches, times, base, first_steps,
+            max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
+            max(end_tol - space_shift, end_tol / 2), first)
+        strays = marches.strays(out, band_note["bands"])
+    error = float(time_error + space_error)
+    end_error = float(end_shift + space_shift)
+    return (base, out, run, band_note, strays, error, end_error, float(time_error),
+            float(space_error))
+
+
+def _in_time(marches: Any, times: np.ndarray, base: Any, first_steps: int, budget: float,
              end_budget: float, first: dict[str, Any] | None = None
              ) -> tuple[dict[str, Any], float, float, dict[str, Any]]:
     """March on halved grids until the time estimate meets ``budget`` (what the panel
     rule left of tol / 3) and that of the zone ends ``end_budget`` (module notes):
     (outputs, their time error, the zone ends' time error, the last march)."""
-    op = rule_operator(space.lam, base)
-    m = space.m(base.nodes)
-    g = space.g(base.nodes)
     plain: list[dict[str, Any]] = []
     extrapolated: list[dict[str, Any]] = []
     time_error = end_shift = np.inf
     for level in range(MAX_HALVINGS + 1):
-        grid, widths, index = time_grid(inp.times, first_steps, level)
+        grid, widths, index = time_grid(times, first_steps, level)
         # the first grid borrows the kink corrections of the second (_borrow_corrections)
-        run = march(space, inp, base, op, m, g, grid, widths, index, exact_ends=level > 0,
-                     first=first)
-        plain.append(march_outputs(run))
+        outputs, run = marches.run(base, grid, widths, index, exact_ends=level > 0,
+                                   first=first)
+        plain.append(outputs)
         if level == 1:
-            _borrow_corrections(plain[0], plain[1])
+            marches.borrow(plain[0], plain[1])
         if len(plain) >= 2:
-            extrapolated.append(_extrapolate(plain[-1], plain[-2]))
+            extrapolated.append(marches.extrapolate(plain[-1], plain[-2]))
         if len(plain) == 2:
             # Two grids: the extrapolated outputs are reported, with the error of the finer
             # plain ones, |fine - coarse| / 3 (order 2), as a conservative estimate.
-            diff, shift = _distance(plain[-1], plain[-2])
+            diff, shift = marches.distance(plain[-1], plain[-2])
             time_error, end_shift = diff / 3.0, shift / 3.0
             if time_error <= budget and end_shift <= end_budget:
                 break
         if len(extrapolated) >= 2:
-            diff, shift = _distance(extrapolated[-1], extrapolated[-2])
+            diff, shift = marches.distance(extrapolated[-1], extrapolated[-2])
             # Order 4 after one extrapolation would make the newer one ~16 times closer;
             # measured in full contact against the projection method (tests/test_contact):
             # the error was 1.17 times diff / 15, so only order 3 (diff / 7) is assumed.
@@ -234,10 +293,9 @@ def _check_times(times: np.ndarray, count: int = 0) -> np.ndarray:
     return times[np.unique(np.linspace(0, times.size - 1, count).round().astype(int))]
 
 
-def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol: float,
-                 end_tol: float, bands: list[tuple[float, float]] | None = None,
-                 first: dict[str, Any] | None = None
-                 ) -> tuple[Panels, float, float, dict[str, Any]]:
+def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, tol: float,
+                 end_tol: float, bands: Any = None, first: dict[str, Any] | None = None
+                 ) -> tuple[Any, float, float, dict[str, Any]]:
     """The panel rule of the stepping and its spatial error (outputs, zone ends).
 
     On the first time grid of a few of the output times: a march on the base rule finds
@@ -248,37 +306,30 @@ def _select_rule(space: Space, inp: Any, res: Resolution, first_steps: int, tol:
     their difference meets a sixth of ``tol`` and half the zone-end tolerance (half of
     what success asks; or ``BAND_WIDTHS`` run out).
     """
-    check = _check_times(inp.times)
+    check = _check_times(times)
     grid, widths, index = time_grid(check, first_steps, 0)
 
-    def check_march(rule: Panels) -> dict[str, Any]:
-        op = rule_operator(space.lam, rule)
-        run = march(space, inp, rule, op, space.m(rule.nodes), space.g(rule.nodes), grid,
-                     widths, index, first=first)
-        return march_outputs(run)
+    def check_march(rule: Any) -> dict[str, Any]:
+        return marches.run(rule, grid, widths, index, first=first)[0]
 
     # The bands need the ends only to well within their margin: fewer times and a
     # coarser grading at the edges do (ends within ~1e-4 of the finer rules' on the
     # preset), at a quarter of the cost of a check march.
     if bands is None:
-        locate = _check_times(inp.times, LOCATE_OUTPUTS)
+        locate = _check_times(times, LOCATE_OUTPUTS)
         grid_l, widths_l, index_l = time_grid(locate, first_steps, 0)
-        coarse = band_rule(space, Resolution(res.width, max(res.edge, LOCATE_EDGE)), [],
-                           0.0)
-        op_l = rule_operator(space.lam, coarse)
-        located = march(space, inp, coarse, op_l, space.m(coarse.nodes),
-                         space.g(coarse.nodes), grid_l, widths_l, index_l, exact_ends=False,
-                         first=first)
-        bands = bands_from_ends(march_outputs(located)["ends"], space.breakpoints)
+        located = marches.run(marches.locating(res), grid_l, widths_l, index_l,
+                              exact_ends=False, first=first)[0]
+        bands = marches.bands(located)
     # every panel finer: the base width halved, its grading at +-1 and the breakpoints too
-    finer = Resolution(res.width / 2.0, res.edge / 2.0)
+    finer = marches.halved(res)
     width = BAND_WIDTHS[0]
-    rule = band_rule(space, res, bands, width)
+    rule = marches.rule(res, bands, width)
     current = check_march(rule)
     while True:
-        half = band_rule(space, finer, bands, width / 2.0)
+        half = marches.rule(finer, bands, width / 2.0)
         halved = check_march(half)
-        diff, shift = _distance(current, halved)
+        diff, shift = marches.distance(current, halved)
         error, end_error = SPACE_FACTOR * diff, SPACE_FACTOR * shift
         if (error <= tol / 6 and end_error <= end_tol / 2) or width / 2.0 < BAND_WIDTHS[-1]:
             break

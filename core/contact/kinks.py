@@ -27,6 +27,7 @@ the nodal ones were 2.4e-6 off (tests/contact/test_contact.py).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -173,6 +174,9 @@ class Corrected:
     delta: float
     alpha: float
     step: Step
+    # the displacement e(x) other punches on the base add (their corrected pressures and
+    # memories: core.contact.coupled_creep); None for one punch
+    coupling: Callable[[np.ndarray], np.ndarray] | None = None
 
 
 def kink_corrected(space: Space, step: Step, state: NodalState, op: np.ndarray,
@@ -285,6 +289,7 @@ def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL
     scale = np.array([steps[s].step.scale for s in owner])
     c_val = np.array([steps[s].step.c for s in owner])
     mine = cut_owner[None, :] == owner[:, None]  # (ends, cut nodes): each end's own cut
+    coupled = any(c.coupling is not None for c in steps)
 
     def nystrom(t: np.ndarray, rep: int) -> np.ndarray:
         base_rows = _part_rows(space.lam, panels, t, accuracy=accuracy)
@@ -296,6 +301,8 @@ def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL
             cut_rows * np.tile(mine, (rep, 1))) @ cut_density
         e = 0.0 if memory is None else np.einsum("ij,ij->i", base_rows,
                                                  np.tile(memory, (rep, 1)))
+        if coupled:
+            e = e + _couplings(steps, np.tile(owner, rep), t)
         return ((np.tile(delta, rep) + np.tile(alpha, rep) * t - space.g(t) + e
                  - np.tile(scale, rep) * fq) / (np.tile(c_val, rep) * space.m(t)))
 
@@ -325,6 +332,18 @@ def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL
             if lo < b[j] < hi and abs(b[j] - ends[k]) < widest:
                 out[s][k] = float(b[j])
             j += 1
+    return out
+
+
+def _couplings(steps: list[Corrected], owner: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The other punches' displacement at the points ``t``, each from its own step
+    (``owner``)."""
+    out = np.zeros(t.size)
+    for s in np.unique(owner):
+        coupling = steps[int(s)].coupling
+        if coupling is not None:
+            at = owner == s
+            out[at] = coupling(t[at])
     return out
 
 

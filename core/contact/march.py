@@ -71,10 +71,7 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
     c_vals = inp.c(grid)
     loads = {name: np.asarray(fn(grid), dtype=float) for name, fn in inp.loads.items()}
     check_loads(inp.given, loads, grid)
-    inner = np.zeros(steps)
-    inner[:-1] += 0.5 * widths
-    inner[1:] += 0.5 * widths
-    memory_of = pressure_memory(inp.kernel, grid, inner, n_nodes)
+    memory_of = creep_memory(inp.kernel, grid, widths, n_nodes)
     wanted = {int(i): k for k, i in enumerate(out_index)}
     # per output time: the state, its step, the memory density, the ends, the nodal ends
     states: list[tuple[NodalState, Step, np.ndarray, list[float], list[float]]] = (
@@ -96,7 +93,7 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         displacement = op @ memory_density
         start = active
         if n == 0 and first is not None and "zones" in first:
-            start = _nodes_in(base.nodes, first["zones"])
+            start = nodes_in(base.nodes, first["zones"])
         try:
             state, count, settled = _step_state(base, op, m, g, step, displacement, start,
                                                 solver, retry=n == 0)
@@ -135,7 +132,16 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
             "back_substitutions": solver.back_substitutions}
 
 
-def _nodes_in(x: np.ndarray, zones: list[tuple[float, float]]) -> np.ndarray:
+def creep_memory(kernel: Any, grid: np.ndarray, widths: np.ndarray, n_nodes: int) -> Any:
+    """The memory of past pressures (:func:`core.contact.memory.pressure_memory`) of a
+    march over ``grid`` (steps ``widths``) on ``n_nodes`` nodes: its trapezoid weights."""
+    inner = np.zeros(grid.size)
+    inner[:-1] += 0.5 * widths
+    inner[1:] += 0.5 * widths
+    return pressure_memory(kernel, grid, inner, n_nodes)
+
+
+def nodes_in(x: np.ndarray, zones: list[tuple[float, float]]) -> np.ndarray:
     """The nodes ``x`` inside the ``zones`` (a contact set as a start)."""
     inside = np.zeros(x.size, dtype=bool)
     for lo, hi in zones:

@@ -82,7 +82,6 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     loads = {name: np.asarray(fn(times_arr), dtype=float) for name, fn in inp.loads.items()}
     check_loads(inp.given, loads, times_arr)
     space = Space(inp.lam, inp.m, inp.g, inp.breakpoints)
-    m_probe = inp.m(np.linspace(-1.0, 1.0, 257))
     res = zone_resolution(inp.lam, inp.m)
     nodal_res = nodal_resolution(inp.lam, inp.m)
     if inp.kernel is None:
@@ -90,9 +89,7 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     else:
         from core.contact.creep import solve_creep
 
-        creep_res = Resolution(min(_CREEP_WIDTH, 3.0 / inp.lam), max(res.edge, min(
-            _CREEP_EDGE, 0.25 * float(np.min(m_probe)))))
-        out = solve_creep(space, inp, c_t, loads, creep_res,
+        out = solve_creep(space, inp, c_t, loads, creep_resolution(inp.lam, inp.m),
                           **({} if time_steps is None else {"first_steps": time_steps}))
     out["info"]["seconds"] = _time.perf_counter() - started
     return UnilateralSolution(times_arr.copy(), out["settlement"], out["tilt"], out["force"],
@@ -107,6 +104,16 @@ def zone_resolution(lam: float, m: Callable[[np.ndarray], np.ndarray]) -> Resolu
     m_probe = m(np.linspace(-1.0, 1.0, 257))
     return Resolution(min(ZONE_PANEL_WIDTH, 3.0 / lam),
                       min(ZONE_EDGE_WIDTH, 0.25 * float(np.min(m_probe))))
+
+
+def creep_resolution(lam: float, m: Callable[[np.ndarray], np.ndarray]) -> Resolution:
+    """The base of the fixed rule of creep steps: panels at most ``_CREEP_WIDTH`` (and
+    3/lam) wide, graded to ``_CREEP_EDGE`` at +-1 and the breakpoints, finer for a thin
+    coating (never coarser than :func:`zone_resolution`'s grading)."""
+    m_probe = m(np.linspace(-1.0, 1.0, 257))
+    res = zone_resolution(lam, m)
+    return Resolution(min(_CREEP_WIDTH, 3.0 / lam), max(res.edge, min(
+        _CREEP_EDGE, 0.25 * float(np.min(m_probe)))))
 
 
 def nodal_resolution(lam: float, m: Callable[[np.ndarray], np.ndarray]) -> Resolution:

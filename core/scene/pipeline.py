@@ -21,7 +21,13 @@ import numpy as np
 from core.engines.layered import solve_scene_layered
 from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
-from core.scene.punches import PunchesScene, PunchesSolution, has_punches, solve_punches_scene
+from core.scene.punches import (
+    PunchesScene,
+    PunchesSolution,
+    has_punches,
+    punches_from_dict,
+    solve_punches_scene,
+)
 from core.scene.results import SceneSolution, _check_finite
 from core.scene.uncoated import lift_off_refusal
 from core.scene.validate import scene_from_dict
@@ -40,9 +46,9 @@ def solve(scene: Scene | PunchesScene | Mapping[str, Any]) -> SceneSolution | Pu
             with work_bound():
                 return solve_punches_scene(scene)
         except WorkLimitExceeded as exc:
-            # the time stepping of the coupled modes is what can run long
-            raise ValueError(f"punches: {exc}; fewer or earlier output times, or a looser "
-                             "solver.tol, costs less") from None
+            # the time stepping of the coupled modes, or their lift-off under creep
+            # followed step by step, is what can run long
+            raise ValueError(_costly_punches(scene, exc)) from None
     # CPU time of this thread [s] from the dict to the answer, validation included: what
     # the scene costs, whatever else the machine runs (info["seconds"] is the solver's
     # wall time)
@@ -64,6 +70,20 @@ def solve(scene: Scene | PunchesScene | Mapping[str, Any]) -> SceneSolution | Pu
     result.info["cpu_seconds"] = time.thread_time() - started
     _check_finite(result)
     return result
+
+
+def _costly_punches(scene: PunchesScene | Mapping[str, Any], exc: WorkLimitExceeded) -> str:
+    """:func:`_costly` for a scene of several punches: the first load that varies in
+    time, named ``punches[k].loading.<quantity>`` (else ``punches``)."""
+    field = "punches"
+    for k, sub in enumerate(punches_from_dict(scene).scenes):
+        varying = [q for q, profile in sub.loading.items()
+                   if getattr(profile, "kind", None) != "constant"]
+        if varying:
+            field = f"punches[{k}].loading.{varying[0]}"
+            break
+    return (f"{field}: {exc}; a smoother or shorter history of the loads, fewer or earlier "
+            "output times, a looser solver.tol, or solver.contact 'full' costs less")
 
 
 def _costly(scene: Scene, exc: WorkLimitExceeded) -> str:

@@ -9,13 +9,15 @@ so every field keeps its rules; a refusal names it as ``punches[k].<field>``.
 One punch is the single-punch scene at its centre, answered by :func:`core.scene.solve`
 (every base, contact model and engine). Several punches are coupled by the default engine
 (:mod:`core.engines.nystrom.multi`) with the thin-layer coating model, in full contact (on
-an elastic, aging or creeping base); on an elastic base they may lift off
-(:func:`core.contact.solve_unilateral_punches`: ``solver.contact`` ``"unilateral"``, or
-``"auto"`` when full contact is lost under some punch; then every punch's contact set is
-an unknown). The coating's profiles are functions of the global x along the whole surface
-(checked over the punches' span); each punch sees them from its centre. What is not
-coupled yet (lift-off under creep) is refused with a ValueError naming the field and the
-reason.
+an elastic, aging or creeping base); they may lift off (``solver.contact``
+``"unilateral"``, or ``"auto"`` when full contact is lost under some punch; then every
+punch's contact set is an unknown): on an elastic base by
+:func:`core.contact.solve_unilateral_punches`, each time on its own, on a creeping or
+aging one by :func:`core.contact.solve_creep_punches`, one march in time over all
+punches. Lift-off needs every punch pressed (a pulled punch is refused naming
+``punches[k].loading.<field>``). The coating's profiles are functions of the global x
+along the whole surface (checked over the punches' span); each punch sees them from its
+centre.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ import numpy as np
 
 from core import limits
 from core.coating import DEFAULT_INTERFACE
-from core.contact import solve_unilateral_punches
+from core.contact import solve_creep_punches, solve_unilateral_punches
 from core.engines.nystrom import PunchGeometry, solve_punches
 from core.problem import TimeInputs, validate_geometry, validate_time_inputs
 from core.profiles import shifted
@@ -41,9 +43,6 @@ from core.scene.design import DesignCheck, DesignLimits
 from core.scene.model import Scene
 from core.scene.results import SceneSolution
 from core.validation import bounded_list, finite_number
-
-#: What the coupled solve does not answer yet, named in its refusals.
-COUPLED_SCOPE = "lift-off of several punches is solved on an elastic base for now"
 
 
 @dataclass(frozen=True, eq=False)
@@ -229,15 +228,6 @@ def _along_x(common: Mapping[str, Any], scenes: list[Scene], centers: list[float
     return out
 
 
-def _check_coupled(scene: PunchesScene) -> None:
-    """Refuse what the coupled solve does not answer yet, naming the field."""
-    first = scene.scenes[0]
-    if first.contact == "unilateral" and first.dimensionless.kernel is not None:
-        raise ValueError(f"solver.contact: {COUPLED_SCOPE}, and the base creeps (give 'full' "
-                         "for the full-contact answer, a lost contact flagged contact_lost "
-                         "on its punch)")
-
-
 def _check_touch(scene: PunchesScene) -> None:
     """Refuse, naming ``punches[k].loading.<field>``, loads no contact can carry (the
     single punch's :func:`core.scene.load_limits.check_loads_touch`, punch by punch): a
@@ -253,9 +243,12 @@ def _check_touch(scene: PunchesScene) -> None:
 
 def _lift_off(scene: PunchesScene, geometries: list[PunchGeometry],
               inputs: list[TimeInputs]) -> list[Any]:
-    """Every punch's answer with lift-off (:func:`core.contact.solve_unilateral_punches`)."""
+    """Every punch's answer with lift-off (:func:`core.contact.solve_unilateral_punches`
+    on an elastic base, :func:`core.contact.solve_creep_punches` on a creeping one)."""
     _check_touch(scene)
-    return solve_unilateral_punches(geometries, inputs)
+    if inputs[0].kernel is None:
+        return solve_unilateral_punches(geometries, inputs)
+    return solve_creep_punches(geometries, inputs)
 
 
 class PunchSolution(SceneSolution):
@@ -375,7 +368,6 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
         solution = single.dimensionless
         punches = [PunchSolution(scene.scenes[0], scene.centers[0], solution)]
     else:
-        _check_coupled(scene)
         geometries, inputs = [], []
         for sub, center in zip(scene.scenes, scene.centers, strict=True):
             problem = sub.dimensionless
@@ -396,14 +388,6 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
                     answer.info["contact"] = "full"
                 lost = [k for k, a in enumerate(answers) if "contact_lost" in a.info["flags"]]
                 if lost and first.contact == "auto":
-                    if first.dimensionless.kernel is not None:
-                        k = lost[0]
-                        raise ValueError(
-                            f"solver.contact: punches[{k}] loses contact (q < 0 under it in "
-                            f"full contact, down to {answers[k].info['min_pressure']:.3g} of "
-                            f"q*) and {COUPLED_SCOPE}: give solver.contact 'full' for the "
-                            "full-contact answer flagged contact_lost, or loads that keep "
-                            "every punch pressed")
                     full = answers
                     answers = _lift_off(scene, geometries, inputs)
                     for answer, before in zip(answers, full, strict=True):

@@ -1,6 +1,7 @@
 """Lift-off of several punches on one elastic base (core/contact/coupled.py): far apart as
 single punches, a mirrored pair, convergence of a close pair where one punch lifts off,
-full contact where it holds, and what stays refused."""
+full contact where it holds, and the refusals (on a creeping base:
+tests/scene/test_punches_creep_liftoff.py)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import pytest
 import core
 from core.contact.result import UNILATERAL_MARGIN
 from core.contact.zones import SKIP_END_STEP, ZONE_END_TOL
-from tests.scene.test_punches import QUANTITIES, _base, _creeping, _pair, _single
+from tests.scene.test_punches import QUANTITIES, _base, _pair, _single
 
 #: Punch 0 of :func:`_pair` lifts its heel off under this load (e = 0.4 a).
 LIFTING = {"force": 5e5, "moment": 2e5}
@@ -185,15 +186,6 @@ def test_one_punch_pulled_away_is_refused_naming_it() -> None:
         core.solve(d)
     d["solver"]["contact"] = "full"  # a bonded punch may be pulled
     assert "punches[0].contact_lost" in core.solve(d).flags
-
-
-def test_lift_off_under_creep_is_refused_naming_the_contact_model() -> None:
-    d = _creeping(_pair(0.5, loads=(LIFTING, {"force": 3e5, "moment": 0.0})))
-    d["times"]["count"] = 2
-    d["solver"]["contact"] = "unilateral"
-    with pytest.raises(ValueError, match=r"solver\.contact: lift-off of several punches is "
-                                         r"solved on an elastic base for now"):
-        core.solve(d)
 
 
 def test_a_punch_off_the_centre_measures_its_zones_from_its_own_centre() -> None:

@@ -56,7 +56,8 @@ Creep and a modulus varying in time: the same coupled operator in modal form
 (:mod:`core.engines.nystrom.multi_modal`), stepped by :mod:`core.time`; the time
 stepping's estimate is added to the punches' spatial ones. Lift-off is not solved here:
 :mod:`core.contact.coupled` runs the single punch's lift-off machinery over the punches
-(elastic base), with the same scaling, coupling and :func:`interacting` pairs.
+(elastic base; :mod:`core.contact.coupled_creep` its creep march), with the same scaling,
+coupling and :func:`interacting` pairs.
 """
 
 from __future__ import annotations

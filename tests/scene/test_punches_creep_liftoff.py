@@ -1,0 +1,174 @@
+"""Lift-off of several punches on a creeping base (core/contact/coupled_creep.py): far apart
+as single punches, a mirrored pair that lifts off as it creeps, convergence of a close pair
+where both lift off, and what is refused."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import numpy as np
+import pytest
+
+import core
+from core.contact.result import UNILATERAL_MARGIN
+from core.contact.zones import ZONE_END_TOL
+from core.work import work_bound
+from tests.conftest import scene_file
+from tests.scene.test_punches import QUANTITIES, _base, _creeping, _pair, _single
+from tests.scene.test_punches_liftoff import LIFTING, _errors, _relative
+
+#: Punch 1 of :func:`_pair` lifts its right edge off under this load (e = -0.56 a).
+LIFTING_RIGHT = {"force": 3e5, "moment": -1e5}
+
+
+def _lifting_pair(gap: float, tol: float = 1e-6, count: int = 6) -> dict[str, Any]:
+    """Both punches of :func:`_pair` lifting off (each its outer side) on the creeping
+    base of tests/scene/test_punches.py, ``count`` output times up to a year."""
+    d = _creeping(_pair(gap, tol=tol, loads=(LIFTING, LIFTING_RIGHT)))
+    d["times"]["count"] = count
+    d["solver"]["contact"] = "unilateral"
+    return d
+
+
+def test_far_apart_punches_lift_off_under_creep_as_single_punches() -> None:
+    d = _lifting_pair(60.0)  # 15 base thicknesses apart
+    result = core.solve(d)
+    assert not result.flags and result.info["success"]
+    for k, punch in enumerate(result.punches):
+        alone = _single(d, k)
+        assert punch.info["contact"] == alone.info["contact"] == "unilateral"
+        shifted = copy.copy(alone)
+        shifted.contact_set = [[(punch.center + lo, punch.center + hi) for lo, hi in zones]
+                               for zones in alone.contact_set]
+        errors = _errors(punch, shifted)
+        # measured: settlement, tilt, force, moment <= 5.9e-15, q 5.0e-14, zone ends
+        # 4.8e-15 half-widths: the same rules and grids, the coupling at 15 H ~exp(-2.1 *
+        # 15) = 2e-14; the single solves' estimates are 5.6e-8 and 1.1e-7 (outputs),
+        # 1.7e-7 and 4.9e-8 (zone ends)
+        for q in (*QUANTITIES, "q"):
+            assert errors[q] < min(1e-9, alone.info["error_estimate"]), (k, q, errors)
+        assert errors["ends"] < min(1e-9, alone.info["zone_end_error"])
+        # one march serves both: its estimate is the larger of the two punches'
+        assert punch.info["error_estimate"] >= 0.5 * alone.info["error_estimate"]
+        assert punch.settlement[-1] > 1.2 * punch.settlement[0]  # it creeps
+    lifted, right = result.punches[0].contact_set, result.punches[1].contact_set
+    assert all(len(z) == 1 and z[0][0] > -1.0 and z[0][1] == 1.0 for z in lifted)
+    assert all(len(z) == 1 and z[0][0] == pytest.approx(61.0) and z[0][1] < 62.2
+               for z in right)
+    # the zone shrinks as the base creeps (measured: its end from -0.773 to -0.876 m)
+    assert lifted[-1][0][0] < lifted[0][0][0] - 0.03
+
+
+@pytest.mark.slow
+def test_far_apart_punches_on_an_aging_base_lift_off_as_single_punches() -> None:
+    young = scene_file("young_concrete_50_years")
+    d = _lifting_pair(60.0, tol=1e-4)
+    d["base"]["creep"] = copy.deepcopy(young["base"]["creep"])
+    d["base"]["age_at_loading"] = young["base"]["age_at_loading"]
+    result = core.solve(d)
+    estimates = []
+    for k, punch in enumerate(result.punches):
+        alone = _single(d, k)
+        shifted = copy.copy(alone)
+        shifted.contact_set = [[(punch.center + lo, punch.center + hi) for lo, hi in zones]
+                               for zones in alone.contact_set]
+        errors = _errors(punch, shifted)
+        # measured: outputs <= 2.3e-15, q 4.3e-14, zone ends 1.2e-14 half-widths. The
+        # aging kernel is fast just after loading: the single punches and the pair stop
+        # at the finest time grid with estimates of 1.2e-4 (flagged, all)
+        for q in (*QUANTITIES, "q"):
+            assert errors[q] < 1e-9, (k, q, errors)
+        assert errors["ends"] < 1e-9
+        assert punch.flags == alone.flags
+        estimates.append(alone.info["time_error_estimate"])
+    # one march for both: its estimate is the larger of theirs (measured 1.2457e-4 and
+    # 1.2457e-4 against 1.2113e-4 and 1.2457e-4 alone)
+    for punch in result.punches:
+        assert punch.info["time_error_estimate"] == pytest.approx(max(estimates), rel=1e-6)
+
+
+@pytest.mark.slow
+def test_a_mirrored_pair_lifts_off_in_mirror_as_the_base_creeps() -> None:
+    """contact "auto": full contact while it holds under both punches, then lift-off of
+    their outer heels as the moment grows (the full-contact answer flags it)."""
+    d = _creeping(_base())
+    d["times"]["count"] = 6  # log-spaced: the heels lift between the last two
+    ramp = {"kind": "linear", "start": 0.0, "end": 3e5}
+    d["punches"] = [
+        {"center": -1.2, "half_width": 1.0, "loading": {"force": 5e5, "moment": ramp}},
+        {"center": 1.2, "half_width": 1.0,
+         "loading": {"force": 5e5, "moment": dict(ramp, end=-3e5)}}]
+    result = core.solve(d)
+    assert not result.flags
+    left, right = result.punches
+    assert left.info["contact"] == "unilateral"
+    assert "contact_lost" in left.info["full_contact"]["flags"]
+    # measured: settlement 5.1e-15, tilt 5.6e-15 of the largest, zone ends 2.0e-15 m,
+    # q 6.4e-15 (mirrored rules, equal to rounding)
+    np.testing.assert_allclose(left.settlement, right.settlement, rtol=1e-12)
+    np.testing.assert_allclose(left.tilt, -right.tilt, rtol=0,
+                               atol=1e-12 * np.max(np.abs(left.tilt)))
+    for zl, zr in zip(left.contact_set, right.contact_set, strict=True):
+        mirrored = [(-hi, -lo) for lo, hi in reversed(zr)]
+        np.testing.assert_allclose(np.ravel(zl), np.ravel(mirrored), rtol=0, atol=1e-12)
+    x = np.linspace(-1.0, 1.0, 101)
+    assert _relative(left.pressure(x), right.pressure(-x)) < 1e-12
+    assert left.contact_set[0] == [pytest.approx((-2.2, -0.2))]  # no moment: full contact
+    lo, hi = left.contact_set[-1][0]
+    assert -2.2 < lo and hi == pytest.approx(-0.2)  # each lifts its outer heel
+    assert np.all(left.tilt[1:] > 0) and np.all(np.diff(left.tilt) > 0)
+
+
+@pytest.mark.slow
+def test_a_close_pair_lifting_off_under_creep_converges() -> None:
+    """Both punches lift off 0.2 m apart: the coupling moves the zones (see the checks of
+    the far pair above), and the answer converges to one on the finest rules."""
+    # The reference asks 1e-8: its rule ends at the finest band panels (0.005) and its
+    # estimate is 1.5e-8 (flagged tol_not_met, measured), an order below the errors below.
+    reference = core.solve(_lifting_pair(0.2, 1e-8, count=10))
+    for tol in (1e-4, 1e-6):
+        result = core.solve(_lifting_pair(0.2, tol, count=10))
+        assert result.info["success"] and not result.flags
+        for mine, best in zip(result.punches, reference.punches, strict=True):
+            errors = _errors(mine, best)
+            estimate = mine.info["error_estimate"]
+            # measured at 1e-4 and 1e-6 (the zone ends' own budget, 1e-6, sets the same
+            # rule and grids at both), punch 0 / punch 1: settlement 1.5e-8 / 4.0e-8, tilt
+            # 3.0e-8 / 7.1e-8, force and moment 7e-15 (given) against the estimate 1.8e-7;
+            # zone ends 1.2e-7 / 2.5e-8 half-widths against 3.0e-7; q 2.7e-7 / 2.1e-7 of its
+            # largest value, 1.5 times the estimate (which is of the histories: a single
+            # punch's q under creep erred by 2.9 times its estimate, measured on punch 0
+            # of the close pair of tests/scene/test_punches_liftoff.py alone)
+            for q in QUANTITIES:
+                assert errors[q] <= min(tol, estimate), (tol, q, errors)
+            assert errors["ends"] <= min(ZONE_END_TOL, mine.info["zone_end_error"])
+            assert errors["q"] <= UNILATERAL_MARGIN * estimate
+    lifted, right = reference.punches
+    # the neighbour's pressure changes the zones at a year (measured): punch 0 from -0.876
+    # m alone to -0.783 m, punch 1 from 2.091 m to 2.050 m
+    assert -0.80 < lifted.contact_set[-1][0][0] < -0.76
+    assert 2.04 < right.contact_set[-1][0][1] < 2.06
+
+
+def test_a_punch_pulled_away_between_output_times_is_refused_naming_it() -> None:
+    """A creeping base remembers the loads between the output times: a pull there is
+    refused as for one punch, naming the punch's field."""
+    d = _lifting_pair(0.5, count=2)
+    # zero at both output times (0 and 365 days), negative between them
+    d["punches"][1]["loading"]["force"] = {"kind": "sine", "mean": 0.0,
+                                           "amplitude": 1e5, "wavelength": 365.0,
+                                           "phase": 0.0}
+    d["punches"][1]["loading"]["moment"] = 0.0
+    with pytest.raises(ValueError, match=r"punches\[1\]\.loading\.force: the punch is pulled"):
+        core.solve(d)
+
+
+def test_a_creep_lift_off_past_its_work_bound_names_the_load_that_varies() -> None:
+    d = _lifting_pair(0.5, count=40)
+    d["punches"][1]["loading"]["moment"] = {"kind": "linear", "start": 0.0, "end": -1e5}
+    with work_bound(0.2), pytest.raises(ValueError) as refused:
+        core.solve(d)
+    message = str(refused.value)
+    assert message.startswith("punches[1].loading.moment: the solve was stopped after 0.2 s")
+    assert "several punches under creep" in message
