@@ -148,8 +148,10 @@ class ContactDrawing:
                                     "ys": [p[1] for p in pieces]}
         t = float(view.times[index])
         width = float(self._widths[index]) if index < len(self._widths) else 2 * a
-        lo, hi = view.span  # (-a, a) for one punch
-        self.zone_label.update(x=lo - 0.26 * (hi - lo), y=float(np.max(y)))
+        # at the drawing's left edge: 0.52 of the widest punch's half-width left of the
+        # loaded stretch (-1.52 a for one punch)
+        widest = max((p.half_width for p in view.punches), default=a)
+        self.zone_label.update(x=view.span[0] - 0.52 * widest, y=float(np.max(y)))
         if width < 2 * a and lifted:
             self.zone_label.text = f"contact {width:.3f} m of {2 * a:.3g} m at t = {days_text(t)}"
         elif lifted:

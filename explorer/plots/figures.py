@@ -451,7 +451,7 @@ class Figures:
 
     def _show_image(self, view: ResultView) -> None:
         unit, size = self.scales.pressure_unit(view)
-        lo, hi = view.span  # (-a, a) for one punch
+        x0, x1 = view.span  # (-a, a) for one punch
         t0, t1 = float(view.times[0]), float(view.times[-1])
         span = t1 - t0
         if not span > 0:
@@ -460,14 +460,14 @@ class Figures:
             span = max(0.1 * abs(t0), 1.0)
             t0 -= span / 2
         img = f32(view.image / size)
-        set_data(self.image_src, {"image": [img], "x": [lo], "y": [t0], "dw": [hi - lo],
+        set_data(self.image_src, {"image": [img], "x": [x0], "y": [t0], "dw": [x1 - x0],
                                   "dh": [span]})
         lo, hi = self.scales.image_range(view)
         self.image_mapper.update(low=lo, high=hi)
         self.image_bar.title = f"q [{unit}]"
         self.image_hover.tooltips = [("x", "$x{0.000} m"), ("t", "$y{0.0} days"),
                                      ("q", f"@image{{0.000}} {unit}")]
-        self.image_fig.x_range.update(start=lo, end=hi)
+        self.image_fig.x_range.update(start=x0, end=x1)
         self.image_fig.y_range.update(start=t0, end=t0 + span)
 
     _scene_key: str | None = None
