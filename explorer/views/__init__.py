@@ -7,10 +7,10 @@ to refresh them. :mod:`explorer.app` builds the views and assembles the page fro
 
 - Sidebar tabs: ``scene`` (presets, undo, the loading, with the slider of
   ``eccentricity``), ``punch`` (with ``punches``, the section of a scene of several
-  punches, and the note standing in for what is for one punch only), ``coating`` (with the coating-model check), ``base`` (with
-  ``creep``, the design codes' creep), ``times``, ``check``, ``files``, ``lessons``,
-  ``study``, ``fit`` (back-analysis from readings); ``fidelity``: the model-fidelity
-  widgets of the Coating and Time tabs.
+  punches, and the note standing in for what is for one punch only), ``coating`` (with
+  the coating-model check), ``base`` (with ``creep``, the design codes' creep),
+  ``times``, ``check``, ``files``, ``lessons``, ``study``, ``fit`` (back-analysis from
+  readings); ``fidelity``: the model-fidelity widgets of the Coating and Time tabs.
 - The results column: ``results`` (messages, plots, player, readout, design check),
   ``contact`` (the contact figures' slots), ``pins`` (pin, remove, pin every step, pins
   of a link), ``busy`` (the busy indicator), ``status`` (the status line in words).
