@@ -8,6 +8,7 @@ lessons (tests/explorer/test_explorer_lessons.py): a test fails if they drift.
 from __future__ import annotations
 
 import copy
+import json
 import pickle
 from functools import cache
 
@@ -141,6 +142,9 @@ def test_the_page_shows_each_punch_and_turns_off_what_is_for_one(explorer_app) -
     assert app.pins.pin_button.disabled and app.results.classical.disabled
     assert app.scene_tab.loading.note.visible and not app.scene_tab.loading.body.visible
     assert app.punch_tab.punches.panel.visible and not app.punch_tab.single.visible
+    # the JSON of the result is the core's, every punch in it
+    saved = json.loads(app.controller.download(view, "to_json"))
+    assert [p["center"] for p in saved["punches"]] == [0.0, 3.0]
     # back to one punch: the single-punch page as it was
     assert app.load_scene(presets()["uniform_flat"])
     assert app.controller.wait(120) and app.controller.error == ""
