@@ -206,12 +206,13 @@ class Figures:
         for k in range(SCREEN_PUNCHES):
             src = ColumnDataSource({"t": [], "v": []}, name=f"{q}_punch{k}_source")
             line = p.line(x="t", y="v", source=src, line_color=PUNCH_COLORS[k],
-                          line_width=2.5, legend_label=f"punch {k + 1}", visible=False)
-            p.add_tools(HoverTool(renderers=[line], mode="vline", tooltips=[
-                ("punch", str(k + 1)), ("t", "@t{0.0} days"),
-                (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
+                          line_width=2.5, legend_label=f"punch {k + 1}", visible=False,
+                          name=f"punch {k + 1}")
             sources.append(src)
             lines.append(line)
+        # one hover for the punches' lines (one per line added a toolbar button each)
+        p.add_tools(HoverTool(renderers=lines, mode="vline", tooltips=[
+            ("", "$name"), ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
         legend = p.legend[0]
         legend.location = "top_left"
         legend.label_text_font_size = "10px"
