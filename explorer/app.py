@@ -19,8 +19,6 @@ from typing import Any
 
 import panel as pn
 
-from core import scene_from_dict
-
 from .fixes import bokeh_fixes, closed_pages, gc_policy, idle_painter, panel_fixes
 from .model import (
     DEFAULT_PRESET,
@@ -34,6 +32,7 @@ from .model import (
     presets,
     read_study_query,
     read_view_query,
+    validated_scene,
 )
 from .plots import Figures
 from .solving import SolveController, format_error, install_websocket_marks, mark
@@ -180,7 +179,7 @@ class ExplorerApp(pn.viewable.Viewer):
         if chosen is None and query.get("scene"):
             try:
                 chosen = decode_scene(query["scene"])
-                scene_from_dict(chosen)
+                validated_scene(chosen)
             except ValueError as exc:
                 self.screen.notice = (f"The scene in the link was not used: "
                                       f"{format_error(str(exc))}. Showing the default scene "
@@ -268,7 +267,7 @@ class ExplorerApp(pn.viewable.Viewer):
     def load_scene(self, scene: dict[str, Any]) -> bool:
         """Validate a scene dict with the core and show it; False (and a notice) if bad."""
         try:
-            scene_from_dict(scene)
+            validated_scene(scene)
             self.state.load_scene(scene)
         except ValueError as exc:
             self.screen.notice = f"The scene was not loaded: {format_error(str(exc))}"

@@ -5,7 +5,8 @@ prepared where it is solved), and the state can be used without a server.
 
 - ``state``: :class:`ExplorerState`, the scene on screen in display units, and its parts:
   ``scene_parts`` (punch, coating layers, base), ``loading_state`` (which two quantities
-  are given, and their histories), ``code_creep_state`` (design-code creep inputs).
+  are given, and their histories), ``punches_state`` (the punches of a scene of
+  several), ``code_creep_state`` (design-code creep inputs).
 - ``results``: :class:`ResultView`, a solution turned into the arrays the plots show.
 - ``contact_zone``: the contact zone of a result in numbers.
 - ``design``: the design check against the limits the user sets.
@@ -59,7 +60,8 @@ from .links import decode_scene, encode_scene
 from .loading_state import QUANTITIES, QUANTITY_RANGES, QUANTITY_UNITS, STATEMENTS, HistoryState
 from .pins import MAX_PINS, Pin, PinBoard, eccentricity
 from .presets import DEFAULT_PRESET, ORDER, preset_label, presets
-from .results import Geometry, ResultView, model_evidence, prepare_view, shown_flags
+from .punches_state import SCREEN_PUNCHES, PunchEntryState, validated_scene
+from .results import Geometry, PunchResult, ResultView, model_evidence, prepare_view, shown_flags
 from .scales import DisplayScales
 from .scene_parts import (
     CONTACT_MODELS,
@@ -94,7 +96,8 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "QUANTITY_UNITS", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES",
            "Axis", "CodeCreepState", "DesignLimits", "DisplayScales", "ExplorerState",
            "FitOutcome", "Geometry", "HistoryState", "LayerState", "Lesson", "Pin", "PinBoard",
-           "PlannedStudy", "ProfileState", "ResultView", "SceneHistory", "Screen", "StudyResult",
+           "PlannedStudy", "PunchEntryState", "PunchResult", "SCREEN_PUNCHES", "ProfileState",
+           "ResultView", "SceneHistory", "Screen", "StudyResult",
            "check_html", "check_text", "contact_text", "contact_widths", "contact_zones",
            "creep_coefficient_data", "days_text", "decode_scene", "default_range",
            "design_check", "eccentricity", "encode_scene", "fit_choices", "forecast_columns",
@@ -102,4 +105,5 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "plain_number", "plan_fit", "plan_study", "read_upload", "readings_columns",
            "readings_note", "run_fit", "prepare_view", "preset_label", "presets",
            "read_study_query", "read_view_query", "shown_flags", "scene_limits",
-           "scene_with_limits", "screen_limits", "step_scene", "study_choices", "view_query"]
+           "scene_with_limits", "screen_limits", "step_scene", "study_choices", "validated_scene",
+           "view_query"]

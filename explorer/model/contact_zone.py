@@ -17,7 +17,14 @@ import numpy as np
 from core.scene import contact_width, lift_off_length
 from core.scene import lifts_off as core_lifts_off
 
-from .results import ResultView, lifted_intervals
+from .results import PunchResult, ResultView, lifted_intervals
+
+
+def _local_set(p: PunchResult) -> list[list[tuple[float, float]]]:
+    """A punch's contact set in its own x (from its centre) [m], for the core's width
+    functions, which take the zones within ``[-a, a]``."""
+    c = p.center
+    return [[(lo - c, hi - c) for lo, hi in zones] for zones in p.contact_set]
 
 
 def _contact_set(view: ResultView) -> list[list[tuple[float, float]]]:
@@ -31,26 +38,44 @@ def _contact_set(view: ResultView) -> list[list[tuple[float, float]]]:
 
 def contact_zones(view: ResultView, index: int) -> list[tuple[float, float]]:
     """Intervals of ``x`` [m] drawn in contact at output ``index`` (the whole ``[-a, a]``
-    in full contact): the complement of the parts drawn lifted off or pulling."""
+    in full contact): the complement of the parts drawn lifted off or pulling (under
+    every punch, for several)."""
+    if view.punches:
+        zones = []
+        for p in view.punches:
+            c = p.center
+            off = [(lo - c, hi - c) for lo, hi in p.negative_intervals(index)]
+            zones += [(lo + c, hi + c) for lo, hi in lifted_intervals(off, p.half_width)]
+        return zones
     a = view.geometry.half_width
     return lifted_intervals(view.negative_intervals(index), a)
 
 
 def contact_widths(view: ResultView) -> np.ndarray:
     """The contact width [m] at each output time (``2a`` in full contact), the core's
-    :func:`core.scene.contact_width` of the view's contact set."""
+    :func:`core.scene.contact_width` of the view's contact set (summed over the punches,
+    for several)."""
+    if view.punches:
+        return np.sum([contact_width(_local_set(p), p.half_width) for p in view.punches],
+                      axis=0)
     return contact_width(_contact_set(view), view.geometry.half_width)
 
 
 def lift_off_lengths(view: ResultView) -> np.ndarray:
     """The length of the base lifted off [m] at each output time (0 in full contact), the
-    core's :func:`core.scene.lift_off_length`."""
+    core's :func:`core.scene.lift_off_length` (summed over the punches, for several)."""
+    if view.punches:
+        return np.sum([lift_off_length(_local_set(p), p.half_width) for p in view.punches],
+                      axis=0)
     return lift_off_length(_contact_set(view), view.geometry.half_width)
 
 
 def lifts_off(view: ResultView) -> bool:
     """Whether the contact set is narrower than the base at some output time (the core's
-    :func:`core.scene.lifts_off`)."""
+    :func:`core.scene.lifts_off`; of any punch, for several)."""
+    if view.punches:
+        return any(bool(np.any(core_lifts_off(_local_set(p), p.half_width)))
+                   for p in view.punches)
     return bool(np.any(core_lifts_off(_contact_set(view), view.geometry.half_width)))
 
 
@@ -78,7 +103,11 @@ def contact_text(view: ResultView, index: int) -> str:
     """The contact at output ``index`` in plain words, lengths in m, e.g. "contact
     1.306 m of 2 m (65 %), lifted 0.694 m: x = -1 to -0.306 m (unilateral contact)", or
     for a full-contact answer that pulls "contact 2 m of 2 m, as the full-contact model
-    assumes; q < 0 (contact lost) on 0.372 m: x = -1 to -0.628 m (not physical)"."""
+    assumes; q < 0 (contact lost) on 0.372 m: x = -1 to -0.628 m (not physical)"; for
+    several punches, one such text per punch ("punch 1: ...; punch 2: ...")."""
+    if view.punches:
+        return "; ".join(f"punch {k + 1}: {_punch_contact_text(view, p, index)}"
+                         for k, p in enumerate(view.punches))
     a = view.geometry.half_width
     full = 2 * a
     off = view.negative_intervals(index)
@@ -92,3 +121,17 @@ def contact_text(view: ResultView, index: int) -> str:
         return (f"contact {_fmt_m(width)} m of {_fmt_m(full)} m, as the {model_name(view)} "
                 f"assumes; q < 0 (contact lost) on {_fmt_m(pulled)} m: {where} (not physical)")
     return f"full contact: the whole width 2a = {_fmt_m(full)} m touches"
+
+
+def _punch_contact_text(view: ResultView, p: PunchResult, index: int) -> str:
+    """The contact of one punch of several at output ``index``, in words (global x)."""
+    full = 2 * p.half_width
+    width = float(contact_width(_local_set(p)[index:index + 1], p.half_width)[0])
+    off = p.negative_intervals(index)
+    where = ", ".join(f"x = {_fmt_m(lo)} to {_fmt_m(hi)} m" for lo, hi in off)
+    if core_lifts_off(_local_set(p)[index:index + 1], p.half_width)[0]:
+        return (f"contact {_fmt_m(width)} m of {_fmt_m(full)} m, lifted "
+                f"{_fmt_m(full - width)} m: {where}")
+    if off:
+        return f"full-contact model, q < 0 (contact lost) at {where} (not physical)"
+    return f"full contact over {_fmt_m(full)} m"

@@ -29,7 +29,8 @@ class Step:
 @dataclass(frozen=True)
 class Lesson:
     """A preset and its steps; ``pin_steps``: each step's result stays pinned when the
-    class moves on, so the legend reads the steps."""
+    class moves on, so the legend reads the steps (not for several punches: pins
+    compare results of one punch)."""
 
     key: str
     title: str
@@ -102,6 +103,39 @@ LESSONS: tuple[Lesson, ...] = (
                  "springs. The settlement is now 0.064 mm, mostly the coating's.",
                  {"coating.0.thickness": 0.05, "coating.0.modulus": 2.0e8}),
         ),
+    ),
+    Lesson(
+        key="neighbour_footing",
+        title="A new footing beside an old one",
+        preset="new_footing_beside_old",
+        steps=(
+            Step("Punch 1, the old footing, carries 600 kN/m from the start, on concrete 7 "
+                 "days old: it settles 0.026 mm at once and 0.065 mm by one year. Then "
+                 "punch 2, 1 m to its right, is loaded from its own weight (100 kN/m) to "
+                 "600 kN/m: the old footing goes down to 0.067 mm at once and to 0.085 mm "
+                 "at 50 years. It tilts toward the new one (its right side goes down): "
+                 "0.0012 mrad before, 0.0031 mrad just after and 0.0058 mrad at 50 years, "
+                 "its right edge 12 µm below its left. Why: the new load sinks the layer "
+                 "most under itself. Were the old footing to stay level, its right edge "
+                 "would lose support and its left carry more, off its centre; no moment "
+                 "holds it level, so it turns toward the neighbour until its pressure is "
+                 "centred again. The new footing, likewise, tilts toward the old one.",
+                 log_time=True),
+            Step("The same, but the new footing is never loaded beyond its own weight: "
+                 "the old one settles 0.080 mm at 50 years and tilts 0.0015 mrad. So the "
+                 "new load added 0.0022 mm at once and 0.0050 mm (6 %) by 50 years: the "
+                 "creeping concrete more than doubles what the neighbour adds.",
+                 {"punches.1.loading.force": 1.0e5}),
+            Step("Load the new footing again, but 3 m farther (centre x = 6 m, a gap of "
+                 "4 m, the layer's thickness): the old footing settles 0.078 mm at 50 "
+                 "years, as it would alone (0.079 mm), and tilts 15 times less, 0.0004 "
+                 "mrad. A 4 m layer on rock spreads a load over about its own thickness: "
+                 "farther apart, footings hardly feel each other.",
+                 {"punches.1.center": 6.0,
+                  "punches.1.loading.force": {"kind": "step", "values": [1.0e5, 6.0e5],
+                                              "breaks": [365.25]}}),
+        ),
+        pin_steps=False,
     ),
 )
 

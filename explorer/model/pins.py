@@ -154,7 +154,10 @@ class PinBoard:
         return [pin.view.scene for pin in self.pins]
 
     def add(self, view: ResultView) -> bool:
-        """Pin ``view`` (a result already pinned is not pinned twice); False if it was."""
+        """Pin ``view`` (a result already pinned is not pinned twice); False if it was, or
+        if it is of several punches (pins compare results of one punch)."""
+        if view.several:
+            return False
         if any(pin.view.scene == view.scene for pin in self.pins):
             return False
         self.pins.append(Pin(view))

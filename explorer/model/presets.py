@@ -17,7 +17,8 @@ DEFAULT_PRESET = "uniform_flat"
 
 #: Order in which presets are offered (others follow alphabetically).
 ORDER = ("uniform_flat", "worn_coating", "patched_insert", "rounded_graded",
-         "eccentric_creep", "eccentric_footing_liftoff", "stepped_punch", "bare_layer")
+         "eccentric_creep", "eccentric_footing_liftoff", "stepped_punch", "bare_layer",
+         "new_footing_beside_old")
 
 
 @lru_cache(maxsize=1)

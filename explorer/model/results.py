@@ -36,7 +36,53 @@ class Geometry:
     modulus: list[np.ndarray]     # per layer E_k(x) [Pa]
     base_thickness: float         # H [m]
     base_modulus: float           # E of the base at loading [Pa]
-    half_width: float             # a [m]
+    half_width: float             # a [m]; several punches: the sum of theirs
+    # several punches: each punch's x [m] (global) and shape f [m], in order
+    punch_x: list[np.ndarray] = field(default_factory=list)
+    punch_shape: list[np.ndarray] = field(default_factory=list)
+
+
+@dataclass
+class PunchResult:
+    """One punch of several, ready to draw (arrays and plain values: it pickles).
+
+    ``x`` is the punch's plotting grid in the global x [m]; ``values`` its SI histories
+    (the moment about its own centre); ``contact_set`` per output time, global x [m]."""
+
+    center: float                          # [m]
+    half_width: float                      # a [m]
+    given: tuple[str, ...]
+    values: dict[str, np.ndarray]
+    x: np.ndarray                          # [m], global
+    pressure: np.ndarray                   # [Pa], (len(x), len(times))
+    contact_set: list[list[tuple[float, float]]]
+    flags: list[str]
+    error_estimate: float
+
+    def display(self, quantity: str) -> np.ndarray:
+        """History of a quantity in its display unit (mm, mrad, kN/m, kN·m/m)."""
+        return self.values[quantity] / QUANTITY_UNITS[quantity][1]
+
+    @property
+    def span(self) -> tuple[float, float]:
+        """The punch's zone ``(center - a, center + a)`` [m]."""
+        return (self.center - self.half_width, self.center + self.half_width)
+
+    def negative_intervals(self, index: int) -> list[tuple[float, float]]:
+        """The lifted parts of the punch (global x [m]) at output ``index``, or where its
+        full-contact pressure is negative beyond its error band (see
+        :meth:`ResultView.lift_off_band`)."""
+        c = self.center
+        if index < len(self.contact_set):
+            local = [(lo - c, hi - c) for lo, hi in self.contact_set[index]]
+            lifted = lifted_intervals(local, self.half_width)
+            if lifted:
+                return [(lo + c, hi + c) for lo, hi in lifted]
+        if "contact_lost" not in self.flags:
+            return []
+        peak = float(np.nanmax(np.abs(self.pressure))) if self.pressure.size else 0.0
+        band = max(self.error_estimate, 1e-12) * peak
+        return negative_intervals(self.x, self.pressure[:, index] + band)
 
 
 @dataclass
@@ -60,6 +106,25 @@ class ResultView:
     # per output time, the intervals of x [m] in contact (solver's contact_set); empty
     # when the solution does not say
     contact_set: list[list[tuple[float, float]]] = field(default_factory=list)
+    # several punches (the ``punches`` form of a scene), in order; empty for one punch.
+    # Then ``x`` and ``pressure`` run over the whole surface (NaN rows between punches
+    # break the line), ``contact_set`` is the union of the punches' zones, and
+    # ``values`` and ``given`` are those of the first punch (each one's are here)
+    punches: list[PunchResult] = field(default_factory=list)
+
+    @property
+    def several(self) -> bool:
+        """Whether the result is of a scene of several punches (``punches``)."""
+        return bool(self.punches)
+
+    @property
+    def span(self) -> tuple[float, float]:
+        """The loaded stretch of the surface [m]: ``(-a, a)``, or from the left edge of
+        the leftmost punch to the right edge of the rightmost."""
+        if not self.punches:
+            a = self.geometry.half_width
+            return (-a, a)
+        return (min(p.span[0] for p in self.punches), max(p.span[1] for p in self.punches))
 
     @property
     def unknowns(self) -> tuple[str, ...]:
@@ -98,7 +163,10 @@ class ResultView:
     def negative_intervals(self, index: int) -> list[tuple[float, float]]:
         """Intervals of ``x`` [m] where the pressure at output ``index`` is negative
         beyond the error band (see :meth:`lift_off_band`), or, when the unilateral
-        contact model lifted part of the base off, the lifted parts of the base."""
+        contact model lifted part of the base off, the lifted parts of the base (of every
+        punch, for several)."""
+        if self.punches:
+            return [span for p in self.punches for span in p.negative_intervals(index)]
         if index < len(self.contact_set):
             lifted = lifted_intervals(self.contact_set[index], self.geometry.half_width)
             if lifted:
@@ -210,6 +278,8 @@ def _resample_time(times: np.ndarray, q: np.ndarray, rows: int) -> np.ndarray:
 
 def prepare_view(solution: Any, scene: dict[str, Any]) -> ResultView:
     """Everything the explorer draws for one solution of ``scene`` (a valid scene dict)."""
+    if getattr(solution, "punches", None) is not None:
+        return _prepare_punches(solution, scene)
     scene_obj = getattr(solution, "scene", None)
     if scene_obj is None or not hasattr(scene_obj, "coating"):
         scene_obj = scene_from_dict(scene)
@@ -243,3 +313,97 @@ def prepare_view(solution: Any, scene: dict[str, Any]) -> ResultView:
                       flags=flags, flag_messages=messages, info=info,
                       contact_set=[[(float(lo), float(hi)) for lo, hi in zones]
                                    for zones in getattr(solution, "contact_set", None) or []])
+
+
+def _punch_result(p: Any, spec: dict[str, Any]) -> PunchResult:
+    """One punch of a :class:`core.scene.PunchesSolution` ready to draw."""
+    c = float(p.center)
+    a = float(p.scene.half_width)
+    times = np.asarray(p.times, dtype=float)
+    values = {q: np.asarray(getattr(p, q), dtype=float) for q in QUANTITIES}
+    for q, profile in p.scene.loading.items():
+        values[q] = _values(profile, times)  # as given (see prepare_view)
+    _drop_round_off(values, a)
+    grid = getattr(p, "x", None)
+    if grid is not None and len(grid) >= 101:
+        x = np.asarray(grid, dtype=float)
+        pressure = np.asarray(p.pressure_on_grid, dtype=float)
+    else:
+        x = np.linspace(-a, a, LINE_POINTS)
+        pressure = np.asarray(p.pressure(x), dtype=float)
+    err = p.info.get("error_estimate")
+    return PunchResult(
+        center=c, half_width=a, given=tuple(q for q in QUANTITIES if q in spec["loading"]),
+        values=values, x=x + c, pressure=pressure.reshape(len(x), len(times)),
+        contact_set=[[(float(lo), float(hi)) for lo, hi in zones] for zones in p.contact_set],
+        flags=list(p.flags),
+        error_estimate=float(err) if isinstance(err, (int, float)) else 0.0)
+
+
+def _prepare_punches(solution: Any, scene: dict[str, Any]) -> ResultView:
+    """The :class:`ResultView` of a scene of several punches (a ``PunchesSolution``)."""
+    times = np.asarray(solution.times, dtype=float)
+    punches = [_punch_result(p, spec) for p, spec in zip(solution.punches, scene["punches"],
+                                                           strict=True)]
+    # the pressure over the whole surface: each punch's grid, a NaN row between two
+    # (the line breaks over the free surface, where q = 0)
+    order = sorted(range(len(punches)), key=lambda k: punches[k].center)
+    gap_x, gap_q = np.array([np.nan]), np.full((1, len(times)), np.nan)
+    xs, qs = [], []
+    for k in order:
+        xs += [punches[k].x, gap_x]
+        qs += [punches[k].pressure, gap_q]
+    x, pressure = np.concatenate(xs[:-1]), np.concatenate(qs[:-1])
+    # q(x, t) over the loaded stretch, 0 on the free surface between the punches
+    lo = min(p.span[0] for p in punches)
+    hi = max(p.span[1] for p in punches)
+    xi = np.linspace(lo, hi, IMAGE_X)
+    qi = np.zeros((IMAGE_X, len(times)))
+    for p in punches:
+        inside = (xi >= p.x[0]) & (xi <= p.x[-1])
+        for j in range(len(times)):
+            qi[inside, j] = np.interp(xi[inside], p.x, p.pressure[:, j])
+    image = _resample_time(times, qi, IMAGE_T)
+    geometry = _punches_geometry(solution)
+    # a flag of any punch is the scene's (the badges read the names); the message says
+    # which punch raised it
+    flags: list[str] = []
+    messages: dict[str, str] = {}
+    for k, p in enumerate(solution.punches):
+        for flag in p.flags:
+            if flag not in flags:
+                flags.append(flag)
+            text = dict(getattr(p, "flag_messages", {}) or {}).get(flag, flag)
+            messages[flag] = "; ".join(m for m in (messages.get(flag), f"punch {k + 1}: {text}")
+                                       if m)
+    info = {k: v for k, v in dict(solution.info).items() if k != "flags"}
+    info["flags"] = list(solution.flags)
+    first = solution.punches[0].info
+    info.setdefault("contact", first.get("contact", "full") if len(punches) == 1 else "full")
+    union = [sorted(zone for p in punches for zone in p.contact_set[j])
+             for j in range(len(times))]
+    return ResultView(scene=scene, given=punches[0].given, times=times,
+                      values=dict(punches[0].values), x=x, pressure=pressure, image=image,
+                      geometry=geometry, flags=flags, flag_messages=messages, info=info,
+                      contact_set=union, punches=punches)
+
+
+def _punches_geometry(solution: Any) -> Geometry:
+    """The drawing of several punches: the coating along the loaded stretch (each punch's
+    profiles under it, straight between two), each punch's base shape (in the scene's
+    order), in global x."""
+    geos = [(scene_geometry(s), c) for s, c in zip(solution.scene.scenes,
+                                                   solution.scene.centers, strict=True)]
+    left_first = sorted(geos, key=lambda gc: gc[1])
+    n_layers = len(geos[0][0].thickness)
+    first = geos[0][0]
+    return Geometry(
+        x=np.concatenate([g.x + c for g, c in left_first]),
+        shape=np.concatenate([g.shape for g, _ in left_first]),
+        thickness=[np.concatenate([g.thickness[k] for g, _ in left_first])
+                   for k in range(n_layers)],
+        modulus=[np.concatenate([g.modulus[k] for g, _ in left_first])
+                 for k in range(n_layers)],
+        base_thickness=first.base_thickness, base_modulus=first.base_modulus,
+        half_width=float(sum(g.half_width for g, _ in geos)),
+        punch_x=[g.x + c for g, c in geos], punch_shape=[g.shape for g, _ in geos])

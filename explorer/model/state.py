@@ -29,6 +29,7 @@ from core.scene import default_tol
 
 from .code_creep_state import CODE_CREEP_MODELS
 from .loading_state import QUANTITY_RANGES, QUANTITY_UNITS, STATEMENTS, HistoryState, LoadingState
+from .punches_state import SCREEN_PUNCHES, PunchEntryState, next_center
 from .scene_parts import (
     _RTOL,
     CONTACT_MODELS,
@@ -81,6 +82,10 @@ class ExplorerState(param.Parameterized):
         default=100.0 * DEFAULT_MODEL_TOL,
         bounds=(100.0 * MODEL_TOL_RANGE[0], 100.0 * MODEL_TOL_RANGE[1]),
         doc="Coating-model error a result may carry unflagged (solver.model_tol) [%].")
+    n_punches = param.Integer(
+        default=0, bounds=(0, SCREEN_PUNCHES),
+        doc="Punches of a scene of several (``punches``, the first ``n_punches`` of "
+            "``punch_entries``); 0: the scene's one ``punch`` and ``loading``.")
     revision = param.Integer(default=0, doc="Counts changes of the scene.")
     tol_note = param.String(
         default="", doc="Why the accuracy target was raised (a design code's creep law "
@@ -92,6 +97,7 @@ class ExplorerState(param.Parameterized):
         self.layers = [LayerState(name=f"layer{k}") for k in range(MAX_LAYERS)]
         self.base = BaseState(name="base")
         self.loading = LoadingState(name="loading")
+        self.punch_entries = [PunchEntryState(name=f"punches{k}") for k in range(SCREEN_PUNCHES)]
         self._extra: dict[str, Any] = {}
         # name of the scene as loaded, while it is shown unchanged (see _rename_modified)
         self._loaded_name: str | None = None
@@ -105,12 +111,14 @@ class ExplorerState(param.Parameterized):
                    *self.loading.histories.values(),
                    *(p for layer in self.layers for p in layer.profiles)]
         watched += self.layers
+        watched += [part for entry in self.punch_entries for part in entry.watched]
         for obj in watched:
             names = [n for n in obj.param if n != "name"]
             obj.param.watch(self._on_change, names)
         self.param.watch(self._on_change, ["scene_name", "description", "n_layers",
                                            "time_end", "time_count", "time_spacing", "tol",
-                                           "time_list", "contact", "model_tol_percent"])
+                                           "time_list", "contact", "model_tol_percent",
+                                           "n_punches"])
         self.param.watch(self._on_times, ["time_end", "time_count", "time_spacing"])
 
     # -- the accuracy a creep law allows ----------------------------------------------
@@ -179,16 +187,55 @@ class ExplorerState(param.Parameterized):
         if not self._batch and self.time_list is not None:
             self.time_list = None
 
+    @property
+    def punches(self) -> list[PunchEntryState]:
+        """The punches of a scene of several (empty for the single-punch form)."""
+        return self.punch_entries[: self.n_punches]
+
+    def add_punch(self) -> int:
+        """Add a punch to a scene of several (a copy of the rightmost, beside it), as one
+        change; returns its index. ValueError when the screen holds no more."""
+        n = self.n_punches
+        if not 0 < n < SCREEN_PUNCHES:
+            raise ValueError(f"punches: the page edits 1 to {SCREEN_PUNCHES} punches "
+                             f"(a scene of several punches), it has {n}")
+        entries = self.punches
+        right = max(entries, key=lambda e: e.center + e.punch.half_width)
+        with self.batch():
+            self.punch_entries[n].copy_from(right, next_center(entries))
+            self.n_punches = n + 1
+        return n
+
+    def remove_punch(self, index: int) -> None:
+        """Remove punch ``index`` (the others keep their order), as one change; the last
+        punch stays (ValueError)."""
+        n = self.n_punches
+        if n <= 1 or not 0 <= index < n:
+            raise ValueError(f"punches: punch {index + 1} cannot be removed (the scene has "
+                             f"{n}; one at least stays)")
+        specs = [e.to_dict() for k, e in enumerate(self.punches) if k != index]
+        with self.batch():
+            for entry, spec in zip(self.punch_entries, specs, strict=False):
+                entry.load(spec)
+            self.n_punches = n - 1
+
+    def batch(self) -> _Batch:
+        """A context in which changes count as one (``revision`` goes up once at its end,
+        if anything changed)."""
+        return _Batch(self)
+
     def to_scene(self) -> dict[str, Any]:
         """The scene dict (schema version 1, SI units, days) of the current values."""
+        several = self.n_punches > 0
         scene: dict[str, Any] = {
             "schema_version": 1,
             "name": self.scene_name,
             "description": self.description,
-            "punch": self.punch.to_dict(),
+            **({"punches": [entry.to_dict() for entry in self.punches]} if several
+               else {"punch": self.punch.to_dict()}),
             "coating": [layer.to_dict() for layer in self.layers[: self.n_layers]],
             "base": self.base.to_dict(),
-            "loading": self.loading.to_dict(),
+            **({} if several else {"loading": self.loading.to_dict()}),
             "times": (list(self.time_list) if self.time_list is not None else
                       {"end": self.time_end, "count": self.time_count,
                        "spacing": self.time_spacing}),
@@ -240,14 +287,25 @@ class ExplorerState(param.Parameterized):
 
     def _load(self, scene: dict[str, Any]) -> None:
         known = {"schema_version", "name", "description", "punch", "coating", "base",
-                 "loading", "times", "solver"}
+                 "loading", "times", "solver", "punches"}
         # Keys outside the on-screen schema (later schema additions) travel unchanged.
         self._extra = {k: copy.deepcopy(v) for k, v in scene.items() if k not in known}
-        self.punch.load(scene["punch"])
+        punches = scene.get("punches")
+        if punches is not None:
+            if not 1 <= len(punches) <= SCREEN_PUNCHES:
+                raise ValueError(f"punches: the page edits 1 to {SCREEN_PUNCHES} punches, "
+                                 f"the scene has {len(punches)}")
+            for entry, spec in zip(self.punch_entries, punches, strict=False):
+                entry.load(spec)
+            self.n_punches = len(punches)
+        else:
+            self.n_punches = 0
+            self.punch.load(scene["punch"])
         for layer, spec in zip(self.layers, scene["coating"], strict=False):
             layer.load(spec)
         self.base.load(scene["base"])
-        self.loading.load(scene["loading"])
+        if punches is None:
+            self.loading.load(scene["loading"])
         times = scene.get("times", {})
         time_list = None
         if isinstance(times, list):
@@ -272,4 +330,23 @@ class ExplorerState(param.Parameterized):
 
     def is_load_event(self, obj: param.Parameterized) -> bool:
         """Whether ``obj`` belongs to the loading histories (cheap re-solve expected)."""
-        return obj in self.loading.histories.values()
+        return obj in self.loading.histories.values() or any(
+            obj in entry.loading.histories.values() for entry in self.punch_entries)
+
+
+class _Batch:
+    """Changes of an :class:`ExplorerState` made inside count as one change."""
+
+    def __init__(self, state: ExplorerState) -> None:
+        self.state = state
+
+    def __enter__(self) -> ExplorerState:
+        self.state._batch += 1
+        return self.state
+
+    def __exit__(self, *exc: object) -> None:
+        state = self.state
+        state._batch -= 1
+        if not state._batch and state._dirty:
+            state._dirty = False
+            state._on_change()

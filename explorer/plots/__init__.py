@@ -12,8 +12,10 @@
 
 from .figures import Figures
 from .pins import PIN_COLORS
+from .scene import PUNCH_COLORS
 from .study import DesignChart, flag_note
 from .study_png import design_chart_png
 from .time_axis import LogTime
 
-__all__ = ["PIN_COLORS", "DesignChart", "Figures", "LogTime", "design_chart_png", "flag_note"]
+__all__ = ["PIN_COLORS", "PUNCH_COLORS", "DesignChart", "Figures", "LogTime",
+           "design_chart_png", "flag_note"]

@@ -148,7 +148,10 @@ class ContactDrawing:
                                     "ys": [p[1] for p in pieces]}
         t = float(view.times[index])
         width = float(self._widths[index]) if index < len(self._widths) else 2 * a
-        self.zone_label.update(x=-1.52 * a, y=float(np.max(y)))
+        # at the drawing's left edge: 0.52 of the widest punch's half-width left of the
+        # loaded stretch (-1.52 a for one punch)
+        widest = max((p.half_width for p in view.punches), default=a)
+        self.zone_label.update(x=view.span[0] - 0.52 * widest, y=float(np.max(y)))
         if width < 2 * a and lifted:
             self.zone_label.text = f"contact {width:.3f} m of {2 * a:.3g} m at t = {days_text(t)}"
         elif lifted:
@@ -192,6 +195,11 @@ class FeatureInset:
         legend.padding = 2
         legend.spacing = 0
         self.fig = p
+
+    def hide(self) -> None:
+        """Show no features (a scene of several punches: the inset draws one punch)."""
+        self.fig.visible = False
+        self.src.data = {"x": [], "punch": [], "surface": []}
 
     def show(self, g: Geometry) -> None:
         """Draw the features of ``g`` (heights above the coating's highest point [µm])."""

@@ -28,6 +28,7 @@ from bokeh.plotting import figure
 from ..model import (
     QUANTITIES,
     QUANTITY_UNITS,
+    SCREEN_PUNCHES,
     DisplayScales,
     Pin,
     ResultView,
@@ -38,7 +39,7 @@ from .bokeh_data import MOVING, f32, legend_above, set_data, steady_range, wrap_
 from .classical import bearing_rule_pressure, half_space_pressure
 from .contact import ContactDrawing, FeatureInset
 from .pins import PinLines
-from .scene import TOOLS, SceneDrawing, empty_columns
+from .scene import PUNCH_COLORS, TOOLS, SceneDrawing, empty_columns
 
 SYMBOLS = {"settlement": "δ", "tilt": "α", "force": "P", "moment": "M"}
 TITLES = {"settlement": "Settlement", "tilt": "Tilt", "force": "Force", "moment": "Moment"}
@@ -166,6 +167,9 @@ class Figures:
         self.history_fig = {}
         self.history_line = {}
         self.history_cursor = {}
+        # several punches: a line per punch on each history (hidden for one punch)
+        self.punch_history_src: dict[str, list[ColumnDataSource]] = {}
+        self.punch_history_line: dict[str, list] = {}
         shared_x = None
         for q in QUANTITIES:
             unit = QUANTITY_UNITS[q][0]
@@ -187,12 +191,55 @@ class Figures:
             cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted",
                           level=MOVING)
             p.add_layout(cursor)
+            self._build_punch_lines(p, q, unit)
             if q in READ_SERIES:
                 self._build_readings(p, q, unit)
             self.history_src[q] = src
             self.history_point_src[q] = point
             self.history_fig[q], self.history_line[q] = p, line
             self.history_cursor[q] = cursor
+
+    def _build_punch_lines(self, p: figure, q: str, unit: str) -> None:
+        """The history of ``q`` of each punch of several, in its colour, with a legend
+        (hidden, and empty, for a scene of one punch)."""
+        sources, lines = [], []
+        for k in range(SCREEN_PUNCHES):
+            src = ColumnDataSource({"t": [], "v": []}, name=f"{q}_punch{k}_source")
+            line = p.line(x="t", y="v", source=src, line_color=PUNCH_COLORS[k],
+                          line_width=2.5, legend_label=f"punch {k + 1}", visible=False,
+                          name=f"punch {k + 1}")
+            sources.append(src)
+            lines.append(line)
+        # one hover for the punches' lines (one per line added a toolbar button each)
+        p.add_tools(HoverTool(renderers=lines, mode="vline", tooltips=[
+            ("", "$name"), ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
+        legend = p.legend[0]
+        legend.location = "top_left"
+        legend.label_text_font_size = "10px"
+        legend.background_fill_alpha = 0.7
+        legend.padding = 2
+        legend.spacing = 0
+        legend.visible = False
+        self.punch_history_src[q] = sources
+        self.punch_history_line[q] = lines
+
+    def _show_punch_histories(self, view: ResultView) -> None:
+        """A line per punch on each history (several punches), or none (one punch)."""
+        n = len(view.punches)
+        for q in QUANTITIES:
+            for k, (src, line) in enumerate(zip(self.punch_history_src[q],
+                                                self.punch_history_line[q], strict=True)):
+                if k < n:
+                    set_data(src, {"t": f32(view.times), "v": f32(view.punches[k].display(q))})
+                elif src.data["t"] is not None and len(src.data["t"]):
+                    set_data(src, {"t": [], "v": []})
+                if line.visible != (k < n):
+                    line.visible = k < n
+            legend = self.history_fig[q].legend[0]
+            for k, item in enumerate(legend.items):
+                item.visible = k < n
+            legend.visible = n > 0
+            self.history_line[q].visible = n == 0
 
     def _build_readings(self, p: figure, q: str, unit: str) -> None:
         """The readings of a fit (points with one-standard-deviation bars) and the fitted
@@ -242,21 +289,35 @@ class Figures:
     def show(self, view: ResultView, index: int, pins: Sequence[Pin] = ()) -> None:
         """Draw a new result (call inside ``pn.io.hold`` to send one message)."""
         # A change of the loads leaves the drawing as it is: do not send it again.
-        key = json.dumps([view.scene.get(k) for k in ("punch", "coating", "base")],
+        punches = [{k: v for k, v in spec.items() if k != "loading"}
+                   for spec in view.scene.get("punches", [])]
+        key = json.dumps([view.scene.get(k) for k in ("punch", "coating", "base")] + punches,
                          sort_keys=True, default=str)
         if key != self._scene_key:
             self.drawing.show(view, self.contact)
-            self.inset.show(view.geometry)
+            if view.several:
+                self.inset.hide()
+            else:
+                self.inset.show(view.geometry)
             self._scene_key = key
+        if view.several:
+            pins = ()  # pins compare results of one punch
         self.contact.show(view)
         self.scene_fig.title.text = f"Scene: {short(view.scene.get('name', ''))}"
         self._show_image(view)
         self._label_strips(view)
+        self._show_punch_histories(view)
         for q in QUANTITIES:
             given = q in view.given
-            set_data(self.history_src[q], {"t": f32(view.times), "v": f32(view.display(q))})
+            shown = view.times if not view.several else []
+            set_data(self.history_src[q], {"t": f32(shown), "v": f32(
+                view.display(q) if not view.several else [])})
             self.history_line[q].glyph.line_color = GIVEN_COLOR if given else UNKNOWN_COLOR
             state = "given" if given else "computed"
+            if view.several:
+                gives = [q in p.given for p in view.punches]
+                state = ("given, per punch" if all(gives) else "computed, per punch"
+                         if not any(gives) else "per punch (given for some)")
             unit = QUANTITY_UNITS[q][0]
             self.history_fig[q].title.text = f"{TITLES[q]} {SYMBOLS[q]} [{unit}]: {state}"
         self.pins.show(view, pins, index)
@@ -272,12 +333,16 @@ class Figures:
         """Value axes of q(x) and the histories that hold the result at every output
         time and the pins (kept while they fit, see :func:`steady_range`): playing the
         times or stepping the load moves the curves, not the axes."""
+        if view.several:
+            pins = ()
         self._pins = tuple(pins)
         for q in QUANTITIES:
             extra = [] if q not in READ_SERIES else [
                 src.data.get(k, []) for src in (self.readings_src[q], self.forecast_src[q])
                 for k in ("lower", "upper")]
-            steady_range(self.history_fig[q].y_range, view.display(q),
+            extra += [p.display(q) for p in view.punches]
+            steady_range(self.history_fig[q].y_range,
+                         view.display(q) if not view.several else [],
                          *(pin.view.display(q) for pin in pins), *extra)
         self._fit_pressure(view)
 
@@ -291,6 +356,8 @@ class Figures:
     def show_time(self, view: ResultView, index: int, pins: Sequence[Pin] = (),
                   pinned_drawn: bool = False) -> None:
         """Move every time cursor to output ``index`` (no solve)."""
+        if view.several:
+            pins = ()
         unit, size = self.scales.pressure_unit(view)
         t = float(view.times[index])
         q = view.pressure[:, index]
@@ -307,8 +374,9 @@ class Figures:
         self.image_cursor.location = t
         for name in QUANTITIES:
             self.history_cursor[name].location = t
-            set_data(self.history_point_src[name],
-                     {"t": [t], "v": [float(view.display(name)[index])]})
+            values = ([float(p.display(name)[index]) for p in view.punches] if view.several
+                      else [float(view.display(name)[index])])
+            set_data(self.history_point_src[name], {"t": [t] * len(values), "v": values})
         self.drawing.show_arrow(view, index)
         self.contact.show_time(view, index)
 
@@ -338,6 +406,9 @@ class Figures:
 
     def _show_classical(self, view: ResultView, index: int) -> None:
         if not self.classical:
+            return
+        if view.several:  # the classical answers are of one punch
+            set_data(self.classic_src, empty_columns("x", "half_space", "bearing_rule"))
             return
         size = self.scales.pressure_unit(view)[1]
         a = view.geometry.half_width
@@ -381,7 +452,7 @@ class Figures:
 
     def _show_image(self, view: ResultView) -> None:
         unit, size = self.scales.pressure_unit(view)
-        a = view.geometry.half_width
+        x0, x1 = view.span  # (-a, a) for one punch
         t0, t1 = float(view.times[0]), float(view.times[-1])
         span = t1 - t0
         if not span > 0:
@@ -390,14 +461,14 @@ class Figures:
             span = max(0.1 * abs(t0), 1.0)
             t0 -= span / 2
         img = f32(view.image / size)
-        set_data(self.image_src, {"image": [img], "x": [-a], "y": [t0], "dw": [2 * a],
+        set_data(self.image_src, {"image": [img], "x": [x0], "y": [t0], "dw": [x1 - x0],
                                   "dh": [span]})
         lo, hi = self.scales.image_range(view)
         self.image_mapper.update(low=lo, high=hi)
         self.image_bar.title = f"q [{unit}]"
         self.image_hover.tooltips = [("x", "$x{0.000} m"), ("t", "$y{0.0} days"),
                                      ("q", f"@image{{0.000}} {unit}")]
-        self.image_fig.x_range.update(start=-a, end=a)
+        self.image_fig.x_range.update(start=x0, end=x1)
         self.image_fig.y_range.update(start=t0, end=t0 + span)
 
     _scene_key: str | None = None

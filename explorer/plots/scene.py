@@ -17,6 +17,7 @@ from bokeh.models import (
     ColumnDataSource,
     HoverTool,
     Label,
+    LabelSet,
     LogColorMapper,
     NormalHead,
     Range1d,
@@ -32,6 +33,10 @@ _SLABS = 120
 
 #: The tools of every figure of the explorer.
 TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
+
+#: The colour of each punch of a scene of several, in order (drawing, histories,
+#: readout): Bokeh's Category10 less its red, which marks loads and lift-off.
+PUNCH_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd")
 
 
 def _nice(value: float) -> float:
@@ -76,6 +81,20 @@ class SceneDrawing:
         p.patch(x="x", y="y", source=self.punch_src, fill_color="#b0b7c3", line_color="#333",
                 line_width=1.5)
         p.line(x="x", y="y", source=self.cut_src, line_dash="dashed", line_color="#333")
+        # several punches: one patch each, edged in its colour, its load's arrow and label
+        self.punches_src = ColumnDataSource(empty_columns("xs", "ys", "color", "name"),
+                                            name="punches_source")
+        p.patches(xs="xs", ys="ys", source=self.punches_src, fill_color="#b0b7c3",
+                  line_color="color", line_width=2.5)
+        self.punch_arrow_src = ColumnDataSource(
+            empty_columns("x", "y_start", "y_end", "label_y", "text"), name="punch_arrow_source")
+        p.add_layout(Arrow(end=NormalHead(size=10, fill_color="#d62728", line_color="#d62728"),
+                           x_start="x", y_start="y_start", x_end="x", y_end="y_end",
+                           source=self.punch_arrow_src, line_width=3, line_color="#d62728",
+                           level=MOVING))
+        p.add_layout(LabelSet(x="x", y="label_y", text="text", source=self.punch_arrow_src,
+                              text_font_size="11px", text_color="#d62728", x_offset=4,
+                              level=MOVING))
         p.add_tools(HoverTool(renderers=[layers], tooltips=[
             ("layer", "@layer"), ("thickness", "@h_mm{0.00} mm"), ("E", "@E{0.0} MPa")]))
         self.arrow = Arrow(end=NormalHead(size=12, fill_color="#d62728", line_color="#d62728"),
@@ -100,7 +119,16 @@ class SceneDrawing:
         self.fig = p
 
     def show_arrow(self, view: ResultView, index: int) -> None:
-        """The load's arrow and label at output ``index`` (at e = M/P) [m]."""
+        """The load's arrow and label at output ``index`` (at e = M/P) [m]; one per punch
+        for several."""
+        if view.punches:
+            self.arrow.visible = False
+            self.arrow_label.text = ""
+            self._show_punch_arrows(view, index)
+            return
+        if self.punch_arrow_src.data["x"]:
+            self.punch_arrow_src.data = empty_columns("x", "y_start", "y_end", "label_y",
+                                                      "text")
         g = view.geometry
         force = float(view.values["force"][index])
         moment = float(view.values["moment"][index])
@@ -119,9 +147,33 @@ class SceneDrawing:
             self.arrow_label.update(x=-g.half_width, y=top + 0.3 * g.half_width,
                                     text=f"P = {force / 1e3:.4g} kN/m (no compressive load)")
 
+    def _show_punch_arrows(self, view: ResultView, index: int) -> None:
+        """Each punch's force at output ``index``, drawn at its e = M/P [m] (within the
+        punch; the label says where it acts)."""
+        cols: dict[str, list] = empty_columns("x", "y_start", "y_end", "label_y", "text")
+        top = self._punch_top
+        for k, p in enumerate(view.punches):
+            force = float(p.values["force"][index])
+            moment = float(p.values["moment"][index])
+            a = p.half_width
+            e = moment / force if force > 0 else 0.0
+            xe = p.center + float(np.clip(e, -a, a))
+            cols["x"].append(xe)
+            cols["y_start"].append(top + 0.45 * self._a_ref)
+            cols["y_end"].append(top + 0.02 * self._a_ref)
+            cols["label_y"].append(top + 0.3 * self._a_ref)
+            where = f", e = {e:.3g} m" if force > 0 and e else ""
+            cols["text"].append(f"{k + 1}: P = {force / 1e3:.4g} kN/m{where}")
+        self.punch_arrow_src.data = cols
+
     def show(self, view: ResultView, contact: ContactDrawing) -> None:
         """Draw the scene of ``view`` (``contact`` gets the coating's surface, for its
         contact zone)."""
+        if view.punches:
+            self._show_punches(view, contact)
+            return
+        if self.punches_src.data["xs"]:
+            self.punches_src.data = empty_columns("xs", "ys", "color", "name")
         g = view.geometry
         a = g.half_width
         depth = min(g.base_thickness, 1.2 * a)
@@ -171,4 +223,69 @@ class SceneDrawing:
             "drawn to scale"
         self.scale_label.text = note
 
+    def _show_punches(self, view: ResultView, contact: ContactDrawing) -> None:
+        """Draw a scene of several punches: the coating along the loaded stretch and
+        beyond, and each punch in its colour (global x [m])."""
+        g = view.geometry
+        lo, hi = view.span
+        a_ref = max(p.half_width for p in view.punches)
+        self._a_ref = a_ref
+        left, right = lo - 0.5 * a_ref, hi + 0.5 * a_ref
+        depth = min(g.base_thickness, 0.6 * (hi - lo))
+        total = np.sum(g.thickness, axis=0) if len(g.thickness) else np.zeros_like(g.x)
+        t_max = float(np.max(total)) if total.size else 0.0
+        scale = _nice(0.15 * depth / t_max) if t_max > 0 else 1.0
+        slabs = _SLABS * len(view.punches)
+        edges = np.linspace(left, right, slabs + 1)
+        centres = 0.5 * (edges[1:] + edges[:-1])
+        bottom = np.zeros(slabs)
+        cols: dict[str, list] = {k: [] for k in ("left", "right", "bottom", "top", "E",
+                                                 "layer", "h_mm")}
+        for k in reversed(range(len(g.thickness))):
+            h = np.interp(centres, g.x, g.thickness[k])
+            e = np.interp(centres, g.x, g.modulus[k])
+            top = bottom + scale * h
+            cols["left"].extend(edges[:-1])
+            cols["right"].extend(edges[1:])
+            cols["bottom"].extend(bottom)
+            cols["top"].extend(top)
+            cols["E"].extend(e / 1e6)
+            cols["layer"].extend([k + 1] * slabs)
+            cols["h_mm"].extend(h * 1e3)
+            bottom = top
+        self.layer_src.data = cols
+        self.base_src.data = {"left": [left], "right": [right], "bottom": [-depth],
+                              "top": [0.0], "E": [g.base_modulus / 1e6]}
+        if g.base_thickness > depth:
+            self.cut_src.data = {"x": [left, right], "y": [-depth, -depth]}
+            self.base_label.update(x=left, y=-depth,
+                                   text=f"base continues to H = {g.base_thickness:.3g} m")
+        else:
+            self.cut_src.data = {"x": [], "y": []}
+            self.base_label.update(x=left, y=-depth,
+                                   text=f"base H = {g.base_thickness:.3g} m on rigid ground")
+        self.punch_src.data = {"x": [], "y": []}
+        xs, ys = [], []
+        punch_top = 0.0
+        bottoms = []
+        for x, shape in zip(g.punch_x, g.punch_shape, strict=True):
+            under = np.interp(x, g.x, total)
+            lift = float(np.min(shape - under))
+            bottom_y = scale * (shape - lift)
+            bottoms.append((x, bottom_y))
+            punch_top = max(punch_top, float(np.max(bottom_y)) + 0.35 * a_ref)
+        for x, bottom_y in bottoms:
+            xs.append(np.concatenate([x, [x[-1], x[0]]]))
+            ys.append(np.concatenate([bottom_y, [punch_top, punch_top]]))
+        self._punch_top = punch_top
+        self.punches_src.data = {"xs": xs, "ys": ys,
+                                 "color": list(PUNCH_COLORS[: len(xs)]),
+                                 "name": [f"punch {k + 1}" for k in range(len(xs))]}
+        contact.set_surface(g.x, scale * total)
+        self.fig.x_range.update(start=left - 0.05 * a_ref, end=right + 0.05 * a_ref)
+        self.fig.y_range.update(start=-1.08 * depth, end=punch_top + 0.55 * a_ref)
+        self.scale_label.text = (f"coating and punch profiles drawn ×{scale:g} vertically"
+                                 if scale > 1 else "drawn to scale")
+
     _punch_top = 0.0
+    _a_ref = 1.0

@@ -105,6 +105,7 @@ def worker_processes() -> SolverProcesses | None:
 #: Translation of the first part of a core field path into words on screen.
 _FIELD_WORDS = {
     "punch": "Punch",
+    "punches": "Punches",
     "coating": "Coating",
     "base": "Base",
     "loading": "Loading",
@@ -117,7 +118,13 @@ def describe_field(path: str) -> str:
     """A field path of the core (``coating[1].thickness``) in words (``Coating layer 2,
     thickness``); unknown paths come back unchanged."""
     head, _, rest = path.partition(".")
-    if head.startswith("coating[") and head.endswith("]"):
+    if head.startswith("punches[") and head.endswith("]"):
+        try:
+            index = int(head[len("punches["):-1])
+        except ValueError:
+            return path
+        words = f"Punch {index + 1}"
+    elif head.startswith("coating[") and head.endswith("]"):
         try:
             index = int(head[len("coating["):-1])
         except ValueError:

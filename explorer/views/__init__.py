@@ -6,10 +6,11 @@ controller, ...), never the whole session; it builds its widgets over them and k
 to refresh them. :mod:`explorer.app` builds the views and assembles the page from them.
 
 - Sidebar tabs: ``scene`` (presets, undo, the loading, with the slider of
-  ``eccentricity``), ``punch``, ``coating`` (with the coating-model check), ``base`` (with
-  ``creep``, the design codes' creep), ``times``, ``check``, ``files``, ``lessons``,
-  ``study``, ``fit`` (back-analysis from readings); ``fidelity``: the model-fidelity
-  widgets of the Coating and Time tabs.
+  ``eccentricity``), ``punch`` (with ``punches``, the section of a scene of several
+  punches, and the note standing in for what is for one punch only), ``coating`` (with
+  the coating-model check), ``base`` (with ``creep``, the design codes' creep),
+  ``times``, ``check``, ``files``, ``lessons``, ``study``, ``fit`` (back-analysis from
+  readings); ``fidelity``: the model-fidelity widgets of the Coating and Time tabs.
 - The results column: ``results`` (messages, plots, player, readout, design check),
   ``contact`` (the contact figures' slots), ``pins`` (pin, remove, pin every step, pins
   of a link), ``busy`` (the busy indicator), ``status`` (the status line in words).

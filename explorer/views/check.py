@@ -8,6 +8,7 @@ from typing import Any
 import panel as pn
 
 from ..model import DesignLimits, ExplorerState, Screen, screen_limits
+from .punches import OnePunchOnly
 from .style import TAB_COLUMN, html_pane
 
 
@@ -47,12 +48,13 @@ class CheckView:
 
     def content(self) -> pn.Column:
         """The tab's column."""
-        return pn.Column(
+        return pn.Column(OnePunchOnly(
+            self.state, "The design check and the eccentricity",
             html_pane("<small>Limits of the design check (leave empty: not checked). "
                       "The check covers the whole history. A scene file's limits fill "
                       "them, and a saved scene keeps them.</small>"),
             self.allowable_pressure, self.settlement_limit, self.tilt_limit,
-            self.eccentricity, **TAB_COLUMN)
+            self.eccentricity).panel, **TAB_COLUMN)
 
     def _on_eccentricity(self, event: Any) -> None:
         """Set the moment so that M = e P (force and moment given, constant force)."""

@@ -16,6 +16,7 @@ from ..model import SCREEN_LAYERS, ExplorerState, Screen
 from ..solving import SolveController, worker_processes
 from .fidelity import FidelityView
 from .loop import PageLoop
+from .punches import OnePunchOnly
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
 from .widgets import ProfileEditor, PromptIntSlider
 
@@ -85,7 +86,9 @@ class CoatingView:
             self.n_layers, self.bare_note, self.layer, self.layer_note,
             self.thickness_editor.panel,
             self.modulus_editor.panel, self.poisson_editor.panel,
-            self.fidelity.interface_panel, self.check.panel, **TAB_COLUMN)
+            self.fidelity.interface_panel,
+            OnePunchOnly(self.state, "The coating model's FE check", self.check.panel).panel,
+            **TAB_COLUMN)
 
     def refresh(self) -> None:
         """Offer one button per layer on screen; say so when the scene has more; with no

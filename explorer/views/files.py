@@ -26,6 +26,7 @@ from ..model import (
     scene_with_limits,
 )
 from ..solving import SolveController
+from .punches import OnePunchOnly
 from .style import TAB_COLUMN, html_pane, slug
 from .widgets import Binding, BoundedUpload
 
@@ -93,10 +94,14 @@ class FilesView:
     def content(self) -> pn.Column:
         """The tab's column."""
         return pn.Column(
-            self.report_download, self.pdf_report_download, self.scene_name,
-            self.description, self.save_scene,
+            OnePunchOnly(self.state, "The printable reports", self.report_download,
+                         self.pdf_report_download).panel,
+            self.scene_name, self.description, self.save_scene,
             html_pane("<small>Load a scene (the JSON the command line reads):</small>"),
-            self.load_file, self.csv_download, self.pressure_download, self.json_download,
+            self.load_file,
+            OnePunchOnly(self.state, "The CSV downloads", self.csv_download,
+                         self.pressure_download).panel,
+            self.json_download,
             html_pane("<small>Downloads hold the result on screen. The address bar holds "
                       "a link to it.</small>"), **TAB_COLUMN)
 

@@ -35,6 +35,7 @@ from ..model import (
 from ..plots import Figures
 from ..solving import FitRun, SolveController
 from .loop import PageLoop
+from .punches import OnePunchOnly
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
 from .upload import BoundedUpload
 
@@ -86,7 +87,8 @@ class FitView:
 
     def content(self) -> pn.Column:
         """The tab's column."""
-        return pn.Column(
+        return pn.Column(OnePunchOnly(
+            self.state, "The back-analysis",
             html_pane("<small>Back-analysis: fit fields of the scene on screen to measured "
                       "settlements and tilts. Upload a readings file (CSV or JSON): "
                       "<code>time [day], settlement [mm], settlement_std, tilt [urad], "
@@ -100,7 +102,7 @@ class FitView:
                       f"{100 * BAND_LEVEL:.0f} % band from the fields' uncertainty only, "
                       "not the model's error. Every step of a fit is a full solve at the "
                       "readings' times. Once the fitted values are applied, the printable "
-                      "report (Files tab) carries the fit.</small>", styles=NOTE_STYLE),
+                      "report (Files tab) carries the fit.</small>", styles=NOTE_STYLE)).panel,
             **TAB_COLUMN)
 
     # -- choices ---------------------------------------------------------------------------

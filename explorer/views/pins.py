@@ -63,6 +63,16 @@ class PinsView:
         self._pending: dict[int, ResultView | None] = {}
         self._expected = 0
         self._controllers: list[SolveController] = []
+        # pins compare results of one punch: off while the scene has several
+        state.param.watch(lambda e: self._follow_punches(), "n_punches")
+        self._follow_punches()
+
+    def _follow_punches(self) -> None:
+        several = self.state.n_punches > 0
+        for widget in (self.pin_button, self.every_step, self.steps_button):
+            widget.disabled = several
+        if several and self.every_step.value:
+            self.every_step.value = False
 
     def content(self) -> pn.Column:
         """The pin buttons and the list of pins (next to the readout)."""

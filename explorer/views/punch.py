@@ -1,4 +1,5 @@
-"""The Punch tab: half-width and base shape of the punch, and a shape table upload."""
+"""The Punch tab: half-width and base shape of the punch, and a shape table upload; for a
+scene of several punches, their section (:mod:`explorer.views.punches`) instead."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from core.profiles import MAX_TABLE_BYTES, profile_from_csv
 
 from ..model import ExplorerState, Screen
 from ..solving import format_error
+from .punches import PunchesSection
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
 from .widgets import Binding, BoundedUpload, slider
 
@@ -60,18 +62,28 @@ class PunchView:
         pb.bind(s.punch)
         s.punch.param.watch(lambda *e: self.refresh(), ["shape", "half_width",
                                                        "custom_label"])
-        self.refresh()
-
-    def content(self) -> pn.Column:
-        """The tab's column."""
-        return pn.Column(
+        self.punches = PunchesSection(s, screen.reject, live_when)
+        self.single = pn.Column(
             self.half_width, self.shape, self.radius, self.slope, self.step_height,
             self.step_position, self.land_height, self.land_width, self.wave_amplitude,
             self.wave_length, self.shape_note,
             html_pane("<small>Upload a shape table: CSV with two columns, x [m] and "
                       "f(x) [m], f the height of the punch base above its lowest point."
                       "</small>"),
-            self.shape_file, **TAB_COLUMN)
+            self.shape_file, margin=0, sizing_mode="stretch_width")
+        s.param.watch(lambda *e: self._follow_punches(), "n_punches")
+        self._follow_punches()
+        self.refresh()
+
+    def content(self) -> pn.Column:
+        """The tab's column."""
+        return pn.Column(self.single, self.punches.panel, **TAB_COLUMN)
+
+    def _follow_punches(self) -> None:
+        """The one punch's widgets, or the section of several punches."""
+        several = self.state.n_punches > 0
+        self.single.visible = not several
+        self.punches.panel.visible = several
 
     def refresh(self) -> None:
         """Show the sliders of the chosen shape only."""

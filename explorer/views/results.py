@@ -25,7 +25,7 @@ from ..model import (
     model_evidence,
     shown_flags,
 )
-from ..plots import PIN_COLORS, Figures, LogTime
+from ..plots import PIN_COLORS, PUNCH_COLORS, Figures, LogTime
 from ..solving import SolveController
 from .busy import BusyIndicator, BusySpinner
 from .contact import ContactPanes
@@ -86,10 +86,49 @@ def badges_html(view: ResultView | None, group: str,
     return "".join(parts)
 
 
+#: What the page does not show for a scene of several punches yet, said under its
+#: readout (the features of one punch that are off for several).
+SEVERAL_PUNCHES_NOTE = ("Several punches: pins, the classical solutions, the design check, "
+                        "the coating model's FE check, studies, the back-analysis and the "
+                        "CSV and report downloads are for one punch and are off here (the "
+                        "scene and the JSON of the result can be saved).")
+
+
+def punches_readout_html(view: ResultView, index: int) -> str:
+    """Values of every punch of several at the selected time, a column per punch."""
+    t = float(view.times[index])
+    head = "<tr><th></th>" + "".join(
+        f"<th class='readout-punch-{k}' style='border-bottom:3px solid {PUNCH_COLORS[k]}'>"
+        f"punch {k + 1} (x = {p.center:.3g} m)</th>" for k, p in enumerate(view.punches))
+    rows = [head + "</tr>"]
+    for q in QUANTITIES:
+        unit = QUANTITY_UNITS[q][0]
+        cells = "".join(
+            f"<td class='readout-punch-{k}-{q}{' cp-given' if q in p.given else ''}'>"
+            f"{_fmt(float(p.display(q)[index]))}{' (given)' if q in p.given else ''}</td>"
+            for k, p in enumerate(view.punches))
+        rows.append(f"<tr><td>{NAMES[q]} [{unit}]</td>{cells}</tr>")
+    eccs = "".join(
+        f"<td>{float(p.values['moment'][index]) / float(p.values['force'][index]):.4g} m</td>"
+        if float(p.values["force"][index]) > 0 else "<td>undefined (P ≤ 0)</td>"
+        for p in view.punches)
+    rows.append(f"<tr><td>e = M/P</td>{eccs}</tr>")
+    contact = html.escape(contact_text(view, index))
+    return (f"<div class='readout punches-readout'><b>At t = {days_text(t)} after loading"
+            f"</b> · each punch's moment and tilt about its own centre"
+            f"<table class='cp-readout'>{''.join(rows)}</table>"
+            f"<div class='contact-readout'>{contact}</div>"
+            f"<div class='cp-status several-punches-note'>{html.escape(SEVERAL_PUNCHES_NOTE)}"
+            f"</div></div>")
+
+
 def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) -> str:
-    """Values at the selected time: current, and each pin with the change to it."""
+    """Values at the selected time: current, and each pin with the change to it (for
+    several punches, each punch's; pins compare results of one punch)."""
     if view is None:
         return ""
+    if view.several:
+        return punches_readout_html(view, index)
     t = float(view.times[index])
     head = "<tr><th></th><th>current</th>"
     for k, pin in enumerate(pins):
@@ -210,6 +249,7 @@ class ResultsView:
 
     def draw(self, view: ResultView, index: int, new_range: bool) -> None:
         """Show a new result at output time ``index`` (call inside ``pn.io.hold()``)."""
+        self.classical.disabled = view.several
         self.figures.show(view, index, self.pins.board.pins)
         self.contact_panes.update(view)
         if new_range:
@@ -258,6 +298,9 @@ class ResultsView:
     def show_design(self) -> None:
         """The design check of the result on screen against the session's limits."""
         view = self.screen.shown()
+        if view is not None and view.several:
+            self.design.object = ""  # said by the readout's note
+            return
         self.design.object = check_html(design_check(view, self.limits)) if view else ""
 
     def show_pins(self) -> None:

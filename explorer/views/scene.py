@@ -10,6 +10,7 @@ import panel as pn
 from ..model import STATEMENTS, ExplorerState, SceneHistory, preset_label
 from ..solving import SolveController
 from .eccentricity import EccentricityControl
+from .punches import OnePunchOnly
 from .style import TAB_COLUMN, html_pane
 from .widgets import NAMES, HistoryEditor
 
@@ -57,6 +58,12 @@ class SceneView:
         self.history_editors = (HistoryEditor("load-0"), HistoryEditor("load-1"))
         self.unknowns_note = html_pane("", styles={"font-size": "13px"})
         self.eccentric_load = EccentricityControl(state, controller, reject)
+        self.loading = OnePunchOnly(
+            state, "This loading", self.statement, self.eccentric_load.panel,
+            self.history_editors[0].panel, self.history_editors[1].panel,
+            self.unknowns_note)
+        self.loading.note.object = ("This scene has several punches: each one's loads are "
+                                    "set in the Punch tab.")
         self.refresh()
 
     def content(self) -> pn.Column:
@@ -65,8 +72,7 @@ class SceneView:
             self.preset, pn.Row(self.undo_button, self.reset_button),
             self.preset_description,
             html_pane("<b>Loading</b> (updates while you drag)", margin=(10, 10, 0, 10)),
-            self.statement, self.eccentric_load.panel, self.history_editors[0].panel,
-            self.history_editors[1].panel, self.unknowns_note, **TAB_COLUMN)
+            self.loading.panel, **TAB_COLUMN)
 
     def _preset_text(self) -> str:
         key = getattr(self, "preset", None) and self.preset.value

@@ -34,6 +34,7 @@ from ..model import (
 from ..plots import DesignChart, design_chart_png, flag_note
 from ..solving import SolveController, StudyRun
 from .loop import PageLoop
+from .punches import OnePunchOnly
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
 
 #: The second parameter's choice for "no second parameter".
@@ -152,7 +153,8 @@ class StudyView:
 
     def content(self) -> pn.Column:
         """The tab's column."""
-        return pn.Column(
+        return pn.Column(OnePunchOnly(
+            self.state, "Studies",
             html_pane("<small>A design chart around the scene on screen: one field over a "
                       f"range (a line) or two (a heat map), at most {MAX_POINTS} points. "
                       "Every point is a full solve.</small>"),
@@ -162,7 +164,7 @@ class StudyView:
             html_pane("<small>Red x: the solver flagged the point (outside the model's "
                       "validity, e.g. contact lost); grey or a gap: the point failed. The "
                       "CSV holds every output at every time.</small>", styles=NOTE_STYLE),
-            self.study_csv, self.study_png, **TAB_COLUMN)
+            self.study_csv, self.study_png).panel, **TAB_COLUMN)
 
     # -- choices -------------------------------------------------------------------------
     def refresh(self, scene: dict[str, Any] | None = None) -> None:
@@ -173,6 +175,8 @@ class StudyView:
                 scene = self.state.to_scene()
             except ValueError:
                 return  # not a scene now; its message comes with the solve
+        if "punches" in scene:
+            return  # studies vary a scene of one punch (the tab says so)
         choices = {c.key: c for c in study_choices(scene)}
         if list(choices) == list(self._choices):
             self._choices = choices

@@ -40,7 +40,8 @@ def small(scene: dict[str, Any], count: int = 6) -> dict[str, Any]:
 def scenes() -> list[dict[str, Any]]:
     """Different geometries, materials and loads (all six presets, and load variants that
     share their geometry with a preset)."""
-    out = [small(s) for s in PRESETS.values()]
+    # the presets of one punch (the histories compared are a single punch's)
+    out = [small(s) for s in PRESETS.values() if "punch" in s]
     for k, force in enumerate((3e5, 7e5)):
         variant = small(PRESETS["uniform_flat"])
         variant["loading"]["force"] = force

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import core
+from explorer.model import validated_scene
 from explorer.model.lessons import LESSONS, lessons, step_scene
 
 LESSON = {lesson.key: lesson for lesson in LESSONS}
@@ -41,7 +42,7 @@ def test_every_lesson_step_is_a_valid_scene_with_its_note() -> None:
     for lesson in LESSONS:
         for k, step in enumerate(lesson.steps):
             scene = step_scene(lesson, k)
-            core.scene_from_dict(scene)  # raises on a bad step
+            validated_scene(scene)  # raises on a bad step (one punch or several)
             assert scene["description"] == step.note
             for number in step.changes:
                 assert "." in number  # a dotted field of the scene

@@ -29,6 +29,7 @@ from explorer.model import (
     decode_scene,
     encode_scene,
     presets,
+    validated_scene,
 )
 from explorer.model.results import negative_intervals
 from explorer.solving import SolveController, describe_field, format_error
@@ -41,7 +42,7 @@ GEOMETRIC_STAGES = ("grid", "bordered", "modal")
 
 
 def canonical(scene: dict[str, Any]) -> dict[str, Any]:
-    return scene_from_dict(scene).to_dict()
+    return validated_scene(scene).to_dict()  # one punch, or several
 
 
 def assert_same(a: Any, b: Any, path: str = "scene") -> None:

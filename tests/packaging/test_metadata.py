@@ -145,7 +145,8 @@ def test_every_optional_module_maps_to_a_declared_extra():
 def test_the_shipped_presets_and_studies_are_valid():
     assert len(preset_names()) >= 8 and "worn_coating" in preset_names()
     for name in preset_names():
-        core.scene_from_dict(read_preset(name))
+        # either form: one punch, or several (core.scene.punches_from_dict)
+        core.load_scene(f"preset:{name}")
     for name in study_names():
         assert read_study(name)["scene"].startswith("../scenes/")
     with pytest.raises(KeyError, match="known: bare_layer, eccentric_creep"):

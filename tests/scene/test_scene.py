@@ -30,7 +30,11 @@ from core.scene import (
 from core.scene.schema import migrate
 from tests.conftest import DELETE, SCENES_DIR, edited, scene_file
 
-SCENE_FILES = sorted(SCENES_DIR.glob("*.json"))
+#: The preset of several punches (the ``punches`` form: tests/explorer/test_explorer_punches.py
+#: checks its numbers and its lesson).
+PUNCHES_PRESET = "new_footing_beside_old.json"
+#: The shipped scenes of one punch.
+SCENE_FILES = sorted(p for p in SCENES_DIR.glob("*.json") if p.name != PUNCHES_PRESET)
 
 
 def base_dict() -> dict:
@@ -63,10 +67,11 @@ def edit(path: str, value, d: dict | None = None) -> dict:
 LIFT_OFF_PRESET = "eccentric_footing_liftoff.json"
 
 
-def test_there_are_nine_shipped_scenes():
-    names = {p.name for p in SCENE_FILES}
-    assert names == {"uniform_flat.json", "worn_coating.json", "patched_insert.json",
-                     "rounded_graded.json", "eccentric_creep.json", "stepped_punch.json",
+def test_there_are_ten_shipped_scenes():
+    names = {p.name for p in SCENES_DIR.glob("*.json")}
+    assert names == {PUNCHES_PRESET, "uniform_flat.json", "worn_coating.json",
+                     "patched_insert.json", "rounded_graded.json", "eccentric_creep.json",
+                     "stepped_punch.json",
                      "young_concrete_50_years.json", "bare_layer.json", LIFT_OFF_PRESET}
 
 
@@ -115,6 +120,29 @@ def test_shipped_scene_solves_in_full_contact(path: Path):
     bound = 2 * a * result.info["error_estimate"] * np.max(np.abs(q))
     assert np.max(np.abs(force - result.force)) < max(bound, 1e-11 * scale)
     assert np.max(np.abs(moment - result.moment)) < max(bound, 1e-11 * scale) * a
+
+
+def test_the_shipped_scene_of_several_punches_solves_in_full_contact():
+    path = SCENES_DIR / PUNCHES_PRESET
+    scene = load_scene(path)
+    assert len(scene.scenes) == 2 and len(scene.to_dict()["description"]) > 80
+    # the canonical dict is a fixed point of validation
+    assert load_scene(path).to_dict() == scene_from_dict_any(scene.to_dict()).to_dict()
+    result = solve(scene)
+    assert result.flags == [] and result.info["success"]
+    for punch in result.punches:
+        assert punch.info["error_estimate"] <= punch.scene.tol
+        # full contact under each punch with a margin: the least pressure is 0.70 (old
+        # footing) and 0.76 (new one) of its mean pressure at worst (measured)
+        mean = punch.force / (2 * punch.scene.half_width)
+        assert np.all(punch.pressure_on_grid.min(axis=0) > 0.5 * mean)
+
+
+def scene_from_dict_any(d: dict):
+    """A scene dict of either form, validated (one punch, or ``punches``)."""
+    from core.scene import has_punches, punches_from_dict
+
+    return punches_from_dict(d) if has_punches(d) else scene_from_dict(d)
 
 
 def _integrals(result: SceneSolution, panels: int = 4) -> tuple[np.ndarray, np.ndarray]:
