@@ -359,3 +359,27 @@ def test_three_punches_in_a_row() -> None:
     assert np.max(np.abs(middle.tilt)) < 1e-10 * np.max(np.abs(left.tilt))
     # the middle one has a neighbour on each side: it settles most
     assert np.all(middle.settlement > left.settlement)
+
+
+def test_a_load_change_under_creep_reuses_the_stepped_responses() -> None:
+    """Creep: the coupled answer is a sum of time-stepped responses to each load's shape
+    (cached); a new force of either punch is a new amplitude, so no time stepping runs
+    again (counted), and the answer is the one a fresh solve gives."""
+    from core.cache import clear_caches
+
+    d = _creeping(_pair(2.0))
+    first = core.solve(d)
+    built = first.punches[0].info["coupled_builds"]["time_response"]
+    assert built >= 2  # a force shape of each punch (and the moments)
+    moved = copy.deepcopy(d)
+    moved["punches"][0]["loading"]["force"] *= 1.3
+    moved["punches"][1]["loading"]["force"] *= 0.7
+    again = core.solve(moved)
+    assert again.punches[0].info["coupled_builds"]["time_response"] == built
+    clear_caches()
+    fresh = core.solve(moved)
+    for k in range(2):
+        for q in QUANTITIES:
+            # measured: equal to rounding (the same parts, stepped the same way)
+            assert _relative(getattr(again.punches[k], q),
+                             getattr(fresh.punches[k], q)) < 1e-12, q

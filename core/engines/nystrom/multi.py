@@ -76,10 +76,11 @@ from core.creep import stepping_kernel
 from core.discretize import panel_index
 from core.engines.nystrom.adapt import LEVEL_SPLIT, MAX_PANELS, grade
 from core.engines.nystrom.bordered import build_grid, touches
-from core.engines.nystrom.multi_modal import CoupledModalForm
+from core.engines.nystrom.multi_modal import CoupledModalAnswer, CoupledModalForm
 from core.engines.nystrom.prepared import (
     HISTORY_SAMPLES,
     PREPARED,
+    SHAPE_DIGITS,
     TIME_SHARE,
     PreparedContact,
     geometry_key,
@@ -87,6 +88,20 @@ from core.engines.nystrom.prepared import (
 )
 from core.engines.nystrom.result import TimeSide, nystrom_solution
 from core.problem import QUANTITIES, ContactSolution, Geometry, TimeInputs
+
+#: Time-stepped responses of the coupled system kept per set of punches (as one punch
+#: keeps 24 of its own): a load slider alternates among a few shapes.
+RESPONSES_KEPT = 24
+
+
+@dataclass
+class _PartLoads:
+    """One punch's loads in one part of a superposed answer (``given`` and ``loads`` as a
+    :class:`core.problem.TimeInputs` has them)."""
+
+    given: frozenset[str]
+    loads: dict[str, Any]
+
 
 #: Zones further apart than this many base thicknesses are not coupled (see the notes:
 #: 2 exp(-2.106 * 18) = 1.1e-16).
@@ -189,6 +204,10 @@ class CoupledPunches:
                     self.blocks[p][r] = self.coupling_rows(p, r, self.prepared[p].grid.nodes)
         # bordered systems (LU, unit responses, names) and modal forms, by statements
         self._systems: dict[tuple, Any] = {}
+        # time-stepped responses to each load shape and the gap, by their joint key
+        self._responses: dict[tuple, list[Any]] = {}
+        #: what the solves built: time-stepped responses of the coupled system
+        self.counts = {"time_response": 0}
         self._lock = threading.Lock()
         self.seconds = _time.perf_counter() - t0
 
@@ -227,14 +246,17 @@ class CoupledPunches:
 
     @property
     def nbytes(self) -> int:
-        """Memory of the coupling blocks and the factored systems [bytes] (the grids are
-        counted by :data:`core.engines.nystrom.PREPARED`)."""
+        """Memory of the coupling blocks, the factored systems and the time-stepped
+        responses kept [bytes] (the grids are counted by
+        :data:`core.engines.nystrom.PREPARED`)."""
         blocks = sum(b.nbytes for row in self.blocks for b in row if b is not None)
         systems = sum(entry[0][0].nbytes + entry[1].nbytes + sum(c.nbytes for c in entry[3])
                       for key, entry in self._systems.items() if key[0] != "modal")
         modal = sum(3 * entry.q.nbytes for key, entry in self._systems.items()
                     if key[0] == "modal")
-        return int(blocks + systems + modal)
+        responses = sum(r.nodal.nbytes + r.effective.nbytes for found in
+                        list(self._responses.values()) for r in found)
+        return int(blocks + systems + modal + responses)
 
     @property
     def size(self) -> int:
@@ -368,19 +390,22 @@ class CoupledPunches:
                                                     probe.shape).astype(float)
                 scalars_all.append(scalars)
             c_probe = np.full(probe.size, c)
-            time_side = TimeSide(message="elastic base, several punches")
+            time_sides = [TimeSide(message="elastic base, several punches")] * len(self.punches)
         else:
             probe = (times if times.size == 1 else np.union1d(
                 times, np.linspace(times[0], times[-1], HISTORY_SAMPLES["creep"])))
             tol = min(pc.geometry.tol for pc in self.prepared)
             kernel, fit_error = stepping_kernel(first.kernel, float(times[-1]), 0.5 * tol)
             breaks = [b for b in time_breaks if times[0] < b < times[-1]]
-            answer = self.modal(givens, tol).solve(inputs, probe, first.c, kernel,
-                                                   tol / TIME_SHARE, breaks)
+            answer = self._superposed(self.modal(givens, tol), inputs, probe, first.c,
+                                      kernel, tol / TIME_SHARE, breaks)
             nodal, effective, scalars_all = answer.nodal, answer.effective, answer.scalars
             c_probe = np.asarray(first.c(probe), dtype=float)
-            time_side = TimeSide(answer.time_error + fit_error, answer.steps, answer.success,
-                                 answer.message, fit_error)
+            # each punch's time error its own (a far neighbour's march does not count)
+            time_sides = [TimeSide(error + fit_error, answer.steps, answer.success,
+                                   answer.message, fit_error)
+                          for error in (answer.time_errors
+                                        or (answer.time_error,) * len(self.punches))]
             checks = [self._pressure(p, pc.check_x, nodal[self.offsets[p]:self.offsets[p + 1]],
                                      effective[self.offsets[p]:self.offsets[p + 1]],
                                      self._coupling_at_nodes(p, effective), scalars_all[p],
@@ -398,14 +423,102 @@ class CoupledPunches:
                                                coupling, out, c_probe[at])
             built = dict(prepared.counts)
             solution = nystrom_solution(
-                prepared, inputs[p], out, pressure, q_extremes, time_side,
+                prepared, inputs[p], out, pressure, q_extremes, time_sides[p],
                 _time.perf_counter() - t0, {k: 0 for k in built},
                 float(np.max(np.abs(scalars["tilt"]))), False)
             solution.info["punches"] = len(self.punches)
             solution.info["coupling_seconds"] = self.seconds
+            solution.info["coupled_builds"] = dict(self.counts)
             solution.contact_set.extend([[(-1.0, 1.0)] for _ in range(times.size)])
             answers.append(solution)
         return answers
+
+    def _superposed(self, form: CoupledModalForm, inputs: Sequence[TimeInputs],
+                    times: np.ndarray, c: Any, kernel: Any, time_tol: float,
+                    breaks: Sequence[float]) -> CoupledModalAnswer:
+        """The time-stepped answer as a sum of cached responses to each given load's shape
+        and to the gaps, as one punch's is (:meth:`PreparedContact._superposed`).
+
+        The coupled equations are linear: each given load of each punch is split into its
+        amplitude and its shape (normalized to unit peak), and the responses to the shapes
+        (each with every other load zero and no gap; the gaps' alone) are stepped in one
+        time march and kept together, keyed by the times, ``c``, the kernel and the shapes.
+        A load slider of any punch then changes an amplitude: a few array operations
+        instead of a time integration of the coupled system.
+        """
+        from core.cache import SameObject
+
+        c_t = np.asarray(c(times), dtype=float)
+        content = getattr(kernel, "key", None)
+        identity = SameObject(kernel) if content is None and kernel is not None else None
+        try:
+            kernel_key = fingerprint(content)
+        except TypeError:
+            kernel_key, identity = fingerprint(None), SameObject(kernel)
+        givens = tuple(tuple(sorted(one.given)) for one in inputs)
+        common = fingerprint("coupled modal", givens, times, c_t, kernel_key, time_tol,
+                             tuple(float(b) for b in breaks))
+
+        def zero(tt: np.ndarray) -> np.ndarray:
+            return np.zeros(np.shape(tt))
+
+        def quiet() -> list[_PartLoads]:
+            return [_PartLoads(one.given, {name: zero for name in one.loads})
+                    for one in inputs]
+
+        parts: list[tuple[float, tuple, list[_PartLoads], float]] = []
+        for p, one in enumerate(inputs):
+            for name in sorted(one.given):
+                fn = one.loads[name]
+                values = np.broadcast_to(np.asarray(fn(times), dtype=float), times.shape)
+                amplitude = float(values[np.argmax(np.abs(values))])
+                if amplitude == 0.0:
+                    continue
+                loads = quiet()
+                loads[p].loads[name] = lambda tt, f=fn, a=amplitude: f(tt) / a
+                # the shape to SHAPE_DIGITS digits, as for one punch
+                shape = np.round(values / amplitude, SHAPE_DIGITS) + 0.0
+                parts.append((amplitude, (common, p, name, fingerprint(shape)), loads, 0.0))
+        if form.has_gap or not parts:
+            parts.append((1.0, (common, "gap"), quiet(), 1.0))
+        joint_key = (identity, *(key for _, key, _, _ in parts))
+        with self._lock:
+            found = self._responses.get(joint_key)
+        if found is None:
+            found = form.solve_parts([(loads, gap) for _, _, loads, gap in parts], times, c,
+                                     kernel, time_tol, breaks)
+            with self._lock:
+                self.counts["time_response"] += len(found)
+                self._responses[joint_key] = found
+                while len(self._responses) > RESPONSES_KEPT:
+                    self._responses.pop(next(iter(self._responses)))
+        weights = [weight for weight, _, _, _ in parts]
+        nodal = sum(w * r.nodal for w, r in zip(weights, found, strict=True))
+        effective = sum(w * r.effective for w, r in zip(weights, found, strict=True))
+        scalars = []
+        for p, one in enumerate(inputs):
+            combined = {q: sum(w * r.scalars[p][q] for w, r in zip(weights, found,
+                                                                   strict=True))
+                        for q in QUANTITIES}
+            for name in one.given:  # exactly the loads given
+                combined[name] = np.broadcast_to(np.asarray(one.loads[name](times),
+                                                            dtype=float), times.shape).copy()
+            scalars.append(combined)
+        # each part's error is relative to its own size; on punch p it counts by the size
+        # of the part's answer there (a far neighbour's load moves p by nothing, and its
+        # error with it), against the size of p's whole answer
+        def size_at(s: dict[str, np.ndarray]) -> float:
+            return max(float(np.max(np.abs(s["settlement"]))),
+                       float(np.max(np.abs(s["force"]))), 1e-300)
+
+        errors = tuple(
+            sum(abs(w) * r.time_error * size_at(r.scalars[p])
+                for w, r in zip(weights, found, strict=True)) / size_at(scalars[p])
+            for p in range(len(inputs)))
+        failed = [r.message for r in found if not r.success]
+        return CoupledModalAnswer(nodal, effective, scalars, max(errors),
+                                  max(r.steps for r in found), not failed,
+                                  "; ".join(failed) or found[0].message, errors)
 
     def modal(self, givens: tuple[frozenset[str], ...], tol: float) -> CoupledModalForm:
         """The modal form of the coupled equations for the punches' statements (cached)."""

@@ -53,7 +53,8 @@ _DRIVES = {"settlement": 0, "tilt": 1}
 class CoupledModalAnswer:
     """The time-stepped answer: nodal q and ``q - V q`` (N, T) over all zones, the four
     scalars of every punch (dict per punch, arrays over the times), and the stepping's
-    report (``time_error`` relative to the size of the modal unknowns)."""
+    report (``time_error`` relative to the size of the modal unknowns; ``time_errors``,
+    where known, each punch's relative to its own answer)."""
 
     nodal: np.ndarray
     effective: np.ndarray
@@ -62,6 +63,7 @@ class CoupledModalAnswer:
     steps: int
     success: bool
     message: str
+    time_errors: tuple[float, ...] = ()
 
 
 class CoupledModalForm:
@@ -144,44 +146,83 @@ class CoupledModalForm:
               ) -> CoupledModalAnswer:
         """The answer at ``times`` for relative modulus ``c(t)`` and the stepping kernel
         ``kernel`` (None: no creep, ``c`` varying)."""
+        return self.solve_parts([(inputs, 1.0)], times, c, kernel, time_tol, breaks)[0]
+
+    def solve_parts(self, parts: Sequence[tuple[Sequence[TimeInputs], float]],
+                    times: np.ndarray, c: Callable, kernel: object, time_tol: float,
+                    breaks: Sequence[float] = ()) -> list[CoupledModalAnswer]:
+        """:meth:`solve` for several ``(inputs, gap)`` at once, in one time march.
+
+        ``inputs``: every punch's loads (``.given`` and ``.loads`` as a
+        :class:`core.problem.TimeInputs` has them); ``gap``: the weight of the gap in the
+        part. The parts share ``c``, the kernel and the times, so their modal equations
+        are stepped together as one problem with the modes of every part, each part's
+        error against its own size (``ModalProblem.parts``), as the single punch's
+        :meth:`core.engines.nystrom.modal.ModalSet.solve_parts` does.
+        """
         gamma = self.gamma
+        n_parts, n_free = len(parts), gamma.size
         single = self.coupling / gamma[:, None]
+        n_known = max(self.k, 1)
+        memo: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
-        def r(tt: np.ndarray) -> np.ndarray:
-            x, a_k = self._given(inputs, tt)
-            out = (self.drive_free @ x + self.gap_free[:, None]) / gamma[:, None]
-            return out - single @ a_k if self.k else out
-
-        def d(tt: np.ndarray) -> np.ndarray:
-            return 1.0 + np.asarray(c(tt), dtype=float)[None, :] / gamma[:, None]
-
-        def u(tt: np.ndarray) -> np.ndarray:
-            a_k = self._given(inputs, tt)[1]
-            return a_k if self.k else np.zeros((1, tt.size))
+        def evaluate(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            key = tt.tobytes()
+            if key not in memo:
+                memo.clear()
+                d = 1.0 + np.asarray(c(tt), dtype=float)[None, :] / gamma[:, None]
+                r = np.empty((n_parts * n_free, tt.size))
+                us = np.zeros((n_parts * n_known, tt.size))
+                for j, (inputs, gap) in enumerate(parts):
+                    x, a_k = self._given(inputs, tt)
+                    rows = r[j * n_free:(j + 1) * n_free]
+                    rows[:] = (self.drive_free @ x + gap * self.gap_free[:, None]) \
+                        / gamma[:, None]
+                    if self.k:
+                        rows -= single @ a_k
+                        us[j * n_known:(j + 1) * n_known] = a_k
+                memo[key] = (np.tile(d, (n_parts, 1)) if n_parts > 1 else d, r, us)
+            return memo[key]
 
         c_t = np.asarray(c(times), dtype=float)
         if kernel is None:
-            z = r(times) / d(times)
-            vz, vu = np.zeros_like(z), np.zeros((max(self.k, 1), times.size))
-            error, steps, success, message = 0.0, 0, True, "no creep: no time stepping"
+            d, r, _ = evaluate(times)
+            z = r / d
+            vz, vu = np.zeros_like(z), np.zeros((n_parts * n_known, times.size))
+            estimates: tuple[float, ...] = (0.0,) * n_parts
+            steps, success, message = 0, True, "no creep: no time stepping"
         else:
-            problem = ModalProblem(d=d, r=r, u=u,
-                                   coupling=single if self.k else np.zeros((gamma.size, 1)))
+            coupling = single if self.k else np.zeros((n_free, 1))
+            problem = ModalProblem(d=lambda tt: evaluate(tt)[0], r=lambda tt: evaluate(tt)[1],
+                                   u=lambda tt: evaluate(tt)[2],
+                                   coupling=(np.kron(np.eye(n_parts), coupling)
+                                             if n_parts > 1 else coupling), parts=n_parts)
             jumps = tuple(float(b) for b in breaks)
             if hasattr(kernel, "rates") and hasattr(kernel, "exponential_parts"):
                 sol = solve_degenerate(kernel, problem, times, tol=time_tol, breaks=jumps)
             else:
                 sol = solve_general(kernel, problem, times, tol=time_tol, breaks=jumps)
             z, vz, vu = sol.w, sol.vw, sol.vu
-            error, steps, success, message = (float(sol.error_estimate), int(sol.steps),
-                                              bool(sol.success), sol.message)
+            estimates = tuple(sol.part_errors) or (float(sol.error_estimate),) * n_parts
+            steps, success, message = int(sol.steps), bool(sol.success), sol.message
+        answers = []
+        for j, (inputs, gap) in enumerate(parts):
+            rows = slice(j * n_free, (j + 1) * n_free)
+            known = slice(j * n_known, j * n_known + self.k)
+            answers.append(self._finish(inputs, times, c_t, z[rows], vz[rows], vu[known],
+                                        gap, float(estimates[j]), steps, success, message))
+        return answers
+
+    def _finish(self, inputs: Sequence[TimeInputs], times: np.ndarray, c_t: np.ndarray,
+                z: np.ndarray, vz: np.ndarray, va_k: np.ndarray, gap: float, error: float,
+                steps: int, success: bool, message: str) -> CoupledModalAnswer:
+        """The answer of one part from its stepped modal coordinates."""
         x, a_k = self._given(inputs, times)
         a_f, va_f = self.psi @ z, self.psi @ vz
-        va_k = vu[:self.k]
         if self.k:
             # fixed rows: c a_k + (I - V)(G_kf a_f + G_kk a_k) = e_k x + gap_k
             lhs = (c_t[None, :] * a_k + self.g_kf @ (a_f - va_f) + self.g_kk @ (a_k - va_k)
-                   - self.e_k @ x - self.gap_k[:, None])
+                   - self.e_k @ x - gap * self.gap_k[:, None])
             x[self.driven] = np.linalg.solve(self.unknown_matrix, lhs)
         u_all = np.vstack([a_k, a_f])
         u_eff = np.vstack([a_k - va_k, a_f - va_f])
@@ -198,3 +239,8 @@ class CoupledModalForm:
                                                 times.shape).astype(float)
             scalars.append({q: np.asarray(values[q], dtype=float) for q in QUANTITIES})
         return CoupledModalAnswer(nodal, effective, scalars, error, steps, success, message)
+
+    @property
+    def has_gap(self) -> bool:
+        """Whether any zone's base has a gap (its response is a part of its own)."""
+        return bool(np.any(self.gap_free) or np.any(self.gap_k))
