@@ -26,7 +26,6 @@ from ..model import (
     scene_with_limits,
 )
 from ..solving import SolveController
-from .punches import OnePunchOnly
 from .style import TAB_COLUMN, html_pane, slug
 from .widgets import Binding, BoundedUpload
 
@@ -94,13 +93,11 @@ class FilesView:
     def content(self) -> pn.Column:
         """The tab's column."""
         return pn.Column(
-            OnePunchOnly(self.state, "The printable reports", self.report_download,
-                         self.pdf_report_download).panel,
+            self.report_download, self.pdf_report_download,
             self.scene_name, self.description, self.save_scene,
             html_pane("<small>Load a scene (the JSON the command line reads):</small>"),
             self.load_file,
-            OnePunchOnly(self.state, "The CSV downloads", self.csv_download,
-                         self.pressure_download).panel,
+            self.csv_download, self.pressure_download,
             self.json_download,
             html_pane("<small>Downloads hold the result on screen. The address bar holds "
                       "a link to it.</small>"), **TAB_COLUMN)
@@ -193,12 +190,16 @@ class FilesView:
         view = self.screen.shown()
         if view is None:
             return io.StringIO("")
+        if view.several:  # every punch's columns, in SI units (the core's file)
+            return io.StringIO(str(await self._fetch("to_csv") or ""))
         return io.StringIO(await asyncio.to_thread(histories_csv, view))
 
     async def _pressure_file(self) -> io.StringIO:
         view = self.screen.shown()
         if view is None:
             return io.StringIO("")
+        if view.several:  # q on every punch's zone, global x, in Pa (the core's file)
+            return io.StringIO(str(await self._fetch("pressure_csv") or ""))
         unit = self.scales.pressure_unit(view)
         return io.StringIO(await asyncio.to_thread(pressure_csv, view, unit))
 

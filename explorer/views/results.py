@@ -89,9 +89,9 @@ def badges_html(view: ResultView | None, group: str,
 #: What the page does not show for a scene of several punches yet, said under its
 #: readout (the features of one punch that are off for several).
 SEVERAL_PUNCHES_NOTE = ("Several punches: pins, the classical solutions, the design check, "
-                        "the coating model's FE check, studies, the back-analysis and the "
-                        "CSV and report downloads are for one punch and are off here (the "
-                        "scene and the JSON of the result can be saved).")
+                        "the coating model's FE check, studies and the back-analysis are "
+                        "for one punch and are off here; the Files tab's CSV files (SI "
+                        "units, a column per punch), reports and JSON hold every punch.")
 
 
 def punches_readout_html(view: ResultView, index: int) -> str:

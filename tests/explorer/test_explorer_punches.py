@@ -7,6 +7,7 @@ lessons (tests/explorer/test_explorer_lessons.py): a test fails if they drift.
 
 from __future__ import annotations
 
+import asyncio
 import copy
 import json
 import pickle
@@ -145,6 +146,18 @@ def test_the_page_shows_each_punch_and_turns_off_what_is_for_one(explorer_app) -
     # the JSON of the result is the core's, every punch in it
     saved = json.loads(app.controller.download(view, "to_json"))
     assert [p["center"] for p in saved["punches"]] == [0.0, 3.0]
+    # so are the CSV files and the reports: a column, a zone, a section per punch
+    files = app.files_tab
+    histories = asyncio.run(files._csv_file()).getvalue().splitlines()
+    assert histories[0].startswith("time_day,punches[0].settlement_m,")
+    assert "punches[1].settlement_m" in histories[0] and len(histories) == 201
+    pressure = asyncio.run(files._pressure_file()).getvalue().splitlines()
+    assert pressure[0] == "time_day,x_m,pressure_Pa"
+    xs = {float(line.split(",")[1]) for line in pressure[1:2000]}
+    assert min(xs) == -1.0 and max(xs) == 4.0  # both zones, in the global x
+    report = asyncio.run(files._report_file()).getvalue()
+    assert "punches[1]" in report and "<h2>Results" in report
+    assert asyncio.run(files._pdf_report_file()).getvalue().startswith(b"%PDF")
     # back to one punch: the single-punch page as it was
     assert app.load_scene(presets()["uniform_flat"])
     assert app.controller.wait(120) and app.controller.error == ""
