@@ -24,6 +24,7 @@ from core.creep.design_codes import (
     fit_advice,
 )
 from core.creep.design_codes import SPEC_FIELDS as CODE_SPEC_FIELDS
+from core.creep.fitted_kernel import integrated_kernel
 from core.creep.inputs import MAX_RATE, MAX_TERMS
 from core.creep.kernel_fit import stepping_kernel
 from core.creep.models import (
@@ -45,6 +46,7 @@ __all__ = [
     "DEFAULT_TOL_LADDER",
     "FIT_ERROR_SHARE",
     "fit_advice",
+    "integrated_kernel",
     "Elastic",
     "KNOWN_MODELS",
     "MAX_RATE",

@@ -124,12 +124,16 @@ class PreparedContact:
 
     method = "nystrom"
 
-    def __init__(self, geometry: Geometry) -> None:
+    def __init__(self, geometry: Geometry, c_ref: float = 1.0) -> None:
+        """``c_ref``: the relative modulus the grid is refined at (1: the base at loading;
+        below 1 for a base whose creep makes the coating count less, see
+        :func:`core.engines.nystrom.engine.creep_reference`)."""
         t0 = _time.perf_counter()
         self.geometry = geometry
+        self.c_ref = float(c_ref)
         self.counts: Counter[str] = Counter()
         adaptive = adapt(geometry.lam, geometry.m, geometry.g, geometry.g_is_zero,
-                         geometry.breakpoints, geometry.tol)
+                         geometry.breakpoints, geometry.tol, c_ref=self.c_ref)
         self.counts["grid"] += 1
         self.grid = adaptive.grid
         self.spatial_error = adaptive.spatial_error
@@ -483,9 +487,10 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
     return prepared_for(geometry).solve_validated(inputs, time_breaks, check_only=check_only)
 
 
-def prepared_for(geometry: Geometry) -> PreparedContact:
-    """The prepared form of a validated geometry: from :data:`PREPARED` when a geometry of
-    the same values was prepared before, else prepared now and kept there."""
-    prepared, _ = PREPARED.get_or_compute(geometry_key(geometry),
-                                          lambda: PreparedContact(geometry))
+def prepared_for(geometry: Geometry, c_ref: float = 1.0) -> PreparedContact:
+    """The prepared form of a validated geometry, refined at relative modulus ``c_ref``:
+    from :data:`PREPARED` when a geometry of the same values was prepared before, else
+    prepared now and kept there."""
+    key = geometry_key(geometry) if c_ref == 1.0 else (geometry_key(geometry), float(c_ref))
+    prepared, _ = PREPARED.get_or_compute(key, lambda: PreparedContact(geometry, c_ref))
     return prepared
