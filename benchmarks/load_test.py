@@ -225,17 +225,22 @@ def process_tree(pid: int) -> list[int]:
 
 class Sampler(threading.Thread):
     """Samples the RSS and CPU time of the server with its solver processes, the server
-    process's own CPU time, and the machine's CPU use every ``period`` seconds; ``mark``
-    records events on the same clock."""
+    process's own CPU time, the CPU time of this load test's own processes (the driver
+    and what it started besides the server: Chromium, the probe) and the machine's CPU
+    use every ``period`` seconds; ``mark`` records events on the same clock."""
 
     def __init__(self, pid: int, period: float = 2.0) -> None:
         super().__init__(daemon=True)
         self.pid = pid
         self.period = period
         # (s since start, RSS bytes and CPU s of the server with its solver processes,
-        #  machine busy ticks, machine ticks, CPU s of the server's own process)
-        self.samples: list[tuple[float, int, float, int, int, float]] = []
+        #  machine busy ticks, machine ticks, CPU s of the server's own process, CPU s
+        #  of the load test's own processes)
+        self.samples: list[tuple[float, int, float, int, int, float, float]] = []
         self.marks: list[tuple[float, str]] = []
+        # the last CPU time [s] seen of every process of each tree: a process that ended
+        # (a study's, Chromium's) keeps counting with what it had used
+        self._seen: dict[str, dict[int, float]] = {"server": {}, "clients": {}}
         self._halt = threading.Event()
         self.t0 = time.monotonic()
 
@@ -247,12 +252,19 @@ class Sampler(threading.Thread):
             own = cpu_seconds(self.pid)
             tree = process_tree(self.pid)
             rss = [rss_bytes(p) for p in tree]
-            cpu = [cpu_seconds(p) for p in tree]
+            # the driver's tree holds the server's: what is left is the load test's own
+            clients = set(process_tree(os.getpid())) - set(tree)
+            for name, pids in (("server", tree), ("clients", clients)):
+                for p in pids:
+                    cpu = cpu_seconds(p)
+                    if cpu is not None:
+                        self._seen[name][p] = cpu
             if own is not None:
                 self.samples.append((time.monotonic() - self.t0,
                                      sum(r for r in rss if r is not None),
-                                     sum(c for c in cpu if c is not None),
-                                     *machine_ticks(), own))
+                                     sum(self._seen["server"].values()),
+                                     *machine_ticks(), own,
+                                     sum(self._seen["clients"].values())))
             self._halt.wait(self.period)
 
     def stop(self) -> None:
@@ -265,11 +277,23 @@ class Sampler(threading.Thread):
         marks = {label: t for t, label in self.marks}
         inside = [s for s in self.samples if marks[start] <= s[0] <= marks[stop]]
         if len(inside) < 2:
-            return {"server": float("nan"), "machine": float("nan"), "own": float("nan")}
-        (t0, _, c0, b0, n0, o0), (t1, _, c1, b1, n1, o1) = inside[0], inside[-1]
-        return {"server": 100 * (c1 - c0) / max(t1 - t0, 1e-9),
-                "own": 100 * (o1 - o0) / max(t1 - t0, 1e-9),
-                "machine": 100 * (b1 - b0) / max(n1 - n0, 1)}
+            return dict.fromkeys(("server", "machine", "own", "clients", "others"),
+                                 float("nan"))
+        return cpu_between(inside[0], inside[-1])
+
+
+def cpu_between(first: tuple[Any, ...], last: tuple[Any, ...]) -> dict[str, float]:
+    """CPU use between two samples of :class:`Sampler`: the server with its solver
+    processes, the server's own process, the load test's own processes ("clients") and
+    the machine's other work ("others") [% of one core], the machine [% of all cores]."""
+    (t0, _, c0, b0, n0, o0, d0), (t1, _, c1, b1, n1, o1, d1) = first, last
+    span = max(t1 - t0, 1e-9)
+    machine = (b1 - b0) / max(n1 - n0, 1)
+    server, clients = 100 * (c1 - c0) / span, 100 * (d1 - d0) / span
+    return {"server": server, "own": 100 * (o1 - o0) / span, "clients": clients,
+            "machine": 100 * machine,
+            "others": max(100 * machine * (os.cpu_count() or 1) - server - clients, 0.0)}
+
 
 
 _FREEZE_LOCK = threading.Lock()
@@ -699,7 +723,10 @@ def report(args: argparse.Namespace, single: Stats, crowd: Stats, sampler: Sampl
         f"alone, {cpu_crowd['server']:.0f} % with the crowd (the server's own process "
         f"{cpu_single['own']:.0f} % and {cpu_crowd['own']:.0f} %); the whole machine "
         f"{cpu_single['machine']:.0f} % and {cpu_crowd['machine']:.0f} % of its "
-        f"{os.cpu_count()} cores.",
+        f"{os.cpu_count()} cores, of which this load test's own clients (the driver with "
+        f"its threads, and Chromium and the probe where used) {cpu_single['clients']:.0f} % "
+        f"and {cpu_crowd['clients']:.0f} % of one core, and other work on the machine "
+        f"{cpu_single['others']:.0f} % and {cpu_crowd['others']:.0f} %.",
         "",
         "Latency from the move, ms (p50 / p95 / p99):",
         "",
@@ -727,16 +754,36 @@ def report(args: argparse.Namespace, single: Stats, crowd: Stats, sampler: Sampl
                   "    " + ", ".join(f"{t - sampler.t0:.0f} s {ms:.0f} {name}"
                                      for t, ms, name in slow[:60])]
     lines += extra or []
-    lines += ["", "Server memory over time (RSS; t from the server's start):", "",
-              "| t [s] | RSS [MiB] | event |", "| --- | --- | --- |"]
+    lines += ["", "Server memory over time (RSS; t from the server's start), and the CPU "
+              "used since the row before [% of one core] by the server with its solver "
+              "processes, by this load test's own clients and by other work on the "
+              "machine:", "",
+              "| t [s] | RSS [MiB] | CPU server / clients / other work | event |",
+              "| --- | --- | --- | --- |"]
     step = max(1, int(30 / sampler.period))
-    for i, (t, rss, *_rest) in enumerate(samples):
+    previous = samples[0]
+    for i, sample in enumerate(samples):
+        t, rss = sample[0], sample[1]
         events = [label for m, label in sampler.marks
                   if t - sampler.period / 2 < m <= t + sampler.period / 2]
         if i % step == 0 or events or i == len(samples) - 1:
-            lines.append(f"| {t:.0f} | {rss / 2**20:.0f} | {', '.join(events)} |")
+            cpu = cpu_between(previous, sample) if sample is not previous else None
+            shown = (f"{cpu['server']:.0f} / {cpu['clients']:.0f} / {cpu['others']:.0f}"
+                     if cpu is not None else "")
+            lines.append(f"| {t:.0f} | {rss / 2**20:.0f} | {shown} | {', '.join(events)} |")
+            previous = sample
     if errors:
-        lines += ["", "Errors (first 20):", ""] + [f"- {e}" for e in errors[:20]]
+        # the kinds that come by the dozen are counted, with their first; the others listed
+        common = ("could not open a session", "no plot update within")
+        rest = [e for e in errors if not any(c in e for c in common)]
+        lines += ["", "Errors:", ""]
+        for kind in common:
+            those = [e for e in errors if kind in e]
+            if those:
+                lines.append(f"- {len(those)} x \"{kind}\", the first: {those[0]}")
+        lines += [f"- {e}" for e in rest[:20]]
+        if len(rest) > 20:
+            lines.append(f"- ... and {len(rest) - 20} more")
     return "\n".join(lines) + "\n"
 
 
@@ -824,7 +871,7 @@ def main() -> int:
             if args.heavy:
                 from benchmarks.load_heavy import HeavyRun
 
-                heavy = HeavyRun(url, sampler.mark)  # the probe starts now
+                heavy = HeavyRun(url, server.pid, sampler.mark)  # the probe starts now
             think = tuple(args.think)
             single = phase(url, 1, args.baseline_seconds, args.max_requests,
                            args.geometry_share, think, 0.0, sampler, "single")
