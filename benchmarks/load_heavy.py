@@ -14,18 +14,21 @@ does not share the movers' interpreter), do the heavy things a page can ask for:
   resolved finite-element check, one at a time per server), again and again;
 - **files**: opens a heavy view link (the default preset at
   :data:`core.limits.MAX_SCENE_TIMES` output times, with three pinned variants, solved
-  again when the link opens), downloads the q(x, t) CSV (~10 MB) and reloads the link,
+  again when the link opens), downloads the q(x, t) CSV (~15 MB) and reloads the link,
   again and again.
 
 The pages open before the crowd arrives; their work starts when the last mover is ready
 and stops when the movers stop (the first study is awaited to its end). A probe, also a
 process of its own, GETs the server's liveness URL (:data:`LIVENESS_PATH`, answered by
 the event loop without building a page) every :data:`PROBE_PERIOD_S` from the server's
-start to the end of the run, and records each answer's latency. The report
-(:func:`heavy_lines`) gives the goals of issue "Reliability" (movers' p95 at most 2x the
-single session, no answer lost, the probe under :data:`PROBE_GOAL_S`, the memory back
-within :data:`MEMORY_GOAL` of its level before the crowd), the heavy sessions' outcomes,
-and the movers' and the probe's latencies by what ran beside them.
+start to the end of the run, and records each answer's latency; when ``py-spy`` is
+installed, a wait over :data:`DUMP_AFTER_S` has the server's stacks dumped, which say
+what its event loop was doing meanwhile. The report (:func:`heavy_lines`) gives the
+goals of issue "Reliability" (movers' p95 at most 2x the single session, no answer lost,
+the probe under :data:`PROBE_GOAL_S`, the memory after all sessions closed within
+:data:`MEMORY_GOAL` of its level before the heavy pages and the crowd opened), the heavy
+sessions' outcomes, the movers' and the probe's latencies by what ran beside them, and
+the dumps grouped by the project's code the loop was in.
 """
 
 from __future__ import annotations
@@ -56,9 +59,13 @@ PROBE_TIMEOUT_S = 30.0
 DUMP_AFTER_S = 0.5
 DUMP_EVERY_S = 1.0
 MOST_DUMPS = 400
+#: Frames kept of a thread's stack (Bokeh's validation of a page recurses deep: 40
+#: frames lost the project's frames below it).
+MOST_FRAMES = 400
 #: Goals of issue "Reliability": the probe's answer under this [s] while heavy work runs;
 #: the movers' p95 at most this many times the single session's; the server's memory
-#: after all sessions closed within this fraction of its level before the crowd.
+#: after all sessions closed within this fraction of its level before them (the single
+#: session closed, the heavy pages and the crowd not yet opened).
 PROBE_GOAL_S = 0.2
 P95_GOAL = 2.0
 MEMORY_GOAL = 0.10
@@ -135,7 +142,7 @@ def _dump_stacks(py_spy: str, pid: int) -> dict[str, Any] | None:
         found = re.match(r'Thread \S+ \(([^)]*)\): "(.*)"', line)
         if found:
             threads.append({"status": found.group(1), "name": found.group(2), "frames": []})
-        elif threads and line.startswith("    ") and len(threads[-1]["frames"]) < 40:
+        elif threads and line.startswith("    ") and len(threads[-1]["frames"]) < MOST_FRAMES:
             threads[-1]["frames"].append(line.strip())
     main = next((t for t in threads if t["name"] == "MainThread"), None)
     if main is None:
@@ -669,9 +676,11 @@ def heavy_lines(single: Any, crowd: Any, sampler: Any, heavy: HeavyRun) -> tuple
                                                         "p95": float("nan")}
     probe_max = max(probe_ms, default=float("nan"))
 
-    # memory of the server tree: before the crowd, peak, after all closed
+    # memory of the server tree: before any session of the load (the single session
+    # closed, the heavy pages and the crowd not yet there), peak, after all closed
     samples = sampler.samples
-    before_rss = [s[1] for s in samples if s[0] <= _crowd_arriving(sampler)]
+    opening = marks.get("heavy: 3 pages opening", _crowd_arriving(sampler))
+    before_rss = [s[1] for s in samples if s[0] <= opening]
     before = before_rss[-1] if before_rss else samples[0][1]
     idle = samples[0][1]
     peak_sample = max(samples, key=lambda s: s[1])
@@ -737,7 +746,8 @@ def heavy_lines(single: Any, crowd: Any, sampler: Any, heavy: HeavyRun) -> tuple
         f"{sum(v > 1e3 * PROBE_GOAL_S for v in probe_ms)} over "
         f"{1e3 * PROBE_GOAL_S:.0f} ms | {met(probe_max < 1e3 * PROBE_GOAL_S)} |",
         f"| server memory after all closed within {100 * MEMORY_GOAL:.0f} % of before "
-        f"the crowd | {before / 2**20:.0f} MiB before, peak {peak_sample[1] / 2**20:.0f} MiB "
+        f"| {before / 2**20:.0f} MiB before (the single session closed, neither the heavy "
+        f"pages nor the crowd there yet), peak {peak_sample[1] / 2**20:.0f} MiB "
         f"(t = {peak_sample[0]:.0f} s), **{after / 2**20:.0f} MiB** after "
         f"(**{100 * growth:+.0f} %**; idle server at its start: {idle / 2**20:.0f} MiB) | "
         f"{met(growth <= MEMORY_GOAL)} |",
@@ -837,29 +847,43 @@ def stack_summary(frames: list[str]) -> str:
         found = next((line for line in frames if test(_frame(line)[1])), None)
         if found is not None and found not in chosen:
             chosen.append(found)
-    return " < ".join(f"{func} ({path.rsplit('site-packages/', 1)[-1]})"
-                      for func, path in map(_frame, chosen))
+    return " < ".join(_short(line) for line in chosen)
 
 
-def stall_kind(dump: dict[str, Any]) -> str:
-    """What the server's event loop was doing in a dump: idle, busy (where), or
-    waiting for the GIL held by another thread (doing what)."""
+def _short(line: str) -> str:
+    func, path = _frame(line)
+    return f"{func} ({path.rsplit('site-packages/', 1)[-1]})"
+
+
+def stall_place(dump: dict[str, Any]) -> tuple[str, str]:
+    """Where a dump found the server's event loop: (the innermost frame of the project's
+    code, or what else, with the thread's state; the innermost frame)."""
     main, holder = dump["main"], dump.get("holder")
     if "idle" in main["status"]:
-        return "idle: waiting for events (the stall was not in the server's loop)"
-    if "gil" in main["status"]:
-        return "running: " + stack_summary(main["frames"])
-    if holder is not None:
-        return (f"waiting for the GIL, held by thread {holder['name']!r}: "
-                + stack_summary(holder["frames"]))
-    return ("active, not holding the GIL (in a system call, or waiting for the GIL): "
-            + stack_summary(main["frames"]))
+        return "idle: waiting for events (the wait was not in the server's loop)", ""
+    frames = main["frames"]
+    state = ""
+    if "gil" not in main["status"]:
+        if holder is not None:
+            return (f"waiting for the GIL, held by thread {holder['name']!r}",
+                    stack_summary(holder["frames"]))
+        state = "not holding the GIL (a system call, or waiting for it): "
+    # the server's own loop (python -m explorer's _serve) is below everything: not a place
+    own = next((line for line in frames if _own(_frame(line)[1])
+                and not _frame(line)[1].endswith("explorer/__main__.py")), None)
+    served = any(_frame(line)[1].endswith("explorer/__main__.py") for line in frames)
+    place = (_short(own) if own is not None else
+             "the libraries only (Bokeh, Panel, Tornado: a page's document built, a "
+             "message handled or sent)" if served else
+             f"(a stack deeper than the {MOST_FRAMES} frames kept)")
+    return state + place, _short(frames[0]) if frames else ""
 
 
 def stall_lines(probe: Probe, t0: float,
                 beside: Callable[[float, float], list[str]]) -> list[str]:
     """The report's lines on what the server's event loop did while the probe waited
-    (the py-spy dumps), grouped, with when and what heavy work ran beside."""
+    (the py-spy dumps), grouped by the innermost frame of the project's code, with when
+    and what heavy work ran beside."""
     if probe.py_spy is None:
         return ["", "What the event loop did during the probe's long waits: not seen "
                 "(py-spy is not installed; `pip install py-spy` to have the server's "
@@ -867,20 +891,28 @@ def stall_lines(probe: Probe, t0: float,
     dumps = probe.stacks()
     if not dumps:
         return ["", f"No probe waited over {DUMP_AFTER_S:g} s for a stack dump."]
-    groups: dict[str, list[dict[str, Any]]] = {}
+    groups: dict[str, list[tuple[dict[str, Any], str]]] = {}
     for dump in dumps:
-        groups.setdefault(stall_kind(dump), []).append(dump)
-    lines = ["", f"What the server's main thread (its event loop) was doing while the probe "
+        place, innermost = stall_place(dump)
+        groups.setdefault(place, []).append((dump, innermost))
+    lines = ["", f"Where the server's main thread (its event loop) was while the probe "
              f"waited over {DUMP_AFTER_S:g} s: {len(dumps)} stack dumps (py-spy, at most one "
-             f"a {DUMP_EVERY_S:g} s), innermost frame first, then the innermost of the web "
-             "libraries and of the project's code:", "",
-             "| the main thread | dumps | when (t [s]) and what heavy work ran beside |",
-             "| --- | --- | --- |"]
-    for kind, members in sorted(groups.items(), key=lambda kv: -len(kv[1])):
-        when = ", ".join(f"{d['t'] - t0:.0f}" for d in members[:12]) + (
-            ", ..." if len(members) > 12 else "")
-        kinds = sorted({k for d in members for k in beside(d["t"], d["t"])})
-        lines.append(f"| {kind.replace('|', '/')} | {len(members)} | {when}"
+             f"a {DUMP_EVERY_S:g} s), by the innermost frame of the project's code, with the "
+             "innermost frames seen most often:", "",
+             "| the loop was in | dumps | innermost frames | when (t [s]) and what heavy work "
+             "ran beside |", "| --- | --- | --- | --- |"]
+    for place, members in sorted(groups.items(), key=lambda kv: -len(kv[1])):
+        times = sorted(d["t"] - t0 for d, _ in members)
+        when = ", ".join(f"{t:.0f}" for t in times[:12]) + (", ..." if len(times) > 12 else "")
+        kinds = sorted({k for d, _ in members for k in beside(d["t"], d["t"])})
+        seen: dict[str, int] = {}
+        for _, innermost in members:
+            if innermost:
+                seen[innermost] = seen.get(innermost, 0) + 1
+        common = "; ".join(f"{frame} x{n}" if n > 1 else frame for frame, n in
+                           sorted(seen.items(), key=lambda kv: -kv[1])[:2])
+        lines.append(f"| {place.replace('|', '/')} | {len(members)} | "
+                     f"{common.replace('|', '/')} | {when}"
                      + (f" ({'; '.join(kinds)})" if kinds else "") + " |")
     return lines
 
