@@ -50,15 +50,14 @@ from typing import Any
 import numpy as np
 
 from core.contact.active_set import MAX_SWEEPS, NoContact, NodalState, zones_from_nodes
-from core.contact.elastic import _bad_pins, _verify
+from core.contact.elastic import _bad_pins, _verify, verdict
 from core.contact.nodal import coarse_start, nodal_operator
-from core.contact.result import UNILATERAL_MARGIN, UnilateralSolution, _Snapshot
+from core.contact.result import UnilateralSolution, _Snapshot
 from core.contact.step import Space, Step, check_loads, nystrom_pressure
-from core.contact.systems import StepSolver
+from core.contact.systems import StepSolver, bordered_operator
 from core.contact.unilateral import nodal_resolution, zone_resolution
 from core.contact.zones import (
     MAX_LEVELS,
-    ZONE_END_TOL,
     Resolution,
     ZoneSolution,
     _walls,
@@ -70,7 +69,7 @@ from core.contact.zones import (
 from core.discretize import Panels, kernel_operator, operator_rows
 from core.engines.nystrom import PunchGeometry, coupled_x, interacting
 from core.kernel import FULL_ACCURACY, KERNEL_DECAY, KERNEL_ENVELOPE
-from core.problem import TimeInputs, accepts
+from core.problem import TimeInputs
 
 
 @dataclass(frozen=True)
@@ -171,19 +170,7 @@ def coupled_bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.n
     n = idx.size
     own = owner[idx]
     xi, wi = x[idx], w[idx]
-    cols, names, rows, values = [], [], [], []
-    for p, given in enumerate(givens):
-        on = (own == p).astype(float)
-        if "settlement" not in given:
-            cols.append(-on)
-            names.append((p, "settlement"))
-        if "tilt" not in given:
-            cols.append(-xi * on)
-            names.append((p, "tilt"))
-        for name, weight in (("force", wi), ("moment", wi * xi)):
-            if name in given:
-                rows.append(weight * on)
-                values.append(given[name])
+    cols, names, rows, values, _ = _borders(givens, own, xi, wi)
     k = len(cols)
     a = np.zeros((n + k, n + k))
     a[:n, :n] = op[np.ix_(idx, idx)]
@@ -310,17 +297,12 @@ class CoupledStepSolver:
         return x
 
 
-def _kept_factors_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray,
-                        owner: np.ndarray, step_c: float, scale: float,
-                        givens: Sequence[dict[str, float]], rhs: np.ndarray, idx: np.ndarray,
-                        solver: CoupledStepSolver
-                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`coupled_bordered_solve` by ``solver`` (the system of
-    :func:`core.contact.systems.bordered_solve`, divided by ``scale`` likewise: the
-    factors of one step precondition the next up to the change of c/s)."""
-    n = idx.size
-    own = owner[idx]
-    xi, wi = x[idx], w[idx]
+def _borders(givens: Sequence[dict[str, float]], own: np.ndarray, xi: np.ndarray,
+             wi: np.ndarray) -> tuple[list, list, list, list, list]:
+    """The border of the coupled system on the nodes kept: per punch, a column of each
+    unknown settlement (``-1`` on its nodes) and tilt (``-x``), named ``(p, quantity)``,
+    and a row of each given force (the weights ``w``) and moment (``w x``) with its value
+    and its punch. ``own``, ``xi``, ``wi``: the owner, x and weight of each node kept."""
     cols, names, rows, values, row_owner = [], [], [], [], []
     for p, given in enumerate(givens):
         on = (own == p).astype(float)
@@ -335,6 +317,21 @@ def _kept_factors_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndar
                 rows.append(weight * on)
                 values.append(given[name])
                 row_owner.append(p)
+    return cols, names, rows, values, row_owner
+
+
+def _kept_factors_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray,
+                        owner: np.ndarray, step_c: float, scale: float,
+                        givens: Sequence[dict[str, float]], rhs: np.ndarray, idx: np.ndarray,
+                        solver: CoupledStepSolver
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`coupled_bordered_solve` by ``solver`` (the system of
+    :func:`core.contact.systems.bordered_solve`, divided by ``scale`` likewise: the
+    factors of one step precondition the next up to the change of c/s)."""
+    n = idx.size
+    own = owner[idx]
+    xi, wi = x[idx], w[idx]
+    cols, names, rows, values, row_owner = _borders(givens, own, xi, wi)
     k = len(cols)
     border_cols = np.array(cols).T.reshape(n, k)
     border_rows = np.array(rows).reshape(k, n)
@@ -350,19 +347,7 @@ def _kept_factors_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndar
                        np.concatenate([mine, n + np.nonzero(row_owner_arr == p)[0]]),
                        np.concatenate([mine, n + np.nonzero(col_owner == p)[0]])))
 
-    def build() -> np.ndarray:
-        a = np.zeros((n + k, n + k))
-        a[:n, :n] = sub
-        a[np.arange(n), np.arange(n)] += diagonal
-        a[:n, n:] = border_cols
-        a[n:, :n] = border_rows
-        return a
-
-    def apply(z: np.ndarray) -> np.ndarray:
-        zq = z[:n]
-        return np.concatenate([diagonal * zq + sub @ zq + border_cols @ z[n:],
-                               border_rows @ zq])
-
+    build, apply = bordered_operator(sub, diagonal, border_cols, border_rows)
     b = np.concatenate([rhs[idx] / scale, values])
     return _unpack_all(solver.solve(build, apply, b, blocks), n, scale, givens, names)
 
@@ -678,24 +663,9 @@ def solve_unilateral_punches(punches: Sequence[PunchGeometry], inputs: Sequence[
                                                             base.reach(p, k))
                     for r in per_time for k in (p, *base.pairs[p]))
         verified = all(i["verified"] for _, i in mine)
-        success = (accepts(error, tol, UNILATERAL_MARGIN) and end_error <= ZONE_END_TOL
-                   and verified and converged)
-        flags = [] if success else ["tol_not_met"]
-        if not verified:
-            flags.append("contact_set_unverified")
-        message = (f"unilateral contact (elastic, {len(base.punches)} punches): estimated "
-                   f"error {error:.1e}, zone ends to {end_error:.1e} half-widths")
-        if not success:
-            message += (f"; not within tol {tol:.1e} / zone-end tolerance {ZONE_END_TOL:g}"
-                        + ("" if verified else "; the contact set failed its check (q < 0 "
-                           "on it or the surfaces overlap off it)"))
         info = {
-            "contact": "unilateral",
-            "error_estimate": float(error),
-            "zone_end_error": float(end_error),
-            "success": bool(success),
-            "flags": flags,
-            "message": message,
+            **verdict(error, end_error, verified, converged, tol,
+                      f"elastic, {len(base.punches)} punches"),
             "n_steps": int(times.size),
             "n_solves": len(results),
             "n_nodes": max(int(r["n_nodes"]) for r in per_time),

@@ -44,24 +44,8 @@ def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
     error = max(r[1]["error_estimate"] for r in per_time)
     verified = all(r[1]["verified"] for r in per_time)
     converged = all(r[1]["converged"] for r in per_time)
-    success = (accepts(error, tol, UNILATERAL_MARGIN) and end_error <= ZONE_END_TOL
-               and verified and converged)
-    flags = [] if success else ["tol_not_met"]
-    if not verified:
-        flags.append("contact_set_unverified")
-    message = (f"unilateral contact (elastic): estimated error {error:.1e}, zone ends to "
-               f"{end_error:.1e} half-widths")
-    if not success:
-        message += (f"; not within tol {tol:.1e} / zone-end tolerance {ZONE_END_TOL:g}"
-                    + ("" if verified else "; the contact set failed its check (q < 0 on "
-                       "it or the surfaces overlap off it)"))
     info = {
-        "contact": "unilateral",
-        "error_estimate": float(error),
-        "zone_end_error": float(end_error),
-        "success": bool(success),
-        "flags": flags,
-        "message": message,
+        **verdict(error, end_error, verified, converged, tol, "elastic"),
         "n_steps": int(times.size),
         "n_solves": len(results),
         "n_nodes": max(int(r[0].panels.size) for r in per_time),
@@ -165,3 +149,27 @@ def _verify(space: Space, step: Step, sol, base: Panels, zones, accuracy: float,
     values = nystrom_pressure(space, step, sol.panels, sol.q, sol.settlement, sol.tilt, off,
                               memory_at=memory_at, accuracy=accuracy)
     return bool(np.max(values) <= 1e-8 * scale)
+
+
+def verdict(error: float, end_error: float, verified: bool, converged: bool, tol: float,
+            what: str) -> dict[str, object]:
+    """The verdict of an elastic unilateral answer as its info entries (``contact``,
+    ``error_estimate``, ``zone_end_error``, ``success``, ``flags``, ``message``): from its
+    estimated error of q and the scalars (``error``, relative), of the zone ends
+    (``end_error``, half-widths), whether its contact set passed its check and the zone
+    ends converged; ``what`` names the problem in the message (``"elastic"``, ``"elastic,
+    2 punches"``)."""
+    success = (accepts(error, tol, UNILATERAL_MARGIN) and end_error <= ZONE_END_TOL
+               and verified and converged)
+    flags = [] if success else ["tol_not_met"]
+    if not verified:
+        flags.append("contact_set_unverified")
+    message = (f"unilateral contact ({what}): estimated error {error:.1e}, zone ends to "
+               f"{end_error:.1e} half-widths")
+    if not success:
+        message += (f"; not within tol {tol:.1e} / zone-end tolerance {ZONE_END_TOL:g}"
+                    + ("" if verified else "; the contact set failed its check (q < 0 on "
+                       "it or the surfaces overlap off it)"))
+    return {"contact": "unilateral", "error_estimate": float(error),
+            "zone_end_error": float(end_error), "success": bool(success), "flags": flags,
+            "message": message}

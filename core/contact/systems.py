@@ -137,6 +137,30 @@ class StepSolver:
         return np.linalg.solve(build(), b)
 
 
+def bordered_operator(sub: np.ndarray, diagonal: np.ndarray, border_cols: np.ndarray,
+                      border_rows: np.ndarray
+                      ) -> tuple[Callable[[], np.ndarray], Callable[[np.ndarray], np.ndarray]]:
+    """``build()``, the bordered matrix ``[[diag + sub, cols], [rows, 0]]``, and
+    ``apply(z)``, its product with ``z`` without building it (the refinement of
+    :meth:`StepSolver.solve` needs only products)."""
+    n, k = sub.shape[0], border_cols.shape[1]
+
+    def build() -> np.ndarray:
+        a = np.zeros((n + k, n + k))
+        a[:n, :n] = sub
+        a[np.arange(n), np.arange(n)] += diagonal
+        a[:n, n:] = border_cols
+        a[n:, :n] = border_rows
+        return a
+
+    def apply(z: np.ndarray) -> np.ndarray:
+        zq = z[:n]
+        top = diagonal * zq + sub @ zq + border_cols @ z[n:]
+        return np.concatenate([top, border_rows @ zq])
+
+    return build, apply
+
+
 def _bordered_system(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, c: float,
                      scale: float, given: Sequence[str], idx: np.ndarray,
                      solver: StepSolver | None):
@@ -161,21 +185,7 @@ def _bordered_system(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray
     # the border unknowns come out divided by s): kept factors then precondition the
     # next steps up to the change of c/s alone.
     diagonal = (c / scale) * m[idx]
-
-    def build() -> np.ndarray:
-        a = np.zeros((n + k, n + k))
-        a[:n, :n] = sub
-        a[np.arange(n), np.arange(n)] += diagonal
-        a[:n, n:] = border_cols
-        a[n:, :n] = border_rows
-        return a
-
-    def apply(z: np.ndarray) -> np.ndarray:
-        zq = z[:n]
-        top = diagonal * zq + sub @ zq + border_cols @ z[n:]
-        return np.concatenate([top, border_rows @ zq])
-
-    return build, apply
+    return bordered_operator(sub, diagonal, border_cols, border_rows)
 
 
 def bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, c: float,
