@@ -57,17 +57,18 @@ from core.contact.creep import (
     _merge,
     _outside_bands,
     controlled_march,
+    creep_verdict,
 )
 from core.contact.kinks import Corrected, _contact_parts, _cut_rule, _part_rows, corrected_roots
 from core.contact.march import creep_memory, nodes_in, rule_operator
-from core.contact.result import UNILATERAL_MARGIN, UnilateralSolution, _Snapshot
+from core.contact.result import UnilateralSolution, _Snapshot
 from core.contact.step import Step, check_loads
 from core.contact.unilateral import creep_resolution
-from core.contact.zones import ZONE_END_TOL, Resolution, zone_kernel_accuracy
+from core.contact.zones import Resolution, zone_kernel_accuracy
 from core.discretize import NODES_PER_PANEL, Panels
 from core.engines.nystrom import PunchGeometry
 from core.kernel import FULL_ACCURACY
-from core.problem import TimeInputs, accepts
+from core.problem import TimeInputs
 from core.work import check_work
 
 
@@ -410,17 +411,9 @@ def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeI
     marches = CoupledMarches(base, inputs, [one.loads for one in inputs], tol)
     (rules, out, run, band_note, strays, error, end_error, time_error,
      space_error) = controlled_march(marches, times, tol, res, first_steps)
-    success = (accepts(error, tol, UNILATERAL_MARGIN) and end_error <= ZONE_END_TOL
-               and run["unsettled"] == 0 and not strays)
-    flags = [] if success else ["tol_not_met"]
-    message = (f"unilateral contact under creep ({len(base.punches)} punches): "
-               f"{run['steps']} steps, estimated error {error:.1e} (time {time_error:.1e}, "
-               f"space {space_error:.1e}), zone ends to {end_error:.1e} half-widths")
-    if strays:
-        message += (f"; a zone end left the finely paneled band around the ends at "
-                    f"{strays} time(s), its estimate does not hold there")
-    if not success:
-        message += f"; not within tol {tol:.1e} (zone ends: {ZONE_END_TOL:g})"
+    success, flags, message = creep_verdict(error, end_error, time_error, space_error, run,
+                                            strays, tol,
+                                            f"under creep ({len(base.punches)} punches)")
     seconds = _time.perf_counter() - started
     answers = []
     for p, (space, mine) in enumerate(zip(base.spaces, out, strict=True)):

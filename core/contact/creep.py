@@ -109,22 +109,12 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     """
     times = inp.times
     tol = inp.tol
-    end_tol = ZONE_END_TOL
     (base, out, run, band_note, strays, error, end_error, time_error,
      space_error) = controlled_march(OnePunchMarches(space, inp), times, tol, res,
                                      first_steps)
-    unsettled, sweeps, steps = run["unsettled"], run["sweeps"], run["steps"]
-    success = (accepts(error, tol, UNILATERAL_MARGIN) and end_error <= end_tol
-               and unsettled == 0 and not strays)
-    flags = [] if success else ["tol_not_met"]
-    message = (f"unilateral contact under creep: {steps} steps, estimated error "
-               f"{error:.1e} (time {time_error:.1e}, space {space_error:.1e}), zone ends to "
-               f"{end_error:.1e} half-widths")
-    if strays:
-        message += (f"; a zone end left the finely paneled band around the ends at "
-                    f"{strays} time(s), its estimate does not hold there")
-    if not success:
-        message += f"; not within tol {tol:.1e} (zone ends: {end_tol:g})"
+    sweeps, steps = run["sweeps"], run["steps"]
+    success, flags, message = creep_verdict(error, end_error, time_error, space_error, run,
+                                            strays, tol, "under creep")
     zones = [[(float(e[2 * i]), float(e[2 * i + 1])) for i in range(len(e) // 2)]
              for e in out["ends"]]
     snapshots = [
@@ -349,3 +339,25 @@ def _outside_bands(ends: list[list[float]], bands: list[tuple[float, float]],
             count += 1
     return count
 
+
+def creep_verdict(error: float, end_error: float, time_error: float, space_error: float,
+                  run: dict, strays: int, tol: float, what: str
+                  ) -> tuple[bool, list[str], str]:
+    """Success, flags and message of a lift-off answer under creep: its estimated error
+    (``error``, of which ``time_error`` and ``space_error``, relative), of the zone ends
+    (``end_error``, half-widths), the march's report ``run`` (``steps``, ``unsettled``
+    steps) and the steps whose zone end left the band of fine panels (``strays``);
+    ``what`` names the problem in the message (``"under creep"``, ``"under creep (2
+    punches)"``)."""
+    success = (accepts(error, tol, UNILATERAL_MARGIN) and end_error <= ZONE_END_TOL
+               and run["unsettled"] == 0 and not strays)
+    flags = [] if success else ["tol_not_met"]
+    message = (f"unilateral contact {what}: {run['steps']} steps, estimated error "
+               f"{error:.1e} (time {time_error:.1e}, space {space_error:.1e}), zone ends to "
+               f"{end_error:.1e} half-widths")
+    if strays:
+        message += (f"; a zone end left the finely paneled band around the ends at "
+                    f"{strays} time(s), its estimate does not hold there")
+    if not success:
+        message += f"; not within tol {tol:.1e} (zone ends: {ZONE_END_TOL:g})"
+    return success, flags, message

@@ -24,7 +24,7 @@ from bokeh.models import (
 )
 from bokeh.plotting import figure
 
-from ..model import ResultView
+from ..model import Geometry, ResultView
 from .bokeh_data import MOVING
 from .contact import ContactDrawing
 
@@ -180,26 +180,7 @@ class SceneDrawing:
         total = np.sum(g.thickness, axis=0) if len(g.thickness) else np.zeros_like(g.x)
         t_max = float(np.max(total)) if total.size else 0.0
         scale = _nice(0.15 * depth / t_max) if t_max > 0 else 1.0
-        # slabs: boundaries and values at the centres, interpolated from the fine grid
-        edges = np.linspace(-a, a, _SLABS + 1)
-        centres = 0.5 * (edges[1:] + edges[:-1])
-        bottom = np.zeros(_SLABS)
-        cols: dict[str, list] = {k: [] for k in ("left", "right", "bottom", "top", "E",
-                                                 "layer", "h_mm")}
-        # layer 1 is drawn on top, in contact with the punch
-        for k in reversed(range(len(g.thickness))):
-            h = np.interp(centres, g.x, g.thickness[k])
-            e = np.interp(centres, g.x, g.modulus[k])
-            top = bottom + scale * h
-            cols["left"].extend(edges[:-1])
-            cols["right"].extend(edges[1:])
-            cols["bottom"].extend(bottom)
-            cols["top"].extend(top)
-            cols["E"].extend(e / 1e6)
-            cols["layer"].extend([k + 1] * _SLABS)
-            cols["h_mm"].extend(h * 1e3)
-            bottom = top
-        self.layer_src.data = cols
+        self.layer_src.data = _slabs(g, -a, a, _SLABS, scale)
         self.base_src.data = {"left": [-1.5 * a], "right": [1.5 * a], "bottom": [-depth],
                               "top": [0.0], "E": [g.base_modulus / 1e6]}
         if g.base_thickness > depth:
@@ -235,25 +216,7 @@ class SceneDrawing:
         total = np.sum(g.thickness, axis=0) if len(g.thickness) else np.zeros_like(g.x)
         t_max = float(np.max(total)) if total.size else 0.0
         scale = _nice(0.15 * depth / t_max) if t_max > 0 else 1.0
-        slabs = _SLABS * len(view.punches)
-        edges = np.linspace(left, right, slabs + 1)
-        centres = 0.5 * (edges[1:] + edges[:-1])
-        bottom = np.zeros(slabs)
-        cols: dict[str, list] = {k: [] for k in ("left", "right", "bottom", "top", "E",
-                                                 "layer", "h_mm")}
-        for k in reversed(range(len(g.thickness))):
-            h = np.interp(centres, g.x, g.thickness[k])
-            e = np.interp(centres, g.x, g.modulus[k])
-            top = bottom + scale * h
-            cols["left"].extend(edges[:-1])
-            cols["right"].extend(edges[1:])
-            cols["bottom"].extend(bottom)
-            cols["top"].extend(top)
-            cols["E"].extend(e / 1e6)
-            cols["layer"].extend([k + 1] * slabs)
-            cols["h_mm"].extend(h * 1e3)
-            bottom = top
-        self.layer_src.data = cols
+        self.layer_src.data = _slabs(g, left, right, _SLABS * len(view.punches), scale)
         self.base_src.data = {"left": [left], "right": [right], "bottom": [-depth],
                               "top": [0.0], "E": [g.base_modulus / 1e6]}
         if g.base_thickness > depth:
@@ -289,3 +252,29 @@ class SceneDrawing:
 
     _punch_top = 0.0
     _a_ref = 1.0
+
+
+def _slabs(g: Geometry, left: float, right: float, count: int, scale: float
+           ) -> dict[str, list]:
+    """The coating drawn as ``count`` slabs a layer over [left, right] [m]: their bounds,
+    tops (thickness times the drawing's vertical ``scale``) and, at their centres
+    (interpolated from the geometry's fine grid), modulus [MPa], layer and thickness [mm];
+    layer 1 on top, in contact with the punch."""
+    edges = np.linspace(left, right, count + 1)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    bottom = np.zeros(count)
+    cols: dict[str, list] = {k: [] for k in ("left", "right", "bottom", "top", "E",
+                                             "layer", "h_mm")}
+    for k in reversed(range(len(g.thickness))):
+        h = np.interp(centres, g.x, g.thickness[k])
+        e = np.interp(centres, g.x, g.modulus[k])
+        top = bottom + scale * h
+        cols["left"].extend(edges[:-1])
+        cols["right"].extend(edges[1:])
+        cols["bottom"].extend(bottom)
+        cols["top"].extend(top)
+        cols["E"].extend(e / 1e6)
+        cols["layer"].extend([k + 1] * count)
+        cols["h_mm"].extend(h * 1e3)
+        bottom = top
+    return cols
