@@ -297,6 +297,23 @@ class CoupledStepSolver:
         return x
 
 
+def checked_loads(inputs: Sequence[TimeInputs], times: np.ndarray
+                  ) -> list[dict[str, np.ndarray]]:
+    """Every punch's given loads at ``times``, checked as one punch's are (a load no
+    contact can carry is refused naming ``punches[k].loading.<quantity>``)."""
+    loads = []
+    for k, one in enumerate(inputs):
+        values = {name: np.broadcast_to(np.asarray(fn(times), dtype=float),
+                                        times.shape).astype(float)
+                  for name, fn in one.loads.items()}
+        try:
+            check_loads(one.given, values, times)
+        except ValueError as exc:
+            raise ValueError(f"punches[{k}].{exc}") from None
+        loads.append(values)
+    return loads
+
+
 def _borders(givens: Sequence[dict[str, float]], own: np.ndarray, xi: np.ndarray,
              wi: np.ndarray) -> tuple[list, list, list, list, list]:
     """The border of the coupled system on the nodes kept: per punch, a column of each
@@ -618,16 +635,7 @@ def solve_unilateral_punches(punches: Sequence[PunchGeometry], inputs: Sequence[
                              "elastic base only")
         if not np.array_equal(one.times, times):
             raise ValueError(f"punches[{k}]: all punches share the output times")
-    loads = []
-    for k, one in enumerate(inputs):
-        values = {name: np.broadcast_to(np.asarray(fn(times), dtype=float),
-                                        times.shape).astype(float)
-                  for name, fn in one.loads.items()}
-        try:
-            check_loads(one.given, values, times)
-        except ValueError as exc:
-            raise ValueError(f"punches[{k}].{exc}") from None
-        loads.append(values)
+    loads = checked_loads(inputs, times)
     c_t = np.broadcast_to(np.asarray(inputs[0].c(times), dtype=float), times.shape)
     tol = min(p.geometry.tol for p in base.punches)
     res = Resolutions(tuple(zone_resolution(s.lam, s.m) for s in base.spaces))

@@ -45,6 +45,7 @@ from core.contact.coupled import (
     CoupledStepSolver,
     Resolutions,
     _given_rhs_all,
+    checked_loads,
     coupled_active_set,
     coupled_bordered_solve,
 )
@@ -399,13 +400,7 @@ def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeI
                              "creeping base")
         if not np.array_equal(one.times, times):
             raise ValueError(f"punches[{k}]: all punches share the output times")
-        values = {name: np.broadcast_to(np.asarray(fn(times), dtype=float),
-                                        times.shape).astype(float)
-                  for name, fn in one.loads.items()}
-        try:
-            check_loads(one.given, values, times)
-        except ValueError as exc:
-            raise ValueError(f"punches[{k}].{exc}") from None
+    checked_loads(inputs, times)
     tol = min(p.geometry.tol for p in base.punches)
     res = Resolutions(tuple(creep_resolution(s.lam, s.m) for s in base.spaces))
     marches = CoupledMarches(base, inputs, [one.loads for one in inputs], tol)
