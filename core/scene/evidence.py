@@ -84,7 +84,10 @@ def model_error_evidence(scene: Scene | Mapping[str, Any], estimate: float,
 
 def flags_with_evidence(flags: list[str], evidence: Mapping[str, Any]) -> list[str]:
     """``flags`` with ``model_error`` raised or lowered as ``evidence`` says
-    (:func:`model_error_evidence`); the other flags and their order kept."""
+    (:func:`model_error_evidence`), and ``beyond_model_map`` lowered once the error is
+    measured (no extrapolation is left to doubt); the other flags and their order kept."""
+    if evidence["source"] == "measured":
+        flags = [name for name in flags if name != "beyond_model_map"]
     kept = [name for name in flags if name != "model_error"]
     if not evidence["flagged"]:
         return kept

@@ -59,6 +59,10 @@ FLAG_MESSAGES: dict[str, str] = {
     "model_error": "The estimated error of the thin-coating model (info.model_error_estimate, "
                    "from measurements against a resolved finite-element model) exceeds "
                    "solver.model_tol: check the coating model (python -m core check).",
+    "beyond_model_map": "The coating lies outside the range its model's error was measured "
+                        "on (info.model_error.beyond_map: softer against the base, or "
+                        "nearer to incompressible): the estimate is an extrapolation. "
+                        "Measure it: python -m core check, or the explorer's coating check.",
     "tol_not_met": "The solver could not reach the requested tolerance: see info.message.",
     "unresolved_input": "A profile has features finer than the quadrature resolves: "
                         "see info.message.",
@@ -164,6 +168,8 @@ class SceneSolution:
             flags.append("thick_coating")
         if self.model_error["estimate"] > scene.model_tol:
             flags.append("model_error")
+        if thin and self.model_error.get("beyond_map"):
+            flags.append("beyond_model_map")
         e0 = self.problem.modulus_at_loading
         if thin and any(largest > e0 for largest in scene.layer_modulus_max):
             flags.append("stiff_coating")

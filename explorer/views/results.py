@@ -42,7 +42,9 @@ BADGES: dict[str, dict[str, tuple[str, str]]] = {
     "scene": {"thick_coating": ("coating not thin", "coating thin"),
               "stiff_coating": ("coating stiffer than base", "coating softer than base"),
               "model_error": ("coating model error above solver.model_tol",
-                              "coating model within solver.model_tol")},
+                              "coating model within solver.model_tol"),
+              "beyond_model_map": ("coating model error extrapolated: check it (Coating "
+                                   "tab)", "")},
     "pressure": {"contact_lost": ("contact lost: q < 0 (shaded)", "full contact")},
     "history": {"large_tilt": ("large tilt", "small tilt")},
     "status": {"tol_not_met": ("tolerance not met", ""),
@@ -77,6 +79,8 @@ def badges_html(view: ResultView | None, group: str,
             bad, good = (f"{word} ({evidence['label']} "
                          f"{100 * evidence['error']:.3g} %)" for word in (bad, good))
             text = evidence["message"]
+        if flag == "model_error" and "beyond_model_map" in flags:
+            good = ""  # an extrapolated estimate vouches for nothing: its own badge says so
         if flag in flags:
             message = html.escape(text)
             parts.append(f'<span class="cp-badge cp-bad flag-{flag}" title="{message}">'

@@ -233,3 +233,32 @@ def test_a_smooth_layer_held_by_a_bonded_one_is_flagged(top, lower):
         assert "model_error" in result.flags
     else:
         assert report["estimate"] < 0.03  # the map's: 1.6 % or 2.6 %
+
+
+def test_a_stack_beyond_the_measured_map_is_flagged_until_measured() -> None:
+    """A pad softer against the base than the map was measured on (E_c/E 0.0019 against
+    0.005) is read at the map's edge: its estimate (1.56 %) under-read the FE check's
+    3.58 %, so the answer is flagged beyond_model_map, naming the axis; the FE check's
+    measurement, once made for the scene, lifts the flag. The shipped presets are inside
+    the map."""
+    from core.presets import preset_names, read_preset
+    from core.scene import checked_key, flags_with_evidence, model_error_evidence
+    from tests.support.under_read import under_read_scene
+
+    scene = under_read_scene()
+    result = solve(scene)
+    assert "beyond_model_map" in result.flags
+    assert result.model_error["beyond_map"] == ["E_c/E 0.0019 is below the map's 0.005"]
+    estimated = model_error_evidence(scene, result.model_error["estimate"])
+    assert "beyond_model_map" in flags_with_evidence(result.flags, estimated)
+    check = {"scene_key": checked_key(scene), "model_error": 0.0358, "time_day": 0.0}
+    measured = model_error_evidence(scene, result.model_error["estimate"], check)
+    shown = flags_with_evidence(result.flags, measured)
+    assert "beyond_model_map" not in shown and "model_error" in shown
+    for name in preset_names():
+        answer = solve(read_preset(name))
+        assert "beyond_model_map" not in answer.flags, name
+    # nearer to incompressible than the map: nu_c 0.48 > 0.45
+    soft = under_read_scene()
+    soft["coating"] = [{"thickness": 0.01, "modulus": 5.0e8, "poisson": 0.48}]
+    assert solve(soft).model_error["beyond_map"] == ["nu_c 0.48 is above the map's 0.45"]

@@ -22,10 +22,12 @@ def _scene_badges(app) -> str:
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
 def test_the_fe_check_overrides_the_estimate_until_the_geometry_changes(explorer_app):
     app = explorer_app(scene=under_read_scene(), solved=True)
-    # before the check: the estimate (1.56 %) is within the 2 % tolerance
+    # before the check: the estimate (1.56 %) is within the 2 % tolerance, but the pad
+    # (E_c/E 0.0019) is softer than the map was measured on: the page does not vouch for
+    # the estimate, it says it is extrapolated and asks for the check
     badges = _scene_badges(app)
-    assert "ok-model_error" in badges and "flag-model_error" not in badges, badges
-    assert "estimated 1.56 %" in badges
+    assert "flag-model_error" not in badges and "ok-model_error" not in badges, badges
+    assert "flag-beyond_model_map" in badges and "extrapolated" in badges
     assert "model-estimated" in app.results.status.object
 
     app.coating_tab.check.run()  # no executor: runs here
@@ -36,6 +38,7 @@ def test_the_fe_check_overrides_the_estimate_until_the_geometry_changes(explorer
     badges = _scene_badges(app)
     assert "flag-model_error" in badges and "ok-model_error" not in badges, badges
     assert "measured by the FE check 3.58 %" in badges
+    assert "flag-beyond_model_map" not in badges  # measured: nothing extrapolated
     status = app.results.status.object
     assert "model-measured" in status and "model-flagged" in status
     assert "3.58 % (measured by the FE check), above solver.model_tol 2 %" in status
@@ -47,7 +50,7 @@ def test_the_fe_check_overrides_the_estimate_until_the_geometry_changes(explorer
     app.state.layers[1].thickness.mean = 21.0  # mm
     assert app.controller.wait(120) and app.controller.error == "", app.controller.error
     badges = _scene_badges(app)
-    assert "flag-model_error" not in badges and "estimated" in badges, badges
+    assert "flag-model_error" not in badges and "flag-beyond_model_map" in badges, badges
     assert "model-estimated" in app.results.status.object
     text = asyncio.run(app.files_tab._report_file()).getvalue()
     assert MEASURED_ROW not in text and "<td>model_error</td>" not in text
