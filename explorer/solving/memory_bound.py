@@ -14,9 +14,10 @@ from __future__ import annotations
 import os
 
 #: The address space of a solver worker [bytes]: a worker that has written both reports
-#: (HoloViews, Bokeh and Matplotlib loaded) maps ~1.7 GiB with ~0.3 GiB resident, and
-#: holds its share of the stage caches (``core.STAGE_CACHE_BYTES`` divided among the
-#: workers).
+#: (HoloViews, Bokeh and Matplotlib loaded) maps ~1.7 GiB with ~0.3 GiB resident, the FE
+#: coating check it runs peaks at ~1.6 GiB mapped (0.5 GiB resident; the default and
+#: worn-coating presets), and it holds its share of the stage caches
+#: (``core.STAGE_CACHE_BYTES`` divided among the workers).
 WORKER_MEMORY_BYTES = 4 * 1024**3
 #: The address space of a study's process [bytes]: 400 points of the young-concrete
 #: preset (200 output times) peaked at 1.09 GiB mapped, 0.71 GiB resident; 100 points at
