@@ -325,12 +325,18 @@ _STUDY_BUSY = ("starting", "waiting", "running", "paused")
 _STUDY_ENDED = ("Done:", "Not run", "cancelled", "fail", "stopped", "could not")
 
 
-async def _study_session(context: Any, url: str, log: _Log, ready: Callable[[], None],
-                         go: Any, stop: Any) -> None:
-    name = "study"
+async def _logged_page(context: Any, name: str, log: _Log) -> Any:
+    """A new page of ``context`` whose script errors go to ``log`` under ``name``."""
     page = await context.new_page()
     page.on("pageerror", lambda e: log.add("page error", name, time.monotonic(),
                                            time.monotonic(), False, str(e)))
+    return page
+
+
+async def _study_session(context: Any, url: str, log: _Log, ready: Callable[[], None],
+                         go: Any, stop: Any) -> None:
+    name = "study"
+    page = await _logged_page(context, name, log)
     try:
         await _open(page, study_link(url))
         run = page.locator(".study-run button").first
@@ -409,9 +415,7 @@ _CHECK_ENDED = ("model error: measured", "Not checked", "check failed")
 async def _check_session(context: Any, url: str, log: _Log, ready: Callable[[], None],
                          go: Any, stop: Any) -> None:
     name = "FE check"
-    page = await context.new_page()
-    page.on("pageerror", lambda e: log.add("page error", name, time.monotonic(),
-                                           time.monotonic(), False, str(e)))
+    page = await _logged_page(context, name, log)
     try:
         await _open(page, check_link(url))
         button = page.locator(".coating-check-button button").first
@@ -455,9 +459,7 @@ async def _files_session(context: Any, url: str, log: _Log, ready: Callable[[], 
                          go: Any, stop: Any) -> None:
     name = "files"
     link = files_link(url)
-    page = await context.new_page()
-    page.on("pageerror", lambda e: log.add("page error", name, time.monotonic(),
-                                           time.monotonic(), False, str(e)))
+    page = await _logged_page(context, name, log)
     try:
         await _open(page, link)
     finally:
