@@ -15,7 +15,7 @@ from ..model import ExplorerState, Screen
 from ..solving import format_error
 from .punches import PunchesSection
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-from .widgets import Binding, BoundedUpload, slider
+from .widgets import Binding, BoundedUpload, LazySlider, slider
 
 SHAPES = {
     "flat": "flat", "crowned (parabolic, radius R)": "parabolic",
@@ -41,32 +41,38 @@ class PunchView:
                                                       css_classes=["punch-half-width"]))
         self.shape = pb.add("shape", pn.widgets.Select(label="base shape", options=SHAPES,
                                                        sizing_mode="stretch_width"))
-        self.radius = pb.add("radius", slider("crown radius R [km]", 1.0, 500.0, 0.5,
-                                              "0[.]0", css_classes=["punch-crown-radius"]))
-        self.slope = pb.add("slope", slider("slope of each face [µrad]", 0.0, 200.0,
-                                                 0.5, "0[.]0"))
-        self.step_height = pb.add("step_height", slider(
-            "step height [µm] (right part raised)", -100.0, 100.0, 0.5, "0[.]0"))
-        self.step_position = pb.add("step_position", slider(
-            "step position x [m]", -1.0, 1.0, 0.01))
-        self.land_height = pb.add("land_height", slider(
-            "land height [µm] (middle protrudes)", 0.0, 100.0, 0.5, "0[.]0"))
-        self.land_width = pb.add("land_width", slider("land width [m]", 0.05, 2.0, 0.01))
-        self.wave_amplitude = pb.add("wave_amplitude", slider(
-            "wave amplitude [µm]", 0.0, 50.0, 0.1, "0[.]0"))
-        self.wave_length = pb.add("wave_length", slider("wavelength [m]", 0.02, 5.0,
-                                                             0.01))
+        # each shape's sliders are made when the shape is first chosen (LazySlider)
+        self.radius = LazySlider(pb, "radius", "crown radius R [km]", 1.0, 500.0, 0.5,
+                                 "0[.]0", css_classes=["punch-crown-radius"])
+        self.slope = LazySlider(pb, "slope", "slope of each face [µrad]", 0.0, 200.0, 0.5,
+                                "0[.]0")
+        self.step_height = LazySlider(pb, "step_height",
+                                      "step height [µm] (right part raised)", -100.0, 100.0,
+                                      0.5, "0[.]0")
+        self.step_position = LazySlider(pb, "step_position", "step position x [m]", -1.0,
+                                        1.0, 0.01)
+        self.land_height = LazySlider(pb, "land_height", "land height [µm] (middle protrudes)",
+                                      0.0, 100.0, 0.5, "0[.]0")
+        self.land_width = LazySlider(pb, "land_width", "land width [m]", 0.05, 2.0, 0.01)
+        self.wave_amplitude = LazySlider(pb, "wave_amplitude", "wave amplitude [µm]", 0.0,
+                                         50.0, 0.1, "0[.]0")
+        self.wave_length = LazySlider(pb, "wave_length", "wavelength [m]", 0.02, 5.0, 0.01)
         self.shape_file = BoundedUpload(accept=(".csv", ".txt"), max_bytes=MAX_TABLE_BYTES)
         self.shape_file.param.watch(self._on_shape_file, "value")
         self.shape_note = html_pane("", styles=NOTE_STYLE)
         pb.bind(s.punch)
         s.punch.param.watch(lambda *e: self.refresh(), ["shape", "half_width",
                                                        "custom_label"])
-        self.punches = PunchesSection(s, screen.reject, live_when)
+        # the section of several punches is made when a scene of several first shows: a
+        # page of one punch (most pages) does not pay for its widgets (~25 ms a page)
+        self._section: PunchesSection | None = None
+        self._section_args = (screen.reject, live_when)
+        self.section_holder = pn.Column(margin=0, sizing_mode="stretch_width", visible=False)
         self.single = pn.Column(
-            self.half_width, self.shape, self.radius, self.slope, self.step_height,
-            self.step_position, self.land_height, self.land_width, self.wave_amplitude,
-            self.wave_length, self.shape_note,
+            self.half_width, self.shape, *(lazy.holder for lazy in (
+                self.radius, self.slope, self.step_height, self.step_position,
+                self.land_height, self.land_width, self.wave_amplitude, self.wave_length)),
+            self.shape_note,
             html_pane("<small>Upload a shape table: CSV with two columns, x [m] and "
                       "f(x) [m], f the height of the punch base above its lowest point."
                       "</small>"),
@@ -77,19 +83,29 @@ class PunchView:
 
     def content(self) -> pn.Column:
         """The tab's column."""
-        return pn.Column(self.single, self.punches.panel, **TAB_COLUMN)
+        return pn.Column(self.single, self.section_holder, **TAB_COLUMN)
+
+    @property
+    def punches(self) -> PunchesSection:
+        """The section of several punches (made on first use)."""
+        if self._section is None:
+            self._section = PunchesSection(self.state, *self._section_args)
+            self.section_holder.objects = [self._section.panel]
+        return self._section
 
     def _follow_punches(self) -> None:
         """The one punch's widgets, or the section of several punches."""
         several = self.state.n_punches > 0
         self.single.visible = not several
-        self.punches.panel.visible = several
+        if several or self._section is not None:
+            self.punches.panel.visible = several
+        self.section_holder.visible = several
 
     def refresh(self) -> None:
         """Show the sliders of the chosen shape only."""
         p = self.state.punch
         a = p.half_width
-        self.step_position.param.update(start=-a, end=a)
+        self.step_position.update(start=-a, end=a)
         shape = p.shape
         self.radius.visible = shape == "parabolic"
         self.slope.visible = shape == "wedge"

@@ -24,8 +24,8 @@ from ..solving import mark
 from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
 
 __all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
-           "EditableIntSlider", "EditableSlider", "HistoryEditor", "ProfileEditor",
-           "slider"]
+           "EditableIntSlider", "EditableSlider", "HistoryEditor", "LazySlider",
+           "ProfileEditor", "slider"]
 
 
 # Panel holds every change from the browser for 50 ms before handling it, to gather a
@@ -197,6 +197,14 @@ class Binding:
         self._watcher = target.param.watch(self._from_target,
                                            sorted({name for name, _ in self._pairs}))
 
+    def add_late(self, name: str, widget: pn.widgets.Widget) -> pn.widgets.Widget:
+        """:meth:`add` once the binding is pointed at its target: the widget shows the
+        target's value and follows it from now on."""
+        self.add(name, widget)
+        if self._target is not None:
+            self.bind(self._target)
+        return widget
+
     def _to_target(self, name: str, value: Any) -> None:
         mark("widget_value")
         if self._syncing or self._target is None or value is None:
@@ -228,6 +236,51 @@ class Binding:
             self._syncing = False
 
 
+class LazySlider:
+    """A slider with a text box (:func:`slider`) made the first time it is shown.
+
+    Such a slider costs ~9 ms of a page's build (its text box, its slider and their
+    links), and most pages never show most of the sliders of shapes and variations (a
+    flat punch shows none of its eight). Until then a hidden, empty column stands in its
+    place (:attr:`holder`); ``visible`` and :meth:`update` act on the slider once made,
+    and its range set before is kept for it.
+    """
+
+    def __init__(self, binding: Binding, name: str, label: str, start: float, end: float,
+                 step: float, fmt: str = "0[.]000", **kwargs: Any) -> None:
+        self.binding, self.name = binding, name
+        self._spec: dict[str, Any] = dict(label=label, start=start, end=end, step=step,
+                                          fmt=fmt, **kwargs)
+        self.widget: pn.widgets.Widget | None = None
+        self.holder = pn.Column(margin=0, sizing_mode="stretch_width", visible=False)
+
+    @property
+    def visible(self) -> bool:
+        """Whether the slider shows (it is made when first shown)."""
+        return bool(self.holder.visible)
+
+    @visible.setter
+    def visible(self, value: bool) -> None:
+        if value and self.widget is None:
+            spec = dict(self._spec)
+            self.widget = self.binding.add_late(self.name, slider(
+                spec.pop("label"), spec.pop("start"), spec.pop("end"), spec.pop("step"),
+                spec.pop("fmt"), **spec))
+            self.holder.objects = [self.widget]
+        self.holder.visible = bool(value)
+
+    @property
+    def end(self) -> float:
+        """The slider's upper end."""
+        return float(self.widget.end if self.widget is not None else self._spec["end"])
+
+    def update(self, **values: Any) -> None:
+        """Set the slider's ``start`` and ``end`` (now, or when it is made)."""
+        self._spec.update(values)
+        if self.widget is not None:
+            self.widget.param.update(**values)
+
+
 #: The variations of a function of x offered on screen (label -> name), from core's list.
 PROFILE_KINDS = {**{v.label: v.name for v in VARIATIONS.values()},
                  "custom (from file)": "custom"}
@@ -256,24 +309,25 @@ class ProfileEditor:
                 sizing_mode="stretch_width"))
             a_unit, a_lo, a_hi, a_step = amplitude
             a_label = f"{a_unit} of the level" if a_unit == "%" else a_unit
-            self.amplitude = self.binding.add("amplitude", slider(
-                f"variation A [{a_label}]", a_lo, a_hi, a_step, "0[.]0",
-                css_classes=[f"{css}-amplitude"] if css else []))
-            self.position = self.binding.add("position", slider(
-                "step position / patch or bump centre [m]", -1.0, 1.0, 0.01,
-                css_classes=[f"{css}-position"] if css else []))
-            self.length = self.binding.add("length", slider(
-                "wavelength / patch or bump width [m]", 0.02, 2.0, 0.01,
-                css_classes=[f"{css}-length"] if css else []))
-            widgets += [self.kind, self.amplitude, self.position, self.length]
+            self.amplitude = LazySlider(
+                self.binding, "amplitude", f"variation A [{a_label}]", a_lo, a_hi, a_step,
+                "0[.]0", css_classes=[f"{css}-amplitude"] if css else [])
+            self.position = LazySlider(
+                self.binding, "position", "step position / patch or bump centre [m]",
+                -1.0, 1.0, 0.01, css_classes=[f"{css}-position"] if css else [])
+            self.length = LazySlider(
+                self.binding, "length", "wavelength / patch or bump width [m]", 0.02, 2.0,
+                0.01, css_classes=[f"{css}-length"] if css else [])
+            widgets += [self.kind, self.amplitude.holder, self.position.holder,
+                        self.length.holder]
         self.panel = pn.Column(*widgets, self.note, sizing_mode="stretch_width", margin=0)
         self._watched: ProfileState | None = None
         self._watcher: Any = None
 
     def bind(self, profile: ProfileState, half_width: float) -> None:
         if self.variations:
-            self.position.param.update(start=-half_width, end=half_width)
-            self.length.end = max(self.length.end, 2 * half_width)
+            self.position.update(start=-half_width, end=half_width)
+            self.length.update(end=max(self.length.end, 2 * half_width))
         self.binding.bind(profile)
         if self._watched is not None and self._watcher is not None:
             self._watched.param.unwatch(self._watcher)
