@@ -100,6 +100,18 @@ def legend_above(fig: Any, font_size: str | None = None) -> Any:
     return legend
 
 
+def legend_inside(fig: Any, location: str, font_size: str = "10px") -> Any:
+    """Make the legend of ``fig`` a compact, half-transparent box at ``location`` inside
+    its plot; returns it."""
+    legend = fig.legend[0]
+    legend.location = location
+    legend.label_text_font_size = font_size
+    legend.background_fill_alpha = 0.7
+    legend.padding = 2
+    legend.spacing = 0
+    return legend
+
+
 #: Entries of a legend above a plot laid out in one row up to this many, else in two
 #: columns: at 1024 px the q(x) plot is ~320 px wide and four entries in one row
 #: reached ~250 px past its left edge, over the sidebar.

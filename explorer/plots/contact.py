@@ -22,7 +22,7 @@ from ..model import (
     lifts_off,
     lifts_or_pulls,
 )
-from .bokeh_data import MOVING, f32, legend_above, set_data
+from .bokeh_data import MOVING, f32, legend_above, legend_inside, set_data
 
 # navy: apart from the viridis colours of the coating it lies on; red as the lifted
 # (shaded) parts of q(x)
@@ -58,14 +58,8 @@ class ContactDrawing:
         self.lifted_line = scene_fig.multi_line(xs="xs", ys="ys", source=self.lifted_src,
                                                 line_color=LIFTED_COLOR, line_width=5,
                                                 line_dash="dashed", legend_label=GAP_LABEL)
-        self.scene_legend = scene_fig.legend[0]
-        legend = scene_fig.legend[0]
         # in the base's corner: the load's arrow and its label use the top of the drawing
-        legend.location = "bottom_right"
-        legend.label_text_font_size = "11px"
-        legend.background_fill_alpha = 0.7
-        legend.padding = 2
-        legend.spacing = 0
+        self.scene_legend = legend_inside(scene_fig, "bottom_right", "11px")
         # beside the punch, just above the coating (placed at each time, see show_time)
         self.zone_label = Label(x=0, y=0, text="", text_font_size="11px", y_offset=6,
                                 text_color="#333", background_fill_color="white",
@@ -188,12 +182,7 @@ class FeatureInset:
         p.add_tools(HoverTool(renderers=[punch], mode="vline", tooltips=[
             ("x", "@x{0.000} m"), ("punch base", "@punch{0.00} µm"),
             ("coating top", "@surface{0.00} µm")]))
-        legend = p.legend[0]
-        legend.location = "bottom_right"
-        legend.label_text_font_size = "10px"
-        legend.background_fill_alpha = 0.7
-        legend.padding = 2
-        legend.spacing = 0
+        legend_inside(p, "bottom_right")
         self.fig = p
 
     def hide(self) -> None:

@@ -35,7 +35,15 @@ from ..model import (
     days_text,
     lifts_or_pulls,
 )
-from .bokeh_data import MOVING, f32, legend_above, set_data, steady_range, wrap_legend
+from .bokeh_data import (
+    MOVING,
+    f32,
+    legend_above,
+    legend_inside,
+    set_data,
+    steady_range,
+    wrap_legend,
+)
 from .classical import bearing_rule_pressure, half_space_pressure
 from .contact import ContactDrawing, FeatureInset
 from .pins import PinLines
@@ -213,13 +221,7 @@ class Figures:
         # one hover for the punches' lines (one per line added a toolbar button each)
         p.add_tools(HoverTool(renderers=lines, mode="vline", tooltips=[
             ("", "$name"), ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
-        legend = p.legend[0]
-        legend.location = "top_left"
-        legend.label_text_font_size = "10px"
-        legend.background_fill_alpha = 0.7
-        legend.padding = 2
-        legend.spacing = 0
-        legend.visible = False
+        legend_inside(p, "top_left").visible = False
         self.punch_history_src[q] = sources
         self.punch_history_line[q] = lines
 

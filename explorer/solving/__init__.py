@@ -10,7 +10,8 @@ Nothing here imports Panel or Bokeh when imported (the solver workers import it 
 - ``answer_wait``: a worker's answer awaited on the server's event loop.
 - ``result_cache``: the process-wide cache of prepared results.
 - ``warm_up``: presets solved before the first visitor comes.
-- ``fit_runner``: :class:`FitRun`, a fit of the Fit tab on a thread of its own.
+- ``fit_runner``: :class:`FitRun`, a fit of the Fit tab on a thread of its own;
+  ``background``: the lifecycle it shares with :class:`StudyRun`.
 - ``study_runner``: :class:`StudyRun`, a design study in a process of its own;
   ``fair_share``: the turns the server's studies take (:class:`StudyShare`).
 - ``memory_bound``: the address-space bounds of the worker and study processes.

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import param
@@ -22,6 +22,7 @@ import param
 from core.back_analysis import Readings
 
 from ..model import run_fit
+from .background import BackgroundRun
 
 log = logging.getLogger(__name__)
 
@@ -31,7 +32,7 @@ MAX_RUNNING_FITS = 1
 _SLOTS = threading.BoundedSemaphore(MAX_RUNNING_FITS)
 
 
-class FitRun(param.Parameterized):
+class FitRun(BackgroundRun):
     """The fit of one session: its status, a message, and the last outcome.
 
     ``dispatch`` runs a callback on the session's event loop (the app's); without one the
@@ -41,17 +42,6 @@ class FitRun(param.Parameterized):
     status = param.Selector(default="idle", objects=["idle", "running", "done", "failed"])
     message = param.String(default="", doc="What the fit did, or why it failed.")
     outcome = param.Parameter(default=None, doc="The last FitOutcome.")
-
-    def __init__(self, dispatch: Callable[[Callable[[], None]], None] | None = None,
-                 **params: Any) -> None:
-        super().__init__(**params)
-        self._dispatch = dispatch or (lambda callback: callback())
-        self._thread: threading.Thread | None = None
-
-    @property
-    def running(self) -> bool:
-        """Whether a fit is waiting or running."""
-        return self._thread is not None and self._thread.is_alive()
 
     def start(self, scene: Mapping[str, Any], readings: Readings,
               keys: Sequence[str | None], background: bool = True) -> None:
@@ -64,19 +54,7 @@ class FitRun(param.Parameterized):
         if not background:
             self._work(*args)
             return
-        self._thread = threading.Thread(target=self._work, args=args, name="fit",
-                                        daemon=True)
-        self._thread.start()
-
-    def wait(self, timeout: float = 300.0) -> bool:
-        """Wait for the fit to end; False if it still runs after ``timeout`` [s]."""
-        thread = self._thread
-        if thread is not None:
-            thread.join(timeout)
-        return not self.running
-
-    def _set(self, **values: Any) -> None:
-        self._dispatch(lambda: self.param.update(**values))
+        self._launch(self._work, args, "fit")
 
     def _work(self, scene: dict[str, Any], readings: Readings, keys: list[str | None]
               ) -> None:

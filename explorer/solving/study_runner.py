@@ -41,6 +41,7 @@ from core import set_stage_cache_budget
 from core.study import sweep
 
 from ..model import PlannedStudy, StudyResult
+from .background import BackgroundRun
 from .fair_share import SHARE, StudyShare, resume
 from .memory_bound import STUDY_MEMORY_BYTES, bound_memory, out_of_memory
 
@@ -120,7 +121,7 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
 
 
 # -- the server's side ---------------------------------------------------------------------
-class StudyRun(param.Parameterized):
+class StudyRun(BackgroundRun):
     """The study of one session: its state, its progress and its result.
 
     ``dispatch`` runs a callback on the session's event loop (the app's); without one the
@@ -134,20 +135,15 @@ class StudyRun(param.Parameterized):
     message = param.String(default="", doc="What the run did, or why it stopped.")
     result = param.Parameter(default=None, doc="The last StudyResult.")
 
+    WAIT_S = STUDY_TIMEOUT_S + 30
+
     def __init__(self, dispatch: Callable[[Callable[[], None]], None] | None = None,
                  share: StudyShare | None = None, **params: Any) -> None:
         """``share``: the studies this one takes turns with (default: the server's)."""
-        super().__init__(**params)
-        self._dispatch = dispatch or (lambda callback: callback())
+        super().__init__(dispatch, **params)
         self._share = SHARE if share is None else share
         self._cancel = threading.Event()
-        self._thread: threading.Thread | None = None
         self.process: Any = None
-
-    @property
-    def running(self) -> bool:
-        """Whether a study is waiting or running."""
-        return self._thread is not None and self._thread.is_alive()
 
     def start(self, planned: PlannedStudy) -> None:
         """Run ``planned`` in the background (one study per session at a time)."""
@@ -156,23 +152,11 @@ class StudyRun(param.Parameterized):
         self._cancel = threading.Event()
         self.param.update(status="waiting", done=0, total=planned.study.n_points,
                           message="starting")
-        self._thread = threading.Thread(target=self._work, args=(planned, self._cancel),
-                                        name="study", daemon=True)
-        self._thread.start()
+        self._launch(self._work, (planned, self._cancel), "study")
 
     def cancel(self) -> None:
         """Stop the running study now (its process is terminated)."""
         self._cancel.set()
-
-    def wait(self, timeout: float = STUDY_TIMEOUT_S + 30) -> bool:
-        """Wait for the run to end; False if it is still running after ``timeout`` [s]."""
-        thread = self._thread
-        if thread is not None:
-            thread.join(timeout)
-        return not self.running
-
-    def _set(self, **values: Any) -> None:
-        self._dispatch(lambda: self.param.update(**values))
 
     def _work(self, planned: PlannedStudy, cancel: threading.Event) -> None:
         ticket = object()  # this run's place in the server's turns

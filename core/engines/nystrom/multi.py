@@ -84,6 +84,7 @@ from core.engines.nystrom.prepared import (
     TIME_SHARE,
     PreparedContact,
     geometry_key,
+    kernel_cache_key,
     prepared_for,
 )
 from core.engines.nystrom.result import TimeSide, nystrom_solution
@@ -446,15 +447,8 @@ class CoupledPunches:
         A load slider of any punch then changes an amplitude: a few array operations
         instead of a time integration of the coupled system.
         """
-        from core.cache import SameObject
-
         c_t = np.asarray(c(times), dtype=float)
-        content = getattr(kernel, "key", None)
-        identity = SameObject(kernel) if content is None and kernel is not None else None
-        try:
-            kernel_key = fingerprint(content)
-        except TypeError:
-            kernel_key, identity = fingerprint(None), SameObject(kernel)
+        kernel_key, identity = kernel_cache_key(kernel)
         givens = tuple(tuple(sorted(one.given)) for one in inputs)
         common = fingerprint("coupled modal", givens, times, c_t, kernel_key, time_tol,
                              tuple(float(b) for b in breaks))

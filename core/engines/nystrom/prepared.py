@@ -324,19 +324,10 @@ class PreparedContact:
         together, keyed by the times, c, the kernel and the shapes. A load slider changes
         an amplitude, so it costs a few array operations instead of a time integration.
         """
-        from core.cache import SameObject, fingerprint
+        from core.cache import fingerprint
 
         c_t = inputs.c(times)
-        # A kernel without a content key is known by identity: the cache key then holds
-        # the kernel itself, so its id cannot pass to another kernel while the response
-        # is kept (keyed by id() alone, a kernel freed and replaced by another at the
-        # same address handed the new one the old one's response).
-        content = getattr(kernel, "key", None)
-        identity = SameObject(kernel) if content is None and kernel is not None else None
-        try:
-            kernel_key = fingerprint(content)
-        except TypeError:  # a key of objects the fingerprint does not know: the instance
-            kernel_key, identity = fingerprint(None), SameObject(kernel)
+        kernel_key, identity = kernel_cache_key(kernel)
         common = fingerprint("modal", tuple(sorted(inputs.given)), times, c_t, kernel_key,
                              time_tol, breaks)
         zero = {name: (lambda tt: np.zeros(np.shape(tt))) for name in inputs.loads}
@@ -431,6 +422,21 @@ class PreparedContact:
             gap = times[after] - times[np.maximum(after - 1, 0)]
             samples = samples[gap > samples[1] - samples[0]]
         return np.union1d(times, samples)
+
+
+def kernel_cache_key(kernel: Any) -> tuple[str, Any]:
+    """How a creep kernel keys the time-stepped responses kept for it: a fingerprint of
+    its content key, and the kernel itself (``core.cache.SameObject``) where it has none
+    it can be known by. Keyed by ``id()`` alone, a kernel freed and replaced by another
+    at the same address handed the new one the old one's response."""
+    from core.cache import SameObject, fingerprint
+
+    content = getattr(kernel, "key", None)
+    identity = SameObject(kernel) if content is None and kernel is not None else None
+    try:
+        return fingerprint(content), identity
+    except TypeError:  # a key of objects the fingerprint does not know: the instance
+        return fingerprint(None), SameObject(kernel)
 
 
 def prepare(lam: float, m: Scalar, g: Scalar, *, breakpoints: Sequence[float] = (),
