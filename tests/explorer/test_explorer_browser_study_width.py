@@ -45,9 +45,20 @@ def test_the_study_csv_holds_the_width_the_readout_gives(page: Page):
     page.page.locator(".study-run button").first.wait_for(timeout=60_000 * patience())
     page.page.locator(".study-p1-field select").first.select_option(
         label="loading: eccentricity e = M/P [m]")
-    page.type_into(".study-p1-from", "0.6")
-    page.type_into(".study-p1-to", "0.8")
-    page.type_into(".study-p1-count", "2")
+    # the server answers a new field with its first range (0 to 2e = 1.2 m, 9 points): a
+    # value typed before that answer arrives is overwritten by it, so wait for it first
+    boxes = {css: page.page.locator(f"{css} input").first
+             for css in (".study-p1-from", ".study-p1-to", ".study-p1-count")}
+    until(lambda: (float(boxes[".study-p1-to"].input_value() or "nan") == 1.2
+                   and boxes[".study-p1-count"].input_value() == "9"),
+          "the eccentricity's first range", describe=lambda: {
+              css: box.input_value() for css, box in boxes.items()})
+    typed = {".study-p1-from": "0.6", ".study-p1-to": "0.8", ".study-p1-count": "2"}
+    for css, value in typed.items():
+        page.type_into(css, value)
+    until(lambda: all(float(boxes[css].input_value() or "nan") == float(value)
+                      for css, value in typed.items()), "the range typed",
+          describe=lambda: {css: box.input_value() for css, box in boxes.items()})
     page.page.locator(".study-run button").first.click()
     until(lambda: len(page.page.evaluate(JS_STUDY_Y) or []) == 2, "the chart of 2 points",
           240, lambda: page.pane_text(".study-status"))
@@ -61,6 +72,7 @@ def test_the_study_csv_holds_the_width_the_readout_gives(page: Page):
     header, *rows = csv.reader(lines)
     assert header[0] == "loading_eccentricity_e_m"
     width = header.index("contact_width_m")
+    assert sorted({float(row[0]) for row in rows}) == [0.6, 0.8]
     at_06 = [row for row in rows if float(row[0]) == 0.6]
     assert len(at_06) == 20  # the preset's output times
     assert f"{float(at_06[-1][width]):.3f}" == "1.349"  # at 1000 days, as the readout
