@@ -80,7 +80,7 @@ def _presets(out: dict[str, np.ndarray]) -> None:
             if tol is not None:
                 data = json.loads(path.read_text())
                 data.setdefault("solver", {})["tol"] = tol
-                scene = core.scene_from_dict(data)
+                scene = data  # core.solve reads either form (one punch or several)
             key = f"preset.{path.stem}.{tol}"
             result = core.solve(scene)
             document = json.loads(result.to_json())

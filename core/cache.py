@@ -78,6 +78,20 @@ class SameObject:
         return id(self.obj)
 
 
+def content_key(obj: Any) -> tuple[str, SameObject | None]:
+    """How a cache knows ``obj`` (a creep kernel): a fingerprint of its content
+    (``obj.key``) and None, or, where it has no key the fingerprint can hash, the object
+    itself (:class:`SameObject`) beside ``fingerprint(None)``. Keyed by ``id()`` alone, a
+    kernel freed and replaced by another at the same address handed the new one the old
+    one's answers."""
+    content = getattr(obj, "key", None)
+    identity = SameObject(obj) if content is None and obj is not None else None
+    try:
+        return fingerprint(content), identity
+    except TypeError:  # a key of objects the fingerprint does not know: the instance
+        return fingerprint(None), SameObject(obj)
+
+
 def freeze(value: T, depth: int = 0) -> T:
     """Make the numpy arrays of a cached value read-only, in place; returns ``value``.
 

@@ -37,9 +37,11 @@ fast): the caller then steps adaptively (:mod:`core.time.radau`).
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from core.cache import StageCache, content_key, fingerprint
 from core.time.exponential_modes import by_step, mode_march
 from core.time.exponential_weights import (
     NODES,
@@ -122,21 +124,44 @@ def grid(start: float, end: float, jumps: np.ndarray, first_step: float,
     return ends, jump_start
 
 
-def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
-                  beta: np.ndarray, end_weight: np.ndarray,
-                  channels: list[tuple[np.ndarray, np.ndarray]], parts: int,
-                  t_out: np.ndarray) -> np.ndarray:
-    """Sum of the steps' local errors at the output times, largest per group (parts,).
+#: The step grids of :func:`grid` met last (a geometry slider asks for the same ones).
+GRIDS = StageCache("creep_time_grids", max_items=64, max_bytes=16 * 2**20)
+
+
+def _kept_grid(start: float, end: float, jumps: np.ndarray, first_step: float,
+               level: int, density: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`grid`, kept in :data:`GRIDS` (its arrays read-only)."""
+    key = fingerprint(float(start), float(end), np.asarray(jumps, dtype=float),
+                      float(first_step), int(level), float(density))
+    return GRIDS.get_or_compute(key, lambda: grid(start, end, jumps, first_step, level,
+                                                  density))[0]
+
+
+@dataclass(frozen=True)
+class LocalErrorFactors:
+    """What the local errors of one grid's steps read of the kernel alone
+    (:func:`local_error_factors`): ``side`` (B,) the neighbour of each step's sextic,
+    ``drive`` (B, 7) the fast states' sextic-minus-cubic weights, ``step_of`` (T,) the
+    step of each output time, ``carry`` (B, B) the carrying of a step's error to the later
+    steps (None for a march longer than :data:`CARRY_MATRIX_STEPS`)."""
+
+    side: np.ndarray
+    drive: np.ndarray
+    step_of: np.ndarray
+    carry: np.ndarray | None
+
+
+def local_error_factors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
+                        beta: np.ndarray, end_weight: np.ndarray,
+                        t_out: np.ndarray) -> LocalErrorFactors:
+    """The kernel's part of :func:`_local_errors` on the steps ``ends``.
 
     A state that decays fast within a step forgets all but its last steps, so its error
     at a time is the local error of the steps just before it, which depends on where the
     time falls in them: two grids may then agree by chance (measured on a stiff aging
     kernel: 2.1e-9 on the finer grid, 8.9e-10 on the coarser, their difference 1.1e-9).
-    Here each step's error is estimated as the difference of its cubic from the sextic
-    through its points and three of a neighbour (:func:`sextic_weights`), and carried to
-    the output times (its absolute value: no cancelling between steps), relative to
-    ``rows`` (the size of each channel, ``values`` (B, 4, C) at the points of the steps),
-    for each ``(values, rows)`` of ``channels``: the larger.
+    Each step's error is estimated as the difference of its cubic from the sextic through
+    its points and three of a neighbour (:func:`sextic_weights`).
     """
     h = np.diff(ends)
     n_steps = h.size
@@ -165,6 +190,21 @@ def _local_errors(ends: np.ndarray, jump_start: np.ndarray, decay: np.ndarray,
     if n_steps <= CARRY_MATRIX_STEPS:
         lag = np.subtract.outer(np.arange(n_steps), np.arange(n_steps)) - 1.0
         carry = np.where(lag >= 0.0, np.exp(-np.maximum(lag, 0.0)), 0.0)
+    return LocalErrorFactors(side, drive, step_of, carry)
+
+
+def _local_errors(factors: LocalErrorFactors,
+                  channels: list[tuple[np.ndarray, np.ndarray]], parts: int) -> np.ndarray:
+    """Sum of the steps' local errors at the output times, largest per group (parts,).
+
+    Each step's error (``factors``: :func:`local_error_factors`) is carried to the output
+    times (its absolute value: no cancelling between steps), relative to ``rows`` (the
+    size of each channel), for each ``(values, rows)`` of ``channels`` (``values``
+    (B, 4, C) at the points of the steps): the larger.
+    """
+    side, drive, step_of, carry = factors.side, factors.drive, factors.step_of, factors.carry
+    n_steps = side.size
+    steps = np.arange(n_steps)
     worst = np.zeros(parts)
     for values, rows in channels:
         values7 = seven(values, steps, side)                     # (B, 7, C)
@@ -201,19 +241,77 @@ def march(kernel, problem, ends: np.ndarray, jump_start: np.ndarray, jump_end: n
     return march_grids(kernel, problem, [(ends, jump_start, jump_end)], times, rows)[0]
 
 
-def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
-                rows: tuple[np.ndarray, np.ndarray] | None = None) -> list[March]:
-    """:func:`march` on each of ``grids`` (``(ends, jump_start, jump_end)``), in one pass.
+@dataclass(frozen=True)
+class GridFactors:
+    """What a march on some grids reads of the kernel alone: the same for every problem
+    marched on them (every geometry and load under one creep law and output times).
 
-    The steps of all grids are laid one after the other and every factor (kernel values,
-    histories, weights, point systems, output weights) is formed for all of them at once;
-    only the march itself restarts from zero states at each grid's first step. The
-    answers are those of separate marches (a few fixed costs a call, ~0.9 ms of CPU
-    measured on the aging scene, are paid once).
+    The steps of all grids one after the other (B steps, S kernel states, T outputs a
+    grid): ``flat`` (4B,) the times of the steps' points, ``restart`` (B + 1,) where the
+    states start at zero, ``first`` (grids + 1,) each grid's first step, ``jump_start``
+    (B,), ``beta`` (B, S, 4) and ``decay`` (S,) the kernel's factors, ``total``
+    (B, 3, 4), ``end_drive`` (B, 4, S), ``end_carry`` (B, S), ``end_weight`` (B, S, 4)
+    and ``reads`` (B, S, 4) the step weights; ``step_of``, ``side``, ``out_total`` (GT,)
+    the outputs' steps, neighbours and weights, ``order``, ``bounds`` and the sorted
+    ``out_carry_s``, ``out_total_s`` the outputs in the order of their steps.
+    ``local`` keeps each grid's :class:`LocalErrorFactors` once asked for.
     """
+
+    ends_of: tuple[np.ndarray, ...]
+    flat: np.ndarray
+    restart: np.ndarray
+    first: np.ndarray
+    jump_start: np.ndarray
+    beta: np.ndarray
+    decay: np.ndarray
+    total: np.ndarray
+    end_drive: np.ndarray
+    end_carry: np.ndarray
+    end_weight: np.ndarray
+    reads: np.ndarray
+    step_of: np.ndarray
+    side: np.ndarray
+    out_total: np.ndarray
+    order: np.ndarray
+    in_order: bool
+    bounds: np.ndarray
+    out_carry_s: np.ndarray
+    out_total_s: np.ndarray
+    t_out: np.ndarray
+    local: dict[int, LocalErrorFactors] = field(default_factory=dict, compare=False)
+
+    def local_factors(self, g: int) -> LocalErrorFactors:
+        """Grid ``g``'s :class:`LocalErrorFactors` (made at the first ask: the local
+        errors are read on the grid whose answer is taken only)."""
+        found = self.local.get(g)
+        if found is None:
+            steps = slice(self.first[g], self.first[g + 1])
+            found = local_error_factors(self.ends_of[g], self.jump_start[steps], self.decay,
+                                        self.beta[steps], self.end_weight[steps], self.t_out)
+            self.local[g] = found  # two threads may both make it: the same value
+        return found
+
+
+def grid_factors(kernel, grids: list[Grid], times: np.ndarray) -> GridFactors:
+    """The :class:`GridFactors` of ``grids`` (``(ends, jump_start, jump_end)``) and the
+    output ``times`` under ``kernel``.
+
+    Kept in :data:`GRID_FACTORS`, the kernel known by its content or as the same object
+    (:func:`core.cache.content_key`): a geometry slider changes the modes but neither the
+    kernel nor the steps, and these factors were ~40 % of a new geometry's march
+    (measured on the 50-year fib MC2010 preset).
+    """
+    content, identity = content_key(kernel)
+    key = (identity, fingerprint(content, [tuple(np.asarray(part) for part in g)
+                                           for g in grids], np.asarray(times, dtype=float)))
+    return GRID_FACTORS.get_or_compute(key, lambda: _grid_factors(kernel, grids, times))[0]
+
+
+def _grid_factors(kernel, grids: list[Grid], times: np.ndarray) -> GridFactors:
     from core.time.radau import _kernel_factors
 
-    ends_of = [np.asarray(g[0], dtype=float) for g in grids]
+    # copies: the cached value's arrays are made read-only, not the caller's
+    ends_of = tuple(np.array(g[0], dtype=float) for g in grids)
     counts = np.array([e.size - 1 for e in ends_of])
     first = np.concatenate([[0], np.cumsum(counts)])               # first step of each grid
     h = np.concatenate([np.diff(e) for e in ends_of])
@@ -243,7 +341,6 @@ def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
 
     # the outputs of every grid, one grid after the other (G T outputs)
     t_out = np.asarray(times, dtype=float)
-    n_out = t_out.size
     placed = [output_steps(e, t_out) for e in ends_of]
     step_of = np.concatenate([s + f for (s, _), f in zip(placed, first[:-1], strict=True)])
     a = np.concatenate([a for _, a in placed])
@@ -255,7 +352,33 @@ def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
     order = np.argsort(step_of, kind="stable")
     in_order = bool(np.array_equal(order, np.arange(order.size)))
     bounds = np.searchsorted(step_of[order], np.arange(n_steps + 1))
-    out_carry_s, out_total_s = out_carry[order], out_total[order]
+    return GridFactors(ends_of, flat, restart, first, jump_start, beta, decay, total,
+                       end_drive, end_carry, end_weight, reads, step_of, side, out_total,
+                       order, in_order, bounds, out_carry[order], out_total[order], t_out)
+
+
+#: The :class:`GridFactors` of the kernels and grids met last (LRU; cleared by
+#: core.cache.clear_caches). A 50-year march of three grids holds ~0.3 MiB.
+GRID_FACTORS = StageCache("creep_grid_factors", max_items=16, max_bytes=64 * 2**20)
+
+
+def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
+                rows: tuple[np.ndarray, np.ndarray] | None = None) -> list[March]:
+    """:func:`march` on each of ``grids`` (``(ends, jump_start, jump_end)``), in one pass.
+
+    The steps of all grids are laid one after the other and every factor (kernel values,
+    histories, weights, point systems, output weights) is formed for all of them at once;
+    only the march itself restarts from zero states at each grid's first step. The
+    answers are those of separate marches (a few fixed costs a call, ~0.9 ms of CPU
+    measured on the aging scene, are paid once). The kernel's factors come from
+    :func:`grid_factors` (kept across problems).
+    """
+    f = grid_factors(kernel, grids, times)
+    flat, restart, first, step_of, side = f.flat, f.restart, f.first, f.step_of, f.side
+    total, reads, end_drive, end_carry = f.total, f.reads, f.end_drive, f.end_carry
+    order, bounds, out_carry_s, out_total_s = f.order, f.bounds, f.out_carry_s, f.out_total_s
+    n_steps, n_states = flat.size // 4, f.decay.size
+    n_out = f.t_out.size
 
     def read(fn) -> np.ndarray:
         return by_step(fn(flat), 4)                              # (B, channels, 4)
@@ -280,8 +403,8 @@ def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
                 s_known[b + 1] += next_drive[b]
         vu_nodes += s_known[:-1] @ reads
         vu_out[:, order] = np.einsum("tks,ts->kt", s_known[step_of[order]], out_carry_s)
-        vu_out += np.einsum("tj,tjk->kt", out_total, seven(u.transpose(0, 2, 1), step_of,
-                                                            side))
+        vu_out += np.einsum("tj,tjk->kt", f.out_total, seven(u.transpose(0, 2, 1), step_of,
+                                                              side))
         if rows is not None:
             channels.append((u.transpose(0, 2, 1), 1))
     vw_out = np.zeros((nm, step_of.size))
@@ -300,7 +423,7 @@ def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
                   np.concatenate([z_all[b], z_all[b + 1, 1:]]) if sd == 1 else
                   np.concatenate([z_all[b], np.zeros((3, nm))]))
             vw_rows[lo:hi] = out_carry_s[lo:hi] @ states[b] + out_total_s[lo:hi] @ z7
-        if in_order:  # increasing times: as marched
+        if f.in_order:  # increasing times: as marched
             vw_out = vw_rows.T
         else:
             vw_out[:, order] = vw_rows.T
@@ -314,10 +437,9 @@ def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
         def local(sizes: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
             # ``sizes`` replace ``rows`` (sizes measured after the march)
             sizes = rows if sizes is None else sizes
-            return _local_errors(ends_of[g], jump_start[steps], decay, beta[steps],
-                                 end_weight[steps],
+            return _local_errors(f.local_factors(g),
                                  [(values[steps], sizes[which]) for values, which in channels],
-                                 problem.parts, t_out)
+                                 problem.parts)
 
         return (vw_out[:, columns], vu_out[:, columns],
                 local if rows is not None else None)
@@ -380,7 +502,7 @@ def solve_exponential(kernel, problem, times: np.ndarray, jumps: np.ndarray, *, 
             levels = range(level, MIN_LEVEL + 1) if level < MIN_LEVEL else [level]
             grids = []
             for lev in levels:
-                ends, jump_start = grid(start, end, jumps, theta, lev, density)
+                ends, jump_start = _kept_grid(start, end, jumps, theta, lev, density)
                 grids.append((ends, jump_start, np.isin(ends[1:], jumps)))
             used += sum(g[0].size - 1 for g in grids)
             if used > max_steps:

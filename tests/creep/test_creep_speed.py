@@ -132,3 +132,27 @@ def test_creep_validity_samples_keep_the_checked_times_close():
         assert np.max(np.diff(checked)) <= spacing * (1 + 1e-12)
     dense = 1.0 + np.linspace(0.0, 35.7, 100)
     np.testing.assert_array_equal(history(None, dense, "creep"), dense)
+
+
+def test_a_geometry_change_of_an_aging_scene_reuses_the_kernels_step_factors():
+    """A new half-width changes the modes, not the kernel nor the time steps: the march
+    takes the kernel's factors of its grids from the cache (core.time.exponential
+    .GRID_FACTORS) and answers bit for bit as with nothing shared."""
+    from core.scene import solve
+    from core.time.exponential import GRID_FACTORS
+
+    clear_caches()
+    solve(_young_concrete(6.0e5))
+    built = GRID_FACTORS.evaluations
+    assert built >= 1
+    wider = _young_concrete(6.0e5)
+    wider["punch"]["half_width"] *= 1.01
+    shared = solve(wider)
+    assert GRID_FACTORS.evaluations == built  # every grid's factors were kept
+    assert shared.info["builds"]["time_response"] >= 1  # the modes were stepped anew
+    clear_caches()
+    fresh = solve(wider)
+    assert GRID_FACTORS.evaluations > built
+    for name in ("settlement", "tilt", "force", "moment"):
+        assert np.array_equal(getattr(shared, name), getattr(fresh, name))
+    assert np.array_equal(shared.pressure_on_grid, fresh.pressure_on_grid)

@@ -71,7 +71,7 @@ from typing import Any
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 
-from core.cache import StageCache, fingerprint
+from core.cache import StageCache, content_key, fingerprint
 from core.creep import stepping_kernel
 from core.discretize import panel_index
 from core.engines.nystrom.adapt import LEVEL_SPLIT, MAX_PANELS, grade
@@ -84,7 +84,6 @@ from core.engines.nystrom.prepared import (
     TIME_SHARE,
     PreparedContact,
     geometry_key,
-    kernel_cache_key,
     prepared_for,
 )
 from core.engines.nystrom.result import TimeSide, nystrom_solution
@@ -448,7 +447,7 @@ class CoupledPunches:
         instead of a time integration of the coupled system.
         """
         c_t = np.asarray(c(times), dtype=float)
-        kernel_key, identity = kernel_cache_key(kernel)
+        kernel_key, identity = content_key(kernel)
         givens = tuple(tuple(sorted(one.given)) for one in inputs)
         common = fingerprint("coupled modal", givens, times, c_t, kernel_key, time_tol,
                              tuple(float(b) for b in breaks))

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from core.cache import StageCache
+from core.cache import StageCache, content_key
 from core.creep import stepping_kernel
 from core.discretize import NODES_PER_PANEL, interpolation_weights, panel_index
 from core.engines.nystrom.adapt import adapt
@@ -327,7 +327,7 @@ class PreparedContact:
         from core.cache import fingerprint
 
         c_t = inputs.c(times)
-        kernel_key, identity = kernel_cache_key(kernel)
+        kernel_key, identity = content_key(kernel)
         common = fingerprint("modal", tuple(sorted(inputs.given)), times, c_t, kernel_key,
                              time_tol, breaks)
         zero = {name: (lambda tt: np.zeros(np.shape(tt))) for name in inputs.loads}
@@ -422,21 +422,6 @@ class PreparedContact:
             gap = times[after] - times[np.maximum(after - 1, 0)]
             samples = samples[gap > samples[1] - samples[0]]
         return np.union1d(times, samples)
-
-
-def kernel_cache_key(kernel: Any) -> tuple[str, Any]:
-    """How a creep kernel keys the time-stepped responses kept for it: a fingerprint of
-    its content key, and the kernel itself (``core.cache.SameObject``) where it has none
-    it can be known by. Keyed by ``id()`` alone, a kernel freed and replaced by another
-    at the same address handed the new one the old one's response."""
-    from core.cache import SameObject, fingerprint
-
-    content = getattr(kernel, "key", None)
-    identity = SameObject(kernel) if content is None and kernel is not None else None
-    try:
-        return fingerprint(content), identity
-    except TypeError:  # a key of objects the fingerprint does not know: the instance
-        return fingerprint(None), SameObject(kernel)
 
 
 def prepare(lam: float, m: Scalar, g: Scalar, *, breakpoints: Sequence[float] = (),
