@@ -5,10 +5,11 @@ stand on (its projection divides by ``m``); the exact layered kernel
 (:mod:`core.engines.layered.answer`) with an empty stack is the base's own kernel and
 solves the bare layer exactly, inverse square-root corners included (a creeping or aging
 base by scalar Volterra equations in time, :mod:`core.engines.layered.bare_creep`). It
-answers full contact under a smooth punch; :func:`check_uncoated` refuses the
-rest when the scene is read, naming the field and the reason, and
-:func:`lift_off_refusal` words the refusal of a punch that lifts off (known only once
-solved).
+answers full contact under a smooth punch, and on an elastic base a punch lifting off at
+one corner (:mod:`core.engines.layered.bare_lift_off`); :func:`check_uncoated` refuses
+the rest when the scene is read, naming the field and the reason, and
+:func:`lift_off_refusal` words the refusal of a punch that lifts off where that is not
+answered (known only once solved).
 """
 
 from __future__ import annotations
@@ -20,8 +21,8 @@ from core.engines.layered import bare_creep_declines
 __all__ = ["check_uncoated", "lift_off_refusal", "UNCOATED_SCOPE"]
 
 #: What a scene without coating layers is solved for, as its refusals say it.
-UNCOATED_SCOPE = ("a scene with no coating layers is solved in full contact under a punch "
-                  "shape without jumps or kinks only, for now")
+UNCOATED_SCOPE = ("a scene with no coating layers is solved under a punch shape without "
+                  "jumps or kinks, lifting off at one corner on an elastic base only, for now")
 
 
 def check_uncoated(scene: Any) -> None:
@@ -29,16 +30,18 @@ def check_uncoated(scene: Any) -> None:
     answer (ValueError naming the field); nothing for a coated scene or one it answers."""
     if scene.coating:
         return
-    if scene.contact == "unilateral":
-        raise ValueError(f"solver.contact: {UNCOATED_SCOPE}; got 'unilateral': use 'auto' "
-                         "or 'full', or add a coating layer")
+    problem = scene.dimensionless
+    if scene.contact == "unilateral" and (problem.kernel is not None or callable(problem.c)
+                                          or problem.c != 1.0):
+        raise ValueError(f"solver.contact: {UNCOATED_SCOPE}; got 'unilateral' on a base that "
+                         "creeps or ages: use 'auto' or 'full', or add a coating layer")
     if scene.breakpoints:
         raise ValueError(
             f"punch.shape: {UNCOATED_SCOPE}; this shape jumps or kinks at x = "
             f"{', '.join(f'{b:.6g}' for b in scene.breakpoints[:3])} m (on a bare elastic base a "
             "jump carries an infinite force in full contact, a kink a log-singular pressure):"
             " use a smooth shape, or add a coating layer")
-    reason = bare_creep_declines(scene, scene.dimensionless)
+    reason = bare_creep_declines(scene, problem)
     if reason is not None:
         # the stack's table grows like (a / H)^2: past ~88 its cost bound declines
         field = "base.thickness" if "table" in reason else "coating"
@@ -48,7 +51,11 @@ def check_uncoated(scene: Any) -> None:
 def lift_off_refusal(scene: Any) -> str:
     """The refusal of a scene without coating layers whose punch lifts off
     (``solver.contact = "auto"``)."""
-    return (f"loading: the punch lifts off the bare base (the pressure turns negative at an "
-            f"edge); {UNCOATED_SCOPE}: set solver.contact to 'full' for the full-contact "
-            "answer (flagged contact_lost), lower the eccentricity or the punch's crown, or add "
-            "a coating layer")
+    problem = scene.dimensionless
+    creeps = problem.kernel is not None or callable(problem.c) or problem.c != 1.0
+    where = ("on a base that creeps or ages" if creeps
+             else "at both corners (a crown pressed lightly)")
+    return (f"loading: the punch lifts off the bare base {where} (the pressure turns negative "
+            f"at an edge); {UNCOATED_SCOPE}: set solver.contact to 'full' for the "
+            "full-contact answer (flagged contact_lost), lower the eccentricity or the punch's "
+            "crown, or add a coating layer")

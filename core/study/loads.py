@@ -188,7 +188,8 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
     regular = response.regular_part(np.cos(theta), fine["settlement"], fine["tilt"])
     q_scale = np.maximum(np.max(np.abs(regular), axis=0), 1e-300)
     lost = np.min(regular, axis=0) < -np.maximum(error, LIFT_OFF_SHARE) * q_scale
-    if scene.contact == "auto":
+    if scene.contact in ("auto", "unilateral"):
+        # solved one by one (without coating the lift-off is the layered path's too)
         keep &= ~lost
     # the pressure on the plotting grid, as the solution's evaluate gives it
     x = plotting_grid(a)

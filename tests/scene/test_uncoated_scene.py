@@ -108,7 +108,8 @@ def test_the_bare_layer_agrees_with_the_fe_model():
 
 # What the bare path does not solve yet: each refused naming the field and the reason.
 REFUSED = [
-    ("unilateral", lambda d: d["solver"].update(contact="unilateral"),
+    ("unilateral under creep", lambda d: (d["solver"].update(contact="unilateral"),
+                                          d["base"].update(creep=dict(CREEP))),
      "solver.contact: a scene with no coating layers"),
     ("step", lambda d: d["punch"].update(shape={"kind": "step", "values": [1.5e-5, 0.0, 1.5e-5],
                                                 "breaks": [-0.4, 0.4]}),
@@ -132,13 +133,27 @@ def test_what_the_bare_path_does_not_solve_is_refused_when_read(change, message)
     assert "for now" in str(refused.value)
 
 
-def test_a_lifting_punch_is_refused_under_auto_and_flagged_in_full_contact():
+def test_a_lifting_punch_is_solved_under_auto_and_flagged_in_full_contact():
     lifting = {"force": 5e5, "moment": 4e5}  # e = 0.8 a: the far corner lifts off
-    with pytest.raises(ValueError, match=r"^loading: the punch lifts off the bare base"):
-        solve(bare(loading=lifting))
+    for contact in ("auto", "unilateral"):
+        result = solve(bare(loading=lifting, solver={"tol": 1e-6, "contact": contact}))
+        assert result.flags == [] and result.info["contact"] == "unilateral"
+        (lo, hi), = result.contact_set[0]
+        assert hi == 1.0 and 0.2 < lo < 0.3  # the heel lifts (tests/engines/test_bare_lift_off.py)
     result = solve(bare(loading=lifting, solver={"tol": 1e-6, "contact": "full"}))
     assert "contact_lost" in result.flags
     assert result.info["coating_model"] == NO_COATING
+
+
+def test_a_punch_lifting_at_both_corners_or_under_creep_is_refused():
+    crowned = bare(loading={"force": 5e4, "moment": 0.0})
+    crowned["punch"]["shape"] = {"kind": "polynomial", "coefficients": [0.0, 0.0, 1e-4]}
+    with pytest.raises(ValueError, match=r"^loading: the punch lifts off the bare base at "
+                                         r"both corners"):
+        solve(crowned)
+    with pytest.raises(ValueError, match=r"^loading: the punch lifts off the bare base on a "
+                                         r"base that creeps"):
+        solve(creeping({"force": 5e5, "moment": 4e5}))
 
 
 def test_a_smooth_crowned_punch_in_full_contact_is_solved():

@@ -12,6 +12,11 @@ with the common ``info`` keys and :func:`core.problem.accepts` (margin 1).
 - :mod:`~core.engines.layered.solve`: :func:`solve_layered` (Chebyshev-Galerkin on the
   stack's kernel) and **the error estimate**: the answers with half and a quarter of the
   modes, their differences extrapolated geometrically;
+- :mod:`~core.engines.layered.bare_creep`: the bare base that creeps or ages (scalar
+  Volterra equations over the elastic unit responses);
+  :mod:`~core.engines.layered.bare_lift_off`: a punch lifting off the bare elastic base
+  (the zone a narrower punch's, its free end where the pressure's singular coefficient
+  vanishes);
 - :mod:`~core.engines.layered.galerkin`: modes, nodes and the Galerkin matrix;
 - :mod:`~core.engines.layered.cache`: the bounded caches of tables, operators and
   responses; :mod:`~core.engines.layered.stiffness`: flat-punch stiffnesses in SI units.

@@ -51,8 +51,9 @@ import numpy as np
 
 from core.coating import model_error_estimate, tilt_share
 from core.engines.layered.bare_creep import solve_bare_creep
+from core.engines.layered.bare_lift_off import bare_lift_off
 from core.engines.layered.galerkin import MAX_MODES, MAX_NODES, default_modes, node_count
-from core.engines.layered.solve import solve_layered
+from core.engines.layered.solve import ERROR_FLOOR, solve_layered
 from core.kernel import UniformLayer, table_cost
 from core.problem import ContactSolution, accepts
 
@@ -114,7 +115,10 @@ def bare_creep_declines(scene: Any, problem: Any) -> str | None:
     if scene.coating and (problem.kernel is not None or callable(problem.c)
                           or problem.c != 1.0):
         return "the base creeps or ages"
-    if scene.contact not in ("auto", "full"):
+    if scene.contact not in ("auto", "full") and (
+            scene.coating or problem.kernel is not None or callable(problem.c)
+            or problem.c != 1.0):
+        # without coating on an elastic base the lift-off is this path's own
         return "unilateral contact"
     if not all(getattr(p, "kind", None) == "constant" for layer in scene.coating
                for p in (layer.thickness, layer.modulus, layer.poisson)):
@@ -190,8 +194,11 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
     regular = regular_part(np.cos(theta))
     scale = max(float(np.max(np.abs(regular))), 1e-300)
     lost = float(np.min(regular)) < -max(error_estimate, LIFT_OFF_SHARE) * scale
-    if lost and scene.contact == "auto":
-        return None
+    if lost and scene.contact in ("auto", "unilateral"):
+        if layers or history is not None:
+            return None  # the thin layer's unilateral solver answers; creep: refused
+        return _bare_lift_off(scene, problem, times, answer, regular_part,
+                              max(error_estimate, LIFT_OFF_SHARE) * scale, start)
     if history is None:
         dense = np.linspace(times[0], times[-1], TILT_SAMPLES)
         largest_tilt = float(np.max(np.abs(
@@ -262,3 +269,71 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
     return ContactSolution(times.copy(), settlement, tilt, force, moment, info, None,
                            np.zeros((0, times.size)), np.ones(times.size), None, None,
                            _evaluate=evaluate, contact_set=[[(-1.0, 1.0)] for _ in times])
+
+
+def _bare_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: Any,
+                   regular_part: Any, pulls: float, start: float) -> ContactSolution | None:
+    """The answer of a punch lifting off the bare elastic base
+    (:mod:`core.engines.layered.bare_lift_off`), or None where it lifts at both corners.
+    ``pulls``: the value of ``sqrt(1 - t^2) q*`` below which a corner lifts."""
+    loads = _load_values(problem, times)
+    ends = regular_part(np.array([-1.0, 1.0]))
+    free = np.where(ends[0] < -pulls, -1, 0) + np.where(ends[1] < -pulls, 1, 0)
+    if np.any((ends[0] < -pulls) & (ends[1] < -pulls)):
+        return None
+    lifted = bare_lift_off(scene.half_width, (scene.base_thickness,
+                                              problem.modulus_at_loading, scene.base_poisson),
+                           problem.g, loads, free, answer.modes, problem.tol,
+                           full_error=answer.error_estimate)
+    # the full-contact solve's error is that of the times in full contact only
+    error_estimate = max(max(z.error for z in lifted.zones), ERROR_FLOOR)
+    end_error = max(z.end_error for z in lifted.zones)
+    success = accepts(error_estimate, problem.tol, SUCCESS_MARGIN)
+    flags = [] if success else ["tol_not_met"]
+    modes = max(z.response.modes for z in lifted.zones)
+    if success:
+        message = (f"exact layered kernel, lifting off the bare base: estimated error "
+                   f"{error_estimate:.1e} <= tol {problem.tol:.1e} with {modes} modes")
+    else:
+        message = (f"tol {problem.tol:.1e} not met: the exact layered kernel, lifting off the "
+                   f"bare base, reached {modes} modes with estimated error "
+                   f"{error_estimate:.1e}")
+    edge = corner_reach([], scene.half_width)
+
+    def evaluate(x: np.ndarray) -> np.ndarray:
+        return lifted.pressure(np.asarray(x, dtype=float), edge)
+
+    q_interior = evaluate(np.cos(np.linspace(0.0, np.pi, 8 * modes + 1)[1:-1]))
+    tilt = lifted.quantity("tilt")
+    info = {
+        "error_estimate": float(error_estimate),
+        "spatial_error_estimate": float(error_estimate),
+        "time_error_estimate": 0.0,
+        "kernel_fit_error": 0.0,
+        "seconds": time.perf_counter() - start,
+        "flags": flags,
+        "success": bool(success),
+        "message": message,
+        "n_modes": int(modes),
+        "n_steps": 0,
+        "n_nodes": int(max(z.response.nodes for z in lifted.zones)),
+        "statement": scene.statement,
+        "given": sorted(problem.loads),
+        "min_pressure": float(np.min(q_interior)),
+        "max_pressure": float(np.max(np.abs(q_interior))),
+        "basis": "chebyshev",
+        "element_ends": [],
+        "method": "layered",
+        "contact": "unilateral",
+        "zone_end_error": float(end_error),
+        "max_abs_tilt": float(np.max(np.abs(tilt))),
+        "stages": answer.stages,
+        "coating_model": NO_COATING,
+        "layered_model_error": {"estimate": 0.0, "force": 0.0, "moment": 0.0, "where_m": 0.0,
+                                "model": NO_COATING, "thin_layer_estimate": 0.0},
+    }
+    return ContactSolution(times.copy(), lifted.quantity("settlement"), tilt,
+                           lifted.quantity("force"), lifted.quantity("moment"), info, None,
+                           np.zeros((0, times.size)), np.ones(times.size), None, None,
+                           _evaluate=evaluate,
+                           contact_set=[[(z.lo, z.hi)] for z in lifted.zones])

@@ -1,0 +1,279 @@
+"""Lift-off on the bare base: the contact zone of a punch without coating layers.
+
+On a bare elastic base the pressure under a punch edge that touches is inverse-square-root
+singular. Where the punch lifts off, the base leaves it smoothly: at the zone's free end
+the pressure vanishes like the square root of the distance (the end is where the
+singular coefficient is zero), while the end at the punch's corner keeps its singularity.
+
+On a zone ``[c, d]`` of the punch (``t = x / a``), centred at ``x0 = (c + d) / 2`` with
+half-width ``b = (d - c) / 2``, the base's equation (:mod:`core.engines.layered.solve`)
+
+    (1 / pi) int_c^d k(lam (t - s)) q*(s) ds = delta* + alpha t - g*(t)
+
+is, in ``sigma = (t - x0) / b``, that of a narrower punch of half-width ``b a`` (the
+base's kernel depends on the distance alone):
+
+    (1 / pi) int_{-1}^{1} k(lam b (sigma - s')) q*(s') ds'
+        = (delta* + alpha x0) / b + alpha sigma - g*(x0 + b sigma) / b,
+
+so the unit responses of that punch (:func:`core.engines.layered.solve.layered_response`,
+the whole punch's kernel table) answer any zone: its settlement ``delta' = (delta* +
+alpha x0) / b``, tilt ``alpha' = alpha``, force ``P' = P* / b`` and moment about ``x0``
+``M' = (M* - x0 P*) / b^2``. Any two of the four given fix ``delta', alpha'`` (a 2 x 2
+solve); the zone's free end is the root of the singular coefficient there
+(``sqrt(1 - sigma^2) q*`` at ``sigma = -1`` or ``+1``), found by a scan and Brent's
+method. One end is free: the punch's heel (or toe) lifts, the other corner touches; a
+punch lifting at both ends (a crown) is refused for now.
+
+The error: the zone's own solve (its mode truncation, as :func:`solve_layered` estimates
+it) and the zone's end, found again with half the modes: the answers' change between the
+two ends, extrapolated as the modes' (``MAX_RATIO``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from core.engines.layered.cache import LAYERED_TABLE, stack_key
+from core.engines.layered.galerkin import MAX_MODES, table_degree
+from core.engines.layered.solve import (
+    MAX_RATIO,
+    Gap,
+    LayeredResponse,
+    layered_response,
+    solve_layered,
+)
+from core.kernel import RegularPartTable
+
+__all__ = ["BareLiftOff", "TWO_FREE_ENDS", "bare_lift_off"]
+
+_NAMES = ("settlement", "tilt", "force", "moment")
+#: Zone ends tried before Brent's method, as shares of the way from the lifting corner
+#: to the other (the root lies between the last two with opposite signs).
+SCAN = np.linspace(0.0, 1.0, 17)[1:-1]
+#: The zone's end is found to this many half-widths (far below what the modes resolve).
+END_TOL = 1e-13
+#: Why a punch lifting at both ends is not answered.
+TWO_FREE_ENDS = ("the punch lifts off at both corners (a crown pressed lightly); on the bare "
+                 "base a zone with two free ends is not solved for now")
+
+
+@dataclass(frozen=True)
+class ZoneAnswer:
+    """The answer on one zone: its ends ``lo``, ``hi`` [-], which end is free (``free``:
+    -1 the lower, +1 the upper), the narrower punch's unit ``response`` and its
+    settlement ``delta`` and tilt ``alpha`` (its own units), the four quantities of the
+    whole punch (``values``), its ``error`` [-] relative and the end's uncertainty
+    ``end_error`` [half-widths]."""
+
+    lo: float
+    hi: float
+    free: int
+    response: LayeredResponse
+    delta: float
+    alpha: float
+    values: dict[str, float]
+    error: float
+    end_error: float
+
+    @property
+    def centre(self) -> float:
+        return 0.5 * (self.lo + self.hi)
+
+    @property
+    def half(self) -> float:
+        return 0.5 * (self.hi - self.lo)
+
+    def pressure(self, x: np.ndarray, corner: float) -> np.ndarray:
+        """``q*`` at points ``x`` of [-1, 1] (0 off the zone); within ``1 - corner`` of the
+        punch's corner the value there is held (q is infinite at the corner)."""
+        x = np.clip(np.asarray(x, dtype=float), -corner, corner)
+        s = (x - self.centre) / self.half
+        out = np.zeros(x.shape)
+        inside = (s > -1.0) & (s < 1.0)
+        si = s[inside]
+        regular = self.response.regular_part(si, np.array([self.delta]),
+                                             np.array([self.alpha]))[:, 0]
+        out[inside] = regular / np.sqrt((1.0 - si) * (1.0 + si))
+        return out
+
+
+def _zone(free: int, end: float) -> tuple[float, float]:
+    """The zone whose free end (``free`` -1: lower, +1: upper) is at ``end``."""
+    return (end, 1.0) if free < 0 else (-1.0, end)
+
+
+def _kinematics(response: LayeredResponse, x0: float, b: float, given: dict[str, float],
+                level: int = 0) -> tuple[float, float, dict[str, float]]:
+    """The narrower punch's settlement and tilt (its units) from two of the whole punch's
+    quantities, and all four of those."""
+    c = response.coefficients if level == 0 else response.coarser[level - 1]
+    force = np.pi * c[0]            # P' = force . (1, delta', alpha')
+    moment = 0.5 * np.pi * c[1]     # M' about x0
+    # each whole-punch quantity as const + row . (delta', alpha')
+    rows = {"settlement": (0.0, np.array([b, -x0])),
+            "tilt": (0.0, np.array([0.0, 1.0])),
+            "force": (b * force[0], b * force[1:]),
+            "moment": (b * b * moment[0] + b * x0 * force[0],
+                       b * b * moment[1:] + b * x0 * force[1:])}
+    names = [n for n in _NAMES if n in given]
+    matrix = np.array([rows[n][1] for n in names])
+    rhs = np.array([given[n] - rows[n][0] for n in names])
+    delta, alpha = np.linalg.solve(matrix, rhs)
+    values = {n: float(rows[n][0] + rows[n][1] @ (delta, alpha)) for n in _NAMES}
+    return float(delta), float(alpha), values
+
+
+@dataclass
+class _Zones:
+    """Unit responses of the zones met while one end is sought (a zone's response is
+    built once)."""
+
+    half_width: float
+    base: tuple[float, float, float]   # H [m], E [Pa], nu
+    gap: Gap
+    modes: int
+    table: RegularPartTable
+    tol: float
+
+    def __post_init__(self) -> None:
+        self._kept: dict[tuple[float, float], LayeredResponse] = {}
+
+    def sub_gap(self, x0: float, b: float) -> Gap:
+        gap = self.gap
+        if callable(gap):
+            return lambda s: np.asarray(gap(x0 + b * np.asarray(s)), dtype=float) / b
+        return None  # a constant gap is a settlement: no pressure of its own
+
+    def response(self, lo: float, hi: float) -> LayeredResponse:
+        found = self._kept.get((lo, hi))
+        if found is None:
+            x0, b = 0.5 * (lo + hi), 0.5 * (hi - lo)
+            thickness, modulus, poisson = self.base
+            found = layered_response(b * self.half_width, [], thickness, modulus, poisson,
+                                     self.sub_gap(x0, b), modes=self.modes,
+                                     table=self.table, tol=self.tol)
+            self._kept[(lo, hi)] = found
+        return found
+
+    def intensity(self, free: int, end: float, given: dict[str, float],
+                  level: int = 0) -> float:
+        """``sqrt(1 - sigma^2) q*`` at the free end of the zone ending there (its sign:
+        > 0 the zone is too short, < 0 too long)."""
+        lo, hi = _zone(free, end)
+        x0, b = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        response = self.response(lo, hi)
+        delta, alpha, _ = _kinematics(response, x0, b, given, level)
+        return float(response.regular_part(np.array([float(free)]), np.array([delta]),
+                                           np.array([alpha]), level=level)[0, 0])
+
+
+def _free_end(zones: _Zones, free: int, given: dict[str, float], level: int) -> float:
+    """The free end of the zone (``free`` -1: the lower end lifts, +1: the upper)."""
+    # here, not at the top: scipy.optimize brings scipy.fft and scipy.special, which a
+    # solve that lifts off nothing need not load (tests/cli/test_cold_start.py)
+    from scipy.optimize import brentq
+
+    corner = float(free)                 # the lifting corner
+    other = -float(free)
+
+    def f(end: float) -> float:
+        return zones.intensity(free, end, given, level)
+
+    if f(corner) >= 0.0:
+        raise ValueError(f"free: the corner at t = {corner:g} does not lift off")
+    previous = corner
+    for share in SCAN:
+        end = corner + share * (other - corner)
+        if f(end) > 0.0:
+            return float(brentq(f, previous, end, xtol=END_TOL, rtol=4 * np.finfo(float).eps))
+        previous = end
+    raise ValueError("loading: no contact zone carries these loads on the bare base (the "
+                     "singular pressure at the free end keeps its sign over the punch)")
+
+
+@dataclass(frozen=True)
+class BareLiftOff:
+    """The lift-off answer at each load value: per value its :class:`ZoneAnswer`."""
+
+    zones: list[ZoneAnswer]
+
+    def quantity(self, name: str) -> np.ndarray:
+        return np.array([z.values[name] for z in self.zones])
+
+    def pressure(self, x: np.ndarray, corner: float) -> np.ndarray:
+        """``q*`` (len(x), values)."""
+        return np.stack([z.pressure(x, corner) for z in self.zones], axis=1)
+
+
+def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
+                  given: dict[str, np.ndarray], free: np.ndarray, modes: int, tol: float,
+                  full_error: float = 0.0) -> BareLiftOff:
+    """The zone, the pressure and the four quantities of a punch lifting off the bare
+    elastic base, at each value of the given loads.
+
+    ``half_width`` a [m]; ``base`` its thickness H [m], modulus E [Pa] and Poisson ratio;
+    ``gap`` g* as in :func:`core.engines.layered.solve.layered_response`; ``given`` two
+    of delta*, alpha, P*, M* (arrays over the values); ``free`` per value -1 (the lower
+    end lifts), +1 (the upper) or 0 (full contact holds: the whole punch's zone, whose
+    error is ``full_error``, the full-contact solve's); ``modes`` the full-contact
+    solve's; ``tol`` the accuracy asked for.
+    """
+    thickness, modulus, poisson = base
+    degree = table_degree(tol)
+    table, _ = LAYERED_TABLE.get_or_compute(
+        (stack_key(half_width, [], thickness, modulus, poisson), degree),
+        lambda: RegularPartTable(2 * half_width / thickness, [], thickness, modulus, poisson,
+                                 degree=degree))
+    out: list[ZoneAnswer] = []
+    solved: dict[tuple, ZoneAnswer] = {}
+    for k in range(len(free)):
+        values = {n: float(np.asarray(v)[k]) for n, v in given.items()}
+        if free[k] == 0:  # full contact holds at this value: the whole punch's zone
+            zones = _Zones(half_width, base, gap, modes, table, tol)
+            response = zones.response(-1.0, 1.0)
+            delta, alpha, four = _kinematics(response, 0.0, 1.0, values)
+            out.append(ZoneAnswer(-1.0, 1.0, 0, response, delta, alpha, four, full_error,
+                                  0.0))
+            continue
+        key = (int(free[k]), *sorted(values.items()))
+        if key not in solved:
+            solved[key] = _solve_one(half_width, base, gap, values, int(free[k]), modes,
+                                     table, tol)
+        out.append(solved[key])
+    return BareLiftOff(out)
+
+
+def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
+               given: dict[str, float], free: int, modes: int, table: RegularPartTable,
+               tol: float) -> ZoneAnswer:
+    thickness, modulus, poisson = base
+    while True:
+        zones = _Zones(half_width, base, gap, modes, table, tol)
+        end = _free_end(zones, free, given, level=0)
+        coarse_end = _free_end(zones, free, given, level=1)
+        lo, hi = _zone(free, end)
+        x0, b = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        response = zones.response(lo, hi)
+        delta, alpha, values = _kinematics(response, x0, b, given)
+        # the zone's own truncation error, as the full-contact solve estimates it
+        own = solve_layered(b * half_width, [], thickness, modulus, poisson,
+                            {"settlement": np.array([delta]), "tilt": np.array([alpha])},
+                            gap=zones.sub_gap(x0, b), tol=tol, max_modes=modes)
+        # the end's: the answers on the end found with half the modes
+        clo, chi = _zone(free, coarse_end)
+        _, _, coarse = _kinematics(zones.response(clo, chi), 0.5 * (clo + chi),
+                                   0.5 * (chi - clo), given, level=1)
+        kin = max(abs(values["settlement"]), abs(values["tilt"]), 1e-300)
+        stat = max(abs(values["force"]), abs(values["moment"]), 1e-300)
+        change = max(abs(values[n] - coarse[n]) / (kin if n in ("settlement", "tilt") else stat)
+                     for n in _NAMES if n not in given)
+        extrapolate = MAX_RATIO / (1.0 - MAX_RATIO)
+        error = max(own.error_estimate, extrapolate * change)
+        end_error = extrapolate * abs(end - coarse_end)
+        if error <= 0.5 * tol or 2 * modes > MAX_MODES:
+            return ZoneAnswer(lo, hi, free, response, delta, alpha, values, float(error),
+                              float(end_error))
+        modes *= 2

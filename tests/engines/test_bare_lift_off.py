@@ -1,0 +1,143 @@
+"""A punch lifting off the bare elastic base (core/engines/layered/bare_lift_off.py).
+
+Shown against the half-space's closed form (the layer's answer tends to it like
+``(a / H)^2``), between the four statements, under refinement, and at the free end (the
+pressure vanishes there like the square root of the distance)."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+from core.engines.layered.bare_lift_off import bare_lift_off
+from core.presets import read_preset
+from core.scene import solve
+
+
+def _half_space_deviation(lam: float, e: float) -> tuple[float, float, float]:
+    """The layer's zone end, tilt and pressure at ``a / H = lam`` against the half-space's
+    under a unit force at ``e = M / P`` (dimensionless, a = 1): on a half-space the zone is
+    ``[c, 1]`` with ``c = 4 e - 3`` (the resultant of ``sqrt((t - c) / (1 - t))`` lies a
+    quarter of the zone from its middle), ``q* = sqrt((t - c) / (1 - t)) / (pi b)`` and
+    the tilt ``2 M' / pi`` with ``b = (1 - c) / 2`` and ``M' = (e - x0) / b^2`` the moment
+    about the zone's middle ``x0``, in the zone's own units."""
+    answer = bare_lift_off(1.0, (1.0 / lam, 3.0e10, 0.2), None,
+                           {"force": np.array([1.0]), "moment": np.array([e])},
+                           np.array([-1]), 32, 1e-10)
+    zone = answer.zones[0]
+    c = 4 * e - 3
+    b, x0 = (1 - c) / 2, (1 + c) / 2
+    t = c + (1 - c) * np.array([0.1, 0.3, 0.5, 0.7, 0.9])
+    q = answer.pressure(t, 1.0 - 1e-3)[:, 0]
+    exact = np.sqrt((t - c) / (1 - t)) / (np.pi * b)
+    tilt = 2 * (e - x0) / b**2 / np.pi
+    return (abs(zone.lo - c), abs(zone.values["tilt"] / tilt - 1),
+            float(np.max(np.abs(q / exact - 1))))
+
+
+@pytest.mark.parametrize("e", [0.6, 0.75, 0.9])
+def test_a_thick_layer_lifts_off_as_the_half_space(e):
+    # measured at a / H = 1e-4: zone end 5.3e-9, tilt 3.3e-9, q 4.7e-9 (e = 0.6; less for
+    # larger e): the layer's own correction, which falls like (a / H)^2 (100x a decade,
+    # measured 99.9-100.1x between 1e-2 and 1e-3)
+    deviations = _half_space_deviation(1e-4, e)
+    assert max(deviations) < 1e-8, deviations
+    coarse, fine = _half_space_deviation(1e-2, e), _half_space_deviation(1e-3, e)
+    for before, after in zip(coarse, fine, strict=True):
+        assert 95 < before / after < 105, (coarse, fine)
+
+
+def _bare(loading: dict[str, float], tol: float = 1e-9, thickness: float = 1.0) -> dict:
+    d = read_preset("bare_layer")
+    d["loading"] = dict(loading)
+    d["solver"] = {"tol": tol}
+    d["base"]["thickness"] = thickness
+    return d
+
+
+def test_the_four_statements_give_one_answer():
+    # e = 0.6 a on a layer as thick as the punch is wide (H = a): the heel lifts, the zone
+    # is [-0.39996 a, a]; each statement given two of the others' answers gives the rest
+    # and the zone back (measured within 2e-14: the same zone's unit responses)
+    first = solve(_bare({"force": 5e5, "moment": 3e5}))
+    (lo, hi), = first.contact_set[0]
+    assert hi == 1.0 and lo == pytest.approx(-0.3999646, abs=1e-7)
+    assert first.flags == [] and first.info["contact"] == "unilateral"
+    values = {q: float(getattr(first, q)[0]) for q in ("settlement", "tilt", "force", "moment")}
+    for pair in (("settlement", "tilt"), ("settlement", "moment"), ("tilt", "force")):
+        other = solve(_bare({q: values[q] for q in pair}))
+        assert other.contact_set[0][0][0] == pytest.approx(lo, abs=1e-12)
+        for q, v in values.items():
+            assert float(getattr(other, q)[0]) == pytest.approx(v, rel=1e-12), (pair, q)
+    # the mirror image: the toe lifts instead
+    mirror = solve(_bare({"force": 5e5, "moment": -3e5}))
+    assert mirror.contact_set[0] == [(-1.0, pytest.approx(-lo, abs=1e-14))]
+    assert mirror.tilt[0] == pytest.approx(-first.tilt[0], rel=1e-13)
+
+
+@pytest.mark.parametrize("thickness", [0.1, 1.0 / 60])
+def test_the_zone_converges_within_its_estimates(thickness):
+    # a / H = 10 and 60 need 32-256 modes; against tol 1e-10 the answers at tol 1e-4 and
+    # 1e-6 differ by <= 1.9e-10 (zone end) and 4.4e-14 (settlement, tilt), far inside the
+    # estimates (2.7e-6 - 4e-8 and 1.7e-9 - 1.1e-4 half-widths at the end)
+    loading = {"force": 5e5, "moment": 3.5e5}
+    reference = solve(_bare(loading, 1e-10, thickness))
+    assert reference.flags == []
+    for tol in (1e-4, 1e-6):
+        result = solve(_bare(loading, tol, thickness))
+        assert result.flags == [] and result.info["error_estimate"] <= tol
+        end = result.contact_set[0][0][0]
+        assert abs(end - reference.contact_set[0][0][0]) <= max(
+            result.info["zone_end_error"], 1e-12)
+        for q in ("settlement", "tilt"):
+            value, exact = getattr(result, q)[0], getattr(reference, q)[0]
+            assert abs(value / exact - 1) <= result.info["error_estimate"]
+
+
+def test_the_pressure_vanishes_like_a_square_root_at_the_free_end():
+    result = solve(_bare({"force": 5e5, "moment": 3e5}))
+    c = result.contact_set[0][0][0]
+    # q / sqrt(distance) tends to a limit: 244501, 243499, 243489 Pa at 1e-2, 1e-4, 1e-6
+    ratios = [result.pressure(np.array([c + eps]))[0, 0] / np.sqrt(eps)
+              for eps in (1e-4, 1e-6)]
+    assert ratios[0] == pytest.approx(ratios[1], rel=1e-4)
+    inside = np.linspace(c, 1.0, 1001)[1:-1]
+    assert np.all(result.pressure(inside) > 0)
+    assert np.all(result.pressure(np.linspace(-1.0, c, 50)[:-1]) == 0)
+
+
+def test_just_past_the_threshold_the_zone_opens_from_the_corner():
+    # on this layer full contact holds up to e = 0.4011 a (found by bisection below); just
+    # beyond, the lifted stretch is short and the answer continues the full-contact one
+    lo_e, hi_e = 0.2, 0.7
+    for _ in range(30):
+        mid = 0.5 * (lo_e + hi_e)
+        if solve(_bare({"force": 5e5, "moment": 5e5 * mid})).info["contact"] == "full":
+            lo_e = mid
+        else:
+            hi_e = mid
+    full = solve(_bare({"force": 5e5, "moment": 5e5 * lo_e}))
+    lifted = solve(_bare({"force": 5e5, "moment": 5e5 * hi_e}))
+    assert lifted.info["contact"] == "unilateral"
+    assert -1.0 < lifted.contact_set[0][0][0] < -1.0 + 1e-6
+    for q in ("settlement", "tilt"):
+        assert getattr(lifted, q)[0] == pytest.approx(getattr(full, q)[0], rel=1e-6)
+
+
+def test_a_loading_that_varies_in_time_lifts_off_only_when_it_must():
+    # an elastic base: each time is its own problem; the moment grows from 0 to 0.8 P a
+    d = _bare({"force": 5e5, "moment": {"kind": "linear", "start": 0.0, "end": 4e5}}, 1e-8)
+    d["times"] = {"end": 10.0, "count": 9}
+    result = solve(d)
+    assert result.flags == [] and result.info["contact"] == "unilateral"
+    ends = [zones[0][0] for zones in result.contact_set]
+    assert ends[0] == -1.0 and ends[-1] > 0.2  # full contact, then the heel lifts
+    assert all(b >= a for a, b in zip(ends, ends[1:], strict=False))
+    for k in range(result.times.size):
+        single = copy.deepcopy(d)
+        single["loading"]["moment"] = float(result.moment[k])
+        single["times"] = {"end": 1.0, "count": 1}
+        alone = solve(single)
+        assert alone.contact_set[0][0][0] == pytest.approx(ends[k], abs=1e-12)
