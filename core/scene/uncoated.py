@@ -22,7 +22,9 @@ __all__ = ["check_uncoated", "lift_off_refusal", "UNCOATED_SCOPE"]
 
 #: What a scene without coating layers is solved for, as its refusals say it.
 UNCOATED_SCOPE = ("a scene with no coating layers is solved under a punch shape without "
-                  "jumps or kinks, lifting off at one corner on an elastic base only, for now")
+                  "jumps or kinks; it lifts off at one corner only, and on a base that creeps "
+                  "or ages only a flat punch under given loads that keep their ratio (force "
+                  "and moment, or settlement and tilt), for now")
 
 
 def check_uncoated(scene: Any) -> None:
@@ -31,10 +33,6 @@ def check_uncoated(scene: Any) -> None:
     if scene.coating:
         return
     problem = scene.dimensionless
-    if scene.contact == "unilateral" and (problem.kernel is not None or callable(problem.c)
-                                          or problem.c != 1.0):
-        raise ValueError(f"solver.contact: {UNCOATED_SCOPE}; got 'unilateral' on a base that "
-                         "creeps or ages: use 'auto' or 'full', or add a coating layer")
     if scene.breakpoints:
         raise ValueError(
             f"punch.shape: {UNCOATED_SCOPE}; this shape jumps or kinks at x = "
@@ -53,8 +51,8 @@ def lift_off_refusal(scene: Any) -> str:
     (``solver.contact = "auto"``)."""
     problem = scene.dimensionless
     creeps = problem.kernel is not None or callable(problem.c) or problem.c != 1.0
-    where = ("on a base that creeps or ages" if creeps
-             else "at both corners (a crown pressed lightly)")
+    where = ("on a base that creeps or ages, with a curved punch or loads whose ratio "
+             "changes in time" if creeps else "at both corners (a crown pressed lightly)")
     return (f"loading: the punch lifts off the bare base {where} (the pressure turns negative "
             f"at an edge); {UNCOATED_SCOPE}: set solver.contact to 'full' for the "
             "full-contact answer (flagged contact_lost), lower the eccentricity or the punch's "

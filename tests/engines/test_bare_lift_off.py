@@ -141,3 +141,79 @@ def test_a_loading_that_varies_in_time_lifts_off_only_when_it_must():
         single["times"] = {"end": 1.0, "count": 1}
         alone = solve(single)
         assert alone.contact_set[0][0][0] == pytest.approx(ends[k], abs=1e-12)
+
+
+# --------------------------------------------------------------- a creeping bare base
+
+#: The standard linear solid of tests/scene/test_uncoated_scene.py: J(t) = 1 / E + c (1 -
+#: exp(-r t)), relaxing like R(t) = E (1 + E c exp(-r (1 + E c) t)) / (1 + E c).
+CREEP = {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11, "rate": 0.05}
+
+
+def _creeping(loading: dict, creep: dict = CREEP) -> dict:
+    d = _bare(loading, 1e-6)
+    d["base"]["creep"] = dict(creep)
+    d["times"] = {"end": 365.0, "count": 40, "spacing": "log"}
+    return d
+
+
+@pytest.mark.parametrize("loading", [{"force": 5e5, "moment": 4e5},
+                                     {"settlement": 1e-5, "tilt": 2e-5}],
+                         ids=lambda loading: "+".join(loading))
+def test_a_creeping_bare_base_keeps_the_elastic_zone_and_follows_its_laws(loading):
+    # Loads that keep their ratio scale the whole answer on the zone: it stays the elastic
+    # one, the kinematics grow like J(t) under given forces (measured 6.4e-14) and the
+    # forces relax like R(t) under given kinematics (2.0e-8: the Volterra solve's, as in
+    # full contact)
+    result = solve(_creeping(loading))
+    assert result.flags == [] and result.info["contact"] == "unilateral"
+    assert result.info["n_steps"] > 0 or "force" in loading
+    elastic = solve(_bare(loading, 1e-6))
+    zone = elastic.contact_set[0]
+    assert zone[0][0] > -1.0
+    assert all(zones == [pytest.approx(zone[0], abs=1e-12)] for zones in result.contact_set)
+    t = result.times
+    e_c = CREEP["modulus"] * CREEP["compliance"]
+    growth = 1 + e_c * (1 - np.exp(-CREEP["rate"] * t))
+    relaxation = (1 + e_c * np.exp(-CREEP["rate"] * (1 + e_c) * t)) / (1 + e_c)
+    for q in ("settlement", "tilt", "force", "moment"):
+        if q in loading:
+            continue
+        values = getattr(result, q)
+        law = growth if q in ("settlement", "tilt") else relaxation
+        assert np.max(np.abs(values / values[0] / (law / law[0]) - 1)) < 1e-7, q
+        assert values[0] == pytest.approx(getattr(elastic, q)[0], rel=1e-7), q
+    # the pressure keeps its shape, vanishing at the free end as in the elastic answer
+    inside = np.linspace(*zone[0], 9)[1:-1]
+    q = result.pressure(inside)
+    assert np.max(np.abs(q / q[:, :1] - q[0] / q[0, 0])) < 1e-12
+
+
+def test_an_aging_bare_base_lifting_off_settles_like_its_creep_function():
+    # aging (Arutyunyan, the eccentric_creep preset's) at e = 0.8 a: settlement and tilt
+    # are their values at loading times E(tau0) J(t, tau0) (measured 1.1e-8, as in full
+    # contact)
+    creep = read_preset("eccentric_creep")["base"]["creep"]
+    d = _creeping({"force": 5e5, "moment": 4e5}, creep)
+    d["times"] = read_preset("eccentric_creep")["times"]
+    result = solve(d)
+    assert result.flags == [] and result.info["contact"] == "unilateral"
+    scene = result.scene
+    tau0 = scene.age_at_loading
+    e0 = float(np.asarray(scene.creep.modulus(tau0)))
+    law = 1 + e0 * np.asarray(scene.creep.compliance(tau0 + result.times, tau0))
+    for name in ("settlement", "tilt"):
+        values = getattr(result, name)
+        assert np.max(np.abs(values / values[0] / law - 1)) < 1e-7, name
+
+
+def test_a_creeping_bare_base_whose_zone_would_move_is_refused():
+    # the eccentricity grows in time: the zone moves as the base creeps (not solved yet)
+    moving = _creeping({"force": 5e5, "moment": {"kind": "linear", "start": 3e5,
+                                                 "end": 4e5}})
+    crowned = _creeping({"force": 5e5, "moment": 4e5})
+    crowned["punch"]["shape"] = {"kind": "polynomial", "coefficients": [0.0, 0.0, 1e-6]}
+    for d in (moving, crowned):
+        with pytest.raises(ValueError, match=r"^loading: the punch lifts off the bare base "
+                                             r"on a base that creeps or ages, with a curved"):
+            solve(d)

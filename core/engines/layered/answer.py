@@ -115,10 +115,8 @@ def bare_creep_declines(scene: Any, problem: Any) -> str | None:
     if scene.coating and (problem.kernel is not None or callable(problem.c)
                           or problem.c != 1.0):
         return "the base creeps or ages"
-    if scene.contact not in ("auto", "full") and (
-            scene.coating or problem.kernel is not None or callable(problem.c)
-            or problem.c != 1.0):
-        # without coating on an elastic base the lift-off is this path's own
+    if scene.contact not in ("auto", "full") and scene.coating:
+        # without coating the lift-off is this path's own
         return "unilateral contact"
     if not all(getattr(p, "kind", None) == "constant" for layer in scene.coating
                for p in (layer.thickness, layer.modulus, layer.poisson)):
@@ -195,10 +193,13 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
     scale = max(float(np.max(np.abs(regular))), 1e-300)
     lost = float(np.min(regular)) < -max(error_estimate, LIFT_OFF_SHARE) * scale
     if lost and scene.contact in ("auto", "unilateral"):
-        if layers or history is not None:
-            return None  # the thin layer's unilateral solver answers; creep: refused
-        return _bare_lift_off(scene, problem, times, answer, regular_part,
-                              max(error_estimate, LIFT_OFF_SHARE) * scale, start)
+        if layers:
+            return None  # the thin layer's unilateral solver answers
+        pulls = max(error_estimate, LIFT_OFF_SHARE) * scale
+        if history is not None:
+            return _bare_creep_lift_off(scene, problem, times, answer, regular_part, pulls,
+                                        start)
+        return _bare_lift_off(scene, problem, times, answer, regular_part, pulls, start)
     if history is None:
         dense = np.linspace(times[0], times[-1], TILT_SAMPLES)
         largest_tilt = float(np.max(np.abs(
@@ -277,20 +278,142 @@ def _bare_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: Any,
     (:mod:`core.engines.layered.bare_lift_off`), or None where it lifts at both corners.
     ``pulls``: the value of ``sqrt(1 - t^2) q*`` below which a corner lifts."""
     loads = _load_values(problem, times)
-    ends = regular_part(np.array([-1.0, 1.0]))
-    free = np.where(ends[0] < -pulls, -1, 0) + np.where(ends[1] < -pulls, 1, 0)
-    if np.any((ends[0] < -pulls) & (ends[1] < -pulls)):
+    free = _free_corners(regular_part, pulls)
+    if free is None:
         return None
     lifted = bare_lift_off(scene.half_width, (scene.base_thickness,
                                               problem.modulus_at_loading, scene.base_poisson),
                            problem.g, loads, free, answer.modes, problem.tol,
                            full_error=answer.error_estimate)
+    zones = [(z.lo, z.hi) for z in lifted.zones]
     # the full-contact solve's error is that of the times in full contact only
     error_estimate = max(max(z.error for z in lifted.zones), ERROR_FLOOR)
-    end_error = max(z.end_error for z in lifted.zones)
-    success = accepts(error_estimate, problem.tol, SUCCESS_MARGIN)
+    quantities = {q: lifted.quantity(q) for q in ("settlement", "tilt", "force", "moment")}
+    return _lifted_solution(scene, problem, times, answer, start, zones, quantities,
+                            lambda x, edge: lifted.pressure(x, edge), error_estimate,
+                            max(z.end_error for z in lifted.zones),
+                            max(z.response.modes for z in lifted.zones),
+                            max(z.response.nodes for z in lifted.zones))
+
+
+def _free_corners(regular_part: Any, pulls: float) -> np.ndarray | None:
+    """Per time which corner lifts (-1 the lower, +1 the upper, 0 none), or None where one
+    lifts at both."""
+    ends = regular_part(np.array([-1.0, 1.0]))
+    lower, upper = ends[0] < -pulls, ends[1] < -pulls
+    if np.any(lower & upper):
+        return None
+    return np.where(lower, -1, 0) + np.where(upper, 1, 0)
+
+
+#: Given loads whose ratio departs from the reference one by less than this share of
+#: their size keep it (a creeping bare base keeps then its elastic zone).
+RATIO_SHARE = 1e-12
+
+
+def _proportional(problem: Any, times: np.ndarray) -> tuple[str, str, float] | None:
+    """``(first, second, ratio)`` when the given loads are force and moment, or settlement
+    and tilt, whose second is ``ratio`` times the first at every time (sampled at the
+    output times and :data:`TILT_SAMPLES` between), else None."""
+    given = sorted(problem.loads)
+    if given not in (["force", "moment"], ["settlement", "tilt"]):
+        return None
+    first, second = ("force", "moment") if "force" in given else ("settlement", "tilt")
+    sample = np.union1d(times, np.linspace(times[0], times[-1], TILT_SAMPLES))
+    values = _load_values(problem, sample)
+    a, b = values[first], values[second]
+    k = int(np.argmax(np.abs(a)))
+    if a[k] == 0.0:
+        return None
+    ratio = float(b[k] / a[k])
+    size = max(float(np.max(np.abs(a))), float(np.max(np.abs(b))))
+    if np.max(np.abs(b - ratio * a)) > RATIO_SHARE * size:
+        return None
+    return first, second, ratio
+
+
+def _bare_creep_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: Any,
+                         regular_part: Any, pulls: float,
+                         start: float) -> ContactSolution | None:
+    """A flat punch lifting off the bare base that creeps or ages, under given loads that
+    keep their ratio (force and moment: the eccentricity; settlement and tilt): or None.
+
+    With no coating the creep operator and the base's space operator commute
+    (:mod:`core.engines.layered.bare_creep`), and on the zone the loads' common history
+    then scales the whole answer's pressure: the free end, where its singular coefficient
+    is zero at one time, stays there. So the zone is the elastic one of the loads' ratio
+    (:mod:`core.engines.layered.bare_lift_off`), and the creep is the narrower punch's
+    full-contact one on it (its loads ``P / b`` and ``(M - x0 P) / b^2``, or ``(delta +
+    x0 alpha) / b`` and ``alpha``).
+    """
+    from types import SimpleNamespace
+
+    if callable(problem.g) or problem.g != 0.0:
+        return None  # a curved punch: its gap does not creep, so the zone moves
+    kept = _proportional(problem, times)
+    free = _free_corners(regular_part, pulls)
+    if kept is None or free is None:
+        return None
+    first, second, ratio = kept
+    corner = int(free[np.flatnonzero(free)[0]]) if np.any(free) else 0
+    if np.any((free != 0) & (free != corner)):
+        return None
+    reference = {first: np.array([1.0]), second: np.array([ratio])}
+    lifted = bare_lift_off(scene.half_width, (scene.base_thickness,
+                                              problem.modulus_at_loading, scene.base_poisson),
+                           None, reference, np.array([corner]), answer.modes, problem.tol)
+    zone = lifted.zones[0]
+    x0, b = zone.centre, zone.half
+    loads = problem.loads
+
+    def load(name: str) -> Any:
+        value = loads[name]
+        return value if callable(value) else (lambda tt, v=float(value): np.full(
+            np.shape(tt), v))
+
+    if first == "force":
+        force, moment = load("force"), load("moment")
+        narrower = {"force": lambda tt: force(tt) / b,
+                    "moment": lambda tt: (moment(tt) - x0 * force(tt)) / (b * b)}
+    else:
+        settlement, tilt = load("settlement"), load("tilt")
+        narrower = {"settlement": lambda tt: (settlement(tt) + x0 * tilt(tt)) / b,
+                    "tilt": tilt}
+    sub_problem = SimpleNamespace(loads=narrower, kernel=problem.kernel,
+                                  time_breaks=problem.time_breaks)
+    history = solve_bare_creep(zone.response, sub_problem, times, problem.tol)
+    quantities = {"settlement": b * history.settlement - x0 * history.tilt,
+                  "tilt": history.tilt, "force": b * history.force,
+                  "moment": b * b * history.moment + b * x0 * history.force}
+
+    def pressure(x: np.ndarray, edge: float) -> np.ndarray:
+        x = np.clip(np.asarray(x, dtype=float), -edge, edge)
+        s = (x - x0) / b
+        out = np.zeros((x.size, times.size))
+        inside = (s > -1.0) & (s < 1.0)
+        si = s[inside]
+        out[inside] = history.regular_part(zone.response, si) / np.sqrt(
+            (1.0 - si) * (1.0 + si))[:, None]
+        return out
+
+    error_estimate = max(zone.error, ERROR_FLOOR) + history.time_error
+    solution = _lifted_solution(scene, problem, times, answer, start,
+                                [(zone.lo, zone.hi)] * times.size, quantities, pressure,
+                                error_estimate, zone.end_error, zone.response.modes,
+                                zone.response.nodes, history)
+    return solution
+
+
+def _lifted_solution(scene: Any, problem: Any, times: np.ndarray, answer: Any, start: float,
+                     zones: list[tuple[float, float]], quantities: dict[str, np.ndarray],
+                     pressure: Any, error_estimate: float, end_error: float, modes: int,
+                     nodes: int, history: Any = None) -> ContactSolution:
+    """The :class:`ContactSolution` of a punch lifting off the bare base (``zones`` its
+    contact zone per time, ``pressure(x, edge)`` its q*, ``history`` the time stepping
+    under creep, None elastic)."""
+    success = accepts(error_estimate, problem.tol, SUCCESS_MARGIN) and (
+        history is None or history.success)
     flags = [] if success else ["tol_not_met"]
-    modes = max(z.response.modes for z in lifted.zones)
     if success:
         message = (f"exact layered kernel, lifting off the bare base: estimated error "
                    f"{error_estimate:.1e} <= tol {problem.tol:.1e} with {modes} modes")
@@ -298,25 +421,28 @@ def _bare_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: Any,
         message = (f"tol {problem.tol:.1e} not met: the exact layered kernel, lifting off the "
                    f"bare base, reached {modes} modes with estimated error "
                    f"{error_estimate:.1e}")
+        if history is not None:
+            message += (f"; time stepping: {history.message} (estimated error "
+                        f"{history.time_error:.1e})")
     edge = corner_reach([], scene.half_width)
 
     def evaluate(x: np.ndarray) -> np.ndarray:
-        return lifted.pressure(np.asarray(x, dtype=float), edge)
+        return pressure(np.asarray(x, dtype=float), edge)
 
     q_interior = evaluate(np.cos(np.linspace(0.0, np.pi, 8 * modes + 1)[1:-1]))
-    tilt = lifted.quantity("tilt")
+    time_error = 0.0 if history is None else history.time_error
     info = {
         "error_estimate": float(error_estimate),
-        "spatial_error_estimate": float(error_estimate),
-        "time_error_estimate": 0.0,
-        "kernel_fit_error": 0.0,
+        "spatial_error_estimate": float(error_estimate - time_error),
+        "time_error_estimate": float(time_error),
+        "kernel_fit_error": 0.0 if history is None else history.fit_error,
         "seconds": time.perf_counter() - start,
         "flags": flags,
         "success": bool(success),
         "message": message,
         "n_modes": int(modes),
-        "n_steps": 0,
-        "n_nodes": int(max(z.response.nodes for z in lifted.zones)),
+        "n_steps": 0 if history is None else history.steps,
+        "n_nodes": int(nodes),
         "statement": scene.statement,
         "given": sorted(problem.loads),
         "min_pressure": float(np.min(q_interior)),
@@ -326,14 +452,13 @@ def _bare_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: Any,
         "method": "layered",
         "contact": "unilateral",
         "zone_end_error": float(end_error),
-        "max_abs_tilt": float(np.max(np.abs(tilt))),
+        "max_abs_tilt": float(np.max(np.abs(quantities["tilt"]))),
         "stages": answer.stages,
         "coating_model": NO_COATING,
         "layered_model_error": {"estimate": 0.0, "force": 0.0, "moment": 0.0, "where_m": 0.0,
                                 "model": NO_COATING, "thin_layer_estimate": 0.0},
     }
-    return ContactSolution(times.copy(), lifted.quantity("settlement"), tilt,
-                           lifted.quantity("force"), lifted.quantity("moment"), info, None,
+    return ContactSolution(times.copy(), quantities["settlement"], quantities["tilt"],
+                           quantities["force"], quantities["moment"], info, None,
                            np.zeros((0, times.size)), np.ones(times.size), None, None,
-                           _evaluate=evaluate,
-                           contact_set=[[(z.lo, z.hi)] for z in lifted.zones])
+                           _evaluate=evaluate, contact_set=[[zone] for zone in zones])

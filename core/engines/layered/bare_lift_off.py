@@ -23,7 +23,9 @@ alpha x0) / b``, tilt ``alpha' = alpha``, force ``P' = P* / b`` and moment about
 solve); the zone's free end is the root of the singular coefficient there
 (``sqrt(1 - sigma^2) q*`` at ``sigma = -1`` or ``+1``), found by a scan and Brent's
 method. One end is free: the punch's heel (or toe) lifts, the other corner touches; a
-punch lifting at both ends (a crown) is refused for now.
+punch lifting at both ends (a crown) is refused for now. A creeping or aging bare base is
+answered on the elastic zone where the loads keep their ratio
+(:mod:`core.engines.layered.answer`).
 
 The error: the zone's own solve (its mode truncation, as :func:`solve_layered` estimates
 it) and the zone's end, found again with half the modes: the answers' change between the
