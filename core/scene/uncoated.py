@@ -22,9 +22,9 @@ __all__ = ["check_uncoated", "lift_off_refusal", "UNCOATED_SCOPE"]
 
 #: What a scene without coating layers is solved for, as its refusals say it.
 UNCOATED_SCOPE = ("a scene with no coating layers is solved under a punch shape without "
-                  "jumps or kinks; it lifts off at one corner only, and on a base that creeps "
-                  "or ages only a flat punch under given loads that keep their ratio (force "
-                  "and moment, or settlement and tilt), for now")
+                  "jumps or kinks; on a base that creeps or ages it lifts off only as a flat "
+                  "punch under given loads that keep their ratio (force and moment, or "
+                  "settlement and tilt), for now")
 
 
 def check_uncoated(scene: Any) -> None:
@@ -47,13 +47,10 @@ def check_uncoated(scene: Any) -> None:
 
 
 def lift_off_refusal(scene: Any) -> str:
-    """The refusal of a scene without coating layers whose punch lifts off
-    (``solver.contact = "auto"``)."""
-    problem = scene.dimensionless
-    creeps = problem.kernel is not None or callable(problem.c) or problem.c != 1.0
-    where = ("on a base that creeps or ages, with a curved punch or loads whose ratio "
-             "changes in time" if creeps else "at both corners (a crown pressed lightly)")
-    return (f"loading: the punch lifts off the bare base {where} (the pressure turns negative "
+    """The refusal of a scene without coating layers whose punch lifts off on a base that
+    creeps or ages where that is not answered (``scene`` is not read: one wording)."""
+    return ("loading: the punch lifts off the bare base on a base that creeps or ages, with a "
+            "curved punch or loads whose ratio changes in time (the pressure turns negative "
             f"at an edge); {UNCOATED_SCOPE}: set solver.contact to 'full' for the "
-            "full-contact answer (flagged contact_lost), lower the eccentricity or the punch's "
-            "crown, or add a coating layer")
+            "full-contact answer (flagged contact_lost), keep the eccentricity constant, or "
+            "add a coating layer")

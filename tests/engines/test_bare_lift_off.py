@@ -217,3 +217,47 @@ def test_a_creeping_bare_base_whose_zone_would_move_is_refused():
         with pytest.raises(ValueError, match=r"^loading: the punch lifts off the bare base "
                                              r"on a base that creeps or ages, with a curved"):
             solve(d)
+
+
+# --------------------------------------------------------------- a crown lifting at both corners
+
+def _crowned(loading: dict, radius: float = 50.0, thickness: float = 1.0) -> dict:
+    d = _bare(loading, 1e-9, thickness)
+    d["punch"]["shape"] = {"kind": "polynomial", "coefficients": [0.0, 0.0, 0.5 / radius]}
+    return d
+
+
+@pytest.mark.parametrize("thickness", [100.0, 1000.0])
+def test_a_crown_on_a_thick_layer_touches_as_hertz_says(thickness):
+    # a cylinder of radius R = 1000 m pressed by P = 1 kN/m: Hertz's half-width
+    # b = sqrt(4 R P / (pi E*)), E* = E / (1 - nu^2), and elliptic pressure of peak 2 P /
+    # (pi b); measured off by 1.06e-9 (H = 100 m) and 1.06e-11 (H = 1000 m): the layer's
+    # own (b / H)^2 correction
+    radius, force = 1000.0, 1e3
+    result = solve(_crowned({"force": force, "moment": 0.0}, radius, thickness))
+    assert result.flags == [] and result.info["contact"] == "unilateral"
+    e_star = 3.0e10 / (1 - 0.2**2)
+    b = np.sqrt(4 * radius * force / (np.pi * e_star))
+    (lo, hi), = result.contact_set[0]
+    bound = 2e-9 * (100.0 / thickness) ** 2
+    assert abs(hi / b - 1) < bound and abs(lo / b + 1) < bound
+    x = np.linspace(-b, b, 11)[1:-1]
+    exact = 2 * force / (np.pi * b) * np.sqrt(1 - (x / b) ** 2)
+    assert np.max(np.abs(result.pressure(x)[:, 0] / exact - 1)) < bound
+
+
+def test_a_crown_lifting_at_both_corners_gives_one_answer_in_every_statement():
+    # R = 50 m, P = 50 kN/m at e = 0.2 m on H = a: the zone [0.18991, 0.21009] a, found
+    # again from each statement given two of its answers (measured within 5e-15 in the
+    # ends and 2e-14 in the values)
+    first = solve(_crowned({"force": 5e4, "moment": 1e4}))
+    (lo, hi), = first.contact_set[0]
+    assert lo == pytest.approx(0.1899077, abs=1e-7) and hi == pytest.approx(0.2100923, abs=1e-7)
+    values = {q: float(getattr(first, q)[0]) for q in ("settlement", "tilt", "force", "moment")}
+    for pair in (("settlement", "tilt"), ("settlement", "moment"), ("tilt", "force")):
+        other = solve(_crowned({q: values[q] for q in pair}))
+        assert other.info["contact"] == "unilateral"
+        assert other.contact_set[0][0] == (pytest.approx(lo, abs=1e-12),
+                                           pytest.approx(hi, abs=1e-12)), pair
+        for q, v in values.items():
+            assert float(getattr(other, q)[0]) == pytest.approx(v, rel=1e-12), (pair, q)

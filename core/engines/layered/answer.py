@@ -273,14 +273,12 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
 
 
 def _bare_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: Any,
-                   regular_part: Any, pulls: float, start: float) -> ContactSolution | None:
+                   regular_part: Any, pulls: float, start: float) -> ContactSolution:
     """The answer of a punch lifting off the bare elastic base
-    (:mod:`core.engines.layered.bare_lift_off`), or None where it lifts at both corners.
-    ``pulls``: the value of ``sqrt(1 - t^2) q*`` below which a corner lifts."""
+    (:mod:`core.engines.layered.bare_lift_off`). ``pulls``: the value of ``sqrt(1 - t^2)
+    q*`` below which a corner lifts."""
     loads = _load_values(problem, times)
     free = _free_corners(regular_part, pulls)
-    if free is None:
-        return None
     lifted = bare_lift_off(scene.half_width, (scene.base_thickness,
                                               problem.modulus_at_loading, scene.base_poisson),
                            problem.g, loads, free, answer.modes, problem.tol,
@@ -296,14 +294,11 @@ def _bare_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: Any,
                             max(z.response.nodes for z in lifted.zones))
 
 
-def _free_corners(regular_part: Any, pulls: float) -> np.ndarray | None:
-    """Per time which corner lifts (-1 the lower, +1 the upper, 0 none), or None where one
-    lifts at both."""
+def _free_corners(regular_part: Any, pulls: float) -> np.ndarray:
+    """Per time which corner lifts: -1 the lower, +1 the upper, 2 both, 0 none."""
     ends = regular_part(np.array([-1.0, 1.0]))
     lower, upper = ends[0] < -pulls, ends[1] < -pulls
-    if np.any(lower & upper):
-        return None
-    return np.where(lower, -1, 0) + np.where(upper, 1, 0)
+    return np.where(lower & upper, 2, np.where(lower, -1, 0) + np.where(upper, 1, 0))
 
 
 #: Given loads whose ratio departs from the reference one by less than this share of
@@ -352,7 +347,7 @@ def _bare_creep_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: An
         return None  # a curved punch: its gap does not creep, so the zone moves
     kept = _proportional(problem, times)
     free = _free_corners(regular_part, pulls)
-    if kept is None or free is None:
+    if kept is None:
         return None
     first, second, ratio = kept
     corner = int(free[np.flatnonzero(free)[0]]) if np.any(free) else 0

@@ -22,9 +22,12 @@ alpha x0) / b``, tilt ``alpha' = alpha``, force ``P' = P* / b`` and moment about
 ``M' = (M* - x0 P*) / b^2``. Any two of the four given fix ``delta', alpha'`` (a 2 x 2
 solve); the zone's free end is the root of the singular coefficient there
 (``sqrt(1 - sigma^2) q*`` at ``sigma = -1`` or ``+1``), found by a scan and Brent's
-method. One end is free: the punch's heel (or toe) lifts, the other corner touches; a
-punch lifting at both ends (a crown) is refused for now. A creeping or aging bare base is
-answered on the elastic zone where the loads keep their ratio
+method. Where the punch's heel (or toe) lifts, one end is free and the other corner
+touches; where both corners lift (a crown pressed lightly), both ends are free, and the
+zone's middle and half-width are the root of both coefficients (Powell's hybrid method,
+from Hertz's half-width on a half-space, ``b = sqrt(2 R P* / pi)`` with ``R`` the crown's
+radius at the gap's lowest point, or from the best of a scan of zones). A creeping or
+aging bare base is answered on the elastic zone where the loads keep their ratio
 (:mod:`core.engines.layered.answer`).
 
 The error: the zone's own solve (its mode truncation, as :func:`solve_layered` estimates
@@ -57,15 +60,23 @@ _NAMES = ("settlement", "tilt", "force", "moment")
 SCAN = np.linspace(0.0, 1.0, 17)[1:-1]
 #: The zone's end is found to this many half-widths (far below what the modes resolve).
 END_TOL = 1e-13
-#: Why a punch lifting at both ends is not answered.
-TWO_FREE_ENDS = ("the punch lifts off at both corners (a crown pressed lightly); on the bare "
-                 "base a zone with two free ends is not solved for now")
+#: Why a zone with two free ends was not answered.
+TWO_FREE_ENDS = ("loading: the punch lifts off the bare base at both corners and no contact "
+                 "zone with two free ends was found for these loads (the crown's contact "
+                 "would reach a corner or vanish)")
+#: Both free ends are taken when their singular coefficients are below this share of the
+#: pressure's scale (the zone's force over its half-width).
+TWO_ENDS_TOL = 1e-10
+#: Zone middles and half-widths tried when no first zone is known (or Powell's method
+#: from it failed): the best of them starts it again.
+SCAN_MIDDLES = np.linspace(-0.9, 0.9, 19)
+SCAN_HALF_WIDTHS = np.geomspace(0.002, 0.9, 12)
 
 
 @dataclass(frozen=True)
 class ZoneAnswer:
     """The answer on one zone: its ends ``lo``, ``hi`` [-], which end is free (``free``:
-    -1 the lower, +1 the upper), the narrower punch's unit ``response`` and its
+    -1 the lower, +1 the upper, 2 both, 0 none), the narrower punch's unit ``response`` and its
     settlement ``delta`` and tilt ``alpha`` (its own units), the four quantities of the
     whole punch (``values``), its ``error`` [-] relative and the end's uncertainty
     ``end_error`` [half-widths]."""
@@ -219,7 +230,8 @@ def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
     ``half_width`` a [m]; ``base`` its thickness H [m], modulus E [Pa] and Poisson ratio;
     ``gap`` g* as in :func:`core.engines.layered.solve.layered_response`; ``given`` two
     of delta*, alpha, P*, M* (arrays over the values); ``free`` per value -1 (the lower
-    end lifts), +1 (the upper) or 0 (full contact holds: the whole punch's zone, whose
+    end lifts), +1 (the upper), 2 (both: a crown pressed lightly) or 0 (full contact
+    holds: the whole punch's zone, whose
     error is ``full_error``, the full-contact solve's); ``modes`` the full-contact
     solve's; ``tol`` the accuracy asked for.
     """
@@ -254,9 +266,12 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
     thickness, modulus, poisson = base
     while True:
         zones = _Zones(half_width, base, gap, modes, table, tol)
-        end = _free_end(zones, free, given, level=0)
-        coarse_end = _free_end(zones, free, given, level=1)
-        lo, hi = _zone(free, end)
+        if free == 2:
+            lo, hi = _two_free_ends(zones, given, level=0)
+            clo, chi = _two_free_ends(zones, given, level=1, guess=(lo, hi))
+        else:
+            lo, hi = _zone(free, _free_end(zones, free, given, level=0))
+            clo, chi = _zone(free, _free_end(zones, free, given, level=1))
         x0, b = 0.5 * (lo + hi), 0.5 * (hi - lo)
         response = zones.response(lo, hi)
         delta, alpha, values = _kinematics(response, x0, b, given)
@@ -264,8 +279,7 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
         own = solve_layered(b * half_width, [], thickness, modulus, poisson,
                             {"settlement": np.array([delta]), "tilt": np.array([alpha])},
                             gap=zones.sub_gap(x0, b), tol=tol, max_modes=modes)
-        # the end's: the answers on the end found with half the modes
-        clo, chi = _zone(free, coarse_end)
+        # the ends': the answers on the ends found with half the modes
         _, _, coarse = _kinematics(zones.response(clo, chi), 0.5 * (clo + chi),
                                    0.5 * (chi - clo), given, level=1)
         kin = max(abs(values["settlement"]), abs(values["tilt"]), 1e-300)
@@ -274,8 +288,73 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
                      for n in _NAMES if n not in given)
         extrapolate = MAX_RATIO / (1.0 - MAX_RATIO)
         error = max(own.error_estimate, extrapolate * change)
-        end_error = extrapolate * abs(end - coarse_end)
+        end_error = extrapolate * max(abs(lo - clo), abs(hi - chi))
         if error <= 0.5 * tol or 2 * modes > MAX_MODES:
             return ZoneAnswer(lo, hi, free, response, delta, alpha, values, float(error),
                               float(end_error))
         modes *= 2
+
+
+def _hertz_guess(gap: Gap, given: dict[str, float]) -> tuple[float, float] | None:
+    """A first zone for a crown lifting at both corners where the force is given: Hertz's
+    on a half-space, ``b = sqrt(2 R P* / pi)`` (``R`` the radius at the gap's lowest point)
+    about the resultant (the moment given) or the punch's deepest point (the tilt given);
+    None without a given force."""
+    if given.get("force", 0.0) <= 0 or not callable(gap):
+        return None
+    t = np.linspace(-1.0, 1.0, 2001)
+    g = np.asarray(gap(t), dtype=float)
+    k = int(np.clip(np.argmin(g), 1, t.size - 2))
+    h = t[1] - t[0]
+    curvature = (g[k - 1] - 2 * g[k] + g[k + 1]) / (h * h)
+    b = np.sqrt(2 * given["force"] / (np.pi * curvature)) if curvature > 0 else 0.5
+    if "moment" in given:
+        x0 = given["moment"] / given["force"]
+    else:  # the tilted punch's deepest point
+        x0 = float(t[np.argmax(given["tilt"] * t - g)])
+    b = float(np.clip(b, 1e-3, 0.95))
+    x0 = float(np.clip(x0, -1 + b, 1 - b))
+    return x0 - b, x0 + b
+
+
+def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
+                   guess: tuple[float, float] | None = None) -> tuple[float, float]:
+    """The zone of a punch lifting at both corners: both ends' singular coefficients zero
+    (``guess`` a first zone, else :func:`_hertz_guess`, else the best of a scan)."""
+    from scipy.optimize import root  # here: see _free_end
+
+    def coefficients(v: np.ndarray) -> np.ndarray:
+        x0, b = float(v[0]), float(np.exp(v[1]))
+        response = zones.response(x0 - b, x0 + b)
+        delta, alpha, values = _kinematics(response, x0, b, given, level)
+        ends = response.regular_part(np.array([-1.0, 1.0]), np.array([delta]),
+                                     np.array([alpha]), level=level)[:, 0]
+        return ends / max(abs(values["force"]) / b, 1e-300)
+
+    def solved(start: np.ndarray) -> np.ndarray | None:
+        found = root(coefficients, start, method="hybr", options={"xtol": 1e-14})
+        x0, b = float(found.x[0]), float(np.exp(found.x[1]))
+        inside = bool(np.all(np.isfinite(found.x))) and x0 - b >= -1.0 and x0 + b <= 1.0
+        if inside and np.max(np.abs(coefficients(found.x))) <= TWO_ENDS_TOL:
+            return found.x
+        return None
+
+    first = guess if guess is not None else _hertz_guess(zones.gap, given)
+    found = None
+    if first is not None:
+        found = solved(np.array([0.5 * (first[0] + first[1]),
+                                 np.log(0.5 * (first[1] - first[0]))]))
+    if found is None:
+        # the zones within the punch, scanned: the smallest coefficients start it again
+        best, start = np.inf, None
+        for b in SCAN_HALF_WIDTHS:
+            for x0 in SCAN_MIDDLES[np.abs(SCAN_MIDDLES) <= 1.0 - b]:
+                v = np.array([x0, np.log(b)])
+                size = float(np.max(np.abs(coefficients(v))))
+                if size < best:
+                    best, start = size, v
+        found = solved(start) if start is not None else None
+    if found is None:
+        raise ValueError(TWO_FREE_ENDS)
+    x0, b = float(found[0]), float(np.exp(found[1]))
+    return x0 - b, x0 + b
