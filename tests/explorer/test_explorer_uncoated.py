@@ -62,3 +62,20 @@ def test_the_coating_tab_hides_the_layer_widgets_with_no_layer(explorer_app):
     assert tab.layer.options == ["1"]
     app.state.n_layers = 0
     assert tab.bare_note.visible and not tab.layer.visible
+
+
+def test_the_heel_lifting_off_the_bare_layer_is_drawn_and_said(explorer_app):
+    # e = 0.6 a on the bare layer (H = a): the heel lifts off, the zone [-0.39996 a, a]
+    # (tests/engines/test_bare_lift_off.py); the page says it in words
+    from explorer.model.contact_zone import contact_text, contact_widths
+
+    app = explorer_app("bare_layer", solved=True)
+    app.state.loading.histories["moment"].value = 300.0  # kN m/m with P = 500 kN/m
+    assert app.controller.wait(60) and app.controller.error == "", app.controller.error
+    view = app.controller.view
+    assert view.contact_set[0] == [(pytest.approx(-0.3999646, abs=1e-6), 1.0)]
+    assert contact_widths(view)[0] == pytest.approx(1.3999646, abs=1e-6)
+    assert contact_text(view, 0) == ("contact 1.4 m of 2 m (70 %), lifted 0.6 m: x = -1 to "
+                                     "-0.4 m (unilateral contact)")
+    assert np.all(view.pressure[view.x < -0.4, 0] == 0)
+    assert np.all(view.pressure[view.x > -0.399, 0] > 0)
