@@ -1,0 +1,125 @@
+"""Speed against error of a punch lifting off the bare base, against closed forms.
+
+    OPENBLAS_NUM_THREADS=1 python -m benchmarks.bare_lift_off [--no-write]
+
+Two scenes whose answers are known in closed form on a half-space, solved on a layer so
+thick (``H = 1e4 a``, the thickest a scene takes; ``1000 m``, ``1.6e5 b``, for the crown)
+that the layer's own correction, ``(a / H)^2`` (``(b / H)^2``), is ~1e-9 or less (the
+heel's errors below are that correction: 1.3e-9, falling 100x for each tenfold ``H``,
+tests/engines/test_bare_lift_off.py):
+
+* *heel*: a flat punch (a = 1 m) under P at e = M / P = 0.75 a: the zone ``[c, a]`` with
+  ``c = 4 e - 3 a``, the pressure ``P sqrt((x - c) / (a - x)) / (pi b)`` and the tilt
+  ``2 M' / (pi b^2) / theta`` (``b`` the zone's half-width, ``M'`` the moment about its
+  middle);
+* *crown*: a parabolic punch of radius R = 1000 m under P = 1 kN/m (Hertz): the half-width
+  ``b = sqrt(4 R P / (pi E*))`` and the elliptic pressure of peak ``2 P / (pi b)``.
+
+For each tol: the median CPU time of ``core.solve`` [ms] (caches cleared before each
+solve), the solver's estimate, the error of the zone's ends [half-widths of the punch],
+of the pressure (largest relative error over the zone's inner 80 %) and of the tilt.
+Written to ``benchmarks/results/bare_lift_off.md`` unless ``--no-write``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks import run_lines
+from core.cache import clear_caches
+from core.presets import read_preset
+from core.scene import solve
+
+TOLS = (1e-4, 1e-6, 1e-8, 1e-10)
+SOLVES = 5
+RESULTS = Path(__file__).resolve().parent / "results" / "bare_lift_off.md"
+E, NU = 3.0e10, 0.2
+
+
+def _scene(kind: str, tol: float) -> dict:
+    d = read_preset("bare_layer")
+    d["solver"] = {"tol": tol}
+    d["base"]["thickness"] = 1e4 if kind == "heel" else 1000.0
+    if kind == "heel":
+        d["loading"] = {"force": 1e6, "moment": 0.75e6}
+    else:
+        d["punch"]["shape"] = {"kind": "polynomial", "coefficients": [0.0, 0.0, 0.5e-3]}
+        d["loading"] = {"force": 1e3, "moment": 0.0}
+    return d
+
+
+def _errors(kind: str, result) -> tuple[float, float, float]:
+    """Errors of the zone's ends [half-widths], the pressure and the tilt [relative]."""
+    (lo, hi), = result.contact_set[0]
+    theta = E / (2 * (1 - NU**2))
+    if kind == "heel":
+        p, e = 1e6, 0.75
+        c = 4 * e - 3
+        b, x0 = (1 - c) / 2, (1 + c) / 2
+        ends = max(abs(lo - c), abs(hi - 1.0))
+        x = c + (1 - c) * np.linspace(0.1, 0.9, 17)
+        exact = p * np.sqrt((x - c) / (1 - x)) / (np.pi * b)
+        tilt = 2 * p * (e - x0) / (np.pi * b**2) / theta
+        tilt_error = abs(float(result.tilt[0]) / tilt - 1)
+    else:
+        p, radius = 1e3, 1000.0
+        b = np.sqrt(4 * radius * p / (np.pi * E / (1 - NU**2)))
+        ends = max(abs(lo + b), abs(hi - b))
+        x = b * np.linspace(-0.8, 0.8, 17)
+        exact = 2 * p / (np.pi * b) * np.sqrt(1 - (x / b) ** 2)
+        tilt_error = float("nan")  # centred: no tilt
+    pressure = float(np.max(np.abs(result.pressure(x)[:, 0] / exact - 1)))
+    return ends, pressure, tilt_error
+
+
+def measure() -> list[tuple]:
+    rows = []
+    for kind in ("heel", "crown"):
+        for tol in TOLS:
+            cpu = []
+            for _ in range(SOLVES):
+                clear_caches()
+                started = time.process_time()
+                result = solve(_scene(kind, tol))
+                cpu.append(time.process_time() - started)
+            ends, pressure, tilt = _errors(kind, result)
+            rows.append((kind, tol, 1e3 * float(np.median(cpu)),
+                         float(result.info["error_estimate"]),
+                         float(result.info["zone_end_error"]), ends, pressure, tilt,
+                         bool(result.info["success"])))
+    return rows
+
+
+def main(argv: list[str]) -> None:
+    started = datetime.now(timezone.utc)
+    before = os.getloadavg()[0]
+    rows = measure()
+    after = os.getloadavg()[0]
+    lines = ["# A punch lifting off the bare base: speed against error", "",
+             "    OPENBLAS_NUM_THREADS=1 python -m benchmarks.bare_lift_off", "",
+             *run_lines(started, before, after, "CPU times move little with the load"),
+             "- a layer 1e4 a (heel) or 1.6e5 b (crown) thick against the half-space's closed "
+             "forms (module docstring); caches cleared before each solve, medians of "
+             f"{SOLVES}", "",
+             "| scene | tol | CPU [ms] | estimate | zone-end estimate | zone-end error | "
+             "q error | tilt error | success |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for kind, tol, ms, est, end_est, ends, q, tilt, ok in rows:
+        lines.append(f"| {kind} | {tol:.0e} | {ms:.1f} | {est:.1e} | {end_est:.1e} | "
+                     f"{ends:.1e} | {q:.1e} | {'' if np.isnan(tilt) else f'{tilt:.1e}'} | "
+                     f"{'yes' if ok else 'no'} |")
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if "--no-write" not in argv:
+        RESULTS.write_text(text)
+        print(f"written: {RESULTS}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
