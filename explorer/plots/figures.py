@@ -199,13 +199,28 @@ class Figures:
             cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted",
                           level=MOVING)
             p.add_layout(cursor)
-            self._build_punch_lines(p, q, unit)
-            if q in READ_SERIES:
-                self._build_readings(p, q, unit)
+            # the lines of several punches and a fit's readings are made when first drawn
+            # (_punch_lines, _readings): with them a page held 43 plot renderers where it
+            # shows 19 (~220 of its 1015 Bokeh models, which the server builds and the
+            # browser renders for every page)
             self.history_src[q] = src
             self.history_point_src[q] = point
             self.history_fig[q], self.history_line[q] = p, line
             self.history_cursor[q] = cursor
+
+    def _punch_lines(self) -> None:
+        """The lines of several punches on every history, made at the first result of
+        several punches (:meth:`_build_punch_lines`)."""
+        if not self.punch_history_src:
+            for q in QUANTITIES:
+                self._build_punch_lines(self.history_fig[q], q, QUANTITY_UNITS[q][0])
+
+    def _readings(self) -> None:
+        """The readings and forecast of a fit on its histories, made when a fit's readings
+        or forecast are first drawn (:meth:`_build_readings`)."""
+        if not self.readings_src:
+            for q in READ_SERIES:
+                self._build_readings(self.history_fig[q], q, QUANTITY_UNITS[q][0])
 
     def _build_punch_lines(self, p: figure, q: str, unit: str) -> None:
         """The history of ``q`` of each punch of several, in its colour, with a legend
@@ -228,6 +243,12 @@ class Figures:
     def _show_punch_histories(self, view: ResultView) -> None:
         """A line per punch on each history (several punches), or none (one punch)."""
         n = len(view.punches)
+        if n:
+            self._punch_lines()
+        elif not self.punch_history_src:
+            for q in QUANTITIES:
+                self.history_line[q].visible = True
+            return
         for q in QUANTITIES:
             for k, (src, line) in enumerate(zip(self.punch_history_src[q],
                                                 self.punch_history_line[q], strict=True)):
@@ -268,6 +289,10 @@ class Figures:
     def show_readings(self, columns: dict[str, dict[str, list[float]]]) -> None:
         """Draw the readings of a fit (:func:`explorer.model.readings_columns`, display
         units) on the settlement and tilt histories; empty lists clear them."""
+        if not self.readings_src and not any(len(v) for q in READ_SERIES
+                                             for v in columns[q].values()):
+            return  # nothing drawn, nothing to clear
+        self._readings()
         for q in READ_SERIES:
             set_data(self.readings_src[q], {k: f32(v) for k, v in columns[q].items()})
         self._fit_extra()
@@ -275,6 +300,10 @@ class Figures:
     def show_forecast(self, columns: dict[str, dict[str, list[float]]]) -> None:
         """Draw the fitted scene's forecast and its band
         (:func:`explorer.model.forecast_columns`, display units); empty lists clear it."""
+        if not self.forecast_src and not any(len(v) for q in READ_SERIES
+                                             for v in columns[q].values()):
+            return  # nothing drawn, nothing to clear
+        self._readings()
         for q in READ_SERIES:
             set_data(self.forecast_src[q], {k: f32(v) for k, v in columns[q].items()})
         self._fit_extra()
@@ -339,7 +368,7 @@ class Figures:
             pins = ()
         self._pins = tuple(pins)
         for q in QUANTITIES:
-            extra = [] if q not in READ_SERIES else [
+            extra = [] if q not in READ_SERIES or not self.readings_src else [
                 src.data.get(k, []) for src in (self.readings_src[q], self.forecast_src[q])
                 for k in ("lower", "upper")]
             extra += [p.display(q) for p in view.punches]
