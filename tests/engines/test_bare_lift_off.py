@@ -14,6 +14,7 @@ import pytest
 from core.engines.layered.bare_lift_off import bare_lift_off
 from core.presets import read_preset
 from core.scene import solve
+from tests.support.creep_laws import CREEP, aging_growth, laws
 
 
 def _half_space_deviation(lam: float, e: float) -> tuple[float, float, float]:
@@ -176,9 +177,6 @@ def test_a_loading_that_varies_in_time_lifts_off_only_when_it_must():
 
 # --------------------------------------------------------------- a creeping bare base
 
-#: The standard linear solid of tests/scene/test_uncoated_scene.py: J(t) = 1 / E + c (1 -
-#: exp(-r t)), relaxing like R(t) = E (1 + E c exp(-r (1 + E c) t)) / (1 + E c).
-CREEP = {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11, "rate": 0.05}
 
 
 def _creeping(loading: dict, creep: dict = CREEP) -> dict:
@@ -203,10 +201,7 @@ def test_a_creeping_bare_base_keeps_the_elastic_zone_and_follows_its_laws(loadin
     zone = elastic.contact_set[0]
     assert zone[0][0] > -1.0
     assert all(zones == [pytest.approx(zone[0], abs=1e-12)] for zones in result.contact_set)
-    t = result.times
-    e_c = CREEP["modulus"] * CREEP["compliance"]
-    growth = 1 + e_c * (1 - np.exp(-CREEP["rate"] * t))
-    relaxation = (1 + e_c * np.exp(-CREEP["rate"] * (1 + e_c) * t)) / (1 + e_c)
+    growth, relaxation = laws(result.times)
     for q in ("settlement", "tilt", "force", "moment"):
         if q in loading:
             continue
@@ -229,10 +224,7 @@ def test_an_aging_bare_base_lifting_off_settles_like_its_creep_function():
     d["times"] = read_preset("eccentric_creep")["times"]
     result = solve(d)
     assert result.flags == [] and result.info["contact"] == "unilateral"
-    scene = result.scene
-    tau0 = scene.age_at_loading
-    e0 = float(np.asarray(scene.creep.modulus(tau0)))
-    law = 1 + e0 * np.asarray(scene.creep.compliance(tau0 + result.times, tau0))
+    law = aging_growth(result)
     for name in ("settlement", "tilt"):
         values = getattr(result, name)
         assert np.max(np.abs(values / values[0] / law - 1)) < 1e-7, name

@@ -12,6 +12,7 @@ import pytest
 from core.engines.layered import NO_COATING
 from core.presets import read_preset
 from core.scene import load_json_schema, scene_from_dict, schema_errors, solve
+from tests.support.creep_laws import CREEP, aging_growth, laws
 
 #: pi theta delta / P of a flat punch on a layer with H = a, to the benchmark's 8 digits
 #: (tests/engines/test_uncoated.py reproduces it on the kernel alone).
@@ -168,9 +169,6 @@ def test_a_layer_of_zero_thickness_is_still_refused():
 
 # --------------------------------------------------------------- a creeping bare base
 
-#: Non-aging exponential creep: J(t) = 1 / E + c (1 - exp(-r t)) (a standard linear solid),
-#: its relaxation in closed form R(t) = E (1 + E c exp(-r (1 + E c) t)) / (1 + E c).
-CREEP = {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11, "rate": 0.05}
 
 
 def creeping(loading: dict[str, float], creep: dict[str, Any] = CREEP) -> dict[str, Any]:
@@ -191,10 +189,7 @@ def test_a_creeping_bare_base_follows_the_creep_and_relaxation_functions(loading
     result = solve(creeping(loading))
     assert result.flags == [] and result.info["coating_model"] == NO_COATING
     assert result.info["n_steps"] > 0 and result.info["time_error_estimate"] > 0
-    t = result.times
-    e_c = CREEP["modulus"] * CREEP["compliance"]
-    growth = 1 + e_c * (1 - np.exp(-CREEP["rate"] * t))
-    relaxation = (1 + e_c * np.exp(-CREEP["rate"] * (1 + e_c) * t)) / (1 + e_c)
+    growth, relaxation = laws(result.times)
     for q in ("settlement", "tilt", "force", "moment"):
         if q in loading:
             continue
@@ -214,10 +209,7 @@ def test_an_aging_bare_base_settles_like_its_creep_function():
     d = creeping({"force": 5e5, "moment": 5e4}, creep)
     d["times"] = read_preset("eccentric_creep")["times"]
     result = solve(d)
-    scene = result.scene
-    tau0 = scene.age_at_loading
-    e0 = float(np.asarray(scene.creep.modulus(tau0)))
-    law = 1 + e0 * np.asarray(scene.creep.compliance(tau0 + result.times, tau0))
+    law = aging_growth(result)
     for q in ("settlement", "tilt"):
         values = getattr(result, q)
         assert np.max(np.abs(values / values[0] / law - 1)) < 1e-7, q

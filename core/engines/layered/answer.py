@@ -225,8 +225,7 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
     else:
         # no coating, no coating model: the base's own kernel is the whole problem, and
         # the numerical estimate above is the only error
-        model_error = {"estimate": 0.0, "force": 0.0, "moment": 0.0, "where_m": 0.0,
-                       "model": NO_COATING, "thin_layer_estimate": 0.0}
+        model_error = _no_coating_model_error()
     flags = ["contact_lost"] if lost else []
     success = accepts(error_estimate, problem.tol, SUCCESS_MARGIN) and (
         history is None or history.success)
@@ -241,32 +240,13 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
         if history is not None:
             message += (f"; time stepping: {history.message} (estimated error "
                         f"{history.time_error:.1e})")
-    q_interior = evaluate(np.cos(theta[1:-1]))
-    info = {
-        "error_estimate": float(error_estimate),
-        "spatial_error_estimate": float(answer.error_estimate),
-        "time_error_estimate": float(time_error),
-        "kernel_fit_error": 0.0 if history is None else history.fit_error,
-        "seconds": time.perf_counter() - start,
-        "flags": flags,
-        "success": bool(success),
-        "message": message,
-        "n_modes": int(answer.modes),
-        "n_steps": 0 if history is None else history.steps,
-        "n_nodes": int(response.nodes),
-        "statement": scene.statement,
-        "given": sorted(problem.loads),
-        "min_pressure": float(np.min(q_interior)),
-        "max_pressure": float(np.max(np.abs(q_interior))),
-        "basis": "chebyshev",
-        "element_ends": [],
-        "method": "layered",
-        "contact": "full",
-        "max_abs_tilt": largest_tilt,
-        "stages": answer.stages,
-        "coating_model": "exact layered" if layers else NO_COATING,
-        "layered_model_error": model_error,
-    }
+    info = _info(scene, problem, history, start, evaluate(np.cos(theta[1:-1])),
+                 error_estimate=error_estimate, spatial=answer.error_estimate,
+                 success=success, flags=flags, message=message, modes=answer.modes,
+                 nodes=response.nodes, stages=answer.stages, contact="full")
+    info.update(max_abs_tilt=largest_tilt,
+                coating_model="exact layered" if layers else NO_COATING,
+                layered_model_error=model_error)
     return ContactSolution(times.copy(), settlement, tilt, force, moment, info, None,
                            np.zeros((0, times.size)), np.ones(times.size), None, None,
                            _evaluate=evaluate, contact_set=[[(-1.0, 1.0)] for _ in times])
@@ -424,12 +404,37 @@ def _lifted_solution(scene: Any, problem: Any, times: np.ndarray, answer: Any, s
     def evaluate(x: np.ndarray) -> np.ndarray:
         return pressure(np.asarray(x, dtype=float), edge)
 
-    q_interior = evaluate(np.cos(np.linspace(0.0, np.pi, 8 * modes + 1)[1:-1]))
     time_error = 0.0 if history is None else history.time_error
-    info = {
+    info = _info(scene, problem, history, start,
+                 evaluate(np.cos(np.linspace(0.0, np.pi, 8 * modes + 1)[1:-1])),
+                 error_estimate=error_estimate, spatial=error_estimate - time_error,
+                 success=success, flags=flags, message=message, modes=modes, nodes=nodes,
+                 stages=answer.stages, contact="unilateral")
+    info.update(zone_end_error=float(end_error),
+                max_abs_tilt=float(np.max(np.abs(quantities["tilt"]))),
+                coating_model=NO_COATING, layered_model_error=_no_coating_model_error())
+    return ContactSolution(times.copy(), quantities["settlement"], quantities["tilt"],
+                           quantities["force"], quantities["moment"], info, None,
+                           np.zeros((0, times.size)), np.ones(times.size), None, None,
+                           _evaluate=evaluate, contact_set=[[zone] for zone in zones])
+
+
+def _no_coating_model_error() -> dict[str, Any]:
+    """``info["layered_model_error"]`` without coating: no coating to model, no error."""
+    return {"estimate": 0.0, "force": 0.0, "moment": 0.0, "where_m": 0.0,
+            "model": NO_COATING, "thin_layer_estimate": 0.0}
+
+
+def _info(scene: Any, problem: Any, history: Any, start: float, q_interior: np.ndarray, *,
+          error_estimate: float, spatial: float, success: bool, flags: list[str],
+          message: str, modes: int, nodes: int, stages: dict[str, Any],
+          contact: str) -> dict[str, Any]:
+    """The ``info`` keys every answer of this path carries (``q_interior``: q* inside the
+    punch, for its extremes; ``history``: the time stepping under creep, None elastic)."""
+    return {
         "error_estimate": float(error_estimate),
-        "spatial_error_estimate": float(error_estimate - time_error),
-        "time_error_estimate": float(time_error),
+        "spatial_error_estimate": float(spatial),
+        "time_error_estimate": 0.0 if history is None else float(history.time_error),
         "kernel_fit_error": 0.0 if history is None else history.fit_error,
         "seconds": time.perf_counter() - start,
         "flags": flags,
@@ -445,15 +450,6 @@ def _lifted_solution(scene: Any, problem: Any, times: np.ndarray, answer: Any, s
         "basis": "chebyshev",
         "element_ends": [],
         "method": "layered",
-        "contact": "unilateral",
-        "zone_end_error": float(end_error),
-        "max_abs_tilt": float(np.max(np.abs(quantities["tilt"]))),
-        "stages": answer.stages,
-        "coating_model": NO_COATING,
-        "layered_model_error": {"estimate": 0.0, "force": 0.0, "moment": 0.0, "where_m": 0.0,
-                                "model": NO_COATING, "thin_layer_estimate": 0.0},
+        "contact": contact,
+        "stages": stages,
     }
-    return ContactSolution(times.copy(), quantities["settlement"], quantities["tilt"],
-                           quantities["force"], quantities["moment"], info, None,
-                           np.zeros((0, times.size)), np.ones(times.size), None, None,
-                           _evaluate=evaluate, contact_set=[[zone] for zone in zones])
