@@ -383,7 +383,11 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
             if first.contact == "unilateral":
                 answers = _lift_off(scene, geometries, inputs)
             else:
-                answers = solve_punches(geometries, inputs, first.dimensionless.time_breaks)
+                # where any punch's given loads jump or kink (a punch loaded later):
+                # the time steps land on each of them
+                breaks = sorted({b for sub in scene.scenes
+                                 for b in sub.dimensionless.time_breaks})
+                answers = solve_punches(geometries, inputs, tuple(breaks))
                 for answer in answers:
                     answer.info["contact"] = "full"
                 lost = [k for k, a in enumerate(answers) if "contact_lost" in a.info["flags"]]
