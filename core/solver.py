@@ -127,7 +127,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                                         "time_breaks": time_breaks}, options)
     loads = {"settlement": settlement, "tilt": tilt, "force": force, "moment": moment}
     unilateral_args = dict(lam=lam, m=m, g=g, times=times, c=c, kernel=kernel,
-                           breakpoints=breakpoints, tol=tol, **loads)
+                           breakpoints=breakpoints, tol=tol, time_breaks=time_breaks,
+                           **loads)
     geometry = validate_geometry(lam, m, g, breakpoints, tol)
     inputs = validate_time_inputs(times, c, kernel, loads)
     if contact == "unilateral":

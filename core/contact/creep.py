@@ -16,6 +16,7 @@ with the one of halved panels over a few of the output times (:func:`_select_rul
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -100,18 +101,20 @@ def _distance(a: dict[str, Any], b: dict[str, Any]) -> tuple[float, float]:
 
 
 def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.ndarray],
-                res: Resolution, first_steps: int = FIRST_STEPS) -> dict[str, Any]:
+                res: Resolution, first_steps: int = FIRST_STEPS,
+                jumps: Sequence[float] = ()) -> dict[str, Any]:
     """Time-step the unilateral problem under creep (see the module notes).
 
     ``first_steps`` nominal steps on the first grid; the grid is halved until the
     Richardson-extrapolated outputs of two successive pairs of grids agree to ``tol``/3
-    (their difference / 7 is the estimate) or ``MAX_HALVINGS`` is reached.
+    (their difference / 7 is the estimate) or ``MAX_HALVINGS`` is reached. ``jumps``:
+    times where a given load jumps (no step straddles one, :func:`time_grid`).
     """
     times = inp.times
     tol = inp.tol
     (base, out, run, band_note, strays, error, end_error, time_error,
      space_error) = controlled_march(OnePunchMarches(space, inp), times, tol, res,
-                                     first_steps)
+                                     first_steps, jumps)
     sweeps, steps = run["sweeps"], run["steps"]
     success, flags, message = creep_verdict(error, end_error, time_error, space_error, run,
                                             strays, tol, "under creep")
@@ -189,11 +192,12 @@ class OnePunchMarches:
 
 
 def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
-                     first_steps: int) -> tuple:
+                     first_steps: int, jumps: Sequence[float] = ()) -> tuple:
     """The panel rule and time grids of the marches of ``marches`` (module notes), with
     their estimates: (rule, extrapolated outputs, last march, band note, output times
     with an end outside the bands, error of the outputs, of the zone ends, the time and
-    space parts of the former)."""
+    space parts of the former; ``jumps``: times where a given load jumps, on which every
+    time grid lands)."""
     # The zone ends have their own budget whatever tol is (issue 13): half of it for the
     # panel rule (core/contact/kinks.py takes the kinks at the ends out of its error), the
     # rest, or at least the other half, for the time grid; likewise tol / 3 of the outputs
@@ -203,22 +207,23 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
     first: dict[str, Any] = {}
     base, space_error, space_shift, band_note = _select_rule(marches, times, res,
                                                              first_steps, tol, end_tol,
-                                                             first=first)
+                                                             first=first, jumps=jumps)
     out, time_error, end_shift, run = _in_time(
         marches, times, base, first_steps,
         max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
-        max(end_tol - space_shift, end_tol / 2), first)
+        max(end_tol - space_shift, end_tol / 2), first, jumps)
     strays = marches.strays(out, band_note["bands"])
     if strays:
         # An end went where the first march did not see it (between its few times, or as
         # a zone opening late): the bands of every output time, and everything again.
         bands = marches.bands(out, band_note["bands"])
         base, space_error, space_shift, band_note = _select_rule(
-            marches, times, res, first_steps, tol, end_tol, bands=bands, first=first)
+            marches, times, res, first_steps, tol, end_tol, bands=bands, first=first,
+            jumps=jumps)
         out, time_error, end_shift, run = _in_time(
             marches, times, base, first_steps,
             max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
-            max(end_tol - space_shift, end_tol / 2), first)
+            max(end_tol - space_shift, end_tol / 2), first, jumps)
         strays = marches.strays(out, band_note["bands"])
     error = float(time_error + space_error)
     end_error = float(end_shift + space_shift)
@@ -227,8 +232,8 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
 
 
 def _in_time(marches: Any, times: np.ndarray, base: Any, first_steps: int, budget: float,
-             end_budget: float, first: dict[str, Any] | None = None
-             ) -> tuple[dict[str, Any], float, float, dict[str, Any]]:
+             end_budget: float, first: dict[str, Any] | None = None,
+             jumps: Sequence[float] = ()) -> tuple[dict[str, Any], float, float, dict[str, Any]]:
     """March on halved grids until the time estimate meets ``budget`` (what the panel
     rule left of tol / 3) and that of the zone ends ``end_budget`` (module notes):
     (outputs, their time error, the zone ends' time error, the last march)."""
@@ -236,7 +241,7 @@ def _in_time(marches: Any, times: np.ndarray, base: Any, first_steps: int, budge
     extrapolated: list[dict[str, Any]] = []
     time_error = end_shift = np.inf
     for level in range(MAX_HALVINGS + 1):
-        grid, widths, index = time_grid(times, first_steps, level)
+        grid, widths, index = time_grid(times, first_steps, level, jumps)
         # the first grid borrows the kink corrections of the second (_borrow_corrections)
         outputs, run = marches.run(base, grid, widths, index, exact_ends=level > 0,
                                    first=first)
@@ -284,8 +289,8 @@ def _check_times(times: np.ndarray, count: int = 0) -> np.ndarray:
 
 
 def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, tol: float,
-                 end_tol: float, bands: Any = None, first: dict[str, Any] | None = None
-                 ) -> tuple[Any, float, float, dict[str, Any]]:
+                 end_tol: float, bands: Any = None, first: dict[str, Any] | None = None,
+                 jumps: Sequence[float] = ()) -> tuple[Any, float, float, dict[str, Any]]:
     """The panel rule of the stepping and its spatial error (outputs, zone ends).
 
     On the first time grid of a few of the output times: a march on the base rule finds
@@ -297,7 +302,7 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     what success asks; or ``BAND_WIDTHS`` run out).
     """
     check = _check_times(times)
-    grid, widths, index = time_grid(check, first_steps, 0)
+    grid, widths, index = time_grid(check, first_steps, 0, jumps)
 
     def check_march(rule: Any) -> dict[str, Any]:
         return marches.run(rule, grid, widths, index, first=first)[0]
@@ -307,7 +312,7 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     # preset), at a quarter of the cost of a check march.
     if bands is None:
         locate = _check_times(times, LOCATE_OUTPUTS)
-        grid_l, widths_l, index_l = time_grid(locate, first_steps, 0)
+        grid_l, widths_l, index_l = time_grid(locate, first_steps, 0, jumps)
         located = marches.run(marches.locating(res), grid_l, widths_l, index_l,
                               exact_ends=False, first=first)[0]
         bands = marches.bands(located)

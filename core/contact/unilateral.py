@@ -52,7 +52,8 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
                      settlement: Scalar | None = None, tilt: Scalar | None = None,
                      force: Scalar | None = None, moment: Scalar | None = None,
                      breakpoints: Sequence[float] = (), tol: float = 1e-8,
-                     time_steps: int | None = None) -> UnilateralSolution:
+                     time_steps: int | None = None,
+                     time_breaks: Sequence[float] = ()) -> UnilateralSolution:
     """Solve the dimensionless problem with unilateral contact (the punch may lift off).
 
     Arguments as :func:`core.solver.solve_dimensionless` (all dimensionless): ``lam`` =
@@ -62,6 +63,8 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
     where m or g may jump; ``tol`` for delta, alpha, P, M (relative, as in the solver).
     ``time_steps``: nominal steps of the first creep grid over ``[1, times[-1]]`` (default
     ``core.contact.creep.FIRST_STEPS``; the grid is then halved until ``tol`` is met).
+    ``time_breaks``: times where a given load jumps (under creep, no time step straddles
+    one; elastic answers read each time on its own).
 
     Returns a :class:`UnilateralSolution` whose ``contact_set`` gives the contact zones
     at each time (free ends located to ``ZONE_END_TOL`` half-widths on an elastic base).
@@ -90,7 +93,8 @@ def solve_unilateral(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | 
         from core.contact.creep import solve_creep
 
         out = solve_creep(space, inp, c_t, loads, creep_resolution(inp.lam, inp.m),
-                          **({} if time_steps is None else {"first_steps": time_steps}))
+                          **({} if time_steps is None else {"first_steps": time_steps}),
+                          jumps=tuple(float(b) for b in time_breaks))
     out["info"]["seconds"] = _time.perf_counter() - started
     return UnilateralSolution(times_arr.copy(), out["settlement"], out["tilt"], out["force"],
                               out["moment"], out["contact_set"], out["info"], space,

@@ -370,3 +370,23 @@ def test_pressure_outside_the_contact_is_refused():
     sol = solve_collocation(**GOOD, panels_per_unit=4, edge_width=1e-2)
     with pytest.raises(ValueError, match="x: "):
         sol.pressure([1.5])
+
+
+def test_a_time_grid_lands_on_both_sides_of_every_load_jump():
+    # no step straddles a jump: the grid holds its two sides (1e-12 relative apart), an
+    # output on a jump is its side after it, and without jumps the grid is as it was
+    from core.time.radau import JUMP_SIDE
+
+    times = np.array([1.0, 2.0, 5.0, 10.0])
+    plain = time_grid(times, 4, 1)
+    grid, widths, index = time_grid(times, 4, 1, jumps=[3.0, 5.0, 12.0])
+    for jump in (3.0, 5.0):
+        side = JUMP_SIDE * jump
+        assert np.any(np.abs(grid - (jump - side)) <= 1e-15)
+        assert np.any(np.abs(grid - (jump + side)) <= 1e-15)
+        assert not np.any((grid[:-1] < jump - side) & (grid[1:] > jump + side))
+    assert grid[index[2]] == pytest.approx(5.0 + JUMP_SIDE * 5.0, abs=1e-15)
+    assert np.array_equal(grid[index[[0, 1, 3]]], times[[0, 1, 3]])
+    assert np.allclose(np.diff(grid), widths, rtol=0, atol=1e-13)
+    assert all(np.array_equal(a, b) for a, b in zip(time_grid(times, 4, 1, jumps=[]), plain,
+                                                   strict=True))

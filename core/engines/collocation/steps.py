@@ -11,13 +11,14 @@ estimate of the relative error in time. All quantities dimensionless.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve, rsf2csf, schur, solve_triangular
 
 from core.discretize import Panels
+from core.time.radau import JUMP_SIDE
 
 #: Coarsest nominal grid of the automatic time refinement, and the finest allowed.
 FIRST_STEPS = 16
@@ -209,8 +210,8 @@ class CollocationSystem:
                        effective, nodal)
 
 
-def time_grid(times: np.ndarray, steps: int,
-              refine: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def time_grid(times: np.ndarray, steps: int, refine: int = 0,
+              jumps: Sequence[float] = ()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A grid on ``[1, times[-1]]`` containing every requested time (dimensionless t).
 
     The nominal step is ``(times[-1] - 1) / steps``; each interval between consecutive
@@ -220,25 +221,48 @@ def time_grid(times: np.ndarray, steps: int,
     step) keeps the trapezoid error expansion in even powers of one step, which is what
     Richardson extrapolation needs. Returns the grid (G,), the step lengths (G-1,),
     exactly equal within an interval, and the grid index of each requested time.
+
+    ``jumps``: times where a given load jumps. No step straddles one: the grid holds both
+    of its sides, ``JUMP_SIDE`` (relative) before and after it, so the loads are read on
+    each side of the jump and the trapezoid's error keeps its expansion on either side (a
+    step across a jump erred to first order: the halved grids' difference was no
+    estimate). A requested time on a jump is its side after it.
     """
     times = np.asarray(times, dtype=float)
     h = (times[-1] - 1.0) / steps
+    # the ends of the intervals: (time, index of the requested time or -1)
+    ends: list[tuple[float, int]] = []
+    inside = sorted({float(j) for j in jumps if 1.0 < float(j) < float(times[-1])})
+    on_jump: dict[int, int] = {}
+    for j in inside:
+        side = JUMP_SIDE * max(1.0, abs(j))
+        ends += [(j - side, -1), (j + side, -1)]
+        hit = np.flatnonzero(np.abs(times - j) <= side)
+        if hit.size:
+            on_jump[int(hit[0])] = len(ends) - 1
+    ends += [(float(t), k) for k, t in enumerate(times) if k not in on_jump]
+    order = sorted(range(len(ends)), key=lambda i: ends[i][0])
     points = [1.0]
     widths: list[float] = []
-    index = []
+    index = np.zeros(times.size, dtype=int)
     start = 1.0
-    for t in times:
-        length = float(t) - start
+    for i in order:
+        t, k = ends[i]
+        length = t - start
         if length > 0.0:
             count = max(1, math.ceil(length / h - 1e-9)) * 2**refine
             points.extend(start + length * np.arange(1, count + 1) / count)
-            points[-1] = float(t)
+            points[-1] = t
             # One width per interval, not np.diff of the points: equal widths keep the
             # step matrix bit-identical, so its factorization is reused.
             widths.extend([length / count] * count)
-        index.append(len(points) - 1)
-        start = float(t)
-    return np.array(points), np.array(widths), np.array(index)
+            start = t
+        if k >= 0:
+            index[k] = len(points) - 1
+        for out, end in on_jump.items():
+            if end == i:
+                index[out] = len(points) - 1
+    return np.array(points), np.array(widths), index
 
 
 def fixed_grids(system: CollocationSystem, times: np.ndarray, steps: int,
