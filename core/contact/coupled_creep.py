@@ -381,12 +381,14 @@ def punch_outputs(run: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeInputs],
-                        first_steps: int = FIRST_STEPS) -> list[UnilateralSolution]:
+                        first_steps: int = FIRST_STEPS,
+                        time_breaks: Sequence[float] = ()) -> list[UnilateralSolution]:
     """Lift-off of several punches on one creeping base (see the module notes).
 
     ``punches`` and ``inputs`` as for :func:`core.contact.solve_unilateral_punches`, on
     one creeping base (every ``kernel`` set; the same times, ``c`` and kernel).
-    ``first_steps``: nominal steps of the first time grid. Returns one
+    ``first_steps``: nominal steps of the first time grid; ``time_breaks``: times where a
+    given load of any punch jumps (no time step straddles one). Returns one
     :class:`core.contact.result.UnilateralSolution` per punch (its own scaling,
     ``contact_set`` in its own coordinates). Raises ValueError naming ``punches[k]``
     when its loads leave it no contact.
@@ -405,7 +407,8 @@ def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeI
     res = Resolutions(tuple(creep_resolution(s.lam, s.m) for s in base.spaces))
     marches = CoupledMarches(base, inputs, [one.loads for one in inputs], tol)
     (rules, out, run, band_note, strays, error, end_error, time_error,
-     space_error) = controlled_march(marches, times, tol, res, first_steps)
+     space_error) = controlled_march(marches, times, tol, res, first_steps,
+                                     tuple(float(b) for b in time_breaks))
     success, flags, message = creep_verdict(error, end_error, time_error, space_error, run,
                                             strays, tol,
                                             f"under creep ({len(base.punches)} punches)")

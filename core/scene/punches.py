@@ -248,7 +248,13 @@ def _lift_off(scene: PunchesScene, geometries: list[PunchGeometry],
     _check_touch(scene)
     if inputs[0].kernel is None:
         return solve_unilateral_punches(geometries, inputs)
-    return solve_creep_punches(geometries, inputs)
+    return solve_creep_punches(geometries, inputs, time_breaks=_time_breaks(scene))
+
+
+def _time_breaks(scene: PunchesScene) -> tuple[float, ...]:
+    """Where any punch's given loads jump or kink (a punch loaded later): every time grid
+    lands on each of them."""
+    return tuple(sorted({b for sub in scene.scenes for b in sub.dimensionless.time_breaks}))
 
 
 class PunchSolution(SceneSolution):
@@ -383,11 +389,7 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
             if first.contact == "unilateral":
                 answers = _lift_off(scene, geometries, inputs)
             else:
-                # where any punch's given loads jump or kink (a punch loaded later):
-                # the time steps land on each of them
-                breaks = sorted({b for sub in scene.scenes
-                                 for b in sub.dimensionless.time_breaks})
-                answers = solve_punches(geometries, inputs, tuple(breaks))
+                answers = solve_punches(geometries, inputs, _time_breaks(scene))
                 for answer in answers:
                     answer.info["contact"] = "full"
                 lost = [k for k, a in enumerate(answers) if "contact_lost" in a.info["flags"]]
