@@ -6,7 +6,9 @@ and ``solve_general`` (any kernel); the steppers behind them:
 - ``exponential.py``, ``exponential_weights.py``, ``exponential_modes.py``: exponential
   collocation for kernels that are sums of exponentials (the default; error from three
   grids);
-- ``radau.py``: adaptive Radau IIA, the fallback and the reference;
+- ``radau.py``: adaptive Radau IIA, the fallback and the reference; ``JUMP_SIDE``, how
+  far from a load's jump each side of it is read (the time grids of the contact march
+  hold both sides);
 - ``product_quadrature.py``: a general kernel by the product trapezoid rule with
   Richardson extrapolation;
 - ``volterra.py``: the problem and solution types the steppers share.
@@ -16,9 +18,11 @@ from __future__ import annotations
 
 from core.time.integration import solve_degenerate
 from core.time.product_quadrature import solve_general
+from core.time.radau import JUMP_SIDE
 from core.time.volterra import ModalProblem
 
 __all__ = [
+    "JUMP_SIDE",
     "ModalProblem",
     "solve_degenerate",
     "solve_general",

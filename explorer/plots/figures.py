@@ -199,21 +199,15 @@ class Figures:
             cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted",
                           level=MOVING)
             p.add_layout(cursor)
-            # the lines of several punches and a fit's readings are made when first drawn
-            # (_punch_lines, _readings): with them a page held 43 plot renderers where it
-            # shows 19 (~220 of its 1015 Bokeh models, which the server builds and the
-            # browser renders for every page)
+            # a fit's readings are made when first drawn (_readings): 8 plot renderers and
+            # their sources, ~70 of a page's Bokeh models, which the server builds and the
+            # browser renders for every page. The lines of several punches are made here:
+            # made later, their legend found no view in the page (BokehJS)
+            self._build_punch_lines(p, q, unit)
             self.history_src[q] = src
             self.history_point_src[q] = point
             self.history_fig[q], self.history_line[q] = p, line
             self.history_cursor[q] = cursor
-
-    def _punch_lines(self) -> None:
-        """The lines of several punches on every history, made at the first result of
-        several punches (:meth:`_build_punch_lines`)."""
-        if not self.punch_history_src:
-            for q in QUANTITIES:
-                self._build_punch_lines(self.history_fig[q], q, QUANTITY_UNITS[q][0])
 
     def _readings(self) -> None:
         """The readings and forecast of a fit on its histories, made when a fit's readings
@@ -243,12 +237,6 @@ class Figures:
     def _show_punch_histories(self, view: ResultView) -> None:
         """A line per punch on each history (several punches), or none (one punch)."""
         n = len(view.punches)
-        if n:
-            self._punch_lines()
-        elif not self.punch_history_src:
-            for q in QUANTITIES:
-                self.history_line[q].visible = True
-            return
         for q in QUANTITIES:
             for k, (src, line) in enumerate(zip(self.punch_history_src[q],
                                                 self.punch_history_line[q], strict=True)):

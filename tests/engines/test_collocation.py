@@ -375,7 +375,7 @@ def test_pressure_outside_the_contact_is_refused():
 def test_a_time_grid_lands_on_both_sides_of_every_load_jump():
     # no step straddles a jump: the grid holds its two sides (1e-12 relative apart), an
     # output on a jump is its side after it, and without jumps the grid is as it was
-    from core.time.radau import JUMP_SIDE
+    from core.time import JUMP_SIDE
 
     times = np.array([1.0, 2.0, 5.0, 10.0])
     plain = time_grid(times, 4, 1)

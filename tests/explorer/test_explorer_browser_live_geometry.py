@@ -54,17 +54,14 @@ def test_a_geometry_drag_on_a_creep_preset_draws_while_the_handle_moves(page: Pa
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
     page.page.mouse.move(x, y)
     page.page.mouse.down()
-    start = time.monotonic()
-    for k in range(1, 21):  # 20 moves of 2 px, 50 ms apart: a 1 s drag
-        time.sleep(max(0.0, start + 0.05 * k - time.monotonic()))
-        page.page.mouse.move(x + 2 * k, y)
+    held = page.page.evaluate(CHANGES)
+    for k in range(1, 6):  # a few moves of 4 px, then the handle is held still
+        page.page.mouse.move(x + 4 * k, y)
+        time.sleep(0.05)
+    # while the button is still down the plot follows the handle (on release only, it
+    # would wait for the mouse up: measured 11-14 frames in a 1 s drag on a quiet
+    # machine, benchmarks/explorer_latency.py)
+    until(lambda: page.page.evaluate(CHANGES) > held, "a frame while the handle is held",
+          timeout=60)
     page.page.mouse.up()
-    down, up = page.page.evaluate("() => [window.__down, window.__up]")
-    # the last drag step's answer, after the release
-    until(lambda: any(t > up for t in page.page.evaluate("() => window.__changes")),
-          "the answer after the release", timeout=60)
-    during = [t for t in page.page.evaluate("() => window.__changes") if down < t <= up]
-    # measured 11-14 frames in a 1 s drag (benchmarks/explorer_latency.py); a loaded
-    # machine draws fewer, but more than none
-    assert len(during) >= 1, during
     assert page.errors == []

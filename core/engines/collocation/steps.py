@@ -18,7 +18,7 @@ import numpy as np
 from scipy.linalg import lu_factor, lu_solve, rsf2csf, schur, solve_triangular
 
 from core.discretize import Panels
-from core.time.radau import JUMP_SIDE
+from core.time import JUMP_SIDE
 
 #: Coarsest nominal grid of the automatic time refinement, and the finest allowed.
 FIRST_STEPS = 16
