@@ -17,7 +17,7 @@ from core.report import report_html, report_pdf, sections
 from core.report.content import key_numbers
 from core.report.punches import local_view
 from core.scene import PunchesSolution
-from tests.conftest import scene_file
+from tests.support.punch_pairs import wide_and_narrow
 
 CREEP = {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11, "rate": 0.05}
 
@@ -25,14 +25,7 @@ CREEP = {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11, "rate
 def _pair(**extra: Any) -> dict[str, Any]:
     """Two punches on a creeping base: a wide one under a force and a moment, a narrow
     one held level under a force (its moment changes as the base creeps)."""
-    d = scene_file("uniform_flat")
-    d["base"]["creep"] = dict(CREEP)
-    d["times"] = {"end": 365.0, "count": 6, "spacing": "log"}
-    del d["punch"], d["loading"]
-    d["punches"] = [
-        {"center": -1.5, "half_width": 1.0, "loading": {"force": 5e5, "moment": 2e4}},
-        {"center": 1.5, "half_width": 0.6, "loading": {"tilt": 0, "force": 3e5}}]
-    return d | extra
+    return wide_and_narrow(CREEP, {"end": 365.0, "count": 6, "spacing": "log"}) | extra
 
 
 @pytest.fixture(scope="module")

@@ -16,7 +16,11 @@ from core.contact.zones import ZONE_END_TOL
 from core.work import work_bound
 from tests.conftest import scene_file
 from tests.scene.test_punches import QUANTITIES, _base, _creeping, _pair, _single
-from tests.scene.test_punches_liftoff import LIFTING, _errors, _relative
+from tests.scene.test_punches_liftoff import (
+    LIFTING,
+    _errors,
+    assert_lift_off_in_mirror,
+)
 
 #: Punch 1 of :func:`_pair` lifts its right edge off under this load (e = -0.56 a).
 LIFTING_RIGHT = {"force": 3e5, "moment": -1e5}
@@ -106,17 +110,7 @@ def test_a_mirrored_pair_lifts_off_in_mirror_as_the_base_creeps() -> None:
     assert "contact_lost" in left.info["full_contact"]["flags"]
     # measured: settlement 5.1e-15, tilt 5.6e-15 of the largest, zone ends 2.0e-15 m,
     # q 6.4e-15 (mirrored rules, equal to rounding)
-    np.testing.assert_allclose(left.settlement, right.settlement, rtol=1e-12)
-    np.testing.assert_allclose(left.tilt, -right.tilt, rtol=0,
-                               atol=1e-12 * np.max(np.abs(left.tilt)))
-    for zl, zr in zip(left.contact_set, right.contact_set, strict=True):
-        mirrored = [(-hi, -lo) for lo, hi in reversed(zr)]
-        np.testing.assert_allclose(np.ravel(zl), np.ravel(mirrored), rtol=0, atol=1e-12)
-    x = np.linspace(-1.0, 1.0, 101)
-    assert _relative(left.pressure(x), right.pressure(-x)) < 1e-12
-    assert left.contact_set[0] == [pytest.approx((-2.2, -0.2))]  # no moment: full contact
-    lo, hi = left.contact_set[-1][0]
-    assert -2.2 < lo and hi == pytest.approx(-0.2)  # each lifts its outer heel
+    assert_lift_off_in_mirror(left, right)
     assert np.all(left.tilt[1:] > 0) and np.all(np.diff(left.tilt) > 0)
 
 

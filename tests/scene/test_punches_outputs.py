@@ -15,20 +15,13 @@ import core
 from core import limits
 from core.scene import PunchesSolution
 from core.scene.punches_output import EDGE_ROUNDING
-from tests.conftest import scene_file
+from tests.support.punch_pairs import ELASTIC, wide_and_narrow
 
 
 def _pair(**extra: Any) -> dict[str, Any]:
     """Two punches 1.9 m apart on an elastic base: a wide one under a force and a moment,
     a narrow one held level under a force."""
-    d = scene_file("uniform_flat")
-    d["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
-    d["times"] = {"end": 10.0, "count": 3}
-    del d["punch"], d["loading"]
-    d["punches"] = [
-        {"center": -1.5, "half_width": 1.0, "loading": {"force": 5e5, "moment": 2e4}},
-        {"center": 1.5, "half_width": 0.6, "loading": {"tilt": 0, "force": 3e5}}]
-    return d | extra
+    return wide_and_narrow(ELASTIC, {"end": 10.0, "count": 3}) | extra
 
 
 @pytest.fixture(scope="module")

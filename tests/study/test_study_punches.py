@@ -18,6 +18,7 @@ from core.study import study_from_dict, sweep
 from core.study.definition import apply_point
 from tests.cli_runs import run_cli
 from tests.conftest import scene_file
+from tests.support.punch_pairs import ELASTIC, wide_and_narrow
 
 #: Centres of the narrow punch: gaps of 0.9, 3.9, 15.9 and 39.9 m to the wide one, about
 #: 0.2, 1, 4 and 10 base thicknesses (H = 4 m).
@@ -27,14 +28,7 @@ CENTRES = [1.0, 4.0, 16.0, 40.0]
 def _pair() -> dict[str, Any]:
     """A wide punch under a force and a moment at -1.5 m, a narrow one held level under a
     force to its right, on an elastic base."""
-    d = scene_file("uniform_flat")
-    d["base"]["creep"] = {"model": "elastic", "modulus": 3.0e10}
-    d["times"] = {"end": 10.0, "count": 2}
-    del d["punch"], d["loading"]
-    d["punches"] = [
-        {"center": -1.5, "half_width": 1.0, "loading": {"force": 5e5, "moment": 2e4}},
-        {"center": 1.5, "half_width": 0.6, "loading": {"tilt": 0, "force": 3e5}}]
-    return d
+    return wide_and_narrow(ELASTIC, {"end": 10.0, "count": 2})
 
 
 def _spacing_study(**extra: Any) -> dict[str, Any]:

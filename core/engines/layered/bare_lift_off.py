@@ -30,9 +30,10 @@ radius at the gap's lowest point, or from the best of a scan of zones). A creepi
 aging bare base is answered on the elastic zone where the loads keep their ratio
 (:mod:`core.engines.layered.answer`).
 
-The error: the zone's own solve (its mode truncation, as :func:`solve_layered` estimates
-it) and the zone's end, found again with half the modes: the answers' change between the
-two ends, extrapolated as the modes' (``MAX_RATIO``).
+The error: the zone's own mode truncation (``truncation_errors`` of
+:mod:`core.engines.layered.solve`, as a full-contact solve estimates it) and the zone's
+end, found again with half the modes: the answers' change between the two ends,
+extrapolated as the modes' (``MAX_RATIO``).
 """
 
 from __future__ import annotations
@@ -42,13 +43,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.engines.layered.cache import LAYERED_TABLE, stack_key
-from core.engines.layered.galerkin import MAX_MODES, table_degree
+from core.engines.layered.galerkin import COARSE_TOL, MAX_MODES, table_degree
 from core.engines.layered.solve import (
+    COARSE_ERROR_FLOOR,
+    ERROR_FLOOR,
     MAX_RATIO,
     Gap,
     LayeredResponse,
     layered_response,
-    solve_layered,
+    truncation_errors,
 )
 from core.kernel import RegularPartTable
 
@@ -263,7 +266,7 @@ def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
 def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
                given: dict[str, float], free: int, modes: int, table: RegularPartTable,
                tol: float) -> ZoneAnswer:
-    thickness, modulus, poisson = base
+    floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
     while True:
         zones = _Zones(half_width, base, gap, modes, table, tol)
         if free == 2:
@@ -276,9 +279,10 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
         response = zones.response(lo, hi)
         delta, alpha, values = _kinematics(response, x0, b, given)
         # the zone's own truncation error, as the full-contact solve estimates it
-        own = solve_layered(b * half_width, [], thickness, modulus, poisson,
-                            {"settlement": np.array([delta]), "tilt": np.array([alpha])},
-                            gap=zones.sub_gap(x0, b), tol=tol, max_modes=modes)
+        own = max(truncation_errors(
+            response, {"settlement": np.array([delta]), "tilt": np.array([alpha])},
+            response.complete({"settlement": np.array([delta]),
+                               "tilt": np.array([alpha])}), floor).values())
         # the ends': the answers on the ends found with half the modes
         _, _, coarse = _kinematics(zones.response(clo, chi), 0.5 * (clo + chi),
                                    0.5 * (chi - clo), given, level=1)
@@ -287,7 +291,7 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
         change = max(abs(values[n] - coarse[n]) / (kin if n in ("settlement", "tilt") else stat)
                      for n in _NAMES if n not in given)
         extrapolate = MAX_RATIO / (1.0 - MAX_RATIO)
-        error = max(own.error_estimate, extrapolate * change)
+        error = max(own, extrapolate * change)
         end_error = extrapolate * max(abs(lo - clo), abs(hi - chi))
         if error <= 0.5 * tol or 2 * modes > MAX_MODES:
             return ZoneAnswer(lo, hi, free, response, delta, alpha, values, float(error),

@@ -292,6 +292,21 @@ def _differences(response: LayeredResponse, given: dict[str, np.ndarray],
     return out
 
 
+def truncation_errors(response: LayeredResponse, given: dict[str, np.ndarray],
+                      fine: dict[str, np.ndarray], floor: float) -> dict[str, float]:
+    """The estimated error of each unknown and of q of ``response`` for the ``given``
+    loads (``fine``: its answer, :meth:`LayeredResponse.complete`): ``d1 r / (1 - r)``
+    from the differences ``d1`` of the answer with half the modes and ``d0`` of half
+    against a quarter, ``r = min(d1 / d0, MAX_RATIO)``, at least ``floor``."""
+    d1 = _differences(response, given, fine, level=1)
+    d0 = _differences(response, given, fine, level=2)
+    errors = {}
+    for name in [n for n in _NAMES if n not in given] + ["pressure"]:
+        ratio = min(d1[name] / d0[name], MAX_RATIO) if d0[name] > 0 else MAX_RATIO
+        errors[name] = max(d1[name] * ratio / (1 - ratio), floor)
+    return errors
+
+
 def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickness: float,
                   base_modulus: float, base_poisson: float, given: dict[str, np.ndarray],
                   gap: Gap = None, breakpoints: Sequence[float] = (), *,
@@ -324,18 +339,12 @@ def solve_layered(half_width: float, layers: Sequence[UniformLayer], base_thickn
     floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
     built: dict[str, float] = {}
     start = time.perf_counter()
-    unknowns = [n for n in _NAMES if n not in given]
     while True:
         response = cached_response(half_width, layers, base_thickness, base_modulus,
                                     base_poisson, gap, breakpoints, modes, keys, built,
                                     tol=tol, room=room)
         fine = response.complete(given)
-        d1 = _differences(response, given, fine, level=1)
-        d0 = _differences(response, given, fine, level=2)
-        errors = {}
-        for name in unknowns + ["pressure"]:
-            ratio = min(d1[name] / d0[name], MAX_RATIO) if d0[name] > 0 else MAX_RATIO
-            errors[name] = max(d1[name] * ratio / (1 - ratio), floor)
+        errors = truncation_errors(response, given, fine, floor)
         estimate = max(errors.values())
         if estimate <= 0.5 * tol or 2 * modes > max_modes:
             break
