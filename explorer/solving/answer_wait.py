@@ -18,6 +18,7 @@ Nothing here imports Panel.
 
 from __future__ import annotations
 
+import array
 import asyncio
 from collections.abc import Callable
 
@@ -56,8 +57,11 @@ def when_answered(sent: SentRequest, on_answer: Callable[[], None],
             loop.remove_reader(fd)
         try:
             # a pipe whose worker ended reads as ready too (its end): the thread's way
-            # tells the two apart and replaces the worker
-            answered = connection.poll(0) and lane.process.is_alive()
+            # tells the two apart and replaces the worker. Just after the worker is killed
+            # its pipe's end can be read before the process is seen to have ended (on a
+            # loaded machine): an answer has bytes waiting, the end has none
+            answered = (connection.poll(0) and lane.process.is_alive()
+                        and _bytes_waiting(connection.fileno()))
         except (OSError, EOFError, ValueError):  # the pipe closed (a shutdown)
             answered = False
         (on_answer if answered else on_other)()
@@ -72,3 +76,19 @@ def when_answered(sent: SentRequest, on_answer: Callable[[], None],
             loop.remove_reader(fd)
         return False
     return True
+
+
+def _bytes_waiting(fd: int) -> bool:
+    """Whether bytes wait to be read on the pipe ``fd`` (True where that cannot be asked:
+    then the process's state alone decides)."""
+    try:
+        import fcntl
+        import termios
+    except ImportError:  # not a POSIX system
+        return True
+    count = array.array("i", [0])
+    try:
+        fcntl.ioctl(fd, termios.FIONREAD, count, True)
+    except OSError:
+        return True
+    return count[0] > 0
