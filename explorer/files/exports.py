@@ -25,7 +25,14 @@ import numpy as np
 import core
 from core.scene import provenance_lines
 
-from ..model import OUTPUTS, QUANTITIES, QUANTITY_UNITS, ResultView, StudyResult, contact_widths
+from ..model import (
+    PUNCH_OUTPUT,
+    QUANTITIES,
+    QUANTITY_UNITS,
+    ResultView,
+    StudyResult,
+    contact_widths,
+)
 
 #: Significant digits of every number in a CSV file.
 DIGITS = 10
@@ -189,7 +196,8 @@ def study_csv(result: StudyResult) -> str:
         lines.append(f"# varied: {c.label} [{c.unit}] from {number(v[0])} to "
                      f"{number(v[-1])}, {len(v)} values")
     header = [_study_column(c.label, c.unit) for c in planned.choices] + ["time_day"]
-    header += [_study_column(name, unit) for name, (_, unit, _) in OUTPUTS.items()]
+    header += [_study_column(_output_column(name), unit)
+               for name, (_, unit, _) in planned.outputs.items()]
     lines.append(",".join(header + ["flags", "error"]))
     grids = np.meshgrid(*planned.values, indexing="ij")
     for index in np.ndindex(planned.shape):
@@ -198,11 +206,18 @@ def study_csv(result: StudyResult) -> str:
         error = '"' + str(result.errors[index]).replace('"', '""') + '"'
         for k, t in enumerate(result.times):
             row = params + [number(float(t))]
-            for name, (_, _, factor) in OUTPUTS.items():
+            for name, (_, _, factor) in planned.outputs.items():
                 value = float(result.outputs[name][index + (k,)])
                 row.append(number(value * factor) if math.isfinite(value) else "")
             lines.append(",".join(row + [flags, error]))
     return "\n".join(lines) + "\n"
+
+
+def _output_column(key: str) -> str:
+    """An output's CSV name: its key (``settlement``), or of a punch of several
+    ``punches[1].tilt`` -> ``punch 2 tilt`` (punches counted from 1, as on the page)."""
+    match = PUNCH_OUTPUT.fullmatch(key)
+    return key if match is None else f"punch {int(match[1]) + 1} {match[2]}"
 
 
 def _study_column(label: str, unit: str) -> str:

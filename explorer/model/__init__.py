@@ -79,6 +79,7 @@ from .state import MODEL_TOL_RANGE, ExplorerState
 from .study import (
     MAX_POINTS,
     OUTPUTS,
+    PUNCH_OUTPUT,
     SPACINGS,
     Axis,
     PlannedStudy,
@@ -86,14 +87,16 @@ from .study import (
     default_range,
     plan_study,
     study_choices,
+    study_outputs,
 )
 from .time_text import days_text, plain_number
 from .view_link import read_study_query, read_view_query, view_query
 
 __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
            "MAX_DESCRIPTION_CHARS", "MAX_FIT_FIELDS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS",
-           "MODEL_TOL_RANGE", "ORDER", "OUTPUTS", "QUANTITIES", "QUANTITY_RANGES",
-           "QUANTITY_UNITS", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS", "STRENGTH_CLASSES",
+           "MODEL_TOL_RANGE", "ORDER", "OUTPUTS", "PUNCH_OUTPUT", "QUANTITIES",
+           "QUANTITY_RANGES", "QUANTITY_UNITS", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS",
+           "STRENGTH_CLASSES",
            "Axis", "CodeCreepState", "DesignLimits", "DisplayScales", "ExplorerState",
            "FitOutcome", "Geometry", "HistoryState", "LayerState", "Lesson", "Pin", "PinBoard",
            "PlannedStudy", "PunchEntryState", "PunchResult", "SCREEN_PUNCHES", "ProfileState",
@@ -105,5 +108,5 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "plain_number", "plan_fit", "plan_study", "read_upload", "readings_columns",
            "readings_note", "run_fit", "prepare_view", "preset_label", "presets",
            "read_study_query", "read_view_query", "shown_flags", "scene_limits",
-           "scene_with_limits", "screen_limits", "step_scene", "study_choices", "validated_scene",
-           "view_query"]
+           "scene_with_limits", "screen_limits", "step_scene", "study_choices", "study_outputs",
+           "validated_scene", "view_query"]

@@ -8,6 +8,10 @@ naming the field of the tab, e.g. ``parameter 2, points: ...``), and a
 point. Running it is :mod:`explorer.solving.study_runner`'s job; its CSV file is
 :func:`explorer.files.exports.study_csv`.
 
+A scene of several punches (``punches``) is studied as one of a punch: its punches'
+centres (the spacing), half-widths and loads are offered besides the coating and base,
+and every output is one punch's (``punches[k].settlement``, :func:`study_outputs`).
+
 Nothing here imports Panel (the study's process imports this module).
 """
 
@@ -16,7 +20,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -41,6 +45,8 @@ OUTPUTS: dict[str, tuple[str, str, float]] = {
     "q_min": ("smallest pressure q_min", "kPa", 1e-3),
     "contact_width": ("contact width", "m", 1.0),
 }
+#: An output of one punch of a scene of several: ``punches[k].<name of OUTPUTS>``.
+PUNCH_OUTPUT = re.compile(r"punches\[(\d{1,4})\]\.([a-z_]+)")
 #: The key of the derived parameter e = M/P (it sets ``loading.moment``).
 ECCENTRICITY = "eccentricity"
 SPACINGS = ("linear", "log")
@@ -53,6 +59,10 @@ _FIELDS: tuple[tuple[str, str, str, float], ...] = (
     (r"loading\.moment", "loading: moment M", "kN·m/m", 1e3),
     (r"loading\.settlement", "loading: settlement", "mm", 1e-3),
     (r"loading\.tilt", "loading: tilt", "mrad", 1e-3),
+    (r"punches\[(\d+)\]\.loading\.force", "punch {k}: force P", "kN/m", 1e3),
+    (r"punches\[(\d+)\]\.loading\.moment", "punch {k}: moment M", "kN·m/m", 1e3),
+    (r"punches\[(\d+)\]\.loading\.settlement", "punch {k}: settlement", "mm", 1e-3),
+    (r"punches\[(\d+)\]\.loading\.tilt", "punch {k}: tilt", "mrad", 1e-3),
     (r"coating\[(\d+)\]\.thickness", "coating {k}: thickness", "mm", 1e-3),
     (r"coating\[(\d+)\]\.modulus", "coating {k}: Young's modulus", "MPa", 1e6),
     (r"coating\[(\d+)\]\.poisson", "coating {k}: Poisson ratio", "-", 1.0),
@@ -61,6 +71,8 @@ _FIELDS: tuple[tuple[str, str, str, float], ...] = (
     (r"base\.thickness", "base: thickness H", "m", 1.0),
     (r"base\.poisson", "base: Poisson ratio", "-", 1.0),
     (r"punch\.half_width", "punch: half-width a", "m", 1.0),
+    (r"punches\[(\d+)\]\.center", "punch {k}: centre x", "m", 1.0),
+    (r"punches\[(\d+)\]\.half_width", "punch {k}: half-width a", "m", 1.0),
 )
 
 
@@ -103,6 +115,7 @@ class PlannedStudy:
     choices: tuple[Choice, ...]
     values: tuple[np.ndarray, ...]
     spacings: tuple[str, ...] = ()
+    outputs: dict[str, tuple[str, str, float]] = field(default_factory=lambda: dict(OUTPUTS))
 
     def is_log(self, k: int) -> bool:
         """Whether parameter ``k`` is spaced evenly in log."""
@@ -135,12 +148,59 @@ def study_choices(scene: Mapping[str, Any]) -> list[Choice]:
     return out
 
 
-def default_range(choice: Choice, half_width: float = 1.0) -> Axis:
+def study_outputs(scene: Mapping[str, Any]) -> dict[str, tuple[str, str, float]]:
+    """The outputs a study of ``scene`` computes, as :data:`OUTPUTS` (key: name on screen,
+    unit on screen, factor from SI): those of :data:`OUTPUTS` for a scene of one punch;
+    of a scene of several, each of them for every punch (``punches[k].settlement``:
+    "punch 1: settlement"), by punch."""
+    punches = scene.get("punches")
+    if not isinstance(punches, (list, tuple)):
+        return dict(OUTPUTS)
+    return {f"punches[{k}].{key}": (f"punch {k + 1}: {name}", unit, factor)
+            for k in range(len(punches)) for key, (name, unit, factor) in OUTPUTS.items()}
+
+
+def _room(scene: Mapping[str, Any], k: int) -> tuple[float, float]:
+    """The free surface on each side of punch ``k`` of a scene of several [m]: the gaps
+    to the nearest neighbour's edge on its left and its right (inf where it has none)."""
+    punches = scene["punches"]
+    c, a = float(punches[k]["center"]), float(punches[k]["half_width"])
+    left = right = math.inf
+    for j, other in enumerate(punches):
+        if j == k:
+            continue
+        cj, aj = float(other["center"]), float(other["half_width"])
+        if cj < c:
+            left = min(left, (c - a) - (cj + aj))
+        else:
+            right = min(right, (cj - aj) - (c + a))
+    return left, right
+
+
+def default_range(choice: Choice, half_width: float = 1.0,
+                  scene: Mapping[str, Any] | None = None) -> Axis:
     """A first range for ``choice`` around its value on screen (``half_width`` a [m]
     sizes the eccentricity and moment ranges when they are zero): moduli and the age over
     a decade each way (log), the Poisson ratio +-0.1, loads 0 to the middle third's edge
-    (e = a/3) when zero, anything else half to one and a half times its value."""
+    (e = a/3) when zero, anything else half to one and a half times its value. A punch's
+    centre of a scene of several (``scene`` given) moves away from its nearest
+    neighbour, from a quarter of the gap to four times it (the spacing's study); one
+    between two moves by half the smaller gap each way. A punch's half-width grows at
+    most to touching 90 % of the free room beside it."""
     v = choice.value
+    match = re.fullmatch(r"punches\[(\d+)\]\.(center|half_width)", choice.key)
+    if match is not None and scene is not None and "punches" in scene:
+        left, right = _room(scene, int(match[1]))
+        if match[2] == "half_width":
+            stop = v + 0.9 * min(left, right)  # both edges move by the growth
+            return Axis(choice.key, round(0.5 * v, 6), round(min(1.5 * v, stop), 6), 9)
+        if math.isfinite(left) and math.isfinite(right):
+            d = 0.5 * min(left, right)
+            return Axis(choice.key, round(v - d, 6), round(v + d, 6), 9)
+        if math.isfinite(left):  # the rightmost: further right
+            return Axis(choice.key, round(v - 0.75 * left, 6), round(v + 3 * left, 6), 9)
+        if math.isfinite(right):  # the leftmost: further left
+            return Axis(choice.key, round(v - 3 * right, 6), round(v + 0.75 * right, 6), 9)
     if choice.key.endswith(".modulus") or choice.key.endswith("modulus_final"):
         return Axis(choice.key, v / 10, v * 10, 9, "log")
     if choice.key == "base.age_at_loading":
@@ -215,13 +275,15 @@ def plan_study(scene: Mapping[str, Any], axes: Sequence[Axis],
             vary.append({"field": "loading.moment", "values": [float(e * force) for e in v]})
         else:
             vary.append({"field": c.key, "values": [float(x * c.scale) for x in v]})
+    outputs = study_outputs(scene)
     spec = {"study_version": 1, "name": f"{scene.get('name') or 'scene'}: study"[:200],
-            "scene": dict(scene), "vary": vary, "outputs": list(OUTPUTS)}
+            "scene": dict(scene), "vary": vary, "outputs": list(outputs)}
     try:
         study = study_from_dict(spec, max_points=max_points)
     except ValueError as exc:
         raise ValueError(_tab_message(str(exc), choices)) from None
-    return PlannedStudy(study, tuple(choices), values, tuple(a.spacing for a in axes))
+    return PlannedStudy(study, tuple(choices), values, tuple(a.spacing for a in axes),
+                        outputs)
 
 
 def _tab_message(message: str, choices: Sequence[Choice]) -> str:
@@ -252,7 +314,7 @@ class StudyResult:
         the last parameter fastest) on the grid."""
         shape = planned.shape
         outputs = {name: np.asarray(arrays[name], dtype=float).reshape(shape + (-1,))
-                   for name in OUTPUTS}
+                   for name in planned.outputs}
         return cls(planned, np.asarray(arrays["time"], dtype=float), outputs,
                    np.asarray(arrays["flags"], dtype=str).reshape(shape),
                    np.asarray(arrays["error"], dtype=str).reshape(shape),
@@ -270,4 +332,4 @@ class StudyResult:
 
     def shown(self, output: str, time_index: int) -> np.ndarray:
         """``output`` at output time ``time_index`` on the grid [screen units]."""
-        return self.outputs[output][..., time_index] * OUTPUTS[output][2]
+        return self.outputs[output][..., time_index] * self.planned.outputs[output][2]

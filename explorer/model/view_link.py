@@ -17,7 +17,8 @@ from typing import Any
 
 from .links import decode_scene, encode_scene
 from .pins import MAX_PINS
-from .study import MAX_POINTS, OUTPUTS, SPACINGS
+from .punches_state import SCREEN_PUNCHES
+from .study import MAX_POINTS, OUTPUTS, PUNCH_OUTPUT, SPACINGS
 
 #: Largest output-time index a link may ask for (the scene schema's limit is lower).
 MAX_INDEX = 100_000
@@ -47,7 +48,8 @@ def study_settings(settings: Any) -> dict[str, Any]:
     """The Study tab's settings checked: ``{"axes": [[key, from, to, points, spacing],
     ...], "output": key}`` (one or two axes; from and to in the units on screen, finite;
     points an integer in [2, MAX_POINTS]; spacing one of ``SPACINGS``; output one of
-    ``OUTPUTS``). Raises ValueError naming the setting and the reason."""
+    ``OUTPUTS``, or one of a punch of several, ``punches[k].<output>``). Raises ValueError
+    naming the setting and the reason."""
     if not isinstance(settings, dict):
         raise ValueError("the study settings are not a JSON object")
     axes = settings.get("axes")
@@ -75,8 +77,11 @@ def study_settings(settings: Any) -> dict[str, Any]:
                              f"{', '.join(SPACINGS)}")
         checked.append([key, float(start), float(stop), int(count), spacing])
     output = settings.get("output")
-    if output not in OUTPUTS:
-        raise ValueError(f"study output: must be one of {', '.join(OUTPUTS)}")
+    match = PUNCH_OUTPUT.fullmatch(output) if isinstance(output, str) else None
+    if output not in OUTPUTS and (match is None or match[2] not in OUTPUTS
+                                  or int(match[1]) >= SCREEN_PUNCHES):
+        raise ValueError(f"study output: must be one of {', '.join(OUTPUTS)}, or "
+                         f"punches[k].<one of them> (k from 0 to {SCREEN_PUNCHES - 1})")
     return {"axes": checked, "output": output}
 
 

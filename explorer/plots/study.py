@@ -22,7 +22,7 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from ..model import OUTPUTS, StudyResult, days_text
+from ..model import StudyResult, days_text
 
 #: Most tick labels along a heat map's axis.
 MAX_TICKS = 7
@@ -37,7 +37,7 @@ def fmt(value: float) -> str:
 
 def chart_title(result: StudyResult, output: str, time_index: int) -> str:
     """``settlement [mm] at t = 365 days``."""
-    name, unit, _ = OUTPUTS[output]
+    name, unit, _ = result.planned.outputs[output]
     return f"{name} [{unit}] at t = {days_text(float(result.times[time_index]))}"
 
 
@@ -141,7 +141,7 @@ class DesignChart:
         z = result.shown(output, time_index)
         flags = result.flags
         mark = result.flagged
-        name, unit, _ = OUTPUTS[output]
+        name, unit, _ = result.planned.outputs[output]
         self.shown.title.text = chart_title(result, output, time_index)
         if len(planned.values) == 1:
             x = planned.values[0]

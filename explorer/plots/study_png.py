@@ -16,7 +16,7 @@ import numpy as np
 from bokeh.palettes import Viridis256
 from PIL import Image, ImageDraw, ImageFont
 
-from ..model import OUTPUTS, StudyResult
+from ..model import StudyResult
 from .study import chart_title, flag_note, fmt, tick_indices
 
 #: Size of the picture [px].
@@ -66,7 +66,7 @@ def design_chart_png(result: StudyResult, output: str, time_index: int) -> bytes
     x0, y0, x1, y1 = _LEFT, _TOP, WIDTH - _RIGHT, HEIGHT - _BOTTOM
     planned = result.planned
     z = result.shown(output, time_index)
-    name, unit, _ = OUTPUTS[output]
+    name, unit, _ = result.planned.outputs[output]
     draw.text((_LEFT, 15), chart_title(result, output, time_index), fill=_INK, font=normal)
     scene = str(planned.study.base.get("name", ""))[:90]
     draw.text((_LEFT, HEIGHT - 28), f"{flag_note(result)} · scene: {scene}", fill=_INK,

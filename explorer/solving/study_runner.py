@@ -106,8 +106,10 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
         ds = sweep(planned.study, client="serial", batch_points=batch_points,
                    progress=progress)
         arrays = {name: ds[name].values for name in ("flags", "error")}
-        arrays |= {name: ds[name].values for name in ds.data_vars
-                   if name in planned.study.outputs}
+        # a punch's output of several is named like punches_1_tilt, its path in "output"
+        arrays |= {ds[name].attrs.get("output", name): ds[name].values
+                   for name in ds.data_vars
+                   if ds[name].attrs.get("output", name) in planned.study.outputs}
         arrays["time"] = ds.time.values
         arrays["seconds"] = time.perf_counter() - start
         arrays["cpu_seconds"] = time.process_time() - cpu

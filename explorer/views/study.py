@@ -30,11 +30,11 @@ from ..model import (
     default_range,
     plan_study,
     study_choices,
+    study_outputs,
 )
 from ..plots import DesignChart, design_chart_png, flag_note
 from ..solving import SolveController, StudyRun
 from .loop import PageLoop
-from .punches import OnePunchOnly
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
 
 #: The second parameter's choice for "no second parameter".
@@ -97,6 +97,7 @@ class StudyView:
         # (a 400-point study over 2000 output times is ~75 MB: 12 s of the loop's time)
         self._csv_data: bytes | None = None
         self._choices: dict[str, Any] = {}
+        self._scene: dict[str, Any] | None = None
         self.study_first = _AxisInputs(1, optional=False)
         self.study_second = _AxisInputs(2, optional=True)
         stretch = {"sizing_mode": "stretch_width"}
@@ -153,18 +154,18 @@ class StudyView:
 
     def content(self) -> pn.Column:
         """The tab's column."""
-        return pn.Column(OnePunchOnly(
-            self.state, "Studies",
+        return pn.Column(
             html_pane("<small>A design chart around the scene on screen: one field over a "
                       f"range (a line) or two (a heat map), at most {MAX_POINTS} points. "
-                      "Every point is a full solve.</small>"),
+                      "Every point is a full solve. Of several punches, each output is "
+                      "one punch's (a punch's centre is the spacing).</small>"),
             self.study_first.panel(), self.study_second.panel(), self.study_output,
             pn.Row(self.study_run_button, self.study_cancel_button, **stretch_row()),
             self.study_progress, self.study_status, self._chart_box, self.study_time,
             html_pane("<small>Red x: the solver flagged the point (outside the model's "
                       "validity, e.g. contact lost); grey or a gap: the point failed. The "
                       "CSV holds every output at every time.</small>", styles=NOTE_STYLE),
-            self.study_csv, self.study_png).panel, **TAB_COLUMN)
+            self.study_csv, self.study_png, **TAB_COLUMN)
 
     # -- choices -------------------------------------------------------------------------
     def refresh(self, scene: dict[str, Any] | None = None) -> None:
@@ -175,14 +176,15 @@ class StudyView:
                 scene = self.state.to_scene()
             except ValueError:
                 return  # not a scene now; its message comes with the solve
-        if "punches" in scene:
-            return  # studies vary a scene of one punch (the tab says so)
+        self._scene = scene
+        self._half_width = float((scene["punches"][0] if "punches" in scene
+                                  else scene["punch"])["half_width"])
+        self._offer_outputs(study_outputs(scene))
         choices = {c.key: c for c in study_choices(scene)}
         if list(choices) == list(self._choices):
             self._choices = choices
             return
         self._choices = choices
-        self._half_width = float(scene["punch"]["half_width"])
         options = {c.title: c.key for c in choices.values()}
         for inputs, extra in ((self.study_first, {}), (self.study_second, {NONE: NONE})):
             keep = inputs.field.value
@@ -195,12 +197,30 @@ class StudyView:
         if self._wanted is not None:
             self.apply_study_settings(self._wanted)
 
+    def _offer_outputs(self, outputs: dict[str, tuple[str, str, float]]) -> None:
+        """Offer ``outputs`` (those of one punch, or of each of several), keeping the one
+        chosen when it is still there (else the same quantity of the first punch, or of
+        the single punch)."""
+        options = {f"{n} [{u}]": k for k, (n, u, _) in outputs.items()}
+        if options == self.study_output.options:
+            return
+        keep = self.study_output.value
+        self.study_output.options = options
+        if keep in outputs:
+            self.study_output.value = keep
+            return
+        quantity = str(keep).rsplit(".", 1)[-1]
+        self.study_output.value = next((k for k in outputs
+                                        if k.rsplit(".", 1)[-1] == quantity),
+                                       next(iter(outputs)))
+
     def _on_field(self, inputs: _AxisInputs) -> None:
         """A new field: its first range around the value on screen."""
         choice = self._choices.get(inputs.field.value)
         inputs.row.visible = choice is not None
         if choice is not None:
-            inputs.fill(default_range(choice, getattr(self, "_half_width", 1.0)))
+            inputs.fill(default_range(choice, getattr(self, "_half_width", 1.0),
+                                      self._scene))
 
     # -- the link ------------------------------------------------------------------------
     def study_settings(self) -> dict[str, Any] | None:

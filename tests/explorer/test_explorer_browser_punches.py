@@ -110,3 +110,33 @@ def test_the_lesson_of_the_new_footing(page: Page):
           timeout=120)
     assert "Step 3 of 3" in page.pane_text(".lesson-note")
     assert page.errors == []
+
+
+# The points of the study's line chart, empty before a study has run.
+JS_STUDY_Y = """() => {
+  const src = Bokeh.documents[0].get_model_by_name('study_source');
+  return src && src.data.y ? Array.from(src.data.y) : null;
+}"""
+
+
+def test_a_study_of_the_spacing(server: str, page: Page):
+    _open_preset(server, page)
+    page.open_tab("Study")
+    field = page.page.locator(".study-p1-field select").first
+    field.wait_for(state="visible", timeout=30_000 * patience())
+    field.select_option(label="punch 2: centre x [m]")
+    # the server answers a new field with its first range: away from the old footing,
+    # from a quarter of the 1 m gap to four times it (typing before would be overwritten)
+    start = page.page.locator(".study-p1-from input").first
+    until(lambda: start.input_value() == "2.25", "the centre's first range",
+          describe=start.input_value)
+    page.type_into(".study-p1-count", "3")
+    page.page.locator(".study-output select").first.select_option(
+        label="punch 1: tilt [mrad]")
+    page.page.locator(".study-run button").first.click()
+    until(lambda: len(page.page.evaluate(JS_STUDY_Y) or []) == 3, "the chart of 3 points",
+          240, lambda: page.pane_text(".study-status"))
+    # at 50 years the old footing tilts toward the new one, less the further it is
+    y = page.page.evaluate(JS_STUDY_Y)
+    assert y[0] > y[1] > y[2] > 0
+    assert page.errors == []

@@ -158,6 +158,11 @@ def test_the_page_shows_each_punch_and_turns_off_what_is_for_one(explorer_app) -
     report = asyncio.run(files._report_file()).getvalue()
     assert "punches[1]" in report and "<h2>Results" in report
     assert asyncio.run(files._pdf_report_file()).getvalue().startswith(b"%PDF")
+    # a study varies a punch's centre (the spacing) and shows each punch's outputs
+    study = app.study_tab
+    assert "punches[1].center" in study.study_first.field.options.values()
+    assert study.study_output.value == "punches[0].settlement"
+    assert "punch 2: tilt [mrad]" in study.study_output.options
     # back to one punch: the single-punch page as it was
     assert app.load_scene(presets()["uniform_flat"])
     assert app.controller.wait(120) and app.controller.error == ""
@@ -166,6 +171,7 @@ def test_the_page_shows_each_punch_and_turns_off_what_is_for_one(explorer_app) -
     assert figures.history_line["settlement"].visible
     assert not app.pins.pin_button.disabled and not app.scene_tab.loading.note.visible
     assert not app.punch_tab.punches.panel.visible and app.punch_tab.single.visible
+    assert app.study_tab.study_output.value == "settlement"
 
 
 def test_the_punches_section_edits_the_chosen_punch(explorer_app) -> None:
