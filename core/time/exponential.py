@@ -411,9 +411,9 @@ def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
     if nm:
         # V w at the outputs, a row per output in the order of their steps
         vw_rows = np.empty((step_of.size, nm))
-        states, z_all = mode_march(problem, flat.reshape(n_steps, 4), total, reads,
-                                   end_drive, end_carry, vu_nodes, MAX_BLOCK_ELEMENTS,
-                                   restart[1:])
+        carried, z_all = mode_march(problem, flat.reshape(n_steps, 4), total, reads,
+                                    end_drive, end_carry, vu_nodes, MAX_BLOCK_ELEMENTS,
+                                    restart[1:], read_at=(bounds, out_carry_s))
         # the outputs of each step: its carried states and the drive by z at its seven
         # points (the neighbour read, ``side``, is the same for all outputs of a step)
         for b in np.flatnonzero(bounds[1:] > bounds[:-1]):
@@ -422,7 +422,7 @@ def march_grids(kernel, problem, grids: list[Grid], times: np.ndarray,
             z7 = (np.concatenate([z_all[b - 1, :3], z_all[b]]) if sd == -1 else
                   np.concatenate([z_all[b], z_all[b + 1, 1:]]) if sd == 1 else
                   np.concatenate([z_all[b], np.zeros((3, nm))]))
-            vw_rows[lo:hi] = out_carry_s[lo:hi] @ states[b] + out_total_s[lo:hi] @ z7
+            vw_rows[lo:hi] = carried[lo:hi] + out_total_s[lo:hi] @ z7
         if f.in_order:  # increasing times: as marched
             vw_out = vw_rows.T
         else:

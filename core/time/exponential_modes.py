@@ -80,9 +80,16 @@ def point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray
 
 def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarray,
                end_drive: np.ndarray, end_carry: np.ndarray, vu_nodes: np.ndarray | None,
-               block_elements: int, restart: np.ndarray | None = None
+               block_elements: int, restart: np.ndarray | None = None,
+               read_at: tuple[np.ndarray, np.ndarray] | None = None
                ) -> tuple[np.ndarray, np.ndarray]:
     """States at each step's start (B + 1, S, M) and ``z`` at each step's points (B, 4, M).
+
+    ``read_at`` (``bounds`` (B + 1,), ``weights`` (R, S)): instead of the states, their
+    reads ``rows`` (R, M), ``rows[bounds[b]:bounds[b + 1]] = weights[...] @ states[b]``
+    (the outputs of step ``b``, read from its start). The many-state march then keeps two
+    steps' states, not all: on the 50-year two-punch preset (36 states, 504 channels,
+    ~200 steps) the whole array was 27 MB, whose first touch cost more than its march.
 
     ``at_steps`` (B, 4) the times of the points; ``total`` (B, 3, 4) the step's drive of
     ``V w`` at its later points by ``z`` at its four; ``reads`` (B, S, 4) the states'
@@ -100,7 +107,11 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
     block = max(1, block_elements // (per_step * nm))
     reads_t = reads.transpose(0, 2, 1).copy()                     # (B, 4, S)
     drive_t = end_drive.transpose(0, 2, 1).copy()                 # (B, S, 4)
-    states = np.zeros((n_steps + 1, n_states, nm))
+    rolling = read_at is not None and not affine
+    states = np.zeros((2 if rolling else n_steps + 1, n_states, nm))
+    if read_at is not None:
+        bounds, weights = read_at
+        rows = np.empty((weights.shape[0], nm))
     z_all = np.empty((n_steps, 4, nm))
     diagonal = np.arange(n_states)
     if restart is None:
@@ -127,14 +138,19 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
         if not affine:
             for k in range(n_block):
                 b = first + k
+                now, after = (states[b % 2], states[(b + 1) % 2]) if rolling else \
+                    (states[b], states[b + 1])
+                if rolling and bounds[b + 1] > bounds[b]:
+                    rows[bounds[b]:bounds[b + 1]] = weights[bounds[b]:bounds[b + 1]] @ now
                 # z at the step's four points: affine in the state sums there
-                sums = (reads_b[k] @ states[b]).reshape(4, groups, n_each)
+                sums = (reads_b[k] @ now).reshape(4, groups, n_each)
                 z = z_all[b] = constant[k] + np.einsum(
                     "ikf,kpf->ipf", response[k], sums).reshape(4, nm)
                 if restart[b]:
+                    after.fill(0.0)  # the next grid starts from rest
                     continue
-                np.multiply(states[b], end_carry[b][:, None], out=states[b + 1])
-                states[b + 1] += drive_b[k] @ z
+                np.multiply(now, end_carry[b][:, None], out=after)
+                after += drive_b[k] @ z
             continue
         # A[s, t] = carry_s delta_st + sum_ik drive[s, i] response[i, k] reads[k, t]
         through = (drive_b @ response.reshape(n_block, 4, -1)).reshape(
@@ -154,4 +170,9 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
         z = constant.reshape(n_block, 4, groups, n_each) + np.einsum(
             "bikf,bkpf->bipf", response, sums)
         z_all[steps] = z.reshape(n_block, 4, nm)
-    return states, z_all
+    if read_at is None:
+        return states, z_all
+    if not rolling:
+        for b in np.flatnonzero(bounds[1:] > bounds[:-1]):
+            rows[bounds[b]:bounds[b + 1]] = weights[bounds[b]:bounds[b + 1]] @ states[b]
+    return rows, z_all
