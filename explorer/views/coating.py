@@ -81,8 +81,8 @@ class CoatingView:
     def content(self) -> pn.Column:
         """The tab's column."""
         return pn.Column(
-            html_pane("<small>Layer 1 touches the punch. Changes apply when you release "
-                      "a slider.</small>"),
+            html_pane("<small>Layer 1 touches the punch. Changes apply while you drag "
+                      "when solves are quick, else when you release a slider.</small>"),
             self.n_layers, self.bare_note, self.layer, self.layer_note,
             self.thickness_editor.panel,
             self.modulus_editor.panel, self.poisson_editor.panel,

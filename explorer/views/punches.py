@@ -79,7 +79,8 @@ class PunchesSection:
         self.note = html_pane(
             "Each punch's settlement and tilt are its own, its moment is about its own "
             "centre. Punches may not overlap or touch: the solver says which do. Loads "
-            "update while you drag; the centre and half-width when you release.",
+            "update while you drag; the centre and half-width too while solves are "
+            "quick, else when you release (the page says so).",
             styles=NOTE_STYLE)
         self.panel = pn.Column(
             html_pane("<b>Punches</b> (a scene of several)", margin=(10, 10, 0, 10)),
@@ -177,7 +178,8 @@ class PunchesSection:
             f"Computed for punch {self.index + 1}: <b>{unknowns}</b>. Each punch's "
             "settlement and tilt are its own, its moment is about its own centre. Punches "
             "may not overlap or touch: the solver says which do. Loads update while you "
-            "drag; the centre and half-width when you release.")
+            "drag; the centre and half-width too while solves are quick, else when you "
+            "release (the page says so).")
 
     def _on_statement(self, event: Any) -> None:
         if self._syncing or not 0 <= self.index < self.state.n_punches:
