@@ -184,7 +184,8 @@ def default_range(choice: Choice, half_width: float = 1.0,
     a decade each way (log), the Poisson ratio +-0.1, loads 0 to the middle third's edge
     (e = a/3) when zero, anything else half to one and a half times its value. A punch's
     centre of a scene of several (``scene`` given) moves away from its nearest
-    neighbour, from a quarter of the gap to four times it (the spacing's study); one
+    neighbour, from half the gap to four times it (the spacing's study: closer, a punch
+    may lift off, which under creep costs seconds to a minute a point); one
     between two moves by half the smaller gap each way. A punch's half-width grows at
     most to touching 90 % of the free room beside it."""
     v = choice.value
@@ -198,9 +199,9 @@ def default_range(choice: Choice, half_width: float = 1.0,
             d = 0.5 * min(left, right)
             return Axis(choice.key, round(v - d, 6), round(v + d, 6), 9)
         if math.isfinite(left):  # the rightmost: further right
-            return Axis(choice.key, round(v - 0.75 * left, 6), round(v + 3 * left, 6), 9)
+            return Axis(choice.key, round(v - 0.5 * left, 6), round(v + 3 * left, 6), 9)
         if math.isfinite(right):  # the leftmost: further left
-            return Axis(choice.key, round(v - 3 * right, 6), round(v + 0.75 * right, 6), 9)
+            return Axis(choice.key, round(v - 3 * right, 6), round(v + 0.5 * right, 6), 9)
     if choice.key.endswith(".modulus") or choice.key.endswith("modulus_final"):
         return Axis(choice.key, v / 10, v * 10, 9, "log")
     if choice.key == "base.age_at_loading":

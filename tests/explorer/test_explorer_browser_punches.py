@@ -126,9 +126,9 @@ def test_a_study_of_the_spacing(server: str, page: Page):
     field.wait_for(state="visible", timeout=30_000 * patience())
     field.select_option(label="punch 2: centre x [m]")
     # the server answers a new field with its first range: away from the old footing,
-    # from a quarter of the 1 m gap to four times it (typing before would be overwritten)
+    # from half the 1 m gap to four times it (typing before would be overwritten)
     start = page.page.locator(".study-p1-from input").first
-    until(lambda: start.input_value() == "2.25", "the centre's first range",
+    until(lambda: start.input_value() == "2.5", "the centre's first range",
           describe=start.input_value)
     page.type_into(".study-p1-count", "3")
     page.page.locator(".study-output select").first.select_option(

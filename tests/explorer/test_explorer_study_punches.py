@@ -62,11 +62,11 @@ def test_a_punchs_first_range_keeps_the_punches_apart(key: str) -> None:
     choice = {c.key: c for c in study_choices(scene)}[key]
     axis = default_range(choice, 1.0, scene)
     # the old footing (x = 0) and the new (x = 3), 1 m apart: a centre moves away from
-    # the other punch, from a quarter of the gap to four times it
+    # the other punch, from half the gap to four times it
     if key == "punches[1].center":
-        assert (axis.start, axis.stop) == (2.25, 6.0)
+        assert (axis.start, axis.stop) == (2.5, 6.0)
     if key == "punches[0].center":
-        assert (axis.start, axis.stop) == (-3.0, 0.75)
+        assert (axis.start, axis.stop) == (-3.0, 0.5)
     plan_study(scene, [axis])  # valid at both ends: plan_study checks them
 
 
