@@ -59,6 +59,7 @@ from core.contact.creep import (
     _outside_bands,
     controlled_march,
     creep_verdict,
+    graded_halvings,
 )
 from core.contact.kinks import Corrected, _contact_parts, _cut_rule, _part_rows, corrected_roots
 from core.contact.march import creep_memory, nodes_in, rule_operator
@@ -408,7 +409,8 @@ def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeI
     marches = CoupledMarches(base, inputs, [one.loads for one in inputs], tol)
     (rules, out, run, band_note, strays, error, end_error, time_error,
      space_error) = controlled_march(marches, times, tol, res, first_steps,
-                                     tuple(float(b) for b in time_breaks))
+                                     tuple(float(b) for b in time_breaks),
+                                     graded_halvings(inputs[0].kernel, times))
     success, flags, message = creep_verdict(error, end_error, time_error, space_error, run,
                                             strays, tol,
                                             f"under creep ({len(base.punches)} punches)")

@@ -5,7 +5,8 @@ and ``solve_general`` (any kernel); the steppers behind them:
 
 - ``exponential.py``, ``exponential_weights.py``, ``exponential_modes.py``: exponential
   collocation for kernels that are sums of exponentials (the default; error from three
-  grids);
+  grids); ``exponential_moments``, the integrals of ``exp(-x (1 - u)) u^k`` on [0, 1]
+  its weights are made of (the contact march's memory integrates its decays by them);
 - ``radau.py``: adaptive Radau IIA, the fallback and the reference; ``JUMP_SIDE``, how
   far from a load's jump each side of it is read (the time grids of the contact march
   hold both sides);
@@ -16,6 +17,7 @@ and ``solve_general`` (any kernel); the steppers behind them:
 
 from __future__ import annotations
 
+from core.time.exponential_weights import moments as exponential_moments
 from core.time.integration import solve_degenerate
 from core.time.product_quadrature import solve_general
 from core.time.radau import JUMP_SIDE
@@ -23,6 +25,7 @@ from core.time.volterra import ModalProblem
 
 __all__ = [
     "JUMP_SIDE",
+    "exponential_moments",
     "ModalProblem",
     "solve_degenerate",
     "solve_general",

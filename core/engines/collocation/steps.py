@@ -211,7 +211,8 @@ class CollocationSystem:
 
 
 def time_grid(times: np.ndarray, steps: int, refine: int = 0,
-              jumps: Sequence[float] = ()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+              jumps: Sequence[float] = (), graded: int = 0
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A grid on ``[1, times[-1]]`` containing every requested time (dimensionless t).
 
     The nominal step is ``(times[-1] - 1) / steps``; each interval between consecutive
@@ -227,12 +228,25 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
     each side of the jump and the trapezoid's error keeps its expansion on either side (a
     step across a jump erred to first order: the halved grids' difference was no
     estimate). A requested time on a jump is its side after it.
+
+    ``graded``: the first interval after the start and after each jump is split at
+    ``length / 2**k`` (k = 1 .. graded) from its start before its steps are counted, so
+    the steps grow geometrically out of the start (a creep law's transient just after a
+    load is applied, such as the ``(t - t0)^0.3`` of the design codes); these points do
+    not depend on ``refine``, so halving stays exact.
     """
     times = np.asarray(times, dtype=float)
     h = (times[-1] - 1.0) / steps
     # the ends of the intervals: (time, index of the requested time or -1)
     ends: list[tuple[float, int]] = []
     inside = sorted({float(j) for j in jumps if 1.0 < float(j) < float(times[-1])})
+    if graded:
+        marks = np.unique(np.concatenate([times, inside]))
+        for start in [1.0] + [j + JUMP_SIDE * max(1.0, abs(j)) for j in inside]:
+            after = marks[marks > start * (1.0 + 1e-9)]
+            if after.size:
+                length = float(after[0]) - start
+                ends += [(start + length * 2.0**-k, -1) for k in range(graded, 0, -1)]
     on_jump: dict[int, int] = {}
     for j in inside:
         side = JUMP_SIDE * max(1.0, abs(j))
