@@ -292,6 +292,15 @@ class PunchSolution(SceneSolution):
         return lift_off_length(self.local_contact_set, self.scene.half_width)
 
 
+def _joint_message(messages: list[str]) -> str:
+    """What a flag's text points to ("see info.message") for the scene: the punches' one
+    message when they share it (one march answers them together), else each punch's,
+    named (``punches[0]: ...; punches[1]: ...``)."""
+    if len(set(messages)) == 1:
+        return messages[0]
+    return "; ".join(f"punches[{k}]: {m}" for k, m in enumerate(messages) if m)
+
+
 class PunchesSolution:
     """The answer for a scene of several punches (see :func:`solve_punches_scene`).
 
@@ -312,6 +321,7 @@ class PunchesSolution:
             "success": all(bool(p.info["success"]) for p in punches),
             "flags": list(self.flags),
             "coating_model": punches[0].info.get("coating_model", "thin layer"),
+            "message": _joint_message([str(p.info.get("message", "")) for p in punches]),
         }
 
     def to_dict(self) -> dict[str, Any]:
