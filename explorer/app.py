@@ -30,6 +30,7 @@ from .model import (
     Screen,
     decode_scene,
     presets,
+    read_fit_query,
     read_study_query,
     read_view_query,
     validated_scene,
@@ -127,6 +128,11 @@ class ExplorerApp(pn.viewable.Viewer):
             self.study_tab.apply_study_settings(study_settings)
         if study_message and not self.screen.notice:
             self.screen.notice = study_message
+        fit_settings, fit_message = read_fit_query(query or {})
+        if fit_settings is not None:
+            self.fit_tab.apply_fit_settings(fit_settings)
+        if fit_message and not self.screen.notice:
+            self.screen.notice = fit_message
         # Changes to plain Bokeh models made after the page was generated but before its
         # websocket connects would never reach the browser: hold them until it does.
         self._initializing = True
@@ -168,7 +174,8 @@ class ExplorerApp(pn.viewable.Viewer):
                                    self._load_file, self.results.show_download_error)
         self.lessons_tab = LessonsView(self.pins, self.results.log_time, self.load_scene)
         self.study_tab = StudyView(state, controller, loop, self.link.schedule)
-        self.fit_tab = FitView(state, controller, loop, self.figures, self.load_scene, screen)
+        self.fit_tab = FitView(state, controller, loop, self.figures, self.load_scene, screen,
+                               on_settings=self.link.schedule)
         return [self.scene_tab, self.punch_tab, self.coating_tab, self.base_tab,
                 self.times_tab, self.check_tab, self.files_tab, self.lessons_tab,
                 self.study_tab, self.fit_tab]
@@ -289,10 +296,12 @@ class ExplorerApp(pn.viewable.Viewer):
         self.scene_tab.forget_preset()
         return True
 
-    def _view_parts(self) -> tuple[int, list[dict[str, Any]], dict[str, Any] | None]:
+    def _view_parts(self) -> tuple[int, list[dict[str, Any]], dict[str, Any] | None,
+                                   dict[str, Any] | None]:
         """What a link keeps besides the scene and the time: the open tab, the pinned
-        scenes and the Study tab's settings."""
-        return self.sidebar.active, self.pins.board.scenes(), self.study_tab.study_settings()
+        scenes, the Study tab's settings and the Fit tab's readings and fields."""
+        return (self.sidebar.active, self.pins.board.scenes(),
+                self.study_tab.study_settings(), self.fit_tab.fit_settings())
 
     def _on_pins(self) -> None:
         self.results.show_pins()

@@ -1,5 +1,5 @@
 """What a link keeps besides the scene: the output time shown, the open tab, the pins,
-the Study tab's settings.
+the Study tab's settings, the Fit tab's readings and fields.
 
 ``?scene=…&t=12&tab=3&pin=…&study=…``: ``t`` is the index of the output time, ``tab`` the
 index of the open sidebar tab, ``pin`` the pinned results' scenes (encoded as the scene
@@ -7,14 +7,21 @@ is, see :mod:`explorer.model.links`: one pin as its scene, several as ``{"pins":
 ...]}``, which deflates to little more than one scene since pins differ in a few fields;
 the pins are solved again when the link is opened), ``study`` the Study tab's parameters
 (field, from, to, points, spacing of each) and output, encoded the same way (see
-:func:`study_settings`; the study is not run when the link is opened). Anything odd is
-ignored with a message, never fatal: the scene is what matters. No Panel import.
+:func:`study_settings`; the study is not run when the link is opened), ``fit`` the Fit
+tab's readings (in SI units, as ``Readings.to_dict`` gives them) and fields to fit,
+encoded the same way (:func:`fit_settings`; drawn on the histories when the link is
+opened, not fitted). Anything odd is ignored with a message, never fatal: the scene is
+what matters. No Panel import.
 """
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
+from core.back_analysis import Readings, readings_from_text
+
+from .fit import MAX_FIT_FIELDS
 from .links import decode_scene, encode_scene
 from .pins import MAX_PINS
 from .punches_state import SCREEN_PUNCHES
@@ -28,19 +35,28 @@ MAX_INDEX = 100_000
 MAX_STUDY_KEY = 100
 #: Most parameters of the Study tab.
 MAX_STUDY_AXES = 2
+#: Most readings a link carries: deflated, ~12 bytes a reading of settlement and its
+#: standard deviation (measured on 200 synthetic readings: 2.4 kB), so 500 make a link of
+#: ~6 kB, which browsers and the server take; more stay with the page that uploaded them.
+MAX_LINK_READINGS = 500
 
 
 def view_query(scene: dict[str, Any], time_index: int, tab: int,
                pins: list[dict[str, Any]],
-               study: dict[str, Any] | None = None) -> dict[str, str]:
+               study: dict[str, Any] | None = None,
+               fit: dict[str, Any] | None = None) -> dict[str, str]:
     """The query arguments of a link to this view (``pins``: the pinned scenes; ``study``:
-    the Study tab's settings, :func:`study_settings`)."""
+    the Study tab's settings, :func:`study_settings`; ``fit``: the Fit tab's, ``{"fields":
+    [...], "readings": Readings.to_dict(), "source": name}``, left out of the link when
+    the readings are more than :data:`MAX_LINK_READINGS`)."""
     query = {"scene": encode_scene(scene), "t": str(int(time_index)), "tab": str(int(tab))}
     if len(pins) == 1:
         query["pin"] = encode_scene(pins[0])
     else:
         query["pin"] = encode_scene({"pins": list(pins)}) if pins else ""
     query["study"] = encode_scene(study_settings(study)) if study else ""
+    fits = fit is not None and len(fit["readings"]["time"]) <= MAX_LINK_READINGS
+    query["fit"] = encode_scene(fit) if fits else ""
     return query
 
 
@@ -83,6 +99,42 @@ def study_settings(settings: Any) -> dict[str, Any]:
         raise ValueError(f"study output: must be one of {', '.join(OUTPUTS)}, or "
                          f"punches[k].<one of them> (k from 0 to {SCREEN_PUNCHES - 1})")
     return {"axes": checked, "output": output}
+
+
+def fit_settings(settings: Any) -> dict[str, Any]:
+    """The Fit tab's settings of a link checked: ``{"fields": [key or None, ...],
+    "readings": {...}, "source": name}`` with 1 to ``MAX_FIT_FIELDS`` fields and at most
+    :data:`MAX_LINK_READINGS` readings, read as a readings file's JSON
+    (``core.back_analysis``: a bad value is named by its column and row). Returns
+    ``{"fields": [...], "readings": Readings}``; ValueError naming the setting."""
+    if not isinstance(settings, dict):
+        raise ValueError("the fit settings are not a JSON object")
+    fields = settings.get("fields")
+    if not isinstance(fields, list) or not 1 <= len(fields) <= MAX_FIT_FIELDS or not all(
+            f is None or (isinstance(f, str) and 0 < len(f) <= MAX_STUDY_KEY)
+            for f in fields):
+        raise ValueError(f"fit fields: must be a list of 1 to {MAX_FIT_FIELDS} field keys "
+                         "(or null)")
+    source = settings.get("source", "readings")
+    if not isinstance(source, str) or not 0 < len(source) <= MAX_STUDY_KEY:
+        raise ValueError(f"fit source: must be a name of 1 to {MAX_STUDY_KEY} characters")
+    data = settings.get("readings")
+    times = data.get("time") if isinstance(data, dict) else None
+    if not isinstance(times, list) or len(times) > MAX_LINK_READINGS:
+        raise ValueError(f"fit readings: must hold a list 'time' of at most "
+                         f"{MAX_LINK_READINGS} readings")
+    readings: Readings = readings_from_text(json.dumps(data), source)
+    return {"fields": list(fields), "readings": readings}
+
+
+def read_fit_query(query: dict[str, str]) -> tuple[dict[str, Any] | None, str]:
+    """(the Fit tab's settings or None, message) from a link's query arguments."""
+    if not query.get("fit"):
+        return None, ""
+    try:
+        return fit_settings(decode_scene(query["fit"])), ""
+    except (ValueError, TypeError) as exc:
+        return None, f"The readings in the link were not used: {exc}."
 
 
 def read_study_query(query: dict[str, str]) -> tuple[dict[str, Any] | None, str]:

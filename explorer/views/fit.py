@@ -50,12 +50,14 @@ class FitView:
 
     def __init__(self, state: ExplorerState, controller: SolveController, loop: PageLoop,
                  figures: Figures, load_scene: Callable[[dict[str, Any]], bool],
-                 screen: Screen | None = None) -> None:
+                 screen: Screen | None = None,
+                 on_settings: Callable[[], None] | None = None) -> None:
         """``state``: the scene fitted; ``controller``: the fields offered follow its
         results; ``loop``: where the fit's answer is shown; ``figures``: the histories the
         readings and the forecast are drawn on; ``load_scene``: shows the fitted scene;
         ``screen``: receives each fit (the report carries it while its fitted scene is on
-        screen)."""
+        screen); ``on_settings``: called when the readings or the fields change (the
+        page's link keeps them)."""
         self.state = state
         self.screen = screen
         self.figures = figures
@@ -82,6 +84,11 @@ class FitView:
         self.fit_run.param.watch(self._on_run, ["status", "message"])
         self.fit_run.param.watch(self._on_outcome, "outcome")
         self._choices: dict[str, Any] = {}
+        # fields a link asked for that the scene on screen does not offer yet
+        self._wanted: list[str | None] | None = None
+        self.on_settings = on_settings or (lambda: None)
+        for select in self.fields:
+            select.param.watch(lambda e: self.on_settings(), "value")
         controller.param.watch(lambda e: self.refresh(getattr(e.new, "scene", None)), "view")
         self.refresh()
 
@@ -102,7 +109,8 @@ class FitView:
                       f"{100 * BAND_LEVEL:.0f} % band from the fields' uncertainty only, "
                       "not the model's error. Every step of a fit is a full solve at the "
                       "readings' times. Once the fitted values are applied, the printable "
-                      "report (Files tab) carries the fit.</small>", styles=NOTE_STYLE)).panel,
+                      "report (Files tab) carries the fit. The page's link keeps the "
+                      "readings and the fields.</small>", styles=NOTE_STYLE)).panel,
             **TAB_COLUMN)
 
     # -- choices ---------------------------------------------------------------------------
@@ -126,6 +134,37 @@ class FitView:
                 select.value = keep
             else:
                 select.value = next(iter(choices), None) if k == 0 else NONE
+        if self._wanted is not None:
+            self._choose(self._wanted)
+
+    def _choose(self, fields: list[str | None]) -> None:
+        """Choose ``fields`` (None: no field) when the scene offers them all, else keep
+        them for when it does."""
+        offered = set(self._choices)
+        if not all(f is None or f in offered for f in fields):
+            self._wanted = list(fields)
+            return
+        self._wanted = None
+        for k, select in enumerate(self.fields):
+            field = fields[k] if k < len(fields) else None
+            if field is None and k == 0:
+                continue  # the first field is always one
+            select.value = NONE if field is None else field
+
+    # -- the link --------------------------------------------------------------------------
+    def fit_settings(self) -> dict[str, Any] | None:
+        """The readings and the fields chosen, as a link keeps them
+        (:func:`explorer.model.view_link.fit_settings`), or None without readings."""
+        if self.readings is None:
+            return None
+        return {"fields": self.chosen(), "readings": self.readings.to_dict(),
+                "source": self.readings.source}
+
+    def apply_fit_settings(self, settings: dict[str, Any]) -> None:
+        """Show the readings of a link and choose its fields (checked by
+        :func:`explorer.model.view_link.fit_settings`); the fit is not run."""
+        self.show_readings(settings["readings"])
+        self._choose(settings["fields"])
 
     def chosen(self) -> list[str | None]:
         """The fields chosen (None: no field)."""
@@ -154,6 +193,7 @@ class FitView:
         self.apply_button.disabled = True
         self._readings_text(f"{readings.source}: {readings_note(readings)}.")
         self.fit_button.disabled = self.fit_run.running
+        self.on_settings()
 
     def _readings_text(self, text: str, bad: bool = False) -> None:
         color = "#9b1c1c" if bad else "#333"

@@ -1,5 +1,5 @@
-"""The page's address follows the view on screen: scene, time, open tab, pins and the
-Study tab's settings."""
+"""The page's address follows the view on screen: scene, time, open tab, pins, the
+Study tab's settings and the Fit tab's readings and fields."""
 
 from __future__ import annotations
 
@@ -24,11 +24,11 @@ class AddressLink:
     """Writes a link that reproduces the view into the page's address bar, calmly."""
 
     def __init__(self, screen: Screen, controller: SolveController, loop: PageLoop,
-                 location: Any, view_parts: Callable[[], tuple[int, list[Any], Any]]) -> None:
+                 location: Any, view_parts: Callable[[], tuple[int, list[Any], Any, Any]]) -> None:
         """``screen``: the result and time on screen; ``controller``: a link waits while a
         newer result is coming; ``location``: the page's address (None: not served, no
-        link); ``view_parts``: the open tab, the pinned scenes and the Study tab's
-        settings, asked when the link is written."""
+        link); ``view_parts``: the open tab, the pinned scenes, the Study tab's settings
+        and the Fit tab's, asked when the link is written."""
         self.screen = screen
         self.controller = controller
         self.loop = loop
@@ -56,8 +56,8 @@ class AddressLink:
         if view is None or self.location is None or self.controller.busy:
             return  # a newer result is coming, and will ask again
         try:
-            tab, pins, study = self.view_parts()
-            query = view_query(view.scene, self.screen.time_index, tab, pins, study)
+            tab, pins, study, fit = self.view_parts()
+            query = view_query(view.scene, self.screen.time_index, tab, pins, study, fit)
             # the whole query at once: the values are URL-safe already (base64url, digits)
             link = "?" + "&".join(f"{k}={v}" for k, v in query.items() if v)
             if link != self.linked:

@@ -19,7 +19,7 @@ require_browser()
 from core import solve  # noqa: E402
 from core.back_analysis import readings_csv  # noqa: E402
 from explorer.model import DEFAULT_PRESET, presets  # noqa: E402
-from tests.browser_pages import Page, page_fixtures, patience, until  # noqa: E402
+from tests.browser_pages import JS_READY, Page, page_fixtures, patience, until  # noqa: E402
 
 # The values of a named source of the page (null when it is not on the page).
 JS_VALUES = """([name, column]) => {
@@ -46,6 +46,16 @@ def values(page: Page, name: str, column: str = "v") -> list[float]:
     return page.page.evaluate(JS_VALUES, [name, column]) or []
 
 
+def _linked_fields(url: str) -> list:
+    """The fields to fit a page's address keeps ([] without readings in it)."""
+    from urllib.parse import parse_qs, urlparse
+
+    from explorer.model import decode_scene
+
+    fit = parse_qs(urlparse(url).query).get("fit")
+    return decode_scene(fit[0])["fields"] if fit else []
+
+
 server, browser_context, page = page_fixtures(1400, 900)
 
 
@@ -61,6 +71,15 @@ def test_readings_are_uploaded_drawn_and_fitted(page: Page):
     assert "7 settlement readings" in page.pane_text(".fit-readings")
     page.page.locator(".fit-field-1 select").first.select_option(
         label="coating 1: Young's modulus [MPa]")
+    # the page's address keeps the readings and the field (a link to this view)
+    # (read from the page: Playwright's page.url does not follow history.replaceState)
+    def href() -> str:
+        return page.page.evaluate("() => window.location.href")
+
+    until(lambda: _linked_fields(href())[:1] == ["coating[0].modulus"],
+          "the readings and the field in the page's address",
+          describe=lambda: _linked_fields(href()))
+    link = href()
     run = page.page.locator(".fit-run button").first
     until(lambda: run.is_enabled(), "the Fit button enabled")
     run.click()
@@ -92,4 +111,16 @@ def test_readings_are_uploaded_drawn_and_fitted(page: Page):
 
     until(fitted_report, "the report of the applied fit", 120)
     assert "coating[0].modulus" in text and "7 (settlement [m])" in text
+
+    # the link opens the readings on the histories with the field chosen, not yet fitted
+    page.page.goto(link, timeout=30_000 * patience())
+    page.page.wait_for_function(JS_READY, timeout=60_000 * patience())
+    page.open_tab("Fit")
+    until(lambda: len(values(page, "readings_settlement")) == 7,
+          "the link's readings on the settlement figure", 60,
+          lambda: page.pane_text(".fit-readings"))
+    field = page.page.locator(".fit-field-1 select").first
+    until(lambda: "modulus" in field.input_value(), "the link's field",
+          describe=field.input_value)
+    assert "±" not in page.pane_text(".fit-table")  # not fitted again
     assert page.errors == []

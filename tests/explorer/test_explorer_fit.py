@@ -142,3 +142,49 @@ def test_readings_columns_in_display_units_with_error_bars():
     assert columns["tilt"]["upper"] == pytest.approx([0.5])
     assert readings_note(readings).startswith("1 settlement reading with standard "
                                               "deviations and 1 tilt reading")
+
+
+def test_a_link_keeps_the_readings_and_the_fields(explorer_app):
+    """The Fit tab's readings and fields go into the page's link, and a page opened from
+    it draws the same readings and chooses the same fields (the fit is not run); bad or
+    oversized readings in a link are refused with a message, the page opens."""
+    from explorer.model.view_link import MAX_LINK_READINGS, fit_settings, read_fit_query, view_query
+
+    app = explorer_app(solved=True)
+    tab = app.fit_tab
+    assert tab.fit_settings() is None  # no readings: nothing for the link
+    text = _readings_text(app.state.to_scene())
+    tab.upload.param.update(filename="levelling.csv", value=text.encode())
+    tab.fields[0].value = "coating[0].modulus"
+    tab.fields[1].value = "loading.force"
+    settings = tab.fit_settings()
+    assert settings["fields"] == ["coating[0].modulus", "loading.force", None]
+    query = view_query(app.controller.view.scene, 0, 0, [], None, settings)
+    opened = explorer_app(query=query, solved=True)
+    assert opened.fit_tab.chosen() == ["coating[0].modulus", "loading.force", None]
+    assert opened.fit_tab.readings.to_dict() == tab.readings.to_dict()
+    assert "levelling.csv: 7 settlement readings" in opened.fit_tab.readings_status.object
+    assert len(opened.figures.readings_src["settlement"].data["t"]) == 7
+    assert opened.fit_tab.fit_run.outcome is None and not opened.fit_tab.fit_button.disabled
+    # more readings than a link carries: left out of the link, not cut short
+    many = dict(settings, readings=dict(settings["readings"],
+                                        time=list(range(1, MAX_LINK_READINGS + 2))))
+    assert "fit" not in {k for k, v in view_query(app.controller.view.scene, 0, 0, [], None,
+                                                   many).items() if v}
+    # settings a page never writes: refused with the setting named, the page opens
+    readings = settings["readings"]
+    for bad, reason in (({"fields": [], "readings": readings}, "fit fields"),
+                        ({"fields": ["x" * 500], "readings": readings}, "fit fields"),
+                        ({"fields": ["loading.force"], "readings": {"time": "1"}},
+                         "fit readings"),
+                        ({"fields": ["loading.force"],
+                          "readings": dict(readings, settlement=["a"] * 7)},
+                         "settlement")):
+        with pytest.raises(ValueError, match=reason):
+            fit_settings(bad)
+    from explorer.model import encode_scene
+
+    none, message = read_fit_query({"fit": encode_scene({"fields": 3})})
+    assert none is None and message.startswith("The readings in the link were not used")
+    opened = explorer_app(query={"fit": encode_scene({"fields": 3})})
+    assert "The readings in the link were not used" in opened.screen.notice
