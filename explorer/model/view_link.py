@@ -22,7 +22,7 @@ from typing import Any
 from core.back_analysis import Readings, readings_from_text
 
 from .fit import MAX_FIT_FIELDS
-from .links import decode_scene, encode_scene
+from .links import MAX_ENCODED, decode_scene, encode_scene
 from .pins import MAX_PINS
 from .punches_state import SCREEN_PUNCHES
 from .study import MAX_POINTS, OUTPUTS, PUNCH_OUTPUT, SPACINGS
@@ -35,10 +35,11 @@ MAX_INDEX = 100_000
 MAX_STUDY_KEY = 100
 #: Most parameters of the Study tab.
 MAX_STUDY_AXES = 2
-#: Most readings a link carries: deflated, ~12 bytes a reading of settlement and its
-#: standard deviation (measured on 200 synthetic readings: 2.4 kB), so 500 make a link of
-#: ~6 kB, which browsers and the server take; more stay with the page that uploaded them.
-MAX_LINK_READINGS = 500
+#: Most readings a link may hold. What bounds a link in practice is its length
+#: (:data:`explorer.model.links.MAX_ENCODED`, 6000 characters): readings of settlement
+#: with a standard deviation take ~22 characters each once deflated (measured on 200 and
+#: 500 noisy synthetic readings), so ~260 fit; more stay with the page that uploaded them.
+MAX_LINK_READINGS = 1000
 
 
 def view_query(scene: dict[str, Any], time_index: int, tab: int,
@@ -48,15 +49,15 @@ def view_query(scene: dict[str, Any], time_index: int, tab: int,
     """The query arguments of a link to this view (``pins``: the pinned scenes; ``study``:
     the Study tab's settings, :func:`study_settings`; ``fit``: the Fit tab's, ``{"fields":
     [...], "readings": Readings.to_dict(), "source": name}``, left out of the link when
-    the readings are more than :data:`MAX_LINK_READINGS`)."""
+    its encoding is longer than a link may be, ``MAX_ENCODED``)."""
     query = {"scene": encode_scene(scene), "t": str(int(time_index)), "tab": str(int(tab))}
     if len(pins) == 1:
         query["pin"] = encode_scene(pins[0])
     else:
         query["pin"] = encode_scene({"pins": list(pins)}) if pins else ""
     query["study"] = encode_scene(study_settings(study)) if study else ""
-    fits = fit is not None and len(fit["readings"]["time"]) <= MAX_LINK_READINGS
-    query["fit"] = encode_scene(fit) if fits else ""
+    encoded = encode_scene(fit) if fit is not None else ""
+    query["fit"] = encoded if len(encoded) <= MAX_ENCODED else ""
     return query
 
 
