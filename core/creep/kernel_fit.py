@@ -162,19 +162,14 @@ def _fit(creep: Callable, modulus: Callable | None, log_slope: Callable | None, 
     lags = lags[(lags >= resolution) & (lags <= end - 1.0)]
     tau_test = np.broadcast_to(age_test[:, None], (age_test.size, lags.size + 1))
     # durations past the end are not claimed, and one of at least ``resolution`` ends there
-    lag_test = np.concatenate([np.broadcast_to(lags, (age_test.size, lags.size)),
-                               np.maximum(end - age_test, resolution)[:, None]], axis=1)
-    t_test = tau_test + lag_test
+    last = np.maximum(end, age_test + resolution)
+    t_test = np.concatenate([age_test[:, None] + lags[None, :], last[:, None]], axis=1)
     keep = t_test <= end * (1.0 + 1e-15)
+    # the shared durations on their grid, the last one age by age
+    fitted_values = np.concatenate([fitted.compliance_grid(age_test, lags),
+                                    fitted.compliance(last, age_test)[:, None]], axis=1)
     inv_e_ages = (1.0 / np.asarray(modulus(age_test), dtype=float) if modulus is not None
                   else np.ones_like(age_test))
-    # the fitted compliance on the ages x durations grid: the amplitudes once per age and
-    # the exponentials once per duration, one product (J~ of :class:`FittedKernel`)
-    amp, _ = fitted.amplitudes(age_test)                                # (R, ages)
-    tail = -np.expm1(-lag_test[:, -1][None, :] / thetas[:, None])       # (R, ages)
-    fitted_values = inv_e_ages[:, None] + np.concatenate(
-        [amp.T @ -np.expm1(-lags[None, :] / thetas[:, None]),
-         np.sum(amp * tail, axis=0)[:, None]], axis=1)
     exact = (np.broadcast_to(inv_e_ages[:, None], keep.shape)[keep]
              + np.asarray(creep(t_test[keep], tau_test[keep]), dtype=float))
     error = FIT_ERROR_MARGIN * float(np.max(np.abs(fitted_values[keep] - exact)

@@ -18,6 +18,7 @@ from __future__ import annotations
 from core.study.definition import (
     FIELD_UNITS,
     FIXED_ROOTS,
+    PUNCH_OUTPUT,
     Study,
     apply_point,
     field_unit,
@@ -37,6 +38,7 @@ __all__ = [
     "FIELD_UNITS",
     "field_unit",
     "FIXED_ROOTS",
+    "PUNCH_OUTPUT",
     "get_field",
     "load_study",
     "numeric_fields",

@@ -4,15 +4,18 @@ Every mode carries its memory in ``S`` states (one per exponential of the kernel
 the kernel's constant part). At a step's start the states are known; ``z`` at the
 step's four points follows from them by a small solve (:func:`point_values`, formed for
 all steps at once) and the states take the step's drive by ``z``. :func:`mode_march`
-does this step after step and returns the states at every step's start and ``z`` at
-every point; two ways, chosen by the number of states (:data:`AFFINE_STATES`):
+does this step after step and returns the outputs' reads of the states at their steps'
+starts and ``z`` at every point; two ways, chosen by the number of states
+(:data:`AFFINE_STATES`):
 
 * few states: the step is an affine map of each mode's states, ``s' = A s + e``
   (``A`` S x S per mode), formed for a block of steps at once, so the march is one
   small product a step and ``z`` is read afterwards for all steps at once;
 * many states (the fitted code-creep kernels, 36): ``A`` would cost ``S**2`` a mode and
   step against ``~8 S`` for forming ``z`` on the way, so the step forms ``z`` from the
-  state sums and moves the states by it.
+  state sums and moves the states by it, keeping two steps' states (all of them were
+  27 MB on the 50-year two-punch preset: 36 states, 504 channels, ~200 steps, whose
+  first touch cost more than the march).
 """
 
 from __future__ import annotations
@@ -80,16 +83,13 @@ def point_values(d: np.ndarray, r: np.ndarray, total: np.ndarray
 
 def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarray,
                end_drive: np.ndarray, end_carry: np.ndarray, vu_nodes: np.ndarray | None,
-               block_elements: int, restart: np.ndarray | None = None,
-               read_at: tuple[np.ndarray, np.ndarray] | None = None
-               ) -> tuple[np.ndarray, np.ndarray]:
-    """States at each step's start (B + 1, S, M) and ``z`` at each step's points (B, 4, M).
+               block_elements: int, restart: np.ndarray | None,
+               read_at: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The outputs' reads of the states (R, M) and ``z`` at each step's points (B, 4, M).
 
-    ``read_at`` (``bounds`` (B + 1,), ``weights`` (R, S)): instead of the states, their
-    reads ``rows`` (R, M), ``rows[bounds[b]:bounds[b + 1]] = weights[...] @ states[b]``
-    (the outputs of step ``b``, read from its start). The many-state march then keeps two
-    steps' states, not all: on the 50-year two-punch preset (36 states, 504 channels,
-    ~200 steps) the whole array was 27 MB, whose first touch cost more than its march.
+    ``read_at`` (``bounds`` (B + 1,), ``weights`` (R, S)): the outputs of step ``b`` are
+    ``rows[bounds[b]:bounds[b + 1]] = weights[bounds[b]:bounds[b + 1]] @ states[b]``,
+    ``states[b]`` (S, M) the states at the step's start.
 
     ``at_steps`` (B, 4) the times of the points; ``total`` (B, 3, 4) the step's drive of
     ``V w`` at its later points by ``z`` at its four; ``reads`` (B, S, 4) the states'
@@ -107,11 +107,10 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
     block = max(1, block_elements // (per_step * nm))
     reads_t = reads.transpose(0, 2, 1).copy()                     # (B, 4, S)
     drive_t = end_drive.transpose(0, 2, 1).copy()                 # (B, S, 4)
-    rolling = read_at is not None and not affine
-    states = np.zeros((2 if rolling else n_steps + 1, n_states, nm))
-    if read_at is not None:
-        bounds, weights = read_at
-        rows = np.empty((weights.shape[0], nm))
+    # the many-state march keeps two steps' states (see the module notes)
+    states = np.zeros((n_steps + 1 if affine else 2, n_states, nm))
+    bounds, weights = read_at
+    rows = np.empty((weights.shape[0], nm))
     z_all = np.empty((n_steps, 4, nm))
     diagonal = np.arange(n_states)
     if restart is None:
@@ -138,9 +137,8 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
         if not affine:
             for k in range(n_block):
                 b = first + k
-                now, after = (states[b % 2], states[(b + 1) % 2]) if rolling else \
-                    (states[b], states[b + 1])
-                if rolling and bounds[b + 1] > bounds[b]:
+                now, after = states[b % 2], states[(b + 1) % 2]
+                if bounds[b + 1] > bounds[b]:
                     rows[bounds[b]:bounds[b + 1]] = weights[bounds[b]:bounds[b + 1]] @ now
                 # z at the step's four points: affine in the state sums there
                 sums = (reads_b[k] @ now).reshape(4, groups, n_each)
@@ -170,9 +168,7 @@ def mode_march(problem, at_steps: np.ndarray, total: np.ndarray, reads: np.ndarr
         z = constant.reshape(n_block, 4, groups, n_each) + np.einsum(
             "bikf,bkpf->bipf", response, sums)
         z_all[steps] = z.reshape(n_block, 4, nm)
-    if read_at is None:
-        return states, z_all
-    if not rolling:
+    if affine:
         for b in np.flatnonzero(bounds[1:] > bounds[:-1]):
             rows[bounds[b]:bounds[b + 1]] = weights[bounds[b]:bounds[b + 1]] @ states[b]
     return rows, z_all

@@ -24,9 +24,9 @@ import numpy as np
 
 import core
 from core.scene import provenance_lines
+from core.study import PUNCH_OUTPUT
 
 from ..model import (
-    PUNCH_OUTPUT,
     QUANTITIES,
     QUANTITY_UNITS,
     ResultView,

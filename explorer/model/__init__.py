@@ -79,7 +79,6 @@ from .state import MODEL_TOL_RANGE, ExplorerState
 from .study import (
     MAX_POINTS,
     OUTPUTS,
-    PUNCH_OUTPUT,
     SPACINGS,
     Axis,
     PlannedStudy,
@@ -94,7 +93,7 @@ from .view_link import read_fit_query, read_study_query, read_view_query, view_q
 
 __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
            "MAX_DESCRIPTION_CHARS", "MAX_FIT_FIELDS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS",
-           "MODEL_TOL_RANGE", "ORDER", "OUTPUTS", "PUNCH_OUTPUT", "QUANTITIES",
+           "MODEL_TOL_RANGE", "ORDER", "OUTPUTS", "QUANTITIES",
            "QUANTITY_RANGES", "QUANTITY_UNITS", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS",
            "STRENGTH_CLASSES",
            "Axis", "CodeCreepState", "DesignLimits", "DisplayScales", "ExplorerState",

@@ -45,8 +45,6 @@ OUTPUTS: dict[str, tuple[str, str, float]] = {
     "q_min": ("smallest pressure q_min", "kPa", 1e-3),
     "contact_width": ("contact width", "m", 1.0),
 }
-#: An output of one punch of a scene of several: ``punches[k].<name of OUTPUTS>``.
-PUNCH_OUTPUT = re.compile(r"punches\[(\d{1,4})\]\.([a-z_]+)")
 #: The key of the derived parameter e = M/P (it sets ``loading.moment``).
 ECCENTRICITY = "eccentricity"
 SPACINGS = ("linear", "log")

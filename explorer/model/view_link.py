@@ -20,12 +20,13 @@ import json
 from typing import Any
 
 from core.back_analysis import Readings, readings_from_text
+from core.study import PUNCH_OUTPUT
 
 from .fit import MAX_FIT_FIELDS
 from .links import MAX_ENCODED, decode_scene, encode_scene
 from .pins import MAX_PINS
 from .punches_state import SCREEN_PUNCHES
-from .study import MAX_POINTS, OUTPUTS, PUNCH_OUTPUT, SPACINGS
+from .study import MAX_POINTS, OUTPUTS, SPACINGS
 
 #: Largest output-time index a link may ask for (the scene schema's limit is lower).
 MAX_INDEX = 100_000

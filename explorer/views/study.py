@@ -177,8 +177,6 @@ class StudyView:
             except ValueError:
                 return  # not a scene now; its message comes with the solve
         self._scene = scene
-        self._half_width = float((scene["punches"][0] if "punches" in scene
-                                  else scene["punch"])["half_width"])
         self._offer_outputs(study_outputs(scene))
         choices = {c.key: c for c in study_choices(scene)}
         if list(choices) == list(self._choices):
@@ -219,8 +217,9 @@ class StudyView:
         choice = self._choices.get(inputs.field.value)
         inputs.row.visible = choice is not None
         if choice is not None:
-            inputs.fill(default_range(choice, getattr(self, "_half_width", 1.0),
-                                      self._scene))
+            scene = self._scene or {}
+            punch = scene["punches"][0] if "punches" in scene else scene.get("punch", {})
+            inputs.fill(default_range(choice, float(punch.get("half_width", 1.0)), scene))
 
     # -- the link ------------------------------------------------------------------------
     def study_settings(self) -> dict[str, Any] | None:

@@ -240,16 +240,16 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
     # the ends of the intervals: (time, index of the requested time or -1)
     ends: list[tuple[float, int]] = []
     inside = sorted({float(j) for j in jumps if 1.0 < float(j) < float(times[-1])})
+    sides = {j: JUMP_SIDE * max(1.0, abs(j)) for j in inside}
     if graded:
         marks = np.unique(np.concatenate([times, inside]))
-        for start in [1.0] + [j + JUMP_SIDE * max(1.0, abs(j)) for j in inside]:
+        for start in [1.0] + [j + sides[j] for j in inside]:
             after = marks[marks > start * (1.0 + 1e-9)]
             if after.size:
                 length = float(after[0]) - start
                 ends += [(start + length * 2.0**-k, -1) for k in range(graded, 0, -1)]
     on_jump: dict[int, int] = {}
-    for j in inside:
-        side = JUMP_SIDE * max(1.0, abs(j))
+    for j, side in sides.items():
         ends += [(j - side, -1), (j + side, -1)]
         hit = np.flatnonzero(np.abs(times - j) <= side)
         if hit.size:
