@@ -59,6 +59,7 @@ from core.contact.creep import (
     _outside_bands,
     controlled_march,
     creep_verdict,
+    free_end_slope,
     graded_halvings,
 )
 from core.contact.kinks import Corrected, _contact_parts, _cut_rule, _part_rows, corrected_roots
@@ -141,6 +142,11 @@ class CoupledMarches:
         punch's histories relative to its own size)."""
         pairs = [_distance(one, two) for one, two in zip(a, b, strict=True)]
         return max(d for d, _ in pairs), max(s for _, s in pairs)
+
+    def end_slope(self, rules: Sequence[Panels], out: list[dict[str, Any]]) -> float:
+        """The largest over the punches of :func:`core.contact.creep.free_end_slope`."""
+        return max(free_end_slope(rule.nodes, one["q"], one["ends"], space.breakpoints)
+                   for rule, one, space in zip(rules, out, self.base.spaces, strict=True))
 
     @staticmethod
     def extrapolate(fine: list[dict[str, Any]], coarse: list[dict[str, Any]]
@@ -376,6 +382,7 @@ def punch_outputs(run: dict[str, Any]) -> list[dict[str, Any]]:
             # Q_p = [delta + alpha x - g - sum_r A_pr (effective_r)] / (c m), as one punch
             "effective": np.column_stack([row[1][p].scale * row[0][p].q
                                           - row[2][part] for row in rows]),
+            "q": np.column_stack([row[0][p].q for row in rows]),
             "c": np.array([row[1][p].c for row in rows]),
         })
     return out
@@ -408,12 +415,13 @@ def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeI
     res = Resolutions(tuple(creep_resolution(s.lam, s.m) for s in base.spaces))
     marches = CoupledMarches(base, inputs, [one.loads for one in inputs], tol)
     (rules, out, run, band_note, strays, error, end_error, time_error,
-     space_error) = controlled_march(marches, times, tol, res, first_steps,
-                                     tuple(float(b) for b in time_breaks),
-                                     graded_halvings(inputs[0].kernel, times))
+     space_error, end_q_error) = controlled_march(marches, times, tol, res, first_steps,
+                                                  tuple(float(b) for b in time_breaks),
+                                                  graded_halvings(inputs[0].kernel, times))
     success, flags, message = creep_verdict(error, end_error, time_error, space_error, run,
                                             strays, tol,
-                                            f"under creep ({len(base.punches)} punches)")
+                                            f"under creep ({len(base.punches)} punches)",
+                                            end_q_error)
     seconds = _time.perf_counter() - started
     answers = []
     for p, (space, mine) in enumerate(zip(base.spaces, out, strict=True)):
@@ -433,6 +441,7 @@ def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeI
             "time_error_estimate": time_error,
             "spatial_error_estimate": space_error,
             "zone_end_error": end_error,
+            "zone_end_pressure_error": float(end_q_error),
             "success": bool(success),
             "flags": list(flags),
             "message": message,

@@ -195,6 +195,8 @@ def march_outputs(run: dict[str, Any]) -> dict[str, Any]:
         "nodal_ends": [list(row[4]) for row in states],
         # Q(x) = [delta + alpha x - g - F(effective)(x)] / (c m), effective = s q - memory
         "effective": np.column_stack([row[1].scale * row[0].q - row[2] for row in states]),
+        # the pressure at the nodes, for the time estimate of q (grids on one rule)
+        "q": np.column_stack([row[0].q for row in states]),
         "c": np.array([row[1].c for row in states]),
     }
 
