@@ -132,8 +132,9 @@ def _distance(a: dict[str, Any], b: dict[str, Any]) -> tuple[float, float]:
     return float(outputs), shift
 
 
-#: The finest the zone ends are located to for q beside them [half-widths] (the band
-#: panels' finest width, 0.005, holds the ends to ~1e-8 on the presets).
+#: The finest the zone ends are asked to for q beside them [half-widths]. What they
+#: reach is set by the finest band panels (0.005 wide): 7e-8 to 3e-7 measured on the
+#: scenes of benchmarks/creep_honesty.py.
 MIN_END_TOL = 1e-8
 #: Points of a zone nearer its free end than this [half-widths] do not give the slope of q
 #: there: q at them is the nodal error as much as the slope times the distance.
@@ -308,12 +309,14 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
     end_error = float(end_shift + space_shift)
     slope = marches.end_slope(base, out)
     rest = float(time_error + space_error)
-    if (not accepts(rest + end_error * slope, tol, UNILATERAL_MARGIN)
-            and accepts(rest, tol, UNILATERAL_MARGIN) and not strays):
-        # q beside a free end is what misses tol: the ends are located again, finely
-        # enough for a third of what success allows of q, or half of what the rest of the
-        # estimate leaves of it (at tol 1e-6 on the aging base, e = 0.45: ends 4.8e-7 ->
-        # ~1e-7 half-widths, q's error 4.7e-7 -> 5.4e-8)
+    end_q_error = end_error * slope
+    if (not accepts(rest + end_q_error, tol, UNILATERAL_MARGIN) and not strays
+            and (accepts(rest, tol, UNILATERAL_MARGIN) or end_q_error > rest)):
+        # q beside a free end is what misses tol (or the most of it): the ends are
+        # located again, finely enough for a third of what success allows of q, or half
+        # of what the rest of the estimate leaves of it, at most to MIN_END_TOL (at tol
+        # 1e-6 on the aging base, e = 0.45: ends 4.8e-7 -> ~1e-7 half-widths, q's error
+        # 4.7e-7 -> 5.4e-8)
         allowed = min(tol / 3.0, 0.5 * (tol - UNILATERAL_MARGIN * rest)) / UNILATERAL_MARGIN
         end_tol = max(allowed / slope, MIN_END_TOL)
         if end_tol < end_error:
