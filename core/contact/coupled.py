@@ -463,6 +463,13 @@ class CoupledEnds:
         self.errors = [output_error(a, b) for a, b in zip(sol.parts, fine.parts, strict=True)]
         return max(self.errors)
 
+    def moved_error(self, moved: CoupledZones, sol: CoupledZones) -> float:
+        """The largest of the punches' output changes when an end moves by its error
+        (each punch's added to its part of ``errors``)."""
+        parts = [output_error(a, b) for a, b in zip(moved.parts, sol.parts, strict=True)]
+        self.errors = [e + d for e, d in zip(self.errors, parts, strict=True)]
+        return max(parts)
+
 
 def _given_rhs_all(steps: Sequence[Step], owner: np.ndarray, x: np.ndarray,
                    g: np.ndarray) -> np.ndarray:
