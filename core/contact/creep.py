@@ -289,6 +289,7 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
                                                              first_steps, tol, end_tol,
                                                              first=first, jumps=jumps,
                                                              graded=graded)
+    end_tol = band_note["end_tol"]  # finer where q beside the ends asks for it
     out, time_error, end_shift, run = _in_time(
         marches, times, base, first_steps,
         max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
@@ -420,9 +421,16 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     if bands is None:
         locate = _check_times(times, LOCATE_OUTPUTS)
         grid_l, widths_l, index_l = time_grid(locate, first_steps, 0, jumps, graded)
-        located = marches.run(marches.locating(res), grid_l, widths_l, index_l,
-                              exact_ends=False, first=first)[0]
+        locating = marches.locating(res)
+        located = marches.run(locating, grid_l, widths_l, index_l, exact_ends=False,
+                              first=first)[0]
         bands = marches.bands(located)
+        # Where q rises steeply from a free end, the ends are asked finely enough for a
+        # third of what success allows of q beside them (controlled_march), from the
+        # start: the crowned default (R = 20 km, tol 1e-6) located them twice, 2.7 s.
+        slope = marches.end_slope(locating, located)
+        if slope > 0.0:
+            end_tol = min(end_tol, max(tol / (3.0 * UNILATERAL_MARGIN * slope), MIN_END_TOL))
     # every panel finer: the base width halved, its grading at +-1 and the breakpoints too
     finer = marches.halved(res)
     width = BAND_WIDTHS[0]
@@ -438,7 +446,8 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         # The halved rule becomes the candidate (its base is already the finer one).
         width /= 2.0
         rule, current = half, halved
-    return rule, float(error), float(end_error), {"bands": bands, "width": width}
+    return rule, float(error), float(end_error), {"bands": bands, "width": width,
+                                                  "end_tol": end_tol}
 
 
 def _outside_bands(ends: list[list[float]], bands: list[tuple[float, float]],

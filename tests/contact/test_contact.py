@@ -384,6 +384,19 @@ def test_band_rule_covers_the_bands_finely_and_keeps_the_breaks():
     assert abs(np.sum(panels.weights) - 2.0) < 1e-13
 
 
+def test_a_band_covers_the_way_an_end_went_to_a_corner():
+    from core.contact.bands import bands_from_ends
+
+    # A crown's zone spreading to full contact between two times (the crowned default,
+    # R = 20 km): its ends went from +-0.944 to the corners, and the steps between put
+    # their kinks on that way. Without it in the band an end strayed out and the rule was
+    # chosen again (2.9 s instead of 1.5 s).
+    bands = bands_from_ends([[-0.90, 0.90], [-0.944, 0.944], [-1.0, 1.0]])
+    assert bands == [(-1.0, pytest.approx(-0.88)), (pytest.approx(0.88), 1.0)]
+    # and an end leaving a corner (lift-off starting after loading)
+    assert bands_from_ends([[-1.0, 1.0], [-0.8, 1.0]]) == [(-1.0, pytest.approx(-0.78))]
+
+
 def test_creep_zone_ends_converge_over_the_band_and_the_space_estimate_holds():
     # The preset at 5 output times, one time grid: the free end on rules with panels
     # 0.04, 0.02, 0.01 wide over the band it sweeps, against 0.0025. Measured largest
