@@ -1,0 +1,130 @@
+"""Lift-off under creep: CPU time against the goals of slider speed, with the estimates.
+
+    OPENBLAS_NUM_THREADS=1 python -m benchmarks.creep_liftoff_speed [--no-write]
+    # writes benchmarks/results/creep_liftoff_speed.md (~2 min)
+
+Goals (issue "Honest to the edges under creep", point 3): a load change of the lift-off
+preset <= 20 ms, its new scene <= 100 ms, a lift-off whose eccentricity grows under creep
+<= 1 s; and the crown radius as a live slider of the explorer (its live bound,
+``explorer.app.LIVE_SOLVE_S``, 0.1 s). Cases, each through ``core.solve`` (or
+``solve_dimensionless`` where it is a dimensionless scene), the CPU time of this process:
+
+* the preset ``eccentric_footing_liftoff`` (creep, 20 outputs, tol 1e-4): a new scene
+  (caches cleared) and a load change (the moment 1 % up, the rest warm);
+* the default scene (``uniform_flat``: a creeping slab under a 20 mm coating) with a
+  crowned punch of radius R = 5 ... 25 km, at its tol 1e-6 and at 1e-4, caches cleared:
+  its contact spreads as the slab creeps;
+* ``liftoff_exp_growing`` of ``benchmarks/creep_honesty.py``: e(t) from 0.3 to 0.6 a on an
+  exponential kernel, tol 1e-4.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from collections.abc import Callable
+from datetime import UTC, datetime
+from typing import Any
+
+from benchmarks import ROOT, run_lines
+from benchmarks.creep_honesty import cases
+from core.cache import clear_caches
+from core.presets import read_preset
+from core.scene import solve
+from core.solver import solve_dimensionless
+
+RESULTS = ROOT / "benchmarks" / "results" / "creep_liftoff_speed.md"
+RADII_KM = (5.0, 10.0, 15.0, 20.0, 25.0)
+
+
+def cpu(call: Callable[[], Any], repeats: int = 3, cold: bool = True) -> tuple[float, Any]:
+    """Median CPU seconds of ``repeats`` runs (caches cleared before each when ``cold``)."""
+    times, out = [], None
+    for _ in range(repeats):
+        if cold:
+            clear_caches()
+        start = time.process_time()
+        out = call()
+        times.append(time.process_time() - start)
+    return sorted(times)[len(times) // 2], out
+
+
+def _crowned(radius_km: float, tol: float) -> dict[str, Any]:
+    scene = read_preset("uniform_flat")
+    scene["punch"]["shape"] = {"kind": "polynomial",
+                               "coefficients": [0.0, 0.0, 1.0 / (2.0 * radius_km * 1e3)]}
+    scene["solver"]["tol"] = tol
+    return scene
+
+
+def _row(label: str, seconds: float, goal: float | None, result: Any) -> str:
+    info = result.info
+    met = "-" if goal is None else ("yes" if seconds <= goal else "no")
+    return (f"| {label} | {1e3 * seconds:.0f} | {'-' if goal is None else f'{1e3 * goal:.0f}'}"
+            f" | {met} | {info.get('success')} | {info.get('contact', '')} | "
+            f"{info.get('n_steps', '')} | {info.get('n_nodes', '')} | "
+            f"{float(info.get('error_estimate', float('nan'))):.1e} |")
+
+
+def rows(progress: bool = True) -> list[str]:
+    out = []
+
+    def say(line: str) -> None:
+        out.append(line)
+        if progress:
+            print(line, flush=True)
+
+    preset = read_preset("eccentric_footing_liftoff")
+    seconds, result = cpu(lambda: solve(preset))
+    say(_row("lift-off preset, new scene", seconds, 0.1, result))
+    moments = iter(1.0 + 0.01 * k for k in range(1, 100))
+
+    def load_change() -> Any:
+        moved = dict(preset, loading=dict(preset["loading"]))
+        moved["loading"]["moment"] = preset["loading"]["moment"] * next(moments)
+        return solve(moved)
+
+    solve(preset)
+    seconds, result = cpu(load_change, cold=False)
+    say(_row("lift-off preset, a load change (moment +1 %)", seconds, 0.02, result))
+    for tol in (1e-6, 1e-4):
+        for radius in RADII_KM:
+            scene = _crowned(radius, tol)
+            seconds, result = cpu(lambda scene=scene: solve(scene), repeats=1)
+            say(_row(f"crowned default, R = {radius:g} km, tol {tol:.0e}", seconds, 0.1,
+                     result))
+    growing = next(c for c in cases() if c.key == "liftoff_exp_growing")
+    seconds, result = cpu(lambda: solve_dimensionless(tol=1e-4, contact=growing.contact,
+                                                      **growing.at(1e-4)), repeats=1)
+    say(_row("growing eccentricity e(t) 0.3 -> 0.6 a, tol 1e-4", seconds, 1.0, result))
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--no-write", action="store_true")
+    args = parser.parse_args(argv)
+    started, load_before = datetime.now(UTC), os.getloadavg()[0]
+    table = rows()
+    text = "\n".join([
+        "# Lift-off under creep: CPU time against slider speed", "", "Made with:", "",
+        "```", "OPENBLAS_NUM_THREADS=1 python -m benchmarks.creep_liftoff_speed", "```", "",
+        *run_lines(started, load_before, os.getloadavg()[0],
+                   "CPU times of this process: the steadier figure on a shared machine"),
+        "", "The cases and goals: the docstring of `benchmarks/creep_liftoff_speed.py`. "
+        "Medians of 3 runs for the preset, one run for the others.", "",
+        "| case | CPU ms | goal ms | goal met | success | contact | steps | nodes | "
+        "error estimate |", "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        *table, ""])
+    if args.no_write:
+        print(text)
+    else:
+        RESULTS.write_text(text)
+        print(f"wrote {RESULTS.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
