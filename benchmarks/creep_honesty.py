@@ -18,8 +18,9 @@ References are computed outside the answers they judge:
   1e-9), a lift-off's time grids allowed ``REFERENCE_HALVINGS`` halvings instead of the
   solver's ``MAX_HALVINGS`` and its band panels ``REFERENCE_BANDS`` (on the solver's
   finest grids and bands, 0.005 wide, its zone ends are located to ~1.5-3e-7
-  half-widths; so, to 7e-9-5e-8), whose own estimate is quoted (it need not meet that tol); a
-  verdict at tol is counted only where the reference's estimate is below tol / 10;
+  half-widths; so, to 7e-9-5e-8; not for the two cases whose ``refine_reference`` says
+  why), whose own estimate is quoted (it need not meet that tol); a verdict at tol is
+  counted only where the reference's estimate is below tol / 10;
 * **an independent method** (full contact): the collocation engine on fixed panels with
   its own time stepping (trapezoid on the Volterra operator, no modes), at the
   resolution given per scene; its distance to the reference is quoted beside it.
@@ -37,7 +38,7 @@ import os
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
@@ -116,7 +117,10 @@ class Case:
     #: collocation cross-check (panels_per_unit, edge_width, time_points), or None
     collocation: tuple[float, float, int] | None = None
     tols: tuple[float, ...] = TOLS
-    extra: dict[str, Any] = field(default_factory=dict)
+    #: whether a lift-off's reference refines beyond the solver's limits (the crown's
+    #: took 327 s so, and its answers below 1e-4 are refused anyway; the growing
+    #: eccentricity's reference is good enough to judge 1e-6 without)
+    refine_reference: bool = True
 
     def at(self, tol: float) -> dict[str, Any]:
         """The arguments of a solve at ``tol``."""
@@ -199,11 +203,13 @@ def cases() -> list[Case]:
         Case("liftoff_exp_PM", "lift-off: m 0.05, exponential kernel, P 1, M 0.5 (e = 0.5)",
              _exp(m=0.05, force=1.0, moment=0.5), contact="unilateral"),
         Case("liftoff_exp_crown", "lift-off at both ends: crown g 0.02 x^2, m 0.05, P 0.05",
-             _exp(m=0.05, g=_crown, force=0.05, moment=0.0), contact="unilateral"),
+             _exp(m=0.05, g=_crown, force=0.05, moment=0.0), contact="unilateral",
+             refine_reference=False),
         Case("liftoff_aging_PM", "lift-off: aging base, m 0.05, P 1, M 0.45",
              _aging(m=0.05, force=1.0, moment=0.45), contact="unilateral"),
         Case("liftoff_exp_growing", "lift-off with a moving zone: e(t) 0.3 -> 0.6",
-             _exp(m=0.05, force=1.0, moment=_growing_moment), contact="unilateral"),
+             _exp(m=0.05, force=1.0, moment=_growing_moment), contact="unilateral",
+             refine_reference=False),
         Case("liftoff_preset", "preset eccentric_footing_liftoff (creep, 1000 days)",
              _preset("eccentric_footing_liftoff"), contact="unilateral"),
         Case("liftoff_mc2010", "young_concrete_50_years at e = a/2 (fib MC2010)",
@@ -270,8 +276,9 @@ class Row:
 
 def audit(case: Case) -> tuple[list[Row], dict[str, Any]]:
     """Every tol of one case against its reference, and the reference's own figures."""
+    refine = case.contact == "unilateral" and case.refine_reference
     reference, ref_s = _solve(case, REFERENCE_TOL[case.contact],
-                              REFERENCE_HALVINGS if case.contact == "unilateral" else None)
+                              REFERENCE_HALVINGS if refine else None)
     xs = sample_points(case.breakpoints)
     ref_info = {"tol": REFERENCE_TOL[case.contact], "success": reference.info["success"],
                 "estimate": float(reference.info["error_estimate"]), "seconds": ref_s,
