@@ -33,6 +33,9 @@ from core.discretize import Panels, base_panels
 #: away from it, the ends and outputs the same to 1e-9), so the chosen rule keeps the
 #: base of the scene: 304 nodes, against 384 when it took the halved base of its check.
 BAND_WIDTHS = (0.02, 0.01, 0.005)
+#: An end this near +-1 or a breakpoint [half-widths] is pinned there (a corner of the
+#: punch), not free.
+PINNED_WITHIN = 1e-12
 #: Margin added on both sides of the range an end sweeps [half-widths]: the ends of a
 #: finer time grid or of output times the first march skipped move a little further.
 BAND_MARGIN = 0.02
@@ -51,7 +54,7 @@ def bands_from_ends(ends: Sequence[Sequence[float]], breakpoints: Sequence[float
     pinned = {-1.0, 1.0, *(float(b) for b in breakpoints)}
 
     def free(e: float) -> bool:
-        return all(abs(float(e) - p) > 1e-12 for p in pinned)
+        return all(abs(float(e) - p) > PINNED_WITHIN for p in pinned)
 
     spans = [(float(e), float(e)) for row in ends for e in row if free(e)]
     for before, after in zip(ends[:-1], ends[1:], strict=False):

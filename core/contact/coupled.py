@@ -470,6 +470,12 @@ class CoupledEnds:
         self.errors = [e + d for e, d in zip(self.errors, parts, strict=True)]
         return max(parts)
 
+    def needs_moved(self, error: float, end_error: float) -> bool:
+        """As :meth:`core.contact.zones.OnePunch.needs_moved`, for the part of any punch
+        with a free end."""
+        return end_error < np.inf and any(self.errors[int(p)] < end_error
+                                          for p in set(self.free_owner.tolist()))
+
 
 def _given_rhs_all(steps: Sequence[Step], owner: np.ndarray, x: np.ndarray,
                    g: np.ndarray) -> np.ndarray:

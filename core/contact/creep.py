@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from core.contact.bands import BAND_WIDTHS, band_rule, bands_from_ends
+from core.contact.bands import BAND_WIDTHS, PINNED_WITHIN, band_rule, bands_from_ends
 from core.contact.march import march, march_outputs, rule_operator
 from core.contact.result import UNILATERAL_MARGIN, _Snapshot
 from core.contact.step import Space, Step
@@ -151,9 +151,11 @@ def free_end_slope(nodes: np.ndarray, q: np.ndarray, ends: Sequence[Sequence[flo
     q vanishes at a free end, so an end off by ``d`` moves q beside it by the slope times
     ``d``: the part of q's error the zone ends make (the four outputs, integrals of q, see
     only ``d^2``). The slope is the largest secant ``q(x) / |x - end|`` over the nodes
-    ``x`` of the zone within :data:`SLOPE_NEAREST` to :data:`SLOPE_REACH` of the end: where
-    q rises steeply and then bends (a soft coating), the nearest secant is the steepest.
-    Ends at +-1 or at a breakpoint (where q need not vanish) are not free.
+    ``x`` of the end's own zone within :data:`SLOPE_NEAREST` to :data:`SLOPE_REACH` of
+    the end: where q rises steeply and then bends (a soft coating), the nearest secant is
+    the steepest. A rise steeper still within SLOPE_NEAREST of the end (a boundary layer
+    thinner than that) would be read low. Ends at +-1 or at a breakpoint (where q need not
+    vanish; :data:`core.contact.bands.PINNED_WITHIN` of them) are not free.
 
     ``nodes`` (N,) of the rule, ``q`` (N, T) its nodal pressure, ``ends[k]`` the zone ends
     at time k in pairs (start, end)."""
@@ -164,10 +166,12 @@ def free_end_slope(nodes: np.ndarray, q: np.ndarray, ends: Sequence[Sequence[flo
     slope = 0.0
     for k, zone_ends in enumerate(ends):
         for j, end in enumerate(zone_ends):
-            if np.any(np.abs(pinned - end) <= 1e-9):
+            if np.any(np.abs(pinned - end) <= PINNED_WITHIN):
                 continue
+            start, stop = zone_ends[j - j % 2], zone_ends[j - j % 2 + 1]
             inward = (nodes - end) * (1.0 if j % 2 == 0 else -1.0)
-            near = (inward >= SLOPE_NEAREST) & (inward <= SLOPE_REACH)
+            near = ((inward >= SLOPE_NEAREST) & (inward <= SLOPE_REACH)
+                    & (nodes >= start) & (nodes <= stop))
             if near.any():
                 slope = max(slope, float(np.max(np.abs(q[near, k]) / inward[near])))
     return slope / scale
@@ -278,40 +282,42 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
     time and space parts of the former and the part of q the zone ends make
     (:func:`free_end_slope`); ``jumps``: times where a given load jumps, on which every
     time grid lands; ``graded``: halvings of each first interval toward its start)."""
-    # The zone ends have their own budget whatever tol is (issue 13): half of it for the
-    # panel rule (core/contact/kinks.py takes the kinks at the ends out of its error), the
-    # rest, or at least the other half, for the time grid; likewise tol / 3 of the outputs
-    # (success asks the sum of the two parts to meet it).
-    end_tol = ZONE_END_TOL
     # the zones at loading found by the first march start the first step of the others
     first: dict[str, Any] = {}
-    base, space_error, space_shift, band_note = _select_rule(marches, times, res,
-                                                             first_steps, tol, end_tol,
-                                                             first=first, jumps=jumps,
-                                                             graded=graded)
-    end_tol = band_note["end_tol"]  # finer where q beside the ends asks for it
-    out, time_error, end_shift, run = _in_time(
-        marches, times, base, first_steps,
-        max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
-        max(end_tol - space_shift, end_tol / 2), first, jumps, graded)
-    strays = marches.strays(out, band_note["bands"])
-    if strays:
-        # An end went where the first march did not see it (between its few times, or as
-        # a zone opening late): the bands of every output time, and everything again.
-        bands = marches.bands(out, band_note["bands"])
+
+    def rule_and_march(end_tol: float, bands: Any = None) -> tuple:
+        """The rule (its bands located first unless given) and the time grids on it."""
         base, space_error, space_shift, band_note = _select_rule(
             marches, times, res, first_steps, tol, end_tol, bands=bands, first=first,
             jumps=jumps, graded=graded)
+        end_tol = band_note["end_tol"]  # finer where q beside the ends asks for it
         out, time_error, end_shift, run = _in_time(
             marches, times, base, first_steps,
             max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
             max(end_tol - space_shift, end_tol / 2), first, jumps, graded)
-        strays = marches.strays(out, band_note["bands"])
+        return (base, space_error, space_shift, band_note, out, time_error, end_shift, run,
+                marches.strays(out, band_note["bands"]))
+
+    # The zone ends have their own budget (ZONE_END_TOL whatever tol is, finer where q
+    # beside them asks for it; issue 13): half of it for the panel rule
+    # (core/contact/kinks.py takes the kinks at the ends out of its error), the rest, or
+    # at least the other half, for the time grid; likewise tol / 3 of the outputs
+    # (success asks the sum of the two parts to meet it).
+    (base, space_error, space_shift, band_note, out, time_error, end_shift, run,
+     strays) = rule_and_march(ZONE_END_TOL)
+    if strays:
+        # An end went where the first march did not see it (between its few times, or as
+        # a zone opening late): the bands of every output time, and everything again.
+        (base, space_error, space_shift, band_note, out, time_error, end_shift, run,
+         strays) = rule_and_march(band_note["end_tol"],
+                                  marches.bands(out, band_note["bands"]))
     end_error = float(end_shift + space_shift)
     slope = marches.end_slope(base, out)
     rest = float(time_error + space_error)
-    end_q_error = end_error * slope
-    if (not accepts(rest + end_q_error, tol, UNILATERAL_MARGIN) and not strays
+    # (an end unresolved, end_error inf, where q has no free end to slope: nothing of q)
+    end_q_error = end_error * slope if slope > 0.0 else 0.0
+    if (slope > 0.0 and np.isfinite(end_error) and not strays
+            and not accepts(rest + end_q_error, tol, UNILATERAL_MARGIN)
             and (accepts(rest, tol, UNILATERAL_MARGIN) or end_q_error > rest)):
         # q beside a free end is what misses tol (or the most of it): the ends are
         # located again, finely enough for a third of what success allows of q, or half
@@ -320,18 +326,14 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
         # 4.7e-7 -> 5.4e-8)
         allowed = min(tol / 3.0, 0.5 * (tol - UNILATERAL_MARGIN * rest)) / UNILATERAL_MARGIN
         end_tol = max(allowed / slope, MIN_END_TOL)
-        if end_tol < end_error:
-            base, space_error, space_shift, band_note = _select_rule(
-                marches, times, res, first_steps, tol, end_tol, bands=band_note["bands"],
-                first=first, jumps=jumps, graded=graded)
-            out, time_error, end_shift, run = _in_time(
-                marches, times, base, first_steps,
-                max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
-                max(end_tol - space_shift, end_tol / 2), first, jumps, graded)
-            strays = marches.strays(out, band_note["bands"])
+        # only when it asks more than the last run did (at MIN_END_TOL the finest bands
+        # have been tried: the same run again would give the same ends)
+        if end_tol < min(end_error, 0.5 * band_note["end_tol"]):
+            (base, space_error, space_shift, band_note, out, time_error, end_shift, run,
+             strays) = rule_and_march(end_tol, band_note["bands"])
             end_error = float(end_shift + space_shift)
             slope = marches.end_slope(base, out)
-    end_q_error = end_error * slope
+    end_q_error = end_error * slope if slope > 0.0 else 0.0
     error = float(time_error + space_error + end_q_error)
     return (base, out, run, band_note, strays, error, end_error, float(time_error),
             float(space_error), float(end_q_error))

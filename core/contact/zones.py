@@ -181,11 +181,11 @@ class OnePunch:
     hold Q at the ends, and Q at ``probes``), ``scale(sol)`` (the q that makes Q at the
     ends relative: a number, or one per end), ``walls(ends, k)`` (how far end ``k`` may
     move), ``edge(res)`` (the end grading of ``res``: a number, or one per end) and
-    ``output_error(sol, fine)`` and ``moved_error(moved, sol)`` (the same for a solution
-    whose end moved by its error, added to the estimate); ``res`` has ``finer()`` and
-    ``coarser()``. Several
-    punches on one base answer the same questions for all their ends at once
-    (:mod:`core.contact.coupled`).
+    ``output_error(sol, fine)``, ``moved_error(moved, sol)`` (the same for a solution
+    whose end moved by its error, added to the estimate) and ``needs_moved(error,
+    end_error)`` (whether to measure that); ``res`` has ``finer()`` and
+    ``coarser()``. Several punches on one base answer the same questions for all their
+    ends at once (:mod:`core.contact.coupled`).
     """
 
     def __init__(self, space: Space, step: Step, accuracy: float) -> None:
@@ -216,6 +216,15 @@ class OnePunch:
     def moved_error(moved: ZoneSolution, sol: ZoneSolution) -> float:
         """The outputs' change when an end moves by its error (added to the estimate)."""
         return output_error(moved, sol)
+
+    @staticmethod
+    def needs_moved(error: float, end_error: float) -> bool:
+        """Whether the ends' part of the outputs' error is to be measured by moving them
+        (:func:`_moved_ends_error`): where the rules' difference ``error`` reads less than
+        the ends' own error (a heuristic across units: the rules may then not differ on
+        the zone at all; it measured below it only where the zone was narrower than its
+        panels, e = 0.99 a, among e = 0.3-0.99 a and tol 1e-4-1e-8)."""
+        return error < end_error < np.inf
 
 
 def refine_zone_ends(space: Space, step: Step, ends: list[float], pinned: list[bool],
@@ -334,9 +343,7 @@ def refine_ends(problem: Any, ends: list[float], pinned: list[bool], slopes: lis
         res = res.finer()
         sol = problem.solve(ends, res)
         builds += 1
-    if free and output_error < end_error < np.inf:
-        # the rules' difference reads less than the ends' own error: they may not differ
-        # on the zone at all (below)
+    if free and problem.needs_moved(output_error, end_error):
         output_error += _moved_ends_error(problem, sol, ends, free, inward, end_error, res)
         builds += len(free)
     return Refined(sol, end_error, output_error, builds, level, converged)

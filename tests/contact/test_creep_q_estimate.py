@@ -48,7 +48,9 @@ def test_a_crown_spreading_over_a_creeping_base_is_within_tol_where_it_says_so()
     # estimate is within a tenth of the tol judged; it is 6.6e-8 from a tol-1e-9 run
     assert reference.info["error_estimate"] <= 1e-5
     error = _q_error(answer, reference)
-    # measured 5.9e-6 against the estimate 6.5e-6 (before: 1.4e-3 against 5.6e-6)
+    # measured 7.5e-7 against the estimate 6.6e-6 (before: 1.4e-3 against 5.6e-6); the
+    # same 7.5e-7 against a reference refined beyond the solver's limits
+    # (benchmarks/results/creep_honesty.md)
     assert error <= answer.info["error_estimate"] <= 1e-4 / UNILATERAL_MARGIN
     # tol 1e-6 cannot be met on these grids: refused, with the same honest estimate
     tighter = _crown(1e-6)
@@ -67,10 +69,13 @@ def test_q_beside_a_free_end_is_in_the_estimate_and_the_end_located_for_it() -> 
     answer, reference = _aging(1e-6), _aging(1e-9)
     assert answer.info["success"]
     assert answer.info["zone_end_pressure_error"] > 0.0
-    # the ends were located again, finer than the 1e-6 asked of them otherwise: measured
-    # ~1e-7 (before: 4.8e-7, and q beside them 4.7e-7 off under an estimate of 1.8e-7)
+    # the ends were located finer than the 1e-6 asked of them otherwise: measured 1.5e-7
+    # (before: 4.8e-7, and q beside them 4.7e-7 off under an estimate of 1.8e-7)
     assert answer.info["zone_end_error"] < 2.5e-7
-    # the reference's estimate: 1.1e-7; the error measured: 5.4e-8
+    # the reference's estimate: 1.1e-7; the error measured: 5.4e-8 under the estimate
+    # 2.2e-7 (2.6e-7 against a reference refined beyond the solver's limits,
+    # benchmarks/results/creep_honesty.md: 1.2 times the estimate, within the margin
+    # success allows it)
     assert reference.info["error_estimate"] <= 2e-7
     error = _q_error(answer, reference)
     assert error <= answer.info["error_estimate"] + reference.info["error_estimate"]

@@ -47,19 +47,19 @@ def test_far_apart_punches_lift_off_under_creep_as_single_punches() -> None:
                                for zones in alone.contact_set]
         errors = _errors(punch, shifted)
         if punch.info["n_steps"] == alone.info["n_steps"]:
-            # the same rules and grids (punch 0): measured <= 5.9e-15 in the histories,
-            # q 5.0e-14, zone ends 4.8e-15 half-widths; the coupling at 15 H ~exp(-2.1 *
+            # the same rules and grids (punch 0): measured <= 1.2e-15 in the histories,
+            # q 5.1e-14, zone ends 2.0e-15 half-widths; the coupling at 15 H ~exp(-2.1 *
             # 15) = 2e-14
-            bound, end_bound = 1e-9, 1e-9
+            bounds = dict.fromkeys((*QUANTITIES, "q", "ends"), 1e-9)
         else:
             # The pair's shared time grid is the one punch 0 needs (160 steps); punch 1
             # alone meets tol on 80, so the two differ by its own time error: measured
-            # 1.8e-9 (settlement), 3.3e-8 (q), ends 2.3e-8, against its estimates 2.3e-7
-            # and 4.9e-8.
-            bound, end_bound = 1.0, 1.0
+            # 1.8e-9 / 8.4e-9 (settlement, tilt), 3.3e-8 (q), ends 2.3e-8 (its estimates
+            # 2.3e-7 and 4.9e-8); bounds 3x those
+            bounds = {**dict.fromkeys(QUANTITIES, 3e-8), "q": 1e-7, "ends": 7e-8}
         for q in (*QUANTITIES, "q"):
-            assert errors[q] < min(bound, alone.info["error_estimate"]), (k, q, errors)
-        assert errors["ends"] < min(end_bound, alone.info["zone_end_error"])
+            assert errors[q] < min(bounds[q], alone.info["error_estimate"]), (k, q, errors)
+        assert errors["ends"] < min(bounds["ends"], alone.info["zone_end_error"])
         # one march serves both: its estimate is the larger of the two punches'
         assert punch.info["error_estimate"] >= 0.5 * alone.info["error_estimate"]
         assert punch.settlement[-1] > 1.2 * punch.settlement[0]  # it creeps
