@@ -47,7 +47,10 @@ class UnilateralSolution(SolveOutcome):
     over ``times``; ``contact_set[k]`` the list of ``(start, end)`` intervals of x in
     [-1, 1] where q > 0 at ``times[k]``; ``pressure(x)`` q of shape ``(len(x), T)`` (0 off
     contact); ``info`` with ``error_estimate``, ``zone_end_error`` [half-widths],
-    ``success``, ``message``, ``flags``, ``contact`` (``"unilateral"``), ``seconds``.
+    ``success``, ``message``, ``flags``, ``contact`` (``"unilateral"``), ``seconds``; under
+    creep also ``time_error_estimate``, ``spatial_error_estimate`` and
+    ``zone_end_pressure_error`` (the part of q's error the located free ends make, in
+    ``error_estimate``).
     """
 
     times: np.ndarray
