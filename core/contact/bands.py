@@ -41,6 +41,13 @@ PINNED_WITHIN = 1e-12
 BAND_MARGIN = 0.02
 
 
+def pinned_end(end: float, breakpoints: Sequence[float] = ()) -> bool:
+    """Whether a zone end sits at +-1 or at a breakpoint (a corner of the punch, where q
+    need not vanish), within :data:`PINNED_WITHIN`; every other end is free."""
+    return any(abs(float(end) - p) <= PINNED_WITHIN
+               for p in (-1.0, 1.0, *(float(b) for b in breakpoints)))
+
+
 def bands_from_ends(ends: Sequence[Sequence[float]], breakpoints: Sequence[float] = (),
                     margin: float = BAND_MARGIN) -> list[tuple[float, float]]:
     """Intervals covering every free zone end of ``ends`` (one list of ends per time).
@@ -51,10 +58,8 @@ def bands_from_ends(ends: Sequence[Sequence[float]], breakpoints: Sequence[float
     kinks there too).
     Each range, widened by ``margin``, is merged with overlapping ones.
     """
-    pinned = {-1.0, 1.0, *(float(b) for b in breakpoints)}
-
     def free(e: float) -> bool:
-        return all(abs(float(e) - p) > PINNED_WITHIN for p in pinned)
+        return not pinned_end(e, breakpoints)
 
     spans = [(float(e), float(e)) for row in ends for e in row if free(e)]
     for before, after in zip(ends[:-1], ends[1:], strict=False):

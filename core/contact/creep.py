@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from core.contact.bands import BAND_WIDTHS, PINNED_WITHIN, band_rule, bands_from_ends
+from core.contact.bands import BAND_WIDTHS, band_rule, bands_from_ends, pinned_end
 from core.contact.march import march, march_outputs, rule_operator
 from core.contact.result import UNILATERAL_MARGIN, _Snapshot
 from core.contact.step import Space, Step
@@ -155,18 +155,17 @@ def free_end_slope(nodes: np.ndarray, q: np.ndarray, ends: Sequence[Sequence[flo
     the end: where q rises steeply and then bends (a soft coating), the nearest secant is
     the steepest. A rise steeper still within SLOPE_NEAREST of the end (a boundary layer
     thinner than that) would be read low. Ends at +-1 or at a breakpoint (where q need not
-    vanish; :data:`core.contact.bands.PINNED_WITHIN` of them) are not free.
+    vanish: :func:`core.contact.bands.pinned_end`) are not free.
 
     ``nodes`` (N,) of the rule, ``q`` (N, T) its nodal pressure, ``ends[k]`` the zone ends
     at time k in pairs (start, end)."""
     scale = float(np.max(np.abs(q), initial=0.0))
     if scale == 0.0:
         return 0.0
-    pinned = np.array([-1.0, 1.0, *breakpoints])
     slope = 0.0
     for k, zone_ends in enumerate(ends):
         for j, end in enumerate(zone_ends):
-            if np.any(np.abs(pinned - end) <= PINNED_WITHIN):
+            if pinned_end(end, breakpoints):
                 continue
             start, stop = zone_ends[j - j % 2], zone_ends[j - j % 2 + 1]
             inward = (nodes - end) * (1.0 if j % 2 == 0 else -1.0)
@@ -175,6 +174,14 @@ def free_end_slope(nodes: np.ndarray, q: np.ndarray, ends: Sequence[Sequence[flo
             if near.any():
                 slope = max(slope, float(np.max(np.abs(q[near, k]) / inward[near])))
     return slope / scale
+
+
+def end_tol_for_q(tol: float, slope: float, rest: float = 0.0) -> float:
+    """The zone-end tolerance [half-widths] that leaves q beside the free ends (slope
+    ``slope``, :func:`free_end_slope`) a third of what success allows of the estimate, or
+    half of what the rest of it (``rest``) leaves, at most down to :data:`MIN_END_TOL`."""
+    allowed = min(tol / 3.0, 0.5 * (tol - UNILATERAL_MARGIN * rest)) / UNILATERAL_MARGIN
+    return max(allowed / slope, MIN_END_TOL)
 
 
 def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.ndarray],
@@ -320,12 +327,9 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
             and not accepts(rest + end_q_error, tol, UNILATERAL_MARGIN)
             and (accepts(rest, tol, UNILATERAL_MARGIN) or end_q_error > rest)):
         # q beside a free end is what misses tol (or the most of it): the ends are
-        # located again, finely enough for a third of what success allows of q, or half
-        # of what the rest of the estimate leaves of it, at most to MIN_END_TOL (at tol
-        # 1e-6 on the aging base, e = 0.45: ends 4.8e-7 -> ~1e-7 half-widths, q's error
-        # 4.7e-7 -> 5.4e-8)
-        allowed = min(tol / 3.0, 0.5 * (tol - UNILATERAL_MARGIN * rest)) / UNILATERAL_MARGIN
-        end_tol = max(allowed / slope, MIN_END_TOL)
+        # located again (at tol 1e-6 on the aging base, e = 0.45: ends 4.8e-7 -> ~1e-7
+        # half-widths, q's error 4.7e-7 -> 5.4e-8)
+        end_tol = end_tol_for_q(tol, slope, rest)
         # only when it asks more than the last run did (at MIN_END_TOL the finest bands
         # have been tried: the same run again would give the same ends)
         if end_tol < min(end_error, 0.5 * band_note["end_tol"]):
@@ -432,7 +436,7 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         # start: the crowned default (R = 20 km, tol 1e-6) located them twice, 2.7 s.
         slope = marches.end_slope(locating, located)
         if slope > 0.0:
-            end_tol = min(end_tol, max(tol / (3.0 * UNILATERAL_MARGIN * slope), MIN_END_TOL))
+            end_tol = min(end_tol, end_tol_for_q(tol, slope))
     # every panel finer: the base width halved, its grading at +-1 and the breakpoints too
     finer = marches.halved(res)
     width = BAND_WIDTHS[0]

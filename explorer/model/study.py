@@ -175,10 +175,10 @@ def _room(scene: Mapping[str, Any], k: int) -> tuple[float, float]:
     return left, right
 
 
-def default_range(choice: Choice, half_width: float = 1.0,
-                  scene: Mapping[str, Any] | None = None) -> Axis:
-    """A first range for ``choice`` around its value on screen (``half_width`` a [m]
-    sizes the eccentricity and moment ranges when they are zero): moduli and the age over
+def default_range(choice: Choice, scene: Mapping[str, Any] | None = None) -> Axis:
+    """A first range for ``choice`` around its value on screen in ``scene`` (its first
+    punch's half-width a [m], 1 m without a scene, sizes the eccentricity range when it is
+    zero): moduli and the age over
     a decade each way (log), the Poisson ratio +-0.1, loads 0 to the middle third's edge
     (e = a/3) when zero, anything else half to one and a half times its value. A punch's
     centre of a scene of several (``scene`` given) moves away from its nearest
@@ -187,6 +187,9 @@ def default_range(choice: Choice, half_width: float = 1.0,
     between two moves by half the smaller gap each way. A punch's half-width grows at
     most to touching 90 % of the free room beside it."""
     v = choice.value
+    punch = {} if scene is None else (scene["punches"][0] if "punches" in scene
+                                      else scene.get("punch", {}))
+    half_width = float(punch.get("half_width", 1.0))
     match = re.fullmatch(r"punches\[(\d+)\]\.(center|half_width)", choice.key)
     if match is not None and scene is not None and "punches" in scene:
         left, right = _room(scene, int(match[1]))

@@ -217,9 +217,7 @@ class StudyView:
         choice = self._choices.get(inputs.field.value)
         inputs.row.visible = choice is not None
         if choice is not None:
-            scene = self._scene or {}
-            punch = scene["punches"][0] if "punches" in scene else scene.get("punch", {})
-            inputs.fill(default_range(choice, float(punch.get("half_width", 1.0)), scene))
+            inputs.fill(default_range(choice, self._scene))
 
     # -- the link ------------------------------------------------------------------------
     def study_settings(self) -> dict[str, Any] | None:

@@ -60,7 +60,7 @@ def test_the_fields_of_each_punch_and_its_outputs_are_offered() -> None:
 def test_a_punchs_first_range_keeps_the_punches_apart(key: str) -> None:
     scene = screen_scene()
     choice = {c.key: c for c in study_choices(scene)}[key]
-    axis = default_range(choice, 1.0, scene)
+    axis = default_range(choice, scene)
     # the old footing (x = 0) and the new (x = 3), 1 m apart: a centre moves away from
     # the other punch, from half the gap to four times it
     if key == "punches[1].center":
