@@ -70,7 +70,8 @@ class Page:
         self.page = context.new_page()
         self.errors: list[str] = []
         self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
-        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+        # an uncaught error of the page with its stack (where BokehJS or Panel threw it)
+        self.page.on("pageerror", lambda e: self.errors.append(f"{e}\n{e.stack}"))
         self.page.goto(url + path, timeout=30_000 * patience())
         self.page.wait_for_function(JS_READY, timeout=60_000 * patience())
 

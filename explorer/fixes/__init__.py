@@ -4,7 +4,8 @@ Each module is one fix, with the versions it was checked with and why it is need
 is used through its module (``panel_fixes.install()``), so a test can replace one part.
 
 - ``panel_fixes``: messages Panel queues for a page and then never sends.
-- ``bokeh_fixes``: style sheets BokehJS rewrites with the same text.
+- ``bokeh_fixes``: style sheets BokehJS rewrites with the same text; the page's layout
+  computed once per frame, not once per change.
 - ``idle_painter``: the file dropper's frame loop, paused while nothing happens.
 - ``closed_pages``: pages closed abruptly (a debug line, not a traceback) and Panel's
   link registry released when a session ends.

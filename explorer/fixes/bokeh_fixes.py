@@ -1,6 +1,7 @@
-"""A fix applied in the page to BokehJS: style sheets rewritten with the same text.
+"""Two fixes applied in the page to BokehJS: style sheets rewritten with the same text,
+and the page's layout computed once per frame.
 
-BokehJS (checked with 3.9.2) writes the text of a ``<style>`` element each time it
+**Style sheets.** BokehJS (checked with 3.9.2) writes the text of a ``<style>`` element each time it
 paints a renderer (``update_position``) or lays a figure out, even when the text is the
 one it holds already. Writing it marks the page's styles as changed; the next renderer
 then reads its colours from the computed style (``getComputedStyle``, so that CSS
@@ -9,6 +10,19 @@ first. A load step repainted ~30 renderers and recomputed the page's styles ~30 
 ~27 ms of the page's CPU per step, half of the time its figures took (measured with a
 Chrome trace, benchmarks/explorer_latency.py). The fix leaves a style element alone when
 its text would not change. Nothing else of BokehJS changes, and a BokehJS without the
+patched method is left as it is (the page logs a warning).
+
+**One layout per frame.** BokehJS computes the layout of the whole page (every figure's
+axes, titles and colours read from the computed style) each time any part of it changes
+in a way that may move things: a widget shown or hidden, a slider's range, a column's
+children (``LayoutDOMView.invalidate_layout``), synchronously, once per change. A preset
+switch brings 30-80 messages from the server, with 10-20 such changes; each layout of
+this page costs ~150-300 ms of the page's CPU, so a switch took 2-9 s, 60-75 % of it in
+repeated layouts (a Chrome CPU profile of the page, ``benchmarks/explorer_latency.py``).
+The fix updates the part of the page that changed at once (its styles and, for a figure
+just added, its layout objects) and lays out each root of the changed views once, at the
+next animation frame: what the page shows is what one layout after the last change
+gives, which is what the repeated layouts ended with. BokehJS without the
 patched method is left as it is (the page logs a warning).
 """
 
@@ -35,10 +49,54 @@ if (!sheet || typeof sheet.prototype._update !== "function") {
 """
 
 
+#: Runs once per page when its document is ready (idempotent: a flag on the method). A
+#: root removed before its frame is not laid out; a hidden page lays out when shown again
+#: (browsers hold animation frames of hidden pages), as it paints.
+LAYOUT_ONCE_JS = """
+const layouts = (window.Bokeh && Bokeh.require) ? Bokeh.require("models/layouts/layout_dom")
+                                                : null;
+const View = layouts && layouts.LayoutDOMView;
+if (!View || typeof View.prototype.invalidate_layout !== "function") {
+  console.warn("explorer: BokehJS layouts have changed; the layout fix is not applied");
+} else if (!View.prototype.invalidate_layout.__once_per_frame) {
+  const invalidate = View.prototype.invalidate_layout;
+  // layouts asked for and laid out (for the page's tests and benchmarks)
+  const count = window.__explorerLayouts = {asked: 0, done: 0};
+  let roots = null;
+  const layOut = () => {
+    const due = roots;
+    roots = null;
+    for (const root of due) {
+      if (!root.is_destroyed) {
+        count.done += 1;
+        invalidate.call(root);
+      }
+    }
+  };
+  const deferred = function () {
+    // its own part now (a figure just added gets its layout objects, which a layout of
+    // the page asked for before the frame, on a resize, would read), the page's once
+    this.update_layout();
+    count.asked += 1;
+    let root = this;
+    while (root.parent instanceof View) root = root.parent;
+    if (roots === null) {
+      roots = new Set();
+      requestAnimationFrame(layOut);
+    }
+    roots.add(root);
+  };
+  deferred.__once_per_frame = true;
+  View.prototype.invalidate_layout = deferred;
+}
+"""
+
+
 def install(doc: Any) -> bool:
-    """Apply the fix in the page of Bokeh document ``doc`` once it is ready; False
+    """Apply both fixes in the page of Bokeh document ``doc`` once it is ready; False
     (nothing done) when there is no document (a notebook, a script)."""
     if doc is None or not hasattr(doc, "js_on_event"):
         return False
     doc.js_on_event("document_ready", CustomJS(code=SAME_STYLE_JS))
+    doc.js_on_event("document_ready", CustomJS(code=LAYOUT_ONCE_JS))
     return True

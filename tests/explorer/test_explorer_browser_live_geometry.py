@@ -65,3 +65,49 @@ def test_a_geometry_drag_on_a_creep_preset_draws_while_the_handle_moves(page: Pa
           timeout=60)
     page.page.mouse.up()
     assert page.errors == []
+
+
+# Asks for the layout of every figure and column of the page at once (as a message from
+# the server showing and hiding widgets does), then waits two frames: how many layouts
+# were asked for, how many the page did, and how many roots the views have.
+JS_ASK_LAYOUTS = """async () => {
+  const View = Bokeh.require("models/layouts/layout_dom").LayoutDOMView;
+  const views = [], stack = Object.values(Bokeh.index);
+  while (stack.length) {
+    const v = stack.pop();
+    if (v instanceof View) views.push(v);
+    if (v.child_views) stack.push(...v.child_views);
+  }
+  const roots = new Set(views.map(v => { let r = v; while (r.parent instanceof View)
+                                                      r = r.parent; return r; }));
+  const count = window.__explorerLayouts, before = {...count};
+  for (const v of views) v.invalidate_layout();
+  await new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)));
+  return {views: views.length, roots: roots.size, asked: count.asked - before.asked,
+          done: count.done - before.done};
+}"""
+
+
+def test_a_preset_switch_lays_the_page_out_once_per_frame(page: Page):
+    """BokehJS lays the whole page out at every change that may move things; a preset
+    switch makes 10-20 such changes, each layout of this page ~150-300 ms of its CPU
+    (explorer/fixes/bokeh_fixes.py). The page lays out once per frame: changes asked
+    together cost one layout per root, and the page works on after a switch."""
+    from explorer.model import preset_label, presets
+
+    page.page.evaluate(JS_WATCH)
+    page.page.locator(".preset-select select").first.select_option(
+        label=preset_label("stepped_punch", presets()["stepped_punch"]))
+    until(lambda: page.page.evaluate(CHANGES) > 0, "the preset's pressure", timeout=120)
+    asked = page.page.evaluate(JS_ASK_LAYOUTS)
+    assert asked["views"] >= 50 and asked["asked"] == asked["views"], asked
+    assert 1 <= asked["done"] <= asked["roots"] < asked["views"] / 10, asked
+    # the page still follows a slider
+    before = page.page.evaluate(CHANGES)
+    page.open_tab("Punch")
+    handle = page.page.locator(".punch-half-width .noUi-handle").first
+    handle.wait_for(timeout=60_000 * patience())
+    handle.focus()
+    handle.press("ArrowRight")
+    until(lambda: page.page.evaluate(CHANGES) > before, "the step's pressure", timeout=60)
+    assert page.errors == []
