@@ -277,16 +277,18 @@ class ExplorerApp(pn.viewable.Viewer):
 
     def load_scene(self, scene: dict[str, Any]) -> bool:
         """Validate a scene dict with the core and show it; False (and a notice) if bad."""
-        try:
-            validated_scene(scene)
-            self.state.load_scene(scene)
-        except ValueError as exc:
-            self.screen.notice = f"The scene was not loaded: {format_error(str(exc))}"
-            return False
-        self.scales.reset()
-        self.history.loaded = scene
-        self.screen.notice = ""
-        self.check_tab.show_limits(scene.get("limits"))
+        # one message to the page for every widget the scene sets
+        with pn.io.hold():
+            try:
+                validated_scene(scene)
+                self.state.load_scene(scene)
+            except ValueError as exc:
+                self.screen.notice = f"The scene was not loaded: {format_error(str(exc))}"
+                return False
+            self.scales.reset()
+            self.history.loaded = scene
+            self.screen.notice = ""
+            self.check_tab.show_limits(scene.get("limits"))
         return True
 
     def _load_file(self, scene: dict[str, Any]) -> bool:

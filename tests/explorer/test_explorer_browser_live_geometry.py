@@ -88,17 +88,41 @@ JS_ASK_LAYOUTS = """async () => {
 }"""
 
 
+# counts the messages from the server the page applies
+JS_COUNT_MESSAGES = """() => {
+  const doc = Bokeh.documents[0], apply = doc.apply_json_patch.bind(doc);
+  window.__messages = 0;
+  doc.apply_json_patch = (...args) => { window.__messages += 1; return apply(...args); };
+}"""
+#: Messages a switch to the stepped punch may bring, every tab filled: 9-20 measured (the
+#: scene's widgets in one, the results, the status; 9-16 for every preset in turn), 55-70
+#: when each widget the scene set was a message of its own (each one the page's work).
+SWITCH_MESSAGES = 30
+
+
 def test_a_preset_switch_lays_the_page_out_once_per_frame(page: Page):
     """BokehJS lays the whole page out at every change that may move things; a preset
     switch makes 10-20 such changes, each layout of this page ~150-300 ms of its CPU
     (explorer/fixes/bokeh_fixes.py). The page lays out once per frame: changes asked
-    together cost one layout per root, and the page works on after a switch."""
+    together cost one layout per root, and the page works on after a switch. The
+    server sends the widgets a scene sets in one message (explorer.app: load_scene)."""
     from explorer.model import preset_label, presets
 
+    # every tab opened once: each then has its widgets (else filled in the background a
+    # few seconds after the page loads, explorer.views.tabs), and the scene sets them all
+    tabs = page.page.locator(".sidebar-tabs .bk-tab")
+    for k in range(tabs.count()):
+        tabs.nth(k).click()
+    page.open_tab("Scene")
+    time.sleep(2.0)
     page.page.evaluate(JS_WATCH)
+    page.page.evaluate(JS_COUNT_MESSAGES)
     page.page.locator(".preset-select select").first.select_option(
         label=preset_label("stepped_punch", presets()["stepped_punch"]))
     until(lambda: page.page.evaluate(CHANGES) > 0, "the preset's pressure", timeout=120)
+    time.sleep(1.0)  # the status after the result
+    messages = page.page.evaluate("() => window.__messages")
+    assert 1 <= messages <= SWITCH_MESSAGES, messages
     asked = page.page.evaluate(JS_ASK_LAYOUTS)
     assert asked["views"] >= 50 and asked["asked"] == asked["views"], asked
     assert 1 <= asked["done"] <= asked["roots"] < asked["views"] / 10, asked
