@@ -15,6 +15,12 @@ from .style import TAB_COLUMN, html_pane
 from .widgets import NAMES, HistoryEditor
 
 
+def _held(change: Callable[[], Any]) -> None:
+    """Make ``change`` (a whole scene set again) reach the page in one message."""
+    with pn.io.hold():
+        change()
+
+
 class SceneView:
     """The preset chooser, undo/reset and the editors of the two given histories."""
 
@@ -42,12 +48,12 @@ class SceneView:
         self.preset.param.watch(self._on_preset, "value")
         self.undo_button = pn.widgets.Button(label="↶ Undo", disabled=not history.can_undo,
                                              css_classes=["undo-button"])
-        self.undo_button.on_click(lambda e: history.undo())
+        self.undo_button.on_click(lambda e: _held(history.undo))
         history.param.watch(lambda e: setattr(self.undo_button, "disabled", not e.new),
                             "can_undo")
         self.reset_button = pn.widgets.Button(label="Reset to the loaded scene",
                                               css_classes=["reset-button"])
-        self.reset_button.on_click(lambda e: history.reset())
+        self.reset_button.on_click(lambda e: _held(history.reset))
 
         self.statement = pn.widgets.Select(label="statement (which two are given)",
                                            options=list(STATEMENTS), value=s.loading.statement,
