@@ -1,9 +1,9 @@
 """Two fixes applied in the page to BokehJS: style sheets rewritten with the same text,
 and the page's layout computed once per frame.
 
-**Style sheets.** BokehJS (checked with 3.9.2) writes the text of a ``<style>`` element each time it
-paints a renderer (``update_position``) or lays a figure out, even when the text is the
-one it holds already. Writing it marks the page's styles as changed; the next renderer
+**Style sheets.** BokehJS (checked with 3.9.2) writes the text of a ``<style>`` element
+each time it paints a renderer (``update_position``) or lays a figure out, even when the
+text is the one it holds already. Writing it marks the page's styles as changed; the next renderer
 then reads its colours from the computed style (``getComputedStyle``, so that CSS
 variables can set them), and the browser must work out every style of the page again
 first. A load step repainted ~30 renderers and recomputed the page's styles ~30 times:
@@ -17,8 +17,9 @@ axes, titles and colours read from the computed style) each time any part of it 
 in a way that may move things: a widget shown or hidden, a slider's range, a column's
 children (``LayoutDOMView.invalidate_layout``), synchronously, once per change. A preset
 switch brings 30-80 messages from the server, with 10-20 such changes; each layout of
-this page costs ~150-300 ms of the page's CPU, so a switch took 2-9 s, 60-75 % of it in
-repeated layouts (a Chrome CPU profile of the page, ``benchmarks/explorer_latency.py``).
+this page costs ~150-300 ms of the page's CPU, so a switch took 1.7-6.6 s on a quiet
+machine, 60-75 % of the page's part in repeated layouts (a Chrome CPU profile of the page
+during the preset switches of ``benchmarks/explorer_latency.py``).
 The fix updates the part of the page that changed at once (its styles and, for a figure
 just added, its layout objects) and lays out each root of the changed views once, at the
 next animation frame: what the page shows is what one layout after the last change
@@ -66,12 +67,14 @@ if (!View || typeof View.prototype.invalidate_layout !== "function") {
   const layOut = () => {
     const due = roots;
     roots = null;
+    let failed = null;
     for (const root of due) {
-      if (!root.is_destroyed) {
-        count.done += 1;
-        invalidate.call(root);
-      }
+      if (root.is_destroyed) continue;
+      count.done += 1;
+      // one root that throws must not leave the others unlaid; its error is the page's
+      try { invalidate.call(root); } catch (error) { failed = failed || error; }
     }
+    if (failed !== null) throw failed;
   };
   const deferred = function () {
     // its own part now (a figure just added gets its layout objects, which a layout of
