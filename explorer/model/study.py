@@ -178,9 +178,9 @@ def _room(scene: Mapping[str, Any], k: int) -> tuple[float, float]:
 def default_range(choice: Choice, scene: Mapping[str, Any] | None = None) -> Axis:
     """A first range for ``choice`` around its value on screen in ``scene`` (its first
     punch's half-width a [m], 1 m without a scene, sizes the eccentricity range when it is
-    zero): moduli and the age over
-    a decade each way (log), the Poisson ratio +-0.1, loads 0 to the middle third's edge
-    (e = a/3) when zero, anything else half to one and a half times its value. A punch's
+    zero): moduli and the age over a decade each way (log), the Poisson ratio +-0.1, loads
+    0 to the middle third's edge (e = a/3) when zero, anything else half to one and a half
+    times its value. A punch's
     centre of a scene of several (``scene`` given) moves away from its nearest
     neighbour, from half the gap to four times it (the spacing's study: closer, a punch
     may lift off, which under creep costs seconds to a minute a point); one
