@@ -19,7 +19,7 @@ from typing import Any
 
 import panel as pn
 
-from .fixes import bokeh_fixes, closed_pages, gc_policy, idle_painter, panel_fixes
+from .fixes import bokeh_fixes, closed_pages, gc_policy, idle_painter, model_walk, panel_fixes
 from .model import (
     DEFAULT_PRESET,
     DesignLimits,
@@ -63,6 +63,7 @@ __all__ = ["ExplorerApp", "LIVE_SOLVE_S", "create_app"]
 
 log = logging.getLogger(__name__)
 panel_fixes.install()
+model_walk.install()
 install_websocket_marks()
 
 #: Geometry and material sliders apply each drag step (not only the release) while the

@@ -10,8 +10,11 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
 - ``closed_pages``: pages closed abruptly (a debug line, not a traceback) and Panel's
   link registry released when a session ends.
 - ``gc_policy``: the garbage collector kept off complete pages, and given them back.
+- ``model_walk``: Bokeh's walk over a document's models without building the constant
+  defaults it reads (each change of the page's shape walks every model).
 """
 
-from . import bokeh_fixes, closed_pages, gc_policy, idle_painter, panel_fixes
+from . import bokeh_fixes, closed_pages, gc_policy, idle_painter, model_walk, panel_fixes
 
-__all__ = ["bokeh_fixes", "closed_pages", "gc_policy", "idle_painter", "panel_fixes"]
+__all__ = ["bokeh_fixes", "closed_pages", "gc_policy", "idle_painter", "model_walk",
+           "panel_fixes"]
