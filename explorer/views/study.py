@@ -15,6 +15,7 @@ import html
 import io
 import threading
 from collections.abc import Callable
+from concurrent.futures import Future
 from typing import Any
 
 import panel as pn
@@ -114,9 +115,12 @@ class StudyView:
                                                      css_classes=["study-progress"],
                                                      **stretch)
         self.study_status = html_pane("", css_classes=["study-status"], **stretch)
-        # the figures are built at the first result: three Bokeh figures cost ~70 ms of
-        # the server's CPU (measured), a seventh of a new session, for a tab few open
+        # the figures are built for the first study, not with the page: three Bokeh
+        # figures cost ~70 ms of the server's CPU (measured), a seventh of a new session,
+        # for a tab few open; on a thread while that study runs (built with its result,
+        # they held the event loop, which every page shares, ~0.3 s)
         self.study_charts: DesignChart | None = None
+        self._charts_built: Future[DesignChart] | None = None
         self._chart_pane: pn.pane.Bokeh | None = None
         self._chart_box = pn.Column(
             html_pane("<small><i>Run a study to see its design chart here.</i></small>"),
@@ -263,7 +267,22 @@ class StudyView:
             self._say(f"Not run: {exc}", bad=True)
             return False
         self.study_run.start(planned)
+        if self.study_charts is None and self._charts_built is None:
+            self._charts_built = Future()
+            if self.loop.served:
+                threading.Thread(target=self._build_charts, name="study-charts",
+                                 daemon=True).start()
+            else:
+                self._build_charts()
         return True
+
+    def _build_charts(self) -> None:
+        # Bokeh models outside any document: no page sees them until one is shown
+        built = self._charts_built
+        try:
+            built.set_result(DesignChart())
+        except Exception as exc:  # shown where the result is drawn
+            built.set_exception(exc)
 
     def _say(self, text: str, bad: bool = False) -> None:
         color = "#9b1c1c" if bad else "#333"
@@ -295,7 +314,10 @@ class StudyView:
         self.study_time.options = times
         self.study_time.value = len(result.times) - 1
         if self.study_charts is None:
-            self.study_charts = DesignChart()
+            # built on a thread since the study started (a result loaded otherwise, or
+            # the thread not done: then built or awaited here)
+            built, self._charts_built = self._charts_built, None
+            self.study_charts = DesignChart() if built is None else built.result()
         shown = self.study_charts.draw(result, self.study_output.value,
                                        self.study_time.value)
         # one figure of the three on the page, in one pane (three panes toggled by their
