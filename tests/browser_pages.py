@@ -68,6 +68,7 @@ class Page:
 
     def __init__(self, context: object, url: str, path: str = "/app") -> None:
         self.page = context.new_page()
+        self.url = url
         self.errors: list[str] = []
         self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
         # an uncaught error of the page with its stack (where BokehJS or Panel threw it)
@@ -97,6 +98,14 @@ class Page:
                 return new
             time.sleep(0.05)
         raise AssertionError(f"{selector} stayed at {old!r}")
+
+    def wait_complete(self, timeout: float = 60.0) -> None:
+        """Wait until every sidebar tab has its widgets (the page's own signal,
+        ``explorer.views.COMPLETE_CLASS``): no more background work of the page is due."""
+        from explorer.views import COMPLETE_CLASS
+
+        self.page.locator(f".{COMPLETE_CLASS}").first.wait_for(
+            state="attached", timeout=1000 * timeout * patience())
 
     def open_tab(self, name: str) -> None:
         """Open a tab of the sidebar (its widgets arrive just after the page)."""

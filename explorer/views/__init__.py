@@ -38,11 +38,11 @@ from .scene import SceneView
 from .status import status_html
 from .study import StudyView
 from .style import html_pane
-from .tabs import FILL_TABS_AFTER_MS, DeferredTabs
+from .tabs import COMPLETE_CLASS, FILL_TABS_AFTER_MS, DeferredTabs
 from .times import TimesView
 
 __all__ = ["BUSY_AFTER_MS", "CONTACT_LABELS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS",
-           "AddressLink", "BaseView", "CheckView", "CoatingView", "DeferredTabs", "FidelityView",
-           "FilesView", "FitView", "LessonsView", "PageLoop", "PinsView", "PunchView",
-           "ResultsView", "SceneView", "StudyView", "TimesView", "badges_html", "html_pane",
-           "readout_html", "status_html"]
+           "AddressLink", "BaseView", "COMPLETE_CLASS", "CheckView", "CoatingView",
+           "DeferredTabs", "FidelityView", "FilesView", "FitView", "LessonsView",
+           "PageLoop", "PinsView", "PunchView", "ResultsView", "SceneView", "StudyView",
+           "TimesView", "badges_html", "html_pane", "readout_html", "status_html"]

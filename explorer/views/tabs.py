@@ -12,6 +12,9 @@ from .loop import PageLoop
 #: Time after a page connects before the sidebar tabs not yet opened are filled in the
 #: background [ms]: after the first paint and a first look (see DeferredTabs.fill_idle).
 FILL_TABS_AFTER_MS = 3000
+#: CSS class the sidebar gets once every tab has its widgets: the page is complete, no
+#: more background work of its own is due (a signal for scripts and tests that drive it).
+COMPLETE_CLASS = "sidebar-complete"
 #: Width of the sidebar [px], the same in presentation mode: a width changed on a page
 #: left the tabs' widgets at their old width, running over the plots (at 1024 px: the
 #: description through the scene's axis label, the readout's heading cut).
@@ -66,4 +69,5 @@ class DeferredTabs:
             loop.later(self.fill_idle, 0)
         elif loop.served:
             # the page is complete; it lives as long as the session
+            self.sidebar.css_classes = [*self.sidebar.css_classes, COMPLETE_CLASS]
             gc_policy.page_built(getattr(loop.doc, "session_context", None))

@@ -6,6 +6,8 @@ Debian's Chromium through Playwright; every wait is on a condition in the page.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
@@ -21,6 +23,7 @@ from tests.browser_pages import (  # noqa: E402
     patience,
     until,
 )
+from tests.support.probe import LivenessProbe, assert_responsive  # noqa: E402
 
 page = module_page_fixture(1400, 900)
 
@@ -28,6 +31,11 @@ page = module_page_fixture(1400, 900)
 def test_check_button_shows_the_measured_model_error_beside_the_estimate(page: Page):
     page.open_tab("Coating")
     button = page.page.locator(".coating-check-button button").first
+    # the server's event loop, which every page shares, answers at once while the check
+    # runs (it runs in a process of its own); the page complete first, so that its own
+    # background filling of tabs is not what the probe measures
+    page.wait_complete()
+    probe = LivenessProbe(page.url).__enter__()
     button.click()
     # the progress bar shows while the FE model solves (or the report is already there)
     bar = page.page.locator(".coating-check-progress").first
@@ -37,4 +45,11 @@ def test_check_button_shows_the_measured_model_error_beside_the_estimate(page: P
     for text in ("estimated", "settlement [mm]", "pressure", "Coating model: thin layer"):
         assert page.page.evaluate(JS_SHOWN, text), text
     assert button.is_enabled()
+    # and while a result's q(x, t) is written for a download (on a thread of the server)
+    page.open_tab("Files")
+    with page.page.expect_download(timeout=60_000 * patience()) as info:
+        page.page.get_by_text("Results: q(x, t) (CSV)").first.click()
+    assert Path(info.value.path()).stat().st_size > 10_000
+    probe.__exit__(None, None, None)
+    assert_responsive(probe)
     assert page.errors == []

@@ -16,7 +16,7 @@ from bokeh.models import ColumnDataSource
 
 from explorer.app import ExplorerApp
 from explorer.plots.bokeh_data import set_data
-from explorer.views import BUSY_AFTER_MS, LINK_EVERY_MS, PageLoop
+from explorer.views import BUSY_AFTER_MS, COMPLETE_CLASS, LINK_EVERY_MS, PageLoop
 
 
 def test_set_data_skips_equal_numbers_and_sends_changes() -> None:
@@ -251,6 +251,8 @@ def test_a_complete_page_is_frozen_out_of_the_collectors_reach(served_app, monke
     while timers.pending and not frozen:  # the tabs are filled one by one
         timers.run()
     assert frozen == [1] and not app.tabs.deferred
+    # the page says it is complete (scripts and tests wait on it)
+    assert COMPLETE_CLASS in app.sidebar.css_classes
     try:
         monkeypatch.undo()
         assert gc_policy.page_built()
