@@ -18,36 +18,59 @@ from __future__ import annotations
 import threading
 import time
 import urllib.request
+from collections.abc import Iterator
 from types import TracebackType
+from typing import Any
 
-__all__ = ["LivenessProbe", "PERIOD_S", "assert_responsive"]
+__all__ = ["LivenessProbe", "PERIOD_S", "assert_responsive", "own_explorer_server"]
 
 #: Time between two questions [s].
 PERIOD_S = 0.05
 #: The most one answer is waited for [s].
 TIMEOUT_S = 60.0
-#: The goal of issue "Reliability" for every answer while heavy work runs [s], asked of
-#: the 95th percentile here, and the bound on the longest wait [s]; both stretched by the
-#: machine's load (``tests.browser_pages.patience``). Measured on a quiet 2-core machine
-#: (three runs each): during the FE check of the coating and a q(x, t) download p95
-#: 13-21 ms, longest 22-92 ms; during a study, its files and a cancelled one p95 14-31
-#: ms, longest 59-245 ms (the study's chart entering the page). What they must catch: a
-#: study's 75 MB CSV built on the event loop held it 11.7 s, heavy view links 7.4-9.5 s,
-#: and the study's charts built with its result 0.27-0.36 s. The longest wait is allowed
-#: a full collection of the sessions other tests ended (explorer/fixes/gc_policy.py).
-P95_BOUND_S = 0.2
+#: Bounds on the waits while heavy work runs, stretched by the machine's load
+#: (``tests.browser_pages.patience``): the median [s] (the loop is idle between the
+#: page's own messages) and the longest wait [s]. Measured on a quiet 2-core machine,
+#: three runs each (a server of the test module's own): during the FE check of the
+#: coating and a q(x, t) download p50 5-6 ms, longest 27-49 ms; during a 400-point study
+#: and its cancellation p50 6 ms, longest 43-56 ms; beside two CPU-bound processes (load
+#: 3.5) p50 9-12 ms, longest 379 and 139 ms. In the whole suite on the run's shared
+#: server the longest were 2.6-2.9 s: that server's collection of the sessions earlier
+#: modules ended (explorer/fixes/gc_policy.py), which these tests do not time. What they
+#: must catch: a study's 75 MB CSV built on the event loop held it
+#: 11.7 s, heavy view links 7.4-9.5 s (issue "Reliability"); a result's handling made
+#: 1.5 s longer failed them. The goal of that issue, every wait under 0.2 s, is measured
+#: by ``benchmarks/load_test.py --heavy`` on a quiet machine, not asserted here.
+P50_BOUND_S = 0.05
 WORST_BOUND_S = 1.0
 
 
 def assert_responsive(probe: LivenessProbe) -> None:
-    """Fail unless the probe's answers meet :data:`P95_BOUND_S` and :data:`WORST_BOUND_S`
+    """Fail unless the probe's answers meet :data:`P50_BOUND_S` and :data:`WORST_BOUND_S`
     (stretched by the machine's load) and none failed."""
     from tests.browser_pages import patience
 
     stretch = patience()
     assert not probe.failures and len(probe.latencies) >= 10, probe.summary()
-    assert probe.quantile(0.95) <= P95_BOUND_S * stretch, probe.summary()
+    assert probe.quantile(0.5) <= P50_BOUND_S * stretch, probe.summary()
     assert probe.worst() <= WORST_BOUND_S * stretch, probe.summary()
+
+
+def own_explorer_server() -> Any:
+    """A module-scoped fixture ``explorer_server`` of a test module's own (a served
+    explorer as the run's, see tests/conftest.py), for a module that must not share the
+    server's event loop with the pages other modules left. Use as ``explorer_server =
+    own_explorer_server()`` at the module's top."""
+    import pytest
+
+    from tests.support.serving import ExplorerProcess
+
+    @pytest.fixture(scope="module", name="explorer_server")
+    def explorer_server() -> Iterator[ExplorerProcess]:
+        with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as served:
+            yield served
+
+    return explorer_server
 
 
 class LivenessProbe:
