@@ -28,7 +28,7 @@ assert set(CONTACT_LABELS) == set(CONTACT_MODELS)
 
 #: A layer of this Poisson ratio or more gets the prompt to set its interface: bonded and
 #: smooth differ most for nearly incompressible layers (0.1485 against 0.0630 mm of 50-year
-#: settlement for the pad of tests/support/under_read.py at nu 0.45, 800 kN/m centred).
+#: settlement for the pad of tests/support/epoxy_on_pad.py at nu 0.45, 800 kN/m centred).
 PROMPT_POISSON = 0.4
 
 

@@ -8,7 +8,7 @@ import pytest
 from core.scene import solve
 from explorer.model import ExplorerState
 from explorer.views.fidelity import PROMPT_POISSON, FidelityView
-from tests.support.under_read import under_read_scene
+from tests.support.epoxy_on_pad import epoxy_on_pad_scene
 
 
 def test_a_nearly_incompressible_layer_prompts_its_interface():
@@ -30,7 +30,7 @@ def test_a_nearly_incompressible_layer_prompts_its_interface():
 
 @pytest.mark.parametrize(("interface", "settlement_mm"), [("smooth", 0.15), ("bonded", 0.063)])
 def test_the_prompts_example_is_what_the_solver_gives(interface, settlement_mm):
-    scene = under_read_scene()
+    scene = epoxy_on_pad_scene()
     scene["times"] = {"end": 18262.5, "count": 20, "spacing": "log"}  # 50 years
     scene["loading"] = {"force": 8.0e5, "moment": 0.0}
     scene["coating"][1]["interface"] = interface  # the pad on the concrete

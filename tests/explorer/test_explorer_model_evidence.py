@@ -8,7 +8,7 @@ import asyncio
 
 import pytest
 
-from tests.support.under_read import under_read_scene
+from tests.support.epoxy_on_pad import epoxy_on_pad_scene
 
 pytestmark = pytest.mark.slow  # the FE check (~1 s) and solves of a creeping base
 
@@ -21,23 +21,24 @@ def _scene_badges(app) -> str:
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
 def test_the_fe_check_overrides_the_estimate_until_the_geometry_changes(explorer_app):
-    app = explorer_app(scene=under_read_scene(), solved=True)
-    # before the check: the estimate (1.56 %) is within the 2 % tolerance, but the pad
-    # (E_c/E 0.0019) is softer than the map was measured on: the page does not vouch for
-    # the estimate, it says it is extrapolated and asks for the check
+    app = explorer_app(scene=epoxy_on_pad_scene(), solved=True)
+    # before the check: the estimate (4.64 %) is over the 2 % tolerance, and the pad
+    # (E_c/E 0.0019) is softer than the map was measured on: the page says the estimate
+    # is extrapolated and asks for the check
     badges = _scene_badges(app)
-    assert "flag-model_error" not in badges and "ok-model_error" not in badges, badges
+    assert "flag-model_error" in badges and "ok-model_error" not in badges, badges
+    assert "estimated 4.64 %" in badges
     assert "flag-beyond_model_map" in badges and "extrapolated" in badges
     assert "model-estimated" in app.results.status.object
 
     app.coating_tab.check.run()  # no executor: runs here
     report = app.screen.model_check
     assert report is not None and report["model_error"] == pytest.approx(0.0358, abs=1e-3)
-    # the page: "measured 3.58 %" in the tab, "within solver.model_tol" in the badge
+    # the measurement replaces the estimate in the tab and the badge
     assert "measured 3.58 %" in app.coating_tab.check.result.object
     badges = _scene_badges(app)
     assert "flag-model_error" in badges and "ok-model_error" not in badges, badges
-    assert "measured by the FE check 3.58 %" in badges
+    assert "measured by the FE check 3.58 %" in badges and "estimated 4.64 %" not in badges
     assert "flag-beyond_model_map" not in badges  # measured: nothing extrapolated
     status = app.results.status.object
     assert "model-measured" in status and "model-flagged" in status
@@ -50,7 +51,8 @@ def test_the_fe_check_overrides_the_estimate_until_the_geometry_changes(explorer
     app.state.layers[1].thickness.mean = 21.0  # mm
     assert app.controller.wait(120) and app.controller.error == "", app.controller.error
     badges = _scene_badges(app)
-    assert "flag-model_error" not in badges and "flag-beyond_model_map" in badges, badges
+    assert "flag-beyond_model_map" in badges and "measured by the FE check" not in badges
     assert "model-estimated" in app.results.status.object
     text = asyncio.run(app.files_tab._report_file()).getvalue()
-    assert MEASURED_ROW not in text and "<td>model_error</td>" not in text
+    assert MEASURED_ROW not in text, "the report still quotes the measurement"
+    assert "<td>model_error</td>" in text  # flagged again, by the estimate

@@ -1,7 +1,10 @@
-"""A scene whose coating-model estimate under-reads the measured error: a 5 mm epoxy
-layer (E 3 GPa) on a 20 mm pad (E 50 MPa, nu 0.45) on 0.6 m of C30/37 (fib MC2010 creep),
-an eccentric force. Measured at loading by the FE check (level 0): 3.58 % against an
-estimate of 1.56 %, either side of the default solver.model_tol of 2 %."""
+"""A scene whose coating model errs by more than the default solver.model_tol of 2 %: a
+5 mm epoxy layer (E 3 GPa) sliding on a 20 mm pad (E 50 MPa, nu 0.45) on 0.6 m of C30/37
+(fib MC2010 creep), an eccentric force. Measured at loading by the FE check (level 0):
+3.58 %. Its estimate under-read that (1.56 %, the map alone) until the estimate had a
+part for a stiff layer spreading the load as a plate (core.coating.plate_spread): now
+4.64 %. The pad is softer against the base than the map was measured on, so the estimate
+is said to be extrapolated until the FE check measures it."""
 
 from __future__ import annotations
 
@@ -9,10 +12,10 @@ import copy
 from typing import Any
 
 #: Measured error [-] of the scene's fast answer by ``check_scene(scene, 0.0, level=0)``
-#: (3.579e-2 measured), and the estimate it carries (1.555e-2); the tests read them
-#: against the 2e-2 tolerance only, so neither needs more digits.
+#: (3.579e-2 measured), and the estimate it carries (4.639e-2); the tests read them
+#: against the tolerances only, so neither needs more digits.
 MEASURED = 0.0358
-ESTIMATE = 0.0156
+ESTIMATE = 0.0464
 
 _SCENE: dict[str, Any] = {
     "schema_version": 1,
@@ -30,6 +33,6 @@ _SCENE: dict[str, Any] = {
 }
 
 
-def under_read_scene() -> dict[str, Any]:
+def epoxy_on_pad_scene() -> dict[str, Any]:
     """A fresh copy of the scene (a dict, as a file holds it)."""
     return copy.deepcopy(_SCENE)
