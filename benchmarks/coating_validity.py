@@ -6,6 +6,7 @@
     python -m benchmarks.coating_validity --presets    # the check on the preset scenes
     python -m benchmarks.coating_validity --aging      # aging bases, early and late
     python -m benchmarks.coating_validity --variable   # bonded, varying thickness
+    python -m benchmarks.coating_validity --stacks     # a stiff layer on a soft pad
 
 ``--table`` solves, for a flat punch with a uniform coating, the fast model (with the
 compliance of :func:`core.coating.layer_compliance`) and the FE model of
@@ -305,6 +306,84 @@ def variable() -> None:
         "ratio = FE-measured error / estimate."), lines)
 
 
+def _stack(half_width: float = 1.0, top: dict | None = None, pad: dict | None = None,
+           pairs: int = 1, base_thickness: float = 0.6, moment: float = 1.2e5) -> dict:
+    """The epoxy-on-pad stack of ``tests/support/epoxy_on_pad.py`` with changes: ``top``
+    and ``pad`` update the two layers (``{"thickness": 0}`` of the top: the pad alone)."""
+    from tests.support.epoxy_on_pad import epoxy_on_pad_scene
+
+    scene = epoxy_on_pad_scene()
+    epoxy, soft = scene["coating"]
+    epoxy.update(top or {})
+    soft.update(pad or {})
+    scene["coating"] = [soft] if epoxy["thickness"] == 0 else [epoxy, soft] * pairs
+    scene["punch"]["half_width"] = half_width
+    scene["base"]["thickness"] = base_thickness
+    scene["loading"]["moment"] = moment
+    return scene
+
+
+#: Stacks of a stiff layer on a soft pad, checked by ``--stacks``: (label, scene). The
+#: reference: 5 mm of epoxy (3 GPa, nu 0.35) sliding on a 20 mm pad (50 MPa, nu 0.45),
+#: 0.6 m of C30/37, a = 1 m, 800 kN/m at e = 0.15 m.
+STACKS = (
+    ("reference", _stack()),
+    ("top of the pad's modulus", _stack(top={"modulus": 5.0e7})),
+    ("top 2.5 mm", _stack(top={"thickness": 0.0025})),
+    ("top 10 mm", _stack(top={"thickness": 0.01})),
+    ("top 1 GPa", _stack(top={"modulus": 1.0e9})),
+    ("top 10 GPa", _stack(top={"modulus": 1.0e10})),
+    ("pad 10 mm", _stack(pad={"thickness": 0.01})),
+    ("pad 40 mm", _stack(pad={"thickness": 0.04})),
+    ("pad nu 0.3", _stack(pad={"poisson": 0.3})),
+    ("the pad alone", _stack(top={"thickness": 0.0})),
+    ("top bonded to the pad", _stack(top={"interface": "bonded"})),
+    ("both bonded", _stack(top={"interface": "bonded"}, pad={"interface": "bonded"})),
+    ("top sliding on a bonded pad", _stack(pad={"interface": "bonded"})),
+    ("two pairs, 3 mm on 10 mm", _stack(top={"thickness": 0.003}, pad={"thickness": 0.01},
+                                        pairs=2)),
+    ("a = 0.5 m", _stack(half_width=0.5)),
+    ("centred force", _stack(moment=0.0)),
+    ("H = 2 m", _stack(base_thickness=2.0)),
+    ("a = 0.5 m, top 10 mm", _stack(half_width=0.5, top={"thickness": 0.01})),
+)
+
+
+def stacks() -> None:
+    """The estimate against the FE check (level 0) on stacks of a stiff layer on a soft
+    pad (``core.coating.model.plate_spread``)."""
+    import os
+    from datetime import UTC, datetime
+
+    import numpy as np
+
+    from benchmarks import run_lines
+    from core.coating.model import plate_spread
+    from core.scene import check_scene, scene_from_dict
+
+    started, load_before = datetime.now(UTC), os.getloadavg()[0]
+    lines = ["| stack | l / a | FE error (settlement / tilt) | estimate | estimate / error | "
+             "FE s |", "| --- | --- | --- | --- | --- | --- |"]
+    for label, d in STACKS:
+        scene = scene_from_dict(d)
+        spread = float(plate_spread(scene.coating, np.zeros(1))[0]) / scene.half_width
+        report = check_scene(d, level=0)
+        errors = report["errors"]
+        lines.append(f"| {label} | {spread:.4f} | {100 * report['model_error']:.2f} % "
+                     f"({100 * errors['settlement']:.2f} / {100 * errors['tilt']:.2f}) | "
+                     f"{100 * report['estimate']:.2f} % | "
+                     f"{report['estimate'] / report['model_error']:.2f} | "
+                     f"{report['fe_seconds']:.1f} |")
+        print(lines[-1], flush=True)
+    _write_section("## A stiff layer on a soft pad", (
+        "Made by `python -m benchmarks.coating_validity --stacks`: `python -m core check` "
+        "(FE level 0) on two-layer stacks, every layer smooth unless said. l / a: the "
+        "spread of the top layer as a plate (`core.coating.model.plate_spread`); the "
+        "estimate adds l / a to the map's force part and 3 l / a to its moment part "
+        "where the top layer and the one under it both slide.\n\n"
+        + "\n".join(run_lines(started, load_before, os.getloadavg()[0]))), lines)
+
+
 def _write_section(marker: str, intro: str, lines: list[str]) -> None:
     """Replace the section ``marker`` of ``benchmarks/results/coating_validity.md`` (up
     to the next ``## ``) by ``intro`` and the table ``lines``; the rest stays."""
@@ -356,6 +435,7 @@ def main() -> None:
     parser.add_argument("--presets", action="store_true")
     parser.add_argument("--aging", action="store_true")
     parser.add_argument("--variable", action="store_true")
+    parser.add_argument("--stacks", action="store_true")
     args = parser.parse_args()
     if args.fe_study:
         fe_study()
@@ -367,6 +447,8 @@ def main() -> None:
         aging()
     if args.variable:
         variable()
+    if args.stacks:
+        stacks()
 
 
 if __name__ == "__main__":
