@@ -193,10 +193,9 @@ def explorer_server() -> Iterator[Any]:
     """The served explorer of the browser tests (``tests.support.serving.ExplorerProcess``,
     default options, one BLAS thread): started when a test first asks, stopped at the end
     of the run."""
-    from tests.support.serving import ExplorerProcess
+    from tests.support.serving import browser_test_server
 
-    # 180 s: the server solves the default scene once before it answers
-    with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as explorer:
+    with browser_test_server() as explorer:
         yield explorer
 
 

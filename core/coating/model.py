@@ -232,7 +232,6 @@ def model_error_map(scene: Any) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     # a stiff layer sliding on softer ones spreads the load past the punch (beyond the
     # map, measured on one layer): its share adds to the map's
     plate = plate_spread(scene.coating, x) / a
-    parts["plate"] = plate
     parts["force_size"] = parts["force_size"] + PLATE_FORCE * plate
     parts["moment_size"] = parts["moment_size"] + PLATE_MOMENT * plate
     # the stack as read, before the map's clamping (beyond_map)
@@ -294,23 +293,16 @@ def plate_spread(layers: Any, x: np.ndarray) -> np.ndarray:
     map reads 2.6 %; bonded on a bonded pad: 0.17 %, the map reads 2.61 %; bonded on a
     smooth pad see :func:`confined_excess`).
     """
-    layers = list(layers)
+    layers = [(_values(one.thickness, x), _values(one.modulus, x), _values(one.poisson, x),
+               getattr(one, "interface", DEFAULT_INTERFACE)) for one in layers]
     spread = np.zeros(x.shape)
-    for k, layer in enumerate(layers[:-1]):
-        if any(getattr(one, "interface", DEFAULT_INTERFACE) != "smooth"
-               for one in (layer, layers[k + 1])):
+    for k, (h, e, nu, interface) in enumerate(layers[:-1]):
+        under = layers[k + 1:]
+        if interface != "smooth" or under[0][3] != "smooth":
             continue
-        below = np.zeros(x.shape)
-        thickness = np.zeros(x.shape)
-        softness = np.zeros(x.shape)
-        for under in layers[k + 1:]:
-            h, e = _values(under.thickness, x), _values(under.modulus, x)
-            below += layer_compliance(h, e, _values(under.poisson, x),
-                                      getattr(under, "interface", DEFAULT_INTERFACE))
-            thickness += h
-            softness += h / e
-        h, e, nu = (_values(layer.thickness, x), _values(layer.modulus, x),
-                    _values(layer.poisson, x))
+        below = sum(layer_compliance(*layer) for layer in under)
+        thickness = sum(layer[0] for layer in under)
+        softness = sum(layer[0] / layer[1] for layer in under)
         with np.errstate(divide="ignore", invalid="ignore"):
             contrast = np.clip(1.0 - thickness / softness / e, 0.0, 1.0)
         bending = e * h ** 3 / (12.0 * (1.0 - nu * nu)) * contrast

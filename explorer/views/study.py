@@ -269,12 +269,16 @@ class StudyView:
         self.study_run.start(planned)
         if self.study_charts is None and self._charts_built is None:
             self._charts_built = Future()
-            if self.loop.served:
-                threading.Thread(target=self._build_charts, name="study-charts",
-                                 daemon=True).start()
-            else:
-                self._build_charts()
+            self._off_the_loop(self._build_charts, "study-charts")
         return True
+
+    def _off_the_loop(self, work: Callable[[], None], name: str) -> None:
+        """Run ``work`` on a thread of its own on a served page (the event loop is every
+        page's), at once elsewhere."""
+        if self.loop.served:
+            threading.Thread(target=work, name=name, daemon=True).start()
+        else:
+            work()
 
     def _build_charts(self) -> None:
         # Bokeh models outside any document: no page sees them until one is shown
@@ -350,10 +354,7 @@ class StudyView:
             data = study_csv(result).encode("utf-8")
             self.loop.dispatch(lambda: self._offer_csv(result, data))
 
-        if self.loop.served:
-            threading.Thread(target=build, name="study-csv", daemon=True).start()
-        else:
-            build()
+        self._off_the_loop(build, "study-csv")
 
     def _offer_csv(self, result: Any, data: bytes) -> None:
         if self.study_run.result is not result:

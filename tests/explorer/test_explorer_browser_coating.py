@@ -38,21 +38,21 @@ def test_check_button_shows_the_measured_model_error_beside_the_estimate(page: P
     # runs (it runs in a process of its own); the page complete first, so that its own
     # background filling of tabs is not what the probe measures
     page.wait_complete()
-    probe = LivenessProbe(page.url).__enter__()
-    button.click()
-    # the progress bar shows while the FE model solves (or the report is already there)
-    bar = page.page.locator(".coating-check-progress").first
-    until(lambda: bar.is_visible() or page.page.evaluate(JS_SHOWN, "model error: measured"),
-          "the check's progress bar", timeout=60)
-    page.page.wait_for_function(JS_SHOWN, arg="model error: measured", timeout=180_000 * patience())
-    for text in ("estimated", "settlement [mm]", "pressure", "Coating model: thin layer"):
-        assert page.page.evaluate(JS_SHOWN, text), text
-    assert button.is_enabled()
-    # and while a result's q(x, t) is written for a download (on a thread of the server)
-    page.open_tab("Files")
-    with page.page.expect_download(timeout=60_000 * patience()) as info:
-        page.page.get_by_text("Results: q(x, t) (CSV)").first.click()
-    assert Path(info.value.path()).stat().st_size > 10_000
-    probe.__exit__(None, None, None)
+    with LivenessProbe(page.url) as probe:
+        button.click()
+        # the progress bar shows while the FE model solves (or the report is already there)
+        bar = page.page.locator(".coating-check-progress").first
+        until(lambda: bar.is_visible() or page.page.evaluate(JS_SHOWN, "model error: measured"),
+              "the check's progress bar", timeout=60)
+        page.page.wait_for_function(JS_SHOWN, arg="model error: measured",
+                                    timeout=180_000 * patience())
+        for text in ("estimated", "settlement [mm]", "pressure", "Coating model: thin layer"):
+            assert page.page.evaluate(JS_SHOWN, text), text
+        assert button.is_enabled()
+        # and while a result's q(x, t) is written for a download (on a thread of the server)
+        page.open_tab("Files")
+        with page.page.expect_download(timeout=60_000 * patience()) as info:
+            page.page.get_by_text("Results: q(x, t) (CSV)").first.click()
+        assert Path(info.value.path()).stat().st_size > 10_000
     assert_responsive(probe)
     assert page.errors == []

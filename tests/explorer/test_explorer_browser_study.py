@@ -22,6 +22,7 @@ from tests.browser_pages import (  # noqa: E402
     patience,
     until,
 )
+from tests.support.probe import LivenessProbe, assert_responsive, own_explorer_server  # noqa: E402,E501
 
 # The points of the line chart (the source named study_source) and of the heat map
 # (study_map_source); empty, or not on the page, before a study of that kind has run.
@@ -39,8 +40,6 @@ def status(page: Page) -> str:
     """The tab's message (what the study did, or why it was not run)."""
     return page.pane_text(".study-status")
 
-
-from tests.support.probe import LivenessProbe, assert_responsive, own_explorer_server  # noqa: E402,E501
 
 server, browser_context, page = page_fixtures(1400, 900, accept_downloads=True)
 # a server of this module's own: the probe below must not time the collection of the
@@ -93,7 +92,7 @@ def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
     # runs (in a process of its own) and reports its progress, and when it is cancelled
     page.wait_complete()
     with LivenessProbe(page.url) as probe:
-        time.sleep(2.0)
+        time.sleep(2.0)  # a window of the study's running, not a wait for the page
         cancel = page.page.locator(".study-cancel button").first
         until(lambda: cancel.is_enabled(), "Cancel enabled")
         cancel.click()

@@ -63,11 +63,11 @@ def own_explorer_server() -> Any:
     own_explorer_server()`` at the module's top."""
     import pytest
 
-    from tests.support.serving import ExplorerProcess
+    from tests.support.serving import ExplorerProcess, browser_test_server
 
     @pytest.fixture(scope="module", name="explorer_server")
     def explorer_server() -> Iterator[ExplorerProcess]:
-        with ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180) as served:
+        with browser_test_server() as served:
             yield served
 
     return explorer_server

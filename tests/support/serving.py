@@ -25,7 +25,7 @@ from pathlib import Path
 from types import TracebackType
 
 __all__ = ["CHROMIUM", "CHROMIUM_ARGS", "ExplorerProcess", "ExplorerStartError", "browser_missing",
-           "free_port"]
+           "browser_test_server", "free_port"]
 
 #: The browser the tests and benchmarks drive the served page with: Debian's Chromium
 #: (installed by tests/run.sh; Playwright's own download does not work everywhere).
@@ -251,3 +251,10 @@ class ExplorerProcess:
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.stop()
+
+
+def browser_test_server() -> ExplorerProcess:
+    """The served explorer the browser tests drive (default options, one BLAS thread), not
+    started yet: use it as a context manager."""
+    # 180 s: the server solves the default scene once before it answers
+    return ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180)
