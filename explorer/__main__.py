@@ -64,6 +64,18 @@ WEBSOCKET_MAX_BYTES = 4 * 2**20
 EXPLORER_PACKAGES = ("panel", "bokeh", "param", "tornado", "holoviews", "distributed", "xarray")
 
 
+def quiet_bokeh_diagnostics() -> None:
+    """Turn off Bokeh's "expensive error diagnostics" (its setting
+    ``perform_error_diagnostics``) in the server: a check of every callback's signature
+    as it is registered (~4,800 a page, each through ``inspect.signature``: 6 % of a
+    page's building, cProfile) and close-match suggestions for a misspelt attribute. They
+    serve whoever writes the code, and the test suite keeps them on (the explorer's code
+    is checked there); a visitor's page gains nothing from them."""
+    from bokeh.settings import settings
+
+    settings.perform_error_diagnostics.set_value(False)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="coated-punch-explorer",
@@ -144,6 +156,7 @@ def main(argv: list[str] | None = None) -> int:
         print("--session-linger must be between 0.5 and 3600 seconds", file=sys.stderr)
         return 2
     closed_pages.install()  # a tab closed abruptly is a debug line, not a traceback
+    quiet_bokeh_diagnostics()
     if args.solver_processes:
         print(f"Starting {args.solver_processes} solver process(es)...", file=sys.stderr,
               flush=True)

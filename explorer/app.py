@@ -19,7 +19,15 @@ from typing import Any
 
 import panel as pn
 
-from .fixes import bokeh_fixes, closed_pages, gc_policy, idle_painter, model_walk, panel_fixes
+from .fixes import (
+    bokeh_fixes,
+    closed_pages,
+    gc_policy,
+    idle_painter,
+    model_walk,
+    panel_fixes,
+    property_defaults,
+)
 from .model import (
     DEFAULT_PRESET,
     DesignLimits,
@@ -64,6 +72,7 @@ __all__ = ["ExplorerApp", "LIVE_SOLVE_S", "create_app"]
 log = logging.getLogger(__name__)
 panel_fixes.install()
 model_walk.install()
+property_defaults.install()
 install_websocket_marks()
 
 #: Geometry and material sliders apply each drag step (not only the release) while the
@@ -399,6 +408,7 @@ def create_app(**kwargs: Any) -> ExplorerApp:
     served = bool(pn.state.curdoc is not None and pn.state.curdoc.session_context)
     kwargs.setdefault("executor", "shared" if served else None)
     if served:
+        gc_policy.pause_for_page()
         pn.state.on_session_destroyed(gc_policy.session_ended)
         bokeh_fixes.install(pn.state.curdoc)
         idle_painter.install(pn.state.curdoc)

@@ -12,9 +12,19 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
 - ``gc_policy``: the garbage collector kept off complete pages, and given them back.
 - ``model_walk``: Bokeh's walk over a document's models without building the constant
   defaults it reads (each change of the page's shape walks every model).
+- ``property_defaults``: Bokeh's property defaults and type names worked out once per
+  class, not per new model.
 """
 
-from . import bokeh_fixes, closed_pages, gc_policy, idle_painter, model_walk, panel_fixes
+from . import (
+    bokeh_fixes,
+    closed_pages,
+    gc_policy,
+    idle_painter,
+    model_walk,
+    panel_fixes,
+    property_defaults,
+)
 
 __all__ = ["bokeh_fixes", "closed_pages", "gc_policy", "idle_painter", "model_walk",
-           "panel_fixes"]
+           "panel_fixes", "property_defaults"]

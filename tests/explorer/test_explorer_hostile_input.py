@@ -175,6 +175,8 @@ def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:
 
     served: list[dict[str, Any]] = []  # the options pn.serve would be given
     monkeypatch.setattr(entry, "_serve", lambda pn, apps, **k: served.append(k))
+    # (the server's switch of Bokeh's diagnostics would outlast this test in the process)
+    monkeypatch.setattr(entry, "quiet_bokeh_diagnostics", lambda: None)
     base = ["--port", "5999", "--warm-up", "none", "--solver-processes", "0"]
     assert entry.main(base) == 0
     assert served[-1]["address"] == "localhost" and served[-1]["websocket_origin"] is None
