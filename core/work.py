@@ -11,12 +11,16 @@ contact where the unilateral solver refuses a scene) must not take it for a refu
 The bound is this thread's CPU time (``time.thread_time``), so a busy machine does not
 stop a solve that a quiet one would finish; it lives in a context variable, so threads
 solving at the same time have their own.
+
+The same loops stop a solve whose answer is no longer wanted (:func:`cancellable`: a
+newer request of the same user superseded it): :class:`SolveCancelled`, which no level
+of the solver words or catches.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 
@@ -24,6 +28,12 @@ from core import limits
 
 #: (deadline in this thread's CPU time [s], the bound it came from [s]), or None.
 _BOUND: ContextVar[tuple[float, float] | None] = ContextVar("solve_work_bound", default=None)
+#: Whether the answer of the solve in this context is no longer wanted, or None.
+_CANCELLED: ContextVar[Callable[[], bool] | None] = ContextVar("solve_cancelled", default=None)
+
+
+class SolveCancelled(RuntimeError):
+    """A solve stopped because its answer is no longer wanted (:func:`cancellable`)."""
 
 
 class WorkLimitExceeded(RuntimeError):
@@ -54,9 +64,24 @@ def work_bound(seconds: float | None = limits.MAX_SOLVE_CPU_SECONDS) -> Iterator
         _BOUND.reset(token)
 
 
+@contextmanager
+def cancellable(cancelled: Callable[[], bool]) -> Iterator[None]:
+    """Stop the work inside with :class:`SolveCancelled` at the next :func:`check_work`
+    once ``cancelled()`` is true (it is asked there, so it must be cheap: ~1 us)."""
+    token = _CANCELLED.set(cancelled)
+    try:
+        yield
+    finally:
+        _CANCELLED.reset(token)
+
+
 def check_work(doing: str) -> None:
-    """Raise :class:`WorkLimitExceeded` if the bound of the solve in this thread is spent;
-    ``doing``: what the loop calling it does (e.g. "following lift-off under creep")."""
+    """Raise :class:`WorkLimitExceeded` if the bound of the solve in this thread is spent,
+    :class:`SolveCancelled` if its answer is no longer wanted; ``doing``: what the loop
+    calling it does (e.g. "following lift-off under creep")."""
     bound = _BOUND.get()
     if bound is not None and time.thread_time() > bound[0]:
         raise WorkLimitExceeded(bound[1], doing)
+    cancelled = _CANCELLED.get()
+    if cancelled is not None and cancelled():
+        raise SolveCancelled(f"the solve was cancelled while {doing}")

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 import param
 
 from core import STAGE_CACHE_BYTES, solve
+from core.work import SolveCancelled
 
 from ..model import DesignLimits, ExplorerState, ResultView, prepare_view, scene_with_limits
 from .answer_wait import when_answered
@@ -67,6 +68,17 @@ def shared_pool(max_workers: int = 4) -> ThreadPoolExecutor:
         if _POOL is None:
             _POOL = ThreadPoolExecutor(max_workers=max_workers, thread_name_prefix="solve")
         return _POOL
+
+
+#: A request that comes while this session's solve has run this long [s] cancels it (in a
+#: worker process): a solve over the explorer's live bound (0.1 s) draws no frame of a
+#: drag anyway, and the newest request (a preset switch, a typed value, a release) then
+#: waits for no answer nobody wants. Measured before: a preset switch behind the stepped
+#: punch's lift-off solves (4-8 s each) took 10.6 s (benchmarks/results/
+#: explorer_latency_presets.md).
+CANCEL_AFTER_S = 0.25
+#: The outcome of a cancelled solve: nothing to show (the newer request's follows).
+CANCELLED = "cancelled"
 
 
 def _default_solve(scene: dict[str, Any]) -> Any:
@@ -191,6 +203,8 @@ class SolveController(param.Parameterized):
         self._shown = 0           # id of the newest outcome shown
         self._running = False
         self._pending: tuple[int, dict[str, Any]] | None = None
+        # this session's request in a worker now, and since when (monotonic [s])
+        self._in_worker: tuple[SentRequest, float] | None = None
         if auto:
             state.param.watch(lambda event: self.request(), "revision")
 
@@ -220,6 +234,10 @@ class SolveController(param.Parameterized):
             if queued:
                 self._pending = (rid, scene)
             self._running = True
+            running = self._in_worker
+        if (queued and running is not None and self._processes is not None
+                and time.monotonic() - running[1] > CANCEL_AFTER_S):
+            self._processes.cancel(running[0])
         # the worker first: the watchers of ``requests`` and ``busy`` (the status line)
         # run while it solves
         sent = None if queued else self._send_now(scene)
@@ -232,6 +250,9 @@ class SolveController(param.Parameterized):
     def _wait(self, rid: int, scene: dict[str, Any], sent: SentRequest | None) -> None:
         # A request written to the worker by the event loop is awaited by that loop
         # (explorer/solving/answer_wait.py); anything else by a thread of the pool.
+        if sent is not None:
+            with self._lock:
+                self._in_worker = (sent, time.monotonic())
         if sent is None or not when_answered(
                 sent, lambda: self._answered(rid, scene, sent),
                 lambda: self._executor.submit(self._work, rid, scene, sent)):
@@ -243,6 +264,11 @@ class SolveController(param.Parameterized):
         outcome = self._collect(scene, sent)
         self._dispatch(lambda: self._deliver(rid, outcome))
         pending = self._take_pending()
+        if pending is None and outcome is CANCELLED:
+            # (not expected: only a newer request cancels; the answer is still wanted)
+            with self._lock:
+                self._running = True
+            pending = (rid, scene)
         if pending is not None:
             self._wait(*pending, self._send_now(pending[1]))
 
@@ -260,8 +286,12 @@ class SolveController(param.Parameterized):
         # event loop must not.
         try:
             view = self._processes.result(sent)
+        except SolveCancelled:
+            return CANCELLED
         except Exception as exc:
             return _failure_text(exc)
+        finally:
+            self._left_worker(sent)
         key = result_key(scene)
         cached = RESULTS.get(key) if key is not None else None
         if cached is not None:
@@ -306,14 +336,27 @@ class SolveController(param.Parameterized):
         self._deliver(rid, outcome)
         return rid
 
+    def _left_worker(self, sent: SentRequest) -> None:
+        with self._lock:
+            if self._in_worker is not None and self._in_worker[0] is sent:
+                self._in_worker = None
+
     def _work(self, rid: int, scene: dict[str, Any], sent: SentRequest | None = None) -> None:
         while True:
             outcome = self._compute(scene, sent)
+            if sent is not None:
+                self._left_worker(sent)
             sent = None
             self._dispatch(lambda rid=rid, outcome=outcome: self._deliver(rid, outcome))
             pending = self._take_pending()
             if pending is None:
-                return
+                if outcome is not CANCELLED:
+                    return
+                # another session's solve of the same scene, which this one waited for,
+                # was cancelled: this session still wants the answer
+                with self._lock:
+                    self._running = True
+                pending = (rid, scene)
             rid, scene = pending
 
     def _view(self, scene: dict[str, Any], sent: list[SentRequest]) -> ResultView:
@@ -332,6 +375,8 @@ class SolveController(param.Parameterized):
                 return self._view(scene, unread)
             view, reused = RESULTS.get_or_compute(key, lambda: self._view(scene, unread))
             return replace(view, info={**view.info, "reused": True}) if reused else view
+        except SolveCancelled:
+            return CANCELLED
         except Exception as exc:
             return _failure_text(exc)
         finally:
@@ -345,7 +390,7 @@ class SolveController(param.Parameterized):
 
     def _deliver(self, rid: int, outcome: ResultView | str) -> None:
         mark("delivered", rid=rid)
-        if rid < self._shown:
+        if rid < self._shown or outcome is CANCELLED:
             return
         self._shown = rid
         with self._lock:

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import core.report
 from core import set_stage_cache_budget, solve, stage_cache_bytes
+from core.work import cancellable
 
 from ..model import ResultView, prepare_view
 from .memory_bound import WORKER_MEMORY_BYTES, bound_memory, out_of_memory
@@ -111,21 +112,30 @@ def worker_info() -> dict[str, int]:
     return {"pid": os.getpid(), "stage_cache_bytes": stage_cache_bytes()}
 
 
-def serve(connection: multiprocessing.connection.Connection, stage_cache_bytes: int) -> None:
+def serve(connection: multiprocessing.connection.Connection, stage_cache_bytes: int,
+          cancel: Any = None) -> None:
     # A worker's main loop: one request (fn, args) in, one ("ok", value) or ("error",
     # exception) out, on its own pipe. No executor between the server and the worker: a
     # ProcessPoolExecutor hands each request and each result over through two more threads
     # of the server (its queue feeder and its manager), and on a busy machine every
     # hand-over waits for a core.
+    # ``cancel`` (a shared integer): the number of the request (1, 2, ... in the order
+    # received) whose answer the server no longer wants; the solve stops at its next
+    # check (core.work.cancellable).
     _start_worker(stage_cache_bytes)
+    received = 0
     while True:
         try:
             fn, args = connection.recv()
         except (EOFError, OSError):  # the server closed the pipe (or is gone)
             return
+        received += 1
         start = time.monotonic()
         try:
-            reply: tuple[str, Any, tuple[float, float]] = ("ok", fn(*args), (start, 0.0))
+            with cancellable(lambda number=received: cancel is not None
+                             and cancel.value == number):
+                value = fn(*args)
+            reply: tuple[str, Any, tuple[float, float]] = ("ok", value, (start, 0.0))
         except MemoryError:  # the bound of this worker, said in words
             reply = ("error", MemoryError(out_of_memory(
                 "this solve", WORKER_MEMORY_BYTES, "fewer output times (times.count) or a "

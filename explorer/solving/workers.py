@@ -72,6 +72,8 @@ class SentRequest:
 
     def __init__(self, lane: _Lane, fn: Any, args: tuple[Any, ...]) -> None:
         self.lane, self.fn, self.args = lane, fn, args
+        # which request of which worker it is (for :meth:`SolverProcesses.cancel`)
+        self.process, self.number = lane.process, lane.sent
 
 
 class _Lane:
@@ -87,7 +89,12 @@ class _Lane:
     def _new_worker(self) -> tuple[Any, multiprocessing.connection.Connection]:
         context = multiprocessing.get_context("spawn")
         ours, theirs = context.Pipe(duplex=True)
-        process = context.Process(target=serve, args=(theirs, self.stage_cache_bytes),
+        # the number of the request whose answer is no longer wanted (requests are
+        # numbered 1, 2, ... in the order sent, by both sides of the pipe)
+        self.cancel = context.RawValue("q", 0)
+        self.sent = 0
+        process = context.Process(target=serve,
+                                  args=(theirs, self.stage_cache_bytes, self.cancel),
                                   name=f"solver-{self.index}", daemon=True)
         process.start()
         theirs.close()  # the worker's end lives in the worker: its death closes the pipe
@@ -109,6 +116,7 @@ class _Lane:
             connection.send((fn, args))
         except (EOFError, OSError):  # a broken pipe, or closed by a shutdown
             raise _WorkerDied("before") from None
+        self.sent += 1
         mark("sent", lane=self.index)
 
     def receive(self, timeout: float) -> Any:
@@ -217,6 +225,16 @@ class SolverProcesses:
                 self._cond.notify_all()
             return None
         return SentRequest(lane, fn, args)
+
+    def cancel(self, sent: SentRequest) -> None:
+        """Tell the worker that the answer of ``sent`` is no longer wanted: the solve stops
+        at its next check of its work (``core.work.check_work``, every time step of a
+        creeping base and every step of lift-off under creep) and :meth:`result` raises
+        ``core.work.SolveCancelled``. A request already answered (the worker then works
+        for someone else, or is a new one) is left alone."""
+        lane = sent.lane
+        if lane.process is sent.process:
+            lane.cancel.value = sent.number
 
     def result(self, sent: SentRequest) -> Any:
         """The value of a request given by :meth:`send_now`, with :meth:`run`'s handling

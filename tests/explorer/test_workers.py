@@ -145,6 +145,51 @@ def test_a_session_sends_a_load_step_from_its_own_thread(processes, monkeypatch)
     assert session.wait(120) and sent == sent[:1]
 
 
+def test_a_solve_no_longer_wanted_is_stopped_in_its_worker(processes) -> None:
+    """A request cancelled while its worker solves stops there (the scene below runs to
+    the 60 s bound of a solve otherwise, refused); the worker's next request is answered."""
+    from core.work import SolveCancelled
+    from tests.scene.test_work_bound import _sine_tilt_on_creep
+
+    sent = processes.send_now(0, solve_view, _sine_tilt_on_creep())
+    assert sent is not None
+    processes.cancel(sent)
+    with pytest.raises(SolveCancelled, match="cancelled while"):
+        processes.result(sent)
+    assert processes.run(0, os.getpid) == processes.pids()[0]  # not cancelled: a new number
+    processes.cancel(sent)  # answered already: nothing to cancel
+    assert processes.run(0, os.getpid) == processes.pids()[0]
+
+
+def test_a_newer_request_cancels_a_slow_solve_of_the_same_session(processes,
+                                                                  monkeypatch) -> None:
+    """A preset switch waited 10.6 s behind a lift-off solve of the scene before it: the
+    newer request cancels a solve that has run CANCEL_AFTER_S, and its answer is shown
+    with no error from the cancelled one."""
+    from tests.scene.test_work_bound import _sine_tilt_on_creep
+
+    monkeypatch.setattr(controller_module, "_PROCESSES", processes)
+    RESULTS.clear()
+    state = ExplorerState()
+    session = SolveController(state, auto=False)
+    errors: list[str] = []
+    session.param.watch(lambda event: errors.append(event.new), "error")
+    slow = _sine_tilt_on_creep()
+    monkeypatch.setattr(state, "to_scene", lambda: slow)
+    session.request()
+    time.sleep(2 * controller_module.CANCEL_AFTER_S)  # it runs in its worker meanwhile
+    monkeypatch.setattr(state, "to_scene", lambda: small_scene())
+    session.request()
+    assert session.wait(120)
+    assert session.error == "" and not errors and session.view is not None
+    assert session.view.scene == small_scene()
+
+
+def small_scene() -> dict[str, Any]:
+    """The explorer's default scene (solved in ~30 ms)."""
+    return ExplorerState().to_scene()
+
+
 def test_a_bad_scene_from_a_worker_names_its_field(processes, monkeypatch,
                                                   small_preset) -> None:
     scene = small_preset(force_kN=400.0)

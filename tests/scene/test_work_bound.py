@@ -10,7 +10,7 @@ import pytest
 
 from core.limits import MAX_SOLVE_CPU_SECONDS
 from core.scene import solve
-from core.work import WorkLimitExceeded, check_work, work_bound
+from core.work import SolveCancelled, WorkLimitExceeded, cancellable, check_work, work_bound
 from tests.conftest import scene_file
 
 
@@ -66,3 +66,20 @@ def test_nested_bounds_keep_the_tighter_and_threads_their_own():
         thread.start()
         thread.join()
         assert seen == [True]
+
+
+def test_a_solve_no_longer_wanted_stops_with_its_own_error():
+    """A cancelled solve (a newer request of the same user superseded it) stops at its
+    next check, mid-way, with an error no level of the solver words as a refusal."""
+    asked = [0]
+
+    def cancelled() -> bool:
+        asked[0] += 1
+        return asked[0] > 20  # after 20 checks: well inside the solve
+
+    with work_bound(30.0), cancellable(cancelled), pytest.raises(SolveCancelled) as stopped:
+        solve(_sine_tilt_on_creep())
+    assert asked[0] == 21
+    assert "following the contact zones under creep" in str(stopped.value)
+    # outside, nothing is cancelled
+    check_work("nothing")
