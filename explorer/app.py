@@ -19,15 +19,7 @@ from typing import Any
 
 import panel as pn
 
-from .fixes import (
-    bokeh_fixes,
-    closed_pages,
-    gc_policy,
-    idle_painter,
-    model_walk,
-    panel_fixes,
-    property_defaults,
-)
+from .fixes import bokeh_fixes, closed_pages, gc_policy, idle_painter, install_in_process
 from .model import (
     DEFAULT_PRESET,
     DesignLimits,
@@ -70,9 +62,7 @@ from .views import (
 __all__ = ["ExplorerApp", "LIVE_SOLVE_S", "create_app"]
 
 log = logging.getLogger(__name__)
-panel_fixes.install()
-model_walk.install()
-property_defaults.install()
+install_in_process()
 install_websocket_marks()
 
 #: Geometry and material sliders apply each drag step (not only the release) while the

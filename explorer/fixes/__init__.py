@@ -26,5 +26,13 @@ from . import (
     property_defaults,
 )
 
-__all__ = ["bokeh_fixes", "closed_pages", "gc_policy", "idle_painter", "model_walk",
-           "panel_fixes", "property_defaults"]
+__all__ = ["bokeh_fixes", "closed_pages", "gc_policy", "idle_painter", "install_in_process",
+           "model_walk", "panel_fixes", "property_defaults"]
+
+
+def install_in_process() -> None:
+    """Install the fixes that hold for the whole process (not per page): Panel's queued
+    messages, Bokeh's model walk and its property defaults."""
+    panel_fixes.install()
+    model_walk.install()
+    property_defaults.install()

@@ -59,7 +59,7 @@ LATE_COLLECT_AFTER_S = 10.0
 PAUSE_AT_MOST_S = 10.0
 
 _collect_due = False
-_paused = 0
+_paused = False
 
 
 def _libc_trim() -> Any:
@@ -99,7 +99,7 @@ def pause_for_page() -> bool:
         return False
     if not gc.isenabled() and not _paused:
         return False  # switched off by someone else: theirs to switch on
-    _paused += 1
+    _paused = True
     gc.disable()
     loop.call_soon(_resume)
     loop.call_later(PAUSE_AT_MOST_S, _resume)
@@ -109,7 +109,7 @@ def pause_for_page() -> bool:
 def _resume() -> None:
     global _paused
     if _paused:
-        _paused = 0
+        _paused = False
         gc.enable()
 
 

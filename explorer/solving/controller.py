@@ -263,12 +263,8 @@ class SolveController(param.Parameterized):
         # (if one came meanwhile) sent
         outcome = self._collect(scene, sent)
         self._dispatch(lambda: self._deliver(rid, outcome))
+        # (a cancelled outcome always has a pending request: only a newer one cancels)
         pending = self._take_pending()
-        if pending is None and outcome is CANCELLED:
-            # (not expected: only a newer request cancels; the answer is still wanted)
-            with self._lock:
-                self._running = True
-            pending = (rid, scene)
         if pending is not None:
             self._wait(*pending, self._send_now(pending[1]))
 
