@@ -2,7 +2,7 @@
 # Installs everything the test suite needs, then runs the whole suite and builds the
 # documentation.
 # Usage (from the repository root):  bash tests/run.sh [pytest args]
-# Without arguments the whole suite runs in two halves at once and the documentation is
+# Without arguments the whole suite runs in three parts at once and the documentation is
 # built beside them (see below); with arguments one pytest run gets them (e.g.
 # bash tests/run.sh tests/scene/test_scene.py -x) and the documentation is not built.
 # SKIP_SETUP=1 skips the installation (an environment already set up).
@@ -44,23 +44,25 @@ if [ "$#" -gt 0 ]; then
     exec python -m pytest -q "$@"
 fi
 
-# The whole suite: the browser tests (marker "browser": a served explorer and Chromium)
-# and the rest run at the same time, one pytest each, so that both cores work (one pytest
-# keeps one core busy; the halves take about as long as each other). Measured on 2 cores
-# shared with other work: 15.4 min (load average 2 -> 7, 355 s of CPU) where one pytest
-# took 20.6 min (load 1 -> 9, 439 s of CPU, before tests were made cheaper). The halves
-# share nothing: each has its own temporary directory, pytest cache and served explorers
-# (a free port each). The soak and slow tests run in the second half: the browser half is
-# the longer one.
+# The whole suite in three parts at once, one pytest each: the browser tests (marker
+# "browser": a served explorer and Chromium), the soak tests (marker "soak": servers and
+# worker processes started, stopped, killed and left idle, much of it waiting on them) and
+# the rest. One pytest keeps one core busy; the soak part's waits leave room for the other
+# two, and when one part ends first the others still have both cores. The parts share
+# nothing: each has its own temporary directory, pytest cache and served explorers (a free
+# port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
 python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
     >"$work/browser.log" 2>&1 &
 browser_pid=$!
+python -m pytest -q -m "soak and not browser" --basetemp "$work/soak" \
+    -o cache_dir=.pytest_cache/soak >"$work/soak.log" 2>&1 &
+soak_pid=$!
 
 # The documentation (docs/, Sphinx): built here so that it cannot rot. Warnings are errors
 # (-W), so a renamed API, a broken docstring, a moved report or link, or a gallery example
 # that no longer runs fails the run. Always from an empty build directory: an incremental
-# build would not repeat the warnings of pages it skips. It runs beside the two halves
+# build would not repeat the warnings of pages it skips. It runs beside the three parts
 # (~30 s of one core; measured in docs/conf.py's docstring). The pages stay in
 # DOCS_BUILD_DIR (default ${TMPDIR:-/tmp}/coated-punch-docs, outside the source tree):
 # open index.html there.
@@ -79,12 +81,15 @@ build_docs() {
 build_docs >"$work/docs.log" 2>&1 &
 docs_pid=$!
 # (kill fails once a job has ended: no status of its own may reach the exit code)
-trap 'kill "$browser_pid" "$docs_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'kill "$browser_pid" "$soak_pid" "$docs_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
 set +e
-python -m pytest -q -m "not browser" --basetemp "$work/rest" -o cache_dir=.pytest_cache/rest
+python -m pytest -q -m "not browser and not soak" --basetemp "$work/rest" \
+    -o cache_dir=.pytest_cache/rest
 rest=$?
 wait "$browser_pid"
 browser=$?
+wait "$soak_pid"
+soak=$?
 wait "$docs_pid"
 docs=$?
 set -e
@@ -92,5 +97,7 @@ echo "---- documentation (sphinx -W) ----"
 cat "$work/docs.log"
 echo "---- browser tests (pytest -m browser) ----"
 cat "$work/browser.log"
-echo "---- exit codes: rest $rest, browser $browser, docs $docs ----"
-[ "$rest" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$docs" -eq 0 ]
+echo "---- soak tests (pytest -m soak) ----"
+cat "$work/soak.log"
+echo "---- exit codes: rest $rest, browser $browser, soak $soak, docs $docs ----"
+[ "$rest" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$soak" -eq 0 ] && [ "$docs" -eq 0 ]
