@@ -15,6 +15,7 @@ Nothing here imports Panel or Bokeh when imported (the solver workers import it 
 - ``study_runner``: :class:`StudyRun`, a design study in a process of its own;
   ``fair_share``: the turns the server's studies take (:class:`StudyShare`).
 - ``memory_bound``: the address-space bounds of the worker and study processes.
+- ``priority``: studies and coating checks at a lower CPU priority than slider solves.
 - ``trace``: timestamps of a slider move's way through the server (latency benchmark).
 """
 
@@ -29,11 +30,13 @@ from .controller import (
     worker_processes,
 )
 from .fit_runner import FitRun
+from .priority import BACKGROUND_NICENESS, at_background_priority
 from .study_runner import StudyRun
 from .trace import install_websocket_marks, mark
 from .warm_up import warm_up
 from .workers import SolverProcesses, WorkerFailed
 
-__all__ = ["RESULTS", "FitRun", "SolveController", "SolverProcesses", "StudyRun", "WorkerFailed",
-           "approx_bytes", "describe_field", "format_error", "install_websocket_marks", "mark",
-           "shared_pool", "use_worker_processes", "warm_up", "worker_processes"]
+__all__ = ["BACKGROUND_NICENESS", "RESULTS", "FitRun", "SolveController", "SolverProcesses",
+           "StudyRun", "WorkerFailed", "approx_bytes", "at_background_priority",
+           "describe_field", "format_error", "install_websocket_marks", "mark", "shared_pool",
+           "use_worker_processes", "warm_up", "worker_processes"]

@@ -44,6 +44,7 @@ from ..model import PlannedStudy, StudyResult
 from .background import BackgroundRun
 from .fair_share import SHARE, StudyShare, resume
 from .memory_bound import STUDY_MEMORY_BYTES, bound_memory, out_of_memory
+from .priority import lower_process_priority
 
 log = logging.getLogger(__name__)
 
@@ -90,6 +91,7 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
     """Run the study and put ``("progress", done, total)`` after every batch, then
     ``("done", arrays)`` or ``("error", message)`` on ``out``."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl+C is the server's to handle
+    lower_process_priority()  # the pages' slider solves come first
     bound_memory(STUDY_MEMORY_BYTES)
     set_stage_cache_budget(STUDY_CACHE_BYTES)
 

@@ -1,8 +1,9 @@
 """The server's studies take turns (explorer/solving/fair_share.py): a study started while
 another runs no longer waits for it to end, only one runs at any moment (the others
 paused), the queue beyond the processes allowed is first come first served, a cancelled
-waiting study leaves the queue, and a study's process and a solver worker are bounded in
-memory (explorer/solving/memory_bound.py).
+waiting study leaves the queue, a study's process and a solver worker are bounded in
+memory (explorer/solving/memory_bound.py), and studies and coating checks run at a lower
+CPU priority than the pages' slider solves (explorer/solving/priority.py).
 
 The turns themselves are checked with a clock of the test's own; the real studies with
 real processes (paused by SIGSTOP, which Windows lacks)."""
@@ -10,6 +11,7 @@ real processes (paused by SIGSTOP, which Windows lacks)."""
 from __future__ import annotations
 
 import copy
+import os
 import threading
 import time
 from pathlib import Path
@@ -24,6 +26,12 @@ from explorer.solving.memory_bound import (
     STUDY_MEMORY_BYTES,
     WORKER_MEMORY_BYTES,
     address_space_bound,
+)
+from explorer.solving.priority import (
+    BACKGROUND_NICENESS,
+    PER_THREAD,
+    at_background_priority,
+    thread_niceness,
 )
 from explorer.solving.workers import SolverProcesses
 
@@ -99,6 +107,10 @@ def test_two_pages_studies_run_in_turns_and_both_finish() -> None:
     while first.process is None or first.done == 0:
         assert time.monotonic() < deadline, first.message
         time.sleep(0.02)
+    if hasattr(os, "getpriority"):
+        # the study yields the CPU to the pages' slider solves (19: the nicest there is)
+        assert os.getpriority(os.PRIO_PROCESS, first.process.pid) == min(
+            os.getpriority(os.PRIO_PROCESS, 0) + BACKGROUND_NICENESS, 19)
     second.start(short)
     both_running = paused_first = 0
     seen_second_alive_with_first = False
@@ -176,3 +188,39 @@ def test_a_solver_worker_is_bounded_in_memory_and_says_so() -> None:
         assert processes.run(0, allocate, 1000) == 1000
     finally:
         processes.shutdown()
+
+
+@pytest.mark.skipif(not PER_THREAD, reason="a niceness per thread (Linux)")
+def test_a_coating_check_runs_nicer_than_the_workers_other_requests() -> None:
+    """A coating check (seconds of FE work) runs in a solver worker at a lower priority
+    than the slider solves of the other workers; the worker's next request runs at the
+    server's priority again (an unprivileged process cannot take back a lower one)."""
+    processes = SolverProcesses(1, 64 * 1024**2)
+    try:
+        base = processes.run(0, thread_niceness)
+        assert processes.run(0, at_background_priority, thread_niceness) == min(
+            base + BACKGROUND_NICENESS, 19)
+        assert processes.run(0, thread_niceness) == base
+        with pytest.raises(MemoryError):  # its failure reaches the server as it was
+            processes.run(0, at_background_priority, allocate,
+                          address_space_bound(WORKER_MEMORY_BYTES))
+    finally:
+        processes.shutdown()
+
+
+def test_the_coating_check_asks_its_worker_for_the_lower_priority(monkeypatch) -> None:
+    from explorer.views import coating
+
+    asked = []
+
+    class Workers:
+        def assign(self) -> int:
+            return 0
+
+        def run(self, lane, fn, *args):
+            asked.append((fn, args[0]))
+            return {"ok": True}
+
+    monkeypatch.setattr(coating, "worker_processes", Workers)
+    assert coating._check(_scene()) == {"ok": True}
+    assert asked == [(at_background_priority, coating.check_scene)]
