@@ -15,7 +15,7 @@ Nothing here imports Panel or Bokeh when imported (the solver workers import it 
 - ``study_runner``: :class:`StudyRun`, a design study in a process of its own;
   ``fair_share``: the turns the server's studies take (:class:`StudyShare`).
 - ``memory_bound``: the address-space bounds of the worker and study processes.
-- ``priority``: studies and coating checks at a lower CPU priority than slider solves.
+- ``priority``: studies, coating checks and fits at a lower CPU priority than slider solves.
 - ``trace``: timestamps of a slider move's way through the server (latency benchmark).
 """
 

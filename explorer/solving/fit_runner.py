@@ -2,7 +2,10 @@
 
 A fit is 10-100 solves at the readings' times (0.3-6 s of CPU, measured on the presets
 with one to three fields): on a thread of its own it leaves the page's loop free, and its
-answer comes back through ``dispatch``. At most :data:`MAX_RUNNING_FITS` run at once in
+answer comes back through ``dispatch``. Served with worker processes, the fit runs in one
+of them at a lower CPU priority than the pages' slider solves
+(:mod:`explorer.solving.priority`): in the server's own process it held Python's lock for
+seconds beside the event loop. At most :data:`MAX_RUNNING_FITS` run at once in
 a server (a fit started meanwhile waits): the machine also serves every page's slider
 solves. A fit cannot be stopped half way (the core's least-squares solver has no hook);
 its work is bounded by ``core.limits.MAX_FIT_SOLVES``.
@@ -23,6 +26,9 @@ from core.back_analysis import Readings
 
 from ..model import run_fit
 from .background import BackgroundRun
+from .controller import worker_processes
+from .priority import at_background_priority
+from .worker_side import fit_outcome
 
 log = logging.getLogger(__name__)
 
@@ -60,7 +66,12 @@ class FitRun(BackgroundRun):
               ) -> None:
         with _SLOTS:
             try:
-                outcome = run_fit(scene, readings, keys)
+                processes = worker_processes()
+                if processes is None:
+                    outcome = run_fit(scene, readings, keys)
+                else:
+                    outcome = processes.run(processes.assign(), at_background_priority,
+                                            fit_outcome, scene, readings, keys)
             except ValueError as exc:
                 self._set(status="failed", message=str(exc))
                 return

@@ -1,16 +1,17 @@
 """Background work gives the CPU to slider solves first.
 
-A study (a process of its own) and a coating check (a worker's request) run for seconds
-to minutes at full speed; on a 2-core server they took a core from every page's slider
-solves, whose answers then came late (benchmarks/results/load_test.md). They now run at
-the operating system's lower priority (niceness :data:`BACKGROUND_NICENESS` over the
-server's): where a slider solve and background work want the same core, the scheduler
-gives the slider ~90 % of it; on an idle core the background work runs at full speed.
+A study (a process of its own), a coating check and a fit (a worker's request each) run
+for seconds to minutes at full speed; on a 2-core server they took a core from every
+page's slider solves, whose answers then came late (benchmarks/results/load_test.md).
+They now run at the operating system's lower priority (niceness
+:data:`BACKGROUND_NICENESS` over the server's): where a slider solve and background work
+want the same core, the scheduler gives the slider ~90 % of it; on an idle core the
+background work runs at full speed.
 
 Linux sets a niceness per thread, which is what a worker needs: it cannot take back a
-lower priority once given (without privileges), so a coating check runs on a thread of
+lower priority once given (without privileges), so a check or a fit runs on a thread of
 its own at the lower priority while the worker's main thread waits, and the worker's next
-request runs at the server's priority again. Elsewhere the check runs as it did.
+request runs at the server's priority again. Elsewhere they run as they did.
 
 Nothing here imports Panel.
 """

@@ -17,13 +17,14 @@ import os
 import signal
 import threading
 import time
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import core.report
 from core import set_stage_cache_budget, solve, stage_cache_bytes
 from core.work import cancellable
 
-from ..model import ResultView, prepare_view
+from ..model import FitOutcome, ResultView, prepare_view, run_fit
 from .memory_bound import WORKER_MEMORY_BYTES, bound_memory, out_of_memory
 
 if TYPE_CHECKING:
@@ -105,6 +106,16 @@ def solution_text(solution: Any, kind: str, info: dict[str, Any] | None = None,
         return getattr(core.report, kind)(solution, shown_time, check=check,
                                           calibration=calibration)
     return getattr(solution, kind)()
+
+
+def fit_outcome(scene: dict[str, Any], readings: Any, keys: list[str | None]) -> FitOutcome:
+    """:func:`explorer.model.run_fit` in a worker: the outcome without the forecast's
+    solution object (which stays in the worker, as a slider solve's does: the page draws
+    the forecast's histories and band, which it keeps)."""
+    outcome = run_fit(scene, readings, keys)
+    if outcome.forecast is None:
+        return outcome
+    return replace(outcome, forecast=replace(outcome.forecast, solution=None))
 
 
 def worker_info() -> dict[str, int]:

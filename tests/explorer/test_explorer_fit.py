@@ -197,3 +197,42 @@ def test_a_link_keeps_the_readings_and_the_fields(explorer_app):
     assert none is None and message.startswith("The readings in the link were not used")
     opened = explorer_app(query={"fit": encode_scene({"fields": 3})})
     assert "The readings in the link were not used" in opened.screen.notice
+
+
+def test_a_served_fit_runs_in_a_worker_at_the_lower_priority(explorer_app, monkeypatch):
+    """Served with worker processes, a fit runs in one of them (it held the server's
+    Python lock for its 0.3-6 s of CPU beside the event loop), at the lower priority of
+    background work, and gives the page what it gives run inline."""
+    from explorer.solving import at_background_priority, fit_runner
+    from explorer.solving.worker_side import fit_outcome
+    from explorer.solving.workers import SolverProcesses
+
+    app = explorer_app(solved=True)
+    scene = app.state.to_scene()
+    tab = app.fit_tab
+    tab.upload.param.update(filename="levelling.csv", value=_readings_text(scene).encode())
+    keys = ["coating[0].modulus"]
+    processes = SolverProcesses(1, 64 * 1024**2)
+    asked = []
+    run = processes.run
+
+    def spy(lane, fn, *args):
+        asked.append((fn, args[0]))
+        return run(lane, fn, *args)
+
+    monkeypatch.setattr(processes, "run", spy)
+    monkeypatch.setattr(fit_runner, "worker_processes", lambda: processes)
+    try:
+        fit = fit_runner.FitRun()
+        fit.start(scene, tab.readings, keys, background=False)
+    finally:
+        processes.shutdown()
+    assert fit.status == "done", fit.message
+    assert asked == [(at_background_priority, fit_outcome)]
+    inline = run_fit(scene, tab.readings, keys)
+    # the solver is deterministic: the same numbers in the worker as here
+    assert fit.outcome.calibration.values == inline.calibration.values
+    assert fit.outcome.rows() == inline.rows()
+    for name in ("settlement", "tilt", "settlement_std"):
+        np.testing.assert_array_equal(getattr(fit.outcome.forecast, name),
+                                      getattr(inline.forecast, name))
