@@ -27,7 +27,6 @@ from core.back_analysis import Readings
 from ..model import run_fit
 from .background import BackgroundRun
 from .controller import worker_processes
-from .priority import at_background_priority
 from .worker_side import fit_outcome
 
 log = logging.getLogger(__name__)
@@ -70,8 +69,8 @@ class FitRun(BackgroundRun):
                 if processes is None:
                     outcome = run_fit(scene, readings, keys)
                 else:
-                    outcome = processes.run(processes.assign(), at_background_priority,
-                                            fit_outcome, scene, readings, keys)
+                    outcome = processes.run_background(processes.assign(), fit_outcome,
+                                                       scene, readings, keys)
             except ValueError as exc:
                 self._set(status="failed", message=str(exc))
                 return

@@ -32,10 +32,11 @@ import time
 from concurrent.futures import Future
 from typing import Any
 
+from .priority import at_background_priority
 from .trace import TRACE_FILE, mark
 from .worker_side import DOWNLOADS, download_text, serve, solution_text, solve_view, worker_info
 
-__all__ = ["DOWNLOADS", "REQUEST_TIMEOUT_S", "SPILL_AFTER_S", "SentRequest",
+__all__ = ["BACKGROUND_TIMEOUT_S", "DOWNLOADS", "REQUEST_TIMEOUT_S", "SPILL_AFTER_S", "SentRequest",
            "SolverProcesses", "WorkerFailed", "download_text", "solution_text",
            "solve_view", "worker_info"]
 
@@ -54,6 +55,11 @@ SPILL_AFTER_S = 0.25
 #: scene is taken to be beyond what the explorer is for (or the worker to be stuck): the
 #: worker is stopped and replaced, and the session told.
 REQUEST_TIMEOUT_S = 60.0
+#: The time limit of background work in a worker [s] (:meth:`SolverProcesses.
+#: run_background`: an FE coating check, a fit of up to ``core.limits.MAX_FIT_SOLVES``
+#: solves), as long as a study's (``explorer.solving.study_runner.STUDY_TIMEOUT_S``): at
+#: the lower priority a saturated machine stretches such work several times.
+BACKGROUND_TIMEOUT_S = 600.0
 
 
 class WorkerFailed(RuntimeError):
@@ -203,6 +209,13 @@ class SolverProcesses:
         """
         return self._finish(self._acquire(preferred), fn, args, sent=False)
 
+    def run_background(self, preferred: int, fn: Any, *args: Any) -> Any:
+        """:meth:`run` for background work (an FE coating check, a fit): ``fn(*args)`` at
+        the lower priority of :func:`explorer.solving.priority.at_background_priority`,
+        bounded by :data:`BACKGROUND_TIMEOUT_S` instead of :data:`REQUEST_TIMEOUT_S`."""
+        return self._finish(self._acquire(preferred), at_background_priority, (fn, *args),
+                            sent=False, timeout=BACKGROUND_TIMEOUT_S)
+
     def send_now(self, preferred: int, fn: Any, *args: Any) -> SentRequest | None:
         """Give ``fn(*args)`` to lane ``preferred`` at once, from the calling thread, if
         that lane is idle with nobody waiting; None otherwise (then use :meth:`run`).
@@ -241,8 +254,12 @@ class SolverProcesses:
         of a worker that dies or gets stuck meanwhile."""
         return self._finish(sent.lane, sent.fn, sent.args, sent=True)
 
-    def _finish(self, lane: _Lane, fn: Any, args: tuple[Any, ...], sent: bool) -> Any:
-        # ``lane`` is held by this request (busy); ``sent``: fn(*args) is in its worker
+    def _finish(self, lane: _Lane, fn: Any, args: tuple[Any, ...], sent: bool,
+                timeout: float | None = None) -> Any:
+        # ``lane`` is held by this request (busy); ``sent``: fn(*args) is in its worker;
+        # ``timeout`` [s]: REQUEST_TIMEOUT_S when None (read now: tests shorten it)
+        if timeout is None:
+            timeout = REQUEST_TIMEOUT_S
         try:
             retried, starts = False, 0
             while True:
@@ -252,8 +269,8 @@ class SolverProcesses:
                 try:
                     if sent:
                         sent = False
-                        return lane.receive(REQUEST_TIMEOUT_S)
-                    return lane.call(fn, args, REQUEST_TIMEOUT_S)
+                        return lane.receive(timeout)
+                    return lane.call(fn, args, timeout)
                 except _WorkerDied as died:
                     self._replace(lane)
                     if str(died) == "before":  # died while idle: nothing was lost
@@ -273,7 +290,7 @@ class SolverProcesses:
                                        "please try again") from None
                 except TimeoutError:
                     self._replace(lane)
-                    raise WorkerFailed(f"the solve took longer than {REQUEST_TIMEOUT_S:.0f} "
+                    raise WorkerFailed(f"the solve took longer than {timeout:.0f} "
                                        "s and was stopped") from None
         finally:
             with self._cond:

@@ -13,7 +13,7 @@ import panel as pn
 from core.scene import check_scene
 
 from ..model import SCREEN_LAYERS, ExplorerState, Screen
-from ..solving import SolveController, at_background_priority, worker_processes
+from ..solving import SolveController, worker_processes
 from .fidelity import FidelityView
 from .loop import PageLoop
 from .punches import OnePunchOnly
@@ -243,8 +243,8 @@ def _check(scene: dict[str, Any], waiting: Callable[[], None] | None = None
         processes = worker_processes()
         if processes is not None:
             # at a lower priority than the pages' slider solves in the other workers
-            return processes.run(processes.assign(), at_background_priority, check_scene,
-                                 scene, 0.0, CHECK_LEVEL)
+            return processes.run_background(processes.assign(), check_scene, scene, 0.0,
+                                            CHECK_LEVEL)
         return check_scene(scene, 0.0, level=CHECK_LEVEL)
     except ValueError as exc:
         return f"Not checked: {exc}"

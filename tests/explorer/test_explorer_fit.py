@@ -203,7 +203,7 @@ def test_a_served_fit_runs_in_a_worker_at_the_lower_priority(explorer_app, monke
     """Served with worker processes, a fit runs in one of them (it held the server's
     Python lock for its 0.3-6 s of CPU beside the event loop), at the lower priority of
     background work, and gives the page what it gives run inline."""
-    from explorer.solving import at_background_priority, fit_runner
+    from explorer.solving import fit_runner
     from explorer.solving.worker_side import fit_outcome
     from explorer.solving.workers import SolverProcesses
 
@@ -214,13 +214,13 @@ def test_a_served_fit_runs_in_a_worker_at_the_lower_priority(explorer_app, monke
     keys = ["coating[0].modulus"]
     processes = SolverProcesses(1, 64 * 1024**2)
     asked = []
-    run = processes.run
+    run = processes.run_background
 
     def spy(lane, fn, *args):
-        asked.append((fn, args[0]))
+        asked.append(fn)
         return run(lane, fn, *args)
 
-    monkeypatch.setattr(processes, "run", spy)
+    monkeypatch.setattr(processes, "run_background", spy)
     monkeypatch.setattr(fit_runner, "worker_processes", lambda: processes)
     try:
         fit = fit_runner.FitRun()
@@ -228,7 +228,7 @@ def test_a_served_fit_runs_in_a_worker_at_the_lower_priority(explorer_app, monke
     finally:
         processes.shutdown()
     assert fit.status == "done", fit.message
-    assert asked == [(at_background_priority, fit_outcome)]
+    assert asked == [fit_outcome]
     inline = run_fit(scene, tab.readings, keys)
     # the solver is deterministic: the same numbers in the worker as here
     assert fit.outcome.calibration.values == inline.calibration.values

@@ -198,14 +198,43 @@ def test_a_coating_check_runs_nicer_than_the_workers_other_requests() -> None:
     processes = SolverProcesses(1, 64 * 1024**2)
     try:
         base = processes.run(0, thread_niceness)
-        assert processes.run(0, at_background_priority, thread_niceness) == min(
+        assert processes.run_background(0, thread_niceness) == min(
             base + BACKGROUND_NICENESS, 19)
         assert processes.run(0, thread_niceness) == base
         with pytest.raises(MemoryError):  # its failure reaches the server as it was
-            processes.run(0, at_background_priority, allocate,
-                          address_space_bound(WORKER_MEMORY_BYTES))
+            processes.run_background(0, allocate, address_space_bound(WORKER_MEMORY_BYTES))
     finally:
         processes.shutdown()
+
+
+@pytest.mark.skipif(not PER_THREAD, reason="a niceness per thread (Linux)")
+def test_background_priority_raises_what_its_work_raises() -> None:
+    assert at_background_priority(thread_niceness) == min(
+        thread_niceness() + BACKGROUND_NICENESS, 19)
+    with pytest.raises(ZeroDivisionError):
+        at_background_priority(divmod, 1, 0)
+
+
+def test_background_work_in_a_worker_has_the_longer_time_limit(monkeypatch) -> None:
+    """A check or a fit at the lower priority may take minutes on a saturated machine: it
+    is bounded by BACKGROUND_TIMEOUT_S, a slider's solve by REQUEST_TIMEOUT_S."""
+    from explorer.solving import workers
+
+    processes = SolverProcesses(1, 64 * 1024**2)
+    limits = []
+    call = workers._Lane.call
+
+    def spy(lane, fn, args, timeout):
+        limits.append(timeout)
+        return call(lane, fn, args, timeout)
+
+    monkeypatch.setattr(workers._Lane, "call", spy)
+    try:
+        processes.run(0, thread_niceness)
+        processes.run_background(0, thread_niceness)
+    finally:
+        processes.shutdown()
+    assert limits == [workers.REQUEST_TIMEOUT_S, workers.BACKGROUND_TIMEOUT_S]
 
 
 def test_the_coating_check_asks_its_worker_for_the_lower_priority(monkeypatch) -> None:
@@ -217,10 +246,10 @@ def test_the_coating_check_asks_its_worker_for_the_lower_priority(monkeypatch) -
         def assign(self) -> int:
             return 0
 
-        def run(self, lane, fn, *args):
-            asked.append((fn, args[0]))
+        def run_background(self, lane, fn, *args):
+            asked.append(fn)
             return {"ok": True}
 
     monkeypatch.setattr(coating, "worker_processes", Workers)
     assert coating._check(_scene()) == {"ok": True}
-    assert asked == [(at_background_priority, coating.check_scene)]
+    assert asked == [coating.check_scene]
