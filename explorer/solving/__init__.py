@@ -30,13 +30,11 @@ from .controller import (
     worker_processes,
 )
 from .fit_runner import FitRun
-from .priority import BACKGROUND_NICENESS, at_background_priority
 from .study_runner import StudyRun
 from .trace import install_websocket_marks, mark
 from .warm_up import warm_up
 from .workers import SolverProcesses, WorkerFailed
 
-__all__ = ["BACKGROUND_NICENESS", "RESULTS", "FitRun", "SolveController", "SolverProcesses",
-           "StudyRun", "WorkerFailed", "approx_bytes", "at_background_priority",
-           "describe_field", "format_error", "install_websocket_marks", "mark", "shared_pool",
-           "use_worker_processes", "warm_up", "worker_processes"]
+__all__ = ["RESULTS", "FitRun", "SolveController", "SolverProcesses", "StudyRun", "WorkerFailed",
+           "approx_bytes", "describe_field", "format_error", "install_websocket_marks", "mark",
+           "shared_pool", "use_worker_processes", "warm_up", "worker_processes"]

@@ -64,9 +64,8 @@ def at_background_priority(fn: Any, *args: Any) -> Any:
 
     def run() -> None:
         try:
-            tid = threading.get_native_id()
-            os.setpriority(os.PRIO_PROCESS, tid,
-                           os.getpriority(os.PRIO_PROCESS, tid) + BACKGROUND_NICENESS)
+            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(),
+                           thread_niceness() + BACKGROUND_NICENESS)
         except OSError:
             pass
         try:
