@@ -123,7 +123,13 @@ def test_a_preset_switch_lays_the_page_out_once_per_frame(page: Page):
     time.sleep(1.0)  # the status after the result
     messages = page.page.evaluate("() => window.__messages")
     assert 1 <= messages <= SWITCH_MESSAGES, messages
-    asked = page.page.evaluate(JS_ASK_LAYOUTS)
+    # a message from the server during the two frames (a late status, under load) asks
+    # for layouts of its own: measured again on a quiet pair of frames (at most 5 tries)
+    for _ in range(5):
+        sent = page.page.evaluate("() => window.__messages")
+        asked = page.page.evaluate(JS_ASK_LAYOUTS)
+        if page.page.evaluate("() => window.__messages") == sent:
+            break
     assert asked["views"] >= 50 and asked["asked"] == asked["views"], asked
     assert 1 <= asked["done"] <= asked["roots"] < asked["views"] / 10, asked
     # the page still follows a slider
