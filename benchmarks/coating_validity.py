@@ -2,6 +2,7 @@
 
     python -m benchmarks.coating_validity --table      # the map and the validity table
     python -m benchmarks.coating_validity --table --keep  # only the map's new grid points
+    python -m benchmarks.coating_validity --table --keep --jobs 2  # two processes
     python -m benchmarks.coating_validity --fe-study   # FE truncation and mesh convergence
     python -m benchmarks.coating_validity --presets    # the check on the preset scenes
     python -m benchmarks.coating_validity --aging      # aging bases, early and late
@@ -82,14 +83,22 @@ def _kept() -> dict:
     return kept
 
 
-def table(keep: bool = False) -> None:
+def _measure_point(point: tuple) -> tuple[float, float]:
+    interface, r, e, nu, hb = point
+    return measure(r, e, nu, interface, hb)
+
+
+def table(keep: bool = False, jobs: int = 1) -> None:
     """Measure the map; with ``keep``, only the grid points the current map lacks (the
-    others are copied from it)."""
+    others are copied from it); ``jobs`` processes measure at once."""
+    from concurrent.futures import ProcessPoolExecutor
+
     shape = (len(THICKNESS_RATIOS), len(MODULUS_RATIOS), len(COATING_POISSON),
              len(BASE_RATIOS))
     errors = {i: {"force": np.zeros(shape), "moment": np.zeros(shape)} for i in INTERFACES}
     kept = _kept() if keep else {}
     start = time.perf_counter()
+    todo = []
     for interface in INTERFACES:
         for idx in itertools.product(*(range(n) for n in shape)):
             r, e, nu, hb = (axis[i] for axis, i in zip(
@@ -98,14 +107,17 @@ def table(keep: bool = False) -> None:
             if (interface, "force", r, e, nu, hb) in kept:
                 for part in ("force", "moment"):
                     errors[interface][part][idx] = kept[(interface, part, r, e, nu, hb)]
-                continue
-            ef, em = measure(r, e, nu, interface, hb)
+            else:
+                todo.append((interface, idx, (interface, r, e, nu, hb)))
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
+        measured = pool.map(_measure_point, [point for _, _, point in todo])
+        for (interface, idx, point), (ef, em) in zip(todo, measured, strict=True):
             errors[interface]["force"][idx] = ef
             errors[interface]["moment"][idx] = em
-            print(interface, r, e, nu, hb, f"{100 * ef:.2f} / {100 * em:.2f}", flush=True)
+            print(*point, f"{100 * ef:.2f} / {100 * em:.2f}", flush=True)
     seconds = time.perf_counter() - start
     _write_module(errors)
-    _write_markdown(errors, seconds, keep)
+    _write_markdown(errors, seconds, keep, jobs)
 
 
 def _write_module(errors: dict) -> None:
@@ -114,7 +126,7 @@ def _write_module(errors: dict) -> None:
     (ROOT / "core" / "coating" / "error_table.json").write_text(table_json(errors))
 
 
-def _write_markdown(errors: dict, seconds: float, keep: bool = False) -> None:
+def _write_markdown(errors: dict, seconds: float, keep: bool = False, jobs: int = 1) -> None:
     path = ROOT / "benchmarks" / "results" / "coating_validity.md"
     old = path.read_text() if path.exists() else ""
     # the sections other commands write are kept
@@ -122,9 +134,10 @@ def _write_markdown(errors: dict, seconds: float, keep: bool = False) -> None:
     made = ("Made by `python -m benchmarks.coating_validity --table` "
             f"({seconds:.0f} s on a shared 2-core machine)")
     if keep and old:
+        jobs_text = f" --jobs {jobs}" if jobs > 1 else ""
         made = (old.split("\n")[2].split(". Error of the fast answer")[0].rstrip(".")
                 + "; the grid points it lacked measured by `python -m "
-                f"benchmarks.coating_validity --table --keep` ({seconds:.0f} s)")
+                f"benchmarks.coating_validity --table --keep{jobs_text}` ({seconds:.0f} s)")
     out = ["# Validity of the thin-coating model",
            "",
            f"{made}. Error of the fast answer against "
@@ -346,6 +359,22 @@ STACKS = (
     ("centred force", _stack(moment=0.0)),
     ("H = 2 m", _stack(base_thickness=2.0)),
     ("a = 0.5 m, top 10 mm", _stack(half_width=0.5, top={"thickness": 0.01})),
+    # nearly incompressible pads (rubber-like, nu 0.47-0.49), sliding and bonded
+    ("pad nu 0.47", _stack(pad={"poisson": 0.47})),
+    ("pad nu 0.49", _stack(pad={"poisson": 0.49})),
+    ("the pad alone, nu 0.49", _stack(top={"thickness": 0.0}, pad={"poisson": 0.49})),
+    ("the pad alone, nu 0.49, bonded", _stack(top={"thickness": 0.0},
+                                              pad={"poisson": 0.49, "interface": "bonded"})),
+    ("top sliding on a bonded pad, nu 0.47", _stack(pad={"poisson": 0.47,
+                                                        "interface": "bonded"})),
+    ("top sliding on a bonded pad, nu 0.49", _stack(pad={"poisson": 0.49,
+                                                        "interface": "bonded"})),
+    ("both bonded, pad nu 0.49", _stack(top={"interface": "bonded"},
+                                        pad={"poisson": 0.49, "interface": "bonded"})),
+    ("pad 10 mm, nu 0.49, bonded", _stack(pad={"thickness": 0.01, "poisson": 0.49,
+                                               "interface": "bonded"})),
+    ("pad 200 MPa, nu 0.49, bonded", _stack(pad={"modulus": 2.0e8, "poisson": 0.49,
+                                                 "interface": "bonded"})),
 )
 
 
@@ -431,6 +460,8 @@ def main() -> None:
     parser.add_argument("--table", action="store_true")
     parser.add_argument("--keep", action="store_true",
                         help="with --table: measure only the grid points the map lacks")
+    parser.add_argument("--jobs", type=int, default=1,
+                        help="with --table: processes measuring at once (default 1)")
     parser.add_argument("--fe-study", action="store_true")
     parser.add_argument("--presets", action="store_true")
     parser.add_argument("--aging", action="store_true")
@@ -440,7 +471,7 @@ def main() -> None:
     if args.fe_study:
         fe_study()
     if args.table:
-        table(keep=args.keep)
+        table(keep=args.keep, jobs=max(1, args.jobs))
     if args.presets:
         presets()
     if args.aging:

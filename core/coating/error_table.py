@@ -5,7 +5,7 @@ benchmarks.coating_validity --table`` (do not edit it by hand): signed relative 
 (fast - FE) / FE of the force per settlement and the moment per tilt, flat punch,
 uniform coating, base Poisson ratio 0.2, FE level 0 (its own error ~2e-4). Axes: sum h /
 2a, E_c / E, nu_c, H / a; ``ERRORS[interface][part]`` is indexed in that order (nested
-lists, 5 x 5 x 3 x 3).
+lists, 5 x 6 x 4 x 3).
 """
 
 from __future__ import annotations

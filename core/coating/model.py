@@ -28,7 +28,13 @@ bonded worn-coating preset (``E_c / E = 0.006``, ``nu_c = 0.4``) was read clampe
 against 0.16 % measured (the uniform layer of its thickness: -0.22 % at both FE levels),
 where the soft bonded error shrinks and changes sign as ``nu_c`` nears 0.5. The map
 was made before the FE mesh's top-layer rows were graded toward the punch edge; the
-entries re-measured with the graded mesh moved by at most 0.04 percentage points.
+entries re-measured with the graded mesh moved by at most 0.04 percentage points. Its
+``E_c / E = 0.001`` and ``nu_c = 0.49`` points were added for rubber-like pads: bonded
+and nearly incompressible, a thin layer errs far more (force / moment +10 / +33 % at
+``sum h / 2a = 0.02``, ``E_c / E = 0.001``, ``H = a``; +2.1 / +6.3 % at ``nu_c = 0.45``),
+which the map clamped at 0.45 and 0.005 read 2-3.8 times too small on such pads under
+epoxy (``benchmarks/results/coating_validity.md``, "A stiff layer on a soft pad": now
+0.64-1.57 times the FE error).
 """
 
 from __future__ import annotations
@@ -190,11 +196,12 @@ def model_error_estimate(scene: Any, share_of_tilt: float = 1.0,
 
 def beyond_map(parts: dict[str, np.ndarray]) -> list[str]:
     """Where the stack of :func:`model_error_map` lies outside the map's measurements, in
-    words: a coating softer than ``E_c / E`` = 0.005 against the base, or nearer to
-    incompressible than ``nu_c`` = 0.45, is read at the map's edge, so its estimate is an
-    extrapolation (measured: a 20 mm pad of 50 MPa, nu 0.45, under 5 mm of epoxy on
-    C30/37, ``E_c / E`` = 0.0018, erred by 3.58 % against an estimate of 1.56 %). A
-    thicker or stiffer coating has its own flags (``thick_coating``, ``stiff_coating``)."""
+    words: a coating softer than the map's lowest ``E_c / E`` (0.001) against the base, or
+    nearer to incompressible than its highest ``nu_c`` (0.49), is read at the map's edge,
+    so its estimate is an extrapolation (measured, with the map's edges at 0.005 and
+    0.45: a 20 mm pad of 50 MPa, nu 0.49, bonded to the base, ``E_c / E`` = 0.0015, erred
+    by 12.2 % against an estimate of 3.2 %). A thicker or stiffer coating has its own
+    flags (``thick_coating``, ``stiff_coating``)."""
     from core.coating import error_table  # read with the map (a JSON file)
 
     out = []

@@ -14,8 +14,8 @@ import numpy as np
 from core.coating import INTERFACES
 
 THICKNESS_RATIOS = (0.002, 0.005, 0.02, 0.05, 0.1)
-MODULUS_RATIOS = (0.005, 0.05, 0.3, 1.0, 3.0)
-COATING_POISSON = (0.2, 0.4, 0.45)
+MODULUS_RATIOS = (0.001, 0.005, 0.05, 0.3, 1.0, 3.0)
+COATING_POISSON = (0.2, 0.4, 0.45, 0.49)
 BASE_RATIOS = (0.25, 1.0, 4.0)
 
 
