@@ -246,7 +246,8 @@ class ExplorerApp(pn.viewable.Viewer):
             "<h2 style='margin:4px 0'>Coated punch explorer</h2>"
             "<div style='font-size:13px;color:#555'>A rigid punch on thin elastic coatings "
             "over an aging viscoelastic layer (plane strain, per metre out of plane). "
-            "Loads update while you drag; geometry and materials when you release.</div>",
+            "Sliders update while you drag when the solver keeps up, else on release."
+            "</div>",
             sizing_mode="stretch_width")
         self.header = header
         self.presenting = pn.widgets.Toggle(label="Presentation mode", width=170,
