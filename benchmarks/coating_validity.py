@@ -131,10 +131,10 @@ def _write_markdown(errors: dict, seconds: float, keep: bool = False, jobs: int 
     old = path.read_text() if path.exists() else ""
     # the sections other commands write are kept
     tail = old[old.index("\n## Preset scenes"):] if "\n## Preset scenes" in old else ""
-    made = ("Made by `python -m benchmarks.coating_validity --table` "
+    jobs_text = f" --jobs {jobs}" if jobs > 1 else ""
+    made = (f"Made by `python -m benchmarks.coating_validity --table{jobs_text}` "
             f"({seconds:.0f} s on a shared 2-core machine)")
     if keep and old:
-        jobs_text = f" --jobs {jobs}" if jobs > 1 else ""
         made = (old.split("\n")[2].split(". Error of the fast answer")[0].rstrip(".")
                 + "; the grid points it lacked measured by `python -m "
                 f"benchmarks.coating_validity --table --keep{jobs_text}` ({seconds:.0f} s)")
