@@ -25,6 +25,7 @@ from .controller import (
     approx_bytes,
     describe_field,
     format_error,
+    run_in_background,
     shared_pool,
     use_worker_processes,
     worker_processes,
@@ -37,4 +38,5 @@ from .workers import SolverProcesses, WorkerFailed
 
 __all__ = ["RESULTS", "FitRun", "SolveController", "SolverProcesses", "StudyRun", "WorkerFailed",
            "approx_bytes", "describe_field", "format_error", "install_websocket_marks", "mark",
-           "shared_pool", "use_worker_processes", "warm_up", "worker_processes"]
+           "run_in_background", "shared_pool", "use_worker_processes", "warm_up",
+           "worker_processes"]

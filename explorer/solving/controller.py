@@ -49,7 +49,8 @@ if TYPE_CHECKING:
     from core.back_analysis import Calibration
 
 __all__ = ["RESULTS", "SolveController", "approx_bytes", "describe_field", "format_error",
-           "result_key", "shared_pool", "use_worker_processes", "worker_processes"]
+           "result_key", "run_in_background", "shared_pool", "use_worker_processes",
+           "worker_processes"]
 
 log = logging.getLogger(__name__)
 
@@ -112,6 +113,16 @@ def use_worker_processes(lanes: int, stage_cache_bytes: int | None = None) -> So
 def worker_processes() -> SolverProcesses | None:
     """The worker processes in use (None when solves run in this process)."""
     return _PROCESSES
+
+
+def run_in_background(fn: Callable[..., Any], *args: Any) -> Any:
+    """``fn(*args)`` as background work (an FE coating check, a fit): in a worker process
+    at the lower priority of :meth:`SolverProcesses.run_background` when the server has
+    worker processes, else here, on the calling thread."""
+    processes = worker_processes()
+    if processes is None:
+        return fn(*args)
+    return processes.run_background(processes.assign(), fn, *args)
 
 
 #: Translation of the first part of a core field path into words on screen.

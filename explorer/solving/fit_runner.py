@@ -24,9 +24,8 @@ import param
 
 from core.back_analysis import Readings
 
-from ..model import run_fit
 from .background import BackgroundRun
-from .controller import worker_processes
+from .controller import run_in_background
 from .worker_side import fit_outcome
 
 log = logging.getLogger(__name__)
@@ -65,12 +64,7 @@ class FitRun(BackgroundRun):
               ) -> None:
         with _SLOTS:
             try:
-                processes = worker_processes()
-                if processes is None:
-                    outcome = run_fit(scene, readings, keys)
-                else:
-                    outcome = processes.run_background(processes.assign(), fit_outcome,
-                                                       scene, readings, keys)
+                outcome = run_in_background(fit_outcome, scene, readings, keys)
             except ValueError as exc:
                 self._set(status="failed", message=str(exc))
                 return

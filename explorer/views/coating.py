@@ -13,7 +13,7 @@ import panel as pn
 from core.scene import check_scene
 
 from ..model import SCREEN_LAYERS, ExplorerState, Screen
-from ..solving import SolveController, worker_processes
+from ..solving import SolveController, run_in_background
 from .fidelity import FidelityView
 from .loop import PageLoop
 from .punches import OnePunchOnly
@@ -240,12 +240,8 @@ def _check(scene: dict[str, Any], waiting: Callable[[], None] | None = None
             return (f"Not checked: other pages' coating checks kept the server busy for "
                     f"{CHECK_WAIT_S:.0f} s; try again later.")
     try:
-        processes = worker_processes()
-        if processes is not None:
-            # at a lower priority than the pages' slider solves in the other workers
-            return processes.run_background(processes.assign(), check_scene, scene, 0.0,
-                                            CHECK_LEVEL)
-        return check_scene(scene, 0.0, level=CHECK_LEVEL)
+        # at a lower priority than the pages' slider solves in the other workers
+        return run_in_background(check_scene, scene, 0.0, CHECK_LEVEL)
     except ValueError as exc:
         return f"Not checked: {exc}"
     except Exception as exc:  # the session must survive a failed check

@@ -203,7 +203,7 @@ def test_a_served_fit_runs_in_a_worker_at_the_lower_priority(explorer_app, monke
     """Served with worker processes, a fit runs in one of them (it held the server's
     Python lock for its 0.3-6 s of CPU beside the event loop), at the lower priority of
     background work, and gives the page what it gives run inline."""
-    from explorer.solving import fit_runner
+    from explorer.solving import controller, fit_runner
     from explorer.solving.worker_side import fit_outcome
     from explorer.solving.workers import SolverProcesses
 
@@ -221,7 +221,7 @@ def test_a_served_fit_runs_in_a_worker_at_the_lower_priority(explorer_app, monke
         return run(lane, fn, *args)
 
     monkeypatch.setattr(processes, "run_background", spy)
-    monkeypatch.setattr(fit_runner, "worker_processes", lambda: processes)
+    monkeypatch.setattr(controller, "worker_processes", lambda: processes)
     try:
         fit = fit_runner.FitRun()
         fit.start(scene, tab.readings, keys, background=False)

@@ -238,6 +238,7 @@ def test_background_work_in_a_worker_has_the_longer_time_limit(monkeypatch) -> N
 
 
 def test_the_coating_check_asks_its_worker_for_the_lower_priority(monkeypatch) -> None:
+    from explorer.solving import controller
     from explorer.views import coating
 
     asked = []
@@ -250,6 +251,6 @@ def test_the_coating_check_asks_its_worker_for_the_lower_priority(monkeypatch) -
             asked.append(fn)
             return {"ok": True}
 
-    monkeypatch.setattr(coating, "worker_processes", Workers)
+    monkeypatch.setattr(controller, "worker_processes", Workers)
     assert coating._check(_scene()) == {"ok": True}
     assert asked == [coating.check_scene]
