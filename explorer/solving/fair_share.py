@@ -33,6 +33,14 @@ MAX_RUNNING_STUDIES = 1
 #: against a person waiting for a study of a few seconds.
 TURN_S = 1.0
 
+#: How long a pause waits for its process to have stopped [s]: ``SIGSTOP`` takes effect
+#: when the process is next scheduled, which for a study's process (nicer than the
+#: server, :mod:`explorer.solving.priority`) on a busy machine can come after the next
+#: study was resumed; both then ran for a moment (6 samples of ~1000 in a suite run at
+#: load ~4, 10 ms apart). Waiting here keeps at most one running; a process that does
+#: not report its state (no ``/proc``) or has ended is not waited for.
+PAUSE_WAIT_S = 0.2
+
 #: Whether this system can pause a process (``SIGSTOP`` / ``SIGCONT``).
 CAN_PAUSE = hasattr(signal, "SIGSTOP") and hasattr(signal, "SIGCONT")
 
@@ -158,8 +166,23 @@ SHARE = StudyShare()
 
 
 def pause(pid: int) -> None:
-    """Stop process ``pid`` where it is (``SIGSTOP``)."""
+    """Stop process ``pid`` where it is (``SIGSTOP``), and wait until it has stopped
+    (at most :data:`PAUSE_WAIT_S`)."""
     os.kill(pid, signal.SIGSTOP)
+    deadline = time.monotonic() + PAUSE_WAIT_S
+    while not _stopped(pid) and time.monotonic() < deadline:
+        time.sleep(0.001)
+
+
+def _stopped(pid: int) -> bool:
+    """Whether process ``pid`` is stopped, or gone, or cannot say (no ``/proc``)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as stat:
+            # the state follows the command name, which may hold spaces and ")"
+            state = stat.read().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return True
+    return state in ("T", "t", "Z", "X")
 
 
 def resume(pid: int) -> None:

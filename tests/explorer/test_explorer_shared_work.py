@@ -134,7 +134,11 @@ def test_two_pages_studies_run_in_turns_and_both_finish() -> None:
 
 def _state(process) -> str | None:
     """'R' for a running process, 'T' for a paused one, None when it is gone."""
-    if process is None or not process.is_alive():
+    if process is None:
+        return None
+    # a study's multiprocessing.Process, or a subprocess.Popen
+    alive = process.is_alive() if hasattr(process, "is_alive") else process.poll() is None
+    if not alive:
         return None
     try:
         with open(f"/proc/{process.pid}/stat") as f:
@@ -254,3 +258,32 @@ def test_the_coating_check_asks_its_worker_for_the_lower_priority(monkeypatch) -
     monkeypatch.setattr(controller, "worker_processes", Workers)
     assert coating._check(_scene()) == {"ok": True}
     assert asked == [coating.check_scene]
+
+
+@pytest.mark.skipif(not CAN_PAUSE or not os.path.exists("/proc/self/stat"),
+                    reason="processes cannot be paused, or do not report their state, here")
+def test_a_pause_returns_once_the_process_has_stopped() -> None:
+    """SIGSTOP takes effect when the process is next scheduled: a study's process, nicer
+    than the server, on a busy machine could still run after the next study was resumed.
+    Here two busy processes keep both cores full while a niced one is paused and resumed
+    50 times: after each pause it reads stopped."""
+    import subprocess
+    import sys
+
+    from explorer.solving.fair_share import pause, resume
+
+    busy = [sys.executable, "-c", "while True: pass"]
+    hogs = [subprocess.Popen(busy) for _ in range(2)]
+    study = subprocess.Popen(["nice", "-n", str(BACKGROUND_NICENESS), *busy])
+    try:
+        running = 0
+        for _ in range(50):
+            pause(study.pid)
+            running += _state(study) != "T"
+            resume(study.pid)
+            time.sleep(0.005)
+        assert running == 0, running
+    finally:
+        for process in (*hogs, study):
+            process.kill()
+            process.wait()
