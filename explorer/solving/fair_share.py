@@ -33,13 +33,16 @@ MAX_RUNNING_STUDIES = 1
 #: against a person waiting for a study of a few seconds.
 TURN_S = 1.0
 
-#: How long a pause waits for its process to have stopped [s]: ``SIGSTOP`` takes effect
-#: when the process is next scheduled, which for a study's process (nicer than the
+#: How long a pause waits at most for its process to have stopped [s]: ``SIGSTOP`` takes
+#: effect when the process is next scheduled, which for a study's process (nicer than the
 #: server, :mod:`explorer.solving.priority`) on a busy machine can come after the next
-#: study was resumed; both then ran for a moment (6 samples of ~1000 in a suite run at
-#: load ~4, 10 ms apart). Waiting here keeps at most one running; a process that does
-#: not report its state (no ``/proc``) or has ended is not waited for.
-PAUSE_WAIT_S = 0.2
+#: study was resumed; both then ran for a moment. The wait grows with the machine's load,
+#: ~25 ms per busy process on 2 cores (niced busy process stopped 200 times beside 2, 6
+#: and 20 busy ones: longest 0.05, 0.15 and 0.51 s); 0.2 s was too short under a test
+#: suite beside a CPU hog. The bound only guards against a process that never reports
+#: stopped: the wait is on a study's own thread, never on the server's event loop. A
+#: process that does not report its state (no ``/proc``) or has ended is not waited for.
+PAUSE_WAIT_S = 5.0
 
 #: Whether this system can pause a process (``SIGSTOP`` / ``SIGCONT``).
 CAN_PAUSE = hasattr(signal, "SIGSTOP") and hasattr(signal, "SIGCONT")

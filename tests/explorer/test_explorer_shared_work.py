@@ -265,8 +265,10 @@ def test_the_coating_check_asks_its_worker_for_the_lower_priority(monkeypatch) -
 def test_a_pause_returns_once_the_process_has_stopped() -> None:
     """SIGSTOP takes effect when the process is next scheduled: a study's process, nicer
     than the server, on a busy machine could still run after the next study was resumed.
-    Here two busy processes keep both cores full while a niced one is paused and resumed
-    50 times: after each pause it reads stopped."""
+    Here two busy processes keep both cores full (beside whatever else the machine runs)
+    while a niced one is paused and resumed 50 times: after each pause it reads stopped.
+    The wait this needs grows with the load (~25 ms per busy process); the pause's bound
+    of 5 s is ~10x the longest measured beside 20 busy processes."""
     import subprocess
     import sys
 
