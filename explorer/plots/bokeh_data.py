@@ -22,10 +22,16 @@ def f32(values: object) -> np.ndarray:
 
 
 def _same(old: object, new: object) -> bool:
+    if (isinstance(old, list | tuple) and isinstance(new, list | tuple)
+            and any(isinstance(v, list | tuple | np.ndarray | str) for v in (*old, *new))):
+        # a column of lines (a multi-line's) or of text: row by row
+        return len(old) == len(new) and all(
+            a == b if isinstance(a, str) or isinstance(b, str) else _same(a, b)
+            for a, b in zip(old, new, strict=True))
     try:
         return bool(np.array_equal(np.asarray(old, dtype=float), np.asarray(new, dtype=float),
                                    equal_nan=True))
-    except (TypeError, ValueError):  # text columns, ragged lists: assume changed
+    except (TypeError, ValueError):  # anything else: assume changed
         return False
 
 

@@ -16,6 +16,8 @@ from bokeh.models import (
     ColorBar,
     ColumnDataSource,
     HoverTool,
+    Legend,
+    LegendItem,
     LinearColorMapper,
     LogColorMapper,
     Range1d,
@@ -175,9 +177,9 @@ class Figures:
         self.history_fig = {}
         self.history_line = {}
         self.history_cursor = {}
-        # several punches: a line per punch on each history (hidden for one punch)
-        self.punch_history_src: dict[str, list[ColumnDataSource]] = {}
-        self.punch_history_line: dict[str, list] = {}
+        # several punches: a line per punch on each history (none for one punch)
+        self.punch_history_src: dict[str, ColumnDataSource] = {}
+        self.punch_history_lines: dict[str, object] = {}
         shared_x = None
         for q in QUANTITIES:
             unit = QUANTITY_UNITS[q][0]
@@ -201,8 +203,8 @@ class Figures:
             p.add_layout(cursor)
             # a fit's readings are made when first drawn (_readings): 8 plot renderers and
             # their sources, ~70 of a page's Bokeh models, which the server builds and the
-            # browser renders for every page. The lines of several punches are made here:
-            # made later, their legend found no view in the page (BokehJS)
+            # browser renders for every page. The lines of several punches are made here
+            # (one renderer, see _build_punch_lines)
             self._build_punch_lines(p, q, unit)
             self.history_src[q] = src
             self.history_point_src[q] = point
@@ -218,34 +220,35 @@ class Figures:
 
     def _build_punch_lines(self, p: figure, q: str, unit: str) -> None:
         """The history of ``q`` of each punch of several, in its colour, with a legend
-        (hidden, and empty, for a scene of one punch)."""
-        sources, lines = [], []
-        for k in range(SCREEN_PUNCHES):
-            src = ColumnDataSource({"t": [], "v": []}, name=f"{q}_punch{k}_source")
-            line = p.line(x="t", y="v", source=src, line_color=PUNCH_COLORS[k],
-                          line_width=2.5, legend_label=f"punch {k + 1}", visible=False,
-                          name=f"punch {k + 1}")
-            sources.append(src)
-            lines.append(line)
-        # one hover for the punches' lines (one per line added a toolbar button each)
-        p.add_tools(HoverTool(renderers=lines, mode="vline", tooltips=[
-            ("", "$name"), ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
-        legend_inside(p, "top_left").visible = False
-        self.punch_history_src[q] = sources
-        self.punch_history_line[q] = lines
+        (hidden, and empty, for a scene of one punch).
+
+        One renderer draws every punch's line (a multi-line, a row per punch), the legend
+        an entry per row: a renderer per punch made 144 of a page's 960 Bokeh models (852
+        now), built by the server and rendered by the browser for every page though most
+        scenes have one punch."""
+        src = ColumnDataSource({"xs": [], "ys": [], "color": [], "label": []},
+                               name=f"{q}_punches_source")
+        lines = p.multi_line(xs="xs", ys="ys", line_color="color", line_width=2.5,
+                             source=src, name=f"{q}_punches")
+        p.add_tools(HoverTool(renderers=[lines], tooltips=[
+            ("", "@label"), ("t", "$x{0.0} days"), (SYMBOLS[q], f"$y{{0.0000}} {unit}")]))
+        # made with the figure: legend entries made later found no view in the page
+        p.add_layout(Legend(items=[
+            LegendItem(label=f"punch {k + 1}", renderers=[lines], index=k, visible=False)
+            for k in range(SCREEN_PUNCHES)], visible=False))
+        legend_inside(p, "top_left")
+        self.punch_history_src[q] = src
+        self.punch_history_lines[q] = lines
 
     def _show_punch_histories(self, view: ResultView) -> None:
         """A line per punch on each history (several punches), or none (one punch)."""
         n = len(view.punches)
         for q in QUANTITIES:
-            for k, (src, line) in enumerate(zip(self.punch_history_src[q],
-                                                self.punch_history_line[q], strict=True)):
-                if k < n:
-                    set_data(src, {"t": f32(view.times), "v": f32(view.punches[k].display(q))})
-                elif src.data["t"] is not None and len(src.data["t"]):
-                    set_data(src, {"t": [], "v": []})
-                if line.visible != (k < n):
-                    line.visible = k < n
+            times = f32(view.times)
+            set_data(self.punch_history_src[q], {
+                "xs": [times] * n, "ys": [f32(view.punches[k].display(q)) for k in range(n)],
+                "color": list(PUNCH_COLORS[:n]),
+                "label": [f"punch {k + 1}" for k in range(n)]})
             legend = self.history_fig[q].legend[0]
             for k, item in enumerate(legend.items):
                 item.visible = k < n

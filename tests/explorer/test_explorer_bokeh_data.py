@@ -51,3 +51,23 @@ def test_the_style_fix_is_sent_with_a_served_document() -> None:
     assert [("__same_text_skipped" in c.code, "__once_per_frame" in c.code)
             for c in callbacks] == [(True, False), (False, True)]
     assert not bokeh_fixes.install(None)
+
+
+def test_lines_and_text_columns_are_resent_only_when_they_change() -> None:
+    """The punches' histories are one multi-line source (a column of lines, a column of
+    colours and labels): the same lines again are not resent, a changed row is."""
+    from bokeh.models import ColumnDataSource
+
+    from explorer.plots.bokeh_data import set_data
+
+    line = np.linspace(0.0, 1.0, 200, dtype=np.float32)
+    data = {"xs": [line, line], "ys": [line, 2 * line], "label": ["punch 1", "punch 2"]}
+    src = ColumnDataSource({"xs": [], "ys": [], "label": []})
+    assert set_data(src, data)
+    same = {"xs": [line.copy(), line.copy()], "ys": [line.copy(), 2 * line],
+            "label": ["punch 1", "punch 2"]}
+    assert not set_data(src, same)
+    assert set_data(src, dict(same, ys=[line, 3 * line]))
+    assert set_data(src, dict(same, label=["punch 1", "punch 3"]))
+    assert set_data(src, {"xs": [], "ys": [], "label": []})
+    assert not set_data(src, {"xs": [], "ys": [], "label": []})

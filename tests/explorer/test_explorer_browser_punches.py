@@ -30,8 +30,8 @@ KEY = "new_footing_beside_old"
 
 # The history of a quantity of punch ``k`` as the page holds it.
 JS_HISTORY = """([q, k]) => {
-  const s = Bokeh.documents[0].get_model_by_name(`${q}_punch${k}_source`);
-  return s ? Array.from(s.data.v) : null;
+  const s = Bokeh.documents[0].get_model_by_name(`${q}_punches_source`);
+  return s && s.data.ys.length > k ? Array.from(s.data.ys[k]) : null;
 }"""
 # The left end of each punch drawn in the scene [m].
 JS_PUNCH_LEFT = """() => {

@@ -133,8 +133,11 @@ def test_the_page_shows_each_punch_and_turns_off_what_is_for_one(explorer_app) -
     view = app.controller.view
     assert view.several
     figures = app.figures
-    lines = figures.punch_history_line["settlement"]
-    assert [line.visible for line in lines] == [True, True, False, False]
+    lines = figures.punch_history_src["settlement"]
+    assert lines.data["label"] == ["punch 1", "punch 2"]
+    assert [len(v) for v in lines.data["ys"]] == [200, 200]
+    legend = figures.history_fig["settlement"].legend[0]
+    assert legend.visible and [i.visible for i in legend.items] == [True, True, False, False]
     assert not figures.history_line["settlement"].visible
     assert figures.drawing.punches_src.data["name"] == ["punch 1", "punch 2"]
     assert "punch 2 (x = 3 m)" in app.results.readout.object
@@ -167,7 +170,7 @@ def test_the_page_shows_each_punch_and_turns_off_what_is_for_one(explorer_app) -
     assert app.load_scene(presets()["uniform_flat"])
     assert app.controller.wait(120) and app.controller.error == ""
     assert not app.controller.view.several
-    assert not any(line.visible for line in lines)
+    assert lines.data["ys"] == [] and not legend.visible
     assert figures.history_line["settlement"].visible
     assert not app.pins.pin_button.disabled and not app.scene_tab.loading.note.visible
     assert not app.punch_tab.punches.panel.visible and app.punch_tab.single.visible
