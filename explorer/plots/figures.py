@@ -231,7 +231,8 @@ class Figures:
         lines = p.multi_line(xs="xs", ys="ys", line_color="color", line_width=2.5,
                              source=src, name=f"{q}_punches")
         p.add_tools(HoverTool(renderers=[lines], tooltips=[
-            ("", "@label"), ("t", "$x{0.0} days"), (SYMBOLS[q], f"$y{{0.0000}} {unit}")]))
+            ("", "@label"), ("t", "$snap_x{0.0} days"),
+            (SYMBOLS[q], f"$snap_y{{0.0000}} {unit}")]))
         # made with the figure: legend entries made later found no view in the page
         p.add_layout(Legend(items=[
             LegendItem(label=f"punch {k + 1}", renderers=[lines], index=k, visible=False)
