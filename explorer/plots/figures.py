@@ -179,7 +179,6 @@ class Figures:
         self.history_cursor = {}
         # several punches: a line per punch on each history (none for one punch)
         self.punch_history_src: dict[str, ColumnDataSource] = {}
-        self.punch_history_lines: dict[str, object] = {}
         shared_x = None
         for q in QUANTITIES:
             unit = QUANTITY_UNITS[q][0]
@@ -239,13 +238,12 @@ class Figures:
             for k in range(SCREEN_PUNCHES)], visible=False))
         legend_inside(p, "top_left")
         self.punch_history_src[q] = src
-        self.punch_history_lines[q] = lines
 
     def _show_punch_histories(self, view: ResultView) -> None:
         """A line per punch on each history (several punches), or none (one punch)."""
         n = len(view.punches)
+        times = f32(view.times) if n else None
         for q in QUANTITIES:
-            times = f32(view.times)
             set_data(self.punch_history_src[q], {
                 "xs": [times] * n, "ys": [f32(view.punches[k].display(q)) for k in range(n)],
                 "color": list(PUNCH_COLORS[:n]),

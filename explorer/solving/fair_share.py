@@ -179,13 +179,18 @@ def pause(pid: int) -> None:
 
 def _stopped(pid: int) -> bool:
     """Whether process ``pid`` is stopped, or gone, or cannot say (no ``/proc``)."""
+    return process_state(pid) in (None, "T", "t", "Z", "X")
+
+
+def process_state(pid: int) -> str | None:
+    """The state letter of process ``pid`` in ``/proc`` ("R" running, "S" sleeping, "T"
+    stopped, ...), or None when it is gone or the system does not say."""
     try:
         with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as stat:
             # the state follows the command name, which may hold spaces and ")"
-            state = stat.read().rsplit(")", 1)[1].split()[0]
+            return stat.read().rsplit(")", 1)[1].split()[0]
     except (OSError, IndexError):
-        return True
-    return state in ("T", "t", "Z", "X")
+        return None
 
 
 def resume(pid: int) -> None:

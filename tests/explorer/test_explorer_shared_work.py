@@ -21,7 +21,7 @@ import pytest
 from explorer.model import ExplorerState, presets
 from explorer.model.study import Axis, plan_study
 from explorer.solving import StudyRun
-from explorer.solving.fair_share import CAN_PAUSE, StudyShare
+from explorer.solving.fair_share import CAN_PAUSE, StudyShare, process_state
 from explorer.solving.memory_bound import (
     STUDY_MEMORY_BYTES,
     WORKER_MEMORY_BYTES,
@@ -140,10 +140,8 @@ def _state(process) -> str | None:
     alive = process.is_alive() if hasattr(process, "is_alive") else process.poll() is None
     if not alive:
         return None
-    try:
-        with open(f"/proc/{process.pid}/stat") as f:
-            state = f.read().rsplit(")", 1)[1].split()[0]
-    except OSError:
+    state = process_state(process.pid)
+    if state is None:
         return None
     return "T" if state in ("T", "t") else "R"
 
