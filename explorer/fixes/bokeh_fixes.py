@@ -1,5 +1,5 @@
 """Two fixes applied in the page to BokehJS: style sheets rewritten with the same text,
-and the page's layout computed once per frame.
+and the page's layout computed once per frame (and not for a closed tab).
 
 **Style sheets.** BokehJS (checked with 3.9.2) writes the text of a ``<style>`` element
 each time it paints a renderer (``update_position``) or lays a figure out, even when the
@@ -23,7 +23,11 @@ during the preset switches of ``benchmarks/explorer_latency.py``).
 The fix updates the part of the page that changed at once (its styles and, for a figure
 just added, its layout objects) and lays out each root of the changed views once, at the
 next animation frame: what the page shows is what one layout after the last change
-gives, which is what the repeated layouts ended with. BokehJS without the
+gives, which is what the repeated layouts ended with. A change inside a sidebar tab that
+is not open (the page fills its closed tabs in the background, one per turn) lays out
+nothing until that tab is opened: each fill laid the whole page out once more, ~0.3 s of
+the page's CPU, 2.6 s of the 8 s a page cost the browser to load and complete (a CPU
+profile of the page through the DevTools protocol). BokehJS without the
 patched method is left as it is (the page logs a warning).
 """
 
@@ -62,7 +66,7 @@ if (!View || typeof View.prototype.invalidate_layout !== "function") {
 } else if (!View.prototype.invalidate_layout.__once_per_frame) {
   const invalidate = View.prototype.invalidate_layout;
   // layouts asked for and laid out (for the page's tests and benchmarks)
-  const count = window.__explorerLayouts = {asked: 0, done: 0};
+  const count = window.__explorerLayouts = {asked: 0, done: 0, held: 0};
   let roots = null;
   const layOut = () => {
     const due = roots;
@@ -76,11 +80,39 @@ if (!View || typeof View.prototype.invalidate_layout !== "function") {
     }
     if (failed !== null) throw failed;
   };
+  // the closed tabs changed since the page was last laid out, by their tabs view
+  const changed = new WeakMap();
+  // the tabs view and tab (a child view of it) of a view inside a closed tab, or null
+  const closedTab = (view) => {
+    let child = view;
+    for (let parent = view.parent; parent instanceof View; parent = parent.parent) {
+      if (parent.model.type.endsWith("Tabs") &&
+          parent.child_views.indexOf(child) !== parent.model.active) return [parent, child];
+      child = parent;
+    }
+    return null;
+  };
   const deferred = function () {
     // its own part now (a figure just added gets its layout objects, which a layout of
     // the page asked for before the frame, on a resize, would read), the page's once
     this.update_layout();
     count.asked += 1;
+    const closed = closedTab(this);
+    if (closed !== null) {
+      // laid out when its tab is opened (a closed tab takes no space: views/tabs.py)
+      const [tabs, tab] = closed;
+      count.held += 1;
+      if (!changed.has(tabs)) {
+        changed.set(tabs, new WeakSet());
+        tabs.connect(tabs.model.properties.active.change, () => {
+          const open = tabs.child_views[tabs.model.active];
+          // (inside another closed tab, that one's opening lays it out)
+          if (open !== undefined && changed.get(tabs).delete(open)) deferred.call(open);
+        });
+      }
+      changed.get(tabs).add(tab);
+      return;
+    }
     let root = this;
     while (root.parent instanceof View) root = root.parent;
     if (roots === null) {

@@ -50,11 +50,13 @@ class _AxisInputs:
         self.optional = optional
         self.field = pn.widgets.Select(label=f"parameter {n}", sizing_mode="stretch_width",
                                        css_classes=[f"{css}-field"])
-        self.start = pn.widgets.FloatInput(label="from", width=95, css_classes=[f"{css}-from"])
-        self.stop = pn.widgets.FloatInput(label="to", width=95, css_classes=[f"{css}-to"])
-        self.count = pn.widgets.IntInput(label="points", value=9, start=2, width=70,
+        # four boxes and their margins in the sidebar's width (the spacing once ran ~70 px
+        # past it, into the scene's axis label)
+        self.start = pn.widgets.FloatInput(label="from", width=64, css_classes=[f"{css}-from"])
+        self.stop = pn.widgets.FloatInput(label="to", width=64, css_classes=[f"{css}-to"])
+        self.count = pn.widgets.IntInput(label="points", value=9, start=2, width=66,
                                          css_classes=[f"{css}-count"])
-        self.spacing = pn.widgets.Select(label="spacing", options=list(SPACINGS), width=80,
+        self.spacing = pn.widgets.Select(label="spacing", options=list(SPACINGS), width=68,
                                          css_classes=[f"{css}-spacing"])
         self.row = pn.Row(self.start, self.stop, self.count, self.spacing,
                           sizing_mode="stretch_width", margin=0)

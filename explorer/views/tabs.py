@@ -22,6 +22,11 @@ SIDEBAR_WIDTH = 340
 #: Style of the sidebar's tab titles: several lines when they do not fit one.
 WRAP_TITLES = (".bk-header, .bk-headers-wrapper, .bk-headers {flex-wrap: wrap; "
                "overflow: visible; height: auto;}")
+#: Style of the sidebar: a closed tab takes no space. Panel stacks the tabs in one cell and
+#: only hides the closed ones, so the page's root grew with each tab filled in the
+#: background (1693 -> 3973 px, the tallest tab), each growth laying out the whole page
+#: again: 7 layouts of 30-140 ms of the page's CPU (see explorer/fixes/bokeh_fixes.py).
+CLOSED_TABS_TAKE_NO_SPACE = "[aria-hidden='true'] {display: none !important;}"
 
 
 class DeferredTabs:
@@ -42,7 +47,8 @@ class DeferredTabs:
         # the tab titles wrap onto a second line: in one line the last tabs were out of
         # reach at 1024 px (presentation mode) and behind the first ones' width at 1400
         self.sidebar = pn.Tabs(*tabs, dynamic=False, width=SIDEBAR_WIDTH, margin=(0, 10, 0, 0),
-                               css_classes=["sidebar-tabs"], stylesheets=[WRAP_TITLES])
+                               css_classes=["sidebar-tabs"],
+                               stylesheets=[WRAP_TITLES, CLOSED_TABS_TAKE_NO_SPACE])
         self.sidebar.param.watch(lambda e: self.fill(e.new), "active")
 
     def fill(self, index: int) -> None:

@@ -460,6 +460,55 @@ def test_presentation_mode_has_projector_fonts_at_1024(page: Page):
     assert page.errors == []
 
 
+# The right edge [px] of the sidebar, how many elements its open tab draws, and those drawn
+# past the edge (each its class and right edge), looked for through the shadow roots of the
+# tab's widgets.
+JS_PAST_THE_SIDEBAR = """() => {
+  const tabs = Array.from(Bokeh.index.all_views())
+    .find(v => (v.model.css_classes || []).includes('sidebar-tabs'));
+  const edge = tabs.el.getBoundingClientRect().right;
+  const past = [];
+  let shown = 0;
+  const stack = [tabs.child_views[tabs.model.active].el];
+  while (stack.length) {
+    const e = stack.pop();
+    const box = e.getBoundingClientRect();
+    const drawn = box.width > 0 && box.height > 0 && getComputedStyle(e).visibility !== 'hidden';
+    shown += drawn;
+    if (drawn && box.right > edge + 1) past.push([String(e.className).slice(0, 60),
+                                                  Math.round(box.right)]);
+    stack.push(...e.children);
+    if (e.shadowRoot) stack.push(...e.shadowRoot.children);
+  }
+  return {edge: Math.round(edge), shown: shown, past: past.slice(0, 8)};
+}"""
+
+TAB_TITLES = ("Scene", "Punch", "Coating", "Base", "Time", "Check", "Files", "Lessons",
+              "Study", "Fit")
+
+
+@pytest.mark.parametrize("presenting", [False, True], ids=["1400px", "1024px-presenting"])
+def test_no_widget_of_any_tab_runs_past_the_sidebar(page: Page, presenting: bool):
+    """Every tab's widgets stay inside the sidebar (the Study tab's "spacing" once ran
+    ~60 px into the scene's axis label), at 1400 px and in presentation mode at 1024 px,
+    each tab opened after the page filled the closed ones in the background."""
+    if presenting:
+        page.page.set_viewport_size({"width": 1024, "height": 768})
+        page.page.locator(".presentation-toggle button").first.click()
+    page.wait_complete()
+    seen: dict = {}
+
+    def inside() -> bool:
+        seen.update(page.page.evaluate(JS_PAST_THE_SIDEBAR))
+        return seen["shown"] > 10 and not seen["past"]
+
+    for title in TAB_TITLES:
+        page.open_tab(title)
+        until(inside, f"the {title} tab inside the sidebar", timeout=10,
+              describe=lambda: seen)
+    assert page.errors == []
+
+
 # Files held by the drop boxes of the page (FilePond's list, in Panel's view of the box).
 JS_DROPPED = """() => {
   let n = 0;
