@@ -573,9 +573,9 @@ def main(argv: list[str] | None = None) -> None:
             page = context.new_page()
             page.goto(url + "/app")
             page.wait_for_function(READY, timeout=120_000)
-            # the sidebar tabs not yet opened are filled a few seconds after the page
-            # loads (explorer.views.tabs); measured during that, the first moves took
-            # seconds: the steady state is what a user dragging a slider meets
+            # the sidebar tabs not yet opened are filled once the page has been left
+            # alone for a while (explorer.views.tabs); measured during that, the first
+            # moves took seconds: the steady state is what a user dragging a slider meets
             time.sleep(FILL_TABS_AFTER_MS / 1000 + 5)
             page.evaluate(INSTRUMENT)
             cdp = context.new_cdp_session(page)

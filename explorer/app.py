@@ -38,7 +38,6 @@ from .model import (
 from .plots import Figures
 from .solving import SolveController, format_error, install_websocket_marks, mark
 from .views import (
-    FILL_TABS_AFTER_MS,
     AddressLink,
     BaseView,
     CheckView,
@@ -228,6 +227,7 @@ class ExplorerApp(pn.viewable.Viewer):
     def _drag_step_applies(self) -> bool:
         """At a drag step of a slider that otherwise waits for its release: whether the
         step applies now (:meth:`fast_solves`); when not, the page says so."""
+        self.tabs.touch()
         fast = self.fast_solves()
         view = self.controller.view
         spent = None if view is None else view.info.get("cpu_seconds", view.info.get("seconds"))
@@ -272,6 +272,7 @@ class ExplorerApp(pn.viewable.Viewer):
     # -- events ----------------------------------------------------------------------
     def _on_revision(self, event: Any) -> None:
         mark("revision")
+        self.tabs.touch()  # the closed tabs are filled once the page is left alone
         self.results.say_held(False)   # a release applied: the plots follow now
         self.history.remember()
         self.controller.request()
@@ -321,7 +322,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self._connected = True
         if self.controller.view is not None and self.controller.view is not self.screen.drawn:
             self._on_view(None)
-        self.loop.later(self.tabs.fill_idle, FILL_TABS_AFTER_MS)
+        self.tabs.fill_when_idle()
 
     def _on_view(self, event: Any) -> None:
         view = self.controller.view
@@ -367,6 +368,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.link.schedule()
 
     def _on_time(self, event: Any) -> None:
+        self.tabs.touch()
         view = self.screen.drawn
         if view is None:
             return

@@ -29,6 +29,17 @@ class PageLoop:
         """Whether this session is a served page (not a notebook or a script)."""
         return bool(self.doc is not None and self.doc.session_context)
 
+    @property
+    def connected(self) -> bool:
+        """Whether a browser is connected to this session now (True outside a server).
+
+        A closed page's session is kept for the server's ``--session-linger`` (for the
+        page to reconnect), and its timers still run meanwhile."""
+        # Bokeh's session context offers its session only through this attribute
+        context = getattr(self.doc, "session_context", None)
+        session = getattr(context, "_session", None)
+        return session is None or session.connection_count > 0
+
     def later(self, callback: Callable[[], None], delay_ms: float) -> None:
         """Run ``callback`` on this session's event loop after ``delay_ms`` [ms]."""
         doc = self.doc

@@ -9,9 +9,12 @@ import panel as pn
 from ..fixes import gc_policy
 from .loop import PageLoop
 
-#: Time after a page connects before the sidebar tabs not yet opened are filled in the
-#: background [ms]: after the first paint and a first look (see DeferredTabs.fill_idle).
-FILL_TABS_AFTER_MS = 3000
+#: How long a page must be left alone before the sidebar tabs not yet opened are filled in
+#: the background [ms] (see DeferredTabs.fill_idle). Filling them costs ~1.8 s of the
+#: server's CPU and ~1.5 s of the browser's per page; 3 s after the page connected, it
+#: came just as a user's first moves did (which then took seconds, explorer_latency's
+#: note), and it came in nearly every one of the browser tests' ~50 short-lived pages.
+FILL_TABS_AFTER_MS = 15000
 #: CSS class the sidebar gets once every tab has its widgets: the page is complete, no
 #: more background work of its own is due (a signal for scripts and tests that drive it).
 COMPLETE_CLASS = "sidebar-complete"
@@ -33,12 +36,13 @@ class DeferredTabs:
     """The sidebar: a served page arrives with the first tab's widgets only.
 
     That is a fifth of the widget models, 0.4 s less to the first paint; another tab gets
-    its widgets when first opened, or a few seconds after the page, and keeps them.
-    Panel's dynamic tabs would rebuild a tab at every switch: measured 110 ms of server
-    time each, which made 20 sessions 8x slower."""
+    its widgets when first opened, or once the page has been left alone for
+    :data:`FILL_TABS_AFTER_MS`, and keeps them. Panel's dynamic tabs would rebuild a tab at
+    every switch: measured 110 ms of server time each, which made 20 sessions 8x slower."""
 
     def __init__(self, loop: PageLoop, tabs: list[tuple[str, pn.Column]]) -> None:
         self.loop = loop
+        self.used = False  # the page was used since the background filling was scheduled
         self.deferred: dict[int, tuple[pn.Column, list[Any]]] = {}
         for k, (_title, content) in enumerate(tabs):
             if k and loop.served:
@@ -49,7 +53,16 @@ class DeferredTabs:
         self.sidebar = pn.Tabs(*tabs, dynamic=False, width=SIDEBAR_WIDTH, margin=(0, 10, 0, 0),
                                css_classes=["sidebar-tabs"],
                                stylesheets=[WRAP_TITLES, CLOSED_TABS_TAKE_NO_SPACE])
-        self.sidebar.param.watch(lambda e: self.fill(e.new), "active")
+        self.sidebar.param.watch(self._opened, "active")
+
+    def _opened(self, event: Any) -> None:
+        self.fill(event.new)
+        self.touch()
+
+    def touch(self) -> None:
+        """Note that the page is in use: the background filling waits until it has been
+        left alone for :data:`FILL_TABS_AFTER_MS` again."""
+        self.used = True
 
     def fill(self, index: int) -> None:
         """Give the tab at ``index`` its widgets (they then stay)."""
@@ -62,13 +75,24 @@ class DeferredTabs:
         """The widgets of the tabs not filled yet (part of the page all the same)."""
         return [obj for _, objects in self.deferred.values() for obj in objects]
 
+    def fill_when_idle(self) -> None:
+        """Start the background filling (:meth:`fill_idle`) once the page has been left
+        alone for :data:`FILL_TABS_AFTER_MS` from now."""
+        self.used = False
+        self.loop.later(self.fill_idle, FILL_TABS_AFTER_MS)
+
     def fill_idle(self) -> None:
-        """Fill the next unopened tab, then the others one per turn of the event loop.
+        """Fill the next unopened tab, then the others one per turn of the event loop, as
+        long as the page is left alone (:meth:`fill_when_idle` schedules it); once the page
+        is used (:meth:`touch`) the filling waits that long again.
 
         Under load the server can miss a tab click (measured once in ~600 first openings
         with 20 sessions: the client showed the tab, the server never heard of it), and
         the tab stayed empty; filled in the background it cannot."""
         loop = self.loop
+        if self.used or not loop.connected:  # (a closed page's lingering session: no work)
+            self.fill_when_idle()
+            return
         if self.deferred:
             self.fill(min(self.deferred))
         if self.deferred:

@@ -85,12 +85,14 @@ def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
           describe=p2_count.input_value)
     page.type_into(".study-p1-count", "20")
     page.type_into(".study-p2-count", "20")
+    # the page complete first: its background filling of tabs is not what the probe below
+    # measures (and it waits for the page to be left alone, longer than the study runs)
+    page.wait_complete()
     page.page.locator(".study-run button").first.click()
     until(lambda: page.page.evaluate(JS_SHOWN, "running:"), "the study running", 120,
           lambda: status(page))
     # the server's event loop, which every page shares, answers at once while the study
     # runs (in a process of its own) and reports its progress, and when it is cancelled
-    page.wait_complete()
     with LivenessProbe(page.url) as probe:
         time.sleep(2.0)  # a window of the study's running, not a wait for the page
         cancel = page.page.locator(".study-cancel button").first

@@ -16,7 +16,13 @@ from bokeh.models import ColumnDataSource
 
 from explorer.app import ExplorerApp
 from explorer.plots.bokeh_data import set_data
-from explorer.views import BUSY_AFTER_MS, COMPLETE_CLASS, LINK_EVERY_MS, PageLoop
+from explorer.views import (
+    BUSY_AFTER_MS,
+    COMPLETE_CLASS,
+    FILL_TABS_AFTER_MS,
+    LINK_EVERY_MS,
+    PageLoop,
+)
 
 
 def test_set_data_skips_equal_numbers_and_sends_changes() -> None:
@@ -234,6 +240,55 @@ def test_a_message_left_queued_by_a_finished_write_task_is_still_sent() -> None:
         pdoc.extra_socket_handlers.pop(Socket, None)
         pdoc._WRITE_MSGS.pop(doc, None)
         pdoc._WRITE_BLOCK.pop(doc, None)
+
+
+def test_closed_tabs_are_filled_only_once_the_page_is_left_alone(monkeypatch) -> None:
+    """Filling the closed tabs costs a page ~3 s of CPU (server and browser): it waits
+    until the page has been left alone for FILL_TABS_AFTER_MS, a tab opened meanwhile is
+    filled at once, and a use of the page between two fills puts the rest off again."""
+    import panel as pn
+
+    from explorer.fixes import gc_policy
+    from explorer.views import DeferredTabs
+
+    timers = _Timers()
+    monkeypatch.setattr(PageLoop, "served", property(lambda self: True))
+    loop = PageLoop(None)
+    monkeypatch.setattr(loop, "later", timers)
+    monkeypatch.setattr(gc_policy, "page_built", lambda context=None: True)
+    tabs = DeferredTabs(loop, [(f"tab {k}", pn.Column(pn.pane.Markdown(f"tab {k}")))
+                               for k in range(4)])
+    assert sorted(tabs.deferred) == [1, 2, 3]
+    tabs.fill_when_idle()
+    tabs.sidebar.active = 2                      # opened: filled at once
+    assert sorted(tabs.deferred) == [1, 3]
+    assert timers.run() == [FILL_TABS_AFTER_MS]  # used meanwhile: put off, nothing filled
+    assert sorted(tabs.deferred) == [1, 3]
+    assert timers.run() == [FILL_TABS_AFTER_MS]  # left alone: the first closed tab
+    assert sorted(tabs.deferred) == [3]
+    tabs.touch()                                 # used between two fills
+    assert timers.run() == [0]
+    assert sorted(tabs.deferred) == [3]
+    # a closed page's session lingers for the page to come back: no filling meanwhile
+    monkeypatch.setattr(PageLoop, "connected", property(lambda self: False))
+    assert timers.run() == [FILL_TABS_AFTER_MS]
+    assert sorted(tabs.deferred) == [3]
+    monkeypatch.setattr(PageLoop, "connected", property(lambda self: True))
+    assert timers.run() == [FILL_TABS_AFTER_MS]
+    assert not tabs.deferred and COMPLETE_CLASS in tabs.sidebar.css_classes
+    assert timers.pending == []
+
+
+def test_a_page_loop_knows_whether_a_browser_is_connected() -> None:
+    from types import SimpleNamespace as Fake
+
+    def loop(connections: int | None) -> PageLoop:
+        session = None if connections is None else Fake(connection_count=connections)
+        return PageLoop(Fake(session_context=Fake(_session=session)))
+
+    assert loop(1).connected and not loop(0).connected
+    assert loop(None).connected            # the session being created: not yet counted
+    assert PageLoop(None).connected        # a script or a notebook
 
 
 def test_a_complete_page_is_frozen_out_of_the_collectors_reach(served_app, monkeypatch) -> None:
