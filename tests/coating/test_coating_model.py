@@ -275,8 +275,12 @@ def test_a_nearly_incompressible_pad_is_read_from_the_map(case, measured):
     errs by 3.6-12 % (FE level 0; levels 0 and 1 differ by < 0.1 percentage points at nu
     0.49, ``/tmp`` study of six single layers). The map, measured up to nu_c = 0.45 and
     down to E_c/E = 0.005, read 2.0-3.9 % (2-3.8x under; flagged beyond the map); measured
-    now up to 0.49 and down to 0.001, its estimate is 0.64-1.57 times the error (``python
-    -m benchmarks.coating_validity --stacks``), inside the map."""
+    now up to 0.49 and down to 0.001, its estimate was 0.64-1.57 times the error (``python
+    -m benchmarks.coating_validity --stacks``), inside the map. The stack read as its average
+    layer alone (5 mm of epoxy, nu 0.35, diluting the pad's nu 0.49 to 0.44) read the 10 mm
+    pad 0.64 times its error; read also as its softest material and layer by layer
+    (:func:`core.coating.model.equivalent_layers`, the largest reading kept) and along
+    ``1 / (1 - 2 nu)``, 1.57-2.41 times (the pad alone 1.57): never under."""
     from tests.support.epoxy_on_pad import epoxy_on_pad_scene
 
     scene = epoxy_on_pad_scene()
@@ -286,7 +290,7 @@ def test_a_nearly_incompressible_pad_is_read_from_the_map(case, measured):
     scene["coating"] = [pad] if case.get("alone") else [top, pad]
     report = check_scene(scene, 0.0, level=0)
     assert report["model_error"] == pytest.approx(measured, abs=1e-3)
-    assert report["model_error"] / 1.6 <= report["estimate"] <= 1.6 * report["model_error"]
+    assert report["model_error"] <= report["estimate"] <= 2.5 * report["model_error"]
     result = solve(scene)
     assert "beyond_model_map" not in result.flags and "model_error" in result.flags
 
@@ -297,7 +301,7 @@ def test_a_smooth_layer_held_by_a_bonded_one_is_flagged(top, lower):
     """A pad smooth on the base under epoxy bonded to it: the thin layer errs by 135 %
     (FE level 0), the map alone read 2.6 %; the estimate now bounds it. Both smooth, the
     epoxy spreads the load as a plate (3.6 %, estimate 4.6 %); the other two orders keep
-    the map's estimate (measured 0.5 %, 0.2 %)."""
+    the map's estimate of the pad they read as (measured 0.5 %, 0.2 %; estimated 3.7 %)."""
     from tests.support.epoxy_on_pad import epoxy_on_pad_scene
 
     scene = epoxy_on_pad_scene()
@@ -314,14 +318,15 @@ def test_a_smooth_layer_held_by_a_bonded_one_is_flagged(top, lower):
         assert report["model_error"] == pytest.approx(0.0358, abs=1e-3)
         assert report["model_error"] <= report["estimate"] < 1.5 * report["model_error"]
     else:
-        assert report["estimate"] < 0.03  # the map's: 2.6 %
+        # the map's, of the pad as one layer bonded to the base: 3.76 %
+        assert report["model_error"] <= report["estimate"] < 0.04
 
 
 def test_a_stack_beyond_the_measured_map_is_flagged_until_measured() -> None:
-    """A pad softer against the base than the map was measured on (E_c/E 0.00074 against
+    """A pad softer against the base than the map was measured on (E_c/E 0.0006 against
     0.001) is read at the map's edge, so the answer is flagged beyond_model_map, naming
     the axis; the FE check's measurement, once made for the scene, lifts the flag. The
-    issue's stack (E_c/E 0.0019), beyond the map until it was measured down to 0.001, and
+    issue's stack (E_c/E 0.0015), beyond the map until it was measured down to 0.001, and
     the shipped presets are inside it."""
     from core.presets import preset_names, read_preset
     from core.scene import checked_key, flags_with_evidence, model_error_evidence
@@ -334,7 +339,7 @@ def test_a_stack_beyond_the_measured_map_is_flagged_until_measured() -> None:
     scene = softer_pad_scene()
     result = solve(scene)
     assert "beyond_model_map" in result.flags
-    assert result.model_error["beyond_map"] == ["E_c/E 0.00074 is below the map's 0.001"]
+    assert result.model_error["beyond_map"] == ["E_c/E 0.0006 is below the map's 0.001"]
     estimated = model_error_evidence(scene, result.model_error["estimate"])
     assert "beyond_model_map" in flags_with_evidence(result.flags, estimated)
     check = {"scene_key": checked_key(scene), "model_error": SOFTER_MEASURED, "time_day": 0.0}
@@ -349,3 +354,48 @@ def test_a_stack_beyond_the_measured_map_is_flagged_until_measured() -> None:
     soft = epoxy_on_pad_scene()
     soft["coating"] = [{"thickness": 0.01, "modulus": 5.0e8, "poisson": 0.495}]
     assert solve(soft).model_error["beyond_map"] == ["nu_c 0.495 is above the map's 0.49"]
+
+
+def _stack_of(*layers: tuple[float, float, float, str]) -> dict:
+    """The epoxy-on-pad scene with the coating ``layers`` (thickness m, modulus Pa, nu,
+    interface), top first."""
+    from tests.support.epoxy_on_pad import epoxy_on_pad_scene
+
+    scene = epoxy_on_pad_scene()
+    scene["coating"] = [{"thickness": h, "modulus": e, "poisson": nu, "interface": joint}
+                        for h, e, nu, joint in layers]
+    return scene
+
+
+@pytest.mark.parametrize("interface", ["smooth", "bonded"])
+def test_one_material_split_into_layers_reads_as_that_material(interface):
+    # every reading of a stack (average layer, softest material, layer by layer) gives a
+    # layer split in two the estimate of the whole layer
+    whole = solve(_stack_of((0.02, 5.0e7, 0.47, interface))).model_error
+    halves = solve(_stack_of((0.01, 5.0e7, 0.47, interface),
+                             (0.01, 5.0e7, 0.47, interface))).model_error
+    assert halves["estimate"] == pytest.approx(whole["estimate"], rel=1e-12)
+    assert halves["beyond_map"] == whole["beyond_map"] == []
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("layers", "measured"), [
+    # a 10 mm pad of nu 0.49 bonded to the base under 5 mm of epoxy (read 0.64x as the
+    # stack's average layer, nu_c 0.44)
+    (((0.005, 3.0e9, 0.35, "smooth"), (0.01, 5.0e7, 0.49, "bonded")), 0.0361),
+    # bonded layers of unlike Poisson ratios (read 0.40 and 0.70x by the average layer)
+    (((0.01, 5.0e7, 0.49, "bonded"), (0.01, 1.0e8, 0.3, "bonded")), 0.0168),
+    (((0.01, 5.0e7, 0.3, "bonded"), (0.01, 5.0e7, 0.49, "bonded")), 0.0104),
+    # single bonded pads between the map's nu 0.45 and 0.49 (read 2.0-2.2x linearly in nu)
+    (((0.02, 5.0e7, 0.47, "bonded"),), 0.0533),
+    (((0.02, 5.0e7, 0.48, "bonded"),), 0.0766)],
+    ids=["epoxy-on-pad-0.49", "pad-0.49-on-0.3", "pads-0.3-0.49", "pad-0.47", "pad-0.48"])
+def test_stacks_are_read_as_the_layers_that_carry_their_error(layers, measured):
+    """The map is read with a stack as its average layer, its softest material and layer
+    by layer, the largest kept (core.coating.model.equivalent_layers), and along
+    1 / (1 - 2 nu) (core.coating.model.confinement). Measured (FE level 0, ``python -m
+    benchmarks.coating_validity --stacks``): these five are now estimated 1.19-3.15 times
+    their error; the average layer read linearly in nu gave 0.40-2.2 times."""
+    report = check_scene(_stack_of(*layers), 0.0, level=0)
+    assert report["model_error"] == pytest.approx(measured, abs=1e-3)
+    assert report["model_error"] <= report["estimate"] <= 3.2 * report["model_error"]
