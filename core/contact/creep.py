@@ -27,8 +27,8 @@ from core.contact.result import UNILATERAL_MARGIN, _Snapshot
 from core.contact.step import Space, Step
 from core.contact.zones import ZONE_END_TOL, Resolution
 from core.discretize import Panels
-from core.engines.collocation import time_grid
 from core.problem import accepts
+from core.time import time_grid
 
 #: Nominal steps of the first time grid over [1, t_end] (every output time is a grid
 #: point; each interval between output times gets whole steps).

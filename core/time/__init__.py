@@ -12,12 +12,15 @@ and ``solve_general`` (any kernel); the steppers behind them:
   hold both sides);
 - ``product_quadrature.py``: a general kernel by the product trapezoid rule with
   Richardson extrapolation;
-- ``volterra.py``: the problem and solution types the steppers share.
+- ``volterra.py``: the problem and solution types the steppers share;
+- ``grids.py``: ``time_grid``, the fixed grids of the steppers that march on them (the
+  collocation engine, the unilateral contact march, the bare base's growing zone).
 """
 
 from __future__ import annotations
 
 from core.time.exponential_weights import moments as exponential_moments
+from core.time.grids import time_grid
 from core.time.integration import solve_degenerate
 from core.time.product_quadrature import solve_general
 from core.time.radau import JUMP_SIDE
@@ -29,4 +32,5 @@ __all__ = [
     "ModalProblem",
     "solve_degenerate",
     "solve_general",
+    "time_grid",
 ]

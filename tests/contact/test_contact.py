@@ -343,8 +343,8 @@ def test_creep_lift_off_zone_moves_and_two_time_resolutions_agree():
 def _creep_rule_march(pb, tol, rule_for, level=0):
     """Zone ends and outputs of the creep stepping on the rule ``rule_for(space, res)``."""
     from core.contact.march import march, march_outputs
-    from core.engines.collocation import time_grid
     from core.engines.projection import validate_inputs
+    from core.time import time_grid
 
     inp = validate_inputs(pb.lam, pb.m, pb.g, pb.times, pb.c, pb.kernel,
                     {"settlement": None, "tilt": None, **pb.loads}, pb.breakpoints, tol)

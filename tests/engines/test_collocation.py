@@ -11,9 +11,9 @@ import pytest
 from scipy.linalg import expm, solve
 
 from core.discretize import kernel_operator
-from core.engines.collocation import time_grid
 from core.engines.collocation.solve import collocation_panels, solve_collocation
 from core.kernel.plane import plane_kernel_regular
+from core.time import time_grid
 
 X_CHECK = np.linspace(-1.0, 1.0, 401)
 

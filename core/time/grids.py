@@ -1,0 +1,82 @@
+"""Time grids for stepping on fixed grids: every requested time a grid point, halvings
+exact (for Richardson extrapolation), load jumps held on both sides."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from core.time.radau import JUMP_SIDE
+
+__all__ = ["time_grid"]
+
+
+def time_grid(times: np.ndarray, steps: int, refine: int = 0,
+              jumps: Sequence[float] = (), graded: int = 0
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A grid on ``[1, times[-1]]`` containing every requested time (dimensionless t).
+
+    The nominal step is ``(times[-1] - 1) / steps``; each interval between consecutive
+    requested times (and from 1 to the first) is split into equal steps no longer than
+    that, and then every step is halved ``refine`` times. Halving the steps of a fixed
+    grid (rather than recounting for ``2 steps``, which need not halve every interval's
+    step) keeps the trapezoid error expansion in even powers of one step, which is what
+    Richardson extrapolation needs. Returns the grid (G,), the step lengths (G-1,),
+    exactly equal within an interval, and the grid index of each requested time.
+
+    ``jumps``: times where a given load jumps. No step straddles one: the grid holds both
+    of its sides, ``JUMP_SIDE`` (relative) before and after it, so the loads are read on
+    each side of the jump and the trapezoid's error keeps its expansion on either side (a
+    step across a jump erred to first order: the halved grids' difference was no
+    estimate). A requested time on a jump is its side after it.
+
+    ``graded``: the first interval after the start and after each jump is split at
+    ``length / 2**k`` (k = 1 .. graded) from its start before its steps are counted, so
+    the steps grow geometrically out of the start (a creep law's transient just after a
+    load is applied, such as the ``(t - t0)^0.3`` of the design codes); these points do
+    not depend on ``refine``, so halving stays exact.
+    """
+    times = np.asarray(times, dtype=float)
+    h = (times[-1] - 1.0) / steps
+    # the ends of the intervals: (time, index of the requested time or -1)
+    ends: list[tuple[float, int]] = []
+    inside = sorted({float(j) for j in jumps if 1.0 < float(j) < float(times[-1])})
+    sides = {j: JUMP_SIDE * max(1.0, abs(j)) for j in inside}
+    if graded:
+        marks = np.unique(np.concatenate([times, inside]))
+        for start in [1.0] + [j + sides[j] for j in inside]:
+            after = marks[marks > start * (1.0 + 1e-9)]
+            if after.size:
+                length = float(after[0]) - start
+                ends += [(start + length * 2.0**-k, -1) for k in range(graded, 0, -1)]
+    on_jump: dict[int, int] = {}
+    for j, side in sides.items():
+        ends += [(j - side, -1), (j + side, -1)]
+        hit = np.flatnonzero(np.abs(times - j) <= side)
+        if hit.size:
+            on_jump[int(hit[0])] = len(ends) - 1
+    ends += [(float(t), k) for k, t in enumerate(times) if k not in on_jump]
+    order = sorted(range(len(ends)), key=lambda i: ends[i][0])
+    points = [1.0]
+    widths: list[float] = []
+    index = np.zeros(times.size, dtype=int)
+    start = 1.0
+    for i in order:
+        t, k = ends[i]
+        length = t - start
+        if length > 0.0:
+            count = max(1, math.ceil(length / h - 1e-9)) * 2**refine
+            points.extend(start + length * np.arange(1, count + 1) / count)
+            points[-1] = t
+            # One width per interval, not np.diff of the points: equal widths keep the
+            # step matrix bit-identical, so its factorization is reused.
+            widths.extend([length / count] * count)
+            start = t
+        if k >= 0:
+            index[k] = len(points) - 1
+        for out, end in on_jump.items():
+            if end == i:
+                index[out] = len(points) - 1
+    return np.array(points), np.array(widths), index
