@@ -5,8 +5,9 @@ stand on (its projection divides by ``m``); the exact layered kernel
 (:mod:`core.engines.layered.answer`) with an empty stack is the base's own kernel and
 solves the bare layer exactly, inverse square-root corners included (a creeping or aging
 base by scalar Volterra equations in time, :mod:`core.engines.layered.bare_creep`). It
-answers full contact under a smooth punch, and on an elastic base a punch lifting off at
-one corner (:mod:`core.engines.layered.bare_lift_off`); :func:`check_uncoated` refuses
+answers full contact under a smooth punch, and a punch lifting off
+(:mod:`core.engines.layered.bare_lift_off`; on a base that creeps or ages while the zone
+does not recede, :mod:`core.engines.layered.bare_growing_zone`); :func:`check_uncoated` refuses
 the rest when the scene is read, naming the field and the reason, and
 :func:`lift_off_refusal` words the refusal of a punch that lifts off where that is not
 answered (known only once solved).
@@ -22,9 +23,10 @@ __all__ = ["check_uncoated", "lift_off_refusal", "UNCOATED_SCOPE"]
 
 #: What a scene without coating layers is solved for, as its refusals say it.
 UNCOATED_SCOPE = ("a scene with no coating layers is solved under a punch shape without "
-                  "jumps or kinks; on a base that creeps or ages it lifts off only as a flat "
-                  "punch under given loads that keep their ratio (force and moment, or "
-                  "settlement and tilt), for now")
+                  "jumps or kinks; on a base that creeps or ages it lifts off where its "
+                  "contact zone keeps its size or grows (a flat punch under given loads that "
+                  "keep their ratio, a crown pressed as the base creeps), not where the zone "
+                  "recedes or a given load jumps, for now")
 
 
 def check_uncoated(scene: Any) -> None:
@@ -49,8 +51,8 @@ def check_uncoated(scene: Any) -> None:
 def lift_off_refusal(scene: Any) -> str:
     """The refusal of a scene without coating layers whose punch lifts off on a base that
     creeps or ages where that is not answered (``scene`` is not read: one wording)."""
-    return ("loading: the punch lifts off the bare base on a base that creeps or ages, with a "
-            "curved punch or loads whose ratio changes in time (the pressure turns negative "
-            f"at an edge); {UNCOATED_SCOPE}: set solver.contact to 'full' for the "
-            "full-contact answer (flagged contact_lost), keep the eccentricity constant, or "
-            "add a coating layer")
+    return ("loading: the punch lifts off the bare base on a base that creeps or ages, and its "
+            "contact zone would recede as the base creeps (a point that touched would leave "
+            "the punch) or a given load jumps; "
+            f"{UNCOATED_SCOPE}: set solver.contact to 'full' for the full-contact answer "
+            "(flagged contact_lost), keep the eccentricity constant, or add a coating layer")

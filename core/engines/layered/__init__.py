@@ -16,7 +16,9 @@ with the common ``info`` keys and :func:`core.problem.accepts` (margin 1).
   Volterra equations over the elastic unit responses);
   :mod:`~core.engines.layered.bare_lift_off`: a punch lifting off the bare elastic base
   (the zone a narrower punch's, its free end where the pressure's singular coefficient
-  vanishes);
+  vanishes); :mod:`~core.engines.layered.bare_growing_zone`: lifting off the bare base
+  that creeps or ages while the zone grows (the elastic zones of the crept loads, the
+  pressure their hereditary transform);
 - :mod:`~core.engines.layered.galerkin`: modes, nodes and the Galerkin matrix;
 - :mod:`~core.engines.layered.cache`: the bounded caches of tables, operators and
   responses; :mod:`~core.engines.layered.stiffness`: flat-punch stiffnesses in SI units.

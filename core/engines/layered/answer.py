@@ -51,6 +51,7 @@ import numpy as np
 
 from core.coating import model_error_estimate, tilt_share
 from core.engines.layered.bare_creep import solve_bare_creep
+from core.engines.layered.bare_growing_zone import solve_growing_zone
 from core.engines.layered.bare_lift_off import bare_lift_off
 from core.engines.layered.galerkin import MAX_MODES, MAX_NODES, default_modes, node_count
 from core.engines.layered.solve import ERROR_FLOOR, solve_layered
@@ -323,16 +324,14 @@ def _bare_creep_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: An
     """
     from types import SimpleNamespace
 
-    if callable(problem.g) or problem.g != 0.0:
-        return None  # a curved punch: its gap does not creep, so the zone moves
-    kept = _proportional(problem, times)
+    kept = None if callable(problem.g) or problem.g != 0.0 else _proportional(problem, times)
     free = _free_corners(regular_part, pulls)
-    if kept is None:
-        return None
-    first, second, ratio = kept
     corner = int(free[np.flatnonzero(free)[0]]) if np.any(free) else 0
-    if np.any((free != 0) & (free != corner)):
-        return None
+    if kept is None or np.any((free != 0) & (free != corner)):
+        # a curved punch (its gap does not creep) or loads whose ratio changes: the zone
+        # moves
+        return _bare_creep_growing_zone(scene, problem, times, answer, start)
+    first, second, ratio = kept
     reference = {first: np.array([1.0]), second: np.array([ratio])}
     lifted = bare_lift_off(scene.half_width, (scene.base_thickness,
                                               problem.modulus_at_loading, scene.base_poisson),
@@ -377,6 +376,34 @@ def _bare_creep_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: An
                                 error_estimate, zone.end_error, zone.response.modes,
                                 zone.response.nodes, history)
     return solution
+
+
+def _bare_creep_growing_zone(scene: Any, problem: Any, times: np.ndarray, answer: Any,
+                             start: float) -> ContactSolution | None:
+    """A punch lifting off the bare base that creeps or ages, its zone moving as it does
+    (:mod:`core.engines.layered.bare_growing_zone`), or None where that zone would recede
+    or a given load jumps (the scene is then refused, :func:`core.scene.uncoated.
+    lift_off_refusal`)."""
+    from types import SimpleNamespace
+
+    if len(problem.time_breaks):
+        return None
+    try:
+        grown = solve_growing_zone(
+            scene.half_width, (scene.base_thickness, problem.modulus_at_loading,
+                               scene.base_poisson),
+            problem.g, problem.kernel, problem.loads, times, answer.response, answer.modes,
+            problem.tol, corner_reach([], scene.half_width), LIFT_OFF_SHARE)
+    except ValueError:
+        return None
+    history = SimpleNamespace(
+        time_error=grown.time_error, fit_error=grown.fit_error, steps=grown.steps,
+        success=bool(np.isfinite(grown.time_error)), message=(
+            f"{grown.steps} steps of the product trapezoid rule with Richardson "
+            f"extrapolation, an elastic zone at each"))
+    return _lifted_solution(scene, problem, times, answer, start, grown.zones,
+                            grown.histories, grown.pressure, grown.error + grown.time_error,
+                            grown.end_error, grown.modes, grown.nodes, history)
 
 
 def _lifted_solution(scene: Any, problem: Any, times: np.ndarray, answer: Any, start: float,

@@ -28,7 +28,8 @@ zone's middle and half-width are the root of both coefficients (Powell's hybrid 
 from Hertz's half-width on a half-space, ``b = sqrt(2 R P* / pi)`` with ``R`` the crown's
 radius at the gap's lowest point, or from the best of a scan of zones). A creeping or
 aging bare base is answered on the elastic zone where the loads keep their ratio
-(:mod:`core.engines.layered.answer`).
+(:mod:`core.engines.layered.answer`), and on the elastic zones of its crept loads where
+the zone grows (:mod:`core.engines.layered.bare_growing_zone`).
 
 The error: the zone's own mode truncation (``truncation_errors`` of
 :mod:`core.engines.layered.solve`, as a full-contact solve estimates it) and the zone's
