@@ -290,7 +290,8 @@ class _Grid:
 
 def _on_grid(half_width: float, base: tuple[float, float, float], gap: Any, kernel: Any,
              loads: dict[str, Any], response: LayeredResponse, grid: np.ndarray,
-             index: np.ndarray, modes: int, tol: float, share: float) -> _Grid:
+             index: np.ndarray, modes: int, tol: float, share: float,
+             solved: dict[tuple, Any]) -> _Grid:
     relax = np.eye(grid.size) - _volterra(kernel, grid)
     given = {}
     for name, load in loads.items():
@@ -299,7 +300,7 @@ def _on_grid(half_width: float, base: tuple[float, float, float], gap: Any, kern
         # the force and moment of Q = (I - V) q*; the kinematics as they are
         given[name] = relax @ values if name in _STATIC else np.array(values)
     free = _free_corners(response, given, share)
-    lifted = bare_lift_off(half_width, base, gap, given, free, modes, tol)
+    lifted = bare_lift_off(half_width, base, gap, given, free, modes, tol, solved=solved)
     _check_growing(lifted, free)
     histories = {}
     for name in _NAMES:
@@ -359,6 +360,9 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
     finite on the grid.
     """
     stepping, fit_error = stepping_kernel(kernel, float(times[-1]), 0.5 * tol)
+    # a halved grid holds the points of the last: where their crept loads are the same
+    # (constant or linear loads, given kinematics), their zones are found once
+    solved: dict[tuple, Any] = {}
     plain: list[dict[str, np.ndarray]] = []
     extrapolations: list[dict[str, np.ndarray]] = []
     grids: list[_Grid] = []
@@ -367,7 +371,7 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
     for level in range(MAX_HALVINGS + 1):
         grid, _, index = time_grid(times, FIRST_STEPS, level)
         grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid, index,
-                              modes, tol, lift_off_share))
+                              modes, tol, lift_off_share, solved))
         if nodes is None:
             # q* is compared where the zones lie (the last, largest one), densely: the
             # points a growing end sweeps get their pressure later, less smoothly in time

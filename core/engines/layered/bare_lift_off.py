@@ -55,6 +55,7 @@ from core.engines.layered.solve import (
     truncation_errors,
 )
 from core.kernel import RegularPartTable
+from core.work import check_work
 
 __all__ = ["BareLiftOff", "TWO_FREE_ENDS", "bare_lift_off"]
 
@@ -187,8 +188,11 @@ class _Zones:
                                            np.array([alpha]), level=level)[0, 0])
 
 
-def _free_end(zones: _Zones, free: int, given: dict[str, float], level: int) -> float:
-    """The free end of the zone (``free`` -1: the lower end lifts, +1: the upper)."""
+def _free_end(zones: _Zones, free: int, given: dict[str, float], level: int,
+              near: float | None = None) -> float:
+    """The free end of the zone (``free`` -1: the lower end lifts, +1: the upper);
+    ``near``: an end found for nearby loads, bracketed first (a creeping base asks one
+    zone per time-grid point, each near the last)."""
     # here, not at the top: scipy.optimize brings scipy.fft and scipy.special, which a
     # solve that lifts off nothing need not load (tests/cli/test_cold_start.py)
     from scipy.optimize import brentq
@@ -199,13 +203,27 @@ def _free_end(zones: _Zones, free: int, given: dict[str, float], level: int) -> 
     def f(end: float) -> float:
         return zones.intensity(free, end, given, level)
 
+    def root(a: float, b: float) -> float:
+        return float(brentq(f, a, b, xtol=END_TOL, rtol=4 * np.finfo(float).eps))
+
+    if near is not None and -1.0 < near < 1.0:
+        # f < 0 toward the lifting corner, > 0 toward the other: widen a bracket about it
+        width = 1e-3
+        while width < 0.5:
+            a = float(np.clip(near - width * (other - corner) / 2, min(corner, other),
+                              max(corner, other)))
+            b = float(np.clip(near + width * (other - corner) / 2, min(corner, other),
+                              max(corner, other)))
+            if a != b and f(a) < 0.0 < f(b):
+                return root(a, b)
+            width *= 8.0
     if f(corner) >= 0.0:
         raise ValueError(f"free: the corner at t = {corner:g} does not lift off")
     previous = corner
     for share in SCAN:
         end = corner + share * (other - corner)
         if f(end) > 0.0:
-            return float(brentq(f, previous, end, xtol=END_TOL, rtol=4 * np.finfo(float).eps))
+            return root(previous, end)
         previous = end
     raise ValueError("loading: no contact zone carries these loads on the bare base (the "
                      "singular pressure at the free end keeps its sign over the punch)")
@@ -227,7 +245,8 @@ class BareLiftOff:
 
 def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
                   given: dict[str, np.ndarray], free: np.ndarray, modes: int, tol: float,
-                  full_error: float = 0.0) -> BareLiftOff:
+                  full_error: float = 0.0,
+                  solved: dict[tuple, ZoneAnswer] | None = None) -> BareLiftOff:
     """The zone, the pressure and the four quantities of a punch lifting off the bare
     elastic base, at each value of the given loads.
 
@@ -237,7 +256,8 @@ def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
     end lifts), +1 (the upper), 2 (both: a crown pressed lightly) or 0 (full contact
     holds: the whole punch's zone, whose
     error is ``full_error``, the full-contact solve's); ``modes`` the full-contact
-    solve's; ``tol`` the accuracy asked for.
+    solve's; ``tol`` the accuracy asked for; ``solved``: the zones already found for
+    other calls on the same punch, base, gap and tol (by corner and values; updated).
     """
     thickness, modulus, poisson = base
     degree = table_degree(tol)
@@ -246,8 +266,11 @@ def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
         lambda: RegularPartTable(2 * half_width / thickness, [], thickness, modulus, poisson,
                                  degree=degree))
     out: list[ZoneAnswer] = []
-    solved: dict[tuple, ZoneAnswer] = {}
+    solved = {} if solved is None else solved
+    last: dict[int, ZoneAnswer] = {}  # the last zone found, per corner lifting
     for k in range(len(free)):
+        # a creeping base asks one zone per time-grid point: the solve's CPU bound applies
+        check_work("finding the contact zone of a punch lifting off the bare base")
         values = {n: float(np.asarray(v)[k]) for n, v in given.items()}
         if free[k] == 0:  # full contact holds at this value: the whole punch's zone
             zones = _Zones(half_width, base, gap, modes, table, tol)
@@ -256,26 +279,33 @@ def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
             out.append(ZoneAnswer(-1.0, 1.0, 0, response, delta, alpha, four, full_error,
                                   0.0))
             continue
-        key = (int(free[k]), *sorted(values.items()))
+        # to 13 digits: the same crept load reached through other sums (a halved time grid)
+        key = (int(free[k]), *sorted((n, float(f"{v:.13g}")) for n, v in values.items()))
         if key not in solved:
             solved[key] = _solve_one(half_width, base, gap, values, int(free[k]), modes,
-                                     table, tol)
+                                     table, tol, near=last.get(int(free[k])))
         out.append(solved[key])
+        last[int(free[k])] = solved[key]
     return BareLiftOff(out)
 
 
 def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
                given: dict[str, float], free: int, modes: int, table: RegularPartTable,
-               tol: float) -> ZoneAnswer:
+               tol: float, near: ZoneAnswer | None = None) -> ZoneAnswer:
+    """The zone answer at one value of the loads (``near``: one for nearby loads, the
+    same corners lifting, where its ends are looked for first)."""
     floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
     while True:
         zones = _Zones(half_width, base, gap, modes, table, tol)
         if free == 2:
-            lo, hi = _two_free_ends(zones, given, level=0)
+            lo, hi = _two_free_ends(zones, given, level=0,
+                                    guess=None if near is None else (near.lo, near.hi))
             clo, chi = _two_free_ends(zones, given, level=1, guess=(lo, hi))
         else:
-            lo, hi = _zone(free, _free_end(zones, free, given, level=0))
-            clo, chi = _zone(free, _free_end(zones, free, given, level=1))
+            start = None if near is None else (near.lo if free < 0 else near.hi)
+            end = _free_end(zones, free, given, level=0, near=start)
+            lo, hi = _zone(free, end)
+            clo, chi = _zone(free, _free_end(zones, free, given, level=1, near=end))
         x0, b = 0.5 * (lo + hi), 0.5 * (hi - lo)
         response = zones.response(lo, hi)
         delta, alpha, values = _kinematics(response, x0, b, given)
