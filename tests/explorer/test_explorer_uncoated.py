@@ -79,3 +79,30 @@ def test_the_heel_lifting_off_the_bare_layer_is_drawn_and_said(explorer_app):
                                      "-0.4 m (unilateral contact)")
     assert np.all(view.pressure[view.x < -0.4, 0] == 0)
     assert np.all(view.pressure[view.x > -0.399, 0] > 0)
+
+
+@pytest.mark.slow
+def test_a_crown_lifting_off_the_creeping_bare_layer_is_drawn_as_its_zone_grows(explorer_app):
+    # a crown (R = 20 km) on the bare layer that creeps (a standard linear solid): it lifts
+    # at both corners and its zone grows as the base creeps
+    # (core/engines/layered/bare_growing_zone.py), which the page draws and says; at tol
+    # 1e-4 (at 1e-6 its time grids stop at an estimate of 4.5e-5, flagged tol_not_met)
+    import copy
+
+    from explorer.model.contact_zone import contact_text, contact_widths
+    from tests.support.creep_laws import CREEP
+
+    scene = copy.deepcopy(PRESETS["bare_layer"])
+    scene["base"]["creep"] = dict(CREEP)
+    scene["punch"]["shape"] = {"kind": "polynomial", "coefficients": [0.0, 0.0, 2.5e-5]}
+    scene["times"] = {"end": 365.0, "count": 8, "spacing": "log"}
+    scene["solver"] = {"tol": 1e-4}
+    app = explorer_app(scene=scene, solved=True)
+    assert app.controller.wait(120) and app.controller.error == "", app.controller.error
+    view = app.controller.view
+    assert view.info["success"] and view.info["flags"] == [], view.info["message"]
+    widths = contact_widths(view)
+    assert 0.0 < widths[0] < widths[-1] < 2.0 and np.all(np.diff(widths) > 0), widths
+    assert contact_text(view, 0).startswith("contact ") and "lifted" in contact_text(view, 0)
+    outside = np.abs(view.x) > 0.5 * widths[-1] + 1e-3
+    assert np.all(view.pressure[outside, :] == 0) and np.all(np.isfinite(view.pressure))
