@@ -18,6 +18,15 @@ tests/engines/test_bare_lift_off.py):
 For each tol: the median CPU time of ``core.solve`` [ms] (caches cleared before each
 solve), the solver's estimate, the error of the zone's ends [half-widths of the punch],
 of the pressure (largest relative error over the zone's inner 80 %) and of the tilt.
+
+And the crown on a base that creeps (a standard linear solid, ``tests/support/
+creep_laws.CREEP``, 8 output times to 365 days, ``H = 100 m``): its zone grows as the base
+creeps (``core/engines/layered/bare_growing_zone.py``), against Lee and Radok's
+hereditary integral by quadrature (``tests.support.creep_laws.lee_radok_pressure``): the
+half-width ``b0 sqrt(E J(t))`` and the pressure at points in contact from the start and
+at points the ends reach later (error relative to the largest pressure, over the output
+times). One solve each (seconds).
+
 Written to ``benchmarks/results/bare_lift_off.md`` unless ``--no-write``.
 """
 
@@ -96,10 +105,43 @@ def measure() -> list[tuple]:
     return rows
 
 
+CREEP_TOLS = (1e-3, 1e-4, 1e-5)
+
+
+def measure_creeping() -> list[tuple]:
+    """(tol, CPU [s], time steps, estimate, half-width error, q error, success) of the
+    crown growing on the creeping layer (module docstring)."""
+    from tests.support.creep_laws import CREEP, laws, lee_radok_pressure
+
+    radius, force = 1000.0, 1e3
+    rows = []
+    for tol in CREEP_TOLS:
+        d = _scene("crown", tol)
+        d["base"]["thickness"] = 100.0
+        d["base"]["creep"] = dict(CREEP)
+        d["times"] = {"end": 365.0, "count": 8, "spacing": "log"}
+        clear_caches()
+        started = time.process_time()
+        result = solve(d)
+        cpu = time.process_time() - started
+        growth, _ = laws(result.times)
+        b0 = np.sqrt(4 * radius * force / (np.pi * E / (1 - NU**2)))
+        b = np.array([zones[0][1] for zones in result.contact_set])
+        width = float(np.max(np.abs(b / (b0 * np.sqrt(growth / growth[0])) - 1)))
+        x = b0 * np.array([0.0, 0.5, 0.9, 1.05, 1.2, 1.35])
+        exact = lee_radok_pressure(x, result.times, b0, 2 * force / (np.pi * b0))
+        q = float(np.max(np.abs(result.pressure(x) - exact)) / np.max(np.abs(exact)))
+        rows.append((tol, cpu, int(result.info["n_steps"]),
+                     float(result.info["error_estimate"]), width, q,
+                     bool(result.info["success"])))
+    return rows
+
+
 def main(argv: list[str]) -> None:
     started = datetime.now(timezone.utc)
     before = os.getloadavg()[0]
     rows = measure()
+    creeping = measure_creeping()
     after = os.getloadavg()[0]
     lines = ["# A punch lifting off the bare base: speed against error", "",
              "    OPENBLAS_NUM_THREADS=1 python -m benchmarks.bare_lift_off", "",
@@ -114,6 +156,14 @@ def main(argv: list[str]) -> None:
         lines.append(f"| {kind} | {tol:.0e} | {ms:.1f} | {est:.1e} | {end_est:.1e} | "
                      f"{ends:.1e} | {q:.1e} | {'' if np.isnan(tilt) else f'{tilt:.1e}'} | "
                      f"{'yes' if ok else 'no'} |")
+    lines += ["", "## The crown on a creeping layer (its zone grows)", "",
+              "Against Lee and Radok's hereditary integral (module docstring); one solve "
+              "each.", "",
+              "| tol | CPU [s] | time steps | estimate | half-width error | q error | "
+              "success |", "| --- | --- | --- | --- | --- | --- | --- |"]
+    for tol, seconds, steps, est, width, q, ok in creeping:
+        lines.append(f"| {tol:.0e} | {seconds:.1f} | {steps} | {est:.1e} | {width:.1e} | "
+                     f"{q:.1e} | {'yes' if ok else 'no'} |")
     text = "\n".join(lines) + "\n"
     print(text)
     if "--no-write" not in argv:

@@ -14,7 +14,7 @@ import pytest
 from core.engines.layered.bare_lift_off import bare_lift_off
 from core.presets import read_preset
 from core.scene import solve
-from tests.support.creep_laws import CREEP, aging_growth, laws
+from tests.support.creep_laws import CREEP, aging_growth, laws, lee_radok_pressure
 
 
 def _half_space_deviation(lam: float, e: float) -> tuple[float, float, float]:
@@ -315,40 +315,6 @@ def test_a_crown_lifting_at_both_corners_gives_one_answer_in_every_statement():
 
 # --------------------------------------------------------------- a zone growing as the base creeps
 
-def _lee_radok(x: np.ndarray, days: np.ndarray, b0: float, peak: float) -> np.ndarray:
-    """The pressure [Pa] of a Hertz contact (elastic half-width ``b0`` [m], pressure ``peak
-    sqrt(1 - x^2 / b0^2)`` [Pa] at loading) growing under a constant force on the standard
-    linear solid of :data:`CREEP` (Lee and Radok's hereditary integral, by quadrature):
-    ``q(x, t) = C int R(t - tau) / E d sqrt(b(tau)^2 - x^2)`` with ``b(tau)^2 = b0^2 E
-    J(tau)``, ``C = peak / b0``, integrated in ``s = sqrt(b^2 - x^2)`` (smooth there)."""
-    from scipy.integrate import quad
-
-    e_c = CREEP["modulus"] * CREEP["compliance"]
-    rate = CREEP["rate"]
-
-    def relaxation(lag: float) -> float:  # R(lag) / E
-        return (1 + e_c * np.exp(-rate * (1 + e_c) * lag)) / (1 + e_c)
-
-    def grown(days_: float) -> float:  # b(t)^2
-        return b0 * b0 * (1 + e_c * (1 - np.exp(-rate * days_)))
-
-    def reached(square: float) -> float:  # the time b^2 reaches ``square``
-        return -np.log(1 - (square / (b0 * b0) - 1) / e_c) / rate
-
-    out = np.zeros((x.size, days.size))
-    for i, xi in enumerate(x):
-        for k, t in enumerate(days):
-            top = grown(t) - xi * xi
-            if top <= 0:
-                continue
-            start = max(b0 * b0 - xi * xi, 0.0)
-            value = relaxation(t) * np.sqrt(start)  # the jump at loading
-            value += quad(lambda s, t=t, xi=xi: relaxation(t - reached(xi * xi + s * s)),
-                          np.sqrt(start), np.sqrt(top), epsabs=0.0, epsrel=1e-13)[0]
-            out[i, k] = peak / b0 * value
-    return out
-
-
 @pytest.mark.slow
 def test_a_crown_on_a_creeping_thick_layer_grows_as_lee_and_radok_say():
     """A cylinder (R = 1000 m, P = 1 kN/m) on a thick (H = 100 m) creeping bare layer: the
@@ -373,7 +339,7 @@ def test_a_crown_on_a_creeping_thick_layer_grows_as_lee_and_radok_say():
     b0 = np.sqrt(4 * radius * force / (np.pi * e_star))
     assert b[0] == pytest.approx(b0, rel=2e-9)
     x = b0 * np.array([0.0, 0.5, 0.9, 1.05, 1.2, 1.35])
-    exact = _lee_radok(x, days, b0, 2 * force / (np.pi * b0))
+    exact = lee_radok_pressure(x, days, b0, 2 * force / (np.pi * b0))
     error = np.max(np.abs(result.pressure(x) - exact)) / np.max(np.abs(exact))
     assert error <= result.info["error_estimate"], (error, result.info["error_estimate"])
 
