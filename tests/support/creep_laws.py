@@ -61,6 +61,6 @@ def lee_radok_pressure(x: np.ndarray, days: np.ndarray, b0: float, peak: float) 
             start = max(b0 * b0 - xi * xi, 0.0)
             value = relaxation(t) * np.sqrt(start)  # the jump at loading
             value += quad(lambda s, t=t, xi=xi: relaxation(t - reached(xi * xi + s * s)),
-                          np.sqrt(start), np.sqrt(top), epsabs=0.0, epsrel=1e-13)[0]
+                          np.sqrt(start), np.sqrt(top), epsabs=0.0, epsrel=1e-11, limit=200)[0]
             out[i, k] = peak / b0 * value
     return out
