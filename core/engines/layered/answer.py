@@ -399,8 +399,8 @@ def _bare_creep_growing_zone(scene: Any, problem: Any, times: np.ndarray, answer
     history = SimpleNamespace(
         time_error=grown.time_error, fit_error=grown.fit_error, steps=grown.steps,
         success=bool(np.isfinite(grown.time_error)), message=(
-            f"{grown.steps} steps of the product trapezoid rule with Richardson "
-            f"extrapolation, an elastic zone at each"))
+            f"{grown.steps} steps (the creep kernel's exponentials integrated exactly), "
+            f"Richardson over halved grids, an elastic zone at each"))
     return _lifted_solution(scene, problem, times, answer, start, grown.zones,
                             grown.histories, grown.pressure, grown.error + grown.time_error,
                             grown.end_error, grown.modes, grown.nodes, history)
