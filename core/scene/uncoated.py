@@ -26,7 +26,7 @@ UNCOATED_SCOPE = ("a scene with no coating layers is solved under a punch shape 
                   "jumps or kinks; on a base that creeps or ages it lifts off where its "
                   "contact zone keeps its size or grows (a flat punch under given loads that "
                   "keep their ratio, a crown pressed as the base creeps), not where the zone "
-                  "recedes or a given load jumps, for now")
+                  "recedes, for now")
 
 
 def check_uncoated(scene: Any) -> None:
@@ -53,6 +53,6 @@ def lift_off_refusal(scene: Any) -> str:
     creeps or ages where that is not answered (``scene`` is not read: one wording)."""
     return ("loading: the punch lifts off the bare base on a base that creeps or ages, and its "
             "contact zone would recede as the base creeps (a point that touched would leave "
-            "the punch) or a given load jumps; "
+            "the punch); "
             f"{UNCOATED_SCOPE}: set solver.contact to 'full' for the full-contact answer "
             "(flagged contact_lost), keep the eccentricity constant, or add a coating layer")

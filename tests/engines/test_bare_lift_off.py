@@ -370,3 +370,30 @@ def test_a_crown_under_a_given_settlement_keeps_its_zone_and_its_force_relaxes()
     _, relaxation = laws(result.times)
     error = np.max(np.abs(result.force / result.force[0] - relaxation / relaxation[0]))
     assert error <= result.info["error_estimate"] < 1e-6, (error, result.info)
+
+
+def test_a_crown_whose_force_steps_up_grows_its_zone_at_once_and_then_as_the_base_creeps():
+    # P steps from 1 to 2 kN/m at 50 days on the thick creeping layer: the zone's
+    # half-width follows the crept force, b(t)^2 / b0^2 = (E J(t) P1 + E J(t - 50) (P2 -
+    # P1)) / P1 (measured 5.8e-9); stepping down, the zone would recede: refused
+    from core.profiles import HISTORY_FORMS
+
+    def scene(first: float, second: float) -> dict:
+        d = _creeping({"force": HISTORY_FORMS["step"].spec(
+            {"value": first, "second": second, "time": 50.0}), "moment": 0.0})
+        d["punch"]["shape"] = {"kind": "polynomial", "coefficients": [0.0, 0.0, 0.5e-3]}
+        d["base"]["thickness"] = 100.0
+        d["times"] = {"end": 365.0, "count": 6, "spacing": "log"}
+        d["solver"] = {"tol": 1e-3}
+        return d
+
+    result = solve(scene(1e3, 2e3))
+    assert result.flags == [] and result.info["contact"] == "unilateral"
+    days = result.times
+    growth, _ = laws(days)
+    later, _ = laws(np.maximum(days - 50.0, 0.0))
+    crept = growth + np.where(days >= 50.0, later, 0.0)
+    b = np.array([zones[0][1] for zones in result.contact_set])
+    assert np.max(np.abs(b / b[0] - np.sqrt(crept / crept[0]))) < 1e-8
+    with pytest.raises(ValueError, match="contact zone would recede"):
+        solve(scene(2e3, 1e3))

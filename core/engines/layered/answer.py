@@ -382,18 +382,16 @@ def _bare_creep_growing_zone(scene: Any, problem: Any, times: np.ndarray, answer
                              start: float) -> ContactSolution | None:
     """A punch lifting off the bare base that creeps or ages, its zone moving as it does
     (:mod:`core.engines.layered.bare_growing_zone`), or None where that zone would recede
-    or a given load jumps (the scene is then refused, :func:`core.scene.uncoated.
-    lift_off_refusal`)."""
+    (the scene is then refused, :func:`core.scene.uncoated.lift_off_refusal`)."""
     from types import SimpleNamespace
 
-    if len(problem.time_breaks):
-        return None
     try:
         grown = solve_growing_zone(
             scene.half_width, (scene.base_thickness, problem.modulus_at_loading,
                                scene.base_poisson),
             problem.g, problem.kernel, problem.loads, times, answer.response, answer.modes,
-            problem.tol, corner_reach([], scene.half_width), LIFT_OFF_SHARE)
+            problem.tol, corner_reach([], scene.half_width), LIFT_OFF_SHARE,
+            tuple(float(b) for b in problem.time_breaks))
     except ValueError:
         return None
     history = SimpleNamespace(

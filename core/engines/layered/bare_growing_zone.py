@@ -29,6 +29,7 @@ says so).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -52,6 +53,8 @@ TIME_SHARE = 3.0
 #: A zone end may move back by this many half-widths between grid points and still count
 #: as not receding (the ends are found to ~1e-13; their modes' error is far smaller).
 RECEDE_SLACK = 1e-9
+#: A grid step this short [relative] is the two sides of a load's jump (``time_grid``).
+JUMP_STEP = 1e-9
 #: Why a growing-zone answer was not given.
 RECEDES = ("the contact zone would recede as the base creeps (a point that touched "
            "leaves the punch): the bare base's creep is solved while the zone only grows")
@@ -172,11 +175,15 @@ def _onsets(grid: np.ndarray, lo: np.ndarray, hi: np.ndarray, x: np.ndarray) -> 
     onset = np.full(x.shape, np.inf)
     for m in np.flatnonzero(inside.any(axis=1)):
         k = int(np.argmax(inside[m]))
-        if k == 0:
+        if k == 0 or grid[k] - grid[k - 1] <= JUMP_STEP * max(1.0, abs(grid[k])):
+            # in the first zone, or reached as a given load jumps: its pressure starts at
+            # once, not like a root of the time since, and is taken linear as the rest
             onset[m] = grid[0]
             continue
         end = lo if x[m] <= lo[k - 1] else hi
         near = np.arange(max(0, min(k - 2, grid.size - 4)), min(grid.size, max(k - 2, 0) + 4))
+        if np.any(np.diff(grid[near]) <= JUMP_STEP * max(1.0, abs(grid[k]))):
+            near = near[:0]  # the two sides of a jump among them: the linear crossing
         h = grid[k] - grid[k - 1]
         share = (x[m] - end[k - 1]) / (end[k] - end[k - 1])
         t = grid[k - 1] + h * float(np.clip(share, 0.0, 1.0))
@@ -346,7 +353,8 @@ def _differences(a: dict[str, np.ndarray], b: dict[str, np.ndarray]) -> tuple[fl
 def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap: Any,
                        kernel: Any, loads: dict[str, Any], times: np.ndarray,
                        response: LayeredResponse, modes: int, tol: float,
-                       corner: float, lift_off_share: float) -> GrowingZone:
+                       corner: float, lift_off_share: float,
+                       jumps: Sequence[float] = ()) -> GrowingZone:
     """The punch lifting off the bare base that creeps or ages, its zone growing.
 
     ``half_width`` a [m]; ``base`` its thickness [m], modulus at loading [Pa] and Poisson
@@ -356,7 +364,8 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
     answer, which tells the corners that lift); ``modes`` its modes; ``tol`` [-];
     ``corner`` where q* is held near a corner in contact (its value is infinite there);
     ``lift_off_share`` how far below zero, relative, the full-contact pressure at a corner
-    means that corner lifts.
+    means that corner lifts; ``jumps`` the times where a given load jumps or kinks (each
+    grid holds both sides of them).
     Raises ValueError (:data:`RECEDES`) where the zone would recede, or the kernel is not
     finite on the grid.
     """
@@ -370,7 +379,7 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
     time_error = np.inf
     nodes = None
     for level in range(MAX_HALVINGS + 1):
-        grid, _, index = time_grid(times, FIRST_STEPS, level)
+        grid, _, index = time_grid(times, FIRST_STEPS, level, jumps)
         grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid, index,
                               modes, tol, lift_off_share, solved))
         if nodes is None:
