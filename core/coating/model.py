@@ -82,10 +82,12 @@ def layer_compliance(thickness: Any, modulus: Any, poisson: Any,
 
 
 def _multilinear(axes: tuple[np.ndarray, ...], values: np.ndarray) -> Any:
-    """Multilinear interpolation on a rectangular grid, for points inside it (..., dims).
+    """Multilinear interpolation on a rectangular grid, for points inside it (..., dims),
+    of several tables at once: ``values`` (tables, *grid), the result (tables, ...).
 
     Written out (a few lines) because scipy.interpolate was 2/3 of a cold CLI solve's
-    imports.
+    imports; the tables share the points' cells and weights (a stack is read several
+    ways, each in four tables, on every geometry change).
     """
     def evaluate(pts: np.ndarray) -> np.ndarray:
         pts = np.asarray(pts, dtype=float)
@@ -95,7 +97,7 @@ def _multilinear(axes: tuple[np.ndarray, ...], values: np.ndarray) -> Any:
                         len(axis) - 2)
             lower.append(i)
             frac.append((pts[..., k] - axis[i]) / (axis[i + 1] - axis[i]))
-        out = np.zeros(pts.shape[:-1])
+        out = np.zeros((values.shape[0],) + pts.shape[:-1])
         for corner in range(2 ** len(axes)):
             weight = np.ones(pts.shape[:-1])
             index = []
@@ -103,7 +105,7 @@ def _multilinear(axes: tuple[np.ndarray, ...], values: np.ndarray) -> Any:
                 up = (corner >> k) & 1
                 weight = weight * (frac[k] if up else 1.0 - frac[k])
                 index.append(lower[k] + up)
-            out = out + weight * values[tuple(index)]
+            out = out + weight * values[(slice(None), *index)]
         return out
 
     return evaluate
@@ -121,16 +123,19 @@ def confinement(poisson: Any) -> np.ndarray:
     return 1.0 / (1.0 - 2.0 * np.asarray(poisson, dtype=float))
 
 
+#: The map's tables per interface, in the order :func:`_interpolator` stacks them.
+_PARTS = ("force", "moment", "force_size", "moment_size")
+
+
 def _interpolator():
     from core.coating import error_table as table
     axes = (np.log(table.THICKNESS_RATIOS), np.log(table.MODULUS_RATIOS),
             confinement(table.COATING_POISSON), np.log(table.BASE_RATIOS))
     out = {}
     for interface in INTERFACES:
-        for part in ("force", "moment"):
-            values = np.array(table.ERRORS[interface][part], dtype=float)
-            out[interface, part] = _multilinear(axes, values)
-            out[interface, part + "_size"] = _multilinear(axes, np.abs(values))
+        signed = [np.array(table.ERRORS[interface][part], dtype=float)
+                  for part in ("force", "moment")]
+        out[interface] = _multilinear(axes, np.stack(signed + [np.abs(v) for v in signed]))
     return out, table
 
 
@@ -167,8 +172,8 @@ def mapped_error(thickness_ratio: Any, modulus_ratio: Any, coating_poisson: Any,
         confinement(np.clip(np.asarray(coating_poisson, dtype=float),
                             table.COATING_POISSON[0], table.COATING_POISSON[-1])),
         np.log(np.clip(base_ratio, table.BASE_RATIOS[0], table.BASE_RATIOS[-1]))), axis=-1)
-    return {part: scale * maps[interface, part](pts)
-            for part in ("force", "moment", "force_size", "moment_size")}
+    read = scale * maps[interface](pts)
+    return dict(zip(_PARTS, read, strict=True))
 
 
 def tilt_share(half_width: float, settlement: Any, tilt: Any) -> float:
@@ -236,7 +241,9 @@ def model_error_map(scene: Any) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     x = np.linspace(-a, a, ESTIMATE_POINTS)
     e0, base_ratio = scene.modulus_at_loading(), scene.base_thickness / a
     parts: dict[str, np.ndarray] = {}
-    for thickness, modulus, poisson, interface in equivalent_layers(scene.coating, x):
+    # one layer is its own average and its own softest material: one reading
+    readings = equivalent_layers(scene.coating, x)[:1 if len(scene.coating) == 1 else 2]
+    for thickness, modulus, poisson, interface in readings:
         read = mapped_error(thickness / (2 * a), modulus / e0, poisson, interface,
                             base_ratio)
         # the stack as read, before the map's clamping (beyond_map)
@@ -266,19 +273,21 @@ def _each_layer_reading(layers: Any, x: np.ndarray, base_modulus: float, half_wi
     erred by 1.04 % and both readings said 0.73 %; this one 3.3 %. Measured on the 37
     stacks of ``python -m benchmarks.coating_validity --stacks`` it raised no other reading
     by more than a fifth."""
-    softness = [_values(layer.thickness, x) / _values(layer.modulus, x) for layer in layers]
-    total = sum(softness)
-    out = {part: np.zeros(x.shape) for part in ("force", "moment", "force_size",
-                                                  "moment_size")}
-    for layer, soft in zip(layers, softness, strict=True):
-        read = mapped_error(_values(layer.thickness, x) / (2 * half_width),
-                            _values(layer.modulus, x) / base_modulus,
-                            _values(layer.poisson, x),
-                            getattr(layer, "interface", DEFAULT_INTERFACE), base_ratio)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            share = np.where(total > 0, soft / total, 0.0)
+    thickness = np.array([_values(layer.thickness, x) for layer in layers])
+    modulus = np.array([_values(layer.modulus, x) for layer in layers])
+    poisson = np.array([_values(layer.poisson, x) for layer in layers])
+    joints = np.array([getattr(layer, "interface", DEFAULT_INTERFACE) for layer in layers])
+    softness = thickness / modulus
+    total = softness.sum(axis=0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        share = np.where(total > 0, softness / total, 0.0)
+    out = {part: np.zeros(x.shape) for part in _PARTS}
+    for interface in np.unique(joints):
+        these = joints == interface  # the layers of one interface read at once
+        read = mapped_error(thickness[these] / (2 * half_width), modulus[these] / base_modulus,
+                            poisson[these], str(interface), base_ratio)
         for part in out:
-            out[part] += share * read[part]
+            out[part] += (share[these] * read[part]).sum(axis=0)
     return out
 
 
