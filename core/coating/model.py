@@ -241,8 +241,9 @@ def model_error_map(scene: Any) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     x = np.linspace(-a, a, ESTIMATE_POINTS)
     e0, base_ratio = scene.modulus_at_loading(), scene.base_thickness / a
     parts: dict[str, np.ndarray] = {}
-    # one layer is its own average and its own softest material: one reading
-    readings = equivalent_layers(scene.coating, x)[:1 if len(scene.coating) == 1 else 2]
+    readings = equivalent_layers(scene.coating, x)
+    if len(scene.coating) == 1:
+        readings = readings[:1]  # one layer is its own average and softest material
     for thickness, modulus, poisson, interface in readings:
         read = mapped_error(thickness / (2 * a), modulus / e0, poisson, interface,
                             base_ratio)

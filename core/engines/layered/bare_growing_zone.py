@@ -39,7 +39,7 @@ from scipy.linalg import solve_triangular
 from core.creep import stepping_kernel
 from core.engines.layered.bare_lift_off import BareLiftOff, bare_lift_off
 from core.engines.layered.solve import ERROR_FLOOR, LayeredResponse
-from core.time import time_grid
+from core.time import exponential_moments, time_grid
 
 __all__ = ["GrowingZone", "RECEDES", "solve_growing_zone"]
 
@@ -93,16 +93,20 @@ def _trapezoid(grid: np.ndarray) -> np.ndarray:
     return weights
 
 
+def _linear_weights(rates: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(early, late)`` (rates, steps): ``int_0^h exp(-rate (h - s)) g(s) ds = early
+    g(0) + late g(h)`` for ``g`` linear over a step of length ``h``, from the moments
+    ``mu_k(rate h)`` of :func:`core.time.exponential_moments` (``late = h mu_1``, ``early
+    = h (mu_0 - mu_1)``)."""
+    mu = exponential_moments(np.asarray(rates, dtype=float)[:, None] * h[None, :], 2)
+    return h * (mu[..., 0] - mu[..., 1]), h * mu[..., 1]
+
+
 def _exponential_weights(grid: np.ndarray, rate: float) -> np.ndarray:
     """Weights ``C`` with ``int_1^{t_i} exp(-rate (t_i - tau)) g(tau) dtau = sum_j C_ij g_j``
     for ``g`` linear between the grid points, the exponential integrated exactly."""
-    h = np.diff(grid)
-    x = rate * h
-    small = np.abs(x) < 1e-4
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lost = -np.expm1(-x)  # 1 - exp(-x)
-        late = np.where(small, h * (0.5 - x / 6.0 + x * x / 24.0), h * (x - lost) / (x * x))
-        early = np.where(small, h * (0.5 - x / 3.0 + x * x / 8.0), h * lost / x - late)
+    early, late = _linear_weights(np.array([rate]), np.diff(grid))
+    early, late = early[0], late[0]
     n = grid.size
     # decay from the end of step k (grid point k) to grid point i >= k
     decay = np.exp(-rate * np.clip(grid[:, None] - grid[None, 1:], 0.0, None))
@@ -212,12 +216,7 @@ def _step_weights(grid: np.ndarray, rates: np.ndarray, onset: np.ndarray
     hereditary integral converged like ``h^1.5`` (q* off by 2e-4 after 376 steps of a
     Hertz contact growing on a creeping base); with the root taken out, like ``h^2``."""
     h = np.diff(grid)
-    x = rates[:, None] * h[None, :]
-    small = np.abs(x) < 1e-4
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lost = -np.expm1(-x)
-        late = np.where(small, h * (0.5 - x / 6.0 + x * x / 24.0), h * (x - lost) / (x * x))
-        early = np.where(small, h * (0.5 - x / 3.0 + x * x / 8.0), h * lost / x - late)
+    early, late = _linear_weights(rates, h)
     count = onset.size
     early = np.broadcast_to(early, (count,) + early.shape).copy()
     late = np.broadcast_to(late, (count,) + late.shape).copy()
