@@ -50,6 +50,13 @@ JS_READY = """() => {
 }"""
 JS_Q = """() => Array.from(Bokeh.documents[0].get_model_by_name('q_source').data.q)"""
 JS_TITLE = """(name) => Bokeh.documents[0].get_model_by_name(name).title.text"""
+# Whether the sidebar's tab at index k has its widgets on the page.
+JS_TAB_FILLED = """(k) => Array.from(Bokeh.index.all_views())
+  .find(v => (v.model.css_classes || []).includes('sidebar-tabs'))
+  .model.tabs[k].child.children.length > 0"""
+# The titles of the sidebar's tabs, in their order.
+JS_TAB_TITLES = """() => Array.from(Bokeh.index.all_views())
+  .find(v => (v.model.css_classes || []).includes('sidebar-tabs')).model.tabs.map(t => t.title)"""
 
 
 # Closing a page while the server still writes to its websocket makes tornado log a
@@ -110,6 +117,19 @@ class Page:
     def open_tab(self, name: str) -> None:
         """Open a tab of the sidebar (its widgets arrive just after the page)."""
         self.page.locator(".bk-tab", has_text=name).first.click()
+
+    def complete_by_hand(self, then: str) -> None:
+        """Open every tab of the sidebar, as a user looking around would, then the tab
+        ``then``, and wait until the page is complete: no background filling of tabs is
+        left to come (it would come only after the page was left alone for
+        ``explorer.views.FILL_TABS_AFTER_MS``)."""
+        for k, title in enumerate(self.page.evaluate(JS_TAB_TITLES)):
+            self.open_tab(title)
+            # its widgets arrived before the next click: the page sends a tab's opening
+            # once the server has taken the one before (clicks in a row reach it as one)
+            self.page.wait_for_function(JS_TAB_FILLED, arg=k, timeout=30_000 * patience())
+        self.open_tab(then)
+        self.wait_complete()
 
     def type_into(self, css: str, value: str) -> None:
         """Type a value in the number box of a slider and confirm it with Enter."""

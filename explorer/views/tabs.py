@@ -65,11 +65,22 @@ class DeferredTabs:
         self.used = True
 
     def fill(self, index: int) -> None:
-        """Give the tab at ``index`` its widgets (they then stay)."""
+        """Give the tab at ``index`` its widgets (they then stay); the page is complete
+        once the last tab has them, whether opened or filled in the background."""
         content = self.deferred.pop(index, None)
         if content is not None:
             column, objects = content
             column.objects = objects
+            if not self.deferred:
+                self._complete()
+
+    def _complete(self) -> None:
+        """Mark the page complete (:data:`COMPLETE_CLASS`): no more background work of
+        its own is due, and it lives as long as the session."""
+        if not self.loop.served or COMPLETE_CLASS in self.sidebar.css_classes:
+            return
+        self.sidebar.css_classes = [*self.sidebar.css_classes, COMPLETE_CLASS]
+        gc_policy.page_built(getattr(self.loop.doc, "session_context", None))
 
     def parts(self) -> list[Any]:
         """The widgets of the tabs not filled yet (part of the page all the same)."""
@@ -97,7 +108,5 @@ class DeferredTabs:
             self.fill(min(self.deferred))
         if self.deferred:
             loop.later(self.fill_idle, 0)
-        elif loop.served:
-            # the page is complete; it lives as long as the session
-            self.sidebar.css_classes = [*self.sidebar.css_classes, COMPLETE_CLASS]
-            gc_policy.page_built(getattr(loop.doc, "session_context", None))
+        else:
+            self._complete()  # (every tab was opened before the page was left alone)

@@ -122,16 +122,20 @@ def test_both_series_need_their_deviations() -> None:
 
 @pytest.mark.slow
 def test_standard_errors_cover_the_truth_in_95_percent_of_draws() -> None:
-    # 200 noise draws of settlements and tilts with stated deviations; each fit starts at
+    # 100 noise draws of settlements and tilts with stated deviations; each fit starts at
     # the truth (what is tested is the spread of the answers, not the way there). A
-    # nominal 95 % interval covers in 95 % +/- 1.5 % (binomial, 200 draws): the accepted
-    # [90 %, 99 %] is -3.2 and +2.6 of those. Measured: 0.98 and 0.95 (37 s wall on the
-    # shared machine).
-    exact = _exact()
+    # nominal 95 % interval covers in 95 % +/- 2.2 % (binomial, 100 draws): the accepted
+    # [90 %, 99 %] is -2.3 and +1.8 of those (a chance failure of a right answer: 1.2 %
+    # below, 0.6 % above). Measured on this seed 0.98 and 0.96 (and 0.93 / 0.97, 0.95 /
+    # 0.96 on seeds 1 and 2). The scene is solved at tol 1e-4, four orders below the
+    # readings' noise (1 %), where a fit costs ~0.35 s of CPU instead of ~0.5 s at 1e-6
+    # (200 draws at 1e-6 took 100-170 s of the suite).
+    scene = dict(SCENE, solver={"tol": 1e-4})
+    exact = core.solve(apply_point(scene, TRUTH) | {"times": TIMES.tolist()})
     rng = np.random.default_rng(20261129)
     paths = ["base.creep.compliance", "base.creep.rate"]
     hits = np.zeros(len(paths))
-    draws = 200
+    draws = 100
     for _ in range(draws):
         readings = {
             "time": TIMES.tolist(),
@@ -140,7 +144,7 @@ def test_standard_errors_cover_the_truth_in_95_percent_of_draws() -> None:
             "settlement_std": SETTLEMENT_STD,
             "tilt": (exact.tilt + TILT_STD * rng.standard_normal(TIMES.size)).tolist(),
             "tilt_std": TILT_STD}
-        fit = calibrate(SCENE, readings, fit=paths)
+        fit = calibrate(scene, readings, fit=paths)
         for j, path in enumerate(paths):
             hits[j] += abs(fit.values[path] - TRUTH[path]) <= 1.96 * fit.standard_errors[path]
     coverage = hits / draws

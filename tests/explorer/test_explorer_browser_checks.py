@@ -20,6 +20,7 @@ require_browser()
 
 from tests.browser_pages import (  # noqa: E402
     JS_SHOWN,
+    JS_TAB_TITLES,
     JS_VIEW_WIDTH,
     Page,
     page_fixtures,
@@ -486,10 +487,6 @@ JS_PAST_THE_SIDEBAR = """() => {
 }"""
 
 # The titles of the sidebar's tabs, read from the page (a tab added is checked too).
-JS_TAB_TITLES = """() => Array.from(Bokeh.index.all_views())
-  .find(v => (v.model.css_classes || []).includes('sidebar-tabs')).model.tabs.map(t => t.title)"""
-
-
 @pytest.mark.parametrize("presenting", [False, True], ids=["1400px", "1024px-presenting"])
 def test_no_widget_of_any_tab_runs_past_the_sidebar(page: Page, presenting: bool):
     """Every tab's widgets stay inside the sidebar (the Study tab's "spacing" once ran

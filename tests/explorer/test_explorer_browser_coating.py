@@ -32,12 +32,11 @@ explorer_server = own_explorer_server()
 
 
 def test_check_button_shows_the_measured_model_error_beside_the_estimate(page: Page):
-    page.open_tab("Coating")
-    button = page.page.locator(".coating-check-button button").first
     # the server's event loop, which every page shares, answers at once while the check
-    # runs (it runs in a process of its own); the page complete first, so that its own
-    # background filling of tabs is not what the probe measures
-    page.wait_complete()
+    # runs (it runs in a process of its own); the page complete first (every tab opened),
+    # so that its own background filling of tabs is not what the probe measures
+    page.complete_by_hand(then="Coating")
+    button = page.page.locator(".coating-check-button button").first
     with LivenessProbe(page.url) as probe:
         button.click()
         # the progress bar shows while the FE model solves (or the report is already there)

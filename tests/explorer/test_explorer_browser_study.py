@@ -85,9 +85,10 @@ def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
           describe=p2_count.input_value)
     page.type_into(".study-p1-count", "20")
     page.type_into(".study-p2-count", "20")
-    # the page complete first: its background filling of tabs is not what the probe below
-    # measures (and it waits for the page to be left alone, longer than the study runs)
-    page.wait_complete()
+    # the page complete first (every tab opened): its background filling of tabs is not
+    # what the probe below measures (and it waits for the page to be left alone, longer
+    # than the study runs)
+    page.complete_by_hand(then="Study")
     page.page.locator(".study-run button").first.click()
     until(lambda: page.page.evaluate(JS_SHOWN, "running:"), "the study running", 120,
           lambda: status(page))

@@ -86,7 +86,8 @@ def test_a_crown_lifting_off_the_creeping_bare_layer_is_drawn_as_its_zone_grows(
     # a crown (R = 20 km) on the bare layer that creeps (a standard linear solid): it lifts
     # at both corners and its zone grows as the base creeps
     # (core/engines/layered/bare_growing_zone.py), which the page draws and says; at tol
-    # 1e-4 (at 1e-6 its time grids stop at an estimate of 2.2e-5, flagged tol_not_met)
+    # 1e-3, met (estimate 1.1e-4; 5.7 s of CPU, 13 s at 1e-4 for the same zones to the
+    # digits drawn; at 1e-6 its time grids stop at an estimate of 2.2e-5, tol_not_met)
     import copy
 
     from explorer.model.contact_zone import contact_text, contact_widths
@@ -96,7 +97,7 @@ def test_a_crown_lifting_off_the_creeping_bare_layer_is_drawn_as_its_zone_grows(
     scene["base"]["creep"] = dict(CREEP)
     scene["punch"]["shape"] = {"kind": "polynomial", "coefficients": [0.0, 0.0, 2.5e-5]}
     scene["times"] = {"end": 365.0, "count": 8, "spacing": "log"}
-    scene["solver"] = {"tol": 1e-4}
+    scene["solver"] = {"tol": 1e-3}
     app = explorer_app(scene=scene, solved=True)
     assert app.controller.wait(120) and app.controller.error == "", app.controller.error
     view = app.controller.view

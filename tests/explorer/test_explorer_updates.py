@@ -279,6 +279,35 @@ def test_closed_tabs_are_filled_only_once_the_page_is_left_alone(monkeypatch) ->
     assert timers.pending == []
 
 
+def test_a_page_whose_tabs_were_all_opened_is_complete_at_once(monkeypatch) -> None:
+    """The page is complete (its signal for scripts and tests, and the freeze of its
+    objects, once) when its last tab gets its widgets, also when a user opened them all:
+    the background filling then has nothing left to do."""
+    import panel as pn
+
+    from explorer.fixes import gc_policy
+    from explorer.views import DeferredTabs
+
+    timers = _Timers()
+    frozen: list[object] = []
+    monkeypatch.setattr(PageLoop, "served", property(lambda self: True))
+    loop = PageLoop(None)
+    monkeypatch.setattr(loop, "later", timers)
+    monkeypatch.setattr(gc_policy, "page_built", lambda context=None: frozen.append(context))
+    tabs = DeferredTabs(loop, [(f"tab {k}", pn.Column(pn.pane.Markdown(f"tab {k}")))
+                               for k in range(3)])
+    tabs.fill_when_idle()
+    tabs.sidebar.active = 1
+    assert COMPLETE_CLASS not in tabs.sidebar.css_classes
+    tabs.sidebar.active = 2
+    assert not tabs.deferred and COMPLETE_CLASS in tabs.sidebar.css_classes
+    assert len(frozen) == 1
+    assert timers.run() == [FILL_TABS_AFTER_MS]  # (put off: the page was used)
+    assert timers.run() == [FILL_TABS_AFTER_MS]  # left alone: nothing left to fill
+    assert timers.pending == []
+    assert len(frozen) == 1 and tabs.sidebar.css_classes.count(COMPLETE_CLASS) == 1
+
+
 def test_a_page_loop_knows_whether_a_browser_is_connected() -> None:
     from types import SimpleNamespace as Fake
 

@@ -103,7 +103,9 @@ def test_far_apart_punches_on_an_aging_base_lift_off_as_single_punches() -> None
 def test_a_mirrored_pair_lifts_off_in_mirror_as_the_base_creeps() -> None:
     """contact "auto": full contact while it holds under both punches, then lift-off of
     their outer heels as the moment grows (the full-contact answer flags it)."""
-    d = _creeping(_base())
+    # tol 1e-4: what is checked is the mirror (to rounding) and the switch to lift-off,
+    # the same at 1e-6 (27 s of CPU there, 16 s here)
+    d = _creeping(_base(1e-4))
     d["times"]["count"] = 6  # log-spaced: the heels lift between the last two
     ramp = {"kind": "linear", "start": 0.0, "end": 3e5}
     d["punches"] = [
