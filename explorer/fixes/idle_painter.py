@@ -7,10 +7,16 @@ redraws its views. An idle page kept ~9 % of a core of the browser busy with it
 (measured with ``benchmarks/explorer_idle.py``). FilePond does all its drawing, and
 handles its own actions (a file added, removed, uploaded), in that loop, so the loop is
 not stopped for good: it is held while the page is idle and runs again for
-:data:`AWAKE_MS` after anything that may concern a dropper: a click, a key, a file dragged
-over the page or dropped or chosen in the file dialog, a dropper created, a file being
-uploaded, any change of the page's models from the server, or a call of
-``window.__explorerPainter.wake()`` (the server's "empty the dropper" does that).
+:data:`AWAKE_MS` after anything that may concern a dropper: a click on a dropper or on a
+tab's title (a tab opened may show one), a key or the focus on a dropper, a file dragged
+over the page or dropped or pasted or chosen in the file dialog, the window resized, a
+dropper created, a file being uploaded, a change of a dropper's model from the server, or
+a call of ``window.__explorerPainter.wake()`` (the server's "empty the dropper" does that).
+
+Only those: the loop once woke at every key and every change from the server, so a
+slider moved with the keys or dragged kept it running, ~32 frames of the dropper a load
+step, about half of the page's ~200 ms of CPU a step (measured through the browser's
+profiler on the default scene).
 
 How: the page's ``requestAnimationFrame`` passes every callback on, except FilePond's
 frame function (recognised by its text: it calls its ``readers`` and ``writers``), which
@@ -74,9 +80,27 @@ if (!window.__explorerPainter) {
     awakeUntil = Math.max(awakeUntil, performance.now() + AWAKE_MS);
     schedule();
   };
-  for (const type of ["pointerdown", "keydown", "dragenter", "dragover", "drop", "paste",
-                      "focusin", "resize"]) {
+  // whether an event happened on a dropper (or, for a click, on a tab's title); the
+  // page's parts live in shadow roots, so the event's whole path is looked at
+  const onDropper = (event, tabs) => {
+    const path = typeof event.composedPath === "function" ? event.composedPath() : [];
+    return path.some((el) => {
+      const names = el && el.classList;
+      if (!names) return false;
+      for (const name of names) {
+        if (name.startsWith("filepond") || (tabs && name === "bk-tab")) return true;
+      }
+      return false;
+    });
+  };
+  for (const type of ["dragenter", "dragover", "drop", "paste", "resize"]) {
     window.addEventListener(type, wake, {capture: true, passive: true});
+  }
+  window.addEventListener("pointerdown", (e) => { if (onDropper(e, true)) wake(); },
+                          {capture: true, passive: true});
+  for (const type of ["keydown", "focusin"]) {
+    window.addEventListener(type, (e) => { if (onDropper(e, false)) wake(); },
+                            {capture: true, passive: true});
   }
   const create = window.FilePond && window.FilePond.create;
   if (typeof create === "function") {
@@ -94,12 +118,23 @@ if (!window.__explorerPainter) {
       return pond;
     };
   }
-  // a change from the server (a dropper emptied, options set, an upload answered)
+  // a change of a dropper from the server (emptied, options set, an upload answered);
+  // a change without a model (a root added or removed) may bring one too
+  const ofDropper = (event) => {
+    const model = event && event.model;
+    if (!model) return true;
+    const type = String(model.type || "");
+    return type.includes("FileDropper");
+  };
   for (const doc of (window.Bokeh && Bokeh.documents) || []) {
-    try { doc.on_change(() => wake()); } catch (e) { /* an older BokehJS: clicks only */ }
+    try {
+      doc.on_change((event) => { if (ofDropper(event)) wake(); });
+    } catch (e) { /* an older BokehJS: clicks only */ }
   }
-  window.__explorerPainter = {wake: wake, awake: () => performance.now() < awakeUntil,
-                              ponds: ponds};
+  // awake: a frame of the dropper's loop is still to come (also one asked for just
+  // before the loop fell asleep)
+  window.__explorerPainter = {wake: wake, ponds: ponds,
+                              awake: () => performance.now() < awakeUntil || pending !== 0};
 }
 """.replace("AWAKE_MS_VALUE", str(AWAKE_MS))
 

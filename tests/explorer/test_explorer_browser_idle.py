@@ -22,7 +22,7 @@ from tests.browser_pages import patience, require_browser  # noqa: E402
 require_browser()
 
 from explorer.fixes.idle_painter import AWAKE_MS  # noqa: E402
-from tests.browser_pages import Page, page_fixtures  # noqa: E402
+from tests.browser_pages import Page, page_fixtures, until  # noqa: E402
 
 server, browser_context, page = page_fixtures(1400, 900)
 
@@ -41,6 +41,15 @@ def _painter_runs(page: Page, ms: int) -> int:
     })""", ms)
 
 
+# Counts the frames of FilePond's loop from now on (window.__droppersFrames.runs).
+JS_COUNT_FRAMES = """() => {
+  const counter = {runs: 0};
+  const writers = window.__framePainter ? window.__framePainter.writers : [];
+  writers.push(() => { counter.runs += 1; });
+  window.__droppersFrames = counter;
+}"""
+
+
 def _wait_asleep(page: Page, timeout: float = 90.0) -> None:
     deadline = time.monotonic() + timeout
     while page.page.evaluate("() => window.__explorerPainter.awake()"):
@@ -54,13 +63,24 @@ def test_an_idle_page_holds_the_droppers_loop_and_a_late_file_still_loads(page: 
     upload.wait_for(state="attached", timeout=30_000 * patience())
     # awake after the click on the tab: the loop runs (the dropper draws itself)
     assert _painter_runs(page, 500) > 5
-    # idle: once the page has filled its other tabs in the background (a few seconds
-    # after loading: changes from the server wake the loop too), no more frames of the
-    # dropper, for longer than the wake. The last tab's box on the page: all are filled.
-    page.page.locator(".fit-upload input[type=file]").first.wait_for(
-        state="attached", timeout=60_000 * patience())
+    # idle: once every tab has its widgets (the Fit tab's dropper too, which wakes the
+    # loop when it is made), no more frames of the dropper, for longer than the wake
+    page.complete_by_hand(then="Scene")
     _wait_asleep(page)
     assert _painter_runs(page, AWAKE_MS + 500) == 0
+    # a load step with the keys, away from the droppers: the answer comes and is drawn,
+    # and the dropper's loop sleeps on (it woke at every key and every change from the
+    # server, ~32 frames of it a step)
+    page.page.evaluate(JS_COUNT_FRAMES)
+    before = page.q()
+    handle = page.page.locator(".load-0-value .noUi-handle").first
+    handle.focus()
+    handle.press("ArrowRight")
+    until(lambda: page.q() != before, "the load step's pressure")
+    time.sleep(0.5)  # its frames drawn (a window for the loop to run in, not a wait)
+    assert page.page.evaluate("() => window.__droppersFrames.runs") == 0
+    page.open_tab("Files")  # (a tab's title clicked: the loop wakes, a dropper may show)
+    _wait_asleep(page)
     # a file chosen now (as after a long look through the file dialog): only the file
     # input's own events happen on the page, and the dropper takes it up all the same
     scene = json.loads((ROOT / "core" / "presets" / "scenes" / "stepped_punch.json").read_text())
