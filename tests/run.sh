@@ -2,7 +2,7 @@
 # Installs everything the test suite needs, then runs the whole suite and builds the
 # documentation.
 # Usage (from the repository root):  bash tests/run.sh [pytest args]
-# Without arguments the whole suite runs in four parts at once and the documentation is
+# Without arguments the whole suite runs in three parts at once and the documentation is
 # built beside them (see below); with arguments one pytest run gets them (e.g.
 # bash tests/run.sh tests/scene/test_scene.py -x) and the documentation is not built.
 # SKIP_SETUP=1 skips the installation (an environment already set up).
@@ -44,17 +44,15 @@ if [ "$#" -gt 0 ]; then
     exec python -m pytest -q "$@"
 fi
 
-# The whole suite in four parts at once, one pytest each: the browser tests (marker
+# The whole suite in three parts at once, one pytest each: the browser tests (marker
 # "browser": a served explorer and Chromium), the soak tests (marker "soak": servers and
 # worker processes started, stopped, killed and left idle, much of it waiting on them) and
-# the rest in two halves by folder (the explorer's, the back-analysis', the command
-# line's, the packaging's, the reports' and the studies' tests; and all others, so that a
-# new folder is never left out). One pytest keeps at most one core busy: with the rest in
-# one part, it ran alone on one core for the last minutes while the other core idled
-# (measured on a fresh clone, 2 cores with nothing else running: 21.4 min of wall time
-# for 30 min of CPU, rest 19.9, browser 17.6, soak 8.8 min, documentation 5.3 min; the
-# rest alone: 12.6 min). The parts share nothing: each has its own temporary directory,
-# pytest cache and served explorers (a free port each).
+# the rest. One pytest keeps at most one core busy, and the soak part waits much of its
+# time; when one part ends first the others still have both cores. Measured on a fresh
+# clone, 2 cores with nothing else running: 23.3 min with the installation (rest 21.9,
+# browser 20.3, soak 8.8 min, documentation 5.1 min) at load average ~4: the whole is
+# bound by the cores' time (the rest alone: 12.6 min). The parts share nothing: each has
+# its own temporary directory, pytest cache and served explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
 python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
     >"$work/browser.log" 2>&1 &
@@ -66,7 +64,7 @@ soak_pid=$!
 # The documentation (docs/, Sphinx): built here so that it cannot rot. Warnings are errors
 # (-W), so a renamed API, a broken docstring, a moved report or link, or a gallery example
 # that no longer runs fails the run. Always from an empty build directory: an incremental
-# build would not repeat the warnings of pages it skips. It runs beside the four parts
+# build would not repeat the warnings of pages it skips. It runs beside the three parts
 # (~110 s of one core; measured in docs/conf.py's docstring). The pages stay in
 # DOCS_BUILD_DIR (default ${TMPDIR:-/tmp}/coated-punch-docs, outside the source tree):
 # open index.html there.
@@ -85,19 +83,11 @@ build_docs() {
 build_docs >"$work/docs.log" 2>&1 &
 docs_pid=$!
 # (kill fails once a job has ended: no status of its own may reach the exit code)
-trap 'kill "$browser_pid" "$soak_pid" "$docs_pid" ${rest1_pid:-} 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'kill "$browser_pid" "$soak_pid" "$docs_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
 set +e
-# the rest's first half in the background, its second here
-first_half=(tests/explorer tests/back_analysis tests/cli tests/packaging tests/report
-            tests/study)
-python -m pytest -q -m "not browser and not soak" --basetemp "$work/rest1" \
-    -o cache_dir=.pytest_cache/rest1 "${first_half[@]}" >"$work/rest1.log" 2>&1 &
-rest1_pid=$!
-python -m pytest -q -m "not browser and not soak" --basetemp "$work/rest2" \
-    -o cache_dir=.pytest_cache/rest2 "${first_half[@]/#/--ignore=}"
-rest2=$?
-wait "$rest1_pid"
-rest1=$?
+python -m pytest -q -m "not browser and not soak" --basetemp "$work/rest" \
+    -o cache_dir=.pytest_cache/rest
+rest=$?
 wait "$browser_pid"
 browser=$?
 wait "$soak_pid"
@@ -111,8 +101,5 @@ echo "---- browser tests (pytest -m browser) ----"
 cat "$work/browser.log"
 echo "---- soak tests (pytest -m soak) ----"
 cat "$work/soak.log"
-echo "---- the rest's first half (${first_half[*]}) ----"
-cat "$work/rest1.log"
-echo "---- exit codes: rest $rest1 and $rest2, browser $browser, soak $soak, docs $docs ----"
-[ "$rest1" -eq 0 ] && [ "$rest2" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$soak" -eq 0 ] &&
-    [ "$docs" -eq 0 ]
+echo "---- exit codes: rest $rest, browser $browser, soak $soak, docs $docs ----"
+[ "$rest" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$soak" -eq 0 ] && [ "$docs" -eq 0 ]
