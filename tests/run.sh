@@ -49,9 +49,11 @@ fi
 # worker processes started, stopped, killed and left idle, much of it waiting on them) and
 # the rest. One pytest keeps at most one core busy, and the soak part waits much of its
 # time; when one part ends first the others still have both cores. Measured on a fresh
-# clone, 2 cores with nothing else running: 23.3 min with the installation (rest 21.9,
-# browser 20.3, soak 8.8 min, documentation 5.1 min) at load average ~4: the whole is
-# bound by the cores' time (the rest alone: 12.6 min). The parts share nothing: each has
+# clone, 2 cores with nothing else running (2026-11-30): 19.8-21.4 min with the
+# installation (rest 18.5-19.9, browser 16.0-17.6, soak 7.5-8.8 min, documentation
+# 4.5-5.3 min) at load average ~4: the whole is bound by the cores' time (the rest alone:
+# 12.6 min; the rest in two halves took as long, the browser part then the longest).
+# The parts share nothing: each has
 # its own temporary directory, pytest cache and served explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
 python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
