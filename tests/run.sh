@@ -53,8 +53,8 @@ fi
 # installation (rest 18.5-19.9, browser 16.0-17.6, soak 7.5-8.8 min, documentation
 # 4.5-5.3 min) at load average ~4: the whole is bound by the cores' time (the rest alone:
 # 12.6 min; the rest in two halves took as long, the browser part then the longest).
-# The parts share nothing: each has
-# its own temporary directory, pytest cache and served explorers (a free port each).
+# The parts share nothing: each has its own temporary directory, pytest cache and served
+# explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
 python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
     >"$work/browser.log" 2>&1 &
