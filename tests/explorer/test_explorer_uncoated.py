@@ -86,8 +86,9 @@ def test_a_crown_lifting_off_the_creeping_bare_layer_is_drawn_as_its_zone_grows(
     # a crown (R = 20 km) on the bare layer that creeps (a standard linear solid): it lifts
     # at both corners and its zone grows as the base creeps
     # (core/engines/layered/bare_growing_zone.py), which the page draws and says; at tol
-    # 1e-3, met (estimate 1.1e-4; 5.7 s of CPU, 13 s at 1e-4 for the same zones to the
-    # digits drawn; at 1e-6 its time grids stop at an estimate of 2.2e-5, tol_not_met)
+    # 1e-3, met (estimate 1.1e-4; the solve 2.2 s of CPU, 4.0 s at 1e-4 for the same
+    # zones to the digits drawn; at 1e-6 its time grids stop at an estimate of 2.2e-5,
+    # tol_not_met)
     import copy
 
     from explorer.model.contact_zone import contact_text, contact_widths

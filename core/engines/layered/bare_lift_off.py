@@ -26,7 +26,11 @@ method. Where the punch's heel (or toe) lifts, one end is free and the other cor
 touches; where both corners lift (a crown pressed lightly), both ends are free, and the
 zone's middle and half-width are the root of both coefficients (Powell's hybrid method,
 from Hertz's half-width on a half-space, ``b = sqrt(2 R P* / pi)`` with ``R`` the crown's
-radius at the gap's lowest point, or from the best of a scan of zones). A creeping or
+radius at the gap's lowest point, or from the best of a scan of zones). From a nearby
+zone (the last time-grid point's on a creeping base; the zone with all the modes for
+the one with half of them) secant steps (:func:`_secant_end`) or Broyden's method from
+its Jacobian (:func:`_broyden`) find the ends in a few layered solves, the bracketing
+methods above taking over where they fail. A creeping or
 aging bare base is answered on the elastic zone where the loads keep their ratio
 (:mod:`core.engines.layered.answer`), and on the elastic zones of its crept loads where
 the zone grows (:mod:`core.engines.layered.bare_growing_zone`).
@@ -39,6 +43,7 @@ extrapolated as the modes' (``MAX_RATIO``).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,6 +70,18 @@ _NAMES = ("settlement", "tilt", "force", "moment")
 SCAN = np.linspace(0.0, 1.0, 17)[1:-1]
 #: The zone's end is found to this many half-widths (far below what the modes resolve).
 END_TOL = 1e-13
+#: Secant steps from a nearby end (the last time-grid point's, or the same zone's with
+#: all the modes) before the end is bracketed and found by Brent's method instead.
+SECANT_STEPS = 10
+#: Broyden's steps from a nearby zone with two free ends before Powell's method instead,
+#: and the last step's size (relative) at which it has converged (as Powell's xtol).
+BROYDEN_STEPS = 12
+BROYDEN_XTOL = 1e-14
+#: The forward-difference step of the first Jacobian of the two ends' coefficients.
+JACOBIAN_STEP = 1e-7
+#: The second point of the secant for the zone with half the modes: this far from the
+#: end found with all of them [half-widths] (their ends differ by ~1e-10 and less).
+COARSE_STEP = 1e-8
 #: Why a zone with two free ends was not answered.
 TWO_FREE_ENDS = ("loading: the punch lifts off the bare base at both corners and no contact "
                  "zone with two free ends was found for these loads (the crown's contact "
@@ -95,6 +112,9 @@ class ZoneAnswer:
     values: dict[str, float]
     error: float
     end_error: float
+    #: With two free ends: the Jacobian of their singular coefficients in the zone's
+    #: middle and log half-width where they were found (a nearby zone starts from it).
+    jacobian: np.ndarray | None = None
 
     @property
     def centre(self) -> float:
@@ -165,6 +185,10 @@ class _Zones:
             return lambda s: np.asarray(gap(x0 + b * np.asarray(s)), dtype=float) / b
         return None  # a constant gap is a settlement: no pressure of its own
 
+    def keep(self, lo: float, hi: float, response: LayeredResponse) -> None:
+        """Keep ``response`` as the zone ``(lo, hi)``'s (built for other loads)."""
+        self._kept[(lo, hi)] = response
+
     def response(self, lo: float, hi: float) -> LayeredResponse:
         found = self._kept.get((lo, hi))
         if found is None:
@@ -188,11 +212,50 @@ class _Zones:
                                            np.array([alpha]), level=level)[0, 0])
 
 
+def _secant_end(f: Callable[[float], float], x0: float, x1: float, lo: float, hi: float
+                ) -> float | None:
+    """The root of ``f`` in ``(lo, hi)`` by secant steps from ``x0`` and ``x1``, kept
+    inside the bracket of the points of opposite signs once there is one (bisected where
+    a step leaves it), to a last step of ``END_TOL``; None when the steps stall or
+    leave ``(lo, hi)`` (the caller brackets the root instead). The point returned is the
+    last one evaluated (its zone's response is kept), within the last step of the root.
+    """
+    f0, f1 = f(x0), f(x1)
+    below = above = None  # the latest points where f < 0 and f > 0
+    for x, fx in ((x0, f0), (x1, f1)):
+        if fx < 0.0:
+            below = x
+        elif fx > 0.0:
+            above = x
+    for _ in range(SECANT_STEPS):
+        if f1 == 0.0:
+            return x1
+        if f1 == f0:
+            return None
+        x2 = x1 - f1 * (x1 - x0) / (f1 - f0)
+        if below is not None and above is not None and not (
+                min(below, above) < x2 < max(below, above)):
+            x2 = 0.5 * (below + above)
+        if not lo < x2 < hi:
+            return None
+        if abs(x2 - x1) <= END_TOL:
+            return x1
+        x0, f0, x1, f1 = x1, f1, x2, f(x2)
+        if f1 < 0.0:
+            below = x1
+        elif f1 > 0.0:
+            above = x1
+    return None
+
+
 def _free_end(zones: _Zones, free: int, given: dict[str, float], level: int,
-              near: float | None = None) -> float:
+              near: float | None = None, second: float | None = None) -> float:
     """The free end of the zone (``free`` -1: the lower end lifts, +1: the upper);
-    ``near``: an end found for nearby loads, bracketed first (a creeping base asks one
-    zone per time-grid point, each near the last)."""
+    ``near``: an end found for nearby loads, from which secant steps start (a creeping
+    base asks one zone per time-grid point, each near the last; the zone with half the
+    modes is next to the one with all of them), with ``second`` as the other first point
+    (default: ``COARSE_STEP`` away); where they fail, an end is bracketed about ``near``
+    and found by Brent's method."""
     # here, not at the top: scipy.optimize brings scipy.fft and scipy.special, which a
     # solve that lifts off nothing need not load (tests/cli/test_cold_start.py)
     from scipy.optimize import brentq
@@ -207,6 +270,14 @@ def _free_end(zones: _Zones, free: int, given: dict[str, float], level: int,
         return float(brentq(f, a, b, xtol=END_TOL, rtol=4 * np.finfo(float).eps))
 
     if near is not None and -1.0 < near < 1.0:
+        # From a nearby end the secant converges in a few zones (a zone is a layered
+        # solve): a crown on the creeping bare layer asked ~6 of Brent's bracketed
+        # search per end.
+        if second is None or not -1.0 < second < 1.0 or abs(second - near) <= END_TOL:
+            second = near + COARSE_STEP * (other - corner) / 2
+        found = _secant_end(f, near, second, -1.0, 1.0)
+        if found is not None:
+            return found
         # f < 0 toward the lifting corner, > 0 toward the other: widen a bracket about it
         width = 1e-3
         while width < 0.5:
@@ -268,6 +339,7 @@ def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
     out: list[ZoneAnswer] = []
     solved = {} if solved is None else solved
     last: dict[int, ZoneAnswer] = {}  # the last zone found, per corner lifting
+    before: dict[int, ZoneAnswer] = {}  # and the one before it
     for k in range(len(free)):
         # a creeping base asks one zone per time-grid point: the solve's CPU bound applies
         check_work("finding the contact zone of a punch lifting off the bare base")
@@ -283,27 +355,47 @@ def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
         key = (int(free[k]), *sorted((n, float(f"{v:.13g}")) for n, v in values.items()))
         if key not in solved:
             solved[key] = _solve_one(half_width, base, gap, values, int(free[k]), modes,
-                                     table, tol, near=last.get(int(free[k])))
+                                     table, tol, near=last.get(int(free[k])),
+                                     before=before.get(int(free[k])))
         out.append(solved[key])
-        last[int(free[k])] = solved[key]
+        if last.get(int(free[k])) is not solved[key]:
+            if int(free[k]) in last:
+                before[int(free[k])] = last[int(free[k])]
+            last[int(free[k])] = solved[key]
     return BareLiftOff(out)
 
 
 def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
                given: dict[str, float], free: int, modes: int, table: RegularPartTable,
-               tol: float, near: ZoneAnswer | None = None) -> ZoneAnswer:
+               tol: float, near: ZoneAnswer | None = None,
+               before: ZoneAnswer | None = None) -> ZoneAnswer:
     """The zone answer at one value of the loads (``near``: one for nearby loads, the
-    same corners lifting, where its ends are looked for first)."""
+    same corners lifting, where its ends are looked for first; ``before``: the one
+    before it, through which the end is extrapolated)."""
     floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
     while True:
         zones = _Zones(half_width, base, gap, modes, table, tol)
+        if near is not None and near.response.modes == modes:
+            # a zone's response does not depend on the loads: the nearby one's serves
+            zones.keep(near.lo, near.hi, near.response)
+        jacobian = None
         if free == 2:
-            lo, hi = _two_free_ends(zones, given, level=0,
-                                    guess=None if near is None else (near.lo, near.hi))
-            clo, chi = _two_free_ends(zones, given, level=1, guess=(lo, hi))
+            guess = second = None
+            if near is not None:
+                guess, jacobian = (near.lo, near.hi), near.jacobian
+                if before is not None and before.free == 2:
+                    second = (2.0 * near.lo - before.lo, 2.0 * near.hi - before.hi)
+            lo, hi, jacobian = _two_free_ends(zones, given, level=0, guess=guess,
+                                              jacobian=jacobian, second=second)
+            clo, chi, _ = _two_free_ends(zones, given, level=1, guess=(lo, hi),
+                                         jacobian=jacobian)
         else:
-            start = None if near is None else (near.lo if free < 0 else near.hi)
-            end = _free_end(zones, free, given, level=0, near=start)
+            start = second = None
+            if near is not None:
+                start = near.lo if free < 0 else near.hi
+                if before is not None and before.free == free:
+                    second = 2.0 * start - (before.lo if free < 0 else before.hi)
+            end = _free_end(zones, free, given, level=0, near=start, second=second)
             lo, hi = _zone(free, end)
             clo, chi = _zone(free, _free_end(zones, free, given, level=1, near=end))
         x0, b = 0.5 * (lo + hi), 0.5 * (hi - lo)
@@ -323,10 +415,12 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
                      for n in _NAMES if n not in given)
         extrapolate = MAX_RATIO / (1.0 - MAX_RATIO)
         error = max(own, extrapolate * change)
-        end_error = extrapolate * max(abs(lo - clo), abs(hi - chi))
+        # the ends are found to END_TOL: no estimate below it (the ends with half the
+        # modes, sought from these, may not move at all)
+        end_error = max(extrapolate * max(abs(lo - clo), abs(hi - chi)), END_TOL)
         if error <= 0.5 * tol or 2 * modes > MAX_MODES:
             return ZoneAnswer(lo, hi, free, response, delta, alpha, values, float(error),
-                              float(end_error))
+                              float(end_error), jacobian)
         modes *= 2
 
 
@@ -352,10 +446,43 @@ def _hertz_guess(gap: Gap, given: dict[str, float]) -> tuple[float, float] | Non
     return x0 - b, x0 + b
 
 
+def _broyden(f: Callable[[np.ndarray], np.ndarray], v: np.ndarray, jacobian: np.ndarray,
+             inside: Callable[[np.ndarray], bool]) -> tuple[np.ndarray, np.ndarray] | None:
+    """The root of ``f`` (two equations in two unknowns) by Broyden's method from ``v``
+    with a first ``jacobian`` (a nearby root's), to a last step of ``BROYDEN_XTOL``
+    relative; (the root, the Jacobian updated) or None when it does not converge within
+    ``BROYDEN_STEPS`` or a step leaves the punch (``inside``)."""
+    fv = f(v)
+    jac = np.array(jacobian, dtype=float)
+    for _ in range(BROYDEN_STEPS):
+        try:
+            step = -np.linalg.solve(jac, fv)
+        except np.linalg.LinAlgError:
+            return None
+        if not np.all(np.isfinite(step)):
+            return None
+        if np.max(np.abs(step)) <= BROYDEN_XTOL * max(1.0, float(np.max(np.abs(v)))):
+            return v, jac  # the last point evaluated: within the step of the root
+        moved = v + step
+        if not inside(moved):
+            return None
+        f_moved = f(moved)
+        # Broyden's good update: the secant condition along the step
+        jac = jac + np.outer(f_moved - fv - jac @ step, step) / float(step @ step)
+        v, fv = moved, f_moved
+    return None
+
+
 def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
-                   guess: tuple[float, float] | None = None) -> tuple[float, float]:
+                   guess: tuple[float, float] | None = None,
+                   jacobian: np.ndarray | None = None,
+                   second: tuple[float, float] | None = None
+                   ) -> tuple[float, float, np.ndarray | None]:
     """The zone of a punch lifting at both corners: both ends' singular coefficients zero
-    (``guess`` a first zone, else :func:`_hertz_guess`, else the best of a scan)."""
+    (``guess`` a first zone, else :func:`_hertz_guess`, else the best of a scan), with the
+    Jacobian of the coefficients there when Broyden's method found it. With
+    ``jacobian`` (a nearby zone's) Broyden's method starts from ``second`` (the guess
+    extrapolated; default the guess), else Powell's hybrid method from the guess."""
     from scipy.optimize import root  # here: see _free_end
 
     def coefficients(v: np.ndarray) -> np.ndarray:
@@ -366,19 +493,32 @@ def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
                                      np.array([alpha]), level=level)[:, 0]
         return ends / max(abs(values["force"]) / b, 1e-300)
 
+    def within(v: np.ndarray) -> bool:
+        x0, b = float(v[0]), float(np.exp(v[1]))
+        return bool(np.all(np.isfinite(v))) and x0 - b >= -1.0 and x0 + b <= 1.0
+
     def solved(start: np.ndarray) -> np.ndarray | None:
         found = root(coefficients, start, method="hybr", options={"xtol": 1e-14})
-        x0, b = float(found.x[0]), float(np.exp(found.x[1]))
-        inside = bool(np.all(np.isfinite(found.x))) and x0 - b >= -1.0 and x0 + b <= 1.0
-        if inside and np.max(np.abs(coefficients(found.x))) <= TWO_ENDS_TOL:
+        if within(found.x) and np.max(np.abs(coefficients(found.x))) <= TWO_ENDS_TOL:
             return found.x
         return None
 
+    def unknowns(zone: tuple[float, float]) -> np.ndarray:
+        return np.array([0.5 * (zone[0] + zone[1]), np.log(0.5 * (zone[1] - zone[0]))])
+
+    found, updated = None, None
+    if guess is not None and jacobian is not None:
+        # from a nearby zone (the last time-grid point's, or this one's with all the
+        # modes) Broyden's method needs ~2 zones where Powell's asked ~6 (a zone is a
+        # layered solve: a Hertz crown on a creeping layer, 674 solves of 5.6 zones)
+        start = unknowns(second if second is not None and within(unknowns(second))
+                         else guess)
+        broyden = _broyden(coefficients, start, jacobian, within)
+        if broyden is not None and np.max(np.abs(coefficients(broyden[0]))) <= TWO_ENDS_TOL:
+            found, updated = broyden
     first = guess if guess is not None else _hertz_guess(zones.gap, given)
-    found = None
-    if first is not None:
-        found = solved(np.array([0.5 * (first[0] + first[1]),
-                                 np.log(0.5 * (first[1] - first[0]))]))
+    if found is None and first is not None:
+        found = solved(unknowns(first))
     if found is None:
         # the zones within the punch, scanned: the smallest coefficients start it again
         best, start = np.inf, None
@@ -391,5 +531,19 @@ def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
         found = solved(start) if start is not None else None
     if found is None:
         raise ValueError(TWO_FREE_ENDS)
+    if updated is None:
+        updated = _jacobian(coefficients, found)
     x0, b = float(found[0]), float(np.exp(found[1]))
-    return x0 - b, x0 + b
+    return x0 - b, x0 + b, updated
+
+
+def _jacobian(f: Callable[[np.ndarray], np.ndarray], v: np.ndarray) -> np.ndarray:
+    """``f``'s Jacobian at ``v`` by forward differences (the first of Broyden's)."""
+    fv = f(v)
+    jac = np.empty((fv.size, v.size))
+    for i in range(v.size):
+        h = JACOBIAN_STEP * max(1.0, abs(float(v[i])))
+        moved = v.copy()
+        moved[i] += h
+        jac[:, i] = (f(moved) - fv) / h
+    return jac
