@@ -26,7 +26,7 @@ def test_each_readme_example_runs_as_a_script(k: int, tmp_path: Path):
     script = tmp_path / "example.py"
     script.write_text(BLOCKS[k])
     env = dict(os.environ, PYTHONPATH=str(ROOT), OPENBLAS_NUM_THREADS="1")
-    # the study example runs 338 points on a local cluster: ~25 s measured on 2 cores
+    # the study example runs 20 points on a local cluster: ~9 s measured on 2 cores
     run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env,
                          capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr[-3000:]
