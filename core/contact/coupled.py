@@ -54,7 +54,7 @@ from core.contact.elastic import _bad_pins, _verify, verdict
 from core.contact.nodal import coarse_start, nodal_operator
 from core.contact.result import UnilateralSolution, _Snapshot
 from core.contact.step import Space, Step, check_loads, nystrom_pressure
-from core.contact.systems import StepSolver, bordered_operator
+from core.contact.systems import BorderedLayout, StepSolver, bordered_operator
 from core.contact.unilateral import nodal_resolution, zone_resolution
 from core.contact.zones import (
     MAX_LEVELS,
@@ -230,16 +230,18 @@ class CoupledStepSolver:
         return self._whole.submatrix(op, idx, key)
 
     def solve(self, build: Callable[[], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
-              b: np.ndarray, blocks: Sequence[tuple[tuple, np.ndarray, np.ndarray]]
-              ) -> np.ndarray:
+              b: np.ndarray, blocks: Sequence[tuple[tuple, np.ndarray, np.ndarray]],
+              layout: BorderedLayout | None = None) -> np.ndarray:
         """Solve ``A x = b`` for the matrix ``build()`` whose product is ``apply``;
-        ``blocks`` per punch: (key, its rows, its columns) in ``A``."""
+        ``blocks`` per punch: (key, its rows, its columns) in ``A``; ``layout``: the
+        system over all nodes (the whole system's factors then serve nearby contact
+        sets)."""
         from scipy.linalg import lu_factor, lu_solve
         from scipy.sparse.linalg import LinearOperator, gmres
 
         if b.size <= self.WHOLE_SIZE:
             before = self._whole.factorizations
-            x = self._whole.solve(build, apply, b)
+            x = self._whole.solve(build, apply, b, layout)
             self.factorizations += self._whole.factorizations - before
             return x
         full: list[np.ndarray] = []
@@ -347,11 +349,13 @@ def _kept_factors_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndar
     factors of one step precondition the next up to the change of c/s)."""
     n = idx.size
     own = owner[idx]
-    xi, wi = x[idx], w[idx]
-    cols, names, rows, values, row_owner = _borders(givens, own, xi, wi)
+    # the border on every node: the system over all of them (a layout) lets the kept
+    # factors of other contact nodes serve (core.contact.systems.StepSolver)
+    cols, names, rows, values, row_owner = _borders(givens, owner, x, w)
     k = len(cols)
-    border_cols = np.array(cols).T.reshape(n, k)
-    border_rows = np.array(rows).reshape(k, n)
+    all_cols = np.array(cols).T.reshape(x.size, k)
+    all_rows = np.array(rows).reshape(k, x.size)
+    border_cols, border_rows = all_cols[idx], all_rows[:, idx]
     key = (idx.tobytes(), tuple(tuple(sorted(given)) for given in givens))
     sub = solver.submatrix(op, idx, key)
     diagonal = (step_c / scale) * m[idx]
@@ -365,8 +369,10 @@ def _kept_factors_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndar
                        np.concatenate([mine, n + np.nonzero(col_owner == p)[0]])))
 
     build, apply = bordered_operator(sub, diagonal, border_cols, border_rows)
+    layout = BorderedLayout(op, (step_c / scale) * m, all_cols, all_rows, idx)
     b = np.concatenate([rhs[idx] / scale, values])
-    return _unpack_all(solver.solve(build, apply, b, blocks), n, scale, givens, names)
+    return _unpack_all(solver.solve(build, apply, b, blocks, layout), n, scale, givens,
+                       names)
 
 
 @dataclass

@@ -6,12 +6,14 @@ On the contact nodes ``idx`` of a panel rule (q = 0 elsewhere) one solve is
 
 with the unknown ones of delta, alpha as border columns and the given ones of P, M as
 border rows (:func:`bordered_solve`). :class:`StepSolver` carries the LU factors from one
-creep step to the next.
+creep step to the next, also across a few contact nodes gained or lost
+(:class:`_FactorUpdate`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import lu_factor
@@ -26,14 +28,136 @@ def restrict(op: np.ndarray, idx: np.ndarray) -> np.ndarray:
     return op[np.ix_(idx, idx)]
 
 
+@dataclass(frozen=True)
+class BorderedLayout:
+    """The bordered matrix of one step over all nodes of a panel rule, read by blocks.
+
+    Its indices: node ``i`` is ``i``, border unknown ``t`` (an unknown settlement or
+    tilt as a column, a given force or moment as a row; :func:`_bordered_system`) is
+    ``n + t``. The matrix is ``op + diag(diagonal)`` between nodes, ``border_cols`` from
+    the border unknowns into the nodes' rows, ``border_rows`` from the nodes into the
+    border rows, and 0 between border entries. ``idx``: the contact nodes of the system
+    solved (its indices are ``idx`` and then the border's)."""
+
+    op: np.ndarray
+    diagonal: np.ndarray      # (c / s) m at every node
+    border_cols: np.ndarray   # (n, k)
+    border_rows: np.ndarray   # (k, n)
+    idx: np.ndarray
+
+    @property
+    def indices(self) -> np.ndarray:
+        n, k = self.op.shape[0], self.border_cols.shape[1]
+        return np.concatenate([self.idx, n + np.arange(k)])
+
+    def block(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """The matrix's entries in ``rows`` and ``cols`` (indices as above)."""
+        n = self.op.shape[0]
+        node_r, node_c = rows < n, cols < n
+        r, c = rows[node_r], cols[node_c]
+        out = np.zeros((rows.size, cols.size))
+        nodes = self.op[np.ix_(r, c)]
+        same = r[:, None] == c[None, :]
+        if same.any():
+            nodes = nodes + np.where(same, self.diagonal[r][:, None], 0.0)
+        out[np.ix_(node_r, node_c)] = nodes
+        out[np.ix_(node_r, ~node_c)] = self.border_cols[np.ix_(r, cols[~node_c] - n)]
+        out[np.ix_(~node_r, node_c)] = self.border_rows[np.ix_(rows[~node_r] - n, c)]
+        return out
+
+
+class _FactorUpdate:
+    """The LU factors of one system made to solve another whose contact nodes differ by
+    a few: an exact solve of the new system (up to its diagonal's drift since the
+    factors, which the refinement takes out) from the old factors and a small Schur
+    complement.
+
+    With ``K`` the factored matrix on the indices ``A``, the new system on ``A'`` is the
+    augmented one
+
+        [[K, E_R, B], [E_R^T, 0, 0], [C, 0, D]] [z; r; y] = [b_A; 0; b_N]
+
+    where ``R = A - A'`` (the nodes left: ``z_R = 0`` and their rows free, their
+    multipliers ``r``), ``N = A' - A`` (the nodes gained: ``B = K[A, N]``,
+    ``C = K[N, A]``, ``D = K[N, N]``); eliminating ``z`` with ``K``'s factors leaves a
+    Schur system of ``|R| + |N|`` unknowns. ``K^-1`` of the columns ``E_R`` and ``B``
+    are kept per anchor (:attr:`StepSolver._columns`) while its factors stay.
+    """
+
+    def __init__(self, solver: StepSolver, layout: BorderedLayout) -> None:
+        anchor, new = solver._anchor, layout.indices
+        # the factors themselves: a snapshot's update must outlive a refactoring
+        self.lu = solver._lu
+        in_old = np.isin(anchor, new)
+        in_new = np.isin(new, anchor)
+        self.kept_old = np.flatnonzero(in_old)          # positions in the anchor
+        self.kept_new = np.flatnonzero(in_new)          # the same indices' positions here
+        self.removed = np.flatnonzero(~in_old)          # positions in the anchor
+        self.added = np.flatnonzero(~in_new)            # positions here
+        added_ids = new[self.added]
+        self.size = anchor.size
+        columns = solver._columns
+        wanted = [("out", int(p)) for p in self.removed] + [("in", int(j)) for j in added_ids]
+        missing = [key for key in wanted if key not in columns]
+        if missing:
+            rhs = np.zeros((anchor.size, len(missing)))
+            for col, (kind, value) in enumerate(missing):
+                if kind == "out":
+                    rhs[value, col] = 1.0
+            gained = [col for col, (kind, _) in enumerate(missing) if kind == "in"]
+            if gained:
+                ids = np.array([missing[col][1] for col in gained])
+                rhs[:, gained] = layout.block(anchor, ids)
+            solved = self._back(rhs)
+            solver.back_substitutions += len(missing)
+            for col, key in enumerate(missing):
+                columns[key] = solved[:, col]
+        self.ku = (np.column_stack([columns[key] for key in wanted]) if wanted
+                   else np.zeros((anchor.size, 0)))
+        r = self.removed.size
+        self.c = layout.block(added_ids, anchor)
+        schur = np.zeros((len(wanted), len(wanted)))
+        schur[r:, r:] = layout.block(added_ids, added_ids)
+        schur[:r] -= self.ku[self.removed]
+        schur[r:] -= self.c @ self.ku
+        self.schur = lu_factor(schur, check_finite=False) if len(wanted) else None
+
+    def _back(self, r: np.ndarray) -> np.ndarray:
+        x, _ = dgetrs(self.lu[0], self.lu[1], r)
+        return x
+
+    def __call__(self, b: np.ndarray) -> np.ndarray:
+        """The augmented system's solution for right-hand sides ``b`` (a vector, or
+        columns) on the new indices."""
+        b_old = np.zeros((self.size,) + b.shape[1:])
+        b_old[self.kept_old] = b[self.kept_new]
+        y0 = self._back(b_old)
+        out = np.zeros_like(b, dtype=float)
+        if self.schur is None:
+            out[self.kept_new] = y0[self.kept_old]
+            return out
+        r = self.removed.size
+        rhs = np.concatenate([-y0[self.removed], b[self.added] - self.c @ y0])
+        s, _ = dgetrs(self.schur[0], self.schur[1], rhs)
+        z = y0 - self.ku @ s
+        out[self.kept_new] = z[self.kept_old]
+        out[self.added] = s[r:]
+        return out
+
+
 class StepSolver:
     """Solves the bordered systems of one panel rule, keeping the last factorization.
 
     Consecutive creep steps change only ``c`` and ``scale`` by a little, and the contact
-    set rarely: the kept LU factors of the last matrix with the same contact nodes
-    precondition a few steps of iterative refinement (each O(N^2)) instead of a new
-    factorization (O(N^3)); a new one is made when the refinement does not converge
-    within ``_REFINE_STEPS`` steps.
+    set by a few nodes at a time: the kept LU factors of the last matrix precondition a
+    few steps of iterative refinement (each O(N^2)) instead of a new factorization
+    (O(N^3)). Where the contact nodes changed since the factors were made (up to
+    ``MAX_UPDATE`` of them gained or lost, the statement the same), the factors solve the
+    new system through a small Schur complement (:class:`_FactorUpdate`; a crown whose
+    zone grows node by node as the base creeps made a new factorization at 286 of its
+    302 solves), on systems of ``UPDATE_MIN_SIZE`` unknowns and more. A new factorization
+    is made when the refinement does not converge within ``_REFINE_STEPS`` steps, or took
+    more than ``REFRESH_AFTER``.
     """
 
     _REFINE_STEPS = 12
@@ -42,14 +166,33 @@ class StepSolver:
     CHANGE_RESIDUAL = 1e-9
     #: start the refinement from the line through the last two solutions
     EXTRAPOLATE = True
+    #: Contact nodes gained or lost since the factors beyond which new ones are made (the
+    #: Schur complement's columns cost a back-substitution each; the crowned default of
+    #: ~1000 unknowns: 6.4, 6.0, 4.9 and 5.0 s of CPU at 16, 48, 96 and 160).
+    MAX_UPDATE = 96
+    #: Systems smaller than this are factored anew at every new contact set: there a
+    #: factorization costs less than the update and the refinement steps it adds
+    #: (measured, CPU: the lift-off preset's ~300 unknowns 0.37 s factored anew, 0.51 s
+    #: updated; a crowned default of ~1000 6.6 -> 4.8 s, a receding heel of ~1200
+    #: 14.6 -> 8.9 s; ~600 unknowns alike either way).
+    UPDATE_MIN_SIZE = 400
 
     def __init__(self) -> None:
         self._key: tuple | None = None
         self._lu = None
         self._sub: np.ndarray | None = None  # F on the contact nodes of _key
-        self._last: np.ndarray | None = None  # the last solution with these factors
+        self._last: np.ndarray | None = None  # the last solution with these contact nodes
         self._prev: np.ndarray | None = None  # the one before it (same contact nodes)
+        # The factors' own contact nodes and statement (_lu_key), their indices in the
+        # layout (_anchor, None when they were made without one), K^-1 of the columns
+        # an update asked for (_columns), and the solve of the current contact nodes
+        # with them (_precondition: the factors themselves or an update).
+        self._lu_key: tuple | None = None
+        self._anchor: np.ndarray | None = None
+        self._columns: dict[tuple[str, int], np.ndarray] = {}
+        self._precondition: Callable[[np.ndarray], np.ndarray] | None = None
         self.factorizations = 0
+        self.updates = 0
         self.back_substitutions = 0
 
     def submatrix(self, op: np.ndarray, idx: np.ndarray, key: tuple) -> np.ndarray:
@@ -57,9 +200,9 @@ class StepSolver:
         if self._key != key or self._sub is None:
             self._sub = restrict(op, idx)
             self._key = key
-            self._lu = None
             self._last = None
             self._prev = None
+            self._precondition = self._back if self._lu_key == key else None
         return self._sub
 
     def snapshot(self) -> StepSolver:
@@ -68,6 +211,10 @@ class StepSolver:
         change on this step (:func:`bordered_change`) can be solved after later steps."""
         kept = StepSolver()
         kept._key, kept._lu, kept._sub, kept._last = self._key, self._lu, self._sub, self._last
+        kept._lu_key, kept._anchor = self._lu_key, self._anchor
+        # an update solves with the factors it was made from: the same ones, shared
+        kept._precondition = (kept._back if self._precondition == self._back
+                              else self._precondition)
         return kept
 
     def _back(self, r: np.ndarray) -> np.ndarray:
@@ -75,20 +222,39 @@ class StepSolver:
         x, _ = dgetrs(self._lu[0], self._lu[1], r)
         return x
 
+    def _prepare(self, layout: BorderedLayout | None) -> Callable[[np.ndarray], np.ndarray] | None:
+        """The solve of the current contact nodes with the kept factors, if they serve."""
+        if self._precondition is not None or self._lu is None:
+            return self._precondition
+        if (layout is None or self._anchor is None or self._key is None
+                or self._lu_key is None or self._lu_key[1] != self._key[1]
+                or self._anchor.size < self.UPDATE_MIN_SIZE):
+            return None
+        new = layout.indices
+        changed = (self._anchor.size + new.size
+                   - 2 * np.intersect1d(self._anchor, new, assume_unique=True).size)
+        if changed > self.MAX_UPDATE:
+            return None
+        self._precondition = _FactorUpdate(self, layout)
+        self.updates += 1
+        return self._precondition
+
     def solve(self, build: Callable[[], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
-              b: np.ndarray) -> np.ndarray:
+              b: np.ndarray, layout: BorderedLayout | None = None) -> np.ndarray:
         """Solve ``A x = b`` for the matrix ``build()`` whose product is ``apply``.
 
         The refinement starts from the last solution on the same contact nodes (the next
         step's is close to it; extrapolated from the last two when there are two) and
-        stops at a residual of ``_RESIDUAL`` relative to ``b``.
+        stops at a residual of ``_RESIDUAL`` relative to ``b``. ``layout``: the system
+        in the indices of all nodes, with which factors of other contact nodes serve.
         """
         if self._lu is None and self._sub is not None and self._last is not None:
-            self._factor(build)
-        if self._lu is not None:
+            self._factor(build, layout)
+        precondition = self._prepare(layout)
+        if precondition is not None:
             scale = max(float(np.abs(b).max()), 1e-300)
             if self._last is None:
-                x = self._back(b)
+                x = precondition(b)
             elif self._prev is not None and self.EXTRAPOLATE:
                 # the solutions of successive steps change smoothly: their line starts
                 # the refinement closer than the last alone (in the 202-step march of
@@ -101,17 +267,26 @@ class StepSolver:
                 if float(np.abs(r).max()) <= self._RESIDUAL * scale:
                     self._prev, self._last = self._last, x
                     if count > self.REFRESH_AFTER:
-                        self._lu = None  # c/s has drifted: new factors next time
+                        self._drop_factors()  # c/s has drifted: new factors next time
                     return x
-                x = x + self._back(r)
+                x = x + precondition(r)
                 self.back_substitutions += 1
-        self._factor(build)
+        self._factor(build, layout)
         self._last = self._back(b)
         self._prev = None
         return self._last
 
-    def _factor(self, build: Callable[[], np.ndarray]) -> None:
+    def _drop_factors(self) -> None:
+        self._lu = self._lu_key = self._anchor = self._precondition = None
+        self._columns = {}
+
+    def _factor(self, build: Callable[[], np.ndarray], layout: BorderedLayout | None = None
+                ) -> None:
+        self._drop_factors()
         self._lu = lu_factor(build(), check_finite=False)
+        self._lu_key = self._key
+        self._anchor = None if layout is None else layout.indices
+        self._precondition = self._back
         self.factorizations += 1
 
     def solve_change(self, build: Callable[[], np.ndarray],
@@ -122,16 +297,17 @@ class StepSolver:
         error enters the total far below ``_RESIDUAL`` of it). The last solution and the
         factors are left as they were for the next step (new factors are kept only when
         there were none)."""
-        if self._lu is None:
+        if self._precondition is None:
             self._factor(build)
+        precondition = self._precondition
         scale = max(float(np.abs(b).max()), 1e-300)
-        x = self._back(b)
+        x = precondition(b)
         self.back_substitutions += 1
         for _ in range(self._REFINE_STEPS):
             r = b - apply(x)
             if float(np.abs(r).max()) <= self.CHANGE_RESIDUAL * scale:
                 return x
-            x = x + self._back(r)
+            x = x + precondition(r)
             self.back_substitutions += 1
         # the kept factors no longer precondition well (c/s drifted): exact ones
         return np.linalg.solve(build(), b)
@@ -164,28 +340,30 @@ def bordered_operator(sub: np.ndarray, diagonal: np.ndarray, border_cols: np.nda
 def _bordered_system(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, c: float,
                      scale: float, given: Sequence[str], idx: np.ndarray,
                      solver: StepSolver | None):
-    """(build, apply, key, unknown border names) of the system on ``idx``, divided by
-    ``scale``: see :func:`bordered_solve`."""
-    n = idx.size
+    """(build, apply, layout) of the system on ``idx``, divided by ``scale``: see
+    :func:`bordered_solve`; ``layout`` (:class:`BorderedLayout`, None without ``solver``)
+    the same system over all nodes."""
     cols, rows = [], []
     if "settlement" not in given:
-        cols.append(-np.ones(n))
+        cols.append(-np.ones(x.size))
     if "tilt" not in given:
-        cols.append(-x[idx])
+        cols.append(-x)
     if "force" in given:
-        rows.append(w[idx])
+        rows.append(w)
     if "moment" in given:
-        rows.append(w[idx] * x[idx])
+        rows.append(w * x)
     k = len(cols)
-    border_cols = np.array(cols).T.reshape(n, k)
-    border_rows = np.array(rows).reshape(k, n)
+    all_cols = np.array(cols).T.reshape(x.size, k)
+    all_rows = np.array(rows).reshape(k, x.size)
     key = (idx.tobytes(), tuple(sorted(given)))
     sub = restrict(op, idx) if solver is None else solver.submatrix(op, idx, key)
     # Divided by the weight s of F, the system depends on c and s only through c/s (and
     # the border unknowns come out divided by s): kept factors then precondition the
     # next steps up to the change of c/s alone.
-    diagonal = (c / scale) * m[idx]
-    return bordered_operator(sub, diagonal, border_cols, border_rows)
+    ratio = c / scale
+    build, apply = bordered_operator(sub, ratio * m[idx], all_cols[idx], all_rows[:, idx])
+    layout = None if solver is None else BorderedLayout(op, ratio * m, all_cols, all_rows, idx)
+    return build, apply, layout
 
 
 def bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, c: float,
@@ -196,10 +374,11 @@ def bordered_solve(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray, 
     Returns (q on idx, settlement, tilt). ``rhs`` = ``delta_g + alpha_g x - g + e`` at all
     nodes (with the given ones of delta, alpha; 0 for the unknown ones).
     """
-    build, apply = _bordered_system(op, m, x, w, c, scale, tuple(given), idx, solver)
+    build, apply, layout = _bordered_system(op, m, x, w, c, scale, tuple(given), idx, solver)
     extra = [given[name] for name in ("force", "moment") if name in given]
     b = np.concatenate([rhs[idx] / scale, extra])
-    sol = np.linalg.solve(build(), b) if solver is None else solver.solve(build, apply, b)
+    sol = (np.linalg.solve(build(), b) if solver is None
+           else solver.solve(build, apply, b, layout))
     return _unpack(sol, idx.size, scale, given)
 
 
@@ -211,7 +390,7 @@ def bordered_change(op: np.ndarray, m: np.ndarray, x: np.ndarray, w: np.ndarray,
     by their entries), solved with the kept factors of ``solver`` to a residual of
     ``StepSolver.CHANGE_RESIDUAL`` of the change, and leaving its state for the next step.
     Returns (change of q on idx, of the settlement, of the tilt)."""
-    build, apply = _bordered_system(op, m, x, w, c, scale, tuple(given), idx, solver)
+    build, apply, _ = _bordered_system(op, m, x, w, c, scale, tuple(given), idx, solver)
     extra = [given[name] for name in ("force", "moment") if name in given]
     b = np.concatenate([rhs[idx] / scale, extra])
     return _unpack(solver.solve_change(build, apply, b), idx.size, scale, given)
