@@ -407,7 +407,7 @@ def test_a_crown_whose_force_steps_up_grows_its_zone_at_once_and_then_as_the_bas
 def test_a_growing_zone_costs_a_few_layered_solves_a_time_grid_point(corners, monkeypatch):
     """On a creeping bare base the zone of each time-grid point is sought from the last
     one (secant steps, with Broyden's method where both ends are free, from the last
-    Jacobian): at most 6 layered solves a point (measured 5.3 for a crown lifting at the
+    Jacobian): at most 6 layered solves a point (measured 5.4 for a crown lifting at the
     heel, 4.9 for Hertz's crown; Brent's and Powell's methods asked 12.3 and 11.9)."""
     import core.engines.layered.bare_lift_off as lift_off
 
@@ -437,3 +437,17 @@ def test_a_growing_zone_costs_a_few_layered_solves_a_time_grid_point(corners, mo
     result = solve(d)
     assert result.flags == [] and result.info["contact"] == "unilateral"
     assert counts["points"] > 20 and counts["zones"] <= 6 * counts["points"]
+
+
+def test_the_secant_from_a_nearby_end_takes_only_a_root_crossed_the_right_way():
+    """From a nearby end the secant may meet a root where the singular coefficient
+    crosses zero the other way (not a free end of this corner): it gives up there and
+    the bracketing search, which asks the right signs, takes over."""
+    from core.engines.layered.bare_lift_off import _secant_end
+
+    def f(x: float) -> float:
+        return (x - 0.1) * (x - 0.3)   # rises through 0.3, falls through 0.1
+
+    assert _secant_end(f, 0.12, 0.12 + 1e-8, -1.0, 1.0, rising=1.0) is None
+    found = _secant_end(f, 0.28, 0.28 + 1e-8, -1.0, 1.0, rising=1.0)
+    assert found is not None and abs(found - 0.3) <= END_TOL

@@ -212,13 +212,16 @@ class _Zones:
                                            np.array([alpha]), level=level)[0, 0])
 
 
-def _secant_end(f: Callable[[float], float], x0: float, x1: float, lo: float, hi: float
-                ) -> float | None:
-    """The root of ``f`` in ``(lo, hi)`` by secant steps from ``x0`` and ``x1``, kept
-    inside the bracket of the points of opposite signs once there is one (bisected where
-    a step leaves it), to a last step of ``END_TOL``; None when the steps stall or
-    leave ``(lo, hi)`` (the caller brackets the root instead). The point returned is the
-    last one evaluated (its zone's response is kept), within the last step of the root.
+def _secant_end(f: Callable[[float], float], x0: float, x1: float, lo: float, hi: float,
+                rising: float) -> float | None:
+    """The root of ``f`` in ``(lo, hi)`` where it rises in the direction ``rising``
+    (+1 toward larger x, -1 toward smaller: the zone's end, f < 0 toward the lifting
+    corner) by secant steps from ``x0`` and ``x1``, kept inside the bracket of the points
+    of opposite signs once there is one (bisected where a step leaves it), to a last
+    step of ``END_TOL``; None when the steps stall, leave ``(lo, hi)`` or end on a root
+    crossed the other way (the caller brackets the root instead). The point returned is
+    the last one evaluated (its zone's response is kept), within the last step of the
+    root, or the midpoint of a bracket narrower than ``2 END_TOL``.
     """
     f0, f1 = f(x0), f(x1)
     below = above = None  # the latest points where f < 0 and f > 0
@@ -228,17 +231,23 @@ def _secant_end(f: Callable[[float], float], x0: float, x1: float, lo: float, hi
         elif fx > 0.0:
             above = x
     for _ in range(SECANT_STEPS):
-        if f1 == 0.0:
-            return x1
         if f1 == f0:
             return None
-        x2 = x1 - f1 * (x1 - x0) / (f1 - f0)
-        if below is not None and above is not None and not (
-                min(below, above) < x2 < max(below, above)):
+        slope = (f1 - f0) / (x1 - x0)
+        if slope * rising <= 0.0:
+            return None  # near a root crossed the other way (or a turning point)
+        if f1 == 0.0:
+            return x1
+        x2 = x1 - f1 / slope
+        bisected = below is not None and above is not None and not (
+            min(below, above) < x2 < max(below, above))
+        if bisected:
             x2 = 0.5 * (below + above)
         if not lo < x2 < hi:
             return None
-        if abs(x2 - x1) <= END_TOL:
+        if bisected and abs(above - below) <= 2.0 * END_TOL:
+            return x2
+        if not bisected and abs(x2 - x1) <= END_TOL:
             return x1
         x0, f0, x1, f1 = x1, f1, x2, f(x2)
         if f1 < 0.0:
@@ -275,7 +284,7 @@ def _free_end(zones: _Zones, free: int, given: dict[str, float], level: int,
         # search per end.
         if second is None or not -1.0 < second < 1.0 or abs(second - near) <= END_TOL:
             second = near + COARSE_STEP * (other - corner) / 2
-        found = _secant_end(f, near, second, -1.0, 1.0)
+        found = _secant_end(f, near, second, -1.0, 1.0, rising=other - corner)
         if found is not None:
             return found
         # f < 0 toward the lifting corner, > 0 toward the other: widen a bracket about it
@@ -511,8 +520,9 @@ def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
         # from a nearby zone (the last time-grid point's, or this one's with all the
         # modes) Broyden's method needs ~2 zones where Powell's asked ~6 (a zone is a
         # layered solve: a Hertz crown on a creeping layer, 674 solves of 5.6 zones)
-        start = unknowns(second if second is not None and within(unknowns(second))
-                         else guess)
+        # (an extrapolated zone that closes up is no start)
+        start = unknowns(second if second is not None and second[1] > second[0]
+                         and within(unknowns(second)) else guess)
         broyden = _broyden(coefficients, start, jacobian, within)
         if broyden is not None and np.max(np.abs(coefficients(broyden[0]))) <= TWO_ENDS_TOL:
             found, updated = broyden
