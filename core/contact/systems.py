@@ -174,7 +174,7 @@ class StepSolver:
     #: factorization costs less than the update and the refinement steps it adds
     #: (measured, CPU: the lift-off preset's ~300 unknowns 0.37 s factored anew, 0.51 s
     #: updated; a crowned default of ~1000 6.6 -> 4.8 s, a receding heel of ~1200
-    #: 14.6 -> 8.9 s; ~600 unknowns alike either way).
+    #: 14.6 -> 10.1 s; ~450-600 unknowns alike either way).
     UPDATE_MIN_SIZE = 400
 
     def __init__(self) -> None:
