@@ -28,6 +28,13 @@ def restrict(op: np.ndarray, idx: np.ndarray) -> np.ndarray:
     return op[np.ix_(idx, idx)]
 
 
+def _lu_solve(lu: tuple[np.ndarray, np.ndarray], r: np.ndarray) -> np.ndarray:
+    """``r`` solved with the LU factors ``lu`` (of ``lu_factor``). LAPACK directly: the
+    checked wrapper costs more than the O(N^2) solve here."""
+    x, _ = dgetrs(lu[0], lu[1], r)
+    return x
+
+
 @dataclass(frozen=True)
 class BorderedLayout:
     """The bordered matrix of one step over all nodes of a panel rule, read by blocks.
@@ -123,8 +130,7 @@ class _FactorUpdate:
         self.schur = lu_factor(schur, check_finite=False) if len(wanted) else None
 
     def _back(self, r: np.ndarray) -> np.ndarray:
-        x, _ = dgetrs(self.lu[0], self.lu[1], r)
-        return x
+        return _lu_solve(self.lu, r)
 
     def __call__(self, b: np.ndarray) -> np.ndarray:
         """The augmented system's solution for right-hand sides ``b`` (a vector, or
@@ -138,7 +144,7 @@ class _FactorUpdate:
             return out
         r = self.removed.size
         rhs = np.concatenate([-y0[self.removed], b[self.added] - self.c @ y0])
-        s, _ = dgetrs(self.schur[0], self.schur[1], rhs)
+        s = _lu_solve(self.schur, rhs)
         z = y0 - self.ku @ s
         out[self.kept_new] = z[self.kept_old]
         out[self.added] = s[r:]
@@ -218,9 +224,7 @@ class StepSolver:
         return kept
 
     def _back(self, r: np.ndarray) -> np.ndarray:
-        # LAPACK directly: the checked wrapper costs more than the O(N^2) solve here.
-        x, _ = dgetrs(self._lu[0], self._lu[1], r)
-        return x
+        return _lu_solve(self._lu, r)
 
     def _prepare(self, layout: BorderedLayout | None) -> Callable[[np.ndarray], np.ndarray] | None:
         """The solve of the current contact nodes with the kept factors, if they serve."""

@@ -28,26 +28,31 @@ server, browser_context, page = page_fixtures(1400, 900)
 
 ROOT = Path(__file__).resolve().parents[2]
 
-def _painter_runs(page: Page, ms: int) -> int:
-    """Frames FilePond's loop ran during ``ms`` [ms]."""
-    return page.page.evaluate("""(ms) => new Promise(resolve => {
-      const painter = window.__explorerPainter;
-      let runs = 0;
-      const writers = window.__framePainter ? window.__framePainter.writers : [];
-      const count = () => { runs += 1; };
-      writers.push(count);
-      setTimeout(() => { writers.splice(writers.indexOf(count), 1); resolve(runs); }, ms);
-      if (!painter) resolve(-1);
-    })""", ms)
-
-
-# Counts the frames of FilePond's loop from now on (window.__droppersFrames.runs).
-JS_COUNT_FRAMES = """() => {
+# Counting the frames of FilePond's loop: a writer of its frame function that counts
+# (window.__droppersFrames), added by JS_START_COUNT and taken out by JS_STOP_COUNT,
+# which returns the count.
+JS_START_COUNT = """() => {
   const counter = {runs: 0};
-  const writers = window.__framePainter ? window.__framePainter.writers : [];
-  writers.push(() => { counter.runs += 1; });
+  counter.count = () => { counter.runs += 1; };
+  (window.__framePainter ? window.__framePainter.writers : []).push(counter.count);
   window.__droppersFrames = counter;
 }"""
+JS_STOP_COUNT = """() => {
+  const counter = window.__droppersFrames;
+  const writers = window.__framePainter ? window.__framePainter.writers : [];
+  const at = writers.indexOf(counter.count);
+  if (at >= 0) writers.splice(at, 1);
+  return counter.runs;
+}"""
+
+
+def _painter_runs(page: Page, ms: int) -> int:
+    """Frames FilePond's loop ran during ``ms`` [ms] (-1: no painter on the page)."""
+    if not page.page.evaluate("() => Boolean(window.__explorerPainter)"):
+        return -1
+    page.page.evaluate(JS_START_COUNT)
+    page.page.wait_for_timeout(ms)
+    return page.page.evaluate(JS_STOP_COUNT)
 
 
 def _wait_asleep(page: Page, timeout: float = 90.0) -> None:
@@ -71,14 +76,14 @@ def test_an_idle_page_holds_the_droppers_loop_and_a_late_file_still_loads(page: 
     # a load step with the keys, away from the droppers: the answer comes and is drawn,
     # and the dropper's loop sleeps on (it woke at every key and every change from the
     # server, ~32 frames of it a step)
-    page.page.evaluate(JS_COUNT_FRAMES)
+    page.page.evaluate(JS_START_COUNT)
     before = page.q()
     handle = page.page.locator(".load-0-value .noUi-handle").first
     handle.focus()
     handle.press("ArrowRight")
     until(lambda: page.q() != before, "the load step's pressure")
     time.sleep(0.5)  # its frames drawn (a window for the loop to run in, not a wait)
-    assert page.page.evaluate("() => window.__droppersFrames.runs") == 0
+    assert page.page.evaluate(JS_STOP_COUNT) == 0
     page.open_tab("Files")  # (a tab's title clicked: the loop wakes, a dropper may show)
     _wait_asleep(page)
     # a file chosen now (as after a long look through the file dialog): only the file

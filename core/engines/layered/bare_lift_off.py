@@ -397,7 +397,7 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
             lo, hi, jacobian = _two_free_ends(zones, given, level=0, guess=guess,
                                               jacobian=jacobian, second=second)
             clo, chi, _ = _two_free_ends(zones, given, level=1, guess=(lo, hi),
-                                         jacobian=jacobian)
+                                         jacobian=jacobian, keep_jacobian=False)
         else:
             start = second = None
             if near is not None:
@@ -485,13 +485,14 @@ def _broyden(f: Callable[[np.ndarray], np.ndarray], v: np.ndarray, jacobian: np.
 def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
                    guess: tuple[float, float] | None = None,
                    jacobian: np.ndarray | None = None,
-                   second: tuple[float, float] | None = None
-                   ) -> tuple[float, float, np.ndarray | None]:
+                   second: tuple[float, float] | None = None,
+                   keep_jacobian: bool = True) -> tuple[float, float, np.ndarray | None]:
     """The zone of a punch lifting at both corners: both ends' singular coefficients zero
     (``guess`` a first zone, else :func:`_hertz_guess`, else the best of a scan), with the
     Jacobian of the coefficients there when Broyden's method found it. With
     ``jacobian`` (a nearby zone's) Broyden's method starts from ``second`` (the guess
-    extrapolated; default the guess), else Powell's hybrid method from the guess."""
+    extrapolated; default the guess), else Powell's hybrid method from the guess; then
+    (``keep_jacobian``) the Jacobian is made by forward differences, two more zones."""
     from scipy.optimize import root  # here: see _free_end
 
     def coefficients(v: np.ndarray) -> np.ndarray:
@@ -541,7 +542,7 @@ def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
         found = solved(start) if start is not None else None
     if found is None:
         raise ValueError(TWO_FREE_ENDS)
-    if updated is None:
+    if updated is None and keep_jacobian:
         updated = _jacobian(coefficients, found)
     x0, b = float(found[0]), float(np.exp(found[1]))
     return x0 - b, x0 + b, updated
