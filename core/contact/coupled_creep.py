@@ -61,6 +61,7 @@ from core.contact.creep import (
     creep_verdict,
     free_end_slope,
     graded_halvings,
+    transient_windows,
 )
 from core.contact.kinks import Corrected, _contact_parts, _cut_rule, _part_rows, corrected_roots
 from core.contact.march import creep_memory, nodes_in, rule_operator
@@ -417,7 +418,9 @@ def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeI
     (rules, out, run, band_note, strays, error, end_error, time_error,
      space_error, end_q_error) = controlled_march(marches, times, tol, res, first_steps,
                                                   tuple(float(b) for b in time_breaks),
-                                                  graded_halvings(inputs[0].kernel, times))
+                                                  graded_halvings(inputs[0].kernel, times),
+                                                  transient_windows(inputs[0].kernel, times,
+                                                                  time_breaks, tol))
     success, flags, message = creep_verdict(error, end_error, time_error, space_error, run,
                                             strays, tol,
                                             f"under creep ({len(base.punches)} punches)",

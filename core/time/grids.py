@@ -14,7 +14,8 @@ __all__ = ["time_grid"]
 
 
 def time_grid(times: np.ndarray, steps: int, refine: int = 0,
-              jumps: Sequence[float] = (), graded: int = 0
+              jumps: Sequence[float] = (), graded: int = 0,
+              windows: Sequence[tuple[float, float, float]] = ()
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A grid on ``[1, times[-1]]`` containing every requested time (dimensionless t).
 
@@ -37,6 +38,10 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
     the steps grow geometrically out of the start (a creep law's transient just after a
     load is applied, such as the ``(t - t0)^0.3`` of the design codes); these points do
     not depend on ``refine``, so halving stays exact.
+
+    ``windows``: (from, to, longest step): the intervals between ``from`` and ``to`` (each
+    ``to`` an interval end) get steps no longer than that (a creep law's decay, stepped
+    finely while it lasts); also independent of ``refine``.
     """
     times = np.asarray(times, dtype=float)
     h = (times[-1] - 1.0) / steps
@@ -51,6 +56,11 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
             if after.size:
                 length = float(after[0]) - start
                 ends += [(start + length * 2.0**-k, -1) for k in range(graded, 0, -1)]
+    # a window shorter than the nominal step ends on an interval end, so that each
+    # interval is inside it or outside it
+    windows = [(float(a), float(b), float(step)) for a, b, step in windows if step < h]
+    ends += [(b, -1) for _, b, _ in windows if 1.0 < b < float(times[-1])
+             and all(abs(b - j) > sides[j] for j in inside)]
     on_jump: dict[int, int] = {}
     for j, side in sides.items():
         ends += [(j - side, -1), (j + side, -1)]
@@ -67,7 +77,8 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
         t, k = ends[i]
         length = t - start
         if length > 0.0:
-            count = max(1, math.ceil(length / h - 1e-9)) * 2**refine
+            step = min([h] + [w for a, b, w in windows if a < t and b > start])
+            count = max(1, math.ceil(length / step - 1e-9)) * 2**refine
             points.extend(start + length * np.arange(1, count + 1) / count)
             points[-1] = t
             # One width per interval, not np.diff of the points: equal widths keep the
