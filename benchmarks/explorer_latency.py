@@ -26,8 +26,9 @@ from the choice to the frame showing the new scene's pressure is reported), and 
 slider kind the preset shows is measured twice: by key presses as above (p50 and p95),
 and by a drag (mouse down on the handle, 20 small moves over about a second, mouse up),
 counting the pressure plot's updates during the drag (live: the plots follow the handle)
-and after the release, and the time from the release to the last update. A slider the
-preset hides is said so. The table is written as Markdown to ``--markdown`` (default
+and after the release, and the time from the release to the last update. Each slider
+starts from the preset as loaded (the Scene tab's reset, waited for, between rows). A
+slider the preset hides is said so. The table is written as Markdown to ``--markdown`` (default
 ``benchmarks/results/explorer_latency_presets.md``) with the commit, the date, the load
 average and the command line.
 Not part of the test suite. Usage::
@@ -481,6 +482,18 @@ def switch_preset(page, label: str, timeout_s: float) -> float | None:
     return (max(updates) - t0) if updates else float("nan")
 
 
+def reset_scene(page, timeout_s: float) -> None:
+    """Back to the preset as loaded (the Scene tab's reset button), its answer on screen:
+    each row starts from the preset, not from where the last row's drag left it (on
+    ``stepped_punch`` the coating-modulus drag ends in a stiffer coating whose outer parts
+    lift off beside the steps, 5-12 s a solve, which the next rows then measured)."""
+    page.locator(".bk-tab", has_text="Scene").first.click()
+    page.evaluate("() => { window.__updates = []; }")
+    t0 = page.evaluate("() => performance.now()")
+    page.locator(".reset-button button").first.click()
+    _wait_quiet(page, t0, need_one=True, timeout_s=timeout_s)
+
+
 def measure_row(page, preset: str, kind: SliderKind, repeats: int, cdp,
                 timeout_s: float) -> dict:
     """Key steps and a drag of ``kind``'s slider on the page (the preset on it)."""
@@ -585,9 +598,13 @@ def main(argv: list[str] | None = None) -> None:
                                                  timeout_s)
                 print(f"{preset}: switch {_fmt(switches[preset]) or 'none'} ms",
                       file=sys.stderr)
+                moved = False
                 for kind in SLIDER_KINDS:
+                    if moved:
+                        reset_scene(page, timeout_s)
                     row = measure_row(page, preset, kind, args.repeats, cdp, timeout_s)
                     rows.append(row)
+                    moved = not row.get("hidden")
                     print(f"  {kind.name}: "
                           + ("hidden" if row.get("hidden") else
                              f"p50 {_fmt(percentile(row['key_ms'], 50))} "
