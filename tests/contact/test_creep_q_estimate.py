@@ -67,19 +67,22 @@ def _aging(tol: float):
 
 def test_q_beside_a_free_end_is_in_the_estimate_and_the_end_located_for_it() -> None:
     answer, reference = _aging(1e-6), _aging(1e-9)
-    assert answer.info["success"]
     assert answer.info["zone_end_pressure_error"] > 0.0
-    # the ends were located finer than the 1e-6 asked of them otherwise: measured 1.5e-7
+    # the ends were located finer than the 1e-6 asked of them otherwise: measured 1.2e-7
     # (before: 4.8e-7, and q beside them 4.7e-7 off under an estimate of 1.8e-7)
     assert answer.info["zone_end_error"] < 2.5e-7
-    # the reference's estimate: 1.1e-7; the error measured: 5.4e-8 under the estimate
-    # 2.2e-7 (2.6e-7 against a reference refined beyond the solver's limits,
-    # benchmarks/results/creep_honesty.md: 1.2 times the estimate, within the margin
-    # success allows it)
-    assert reference.info["error_estimate"] <= 2e-7
+    # Refused at tol 1e-6: the pressure the answer gives at its reported free ends (2.2e-7
+    # of max q, core.contact.creep.free_end_residual) is in the estimate, 4.0e-7 (q beside
+    # the ends 2.8e-7) against tol / 3. q beside the end is 2.3e-7 off against a reference
+    # refined beyond the solver's limits (benchmarks/results/creep_honesty.md), which the
+    # estimate read 0.75 times before that part. The reference here (tol 1e-9, the same
+    # finest band panels: 3.1e-7, the same pressure at its ends) shares that error: 4.3e-8
+    # apart.
+    assert not answer.info["success"] and "tol_not_met" in answer.info["flags"]
+    assert 2.3e-7 <= answer.info["error_estimate"] <= 1e-6
+    assert reference.info["error_estimate"] <= 4e-7
     error = _q_error(answer, reference)
     assert error <= answer.info["error_estimate"] + reference.info["error_estimate"]
-    assert error <= 1e-6
 
 
 def test_the_slope_at_a_free_end_is_read_from_the_nodes_inside_the_zone() -> None:
