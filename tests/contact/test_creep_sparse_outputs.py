@@ -1,12 +1,14 @@
 """A creep march asked for a few output times far apart is honest and converges
-(core/contact/creep.py: ``transient_windows``, the observed ratio in ``_in_time``).
+(core/contact/creep.py: ``transient_windows``, the observed ratio in ``_in_time``,
+``free_end_residual``).
 
 Found on the design chart (``preset:eccentric_design``: outputs at loading and at 50
 years only, an aging law of one rate of 0.03 / day): its 16 nominal steps are each ~40
 decay times long, so the halved grids were outside their asymptotic range. Marched in full
 contact (the exact answer is the modal one), the settlement's error fell 7.6, 6.4, 4.7,
 2.9, 1.3 (x1e-7, of 7.4e-5) over grids of 18 to 273 points; Richardson's estimate read
-3.0e-4 against an error of 1.8e-3 (relative).
+3.0e-4 against an error of 1.8e-3 (relative). Once those points met tol, one that lifts off
+showed q not vanishing at its own reported free end (``free_end_residual``).
 """
 
 from __future__ import annotations
