@@ -86,15 +86,20 @@ def _given_rhs(step: Step, x: np.ndarray, g: np.ndarray, memory: np.ndarray | No
 def nystrom_pressure(space: Space, step: Step, panels: Panels, q: np.ndarray, delta: float,
                      alpha: float, targets: np.ndarray, inward: np.ndarray | None = None,
                      memory_at: Callable[[np.ndarray], np.ndarray] | None = None,
-                     accuracy: float = FULL_ACCURACY) -> np.ndarray:
+                     accuracy: float = FULL_ACCURACY, rows: np.ndarray | None = None
+                     ) -> np.ndarray:
     """Q at ``targets`` for the nodal pressure ``q`` on ``panels`` (see the module notes).
 
     ``inward`` (+-1 per target) says from which side m and g are sampled at a jump;
-    ``accuracy`` is the absolute accuracy of the kernel values (default: rounding).
+    ``accuracy`` is the absolute accuracy of the kernel values (default: rounding);
+    ``rows``: F's rows at ``targets`` on ``panels`` if already evaluated
+    (``operator_rows``; one evaluation then serves several pressures on one rule).
     """
     targets = np.asarray(targets, dtype=float)
     side = targets if inward is None else np.clip(targets + 1e-13 * inward, -1.0, 1.0)
-    fq = operator_rows(space.lam, panels, targets, accuracy=accuracy) @ q
+    if rows is None:
+        rows = operator_rows(space.lam, panels, targets, accuracy=accuracy)
+    fq = rows @ q
     memory = 0.0 if memory_at is None else memory_at(targets)
     return (delta + alpha * targets - space.g(side) + memory - step.scale * fq) / (
         step.c * space.m(side))
