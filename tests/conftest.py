@@ -156,8 +156,17 @@ def elastic_dict(**changes: Any) -> dict[str, Any]:
     return d
 
 
+class _Delete:
+    """The type of :data:`DELETE`: its name in test ids is the same in every process (an
+    ``object()`` is named by its address, and the processes of the suite would collect
+    different tests)."""
+
+    def __repr__(self) -> str:
+        return "DELETE"
+
+
 #: The value :func:`edited` reads as "remove the field".
-DELETE = object()
+DELETE = _Delete()
 
 
 def edited(path: str, value: Any, scene: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -236,3 +245,4 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     solving = sys.modules.get("explorer.solving")
     if solving is not None:
         solving.shared_pool().shutdown(wait=False, cancel_futures=True)
+
