@@ -241,7 +241,9 @@ def free_end_residual(space: Space, snapshots: Sequence[_Snapshot], scale: float
     lifting off (e = 0.45, tol 1e-6) q was 2.2e-7 at the reported end, and q's error
     beside it 2.3-2.5e-7 against an estimate of 1.7e-7 (the end 4e-8 from the
     reference's, at a slope of 0.5: 2e-8 of q). Ends at +-1 or at a breakpoint are not
-    free. The snapshots share one panel rule: F's rows at every end are evaluated once."""
+    free. The snapshots share one panel rule: F's rows at every end are evaluated once.
+    A snapshot's ``coupling`` (the other punches' displacement on one of several punches,
+    :mod:`core.contact.coupled_creep`) is part of its pressure formula."""
     found = [(k, end, inward) for k, snap in enumerate(snapshots) for lo, hi in snap.zones
              for end, inward in ((lo, 1.0), (hi, -1.0))
              if not pinned_end(end, space.breakpoints)]
@@ -256,7 +258,8 @@ def free_end_residual(space: Space, snapshots: Sequence[_Snapshot], scale: float
         mine = owner == k
         snap = snapshots[k]
         values = nystrom_pressure(space, snap.step, snap.panels, snap.q, snap.settlement,
-                                  snap.tilt, at[mine], inward[mine], rows=rows[mine])
+                                  snap.tilt, at[mine], inward[mine], snap.coupling,
+                                  rows=rows[mine])
         worst = max(worst, float(np.max(np.abs(values))))
     return worst / scale
 

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 import core
-from core.contact.result import UNILATERAL_MARGIN
 from core.contact.zones import ZONE_END_TOL
 from core.work import work_bound
 from tests.conftest import scene_file
@@ -38,10 +37,15 @@ def _lifting_pair(gap: float, tol: float = 1e-6, count: int = 6) -> dict[str, An
 def test_far_apart_punches_lift_off_under_creep_as_single_punches() -> None:
     d = _lifting_pair(60.0)  # 15 base thicknesses apart
     result = core.solve(d)
-    assert not result.flags and result.info["success"]
     for k, punch in enumerate(result.punches):
         alone = _single(d, k)
         assert punch.info["contact"] == alone.info["contact"] == "unilateral"
+        # The verdict of each alone: at tol 1e-6 both are refused, alone and paired, on
+        # the pressure their own formula gives at their free ends (core.contact.creep.
+        # free_end_residual: 2.5e-7 / 1.7e-7 of the largest q, the estimates 3.7e-7 alone
+        # and 4.7e-7 paired, measured, against tol / 3).
+        assert punch.info["success"] == alone.info["success"]
+        assert punch.flags == alone.flags
         shifted = copy.copy(alone)
         shifted.contact_set = [[(punch.center + lo, punch.center + hi) for lo, hi in zones]
                                for zones in alone.contact_set]
@@ -136,17 +140,17 @@ def test_a_close_pair_lifting_off_under_creep_converges() -> None:
         for mine, best in zip(result.punches, reference.punches, strict=True):
             errors = _errors(mine, best)
             estimate = mine.info["error_estimate"]
-            # measured at 1e-4 and 1e-6 (the zone ends' own budget, 1e-6, sets the same
-            # rule and grids at both), punch 0 / punch 1: settlement 1.5e-8 / 4.0e-8, tilt
-            # 3.0e-8 / 7.1e-8, force and moment 7e-15 (given) against the estimate 1.8e-7;
-            # zone ends 1.2e-7 / 2.5e-8 half-widths against 3.0e-7; q 2.7e-7 / 2.1e-7 of its
-            # largest value, 1.5 times the estimate (which is of the histories: a single
-            # punch's q under creep erred by 2.9 times its estimate, measured on punch 0
-            # of the close pair of tests/scene/test_punches_liftoff.py alone)
+            # measured, punch 0 / punch 1: at 1e-4 settlement 1.5e-8 / 4.0e-8, tilt 3.0e-8 /
+            # 7.1e-8, force and moment 6e-15 (given) against the estimate 1.2e-6; zone ends
+            # 1.2e-7 / 2.5e-8 half-widths against 3.0e-7; q 2.7e-7 / 2.1e-7 of its largest
+            # value. At 1e-6 (finer grids) q 2.7e-8 / 4.1e-9 against 1.6e-7, the rest below
+            # 1e-8. q is within the estimate since the pressure at the free ends counts
+            # in it (core.contact.creep.free_end_residual: 5.0e-7 at 1e-4, 1.1e-7 at 1e-6);
+            # before, q was 1.5 times its estimate of 1.8e-7 at 1e-4.
             for q in QUANTITIES:
                 assert errors[q] <= min(tol, estimate), (tol, q, errors)
             assert errors["ends"] <= min(ZONE_END_TOL, mine.info["zone_end_error"])
-            assert errors["q"] <= UNILATERAL_MARGIN * estimate
+            assert errors["q"] <= estimate
     lifted, right = reference.punches
     # the neighbour's pressure changes the zones at a year (measured): punch 0 from -0.876
     # m alone to -0.783 m, punch 1 from 2.091 m to 2.050 m
