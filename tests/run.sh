@@ -53,6 +53,11 @@ fi
 # installation (rest 18.5-19.9, browser 16.0-17.6, soak 7.5-8.8 min, documentation
 # 4.5-5.3 min) at load average ~4: the whole is bound by the cores' time (the rest alone:
 # 12.6 min; the rest in two halves took as long, the browser part then the longest).
+# Two pytest-xdist workers each for the rest and the browser tests (2026-12-01) took more
+# of the cores' time, 1677 s against ~1390 (each worker imports and warms its own caches,
+# each browser worker serves its own explorer), with the load at ~9; and one Chromium per
+# pytest instead of one per module saved nothing measurable (5 modules: 58.3 against
+# 58.8 s of CPU).
 # The parts share nothing: each has its own temporary directory, pytest cache and served
 # explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
