@@ -31,6 +31,7 @@ largest over the punches), as one march serves all. Zones further apart than
 
 from __future__ import annotations
 
+import dataclasses
 import time as _time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -62,11 +63,12 @@ from core.contact.creep import (
     free_end_residual,
     free_end_slope,
     graded_halvings,
+    output_snapshot,
     transient_windows,
 )
 from core.contact.kinks import Corrected, _contact_parts, _cut_rule, _part_rows, corrected_roots
-from core.contact.march import creep_memory, nodes_in, rule_operator
-from core.contact.result import UnilateralSolution, _Snapshot
+from core.contact.march import creep_memory, kink_correction, nodes_in, rule_operator
+from core.contact.result import UnilateralSolution
 from core.contact.step import Step, check_loads
 from core.contact.unilateral import creep_resolution
 from core.contact.zones import Resolution, zone_kernel_accuracy
@@ -386,6 +388,9 @@ def punch_outputs(run: dict[str, Any]) -> list[dict[str, Any]]:
                                           - row[2][part] for row in rows]),
             "q": np.column_stack([row[0][p].q for row in rows]),
             "c": np.array([row[1][p].c for row in rows]),
+            # the kink corrections (core.contact.march.kink_correction), None where not made
+            "corrections": [None if row[4] is None else kink_correction(row[0][p], row[4][p])
+                            for row in rows],
         })
     return out
 
@@ -428,12 +433,16 @@ def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeI
                  for e in mine["ends"]]
         snapshots = []
         for k in range(times.size):
-            sources = [(r, rules[r], -out[r]["effective"][:, k], None, None)
-                       for r in base.pairs[p]]
-            snapshots.append(_Snapshot(
-                rules[p], mine["effective"][:, k], float(mine["settlement"][k]),
-                float(mine["tilt"][k]), Step(float(mine["c"][k]), 1.0, {}), zones[k],
-                coupling=_coupling(base, p, sources, FULL_ACCURACY) if sources else None))
+            # each punch's pressure as one punch's (kink-corrected where made, see
+            # core.contact.creep.output_snapshot), its neighbours' in its formula the same way
+            own = output_snapshot(rules[p], mine, k, zones[k])
+            sources = []
+            for r in base.pairs[p]:
+                other = output_snapshot(rules[r], out[r], k, [])
+                sources.append((r, rules[r], -other.q, other.cut,
+                                None if other.cut_q is None else -other.cut_q))
+            snapshots.append(dataclasses.replace(
+                own, coupling=_coupling(base, p, sources, FULL_ACCURACY) if sources else None))
         zones_of.append(zones)
         snapshots_of.append(snapshots)
     # q at each punch's own free ends, of its own largest q (as for one punch)

@@ -154,6 +154,9 @@ def _extrapolate(fine: dict[str, Any], coarse: dict[str, Any]) -> dict[str, Any]
                                                         "moment", "effective", "q")}
     out["ends"] = ends
     out["c"] = fine["c"]
+    # The kink correction is spatial, the same on both grids to ~2e-8 (see
+    # _borrow_corrections): the finer grid's serves the extrapolated outputs.
+    out["corrections"] = fine.get("corrections")
     return out
 
 
@@ -258,8 +261,8 @@ def free_end_residual(space: Space, snapshots: Sequence[_Snapshot], scale: float
         mine = owner == k
         snap = snapshots[k]
         values = nystrom_pressure(space, snap.step, snap.panels, snap.q, snap.settlement,
-                                  snap.tilt, at[mine], inward[mine], snap.coupling,
-                                  rows=rows[mine])
+                                  snap.tilt, at[mine], inward[mine],
+                                  snap.displacement(space.lam), rows=rows[mine])
         worst = max(worst, float(np.max(np.abs(values))))
     return worst / scale
 
@@ -270,6 +273,24 @@ def end_tol_for_q(tol: float, slope: float, rest: float = 0.0) -> float:
     half of what the rest of it (``rest``) leaves, at most down to :data:`MIN_END_TOL`."""
     allowed = min(tol / 3.0, 0.5 * (tol - UNILATERAL_MARGIN * rest)) / UNILATERAL_MARGIN
     return max(allowed / slope, MIN_END_TOL)
+
+
+def output_snapshot(base: Panels, out: dict[str, Any], k: int,
+                    zones: list[tuple[float, float]]) -> _Snapshot:
+    """The pressure of output time ``k`` of the outputs ``out`` on the rule ``base``: the
+    kink-corrected solution where the march made the correction (the nodal one
+    extrapolated in time plus the finer grid's correction, which is spatial), so that q
+    vanishes at the free ends it reports; else the nodal one."""
+    effective = out["effective"][:, k]
+    delta, alpha = float(out["settlement"][k]), float(out["tilt"][k])
+    corrections = out.get("corrections")
+    change = None if corrections is None else corrections[k]
+    if change is None or change["effective"].size != effective.size:
+        return _Snapshot(base, effective, delta, alpha, Step(float(out["c"][k]), 1.0, {}),
+                         zones)
+    return _Snapshot(base, effective + change["effective"], delta + change["settlement"],
+                     alpha + change["tilt"], Step(float(out["c"][k]), 1.0, {}), zones,
+                     cut=change["cut"], cut_q=change["cut_effective"])
 
 
 def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.ndarray],
@@ -293,10 +314,7 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     sweeps, steps = run["sweeps"], run["steps"]
     zones = [[(float(e[2 * i]), float(e[2 * i + 1])) for i in range(len(e) // 2)]
              for e in out["ends"]]
-    snapshots = [
-        _Snapshot(base, out["effective"][:, k], float(out["settlement"][k]),
-                  float(out["tilt"][k]), Step(float(out["c"][k]), 1.0, {}), zones[k])
-        for k in range(times.size)]
+    snapshots = [output_snapshot(base, out, k, zones[k]) for k in range(times.size)]
     residual = free_end_residual(space, snapshots, float(np.max(np.abs(out["q"]),
                                                                 initial=0.0)))
     error, end_q_error = error + residual, end_q_error + residual

@@ -21,7 +21,7 @@ import numpy as np
 
 from core.cache import StageCache, fingerprint
 from core.contact.active_set import NoContact, NodalState, nodal_active_set, zones_from_nodes
-from core.contact.kinks import corrected_roots, kinks_corrected
+from core.contact.kinks import Corrected, corrected_roots, kinks_corrected
 from core.contact.memory import pressure_memory
 from core.contact.step import Space, Step, check_loads
 from core.contact.systems import StepSolver
@@ -124,8 +124,8 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         pending += _corrected(space, op, m, g, batch, accuracy)
     if pending:
         roots = corrected_roots(space, [c for _, c in pending], accuracy)
-        for (k, _), ends in zip(pending, roots, strict=True):
-            states[k] = states[k][:3] + (ends, states[k][4])
+        for (k, c), ends in zip(pending, roots, strict=True):
+            states[k] = states[k][:3] + (ends, states[k][4], kink_correction(states[k][0], c))
     return {"states": states, "sweeps": sweeps, "unsettled": unsettled, "steps": steps - 1,
             "breakpoints": space.breakpoints,
             "factorizations": solver.factorizations,
@@ -182,6 +182,30 @@ def _corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
     return [(k, c) for (k, _), c in zip(batch, done, strict=True)]
 
 
+def kink_correction(state: NodalState, corrected: Corrected) -> dict[str, Any] | None:
+    """What the kink-corrected solution of an output time adds to its nodal state
+    (:mod:`core.contact.kinks`), in the terms of :func:`march_outputs`: to the effective
+    density on the rule (``effective``), on the cut parts of the end panels (``cut``,
+    ``cut_effective``), and to the four scalars. The pressure formula with it vanishes at
+    the corrected zone ends; with the nodal state alone it does not quite (the end panel's
+    Gauss rule across the kink). None without a free end."""
+    if not corrected.free:
+        return None
+    panels, scale = state.panels, corrected.step.scale
+    change = corrected.density - state.q  # the end panels' Gauss sums are taken off
+    return {
+        "effective": scale * change,
+        "cut": corrected.cut,
+        "cut_effective": scale * corrected.cut_density,
+        "settlement": corrected.delta - state.settlement,
+        "tilt": corrected.alpha - state.tilt,
+        "force": float(panels.weights @ change + corrected.cut.weights @ corrected.cut_density),
+        "moment": float((panels.weights * panels.nodes) @ change
+                        + (corrected.cut.weights * corrected.cut.nodes)
+                        @ corrected.cut_density),
+    }
+
+
 def march_outputs(run: dict[str, Any]) -> dict[str, Any]:
     """The outputs of one march, with what the pressure needs (all linear in the steps)."""
     states = run["states"]
@@ -198,5 +222,7 @@ def march_outputs(run: dict[str, Any]) -> dict[str, Any]:
         # the pressure at the nodes, for the time estimate of q (grids on one rule)
         "q": np.column_stack([row[0].q for row in states]),
         "c": np.array([row[1].c for row in states]),
+        # the kink corrections (kink_correction), None where not made
+        "corrections": [row[5] if len(row) > 5 else None for row in states],
     }
 

@@ -36,6 +36,31 @@ class _Snapshot:
     memory: np.ndarray | None = None  # creep memory density at the nodes (F of it is e(x))
     # the displacement e(x) the other punches on the base add (core.contact.coupled)
     coupling: Callable[[np.ndarray], np.ndarray] | None = None
+    # the contact parts of the panels holding a free end, each one Gauss panel, and the
+    # density on them that goes with ``q`` (core.contact.march.kink_correction): q on those
+    # panels is the kink-corrected pressure, cut at the zone's end
+    cut: Panels | None = None
+    cut_q: np.ndarray | None = None
+
+    def displacement(self, lam: float) -> Callable[[np.ndarray], np.ndarray] | None:
+        """What the pressure formula adds to ``delta + alpha x - g - F(q)`` besides the
+        rule's own density, as a function of x: the creep memory's e(x), the other
+        punches' (``coupling``) and F of the cut parts' density (taken off); None when
+        nothing."""
+        parts: list[Callable[[np.ndarray], np.ndarray]] = []
+        if self.coupling is not None:
+            parts.append(self.coupling)
+        if self.memory is not None or (self.cut is not None and self.cut.n_panels):
+            from core.discretize import operator_rows
+
+            if self.memory is not None:
+                parts.append(lambda t: operator_rows(lam, self.panels, t) @ self.memory)
+            if self.cut is not None and self.cut.n_panels:
+                parts.append(lambda t: -self.step.scale * (operator_rows(lam, self.cut, t)
+                                                           @ self.cut_q))
+        if not parts:
+            return None
+        return lambda t: sum(part(np.asarray(t, dtype=float)) for part in parts)
 
 
 # repr=False: the short repr of SolveOutcome, not every array and snapshot
@@ -104,6 +129,10 @@ class UnilateralSolution(SolveOutcome):
             rows = operator_rows(self._space.lam, snaps[0].panels, xi,
                                  accuracy=self._kernel_accuracy)
             fq = rows @ np.column_stack([snap.q for snap in snaps])
+            for j, snap in enumerate(snaps):
+                if snap.cut is not None and snap.cut.n_panels:
+                    fq[:, j] += operator_rows(self._space.lam, snap.cut, xi,
+                                              accuracy=self._kernel_accuracy) @ snap.cut_q
             delta, alpha, scale, c = (np.array(v, dtype=float)[None, :] for v in zip(
                 *((snap.settlement, snap.tilt, snap.step.scale, snap.step.c)
                   for snap in snaps), strict=True))
@@ -119,13 +148,8 @@ class UnilateralSolution(SolveOutcome):
         return out
 
     def _pressure_one(self, snap: _Snapshot, xi: np.ndarray) -> np.ndarray:
-        memory_at = snap.coupling
+        memory_at = snap.displacement(self._space.lam)
         accuracy = FULL_ACCURACY if snap.coupling is None else self._kernel_accuracy
-        if snap.memory is not None:
-            from core.discretize import operator_rows
-
-            def memory_at(t, _v=snap.memory, _p=snap.panels):
-                return operator_rows(self._space.lam, _p, t) @ _v
         # Sample m and g from inside the zone at its ends (they may jump there).
         inward = np.zeros(xi.size)
         for lo, hi in snap.zones:

@@ -8,7 +8,7 @@ decay times long, so the halved grids were outside their asymptotic range. March
 contact (the exact answer is the modal one), the settlement's error fell 7.6, 6.4, 4.7,
 2.9, 1.3 (x1e-7, of 7.4e-5) over grids of 18 to 273 points; Richardson's estimate read
 3.0e-4 against an error of 1.8e-3 (relative). Once those points met tol, one that lifts off
-showed q not vanishing at its own reported free end (``free_end_residual``).
+showed q not vanishing at its own reported free end (``free_end_residual``); it does now.
 """
 
 from __future__ import annotations
@@ -85,13 +85,16 @@ def test_each_rate_is_stepped_finely_while_its_decay_lasts() -> None:
     assert transient_windows(lambda t, tau: 0.0 * t, times, (), 1e-6) == ()
 
 
-def test_the_pressure_at_a_free_end_is_within_the_estimate() -> None:
-    # A stiff coat lifting off at e = 0.5 m: q at the reported zone end should vanish; what
-    # the answer's own pressure formula gives there is q's error beside the end, and the
-    # estimate must hold it (core.contact.creep.free_end_residual). Measured: q there 2.1e-6
-    # of the largest q, the estimate 2.2e-6, q's error against a reference refined beyond
-    # the solver's limits (tol 1e-9, six halvings, bands to 0.00125) 2.3e-6 at x = -0.921 m,
-    # so refused at tol 1e-6; before, a success with an estimate of 1.8e-7.
+def test_the_pressure_vanishes_at_the_free_ends_it_reports() -> None:
+    # A stiff coat lifting off at e = 0.5 m: q at the reported zone end vanishes, q on the
+    # panel holding it being the kink-corrected pressure cut there
+    # (core.contact.march.kink_correction); what the answer's pressure formula gives at its
+    # end is part of the estimate (core.contact.creep.free_end_residual). Measured against
+    # a reference refined beyond the solver's limits (tol 1e-9, six halvings, bands to
+    # 0.00125): q 1.5e-7 off beside the free end, 4.8e-7 at x = +1 m (the pinned edge;
+    # within UNILATERAL_MARGIN of the estimate 2.1e-7), settlement and tilt 6.6e-8 and
+    # 6.7e-8. With q taken on the end panel's Gauss rule across the kink, q at the end was
+    # 2.0e-6 of the largest, 2.3e-6 off beside it, and the answer was refused.
     answer = _design_point(4e5)
     assert answer.info["contact"] == "unilateral"
     (start, _), = answer.contact_set[-1]
@@ -99,6 +102,9 @@ def test_the_pressure_at_a_free_end_is_within_the_estimate() -> None:
     scale = float(np.max(answer.pressure(np.linspace(-1.0, 1.0, 2001))))
     at_ends = [float(answer.pressure([zones[0][0]])[0, k]) / scale
                for k, zones in enumerate(answer.contact_set)]
+    # measured 5.4e-9 and 0 (the first time's end is the extrapolated one, the cut the
+    # finer grid's: ~1e-8 apart)
+    assert max(at_ends) <= 1e-8
     assert max(at_ends) <= answer.info["zone_end_pressure_error"] <= answer.info[
         "error_estimate"]
-    assert not answer.info["success"] and "tol_not_met" in answer.info["flags"]
+    assert answer.info["success"] and not answer.info["flags"]
