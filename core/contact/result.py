@@ -129,10 +129,21 @@ class UnilateralSolution(SolveOutcome):
             rows = operator_rows(self._space.lam, snaps[0].panels, xi,
                                  accuracy=self._kernel_accuracy)
             fq = rows @ np.column_stack([snap.q for snap in snaps])
-            for j, snap in enumerate(snaps):
-                if snap.cut is not None and snap.cut.n_panels:
-                    fq[:, j] += operator_rows(self._space.lam, snap.cut, xi,
-                                              accuracy=self._kernel_accuracy) @ snap.cut_q
+            cut = [j for j, snap in enumerate(snaps) if snap.cut is not None
+                   and snap.cut.n_panels]
+            if cut:
+                # every cut part of every time in one evaluation (one per time: 10x slower)
+                parts = [snaps[j].cut for j in cut]
+                joined = Panels(*(np.concatenate([getattr(p, name) for p in parts])
+                                  for name in ("edges", "nodes", "weights", "centers",
+                                               "half_widths")))
+                cut_rows = operator_rows(self._space.lam, joined, xi,
+                                         accuracy=self._kernel_accuracy)
+                start = 0
+                for j, part in zip(cut, parts, strict=True):
+                    stop = start + part.nodes.size
+                    fq[:, j] += cut_rows[:, start:stop] @ snaps[j].cut_q
+                    start = stop
             delta, alpha, scale, c = (np.array(v, dtype=float)[None, :] for v in zip(
                 *((snap.settlement, snap.tilt, snap.step.scale, snap.step.c)
                   for snap in snaps), strict=True))
