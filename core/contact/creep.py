@@ -154,8 +154,10 @@ def _extrapolate(fine: dict[str, Any], coarse: dict[str, Any]) -> dict[str, Any]
                                                         "moment", "effective", "q")}
     out["ends"] = ends
     out["c"] = fine["c"]
-    # The kink correction is spatial, the same on both grids to ~2e-8 (see
-    # _borrow_corrections): the finer grid's serves the extrapolated outputs.
+    # The kink correction is spatial: the finer grid's serves the extrapolated outputs, as
+    # its end shifts serve the coarser grid's ends (_borrow_corrections, where those shifts
+    # were measured the same on both grids to ~2e-8). The pressure it leaves at the
+    # extrapolated ends is measured (free_end_residual): ~1e-8 of the largest q.
     out["corrections"] = fine.get("corrections")
     return out
 
@@ -235,18 +237,18 @@ def free_end_residual(space: Space, snapshots: Sequence[_Snapshot], scale: float
     """The largest pressure the answer's own formula gives at its free zone ends over the
     output times, relative to ``scale`` (the largest |q|) [-].
 
-    q vanishes at a free end, but the ends reported are the roots of the kink-corrected
-    pressure (:mod:`core.contact.kinks`: the end panel cut at the end and integrated
-    exactly), while q is evaluated with the end panel's Gauss rule, so it steps up from 0
-    at a reported end; that step is q's error beside the end, on top of what the end's own
-    error makes (:func:`free_end_slope`). It is spatial: the same on every time grid,
-    plain or extrapolated. Found by ``benchmarks/creep_honesty.py``: on the aging base
-    lifting off (e = 0.45, tol 1e-6) q was 2.2e-7 at the reported end, and q's error
-    beside it 2.3-2.5e-7 against an estimate of 1.7e-7 (the end 4e-8 from the
-    reference's, at a slope of 0.5: 2e-8 of q). Ends at +-1 or at a breakpoint are not
-    free. The snapshots share one panel rule: F's rows at every end are evaluated once.
+    q vanishes at a free end. The ends reported are the roots of the kink-corrected
+    pressure (:mod:`core.contact.kinks`), extrapolated in time, and q on the panels holding
+    them is that corrected pressure from the finer time grid (:func:`output_snapshot`), cut
+    at that grid's nodal end and given by the formula beyond it: what is left at a reported
+    end is the two ends' difference times q's slope, ~1e-8 of the largest q (measured on
+    the scenes of ``benchmarks/creep_honesty.py``). It is q's error beside the end on top of
+    what the end's own error makes (:func:`free_end_slope`). With q on the end panel's
+    Gauss rule across the kink it was 2.2e-7 on the aging base lifting off (e = 0.45, tol
+    1e-6) and 2.0e-6 on the design chart's stiff coat. Ends at +-1 or at a breakpoint are
+    not free. The snapshots share one panel rule: F's rows at every end are evaluated once.
     A snapshot's ``coupling`` (the other punches' displacement on one of several punches,
-    :mod:`core.contact.coupled_creep`) is part of its pressure formula."""
+    :mod:`core.contact.coupled_creep`) and its cut parts are part of its formula."""
     found = [(k, end, inward) for k, snap in enumerate(snapshots) for lo, hi in snap.zones
              for end, inward in ((lo, 1.0), (hi, -1.0))
              if not pinned_end(end, space.breakpoints)]
@@ -285,12 +287,13 @@ def output_snapshot(base: Panels, out: dict[str, Any], k: int,
     delta, alpha = float(out["settlement"][k]), float(out["tilt"][k])
     corrections = out.get("corrections")
     change = None if corrections is None else corrections[k]
-    if change is None or change["effective"].size != effective.size:
+    if change is None:
         return _Snapshot(base, effective, delta, alpha, Step(float(out["c"][k]), 1.0, {}),
                          zones)
+    cut = change["cut"] if change["cut"].n_panels else None
     return _Snapshot(base, effective + change["effective"], delta + change["settlement"],
                      alpha + change["tilt"], Step(float(out["c"][k]), 1.0, {}), zones,
-                     cut=change["cut"], cut_q=change["cut_effective"])
+                     cut=cut, cut_q=None if cut is None else change["cut_effective"])
 
 
 def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.ndarray],

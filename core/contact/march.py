@@ -74,8 +74,8 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
     memory_of = creep_memory(inp.kernel, grid, widths, n_nodes)
     wanted = {int(i): k for k, i in enumerate(out_index)}
     # per output time: the state, its step, the memory density, the ends, the nodal ends
-    states: list[tuple[NodalState, Step, np.ndarray, list[float], list[float]]] = (
-        [None] * len(out_index))  # type: ignore
+    # and, once corrected, the kink correction (kink_correction)
+    states: list[tuple] = [None] * len(out_index)  # type: ignore
     active = None
     solver = StepSolver()
     pending: list[tuple[int, Any]] = []
@@ -182,27 +182,23 @@ def _corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
     return [(k, c) for (k, _), c in zip(batch, done, strict=True)]
 
 
-def kink_correction(state: NodalState, corrected: Corrected) -> dict[str, Any] | None:
+def kink_correction(state: NodalState, corrected: Corrected) -> dict[str, Any]:
     """What the kink-corrected solution of an output time adds to its nodal state
     (:mod:`core.contact.kinks`), in the terms of :func:`march_outputs`: to the effective
-    density on the rule (``effective``), on the cut parts of the end panels (``cut``,
-    ``cut_effective``), and to the four scalars. The pressure formula with it vanishes at
-    the corrected zone ends; with the nodal state alone it does not quite (the end panel's
-    Gauss rule across the kink). None without a free end."""
-    if not corrected.free:
-        return None
-    panels, scale = state.panels, corrected.step.scale
-    change = corrected.density - state.q  # the end panels' Gauss sums are taken off
+    density on the rule (``effective``), the density on the cut parts of the end panels
+    (``cut``, ``cut_effective``; none without a free end) and to the settlement and tilt.
+    The pressure formula with it vanishes at the corrected zone ends; with the nodal state
+    alone it does not quite (the end panel's Gauss rule across the kink). A punch of several
+    whose own ends are all pinned still has one where a neighbour's were corrected (the
+    coupled solve moves its density too); for one punch it is then zero."""
+    scale = corrected.step.scale
     return {
-        "effective": scale * change,
+        # the end panels' Gauss sums of the nodal q are taken off in ``density``
+        "effective": scale * (corrected.density - state.q),
         "cut": corrected.cut,
         "cut_effective": scale * corrected.cut_density,
         "settlement": corrected.delta - state.settlement,
         "tilt": corrected.alpha - state.tilt,
-        "force": float(panels.weights @ change + corrected.cut.weights @ corrected.cut_density),
-        "moment": float((panels.weights * panels.nodes) @ change
-                        + (corrected.cut.weights * corrected.cut.nodes)
-                        @ corrected.cut_density),
     }
 
 

@@ -38,15 +38,16 @@ class _Snapshot:
     coupling: Callable[[np.ndarray], np.ndarray] | None = None
     # the contact parts of the panels holding a free end, each one Gauss panel, and the
     # density on them that goes with ``q`` (core.contact.march.kink_correction): q on those
-    # panels is the kink-corrected pressure, cut at the zone's end
+    # panels is the kink-corrected pressure, cut at the nodal end (the interpolant's root;
+    # the formula gives q beyond it, up to the zone's reported end)
     cut: Panels | None = None
     cut_q: np.ndarray | None = None
 
     def displacement(self, lam: float) -> Callable[[np.ndarray], np.ndarray] | None:
-        """What the pressure formula adds to ``delta + alpha x - g - F(q)`` besides the
+        """What the pressure formula adds to ``delta + alpha x - g - s F(q)`` besides the
         rule's own density, as a function of x: the creep memory's e(x), the other
-        punches' (``coupling``) and F of the cut parts' density (taken off); None when
-        nothing."""
+        punches' (``coupling``) and ``s F`` of the cut parts' density (taken off); None
+        when nothing."""
         parts: list[Callable[[np.ndarray], np.ndarray]] = []
         if self.coupling is not None:
             parts.append(self.coupling)
