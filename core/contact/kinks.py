@@ -218,7 +218,7 @@ def kinks_corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
     # one evaluation: every node against every step's cut parts (near-field weights only
     # for each step's own; the other columns are never read)
     bounds = np.cumsum([0] + [c.nodes.size for c in cuts])
-    rows_all = _part_rows(space.lam, _join(cuts), panels.nodes, accuracy=accuracy)
+    rows_all = _part_rows(space.lam, Panels.side_by_side(cuts), panels.nodes, accuracy=accuracy)
     for k, (step, state, memory, memory_density, solver, ends, free, idx, parts, cut,
             values) in enumerate(prepared):
         if not free:
@@ -278,7 +278,7 @@ def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL
     cut_owner = np.concatenate([np.full(c.nodes.size, s) for s, c in enumerate(cuts)])
     panel_owner = cut_owner[::NODES_PER_PANEL]
     cut_density = np.concatenate([c.cut_density for c in steps])
-    joined_cuts = _join(cuts)
+    joined_cuts = Panels.side_by_side(cuts)
     density = np.stack([c.density for c in steps])[owner]  # (ends, N)
     memory = None
     if any(c.memory_density is not None for c in steps):
@@ -356,21 +356,10 @@ def _cut_rule(panels: Panels, state: NodalState,
     """One Gauss panel on every contact part, and there the values of the interpolant of
     the nodal Q of its panel (the pressure cut at its root)."""
     pieces = [(p, lo, hi) for p, spans in parts.items() for lo, hi in spans]
-    rule = _join([Panels.from_edges(np.array([lo, hi])) for _, lo, hi in pieces])
+    rule = Panels.side_by_side([Panels.from_edges(np.array([lo, hi])) for _, lo, hi in pieces])
     values = np.concatenate([
         _interpolation(panels.centers[p], panels.half_widths[p],
                        rule.nodes[k * NODES_PER_PANEL:(k + 1) * NODES_PER_PANEL])
         @ state.nystrom[p * NODES_PER_PANEL:(p + 1) * NODES_PER_PANEL]
         for k, (p, _, _) in enumerate(pieces)]) if pieces else np.zeros(0)
     return rule, values
-
-
-def _join(rules: list[Panels]) -> Panels:
-    """Panels side by side as one rule (they need not touch; ``edges`` unused)."""
-    if not rules:
-        return Panels(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0))
-    return Panels(np.concatenate([r.edges for r in rules]),
-                  np.concatenate([r.nodes for r in rules]),
-                  np.concatenate([r.weights for r in rules]),
-                  np.concatenate([r.centers for r in rules]),
-                  np.concatenate([r.half_widths for r in rules]))

@@ -135,9 +135,7 @@ class UnilateralSolution(SolveOutcome):
             if cut:
                 # every cut part of every time in one evaluation (one per time: 10x slower)
                 parts = [snaps[j].cut for j in cut]
-                joined = Panels(*(np.concatenate([getattr(p, name) for p in parts])
-                                  for name in ("edges", "nodes", "weights", "centers",
-                                               "half_widths")))
+                joined = Panels.side_by_side(parts)
                 cut_rows = operator_rows(self._space.lam, joined, xi,
                                          accuracy=self._kernel_accuracy)
                 start = 0

@@ -60,6 +60,15 @@ class Panels:
         weights = (half[:, None] * GAUSS_WEIGHTS[None, :]).ravel()
         return cls(edges, nodes, weights, centers, half)
 
+    @classmethod
+    def side_by_side(cls, rules: Sequence[Panels]) -> Panels:
+        """``rules`` as one rule, their panels in the order given (they need not touch nor
+        be sorted: ``edges`` are then only the rules' edges one after the other)."""
+        if not rules:
+            return cls(*(np.zeros(0) for _ in range(5)))
+        return cls(*(np.concatenate([getattr(rule, name) for rule in rules])
+                     for name in ("edges", "nodes", "weights", "centers", "half_widths")))
+
     def integrate(self, values: np.ndarray) -> np.ndarray:
         """Integral over [-1, 1] of node values (first axis), by the composite rule."""
         return np.tensordot(self.weights, values, axes=(0, 0))
