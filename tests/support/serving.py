@@ -123,7 +123,10 @@ class ExplorerProcess:
         self.ready_timeout = ready_timeout
         self.stop_timeout = stop_timeout
         self._installed = program is not None
-        self.command = [*(program or (sys.executable, "-m", "explorer")), "--port", str(self.port)]
+        # --exit-with-parent: a test run killed with no time to clean up (SIGTERM to
+        # pytest, a CI timeout) takes its servers with it
+        self.command = [*(program or (sys.executable, "-m", "explorer")), "--port",
+                        str(self.port), "--exit-with-parent"]
         if host != "localhost":
             self.command += ["--address", host,
                              "--allow-websocket-origin", f"{host}:{self.port}"]
