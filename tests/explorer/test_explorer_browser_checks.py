@@ -69,7 +69,7 @@ def test_time_slider_range_follows_a_preset_switch(page: Page):
     assert _player_range(page)["max"] == "39"
     _choose_preset(page, "eccentric_creep", "Eccentric")
     # the new range first, its value a turn of the server's loop later (results.py,
-    # _replace_player): read at once after the range, the value was still 0 under load
+    # _set_range): read at once after the range, the value was still 0 under load
     until(lambda: _player_range(page) == {"min": "0", "max": "59", "value": "59"},
           "the slider at the last of 60 times", 60, lambda: _player_range(page))
     # the first time, then the last, land where they say
@@ -87,6 +87,14 @@ def test_time_slider_range_follows_a_preset_switch(page: Page):
     until(lambda: _player_range(page) == {"min": "0", "max": "199", "value": "199"},
           "the slider at the last of 200 times", 60, lambda: _player_range(page))
     assert "50.0 years" in page.text(".time-label")
+    # a new range whose last time is the index the slider holds: the page's slider sets
+    # its range only when its value changes (the player is moved to a neighbour and back)
+    slider.fill("59")
+    until(lambda: _player_range(page)["value"] == "59", "the handle at 59 of 199")
+    _choose_preset(page, "eccentric_creep", "Eccentric")
+    until(lambda: _player_range(page) == {"min": "0", "max": "59", "value": "59"},
+          "the slider at the last of 60 times", 60, lambda: _player_range(page))
+    until(lambda: "t = 1000 days" in page.text(".time-label"), "t = 1000")
     assert page.errors == []
 
 
