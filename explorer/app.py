@@ -111,8 +111,7 @@ class ExplorerApp(pn.viewable.Viewer):
         # model fidelity (layer interface, contact model, coating-model tolerance): one
         # view whose widgets sit in the Coating and Time tabs
         self.fidelity = FidelityView(self.state, self.screen.reject)
-        self.views = self._build_sidebar()
-        self._layout = self._build_layout()
+        self._layout = self._build_layout(self._build_sidebar())
         self._wanted_index, tab, pin_scenes, pin_message = read_view_query(
             query or {}, len(self.sidebar))
         if tab:
@@ -155,29 +154,66 @@ class ExplorerApp(pn.viewable.Viewer):
             self.results.status.object = status_html(None, True)
         self._initializing = False
 
-    def _build_sidebar(self) -> list[Any]:
-        """The sidebar's tabs, in their order on the page (each view with a ``title`` and
-        a ``content()`` column). The index of a tab is part of the page's links
-        (``explorer.model.view_link``): a new tab is appended, never inserted."""
+    def _build_sidebar(self) -> list[tuple[str, Any]]:
+        """The sidebar's tabs, in their order on the page: each its title and its view's
+        column, or the function that makes the view and its column. The index of a tab is
+        part of the page's links (``explorer.model.view_link``): a new tab is appended,
+        never inserted.
+
+        The Scene, Check, Files and Lessons views are made at once (the others' results
+        reach them, and they cost ~40 ms together); the other six only when their tab is
+        filled on a served page (:class:`~explorer.views.DeferredTabs`), or when asked for
+        (``app.base_tab``): they are ~0.6-0.9 s of the ~2 s of the server's CPU that a new
+        page cost, and a page may never show them."""
         state, screen, controller, loop = self.state, self.screen, self.controller, self.loop
         live = self._drag_step_applies
-        self.scene_tab = SceneView(state, self.presets, self.preset_key, self.history,
-                                   self.load_scene, controller, screen.reject)
-        self.punch_tab = PunchView(state, screen, live)
-        self.coating_tab = CoatingView(state, self.fidelity, controller, loop, live,
-                                       screen)
-        self.base_tab = BaseView(state, screen.reject, live)
-        self.times_tab = TimesView(state, self.fidelity, screen.reject, live)
-        self.check_tab = CheckView(state, self.limits, screen)
-        self.files_tab = FilesView(state, screen, controller, self.scales, self.limits,
-                                   self._load_file, self.results.show_download_error)
-        self.lessons_tab = LessonsView(self.pins, self.results.log_time, self.load_scene)
-        self.study_tab = StudyView(state, controller, loop, self.link.schedule)
-        self.fit_tab = FitView(state, controller, loop, self.figures, self.load_scene, screen,
-                               on_settings=self.link.schedule)
-        return [self.scene_tab, self.punch_tab, self.coating_tab, self.base_tab,
-                self.times_tab, self.check_tab, self.files_tab, self.lessons_tab,
-                self.study_tab, self.fit_tab]
+        self._views: dict[str, Any] = {}
+        self._makers: dict[str, Callable[[], Any]] = {
+            "punch": lambda: PunchView(state, screen, live),
+            "coating": lambda: CoatingView(state, self.fidelity, controller, loop, live,
+                                           screen),
+            "base": lambda: BaseView(state, screen.reject, live),
+            "times": lambda: TimesView(state, self.fidelity, screen.reject, live),
+            "study": lambda: StudyView(state, controller, loop, self.link.schedule),
+            "fit": lambda: FitView(state, controller, loop, self.figures, self.load_scene,
+                                   screen, on_settings=self.link.schedule),
+        }
+        self._views["scene"] = SceneView(state, self.presets, self.preset_key, self.history,
+                                         self.load_scene, controller, screen.reject)
+        self._views["check"] = CheckView(state, self.limits, screen)
+        self._views["files"] = FilesView(state, screen, controller, self.scales, self.limits,
+                                         self._load_file, self.results.show_download_error)
+        self._views["lessons"] = LessonsView(self.pins, self.results.log_time,
+                                             self.load_scene)
+        order = (("scene", SceneView), ("punch", PunchView), ("coating", CoatingView),
+                 ("base", BaseView), ("times", TimesView), ("check", CheckView),
+                 ("files", FilesView), ("lessons", LessonsView), ("study", StudyView),
+                 ("fit", FitView))
+        return [(cls.title, self._views[name].content() if name in self._views
+                 else (lambda name=name: self._view(name).content()))
+                for name, cls in order]
+
+    def _view(self, name: str) -> Any:
+        """The view of sidebar tab ``name``, made now if it was not yet."""
+        view = self._views.get(name)
+        if view is None:
+            view = self._views[name] = self._makers[name]()
+        return view
+
+    def _made(self, name: str) -> Any | None:
+        """The view of sidebar tab ``name`` if it was made, else None."""
+        return self._views.get(name)
+
+    scene_tab = property(lambda self: self._view("scene"), doc="The Scene tab's view.")
+    punch_tab = property(lambda self: self._view("punch"), doc="The Punch tab's view.")
+    coating_tab = property(lambda self: self._view("coating"), doc="The Coating tab's view.")
+    base_tab = property(lambda self: self._view("base"), doc="The Base tab's view.")
+    times_tab = property(lambda self: self._view("times"), doc="The Time tab's view.")
+    check_tab = property(lambda self: self._view("check"), doc="The Check tab's view.")
+    files_tab = property(lambda self: self._view("files"), doc="The Files tab's view.")
+    lessons_tab = property(lambda self: self._view("lessons"), doc="The Lessons tab's view.")
+    study_tab = property(lambda self: self._view("study"), doc="The Study tab's view.")
+    fit_tab = property(lambda self: self._view("fit"), doc="The Fit tab's view.")
 
     def page_parts(self) -> list[Any]:
         """Every viewable of the page: the layout and the sidebar tabs not filled yet."""
@@ -236,9 +272,8 @@ class ExplorerApp(pn.viewable.Viewer):
         return fast
 
     # -- layout ----------------------------------------------------------------------
-    def _build_layout(self) -> pn.viewable.Viewable:
-        self.tabs = DeferredTabs(self.loop,
-                                 [(view.title, view.content()) for view in self.views])
+    def _build_layout(self, tabs: list[tuple[str, Any]]) -> pn.viewable.Viewable:
+        self.tabs = DeferredTabs(self.loop, tabs)
         sidebar = self.tabs.sidebar
         sidebar.param.watch(lambda e: self.link.schedule(), "active")
         self.sidebar = sidebar
@@ -304,8 +339,11 @@ class ExplorerApp(pn.viewable.Viewer):
                                    dict[str, Any] | None]:
         """What a link keeps besides the scene and the time: the open tab, the pinned
         scenes, the Study tab's settings and the Fit tab's readings and fields."""
+        # (a tab never made has nothing of its own to keep: its defaults follow the scene)
+        study, fit = self._made("study"), self._made("fit")
         return (self.sidebar.active, self.pins.board.scenes(),
-                self.study_tab.study_settings(), self.fit_tab.fit_settings())
+                None if study is None else study.study_settings(),
+                None if fit is None else fit.fit_settings())
 
     def _on_pins(self) -> None:
         self.results.show_pins()

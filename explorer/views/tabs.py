@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import panel as pn
 
 from ..fixes import gc_policy
 from .loop import PageLoop
+from .style import TAB_COLUMN
 
 #: How long a page must be left alone before the sidebar tabs not yet opened are filled in
 #: the background [ms] (see DeferredTabs.fill_idle). Filling them costs ~1.8 s of the
@@ -38,16 +40,35 @@ class DeferredTabs:
     That is a fifth of the widget models, 0.4 s less to the first paint; another tab gets
     its widgets when first opened, or once the page has been left alone for
     :data:`FILL_TABS_AFTER_MS`, and keeps them. Panel's dynamic tabs would rebuild a tab at
-    every switch: measured 110 ms of server time each, which made 20 sessions 8x slower."""
+    every switch: measured 110 ms of server time each, which made 20 sessions 8x slower.
 
-    def __init__(self, loop: PageLoop, tabs: list[tuple[str, pn.Column]]) -> None:
+    A tab is given as its column, or as a function that makes it: a served page calls
+    that function when the tab is filled, so the view behind it (its widgets and their
+    watchers) is not even made for a page that never shows it (see
+    ``explorer.app.ExplorerApp``); elsewhere (a notebook, a script) every tab is made at
+    once."""
+
+    def __init__(self, loop: PageLoop,
+                 tabs: list[tuple[str, pn.Column | Callable[[], pn.Column]]]) -> None:
         self.loop = loop
         self.used = False  # the page was used since the background filling was scheduled
-        self.deferred: dict[int, tuple[pn.Column, list[Any]]] = {}
+        # a tab not filled yet: its column, and its widgets (made, not shown yet) or the
+        # function that makes its column
+        self.deferred: dict[int, tuple[pn.Column, list[Any] | Callable[[], pn.Column]]] = {}
+        columns = []
         for k, (_title, content) in enumerate(tabs):
-            if k and loop.served:
-                self.deferred[k] = (content, list(content.objects))
-                content.objects = []
+            if not (k and loop.served):
+                column = content if isinstance(content, pn.Column) else content()
+            elif isinstance(content, pn.Column):
+                column = content
+                self.deferred[k] = (column, list(column.objects))
+                column.objects = []
+            else:
+                # (the views' columns all share these options: the tab's column is the same)
+                column = pn.Column(**TAB_COLUMN)
+                self.deferred[k] = (column, content)
+            columns.append(column)
+        tabs = [(title, column) for (title, _), column in zip(tabs, columns, strict=True)]
         # the tab titles wrap onto a second line: in one line the last tabs were out of
         # reach at 1024 px (presentation mode) and behind the first ones' width at 1400
         self.sidebar = pn.Tabs(*tabs, dynamic=False, width=SIDEBAR_WIDTH, margin=(0, 10, 0, 0),
@@ -70,7 +91,7 @@ class DeferredTabs:
         content = self.deferred.pop(index, None)
         if content is not None:
             column, objects = content
-            column.objects = objects
+            column.objects = objects if isinstance(objects, list) else objects().objects
             if not self.deferred:
                 self._complete()
 
@@ -83,8 +104,10 @@ class DeferredTabs:
         gc_policy.page_built(getattr(self.loop.doc, "session_context", None))
 
     def parts(self) -> list[Any]:
-        """The widgets of the tabs not filled yet (part of the page all the same)."""
-        return [obj for _, objects in self.deferred.values() for obj in objects]
+        """The widgets of the tabs not filled yet that exist (made, not shown yet: part of
+        the page all the same)."""
+        return [obj for _, objects in self.deferred.values() if isinstance(objects, list)
+                for obj in objects]
 
     def fill_when_idle(self) -> None:
         """Start the background filling (:meth:`fill_idle`) once the page has been left

@@ -422,3 +422,32 @@ async def _pause() -> bool:
     from explorer.fixes import gc_policy
 
     return gc_policy.pause_for_page()
+
+
+def test_a_served_page_makes_a_tab_s_view_only_when_the_tab_is_filled(monkeypatch,
+                                                                      explorer_app) -> None:
+    """The Punch, Coating, Base, Time, Study and Fit views (~0.6-0.9 s of the server's
+    CPU per page, of ~2 s) are made when their tab is filled, from the scene as it is
+    then; a link keeps no settings of a Study or Fit tab never made."""
+    from explorer.model import presets
+
+    monkeypatch.setattr(PageLoop, "served", property(lambda self: True))
+    app = explorer_app()
+    lazy = {"punch", "coating", "base", "times", "study", "fit"}
+    assert set(app._views) == {"scene", "check", "files", "lessons"}
+    assert app._view_parts()[2:] == (None, None)
+    # a scene shown before the tab is opened: its view starts from it
+    scene = presets()["eccentric_creep"]
+    assert app.load_scene(scene)
+    assert app.state.base.thickness != presets()["uniform_flat"]["base"]["thickness"]
+    base_index = 3  # Scene, Punch, Coating, Base, ...: the order is part of the links
+    app.sidebar.active = base_index
+    assert "base" in app._views and app.base_tab.base_thickness.value == pytest.approx(
+        app.state.base.thickness)
+    assert app.tabs.sidebar[base_index].objects  # its widgets on the page
+    assert set(app._views) & lazy == {"base"}
+    # the others once filled (the page left alone)
+    for index in list(app.tabs.deferred):
+        app.tabs.fill(index)
+    assert set(app._views) == lazy | {"scene", "check", "files", "lessons"}
+    assert app._view_parts()[2] is not None  # the Study tab's settings, now made
