@@ -14,6 +14,7 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
   defaults it reads (each change of the page's shape walks every model).
 - ``property_defaults``: Bokeh's property defaults and type names worked out once per
   class, not per new model.
+- ``patch_refs``: Bokeh's patch messages written without listing every model of the page.
 """
 
 from . import (
@@ -23,16 +24,18 @@ from . import (
     idle_painter,
     model_walk,
     panel_fixes,
+    patch_refs,
     property_defaults,
 )
 
 __all__ = ["bokeh_fixes", "closed_pages", "gc_policy", "idle_painter", "install_in_process",
-           "model_walk", "panel_fixes", "property_defaults"]
+           "model_walk", "panel_fixes", "patch_refs", "property_defaults"]
 
 
 def install_in_process() -> None:
     """Install the fixes that hold for the whole process (not per page): Panel's queued
-    messages, Bokeh's model walk and its property defaults."""
+    messages, Bokeh's model walk, its property defaults and its patch messages."""
     panel_fixes.install()
     model_walk.install()
     property_defaults.install()
+    patch_refs.install()
