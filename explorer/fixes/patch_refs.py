@@ -8,7 +8,8 @@ of every model of the document the page has been sent and a dict of a reference 
 page's models, for every message, however small. The explorer's page has ~700-960 models
 with its sidebar tabs filled, and a load step or a preset switch sends many messages.
 Measured in Chromium on the served explorer (the server process's CPU time): a load step
-of the default scene 71-80 -> 66-67 ms, a preset switch 250 -> 170 ms (medians of 10).
+of the default scene 71-80 -> 66-67 ms (mean of 30 key steps, two runs each), a preset
+switch 250 -> 170 ms (median of 10).
 
 Here the message's serializer asks the document, model by model, whether the page has
 a model (the same test ``synced_references`` applies: in the document, not new), when
