@@ -143,6 +143,10 @@ def measure_slider(page, tab: str, css: str, presses: int, key: str,
     if handle is None:
         handle = page.locator(f"{css} .noUi-handle").first
     handle.focus()
+    # resolved once: a locator is looked up again at each press, through every shadow root
+    # of the page (~30 ms of the page's main thread on the complete page, which the page's
+    # CPU per step then counted)
+    handle = handle.element_handle()
     out, solves = [], []
     for _ in range(presses):
         before = page.evaluate("() => window.__latencies.length")
