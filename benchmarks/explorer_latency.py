@@ -67,9 +67,10 @@ from tests.support.serving import (  # noqa: E402
 from tests.support.trace_steps import STEPS, server_steps  # noqa: E402
 
 try:
+    from playwright.sync_api import Error as PlaywrightError
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 except ImportError:  # the pure parts (tables, arguments) work without a browser
-    PlaywrightTimeout = TimeoutError
+    PlaywrightError = PlaywrightTimeout = TimeoutError
 
 #: The Markdown table of the presets run (the older explorer_latency.md is history).
 RESULTS = ROOT / "benchmarks" / "results" / "explorer_latency_presets.md"
@@ -146,12 +147,16 @@ def measure_slider(page, tab: str, css: str, presses: int, key: str,
     # resolved once: a locator is looked up again at each press, through every shadow root
     # of the page (~30 ms of the page's main thread on the complete page, which the page's
     # CPU per step then counted)
-    handle = handle.element_handle()
+    located, handle = handle, handle.element_handle()
     out, solves = [], []
     for _ in range(presses):
         before = page.evaluate("() => window.__latencies.length")
         busy = _main_thread_seconds(cdp) if cdp is not None else 0.0
-        handle.press(key)
+        try:
+            handle.press(key)
+        except PlaywrightError:  # the page made the slider anew: find it again
+            handle = located.element_handle()
+            handle.press(key)
         try:
             page.wait_for_function(f"() => window.__latencies.length > {before}",
                                    timeout=timeout_ms)

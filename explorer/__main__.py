@@ -185,6 +185,12 @@ def main(argv: list[str] | None = None) -> int:
         origins = [f"localhost:{args.port}", f"{host}:{args.port}"]
         print("Pages are accepted from " + ", ".join(origins) + " (add others with "
               "--allow-websocket-origin)", file=sys.stderr, flush=True)
+    if parent is not None and os.getppid() != parent:
+        # (the parent ended during the start-up: the serving loop would look only now)
+        processes = worker_processes()
+        if processes is not None:
+            processes.shutdown()
+        return 0
     print(f"Serving the explorer at http://{args.address}:{args.port}/app", file=sys.stderr,
           flush=True)
     linger_ms = int(args.session_linger * 1000)

@@ -90,7 +90,7 @@ class FitView:
         for select in self.fields:
             select.param.watch(lambda e: self.on_settings(), "value")
         controller.param.watch(lambda e: self.refresh(getattr(e.new, "scene", None)), "view")
-        self.refresh()
+        self.refresh(getattr(controller.view, "scene", None))  # (as study.py)
 
     def content(self) -> pn.Column:
         """The tab's column."""

@@ -209,6 +209,7 @@ class ResultsView:
         self._nudging = False  # the player moves without moving the plots
         self._range_token = 0  # counts the ranges set (a later one overrides a move)
         self.player = self._new_player(1, 0)
+        self.player_box = pn.Row(self.player, sizing_mode="stretch_width", margin=0)
         self.time_label = html_pane("", margin=(12, 10))
         self.readout = html_pane("", sizing_mode="stretch_width")
         self.design = html_pane("", sizing_mode="stretch_width", css_classes=["design-pane"])
@@ -242,7 +243,7 @@ class ResultsView:
             pn.Row(scene_pane, self.contact_panes.inset_slot, sizing_mode="stretch_width"),
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
-            pn.Row(self.player, self.time_label, sizing_mode="stretch_width"),
+            pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
             pn.Row(self.readout, pn.Column(self.pins.content(), self.classical),
                    sizing_mode="stretch_width"),
             self.design,
@@ -407,18 +408,21 @@ class ResultsView:
         message of its own; when the value is the one the player holds, the player is
         moved to a neighbour and back (the plots are not). A new player for each range
         did the same, but adding it to the page made Bokeh walk the whole document:
-        ~330 ms of the server's CPU per preset switch on a page with its tabs filled."""
-        player = self.player
+        ~330 ms of the server's CPU per preset switch on a page with its tabs filled.
+        Outside a server (a notebook: no later turn of a loop to send the value in) a new
+        player still replaces the old one."""
         if not self.loop.served:
-            player.param.update(end=end, value=value)
+            self.player = self._new_player(end, value)
+            self.player_box.objects = [self.player]
             return
+        player = self.player
         self._range_token += 1
         token = self._range_token
         player.end = end
 
         def move(step: int) -> None:
-            if token != self._range_token:
-                return  # a newer range came
+            if token != self._range_token or self.screen.time_index != value:
+                return  # a newer range came, or the user chose another time meanwhile
             if step == 0 and player.value == value:
                 self._nudging = True
                 try:

@@ -156,7 +156,9 @@ class StudyView:
         if loop.served:
             # a closed page stops its study
             pn.state.on_session_destroyed(lambda ctx: self.study_run.cancel())
-        self.refresh()
+        # (made when its tab is filled: the scene of the result on screen, as its watcher
+        # gives the later ones)
+        self.refresh(getattr(controller.view, "scene", None))
 
     def content(self) -> pn.Column:
         """The tab's column."""

@@ -88,10 +88,12 @@ class DeferredTabs:
     def fill(self, index: int) -> None:
         """Give the tab at ``index`` its widgets (they then stay); the page is complete
         once the last tab has them, whether opened or filled in the background."""
-        content = self.deferred.pop(index, None)
+        content = self.deferred.get(index)
         if content is not None:
             column, objects = content
+            # (made before it leaves the queue: a view that fails to be made is tried again)
             column.objects = objects if isinstance(objects, list) else objects().objects
+            del self.deferred[index]
             if not self.deferred:
                 self._complete()
 
