@@ -1,5 +1,6 @@
-"""Two fixes applied in the page to BokehJS: style sheets rewritten with the same text,
-and the page's layout computed once per frame (and not for a closed tab).
+"""Three fixes applied in the page to BokehJS: style sheets rewritten with the same text,
+the page's layout computed once per frame (and not for a closed tab), and colours and
+line styles no longer read back from the computed style at each paint.
 
 **Style sheets.** BokehJS (checked with 3.9.2) writes the text of a ``<style>`` element
 each time it paints a renderer (``update_position``) or lays a figure out, even when the
@@ -29,6 +30,18 @@ nothing until that tab is opened: each fill laid the whole page out once more, ~
 the page's CPU, 2.6 s of the 8 s a page cost the browser to load and complete (a CPU
 profile of the page through the DevTools protocol). BokehJS without the
 patched method is left as it is (the page logs a warning).
+
+**Visual properties without CSS variables.** Before it strokes or fills anything,
+BokehJS asks the computed style of the figure whether a CSS variable (``--bk-line-color``,
+``--bk-fill-alpha``, ...; ``VisualProperties._get_css_value``) overrides the model's
+colour, alpha, width, dash or font: one ``getComputedStyle`` per property per glyph per
+paint, each a style recalculation of the page when anything changed since the last one
+(a repaint after new data always has). That was ~18 ms of the page's ~130 ms of CPU per
+load step (a DevTools CPU profile of key steps on the default scene). No style sheet of
+this page defines such a variable: Bokeh's and Panel's own define none, nor do ours
+(``test_no_style_sheet_of_the_page_defines_bokeh_css_variables`` checks the installed
+packages), so every such read returned "" and the model's value was used. The fix
+answers "" without asking the browser; what is drawn is the same.
 """
 
 from __future__ import annotations
@@ -127,11 +140,32 @@ if (!View || typeof View.prototype.invalidate_layout !== "function") {
 """
 
 
+#: Runs once per page when its document is ready (idempotent: a flag on the method). Only
+#: BokehJS's read of CSS variables changes: the model's values are drawn as before.
+NO_CSS_VARIABLES_JS = """
+const visual = (window.Bokeh && Bokeh.require) ? Bokeh.require("core/visuals/visual") : null;
+const Props = visual && visual.VisualProperties;
+if (!Props || typeof Props.prototype._get_css_value !== "function") {
+  console.warn("explorer: BokehJS visual properties have changed; the style read fix is "
+               + "not applied");
+} else if (!Props.prototype._get_css_value.__no_css_variables) {
+  // no style sheet of this page defines a --bk- variable (see the module's docstring)
+  const none = function (name) { return ""; };
+  none.__no_css_variables = true;
+  Props.prototype._get_css_value = none;
+}
+"""
+
+#: The prefix of the CSS variables BokehJS reads for visual properties (core/visuals).
+BOKEH_CSS_VARIABLE_PREFIX = "--bk-"
+
+
 def install(doc: Any) -> bool:
-    """Apply both fixes in the page of Bokeh document ``doc`` once it is ready; False
+    """Apply the three fixes in the page of Bokeh document ``doc`` once it is ready; False
     (nothing done) when there is no document (a notebook, a script)."""
     if doc is None or not hasattr(doc, "js_on_event"):
         return False
     doc.js_on_event("document_ready", CustomJS(code=SAME_STYLE_JS))
     doc.js_on_event("document_ready", CustomJS(code=LAYOUT_ONCE_JS))
+    doc.js_on_event("document_ready", CustomJS(code=NO_CSS_VARIABLES_JS))
     return True

@@ -48,9 +48,38 @@ def test_the_style_fix_is_sent_with_a_served_document() -> None:
     doc = Document()
     assert bokeh_fixes.install(doc)
     callbacks = doc.callbacks._js_event_callbacks["document_ready"]
-    assert [("__same_text_skipped" in c.code, "__once_per_frame" in c.code)
-            for c in callbacks] == [(True, False), (False, True)]
+    flags = ("__same_text_skipped", "__once_per_frame", "__no_css_variables")
+    assert [tuple(flag in c.code for flag in flags) for c in callbacks] == [
+        (True, False, False), (False, True, False), (False, False, True)]
     assert not bokeh_fixes.install(None)
+
+
+def test_no_style_sheet_of_the_page_defines_bokeh_css_variables() -> None:
+    """The page's BokehJS no longer reads ``--bk-`` CSS variables for colours and line
+    styles (explorer/fixes/bokeh_fixes.py): right only while no style sheet it loads
+    defines one. Its style sheets come from Bokeh, Panel and the explorer (their CSS,
+    and the style text in their scripts and modules); a version that starts to define
+    such a variable fails here, and the fix must then go."""
+    import re
+    from pathlib import Path
+
+    import bokeh
+    import panel
+
+    import explorer
+
+    definition = re.compile(
+        rb"%s[\w-]+\s*:" % re.escape(bokeh_fixes.BOKEH_CSS_VARIABLE_PREFIX.encode()))
+    found, read = [], 0
+    for package, suffixes in ((bokeh, {".css", ".js"}), (panel, {".css", ".js"}),
+                              (explorer, {".css", ".js", ".py"})):
+        for path in Path(package.__file__).parent.rglob("*"):
+            if path.suffix in suffixes and path.is_file():
+                read += 1
+                match = definition.search(path.read_bytes())
+                if match:
+                    found.append(f"{path}: {match.group().decode()}")
+    assert read > 100 and found == []
 
 
 def test_lines_and_text_columns_are_resent_only_when_they_change() -> None:

@@ -258,6 +258,8 @@ def test_a_load_step_repaints_only_the_figures_whose_data_changed(page: Page):
     back to the server; BokehJS no longer rewrites unchanged style sheets."""
     _wait(page, "() => Bokeh.require('core/dom').InlineStyleSheet.prototype._update"
           ".__same_text_skipped === true")
+    assert page.page.evaluate("() => Bokeh.require('core/visuals/visual').VisualProperties"
+                              ".prototype._get_css_value.__no_css_variables === true")
     # the sidebar's last tab is filled a few seconds after the page loads, and the page
     # is laid out again then: wait for it, and for a second without any repaint
     _wait(page, "() => [...Bokeh.documents[0].all_models].some(m => m.css_classes && "
