@@ -114,6 +114,12 @@ def build_parser() -> argparse.ArgumentParser:
                         help="how long a page's session is kept after its connection is "
                              "lost, for the page to reconnect, before everything it holds "
                              "is given back (default 15)")
+    parser.add_argument("--live-bound", type=float, default=None, metavar="SECONDS",
+                        help="sliders that wait for their release on slow scenes (geometry, "
+                             "coating, base) follow a drag while the last solve took less "
+                             "CPU time than this (default 0.1: ten answers a second); "
+                             "raise it on a slow server to keep more sliders live at fewer "
+                             "frames, lower it to keep drags smooth")
     parser.add_argument("--exit-with-parent", action="store_true",
                         help="stop the server (as on SIGTERM) when the process that started "
                              "it ends, even if that process is killed: for scripts and test "
@@ -161,6 +167,9 @@ def main(argv: list[str] | None = None) -> int:
         print("--solver-processes must be 0 or more and --solver-threads 1 or more",
               file=sys.stderr)
         return 2
+    if args.live_bound is not None and not 0.001 <= args.live_bound <= 60:
+        print("--live-bound must be between 0.001 and 60 seconds", file=sys.stderr)
+        return 2
     if not 0.5 <= args.session_linger <= 3600:
         print("--session-linger must be between 0.5 and 3600 seconds", file=sys.stderr)
         return 2
@@ -195,7 +204,12 @@ def main(argv: list[str] | None = None) -> int:
           flush=True)
     linger_ms = int(args.session_linger * 1000)
     try:
-        _serve(pn, {"app": create_app}, parent=parent, port=args.port, address=args.address,
+        app = create_app
+        if args.live_bound is not None:
+            # a function (Panel serves a partial object as its text, not as a page)
+            def app(bound: float = args.live_bound) -> Any:
+                return create_app(live_bound=bound)
+        _serve(pn, {"app": app}, parent=parent, port=args.port, address=args.address,
                show=args.show, websocket_origin=origins, title="Coated punch explorer",
                liveness=True, websocket_max_message_size=WEBSOCKET_MAX_BYTES,
                unused_session_lifetime_milliseconds=linger_ms,

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import html
 import logging
+import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -88,8 +89,16 @@ class ExplorerApp(pn.viewable.Viewer):
     def __init__(self, scene: dict[str, Any] | None = None, *,
                  query: dict[str, str] | None = None,
                  solve: Callable[[dict[str, Any]], Any] | None = None,
-                 executor: Any = "shared", **params: Any) -> None:
+                 executor: Any = "shared", live_bound: float | None = None,
+                 **params: Any) -> None:
+        """``live_bound`` [s]: sliders that otherwise wait for their release follow a drag
+        while the last solve took less CPU time than this (default :data:`LIVE_SOLVE_S`;
+        the server's ``--live-bound``)."""
         super().__init__(**params)
+        if live_bound is not None and not (isinstance(live_bound, (int, float))
+                                           and math.isfinite(live_bound) and live_bound > 0):
+            raise ValueError(f"live_bound: must be a number of seconds > 0, got {live_bound!r}")
+        self.live_bound = live_bound
         self.loop = PageLoop(pn.state.curdoc)
         self.state = ExplorerState()
         self.screen = Screen()
@@ -258,7 +267,8 @@ class ExplorerApp(pn.viewable.Viewer):
 
     def fast_solves(self) -> bool:
         """Whether the last solve was quick enough for sliders to apply every drag step."""
-        return self.controller.solved_within(LIVE_SOLVE_S)
+        bound = LIVE_SOLVE_S if self.live_bound is None else self.live_bound
+        return self.controller.solved_within(bound)
 
     def _drag_step_applies(self) -> bool:
         """At a drag step of a slider that otherwise waits for its release: whether the

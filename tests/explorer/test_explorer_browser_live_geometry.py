@@ -16,12 +16,27 @@ require_browser()
 
 from tests.browser_pages import Page, page_fixtures, patience, until  # noqa: E402
 
-#: The default scene, a creep preset (exponential creep): the page opens on it. Its
-#: half-width steps cost ~60-70 ms of CPU, under the live bound (explorer.app.LIVE_SOLVE_S);
-#: eccentric_creep's cost 70-110 ms here, with the scene's validation, and its drags were
-#: live in 2 of 3 tries (2026-12-01, this 2-core machine): a test of the bound's edge.
+#: The default scene, a creep preset (exponential creep): the page opens on it.
 KEY = "uniform_flat"
+#: The live bound of this module's server (``--live-bound``) [s]. Whether a slider
+#: follows a drag depends on the CPU time of the last solve against the bound: this test
+#: checks that a drag does follow when the solver keeps up, not how fast this machine is.
+#: At the default bound (explorer.app.LIVE_SOLVE_S, 0.1 s) it failed on loaded machines:
+#: the default scene's half-width steps cost ~60-70 ms of CPU on a quiet 2-core machine
+#: and over 0.1 s beside the rest of the suite (2 of 4 runs, 2026-12-01). How many
+#: presets keep up at the default bound is measured by benchmarks/explorer_latency.py.
+LIVE_BOUND_S = 2.0
 server, browser_context, page = page_fixtures(1400, 900)
+
+
+@pytest.fixture(scope="module")
+def explorer_server():
+    """This module's served explorer: the run's (tests/conftest.py) with a live bound the
+    default scene's solves keep under on a loaded machine."""
+    from tests.support.serving import browser_test_server
+
+    with browser_test_server(["--live-bound", f"{LIVE_BOUND_S:g}"]) as explorer:
+        yield explorer
 
 # every change of the pressure plot's data, and the page times of the mouse down and up
 JS_WATCH = """() => {
@@ -46,11 +61,9 @@ def test_a_geometry_drag_on_a_creep_preset_draws_while_the_handle_moves(page: Pa
     page.open_tab("Punch")
     handle = page.page.locator(".punch-half-width .noUi-handle").first
     handle.wait_for(timeout=60_000 * patience())
-    # one step first: the preset's own first solve (its creep law set up) is slow, and the
-    # sliders follow a drag while the last solve was quick (explorer.app.LIVE_SOLVE_S); a
-    # new half-width costs ~25-50 ms of CPU here
-    # (two steps: the first new half-width after the page opens cost ~1.5x the next ones,
-    # 64 against 37-47 ms of wall time, at the bound in 1 of 5 runs)
+    # two steps first: the sliders follow a drag while the last solve was quick (under
+    # LIVE_BOUND_S), and the preset's first solves (its creep law set up, the first new
+    # half-width) are the slowest
     handle.focus()
     for _ in range(2):
         before = page.page.evaluate(CHANGES)

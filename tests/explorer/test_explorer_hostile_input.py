@@ -189,3 +189,35 @@ def test_the_server_listens_on_localhost_unless_told(monkeypatch) -> None:
     count = len(served)
     assert entry.main([*base[:-1], "-1"]) == 2  # --solver-processes -1: refused, not served
     assert len(served) == count
+
+
+def test_the_live_bound_of_the_server_reaches_every_session(monkeypatch, explorer_app) -> None:
+    """``--live-bound``: the CPU time of a solve under which sliders that otherwise wait
+    for their release follow a drag (default ``explorer.app.LIVE_SOLVE_S``)."""
+    import explorer.__main__ as entry
+    from explorer.app import LIVE_SOLVE_S, create_app
+
+    assert f"(default {LIVE_SOLVE_S:g}:" in entry.build_parser().format_help().replace("\n", " ")
+    served: list[dict[str, Any]] = []  # the apps pn.serve would be given
+    monkeypatch.setattr(entry, "_serve", lambda pn, apps, **k: served.append(apps))
+    monkeypatch.setattr(entry, "quiet_bokeh_diagnostics", lambda: None)
+    base = ["--port", "5999", "--warm-up", "none", "--solver-processes", "0"]
+    assert entry.main(base) == 0 and served[-1]["app"] is create_app
+    made: list[dict[str, Any]] = []
+    monkeypatch.setattr("explorer.app.create_app", lambda **k: made.append(k))
+    assert entry.main([*base, "--live-bound", "0.5"]) == 0
+    served[-1]["app"]()  # as the server does for each page
+    assert made == [{"live_bound": 0.5}]
+    for bad in ("0", "-1", "61", "nan"):
+        assert entry.main([*base, "--live-bound", bad]) == 2
+    assert len(served) == 2
+    # a session decides on its own bound: the default scene's last solve took some CPU
+    app = explorer_app(solved=True)
+    spent = app.controller.view.info["cpu_seconds"]
+    assert app.fast_solves() == (spent < LIVE_SOLVE_S)
+    app.live_bound = 2 * spent
+    assert app.fast_solves()
+    app.live_bound = 0.5 * spent
+    assert not app.fast_solves()
+    with pytest.raises(ValueError, match="live_bound: must be a number of seconds > 0"):
+        explorer_app(live_bound=-1.0)

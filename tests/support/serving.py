@@ -256,8 +256,8 @@ class ExplorerProcess:
         self.stop()
 
 
-def browser_test_server() -> ExplorerProcess:
-    """The served explorer the browser tests drive (default options, one BLAS thread), not
-    started yet: use it as a context manager."""
+def browser_test_server(args: Sequence[str] = ()) -> ExplorerProcess:
+    """The served explorer the browser tests drive (default options but ``args``, one BLAS
+    thread), not started yet: use it as a context manager."""
     # 180 s: the server solves the default scene once before it answers
-    return ExplorerProcess(env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180)
+    return ExplorerProcess(args, env={"OPENBLAS_NUM_THREADS": "1"}, ready_timeout=180)
