@@ -12,6 +12,7 @@ import os
 import signal
 import socket
 import sys
+from collections.abc import Callable
 from typing import Any
 
 import core
@@ -115,11 +116,12 @@ def build_parser() -> argparse.ArgumentParser:
                              "lost, for the page to reconnect, before everything it holds "
                              "is given back (default 15)")
     parser.add_argument("--live-bound", type=float, default=None, metavar="SECONDS",
-                        help="sliders that wait for their release on slow scenes (geometry, "
-                             "coating, base) follow a drag while the last solve took less "
-                             "CPU time than this (default 0.1: ten answers a second); "
-                             "raise it on a slow server to keep more sliders live at fewer "
-                             "frames, lower it to keep drags smooth")
+                        help="the sliders of the Punch, Coating, Base and Time tabs, which "
+                             "otherwise wait for their release, follow a drag while the last "
+                             "solve took less CPU time than this, 0.001 to 60 (default 0.1: "
+                             "ten answers a second; the eccentricity slider of a lift-off "
+                             "keeps its own 0.2); raise it on a slow server to keep more "
+                             "sliders live at fewer frames, lower it to keep drags smooth")
     parser.add_argument("--exit-with-parent", action="store_true",
                         help="stop the server (as on SIGTERM) when the process that started "
                              "it ends, even if that process is killed: for scripts and test "
@@ -204,11 +206,13 @@ def main(argv: list[str] | None = None) -> int:
           flush=True)
     linger_ms = int(args.session_linger * 1000)
     try:
-        app = create_app
+        app: Callable[[], Any] = create_app
         if args.live_bound is not None:
             # a function (Panel serves a partial object as its text, not as a page)
-            def app(bound: float = args.live_bound) -> Any:
+            def app_with_bound(bound: float = args.live_bound) -> Any:
                 return create_app(live_bound=bound)
+
+            app = app_with_bound
         _serve(pn, {"app": app}, parent=parent, port=args.port, address=args.address,
                show=args.show, websocket_origin=origins, title="Coated punch explorer",
                liveness=True, websocket_max_message_size=WEBSOCKET_MAX_BYTES,

@@ -75,7 +75,10 @@ install_websocket_marks()
 #: 2-core machine): at 0.030 s the geometry sliders of both creep presets (solves of 36 and
 #: 53 ms of CPU) applied on release only, one update 363-418 ms after it; at 0.100 s they
 #: drew 3-16 frames during the drag and their last 206-682 ms after the release, as the
-#: load sliders do. The lift-off preset's solves (~230 ms) stay on release.
+#: load sliders do. The lift-off preset's solves (~230 ms) stay on release. The default of
+#: a session's ``live_bound`` (the server's ``--live-bound``). The CPU time of a scene is
+#: steadier than its wall time, not fixed: on a loaded 2-core machine the default scene's
+#: half-width steps cost 60-115 ms of CPU against ~35 ms on a quiet day.
 LIVE_SOLVE_S = 0.100
 #: Shortest time between two results drawn on a served page [ms]: the page takes ~45-65
 #: ms of its CPU to show one (benchmarks/results/explorer_latency.md), so a faster stream
@@ -95,8 +98,9 @@ class ExplorerApp(pn.viewable.Viewer):
         while the last solve took less CPU time than this (default :data:`LIVE_SOLVE_S`;
         the server's ``--live-bound``)."""
         super().__init__(**params)
-        if live_bound is not None and not (isinstance(live_bound, (int, float))
-                                           and math.isfinite(live_bound) and live_bound > 0):
+        if live_bound is not None and (isinstance(live_bound, bool) or not (
+                isinstance(live_bound, (int, float)) and math.isfinite(live_bound)
+                and live_bound > 0)):
             raise ValueError(f"live_bound: must be a number of seconds > 0, got {live_bound!r}")
         self.live_bound = live_bound
         self.loop = PageLoop(pn.state.curdoc)

@@ -10,10 +10,11 @@
 - Property tests draw the same examples on every run (hypothesis profile ``suite``,
   derandomized); ``HYPOTHESIS_PROFILE=explore`` draws new ones.
 - One served explorer (:func:`explorer_server`, ``python -m explorer`` in a child
-  process) serves every browser test of a run: each test opens its own page (a session of
-  its own), and each browser module checks the server's output written while it ran
-  (tests/browser_pages.py). Starting a server costs a warm-up solve and its solver
-  processes; once per run instead of once per module.
+  process) serves the browser tests of a run (but for the few modules that need a server
+  of their own, ``tests.support.probe.own_explorer_server``): each test opens its own
+  page (a session of its own), and each browser module checks the server's output
+  written while it ran (tests/browser_pages.py). Starting a server costs a warm-up solve
+  and its solver processes; once per run instead of once per module.
 - The command line runs in the test's own process (``run_cli`` of tests/cli_runs.py:
   ``core.cli.main`` with stdout and stderr captured): a child process costs ~1 s of
   imports each and tests nothing more, except the entry point itself, which a few tests

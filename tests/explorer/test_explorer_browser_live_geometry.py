@@ -15,6 +15,7 @@ from tests.browser_pages import require_browser  # noqa: E402
 require_browser()
 
 from tests.browser_pages import Page, page_fixtures, patience, until  # noqa: E402
+from tests.support.probe import own_explorer_server  # noqa: E402
 
 #: The default scene, a creep preset (exponential creep): the page opens on it.
 KEY = "uniform_flat"
@@ -26,17 +27,9 @@ KEY = "uniform_flat"
 #: and over 0.1 s beside the rest of the suite (2 of 4 runs, 2026-12-01). How many
 #: presets keep up at the default bound is measured by benchmarks/explorer_latency.py.
 LIVE_BOUND_S = 2.0
+# this module's served explorer: the run's (tests/conftest.py) with that live bound
+explorer_server = own_explorer_server(["--live-bound", f"{LIVE_BOUND_S:g}"])
 server, browser_context, page = page_fixtures(1400, 900)
-
-
-@pytest.fixture(scope="module")
-def explorer_server():
-    """This module's served explorer: the run's (tests/conftest.py) with a live bound the
-    default scene's solves keep under on a loaded machine."""
-    from tests.support.serving import browser_test_server
-
-    with browser_test_server(["--live-bound", f"{LIVE_BOUND_S:g}"]) as explorer:
-        yield explorer
 
 # every change of the pressure plot's data, and the page times of the mouse down and up
 JS_WATCH = """() => {

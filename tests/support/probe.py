@@ -18,7 +18,7 @@ from __future__ import annotations
 import threading
 import time
 import urllib.request
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from types import TracebackType
 from typing import Any
 
@@ -56,18 +56,19 @@ def assert_responsive(probe: LivenessProbe) -> None:
     assert probe.worst() <= WORST_BOUND_S * stretch, probe.summary()
 
 
-def own_explorer_server() -> Any:
+def own_explorer_server(args: Sequence[str] = ()) -> Any:
     """A module-scoped fixture ``explorer_server`` of a test module's own (a served
-    explorer as the run's, see tests/conftest.py), for a module that must not share the
-    server's event loop with the pages other modules left. Use as ``explorer_server =
-    own_explorer_server()`` at the module's top."""
+    explorer as the run's, see tests/conftest.py, with the server options ``args``), for
+    a module that must not share the server's event loop with the pages other modules
+    left, or needs other options. Use as ``explorer_server = own_explorer_server()`` at
+    the module's top."""
     import pytest
 
     from tests.support.serving import ExplorerProcess, browser_test_server
 
     @pytest.fixture(scope="module", name="explorer_server")
     def explorer_server() -> Iterator[ExplorerProcess]:
-        with browser_test_server() as served:
+        with browser_test_server(args) as served:
             yield served
 
     return explorer_server
