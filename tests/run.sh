@@ -46,28 +46,28 @@ fi
 
 # The whole suite in three parts at once, one pytest each: the browser tests (marker
 # "browser": a served explorer and Chromium), the soak tests (marker "soak": servers and
-# worker processes started, stopped, killed and left idle, much of it waiting on them)
-# together with the checks of seconds each (marker "slow"), and the rest. One pytest keeps
-# at most one core busy, and the soak tests wait much of their time: the slow checks fill
-# that part's idle core (the soak part alone ended at ~10 min of a ~25-29 min run, while
-# the run used 1.2 of its 2 cores on average). When one part ends first the others still
-# have both cores. Measured on a fresh clone, 2 cores with nothing else running
-# (2026-11-30): 19.8-21.4 min with the installation (rest 18.5-19.9, browser 16.0-17.6,
-# soak 7.5-8.8 min, documentation 4.5-5.3 min) at load average ~4: the whole is bound by
-# the cores' time (the rest alone: 12.6 min; the rest in two halves took as long, the
-# browser part then the longest).
+# worker processes started, stopped, killed and left idle, much of it waiting on them) and
+# the rest. One pytest keeps at most one core busy, and the soak part waits much of its
+# time; when one part ends first the others still have both cores. Measured on a fresh
+# clone, 2 cores with nothing else running (2026-11-30): 19.8-21.4 min with the
+# installation (rest 18.5-19.9, browser 16.0-17.6, soak 7.5-8.8 min, documentation
+# 4.5-5.3 min) at load average ~4: the whole is bound by the cores' time (the rest alone:
+# 12.6 min; the rest in two halves took as long, the browser part then the longest).
 # Two pytest-xdist workers each for the rest and the browser tests (2026-12-01) took more
 # of the cores' time, 1677 s against ~1390 (each worker imports and warms its own caches,
 # each browser worker serves its own explorer), with the load at ~9; and one Chromium per
 # pytest instead of one per module saved nothing measurable (5 modules: 58.3 against
-# 58.8 s of CPU).
+# 58.8 s of CPU). The checks of seconds each (marker "slow", 75 tests with the soak ones)
+# run in the soak part instead (2026-12-01) balanced the parts (rest 25.4, browser 24.5,
+# soak 23.9 min) but not the whole: 26.1 min on a fresh clone, 2107 s user + 110 s system
+# CPU, against 25.3 min for the split above the day before.
 # The parts share nothing: each has its own temporary directory, pytest cache and served
 # explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
 python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
     >"$work/browser.log" 2>&1 &
 browser_pid=$!
-python -m pytest -q -m "(soak or slow) and not browser" --basetemp "$work/soak" \
+python -m pytest -q -m "soak and not browser" --basetemp "$work/soak" \
     -o cache_dir=.pytest_cache/soak >"$work/soak.log" 2>&1 &
 soak_pid=$!
 
@@ -95,7 +95,7 @@ docs_pid=$!
 # (kill fails once a job has ended: no status of its own may reach the exit code)
 trap 'kill "$browser_pid" "$soak_pid" "$docs_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
 set +e
-python -m pytest -q -m "not browser and not soak and not slow" --basetemp "$work/rest" \
+python -m pytest -q -m "not browser and not soak" --basetemp "$work/rest" \
     -o cache_dir=.pytest_cache/rest
 rest=$?
 wait "$browser_pid"
@@ -109,7 +109,7 @@ echo "---- documentation (sphinx -W) ----"
 cat "$work/docs.log"
 echo "---- browser tests (pytest -m browser) ----"
 cat "$work/browser.log"
-echo "---- soak and slow tests (pytest -m '(soak or slow) and not browser') ----"
+echo "---- soak tests (pytest -m soak) ----"
 cat "$work/soak.log"
 echo "---- exit codes: rest $rest, browser $browser, soak $soak, docs $docs ----"
 [ "$rest" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$soak" -eq 0 ] && [ "$docs" -eq 0 ]
