@@ -160,7 +160,7 @@ def main(argv: list[str] | None = None) -> int:
         _restart_with_server_allocator()
     import panel as pn
 
-    from explorer.app import create_app
+    from explorer.app import check_live_bound, create_app
     from explorer.fixes import closed_pages
     from explorer.model import ORDER
     from explorer.solving import shared_pool, use_worker_processes, warm_up, worker_processes
@@ -169,9 +169,12 @@ def main(argv: list[str] | None = None) -> int:
         print("--solver-processes must be 0 or more and --solver-threads 1 or more",
               file=sys.stderr)
         return 2
-    if args.live_bound is not None and not 0.001 <= args.live_bound <= 60:
-        print("--live-bound must be between 0.001 and 60 seconds", file=sys.stderr)
-        return 2
+    if args.live_bound is not None:
+        try:
+            check_live_bound(args.live_bound)
+        except ValueError as exc:
+            print(str(exc).replace("live_bound", "--live-bound", 1), file=sys.stderr)
+            return 2
     if not 0.5 <= args.session_linger <= 3600:
         print("--session-linger must be between 0.5 and 3600 seconds", file=sys.stderr)
         return 2

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import html
 import logging
-import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -59,7 +58,8 @@ from .views import (
     status_html,
 )
 
-__all__ = ["ExplorerApp", "LIVE_SOLVE_S", "create_app"]
+__all__ = ["ExplorerApp", "LIVE_BOUND_LIMITS_S", "LIVE_SOLVE_S", "check_live_bound",
+           "create_app"]
 
 log = logging.getLogger(__name__)
 install_in_process()
@@ -80,6 +80,18 @@ install_websocket_marks()
 #: steadier than its wall time, not fixed: on a loaded 2-core machine the default scene's
 #: half-width steps cost 60-115 ms of CPU against ~35 ms on a quiet day.
 LIVE_SOLVE_S = 0.100
+#: The live bounds a session accepts [s] (``live_bound``, the server's ``--live-bound``).
+LIVE_BOUND_LIMITS_S = (0.001, 60.0)
+
+
+def check_live_bound(value: object) -> float:
+    """``value`` as a live bound [s], or ValueError naming ``live_bound`` and the reason."""
+    low, high = LIVE_BOUND_LIMITS_S
+    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+            or not low <= value <= high:
+        raise ValueError(f"live_bound: must be a number of seconds from {low:g} to "
+                         f"{high:g}, got {value!r}")
+    return float(value)
 #: Shortest time between two results drawn on a served page [ms]: the page takes ~45-65
 #: ms of its CPU to show one (benchmarks/results/explorer_latency.md), so a faster stream
 #: of results only queues up in front of it (12 fps at most: a drag stays live).
@@ -98,11 +110,7 @@ class ExplorerApp(pn.viewable.Viewer):
         while the last solve took less CPU time than this (default :data:`LIVE_SOLVE_S`;
         the server's ``--live-bound``)."""
         super().__init__(**params)
-        if live_bound is not None and (isinstance(live_bound, bool) or not (
-                isinstance(live_bound, (int, float)) and math.isfinite(live_bound)
-                and live_bound > 0)):
-            raise ValueError(f"live_bound: must be a number of seconds > 0, got {live_bound!r}")
-        self.live_bound = live_bound
+        self.live_bound = None if live_bound is None else check_live_bound(live_bound)
         self.loop = PageLoop(pn.state.curdoc)
         self.state = ExplorerState()
         self.screen = Screen()

@@ -195,12 +195,13 @@ def test_the_live_bound_of_the_server_reaches_every_session(monkeypatch, explore
     """``--live-bound``: the CPU time of a solve under which sliders that otherwise wait
     for their release follow a drag (default ``explorer.app.LIVE_SOLVE_S``)."""
     import explorer.__main__ as entry
-    from explorer.app import LIVE_SOLVE_S, create_app
+    from explorer.app import LIVE_BOUND_LIMITS_S, LIVE_SOLVE_S, create_app
     from explorer.views import eccentricity
 
     shown = " ".join(entry.build_parser().format_help().split())
     assert f"(default {LIVE_SOLVE_S:g}:" in shown
     assert f"keeps its own {eccentricity.LIVE_SOLVE_S:g})" in shown
+    assert "this, {:g} to {:g} (default".format(*LIVE_BOUND_LIMITS_S) in shown
     served: list[dict[str, Any]] = []  # the apps pn.serve would be given
     monkeypatch.setattr(entry, "_serve", lambda pn, apps, **k: served.append(apps))
     monkeypatch.setattr(entry, "quiet_bokeh_diagnostics", lambda: None)
@@ -222,6 +223,7 @@ def test_the_live_bound_of_the_server_reaches_every_session(monkeypatch, explore
     assert app.fast_solves()
     app.live_bound = 0.5 * spent
     assert not app.fast_solves()
-    for bad in (-1.0, 0.0, float("inf"), True, "0.1"):
-        with pytest.raises(ValueError, match="live_bound: must be a number of seconds > 0"):
+    for bad in (-1.0, 0.0, 61.0, float("nan"), float("inf"), True, "0.1"):
+        with pytest.raises(ValueError, match="live_bound: must be a number of seconds from "
+                                             "0.001 to 60, got"):
             explorer_app(live_bound=bad)
