@@ -470,4 +470,5 @@ def create_app(**kwargs: Any) -> ExplorerApp:
     app = ExplorerApp(**kwargs)
     if served:
         pn.state.on_session_destroyed(closed_pages.page_releaser(app.page_parts))
+        pn.state.on_session_destroyed(gc_policy.watch_page(app))
     return app

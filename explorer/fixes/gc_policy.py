@@ -23,7 +23,12 @@ held for a moment after its session's collection (a solve of the page coming bac
 a worker): frozen with the live pages, it would wait for the next session to end. One
 more collection :data:`LATE_COLLECT_AFTER_S` after the first frees it (measured with
 benchmarks/load_test.py --mode abandon: without it, two rounds of 25 in eight left the
-server 60-85 MiB above its level until the next round ended).
+server 60-85 MiB above its level until the next round ended). On a loaded server a page
+can be held longer than that (its last solve queued behind others): :func:`watch_page`
+follows each page whose session has ended, and while one of them is still alive after
+a collection, one more comes :data:`LATE_COLLECT_AFTER_S` later, for at most
+:data:`HELD_AT_MOST_S` after its session ended (then a warning names how many are still
+held: a page that outlives that is kept by something other than its work).
 
 While a page is being built (:func:`pause_for_page`, from the start of the session's
 page to the end of the request that asked for it) the collector does not run: building
@@ -43,6 +48,9 @@ import ctypes
 import ctypes.util
 import gc
 import logging
+import time
+import weakref
+from collections.abc import Callable
 from typing import Any
 
 log = logging.getLogger(__name__)
@@ -51,8 +59,13 @@ log = logging.getLogger(__name__)
 #: discards the sessions of closed pages in batches (every 17 s by default): one
 #: collection serves a whole batch, and a class closing its tabs costs one pause.
 COLLECT_AFTER_S = 2.0
-#: Delay from that collection to one more, for pages let go just after it [s].
+#: Delay from that collection to one more, for pages let go just after it [s]; and from
+#: each later one to the next while a page of an ended session is still held.
 LATE_COLLECT_AFTER_S = 10.0
+#: How long after its session ended a page still held is looked for [s]: a page's work
+#: ends well within this even on a saturated server (a solve is bounded by
+#: ``core.limits.MAX_SOLVE_CPU_SECONDS`` of CPU; a page's build takes seconds).
+HELD_AT_MOST_S = 300.0
 
 #: Longest the collector stays paused for a page being built [s] (the build takes 1-2 s
 #: of CPU; the pause normally ends with the request, much sooner).
@@ -60,6 +73,10 @@ PAUSE_AT_MOST_S = 10.0
 
 _collect_due = False
 _paused = False
+_look_due = False
+#: The pages of ended sessions not yet seen freed, with when their session ended
+#: (``time.monotonic``).
+_held: list[tuple[weakref.ref, float]] = []
 
 
 def _libc_trim() -> Any:
@@ -129,20 +146,57 @@ def session_ended(session_context: Any) -> None:
     _collect_due = True
 
 
+def watch_page(page: Any) -> Callable[[Any], None]:
+    """The session-destroyed callback that follows ``page`` (weakly) once its session
+    has ended, until a collection has freed it (module notes)."""
+    ref = weakref.ref(page)
+
+    def ended(session_context: Any) -> None:
+        _held.append((ref, time.monotonic()))
+
+    return ended
+
+
+def held_pages() -> int:
+    """How many pages of ended sessions are still alive (those seen freed are dropped)."""
+    _held[:] = [(ref, since) for ref, since in _held if ref() is not None]
+    return len(_held)
+
+
 def _collect_and_look_again() -> None:
     """The collection for ended sessions, and one more a little later (unless another
     session ends meanwhile, whose own collection then comes first and looks again)."""
     collect_ended_sessions()
+    _look_again()
+
+
+def _look_again() -> None:
+    global _look_due
+    if _look_due:
+        return
     try:
         loop = asyncio.get_running_loop()
     except RuntimeError:
         return
+    _look_due = True
     loop.call_later(LATE_COLLECT_AFTER_S, _late_collection)
 
 
 def _late_collection() -> None:
-    if not _collect_due:  # a collection already due covers it
-        collect_ended_sessions()
+    global _look_due
+    _look_due = False
+    if _collect_due:  # a collection already due covers it, and looks again after
+        return
+    collect_ended_sessions()
+    if not held_pages():
+        return
+    now = time.monotonic()
+    if any(now - since < HELD_AT_MOST_S for _, since in _held):
+        _look_again()
+    else:
+        log.warning("%d page(s) of sessions that ended over %g s ago are still held",
+                    len(_held), HELD_AT_MOST_S)
+        _held.clear()
 
 
 def collect_ended_sessions() -> int:

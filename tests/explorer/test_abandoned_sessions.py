@@ -10,6 +10,7 @@ its level before those visitors, and its log must hold no traceback.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Iterator
 
@@ -90,7 +91,10 @@ def test_dropped_sessions_give_back_their_memory_and_log_no_traceback(server,
     assert visits == {way: ROUND // len(WAYS) for way in WAYS}, visits
     peak = rss_mib(server.pid)
     assert wait_until(lambda: rss_mib(server.pid) <= before + GROWTH_MIB,
-                      timeout=90, every=0.5), (before, peak, rss_mib(server.pid))
+                      timeout=90, every=0.5), (
+        f"before {before:.1f} MiB, peak {peak:.1f}, now {rss_mib(server.pid):.1f}; load "
+        f"average {os.getloadavg()[0]:.1f}; the server's output ends: "
+        f"{server.output()[-3000:]}")
     output = server.output()
     assert "Traceback" not in output, output[-5000:]
     # the server restarted itself with the C library's allocator (explorer/__main__.py:
