@@ -26,8 +26,10 @@ benchmarks/load_test.py --mode abandon: without it, two rounds of 25 in eight le
 server 60-85 MiB above its level until the next round ended). On a loaded server a page
 can be held longer than that (its last solve queued behind others): :func:`watch_page`
 follows each page whose session has ended, and while one of them is still alive after
-a collection, one more comes :data:`LATE_COLLECT_AFTER_S` later, for at most
-:data:`HELD_AT_MOST_S` after its session ended (then a warning names how many are still
+a collection, one more comes later, each wait twice the last (from
+:data:`LATE_COLLECT_AFTER_S`: a full collection walks every live page, so a page held
+long costs a few pauses, not one every 10 s), for at most :data:`HELD_AT_MOST_S` after
+its session ended (then a warning names how many are still
 held: a page that outlives that is kept by something other than its work).
 
 While a page is being built (:func:`pause_for_page`, from the start of the session's
@@ -59,8 +61,8 @@ log = logging.getLogger(__name__)
 #: discards the sessions of closed pages in batches (every 17 s by default): one
 #: collection serves a whole batch, and a class closing its tabs costs one pause.
 COLLECT_AFTER_S = 2.0
-#: Delay from that collection to one more, for pages let go just after it [s]; and from
-#: each later one to the next while a page of an ended session is still held.
+#: Delay from that collection to one more, for pages let go just after it [s]; the first
+#: of the doubling waits while a page of an ended session is still held.
 LATE_COLLECT_AFTER_S = 10.0
 #: How long after its session ended a page still held is looked for [s]: a page's work
 #: ends well within this even on a saturated server (a solve is bounded by
@@ -74,6 +76,7 @@ PAUSE_AT_MOST_S = 10.0
 _collect_due = False
 _paused = False
 _look_due = False
+_look_after_s = LATE_COLLECT_AFTER_S
 #: The pages of ended sessions not yet seen freed, with when their session ended
 #: (``time.monotonic``).
 _held: list[tuple[weakref.ref, float]] = []
@@ -166,12 +169,14 @@ def held_pages() -> int:
 def _collect_and_look_again() -> None:
     """The collection for ended sessions, and one more a little later (unless another
     session ends meanwhile, whose own collection then comes first and looks again)."""
+    global _look_after_s
     collect_ended_sessions()
+    _look_after_s = LATE_COLLECT_AFTER_S
     _look_again()
 
 
 def _look_again() -> None:
-    global _look_due
+    global _look_due, _look_after_s
     if _look_due:
         return
     try:
@@ -179,7 +184,8 @@ def _look_again() -> None:
     except RuntimeError:
         return
     _look_due = True
-    loop.call_later(LATE_COLLECT_AFTER_S, _late_collection)
+    loop.call_later(_look_after_s, _late_collection)
+    _look_after_s *= 2.0
 
 
 def _late_collection() -> None:

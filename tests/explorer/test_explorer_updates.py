@@ -397,6 +397,7 @@ def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch,
     monkeypatch.setattr(gc_policy, "_held", [])
     monkeypatch.setattr(gc_policy, "_collect_due", False)
     monkeypatch.setattr(gc_policy, "_look_due", False)
+    monkeypatch.setattr(gc_policy, "_look_after_s", 0.05)
 
     class Page:
         pass
