@@ -63,8 +63,10 @@ F_TOL = 1e-10
 #: its uncertainty, and the last iteration (1 + p solves) or two are not paid. Measured
 #: on the creeping footing of tests/back_analysis (two creep fields, 12 noise draws):
 #: 137 -> 102 solves, the values within 2.4e-4 of their standard errors of the fit run to
-#: ``X_TOL``, the standard errors within 5e-6 (relative). Exact readings (residuals at the
-#: solver's level) make the standard errors tiny, and the fit runs on to ``X_TOL``.
+#: ``X_TOL``, the standard errors within 5e-6 (relative). Exact readings without standard
+#: deviations (residuals at the solver's level) make the standard errors tiny, and the fit
+#: runs on to ``X_TOL``; so does a fit whose fields the readings do not determine (its
+#: standard errors do not hold: :data:`MAX_CONDITION`).
 STEP_TO_SE = 1e-3
 #: The least-squares solver's message when that criterion stopped it.
 SETTLED = (f"the Gauss-Newton step is below {STEP_TO_SE:g} of every standard error "
@@ -195,9 +197,10 @@ def calibrate(scene: Scene | Mapping[str, Any],
         step = np.linalg.lstsq(J, -r, rcond=None)[0]
         if not np.all((x + step >= lo) & (x + step <= hi)):
             return  # the minimum is at a bound: the solver's own tolerances decide there
-        se = np.sqrt(np.abs(np.diag(_covariance(J, 1.0 if std_given else
-                                                float(r @ r) / dof)[0])))
-        if np.all(np.isfinite(se)) and np.all(np.abs(step) <= STEP_TO_SE * se):
+        cov, condition = _covariance(J, 1.0 if std_given else float(r @ r) / dof)
+        se = np.sqrt(np.abs(np.diag(cov)))
+        if (condition <= MAX_CONDITION and np.all(np.isfinite(se))
+                and np.all(np.abs(step) <= STEP_TO_SE * se)):
             stopped.append(True)
             raise StopIteration
 

@@ -27,10 +27,12 @@ server 60-85 MiB above its level until the next round ended). On a loaded server
 can be held longer than that (its last solve queued behind others): :func:`watch_page`
 follows each page whose session has ended, and while one of them is still alive after
 a collection, one more comes later, each wait twice the last (from
-:data:`LATE_COLLECT_AFTER_S`: a full collection walks every live page, so a page held
-long costs a few pauses, not one every 10 s), for at most :data:`HELD_AT_MOST_S` after
-its session ended (then a warning names how many are still
-held: a page that outlives that is kept by something other than its work).
+:data:`LATE_COLLECT_AFTER_S` up to :data:`LOOK_AT_MOST_EVERY_S`: a full collection walks
+every live page, so a page held long costs a few pauses, not one every 10 s), for at
+most :data:`HELD_AT_MOST_S` after its session ended (then a warning names how many are
+still held: a page that outlives that is kept by something other than its work). The
+sessions that end meanwhile get their own collection and the late one after it, as
+always.
 
 While a page is being built (:func:`pause_for_page`, from the start of the session's
 page to the end of the request that asked for it) the collector does not run: building
@@ -64,9 +66,12 @@ COLLECT_AFTER_S = 2.0
 #: Delay from that collection to one more, for pages let go just after it [s]; the first
 #: of the doubling waits while a page of an ended session is still held.
 LATE_COLLECT_AFTER_S = 10.0
+#: The longest wait between two looks for a page still held [s].
+LOOK_AT_MOST_EVERY_S = 60.0
 #: How long after its session ended a page still held is looked for [s]: a page's work
 #: ends well within this even on a saturated server (a solve is bounded by
-#: ``core.limits.MAX_SOLVE_CPU_SECONDS`` of CPU; a page's build takes seconds).
+#: ``core.limits.MAX_SOLVE_CPU_SECONDS`` of CPU, a page's build takes 1-2 s of CPU; both
+#: wait for the cores on a loaded machine).
 HELD_AT_MOST_S = 300.0
 
 #: Longest the collector stays paused for a page being built [s] (the build takes 1-2 s
@@ -75,7 +80,8 @@ PAUSE_AT_MOST_S = 10.0
 
 _collect_due = False
 _paused = False
-_look_due = False
+#: The pending look (at most one) and the wait before the next.
+_look: asyncio.TimerHandle | None = None
 _look_after_s = LATE_COLLECT_AFTER_S
 #: The pages of ended sessions not yet seen freed, with when their session ended
 #: (``time.monotonic``).
@@ -167,8 +173,9 @@ def held_pages() -> int:
 
 
 def _collect_and_look_again() -> None:
-    """The collection for ended sessions, and one more a little later (unless another
-    session ends meanwhile, whose own collection then comes first and looks again)."""
+    """The collection for ended sessions, and one more :data:`LATE_COLLECT_AFTER_S`
+    later (it replaces a longer wait pending for an older page: that page is looked for
+    again then too)."""
     global _look_after_s
     collect_ended_sessions()
     _look_after_s = LATE_COLLECT_AFTER_S
@@ -176,33 +183,34 @@ def _collect_and_look_again() -> None:
 
 
 def _look_again() -> None:
-    global _look_due, _look_after_s
-    if _look_due:
-        return
+    """Schedule the next look (instead of the one pending, if any)."""
+    global _look, _look_after_s
     try:
         loop = asyncio.get_running_loop()
     except RuntimeError:
         return
-    _look_due = True
-    loop.call_later(_look_after_s, _late_collection)
-    _look_after_s *= 2.0
+    if _look is not None:
+        _look.cancel()
+    _look = loop.call_later(_look_after_s, _late_collection)
+    _look_after_s = min(2.0 * _look_after_s, LOOK_AT_MOST_EVERY_S)
 
 
 def _late_collection() -> None:
-    global _look_due
-    _look_due = False
-    if _collect_due:  # a collection already due covers it, and looks again after
+    global _look
+    _look = None
+    if _collect_due:  # the collection due runs first and schedules the next look
         return
     collect_ended_sessions()
     if not held_pages():
         return
     now = time.monotonic()
-    if any(now - since < HELD_AT_MOST_S for _, since in _held):
-        _look_again()
-    else:
+    given_up = [ref for ref, since in _held if now - since >= HELD_AT_MOST_S]
+    if given_up:
         log.warning("%d page(s) of sessions that ended over %g s ago are still held",
-                    len(_held), HELD_AT_MOST_S)
-        _held.clear()
+                    len(given_up), HELD_AT_MOST_S)
+        _held[:] = [(ref, since) for ref, since in _held if now - since < HELD_AT_MOST_S]
+    if _held:
+        _look_again()
 
 
 def collect_ended_sessions() -> int:

@@ -376,14 +376,15 @@ def test_a_page_completed_after_its_session_ended_is_not_frozen() -> None:
         gc.unfreeze()
 
 
-def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch,
-                                                                   caplog) -> None:
+def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch, caplog,
+                                                                   wait_until) -> None:
     """On a loaded server a dropped page can be held longer than the collection after its
     session ended and the late one (its last solve queued behind others). Frozen with
     the live pages by those collections, it was freed by nothing once let go, until
     another session ended (the abandoned-sessions soak test, run beside the suite:
     +43 MiB after 90 s). The collector now looks again while such a page is alive, and
-    gives up with a warning after ``HELD_AT_MOST_S``."""
+    gives up with a warning after ``HELD_AT_MOST_S``. A session ending meanwhile still
+    gets its late collection soon, not after the longer wait pending for the older page."""
     import asyncio
     import gc
     import logging
@@ -392,11 +393,12 @@ def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch,
 
     monkeypatch.setattr(gc_policy, "COLLECT_AFTER_S", 0.01)
     monkeypatch.setattr(gc_policy, "LATE_COLLECT_AFTER_S", 0.05)
-    # the module's state, restored afterwards (a look left scheduled on the closed loop
+    monkeypatch.setattr(gc_policy, "LOOK_AT_MOST_EVERY_S", 30.0)
+    # the module's state, restored afterwards (a look left scheduled on a closed loop
     # must not stop another test's)
     monkeypatch.setattr(gc_policy, "_held", [])
     monkeypatch.setattr(gc_policy, "_collect_due", False)
-    monkeypatch.setattr(gc_policy, "_look_due", False)
+    monkeypatch.setattr(gc_policy, "_look", None)
     monkeypatch.setattr(gc_policy, "_look_after_s", 0.05)
 
     class Page:
@@ -407,35 +409,68 @@ def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch,
         page.me = page  # a page's objects are cycles: only a full collection frees them
         return page
 
-    async def drop(page: Page, hold_s: float) -> weakref.ref:
-        alive = weakref.ref(page)
+    async def until(condition, timeout: float = 20.0) -> bool:
+        # every wait on a condition (full collections of this whole process take time
+        # on a loaded machine): the timeout is a bound, not a measurement
+        deadline = asyncio.get_running_loop().time() + timeout
+        while not condition():
+            if asyncio.get_running_loop().time() > deadline:
+                return False
+            await asyncio.sleep(0.01)
+        return True
+
+    async def end_session(page: Page) -> weakref.ref:
         gc_policy.session_ended(None)
         gc_policy.watch_page(page)(None)
-        holder = [page]
-        del page
-        await asyncio.sleep(hold_s)  # the collections run while the page is still held
+        return weakref.ref(page)
+
+    collections: list[int] = []
+    collect = gc_policy.collect_ended_sessions
+    monkeypatch.setattr(gc_policy, "collect_ended_sessions",
+                        lambda: collections.append(1) or collect())
+
+    async def held_then_let_go() -> None:
+        holder = [cyclic_page()]
+        alive = await end_session(holder[0])
+        # held past the collection (0.01 s) and the late one (0.06 s), then let go while
+        # frozen with the live pages
+        assert await until(lambda: len(collections) >= 2)
         assert gc.get_freeze_count() > 0 and alive() is not None
-        holder.clear()  # let go, while frozen with the live pages
-        await asyncio.sleep(0.3)
-        return alive
+        holder.clear()
+        assert await until(lambda: alive() is None), "the page was not freed once let go"
+        assert await until(lambda: gc_policy._look is None and gc_policy.held_pages() == 0)
+
+    async def a_new_session_while_an_old_page_waits() -> None:
+        old = cyclic_page()
+        gc_policy.watch_page(old)(None)
+        monkeypatch.setattr(gc_policy, "_look_after_s", 30.0)
+        gc_policy._look_again()  # the old page's next look, 30 s away
+        holder = [cyclic_page()]
+        alive = await end_session(holder[0])
+        assert await until(lambda: not gc_policy._collect_due)  # its collection has run
+        # its late collection comes LATE_COLLECT_AFTER_S after that, not in 30 s
+        loop = asyncio.get_running_loop()
+        assert gc_policy._look is not None and gc_policy._look.when() < loop.time() + 1.0
+        holder.clear()  # let go just after its collection
+        assert await until(lambda: alive() is None)
+        del old
+        assert await until(lambda: gc_policy._look is None and gc_policy.held_pages() == 0)
+
+    async def held_for_good(kept: Page) -> None:
+        await end_session(kept)
+        assert await until(lambda: "are still held" in caplog.text)
+        assert await until(lambda: gc_policy._look is None)
 
     try:
-        # held past the collection (0.01 s) and the late one (0.06 s)
-        alive = asyncio.run(drop(cyclic_page(), 0.2))
-        assert alive() is None and gc_policy.held_pages() == 0
+        asyncio.run(held_then_let_go())
+        asyncio.run(a_new_session_while_an_old_page_waits())
         # a page still held HELD_AT_MOST_S after its session ended is given up, named
         monkeypatch.setattr(gc_policy, "HELD_AT_MOST_S", 0.1)
         kept = cyclic_page()
-
-        async def held_for_good() -> None:
-            gc_policy.session_ended(None)
-            gc_policy.watch_page(kept)(None)
-            await asyncio.sleep(0.5)
-
         with caplog.at_level(logging.WARNING, logger=gc_policy.__name__):
-            asyncio.run(held_for_good())
+            asyncio.run(held_for_good(kept))
         assert "1 page(s) of sessions that ended over 0.1 s ago are still held" in caplog.text
-        assert gc_policy.held_pages() == 0 and not gc_policy._look_due
+        assert gc_policy.held_pages() == 0
     finally:
         gc.unfreeze()
 
