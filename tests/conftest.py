@@ -69,6 +69,25 @@ def wait_until(condition: Callable[[], Any], timeout: float = 30.0,
         time.sleep(every)
 
 
+@pytest.hookimpl(hookwrapper=True, tryfirst=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
+    """A test's hard time limit (its ``timeout`` marker, pytest-timeout) stretched as its
+    waits are (:func:`tests.browser_pages.patience`, read when the test starts): the
+    limit catches a test that hangs, it does not time the machine. On a 2-core machine
+    running the suite beside a CPU hog (load ~6) the browser test of the FE coating
+    check ran out of its fixed 300 s while its own wait for the check, 180 s stretched,
+    still had time."""
+    from tests.browser_pages import patience
+
+    marker = item.get_closest_marker("timeout")
+    seconds = None if marker is None else (marker.args[0] if marker.args
+                                           else marker.kwargs.get("timeout"))
+    if isinstance(seconds, (int, float)) and seconds > 0:
+        # first among the item's markers: the closest one, which pytest-timeout reads
+        item.add_marker(pytest.mark.timeout(float(seconds) * patience()), append=False)
+    yield
+
+
 @pytest.fixture(name="wait_until")
 def wait_until_fixture() -> Callable[..., bool]:
     """:func:`wait_until` for the tests: ``assert wait_until(lambda: done, timeout=60)``."""
