@@ -29,6 +29,17 @@ def _exact() -> core.SceneSolution:
     return core.solve(scene)
 
 
+def _noisy(exact: core.SceneSolution, rng: np.random.Generator) -> dict:
+    """Readings of ``exact``'s settlements and tilts with normal noise of the stated
+    deviations (drawn from ``rng``: the settlements first, then the tilts)."""
+    return {"time": TIMES.tolist(),
+            "settlement": (exact.settlement
+                           + SETTLEMENT_STD * rng.standard_normal(TIMES.size)).tolist(),
+            "settlement_std": SETTLEMENT_STD,
+            "tilt": (exact.tilt + TILT_STD * rng.standard_normal(TIMES.size)).tolist(),
+            "tilt_std": TILT_STD}
+
+
 def test_exact_readings_give_the_exact_fields() -> None:
     exact = _exact()
     start = apply_point(SCENE, {path: 1.3 * v for path, v in TRUTH.items()})
@@ -47,13 +58,7 @@ def test_exact_readings_give_the_exact_fields() -> None:
 
 def test_result_serialises_with_units_and_forecasts_a_band() -> None:
     exact = _exact()
-    rng = np.random.default_rng(7)
-    readings = {"time": TIMES.tolist(),
-                "settlement": (exact.settlement
-                               + SETTLEMENT_STD * rng.standard_normal(TIMES.size)).tolist(),
-                "settlement_std": SETTLEMENT_STD,
-                "tilt": (exact.tilt + TILT_STD * rng.standard_normal(TIMES.size)).tolist(),
-                "tilt_std": TILT_STD}
+    readings = _noisy(exact, np.random.default_rng(7))
     fit = calibrate(SCENE, readings, fit=["base.creep.compliance", "base.creep.rate"],
                     bounds={"base.creep.rate": (1e-3, 1.0)})
     assert fit.identifiable and fit.std_given
@@ -138,14 +143,7 @@ def test_standard_errors_cover_the_truth_in_95_percent_of_draws() -> None:
     hits = np.zeros(len(paths))
     draws = 100
     for _ in range(draws):
-        readings = {
-            "time": TIMES.tolist(),
-            "settlement": (exact.settlement
-                           + SETTLEMENT_STD * rng.standard_normal(TIMES.size)).tolist(),
-            "settlement_std": SETTLEMENT_STD,
-            "tilt": (exact.tilt + TILT_STD * rng.standard_normal(TIMES.size)).tolist(),
-            "tilt_std": TILT_STD}
-        fit = calibrate(scene, readings, fit=paths)
+        fit = calibrate(scene, _noisy(exact, rng), fit=paths)
         for j, path in enumerate(paths):
             hits[j] += abs(fit.values[path] - TRUTH[path]) <= 1.96 * fit.standard_errors[path]
     coverage = hits / draws
@@ -160,13 +158,7 @@ def test_a_fit_stops_once_its_step_is_far_inside_the_standard_errors(monkeypatch
     import core.back_analysis.fit as fit_module
 
     exact = _exact()
-    rng = np.random.default_rng(11)
-    readings = {"time": TIMES.tolist(),
-                "settlement": (exact.settlement
-                               + SETTLEMENT_STD * rng.standard_normal(TIMES.size)).tolist(),
-                "settlement_std": SETTLEMENT_STD,
-                "tilt": (exact.tilt + TILT_STD * rng.standard_normal(TIMES.size)).tolist(),
-                "tilt_std": TILT_STD}
+    readings = _noisy(exact, np.random.default_rng(11))
     paths = ["base.creep.compliance", "base.creep.rate"]
     fit = calibrate(SCENE, readings, fit=paths)
     assert fit.status == fit_module.SETTLED and not fit.warnings
