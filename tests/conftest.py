@@ -6,7 +6,8 @@
   so a count does not depend on which tests ran before; a test that looks at what the
   caches hold asks for :func:`cold_caches`.
 - Tests wait on conditions, never on the clock: :func:`wait_until` polls a condition and
-  returns False when a generous bound runs out (a failure bound, not a measurement).
+  returns False when a generous bound runs out (a failure bound, not a measurement),
+  stretched on a busy machine; so is a test's hard limit (its ``timeout`` marker).
 - Property tests draw the same examples on every run (hypothesis profile ``suite``,
   derandomized); ``HYPOTHESIS_PROFILE=explore`` draws new ones.
 - One served explorer (:func:`explorer_server`, ``python -m explorer`` in a child
