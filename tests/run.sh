@@ -60,7 +60,10 @@ fi
 # 58.8 s of CPU). The checks of seconds each (marker "slow", 75 tests with the soak ones)
 # run in the soak part instead (2026-12-01) balanced the parts (rest 25.4, browser 24.5,
 # soak 23.9 min) but not the whole: 26.1 min on a fresh clone, 2107 s user + 110 s system
-# CPU, against 23.6 min (1773 s + 86 s) for the split above on the same day.
+# CPU, against 23.6 min (1773 s + 86 s) for the split above on the same day. Beside a CPU
+# hog (two busy-loop processes, load 5-8; 2026-12-01, a fresh clone): 51.3 min, all
+# green (rest 50.2, browser 35.2, soak 15.4 min, documentation 580 s), 2216 s user +
+# 107 s system CPU of the suite.
 # The parts share nothing: each has its own temporary directory, pytest cache and served
 # explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
