@@ -92,6 +92,8 @@ def check_live_bound(value: object) -> float:
         raise ValueError(f"live_bound: must be a number of seconds from {low:g} to "
                          f"{high:g}, got {value!r}")
     return float(value)
+
+
 #: Shortest time between two results drawn on a served page [ms]: the page takes ~45-65
 #: ms of its CPU to show one (benchmarks/results/explorer_latency.md), so a faster stream
 #: of results only queues up in front of it (12 fps at most: a drag stays live).

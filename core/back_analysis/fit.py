@@ -16,6 +16,7 @@ tolerances :data:`X_TOL` and :data:`F_TOL`.
 
 from __future__ import annotations
 
+import inspect
 import math
 import os
 import time
@@ -68,6 +69,9 @@ F_TOL = 1e-10
 #: runs on to ``X_TOL``; so does a fit whose fields the readings do not determine (its
 #: standard errors do not hold: :data:`MAX_CONDITION`).
 STEP_TO_SE = 1e-3
+#: Whether the installed SciPy's ``least_squares`` takes the callback that stops there
+#: (from SciPy 1.16; with an older one the fit runs on to ``X_TOL``, as it did before).
+STOPS_SETTLED = "callback" in inspect.signature(least_squares).parameters
 #: The least-squares solver's message when that criterion stopped it.
 SETTLED = (f"the Gauss-Newton step is below {STEP_TO_SE:g} of every standard error "
            "(relative offset)")
@@ -183,8 +187,6 @@ def calibrate(scene: Scene | Mapping[str, Any],
     max_nfev = max(1, MAX_FIT_SOLVES // (p + 1))
     dof = n - p
 
-    stopped = []
-
     def settled(intermediate_result: Any) -> None:
         """Stop where the Gauss-Newton step from the point is below :data:`STEP_TO_SE`
         of every standard error (its Jacobian is the one the solver has just asked for,
@@ -201,13 +203,13 @@ def calibrate(scene: Scene | Mapping[str, Any],
         se = np.sqrt(np.abs(np.diag(cov)))
         if (condition <= MAX_CONDITION and np.all(np.isfinite(se))
                 and np.all(np.abs(step) <= STEP_TO_SE * se)):
-            stopped.append(True)
             raise StopIteration
 
     answer = least_squares(residuals, x0, jac=jacobian, bounds=(lo, hi), method="trf",
                            x_scale=1.0, xtol=X_TOL, ftol=F_TOL, gtol=F_TOL,
-                           max_nfev=max_nfev, callback=settled)
-    if stopped:
+                           max_nfev=max_nfev,
+                           **({"callback": settled} if STOPS_SETTLED else {}))
+    if answer.status == -2:  # SciPy's status of a stop by the callback: settled
         answer.success, answer.message = True, SETTLED
     x = answer.x
     solution = model.solve(x)

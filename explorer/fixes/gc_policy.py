@@ -204,11 +204,11 @@ def _late_collection() -> None:
     if not held_pages():
         return
     now = time.monotonic()
-    given_up = [ref for ref, since in _held if now - since >= HELD_AT_MOST_S]
-    if given_up:
+    young = [(ref, since) for ref, since in _held if now - since < HELD_AT_MOST_S]
+    if len(young) < len(_held):
         log.warning("%d page(s) of sessions that ended over %g s ago are still held",
-                    len(given_up), HELD_AT_MOST_S)
-        _held[:] = [(ref, since) for ref, since in _held if now - since < HELD_AT_MOST_S]
+                    len(_held) - len(young), HELD_AT_MOST_S)
+        _held[:] = young
     if _held:
         _look_again()
 

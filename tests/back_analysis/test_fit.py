@@ -161,11 +161,14 @@ def test_a_fit_stops_once_its_step_is_far_inside_the_standard_errors(monkeypatch
     readings = _noisy(exact, np.random.default_rng(11))
     paths = ["base.creep.compliance", "base.creep.rate"]
     fit = calibrate(SCENE, readings, fit=paths)
-    assert fit.status == fit_module.SETTLED and not fit.warnings
+    assert not fit.warnings
     monkeypatch.setattr(fit_module, "STEP_TO_SE", 0.0)
     full = calibrate(SCENE, readings, fit=paths)
     assert "xtol" in full.status or "ftol" in full.status
-    assert fit.solves < full.solves
+    if fit_module.STOPS_SETTLED:
+        assert fit.status == fit_module.SETTLED and fit.solves < full.solves
+    else:  # SciPy < 1.16 (pyproject allows 1.10): no callback, the fit runs on as before
+        assert fit.status == full.status and fit.solves == full.solves
     for path in paths:
         assert abs(fit.values[path] - full.values[path]) <= 1e-3 * full.standard_errors[path]
         assert fit.standard_errors[path] == pytest.approx(full.standard_errors[path], rel=1e-3)
