@@ -185,7 +185,8 @@ class ExplorerApp(pn.viewable.Viewer):
 
         The Scene, Check, Files and Lessons views are made at once (the others' results
         reach them, and they cost ~40 ms together); the other six only when their tab is
-        filled on a served page (:class:`~explorer.views.DeferredTabs`), or when asked for
+        filled (:class:`~explorer.views.DeferredTabs`: on a served page when opened or in
+        the background; elsewhere when the page is first shown), or when asked for
         (``app.base_tab``): they are ~0.6-0.9 s of the ~2 s of the server's CPU that a new
         page cost, and a page may never show them."""
         state, screen, controller, loop = self.state, self.screen, self.controller, self.loop
@@ -326,6 +327,10 @@ class ExplorerApp(pn.viewable.Viewer):
         self.results.push()
 
     def __panel__(self) -> pn.viewable.Viewable:
+        if not self.loop.served:
+            # a notebook or a saved page shows every tab as it is: no event loop fills
+            # them later
+            self.tabs.fill_all()
         return self._layout
 
     # -- events ----------------------------------------------------------------------

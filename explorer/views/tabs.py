@@ -42,11 +42,12 @@ class DeferredTabs:
     :data:`FILL_TABS_AFTER_MS`, and keeps them. Panel's dynamic tabs would rebuild a tab at
     every switch: measured 110 ms of server time each, which made 20 sessions 8x slower.
 
-    A tab is given as its column, or as a function that makes it: a served page calls
-    that function when the tab is filled, so the view behind it (its widgets and their
-    watchers) is not even made for a page that never shows it (see
-    ``explorer.app.ExplorerApp``); elsewhere (a notebook, a script) every tab is made at
-    once."""
+    A tab is given as its column, or as a function that makes it: that function is called
+    when the tab is filled, so the view behind it (its widgets and their watchers) is not
+    even made for a page that never shows it (see ``explorer.app.ExplorerApp``). Outside a
+    server (a notebook, a script) there is no page to fill tabs in the background: every
+    tab is filled when the page is first shown (:meth:`fill_all`), and a session that is
+    never shown (a script driving the state) makes only the views it asks for."""
 
     def __init__(self, loop: PageLoop,
                  tabs: list[tuple[str, pn.Column | Callable[[], pn.Column]]]) -> None:
@@ -57,7 +58,7 @@ class DeferredTabs:
         self.deferred: dict[int, tuple[pn.Column, list[Any] | Callable[[], pn.Column]]] = {}
         columns = []
         for k, (_title, content) in enumerate(tabs):
-            if not (k and loop.served):
+            if not k:
                 column = content if isinstance(content, pn.Column) else content()
             elif isinstance(content, pn.Column):
                 column = content
@@ -96,6 +97,11 @@ class DeferredTabs:
             del self.deferred[index]
             if not self.deferred:
                 self._complete()
+
+    def fill_all(self) -> None:
+        """Give every tab its widgets now (a page shown outside a server)."""
+        for index in sorted(self.deferred):
+            self.fill(index)
 
     def _complete(self) -> None:
         """Mark the page complete (:data:`COMPLETE_CLASS`): no more background work of

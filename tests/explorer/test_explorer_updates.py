@@ -523,6 +523,21 @@ async def _pause() -> bool:
     return gc_policy.pause_for_page()
 
 
+def test_a_session_outside_a_server_fills_every_tab_when_shown(explorer_app) -> None:
+    """Outside a server (a script, a notebook) the six costly views wait as well: a
+    script that drives the state makes only those it asks for; shown (a notebook cell, a
+    saved page), the page has every tab filled, as no event loop fills them later."""
+    app = explorer_app()
+    made_first = {"scene", "check", "files", "lessons"}
+    assert set(app._views) == made_first
+    assert app.base_tab.base_thickness.value == pytest.approx(app.state.base.thickness)
+    assert set(app._views) == made_first | {"base"}
+    assert app.__panel__() is app.page_parts()[0]
+    assert set(app._views) == made_first | {"punch", "coating", "base", "times", "study",
+                                            "fit"}
+    assert not app.tabs.deferred and all(tab.objects for tab in app.sidebar.objects)
+
+
 def test_a_served_page_makes_a_tab_s_view_only_when_the_tab_is_filled(monkeypatch,
                                                                       explorer_app) -> None:
     """The Punch, Coating, Base, Time, Study and Fit views (~0.6-0.9 s of the server's
