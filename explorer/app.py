@@ -132,8 +132,8 @@ class ExplorerApp(pn.viewable.Viewer):
         self.results = ResultsView(self.screen, self.controller, self.loop, self.figures,
                                    self.limits, self.pins, self.link)
         # model fidelity (layer interface, contact model, coating-model tolerance): one
-        # view whose widgets sit in the Coating and Time tabs
-        self.fidelity = FidelityView(self.state, self.screen.reject)
+        # view whose widgets sit in the Coating and Time tabs (see ``fidelity``)
+        self._fidelity = FidelityView(self.state, self.screen.reject)
         self._layout = self._build_layout(self._build_sidebar())
         self._wanted_index, tab, pin_scenes, pin_message = read_view_query(
             query or {}, len(self.sidebar))
@@ -185,19 +185,19 @@ class ExplorerApp(pn.viewable.Viewer):
 
         The Scene, Check, Files and Lessons views are made at once (the others' results
         reach them, and they cost ~40 ms together); the other six only when their tab is
-        filled (:class:`~explorer.views.DeferredTabs`: on a served page when opened or in
-        the background; elsewhere when the page is first shown), or when asked for
-        (``app.base_tab``): they are ~0.6-0.9 s of the ~2 s of the server's CPU that a new
-        page cost, and a page may never show them."""
+        filled (:class:`~explorer.views.DeferredTabs`: when opened, or a link names it; on
+        a served page also in the background, elsewhere when the page is first shown), or
+        when asked for (``app.base_tab``): they are ~0.6-0.9 s of the ~2 s of the server's
+        CPU that a new page cost, and a page may never show them."""
         state, screen, controller, loop = self.state, self.screen, self.controller, self.loop
         live = self._drag_step_applies
         self._views: dict[str, Any] = {}
         self._makers: dict[str, Callable[[], Any]] = {
             "punch": lambda: PunchView(state, screen, live),
-            "coating": lambda: CoatingView(state, self.fidelity, controller, loop, live,
+            "coating": lambda: CoatingView(state, self._fidelity, controller, loop, live,
                                            screen),
             "base": lambda: BaseView(state, screen.reject, live),
-            "times": lambda: TimesView(state, self.fidelity, screen.reject, live),
+            "times": lambda: TimesView(state, self._fidelity, screen.reject, live),
             "study": lambda: StudyView(state, controller, loop, self.link.schedule),
             "fit": lambda: FitView(state, controller, loop, self.figures, self.load_scene,
                                    screen, on_settings=self.link.schedule),
@@ -213,6 +213,7 @@ class ExplorerApp(pn.viewable.Viewer):
                  ("base", BaseView), ("times", TimesView), ("check", CheckView),
                  ("files", FilesView), ("lessons", LessonsView), ("study", StudyView),
                  ("fit", FitView))
+        self._tab_names = [name for name, _ in order]
         return [(cls.title, self._views[name].content() if name in self._views
                  else (lambda name=name: self._view(name).content()))
                 for name, cls in order]
@@ -228,6 +229,14 @@ class ExplorerApp(pn.viewable.Viewer):
         """The view of sidebar tab ``name`` if it was made, else None."""
         return self._views.get(name)
 
+    @property
+    def fidelity(self) -> FidelityView:
+        """The model-fidelity view (the layer interface, the contact model, the coating
+        model's tolerance). Its interface selector edits the layer that the Coating tab
+        edits: that tab's view is made first, if it was not yet."""
+        self._view("coating")
+        return self._fidelity
+
     scene_tab = property(lambda self: self._view("scene"), doc="The Scene tab's view.")
     punch_tab = property(lambda self: self._view("punch"), doc="The Punch tab's view.")
     coating_tab = property(lambda self: self._view("coating"), doc="The Coating tab's view.")
@@ -240,8 +249,13 @@ class ExplorerApp(pn.viewable.Viewer):
     fit_tab = property(lambda self: self._view("fit"), doc="The Fit tab's view.")
 
     def page_parts(self) -> list[Any]:
-        """Every viewable of the page: the layout and the sidebar tabs not filled yet."""
-        return [self._layout, *self.tabs.parts()]
+        """Every viewable of the page: the layout, the sidebar tabs not filled yet, and
+        the views made before their tab was filled (a link's Study or Fit settings)."""
+        waiting = {k for k, (_, objects) in self.tabs.deferred.items()
+                   if not isinstance(objects, list)}
+        made = [self._views[name].content() for k, name in enumerate(self._tab_names)
+                if k in waiting and name in self._views]
+        return [self._layout, *self.tabs.parts(), *made]
 
     def _initial_scene(self, scene: dict[str, Any] | None, query: dict[str, str]) -> None:
         default = self.presets.get(DEFAULT_PRESET) or next(iter(self.presets.values()), None)

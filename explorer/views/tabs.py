@@ -45,9 +45,10 @@ class DeferredTabs:
     A tab is given as its column, or as a function that makes it: that function is called
     when the tab is filled, so the view behind it (its widgets and their watchers) is not
     even made for a page that never shows it (see ``explorer.app.ExplorerApp``). Outside a
-    server (a notebook, a script) there is no page to fill tabs in the background: every
-    tab is filled when the page is first shown (:meth:`fill_all`), and a session that is
-    never shown (a script driving the state) makes only the views it asks for."""
+    server (a notebook, a script) there is no page to fill tabs in the background: a tab
+    is filled when opened, and every tab when the page is first shown
+    (``ExplorerApp.__panel__`` calls :meth:`fill_all`); a session that is never shown (a
+    script driving the state) makes only the views it asks for."""
 
     def __init__(self, loop: PageLoop,
                  tabs: list[tuple[str, pn.Column | Callable[[], pn.Column]]]) -> None:

@@ -70,9 +70,6 @@ def test_widgets_edit_and_show_the_fidelity_fields(explorer_app) -> None:
 
     app = explorer_app()
     view = app.fidelity
-    # the interface selector sits in the Coating tab, which points it at the layer being
-    # edited when it is made: when the tab is opened
-    app.sidebar.active = 2  # Scene, Punch, Coating, ...: the order is part of the links
     view.interface.value = "bonded"
     assert app.state.layers[0].interface == "bonded"
     view.contact.value = "unilateral"

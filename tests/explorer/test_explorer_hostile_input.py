@@ -24,7 +24,8 @@ def _rendered_markup(app: Any) -> list[str]:
     import panel as pn
 
     texts = []
-    for pane in app._layout.select(pn.pane.Markdown) + app._layout.select(pn.pane.HTML):
+    page = app.__panel__()  # (every tab filled, as shown)
+    for pane in page.select(pn.pane.Markdown) + page.select(pn.pane.HTML):
         texts.append(str(pane.object))
     texts += [str(app.results.notice_alert.object), str(app.results.alert.object)]
     return texts

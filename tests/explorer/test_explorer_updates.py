@@ -523,6 +523,26 @@ async def _pause() -> bool:
     return gc_policy.pause_for_page()
 
 
+def test_a_view_made_before_its_tab_is_filled_is_released_with_the_page(monkeypatch,
+                                                                         explorer_app):
+    """A link's Fit or Study settings make that view before its tab is filled; when the
+    session ends, the links its widgets registered with Panel go with the page's (they
+    were left out of ``page_parts``, and through them the whole page stayed)."""
+    from panel.links import Callback
+
+    from explorer.fixes.closed_pages import release_links
+
+    monkeypatch.setattr(PageLoop, "served", property(lambda self: True))
+    app = explorer_app()
+    fit = app.fit_tab  # made as a link's readings make it, its tab not filled
+    assert "fit" in app._views and any(
+        not isinstance(objects, list) for _, objects in app.tabs.deferred.values())
+    held = [obj for obj in fit.content().select() if obj in Callback.registry]
+    assert held  # (its file box's links)
+    release_links(app.page_parts())
+    assert not [obj for obj in held if obj in Callback.registry]
+
+
 def test_a_session_outside_a_server_fills_every_tab_when_shown(explorer_app) -> None:
     """Outside a server (a script, a notebook) the six costly views wait as well: a
     script that drives the state makes only those it asks for; shown (a notebook cell, a
