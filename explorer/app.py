@@ -342,8 +342,8 @@ class ExplorerApp(pn.viewable.Viewer):
 
     def __panel__(self) -> pn.viewable.Viewable:
         if not self.loop.served:
-            # a notebook or a saved page shows every tab as it is: no event loop fills
-            # them later
+            # a notebook cell (or the page saved with pn.panel(app).save) shows every tab
+            # as it is: no event loop fills them later
             self.tabs.fill_all()
         return self._layout
 

@@ -545,8 +545,9 @@ def test_a_view_made_before_its_tab_is_filled_is_released_with_the_page(monkeypa
 
 def test_a_session_outside_a_server_fills_every_tab_when_shown(explorer_app) -> None:
     """Outside a server (a script, a notebook) the six costly views wait as well: a
-    script that drives the state makes only those it asks for; shown (a notebook cell, a
-    saved page), the page has every tab filled, as no event loop fills them later."""
+    script that drives the state makes only those it asks for; shown (a notebook cell,
+    ``pn.panel(app).save``), the page has every tab filled, as no event loop fills them
+    later."""
     app = explorer_app()
     made_first = {"scene", "check", "files", "lessons"}
     assert set(app._views) == made_first
