@@ -144,8 +144,12 @@ def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:
                 "or narrow a punch so that a gap remains between them")
     if len(scenes) > 1 and not _uniform(common["coating"]):
         scenes = _along_x(common, scenes, centers, spans)
-    data = {k: v for k, v in scenes[0].to_dict().items() if k not in ("punch", "loading")}
-    data["punches"] = [{"center": c, **s.to_dict()["punch"], "loading": s.to_dict()["loading"]}
+    # copies of only the parts kept (a whole scene's copy per part read was ~a tenth of a
+    # load change of two punches)
+    data = {k: copy.deepcopy(v) for k, v in scenes[0]._data.items()
+            if k not in ("punch", "loading")}
+    data["punches"] = [{"center": c, **copy.deepcopy(s._data["punch"]),
+                        "loading": copy.deepcopy(s._data["loading"])}
                        for c, s in zip(centers, scenes, strict=True)]
     return PunchesScene(tuple(scenes), tuple(centers), data)
 

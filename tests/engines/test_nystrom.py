@@ -232,6 +232,34 @@ def test_bordered_solve_on_the_refinement_lu_matches_its_own_lu(given):
         assert np.max(np.abs(a[key] - b[key])) <= 1e-12 * np.max(np.abs(b[key]))
 
 
+def test_the_interpolant_on_a_grid_is_each_panels_polynomial_at_any_points():
+    """``NystromGrid.interpolate`` (one product per panel) gives the degree-15 polynomial
+    of each panel through its node values, at points in any order, for node values of
+    one or several columns (a polynomial of degree <= 15 on each panel is reproduced)."""
+    from core.discretize import Panels
+    from core.engines.nystrom.bordered import NystromGrid
+
+    panels = Panels.from_edges(np.array([-1.0, -0.6, -0.1, 0.05, 0.7, 1.0]))
+    grid = NystromGrid(1.0, panels, np.zeros((panels.size, panels.size)),
+                       np.ones(panels.size), np.zeros(panels.size))
+    rng = np.random.default_rng(5)
+    x = rng.uniform(-1.0, 1.0, 300)  # unsorted, every panel hit, some twice in a row
+    x[:4] = [-1.0, 1.0, 0.05, panels.nodes[7]]  # the ends, a panel end, a node
+    powers = np.arange(16)
+    coefficients = rng.normal(size=(16, 3, 2))
+
+    def poly(t: np.ndarray) -> np.ndarray:
+        return np.tensordot(t[:, None] ** powers, coefficients, axes=1)
+
+    values = grid.interpolate(x, poly(panels.nodes))
+    assert values.shape == (x.size, 3, 2)
+    # measured: 9e-16 of the largest value (rounding of the degree-15 polynomial)
+    assert np.max(np.abs(values - poly(x))) <= 1e-13 * np.max(np.abs(poly(x)))
+    one = grid.interpolate(x, poly(panels.nodes)[:, 1, 0])
+    assert one.shape == x.shape
+    assert np.max(np.abs(one - values[:, 1, 0])) <= 1e-13 * np.max(np.abs(one))
+
+
 def test_single_precision_lu_refines_to_the_double_precision_answer():
     """The refined single-precision solve gives the double-precision LU's answer; a matrix
     too ill-conditioned for single precision is factored again in double precision."""

@@ -74,7 +74,19 @@ class NystromGrid:
         """Values at ``x`` of the panel-wise interpolant of ``nodal`` (N, ...)."""
         index, weights = interpolation_weights(self.panels, x)
         per_panel = nodal.reshape((-1, NODES_PER_PANEL) + nodal.shape[1:])
-        return np.einsum("ij,ij...->i...", weights, per_panel[index])
+        if nodal.ndim == 1:
+            return np.einsum("ij,ij->i", weights, per_panel[index])
+        # One product per panel holding points: gathering each point's 16 node rows of
+        # every column first (einsum over per_panel[index]) cost ~10x as much for the
+        # several punches' pressure at ~340 points and ~260 times (4.8 -> 0.5 ms).
+        columns = per_panel.reshape(per_panel.shape[0], NODES_PER_PANEL, -1)
+        out = np.empty((index.size, columns.shape[2]))
+        order = np.argsort(index, kind="stable")
+        starts = np.flatnonzero(np.diff(index[order], prepend=-1))
+        for lo, hi in zip(starts, [*starts[1:], index.size], strict=True):
+            rows = order[lo:hi]
+            out[rows] = weights[rows] @ columns[index[rows[0]]]
+        return out.reshape((index.size,) + nodal.shape[1:])
 
     def rows(self, x: np.ndarray) -> np.ndarray:
         """Rows of ``F`` at points ``x``: ``(F q)(x) = rows @ q`` (len(x), N)."""
