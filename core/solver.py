@@ -138,7 +138,7 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
     # would (one combination of the prepared unit responses): no check first.
     if (contact == "auto" and engines[0].name == "nystrom"
             and (kernel is not None or callable(c))):
-        predicted = predicted_unilateral(unilateral_args)
+        predicted = predicted_unilateral(unilateral_args, geometry, inputs)
         if predicted is not None:
             return predicted
     full = _first_answer(engines, geometry, inputs, asked)

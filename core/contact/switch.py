@@ -85,7 +85,8 @@ def refuse_loads_without_contact(times: Any, kernel: Any, force: Any, moment: An
                          "contact can carry it")
 
 
-def predicted_unilateral(arguments: dict[str, Any]):
+def predicted_unilateral(arguments: dict[str, Any], geometry: Any = None,
+                         inputs: Any = None):
     """The unilateral answer when a cheap check shows full contact lost, else None.
 
     ``contact="auto"`` would solve full contact over all times and then, finding q < 0,
@@ -103,26 +104,30 @@ def predicted_unilateral(arguments: dict[str, Any]):
     prepared for the check as well: preparing it (3-10 ms on the work-precision scenes at
     tol 1e-6) is work the full-contact answer needs anyway, where a separate check on
     the unilateral solver's nodal rule cost 3-14 ms on top of it.
-    ``arguments`` are those of :func:`solve_unilateral`.
+    ``arguments`` are those of :func:`solve_unilateral`; ``geometry`` and ``inputs``, when
+    given, the same arguments as :func:`core.problem.validate_geometry` and
+    :func:`core.problem.validate_time_inputs` returned them (not checked again).
     """
-    from core.engines.nystrom import solve_with_prepared
-    from core.problem import validate_time_inputs
+    from core.engines.nystrom import prepared_for
+    from core.problem import validate_geometry, validate_time_inputs
 
     loads = {k: arguments.get(k) for k in ("settlement", "tilt", "force", "moment")}
-    breakpoints = arguments.get("breakpoints", ())
-    tol = arguments.get("tol", 1e-8)
     try:
-        inputs = validate_time_inputs(arguments["times"], arguments.get("c", 1.0),
-                                      arguments.get("kernel"), loads)
+        if geometry is None:
+            geometry = validate_geometry(arguments["lam"], arguments["m"], arguments["g"],
+                                         arguments.get("breakpoints", ()),
+                                         arguments.get("tol", 1e-8))
+        if inputs is None:
+            inputs = validate_time_inputs(arguments["times"], arguments.get("c", 1.0),
+                                          arguments.get("kernel"), loads)
         first = float(inputs.times[0])
         if inputs.kernel is not None and first != 1.0:
             return None
         at = np.array([first])
         values = {k: float(inputs.loads[k](at)[0]) for k in inputs.given}
         c_first = float(inputs.c(at)[0])
-        check = solve_with_prepared(arguments["lam"], arguments["m"], arguments["g"],
-                                    [first], c=c_first, breakpoints=breakpoints, tol=tol,
-                                    check_only=True, **values)
+        check = prepared_for(geometry).solve_validated(
+            validate_time_inputs([first], c_first, None, values), check_only=True)
         if "contact_lost" not in check.info["flags"]:
             return None
         check_info = {"flags": list(check.info["flags"]),

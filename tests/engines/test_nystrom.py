@@ -126,6 +126,27 @@ def test_a_load_change_builds_nothing_geometric():
     assert sol.force[-1] == pytest.approx(15.0)
 
 
+def test_a_creep_solve_samples_its_geometry_once():
+    """Under ``contact="auto"`` on a creeping base, the check at loading and the answer
+    share one validated geometry: m is sampled once to validate it (257 points) and once
+    for its key (2049 points and more), also for a load change of a prepared one."""
+    sizes = []
+
+    def counted_m(x: np.ndarray) -> np.ndarray:
+        sizes.append(np.size(x))
+        return smooth_m(x)
+
+    kw = dict(c=CONCRETE.relative_modulus(28.0), kernel=CONCRETE.dimensionless_kernel(28.0),
+              moment=0.1, tol=1e-6)
+    for force in (1.0, 1.1):
+        sizes.clear()
+        sol = solve_dimensionless(1.0, counted_m, 0.0, np.linspace(1.0, 3.0, 5), force=force,
+                                  **kw)
+        assert sol.info["contact"] == "full" and sol.success, sol.message
+        # before: validated twice and keyed three times (the check validated its own)
+        assert [n for n in sizes if n == 257 or n >= 2049] == [257, 2049]
+
+
 def test_many_output_times_equal_single_solves():
     prepared = core.prepare(1.0, smooth_m, 0.0, tol=1e-8)
     times = np.linspace(1.0, 100.0, 10_000)

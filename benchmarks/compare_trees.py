@@ -1,0 +1,157 @@
+"""A scene solve's CPU time in this tree against another tree (a commit checked out
+elsewhere), the two measured in turn.
+
+    OPENBLAS_NUM_THREADS=1 python -m benchmarks.compare_trees OTHER_TREE [PRESET ...]
+        [--kind loads|geometry] [--rounds 12] [--solves 10] [--no-write]
+
+On a shared machine the CPU time of one solve moves by tens of per cent from one minute
+to the next, more than a change of a few per cent makes: :mod:`benchmarks.scene_overhead`
+run once per tree cannot tell them apart. Here one worker process per tree (each
+importing ``core`` from its own tree) solves a preset's scene ``--solves`` times per
+round, and the rounds alternate between the two (``--rounds``, the order swapped every
+round), so both see the same machine. The kinds of change are those of
+``scene_overhead``: ``loads`` (the first given load larger at each solve) or
+``geometry`` (the punch, or the last of several, a little wider or moved). Reported per
+preset: the median over rounds of each tree's median CPU time per solve [ms], and the
+median and range of the per-round ratios (this tree / the other). The table (both
+commits, the date, the load) is written to ``benchmarks/results/compare_trees.md``
+unless ``--no-write`` is given.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+from datetime import datetime, timezone
+from pathlib import Path
+
+from benchmarks import ROOT, run_lines
+
+#: Where :func:`main` writes its table.
+RESULTS = Path(__file__).resolve().parent / "results" / "compare_trees.md"
+
+#: The worker, run with ``python -c`` so that it imports ``core`` from its own tree (an
+#: older tree need not have this module): argv tree, preset, kind; it reads a count of
+#: solves per line and answers the median CPU time per solve [ms].
+WORKER = r"""
+import copy, statistics, sys, time
+tree, preset, kind = sys.argv[1:4]
+sys.path.insert(0, tree)
+from core.presets import read_preset
+from core.scene import solve
+
+scene = read_preset(preset)
+solve(scene)  # imports and the first build: not measured
+i = 0
+for line in sys.stdin:
+    cpu = []
+    for _ in range(int(line)):
+        i += 1
+        new = copy.deepcopy(scene)
+        several = "punches" in new
+        if kind == "geometry" and several:
+            last = new["punches"][-1]
+            last["center"] = last["center"] + 1e-6 * i * last["half_width"]
+        elif kind == "geometry":
+            new["punch"]["half_width"] = scene["punch"]["half_width"] * (1 + 1e-6 * i)
+        else:
+            loading = new["punches"][0]["loading"] if several else new["loading"]
+            name = next(q for q, v in loading.items() if not isinstance(v, dict))
+            value = loading[name]
+            loading[name] = value * (1 + 1e-5 * i) if value else 1e-9 * i
+        started = time.process_time()
+        solve(new)
+        cpu.append(time.process_time() - started)
+    print(1e3 * statistics.median(cpu), flush=True)
+"""
+
+
+def _commit(tree: Path) -> str:
+    return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=tree,
+                          capture_output=True, text=True).stdout.strip() or "unknown"
+
+
+def compare(other: Path, preset: str, kind: str, rounds: int, solves: int
+            ) -> tuple[float, float, list[float]]:
+    """(this tree's ms, the other's ms, per-round ratios this / other) for one preset."""
+    env = dict(os.environ, OPENBLAS_NUM_THREADS=os.environ.get("OPENBLAS_NUM_THREADS", "1"))
+    workers = {name: subprocess.Popen([sys.executable, "-c", WORKER, str(tree), preset, kind],
+                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                      text=True, env=env, cwd=str(tree))
+               for name, tree in (("this", ROOT), ("other", other))}
+    times: dict[str, list[float]] = {"this": [], "other": []}
+    try:
+        for r in range(rounds):
+            for name in (("this", "other") if r % 2 == 0 else ("other", "this")):
+                worker = workers[name]
+                worker.stdin.write(f"{solves}\n")
+                worker.stdin.flush()
+                answer = worker.stdout.readline()
+                if not answer:
+                    raise RuntimeError(f"the worker of {name} tree ended (preset {preset})")
+                times[name].append(float(answer))
+    finally:
+        for worker in workers.values():
+            worker.stdin.close()
+            worker.wait()
+    ratios = [a / b for a, b in zip(times["this"], times["other"], strict=True)]
+    return statistics.median(times["this"]), statistics.median(times["other"]), ratios
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("other", type=Path, help="the other tree (a checkout of a commit)")
+    parser.add_argument("presets", nargs="*", help="preset names (default: all)")
+    parser.add_argument("--kind", choices=("loads", "geometry"), default="loads")
+    parser.add_argument("--rounds", type=int, default=12)
+    parser.add_argument("--solves", type=int, default=10)
+    parser.add_argument("--no-write", action="store_true")
+    args = parser.parse_args(argv)
+    if not (args.other / "core" / "__init__.py").is_file():
+        parser.error(f"other: {args.other} holds no core package (a checkout of the "
+                     "repository is needed)")
+    for name in ("rounds", "solves"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name}: must be at least 1")
+    return args
+
+
+def main(argv: list[str] | None = None) -> None:
+    from core.presets import preset_names
+
+    args = parse_args(argv)
+    names = args.presets or list(preset_names())
+    unknown = sorted(set(names) - set(preset_names()))
+    if unknown:
+        raise SystemExit(f"presets: unknown {', '.join(unknown)}")
+    started = datetime.now(timezone.utc)
+    load_before = os.getloadavg()[0]
+    lines = ["| preset | this tree [ms] | other tree [ms] | ratio (median) | ratio (range) |",
+             "| --- | --- | --- | --- | --- |"]
+    for name in names:
+        mine, theirs, ratios = compare(args.other.resolve(), name, args.kind, args.rounds,
+                                       args.solves)
+        lines.append(f"| {name} | {mine:.2f} | {theirs:.2f} | {statistics.median(ratios):.3f} "
+                     f"| {min(ratios):.2f}-{max(ratios):.2f} |")
+        print(lines[-1], flush=True)
+    load_after = os.getloadavg()[0]
+    text = "\n".join([
+        "# A scene solve's CPU time against another tree", "",
+        f"    OPENBLAS_NUM_THREADS=1 python -m benchmarks.compare_trees OTHER "
+        f"--kind {args.kind} --rounds {args.rounds} --solves {args.solves}", "",
+        *run_lines(started, load_before, load_after,
+                   "both trees measured in turn, so both see the same load"),
+        f"- the other tree: commit {_commit(args.other)}",
+        f"- change: {args.kind}; per round {args.solves} solves per tree (median), "
+        f"{args.rounds} rounds alternating; the medians over rounds and the per-round "
+        "ratios this / other", "", *lines, ""])
+    if not args.no_write:
+        RESULTS.write_text(text)
+        print(f"written: {RESULTS}")
+
+
+if __name__ == "__main__":
+    main()
