@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks import cold_start, engines
+from benchmarks import cold_start, compare_trees, engines
 
 
 def test_engines_out_is_a_folder_not_a_file_name(tmp_path: Path, capsys):
@@ -26,3 +26,19 @@ def test_cold_start_out_is_a_folder_not_a_file_name(tmp_path: Path, capsys):
     assert stop.value.code == 2
     assert "--out: " in capsys.readouterr().err
     assert target.read_text() == "kept\n"  # refused before any run
+
+
+def test_compare_trees_refuses_a_folder_without_the_package(tmp_path: Path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        compare_trees.main([str(tmp_path), "bare_layer", "--no-write"])
+    assert stop.value.code == 2
+    assert "other: " in capsys.readouterr().err
+
+
+def test_compare_trees_measures_this_tree_against_itself(capsys):
+    """Two workers of the same tree, two rounds of one solve each: the table's row."""
+    root = Path(compare_trees.__file__).resolve().parent.parent
+    compare_trees.main([str(root), "bare_layer", "--rounds", "2", "--solves", "1",
+                        "--no-write"])
+    row = capsys.readouterr().out.strip().splitlines()[-1]
+    assert row.startswith("| bare_layer | ") and row.count("|") == 6
