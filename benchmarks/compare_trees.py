@@ -34,12 +34,16 @@ from benchmarks import ROOT, run_lines
 RESULTS = Path(__file__).resolve().parent / "results" / "compare_trees.md"
 
 #: The worker, run with ``python -c`` so that it imports ``core`` from its own tree (an
-#: older tree need not have this module): argv tree, preset, kind; it reads a count of
-#: solves per line and answers the median CPU time per solve [ms].
+#: older tree need not have this module): argv tree, preset, kind and the path of this
+#: tree's :mod:`benchmarks.scene_changes`; it reads a count of solves per line and
+#: answers the median CPU time per solve [ms].
 WORKER = r"""
-import copy, statistics, sys, time
-tree, preset, kind = sys.argv[1:4]
+import importlib.util, statistics, sys, time
+tree, preset, kind, changes = sys.argv[1:5]
 sys.path.insert(0, tree)
+spec = importlib.util.spec_from_file_location("scene_changes", changes)
+scene_changes = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(scene_changes)
 from core.presets import read_preset
 from core.scene import solve
 
@@ -50,18 +54,8 @@ for line in sys.stdin:
     cpu = []
     for _ in range(int(line)):
         i += 1
-        new = copy.deepcopy(scene)
-        several = "punches" in new
-        if kind == "geometry" and several:
-            last = new["punches"][-1]
-            last["center"] = last["center"] + 1e-6 * i * last["half_width"]
-        elif kind == "geometry":
-            new["punch"]["half_width"] = scene["punch"]["half_width"] * (1 + 1e-6 * i)
-        else:
-            loading = new["punches"][0]["loading"] if several else new["loading"]
-            name = next(q for q, v in loading.items() if not isinstance(v, dict))
-            value = loading[name]
-            loading[name] = value * (1 + 1e-5 * i) if value else 1e-9 * i
+        # steps 100 times smaller than scene_overhead's: many more solves, each still new
+        new = scene_changes.changed_scene(scene, kind, i, 1e-5 if kind == "loads" else 1e-6)
         started = time.process_time()
         solve(new)
         cpu.append(time.process_time() - started)
@@ -78,7 +72,9 @@ def compare(other: Path, preset: str, kind: str, rounds: int, solves: int
             ) -> tuple[float, float, list[float]]:
     """(this tree's ms, the other's ms, per-round ratios this / other) for one preset."""
     env = dict(os.environ, OPENBLAS_NUM_THREADS=os.environ.get("OPENBLAS_NUM_THREADS", "1"))
-    workers = {name: subprocess.Popen([sys.executable, "-c", WORKER, str(tree), preset, kind],
+    changes = str(Path(__file__).resolve().parent / "scene_changes.py")
+    workers = {name: subprocess.Popen([sys.executable, "-c", WORKER, str(tree), preset, kind,
+                                       changes],
                                       stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                       text=True, env=env, cwd=str(tree))
                for name, tree in (("this", ROOT), ("other", other))}

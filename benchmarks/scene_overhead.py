@@ -22,7 +22,6 @@ with the load. The table (with the commit, the date and the load) is written to
 
 from __future__ import annotations
 
-import copy
 import os
 import sys
 import time
@@ -32,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks import run_lines
+from benchmarks.scene_changes import changed_scene
 from core.presets import preset_names, read_preset
 from core.scene import solve
 
@@ -40,23 +40,10 @@ SOLVES = 8
 
 
 def _variants(scene: dict, kind: str) -> list[dict]:
-    out = []
-    several = "punches" in scene
-    for i in range(1, SOLVES + 1):
-        new = copy.deepcopy(scene)
-        if kind == "new geometry" and several:
-            last = new["punches"][-1]
-            last["center"] = last["center"] + 1e-4 * i * last["half_width"]
-        elif kind == "new geometry":
-            new["punch"]["half_width"] = scene["punch"]["half_width"] * (1 + 1e-4 * i)
-        else:
-            loading = new["punches"][0]["loading"] if several else new["loading"]
-            quantity = next(q for q, v in loading.items() if not isinstance(v, dict))
-            value = loading[quantity]
-            # a zero load (a centred force's moment) gets a tiny one instead
-            loading[quantity] = value * (1 + 1e-3 * i) if value else 1e-9 * i
-        out.append(new)
-    return out
+    # 0.01 % of the half-width, 0.1 % of the load a solve (benchmarks/scene_changes.py)
+    if kind == "new geometry":
+        return [changed_scene(scene, "geometry", i, 1e-4) for i in range(1, SOLVES + 1)]
+    return [changed_scene(scene, "loads", i, 1e-3) for i in range(1, SOLVES + 1)]
 
 
 def measure(name: str) -> list[tuple[str, float, float, float]]:
