@@ -2,14 +2,14 @@
 elsewhere), the two measured in turn.
 
     OPENBLAS_NUM_THREADS=1 python -m benchmarks.compare_trees OTHER_TREE [PRESET ...]
-        [--kind loads|geometry] [--rounds 12] [--solves 10] [--no-write]
+        [--kind loads|geometry] [--rounds 12] [--seconds 0.5] [--no-write]
 
 On a shared machine the CPU time of one solve moves by tens of per cent from one minute
 to the next, more than a change of a few per cent makes: :mod:`benchmarks.scene_overhead`
 run once per tree cannot tell them apart. Here one worker process per tree (each
-importing ``core`` from its own tree) solves a preset's scene ``--solves`` times per
-round, and the rounds alternate between the two (``--rounds``, the order swapped every
-round), so both see the same machine. The kinds of change are those of
+importing ``core`` from its own tree) solves a preset's scene for ``--seconds`` of CPU
+time per round (at least once), and the rounds alternate between the two (``--rounds``,
+the order swapped every round), so both see the same machine. The kinds of change are those of
 ``scene_overhead``: ``loads`` (the first given load larger at each solve) or
 ``geometry`` (the punch, or the last of several, a little wider or moved). Reported per
 preset: the median over rounds of each tree's median CPU time per solve [ms], and the
@@ -35,8 +35,9 @@ RESULTS = Path(__file__).resolve().parent / "results" / "compare_trees.md"
 
 #: The worker, run with ``python -c`` so that it imports ``core`` from its own tree (an
 #: older tree need not have this module): argv tree, preset, kind and the path of this
-#: tree's :mod:`benchmarks.scene_changes`; it reads a count of solves per line and
-#: answers the median CPU time per solve [ms].
+#: tree's :mod:`benchmarks.scene_changes`; it reads a CPU time budget [s] per line,
+#: solves until it is spent (at least once) and answers the median CPU time per solve
+#: [ms].
 WORKER = r"""
 import importlib.util, statistics, sys, time
 tree, preset, kind, changes = sys.argv[1:5]
@@ -52,7 +53,7 @@ solve(scene)  # imports and the first build: not measured
 i = 0
 for line in sys.stdin:
     cpu = []
-    for _ in range(int(line)):
+    while not cpu or sum(cpu) < float(line):
         i += 1
         # steps 100 times smaller than scene_overhead's: many more solves, each still new
         new = scene_changes.changed_scene(scene, kind, i, 1e-5 if kind == "loads" else 1e-6)
@@ -68,7 +69,7 @@ def _commit(tree: Path) -> str:
                           capture_output=True, text=True).stdout.strip() or "unknown"
 
 
-def compare(other: Path, preset: str, kind: str, rounds: int, solves: int
+def compare(other: Path, preset: str, kind: str, rounds: int, seconds: float
             ) -> tuple[float, float, list[float]]:
     """(this tree's ms, the other's ms, per-round ratios this / other) for one preset."""
     env = dict(os.environ, OPENBLAS_NUM_THREADS=os.environ.get("OPENBLAS_NUM_THREADS", "1"))
@@ -83,7 +84,7 @@ def compare(other: Path, preset: str, kind: str, rounds: int, solves: int
         for r in range(rounds):
             for name in (("this", "other") if r % 2 == 0 else ("other", "this")):
                 worker = workers[name]
-                worker.stdin.write(f"{solves}\n")
+                worker.stdin.write(f"{seconds}\n")
                 worker.stdin.flush()
                 answer = worker.stdout.readline()
                 if not answer:
@@ -103,15 +104,17 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("presets", nargs="*", help="preset names (default: all)")
     parser.add_argument("--kind", choices=("loads", "geometry"), default="loads")
     parser.add_argument("--rounds", type=int, default=12)
-    parser.add_argument("--solves", type=int, default=10)
+    parser.add_argument("--seconds", type=float, default=0.5,
+                        help="CPU time of each tree's solves per round [s]")
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
     if not (args.other / "core" / "__init__.py").is_file():
         parser.error(f"other: {args.other} holds no core package (a checkout of the "
                      "repository is needed)")
-    for name in ("rounds", "solves"):
-        if getattr(args, name) < 1:
-            parser.error(f"--{name}: must be at least 1")
+    if args.rounds < 1:
+        parser.error("--rounds: must be at least 1")
+    if not 0.0 < args.seconds <= 600.0:
+        parser.error("--seconds: must be > 0 and at most 600")
     return args
 
 
@@ -129,7 +132,7 @@ def main(argv: list[str] | None = None) -> None:
              "| --- | --- | --- | --- | --- |"]
     for name in names:
         mine, theirs, ratios = compare(args.other.resolve(), name, args.kind, args.rounds,
-                                       args.solves)
+                                       args.seconds)
         lines.append(f"| {name} | {mine:.2f} | {theirs:.2f} | {statistics.median(ratios):.3f} "
                      f"| {min(ratios):.2f}-{max(ratios):.2f} |")
         print(lines[-1], flush=True)
@@ -137,11 +140,12 @@ def main(argv: list[str] | None = None) -> None:
     text = "\n".join([
         "# A scene solve's CPU time against another tree", "",
         f"    OPENBLAS_NUM_THREADS=1 python -m benchmarks.compare_trees OTHER "
-        f"--kind {args.kind} --rounds {args.rounds} --solves {args.solves}", "",
+        f"--kind {args.kind} --rounds {args.rounds} --seconds {args.seconds:g}", "",
         *run_lines(started, load_before, load_after,
                    "both trees measured in turn, so both see the same load"),
         f"- the other tree: commit {_commit(args.other)}",
-        f"- change: {args.kind}; per round {args.solves} solves per tree (median), "
+        f"- change: {args.kind}; per round {args.seconds:g} s of CPU of solves per tree "
+        "(at least one; their median), "
         f"{args.rounds} rounds alternating; the medians over rounds and the per-round "
         "ratios this / other", "", *lines, ""])
     if not args.no_write:
