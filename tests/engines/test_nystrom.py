@@ -279,6 +279,7 @@ def test_the_interpolant_on_a_grid_is_each_panels_polynomial_at_any_points():
     one = grid.interpolate(x, poly(panels.nodes)[:, 1, 0])
     assert one.shape == x.shape
     assert np.max(np.abs(one - values[:, 1, 0])) <= 1e-13 * np.max(np.abs(one))
+    assert grid.interpolate(np.zeros(0), poly(panels.nodes)).shape == (0, 3, 2)
 
 
 def test_single_precision_lu_refines_to_the_double_precision_answer():

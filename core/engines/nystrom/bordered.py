@@ -73,17 +73,20 @@ class NystromGrid:
     def interpolate(self, x: np.ndarray, nodal: np.ndarray) -> np.ndarray:
         """Values at ``x`` of the panel-wise interpolant of ``nodal`` (N, ...)."""
         index, weights = interpolation_weights(self.panels, x)
-        per_panel = nodal.reshape((-1, NODES_PER_PANEL) + nodal.shape[1:])
+        per_panel = nodal.reshape((nodal.shape[0] // NODES_PER_PANEL, NODES_PER_PANEL)
+                                  + nodal.shape[1:])
         if nodal.ndim == 1:
             return np.einsum("ij,ij->i", weights, per_panel[index])
         # One product per panel holding points: gathering each point's 16 node rows of
         # every column first (einsum over per_panel[index]) cost ~10x as much for the
         # several punches' pressure at ~340 points and ~260 times (4.8 -> 0.5 ms).
-        columns = per_panel.reshape(per_panel.shape[0], NODES_PER_PANEL, -1)
+        columns = per_panel.reshape(per_panel.shape[0], NODES_PER_PANEL,
+                                    int(np.prod(nodal.shape[1:])))
         out = np.empty((index.size, columns.shape[2]))
         order = np.argsort(index, kind="stable")
-        starts = np.flatnonzero(np.diff(index[order], prepend=-1))
-        for lo, hi in zip(starts, [*starts[1:], index.size], strict=True):
+        # the runs of points of one panel (none for no points)
+        bounds = np.append(np.flatnonzero(np.diff(index[order], prepend=-1)), index.size)
+        for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
             rows = order[lo:hi]
             out[rows] = weights[rows] @ columns[index[rows[0]]]
         return out.reshape((index.size,) + nodal.shape[1:])
