@@ -15,12 +15,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def tree_commit() -> str:
-    """The short hash of this tree's commit, ``+`` when it has uncommitted changes."""
-    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+def tree_commit(tree: Path = ROOT) -> str:
+    """The short hash of the commit of ``tree`` (default: this one), ``+`` when it has
+    uncommitted changes."""
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=tree,
                           capture_output=True, text=True).stdout.strip() or "unknown"
     dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
-                           cwd=ROOT, capture_output=True, text=True).stdout.strip()
+                           cwd=tree, capture_output=True, text=True).stdout.strip()
     return head + ("+" if dirty else "")
 
 

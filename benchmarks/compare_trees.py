@@ -16,6 +16,9 @@ preset: the median over rounds of each tree's median CPU time per solve [ms], an
 median and range of the per-round ratios (this tree / the other). The table (both
 commits, the date, the load) is written to ``benchmarks/results/compare_trees.md``
 unless ``--no-write`` is given.
+
+The other tree must be a whole checkout (``git worktree add /tmp/old COMMIT``): a module
+it lacks would be imported from the installed package instead.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ import sys
 from datetime import datetime, timezone
 from pathlib import Path
 
-from benchmarks import ROOT, run_lines
+from benchmarks import ROOT, run_lines, tree_commit
 
 #: Where :func:`main` writes its table.
 RESULTS = Path(__file__).resolve().parent / "results" / "compare_trees.md"
@@ -64,36 +67,46 @@ for line in sys.stdin:
 """
 
 
-def _commit(tree: Path) -> str:
-    return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=tree,
-                          capture_output=True, text=True).stdout.strip() or "unknown"
-
-
 def compare(other: Path, preset: str, kind: str, rounds: int, seconds: float
             ) -> tuple[float, float, list[float]]:
-    """(this tree's ms, the other's ms, per-round ratios this / other) for one preset."""
+    """(this tree's ms, the other's ms, per-round ratios this / other) for one preset.
+
+    Raises RuntimeError naming the tree whose worker ended (a preset it does not have,
+    an error of its solve: its message is on standard error)."""
     env = dict(os.environ, OPENBLAS_NUM_THREADS=os.environ.get("OPENBLAS_NUM_THREADS", "1"))
     changes = str(Path(__file__).resolve().parent / "scene_changes.py")
-    workers = {name: subprocess.Popen([sys.executable, "-c", WORKER, str(tree), preset, kind,
-                                       changes],
-                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                      text=True, env=env, cwd=str(tree))
-               for name, tree in (("this", ROOT), ("other", other))}
+    workers: dict[str, subprocess.Popen] = {}
     times: dict[str, list[float]] = {"this": [], "other": []}
     try:
+        for name, tree in (("this", ROOT), ("other", other)):
+            workers[name] = subprocess.Popen(
+                [sys.executable, "-c", WORKER, str(tree), preset, kind, changes],
+                stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env,
+                cwd=str(tree))
         for r in range(rounds):
             for name in (("this", "other") if r % 2 == 0 else ("other", "this")):
                 worker = workers[name]
-                worker.stdin.write(f"{seconds}\n")
-                worker.stdin.flush()
-                answer = worker.stdout.readline()
+                try:
+                    worker.stdin.write(f"{seconds}\n")
+                    worker.stdin.flush()
+                    answer = worker.stdout.readline()
+                except OSError:  # its pipe closed: it ended
+                    answer = ""
                 if not answer:
-                    raise RuntimeError(f"the worker of {name} tree ended (preset {preset})")
+                    raise RuntimeError(f"the worker of the {name} tree ended (preset "
+                                       f"{preset}); its error is above")
                 times[name].append(float(answer))
     finally:
         for worker in workers.values():
-            worker.stdin.close()
-            worker.wait()
+            try:
+                worker.stdin.close()
+            except OSError:
+                pass
+            try:
+                worker.wait(timeout=60)
+            except subprocess.TimeoutExpired:
+                worker.kill()
+                worker.wait()
     ratios = [a / b for a, b in zip(times["this"], times["other"], strict=True)]
     return statistics.median(times["this"]), statistics.median(times["other"]), ratios
 
@@ -131,8 +144,11 @@ def main(argv: list[str] | None = None) -> None:
     lines = ["| preset | this tree [ms] | other tree [ms] | ratio (median) | ratio (range) |",
              "| --- | --- | --- | --- | --- |"]
     for name in names:
-        mine, theirs, ratios = compare(args.other.resolve(), name, args.kind, args.rounds,
-                                       args.seconds)
+        try:
+            mine, theirs, ratios = compare(args.other.resolve(), name, args.kind,
+                                           args.rounds, args.seconds)
+        except RuntimeError as exc:
+            raise SystemExit(str(exc)) from None
         lines.append(f"| {name} | {mine:.2f} | {theirs:.2f} | {statistics.median(ratios):.3f} "
                      f"| {min(ratios):.2f}-{max(ratios):.2f} |")
         print(lines[-1], flush=True)
@@ -143,7 +159,7 @@ def main(argv: list[str] | None = None) -> None:
         f"--kind {args.kind} --rounds {args.rounds} --seconds {args.seconds:g}", "",
         *run_lines(started, load_before, load_after,
                    "both trees measured in turn, so both see the same load"),
-        f"- the other tree: commit {_commit(args.other)}",
+        f"- the other tree: commit {tree_commit(args.other)}",
         f"- change: {args.kind}; per round {args.seconds:g} s of CPU of solves per tree "
         "(at least one; their median), "
         f"{args.rounds} rounds alternating; the medians over rounds and the per-round "

@@ -42,3 +42,17 @@ def test_compare_trees_measures_this_tree_against_itself(capsys):
                         "--no-write"])
     row = capsys.readouterr().out.strip().splitlines()[-1]
     assert row.startswith("| bare_layer | ") and row.count("|") == 6
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    mine, theirs, ratio = (float(c) for c in cells[1:4])
+    assert mine > 0.0 and theirs > 0.0 and 0.0 < ratio < float("inf")
+
+
+def test_compare_trees_names_the_tree_whose_worker_ended(tmp_path: Path):
+    """A tree whose worker cannot solve (here: its core package fails to import) ends
+    the run with a message naming it."""
+    (tmp_path / "core").mkdir()
+    (tmp_path / "core" / "__init__.py").write_text("raise ImportError('a broken tree')\n")
+    with pytest.raises(SystemExit) as stop:
+        compare_trees.main([str(tmp_path), "bare_layer", "--rounds", "1", "--seconds",
+                            "0.01", "--no-write"])
+    assert "worker of the other tree ended" in str(stop.value)

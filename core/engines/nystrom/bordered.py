@@ -82,7 +82,7 @@ class NystromGrid:
         # several punches' pressure at ~340 points and ~260 times (4.8 -> 0.5 ms).
         columns = per_panel.reshape(per_panel.shape[0], NODES_PER_PANEL,
                                     int(np.prod(nodal.shape[1:])))
-        out = np.empty((index.size, columns.shape[2]))
+        out = np.empty((index.size, columns.shape[2]), dtype=np.result_type(weights, nodal))
         order = np.argsort(index, kind="stable")
         # the runs of points of one panel (none for no points)
         bounds = np.append(np.flatnonzero(np.diff(index[order], prepend=-1)), index.size)
