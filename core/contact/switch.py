@@ -9,11 +9,14 @@ the cheap check that lets ``"auto"`` skip a full-contact solve that would be thr
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from core.contact.unilateral import CONTACT_MODELS, FULL_CONTACT, solve_unilateral
+
+if TYPE_CHECKING:
+    from core.problem import Geometry, TimeInputs
 
 
 def check_contact_model(contact: object) -> str:
@@ -85,8 +88,8 @@ def refuse_loads_without_contact(times: Any, kernel: Any, force: Any, moment: An
                          "contact can carry it")
 
 
-def predicted_unilateral(arguments: dict[str, Any], geometry: Any = None,
-                         inputs: Any = None):
+def predicted_unilateral(arguments: dict[str, Any], geometry: Geometry | None = None,
+                         inputs: TimeInputs | None = None):
     """The unilateral answer when a cheap check shows full contact lost, else None.
 
     ``contact="auto"`` would solve full contact over all times and then, finding q < 0,
