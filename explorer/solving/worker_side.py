@@ -25,7 +25,13 @@ from core import set_stage_cache_budget, solve, stage_cache_bytes
 from core.work import cancellable
 
 from ..model import FitOutcome, ResultView, prepare_view, run_fit
-from .memory_bound import WORKER_MEMORY_BYTES, bound_memory, out_of_memory
+from .memory_bound import (
+    RELEASE_AFTER_S,
+    WORKER_MEMORY_BYTES,
+    bound_memory,
+    out_of_memory,
+    release_freed_memory,
+)
 
 if TYPE_CHECKING:
     from core.back_analysis import Calibration
@@ -161,3 +167,5 @@ def serve(connection: multiprocessing.connection.Connection, stage_cache_bytes: 
         except Exception as exc:  # a value or exception that does not pickle
             connection.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}"),
                              reply[2]))
+        if reply[2][1] - start >= RELEASE_AFTER_S and not connection.poll():
+            release_freed_memory()

@@ -29,6 +29,7 @@ from core import budget, solve
 from core.budget import stage_cache_bounds
 from explorer.model import QUANTITIES, DesignLimits, ExplorerState, prepare_view
 from explorer.solving import RESULTS, SolveController
+from explorer.solving.memory_bound import RELEASE_AFTER_S
 from explorer.solving.workers import (
     SolverProcesses,
     WorkerFailed,
@@ -454,3 +455,43 @@ def test_a_worker_solves_without_importing_the_page_libraries() -> None:
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                          env=env, timeout=120, check=True).stdout.split()
     assert out[0] == "4" and out[1:] == ["[]"], out
+
+
+#: What :func:`_free_most_of_a_heap` allocates and frees [bytes] in a worker.
+_FREED_BYTES = 150 * 2**20
+_KEPT: list[bytes] = []
+
+
+def _free_most_of_a_heap(seconds: float) -> int:
+    """In a worker: fill the heap with 1 kB objects, keep the last (so the heap's top
+    cannot shrink), free the rest, and last ``seconds`` [s] in all."""
+    start = time.monotonic()
+    blocks = [bytes(1000) + bytes([i % 256]) for i in range(_FREED_BYTES // 1000)]
+    _KEPT.append(blocks[-1])
+    del blocks
+    time.sleep(max(0.0, seconds - (time.monotonic() - start)))
+    return os.getpid()
+
+
+def resident_bytes(pid: int) -> int:
+    with open(f"/proc/{pid}/status", encoding="ascii") as fh:
+        line = next(row for row in fh if row.startswith("VmRSS:"))
+    return int(line.split()[1]) * 1024
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc_trim")
+def test_a_worker_gives_back_the_memory_a_long_request_freed(wait_until) -> None:
+    # An FE coating check took a worker from 180 to 345 MiB, which glibc kept after the
+    # check for reuse (the load test's memory after all pages closed, issue
+    # "Reliability"). After a request of RELEASE_AFTER_S or more, the worker returns it.
+    pool = SolverProcesses(1, budget.STAGE_CACHE_BYTES)
+    pool.start()
+    try:
+        pid = pool.pids()[0]
+        before = resident_bytes(pid)
+        assert pool.run(0, _free_most_of_a_heap, RELEASE_AFTER_S + 0.1) == pid
+        # the worker trims after it has sent the answer: a moment later
+        assert wait_until(lambda: resident_bytes(pid) < before + _FREED_BYTES // 4,
+                          timeout=30), (before, resident_bytes(pid))
+    finally:
+        pool.shutdown()
