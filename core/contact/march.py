@@ -104,10 +104,20 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         if n == 0 and first is not None and "zones" not in first and state.active.any():
             ends = zones_from_nodes(state, space.breakpoints)[0]
             first["zones"] = list(zip(ends[0::2], ends[1::2], strict=True))
+        crossed = None if n == 0 else memory_of.crossing_density(n, state.q, state.nystrom)
+        if crossed is not None:
+            # nodes that entered or left contact within the step: their part of the step's
+            # memory from where they crossed (core/contact/memory.py), the step again
+            memory_density = memory_density + crossed
+            moved = np.nonzero(crossed)[0]
+            displacement = displacement + op[:, moved] @ crossed[moved]
+            state, more, settled = _step_state(base, op, m, g, step, displacement,
+                                               state.active, solver, retry=False)
+            count += more
         sweeps += count
         unsettled += not settled
         active = state.active
-        memory_of.record(n, state.q)
+        memory_of.record(n, state.q, state.nystrom)
         if n in wanted:
             nodal, pinned = ([], []) if not state.active.any() else zones_from_nodes(
                 state, space.breakpoints)[:2]
