@@ -16,7 +16,8 @@ The public entry points, loaded on first use (importing one subpackage, say
   measured settlements and tilts with their standard errors and a forecast band;
 - :func:`creep_coefficient_curve` (:mod:`core.creep`): the design codes' creep laws;
 - :data:`STAGE_CACHE_BYTES`, :func:`set_stage_cache_budget`, :func:`stage_cache_bytes`
-  (:mod:`core.budget`): the memory the solver's caches may hold.
+  (:mod:`core.budget`): the memory the solver's caches may hold;
+  :func:`release_freed_memory`: freed memory given back to the system.
 
 ``core/README.md`` maps the subpackages.
 """
@@ -30,7 +31,12 @@ from core.version import VERSION as __version__
 
 if TYPE_CHECKING:
     from core.back_analysis import calibrate
-    from core.budget import STAGE_CACHE_BYTES, set_stage_cache_budget, stage_cache_bytes
+    from core.budget import (
+        STAGE_CACHE_BYTES,
+        release_freed_memory,
+        set_stage_cache_budget,
+        stage_cache_bytes,
+    )
     from core.creep import creep_coefficient_curve
     from core.engines.nystrom import prepare
     from core.problem import ContactSolution
@@ -56,6 +62,7 @@ _EXPORTS: dict[str, str] = {
     "STAGE_CACHE_BYTES": "core.budget",
     "set_stage_cache_budget": "core.budget",
     "stage_cache_bytes": "core.budget",
+    "release_freed_memory": "core.budget",
 }
 
 __all__ = [
@@ -77,6 +84,7 @@ __all__ = [
     "STAGE_CACHE_BYTES",
     "set_stage_cache_budget",
     "stage_cache_bytes",
+    "release_freed_memory",
 ]
 
 

@@ -1,4 +1,5 @@
-"""The memory budget of the solver's stage caches, shared by all engines.
+"""The memory budget of the solver's stage caches, shared by all engines, and the freed
+memory given back to the system.
 
 The caches themselves stay inside their engines (no other module may rebind or clear
 them); this module bounds them together and reads their bounds, which the explorer
@@ -6,6 +7,10 @@ reports per worker process.
 """
 
 from __future__ import annotations
+
+import ctypes
+import ctypes.util
+from typing import Any
 
 _MiB = 2**20
 #: Upper bound of the memory all stage caches of the solver may hold together [bytes].
@@ -48,3 +53,30 @@ def stage_cache_bounds() -> dict[str, int]:
 def stage_cache_bytes() -> int:
     """The bound on the memory all projection stage caches may hold together [bytes]."""
     return sum(stage_cache_bounds().values())
+
+
+def _malloc_trim() -> Any:
+    name = ctypes.util.find_library("c")
+    try:
+        return ctypes.CDLL(name).malloc_trim if name else None
+    except (OSError, AttributeError):  # not glibc: memory is returned as the allocator does
+        return None
+
+
+_MALLOC_TRIM = _malloc_trim()
+
+
+def release_freed_memory() -> bool:
+    """Give the heap memory this process has freed back to the system.
+
+    glibc keeps the pages of freed memory for the process's own reuse, so a long-running
+    process (a server, its solver workers) stays at its peak after heavy work; this asks
+    it to return them (``malloc_trim``). Costs well under a millisecond after ordinary
+    solves, ~70 ms after an FE coating check.
+
+    Returns
+    -------
+    bool
+        Whether any memory was returned (always False without glibc).
+    """
+    return bool(_MALLOC_TRIM(0)) if _MALLOC_TRIM is not None else False

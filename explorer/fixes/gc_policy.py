@@ -48,14 +48,14 @@ Used by served sessions only, on the server's event loop.
 from __future__ import annotations
 
 import asyncio
-import ctypes
-import ctypes.util
 import gc
 import logging
 import time
 import weakref
 from collections.abc import Callable
 from typing import Any
+
+from core import release_freed_memory
 
 log = logging.getLogger(__name__)
 
@@ -88,15 +88,6 @@ _look_after_s = LATE_COLLECT_AFTER_S
 _held: list[tuple[weakref.ref, float]] = []
 
 
-def _libc_trim() -> Any:
-    name = ctypes.util.find_library("c")
-    try:
-        return ctypes.CDLL(name).malloc_trim if name else None
-    except (OSError, AttributeError):  # not glibc: memory is returned as the allocator does
-        return None
-
-
-_MALLOC_TRIM = _libc_trim()
 
 
 def page_built(session_context: Any = None) -> bool:
@@ -220,8 +211,7 @@ def collect_ended_sessions() -> int:
     _collect_due = False
     gc.unfreeze()
     found = gc.collect()
-    if _MALLOC_TRIM is not None:
-        _MALLOC_TRIM(0)
+    release_freed_memory()
     gc.freeze()
     log.debug("collected %d objects of ended sessions", found)
     return found

@@ -11,10 +11,7 @@ Nothing here imports Panel.
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import os
-from typing import Any
 
 #: The address space of a solver worker [bytes]: a worker that has written both reports
 #: (HoloViews, Bokeh and Matplotlib loaded) maps ~1.7 GiB with ~0.3 GiB resident, the FE
@@ -62,27 +59,12 @@ def out_of_memory(what: str, work_bytes: int, advice: str) -> str:
             f"GiB of memory it may take on this server; {advice}")
 
 
-#: A worker gives the memory its work freed back to the system after a request that
-#: took at least this long [s] (an FE coating check, a fit, a slow solve): glibc keeps
-#: freed heap pages for reuse, so a worker that ran three FE checks stayed at 345 MiB
-#: resident where it had started at 180, and went back to 187 MiB once trimmed. The trim
-#: costs ~70 ms after an FE check and under 1 ms after ordinary solves; it runs after the
-#: answer is sent, and only when no request waits.
+#: A worker gives the memory its work freed back to the system
+#: (``core.release_freed_memory``) after a request that took at least this long [s] (an
+#: FE coating check, a fit, a slow solve): glibc keeps freed heap pages for reuse, so a
+#: worker that ran three FE checks stayed at 345 MiB resident where it had started at 180,
+#: and went back to 187 MiB once trimmed. The trim costs ~70 ms after an FE check and
+#: under 1 ms after ordinary solves; it runs after the answer is sent, and only when no
+#: request waits.
 RELEASE_AFTER_S = 1.0
 
-
-def _malloc_trim() -> Any:
-    name = ctypes.util.find_library("c")
-    try:
-        return ctypes.CDLL(name).malloc_trim if name else None
-    except (OSError, AttributeError):  # not glibc: memory is returned as the allocator does
-        return None
-
-
-_MALLOC_TRIM = _malloc_trim()
-
-
-def release_freed_memory() -> bool:
-    """Give the heap memory this process has freed back to the system (glibc's
-    ``malloc_trim``); whether anything was returned (False without glibc)."""
-    return bool(_MALLOC_TRIM(0)) if _MALLOC_TRIM is not None else False

@@ -21,7 +21,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import core.report
-from core import set_stage_cache_budget, solve, stage_cache_bytes
+from core import release_freed_memory, set_stage_cache_budget, solve, stage_cache_bytes
 from core.work import cancellable
 
 from ..model import FitOutcome, ResultView, prepare_view, run_fit
@@ -30,7 +30,6 @@ from .memory_bound import (
     WORKER_MEMORY_BYTES,
     bound_memory,
     out_of_memory,
-    release_freed_memory,
 )
 
 if TYPE_CHECKING:
