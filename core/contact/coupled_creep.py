@@ -223,18 +223,6 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
         try:
             states, settled = _step_states(base, system, step_data, displacement, start,
                                            solver, retry=n == 0)
-            crossed = None if n == 0 else memory_of.crossing_density(
-                n, np.concatenate([s.q for s in states]),
-                np.concatenate([s.nystrom for s in states]))
-            if crossed is not None:
-                # nodes that entered or left contact within the step
-                # (core/contact/memory.py), the step solved again with it
-                memory_density = memory_density + crossed
-                moved = np.nonzero(crossed)[0]
-                displacement = displacement + op[:, moved] @ crossed[moved]
-                states, settled = _step_states(base, system, step_data, displacement,
-                                               np.concatenate([s.active for s in states]),
-                                               solver, retry=False)
         except NoContact as exc:
             raise ValueError(f"{exc}: the loads pull the punch away at t = {grid[n]:g}"
                              ) from None
@@ -248,8 +236,7 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
             first["zones"] = zones
         unsettled += not settled
         active = np.concatenate([s.active for s in states])
-        memory_of.record(n, np.concatenate([s.q for s in states]),
-                         np.concatenate([s.nystrom for s in states]))
+        memory_of.record(n, np.concatenate([s.q for s in states]))
         if n in wanted:
             nodal = [zones_from_nodes(s, space.breakpoints)[:2] if s.active.any() else
                      ([], []) for s, space in zip(states, base.spaces, strict=True)]

@@ -97,18 +97,6 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         try:
             state, count, settled = _step_state(base, op, m, g, step, displacement, start,
                                                 solver, retry=n == 0)
-            crossed = None if n == 0 else memory_of.crossing_density(n, state.q,
-                                                                     state.nystrom)
-            if crossed is not None:
-                # nodes that entered or left contact within the step: their part of the
-                # step's memory from where they crossed (core/contact/memory.py), the step
-                # solved again with it
-                memory_density = memory_density + crossed
-                moved = np.nonzero(crossed)[0]
-                displacement = displacement + op[:, moved] @ crossed[moved]
-                state, more, settled = _step_state(base, op, m, g, step, displacement,
-                                                   state.active, solver, retry=False)
-                count += more
         except NoContact as exc:
             name = "force" if "force" in step.given else "moment"
             raise ValueError(f"{name}: the loads pull the punch away at t = {grid[n]:g} "
@@ -119,7 +107,7 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         sweeps += count
         unsettled += not settled
         active = state.active
-        memory_of.record(n, state.q, state.nystrom)
+        memory_of.record(n, state.q)
         if n in wanted:
             nodal, pinned = ([], []) if not state.active.any() else zones_from_nodes(
                 state, space.breakpoints)[:2]

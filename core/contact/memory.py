@@ -6,18 +6,11 @@ the weight of the current one, taken implicitly by the step (:mod:`core.contact.
 Degenerate kernels (those of the shipped creep models) carry it by recursion with
 exponential product integration; any other kernel by the trapezoid on ``K q``. Both are of
 order 2 in the step.
-
-A node whose pressure starts or stops within a step (the contact zone spreading or
-receding over it) has a kink in time there. The recursion takes its part of that step
-from where its Nystrom pressure crossed zero (:meth:`_SeparableMemory.crossing_density`,
-the march solving the step again with it), so that the error of the halved grids stays
-smooth enough for Richardson's extrapolation; the trapezoid memory does not.
 """
 
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -55,12 +48,8 @@ class _HistoryMemory:
         weight = 0.5 * (grid[n] - grid[n - 1]) * float(kv[n])
         return self.history[:, :n] @ (self.inner[:n] * kv[:n]), weight
 
-    def record(self, n: int, q: np.ndarray, nystrom: np.ndarray | None = None) -> None:
+    def record(self, n: int, q: np.ndarray) -> None:
         self.history[:, n] = q
-
-    def crossing_density(self, n: int, q: np.ndarray, nystrom: np.ndarray) -> None:
-        """The trapezoid memory takes no crossings (see :class:`_SeparableMemory`)."""
-        return None
 
 
 class _SeparableMemory:
@@ -104,11 +93,9 @@ class _SeparableMemory:
         self.b_old = np.sum(weight * b * (1.0 - rising), axis=1)  # (S,)
         self.b_new = np.sum(weight * b * rising, axis=1)
         self.decay = np.exp(-rates[:, None] * h[None, :])  # (R, S)
-        self.stiffness = rates[:, None] * h[None, :]  # (R, S): each decay over each step
         self.aged = np.zeros(n_nodes)  # int b q up to the last step
         self.modes = np.zeros((rates.size, n_nodes))  # each mode up to the last step
         self._last = np.zeros(n_nodes)
-        self._last_nystrom: np.ndarray | None = None
 
     @classmethod
     def _decay_weights(cls, kernel: Any, rates: np.ndarray, grid: np.ndarray,
@@ -137,84 +124,10 @@ class _SeparableMemory:
         self.aged = self.aged + self.b_old[j] * self._last
         return self.aged + self.modes.sum(axis=0), float(self.b_new[j] + self.a_new[:, j].sum())
 
-    def record(self, n: int, q: np.ndarray, nystrom: np.ndarray | None = None) -> None:
+    def record(self, n: int, q: np.ndarray) -> None:
         if n > 0:
             j = n - 1
             self.modes = self.modes + self.a_new[:, j, None] * q[None, :]
             self.aged = self.aged + self.b_new[j] * q
-            for nodes, modes, aged in self._crossing_parts(j, q, nystrom):
-                self.modes[:, nodes] += modes
-                self.aged[nodes] += aged
         self._last = q
-        self._last_nystrom = nystrom
-
-    def crossing_density(self, n: int, q: np.ndarray, nystrom: np.ndarray
-                         ) -> np.ndarray | None:
-        """What the nodes that entered or left contact during step ``n`` add to its memory
-        density (:meth:`at`) when their pressure is taken as a ramp from or to the time it
-        crossed zero (None: no node crossed). ``q``, ``nystrom``: the step's pressure and
-        Nystrom pressure (:class:`core.contact.active_set.NodalState`) as first solved."""
-        if n == 0:
-            return None
-        parts = self._crossing_parts(n - 1, q, nystrom)
-        if not parts:
-            return None
-        extra = np.zeros(q.size)
-        for nodes, modes, aged in parts:
-            extra[nodes] += modes.sum(axis=0) + aged
-        return extra
-
-    def _crossing_parts(self, j: int, q: np.ndarray, nystrom: np.ndarray | None
-                        ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        """(nodes, change of each mode, change of the aged part) for the nodes that entered
-        and for those that left contact during step ``j``.
-
-        The pressure at such a node has a kink in time where its Nystrom pressure ``Q``
-        (smooth in time) crosses zero, inside the step: the hat functions of the whole step
-        integrate it to O(h^2) with a coefficient that jumps with where the crossing falls,
-        which Richardson's extrapolation of halved grids does not remove (the crowned punch
-        spreading over a creeping base: extrapolated outputs of successive grids converged
-        at ratios 5-6 instead of 8 or more). Here it is a ramp from the crossing, ``theta``
-        of the step from its start by linear interpolation of ``Q`` (q itself where the node
-        touches), to the step's end value (entering) or from its start value to it
-        (leaving), each decay integrated against it exactly, the amplitudes ``a_r`` and
-        ``b`` taken as the hat's weights scale (they vary little over a step)."""
-        last, last_q = self._last, self._last_nystrom
-        if nystrom is None or last_q is None:
-            return []
-        parts = []
-        x = self.stiffness[:, j, None]
-        entering = np.nonzero((last == 0.0) & (q > 0.0) & (last_q < 0.0))[0]
-        if entering.size:
-            length = q[entering] / (q[entering] - last_q[entering])  # 1 - theta
-            ratio = length * _psi(x * length) / _psi(x)
-            parts.append((entering, self.a_new[:, j, None] * q[entering] * (ratio - 1.0),
-                          self.b_new[j] * q[entering] * (length - 1.0)))
-        leaving = np.nonzero((last > 0.0) & (q == 0.0) & (nystrom < 0.0))[0]
-        if leaving.size:
-            theta = last[leaving] / (last[leaving] - nystrom[leaving])
-            ratio = np.exp(-x * (1.0 - theta)) * theta * _chi(x * theta) / _chi(x)
-            parts.append((leaving, self.a_old[:, j, None] * last[leaving] * (ratio - 1.0),
-                          self.b_old[j] * last[leaving] * (theta - 1.0)))
-        return parts
-
-
-def _psi(y: np.ndarray) -> np.ndarray:
-    """int_0^1 exp(-y s) (1 - s) ds (y >= 0)."""
-    y = np.asarray(y, dtype=float)
-    small = y < 1e-2
-    safe = np.where(small, 1.0, y)
-    out = (safe + np.expm1(-safe)) / safe**2
-    series = sum((-y) ** k / (math.factorial(k) * (k + 1) * (k + 2)) for k in range(6))
-    return np.where(small, series, out)
-
-
-def _chi(y: np.ndarray) -> np.ndarray:
-    """int_0^1 exp(-y w) w dw (y >= 0)."""
-    y = np.asarray(y, dtype=float)
-    small = y < 1e-2
-    safe = np.where(small, 1.0, y)
-    out = (-np.expm1(-safe) - safe * np.exp(-safe)) / safe**2
-    series = sum((-y) ** k / (math.factorial(k) * (k + 2)) for k in range(6))
-    return np.where(small, series, out)
 

