@@ -88,8 +88,6 @@ _look_after_s = LATE_COLLECT_AFTER_S
 _held: list[tuple[weakref.ref, float]] = []
 
 
-
-
 def page_built(session_context: Any = None) -> bool:
     """A page is complete: collect the young garbage of its building, then freeze.
 

@@ -67,4 +67,3 @@ def out_of_memory(what: str, work_bytes: int, advice: str) -> str:
 #: under 1 ms after ordinary solves; it runs after the answer is sent, and only when no
 #: request waits.
 RELEASE_AFTER_S = 1.0
-
