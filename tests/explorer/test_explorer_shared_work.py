@@ -34,6 +34,7 @@ from explorer.solving.priority import (
     thread_niceness,
 )
 from explorer.solving.workers import SolverProcesses
+from tests.browser_pages import patience
 
 
 class Clock:
@@ -113,20 +114,29 @@ def test_two_pages_studies_run_in_turns_and_both_finish() -> None:
             os.getpriority(os.PRIO_PROCESS, 0) + BACKGROUND_NICENESS, 19)
     second.start(short)
     both_running = paused_first = 0
+    both_since, longest_both = None, 0.0
     seen_second_alive_with_first = False
     while first.running or second.running:
         assert time.monotonic() < deadline + 300, (first.message, second.message)
         states = [_state(run.process) for run in (first, second)]
         if states[0] is not None and states[1] is not None:
             seen_second_alive_with_first = True
-            both_running += states == ["R", "R"]
             paused_first += states[0] == "T"
+        if states == ["R", "R"]:
+            both_running += 1
+            now = time.monotonic()
+            both_since = now if both_since is None else both_since
+            longest_both = max(longest_both, now - both_since)
+        else:
+            both_since = None
         time.sleep(0.01)
     assert first.status == second.status == "done", (first.message, second.message)
     assert seen_second_alive_with_first  # the short study did not wait for the long one
-    # a process reads "R" a moment after its pause (the signal is asynchronous): a few
-    # samples of the ~1000 taken, never a whole turn
-    assert both_running <= 5, both_running
+    # Both read "R" for a moment (a new study's process runs until it is paused, and
+    # SIGSTOP takes effect when the process is next scheduled): a few samples of the
+    # ~1000 taken on a quiet machine (at most 5 seen), 18 in a run of the whole suite,
+    # never for a whole turn (scaled to the machine's load, as every wait here).
+    assert longest_both < share.turn_s * patience(), (longest_both, both_running)
     assert paused_first > 0  # the long study gave the short one turns
     assert first.result.outputs["settlement"].shape[0] == 40
     assert second.result.outputs["settlement"].shape[0] == 3
