@@ -17,7 +17,7 @@ from collections.abc import Iterator
 import pytest
 
 from tests.support.abandon import WAYS, abandon_sessions, discard_wait_s
-from tests.support.serving import ExplorerProcess
+from tests.support.serving import ExplorerProcess, rss_mib
 
 pytestmark = [pytest.mark.soak, pytest.mark.timeout(600)]
 
@@ -43,15 +43,6 @@ ROUND = 16
 GROWTH_MIB = 20.0
 #: The server's --session-linger [s].
 LINGER_S = 1.0
-
-
-def rss_mib(pid: int) -> float:
-    """Resident memory of process ``pid`` [MiB], from /proc."""
-    with open(f"/proc/{pid}/status", encoding="ascii") as fh:
-        for line in fh:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024
-    raise AssertionError(f"no VmRSS for process {pid}")
 
 
 @pytest.fixture(scope="module")

@@ -38,6 +38,7 @@ from explorer.solving.workers import (
     worker_info,
 )
 from tests.browser_pages import patience
+from tests.support.serving import rss_mib
 
 pytestmark = pytest.mark.timeout(300)
 
@@ -457,8 +458,8 @@ def test_a_worker_solves_without_importing_the_page_libraries() -> None:
     assert out[0] == "4" and out[1:] == ["[]"], out
 
 
-#: What :func:`_free_most_of_a_heap` allocates and frees [bytes] in a worker.
-_FREED_BYTES = 150 * 2**20
+#: What :func:`_free_most_of_a_heap` allocates and frees [MiB] in a worker.
+_FREED_MIB = 150
 _KEPT: list[bytes] = []
 
 
@@ -466,20 +467,15 @@ def _free_most_of_a_heap(seconds: float) -> int:
     """In a worker: fill the heap with 1 kB objects, keep the last (so the heap's top
     cannot shrink), free the rest, and last ``seconds`` [s] in all."""
     start = time.monotonic()
-    blocks = [bytes(1000) + bytes([i % 256]) for i in range(_FREED_BYTES // 1000)]
+    blocks = [bytes(1000) + bytes([i % 256]) for i in range(_FREED_MIB * 2**20 // 1000)]
     _KEPT.append(blocks[-1])
     del blocks
     time.sleep(max(0.0, seconds - (time.monotonic() - start)))
     return os.getpid()
 
 
-def resident_bytes(pid: int) -> int:
-    with open(f"/proc/{pid}/status", encoding="ascii") as fh:
-        line = next(row for row in fh if row.startswith("VmRSS:"))
-    return int(line.split()[1]) * 1024
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc_trim")
+@pytest.mark.skipif(not sys.platform.startswith("linux"),
+                    reason="reads /proc and glibc's malloc_trim: Linux only")
 def test_a_worker_gives_back_the_memory_a_long_request_freed(wait_until) -> None:
     # Three FE coating checks took a worker from 180 to 345 MiB, which glibc kept for
     # reuse (the load test's memory after all pages closed, issue "Reliability"). After a
@@ -490,10 +486,10 @@ def test_a_worker_gives_back_the_memory_a_long_request_freed(wait_until) -> None
     pool.start()
     try:
         pid = pool.pids()[0]
-        before = resident_bytes(pid)
+        before = rss_mib(pid)
         assert pool.run(0, _free_most_of_a_heap, RELEASE_AFTER_S + 0.1) == pid
         # the worker trims after it has sent the answer: a moment later
-        assert wait_until(lambda: resident_bytes(pid) < before + _FREED_BYTES // 4,
-                          timeout=30), (before, resident_bytes(pid))
+        assert wait_until(lambda: rss_mib(pid) < before + _FREED_MIB / 4, timeout=30), \
+            (before, rss_mib(pid))
     finally:
         pool.shutdown()

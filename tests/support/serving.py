@@ -56,6 +56,15 @@ def browser_missing() -> str | None:
     return None
 
 
+def rss_mib(pid: int) -> float:
+    """Resident memory of process ``pid`` [MiB], from /proc."""
+    with open(f"/proc/{pid}/status", encoding="ascii") as fh:
+        for line in fh:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    raise AssertionError(f"no VmRSS for process {pid}")
+
+
 def free_port(host: str = "127.0.0.1") -> int:
     """A TCP port on ``host`` that nothing listens on at the time of the call.
 
