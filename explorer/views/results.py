@@ -34,7 +34,7 @@ from .loop import PageLoop
 from .pins import PinsView
 from .status import held_text, status_html
 from .style import NOTE_STYLE, html_pane
-from .widgets import NAMES
+from .widgets import NAMES, TimePlayer
 
 #: Which validity flags are shown next to which plot.
 BADGES: dict[str, dict[str, tuple[str, str]]] = {
@@ -386,10 +386,10 @@ class ResultsView:
         self.push()
 
     def _new_player(self, end: int, value: int) -> pn.widgets.Player:
-        player = pn.widgets.Player(label="time", start=0, end=end, value=value, interval=250,
-                                   loop_policy="once", show_loop_controls=False,
-                                   sizing_mode="stretch_width", show_value=False,
-                                   css_classes=["time-player"])
+        player = TimePlayer(label="time", start=0, end=end, value=value, interval=250,
+                            loop_policy="once", show_loop_controls=False,
+                            sizing_mode="stretch_width", show_value=False,
+                            css_classes=["time-player"])
         player.param.watch(self._on_player, "value")
         return player
 

@@ -25,19 +25,30 @@ from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
 
 __all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
            "EditableIntSlider", "EditableSlider", "HistoryEditor", "LazySlider",
-           "ProfileEditor", "slider"]
+           "ProfileEditor", "TimePlayer", "slider"]
 
 
 # Panel holds every change from the browser for 50 ms before handling it, to gather a
 # burst into one event. The explorer gathers bursts itself (a solve runs at most once at
 # a time and the newest request waits), so here the wait is only latency: measured 50 of
 # the 140 ms from a load slider step to the new pressure data on the server's side.
+#
+# Panel also counts every browser change as a busy event of its global state
+# (``pn.state.busy``: four watched parameter changes an event, two events a slider step).
+# The explorer shows its own busy indicator (views/busy.py) and nothing follows Panel's,
+# so the value changes of these widgets (and of the time player) are left out of that
+# count: ~4 of the 50-66 ms of server CPU a load step cost (uniform_flat preset in
+# Chromium, py-spy).
+_NOT_BUSY = ["value", "value_throttled"]
+
+
 class PromptFloatSlider(pn.widgets.FloatSlider):
     """A FloatSlider whose browser changes are handled at once (no 50 ms debounce), and
     without the tooltip over its handle: the label shows the value, and a tooltip left on
     screen after a drag (a tab switched, the slider hidden) covered the label above."""
 
     _debounce = 0
+    _busy__ignore = _NOT_BUSY
     tooltips = param.Boolean(default=False, doc="Whether the handle shows its value.")
 
 
@@ -45,6 +56,7 @@ class PromptFloatInput(pn.widgets.FloatInput):
     """A FloatInput whose browser changes are handled at once (no 50 ms debounce)."""
 
     _debounce = 0
+    _busy__ignore = _NOT_BUSY
 
 
 class PromptIntSlider(pn.widgets.IntSlider):
@@ -52,6 +64,7 @@ class PromptIntSlider(pn.widgets.IntSlider):
     the tooltip over its handle (see :class:`PromptFloatSlider`)."""
 
     _debounce = 0
+    _busy__ignore = _NOT_BUSY
     tooltips = param.Boolean(default=False, doc="Whether the handle shows its value.")
 
 
@@ -59,6 +72,13 @@ class PromptIntInput(pn.widgets.IntInput):
     """An IntInput whose browser changes are handled at once (no 50 ms debounce)."""
 
     _debounce = 0
+    _busy__ignore = _NOT_BUSY
+
+
+class TimePlayer(pn.widgets.Player):
+    """The player of the output times, left out of Panel's busy count (see above)."""
+
+    _busy__ignore = _NOT_BUSY
 
 
 class EditableSlider(pn.widgets.EditableFloatSlider):
@@ -66,6 +86,7 @@ class EditableSlider(pn.widgets.EditableFloatSlider):
 
     _slider_widget = PromptFloatSlider
     _input_widget = PromptFloatInput
+    _busy__ignore = _NOT_BUSY
     tooltips = param.Boolean(default=False, doc="Whether the handle shows its value (the "
                              "text box does).")
 
@@ -98,6 +119,7 @@ class EditableIntSlider(pn.widgets.EditableIntSlider):
 
     _slider_widget = PromptIntSlider
     _input_widget = PromptIntInput
+    _busy__ignore = _NOT_BUSY
     tooltips = param.Boolean(default=False, doc="Whether the handle shows its value (the "
                              "text box does).")
 
