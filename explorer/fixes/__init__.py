@@ -16,11 +16,13 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
 - ``property_defaults``: Bokeh's property defaults and type names worked out once per
   class, not per new model.
 - ``patch_refs``: Bokeh's patch messages written without listing every model of the page.
+- ``design_updates``: a changed parameter sent without the theme worked out again.
 """
 
 from . import (
     bokeh_fixes,
     closed_pages,
+    design_updates,
     gc_policy,
     idle_painter,
     model_walk,
@@ -29,14 +31,16 @@ from . import (
     property_defaults,
 )
 
-__all__ = ["bokeh_fixes", "closed_pages", "gc_policy", "idle_painter", "install_in_process",
-           "model_walk", "panel_fixes", "patch_refs", "property_defaults"]
+__all__ = ["bokeh_fixes", "closed_pages", "design_updates", "gc_policy", "idle_painter",
+           "install_in_process", "model_walk", "panel_fixes", "patch_refs", "property_defaults"]
 
 
 def install_in_process() -> None:
     """Install the fixes that hold for the whole process (not per page): Panel's queued
-    messages, Bokeh's model walk, its property defaults and its patch messages."""
+    messages and property updates, Bokeh's model walk, its property defaults and its patch
+    messages."""
     panel_fixes.install()
+    design_updates.install()
     model_walk.install()
     property_defaults.install()
     patch_refs.install()
