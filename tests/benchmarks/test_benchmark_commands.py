@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks import cold_start, compare_trees, engines
+from benchmarks import cold_start, compare_servers, compare_trees, engines
 
 
 def test_engines_out_is_a_folder_not_a_file_name(tmp_path: Path, capsys):
@@ -56,3 +56,17 @@ def test_compare_trees_names_the_tree_whose_worker_ended(tmp_path: Path):
         compare_trees.main([str(tmp_path), "bare_layer", "--rounds", "1", "--seconds",
                             "0.01", "--no-write"])
     assert "worker of the other tree ended" in str(stop.value)
+
+
+def test_compare_servers_refuses_a_folder_without_the_package(tmp_path: Path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        compare_servers.main([str(tmp_path), "--no-write"])
+    assert stop.value.code == 2
+    assert "other: " in capsys.readouterr().err
+
+
+def test_compare_servers_refuses_an_unknown_preset_before_starting_a_server():
+    root = Path(compare_servers.__file__).resolve().parent.parent
+    with pytest.raises(SystemExit) as stop:
+        compare_servers.main([str(root), "no_such_preset", "--no-write"])
+    assert "presets: unknown no_such_preset" in str(stop.value)
