@@ -50,6 +50,15 @@ class PromptFloatSlider(pn.widgets.FloatSlider):
     _debounce = 0
     _busy__ignore = _NOT_BUSY
     tooltips = param.Boolean(default=False, doc="Whether the handle shows its value.")
+    #: Whether the page's release of the handle (``value_throttled``) reaches Python
+    #: (:meth:`EditableSlider.apply_steps_only` turns it off for one slider).
+    _releases = True
+
+    @property
+    def _linked_properties(self) -> tuple[str, ...]:
+        linked = super()._linked_properties
+        return linked if self._releases else tuple(p for p in linked
+                                                   if p != "value_throttled")
 
 
 class PromptFloatInput(pn.widgets.FloatInput):
@@ -89,6 +98,17 @@ class EditableSlider(pn.widgets.EditableFloatSlider):
     _busy__ignore = _NOT_BUSY
     tooltips = param.Boolean(default=False, doc="Whether the handle shows its value (the "
                              "text box does).")
+
+    def apply_steps_only(self) -> None:
+        """Leave the page's releases of the handle out of Python (call before the slider
+        is first shown: its model is linked then).
+
+        A key press sends the slider's value and then its release (``value_throttled``),
+        and Panel handles each in full (its event, the composite's values brought in
+        line): for a slider that applies every step (a load) the release carries nothing
+        new, yet it cost the server about as much as the step's own event.
+        """
+        self._slider._releases = False
 
     def watch_drag_first(self, callback: Callable[[Any], None]) -> None:
         """Call ``callback(value)`` [the slider's value] at each move of the slider,
@@ -182,6 +202,7 @@ class Binding:
             # a drag step reaches the state before the text box follows (the watcher
             # above then finds the state at the value already: no second change)
             widget.watch_drag_first(lambda value, name=name: self._lead(name, value))
+            widget.apply_steps_only()
         if event == "value_throttled" and self._live_when is not None:
             widget.param.watch(lambda e, name=name: self._drag_step(name, e.new), "value")
         if check is not None:

@@ -6,19 +6,24 @@ the page does not need are left out (explorer/views/widgets.py and style.py).
   its own): the sliders, their text boxes and the time player are left out of that count.
 - A text pane's new text reaches its model alone, not with every other property worked
   out again (styles, style sheets, the theme's modifiers).
+- A slider that applies every step (a load) does not hear the page's release of its
+  handle, which carries nothing new and cost as much as the step's own event.
 """
 
 from __future__ import annotations
 
 import panel as pn
+import param
 import pytest
 from bokeh.document import Document
 
 from explorer.views.style import CSS, TextPane, html_pane
 from explorer.views.widgets import (
+    Binding,
     EditableIntSlider,
     EditableSlider,
     TimePlayer,
+    slider,
 )
 
 
@@ -83,3 +88,24 @@ def test_a_text_pane_sends_the_text_panel_would_and_nothing_else(options, monkey
 
 def test_html_panes_of_the_page_are_text_panes() -> None:
     assert isinstance(html_pane("x"), TextPane)
+
+
+class _Target(param.Parameterized):
+    value = param.Number(0.0)
+
+
+def _heard(widget: EditableSlider) -> set[str]:
+    """The properties of the page's slider whose changes reach Python."""
+    root = widget.get_root(Document())
+    model = widget._slider._models[root.ref["id"]][0]
+    return set(model._callbacks)
+
+
+def test_a_slider_that_applies_every_step_does_not_hear_the_release() -> None:
+    live, on_release = Binding(), Binding()
+    steps = live.add("value", slider("load", 0.0, 10.0, 0.1), live=True)
+    releases = on_release.add("value", slider("thickness", 0.0, 10.0, 0.1))
+    live.bind(_Target())
+    on_release.bind(_Target())
+    assert "value" in _heard(steps) and "value_throttled" not in _heard(steps)
+    assert {"value", "value_throttled"} <= _heard(releases)
