@@ -35,6 +35,7 @@ from pathlib import Path
 
 from benchmarks import ROOT, run_lines, tree_commit
 from benchmarks.explorer_latency import INSTRUMENT, READY
+from benchmarks.load_test import cpu_seconds
 from tests.support.serving import CHROMIUM, CHROMIUM_ARGS, ExplorerProcess
 
 #: Where :func:`main` writes its table.
@@ -44,12 +45,6 @@ SLIDERS = {"load": ("Scene", ".load-0-value"), "thickness": ("Coating", ".coatin
 #: Seconds waited after each update before the next step (the server's work after the
 #: message, e.g. the page's address, is counted with its step).
 SETTLE_S = 0.2
-
-
-def process_cpu_seconds(pid: int) -> float:
-    """CPU time [s] (user and system) process ``pid`` has used so far."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def compare(other: Path, preset: str, slider: str, steps: int
@@ -96,10 +91,14 @@ def compare(other: Path, preset: str, slider: str, steps: int
                     step(name, "ArrowRight")
             for i in range(steps):
                 for name in (("this", "other") if i % 2 == 0 else ("other", "this")):
-                    pid = servers[name].pid
-                    started = process_cpu_seconds(pid)
+                    server = servers[name]
+                    started = cpu_seconds(server.pid)
                     latency[name].append(step(name, "ArrowLeft"))
-                    spent[name] += process_cpu_seconds(pid) - started
+                    ended = cpu_seconds(server.pid)
+                    if started is None or ended is None:
+                        raise SystemExit(f"the server of the {name} tree ended; its log: "
+                                         f"{server.output()[-2000:]}")
+                    spent[name] += ended - started
             browser.close()
     finally:
         for server in servers.values():
