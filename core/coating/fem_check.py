@@ -161,7 +161,12 @@ def solve_stack(stack: Stack, *, level: int = 0, extent: float | None = None) ->
     free = np.setdiff1d(np.arange(reps.size), fixed_red)
     u = np.zeros((reps.size, 3))
     u[fixed_red] = fixed_vals
-    lu = splu(k_red[free][:, free].tocsc())
+    # The stiffness is symmetric positive definite (the pins remove every rigid motion):
+    # a symmetric ordering without pivoting, measured on the default preset's check (63.5k
+    # unknowns): factors 6.4M entries instead of 18.3M, 1.4-1.8 s instead of 3.6 s, the
+    # answer the same to 2e-7 of its size (the conditioning; the check's own error is 1e-4)
+    lu = splu(k_red[free][:, free].tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+              options={"SymmetricMode": True})
     u[free] = lu.solve(-(k_red[free][:, fixed_red] @ fixed_vals))
     reaction = tie.T @ (stiffness @ (tie @ u))  # reduced forces; nonzero on fixed only
     r_top = np.asarray(reaction[reduced_of[top[contact]]])  # (nodes, 3)
