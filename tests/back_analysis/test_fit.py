@@ -99,6 +99,32 @@ def test_a_degenerate_pair_is_not_identifiable() -> None:
     assert set(fit.unidentified) == {"coating[0].thickness", "coating[0].modulus"}
 
 
+
+def test_a_degenerate_pair_stops_once_the_combination_the_readings_fix_has_settled() -> None:
+    """The readings fix h / E of the thin coating: the fit of both stops when the step
+    along that combination is below STEP_TO_SE of its standard error, with that ratio the
+    one the modulus alone fits. Before, it ran on to X_TOL drifting along h / E = const
+    (55 solves; now 26)."""
+    import core.back_analysis.fit as fit_module
+
+    exact = core.solve(dict(SCENE, times=TIMES.tolist()))
+    rng = np.random.default_rng(3)
+    readings = {"time": TIMES.tolist(), "settlement_std": SETTLEMENT_STD,
+                "settlement": (exact.settlement
+                               + SETTLEMENT_STD * rng.standard_normal(TIMES.size)).tolist()}
+    one = calibrate(SCENE, readings, fit=["coating[0].modulus"])
+    both = calibrate(SCENE, readings, fit=["coating[0].thickness", "coating[0].modulus"])
+    assert not both.identifiable
+    ratio_one = SCENE["coating"][0]["thickness"] / one.values["coating[0].modulus"]
+    ratio_both = both.values["coating[0].thickness"] / both.values["coating[0].modulus"]
+    relative_se = one.standard_errors["coating[0].modulus"] / one.values["coating[0].modulus"]
+    # each fit stops within ~STEP_TO_SE standard errors of its minimum (measured 7e-4
+    # standard errors apart)
+    assert abs(ratio_both / ratio_one - 1.0) <= 2 * fit_module.STEP_TO_SE * relative_se
+    if fit_module.STOPS_SETTLED:
+        assert both.status == fit_module.SETTLED_DETERMINED
+        assert both.solves <= 30
+
 @pytest.mark.parametrize(("kwargs", "message"), [
     ({"fit": ["coating[3].modulus"]}, "fit[0]: coating[3].modulus: no such field"),
     ({"fit": ["name"]}, "fit[0]: 'name' cannot be fitted"),
