@@ -198,14 +198,13 @@ def calibrate(scene: Scene | Mapping[str, Any],
 
     stopped_determined = False
 
-    def settled(intermediate_result: Any) -> None:
+    def settled(x: np.ndarray, fun: np.ndarray) -> None:
         """Stop where the Gauss-Newton step from the point is below :data:`STEP_TO_SE`
         of every standard error (its Jacobian is the one the solver has just asked for,
         so this costs no solve); for fields the readings do not determine, of the
         standard error of every combination they do determine."""
         nonlocal stopped_determined
-        x = np.asarray(intermediate_result.x, dtype=float)
-        r = np.asarray(intermediate_result.fun, dtype=float)
+        r = np.asarray(fun, dtype=float)
         J = jacobian(x)
         if not (np.all(np.isfinite(J)) and np.all(np.isfinite(r))):
             return
@@ -224,14 +223,22 @@ def calibrate(scene: Scene | Mapping[str, Any],
         if np.all(np.isfinite(se)) and np.all(np.abs(step) <= STEP_TO_SE * se):
             raise StopIteration
 
-    answer = least_squares(residuals, x0, jac=jacobian, bounds=(lo, hi), method="trf",
-                           x_scale=1.0, xtol=X_TOL, ftol=F_TOL, gtol=F_TOL,
+    # The least-squares solver starts with a trust radius of the norm of its start. It
+    # is given the coordinates from the start (x - x0), so that radius is 1 (a factor e
+    # of a field fitted by its logarithm, the start's size of another) instead of the
+    # size of the logarithm of an SI value (~20-40): a first step along a direction the
+    # readings hardly see took a 20 mm coating to 20 km.
+    answer = least_squares(lambda z: residuals(x0 + z), np.zeros_like(x0),
+                           jac=lambda z: jacobian(x0 + z), bounds=(lo - x0, hi - x0),
+                           method="trf", x_scale=1.0, xtol=X_TOL, ftol=F_TOL, gtol=F_TOL,
                            max_nfev=max_nfev,
-                           **({"callback": settled} if STOPS_SETTLED else {}))
+                           **({"callback": lambda intermediate_result: settled(
+                               x0 + intermediate_result.x, intermediate_result.fun)}
+                              if STOPS_SETTLED else {}))
     if answer.status == -2:  # SciPy's status of a stop by the callback: settled
         answer.success = True
         answer.message = SETTLED_DETERMINED if stopped_determined else SETTLED
-    x = answer.x
+    x = x0 + answer.x
     solution = model.solve(x)
     values_fit = model.values(x)
     J = jacobian(x)
