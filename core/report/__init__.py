@@ -1,7 +1,7 @@
 """The printable report of a solved scene: what an engineer files with a design check.
 
 - :func:`report_html`: one self-contained HTML file (Bokeh plots inline, no network);
-- :func:`report_pdf`: the same as PDF (HoloViews' Matplotlib backend);
+- :func:`report_pdf`: the same as PDF (its plots drawn with Matplotlib);
 - :func:`write_report`: either, by the file name;
 - :func:`sections`: the report's text, for other layouts;
 - :func:`output_index`: the output time a chosen time stands for (checked).

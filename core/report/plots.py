@@ -4,7 +4,7 @@ settlement and tilt over time), the contact width and the lifted length over tim
 the punch lifts off, and the punch base and the coating thickness over x when they vary.
 
 Options are set for the Bokeh backend, as :mod:`core.scene.plotting` sets them (the HTML
-report); :func:`matplotlib_layout` restyles the layout for the PDF. HoloViews is imported
+report); :mod:`core.report.pdf` draws the same elements with Matplotlib. HoloViews is imported
 when a plot is made, never with :mod:`core.report`.
 """
 
@@ -17,7 +17,6 @@ import numpy as np
 from core.report.contact import lift_off_times, output_index
 from core.report.inputs import LAYER_FIELDS, SHAPE_UNIT
 from core.scene import (
-    LIFT_OFF_COLOUR,
     PunchesSolution,
     SceneSolution,
     holoviews_for_bokeh,
@@ -129,34 +128,6 @@ def report_layout(result: SceneSolution | PunchesSolution,
     titles = [*PLOT_TITLES, *(title for title, _ in extra)]
     # a clone keeps the layout's title (the scene and its flags)
     return layout.clone([*layout, *(element for _, element in extra)]).cols(2), titles
-
-
-def matplotlib_layout(layout: Any) -> Any:
-    """``layout`` styled for HoloViews' Matplotlib backend (registered by the caller): the
-    lift-off shading and the zones of several punches, the contact and the geometry
-    curves and a punch's line of several in the colours of the HTML report."""
-    hv = holoviews_for_bokeh("the report's plots")
-    by_label = dict(CONTACT_CURVES) | {f"punches[{k}]": colour
-                                       for k, colour in enumerate(PUNCH_COLOURS)}
-    by_value = {name: colour for name, _, colour in GEOMETRY_PLOTS}
-
-    def colour(curve: Any) -> str | None:
-        return by_label.get(curve.label) or by_value.get(curve.vdims[0].name)
-
-    def shade(span: Any) -> Any:
-        tone = ZONE_COLOUR if span.group == ZONE_GROUP else LIFT_OFF_COLOUR
-        return span.opts(color=tone, facecolor=tone, alpha=0.5, backend="matplotlib")
-
-    def labels(overlay: Any) -> Any:
-        # an overlay's axis labels are Bokeh options (its first element, a span, would
-        # name them x and y): the same words here
-        given = overlay.opts.get("plot", backend="bokeh").kwargs
-        named = {k: given[k] for k in ("xlabel", "ylabel") if k in given}
-        return overlay.opts(**named, backend="matplotlib") if named else overlay
-
-    layout = layout.map(labels, hv.Overlay).map(shade, hv.VSpan)
-    return layout.map(lambda curve: curve.opts(color=colour(curve), backend="matplotlib"),
-                      lambda item: isinstance(item, hv.Curve) and colour(item) is not None)
 
 
 def readings_overlay(result: SceneSolution, calibration: Any) -> Any:
