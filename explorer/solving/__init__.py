@@ -16,6 +16,7 @@ Nothing here imports Panel or Bokeh when imported (the solver workers import it 
   ``fair_share``: the turns the server's studies take (:class:`StudyShare`).
 - ``memory_bound``: the address-space bounds of the worker and study processes.
 - ``priority``: studies, coating checks and fits at a lower CPU priority than slider solves.
+- ``process_start``: the fork server the worker and study processes start from, warm.
 - ``trace``: timestamps of a slider move's way through the server (latency benchmark).
 """
 

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import logging
 import math
-import multiprocessing
 import os
 import queue
 import signal
@@ -45,6 +44,7 @@ from .background import BackgroundRun
 from .fair_share import SHARE, StudyShare, resume
 from .memory_bound import STUDY_MEMORY_BYTES, bound_memory, out_of_memory
 from .priority import lower_process_priority
+from .process_start import process_context
 
 log = logging.getLogger(__name__)
 
@@ -60,32 +60,6 @@ STUDY_CACHE_BYTES = 256 * 1024**2
 PROGRESS_STEPS = 50
 #: Least time between two progress updates sent to the page [s].
 PROGRESS_EVERY_S = 0.1
-#: Modules the fork server imports once, so that a study's process starts warm: the
-#: solver's modules and scipy's parts it uses cost ~1 s of CPU to import (measured), which
-#: every study would pay again.
-_PRELOAD = ["core.study", "core.scene", "core.solver", "core.engines.nystrom",
-            "core.engines.projection", "core.contact", "core.creep", "core.time", "scipy.linalg",
-            "scipy.interpolate", "scipy.optimize", "scipy.special", "scipy.sparse",
-            "scipy.fft", "xarray", "explorer.solving.study_runner"]
-
-_CONTEXT: Any = None
-_CONTEXT_LOCK = threading.Lock()
-
-
-def _context() -> Any:
-    """The multiprocessing context studies start from (a fork server, started once)."""
-    global _CONTEXT
-    with _CONTEXT_LOCK:
-        if _CONTEXT is None:
-            if "forkserver" in multiprocessing.get_all_start_methods():
-                ctx = multiprocessing.get_context("forkserver")
-                ctx.set_forkserver_preload(_PRELOAD)
-            else:  # Windows: a fresh interpreter per study (a slower start)
-                ctx = multiprocessing.get_context("spawn")
-            _CONTEXT = ctx
-        return _CONTEXT
-
-
 # -- what runs in the study's process ------------------------------------------------------
 def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: int) -> None:
     """Run the study and put ``("progress", done, total)`` after every batch, then
@@ -183,7 +157,7 @@ class StudyRun(BackgroundRun):
 
     def _run(self, planned: PlannedStudy, cancel: threading.Event, ticket: object) -> None:
         n = planned.study.n_points
-        ctx = _context()
+        ctx = process_context()
         out = ctx.Queue()
         batch = max(1, math.ceil(n / PROGRESS_STEPS))
         process = ctx.Process(target=_run_study, args=(planned, batch, out, os.getpid()),

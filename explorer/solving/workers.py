@@ -5,9 +5,10 @@ Python runs one thread of a process at a time. Served with solver threads, a sol
 with 20 sessions the server ran at ~70 % of one core and the slowest 5 % of slider steps
 took 4x as long as for a single session (benchmarks/results/load_test.md, run J).
 
-A :class:`SolverProcesses` runs *lanes*: each lane is one worker process (started with
-the spawn method: a fork would copy the server's threads and locks in whatever state they
-are). A worker does one request at a time. A session keeps to its lane, so the solver's
+A :class:`SolverProcesses` runs *lanes*: each lane is one worker process (forked from
+the fork server of :mod:`explorer.solving.process_start`, warm: a fork of the server
+itself would copy its threads and locks in whatever state they are). A worker does one
+request at a time. A session keeps to its lane, so the solver's
 stage caches in that process (kernel operator, basis) serve its next slider step; a
 request that has waited :data:`SPILL_AFTER_S` for its lane takes any idle one, so a slow
 solve of one session delays the others by that much at most.
@@ -33,6 +34,7 @@ from concurrent.futures import Future
 from typing import Any
 
 from .priority import at_background_priority
+from .process_start import process_context
 from .trace import TRACE_FILE, mark
 from .worker_side import DOWNLOADS, download_text, serve, solution_text, solve_view, worker_info
 
@@ -93,7 +95,7 @@ class _Lane:
         self.process, self.connection = self._new_worker()
 
     def _new_worker(self) -> tuple[Any, multiprocessing.connection.Connection]:
-        context = multiprocessing.get_context("spawn")
+        context = process_context()
         ours, theirs = context.Pipe(duplex=True)
         # the number of the request whose answer is no longer wanted (requests are
         # numbered 1, 2, ... in the order sent, by both sides of the pipe)
