@@ -73,49 +73,40 @@ def _style(element: Any) -> dict[str, Any]:
     return dict(element.opts.get("style", backend="bokeh").kwargs)
 
 
-def _axis_labels(item: Any) -> tuple[str, str]:
+def _axis_labels(item: Any, curves: list[Any]) -> tuple[str, str]:
     """The x and y labels of a plot: its own (an overlay's, set because its spans would
     name the axes x and y), else its first curve's dimensions with their units."""
     given = item.opts.get("plot", backend="bokeh").kwargs
-    curves = [e for e in (item if _is_overlay(item) else [item]) if hasattr(e, "vdims")
-              and type(e).__name__ == "Curve"]
     first = curves[0] if curves else None
     x = given.get("xlabel") or (first.kdims[0].pprint_label if first is not None else "")
     y = given.get("ylabel") or (first.vdims[0].pprint_label if first is not None else "")
     return x, y
 
 
-def _is_overlay(item: Any) -> bool:
-    return type(item).__name__ == "Overlay"
-
-
 def _draw(axes: Any, item: Any, title: str) -> None:
     """One plot of the layout on ``axes``: its shaded spans under its curves."""
-    elements = list(item) if _is_overlay(item) else [item]
-    for element in elements:
-        if type(element).__name__ == "VSpan":
-            lo, hi = element.data
-            style = _style(element)
-            axes.axvspan(lo, hi, color=style.get("color", "#dddddd"),
-                         alpha=style.get("alpha", 0.5), linewidth=0, zorder=0)
-    labelled = False
+    import holoviews as hv  # loaded already: the layout is made of its elements
+
+    elements = list(item) if isinstance(item, hv.Overlay) else [item]
+    for span in (e for e in elements if isinstance(e, hv.VSpan)):
+        lo, hi = span.data
+        style = _style(span)
+        axes.axvspan(lo, hi, color=style.get("color", "#dddddd"), alpha=style.get("alpha", 0.5),
+                     linewidth=0, zorder=0)
+    curves = [e for e in elements if isinstance(e, hv.Curve)]
     drawn = []
-    for element in elements:
-        if type(element).__name__ != "Curve":
-            continue
-        colour = _style(element).get("color")
+    for curve in curves:
+        colour = _style(curve).get("color")
         if not isinstance(colour, str):
             # a curve without a colour of its own takes HoloViews' next default, as in
             # the HTML report
             cycle = list(getattr(colour, "values", None) or ["#30a2da"])
             colour = cycle[len(drawn) % len(cycle)]
-        label = element.label or None
-        labelled = labelled or label is not None
-        y = np.asarray(element.dimension_values(1), dtype=float)
+        y = np.asarray(curve.dimension_values(1), dtype=float)
         drawn.append(y)
-        axes.plot(element.dimension_values(0), y, color=colour, linewidth=1.4, label=label,
-                  zorder=2)
-    x_label, y_label = _axis_labels(item)
+        axes.plot(curve.dimension_values(0), y, color=colour, linewidth=1.4,
+                  label=curve.label or None, zorder=2)
+    x_label, y_label = _axis_labels(item, curves)
     axes.set_xlabel(x_label, fontsize=8)
     axes.set_ylabel(y_label, fontsize=8)
     axes.set_title(title, fontsize=9)
@@ -135,7 +126,7 @@ def _draw(axes: Any, item: Any, title: str) -> None:
             # a history that does not change: flat at its value
             axes.set_ylim(float(np.min(values)) - 0.05 * largest,
                           float(np.max(values)) + 0.05 * largest)
-    if labelled:
+    if any(curve.label for curve in curves):
         axes.legend(fontsize=6.5, loc="best", frameon=False)
 
 
