@@ -47,9 +47,9 @@ class Forecast:
     @property
     def z(self) -> float:
         """The normal quantile of the band's two-sided ``level``."""
-        from scipy.stats import norm
+        from scipy.special import ndtri  # the normal quantile, without scipy.stats
 
-        return float(norm.ppf(0.5 + self.level / 2))
+        return float(ndtri(0.5 + self.level / 2))
 
     def band(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """The lower and upper edge of the band of ``settlement`` or ``tilt``."""

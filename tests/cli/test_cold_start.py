@@ -78,3 +78,28 @@ def test_the_lazy_names_are_the_modules_own():
         core.scene.no_such_name  # noqa: B018
     with pytest.raises(AttributeError, match="no attribute 'no_such_name'"):
         core.coating.no_such_name  # noqa: B018
+
+
+_FIT_CHILD = """
+import json, sys
+import core
+from core.presets import read_preset
+
+scene = read_preset("uniform_flat")
+measured = core.solve(scene)
+readings = {"time": measured.times.tolist(), "settlement_std": 1e-6,
+            "settlement": (1.01 * measured.settlement).tolist()}
+fit = core.calibrate(scene, readings, fit=["base.creep.modulus"])
+fit.forecast([1.0, 3650.0]).band("settlement")
+print(json.dumps({"warnings": len(fit.warnings), "stats": "scipy.stats" in sys.modules}))
+"""
+
+
+def test_a_fit_and_its_band_load_no_statistics_module():
+    # the chi^2 range and the band's normal quantile come from scipy.special: scipy.stats
+    # cost a cold fit ~0.5 s (1.5 s beside a test run) to import for two numbers
+    env = dict(os.environ, PYTHONPATH=str(ROOT), OPENBLAS_NUM_THREADS="1")
+    proc = subprocess.run([sys.executable, "-c", _FIT_CHILD], cwd=ROOT, env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout.splitlines()[-1])["stats"] is False
