@@ -78,9 +78,9 @@ SETTLED = (f"the Gauss-Newton step is below {STEP_TO_SE:g} of every standard err
 #: The message when it stopped a fit of fields the readings do not all determine: each
 #: combination of them that the readings determine (a singular direction of the scaled
 #: Jacobian within :data:`MAX_CONDITION` of the strongest) has settled, and along the
-#: others the readings give no direction to go. Run on, such a fit drifted: a coating's
-#: thickness and modulus, whose ratio alone counts, went from 5 mm and 3e8 Pa to 3.8e8 m
-#: and 3.6e18 Pa in 55 solves, where it now stops after 3 (tests/back_analysis).
+#: others the readings give no direction to go. Run on to X_TOL, such a fit took 55 solves
+#: for a coating's thickness and modulus (whose ratio alone counts), now 11
+#: (tests/back_analysis).
 SETTLED_DETERMINED = (f"the Gauss-Newton step along each combination of the fields that "
                       f"the readings determine is below {STEP_TO_SE:g} of its standard "
                       "error (relative offset); the readings do not determine the others")
