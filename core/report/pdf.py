@@ -21,7 +21,7 @@ import numpy as np
 from core.optional import import_optional
 from core.report.content import scene_json, sections
 from core.report.plots import report_layout
-from core.scene import PunchesSolution, SceneSolution
+from core.scene import PunchesSolution, SceneSolution, holoviews_for_bokeh
 
 #: A4 portrait [inch].
 PAGE = (8.27, 11.69)
@@ -85,7 +85,7 @@ def _axis_labels(item: Any, curves: list[Any]) -> tuple[str, str]:
 
 def _draw(axes: Any, item: Any, title: str) -> None:
     """One plot of the layout on ``axes``: its shaded spans under its curves."""
-    import holoviews as hv  # loaded already: the layout is made of its elements
+    hv = holoviews_for_bokeh("the PDF report")  # loaded already: the layout's elements
 
     elements = list(item) if isinstance(item, hv.Overlay) else [item]
     for span in (e for e in elements if isinstance(e, hv.VSpan)):
