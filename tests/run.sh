@@ -64,6 +64,12 @@ fi
 # hog (two busy-loop processes, load 5-8; 2026-12-01, a fresh clone): 51.3 min, all
 # green (rest 50.2, browser 35.2, soak 15.4 min, documentation 580 s), 2216 s user +
 # 107 s system CPU of the suite.
+# On a fresh clone, 2 cores, quiet (2026-12-02): 20.1 min, 1481 s user + 70 s system
+# (rest 19.6, browser 16.1, soak 7.1 min, documentation 275 s), after the FE check's
+# ordering, warm solver workers and the PDF report's own plots cut their CPU. Where the
+# rest's CPU went before them (py-spy, 50 Hz, its subprocesses included): the solver
+# 34 % (creep lift-off marches 17 %), imports 13 %, explorer sessions built in-process
+# 9 %, fits 7 %, FE checks 7 %, PDF reports 3 %.
 # The parts share nothing: each has its own temporary directory, pytest cache and served
 # explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
