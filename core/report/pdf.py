@@ -5,7 +5,7 @@ The plots are HoloViews elements with Bokeh options (the HTML report's); they ar
 here element by element (curves and shaded spans, in their Bokeh colours), not through
 HoloViews' Matplotlib backend, which took ~8 s of CPU for the three plots of a preset
 (its layout engine drew the figure to fit it, and each plot set Matplotlib's settings
-again); drawn directly, the whole report takes ~1.5 s.
+again); drawn directly, the whole report takes 1.5-3 s (measured on three presets).
 """
 
 from __future__ import annotations
