@@ -6,7 +6,8 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
 - ``panel_fixes``: messages Panel queues for a page and then never sends.
 - ``bokeh_fixes``: style sheets BokehJS rewrites with the same text; the page's layout
   computed once per frame, not once per change; colours and line styles not read back
-  from the computed style at each paint.
+  from the computed style at each paint; a renderer's place written on its element, not
+  into a style sheet.
 - ``idle_painter``: the file dropper's frame loop, paused while nothing happens.
 - ``closed_pages``: pages closed abruptly (a debug line, not a traceback) and Panel's
   link registry released when a session ends.
