@@ -69,3 +69,57 @@ def test_the_messages_are_bokehs(explorer_app) -> None:
     compare()
     assert compared >= 3
     assert any("a new part" in text for text in sent)  # a model the page had not had went out whole
+
+
+
+def _page_doc() -> tuple[Document, dict[str, str]]:
+    """A document as a page has it (a column of two texts, every model sent), and the ids
+    of its column and texts."""
+    doc = Document()
+    first, second = Div(text="a"), Div(text="b")
+    column = Column(children=[first, second])
+    doc.add_root(column)
+    doc.models.flush_synced()
+    return doc, {"c1": column.id, "d1": first.id, "d2": second.id}
+
+
+def _state(doc: Document) -> Any:
+    """What the document holds: its column's texts, its texts, the texts not yet sent."""
+    [column] = doc.roots
+    texts = sorted(m.text for m in doc.models if isinstance(m, Div))
+    return ([m.text for m in column.children], texts,
+            sorted(m.text for m in doc.models._new_models if isinstance(m, Div)))
+
+
+def test_the_pages_messages_are_read_as_bokeh_reads_them() -> None:
+    """What the page sends: a changed property, a model new to the server (its whole
+    object), a change of a model the server has just removed (dropped), of one it never
+    had (an error): the same document after each, read either way."""
+    from bokeh.core.serialization import UnknownReferenceError
+    from bokeh.document.document import Document as Doc
+
+    assert patch_refs.install() and hasattr(Doc.apply_json_patch, "__wrapped__")
+    read = {"bokeh": Doc.apply_json_patch.__wrapped__, "ours": Doc.apply_json_patch}
+    states: dict[str, list[Any]] = {"bokeh": [], "ours": []}
+    for way in read:
+        doc, ids = _page_doc()
+        text = {"kind": "ModelChanged", "model": {"id": ids["d1"]}, "attr": "text",
+                "new": "A"}
+        added = {"kind": "ModelChanged", "model": {"id": ids["c1"]}, "attr": "children",
+                 "new": [{"id": ids["d1"]}, {"type": "object", "name": "Div",
+                                             "id": "from-the-page",
+                                             "attributes": {"text": "new"}}]}
+        gone = {"kind": "ModelChanged", "model": {"id": ids["d2"]}, "attr": "text",
+                "new": "B"}
+        never = {"kind": "ModelChanged", "model": {"id": "never-had"}, "attr": "text",
+                 "new": "?"}
+        for event in (text, added, gone):
+            read[way](doc, {"events": [event]})
+            states[way].append(_state(doc))
+        try:
+            read[way](doc, {"events": [never]})
+        except UnknownReferenceError:
+            states[way].append("refused")
+    assert states["ours"] == states["bokeh"]
+    assert states["ours"][1] == (["A", "new"], ["A", "new"], [])
+    assert states["ours"][-1] == "refused"
