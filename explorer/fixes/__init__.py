@@ -7,7 +7,7 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
 - ``bokeh_fixes``: style sheets BokehJS rewrites with the same text; the page's layout
   computed once per frame, not once per change; colours and line styles not read back
   from the computed style at each paint; a renderer's place written on its element, not
-  into a style sheet.
+  into a style sheet; a figure's base font size read once.
 - ``idle_painter``: the file dropper's frame loop, paused while nothing happens.
 - ``closed_pages``: pages closed abruptly (a debug line, not a traceback) and Panel's
   link registry released when a session ends.

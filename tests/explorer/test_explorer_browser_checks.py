@@ -506,8 +506,33 @@ def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
         other.close()
 
 
+# Every font size a model of the page sets: [how many, those not in px].
+JS_FONT_SIZES = """() => {
+  let sizes = 0;
+  const other = [];
+  for (const m of Bokeh.documents[0].all_models) {
+    for (const name of Object.keys(m.properties)) {
+      if (!name.endsWith('font_size')) continue;
+      let v = m.properties[name].get_value();
+      if (v !== null && typeof v === 'object' && 'value' in v) v = v.value;
+      if (v === null || v === undefined) continue;
+      sizes++;
+      if (!/^[0-9.]+px$/.test(String(v))) other.push(`${m.type}.${name}: ${JSON.stringify(v)}`);
+    }
+  }
+  return [sizes, other.slice(0, 8)];
+}"""
+
+
 def test_presentation_mode_has_projector_fonts_at_1024(page: Page):
-    """Feature 5: at 1024x768, ticks of at least 18 px; the plots stay on screen."""
+    """Feature 5: at 1024x768, ticks of at least 18 px; the plots stay on screen. Every
+    text of the page is sized in px, both ways: BokehJS's base font size (read once per
+    figure, explorer/fixes/bokeh_fixes.py) sizes only text in em."""
+    assert page.page.evaluate("() => Object.getOwnPropertyDescriptor(Bokeh.require("
+                              "'models/plots/plot_canvas').PlotView.prototype, "
+                              "'base_font_size').get.__read_once === true")
+    sizes, other = page.page.evaluate(JS_FONT_SIZES)
+    assert sizes > 50 and other == [], other
     page.page.set_viewport_size({"width": 1024, "height": 768})
     page.page.locator(".presentation-toggle button").first.click()
     doc = "Bokeh.documents[0]"
@@ -518,6 +543,8 @@ def test_presentation_mode_has_projector_fonts_at_1024(page: Page):
                                   ".major_label_text_font_size", name)
         assert int(size.rstrip("px")) >= 18, (name, size)
     assert page.page.evaluate(JS_VIEW_WIDTH, "pressure_figure") > 250
+    sizes, other = page.page.evaluate(JS_FONT_SIZES)
+    assert sizes > 50 and other == [], other
     assert page.errors == []
 
 
