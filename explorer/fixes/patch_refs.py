@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import ast
 import hashlib
+import importlib
 import inspect
 import logging
 from typing import Any
@@ -38,6 +39,8 @@ from typing import Any
 log = logging.getLogger(__name__)
 
 _INSTALLED = False
+#: Whether the reading of messages was replaced too (see :func:`install`).
+_READING = False
 
 
 def _serializer_class() -> type:
@@ -98,8 +101,6 @@ def _install_reading() -> bool:
     """Replace ``Document.apply_json_patch`` with Bokeh's method reading the references
     from a copy of the document's dict of models; False (nothing replaced, a warning) if
     Bokeh's method or its model registry differ from the ones checked."""
-    import importlib
-
     from bokeh.core.serialization import Deserializer, UnknownReferenceError
     from bokeh.document.events import DocumentPatchedEvent
 
@@ -152,11 +153,10 @@ def _install_reading() -> bool:
 def install() -> bool:
     """Replace Bokeh's ``PATCH-DOC`` message creation and reading once per process; False
     if Bokeh's internals differ (what differs is left as it is, and a warning says so)."""
-    global _INSTALLED
+    global _INSTALLED, _READING
     if _INSTALLED:
-        return True
-    reading = _install_reading()
-    import importlib
+        return _READING
+    _READING = _install_reading()
 
     from bokeh.core.serialization import Serializer
     from bokeh.document import Document
@@ -205,4 +205,4 @@ def install() -> bool:
     create.__wrapped__ = original  # type: ignore[attr-defined]
     message.create = classmethod(create)
     _INSTALLED = True
-    return reading
+    return _READING
