@@ -70,6 +70,10 @@ fi
 # rest's CPU went before them (py-spy, 50 Hz, its subprocesses included): the solver
 # 34 % (creep lift-off marches 17 %), imports 13 %, explorer sessions built in-process
 # 9 %, fits 7 %, FE checks 7 %, PDF reports 3 %.
+# On a faster machine (AMD EPYC, 2 cores; 2026-12-02), fresh clones: quiet 7.5 min, 554 s
+# user + 52 s system (rest 7.1, browser 7.3, soak 3.6 min, documentation 140 s); beside
+# one busy loop (load average 3.3-5.2) 11.5 min (rest 11.1, browser 10.3, soak 4.8 min,
+# documentation 188 s); beside two (load 5-7.7) 15.5 min (rest 15.0): all green.
 # The parts share nothing: each has its own temporary directory, pytest cache and served
 # explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
