@@ -326,7 +326,7 @@ def test_a_load_step_repaints_only_the_figures_whose_data_changed(page: Page):
     for name in ("pressure_figure", "image_figure", "settlement_figure", "force_figure"):
         assert painted[name] == 1, painted
     assert page.page.evaluate("() => window.__ranges_sent") == 0
-    # (~7 sheets a step before: the lines' rectangles move with their data)
+    # (5-7 sheets a step before: the lines' rectangles move with their data)
     assert page.page.evaluate("() => window.__sheets_written") == 0
     placed, off = page.page.evaluate(JS_PLACED)
     # the default scene's lines, curves and markers; Bokeh's placement differed from this
@@ -531,6 +531,7 @@ def test_presentation_mode_has_projector_fonts_at_1024(page: Page):
     assert page.page.evaluate("() => Object.getOwnPropertyDescriptor(Bokeh.require("
                               "'models/plots/plot_canvas').PlotView.prototype, "
                               "'base_font_size').get.__read_once === true")
+    # (the default page sets 56: a check that saw few would say nothing)
     sizes, other = page.page.evaluate(JS_FONT_SIZES)
     assert sizes > 50 and other == [], other
     page.page.set_viewport_size({"width": 1024, "height": 768})
