@@ -73,16 +73,18 @@ def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
         page.page.locator(".study-png").first.click()
     assert Path(info.value.path()).read_bytes().startswith(b"\x89PNG")
 
-    # the largest study the tab takes, 20 x 20 over the force and the coating modulus
-    # (400 solves, 20 geometries: some seconds; 9 x 9 ended in 2 s, before the test saw it
-    # running), cancelled
-    page.page.locator(".study-p2-field select").first.select_option(
-        label="coating 1: Young's modulus [MPa]")
-    # the server answers a new field with its first range (9 points): a count typed before
-    # that answer arrives would be overwritten by it
-    p2_count = page.page.locator(".study-p2-count input").first
-    until(lambda: p2_count.input_value() == "9", "the modulus's first range",
-          describe=p2_count.input_value)
+    # the largest study the tab takes, 20 x 20, cancelled while it runs. Over the coating's
+    # thickness and modulus every point is a new geometry: 9.7 s of CPU on a quiet 2-core
+    # machine (2026-12-02, core.sweep of the same grid). Over the force and the modulus (20
+    # geometries) it took 1.7 s there and ended before the wait below saw Cancel.
+    for part, label in (("p1", "coating 1: thickness [mm]"),
+                        ("p2", "coating 1: Young's modulus [MPa]")):
+        page.page.locator(f".study-{part}-field select").first.select_option(label=label)
+        # the server answers a new field with its first range (9 points): a count typed
+        # before that answer arrives would be overwritten by it
+        count = page.page.locator(f".study-{part}-count input").first
+        until(lambda count=count: count.input_value() == "9", f"the {part} field's first range",
+              describe=count.input_value)
     page.type_into(".study-p1-count", "20")
     page.type_into(".study-p2-count", "20")
     # the page complete first (every tab opened): its background filling of tabs is not
