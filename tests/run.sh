@@ -44,52 +44,53 @@ if [ "$#" -gt 0 ]; then
     exec python -m pytest -q "$@"
 fi
 
-# The whole suite in six parts at once: four pytest runs and the documentation beside the
-# soak tests. A pytest run keeps at most one core busy (its served explorers and Chromium
-# aside), and on a shared machine each runnable process gets its share of the cores: one
-# pytest for all unit tests was the whole run's length (beside one busy loop: rest 11.1
-# of 11.5 min, 2026-12-02). The parts, and what each took on a quiet 2-core machine
-# (AMD EPYC, 2026-12-02, the six run together as here):
-# - solver: the unit tests of core's lower layers (everything outside the five folders
-#   of "front" below; ~175 s of one core alone),
-# - front: the unit tests of the explorer, studies, reports, the command line, packaging
-#   and the README (~195 s alone),
-# - browser-a, browser-b: the browser tests (marker "browser": a served explorer and
-#   Chromium each; ~200 s each alone, half of it waiting on the page),
-# - soak (marker "soak"): servers and worker processes started, stopped, killed and left
-#   idle (~250 s, much of it waiting on them),
-# - the documentation (~70 s of CPU).
-# Each part has its own temporary directory, pytest cache and served explorers (a free
-# port each); the parts of one marker are split by paths with --ignore, so that a new test
-# file runs in one of them. History of the split: CHANGELOG.md.
+# The whole suite in three parts at once, one pytest each: the browser tests (marker
+# "browser": a served explorer and Chromium), the soak tests (marker "soak": servers and
+# worker processes started, stopped, killed and left idle, much of it waiting on them) and
+# the rest. One pytest keeps at most one core busy, and the soak part waits much of its
+# time; when one part ends first the others still have both cores. Measured on a fresh
+# clone, 2 cores with nothing else running (2026-11-30): 19.8-21.4 min with the
+# installation (rest 18.5-19.9, browser 16.0-17.6, soak 7.5-8.8 min, documentation
+# 4.5-5.3 min) at load average ~4: the whole is bound by the cores' time (the rest alone:
+# 12.6 min; the rest in two halves took as long, the browser part then the longest).
+# Two pytest-xdist workers each for the rest and the browser tests (2026-12-01) took more
+# of the cores' time, 1677 s against ~1390 (each worker imports and warms its own caches,
+# each browser worker serves its own explorer), with the load at ~9; and one Chromium per
+# pytest instead of one per module saved nothing measurable (5 modules: 58.3 against
+# 58.8 s of CPU). The checks of seconds each (marker "slow", 75 tests with the soak ones)
+# run in the soak part instead (2026-12-01) balanced the parts (rest 25.4, browser 24.5,
+# soak 23.9 min) but not the whole: 26.1 min on a fresh clone, 2107 s user + 110 s system
+# CPU, against 23.6 min (1773 s + 86 s) for the split above on the same day. Beside a CPU
+# hog (two busy-loop processes, load 5-8; 2026-12-01, a fresh clone): 51.3 min, all
+# green (rest 50.2, browser 35.2, soak 15.4 min, documentation 580 s), 2216 s user +
+# 107 s system CPU of the suite.
+# On a fresh clone, 2 cores, quiet (2026-12-02): 20.1 min, 1481 s user + 70 s system
+# (rest 19.6, browser 16.1, soak 7.1 min, documentation 275 s), after the FE check's
+# ordering, warm solver workers and the PDF report's own plots cut their CPU. Where the
+# rest's CPU went before them (py-spy, 50 Hz, its subprocesses included): the solver
+# 34 % (creep lift-off marches 17 %), imports 13 %, explorer sessions built in-process
+# 9 %, fits 7 %, FE checks 7 %, PDF reports 3 %.
+# On a faster machine (AMD EPYC, 2 cores; 2026-12-02), fresh clones: quiet 7.5 min, 554 s
+# user + 52 s system (rest 7.1, browser 7.3, soak 3.6 min, documentation 140 s); beside
+# one busy loop (load average 3.3-5.2) 11.5 min (rest 11.1, browser 10.3, soak 4.8 min,
+# documentation 188 s); beside two (load 5-7.7) 15.5 min (rest 15.0): all green.
+# The parts share nothing: each has its own temporary directory, pytest cache and served
+# explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
-names=()
-pids=()
-# part NAME PYTEST-ARGS...: one pytest in the background, its output in $work/NAME.log
-part() {
-    local name=$1
-    shift
-    python -m pytest -q --basetemp "$work/$name" -o cache_dir=".pytest_cache/$name" "$@" \
-        >"$work/$name.log" 2>&1 &
-    names+=("$name")
-    pids+=($!)
-}
-front=(tests/explorer tests/study tests/report tests/cli tests/packaging tests/test_readme.py)
-browser_a=(tests/explorer/test_explorer_browser_checks.py tests/explorer/test_explorer_browser.py
-           tests/explorer/test_explorer_browser_classroom.py
-           tests/explorer/test_explorer_browser_fit.py)
-part solver -m "not browser and not soak" tests "${front[@]/#/--ignore=}"
-part front -m "not browser and not soak" "${front[@]}"
-part browser-a -m browser "${browser_a[@]}"
-part browser-b -m browser tests "${browser_a[@]/#/--ignore=}"
-part soak -m "soak and not browser" tests
+python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
+    >"$work/browser.log" 2>&1 &
+browser_pid=$!
+python -m pytest -q -m "soak and not browser" --basetemp "$work/soak" \
+    -o cache_dir=.pytest_cache/soak >"$work/soak.log" 2>&1 &
+soak_pid=$!
 
 # The documentation (docs/, Sphinx): built here so that it cannot rot. Warnings are errors
 # (-W), so a renamed API, a broken docstring, a moved report or link, or a gallery example
 # that no longer runs fails the run. Always from an empty build directory: an incremental
-# build would not repeat the warnings of pages it skips. The pages stay in DOCS_BUILD_DIR
-# (default ${TMPDIR:-/tmp}/coated-punch-docs, outside the source tree): open index.html
-# there.
+# build would not repeat the warnings of pages it skips. It runs beside the three parts
+# (~110 s of one core; measured in docs/conf.py's docstring). The pages stay in
+# DOCS_BUILD_DIR (default ${TMPDIR:-/tmp}/coated-punch-docs, outside the source tree):
+# open index.html there.
 docs_dir="${DOCS_BUILD_DIR:-${TMPDIR:-/tmp}/coated-punch-docs}"
 build_docs() {
     local start=$SECONDS
@@ -103,21 +104,25 @@ build_docs() {
         echo "built in $((SECONDS - start)) s: $docs_dir/index.html"
 }
 build_docs >"$work/docs.log" 2>&1 &
-names+=(docs)
-pids+=($!)
+docs_pid=$!
 # (kill fails once a job has ended: no status of its own may reach the exit code)
-trap 'kill "${pids[@]}" 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'kill "$browser_pid" "$soak_pid" "$docs_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
 set +e
-codes=""
-failed=0
-for i in "${!pids[@]}"; do
-    wait "${pids[$i]}"
-    code=$?
-    [ "$code" -eq 0 ] || failed=1
-    codes+="${codes:+, }${names[$i]} $code"
-    echo "---- ${names[$i]} ----"
-    cat "$work/${names[$i]}.log"
-done
+python -m pytest -q -m "not browser and not soak" --basetemp "$work/rest" \
+    -o cache_dir=.pytest_cache/rest
+rest=$?
+wait "$browser_pid"
+browser=$?
+wait "$soak_pid"
+soak=$?
+wait "$docs_pid"
+docs=$?
 set -e
-echo "---- exit codes: $codes ----"
-[ "$failed" -eq 0 ]
+echo "---- documentation (sphinx -W) ----"
+cat "$work/docs.log"
+echo "---- browser tests (pytest -m browser) ----"
+cat "$work/browser.log"
+echo "---- soak tests (pytest -m soak) ----"
+cat "$work/soak.log"
+echo "---- exit codes: rest $rest, browser $browser, soak $soak, docs $docs ----"
+[ "$rest" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$soak" -eq 0 ] && [ "$docs" -eq 0 ]
