@@ -34,6 +34,7 @@ from core.problem import (
     validate_geometry,
     validate_time_inputs,
 )
+from core.work import one_blas_thread
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
@@ -44,6 +45,7 @@ Scalar = float | Callable[[np.ndarray], np.ndarray]
 SIGNATURE_OPTIONS: dict[str, Any] = {"basis": "graded", "n_modes": None, "time_breaks": ()}
 
 
+@one_blas_thread()
 def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float] | np.ndarray,
                         *, c: Scalar = 1.0, kernel: Callable | None = None,
                         settlement: Scalar | None = None, tilt: Scalar | None = None,

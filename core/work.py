@@ -15,16 +15,27 @@ solving at the same time have their own.
 The same loops stop a solve whose answer is no longer wanted (:func:`cancellable`: a
 newer request of the same user superseded it): :class:`SolveCancelled`, which no level
 of the solver words or catches.
+
+A solve runs its dense linear algebra on one BLAS thread (:func:`one_blas_thread`): its
+matrices are small, and more BLAS threads only fight for the cores.
 """
 
 from __future__ import annotations
 
+import os
+import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
+from typing import Any
 
 from core import limits
+
+#: Variables by which a user sets the BLAS libraries' threads: where one is set, solves
+#: keep that setting (:func:`one_blas_thread`).
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS",
+                         "BLIS_NUM_THREADS")
 
 #: (deadline in this thread's CPU time [s], the bound it came from [s]), or None.
 _BOUND: ContextVar[tuple[float, float] | None] = ContextVar("solve_work_bound", default=None)
@@ -85,3 +96,56 @@ def check_work(doing: str) -> None:
     cancelled = _CANCELLED.get()
     if cancelled is not None and cancelled():
         raise SolveCancelled(f"the solve was cancelled while {doing}")
+
+
+# One BLAS thread during solves: the libraries' thread counts are process-wide, so the
+# first solve to start sets them and the last to end restores them (solves may run in
+# several threads at once).
+_blas_lock = threading.Lock()
+_blas_solves = 0
+_blas_limiter: Any = None
+_blas_controller: Any = None
+
+
+@contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """Run the work inside with the BLAS libraries (NumPy's and SciPy's) on one thread each,
+    and give them back their thread counts once no solve runs.
+
+    The solver's dense matrices are small (tens to a few thousand rows) and it is called
+    again and again; BLAS threads on top of that mostly fight for the cores. In a Python
+    session on a 2-core machine (OpenBLAS at its default of one thread per core), a new
+    geometry of the presets took 0.9-2.8x the wall time and 1-5.5x the CPU time of the same
+    solve on one thread, a load change 0.9-1.4x and 0.9-2.6x (``python -m
+    benchmarks.blas_threads``, ``benchmarks/results/blas_threads.md``). Where the user set
+    the threads (one of :data:`BLAS_THREAD_VARIABLES`), that setting is kept. Costs ~11 us
+    a solve (6 ms once, to find the libraries).
+    """
+    global _blas_solves, _blas_limiter
+    if any(os.environ.get(name) for name in BLAS_THREAD_VARIABLES):
+        yield
+        return
+    with _blas_lock:
+        if _blas_solves == 0:
+            _blas_limiter = _controller().limit(limits=1, user_api="blas")
+        _blas_solves += 1
+    try:
+        yield
+    finally:
+        with _blas_lock:
+            _blas_solves -= 1
+            if _blas_solves == 0:
+                _blas_limiter.restore_original_limits()
+                _blas_limiter = None
+
+
+def _controller() -> Any:
+    """The BLAS libraries of this process (found once; SciPy's own OpenBLAS is loaded with
+    :mod:`scipy.linalg`, which every solve imports)."""
+    global _blas_controller
+    if _blas_controller is None:
+        import scipy.linalg  # noqa: F401
+        from threadpoolctl import ThreadpoolController
+
+        _blas_controller = ThreadpoolController()
+    return _blas_controller

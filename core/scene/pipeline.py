@@ -31,9 +31,10 @@ from core.scene.punches import (
 from core.scene.results import SceneSolution, _check_finite
 from core.scene.uncoated import lift_off_refusal
 from core.scene.validate import scene_from_dict
-from core.work import WorkLimitExceeded, work_bound
+from core.work import WorkLimitExceeded, one_blas_thread, work_bound
 
 
+@one_blas_thread()
 def solve(scene: Scene | PunchesScene | Mapping[str, Any]) -> SceneSolution | PunchesSolution:
     """Solve a scene (a :class:`Scene` or a scene dict, validated first).
 

@@ -50,6 +50,7 @@ from core.problem import (
     validate_geometry,
     validate_time_inputs,
 )
+from core.work import one_blas_thread
 
 #: The time stepping aims this many times below its share of tol: its step-doubling
 #: estimate read up to ~20x the true error on decaying creep (as the projection's, see
@@ -247,6 +248,7 @@ class PreparedContact:
 
     # --------------------------------------------------------------------- solve
 
+    @one_blas_thread()
     def solve(self, times: Sequence[float] | np.ndarray, *, c: Scalar = 1.0,
               kernel: Callable | None = None, settlement: Scalar | None = None,
               tilt: Scalar | None = None, force: Scalar | None = None,
@@ -425,6 +427,7 @@ class PreparedContact:
         return np.union1d(times, samples)
 
 
+@one_blas_thread()
 def prepare(lam: float, m: Scalar, g: Scalar, *, breakpoints: Sequence[float] = (),
             tol: float = 1e-8, method: str = "nystrom") -> Any:
     """Discretize the geometry once (dimensionless); ``.solve(times, ...)`` takes the loads.
