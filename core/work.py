@@ -116,10 +116,13 @@ def one_blas_thread() -> Iterator[None]:
     again and again; BLAS threads on top of that mostly fight for the cores. In a Python
     session on a 2-core machine (OpenBLAS at its default of one thread per core), a new
     geometry of the presets took 0.9-2.8x the wall time and 1-5.5x the CPU time of the same
-    solve on one thread, a load change 0.9-1.4x and 0.9-2.6x (``python -m
+    solve on one thread, a load change 0.8-2.0x and 0.8-3.8x (two runs of ``python -m
     benchmarks.blas_threads``, ``benchmarks/results/blas_threads.md``). Where the user set
     the threads (one of :data:`BLAS_THREAD_VARIABLES`), that setting is kept. Costs ~11 us
-    a solve (6 ms once, to find the libraries).
+    a solve (6 ms once, to find the libraries). ``OPENBLAS_NUM_THREADS=1`` set before NumPy
+    is imported (the explorer's server and the study workers set it) does a little more:
+    OpenBLAS then starts no worker threads, which on some paths keep spinning beside a
+    solve even on one thread (``worn_coating``'s new geometry: CPU twice its wall time).
     """
     global _blas_solves, _blas_limiter
     if any(os.environ.get(name) for name in BLAS_THREAD_VARIABLES):
