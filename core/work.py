@@ -130,14 +130,17 @@ def one_blas_thread() -> Iterator[None]:
         return
     with _blas_lock:
         if _blas_solves == 0:
-            _blas_limiter = _controller().limit(limits=1, user_api="blas")
+            try:
+                _blas_limiter = _controller().limit(limits=1, user_api="blas")
+            except Exception:  # noqa: BLE001 - a library it cannot set: solve as it is
+                _blas_limiter = None
         _blas_solves += 1
     try:
         yield
     finally:
         with _blas_lock:
             _blas_solves -= 1
-            if _blas_solves == 0:
+            if _blas_solves == 0 and _blas_limiter is not None:
                 _blas_limiter.restore_original_limits()
                 _blas_limiter = None
 

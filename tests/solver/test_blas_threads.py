@@ -94,3 +94,21 @@ def test_a_count_set_by_environment_variable_is_kept() -> None:
     assert seen["before"] == [2]
     assert seen["inside"] == [[2]] * 6
     assert seen["after"] == [2]
+
+
+def test_a_library_that_cannot_be_set_leaves_the_solve_as_it_was(monkeypatch) -> None:
+    """The thread count is a matter of speed: where the libraries cannot be read or set,
+    the solve runs as it would have without the limit."""
+    import core
+    import core.work as work
+
+    for name in BLAS_THREAD_VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+
+    def unreadable():
+        raise RuntimeError("no BLAS library this tool knows")
+
+    monkeypatch.setattr(work, "_controller", unreadable)
+    result = core.solve(core.load_scene("preset:worn_coating"))
+    assert result.info["success"]
+    assert work._blas_solves == 0 and work._blas_limiter is None
