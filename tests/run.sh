@@ -80,7 +80,7 @@ work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
 python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
     >"$work/browser.log" 2>&1 &
 browser_pid=$!
-python -m pytest -q -m "(soak or slow) and not browser" --basetemp "$work/soak" \
+python -m pytest -q -m "soak and not browser" --basetemp "$work/soak" \
     -o cache_dir=.pytest_cache/soak >"$work/soak.log" 2>&1 &
 soak_pid=$!
 
@@ -108,7 +108,7 @@ docs_pid=$!
 # (kill fails once a job has ended: no status of its own may reach the exit code)
 trap 'kill "$browser_pid" "$soak_pid" "$docs_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
 set +e
-python -m pytest -q -m "not browser and not soak and not slow" --basetemp "$work/rest" \
+python -m pytest -q -m "not browser and not soak" --basetemp "$work/rest" \
     -o cache_dir=.pytest_cache/rest
 rest=$?
 wait "$browser_pid"
