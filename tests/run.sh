@@ -70,10 +70,13 @@ fi
 # rest's CPU went before them (py-spy, 50 Hz, its subprocesses included): the solver
 # 34 % (creep lift-off marches 17 %), imports 13 %, explorer sessions built in-process
 # 9 %, fits 7 %, FE checks 7 %, PDF reports 3 %.
-# On a faster machine (AMD EPYC, 2 cores; 2026-12-02), fresh clones: quiet 7.5 min, 554 s
-# user + 52 s system (rest 7.1, browser 7.3, soak 3.6 min, documentation 140 s); beside
-# one busy loop (load average 3.3-5.2) 11.5 min (rest 11.1, browser 10.3, soak 4.8 min,
-# documentation 188 s); beside two (load 5-7.7) 15.5 min (rest 15.0): all green.
+# On a faster machine (AMD EPYC, 2 cores; 2026-12-02), fresh clones: quiet 6.8-10.1 min,
+# 544-809 s of CPU (the machine's speed moves by a third from hour to hour); beside one
+# busy loop (mean load average 4.2-4.8) 9.7-11.5 min, 601-720 s of CPU (rest 9.4-11.1,
+# browser 8.9-10.3, soak 4.0-4.8 min); beside two (load 5-7.7) 15.5 min: all green. Other
+# splits beside one busy loop took as long: six parts (the rest and the browser tests in
+# two each) 11.4 min, the "slow" checks in the soak part 10.2 min (load 5.4). The cores'
+# time is the bound: a shorter run needs less CPU, not other parts.
 # The parts share nothing: each has its own temporary directory, pytest cache and served
 # explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
