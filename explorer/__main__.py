@@ -16,11 +16,12 @@ from collections.abc import Callable
 from typing import Any
 
 import core
+from core.work import BLAS_THREAD_VARIABLES
 
 # The solver works on small dense matrices from several threads at once; BLAS threads on
 # top of those only fight for the cores (a cold solve measured 1.5 s instead of 0.09 s on
 # 2 cores). Set before numpy is first imported; an explicit setting is respected.
-for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+for _name in BLAS_THREAD_VARIABLES:
     os.environ.setdefault(_name, "1")
 
 #: The memory allocator the served explorer runs with (``PYTHONMALLOC``). Python's own

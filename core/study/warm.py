@@ -22,6 +22,8 @@ from typing import Any
 import numpy as np
 from distributed.diagnostics.plugin import WorkerPlugin
 
+from core.work import BLAS_THREAD_VARIABLES
+
 #: The scene of the warming batches (SI units): unlike any study's base but solved by the
 #: same paths (exact layered kernel, load batches, lift-off families, one-point solves).
 WARM_SCENE: dict[str, Any] = {
@@ -86,8 +88,7 @@ def start_local_cluster(n_workers: int | None = None,
     # one single-threaded worker process per core; BLAS threads would only compete
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                            host="127.0.0.1", dashboard_address=None,
-                           env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-                                "MKL_NUM_THREADS": "1"})
+                           env=dict.fromkeys(BLAS_THREAD_VARIABLES, "1"))
     client = Client(cluster)
 
     def close() -> None:
