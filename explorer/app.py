@@ -19,7 +19,14 @@ from typing import Any
 
 import panel as pn
 
-from .fixes import bokeh_fixes, closed_pages, gc_policy, idle_painter, install_in_process
+from .fixes import (
+    bokeh_fixes,
+    closed_pages,
+    gc_policy,
+    idle_painter,
+    install_in_process,
+    layout_batch,
+)
 from .model import (
     DEFAULT_PRESET,
     DesignLimits,
@@ -357,8 +364,9 @@ class ExplorerApp(pn.viewable.Viewer):
 
     def load_scene(self, scene: dict[str, Any]) -> bool:
         """Validate a scene dict with the core and show it; False (and a notice) if bad."""
-        # one message to the page for every widget the scene sets
-        with pn.io.hold():
+        # one message to the page for every widget the scene sets, and the page's models
+        # walked once for all the sliders it shows for the first time
+        with pn.io.hold(), layout_batch.batch():
             try:
                 validated_scene(scene)
                 self.state.load_scene(scene)

@@ -18,6 +18,8 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
   class, not per new model.
 - ``patch_refs``: Bokeh's patch messages written without listing every model of the page.
 - ``design_updates``: a changed parameter sent without the theme worked out again.
+- ``layout_batch``: many layout changes of a page (a preset's new sliders) with the
+  page's models walked once, not once per change.
 """
 
 from . import (
@@ -26,6 +28,7 @@ from . import (
     design_updates,
     gc_policy,
     idle_painter,
+    layout_batch,
     model_walk,
     panel_fixes,
     patch_refs,
@@ -33,7 +36,8 @@ from . import (
 )
 
 __all__ = ["bokeh_fixes", "closed_pages", "design_updates", "gc_policy", "idle_painter",
-           "install_in_process", "model_walk", "panel_fixes", "patch_refs", "property_defaults"]
+           "install_in_process", "layout_batch", "model_walk", "panel_fixes", "patch_refs",
+           "property_defaults"]
 
 
 def install_in_process() -> None:

@@ -7,6 +7,7 @@ from typing import Any
 
 import panel as pn
 
+from ..fixes import layout_batch
 from ..model import STATEMENTS, ExplorerState, SceneHistory, preset_label
 from ..solving import SolveController
 from .eccentricity import EccentricityControl
@@ -16,8 +17,9 @@ from .widgets import NAMES, HistoryEditor
 
 
 def _held(change: Callable[[], Any]) -> None:
-    """Make ``change`` (a whole scene set again) reach the page in one message."""
-    with pn.io.hold():
+    """Make ``change`` (a whole scene set again) reach the page in one message, the
+    page's models walked once for the sliders it makes (``layout_batch``)."""
+    with pn.io.hold(), layout_batch.batch():
         change()
 
 
