@@ -18,7 +18,7 @@ from typing import Any
 from core.cache import fingerprint
 from core.scene.model import Scene
 from core.scene.results import FLAG_MESSAGES
-from core.scene.validate import scene_from_dict
+from core.scene.validate import scene_from_dict, solver_model_tol
 
 #: The parts of a scene the FE check's answer depends on (its geometry, materials, age at
 #: loading and loads); the name, output times, solver settings and limits do not enter it.
@@ -44,7 +44,9 @@ def model_error_evidence(scene: Scene | Mapping[str, Any], estimate: float,
     Parameters
     ----------
     scene : Scene or mapping
-        The scene of the result (its ``solver.model_tol`` is the flag's threshold).
+        The scene of the result (its ``solver.model_tol`` is the flag's threshold; a
+        mapping is validated as a whole only when ``check`` is given, to compare it with
+        the checked scene, else only its ``solver.model_tol`` is read and checked).
     estimate : float
         The result's estimated relative error of its coating model
         (``info["model_error_estimate"]``) [-].
@@ -63,8 +65,14 @@ def model_error_evidence(scene: Scene | Mapping[str, Any], estimate: float,
         (None without one); ``"model_tol"``; ``"flagged"``: ``error > model_tol``;
         ``"message"``: the ``model_error`` flag's explanation.
     """
-    scene = scene_from_dict(scene)
-    tol = float(scene.model_tol)
+    if check is None and isinstance(scene, Mapping) and isinstance(
+            scene.get("solver", {}), Mapping):
+        # the flag's threshold alone: a result's scene was validated when it was solved
+        # (a whole validation here cost the explorer's server 1-2 ms a geometry step)
+        tol = solver_model_tol(scene.get("solver", {}))
+    else:
+        scene = scene_from_dict(scene)
+        tol = float(scene.model_tol)
     estimate = float(estimate)
     applies = check is not None and check.get("scene_key") == checked_key(scene)
     if applies:

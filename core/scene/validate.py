@@ -185,10 +185,7 @@ def _validated(d: dict[str, Any]) -> Scene:
         if not isinstance(contact, str) or contact not in CONTACT_MODELS:
             raise ValueError(f"solver.contact: must be one of {', '.join(CONTACT_MODELS)}, "
                              f"got {show_value(contact)}")
-    model_tol = finite_number(solver.get("model_tol", DEFAULT_MODEL_TOL), "solver.model_tol")
-    if not MODEL_TOL_RANGE[0] <= model_tol <= MODEL_TOL_RANGE[1]:
-        raise ValueError(f"solver.model_tol: must be in [{MODEL_TOL_RANGE[0]:g}, "
-                         f"{MODEL_TOL_RANGE[1]:g}], got {show_value(model_tol)}")
+    model_tol = solver_model_tol(solver)
 
     design = DesignLimits.from_dict(check_fields(d.get("limits", {}), "limits", (),
                                                  schema.optional_fields("limits")))
@@ -223,6 +220,18 @@ def _validated(d: dict[str, Any]) -> Scene:
     check_uncoated(scene)
     _check_load_rates(scene)
     return scene
+
+
+def solver_model_tol(solver: Mapping[str, Any]) -> float:
+    """A scene's ``solver.model_tol`` [-] (the default when absent) from its ``solver``
+    section, checked as :func:`scene_from_dict` checks it (``ValueError`` naming the
+    field otherwise): the flag threshold of the coating model's error, which
+    :func:`core.scene.model_error_evidence` reads without validating the whole scene."""
+    model_tol = finite_number(solver.get("model_tol", DEFAULT_MODEL_TOL), "solver.model_tol")
+    if not MODEL_TOL_RANGE[0] <= model_tol <= MODEL_TOL_RANGE[1]:
+        raise ValueError(f"solver.model_tol: must be in [{MODEL_TOL_RANGE[0]:g}, "
+                         f"{MODEL_TOL_RANGE[1]:g}], got {show_value(model_tol)}")
+    return model_tol
 
 
 def default_tol(creep: Any, age_at_loading: float) -> float:

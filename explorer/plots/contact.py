@@ -39,12 +39,14 @@ _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 FEATURE_FLOOR_M = 1e-9
 
 
-def _along(x: np.ndarray, y: np.ndarray, lo: float, hi: float) -> tuple[list, list]:
-    """The curve ``y(x)`` from ``lo`` to ``hi`` (ends interpolated)."""
+def _along(x: np.ndarray, y: np.ndarray, lo: float, hi: float
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """The curve ``y(x)`` from ``lo`` to ``hi`` (ends interpolated), as arrays: the page
+    gets them as binary buffers, not as JSON lists of numbers to write and parse (a zone
+    over a whole drawing: ~400 points), and keeps the zone's ends as computed."""
     inside = (x > lo) & (x < hi)
     xs = np.concatenate([[lo], x[inside], [hi]])
-    ys = np.interp(xs, x, y)
-    return [float(v) for v in xs], [float(v) for v in ys]
+    return xs, np.interp(xs, x, y)
 
 
 class ContactDrawing:

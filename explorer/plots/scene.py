@@ -25,7 +25,7 @@ from bokeh.models import (
 from bokeh.plotting import figure
 
 from ..model import Geometry, ResultView
-from .bokeh_data import MOVING
+from .bokeh_data import MOVING, f32
 from .contact import ContactDrawing
 
 # Number of slabs each coating layer is drawn with (its colour follows E(x)).
@@ -255,26 +255,22 @@ class SceneDrawing:
 
 
 def _slabs(g: Geometry, left: float, right: float, count: int, scale: float
-           ) -> dict[str, list]:
+           ) -> dict[str, np.ndarray]:
     """The coating drawn as ``count`` slabs a layer over [left, right] [m]: their bounds,
     tops (thickness times the drawing's vertical ``scale``) and, at their centres
     (interpolated from the geometry's fine grid), modulus [MPa], layer and thickness [mm];
-    layer 1 on top, in contact with the punch."""
+    layer 1 on top, in contact with the punch. Arrays (float32: a drawing and its hover
+    need no more), which the page gets as binary buffers instead of JSON lists."""
     edges = np.linspace(left, right, count + 1)
     centres = 0.5 * (edges[1:] + edges[:-1])
-    bottom = np.zeros(count)
-    cols: dict[str, list] = {k: [] for k in ("left", "right", "bottom", "top", "E",
-                                             "layer", "h_mm")}
-    for k in reversed(range(len(g.thickness))):
-        h = np.interp(centres, g.x, g.thickness[k])
-        e = np.interp(centres, g.x, g.modulus[k])
-        top = bottom + scale * h
-        cols["left"].extend(edges[:-1])
-        cols["right"].extend(edges[1:])
-        cols["bottom"].extend(bottom)
-        cols["top"].extend(top)
-        cols["E"].extend(e / 1e6)
-        cols["layer"].extend([k + 1] * count)
-        cols["h_mm"].extend(h * 1e3)
-        bottom = top
-    return cols
+    n = len(g.thickness)
+    h = np.array([np.interp(centres, g.x, g.thickness[k])
+                  for k in reversed(range(n))]).reshape(n, count)
+    e = np.array([np.interp(centres, g.x, g.modulus[k])
+                  for k in reversed(range(n))]).reshape(n, count)
+    tops = np.cumsum(scale * h, axis=0)
+    bottoms = tops - scale * h
+    return {"left": f32(np.tile(edges[:-1], n)), "right": f32(np.tile(edges[1:], n)),
+            "bottom": f32(bottoms.ravel()), "top": f32(tops.ravel()),
+            "E": f32(e.ravel() / 1e6), "h_mm": f32(h.ravel() * 1e3),
+            "layer": np.repeat(np.arange(n, 0, -1, dtype=np.int32), count)}

@@ -97,3 +97,27 @@ def test_the_command_line_report_runs_the_check(tmp_path):
     strict = run_cli("report", path, "-o", tmp_path / "strict.html", "--fe-check",
                      "--strict")
     assert strict.returncode == 4 and "model_error" in strict.stderr
+
+
+def test_without_a_check_only_the_threshold_is_read(monkeypatch):
+    """A result's scene was validated when it was solved: without a check, the evidence
+    reads its solver.model_tol (default or given, checked) and nothing else of it, the
+    same answer as from the validated scene."""
+    import core.scene.evidence as evidence_module
+
+    scene = epoxy_on_pad_scene()
+    validated = core.scene_from_dict(scene)
+    expected = model_error_evidence(validated, ESTIMATE)
+    assert expected["model_tol"] == pytest.approx(0.02)  # the default
+    calls = []
+    monkeypatch.setattr(evidence_module, "scene_from_dict",
+                        lambda d: calls.append(d) or validated)
+    assert model_error_evidence(scene, ESTIMATE) == expected and calls == []
+    scene["solver"] = {"model_tol": 0.05}
+    assert not model_error_evidence(scene, ESTIMATE)["flagged"]  # 4.6 % within 5 %
+    scene["solver"] = {"model_tol": 2.0}
+    with pytest.raises(ValueError, match=r"solver\.model_tol: must be in"):
+        model_error_evidence(scene, ESTIMATE)
+    # with a check the whole scene is validated, to compare it with the checked one
+    model_error_evidence(epoxy_on_pad_scene(), ESTIMATE, _check(epoxy_on_pad_scene(), MEASURED))
+    assert len(calls) >= 1
