@@ -224,3 +224,25 @@ def test_the_contact_figures_join_the_page_only_when_a_result_needs_them(explore
         assert (slots.width_slot.visible, slots.inset_slot.visible) == (width, inset), key
     # once sent, a figure stays on the page (hidden), ready for the next scene that needs it
     assert len(slots.width_slot.objects) == len(slots.inset_slot.objects) == 1
+
+
+def test_the_drawing_goes_to_the_page_as_binary_arrays() -> None:
+    """The coating's slabs and the zone's line are arrays, which Bokeh sends as binary
+    buffers; as lists of numbers they were ~17 kB of JSON a geometry step, written by the
+    server and parsed by the page. The zone's ends stay as computed (float64)."""
+    from bokeh.core.serialization import Serializer
+
+    figures, view, last = _drawn("eccentric_footing_liftoff")
+    slabs = figures.layer_src.data
+    assert slabs and all(isinstance(v, np.ndarray) for v in slabs.values())
+    assert slabs["left"].size == 120 and set(slabs["layer"].tolist()) == {1}
+    for source in (figures.contact.zone_src, figures.contact.lifted_src):
+        assert all(isinstance(v, np.ndarray) and v.dtype == np.float64
+                   for column in ("xs", "ys") for v in source.data[column])
+    (xs,) = figures.contact.zone_src.data["xs"]
+    assert xs[0] == view.contact_set[last][0][0]
+    # serialized for the page: seven buffers and a short JSON text (as lists: ~8 kB)
+    serializer = Serializer(deferred=True)
+    encoded = serializer.encode(dict(figures.layer_src.data))
+    text = json.dumps(encoded, default=lambda buffer: {"id": buffer.id})
+    assert len(serializer.buffers) == 7 and len(text) < 1500
