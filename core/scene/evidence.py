@@ -65,11 +65,11 @@ def model_error_evidence(scene: Scene | Mapping[str, Any], estimate: float,
         (None without one); ``"model_tol"``; ``"flagged"``: ``error > model_tol``;
         ``"message"``: the ``model_error`` flag's explanation.
     """
-    if check is None and isinstance(scene, Mapping) and isinstance(
-            scene.get("solver", {}), Mapping):
+    solver = scene.get("solver", {}) if check is None and isinstance(scene, Mapping) else None
+    if isinstance(solver, Mapping):
         # the flag's threshold alone: a result's scene was validated when it was solved
         # (a whole validation here cost the explorer's server 1-2 ms a geometry step)
-        tol = solver_model_tol(scene.get("solver", {}))
+        tol = solver_model_tol(solver)
     else:
         scene = scene_from_dict(scene)
         tol = float(scene.model_tol)

@@ -32,14 +32,19 @@ def batch(doc: Any = None) -> Iterator[None]:
     document) to the end of the block (see the module notes).
 
     Nested in another batch, in a block where the document's models are frozen already,
-    or without a document, the block runs as it would without it.
+    without a document, or with Panel or Bokeh changed from the versions checked, the
+    block runs as it would without it.
     """
     from panel.io.state import state
     from panel.layout.base import Panel
 
     doc = state.curdoc if doc is None else doc
     models = getattr(doc, "models", None)
-    if models is None or Panel._batch_update or getattr(models, "_freeze_count", 1):
+    # (Panel's and Bokeh's internals as checked; if they changed, nothing is batched)
+    usable = (isinstance(getattr(Panel, "_batch_update", None), bool)
+              and all(hasattr(models, name) for name in ("_push_freeze", "_pop_freeze",
+                                                          "_freeze_count")))
+    if not usable or Panel._batch_update or models._freeze_count:
         yield
         return
     # Panel freezes the models around each change that may add or drop models (a

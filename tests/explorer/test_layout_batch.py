@@ -145,3 +145,18 @@ def test_a_preset_switch_walks_the_page_once(explorer_app, monkeypatch) -> None:
         assert app.load_scene(read_preset("rounded_graded"))
     assert counts["recompute"] == 1 and counts["preprocess"] <= 1, counts
     assert app.controller.wait(120) and app.controller.error == ""
+
+
+def test_a_document_without_bokehs_freeze_is_left_as_it_is() -> None:
+    """Bokeh's model manager as checked (3.9.2) has ``_push_freeze``; another one is not
+    batched, and nothing of it or of Panel is touched."""
+
+    class OtherModels:
+        _freeze_count = 0
+
+    class OtherDocument:
+        models = OtherModels()
+
+    with layout_batch.batch(OtherDocument()):
+        assert not Panel._batch_update
+    assert not vars(OtherDocument.models)
