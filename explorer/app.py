@@ -490,6 +490,7 @@ def create_app(**kwargs: Any) -> ExplorerApp:
     served = bool(pn.state.curdoc is not None and pn.state.curdoc.session_context)
     kwargs.setdefault("executor", "shared" if served else None)
     if served:
+        closed_pages.start_busy_cleanup()  # before this page can be busy
         gc_policy.pause_for_page()
         pn.state.on_session_destroyed(gc_policy.session_ended)
         bokeh_fixes.install(pn.state.curdoc)

@@ -9,8 +9,9 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
   from the computed style at each paint; a renderer's place written on its element, not
   into a style sheet; a figure's base font size read once.
 - ``idle_painter``: the file dropper's frame loop, paused while nothing happens.
-- ``closed_pages``: pages closed abruptly (a debug line, not a traceback) and Panel's
-  link registry released when a session ends.
+- ``closed_pages``: pages closed abruptly (a debug line, not a traceback), Panel's
+  link registry released when a session ends, and Panel's busy-counter task started
+  holding no page.
 - ``gc_policy``: the garbage collector kept off complete pages, and given them back.
 - ``model_walk``: Bokeh's walk over a document's models without building the constant
   defaults it reads (each change of the page's shape walks every model).

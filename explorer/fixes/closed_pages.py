@@ -21,10 +21,24 @@ values hold the key itself: an entry never goes, and through the slider's watche
 kept the whole page alive, every page ever opened (~6 MiB each; rounds of 50 dropped
 sessions grew the server by ~300 MiB, none of it returned). The registry is also walked
 at every page's first render, so it slowed the server down as it grew.
+
+:func:`start_busy_cleanup` keeps the first busy page out of Panel's busy-counter task.
+Panel (1.9) starts one task for the whole process, at the first event that marks a page
+busy, to drop stale entries of ``pn.state``'s busy counter every 10 s. ``asyncio`` gives
+a task a copy of the context it was created in, and that context holds Panel's current
+document (the ``curdoc`` context variable): the page whose event started the task, with
+its ~46,000 objects, lived as long as the server. Each collection after a session ended
+then found a closed page still held, so ``gc_policy`` looked again (a full collection,
+0.25-0.3 s on the event loop) 10, 20, 40, 60... s later for five minutes, and logged a
+warning at the end. Started before any page is busy, in an empty context, the task holds
+no page.
 """
 
 from __future__ import annotations
 
+import asyncio
+import contextvars
+import importlib
 import logging
 from collections.abc import Callable, Iterable
 from typing import Any
@@ -85,6 +99,30 @@ def page_releaser(roots: Callable[[], Iterable[Any]]) -> Callable[[Any], None]:
             log.exception("could not release the links of a closed page")
 
     return release
+
+
+def start_busy_cleanup() -> bool:
+    """Start Panel's busy-counter cleanup task in an empty context, so that it keeps no
+    page alive (module notes). Call it on the server's event loop before a page can be
+    busy (each new session does; once started, later calls do nothing).
+
+    Returns whether it started the task here: False when it already runs, outside an
+    event loop, or when Panel's busy counter has changed shape (then nothing is done).
+    """
+    panel_state = importlib.import_module("panel.io.state")  # the module: panel.io.state
+    # is also the name of its instance
+    holder = getattr(panel_state, "_state", None)
+    schedule = getattr(panel_state.state, "_schedule_busy_cleanup", None)
+    if holder is None or schedule is None or not hasattr(holder, "_busy_cleanup_scheduled"):
+        return False
+    if holder._busy_cleanup_scheduled:
+        return False
+    try:
+        asyncio.get_running_loop()
+    except RuntimeError:  # no loop to run the task on
+        return False
+    contextvars.Context().run(schedule)
+    return bool(holder._busy_cleanup_scheduled)
 
 
 def install() -> bool:

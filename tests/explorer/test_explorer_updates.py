@@ -523,6 +523,52 @@ async def _pause() -> bool:
     return gc_policy.pause_for_page()
 
 
+def test_panels_busy_counter_task_holds_no_page() -> None:
+    """Panel starts one task for the whole process at the first event that marks a page
+    busy; made in that page's context, it held the page (its document, through Panel's
+    ``curdoc`` context variable) as long as the server ran, and the collector was asked
+    again and again for a closed page that never went (the server's trace: 0.25-0.3 s
+    pauses for five minutes after the first page closed). Started by each new session
+    before its page can be busy, the task holds no page.
+
+    The first half shows Panel's behaviour as it is (checked with 1.9.4); if it fails,
+    Panel no longer holds the page and ``closed_pages.start_busy_cleanup`` can go."""
+    import asyncio
+    import gc
+
+    from bokeh.document import Document
+    from panel.io.state import _state, set_curdoc, state
+
+    from explorer.fixes import closed_pages
+
+    async def page_held(fixed: bool) -> bool:
+        doc = Document()
+        with set_curdoc(doc):  # as during a page's event
+            if fixed:
+                assert closed_pages.start_busy_cleanup()
+                assert not closed_pages.start_busy_cleanup()  # once only
+            state._add_busy_event("event")  # what Panel does as the event starts
+            state._remove_busy_event("event")
+        assert _state._busy_cleanup_scheduled is not None
+        page = weakref.ref(doc)
+        del doc
+        gc.collect()
+        _state._busy_cleanup_scheduled.stop()
+        return page() is not None
+
+    saved = _state._busy_cleanup_scheduled
+    try:
+        _state._busy_cleanup_scheduled = None
+        assert asyncio.run(page_held(fixed=False))
+        _state._busy_cleanup_scheduled = None
+        assert not asyncio.run(page_held(fixed=True))
+        _state._busy_cleanup_scheduled = None
+        assert not closed_pages.start_busy_cleanup()  # no event loop: nothing started
+        assert _state._busy_cleanup_scheduled is None
+    finally:
+        _state._busy_cleanup_scheduled = saved
+
+
 def test_a_view_made_before_its_tab_is_filled_is_released_with_the_page(monkeypatch,
                                                                          explorer_app):
     """A link's Fit or Study settings make that view before its tab is filled; when the
