@@ -404,6 +404,8 @@ def protocol_session(url: str, seed: int, clock: Clock, max_requests: int, stats
     shown = {"force": doc.select_one({"name": "force_source"}),
              "thickness": doc.select_one({"name": "layer_source"})}
     column = {"force": "v", "thickness": "h_mm"}
+    # the drawing's thicknesses are float32 (explorer/plots/scene.py): 6e-8 relative
+    match = {"force": 1e-9, "thickness": 1e-6}
     waiting: dict[str, Any] = {"future": None, "name": None, "value": None}
 
     def check(attr: str, old: Any, new: Any) -> None:
@@ -412,7 +414,7 @@ def protocol_session(url: str, seed: int, clock: Clock, max_requests: int, stats
             return
         values = shown[name].data.get(column[name], [])
         if len(values) and min(abs(float(v) - waiting["value"]) for v in values) <= \
-                1e-9 * max(abs(waiting["value"]), 1.0):
+                match[name] * max(abs(waiting["value"]), 1.0):
             future.set_result(time.perf_counter())
 
     for source in shown.values():
