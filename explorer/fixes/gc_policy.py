@@ -20,8 +20,10 @@ closed pages' garbage, out of reach for good (with visitors who leave abruptly, 
 50 dropped sessions grew the server by ~350 MiB each, none of it returned). A page whose
 session has already ended when it completes is not frozen either. A page can still be
 held for a moment after its session's collection (a solve of the page coming back from
-a worker): frozen with the live pages, it would wait for the next session to end. One
-more collection :data:`LATE_COLLECT_AFTER_S` after the first frees it (measured with
+a worker): frozen with the live pages, it would wait for the next session to end. Where
+one is, one more collection :data:`LATE_COLLECT_AFTER_S` after the first frees it (where
+none is, there is none: a full collection walks every live page, 0.5-1 s with 20 pages
+open) (measured with
 benchmarks/load_test.py --mode abandon: without it, two rounds of 25 in eight left the
 server 60-85 MiB above its level until the next round ended). On a loaded server a page
 can be held longer than that (its last solve queued behind others): :func:`watch_page`
@@ -162,13 +164,17 @@ def held_pages() -> int:
 
 
 def _collect_and_look_again() -> None:
-    """The collection for ended sessions, and one more :data:`LATE_COLLECT_AFTER_S`
-    later (it replaces a longer wait pending for an older page: that page is looked for
-    again then too)."""
-    global _look_after_s
+    """The collection for ended sessions, and, while a page of an ended session is
+    still alive after it, one more :data:`LATE_COLLECT_AFTER_S` later (it replaces a
+    longer wait pending for an older page: that page is looked for again then too)."""
+    global _look, _look_after_s
     collect_ended_sessions()
     _look_after_s = LATE_COLLECT_AFTER_S
-    _look_again()
+    if held_pages():
+        _look_again()
+    elif _look is not None:  # the pages it was for have gone
+        _look.cancel()
+        _look = None
 
 
 def _look_again() -> None:
@@ -188,6 +194,8 @@ def _late_collection() -> None:
     global _look
     _look = None
     if _collect_due:  # the collection due runs first and schedules the next look
+        return
+    if not held_pages():  # freed since (not frozen, so no collection was needed)
         return
     collect_ended_sessions()
     if not held_pages():

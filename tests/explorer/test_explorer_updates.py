@@ -475,6 +475,49 @@ def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch, 
         gc.unfreeze()
 
 
+def test_no_late_collection_once_the_ended_sessions_pages_are_gone(monkeypatch) -> None:
+    """The collection after a session ended frees its page: nothing is left for a late
+    look, and no second full collection runs (each walks every live page, 0.5-1 s on the
+    event loop with 20 pages open; every ended session paid two)."""
+    import asyncio
+    import gc
+
+    from explorer.fixes import gc_policy
+
+    monkeypatch.setattr(gc_policy, "COLLECT_AFTER_S", 0.01)
+    monkeypatch.setattr(gc_policy, "LATE_COLLECT_AFTER_S", 0.05)
+    monkeypatch.setattr(gc_policy, "_held", [])
+    monkeypatch.setattr(gc_policy, "_collect_due", False)
+    monkeypatch.setattr(gc_policy, "_look", None)
+    monkeypatch.setattr(gc_policy, "_look_after_s", 0.05)
+    collections: list[int] = []
+    collect = gc_policy.collect_ended_sessions
+    monkeypatch.setattr(gc_policy, "collect_ended_sessions",
+                        lambda: collections.append(1) or collect())
+
+    class Page:
+        pass
+
+    async def a_session_ends() -> None:
+        page = Page()
+        page.me = page  # cyclic, as a page is: freed by the full collection
+        gc_policy.session_ended(None)
+        gc_policy.watch_page(page)(None)
+        del page
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + 20.0  # a bound on a loaded machine, not a measurement
+        while not collections and loop.time() < deadline:
+            await asyncio.sleep(0.01)
+        await asyncio.sleep(0.5)  # ten times the late look's delay
+        assert gc_policy.held_pages() == 0 and gc_policy._look is None
+
+    try:
+        asyncio.run(a_session_ends())
+        assert collections == [1]
+    finally:
+        gc.unfreeze()
+
+
 def test_one_output_time_draws_q_x_t_as_a_band_around_it(explorer_app) -> None:
     app = explorer_app()
     app.state.time_count = 1
