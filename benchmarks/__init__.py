@@ -26,10 +26,14 @@ def tree_commit(tree: Path = ROOT) -> str:
 
 
 def run_lines(started: datetime, load_before: float, load_after: float,
-              load_note: str = "") -> list[str]:
+              load_note: str = "", commit: str | None = None) -> list[str]:
     """A report's lines on its run: the commit, the date [UTC] and the machine, and the
-    load average before and after (``load_note``: what the load means for its figures)."""
-    return [f"- commit {tree_commit()}, {started:%Y-%m-%d %H:%M} UTC, {platform.machine()}, "
+    load average before and after (``load_note``: what the load means for its figures).
+
+    ``commit``: :func:`tree_commit` taken when the run started (default: now); a long
+    run takes it at its start, as the tree may move on while it runs."""
+    commit = tree_commit() if commit is None else commit
+    return [f"- commit {commit}, {started:%Y-%m-%d %H:%M} UTC, {platform.machine()}, "
             f"{os.cpu_count()} cores, Python {platform.python_version()}",
             f"- load average {load_before:.2f} before, {load_after:.2f} after"
             + (f" ({load_note})" if load_note else "")]

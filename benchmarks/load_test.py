@@ -853,6 +853,9 @@ def main() -> int:
     phase = run_browser_phase if args.client == "browser" else run_protocol_phase
     started = datetime.now(timezone.utc)
     load_before = os.getloadavg()[0]
+    from benchmarks import run_lines, tree_commit
+
+    commit = tree_commit()  # the code the server starts with (the tree may move on)
     heavy: Any = None
 
     with tempfile.TemporaryDirectory(prefix="load-test-") as tmp:
@@ -896,10 +899,9 @@ def main() -> int:
                 server.stop()
         log_errors = server_tracebacks(log_path)
     load_after = os.getloadavg()[0]
-    from benchmarks import run_lines
-
     run = run_lines(started, load_before, load_after,
-                    "1-minute load average; the machine is shared, its other work included")
+                    "1-minute load average; the machine is shared, its other work included",
+                    commit=commit)
     extra: list[str] = []
     goals_met = True
     if heavy is not None:
