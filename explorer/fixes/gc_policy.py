@@ -12,8 +12,9 @@ as before, and reference counting frees non-cyclic garbage whatever its generati
 cyclic garbage among the frozen objects waits.
 
 When a session ends, :func:`session_ended` gives everything back to the collector
-(``gc.unfreeze``) and asks for one full collection :data:`COLLECT_AFTER_S` later (the
-sessions ending meanwhile share it); that collection frees the closed pages' cycles,
+(``gc.unfreeze``) and asks for one full collection :data:`COLLECT_AFTER_S` later, and
+no sooner than :data:`COLLECT_AT_MOST_EVERY_S` after the last (the sessions ending
+meanwhile share it); that collection frees the closed pages' cycles,
 hands the freed memory back to the system (``malloc_trim``) and freezes the pages still
 open again. Until it has run no page is frozen: a freeze then would also freeze the
 closed pages' garbage, out of reach for good (with visitors who leave abruptly, rounds of
@@ -52,6 +53,7 @@ from __future__ import annotations
 import asyncio
 import gc
 import logging
+import math
 import time
 import weakref
 from collections.abc import Callable
@@ -65,6 +67,14 @@ log = logging.getLogger(__name__)
 #: discards the sessions of closed pages in batches (every 17 s by default): one
 #: collection serves a whole batch, and a class closing its tabs costs one pause.
 COLLECT_AFTER_S = 2.0
+#: The shortest time between two collections for ended sessions [s]. Each walks every
+#: live page: 0.5-1.0 s on the event loop with 20 pages open, 1-3 s on a saturated
+#: server, where pages reloaded every few seconds ended sessions in every one of Bokeh's
+#: batches (benchmarks/load_test.py --heavy: such collections were the most frequent
+#: place of the event loop in the liveness probe's long waits, 28-32 py-spy dumps a run).
+#: Sessions ending sooner after the last wait for this, and
+#: their pages' memory (~3-6 MiB a page) is given back that much later.
+COLLECT_AT_MOST_EVERY_S = 30.0
 #: Delay from that collection to one more, for pages let go just after it [s]; the first
 #: of the doubling waits while a page of an ended session is still held.
 LATE_COLLECT_AFTER_S = 10.0
@@ -81,6 +91,8 @@ HELD_AT_MOST_S = 300.0
 PAUSE_AT_MOST_S = 10.0
 
 _collect_due = False
+#: When the last collection for ended sessions ran (``time.monotonic``).
+_last_collection = -math.inf
 _paused = False
 #: The pending look (at most one) and the wait before the next.
 _look: asyncio.TimerHandle | None = None
@@ -142,7 +154,9 @@ def session_ended(session_context: Any) -> None:
     except RuntimeError:  # not on an event loop (a script, a test): collect now
         collect_ended_sessions()
         return
-    loop.call_later(COLLECT_AFTER_S, _collect_and_look_again)
+    since = time.monotonic() - _last_collection
+    loop.call_later(max(COLLECT_AFTER_S, COLLECT_AT_MOST_EVERY_S - since),
+                    _collect_and_look_again)
     _collect_due = True
 
 
@@ -213,10 +227,11 @@ def _late_collection() -> None:
 def collect_ended_sessions() -> int:
     """Free the pages of ended sessions now: a full collection, the freed memory given
     back to the system, the live pages frozen again. Returns the objects collected."""
-    global _collect_due
+    global _collect_due, _last_collection
     _collect_due = False
     gc.unfreeze()
     found = gc.collect()
+    _last_collection = time.monotonic()
     release_freed_memory()
     gc.freeze()
     log.debug("collected %d objects of ended sessions", found)

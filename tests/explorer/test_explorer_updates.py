@@ -392,6 +392,8 @@ def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch, 
     from explorer.fixes import gc_policy
 
     monkeypatch.setattr(gc_policy, "COLLECT_AFTER_S", 0.01)
+    monkeypatch.setattr(gc_policy, "COLLECT_AT_MOST_EVERY_S", 0.0)
+    monkeypatch.setattr(gc_policy, "_last_collection", -float("inf"))
     monkeypatch.setattr(gc_policy, "LATE_COLLECT_AFTER_S", 0.05)
     monkeypatch.setattr(gc_policy, "LOOK_AT_MOST_EVERY_S", 30.0)
     # the module's state, restored afterwards (a look left scheduled on a closed loop
@@ -485,6 +487,8 @@ def test_no_late_collection_once_the_ended_sessions_pages_are_gone(monkeypatch) 
     from explorer.fixes import gc_policy
 
     monkeypatch.setattr(gc_policy, "COLLECT_AFTER_S", 0.01)
+    monkeypatch.setattr(gc_policy, "COLLECT_AT_MOST_EVERY_S", 0.0)
+    monkeypatch.setattr(gc_policy, "_last_collection", -float("inf"))
     monkeypatch.setattr(gc_policy, "LATE_COLLECT_AFTER_S", 0.05)
     monkeypatch.setattr(gc_policy, "_held", [])
     monkeypatch.setattr(gc_policy, "_collect_due", False)
@@ -514,6 +518,61 @@ def test_no_late_collection_once_the_ended_sessions_pages_are_gone(monkeypatch) 
     try:
         asyncio.run(a_session_ends())
         assert collections == [1]
+    finally:
+        gc.unfreeze()
+
+
+def test_sessions_ending_soon_after_a_collection_wait_for_the_next(monkeypatch) -> None:
+    """A full collection walks every live page (0.5-1 s on the event loop with 20 pages
+    open): sessions that end within ``COLLECT_AT_MOST_EVERY_S`` of the last collection
+    share the next one, due that long after the last, not ``COLLECT_AFTER_S`` after they
+    ended; their pages are freed by it."""
+    import asyncio
+    import gc
+    import time
+
+    from explorer.fixes import gc_policy
+
+    monkeypatch.setattr(gc_policy, "COLLECT_AFTER_S", 0.01)
+    monkeypatch.setattr(gc_policy, "COLLECT_AT_MOST_EVERY_S", 0.5)
+    monkeypatch.setattr(gc_policy, "_last_collection", -float("inf"))
+    monkeypatch.setattr(gc_policy, "_held", [])
+    monkeypatch.setattr(gc_policy, "_collect_due", False)
+    monkeypatch.setattr(gc_policy, "_look", None)
+    collections: list[float] = []
+    collect = gc_policy.collect_ended_sessions
+    monkeypatch.setattr(gc_policy, "collect_ended_sessions",
+                        lambda: collections.append(time.monotonic()) or collect())
+
+    class Page:
+        pass
+
+    async def end_session() -> weakref.ref:
+        page = Page()
+        page.me = page  # cyclic, as a page is: freed by the full collection
+        gc_policy.session_ended(None)
+        gc_policy.watch_page(page)(None)
+        return weakref.ref(page)
+
+    async def until(condition) -> None:
+        deadline = asyncio.get_running_loop().time() + 20.0  # a bound, not a measurement
+        while not condition() and asyncio.get_running_loop().time() < deadline:
+            await asyncio.sleep(0.01)
+
+    async def three_sessions() -> list[weakref.ref]:
+        first = await end_session()
+        await until(lambda: len(collections) == 1)
+        second, third = await end_session(), await end_session()  # soon after it
+        await until(lambda: len(collections) == 2)
+        await asyncio.sleep(0.2)
+        return [first, second, third]
+
+    try:
+        pages = asyncio.run(three_sessions())
+        assert len(collections) == 2  # the two later sessions shared one
+        # due COLLECT_AT_MOST_EVERY_S after the first (the timer's own lateness aside)
+        assert collections[1] - collections[0] >= 0.5 - 0.01
+        assert all(page() is None for page in pages)
     finally:
         gc.unfreeze()
 

@@ -41,7 +41,9 @@ def discard_wait_s(session_linger: float) -> float:
     [s]: Bokeh keeps it ``session_linger`` s, looks for such sessions every
     ``session_linger`` s (``python -m explorer`` sets both from --session-linger), the
     full collection that frees its page comes ``COLLECT_AFTER_S`` later, and one more
-    for pages let go late ``LATE_COLLECT_AFTER_S`` after that."""
+    for pages let go late ``LATE_COLLECT_AFTER_S`` after that. For sessions that end
+    within ``gc_policy.COLLECT_AT_MOST_EVERY_S`` of an earlier collection the wait is
+    longer (the first round a server sees has none before it)."""
     return 2 * session_linger + COLLECT_AFTER_S + LATE_COLLECT_AFTER_S + DISCARD_MARGIN_S
 
 
