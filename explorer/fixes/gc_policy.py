@@ -22,20 +22,19 @@ closed pages' garbage, out of reach for good (with visitors who leave abruptly, 
 session has already ended when it completes is not frozen either. A page can still be
 held for a moment after its session's collection (a solve of the page coming back from
 a worker): frozen with the live pages, it would wait for the next session to end. Where
-one is, one more collection :data:`LATE_COLLECT_AFTER_S` after the first frees it (where
-none is, there is none: a full collection walks every live page, 0.5-1 s with 20 pages
-open) (measured with
-benchmarks/load_test.py --mode abandon: without it, two rounds of 25 in eight left the
-server 60-85 MiB above its level until the next round ended). On a loaded server a page
-can be held longer than that (its last solve queued behind others): :func:`watch_page`
+one is, one more collection :data:`LATE_COLLECT_AFTER_S` after the first frees it
+(measured with benchmarks/load_test.py --mode abandon: without it, two rounds of 25 in
+eight left the server 60-85 MiB above its level until the next round ended); where none
+is, none runs (a full collection walks every live page, 0.5-1 s with 20 pages open).
+On a loaded server a page can be held longer than that (its last solve queued behind others): :func:`watch_page`
 follows each page whose session has ended, and while one of them is still alive after
 a collection, one more comes later, each wait twice the last (from
 :data:`LATE_COLLECT_AFTER_S` up to :data:`LOOK_AT_MOST_EVERY_S`: a full collection walks
 every live page, so a page held long costs a few pauses, not one every 10 s), for at
 most :data:`HELD_AT_MOST_S` after its session ended (then a warning names how many are
 still held: a page that outlives that is kept by something other than its work). The
-sessions that end meanwhile get their own collection and the late one after it, as
-always.
+sessions that end meanwhile get their own collection, and the late one after it where a
+page is still held.
 
 While a page is being built (:func:`pause_for_page`, from the start of the session's
 page to the end of the request that asked for it) the collector does not run: building
@@ -72,8 +71,8 @@ COLLECT_AFTER_S = 2.0
 #: server, where pages reloaded every few seconds ended sessions in every one of Bokeh's
 #: batches (benchmarks/load_test.py --heavy: such collections were the most frequent
 #: place of the event loop in the liveness probe's long waits, 28-32 py-spy dumps a run).
-#: Sessions ending sooner after the last wait for this, and
-#: their pages' memory (~3-6 MiB a page) is given back that much later.
+#: Sessions ending sooner after the last wait for this, and their pages' memory (~3-6
+#: MiB a page) is given back that much later.
 COLLECT_AT_MOST_EVERY_S = 30.0
 #: Delay from that collection to one more, for pages let go just after it [s]; the first
 #: of the doubling waits while a page of an ended session is still held.
