@@ -26,9 +26,10 @@ one is, one more collection :data:`LATE_COLLECT_AFTER_S` after the first frees i
 (measured with benchmarks/load_test.py --mode abandon: without it, two rounds of 25 in
 eight left the server 60-85 MiB above its level until the next round ended); where none
 is, none runs (a full collection walks every live page, 0.5-1 s with 20 pages open).
-On a loaded server a page can be held longer than that (its last solve queued behind others): :func:`watch_page`
-follows each page whose session has ended, and while one of them is still alive after
-a collection, one more comes later, each wait twice the last (from
+On a loaded server a page can be held longer than that (its last solve queued behind
+others): :func:`watch_page` follows each page whose session has ended, and while one of
+them is still alive after a collection, one more comes later, each wait twice the last
+(from
 :data:`LATE_COLLECT_AFTER_S` up to :data:`LOOK_AT_MOST_EVERY_S`: a full collection walks
 every live page, so a page held long costs a few pauses, not one every 10 s), for at
 most :data:`HELD_AT_MOST_S` after its session ended (then a warning names how many are
