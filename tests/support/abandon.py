@@ -28,7 +28,11 @@ import struct
 from collections import Counter
 from typing import Any
 
-from explorer.fixes.gc_policy import COLLECT_AFTER_S, LATE_COLLECT_AFTER_S
+from explorer.fixes.gc_policy import (
+    COLLECT_AFTER_S,
+    COLLECT_AT_MOST_EVERY_S,
+    LATE_COLLECT_AFTER_S,
+)
 
 WAYS = ("get", "ack", "pull", "loaded")
 #: Added to the time the server needs to discard a round's sessions [s] (a loaded
@@ -40,11 +44,11 @@ def discard_wait_s(session_linger: float) -> float:
     """How long after its connection is lost a session is surely discarded and collected
     [s]: Bokeh keeps it ``session_linger`` s, looks for such sessions every
     ``session_linger`` s (``python -m explorer`` sets both from --session-linger), the
-    full collection that frees its page comes ``COLLECT_AFTER_S`` later, and one more
-    for pages let go late ``LATE_COLLECT_AFTER_S`` after that. For sessions that end
-    within ``gc_policy.COLLECT_AT_MOST_EVERY_S`` of an earlier collection the wait is
-    longer (the first round a server sees has none before it)."""
-    return 2 * session_linger + COLLECT_AFTER_S + LATE_COLLECT_AFTER_S + DISCARD_MARGIN_S
+    full collection that frees its page comes ``COLLECT_AFTER_S`` later, or
+    ``COLLECT_AT_MOST_EVERY_S`` after the one before (a round soon after another), and
+    one more for pages let go late ``LATE_COLLECT_AFTER_S`` after that."""
+    return (2 * session_linger + max(COLLECT_AFTER_S, COLLECT_AT_MOST_EVERY_S)
+            + LATE_COLLECT_AFTER_S + DISCARD_MARGIN_S)
 
 
 def _linger_zero(sock: Any) -> None:
