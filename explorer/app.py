@@ -492,6 +492,7 @@ def create_app(**kwargs: Any) -> ExplorerApp:
     if served:
         closed_pages.start_busy_cleanup()  # before this page can be busy
         gc_policy.pause_for_page()
+        gc_policy.install()  # the collection for ended sessions is the policy's alone
         pn.state.on_session_destroyed(gc_policy.session_ended)
         bokeh_fixes.install(pn.state.curdoc)
         idle_painter.install(pn.state.curdoc)

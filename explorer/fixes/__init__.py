@@ -12,7 +12,8 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
 - ``closed_pages``: pages closed abruptly (a debug line, not a traceback), Panel's
   link registry released when a session ends, and Panel's busy-counter task started
   holding no page.
-- ``gc_policy``: the garbage collector kept off complete pages, and given them back.
+- ``gc_policy``: the garbage collector kept off complete pages, and given them back
+  (Panel's own collection after a destroyed page left to it).
 - ``model_walk``: Bokeh's walk over a document's models without building the constant
   defaults it reads (each change of the page's shape walks every model).
 - ``property_defaults``: Bokeh's property defaults and type names worked out once per

@@ -37,6 +37,13 @@ still held: a page that outlives that is kept by something other than its work).
 sessions that end meanwhile get their own collection, and the late one after it where a
 page is still held.
 
+Panel (1.9) runs a full collection of its own 5 s after each page's document is
+destroyed (``panel.io.document._garbage_collect``): with everything unfrozen by
+:func:`session_ended` it walked every live page again, one more pause per batch of ended
+sessions, beside this policy's own and not bound by :data:`COLLECT_AT_MOST_EVERY_S`
+(benchmarks/load_test.py --heavy: 14 py-spy dumps of the probe's long waits in it, once
+this policy's own were bounded). :func:`install` leaves those collections to this policy.
+
 While a page is being built (:func:`pause_for_page`, from the start of the session's
 page to the end of the request that asked for it) the collector does not run: building
 a page makes ~100,000 objects, and the collections they set off walked the objects not
@@ -52,6 +59,7 @@ from __future__ import annotations
 
 import asyncio
 import gc
+import importlib
 import logging
 import math
 import time
@@ -90,6 +98,7 @@ HELD_AT_MOST_S = 300.0
 #: of CPU; the pause normally ends with the request, much sooner).
 PAUSE_AT_MOST_S = 10.0
 
+_INSTALLED = False
 _collect_due = False
 #: When the last collection for ended sessions ran (``time.monotonic``).
 _last_collection = -math.inf
@@ -100,6 +109,29 @@ _look_after_s = LATE_COLLECT_AFTER_S
 #: The pages of ended sessions not yet seen freed, with when their session ended
 #: (``time.monotonic``).
 _held: list[tuple[weakref.ref, float]] = []
+
+
+def install() -> bool:
+    """Leave the collections for ended sessions to this policy: Panel's own full
+    collection after a page's document is destroyed does nothing (module notes). Once
+    per process; returns False, with a warning, if Panel's has changed shape (it then
+    runs as before)."""
+    global _INSTALLED
+    if _INSTALLED:
+        return True
+    document = importlib.import_module("panel.io.document")
+    if not callable(getattr(document, "_garbage_collect", None)):
+        log.warning("Panel's collection after a destroyed document has changed; it runs "
+                    "beside the explorer's")
+        return False
+    document._garbage_collect = _left_to_policy
+    _INSTALLED = True
+    return True
+
+
+def _left_to_policy() -> None:
+    """Panel's collection after a destroyed document: :func:`session_ended` has asked
+    for the one that frees the page."""
 
 
 def page_built(session_context: Any = None) -> bool:

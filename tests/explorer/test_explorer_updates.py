@@ -577,6 +577,30 @@ def test_sessions_ending_soon_after_a_collection_wait_for_the_next(monkeypatch) 
         gc.unfreeze()
 
 
+def test_panels_own_collection_after_a_destroyed_page_is_left_to_the_policy(
+        monkeypatch) -> None:
+    """Panel runs a full collection 5 s after each destroyed document; beside the
+    policy's own (every live page unfrozen by then) it was one more pause per batch of
+    ended sessions, not bound by ``COLLECT_AT_MOST_EVERY_S``. Installed, it collects
+    nothing; the policy's collection frees the page."""
+    import gc
+
+    import panel.io.document as panel_document
+
+    from explorer.fixes import gc_policy
+
+    collected: list[int] = []
+    monkeypatch.setattr(gc, "collect", lambda *args: collected.append(1) or 0)
+    monkeypatch.setattr(panel_document, "_panel_last_cleanup", -1e9)  # not debounced
+    monkeypatch.setattr(gc_policy, "_INSTALLED", False)
+    monkeypatch.setattr(panel_document, "_garbage_collect", panel_document._garbage_collect)
+    panel_document._garbage_collect()
+    assert collected == [1]  # Panel's, as it is
+    assert gc_policy.install() and gc_policy.install()
+    panel_document._garbage_collect()
+    assert collected == [1]
+
+
 def test_one_output_time_draws_q_x_t_as_a_band_around_it(explorer_app) -> None:
     app = explorer_app()
     app.state.time_count = 1
