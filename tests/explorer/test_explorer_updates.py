@@ -376,8 +376,30 @@ def test_a_page_completed_after_its_session_ended_is_not_frozen() -> None:
         gc.unfreeze()
 
 
+@pytest.fixture
+def ended_sessions(monkeypatch: pytest.MonkeyPatch) -> tuple[Any, list[float]]:
+    """``explorer.fixes.gc_policy`` with short delays (collection 0.01 s after a session
+    ended, no shortest interval, the late look 0.05 s after) and its state fresh, all
+    restored afterwards (a look left scheduled on a closed loop must not stop another
+    test's); and the times (``time.monotonic``) of its collections for ended sessions."""
+    import time
+
+    from explorer.fixes import gc_policy
+
+    for name, value in (("COLLECT_AFTER_S", 0.01), ("COLLECT_AT_MOST_EVERY_S", 0.0),
+                        ("LATE_COLLECT_AFTER_S", 0.05), ("_look_after_s", 0.05),
+                        ("_last_collection", -float("inf")), ("_held", []),
+                        ("_collect_due", False), ("_look", None)):
+        monkeypatch.setattr(gc_policy, name, value)
+    collections: list[float] = []
+    collect = gc_policy.collect_ended_sessions
+    monkeypatch.setattr(gc_policy, "collect_ended_sessions",
+                        lambda: collections.append(time.monotonic()) or collect())
+    return gc_policy, collections
+
+
 def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch, caplog,
-                                                                   wait_until) -> None:
+                                                                   ended_sessions) -> None:
     """On a loaded server a dropped page can be held longer than the collection after its
     session ended and the late one (its last solve queued behind others). Frozen with
     the live pages by those collections, it was freed by nothing once let go, until
@@ -389,19 +411,8 @@ def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch, 
     import gc
     import logging
 
-    from explorer.fixes import gc_policy
-
-    monkeypatch.setattr(gc_policy, "COLLECT_AFTER_S", 0.01)
-    monkeypatch.setattr(gc_policy, "COLLECT_AT_MOST_EVERY_S", 0.0)
-    monkeypatch.setattr(gc_policy, "_last_collection", -float("inf"))
-    monkeypatch.setattr(gc_policy, "LATE_COLLECT_AFTER_S", 0.05)
+    gc_policy, collections = ended_sessions
     monkeypatch.setattr(gc_policy, "LOOK_AT_MOST_EVERY_S", 30.0)
-    # the module's state, restored afterwards (a look left scheduled on a closed loop
-    # must not stop another test's)
-    monkeypatch.setattr(gc_policy, "_held", [])
-    monkeypatch.setattr(gc_policy, "_collect_due", False)
-    monkeypatch.setattr(gc_policy, "_look", None)
-    monkeypatch.setattr(gc_policy, "_look_after_s", 0.05)
 
     class Page:
         pass
@@ -425,11 +436,6 @@ def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch, 
         gc_policy.session_ended(None)
         gc_policy.watch_page(page)(None)
         return weakref.ref(page)
-
-    collections: list[int] = []
-    collect = gc_policy.collect_ended_sessions
-    monkeypatch.setattr(gc_policy, "collect_ended_sessions",
-                        lambda: collections.append(1) or collect())
 
     async def held_then_let_go() -> None:
         holder = [cyclic_page()]
@@ -477,27 +483,14 @@ def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch, 
         gc.unfreeze()
 
 
-def test_no_late_collection_once_the_ended_sessions_pages_are_gone(monkeypatch) -> None:
+def test_no_late_collection_once_the_ended_sessions_pages_are_gone(ended_sessions) -> None:
     """The collection after a session ended frees its page: nothing is left for a late
     look, and no second full collection runs (each walks every live page, 0.5-1 s on the
     event loop with 20 pages open; every ended session paid two)."""
     import asyncio
     import gc
 
-    from explorer.fixes import gc_policy
-
-    monkeypatch.setattr(gc_policy, "COLLECT_AFTER_S", 0.01)
-    monkeypatch.setattr(gc_policy, "COLLECT_AT_MOST_EVERY_S", 0.0)
-    monkeypatch.setattr(gc_policy, "_last_collection", -float("inf"))
-    monkeypatch.setattr(gc_policy, "LATE_COLLECT_AFTER_S", 0.05)
-    monkeypatch.setattr(gc_policy, "_held", [])
-    monkeypatch.setattr(gc_policy, "_collect_due", False)
-    monkeypatch.setattr(gc_policy, "_look", None)
-    monkeypatch.setattr(gc_policy, "_look_after_s", 0.05)
-    collections: list[int] = []
-    collect = gc_policy.collect_ended_sessions
-    monkeypatch.setattr(gc_policy, "collect_ended_sessions",
-                        lambda: collections.append(1) or collect())
+    gc_policy, collections = ended_sessions
 
     class Page:
         pass
@@ -517,32 +510,22 @@ def test_no_late_collection_once_the_ended_sessions_pages_are_gone(monkeypatch) 
 
     try:
         asyncio.run(a_session_ends())
-        assert collections == [1]
+        assert len(collections) == 1
     finally:
         gc.unfreeze()
 
 
-def test_sessions_ending_soon_after_a_collection_wait_for_the_next(monkeypatch) -> None:
+def test_sessions_ending_soon_after_a_collection_wait_for_the_next(monkeypatch,
+                                                                   ended_sessions) -> None:
     """A full collection walks every live page (0.5-1 s on the event loop with 20 pages
     open): sessions that end within ``COLLECT_AT_MOST_EVERY_S`` of the last collection
     share the next one, due that long after the last, not ``COLLECT_AFTER_S`` after they
     ended; their pages are freed by it."""
     import asyncio
     import gc
-    import time
 
-    from explorer.fixes import gc_policy
-
-    monkeypatch.setattr(gc_policy, "COLLECT_AFTER_S", 0.01)
+    gc_policy, collections = ended_sessions
     monkeypatch.setattr(gc_policy, "COLLECT_AT_MOST_EVERY_S", 0.5)
-    monkeypatch.setattr(gc_policy, "_last_collection", -float("inf"))
-    monkeypatch.setattr(gc_policy, "_held", [])
-    monkeypatch.setattr(gc_policy, "_collect_due", False)
-    monkeypatch.setattr(gc_policy, "_look", None)
-    collections: list[float] = []
-    collect = gc_policy.collect_ended_sessions
-    monkeypatch.setattr(gc_policy, "collect_ended_sessions",
-                        lambda: collections.append(time.monotonic()) or collect())
 
     class Page:
         pass
