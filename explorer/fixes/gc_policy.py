@@ -11,15 +11,17 @@ exist then out of the collector's reach (``gc.freeze``). Objects made later are 
 as before, and reference counting frees non-cyclic garbage whatever its generation; only
 cyclic garbage among the frozen objects waits.
 
-When a session ends, :func:`session_ended` gives everything back to the collector
-(``gc.unfreeze``) and asks for one full collection :data:`COLLECT_AFTER_S` later, and
-no sooner than :data:`COLLECT_AT_MOST_EVERY_S` after the last (the sessions ending
-meanwhile share it); that collection frees the closed pages' cycles,
-hands the freed memory back to the system (``malloc_trim``) and freezes the pages still
-open again. Until it has run no page is frozen: a freeze then would also freeze the
-closed pages' garbage, out of reach for good (with visitors who leave abruptly, rounds of
-50 dropped sessions grew the server by ~350 MiB each, none of it returned). A page whose
-session has already ended when it completes is not frozen either. A page can still be
+When a session ends, :func:`session_ended` asks for one full collection
+:data:`COLLECT_AFTER_S` later, and no sooner than :data:`COLLECT_AT_MOST_EVERY_S` after
+the last (the sessions ending meanwhile share it); that collection gives everything back
+to the collector (``gc.unfreeze``), frees the closed pages' cycles, hands the freed
+memory back to the system (``malloc_trim``) and freezes the pages still open again. Until
+it has run the pages frozen before stay frozen (the collector's own full collections,
+set off by the pages built meanwhile, would otherwise walk them all), and no page is
+frozen: a freeze then would also freeze the closed pages' garbage (with visitors who
+leave abruptly and no collection after, rounds of 50 dropped sessions grew the server by
+~350 MiB each, none of it returned). A page whose session has already ended when it
+completes is not frozen either. A page can still be
 held for a moment after its session's collection (a solve of the page coming back from
 a worker): frozen with the live pages, it would wait for the next session to end. Where
 one is, one more collection :data:`LATE_COLLECT_AFTER_S` after the first frees it
@@ -175,10 +177,9 @@ def _resume() -> None:
 
 
 def session_ended(session_context: Any) -> None:
-    """A session has ended: let the collector see every object again and ask for a full
-    collection soon (Bokeh's session-destroyed callback; ``session_context`` unused)."""
+    """A session has ended: ask for a full collection soon (Bokeh's session-destroyed
+    callback; ``session_context`` unused)."""
     global _collect_due
-    gc.unfreeze()
     if _collect_due:
         return
     try:
@@ -241,7 +242,7 @@ def _late_collection() -> None:
     _look = None
     if _collect_due:  # the collection due runs first and schedules the next look
         return
-    if not held_pages():  # freed since (not frozen, so no collection was needed)
+    if not held_pages():  # the pages it was for have gone (by reference counting)
         return
     collect_ended_sessions()
     if not held_pages():
