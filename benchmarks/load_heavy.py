@@ -684,6 +684,9 @@ def heavy_lines(single: Any, crowd: Any, sampler: Any, heavy: HeavyRun) -> tuple
     opening = marks.get("heavy: 3 pages opening", _crowd_arriving(sampler))
     before_rss = [s[1] for s in samples if s[0] <= opening]
     before = before_rss[-1] if before_rss else samples[0][1]
+    # the server's own process apart from its solver and study processes
+    own_before = sampler.server_rss[max(len(before_rss) - 1, 0)]
+    own_after = sampler.server_rss[-1]
     idle = samples[0][1]
     peak_sample = max(samples, key=lambda s: s[1])
     after = samples[-1][1]
@@ -751,8 +754,10 @@ def heavy_lines(single: Any, crowd: Any, sampler: Any, heavy: HeavyRun) -> tuple
         f"| {before / 2**20:.0f} MiB before (the single session closed, neither the heavy "
         f"pages nor the crowd there yet), peak {peak_sample[1] / 2**20:.0f} MiB "
         f"(t = {peak_sample[0]:.0f} s), **{after / 2**20:.0f} MiB** after "
-        f"(**{100 * growth:+.0f} %**; idle server at its start: {idle / 2**20:.0f} MiB) | "
-        f"{met(growth <= MEMORY_GOAL)} |",
+        f"(**{100 * growth:+.0f} %**; idle server at its start: {idle / 2**20:.0f} MiB; "
+        f"the server's own process {own_before / 2**20:.0f} -> {own_after / 2**20:.0f} MiB, "
+        f"its solver and study processes {(before - own_before) / 2**20:.0f} -> "
+        f"{(after - own_after) / 2**20:.0f} MiB) | {met(growth <= MEMORY_GOAL)} |",
         "",
         f"Heavy outcomes: studies {took(study_runs)}; FE checks {took(checks)}; "
         f"q(x, t) CSV downloads {took([a for a in actions if a['kind'] == 'q(x,t) CSV'])}; "

@@ -237,6 +237,9 @@ class Sampler(threading.Thread):
         #  machine busy ticks, machine ticks, CPU s of the server's own process, CPU s
         #  of the load test's own processes)
         self.samples: list[tuple[float, int, float, int, int, float, float]] = []
+        # the RSS of the server's own process at each sample [bytes] (its solver and
+        # study processes are the rest of the sample's sum)
+        self.server_rss: list[int] = []
         self.marks: list[tuple[float, str]] = []
         # the last CPU time [s] seen of every process of each tree: a process that ended
         # (a study's, Chromium's) keeps counting with what it had used
@@ -260,6 +263,7 @@ class Sampler(threading.Thread):
                     if cpu is not None:
                         self._seen[name][p] = cpu
             if own is not None:
+                self.server_rss.append(rss[0] or 0)
                 self.samples.append((time.monotonic() - self.t0,
                                      sum(r for r in rss if r is not None),
                                      sum(self._seen["server"].values()),
@@ -811,8 +815,11 @@ def main() -> int:
                              "default; 0: solve in the server's threads)")
     parser.add_argument("--solver-threads", type=int, default=2,
                         help="the server's --solver-threads (used with --solver-processes 0)")
-    parser.add_argument("--after-seconds", type=float, default=45.0,
-                        help="seconds of memory samples after the crowd has left")
+    parser.add_argument("--after-seconds", type=float, default=75.0,
+                        help="seconds of memory samples after the crowd has left (the "
+                             "server discards closed sessions within twice its 15 s "
+                             "linger and collects them within 30 s after: "
+                             "explorer/fixes/gc_policy.py)")
     parser.add_argument("--heavy", action="store_true",
                         help="crowd: three more sessions (Chromium pages) run a 400-point "
                              "study, the FE coating check and large downloads with heavy "
