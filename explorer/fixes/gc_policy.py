@@ -31,8 +31,7 @@ is, none runs (a full collection walks every live page, 0.5-1 s with 20 pages op
 On a loaded server a page can be held longer than that (its last solve queued behind
 others): :func:`watch_page` follows each page whose session has ended, and while one of
 them is still alive after a collection, one more comes later, each wait twice the last
-(from
-:data:`LATE_COLLECT_AFTER_S` up to :data:`LOOK_AT_MOST_EVERY_S`: a full collection walks
+(from :data:`LATE_COLLECT_AFTER_S` up to :data:`LOOK_AT_MOST_EVERY_S`: a full collection walks
 every live page, so a page held long costs a few pauses, not one every 10 s), for at
 most :data:`HELD_AT_MOST_S` after its session ended (then a warning names how many are
 still held: a page that outlives that is kept by something other than its work). The
@@ -40,11 +39,11 @@ sessions that end meanwhile get their own collection, and the late one after it 
 page is still held.
 
 Panel (1.9) runs a full collection of its own 5 s after each page's document is
-destroyed (``panel.io.document._garbage_collect``): with everything unfrozen by
-:func:`session_ended` it walked every live page again, one more pause per batch of ended
-sessions, beside this policy's own and not bound by :data:`COLLECT_AT_MOST_EVERY_S`
-(benchmarks/load_test.py --heavy: 14 py-spy dumps of the probe's long waits in it, once
-this policy's own were bounded). :func:`install` leaves those collections to this policy.
+destroyed (``panel.io.document._garbage_collect``), one more per batch of ended
+sessions beside this policy's and not bound by :data:`COLLECT_AT_MOST_EVERY_S` (while a
+session's end unfroze every page, it walked them all: benchmarks/load_test.py --heavy
+found the event loop in it in 14 py-spy dumps of the probe's long waits).
+:func:`install` leaves those collections to this policy.
 
 While a page is being built (:func:`pause_for_page`, from the start of the session's
 page to the end of the request that asked for it) the collector does not run: building

@@ -376,6 +376,36 @@ def test_a_page_completed_after_its_session_ended_is_not_frozen() -> None:
         gc.unfreeze()
 
 
+class _Page:
+    """A stand-in for a closed session's page."""
+
+
+def _cyclic_page() -> _Page:
+    page = _Page()
+    page.me = page  # a page's objects are cycles: only a full collection frees them
+    return page
+
+
+async def _until(condition: Any, timeout: float = 20.0) -> bool:
+    """Wait for ``condition()`` on the running loop (full collections of this whole
+    process take time on a loaded machine: the timeout is a bound, not a measurement)."""
+    import asyncio
+
+    deadline = asyncio.get_running_loop().time() + timeout
+    while not condition():
+        if asyncio.get_running_loop().time() > deadline:
+            return False
+        await asyncio.sleep(0.01)
+    return True
+
+
+def _end_session(gc_policy: Any, page: _Page) -> weakref.ref:
+    """What the server does when ``page``'s session ends; a weak reference to it."""
+    gc_policy.session_ended(None)
+    gc_policy.watch_page(page)(None)
+    return weakref.ref(page)
+
+
 @pytest.fixture
 def ended_sessions(monkeypatch: pytest.MonkeyPatch) -> tuple[Any, list[float]]:
     """``explorer.fixes.gc_policy`` with short delays (collection 0.01 s after a session
@@ -414,67 +444,44 @@ def test_a_page_held_past_the_late_collection_is_freed_once_let_go(monkeypatch, 
     gc_policy, collections = ended_sessions
     monkeypatch.setattr(gc_policy, "LOOK_AT_MOST_EVERY_S", 30.0)
 
-    class Page:
-        pass
-
-    def cyclic_page() -> Page:
-        page = Page()
-        page.me = page  # a page's objects are cycles: only a full collection frees them
-        return page
-
-    async def until(condition, timeout: float = 20.0) -> bool:
-        # every wait on a condition (full collections of this whole process take time
-        # on a loaded machine): the timeout is a bound, not a measurement
-        deadline = asyncio.get_running_loop().time() + timeout
-        while not condition():
-            if asyncio.get_running_loop().time() > deadline:
-                return False
-            await asyncio.sleep(0.01)
-        return True
-
-    async def end_session(page: Page) -> weakref.ref:
-        gc_policy.session_ended(None)
-        gc_policy.watch_page(page)(None)
-        return weakref.ref(page)
-
     async def held_then_let_go() -> None:
-        holder = [cyclic_page()]
-        alive = await end_session(holder[0])
+        holder = [_cyclic_page()]
+        alive = _end_session(gc_policy, holder[0])
         # held past the collection (0.01 s) and the late one (0.06 s), then let go while
         # frozen with the live pages
-        assert await until(lambda: len(collections) >= 2)
+        assert await _until(lambda: len(collections) >= 2)
         assert gc.get_freeze_count() > 0 and alive() is not None
         holder.clear()
-        assert await until(lambda: alive() is None), "the page was not freed once let go"
-        assert await until(lambda: gc_policy._look is None and gc_policy.held_pages() == 0)
+        assert await _until(lambda: alive() is None), "the page was not freed once let go"
+        assert await _until(lambda: gc_policy._look is None and gc_policy.held_pages() == 0)
 
     async def a_new_session_while_an_old_page_waits() -> None:
-        old = cyclic_page()
+        old = _cyclic_page()
         gc_policy.watch_page(old)(None)
         monkeypatch.setattr(gc_policy, "_look_after_s", 30.0)
         gc_policy._look_again()  # the old page's next look, 30 s away
-        holder = [cyclic_page()]
-        alive = await end_session(holder[0])
-        assert await until(lambda: not gc_policy._collect_due)  # its collection has run
+        holder = [_cyclic_page()]
+        alive = _end_session(gc_policy, holder[0])
+        assert await _until(lambda: not gc_policy._collect_due)  # its collection has run
         # its late collection comes LATE_COLLECT_AFTER_S after that, not in 30 s
         loop = asyncio.get_running_loop()
         assert gc_policy._look is not None and gc_policy._look.when() < loop.time() + 1.0
         holder.clear()  # let go just after its collection
-        assert await until(lambda: alive() is None)
+        assert await _until(lambda: alive() is None)
         del old
-        assert await until(lambda: gc_policy._look is None and gc_policy.held_pages() == 0)
+        assert await _until(lambda: gc_policy._look is None and gc_policy.held_pages() == 0)
 
-    async def held_for_good(kept: Page) -> None:
-        await end_session(kept)
-        assert await until(lambda: "are still held" in caplog.text)
-        assert await until(lambda: gc_policy._look is None)
+    async def held_for_good(kept: _Page) -> None:
+        _end_session(gc_policy, kept)
+        assert await _until(lambda: "are still held" in caplog.text)
+        assert await _until(lambda: gc_policy._look is None)
 
     try:
         asyncio.run(held_then_let_go())
         asyncio.run(a_new_session_while_an_old_page_waits())
         # a page still held HELD_AT_MOST_S after its session ended is given up, named
         monkeypatch.setattr(gc_policy, "HELD_AT_MOST_S", 0.1)
-        kept = cyclic_page()
+        kept = _cyclic_page()
         with caplog.at_level(logging.WARNING, logger=gc_policy.__name__):
             asyncio.run(held_for_good(kept))
         assert "1 page(s) of sessions that ended over 0.1 s ago are still held" in caplog.text
@@ -492,19 +499,9 @@ def test_no_late_collection_once_the_ended_sessions_pages_are_gone(ended_session
 
     gc_policy, collections = ended_sessions
 
-    class Page:
-        pass
-
     async def a_session_ends() -> None:
-        page = Page()
-        page.me = page  # cyclic, as a page is: freed by the full collection
-        gc_policy.session_ended(None)
-        gc_policy.watch_page(page)(None)
-        del page
-        loop = asyncio.get_running_loop()
-        deadline = loop.time() + 20.0  # a bound on a loaded machine, not a measurement
-        while not collections and loop.time() < deadline:
-            await asyncio.sleep(0.01)
+        _end_session(gc_policy, _cyclic_page())
+        await _until(lambda: collections)
         await asyncio.sleep(0.5)  # ten times the late look's delay
         assert gc_policy.held_pages() == 0 and gc_policy._look is None
 
@@ -527,26 +524,12 @@ def test_sessions_ending_soon_after_a_collection_wait_for_the_next(monkeypatch,
     gc_policy, collections = ended_sessions
     monkeypatch.setattr(gc_policy, "COLLECT_AT_MOST_EVERY_S", 0.5)
 
-    class Page:
-        pass
-
-    async def end_session() -> weakref.ref:
-        page = Page()
-        page.me = page  # cyclic, as a page is: freed by the full collection
-        gc_policy.session_ended(None)
-        gc_policy.watch_page(page)(None)
-        return weakref.ref(page)
-
-    async def until(condition) -> None:
-        deadline = asyncio.get_running_loop().time() + 20.0  # a bound, not a measurement
-        while not condition() and asyncio.get_running_loop().time() < deadline:
-            await asyncio.sleep(0.01)
-
     async def three_sessions() -> list[weakref.ref]:
-        first = await end_session()
-        await until(lambda: len(collections) == 1)
-        second, third = await end_session(), await end_session()  # soon after it
-        await until(lambda: len(collections) == 2)
+        first = _end_session(gc_policy, _cyclic_page())
+        await _until(lambda: len(collections) == 1)
+        # two more soon after it
+        second, third = (_end_session(gc_policy, _cyclic_page()) for _ in range(2))
+        await _until(lambda: len(collections) == 2)
         await asyncio.sleep(0.2)
         return [first, second, third]
 
@@ -562,10 +545,10 @@ def test_sessions_ending_soon_after_a_collection_wait_for_the_next(monkeypatch,
 
 def test_panels_own_collection_after_a_destroyed_page_is_left_to_the_policy(
         monkeypatch) -> None:
-    """Panel runs a full collection 5 s after each destroyed document; beside the
-    policy's own (every live page unfrozen by then) it was one more pause per batch of
-    ended sessions, not bound by ``COLLECT_AT_MOST_EVERY_S``. Installed, it collects
-    nothing; the policy's collection frees the page."""
+    """Panel runs a collection 5 s after each destroyed document, beside the policy's
+    own, not bound by ``COLLECT_AT_MOST_EVERY_S`` (while a session's end unfroze every
+    page, it walked them all). Installed, it collects nothing; the policy's collection
+    frees the page."""
     import gc
 
     import panel.io.document as panel_document
