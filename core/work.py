@@ -131,9 +131,12 @@ def one_blas_thread() -> Iterator[None]:
     with _blas_lock:
         if _blas_solves == 0:
             try:
+                _free_shared_pool()
                 _blas_limiter = _controller().limit(limits=1, user_api="blas")
             except Exception:  # noqa: BLE001 - a library it cannot set: solve as it is
                 _blas_limiter = None
+            finally:
+                _free_shared_pool()
         _blas_solves += 1
     try:
         yield
@@ -141,8 +144,31 @@ def one_blas_thread() -> Iterator[None]:
         with _blas_lock:
             _blas_solves -= 1
             if _blas_solves == 0 and _blas_limiter is not None:
-                _blas_limiter.restore_original_limits()
-                _blas_limiter = None
+                # the last solve to end may run in another thread than the first
+                _free_shared_pool()
+                try:
+                    _blas_limiter.restore_original_limits()
+                finally:
+                    _blas_limiter = None
+                    _free_shared_pool()
+
+
+def _free_shared_pool() -> None:
+    """Let this thread set OpenBLAS's shared (pthreads) thread pool, and leave it free to
+    the next thread after.
+
+    threadpoolctl (from 3.8) lets only one thread set that pool's size: the first to set it,
+    until it is cleared; calls from any other thread silently do nothing. A solve in a
+    thread after a solve in the main thread (or after the user set the count there) then
+    ran on the user's count: 2 threads read inside two solves at once in threads, where
+    this lock's count already keeps solves from fighting over the setting. Older
+    threadpoolctl has no such rule (nothing to clear)."""
+    try:
+        from threadpoolctl import OpenBLASController
+
+        OpenBLASController.clear_controlling_thread(force=True)
+    except (ImportError, AttributeError):
+        pass
 
 
 def _controller() -> Any:
