@@ -69,6 +69,13 @@ WEBSOCKET_MAX_BYTES = 4 * 2**20
 EXPLORER_PACKAGES = ("panel", "bokeh", "param", "tornado", "holoviews", "distributed", "xarray")
 
 
+#: Seconds with no page open after which the server empties its caches and warms up again
+#: (``--release-after-idle``; explorer/solving/idle_release.py). Longer than a page reload
+#: or a class moving rooms takes, short enough that a server left running gives its memory
+#: back within minutes.
+RELEASE_AFTER_IDLE_S = 60.0
+
+
 def quiet_bokeh_diagnostics() -> None:
     """Turn off Bokeh's "expensive error diagnostics" (its setting
     ``perform_error_diagnostics``) in the server: a check of every callback's signature
@@ -116,6 +123,12 @@ def build_parser() -> argparse.ArgumentParser:
                         help="how long a page's session is kept after its connection is "
                              "lost, for the page to reconnect, before everything it holds "
                              "is given back (default 15)")
+    parser.add_argument("--release-after-idle", type=float, default=RELEASE_AFTER_IDLE_S,
+                        metavar="SECONDS",
+                        help="empty the caches of solved scenes (the server's and its solver "
+                             "processes') once no page has been open for this long, and warm "
+                             "up again, 1 to 86400, or 0 never (default "
+                             f"{RELEASE_AFTER_IDLE_S:g})")
     parser.add_argument("--live-bound", type=float, default=None, metavar="SECONDS",
                         help="the sliders of the Punch, Coating, Base and Time tabs, which "
                              "otherwise wait for their release, follow a drag while the last "
@@ -164,7 +177,13 @@ def main(argv: list[str] | None = None) -> int:
     from explorer.app import check_live_bound, create_app
     from explorer.fixes import closed_pages
     from explorer.model import ORDER
-    from explorer.solving import shared_pool, use_worker_processes, warm_up, worker_processes
+    from explorer.solving import (
+        idle_release,
+        shared_pool,
+        use_worker_processes,
+        warm_up,
+        worker_processes,
+    )
 
     if args.solver_processes < 0 or args.solver_threads < 1:
         print("--solver-processes must be 0 or more and --solver-threads 1 or more",
@@ -178,6 +197,10 @@ def main(argv: list[str] | None = None) -> int:
             return 2
     if not 0.5 <= args.session_linger <= 3600:
         print("--session-linger must be between 0.5 and 3600 seconds", file=sys.stderr)
+        return 2
+    if not (args.release_after_idle == 0 or 1 <= args.release_after_idle <= 86400):
+        print("--release-after-idle must be 0 (never) or between 1 and 86400 seconds",
+              file=sys.stderr)
         return 2
     closed_pages.install()  # a tab closed abruptly is a debug line, not a traceback
     quiet_bokeh_diagnostics()
@@ -194,6 +217,15 @@ def main(argv: list[str] | None = None) -> int:
         print(f"Solving {len(keys)} preset scene(s) once before serving...", file=sys.stderr,
               flush=True)
         warm_up(keys)
+    if args.release_after_idle:
+        def released(done: dict[str, float]) -> None:
+            print(f"No page open for {args.release_after_idle:g} s: emptied the caches "
+                  f"({done['bytes'] / 2**20:.1f} MiB here, {done['worker_bytes'] / 2**20:.1f} "
+                  f"MiB in {done['workers']:.0f} solver process(es)) in "
+                  f"{done['seconds']:.1f} s", file=sys.stderr, flush=True)
+
+        idle_release.enable(args.release_after_idle, on_release=released,
+                            rewarm=None if args.warm_up == "none" else lambda: warm_up(keys))
     origins = args.allow_websocket_origin
     if origins is None and args.address not in ("localhost", "127.0.0.1"):
         host = socket.gethostname() if args.address in ("0.0.0.0", "::") else args.address

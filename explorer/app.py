@@ -43,7 +43,7 @@ from .model import (
     validated_scene,
 )
 from .plots import Figures
-from .solving import SolveController, format_error, install_websocket_marks, mark
+from .solving import SolveController, format_error, idle_release, install_websocket_marks, mark
 from .views import (
     AddressLink,
     BaseView,
@@ -494,6 +494,8 @@ def create_app(**kwargs: Any) -> ExplorerApp:
         gc_policy.pause_for_page()
         gc_policy.install()  # the collection for ended sessions is the policy's alone
         pn.state.on_session_destroyed(gc_policy.session_ended)
+        idle_release.session_opened()
+        pn.state.on_session_destroyed(idle_release.session_closed)
         bokeh_fixes.install(pn.state.curdoc)
         idle_painter.install(pn.state.curdoc)
     if "query" not in kwargs:

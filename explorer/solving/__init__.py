@@ -9,7 +9,8 @@ Nothing here imports Panel or Bokeh when imported (the solver workers import it 
   ``worker_side``, what runs inside them.
 - ``answer_wait``: a worker's answer awaited on the server's event loop.
 - ``result_cache``: the process-wide cache of prepared results.
-- ``warm_up``: presets solved before the first visitor comes.
+- ``warm_up``: presets solved before the first visitor comes; ``idle_release``: the
+  caches emptied once no session has been open for a while (and the presets warmed again).
 - ``fit_runner``: :class:`FitRun`, a fit of the Fit tab on a thread of its own;
   ``background``: the lifecycle it shares with :class:`StudyRun`.
 - ``study_runner``: :class:`StudyRun`, a design study in a process of its own;
@@ -20,6 +21,7 @@ Nothing here imports Panel or Bokeh when imported (the solver workers import it 
 - ``trace``: timestamps of a slider move's way through the server (latency benchmark).
 """
 
+from . import idle_release
 from .controller import (
     RESULTS,
     SolveController,
@@ -38,6 +40,7 @@ from .warm_up import warm_up
 from .workers import SolverProcesses, WorkerFailed
 
 __all__ = ["RESULTS", "FitRun", "SolveController", "SolverProcesses", "StudyRun", "WorkerFailed",
-           "approx_bytes", "describe_field", "format_error", "install_websocket_marks", "mark",
+           "approx_bytes", "describe_field", "format_error", "idle_release",
+           "install_websocket_marks", "mark",
            "run_in_background", "shared_pool", "use_worker_processes", "warm_up",
            "worker_processes"]
