@@ -815,11 +815,12 @@ def main() -> int:
                              "default; 0: solve in the server's threads)")
     parser.add_argument("--solver-threads", type=int, default=2,
                         help="the server's --solver-threads (used with --solver-processes 0)")
-    parser.add_argument("--after-seconds", type=float, default=75.0,
+    parser.add_argument("--after-seconds", type=float, default=120.0,
                         help="seconds of memory samples after the crowd has left (the "
                              "server discards closed sessions within twice its 15 s "
-                             "linger and collects them within 30 s after: "
-                             "explorer/fixes/gc_policy.py)")
+                             "linger, collects them within 30 s after "
+                             "(explorer/fixes/gc_policy.py) and empties its caches 60 s "
+                             "after the last has gone (--release-after-idle))")
     parser.add_argument("--heavy", action="store_true",
                         help="crowd: three more sessions (Chromium pages) run a 400-point "
                              "study, the FE coating check and large downloads with heavy "
@@ -905,6 +906,8 @@ def main() -> int:
             finally:
                 server.stop()
         log_errors = server_tracebacks(log_path)
+        releases = [line.strip() for line in log_path.read_text(errors="replace").splitlines()
+                    if line.startswith("No page open for")]
     load_after = os.getloadavg()[0]
     run = run_lines(started, load_before, load_after,
                     "1-minute load average; the machine is shared, its other work included",
@@ -918,6 +921,10 @@ def main() -> int:
         extra, figures = heavy_lines(single, crowd, sampler, heavy)
         goals_met = met_all(figures)
         heavy.cleanup()
+    # the idle server's releases of its caches (explorer/solving/idle_release.py), as its
+    # log says them
+    extra += ["", "Releases of the idle server's caches (its log): "
+              + ("; ".join(f"`{line}`" for line in releases) or "none") + "."]
     text = report(args, single, crowd, sampler, log_errors, command, run, extra)
     print(text)
     if args.report:
