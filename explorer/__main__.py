@@ -125,8 +125,8 @@ def build_parser() -> argparse.ArgumentParser:
                              "is given back (default 15)")
     parser.add_argument("--release-after-idle", type=float, default=RELEASE_AFTER_IDLE_S,
                         metavar="SECONDS",
-                        help="empty the caches of solved scenes (the server's and its solver "
-                             "processes') once no page has been open for this long, and warm "
+                        help="empty the caches of solved scenes and renew the solver "
+                             "processes once no page has been open for this long, then warm "
                              "up again, 1 to 86400, or 0 never (default "
                              f"{RELEASE_AFTER_IDLE_S:g})")
     parser.add_argument("--live-bound", type=float, default=None, metavar="SECONDS",
@@ -220,9 +220,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.release_after_idle:
         def released(done: dict[str, float]) -> None:
             print(f"No page open for {args.release_after_idle:g} s: emptied the caches "
-                  f"({done['bytes'] / 2**20:.1f} MiB here, {done['worker_bytes'] / 2**20:.1f} "
-                  f"MiB in {done['workers']:.0f} solver process(es)) in "
-                  f"{done['seconds']:.1f} s", file=sys.stderr, flush=True)
+                  f"({done['bytes'] / 2**20:.1f} MiB) and renewed {done['workers']:.0f} "
+                  f"solver process(es) in {done['seconds']:.1f} s", file=sys.stderr,
+                  flush=True)
 
         idle_release.enable(args.release_after_idle, on_release=released,
                             rewarm=None if args.warm_up == "none" else lambda: warm_up(keys))

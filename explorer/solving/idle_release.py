@@ -1,25 +1,28 @@
-"""Giving the caches' memory back once nobody has used the server for a while.
+"""Giving memory back once nobody has used the server for a while.
 
-A served explorer keeps what it solved, for the next request: its process-wide cache of
-results (:data:`~explorer.solving.result_cache.RESULTS`, up to 96 MiB) and, in each
-solver worker, the solver's stage caches (kernel operators, bases, prepared geometries).
-While pages are open they make slider steps and preset switches cheap; once every page
-has closed they only hold memory. Measured with ``benchmarks/load_test.py --heavy`` (run
-Z in ``benchmarks/results/load_test.md``): 75 s after 20 sessions and three heavy pages
-had left, the server's own process stood 101 MiB and its workers 106 MiB above their level
-before the crowd (+35 % in all), about the caches' bounds.
+A served explorer keeps what it solved for the next request: its process-wide cache of
+results (:data:`~explorer.solving.result_cache.RESULTS`) and, in each solver worker, the
+solver's stage caches; a worker also keeps what its work loaded (the printable report's
+and the FE check's libraries) and heap its allocator does not give back. While pages are
+open that makes slider steps, preset switches and reports cheap; once every page has
+closed it only holds memory. Measured with ``benchmarks/load_test.py --heavy`` (20
+sessions and three heavy pages; ``benchmarks/results/load_test.md``): 75 s after they
+had left, the server's own process stood 101 MiB and its workers 106 MiB above their
+level before (+35 % in all, run Z); emptying the caches alone (19.7 MiB in the server,
+13.3 MiB in the workers) left +25 % (run AA).
 
 :func:`session_opened` and :func:`session_closed` count the server's sessions. Once the
 last has closed and none has opened for a while (``python -m explorer
---release-after-idle``, default 60 s), :func:`release` runs
-on a thread of its own (never on the server's event loop): it empties the caches of the
-server and of every worker, hands the freed heap back to the system (``malloc_trim``), and
-solves the presets the server warmed up at its start again, so that the next visitor finds
-the first page as quick as the first visitor did. A session opening meanwhile cancels a
-release not yet started; one opening during a release finds colder caches, nothing else.
+--release-after-idle``, default 60 s), :func:`release` runs on a thread of its own (never
+on the server's event loop): it empties the server's caches, hands its freed heap back to
+the system (``malloc_trim``), replaces every solver worker with a new one forked from the
+warm fork server (:meth:`~explorer.solving.workers.SolverProcesses.renew`), and solves the
+presets the server warmed up at its start again, so that the next visitor finds the first
+page as quick as the first visitor did. A session opening meanwhile cancels a release not
+yet started; one opening during a release finds colder caches, nothing else.
 
-Enabled by :func:`enable` (``python -m explorer`` does, ``--release-after-idle``); without
-it the sessions are only counted. Nothing here imports Panel.
+Enabled by :func:`enable` (``python -m explorer`` does); without it the sessions are only
+counted. Nothing here imports Panel.
 """
 
 from __future__ import annotations
@@ -34,7 +37,6 @@ from core import release_freed_memory
 from core.cache import cache_report, clear_caches
 
 from .controller import worker_processes
-from .worker_side import release_caches
 
 _lock = threading.Lock()
 _open = 0
@@ -43,8 +45,8 @@ _after_s: float | None = None
 _rewarm: Callable[[], None] | None = None
 _on_release: Callable[[dict[str, float]], None] | None = None
 #: What each release did, newest last (bounded): ``time`` (``time.monotonic``), ``bytes``
-#: held by the server's caches before, ``worker_bytes`` by the workers', ``workers`` (how
-#: many), ``seconds`` it took (the warm-up after it included).
+#: held by the server's caches before, ``workers`` renewed, ``seconds`` it took (the
+#: warm-up after it included).
 RELEASES: list[dict[str, float]] = []
 _KEEP = 20
 
@@ -118,20 +120,21 @@ def _release_if_idle() -> None:
 
 
 def release(rewarm: Callable[[], None] | None = None) -> dict[str, float]:
-    """Empty the server's caches and every solver worker's, give the freed memory back to
-    the system, then call ``rewarm``; returns what it did (also kept in :data:`RELEASES`)."""
+    """Empty the server's caches, give the freed memory back to the system, renew every
+    solver worker, then call ``rewarm``; returns what it did (also kept in
+    :data:`RELEASES`)."""
     start = time.monotonic()
     held = sum(stage["bytes"] for stage in cache_report().values())
     clear_caches()  # the server's results and the solver stages it ran itself
     processes = worker_processes()
-    freed = processes.run_everywhere(release_caches) if processes is not None else []
+    renewed = processes.renew() if processes is not None else 0
     # (no collection here: the server's are explorer/fixes/gc_policy.py's, and the caches'
     # values are freed by their reference counts)
     release_freed_memory()
     if rewarm is not None:
         rewarm()
-    done = {"time": start, "bytes": float(held), "worker_bytes": float(sum(freed)),
-            "workers": float(len(freed)), "seconds": time.monotonic() - start}
+    done = {"time": start, "bytes": float(held), "workers": float(renewed),
+            "seconds": time.monotonic() - start}
     with _lock:
         RELEASES.append(done)
         del RELEASES[:-_KEEP]

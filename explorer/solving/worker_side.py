@@ -11,7 +11,6 @@ that builds it, when it does).
 
 from __future__ import annotations
 
-import gc
 import multiprocessing
 import multiprocessing.connection
 import os
@@ -23,7 +22,6 @@ from typing import TYPE_CHECKING, Any
 
 import core.report
 from core import release_freed_memory, set_stage_cache_budget, solve, stage_cache_bytes
-from core.cache import cache_report, clear_caches
 from core.work import cancellable
 
 from ..model import FitOutcome, ResultView, prepare_view, run_fit
@@ -123,17 +121,6 @@ def fit_outcome(scene: dict[str, Any], readings: Any, keys: list[str | None]) ->
     if outcome.forecast is None:
         return outcome
     return replace(outcome, forecast=replace(outcome.forecast, solution=None))
-
-
-def release_caches() -> int:
-    """Empty this worker's solver stage caches and give the freed memory back to the
-    system (the server, idle: :mod:`explorer.solving.idle_release`); returns the bytes the
-    caches held."""
-    held = sum(stage["bytes"] for stage in cache_report().values())
-    clear_caches()
-    gc.collect()
-    release_freed_memory()
-    return held
 
 
 def worker_info() -> dict[str, int]:

@@ -357,6 +357,28 @@ class SolverProcesses:
                 own.busy = False
                 self._cond.notify_all()
 
+    def renew(self) -> int:
+        """Replace every worker with a new one, each once it is idle; returns how many.
+
+        A worker keeps what it loaded and allocated while it worked (the report's and the
+        FE check's libraries, heap the allocator does not give back): a new one, forked
+        from the warm fork server, holds none of it. Requests wait for their lane while
+        it is renewed, as for a request before them."""
+        for lane in self._lanes:
+            with self._cond:
+                while lane.busy and not self._closed:
+                    self._cond.wait()
+                if self._closed:
+                    break
+                lane.busy = True
+            try:
+                lane.restart()
+            finally:
+                with self._cond:
+                    lane.busy = False
+                    self._cond.notify_all()
+        return len(self._lanes)
+
     def start(self) -> list[dict[str, int]]:
         """Start every worker now rather than at the first request; returns
         :func:`worker_info` of each."""

@@ -7,14 +7,17 @@ presets are warmed again; a session opening before then keeps everything as it i
 
 from __future__ import annotations
 
+import threading
+import time
 from collections.abc import Iterator
 
+import numpy as np
 import pytest
 
 from core import solve
 from core.cache import cache_report
 from explorer.solving import RESULTS, SolverProcesses, idle_release
-from explorer.solving.worker_side import release_caches, solve_view
+from explorer.solving.worker_side import solve_view
 
 pytestmark = pytest.mark.timeout(120)
 
@@ -91,13 +94,23 @@ def test_the_time_must_be_positive() -> None:
         idle_release.enable(0.0)
 
 
-def test_a_worker_empties_its_caches_and_says_how_much_they_held(small_preset) -> None:
-    pool = SolverProcesses(1, 64 * 2**20)
+def test_renewed_workers_are_new_processes_that_solve_as_before(small_preset) -> None:
+    scene = small_preset(force_kN=420.0)
+    pool = SolverProcesses(2, 64 * 2**20)
     try:
-        pool.run(0, solve_view, small_preset(force_kN=420.0))
-        held = pool.run_everywhere(release_caches)
-        assert held[0] > 0
-        assert pool.run_everywhere(release_caches) == [0]  # nothing left to empty
+        before = [pool.run(k, solve_view, scene) for k in range(2)]
+        old = pool.pids()
+        # a lane busy with a request is renewed once that request is answered
+        slow = threading.Thread(target=pool.run, args=(0, time.sleep, 0.5))
+        slow.start()
+        time.sleep(0.1)
+        assert pool.renew() == 2
+        slow.join()
+        new = pool.pids()
+        assert len(new) == 2 and not set(new) & set(old)
+        after = [pool.run(k, solve_view, scene) for k in range(2)]
+        for a, b in zip(before, after, strict=True):
+            assert np.array_equal(a.pressure, b.pressure)
     finally:
         pool.shutdown()
 
@@ -106,8 +119,7 @@ def test_a_worker_empties_its_caches_and_says_how_much_they_held(small_preset) -
 def test_a_served_explorer_left_idle_empties_its_caches_and_still_serves(wait_until) -> None:
     """``python -m explorer --release-after-idle 2``: a page asked for and left (its
     session discarded after the 1 s linger), then the release, said in the server's output,
-    with the caches of the warmed default scene in the server and in its worker; the next
-    page is served as before."""
+    its worker renewed; the next page is served as before."""
     import re
     import urllib.request
 
@@ -119,8 +131,8 @@ def test_a_served_explorer_left_idle_empties_its_caches_and_still_serves(wait_un
                          ready_timeout=300) as server:
         with opener.open(server.url + "/app", timeout=120) as page:
             assert page.status == 200
-        said = re.compile(r"No page open for 2 s: emptied the caches \(([\d.]+) MiB here, "
-                          r"([\d.]+) MiB in 1 solver process\(es\)\)")
+        said = re.compile(r"No page open for 2 s: emptied the caches \([\d.]+ MiB\) and "
+                          r"renewed 1 solver process\(es\)")
         assert wait_until(lambda: said.search(server.output()), timeout=120, every=0.2), (
             server.output()[-3000:])
         with opener.open(server.url + "/app", timeout=120) as page:
