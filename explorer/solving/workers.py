@@ -363,7 +363,8 @@ class SolverProcesses:
         A worker keeps what it loaded and allocated while it worked (the report's and the
         FE check's libraries, heap the allocator does not give back): a new one, forked
         from the warm fork server, holds none of it. Requests wait for their lane while
-        it is renewed, as for a request before them."""
+        it is renewed, as for a request before them. None once :meth:`shutdown` began."""
+        renewed = 0
         for lane in self._lanes:
             with self._cond:
                 while lane.busy and not self._closed:
@@ -373,11 +374,12 @@ class SolverProcesses:
                 lane.busy = True
             try:
                 lane.restart()
+                renewed += 1
             finally:
                 with self._cond:
                     lane.busy = False
                     self._cond.notify_all()
-        return len(self._lanes)
+        return renewed
 
     def start(self) -> list[dict[str, int]]:
         """Start every worker now rather than at the first request; returns

@@ -113,6 +113,7 @@ def test_renewed_workers_are_new_processes_that_solve_as_before(small_preset) ->
             assert np.array_equal(a.pressure, b.pressure)
     finally:
         pool.shutdown()
+    assert pool.renew() == 0  # a pool shut down renews nothing
 
 
 @pytest.mark.soak
