@@ -244,7 +244,8 @@ def cache_report() -> dict[str, dict[str, int]]:
 
 
 def clear_caches() -> None:
-    """Empty every stage cache (for tests and benchmarks measuring cold solves)."""
+    """Empty every stage cache of this process (tests and benchmarks measuring cold solves;
+    the explorer's server once idle, explorer/solving/idle_release.py)."""
     with _REGISTRY_LOCK:
         caches = list(_REGISTRY.values())
     for cache in caches:

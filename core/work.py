@@ -28,9 +28,11 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
-from typing import Any
+from typing import Any, TypeVar
 
 from core import limits
+
+T = TypeVar("T")
 
 #: Variables by which a user sets the BLAS libraries' threads: where one is set, solves
 #: keep that setting (:func:`one_blas_thread`).
@@ -131,12 +133,10 @@ def one_blas_thread() -> Iterator[None]:
     with _blas_lock:
         if _blas_solves == 0:
             try:
-                _free_shared_pool()
-                _blas_limiter = _controller().limit(limits=1, user_api="blas")
+                _blas_limiter = _as_openblas_owner(
+                    lambda: _controller().limit(limits=1, user_api="blas"))
             except Exception:  # noqa: BLE001 - a library it cannot set: solve as it is
                 _blas_limiter = None
-            finally:
-                _free_shared_pool()
         _blas_solves += 1
     try:
         yield
@@ -145,30 +145,40 @@ def one_blas_thread() -> Iterator[None]:
             _blas_solves -= 1
             if _blas_solves == 0 and _blas_limiter is not None:
                 # the last solve to end may run in another thread than the first
-                _free_shared_pool()
                 try:
-                    _blas_limiter.restore_original_limits()
+                    _as_openblas_owner(_blas_limiter.restore_original_limits)
                 finally:
                     _blas_limiter = None
-                    _free_shared_pool()
 
 
-def _free_shared_pool() -> None:
-    """Let this thread set OpenBLAS's shared (pthreads) thread pool, and leave it free to
-    the next thread after.
+def _as_openblas_owner(action: Callable[[], T]) -> T:
+    """``action()`` with this thread taken, for its length, as the one that may set the size
+    of OpenBLAS's shared (pthreads) thread pool; the thread that held that role before gets
+    it back after.
 
-    threadpoolctl (from 3.8) lets only one thread set that pool's size: the first to set it,
-    until it is cleared; calls from any other thread silently do nothing. A solve in a
-    thread after a solve in the main thread (or after the user set the count there) then
-    ran on the user's count: 2 threads read inside two solves at once in threads, where
-    this lock's count already keeps solves from fighting over the setting. Older
-    threadpoolctl has no such rule (nothing to clear)."""
+    threadpoolctl (from 3.8) lets only one thread set that size, the first to set it; the
+    settings of every other thread silently do nothing. Without this, a solve in a thread
+    after a solve in the main thread (or after the user set the count there) ran on the
+    user's count (two solves at once in threads read 2 threads inside). Solves do not fight
+    over the size among themselves (this module's lock and count of running solves), and
+    a user's own ``threadpool_limits`` keeps its role (restored after). The role lives in
+    threadpoolctl's private ``OpenBLASController._SHARED_STATE``; a version without it
+    (older ones have no such rule) just runs ``action``."""
     try:
         from threadpoolctl import OpenBLASController
-
-        OpenBLASController.clear_controlling_thread(force=True)
-    except (ImportError, AttributeError):
-        pass
+    except ImportError:
+        return action()
+    state = getattr(OpenBLASController, "_SHARED_STATE", None)
+    if state is None or not hasattr(state, "controlling_thread"):
+        return action()
+    with state.lock:
+        before = state.controlling_thread
+        state.controlling_thread = threading.current_thread()
+    try:
+        return action()
+    finally:
+        with state.lock:
+            state.controlling_thread = before
 
 
 def _controller() -> Any:

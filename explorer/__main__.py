@@ -126,8 +126,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--release-after-idle", type=float, default=RELEASE_AFTER_IDLE_S,
                         metavar="SECONDS",
                         help="empty the caches of solved scenes and renew the solver "
-                             "processes once no page has been open for this long, then warm "
-                             "up again, 1 to 86400, or 0 never (default "
+                             "processes once no page has been open for this long (then "
+                             "solve the --warm-up scenes again), 1 to 86400, or 0 never "
+                             "(default "
                              f"{RELEASE_AFTER_IDLE_S:g})")
     parser.add_argument("--live-bound", type=float, default=None, metavar="SECONDS",
                         help="the sliders of the Punch, Coating, Base and Time tabs, which "
@@ -217,15 +218,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"Solving {len(keys)} preset scene(s) once before serving...", file=sys.stderr,
               flush=True)
         warm_up(keys)
-    if args.release_after_idle:
-        def released(done: dict[str, float]) -> None:
-            print(f"No page open for {args.release_after_idle:g} s: emptied the caches "
-                  f"({done['bytes'] / 2**20:.1f} MiB) and renewed {done['workers']:.0f} "
-                  f"solver process(es) in {done['seconds']:.1f} s", file=sys.stderr,
-                  flush=True)
-
-        idle_release.enable(args.release_after_idle, on_release=released,
-                            rewarm=None if args.warm_up == "none" else lambda: warm_up(keys))
     origins = args.allow_websocket_origin
     if origins is None and args.address not in ("localhost", "127.0.0.1"):
         host = socket.gethostname() if args.address in ("0.0.0.0", "::") else args.address
@@ -242,6 +234,16 @@ def main(argv: list[str] | None = None) -> int:
           flush=True)
     linger_ms = int(args.session_linger * 1000)
     try:
+        if args.release_after_idle:
+            def released(done: dict[str, float]) -> None:
+                print(f"No page open for {args.release_after_idle:g} s: emptied the caches "
+                      f"({done['bytes'] / 2**20:.1f} MiB) and renewed {done['workers']:.0f} "
+                      f"solver process(es) in {done['seconds']:.1f} s", file=sys.stderr,
+                      flush=True)
+
+            idle_release.enable(args.release_after_idle, on_release=released,
+                                rewarm=None if args.warm_up == "none"
+                                else lambda: warm_up(keys))
         app: Callable[[], Any] = create_app
         if args.live_bound is not None:
             # a function (Panel serves a partial object as its text, not as a page)
@@ -258,6 +260,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         pass  # Ctrl+C during the server's set-up
     finally:
+        idle_release.disable()  # a release running stops before the workers do
         processes = worker_processes()
         if processes is not None:
             processes.shutdown()

@@ -6,20 +6,22 @@ solver's stage caches; a worker also keeps what its work loaded (the printable r
 and the FE check's libraries) and heap its allocator does not give back. While pages are
 open that makes slider steps, preset switches and reports cheap; once every page has
 closed it only holds memory. Measured with ``benchmarks/load_test.py --heavy`` (20
-sessions and three heavy pages; ``benchmarks/results/load_test.md``): 75 s after they
-had left, the server's own process stood 101 MiB and its workers 106 MiB above their
-level before (+35 % in all, run Z); emptying the caches alone (19.7 MiB in the server,
-13.3 MiB in the workers) left +25 % (run AA).
+sessions and three heavy pages; ``benchmarks/results/load_test.md``): after they had left,
+the server's own process stood 101 MiB and its workers 106 MiB above their level before
+(+35 % in all, run Z); emptying every cache (19.7 MiB in the server, 13.3 MiB in the
+workers) left +25 % (run AA); emptying the server's and renewing the workers, +15 %, the
+workers back at their level (run AB, read 120 s after the crowd).
 
 :func:`session_opened` and :func:`session_closed` count the server's sessions. Once the
 last has closed and none has opened for a while (``python -m explorer
 --release-after-idle``, default 60 s), :func:`release` runs on a thread of its own (never
 on the server's event loop): it empties the server's caches, hands its freed heap back to
 the system (``malloc_trim``), replaces every solver worker with a new one forked from the
-warm fork server (:meth:`~explorer.solving.workers.SolverProcesses.renew`), and solves the
-presets the server warmed up at its start again, so that the next visitor finds the first
-page as quick as the first visitor did. A session opening meanwhile cancels a release not
-yet started; one opening during a release finds colder caches, nothing else.
+warm fork server (:meth:`~explorer.solving.workers.SolverProcesses.renew`, each once its
+lane is idle), and solves the presets the server warmed up at its start again, so that
+the next visitor finds the first page as quick as the first visitor did. A session opening
+before the time cancels the release; one opening during a release stops it before its
+next worker and its warm-up (the session finds the caches emptied, its first solves cold).
 
 Enabled by :func:`enable` (``python -m explorer`` does); without it the sessions are only
 counted. Nothing here imports Panel.
@@ -41,12 +43,17 @@ from .controller import worker_processes
 _lock = threading.Lock()
 _open = 0
 _timer: threading.Timer | None = None
+# A timer's release runs only if it is still the newest (a session opening or closing
+# since makes another; Timer.cancel() cannot stop a timer already running), and never
+# beside another release.
+_generation = 0
+_releasing = False
 _after_s: float | None = None
 _rewarm: Callable[[], None] | None = None
 _on_release: Callable[[dict[str, float]], None] | None = None
 #: What each release did, newest last (bounded): ``time`` (``time.monotonic``), ``bytes``
-#: held by the server's caches before, ``workers`` renewed, ``seconds`` it took (the
-#: warm-up after it included).
+#: held by the server's caches before, ``workers`` renewed, ``warmed`` (1 if the warm-up
+#: ran after it), ``seconds`` it took (the warm-up included).
 RELEASES: list[dict[str, float]] = []
 _KEEP = 20
 
@@ -64,7 +71,8 @@ def enable(after_s: float, rewarm: Callable[[], None] | None = None,
 
 
 def disable() -> None:
-    """Stop releasing (a release already running finishes)."""
+    """Stop releasing: no release is due any more, and one running stops before its next
+    worker and does not warm up (the server calls it before stopping its workers)."""
     global _after_s, _rewarm, _on_release
     with _lock:
         _after_s, _rewarm, _on_release = None, None, None
@@ -77,7 +85,8 @@ def open_sessions() -> int:
 
 
 def session_opened() -> None:
-    """A session has started: no release while it is open."""
+    """A session has started: no release while it is open (one running stops before its
+    next worker and does not warm up)."""
     global _open
     with _lock:
         _open += 1
@@ -93,48 +102,62 @@ def session_closed(_session_context: Any = None) -> None:
         if _open or _after_s is None:
             return
         _cancel()
-        _timer = threading.Timer(_after_s, _release_if_idle)
+        _timer = threading.Timer(_after_s, _release_if_idle, args=(_generation,))
         _timer.name = "release-after-idle"
         _timer.daemon = True
         _timer.start()
 
 
 def _cancel() -> None:
-    global _timer
+    global _timer, _generation
+    _generation += 1
     if _timer is not None:
         _timer.cancel()
         _timer = None
 
 
-def _release_if_idle() -> None:
+def _wanted() -> bool:
+    """Whether a release may go on: enabled, and no session open."""
+    return _after_s is not None and not _open
+
+
+def _release_if_idle(generation: int) -> None:
+    global _releasing
     with _lock:
-        if _open or _after_s is None:
+        if generation != _generation or _releasing or not _wanted():
             return
+        _releasing = True
         rewarm, on_release = _rewarm, _on_release
     try:
-        done = release(rewarm)
+        done = release(rewarm, go_on=_wanted)
         if on_release is not None:
             on_release(done)
     except Exception:  # noqa: BLE001 - the server goes on: a release is an economy
         logging.getLogger(__name__).exception("releasing the caches of an idle server failed")
+    finally:
+        with _lock:
+            _releasing = False
 
 
-def release(rewarm: Callable[[], None] | None = None) -> dict[str, float]:
-    """Empty the server's caches, give the freed memory back to the system, renew every
-    solver worker, then call ``rewarm``; returns what it did (also kept in
-    :data:`RELEASES`)."""
+def release(rewarm: Callable[[], None] | None = None,
+            go_on: Callable[[], bool] = lambda: True) -> dict[str, float]:
+    """Empty the server's caches, give the freed memory back to the system, renew the
+    solver workers, then call ``rewarm``; returns what it did (also kept in
+    :data:`RELEASES`). ``go_on()`` is asked before each worker and before ``rewarm``: once
+    it is false (a session opened, the server stopping) the rest is left as it is."""
     start = time.monotonic()
     held = sum(stage["bytes"] for stage in cache_report().values())
     clear_caches()  # the server's results and the solver stages it ran itself
-    processes = worker_processes()
-    renewed = processes.renew() if processes is not None else 0
     # (no collection here: the server's are explorer/fixes/gc_policy.py's, and the caches'
     # values are freed by their reference counts)
     release_freed_memory()
-    if rewarm is not None:
+    processes = worker_processes()
+    renewed = processes.renew(stop=lambda: not go_on()) if processes is not None else 0
+    warmed = rewarm is not None and go_on()
+    if warmed:
         rewarm()
     done = {"time": start, "bytes": float(held), "workers": float(renewed),
-            "seconds": time.monotonic() - start}
+            "warmed": float(warmed), "seconds": time.monotonic() - start}
     with _lock:
         RELEASES.append(done)
         del RELEASES[:-_KEEP]

@@ -30,6 +30,7 @@ import multiprocessing
 import multiprocessing.connection
 import threading
 import time
+from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
@@ -150,11 +151,14 @@ class _Lane:
             raise value
         return value
 
-    def restart(self) -> None:
-        """Stop the worker (whatever it is doing) and start a new one."""
+    def restart(self, gently: bool = False) -> None:
+        """Stop the worker (whatever it is doing) and start a new one; ``gently``: an
+        idle worker (renewed, not stuck) gets a second to end by itself first."""
         old, old_connection = self.process, self.connection
         self.process, self.connection = self._new_worker()
         old_connection.close()  # an idle worker reads the end of the pipe and returns
+        if gently:
+            old.join(1.0)
         if old.is_alive():
             old.kill()  # a working or stuck one would never read it
         old.join(5)
@@ -357,28 +361,34 @@ class SolverProcesses:
                 own.busy = False
                 self._cond.notify_all()
 
-    def renew(self) -> int:
-        """Replace every worker with a new one, each once it is idle; returns how many.
+    def renew(self, stop: Callable[[], bool] = lambda: False) -> int:
+        """Replace every worker with a new one, each once it is idle; returns how many
+        (0 once :meth:`shutdown` began).
 
         A worker keeps what it loaded and allocated while it worked (the report's and the
         FE check's libraries, heap the allocator does not give back): a new one, forked
         from the warm fork server, holds none of it. Requests wait for their lane while
-        it is renewed, as for a request before them. None once :meth:`shutdown` began."""
+        it is renewed, as for a request before them. ``stop()`` is asked before each lane
+        and while waiting for a busy one: once true, the lanes left keep their workers."""
         renewed = 0
         for lane in self._lanes:
             with self._cond:
-                while lane.busy and not self._closed:
-                    self._cond.wait()
-                if self._closed:
+                while lane.busy and not self._closed and not stop():
+                    self._cond.wait(1.0)
+                if self._closed or stop():
                     break
                 lane.busy = True
             try:
-                lane.restart()
+                lane.restart(gently=True)
                 renewed += 1
             finally:
                 with self._cond:
                     lane.busy = False
                     self._cond.notify_all()
+                    closed = self._closed
+            if closed:  # the shutdown stopped the old worker, not this new one
+                lane.stop()
+                break
         return renewed
 
     def start(self) -> list[dict[str, int]]:

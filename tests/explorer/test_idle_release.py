@@ -29,18 +29,30 @@ def held_bytes() -> int:
     return sum(stage["bytes"] for stage in cache_report().values())
 
 
-@pytest.fixture
-def released() -> Iterator[list[str]]:
-    """Releases enabled after :data:`AFTER_S`; the list records each warm-up after one."""
-    warmed: list[str] = []
-    count = len(idle_release.RELEASES)
-    idle_release.enable(AFTER_S, rewarm=lambda: warmed.append("warm"))
-    yield warmed
+def _reset() -> None:
     idle_release.disable()
     while idle_release.open_sessions():
         idle_release.session_closed()
-    idle_release.disable()  # the close above may have set a timer
+    idle_release.disable()  # (a close while enabled would have set a timer)
+
+
+@pytest.fixture(autouse=True)
+def no_release_left() -> Iterator[None]:
+    """Every test starts and ends with releases off and no session counted: a timer left
+    running would empty the caches of tests that count their evaluations."""
+    _reset()
+    count = len(idle_release.RELEASES)
+    yield
+    _reset()
     del idle_release.RELEASES[count:]
+
+
+@pytest.fixture
+def released() -> list[str]:
+    """Releases enabled after :data:`AFTER_S`; the list records each warm-up after one."""
+    warmed: list[str] = []
+    idle_release.enable(AFTER_S, rewarm=lambda: warmed.append("warm"))
+    return warmed
 
 
 def fill(small_preset) -> None:
@@ -89,6 +101,33 @@ def test_without_enable_the_sessions_are_only_counted(small_preset, wait_until) 
     assert len(RESULTS) > 0
 
 
+def test_a_release_stops_before_the_warm_up_once_a_session_opens(released,
+                                                                   small_preset) -> None:
+    fill(small_preset)
+    done = idle_release.release(rewarm=lambda: released.append("warm"),
+                                go_on=lambda: False)
+    assert done["warmed"] == 0.0 and released == []
+    assert held_bytes() == 0  # the server's own caches are emptied first, whatever follows
+
+
+def test_a_timer_superseded_by_a_later_session_does_nothing(released, small_preset,
+                                                            wait_until) -> None:
+    """A timer already running when a session opens and closes again (``Timer.cancel``
+    cannot stop it) must not release: only the newest timer does, once."""
+    fill(small_preset)
+    count = len(idle_release.RELEASES)
+    idle_release.session_opened()
+    idle_release.session_closed()
+    stale = idle_release._generation
+    idle_release.session_opened()
+    idle_release.session_closed()
+    idle_release._release_if_idle(stale)  # as the first timer would, late
+    assert len(idle_release.RELEASES) == count and len(RESULTS) > 0
+    assert wait_until(lambda: len(idle_release.RELEASES) > count, timeout=30, every=0.02)
+    time.sleep(3 * AFTER_S)
+    assert len(idle_release.RELEASES) == count + 1 and released == ["warm"]
+
+
 def test_the_time_must_be_positive() -> None:
     with pytest.raises(ValueError, match="after_s"):
         idle_release.enable(0.0)
@@ -101,11 +140,15 @@ def test_renewed_workers_are_new_processes_that_solve_as_before(small_preset) ->
         before = [pool.run(k, solve_view, scene) for k in range(2)]
         old = pool.pids()
         # a lane busy with a request is renewed once that request is answered
-        slow = threading.Thread(target=pool.run, args=(0, time.sleep, 0.5))
+        answered: list[float] = []
+        slow = threading.Thread(target=lambda: answered.append(
+            (pool.run(0, time.sleep, 0.5), time.monotonic())[1]))
         slow.start()
         time.sleep(0.1)
         assert pool.renew() == 2
+        renewed_at = time.monotonic()
         slow.join()
+        assert answered and answered[0] <= renewed_at
         new = pool.pids()
         assert len(new) == 2 and not set(new) & set(old)
         after = [pool.run(k, solve_view, scene) for k in range(2)]
