@@ -51,11 +51,6 @@ _releasing = False
 _after_s: float | None = None
 _rewarm: Callable[[], None] | None = None
 _on_release: Callable[[dict[str, float]], None] | None = None
-#: What each release did, newest last (bounded): ``time`` (``time.monotonic``), ``bytes``
-#: held by the server's caches before, ``workers`` renewed, ``warmed`` (1 if the warm-up
-#: ran after it), ``seconds`` it took (the warm-up included).
-RELEASES: list[dict[str, float]] = []
-_KEEP = 20
 
 
 def enable(after_s: float, rewarm: Callable[[], None] | None = None,
@@ -142,9 +137,11 @@ def _release_if_idle(generation: int) -> None:
 def release(rewarm: Callable[[], None] | None = None,
             go_on: Callable[[], bool] = lambda: True) -> dict[str, float]:
     """Empty the server's caches, give the freed memory back to the system, renew the
-    solver workers, then call ``rewarm``; returns what it did (also kept in
-    :data:`RELEASES`). ``go_on()`` is asked before each worker and before ``rewarm``: once
-    it is false (a session opened, the server stopping) the rest is left as it is."""
+    solver workers, then call ``rewarm``; returns what it did: ``time``
+    (``time.monotonic``), ``bytes`` held by the server's caches before, ``workers``
+    renewed, ``warmed`` (1 if ``rewarm`` ran), ``seconds`` (``rewarm`` included).
+    ``go_on()`` is asked before each worker and before ``rewarm``: once it is false (a
+    session opened, the server stopping) the rest is left as it is."""
     start = time.monotonic()
     held = sum(stage["bytes"] for stage in cache_report().values())
     clear_caches()  # the server's results and the solver stages it ran itself
@@ -156,9 +153,5 @@ def release(rewarm: Callable[[], None] | None = None,
     warmed = rewarm is not None and go_on()
     if warmed:
         rewarm()
-    done = {"time": start, "bytes": float(held), "workers": float(renewed),
+    return {"time": start, "bytes": float(held), "workers": float(renewed),
             "warmed": float(warmed), "seconds": time.monotonic() - start}
-    with _lock:
-        RELEASES.append(done)
-        del RELEASES[:-_KEEP]
-    return done

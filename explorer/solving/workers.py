@@ -25,12 +25,13 @@ workers import only ``core`` and :mod:`explorer.model.results`.
 from __future__ import annotations
 
 import collections
+import contextlib
 import logging
 import multiprocessing
 import multiprocessing.connection
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import Future
 from typing import Any
 
@@ -348,17 +349,32 @@ class SolverProcesses:
 
     def _run_into(self, index: int, fn: Any, args: tuple[Any, ...], done: Future[Any]) -> None:
         own = self._lanes[index]
-        with self._cond:  # this lane and no other, whatever waits
-            while own.busy and not self._closed:
-                self._cond.wait()
-            own.busy = True
+        with self._holding(own):
+            try:
+                done.set_result(own.call(fn, args, REQUEST_TIMEOUT_S))
+            except BaseException as exc:
+                done.set_exception(exc)
+
+    @contextlib.contextmanager
+    def _holding(self, lane: _Lane, give_up: Callable[[], bool] | None = None
+                 ) -> Iterator[bool]:
+        """This lane and no other, whatever waits, once it is idle: yields True while it is
+        held. With ``give_up`` (asked while waiting), yields False without the lane once the
+        pool is shut down or ``give_up()`` is true."""
+        with self._cond:
+            while lane.busy and not self._closed and not (give_up is not None and give_up()):
+                self._cond.wait(None if give_up is None else 1.0)
+            held = give_up is None or not (self._closed or give_up())
+            if held:
+                lane.busy = True
+        if not held:
+            yield False
+            return
         try:
-            done.set_result(own.call(fn, args, REQUEST_TIMEOUT_S))
-        except BaseException as exc:
-            done.set_exception(exc)
+            yield True
         finally:
             with self._cond:
-                own.busy = False
+                lane.busy = False
                 self._cond.notify_all()
 
     def renew(self, stop: Callable[[], bool] = lambda: False) -> int:
@@ -372,21 +388,12 @@ class SolverProcesses:
         and while waiting for a busy one: once true, the lanes left keep their workers."""
         renewed = 0
         for lane in self._lanes:
-            with self._cond:
-                while lane.busy and not self._closed and not stop():
-                    self._cond.wait(1.0)
-                if self._closed or stop():
+            with self._holding(lane, give_up=stop) as held:
+                if not held:
                     break
-                lane.busy = True
-            try:
                 lane.restart(gently=True)
                 renewed += 1
-            finally:
-                with self._cond:
-                    lane.busy = False
-                    self._cond.notify_all()
-                    closed = self._closed
-            if closed:  # the shutdown stopped the old worker, not this new one
+            if self._closed:  # the shutdown stopped the old worker, not this new one
                 lane.stop()
                 break
         return renewed

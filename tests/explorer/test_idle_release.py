@@ -41,18 +41,28 @@ def no_release_left() -> Iterator[None]:
     """Every test starts and ends with releases off and no session counted: a timer left
     running would empty the caches of tests that count their evaluations."""
     _reset()
-    count = len(idle_release.RELEASES)
     yield
     _reset()
-    del idle_release.RELEASES[count:]
+
+
+class Released:
+    """What the releases of a test did: their reports (``done``) and warm-ups."""
+
+    def __init__(self) -> None:
+        self.done: list[dict[str, float]] = []
+        self.warmed = 0
 
 
 @pytest.fixture
-def released() -> list[str]:
-    """Releases enabled after :data:`AFTER_S`; the list records each warm-up after one."""
-    warmed: list[str] = []
-    idle_release.enable(AFTER_S, rewarm=lambda: warmed.append("warm"))
-    return warmed
+def released() -> Released:
+    """Releases enabled after :data:`AFTER_S`, each recorded."""
+    record = Released()
+
+    def warm() -> None:
+        record.warmed += 1
+
+    idle_release.enable(AFTER_S, rewarm=warm, on_release=record.done.append)
+    return record
 
 
 def fill(small_preset) -> None:
@@ -64,49 +74,44 @@ def fill(small_preset) -> None:
 def test_the_caches_are_emptied_once_the_last_session_has_been_closed_a_while(
         released, small_preset, wait_until) -> None:
     fill(small_preset)
-    count = len(idle_release.RELEASES)
     idle_release.session_opened()
     idle_release.session_opened()
     idle_release.session_closed()
-    assert not wait_until(lambda: len(idle_release.RELEASES) > count, timeout=3 * AFTER_S,
+    assert not wait_until(lambda: released.done, timeout=3 * AFTER_S,
                           every=0.02)  # one session is still open
-    assert held_bytes() > 0 and released == []
+    assert held_bytes() > 0 and released.warmed == 0
     idle_release.session_closed()
-    assert wait_until(lambda: len(idle_release.RELEASES) > count, timeout=30, every=0.02)
-    assert released == ["warm"]
+    assert wait_until(lambda: released.done, timeout=30, every=0.02)
+    assert released.warmed == 1
     assert len(RESULTS) == 0 and held_bytes() == 0
-    assert idle_release.RELEASES[-1]["bytes"] > 0
+    assert released.done[-1]["bytes"] > 0 and released.done[-1]["warmed"] == 1.0
 
 
 def test_a_session_opening_in_time_keeps_the_caches(released, small_preset,
                                                      wait_until) -> None:
     fill(small_preset)
-    count = len(idle_release.RELEASES)
     idle_release.session_opened()
     idle_release.session_closed()
     idle_release.session_opened()  # before AFTER_S has passed
-    assert not wait_until(lambda: len(idle_release.RELEASES) > count, timeout=3 * AFTER_S,
-                          every=0.02)
-    assert len(RESULTS) > 0 and released == []
+    assert not wait_until(lambda: released.done, timeout=3 * AFTER_S, every=0.02)
+    assert len(RESULTS) > 0 and released.warmed == 0
 
 
 def test_without_enable_the_sessions_are_only_counted(small_preset, wait_until) -> None:
     fill(small_preset)
-    count = len(idle_release.RELEASES)
     idle_release.session_opened()
     assert idle_release.open_sessions() == 1
     idle_release.session_closed()
     assert idle_release.open_sessions() == 0
-    assert not wait_until(lambda: len(idle_release.RELEASES) > count, timeout=0.5, every=0.05)
-    assert len(RESULTS) > 0
+    assert not wait_until(lambda: len(RESULTS) == 0, timeout=0.5, every=0.05)
 
 
 def test_a_release_stops_before_the_warm_up_once_a_session_opens(released,
                                                                    small_preset) -> None:
     fill(small_preset)
-    done = idle_release.release(rewarm=lambda: released.append("warm"),
+    done = idle_release.release(rewarm=lambda: setattr(released, "warmed", 1),
                                 go_on=lambda: False)
-    assert done["warmed"] == 0.0 and released == []
+    assert done["warmed"] == 0.0 and released.warmed == 0
     assert held_bytes() == 0  # the server's own caches are emptied first, whatever follows
 
 
@@ -115,17 +120,16 @@ def test_a_timer_superseded_by_a_later_session_does_nothing(released, small_pres
     """A timer already running when a session opens and closes again (``Timer.cancel``
     cannot stop it) must not release: only the newest timer does, once."""
     fill(small_preset)
-    count = len(idle_release.RELEASES)
     idle_release.session_opened()
     idle_release.session_closed()
     stale = idle_release._generation
     idle_release.session_opened()
     idle_release.session_closed()
     idle_release._release_if_idle(stale)  # as the first timer would, late
-    assert len(idle_release.RELEASES) == count and len(RESULTS) > 0
-    assert wait_until(lambda: len(idle_release.RELEASES) > count, timeout=30, every=0.02)
+    assert not released.done and len(RESULTS) > 0
+    assert wait_until(lambda: released.done, timeout=30, every=0.02)
     time.sleep(3 * AFTER_S)
-    assert len(idle_release.RELEASES) == count + 1 and released == ["warm"]
+    assert len(released.done) == 1 and released.warmed == 1
 
 
 def test_the_time_must_be_positive() -> None:
