@@ -106,12 +106,14 @@ def predicted_unilateral(arguments: dict[str, Any], geometry: Geometry | None = 
     full-contact path, whose messages and flags then speak. A new elastic geometry is
     prepared for the check as well: preparing it (3-10 ms on the work-precision scenes at
     tol 1e-6) is work the full-contact answer needs anyway, where a separate check on
-    the unilateral solver's nodal rule cost 3-14 ms on top of it.
+    the unilateral solver's nodal rule cost 3-14 ms on top of it. Under creep the grid is
+    the one the engine refines at :func:`core.engines.nystrom.creep_reference` (finer than
+    the grid at loading, so the check is as good, and no second grid is built).
     ``arguments`` are those of :func:`solve_unilateral`; ``geometry`` and ``inputs``, when
     given, the same arguments as :func:`core.problem.validate_geometry` and
     :func:`core.problem.validate_time_inputs` returned them (not checked again).
     """
-    from core.engines.nystrom import prepared_for
+    from core.engines.nystrom import creep_reference, prepared_for
     from core.problem import validate_geometry, validate_time_inputs
 
     loads = {k: arguments.get(k) for k in ("settlement", "tilt", "force", "moment")}
@@ -129,7 +131,8 @@ def predicted_unilateral(arguments: dict[str, Any], geometry: Geometry | None = 
         at = np.array([first])
         values = {k: float(inputs.loads[k](at)[0]) for k in inputs.given}
         c_first = float(inputs.c(at)[0])
-        check = prepared_for(geometry).solve_validated(
+        # on the grid the engine solves the creep on: one refinement a geometry
+        check = prepared_for(geometry, creep_reference(inputs)).solve_validated(
             validate_time_inputs([first], c_first, None, values), check_only=True)
         if "contact_lost" not in check.info["flags"]:
             return None

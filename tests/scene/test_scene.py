@@ -456,6 +456,22 @@ def test_a_load_change_reuses_every_cached_stage():
                if name != "solve")
 
 
+@pytest.mark.parametrize("name", ["eccentric_creep", "young_concrete_50_years"])
+def test_a_creeping_scenes_new_geometry_refines_one_grid(name):
+    """Under creep the grid is refined at the creep reference (finer than at loading):
+    the engine's prepare and the lift-off check at loading take that grid too, so a new
+    geometry (a drag of the punch width) builds one grid, not two."""
+    from core.engines.nystrom import PREPARED
+
+    d = scene_file(name)
+    solve(d)
+    d["punch"]["half_width"] *= 1.0001
+    before = PREPARED.evaluations
+    result = solve(d)
+    assert result.info["success"]
+    assert PREPARED.evaluations - before == 1
+
+
 def test_solution_dict_is_json():
     result = solve(base_dict())
     text = result.to_json()

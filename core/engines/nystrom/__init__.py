@@ -23,7 +23,7 @@
 
 from __future__ import annotations
 
-from core.engines.nystrom.engine import NYSTROM, NystromEngine
+from core.engines.nystrom.engine import NYSTROM, NystromEngine, creep_reference
 from core.engines.nystrom.multi import (
     COUPLED,
     CoupledPunches,
@@ -46,6 +46,7 @@ __all__ = [
     "COUPLED",
     "coupled_for",
     "coupled_x",
+    "creep_reference",
     "CoupledPunches",
     "interacting",
     "PunchGeometry",

@@ -496,10 +496,19 @@ def solve_with_prepared(lam: float, m: Scalar, g: Scalar, times: Any, *, c: Scal
     return prepared_for(geometry).solve_validated(inputs, time_breaks, check_only=check_only)
 
 
+def _prepared_key(geometry: Geometry, c_ref: float) -> Any:
+    return geometry_key(geometry) if c_ref == 1.0 else (geometry_key(geometry), float(c_ref))
+
+
 def prepared_for(geometry: Geometry, c_ref: float = 1.0) -> PreparedContact:
     """The prepared form of a validated geometry, refined at relative modulus ``c_ref``:
     from :data:`PREPARED` when a geometry of the same values was prepared before, else
     prepared now and kept there."""
-    key = geometry_key(geometry) if c_ref == 1.0 else (geometry_key(geometry), float(c_ref))
-    prepared, _ = PREPARED.get_or_compute(key, lambda: PreparedContact(geometry, c_ref))
+    prepared, _ = PREPARED.get_or_compute(_prepared_key(geometry, c_ref),
+                                          lambda: PreparedContact(geometry, c_ref))
     return prepared
+
+
+def cached_prepared(geometry: Geometry, c_ref: float = 1.0) -> PreparedContact | None:
+    """:func:`prepared_for` when :data:`PREPARED` holds it, else None (nothing is built)."""
+    return PREPARED.get(_prepared_key(geometry, c_ref))
