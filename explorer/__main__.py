@@ -7,6 +7,7 @@ localhost only and opens no browser.
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import importlib.util
 import os
 import signal
@@ -237,13 +238,22 @@ def main(argv: list[str] | None = None) -> int:
         if args.release_after_idle:
             def released(done: dict[str, float]) -> None:
                 print(f"No page open for {args.release_after_idle:g} s: emptied the caches "
-                      f"({done['bytes'] / 2**20:.1f} MiB) and renewed {done['workers']:.0f} "
+                      f"({done['bytes'] / 2**20:.1f} MiB), collected "
+                      f"{done['collected']:.0f} objects and renewed {done['workers']:.0f} "
                       f"solver process(es) in {done['seconds']:.1f} s", file=sys.stderr,
                       flush=True)
 
+            from tornado.ioloop import IOLoop
+
+            from explorer.fixes import gc_policy
+
+            # the loop _serve runs (this thread's)
+            io_loop = IOLoop.current()
             idle_release.enable(args.release_after_idle, on_release=released,
                                 rewarm=None if args.warm_up == "none"
-                                else lambda: warm_up(keys))
+                                else lambda: warm_up(keys),
+                                collect=lambda: _on_event_loop(
+                                    io_loop, gc_policy.collect_ended_sessions))
         app: Callable[[], Any] = create_app
         if args.live_bound is not None:
             # a function (Panel serves a partial object as its text, not as a page)
@@ -265,6 +275,28 @@ def main(argv: list[str] | None = None) -> int:
         if processes is not None:
             processes.shutdown()
     return 0
+
+
+#: The longest a thread waits for a call it handed to the event loop [s].
+ON_LOOP_TIMEOUT_S = 60.0
+
+
+def _on_event_loop(io_loop: Any, fn: Callable[[], Any]) -> Any:
+    """``fn()`` run on ``io_loop`` (a Tornado ``IOLoop`` running in another thread), its
+    result or exception returned or raised here; ``TimeoutError`` after
+    :data:`ON_LOOP_TIMEOUT_S`. The server's collection runs there: finalisers and weakref
+    callbacks of what it frees (Bokeh documents, Tornado handles) expect the loop's
+    thread."""
+    done: concurrent.futures.Future[Any] = concurrent.futures.Future()
+
+    def run() -> None:
+        try:
+            done.set_result(fn())
+        except BaseException as exc:  # noqa: BLE001 - handed to the waiting thread
+            done.set_exception(exc)
+
+    io_loop.add_callback(run)
+    return done.result(timeout=ON_LOOP_TIMEOUT_S)
 
 
 def _serve(pn: Any, apps: dict[str, Any], parent: int | None = None,

@@ -15,7 +15,9 @@ workers back at their level (run AB, read 120 s after the crowd).
 :func:`session_opened` and :func:`session_closed` count the server's sessions. Once the
 last has closed and none has opened for a while (``python -m explorer
 --release-after-idle``, default 60 s), :func:`release` runs on a thread of its own (never
-on the server's event loop): it empties the server's caches, hands its freed heap back to
+on the server's event loop): it empties the server's caches, has the server's full
+collection run (on the event loop: every object frozen by ``explorer/fixes/gc_policy.py``
+given back to the collector, see :func:`release`), hands its freed heap back to
 the system (``malloc_trim``), replaces every solver worker with a new one forked from the
 warm fork server (:meth:`~explorer.solving.workers.SolverProcesses.renew`, each once its
 lane is idle), and solves the presets the server warmed up at its start again, so that
@@ -51,26 +53,29 @@ _releasing = False
 _after_s: float | None = None
 _rewarm: Callable[[], None] | None = None
 _on_release: Callable[[dict[str, float]], None] | None = None
+_collect: Callable[[], int] | None = None
 
 
 def enable(after_s: float, rewarm: Callable[[], None] | None = None,
-           on_release: Callable[[dict[str, float]], None] | None = None) -> None:
+           on_release: Callable[[dict[str, float]], None] | None = None,
+           collect: Callable[[], int] | None = None) -> None:
     """Release the caches ``after_s`` seconds after the last session has closed, then call
     ``rewarm`` (the server's warm-up of its presets) and ``on_release`` with what the
-    release did (:func:`release`), each if given."""
-    global _after_s, _rewarm, _on_release
+    release did (:func:`release`), each if given; ``collect``: the server's full
+    collection (returns the objects collected; see :func:`release`)."""
+    global _after_s, _rewarm, _on_release, _collect
     if not after_s > 0.0:
         raise ValueError(f"after_s: must be a number of seconds above 0, got {after_s!r}")
     with _lock:
-        _after_s, _rewarm, _on_release = float(after_s), rewarm, on_release
+        _after_s, _rewarm, _on_release, _collect = float(after_s), rewarm, on_release, collect
 
 
 def disable() -> None:
     """Stop releasing: no release is due any more, and one running stops before its next
     worker and does not warm up (the server calls it before stopping its workers)."""
-    global _after_s, _rewarm, _on_release
+    global _after_s, _rewarm, _on_release, _collect
     with _lock:
-        _after_s, _rewarm, _on_release = None, None, None
+        _after_s, _rewarm, _on_release, _collect = None, None, None, None
         _cancel()
 
 
@@ -122,9 +127,9 @@ def _release_if_idle(generation: int) -> None:
         if generation != _generation or _releasing or not _wanted():
             return
         _releasing = True
-        rewarm, on_release = _rewarm, _on_release
+        rewarm, on_release, collect = _rewarm, _on_release, _collect
     try:
-        done = release(rewarm, go_on=_wanted)
+        done = release(rewarm, go_on=_wanted, collect=collect)
         if on_release is not None:
             on_release(done)
     except Exception:  # noqa: BLE001 - the server goes on: a release is an economy
@@ -135,23 +140,35 @@ def _release_if_idle(generation: int) -> None:
 
 
 def release(rewarm: Callable[[], None] | None = None,
-            go_on: Callable[[], bool] = lambda: True) -> dict[str, float]:
-    """Empty the server's caches, give the freed memory back to the system, renew the
-    solver workers, then call ``rewarm``; returns what it did: ``time``
-    (``time.monotonic``), ``bytes`` held by the server's caches before, ``workers``
-    renewed, ``warmed`` (1 if ``rewarm`` ran), ``seconds`` (``rewarm`` included).
-    ``go_on()`` is asked before each worker and before ``rewarm``: once it is false (a
-    session opened, the server stopping) the rest is left as it is."""
+            go_on: Callable[[], bool] = lambda: True,
+            collect: Callable[[], int] | None = None) -> dict[str, float]:
+    """Empty the server's caches, run ``collect`` (if given), give the freed memory back
+    to the system, renew the solver workers, then call ``rewarm``; returns what it did:
+    ``time`` (``time.monotonic``), ``bytes`` held by the server's caches before,
+    ``collected`` objects, ``workers`` renewed, ``warmed`` (1 if ``rewarm`` ran),
+    ``seconds`` (``rewarm`` included). ``go_on()`` is asked before ``collect``, each
+    worker and ``rewarm``: once it is false (a session opened, the server stopping) the
+    rest is left as it is.
+
+    ``collect`` is the server's full collection with every frozen object given back to
+    the collector first (``explorer.fixes.gc_policy.collect_ended_sessions``, run on the
+    event loop): the objects alive at the last collection for ended sessions were frozen
+    again by it, and those among them that died after it in reference cycles (a closed
+    page's study, download or view link, let go by its last work) stayed frozen, ~130 MiB
+    after the heavy pages of ``benchmarks/load_test.py --heavy``, until the next session
+    ended."""
     start = time.monotonic()
     held = sum(stage["bytes"] for stage in cache_report().values())
     clear_caches()  # the server's results and the solver stages it ran itself
-    # (no collection here: the server's are explorer/fixes/gc_policy.py's, and the caches'
-    # values are freed by their reference counts)
+    collected = collect() if collect is not None and go_on() else 0
     release_freed_memory()
     processes = worker_processes()
     renewed = processes.renew(stop=lambda: not go_on()) if processes is not None else 0
     warmed = rewarm is not None and go_on()
     if warmed:
         rewarm()
-    return {"time": start, "bytes": float(held), "workers": float(renewed),
+        # the warm-up's passing allocations leave pages of the heap in use again
+        release_freed_memory()
+    return {"time": start, "bytes": float(held), "collected": float(collected),
+            "workers": float(renewed),
             "warmed": float(warmed), "seconds": time.monotonic() - start}

@@ -132,6 +132,74 @@ def test_a_timer_superseded_by_a_later_session_does_nothing(released, small_pres
     assert len(released.done) == 1 and released.warmed == 1
 
 
+def test_garbage_frozen_by_the_last_collection_is_freed_by_the_release(wait_until) -> None:
+    """The collection for ended sessions (explorer/fixes/gc_policy.py) freezes what is
+    alive then; a reference cycle that dies after it stays frozen, out of the collector's
+    reach, until the next session ends (the heavy pages of the load test: ~130 MiB). The
+    release runs the server's collection, which frees it."""
+    import gc
+    import weakref
+
+    from explorer.fixes import gc_policy
+
+    class Node:
+        pass
+
+    holder = [Node()]
+    holder[0].me = holder[0]  # a cycle: reference counting alone never frees it
+    alive = weakref.ref(holder[0])
+    done: list[dict[str, float]] = []
+    try:
+        gc_policy.collect_ended_sessions()  # the node is alive: frozen with the rest
+        holder.clear()
+        gc.collect()
+        assert alive() is not None  # dead, but frozen
+        idle_release.enable(AFTER_S, on_release=done.append,
+                            collect=gc_policy.collect_ended_sessions)
+        idle_release.session_opened()
+        idle_release.session_closed()
+        assert wait_until(lambda: done, timeout=30, every=0.02)
+        assert alive() is None and done[-1]["collected"] >= 1
+    finally:
+        gc.unfreeze()  # the rest of the test session collects as usual
+
+
+def test_the_servers_collection_runs_on_its_event_loop() -> None:
+    """The release's thread hands the collection to the event loop (finalisers of what it
+    frees expect the loop's thread) and gets its result, or its exception, back."""
+    import asyncio
+
+    from tornado.ioloop import IOLoop
+
+    from explorer.__main__ import _on_event_loop
+
+    started = threading.Event()
+    holder: dict[str, object] = {}
+
+    def serve() -> None:
+        asyncio.set_event_loop(asyncio.new_event_loop())
+        holder["loop"] = IOLoop.current()
+        holder["thread"] = threading.get_ident()
+        IOLoop.current().add_callback(started.set)
+        IOLoop.current().start()
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    assert started.wait(30)
+    io_loop = holder["loop"]
+    try:
+        assert _on_event_loop(io_loop, threading.get_ident) == holder["thread"]
+
+        def fails() -> None:
+            raise RuntimeError("from the loop")
+
+        with pytest.raises(RuntimeError, match="from the loop"):
+            _on_event_loop(io_loop, fails)
+    finally:
+        io_loop.add_callback(io_loop.stop)
+        thread.join(30)
+
+
 def test_the_time_must_be_positive() -> None:
     with pytest.raises(ValueError, match="after_s"):
         idle_release.enable(0.0)
@@ -179,8 +247,8 @@ def test_a_served_explorer_left_idle_empties_its_caches_and_still_serves(wait_un
                          ready_timeout=300) as server:
         with opener.open(server.url + "/app", timeout=120) as page:
             assert page.status == 200
-        said = re.compile(r"No page open for 2 s: emptied the caches \([\d.]+ MiB\) and "
-                          r"renewed 1 solver process\(es\)")
+        said = re.compile(r"No page open for 2 s: emptied the caches \([\d.]+ MiB\), "
+                          r"collected \d+ objects and renewed 1 solver process\(es\)")
         assert wait_until(lambda: said.search(server.output()), timeout=120, every=0.2), (
             server.output()[-3000:])
         with opener.open(server.url + "/app", timeout=120) as page:
