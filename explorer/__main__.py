@@ -33,6 +33,14 @@ for _name in BLAS_THREAD_VARIABLES:
 #: ~18 MiB of arenas three-quarters empty per round. The C library's allocator gives
 #: back the free pages around such survivors (``gc_policy`` trims after each collection).
 SERVER_ALLOCATOR = "malloc"
+#: The C library's arenas the served explorer's threads share (``MALLOC_ARENA_MAX``). Each
+#: thread that allocates gets an arena of its own by default (up to 8 per core), and
+#: every arena keeps the pages around the few objects that outlive the work that filled
+#: it: after the load test with its heavy pages (``benchmarks/load_test.py --heavy``, 18
+#: threads) the server's live heap was back to its start +7 MiB, but ten thread arenas
+#: held 63 MiB of pages (the server's own process 158 -> 235 MiB). With two: 158 -> 199
+#: MiB, no slower (the threads allocate under Python's lock anyway).
+SERVER_ARENAS = 2
 
 #: How long the server waits for the headers of a request on an open connection [s].
 #: Tornado's default is an hour: every connection (each page's GET and websocket) left a
@@ -146,12 +154,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _restart_with_server_allocator() -> None:
-    """Start this program again with :data:`SERVER_ALLOCATOR` (same process id, same
-    arguments), unless an allocator was chosen in the environment (``PYTHONMALLOC``, which
-    is respected: ``PYTHONMALLOC=pymalloc`` keeps Python's own)."""
+    """Start this program again with :data:`SERVER_ALLOCATOR` and :data:`SERVER_ARENAS`
+    (same process id, same arguments), unless an allocator was chosen in the environment
+    (``PYTHONMALLOC``, which is respected: ``PYTHONMALLOC=pymalloc`` keeps Python's own;
+    so is ``MALLOC_ARENA_MAX``)."""
     if os.environ.get("PYTHONMALLOC"):
         return
     os.environ["PYTHONMALLOC"] = SERVER_ALLOCATOR
+    os.environ.setdefault("MALLOC_ARENA_MAX", str(SERVER_ARENAS))
     sys.stdout.flush()
     sys.stderr.flush()
     # the command line as given (python -m explorer ..., or the installed script)

@@ -89,7 +89,10 @@ def test_dropped_sessions_give_back_their_memory_and_log_no_traceback(server,
     output = server.output()
     assert "Traceback" not in output, output[-5000:]
     # the server restarted itself with the C library's allocator (explorer/__main__.py:
-    # SERVER_ALLOCATOR), which returns the pages around the few objects a session leaves
+    # SERVER_ALLOCATOR), which returns the pages around the few objects a session leaves,
+    # and few of its arenas (SERVER_ARENAS), each of which keeps such pages
     with open(f"/proc/{server.pid}/environ", "rb") as fh:
-        assert b"PYTHONMALLOC=malloc" in fh.read().split(b"\0")
+        environment = fh.read().split(b"\0")
+    assert b"PYTHONMALLOC=malloc" in environment
+    assert b"MALLOC_ARENA_MAX=2" in environment
     assert "ERROR" not in output, output[-5000:]
