@@ -38,8 +38,11 @@ SERVER_ALLOCATOR = "malloc"
 #: every arena keeps the pages around the few objects that outlive the work that filled
 #: it: after the load test with its heavy pages (``benchmarks/load_test.py --heavy``, 18
 #: threads) the server's live heap was back to its start +7 MiB, but ten thread arenas
-#: held 63 MiB of pages (the server's own process 158 -> 235 MiB). With two: 158 -> 199
-#: MiB, no slower (the threads allocate under Python's lock anyway).
+#: held 63 MiB of pages (the server's own process 158 -> 235 MiB). With two: 158 -> 196
+#: and 199 MiB in two runs, the movers' and the probe's latencies as without (the
+#: threads allocate under Python's lock anyway). The solver and study processes, started
+#: from the server's environment, run with the same setting (their solves run on one
+#: thread each; not measured apart).
 SERVER_ARENAS = 2
 
 #: How long the server waits for the headers of a request on an open connection [s].
@@ -161,7 +164,8 @@ def _restart_with_server_allocator() -> None:
     if os.environ.get("PYTHONMALLOC"):
         return
     os.environ["PYTHONMALLOC"] = SERVER_ALLOCATOR
-    os.environ.setdefault("MALLOC_ARENA_MAX", str(SERVER_ARENAS))
+    if not os.environ.get("MALLOC_ARENA_MAX"):  # (set and empty: as unset)
+        os.environ["MALLOC_ARENA_MAX"] = str(SERVER_ARENAS)
     sys.stdout.flush()
     sys.stderr.flush()
     # the command line as given (python -m explorer ..., or the installed script)
@@ -292,21 +296,28 @@ ON_LOOP_TIMEOUT_S = 60.0
 
 
 def _on_event_loop(io_loop: Any, fn: Callable[[], Any]) -> Any:
-    """``fn()`` run on ``io_loop`` (a Tornado ``IOLoop`` running in another thread), its
-    result or exception returned or raised here; ``TimeoutError`` after
-    :data:`ON_LOOP_TIMEOUT_S`. The server's collection runs there: finalisers and weakref
-    callbacks of what it frees (Bokeh documents, Tornado handles) expect the loop's
-    thread."""
+    """``fn()`` run on ``io_loop`` (a Tornado ``IOLoop`` running in another thread: never
+    call this from the loop's own), its result or exception returned or raised here;
+    ``concurrent.futures.TimeoutError`` after :data:`ON_LOOP_TIMEOUT_S` (a loop stopped or
+    closed never runs it), and then ``fn`` is not run later either. The server's
+    collection runs there: finalisers and weakref callbacks of what it frees (Bokeh
+    documents, Tornado handles) expect the loop's thread."""
     done: concurrent.futures.Future[Any] = concurrent.futures.Future()
 
     def run() -> None:
+        if not done.set_running_or_notify_cancel():
+            return  # the waiting thread gave up
         try:
             done.set_result(fn())
         except BaseException as exc:  # noqa: BLE001 - handed to the waiting thread
             done.set_exception(exc)
 
     io_loop.add_callback(run)
-    return done.result(timeout=ON_LOOP_TIMEOUT_S)
+    try:
+        return done.result(timeout=ON_LOOP_TIMEOUT_S)
+    except concurrent.futures.TimeoutError:
+        done.cancel()
+        raise
 
 
 def _serve(pn: Any, apps: dict[str, Any], parent: int | None = None,

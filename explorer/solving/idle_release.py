@@ -160,7 +160,12 @@ def release(rewarm: Callable[[], None] | None = None,
     start = time.monotonic()
     held = sum(stage["bytes"] for stage in cache_report().values())
     clear_caches()  # the server's results and the solver stages it ran itself
-    collected = collect() if collect is not None and go_on() else 0
+    collected = 0
+    if collect is not None and go_on():
+        try:
+            collected = collect()
+        except Exception:  # noqa: BLE001 - the rest of the release still gives memory back
+            logging.getLogger(__name__).exception("the idle server's collection failed")
     release_freed_memory()
     processes = worker_processes()
     renewed = processes.renew(stop=lambda: not go_on()) if processes is not None else 0

@@ -47,8 +47,10 @@ LINGER_S = 1.0
 
 @pytest.fixture(scope="module")
 def server() -> Iterator[ExplorerProcess]:
+    # (the test's own environment may set the arenas: the server's default is checked)
     with ExplorerProcess(args=["--solver-processes", "1", "--session-linger", f"{LINGER_S:g}"],
-                         host="127.0.0.1", ready_timeout=300) as process:
+                         host="127.0.0.1", ready_timeout=300,
+                         env={"MALLOC_ARENA_MAX": ""}) as process:
         yield process
 
 

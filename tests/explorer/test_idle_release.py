@@ -164,10 +164,26 @@ def test_garbage_frozen_by_the_last_collection_is_freed_by_the_release(wait_unti
         gc.unfreeze()  # the rest of the test session collects as usual
 
 
+def test_a_failed_collection_leaves_the_rest_of_the_release(small_preset) -> None:
+    """A collection that fails (the event loop stopping under it) is logged; the release
+    still empties the caches, renews the workers and warms up."""
+    fill(small_preset)
+    warmed: list[int] = []
+
+    def fails() -> int:
+        raise TimeoutError("the loop did not answer")
+
+    done = idle_release.release(rewarm=lambda: warmed.append(1), collect=fails)
+    assert done["collected"] == 0.0 and done["warmed"] == 1.0 and warmed == [1]
+    assert held_bytes() == 0
+
+
 def test_the_servers_collection_runs_on_its_event_loop() -> None:
     """The release's thread hands the collection to the event loop (finalisers of what it
     frees expect the loop's thread) and gets its result, or its exception, back."""
     import asyncio
+    import concurrent.futures
+    from unittest import mock
 
     from tornado.ioloop import IOLoop
 
@@ -198,6 +214,13 @@ def test_the_servers_collection_runs_on_its_event_loop() -> None:
     finally:
         io_loop.add_callback(io_loop.stop)
         thread.join(30)
+        io_loop.close()
+    # a loop that no longer runs: the waiting thread gives up, and the call is dropped
+    ran: list[int] = []
+    with pytest.raises(concurrent.futures.TimeoutError), \
+            mock.patch("explorer.__main__.ON_LOOP_TIMEOUT_S", 0.2):
+        _on_event_loop(io_loop, lambda: ran.append(1))
+    assert ran == []
 
 
 def test_the_time_must_be_positive() -> None:

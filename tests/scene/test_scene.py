@@ -470,6 +470,9 @@ def test_a_creeping_scenes_new_geometry_refines_one_grid(name):
     result = solve(d)
     assert result.info["success"]
     assert PREPARED.evaluations - before == 1
+    # and the answer says so: every stage built for it (the check's factorization too)
+    assert not any(entry["cached"] for entry in result.info["stages"].values()), (
+        result.info["stages"])
 
 
 def test_solution_dict_is_json():

@@ -1,8 +1,10 @@
 """The Nystrom method as an engine of :func:`core.solver.solve_dimensionless` (the default).
 
-``prepare`` is :func:`core.engines.nystrom.prepared.prepared_for`: the graded, adaptively
-refined grid of the geometry, kept in :data:`core.engines.nystrom.PREPARED` (so a later
-solve of the same geometry with other loads reuses it); ``solve`` is
+``prepare`` gives the geometry's graded, adaptively refined grid when
+:data:`core.engines.nystrom.PREPARED` holds it, else the geometry itself; ``solve``
+builds the grid it needs (:func:`core.engines.nystrom.prepared.prepared_for`, refined at
+:func:`creep_reference`, kept in ``PREPARED`` so that a later solve of the same geometry
+with other loads reuses it) and answers with
 :meth:`core.engines.nystrom.prepared.PreparedContact.solve_validated`.
 """
 
@@ -78,7 +80,7 @@ class NystromEngine:
         itself: which grid a solve needs depends on its time side (a creeping base is
         refined at :func:`creep_reference`), so :meth:`solve` builds it, once, and the
         cache keeps it (building the grid at loading as well cost a creeping scene's
-        new geometry a second refinement, 4-6 ms of 30)."""
+        new geometry a second refinement: 2.6 of 22.8 ms on ``eccentric_creep``)."""
         return cached_prepared(geometry) or geometry
 
     def solve(self, prepared: Geometry | PreparedContact, inputs: TimeInputs, *,

@@ -102,9 +102,12 @@ def nystrom_solution(prepared: Any, inputs: TimeInputs, scalars: dict[str, np.nd
         "basis": "nystrom",
         "element_ends": list(prepared.element_ends),
         # "grid" is the geometric stage (prepared once); "bordered"/"modal" the
-        # factorization of a statement; "cached" says whether this solve built it.
+        # factorization of a statement; "cached" says whether this solve built it (on
+        # the geometry's first answer, a factorization the contact check before it
+        # built counts as built by this request).
         "stages": {"grid": {"seconds": prepared.seconds, "cached": not first_solve},
-                   **{k: {"seconds": 0.0, "cached": built.get(k, 0) == 0}
+                   **{k: {"seconds": 0.0,
+                          "cached": not first_solve and built.get(k, 0) == 0}
                       for k in ("bordered", "modal") if k in counts},
                    "solve": {"seconds": seconds, "cached": False}},
         "builds": dict(counts),
