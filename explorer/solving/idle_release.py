@@ -153,10 +153,11 @@ def release(rewarm: Callable[[], None] | None = None,
     ``collect`` is the server's full collection with every frozen object given back to
     the collector first (``explorer.fixes.gc_policy.collect_ended_sessions``, run on the
     event loop): the objects alive at the last collection for ended sessions were frozen
-    again by it, and those among them that died after it in reference cycles (a closed
-    page's study, download or view link, let go by its last work) stayed frozen, ~130 MiB
-    after the heavy pages of ``benchmarks/load_test.py --heavy``, until the next session
-    ended."""
+    again by it, and those among them that die later in reference cycles stay frozen.
+    Measured with only the heavy pages of ``benchmarks/load_test.py --heavy`` and a
+    release 10 s after they closed: without it ~130 MiB more in use 40 s after they
+    closed, nearly every object frozen; with it the release collected 212,323 objects,
+    and the heap in use was back at its start +4 MiB."""
     start = time.monotonic()
     held = sum(stage["bytes"] for stage in cache_report().values())
     clear_caches()  # the server's results and the solver stages it ran itself
