@@ -135,8 +135,9 @@ def test_a_timer_superseded_by_a_later_session_does_nothing(released, small_pres
 def test_garbage_frozen_by_the_last_collection_is_freed_by_the_release(wait_until) -> None:
     """The collection for ended sessions (explorer/fixes/gc_policy.py) freezes what is
     alive then; a reference cycle that dies after it stays frozen, out of the collector's
-    reach, until the next session ends (the heavy pages of the load test: ~130 MiB). The
-    release runs the server's collection, which frees it."""
+    reach, until a collection gives it back (with the heavy pages of the load test and a
+    release 10 s after they closed: ~130 MiB more in use 40 s after). The release runs
+    the server's collection, which frees it."""
     import gc
     import weakref
 
@@ -166,7 +167,7 @@ def test_garbage_frozen_by_the_last_collection_is_freed_by_the_release(wait_unti
 
 def test_a_failed_collection_leaves_the_rest_of_the_release(small_preset) -> None:
     """A collection that fails (the event loop stopping under it) is logged; the release
-    still empties the caches, renews the workers and warms up."""
+    still empties the caches and warms up (and renews the workers, where there are any)."""
     fill(small_preset)
     warmed: list[int] = []
 
