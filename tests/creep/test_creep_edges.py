@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from core.creep.kernels import DegenerateKernel
-from core.engines.nystrom.engine import creep_reference
+from core.engines.nystrom import creep_reference
 from core.problem import validate_time_inputs
 from core.solver import solve_dimensionless
 

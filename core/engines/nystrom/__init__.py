@@ -23,7 +23,7 @@
 
 from __future__ import annotations
 
-from core.engines.nystrom.engine import NYSTROM, NystromEngine, creep_reference
+from core.engines.nystrom.engine import NYSTROM, NystromEngine
 from core.engines.nystrom.multi import (
     COUPLED,
     CoupledPunches,
@@ -37,6 +37,7 @@ from core.engines.nystrom.prepared import (
     PREPARED,
     PREPARED_BYTES,
     PreparedContact,
+    creep_reference,
     prepare,
     prepared_for,
     solve_with_prepared,

@@ -12,56 +12,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-import numpy as np
-
-from core.cache import StageCache, fingerprint
-from core.creep import integrated_kernel
-from core.engines.nystrom.prepared import PreparedContact, cached_prepared, prepared_for
+from core.engines.nystrom.prepared import (
+    PreparedContact,
+    cached_prepared,
+    creep_reference,
+    prepared_for,
+)
 from core.engines.nystrom.result import SUCCESS_MARGIN
 from core.problem import ContactSolution, Geometry, TimeInputs
-
-#: Steps per octave of the relative modulus a creeping problem's grid is refined at: a
-#: creep parameter moved a little keeps its grid (rounded down: the finer side).
-REFERENCE_STEPS_PER_OCTAVE = 4
-
-_REFERENCES = StageCache("creep_reference", max_items=256, max_bytes=2**16,
-                         sizeof=lambda _: 8)
-
-
-def creep_reference(inputs: TimeInputs) -> float:
-    """The relative modulus [-] a creeping problem's grid is refined at: the smallest of
-    ``c(t) / F(t)`` over the output times, ``F(t) = 1 - int_1^t K(t, u) du`` the compliance
-    of a stress held since loading relative to the elastic one (rounded down to
-    :data:`REFERENCE_STEPS_PER_OCTAVE` steps an octave); 1 without creep or where it is
-    not below 1.
-
-    The coating's term is ``c(t) m q`` against the base's ``(I - V) A q``: as the base
-    creeps its compliance grows by about ``F``, so the coating counts as ``m c / F`` and
-    the pressure at the punch's edges sharpens. A grid refined at loading (``c = 1``) then
-    misses ``tol`` at late times: measured on ``lam = 1, m = 0.1, g = 0.01 x^2`` with an
-    exponential kernel (``F`` up to 2.5), the error of q at ``x = 1`` grew from 1.9e-7 at
-    loading to 1.6e-6 at ``t = 12`` under an estimate of 9.0e-7 (tol 1e-6).
-    """
-    if inputs.kernel is None:
-        return 1.0
-    key = getattr(inputs.kernel, "key", None)
-
-    def compute() -> float:
-        t = np.asarray(inputs.times, dtype=float)
-        held = 1.0 + integrated_kernel(inputs.kernel, t, np.ones_like(t))
-        ratio = float(np.min(np.asarray(inputs.c(t), dtype=float) / held))
-        if not ratio < 1.0:
-            return 1.0
-        steps = REFERENCE_STEPS_PER_OCTAVE
-        return float(2.0 ** (np.floor(steps * np.log2(ratio)) / steps))
-
-    if key is None:  # a plain callable: no content to key it by
-        return compute()
-    # a fitted kernel's key holds the creep law's inputs (a dataclass): its repr is its
-    # content
-    cache_key = fingerprint("creep reference", repr(key), inputs.times,
-                            np.asarray(inputs.c(inputs.times), dtype=float))
-    return _REFERENCES.get_or_compute(cache_key, compute)[0]
 
 
 class NystromEngine:

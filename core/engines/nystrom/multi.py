@@ -19,7 +19,9 @@ Design (dimensionless, elastic base, full contact):
   ``[-1, 1]``), and ``int q_p = P_p``, ``int x q_p = M_p`` on each zone.
 - **Grids.** Each punch has the graded, adaptively refined grid of a single punch of
   its own geometry (:func:`core.engines.nystrom.prepared_for`, cached: two identical
-  punches share one), so each self block is exactly the single-punch operator. Where a
+  punches share one), refined where the coating counts least on a creeping base
+  (:func:`core.engines.nystrom.creep_reference`, as for one punch), so each self block
+  is exactly the single-punch operator. Where a
   neighbour is closer to an end than that end's panel is wide, the neighbour's edge
   pressure makes the drive on this zone vary on the scale of the gap: the end is graded
   further (``h -> h/4`` a level, :class:`ZoneGrid`) until its panel is no wider than the
@@ -79,10 +81,10 @@ from core.engines.nystrom.bordered import build_grid, touches
 from core.engines.nystrom.multi_modal import CoupledModalAnswer, CoupledModalForm
 from core.engines.nystrom.prepared import (
     HISTORY_SAMPLES,
-    PREPARED,
     SHAPE_DIGITS,
     TIME_SHARE,
     PreparedContact,
+    creep_reference,
     geometry_key,
     prepared_for,
 )
@@ -592,17 +594,18 @@ COUPLED = StageCache("coupled_punches", max_items=8, max_bytes=256 * 2**20,
                      sizeof=lambda coupled: coupled.nbytes)
 
 
-def coupled_for(punches: Sequence[PunchGeometry]) -> CoupledPunches:
-    """The coupled discretization of ``punches``: from :data:`COUPLED` when the same
-    geometries at the same centres were coupled before, else built now and kept."""
+def coupled_for(punches: Sequence[PunchGeometry], c_ref: float = 1.0) -> CoupledPunches:
+    """The coupled discretization of ``punches``, each punch's grid refined at the
+    relative modulus ``c_ref`` (:func:`core.engines.nystrom.creep_reference` of a creeping
+    base, as for one punch): from :data:`COUPLED` when the same geometries at the same
+    centres were coupled before at that modulus, else built now and kept."""
     keys = [geometry_key(p.geometry) for p in punches]
 
     def build() -> CoupledPunches:
-        prepared = [PREPARED.get_or_compute(k, lambda p=p: PreparedContact(p.geometry))[0]
-                    for k, p in zip(keys, punches, strict=True)]
-        return CoupledPunches(punches, prepared)
+        return CoupledPunches(punches, [prepared_for(p.geometry, c_ref) for p in punches])
 
-    key = fingerprint("coupled", *[(k, p.center) for k, p in zip(keys, punches, strict=True)])
+    key = fingerprint("coupled", *[(k, p.center) for k, p in zip(keys, punches, strict=True)],
+                      float(c_ref))
     coupled, _ = COUPLED.get_or_compute(key, build)
     return coupled
 
@@ -611,5 +614,8 @@ def solve_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeInputs]
                   time_breaks: Sequence[float] = ()) -> list[ContactSolution]:
     """The coupled full-contact answer of several punches on one base (see the module
     notes); one :class:`core.problem.ContactSolution` per punch, in its own scaling
-    (``x* = (x - e)/a``)."""
-    return coupled_for(punches).solve(inputs, time_breaks)
+    (``x* = (x - e)/a``). On a creeping base every punch's grid is refined at the
+    modulus where the coating counts least (:func:`creep_reference`; the punches share
+    the base and the times)."""
+    c_ref = creep_reference(inputs[0]) if inputs else 1.0
+    return coupled_for(punches, c_ref).solve(inputs, time_breaks)
