@@ -77,11 +77,13 @@ def test_far_apart_punches_lift_off_as_single_punches(second: dict[str, float]) 
                                for zones in alone.contact_set]
         errors = _errors(punch, shifted)
         # measured over the four statements: settlement, tilt, force, moment <= 2.0e-15,
-        # q <= 6.1e-14 (lift-off) and 8.4e-9 against a single punch left in full contact
-        # (the other discretization, its estimate 4.4e-8), zone ends <= 6.2e-12
-        # half-widths (the two root-finds stop on different steps; either may leave one
-        # of up to SKIP_END_STEP * ZONE_END_TOL unmade)
-        closeness = 1e-9 if alone.info["contact"] == "unilateral" else 1e-7
+        # q <= 6.1e-14 (lift-off); against a single punch left in full contact, another
+        # discretization (the coarser grid of its refinement where that meets tol: 96
+        # nodes, estimate 4.3e-7), q 1.5e-7 apart: within the two answers' estimates;
+        # zone ends <= 6.2e-12 half-widths (the two root-finds stop on different steps;
+        # either may leave one of up to SKIP_END_STEP * ZONE_END_TOL unmade)
+        closeness = (1e-9 if alone.info["contact"] == "unilateral"
+                     else alone.info["error_estimate"] + punch.info["error_estimate"])
         for q in (*QUANTITIES, "q"):
             assert errors[q] < closeness, (k, q, errors)
         assert errors["ends"] < SKIP_END_STEP * ZONE_END_TOL
