@@ -256,8 +256,8 @@ class CoupledPunches:
                       for key, entry in self._systems.items() if key[0] != "modal")
         modal = sum(3 * entry.q.nbytes for key, entry in self._systems.items()
                     if key[0] == "modal")
-        responses = sum(r.nodal.nbytes + r.effective.nbytes for found in
-                        list(self._responses.values()) for r in found)
+        responses = sum(r.nodal.nbytes + r.effective.nbytes + sum(c.nbytes for c in checks)
+                        for found in list(self._responses.values()) for r, checks in found)
         return int(blocks + systems + modal + responses)
 
     @property
@@ -399,20 +399,16 @@ class CoupledPunches:
             tol = min(pc.geometry.tol for pc in self.prepared)
             kernel, fit_error = stepping_kernel(first.kernel, float(times[-1]), 0.5 * tol)
             breaks = [b for b in time_breaks if times[0] < b < times[-1]]
-            answer = self._superposed(self.modal(givens, tol), inputs, probe, first.c,
-                                      kernel, tol / TIME_SHARE, breaks)
-            nodal, effective, scalars_all = answer.nodal, answer.effective, answer.scalars
             c_probe = np.asarray(first.c(probe), dtype=float)
+            answer, checks = self._superposed(self.modal(givens, tol), inputs, probe,
+                                              first.c, c_probe, kernel, tol / TIME_SHARE,
+                                              breaks)
+            nodal, effective, scalars_all = answer.nodal, answer.effective, answer.scalars
             # each punch's time error its own (a far neighbour's march does not count)
             time_sides = [TimeSide(error + fit_error, answer.steps, answer.success,
                                    answer.message, fit_error)
                           for error in (answer.time_errors
                                         or (answer.time_error,) * len(self.punches))]
-            checks = [self._pressure(p, pc.check_x, nodal[self.offsets[p]:self.offsets[p + 1]],
-                                     effective[self.offsets[p]:self.offsets[p + 1]],
-                                     self._coupling_at_nodes(p, effective), scalars_all[p],
-                                     c_probe, pc.check_formula)
-                      for p, pc in enumerate(self.prepared)]
         at = np.searchsorted(probe, times)
         answers = []
         for p, prepared in enumerate(self.prepared):
@@ -436,10 +432,12 @@ class CoupledPunches:
         return answers
 
     def _superposed(self, form: CoupledModalForm, inputs: Sequence[TimeInputs],
-                    times: np.ndarray, c: Any, kernel: Any, time_tol: float,
-                    breaks: Sequence[float]) -> CoupledModalAnswer:
+                    times: np.ndarray, c: Any, c_t: np.ndarray, kernel: Any, time_tol: float,
+                    breaks: Sequence[float]) -> tuple[CoupledModalAnswer, list[np.ndarray]]:
         """The time-stepped answer as a sum of cached responses to each given load's shape
-        and to the gaps, as one punch's is (:meth:`PreparedContact._superposed`).
+        and to the gaps, as one punch's is (:meth:`PreparedContact._superposed`), and q of
+        each punch at its check points over ``times`` (X_p, T), summed likewise from each
+        response's checks, kept with it (``c_t``: c at ``times``).
 
         The coupled equations are linear: each given load of each punch is split into its
         amplitude and its shape (normalized to unit peak), and the responses to the shapes
@@ -448,7 +446,6 @@ class CoupledPunches:
         A load slider of any punch then changes an amplitude: a few array operations
         instead of a time integration of the coupled system.
         """
-        c_t = np.asarray(c(times), dtype=float)
         kernel_key, identity = content_key(kernel)
         givens = tuple(tuple(sorted(one.given)) for one in inputs)
         common = fingerprint("coupled modal", givens, times, c_t, kernel_key, time_tol,
@@ -480,14 +477,21 @@ class CoupledPunches:
         with self._lock:
             found = self._responses.get(joint_key)
         if found is None:
-            found = form.solve_parts([(loads, gap) for _, _, loads, gap in parts], times, c,
-                                     kernel, time_tol, breaks)
+            responses = form.solve_parts([(loads, gap) for _, _, loads, gap in parts], times,
+                                         c, kernel, time_tol, breaks)
+            # q >= 0 is checked on the sum: each response's checks, summed like the answer
+            found = [(r, self._checks(r, gap, c_t))
+                     for r, (_, _, _, gap) in zip(responses, parts, strict=True)]
             with self._lock:
                 self.counts["time_response"] += len(found)
                 self._responses[joint_key] = found
                 while len(self._responses) > RESPONSES_KEPT:
                     self._responses.pop(next(iter(self._responses)))
         weights = [weight for weight, _, _, _ in parts]
+        checks = [sum(w * part_checks[p] for w, (_, part_checks) in
+                      zip(weights, found, strict=True))
+                  for p in range(len(inputs))]
+        found = [r for r, _ in found]
         nodal = sum(w * r.nodal for w, r in zip(weights, found, strict=True))
         effective = sum(w * r.effective for w, r in zip(weights, found, strict=True))
         scalars = []
@@ -513,7 +517,19 @@ class CoupledPunches:
         failed = [r.message for r in found if not r.success]
         return CoupledModalAnswer(nodal, effective, scalars, max(errors),
                                   max(r.steps for r in found), not failed,
-                                  "; ".join(failed) or found[0].message, errors)
+                                  "; ".join(failed) or found[0].message, errors), checks
+
+    def _checks(self, response: CoupledModalAnswer, gap: float, c_t: np.ndarray
+                ) -> list[np.ndarray]:
+        """q of one time-stepped response at each punch's check points (X_p, T), with the
+        gap weighted by ``gap`` (the Nystrom formula is linear in the response and the
+        gap: the checks of a sum are the sum of the checks)."""
+        nodal, effective = response.nodal, response.effective
+        return [self._pressure(p, pc.check_x, nodal[self.offsets[p]:self.offsets[p + 1]],
+                               effective[self.offsets[p]:self.offsets[p + 1]],
+                               self._coupling_at_nodes(p, effective), response.scalars[p],
+                               c_t, pc.check_formula, np.full(c_t.size, gap))
+                for p, pc in enumerate(self.prepared)]
 
     def modal(self, givens: tuple[frozenset[str], ...], tol: float) -> CoupledModalForm:
         """The modal form of the coupled equations for the punches' statements (cached)."""
