@@ -66,7 +66,7 @@ from __future__ import annotations
 
 import threading
 import time as _time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -90,6 +90,26 @@ from core.engines.nystrom.prepared import (
 )
 from core.engines.nystrom.result import TimeSide, nystrom_solution
 from core.problem import QUANTITIES, ContactSolution, Geometry, TimeInputs
+
+
+@dataclass
+class _Part:
+    """One time-stepped response of the coupled system (to one given load's shape, or to
+    the gaps: ``gap`` 1), with q at each punch's check points (``checks``) and q at points
+    asked for before (``pressures``, by punch, points and output columns; the plotting
+    grid of a load change is then a weighted sum instead of the Nystrom formula)."""
+
+    response: CoupledModalAnswer
+    gap: float
+    checks: list[np.ndarray]
+    pressures: dict[tuple, np.ndarray]
+
+
+#: Sets of points per response whose q is kept (:class:`_Part`), and the most values
+#: (points times output times) a kept one may hold, 2 MiB (the plotting grid's 201 points
+#: at up to 1300 output times; larger requests are computed each time).
+PRESSURES_KEPT = 4
+PRESSURE_VALUES_KEPT = 2**18
 
 #: Time-stepped responses of the coupled system kept per set of punches (as one punch
 #: keeps 24 of its own): a load slider alternates among a few shapes.
@@ -256,8 +276,10 @@ class CoupledPunches:
                       for key, entry in self._systems.items() if key[0] != "modal")
         modal = sum(3 * entry.q.nbytes for key, entry in self._systems.items()
                     if key[0] == "modal")
-        responses = sum(r.nodal.nbytes + r.effective.nbytes + sum(c.nbytes for c in checks)
-                        for found in list(self._responses.values()) for r, checks in found)
+        responses = sum(part.response.nodal.nbytes + part.response.effective.nbytes
+                        + sum(c.nbytes for c in part.checks)
+                        + sum(q.nbytes for q in list(part.pressures.values()))
+                        for found in list(self._responses.values()) for part in found)
         return int(blocks + systems + modal + responses)
 
     @property
@@ -393,6 +415,7 @@ class CoupledPunches:
                 scalars_all.append(scalars)
             c_probe = np.full(probe.size, c)
             time_sides = [TimeSide(message="elastic base, several punches")] * len(self.punches)
+            terms = None
         else:
             probe = (times if times.size == 1 else np.union1d(
                 times, np.linspace(times[0], times[-1], HISTORY_SAMPLES["creep"])))
@@ -400,9 +423,9 @@ class CoupledPunches:
             kernel, fit_error = stepping_kernel(first.kernel, float(times[-1]), 0.5 * tol)
             breaks = [b for b in time_breaks if times[0] < b < times[-1]]
             c_probe = np.asarray(first.c(probe), dtype=float)
-            answer, checks = self._superposed(self.modal(givens, tol), inputs, probe,
-                                              first.c, c_probe, kernel, tol / TIME_SHARE,
-                                              breaks)
+            answer, checks, terms = self._superposed(self.modal(givens, tol), inputs, probe,
+                                                     first.c, c_probe, kernel,
+                                                     tol / TIME_SHARE, breaks)
             nodal, effective, scalars_all = answer.nodal, answer.effective, answer.scalars
             # each punch's time error its own (a far neighbour's march does not count)
             time_sides = [TimeSide(error + fit_error, answer.steps, answer.success,
@@ -417,8 +440,9 @@ class CoupledPunches:
             coupling = self._coupling_at_nodes(p, effective[:, at])
             q_extremes = (float(checks[p].min()), float(np.max(np.abs(checks[p]))))
             out = {k: v[at] for k, v in scalars.items()}
-            pressure = self._pressure_function(p, nodal[lo:hi, at], effective[lo:hi, at],
-                                               coupling, out, c_probe[at])
+            pressure = (self._pressure_function(p, nodal[lo:hi, at], effective[lo:hi, at],
+                                                coupling, out, c_probe[at]) if terms is None
+                        else self._summed_pressure(p, terms, at, c_probe[at]))
             built = dict(prepared.counts)
             solution = nystrom_solution(
                 prepared, inputs[p], out, pressure, q_extremes, time_sides[p],
@@ -433,11 +457,15 @@ class CoupledPunches:
 
     def _superposed(self, form: CoupledModalForm, inputs: Sequence[TimeInputs],
                     times: np.ndarray, c: Any, c_t: np.ndarray, kernel: Any, time_tol: float,
-                    breaks: Sequence[float]) -> tuple[CoupledModalAnswer, list[np.ndarray]]:
+                    breaks: Sequence[float]
+                    ) -> tuple[CoupledModalAnswer, list[np.ndarray],
+                               list[tuple[float, _Part]] | None]:
         """The time-stepped answer as a sum of cached responses to each given load's shape
-        and to the gaps, as one punch's is (:meth:`PreparedContact._superposed`), and q of
+        and to the gaps, as one punch's is (:meth:`PreparedContact._superposed`), q of
         each punch at its check points over ``times`` (X_p, T), summed likewise from each
-        response's checks, kept with it (``c_t``: c at ``times``).
+        response's checks, kept with it (``c_t``: c at ``times``), and, where the
+        responses were kept from an earlier solve, the terms of the sum, ``(weight,
+        part)`` (:class:`_Part`; None for new responses).
 
         The coupled equations are linear: each given load of each punch is split into its
         amplitude and its shape (normalized to unit peak), and the responses to the shapes
@@ -476,11 +504,12 @@ class CoupledPunches:
         joint_key = (identity, *(key for _, key, _, _ in parts))
         with self._lock:
             found = self._responses.get(joint_key)
+        reused = found is not None
         if found is None:
             responses = form.solve_parts([(loads, gap) for _, _, loads, gap in parts], times,
                                          c, kernel, time_tol, breaks)
             # q >= 0 is checked on the sum: each response's checks, summed like the answer
-            found = [(r, self._checks(r, gap, c_t))
+            found = [_Part(r, gap, self._checks(r, gap, c_t), {})
                      for r, (_, _, _, gap) in zip(responses, parts, strict=True)]
             with self._lock:
                 self.counts["time_response"] += len(found)
@@ -488,10 +517,12 @@ class CoupledPunches:
                 while len(self._responses) > RESPONSES_KEPT:
                     self._responses.pop(next(iter(self._responses)))
         weights = [weight for weight, _, _, _ in parts]
-        checks = [sum(w * part_checks[p] for w, (_, part_checks) in
-                      zip(weights, found, strict=True))
+        checks = [sum(w * part.checks[p] for w, part in zip(weights, found, strict=True))
                   for p in range(len(inputs))]
-        found = [r for r, _ in found]
+        # q between the nodes as a sum of the parts' once loads change (a new response's
+        # first answer takes the formula on the sum: one evaluation, not one a part)
+        terms = list(zip(weights, found, strict=True)) if reused else None
+        found = [part.response for part in found]
         nodal = sum(w * r.nodal for w, r in zip(weights, found, strict=True))
         effective = sum(w * r.effective for w, r in zip(weights, found, strict=True))
         scalars = []
@@ -517,7 +548,7 @@ class CoupledPunches:
         failed = [r.message for r in found if not r.success]
         return CoupledModalAnswer(nodal, effective, scalars, max(errors),
                                   max(r.steps for r in found), not failed,
-                                  "; ".join(failed) or found[0].message, errors), checks
+                                  "; ".join(failed) or found[0].message, errors), checks, terms
 
     def _checks(self, response: CoupledModalAnswer, gap: float, c_t: np.ndarray
                 ) -> list[np.ndarray]:
@@ -593,6 +624,43 @@ class CoupledPunches:
         if not near.all():
             out[~near] = grid.interpolate(x[~near], nodal)
         return out
+
+    def _summed_pressure(self, p: int, terms: list[tuple[float, _Part]], at: np.ndarray,
+                         c: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+        """q of zone ``p`` at points ``x`` over the output columns ``at`` of the stepped
+        times: the weighted sum of each response's q there (the Nystrom formula is linear
+        in the response and the gap), each kept with its response for up to
+        :data:`PRESSURES_KEPT` sets of at most :data:`PRESSURE_VALUES_KEPT` values, so
+        that a load change reads the plotting grid as a sum. ``c`` (T,): c at those
+        columns."""
+        lo, hi = self.offsets[p], self.offsets[p + 1]
+
+        def part_pressure(part: _Part, x: np.ndarray) -> np.ndarray:
+            r = part.response
+            return self._pressure(p, x, r.nodal[lo:hi, at], r.effective[lo:hi, at],
+                                  self._coupling_at_nodes(p, r.effective[:, at]),
+                                  {k: v[at] for k, v in r.scalars[p].items()}, c, None,
+                                  np.full(at.size, part.gap))
+
+        def pressure(x: np.ndarray) -> np.ndarray:
+            x = np.ascontiguousarray(x, dtype=float)
+            key = (p, x.tobytes(), at.tobytes())
+            keep = x.size * at.size <= PRESSURE_VALUES_KEPT
+            total = np.zeros((x.size, at.size))
+            for weight, part in terms:
+                with self._lock:
+                    q = part.pressures.get(key) if keep else None
+                if q is None:
+                    q = part_pressure(part, x)
+                    if keep:
+                        with self._lock:
+                            part.pressures[key] = q
+                            while len(part.pressures) > PRESSURES_KEPT:
+                                part.pressures.pop(next(iter(part.pressures)))
+                total += weight * q
+            return total
+
+        return pressure
 
     def _pressure_function(self, p: int, nodal: np.ndarray, effective: np.ndarray,
                            coupling: np.ndarray, scalars: dict[str, np.ndarray],
