@@ -36,6 +36,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
+from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +47,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 import core  # noqa: E402
+from benchmarks import run_lines, tree_commit  # noqa: E402
 from core.cache import clear_caches  # noqa: E402
 from core.solver import solve_dimensionless  # noqa: E402
 from tests.support.scenes import Scene, creep_times, suite  # noqa: E402
@@ -279,12 +281,13 @@ FIGURES_MISSING = ("Figures: not drawn in this run (matplotlib, from the `[bench
 
 
 def report(results: list[dict], goal: dict[str, float], command: str, out: Path,
-           figures: bool = True) -> None:
+           figures: bool = True, run: list[str] | None = None) -> None:
+    """Write ``engines.md`` to ``out``; ``run``: :func:`benchmarks.run_lines` of the run
+    (the commit, the date, the machine and its load)."""
     lines = ["# The two engines: speed against error", "",
-             f"Made by `{command}` on a 2-core machine (load average at the start: "
-             f"{os.getloadavg()[0]:.1f}; the machine was shared, so absolute times are "
-             "inflated and vary between runs; ratios between the engines measured in "
-             "the same run are the meaningful part).", "",
+             f"Made by `{command}` (absolute times grow with the machine's load and vary "
+             "between runs; ratios between the engines measured in the same run are the "
+             "meaningful part).", "", *(run or []), "",
              "Error: the largest of delta, alpha, P, M and q on the whole of [-1, 1] "
              "(edges and both sides of jumps included) against the default engine at tol "
              "1e-10; 'reference check' is that reference against the projection at tol "
@@ -359,6 +362,7 @@ def main(argv: list[str] | None = None) -> int:
     elif args.quick:
         scenes = scenes[:3]
     repeats = 3 if args.quick else args.repeats
+    started, commit, load_before = datetime.now(timezone.utc), tree_commit(), os.getloadavg()[0]
     args.out.mkdir(parents=True, exist_ok=True)
     results = []
     figures = True
@@ -372,7 +376,8 @@ def main(argv: list[str] | None = None) -> int:
             figures = False
     goal = goals(repeats)
     command = "python benchmarks/engines.py" + (" --quick" if args.quick else "")
-    report(results, goal, command, args.out, figures)
+    report(results, goal, command, args.out, figures,
+           run_lines(started, load_before, os.getloadavg()[0], commit=commit))
     (args.out / "engines.json").write_text(json.dumps({"scenes": results, "goals": goal},
                                                       indent=1))
     print(json.dumps(goal, indent=1))
