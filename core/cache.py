@@ -203,6 +203,33 @@ class StageCache:
             return entry[0]
 
 
+    def resize(self, value: Any) -> None:
+        """Measure ``value`` again, held under any key (by identity), after it grew in
+        place (answers kept with a prepared geometry for later load changes), and drop
+        the least recently used others while the budget is exceeded; a value grown
+        larger than the whole budget is no longer kept. Nothing happens when the value is
+        not held."""
+        with self._lock:
+            if not any(held is value for held, _ in self._data.values()):
+                return
+        size = self._sizeof(value)  # outside the lock, as on insertion
+        with self._lock:
+            key = next((k for k, (held, _) in self._data.items() if held is value), None)
+            if key is None:
+                return
+            self._bytes += size - self._data[key][1]
+            self._data[key] = (value, size)
+            if size > self.max_bytes:
+                del self._data[key]
+                self._bytes -= size
+            while self._bytes > self.max_bytes:
+                oldest = next(iter(self._data))
+                if oldest == key:  # the grown value was just used: keep it, drop others
+                    self._data.move_to_end(key)
+                    oldest = next(iter(self._data))
+                _, dropped = self._data.pop(oldest)
+                self._bytes -= dropped
+
     def values(self) -> list[Any]:
         """A snapshot of the values held, least recently used first."""
         with self._lock:

@@ -153,3 +153,43 @@ def test_pair_tables_emptied_when_full_still_answer_every_key(monkeypatch):
     again = node_rows(1.0, second, second, np.arange(second.n_panels))
     assert np.array_equal(alone, again)
     pair_tables.clear()
+
+
+def test_a_grown_value_is_measured_again():
+    """A value that grew in place after it was cached (answers kept with a prepared
+    geometry) counts at its new size: the least recently used others are dropped to stay
+    within the budget, and a value larger than the whole budget is no longer kept."""
+    from core.cache import StageCache
+
+    sizes = {"a": 30, "b": 30, "c": 30}
+    cache = StageCache("test_grown_values", max_items=8, max_bytes=100,
+                       sizeof=lambda value: sizes[value])
+    for key in sizes:
+        cache.get_or_compute(key, lambda key=key: key)
+    assert cache.size_bytes == 90
+    sizes["b"] = 60
+    cache.resize("b")  # "a" is the least recently used: dropped
+    assert cache.get("a") is None and cache.size_bytes == 90
+    sizes["c"] = 120
+    cache.resize("c")
+    assert cache.get("c") is None and cache.get("b") == "b" and cache.size_bytes == 60
+    cache.resize("z")  # not held: nothing happens
+    assert cache.size_bytes == 60
+
+
+def test_a_prepared_geometrys_kept_responses_count_in_its_size():
+    """The time-stepped responses a prepared geometry keeps for load changes count in
+    its size, and so in the cache's budget."""
+    from core.cache import clear_caches
+    from core.engines.nystrom import PREPARED, solve_with_prepared
+
+    clear_caches()
+    times = np.linspace(1.0, 10.0, 5)
+    kernel = lambda t, s: 0.5 * np.exp(-(t - s))  # noqa: E731
+    solve_with_prepared(2.0, 1.0, 0.0, times, kernel=kernel, force=1.0, moment=0.0,
+                        tol=1e-6)
+    (prepared,) = PREPARED.values()
+    before = prepared.nbytes
+    solve_with_prepared(2.0, 1.0, 0.0, times, kernel=kernel,
+                        force=lambda t: 1.0 + 0.1 * t, moment=0.0, tol=1e-6)
+    assert prepared.nbytes > before and PREPARED.size_bytes == prepared.nbytes

@@ -63,6 +63,11 @@ CHECK_POINTS = 401
 CHECK_BLOCK = 256
 #: Bound of the cached operator rows at evaluation points [bytes].
 ROWS_BYTES = 64 * 2**20
+#: Time-stepped responses kept with one prepared geometry for later load changes: at most
+#: this many sets (a load slider alternates among a few shapes) and this many bytes (a
+#: set of 1300 output times on a 2000-node grid holds ~20 MiB).
+RESPONSES_KEPT = 24
+RESPONSES_BYTES = 64 * 2**20
 #: Samples of the load histories between the output times where the validity of the
 #: answer (q >= 0, the tilt) is checked as well, so a peak between outputs is not missed:
 #: elastic (a matrix product per sample) and creeping (each sample is an output of the
@@ -149,6 +154,7 @@ class PreparedContact:
         self._rows: dict[bytes, np.ndarray] = {}
         self._elastic: dict[tuple, ElasticUnits] = {}
         self._responses: dict[tuple, list[tuple[ModalAnswer, np.ndarray]]] = {}
+        self._response_bytes: dict[tuple, int] = {}
         self.check_x = _check_points(geometry.breakpoints)
         # Check points on panels ending at +-1 or a jump take the Nystrom formula (q has
         # (x - e) ln|x - e| terms there); elsewhere q is analytic and its panel interpolant
@@ -177,7 +183,12 @@ class PreparedContact:
         """Factorized bordered system and its unit responses for a statement and constant c."""
         key = (given, c)
         with self._lock:
-            return self._bordered_locked(key, given, c)
+            known = len(self._bordered)
+            found = self._bordered_locked(key, given, c)
+            grown = len(self._bordered) > known
+        if grown:
+            PREPARED.resize(self)
+        return found
 
     def _bordered_locked(self, key: tuple, given: frozenset[str], c: float
                          ) -> tuple[BorderedSystem, dict[str, np.ndarray]]:
@@ -194,10 +205,16 @@ class PreparedContact:
     def modal(self, given: frozenset[str]) -> ModalForm:
         """Modal decomposition of a statement (for creep or a modulus varying in time)."""
         with self._lock:
-            if given not in self._modal:
-                self._modal[given] = ModalForm(self.grid, given, self.geometry.tol)
+            found = self._modal.get(given)
+            if found is None:
+                found = self._modal[given] = ModalForm(self.grid, given, self.geometry.tol)
                 self.counts["modal"] += 1
-            return self._modal[given]
+                built = True
+            else:
+                built = False
+        if built:
+            PREPARED.resize(self)
+        return found
 
     def _elastic_units(self, given: frozenset[str], c0: float) -> ElasticUnits:
         """Unit responses of a statement at constant c (see :mod:`core.engines.nystrom.elastic`)."""
@@ -244,6 +261,7 @@ class PreparedContact:
         total += sum(r.nbytes for r in self._rows.values())
         total += sum(2 * self.grid.operator.nbytes for _ in self._bordered)
         total += sum(3 * self.grid.operator.nbytes for _ in self._modal)
+        total += sum(self._response_bytes.values())
         return int(total)
 
     # --------------------------------------------------------------------- solve
@@ -353,7 +371,9 @@ class PreparedContact:
         # on which parts happened to be cached before.
         joint_key = (identity, *(key for _, key, _, _ in parts))
         with self._lock:
-            found = self._responses.get(joint_key)
+            found = self._responses.pop(joint_key, None)
+            if found is not None:  # used last: dropped last
+                self._responses[joint_key] = found
         if found is None:
             answers = form.solve_parts(times, inputs.c, kernel,
                                        [(loads, gap) for _, _, loads, gap in parts],
@@ -361,10 +381,19 @@ class PreparedContact:
             found = [(response, self._check_pressure(response, gap, c_t))
                      for (_, _, _, gap), response in zip(parts, answers, strict=True)]
             self.counts["time_response"] += len(found)
+            size = sum(sum(a.nbytes for a in response.modal_effective) + check.nbytes
+                       + sum(v.nbytes for v in response.scalars.values())
+                       for response, check in found)
             with self._lock:
                 self._responses[joint_key] = found
-                while len(self._responses) > 24:
-                    self._responses.pop(next(iter(self._responses)))
+                self._response_bytes[joint_key] = size
+                while len(self._responses) > 1 and (
+                        len(self._responses) > RESPONSES_KEPT
+                        or sum(self._response_bytes.values()) > RESPONSES_BYTES):
+                    dropped = next(iter(self._responses))
+                    self._responses.pop(dropped)
+                    self._response_bytes.pop(dropped)
+            PREPARED.resize(self)  # the kept responses count in the cache's budget
         for (weight, _, _, _), (response, _) in zip(parts, found, strict=True):
             terms.append((weight, response))
             size = max(float(np.max(np.abs(response.scalars["settlement"]))),
