@@ -301,6 +301,93 @@ def test_a_creeping_pairs_load_change_sums_the_kept_pressures(loads, monkeypatch
         assert _relative(grid, punch.pressure_on_grid) < 1e-12
 
 
+def _scaled_pair(factor: float, gap: float = 0.5) -> dict[str, Any]:
+    e = _creeping(_pair(gap))
+    for punch in e["punches"]:
+        punch["loading"] = {k: factor * v for k, v in punch["loading"].items()}
+    return e
+
+
+def _count_formula(monkeypatch) -> list[int]:
+    """The punches whose q the Nystrom formula is evaluated for, call by call."""
+    from core.engines.nystrom import CoupledPunches
+
+    formula = CoupledPunches._pressure
+    calls: list[int] = []
+
+    def counted(self, *args, **kwargs):
+        calls.append(args[0])
+        return formula(self, *args, **kwargs)
+
+    monkeypatch.setattr(CoupledPunches, "_pressure", counted)
+    return calls
+
+
+def test_kept_pressures_survive_more_point_sets_than_punches(monkeypatch) -> None:
+    """q asked at several other point sets of every punch between load changes does not
+    push the plotting grid out of the kept values (least recently used first, room for
+    all of them): the next load change still evaluates no formula."""
+    from core.cache import clear_caches
+
+    clear_caches()
+    for factor in (1.0, 1.01):
+        result = core.solve(_scaled_pair(factor))
+    for punch in result.punches:  # six more sets a punch, each evaluated part by part
+        for k in range(6):
+            punch.pressure(punch.scene.half_width * np.linspace(-0.9, 0.9, 11 + k))
+    calls = _count_formula(monkeypatch)
+    core.solve(_scaled_pair(1.02)).punches[1].pressure_on_grid  # noqa: B018
+    assert calls == []
+
+
+def test_a_set_too_large_to_keep_takes_the_formula_once(monkeypatch) -> None:
+    """Points times output times above the kept bound: q of a load change is the formula
+    on the summed answer (one evaluation a punch, not one a part of the sum), the same
+    answer as the sum of the kept parts' q."""
+    from core.cache import clear_caches
+    from core.engines.nystrom import multi
+
+    def third_change(calls: list[int]) -> list[np.ndarray]:
+        clear_caches()
+        for factor in (1.0, 1.01):
+            core.solve(_scaled_pair(factor))
+        calls.clear()
+        return [p.pressure_on_grid for p in core.solve(_scaled_pair(1.02)).punches]
+
+    calls = _count_formula(monkeypatch)
+    summed = third_change(calls)
+    assert calls == []
+    monkeypatch.setattr(multi, "PRESSURE_VALUES_KEPT", 10)
+    direct = third_change(calls)
+    assert sorted(calls) == [0, 1]
+    for grid, other in zip(summed, direct, strict=True):
+        # measured: 5.2e-15 and 8.5e-15 of q's largest value (shapes kept to 12 digits)
+        assert _relative(grid, other) < 1e-12
+
+
+def test_kept_responses_and_pressures_count_in_the_cache(monkeypatch) -> None:
+    """What a coupled discretization keeps after it was cached (time-stepped responses,
+    q at points) is measured again, so the cache's byte budget holds; its own bounds drop
+    the least recently used responses first."""
+    from core.cache import clear_caches
+    from core.engines.nystrom import COUPLED, multi
+
+    clear_caches()
+    core.solve(_scaled_pair(1.0))
+    (coupled,) = COUPLED.values()
+    held = coupled.nbytes
+    assert COUPLED.size_bytes == held
+    one_set = sum(part.nbytes for kept in coupled._responses.values() for part in kept)
+    monkeypatch.setattr(multi, "RESPONSES_BYTES", int(2.5 * one_set))
+    for k in range(5):  # other load histories: other responses
+        e = _scaled_pair(1.0)
+        e["punches"][1]["loading"]["force"] = {"kind": "ramp", "start": 1e5, "end": 3e5,
+                                                "duration": 10.0 + k}
+        core.solve(e)
+    assert len(coupled._responses) == 2
+    assert COUPLED.size_bytes == coupled.nbytes > held
+
+
 def test_far_apart_punches_age_as_single_punches() -> None:
     young = scene_file("young_concrete_50_years")
     d = _creeping(_pair(60.0, tol=1e-4), young["base"]["creep"])

@@ -64,10 +64,12 @@ coupling and :func:`interacting` pairs.
 
 from __future__ import annotations
 
+import itertools
 import threading
 import time as _time
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -95,25 +97,36 @@ from core.problem import QUANTITIES, ContactSolution, Geometry, TimeInputs
 @dataclass
 class _Part:
     """One time-stepped response of the coupled system (to one given load's shape, or to
-    the gaps: ``gap`` 1), with q at each punch's check points (``checks``) and q at points
-    asked for before (``pressures``, by punch, points and output columns; the plotting
-    grid of a load change is then a weighted sum instead of the Nystrom formula)."""
+    the gaps: ``gap`` 1), with q at each punch's check points (``checks``); ``serial``
+    names it among the q kept at points asked for before (see
+    :meth:`CoupledPunches._summed_pressure`)."""
 
     response: CoupledModalAnswer
     gap: float
     checks: list[np.ndarray]
-    pressures: dict[tuple, np.ndarray]
+    serial: int = field(default_factory=lambda: next(_SERIALS))
+
+    @property
+    def nbytes(self) -> int:
+        """Memory of the response and its checks [bytes]."""
+        r = self.response
+        return int(r.nodal.nbytes + r.effective.nbytes + sum(c.nbytes for c in self.checks)
+                   + sum(v.nbytes for s in r.scalars for v in s.values()))
 
 
-#: Sets of points per response whose q is kept (:class:`_Part`), and the most values
-#: (points times output times) a kept one may hold, 2 MiB (the plotting grid's 201 points
-#: at up to 1300 output times; larger requests are computed each time).
-PRESSURES_KEPT = 4
+_SERIALS = itertools.count()
+
+#: The most values (points times output times) of one part's q at a set of points that
+#: are kept (2 MiB: the plotting grid's 201 points at up to 1300 output times; a larger
+#: request takes the Nystrom formula on the summed answer each time), and the bytes all
+#: kept values of one set of punches may hold (least recently used dropped first).
 PRESSURE_VALUES_KEPT = 2**18
+PRESSURES_BYTES = 32 * 2**20
 
-#: Time-stepped responses of the coupled system kept per set of punches (as one punch
-#: keeps 24 of its own): a load slider alternates among a few shapes.
+#: Time-stepped responses of the coupled system kept per set of punches, at most this many
+#: sets (a load slider alternates among a few shapes) and this many bytes.
 RESPONSES_KEPT = 24
+RESPONSES_BYTES = 64 * 2**20
 
 
 @dataclass
@@ -227,7 +240,11 @@ class CoupledPunches:
         # bordered systems (LU, unit responses, names) and modal forms, by statements
         self._systems: dict[tuple, Any] = {}
         # time-stepped responses to each load shape and the gap, by their joint key
-        self._responses: dict[tuple, list[Any]] = {}
+        self._responses: dict[tuple, list[_Part]] = {}
+        # q of the kept parts at points asked for before: (part's serial, punch, points,
+        # output columns) -> (X, T), least recently used first
+        self._pressures: OrderedDict[tuple, np.ndarray] = OrderedDict()
+        self._pressure_bytes = 0
         #: what the solves built: time-stepped responses of the coupled system
         self.counts = {"time_response": 0}
         self._lock = threading.Lock()
@@ -276,11 +293,9 @@ class CoupledPunches:
                       for key, entry in self._systems.items() if key[0] != "modal")
         modal = sum(3 * entry.q.nbytes for key, entry in self._systems.items()
                     if key[0] == "modal")
-        responses = sum(part.response.nodal.nbytes + part.response.effective.nbytes
-                        + sum(c.nbytes for c in part.checks)
-                        + sum(q.nbytes for q in list(part.pressures.values()))
-                        for found in list(self._responses.values()) for part in found)
-        return int(blocks + systems + modal + responses)
+        responses = sum(part.nbytes for found in list(self._responses.values())
+                        for part in found)
+        return int(blocks + systems + modal + responses + self._pressure_bytes)
 
     @property
     def size(self) -> int:
@@ -440,9 +455,10 @@ class CoupledPunches:
             coupling = self._coupling_at_nodes(p, effective[:, at])
             q_extremes = (float(checks[p].min()), float(np.max(np.abs(checks[p]))))
             out = {k: v[at] for k, v in scalars.items()}
-            pressure = (self._pressure_function(p, nodal[lo:hi, at], effective[lo:hi, at],
-                                                coupling, out, c_probe[at]) if terms is None
-                        else self._summed_pressure(p, terms, at, c_probe[at]))
+            pressure = self._pressure_function(p, nodal[lo:hi, at], effective[lo:hi, at],
+                                               coupling, out, c_probe[at])
+            if terms is not None:
+                pressure = self._summed_pressure(p, terms, at, c_probe[at], pressure)
             built = dict(prepared.counts)
             solution = nystrom_solution(
                 prepared, inputs[p], out, pressure, q_extremes, time_sides[p],
@@ -503,19 +519,28 @@ class CoupledPunches:
             parts.append((1.0, (common, "gap"), quiet(), 1.0))
         joint_key = (identity, *(key for _, key, _, _ in parts))
         with self._lock:
-            found = self._responses.get(joint_key)
+            found = self._responses.pop(joint_key, None)
+            if found is not None:  # used last: dropped last
+                self._responses[joint_key] = found
         reused = found is not None
         if found is None:
             responses = form.solve_parts([(loads, gap) for _, _, loads, gap in parts], times,
                                          c, kernel, time_tol, breaks)
             # q >= 0 is checked on the sum: each response's checks, summed like the answer
-            found = [_Part(r, gap, self._checks(r, gap, c_t), {})
+            found = [_Part(r, gap, self._checks(r, gap, c_t))
                      for r, (_, _, _, gap) in zip(responses, parts, strict=True)]
             with self._lock:
                 self.counts["time_response"] += len(found)
                 self._responses[joint_key] = found
-                while len(self._responses) > RESPONSES_KEPT:
-                    self._responses.pop(next(iter(self._responses)))
+                while len(self._responses) > 1 and (
+                        len(self._responses) > RESPONSES_KEPT
+                        or sum(part.nbytes for kept in self._responses.values()
+                               for part in kept) > RESPONSES_BYTES):
+                    dropped = {part.serial for part in
+                               self._responses.pop(next(iter(self._responses)))}
+                    for key in [k for k in self._pressures if k[0] in dropped]:
+                        self._pressure_bytes -= self._pressures.pop(key).nbytes
+            COUPLED.resize(self)  # the kept responses count in the cache's budget
         weights = [weight for weight, _, _, _ in parts]
         checks = [sum(w * part.checks[p] for w, part in zip(weights, found, strict=True))
                   for p in range(len(inputs))]
@@ -626,14 +651,20 @@ class CoupledPunches:
         return out
 
     def _summed_pressure(self, p: int, terms: list[tuple[float, _Part]], at: np.ndarray,
-                         c: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+                         c: np.ndarray, direct: Callable[[np.ndarray], np.ndarray]
+                         ) -> Callable[[np.ndarray], np.ndarray]:
         """q of zone ``p`` at points ``x`` over the output columns ``at`` of the stepped
         times: the weighted sum of each response's q there (the Nystrom formula is linear
-        in the response and the gap), each kept with its response for up to
-        :data:`PRESSURES_KEPT` sets of at most :data:`PRESSURE_VALUES_KEPT` values, so
-        that a load change reads the plotting grid as a sum. ``c`` (T,): c at those
-        columns."""
+        in the response and the gap), each kept for later load changes (at most
+        :data:`PRESSURE_VALUES_KEPT` values a set, :data:`PRESSURES_BYTES` in all, least
+        recently used dropped first), so that a load change reads the plotting grid as a
+        sum. A set too large to keep takes ``direct`` (the formula on the summed answer:
+        one evaluation, not one a part). ``c`` (T,): c at those columns."""
         lo, hi = self.offsets[p], self.offsets[p + 1]
+        geometry = self.prepared[p].geometry
+        # the gap's weight in the sum: 1 unless no part carries the gap (its values at the
+        # nodes all zero), when -g/(c m) between the nodes is added to the sum
+        missing_gap = 1.0 - sum(weight * part.gap for weight, part in terms)
 
         def part_pressure(part: _Part, x: np.ndarray) -> np.ndarray:
             r = part.response
@@ -644,20 +675,31 @@ class CoupledPunches:
 
         def pressure(x: np.ndarray) -> np.ndarray:
             x = np.ascontiguousarray(x, dtype=float)
-            key = (p, x.tobytes(), at.tobytes())
-            keep = x.size * at.size <= PRESSURE_VALUES_KEPT
+            if x.size * at.size > PRESSURE_VALUES_KEPT:
+                return direct(x)
+            place = (p, x.tobytes(), at.tobytes())
             total = np.zeros((x.size, at.size))
+            grown = False
             for weight, part in terms:
+                key = (part.serial, *place)
                 with self._lock:
-                    q = part.pressures.get(key) if keep else None
+                    q = self._pressures.get(key)
+                    if q is not None:
+                        self._pressures.move_to_end(key)
                 if q is None:
                     q = part_pressure(part, x)
-                    if keep:
-                        with self._lock:
-                            part.pressures[key] = q
-                            while len(part.pressures) > PRESSURES_KEPT:
-                                part.pressures.pop(next(iter(part.pressures)))
+                    with self._lock:
+                        if key not in self._pressures:
+                            self._pressures[key] = q
+                            self._pressure_bytes += q.nbytes
+                            grown = True
+                        while self._pressure_bytes > PRESSURES_BYTES:
+                            self._pressure_bytes -= self._pressures.popitem(last=False)[1].nbytes
                 total += weight * q
+            if grown:
+                COUPLED.resize(self)
+            if missing_gap != 0.0:
+                total -= missing_gap * (geometry.g(x) / geometry.m(x))[:, None] / c[None, :]
             return total
 
         return pressure
