@@ -72,12 +72,11 @@ LEVEL_RATIO = 16.0
 SAFETY = 3.0
 #: The coarser grid of the last two-level comparison carries the answer when its own
 #: estimate (``SAFETY`` times the difference, plus the finer grid's error) is below this
-#: share of the target: the rest is the time stepping's. Measured on the ten scenes of
-#: the work-precision suite at tol 1e-3 and 1e-4 against tol 1e-11 (q on [-1, 1], edges
-#: and both sides of jumps included, and the four scalars): 9 of 10 answer on the coarser
-#: grid (stepped punch 288 -> 192 nodes, smooth 128 -> 96), errors 1.4e-6 to 7.2e-6
-#: under estimates 3.2-9.7 times larger; the patched-insert preset (tol 1e-5) 192 nodes
-#: instead of 288, error 1.8e-7 under 1.4e-6.
+#: share of the target: under creep the rest is the time stepping's. Measured on the
+#: eight scenes of ``benchmarks/engines.py`` at tol 1e-3 and 1e-4 against tol 1e-10 (q
+#: on [-1, 1], edges and both sides of jumps included, and the four scalars;
+#: benchmarks/results/engines.md): errors 1.5e-6 to 2.1e-4 under estimates 2.9 to 5.9
+#: times larger (stepped punch 288 -> 192 nodes, smooth coating 128 -> 96).
 COARSE_SHARE = 0.5
 #: Relative round-off floor of the pressure (measured: ~1e-13 against the projection).
 ROUND_OFF = 2e-13
