@@ -250,6 +250,64 @@ class StageCache:
         return len(self._data)
 
 
+class KeptValues:
+    """What one object keeps for its own later use (the time-stepped responses of a
+    prepared geometry, q at points asked for before), least recently used first, bounded
+    in items and bytes; the newest value is always kept. Not shared across the process
+    (no registry, no counters) and not locked: its owner holds its own lock around it."""
+
+    def __init__(self, max_items: int, max_bytes: int,
+                 sizeof: Callable[[Any], int] | None = None) -> None:
+        self.max_items = max_items
+        self.max_bytes = max_bytes
+        self._sizeof = sizeof or _nbytes
+        self._data: OrderedDict[Hashable, tuple[Any, int]] = OrderedDict()
+        self.nbytes = 0
+
+    def get(self, key: Hashable) -> Any | None:
+        """The value kept for ``key`` (now the most recently used), or None."""
+        entry = self._data.get(key)
+        if entry is None:
+            return None
+        self._data.move_to_end(key)
+        return entry[0]
+
+    def put(self, key: Hashable, value: Any) -> list[Any]:
+        """Keep ``value`` under ``key``; the values dropped to stay within the bounds."""
+        old = self._data.pop(key, None)
+        if old is not None:
+            self.nbytes -= old[1]
+        size = int(self._sizeof(value))
+        self._data[key] = (value, size)
+        self.nbytes += size
+        dropped = []
+        while len(self._data) > 1 and (len(self._data) > self.max_items
+                                       or self.nbytes > self.max_bytes):
+            _, (gone, gone_size) = self._data.popitem(last=False)
+            self.nbytes -= gone_size
+            dropped.append(gone)
+        return dropped
+
+    def drop(self, keep: Callable[[Hashable], bool]) -> None:
+        """Drop every value whose key ``keep`` refuses."""
+        for key in [k for k in self._data if not keep(k)]:
+            self.nbytes -= self._data.pop(key)[1]
+
+    def values(self) -> list[Any]:
+        """The values kept, least recently used first."""
+        return [value for value, _ in self._data.values()]
+
+    def clear(self) -> None:
+        self._data.clear()
+        self.nbytes = 0
+
+    def __contains__(self, key: Hashable) -> bool:
+        return key in self._data
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+
 def stage_counts() -> dict[str, int]:
     """Number of real evaluations of every stage since start (cache hits not counted)."""
     with _REGISTRY_LOCK:

@@ -193,3 +193,20 @@ def test_a_prepared_geometrys_kept_responses_count_in_its_size():
     solve_with_prepared(2.0, 1.0, 0.0, times, kernel=kernel,
                         force=lambda t: 1.0 + 0.1 * t, moment=0.0, tol=1e-6)
     assert prepared.nbytes > before and PREPARED.size_bytes == prepared.nbytes
+
+
+def test_kept_values_drop_the_least_recently_used_and_keep_the_newest():
+    """An object's own kept values (responses of a prepared geometry): bounded in items
+    and bytes, a read refreshes a value, the newest is kept even above the bound."""
+    from core.cache import KeptValues
+
+    kept = KeptValues(max_items=3, max_bytes=100, sizeof=len)
+    for key in "abc":
+        assert kept.put(key, key * 30) == []
+    assert kept.get("a") == "a" * 30           # now the most recently used
+    assert kept.put("d", "d" * 30) == ["b" * 30]  # four items: the oldest goes
+    assert kept.nbytes == 90 and "a" in kept and "b" not in kept
+    assert kept.put("e", "e" * 200) == ["c" * 30, "a" * 30, "d" * 30]
+    assert kept.values() == ["e" * 200] and kept.nbytes == 200
+    kept.drop(lambda key: key != "e")
+    assert len(kept) == 0 and kept.nbytes == 0

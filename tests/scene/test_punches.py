@@ -370,15 +370,15 @@ def test_kept_responses_and_pressures_count_in_the_cache(monkeypatch) -> None:
     q at points) is measured again, so the cache's byte budget holds; its own bounds drop
     the least recently used responses first."""
     from core.cache import clear_caches
-    from core.engines.nystrom import COUPLED, multi
+    from core.engines.nystrom import COUPLED
 
     clear_caches()
     core.solve(_scaled_pair(1.0))
     (coupled,) = COUPLED.values()
     held = coupled.nbytes
     assert COUPLED.size_bytes == held
-    one_set = sum(part.nbytes for kept in coupled._responses.values() for part in kept)
-    monkeypatch.setattr(multi, "RESPONSES_BYTES", int(2.5 * one_set))
+    one_set = coupled._responses.nbytes
+    monkeypatch.setattr(coupled._responses, "max_bytes", int(2.5 * one_set))
     for k in range(5):  # other load histories: other responses
         e = _scaled_pair(1.0)
         e["punches"][1]["loading"]["force"] = {"kind": "ramp", "start": 1e5, "end": 3e5,

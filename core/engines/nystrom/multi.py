@@ -67,7 +67,6 @@ from __future__ import annotations
 import itertools
 import threading
 import time as _time
-from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -75,7 +74,7 @@ from typing import Any
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 
-from core.cache import StageCache, content_key, fingerprint
+from core.cache import KeptValues, StageCache, content_key, fingerprint
 from core.creep import stepping_kernel
 from core.discretize import panel_index
 from core.engines.nystrom.adapt import LEVEL_SPLIT, MAX_PANELS, grade
@@ -240,11 +239,11 @@ class CoupledPunches:
         # bordered systems (LU, unit responses, names) and modal forms, by statements
         self._systems: dict[tuple, Any] = {}
         # time-stepped responses to each load shape and the gap, by their joint key
-        self._responses: dict[tuple, list[_Part]] = {}
+        self._responses = KeptValues(RESPONSES_KEPT, RESPONSES_BYTES,
+                                     lambda parts: sum(part.nbytes for part in parts))
         # q of the kept parts at points asked for before: (part's serial, punch, points,
-        # output columns) -> (X, T), least recently used first
-        self._pressures: OrderedDict[tuple, np.ndarray] = OrderedDict()
-        self._pressure_bytes = 0
+        # output columns) -> (X, T)
+        self._pressures = KeptValues(2**31, PRESSURES_BYTES)
         #: what the solves built: time-stepped responses of the coupled system
         self.counts = {"time_response": 0}
         self._lock = threading.Lock()
@@ -293,9 +292,7 @@ class CoupledPunches:
                       for key, entry in self._systems.items() if key[0] != "modal")
         modal = sum(3 * entry.q.nbytes for key, entry in self._systems.items()
                     if key[0] == "modal")
-        responses = sum(part.nbytes for found in list(self._responses.values())
-                        for part in found)
-        return int(blocks + systems + modal + responses + self._pressure_bytes)
+        return int(blocks + systems + modal + self._responses.nbytes + self._pressures.nbytes)
 
     @property
     def size(self) -> int:
@@ -519,9 +516,7 @@ class CoupledPunches:
             parts.append((1.0, (common, "gap"), quiet(), 1.0))
         joint_key = (identity, *(key for _, key, _, _ in parts))
         with self._lock:
-            found = self._responses.pop(joint_key, None)
-            if found is not None:  # used last: dropped last
-                self._responses[joint_key] = found
+            found = self._responses.get(joint_key)
         reused = found is not None
         if found is None:
             responses = form.solve_parts([(loads, gap) for _, _, loads, gap in parts], times,
@@ -531,15 +526,10 @@ class CoupledPunches:
                      for r, (_, _, _, gap) in zip(responses, parts, strict=True)]
             with self._lock:
                 self.counts["time_response"] += len(found)
-                self._responses[joint_key] = found
-                while len(self._responses) > 1 and (
-                        len(self._responses) > RESPONSES_KEPT
-                        or sum(part.nbytes for kept in self._responses.values()
-                               for part in kept) > RESPONSES_BYTES):
-                    dropped = {part.serial for part in
-                               self._responses.pop(next(iter(self._responses)))}
-                    for key in [k for k in self._pressures if k[0] in dropped]:
-                        self._pressure_bytes -= self._pressures.pop(key).nbytes
+                dropped = {part.serial for parts in self._responses.put(joint_key, found)
+                           for part in parts}
+                if dropped:  # their q at points goes with them
+                    self._pressures.drop(lambda key: key[0] not in dropped)
             COUPLED.resize(self)  # the kept responses count in the cache's budget
         weights = [weight for weight, _, _, _ in parts]
         checks = [sum(w * part.checks[p] for w, part in zip(weights, found, strict=True))
@@ -684,17 +674,11 @@ class CoupledPunches:
                 key = (part.serial, *place)
                 with self._lock:
                     q = self._pressures.get(key)
-                    if q is not None:
-                        self._pressures.move_to_end(key)
                 if q is None:
                     q = part_pressure(part, x)
                     with self._lock:
-                        if key not in self._pressures:
-                            self._pressures[key] = q
-                            self._pressure_bytes += q.nbytes
-                            grown = True
-                        while self._pressure_bytes > PRESSURES_BYTES:
-                            self._pressure_bytes -= self._pressures.popitem(last=False)[1].nbytes
+                        self._pressures.put(key, q)
+                    grown = True
                 total += weight * q
             if grown:
                 COUPLED.resize(self)

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from core.cache import StageCache, content_key, fingerprint
+from core.cache import KeptValues, StageCache, content_key, fingerprint
 from core.creep import integrated_kernel, stepping_kernel
 from core.discretize import NODES_PER_PANEL, interpolation_weights, panel_index
 from core.engines.nystrom.adapt import adapt
@@ -153,8 +153,8 @@ class PreparedContact:
         self._modal: dict[frozenset[str], ModalForm] = {}
         self._rows: dict[bytes, np.ndarray] = {}
         self._elastic: dict[tuple, ElasticUnits] = {}
-        self._responses: dict[tuple, list[tuple[ModalAnswer, np.ndarray]]] = {}
-        self._response_bytes: dict[tuple, int] = {}
+        # time-stepped responses of each joint key: [(answer, q at the check points)]
+        self._responses = KeptValues(RESPONSES_KEPT, RESPONSES_BYTES, _responses_nbytes)
         self.check_x = _check_points(geometry.breakpoints)
         # Check points on panels ending at +-1 or a jump take the Nystrom formula (q has
         # (x - e) ln|x - e| terms there); elsewhere q is analytic and its panel interpolant
@@ -261,7 +261,7 @@ class PreparedContact:
         total += sum(r.nbytes for r in self._rows.values())
         total += sum(2 * self.grid.operator.nbytes for _ in self._bordered)
         total += sum(3 * self.grid.operator.nbytes for _ in self._modal)
-        total += sum(self._response_bytes.values())
+        total += self._responses.nbytes
         return int(total)
 
     # --------------------------------------------------------------------- solve
@@ -371,9 +371,7 @@ class PreparedContact:
         # on which parts happened to be cached before.
         joint_key = (identity, *(key for _, key, _, _ in parts))
         with self._lock:
-            found = self._responses.pop(joint_key, None)
-            if found is not None:  # used last: dropped last
-                self._responses[joint_key] = found
+            found = self._responses.get(joint_key)
         if found is None:
             answers = form.solve_parts(times, inputs.c, kernel,
                                        [(loads, gap) for _, _, loads, gap in parts],
@@ -381,18 +379,8 @@ class PreparedContact:
             found = [(response, self._check_pressure(response, gap, c_t))
                      for (_, _, _, gap), response in zip(parts, answers, strict=True)]
             self.counts["time_response"] += len(found)
-            size = sum(sum(a.nbytes for a in response.modal_effective) + check.nbytes
-                       + sum(v.nbytes for v in response.scalars.values())
-                       for response, check in found)
             with self._lock:
-                self._responses[joint_key] = found
-                self._response_bytes[joint_key] = size
-                while len(self._responses) > 1 and (
-                        len(self._responses) > RESPONSES_KEPT
-                        or sum(self._response_bytes.values()) > RESPONSES_BYTES):
-                    dropped = next(iter(self._responses))
-                    self._responses.pop(dropped)
-                    self._response_bytes.pop(dropped)
+                self._responses.put(joint_key, found)
             PREPARED.resize(self)  # the kept responses count in the cache's budget
         for (weight, _, _, _), (response, _) in zip(parts, found, strict=True):
             terms.append((weight, response))
@@ -498,6 +486,13 @@ def geometry_key(geometry: Geometry) -> str:
     _GEOMETRY_KEYS[id(geometry)] = (weakref.ref(geometry), key)
     weakref.finalize(geometry, _GEOMETRY_KEYS.pop, id(geometry), None)
     return key
+
+
+def _responses_nbytes(found: list[tuple[ModalAnswer, np.ndarray]]) -> int:
+    """Memory of one set of kept time-stepped responses and their checks [bytes] (their
+    modes' basis is the modal form's)."""
+    return sum(sum(a.nbytes for a in response.modal_effective) + check.nbytes
+               + sum(v.nbytes for v in response.scalars.values()) for response, check in found)
 
 
 #: :func:`geometry_key`'s keys of the geometry objects alive: id -> (weak reference, key).
