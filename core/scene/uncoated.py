@@ -7,7 +7,8 @@ solves the bare layer exactly, inverse square-root corners included (a creeping 
 base by scalar Volterra equations in time, :mod:`core.engines.layered.bare_creep`). It
 answers full contact under a smooth punch, and a punch lifting off
 (:mod:`core.engines.layered.bare_lift_off`; on a base that creeps or ages while the zone
-does not recede, :mod:`core.engines.layered.bare_growing_zone`); :func:`check_uncoated` refuses
+only grows, or only recedes under a flat punch with force and moment given,
+:mod:`core.engines.layered.bare_growing_zone`); :func:`check_uncoated` refuses
 the rest when the scene is read, naming the field and the reason, and
 :func:`lift_off_refusal` words the refusal of a punch that lifts off where that is not
 answered (known only once solved).
@@ -25,8 +26,9 @@ __all__ = ["check_uncoated", "lift_off_refusal", "UNCOATED_SCOPE"]
 UNCOATED_SCOPE = ("a scene with no coating layers is solved under a punch shape without "
                   "jumps or kinks; on a base that creeps or ages it lifts off where its "
                   "contact zone keeps its size or grows (a flat punch under given loads that "
-                  "keep their ratio, a crown pressed as the base creeps), not where the zone "
-                  "recedes, for now")
+                  "keep their ratio, a crown pressed as the base creeps), or only recedes "
+                  "under a flat punch with force and moment given (a growing eccentricity), "
+                  "not where the zone grows and recedes or recedes otherwise, for now")
 
 
 def check_uncoated(scene: Any) -> None:
@@ -53,6 +55,7 @@ def lift_off_refusal(scene: Any) -> str:
     creeps or ages where that is not answered (``scene`` is not read: one wording)."""
     return ("loading: the punch lifts off the bare base on a base that creeps or ages, and its "
             "contact zone would recede as the base creeps (a point that touched would leave "
-            "the punch); "
+            "the punch) where that is not answered; "
             f"{UNCOATED_SCOPE}: set solver.contact to 'full' for the full-contact answer "
-            "(flagged contact_lost), keep the eccentricity constant, or add a coating layer")
+            "(flagged contact_lost), give force and moment on a flat punch with an "
+            "eccentricity that only grows or only shrinks, or add a coating layer")

@@ -231,11 +231,78 @@ def test_an_aging_bare_base_lifting_off_settles_like_its_creep_function():
         assert np.max(np.abs(values / values[0] / law - 1)) < 1e-7, name
 
 
-def test_a_creeping_bare_base_whose_zone_would_recede_is_refused():
-    # the eccentricity grows in time: the heel lifts further as the base creeps, and the
-    # points it leaves keep a pressure history no elastic zone carries (not solved yet)
-    moving = _creeping({"force": 5e5, "moment": {"kind": "linear", "start": 3e5,
-                                                 "end": 4e5}})
+def _receding_reference(result) -> dict[str, np.ndarray]:
+    """Settlement* and tilt of a flat punch whose zone only recedes on a creeping bare
+    base under smooth given loads, computed apart from the solver's time grids: ``(I - V)``
+    of the elastic kinematics of the given loads, these interpolated through 17 Chebyshev
+    times (elastic lift-off solves at tol 1e-10; smooth in time, so spectrally), ``V`` by
+    composite 16-point Gauss-Legendre on 24 panels with the scene's exact kernel."""
+    scene = result.scene
+    problem = scene.dimensionless
+    base = (scene.base_thickness, problem.modulus_at_loading, scene.base_poisson)
+    times = np.asarray(problem.times, dtype=float)
+    first, last = float(times[0]), float(times[-1])
+    chebyshev = np.polynomial.chebyshev
+    samples = 0.5 * (first + last) + 0.5 * (last - first) * np.cos(np.pi * np.arange(17) / 16)
+    given = {n: np.ravel(problem.loads[n](samples) if callable(problem.loads[n]) else
+                         np.full(samples.shape, problem.loads[n])) for n in ("force", "moment")}
+    zones = bare_lift_off(scene.half_width, base, None, given, np.full(samples.size, -1), 32,
+                          1e-10)
+    fits = {n: chebyshev.Chebyshev.fit(samples, zones.quantity(n), 16, domain=[first, last])
+            for n in ("settlement", "tilt")}
+    nodes, weights = np.polynomial.legendre.leggauss(16)
+    out = {n: fits[n](times) for n in fits}
+    for k, t in enumerate(times[1:], start=1):
+        edges = np.linspace(first, t, 25)
+        for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+            tau = 0.5 * (lo + hi) + 0.5 * (hi - lo) * nodes
+            kernel = np.array([problem.kernel(t, node) for node in tau], dtype=float).ravel()
+            for n in out:
+                out[n][k] -= 0.5 * (hi - lo) * np.sum(weights * kernel * fits[n](tau))
+    return out
+
+
+def test_a_flat_punch_whose_eccentricity_grows_on_a_creeping_bare_base_keeps_the_elastic_pressure():
+    """The eccentricity grows (a moment ramp): the heel lifts further as the base creeps.
+    Under given force and moment the pressure is then the elastic one
+    of the loads at each time (the zone only recedes: every point in it has touched since
+    loading), and the settlement and tilt are the elastic ones crept, ``(I - V)`` of their
+    histories (core/engines/layered/bare_growing_zone.py). Measured against
+    :func:`_receding_reference` at tol 1e-6 (adaptive quadrature of the same gave 1.0e-8):
+    settlement and tilt relative to their largest under the estimate (2.2e-8); q and the
+    zone ends to 1e-12."""
+    d = _creeping({"force": 5e5, "moment": {"kind": "linear", "start": 3e5, "end": 4e5}})
+    d["times"]["count"] = 8
+    result = solve(d)
+    assert result.flags == [] and result.info["contact"] == "unilateral"
+    lows = np.array([zones[0][0] for zones in result.contact_set])
+    assert np.all(np.diff(lows) >= 0) and lows[-1] > lows[0] + 0.1
+    reference = _receding_reference(result)
+    a = result.scene.half_width
+    got = {"settlement": result.settlement / a, "tilt": result.tilt}
+    size = max(np.max(np.abs(v)) for v in reference.values())
+    error = max(np.max(np.abs(got[n] - reference[n])) for n in got) / size
+    assert error <= result.info["error_estimate"], (error, result.info["error_estimate"])
+    # q and the zone at each time: the elastic answer of the loads of that time
+    for k in (0, result.times.size // 2, -1):
+        elastic = copy.deepcopy(d)
+        modulus = float(np.asarray(result.scene.creep.modulus(result.scene.age_at_loading)))
+        elastic["base"]["creep"] = {"model": "elastic", "modulus": modulus}
+        elastic["loading"] = {"force": 5e5, "moment": float(result.moment[k])}
+        elastic["times"] = {"end": 1.0, "count": 1}
+        alone = solve(elastic)
+        assert alone.contact_set[0][0][0] == pytest.approx(lows[k], abs=1e-12)
+        x = np.linspace(lows[k], a, 9)[1:-1]
+        assert np.max(np.abs(result.pressure(x)[:, k] - alone.pressure(x)[:, 0])) < 1e-12 * \
+            np.max(np.abs(alone.pressure(x)))
+
+
+def test_a_creeping_bare_base_whose_zone_would_grow_and_recede_is_refused():
+    # the eccentricity grows, then shrinks: the points the heel left and then reaches again
+    # keep a pressure history no elastic zone carries (Ting's problem; not solved yet)
+    moving = _creeping({"force": 5e5, "moment": {
+        "kind": "table", "points": [[0.0, 3e5], [100.0, 4e5], [365.0, 3e5]],
+        "interpolation": "linear"}})
     with pytest.raises(ValueError, match=r"^loading: the punch lifts off the bare base "
                                          r"on a base that creeps or ages, and its contact "
                                          r"zone would recede"):

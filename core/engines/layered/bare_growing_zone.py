@@ -10,7 +10,18 @@ stays in contact, ``q* = (I - V)^-1 Q`` vanishes where ``Q`` always did, and the
 that of the elastic zones in turn (Graham's theorem for a contact zone that does not
 shrink; the hereditary integral of Lee and Radok for a growing Hertz contact). A zone
 that recedes (the heel lifting further as the base creeps) breaks it: the points left
-behind keep a pressure history the elastic zones do not carry, and that answer is refused.
+behind keep a pressure history the elastic zones do not carry.
+
+A flat punch (``g* = 0``) under given force and moment whose zone only recedes is the
+other side of the same symmetry: ``q*(., t)`` is then the elastic pressure of the given
+``P*(t)``, ``M*(t)`` themselves. On the zone at ``t`` every point has touched since
+loading, so there ``(I - V) F q* = (I - V) delta_e + x (I - V) alpha_e`` (the elastic
+kinematics' histories crept: the settlement and tilt); outside it the gap is ``(I - V)``
+of the elastic gaps, ``g_e(t) - int K g_e``, which stays >= 0 where ``K <= 0`` (a base
+that creeps: checked on the grid, else refused). No pressure is then integrated in time;
+only the kinematics are, as below. A zone that grows and later recedes, or recedes under
+given kinematics or a curved punch, is refused (Ting's problem: the answer depends on when
+each point was left).
 
 In time: the grids of :func:`core.time.time_grid` (every output time a
 grid point), one elastic lift-off solve per grid point. ``V`` of a kernel ``b(tau) + sum_r
@@ -41,7 +52,7 @@ from core.engines.layered.bare_lift_off import BareLiftOff, bare_lift_off
 from core.engines.layered.solve import ERROR_FLOOR, LayeredResponse
 from core.time import exponential_moments, time_grid
 
-__all__ = ["GrowingZone", "RECEDES", "solve_growing_zone"]
+__all__ = ["GrowingZone", "RECEDES", "RELEASES", "solve_growing_zone"]
 
 #: Nominal steps of the first time grid (every output time is a grid point as well).
 FIRST_STEPS = 16
@@ -57,7 +68,11 @@ RECEDE_SLACK = 1e-9
 JUMP_STEP = 1e-9
 #: Why a growing-zone answer was not given.
 RECEDES = ("the contact zone would recede as the base creeps (a point that touched "
-           "leaves the punch): the bare base's creep is solved while the zone only grows")
+           "leaves the punch): the bare base's creep is solved while the zone only grows, "
+           "or, for a flat punch under given force and moment, only recedes")
+#: Why a zone that only recedes was not given (the kernel releases creep somewhere).
+RELEASES = ("the creep kernel K(t, tau) is positive somewhere on the time grid: a receding "
+            "zone's lifted points could close onto the punch again")
 
 _NAMES = ("settlement", "tilt", "force", "moment")
 _STATIC = ("force", "moment")
@@ -272,8 +287,8 @@ def _relaxed(grid: np.ndarray, parts: tuple[np.ndarray, np.ndarray], values: np.
 @dataclass(frozen=True)
 class _Grid:
     """One time grid's answer: the grid, ``A = I - V`` on it, the kernel's parts on it
-    (None: not a sum of exponentials), the elastic zones at its points and the four
-    histories on it."""
+    (None: not a sum of exponentials), the elastic zones at its points, the four
+    histories on it, and whether the zone recedes (its q* the elastic one)."""
 
     grid: np.ndarray
     index: np.ndarray
@@ -281,11 +296,14 @@ class _Grid:
     parts: tuple[np.ndarray, np.ndarray] | None
     lifted: BareLiftOff
     histories: dict[str, np.ndarray]
+    receding: bool = False
 
     def pressure(self, x: np.ndarray, corner: float) -> np.ndarray:
         """q* at ``x`` on every grid point (len(x), grid): ``(I - V)^-1`` of the elastic
-        zones' pressures, point by point (:func:`_relaxed`)."""
+        zones' pressures, point by point (:func:`_relaxed`); a receding zone's own."""
         q_elastic = self.lifted.pressure(x, corner)
+        if self.receding:
+            return q_elastic
         if self.parts is None:
             return solve_triangular(self.relax, q_elastic.T, lower=True).T
         lo = np.array([z.lo for z in self.lifted.zones])
@@ -298,36 +316,52 @@ class _Grid:
 def _on_grid(half_width: float, base: tuple[float, float, float], gap: Any, kernel: Any,
              loads: dict[str, Any], response: LayeredResponse, grid: np.ndarray,
              index: np.ndarray, modes: int, tol: float, share: float,
-             solved: dict[tuple, Any]) -> _Grid:
-    relax = np.eye(grid.size) - _volterra(kernel, grid)
+             solved: dict[tuple, Any], receding: bool = False) -> _Grid:
+    volterra = _volterra(kernel, grid)
+    relax = np.eye(grid.size) - volterra
+    if receding and np.any(volterra > RECEDE_SLACK * np.max(np.abs(volterra), initial=0.0)):
+        raise ValueError(RELEASES)
     given = {}
     for name, load in loads.items():
         values = np.broadcast_to(np.asarray(load(grid) if callable(load) else load,
                                             dtype=float), grid.shape)
-        # the force and moment of Q = (I - V) q*; the kinematics as they are
-        given[name] = relax @ values if name in _STATIC else np.array(values)
+        # growing: the force and moment of Q = (I - V) q*, the kinematics as they are;
+        # receding: q* is the elastic answer of the given loads themselves
+        given[name] = relax @ values if name in _STATIC and not receding else np.array(values)
     free = _free_corners(response, given, share)
     lifted = bare_lift_off(half_width, base, gap, given, free, modes, tol, solved=solved)
-    _check_growing(lifted, free)
+    _check_monotone(lifted, receding)
     histories = {}
     for name in _NAMES:
         if name in loads:
             histories[name] = np.broadcast_to(np.asarray(
                 loads[name](grid) if callable(loads[name]) else loads[name], dtype=float),
                 grid.shape).copy()
+        elif receding:  # the elastic kinematics crept: delta* = (I - V) delta_e
+            histories[name] = relax @ lifted.quantity(name)
         elif name in _STATIC:  # P* = (I - V)^-1 P_Q
             histories[name] = solve_triangular(relax, lifted.quantity(name), lower=True)
         else:
             histories[name] = lifted.quantity(name)
-    return _Grid(grid, index, relax, _kernel_parts(kernel, grid), lifted, histories)
+    return _Grid(grid, index, relax, _kernel_parts(kernel, grid), lifted, histories,
+                 receding)
 
 
-def _check_growing(lifted: BareLiftOff, free: np.ndarray) -> None:
-    """Refuse (ValueError) a zone that recedes from one grid point to the next."""
+def _check_monotone(lifted: BareLiftOff, receding: bool) -> None:
+    """Refuse (ValueError) a zone that recedes from one grid point to the next (that grows,
+    when ``receding``)."""
     lo = np.array([z.lo for z in lifted.zones])
     hi = np.array([z.hi for z in lifted.zones])
-    if np.any(np.diff(lo) > RECEDE_SLACK) or np.any(np.diff(hi) < -RECEDE_SLACK):
+    sign = -1.0 if receding else 1.0
+    if np.any(sign * np.diff(lo) > RECEDE_SLACK) or np.any(sign * np.diff(hi) < -RECEDE_SLACK):
         raise ValueError(RECEDES)
+
+
+def _may_recede(gap: Any, loads: dict[str, Any]) -> bool:
+    """Whether a receding zone is answered: a flat punch (``g* = 0``) under given force and
+    moment (the elastic pressure of the given loads is then the answer, see above)."""
+    return (not callable(gap) and np.ndim(gap) == 0 and float(gap) == 0.0
+            and set(loads) == set(_STATIC))
 
 
 def _outputs(answer: _Grid, nodes: np.ndarray, corner: float) -> dict[str, np.ndarray]:
@@ -365,8 +399,11 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
     ``lift_off_share`` how far below zero, relative, the full-contact pressure at a corner
     means that corner lifts; ``jumps`` the times where a given load jumps or kinks (each
     grid holds both sides of them).
-    Raises ValueError (:data:`RECEDES`) where the zone would recede, or the kernel is not
-    finite on the grid.
+    A zone that recedes instead is answered for a flat punch (``gap`` 0) under given
+    force and moment, its q* the elastic one of the given loads (see above).
+    Raises ValueError (:data:`RECEDES`) where the zone would recede otherwise, or grows
+    and recedes, (:data:`RELEASES`) where a receding zone meets a kernel that is positive
+    somewhere, or where the kernel is not finite on the grid.
     """
     stepping, fit_error = stepping_kernel(kernel, float(times[-1]), 0.5 * tol)
     # a halved grid holds the points of the last: where their crept loads are the same
@@ -377,10 +414,18 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
     grids: list[_Grid] = []
     time_error = np.inf
     nodes = None
+    receding = False
     for level in range(MAX_HALVINGS + 1):
         grid, _, index = time_grid(times, FIRST_STEPS, level, jumps)
-        grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid, index,
-                              modes, tol, lift_off_share, solved))
+        try:
+            grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid,
+                                  index, modes, tol, lift_off_share, solved, receding))
+        except ValueError as exc:
+            if str(exc) != RECEDES or level > 0 or receding or not _may_recede(gap, loads):
+                raise
+            receding = True  # the zone's elastic answers found so far are kept (solved)
+            grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid,
+                                  index, modes, tol, lift_off_share, solved, receding))
         if nodes is None:
             # q* is compared where the zones lie (the last, largest one), densely: the
             # points a growing end sweeps get their pressure later, less smoothly in time
