@@ -234,7 +234,7 @@ def test_an_aging_bare_base_lifting_off_settles_like_its_creep_function():
 def _receding_reference(result) -> dict[str, np.ndarray]:
     """Settlement* and tilt of a flat punch whose zone only recedes on a creeping bare
     base under smooth given loads, computed apart from the solver's time grids: ``(I - V)``
-    of the elastic kinematics of the given loads, these interpolated through 17 Chebyshev
+    of the elastic kinematics of the given loads, these interpolated through 33 Chebyshev
     times (elastic lift-off solves at tol 1e-10; smooth in time, so spectrally), ``V`` by
     composite 16-point Gauss-Legendre on 24 panels with the scene's exact kernel."""
     scene = result.scene
@@ -243,12 +243,12 @@ def _receding_reference(result) -> dict[str, np.ndarray]:
     times = np.asarray(problem.times, dtype=float)
     first, last = float(times[0]), float(times[-1])
     chebyshev = np.polynomial.chebyshev
-    samples = 0.5 * (first + last) + 0.5 * (last - first) * np.cos(np.pi * np.arange(17) / 16)
+    samples = 0.5 * (first + last) + 0.5 * (last - first) * np.cos(np.pi * np.arange(33) / 32)
     given = {n: np.ravel(problem.loads[n](samples) if callable(problem.loads[n]) else
                          np.full(samples.shape, problem.loads[n])) for n in ("force", "moment")}
     zones = bare_lift_off(scene.half_width, base, None, given, np.full(samples.size, -1), 32,
                           1e-10)
-    fits = {n: chebyshev.Chebyshev.fit(samples, zones.quantity(n), 16, domain=[first, last])
+    fits = {n: chebyshev.Chebyshev.fit(samples, zones.quantity(n), 32, domain=[first, last])
             for n in ("settlement", "tilt")}
     nodes, weights = np.polynomial.legendre.leggauss(16)
     out = {n: fits[n](times) for n in fits}
