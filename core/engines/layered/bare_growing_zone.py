@@ -423,12 +423,13 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
         except ValueError as exc:
             if str(exc) != RECEDES or level > 0 or receding or not _may_recede(gap, loads):
                 raise
-            receding = True  # the zone's elastic answers found so far are kept (solved)
+            receding = True  # elastic zones of the same loads found so far are reused (solved)
             grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid,
                                   index, modes, tol, lift_off_share, solved, receding))
         if nodes is None:
-            # q* is compared where the zones lie (the last, largest one), densely: the
-            # points a growing end sweeps get their pressure later, less smoothly in time
+            # q* is compared where the zones lie (a growing zone's last, largest one),
+            # densely: the points a growing end sweeps get their pressure later, less
+            # smoothly in time (a receding zone's q* is the same elastic one on every grid)
             last = grids[-1].lifted.zones[-1]
             nodes = last.centre + last.half * np.cos(
                 np.linspace(0.0, np.pi, 4 * modes + 1)[1:-1])
