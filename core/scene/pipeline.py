@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from core.engines.layered import solve_scene_layered
+from core.engines.layered import LiftOffNotAnswered, solve_scene_layered
 from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
 from core.scene.punches import (
@@ -60,10 +60,13 @@ def solve(scene: Scene | PunchesScene | Mapping[str, Any]) -> SceneSolution | Pu
     problem = scene.dimensionless
     try:
         with np.errstate(all="ignore"), work_bound():
-            answer = solve_scene_layered(scene, problem)
+            try:
+                answer = solve_scene_layered(scene, problem)
+            except LiftOffNotAnswered as exc:
+                raise ValueError(lift_off_refusal(str(exc))) from None
             if answer is None and not scene.coating:
-                # the thin layer has no bare limit (m = 0): only a lift-off gets here
-                raise ValueError(lift_off_refusal(scene))
+                # the thin layer has no bare limit (m = 0): nothing else answers
+                raise ValueError(lift_off_refusal())
             result = SceneSolution(scene, problem,
                                    problem.solve() if answer is None else answer)
     except WorkLimitExceeded as exc:

@@ -7,8 +7,8 @@ solves the bare layer exactly, inverse square-root corners included (a creeping 
 base by scalar Volterra equations in time, :mod:`core.engines.layered.bare_creep`). It
 answers full contact under a smooth punch, and a punch lifting off
 (:mod:`core.engines.layered.bare_lift_off`; on a base that creeps or ages while the zone
-only grows, or only recedes under a flat punch with force and moment given,
-:mod:`core.engines.layered.bare_growing_zone`); :func:`check_uncoated` refuses
+only grows or only recedes, :mod:`core.engines.layered.bare_growing_zone`);
+:func:`check_uncoated` refuses
 the rest when the scene is read, naming the field and the reason, and
 :func:`lift_off_refusal` words the refusal of a punch that lifts off where that is not
 answered (known only once solved).
@@ -25,10 +25,9 @@ __all__ = ["check_uncoated", "lift_off_refusal", "UNCOATED_SCOPE"]
 #: What a scene without coating layers is solved for, as its refusals say it.
 UNCOATED_SCOPE = ("a scene with no coating layers is solved under a punch shape without "
                   "jumps or kinks; on a base that creeps or ages it lifts off where its "
-                  "contact zone keeps its size or grows (a flat punch under given loads that "
-                  "keep their ratio, a crown pressed as the base creeps), or only recedes "
-                  "under a flat punch with force and moment given (a growing eccentricity), "
-                  "not where the zone grows and recedes or recedes otherwise, for now")
+                  "contact zone keeps its size, only grows (a crown pressed as the base "
+                  "creeps) or only recedes (a growing eccentricity), in every statement, not "
+                  "where the zone grows and later recedes or the reverse, for now")
 
 
 def check_uncoated(scene: Any) -> None:
@@ -50,12 +49,13 @@ def check_uncoated(scene: Any) -> None:
         raise ValueError(f"{field}: {UNCOATED_SCOPE}; this one is not solved: {reason}")
 
 
-def lift_off_refusal(scene: Any) -> str:
+def lift_off_refusal(reason: str | None = None) -> str:
     """The refusal of a scene without coating layers whose punch lifts off on a base that
-    creeps or ages where that is not answered (``scene`` is not read: one wording)."""
-    return ("loading: the punch lifts off the bare base on a base that creeps or ages, and its "
-            "contact zone would recede as the base creeps (a point that touched would leave "
-            "the punch) where that is not answered; "
-            f"{UNCOATED_SCOPE}: set solver.contact to 'full' for the full-contact answer "
-            "(flagged contact_lost), give force and moment on a flat punch with an "
-            "eccentricity that only grows or only shrinks, or add a coating layer")
+    creeps or ages where that is not answered, with the engine's ``reason`` (one wording
+    for every scene)."""
+    why = reason or ("its contact zone would move in a way that is not answered (a point "
+                     "that touched would leave the punch)")
+    return ("loading: the punch lifts off the bare base on a base that creeps or ages, and "
+            f"{why}; {UNCOATED_SCOPE}: set solver.contact to 'full' for the full-contact "
+            "answer (flagged contact_lost), change the loading so that the zone only grows "
+            "or only recedes, or add a coating layer")

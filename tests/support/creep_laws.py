@@ -1,12 +1,15 @@
 """What a bare creeping base must follow: a standard linear solid's creep law as a scene
 field with its creep and relaxation functions in closed form, an aging base's creep
-function, and Lee and Radok's pressure of a Hertz contact growing on that solid
+function, Lee and Radok's pressure of a Hertz contact growing on that solid, and the
+answer of a zone that only recedes computed apart from the solver's time grids
 (tests/scene/test_uncoated_scene.py, tests/engines/test_bare_lift_off.py,
 benchmarks/bare_lift_off.py)."""
 
 from __future__ import annotations
 
 import numpy as np
+
+from core.engines.layered.bare_lift_off import bare_lift_off
 
 #: Non-aging exponential creep: J(t) = 1 / E + c (1 - exp(-r t)) (a standard linear solid),
 #: its relaxation in closed form R(t) = E (1 + E c exp(-r (1 + E c) t)) / (1 + E c).
@@ -64,3 +67,104 @@ def lee_radok_pressure(x: np.ndarray, days: np.ndarray, b0: float, peak: float) 
                           np.sqrt(start), np.sqrt(top), epsabs=0.0, epsrel=1e-11, limit=200)[0]
             out[i, k] = peak / b0 * value
     return out
+
+
+#: Chebyshev points of :func:`receding_reference` over the output times' span (81 moved
+#: its histories by at most 4.9e-10 and q by 4e-13 on the receding cases of
+#: tests/engines/test_bare_lift_off.py, 49 by 2.7e-8).
+REFERENCE_POINTS = 65
+
+
+def receding_reference(result) -> dict:
+    """A punch whose zone only recedes on a creeping bare base, computed apart from the
+    solver's time grids (core/engines/layered/bare_growing_zone.py gives the argument):
+    ``r = (I - V)^-1 1`` and the given kinematics relaxed, ``(I - V)^-1``, by Chebyshev
+    collocation at :data:`REFERENCE_POINTS` times with ``V`` by composite 16-point
+    Gauss-Legendre on 24 panels with the scene's exact kernel; at those times the elastic
+    lift-off answers of the relaxed loads divided by ``r`` (tol 1e-10), times ``r``; the
+    unknown kinematics ``(I - V)`` of theirs by the same quadrature of their interpolant.
+    Returns the four histories (dimensionless) at the output times, the elastic answers
+    there (``elastic``, a ``BareLiftOff``) and ``r`` there (``scale``)."""
+    scene = result.scene
+    problem = scene.dimensionless
+    base = (scene.base_thickness, problem.modulus_at_loading, scene.base_poisson)
+    times = np.asarray(problem.times, dtype=float)
+    first, last = float(times[0]), float(times[-1])
+    chebyshev = np.polynomial.chebyshev
+    degree = REFERENCE_POINTS - 1
+    samples = 0.5 * (first + last) + 0.5 * (last - first) * np.cos(
+        np.pi * np.arange(REFERENCE_POINTS) / degree)
+
+    def interpolant(values: np.ndarray):
+        return chebyshev.Chebyshev.fit(samples, values, degree, domain=[first, last])
+
+    nodes, weights = np.polynomial.legendre.leggauss(16)
+
+    def memory(t: float, f) -> float:
+        """int_first^t K(t, tau) f(tau) dtau."""
+        edges = np.linspace(first, t, 25)
+        tau = (0.5 * (edges[:-1] + edges[1:])[:, None]
+               + 0.5 * np.diff(edges)[:, None] * nodes[None, :]).ravel()
+        w = (0.5 * np.diff(edges)[:, None] * weights[None, :]).ravel()
+        k = np.ravel(np.asarray(problem.kernel(np.full(tau.shape, t), tau), dtype=float))
+        return float(np.sum(w * k * f(tau)))
+
+    basis = [interpolant(np.eye(REFERENCE_POINTS)[j]) for j in range(REFERENCE_POINTS)]
+    relax = np.eye(REFERENCE_POINTS) - np.array(
+        [[memory(t, b) if t > first else 0.0 for b in basis] for t in samples])
+
+    def load(name: str, at: np.ndarray) -> np.ndarray:
+        value = problem.loads[name]
+        return np.ravel(value(at) if callable(value) else np.full(at.shape, value))
+
+    gap = None if not callable(problem.g) and float(problem.g) == 0.0 else problem.g
+    r = np.linalg.solve(relax, np.ones(REFERENCE_POINTS))
+    given = {}
+    for name in problem.loads:
+        values = load(name, samples)
+        relaxed = values if name in ("force", "moment") else np.linalg.solve(relax, values)
+        given[name] = relaxed / r
+    zones = bare_lift_off(scene.half_width, base, gap, given,
+                          np.full(REFERENCE_POINTS, -1), 32, 1e-10)
+    histories = {}
+    for name in ("settlement", "tilt", "force", "moment"):
+        if name in problem.loads:
+            histories[name] = load(name, times)
+            continue
+        fit = interpolant(r * zones.quantity(name))
+        histories[name] = fit(times)
+        if name in ("settlement", "tilt"):  # crept: (I - V) of r times the elastic one
+            histories[name] -= np.array([memory(t, fit) if t > first else 0.0
+                                         for t in times])
+    at_times = {name: interpolant(values)(times) for name, values in given.items()}
+    elastic = bare_lift_off(scene.half_width, base, gap, at_times, np.full(times.size, -1),
+                            32, 1e-10)
+    return {"histories": histories, "elastic": elastic, "scale": interpolant(r)(times)}
+
+
+def receding_errors(result) -> dict[str, float]:
+    """The errors of ``result`` (a ``SceneSolution`` of one punch on the bare base whose zone
+    only recedes, heel lifting) against :func:`receding_reference`: the largest error of
+    the settlement and tilt relative to the larger of the two, and of the force and moment
+    likewise, as the solver's estimate reads them (``histories``), of q over ``|x| <=
+    0.9 a`` relative to its largest there (``q``; the toe's corner, where q is infinite,
+    left out) and of the zones' lower ends [half-widths] (``ends``)."""
+    reference = receding_reference(result)
+    a = result.scene.half_width
+    scale = np.broadcast_to(result._pressure_scale, result.times.shape)
+    got = {"settlement": result.settlement / a, "tilt": result.tilt,
+           "force": result.force / (scale * a), "moment": result.moment / (scale * a * a)}
+    exact = reference["histories"]
+
+    def relative(names: tuple[str, str]) -> float:
+        size = max(float(np.max(np.abs(exact[name]))) for name in names)
+        return max(float(np.max(np.abs(got[name] - exact[name]))) for name in names) / size
+
+    histories = max(relative(("settlement", "tilt")), relative(("force", "moment")))
+    x = np.linspace(-0.9, 0.9, 37)
+    q_exact = reference["elastic"].pressure(x, 1.0) * reference["scale"]
+    q = float(np.max(np.abs(result.pressure(x * a) / scale - q_exact))
+              / np.max(np.abs(q_exact)))
+    lows = np.array([zones[0][0] for zones in result.contact_set])
+    ends = float(np.max(np.abs(lows - [zone.lo for zone in reference["elastic"].zones])))
+    return {"histories": histories, "q": q, "ends": ends}

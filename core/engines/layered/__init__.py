@@ -29,6 +29,7 @@ from __future__ import annotations
 from core.engines.layered.answer import (
     LIFT_OFF_SHARE,
     NO_COATING,
+    LiftOffNotAnswered,
     bare_creep_declines,
     corner_reach,
     layered_declines,
@@ -58,6 +59,7 @@ __all__ = [
     "layered_declines",
     "LayeredResponse",
     "LIFT_OFF_SHARE",
+    "LiftOffNotAnswered",
     "MAX_MODES",
     "MAX_RATIO",
     "NO_COATING",

@@ -58,7 +58,8 @@ from core.engines.layered.solve import ERROR_FLOOR, solve_layered
 from core.kernel import UniformLayer, table_cost
 from core.problem import ContactSolution, accepts
 
-__all__ = ["bare_creep_declines", "corner_reach", "layered_declines", "solve_scene_layered"]
+__all__ = ["bare_creep_declines", "corner_reach", "layered_declines", "LiftOffNotAnswered",
+           "solve_scene_layered"]
 
 #: Time samples of the load histories for the largest tilt between output times.
 TILT_SAMPLES = 257
@@ -158,7 +159,9 @@ def _load_values(problem: Any, times: np.ndarray) -> dict[str, np.ndarray]:
 def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
     """The scene's answer with the exact layered kernel (dimensionless, like
     :meth:`core.scene.pipeline.DimensionlessProblem.solve`), or None where it does not apply
-    (:func:`layered_declines`) or, with ``contact = "auto"``, where the punch lifts off."""
+    (:func:`layered_declines`) or, with ``contact = "auto"``, where the punch lifts off a
+    coating (the thin layer's unilateral solver answers). A punch lifting off the bare base
+    that creeps or ages where that is not answered raises :class:`LiftOffNotAnswered`."""
     if bare_creep_declines(scene, problem) is not None:
         return None
     start = time.perf_counter()
@@ -310,9 +313,11 @@ def _proportional(problem: Any, times: np.ndarray) -> tuple[str, str, float] | N
 
 def _bare_creep_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: Any,
                          regular_part: Any, pulls: float,
-                         start: float) -> ContactSolution | None:
-    """A flat punch lifting off the bare base that creeps or ages, under given loads that
-    keep their ratio (force and moment: the eccentricity; settlement and tilt): or None.
+                         start: float) -> ContactSolution:
+    """A punch lifting off the bare base that creeps or ages: a flat one under given loads
+    that keep their ratio (force and moment: the eccentricity; settlement and tilt) here,
+    any other where its zone only grows or only recedes
+    (:func:`_bare_creep_growing_zone`).
 
     With no coating the creep operator and the base's space operator commute
     (:mod:`core.engines.layered.bare_creep`), and on the zone the loads' common history
@@ -378,11 +383,17 @@ def _bare_creep_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: An
     return solution
 
 
+class LiftOffNotAnswered(ValueError):
+    """A punch lifting off the bare base that creeps or ages where its zone's motion is not
+    answered (a zone that grows and recedes, a kernel that releases creep): the message is
+    the reason, which :func:`core.scene.uncoated.lift_off_refusal` words for the scene."""
+
+
 def _bare_creep_growing_zone(scene: Any, problem: Any, times: np.ndarray, answer: Any,
-                             start: float) -> ContactSolution | None:
+                             start: float) -> ContactSolution:
     """A punch lifting off the bare base that creeps or ages, its zone moving as it does
-    (:mod:`core.engines.layered.bare_growing_zone`), or None where that zone would recede
-    (the scene is then refused, :func:`core.scene.uncoated.lift_off_refusal`)."""
+    (:mod:`core.engines.layered.bare_growing_zone`); :class:`LiftOffNotAnswered` where
+    that motion is not answered."""
     from types import SimpleNamespace
 
     try:
@@ -392,8 +403,8 @@ def _bare_creep_growing_zone(scene: Any, problem: Any, times: np.ndarray, answer
             problem.g, problem.kernel, problem.loads, times, answer.response, answer.modes,
             problem.tol, corner_reach([], scene.half_width), LIFT_OFF_SHARE,
             tuple(float(b) for b in problem.time_breaks))
-    except ValueError:
-        return None
+    except ValueError as exc:
+        raise LiftOffNotAnswered(str(exc)) from None
     history = SimpleNamespace(
         time_error=grown.time_error, fit_error=grown.fit_error, steps=grown.steps,
         success=bool(np.isfinite(grown.time_error)), message=(

@@ -12,16 +12,20 @@ shrink; the hereditary integral of Lee and Radok for a growing Hertz contact). A
 that recedes (the heel lifting further as the base creeps) breaks it: the points left
 behind keep a pressure history the elastic zones do not carry.
 
-A flat punch (``g* = 0``) under given force and moment whose zone only recedes is the
-other side of the same symmetry: ``q*(., t)`` is then the elastic pressure of the given
-``P*(t)``, ``M*(t)`` themselves. On the zone at ``t`` every point has touched since
-loading, so there ``(I - V) F q* = (I - V) delta_e + x (I - V) alpha_e`` (the elastic
-kinematics' histories crept: the settlement and tilt); outside it the gap is ``(I - V)``
-of the elastic gaps, ``g_e(t) - int K g_e``, which stays >= 0 where ``K <= 0`` (a base
-that creeps: checked on the grid, else refused). No pressure is then integrated in time;
-only the kinematics are, as below. A zone that grows and later recedes, or recedes under
-given kinematics or a curved punch, is refused (Ting's problem: the answer depends on when
-each point was left).
+A zone that only recedes is the other side of the same symmetry. With ``r = (I - V)^-1 1``
+(the base's relaxation of a unit settlement, > 0) and the given kinematics relaxed,
+``delta~ = (I - V)^-1 delta*``, ``alpha~ = (I - V)^-1 alpha``, take ``q*(., t) = r(t) q_e``
+where ``q_e`` is the elastic answer with the gap ``g*`` of the loads ``delta~ / r``, ``alpha~ /
+r``, ``P* / r``, ``M* / r`` (the two given ones; a flat punch needs no ``r``: its answer is
+homogeneous in the loads). On the zone at ``t`` every point has touched since loading, so
+there ``F q*(., tau) = delta_r + alpha_r x - r g*`` at every earlier ``tau`` too (``delta_r =
+r delta_e``, ``alpha_r = r alpha_e``), and ``(I - V)`` of it is ``delta* + alpha x - g*`` with
+the settlement and tilt ``(I - V) delta_r``, ``(I - V) alpha_r`` (given or not). Outside it
+the gap is ``(I - V)`` of ``r`` times the elastic gaps, ``u(t) - int K u``, which stays >= 0
+where ``K <= 0`` (a base that creeps: checked on the grid, else refused). No pressure is
+then integrated in time; only ``r``, the kinematics and their relaxations are, as below. A
+zone that grows and later recedes (or recedes and later grows) is refused (Ting's problem:
+the answer depends on when each point was left).
 
 In time: the grids of :func:`core.time.time_grid` (every output time a
 grid point), one elastic lift-off solve per grid point. ``V`` of a kernel ``b(tau) + sum_r
@@ -52,7 +56,7 @@ from core.engines.layered.bare_lift_off import BareLiftOff, bare_lift_off
 from core.engines.layered.solve import ERROR_FLOOR, LayeredResponse
 from core.time import exponential_moments, time_grid
 
-__all__ = ["GrowingZone", "RECEDES", "RELEASES", "solve_growing_zone"]
+__all__ = ["GrowingZone", "RECEDES", "RELEASES", "UNRELAXED", "solve_growing_zone"]
 
 #: Nominal steps of the first time grid (every output time is a grid point as well).
 FIRST_STEPS = 16
@@ -68,11 +72,15 @@ RECEDE_SLACK = 1e-9
 JUMP_STEP = 1e-9
 #: Why a growing-zone answer was not given.
 RECEDES = ("the contact zone would recede as the base creeps (a point that touched "
-           "leaves the punch): the bare base's creep is solved while the zone only grows, "
-           "or, for a flat punch under given force and moment, only recedes")
+           "leaves the punch) and also grow: the bare base's creep is solved while the zone "
+           "only grows or only recedes")
 #: Why a zone that only recedes was not given (the kernel releases creep somewhere).
 RELEASES = ("the creep kernel K(t, tau) is positive somewhere on the time grid: a receding "
             "zone's lifted points could close onto the punch again")
+#: Why a receding zone was not given (the base's relaxation of a unit settlement is not
+#: positive on the grid, which a creeping base's always is).
+UNRELAXED = ("the base's relaxation (I - V)^-1 1 is not positive on the time grid: a "
+             "receding zone is not answered there")
 
 _NAMES = ("settlement", "tilt", "force", "moment")
 _STATIC = ("force", "moment")
@@ -288,7 +296,7 @@ def _relaxed(grid: np.ndarray, parts: tuple[np.ndarray, np.ndarray], values: np.
 class _Grid:
     """One time grid's answer: the grid, ``A = I - V`` on it, the kernel's parts on it
     (None: not a sum of exponentials), the elastic zones at its points, the four
-    histories on it, and whether the zone recedes (its q* the elastic one)."""
+    histories on it, and, for a zone that recedes, the scale ``r`` of its q* (None: 1)."""
 
     grid: np.ndarray
     index: np.ndarray
@@ -297,13 +305,15 @@ class _Grid:
     lifted: BareLiftOff
     histories: dict[str, np.ndarray]
     receding: bool = False
+    relaxation: np.ndarray | None = None
 
     def pressure(self, x: np.ndarray, corner: float) -> np.ndarray:
         """q* at ``x`` on every grid point (len(x), grid): ``(I - V)^-1`` of the elastic
-        zones' pressures, point by point (:func:`_relaxed`); a receding zone's own."""
+        zones' pressures, point by point (:func:`_relaxed`); a receding zone's own, times
+        ``r``."""
         q_elastic = self.lifted.pressure(x, corner)
         if self.receding:
-            return q_elastic
+            return q_elastic if self.relaxation is None else q_elastic * self.relaxation
         if self.parts is None:
             return solve_triangular(self.relax, q_elastic.T, lower=True).T
         lo = np.array([z.lo for z in self.lifted.zones])
@@ -313,38 +323,56 @@ class _Grid:
         return _relaxed(self.grid, self.parts, q_elastic, onset)
 
 
+def _flat(gap: Any) -> bool:
+    """Whether the punch is flat (``g* = 0``: no relaxation scale is needed)."""
+    return not callable(gap) and np.ndim(gap) == 0 and float(gap) == 0.0
+
+
 def _on_grid(half_width: float, base: tuple[float, float, float], gap: Any, kernel: Any,
              loads: dict[str, Any], response: LayeredResponse, grid: np.ndarray,
              index: np.ndarray, modes: int, tol: float, share: float,
              solved: dict[tuple, Any], receding: bool = False) -> _Grid:
     volterra = _volterra(kernel, grid)
     relax = np.eye(grid.size) - volterra
-    if receding and np.any(volterra > RECEDE_SLACK * np.max(np.abs(volterra), initial=0.0)):
-        raise ValueError(RELEASES)
+    relaxation = None
+    if receding:
+        if np.any(volterra > RECEDE_SLACK * np.max(np.abs(volterra), initial=0.0)):
+            raise ValueError(RELEASES)
+        if not _flat(gap):
+            relaxation = solve_triangular(relax, np.ones(grid.size), lower=True)
+            if not np.all(relaxation > 0.0):
+                raise ValueError(UNRELAXED)
+    values = {name: np.broadcast_to(np.asarray(load(grid) if callable(load) else load,
+                                               dtype=float), grid.shape).copy()
+              for name, load in loads.items()}
     given = {}
-    for name, load in loads.items():
-        values = np.broadcast_to(np.asarray(load(grid) if callable(load) else load,
-                                            dtype=float), grid.shape)
-        # growing: the force and moment of Q = (I - V) q*, the kinematics as they are;
-        # receding: q* is the elastic answer of the given loads themselves
-        given[name] = relax @ values if name in _STATIC and not receding else np.array(values)
+    for name, value in values.items():
+        if not receding:
+            # growing: the force and moment of Q = (I - V) q*, the kinematics as they are
+            given[name] = relax @ value if name in _STATIC else value
+            continue
+        # receding: q* / r is the elastic answer of the relaxed kinematics and the given
+        # force and moment, all divided by r
+        relaxed = value if name in _STATIC else solve_triangular(relax, value, lower=True)
+        given[name] = relaxed if relaxation is None else relaxed / relaxation
     free = _free_corners(response, given, share)
     lifted = bare_lift_off(half_width, base, gap, given, free, modes, tol, solved=solved)
     _check_monotone(lifted, receding)
     histories = {}
+    scale = 1.0 if relaxation is None else relaxation
     for name in _NAMES:
         if name in loads:
-            histories[name] = np.broadcast_to(np.asarray(
-                loads[name](grid) if callable(loads[name]) else loads[name], dtype=float),
-                grid.shape).copy()
-        elif receding:  # the elastic kinematics crept: delta* = (I - V) delta_e
-            histories[name] = relax @ lifted.quantity(name)
+            histories[name] = values[name]
+        elif receding and name in _STATIC:  # the force and moment of q* = r q_e
+            histories[name] = scale * lifted.quantity(name)
+        elif receding:  # the kinematics of r q_e crept: delta* = (I - V) (r delta_e)
+            histories[name] = relax @ (scale * lifted.quantity(name))
         elif name in _STATIC:  # P* = (I - V)^-1 P_Q
             histories[name] = solve_triangular(relax, lifted.quantity(name), lower=True)
         else:
             histories[name] = lifted.quantity(name)
     return _Grid(grid, index, relax, _kernel_parts(kernel, grid), lifted, histories,
-                 receding)
+                 receding, relaxation)
 
 
 def _check_monotone(lifted: BareLiftOff, receding: bool) -> None:
@@ -355,13 +383,6 @@ def _check_monotone(lifted: BareLiftOff, receding: bool) -> None:
     sign = -1.0 if receding else 1.0
     if np.any(sign * np.diff(lo) > RECEDE_SLACK) or np.any(sign * np.diff(hi) < -RECEDE_SLACK):
         raise ValueError(RECEDES)
-
-
-def _may_recede(gap: Any, loads: dict[str, Any]) -> bool:
-    """Whether a receding zone is answered: a flat punch (``g* = 0``) under given force and
-    moment (the elastic pressure of the given loads is then the answer, see above)."""
-    return (not callable(gap) and np.ndim(gap) == 0 and float(gap) == 0.0
-            and set(loads) == set(_STATIC))
 
 
 def _outputs(answer: _Grid, nodes: np.ndarray, corner: float) -> dict[str, np.ndarray]:
@@ -399,11 +420,12 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
     ``lift_off_share`` how far below zero, relative, the full-contact pressure at a corner
     means that corner lifts; ``jumps`` the times where a given load jumps or kinks (each
     grid holds both sides of them).
-    A zone that recedes instead is answered for a flat punch (``gap`` 0) under given
-    force and moment, its q* the elastic one of the given loads (see above).
-    Raises ValueError (:data:`RECEDES`) where the zone would recede otherwise, or grows
-    and recedes, (:data:`RELEASES`) where a receding zone meets a kernel that is positive
-    somewhere, or where the kernel is not finite on the grid.
+    A zone that only recedes instead is answered too, its q* ``r`` times an elastic one
+    (see above).
+    Raises ValueError (:data:`RECEDES`) where the zone grows and recedes,
+    (:data:`RELEASES`) where a receding zone meets a kernel that is positive somewhere,
+    (:data:`UNRELAXED`) where its ``r`` is not positive, or where the kernel is not
+    finite on the grid.
     """
     stepping, fit_error = stepping_kernel(kernel, float(times[-1]), 0.5 * tol)
     # a halved grid holds the points of the last: where their crept loads are the same
@@ -421,17 +443,17 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
             grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid,
                                   index, modes, tol, lift_off_share, solved, receding))
         except ValueError as exc:
-            if str(exc) != RECEDES or level > 0 or receding or not _may_recede(gap, loads):
+            if str(exc) != RECEDES or level > 0 or receding:
                 raise
             receding = True  # elastic zones of the same loads found so far are reused (solved)
             grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid,
                                   index, modes, tol, lift_off_share, solved, receding))
         if nodes is None:
-            # q* is compared where the zones lie (a growing zone's last, largest one),
-            # densely: the points a growing end sweeps get their pressure later, less
-            # smoothly in time (a receding zone's q* is the same elastic one on every grid)
-            last = grids[-1].lifted.zones[-1]
-            nodes = last.centre + last.half * np.cos(
+            # q* is compared where the zones lie (a growing zone's last, largest one; a
+            # receding zone's first), densely: the points an end sweeps get or lose their
+            # pressure as it passes, less smoothly in time
+            largest = grids[-1].lifted.zones[0 if receding else -1]
+            nodes = largest.centre + largest.half * np.cos(
                 np.linspace(0.0, np.pi, 4 * modes + 1)[1:-1])
         plain.append(_outputs(grids[-1], nodes, corner))
         if level > 0:
