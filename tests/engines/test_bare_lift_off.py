@@ -316,6 +316,18 @@ def test_a_creeping_bare_base_whose_zone_would_grow_and_recede_is_refused():
         solve(moving)
 
 
+def test_a_flat_punch_pulled_up_at_both_corners_on_a_creeping_bare_base_is_refused_not_crashed():
+    # the settlement turns into a lift while the moment grows: the search for a zone with
+    # two free ends stepped to one far wider than the punch, whose node count overflowed
+    # (OverflowError); it is refused, naming the loading
+    d = _creeping({"settlement": {"kind": "linear", "start": 6e-6, "end": -1.3e-4},
+                   "moment": {"kind": "linear", "start": 3e5, "end": 4.8e5}})
+    d["times"]["count"] = 8
+    with pytest.raises(ValueError, match=r"^loading: the punch lifts off the bare base at "
+                                         r"both corners and no contact zone"):
+        solve(d)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("law", ["standard linear solid", "aging"])
 def test_a_crown_lifting_off_a_creeping_bare_base_has_the_elastic_zone_of_its_crept_loads(law):

@@ -89,7 +89,8 @@ def receding_reference(result) -> dict:
     problem = scene.dimensionless
     base = (scene.base_thickness, problem.modulus_at_loading, scene.base_poisson)
     times = np.asarray(problem.times, dtype=float)
-    first, last = float(times[0]), float(times[-1])
+    # from loading (dimensionless time 1), where the base starts to creep
+    first, last = 1.0, float(times[-1])
     chebyshev = np.polynomial.chebyshev
     degree = REFERENCE_POINTS - 1
     samples = 0.5 * (first + last) + 0.5 * (last - first) * np.cos(

@@ -42,6 +42,7 @@ punch corner's, not the coating's.
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Sequence
 from functools import lru_cache
@@ -404,7 +405,12 @@ def _bare_creep_growing_zone(scene: Any, problem: Any, times: np.ndarray, answer
             problem.tol, corner_reach([], scene.half_width), LIFT_OFF_SHARE,
             tuple(float(b) for b in problem.time_breaks))
     except ValueError as exc:
-        raise LiftOffNotAnswered(str(exc)) from None
+        reason = str(exc)
+        if reason.startswith("loading:"):
+            raise  # the loads no zone carries: a refusal of its own, naming its field
+        # why the motion is not answered (a zone that grows and recedes, a kernel that
+        # releases creep), without the engine's own name for what it checked
+        raise LiftOffNotAnswered(re.sub(r"^[A-Za-z_.]+: ", "", reason)) from None
     history = SimpleNamespace(
         time_error=grown.time_error, fit_error=grown.fit_error, steps=grown.steps,
         success=bool(np.isfinite(grown.time_error)), message=(

@@ -442,12 +442,22 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
         try:
             grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid,
                                   index, modes, tol, lift_off_share, solved, receding))
-        except ValueError as exc:
-            if str(exc) != RECEDES or level > 0 or receding:
+        except ValueError as growing:
+            if level > 0 or receding:
                 raise
-            receding = True  # elastic zones of the same loads found so far are reused (solved)
-            grids.append(_on_grid(half_width, base, gap, stepping, loads, response, grid,
-                                  index, modes, tol, lift_off_share, solved, receding))
+            # the zone recedes (or the growing trial's crept loads found no zone: the
+            # receding one's are other loads); elastic zones of the same loads found so
+            # far are reused (solved)
+            receding = True
+            try:
+                grids.append(_on_grid(half_width, base, gap, stepping, loads, response,
+                                      grid, index, modes, tol, lift_off_share, solved,
+                                      receding))
+            except ValueError as other:
+                if str(other) == RECEDES and str(growing) != RECEDES:
+                    # it grows after all: the growing trial's own refusal says why
+                    raise growing from None
+                raise
         if nodes is None:
             # q* is compared where the zones lie (a growing zone's last, largest one; a
             # receding zone's first), densely: the points an end sweeps get or lose their

@@ -89,6 +89,11 @@ TWO_FREE_ENDS = ("loading: the punch lifts off the bare base at both corners and
 #: Both free ends are taken when their singular coefficients are below this share of the
 #: pressure's scale (the zone's force over its half-width).
 TWO_ENDS_TOL = 1e-10
+#: In the search for two free ends a zone more than twice as wide as the punch (log of
+#: its half-width [half-widths]) is given these scaled coefficients (O(1) near a root):
+#: no root lies there, and its layered solve would not be finite.
+FARTHEST_LOG_HALF_WIDTH = float(np.log(2.0))
+OUTSIDE_COEFFICIENT = 1e3
 #: Zone middles and half-widths tried when no first zone is known (or Powell's method
 #: from it failed): the best of them starts it again.
 SCAN_MIDDLES = np.linspace(-0.9, 0.9, 19)
@@ -495,17 +500,23 @@ def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
     (``keep_jacobian``) the Jacobian is made by forward differences, two more zones."""
     from scipy.optimize import root  # here: see _free_end
 
+    def within(v: np.ndarray) -> bool:
+        if not np.all(np.isfinite(v)) or v[1] > 0.0:
+            return False
+        x0, b = float(v[0]), float(np.exp(v[1]))
+        return x0 - b >= -1.0 and x0 + b <= 1.0
+
     def coefficients(v: np.ndarray) -> np.ndarray:
+        if not np.all(np.isfinite(v)) or v[1] > FARTHEST_LOG_HALF_WIDTH:
+            # a root finder's step to a zone far wider than the punch (its layered solve
+            # overflowed the node count) is sent back: no root lies there
+            return np.full(2, OUTSIDE_COEFFICIENT)
         x0, b = float(v[0]), float(np.exp(v[1]))
         response = zones.response(x0 - b, x0 + b)
         delta, alpha, values = _kinematics(response, x0, b, given, level)
         ends = response.regular_part(np.array([-1.0, 1.0]), np.array([delta]),
                                      np.array([alpha]), level=level)[:, 0]
         return ends / max(abs(values["force"]) / b, 1e-300)
-
-    def within(v: np.ndarray) -> bool:
-        x0, b = float(v[0]), float(np.exp(v[1]))
-        return bool(np.all(np.isfinite(v))) and x0 - b >= -1.0 and x0 + b <= 1.0
 
     def solved(start: np.ndarray) -> np.ndarray | None:
         found = root(coefficients, start, method="hybr", options={"xtol": 1e-14})
