@@ -35,6 +35,11 @@ Not part of the test suite. Usage::
 
     python benchmarks/explorer_latency.py [--repeats 9] [--loads 5] [--url URL]
         [--presets all|NAME,...] [--quick] [--json FILE] [--markdown FILE]
+
+``--switches-only [--rounds 3]`` measures the preset switches alone, each preset chosen
+``--rounds`` times in turn (one switch is one sample: a single one said "ok" or "missed"
+by chance), and writes their median, least and largest to
+``benchmarks/results/explorer_preset_switch.md`` (unless ``--markdown``).
 """
 
 from __future__ import annotations
@@ -74,6 +79,8 @@ except ImportError:  # the pure parts (tables, arguments) work without a browser
 
 #: The Markdown table of the presets run (the older explorer_latency.md is history).
 RESULTS = ROOT / "benchmarks" / "results" / "explorer_latency_presets.md"
+#: The table of ``--switches-only``.
+SWITCH_RESULTS = ROOT / "benchmarks" / "results" / "explorer_preset_switch.md"
 
 READY = """() => {
   const doc = window.Bokeh && Bokeh.documents && Bokeh.documents[0];
@@ -280,9 +287,16 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--json", help="also write the numbers to this file")
     parser.add_argument("--from-json", metavar="FILE",
                         help="write the Markdown table from the --json of a run, no browser")
-    parser.add_argument("--markdown", default=str(RESULTS),
-                        help=f"the table's Markdown file (default {RESULTS.relative_to(ROOT)})")
+    parser.add_argument("--markdown", default=None,
+                        help=f"the table's Markdown file (default {RESULTS.relative_to(ROOT)}"
+                             f", {SWITCH_RESULTS.relative_to(ROOT)} with --switches-only)")
+    parser.add_argument("--switches-only", action="store_true",
+                        help="measure the preset switches alone, --rounds times each")
+    parser.add_argument("--rounds", type=int, default=3,
+                        help="with --switches-only: switches to each preset (default 3)")
     args = parser.parse_args(argv)
+    if args.markdown is None:
+        args.markdown = str(SWITCH_RESULTS if args.switches_only else RESULTS)
     try:
         args.presets = parse_presets(args.presets, preset_names())
     except ValueError as err:
@@ -291,7 +305,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         args.repeats = 3 if args.quick else 9
     if args.loads is None:
         args.loads = 2 if args.quick else 5
-    for name in ("repeats", "loads"):
+    for name in ("repeats", "loads", "rounds"):
         if getattr(args, name) < 1:
             parser.error(f"--{name}: must be at least 1, not {getattr(args, name)}")
     if Path(args.markdown).is_dir():
@@ -380,6 +394,43 @@ def markdown_report(rows: list[dict], switches: dict[str, float | None],
     if notes:
         lines += ["", "Notes:", ""]
         lines += [f"- {r['preset']}, {r['slider']}: {r['note']}" for r in notes]
+    return "\n".join(lines) + "\n"
+
+
+def switch_report(samples: dict[str, list[float]], first_page: list[float],
+                  meta: dict[str, str]) -> str:
+    """The Markdown page of ``--switches-only``: per preset its switch times [ms] (one per
+    round; a switch to the preset already on the page is no sample)."""
+    lines = [
+        "# Explorer: preset switches, each measured several times",
+        "",
+        f"Commit `{meta['commit']}`, {meta['date']}, load average {meta['load_before']} "
+        f"before, {meta['load_after']} after (2 cores, shared).",
+        "",
+        f"    {meta['command']}",
+        "",
+        "Headless Chromium through Playwright: the preset chosen in the sidebar's selector "
+        "-> the second animation frame after the pressure plot's last data change "
+        "(updates waited for until none came for "
+        f"{1e3 * QUIET_S:.0f} ms). The presets are chosen in turn, round after round, so "
+        "each switch comes from another preset, as a user's would. Times in ms; the goal "
+        f"is {GOALS['preset']:.0f} ms.",
+        "",
+        f"First page (median of {len(first_page)}): "
+        f"{_fmt(statistics.median(first_page)) if first_page else ''} ms.",
+        "",
+        "| preset | median | least | largest | n | goal |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    for preset, values in samples.items():
+        kept = [v for v in values if not math.isnan(v)]
+        if not kept:
+            lines.append(f"| {preset} | | | | 0 | {GOALS['preset']:.0f} |")
+            continue
+        median = statistics.median(kept)
+        mark = " ok" if median <= GOALS["preset"] else " **missed**"
+        lines.append(f"| {preset} | {_fmt(median)} | {_fmt(min(kept))} | {_fmt(max(kept))} "
+                     f"| {len(kept)} | {GOALS['preset']:.0f}{mark} |")
     return "\n".join(lines) + "\n"
 
 
@@ -578,6 +629,7 @@ def main(argv: list[str] | None = None) -> None:
     loads: list[float] = []
     rows: list[dict] = []
     switches: dict[str, float | None] = {}
+    samples: dict[str, list[float]] = {}
     timeout_s = 60.0
     try:
         with sync_playwright() as p, tempfile.TemporaryDirectory() as profile:
@@ -602,7 +654,15 @@ def main(argv: list[str] | None = None) -> None:
             page.evaluate(INSTRUMENT)
             cdp = context.new_cdp_session(page)
             cdp.send("Performance.enable")
-            for preset in args.presets:
+            if args.switches_only:
+                for _ in range(args.rounds):
+                    for preset in args.presets:
+                        ms = switch_preset(page, preset_label(preset, scenes[preset]),
+                                           timeout_s)
+                        if ms is not None:
+                            samples.setdefault(preset, []).append(ms)
+                        print(f"{preset}: switch {_fmt(ms) or 'none'} ms", file=sys.stderr)
+            for preset in [] if args.switches_only else args.presets:
                 switches[preset] = switch_preset(page, preset_label(preset, scenes[preset]),
                                                  timeout_s)
                 print(f"{preset}: switch {_fmt(switches[preset]) or 'none'} ms",
@@ -624,6 +684,16 @@ def main(argv: list[str] | None = None) -> None:
         if server is not None:
             server.stop()
     meta["load_after"] = _load_average()
+    if args.switches_only:
+        text = switch_report({p: samples.get(p, []) for p in args.presets}, loads, meta)
+        Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.markdown).write_text(text)
+        print("\n" + text)
+        if args.json:
+            Path(args.json).write_text(json.dumps(
+                {"meta": meta, "first_page": loads, "preset_switch_samples": samples,
+                 "goals": GOALS}, indent=2, default=str))
+        return
 
     measured = [r for r in rows if not r.get("hidden")]
     print(f"{'control':44s} {'median':>9s} {'p95':>9s} {'max':>9s} {'goal':>7s} "

@@ -123,3 +123,20 @@ def test_the_table_is_written_again_from_a_runs_json(tmp_path: Path):
     bench.main(["--from-json", str(data), "--markdown", str(out)])
     assert out.read_text() == bench.markdown_report(rows, {"uniform_flat": None}, [1500.0],
                                                     meta)
+
+
+def test_switches_only_takes_rounds_and_writes_its_own_table(capsys):
+    args = bench.parse_args(["--switches-only"])
+    assert args.rounds == 3 and Path(args.markdown) == bench.SWITCH_RESULTS
+    assert bench.parse_args(["--switches-only", "--rounds", "5"]).rounds == 5
+    with pytest.raises(SystemExit):
+        bench.parse_args(["--switches-only", "--rounds", "0"])
+    assert "--rounds: " in capsys.readouterr().err
+    meta = {"commit": "abc", "date": "today", "load_before": "0.1", "load_after": "0.2",
+            "command": "python -m benchmarks.explorer_latency --switches-only"}
+    text = bench.switch_report({"fast": [420.0, 380.0, 610.0], "slow": [700.0, 520.0],
+                                "never": [float("nan")]}, [1500.0], meta)
+    # one row per preset: median, least, largest, samples and the goal met or missed
+    assert "| fast | 420 | 380 | 610 | 3 | 500 ok |" in text
+    assert "| slow | 610 | 520 | 700 | 2 | 500 **missed** |" in text
+    assert "| never | | | | 0 | 500 |" in text
