@@ -282,7 +282,7 @@ def test_a_zone_that_only_recedes_on_a_creeping_bare_base_is_answered_in_every_s
     kinematics (and the given force or moment) divided by ``r``, ``r = (I - V)^-1 1``; the
     unknown kinematics are ``(I - V)`` of ``r`` times the elastic ones
     (core/engines/layered/bare_growing_zone.py). Against :func:`receding_reference` at
-    tol 1e-4, :func:`receding_errors` (measured: histories 1.8e-6 and 7.0e-8, q 1.8e-6 and
+    tol 1e-4, :func:`receding_errors` (measured: histories 1.8e-6 and 7.1e-8, q 1.8e-6 and
     9.1e-7, against estimates 9.5e-6 and 1.3e-6; at tol 1e-6 6.9e-9 and 5.6e-8 against
     3.5e-8 and 7.2e-8)."""
     if case.startswith("crown"):
