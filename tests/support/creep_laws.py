@@ -7,9 +7,11 @@ benchmarks/bare_lift_off.py)."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from core.engines.layered.bare_lift_off import bare_lift_off
+from core.engines.layered.bare_lift_off import BareLiftOff, bare_lift_off
 
 #: Non-aging exponential creep: J(t) = 1 / E + c (1 - exp(-r t)) (a standard linear solid),
 #: its relaxation in closed form R(t) = E (1 + E c exp(-r (1 + E c) t)) / (1 + E c).
@@ -75,7 +77,7 @@ def lee_radok_pressure(x: np.ndarray, days: np.ndarray, b0: float, peak: float) 
 REFERENCE_POINTS = 65
 
 
-def receding_reference(result) -> dict:
+def receding_reference(result, full_first: bool = False) -> dict:
     """A punch whose zone only recedes on a creeping bare base, computed apart from the
     solver's time grids (core/engines/layered/bare_growing_zone.py gives the argument):
     ``r = (I - V)^-1 1`` and the given kinematics relaxed, ``(I - V)^-1``, by Chebyshev
@@ -84,10 +86,11 @@ def receding_reference(result) -> dict:
     lift-off answers of the relaxed loads divided by ``r`` (tol 1e-10), times ``r``; the
     unknown kinematics ``(I - V)`` of theirs by the same quadrature of their interpolant,
     the unknown force and moment from elastic answers at the output times themselves.
-    For a heel lifting from loading on: the elastic kinematics are then smooth in time,
-    where a lift-off that starts later kinks them at its start, which one interpolant
-    over the whole span does not follow (a moment ramp from 0 read 1.4e-6 with 65
-    points, 9.9e-7 with 129, against 1.8e-8 from an interpolant split there).
+    The heel lifts from loading on, or (``full_first``) the punch touches fully until the
+    heel starts to lift: the elastic kinematics then kink at that time, found by
+    bisection, and are interpolated on either side of it apart (one interpolant over the
+    whole span of a moment ramp from 0 read 1.4e-6 with 65 points, 9.9e-7 with 129, the
+    split one 1.8e-8 with 33 or 65).
     Returns the four histories (dimensionless) at the output times, the elastic answers
     there (``elastic``, a ``BareLiftOff``) and ``r`` there (``scale``)."""
     scene = result.scene
@@ -98,24 +101,28 @@ def receding_reference(result) -> dict:
     first, last = 1.0, float(times[-1])
     chebyshev = np.polynomial.chebyshev
     degree = REFERENCE_POINTS - 1
-    samples = 0.5 * (first + last) + 0.5 * (last - first) * np.cos(
-        np.pi * np.arange(REFERENCE_POINTS) / degree)
 
-    def interpolant(values: np.ndarray):
-        return chebyshev.Chebyshev.fit(samples, values, degree, domain=[first, last])
+    def points(lo: float, hi: float) -> np.ndarray:
+        # (clipped: rounding must not put the first point of the lifting side before it)
+        return np.clip(0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(
+            np.pi * np.arange(REFERENCE_POINTS) / degree), lo, hi)
 
+    def interpolant(at: np.ndarray, values: np.ndarray):
+        return chebyshev.Chebyshev.fit(at, values, degree, domain=[at[-1], at[0]])
+
+    samples = points(first, last)
     nodes, weights = np.polynomial.legendre.leggauss(16)
 
-    def memory(t: float, f) -> float:
-        """int_first^t K(t, tau) f(tau) dtau."""
-        edges = np.linspace(first, t, 25)
+    def memory(t: float, f, lo: float = first, hi: float | None = None) -> float:
+        """int_lo^hi K(t, tau) f(tau) dtau (``hi`` default ``t``)."""
+        edges = np.linspace(lo, t if hi is None else hi, 25)
         tau = (0.5 * (edges[:-1] + edges[1:])[:, None]
                + 0.5 * np.diff(edges)[:, None] * nodes[None, :]).ravel()
         w = (0.5 * np.diff(edges)[:, None] * weights[None, :]).ravel()
         k = np.ravel(np.asarray(problem.kernel(np.full(tau.shape, t), tau), dtype=float))
         return float(np.sum(w * k * f(tau)))
 
-    basis = [interpolant(np.eye(REFERENCE_POINTS)[j]) for j in range(REFERENCE_POINTS)]
+    basis = [interpolant(samples, np.eye(REFERENCE_POINTS)[j]) for j in range(REFERENCE_POINTS)]
     relax = np.eye(REFERENCE_POINTS) - np.array(
         [[memory(t, b) if t > first else 0.0 for b in basis] for t in samples])
 
@@ -124,39 +131,71 @@ def receding_reference(result) -> dict:
         return np.ravel(value(at) if callable(value) else np.full(at.shape, value))
 
     gap = None if not callable(problem.g) and float(problem.g) == 0.0 else problem.g
-    r = np.linalg.solve(relax, np.ones(REFERENCE_POINTS))
-    given = {}
+    r = interpolant(samples, np.linalg.solve(relax, np.ones(REFERENCE_POINTS)))
+    given = {}  # the relaxed given loads over r, as functions of time
     for name in problem.loads:
         values = load(name, samples)
         relaxed = values if name in ("force", "moment") else np.linalg.solve(relax, values)
-        given[name] = relaxed / r
-    zones = bare_lift_off(scene.half_width, base, gap, given,
-                          np.full(REFERENCE_POINTS, -1), 32, 1e-10)
-    at_times = {name: interpolant(values)(times) for name, values in given.items()}
-    elastic = bare_lift_off(scene.half_width, base, gap, at_times, np.full(times.size, -1),
-                            32, 1e-10)
-    scale = interpolant(r)(times)
+        given[name] = interpolant(samples, relaxed / r(samples))
+
+    def elastic_at(at: np.ndarray, lifting: bool) -> Any:
+        loads = {name: f(at) for name, f in given.items()}
+        return bare_lift_off(scene.half_width, base, gap, loads,
+                             np.full(at.size, -1 if lifting else 0), 32, 1e-10)
+
+    def lifts(t: float) -> bool:
+        try:
+            elastic_at(np.array([t]), True)
+        except ValueError:  # the heel's corner does not lift at these loads
+            return False
+        return True
+
+    onset = first
+    if full_first:
+        lo, hi = first, last
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (lo, mid) if lifts(mid) else (mid, hi)
+        onset = hi
+    pieces = [(lo, hi, lo >= onset) for lo, hi in ((first, onset), (onset, last)) if hi > lo]
+    fits = []
+    for lo, hi, lifting in pieces:
+        at = points(lo, hi)
+        zones = elastic_at(at, lifting)
+        fits.append({name: interpolant(at, r(at) * zones.quantity(name))
+                     for name in ("settlement", "tilt")})
+    at_times = times >= onset
+    elastic = elastic_at(times, True) if at_times.all() else \
+        BareLiftOff(elastic_at(times[~at_times], False).zones
+                    + elastic_at(times[at_times], True).zones)
+    scale = r(times)
     histories = {}
     for name in ("settlement", "tilt", "force", "moment"):
         if name in problem.loads:
             histories[name] = load(name, times)
         elif name in ("force", "moment"):  # r times the elastic one, at each time itself
             histories[name] = scale * elastic.quantity(name)
-        else:  # crept: (I - V) of r times the elastic one
-            fit = interpolant(r * zones.quantity(name))
-            histories[name] = fit(times) - np.array([memory(t, fit) if t > first else 0.0
-                                                     for t in times])
+        else:  # crept: (I - V) of r times the elastic one, piece by piece
+            values = []
+            for t in times:
+                k = len(pieces) - 1 if t >= onset else 0
+                value = float(fits[k][name](t))
+                for (lo, hi, _), fit in zip(pieces, fits, strict=True):
+                    if t > lo:
+                        value -= memory(t, fit[name], lo, min(t, hi))
+                values.append(value)
+            histories[name] = np.array(values)
     return {"histories": histories, "elastic": elastic, "scale": scale}
 
 
-def receding_errors(result) -> dict[str, float]:
+def receding_errors(result, full_first: bool = False) -> dict[str, float]:
     """The errors of ``result`` (a ``SceneSolution`` of one punch on the bare base whose zone
     only recedes, heel lifting) against :func:`receding_reference`: the largest error of
     the settlement and tilt relative to the larger of the two, and of the force and moment
     likewise, as the solver's estimate reads them (``histories``), of q over ``|x| <=
     0.9 a`` relative to its largest there (``q``; the toe's corner, where q is infinite,
     left out) and of the zones' lower ends [half-widths] (``ends``)."""
-    reference = receding_reference(result)
+    reference = receding_reference(result, full_first)
     a = result.scene.half_width
     scale = np.broadcast_to(result._pressure_scale, result.times.shape)
     got = {"settlement": result.settlement / a, "tilt": result.tilt,
