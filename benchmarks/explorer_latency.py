@@ -317,6 +317,15 @@ def _fmt(value: float | None, digits: int = 0) -> str:
     return "" if value is None or math.isnan(value) else f"{value:.{digits}f}"
 
 
+def _run_header(title: str, meta: dict[str, str]) -> list[str]:
+    """The first lines of a run's Markdown page: its title, the commit, the date, the load
+    averages and the command."""
+    return [f"# {title}", "",
+            f"Commit `{meta['commit']}`, {meta['date']}, load average {meta['load_before']} "
+            f"before, {meta['load_after']} after (2 cores, shared).", "",
+            f"    {meta['command']}", ""]
+
+
 def markdown_report(rows: list[dict], switches: dict[str, float | None],
                     first_page: list[float], meta: dict[str, str]) -> str:
     """The Markdown page of a run: ``rows`` one per (preset, slider) (see
@@ -325,13 +334,7 @@ def markdown_report(rows: list[dict], switches: dict[str, float | None],
     averages before and after, command."""
     first = _fmt(statistics.median(first_page)) if first_page else ""
     lines = [
-        "# Explorer: latency of every slider kind on every preset",
-        "",
-        f"Commit `{meta['commit']}`, {meta['date']}, load average {meta['load_before']} "
-        f"before, {meta['load_after']} after (2 cores, shared).",
-        "",
-        f"    {meta['command']}",
-        "",
+        *_run_header("Explorer: latency of every slider kind on every preset", meta),
         "Headless Chromium through Playwright. Key step: ArrowRight (or Left near the end "
         "of the range) on the slider's handle -> the second animation frame after the "
         "pressure plot's data changed (p50, p95 over the steps). Drag: mouse down on the "
@@ -402,13 +405,7 @@ def switch_report(samples: dict[str, list[float]], first_page: list[float],
     """The Markdown page of ``--switches-only``: per preset its switch times [ms] (one per
     round; a switch to the preset already on the page is no sample)."""
     lines = [
-        "# Explorer: preset switches, each measured several times",
-        "",
-        f"Commit `{meta['commit']}`, {meta['date']}, load average {meta['load_before']} "
-        f"before, {meta['load_after']} after (2 cores, shared).",
-        "",
-        f"    {meta['command']}",
-        "",
+        *_run_header("Explorer: preset switches, each measured several times", meta),
         "Headless Chromium through Playwright: the preset chosen in the sidebar's selector "
         "-> the second animation frame after the pressure plot's last data change "
         "(updates waited for until none came for "
