@@ -13,7 +13,8 @@ that recedes (the heel lifting further as the base creeps) breaks it: the points
 behind keep a pressure history the elastic zones do not carry.
 
 A zone that only recedes is the other side of the same symmetry. With ``r = (I - V)^-1 1``
-(the base's relaxation of a unit settlement, > 0) and the given kinematics relaxed,
+(the base's relaxation of a unit settlement, which must stay > 0: checked on the grid,
+else refused) and the given kinematics relaxed,
 ``delta~ = (I - V)^-1 delta*``, ``alpha~ = (I - V)^-1 alpha``, take ``q*(., t) = r(t) q_e``
 where ``q_e`` is the elastic answer with the gap ``g*`` of the loads ``delta~ / r``, ``alpha~ /
 r``, ``P* / r``, ``M* / r`` (the two given ones; a flat punch needs no ``r``: its answer is
