@@ -49,12 +49,17 @@ def check_uncoated(scene: Any) -> None:
         raise ValueError(f"{field}: {UNCOATED_SCOPE}; this one is not solved: {reason}")
 
 
-def lift_off_refusal(reason: str | None = None) -> str:
+def lift_off_refusal(reason: str | None = None,
+                     turns: tuple[float, float] | None = None) -> str:
     """The refusal of a scene without coating layers whose punch lifts off on a base that
-    creeps or ages where that is not answered, with the engine's ``reason`` (one wording
-    for every scene)."""
+    creeps or ages where that is not answered, with the engine's ``reason`` and, if known,
+    the days after loading between which the zone turned (``turns``)."""
     why = reason or ("its contact zone would move in a way that is not answered (a point "
                      "that touched would leave the punch)")
+    if turns is not None:
+        lo, hi = (f"{t:.3g}" for t in turns)
+        why += (f" (it turns at about {lo} days after loading)" if lo == hi else
+                f" (it turns between {lo} and {hi} days after loading)")
     return ("loading: the punch lifts off the bare base on a base that creeps or ages, and "
             f"{why}; {UNCOATED_SCOPE}: set solver.contact to 'full' for the full-contact "
             "answer (flagged contact_lost), change the loading so that the zone only grows "

@@ -387,7 +387,12 @@ def _bare_creep_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: An
 class LiftOffNotAnswered(ValueError):
     """A punch lifting off the bare base that creeps or ages where its zone's motion is not
     answered (a zone that grows and recedes, a kernel that releases creep): the message is
-    the reason, which :func:`core.scene.uncoated.lift_off_refusal` words for the scene."""
+    the reason, which :func:`core.scene.uncoated.lift_off_refusal` words for the scene;
+    ``turns`` the dimensionless times between which the zone turned, if known."""
+
+    def __init__(self, reason: str, turns: tuple[float, float] | None = None) -> None:
+        super().__init__(reason)
+        self.turns = turns
 
 
 def _bare_creep_growing_zone(scene: Any, problem: Any, times: np.ndarray, answer: Any,
@@ -410,7 +415,8 @@ def _bare_creep_growing_zone(scene: Any, problem: Any, times: np.ndarray, answer
             raise  # the loads no zone carries: a refusal of its own, naming its field
         # why the motion is not answered (a zone that grows and recedes, a kernel that
         # releases creep), without the engine's own name for what it checked
-        raise LiftOffNotAnswered(re.sub(r"^[A-Za-z_.]+: ", "", reason)) from None
+        raise LiftOffNotAnswered(re.sub(r"^[A-Za-z_.]+: ", "", reason),
+                                 getattr(exc, "between", None)) from None
     history = SimpleNamespace(
         time_error=grown.time_error, fit_error=grown.fit_error, steps=grown.steps,
         success=bool(np.isfinite(grown.time_error)), message=(

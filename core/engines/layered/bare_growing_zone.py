@@ -57,7 +57,7 @@ from core.engines.layered.bare_lift_off import BareLiftOff, bare_lift_off
 from core.engines.layered.solve import ERROR_FLOOR, LayeredResponse
 from core.time import exponential_moments, time_grid
 
-__all__ = ["GrowingZone", "RECEDES", "RELEASES", "UNRELAXED", "solve_growing_zone"]
+__all__ = ["GrowingZone", "RECEDES", "RELEASES", "UNRELAXED", "ZoneTurns", "solve_growing_zone"]
 
 #: Nominal steps of the first time grid (every output time is a grid point as well).
 FIRST_STEPS = 16
@@ -358,7 +358,7 @@ def _on_grid(half_width: float, base: tuple[float, float, float], gap: Any, kern
         given[name] = relaxed if relaxation is None else relaxed / relaxation
     free = _free_corners(response, given, share)
     lifted = bare_lift_off(half_width, base, gap, given, free, modes, tol, solved=solved)
-    _check_monotone(lifted, receding)
+    _check_monotone(lifted, receding, grid)
     histories = {}
     scale = 1.0 if relaxation is None else relaxation
     for name in _NAMES:
@@ -376,14 +376,25 @@ def _on_grid(half_width: float, base: tuple[float, float, float], gap: Any, kern
                  receding, relaxation)
 
 
-def _check_monotone(lifted: BareLiftOff, receding: bool) -> None:
-    """Refuse (ValueError) a zone that recedes from one grid point to the next (that grows,
-    when ``receding``)."""
+class ZoneTurns(ValueError):
+    """:data:`RECEDES`: the zone of a trial (growing or receding) turned between the grid
+    times ``between`` (dimensionless), where that trial stops holding."""
+
+    def __init__(self, between: tuple[float, float]) -> None:
+        super().__init__(RECEDES)
+        self.between = between
+
+
+def _check_monotone(lifted: BareLiftOff, receding: bool, grid: np.ndarray) -> None:
+    """Refuse (:class:`ZoneTurns`) a zone that recedes from one grid point to the next
+    (that grows, when ``receding``)."""
     lo = np.array([z.lo for z in lifted.zones])
     hi = np.array([z.hi for z in lifted.zones])
     sign = -1.0 if receding else 1.0
-    if np.any(sign * np.diff(lo) > RECEDE_SLACK) or np.any(sign * np.diff(hi) < -RECEDE_SLACK):
-        raise ValueError(RECEDES)
+    turned = (sign * np.diff(lo) > RECEDE_SLACK) | (sign * np.diff(hi) < -RECEDE_SLACK)
+    if np.any(turned):
+        k = int(np.argmax(turned))
+        raise ZoneTurns((float(grid[k]), float(grid[k + 1])))
 
 
 def _outputs(answer: _Grid, nodes: np.ndarray, corner: float) -> dict[str, np.ndarray]:
@@ -457,6 +468,10 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
             except ValueError as other:
                 if str(other) == RECEDES and str(growing) != RECEDES:
                     # it grows after all: the growing trial's own refusal says why
+                    raise growing from None
+                if isinstance(other, ZoneTurns) and isinstance(growing, ZoneTurns) and \
+                        growing.between > other.between:
+                    # the zone grows, then recedes: the growing trial held until its turn
                     raise growing from None
                 raise
         if nodes is None:
