@@ -83,6 +83,11 @@ class DimensionlessProblem:
     #: ``t*`` where a given history jumps or kinks (the time stepper lands on them).
     time_breaks: tuple[float, ...] = ()
 
+    def days_after_loading(self, t_star: Any) -> np.ndarray:
+        """The days after loading [day] of the solver's times ``t*``
+        (:func:`days_after_loading`)."""
+        return days_after_loading(t_star, self.age_at_loading)
+
     def modulus_after_loading(self, t: Any) -> np.ndarray:
         """``E(tau0 + t)`` [Pa] at ``t`` days after loading."""
         return np.asarray(self.modulus(self.age_at_loading + np.asarray(t, dtype=float)),
@@ -101,6 +106,12 @@ class DimensionlessProblem:
                                    kernel=self.kernel, breakpoints=self.breakpoints,
                                    tol=self.tol, contact=self.contact,
                                    time_breaks=self.time_breaks, **self.loads)
+
+
+def days_after_loading(t_star: Any, tau0: float) -> np.ndarray:
+    """The days after loading [day] of the solver's times ``t*``: ``t* = (tau0 + days) /
+    tau0`` (``tau0`` the age at loading [day])."""
+    return tau0 * (np.asarray(t_star, dtype=float) - 1.0)
 
 
 def _is_constant(profile: Profile) -> bool:
@@ -158,7 +169,7 @@ def to_dimensionless(scene: Scene) -> DimensionlessProblem:
 
     def days(ts: np.ndarray) -> np.ndarray:
         # the solver may probe a hair outside [1, t*_end]; profiles are defined on [0, end]
-        return np.clip(tau0 * (np.asarray(ts, dtype=float) - 1.0), 0.0, t_end)
+        return np.clip(days_after_loading(ts, tau0), 0.0, t_end)
 
     loads: dict[str, Any] = {}
     for name, profile in scene.loading.items():

@@ -64,7 +64,7 @@ def solve(scene: Scene | PunchesScene | Mapping[str, Any]) -> SceneSolution | Pu
                 answer = solve_scene_layered(scene, problem)
             except LiftOffNotAnswered as exc:
                 turns = None if exc.turns is None else tuple(
-                    scene.age_at_loading * (t - 1.0) for t in exc.turns)
+                    float(problem.days_after_loading(t)) for t in exc.turns)
                 raise ValueError(lift_off_refusal(str(exc), turns)) from None
             if answer is None and not scene.coating:
                 # the thin layer has no bare limit (m = 0): nothing else answers

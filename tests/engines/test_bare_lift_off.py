@@ -22,7 +22,6 @@ from tests.support.creep_laws import (
     laws,
     lee_radok_pressure,
     receding_errors,
-    receding_reference,
 )
 
 
@@ -245,7 +244,7 @@ def test_a_flat_punch_whose_eccentricity_grows_on_a_creeping_bare_base_keeps_the
     of the loads at each time (the zone only recedes: every point in it has touched since
     loading), and the settlement and tilt are the elastic ones crept, ``(I - V)`` of their
     histories (core/engines/layered/bare_growing_zone.py). Measured against
-    :func:`receding_reference` at tol 1e-6 (adaptive quadrature of the same gave 1.0e-8):
+    :func:`receding_errors` at tol 1e-6 (adaptive quadrature of the same gave 1.0e-8):
     settlement and tilt relative to their largest under the estimate (2.2e-8); q and the
     zone ends to 1e-12."""
     d = _creeping({"force": 5e5, "moment": {"kind": "linear", "start": 3e5, "end": 4e5}})
@@ -254,12 +253,9 @@ def test_a_flat_punch_whose_eccentricity_grows_on_a_creeping_bare_base_keeps_the
     assert result.flags == [] and result.info["contact"] == "unilateral"
     lows = np.array([zones[0][0] for zones in result.contact_set])
     assert np.all(np.diff(lows) >= 0) and lows[-1] > lows[0] + 0.1
-    reference = receding_reference(result)["histories"]
-    a = result.scene.half_width
-    got = {"settlement": result.settlement / a, "tilt": result.tilt}
-    size = max(np.max(np.abs(reference[n])) for n in got)
-    error = max(np.max(np.abs(got[n] - reference[n])) for n in got) / size
+    error = receding_errors(result)["histories"]
     assert error <= result.info["error_estimate"], (error, result.info["error_estimate"])
+    a = result.scene.half_width
     # q and the zone at each time: the elastic answer of the loads of that time
     for k in (0, result.times.size // 2, -1):
         elastic = copy.deepcopy(d)
@@ -282,8 +278,8 @@ def test_a_zone_that_only_recedes_on_a_creeping_bare_base_is_answered_in_every_s
     the base creeps. ``q*`` is ``r`` times the elastic answer of the relaxed given
     kinematics (and the given force or moment) divided by ``r``, ``r = (I - V)^-1 1``; the
     unknown kinematics are ``(I - V)`` of ``r`` times the elastic ones
-    (core/engines/layered/bare_growing_zone.py). Against :func:`receding_reference` at
-    tol 1e-4, :func:`receding_errors` (measured: histories 1.8e-6 and 7.1e-8, q 1.8e-6 and
+    (core/engines/layered/bare_growing_zone.py). Against the reference of
+    :func:`receding_errors` at tol 1e-4 (measured: histories 1.8e-6 and 7.1e-8, q 1.8e-6 and
     9.1e-7, against estimates 9.5e-6 and 1.3e-6; at tol 1e-6 6.9e-9 and 5.6e-8 against
     3.5e-8 and 7.2e-8)."""
     if case.startswith("crown"):
@@ -309,7 +305,7 @@ def test_a_heel_that_starts_to_lift_as_the_eccentricity_grows_is_answered_across
     """The moment grows from 0: the punch touches fully, then its heel lifts and the zone
     recedes. The settlement and tilt kink where the lift-off starts (within a time step of
     every grid); their crept histories stay within the estimate against
-    :func:`receding_reference` split there (measured at tol 1e-4: 4.6e-6 against 8.9e-6;
+    :func:`receding_errors`' reference split there (measured at tol 1e-4: 4.6e-6 against 8.9e-6;
     at tol 1e-6: 1.8e-8 against 4.0e-8)."""
     d = _creeping({"force": 5e5, "moment": {"kind": "linear", "start": 0.0, "end": 4e5}})
     d["times"]["count"] = 12

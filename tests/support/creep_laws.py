@@ -197,7 +197,9 @@ def receding_errors(result, full_first: bool = False) -> dict[str, float]:
     left out) and of the zones' lower ends [half-widths] (``ends``)."""
     reference = receding_reference(result, full_first)
     a = result.scene.half_width
-    scale = np.broadcast_to(result._pressure_scale, result.times.shape)
+    # q / q* [Pa] at each output time
+    scale = np.broadcast_to(result.scene.dimensionless.pressure_scale(result.times),
+                            result.times.shape)
     got = {"settlement": result.settlement / a, "tilt": result.tilt,
            "force": result.force / (scale * a), "moment": result.moment / (scale * a * a)}
     exact = reference["histories"]

@@ -52,7 +52,7 @@ import numpy as np
 
 from core.coating import model_error_estimate, tilt_share
 from core.engines.layered.bare_creep import solve_bare_creep
-from core.engines.layered.bare_growing_zone import solve_growing_zone
+from core.engines.layered.bare_growing_zone import flat_punch, solve_growing_zone
 from core.engines.layered.bare_lift_off import bare_lift_off
 from core.engines.layered.galerkin import MAX_MODES, MAX_NODES, default_modes, node_count
 from core.engines.layered.solve import ERROR_FLOOR, solve_layered
@@ -330,7 +330,7 @@ def _bare_creep_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: An
     """
     from types import SimpleNamespace
 
-    kept = None if callable(problem.g) or problem.g != 0.0 else _proportional(problem, times)
+    kept = _proportional(problem, times) if flat_punch(problem.g) else None
     free = _free_corners(regular_part, pulls)
     corner = int(free[np.flatnonzero(free)[0]]) if np.any(free) else 0
     if kept is None or np.any((free != 0) & (free != corner)):

@@ -57,7 +57,8 @@ from core.engines.layered.bare_lift_off import BareLiftOff, bare_lift_off
 from core.engines.layered.solve import ERROR_FLOOR, LayeredResponse
 from core.time import exponential_moments, time_grid
 
-__all__ = ["GrowingZone", "RECEDES", "RELEASES", "UNRELAXED", "ZoneTurns", "solve_growing_zone"]
+__all__ = ["GrowingZone", "RECEDES", "RELEASES", "UNRELAXED", "ZoneTurns", "flat_punch",
+           "solve_growing_zone"]
 
 #: Nominal steps of the first time grid (every output time is a grid point as well).
 FIRST_STEPS = 16
@@ -324,7 +325,7 @@ class _Grid:
         return _relaxed(self.grid, self.parts, q_elastic, onset)
 
 
-def _flat(gap: Any) -> bool:
+def flat_punch(gap: Any) -> bool:
     """Whether the punch is flat (``g* = 0``: no relaxation scale is needed)."""
     return not callable(gap) and np.ndim(gap) == 0 and float(gap) == 0.0
 
@@ -339,7 +340,7 @@ def _on_grid(half_width: float, base: tuple[float, float, float], gap: Any, kern
     if receding:
         if np.any(volterra > RECEDE_SLACK * np.max(np.abs(volterra), initial=0.0)):
             raise ValueError(RELEASES)
-        if not _flat(gap):
+        if not flat_punch(gap):
             relaxation = solve_triangular(relax, np.ones(grid.size), lower=True)
             if not np.all(relaxation > 0.0):
                 raise ValueError(UNRELAXED)
