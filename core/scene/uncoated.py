@@ -6,8 +6,9 @@ stand on (its projection divides by ``m``); the exact layered kernel
 solves the bare layer exactly, inverse square-root corners included (a creeping or aging
 base by scalar Volterra equations in time, :mod:`core.engines.layered.bare_creep`). It
 answers full contact under a smooth punch, and a punch lifting off
-(:mod:`core.engines.layered.bare_lift_off`; on a base that creeps or ages while the zone
-only grows or only recedes, :mod:`core.engines.layered.bare_growing_zone`);
+(:mod:`core.engines.layered.bare_lift_off`; on a base that creeps or ages,
+:mod:`core.engines.layered.bare_growing_zone`, step by step where the zone grows and
+recedes in turn);
 :func:`check_uncoated` refuses
 the rest when the scene is read, naming the field and the reason, and
 :func:`lift_off_refusal` words the refusal of a punch that lifts off where that is not
@@ -24,10 +25,11 @@ __all__ = ["check_uncoated", "lift_off_refusal", "UNCOATED_SCOPE"]
 
 #: What a scene without coating layers is solved for, as its refusals say it.
 UNCOATED_SCOPE = ("a scene with no coating layers is solved under a punch shape without "
-                  "jumps or kinks; on a base that creeps or ages it lifts off where its "
-                  "contact zone keeps its size, only grows (a crown pressed as the base "
-                  "creeps) or only recedes (a growing eccentricity), in every statement, not "
-                  "where the zone grows and later recedes or the reverse, for now")
+                  "jumps or kinks; on a base that creeps or ages it lifts off in every "
+                  "statement, exactly where its contact zone keeps its size, only grows (a "
+                  "crown pressed as the base creeps) or only recedes (a growing "
+                  "eccentricity), and step by step where it grows and recedes in turn, to "
+                  "the tol that march meets (about 1e-3 to 1e-4)")
 
 
 def check_uncoated(scene: Any) -> None:
@@ -61,6 +63,6 @@ def lift_off_refusal(reason: str | None = None,
         why += (f" (it turns at about {lo} days after loading)" if lo == hi else
                 f" (it turns between {lo} and {hi} days after loading)")
     return ("loading: the punch lifts off the bare base on a base that creeps or ages, and "
-            f"{why}; {UNCOATED_SCOPE}: set solver.contact to 'full' for the full-contact "
-            "answer (flagged contact_lost), change the loading so that the zone only grows "
-            "or only recedes, or add a coating layer")
+            f"{why}; {UNCOATED_SCOPE}: loosen solver.tol, set solver.contact to 'full' for "
+            "the full-contact answer (flagged contact_lost), change the loading so that the "
+            "zone only grows or only recedes, or add a coating layer")

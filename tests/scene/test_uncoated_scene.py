@@ -128,7 +128,9 @@ def test_what_the_bare_path_does_not_solve_is_refused_when_read(change, message)
     with pytest.raises(ValueError) as refused:
         scene_from_dict(d)
     assert str(refused.value).startswith(message), str(refused.value)
-    assert "for now" in str(refused.value)
+    # with what a bare base is solved for
+    assert "is solved under a punch shape without jumps or kinks; on a base that creeps" \
+        in str(refused.value)
 
 
 def test_a_lifting_punch_is_solved_under_auto_and_flagged_in_full_contact():

@@ -317,8 +317,8 @@ def _bare_creep_lift_off(scene: Any, problem: Any, times: np.ndarray, answer: An
                          start: float) -> ContactSolution:
     """A punch lifting off the bare base that creeps or ages: a flat one under given loads
     that keep their ratio (force and moment: the eccentricity; settlement and tilt) here,
-    any other where its zone only grows or only recedes
-    (:func:`_bare_creep_growing_zone`).
+    any other as its zone grows or recedes (:func:`_bare_creep_growing_zone`, step by step
+    where it does both in turn).
 
     With no coating the creep operator and the base's space operator commute
     (:mod:`core.engines.layered.bare_creep`), and on the zone the loads' common history

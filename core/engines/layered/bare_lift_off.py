@@ -62,7 +62,8 @@ from core.engines.layered.solve import (
 from core.kernel import RegularPartTable
 from core.work import check_work
 
-__all__ = ["BareLiftOff", "TWO_FREE_ENDS", "bare_lift_off"]
+__all__ = ["BareLiftOff", "TWO_FREE_ENDS", "ZoneAnswer", "bare_lift_off", "bare_table",
+           "lift_off_zone", "zone_displacement"]
 
 _NAMES = ("settlement", "tilt", "force", "moment")
 #: Zone ends tried before Brent's method, as shares of the way from the lifting corner
@@ -82,6 +83,9 @@ JACOBIAN_STEP = 1e-7
 #: The second point of the secant for the zone with half the modes: this far from the
 #: end found with all of them [half-widths] (their ends differ by ~1e-10 and less).
 COARSE_STEP = 1e-8
+#: A gap of its own (``lift_off_zone``) doubles the modes only while the zone's error
+#: estimate falls below this share of the last one.
+STALLED = 0.5
 #: Why a zone with two free ends was not answered.
 TWO_FREE_ENDS = ("loading: the punch lifts off the bare base at both corners and no contact "
                  "zone with two free ends was found for these loads (the crown's contact "
@@ -89,6 +93,8 @@ TWO_FREE_ENDS = ("loading: the punch lifts off the bare base at both corners and
 #: Both free ends are taken when their singular coefficients are below this share of the
 #: pressure's scale (the zone's force over its half-width).
 TWO_ENDS_TOL = 1e-10
+#: The same for a gap that carries a creeping base's memory (``lift_off_zone``).
+MEMORY_ENDS_TOL = 1e-8
 #: In the search for two free ends a zone more than twice as wide as the punch (log of
 #: its half-width [half-widths]) is given these scaled coefficients (O(1) near a root):
 #: no root lies there, and its layered solve would not be finite.
@@ -186,6 +192,10 @@ class _Zones:
 
     def sub_gap(self, x0: float, b: float) -> Gap:
         gap = self.gap
+        on_zone = getattr(gap, "on_zone", None)
+        if on_zone is not None:
+            # a creeping base's memory reads the zone it is asked for (bare_growing_zone)
+            gap = on_zone(x0 - b, x0 + b)
         if callable(gap):
             return lambda s: np.asarray(gap(x0 + b * np.asarray(s)), dtype=float) / b
         return None  # a constant gap is a settlement: no pressure of its own
@@ -344,12 +354,7 @@ def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
     solve's; ``tol`` the accuracy asked for; ``solved``: the zones already found for
     other calls on the same punch, base, gap and tol (by corner and values; updated).
     """
-    thickness, modulus, poisson = base
-    degree = table_degree(tol)
-    table, _ = LAYERED_TABLE.get_or_compute(
-        (stack_key(half_width, [], thickness, modulus, poisson), degree),
-        lambda: RegularPartTable(2 * half_width / thickness, [], thickness, modulus, poisson,
-                                 degree=degree))
+    table = bare_table(half_width, base, tol)
     out: list[ZoneAnswer] = []
     solved = {} if solved is None else solved
     last: dict[int, ZoneAnswer] = {}  # the last zone found, per corner lifting
@@ -379,17 +384,99 @@ def bare_lift_off(half_width: float, base: tuple[float, float, float], gap: Gap,
     return BareLiftOff(out)
 
 
+def bare_table(half_width: float, base: tuple[float, float, float], tol: float
+               ) -> RegularPartTable:
+    """The bare base's regular part ``k(s) + ln|s|`` tabulated to ``2 a / H`` for a solve
+    to ``tol`` (kept: :data:`core.engines.layered.cache.LAYERED_TABLE`)."""
+    thickness, modulus, poisson = base
+    degree = table_degree(tol)
+    table, _ = LAYERED_TABLE.get_or_compute(
+        (stack_key(half_width, [], thickness, modulus, poisson), degree),
+        lambda: RegularPartTable(2 * half_width / thickness, [], thickness, modulus, poisson,
+                                 degree=degree))
+    return table
+
+
+def lift_off_zone(half_width: float, base: tuple[float, float, float], gap: Gap,
+                  given: dict[str, float], free: int, modes: int, tol: float,
+                  near: ZoneAnswer | None = None,
+                  before: ZoneAnswer | None = None) -> ZoneAnswer:
+    """The zone answer of one set of loads under a gap of its own (a gap that changes from
+    one call to the next, as the memory of a creeping base makes it).
+
+    As :func:`bare_lift_off` at one value (``given``: two of delta*, alpha, P*, M* as
+    numbers; ``free`` -1, +1, 2 or 0: full contact, the whole punch's answer with its
+    truncation error), with ``near`` and ``before`` the answers of the last two calls
+    (other gaps, other loads): the search for the ends starts from theirs, and no
+    response of theirs is reused.
+    """
+    table = bare_table(half_width, base, tol)
+    if free == 0:
+        zones = _Zones(half_width, base, gap, modes, table, tol)
+        response = zones.response(-1.0, 1.0)
+        delta, alpha, four = _kinematics(response, 0.0, 1.0, given)
+        floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
+        own = max(truncation_errors(
+            response, {"settlement": np.array([delta]), "tilt": np.array([alpha])},
+            response.complete({"settlement": np.array([delta]),
+                               "tilt": np.array([alpha])}), floor).values())
+        return ZoneAnswer(-1.0, 1.0, 0, response, delta, alpha, four, float(own), 0.0)
+    if near is not None and near.free != free:
+        near = before = None
+    if before is not None and before.free != free:
+        before = None
+    return _solve_one(half_width, base, gap, given, free, modes, table, tol, near=near,
+                      before=before, same_gap=False)
+
+
+def zone_displacement(zone: ZoneAnswer, x: np.ndarray, table: RegularPartTable) -> np.ndarray:
+    """The bare base's surface displacement ``(1 / pi) int k(lam (x - s)) q*(s) ds`` [-]
+    under the zone's pressure at points ``x`` of [-1, 1], on the zone and off it.
+
+    On the zone it is ``delta* + alpha x - g*`` (the equation solved); off it, minus that,
+    the gap the base leaves under the punch. In the zone's ``sigma = (x - x0) / b`` the
+    pressure is ``sum c_n T_n(sigma) / sqrt(1 - sigma^2)``: its logarithmic part in closed
+    form, ``ln 2 c_0 + sum c_n T_n(sigma) / n`` on the zone and ``c_0 (ln 2 - ln(|sigma| +
+    sqrt(sigma^2 - 1))) + sum c_n sign(sigma)^n (|sigma| - sqrt(sigma^2 - 1))^n / n`` off
+    it; the regular part by Gauss-Chebyshev quadrature on the nodes of the zone's solve;
+    times ``b`` (the zone's equation is the whole punch's divided by it).
+    """
+    x = np.asarray(x, dtype=float)
+    b, response = zone.half, zone.response
+    sigma = (x - zone.centre) / b
+    c = response.coefficients @ np.array([1.0, zone.delta, zone.alpha])
+    n = np.arange(1, c.size)
+    size = np.abs(sigma)
+    inside = size <= 1.0
+    # the bare base's L_inf is 1 (core.kernel.symbol_at_infinity)
+    log_part = np.empty(sigma.shape)
+    theta = np.arccos(np.clip(sigma[inside], -1.0, 1.0))
+    log_part[inside] = c[0] * np.log(2.0) + np.cos(np.outer(theta, n)) @ (c[1:] / n)
+    if np.any(~inside):
+        out = size[~inside]
+        ratio = out - np.sqrt((out - 1.0) * (out + 1.0))   # 1 / (|s| + sqrt(s^2 - 1))
+        powers = (np.sign(sigma[~inside])[:, None] * ratio[:, None]) ** n[None, :]
+        log_part[~inside] = c[0] * (np.log(2.0) + np.log(ratio)) + powers @ (c[1:] / n)
+    nodes = np.cos(np.pi * (np.arange(response.nodes) + 0.5) / response.nodes)
+    density = response.regular_part(nodes, np.array([zone.delta]), np.array([zone.alpha]))[:, 0]
+    kernel = table(response.lam * np.abs(sigma[:, None] - nodes[None, :])) \
+        - np.log(response.lam)
+    return b * (log_part + kernel @ density / response.nodes)
+
+
 def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
                given: dict[str, float], free: int, modes: int, table: RegularPartTable,
                tol: float, near: ZoneAnswer | None = None,
-               before: ZoneAnswer | None = None) -> ZoneAnswer:
+               before: ZoneAnswer | None = None, same_gap: bool = True) -> ZoneAnswer:
     """The zone answer at one value of the loads (``near``: one for nearby loads, the
     same corners lifting, where its ends are looked for first; ``before``: the one
-    before it, through which the end is extrapolated)."""
+    before it, through which the end is extrapolated; ``same_gap``: whether theirs was
+    this gap, so that the nearby zone's response serves)."""
     floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
+    last = None
     while True:
         zones = _Zones(half_width, base, gap, modes, table, tol)
-        if near is not None and near.response.modes == modes:
+        if same_gap and near is not None and near.response.modes == modes:
             # a zone's response does not depend on the loads: the nearby one's serves
             zones.keep(near.lo, near.hi, near.response)
         jacobian = None
@@ -399,10 +486,15 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
                 guess, jacobian = (near.lo, near.hi), near.jacobian
                 if before is not None and before.free == 2:
                     second = (2.0 * near.lo - before.lo, 2.0 * near.hi - before.hi)
+            # a gap of its own (a creeping base's memory, interpolated) is smooth to ~1e-9
+            # of itself: its ends' coefficients vanish only to that
+            ends_tol = TWO_ENDS_TOL if same_gap else max(TWO_ENDS_TOL, MEMORY_ENDS_TOL)
             lo, hi, jacobian = _two_free_ends(zones, given, level=0, guess=guess,
-                                              jacobian=jacobian, second=second)
+                                              jacobian=jacobian, second=second,
+                                              ends_tol=ends_tol)
             clo, chi, _ = _two_free_ends(zones, given, level=1, guess=(lo, hi),
-                                         jacobian=jacobian, keep_jacobian=False)
+                                         jacobian=jacobian, keep_jacobian=False,
+                                         ends_tol=ends_tol)
         else:
             start = second = None
             if near is not None:
@@ -432,9 +524,15 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
         # the ends are found to END_TOL: no estimate below it (the ends with half the
         # modes, sought from these, may not move at all)
         end_error = max(extrapolate * max(abs(lo - clo), abs(hi - chi)), END_TOL)
+        answer = ZoneAnswer(lo, hi, free, response, delta, alpha, values, float(error),
+                            float(end_error), jacobian)
         if error <= 0.5 * tol or 2 * modes > MAX_MODES:
-            return ZoneAnswer(lo, hi, free, response, delta, alpha, values, float(error),
-                              float(end_error), jacobian)
+            return answer
+        if not same_gap and last is not None and error > STALLED * last.error:
+            # a gap that is not smooth (a creeping base's memory of where the zone has
+            # been) stops the modes' gain: the better of the last two answers, as it is
+            return answer if error < last.error else last
+        last = answer
         modes *= 2
 
 
@@ -491,7 +589,8 @@ def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
                    guess: tuple[float, float] | None = None,
                    jacobian: np.ndarray | None = None,
                    second: tuple[float, float] | None = None,
-                   keep_jacobian: bool = True) -> tuple[float, float, np.ndarray | None]:
+                   keep_jacobian: bool = True, ends_tol: float = TWO_ENDS_TOL
+                   ) -> tuple[float, float, np.ndarray | None]:
     """The zone of a punch lifting at both corners: both ends' singular coefficients zero
     (``guess`` a first zone, else :func:`_hertz_guess`, else the best of a scan), with the
     Jacobian of the coefficients there when Broyden's method found it. With
@@ -520,7 +619,7 @@ def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
 
     def solved(start: np.ndarray) -> np.ndarray | None:
         found = root(coefficients, start, method="hybr", options={"xtol": 1e-14})
-        if within(found.x) and np.max(np.abs(coefficients(found.x))) <= TWO_ENDS_TOL:
+        if within(found.x) and np.max(np.abs(coefficients(found.x))) <= ends_tol:
             return found.x
         return None
 
@@ -536,7 +635,7 @@ def _two_free_ends(zones: _Zones, given: dict[str, float], level: int,
         start = unknowns(second if second is not None and second[1] > second[0]
                          and within(unknowns(second)) else guess)
         broyden = _broyden(coefficients, start, jacobian, within)
-        if broyden is not None and np.max(np.abs(coefficients(broyden[0]))) <= TWO_ENDS_TOL:
+        if broyden is not None and np.max(np.abs(coefficients(broyden[0]))) <= ends_tol:
             found, updated = broyden
     first = guess if guess is not None else _hertz_guess(zones.gap, given)
     if found is None and first is not None:

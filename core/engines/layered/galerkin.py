@@ -13,6 +13,7 @@ and the table's degree, follow from the coating's thinnest layer and the toleran
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from functools import lru_cache
 
 import numpy as np
 
@@ -147,10 +148,21 @@ def _symmetric_block(table: RegularPartTable, lam: float, x: np.ndarray,
 
 
 def gap_moments(gap: Callable[[np.ndarray], np.ndarray], breakpoints: Sequence[float],
-                 modes: int) -> np.ndarray:
+                modes: int) -> np.ndarray:
     """``G_m = int_0^pi g*(cos th) cos(m th) dth`` [-], m < modes, for a callable ``gap``
     of ``t`` in [-1, 1] (Gauss-Legendre panels in ``th`` broken at the breakpoints)."""
-    cuts = sorted({0.0, np.pi} | {float(np.arccos(b)) for b in breakpoints if -1 < b < 1})
+    cuts = tuple(sorted({0.0, np.pi} | {float(np.arccos(b)) for b in breakpoints
+                                         if -1 < b < 1}))
+    theta, rows = _gap_rule(cuts, modes)
+    values = np.broadcast_to(np.asarray(gap(np.cos(theta)), dtype=float), theta.shape)
+    return rows @ values
+
+
+@lru_cache(maxsize=8)
+def _gap_rule(cuts: tuple[float, ...], modes: int) -> tuple[np.ndarray, np.ndarray]:
+    """The points ``theta`` of :func:`gap_moments`' rule and its rows ``w cos(m theta)``
+    (the same for every gap of a zone: a march under a gap that changes at each step
+    builds them once)."""
     count = max(4, modes // 2)
     edges = np.unique(np.concatenate([np.linspace(lo, hi, max(2, int(np.ceil(
         count * (hi - lo) / np.pi)) + 1)) for lo, hi in zip(cuts[:-1], cuts[1:], strict=True)]))
@@ -158,5 +170,7 @@ def gap_moments(gap: Callable[[np.ndarray], np.ndarray], breakpoints: Sequence[f
     half = 0.5 * np.diff(edges)
     theta = (0.5 * (edges[1:] + edges[:-1])[:, None] + half[:, None] * x).ravel()
     weights = (half[:, None] * w).ravel()
-    values = np.broadcast_to(np.asarray(gap(np.cos(theta)), dtype=float), theta.shape)
-    return np.cos(np.outer(np.arange(modes), theta)) @ (weights * values)
+    rows = np.cos(np.outer(np.arange(modes), theta)) * weights[None, :]
+    theta.setflags(write=False)
+    rows.setflags(write=False)
+    return theta, rows
