@@ -37,6 +37,12 @@ settlement while its tilt grows; against ``tests.support.creep_laws.receding_ref
 moment likewise, of q over ``|x| <= 0.9 a`` (relative to its largest there) and of the
 zone ends [half-widths]. One solve each (seconds).
 
+And a zone that recedes and grows again on that base (Ting's problem, marched step by
+step): the flat punch under 500 kN/m as the moment rises from 300 to 400 kN m/m at 100
+days and falls back by 365 (12 output times): up to the turn against the exact receding
+path at tol 1e-6, over the whole history against the march at tol 1e-5 (answered whatever
+its estimate); tighter than the march meets, the refusal and why.
+
 Written to ``benchmarks/results/bare_lift_off.md`` unless ``--no-write``.
 """
 
@@ -186,12 +192,92 @@ def measure_receding() -> list[tuple]:
     return rows
 
 
+#: The turning zone's tolerances (the march meets ~4e-4 on this heel; tighter is refused).
+TURNING_TOLS = (1e-3, 3e-4)
+#: Its reference: the march itself at this tol, answered whatever its estimate.
+TURNING_REFERENCE_TOL = 1e-5
+
+
+def _turning(tol: float, times: object = None) -> dict:
+    """The heel that lifts further as the moment rises to 400 kN m/m at 100 days and
+    closes again as it falls back to 300 by 365 (tests/engines/test_bare_lift_off.py)."""
+    from tests.support.creep_laws import CREEP
+
+    d = read_preset("bare_layer")
+    d["loading"] = {"force": 5e5, "moment": {
+        "kind": "table", "points": [[0.0, 3e5], [100.0, 4e5], [365.0, 3e5]],
+        "interpolation": "linear"}}
+    d["solver"] = {"tol": tol}
+    d["base"]["creep"] = dict(CREEP)
+    d["times"] = {"end": 365.0, "count": 12, "spacing": "log"} if times is None else times
+    return d
+
+
+def measure_turning() -> list[tuple]:
+    """(tol, CPU [s], time steps, estimate, zone-end estimate, errors up to the turn against
+    the exact receding path (histories, ends), errors over the whole history against the
+    march at :data:`TURNING_REFERENCE_TOL` (histories, ends, q on |x| <= 0.9 a), outcome) of
+    the zone that recedes and grows again, marched step by step."""
+    from core.engines.layered import answer
+    from core.engines.layered.bare_growing_zone import solve_growing_zone
+
+    rows = []
+    for tol in TURNING_TOLS:
+        seen: dict = {}
+        engine = answer.solve_growing_zone
+
+        def spy(*args: object, _seen: dict = seen, _engine: object = engine,
+                **kwargs: object) -> object:
+            _seen["args"] = args
+            _seen["answer"] = _engine(*args, **kwargs)
+            return _seen["answer"]
+
+        answer.solve_growing_zone = spy
+        try:
+            clear_caches()
+            started = time.process_time()
+            try:
+                result = solve(_turning(tol))
+            except ValueError as refused:
+                cpu = time.process_time() - started
+                reason = str(refused).split("followed step by step, ")[-1].split(" (it")[0]
+                rows.append((tol, cpu) + (np.nan,) * 8 + (f"refused: {reason}",))
+                continue
+            cpu = time.process_time() - started
+        finally:
+            answer.solve_growing_zone = engine
+        ours = seen["answer"]
+        before = [float(t) for t in result.times if t <= 100.0]
+        exact = solve(_turning(1e-6, before))
+        k = len(before)
+        hist_turn = max(np.max(np.abs(getattr(result, n)[:k] - getattr(exact, n)))
+                        / np.max(np.abs(getattr(exact, n))) for n in ("settlement", "tilt"))
+        ends_turn = np.max(np.abs(np.array([z[0][0] for z in result.contact_set[:k]])
+                                  - np.array([z[0][0] for z in exact.contact_set])))
+        args = list(seen["args"])
+        args[8] = TURNING_REFERENCE_TOL
+        fine = solve_growing_zone(*args, march=True)
+        hist = max(np.max(np.abs(ours.histories[n] - fine.histories[n]))
+                   / np.max(np.abs(fine.histories[n])) for n in ("settlement", "tilt"))
+        ends = np.max(np.abs(np.array([z[0] for z in ours.zones])
+                             - np.array([z[0] for z in fine.zones])))
+        x = np.linspace(-0.9, 0.9, 37)
+        q_fine = fine.pressure(x, args[9])
+        q = np.max(np.abs(ours.pressure(x, args[9]) - q_fine)) / np.max(np.abs(q_fine))
+        rows.append((tol, cpu, int(result.info["n_steps"]),
+                     float(result.info["error_estimate"]),
+                     float(result.info["zone_end_error"]), hist_turn, ends_turn, hist, ends,
+                     q, "success" if result.info["success"] else "tol not met"))
+    return rows
+
+
 def main(argv: list[str]) -> None:
     started = datetime.now(timezone.utc)
     before = os.getloadavg()[0]
     rows = measure()
     creeping = measure_creeping()
     receding = measure_receding()
+    turning = measure_turning()
     after = os.getloadavg()[0]
     lines = ["# A punch lifting off the bare base: speed against error", "",
              "    OPENBLAS_NUM_THREADS=1 python -m benchmarks.bare_lift_off", "",
@@ -223,6 +309,23 @@ def main(argv: list[str]) -> None:
     for name, tol, seconds, steps, est, hist, q, ends, ok in receding:
         lines.append(f"| {name} | {tol:.0e} | {seconds:.1f} | {steps} | {est:.1e} | "
                      f"{hist:.1e} | {q:.1e} | {ends:.1e} | {'yes' if ok else 'no'} |")
+    lines += ["", "## A zone that recedes and grows again on a creeping layer (marched)", "",
+              "The heel under 500 kN/m as the moment rises from 300 to 400 kN m/m at 100 "
+              "days and falls back by 365 (`measure_turning`): up to the turn against the "
+              "exact receding path (tol 1e-6), over the whole history against the march at "
+              f"tol {TURNING_REFERENCE_TOL:.0e} (answered whatever its estimate); caches "
+              "cleared, one solve each; errors relative, the zone ends' in half-widths.", "",
+              "| tol | CPU [s] | time steps | estimate | zone-end estimate | to the turn: "
+              "histories | ends | whole: histories | ends | q | outcome |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for tol, seconds, steps, est, end_est, hist_turn, ends_turn, hist, ends, q, outcome \
+            in turning:
+        if np.isnan(est):
+            lines.append(f"| {tol:.0e} | {seconds:.1f} |  |  |  |  |  |  |  |  | {outcome} |")
+            continue
+        lines.append(f"| {tol:.0e} | {seconds:.1f} | {steps} | {est:.1e} | {end_est:.1e} | "
+                     f"{hist_turn:.1e} | {ends_turn:.1e} | {hist:.1e} | {ends:.1e} | "
+                     f"{q:.1e} | {outcome} |")
     text = "\n".join(lines) + "\n"
     print(text)
     if "--no-write" not in argv:
