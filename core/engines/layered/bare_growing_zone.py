@@ -437,9 +437,12 @@ def _memory_points(band: tuple[float, float]) -> np.ndarray:
     def lobatto(lo: float, hi: float, count: int) -> np.ndarray:
         return 0.5 * (lo + hi) - 0.5 * (hi - lo) * np.cos(np.pi * np.arange(count)
                                                            / (count - 1))
-    points = np.concatenate([lobatto(-1.0, 1.0, COARSE_POINTS),
-                             lobatto(band[0], band[1], BAND_POINTS)])
-    return np.unique(np.clip(points, -1.0, 1.0))
+    points = np.sort(np.clip(np.concatenate([lobatto(-1.0, 1.0, COARSE_POINTS),
+                                             lobatto(band[0], band[1], BAND_POINTS)]),
+                             -1.0, 1.0))
+    # the two sets share points (rounded apart): one of each, or the splines through them
+    # would turn on steps of 1e-16
+    return points[np.concatenate([[True], np.diff(points) > 1e-12])]
 
 
 def _first_band(zone: ZoneAnswer) -> tuple[float, float]:
@@ -978,6 +981,10 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
             if spatial > 0.5 * tol:
                 raise turned.because(f"the zones' own estimated error {spatial:.1e} is over "
                                      f"half of tol {tol:.1e}")
+            ends = max(grids[-1].lifted.zones[i].end_error for i in grids[-1].index)
+            if ends > tol:
+                raise turned.because(f"its zone ends' estimated error {ends:.1e} half-widths "
+                                     f"is over tol {tol:.1e}")
         if nodes is None:
             # q* is compared where the zones lie (a growing zone's last, largest one; a
             # receding zone's first; the widest of a marched one), densely: the points an
@@ -1039,6 +1046,9 @@ def solve_growing_zone(half_width: float, base: tuple[float, float, float], gap:
              for f, c in zip(zones_fine, zones_coarse, strict=True)]
     error = max(max(z.error for z in fine.lifted.zones), ERROR_FLOOR)
     end_error = max(z.end_error for z in zones_fine) + end_shift
+    if turned is not None and not march and end_error > tol:
+        raise turned.because(f"its zone ends' estimated error {end_error:.1e} half-widths "
+                             f"is over tol {tol:.1e}")
     return GrowingZone(histories, zones, pressure,
                        float(time_error + fit_error), float(fit_error), float(error),
                        float(end_error), int(fine.grid.size - 1),
