@@ -585,9 +585,11 @@ class _Memory:
 
     def _splines(self) -> None:
         """Step ``n``'s interpolants (cubic splines: twice differentiable, so a zone's
-        coefficients move smoothly with its ends): the memory known before the step on the
-        last zone and off it on each side apart (where they join, at the last zone's ends,
-        it is only twice differentiable), and ``C`` off the zone on each side."""
+        coefficients move smoothly with its ends): the memory known before the step, one
+        across the punch (split at the last zone's ends, where the memory is only twice
+        differentiable, the two sides' splines disagreed by a few % and the zones'
+        coefficients jumped as a Gauss point crossed there), and ``C`` off the last zone on
+        each side."""
         from scipy.interpolate import CubicSpline  # here: see bare_lift_off._free_end
 
         lo, hi = self.zone
