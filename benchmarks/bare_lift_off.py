@@ -199,57 +199,30 @@ TURNING_TOLS = (3e-3, 1e-3)
 TURNING_REFERENCE_TOL = 1e-5
 
 
-def _turning(tol: float, times: object = None) -> dict:
-    """The heel that lifts further as the moment rises to 400 kN m/m at 100 days and
-    closes again as it falls back to 300 by 365 (tests/engines/test_bare_lift_off.py)."""
-    from tests.support.creep_laws import CREEP
-
-    d = read_preset("bare_layer")
-    d["loading"] = {"force": 5e5, "moment": {
-        "kind": "table", "points": [[0.0, 3e5], [100.0, 4e5], [365.0, 3e5]],
-        "interpolation": "linear"}}
-    d["solver"] = {"tol": tol}
-    d["base"]["creep"] = dict(CREEP)
-    d["times"] = {"end": 365.0, "count": 12, "spacing": "log"} if times is None else times
-    return d
-
-
 def measure_turning() -> list[tuple]:
     """(tol, CPU [s], time steps, estimate, zone-end estimate, errors up to the turn against
     the exact receding path (histories, ends), errors over the whole history against the
     march at :data:`TURNING_REFERENCE_TOL` (histories, ends, q on |x| <= 0.9 a), outcome) of
     the zone that recedes and grows again, marched step by step."""
-    from core.engines.layered import answer
     from core.engines.layered.bare_growing_zone import solve_growing_zone
+    from tests.support.creep_laws import growing_zone_calls, turning_scene
 
     rows = []
     for tol in TURNING_TOLS:
-        seen: dict = {}
-        engine = answer.solve_growing_zone
-
-        def spy(*args: object, _seen: dict = seen, _engine: object = engine,
-                **kwargs: object) -> object:
-            _seen["args"] = args
-            _seen["answer"] = _engine(*args, **kwargs)
-            return _seen["answer"]
-
-        answer.solve_growing_zone = spy
-        try:
-            clear_caches()
+        clear_caches()
+        with growing_zone_calls() as seen:
             started = time.process_time()
             try:
-                result = solve(_turning(tol))
+                result = solve(turning_scene(tol))
             except ValueError as refused:
                 cpu = time.process_time() - started
                 reason = str(refused).split("followed step by step, ")[-1].split(" (it")[0]
                 rows.append((tol, cpu) + (np.nan,) * 8 + (f"refused: {reason}",))
                 continue
             cpu = time.process_time() - started
-        finally:
-            answer.solve_growing_zone = engine
         ours = seen["answer"]
         before = [float(t) for t in result.times if t <= 100.0]
-        exact = solve(_turning(1e-6, before))
+        exact = solve(turning_scene(1e-6, before))
         k = len(before)
         hist_turn = max(np.max(np.abs(getattr(result, n)[:k] - getattr(exact, n)))
                         / np.max(np.abs(getattr(exact, n))) for n in ("settlement", "tilt"))

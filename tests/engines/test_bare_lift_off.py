@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import copy
 import re
-from typing import Any
 
 import numpy as np
 import pytest
@@ -20,9 +19,11 @@ from core.scene import solve
 from tests.support.creep_laws import (
     CREEP,
     aging_growth,
+    growing_zone_calls,
     laws,
     lee_radok_pressure,
     receding_errors,
+    turning_scene,
 )
 
 
@@ -354,34 +355,6 @@ def test_the_base_under_a_zone_moves_as_its_equation_says_on_it_and_as_quadratur
         assert value == pytest.approx(reference / np.pi, rel=1e-10, abs=1e-14 * scale)
 
 
-def _turning(tol: float, times: Any = None) -> dict:
-    """Force 500 kN/m and a moment from 300 up to 400 kN m/m at 100 days and back down by
-    365: the heel lifts further as the base creeps, then closes again (Ting's problem)."""
-    d = _creeping({"force": 5e5, "moment": {
-        "kind": "table", "points": [[0.0, 3e5], [100.0, 4e5], [365.0, 3e5]],
-        "interpolation": "linear"}})
-    d["times"] = {"end": 365.0, "count": 12, "spacing": "log"} if times is None else times
-    d["solver"]["tol"] = tol
-    return d
-
-
-def _captured(monkeypatch: Any) -> dict:
-    """The arguments and the answer of the engine's creeping lift-off solve, as the scene's
-    solve calls it (to call it again with other options)."""
-    from core.engines.layered import answer
-
-    seen: dict = {}
-    solve_zone = answer.solve_growing_zone
-
-    def spy(*args: Any, **kwargs: Any) -> Any:
-        seen["args"], seen["kwargs"] = args, kwargs
-        seen["answer"] = solve_zone(*args, **kwargs)
-        return seen["answer"]
-
-    monkeypatch.setattr(answer, "solve_growing_zone", spy)
-    return seen
-
-
 def test_a_heel_that_lifts_further_and_then_closes_again_is_marched_step_by_step():
     """The zone recedes until the moment's peak at 100 days, then grows: the points the
     heel left and reaches again keep a memory no elastic zone carries. It is marched step
@@ -392,7 +365,7 @@ def test_a_heel_that_lifts_further_and_then_closes_again_is_marched_step_by_step
     2.6e-3 on the first grid, is over tol) is off that answer (tol 1e-6) by 9.0e-8 in the
     settlement and 2.6e-8 in the tilt (relative to their largest), 1.8e-7 in the zone's
     end and 1.1e-9 in q, against its estimates 4.2e-4 and (ends) 1.5e-3 (~10 s of CPU)."""
-    result = solve(_turning(3e-3))
+    result = solve(turning_scene(3e-3))
     assert result.flags == [] and result.info["success"]
     assert result.info["contact"] == "unilateral"
     lows = np.array([zones[0][0] for zones in result.contact_set])
@@ -401,7 +374,7 @@ def test_a_heel_that_lifts_further_and_then_closes_again_is_marched_step_by_step
     assert np.all(np.diff(lows[:turn + 1]) > 0) and np.all(np.diff(lows[turn:]) < 0)
     assert lows[-1] < lows[turn] - 0.5
     before = [float(t) for t in result.times if t <= 100.0]
-    exact = solve(_turning(1e-6, before))
+    exact = solve(turning_scene(1e-6, before))
     k = len(before)
     estimate = result.info["error_estimate"]
     for name in ("settlement", "tilt"):
@@ -420,7 +393,7 @@ def test_a_turning_zone_the_march_cannot_follow_to_tol_is_refused_saying_why_and
                                          r"zone would recede .* and also grow; followed "
                                          r"step by step, the zones' own estimated error "
                                          r"\S+ is over half of tol 1\.0e-06") as refused:
-        solve(_turning(1e-6))
+        solve(turning_scene(1e-6))
     # the moment's peak at 100 days is a point of every grid
     turn = re.search(r"\(it turns between (\S+) and (\S+) days after loading\)",
                      str(refused.value))
@@ -428,18 +401,18 @@ def test_a_turning_zone_the_march_cannot_follow_to_tol_is_refused_saying_why_and
     assert 100.0 < float(turn[2]) < 130.0
 
 
-def test_the_march_keeps_the_exact_answer_of_a_zone_that_only_recedes(monkeypatch):
+def test_the_march_keeps_the_exact_answer_of_a_zone_that_only_recedes():
     """Marched step by step (``march=True``) where the zone only recedes, the memory on the
     zone is zero (every point of it has touched since loading): the march answers as the
     exact receding path, up to the spline that carries the memory across the punch
     (measured at tol 1e-4: settlement and tilt 2e-9, the zone's ends 1e-6)."""
     from core.engines.layered.bare_growing_zone import solve_growing_zone
 
-    seen = _captured(monkeypatch)
     d = _creeping({"force": 5e5, "moment": {"kind": "linear", "start": 3e5, "end": 4e5}})
     d["times"]["count"] = 6
     d["solver"]["tol"] = 1e-4
-    solve(d)
+    with growing_zone_calls() as seen:
+        solve(d)
     exact = seen["answer"]
     marched = solve_growing_zone(*seen["args"], **{**seen["kwargs"], "march": True})
     estimate = marched.time_error + marched.error
@@ -451,7 +424,7 @@ def test_the_march_keeps_the_exact_answer_of_a_zone_that_only_recedes(monkeypatc
 
 
 @pytest.mark.slow
-def test_the_marched_heel_converges_on_its_march_at_a_finer_tol(monkeypatch):
+def test_the_marched_heel_converges_on_its_march_at_a_finer_tol():
     """The march at tol 3e-3 against itself at tol 1e-5 (answered whatever its estimate,
     ``march=True``), six output times: settlement and tilt 2.1e-5 relative, the ends
     3.0e-5, q 3.6e-4 of its largest on |x| <= 0.9 a, within the coarser answer's estimates
@@ -459,8 +432,8 @@ def test_the_marched_heel_converges_on_its_march_at_a_finer_tol(monkeypatch):
     benchmarks/bare_lift_off.py: 3.2e-7, 2.4e-6, 1.9e-6)."""
     from core.engines.layered.bare_growing_zone import solve_growing_zone
 
-    seen = _captured(monkeypatch)
-    result = solve(_turning(3e-3, {"end": 365.0, "count": 6, "spacing": "log"}))
+    with growing_zone_calls() as seen:
+        result = solve(turning_scene(3e-3, {"end": 365.0, "count": 6, "spacing": "log"}))
     coarse = seen["answer"]
     args = list(seen["args"])
     args[8] = 1e-5  # tol

@@ -1,17 +1,61 @@
 """What a bare creeping base must follow: a standard linear solid's creep law as a scene
 field with its creep and relaxation functions in closed form, an aging base's creep
 function, Lee and Radok's pressure of a Hertz contact growing on that solid, and the
-answer of a zone that only recedes computed apart from the solver's time grids
+answer of a zone that only recedes computed apart from the solver's time grids, and the
+heel whose zone recedes and closes again with a look at the engine's call that answers it
 (tests/scene/test_uncoated_scene.py, tests/engines/test_bare_lift_off.py,
 benchmarks/bare_lift_off.py)."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
 
 from core.engines.layered.bare_lift_off import BareLiftOff, bare_lift_off
+
+
+def turning_scene(tol: float, times: Any = None) -> dict:
+    """The creeping ``bare_layer`` (H = a) under 500 kN/m and a moment from 300 up to 400
+    kN m/m at 100 days and back down by 365: the heel lifts further as the base creeps,
+    then closes again (Ting's problem; twelve log-spaced output times by default)."""
+    from core.presets import read_preset
+
+    d = read_preset("bare_layer")
+    d["loading"] = {"force": 5e5, "moment": {
+        "kind": "table", "points": [[0.0, 3e5], [100.0, 4e5], [365.0, 3e5]],
+        "interpolation": "linear"}}
+    d["solver"] = {"tol": tol}
+    d["base"]["thickness"] = 1.0
+    d["base"]["creep"] = dict(CREEP)
+    d["times"] = {"end": 365.0, "count": 12, "spacing": "log"} if times is None else times
+    return d
+
+
+@contextmanager
+def growing_zone_calls() -> Iterator[dict]:
+    """Within the block, the arguments (``args``, ``kwargs``) and the answer (``answer``)
+    of the engine's last creeping lift-off solve as the scene's solve called it
+    (:func:`core.engines.layered.bare_growing_zone.solve_growing_zone`), to call it again
+    with other options."""
+    from core.engines.layered import answer
+
+    seen: dict = {}
+    solve_zone = answer.solve_growing_zone
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        seen["args"], seen["kwargs"] = args, kwargs
+        seen["answer"] = solve_zone(*args, **kwargs)
+        return seen["answer"]
+
+    answer.solve_growing_zone = spy
+    try:
+        yield seen
+    finally:
+        answer.solve_growing_zone = solve_zone
+
 
 #: Non-aging exponential creep: J(t) = 1 / E + c (1 - exp(-r t)) (a standard linear solid),
 #: its relaxation in closed form R(t) = E (1 + E c exp(-r (1 + E c) t)) / (1 + E c).

@@ -351,6 +351,13 @@ class _Grid:
         return _relaxed(self.grid, self.parts, q_elastic, onset)
 
 
+def _load_values(loads: dict[str, Any], grid: np.ndarray) -> dict[str, np.ndarray]:
+    """The given loads (callables of dimensionless time, or constants) on ``grid``."""
+    return {name: np.broadcast_to(np.asarray(load(grid) if callable(load) else load,
+                                             dtype=float), grid.shape).copy()
+            for name, load in loads.items()}
+
+
 def flat_punch(gap: Any) -> bool:
     """Whether the punch is flat (``g* = 0``: no relaxation scale is needed)."""
     return not callable(gap) and np.ndim(gap) == 0 and float(gap) == 0.0
@@ -370,9 +377,7 @@ def _on_grid(half_width: float, base: tuple[float, float, float], gap: Any, kern
             relaxation = solve_triangular(relax, np.ones(grid.size), lower=True)
             if not np.all(relaxation > 0.0):
                 raise ValueError(UNRELAXED)
-    values = {name: np.broadcast_to(np.asarray(load(grid) if callable(load) else load,
-                                               dtype=float), grid.shape).copy()
-              for name, load in loads.items()}
+    values = _load_values(loads, grid)
     given = {}
     for name, value in values.items():
         if not receding:
@@ -448,11 +453,11 @@ def _memory_points(band: tuple[float, float]) -> np.ndarray:
 def _first_band(zone: ZoneAnswer) -> tuple[float, float]:
     """The stretch about the first zone's free ends, ``max(FIRST_BAND, its half-width)``
     either side (the whole punch where it touches fully)."""
+    if zone.free == 0:
+        return -1.0, 1.0
     reach = max(FIRST_BAND, zone.half)
     lo = zone.lo - reach if zone.free in (-1, 2) else zone.hi - reach
     hi = zone.hi + reach if zone.free in (1, 2) else zone.lo + reach
-    if zone.free == 0:
-        return -1.0, 1.0
     return max(-1.0, lo), min(1.0, hi)
 
 
@@ -499,7 +504,6 @@ class _Memory:
         count = self.points.size
         self.states = np.zeros((count, self.rates.size))
         self.memory = np.zeros(count)       # S at the last recorded step
-        self.separation = np.zeros(count)   # s there
         self.coefficient = np.zeros(count)  # C = s / d^(3/2) there (0 on the zone)
         self.zone: tuple[float, float] | None = None
         self.step_n = 0
@@ -614,12 +618,6 @@ class _Memory:
                 out[pick] = spline(x[pick])
         return out
 
-    def _smooth_at(self, x: np.ndarray) -> np.ndarray:
-        """The part of the memory that does not depend on the step's zone at ``x`` (one
-        cubic spline across the punch: the memory is twice differentiable where the last
-        end lay, and a spline split there would jump)."""
-        return self._smooth_spline(x)
-
     def on_zone(self, zone: tuple[float, float], x: np.ndarray) -> np.ndarray:
         """``S`` at points ``x`` of the zone ``zone`` [-] (at step ``n`` with that zone):
         the memory the gap carries there."""
@@ -627,7 +625,8 @@ class _Memory:
         n = self.step_n
         if n == 0:
             return np.zeros(x.shape)
-        smooth = self._smooth_at(x)
+        # the part that does not depend on the step's zone (one spline: _splines)
+        smooth = self._smooth_spline(x)
         d0 = _distance(x, self.zone)
         onset = d0 > 0.0
         if np.any(onset):
@@ -681,7 +680,6 @@ class _Memory:
             memory = (self._smooth + integral.sum(axis=1)) / (1.0 - late)
             self.states = self._decayed + self._late_r[None, :] * memory[:, None] + integral
             self.memory = memory
-        self.separation = separation
         self.coefficient = coefficient
         self.zone = zone
         return separation
@@ -723,9 +721,7 @@ def _march(half_width: float, base: tuple[float, float, float], gap: Any, kernel
         if answer is not None and used[0] <= swept[0] and swept[1] <= used[1]:
             return answer, used
         band = (min(used[0], swept[0]), max(used[1], swept[1]))
-    if answer is None:
-        raise ValueError(SECOND_ZONE)
-    return answer, band
+    return answer, band  # the last try held (a stopped last try raised above)
 
 
 @dataclass(frozen=True)
@@ -768,9 +764,7 @@ def _marched(half_width: float, base: tuple[float, float, float], gap: Any, kern
     relax = np.eye(grid.size) - volterra
     inverse = solve_triangular(relax, np.eye(grid.size), lower=True)
     relaxation = inverse.sum(axis=1)
-    values = {name: np.broadcast_to(np.asarray(load(grid) if callable(load) else load,
-                                               dtype=float), grid.shape).copy()
-              for name, load in loads.items()}
+    values = _load_values(loads, grid)
     given = {name: value if name in _STATIC else inverse @ value
              for name, value in values.items()}
     table = bare_table(half_width, base, tol)

@@ -415,18 +415,23 @@ def lift_off_zone(half_width: float, base: tuple[float, float, float], gap: Gap,
         zones = _Zones(half_width, base, gap, modes, table, tol)
         response = zones.response(-1.0, 1.0)
         delta, alpha, four = _kinematics(response, 0.0, 1.0, given)
-        floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
-        own = max(truncation_errors(
-            response, {"settlement": np.array([delta]), "tilt": np.array([alpha])},
-            response.complete({"settlement": np.array([delta]),
-                               "tilt": np.array([alpha])}), floor).values())
-        return ZoneAnswer(-1.0, 1.0, 0, response, delta, alpha, four, float(own), 0.0)
+        return ZoneAnswer(-1.0, 1.0, 0, response, delta, alpha, four,
+                          _own_error(response, delta, alpha, tol), 0.0)
     if near is not None and near.free != free:
         near = before = None
     if before is not None and before.free != free:
         before = None
     return _solve_one(half_width, base, gap, given, free, modes, table, tol, near=near,
                       before=before, same_gap=False)
+
+
+def _own_error(response: LayeredResponse, delta: float, alpha: float, tol: float) -> float:
+    """A zone's own truncation error [-] at its settlement and tilt (its units), as the
+    full-contact solve estimates it."""
+    floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
+    kinematics = {"settlement": np.array([delta]), "tilt": np.array([alpha])}
+    return float(max(truncation_errors(response, kinematics,
+                                       response.complete(kinematics), floor).values()))
 
 
 def zone_displacement(zone: ZoneAnswer, x: np.ndarray, table: RegularPartTable) -> np.ndarray:
@@ -472,7 +477,6 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
     same corners lifting, where its ends are looked for first; ``before``: the one
     before it, through which the end is extrapolated; ``same_gap``: whether theirs was
     this gap, so that the nearby zone's response serves)."""
-    floor = COARSE_ERROR_FLOOR if tol >= COARSE_TOL else ERROR_FLOOR
     last = None
     while True:
         zones = _Zones(half_width, base, gap, modes, table, tol)
@@ -507,11 +511,7 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
         x0, b = 0.5 * (lo + hi), 0.5 * (hi - lo)
         response = zones.response(lo, hi)
         delta, alpha, values = _kinematics(response, x0, b, given)
-        # the zone's own truncation error, as the full-contact solve estimates it
-        own = max(truncation_errors(
-            response, {"settlement": np.array([delta]), "tilt": np.array([alpha])},
-            response.complete({"settlement": np.array([delta]),
-                               "tilt": np.array([alpha])}), floor).values())
+        own = _own_error(response, delta, alpha, tol)
         # the ends': the answers on the ends found with half the modes
         _, _, coarse = _kinematics(zones.response(clo, chi), 0.5 * (clo + chi),
                                    0.5 * (chi - clo), given, level=1)
