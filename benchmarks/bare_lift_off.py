@@ -192,9 +192,9 @@ def measure_receding() -> list[tuple]:
     return rows
 
 
-#: The turning zone's tolerances (the march meets ~3e-3 on this heel, held by its zone
-#: ends' estimate; tighter is refused).
-TURNING_TOLS = (3e-3, 1e-3)
+#: The turning zone's tolerances (the march meets 1e-3 on this heel; at 5e-4 the zones' own
+#: estimate is over half of tol and the turn is refused).
+TURNING_TOLS = (3e-3, 1e-3, 5e-4)
 #: Its reference: the march itself at this tol, answered whatever its estimate.
 TURNING_REFERENCE_TOL = 1e-5
 
