@@ -29,7 +29,7 @@ UNCOATED_SCOPE = ("a scene with no coating layers is solved under a punch shape 
                   "statement, exactly where its contact zone keeps its size, only grows (a "
                   "crown pressed as the base creeps) or only recedes (a growing "
                   "eccentricity), and step by step where it grows and recedes in turn, to "
-                  "the tol that march meets (a few 1e-3)")
+                  "the tol that march meets (about 1e-3 to 5e-3)")
 
 
 def check_uncoated(scene: Any) -> None:
