@@ -43,10 +43,26 @@ def set_data(source: ColumnDataSource, data: dict) -> bool:
     resending them cost the server and the browser work for nothing.
     """
     old = source.data
-    if old.keys() == data.keys() and all(_same(old[k], v) for k, v in data.items()):
-        return False
+    if old.keys() == data.keys():
+        changed = {k: v for k, v in data.items() if not _same(old[k], v)}
+        if not changed:
+            return False
+        if len(changed) < len(data) and _one_length(old, changed):
+            # Only the columns that changed go to the page (one message and one buffer
+            # per column: the pressure plot's x and the histories' times stay as they
+            # are on a slider step).
+            source.data.update(changed)
+            return True
     source.data = data
     return True
+
+
+def _one_length(old: dict, changed: dict) -> bool:
+    """Whether the ``changed`` columns are as long as the columns of ``old`` they leave
+    as they are (a source's columns must keep one length)."""
+    lengths = {len(v) for k, v in old.items() if k not in changed}
+    lengths |= {len(v) for v in changed.values()}
+    return len(lengths) <= 1
 
 
 #: A value axis keeps its range while the data lie inside it and fill at least this

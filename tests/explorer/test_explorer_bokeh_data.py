@@ -103,3 +103,30 @@ def test_lines_and_text_columns_are_resent_only_when_they_change() -> None:
     assert set_data(src, dict(same, label=["punch 1", "punch 3"]))
     assert set_data(src, {"xs": [], "ys": [], "label": []})
     assert not set_data(src, {"xs": [], "ys": [], "label": []})
+
+
+def test_only_the_columns_that_changed_are_sent() -> None:
+    """A slider step changes the pressure, not the points it is drawn at: the page gets
+    the changed column alone (one message and buffer fewer a column kept), and all of
+    them when the lengths change."""
+    from bokeh.document.events import ColumnDataChangedEvent
+    from bokeh.models import ColumnDataSource
+
+    from explorer.plots.bokeh_data import set_data
+
+    x = np.linspace(-1.0, 1.0, 201, dtype=np.float32)
+    src = ColumnDataSource({"x": x, "q": x * x})
+    doc = Document()
+    doc.add_root(src)
+    events: list = []
+    doc.on_change(events.append)
+    assert set_data(src, {"x": x.copy(), "q": 2 * x * x})
+    assert len(events) == 1 and isinstance(events[0], ColumnDataChangedEvent)
+    assert events[0].cols == ["q"]
+    np.testing.assert_array_equal(src.data["x"], x)
+    np.testing.assert_array_equal(src.data["q"], 2 * x * x)
+    shorter = np.linspace(-1.0, 1.0, 101, dtype=np.float32)
+    assert set_data(src, {"x": shorter, "q": shorter})
+    # the whole data (cols None: every column), of one length
+    assert isinstance(events[-1], ColumnDataChangedEvent) and events[-1].cols is None
+    assert len(src.data["x"]) == len(src.data["q"]) == 101
