@@ -2,7 +2,7 @@
 # Installs everything the test suite needs, then runs the whole suite and builds the
 # documentation.
 # Usage (from the repository root):  bash tests/run.sh [pytest args]
-# Without arguments the whole suite runs in four parts at once and the documentation is
+# Without arguments the whole suite runs in three parts at once and the documentation is
 # built beside them (see below); with arguments one pytest run gets them (e.g.
 # bash tests/run.sh tests/scene/test_scene.py -x) and the documentation is not built.
 # SKIP_SETUP=1 skips the installation (an environment already set up).
@@ -44,10 +44,10 @@ if [ "$#" -gt 0 ]; then
     exec python -m pytest -q "$@"
 fi
 
-# The whole suite in four parts at once, one pytest each: the browser tests (marker
+# The whole suite in three parts at once, one pytest each: the browser tests (marker
 # "browser": a served explorer and Chromium), the soak tests (marker "soak": servers and
 # worker processes started, stopped, killed and left idle, much of it waiting on them) and
-# the rest in two halves (below; three parts, the rest in one, until 2026-12-04). One pytest keeps at most one core busy, and the soak part waits much of its
+# the rest. One pytest keeps at most one core busy, and the soak part waits much of its
 # time; when one part ends first the others still have both cores. Measured on a fresh
 # clone, 2 cores with nothing else running (2026-11-30): 19.8-21.4 min with the
 # installation (rest 18.5-19.9, browser 16.0-17.6, soak 7.5-8.8 min, documentation
@@ -86,17 +86,11 @@ browser_pid=$!
 python -m pytest -q -m "soak and not browser" --basetemp "$work/soak" \
     -o cache_dir=.pytest_cache/soak >"$work/soak.log" 2>&1 &
 soak_pid=$!
-# The rest in two halves, by directory: the explorer's and the engines' tests here, all
-# the others in the foreground below (each half ~230 s of one core, --durations=0 on
-# 2026-12-04). One pytest for the rest left a core idle once the soak part had ended.
-python -m pytest -q -m "not browser and not soak" tests/explorer tests/engines \
-    --basetemp "$work/rest_a" -o cache_dir=.pytest_cache/rest_a >"$work/rest_a.log" 2>&1 &
-rest_a_pid=$!
 
 # The documentation (docs/, Sphinx): built here so that it cannot rot. Warnings are errors
 # (-W), so a renamed API, a broken docstring, a moved report or link, or a gallery example
 # that no longer runs fails the run. Always from an empty build directory: an incremental
-# build would not repeat the warnings of pages it skips. It runs beside the four parts
+# build would not repeat the warnings of pages it skips. It runs beside the three parts
 # (~110 s of one core; measured in docs/conf.py's docstring). The pages stay in
 # DOCS_BUILD_DIR (default ${TMPDIR:-/tmp}/coated-punch-docs, outside the source tree):
 # open index.html there.
@@ -115,14 +109,11 @@ build_docs() {
 build_docs >"$work/docs.log" 2>&1 &
 docs_pid=$!
 # (kill fails once a job has ended: no status of its own may reach the exit code)
-trap 'kill "$browser_pid" "$soak_pid" "$rest_a_pid" "$docs_pid" 2>/dev/null || true
-      rm -rf "$work"' EXIT
+trap 'kill "$browser_pid" "$soak_pid" "$docs_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
 set +e
-python -m pytest -q -m "not browser and not soak" --ignore=tests/explorer \
-    --ignore=tests/engines --basetemp "$work/rest" -o cache_dir=.pytest_cache/rest
+python -m pytest -q -m "not browser and not soak" --basetemp "$work/rest" \
+    -o cache_dir=.pytest_cache/rest
 rest=$?
-wait "$rest_a_pid"
-rest_a=$?
 wait "$browser_pid"
 browser=$?
 wait "$soak_pid"
@@ -132,12 +123,9 @@ docs=$?
 set -e
 echo "---- documentation (sphinx -W) ----"
 cat "$work/docs.log"
-echo "---- the rest's other half (tests/explorer, tests/engines) ----"
-cat "$work/rest_a.log"
 echo "---- browser tests (pytest -m browser) ----"
 cat "$work/browser.log"
 echo "---- soak tests (pytest -m soak) ----"
 cat "$work/soak.log"
-echo "---- exit codes: rest $rest, rest (explorer, engines) $rest_a, browser $browser, soak $soak, docs $docs ----"
-[ "$rest" -eq 0 ] && [ "$rest_a" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$soak" -eq 0 ] \
-    && [ "$docs" -eq 0 ]
+echo "---- exit codes: rest $rest, browser $browser, soak $soak, docs $docs ----"
+[ "$rest" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$soak" -eq 0 ] && [ "$docs" -eq 0 ]
