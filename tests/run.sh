@@ -76,7 +76,10 @@ fi
 # browser 8.9-10.3, soak 4.0-4.8 min); beside two (load 5-7.7) 15.5 min: all green. Other
 # splits beside one busy loop took as long: six parts (the rest and the browser tests in
 # two each) 11.4 min, the "slow" checks in the soak part 10.2 min (load 5.4). The cores'
-# time is the bound: a shorter run needs less CPU, not other parts.
+# time is the bound: a shorter run needs less CPU, not other parts. On a fresh clone, quiet
+# (2026-12-04): 11:10 (rest 10:37, browser 9:00, soak 5:00; 796 s user CPU, 127 % of a
+# core); the rest in two halves by directory (tests/explorer and tests/engines, ~230 s of
+# one core each, beside the others) 11:12, the browser part then the longest (10:39).
 # The parts share nothing: each has its own temporary directory, pytest cache and served
 # explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
