@@ -41,7 +41,7 @@ end, found again with half the modes: the answers' change between the two ends,
 extrapolated as the modes' (``MAX_RATIO``). Under a gap of its own (a creeping base's
 memory, :mod:`core.engines.layered.bare_growing_zone`), where that estimate is over a tenth
 of tol, the ends are found with a quarter of the modes too, and the ratio of the two changes
-extrapolates them (``RATIO_SHARE``).
+(at least 1/2, ``LEAST_RATIO``) extrapolates them (``RATIO_SHARE``).
 """
 
 from __future__ import annotations
@@ -575,7 +575,7 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
             # quarter of the modes measure the ratio, as the layered solve's own estimate
             # does (``truncation_errors`` of :mod:`core.engines.layered.solve`): on the
             # heel that recedes and grows again (tests/engines/test_bare_lift_off.py) the
-            # fixed one read its ends' error ~1000x, this one 14-60x.
+            # fixed one read 2.6e-3, this one 1.7e-4, against ends off by 2e-7 to 2.4e-6.
             try:
                 qlo, qhi = _coarser_ends(zones, free, given, 2, (clo, chi), jacobian,
                                          ends_tol)
