@@ -101,8 +101,8 @@ RATIO_SHARE = 0.1
 #: ... and that ratio is taken at least this large: the estimate is then at least the last
 #: change itself. Where the gap has a kink inside the zone the changes need not fall
 #: steadily: a heel under ``0.005 t^2 + 0.002 (t - 0.8)_+^2.5`` (128 modes) changed its end
-#: by 3.3e-7 from 64 modes, after 64 against 32 by far more, and was 1.2e-7 off the end
-#: with 512 modes; the measured ratio alone read 3.4e-8.
+#: by 3.3e-7 from 64 modes, after ~3.5e-6 from 32 to 64 (a ratio of ~0.09), and was 1.2e-7
+#: off the end with 512 modes; the measured ratio alone read 3.4e-8.
 LEAST_RATIO = 0.5
 #: Both free ends are taken when their singular coefficients are below this share of the
 #: pressure's scale (the zone's force over its half-width).
@@ -555,7 +555,7 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
                     second = 2.0 * start - (before.lo if free < 0 else before.hi)
             end = _free_end(zones, free, given, level=0, near=start, second=second)
             lo, hi = _zone(free, end)
-            ends_tol = TWO_ENDS_TOL
+            ends_tol = TWO_ENDS_TOL  # (asked of two free ends only)
         x0, b = 0.5 * (lo + hi), 0.5 * (hi - lo)
         response = zones.response(lo, hi)
         delta, alpha, values = _kinematics(response, x0, b, given)
