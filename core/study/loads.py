@@ -30,13 +30,13 @@ from core.engines.layered import (
     ERROR_FLOOR,
     LIFT_OFF_SHARE,
     MAX_MODES,
-    MAX_RATIO,
     PRESSURE_REACH,
     LayeredResponse,
     cached_response,
     corner_reach,
     default_modes,
     gap_key,
+    geometric_tail,
     layered_declines,
     stack_key,
     uniform_layers,
@@ -174,9 +174,7 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
     floor = COARSE_ERROR_FLOOR if problem.tol >= COARSE_TOL else ERROR_FLOOR
     errors = {}
     for name in unknowns + ["pressure"]:
-        ratio = np.where(d0[name] > 0, np.minimum(d1[name] / np.where(
-            d0[name] > 0, d0[name], 1.0), MAX_RATIO), MAX_RATIO)
-        errors[name] = np.maximum(d1[name] * ratio / (1 - ratio), floor)
+        errors[name] = np.maximum(geometric_tail(d1[name], d0[name]), floor)
     error = np.max(np.stack(list(errors.values())), axis=0)
     numerical = np.max(np.stack([errors[name] for name in unknowns]), axis=0)
     met = error <= 0.5 * problem.tol

@@ -45,6 +45,7 @@ from core.engines.layered.solve import (
     PRESSURE_REACH,
     LayeredResponse,
     cached_response,
+    geometric_tail,
 )
 
 __all__ = [
@@ -56,6 +57,7 @@ __all__ = [
     "default_modes",
     "ERROR_FLOOR",
     "gap_key",
+    "geometric_tail",
     "layered_declines",
     "LayeredResponse",
     "LIFT_OFF_SHARE",

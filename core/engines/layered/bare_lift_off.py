@@ -59,6 +59,7 @@ from core.engines.layered.solve import (
     MAX_RATIO,
     Gap,
     LayeredResponse,
+    geometric_tail,
     layered_response,
     truncation_errors,
 )
@@ -511,15 +512,6 @@ def _change(zones: _Zones, given: dict[str, float], level: int, ends: tuple[floa
                for n in _NAMES if n not in given), coarse
 
 
-def _geometric_tail(last: float, before: float) -> float:
-    """The error left after a change ``last`` that followed a change ``before`` (modes
-    doubled each time): ``last r / (1 - r)``, ``r = last / before`` within
-    [``LEAST_RATIO``, ``MAX_RATIO``]."""
-    ratio = (min(max(last / before, LEAST_RATIO), MAX_RATIO) if before > 0.0
-             else MAX_RATIO)
-    return last * ratio / (1.0 - ratio)
-
-
 def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
                given: dict[str, float], free: int, modes: int, table: RegularPartTable,
                tol: float, near: ZoneAnswer | None = None,
@@ -586,8 +578,9 @@ def _solve_one(half_width: float, base: tuple[float, float, float], gap: Gap,
             else:
                 change0, _ = _change(zones, given, 2, (qlo, qhi), coarse, values)
                 end_change0 = max(abs(clo - qlo), abs(chi - qhi))
-                error = max(own, _geometric_tail(change, change0))
-                end_error = max(_geometric_tail(end_change, end_change0), END_TOL)
+                error = max(own, float(geometric_tail(change, change0, LEAST_RATIO)))
+                end_error = max(float(geometric_tail(end_change, end_change0, LEAST_RATIO)),
+                                END_TOL)
         answer = ZoneAnswer(lo, hi, free, response, delta, alpha, values, float(error),
                             float(end_error), jacobian)
         if error <= 0.5 * tol or 2 * modes > MAX_MODES:

@@ -292,6 +292,17 @@ def _differences(response: LayeredResponse, given: dict[str, np.ndarray],
     return out
 
 
+def geometric_tail(last: Any, before: Any, least_ratio: float = 0.0) -> np.ndarray:
+    """The error left after a change ``last`` [-] that followed a change ``before`` (the
+    modes doubled each time): ``last r / (1 - r)``, ``r = last / before`` within
+    [``least_ratio``, ``MAX_RATIO``] (``MAX_RATIO`` where ``before`` is 0). Elementwise."""
+    last = np.asarray(last, dtype=float)
+    before = np.asarray(before, dtype=float)
+    measured = last / np.where(before > 0, before, 1.0)
+    ratio = np.where(before > 0, np.clip(measured, least_ratio, MAX_RATIO), MAX_RATIO)
+    return last * ratio / (1 - ratio)
+
+
 def truncation_errors(response: LayeredResponse, given: dict[str, np.ndarray],
                       fine: dict[str, np.ndarray], floor: float) -> dict[str, float]:
     """The estimated error of each unknown and of q of ``response`` for the ``given``
@@ -302,8 +313,7 @@ def truncation_errors(response: LayeredResponse, given: dict[str, np.ndarray],
     d0 = _differences(response, given, fine, level=2)
     errors = {}
     for name in [n for n in _NAMES if n not in given] + ["pressure"]:
-        ratio = min(d1[name] / d0[name], MAX_RATIO) if d0[name] > 0 else MAX_RATIO
-        errors[name] = max(d1[name] * ratio / (1 - ratio), floor)
+        errors[name] = max(float(geometric_tail(d1[name], d0[name])), floor)
     return errors
 
 
