@@ -25,7 +25,9 @@ returns a ``SceneSolution``.
 - ``coating_check.py``: a scene's fast answer against the finite-element check;
 - ``evidence.py``: ``model_error_evidence``, the coating model's error every output shows
   (the FE check's measurement once run on the scene, else the estimate);
-- ``golden_section.py``: the least gap between punch and coating.
+- ``golden_section.py``: the least gap between punch and coating;
+- ``at_loading.py``: ``elastic_at_loading``, the scene whose base answers as at the instant
+  of loading (elastic at its modulus then), and ``creeps``.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from core.optional import lazy_exports
+from core.scene.at_loading import creeps, elastic_at_loading
 from core.scene.contact_zone import LIFT_OFF_SHARE, contact_width, lift_off_length, lifts_off
 from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
 from core.scene.display import engine_text, known_contact_width, lifts_off_at
@@ -108,7 +111,9 @@ __all__ = [
     "flags_with_evidence",
     "model_error_evidence",
     "contact_width",
+    "creeps",
     "design_check",
+    "elastic_at_loading",
     "DesignCheck",
     "DesignLimits",
     "FLAG_MESSAGES",
