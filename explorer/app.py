@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import Any
 
 import panel as pn
+import param
 
 from .fixes import (
     bokeh_fixes,
@@ -45,6 +46,7 @@ from .model import (
 from .plots import Figures
 from .solving import SolveController, format_error, idle_release, install_websocket_marks, mark
 from .views import (
+    HELD_AFTER_MS,
     AddressLink,
     BaseView,
     CheckView,
@@ -65,7 +67,7 @@ from .views import (
     status_html,
 )
 
-__all__ = ["ExplorerApp", "LIVE_BOUND_LIMITS_S", "LIVE_SOLVE_S", "check_live_bound",
+__all__ = ["DragSteps", "ExplorerApp", "LIVE_BOUND_LIMITS_S", "LIVE_SOLVE_S", "check_live_bound",
            "create_app"]
 
 log = logging.getLogger(__name__)
@@ -107,6 +109,31 @@ def check_live_bound(value: object) -> float:
 DRAW_EVERY_MS = 80.0
 
 
+class DragSteps:
+    """What a drag step of a slider that otherwise waits for its release does (the
+    ``live_when`` of the views' bindings and the eccentricity slider's ``drag``):
+    calling it says whether the step applies at once (the last solve was fast enough,
+    :meth:`ExplorerApp.fast_solves`); a step not applied goes to :meth:`held`, where the
+    page previews the dragged value if the base creeps (its base elastic at loading,
+    17-45 ms where the answer with creep takes 0.2-7 s), and the release to
+    :meth:`released`, after which the answer with creep is shown again."""
+
+    def __init__(self, app: ExplorerApp) -> None:
+        self._app = app
+
+    def __call__(self) -> bool:
+        return self._app._drag_step_applies()
+
+    def held(self, target: Any, name: str, value: Any) -> None:
+        """A step of parameter ``name`` of ``target`` (a part of the session's state) to
+        ``value``, held until the release."""
+        self._app.preview_step(target, name, value)
+
+    def released(self) -> None:
+        """The dragged slider was released (its value, if new, is in the state)."""
+        self._app.end_preview()
+
+
 class ExplorerApp(pn.viewable.Viewer):
     """One session of the explorer: its model objects, views and page."""
 
@@ -141,6 +168,14 @@ class ExplorerApp(pn.viewable.Viewer):
         # model fidelity (layer interface, contact model, coating-model tolerance): one
         # view whose widgets sit in the Coating and Time tabs (see ``fidelity``)
         self._fidelity = FidelityView(self.state, self.screen.reject)
+        # previews of held drag steps: the scene wanted next, whether a preview is asked
+        # for (between a held step and its release), one is due (scheduled), one is drawn
+        self.drag = DragSteps(self)
+        self._preview_scene: dict[str, Any] | None = None
+        self._previewing = False
+        self._preview_due = False
+        self._showing_preview = False
+        self._drawn_preview: ResultView | None = None
         self._layout = self._build_layout(self._build_sidebar())
         self._wanted_index, tab, pin_scenes, pin_message = read_view_query(
             query or {}, len(self.sidebar))
@@ -170,6 +205,7 @@ class ExplorerApp(pn.viewable.Viewer):
         if self.loop.served:
             pn.state.onload(self._on_load)
         self.controller.param.watch(self._on_view, "view")
+        self.controller.param.watch(self._on_preview, "preview")
         self.controller.param.watch(self.results.on_status, ["error", "busy"])
         self.screen.param.watch(self._on_time, "time_index")
         self.screen.param.watch(self._on_notice, "notice")
@@ -197,7 +233,7 @@ class ExplorerApp(pn.viewable.Viewer):
         when asked for (``app.base_tab``): they are ~0.6-0.9 s of the ~2 s of the server's
         CPU that a new page cost, and a page may never show them."""
         state, screen, controller, loop = self.state, self.screen, self.controller, self.loop
-        live = self._drag_step_applies
+        live = self.drag
         self._views: dict[str, Any] = {}
         self._makers: dict[str, Callable[[], Any]] = {
             "punch": lambda: PunchView(state, screen, live),
@@ -210,7 +246,7 @@ class ExplorerApp(pn.viewable.Viewer):
                                    screen, on_settings=self.link.schedule),
         }
         self._views["scene"] = SceneView(state, self.presets, self.preset_key, self.history,
-                                         self.load_scene, controller, screen.reject)
+                                         self.load_scene, controller, screen.reject, live)
         self._views["check"] = CheckView(state, self.limits, screen)
         self._views["files"] = FilesView(state, screen, controller, self.scales, self.limits,
                                          self._load_file, self.results.show_download_error)
@@ -311,11 +347,74 @@ class ExplorerApp(pn.viewable.Viewer):
         step applies now (:meth:`fast_solves`); when not, the page says so."""
         self.tabs.touch()
         fast = self.fast_solves()
+        self.results.say_held(not fast, self._last_cpu_seconds(), self._showing_preview)
+        return fast
+
+    def _last_cpu_seconds(self) -> float | None:
         view = self.controller.view
         spent = None if view is None else view.info.get("cpu_seconds", view.info.get("seconds"))
-        self.results.say_held(not fast, float(spent) if isinstance(spent, (int, float))
-                              else None)
-        return fast
+        return float(spent) if isinstance(spent, (int, float)) else None
+
+    # -- previews of held drag steps -----------------------------------------------
+    def preview_step(self, target: Any, name: str, value: Any) -> None:
+        """A drag step held until the release (:class:`DragSteps`): where the base creeps,
+        the scene with ``target.name = value`` is previewed with its base elastic at
+        loading (:meth:`SolveController.request_preview`), asked :data:`HELD_AFTER_MS`
+        after the step on a served page (a key press's release comes first: no preview
+        then), the newest step's when the worker is free. The state is not changed; a step
+        back to the value applied ends the preview (:meth:`end_preview`)."""
+        scene = self._scene_with(target, name, value)
+        if scene is None:
+            return
+        if scene == self.state.to_scene():
+            # back at the value applied (a release there may not even reach the server:
+            # the browser sends only a changed value): the answer with creep again
+            self.end_preview()
+            return
+        self._preview_scene = scene
+        self._previewing = True
+        if self._preview_due:
+            return
+        self._preview_due = True
+        if self.loop.served:
+            self.loop.later(self._ask_preview, HELD_AFTER_MS)
+        else:
+            self._ask_preview()
+
+    def _scene_with(self, target: Any, name: str, value: Any) -> dict[str, Any] | None:
+        """The state's scene with ``target.name`` at ``value`` (the state left as it was,
+        none of its watchers told); None when the state cannot make one."""
+        old = getattr(target, name)
+        try:
+            with param.parameterized.discard_events(target):
+                setattr(target, name, value)
+                try:
+                    return self.state.to_scene()
+                finally:
+                    setattr(target, name, old)
+        except (ValueError, TypeError):
+            return None
+
+    def _ask_preview(self) -> None:
+        self._preview_due = False
+        scene, self._preview_scene = self._preview_scene, None
+        if scene is not None and self._previewing:
+            self.controller.request_preview(scene)
+
+    def end_preview(self) -> None:
+        """A release: no more previews; a preview on screen gives way to the answer with
+        creep (the new one once solved, or the last one when the value did not change)."""
+        self._previewing = False
+        self._preview_scene = None
+        self.controller.stop_previews()
+        if self._showing_preview and not self.controller.busy \
+                and self.controller.view is not None:
+            self._draw(self.controller.view)
+
+    def _on_preview(self, event: Any) -> None:
+        if self.controller.preview is None or not self._previewing:
+            return
+        self._on_view(None)
 
     # -- layout ----------------------------------------------------------------------
     def _build_layout(self, tabs: list[tuple[str, Any]]) -> pn.viewable.Viewable:
@@ -413,8 +512,16 @@ class ExplorerApp(pn.viewable.Viewer):
             self._on_view(None)
         self.tabs.fill_when_idle()
 
+    def _newest(self) -> ResultView | None:
+        """What the page draws next: a preview while a held drag asks for one and one
+        came, else the controller's result."""
+        preview = self.controller.preview
+        if self._previewing and preview is not None:
+            return preview
+        return self.controller.view
+
     def _on_view(self, event: Any) -> None:
-        view = self.controller.view
+        view = self._newest()
         if view is None or not (self._connected or self._initializing):
             return
         if self.loop.served:
@@ -432,11 +539,18 @@ class ExplorerApp(pn.viewable.Viewer):
     def _draw_due_view(self) -> None:
         """The newest result, when the interval after the last draw is over."""
         self._draw_due = False
-        view = self.controller.view
-        if view is not None and view is not self.screen.drawn:
+        view = self._newest()
+        if view is not None and view is not self.screen.drawn \
+                and view is not self._drawn_preview:
             self._draw(view)
 
     def _draw(self, view: ResultView) -> None:
+        preview = view is self.controller.preview and view is not self.controller.view
+        if preview:
+            self._draw_preview(view)
+            return
+        self._showing_preview = False
+        self._drawn_preview = None
         self._last_draw = time.monotonic()
         n = len(view.times)
         old = self.screen.drawn
@@ -455,6 +569,22 @@ class ExplorerApp(pn.viewable.Viewer):
             mark("drawn")  # the patch goes out as the hold ends
         self.results.push()
         self.link.schedule()
+
+    def _draw_preview(self, view: ResultView) -> None:
+        """Draw a preview (:meth:`preview_step`) at the time on screen. The result on
+        screen stays the last answer with creep (``screen.drawn``: pins, downloads and
+        the page's link speak of it), which the release draws again."""
+        self._last_draw = time.monotonic()
+        self._showing_preview = True
+        self._drawn_preview = view
+        old = self.screen.drawn
+        index = min(self.screen.time_index, len(view.times) - 1)
+        with pn.io.hold():
+            self.results.draw(view, index, new_range=old is None
+                              or len(old.times) != len(view.times))
+            self.results.say_held(True, self._last_cpu_seconds(), preview=True)
+            mark("drawn")
+        self.results.push()
 
     def _on_time(self, event: Any) -> None:
         self.tabs.touch()

@@ -8,6 +8,13 @@ newer outcome has been shown already, so a slow old solve can never overwrite a 
 answer. A rejected scene sets ``error`` (the core's message, naming the field) and leaves
 ``view`` (the last good result) on screen.
 
+Previews (:meth:`SolveController.request_preview`): while a slider waits for its release
+(solves too slow to follow it), the page may ask for a cheaper scene of the dragged value
+(the base elastic at loading, :func:`core.scene.elastic_at_loading`). A preview runs only
+when this session's worker is idle, one at a time, the newest wanted next; it never
+becomes ``view`` (downloads, pins and the live decision keep the last real answer), and
+any request drops the previews asked before it.
+
 Where solves run: on the thread that waits for them (a shared thread pool, or the caller),
 or, once :func:`use_worker_processes` has started them, in worker processes
 (:mod:`explorer.solving.workers`), the thread then only waiting. ``python -m explorer`` uses
@@ -30,6 +37,7 @@ from typing import TYPE_CHECKING, Any
 import param
 
 from core import STAGE_CACHE_BYTES, solve
+from core.scene import creeps, elastic_at_loading
 from core.work import SolveCancelled
 
 from ..model import DesignLimits, ExplorerState, ResultView, prepare_view, scene_with_limits
@@ -41,6 +49,7 @@ from .workers import (
     SolverProcesses,
     WorkerFailed,
     download_text,
+    preview_view,
     solution_text,
     solve_view,
 )
@@ -193,6 +202,9 @@ class SolveController(param.Parameterized):
     busy = param.Boolean(default=False, doc="A newer request than the one shown is running.")
     requests = param.Integer(default=0, doc="Requests made.")
     solves = param.Integer(default=0, doc="Outcomes delivered (results and errors).")
+    preview = param.ClassSelector(
+        class_=ResultView, default=None, allow_None=True,
+        doc="The newest preview (request_preview) since the last request, else None.")
 
     def __init__(self, state: ExplorerState,
                  solve: Callable[[dict[str, Any]], Any] | None = None,
@@ -216,6 +228,10 @@ class SolveController(param.Parameterized):
         self._pending: tuple[int, dict[str, Any]] | None = None
         # this session's request in a worker now, and since when (monotonic [s])
         self._in_worker: tuple[SentRequest, float] | None = None
+        # the preview scene wanted next (the newest asked), and whether one is solving
+        self._preview_wanted: dict[str, Any] | None = None
+        self._preview_running = False
+        self._preview_generation = 0  # up by one at every request and stop_previews
         if auto:
             state.param.watch(lambda event: self.request(), "revision")
 
@@ -230,6 +246,10 @@ class SolveController(param.Parameterized):
         with self._lock:
             self._latest += 1
             rid = self._latest
+            self._preview_wanted = None  # the previews asked before are not wanted
+            self._preview_generation += 1
+        if self.preview is not None:
+            self.preview = None
         try:
             scene = self.state.to_scene()
         except ValueError as exc:  # a state the screen cannot turn into a scene
@@ -342,6 +362,80 @@ class SolveController(param.Parameterized):
             outcome = format_error(str(exc))
         self._deliver(rid, outcome)
         return rid
+
+    # -- previews --------------------------------------------------------------------
+    def request_preview(self, scene: dict[str, Any]) -> bool:
+        """Preview ``scene`` (a scene dict; see the module notes): its base elastic at
+        loading (:func:`~explorer.solving.workers.preview_view`) is solved at once when
+        nothing of this session solves, else after the preview solving now (the newest
+        asked wins); never while a request runs or waits. Its result becomes ``preview``
+        unless a request came meanwhile; a scene that fails is dropped (the release's
+        solve says why). False (and nothing asked) for a base that does not creep: its
+        preview would be the answer itself."""
+        if not creeps(scene):
+            return False
+        with self._lock:
+            self._preview_wanted = scene
+            if self._preview_running or self._running:
+                return True
+            self._preview_running = True
+        self._next_preview()
+        return True
+
+    def stop_previews(self) -> None:
+        """Drop the previews asked and not solved yet (the one solving is not shown)."""
+        with self._lock:
+            self._preview_wanted = None
+            self._preview_generation += 1
+        if self.preview is not None:
+            self.preview = None
+
+    def _next_preview(self) -> None:
+        # with _preview_running set: the wanted scene solved (or nothing is wanted)
+        with self._lock:
+            scene, self._preview_wanted = self._preview_wanted, None
+            epoch = self._preview_generation
+            if scene is None or self._running:
+                self._preview_running = False
+                return
+        if self._executor is None:
+            self._delivered_preview(epoch, scene, self._preview_view(scene, None))
+            return
+        sent = None
+        if self._processes is not None:
+            # only on an idle worker: a preview never delays a real solve
+            sent = self._processes.send_now(self._lane, preview_view, scene)
+            if sent is None:
+                with self._lock:
+                    self._preview_running = False
+                return
+        self._executor.submit(self._preview_work, epoch, scene, sent)
+
+    def _preview_work(self, epoch: int, scene: dict[str, Any],
+                      sent: SentRequest | None) -> None:
+        view = self._preview_view(scene, sent)
+        self._dispatch(lambda: self._delivered_preview(epoch, scene, view))
+
+    def _preview_view(self, scene: dict[str, Any], sent: SentRequest | None
+                      ) -> ResultView | None:
+        try:
+            if sent is not None:
+                return self._processes.result(sent)
+            if self._solve is _default_solve:
+                return preview_view(scene)
+            elastic = elastic_at_loading(scene)
+            return prepare_view(self._solve(elastic), elastic)
+        except Exception:  # noqa: BLE001 - a preview that fails is only not shown
+            log.debug("preview failed", exc_info=True)
+            return None
+
+    def _delivered_preview(self, epoch: int, scene: dict[str, Any],
+                           view: ResultView | None) -> None:
+        with self._lock:
+            wanted = epoch == self._preview_generation and not self._running
+        if view is not None and wanted:
+            self.preview = view
+        self._next_preview()
 
     def _left_worker(self, sent: SentRequest) -> None:
         with self._lock:

@@ -2,7 +2,7 @@
 
 A worker's main loop (:func:`serve`) takes one request ``(fn, args)`` at a time from its
 pipe and answers ``("ok", value, (start, end))`` or ``("error", exception, (start,
-end))``; the functions the server asks for are here: :func:`solve_view`,
+end))``; the functions the server asks for are here: :func:`solve_view`, :func:`preview_view`,
 :func:`download_text` (the downloads, the printable report among them),
 :func:`worker_info`. Nothing here imports Panel: the workers import only ``core`` and
 :mod:`explorer.results` (a report loads HoloViews, Bokeh and Matplotlib in the worker
@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import core.report
 from core import release_freed_memory, set_stage_cache_budget, solve, stage_cache_bytes
+from core.scene import elastic_at_loading
 from core.work import cancellable
 
 from ..model import FitOutcome, ResultView, prepare_view, run_fit
@@ -68,6 +69,15 @@ def solve_view(scene: dict[str, Any]) -> ResultView:
     Runs in a worker. An invalid scene raises the core's ValueError, which names the field.
     """
     return prepare_view(solve(scene), scene)
+
+
+def preview_view(scene: dict[str, Any]) -> ResultView:
+    """The preview of ``scene`` (a scene dict) shown while a slider waits for its release:
+    the scene with its base elastic at loading (:func:`core.scene.elastic_at_loading`:
+    exact at t = 0, without creep later), solved and prepared as :func:`solve_view` does.
+    Runs in a worker; an invalid scene raises the core's ValueError."""
+    elastic = elastic_at_loading(scene)
+    return prepare_view(solve(elastic), elastic)
 
 
 def download_text(scene: dict[str, Any], kind: str, info: dict[str, Any] | None = None,

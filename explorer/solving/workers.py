@@ -38,11 +38,19 @@ from typing import Any
 from .priority import at_background_priority
 from .process_start import process_context
 from .trace import TRACE_FILE, mark
-from .worker_side import DOWNLOADS, download_text, serve, solution_text, solve_view, worker_info
+from .worker_side import (
+    DOWNLOADS,
+    download_text,
+    preview_view,
+    serve,
+    solution_text,
+    solve_view,
+    worker_info,
+)
 
 __all__ = ["BACKGROUND_TIMEOUT_S", "DOWNLOADS", "REQUEST_TIMEOUT_S", "SPILL_AFTER_S", "SentRequest",
            "SolverProcesses", "WorkerFailed", "download_text", "solution_text",
-           "solve_view", "worker_info"]
+           "preview_view", "solve_view", "worker_info"]
 
 log = logging.getLogger(__name__)
 

@@ -33,7 +33,7 @@ from .link import LINK_EVERY_MS, AddressLink
 from .loop import PageLoop
 from .pins import PinsView
 from .punch import PunchView
-from .results import ResultsView, badges_html, readout_html
+from .results import HELD_AFTER_MS, ResultsView, badges_html, readout_html
 from .scene import SceneView
 from .status import status_html
 from .study import StudyView
@@ -42,6 +42,7 @@ from .tabs import COMPLETE_CLASS, FILL_TABS_AFTER_MS, DeferredTabs
 from .times import TimesView
 
 __all__ = ["BUSY_AFTER_MS", "CONTACT_LABELS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS",
+           "HELD_AFTER_MS",
            "AddressLink", "BaseView", "COMPLETE_CLASS", "CheckView", "CoatingView",
            "DeferredTabs", "FidelityView", "FilesView", "FitView", "LessonsView",
            "PageLoop", "PinsView", "PunchView", "ResultsView", "SceneView", "StudyView",

@@ -4,7 +4,9 @@ Moving the force off the centre is how a design engineer meets lift-off: the sli
 the moment M = e P of a constant force P (statement "force + moment given") and shows
 the e of the scene on screen whatever set it (a preset, a file, the moment's own slider).
 When solves are too slow to follow the handle, a note under the slider says so while it
-is dragged, with the e the plots still show, until the release sets the new one.
+is dragged, with the e the plots still show, until the release sets the new one; where the
+base creeps, the page previews each e meanwhile (the base elastic at loading, see
+:mod:`explorer.app`).
 """
 
 from __future__ import annotations
@@ -38,12 +40,19 @@ NOT_APPLICABLE = ("The eccentricity sets the moment when force and moment are gi
                   "the force is a constant above zero.")
 
 
-def lag_text(dragged: float, shown: float | None, cpu_seconds: float | None) -> str:
+def lag_text(dragged: float, shown: float | None, cpu_seconds: float | None,
+             previewed: float | None = None) -> str:
     """What the page says while the handle is at ``dragged`` [m] and the plots still show
     the result solved at e = ``shown`` [m] (None: not known), solved in ``cpu_seconds``
-    [s] of CPU time (None: not known)."""
+    [s] of CPU time (None: not known), or a preview at e = ``previewed`` [m] (the base
+    elastic at loading; None: no preview on screen)."""
     took = ("" if cpu_seconds is None
             else f" (the last one took {1e3 * cpu_seconds:.0f} ms)")
+    if previewed is not None:
+        return (f"Solves with creep are too slow to follow the handle{took}: the plots "
+                f"preview e = {previewed:.3f} m on the base as it answers at loading "
+                f"(without creep), and show the answer with creep at e = {dragged:.3f} m "
+                "when you release it.")
     showing = ("the previous result" if shown is None
                else f"the result at e = {shown:.3f} m")
     return (f"Solves are too slow to follow the handle{took}: the plots show {showing} "
@@ -54,10 +63,13 @@ class EccentricityControl:
     """A slider of e = M/P [m] bound to the loading of the session's state."""
 
     def __init__(self, state: ExplorerState, controller: SolveController,
-                 reject: Callable[[str], None]) -> None:
+                 reject: Callable[[str], None], drag: Any = None) -> None:
         """``controller``: its last solve's time decides whether drag steps apply;
-        ``reject``: says why a value was refused."""
+        ``reject``: says why a value was refused; ``drag``: where a held step's moment
+        goes (``drag.held(history, "value", M)``) and the release (``drag.released()``),
+        as for the other sliders (:class:`~.widgets.Binding`); None: nowhere."""
         self.state = state
+        self.drag = drag
         self.controller = controller
         self.reject = reject
         self.slider = slider("eccentricity e = M/P [m] (sets the moment)", -1.0, 1.0, 0.01,
@@ -75,7 +87,7 @@ class EccentricityControl:
         loading.param.watch(self.refresh, "statement")
         state.punch.param.watch(self.refresh, "half_width")
         # a result arriving mid-drag changes what the plots show: the note follows it
-        controller.param.watch(self._on_result, "view")
+        controller.param.watch(self._on_result, ["view", "preview"])
         self.panel = pn.Column(self.slider, self.lag, self.note, sizing_mode="stretch_width",
                                margin=0)
         self.refresh()
@@ -121,12 +133,19 @@ class EccentricityControl:
         if self.controller.solved_within(LIVE_SOLVE_S):
             self.say_lag(None)
             self.apply(event.new)
-        else:
-            self.say_lag(event.new)
+            return
+        self.say_lag(event.new)
+        moment = self.state.loading.histories["moment"]
+        if (self.drag is not None and event.new is not None and self.applicable()
+                and moment.kind == "constant"):
+            self.drag.held(moment, "value",
+                           float(event.new) * self.state.loading.histories["force"].value)
 
     def _on_release(self, event: Any) -> None:
         self.say_lag(None)
         self.apply(event.new)
+        if self.drag is not None:
+            self.drag.released()
 
     def _on_result(self, event: Any) -> None:
         if self.lag.visible:
@@ -150,8 +169,10 @@ class EccentricityControl:
         view = self.controller.view
         spent = None if view is None else view.info.get("cpu_seconds",
                                                         view.info.get("seconds"))
+        preview = self.controller.preview
         self.lag.object = lag_text(float(dragged), shown,
-                                   float(spent) if isinstance(spent, (int, float)) else None)
+                                   float(spent) if isinstance(spent, (int, float)) else None,
+                                   None if preview is None else eccentricity(preview.scene))
         self.lag.visible = True
 
     def apply(self, e: float | None) -> None:

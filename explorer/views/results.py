@@ -32,7 +32,7 @@ from .contact import ContactPanes
 from .link import AddressLink
 from .loop import PageLoop
 from .pins import PinsView
-from .status import held_text, status_html
+from .status import held_text, preview_text, status_html
 from .style import NOTE_STYLE, html_pane
 from .widgets import NAMES, TimePlayer
 
@@ -272,7 +272,7 @@ class ResultsView:
         self.status_badges.object = badges_html(view, "status")
         if self.time_axis.on:
             self.time_axis.fit()
-        self.show_design()
+        self.show_design(view)
 
     def evidence(self, view: ResultView | None) -> dict[str, Any] | None:
         """The coating model's error to show for ``view``: measured by the Coating tab's
@@ -301,9 +301,10 @@ class ResultsView:
                                   f"{days_text(float(view.times[index]))}</span>")
         self.readout.object = readout_html(view, index, self.pins.board.pins)
 
-    def show_design(self) -> None:
-        """The design check of the result on screen against the session's limits."""
-        view = self.screen.shown()
+    def show_design(self, view: ResultView | None = None) -> None:
+        """The design check of ``view`` (default: the result on screen) against the
+        session's limits."""
+        view = self.screen.shown() if view is None else view
         if view is not None and view.several:
             self.design.object = ""  # said by the readout's note
             return
@@ -330,9 +331,11 @@ class ResultsView:
         if not controller.busy:
             self.link.schedule()  # a link skipped while busy, if no newer result came
 
-    def say_held(self, held: bool, cpu_seconds: float | None = None) -> None:
+    def say_held(self, held: bool, cpu_seconds: float | None = None,
+                 preview: bool = False) -> None:
         """Say (``held``) or stop saying that a dragged slider waits for its release, the
-        last solve having taken ``cpu_seconds`` [s] of CPU time (None: not known).
+        last solve having taken ``cpu_seconds`` [s] of CPU time (None: not known);
+        ``preview``: the plots show a preview of the dragged value meanwhile (said at once).
 
         On a served page the note comes :data:`HELD_AFTER_MS` after the step, if no
         release came meanwhile: a key press on such a slider is a step and its release at
@@ -343,14 +346,14 @@ class ResultsView:
             if self.held.visible:
                 self.held.object, self.held.visible = "", False
             return
-        text = held_text(cpu_seconds)
+        text = preview_text(cpu_seconds) if preview else held_text(cpu_seconds)
 
         def show() -> None:
             if self._held_wanted:
                 self.held.object = text
                 self.held.visible = True
 
-        if self.loop.served:
+        if self.loop.served and not preview:
             self.loop.later(show, HELD_AFTER_MS)
         else:
             show()

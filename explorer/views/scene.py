@@ -31,10 +31,11 @@ class SceneView:
     def __init__(self, state: ExplorerState, presets: dict[str, dict[str, Any]],
                  preset_key: str | None, history: SceneHistory,
                  load_scene: Callable[[dict[str, Any]], bool], controller: SolveController,
-                 reject: Callable[[str], None]) -> None:
+                 reject: Callable[[str], None], drag: Any = None) -> None:
         """``presets``: key -> scene, offered in this order; ``preset_key``: the preset on
         screen (None: another scene); ``history``: undo and reset; ``load_scene``: shows
-        a preset chosen; ``controller`` and ``reject``: for the eccentricity slider."""
+        a preset chosen; ``controller``, ``reject`` and ``drag`` (its drag steps held:
+        see :class:`~.eccentricity.EccentricityControl`): for the eccentricity slider."""
         self.state = s = state
         self.presets = presets
         self.history = history
@@ -65,7 +66,7 @@ class SceneView:
         s.loading.param.watch(self.refresh, "statement")
         self.history_editors = (HistoryEditor("load-0"), HistoryEditor("load-1"))
         self.unknowns_note = html_pane("", styles={"font-size": "13px"})
-        self.eccentric_load = EccentricityControl(state, controller, reject)
+        self.eccentric_load = EccentricityControl(state, controller, reject, drag)
         self.loading = OnePunchOnly(
             state, "This loading", self.statement, self.eccentric_load.panel,
             self.history_editors[0].panel, self.history_editors[1].panel,

@@ -102,6 +102,17 @@ def held_text(cpu_seconds: float | None) -> str:
             "last result and update when you release it.")
 
 
+def preview_text(cpu_seconds: float | None) -> str:
+    """What the page says while it shows a preview of a dragged slider's value (solves
+    with creep too slow to follow it, ``cpu_seconds`` [s] the last one; None: not
+    known): the base elastic at loading, exact at t = 0, the answer with creep on release."""
+    took = "" if cpu_seconds is None else f" (the last one took {_duration(cpu_seconds)})"
+    return (f"Preview while you drag: solves with creep are too slow to follow the "
+            f"slider{took}, so the plots show the base as it answers at loading, elastic "
+            "and without creep (exact at t = 0 d, later without the creep). The answer "
+            "with creep follows when you release it.")
+
+
 def model_error_text(evidence: Mapping[str, Any]) -> str:
     """The coating model's error in words: measured by the FE check, or estimated."""
     side = "above" if evidence["flagged"] else "within"

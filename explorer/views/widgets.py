@@ -176,7 +176,9 @@ class Binding:
                  live_when: Callable[[], bool] | None = None) -> None:
         """``live_when``: asked at each drag step of a slider that updates on release;
         when it answers True the step is applied at once (a fast solver makes every
-        slider live)."""
+        slider live). Where it also has ``held(target, name, value)`` and ``released()``
+        (the explorer's :class:`~explorer.app.DragSteps`), a step not applied is passed
+        to ``held`` (the page may preview it) and every release to ``released``."""
         self._pairs: list[tuple[str, pn.widgets.Widget]] = []
         self._checks: dict[str, Callable[[Any], Any]] = {}
         self._live_when = live_when
@@ -205,6 +207,11 @@ class Binding:
             widget.apply_steps_only()
         if event == "value_throttled" and self._live_when is not None:
             widget.param.watch(lambda e, name=name: self._drag_step(name, e.new), "value")
+            # a policy that previews held steps hears of the release too (after the
+            # state has taken the value)
+            released = getattr(self._live_when, "released", None)
+            if released is not None:
+                widget.param.watch(lambda e: released(), "value_throttled")
         if check is not None:
             self._checks[name] = check
         self._pairs.append((name, widget))
@@ -225,6 +232,17 @@ class Binding:
             return
         if self._live_when():
             self._to_target(name, value)
+            return
+        # held until the release: a policy with ``held`` may preview the value meanwhile
+        held = getattr(self._live_when, "held", None)
+        if held is None or self._target is None or value is None:
+            return
+        try:
+            if name in self._checks:
+                self._checks[name](value)
+        except ValueError:
+            return  # refused: the release says why
+        held(self._target, name, value)
 
     def bind(self, target: param.Parameterized) -> None:
         """Point every widget at ``target`` and show its values."""

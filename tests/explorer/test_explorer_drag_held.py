@@ -1,30 +1,37 @@
 """A slider that updates on release, dragged while solves are slow: the page says that the
-plots wait for the release, and stops saying it once the release applies."""
+plots wait for the release, and stops saying it once the release applies. Where the base
+creeps, the plots preview each dragged value meanwhile: the scene with its base elastic at
+loading (``core.scene.elastic_at_loading``, exact at t = 0), never in the state, the
+pins, the downloads or the link; the release shows the answer with creep."""
 
 from __future__ import annotations
 
+import numpy as np
 import param
 import pytest
+
+from core import solve
+from core.scene import elastic_at_loading
 
 
 def test_a_held_drag_step_is_said_and_the_release_clears_it(monkeypatch, explorer_app) -> None:
     from explorer import app as page
 
-    app = explorer_app("uniform_flat", solved=True)
-    age = app.base_tab.age
-    before = app.state.base.age_at_loading
+    app = explorer_app("worn_coating", solved=True)   # an elastic base: nothing to preview
+    thickness = app.base_tab.base_thickness
+    before = app.state.base.thickness
     assert not app.results.held.visible
     monkeypatch.setitem(app.controller.view.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
-    age.value = before + 10.0               # a drag step, slow solves: held
-    assert app.state.base.age_at_loading == before
-    assert app.results.held.visible
+    thickness.value = before * 1.1            # a drag step, slow solves: held
+    assert app.state.base.thickness == before
+    assert app.results.held.visible and app.controller.preview is None
     took = f"{1e3 * 3 * page.LIVE_SOLVE_S:.0f}"
     assert app.results.held.object == (
         f"Solves are too slow to follow a dragged slider (the last one took {took} ms): the "
         "plots show the last result and update when you release it.")
-    with param.edit_constant(age):           # the release (set by the browser)
-        age.value_throttled = before + 10.0
-    assert app.state.base.age_at_loading == pytest.approx(before + 10.0)
+    with param.edit_constant(thickness):       # the release (set by the browser)
+        thickness.value_throttled = before * 1.1
+    assert app.state.base.thickness == pytest.approx(before * 1.1)
     assert not app.results.held.visible
 
 
@@ -37,7 +44,72 @@ def test_fast_solves_and_values_shown_from_the_state_say_nothing(monkeypatch,
         slow.setattr(app.controller, "solved_within", lambda seconds: False)
         app.state.base.age_at_loading = 90.0     # the slider follows the state: no drag
         assert app.base_tab.age.value == 90.0 and not app.results.held.visible
+        assert app.controller.preview is None
     monkeypatch.setitem(app.controller.view.info, "cpu_seconds",
                         0.5 * page.LIVE_SOLVE_S)
     app.base_tab.age.value = 120.0           # fast solves: the step applies at once
     assert app.state.base.age_at_loading == 120.0 and not app.results.held.visible
+    assert app.controller.preview is None
+
+
+def _pressure_line(app) -> np.ndarray:
+    """The q(x) line the pressure plot draws now [its display unit]."""
+    return np.asarray(app.figures.q_src.data["q"], dtype=float)
+
+
+def test_a_creeping_base_previews_each_held_step_and_the_release_shows_creep_again(
+        monkeypatch, explorer_app) -> None:
+    from explorer import app as page
+
+    app = explorer_app("uniform_flat", solved=True)
+    real = app.controller.view
+    drawn = _pressure_line(app).copy()
+    thickness = app.base_tab.base_thickness
+    before = app.state.base.thickness
+    monkeypatch.setitem(real.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
+    thickness.value = before * 1.5            # held: previewed, not applied
+    assert app.state.base.thickness == before
+    preview = app.controller.preview
+    assert preview is not None and app.controller.view is real
+    # the preview is the scene of the dragged value with its base elastic at loading
+    wanted = app.state.to_scene()
+    wanted["base"]["thickness"] = before * 1.5
+    assert preview.scene == elastic_at_loading(wanted)
+    assert app.results.held.visible and app.results.held.object.startswith(
+        "Preview while you drag: solves with creep are too slow")
+    # drawn at the time on screen; the result on screen (pins, downloads, the link) is
+    # still the answer with creep
+    assert not np.allclose(_pressure_line(app), drawn)
+    assert app.screen.shown() is real
+    # a thicker slab settles more at loading too: the preview's t = 0 is the answer's
+    exact = solve(elastic_at_loading(wanted))
+    assert preview.values["settlement"][0] == pytest.approx(float(exact.settlement[0]),
+                                                            rel=1e-12)
+    # the release applies the value: the answer with creep, the preview gone
+    with param.edit_constant(thickness):
+        thickness.value_throttled = before * 1.5
+    assert app.state.base.thickness == pytest.approx(before * 1.5)
+    assert app.controller.view is not real and app.controller.preview is None
+    assert app.screen.shown() is app.controller.view
+    assert not app.results.held.visible
+
+
+def test_a_release_where_the_drag_began_shows_the_kept_answer_again(monkeypatch,
+                                                                    explorer_app) -> None:
+    from explorer import app as page
+
+    app = explorer_app("uniform_flat", solved=True)
+    real = app.controller.view
+    drawn = _pressure_line(app).copy()
+    thickness = app.base_tab.base_thickness
+    before = app.state.base.thickness
+    monkeypatch.setitem(real.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
+    thickness.value = before * 1.5
+    assert app.controller.preview is not None
+    assert not np.allclose(_pressure_line(app), drawn)
+    thickness.value = before                  # back where it began, and released there
+    with param.edit_constant(thickness):
+        thickness.value_throttled = before
+    assert app.controller.view is real and app.controller.preview is None
+    assert np.array_equal(_pressure_line(app), drawn)
+    assert not app.results.held.visible

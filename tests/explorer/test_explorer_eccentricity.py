@@ -112,8 +112,10 @@ def test_the_lesson_is_true_to_the_numbers() -> None:
 
 
 def test_a_drag_step_that_waits_for_the_release_says_so(monkeypatch, explorer_app) -> None:
-    """Slow solves: the box follows the handle but the plots do not; the note under the
-    slider says so, with the e the plots still show, and goes on release."""
+    """Slow solves: the box follows the handle but the answer with creep does not; the
+    plots preview the dragged e on the base elastic at loading, the note under the slider
+    says so, and goes on release."""
+    from explorer.model import eccentricity as scene_eccentricity
     from explorer.views import eccentricity
 
     app = explorer_app(KEY, solved=True)
@@ -123,9 +125,14 @@ def test_a_drag_step_that_waits_for_the_release_says_so(monkeypatch, explorer_ap
     control.slider.value = 0.72           # a drag step the solver cannot follow
     assert app.state.loading.histories["moment"].value == pytest.approx(480.0)
     assert control.lag.visible
+    preview = app.controller.preview
+    assert preview is not None and scene_eccentricity(preview.scene) == pytest.approx(0.72)
+    assert preview.scene["base"]["creep"]["model"] == "elastic"
     note = control.lag.object
-    assert "the result at e = 0.600 m" in note and "e = 0.720 m when you release" in note
+    assert "preview e = 0.720 m" in note and "with creep at e = 0.720 m when you release" in note
     assert "400 ms" in note               # the cost that keeps the slider from following
+    # without a preview (none came yet) the note names the result the plots still show
+    assert "the result at e = 0.600 m" in eccentricity.lag_text(0.72, 0.6, 0.4)
     control.slider.value = 0.6            # back where the plots are: nothing to wait for
     assert not control.lag.visible
     control.slider.value = 0.72
