@@ -359,9 +359,10 @@ class ExplorerApp(pn.viewable.Viewer):
     def preview_step(self, target: Any, name: str, value: Any) -> None:
         """A drag step held until the release (:class:`DragSteps`): where the base creeps,
         the scene with ``target.name = value`` is previewed with its base elastic at
-        loading (:meth:`SolveController.request_preview`), asked :data:`HELD_AFTER_MS`
-        after the step on a served page (a key press's release comes first: no preview
-        then), the newest step's when the worker is free. The state is not changed; a step
+        loading (:meth:`SolveController.request_preview`): the first step of a drag is
+        asked :data:`HELD_AFTER_MS` after it on a served page (a key press's release comes
+        first: no preview then), the next ones at once (the newest when the worker is
+        free). The state is not changed; a step
         back to the value applied ends the preview (:meth:`end_preview`)."""
         scene = self._scene_with(target, name, value)
         if scene is None:
@@ -372,14 +373,14 @@ class ExplorerApp(pn.viewable.Viewer):
             self.end_preview()
             return
         self._preview_scene = scene
-        self._previewing = True
+        dragging, self._previewing = self._previewing, True
         if self._preview_due:
             return
+        if dragging or not self.loop.served:
+            self._ask_preview()  # a drag under way: every step (the newest when free)
+            return
         self._preview_due = True
-        if self.loop.served:
-            self.loop.later(self._ask_preview, HELD_AFTER_MS)
-        else:
-            self._ask_preview()
+        self.loop.later(self._ask_preview, HELD_AFTER_MS)
 
     def _scene_with(self, target: Any, name: str, value: Any) -> dict[str, Any] | None:
         """The state's scene with ``target.name`` at ``value`` (the state left as it was,

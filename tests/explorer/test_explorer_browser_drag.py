@@ -1,6 +1,8 @@
-"""A slow scene in a real browser: the eccentricity slider says while it is dragged that
-the plots wait for the release, the times of a 50-year history read in days and years
-(never 1.826e+04), and the status line claims nothing the solver did not report.
+"""A slow scene in a real browser: the eccentricity slider, dragged faster than the solves
+with creep can follow, previews each e on the base elastic at loading while the handle
+moves and says so, the answer with creep comes on release; the times of a 50-year history
+read in days and years (never 1.826e+04), and the status line claims nothing the solver
+did not report.
 
 Every wait is on a condition in the page.
 """
@@ -21,7 +23,17 @@ from tests.browser_pages import JS_SHOWN, Page, page_fixtures, until  # noqa: E4
 
 server, browser_context, page = page_fixtures(1400, 900)
 
-LAG = "Solves are too slow to follow the handle"
+LAG = "too slow to follow the handle"
+#: The note under the slider once a preview is drawn, and the one above the plots.
+PREVIEWED = "the plots preview e = "
+PREVIEW = "Preview while you drag"
+# every change of the pressure plot's data
+JS_WATCH = """() => {
+  const src = Bokeh.documents[0].get_model_by_name('q_source');
+  window.__changes = 0;
+  src.change.connect(() => { window.__changes += 1; });
+}"""
+CHANGES = "() => window.__changes"
 
 
 def _slow_scene() -> dict:
@@ -49,7 +61,9 @@ def test_a_slow_drag_says_it_waits_and_long_times_read_in_years(server: str, pag
     assert page.page.evaluate(JS_SHOWN, "unilateral contact under creep")   # its details
     assert not page.page.evaluate(JS_SHOWN, "computed afresh")
     assert not page.page.evaluate(JS_SHOWN, "? modes")
-    # a drag of the handle, held: the box follows, the plots do not, and the page says so
+    # a drag of the handle, held: the box follows, the answer with creep does not; the
+    # plots preview the e dragged to on the base elastic at loading, and the page says so
+    page.page.evaluate(JS_WATCH)
     handle = page.page.locator(".eccentricity-slider .noUi-handle").first
     box = handle.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
@@ -57,7 +71,12 @@ def test_a_slow_drag_says_it_waits_and_long_times_read_in_years(server: str, pag
     page.page.mouse.down()
     page.page.mouse.move(x + 40, y, steps=8)
     until(lambda: page.page.evaluate(JS_SHOWN, LAG), "the note while dragging")
-    assert page.page.evaluate(JS_SHOWN, "the plots show the result at e = 0.600 m")
+    until(lambda: page.page.evaluate(JS_SHOWN, PREVIEWED), "the preview's note",
+          timeout=60)
+    assert page.page.evaluate(CHANGES) > 0      # the preview drawn, the button still down
+    assert page.page.evaluate(JS_SHOWN, PREVIEW)
     page.page.mouse.up()
     until(lambda: not page.page.evaluate(JS_SHOWN, LAG), "the note gone on release")
+    until(lambda: not page.page.evaluate(JS_SHOWN, PREVIEW), "the answer with creep",
+          timeout=120)
     assert page.errors == []
