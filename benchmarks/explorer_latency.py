@@ -245,15 +245,44 @@ def percentile(values: list[float], q: float) -> float:
     return data[lo] + (data[hi] - data[lo]) * (pos - lo)
 
 
-def drag_summary(updates: list[float], down: float, up: float) -> dict[str, float]:
+def drag_summary(updates: list[float], down: float, up: float,
+                 previewed: bool = False) -> dict[str, float]:
     """What a drag showed, from the page times [ms] of the pressure plot's updates (frames
     drawn), of the mouse down and up: updates during the drag, after the release, and the
-    time from the release to the last update [ms] (0 when none came after it)."""
+    time from the release to the last update [ms] (0 when none came after it);
+    ``previewed``: the updates during the drag were previews (the page said so before
+    the release), not the scene's answers."""
     during = [t for t in updates if down < t <= up]
     after = [t for t in updates if t > up]
     return {"during": len(during), "after": len(after),
             "last_after_ms": (max(after) - up) if after else 0.0,
-            "drag_ms": up - down}
+            "drag_ms": up - down, "previewed": bool(previewed and during)}
+
+
+def drag_kind(drag: dict[str, float]) -> str:
+    """``live`` (the answers follow the handle), ``preview`` (previews do: the base
+    elastic at loading, the answer with creep on release) or ``release`` (nothing until
+    the release) for a :func:`drag_summary`; "" for none."""
+    if not drag:
+        return ""
+    if drag["during"] == 0:
+        return "release"
+    return "preview" if drag.get("previewed") else "live"
+
+
+#: Whether the page says that it previews a held drag (any shadow root's text).
+JS_PREVIEWING = """() => {
+  const roots = [document];
+  while (roots.length) {
+    const r = roots.pop();
+    for (const e of r.querySelectorAll('*')) {
+      if (!e.shadowRoot) continue;
+      if (e.shadowRoot.textContent.includes('Preview while you drag')) return true;
+      roots.push(e.shadowRoot);
+    }
+  }
+  return false;
+}"""
 
 
 def parse_presets(text: str, known: tuple[str, ...]) -> list[str]:
@@ -339,7 +368,9 @@ def markdown_report(rows: list[dict], switches: dict[str, float | None],
         "of the range) on the slider's handle -> the second animation frame after the "
         "pressure plot's data changed (p50, p95 over the steps). Drag: mouse down on the "
         f"handle, {DRAG_MOVES} moves of {DRAG_PX} px {1e3 * DRAG_PAUSE_S:.0f} ms apart, "
-        "mouse up; *live* when the pressure plot updated during the drag; *drag took*: "
+        "mouse up; *live* when the pressure plot updated during the drag, *preview* when "
+        "those updates were previews (the base elastic at loading, said on the page: the "
+        "answer with creep comes on release); *drag took*: "
         "mouse down to up in the page, longer than ~1 s when the page was too busy to "
         "take the moves at once. Page CPU: "
         "median CPU time of the page's main thread per key step. Solve: median of the "
@@ -376,7 +407,7 @@ def markdown_report(rows: list[dict], switches: dict[str, float | None],
         goal = GOALS[r["goal"]]
         mark = "" if math.isnan(p95) else (" ok" if p95 <= goal else " **missed**")
         drag = r.get("drag") or {}
-        live = ("" if not drag else "live" if drag["during"] > 0 else "release")
+        live = drag_kind(drag)
         last = drag.get("last_after_ms")
         last_text = _fmt(last) + ("" if last is None else
                                   " ok" if last <= GOALS["release"] else " **missed**")
@@ -386,13 +417,15 @@ def markdown_report(rows: list[dict], switches: dict[str, float | None],
             f"{_fmt(percentile(r['solve_ms'], 50))} | {live} | {drag.get('during', '')} | "
             f"{drag.get('after', '')} | {last_text} | {_fmt(drag.get('drag_ms'))} | "
             f"{len(keys)} |")
-    lines += ["", "Per preset: the worst key step p95, the sliders whose drag is live, and "
-              "the latest update after a release.", "",
-              "| preset | switch | worst key p95 | live | on release | latest after release |",
-              "| --- | --- | --- | --- | --- | --- |"]
+    lines += ["", "Per preset: the worst key step p95, the sliders whose drag is live, "
+              "previewed or on release, and the latest update after a release.", "",
+              "| preset | switch | worst key p95 | live | previewed | on release | latest after "
+              "release |",
+              "| --- | --- | --- | --- | --- | --- | --- |"]
     for preset, summary in preset_summary(rows, switches).items():
         lines.append(f"| {preset} | {summary['switch']} | {summary['worst_p95']} | "
-                     f"{summary['live']} | {summary['release']} | {summary['latest']} |")
+                     f"{summary['live']} | {summary.get('preview', '')} | {summary['release']} | "
+                     f"{summary['latest']} |")
     notes = [r for r in rows if r.get("note")]
     if notes:
         lines += ["", "Notes:", ""]
@@ -447,7 +480,9 @@ def preset_summary(rows: list[dict], switches: dict[str, float | None]
             "switch": "on the page already" if ms is None else _fmt(ms),
             "worst_p95": "" if worst is None else
             f"{_fmt(percentile(worst['key_ms'], 95))} ({worst['slider']})",
-            "live": ", ".join(r["slider"] for r in dragged if r["drag"]["during"] > 0),
+            "live": ", ".join(r["slider"] for r in dragged if drag_kind(r["drag"]) == "live"),
+            "preview": ", ".join(r["slider"] for r in dragged
+                                 if drag_kind(r["drag"]) == "preview"),
             "release": ", ".join(r["slider"] for r in dragged if r["drag"]["during"] == 0),
             "latest": "" if latest is None else
             f"{_fmt(latest['drag']['last_after_ms'])} ({latest['slider']})"}
@@ -514,11 +549,12 @@ def measure_drag(page, handle, sign: int, timeout_s: float) -> dict[str, float]:
         # browser (tens of ms on a loaded machine) would stretch the drag to 2-3 s
         time.sleep(max(0.0, start + k * DRAG_PAUSE_S - time.monotonic()))
         page.mouse.move(x + sign * DRAG_PX * k, y)
+    previewed = bool(page.evaluate(JS_PREVIEWING))
     page.mouse.up()
     down, up, during = page.evaluate(
         "() => [window.__down, window.__up, window.__updates.length]")
     _wait_quiet(page, up, need_one=during == 0, timeout_s=timeout_s)
-    return drag_summary(page.evaluate("() => window.__updates"), down, up)
+    return drag_summary(page.evaluate("() => window.__updates"), down, up, previewed)
 
 
 def switch_preset(page, label: str, timeout_s: float) -> float | None:

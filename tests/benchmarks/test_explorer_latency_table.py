@@ -26,10 +26,15 @@ def test_percentile_interpolates_between_order_statistics():
 
 def test_drag_summary_splits_updates_at_the_release():
     summary = bench.drag_summary([5.0, 120.0, 300.0, 1040.0, 1150.0], down=100.0, up=1000.0)
-    assert summary == {"during": 2, "after": 2, "last_after_ms": 150.0, "drag_ms": 900.0}
-    released = bench.drag_summary([1300.0], down=100.0, up=1000.0)
+    assert summary == {"during": 2, "after": 2, "last_after_ms": 150.0, "drag_ms": 900.0,
+                       "previewed": False}
+    assert bench.drag_kind(summary) == "live"
+    released = bench.drag_summary([1300.0], down=100.0, up=1000.0, previewed=True)
     assert (released["during"], released["after"]) == (0, 1)
+    assert bench.drag_kind(released) == "release"   # said, but nothing drawn: no preview
     assert bench.drag_summary([], down=0.0, up=10.0)["last_after_ms"] == 0.0
+    previewed = bench.drag_summary([120.0, 1300.0], down=100.0, up=1000.0, previewed=True)
+    assert bench.drag_kind(previewed) == "preview" and bench.drag_kind({}) == ""
 
 
 def test_presets_all_or_named_in_the_order_given():
@@ -93,10 +98,10 @@ def test_markdown_table_marks_goals_live_and_hidden_sliders():
             "release | 0 | 1 | 350 **missed** | 1000 | 5 |") in lines
     assert any(line.startswith("| uniform_flat | punch shape | hidden on this preset")
                for line in lines)
-    # the summary per preset: worst p95, live and release sliders, latest update
-    assert ("| uniform_flat | on the page already | 356 (base thickness) | load | "
+    # the summary per preset: worst p95, live, previewed and release sliders, latest update
+    assert ("| uniform_flat | on the page already | 356 (base thickness) | load |  | "
             "base thickness | 350 (base thickness) |") in lines
-    assert "| worn_coating | 620 |  |  |  |  |" in lines
+    assert "| worn_coating | 620 |  |  |  |  |  |" in lines
     # every table row has as many cells as its header
     for table_header in ("| preset | switch |", "| preset | slider |",
                          "| preset | switch | worst"):
