@@ -206,6 +206,7 @@ class ExplorerApp(pn.viewable.Viewer):
             pn.state.onload(self._on_load)
         self.controller.param.watch(self._on_view, "view")
         self.controller.param.watch(self._on_preview, "preview")
+        self.controller.param.watch(self._on_settled, "busy")
         self.controller.param.watch(self.results.on_status, ["error", "busy"])
         self.screen.param.watch(self._on_time, "time_index")
         self.screen.param.watch(self._on_notice, "notice")
@@ -410,6 +411,13 @@ class ExplorerApp(pn.viewable.Viewer):
         self.controller.stop_previews()
         if self._showing_preview and not self.controller.busy \
                 and self.controller.view is not None:
+            self._draw(self.controller.view)
+
+    def _on_settled(self, event: Any) -> None:
+        # the release's request answered without a new result (refused, or the one on
+        # screen): a preview drawn gives way to the answer with creep kept
+        if (not event.new and self._showing_preview and not self._previewing
+                and self.controller.view is not None):
             self._draw(self.controller.view)
 
     def _on_preview(self, event: Any) -> None:

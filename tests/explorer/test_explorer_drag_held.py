@@ -113,3 +113,31 @@ def test_a_release_where_the_drag_began_shows_the_kept_answer_again(monkeypatch,
     assert app.controller.view is real and app.controller.preview is None
     assert np.array_equal(_pressure_line(app), drawn)
     assert not app.results.held.visible
+
+
+def test_a_release_the_solver_refuses_shows_the_kept_answer_not_the_preview(
+        monkeypatch, explorer_app) -> None:
+    from explorer import app as page
+
+    app = explorer_app("uniform_flat", solved=True)
+    real = app.controller.view
+    drawn = _pressure_line(app).copy()
+    thickness = app.base_tab.base_thickness
+    before = app.state.base.thickness
+    monkeypatch.setitem(real.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
+    thickness.value = before * 1.5
+    assert app.controller.preview is not None
+    solve_scene = app.controller._solve
+
+    def refuse_with_creep(scene):
+        if scene["base"]["creep"]["model"] != "elastic":
+            raise ValueError("base.thickness: refused here")
+        return solve_scene(scene)
+
+    monkeypatch.setattr(app.controller, "_solve", refuse_with_creep)
+    with param.edit_constant(thickness):
+        thickness.value_throttled = before * 1.5
+    assert app.controller.error.startswith("Base, thickness (base.thickness): refused")
+    assert app.controller.view is real and app.controller.preview is None
+    assert np.array_equal(_pressure_line(app), drawn)
+    assert not app.results.held.visible
