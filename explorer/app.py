@@ -363,8 +363,8 @@ class ExplorerApp(pn.viewable.Viewer):
         loading (:meth:`SolveController.request_preview`): the first step of a drag is
         asked :data:`HELD_AFTER_MS` after it on a served page (a key press's release comes
         first: no preview then), the next ones at once (the newest when the worker is
-        free). The state is not changed; a step
-        back to the value applied ends the preview (:meth:`end_preview`)."""
+        free). The state is not changed; a step back to the value applied ends the
+        preview (:meth:`end_preview`)."""
         scene = self._scene_with(target, name, value)
         if scene is None:
             return
@@ -570,7 +570,8 @@ class ExplorerApp(pn.viewable.Viewer):
         else:
             index = min(self.screen.time_index, n - 1)
         self.screen.drawn = view
-        self.pins.on_result(view)
+        if view is not old:  # (drawn again in place of a preview: pinned already)
+            self.pins.on_result(view)
         self.results.say_held(False)
         with pn.io.hold():
             self.results.draw(view, index, new_range=old is None or len(old.times) != n)

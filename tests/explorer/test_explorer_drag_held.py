@@ -141,3 +141,25 @@ def test_a_release_the_solver_refuses_shows_the_kept_answer_not_the_preview(
     assert app.controller.view is real and app.controller.preview is None
     assert np.array_equal(_pressure_line(app), drawn)
     assert not app.results.held.visible
+
+
+def test_pinning_every_step_pins_answers_not_previews(monkeypatch, explorer_app) -> None:
+    from explorer import app as page
+
+    app = explorer_app("uniform_flat", solved=True)
+    app.pins.every_step.value = True
+    pinned = len(app.pins.board.pins)
+    monkeypatch.setitem(app.controller.view.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
+    thickness = app.base_tab.base_thickness
+    before = app.state.base.thickness
+    thickness.value = before * 1.5            # previewed: nothing pinned
+    assert app.controller.preview is not None
+    assert len(app.pins.board.pins) == pinned
+    thickness.value = before                  # back: the kept answer drawn again, not pinned
+    assert len(app.pins.board.pins) == pinned
+    thickness.value = before * 1.2
+    with param.edit_constant(thickness):       # the release: the new answer, pinned
+        thickness.value_throttled = before * 1.2
+    assert len(app.pins.board.pins) == pinned + 1
+    assert all(p.view.scene["base"]["creep"]["model"] != "elastic"
+               for p in app.pins.board.pins)
