@@ -591,7 +591,7 @@ class ExplorerApp(pn.viewable.Viewer):
         index = min(self.screen.time_index, len(view.times) - 1)
         with pn.io.hold():
             self.results.draw(view, index, new_range=old is None
-                              or len(old.times) != len(view.times))
+                              or len(old.times) != len(view.times), preview=True)
             self.results.say_held(True, self._last_cpu_seconds(), preview=True)
             mark("drawn")
         self.results.push()

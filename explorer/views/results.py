@@ -253,8 +253,10 @@ class ResultsView:
             sizing_mode="stretch_width",
         )
 
-    def draw(self, view: ResultView, index: int, new_range: bool) -> None:
-        """Show a new result at output time ``index`` (call inside ``pn.io.hold()``)."""
+    def draw(self, view: ResultView, index: int, new_range: bool,
+             preview: bool = False) -> None:
+        """Show a new result at output time ``index`` (call inside ``pn.io.hold()``);
+        ``preview``: a preview of a dragged value, which the status line says."""
         self.classical.disabled = view.several
         self.figures.show(view, index, self.pins.board.pins)
         self.contact_panes.update(view)
@@ -265,7 +267,7 @@ class ResultsView:
         with param.discard_events(self.screen):
             self.screen.time_index = index
         self.show_time_texts(view, index)
-        self.status.object = status_html(view, self.busy.shown, self.evidence(view))
+        self.status.object = status_html(view, self.busy.shown, self.evidence(view), preview)
         self.scene_badges.object = badges_html(view, "scene", self.evidence(view))
         self.pressure_badges.object = badges_html(view, "pressure")
         self.history_badges.object = badges_html(view, "history")

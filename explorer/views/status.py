@@ -121,13 +121,16 @@ def model_error_text(evidence: Mapping[str, Any]) -> str:
 
 
 def status_html(view: ResultView | None, busy: bool,
-                evidence: Mapping[str, Any] | None = None) -> str:
+                evidence: Mapping[str, Any] | None = None, preview: bool = False) -> str:
     """The status line (plain words) and its details (the solver's numbers); ``evidence``
-    (:func:`explorer.model.model_evidence`): the coating model's error it states."""
+    (:func:`explorer.model.model_evidence`): the coating model's error it states;
+    ``preview``: ``view`` is a preview of a dragged value (the base elastic at loading)."""
     if view is None:
         return ("<span class='cp-status solve-status first-solve'>Solving this scene for the "
                 "first time… the plots appear when it is done.</span>") if busy else ""
     text = plain_status(view)
+    if preview:
+        text = "Preview (the base elastic at loading, without creep): " + text
     if busy:
         text = "Solving the newest change… showing the previous result. " + text
     if evidence is not None:

@@ -77,6 +77,8 @@ def test_a_creeping_base_previews_each_held_step_and_the_release_shows_creep_aga
     assert preview.scene == elastic_at_loading(wanted)
     assert app.results.held.visible and app.results.held.object.startswith(
         "Preview while you drag: solves with creep are too slow")
+    assert "Preview (the base elastic at loading, without creep): Solved in" in \
+        app.results.status.object
     # drawn at the time on screen; the result on screen (pins, downloads, the link) is
     # still the answer with creep
     assert not np.allclose(_pressure_line(app), drawn)
@@ -91,7 +93,7 @@ def test_a_creeping_base_previews_each_held_step_and_the_release_shows_creep_aga
     assert app.state.base.thickness == pytest.approx(before * 1.5)
     assert app.controller.view is not real and app.controller.preview is None
     assert app.screen.shown() is app.controller.view
-    assert not app.results.held.visible
+    assert not app.results.held.visible and "Preview" not in app.results.status.object
 
 
 def test_a_release_where_the_drag_began_shows_the_kept_answer_again(monkeypatch,
