@@ -158,6 +158,21 @@ JS_SHOWN = """(text) => {
 }"""
 
 
+#: Records every change of the pressure plot's data (``window.__changes``: page times
+#: [ms]) and the page times of the mouse down and up (``window.__down``, ``window.__up``).
+JS_WATCH_PRESSURE = """() => {
+  const src = Bokeh.documents[0].get_model_by_name('q_source');
+  window.__changes = [];
+  window.__down = window.__up = null;
+  src.change.connect(() => window.__changes.push(performance.now()));
+  document.addEventListener('pointerdown', () => { window.__down = performance.now(); },
+                            true);
+  document.addEventListener('pointerup', () => { window.__up = performance.now(); }, true);
+}"""
+#: How many changes :data:`JS_WATCH_PRESSURE` has seen.
+PRESSURE_CHANGES = "() => window.__changes.length"
+
+
 def until(check, what: str, timeout: float = 60.0, describe=None) -> None:
     """Poll ``check`` (a look at the page) until it holds; fail after ``timeout`` [s] on a
     quiet machine, stretched by :func:`patience` on a busy one (saying what

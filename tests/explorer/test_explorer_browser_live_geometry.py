@@ -14,7 +14,14 @@ from tests.browser_pages import require_browser  # noqa: E402
 
 require_browser()
 
-from tests.browser_pages import Page, page_fixtures, patience, until  # noqa: E402
+from tests.browser_pages import (  # noqa: E402
+    JS_WATCH_PRESSURE,
+    PRESSURE_CHANGES,
+    Page,
+    page_fixtures,
+    patience,
+    until,
+)
 from tests.support.probe import own_explorer_server  # noqa: E402
 
 #: The default scene, a creep preset (exponential creep): the page opens on it.
@@ -31,17 +38,7 @@ LIVE_BOUND_S = 2.0
 explorer_server = own_explorer_server(["--live-bound", f"{LIVE_BOUND_S:g}"])
 server, browser_context, page = page_fixtures(1400, 900)
 
-# every change of the pressure plot's data, and the page times of the mouse down and up
-JS_WATCH = """() => {
-  const src = Bokeh.documents[0].get_model_by_name('q_source');
-  window.__changes = [];
-  window.__down = window.__up = null;
-  src.change.connect(() => window.__changes.push(performance.now()));
-  document.addEventListener('pointerdown', () => { window.__down = performance.now(); },
-                            true);
-  document.addEventListener('pointerup', () => { window.__up = performance.now(); }, true);
-}"""
-CHANGES = "() => window.__changes.length"
+JS_WATCH, CHANGES = JS_WATCH_PRESSURE, PRESSURE_CHANGES
 
 
 def test_a_geometry_drag_on_a_creep_preset_draws_while_the_handle_moves(page: Page):

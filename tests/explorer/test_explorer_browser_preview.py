@@ -16,7 +16,14 @@ from tests.browser_pages import require_browser  # noqa: E402
 
 require_browser()
 
-from tests.browser_pages import JS_SHOWN, Page, page_fixtures, patience, until  # noqa: E402
+from tests.browser_pages import (  # noqa: E402
+    JS_SHOWN,
+    JS_WATCH_PRESSURE,
+    Page,
+    page_fixtures,
+    patience,
+    until,
+)
 
 server, browser_context, page = page_fixtures(1400, 900)
 
@@ -36,16 +43,6 @@ def _crowned() -> dict:
 
 
 PREVIEW = "Preview while you drag"
-# every change of the pressure plot's data, with the page times of the mouse down and up
-JS_WATCH = """() => {
-  const src = Bokeh.documents[0].get_model_by_name('q_source');
-  window.__changes = [];
-  window.__down = window.__up = null;
-  src.change.connect(() => window.__changes.push(performance.now()));
-  document.addEventListener('pointerdown', () => { window.__down = performance.now(); },
-                            true);
-  document.addEventListener('pointerup', () => { window.__up = performance.now(); }, true);
-}"""
 DURING = "() => window.__changes.filter(t => t > window.__down).length"
 
 
@@ -81,7 +78,7 @@ def test_a_held_drag_on_a_creep_scene_previews_while_the_handle_moves(server: st
           timeout=120)
     time.sleep(1.0)
     half_width = _linked_half_width(page)
-    page.page.evaluate(JS_WATCH)
+    page.page.evaluate(JS_WATCH_PRESSURE)
     box = handle.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
     page.page.mouse.move(x, y)

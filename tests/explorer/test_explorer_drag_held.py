@@ -57,16 +57,22 @@ def _pressure_line(app) -> np.ndarray:
     return np.asarray(app.figures.q_src.data["q"], dtype=float)
 
 
-def test_a_creeping_base_previews_each_held_step_and_the_release_shows_creep_again(
-        monkeypatch, explorer_app) -> None:
+def _slow_default(monkeypatch, explorer_app):
+    """The default scene (a creeping base) solved, its last solve made to look slow (3
+    live bounds of CPU): (app, the answer on screen, its q line, the base-thickness
+    slider, the thickness before)."""
     from explorer import app as page
 
     app = explorer_app("uniform_flat", solved=True)
     real = app.controller.view
-    drawn = _pressure_line(app).copy()
-    thickness = app.base_tab.base_thickness
-    before = app.state.base.thickness
     monkeypatch.setitem(real.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
+    return (app, real, _pressure_line(app).copy(), app.base_tab.base_thickness,
+            app.state.base.thickness)
+
+
+def test_a_creeping_base_previews_each_held_step_and_the_release_shows_creep_again(
+        monkeypatch, explorer_app) -> None:
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
     thickness.value = before * 1.5            # held: previewed, not applied
     assert app.state.base.thickness == before
     preview = app.controller.preview
@@ -98,14 +104,7 @@ def test_a_creeping_base_previews_each_held_step_and_the_release_shows_creep_aga
 
 def test_a_release_where_the_drag_began_shows_the_kept_answer_again(monkeypatch,
                                                                     explorer_app) -> None:
-    from explorer import app as page
-
-    app = explorer_app("uniform_flat", solved=True)
-    real = app.controller.view
-    drawn = _pressure_line(app).copy()
-    thickness = app.base_tab.base_thickness
-    before = app.state.base.thickness
-    monkeypatch.setitem(real.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
     thickness.value = before * 1.5
     assert app.controller.preview is not None
     assert not np.allclose(_pressure_line(app), drawn)
@@ -119,14 +118,7 @@ def test_a_release_where_the_drag_began_shows_the_kept_answer_again(monkeypatch,
 
 def test_a_release_the_solver_refuses_shows_the_kept_answer_not_the_preview(
         monkeypatch, explorer_app) -> None:
-    from explorer import app as page
-
-    app = explorer_app("uniform_flat", solved=True)
-    real = app.controller.view
-    drawn = _pressure_line(app).copy()
-    thickness = app.base_tab.base_thickness
-    before = app.state.base.thickness
-    monkeypatch.setitem(real.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
     thickness.value = before * 1.5
     assert app.controller.preview is not None
     solve_scene = app.controller._solve
@@ -146,14 +138,9 @@ def test_a_release_the_solver_refuses_shows_the_kept_answer_not_the_preview(
 
 
 def test_pinning_every_step_pins_answers_not_previews(monkeypatch, explorer_app) -> None:
-    from explorer import app as page
-
-    app = explorer_app("uniform_flat", solved=True)
+    app, _, _, thickness, before = _slow_default(monkeypatch, explorer_app)
     app.pins.every_step.value = True
     pinned = len(app.pins.board.pins)
-    monkeypatch.setitem(app.controller.view.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
-    thickness = app.base_tab.base_thickness
-    before = app.state.base.thickness
     thickness.value = before * 1.5            # previewed: nothing pinned
     assert app.controller.preview is not None
     assert len(app.pins.board.pins) == pinned
