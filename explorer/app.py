@@ -206,7 +206,6 @@ class ExplorerApp(pn.viewable.Viewer):
             pn.state.onload(self._on_load)
         self.controller.param.watch(self._on_view, "view")
         self.controller.param.watch(self._on_preview, "preview")
-        self.controller.param.watch(self._on_settled, "busy")
         self.controller.param.watch(self.results.on_status, ["error", "busy"])
         self.screen.param.watch(self._on_time, "time_index")
         self.screen.param.watch(self._on_notice, "notice")
@@ -368,11 +367,14 @@ class ExplorerApp(pn.viewable.Viewer):
         scene = self._scene_with(target, name, value)
         if scene is None:
             return
-        if scene == self.state.to_scene():
+        applied = self.state.to_scene()
+        if scene == applied:
             # back at the value applied (a release there may not even reach the server:
             # the browser sends only a changed value): the answer with creep again
             self.end_preview()
             return
+        if not self.controller.previews_differ(scene, applied):
+            return  # a creep field alone (C∞, a rate): its preview would not move
         self._preview_scene = scene
         dragging, self._previewing = self._previewing, True
         if self._preview_due:
@@ -405,19 +407,12 @@ class ExplorerApp(pn.viewable.Viewer):
 
     def end_preview(self) -> None:
         """A release: no more previews; a preview on screen gives way to the answer with
-        creep (the new one once solved, or the last one when the value did not change)."""
+        creep kept at once, and to the new one when it is solved."""
         self._previewing = False
         self._preview_scene = None
         self.controller.stop_previews()
-        if self._showing_preview and not self.controller.busy \
-                and self.controller.view is not None:
-            self._draw(self.controller.view)
-
-    def _on_settled(self, event: Any) -> None:
-        # the release's request answered without a new result (refused, or the one on
-        # screen): a preview drawn gives way to the answer with creep kept
-        if (not event.new and self._showing_preview and not self._previewing
-                and self.controller.view is not None):
+        if self._showing_preview and self.controller.view is not None:
+            # the kept answer at once (the status says when a newer one is solving)
             self._draw(self.controller.view)
 
     def _on_preview(self, event: Any) -> None:

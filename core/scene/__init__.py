@@ -27,7 +27,7 @@ returns a ``SceneSolution``.
   (the FE check's measurement once run on the scene, else the estimate);
 - ``golden_section.py``: the least gap between punch and coating;
 - ``at_loading.py``: ``elastic_at_loading``, the scene whose base answers as at the instant
-  of loading (elastic at its modulus then), and ``creeps``.
+  of loading (elastic at its modulus then, ``modulus_at_loading``), and ``creeps``.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from core.optional import lazy_exports
-from core.scene.at_loading import creeps, elastic_at_loading
+from core.scene.at_loading import creeps, elastic_at_loading, modulus_at_loading
 from core.scene.contact_zone import LIFT_OFF_SHARE, contact_width, lift_off_length, lifts_off
 from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
 from core.scene.display import engine_text, known_contact_width, lifts_off_at
@@ -127,6 +127,7 @@ __all__ = [
     "load_scene",
     "MAX_SCENE_BYTES",
     "migrate",
+    "modulus_at_loading",
     "plotting_grid",
     "pressure_unit",
     "provenance",

@@ -10,10 +10,12 @@ answer. A rejected scene sets ``error`` (the core's message, naming the field) a
 
 Previews (:meth:`SolveController.request_preview`): while a slider waits for its release
 (solves too slow to follow it), the page may ask for a cheaper scene of the dragged value
-(the base elastic at loading, :func:`core.scene.elastic_at_loading`). A preview runs only
-when this session's worker is idle, one at a time, the newest wanted next; it never
-becomes ``view`` (downloads, pins and the live decision keep the last real answer), and
-any request drops the previews asked before it.
+(the base elastic at loading, :func:`core.scene.elastic_at_loading`). A preview starts
+only when this session's worker is idle (one asked while a request runs starts when it
+ends), one at a time, the newest wanted next; it never becomes ``view`` (downloads, pins
+and the live decision keep the last real answer), and any request drops the previews
+asked before it (a request that comes while one solves waits for it: one preview's solve,
+6-50 ms).
 
 Where solves run: on the thread that waits for them (a shared thread pool, or the caller),
 or, once :func:`use_worker_processes` has started them, in worker processes
@@ -300,12 +302,19 @@ class SolveController(param.Parameterized):
             self._wait(*pending, self._send_now(pending[1]))
 
     def _take_pending(self) -> tuple[int, dict[str, Any]] | None:
-        # the request that came while one ran (the newest), or None: then nothing runs
+        # the request that came while one ran (the newest), or None: then nothing runs,
+        # and a preview asked meanwhile (another slider held) starts
         with self._lock:
             pending, self._pending = self._pending, None
-            if pending is None:
-                self._running = False
-            return pending
+            if pending is not None:
+                return pending
+            self._running = False
+            start = self._preview_wanted is not None and not self._preview_running
+            if start:
+                self._preview_running = True
+        if start:
+            self._next_preview()
+        return None
 
     def _collect(self, scene: dict[str, Any], sent: SentRequest) -> ResultView | str:
         # The answer of ``sent`` (there to read), kept in RESULTS by a thread of the pool:
@@ -382,6 +391,23 @@ class SolveController(param.Parameterized):
         self._next_preview()
         return True
 
+    @staticmethod
+    def previews_differ(scene: dict[str, Any], applied: dict[str, Any]) -> bool:
+        """Whether ``scene`` has a preview that differs from that of the scene ``applied``
+        (their bases elastic at loading, the name and description aside): False for a
+        base that does not creep, a change of a creep field alone that leaves the modulus
+        at loading (C∞, a rate: every preview would be the same) and a scene whose preview
+        cannot be made (its release says why). Well under a millisecond of checks."""
+        if not creeps(scene):
+            return False
+        try:
+            ours, theirs = elastic_at_loading(scene), elastic_at_loading(applied)
+        except ValueError:
+            return False
+        aside = ("name", "description")
+        return ({k: v for k, v in ours.items() if k not in aside}
+                != {k: v for k, v in theirs.items() if k not in aside})
+
     def stop_previews(self) -> None:
         """Drop the previews asked and not solved yet (the one solving is not shown)."""
         with self._lock:
@@ -403,13 +429,25 @@ class SolveController(param.Parameterized):
             return
         sent = None
         if self._processes is not None:
-            # only on an idle worker: a preview never delays a real solve
+            # only on an idle worker (it may still delay a request that comes meanwhile,
+            # by one preview's solve)
             sent = self._processes.send_now(self._lane, preview_view, scene)
             if sent is None:
                 with self._lock:
+                    # kept for the next step or the end of the work on the lane
+                    if self._preview_wanted is None and epoch == self._preview_generation:
+                        self._preview_wanted = scene
                     self._preview_running = False
                 return
-        self._executor.submit(self._preview_work, epoch, scene, sent)
+        try:
+            self._executor.submit(self._preview_work, epoch, scene, sent)
+        except BaseException:
+            # (a pool shut down): the answer read here, so that the lane is freed
+            with self._lock:
+                self._preview_running = False
+            if sent is not None:
+                self._preview_view(scene, sent)
+            raise
 
     def _preview_work(self, epoch: int, scene: dict[str, Any],
                       sent: SentRequest | None) -> None:
@@ -433,9 +471,11 @@ class SolveController(param.Parameterized):
                            view: ResultView | None) -> None:
         with self._lock:
             wanted = epoch == self._preview_generation and not self._running
-        if view is not None and wanted:
-            self.preview = view
-        self._next_preview()
+        try:
+            if view is not None and wanted:
+                self.preview = view
+        finally:  # (a page failing to draw it must not stop the previews for good)
+            self._next_preview()
 
     def _left_worker(self, sent: SentRequest) -> None:
         with self._lock:

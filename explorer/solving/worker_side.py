@@ -74,7 +74,8 @@ def solve_view(scene: dict[str, Any]) -> ResultView:
 def preview_view(scene: dict[str, Any]) -> ResultView:
     """The preview of ``scene`` (a scene dict) shown while a slider waits for its release:
     the scene with its base elastic at loading (:func:`core.scene.elastic_at_loading`:
-    exact at t = 0, without creep later), solved and prepared as :func:`solve_view` does.
+    at t = 0 the scene's answer up to the coating model, without creep later), solved and
+    prepared as :func:`solve_view` does.
     Runs in a worker; an invalid scene raises the core's ValueError."""
     elastic = elastic_at_loading(scene)
     return prepare_view(solve(elastic), elastic)

@@ -105,11 +105,13 @@ def held_text(cpu_seconds: float | None) -> str:
 def preview_text(cpu_seconds: float | None) -> str:
     """What the page says while it shows a preview of a dragged slider's value (solves
     with creep too slow to follow it, ``cpu_seconds`` [s] the last one; None: not
-    known): the base elastic at loading, exact at t = 0, the answer with creep on release."""
+    known): the base elastic at loading (at t = 0 the answer with creep up to the coating
+    model, later without creep), the answer with creep on release."""
     took = "" if cpu_seconds is None else f" (the last one took {_duration(cpu_seconds)})"
     return (f"Preview while you drag: solves with creep are too slow to follow the "
             f"slider{took}, so the plots show the base as it answers at loading, elastic "
-            "and without creep (exact at t = 0 d, later without the creep). The answer "
+            "and without creep (at t = 0 d the answer with creep, up to the coating model; "
+            "later without creep). The answer "
             "with creep follows when you release it.")
 
 

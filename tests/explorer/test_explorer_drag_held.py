@@ -1,7 +1,8 @@
 """A slider that updates on release, dragged while solves are slow: the page says that the
 plots wait for the release, and stops saying it once the release applies. Where the base
 creeps, the plots preview each dragged value meanwhile: the scene with its base elastic at
-loading (``core.scene.elastic_at_loading``, exact at t = 0), never in the state, the
+loading (``core.scene.elastic_at_loading``: at t = 0 the answer with creep up to the
+coating model), never in the state, the
 pins, the downloads or the link; the release shows the answer with creep."""
 
 from __future__ import annotations
@@ -89,10 +90,13 @@ def test_a_creeping_base_previews_each_held_step_and_the_release_shows_creep_aga
     # still the answer with creep
     assert not np.allclose(_pressure_line(app), drawn)
     assert app.screen.shown() is real
-    # a thicker slab settles more at loading too: the preview's t = 0 is the answer's
-    exact = solve(elastic_at_loading(wanted))
-    assert preview.values["settlement"][0] == pytest.approx(float(exact.settlement[0]),
-                                                            rel=1e-12)
+    # at t = 0 the preview is the answer with creep up to the coating model (an even
+    # coating on an elastic base is answered by the exact layered kernel: 0.23 % here,
+    # within the 0.35 % the answer with creep estimates for its thin-layer model)
+    creeping = solve(wanted)
+    bound = float(creeping.info["model_error_estimate"]) + 1e-6
+    assert preview.values["settlement"][0] == pytest.approx(float(creeping.settlement[0]),
+                                                            rel=bound)
     # the release applies the value: the answer with creep, the preview gone
     with param.edit_constant(thickness):
         thickness.value_throttled = before * 1.5
@@ -152,3 +156,15 @@ def test_pinning_every_step_pins_answers_not_previews(monkeypatch, explorer_app)
     assert len(app.pins.board.pins) == pinned + 1
     assert all(p.view.scene["base"]["creep"]["model"] != "elastic"
                for p in app.pins.board.pins)
+
+
+def test_a_creep_field_that_leaves_the_modulus_at_loading_is_not_previewed(
+        monkeypatch, explorer_app) -> None:
+    # the final creep compliance of the default scene's law: every preview would be the
+    # same no-creep answer, which does not follow the handle; the plots wait as before
+    app, real, drawn, _, _ = _slow_default(monkeypatch, explorer_app)
+    compliance = app.base_tab.compliance
+    compliance.value = compliance.value * 1.5
+    assert app.controller.preview is None and app.controller.view is real
+    assert np.array_equal(_pressure_line(app), drawn)
+    assert app.results.held.object.startswith("Solves are too slow to follow")

@@ -40,8 +40,11 @@ def test_previews_run_one_at_a_time_the_newest_next_and_a_request_drops_them() -
     seen: list[float] = []
 
     def gated(scene: dict[str, Any]) -> Any:
+        # previews, and the request at thickness 3.5, wait for the gate
         if scene["base"]["creep"]["model"] == "elastic":
             seen.append(scene["base"]["thickness"])
+            gate.wait(60)
+        elif scene["base"]["thickness"] == 3.5:
             gate.wait(60)
         return solve(scene)
 
@@ -73,8 +76,20 @@ def test_previews_run_one_at_a_time_the_newest_next_and_a_request_drops_them() -
         assert controller.preview is None
         gate.set()
         assert controller.wait(120)
-        time.sleep(0.2)                          # the dropped preview's answer comes back
+        # the dropped preview's answer came back and was not shown
+        assert _wait(lambda: not controller._preview_running)
         assert controller.preview is None and controller.view is not real
+        # a preview asked while a request solves starts when it ends
+        gate.clear()
+        state.base.thickness = 3.5
+        controller.request()
+        controller.request_preview({**scene, "base": {**scene["base"], "thickness": 5.0}})
+        time.sleep(0.2)
+        assert controller.preview is None and 5.0 not in seen and controller.busy
+        gate.set()
+        assert controller.wait(120)
+        assert _wait(lambda: controller.preview is not None
+                     and controller.preview.scene["base"]["thickness"] == 5.0)
     finally:
         gate.set()
         pool.shutdown(wait=True)
