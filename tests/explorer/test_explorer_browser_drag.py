@@ -19,7 +19,14 @@ from tests.browser_pages import require_browser  # noqa: E402
 
 require_browser()
 
-from tests.browser_pages import JS_SHOWN, Page, page_fixtures, until  # noqa: E402
+from tests.browser_pages import (  # noqa: E402
+    JS_SHOWN,
+    JS_WATCH_PRESSURE,
+    PRESSURE_CHANGES,
+    Page,
+    page_fixtures,
+    until,
+)
 
 server, browser_context, page = page_fixtures(1400, 900)
 
@@ -27,13 +34,6 @@ LAG = "too slow to follow the handle"
 #: The note under the slider once a preview is drawn, and the one above the plots.
 PREVIEWED = "the plots preview e = "
 PREVIEW = "Preview while you drag"
-# every change of the pressure plot's data
-JS_WATCH = """() => {
-  const src = Bokeh.documents[0].get_model_by_name('q_source');
-  window.__changes = 0;
-  src.change.connect(() => { window.__changes += 1; });
-}"""
-CHANGES = "() => window.__changes"
 
 
 def _slow_scene() -> dict:
@@ -63,7 +63,7 @@ def test_a_slow_drag_says_it_waits_and_long_times_read_in_years(server: str, pag
     assert not page.page.evaluate(JS_SHOWN, "? modes")
     # a drag of the handle, held: the box follows, the answer with creep does not; the
     # plots preview the e dragged to on the base elastic at loading, and the page says so
-    page.page.evaluate(JS_WATCH)
+    page.page.evaluate(JS_WATCH_PRESSURE)
     handle = page.page.locator(".eccentricity-slider .noUi-handle").first
     box = handle.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
@@ -73,7 +73,7 @@ def test_a_slow_drag_says_it_waits_and_long_times_read_in_years(server: str, pag
     until(lambda: page.page.evaluate(JS_SHOWN, LAG), "the note while dragging")
     until(lambda: page.page.evaluate(JS_SHOWN, PREVIEWED), "the preview's note",
           timeout=60)
-    assert page.page.evaluate(CHANGES) > 0      # the preview drawn, the button still down
+    assert page.page.evaluate(PRESSURE_CHANGES) > 0      # the preview drawn, the button still down
     assert page.page.evaluate(JS_SHOWN, PREVIEW)
     page.page.mouse.up()
     until(lambda: not page.page.evaluate(JS_SHOWN, LAG), "the note gone on release")
