@@ -73,7 +73,9 @@ def test_a_slow_drag_says_it_waits_and_long_times_read_in_years(server: str, pag
     until(lambda: page.page.evaluate(JS_SHOWN, LAG), "the note while dragging")
     until(lambda: page.page.evaluate(JS_SHOWN, PREVIEWED), "the preview's note",
           timeout=60)
-    assert page.page.evaluate(PRESSURE_CHANGES) > 0      # the preview drawn, the button still down
+    # the preview drawn, the button still down (the note may come a little before the
+    # plot: the draws of a page are spaced)
+    until(lambda: page.page.evaluate(PRESSURE_CHANGES) > 0, "the preview drawn", timeout=60)
     assert page.page.evaluate(JS_SHOWN, PREVIEW)
     page.page.mouse.up()
     until(lambda: not page.page.evaluate(JS_SHOWN, LAG), "the note gone on release")

@@ -81,7 +81,11 @@ def test_two_punches_their_histories_and_a_drag_of_a_centre(server: str, page: P
     page.page.mouse.up()
     # released: the new footing further right on the drawing and on q(x); the old one
     # tilts less toward it
-    until(lambda: page.page.evaluate(JS_PUNCH_LEFT)[1] > 2.5, "punch 2 moved", timeout=120)
+    # (a drag slower than its solves is previewed, and the preview stays on screen until
+    # the answer of the release comes: the status line then no longer says "Preview")
+    until(lambda: page.page.evaluate(JS_PUNCH_LEFT)[1] > 2.5
+          and not page.page.evaluate(JS_SHOWN, "Preview (the base elastic at loading"),
+          "punch 2 moved", timeout=120)
     moved = page.page.evaluate(JS_PUNCH_LEFT)[1]
     until(lambda: page.page.evaluate(JS_Q_RIGHT) == pytest.approx(moved + 2.0, abs=1e-4),
           "q(x) over the moved punch")
