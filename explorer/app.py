@@ -169,13 +169,12 @@ class ExplorerApp(pn.viewable.Viewer):
         # view whose widgets sit in the Coating and Time tabs (see ``fidelity``)
         self._fidelity = FidelityView(self.state, self.screen.reject)
         # previews of held drag steps: the scene wanted next, whether a preview is asked
-        # for (between a held step and its release), one is due (scheduled), one is drawn
+        # for (between a held step and its release), one is due (scheduled), the one drawn
         self.drag = DragSteps(self)
         self._preview_scene: dict[str, Any] | None = None
         self._previewing = False
         self._preview_due = False
-        self._showing_preview = False
-        self._drawn_preview: ResultView | None = None
+        self._drawn_preview: ResultView | None = None  # the preview on screen, if one
         self._layout = self._build_layout(self._build_sidebar())
         self._wanted_index, tab, pin_scenes, pin_message = read_view_query(
             query or {}, len(self.sidebar))
@@ -348,7 +347,7 @@ class ExplorerApp(pn.viewable.Viewer):
         step applies now (:meth:`fast_solves`); when not, the page says so."""
         self.tabs.touch()
         fast = self.fast_solves()
-        self.results.say_held(not fast, self._last_cpu_seconds(), self._showing_preview)
+        self.results.say_held(not fast, self._last_cpu_seconds(), self._drawn_preview is not None)
         return fast
 
     def _last_cpu_seconds(self) -> float | None:
@@ -412,17 +411,16 @@ class ExplorerApp(pn.viewable.Viewer):
         self._previewing = False
         self._preview_scene = None
         self.controller.stop_previews()
-        # while the release's answer is solving the preview stays (drawing the kept
-        # answer first cost the page a draw: the new one came 0.43-0.75 s after the
-        # release instead of 0.26-0.42 s on the lift-off preset); without one, at once
-        if self._showing_preview and not self.controller.busy \
+        # while the release's answer is solving the preview stays (the kept answer drawn
+        # first would cost the page one more draw); without one, the kept answer at once
+        if self._drawn_preview is not None and not self.controller.busy \
                 and self.controller.view is not None:
             self._draw(self.controller.view)
 
     def _on_settled(self, event: Any) -> None:
         # the release's request answered without a new result (refused, or the result on
         # screen again): a preview drawn gives way to the answer with creep kept
-        if (not event.new and self._showing_preview and not self._previewing
+        if (not event.new and self._drawn_preview is not None and not self._previewing
                 and self.controller.view is not None):
             self._draw(self.controller.view)
 
@@ -564,7 +562,6 @@ class ExplorerApp(pn.viewable.Viewer):
         if preview:
             self._draw_preview(view)
             return
-        self._showing_preview = False
         self._drawn_preview = None
         self._last_draw = time.monotonic()
         n = len(view.times)
@@ -576,8 +573,7 @@ class ExplorerApp(pn.viewable.Viewer):
         else:
             index = min(self.screen.time_index, n - 1)
         self.screen.drawn = view
-        if view is not old:  # (drawn again in place of a preview: pinned already)
-            self.pins.on_result(view)
+        self.pins.on_result(view)  # (the board pins a scene once: a redraw adds none)
         self.results.say_held(False)
         with pn.io.hold():
             self.results.draw(view, index, new_range=old is None or len(old.times) != n)
@@ -591,7 +587,6 @@ class ExplorerApp(pn.viewable.Viewer):
         screen stays the last answer with creep (``screen.drawn``: pins, downloads and
         the page's link speak of it), which the release draws again."""
         self._last_draw = time.monotonic()
-        self._showing_preview = True
         self._drawn_preview = view
         old = self.screen.drawn
         index = min(self.screen.time_index, len(view.times) - 1)

@@ -459,10 +459,7 @@ class SolveController(param.Parameterized):
         try:
             if sent is not None:
                 return self._processes.result(sent)
-            if self._solve is _default_solve:
-                return preview_view(scene)
-            elastic = elastic_at_loading(scene)
-            return prepare_view(self._solve(elastic), elastic)
+            return preview_view(scene, self._solve)
         except Exception:  # noqa: BLE001 - a preview that fails is only not shown
             log.debug("preview failed", exc_info=True)
             return None

@@ -71,14 +71,14 @@ def solve_view(scene: dict[str, Any]) -> ResultView:
     return prepare_view(solve(scene), scene)
 
 
-def preview_view(scene: dict[str, Any]) -> ResultView:
+def preview_view(scene: dict[str, Any], solve_scene: Any = solve) -> ResultView:
     """The preview of ``scene`` (a scene dict) shown while a slider waits for its release:
     the scene with its base elastic at loading (:func:`core.scene.elastic_at_loading`:
-    at t = 0 the scene's answer up to the coating model, without creep later), solved and
-    prepared as :func:`solve_view` does.
-    Runs in a worker; an invalid scene raises the core's ValueError."""
+    at t = 0 the scene's answer up to the coating model, without creep later), solved
+    (by ``solve_scene``, default :func:`core.solve`) and prepared as :func:`solve_view`
+    does. Runs in a worker; an invalid scene raises the core's ValueError."""
     elastic = elastic_at_loading(scene)
-    return prepare_view(solve(elastic), elastic)
+    return prepare_view(solve_scene(elastic), elastic)
 
 
 def download_text(scene: dict[str, Any], kind: str, info: dict[str, Any] | None = None,
