@@ -51,12 +51,17 @@ class BusyIndicator:
     """Follows the controller's ``busy`` for the page's spinner and status line."""
 
     def __init__(self, controller: SolveController, loop: PageLoop, spinner: BusySpinner,
-                 status: Any, evidence: Callable[[Any], Any] | None = None) -> None:
+                 status: Any, evidence: Callable[[Any], Any] | None = None,
+                 on_screen: Callable[[], tuple[Any, bool]] | None = None) -> None:
         """``status``: the pane of the status line (it says when a solve is running);
         ``evidence``: the coating model's error to state for a result
-        (:meth:`explorer.views.ResultsView.evidence`), none by default."""
+        (:meth:`explorer.views.ResultsView.evidence`), none by default; ``on_screen``:
+        the result the plots show and whether it is a preview of a dragged value (default:
+        the controller's result), which the status line describes."""
         self.controller = controller
         self.evidence = evidence if evidence is not None else (lambda view: None)
+        self.on_screen = on_screen if on_screen is not None else (
+            lambda: (controller.view, False))
         self.loop = loop
         self.spinner = spinner
         self.status = status
@@ -84,5 +89,7 @@ class BusyIndicator:
             return
         self.shown = busy
         self.spinner.value = busy
-        view = self.controller.view
-        self.status.object = status_html(view, busy, self.evidence(view))
+        # (a preview stays on screen while the release's answer solves: the line speaks
+        # of the preview, not of the answer kept behind it)
+        view, preview = self.on_screen()
+        self.status.object = status_html(view, busy, self.evidence(view), preview)

@@ -194,8 +194,9 @@ class ResultsView:
         self.spinner = BusySpinner()
         self.status = html_pane("", sizing_mode="stretch_width", margin=(5, 5))
         self._evidence: tuple[tuple[int, int], dict[str, Any] | None] = ((0, 0), None)
+        self._preview: ResultView | None = None  # the preview drawn, while it is
         self.busy = BusyIndicator(controller, loop, self.spinner, self.status,
-                                  evidence=self.evidence)
+                                  evidence=self.evidence, on_screen=self.on_screen)
         screen.param.watch(lambda *e: self.show_model_check(), "model_check")
         # said while a slider is dragged that only its release applies (slow solves)
         self._held_wanted = False
@@ -267,6 +268,7 @@ class ResultsView:
         with param.discard_events(self.screen):
             self.screen.time_index = index
         self.show_time_texts(view, index)
+        self._preview = view if preview else None
         self.status.object = status_html(view, self.busy.shown, self.evidence(view), preview)
         self.scene_badges.object = badges_html(view, "scene", self.evidence(view))
         self.pressure_badges.object = badges_html(view, "pressure")
@@ -291,11 +293,18 @@ class ResultsView:
     def show_model_check(self) -> None:
         """A new FE check: the status and the badges of the result on screen say what it
         measured (or the estimate still, when it was run on another scene)."""
-        view = self.screen.shown()
+        view, preview = self.on_screen()
         if view is None:
             return
-        self.status.object = status_html(view, self.busy.shown, self.evidence(view))
+        self.status.object = status_html(view, self.busy.shown, self.evidence(view), preview)
         self.scene_badges.object = badges_html(view, "scene", self.evidence(view))
+
+    def on_screen(self) -> tuple[ResultView | None, bool]:
+        """The result the plots show and whether it is a preview of a dragged value (the
+        answer kept behind a preview is ``screen.shown()``)."""
+        if self._preview is not None:
+            return self._preview, True
+        return self.screen.shown(), False
 
     def show_time_texts(self, view: ResultView, index: int) -> None:
         """The time label and the readout at output time ``index``."""

@@ -134,7 +134,9 @@ def status_html(view: ResultView | None, busy: bool,
     if preview:
         text = "Preview (the base elastic at loading, without creep): " + text
     if busy:
-        text = "Solving the newest change… showing the previous result. " + text
+        text = ("Solving the released value with creep… showing its preview until then. "
+                if preview else "Solving the newest change… showing the previous result. "
+                ) + text
     if evidence is not None:
         tone = " model-flagged" if evidence["flagged"] else ""
         text_model = html.escape(model_error_text(evidence))

@@ -168,3 +168,28 @@ def test_a_creep_field_that_leaves_the_modulus_at_loading_is_not_previewed(
     assert app.controller.preview is None and app.controller.view is real
     assert np.array_equal(_pressure_line(app), drawn)
     assert app.results.held.object.startswith("Solves are too slow to follow")
+
+
+def test_a_solve_running_behind_a_preview_says_the_preview_is_shown(monkeypatch,
+                                                                    explorer_app) -> None:
+    """The release's answer with creep can take seconds; the preview stays on screen
+    meanwhile, and the status line (busy after BUSY_AFTER_MS) speaks of it, not of the
+    answer kept behind it ("showing the previous result" contradicted the plots)."""
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
+    thickness.value = before * 1.5
+    preview = app.controller.preview
+    assert preview is not None
+    app.results.busy.follow(True)            # the release's solve running (no server: at once)
+    status = app.results.status.object
+    assert ("Solving the released value with creep… showing its preview until then. "
+            "Preview (the base elastic at loading, without creep): ") in status
+    assert "showing the previous result" not in status
+    app.results.busy.follow(False)
+    assert "Preview (the base elastic at loading" in app.results.status.object
+    assert app.results.on_screen() == (preview, True)
+    # the answer drawn again: the line speaks of it
+    app.end_preview()
+    assert app.results.on_screen() == (real, False)
+    app.results.busy.follow(True)
+    assert "Solving the newest change… showing the previous result. " in \
+        app.results.status.object
