@@ -94,7 +94,8 @@ def quiet_bokeh_diagnostics() -> None:
     as it is registered (~4,800 a page, each through ``inspect.signature``: 6 % of a
     page's building, cProfile) and close-match suggestions for a misspelt attribute. They
     serve whoever writes the code, and the test suite keeps them on (the explorer's code
-    is checked there); a visitor's page gains nothing from them."""
+    is checked there: tests/explorer/test_served_by_panel.py serves a page with them, as
+    any other server does); a visitor's page gains nothing from them."""
     from bokeh.settings import settings
 
     settings.perform_error_diagnostics.set_value(False)

@@ -93,7 +93,7 @@ def session_opened() -> None:
         _cancel()
 
 
-def session_closed(_session_context: Any = None) -> None:
+def session_closed(session_context: Any) -> None:
     """A session has ended (an ``on_session_destroyed`` callback): once none is open, a
     release is due the time given to :func:`enable` later (if enabled)."""
     global _open, _timer

@@ -32,7 +32,7 @@ def held_bytes() -> int:
 def _reset() -> None:
     idle_release.disable()
     while idle_release.open_sessions():
-        idle_release.session_closed()
+        idle_release.session_closed(None)
     idle_release.disable()  # (a close while enabled would have set a timer)
 
 
@@ -76,11 +76,11 @@ def test_the_caches_are_emptied_once_the_last_session_has_been_closed_a_while(
     fill(small_preset)
     idle_release.session_opened()
     idle_release.session_opened()
-    idle_release.session_closed()
+    idle_release.session_closed(None)
     assert not wait_until(lambda: released.done, timeout=3 * AFTER_S,
                           every=0.02)  # one session is still open
     assert held_bytes() > 0 and released.warmed == 0
-    idle_release.session_closed()
+    idle_release.session_closed(None)
     assert wait_until(lambda: released.done, timeout=30, every=0.02)
     assert released.warmed == 1
     assert len(RESULTS) == 0 and held_bytes() == 0
@@ -91,7 +91,7 @@ def test_a_session_opening_in_time_keeps_the_caches(released, small_preset,
                                                      wait_until) -> None:
     fill(small_preset)
     idle_release.session_opened()
-    idle_release.session_closed()
+    idle_release.session_closed(None)
     idle_release.session_opened()  # before AFTER_S has passed
     assert not wait_until(lambda: released.done, timeout=3 * AFTER_S, every=0.02)
     assert len(RESULTS) > 0 and released.warmed == 0
@@ -101,7 +101,7 @@ def test_without_enable_the_sessions_are_only_counted(small_preset, wait_until) 
     fill(small_preset)
     idle_release.session_opened()
     assert idle_release.open_sessions() == 1
-    idle_release.session_closed()
+    idle_release.session_closed(None)
     assert idle_release.open_sessions() == 0
     assert not wait_until(lambda: len(RESULTS) == 0, timeout=0.5, every=0.05)
 
@@ -121,10 +121,10 @@ def test_a_timer_superseded_by_a_later_session_does_nothing(released, small_pres
     cannot stop it) must not release: only the newest timer does, once."""
     fill(small_preset)
     idle_release.session_opened()
-    idle_release.session_closed()
+    idle_release.session_closed(None)
     stale = idle_release._generation
     idle_release.session_opened()
-    idle_release.session_closed()
+    idle_release.session_closed(None)
     idle_release._release_if_idle(stale)  # as the first timer would, late
     assert not released.done and len(RESULTS) > 0
     assert wait_until(lambda: released.done, timeout=30, every=0.02)
@@ -158,7 +158,7 @@ def test_garbage_frozen_by_the_last_collection_is_freed_by_the_release(wait_unti
         idle_release.enable(AFTER_S, on_release=done.append,
                             collect=gc_policy.collect_ended_sessions)
         idle_release.session_opened()
-        idle_release.session_closed()
+        idle_release.session_closed(None)
         assert wait_until(lambda: done, timeout=30, every=0.02)
         assert alive() is None and done[-1]["collected"] >= 1
     finally:
