@@ -169,12 +169,11 @@ class ExplorerApp(pn.viewable.Viewer):
         # view whose widgets sit in the Coating and Time tabs (see ``fidelity``)
         self._fidelity = FidelityView(self.state, self.screen.reject)
         # previews of held drag steps: the scene wanted next, whether a preview is asked
-        # for (between a held step and its release), one is due (scheduled), the one drawn
+        # for (between a held step and its release), one is due (scheduled)
         self.drag = DragSteps(self)
         self._preview_scene: dict[str, Any] | None = None
         self._previewing = False
         self._preview_due = False
-        self._drawn_preview: ResultView | None = None  # the preview on screen, if one
         self._layout = self._build_layout(self._build_sidebar())
         self._wanted_index, tab, pin_scenes, pin_message = read_view_query(
             query or {}, len(self.sidebar))
@@ -349,6 +348,12 @@ class ExplorerApp(pn.viewable.Viewer):
         fast = self.fast_solves()
         self.results.say_held(not fast, self._last_cpu_seconds(), self._drawn_preview is not None)
         return fast
+
+    @property
+    def _drawn_preview(self) -> ResultView | None:
+        """The preview on screen, if one (the results view keeps what it drew)."""
+        view, preview = self.results.on_screen()
+        return view if preview else None
 
     def _last_cpu_seconds(self) -> float | None:
         view = self.controller.view
@@ -562,7 +567,6 @@ class ExplorerApp(pn.viewable.Viewer):
         if preview:
             self._draw_preview(view)
             return
-        self._drawn_preview = None
         self._last_draw = time.monotonic()
         n = len(view.times)
         old = self.screen.drawn
@@ -587,7 +591,6 @@ class ExplorerApp(pn.viewable.Viewer):
         screen stays the last answer with creep (``screen.drawn``: pins, downloads and
         the page's link speak of it), which the release draws again."""
         self._last_draw = time.monotonic()
-        self._drawn_preview = view
         old = self.screen.drawn
         index = min(self.screen.time_index, len(view.times) - 1)
         with pn.io.hold():
@@ -599,7 +602,9 @@ class ExplorerApp(pn.viewable.Viewer):
 
     def _on_time(self, event: Any) -> None:
         self.tabs.touch()
-        view = self.screen.drawn
+        # the result the plots show: a preview stays on screen while the release's
+        # answer solves, and the time moved meanwhile is the preview's
+        view = self.results.on_screen()[0]
         if view is None:
             return
         index = min(max(int(event.new), 0), len(view.times) - 1)

@@ -323,7 +323,7 @@ class ResultsView:
 
     def show_pins(self) -> None:
         """Draw the pins on the figures and in the readout (they changed)."""
-        view = self.screen.shown()
+        view = self.on_screen()[0]
         if view is None:
             return
         index = self.screen.time_index

@@ -193,3 +193,24 @@ def test_a_solve_running_behind_a_preview_says_the_preview_is_shown(monkeypatch,
     app.results.busy.follow(True)
     assert "Solving the newest change… showing the previous result. " in \
         app.results.status.object
+
+
+def test_the_time_moved_under_a_preview_moves_the_preview(monkeypatch, explorer_app) -> None:
+    """A preview stays on screen until the release's answer comes (seconds on a slow
+    scene), and the time slider or the player may move meanwhile: q(x) is then the
+    preview's at the new time, as its histories and status line are (it was the kept
+    answer's q under the preview's histories)."""
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
+    thickness.value = before * 1.5
+    preview = app.controller.preview
+    assert preview is not None and app.screen.time_index == len(real.times) - 1
+    app.screen.time_index = 0
+    size = app.scales.pressure_unit(preview)[1]
+    shown = _pressure_line(app)
+    assert np.allclose(shown, preview.pressure[:, 0] / size, rtol=1e-6)
+    assert not np.allclose(shown, real.pressure[:, 0] / size, rtol=1e-6)
+    assert app.results.on_screen() == (preview, True)
+    # the kept answer drawn again: the time moves it
+    app.end_preview()
+    app.screen.time_index = 1
+    assert np.allclose(_pressure_line(app), real.pressure[:, 1] / size, rtol=1e-6)
