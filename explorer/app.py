@@ -174,6 +174,8 @@ class ExplorerApp(pn.viewable.Viewer):
         self._preview_scene: dict[str, Any] | None = None
         self._previewing = False
         self._preview_due = False
+        # the time on screen before the first preview drawn (given back with the answer)
+        self._index_before_preview: int | None = None
         self._layout = self._build_layout(self._build_sidebar())
         self._wanted_index, tab, pin_scenes, pin_message = read_view_query(
             query or {}, len(self.sidebar))
@@ -570,17 +572,24 @@ class ExplorerApp(pn.viewable.Viewer):
         self._last_draw = time.monotonic()
         n = len(view.times)
         old = self.screen.drawn
+        # what the plots show now (a preview of another count of times may have clipped
+        # the time and the player's range), and the time before the previews
+        shown = self.results.on_screen()[0]
+        before, self._index_before_preview = self._index_before_preview, None
         if old is None and self._wanted_index is not None:
             index = min(self._wanted_index, n - 1)  # the time the link was made at
         elif old is None or len(old.times) != n:
             index = n - 1
+        elif (shown is not old and shown is not None and len(shown.times) != n
+              and before is not None):
+            index = min(before, n - 1)  # (a time moved under a same-count preview stays)
         else:
             index = min(self.screen.time_index, n - 1)
         self.screen.drawn = view
         self.pins.on_result(view)  # (the board pins a scene once: a redraw adds none)
         self.results.say_held(False)
         with pn.io.hold():
-            self.results.draw(view, index, new_range=old is None or len(old.times) != n)
+            self.results.draw(view, index, new_range=shown is None or len(shown.times) != n)
             self.files_tab.name_files(view)
             mark("drawn")  # the patch goes out as the hold ends
         self.results.push()
@@ -591,11 +600,13 @@ class ExplorerApp(pn.viewable.Viewer):
         screen stays the last answer with creep (``screen.drawn``: pins, downloads and
         the page's link speak of it), which the release draws again."""
         self._last_draw = time.monotonic()
-        old = self.screen.drawn
+        shown = self.results.on_screen()[0]
+        if self._drawn_preview is None:
+            self._index_before_preview = self.screen.time_index
         index = min(self.screen.time_index, len(view.times) - 1)
         with pn.io.hold():
-            self.results.draw(view, index, new_range=old is None
-                              or len(old.times) != len(view.times), preview=True)
+            self.results.draw(view, index, new_range=shown is None
+                              or len(shown.times) != len(view.times), preview=True)
             self.results.say_held(True, self._last_cpu_seconds(), preview=True)
             mark("drawn")
         self.results.push()

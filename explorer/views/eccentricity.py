@@ -138,8 +138,7 @@ class EccentricityControl:
         moment = self.state.loading.histories["moment"]
         if (self.drag is not None and event.new is not None and self.applicable()
                 and moment.kind == "constant"):
-            self.drag.held(moment, "value",
-                           float(event.new) * self.state.loading.histories["force"].value)
+            self.drag.held(moment, "value", self._moment_for(float(event.new)))
 
     def _on_release(self, event: Any) -> None:
         self.say_lag(None)
@@ -182,8 +181,20 @@ class EccentricityControl:
         if not self.applicable():
             self.reject(NOT_APPLICABLE)
             return
-        loading = self.state.loading
-        moment = loading.histories["moment"]
-        value = float(e) * loading.histories["force"].value
+        moment = self.state.loading.histories["moment"]
+        value = self._moment_for(float(e))
         if moment.kind != "constant" or moment.value != value:
             moment.param.update(kind="constant", value=value)
+
+    def _moment_for(self, e: float) -> float:
+        """M = e P [N·m/m] for the eccentricity ``e`` [m]; an ``e`` within round-off of the
+        state's own (the handle back where it was) gives the state's moment itself: e P
+        after e = M / P can differ from M in the last digit, and that step back read as a
+        new value (a preview kept on screen after a release that changed nothing)."""
+        loading = self.state.loading
+        moment, force = loading.histories["moment"], loading.histories["force"].value
+        current = self.eccentricity()
+        if (current is not None and moment.kind == "constant"
+                and abs(e - current) <= 1e-9 * max(self.state.punch.half_width, 1.0)):
+            return float(moment.value)
+        return e * force

@@ -92,6 +92,10 @@ def badges_html(view: ResultView | None, group: str,
 
 #: What the page does not show for a scene of several punches yet, said under its
 #: readout (the features of one punch that are off for several).
+#: The design check while a preview is on screen: no verdict on a history without creep
+#: (its largest settlement is the one at loading; the answer with creep comes on release).
+PREVIEW_DESIGN = ("<span class='cp-badge check-none design-preview'>design check on "
+                  "release: the preview leaves out creep</span>")
 SEVERAL_PUNCHES_NOTE = ("Several punches: pins, the classical solutions, the design check, "
                         "the coating model's FE check, studies and the back-analysis are "
                         "for one punch and are off here; the Files tab's CSV files (SI "
@@ -314,10 +318,17 @@ class ResultsView:
 
     def show_design(self, view: ResultView | None = None) -> None:
         """The design check of ``view`` (default: the result on screen) against the
-        session's limits."""
-        view = self.screen.shown() if view is None else view
+        session's limits. A preview (no creep) gets no verdict: the largest settlement
+        and pressure of the whole history come with creep, on release."""
+        if view is None:
+            view, preview = self.on_screen()
+        else:
+            preview = view is self._preview
         if view is not None and view.several:
             self.design.object = ""  # said by the readout's note
+            return
+        if preview:
+            self.design.object = PREVIEW_DESIGN
             return
         self.design.object = check_html(design_check(view, self.limits)) if view else ""
 
@@ -360,7 +371,8 @@ class ResultsView:
         text = preview_text(cpu_seconds) if preview else held_text(cpu_seconds)
 
         def show() -> None:
-            if self._held_wanted:
+            # (a preview drawn since this note was scheduled says its own note)
+            if self._held_wanted and (preview or self._preview is None):
                 self.held.object = text
                 self.held.visible = True
 
@@ -390,7 +402,7 @@ class ResultsView:
 
     def _on_classical(self, event: Any) -> None:
         with pn.io.hold():
-            self.figures.set_classical(self.screen.shown(), self.screen.time_index,
+            self.figures.set_classical(self.on_screen()[0], self.screen.time_index,
                                        bool(event.new))
         self.push()
 

@@ -134,7 +134,7 @@ def status_html(view: ResultView | None, busy: bool,
     if preview:
         text = "Preview (the base elastic at loading, without creep): " + text
     if busy:
-        text = ("Solving the released value with creep… showing its preview until then. "
+        text = ("Solving the newest change… showing a preview until its answer comes. "
                 if preview else "Solving the newest change… showing the previous result. "
                 ) + text
     if evidence is not None:

@@ -211,7 +211,9 @@ class Binding:
             # state has taken the value)
             released = getattr(self._live_when, "released", None)
             if released is not None:
-                widget.param.watch(lambda e: released(), "value_throttled")
+                # (not a value set from the state: a tab made mid-drag ended its preview)
+                widget.param.watch(lambda e: None if self._syncing else released(),
+                                   "value_throttled")
         if check is not None:
             self._checks[name] = check
         self._pairs.append((name, widget))

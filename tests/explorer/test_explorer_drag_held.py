@@ -181,7 +181,7 @@ def test_a_solve_running_behind_a_preview_says_the_preview_is_shown(monkeypatch,
     assert preview is not None
     app.results.busy.follow(True)            # the release's solve running (no server: at once)
     status = app.results.status.object
-    assert ("Solving the released value with creep… showing its preview until then. "
+    assert ("Solving the newest change… showing a preview until its answer comes. "
             "Preview (the base elastic at loading, without creep): ") in status
     assert "showing the previous result" not in status
     app.results.busy.follow(False)
@@ -214,3 +214,98 @@ def test_the_time_moved_under_a_preview_moves_the_preview(monkeypatch, explorer_
     app.end_preview()
     app.screen.time_index = 1
     assert np.allclose(_pressure_line(app), real.pressure[:, 1] / size, rtol=1e-6)
+
+
+def test_the_design_check_gives_no_verdict_on_a_preview(monkeypatch, explorer_app) -> None:
+    """A preview leaves creep out: its largest settlement is the one at loading, so a
+    limit between that and the answer with creep read "all set limits hold" under a
+    preview (a false pass for up to seconds after the release). It says the check comes
+    on release; the answer with creep gets its verdict back."""
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
+    settlement = real.values["settlement"]
+    app.limits.settlement_limit = 1e3 * 0.5 * (float(settlement[0])
+                                               + float(np.max(settlement)))  # [mm]
+    assert "a limit is exceeded" in app.results.design.object
+    thickness.value = before * 1.02
+    assert app.controller.preview is not None
+    assert "design check on release" in app.results.design.object
+    assert "all set limits hold" not in app.results.design.object
+    app.end_preview()
+    assert "a limit is exceeded" in app.results.design.object
+
+
+def test_the_classical_curves_under_a_preview_are_the_previews(monkeypatch,
+                                                                explorer_app) -> None:
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
+    thickness.value = before * 1.5
+    preview = app.controller.preview
+    seen = []
+    monkeypatch.setattr(app.figures, "set_classical",
+                        lambda view, index, on: seen.append(view))
+    app.results.classical.value = True
+    assert seen == [preview]
+
+
+def test_a_count_of_times_dragged_and_back_gives_the_answer_its_time_and_range(
+        monkeypatch, explorer_app) -> None:
+    """A preview of fewer output times clips the time on screen; the step back draws the
+    kept answer at the time it had, over its whole range (it stayed at the clipped index
+    with the player's end at it: times past it unreachable)."""
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
+    n = len(real.times)
+    assert app.screen.time_index == n - 1
+    count = app.times_tab.time_count
+    assert count.value == n
+    count.value = 5                           # a held step: previewed with 5 output times
+    preview = app.controller.preview
+    assert preview is not None and len(preview.times) == 5
+    assert app.screen.time_index == 4
+    count.value = n                           # back where it began (no release is sent)
+    assert app.results.on_screen() == (real, False)
+    assert app.screen.time_index == n - 1 and app.results.player.end == n - 1
+
+
+def test_a_step_back_on_the_eccentricity_slider_within_round_off_ends_the_preview(
+        explorer_app) -> None:
+    """e = M / P shown on the slider, times P, can differ from M in its last digit
+    (M = 28 kN m/m, P = 100 kN/m: 28.000000000000004): the handle back where it began
+    was a new value, its preview stayed on screen after a release that sent nothing."""
+    from explorer.model import presets
+    from explorer.views.eccentricity import LIVE_SOLVE_S
+
+    scene = presets()["eccentric_creep"]
+    scene["loading"]["force"], scene["loading"]["moment"] = 100000.0, 28000.0
+    app = explorer_app(scene=scene, solved=True)
+    app.controller.view.info["cpu_seconds"] = 3 * LIVE_SOLVE_S
+    control = app.scene_tab.eccentric_load
+    e0 = control.slider.value
+    assert e0 * 100.0 != 28.0  # the round-off this is about (the state in kN, kN m)
+    control.slider.value = e0 + 0.05
+    assert app.results.on_screen()[1]
+    control.slider.value = e0
+    assert app.results.on_screen() == (app.controller.view, False)
+    assert not app._previewing and app.state.loading.histories["moment"].value == 28.0
+
+
+def test_a_held_note_due_after_a_preview_was_drawn_does_not_cover_it(monkeypatch,
+                                                                     explorer_app) -> None:
+    """On a served page the plain held note comes HELD_AFTER_MS after a step; a preview
+    drawn meanwhile says its own note at once, which the late one overwrote ("the plots
+    show the last result" over a preview)."""
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
+    later = []
+
+    class Served:
+        served = True
+
+        @staticmethod
+        def later(call, ms):
+            later.append(call)
+
+    monkeypatch.setattr(app.results, "loop", Served())
+    app.results.say_held(True, 1.0)                # a step: the plain note, due later
+    thickness.value = before * 1.5                 # the preview drawn, its note at once
+    assert app.results.on_screen()[1]
+    for call in later:
+        call()
+    assert app.results.held.object.startswith("Preview while you drag")
