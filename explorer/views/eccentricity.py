@@ -187,7 +187,7 @@ class EccentricityControl:
             moment.param.update(kind="constant", value=value)
 
     def _moment_for(self, e: float) -> float:
-        """M = e P [N·m/m] for the eccentricity ``e`` [m]; an ``e`` within round-off of the
+        """M = e P [kN·m/m] for the eccentricity ``e`` [m]; an ``e`` within round-off of the
         state's own (the handle back where it was) gives the state's moment itself: e P
         after e = M / P can differ from M in the last digit, and that step back read as a
         new value (a preview kept on screen after a release that changed nothing)."""

@@ -90,12 +90,12 @@ def badges_html(view: ResultView | None, group: str,
     return "".join(parts)
 
 
-#: What the page does not show for a scene of several punches yet, said under its
-#: readout (the features of one punch that are off for several).
 #: The design check while a preview is on screen: no verdict on a history without creep
 #: (its largest settlement is the one at loading; the answer with creep comes on release).
 PREVIEW_DESIGN = ("<span class='cp-badge check-none design-preview'>design check on "
                   "release: the preview leaves out creep</span>")
+#: What the page does not show for a scene of several punches yet, said under its
+#: readout (the features of one punch that are off for several).
 SEVERAL_PUNCHES_NOTE = ("Several punches: pins, the classical solutions, the design check, "
                         "the coating model's FE check, studies and the back-analysis are "
                         "for one punch and are off here; the Files tab's CSV files (SI "
