@@ -578,6 +578,9 @@ class ExplorerApp(pn.viewable.Viewer):
         before, self._index_before_preview = self._index_before_preview, None
         if old is None and self._wanted_index is not None:
             index = min(self._wanted_index, n - 1)  # the time the link was made at
+        elif shown is not old and shown is not None and old is not None \
+                and len(shown.times) == n:
+            index = min(self.screen.time_index, n - 1)  # a time moved under the preview
         elif old is None or len(old.times) != n:
             index = n - 1
         elif (shown is not old and shown is not None and len(shown.times) != n

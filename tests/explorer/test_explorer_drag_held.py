@@ -309,3 +309,21 @@ def test_a_held_note_due_after_a_preview_was_drawn_does_not_cover_it(monkeypatch
     for call in later:
         call()
     assert app.results.held.object.startswith("Preview while you drag")
+
+
+def test_a_time_moved_under_a_preview_of_the_released_count_stays(monkeypatch,
+                                                                  explorer_app) -> None:
+    """Released at 5 output times while its answer solves, the 5-time preview stays on
+    screen; a time moved there is kept when the 5-time answer comes (it went to the end,
+    the answer's count differing from the one kept before)."""
+    app, real, drawn, thickness, before = _slow_default(monkeypatch, explorer_app)
+    count = app.times_tab.time_count
+    count.value = 5
+    assert app.results.on_screen()[1]
+    app.screen.time_index = 1                 # moved while the answer would be solving
+    app._previewing = False                   # the release: the preview stays until it comes
+    with param.edit_constant(count):
+        count.value_throttled = 5
+    view = app.controller.view
+    assert len(view.times) == 5 and app.results.on_screen() == (view, False)
+    assert app.screen.time_index == 1 and app.results.player.end == 4
