@@ -131,9 +131,51 @@ def _real_modes(gamma: np.ndarray, psi: np.ndarray) -> np.ndarray:
     return out / np.where(norms > 0, norms, 1.0)[None, :]
 
 
+def _rotated_groups(blocks: tuple[np.ndarray, ...] | None, rotation: np.ndarray, n: int
+                    ) -> np.ndarray | None:
+    """The group of each rotated coordinate (n,), or None where there are no groups or the
+    rotation mixes two of them (it then takes each of the first two coordinates from
+    one basis function alone, exactly)."""
+    if blocks is None:
+        return None
+    label = np.full(n, -1)
+    for g, members in enumerate(blocks):
+        label[np.asarray(members)] = g
+    if np.any(label < 0):
+        raise ValueError("blocks: every basis function must be in one group")
+    rotated = label.copy()
+    for j in range(2):
+        column = np.abs(rotation[:, j])
+        if np.count_nonzero(column) != 1:
+            return None
+        rotated[j] = label[int(np.argmax(column))]
+    return rotated
+
+
+def _free_modes(r_rot: np.ndarray, free: np.ndarray, groups: np.ndarray | None
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """``eig`` of the free block (gamma, psi), group by group where ``groups`` are given
+    (``psi`` block-diagonal), with real eigenvectors; ``UnresolvedOperator`` where the
+    eigenvalues are not real and positive."""
+    parts = ([np.arange(free.size)] if groups is None
+             else [np.flatnonzero(groups[free] == g) for g in np.unique(groups[free])])
+    gamma = np.empty(free.size, dtype=complex)
+    psi = np.zeros((free.size, free.size))
+    for part in parts:
+        values, vectors = np.linalg.eig(r_rot[np.ix_(free[part], free[part])])
+        gamma[part] = values
+        psi[np.ix_(part, part)] = _real_modes(values, vectors)
+    scale = float(np.max(np.abs(gamma))) if gamma.size else 1.0
+    if gamma.size and (np.max(np.abs(gamma.imag)) > 1e-8 * scale or np.min(gamma.real) <= 0):
+        raise UnresolvedOperator("operator: eigenvalues not real and positive; the grid does "
+                                 "not resolve the problem")
+    return gamma.real, psi
+
+
 def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
                  given: frozenset[str], n: int, *, symmetric: bool = True,
-                 inverse: bool = True) -> ModalSystem:
+                 inverse: bool = True, blocks: tuple[np.ndarray, ...] | None = None
+                 ) -> ModalSystem:
     """Build the decoupled system for a statement at ``n`` functions of the basis.
 
     ``r_matrix`` is the Galerkin matrix ``R`` (at least n x n, symmetric positive definite);
@@ -142,7 +184,13 @@ def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
     ``R_FF = psi diag(gamma) psi^-1``; its eigenvalues are real and positive up to
     round-off (the operator is similar to a symmetric positive one), else ``ValueError``;
     ``inverse=False`` leaves ``psi_inv`` None (a caller that applies it to a few vectors
-    solves with ``psi`` instead of inverting it).
+    solves with ``psi`` instead of inverting it). ``blocks``: groups of the basis
+    functions (indices, together 0 .. n-1) between which ``R`` has no entries, as a
+    geometry symmetric about the punch's centre gives its even and odd functions; each
+    group's free block is then diagonalized on its own (``psi`` block-diagonal in their
+    order), which ``eig`` does in a fraction of the time (half the size: ~1/2 of the CPU
+    measured at 288 modes, ~1/3 at 128). They are used only where the rotation below keeps
+    them apart (``J_1 = 0``, as such a geometry has it).
     """
     statement_number(given)
     j0, j1, j2 = moments
@@ -183,13 +231,7 @@ def modal_system(r_matrix: np.ndarray, moments: tuple[float, float, float],
         gamma, psi = np.linalg.eigh(r_rot[np.ix_(free, free)])
         psi_inv = psi.T
     else:
-        gamma, psi = np.linalg.eig(r_rot[np.ix_(free, free)])
-        scale = float(np.max(np.abs(gamma))) if gamma.size else 1.0
-        if gamma.size and (np.max(np.abs(gamma.imag)) > 1e-8 * scale
-                           or np.min(gamma.real) <= 0):
-            raise UnresolvedOperator("operator: eigenvalues not real and positive; the grid does "
-                             "not resolve the problem")
-        gamma, psi = gamma.real, _real_modes(gamma, psi)
+        gamma, psi = _free_modes(r_rot, free, _rotated_groups(blocks, rotation, n))
         psi_inv = np.linalg.inv(psi) if inverse else None
     constraint = np.array([[(e0_rot if name == "force" else e1_rot)[i] for i in known]
                            for name in constraint_names]).reshape(k, k)
