@@ -324,7 +324,8 @@ def _check_coefficients(scene: Scene, problem: DimensionlessProblem) -> bool:
         lo, hi = schema.M_STAR_RANGE
         # no coating: m* = 0 exactly, which the exact layered kernel solves
         refuse_first(bool(scene.coating) & (~np.isfinite(m) | (m < lo) | (m > hi)), lambda i: (
-            f"coating: the coating compliance relative to the base, m* = E0 sum_k (1 - "
+            f"{_m_star_field(scene, x[i])}: the coating compliance relative to the base, "
+            f"m* = E0 sum_k (1 - "
             f"nu_k^2) h_k / E_k / (2 (1 - nu^2) a), is {m[i]:.3g} at x = {x[i]:.6g} m, "
             f"outside [{lo:g}, {hi:g}]: the layers are too stiff or soft, thin or thick "
             "against the base to be solved in double precision"))
@@ -344,9 +345,45 @@ def _check_coefficients(scene: Scene, problem: DimensionlessProblem) -> bool:
     return True
 
 
+def _m_star_field(scene: Scene, x: float) -> str:
+    """The field to change when ``m*`` at ``x`` [m] is out of range: of the layer that
+    weighs most there, its thickness when ``h_k / a`` is further from 1 than ``E0 / E_k``,
+    else its modulus, or the base's when ``E0`` is further than ``E_k`` from engineering
+    moduli (``TYPICAL_MODULUS``, on a log scale)."""
+    with np.errstate(all="ignore"):
+        at = np.array([float(x)])
+        h = [float(profile_values(layer.thickness, at)[0]) for layer in scene.coating]
+        e = [float(profile_values(layer.modulus, at)[0]) for layer in scene.coating]
+        nu = [float(profile_values(layer.poisson, at)[0]) for layer in scene.coating]
+        weights = [(1.0 - n * n) * hk / ek for hk, ek, n in zip(h, e, nu, strict=True)]
+        k = int(np.nanargmax(np.nan_to_num(weights, nan=-1.0, posinf=np.inf)))
+        e0 = scene.modulus_at_loading()
+
+        def spread(value: float) -> float:
+            return abs(math.log10(value)) if 0.0 < value < math.inf else math.inf
+
+        if spread(h[k] / scene.half_width) > spread(e0 / e[k]):
+            return f"coating[{k}].thickness"
+        if spread(e0 / TYPICAL_MODULUS) > spread(e[k] / TYPICAL_MODULUS):
+            # a design-code law gives E0 by its strength class, not by a modulus field
+            creep = scene._data["base"]["creep"]
+            return ("base.creep.modulus" if isinstance(creep, Mapping) and "modulus" in creep
+                    else "base.creep")
+        return f"coating[{k}].modulus"
+
+
+#: A modulus of engineering materials [Pa] (concrete ~3e10, polymers ~1e9): which of two
+#: moduli whose ratio is out of range is the outlier (:func:`_m_star_field`).
+TYPICAL_MODULUS = 1e10
+
+
 def _check_loads_scalable(scene: Scene, problem: DimensionlessProblem) -> None:
-    """Refuse a load whose dimensionless value leaves double precision."""
+    """Refuse a load whose dimensionless value leaves double precision: beyond
+    ``MAX_MAGNITUDE``, or a load that is not zero in the scene but below its inverse once
+    scaled (a force of 1e-320 N/m became P* = 0, which the solver then refused as "nothing
+    presses it", after ``validate`` had passed the scene)."""
     ts = problem.times
+    days = np.asarray(scene.times, dtype=float)
     with np.errstate(all="ignore"):
         for name, load in problem.loads.items():
             values = np.broadcast_to(load(ts) if callable(load) else load, ts.shape)
@@ -355,6 +392,18 @@ def _check_loads_scalable(scene: Scene, problem: DimensionlessProblem) -> None:
                              f"loading.{name}: cannot be scaled by the base modulus and the "
                              f"half-width in double precision at t = {scene.times[i]:.6g} "
                              "days after loading (the sizes in the scene are too far apart)"))
+            given = np.broadcast_to(profile_values(scene.loading[name], days), ts.shape)
+            refuse_first((given != 0.0) & (np.abs(values) < 1.0 / MAX_MAGNITUDE),
+                         lambda i, name=name, given=given: (
+                             f"loading.{name}: {given[i]:.6g} {_unit('loading', name)} at t = "
+                             f"{scene.times[i]:.6g} days after loading is too small against "
+                             "the base modulus and the half-width to be solved in double "
+                             "precision (give 0 for none)"))
+
+
+def _unit(section: str, name: str) -> str:
+    """The unit of the field ``name`` of ``section`` in the scene file (its schema rule)."""
+    return next(rule.unit for rule in schema.FIELDS[section] if rule.name == name)
 
 
 #: Cached properties of a :class:`Scene` that do not depend on the loads: a scene with

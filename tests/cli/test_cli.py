@@ -129,6 +129,18 @@ def test_bad_value(tmp_path: Path):
                           "coating[0].modulus: must be > 0, is -3e+06 at x = 0.12 m")
 
 
+def test_validate_refuses_what_solve_would(tmp_path: Path):
+    """A force that underflows once scaled by the base modulus: ``validate`` said ok (exit
+    0) while ``solve`` failed (exit 1, naming ``force``); both now refuse it as input."""
+    d = scene_dict()
+    d["loading"]["force"] = 1e-320
+    path = tmp_path / "tiny.json"
+    path.write_text(json.dumps(d))
+    for proc in (run("validate", path), run("solve", path)):
+        assert_one_line_error(proc, "loading.force: 9.99989e-321 N/m at t = 0 days after "
+                                    "loading is too small")
+
+
 def test_not_json(tmp_path: Path):
     path = tmp_path / "scene.json"
     path.write_text("{\n  \"schema_version\": 1,\n  oops\n}\n")
