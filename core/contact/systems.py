@@ -22,10 +22,27 @@ from scipy.linalg.lapack import dgetrs
 
 def restrict(op: np.ndarray, idx: np.ndarray) -> np.ndarray:
     """``op`` on the nodes ``idx`` (sorted): a view when they are one run of nodes (one
-    contact zone, the usual case: no copy of the block), a copy otherwise."""
+    contact zone, the usual case: no copy of the block), a copy otherwise, made block by
+    block when the nodes form a few runs (several zones)."""
     if idx.size and int(idx[-1]) - int(idx[0]) + 1 == idx.size:
         return op[idx[0]:idx[-1] + 1, idx[0]:idx[-1] + 1]
-    return op[np.ix_(idx, idx)]
+    cuts = np.flatnonzero(np.diff(idx) != 1) + 1
+    if not idx.size or cuts.size >= MAX_RUNS:
+        return op[np.ix_(idx, idx)]
+    # slices copy at the memory's speed, fancy indexing ~3x slower: 6.6 of the 44 s of a
+    # stepped punch whose outer steps come into contact (three zones, ~2000 nodes)
+    starts, stops = np.r_[0, cuts], np.r_[cuts, idx.size]
+    runs = [(int(a), int(b), slice(int(idx[a]), int(idx[b - 1]) + 1))
+            for a, b in zip(starts, stops, strict=True)]
+    out = np.empty((idx.size, idx.size), dtype=op.dtype)
+    for a0, a1, rows in runs:
+        for b0, b1, cols in runs:
+            out[a0:a1, b0:b1] = op[rows, cols]
+    return out
+
+
+#: Runs of consecutive nodes up to which :func:`restrict` copies block by block.
+MAX_RUNS = 16
 
 
 def _lu_solve(lu: tuple[np.ndarray, np.ndarray], r: np.ndarray) -> np.ndarray:

@@ -11,6 +11,7 @@ from core.contact.systems import (
     _bordered_system,
     bordered_change,
     bordered_solve,
+    restrict,
 )
 from core.discretize import base_panels, kernel_operator
 
@@ -154,3 +155,16 @@ def test_small_systems_are_factored_anew(rule):
     for lo in (0, 1, 2):
         bordered_solve(op, m, x, w, 1.0, 1.0, given, rhs, np.arange(lo, lo + small), solver)
     assert solver.factorizations == 3 and solver.updates == 0
+
+
+@pytest.mark.parametrize("pattern", ["one run", "three runs", "scattered", "empty"])
+def test_the_operator_on_contact_nodes_is_the_submatrix(pattern: str) -> None:
+    """:func:`restrict` copies several zones block by block: the same entries as indexing
+    by the nodes, for one zone (a view), a few, more runs than it copies by blocks, none."""
+    rng = np.random.default_rng(7)
+    op = rng.standard_normal((60, 60))
+    idx = {"one run": np.arange(5, 41),
+           "three runs": np.r_[0:10, 15:30, 52:60],
+           "scattered": np.arange(0, 60, 2),
+           "empty": np.arange(0)}[pattern]
+    assert np.array_equal(restrict(op, idx), op[np.ix_(idx, idx)])
