@@ -78,6 +78,11 @@ PRESENTATION_FONT = "18px"
 TITLE_CHARS = 40
 
 
+#: Room beside the loaded stretch on the pressure plot's x axis, a share of its width on
+#: each side (as Bokeh's automatic ranges pad: the punch's edges clear of the frame).
+X_PADDING = 0.05
+
+
 def short(text: str, limit: int = TITLE_CHARS) -> str:
     """``text`` cut to ``limit`` characters with an ellipsis."""
     text = " ".join(str(text).split())
@@ -111,7 +116,7 @@ class Figures:
         # the value axes are set here, not fitted in the page (see steady_range)
         p = figure(height=280, sizing_mode="stretch_width", tools=TOOLS,
                    title="Contact pressure q(x)", toolbar_location="above",
-                   name="pressure_figure", y_range=Range1d(0, 1))
+                   name="pressure_figure", x_range=Range1d(-1, 1), y_range=Range1d(0, 1))
         p.toolbar.autohide = True
         p.xaxis.axis_label = "x [m]"
         p.yaxis.axis_label = "q [kPa]"
@@ -368,6 +373,15 @@ class Figures:
         self._fit_pressure(view)
 
     def _fit_pressure(self, view: ResultView) -> None:
+        # x: the punch (or punches) and the pins, set here rather than fitted in the page,
+        # whose automatic range sent its new ends back to the server at every geometry
+        # step (a message each way)
+        lo, hi = view.span
+        for pin in self._pins:
+            lo, hi = min(lo, pin.view.span[0]), max(hi, pin.view.span[1])
+        pad = X_PADDING * (hi - lo)
+        self.q_fig.x_range.update(start=lo - pad, end=hi + pad, reset_start=lo - pad,
+                                  reset_end=hi + pad)
         size = self.scales.pressure_unit(view)[1]
         shown = [view.pressure / size, *(pin.view.pressure / size for pin in self._pins)]
         if self.classical:

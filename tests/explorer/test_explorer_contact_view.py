@@ -246,3 +246,21 @@ def test_the_drawing_goes_to_the_page_as_binary_arrays() -> None:
     encoded = serializer.encode(dict(figures.layer_src.data))
     text = json.dumps(encoded, default=lambda buffer: {"id": buffer.id})
     assert len(serializer.buffers) == 7 and len(text) < 1500
+
+
+def test_the_pressure_plot_spans_the_punch_and_its_pins_set_by_the_server() -> None:
+    """The x axis of q(x) is set with each result (the punch, the pins), not fitted in the
+    page: an automatic range sent its new ends back to the server at every geometry step."""
+    from explorer.model import Pin
+
+    figures, view, last = _drawn("rounded_graded")
+    a = view.geometry.half_width
+    rng = figures.q_fig.x_range
+    assert type(rng).__name__ == "Range1d"
+    assert (rng.start, rng.end) == pytest.approx((-1.1 * a, 1.1 * a), rel=1e-12)
+    assert (rng.reset_start, rng.reset_end) == (rng.start, rng.end)
+    wider = _solved("uniform_flat")   # its punch is wider: a pin of it widens the axis
+    b = wider.geometry.half_width
+    assert b > a
+    figures.show(view, last, (Pin(wider, "wider"),))
+    assert (rng.start, rng.end) == pytest.approx((-1.1 * b, 1.1 * b), rel=1e-12)
