@@ -165,9 +165,20 @@ def _validated(d: dict[str, Any]) -> Scene:
     loads = {q: _profile(loading[q], f"loading.{q}", "t", t_domain)
              for q in QUANTITIES if q in given}
     # the solver's time is the age over tau0: times closer than its rounding would merge
-    ages = (tau0 + times) / tau0
+    with np.errstate(over="ignore", invalid="ignore"):
+        ages = (tau0 + times) / tau0
+    if not np.all(np.isfinite(ages)):
+        raise ValueError(f"base.age_at_loading: {tau0:g} days is too small against the output "
+                         f"times (up to {float(times[-1]):g} days after loading): the age over "
+                         "the age at loading overflows double precision")
     if np.any(np.diff(ages) <= 0):
         i = int(np.argmax(np.diff(ages) <= 0)) + 1
+        if times[i] - times[i - 1] > RESOLVED_TIMES * float(times[-1]):
+            # the times are apart on their own scale: the age at loading swamps them
+            raise ValueError(f"base.age_at_loading: {tau0:g} days is too large against the "
+                             f"output times: times[{i - 1}] and times[{i}] ({times[i - 1]:g} "
+                             f"and {times[i]:g} days after loading) cannot be told apart in "
+                             "the age over the age at loading")
         raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
                          f"an age at loading of {tau0:g} days")
 
@@ -399,6 +410,12 @@ def _check_loads_scalable(scene: Scene, problem: DimensionlessProblem) -> None:
                              f"{scene.times[i]:.6g} days after loading is too small against "
                              "the base modulus and the half-width to be solved in double "
                              "precision (give 0 for none)"))
+
+
+#: Output times further apart than this share of the last one are apart on their own
+#: scale: when the solver's time (the age over the age at loading) merges them, the age at
+#: loading is named, not the times.
+RESOLVED_TIMES = 1e-9
 
 
 def _unit(section: str, name: str) -> str:

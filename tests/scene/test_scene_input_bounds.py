@@ -195,6 +195,11 @@ def test_many_jumps_are_refused_before_the_solver_sees_them() -> None:
      "punch.shape: the gap between the punch base and the coating surface is"),
     # a tiny age at loading makes the aging term A / age^2 infinite
     ("base.age_at_loading", 1e-300, "base.creep: the creep kernel K(t, tau) is"),
+    # ... or the age over it overflow (numpy's warnings came first); a huge one merges
+    # every output time (the message named times[1])
+    ("base.age_at_loading", 1e-320, "base.age_at_loading: 9.99989e-321 days is too small"),
+    ("base.age_at_loading", 1e308, "base.age_at_loading: 1e+308 days is too large against "
+                                   "the output times: times[0] and times[1]"),
     # 1e200 m squared overflowed Python's float power (OverflowError, a traceback)
     ("punch.half_width", 1e200, "base.thickness: the ratio"),
 ])
