@@ -107,6 +107,10 @@ def check_live_bound(value: object) -> float:
 #: ms of its CPU to show one (benchmarks/results/explorer_latency.md), so a faster stream
 #: of results only queues up in front of it (12 fps at most: a drag stays live).
 DRAW_EVERY_MS = 80.0
+#: For this long after a slider's release (a key step is one too), results are drawn as
+#: they come, not spaced out by DRAW_EVERY_MS: only the answer in flight and the
+#: release's own are still to come [s]. A new drag step ends it.
+AFTER_RELEASE_S = 2.0
 
 
 class DragSteps:
@@ -201,6 +205,8 @@ class ExplorerApp(pn.viewable.Viewer):
         self._initializing = True
         self._last_draw = float("-inf")  # when a result was last drawn (time.monotonic)
         self._draw_due = False  # a later draw of the newest result is scheduled
+        # when a slider was last released, and no drag step since (time.monotonic)
+        self._released_at = float("-inf")
         self._connected = not self.loop.served
         if self.loop.served:
             pn.state.onload(self._on_load)
@@ -347,6 +353,7 @@ class ExplorerApp(pn.viewable.Viewer):
         """At a drag step of a slider that otherwise waits for its release: whether the
         step applies now (:meth:`fast_solves`); when not, the page says so."""
         self.tabs.touch()
+        self._released_at = float("-inf")  # a drag (again): its results are spaced out
         fast = self.fast_solves()
         self.results.say_held(not fast, self._last_cpu_seconds(), self._drawn_preview is not None)
         return fast
@@ -415,6 +422,7 @@ class ExplorerApp(pn.viewable.Viewer):
     def end_preview(self) -> None:
         """A release: no more previews; a preview on screen gives way to the new answer
         with creep once solved (to the one kept when none is solving)."""
+        self._released_at = time.monotonic()
         self._previewing = False
         self._preview_scene = None
         self.controller.stop_previews()
@@ -548,7 +556,13 @@ class ExplorerApp(pn.viewable.Viewer):
             # results drawn at most every DRAW_EVERY_MS, the newest when the time comes: a
             # drag solved 20 steps a second, each patch took the page ~65 ms of its CPU,
             # and the queued patches kept coming 1.5 s after the release
-            wait = self._last_draw + DRAW_EVERY_MS / 1000.0 - time.monotonic()
+            now = time.monotonic()
+            wait = self._last_draw + DRAW_EVERY_MS / 1000.0 - now
+            # after a release at most the answer in flight and the release's own come: a
+            # wait only delays the last frame (up to DRAW_EVERY_MS of the time from the
+            # release to it, whose goal is 200 ms)
+            if now - self._released_at < AFTER_RELEASE_S:
+                wait = 0.0
             if wait > 0:
                 if not self._draw_due:
                     self._draw_due = True

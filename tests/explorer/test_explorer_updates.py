@@ -169,6 +169,35 @@ def test_results_reach_a_served_page_at_most_every_draw_interval(served_app,
     assert app.screen.drawn is app.controller.view
 
 
+def test_results_after_a_release_are_drawn_as_they_come(served_app, monkeypatch) -> None:
+    """After a slider's release only the answer in flight and the release's own come: a
+    wait for the draw interval only delayed the last frame (the release's goal is 200 ms).
+    A drag step spaces the results out again."""
+    from types import SimpleNamespace
+
+    from explorer import app as page
+
+    monkeypatch.setattr(page, "time", SimpleNamespace(monotonic=lambda: 0.0))
+    app, timers = served_app
+    drawn: list[float] = []
+    app.results.draw = lambda view, *args, **kwargs: drawn.append(
+        view.values["force"][0] / 1e3)  # kN/m
+    app._last_draw = float("-inf")
+    force = app.state.loading.histories["force"]
+    app.drag.released()
+    for value in (510.0, 520.0):
+        force.value = value
+        assert app.controller.wait(60)
+    assert drawn == [510.0, 520.0]          # no draw interval waited for
+    app._drag_step_applies()                 # a drag again
+    for value in (530.0, 540.0):
+        force.value = value
+        assert app.controller.wait(60)
+    assert drawn == [510.0, 520.0]           # within the interval of the last draw
+    timers.run()
+    assert drawn == [510.0, 520.0, 540.0]
+
+
 def test_the_link_follows_the_screen_at_most_once_a_second(served_app, monkeypatch) -> None:
     from explorer import app as page
     from explorer.model import decode_scene
