@@ -135,7 +135,7 @@ class DragSteps:
 
     def released(self) -> None:
         """The dragged slider was released (its value, if new, is in the state)."""
-        self._app.end_preview()
+        self._app.released()
 
 
 class ExplorerApp(pn.viewable.Viewer):
@@ -419,10 +419,16 @@ class ExplorerApp(pn.viewable.Viewer):
         if scene is not None and self._previewing:
             self.controller.request_preview(scene)
 
-    def end_preview(self) -> None:
-        """A release: no more previews; a preview on screen gives way to the new answer
-        with creep once solved (to the one kept when none is solving)."""
+    def released(self) -> None:
+        """A slider was released: results are drawn as they come for a while
+        (:data:`AFTER_RELEASE_S`), and the preview ends (:meth:`end_preview`)."""
         self._released_at = time.monotonic()
+        self.end_preview()
+
+    def end_preview(self) -> None:
+        """A release, or a held drag back at the value applied: no more previews; a
+        preview on screen gives way to the new answer with creep once solved (to the one
+        kept when none is solving)."""
         self._previewing = False
         self._preview_scene = None
         self.controller.stop_previews()
