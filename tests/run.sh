@@ -82,7 +82,7 @@ fi
 # one core each, beside the others) 11:12, the browser part then the longest (10:39).
 # Beside a CPU hog on the faster machine (AMD EPYC, 2026-12-04, fresh clones, five runs in
 # a row, all green): two busy loops (load 3.4-7) 11:09; one busy loop (load ~4-6) 8:20,
-# 8:02, 8:03 and the fifth (see the session's note), the rest part 7:45-8:03 of each.
+# 8:02, 8:03 and 7:48, the rest part 7:31-8:03 of each.
 # The parts share nothing: each has its own temporary directory, pytest cache and served
 # explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
