@@ -18,7 +18,13 @@ import numpy as np
 
 from core import limits
 from core.cache import StageCache, fingerprint
-from core.coating import DEFAULT_INTERFACE, DEFAULT_MODEL_TOL, INTERFACES, MODEL_TOL_RANGE
+from core.coating import (
+    DEFAULT_INTERFACE,
+    DEFAULT_MODEL_TOL,
+    INTERFACES,
+    MODEL_TOL_RANGE,
+    layer_compliance,
+)
 from core.creep import CodeCreep, Elastic, UserKernel, creep_model_from_spec, default_tolerance
 from core.problem import QUANTITIES, STATEMENTS
 from core.profiles import Profile, profile_values
@@ -365,8 +371,9 @@ def _m_star_field(scene: Scene, x: float) -> str:
         at = np.array([float(x)])
         h = [float(profile_values(layer.thickness, at)[0]) for layer in scene.coating]
         e = [float(profile_values(layer.modulus, at)[0]) for layer in scene.coating]
-        nu = [float(profile_values(layer.poisson, at)[0]) for layer in scene.coating]
-        weights = [(1.0 - n * n) * hk / ek for hk, ek, n in zip(h, e, nu, strict=True)]
+        weights = [float(layer_compliance(hk, ek, profile_values(layer.poisson, at)[0],
+                                          layer.interface))
+                   for layer, hk, ek in zip(scene.coating, h, e, strict=True)]
         k = int(np.nanargmax(np.nan_to_num(weights, nan=-1.0, posinf=np.inf)))
         e0 = scene.modulus_at_loading()
 
@@ -403,8 +410,11 @@ def _check_loads_scalable(scene: Scene, problem: DimensionlessProblem) -> None:
                              f"loading.{name}: cannot be scaled by the base modulus and the "
                              f"half-width in double precision at t = {scene.times[i]:.6g} "
                              "days after loading (the sizes in the scene are too far apart)"))
+            small = np.abs(values) < 1.0 / MAX_MAGNITUDE
+            if not small.any():
+                continue  # (every load move of a slider: no second sampling)
             given = np.broadcast_to(profile_values(scene.loading[name], days), ts.shape)
-            refuse_first((given != 0.0) & (np.abs(values) < 1.0 / MAX_MAGNITUDE),
+            refuse_first((given != 0.0) & small,
                          lambda i, name=name, given=given: (
                              f"loading.{name}: {given[i]:.6g} {_unit('loading', name)} at t = "
                              f"{scene.times[i]:.6g} days after loading is too small against "

@@ -370,18 +370,21 @@ class Figures:
             steady_range(self.history_fig[q].y_range,
                          view.display(q) if not view.several else [],
                          *(pin.view.display(q) for pin in pins), *extra)
+        self._fit_pressure_x(view)
         self._fit_pressure(view)
 
-    def _fit_pressure(self, view: ResultView) -> None:
-        # x: the punch (or punches) and the pins, set here rather than fitted in the page,
-        # whose automatic range sent its new ends back to the server at every geometry
-        # step (a message each way)
+    def _fit_pressure_x(self, view: ResultView) -> None:
+        """The x axis of q(x): the punch (or punches) and the pins, set here rather than
+        fitted in the page, whose automatic range sent its new ends back to the server at
+        every geometry step (a message each way). Not a function of the time shown."""
         lo, hi = view.span
         for pin in self._pins:
             lo, hi = min(lo, pin.view.span[0]), max(hi, pin.view.span[1])
         pad = X_PADDING * (hi - lo)
         self.q_fig.x_range.update(start=lo - pad, end=hi + pad, reset_start=lo - pad,
                                   reset_end=hi + pad)
+
+    def _fit_pressure(self, view: ResultView) -> None:
         size = self.scales.pressure_unit(view)[1]
         shown = [view.pressure / size, *(pin.view.pressure / size for pin in self._pins)]
         if self.classical:
