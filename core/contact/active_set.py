@@ -50,11 +50,18 @@ def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarra
     values; ``start`` the first guess of the contact nodes (default: all). Returns the
     state, the number of sweeps and whether the set settled (it may cycle between two
     sets on a degenerate node; the last one is kept). Raises :class:`NoContact` when
-    no node stays in contact under a given force or moment.
+    no node stays in contact under a given force or moment. With a ``solver`` made for a
+    :class:`~core.contact.systems.Mirror` (an even problem) the sets and the pressure
+    are exactly even.
     """
     x, w = panels.nodes, panels.weights
+    mirror = None if solver is None else solver.mirror
+    if mirror is not None and memory is not None:
+        memory = mirror.unfold(mirror.even(memory))
     rhs = _given_rhs(step, x, g, memory)
     active = np.ones(x.size, dtype=bool) if start is None else start.copy()
+    if mirror is not None:
+        active &= active[::-1]  # a symmetric start (the rounding of its zones' ends aside)
     seen: set[bytes] = set()
     settled = False
     sweeps = 0
@@ -73,8 +80,14 @@ def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarra
             raise NoContact("the contact shrinks to a point")
         else:
             q[idx], delta, alpha = _bordered_solve(op, m, x, w, step, rhs, idx, solver)
-        nystrom = (delta + alpha * x - g + (0.0 if memory is None else memory)
-                   - step.scale * (op @ q)) / (step.c * m)
+        if mirror is None:
+            nystrom = (delta + alpha * x - g + (0.0 if memory is None else memory)
+                       - step.scale * (op @ q)) / (step.c * m)
+        else:
+            # on the half x > 0 and mirrored: the contact set stays exactly symmetric
+            h = mirror.half
+            nystrom = mirror.unfold((delta - g[h:] + (0.0 if memory is None else memory[h:])
+                                     - step.scale * mirror.apply(q)) / (step.c * m[h:]))
         # Keep the contact nodes the equation solved exactly (rounding must not flip them).
         nystrom[idx] = q[idx]
         new = nystrom > 0.0

@@ -10,7 +10,9 @@ wide, 3.9e-6 / 1.6e-6 / 4.8e-7 (ratio 2.4-3.3 per halving), and the panels outsi
 band did not matter (0.5 or 0.0625 wide: the same ends to 1e-14, q is smooth there).
 
 :func:`band_rule` builds such a rule; :func:`bands_from_ends` finds the bands from the
-ends of a first, coarse march.
+ends of a first, coarse march. For a problem even in x the rule is made symmetric about
+0 (:func:`even_rule`), so that the march solves it on the half x > 0
+(:class:`core.contact.systems.Mirror`).
 """
 
 from __future__ import annotations
@@ -122,3 +124,33 @@ def band_rule(space: Space, res: Resolution, bands: Sequence[tuple[float, float]
         else:
             merged.append(e)
     return Panels.from_edges(np.asarray(merged))
+
+
+def mirrored_bands(bands: Sequence[tuple[float, float]]) -> list[tuple[float, float]]:
+    """``bands`` and their mirror images about x = 0, merged where they overlap."""
+    merged: list[list[float]] = []
+    for lo, hi in sorted([(float(a), float(b)) for a, b in bands]
+                         + [(-float(b), -float(a)) for a, b in bands]):
+        if merged and lo <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], hi)
+        else:
+            merged.append([lo, hi])
+    return [(lo, hi) for lo, hi in merged]
+
+
+def even_rule(rule: Panels) -> Panels:
+    """``rule`` made symmetric about x = 0: its edges on x > 0 and their mirror images,
+    with 0 an edge where it was one or where the panel across 0 would otherwise be wider
+    than it was. (The edges of a rule on symmetric bands differ from their mirror images
+    where :func:`band_rule` merged close edges, scanning from -1: by up to a tenth of a
+    band panel.)"""
+    edges = rule.edges
+    right = edges[edges > PINNED_WITHIN]
+    middle = bool(np.any(np.abs(edges) <= PINNED_WITHIN))
+    if not middle:
+        k = int(np.searchsorted(edges, 0.0))
+        middle = 2.0 * right[0] > (edges[k] - edges[k - 1]) * (1.0 + 1e-9)
+    symmetric = np.concatenate([-right[::-1], [0.0] if middle else [], right])
+    if symmetric.size == edges.size and np.array_equal(symmetric, edges):
+        return rule
+    return Panels.from_edges(symmetric)

@@ -21,10 +21,18 @@ from typing import Any
 
 import numpy as np
 
-from core.contact.bands import BAND_WIDTHS, band_rule, bands_from_ends, pinned_end
+from core.contact.bands import (
+    BAND_WIDTHS,
+    band_rule,
+    bands_from_ends,
+    even_rule,
+    mirrored_bands,
+    pinned_end,
+)
 from core.contact.march import march, march_outputs, rule_operator
 from core.contact.result import UNILATERAL_MARGIN, _Snapshot
 from core.contact.step import Space, Step, nystrom_pressure
+from core.contact.systems import MIRROR_DATA_TOL, MIRROR_NODE_TOL, Mirror
 from core.contact.zones import ZONE_END_TOL, Resolution
 from core.discretize import Panels, operator_rows
 from core.problem import accepts
@@ -309,7 +317,10 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     times = inp.times
     tol = inp.tol
     (base, out, run, band_note, strays, error, end_error, time_error,
-     space_error, end_q_error) = controlled_march(OnePunchMarches(space, inp), times, tol,
+     space_error, end_q_error) = controlled_march(OnePunchMarches(space, inp,
+                                                                  even_problem(space, inp,
+                                                                               loads)),
+                                                  times, tol,
                                                   res, first_steps, jumps,
                                                   graded_halvings(inp.kernel, times),
                                                   transient_windows(inp.kernel, times, jumps,
@@ -345,16 +356,41 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
             "info": info}
 
 
+#: Points x > 0 at which :func:`even_problem` compares m and g with their mirror images
+#: (the march compares them at its rule's nodes again before it folds the problem).
+_EVEN_PROBES = np.linspace(0.0, 1.0, 203)[1:]
+
+
+def even_problem(space: Space, inp: Any, loads: dict[str, np.ndarray]) -> bool:
+    """Whether the problem is even in x: a centred load (moment or tilt 0 at the output
+    times ``inp.times``, whose ``loads`` these are), breakpoints, m and g symmetric about
+    0 (:class:`core.contact.systems.Mirror`'s tolerances)."""
+    if not Mirror.centred(inp.given, loads):
+        return False
+    points = np.sort(np.asarray(space.breakpoints, dtype=float))
+    if np.any(np.abs(points + points[::-1]) > MIRROR_NODE_TOL):
+        return False
+    x = _EVEN_PROBES
+    m_right, m_left = space.m(x), space.m(-x)
+    g_right, g_left = space.g(x), space.g(-x)
+    return bool(np.all(np.abs(m_right - m_left) <= MIRROR_DATA_TOL * np.abs(m_right))
+                and np.max(np.abs(g_right - g_left))
+                <= MIRROR_DATA_TOL * np.max(np.abs(g_right), initial=0.0))
+
+
 class OnePunchMarches:
     """What the error control (:func:`controlled_march`) asks of the marches of one
     punch: its panel rules, a march on one of them, and the comparison of two marches'
     outputs. Several punches on one base answer the same for all of them at once
-    (:class:`core.contact.coupled_creep.CoupledMarches`)."""
+    (:class:`core.contact.coupled_creep.CoupledMarches`). ``even``: the problem is even
+    in x (:func:`even_problem`), its rules are made symmetric about 0."""
 
-    def __init__(self, space: Space, inp: Any) -> None:
-        self.space, self.inp = space, inp
+    def __init__(self, space: Space, inp: Any, even: bool = False) -> None:
+        self.space, self.inp, self.even = space, inp, even
 
     def rule(self, res: Resolution, bands: list[tuple[float, float]], width: float) -> Panels:
+        if self.even:
+            return even_rule(band_rule(self.space, res, mirrored_bands(bands), width))
         return band_rule(self.space, res, bands, width)
 
     @staticmethod
@@ -364,8 +400,9 @@ class OnePunchMarches:
 
     def locating(self, res: Resolution) -> Panels:
         """The rule of the march that locates the bands (graded only to ``LOCATE_EDGE``)."""
-        return band_rule(self.space, Resolution(res.width, max(res.edge, LOCATE_EDGE)), [],
+        rule = band_rule(self.space, Resolution(res.width, max(res.edge, LOCATE_EDGE)), [],
                          0.0)
+        return even_rule(rule) if self.even else rule
 
     def run(self, rule: Panels, grid: np.ndarray, widths: np.ndarray, index: np.ndarray,
             exact_ends: bool = True, first: dict[str, Any] | None = None

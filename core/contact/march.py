@@ -5,7 +5,8 @@ turns the problem into the elastic one of :mod:`core.contact.zones` with
 ``scale = 1 - w_n`` on the current pressure and the memory displacement
 ``e = F (memory of q_0 .. q_{n-1})``. The contact set is found at every step by the nodal
 active set (warm-started from the step before), on one panel rule, so the memory of every
-past pressure lives on the same nodes. The zone ends of each output time are the roots of
+past pressure lives on the same nodes (an even problem, on its half x > 0:
+:class:`~core.contact.systems.Mirror`). The zone ends of each output time are the roots of
 the Nystrom pressure's interpolant on those nodes, after the kink of the pressure at each
 end is taken out of the panel rule (:mod:`core.contact.kinks`; the corrections of
 ``_KINK_BATCH`` output times at once, the roots of all after the march). The error
@@ -24,7 +25,7 @@ from core.contact.active_set import NoContact, NodalState, nodal_active_set, zon
 from core.contact.kinks import Corrected, corrected_roots, kinks_corrected
 from core.contact.memory import pressure_memory
 from core.contact.step import Space, Step, check_loads
-from core.contact.systems import StepSolver
+from core.contact.systems import Mirror, StepSolver
 from core.contact.zones import zone_kernel_accuracy
 from core.discretize import KernelOperator, Panels, kernel_operator
 from core.work import check_work
@@ -56,6 +57,21 @@ def rule_operator(lam: float, rule: Panels) -> np.ndarray:
     return _RULE_OPERATORS.get_or_compute(key, build)[0].matrix
 
 
+#: The mirrors of even problems' rules (:meth:`Mirror.of` compares F with its mirror image
+#: entry by entry, ~30 ms at 2256 nodes), keyed by lam, the panel edges and m and g at the
+#: nodes: the marches of one solve (its spatial check, its time grids) share their rules.
+_RULE_MIRRORS = StageCache("contact_rule_mirror", max_items=12, max_bytes=48 * 2**20)
+
+
+def rule_mirror(lam: float, rule: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarray
+                ) -> Mirror | None:
+    """:meth:`Mirror.of` the rule ``rule`` (its operator ``op``, m and g at its nodes),
+    cached; None when the problem on it is not even."""
+    key = fingerprint(float(lam), np.asarray(rule.edges, dtype=float), np.asarray(m),
+                      np.asarray(g))
+    return _RULE_MIRRORS.get_or_compute(key, lambda: Mirror.of(rule.nodes, op, m, g))[0]
+
+
 def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.ndarray,
            grid: np.ndarray, widths: np.ndarray, out_index: np.ndarray,
            exact_ends: bool = True, first: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -77,7 +93,10 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
     # and, once corrected, the kink correction (kink_correction)
     states: list[tuple] = [None] * len(out_index)  # type: ignore
     active = None
-    solver = StepSolver()
+    # an even problem (symmetric rule, m, g and F, a centred load) on the half x > 0
+    mirror = (rule_mirror(space.lam, base, op, m, g) if Mirror.centred(inp.given, loads)
+              else None)
+    solver = StepSolver(mirror)
     pending: list[tuple[int, Any]] = []
     batch: list[tuple[int, tuple]] = []
     sweeps = 0
@@ -90,7 +109,8 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
             memory_density, diag = memory_of.at(n)
         step = Step(float(c_vals[n]), 1.0 - diag,
                     {name: float(v[n]) for name, v in loads.items()})
-        displacement = op @ memory_density
+        displacement = (op @ memory_density if mirror is None
+                        else mirror.unfold(mirror.apply(memory_density)))
         start = active
         if n == 0 and first is not None and "zones" in first:
             start = nodes_in(base.nodes, first["zones"])
