@@ -262,6 +262,16 @@ class SolveController(param.Parameterized):
             self.requests = rid
             self._deliver(rid, self._compute(scene))
             return rid
+        known = self._known(scene)
+        if known is not None:
+            # (a preset switched back to, a value stepped back over) shown at once: in
+            # the same message to the page as the change that asked for it, where a
+            # thread's turn had sent it apart (the page laid out twice on a preset switch)
+            with self._lock:
+                self._pending = None  # an older request waiting for the running one
+            self.requests = rid
+            self._deliver(rid, known)
+            return rid
         with self._lock:
             queued = self._running
             if queued:
@@ -279,6 +289,14 @@ class SolveController(param.Parameterized):
         if not queued:
             self._wait(rid, scene, sent)
         return rid
+
+    def _known(self, scene: dict[str, Any]) -> ResultView | None:
+        """The result of ``scene`` if one is kept already (:data:`RESULTS`), else None."""
+        if self._solve is not _default_solve:
+            return None
+        key = result_key(scene)
+        view = RESULTS.get(key) if key is not None else None
+        return None if view is None else replace(view, info={**view.info, "reused": True})
 
     def _wait(self, rid: int, scene: dict[str, Any], sent: SentRequest | None) -> None:
         # A request written to the worker by the event loop is awaited by that loop

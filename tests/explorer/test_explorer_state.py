@@ -33,6 +33,7 @@ from explorer.model import (
 )
 from explorer.model.results import negative_intervals
 from explorer.solving import SolveController, describe_field, format_error
+from explorer.solving.result_cache import RESULTS
 
 PRESETS = presets()
 
@@ -376,6 +377,10 @@ def test_a_late_old_result_is_dropped():
 
 
 def test_results_arrive_through_the_dispatcher():
+    """A result solved on a thread of the pool reaches the page through the dispatcher
+    (the event loop's turn); one kept already is shown at once, by the caller, in the
+    same call (and so in the same message to the page as the change that asked)."""
+    RESULTS.clear()
     state = small(ExplorerState())
     delivered: list[Any] = []
 
@@ -387,8 +392,16 @@ def test_results_arrive_through_the_dispatcher():
         controller = SolveController(state, executor=pool, dispatch=dispatch)
         controller.request()
         assert controller.wait(60)
-    assert delivered and delivered[0].startswith("worker")
-    assert controller.view is not None
+        assert delivered and delivered[0].startswith("worker")
+        assert controller.view is not None
+        first = controller.view
+        state.loading.histories["force"].value *= 1.5
+        assert controller.wait(60)
+        solved = len(delivered)
+        state.loading.histories["force"].value /= 1.5   # back to a scene solved before
+        assert controller.view is not first and controller.view.scene == first.scene
+        assert controller.view.info["reused"] and not controller.busy
+        assert len(delivered) == solved
 
 
 # ------------------------------------------------------------------------- links
