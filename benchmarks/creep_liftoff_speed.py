@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks import ROOT, run_lines
+from benchmarks import ROOT, run_lines, tree_commit
 from benchmarks.creep_honesty import cases
 from core.cache import clear_caches
 from core.contact.systems import Mirror
@@ -153,13 +153,14 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
-    started, load_before = datetime.now(UTC), os.getloadavg()[0]
+    started, load_before, commit = datetime.now(UTC), os.getloadavg()[0], tree_commit()
     table = rows()
     text = "\n".join([
         "# Lift-off under creep: CPU time against slider speed", "", "Made with:", "",
         "```", "OPENBLAS_NUM_THREADS=1 python -m benchmarks.creep_liftoff_speed", "```", "",
         *run_lines(started, load_before, os.getloadavg()[0],
-                   "CPU times of this process: the steadier figure on a shared machine"),
+                   "CPU times of this process: the steadier figure on a shared machine",
+                   commit=commit),
         "", "The cases and goals: the docstring of `benchmarks/creep_liftoff_speed.py`. "
         "Medians of 3 runs (the stepped punch: one; CPU times of one run vary by up to ~30 % "
         "on this shared machine).", "",
