@@ -40,7 +40,7 @@ import numpy as np
 
 from core.cache import fingerprint
 from core.contact.active_set import NoContact, NodalState, zones_from_nodes
-from core.contact.bands import band_rule, bands_from_ends
+from core.contact.bands import band_rule, bands_from_ends, merge_bands
 from core.contact.coupled import (
     CoupledBase,
     CoupledStepSolver,
@@ -56,7 +56,6 @@ from core.contact.creep import (
     _borrow_corrections,
     _distance,
     _extrapolate,
-    _merge,
     _outside_bands,
     controlled_march,
     creep_verdict,
@@ -169,7 +168,7 @@ class CoupledMarches:
                  for one, space in zip(out, self.base.spaces, strict=True)]
         if bands is None:
             return found
-        return [_merge(list(old) + new) for old, new in zip(bands, found, strict=True)]
+        return [merge_bands(list(old) + new) for old, new in zip(bands, found, strict=True)]
 
     def strays(self, out: list[dict[str, Any]],
                bands: Sequence[list[tuple[float, float]]]) -> int:

@@ -26,15 +26,16 @@ from core.contact.bands import (
     band_rule,
     bands_from_ends,
     even_rule,
+    merge_bands,
     mirrored_bands,
     pinned_end,
 )
 from core.contact.march import march, march_outputs, rule_operator
 from core.contact.result import UNILATERAL_MARGIN, _Snapshot
 from core.contact.step import Space, Step, nystrom_pressure
-from core.contact.systems import MIRROR_DATA_TOL, MIRROR_NODE_TOL, Mirror
+from core.contact.systems import Mirror
 from core.contact.zones import ZONE_END_TOL, Resolution
-from core.discretize import Panels, operator_rows
+from core.discretize import Panels, even_overall, even_per_node, operator_rows
 from core.problem import accepts
 from core.time import time_grid
 
@@ -364,18 +365,17 @@ _EVEN_PROBES = np.linspace(0.0, 1.0, 203)[1:]
 def even_problem(space: Space, inp: Any, loads: dict[str, np.ndarray]) -> bool:
     """Whether the problem is even in x: a centred load (moment or tilt 0 at the output
     times ``inp.times``, whose ``loads`` these are), breakpoints, m and g symmetric about
-    0 (:class:`core.contact.systems.Mirror`'s tolerances)."""
+    0 (to :data:`~core.discretize.MIRROR_TOL`). Only the rules follow it: each march
+    folds the problem only where its own grid's loads and its rule's nodes are even
+    (:class:`~core.contact.systems.Mirror`)."""
     if not Mirror.centred(inp.given, loads):
         return False
     points = np.sort(np.asarray(space.breakpoints, dtype=float))
-    if np.any(np.abs(points + points[::-1]) > MIRROR_NODE_TOL):
+    if not even_overall(points, -points[::-1]):
         return False
     x = _EVEN_PROBES
-    m_right, m_left = space.m(x), space.m(-x)
-    g_right, g_left = space.g(x), space.g(-x)
-    return bool(np.all(np.abs(m_right - m_left) <= MIRROR_DATA_TOL * np.abs(m_right))
-                and np.max(np.abs(g_right - g_left))
-                <= MIRROR_DATA_TOL * np.max(np.abs(g_right), initial=0.0))
+    return (even_per_node(space.m(x), space.m(-x))
+            and even_overall(space.g(x), space.g(-x)))
 
 
 class OnePunchMarches:
@@ -422,7 +422,9 @@ class OnePunchMarches:
               ) -> list[tuple[float, float]]:
         """The bands the free ends of ``out`` sweep (merged with ``bands`` if given)."""
         found = bands_from_ends(out["ends"], self.space.breakpoints)
-        return found if bands is None else _merge(bands + found)
+        if self.even:
+            found = mirrored_bands(found)  # (those the rules are made on)
+        return found if bands is None else merge_bands(bands + found)
 
     def strays(self, out: dict[str, Any], bands: list[tuple[float, float]]) -> int:
         return _outside_bands(out["ends"], bands, self.space.breakpoints)
@@ -554,16 +556,6 @@ def _in_time(marches: Any, times: np.ndarray, base: Any, first_steps: int, budge
 #: without :func:`transient_windows`), where Richardson's read 1/6 of it.
 ASYMPTOTIC_RATIO = 3.0
 MIN_RATIO = 1.25
-
-
-def _merge(bands: list[tuple[float, float]]) -> list[tuple[float, float]]:
-    merged: list[list[float]] = []
-    for lo, hi in sorted(bands):
-        if merged and lo <= merged[-1][1]:
-            merged[-1][1] = max(merged[-1][1], hi)
-        else:
-            merged.append([lo, hi])
-    return [(float(lo), float(hi)) for lo, hi in merged]
 
 
 def _check_times(times: np.ndarray, count: int = 0) -> np.ndarray:

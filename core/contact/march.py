@@ -16,6 +16,7 @@ control over rules and grids is :mod:`core.contact.creep`'s.
 
 from __future__ import annotations
 
+import weakref
 from typing import Any
 
 import numpy as np
@@ -58,18 +59,25 @@ def rule_operator(lam: float, rule: Panels) -> np.ndarray:
 
 
 #: The mirrors of even problems' rules (:meth:`Mirror.of` compares F with its mirror image
-#: entry by entry, ~30 ms at 2256 nodes), keyed by lam, the panel edges and m and g at the
-#: nodes: the marches of one solve (its spatial check, its time grids) share their rules.
+#: entry by entry, ~30 ms at 2256 nodes), keyed by lam, the panel edges, m and g at the
+#: nodes and the operator itself: the marches of one solve (its spatial check, its time
+#: grids) share their rules and the rules' operators (:func:`rule_operator`).
 _RULE_MIRRORS = StageCache("contact_rule_mirror", max_items=12, max_bytes=48 * 2**20)
 
 
 def rule_mirror(lam: float, rule: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarray
                 ) -> Mirror | None:
-    """:meth:`Mirror.of` the rule ``rule`` (its operator ``op``, m and g at its nodes),
-    cached; None when the problem on it is not even."""
+    """:meth:`Mirror.of` the rule ``rule`` with its operator ``op`` and m and g at its
+    nodes, cached; None when the problem on it is not even."""
+    # the operator by identity (its entries hashed would cost as much as the comparison),
+    # and a weak reference to it, so that an id reused by another array is not taken
     key = fingerprint(float(lam), np.asarray(rule.edges, dtype=float), np.asarray(m),
-                      np.asarray(g))
-    return _RULE_MIRRORS.get_or_compute(key, lambda: Mirror.of(rule.nodes, op, m, g))[0]
+                      np.asarray(g), id(op))
+    source, mirror = _RULE_MIRRORS.get_or_compute(
+        key, lambda: (weakref.ref(op), Mirror.of(rule.nodes, rule.weights, op, m, g)))[0]
+    if source() is not op:
+        return Mirror.of(rule.nodes, rule.weights, op, m, g)
+    return mirror
 
 
 def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.ndarray,

@@ -20,6 +20,8 @@ import numpy as np
 from scipy.linalg import lu_factor
 from scipy.linalg.lapack import dgetrs
 
+from core.discretize import even_overall, even_per_node, mirrored_rule
+
 
 def restrict(op: np.ndarray, idx: np.ndarray) -> np.ndarray:
     """``op`` on the nodes ``idx`` (sorted): a view when they are one run of nodes (one
@@ -45,18 +47,6 @@ def restrict(op: np.ndarray, idx: np.ndarray) -> np.ndarray:
 #: Runs of consecutive nodes up to which :func:`restrict` copies block by block.
 MAX_RUNS = 16
 
-#: Largest difference between a node and its mirror image [half-widths], and between
-#: F's entries and their mirror images (relative to its largest entry), at which a rule
-#: and its operator count as symmetric about x = 0 (:meth:`Mirror.of`). A rule whose
-#: bands come from zone ends located on both sides is symmetric to ~1e-15.
-MIRROR_NODE_TOL = 1e-12
-MIRROR_OPERATOR_TOL = 1e-12
-#: Largest difference of m and g from their mirror images, node by node, relative to the
-#: node's own m and to the largest |g|: an asymmetry of the coating of 3e-11 changed q by
-#: 2.7e-10 where the engine's mirror split dropped it, so only rounding is let pass.
-MIRROR_DATA_TOL = 1e-13
-
-
 @dataclass(frozen=True)
 class Mirror:
     """The even half of a unilateral problem symmetric about x = 0.
@@ -67,32 +57,29 @@ class Mirror:
     bordered systems are then solved for the nodes x > 0 alone, with F folded,
     ``F[h:, h:] + F[h:, :h]`` with its columns mirrored (:attr:`op`), the force row's
     weights doubled and no tilt: a quarter of the entries (a factorization ~8x
-    cheaper) and answers exactly even, where the whole system's rounding tipped a node
-    on one side only (q 2e-10 asymmetric where a centred force decreased).
+    cheaper), and answers even to the last digit. The rule must be symmetric itself:
+    ``core.contact.bands.even_rule`` makes it so (the band rule of a stepped punch under
+    a centred force was 7e-4 half-widths off, and its answer 1.2e-10 asymmetric in q).
     """
 
     half: int
     op: np.ndarray  # (h, h): F folded onto the nodes x > 0
 
     @classmethod
-    def of(cls, x: np.ndarray, op: np.ndarray, m: np.ndarray, g: np.ndarray
-           ) -> Mirror | None:
-        """The mirror of the rule with nodes ``x`` and operator ``op`` for the node values
-        ``m`` and ``g``, or None when one of them is not symmetric (see the tolerances
-        above)."""
+    def of(cls, x: np.ndarray, w: np.ndarray, op: np.ndarray, m: np.ndarray,
+           g: np.ndarray) -> Mirror | None:
+        """The mirror of the rule with nodes ``x``, weights ``w`` and operator ``op`` for
+        the node values ``m`` and ``g``, or None when one of them is not symmetric
+        (:func:`~core.discretize.mirrored_rule`, m node by node and g and F overall to
+        :data:`~core.discretize.MIRROR_TOL`)."""
         n = x.size
-        if n % 2 or n == 0 or np.max(np.abs(x + x[::-1])) > MIRROR_NODE_TOL:
-            return None
-        if np.any(np.abs(m - m[::-1]) > MIRROR_DATA_TOL * np.abs(m)):
-            return None
-        if np.max(np.abs(g - g[::-1])) > MIRROR_DATA_TOL * np.max(np.abs(g)):
+        if (n % 2 or n == 0 or not mirrored_rule(x, w) or not even_per_node(m, m[::-1])
+                or not even_overall(g, g[::-1])):
             return None
         h = n // 2
-        largest = float(np.max(np.abs(op)))
-        # (by blocks: the whole mirrored matrix at once would be a copy of F)
+        # (by halves: the whole mirrored matrix at once would be a copy of F)
         for rows in (slice(0, h), slice(h, n)):
-            mirrored = op[::-1, ::-1][rows]
-            if np.max(np.abs(op[rows] - mirrored)) > MIRROR_OPERATOR_TOL * largest:
+            if not even_overall(op[rows], op[::-1, ::-1][rows]):
                 return None
         folded = op[h:, h:] + op[h:, :h][:, ::-1]
         folded.flags.writeable = False
@@ -533,8 +520,11 @@ def _folded(solver: StepSolver | None, x: np.ndarray, w: np.ndarray, m: np.ndarr
     a solver are symmetric (:func:`core.contact.active_set.nodal_active_set` keeps them
     so)."""
     mirror = None if solver is None else solver.mirror
-    if mirror is None or x.size != 2 * mirror.half:
+    if mirror is None or x.size == mirror.half:  # (the half's own system)
         return None
+    if x.size != 2 * mirror.half:
+        # its kept systems are the half's: another rule's would be taken for them
+        raise ValueError("a solver made for a mirrored rule is given another rule")
     idx_h = mirror.fold_nodes(idx)
     if idx_h is None:
         raise ValueError("contact nodes not symmetric in a mirrored solve")

@@ -11,6 +11,7 @@ import pytest
 import core
 from core.cache import clear_caches
 from core.contact.bands import band_rule, even_rule, mirrored_bands
+from core.contact.march import rule_mirror
 from core.contact.step import Space
 from core.contact.systems import Mirror, StepSolver, bordered_change, bordered_solve
 from core.contact.zones import Resolution
@@ -45,7 +46,7 @@ def test_the_half_solves_the_whole_system(rule, given):
     the refinement promises (a residual of 1e-13 of b; measured 2e-15 of the largest q),
     the tilt exactly 0 and q exactly even; a change (a kink correction's) likewise."""
     op, m, x, w, rhs = rule
-    mirror = Mirror.of(x, op, m, -rhs)
+    mirror = Mirror.of(x, w, op, m, -rhs)
     assert mirror is not None and mirror.op.shape == (x.size // 2, x.size // 2)
     solver = StepSolver(mirror)
     for k, idx in enumerate(_even_sets(x.size)):
@@ -69,24 +70,48 @@ def test_the_half_solves_the_whole_system(rule, given):
 
 
 def test_only_symmetric_data_is_folded(rule):
-    """The rule, F, m and g must be symmetric to rounding: an asymmetry of the coating
-    of 1e-11 (which the engine's mirror split once let pass, q 2.7e-10 off), of the gap
-    or of a node is refused."""
+    """The rule, F, m and g must be symmetric to rounding (MIRROR_TOL, 1e-14): a coating
+    1e-11 stiffer on one side, a gap tilted by 1e-12 of its largest value, a node moved
+    by 1e-9, an odd count, an entry of F changed by 1e-9 are each refused."""
     op, m, x, w, rhs = rule
     g = -rhs
-    assert Mirror.of(x, op, m, g) is not None
+    assert Mirror.of(x, w, op, m, g) is not None
     soft = m.copy()
     soft[: x.size // 2] *= 1.0 + 1e-11
-    assert Mirror.of(x, op, soft, g) is None
+    assert Mirror.of(x, w, op, soft, g) is None
     tilted = g + 1e-12 * np.abs(g).max() * x
-    assert Mirror.of(x, op, m, tilted) is None
+    assert Mirror.of(x, w, op, m, tilted) is None
     moved = x.copy()
     moved[0] += 1e-9
-    assert Mirror.of(moved, op, m, g) is None
-    assert Mirror.of(x[:-1], op[:-1, :-1], m[:-1], g[:-1]) is None
+    assert Mirror.of(moved, w, op, m, g) is None
+    assert Mirror.of(x[:-1], w[:-1], op[:-1, :-1], m[:-1], g[:-1]) is None
     lopsided = op.copy()
     lopsided[0, 1] *= 1.0 + 1e-9
-    assert Mirror.of(x, lopsided, m, g) is None
+    assert Mirror.of(x, w, lopsided, m, g) is None
+
+
+def test_a_mirrored_solver_takes_no_other_rule(rule):
+    """Its kept systems are the half's: a call with another rule's nodes is refused, not
+    answered from them."""
+    op, m, x, w, rhs = rule
+    solver = StepSolver(Mirror.of(x, w, op, m, -rhs))
+    bordered_solve(op, m, x, w, 1.0, 1.0, CENTRED[0], rhs, np.arange(8, x.size - 8), solver)
+    k = x.size - 16
+    with pytest.raises(ValueError, match="another rule"):
+        bordered_solve(op[:k, :k], m[:k], x[:k], w[:k], 1.0, 1.0, CENTRED[0], rhs[:k],
+                       np.arange(8, k - 8), solver)
+
+
+def test_the_mirror_of_a_rule_is_kept_for_its_own_operator(rule):
+    """rule_mirror keeps the mirror of a rule with the operator it was made of: the same
+    array gives it again, another (a caller's own, here F doubled) its own mirror."""
+    op, m, x, w, rhs = rule
+    panels = base_panels(1.0, (), edge_width=1e-2, max_width=0.05)
+    first = rule_mirror(1.0, panels, op, m, -rhs)
+    assert rule_mirror(1.0, panels, op, m, -rhs) is first
+    doubled = 2.0 * op
+    other = rule_mirror(1.0, panels, doubled, m, -rhs)
+    assert other is not first and np.array_equal(other.op, 2.0 * first.op)
 
 
 @pytest.mark.parametrize(("given", "loads", "centred"), [
@@ -155,10 +180,10 @@ def test_a_centred_crown_under_creep_is_even_and_as_before(monkeypatch):
 
 def test_a_stepped_punch_under_a_falling_force_is_even(monkeypatch):
     """The stepped punch whose outer steps touch as a centred force rises and leave as it
-    falls: the whole march's answer was 2e-10 asymmetric where the force fell; on the
-    half it is even. Its rules are mirrored now (band_rule's were not symmetric), so it
-    differs from before by less than the estimate (measured 5.6e-10 of q against an
-    estimated error of 2.5e-7)."""
+    falls. Its band rule was not symmetric (an edge 7e-4 half-widths off its mirror
+    image), which left q 1.2e-10 asymmetric and a moment of 7.3e-12 P a; on the even rule
+    (even_rule) and the half it is even to rounding. The rule's change moves the answer
+    by far less than its estimate (measured 1.3e-10 of q against 1.2e-6)."""
     scene = _scene("stepped_punch")
     scene["solver"]["tol"] = 1e-5
     p = 4e5

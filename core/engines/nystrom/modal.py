@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from core.discretize import MIRROR_TOL, even_per_node, mirrored_rule
 from core.engines.nystrom.bordered import NystromGrid
 from core.problem import ModalSystem, UnresolvedOperator, modal_system
 from core.time import ModalProblem, solve_degenerate, solve_general
@@ -131,28 +132,13 @@ class _Basis:
         return self.transposed_times(y.T).T
 
 
-#: How far from mirror symmetry about the punch's centre a grid may be for its even and
-#: odd modes to be found apart (:func:`mirrored`, :func:`_mirrored_galerkin`): what the
-#: split drops, the Galerkin matrix's entries between even and odd functions (relative to
-#: its largest) and ``J_1`` (relative to ``sqrt(J_0 J_2)``), at most 1e-14, below the
-#: backward error of the eigendecomposition itself (~N eps, 6e-14 at 288 nodes). Measured
-#: on the symmetric presets: ~1e-16. The coating compliance is compared node by node to
-#: it first (a stiff part beside a soft one is not symmetric to a share of the largest
-#: compliance: a modulus 3e-11 off left to right made 1e-11 between the two kinds, and q
-#: 2.7e-10 off where split).
-MIRROR_TOL = 1e-14
-
-
 def mirrored(grid: NystromGrid) -> bool:
     """Whether ``grid`` may be its own mirror image about the punch's centre: node
     ``N-1-i`` at ``-x_i`` with the same weight (to a few roundings) and coating compliance
-    (to :data:`MIRROR_TOL` of its own value); the operator is judged by what the split
-    would drop (:func:`_mirrored_galerkin`)."""
-    x, w, m = grid.nodes, grid.panels.weights, grid.m
-    eps = np.finfo(float).eps
-    return bool(np.max(np.abs(x + x[::-1]), initial=0.0) <= 4.0 * eps
-                and np.max(np.abs(w - w[::-1]), initial=0.0) <= 4.0 * eps * np.max(w)
-                and np.all(np.abs(m - m[::-1]) <= MIRROR_TOL * np.abs(m)))
+    (to :data:`~core.discretize.MIRROR_TOL` of its own value); the operator is judged by
+    what the split would drop (:func:`_mirrored_galerkin`)."""
+    m = grid.m
+    return mirrored_rule(grid.nodes, grid.panels.weights) and even_per_node(m, m[::-1])
 
 
 class _MirrorBasis:
@@ -218,7 +204,7 @@ def _mirrored_galerkin(first: np.ndarray, scaled: np.ndarray,
                        ) -> tuple[_MirrorBasis, np.ndarray] | None:
     """The mirror basis of ``first`` and the Galerkin matrix of the ``scaled`` operator in
     it, its entries between even and odd functions set to zero, where those and ``J_1``
-    (``moments``) are within :data:`MIRROR_TOL`; else None."""
+    (``moments``) are within :data:`~core.discretize.MIRROR_TOL`; else None."""
     j0, j1, j2 = moments
     if abs(j1) > MIRROR_TOL * np.sqrt(j0 * j2):
         return None
