@@ -13,20 +13,9 @@ from core.contact.systems import (
     bordered_solve,
     restrict,
 )
-from core.discretize import base_panels, kernel_operator
 
 STATEMENTS = [{"force": 1.0, "moment": 0.3}, {"settlement": 0.02, "moment": 0.1},
               {"settlement": 0.02, "tilt": 0.004}, {"tilt": 0.001, "force": 0.8}]
-
-
-@pytest.fixture(scope="module")
-def rule():
-    panels = base_panels(1.0, (), edge_width=1e-2, max_width=0.05)
-    op = kernel_operator(1.0, panels).matrix
-    x, w = panels.nodes, panels.weights
-    m = 0.05 * (1.0 + 0.3 * x ** 2)
-    rhs = -0.01 * x ** 2
-    return op, m, x, w, rhs
 
 
 def _contact_sets(n: int) -> list[np.ndarray]:

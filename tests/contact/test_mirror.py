@@ -15,21 +15,11 @@ from core.contact.march import rule_mirror
 from core.contact.step import Space
 from core.contact.systems import Mirror, StepSolver, bordered_change, bordered_solve
 from core.contact.zones import Resolution
-from core.discretize import base_panels, kernel_operator
+from core.discretize import base_panels
 from core.presets import read_preset
 
 CENTRED = [{"force": 1.0, "moment": 0.0}, {"settlement": 0.02, "moment": 0.0},
            {"settlement": 0.02, "tilt": 0.0}, {"tilt": 0.0, "force": 0.8}]
-
-
-@pytest.fixture(scope="module")
-def rule():
-    panels = base_panels(1.0, (), edge_width=1e-2, max_width=0.05)
-    op = kernel_operator(1.0, panels).matrix
-    x, w = panels.nodes, panels.weights
-    m = 0.05 * (1.0 + 0.3 * x ** 2)
-    rhs = -0.01 * x ** 2
-    return op, m, x, w, rhs
 
 
 def _even_sets(n: int) -> list[np.ndarray]:
