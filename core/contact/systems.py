@@ -47,6 +47,7 @@ def restrict(op: np.ndarray, idx: np.ndarray) -> np.ndarray:
 #: Runs of consecutive nodes up to which :func:`restrict` copies block by block.
 MAX_RUNS = 16
 
+
 @dataclass(frozen=True)
 class Mirror:
     """The even half of a unilateral problem symmetric about x = 0.
