@@ -518,18 +518,31 @@ def _direction(handle) -> tuple[str, int]:
     return "ArrowRight", 1
 
 
+#: Whether the page's busy spinner turns (``explorer/views/busy.py``: a solve running for
+#: more than its 250 ms, newer than the result on screen).
+JS_BUSY = """() => {
+  for (const m of Bokeh.documents[0].all_models)
+    if (m.css_classes && m.css_classes.includes('busy-spinner'))
+      return (m.text || '').includes('cp-spinner');
+  return false;
+}"""
+
+
 def _wait_quiet(page, since: float, need_one: bool, timeout_s: float) -> None:
     """Wait until no update of the pressure plot came for ``QUIET_S`` after the page time
-    ``since`` [ms] (and, with ``need_one``, at least one came after it)."""
+    ``since`` [ms] (and, with ``need_one``, at least one came after it) while the page
+    says no solve is running. Quiet alone ended the wait for a solve of more than
+    ``QUIET_S``: the stepped punch's coating-modulus drag ends where the outer steps lift
+    off, and its last answer came 1-3 s after the release, unseen ("none after")."""
     until = time.monotonic() + timeout_s
     while time.monotonic() < until:
-        last, now = page.evaluate(
+        last, now, busy = page.evaluate(
             "() => [window.__updates.length ? window.__updates[window.__updates.length - 1]"
-            " : -1, performance.now()]")
+            " : -1, performance.now(), (" + JS_BUSY + ")()]")
         if need_one and last <= since:
             time.sleep(0.1)
             continue
-        if now - max(last, since) > 1e3 * QUIET_S:
+        if now - max(last, since) > 1e3 * QUIET_S and not busy:
             return
         time.sleep(0.1)
 
