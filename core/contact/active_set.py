@@ -56,8 +56,6 @@ def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarra
     """
     x, w = panels.nodes, panels.weights
     mirror = None if solver is None else solver.mirror
-    if mirror is not None and memory is not None:
-        memory = mirror.unfold(mirror.even(memory))
     rhs = _given_rhs(step, x, g, memory)
     active = np.ones(x.size, dtype=bool) if start is None else start.copy()
     if mirror is not None:

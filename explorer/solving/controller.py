@@ -182,6 +182,11 @@ def format_error(message: str) -> str:
     return f"{words} ({path.strip()}):{reason}"
 
 
+def _reused(view: ResultView) -> ResultView:
+    """A kept result as shown again: the same view, marked ``info["reused"]``."""
+    return replace(view, info={**view.info, "reused": True})
+
+
 def _failure_text(exc: Exception) -> str:
     """What the page says of a solve that raised ``exc``."""
     if isinstance(exc, ValueError):  # the core's message, naming the field
@@ -296,7 +301,7 @@ class SolveController(param.Parameterized):
             return None
         key = result_key(scene)
         view = RESULTS.get(key) if key is not None else None
-        return None if view is None else replace(view, info={**view.info, "reused": True})
+        return None if view is None else _reused(view)
 
     def _wait(self, rid: int, scene: dict[str, Any], sent: SentRequest | None) -> None:
         # A request written to the worker by the event loop is awaited by that loop
@@ -349,7 +354,7 @@ class SolveController(param.Parameterized):
         key = result_key(scene)
         cached = RESULTS.get(key) if key is not None else None
         if cached is not None:
-            return replace(cached, info={**cached.info, "reused": True})
+            return _reused(cached)
         if key is not None:
             self._executor.submit(RESULTS.get_or_compute, key, lambda: view)
         return view
@@ -372,8 +377,7 @@ class SolveController(param.Parameterized):
             scene = self.state.to_scene()
         except ValueError:
             return self.solve_now()  # delivers the message
-        if self._executor is None or (self._solve is _default_solve
-                                      and RESULTS.get(result_key(scene)) is not None):
+        if self._executor is None or self._known(scene) is not None:
             return self.solve_now()
         return self.request()
 
@@ -530,7 +534,7 @@ class SolveController(param.Parameterized):
             if key is None:
                 return self._view(scene, unread)
             view, reused = RESULTS.get_or_compute(key, lambda: self._view(scene, unread))
-            return replace(view, info={**view.info, "reused": True}) if reused else view
+            return _reused(view) if reused else view
         except SolveCancelled:
             return CANCELLED
         except Exception as exc:
