@@ -29,16 +29,18 @@ server, browser_context, page = page_fixtures(1400, 900)
 
 
 def _crowned() -> dict:
-    """The default scene (creep) with a crown of R = 25 km: its contact spreads as the base
-    creeps, a solve of 0.3-0.6 s of CPU (benchmarks/results/creep_liftoff_speed.md),
-    three times and more the explorer's live bound (0.1 s): its sliders wait for their
-    release on any machine."""
+    """The default scene (creep) with a crown of R = 10 km: its contact spreads as the base
+    creeps, a solve of 0.6-0.75 s of CPU (benchmarks/results/creep_liftoff_speed.md),
+    six times and more the explorer's live bound (0.1 s): its sliders wait for their
+    release on any machine. (R = 25 km took 0.3-0.6 s until the symmetric march on half
+    the punch, 0.10-0.16 s since: at the bound, its drag was live on a warm worker and
+    showed no preview.)"""
     import copy
 
     from explorer.model import presets
 
     scene = copy.deepcopy(presets()["uniform_flat"])
-    scene["punch"]["shape"] = {"kind": "polynomial", "coefficients": [0.0, 0.0, 2e-5]}
+    scene["punch"]["shape"] = {"kind": "polynomial", "coefficients": [0.0, 0.0, 5e-5]}
     return scene
 
 
