@@ -133,9 +133,14 @@ class DragSteps:
         ``value``, held until the release."""
         self._app.preview_step(target, name, value)
 
-    def released(self) -> None:
-        """The dragged slider was released (its value, if new, is in the state)."""
-        self._app.released()
+    def dragging(self) -> None:
+        """A slider is being dragged (its second step since its last release)."""
+        self._app.dragging()
+
+    def released(self, dragged: bool = True) -> None:
+        """A slider was released (its value, if new, is in the state); ``dragged``: after
+        a drag (not a key press)."""
+        self._app.released(dragged)
 
 
 class ExplorerApp(pn.viewable.Viewer):
@@ -353,7 +358,7 @@ class ExplorerApp(pn.viewable.Viewer):
         """At a drag step of a slider that otherwise waits for its release: whether the
         step applies now (:meth:`fast_solves`); when not, the page says so."""
         self.tabs.touch()
-        self._released_at = float("-inf")  # a drag (again): its results are spaced out
+        self.dragging()
         fast = self.fast_solves()
         self.results.say_held(not fast, self._last_cpu_seconds(), self._drawn_preview is not None)
         return fast
@@ -419,10 +424,19 @@ class ExplorerApp(pn.viewable.Viewer):
         if scene is not None and self._previewing:
             self.controller.request_preview(scene)
 
-    def released(self) -> None:
+    def dragging(self) -> None:
+        """A drag (again): its results are spaced out (:data:`DRAW_EVERY_MS`)."""
+        self._released_at = float("-inf")
+
+    def released(self, dragged: bool = True) -> None:
         """A slider was released: results are drawn as they come for a while
-        (:data:`AFTER_RELEASE_S`), and the preview ends (:meth:`end_preview`)."""
+        (:data:`AFTER_RELEASE_S`), and the preview ends (:meth:`end_preview`). After a
+        drag (``dragged``: not a key press) the solve of a value dragged over that still
+        runs gives way to the released value's (:meth:`SolveController.released`), which
+        otherwise waited for it: an answer drawn and at once replaced."""
         self._released_at = time.monotonic()
+        if dragged:
+            self.controller.released()
         self.end_preview()
 
     def end_preview(self) -> None:

@@ -233,8 +233,9 @@ class SolveController(param.Parameterized):
         self._shown = 0           # id of the newest outcome shown
         self._running = False
         self._pending: tuple[int, dict[str, Any]] | None = None
-        # this session's request in a worker now, and since when (monotonic [s])
-        self._in_worker: tuple[SentRequest, float] | None = None
+        # this session's request in a worker now, since when (monotonic [s]) and its
+        # scene's key (result_key)
+        self._in_worker: tuple[SentRequest, float, str | None] | None = None
         # the preview scene wanted next (the newest asked), and whether one is solving
         self._preview_wanted: dict[str, Any] | None = None
         self._preview_running = False
@@ -295,6 +296,22 @@ class SolveController(param.Parameterized):
             self._wait(rid, scene, sent)
         return rid
 
+    def released(self) -> bool:
+        """A slider was let go after a drag: the solve of a value dragged over, still
+        running in this session's worker while the released value waits behind it, is
+        cancelled (``CANCEL_AFTER_S`` aside), so that the released value is solved at
+        once rather than after an answer that would be drawn and at once replaced. Not
+        where the waiting scene is the running one. Returns whether it cancelled."""
+        with self._lock:
+            pending, running = self._pending, self._in_worker
+        if pending is None or running is None or self._processes is None:
+            return False
+        key = result_key(pending[1])
+        if key is not None and key == running[2]:
+            return False
+        self._processes.cancel(running[0])
+        return True
+
     def _known(self, scene: dict[str, Any]) -> ResultView | None:
         """The result of ``scene`` if one is kept already (:data:`RESULTS`), else None."""
         if self._solve is not _default_solve:
@@ -308,7 +325,7 @@ class SolveController(param.Parameterized):
         # (explorer/solving/answer_wait.py); anything else by a thread of the pool.
         if sent is not None:
             with self._lock:
-                self._in_worker = (sent, time.monotonic())
+                self._in_worker = (sent, time.monotonic(), result_key(scene))
         if sent is None or not when_answered(
                 sent, lambda: self._answered(rid, scene, sent),
                 lambda: self._executor.submit(self._work, rid, scene, sent)):

@@ -19,7 +19,7 @@ import panel as pn
 from ..model import ExplorerState, eccentricity
 from ..solving import SolveController
 from .style import NOTE_STYLE, html_pane
-from .widgets import _set_widget, slider
+from .widgets import _set_widget, slider, watch_release
 
 #: Drag steps of the slider are applied at once while the last solve took less than this
 #: [s] of CPU time; slower, the moment is set on release. The speed goal of a lift-off
@@ -66,7 +66,8 @@ class EccentricityControl:
                  reject: Callable[[str], None], drag: Any = None) -> None:
         """``controller``: its last solve's time decides whether drag steps apply;
         ``reject``: says why a value was refused; ``drag``: where a held step's moment
-        goes (``drag.held(history, "value", M)``) and the release (``drag.released()``),
+        goes (``drag.held(history, "value", M)``) and the release
+        (``drag.released(dragged)``),
         as for the other sliders (:class:`~.widgets.Binding`); None: nowhere."""
         self.state = state
         self.drag = drag
@@ -80,7 +81,8 @@ class EccentricityControl:
                              css_classes=["eccentricity-lag"])
         self._syncing = False
         self.slider.param.watch(self._on_drag, "value")
-        self.slider.param.watch(self._on_release, "value_throttled")
+        watch_release(self.slider, self._on_release, lambda: self._syncing,
+                      getattr(drag, "dragging", None))
         loading = state.loading
         for q in ("force", "moment"):
             loading.histories[q].param.watch(self.refresh, ["kind", "value"])
@@ -140,11 +142,11 @@ class EccentricityControl:
                 and moment.kind == "constant"):
             self.drag.held(moment, "value", self._moment_for(float(event.new)))
 
-    def _on_release(self, event: Any) -> None:
+    def _on_release(self, event: Any, dragged: bool) -> None:
         self.say_lag(None)
         self.apply(event.new)
         if self.drag is not None:
-            self.drag.released()
+            self.drag.released(dragged)
 
     def _on_result(self, event: Any) -> None:
         if self.lag.visible:

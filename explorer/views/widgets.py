@@ -25,7 +25,7 @@ from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
 
 __all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
            "EditableIntSlider", "EditableSlider", "HistoryEditor", "LazySlider",
-           "ProfileEditor", "TimePlayer", "slider"]
+           "ProfileEditor", "TimePlayer", "slider", "watch_release"]
 
 
 # Panel holds every change from the browser for 50 ms before handling it, to gather a
@@ -169,6 +169,34 @@ def _set_widget(widget: pn.widgets.Widget, value: Any) -> None:
                 part.param.update(value_throttled=value)
 
 
+def watch_release(widget: pn.widgets.Widget, released: Callable[[Any, bool], None],
+                  skip: Callable[[], bool], dragging: Callable[[], None] | None = None
+                  ) -> None:
+    """Call ``released(event, dragged)`` at each release of the slider ``widget`` (its
+    ``value_throttled`` event), unless ``skip()`` (a value set from the state). ``dragged``: the
+    handle was dragged, its value changed twice or more since the last release (a key
+    press changes it once and releases at once: a key held down is a run of releases,
+    each of which must not cut short the solve of the one before). ``dragging()``, if
+    given, is called at the second change (a drag has begun)."""
+    steps = 0
+
+    def moved(event: Any) -> None:
+        nonlocal steps
+        if not skip():
+            steps += 1
+            if steps == 2 and dragging is not None:
+                dragging()
+
+    def let_go(event: Any) -> None:
+        nonlocal steps
+        dragged, steps = steps > 1, 0
+        if not skip():
+            released(event, dragged)
+
+    widget.param.watch(moved, "value")
+    widget.param.watch(let_go, "value_throttled")
+
+
 class Binding:
     """Widgets editing parameters of one Parameterized at a time (re-bindable)."""
 
@@ -176,9 +204,10 @@ class Binding:
                  live_when: Callable[[], bool] | None = None) -> None:
         """``live_when``: asked at each drag step of a slider that updates on release;
         when it answers True the step is applied at once (a fast solver makes every
-        slider live). Where it also has ``held(target, name, value)`` and ``released()``
-        (the explorer's :class:`~explorer.app.DragSteps`), a step not applied is passed
-        to ``held`` (the page may preview it) and every release to ``released``."""
+        slider live). Where it also has ``held(target, name, value)`` and
+        ``released(dragged)`` (the explorer's :class:`~explorer.app.DragSteps`), a step
+        not applied is passed to ``held`` (the page may preview it) and every release to
+        ``released`` (:func:`watch_release`)."""
         self._pairs: list[tuple[str, pn.widgets.Widget]] = []
         self._checks: dict[str, Callable[[Any], Any]] = {}
         self._live_when = live_when
@@ -208,12 +237,13 @@ class Binding:
         if event == "value_throttled" and self._live_when is not None:
             widget.param.watch(lambda e, name=name: self._drag_step(name, e.new), "value")
             # a policy that previews held steps hears of the release too (after the
-            # state has taken the value)
+            # state has taken the value; not a value set from the state: a tab made
+            # mid-drag ended its preview)
             released = getattr(self._live_when, "released", None)
             if released is not None:
-                # (not a value set from the state: a tab made mid-drag ended its preview)
-                widget.param.watch(lambda e: None if self._syncing else released(),
-                                   "value_throttled")
+                watch_release(widget, lambda event, dragged: released(dragged),
+                              lambda: self._syncing,
+                              getattr(self._live_when, "dragging", None))
         if check is not None:
             self._checks[name] = check
         self._pairs.append((name, widget))

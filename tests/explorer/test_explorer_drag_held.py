@@ -327,3 +327,36 @@ def test_a_time_moved_under_a_preview_of_the_released_count_stays(monkeypatch,
     view = app.controller.view
     assert len(view.times) == 5 and app.results.on_screen() == (view, False)
     assert app.screen.time_index == 1 and app.results.player.end == 4
+
+
+def test_a_release_after_a_drag_and_not_a_key_press_lets_the_released_value_go_first(
+        monkeypatch, explorer_app) -> None:
+    """A drag's release cancels the solve of a value dragged over still running ahead of
+    the released one (``SolveController.released``); a key press (one step and its
+    release at once) does not: held down, each press would cut the one before short and
+    no answer would come until the key is let go."""
+    app = explorer_app("worn_coating", solved=True)
+    calls: list[str] = []
+    monkeypatch.setattr(app.controller, "released", lambda: calls.append("cancel") or False)
+    thickness = app.base_tab.base_thickness
+    control = app.scene_tab.eccentric_load
+    before = app.state.base.thickness
+    thickness.value = before * 1.05                     # a key press
+    with param.edit_constant(thickness):
+        thickness.value_throttled = before * 1.05
+    assert calls == [] and app.state.base.thickness == pytest.approx(before * 1.05)
+    for factor in (1.1, 1.15, 1.2):                     # a drag
+        thickness.value = before * factor
+    with param.edit_constant(thickness):
+        thickness.value_throttled = before * 1.2
+    assert calls == ["cancel"] and app.state.base.thickness == pytest.approx(before * 1.2)
+    e = control.slider.value
+    control.slider.value = e + 0.01                      # the eccentricity: a key press
+    with param.edit_constant(control.slider):
+        control.slider.value_throttled = e + 0.01
+    assert calls == ["cancel"]
+    control.slider.value = e + 0.02                      # and a drag
+    control.slider.value = e + 0.03
+    with param.edit_constant(control.slider):
+        control.slider.value_throttled = e + 0.03
+    assert calls == ["cancel", "cancel"]

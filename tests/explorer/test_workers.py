@@ -188,6 +188,51 @@ def test_a_newer_request_cancels_a_slow_solve_of_the_same_session(processes,
     assert session.view.scene == small_scene()
 
 
+def test_a_release_cancels_the_solve_of_a_value_dragged_over(processes,
+                                                              monkeypatch) -> None:
+    """At a slider's release after a drag, the solve of a value dragged over that still runs
+    gives way to the released value waiting behind it, however short its run so far (the
+    stepped punch's coating modulus: its last answer came 1.3 s after the release, a lift-off
+    solve of a value dragged over ahead of it). Without the release the waiting value would
+    wait for the slow solve (the scene below runs to the 60 s bound of a solve)."""
+    from tests.scene.test_work_bound import _sine_tilt_on_creep
+
+    monkeypatch.setattr(controller_module, "_PROCESSES", processes)
+    monkeypatch.setattr(controller_module, "CANCEL_AFTER_S", 1e9)  # the release alone
+    RESULTS.clear()
+    state = ExplorerState()
+    session = SolveController(state, auto=False)
+    errors: list[str] = []
+    session.param.watch(lambda event: errors.append(event.new), "error")
+    assert not session.released()  # nothing runs
+    slow = _sine_tilt_on_creep()
+    monkeypatch.setattr(state, "to_scene", lambda: slow)
+    session.request()
+    assert not session.released()  # nothing waits behind it
+    monkeypatch.setattr(state, "to_scene", lambda: small_scene())
+    session.request()              # the released value, waiting
+    assert session.released()
+    assert session.wait(30)
+    assert session.error == "" and not errors and session.view is not None
+    assert session.view.scene == small_scene()
+
+
+def test_a_release_leaves_a_solve_of_the_value_released_alone(processes,
+                                                              monkeypatch) -> None:
+    """A drag back to the value whose solve runs: that solve is the one wanted."""
+    monkeypatch.setattr(controller_module, "_PROCESSES", processes)
+    monkeypatch.setattr(controller_module, "CANCEL_AFTER_S", 1e9)
+    RESULTS.clear()
+    state = ExplorerState()
+    state.param.update(time_count=5, tol=1e-5)
+    session = SolveController(state, auto=False)
+    session.request()
+    session.request()              # the same scene again, waiting behind its own solve
+    assert not session.released()
+    assert session.wait(120) and session.error == ""
+    assert session.view.scene == state.to_scene()
+
+
 def small_scene() -> dict[str, Any]:
     """The explorer's default scene (solved in ~30 ms)."""
     return ExplorerState().to_scene()
