@@ -8,10 +8,16 @@ loop, and then hand the result back to the loop: 3-5 ms a step on a loaded serve
 solve itself takes ~1 ms). Here the event loop watches the pipe itself
 (``add_reader``) and reads the answer when it is there.
 
-Only the plain case is taken here: the answer arrives within :data:`LOOP_WAIT_S`. A
-worker that ends, or an answer that takes longer, goes back to the thread's way
+Only the plain case is taken here: the answer arrives within :data:`LOOP_WAIT_S`, whole.
+A worker that ends, or an answer that takes longer, goes back to the thread's way
 (:meth:`explorer.solving.workers.SolverProcesses.result`), which replaces the worker, runs the
-request again or gives up after the time limit.
+request again or gives up after the time limit. So does an answer larger than
+:data:`LOOP_READ_AT_MOST` (its size read from its prefix, not taken from the pipe): a
+result of many output times (3.5 MB at 2000) is larger than the pipe holds, and reading
+it on the loop waited for the worker to write the rest (on a saturated server the loop
+stood in that read for over 0.5 s, three times in one load test:
+benchmarks/results/load_test.md, run AH). A slider step's answer is ~0.2 MB (20 output
+times) to 0.5 MB (200).
 
 Nothing here imports Panel.
 """
@@ -20,6 +26,9 @@ from __future__ import annotations
 
 import array
 import asyncio
+import os
+import socket
+import struct
 from collections.abc import Callable
 
 from .workers import SentRequest
@@ -27,6 +36,8 @@ from .workers import SentRequest
 #: The event loop waits this long for an answer [s] before a thread takes the wait over
 #: (a slow solve, or a stuck worker: the thread applies the time limit).
 LOOP_WAIT_S = 2.0
+#: Answers up to this many bytes are read on the event loop, larger ones by a thread.
+LOOP_READ_AT_MOST = 2**20
 
 
 def when_answered(sent: SentRequest, on_answer: Callable[[], None],
@@ -61,7 +72,8 @@ def when_answered(sent: SentRequest, on_answer: Callable[[], None],
             # its pipe's end can be read before the process is seen to have ended (on a
             # loaded machine): an answer has bytes waiting, the end has none
             answered = (connection.poll(0) and lane.process.is_alive()
-                        and _bytes_waiting(connection.fileno()))
+                        and _bytes_waiting(connection.fileno())
+                        and _message_size(connection.fileno()) <= LOOP_READ_AT_MOST)
         except (OSError, EOFError, ValueError):  # the pipe closed (a shutdown)
             answered = False
         (on_answer if answered else on_other)()
@@ -92,3 +104,28 @@ def _bytes_waiting(fd: int) -> bool:
     except OSError:
         return True
     return count[0] > 0
+
+
+def _message_size(fd: int) -> int:
+    """The size [bytes] of the message of ``multiprocessing.connection`` whose start
+    waits on the socket pair ``fd``, read from its prefix without taking it
+    (``MSG_PEEK``); 0 where it cannot be read so (a plain pipe, the prefix not all there
+    yet)."""
+    copy = os.dup(fd)  # (closing the copy leaves ``fd`` open)
+    try:
+        peer = socket.socket(fileno=copy)
+    except OSError:  # not a socket
+        os.close(copy)
+        return 0
+    try:
+        head = peer.recv(12, socket.MSG_PEEK | socket.MSG_DONTWAIT)
+    except OSError:
+        return 0
+    finally:
+        peer.close()
+    if len(head) < 4:
+        return 0
+    (size,) = struct.unpack("!i", head[:4])
+    if size != -1:
+        return size
+    return struct.unpack("!Q", head[4:12])[0] if len(head) == 12 else 0

@@ -117,3 +117,30 @@ def test_without_an_event_loop_the_thread_waits(processes) -> None:
     assert sent is not None
     assert not when_answered(sent, lambda: None, lambda: None)
     assert processes.result(sent) > 0 and not processes._lanes[0].busy
+
+
+def test_a_large_answer_is_read_by_a_thread_not_the_event_loop(processes) -> None:
+    """An answer larger than the pipe holds (a result of 2000 output times is 3.5 MB) was
+    read on the event loop, which then waited in that read for the worker to write the
+    rest (over 0.5 s on a saturated server). One over ``LOOP_READ_AT_MOST`` goes the
+    thread's way; a small one is still read on the loop, and the size is read from the
+    pipe without taking it."""
+    from explorer.solving import answer_wait
+
+    big = answer_wait.LOOP_READ_AT_MOST + 1
+    for size, way in ((16, "answer"), (big, "other")):
+        outcome: list[str] = []
+
+        async def wait(size: int = size) -> Any:
+            sent = processes.send_now(0, os.urandom, size)
+            assert sent is not None
+            assert when_answered(sent, lambda: outcome.append("answer"),
+                                 lambda: outcome.append("other"))
+            assert await _until(lambda: outcome, 60)
+            return sent
+
+        sent = asyncio.run(wait())
+        assert outcome == [way], size
+        answer = processes.result(sent)  # whole, either way
+        assert isinstance(answer, bytes) and len(answer) == size
+        assert not processes._lanes[0].busy
