@@ -131,12 +131,12 @@ def test_a_large_answer_is_read_by_a_thread_not_the_event_loop(processes) -> Non
     for size, way in ((16, "answer"), (big, "other")):
         outcome: list[str] = []
 
-        async def wait(size: int = size) -> Any:
+        async def wait(size: int = size, outcome: list[str] = outcome) -> Any:
             sent = processes.send_now(0, os.urandom, size)
             assert sent is not None
             assert when_answered(sent, lambda: outcome.append("answer"),
                                  lambda: outcome.append("other"))
-            assert await _until(lambda: outcome, 60)
+            assert await _until(lambda: bool(outcome), 60)
             return sent
 
         sent = asyncio.run(wait())
