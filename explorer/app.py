@@ -134,7 +134,7 @@ class DragSteps:
         self._app.preview_step(target, name, value)
 
     def dragging(self) -> None:
-        """A slider is being dragged (its second step since its last release)."""
+        """A drag step of a slider: its results are spaced out again."""
         self._app.dragging()
 
     def released(self, dragged: bool = True) -> None:

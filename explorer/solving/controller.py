@@ -233,9 +233,8 @@ class SolveController(param.Parameterized):
         self._shown = 0           # id of the newest outcome shown
         self._running = False
         self._pending: tuple[int, dict[str, Any]] | None = None
-        # this session's request in a worker now, since when (monotonic [s]) and its
-        # scene's key (result_key)
-        self._in_worker: tuple[SentRequest, float, str | None] | None = None
+        # this session's request in a worker now, since when (monotonic [s]) and its scene
+        self._in_worker: tuple[SentRequest, float, dict[str, Any]] | None = None
         # the preview scene wanted next (the newest asked), and whether one is solving
         self._preview_wanted: dict[str, Any] | None = None
         self._preview_running = False
@@ -306,8 +305,8 @@ class SolveController(param.Parameterized):
             pending, running = self._pending, self._in_worker
         if pending is None or running is None or self._processes is None:
             return False
-        key = result_key(pending[1])
-        if key is not None and key == running[2]:
+        key = result_key(pending[1])  # (here, not on every request's way)
+        if key is not None and key == result_key(running[2]):
             return False
         self._processes.cancel(running[0])
         return True
@@ -325,7 +324,7 @@ class SolveController(param.Parameterized):
         # (explorer/solving/answer_wait.py); anything else by a thread of the pool.
         if sent is not None:
             with self._lock:
-                self._in_worker = (sent, time.monotonic(), result_key(scene))
+                self._in_worker = (sent, time.monotonic(), scene)
         if sent is None or not when_answered(
                 sent, lambda: self._answered(rid, scene, sent),
                 lambda: self._executor.submit(self._work, rid, scene, sent)):

@@ -81,8 +81,7 @@ class EccentricityControl:
                              css_classes=["eccentricity-lag"])
         self._syncing = False
         self.slider.param.watch(self._on_drag, "value")
-        watch_release(self.slider, self._on_release, lambda: self._syncing,
-                      getattr(drag, "dragging", None))
+        watch_release(self.slider, self._on_release, lambda: self._syncing)
         loading = state.loading
         for q in ("force", "moment"):
             loading.histories[q].param.watch(self.refresh, ["kind", "value"])
@@ -132,6 +131,8 @@ class EccentricityControl:
     def _on_drag(self, event: Any) -> None:
         if self._syncing:
             return
+        if self.drag is not None:
+            self.drag.dragging()  # its results are spaced out, as every drag's
         if self.controller.solved_within(LIVE_SOLVE_S):
             self.say_lag(None)
             self.apply(event.new)

@@ -170,22 +170,18 @@ def _set_widget(widget: pn.widgets.Widget, value: Any) -> None:
 
 
 def watch_release(widget: pn.widgets.Widget, released: Callable[[Any, bool], None],
-                  skip: Callable[[], bool], dragging: Callable[[], None] | None = None
-                  ) -> None:
+                  skip: Callable[[], bool]) -> None:
     """Call ``released(event, dragged)`` at each release of the slider ``widget`` (its
     ``value_throttled`` event), unless ``skip()`` (a value set from the state). ``dragged``: the
     handle was dragged, its value changed twice or more since the last release (a key
     press changes it once and releases at once: a key held down is a run of releases,
-    each of which must not cut short the solve of the one before). ``dragging()``, if
-    given, is called at the second change (a drag has begun)."""
+    each of which must not cut short the solve of the one before)."""
     steps = 0
 
     def moved(event: Any) -> None:
         nonlocal steps
         if not skip():
             steps += 1
-            if steps == 2 and dragging is not None:
-                dragging()
 
     def let_go(event: Any) -> None:
         nonlocal steps
@@ -241,9 +237,9 @@ class Binding:
             # mid-drag ended its preview)
             released = getattr(self._live_when, "released", None)
             if released is not None:
+                # (its drag steps note the drag themselves: ExplorerApp._drag_step_applies)
                 watch_release(widget, lambda event, dragged: released(dragged),
-                              lambda: self._syncing,
-                              getattr(self._live_when, "dragging", None))
+                              lambda: self._syncing)
         if check is not None:
             self._checks[name] = check
         self._pairs.append((name, widget))
