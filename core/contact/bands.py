@@ -34,7 +34,17 @@ from core.discretize import Panels, base_panels
 #: estimate 1.5e-7). The base panels outside the band did not matter (0.5 or 0.25 wide
 #: away from it, the ends and outputs the same to 1e-9), so the chosen rule keeps the
 #: base of the scene: 304 nodes, against 384 when it took the halved base of its check.
-BAND_WIDTHS = (0.02, 0.01, 0.005)
+BAND_WIDTHS = (0.02, 0.01, 0.005, 0.0025)
+#: ... of which those finer than this are tried only while the rule that checks them
+#: (their panels halved) has at most ``MAX_CHECK_NODES`` nodes: the marches are dense in
+#: them (4096 nodes: 134 MB for the operator, ~1.5 s a factorization). 0.0025 reaches the
+#: ends that 0.005 leaves ~5e-8 off where a free end sits a few thousandths from a
+#: breakpoint (the stepped punch's outer parts lifting beside the steps under a stiffer
+#: coating: its check read 9.4e-8 at 0.005 against the 2e-8 asked, 6e-9 at 0.0025), on
+#: bands a few hundredths wide. A band as wide as a growing eccentricity's (~0.66: 2176
+#: nodes at 0.005, its check 4300, 19 s) would need ~8500 there and stops at 0.005.
+BOUNDED_BELOW_WIDTH = 0.005
+MAX_CHECK_NODES = 4096
 #: An end this near +-1 or a breakpoint [half-widths] is pinned there (a corner of the
 #: punch), not free.
 PINNED_WITHIN = 1e-12

@@ -129,6 +129,11 @@ class CoupledMarches:
     def halved(res: Resolutions) -> Resolutions:
         return Resolutions(tuple(Resolution(r.width / 2.0, r.edge / 2.0) for r in res.levels))
 
+    @staticmethod
+    def nodes(rule: tuple[Panels, ...]) -> int:
+        """How many nodes the coupled marches on ``rule`` are dense in (all punches')."""
+        return int(sum(panels.nodes.size for panels in rule))
+
     def locating(self, res: Resolutions) -> tuple[Panels, ...]:
         return tuple(band_rule(space, Resolution(r.width, max(r.edge, LOCATE_EDGE)), [], 0.0)
                      for space, r in zip(self.base.spaces, res.levels, strict=True))

@@ -23,6 +23,8 @@ import numpy as np
 
 from core.contact.bands import (
     BAND_WIDTHS,
+    BOUNDED_BELOW_WIDTH,
+    MAX_CHECK_NODES,
     band_rule,
     bands_from_ends,
     even_rule,
@@ -199,8 +201,9 @@ def _distance(a: dict[str, Any], b: dict[str, Any]) -> tuple[float, float]:
 
 
 #: The finest the zone ends are asked to for q beside them [half-widths]. What they
-#: reach is set by the finest band panels (0.005 wide): 7e-8 to 3e-7 measured on the
-#: scenes of benchmarks/creep_honesty.py.
+#: reach is set by the finest band panels: 7e-8 to 3e-7 measured on the scenes of
+#: benchmarks/creep_honesty.py with panels 0.005 wide, 9e-9 with 0.0025 on the stepped
+#: punch lifting beside its steps (``MAX_CHECK_NODES`` bounds how fine wide bands go).
 MIN_END_TOL = 1e-8
 #: Points of a zone nearer its free end than this [half-widths] do not give the slope of q
 #: there: q at them is the nodal error as much as the slope times the distance.
@@ -398,6 +401,11 @@ class OnePunchMarches:
         """The base width halved, and its grading at +-1 and the breakpoints too."""
         return Resolution(res.width / 2.0, res.edge / 2.0)
 
+    @staticmethod
+    def nodes(rule: Panels) -> int:
+        """How many nodes the marches on ``rule`` are dense in."""
+        return int(rule.nodes.size)
+
     def locating(self, res: Resolution) -> Panels:
         """The rule of the march that locates the bands (graded only to ``LOCATE_EDGE``)."""
         rule = band_rule(self.space, Resolution(res.width, max(res.edge, LOCATE_EDGE)), [],
@@ -579,7 +587,8 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     bands, half the base width and half its grading at +-1 and the breakpoints, so that
     a rule without bands is checked too), halving ``w`` until ``SPACE_FACTOR`` times
     their difference meets a sixth of ``tol`` and half the zone-end tolerance (half of
-    what success asks; or ``BAND_WIDTHS`` run out).
+    what success asks; or ``BAND_WIDTHS`` run out, or, below ``BOUNDED_BELOW_WIDTH``, the
+    next check's rule would have more than ``MAX_CHECK_NODES`` nodes).
     """
     check = _check_times(times)
     grid, widths, index = time_grid(check, first_steps, 0, jumps, graded, windows)
@@ -608,16 +617,19 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     width = BAND_WIDTHS[0]
     rule = marches.rule(res, bands, width)
     current = check_march(rule)
+    half = marches.rule(finer, bands, width / 2.0)
     while True:
-        half = marches.rule(finer, bands, width / 2.0)
         halved = check_march(half)
         diff, shift = marches.distance(current, halved)
         error, end_error = SPACE_FACTOR * diff, SPACE_FACTOR * shift
         if (error <= tol / 6 and end_error <= end_tol / 2) or width / 2.0 < BAND_WIDTHS[-1]:
             break
+        checking = marches.rule(finer, bands, width / 4.0)
+        if width / 2.0 < BOUNDED_BELOW_WIDTH and marches.nodes(checking) > MAX_CHECK_NODES:
+            break
         # The halved rule becomes the candidate (its base is already the finer one).
         width /= 2.0
-        rule, current = half, halved
+        rule, current, half = half, halved, checking
     return rule, float(error), float(end_error), {"bands": bands, "width": width,
                                                   "end_tol": end_tol}
 

@@ -767,3 +767,56 @@ def test_coarse_start_settles_on_the_set_found_from_full_contact(gap, loads):
     assert settled and np.array_equal(state.active, full.active)
     assert sweeps < full_sweeps
 
+
+
+class _BandStub:
+    """Marches whose checks never agree, on a band 0.1 wide: a rule is its band width,
+    its nodes 16 per panel over the band."""
+
+    def __init__(self) -> None:
+        self.marched: list[float] = []
+
+    def rule(self, res, bands, width):
+        return width
+
+    @staticmethod
+    def halved(res):
+        return res
+
+    @staticmethod
+    def nodes(rule) -> int:
+        return int(round(16 * 0.1 / rule))
+
+    def run(self, rule, grid, widths, index, exact_ends=True, first=None):
+        self.marched.append(rule)
+        return {"rule": rule}, None
+
+    @staticmethod
+    def distance(a, b):
+        return 1.0, 1.0
+
+
+def test_band_panels_finer_than_0_005_are_tried_while_the_check_stays_within_its_nodes(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from core.contact import creep
+
+    stub = _BandStub()
+    rule, *_ = creep._select_rule(stub, np.array([1.0, 2.0]), None, 4, 1e-6, 1e-6,
+                                  bands=[(0.0, 0.1)])
+    # every width is tried, the last (0.0025) checked against 0.00125 (1280 nodes)
+    assert rule == creep.BAND_WIDTHS[-1] == 0.0025
+    assert stub.marched == [0.02, 0.01, 0.005, 0.0025, 0.00125]
+    # a check of more nodes than allowed is not marched: the last width stays the rule
+    monkeypatch.setattr(creep, "MAX_CHECK_NODES", 700)
+    stub = _BandStub()
+    rule, *_ = creep._select_rule(stub, np.array([1.0, 2.0]), None, 4, 1e-6, 1e-6,
+                                  bands=[(0.0, 0.1)])
+    assert rule == 0.005
+    assert stub.marched == [0.02, 0.01, 0.005, 0.0025]
+    # the widths down to 0.005 are tried whatever their checks cost (as before 0.0025)
+    monkeypatch.setattr(creep, "MAX_CHECK_NODES", 100)
+    stub = _BandStub()
+    rule, *_ = creep._select_rule(stub, np.array([1.0, 2.0]), None, 4, 1e-6, 1e-6,
+                                  bands=[(0.0, 0.1)])
+    assert rule == 0.005 == creep.BOUNDED_BELOW_WIDTH
+    assert stub.marched == [0.02, 0.01, 0.005, 0.0025]
