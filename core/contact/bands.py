@@ -35,15 +35,19 @@ from core.discretize import Panels, base_panels
 #: away from it, the ends and outputs the same to 1e-9), so the chosen rule keeps the
 #: base of the scene: 304 nodes, against 384 when it took the halved base of its check.
 BAND_WIDTHS = (0.02, 0.01, 0.005, 0.0025)
-#: ... of which those finer than this are tried only while the rule that checks them
-#: (their panels halved) has at most ``MAX_CHECK_NODES`` nodes: the marches are dense in
-#: them (4096 nodes: 134 MB for the operator, ~1.5 s a factorization). 0.0025 reaches the
-#: ends that 0.005 leaves ~5e-8 off where a free end sits a few thousandths from a
-#: breakpoint (the stepped punch's outer parts lifting beside the steps under a stiffer
-#: coating: its check read 9.4e-8 at 0.005 against the 2e-8 asked, 6e-9 at 0.0025), on
-#: bands a few hundredths wide. A band as wide as a growing eccentricity's (~0.66: 2176
-#: nodes at 0.005, its check 4300, 19 s) would need ~8500 there and stops at 0.005.
-BOUNDED_BELOW_WIDTH = 0.005
+#: ... of which those below this are a last resort: tried only where the zone ends' error
+#: that the check finds at the width before would, through the slope of q beside them
+#: (``core.contact.creep.free_end_slope``) alone, fail the answer's tol, and while the rule
+#: that checks them (their panels halved) has at most ``MAX_CHECK_NODES`` nodes (the
+#: marches are dense in them: 4096 nodes, 134 MB for the operator, ~1.5 s a
+#: factorization). 0.0025 reaches the ends that 0.005 leaves ~5e-8 off where a free end
+#: sits a few thousandths from a breakpoint (the stepped punch's outer parts lifting beside
+#: the steps under a 1 GPa coating: its check read 9.4e-8 at 0.005 against the 2e-8 asked,
+#: and q beside them 5.5e-7 at tol 1e-6; 6e-9 at 0.0025), on bands a few hundredths wide.
+#: Where the ends miss only their own share at 0.005 but the answer meets tol (the crowned
+#: default scene at R = 10 km: 0.6 s, 2.6 s at 0.0025), or the band is as wide as a growing
+#: eccentricity's (~0.66: its check at 0.0025 has 4300 nodes, 19 s), 0.005 stays the last.
+LAST_RESORT_BELOW = 0.005
 MAX_CHECK_NODES = 4096
 #: An end this near +-1 or a breakpoint [half-widths] is pinned there (a corner of the
 #: punch), not free.

@@ -23,7 +23,7 @@ import numpy as np
 
 from core.contact.bands import (
     BAND_WIDTHS,
-    BOUNDED_BELOW_WIDTH,
+    LAST_RESORT_BELOW,
     MAX_CHECK_NODES,
     band_rule,
     bands_from_ends,
@@ -455,11 +455,14 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
     # the zones at loading found by the first march start the first step of the others
     first: dict[str, Any] = {}
 
-    def rule_and_march(end_tol: float, bands: Any = None) -> tuple:
-        """The rule (its bands located first unless given) and the time grids on it."""
+    def rule_and_march(end_tol: float, bands: Any = None, slope: float = 0.0,
+                       start_width: float = BAND_WIDTHS[0]) -> tuple:
+        """The rule (its bands located first unless given, with q's ``slope`` at the free
+        ends; its band panels from ``start_width`` down) and the time grids on it."""
         base, space_error, space_shift, band_note = _select_rule(
             marches, times, res, first_steps, tol, end_tol, bands=bands, first=first,
-            jumps=jumps, graded=graded, windows=windows)
+            jumps=jumps, graded=graded, windows=windows, slope=slope,
+            start_width=start_width)
         end_tol = band_note["end_tol"]  # finer where q beside the ends asks for it
         out, time_error, end_shift, run = _in_time(
             marches, times, base, first_steps,
@@ -480,7 +483,7 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
         # a zone opening late): the bands of every output time, and everything again.
         (base, space_error, space_shift, band_note, out, time_error, end_shift, run,
          strays) = rule_and_march(band_note["end_tol"],
-                                  marches.bands(out, band_note["bands"]))
+                                  marches.bands(out, band_note["bands"]), band_note["slope"])
     end_error = float(end_shift + space_shift)
     slope = marches.end_slope(base, out)
     rest = float(time_error + space_error)
@@ -494,10 +497,16 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
         # half-widths, q's error 4.7e-7 -> 5.4e-8)
         end_tol = end_tol_for_q(tol, slope, rest)
         # only when it asks more than the last run did (at MIN_END_TOL the finest bands
-        # have been tried: the same run again would give the same ends)
-        if end_tol < min(end_error, 0.5 * band_note["end_tol"]):
+        # have been tried: the same run again would give the same ends), or when q's
+        # slope, read now on the chosen rule, makes the last resort of the band widths
+        # worth trying where the locating march's did not (LAST_RESORT_BELOW)
+        last_resort = (band_note["width"] >= LAST_RESORT_BELOW > BAND_WIDTHS[-1]
+                       and slope > band_note["slope"]
+                       and not accepts(space_shift * slope, tol, UNILATERAL_MARGIN))
+        if end_tol < min(end_error, 0.5 * band_note["end_tol"]) or last_resort:
             (base, space_error, space_shift, band_note, out, time_error, end_shift, run,
-             strays) = rule_and_march(end_tol, band_note["bands"])
+             strays) = rule_and_march(min(end_tol, band_note["end_tol"]), band_note["bands"],
+                                      slope, band_note["width"])
             end_error = float(end_shift + space_shift)
             slope = marches.end_slope(base, out)
     end_q_error = end_error * slope if slope > 0.0 else 0.0
@@ -577,7 +586,8 @@ def _check_times(times: np.ndarray, count: int = 0) -> np.ndarray:
 
 def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, tol: float,
                  end_tol: float, bands: Any = None, first: dict[str, Any] | None = None,
-                 jumps: Sequence[float] = (), graded: int = 0, windows: Windows = ()
+                 jumps: Sequence[float] = (), graded: int = 0, windows: Windows = (),
+                 slope: float = 0.0, start_width: float = BAND_WIDTHS[0]
                  ) -> tuple[Any, float, float, dict[str, Any]]:
     """The panel rule of the stepping and its spatial error (outputs, zone ends).
 
@@ -587,8 +597,12 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     bands, half the base width and half its grading at +-1 and the breakpoints, so that
     a rule without bands is checked too), halving ``w`` until ``SPACE_FACTOR`` times
     their difference meets a sixth of ``tol`` and half the zone-end tolerance (half of
-    what success asks; or ``BAND_WIDTHS`` run out, or, below ``BOUNDED_BELOW_WIDTH``, the
-    next check's rule would have more than ``MAX_CHECK_NODES`` nodes).
+    what success asks; or ``BAND_WIDTHS`` run out; below ``LAST_RESORT_BELOW`` only where
+    the ends' error times q's ``slope`` beside them would alone fail tol, and while the
+    next check's rule has at most ``MAX_CHECK_NODES`` nodes). ``slope``
+    (:func:`free_end_slope`): the caller's, or the locating march's where it locates the
+    bands. ``start_width``: the first band width tried (the last one a run on the same
+    bands chose: a run asking finer ends would not stop at a coarser one).
     """
     check = _check_times(times)
     grid, widths, index = time_grid(check, first_steps, 0, jumps, graded, windows)
@@ -614,7 +628,7 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
             end_tol = min(end_tol, end_tol_for_q(tol, slope))
     # every panel finer: the base width halved, its grading at +-1 and the breakpoints too
     finer = marches.halved(res)
-    width = BAND_WIDTHS[0]
+    width = start_width
     rule = marches.rule(res, bands, width)
     current = check_march(rule)
     half = marches.rule(finer, bands, width / 2.0)
@@ -625,13 +639,15 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         if (error <= tol / 6 and end_error <= end_tol / 2) or width / 2.0 < BAND_WIDTHS[-1]:
             break
         checking = marches.rule(finer, bands, width / 4.0)
-        if width / 2.0 < BOUNDED_BELOW_WIDTH and marches.nodes(checking) > MAX_CHECK_NODES:
+        if width / 2.0 < LAST_RESORT_BELOW and (
+                accepts(end_error * slope, tol, UNILATERAL_MARGIN)
+                or marches.nodes(checking) > MAX_CHECK_NODES):
             break
         # The halved rule becomes the candidate (its base is already the finer one).
         width /= 2.0
         rule, current, half = half, halved, checking
     return rule, float(error), float(end_error), {"bands": bands, "width": width,
-                                                  "end_tol": end_tol}
+                                                  "end_tol": end_tol, "slope": slope}
 
 
 def _outside_bands(ends: list[list[float]], bands: list[tuple[float, float]],

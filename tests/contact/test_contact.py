@@ -796,27 +796,25 @@ class _BandStub:
         return 1.0, 1.0
 
 
-def test_band_panels_finer_than_0_005_are_tried_while_the_check_stays_within_its_nodes(
+def test_band_panels_finer_than_0_005_are_a_last_resort(
         monkeypatch: pytest.MonkeyPatch) -> None:
     from core.contact import creep
 
-    stub = _BandStub()
-    rule, *_ = creep._select_rule(stub, np.array([1.0, 2.0]), None, 4, 1e-6, 1e-6,
-                                  bands=[(0.0, 0.1)])
-    # every width is tried, the last (0.0025) checked against 0.00125 (1280 nodes)
-    assert rule == creep.BAND_WIDTHS[-1] == 0.0025
-    assert stub.marched == [0.02, 0.01, 0.005, 0.0025, 0.00125]
-    # a check of more nodes than allowed is not marched: the last width stays the rule
+    def select(slope: float) -> tuple[float, list[float]]:
+        stub = _BandStub()
+        rule, *_ = creep._select_rule(stub, np.array([1.0, 2.0]), None, 4, 1e-6, 1e-6,
+                                      bands=[(0.0, 0.1)], slope=slope)
+        return rule, stub.marched
+
+    # where the ends' error through q's slope would alone fail tol: every width, the last
+    # (0.0025) checked against 0.00125 (1280 nodes)
+    assert select(1.0) == (0.0025, [0.02, 0.01, 0.005, 0.0025, 0.00125])
+    assert creep.BAND_WIDTHS[-1] == 0.0025 < creep.LAST_RESORT_BELOW == 0.005
+    # where it would not (no free end: slope 0), 0.005 stays the last
+    assert select(0.0) == (0.005, [0.02, 0.01, 0.005, 0.0025])
+    # a check of more nodes than allowed is not marched
     monkeypatch.setattr(creep, "MAX_CHECK_NODES", 700)
-    stub = _BandStub()
-    rule, *_ = creep._select_rule(stub, np.array([1.0, 2.0]), None, 4, 1e-6, 1e-6,
-                                  bands=[(0.0, 0.1)])
-    assert rule == 0.005
-    assert stub.marched == [0.02, 0.01, 0.005, 0.0025]
+    assert select(1.0) == (0.005, [0.02, 0.01, 0.005, 0.0025])
     # the widths down to 0.005 are tried whatever their checks cost (as before 0.0025)
     monkeypatch.setattr(creep, "MAX_CHECK_NODES", 100)
-    stub = _BandStub()
-    rule, *_ = creep._select_rule(stub, np.array([1.0, 2.0]), None, 4, 1e-6, 1e-6,
-                                  bands=[(0.0, 0.1)])
-    assert rule == 0.005 == creep.BOUNDED_BELOW_WIDTH
-    assert stub.marched == [0.02, 0.01, 0.005, 0.0025]
+    assert select(1.0) == (0.005, [0.02, 0.01, 0.005, 0.0025])
