@@ -127,6 +127,17 @@ def _beside_step(tol: float, modulus: float = 1.0e9):
                                contact="unilateral", **problem.loads)
 
 
+def _within_reference(answer, reference) -> None:
+    """q and the zone ends of ``answer`` within its estimate and the reference's."""
+    error = _q_error(answer, reference)
+    assert error <= answer.info["error_estimate"] + reference.info["error_estimate"]
+    for mine, exact in zip(answer.contact_set, reference.contact_set, strict=True):
+        assert len(mine) == len(exact)
+        ends = np.subtract(np.ravel(mine), np.ravel(exact))
+        assert np.max(np.abs(ends)) <= (answer.info["zone_end_error"]
+                                        + reference.info["zone_end_error"])
+
+
 def test_a_free_end_beside_a_step_is_located_with_band_panels_finer_than_0_005(
         monkeypatch: pytest.MonkeyPatch) -> None:
     answer = _beside_step(1e-6)
@@ -144,13 +155,7 @@ def test_a_free_end_beside_a_step_is_located_with_band_panels_finer_than_0_005(
                         (0.02, 0.01, 0.005, 0.0025, 0.00125))
     reference = _beside_step(1e-9)
     assert reference.info["error_estimate"] <= 1e-7
-    error = _q_error(answer, reference)
-    assert error <= answer.info["error_estimate"] + reference.info["error_estimate"]
-    for mine, exact in zip(answer.contact_set, reference.contact_set, strict=True):
-        assert len(mine) == len(exact)
-        ends = np.subtract(np.ravel(mine), np.ravel(exact))
-        assert np.max(np.abs(ends)) <= (answer.info["zone_end_error"]
-                                        + reference.info["zone_end_error"])
+    _within_reference(answer, reference)
 
 
 @pytest.mark.slow
@@ -178,10 +183,4 @@ def test_a_steeper_end_beside_a_step_is_located_again_when_its_slope_asks(
     monkeypatch.setattr(creep, "BAND_WIDTHS", (0.02, 0.01, 0.005, 0.0025, 0.00125))
     reference = _beside_step(1e-9, 1.5e9)
     assert reference.info["error_estimate"] <= 1e-7
-    error = _q_error(answer, reference)
-    assert error <= answer.info["error_estimate"] + reference.info["error_estimate"]
-    for mine, exact in zip(answer.contact_set, reference.contact_set, strict=True):
-        assert len(mine) == len(exact)
-        ends = np.subtract(np.ravel(mine), np.ravel(exact))
-        assert np.max(np.abs(ends)) <= (answer.info["zone_end_error"]
-                                        + reference.info["zone_end_error"])
+    _within_reference(answer, reference)
