@@ -500,7 +500,7 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
         # have been tried: the same run again would give the same ends), or when q's
         # slope, read now on the chosen rule, makes the last resort of the band widths
         # worth trying where the locating march's did not (LAST_RESORT_BELOW)
-        last_resort = (band_note["width"] >= LAST_RESORT_BELOW > BAND_WIDTHS[-1]
+        last_resort = (band_note["width"] >= LAST_RESORT_BELOW
                        and slope > band_note["slope"]
                        and not accepts(space_shift * slope, tol, UNILATERAL_MARGIN))
         if end_tol < min(end_error, 0.5 * band_note["end_tol"]) or last_resort:

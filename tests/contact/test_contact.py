@@ -768,7 +768,6 @@ def test_coarse_start_settles_on_the_set_found_from_full_contact(gap, loads):
     assert sweeps < full_sweeps
 
 
-
 class _BandStub:
     """Marches whose checks never agree, on a band 0.1 wide: a rule is its band width,
     its nodes 16 per panel over the band."""
