@@ -656,6 +656,11 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _zones(zones: list[list[float]]) -> str:
+    """Contact zones [m] as ``[lo, hi] m`` text."""
+    return " ".join(f"[{lo:.4g}, {hi:.4g}]" for lo, hi in zones) + " m"
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     scene = _read(args.scene)
     end = float(scene.times[-1])
@@ -680,6 +685,11 @@ def _cmd_check(args: argparse.Namespace) -> int:
               f"{100 * report['errors'][q]:8.2f}%")
     print(f"{'pressure':>12} {'':>16} {'':>16} {100 * report['errors']['pressure']:8.2f}% "
           "(largest on |x| <= 0.9 a)")
+    lift = report.get("lift_off")
+    if lift is not None:
+        print(f"{'contact':>12} {_zones(lift['fast']):>16} {_zones(lift['fe']):>16} "
+              f"{report['errors']['contact_ends']:8.3g} half-widths between zone ends "
+              f"(both with lift-off; resolved ends to {lift['fe_end_uncertainty']:.1g} m)")
     print(f"model error of the fast answer: {100 * report['model_error']:.2f} % "
           f"({report['coating_model']}; estimate carried by results: "
           f"{100 * report['estimate']:.2g} %, "

@@ -27,13 +27,15 @@ from core.coating.model import (
 from core.optional import lazy_exports
 
 if TYPE_CHECKING:
-    from core.coating.fem_check import solve_stack
-    from core.coating.fem_stack import CoatingStrip, Stack
+    from core.coating.fem_check import solve_stack, solve_stack_contact
+    from core.coating.fem_stack import CoatingStrip, FEContact, Stack
 
 # The finite-element check, loaded on first use: a scene's solve needs the thin coating
 # model only, and the command line starts faster without the FE modules.
 _LAZY: dict[str, str] = {
     "solve_stack": "core.coating.fem_check",
+    "solve_stack_contact": "core.coating.fem_check",
+    "FEContact": "core.coating.fem_stack",
     "CoatingStrip": "core.coating.fem_stack",
     "Stack": "core.coating.fem_stack",
 }
@@ -44,12 +46,14 @@ __all__ = [
     "DEFAULT_MODEL_TOL",
     "INTERFACES",
     "equivalent_layers",
+    "FEContact",
     "layer_compliance",
     "model_error_estimate",
     "model_error_map",
     "MODEL_TOL_RANGE",
     "NEGLIGIBLE_SHARE",
     "solve_stack",
+    "solve_stack_contact",
     "Stack",
     "tilt_share",
 ]

@@ -67,6 +67,18 @@ class FEResponse:
     dofs: int
     seconds: float
     extent: float = field(default=0.0)
+    nodal_force_parts: np.ndarray | None = None
+    clearance_parts: np.ndarray | None = None
+
+    def nodal_force(self, settlement: float, tilt: float) -> np.ndarray:
+        """The punch's force [N/m] on each node ``x_nodes`` (the consistent nodal forces of
+        the contact pressure; zero where the punch does not hold the surface)."""
+        return np.array([1.0, settlement, tilt]) @ self.nodal_force_parts
+
+    def clearance(self, settlement: float, tilt: float) -> np.ndarray:
+        """The height [m] of the punch's base above the deformed surface at each node
+        ``x_nodes`` (zero where the punch holds it, negative where it would penetrate)."""
+        return np.array([1.0, settlement, tilt]) @ self.clearance_parts
 
     def force_moment(self, settlement: float, tilt: float) -> tuple[float, float]:
         """P [N/m] and M [N] for a settlement delta [m] and a tilt alpha [rad]."""
@@ -107,6 +119,27 @@ class FEResponse:
         """q [Pa] at points ``x`` [m] of ``[-a, a]`` (the P2 interpolant of the nodal values)."""
         values = np.array([1.0, settlement, tilt]) @ self.pressure_parts
         return _p2_interpolate(self.x_nodes, values, np.asarray(x, dtype=float))
+
+
+@dataclass
+class FEContact:
+    """A resolved-model answer with unilateral contact (:func:`core.coating.solve_stack_contact`).
+
+    ``response``: the :class:`FEResponse` on the final contact set; ``state``: settlement
+    [m], tilt [rad], force [N/m], moment [N] of the answer; ``contact``: the intervals [m]
+    of held nodes (first, last node); ``sweeps``: active-set sweeps made; ``converged``:
+    whether the set settled (no node changed in the last sweep); ``end_moved``: how far [m]
+    the zone ends moved on the last mesh refinement (their uncertainty); ``seconds``: the
+    whole solve's time (every mesh).
+    """
+
+    response: FEResponse
+    state: dict[str, float]
+    contact: list[tuple[float, float]]
+    sweeps: int
+    converged: bool
+    end_moved: float = float("nan")
+    seconds: float = float("nan")
 
 
 def _p2_interpolate(nodes: np.ndarray, values: np.ndarray, x: np.ndarray) -> np.ndarray:

@@ -3,7 +3,8 @@
 :func:`check_scene` builds the resolved model of :mod:`core.coating.fem_check` for a scene's
 geometry (punch shape, every coating layer with its profiles and interface, the base) with
 the base elastic at the modulus of a chosen time, solves the scene's statement there with
-the same two given values, and compares the fast answer of the same elastic problem: the
+the same two given values (with lift-off where the scene's own contact model lifts the
+punch off there), and compares the fast answer of the same elastic problem: the
 coating model that answers the scene itself (the exact layered kernel for a uniform
 coating on an elastic base, else the thin layer, :mod:`core.engines.layered.answer`). With an
 aging, creeping base this measures the thin-layer model's error at that modulus; creep
@@ -17,7 +18,13 @@ from typing import Any
 
 import numpy as np
 
-from core.coating import NEGLIGIBLE_SHARE, CoatingStrip, Stack, solve_stack
+from core.coating import (
+    NEGLIGIBLE_SHARE,
+    CoatingStrip,
+    Stack,
+    solve_stack,
+    solve_stack_contact,
+)
 from core.engines.layered import layered_declines
 from core.problem import QUANTITIES
 from core.scene.evidence import checked_key
@@ -29,6 +36,15 @@ from core.scene.validate import scene_from_dict
 #: Pressure errors are measured on |x| <= this fraction of a (the edge singularities of
 #: both answers are not comparable pointwise).
 PRESSURE_REACH = 0.9
+
+
+def _ends_apart(fast: list[tuple[float, float]], fe: list[tuple[float, float]]) -> float:
+    """The largest distance [m] between the zone ends of two contact sets (inf when they
+    have different numbers of zones)."""
+    if len(fast) != len(fe):
+        return float("inf")
+    return max((abs(x - y) for f, e in zip(fast, fe, strict=True)
+                for x, y in zip(f, e, strict=True)), default=0.0)
 
 
 def fe_stack(scene: Scene, time: float = 0.0) -> Stack:
@@ -43,18 +59,18 @@ def fe_stack(scene: Scene, time: float = 0.0) -> Stack:
         base_poisson=scene.base_poisson, shape=scene.shape, breakpoints=scene.breakpoints)
 
 
-def elastic_scene(scene: Scene, time: float = 0.0) -> Scene:
+def elastic_scene(scene: Scene, time: float = 0.0, full_contact: bool = True) -> Scene:
     """The scene with its base elastic at ``E(tau0 + time)``, its two given loads held
-    at their values at ``time`` [days after loading], in full contact (as the FE model)."""
+    at their values at ``time`` [days after loading], in full contact (``full_contact``)
+    or in the scene's own contact model."""
     d = scene.to_dict()
     modulus = float(np.asarray(scene.creep.modulus(scene.age_at_loading + time), dtype=float))
     d["base"]["creep"] = {"model": "elastic", "modulus": modulus}
     d["loading"] = {name: float(np.asarray(profile(np.array([time])), dtype=float).ravel()[0])
                     for name, profile in scene.loading.items()}
     d["times"] = [1.0]
-    # the FE model ties the punch to the surface: the fast model is compared in full
-    # contact too (a lifting punch would compare two contact models, not two coatings)
-    d["solver"]["contact"] = "full"
+    if full_contact:
+        d["solver"]["contact"] = "full"
     return scene_from_dict(d)
 
 
@@ -72,26 +88,50 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
     there), ``"model_error"``: the largest error of the two unknowns, ``"estimate"``: the
     map's estimate that results carry, ``"scene_key"``: :func:`core.scene.checked_key` of
     the scene (which results the measurement applies to), ``"fe_seconds"``, ``"fe_dofs"``.
+
+    Where the scene's own contact model lifts the punch off at this modulus, both answers
+    are of lift-off (the FE model's contact set by :func:`core.coating.solve_stack_contact`,
+    started from the fast one's): ``"lift_off"`` then holds both contact sets [m], the FE
+    ends' uncertainty [m] and its sweeps, and ``errors["contact_ends"]`` the largest
+    distance between their zone ends [half-widths]; else ``"lift_off"`` is None.
     """
     scene = scene_from_dict(scene)
     if not np.isfinite(time) or not 0.0 <= time <= float(scene.times[-1]):
         raise ValueError(f"time: must be in [0, {float(scene.times[-1]):g}] days after "
                          f"loading, got {time!r}")
-    elastic = elastic_scene(scene, time)
-    if not scene.coating or layered_declines(scene, scene.dimensionless) is None:
-        # the exact layered kernel answers the scene itself (a bare base, creeping or not)
-        fast = solve(elastic)
-    else:
-        # the scene's own answer is the thin layer's (a creeping base, a varying coating):
-        # check that model at this modulus, not the exact kernel its elastic copy would get
-        problem = elastic.dimensionless
-        with np.errstate(all="ignore"):
-            fast = SceneSolution(elastic, problem, problem.solve())
-    fe = solve_stack(fe_stack(scene, time), level=level)
-    given = {name: float(getattr(fast, name)[0]) for name in scene.loading}
-    exact = fe.complete(given)
-    quick = {name: float(getattr(fast, name)[0]) for name in QUANTITIES}
+    stack = fe_stack(scene, time)
     a = scene.half_width
+    lifting = None
+    if scene.contact != "full":
+        # the scene's own contact model at this modulus: where the punch lifts off, both
+        # models are compared with lift-off (in full contact they would answer another
+        # problem than the scene's)
+        lifting = solve(elastic_scene(scene, time, full_contact=False))
+        zones = lifting.contact_set[0] if lifting.contact_set else [(-a, a)]
+        if len(zones) == 1 and zones[0][0] <= -a * (1 - 1e-12) and zones[0][1] >= a * (1 - 1e-12):
+            lifting = None
+    if lifting is not None:
+        fast = lifting
+        given = {name: float(getattr(fast, name)[0]) for name in scene.loading}
+        answer = solve_stack_contact(stack, given, level=level, start=fast.contact_set[0])
+        fe, exact = answer.response, answer.state
+    else:
+        elastic = elastic_scene(scene, time)
+        if not scene.coating or layered_declines(scene, scene.dimensionless) is None:
+            # the exact layered kernel answers the scene itself (a bare base, creeping or
+            # not)
+            fast = solve(elastic)
+        else:
+            # the scene's own answer is the thin layer's (a creeping base, a varying
+            # coating): check that model at this modulus, not the exact kernel its elastic
+            # copy would get
+            problem = elastic.dimensionless
+            with np.errstate(all="ignore"):
+                fast = SceneSolution(elastic, problem, problem.solve())
+        fe = solve_stack(stack, level=level)
+        given = {name: float(getattr(fast, name)[0]) for name in scene.loading}
+        exact = fe.complete(given)
+    quick = {name: float(getattr(fast, name)[0]) for name in QUANTITIES}
     kin = max(abs(exact["settlement"]), a * abs(exact["tilt"]))
     stat = max(abs(exact["force"]), abs(exact["moment"]) / a)
     scales = {"settlement": kin, "tilt": kin / a, "force": stat, "moment": stat * a}
@@ -101,9 +141,17 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
     for name in QUANTITIES:
         scale = max(abs(exact[name]), NEGLIGIBLE_SHARE * scales[name])
         errors[name] = (quick[name] - exact[name]) / scale if scale > 0 else 0.0
+    contact = None
+    if lifting is not None:
+        ends = _ends_apart(fast.contact_set[0], answer.contact)
+        errors["contact_ends"] = ends / a
+        contact = {"fast": [list(z) for z in fast.contact_set[0]],
+                   "fe": [list(z) for z in answer.contact],
+                   "fe_end_uncertainty": answer.end_moved, "fe_sweeps": answer.sweeps,
+                   "fe_converged": answer.converged}
     x = np.linspace(-PRESSURE_REACH * a, PRESSURE_REACH * a, 181)
     q_fe = fe.pressure(x, exact["settlement"], exact["tilt"])
-    q_fast = fast.pressure(x)[:, 0]
+    q_fast = fast.pressure(x)[:, 0] if lifting is None else np.maximum(fast.pressure(x)[:, 0], 0)
     q_scale = float(np.max(np.abs(q_fe)))
     errors["pressure"] = float(np.max(np.abs(q_fast - q_fe)) / q_scale) if q_scale > 0 else 0.0
     unknowns = [name for name in QUANTITIES if name not in scene.loading]
@@ -117,7 +165,8 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
         "coating_model": fast.info["coating_model"],
         "given": sorted(scene.loading),
         "contact_lost": fast.contact_lost,
+        "lift_off": contact,
         "scene_key": checked_key(scene),
-        "fe_seconds": fe.seconds,
+        "fe_seconds": fe.seconds if lifting is None else answer.seconds,
         "fe_dofs": fe.dofs,
     }

@@ -149,11 +149,29 @@ def check_report_html(report: dict[str, Any]) -> str:
         f"{report['fe_seconds']:.1f} s). Coating model: {report['coating_model']}.</small>"
         f"<br><b>model error: measured {100 * report['model_error']:.3g} %, "
         f"estimated {100 * report['estimate']:.3g} %</b>"
-        + ("<br><span class='cp-msg'>The punch lifts off here: both models are compared "
-           "in full contact, as the FE model ties the punch to the surface.</span>"
-           if report.get("contact_lost") else "")
+        + _contact_note(report)
         + "<table class='cp-readout'><tr><th></th><th>fast</th><th>FE</th><th>error [%]</th>"
         "</tr>" + "".join(rows) + "</table></div>")
+
+
+def _zones_text(zones: list[list[float]]) -> str:
+    """Contact zones [m] as text."""
+    return ", ".join(f"[{lo:.4g}, {hi:.4g}]" for lo, hi in zones) + " m"
+
+
+def _contact_note(report: dict[str, Any]) -> str:
+    """How the check treated contact: both models with lift-off where the scene lifts
+    off (their contact sets side by side), or a full-contact answer with q < 0."""
+    lift = report.get("lift_off")
+    if lift:
+        return ("<br><span class='cp-msg'>The punch lifts off here: both models are "
+                f"compared with lift-off. Contact: fast {_zones_text(lift['fast'])}, FE "
+                f"{_zones_text(lift['fe'])} (zone ends "
+                f"{report['errors']['contact_ends']:.3g} a apart).</span>")
+    if report.get("contact_lost"):
+        return ("<br><span class='cp-msg'>This full-contact answer has q &lt; 0: both "
+                "models are compared in full contact (solver.contact 'full').</span>")
+    return ""
 
 
 class CoatingCheckView:

@@ -49,3 +49,18 @@ def test_report_marks_the_given_quantities():
               "given": ["force", "moment"], "fe_dofs": 25000, "fe_seconds": 1.2}
     text = check_report_html(report)
     assert text.count("given") == 2 and "+1.000" in text and "measured 2 %" in text
+
+
+def test_report_of_a_lifting_punch_shows_both_contact_sets():
+    report = {"errors": {"settlement": -0.84, "tilt": 0.70, "force": 0.0, "moment": 0.0,
+                         "pressure": 0.39, "contact_ends": 0.0205},
+              "fast": {"settlement": -6e-4, "tilt": 7.5e-4, "force": 5e5, "moment": 4.75e5},
+              "fe": {"settlement": -3.3e-4, "tilt": 4.4e-4, "force": 5e5, "moment": 4.75e5},
+              "model_error": 0.84, "estimate": 0.046, "coating_model": "thin layer",
+              "given": ["force", "moment"], "fe_dofs": 66087, "fe_seconds": 4.5,
+              "contact_lost": False,
+              "lift_off": {"fast": [[0.8463, 1.0]], "fe": [[0.8258, 1.0]],
+                           "fe_end_uncertainty": 2e-4, "fe_sweeps": 4, "fe_converged": True}}
+    text = check_report_html(report)
+    assert "compared with lift-off" in text
+    assert "fast [0.8463, 1] m, FE [0.8258, 1] m" in text and "0.0205 a apart" in text
