@@ -69,13 +69,13 @@ from core.scene import (
     PunchesSolution,
     Scene,
     SceneSolution,
+    check_loads_touch,
     flags_with_evidence,
     has_punches,
     load_json_schema,
     load_scene,
     migrate,
     model_error_evidence,
-    provenance_lines,
     punches_from_dict,
     read_scene_json,
     scene_from_dict,
@@ -147,11 +147,17 @@ def _input_errors(path: str) -> Iterator[None]:
 
 
 def _read(path: str) -> Scene | PunchesScene:
+    """The scene of ``path``, validated; a load no contact model answers (a pulled punch,
+    a resultant outside it) is the user's input too, refused before any solve."""
     with _input_errors(path):
         if path == STDIO:
             data = read_scene_json(_stdin_text(), STDIN_NAME)
-            return punches_from_dict(data) if has_punches(data) else scene_from_dict(data)
-        return load_scene(path)
+            scene = punches_from_dict(data) if has_punches(data) else scene_from_dict(data)
+        else:
+            scene = load_scene(path)
+        if isinstance(scene, Scene):
+            check_loads_touch(scene)
+        return scene
 
 
 def _read_document(path: str) -> Any:
@@ -283,31 +289,6 @@ def _summary(result: SceneSolution) -> str:
     return "\n".join(lines)
 
 
-def _csv_head(result: SceneSolution | PunchesSolution, what: str) -> str:
-    """The ``#`` lines before a CSV table of ``result``: what it is, the version, the
-    scene, the solver settings, the answer's accuracy and flags (and design checks: one
-    per punch of several)."""
-    info = result.info
-    estimate = info.get("error_estimate")
-    several = isinstance(result, PunchesSolution)
-    contact = ", ".join(sorted({str(p.info.get("contact", "full")) for p in result.punches})) \
-        if several else info.get("contact", "full")
-    lines = [f"# coated-punch {VERSION}: {what}",
-             f"# scene: {_one_line(result.scene.name)}",
-             *provenance_lines(result.scene),
-             f"# answered: contact {contact}, coating model "
-             f"{info.get('coating_model', '')}, estimated relative error "
-             + (f"{float(estimate):.1e}" if isinstance(estimate, (int, float)) else "n/a")]
-    lines.append("# flags: " + (", ".join(result.flags) or "none"))
-    checks = [(f"punches[{k}] ", c) for k, c in enumerate(result.design_checks())] \
-        if several else [("", result.design_check())]
-    for who, check in checks:
-        if check is not None:
-            lines.append(f"# {who}design_check: {'pass' if check.passed else 'FAIL'}; "
-                         + "; ".join(line.describe() for line in check.checks))
-    return "\n".join(lines) + "\n"
-
-
 def _shipped_scene_or_study(path: str) -> str:
     """The file of ``preset:NAME``, a shipped scene or else a shipped study."""
     if not path.startswith(PRESET_PREFIX):
@@ -345,7 +326,10 @@ def _cmd_validate(args: argparse.Namespace) -> int:
             print(f"ok: study {checked.name!r}: {checked.n_points} points, "
                   f"{len(checked.parameters)} varied field(s)")
         else:
-            print(f"ok: {_describe(punches_from_dict(data) if has_punches(data) else scene_from_dict(data))}")  # noqa: E501
+            scene = punches_from_dict(data) if has_punches(data) else scene_from_dict(data)
+            if isinstance(scene, Scene):
+                check_loads_touch(scene)
+            print(f"ok: {_describe(scene)}")
     except ValueError as exc:
         raise _InputError(str(exc)) from None
     return EXIT_OK
@@ -413,11 +397,9 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     elif fmt == "json":
         _write(output, result.to_json() + "\n")
     else:
-        _write(output, _csv_head(result, "histories (python -m core solve)")
-               + result.to_csv())
+        _write(output, result.to_csv())
     if pressure_out is not None:
-        _write(pressure_out, _csv_head(result, "contact pressure q(x, t) (python -m core "
-                                               "solve)") + result.pressure_csv())
+        _write(pressure_out, result.pressure_csv())
     for name in result.flags:
         print(f"warning: {name}: {_one_line(result.flag_messages[name].replace('see info.message', result.info.get('message', '')))}", file=sys.stderr)  # noqa: E501
     check = result.design_check()
@@ -435,12 +417,9 @@ def _solved_punches(args: argparse.Namespace, result: PunchesSolution, output: P
     elif fmt == "json":
         _write(output, result.to_json() + "\n")
     else:
-        _write(output, _csv_head(result, "histories of every punch (python -m core solve)")
-               + result.to_csv())
+        _write(output, result.to_csv())
     if pressure_out is not None:
-        _write(pressure_out, _csv_head(result, "contact pressure q(x, t) over the surface, "
-                                               "x global (python -m core solve)")
-               + result.pressure_csv())
+        _write(pressure_out, result.pressure_csv())
     _punches_warnings(result)
     return _punches_strict(result) if args.strict else EXIT_OK
 

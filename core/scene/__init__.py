@@ -52,6 +52,7 @@ from core.scene.json_schema import (
     schema_errors,
     schema_text,
 )
+from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
 from core.scene.pipeline import solve
 from core.scene.plotting import (
@@ -69,6 +70,7 @@ from core.scene.punches import (
     punches_from_dict,
 )
 from core.scene.records import (
+    csv_header,
     provenance,
     provenance_lines,
     solver_settings,
@@ -79,6 +81,7 @@ from core.scene.results import (
     SceneSolution,
     plotting_grid,
     scene_model_error,
+    thick_coating,
 )
 from core.scene.schema import (
     MAX_SCENE_BYTES,
@@ -106,11 +109,13 @@ __all__ = [
     "lifts_off_at",
     "check_design",
     "check_fields",
+    "check_loads_touch",
     "check_scene",
     "checked_key",
     "flags_with_evidence",
     "model_error_evidence",
     "contact_width",
+    "csv_header",
     "creeps",
     "design_check",
     "elastic_at_loading",
@@ -152,6 +157,7 @@ __all__ = [
     "schema_errors",
     "schema_text",
     "scene_model_error",
+    "thick_coating",
     "SceneSolution",
     "shown_times",
     "solve",

@@ -57,6 +57,20 @@ def contact_width(contact_set: ContactSet, half_width: float) -> np.ndarray:
     return widths
 
 
+def narrowest_zone(contact_set: ContactSet, half_width: float) -> float | None:
+    """The length [m] of the narrowest contact zone over all times, None in full contact
+    at every time (a zone of the whole width ``2a`` less the rounding share
+    :data:`LIFT_OFF_SHARE` counts as full contact).
+
+    The thin-coating model is a good model where the coating is thin against the zone
+    it presses (:func:`core.coating.model_error_map` reads its error at this length)."""
+    a = float(half_width)
+    lengths = [min(float(hi), a) - max(float(lo), -a) for zones in contact_set
+               for lo, hi in zones]
+    narrowest = min(lengths, default=2.0 * a)
+    return None if narrowest >= (1.0 - LIFT_OFF_SHARE) * 2.0 * a else max(narrowest, 0.0)
+
+
 def lift_off_length(contact_set: ContactSet, half_width: float) -> np.ndarray:
     """The length of the base lifted off [m] at each time: ``2a`` less the
     :func:`contact_width` (0 in full contact)."""

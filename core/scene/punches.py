@@ -41,6 +41,7 @@ from core.scene import punches_output, schema
 from core.scene.contact_zone import contact_width, lift_off_length
 from core.scene.design import DesignCheck, DesignLimits
 from core.scene.model import Scene
+from core.scene.records import csv_header
 from core.scene.results import SceneSolution
 from core.validation import bounded_list, finite_number
 
@@ -338,11 +339,13 @@ class PunchesSolution:
         """:meth:`to_dict` as compact JSON text."""
         return json.dumps(self.to_dict(), separators=(",", ":"), allow_nan=False)
 
-    def to_csv(self) -> str:
+    def to_csv(self, header: bool = True) -> str:
         """The histories of every punch as CSV: ``time_day``, then ``punches[k].settlement_m``,
         ``punches[k].tilt_rad``, ``punches[k].force_N_per_m``, ``punches[k].moment_N`` for
-        each punch in order (:func:`core.scene.punches_output.histories_csv`)."""
-        return punches_output.histories_csv(self)
+        each punch in order (:func:`core.scene.punches_output.histories_csv`); ``header``:
+        start with the ``#`` lines of :func:`core.scene.csv_header`."""
+        table = punches_output.histories_csv(self)
+        return csv_header(self, "histories of every punch") + table if header else table
 
     def pressure(self, x: Any) -> np.ndarray:
         """Contact pressure q [Pa] at points ``x`` [m] of the global x, shape (len(x),
@@ -360,11 +363,15 @@ class PunchesSolution:
         """q [Pa] at :attr:`x`, shape (len(x), len(times))."""
         return punches_output.surface_pressure_on_grid(self)
 
-    def pressure_csv(self, x: Any = None) -> str:
+    def pressure_csv(self, x: Any = None, header: bool = True) -> str:
         """q(x, t) over the whole surface as CSV in long form: ``time_day``, ``x_m`` (the
         global x), ``pressure_Pa``; by default on :attr:`x` (rows on the contact zones
-        only: q = 0 between the punches), else at the points ``x`` [m]."""
-        return punches_output.pressure_csv(self, x)
+        only: q = 0 between the punches), else at the points ``x`` [m]; ``header`` as
+        :meth:`to_csv`."""
+        table = punches_output.pressure_csv(self, x)
+        if not header:
+            return table
+        return csv_header(self, "contact pressure q(x, t) over the surface, x global") + table
 
     def design_checks(self, limits: DesignLimits | None = None) -> list[DesignCheck | None]:
         """The design check of every punch, in order, over the whole history against

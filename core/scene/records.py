@@ -56,3 +56,30 @@ def provenance_lines(scene: Scene | PunchesScene | Mapping[str, Any]) -> list[st
     return [f"# version: {VERSION}",
             f"# scene_json: {json.dumps(scene.to_dict(), **compact)}",
             f"# solver: {json.dumps(solver_settings(scene), **compact)}"]
+
+
+def csv_header(result: Any, what: str) -> str:
+    """The ``#`` lines before a CSV table of ``result`` (a ``SceneSolution`` or a
+    ``PunchesSolution``): what it is (``what``), the version, the scene, the solver
+    settings, the answer's contact and coating models, its estimated error, its flags and,
+    with limits, its design check (one per punch of several)."""
+    info = result.info
+    estimate = info.get("error_estimate")
+    several = hasattr(result, "punches")
+    contact = ", ".join(sorted({str(p.info.get("contact", "full")) for p in result.punches})) \
+        if several else info.get("contact", "full")
+    name = " ".join(str(result.scene.name).split())
+    lines = [f"# {PROGRAM} {VERSION}: {what}",
+             f"# scene: {name}",
+             *provenance_lines(result.scene),
+             f"# answered: contact {contact}, coating model "
+             f"{info.get('coating_model', '')}, estimated relative error "
+             + (f"{float(estimate):.1e}" if isinstance(estimate, (int, float)) else "n/a")]
+    lines.append("# flags: " + (", ".join(result.flags) or "none"))
+    checks = [(f"punches[{k}] ", c) for k, c in enumerate(result.design_checks())] \
+        if several else [("", result.design_check())]
+    for who, check in checks:
+        if check is not None:
+            lines.append(f"# {who}design_check: {'pass' if check.passed else 'FAIL'}; "
+                         + "; ".join(line.describe() for line in check.checks))
+    return "\n".join(lines) + "\n"

@@ -19,14 +19,14 @@ from core import limits
 from core.cache import StageCache, fingerprint
 from core.coating import model_error_estimate, model_error_map, tilt_share
 from core.problem import QUANTITIES
-from core.scene.contact_zone import contact_width, lift_off_length
+from core.scene.contact_zone import contact_width, lift_off_length, narrowest_zone
 from core.scene.design import DesignCheck, DesignLimits, design_check
 from core.scene.display import HISTORIES, answered_settings, html_summary, text_summary
 from core.scene.display import to_dataframe as _to_dataframe
 from core.scene.display import to_xarray as _to_xarray
 from core.scene.load_rates import oscillations
 from core.scene.model import Scene
-from core.scene.records import PROGRAM
+from core.scene.records import PROGRAM, csv_header
 from core.scene.schema import SCHEMA_VERSION, _jsonable
 from core.version import VERSION
 
@@ -39,7 +39,8 @@ if TYPE_CHECKING:
     from core.problem import ContactSolution
     from core.scene.dimensionless import DimensionlessProblem
 
-#: The thin-coating model is doubtful where sum h_k reaches this fraction of 2a.
+#: The thin-coating model is doubtful where sum h_k reaches this fraction of 2a (or of
+#: the narrowest contact zone of a punch that lifts off).
 THICK_COATING_RATIO = 0.1
 #: Tilts beyond this many radians are not small.
 LARGE_TILT = 0.01
@@ -50,7 +51,8 @@ PLOT_POINTS = 201
 FLAG_MESSAGES: dict[str, str] = {
     "contact_lost": "The computed pressure is negative somewhere: part of the punch base "
                     "lifts off, so this full-contact answer is not physical.",
-    "thick_coating": f"The coating is {THICK_COATING_RATIO:g} of the punch width or thicker "
+    "thick_coating": f"The coating is {THICK_COATING_RATIO:g} of the punch width (or of "
+                     "the narrowest contact zone, where the punch lifts off) or thicker "
                      "somewhere: the thin (Winkler) coating model is doubtful.",
     "stiff_coating": "A coating layer is stiffer than the base at loading somewhere: the "
                      "thin-coating model assumes soft coatings.",
@@ -92,17 +94,33 @@ def plotting_grid(half_width: float, count: int = PLOT_POINTS) -> np.ndarray:
 _MODEL_ERROR_MAPS = StageCache("scene_model_error_map", max_items=128, max_bytes=2**20)
 
 
-def scene_model_error(scene: Scene, share_of_tilt: float) -> dict[str, Any]:
+def scene_model_error(scene: Scene, share_of_tilt: float,
+                      zone: float | None = None) -> dict[str, Any]:
     """:func:`core.coating.model_error_estimate` of ``scene``, its map remembered.
 
-    The map is read on the geometry, the base modulus at loading and the base thickness
-    (:func:`core.coating.model_error_map`); the answer enters only through the
-    share of tilt, which weighs the moment part.
+    The map is read on the geometry, the base modulus at loading, the base thickness and
+    the narrowest contact zone ``zone`` [m] of an answer that lifts off (None in full
+    contact; :func:`core.coating.model_error_map`); the answer enters through the share
+    of tilt, which weighs the moment part, and that zone. The returned dict also holds
+    ``"zone_m"``, the zone the map was read at (None: the punch width).
     """
-    key = fingerprint("model_error_map", scene._geometry_key, scene.modulus_at_loading(),
-                      scene.base_thickness)
-    mapped, _ = _MODEL_ERROR_MAPS.get_or_compute(key, lambda: _read_only(model_error_map(scene)))
-    return model_error_estimate(scene, share_of_tilt, mapped)
+    if zone is None:
+        key = fingerprint("model_error_map", scene._geometry_key, scene.modulus_at_loading(),
+                          scene.base_thickness)
+        mapped, _ = _MODEL_ERROR_MAPS.get_or_compute(
+            key, lambda: _read_only(model_error_map(scene)))
+    else:
+        # read for this answer's zone (~0.3 ms a layer): a load change moves the zone, and
+        # the geometry's stages stay as they were
+        mapped = model_error_map(scene, zone)
+    return {**model_error_estimate(scene, share_of_tilt, mapped), "zone_m": zone}
+
+
+def thick_coating(scene: Scene, zone: float | None = None) -> bool:
+    """Whether the coating reaches :data:`THICK_COATING_RATIO` of the punch width, or of
+    the narrowest contact zone ``zone`` [m] of an answer that lifts off."""
+    width = 2 * scene.half_width if zone is None else zone
+    return scene.sample_extremes["coating_thickness_max_m"] >= THICK_COATING_RATIO * width
 
 
 def _read_only(mapped: tuple[np.ndarray, dict[str, np.ndarray]]
@@ -146,7 +164,8 @@ class SceneSolution:
         # the exact layered kernel (core.engines.layered.answer) carries its own estimate
         layered = solution.info.get("layered_model_error")
         self.model_error = dict(layered) if layered else scene_model_error(
-            scene, tilt_share(a, self.settlement, self.tilt))
+            scene, tilt_share(a, self.settlement, self.tilt),
+            narrowest_zone(self.contact_set, a))
         self.flags = self._flags(solution)
         self.flag_messages = {
             name: FLAG_MESSAGES.get(name, f"{name}: {solution.info.get('message', '')}")
@@ -163,8 +182,8 @@ class SceneSolution:
         flags = [str(f) for f in solution.info.get("flags", [])]
         thin = solution.info.get("coating_model") != "exact layered"
         # the extremes on the scene's samples, shared by scenes of the same geometry
-        if thin and scene.sample_extremes["coating_thickness_max_m"] / (2 * scene.half_width) \
-                >= THICK_COATING_RATIO:
+        # against the narrowest contact zone where the punch lifts off
+        if thin and thick_coating(scene, self.model_error.get("zone_m")):
             flags.append("thick_coating")
         if self.model_error["estimate"] > scene.model_tol:
             flags.append("model_error")
@@ -307,24 +326,30 @@ class SceneSolution:
         """:meth:`to_dict` as compact JSON text."""
         return json.dumps(self.to_dict(), separators=(",", ":"), allow_nan=False)
 
-    def to_csv(self) -> str:
+    def to_csv(self, header: bool = True) -> str:
         """The histories as CSV: time [day], settlement [m], tilt [rad], force [N/m], moment [N].
 
         When the unilateral contact model answered, the contact set follows: the contact
         length [m] and the ends of each zone [m] (``zone1_start_m, zone1_end_m, ...``,
-        ``nan`` where a time has fewer zones).
+        ``nan`` where a time has fewer zones). ``header``: start with the ``#`` lines the
+        command line writes (:func:`core.scene.csv_header`: version, scene, solver
+        settings, error estimate, flags, design check); ``pandas.read_csv(text,
+        comment="#")`` reads the table.
         """
         names, columns = history_columns(self)
-        lines = ["time_day," + ",".join(names)]
+        lines = [csv_header(self, "histories").rstrip("\n")] if header else []
+        lines.append("time_day," + ",".join(names))
         lines.extend(",".join(repr(float(v)) for v in (t, *row))
                      for t, row in zip(self.times, zip(*columns, strict=True), strict=True))
         return "\n".join(lines) + "\n"
 
-    def pressure_csv(self, x: Any = None) -> str:
-        """q(x, t) as CSV in long form: time [day], x [m], pressure [Pa] (default x: ``.x``)."""
+    def pressure_csv(self, x: Any = None, header: bool = True) -> str:
+        """q(x, t) as CSV in long form: time [day], x [m], pressure [Pa] (default x: ``.x``);
+        ``header`` as :meth:`to_csv`."""
         xs = self.x if x is None else np.atleast_1d(np.asarray(x, dtype=float))
         q = self.pressure_on_grid if x is None else self.pressure(xs)
-        lines = ["time_day,x_m,pressure_Pa"]
+        lines = [csv_header(self, "contact pressure q(x, t)").rstrip("\n")] if header else []
+        lines.append("time_day,x_m,pressure_Pa")
         for j, t in enumerate(self.times):
             tt = repr(float(t))
             lines.extend(f"{tt},{float(xi)!r},{float(qi)!r}" for xi, qi in zip(xs, q[:, j],

@@ -44,7 +44,14 @@ from core.contact import (
     zone_panels,
 )
 from core.discretize import kernel_operator, operator_rows
-from core.scene import LARGE_TILT, Scene, contact_width, plotting_grid, scene_model_error
+from core.scene import (
+    LARGE_TILT,
+    Scene,
+    contact_width,
+    plotting_grid,
+    scene_model_error,
+    thick_coating,
+)
 from core.study.outputs import point_outputs
 
 __all__ = ["FAMILY_MIN_ECCENTRICITIES", "LiftoffAnswer", "liftoff_family"]
@@ -204,9 +211,10 @@ def liftoff_family(scene: Scene, eccentricities: np.ndarray, forces: np.ndarray,
     :func:`core.scene.solve` answered with lift-off, whose zone ends ``ends`` [-] are
     the free ends at the smallest and the largest ``|e|``) under the forces ``forces``
     [N/m] (one point per eccentricity), for ``outputs`` of
-    :data:`core.study.definition.OUTPUT_UNITS`. ``flags`` are the geometry's flags of those two
-    answers (the contact-model ones and ``large_tilt``/``model_error`` excluded: they are
-    decided per point here). Requires :func:`core.study.answers_scale_with_loads`
+    :data:`core.study.definition.OUTPUT_UNITS`. ``flags`` are the geometry's flags of those
+    two answers (the contact-model ones and ``large_tilt``, ``model_error`` and
+    ``thick_coating`` excluded: they are decided per point here, the last two on its
+    zone). Requires :func:`core.study.answers_scale_with_loads`
     and a modulus constant over the scene's times.
 
     Returns one :class:`LiftoffAnswer` per eccentricity, None where the estimate misses
@@ -333,7 +341,12 @@ def _answer(scene: Scene, point: tuple[np.ndarray, SimpleNamespace], force: floa
     a = scene.half_width
     point_flags = list(flags)
     share = tilt_share(a, result.settlement, result.tilt)
-    if scene_model_error(scene, share)["estimate"] > scene.model_tol:
+    # the coating's model is read against this point's zone (one zone, the same at every
+    # time), as core.scene.SceneSolution reads it
+    zone = float(result.contact_width[0])
+    if thick_coating(scene, zone):
+        point_flags.append("thick_coating")
+    if scene_model_error(scene, share, zone)["estimate"] > scene.model_tol:
         point_flags.append("model_error")
     largest = float(np.max(np.abs(result.tilt)))
     if largest > LARGE_TILT:
@@ -349,7 +362,7 @@ def family_flags(result_flags: Sequence[str]) -> list[str] | None:
     missed its tolerance or its check (the family is then not built)."""
     if {"tol_not_met", "contact_set_unverified", "contact_lost"} & set(result_flags):
         return None
-    return [f for f in result_flags if f not in ("model_error", "large_tilt")]
+    return [f for f in result_flags if f not in ("model_error", "large_tilt", "thick_coating")]
 
 
 def family_applies(scene: Scene) -> bool:

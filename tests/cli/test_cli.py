@@ -233,3 +233,16 @@ def test_cli_never_prints_a_traceback(monkeypatch, capsys) -> None:
     assert cli_main(["solve", "whatever.json"]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("error: internal error (TypeError: "), err
+
+
+@pytest.mark.parametrize("loading, field", [
+    ({"force": -5e5, "moment": 0.0}, "loading.force"),  # the punch is pulled away
+    ({"force": 5e5, "moment": 6e5}, "loading.moment"),  # the resultant outside the punch
+])
+@pytest.mark.parametrize("command", ["validate", "solve"])
+def test_a_load_no_contact_carries_is_the_users_input(tmp_path, command, loading, field):
+    # SCENES.md: refused naming the field, exit code 2 (it was accepted by validate, and
+    # solve exited 1 as if the solver had failed)
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(edited("loading", loading, scene_dict())))
+    assert_one_line_error(run(command, path), field)

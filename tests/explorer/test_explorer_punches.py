@@ -151,10 +151,14 @@ def test_the_page_shows_each_punch_and_turns_off_what_is_for_one(explorer_app) -
     assert [p["center"] for p in saved["punches"]] == [0.0, 3.0]
     # so are the CSV files and the reports: a column, a zone, a section per punch
     files = app.files_tab
-    histories = asyncio.run(files._csv_file()).getvalue().splitlines()
+    text = asyncio.run(files._csv_file()).getvalue()
+    # the lines of the command line's CSV first: version, scene, settings, flags
+    assert "\n# flags: " in text and "\n# scene_json: " in text
+    histories = [line for line in text.splitlines() if not line.startswith("#")]
     assert histories[0].startswith("time_day,punches[0].settlement_m,")
     assert "punches[1].settlement_m" in histories[0] and len(histories) == 201
-    pressure = asyncio.run(files._pressure_file()).getvalue().splitlines()
+    pressure = [line for line in asyncio.run(files._pressure_file()).getvalue().splitlines()
+                if not line.startswith("#")]
     assert pressure[0] == "time_day,x_m,pressure_Pa"
     xs = {float(line.split(",")[1]) for line in pressure[1:2000]}
     assert min(xs) == -1.0 and max(xs) == 4.0  # both zones, in the global x

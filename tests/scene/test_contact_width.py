@@ -68,7 +68,7 @@ def test_every_output_of_the_answer_gives_that_width(lift_off: SceneSolution) ->
     widths = lift_off.contact_width
     np.testing.assert_array_equal(lift_off.to_xarray().contact_width.values, widths)
     np.testing.assert_array_equal(lift_off.to_dataframe()["contact_width"].to_numpy(), widths)
-    lines = lift_off.to_csv().splitlines()
+    lines = lift_off.to_csv(header=False).splitlines()
     column = lines[0].split(",").index("contact_length_m")
     np.testing.assert_array_equal([float(line.split(",")[column]) for line in lines[1:]],
                                   widths)
@@ -103,3 +103,12 @@ def test_a_contact_shrinking_to_a_point_is_never_a_success() -> None:
     assert result.info["success"] is False
     assert "shrinks to a point" in result.info["unilateral_refused"]
     assert "unilateral contact refused" in result.info["message"]
+
+
+def test_the_narrowest_zone_is_over_every_zone_and_time() -> None:
+    from core.scene.contact_zone import narrowest_zone
+
+    assert narrowest_zone([[(-1.0, 1.0)], [(-1.0, 1.0)]], 1.0) is None
+    assert narrowest_zone([[(-1.0, 1.0)], [(-0.5, 1.0)], [(-1.0, -0.8), (0.2, 1.0)]],
+                          1.0) == pytest.approx(0.2)
+    assert narrowest_zone([[(-1.0, 1.0 - 1e-12)]], 1.0) is None  # rounding: full contact

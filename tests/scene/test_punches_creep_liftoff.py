@@ -145,7 +145,10 @@ def test_a_close_pair_lifting_off_under_creep_converges() -> None:
     reference = core.solve(_lifting_pair(0.2, 1e-8, count=10))
     for tol in (1e-4, 1e-6):
         result = core.solve(_lifting_pair(0.2, tol, count=10))
-        assert result.info["success"] and not result.flags
+        # the right punch's zone (0.83 m of 1.2 m) puts its coating model's estimate at
+        # 2.7 %: that punch alone, elastic at loading, measured 2.25 % (FE check with
+        # lift-off) against model_tol 2 %, so the flag is right; the solve's own are none
+        assert result.info["success"] and result.flags == ["punches[1].model_error"]
         for mine, best in zip(result.punches, reference.punches, strict=True):
             errors = _errors(mine, best)
             estimate = mine.info["error_estimate"]

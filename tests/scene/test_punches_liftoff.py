@@ -67,11 +67,16 @@ def _errors(mine: Any, best: Any) -> dict[str, float]:
 def test_far_apart_punches_lift_off_as_single_punches(second: dict[str, float]) -> None:
     d = _pair(60.0, loads=(LIFTING, second))  # 15 base thicknesses apart
     result = core.solve(d)
-    assert not result.flags and result.info["success"]
+    # the solver's flags none; the right punch's zone under (3e5 N/m, -1e5 N) puts its
+    # coating model's estimate over model_tol (alone, measured by the FE check with
+    # lift-off: 2.25 % against 2 %), as that punch alone says
+    assert result.info["success"]
+    assert set(result.flags) <= {"punches[1].model_error"}
     for k, punch in enumerate(result.punches):
         assert punch.info["contact"] == "unilateral"
         assert "contact_lost" in punch.info["full_contact"]["flags"] or k == 1
         alone = _single(d, k)  # lift-off or full contact, as the single punch decides
+        assert punch.flags == alone.flags
         shifted = copy.copy(alone)
         shifted.contact_set = [[(punch.center + lo, punch.center + hi) for lo, hi in zones]
                                for zones in alone.contact_set]

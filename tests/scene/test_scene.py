@@ -486,12 +486,20 @@ def test_solution_dict_is_json():
     assert back["flags"] == []
     assert back["units"]["pressure"].startswith("Pa")
     assert back["info"]["dimensional"]["lam"] == 0.25
-    lines = result.to_csv().splitlines()
+    lines = result.to_csv(header=False).splitlines()
     assert lines[0] == "time_day,settlement_m,tilt_rad,force_N_per_m,moment_N"
     assert len(lines) == 4
     assert float(lines[1].split(",")[1]) == result.settlement[0]
-    plines = result.pressure_csv().splitlines()
+    plines = result.pressure_csv(header=False).splitlines()
     assert plines[0] == "time_day,x_m,pressure_Pa" and len(plines) == 1 + 3 * 201
+    # by default the table follows the lines the command line writes: what, the scene,
+    # the settings, the accuracy and the flags (as SCENES.md says of a CSV file)
+    for text, table in ((result.to_csv(), lines), (result.pressure_csv(), plines)):
+        head = text.splitlines()[:-len(table)]
+        assert all(line.startswith("# ") for line in head)
+        assert text.endswith("\n".join(table) + "\n")
+        assert {line.split(":")[0] for line in head} >= {
+            "# version", "# scene_json", "# solver", "# answered", "# flags"}
 
 
 # ---------------------------------------------------------------------------- validation
