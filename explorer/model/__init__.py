@@ -89,7 +89,13 @@ from .study import (
     study_outputs,
 )
 from .time_text import days_text, plain_number
-from .view_link import read_fit_query, read_study_query, read_view_query, view_query
+from .view_link import (
+    read_fit_query,
+    read_study_query,
+    read_view_query,
+    study_settings,
+    view_query,
+)
 
 __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
            "MAX_DESCRIPTION_CHARS", "MAX_FIT_FIELDS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS",
@@ -108,4 +114,4 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "readings_note", "run_fit", "prepare_view", "preset_label", "presets",
            "read_fit_query", "read_study_query", "read_view_query", "shown_flags", "scene_limits",
            "scene_with_limits", "screen_limits", "step_scene", "study_choices", "study_outputs",
-           "validated_scene", "view_query"]
+           "study_settings", "validated_scene", "view_query"]

@@ -9,7 +9,7 @@ from typing import Any
 
 import panel as pn
 
-from ..model import Screen, view_query
+from ..model import Screen, study_settings, view_query
 from ..solving import SolveController
 from .loop import PageLoop
 
@@ -36,6 +36,7 @@ class AddressLink:
         self.view_parts = view_parts
         self._due = False
         self.linked = ""
+        self._study: dict[str, Any] | None = None  # the last good Study settings
         # The address bar is written by the page itself when this hidden box changes:
         # Panel's location model delayed an update until the next one (its push waits
         # for the document's first idle signal, which a replaced view never sees).
@@ -57,6 +58,14 @@ class AddressLink:
             return  # a newer result is coming, and will ask again
         try:
             tab, pins, study, fit = self.view_parts()
+            if study is not None:
+                try:
+                    study_settings(study)
+                    self._study = study
+                except ValueError:
+                    # a study setting being typed (points 1000, an empty box): the Study
+                    # tab names it; the link keeps the last good settings and the scene
+                    study = self._study
             query = view_query(view.scene, self.screen.time_index, tab, pins, study, fit)
             # the whole query at once: the values are URL-safe already (base64url, digits)
             link = "?" + "&".join(f"{k}={v}" for k, v in query.items() if v)

@@ -19,6 +19,11 @@ from .loop import PageLoop
 from .style import html_pane
 from .widgets import NAMES
 
+#: How the notices of "Pin the steps" begin: steps refused as asked, a step refused by
+#: the solver (both cleared once steps are pinned as asked).
+STEPS_REFUSED = "Steps not pinned"
+STEP_REFUSED = "A step was not pinned"
+
 
 class PinsView:
     """Results kept on the plots for comparison, each named after what differs."""
@@ -52,10 +57,13 @@ class PinsView:
         number = {"width": 62, "margin": (0, 3)}
         self.step_count = pn.widgets.IntInput(label="steps", value=5, start=2, end=MAX_PINS,
                                               css_classes=["pin-steps-count"], **number)
-        self.step_from = pn.widgets.FloatInput(label="from", css_classes=["pin-steps-from"],
-                                               **number)
-        self.step_to = pn.widgets.FloatInput(label="to", css_classes=["pin-steps-to"],
-                                             **number)
+        # empty until the first result fills them around its load (a box that starts at
+        # 0 would step from 0 to 0)
+        self.step_from = pn.widgets.FloatInput(label="from", value=None,
+                                               css_classes=["pin-steps-from"], **number)
+        self.step_to = pn.widgets.FloatInput(label="to", value=None,
+                                             css_classes=["pin-steps-to"], **number)
+        self._stepped: str | None = None  # the load the boxes were filled for
         self.steps_button = pn.widgets.Button(label="Pin the steps", color="default",
                                               css_classes=["pin-steps-button"])
         self.steps_button.on_click(lambda e: self._on_steps())
@@ -115,17 +123,22 @@ class PinsView:
                 f"[{QUANTITY_UNITS[quantity][0]}]:</span>")
         if self.steps_label.object != text:
             self.steps_label.object = text
-        if self.step_from.value is None and self.step_to.value is None:
-            # around the value on screen, to start from
+        if self._stepped != quantity or (self.step_from.value is None
+                                         and self.step_to.value is None):
+            # around the value on screen, to start from (again when another load is
+            # stepped: the boxes held the last one's values, in its units)
+            self._stepped = quantity
             value = float(self.state.loading.histories[quantity].value)
             self.step_from.value, self.step_to.value = (0.5 * value, 1.5 * value) if value \
                 else (0.0, 1.0)
 
     def _on_steps(self) -> None:
+        if self.screen.notice.startswith((STEPS_REFUSED, STEP_REFUSED)):
+            self.screen.notice = ""  # the last steps' message goes with the new steps
         try:
             self.pin_steps(self.step_count.value, self.step_from.value, self.step_to.value)
         except ValueError as exc:
-            self.screen.notice = f"Steps not pinned: {exc}"
+            self.screen.notice = f"{STEPS_REFUSED}: {exc}"
 
     def pin_steps(self, count: int | None, start: float | None, end: float | None) -> None:
         """Replace the pins by ``count`` results whose stepped load (see
@@ -154,7 +167,7 @@ class PinsView:
             history.value = float(value)
             scenes.append(state.to_scene())
         self.board.clear()
-        self.solve_from_link(scenes, what="A step was not pinned")
+        self.solve_from_link(scenes, what=STEP_REFUSED)
 
     # -- pins of a link ----------------------------------------------------------------
     def solve_from_link(self, scenes: list[dict[str, Any]],
@@ -174,10 +187,16 @@ class PinsView:
             controller = SolveController(state, executor=self.controller.executor,
                                          dispatch=self.loop.dispatch, auto=False)
             controller.param.watch(lambda e, slot=slot: self._arrived(slot, e.new), "view")
-            controller.param.watch(lambda e, slot=slot: e.new and self._arrived(slot, None),
-                                   "error")
+            controller.param.watch(
+                lambda e, slot=slot: e.new and self._refused(slot, what, e.new), "error")
             self._controllers.append(controller)
             controller.request()
+
+    def _refused(self, slot: int, what: str, error: str) -> None:
+        """A pinned scene the solver refused (a step that pulls the punch off): named in a
+        notice, the others pinned."""
+        self.screen.notice = f"{what} (step {slot + 1}): {format_error(str(error))}"
+        self._arrived(slot, None)
 
     def _arrived(self, slot: int, view: ResultView | None) -> None:
         if slot in self._pending:

@@ -117,3 +117,28 @@ def test_a_study_runs_draws_its_chart_and_a_second_is_cancelled(page: Page):
     until(lambda: len(page.page.evaluate(JS_STUDY_VALUES) or []) == 4,
           "the heat map of 2 x 2", 240, lambda: status(page))
     assert page.errors == []
+
+
+def test_the_link_follows_the_scene_while_a_study_setting_is_bad(page: Page):
+    """A Study value out of range (1000 points) is named by the tab; the page's address
+    keeps following the scene on screen, with the last good study settings (it stopped
+    updating: every later change was lost on a reload)."""
+    from urllib.parse import parse_qsl, urlsplit
+
+    from explorer.model import decode_scene
+
+    def linked() -> tuple[float | None, int | None]:
+        query = dict(parse_qsl(urlsplit(page.page.evaluate("() => location.href")).query))
+        force = decode_scene(query["scene"])["loading"]["force"] if "scene" in query else None
+        study = decode_scene(query["study"]) if query.get("study") else None
+        return force, None if study is None else study["axes"][0][3]
+
+    page.open_tab("Study")
+    page.type_into(".study-p1-count", "5")
+    until(lambda: linked()[1] == 5, "5 points in the link", describe=linked)
+    page.type_into(".study-p1-count", "1000")
+    page.open_tab("Scene")
+    page.type_into(".load-0-value", "640")
+    until(lambda: linked() == (640e3, 5), "the new force and the last good study in the link",
+          describe=linked)
+    assert page.errors == []

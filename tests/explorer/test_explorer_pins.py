@@ -118,3 +118,25 @@ def test_pin_the_steps_of_a_load_over_a_range(explorer_app) -> None:
     pins.step_from.value, pins.step_to.value = 100.0, 100.0
     pins.steps_button.clicks += 1
     assert app.screen.notice.startswith("Steps not pinned: from and to")
+
+
+def test_the_steps_start_around_the_load_on_screen_and_say_what_they_refused(
+        explorer_app) -> None:
+    app = explorer_app()
+    pins = app.pins
+    # filled around the force on screen (500 kN/m), not 0 to 0
+    assert (pins.step_from.value, pins.step_to.value) == (250.0, 750.0)
+    pins.step_from.value = pins.step_to.value = 100.0
+    pins.steps_button.clicks += 1
+    assert app.screen.notice.startswith("Steps not pinned: from and to")
+    # steps that pull the punch off are named, the others pinned
+    pins.step_count.value = 3
+    pins.step_from.value, pins.step_to.value = -200.0, 600.0
+    pins.steps_button.clicks += 1
+    assert [pin.label for pin in pins.board] == ["P = 200 kN/m", "P = 600 kN/m"]
+    notice = app.screen.notice
+    assert notice.startswith("A step was not pinned (step 1): ") and "loading.force" in notice
+    # good steps clear the message
+    pins.step_from.value = 300.0
+    pins.steps_button.clicks += 1
+    assert len(pins.board) == 3 and app.screen.notice == ""
