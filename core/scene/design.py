@@ -84,21 +84,50 @@ class LimitCheck:
     time: float
     x: float | None = None
     limit: float | None = None
+    #: [m] for a pressure unbounded at the punch corner ``x`` (a rigid corner in contact
+    #: on an elastic body: q ~ 1 / sqrt(distance)): the distance from the corner where
+    #: ``value`` is read (None: the value is the largest)
+    corner_distance: float | None = None
+    #: whether q ~ K / sqrt(distance) holds from ``corner_distance`` to the corner (so
+    #: that :attr:`exceeded_within` can be read from it)
+    asymptotic: bool = False
+
+    @property
+    def unbounded(self) -> bool:
+        """Whether the quantity has no largest value: the pressure at a rigid corner."""
+        return self.corner_distance is not None
+
+    @property
+    def exceeded_within(self) -> float | None:
+        """For an unbounded pressure with a limit: the distance [m] from the corner within
+        which q exceeds it, from q ~ K / sqrt(distance) through ``value`` at
+        ``corner_distance`` (the corner's asymptote; None otherwise)."""
+        if not self.unbounded or self.limit is None or not self.asymptotic:
+            return None
+        if self.limit <= 0:
+            return math.inf
+        return float(self.corner_distance) * (abs(self.value) / self.limit) ** 2
 
     @property
     def utilisation(self) -> float | None:
-        """``|value| / limit`` [-] (above 1: the limit is exceeded); None without a limit."""
+        """``|value| / limit`` [-] (above 1: the limit is exceeded); None without a limit,
+        infinite for an unbounded pressure."""
         if self.limit is None:
             return None
+        if self.unbounded:
+            return math.inf
         if self.limit == 0:
             return 0.0 if self.value == 0 else math.inf
         return abs(self.value) / self.limit
 
     @property
     def passed(self) -> bool | None:
-        """Whether ``|value| <= limit``; None without a limit."""
+        """Whether ``|value| <= limit``; None without a limit. An unbounded pressure
+        exceeds every limit near its corner: never passed."""
         if self.limit is None:
             return None
+        if self.unbounded:
+            return False
         return bool(abs(self.value) <= self.limit)
 
     def to_dict(self) -> dict[str, Any]:
@@ -106,10 +135,14 @@ class LimitCheck:
         def plain(v: float | None) -> float | None:
             return None if v is None or not math.isfinite(v) else float(v)
 
-        return {"quantity": self.quantity, "limit_name": self.limit_name,
-                "label": self.label, "unit": self.unit, "value": plain(self.value),
-                "limit": plain(self.limit), "utilisation": plain(self.utilisation),
-                "passed": self.passed, "time_day": plain(self.time), "x_m": plain(self.x)}
+        out = {"quantity": self.quantity, "limit_name": self.limit_name,
+               "label": self.label, "unit": self.unit, "value": plain(self.value),
+               "limit": plain(self.limit), "utilisation": plain(self.utilisation),
+               "passed": self.passed, "time_day": plain(self.time), "x_m": plain(self.x)}
+        if self.unbounded:
+            out.update(unbounded=True, corner_distance_m=plain(self.corner_distance),
+                       exceeded_within_m=plain(self.exceeded_within))
+        return out
 
     def describe(self) -> str:
         """One line for a terminal: the label, then :meth:`verdict_text`."""
@@ -129,6 +162,19 @@ class LimitCheck:
         where = f"t = {number(self.time)} {day}" + ("" if self.x is None else
                                                      f", x = {number(self.x)} m")
         text = f"{shown(self.value, self.unit)} at {where}"
+        if self.unbounded:
+            distance = float(self.corner_distance)
+            text = (f"unbounded at the corner x = {number(self.x)} m (a rigid corner: q ~ "
+                    f"1/sqrt(distance)); {shown(self.value, self.unit)} at "
+                    f"{number(1e3 * distance)} mm from it, t = {number(self.time)} {day}")
+            if self.limit is None:
+                return text + "; no limit set"
+            within = self.exceeded_within
+            if within is None:  # not resolved closer to the corner (under a coating)
+                return f"{text}; limit {shown(self.limit, self.unit)}, exceeded at the corner: FAIL"
+            # the corner's asymptote read at the distance where q is held: an estimate
+            return (f"{text}; limit {shown(self.limit, self.unit)}, exceeded within ~"
+                    f"{1e3 * within:.2g} mm of the corner: FAIL")
         if self.limit is None:
             return text + "; no limit set"
         verdict = "pass" if self.passed else "FAIL"
@@ -171,7 +217,8 @@ class DesignCheck:
 
 
 def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
-                 limits: DesignLimits | None = None) -> DesignCheck:
+                 limits: DesignLimits | None = None,
+                 corners: Mapping[str, Any] | None = None) -> DesignCheck:
     """The design check of an answer given as arrays.
 
     Parameters
@@ -186,6 +233,13 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
         Settlement delta [m] and tilt alpha [rad] at ``times``.
     limits : DesignLimits, optional
         The limits (default: none set; the extremes are still found).
+    corners : mapping, optional
+        Where the pressure is unbounded (``info["corner_pressure"]`` of an answer that
+        carries the rigid corner's singularity: ``"corners_m"``, the corners [m] in
+        contact, ``"held_within_m"``, the distance [m] from a corner within which
+        ``pressure`` holds its value there, and ``"asymptotic"``, whether q ~ 1/sqrt
+        (distance) holds from there on). The largest pressure is then the corner's:
+        reported at that distance, never passed against a limit.
 
     Returns
     -------
@@ -205,8 +259,9 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
     for name, quantity, unit, label in CHECKS:
         limit = getattr(limits, name)
         if quantity == "q_max":
-            lines.append(LimitCheck(name, quantity, label, float(q[i_max]), unit,
-                                    float(times[i_max[1]]), float(x[i_max[0]]), limit))
+            lines.append(_corner_line(name, label, unit, times, x, q, limit, corners)
+                         or LimitCheck(name, quantity, label, float(q[i_max]), unit,
+                                       float(times[i_max[1]]), float(x[i_max[0]]), limit))
             continue
         values = histories[quantity]
         k = int(np.nanargmax(np.abs(values)))
@@ -217,6 +272,29 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
     return DesignCheck(tuple(lines), q_min)
 
 
+def _corner_line(name: str, label: str, unit: str, times: np.ndarray, x: np.ndarray,
+                 q: np.ndarray, limit: float | None,
+                 corners: Mapping[str, Any] | None) -> LimitCheck | None:
+    """The largest-pressure line of an answer unbounded at a corner in contact (None
+    without one): the largest held value next to such a corner, and where it is read."""
+    if not corners or not corners.get("corners_m"):
+        return None
+    held = float(corners["held_within_m"])
+    best = None
+    for corner in corners["corners_m"]:
+        near = np.abs(x - float(corner)) <= held * (1 + 1e-9) + 1e-12 * abs(float(corner))
+        if not near.any():
+            continue
+        rows = q[near]
+        j = np.unravel_index(int(np.nanargmax(rows)), rows.shape)
+        if best is None or rows[j] > best[0]:
+            best = (float(rows[j]), float(times[j[1]]), float(corner))
+    if best is None:
+        return None
+    return LimitCheck(name, "q_max", label, best[0], unit, best[1], best[2], limit,
+                      corner_distance=held, asymptotic=bool(corners.get("asymptotic")))
+
+
 def design_check(result: Any, limits: DesignLimits | None = None) -> DesignCheck:
     """The design check of a :class:`~core.scene.SceneSolution` over its whole history:
     the pressure on its plotting grid ``x`` [m] at every output time, its settlement and
@@ -224,4 +302,4 @@ def design_check(result: Any, limits: DesignLimits | None = None) -> DesignCheck
     if limits is None:
         limits = getattr(result.scene, "limits", None)
     return check_design(result.times, result.x, result.pressure_on_grid, result.settlement,
-                        result.tilt, limits)
+                        result.tilt, limits, result.info.get("corner_pressure"))

@@ -115,7 +115,10 @@ def design_checks(result: PunchesSolution, limits: DesignLimits | None = None
     out: list[DesignCheck | None] = []
     for punch in result.punches:
         given = limits if limits is not None else punch.scene.limits
+        corners = punch.info.get("corner_pressure")
+        if corners:  # in the global x, as the grid
+            corners = {**corners, "corners_m": [punch.center + c for c in corners["corners_m"]]}
         out.append(None if given is None or given.empty else check_design(
             punch.times, punch.center + punch.x, punch.pressure_on_grid, punch.settlement,
-            punch.tilt, given))
+            punch.tilt, given, corners))
     return out

@@ -18,6 +18,7 @@ import numpy as np
 from core import limits
 from core.cache import StageCache, fingerprint
 from core.coating import model_error_estimate, model_error_map, tilt_share
+from core.engines.layered import EXACT_LAYERED, NO_COATING, corner_reach, uniform_layers
 from core.problem import QUANTITIES
 from core.scene.contact_zone import contact_width, lift_off_length, narrowest_zone
 from core.scene.design import DesignCheck, DesignLimits, design_check
@@ -116,6 +117,33 @@ def scene_model_error(scene: Scene, share_of_tilt: float,
     return {**model_error_estimate(scene, share_of_tilt, mapped), "zone_m": zone}
 
 
+def corner_pressure(scene: Scene, coating_model: str,
+                    contact_set: list[list[tuple[float, float]]]) -> dict[str, Any] | None:
+    """Where the answer's pressure is unbounded: the punch corners [m] in contact at some
+    time, for a model that carries the rigid corner's square-root singularity (the exact
+    layered kernel, coated or bare; the thin layer's coating springs bound q), and the
+    distance [m] from a corner within which ``pressure(x)`` holds its value there
+    (:func:`core.engines.layered.corner_reach`). None when no
+    corner is in contact or the model bounds q."""
+    if coating_model not in (EXACT_LAYERED, NO_COATING):
+        return None
+    a = scene.half_width
+    zones = [zone for zones in contact_set for zone in zones] or [(-a, a)]
+    corners = sorted({c for lo, hi in zones
+                      for c, touches in ((-a, lo <= -a * (1 - 1e-12)), (a, hi >= a * (1 - 1e-12)))
+                      if touches})
+    if not corners:
+        return None
+    held = a * (1.0 - corner_reach(uniform_layers(scene) if scene.coating else [], a))
+    # without coating q ~ K / sqrt(distance) holds from the held distance on (measured on
+    # the bare layer preset: q sqrt(d) constant within 0.14 % from 1 to 2 mm, 1.2 % to
+    # 10 mm); under a coating the answer is resolved to half the top layer's thickness
+    # from the corner, where q sqrt(d) is not yet constant (20 mm coating: it changes
+    # 36 % from 10 to 20 mm), so the distance where a limit is passed is not estimated
+    return {"corners_m": [float(c) for c in corners], "held_within_m": held,
+            "asymptotic": not scene.coating}
+
+
 def thick_coating(scene: Scene, zone: float | None = None) -> bool:
     """Whether the coating reaches :data:`THICK_COATING_RATIO` of the punch width, or of
     the narrowest contact zone ``zone`` [m] of an answer that lifts off."""
@@ -174,13 +202,16 @@ class SceneSolution:
         self.info["flags"] = list(self.flags)
         self.info["model_error_estimate"] = self.model_error["estimate"]
         self.info["coating_model"] = solution.info.get("coating_model", "thin layer")
+        corners = corner_pressure(scene, self.info["coating_model"], self.contact_set)
+        if corners is not None:
+            self.info["corner_pressure"] = corners
         self.info["model_error"] = dict(self.model_error)
         self.info["dimensional"] = self._extras()
 
     def _flags(self, solution: ContactSolution) -> list[str]:
         scene = self.scene
         flags = [str(f) for f in solution.info.get("flags", [])]
-        thin = solution.info.get("coating_model") != "exact layered"
+        thin = solution.info.get("coating_model") != EXACT_LAYERED
         # the extremes on the scene's samples, shared by scenes of the same geometry
         # against the narrowest contact zone where the punch lifts off
         if thin and thick_coating(scene, self.model_error.get("zone_m")):

@@ -52,6 +52,10 @@ class Check:
     where: str
     limit: float | None = None
     passed: bool | None = None
+    #: [mm] an unbounded pressure (a rigid corner in contact): how far from the corner
+    #: ``value`` is read, and within how far of it q exceeds the limit (None: bounded)
+    corner_distance: float | None = None
+    exceeded_within: float | None = None
 
     @property
     def verdict(self) -> str:
@@ -134,6 +138,11 @@ def _on_screen(line: LimitCheck, limits: DesignLimits | None) -> Check:
         where = f"x = {line.x:.3g} m, " + where
     typed = None if limits is None or line.limit_name is None \
         else getattr(limits, line.limit_name)
+    if line.unbounded:
+        within = line.exceeded_within
+        return Check(line.label, line.value / size, unit, where, typed, line.passed,
+                     corner_distance=1e3 * float(line.corner_distance),
+                     exceeded_within=None if within is None else 1e3 * within)
     return Check(line.label, line.value / size, unit, where, typed, line.passed)
 
 
@@ -142,7 +151,8 @@ def design_check(view: ResultView, limits: DesignLimits | None = None) -> Design
     core's check (:func:`core.scene.check_design`) in the screen's units, with the
     contact width and the eccentricity the screen shows beside it."""
     verdict = check_design(view.times, view.x, view.pressure, view.values["settlement"],
-                           view.values["tilt"], core_limits(limits))
+                           view.values["tilt"], core_limits(limits),
+                           view.info.get("corner_pressure"))
     widths = contact_widths(view)
     j_narrow = int(np.argmin(widths))
     force = float(view.values["force"][-1])
@@ -167,8 +177,16 @@ def check_html(check: DesignCheck) -> str:
     for c in check.checks + [check.q_min]:
         limit = "" if c.limit is None else f"{c.limit:.4g}"
         cls = {"pass": "cp-ok", "FAIL": "cp-bad"}.get(c.verdict, "")
-        rows.append(f"<tr><td>{html.escape(c.name)} [{c.unit}]</td><td>{c.value:.4g}</td>"
-                    f"<td>{html.escape(c.where)}</td><td>{limit}</td>"
+        value, where = f"{c.value:.4g}", html.escape(c.where)
+        if c.corner_distance is not None:
+            # q ~ 1/sqrt(distance) at a rigid corner in contact: no largest value
+            value = (f"<span class='check-unbounded'>unbounded at the corner</span>; "
+                     f"{c.value:.4g} at {c.corner_distance:.2g} mm from it")
+            if c.limit is not None:
+                where += (f"; over the limit within ~{c.exceeded_within:.2g} mm of the corner"
+                          if c.exceeded_within is not None else "; over the limit at the corner")
+        rows.append(f"<tr><td>{html.escape(c.name)} [{c.unit}]</td><td>{value}</td>"
+                    f"<td>{where}</td><td>{limit}</td>"
                     f"<td class='{cls}'>{c.verdict if c.limit is not None else ''}</td></tr>")
     share = 100 * check.contact_width / check.full_width if check.full_width else 0.0
     lift = check.full_width - check.contact_width

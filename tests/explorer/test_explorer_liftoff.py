@@ -72,3 +72,16 @@ def test_histories_csv_carries_the_contact_width_and_the_lifted_length() -> None
     assert widths.min() < 2 * a  # this preset lifts off
     assert table[:, -2] == pytest.approx(widths, rel=1e-9)
     assert table[:, -1] == pytest.approx(2 * a - widths, rel=1e-9, abs=1e-9 * a)
+
+
+def test_design_check_says_the_pressure_is_unbounded_at_a_bare_corner() -> None:
+    from explorer.model import DesignLimits, check_html
+
+    state = ExplorerState()
+    state.load_scene(json.loads(json.dumps(presets()["bare_layer"])))
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    check = design_check(controller.view, DesignLimits(allowable_pressure=3000.0))
+    assert check.q_max.verdict == "FAIL" and check.passed is False
+    text = check_html(check)
+    assert "unbounded at the corner" in text and "over the limit within ~0.8 mm" in text

@@ -101,3 +101,49 @@ def test_a_study_does_not_vary_the_limits() -> None:
     with pytest.raises(ValueError, match=r"^vary\[0\]\.field: 'limits\.tilt_limit' cannot be "
                                          r"varied .*limits do not change an answer"):
         study_from_dict(study)
+
+
+def test_the_pressure_at_a_rigid_corner_is_unbounded_and_never_passes() -> None:
+    # A flat punch on the bare layer: q ~ K / sqrt(distance) at both corners, held at its
+    # value 1 mm (BARE_CORNER a) from them. The grid's largest value (2.68 MPa) once
+    # passed an allowable pressure of 3 MPa with no word of the corner.
+    d = scene_file("bare_layer")
+    d["limits"] = {"allowable_pressure": 3e6}
+    result = solve(d)
+    assert result.info["corner_pressure"] == {
+        "corners_m": [-1.0, 1.0], "held_within_m": pytest.approx(1e-3), "asymptotic": True}
+    line = result.design_check().check("q_max")
+    assert line.unbounded and line.passed is False and line.utilisation == math.inf
+    assert abs(line.x) == 1.0 and line.value == pytest.approx(2.676e6, rel=1e-3)
+    # from the asymptote through the held value: (2.676 / 3)^2 mm; the asymptote holds to
+    # 0.14 % from 1 to 2 mm (q sqrt(d) measured on this answer)
+    assert line.exceeded_within == pytest.approx(1e-3 * (line.value / 3e6) ** 2)
+    x = -1.0 + np.array([1e-3, 2e-3])
+    q = result.pressure(x)[:, -1] * np.sqrt(x + 1.0)
+    assert q[1] == pytest.approx(q[0], rel=2e-3)
+    assert "unbounded at the corner" in line.describe() and line.describe().endswith("FAIL")
+    saved = result.design_check().to_dict()["checks"][0]
+    assert saved["unbounded"] and saved["exceeded_within_m"] == pytest.approx(
+        line.exceeded_within)
+
+
+def test_a_coated_corner_is_unbounded_in_the_exact_model_and_bounded_in_the_thin_one():
+    d = scene_file("uniform_flat")
+    d["limits"] = {"allowable_pressure": 1e6}
+    thin = solve(d).design_check().check("q_max")
+    assert not thin.unbounded and thin.passed  # the coating's springs bound q: 519 kPa
+    d["base"]["creep"] = {"model": "elastic", "modulus": 3e10}
+    exact = solve(d)  # the exact layered kernel: the corner's singularity in the coating
+    line = exact.design_check().check("q_max")
+    assert exact.info["corner_pressure"]["held_within_m"] == pytest.approx(0.01)
+    assert line.unbounded and line.passed is False and line.exceeded_within is None
+    assert line.describe().endswith("exceeded at the corner: FAIL")
+
+
+def test_a_punch_lifting_off_one_corner_is_unbounded_only_at_the_other() -> None:
+    d = scene_file("bare_layer")
+    d["loading"] = {"force": 5e5, "moment": 3e5}
+    result = solve(d)
+    assert result.info["corner_pressure"]["corners_m"] == [1.0]
+    line = result.design_check(DesignLimits(allowable_pressure=1e7)).check("q_max")
+    assert line.unbounded and line.x == 1.0

@@ -27,6 +27,7 @@ with the common ``info`` keys and :func:`core.problem.accepts` (margin 1).
 from __future__ import annotations
 
 from core.engines.layered.answer import (
+    EXACT_LAYERED,
     LIFT_OFF_SHARE,
     NO_COATING,
     LiftOffNotAnswered,
@@ -56,6 +57,7 @@ __all__ = [
     "COARSE_TOL",
     "default_modes",
     "ERROR_FLOOR",
+    "EXACT_LAYERED",
     "gap_key",
     "geometric_tail",
     "layered_declines",

@@ -80,6 +80,8 @@ BARE_CORNER = 1e-3
 #: ``info["coating_model"]`` of a scene without coating layers (its coating-model error
 #: is 0: there is no coating to model).
 NO_COATING = "none (no coating)"
+#: ``info["coating_model"]`` of a coated scene answered by the exact layered kernel.
+EXACT_LAYERED = "exact layered"
 #: A pressure below this share of its largest value is taken as lift-off.
 LIFT_OFF_SHARE = 1e-9
 
@@ -225,7 +227,7 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
         model_error = {"estimate": float(numerical),
                        "force": float(answer.errors.get("force", numerical)),
                        "moment": float(answer.errors.get("moment", numerical)),
-                       "where_m": 0.0, "model": "exact layered",
+                       "where_m": 0.0, "model": EXACT_LAYERED,
                        "thin_layer_estimate": thin["estimate"]}
     else:
         # no coating, no coating model: the base's own kernel is the whole problem, and
@@ -250,7 +252,7 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
                  success=success, flags=flags, message=message, modes=answer.modes,
                  nodes=response.nodes, stages=answer.stages, contact="full")
     info.update(max_abs_tilt=largest_tilt,
-                coating_model="exact layered" if layers else NO_COATING,
+                coating_model=EXACT_LAYERED if layers else NO_COATING,
                 layered_model_error=model_error)
     return ContactSolution(times.copy(), settlement, tilt, force, moment, info, None,
                            np.zeros((0, times.size)), np.ones(times.size), None, None,
