@@ -47,10 +47,9 @@ import json
 import shutil
 import sys
 from collections.abc import Iterator, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, NoReturn
-
-import numpy as np
 
 from core.files import (
     atomic_write_bytes,
@@ -72,6 +71,7 @@ from core.scene import (
     check_loads_touch,
     flags_with_evidence,
     has_punches,
+    largest_pressure,
     load_json_schema,
     load_scene,
     migrate,
@@ -244,10 +244,9 @@ def _punches_summary(result: PunchesSolution) -> str:
         for i in rows:
             values = [getattr(punch, q)[i] for q in QUANTITIES]
             lines.append(f"{result.times[i]:12.6g} " + " ".join(f"{v:16.8g}" for v in values))
-        q = punch.pressure_on_grid
-        i, t = np.unravel_index(int(np.argmax(q)), q.shape)
-        lines.append(f"  largest contact pressure q: {q[i, t]:.6g} Pa at x = "
-                     f"{punch.center + punch.x[i]:.6g} m, t = {result.times[t]:.6g} days")
+        line = largest_pressure(punch)
+        line = replace(line, x=punch.center + line.x)  # the global x
+        lines.append(f"  largest contact pressure q: {line.value_text(place_first=True)}")
         lines.append(f"  {punch.info.get('message', '')}")
         lines.append(f"  flags: {', '.join(punch.flags) if punch.flags else 'none'}")
         if checks[k] is not None:
@@ -270,10 +269,8 @@ def _summary(result: SceneSolution) -> str:
         for i in rows:
             zones = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in result.contact_set[i])
             lines.append(f"contact at {result.times[i]:g} days: {zones or 'none'} m")
-    q = result.pressure_on_grid
-    i, k = np.unravel_index(int(np.argmax(q)), q.shape)
-    lines.append(f"largest contact pressure q: {q[i, k]:.6g} Pa at x = {result.x[i]:.6g} m, "
-                 f"t = {result.times[k]:.6g} days")
+    peak = largest_pressure(result).value_text(place_first=True)
+    lines.append(f"largest contact pressure q: {peak}")
     lines.append(str(result.info.get("message", "")))
     lines.append(f"flags: {', '.join(result.flags) if result.flags else 'none'}")
     estimate = result.info.get("model_error_estimate")

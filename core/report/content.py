@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import datetime, timezone
 from typing import Any
 
@@ -19,6 +19,7 @@ from core.scene import (
     SceneSolution,
     engine_text,
     flags_with_evidence,
+    largest_pressure,
     model_error_evidence,
 )
 from core.version import VERSION
@@ -37,6 +38,15 @@ class Section:
     rows: list[tuple[str, str]] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     tone: str = ""
+
+
+def _largest_pressure_text(result: Any, origin: float = 0.0) -> str:
+    """The largest contact pressure, where and when (``origin + x`` [m]): unbounded at a
+    rigid corner in contact, where the text says so (:func:`core.scene.largest_pressure`)."""
+    line = largest_pressure(result)
+    if line.x is not None and origin:
+        line = replace(line, x=origin + line.x)
+    return line.value_text(number=_number, shown=_shown, day="d", place_first=True)
 
 
 def _at(times: np.ndarray, values: np.ndarray, pick: str) -> tuple[float, float]:
@@ -58,16 +68,12 @@ def key_numbers(result: SceneSolution, time: float | None = None,
     lifts off, when it does and the smallest contact width. Positions are ``origin + x``
     [m] (``x`` from the punch's centre; a punch of several: ``origin`` its centre)."""
     t = result.times
-    q = result.pressure_on_grid
-    k_max = np.unravel_index(int(np.argmax(q)), q.shape)
     settlement, t_s = _at(t, result.settlement, "abs")
     tilt, t_a = _at(t, result.tilt, "abs")
     rows = [
         ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {_number(t_s)} d"),
         ("largest tilt α", f"{_shown(tilt, 'rad')} at t = {_number(t_a)} d"),
-        ("largest contact pressure q", f"{_shown(q[k_max], 'Pa')} at x = "
-                                       f"{_number(origin + result.x[k_max[0]])} m, t = "
-                                       f"{_number(t[k_max[1]])} d"),
+        ("largest contact pressure q", _largest_pressure_text(result, origin)),
         ("force P at the last time", _shown(result.force[-1], "N/m")),
         ("moment M at the last time", _shown(result.moment[-1], "N")),
     ]

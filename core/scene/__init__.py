@@ -37,7 +37,14 @@ from typing import TYPE_CHECKING
 from core.optional import lazy_exports
 from core.scene.at_loading import creeps, elastic_at_loading, modulus_at_loading
 from core.scene.contact_zone import LIFT_OFF_SHARE, contact_width, lift_off_length, lifts_off
-from core.scene.design import DesignCheck, DesignLimits, LimitCheck, check_design, design_check
+from core.scene.design import (
+    DesignCheck,
+    DesignLimits,
+    LimitCheck,
+    check_design,
+    design_check,
+    largest_pressure,
+)
 from core.scene.display import engine_text, known_contact_width, lifts_off_at
 from core.scene.evidence import checked_key, flags_with_evidence, model_error_evidence
 from core.scene.files import load_scene, read_scene_json, save_scene
@@ -106,6 +113,7 @@ __all__ = [
     "engine_text",
     "holoviews_for_bokeh",
     "known_contact_width",
+    "largest_pressure",
     "lifts_off_at",
     "check_design",
     "check_fields",

@@ -148,6 +148,28 @@ class LimitCheck:
         """One line for a terminal: the label, then :meth:`verdict_text`."""
         return f"{self.label} {self.verdict_text()}"
 
+    def value_text(self, number: Callable[[float], str] = _six_digits,
+                   shown: Callable[[float, str], str] | None = None,
+                   day: str = "days", place_first: bool = False) -> str:
+        """Value and where (or, for an unbounded pressure, the corner and the value where
+        it is read), without the limit: :meth:`verdict_text`'s arguments; ``place_first``
+        writes ``x`` before ``t``."""
+        if shown is None:
+            def shown(value: float, unit: str) -> str:
+                return f"{number(value)} {unit}"
+        if self.unbounded:
+            return (f"unbounded at the corner x = {number(self.x)} m (a rigid corner: q ~ "
+                    f"1/sqrt(distance)); {shown(self.value, self.unit)} at "
+                    f"{number(1e3 * float(self.corner_distance))} mm from it, t = "
+                    f"{number(self.time)} {day}")
+        when = f"t = {number(self.time)} {day}"
+        if self.x is None:
+            where = when
+        else:
+            place = f"x = {number(self.x)} m"
+            where = f"{place}, {when}" if place_first else f"{when}, {place}"
+        return f"{shown(self.value, self.unit)} at {where}"
+
     def verdict_text(self, number: Callable[[float], str] = _six_digits,
                      shown: Callable[[float, str], str] | None = None,
                      day: str = "days") -> str:
@@ -159,24 +181,16 @@ class LimitCheck:
         if shown is None:
             def shown(value: float, unit: str) -> str:
                 return f"{number(value)} {unit}"
-        where = f"t = {number(self.time)} {day}" + ("" if self.x is None else
-                                                     f", x = {number(self.x)} m")
-        text = f"{shown(self.value, self.unit)} at {where}"
+        text = self.value_text(number, shown, day)
+        if self.limit is None:
+            return text + "; no limit set"
         if self.unbounded:
-            distance = float(self.corner_distance)
-            text = (f"unbounded at the corner x = {number(self.x)} m (a rigid corner: q ~ "
-                    f"1/sqrt(distance)); {shown(self.value, self.unit)} at "
-                    f"{number(1e3 * distance)} mm from it, t = {number(self.time)} {day}")
-            if self.limit is None:
-                return text + "; no limit set"
             within = self.exceeded_within
             if within is None:  # not resolved closer to the corner (under a coating)
                 return f"{text}; limit {shown(self.limit, self.unit)}, exceeded at the corner: FAIL"
             # the corner's asymptote read at the distance where q is held: an estimate
             return (f"{text}; limit {shown(self.limit, self.unit)}, exceeded within ~"
                     f"{1e3 * within:.2g} mm of the corner: FAIL")
-        if self.limit is None:
-            return text + "; no limit set"
         verdict = "pass" if self.passed else "FAIL"
         return (f"{text}; limit {shown(self.limit, self.unit)}, utilisation "
                 f"{self.utilisation:.3g}: {verdict}")
@@ -293,6 +307,14 @@ def _corner_line(name: str, label: str, unit: str, times: np.ndarray, x: np.ndar
         return None
     return LimitCheck(name, "q_max", label, best[0], unit, best[1], best[2], limit,
                       corner_distance=held, asymptotic=bool(corners.get("asymptotic")))
+
+
+def largest_pressure(result: Any) -> LimitCheck:
+    """The largest contact pressure of a :class:`~core.scene.SceneSolution` over its whole
+    history (the design check's ``q_max`` line without a limit): unbounded at a rigid
+    corner in contact."""
+    return check_design(result.times, result.x, result.pressure_on_grid, result.settlement,
+                        result.tilt, None, result.info.get("corner_pressure")).check("q_max")
 
 
 def design_check(result: Any, limits: DesignLimits | None = None) -> DesignCheck:

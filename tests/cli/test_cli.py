@@ -85,7 +85,9 @@ def test_solve_without_output_prints_a_summary():
     assert proc.stdout.startswith("solved 'Rounded punch on a graded coating'")
     result = core.solve(core.load_scene(SCENES / "rounded_graded.json"))
     peak = result.pressure_on_grid.max()
-    assert f"largest contact pressure q: {peak:.6g} Pa at x = " in proc.stdout
+    # in contact up to the punch's ends: unbounded there, given where the answer holds it
+    assert (f"largest contact pressure q: unbounded at the corner x = 0.5 m (a rigid corner: "
+            f"q ~ 1/sqrt(distance)); {peak:.6g} Pa at 2 mm from it") in proc.stdout
     assert "flags: none" in proc.stdout
 
 
@@ -246,3 +248,10 @@ def test_a_load_no_contact_carries_is_the_users_input(tmp_path, command, loading
     path = tmp_path / "scene.json"
     path.write_text(json.dumps(edited("loading", loading, scene_dict())))
     assert_one_line_error(run(command, path), field)
+
+
+def test_the_summary_says_the_pressure_is_unbounded_at_a_bare_corner():
+    proc = run("solve", "preset:bare_layer")
+    assert proc.returncode == 0, proc.stderr
+    assert ("largest contact pressure q: unbounded at the corner x = -1 m (a rigid corner: "
+            "q ~ 1/sqrt(distance)); 2.67618e+06 Pa at 1 mm from it") in proc.stdout
