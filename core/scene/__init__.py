@@ -84,10 +84,12 @@ from core.scene.records import (
 )
 from core.scene.results import (
     FLAG_MESSAGES,
+    LARGE_SETTLEMENT,
     LARGE_TILT,
     SceneSolution,
     plotting_grid,
     scene_model_error,
+    settlement_share,
     thick_coating,
 )
 from core.scene.schema import (
@@ -133,6 +135,7 @@ __all__ = [
     "integer_in_range",
     "JSON_SCHEMA_DIALECT",
     "load_json_schema",
+    "LARGE_SETTLEMENT",
     "LARGE_TILT",
     "LimitCheck",
     "lift_off_length",
@@ -165,6 +168,7 @@ __all__ = [
     "schema_errors",
     "schema_text",
     "scene_model_error",
+    "settlement_share",
     "thick_coating",
     "SceneSolution",
     "shown_times",

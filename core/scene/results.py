@@ -45,6 +45,10 @@ if TYPE_CHECKING:
 THICK_COATING_RATIO = 0.1
 #: Tilts beyond this many radians are not small.
 LARGE_TILT = 0.01
+#: A punch base moving down more than this share of the foundation's thickness (base
+#: and coating) strains it beyond the small-strain (linear) model: an average strain of
+#: 1 % is about three times the crushing strain of concrete.
+LARGE_SETTLEMENT = 0.01
 #: Points of the default plotting grid :attr:`SceneSolution.x`.
 PLOT_POINTS = 201
 
@@ -57,6 +61,9 @@ FLAG_MESSAGES: dict[str, str] = {
                      "somewhere: the thin (Winkler) coating model is doubtful.",
     "stiff_coating": "A coating layer is stiffer than the base at loading somewhere: the "
                      "thin-coating model assumes soft coatings.",
+    "large_settlement": f"The punch base moves down more than {100 * LARGE_SETTLEMENT:g} % "
+                        "of the foundation's thickness (base and coating): strains this "
+                        "large are beyond the small-strain (linear elastic) model.",
     "large_tilt": f"The tilt exceeds {LARGE_TILT:g} rad: the small-angle assumption is "
                   "doubtful.",
     "model_error": "The estimated error of the thin-coating model (info.model_error_estimate, "
@@ -144,6 +151,19 @@ def corner_pressure(scene: Scene, coating_model: str,
             "asymptotic": not scene.coating}
 
 
+def settlement_share(scene: Scene, settlement: Any, tilt: Any) -> float:
+    """The largest downward reach of the punch base, ``max |delta| + a max |alpha|`` [m]
+    over the histories ``settlement`` [m] and ``tilt`` [rad], as a share of
+    ``LARGE_SETTLEMENT`` times the foundation's thickness (base and thickest coating
+    stack): above 1 raises ``large_settlement``. It scales with the loads."""
+    settlement = np.asarray(settlement, dtype=float)
+    tilt = np.asarray(tilt, dtype=float)
+    reach = (float(np.max(np.abs(settlement), initial=0.0))
+             + scene.half_width * float(np.max(np.abs(tilt), initial=0.0)))
+    thickness = scene.base_thickness + scene.sample_extremes["coating_thickness_max_m"]
+    return reach / (LARGE_SETTLEMENT * thickness)
+
+
 def thick_coating(scene: Scene, zone: float | None = None) -> bool:
     """Whether the coating reaches :data:`THICK_COATING_RATIO` of the punch width, or of
     the narrowest contact zone ``zone`` [m] of an answer that lifts off."""
@@ -226,6 +246,8 @@ class SceneSolution:
         # between the output times too (the default engine samples the load histories)
         largest_tilt = max(float(np.max(np.abs(self.tilt))) if self.tilt.size else 0.0,
                            float(solution.info.get("max_abs_tilt", 0.0)))
+        if settlement_share(scene, self.settlement, largest_tilt) > 1.0:
+            flags.append("large_settlement")
         if largest_tilt > LARGE_TILT:
             flags.append("large_tilt")
         return list(dict.fromkeys(flags))

@@ -28,6 +28,7 @@ from core.scene import (
     Scene,
     replace_loads,
     scene_from_dict,
+    settlement_share,
     solve,
 )
 from core.study.definition import apply_point
@@ -133,33 +134,40 @@ def _eccentricity_key(scene: Scene, point: Mapping[str, float]) -> tuple[int, fl
     return id(scene), round(eccentricity, _ECCENTRICITY_DIGITS)
 
 
-def _scaled(answer: tuple[float, np.ndarray, float, list[str], float], force: float,
+def _scaled(answer: tuple[float, np.ndarray, float, list[str], float, float], force: float,
             outputs: Sequence[str]) -> tuple[np.ndarray, float, str]:
     """Outputs, error estimate and flags of a point with ``force`` [N/m] at the
-    eccentricity of ``answer`` (its force, outputs, estimate, flags, largest |tilt|)."""
-    base_force, values, estimate, flags, tilt = answer
+    eccentricity of ``answer`` (its force, outputs, estimate, flags, largest |tilt|,
+    :func:`core.scene.settlement_share`)."""
+    base_force, values, estimate, flags, tilt, share = answer
     ratio = force / base_force
     scale = np.array([1.0 if name in _LOAD_FREE_OUTPUTS else ratio for name in outputs])
-    # large_tilt is the one flag that depends on the size of the answer
-    kept = [f for f in flags if f != "large_tilt"]
+    # large_settlement and large_tilt are the flags that depend on the size of the
+    # answer, in the order core.scene.SceneSolution raises them
+    kept = [f for f in flags if f not in ("large_settlement", "large_tilt")]
+    if abs(ratio) * share > 1.0:
+        kept.append("large_settlement")
     if abs(ratio * tilt) > LARGE_TILT:
         kept.append("large_tilt")
     return values * scale[:, None], estimate, ",".join(kept)
 
 
 def _kept_answer(result: Any, outputs: Sequence[str]
-                 ) -> tuple[float, np.ndarray, float, list[str], float]:
+                 ) -> tuple[float, np.ndarray, float, list[str], float, float]:
     """What a solved point keeps to answer the points of its eccentricity: its force
-    [N/m], outputs, error estimate, flags and largest |tilt| [rad] (of several punches,
-    whose points are never scaled, NaN for the force and the tilt)."""
+    [N/m], outputs, error estimate, flags, largest |tilt| [rad] and
+    :func:`core.scene.settlement_share` (of several punches, whose points are never
+    scaled, NaN for the force, the tilt and the share)."""
     if isinstance(result, PunchesSolution):
         return (np.nan, point_outputs(result, outputs),
-                float(result.info.get("error_estimate", np.nan)), list(result.flags), np.nan)
+                float(result.info.get("error_estimate", np.nan)), list(result.flags), np.nan,
+                np.nan)
     tilt = max(float(np.max(np.abs(result.tilt))) if result.tilt.size else 0.0,
                float(result.info.get("max_abs_tilt", 0.0)))
     force = result.scene.loading.get("force")
     return (float(force.spec) if force is not None else np.nan, point_outputs(result, outputs),
-            float(result.info.get("error_estimate", np.nan)), list(result.flags), tilt)
+            float(result.info.get("error_estimate", np.nan)), list(result.flags), tilt,
+            settlement_share(result.scene, result.settlement, tilt))
 
 
 def _liftoff_families(validated: Sequence[Scene | None],
@@ -272,7 +280,7 @@ def _one_family(scene: Scene, picked: list[tuple[int, float]],
     for key, answer in zip(picked[middle], answers, strict=True):
         if answer is not None:
             solved[key] = (answer.force, answer.values, answer.estimate, answer.flags,
-                           answer.tilt)
+                           answer.tilt, answer.settlement_share)
             done.append(key)
     return done
 

@@ -50,6 +50,7 @@ from core.scene import (
     contact_width,
     plotting_grid,
     scene_model_error,
+    settlement_share,
     thick_coating,
 )
 from core.study.outputs import point_outputs
@@ -85,14 +86,15 @@ _SOLVE_ACCURACY = 1e-12
 class LiftoffAnswer:
     """One eccentricity's answer at the force ``force`` [N/m]: ``values`` (outputs x
     times, units of :data:`core.study.definition.OUTPUT_UNITS`), ``estimate`` (relative, -),
-    ``flags`` and the largest |tilt| [rad], as :func:`core.study.run_batch` keeps a
-    solved point to scale it."""
+    ``flags``, the largest |tilt| [rad] and :func:`core.scene.settlement_share`, as
+    :func:`core.study.run_batch` keeps a solved point to scale it."""
 
     force: float
     values: np.ndarray
     estimate: float
     flags: list[str]
     tilt: float
+    settlement_share: float
 
 
 def _callable(value: Any) -> Callable[[np.ndarray], np.ndarray]:
@@ -212,9 +214,9 @@ def liftoff_family(scene: Scene, eccentricities: np.ndarray, forces: np.ndarray,
     the free ends at the smallest and the largest ``|e|``) under the forces ``forces``
     [N/m] (one point per eccentricity), for ``outputs`` of
     :data:`core.study.definition.OUTPUT_UNITS`. ``flags`` are the geometry's flags of those
-    two answers (the contact-model ones and ``large_tilt``, ``model_error`` and
-    ``thick_coating`` excluded: they are decided per point here, the last two on its
-    zone). Requires :func:`core.study.answers_scale_with_loads`
+    two answers (the contact-model ones and ``large_settlement``, ``large_tilt``,
+    ``model_error`` and ``thick_coating`` excluded: they are decided per point here, the
+    last two on its zone). Requires :func:`core.study.answers_scale_with_loads`
     and a modulus constant over the scene's times.
 
     Returns one :class:`LiftoffAnswer` per eccentricity, None where the estimate misses
@@ -349,11 +351,14 @@ def _answer(scene: Scene, point: tuple[np.ndarray, SimpleNamespace], force: floa
     if scene_model_error(scene, share, zone)["estimate"] > scene.model_tol:
         point_flags.append("model_error")
     largest = float(np.max(np.abs(result.tilt)))
+    share = settlement_share(scene, result.settlement, largest)
+    if share > 1.0:
+        point_flags.append("large_settlement")
     if largest > LARGE_TILT:
         point_flags.append("large_tilt")
-    order = ("thick_coating", "model_error", "stiff_coating", "large_tilt")
+    order = ("thick_coating", "model_error", "stiff_coating", "large_settlement", "large_tilt")
     point_flags.sort(key=lambda f: order.index(f) if f in order else -1)
-    return LiftoffAnswer(force, values, estimate, point_flags, largest)
+    return LiftoffAnswer(force, values, estimate, point_flags, largest, share)
 
 
 def family_flags(result_flags: Sequence[str]) -> list[str] | None:
@@ -362,7 +367,8 @@ def family_flags(result_flags: Sequence[str]) -> list[str] | None:
     missed its tolerance or its check (the family is then not built)."""
     if {"tol_not_met", "contact_set_unverified", "contact_lost"} & set(result_flags):
         return None
-    return [f for f in result_flags if f not in ("model_error", "large_tilt", "thick_coating")]
+    return [f for f in result_flags
+            if f not in ("model_error", "large_settlement", "large_tilt", "thick_coating")]
 
 
 def family_applies(scene: Scene) -> bool:

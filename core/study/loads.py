@@ -42,7 +42,7 @@ from core.engines.layered import (
     uniform_layers,
 )
 from core.profiles import profile_values
-from core.scene import LARGE_TILT, Scene, contact_width, plotting_grid
+from core.scene import LARGE_TILT, Scene, contact_width, plotting_grid, settlement_share
 from core.study.definition import OUTPUT_UNITS
 from core.validation import MAX_MAGNITUDE
 
@@ -159,6 +159,7 @@ class _Level:
     numerical: np.ndarray
     lost: np.ndarray
     tilt: np.ndarray
+    settlement: np.ndarray
 
 
 def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, np.ndarray],
@@ -222,7 +223,8 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
     keep &= np.all(np.isfinite(rows), axis=(1, 2))
     for name in _NAMES:
         keep &= np.isfinite(dimensional[name]).reshape(n, -1).all(axis=1)
-    return _Level(settled, keep & settled, rows, error, numerical, lost, fine["tilt"])
+    return _Level(settled, keep & settled, rows, error, numerical, lost, fine["tilt"],
+                  a * fine["settlement"])
 
 
 def solve_load_batch(scene: Scene, loads: Mapping[str, np.ndarray],
@@ -260,6 +262,8 @@ def solve_load_batch(scene: Scene, loads: Mapping[str, np.ndarray],
                 # the numerical estimate stands for the coating model's (0 without one)
                 if scene.coating and level.numerical[i] > scene.model_tol:
                     point_flags.append("model_error")
+                if settlement_share(scene, level.settlement[i], level.tilt[i]) > 1.0:
+                    point_flags.append("large_settlement")
                 if abs(level.tilt[i]) > LARGE_TILT:
                     point_flags.append("large_tilt")
                 flags[point] = ",".join(point_flags)

@@ -46,7 +46,8 @@ BADGES: dict[str, dict[str, tuple[str, str]]] = {
               "beyond_model_map": ("coating model error extrapolated: check it (Coating "
                                    "tab)", "")},
     "pressure": {"contact_lost": ("contact lost: q < 0 (shaded)", "full contact")},
-    "history": {"large_tilt": ("large tilt", "small tilt")},
+    "history": {"large_settlement": ("settlement beyond small strains", "small strains"),
+                "large_tilt": ("large tilt", "small tilt")},
     "status": {"tol_not_met": ("tolerance not met", ""),
                "unresolved_input": ("input finer than the quadrature", "")},
 }

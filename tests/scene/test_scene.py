@@ -439,6 +439,18 @@ def test_flag_large_tilt():
     assert result.tilt[0] == 0.015
 
 
+def test_flag_large_settlement():
+    # the punch base moving down more than 1 % of the 4.02 m foundation: 4.08 cm under
+    # 500 MN/m (a load the explorer's number box accepts) raised no flag before
+    d = scene_file("uniform_flat")
+    d["loading"]["force"] = 5e8
+    result = solve(d)
+    assert result.flags == ["large_settlement"]
+    assert "small-strain" in result.flag_messages["large_settlement"]
+    d["loading"]["force"] = 4.5e8  # 3.7 cm
+    assert solve(d).flags == []
+
+
 def test_a_load_change_reuses_every_cached_stage():
     """The conversion builds equal callables for equal scenes, so the prepared geometry
     (recognised by sampled values) is reused when only the loads change: nothing geometric

@@ -293,6 +293,20 @@ def test_load_batch_equals_core_solve_on_a_loads_grid(contact):
     assert kinds["unilateral"] >= 1 if contact == "auto" else lost >= 1
 
 
+def test_load_batch_flags_large_settlements_as_core_solve():
+    from core.scene import scene_from_dict
+    from core.study.loads import solve_load_batch
+
+    base = elastic_scene() | {"times": [1.0]}
+    scene = scene_from_dict(base)
+    force = np.array([1e6, 1e8, 3e8, 1e9])
+    got = solve_load_batch(scene, {"force": force, "moment": 0.1 * force}, list(OUTPUTS))
+    flags = [",".join(solve(apply_point(base, {"loading.force": f, "loading.moment": 0.1 * f}))
+                      .flags) for f in force]
+    assert got.answered.all() and list(got.flags) == flags
+    assert flags[0] == "" and flags[-1] == "large_settlement"
+
+
 def test_load_only_batch_equals_core_solve_point_for_point(monkeypatch):
     """A batch varying only loads validates the base scene once and replaces the loads of
     each point: every output, estimate, flag and message equals core.solve's on the
@@ -635,10 +649,10 @@ def test_scaled_answer_flags_a_large_tilt_by_its_own_size():
     from core.study.batch import _scaled
 
     answer = (1e5, np.array([[1.0], [2.0]]), 1e-9, ["contact_lost", "large_tilt"],
-              0.8 * LARGE_TILT)
+              0.8 * LARGE_TILT, 0.6)
     values, estimate, flags = _scaled(answer, 2e5, ["tilt", "contact_width"])
     np.testing.assert_array_equal(values, [[2.0], [2.0]])
-    assert estimate == 1e-9 and flags == "contact_lost,large_tilt"
+    assert estimate == 1e-9 and flags == "contact_lost,large_settlement,large_tilt"
     assert _scaled(answer, 1e5, ["tilt"])[2] == "contact_lost"
     # a creeping base (the preset as shipped) is not taken as one that scales here
     from core.scene import scene_from_dict
