@@ -76,6 +76,7 @@ from core.scene import (
     load_scene,
     migrate,
     model_error_evidence,
+    percent_text,
     punches_from_dict,
     read_scene_json,
     scene_from_dict,
@@ -276,7 +277,7 @@ def _summary(result: SceneSolution) -> str:
     estimate = result.info.get("model_error_estimate")
     if estimate is not None:
         lines.append(f"coating model error ({result.info.get('coating_model')}, estimate): "
-                     f"{100 * estimate:.2g} % (solver.model_tol "
+                     f"{percent_text(estimate, 2)} (solver.model_tol "
                      f"{100 * result.scene.model_tol:g} %)")
     check = result.design_check()
     if check is not None:
@@ -492,7 +493,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
     messages = {**result.flag_messages, "model_error": evidence["message"]}
     if fe_check is not None:
         print(f"coating model error: {100 * evidence['error']:.2f} % measured by the FE "
-              f"check at loading, {100 * evidence['estimate']:.2g} % estimated "
+              f"check at loading, {percent_text(evidence['estimate'], 2)} estimated "
               f"(solver.model_tol {100 * evidence['model_tol']:g} %)", file=sys.stderr)
     for name in flags:
         print(f"warning: {name}: {_one_line(messages[name])}", file=sys.stderr)
@@ -668,7 +669,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
               f"(both with lift-off; resolved ends to {lift['fe_end_uncertainty']:.1g} m)")
     print(f"model error of the fast answer: {100 * report['model_error']:.2f} % "
           f"({report['coating_model']}; estimate carried by results: "
-          f"{100 * report['estimate']:.2g} %, "
+          f"{percent_text(report['estimate'], 2)}, "
           f"solver.model_tol {100 * scene.model_tol:g} %)")
     if report["model_error"] > scene.model_tol:
         print("warning: model_error: the fast answer's coating model errs by more than "

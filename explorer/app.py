@@ -259,7 +259,7 @@ class ExplorerApp(pn.viewable.Viewer):
         }
         self._views["scene"] = SceneView(state, self.presets, self.preset_key, self.history,
                                          self.load_scene, controller, screen.reject, live)
-        self._views["check"] = CheckView(state, self.limits, screen)
+        self._views["check"] = CheckView(state, self.limits, screen, loop)
         self._views["files"] = FilesView(state, screen, controller, self.scales, self.limits,
                                          self._load_file, self.results.show_download_error)
         self._views["lessons"] = LessonsView(self.pins, self.results.log_time,
@@ -624,6 +624,9 @@ class ExplorerApp(pn.viewable.Viewer):
             index = min(self.screen.time_index, n - 1)
         self.screen.drawn = view
         self.pins.on_result(view)  # (the board pins a scene once: a redraw adds none)
+        check = self._made("check")
+        if check is not None:
+            check.show_eccentricity()
         self.results.say_held(False)
         with pn.io.hold():
             self.results.draw(view, index, new_range=shown is None or len(shown.times) != n)

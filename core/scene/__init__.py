@@ -45,7 +45,7 @@ from core.scene.design import (
     design_check,
     largest_pressure,
 )
-from core.scene.display import engine_text, known_contact_width, lifts_off_at
+from core.scene.display import engine_text, known_contact_width, lifts_off_at, percent_text
 from core.scene.evidence import checked_key, flags_with_evidence, model_error_evidence
 from core.scene.files import load_scene, read_scene_json, save_scene
 from core.scene.json_schema import DIALECT as JSON_SCHEMA_DIALECT
@@ -115,6 +115,7 @@ __all__ = [
     "engine_text",
     "holoviews_for_bokeh",
     "known_contact_width",
+    "percent_text",
     "largest_pressure",
     "lifts_off_at",
     "check_design",

@@ -87,7 +87,8 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
     the pressure (largest difference on ``|x| <= 0.9 a`` over the largest FE pressure
     there), ``"model_error"``: the largest error of the two unknowns, ``"estimate"``: the
     map's estimate that results carry, ``"scene_key"``: :func:`core.scene.checked_key` of
-    the scene (which results the measurement applies to), ``"fe_seconds"``, ``"fe_dofs"``.
+    the scene (which results the measurement applies to), ``"half_width_m"``,
+    ``"fe_seconds"``, ``"fe_dofs"``.
 
     Where the scene's own contact model lifts the punch off at this modulus, both answers
     are of lift-off (the FE model's contact set by :func:`core.coating.solve_stack_contact`,
@@ -167,6 +168,7 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
         "contact_lost": fast.contact_lost,
         "lift_off": contact,
         "scene_key": checked_key(scene),
+        "half_width_m": a,
         "fe_seconds": fe.seconds if lifting is None else answer.seconds,
         "fe_dofs": fe.dofs,
     }

@@ -49,6 +49,26 @@ SHOWN: tuple[tuple[str, float, str], ...] = (
 )
 
 
+#: Shares below this many percent are written as "< 0.001 %" (a numerical estimate of
+#: 5e-10 read "5e-08 %").
+PERCENT_FLOOR = 1e-3
+
+
+def percent_text(share: float, digits: int = 3) -> str:
+    """A relative error or share [-] in percent for people: ``digits`` significant
+    figures, "< 0.001 %" below :data:`PERCENT_FLOOR`, never in exponent notation."""
+    value = 100.0 * float(share)
+    if not math.isfinite(value):
+        return f"{value} %"
+    if value == 0:
+        return "0 %"
+    if abs(value) < PERCENT_FLOOR:
+        return f"{'-' if value < 0 else ''}< {PERCENT_FLOOR:g} %"
+    if abs(value) >= 10.0 ** digits:  # where "g" would turn to exponent notation
+        return f"{value:.0f} %"
+    return f"{value:.{digits}g} %"
+
+
 def _number(value: float) -> str:
     return f"{value:.4g}" if math.isfinite(value) else str(value)
 

@@ -4,6 +4,7 @@ Each module is one fix, with the versions it was checked with and why it is need
 is used through its module (``panel_fixes.install()``), so a test can replace one part.
 
 - ``panel_fixes``: messages Panel queues for a page and then never sends.
+- ``empty_inputs``: an emptied number box shown empty, not as "NaN".
 - ``bokeh_fixes``: style sheets BokehJS rewrites with the same text; the page's layout
   computed once per frame, not once per change; colours and line styles not read back
   from the computed style at each paint; a renderer's place written on its element, not
@@ -28,6 +29,7 @@ from . import (
     bokeh_fixes,
     closed_pages,
     design_updates,
+    empty_inputs,
     gc_policy,
     idle_painter,
     layout_batch,
@@ -37,16 +39,18 @@ from . import (
     property_defaults,
 )
 
-__all__ = ["bokeh_fixes", "closed_pages", "design_updates", "gc_policy", "idle_painter",
+__all__ = ["bokeh_fixes", "closed_pages", "design_updates", "empty_inputs", "gc_policy",
+           "idle_painter",
            "install_in_process", "layout_batch", "model_walk", "panel_fixes", "patch_refs",
            "property_defaults"]
 
 
 def install_in_process() -> None:
     """Install the fixes that hold for the whole process (not per page): Panel's queued
-    messages and property updates, Bokeh's model walk, its property defaults and its patch
-    messages."""
+    messages, its empty number boxes and property updates, Bokeh's model walk, its
+    property defaults and its patch messages."""
     panel_fixes.install()
+    empty_inputs.install()
     design_updates.install()
     model_walk.install()
     property_defaults.install()

@@ -35,6 +35,10 @@ def nice_ceiling(value: float) -> float:
 #: the scale (1, 2, 2.5, 5) is at most 2x, so a drag that wanders within a factor of 2.5
 #: keeps its colours.
 SHRINK_BELOW = 0.4
+#: The family's pressure unit holds while the largest |q| reads within these numbers of
+#: it: 1 MPa crossing reads 1000 kPa and 20 MPa 20000 kPa, not a new unit, but a load
+#: 1000 times larger read "5.000e+5 kPa" on the axes.
+UNIT_READS = (1e-3, 1e5)
 
 
 class DisplayScales:
@@ -49,7 +53,14 @@ class DisplayScales:
         self._range: tuple[float, float] | None = None
 
     def pressure_unit(self, view: ResultView) -> tuple[str, float]:
-        """Display unit of pressure and its size [Pa], fixed for the family."""
+        """Display unit of pressure and its size [Pa], fixed for the family while its
+        pressures read within :data:`UNIT_READS` of it (chosen again, with the colour
+        range, for a result beyond)."""
+        if self._unit is not None:
+            peak = float(np.nanmax(np.abs(view.pressure))) if view.pressure.size else 0.0
+            reads = peak / self._unit[1]
+            if reads >= UNIT_READS[1] or 0 < reads < UNIT_READS[0]:
+                self._unit, self._range = None, None
         if self._unit is None:
             self._unit = view.pressure_unit
         return self._unit

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 
+import numpy as np
 from bokeh.core.properties import value as fixed_label
 from bokeh.models import (
     ColorBar,
@@ -184,15 +185,16 @@ class Figures:
         self.history_cursor = {}
         # several punches: a line per punch on each history (none for one punch)
         self.punch_history_src: dict[str, ColumnDataSource] = {}
-        shared_x = None
+        # the time axis of every history, set from here on each result (fit_time): an
+        # automatic range kept the span of a longer history after a preset with a
+        # shorter one (-50 to 1050 days for 0 to 365)
+        shared_x = self.time_range = Range1d(-0.05, 1.05, name="history_time_range")
         for q in QUANTITIES:
             unit = QUANTITY_UNITS[q][0]
-            kwargs = {"x_range": shared_x} if shared_x is not None else {}
             p = figure(height=210, sizing_mode="stretch_width", tools=TOOLS,
                        toolbar_location="above", name=f"{q}_figure",
                        title=f"{TITLES[q]} {SYMBOLS[q]} [{unit}]", y_range=Range1d(-1, 1),
-                       **kwargs)
-            shared_x = p.x_range
+                       x_range=shared_x)
             p.toolbar.autohide = True
             p.xaxis.axis_label = "t [days after loading]"
             p.yaxis.axis_label = f"{SYMBOLS[q]} [{unit}]"
@@ -303,6 +305,28 @@ class Figures:
             set_data(self.forecast_src[q], {k: f32(v) for k, v in columns[q].items()})
         self._fit_extra()
 
+    def fit_time(self) -> None:
+        """The time axis of the histories: every time drawn (the result, the pins, the
+        readings and the forecast), with 5 % of the span beside each end (as the page's
+        automatic range pads); sent only when it changes."""
+        lo, hi = np.inf, -np.inf
+        for fig in self.history_fig.values():
+            for renderer in fig.renderers:
+                source = getattr(renderer, "data_source", None)
+                if source is None or not renderer.visible:
+                    continue
+                t = np.asarray(source.data.get("t", []), dtype=float)
+                t = t[np.isfinite(t)]
+                if t.size:
+                    lo, hi = min(lo, float(t.min())), max(hi, float(t.max()))
+        if not hi >= lo:
+            return  # nothing drawn
+        pad = 0.05 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.05
+        start, end = lo - pad, hi + pad
+        time_range = self.time_range  # the linear axis's (the log axis fits its own)
+        if (time_range.start, time_range.end) != (start, end):
+            time_range.update(start=start, end=end, reset_start=start, reset_end=end)
+
     def _fit_extra(self) -> None:
         """Value axes of the histories that also hold the readings and the band."""
         for q in READ_SERIES:
@@ -311,6 +335,7 @@ class Figures:
             shown = [self.history_src[q].data.get("v", []), *extra,
                      *(pin.view.display(q) for pin in self._pins)]
             steady_range(self.history_fig[q].y_range, *shown)
+        self.fit_time()
 
     def show(self, view: ResultView, index: int, pins: Sequence[Pin] = ()) -> None:
         """Draw a new result (call inside ``pn.io.hold`` to send one message)."""
@@ -370,6 +395,7 @@ class Figures:
             steady_range(self.history_fig[q].y_range,
                          view.display(q) if not view.several else [],
                          *(pin.view.display(q) for pin in pins), *extra)
+        self.fit_time()
         self._fit_pressure_x(view)
         self._fit_pressure(view)
 

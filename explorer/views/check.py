@@ -8,6 +8,7 @@ from typing import Any
 import panel as pn
 
 from ..model import DesignLimits, ExplorerState, Screen, screen_limits
+from .loop import PageLoop
 from .punches import OnePunchOnly
 from .style import TAB_COLUMN, html_pane
 
@@ -17,11 +18,14 @@ class CheckView:
 
     title = "Check"
 
-    def __init__(self, state: ExplorerState, limits: DesignLimits, screen: Screen) -> None:
-        """``limits``: set here; ``screen``: where a refused eccentricity is said."""
+    def __init__(self, state: ExplorerState, limits: DesignLimits, screen: Screen,
+                 loop: PageLoop) -> None:
+        """``limits``: set here; ``screen``: where a refused value is said; ``loop``: the
+        page's, where a refused box gets its last good value back."""
         self.state = state
         self.limits = limits
         self.screen = screen
+        self.loop = loop
         self.allowable_pressure = self._limit("allowable bearing pressure [kPa]",
                                               "allowable_pressure", "limit-pressure")
         self.settlement_limit = self._limit("settlement limit [mm]", "settlement_limit",
@@ -30,7 +34,9 @@ class CheckView:
         self.eccentricity = pn.widgets.FloatInput(
             label="eccentricity e = M/P [m] (sets the moment)", value=None,
             sizing_mode="stretch_width", css_classes=["eccentricity-input"])
+        self._showing = False  # the box follows the loads: not a value typed
         self.eccentricity.param.watch(self._on_eccentricity, "value")
+        self.show_eccentricity()
 
     def show_limits(self, spec: Mapping[str, Any] | None) -> None:
         """Fill the limits from a scene file's ``limits`` (Pa, m, rad), when it has some;
@@ -41,10 +47,44 @@ class CheckView:
             getattr(self, name).value = value
 
     def _limit(self, label: str, name: str, css: str) -> pn.widgets.FloatInput:
-        box = pn.widgets.FloatInput(label=label, value=None, start=0,
-                                    sizing_mode="stretch_width", css_classes=[css])
-        box.param.watch(lambda e: setattr(self.limits, name, e.new), "value")
+        # no lower bound on the box: the page would clamp -5 to 0 unsaid, a limit that
+        # every answer fails; a negative value is refused here, saying so
+        box = pn.widgets.FloatInput(label=label, value=None, sizing_mode="stretch_width",
+                                    css_classes=[css])
+        box.param.watch(lambda e: self._on_limit(box, label, name, e), "value")
         return box
+
+    def _on_limit(self, box: pn.widgets.FloatInput, label: str, name: str,
+                  event: Any) -> None:
+        value = event.new
+        if value is not None and value != value:
+            value = None  # an emptied box: the page sends NaN; not checked
+        if value is not None and value < 0:
+            good = getattr(self.limits, name)
+            self.screen.reject(f"{label}: must be a number >= 0 (leave it empty: not "
+                               f"checked), got {value:g}; the limit stays "
+                               + ("unset" if good is None else f"{good:g}"))
+            # the last good limit, on the page too: set on the next tick, as a value set
+            # while the page's own change is handled is not sent back to it
+            self.loop.dispatch(lambda: setattr(box, "value", good))
+            return
+        setattr(self.limits, name, value)
+
+    def show_eccentricity(self) -> None:
+        """Show e = M/P of the loads on screen (empty when force and moment are not both
+        given as constants), so that the box never holds a stale value."""
+        loading = self.state.loading
+        force, moment = (loading.histories.get(name) for name in ("force", "moment"))
+        e = None
+        if loading.given == ("force", "moment") and force.kind == "constant" \
+                and moment.kind == "constant" and force.value:
+            e = float(moment.value) / float(force.value)
+        if e != self.eccentricity.value:
+            self._showing = True
+            try:
+                self.eccentricity.value = e
+            finally:
+                self._showing = False
 
     def content(self) -> pn.Column:
         """The tab's column."""
@@ -60,12 +100,13 @@ class CheckView:
         """Set the moment so that M = e P (force and moment given, constant force)."""
         e = event.new
         loading = self.state.loading
-        if e is None:
+        if e is None or self._showing:
             return
         force = loading.histories["force"]
         if loading.given != ("force", "moment") or force.kind != "constant":
             self.screen.reject("the eccentricity sets the moment when force and moment are "
                                "given and the force is constant.")
+            self.show_eccentricity()  # the box says what the loads give, not what was typed
             return
         moment = loading.histories["moment"]
         moment.param.update(kind="constant", value=float(e) * force.value)

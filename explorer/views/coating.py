@@ -10,7 +10,7 @@ from typing import Any
 
 import panel as pn
 
-from core.scene import check_scene
+from core.scene import check_scene, percent_text
 
 from ..model import SCREEN_LAYERS, ExplorerState, Screen
 from ..solving import SolveController, run_in_background
@@ -33,6 +33,8 @@ _CHECKS = threading.BoundedSemaphore(MAX_RUNNING_CHECKS)
 #: Rows of the check's table: quantity, unit shown, factor from SI.
 CHECK_ROWS = (("settlement", "mm", 1e3), ("tilt", "mrad", 1e3), ("force", "kN/m", 1e-3),
               ("moment", "kN·m/m", 1e-3))
+#: A value of the check's table below this share of its pair's scale is shown as 0.
+ROUND_OFF = 1e-12
 
 
 #: What the tab says with no coating layer (the scope of core's bare-base answer).
@@ -136,19 +138,28 @@ def check_report_html(report: dict[str, Any]) -> str:
     error of the fast answer beside its estimate, and a row per quantity."""
     errors = report["errors"]
     given = report.get("given", ())
+    a = float(report.get("half_width_m", 1.0))
+    fe = report["fe"]
+    # a value below 1e-12 of its pair's scale is round-off (the tilt of a centred load
+    # read "-2.4826e-15 mrad"): shown as 0
+    kin = max(abs(fe["settlement"]), a * abs(fe["tilt"]))
+    stat = max(abs(fe["force"]), abs(fe["moment"]) / a)
+    scales = {"settlement": kin, "tilt": kin / a, "force": stat, "moment": stat * a}
     rows = []
     for name, unit, factor in CHECK_ROWS:
         error = "given" if name in given else f"{100 * errors[name]:+.3f}"
-        rows.append(f"<tr><td>{name} [{unit}]</td><td>{factor * report['fast'][name]:.5g}</td>"
-                    f"<td>{factor * report['fe'][name]:.5g}</td><td>{error}</td></tr>")
+        shown = [0.0 if abs(v) < ROUND_OFF * scales[name] else factor * v
+                 for v in (report["fast"][name], fe[name])]
+        rows.append(f"<tr><td>{name} [{unit}]</td><td>{shown[0]:.5g}</td>"
+                    f"<td>{shown[1]:.5g}</td><td>{error}</td></tr>")
     rows.append(f"<tr><td>pressure, |x| &le; 0.9 a</td><td></td><td></td>"
                 f"<td>{100 * errors['pressure']:.3f}</td></tr>")
     return (
         f"<div class='coating-check-report'><small>At loading, against the resolved "
         f"finite-element model ({report['fe_dofs']:,} unknowns, "
         f"{report['fe_seconds']:.1f} s). Coating model: {report['coating_model']}.</small>"
-        f"<br><b>model error: measured {100 * report['model_error']:.3g} %, "
-        f"estimated {100 * report['estimate']:.3g} %</b>"
+        f"<br><b>model error: measured {percent_text(report['model_error'])}, "
+        f"estimated {percent_text(report['estimate'])}</b>"
         + _contact_note(report)
         + "<table class='cp-readout'><tr><th></th><th>fast</th><th>FE</th><th>error [%]</th>"
         "</tr>" + "".join(rows) + "</table></div>")

@@ -9,6 +9,8 @@ from typing import Any
 import panel as pn
 import param
 
+from core.scene import percent_text
+
 from ..files import flag_message
 from ..model import (
     QUANTITIES,
@@ -78,7 +80,7 @@ def badges_html(view: ResultView | None, group: str,
         if flag == "model_error" and evidence is not None:
             # a badge of the model's error says whether it was measured or estimated
             bad, good = (f"{word} ({evidence['label']} "
-                         f"{100 * evidence['error']:.3g} %)" for word in (bad, good))
+                         f"{percent_text(evidence['error'])})" for word in (bad, good))
             text = evidence["message"]
         if flag == "model_error" and "beyond_model_map" in flags:
             good = ""  # an extrapolated estimate vouches for nothing: its own badge says so

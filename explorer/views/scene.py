@@ -64,7 +64,7 @@ class SceneView:
                                            css_classes=["statement-select"])
         self.statement.param.watch(lambda e: setattr(s.loading, "statement", e.new), "value")
         s.loading.param.watch(self.refresh, "statement")
-        self.history_editors = (HistoryEditor("load-0"), HistoryEditor("load-1"))
+        self.history_editors = (HistoryEditor("load-0", reject), HistoryEditor("load-1", reject))
         self.unknowns_note = html_pane("", styles={"font-size": "13px"})
         self.eccentric_load = EccentricityControl(state, controller, reject, drag)
         self.loading = OnePunchOnly(

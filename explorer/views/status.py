@@ -12,6 +12,8 @@ import numbers
 from collections.abc import Mapping
 from typing import Any
 
+from core.scene import percent_text
+
 from ..model import ResultView
 
 #: The solver's stages (``info["stages"]``) in words: what a change made it redo.
@@ -118,7 +120,7 @@ def preview_text(cpu_seconds: float | None) -> str:
 def model_error_text(evidence: Mapping[str, Any]) -> str:
     """The coating model's error in words: measured by the FE check, or estimated."""
     side = "above" if evidence["flagged"] else "within"
-    return (f"Coating model error {100 * evidence['error']:.3g} % ({evidence['label']}), "
+    return (f"Coating model error {percent_text(evidence['error'])} ({evidence['label']}), "
             f"{side} solver.model_tol {100 * evidence['model_tol']:g} %.")
 
 

@@ -16,6 +16,7 @@ from typing import Any
 
 import panel as pn
 import param
+from panel.io.state import set_curdoc
 
 from core.profiles import MAX_TABLE_BYTES, VARIATIONS, profile_from_csv
 
@@ -193,6 +194,20 @@ def watch_release(widget: pn.widgets.Widget, released: Callable[[Any, bool], Non
     widget.param.watch(let_go, "value_throttled")
 
 
+def next_tick(callback: Callable[[], None]) -> None:
+    """Run ``callback`` on the served page's next tick (at once outside a server)."""
+    doc = pn.state.curdoc
+    if doc is None or not doc.session_context:
+        callback()
+        return
+
+    def run() -> None:
+        with set_curdoc(doc):
+            callback()
+
+    doc.add_next_tick_callback(run)
+
+
 class Binding:
     """Widgets editing parameters of one Parameterized at a time (re-bindable)."""
 
@@ -240,10 +255,35 @@ class Binding:
                 # (its drag steps note the drag themselves: ExplorerApp._drag_step_applies)
                 watch_release(widget, lambda event, dragged: released(dragged),
                               lambda: self._syncing)
+        box = getattr(widget, "_value_edit", None)
+        if box is not None:
+            # the text box of a slider emptied: said, and the value shown again (the box
+            # stayed empty, the value unchanged, and nothing said why)
+            box.param.watch(lambda e, name=name, widget=widget: self._emptied(name, widget,
+                                                                               e.new), "value")
         if check is not None:
             self._checks[name] = check
         self._pairs.append((name, widget))
         return widget
+
+    def _emptied(self, name: str, widget: pn.widgets.Widget, value: Any) -> None:
+        if value is not None or self._syncing or self._target is None:
+            return
+        kept = getattr(self._target, name)  # the composite took the None: the state has not
+        if self._on_reject is not None:
+            self._on_reject(f"{widget.name}: a number is needed (the box was empty); it "
+                            f"stays {kept:g}")
+
+        def show() -> None:
+            self._syncing = True
+            try:
+                _set_widget(widget, kept)
+            finally:
+                self._syncing = False
+
+        # on the next tick: a value set while the page's own change is handled is not
+        # sent back to it
+        next_tick(show)
 
     def _lead(self, name: str, value: Any) -> None:
         # the slider moved ahead of its composite: the state follows it now, and the
@@ -475,8 +515,10 @@ def _fit(widget: pn.widgets.Widget, value: float, default: tuple[float, float]) 
 class HistoryEditor:
     """Shape and parameters of the history of one given quantity (live while dragging)."""
 
-    def __init__(self, css: str = "") -> None:
-        self.binding = Binding()
+    def __init__(self, css: str = "", on_reject: Callable[[str], None] | None = None) -> None:
+        """``css``: the class prefix of its widgets; ``on_reject``: says a refused value
+        (an emptied box)."""
+        self.binding = Binding(on_reject)
         self.title = pn.pane.HTML("", margin=(8, 10, 0, 10))
         self.kind = self.binding.add("kind", pn.widgets.Select(
             label="history", options=HISTORY_KINDS, sizing_mode="stretch_width"))

@@ -98,6 +98,22 @@ def test_time_slider_range_follows_a_preset_switch(page: Page):
     assert page.errors == []
 
 
+JS_TIME_RANGE = """() => { const r = Bokeh.documents[0].get_model_by_name('settlement_figure')
+  .x_range; return [r.start, r.end]; }"""
+
+
+def test_the_time_axis_follows_a_preset_with_a_shorter_history(page: Page):
+    """1000 days of lift-off, then the stepped punch's 365: the histories' time axis kept
+    -50 to 1050 days (an automatic range that did not shrink)."""
+    _choose_preset(page, "eccentric_footing_liftoff", "Eccentric footing")
+    until(lambda: page.page.evaluate(JS_TIME_RANGE) == [-50, 1050], "0 to 1000 days",
+          describe=lambda: page.page.evaluate(JS_TIME_RANGE))
+    _choose_preset(page, "stepped_punch", "Stepped punch")
+    until(lambda: page.page.evaluate(JS_TIME_RANGE) == [-18.25, 383.25], "0 to 365 days",
+          describe=lambda: page.page.evaluate(JS_TIME_RANGE))
+    assert page.errors == []
+
+
 def test_a_flag_badge_keeps_the_layout_at_1024px_and_flags_reach_the_csv(page: Page):
     from explorer.files import parse_csv
 
@@ -408,6 +424,46 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
         page.page.get_by_text("Printable report (PDF)").first.click()
     assert Path(info.value.path()).read_bytes().startswith(b"%PDF-")
     assert info.value.suggested_filename.endswith("_report.pdf")
+    assert page.errors == []
+
+
+def test_a_negative_limit_is_refused_saying_so_and_the_last_good_one_stays(page: Page):
+    """The page once clamped -5 to 0 unsaid: a limit every answer fails."""
+    page.open_tab("Check")
+    box = page.page.locator(".limit-settlement input").first
+    box.wait_for(timeout=30_000 * patience())
+    box.fill("50")
+    box.press("Enter")
+    until(lambda: "all set limits hold" in page.text(".design-check"), "the limit checked")
+    box.fill("-5")
+    box.press("Enter")
+    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000 * patience())
+    until(lambda: "settlement limit [mm]: must be a number >= 0" in page.pane_text(".notice"),
+          "the refusal said", describe=lambda: page.pane_text(".notice"))
+    until(lambda: box.input_value() == "50", "the last good limit back in the box",
+          describe=box.input_value)
+    assert "all set limits hold" in page.text(".design-check")
+    # emptied: not checked, and the box is empty (it read "NaN")
+    box.fill("")
+    box.press("Enter")
+    until(lambda: "no limits set" in page.text(".design-check"), "the limit unset")
+    assert box.input_value() == ""
+    assert page.errors == []
+
+
+def test_an_emptied_slider_box_gets_its_value_back_and_says_why(page: Page):
+    """The force's box emptied stayed empty (the force unchanged), with no word."""
+    box = page.page.locator(".load-0-value input").first
+    box.wait_for(timeout=30_000 * patience())
+    kept = box.input_value()
+    box.fill("")
+    box.press("Enter")
+    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000 * patience())
+    until(lambda: "a number is needed" in page.pane_text(".notice"), "the refusal said",
+          describe=lambda: page.pane_text(".notice"))
+    until(lambda: box.input_value() == kept, "the value back in the box",
+          describe=box.input_value)
+    assert page.text(".readout-force") == kept
     assert page.errors == []
 
 

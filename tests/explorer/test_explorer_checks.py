@@ -108,6 +108,13 @@ def test_one_pressure_unit_and_a_colour_scale_that_follows_the_results():
     assert scales.image_range(low) == first
     scales.reset()
     assert scales.pressure_unit(high) == ("MPa", 1e6)
+    # a result 1000 times the family's reads in its own unit (its axes read "5.000e+5
+    # kPa" before), and its colours start again
+    scales.reset()
+    assert scales.pressure_unit(low) == ("kPa", 1e3)
+    huge = replace(low, pressure=low.pressure * 1000, image=low.image * 1000)
+    assert scales.pressure_unit(huge) == ("MPa", 1e6)
+    assert scales.image_range(huge)[1] == nice_ceiling(float(huge.image.max()) / 1e6)
 
 
 def test_pressure_just_below_zero_within_the_error_band_is_not_shaded():
@@ -416,3 +423,26 @@ def test_a_scene_files_limits_fill_the_check_tab_and_a_saved_scene_keeps_them(ex
     for name in ("allowable_pressure", "settlement_limit", "tilt_limit"):
         getattr(app.check_tab, name).value = None
     assert "limits" not in json.loads(app.files_tab._scene_file().getvalue())
+
+
+def test_the_eccentricity_box_follows_the_loads_and_a_negative_limit_is_refused(
+        explorer_app):
+    app = explorer_app(solved=True)
+    check = app.check_tab
+    assert check.eccentricity.value == 0.0  # the default scene's centred force
+    check.eccentricity.value = 0.2
+    moment = app.state.loading.histories["moment"]
+    assert moment.value == pytest.approx(100.0)  # kN m/m: 0.2 m x 500 kN/m
+    # the force changes: the box says the new e, not the 0.2 typed before (re-typing
+    # 0.2 then sets the moment again)
+    app.state.loading.histories["force"].value = 400.0
+    app.controller.solve_now()
+    assert check.eccentricity.value == pytest.approx(0.25)
+    check.eccentricity.value = 0.2
+    assert moment.value == pytest.approx(80.0)
+    # a negative limit is refused, saying so, and the last good one stays
+    check.allowable_pressure.value = 300.0
+    check.allowable_pressure.value = -5.0
+    assert app.limits.allowable_pressure == 300.0 and check.allowable_pressure.value == 300.0
+    assert app.screen.notice.startswith("Value not accepted: allowable bearing pressure "
+                                        "[kPa]: must be a number >= 0")

@@ -64,3 +64,18 @@ def test_report_of_a_lifting_punch_shows_both_contact_sets():
     text = check_report_html(report)
     assert "compared with lift-off" in text
     assert "fast [0.8463, 1] m, FE [0.8258, 1] m" in text and "0.0205 a apart" in text
+
+
+def test_round_off_of_a_centred_load_reads_zero():
+    # the FE tilt of a centred load is round-off (-2.5e-18 rad): it read "-2.4826e-15"
+    report = {"errors": {"settlement": 0.01, "tilt": 0.0, "force": 0.0, "moment": 0.0,
+                         "pressure": 0.03},
+              "fast": {"settlement": 1e-3, "tilt": 3e-20, "force": 1e5, "moment": 1e-11},
+              "fe": {"settlement": 0.99e-3, "tilt": -2.4826e-18, "force": 1e5,
+                     "moment": 2e-10},
+              "model_error": 0.01, "estimate": 0.015, "coating_model": "thin layer",
+              "half_width_m": 1.0, "given": ["force", "moment"], "fe_dofs": 25000,
+              "fe_seconds": 1.2}
+    text = check_report_html(report)
+    assert "e-1" not in text and "e-2" not in text
+    assert "<td>tilt [mrad]</td><td>0</td><td>0</td>" in text

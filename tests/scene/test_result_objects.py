@@ -238,3 +238,12 @@ def test_plot_titles_carry_the_flags_and_render_with_bokeh(flagged: SceneSolutio
     assert any("contact lost" in t for t in titles)
     labels = {a.axis_label for a in figure.select({"type": Axis})}
     assert {"x (m)", "q (MPa)", "t (day)", "settlement (mm)", "tilt (mrad)"} <= labels
+
+
+def test_percentages_for_people_never_in_exponent_notation():
+    from core.scene import percent_text
+
+    # a numerical estimate of 5e-10 read "5e-08 %"
+    assert [percent_text(x) for x in (5e-10, 0.0181, 0.02, 0.000123, 0.0, 15.5)] == [
+        "< 0.001 %", "1.81 %", "2 %", "0.0123 %", "0 %", "1550 %"]
+    assert percent_text(0.0464, 2) == "4.6 %"
