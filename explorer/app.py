@@ -627,6 +627,9 @@ class ExplorerApp(pn.viewable.Viewer):
         check = self._made("check")
         if check is not None:
             check.show_eccentricity()
+        coating = self._made("coating")
+        if coating is not None:
+            coating.check.follow(view.scene)  # a report of another scene says so
         self.results.say_held(False)
         with pn.io.hold():
             self.results.draw(view, index, new_range=shown is None or len(shown.times) != n)

@@ -10,7 +10,7 @@ from typing import Any
 
 import panel as pn
 
-from core.scene import check_scene, percent_text
+from core.scene import check_scene, checked_key, percent_text
 
 from ..model import SCREEN_LAYERS, ExplorerState, Screen
 from ..solving import SolveController, run_in_background
@@ -185,6 +185,13 @@ def _contact_note(report: dict[str, Any]) -> str:
     return ""
 
 
+#: Above a check report made for another scene than the one on screen.
+STALE_NOTE = ("<span class='cp-msg coating-check-stale-note'>Made for an earlier scene "
+              "(the coating, the punch, the base or the loads changed since): these are not "
+              "this scene's numbers, and the badges use the estimate again. Run the check "
+              "again for this scene.</span>")
+
+
 class CoatingCheckView:
     """The "check the coating model" button: runs :func:`core.scene.check_scene`
     on the scene on screen where the session's solves run (a worker process, or a thread
@@ -208,6 +215,8 @@ class CoatingCheckView:
                                                css_classes=["coating-check-progress"])
         self.result = html_pane("", css_classes=["coating-check-result"],
                                 sizing_mode="stretch_width")
+        self._report: dict[str, Any] | None = None  # the report on screen
+        self._stale = False
         self.button.on_click(lambda event: self.run())
         self.panel = pn.Column(
             html_pane("<small>Compare the answer with a finite-element model that resolves "
@@ -246,10 +255,26 @@ class CoatingCheckView:
         """Show a report (dict) or a message (str) and make the button ready again."""
         self.progress.visible = False
         self.button.disabled = False
+        self._report = outcome if isinstance(outcome, dict) else None
+        self._stale = False
         self.result.object = (check_report_html(outcome) if isinstance(outcome, dict)
                               else f"<span class='cp-msg'>{outcome}</span>")
         if isinstance(outcome, dict) and self.screen is not None:
             self.screen.model_check = outcome
+
+    def follow(self, scene: dict[str, Any]) -> None:
+        """A new result of ``scene``: a report made for another scene (the geometry, the
+        materials or the loads changed since) is marked as such, and unmarked when the
+        scene it was made for is back (an undo)."""
+        if self._report is None:
+            return
+        stale = checked_key(scene) != self._report.get("scene_key")
+        if stale == self._stale:
+            return
+        self._stale = stale
+        report = check_report_html(self._report)
+        self.result.object = (STALE_NOTE + f"<div class='coating-check-stale'>{report}</div>"
+                              if stale else report)
 
 
 def start_in_background(work: Callable[[], None]) -> None:

@@ -79,3 +79,20 @@ def test_round_off_of_a_centred_load_reads_zero():
     text = check_report_html(report)
     assert "e-1" not in text and "e-2" not in text
     assert "<td>tilt [mrad]</td><td>0</td><td>0</td>" in text
+
+
+def test_a_report_of_an_earlier_scene_says_so_until_that_scene_is_back(explorer_app):
+    app = explorer_app(solved=True)
+    check = app.coating_tab.check
+    check.run()  # no executor: solved here
+    assert "model error: measured" in check.result.object
+    assert "Made for an earlier scene" not in check.result.object
+    force = app.state.loading.histories["force"]
+    force.value = 400.0
+    app.controller.solve_now()
+    # the report stayed as if it were this scene's (the badges had gone back to the
+    # estimate, the panel had not)
+    assert check.result.object.startswith("<span class='cp-msg coating-check-stale-note'>")
+    force.value = 500.0
+    app.controller.solve_now()
+    assert "Made for an earlier scene" not in check.result.object
