@@ -61,6 +61,9 @@ FLAG_MESSAGES: dict[str, str] = {
                      "somewhere: the thin (Winkler) coating model is doubtful.",
     "stiff_coating": "A coating layer is stiffer than the base at loading somewhere: the "
                      "thin-coating model assumes soft coatings.",
+    "no_contact": "The punch does not touch the coating at some output times: q = 0 and "
+                  "P = M = 0 there (the given settlement and tilt hold it clear of the "
+                  "surface; the settlement is positive downward, into the foundation).",
     "large_settlement": f"The punch base moves down more than {100 * LARGE_SETTLEMENT:g} % "
                         "of the foundation's thickness (base and coating): strains this "
                         "large are beyond the small-strain (linear elastic) model.",
@@ -234,6 +237,8 @@ class SceneSolution:
         thin = solution.info.get("coating_model") != EXACT_LAYERED
         # the extremes on the scene's samples, shared by scenes of the same geometry
         # against the narrowest contact zone where the punch lifts off
+        if any(not zones for zones in self.contact_set):
+            flags.append("no_contact")  # often a settlement's sign: said, not left to q = 0
         if thin and thick_coating(scene, self.model_error.get("zone_m")):
             flags.append("thick_coating")
         if self.model_error["estimate"] > scene.model_tol:

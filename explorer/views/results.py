@@ -47,7 +47,9 @@ BADGES: dict[str, dict[str, tuple[str, str]]] = {
                               "coating model within solver.model_tol"),
               "beyond_model_map": ("coating model error extrapolated: check it (Coating "
                                    "tab)", "")},
-    "pressure": {"contact_lost": ("contact lost: q < 0 (shaded)", "full contact")},
+    "pressure": {"contact_lost": ("contact lost: q < 0 (shaded)", "full contact"),
+                 "no_contact": ("no contact at some times: the punch is clear of the surface",
+                                "")},
     "history": {"large_settlement": ("settlement beyond small strains", "small strains"),
                 "large_tilt": ("large tilt", "small tilt")},
     "status": {"tol_not_met": ("tolerance not met", ""),

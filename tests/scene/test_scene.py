@@ -439,6 +439,18 @@ def test_flag_large_tilt():
     assert result.tilt[0] == 0.015
 
 
+def test_flag_no_contact():
+    # a settlement given upward (a sign slip: it is positive downward) holds the punch
+    # clear: q = 0, P = 0 exactly, which was answered with no flag and an estimate of 0
+    d = scene_file("uniform_flat")
+    d["loading"] = {"settlement": -1e-3, "tilt": 0.0}
+    result = solve(d)
+    assert result.flags == ["no_contact"] and not result.force.any()
+    assert "positive downward" in result.flag_messages["no_contact"]
+    d["loading"]["settlement"] = 1e-4
+    assert solve(d).flags == []
+
+
 def test_flag_large_settlement():
     # the punch base moving down more than 1 % of the 4.02 m foundation: 4.08 cm under
     # 500 MN/m (a load the explorer's number box accepts) raised no flag before
