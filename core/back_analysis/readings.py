@@ -47,6 +47,11 @@ MAX_TILT = 0.5
 MAX_TIME = 365_250.0
 #: ``name [unit]`` or ``name (unit)`` in a header cell.
 _HEADER = re.compile(r"\s*([A-Za-z_]+)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*")
+#: Columns of this program's own history files that are not readings (forces, moments,
+#: the contact zone, flags): a history written by ``solve`` or the explorer reads as
+#: readings with these left out.
+_OUTPUT_COLUMNS = re.compile(r"\s*(force|moment|contact|lifted|lift_off|zone\d+)(_.*)?\s*"
+                             r"|\s*flags\s*", re.IGNORECASE)
 _MAX_RANGE = {"settlement": MAX_SETTLEMENT, "tilt": MAX_TILT}
 
 
@@ -97,6 +102,24 @@ class Readings:
 
 
 # ------------------------------------------------------------------------- checks
+
+
+def _column(cell: str) -> tuple[str | None, str | None]:
+    """The column and its unit of a header cell: ``name``, ``name [unit]``, ``name
+    (unit)`` or ``name_unit`` as this program writes its histories (``time_day``,
+    ``settlement_m``, ``tilt_mrad``); (None, None) for anything else."""
+    match = _HEADER.fullmatch(cell)
+    if match is None:
+        return None, None
+    name = match.group(1).lower()
+    if name in COLUMNS:
+        return name, match.group(2)
+    if match.group(2) is None and "_" in name:
+        base, unit = name.rsplit("_", 1)
+        kind = "time" if base == "time" else base.removesuffix("_std")
+        if base in COLUMNS and unit in UNIT_FACTORS[kind]:
+            return base, unit
+    return None, None
 
 
 def _unit_factor(column: str, unit: str | None, where: str) -> float:
@@ -251,9 +274,10 @@ def _with_source(readings: Readings, source: str) -> Readings:
 def readings_from_csv(text: str, source: str = "readings.csv") -> Readings:
     """Readings from CSV text: ``#`` lines are comments; the first other line is the
     header, naming the columns (``time``, ``settlement``, ``settlement_std``, ``tilt``,
-    ``tilt_std``) each with an optional unit (``settlement [mm]``; a ``_std`` column
-    without one takes its series' unit); an empty cell is no reading. Raises
-    ValueError naming the line and the column."""
+    ``tilt_std``) each with an optional unit (``settlement [mm]`` or ``settlement_mm``; a
+    ``_std`` column without one takes its series' unit); an empty cell is no reading.
+    The histories this program writes read as they are (their force, moment, contact
+    and flag columns are left out). Raises ValueError naming the line and the column."""
     lines = [(k + 1, line) for k, line in enumerate(text.splitlines())
              if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
@@ -261,17 +285,20 @@ def readings_from_csv(text: str, source: str = "readings.csv") -> Readings:
     head_line, head = lines[0]
     names: list[str] = []
     units: dict[str, str | None] = {}
+    skipped: set[int] = set()
     for k, cell in enumerate(next(csv.reader([head]))):
-        match = _HEADER.fullmatch(cell)
-        if match is None or match.group(1).lower() not in COLUMNS:
+        if _OUTPUT_COLUMNS.fullmatch(cell):
+            skipped.add(k)
+            continue
+        name, unit = _column(cell)
+        if name is None:
             raise ValueError(f"{source}: line {head_line}, column {k + 1}: unknown column "
                              f"{cell.strip()!r} (known: {', '.join(COLUMNS)}, each with "
-                             "an optional unit as 'settlement [mm]')")
-        name = match.group(1).lower()
+                             "an optional unit as 'settlement [mm]' or 'settlement_mm')")
         if name in names:
             raise ValueError(f"{source}: line {head_line}, column {name}: given twice")
         names.append(name)
-        units[name] = match.group(2)
+        units[name] = unit
     factors = {}
     for name in names:
         unit = units[name]
@@ -284,11 +311,13 @@ def readings_from_csv(text: str, source: str = "readings.csv") -> Readings:
         raise ValueError(f"{source}: at most {MAX_READINGS} readings (each is an output "
                          f"time of every solve of the fit), got {len(rows)} rows")
     columns: dict[str, list[float | None]] = {name: [] for name in names}
+    width = len(names) + len(skipped)
     for line_no, line in rows:
         cells = next(csv.reader([line]))
-        if len(cells) != len(names):
+        if len(cells) != width:
             raise ValueError(f"{source}: line {line_no}: {len(cells)} cells, the header "
-                             f"names {len(names)} columns")
+                             f"names {width} columns")
+        cells = [cell for k, cell in enumerate(cells) if k not in skipped]
         for name, cell in zip(names, cells, strict=True):
             text_value = cell.strip()
             if not text_value:

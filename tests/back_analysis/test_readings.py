@@ -93,3 +93,24 @@ def test_bad_mapping_entries_are_named(data: dict, message: str) -> None:
     with pytest.raises(ValueError) as info:
         readings_from_mapping(data)
     assert str(info.value).startswith(message), str(info.value)
+
+
+def test_the_histories_this_program_writes_read_as_readings() -> None:
+    # the command line's CSV (its '#' lines, SI units in the column names) and the
+    # explorer's (mm, mrad, contact and flag columns): the header was refused
+    # ("unknown column 'time_day'")
+    import core
+
+    result = core.solve(core.load_scene("preset:eccentric_creep"))
+    read = readings_from_csv(result.to_csv(), "solve.csv")
+    assert read.series == ("settlement", "tilt")
+    np.testing.assert_allclose(read.time, result.times)
+    np.testing.assert_allclose(read.settlement, result.settlement)
+    np.testing.assert_allclose(read.tilt, result.tilt)
+    page = ("# coated-punch explorer: histories\n"
+            "time_day,settlement_mm,tilt_mrad,force_kN_per_m,moment_kN_m_per_m,"
+            "contact_width_m,lifted_length_m,flags\n"
+            "1,2.5,0.5,500,100,2,0,\n10,3.0,0.6,500,100,2,0,large_tilt\n")
+    read = readings_from_csv(page, "page.csv")
+    np.testing.assert_allclose(read.settlement, [2.5e-3, 3.0e-3])
+    np.testing.assert_allclose(read.tilt, [5e-4, 6e-4])
