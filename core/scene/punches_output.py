@@ -15,9 +15,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from core import limits
 from core.scene.design import DesignCheck, DesignLimits, check_design
-from core.scene.results import history_columns
+from core.scene.results import history_columns, pressure_points
 
 if TYPE_CHECKING:
     from core.scene.punches import PunchesSolution
@@ -53,15 +52,8 @@ def surface_pressure(result: PunchesSolution, x: Any) -> np.ndarray:
     Raises ValueError naming ``x``: a point that is not finite, or more points than
     :data:`core.limits.MAX_PRESSURE_VALUES` values allow (checked before any work).
     """
-    xs = np.atleast_1d(np.asarray(x, dtype=float))
     times = result.times.size
-    if xs.size * times > limits.MAX_PRESSURE_VALUES:
-        raise ValueError(
-            f"x: {xs.size} points at {times} times are more than the "
-            f"{limits.MAX_PRESSURE_VALUES} pressure values one call may compute; ask for "
-            "fewer points (or in several calls)")
-    if xs.ndim != 1 or np.any(~np.isfinite(xs)):
-        raise ValueError("x: must be finite numbers (positions along the surface, m)")
+    xs = pressure_points(x, times)
     q = np.zeros((xs.size, times))
     for punch in result.punches:
         a = punch.scene.half_width

@@ -29,6 +29,7 @@ from core.scene.load_rates import oscillations
 from core.scene.model import Scene
 from core.scene.records import PROGRAM, csv_header
 from core.scene.schema import SCHEMA_VERSION, _jsonable
+from core.validation import show_value
 from core.version import VERSION
 
 if TYPE_CHECKING:
@@ -125,6 +126,28 @@ def scene_model_error(scene: Scene, share_of_tilt: float,
         # the geometry's stages stay as they were
         mapped = model_error_map(scene, zone)
     return {**model_error_estimate(scene, share_of_tilt, mapped), "zone_m": zone}
+
+
+def pressure_points(x: Any, times: int) -> np.ndarray:
+    """``x`` as positions [m] where a pressure is asked at ``times`` output times: a number
+    or a list (a 1-D array) of finite numbers, at most
+    :data:`core.limits.MAX_PRESSURE_VALUES` values in all. Raises ValueError naming
+    ``x`` (a text, a 2-D array or NaN gave NumPy's own messages)."""
+    try:
+        xs = np.atleast_1d(np.asarray(x, dtype=float))
+    except (TypeError, ValueError):
+        raise ValueError(f"x: positions must be numbers [m], got {show_value(x)}") from None
+    if xs.ndim != 1:
+        raise ValueError(f"x: a number or a list of positions [m] (one dimension), got an "
+                         f"array of shape {xs.shape}; pass x.ravel() and reshape the rows")
+    if xs.size * times > limits.MAX_PRESSURE_VALUES:
+        raise ValueError(
+            f"x: {xs.size} points at {times} times are more than the "
+            f"{limits.MAX_PRESSURE_VALUES} pressure values one call may compute; ask "
+            "for fewer points (or in several calls)")
+    if not np.all(np.isfinite(xs)):
+        raise ValueError("x: positions must be finite numbers [m]")
+    return xs
 
 
 def corner_pressure(scene: Scene, coating_model: str,
@@ -300,13 +323,8 @@ class SceneSolution:
         :data:`core.limits.MAX_PRESSURE_VALUES` values allow (checked before any work).
         """
         a = self.scene.half_width
-        xs = np.atleast_1d(np.asarray(x, dtype=float))
-        if xs.size * self.times.size > limits.MAX_PRESSURE_VALUES:
-            raise ValueError(
-                f"x: {xs.size} points at {self.times.size} times are more than the "
-                f"{limits.MAX_PRESSURE_VALUES} pressure values one call may compute; ask "
-                "for fewer points (or in several calls)")
-        if np.any(~np.isfinite(xs)) or np.any(np.abs(xs) > a * (1 + 1e-12)):
+        xs = pressure_points(x, self.times.size)
+        if np.any(np.abs(xs) > a * (1 + 1e-12)):
             raise ValueError(f"x: the pressure is defined on [-a, a] = [{-a:g}, {a:g}] m only")
         # x = +-a can land a rounding error outside [-1, 1] after the division
         q_star = self.dimensionless.pressure(np.clip(xs / a, -1.0, 1.0))

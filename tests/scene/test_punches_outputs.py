@@ -96,7 +96,7 @@ def test_pressure_is_zero_on_the_free_surface_and_the_punch_on_its_zone(
 
 
 def test_pressure_refuses_what_it_cannot_answer(pair: PunchesSolution) -> None:
-    with pytest.raises(ValueError, match=r"^x: must be finite"):
+    with pytest.raises(ValueError, match=r"^x: positions must be finite"):
         pair.pressure([0.0, np.nan])
     too_many = limits.MAX_PRESSURE_VALUES // pair.times.size + 1
     with pytest.raises(ValueError, match=r"^x: .* more than"):

@@ -247,3 +247,17 @@ def test_percentages_for_people_never_in_exponent_notation():
     assert [percent_text(x) for x in (5e-10, 0.0181, 0.02, 0.000123, 0.0, 15.5)] == [
         "< 0.001 %", "1.81 %", "2 %", "0.0123 %", "0 %", "1550 %"]
     assert percent_text(0.0464, 2) == "4.6 %"
+
+
+@pytest.mark.parametrize(("x", "message"), [
+    (np.zeros((2, 3)), "x: a number or a list of positions [m] (one dimension)"),
+    ("abc", "x: positions must be numbers [m], got 'abc'"),
+    ([float("nan")], "x: positions must be finite numbers [m]"),
+    ([2.0], "x: the pressure is defined on [-a, a]"),
+])
+def test_bad_positions_of_the_pressure_are_named(x, message):
+    # a 2-D array gave NumPy's "operands could not be broadcast together"
+    result = solve(scene_file("uniform_flat"))
+    with pytest.raises(ValueError) as info:
+        result.pressure(x)
+    assert str(info.value).startswith(message), str(info.value)
