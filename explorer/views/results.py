@@ -129,7 +129,8 @@ def punches_readout_html(view: ResultView, index: int) -> str:
     contact = html.escape(contact_text(view, index))
     return (f"<div class='readout punches-readout'><b>At t = {days_text(t)} after loading"
             f"</b> · each punch's moment and tilt about its own centre"
-            f"<table class='cp-readout'>{''.join(rows)}</table>"
+            f"<div class='readout-scroll'><table class='cp-readout'>{''.join(rows)}</table>"
+            "</div>"
             f"<div class='contact-readout'>{contact}</div>"
             f"<div class='cp-status several-punches-note'>{html.escape(SEVERAL_PUNCHES_NOTE)}"
             f"</div></div>")
@@ -168,7 +169,10 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
     ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
     contact = html.escape(contact_text(view, index))
     return (f"<div class='readout'><b>At t = {days_text(t)} after loading</b> · {ecc}"
-            f"<table class='cp-readout'>{''.join(rows)}</table>"
+            # pins add two columns each: at 1024 px three pins' table is twice the box
+            # wide, and its last columns were cut off with no way to reach them
+            f"<div class='readout-scroll'><table class='cp-readout'>{''.join(rows)}</table>"
+            "</div>"
             f"<div class='contact-readout'>{contact}</div></div>")
 
 

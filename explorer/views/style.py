@@ -14,6 +14,7 @@ CSS = """
 .cp-ok {background: #e3f5e6; color: #1d6b2c; border: 1px solid #a8dcb2;}
 .cp-msg {font-size: 12px; color: #9b1c1c; margin-left: 4px; overflow-wrap: anywhere;}
 .coating-check-stale {opacity: 0.45;}
+.readout-scroll {overflow-x: auto; max-width: 100%;}
 .cp-status {font-size: 12px; color: #444;}
 .cp-status.model-flagged {color: #9b1c1c; font-weight: 600;}
 .cp-readout td, .cp-readout th {padding: 1px 8px; font-size: 13px; text-align: right;}

@@ -165,3 +165,29 @@ def test_pin_the_steps_of_the_force_over_a_range(page: Page) -> None:
     # the scene on screen kept its force
     assert page.text(".readout-force") == "500"
     assert page.errors == []
+
+
+JS_READOUT_SCROLL = """el => { const last = [...el.querySelectorAll('th')].pop();
+  el.scrollLeft = el.scrollWidth;
+  return {overflow: getComputedStyle(el).overflowX, client: el.clientWidth,
+          scroll: el.scrollWidth, right: el.getBoundingClientRect().right,
+          last: last.getBoundingClientRect().right}; }"""
+
+
+def test_three_pins_columns_can_be_reached_at_1024px(page: Page) -> None:
+    """At 1024 px the readout with three pins is wider than its box: its last columns
+    were cut off with no scrollbar (839 px of table in 434 px)."""
+    page.page.set_viewport_size({"width": 1024, "height": 768})
+    clear = page.page.locator(".unpin-button button").first
+    if clear.is_enabled():  # what earlier tests pinned
+        clear.click()
+    until(lambda: _pins(page) == 0, "no pins")
+    for force in ("600", "700", "800"):
+        page.page.get_by_text("Pin this result").first.click()
+        until(lambda n=_pins(page) + 1: _pins(page) == n, "one more pin")
+        page.type_into(".load-0-value", force)
+        until(lambda force=force: page.text(".readout-force") == force, f"force {force}")
+    box = page.page.locator(".readout-scroll").first.evaluate(JS_READOUT_SCROLL)
+    assert box["overflow"] == "auto" and box["scroll"] > box["client"], box
+    assert box["last"] <= box["right"] + 1, box  # scrolled, the last column is in view
+    assert page.errors == []
