@@ -182,9 +182,9 @@ def test_three_pins_columns_can_be_reached_at_1024px(page: Page) -> None:
     if clear.is_enabled():  # what earlier tests pinned
         clear.click()
     until(lambda: _pins(page) == 0, "no pins")
-    for force in ("600", "700", "800"):
+    for n, force in enumerate(("600", "700", "800"), start=1):
         page.page.get_by_text("Pin this result").first.click()
-        until(lambda n=_pins(page) + 1: _pins(page) == n, "one more pin")
+        until(lambda n=n: _pins(page) == n, f"{n} pins")
         page.type_into(".load-0-value", force)
         until(lambda force=force: page.text(".readout-force") == force, f"force {force}")
     box = page.page.locator(".readout-scroll").first.evaluate(JS_READOUT_SCROLL)
