@@ -29,6 +29,7 @@ passes one that schedules on its Bokeh document); the default applies them at on
 from __future__ import annotations
 
 import logging
+import re
 import threading
 import time
 from collections.abc import Callable
@@ -171,8 +172,30 @@ def describe_field(path: str) -> str:
     return f"{words}, {rest.replace('.', ', ').replace('_', ' ')}" if rest else words
 
 
+#: A number with an SI unit of force, moment or stress in the core's messages.
+_SI_VALUE = re.compile(r"(?<![\w.])(-?\d+(?:\.\d*)?(?:e[+-]?\d+)?) (N·m/m|N/m|Pa)(?![\w/·])")
+#: The page's unit of each (its size in SI): loads in kN/m and kN·m/m as the sliders.
+_PAGE_UNITS = {"N/m": ("kN/m", 1e3), "N·m/m": ("kN·m/m", 1e3)}
+
+
+def _page_units(text: str) -> str:
+    """The core's SI values of forces, moments and stresses in the page's units ("P =
+    -200000 N/m" reads "P = -200 kN/m"; a stress in kPa or MPa as it reads best)."""
+    def shown(match: re.Match[str]) -> str:
+        value, unit = float(match.group(1)), match.group(2)
+        if unit == "Pa":
+            unit, size = ("MPa", 1e6) if abs(value) >= 1e6 else ("kPa", 1e3)
+        else:
+            unit, size = _PAGE_UNITS[unit]
+        return f"{value / size:.6g} {unit}"
+
+    return _SI_VALUE.sub(shown, text)
+
+
 def format_error(message: str) -> str:
-    """The core's ``"field.path: reason"`` message with the field also named in words."""
+    """The core's ``"field.path: reason"`` message with the field also named in words,
+    and its SI values of forces, moments and stresses in the page's units."""
+    message = _page_units(message)
     path, sep, reason = message.partition(":")
     if not sep or " " in path.strip():
         return message

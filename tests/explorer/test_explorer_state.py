@@ -299,6 +299,19 @@ def test_solver_crash_is_a_message_not_an_exception():
     assert "boom" in controller.error and controller.view is None
 
 
+def test_format_error_says_loads_and_stresses_in_the_page_units():
+    # the sliders read kN/m and kN·m/m; the messages read "P = -200000 N/m"
+    assert format_error("loading.force: the punch is pulled away (P = -200000 N/m at t = 0 "
+                        "days after loading)") == (
+        "Loading, force (loading.force): the punch is pulled away (P = -200 kN/m at t = 0 "
+        "days after loading)")
+    assert "M = 480 kN·m/m with no force (P = 0 kN/m)" in format_error(
+        "loading.moment: M = 480000 N·m/m with no force (P = 0 N/m) at t = 1 days")
+    assert format_error("coating[0].modulus: got -5e+06 Pa, 2.5e9 Pa, 300 Pa").endswith(
+        "got -5 MPa, 2500 MPa, 0.3 kPa")
+    assert format_error("base.thickness: must be > 0 m, got -1.5 m").endswith("got -1.5 m")
+
+
 def test_format_error_names_the_field_in_words():
     assert describe_field("coating[1].thickness") == "Coating layer 2, thickness"
     assert describe_field("base.creep.rate") == "Base, creep, rate"
