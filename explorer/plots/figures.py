@@ -181,6 +181,8 @@ class Figures:
         self.history_src: dict[str, ColumnDataSource] = {}
         self.history_point_src: dict[str, ColumnDataSource] = {}
         self.history_fig = {}
+        self._presenting = False
+        self._history_state = dict.fromkeys(QUANTITIES, "computed")
         self.history_line = {}
         self.history_cursor = {}
         # several punches: a line per punch on each history (none for one punch)
@@ -369,8 +371,8 @@ class Figures:
                 gives = [q in p.given for p in view.punches]
                 state = ("given, per punch" if all(gives) else "computed, per punch"
                          if not any(gives) else "per punch (given for some)")
-            unit = QUANTITY_UNITS[q][0]
-            self.history_fig[q].title.text = f"{TITLES[q]} {SYMBOLS[q]} [{unit}]: {state}"
+            self._history_state[q] = state
+            self._title_history(q)
         self.pins.show(view, pins, index)
         self.show_time(view, index, pins, pinned_drawn=True)
         self.fit_axes(view, pins)
@@ -491,9 +493,21 @@ class Figures:
         return [self.scene_fig, self.q_fig, self.image_fig,
                 *(self.history_fig[q] for q in QUANTITIES), self.contact_fig, self.inset_fig]
 
+    def _title_history(self, q: str) -> None:
+        """A history's title: the quantity, its unit and whether it is given or computed;
+        without the unit (which its axis label gives) in presentation mode, where at
+        1024 px the title ran past its plot ("Settlement δ [mm]: computed")."""
+        unit = "" if self._presenting else f" [{QUANTITY_UNITS[q][0]}]"
+        text = f"{TITLES[q]} {SYMBOLS[q]}{unit}: {self._history_state[q]}"
+        if self.history_fig[q].title.text != text:
+            self.history_fig[q].title.text = text
+
     def set_presentation(self, on: bool) -> None:
         """Fonts a projector shows from the back of a room (ticks and labels of
         :data:`PRESENTATION_FONT`), or the normal ones."""
+        self._presenting = on
+        for q in QUANTITIES:
+            self._title_history(q)
         tick, label, title = ((PRESENTATION_FONT, PRESENTATION_FONT, PRESENTATION_FONT)
                               if on else ("11px", "13px", "13px"))
         for fig in self.all_figures():
@@ -504,7 +518,9 @@ class Figures:
                 # ticks of 18 px on a 240 px plot: fewer of them, or they touch
                 if hasattr(axis.ticker, "desired_num_ticks"):
                     axis.ticker.desired_num_ticks = PRESENTATION_TICKS if on else 6
-            fig.toolbar_location = None if on else "above"
+            # hidden, not taken off: a toolbar put back (toolbar_location) made BokehJS
+            # throw "cannot find a view for ToolbarPanel" as presentation mode ended
+            fig.toolbar.visible = not on
         legend = self.q_fig.legend[0]
         legend.label_text_font_size = "11px" if on else LEGEND_FONT
         legend.glyph_width = 14 if on else 20

@@ -104,8 +104,9 @@ class SceneDrawing:
         self.arrow_label = Label(x=0, y=0, text="", text_font_size="11px",
                                  text_color="#d62728", x_offset=6, level=MOVING)
         p.add_layout(self.arrow_label)
+        # above the scale note (bottom left, 4 px up): at 4 px both overlapped
         self.base_label = Label(x=0, y=0, text="", text_font_size="11px", text_color="#333",
-                                x_offset=4, y_offset=4)
+                                x_offset=4, y_offset=20)
         p.add_layout(self.base_label)
         # the vertical exaggeration, inside the plot: in the title it made the title too
         # long for a 1024 px screen

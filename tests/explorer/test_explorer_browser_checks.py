@@ -602,6 +602,12 @@ def test_presentation_mode_has_projector_fonts_at_1024(page: Page):
     assert page.page.evaluate(JS_VIEW_WIDTH, "pressure_figure") > 250
     sizes, other = page.page.evaluate(JS_FONT_SIZES)
     assert sizes > 50 and other == [], other
+    # a history's title without its unit (its axis says it): at 18 px "Settlement δ [mm]:
+    # computed" ran past its 1024 px plot
+    title = f"() => {doc}.get_model_by_name('settlement_figure').title.text"
+    _wait(page, f"() => ({title})() === 'Settlement δ: computed'")
+    page.page.locator(".presentation-toggle button").first.click()
+    _wait(page, f"() => ({title})() === 'Settlement δ [mm]: computed'")
     assert page.errors == []
 
 
