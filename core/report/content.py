@@ -21,6 +21,7 @@ from core.scene import (
     flags_with_evidence,
     largest_pressure,
     model_error_evidence,
+    percent_text,
 )
 from core.version import VERSION
 
@@ -118,15 +119,17 @@ def accuracy_rows(result: SceneSolution,
         ("numerical error (estimated, relative)",
          (f"{float(error):.1e}" if isinstance(error, (int, float)) else "not available")
          + target),
+        # in percent, as the page and the command line write them (the report read
+        # "1.8e-02" where the page read 1.81 %)
         *([(f"coating model error ({evidence['label']}, relative)",
-            f"{evidence['measured']:.1e} at t = {_number(evidence['time_day'])} d "
-            f"(flagged above {result.scene.model_tol:g}: "
+            f"{percent_text(evidence['measured'])} at t = {_number(evidence['time_day'])} "
+            f"d (flagged above {percent_text(result.scene.model_tol)}: "
             + ("FLAGGED)" if evidence["flagged"] else "within)"))]
           if evidence["source"] == "measured" else []),
         ("coating model error (estimated, relative)",
          "0: no coating, no coating model" if not result.scene.coating else
-         f"{float(result.model_error['estimate']):.1e} (flagged above "
-         f"{result.scene.model_tol:g})"
+         f"{percent_text(float(result.model_error['estimate']))} (flagged above "
+         f"{percent_text(result.scene.model_tol)})"
          + ("; the FE check's measurement above overrides it"
             if evidence["source"] == "measured" else "")),
         ("solved by", engine_text(result)),

@@ -42,8 +42,9 @@ def test_a_measurement_of_the_scene_overrides_the_estimate(result):
     assert "3.58 %" in validity["rows"]["model_error"]
     assert "measured by the FE check" in validity["rows"]["model_error"]
     rows = text["Accuracy"]["rows"]
-    assert rows[MEASURED_ROW].startswith("3.6e-02") and "FLAGGED" in rows[MEASURED_ROW]
-    assert rows[ESTIMATED_ROW].startswith("4.6e-02")  # next to it, not replaced
+    # in percent, as the page writes them (the report read "3.6e-02")
+    assert rows[MEASURED_ROW].startswith("3.58 % at t = 0 d (flagged above 2 %: FLAGGED)")
+    assert rows[ESTIMATED_ROW].startswith("4.64 %")  # next to it, not replaced
 
 
 def test_a_measurement_within_the_tolerance_lowers_an_estimated_flag(result):
