@@ -317,7 +317,9 @@ class Figures:
                 source = getattr(renderer, "data_source", None)
                 if source is None or not renderer.visible:
                     continue
-                t = np.asarray(source.data.get("t", []), dtype=float)
+                # a line per punch of several holds its times in "xs"
+                columns = [source.data.get("t", []), *source.data.get("xs", [])]
+                t = np.concatenate([np.asarray(c, dtype=float).ravel() for c in columns])
                 t = t[np.isfinite(t)]
                 if t.size:
                     lo, hi = min(lo, float(t.min())), max(hi, float(t.max()))
