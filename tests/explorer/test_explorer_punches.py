@@ -140,7 +140,8 @@ def test_the_page_shows_each_punch_and_turns_off_what_is_for_one(explorer_app) -
     assert legend.visible and [i.visible for i in legend.items] == [True, True, False, False]
     # the time axis spans the punches' lines (their times are in "xs")
     span = float(view.times[-1] - view.times[0])
-    assert figures.time_range.end == pytest.approx(float(view.times[-1]) + 0.05 * span)
+    assert (figures.time_range.start, figures.time_range.end) == pytest.approx(
+        (float(view.times[0]) - 0.05 * span, float(view.times[-1]) + 0.05 * span))
     assert not figures.history_line["settlement"].visible
     assert figures.drawing.punches_src.data["name"] == ["punch 1", "punch 2"]
     assert "punch 2 (x = 3 m)" in app.results.readout.object
