@@ -192,10 +192,19 @@ def _page_units(text: str) -> str:
     return _SI_VALUE.sub(shown, text)
 
 
+#: A length in metres in the core's messages.
+_METRES = re.compile(r"(?<![\w.])(-?\d+(?:\.\d*)?(?:e[+-]?\d+)?) m(?![\w/·²])")
+#: Fields whose box on the page is in millimetres (a coating layer's thickness).
+_MILLIMETRE_FIELDS = re.compile(r"(punches\[\d+\]\.)?coating\[\d+\]\.thickness")
+
+
 def format_error(message: str) -> str:
     """The core's ``"field.path: reason"`` message with the field also named in words,
-    and its SI values of forces, moments and stresses in the page's units."""
+    and its SI values of forces, moments and stresses in the page's units (a coating's
+    thickness in mm, as its box)."""
     message = _page_units(message)
+    if _MILLIMETRE_FIELDS.match(message.partition(":")[0].strip()):
+        message = _METRES.sub(lambda m: f"{1e3 * float(m.group(1)):.6g} mm", message)
     path, sep, reason = message.partition(":")
     if not sep or " " in path.strip():
         return message

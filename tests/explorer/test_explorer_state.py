@@ -310,6 +310,9 @@ def test_format_error_says_loads_and_stresses_in_the_page_units():
     assert format_error("coating[0].modulus: got -5e+06 Pa, 2.5e9 Pa, 300 Pa").endswith(
         "got -5 MPa, 2500 MPa, 0.3 kPa")
     assert format_error("base.thickness: must be > 0 m, got -1.5 m").endswith("got -1.5 m")
+    # a coating layer's thickness box is in mm
+    assert format_error("coating[0].thickness: must be > 0 m, got -0.005 m").endswith(
+        "must be > 0 mm, got -5 mm")
 
 
 def test_format_error_names_the_field_in_words():
