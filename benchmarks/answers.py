@@ -87,7 +87,7 @@ def _presets(out: dict[str, np.ndarray]) -> None:
             for name in RECORD_KEYS:
                 document.pop(name, None)
             out[f"{key}.json"] = np.asarray(json.dumps(_answer_only(document)))
-            out[f"{key}.csv"] = np.asarray(result.to_csv())
+            out[f"{key}.csv"] = np.asarray(result.to_csv(header=False))
             out[f"{key}.q"] = np.asarray(result.pressure_on_grid, dtype=float)
 
 

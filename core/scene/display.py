@@ -63,8 +63,8 @@ def percent_text(share: float, digits: int = 3) -> str:
     if value == 0:
         return "0 %"
     if abs(value) < PERCENT_FLOOR:
-        return f"{'-' if value < 0 else ''}< {PERCENT_FLOOR:g} %"
-    if abs(value) >= 10.0 ** digits:  # where "g" would turn to exponent notation
+        return f"> -{PERCENT_FLOOR:g} %" if value < 0 else f"< {PERCENT_FLOOR:g} %"
+    if abs(float(f"{value:.{digits}g}")) >= 10.0 ** digits:  # "g" would write an exponent
         return f"{value:.0f} %"
     return f"{value:.{digits}g} %"
 

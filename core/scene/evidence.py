@@ -22,7 +22,8 @@ from core.scene.results import FLAG_MESSAGES
 from core.scene.validate import scene_from_dict, solver_model_tol
 
 #: The parts of a scene the FE check's answer depends on (its geometry, materials, age at
-#: loading and loads); the name, output times, solver settings and limits do not enter it.
+#: loading and loads) and its contact model (full contact is checked in full contact, the
+#: others with lift-off); the name, output times, tolerances and limits do not enter it.
 CHECKED_PARTS = ("punch", "coating", "base", "loading")
 #: How a measured error is named wherever it is shown.
 MEASURED = "measured by the FE check"
@@ -33,9 +34,13 @@ ESTIMATED = "estimated"
 def checked_key(scene: Scene | Mapping[str, Any]) -> str:
     """Content hash of what :func:`core.scene.check_scene`'s answer depends on: equal for
     two scenes whose check gives the same measurement (``CHECKED_PARTS`` equal)."""
-    data = scene_from_dict(scene).to_dict()
+    scene = scene_from_dict(scene)
+    data = scene.to_dict()
+    # a check in full contact is no measurement of a scene that may lift off
+    contact = "full" if scene.contact == "full" else "lift-off"
     return fingerprint("coating_check", json.dumps(
-        [data.get(part) for part in CHECKED_PARTS], sort_keys=True, separators=(",", ":")))
+        [data.get(part) for part in CHECKED_PARTS] + [contact], sort_keys=True,
+        separators=(",", ":")))
 
 
 def model_error_evidence(scene: Scene | Mapping[str, Any], estimate: float,

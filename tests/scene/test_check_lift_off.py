@@ -81,3 +81,17 @@ def test_the_estimate_of_a_lifting_punch_reads_the_map_at_its_zone(lifting):
 def test_a_punch_in_full_contact_reads_the_map_at_its_width():
     result = core.solve(read_preset("uniform_flat"))
     assert result.model_error["zone_m"] is None and "thick_coating" not in result.flags
+
+
+def test_a_check_in_full_contact_is_no_measurement_of_a_lifting_scene(lifting):
+    # the key once left the contact model out: a full-contact check (0.02 %) cleared the
+    # flag of the same scene answered with lift-off
+    from core.scene import checked_key
+
+    result, _ = lifting
+    full = _thick_coating_lifting_off()
+    full["solver"] = {**full.get("solver", {}), "contact": "full"}
+    assert checked_key(full) != checked_key(result.scene)
+    measured = {"scene_key": checked_key(full), "model_error": 2e-4, "time_day": 0.0}
+    evidence = model_error_evidence(result.scene, result.model_error["estimate"], measured)
+    assert evidence["source"] == "estimated" and evidence["flagged"]
