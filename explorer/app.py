@@ -259,7 +259,7 @@ class ExplorerApp(pn.viewable.Viewer):
         }
         self._views["scene"] = SceneView(state, self.presets, self.preset_key, self.history,
                                          self.load_scene, controller, screen.reject, live)
-        self._views["check"] = CheckView(state, self.limits, screen, loop)
+        self._views["check"] = CheckView(state, self.limits, screen)
         self._views["files"] = FilesView(state, screen, controller, self.scales, self.limits,
                                          self._load_file, self.results.show_download_error)
         self._views["lessons"] = LessonsView(self.pins, self.results.log_time,

@@ -27,7 +27,7 @@ from core.coating.model import (
 from core.optional import lazy_exports
 
 if TYPE_CHECKING:
-    from core.coating.fem_check import solve_stack, solve_stack_contact
+    from core.coating.fem_check import solve_stack, solve_stack_contact, zone_ends_apart
     from core.coating.fem_stack import CoatingStrip, FEContact, Stack
 
 # The finite-element check, loaded on first use: a scene's solve needs the thin coating
@@ -35,6 +35,7 @@ if TYPE_CHECKING:
 _LAZY: dict[str, str] = {
     "solve_stack": "core.coating.fem_check",
     "solve_stack_contact": "core.coating.fem_check",
+    "zone_ends_apart": "core.coating.fem_check",
     "FEContact": "core.coating.fem_stack",
     "CoatingStrip": "core.coating.fem_stack",
     "Stack": "core.coating.fem_stack",
@@ -56,6 +57,7 @@ __all__ = [
     "solve_stack_contact",
     "Stack",
     "tilt_share",
+    "zone_ends_apart",
 ]
 
 

@@ -126,7 +126,7 @@ def solve_stack_contact(stack: Stack, given: Mapping[str, float], *, level: int 
         graded = replace(stack, breakpoints=tuple(sorted(set(stack.breakpoints) | ends)))
         answer = _active_set(_Assembled.build(graded, level, extent), dict(given), intervals)
         found = answer.contact
-        moved = _ends_moved(intervals, found, a)
+        moved = zone_ends_apart(intervals, found)
         intervals = found
         if moved < CONTACT_END_TOL * a:
             break
@@ -135,14 +135,14 @@ def solve_stack_contact(stack: Stack, given: Mapping[str, float], *, level: int 
     return answer
 
 
-def _ends_moved(old: list[tuple[float, float]], new: list[tuple[float, float]],
-                a: float) -> float:
-    """How far [m] the zone ends moved between two contact sets (inf if the zones differ in
-    number)."""
-    if len(old) != len(new):
-        return np.inf
-    return max((abs(x - y) for o, n in zip(old, new, strict=True)
-                for x, y in zip(o, n, strict=True)), default=0.0)
+def zone_ends_apart(first: Sequence[tuple[float, float]],
+                    second: Sequence[tuple[float, float]]) -> float:
+    """The largest distance [m] between the zone ends of two contact sets (inf when they
+    have different numbers of zones)."""
+    if len(first) != len(second):
+        return float("inf")
+    return max((abs(x - y) for f, s in zip(first, second, strict=True)
+                for x, y in zip(f, s, strict=True)), default=0.0)
 
 
 def _active_set(model: _Assembled, given: dict[str, float],

@@ -36,7 +36,13 @@ from typing import TYPE_CHECKING
 
 from core.optional import lazy_exports
 from core.scene.at_loading import creeps, elastic_at_loading, modulus_at_loading
-from core.scene.contact_zone import LIFT_OFF_SHARE, contact_width, lift_off_length, lifts_off
+from core.scene.contact_zone import (
+    LIFT_OFF_SHARE,
+    contact_width,
+    lift_off_length,
+    lifts_off,
+    narrowest_zone,
+)
 from core.scene.design import (
     DesignCheck,
     DesignLimits,
@@ -141,6 +147,7 @@ __all__ = [
     "LimitCheck",
     "lift_off_length",
     "lifts_off",
+    "narrowest_zone",
     "load_scene",
     "MAX_SCENE_BYTES",
     "migrate",

@@ -24,9 +24,11 @@ from core.coating import (
     Stack,
     solve_stack,
     solve_stack_contact,
+    zone_ends_apart,
 )
 from core.engines.layered import layered_declines
 from core.problem import QUANTITIES
+from core.scene.contact_zone import narrowest_zone
 from core.scene.evidence import checked_key
 from core.scene.model import Scene
 from core.scene.pipeline import solve
@@ -36,15 +38,6 @@ from core.scene.validate import scene_from_dict
 #: Pressure errors are measured on |x| <= this fraction of a (the edge singularities of
 #: both answers are not comparable pointwise).
 PRESSURE_REACH = 0.9
-
-
-def _ends_apart(fast: list[tuple[float, float]], fe: list[tuple[float, float]]) -> float:
-    """The largest distance [m] between the zone ends of two contact sets (inf when they
-    have different numbers of zones)."""
-    if len(fast) != len(fe):
-        return float("inf")
-    return max((abs(x - y) for f, e in zip(fast, fe, strict=True)
-                for x, y in zip(f, e, strict=True)), default=0.0)
 
 
 def fe_stack(scene: Scene, time: float = 0.0) -> Stack:
@@ -108,8 +101,7 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
         # models are compared with lift-off (in full contact they would answer another
         # problem than the scene's)
         lifting = solve(elastic_scene(scene, time, full_contact=False))
-        zones = lifting.contact_set[0] if lifting.contact_set else [(-a, a)]
-        if len(zones) == 1 and zones[0][0] <= -a * (1 - 1e-12) and zones[0][1] >= a * (1 - 1e-12):
+        if narrowest_zone(lifting.contact_set, a) is None:  # in full contact at this modulus
             lifting = None
     if lifting is not None:
         fast = lifting
@@ -144,7 +136,7 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
         errors[name] = (quick[name] - exact[name]) / scale if scale > 0 else 0.0
     contact = None
     if lifting is not None:
-        ends = _ends_apart(fast.contact_set[0], answer.contact)
+        ends = zone_ends_apart(fast.contact_set[0], answer.contact)
         errors["contact_ends"] = ends / a
         contact = {"fast": [list(z) for z in fast.contact_set[0]],
                    "fe": [list(z) for z in answer.contact],

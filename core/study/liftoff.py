@@ -48,6 +48,7 @@ from core.scene import (
     LARGE_TILT,
     Scene,
     contact_width,
+    narrowest_zone,
     plotting_grid,
     scene_model_error,
     settlement_share,
@@ -343,9 +344,9 @@ def _answer(scene: Scene, point: tuple[np.ndarray, SimpleNamespace], force: floa
     a = scene.half_width
     point_flags = list(flags)
     share = tilt_share(a, result.settlement, result.tilt)
-    # the coating's model is read against this point's zone (one zone, the same at every
-    # time), as core.scene.SceneSolution reads it
-    zone = float(result.contact_width[0])
+    # the coating's model is read against this point's zone, as core.scene.SceneSolution
+    # reads it
+    zone = narrowest_zone([[(-a, -a + float(w))] for w in result.contact_width], a)
     if thick_coating(scene, zone):
         point_flags.append("thick_coating")
     if scene_model_error(scene, share, zone)["estimate"] > scene.model_tol:

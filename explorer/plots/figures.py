@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 
-import numpy as np
 from bokeh.core.properties import value as fixed_label
 from bokeh.models import (
     ColorBar,
@@ -51,6 +50,7 @@ from .classical import bearing_rule_pressure, half_space_pressure
 from .contact import ContactDrawing, FeatureInset
 from .pins import PinLines
 from .scene import PUNCH_COLORS, TOOLS, SceneDrawing, empty_columns
+from .time_axis import times_drawn
 
 SYMBOLS = {"settlement": "δ", "tilt": "α", "force": "P", "moment": "M"}
 TITLES = {"settlement": "Settlement", "tilt": "Tilt", "force": "Force", "moment": "Moment"}
@@ -311,20 +311,10 @@ class Figures:
         """The time axis of the histories: every time drawn (the result, the pins, the
         readings and the forecast), with 5 % of the span beside each end (as the page's
         automatic range pads); sent only when it changes."""
-        lo, hi = np.inf, -np.inf
-        for fig in self.history_fig.values():
-            for renderer in fig.renderers:
-                source = getattr(renderer, "data_source", None)
-                if source is None or not renderer.visible:
-                    continue
-                # a line per punch of several holds its times in "xs"
-                columns = [source.data.get("t", []), *source.data.get("xs", [])]
-                t = np.concatenate([np.asarray(c, dtype=float).ravel() for c in columns])
-                t = t[np.isfinite(t)]
-                if t.size:
-                    lo, hi = min(lo, float(t.min())), max(hi, float(t.max()))
-        if not hi >= lo:
+        t = times_drawn(list(self.history_fig.values()))
+        if not t.size:
             return  # nothing drawn
+        lo, hi = float(t.min()), float(t.max())
         pad = 0.05 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.05
         start, end = lo - pad, hi + pad
         time_range = self.time_range  # the linear axis's (the log axis fits its own)

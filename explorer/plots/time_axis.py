@@ -27,6 +27,21 @@ def is_log(fig: Any) -> bool:
     return isinstance(fig.x_scale, LogScale)
 
 
+def times_drawn(figures: Sequence[Any]) -> np.ndarray:
+    """The finite times [day] the visible renderers of ``figures`` draw: their ``t``
+    column, and the ``xs`` lists of multi-lines (a line per punch of several)."""
+    found = [np.empty(0)]
+    for fig in figures:
+        for renderer in fig.renderers:
+            source = getattr(renderer, "data_source", None)
+            if source is None or not renderer.visible:
+                continue
+            for column in (source.data.get("t", []), *source.data.get("xs", [])):
+                found.append(np.asarray(column, dtype=float).ravel())
+    t = np.concatenate(found)
+    return t[np.isfinite(t)]
+
+
 class LogTime:
     """Switches the time axis of figures that share one x range."""
 
@@ -55,16 +70,11 @@ class LogTime:
 
     def fit(self) -> None:
         """Fit the log range to the positive times drawn (call after new data)."""
-        lo, hi = np.inf, 0.0
-        for fig in self.figures:
-            for renderer in fig.renderers:
-                t = np.asarray(getattr(renderer, "data_source", None) and
-                               renderer.data_source.data.get("t", []), dtype=float)
-                t = t[np.isfinite(t) & (t > 0)]
-                if t.size:
-                    lo, hi = min(lo, float(t.min())), max(hi, float(t.max()))
-        if not hi > 0:
+        t = times_drawn(self.figures)
+        t = t[t > 0]
+        if not t.size:
             return  # nothing positive drawn: keep the range
+        lo, hi = float(t.min()), float(t.max())
         if not hi > lo:
             lo = hi / 10.0
         self.log_range.update(start=lo / LOG_MARGIN, end=hi * LOG_MARGIN)

@@ -8,9 +8,9 @@ from typing import Any
 import panel as pn
 
 from ..model import DesignLimits, ExplorerState, Screen, screen_limits
-from .loop import PageLoop
 from .punches import OnePunchOnly
 from .style import TAB_COLUMN, html_pane
+from .widgets import next_tick
 
 
 class CheckView:
@@ -18,14 +18,11 @@ class CheckView:
 
     title = "Check"
 
-    def __init__(self, state: ExplorerState, limits: DesignLimits, screen: Screen,
-                 loop: PageLoop) -> None:
-        """``limits``: set here; ``screen``: where a refused value is said; ``loop``: the
-        page's, where a refused box gets its last good value back."""
+    def __init__(self, state: ExplorerState, limits: DesignLimits, screen: Screen) -> None:
+        """``limits``: set here; ``screen``: where a refused value is said."""
         self.state = state
         self.limits = limits
         self.screen = screen
-        self.loop = loop
         self.allowable_pressure = self._limit("allowable bearing pressure [kPa]",
                                               "allowable_pressure", "limit-pressure")
         self.settlement_limit = self._limit("settlement limit [mm]", "settlement_limit",
@@ -64,9 +61,8 @@ class CheckView:
             self.screen.reject(f"{label}: must be a number >= 0 (leave it empty: not "
                                f"checked), got {value:g}; the limit stays "
                                + ("unset" if good is None else f"{good:g}"))
-            # the last good limit, on the page too: set on the next tick, as a value set
-            # while the page's own change is handled is not sent back to it
-            self.loop.dispatch(lambda: setattr(box, "value", good))
+            # the last good limit, on the page too (next_tick: see there)
+            next_tick(lambda: setattr(box, "value", good))
             return
         setattr(self.limits, name, value)
 

@@ -195,7 +195,9 @@ def watch_release(widget: pn.widgets.Widget, released: Callable[[Any, bool], Non
 
 
 def next_tick(callback: Callable[[], None]) -> None:
-    """Run ``callback`` on the served page's next tick (at once outside a server)."""
+    """Run ``callback`` on the served page's next tick (at once outside a server): a
+    widget's value set while the page's own change of it is handled is not sent back to
+    the page, so a refused value is put back from here."""
     doc = pn.state.curdoc
     if doc is None or not doc.session_context:
         callback()

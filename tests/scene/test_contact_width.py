@@ -106,7 +106,7 @@ def test_a_contact_shrinking_to_a_point_is_never_a_success() -> None:
 
 
 def test_the_narrowest_zone_is_over_every_zone_and_time() -> None:
-    from core.scene.contact_zone import narrowest_zone
+    from core.scene import narrowest_zone
 
     assert narrowest_zone([[(-1.0, 1.0)], [(-1.0, 1.0)]], 1.0) is None
     assert narrowest_zone([[(-1.0, 1.0)], [(-0.5, 1.0)], [(-1.0, -0.8), (0.2, 1.0)]],
