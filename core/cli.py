@@ -156,8 +156,7 @@ def _read(path: str) -> Scene | PunchesScene:
             scene = punches_from_dict(data) if has_punches(data) else scene_from_dict(data)
         else:
             scene = load_scene(path)
-        if isinstance(scene, Scene):
-            check_loads_touch(scene)
+        check_loads_touch(scene)
         return scene
 
 
@@ -325,8 +324,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
                   f"{len(checked.parameters)} varied field(s)")
         else:
             scene = punches_from_dict(data) if has_punches(data) else scene_from_dict(data)
-            if isinstance(scene, Scene):
-                check_loads_touch(scene)
+            check_loads_touch(scene)
             print(f"ok: {_describe(scene)}")
     except ValueError as exc:
         raise _InputError(str(exc)) from None

@@ -10,6 +10,8 @@ dimensionless solver would otherwise name ``t* = 1`` and half-widths).
 
 An instant where both ``P`` and ``M`` are zero (a ramp starting from nothing, a load
 taken off) carries nothing and is allowed; a load that is zero at every time is not.
+Of several punches, those of a full-contact scene are not checked: that model is linear
+and reads an unloaded or pulled punch as a bonded one.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from core.scene.model import Scene
+    from core.scene.punches import PunchesScene
 
 #: Samples of a load history between 0 and the last output time, besides the output
 #: times and the points where the history kinks or jumps: a pull shorter than end/1024
@@ -39,14 +42,33 @@ def _sample_days(scene: Scene) -> np.ndarray:
     return np.unique(np.concatenate(days))
 
 
-def check_loads_touch(scene: Scene) -> None:
+def check_loads_touch(scene: Scene | PunchesScene) -> None:
     """Refuse a given force that pulls the punch away (``P < 0``, or ``P = 0`` at every
     time) or a given moment that puts the resultant outside the punch (``|M/P| >= a``,
     or ``M != 0`` with ``P = 0``), with a ``ValueError`` naming ``loading.force`` or
     ``loading.moment``, the value [N/m, N·m/m, m] and the time [days after loading].
 
-    Scenes whose force is not given (settlement or tilt given) are not checked here.
+    Scenes whose force is not given (settlement or tilt given) are not checked here. A
+    scene of several punches is checked punch by punch, the field named
+    ``punches[k].loading.<field>``, where it may lift off (``solver.contact`` "auto" or
+    "unilateral"): its full-contact model is linear in the loads, a punch unloaded or
+    pulled in it is a bonded one (the pair's influence coefficients are read that way).
     """
+    punches = getattr(scene, "scenes", None)
+    if punches is not None:
+        if punches[0].contact == "full":
+            return
+        for k, sub in enumerate(punches):
+            try:
+                _check_one(sub)
+            except ValueError as exc:
+                raise ValueError(f"punches[{k}].{exc}") from None
+        return
+    _check_one(scene)
+
+
+def _check_one(scene: Scene) -> None:
+    """:func:`check_loads_touch` for one punch."""
     if "force" not in scene.loading:
         return
     days = _sample_days(scene)

@@ -40,6 +40,7 @@ from core.profiles import shifted
 from core.scene import punches_output, schema
 from core.scene.contact_zone import contact_width, lift_off_length
 from core.scene.design import DesignCheck, DesignLimits
+from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
 from core.scene.records import csv_header
 from core.scene.results import SceneSolution
@@ -233,24 +234,10 @@ def _along_x(common: Mapping[str, Any], scenes: list[Scene], centers: list[float
     return out
 
 
-def _check_touch(scene: PunchesScene) -> None:
-    """Refuse, naming ``punches[k].loading.<field>``, loads no contact can carry (the
-    single punch's :func:`core.scene.load_limits.check_loads_touch`, punch by punch): a
-    lift-off answer needs every punch pressed."""
-    from core.scene.load_limits import check_loads_touch
-
-    for k, sub in enumerate(scene.scenes):
-        try:
-            check_loads_touch(sub)
-        except ValueError as exc:
-            raise ValueError(_renamed(str(exc), k)) from None
-
-
 def _lift_off(scene: PunchesScene, geometries: list[PunchGeometry],
               inputs: list[TimeInputs]) -> list[Any]:
     """Every punch's answer with lift-off (:func:`core.contact.solve_unilateral_punches`
     on an elastic base, :func:`core.contact.solve_creep_punches` on a creeping one)."""
-    _check_touch(scene)
     if inputs[0].kernel is None:
         return solve_unilateral_punches(geometries, inputs)
     return solve_creep_punches(geometries, inputs, time_breaks=_time_breaks(scene))
@@ -390,6 +377,8 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
 
     started = time.thread_time()
     scene = punches_from_dict(scene)
+    # a load no contact can carry is refused in every contact mode, as for one punch
+    check_loads_touch(scene)
     if len(scene.scenes) == 1:
         single = solve(scene.scenes[0])
         solution = single.dimensionless

@@ -255,3 +255,17 @@ def test_the_summary_says_the_pressure_is_unbounded_at_a_bare_corner():
     assert proc.returncode == 0, proc.stderr
     assert ("largest contact pressure q: unbounded at the corner x = -1 m (a rigid corner: "
             "q ~ 1/sqrt(distance)); 2.67618e+06 Pa at 1 mm from it") in proc.stdout
+
+
+
+@pytest.mark.parametrize("contact", ["auto", "unilateral"])
+@pytest.mark.parametrize("command", ["validate", "solve"])
+def test_a_pulled_punch_of_several_is_the_users_input(tmp_path, command, contact):
+    # validate said ok and solve exited 1 (an internal failure): lift-off needs every
+    # punch pressed (the full-contact model, linear, answers a bonded punch)
+    data = json.loads((SCENES / "new_footing_beside_old.json").read_text())
+    data["punches"][1]["loading"] = {"force": -1e5, "moment": 0.0}
+    data.setdefault("solver", {})["contact"] = contact
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(data))
+    assert_one_line_error(run(command, path), "punches[1].loading.force: the punch is pulled")
