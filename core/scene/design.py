@@ -91,6 +91,12 @@ class LimitCheck:
     #: whether q ~ K / sqrt(distance) holds from ``corner_distance`` to the corner (so
     #: that :attr:`exceeded_within` can be read from it)
     asymptotic: bool = False
+    #: [m] for an unbounded pressure with a limit: how far from the corner the pressure
+    #: on the answer's grid stays over the limit, at its worst time (the last grid point
+    #: over it); None: not past ``corner_distance``
+    exceeded_on_grid: float | None = None
+    #: whether the pressure is over the limit on the whole base at some time
+    exceeded_everywhere: bool = False
 
     @property
     def unbounded(self) -> bool:
@@ -100,13 +106,33 @@ class LimitCheck:
     @property
     def exceeded_within(self) -> float | None:
         """For an unbounded pressure with a limit: the distance [m] from the corner within
-        which q exceeds it, from q ~ K / sqrt(distance) through ``value`` at
-        ``corner_distance`` (the corner's asymptote; None otherwise)."""
-        if not self.unbounded or self.limit is None or not self.asymptotic:
+        which q exceeds it. Read on the answer's grid where it reaches past
+        ``corner_distance``; closer in, from q ~ K / sqrt(distance) through ``value`` at
+        ``corner_distance`` (the corner's asymptote, which holds only there), or None
+        where the asymptote is not known to hold (under a coating) or the limit is
+        exceeded on the whole base."""
+        if not self.unbounded or self.limit is None or self.exceeded_everywhere:
+            return None
+        if self.exceeded_on_grid is not None:
+            return float(self.exceeded_on_grid)
+        if not self.asymptotic:
             return None
         if self.limit <= 0:
             return math.inf
-        return float(self.corner_distance) * (abs(self.value) / self.limit) ** 2
+        return min(float(self.corner_distance) * (abs(self.value) / self.limit) ** 2,
+                   float(self.corner_distance))
+
+    def exceeded_text(self) -> str:
+        """Where an unbounded pressure exceeds its limit, in words: "over the whole base",
+        "within ~D mm of the corner" or "at the corner" (empty without a limit)."""
+        if not self.unbounded or self.limit is None:
+            return ""
+        if self.exceeded_everywhere:
+            return "over the whole base"
+        within = self.exceeded_within
+        if within is None or not math.isfinite(within):
+            return "at the corner"
+        return f"within ~{_millimetres(within)} mm of the corner"
 
     @property
     def utilisation(self) -> float | None:
@@ -141,7 +167,8 @@ class LimitCheck:
                "passed": self.passed, "time_day": plain(self.time), "x_m": plain(self.x)}
         if self.unbounded:
             out.update(unbounded=True, corner_distance_m=plain(self.corner_distance),
-                       exceeded_within_m=plain(self.exceeded_within))
+                       exceeded_within_m=plain(self.exceeded_within),
+                       exceeded_everywhere=self.exceeded_everywhere)
         return out
 
     def describe(self) -> str:
@@ -185,12 +212,8 @@ class LimitCheck:
         if self.limit is None:
             return text + "; no limit set"
         if self.unbounded:
-            within = self.exceeded_within
-            if within is None:  # not resolved closer to the corner (under a coating)
-                return f"{text}; limit {shown(self.limit, self.unit)}, exceeded at the corner: FAIL"
-            # the corner's asymptote read at the distance where q is held: an estimate
-            return (f"{text}; limit {shown(self.limit, self.unit)}, exceeded within ~"
-                    f"{1e3 * within:.2g} mm of the corner: FAIL")
+            return (f"{text}; limit {shown(self.limit, self.unit)}, exceeded "
+                    f"{self.exceeded_text()}: FAIL")
         verdict = "pass" if self.passed else "FAIL"
         return (f"{text}; limit {shown(self.limit, self.unit)}, utilisation "
                 f"{self.utilisation:.3g}: {verdict}")
@@ -305,8 +328,46 @@ def _corner_line(name: str, label: str, unit: str, times: np.ndarray, x: np.ndar
             best = (float(rows[j]), float(times[j[1]]), float(corner))
     if best is None:
         return None
+    on_grid, everywhere = None, False
+    if limit is not None:
+        on_grid, everywhere = _over_from(x, q, best[2], limit)
+        if on_grid is not None and on_grid <= held * (1 + 1e-9):
+            on_grid = None  # within the held values: the asymptote says more
     return LimitCheck(name, "q_max", label, best[0], unit, best[1], best[2], limit,
-                      corner_distance=held, asymptotic=bool(corners.get("asymptotic")))
+                      corner_distance=held, asymptotic=bool(corners.get("asymptotic")),
+                      exceeded_on_grid=on_grid, exceeded_everywhere=everywhere)
+
+
+def _over_from(x: np.ndarray, q: np.ndarray, corner: float,
+               limit: float) -> tuple[float | None, bool]:
+    """How far from ``corner`` [m] the pressure ``q`` [Pa] on the grid ``x`` stays over
+    ``limit`` without a break, at its worst time (linear in q between the last grid
+    point over it and the next; None: not even the nearest point is over), and whether
+    it is over on the whole grid at some time."""
+    distance = np.abs(x - corner)
+    order = np.argsort(distance, kind="stable")
+    d = distance[order]
+    rows = np.nan_to_num(q[order], nan=-np.inf)
+    over = rows > limit
+    everywhere = bool(over.all(axis=0).any())
+    if everywhere:
+        return float(d[-1]), True
+    # per time, the number of grid points over the limit counted from the corner
+    runs = np.argmin(over, axis=0)
+    reach = None
+    for j, run in enumerate(runs):
+        if run == 0:
+            continue
+        d0, d1, q0, q1 = d[run - 1], d[run], rows[run - 1, j], rows[run, j]
+        at = d0 + (d1 - d0) * (q0 - limit) / (q0 - q1) if q0 > q1 else d0
+        reach = at if reach is None else max(reach, at)
+    return (None if reach is None else float(reach)), False
+
+
+def _millimetres(distance: float) -> str:
+    """A distance [m] in mm to two significant digits, never in exponent form."""
+    return np.format_float_positional(1e3 * distance, precision=2, unique=False,
+                                      fractional=False, trim="-")
 
 
 def largest_pressure(result: Any) -> LimitCheck:

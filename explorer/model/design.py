@@ -53,9 +53,10 @@ class Check:
     limit: float | None = None
     passed: bool | None = None
     #: [mm] an unbounded pressure (a rigid corner in contact): how far from the corner
-    #: ``value`` is read, and within how far of it q exceeds the limit (None: bounded)
+    #: ``value`` is read (None: bounded), and where q exceeds the limit, in words
+    #: (:meth:`core.scene.LimitCheck.exceeded_text`)
     corner_distance: float | None = None
-    exceeded_within: float | None = None
+    exceeded: str = ""
 
     @property
     def verdict(self) -> str:
@@ -139,10 +140,9 @@ def _on_screen(line: LimitCheck, limits: DesignLimits | None) -> Check:
     typed = None if limits is None or line.limit_name is None \
         else getattr(limits, line.limit_name)
     if line.unbounded:
-        within = line.exceeded_within
         return Check(line.label, line.value / size, unit, where, typed, line.passed,
                      corner_distance=1e3 * float(line.corner_distance),
-                     exceeded_within=None if within is None else 1e3 * within)
+                     exceeded=line.exceeded_text())
     return Check(line.label, line.value / size, unit, where, typed, line.passed)
 
 
@@ -183,8 +183,7 @@ def check_html(check: DesignCheck) -> str:
             value = (f"<span class='check-unbounded'>unbounded at the corner</span>; "
                      f"{c.value:.4g} at {c.corner_distance:.2g} mm from it")
             if c.limit is not None:
-                where += (f"; over the limit within ~{c.exceeded_within:.2g} mm of the corner"
-                          if c.exceeded_within is not None else "; over the limit at the corner")
+                where += f"; over the limit {html.escape(c.exceeded)}"
         rows.append(f"<tr><td>{html.escape(c.name)} [{c.unit}]</td><td>{value}</td>"
                     f"<td>{where}</td><td>{limit}</td>"
                     f"<td class='{cls}'>{c.verdict if c.limit is not None else ''}</td></tr>")

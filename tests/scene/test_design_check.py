@@ -127,6 +127,36 @@ def test_the_pressure_at_a_rigid_corner_is_unbounded_and_never_passes() -> None:
         line.exceeded_within)
 
 
+@pytest.mark.parametrize("limit, reach", [(1e6, 7.2875e-3), (3e5, 0.1045625),
+                                          (2.1e5, 0.4239)])
+def test_how_far_a_corner_exceeds_a_limit_is_read_on_the_grid_past_the_held_values(
+        limit, reach) -> None:
+    # The asymptote through the value held 1 mm from the corner was extrapolated with no
+    # end: "exceeded within ~1.8e+02 mm" for 200 kPa on a base whose pressure is over
+    # 200 kPa everywhere. Past the held values the grid is read (linear between its
+    # points); ``reach`` is where q crosses the limit on a grid of 2e5 points over half
+    # the base: the reading is within 1.2 % of it (measured 1.1 % at 1 MPa, 0.1 % at
+    # 300 kPa, 0.01 % at 210 kPa).
+    d = scene_file("bare_layer")
+    d["limits"] = {"allowable_pressure": limit}
+    line = solve(d).design_check().check("q_max")
+    assert line.exceeded_within == pytest.approx(reach, rel=1.2e-2)
+    assert not line.exceeded_everywhere
+    distance = line.exceeded_text()
+    assert distance.startswith("within ~") and distance.endswith(" mm of the corner")
+    assert float(distance.split("~")[1].split()[0]) == pytest.approx(
+        1e3 * line.exceeded_within, rel=0.05)  # two digits, never an exponent
+
+
+def test_a_limit_under_the_pressure_everywhere_is_exceeded_over_the_whole_base() -> None:
+    d = scene_file("bare_layer")  # q >= 202.6 kPa everywhere at every time
+    d["limits"] = {"allowable_pressure": 2e5}
+    line = solve(d).design_check().check("q_max")
+    assert line.exceeded_everywhere and line.exceeded_within is None
+    assert line.describe().endswith("limit 200000 Pa, exceeded over the whole base: FAIL")
+    assert line.to_dict()["exceeded_everywhere"] is True
+
+
 def test_a_coated_corner_is_unbounded_in_the_exact_model_and_bounded_in_the_thin_one():
     d = scene_file("uniform_flat")
     d["limits"] = {"allowable_pressure": 1e6}
