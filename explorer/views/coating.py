@@ -261,6 +261,9 @@ class CoatingCheckView:
                               else f"<span class='cp-msg'>{outcome}</span>")
         if isinstance(outcome, dict) and self.screen is not None:
             self.screen.model_check = outcome
+            # the scene may have changed while the FE model solved
+            if self.screen.drawn is not None:
+                self.follow(self.screen.drawn.scene)
 
     def follow(self, scene: dict[str, Any]) -> None:
         """A new result of ``scene``: a report made for another scene (the geometry, the

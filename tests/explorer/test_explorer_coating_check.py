@@ -96,3 +96,21 @@ def test_a_report_of_an_earlier_scene_says_so_until_that_scene_is_back(explorer_
     force.value = 500.0
     app.controller.solve_now()
     assert "Made for an earlier scene" not in check.result.object
+
+
+def test_a_report_arriving_after_the_scene_changed_says_it_is_of_an_earlier_scene(
+        explorer_app, monkeypatch):
+    from explorer.views import coating
+
+    app = explorer_app(solved=True)
+    app.controller._executor = _Held()
+    started: list = []
+    monkeypatch.setattr(coating, "start_in_background", started.append)
+    check = app.coating_tab.check
+    check.run()
+    app.controller._executor = None
+    app.state.loading.histories["force"].value = 400.0  # changed while the FE model solves
+    app.controller.solve_now()
+    started.pop()()
+    # the report came unmarked, as if it were of the scene on screen
+    assert check.result.object.startswith("<span class='cp-msg coating-check-stale-note'>")
