@@ -214,8 +214,10 @@ def to_dimensionless(scene: Scene) -> DimensionlessProblem:
     )
 
 
-#: Open bounds of the values of each x-profile of a layer, as the loader checks them.
-_LAYER_BOUNDS = {"thickness": (0.0, None), "modulus": (0.0, None), "poisson": (-1.0, 0.5)}
+#: Open bounds of the values of each x-profile of a layer, as the loader checks them,
+#: and the unit its values are written in
+_LAYER_BOUNDS = {"thickness": (0.0, None, " m"), "modulus": (0.0, None, " Pa"),
+                 "poisson": (-1.0, 0.5, "")}
 
 
 def _check_x_profiles_at(scene: Scene, x: np.ndarray) -> None:
@@ -223,10 +225,10 @@ def _check_x_profiles_at(scene: Scene, x: np.ndarray) -> None:
     points ``x`` [m] the solver asked for: the loader checks profiles on samples, and a
     formula's pole or spike between them would otherwise surface under the solver's
     internal names (``m``, ``g``)."""
-    candidates = [("punch.shape", scene.shape, (None, None))] + [
+    candidates = [("punch.shape", scene.shape, (None, None, " m"))] + [
         (f"coating[{k}].{name}", getattr(layer, name), bounds)
         for k, layer in enumerate(scene.coating) for name, bounds in _LAYER_BOUNDS.items()]
-    for path, profile, (lower, upper) in candidates:
+    for path, profile, (lower, upper, unit) in candidates:
         values = profile_values(profile, x)
         checks = [(~np.isfinite(values), "must be finite")]
         if lower is not None:
@@ -234,8 +236,8 @@ def _check_x_profiles_at(scene: Scene, x: np.ndarray) -> None:
         if upper is not None:
             checks.append((values >= upper, f"must be < {upper:g}"))
         for bad, rule in checks:
-            refuse_first(bad, lambda i, path=path, rule=rule, values=values: (
-                f"{path}: {rule}, is {values.flat[i]:.6g} at x = {x.flat[i]:.10g} m, "
+            refuse_first(bad, lambda i, path=path, rule=rule, values=values, unit=unit: (
+                f"{path}: {rule}, is {values.flat[i]:.6g}{unit} at x = {x.flat[i]:.10g} m, "
                 "between the points where the scene was checked (a pole or a spike of a "
                 "formula narrower than the checks): keep it finite and in range on the "
                 "whole punch"))

@@ -368,12 +368,28 @@ def _checked_profile(spec: Any, path: str, variable: str, domain: tuple[float, f
         check_range(profile, field=path, domain=domain, lower=lower, upper=upper)
     except ValueError as exc:
         message = str(exc)
-        # the position is in metres (x) or days after loading (t): say so
+        # the position is in metres (x) or days after loading (t), the value in the
+        # field's unit: say so
         unit = " m" if variable == "x" else " days after loading"
         if re.search(rf" at {variable} = \S+$", message):
             message += unit
+        value_unit = _unit_of(path)
+        if value_unit:
+            message = re.sub(rf"(, is -?\d[\d.]*(?:e[+-]?\d+)?) at {variable} = ",
+                             rf"\1 {value_unit} at {variable} = ", message, count=1)
         raise ValueError(message) from None
     return profile
+
+
+def _unit_of(path: str) -> str:
+    """The unit of the field at ``path`` (``coating[0].thickness``: ``m``) by its rule in
+    :data:`FIELDS`; '' for a field without one (a ratio) or not in it."""
+    obj, _, name = path.rpartition(".")
+    obj = re.sub(r"\[\d+\]", "[k]", obj)
+    if obj not in FIELDS:
+        return ""
+    unit = next((r.unit for r in FIELDS[obj] if r.name == name), "-")
+    return "" if unit == "-" else unit
 
 
 def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:

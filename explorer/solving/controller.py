@@ -192,8 +192,10 @@ def _page_units(text: str) -> str:
     return _SI_VALUE.sub(shown, text)
 
 
-#: A length in metres in the core's messages.
-_METRES = re.compile(r"(?<![\w.])(-?\d+(?:\.\d*)?(?:e[+-]?\d+)?) m(?![\w/·²])")
+#: A length in metres in the core's messages, not a position (``x = -1 m`` is a place
+#: on the punch, whose boxes are in metres)
+_METRES = re.compile(
+    r"(?<!x = )(?<!x = -)(?<![\w.])(-?\d+(?:\.\d*)?(?:e[+-]?\d+)?) m(?![\w/·²])")
 #: Fields whose box on the page is in millimetres (a coating layer's thickness).
 _MILLIMETRE_FIELDS = re.compile(r"(punches\[\d+\]\.)?coating\[\d+\]\.thickness")
 

@@ -313,6 +313,12 @@ def test_format_error_says_loads_and_stresses_in_the_page_units():
     # a coating layer's thickness box is in mm
     assert format_error("coating[0].thickness: must be > 0 m, got -0.005 m").endswith(
         "must be > 0 mm, got -5 mm")
+    # the value in mm, the place on the punch in m as the punch's boxes (it read "is
+    # -0.005 at x = -1000 mm")
+    assert format_error("coating[0].thickness: must be > 0, is -0.005 m at x = -1 m").endswith(
+        "must be > 0, is -5 mm at x = -1 m")
+    assert format_error("punches[1].coating[0].thickness: must be > 0, is 0 m at x = 0.5 m"
+                        ).endswith("is 0 mm at x = 0.5 m")
 
 
 def test_format_error_names_the_field_in_words():

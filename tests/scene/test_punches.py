@@ -447,7 +447,7 @@ def test_overlapping_punches_are_refused_naming_both() -> None:
 @pytest.mark.parametrize(("change", "message"), [
     (lambda d: d["coating"][0].update(thickness={"kind": "linear", "start": 0.02,
                                                  "end": -0.03}),
-     r"coating\[0\]\.thickness: must be > 0, is -[\d.e-]+ at x = 0\.48\d* m"),
+     r"coating\[0\]\.thickness: must be > 0, is -[\d.e-]+ m at x = 0\.48\d* m"),
     (lambda d: d.update(punch={"half_width": 1.0}),
      r"punch: give either punch and loading \(one punch\) or punches"),
     (lambda d: d["punches"][1]["loading"].update(settlement=0.001),

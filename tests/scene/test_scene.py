@@ -550,7 +550,7 @@ BAD_SCENES = [
     ("coating", {"thickness": 0.01}, "coating: must be a list"),
     ("coating[0].thickness", 0.0, "coating[0].thickness: must be > 0"),
     ("coating[0].thickness", {"kind": "linear", "start": 0.01, "end": -0.01},
-     "coating[0].thickness: must be > 0, is 0 at x = 0 m"),
+     "coating[0].thickness: must be > 0, is 0 m at x = 0 m"),
     ("coating[0].modulus", False, "coating[0].modulus: must be a number"),
     ("coating[0].poisson", 0.5, "coating[0].poisson: must be < 0.5"),
     ("coating[0].poisson", -1.0, "coating[0].poisson: must be > -1"),
@@ -605,7 +605,7 @@ def test_modulus_message_names_layer_value_and_position():
     d = base_dict()
     d["coating"].append({"thickness": 0.01, "poisson": 0.3,
                          "modulus": {"kind": "step", "values": [1e9, -3e6], "breaks": [0.12]}})
-    with pytest.raises(ValueError, match=r"^coating\[1\]\.modulus: must be > 0, is -3e\+06 "
+    with pytest.raises(ValueError, match=r"^coating\[1\]\.modulus: must be > 0, is -3e\+06 Pa "
                                          r"at x = 0\.12 m$"):
         scene_from_dict(d)
 

@@ -134,6 +134,6 @@ def test_a_formula_pole_between_check_samples_names_the_scene_field():
     d = elastic_dict()
     d["coating"][0]["thickness"] = {"expr": "0.02 + 1e-7/(x - 0.123456789)"}
     scene = scene_from_dict(d)  # the 4097 check samples miss the pole
-    with pytest.raises(ValueError, match=r"^coating\[0\]\.thickness: must be > 0, is -\S+ "
+    with pytest.raises(ValueError, match=r"^coating\[0\]\.thickness: must be > 0, is -\S+ m "
                                          r"at x = 0\.1234\d* m, between the points"):
         solve(scene)
