@@ -69,6 +69,7 @@ from core.scene import (
     Scene,
     SceneSolution,
     check_loads_touch,
+    check_settled,
     flags_with_evidence,
     has_punches,
     largest_pressure,
@@ -665,6 +666,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
         print(f"{'contact':>12} {_zones(lift['fast']):>16} {_zones(lift['fe']):>16} "
               f"{report['errors']['contact_ends']:8.3g} half-widths between zone ends "
               f"(both with lift-off; resolved ends to {lift['fe_end_uncertainty']:.1g} m)")
+        if not check_settled(report):
+            print(f"warning: fe_unsettled: the FE contact set had not settled after "
+                  f"{lift['fe_sweeps']} sweeps: the errors above are not a measurement",
+                  file=sys.stderr)
     print(f"model error of the fast answer: {100 * report['model_error']:.2f} % "
           f"({report['coating_model']}; estimate carried by results: "
           f"{percent_text(report['estimate'], 2)}, "

@@ -52,7 +52,12 @@ from core.scene.design import (
     largest_pressure,
 )
 from core.scene.display import engine_text, known_contact_width, lifts_off_at, percent_text
-from core.scene.evidence import checked_key, flags_with_evidence, model_error_evidence
+from core.scene.evidence import (
+    check_settled,
+    checked_key,
+    flags_with_evidence,
+    model_error_evidence,
+)
 from core.scene.files import load_scene, read_scene_json, save_scene
 from core.scene.json_schema import DIALECT as JSON_SCHEMA_DIALECT
 from core.scene.json_schema import (
@@ -131,6 +136,7 @@ __all__ = [
     "checked_key",
     "flags_with_evidence",
     "model_error_evidence",
+    "check_settled",
     "contact_width",
     "csv_header",
     "creeps",

@@ -86,8 +86,12 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
     Where the scene's own contact model lifts the punch off at this modulus, both answers
     are of lift-off (the FE model's contact set by :func:`core.coating.solve_stack_contact`,
     started from the fast one's): ``"lift_off"`` then holds both contact sets [m], the FE
-    ends' uncertainty [m] and its sweeps, and ``errors["contact_ends"]`` the largest
-    distance between their zone ends [half-widths]; else ``"lift_off"`` is None.
+    ends' uncertainty [m], its sweeps and ``"fe_converged"`` (False: the FE contact set
+    had not settled when its sweeps ran out, and the report is not evidence of the
+    model's error, :func:`core.scene.model_error_evidence`), and ``errors["contact_ends"]``
+    the largest distance between their zone ends [half-widths]; else ``"lift_off"`` is
+    None. A time where the punch does not touch the coating is refused (ValueError naming
+    ``time``): there is no contact to compare.
     """
     scene = scene_from_dict(scene)
     if not np.isfinite(time) or not 0.0 <= time <= float(scene.times[-1]):
@@ -101,6 +105,11 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
         # models are compared with lift-off (in full contact they would answer another
         # problem than the scene's)
         lifting = solve(elastic_scene(scene, time, full_contact=False))
+        if not any(lifting.contact_set[0]):
+            raise ValueError(
+                f"time: the punch does not touch the coating at t = {time:g} days after "
+                "loading (flag no_contact: q = 0 everywhere), so there is no contact "
+                "model to check; check a time where the punch presses")
         if narrowest_zone(lifting.contact_set, a) is None:  # in full contact at this modulus
             lifting = None
     if lifting is not None:

@@ -58,8 +58,9 @@ def model_error_evidence(scene: Scene | Mapping[str, Any], estimate: float,
         (``info["model_error_estimate"]``) [-].
     check : mapping, optional
         A report of :func:`core.scene.check_scene`. It overrides the estimate when it was
-        made for this scene (same :func:`checked_key`); a check of another scene (the
-        geometry or the loads changed since) is ignored.
+        made for this scene (same :func:`checked_key`) and its FE contact set settled
+        (:func:`check_settled`); a check of another scene (the geometry or the loads
+        changed since) or an unsettled one is ignored.
 
     Returns
     -------
@@ -80,7 +81,8 @@ def model_error_evidence(scene: Scene | Mapping[str, Any], estimate: float,
         scene = scene_from_dict(scene)
         tol = float(scene.model_tol)
     estimate = float(estimate)
-    applies = check is not None and check.get("scene_key") == checked_key(scene)
+    applies = (check is not None and check.get("scene_key") == checked_key(scene)
+               and check_settled(check))
     if applies:
         measured = float(check["model_error"])
         time = float(check.get("time_day", 0.0))
@@ -94,6 +96,14 @@ def model_error_evidence(scene: Scene | Mapping[str, Any], estimate: float,
     return {"source": "estimated", "label": ESTIMATED, "error": estimate,
             "estimate": estimate, "measured": None, "time_day": None, "model_tol": tol,
             "flagged": estimate > tol, "message": FLAG_MESSAGES["model_error"]}
+
+
+def check_settled(check: Mapping[str, Any]) -> bool:
+    """Whether a report of :func:`core.scene.check_scene` measured the model's error: not
+    when its FE model lifted off and its contact set had not settled when its sweeps ran
+    out (``lift_off["fe_converged"]`` False)."""
+    lift = check.get("lift_off") or {}
+    return bool(lift.get("fe_converged", True))
 
 
 def flags_with_evidence(flags: list[str], evidence: Mapping[str, Any]) -> list[str]:

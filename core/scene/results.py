@@ -20,7 +20,12 @@ from core.cache import StageCache, fingerprint
 from core.coating import model_error_estimate, model_error_map, tilt_share
 from core.engines.layered import EXACT_LAYERED, NO_COATING, corner_reach, uniform_layers
 from core.problem import QUANTITIES
-from core.scene.contact_zone import contact_width, lift_off_length, narrowest_zone
+from core.scene.contact_zone import (
+    LIFT_OFF_SHARE,
+    contact_width,
+    lift_off_length,
+    narrowest_zone,
+)
 from core.scene.design import DesignCheck, DesignLimits, design_check
 from core.scene.display import HISTORIES, answered_settings, html_summary, text_summary
 from core.scene.display import to_dataframe as _to_dataframe
@@ -161,10 +166,11 @@ def corner_pressure(scene: Scene, coating_model: str,
     if coating_model not in (EXACT_LAYERED, NO_COATING):
         return None
     a = scene.half_width
-    zones = [zone for zones in contact_set for zone in zones] or [(-a, a)]
+    # no contact set: a full-contact answer; an empty zone list: no contact at that time
+    zones = [zone for zones in contact_set for zone in zones] if contact_set else [(-a, a)]
+    reach = a * (1.0 - 2.0 * LIFT_OFF_SHARE)  # a zone end within rounding of the corner
     corners = sorted({c for lo, hi in zones
-                      for c, touches in ((-a, lo <= -a * (1 - 1e-12)), (a, hi >= a * (1 - 1e-12)))
-                      if touches})
+                      for c, touches in ((-a, lo <= -reach), (a, hi >= reach)) if touches})
     if not corners:
         return None
     held = a * (1.0 - corner_reach(uniform_layers(scene) if scene.coating else [], a))

@@ -10,7 +10,7 @@ from typing import Any
 
 import panel as pn
 
-from core.scene import check_scene, checked_key, percent_text
+from core.scene import check_scene, check_settled, checked_key, percent_text
 
 from ..model import SCREEN_LAYERS, ExplorerState, Screen
 from ..solving import SolveController, run_in_background
@@ -158,11 +158,17 @@ def check_report_html(report: dict[str, Any]) -> str:
         f"<div class='coating-check-report'><small>At loading, against the resolved "
         f"finite-element model ({report['fe_dofs']:,} unknowns, "
         f"{report['fe_seconds']:.1f} s). Coating model: {report['coating_model']}.</small>"
-        f"<br><b>model error: measured {percent_text(report['model_error'])}, "
-        f"estimated {percent_text(report['estimate'])}</b>"
+        f"<br><b>model error: {_measured_word(report)} "
+        f"{percent_text(report['model_error'])}, estimated {percent_text(report['estimate'])}</b>"
         + _contact_note(report)
         + "<table class='cp-readout'><tr><th></th><th>fast</th><th>FE</th><th>error [%]</th>"
         "</tr>" + "".join(rows) + "</table></div>")
+
+
+def _measured_word(report: dict[str, Any]) -> str:
+    """How the report's model error reads: measured, or not (the FE contact set had not
+    settled, :func:`core.scene.check_settled`)."""
+    return "measured" if check_settled(report) else "not measured (FE contact unsettled),"
 
 
 def _zones_text(zones: list[list[float]]) -> str:
@@ -175,10 +181,13 @@ def _contact_note(report: dict[str, Any]) -> str:
     off (their contact sets side by side), or a full-contact answer with q < 0."""
     lift = report.get("lift_off")
     if lift:
+        unsettled = "" if check_settled(report) else (
+            f" The FE contact set had not settled after {lift.get('fe_sweeps', 0)} sweeps: "
+            "these numbers are not a measurement, and the badges keep the estimate.")
         return ("<br><span class='cp-msg'>The punch lifts off here: both models are "
                 f"compared with lift-off. Contact: fast {_zones_text(lift['fast'])}, FE "
                 f"{_zones_text(lift['fe'])} (zone ends "
-                f"{report['errors']['contact_ends']:.3g} a apart).</span>")
+                f"{report['errors']['contact_ends']:.3g} a apart).{unsettled}</span>")
     if report.get("contact_lost"):
         return ("<br><span class='cp-msg'>This full-contact answer has q &lt; 0: both "
                 "models are compared in full contact (solver.contact 'full').</span>")

@@ -96,3 +96,48 @@ def test_a_check_in_full_contact_is_no_measurement_of_a_lifting_scene(lifting):
     measured = {"scene_key": checked_key(full), "model_error": 2e-4, "time_day": 0.0}
     evidence = model_error_evidence(result.scene, result.model_error["estimate"], measured)
     assert evidence["source"] == "estimated" and evidence["flagged"]
+
+
+def test_a_check_whose_fe_contact_set_did_not_settle_is_no_measurement(lifting):
+    # fe_converged False was carried in the report and then ignored: the unsettled
+    # numbers replaced the estimate as if measured
+    from explorer.views.coating import check_report_html
+
+    result, report = lifting
+    unsettled = {**report, "model_error": 2e-4,
+                 "lift_off": {**report["lift_off"], "fe_converged": False}}
+    evidence = model_error_evidence(result.scene, result.model_error["estimate"], unsettled)
+    assert evidence["source"] == "estimated" and evidence["flagged"]
+    settled = model_error_evidence(result.scene, result.model_error["estimate"], report)
+    assert settled["source"] == "measured"
+    text = check_report_html(unsettled)
+    assert "model error: not measured (FE contact unsettled)" in text
+    assert "had not settled after" in text
+
+
+def test_a_time_the_punch_does_not_touch_is_refused_by_the_check():
+    # the check compared a pulled, glued punch (P = -20 MN/m) in full contact and called
+    # it the model error of a scene whose answer is q = 0
+    d = read_preset("uniform_flat")
+    d["base"]["creep"] = {"model": "elastic", "modulus": 3e10}
+    d["loading"] = {"settlement": -1e-3, "tilt": 0.0}
+    d["times"] = [1.0]
+    assert "no_contact" in core.solve(d).flags
+    with pytest.raises(ValueError, match=r"^time: the punch does not touch the coating at "
+                                         r"t = 0 days after loading \(flag no_contact"):
+        check_scene(d)
+
+
+def test_a_punch_touching_nowhere_has_no_corner_in_contact():
+    # an answer with no zone at any time read as in full contact (both corners
+    # unbounded); a zone end within the lift-off rounding of a corner touches it
+    from core.engines.layered.answer import NO_COATING
+    from core.scene import LIFT_OFF_SHARE, scene_from_dict
+    from core.scene.results import corner_pressure
+
+    scene = scene_from_dict(read_preset("bare_layer"))
+    assert corner_pressure(scene, NO_COATING, [[], []]) is None
+    assert corner_pressure(scene, NO_COATING, [])["corners_m"] == [-1.0, 1.0]  # full contact
+    near = 1.0 - LIFT_OFF_SHARE
+    assert corner_pressure(scene, NO_COATING, [[(-near, 0.5)]])["corners_m"] == [-1.0]
+    assert corner_pressure(scene, NO_COATING, [[(-0.99, 0.5)]]) is None
