@@ -70,6 +70,10 @@ MAX_SOLVER_LAM = 1e3
 
 #: Most output times of a scene (``times.count`` or the length of the ``times`` list).
 MAX_SCENE_TIMES = 2_000
+#: Latest output time [day after loading], about 274 years: past any service life a creep
+#: law is fitted for (the presets reach 50 years), and a time typed a thousand times too
+#: large ("1e9 days") is refused as the slip it is rather than answered.
+MAX_SCENE_DAYS = 100_000.0
 #: Most load durations of one ``core.creep_coefficient_curve`` call (a plotted curve
 #: needs a few hundred; each costs a few array operations).
 MAX_CURVE_POINTS = 100_000

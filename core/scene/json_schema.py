@@ -45,7 +45,7 @@ from core.profiles import (
     MAX_POLYNOMIAL_COEFFICIENTS,
     MAX_TABLE_ROWS,
 )
-from core.scene.schema import FIELDS, SCHEMA_KEY, SCHEMA_VERSION, FieldRule
+from core.scene.schema import FIELDS, MAX_DAYS, SCHEMA_KEY, SCHEMA_VERSION, FieldRule
 from core.validation import show_value
 
 #: The JSON Schema dialect of the shipped schemas.
@@ -271,7 +271,8 @@ def _times() -> dict[str, Any]:
             "required": [r.name for r in rules if r.required],
             "properties": {r.name: _field(r) for r in rules},
             "additionalProperties": False,
-            "items": {"type": "number", "minimum": 0}, "minItems": 1, "maxItems": most}
+            "items": {"type": "number", "minimum": 0, "maximum": MAX_DAYS}, "minItems": 1,
+            "maxItems": most}
 
 
 def _loading() -> dict[str, Any]:

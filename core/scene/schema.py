@@ -38,6 +38,8 @@ MAX_SCENE_BYTES = limits.MAX_SCENE_BYTES
 MAX_LAYERS = 10
 #: Largest number of output times.
 MAX_TIMES = limits.MAX_SCENE_TIMES
+#: Latest output time [day after loading].
+MAX_DAYS = limits.MAX_SCENE_DAYS
 #: Accepted range of the solver's relative tolerance, and its default.
 TOL_RANGE = (1e-12, 1e-2)
 DEFAULT_TOL = 1e-6
@@ -175,7 +177,7 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
         for q, unit in zip(QUANTITIES, ("m", "rad", "N/m", "N"), strict=True)),
     "times": (
         _rule("end", "number", "day", "Last output time after loading.", low=0.0,
-              low_open=True),
+              low_open=True, high=MAX_DAYS),
         _rule("count", "integer", "-", "Number of output times.", low=1, high=MAX_TIMES),
         _rule("spacing", "choice", "-", "linear: equally spaced from 0; log: 0, then "
               "geometrically spaced over the last three decades.", required=False,
@@ -397,6 +399,7 @@ def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
     if isinstance(spec, Mapping):
         check_fields(spec, path, ("end", "count"), ("spacing",))
         end = positive_number(spec["end"], f"{path}.end")
+        _check_latest(end, f"{path}.end")
         count = integer_in_range(spec["count"], f"{path}.count", 1, MAX_TIMES)
         spacing = spec.get("spacing", "linear")
         if spacing not in ("linear", "log"):
@@ -428,9 +431,17 @@ def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
         if values[-1] <= 0:
             raise ValueError(f"{path}: the last time must be > 0 days after loading (the "
                              "loads are functions of time on [0, last time])")
+        _check_latest(values[-1], f"{path}[{len(values) - 1}]")
         return np.array(values), values
     raise ValueError(f"{path}: must be an object {{end, count, spacing}} or a list of days "
                      f"after loading, got {show_value(spec)}")
+
+
+def _check_latest(end: float, path: str) -> None:
+    """Refuse an output time past :data:`MAX_DAYS`, naming ``path``."""
+    if end > MAX_DAYS:
+        raise ValueError(f"{path}: must be <= {MAX_DAYS:g} days after loading (about "
+                         f"{MAX_DAYS / 365.25:.0f} years), got {end:g}")
 
 
 def _spec_of(profile: Profile, given: Any) -> Any:

@@ -51,6 +51,10 @@ BAD_VALUES: list[tuple[str, Any, str]] = [
      "base.creep.expr: creep kernel: not finite"),
     ("times", [-1.0, 10.0, 20.0], "times[0]: must be >= 0 days after loading"),
     ("times", [0.0, 20.0, 10.0], "times[2]: times must increase"),
+    # a slip of the keyboard was answered, creep law and all, 2.7 million years on
+    ("times.end", 1e9, "times.end: must be <= 100000 days after loading (about 274 years), "
+                       "got 1e+09"),
+    ("times", [1.0, 10.0, 2e5], "times[2]: must be <= 100000 days after loading"),
 ]
 
 
