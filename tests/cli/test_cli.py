@@ -269,3 +269,18 @@ def test_a_pulled_punch_of_several_is_the_users_input(tmp_path, command, contact
     path = tmp_path / "scene.json"
     path.write_text(json.dumps(data))
     assert_one_line_error(run(command, path), "punches[1].loading.force: the punch is pulled")
+
+
+def test_a_check_where_the_punch_touches_nothing_is_the_users_input(tmp_path):
+    # exit 1 (as if the FE model had failed) for a time the user can change
+    data = scene_dict()
+    data["loading"] = {"settlement": -1e-3, "tilt": 0.0}  # held clear of the surface
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(data))
+    assert_one_line_error(run("check", path), "--time: the punch does not touch the coating")
+    # the report is still written, said without a check
+    out = tmp_path / "report.html"
+    proc = run("report", path, "--fe-check", "-o", out)
+    assert proc.returncode == 0, proc.stderr
+    assert "warning: fe_check: not run: the punch does not touch" in proc.stderr
+    assert out.stat().st_size > 0
