@@ -123,12 +123,12 @@ class LimitCheck:
                    float(self.corner_distance))
 
     def exceeded_text(self) -> str:
-        """Where an unbounded pressure exceeds its limit, in words: "over the whole base",
+        """Where an unbounded pressure exceeds its limit, in words: "on the whole base",
         "within ~D mm of the corner" or "at the corner" (empty without a limit)."""
         if not self.unbounded or self.limit is None:
             return ""
         if self.exceeded_everywhere:
-            return "over the whole base"
+            return "on the whole base"
         within = self.exceeded_within
         if within is None or not math.isfinite(within):
             return "at the corner"

@@ -85,3 +85,9 @@ def test_design_check_says_the_pressure_is_unbounded_at_a_bare_corner() -> None:
     assert check.q_max.verdict == "FAIL" and check.passed is False
     text = check_html(check)
     assert "unbounded at the corner" in text and "over the limit within ~0.8 mm" in text
+    # a limit the pressure passes on the whole base is not extrapolated from the corner
+    # (it read "within ~1.8e+02 mm" for 200 kPa, q >= 202.6 kPa everywhere)
+    text = check_html(design_check(controller.view, DesignLimits(allowable_pressure=200.0)))
+    assert "over the limit on the whole base" in text
+    text = check_html(design_check(controller.view, DesignLimits(allowable_pressure=300.0)))
+    assert "over the limit within ~100 mm of the corner" in text

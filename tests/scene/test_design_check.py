@@ -153,7 +153,7 @@ def test_a_limit_under_the_pressure_everywhere_is_exceeded_over_the_whole_base()
     d["limits"] = {"allowable_pressure": 2e5}
     line = solve(d).design_check().check("q_max")
     assert line.exceeded_everywhere and line.exceeded_within is None
-    assert line.describe().endswith("limit 200000 Pa, exceeded over the whole base: FAIL")
+    assert line.describe().endswith("limit 200000 Pa, exceeded on the whole base: FAIL")
     assert line.to_dict()["exceeded_everywhere"] is True
 
 
