@@ -70,6 +70,12 @@ class DesignLimits:
         return not self.to_dict()
 
 
+#: [m] the least distance from a corner said in words: a limit exceeded closer to the
+#: corner than this is "exceeded within 0.001 mm of the corner" (it read "~0.000000072
+#: mm", a precision no corner is built to)
+CORNER_RESOLUTION = 1e-6
+
+
 @dataclass(frozen=True)
 class LimitCheck:
     """One line of the check: the extreme ``value`` of ``quantity`` [``unit``] at ``time``
@@ -132,6 +138,9 @@ class LimitCheck:
         within = self.exceeded_within
         if within is None or not math.isfinite(within):
             return "at the corner"
+        if within < CORNER_RESOLUTION:
+            # closer than anything a footing's corner is made to: at the corner
+            return f"within {1e3 * CORNER_RESOLUTION:g} mm of the corner"
         return f"within ~{_millimetres(within)} mm of the corner"
 
     @property

@@ -177,3 +177,12 @@ def test_a_punch_lifting_off_one_corner_is_unbounded_only_at_the_other() -> None
     assert result.info["corner_pressure"]["corners_m"] == [1.0]
     line = result.design_check(DesignLimits(allowable_pressure=1e7)).check("q_max")
     assert line.unbounded and line.x == 1.0
+
+
+def test_a_limit_exceeded_only_at_the_very_corner_is_said_without_false_digits() -> None:
+    # 10 MPa on the bare preset read "within ~0.000000072 mm of the corner"
+    d = scene_file("bare_layer")
+    d["limits"] = {"allowable_pressure": 1e8}
+    line = solve(d).design_check().check("q_max")
+    assert line.exceeded_within < 1e-6
+    assert line.exceeded_text() == "within 0.001 mm of the corner"
