@@ -71,10 +71,12 @@ class DesignCheck:
 
     q_max: Check
     q_min: Check
-    contact_width: float           # [m], of the full width 2a
+    contact_width: float           # [m], the smallest over the history, of the full width 2a
     full_width: float              # [m]
     eccentricity: float | None     # e = M/P [m] at the end of the history (None: P <= 0)
     checks: list[Check] = field(default_factory=list)
+    #: [day after loading] when the contact is narrowest (None: not known)
+    narrowest_time: float | None = None
 
     @property
     def passed(self) -> bool | None:
@@ -161,7 +163,8 @@ def design_check(view: ResultView, limits: DesignLimits | None = None) -> Design
     return DesignCheck(q_max=checks[0], q_min=_on_screen(verdict.q_min, limits),
                        contact_width=float(widths[j_narrow]),
                        full_width=2 * view.geometry.half_width,
-                       eccentricity=moment / force if force > 0 else None, checks=checks)
+                       eccentricity=moment / force if force > 0 else None, checks=checks,
+                       narrowest_time=float(view.times[j_narrow]))
 
 
 def check_html(check: DesignCheck) -> str:
@@ -189,11 +192,17 @@ def check_html(check: DesignCheck) -> str:
                     f"<td class='{cls}'>{c.verdict if c.limit is not None else ''}</td></tr>")
     share = 100 * check.contact_width / check.full_width if check.full_width else 0.0
     lift = check.full_width - check.contact_width
-    lifted = f", lift-off length {lift:.4g} m" if lift > 0 else ""
+    if lift > 0:
+        when = ("" if check.narrowest_time is None
+                else f" at t = {days_text(check.narrowest_time)}")
+        contact = (f"smallest contact width {check.contact_width:.4g} m of "
+                   f"{check.full_width:.4g} m ({share:.0f} %){when}, lift-off length "
+                   f"{lift:.4g} m")
+    else:
+        contact = f"full contact: {check.full_width:.4g} m at every time"
     ecc = ("e = M/P = undefined (P ≤ 0)" if check.eccentricity is None else
            f"e = M/P = {check.eccentricity:.4g} m (B/6 = {check.full_width / 6:.4g} m)")
     return (f"<div class='design-check'><b>Design check</b> (whole history) {head}"
             f"<table class='cp-readout'><tr><th></th><th>value</th><th>where</th>"
             f"<th>limit</th><th></th></tr>{''.join(rows)}</table>"
-            f"<div class='cp-status'>contact width {check.contact_width:.4g} m of "
-            f"{check.full_width:.4g} m ({share:.0f} %){lifted} · {ecc}</div></div>")
+            f"<div class='cp-status'>{contact} · {ecc}</div></div>")

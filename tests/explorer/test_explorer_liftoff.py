@@ -52,6 +52,9 @@ def test_design_check_text_gives_the_lift_off_length() -> None:
     check = design_check(controller.view)
     text = check_html(check)
     assert f"lift-off length {check.full_width - check.contact_width:.4g} m" in text
+    # the narrowest over the history, and when: it read "contact width 1.306 m" beside
+    # the result's "contact 1.349 m" at 1000 days, with no word of which time
+    assert "smallest contact width 1.306 m of 2 m (65 %) at t = 0 days" in text
 
 
 def test_histories_csv_carries_the_contact_width_and_the_lifted_length() -> None:
