@@ -27,7 +27,7 @@ from core.scene import LimitCheck, check_design
 from .contact_zone import contact_widths
 from .results import ResultView
 from .state import QUANTITY_UNITS
-from .time_text import days_text
+from .time_text import days_text, plain_number
 
 
 class DesignLimits(param.Parameterized):
@@ -178,13 +178,14 @@ def check_html(check: DesignCheck) -> str:
         head = "<span class='cp-badge cp-bad check-fail'>✗ a limit is exceeded</span>"
     rows = []
     for c in check.checks + [check.q_min]:
-        limit = "" if c.limit is None else f"{c.limit:.4g}"
+        limit = "" if c.limit is None else plain_number(c.limit)
         cls = {"pass": "cp-ok", "FAIL": "cp-bad"}.get(c.verdict, "")
-        value, where = f"{c.value:.4g}", html.escape(c.where)
+        value, where = plain_number(c.value), html.escape(c.where)
         if c.corner_distance is not None:
             # q ~ 1/sqrt(distance) at a rigid corner in contact: no largest value
             value = (f"<span class='check-unbounded'>unbounded at the corner</span>; "
-                     f"{c.value:.4g} at {c.corner_distance:.2g} mm from it")
+                     f"{plain_number(c.value)} at {plain_number(c.corner_distance, 2)} mm "
+                     "from it")
             if c.limit is not None:
                 where += f"; over the limit {html.escape(c.exceeded)}"
         rows.append(f"<tr><td>{html.escape(c.name)} [{c.unit}]</td><td>{value}</td>"

@@ -25,6 +25,7 @@ from ..model import (
     design_check,
     lifts_off,
     model_evidence,
+    plain_number,
     shown_flags,
 )
 from ..plots import PIN_COLORS, PUNCH_COLORS, Figures, LogTime
@@ -58,7 +59,8 @@ BADGES: dict[str, dict[str, tuple[str, str]]] = {
 
 
 def _fmt(value: float) -> str:
-    return f"{value:.5g}" if abs(value) < 1e5 else f"{value:.4e}"
+    # five digits, without an exponent up to a million ("1.0000e+09" past 1e5 before)
+    return plain_number(value, 5)
 
 
 def badges_html(view: ResultView | None, group: str,

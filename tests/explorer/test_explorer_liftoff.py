@@ -94,3 +94,18 @@ def test_design_check_says_the_pressure_is_unbounded_at_a_bare_corner() -> None:
     assert "over the limit on the whole base" in text
     text = check_html(design_check(controller.view, DesignLimits(allowable_pressure=300.0)))
     assert "over the limit within ~100 mm of the corner" in text
+
+
+def test_the_check_and_the_readout_write_realistic_values_without_an_exponent() -> None:
+    # 20 MN/m on the default footing read "q_max [kPa] 2.075e+04"; the readout wrote any
+    # value past 1e5 as "1.0000e+05"
+    from explorer.model import check_html
+    from explorer.model.design import Check, DesignCheck
+    from explorer.views.results import _fmt
+
+    line = Check("largest contact pressure", 20751.3, "kPa", "t = 0 days", 30000.0, True)
+    check = DesignCheck(q_max=line, q_min=line, contact_width=2.0, full_width=2.0,
+                        eccentricity=0.0, checks=[line])
+    text = check_html(check)
+    assert "20750" in text and "30000" in text and "e+0" not in text
+    assert _fmt(123456.0) == "123460" and _fmt(0.040812) == "0.040812"
