@@ -77,9 +77,14 @@ def badges_html(view: ResultView | None, group: str,
     if lifted:  # a unilateral solve: no q < 0, and no full contact either
         parts.append('<span class="cp-badge cp-bad lift-off">⚠ lift-off: part of the base '
                      'carries no load (shaded)</span>')
+    uncoated = group == "scene" and not view.scene.get("coating")
     for flag, (bad, good) in BADGES[group].items():
         if lifted and flag == "contact_lost":
             continue
+        if uncoated and flag not in flags:
+            continue  # no coating: nothing of a coating to vouch for
+        if flag == "model_error" and evidence is None and flag not in flags:
+            good = ""  # no evidence read (several punches): the estimate is not shown
         text = flag_message(view, flag)
         if flag == "model_error" and evidence is not None:
             # a badge of the model's error says whether it was measured or estimated

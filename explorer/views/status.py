@@ -117,8 +117,13 @@ def preview_text(cpu_seconds: float | None) -> str:
             "with creep follows when you release it.")
 
 
-def model_error_text(evidence: Mapping[str, Any]) -> str:
-    """The coating model's error in words: measured by the FE check, or estimated."""
+def model_error_text(evidence: Mapping[str, Any], extrapolated: bool = False) -> str:
+    """The coating model's error in words: measured by the FE check, or estimated;
+    ``extrapolated``: the estimate reads the map beyond what was measured (flag
+    ``beyond_model_map``), so it is no ground for "within"."""
+    if extrapolated and evidence["source"] != "measured":
+        return (f"Coating model error {percent_text(evidence['error'])} (estimated, "
+                "extrapolated beyond the measured map): check it on the Coating tab.")
     side = "above" if evidence["flagged"] else "within"
     return (f"Coating model error {percent_text(evidence['error'])} ({evidence['label']}), "
             f"{side} solver.model_tol {100 * evidence['model_tol']:g} %.")
@@ -141,7 +146,8 @@ def status_html(view: ResultView | None, busy: bool,
                 ) + text
     if evidence is not None:
         tone = " model-flagged" if evidence["flagged"] else ""
-        text_model = html.escape(model_error_text(evidence))
+        text_model = html.escape(model_error_text(
+            evidence, view is not None and "beyond_model_map" in view.flags))
         model = (f" <span class='cp-status model-evidence model-{evidence['source']}{tone}'>"
                  f"{text_model}</span>")
     else:

@@ -264,3 +264,35 @@ def test_the_pressure_plot_spans_the_punch_and_its_pins_set_by_the_server() -> N
     assert b > a
     figures.show(view, last, (Pin(wider, "wider"),))
     assert (rng.start, rng.end) == pytest.approx((-1.1 * b, 1.1 * b), rel=1e-12)
+
+
+def test_no_coating_badges_on_a_bare_layer_nor_an_unread_estimate() -> None:
+    # the bare preset showed "✓ coating thin | ✓ coating softer than base | ✓ coating
+    # model within solver.model_tol (estimated 0 %)"; several punches "✓ coating model
+    # within solver.model_tol" with no estimate behind it
+    from explorer.model import model_evidence
+    from explorer.views.results import badges_html
+
+    bare = _solved("bare_layer")
+    assert "coating" not in badges_html(bare, "scene", model_evidence(bare))
+    pair = _solved("new_footing_beside_old")
+    assert "ok-model_error" not in badges_html(pair, "scene", model_evidence(pair))
+    coated = _solved("uniform_flat")
+    assert "ok-model_error" in badges_html(coated, "scene", model_evidence(coated))
+
+
+def test_the_status_line_does_not_vouch_for_an_extrapolated_estimate() -> None:
+    # "within solver.model_tol 2 %" beside the badge "coating model error extrapolated"
+    from explorer.model import model_evidence
+    from explorer.views.status import status_html
+
+    state = ExplorerState()
+    scene = json.loads(json.dumps(presets()["uniform_flat"]))
+    scene["coating"][0]["modulus"] = 2e5  # 0.2 MPa: beyond the measured map
+    state.load_scene(scene)
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    view = controller.view
+    assert "beyond_model_map" in view.flags
+    text = status_html(view, False, model_evidence(view))
+    assert "extrapolated beyond the measured map" in text and "within solver" not in text
