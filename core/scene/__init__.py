@@ -95,12 +95,14 @@ from core.scene.records import (
 )
 from core.scene.results import (
     FLAG_MESSAGES,
+    LARGE_COATING_STRAIN,
     LARGE_SETTLEMENT,
     LARGE_TILT,
     SceneSolution,
+    coating_strain_per_pressure,
     plotting_grid,
     scene_model_error,
-    settlement_share,
+    strain_share,
     thick_coating,
 )
 from core.scene.schema import (
@@ -149,6 +151,7 @@ __all__ = [
     "JSON_SCHEMA_DIALECT",
     "load_json_schema",
     "LARGE_SETTLEMENT",
+    "LARGE_COATING_STRAIN",
     "LARGE_TILT",
     "LimitCheck",
     "lift_off_length",
@@ -182,7 +185,8 @@ __all__ = [
     "schema_errors",
     "schema_text",
     "scene_model_error",
-    "settlement_share",
+    "strain_share",
+    "coating_strain_per_pressure",
     "thick_coating",
     "SceneSolution",
     "shown_times",

@@ -55,6 +55,10 @@ LARGE_TILT = 0.01
 #: and coating) strains it beyond the small-strain (linear) model: an average strain of
 #: 1 % is about three times the crushing strain of concrete.
 LARGE_SETTLEMENT = 0.01
+#: A coating compressed by more than this share of its thickness (its compliance times
+#: the pressure, over its thickness) is strained beyond its small-strain (linear) model:
+#: a soft pad pressed by more than its own thickness was answered with every badge green.
+LARGE_COATING_STRAIN = 0.01
 #: Points of the default plotting grid :attr:`SceneSolution.x`.
 PLOT_POINTS = 201
 
@@ -71,8 +75,10 @@ FLAG_MESSAGES: dict[str, str] = {
                   "P = M = 0 there (the given settlement and tilt hold it clear of the "
                   "surface; the settlement is positive downward, into the foundation).",
     "large_settlement": f"The punch base moves down more than {100 * LARGE_SETTLEMENT:g} % "
-                        "of the foundation's thickness (base and coating): strains this "
-                        "large are beyond the small-strain (linear elastic) model.",
+                        "of the foundation's thickness (base and coating), or the coating "
+                        "is compressed by more than "
+                        f"{100 * LARGE_COATING_STRAIN:g} % of its own thickness: strains "
+                        "this large are beyond the small-strain (linear elastic) model.",
     "large_tilt": f"The tilt exceeds {LARGE_TILT:g} rad: the small-angle assumption is "
                   "doubtful.",
     "model_error": "The estimated error of the thin-coating model (info.model_error_estimate, "
@@ -183,17 +189,35 @@ def corner_pressure(scene: Scene, coating_model: str,
             "asymptotic": not scene.coating}
 
 
-def settlement_share(scene: Scene, settlement: Any, tilt: Any) -> float:
-    """The largest downward reach of the punch base, ``max |delta| + a max |alpha|`` [m]
-    over the histories ``settlement`` [m] and ``tilt`` [rad], as a share of
-    ``LARGE_SETTLEMENT`` times the foundation's thickness (base and thickest coating
-    stack): above 1 raises ``large_settlement``. It scales with the loads."""
+def strain_share(scene: Scene, settlement: Any, tilt: Any, pressure_max: float) -> float:
+    """How far the answer is from small strains: the larger of the punch base's downward
+    reach ``max |delta| + a max |alpha|`` [m] over the histories ``settlement`` [m] and
+    ``tilt`` [rad] as a share of ``LARGE_SETTLEMENT`` times the foundation's thickness
+    (base and thickest coating stack), and of the coating's compression, its compliance
+    over its thickness times the largest pressure ``pressure_max`` [Pa], as a share of
+    ``LARGE_COATING_STRAIN`` (:func:`coating_strain_per_pressure`). Above 1 raises
+    ``large_settlement``. It scales with the loads."""
     settlement = np.asarray(settlement, dtype=float)
     tilt = np.asarray(tilt, dtype=float)
     reach = (float(np.max(np.abs(settlement), initial=0.0))
              + scene.half_width * float(np.max(np.abs(tilt), initial=0.0)))
     thickness = scene.base_thickness + scene.sample_extremes["coating_thickness_max_m"]
-    return reach / (LARGE_SETTLEMENT * thickness)
+    strain = coating_strain_per_pressure(scene) * max(float(pressure_max), 0.0)
+    return max(reach / (LARGE_SETTLEMENT * thickness), strain / LARGE_COATING_STRAIN)
+
+
+def coating_strain_per_pressure(scene: Scene) -> float:
+    """The largest compressive strain of the coating per unit pressure [1/Pa]: its
+    compliance ``sum c_k`` over its thickness ``sum h_k`` (the thin-layer model's
+    ``(1 - nu^2) / E`` smooth, the constrained ``(1 + nu)(1 - 2 nu) / ((1 - nu) E)``
+    bonded), the largest on the plotting grid; 0 without coating."""
+    if not scene.coating:
+        return 0.0
+    x = plotting_grid(scene.half_width)
+    with np.errstate(all="ignore"):
+        ratio = scene.coating_compliance(x) / scene.coating_thickness(x)
+    ratio = ratio[np.isfinite(ratio)]
+    return float(np.max(ratio, initial=0.0))
 
 
 def thick_coating(scene: Scene, zone: float | None = None) -> bool:
@@ -280,7 +304,8 @@ class SceneSolution:
         # between the output times too (the default engine samples the load histories)
         largest_tilt = max(float(np.max(np.abs(self.tilt))) if self.tilt.size else 0.0,
                            float(solution.info.get("max_abs_tilt", 0.0)))
-        if settlement_share(scene, self.settlement, largest_tilt) > 1.0:
+        if strain_share(scene, self.settlement, largest_tilt,
+                        float(np.nanmax(self.pressure_on_grid, initial=0.0))) > 1.0:
             flags.append("large_settlement")
         if largest_tilt > LARGE_TILT:
             flags.append("large_tilt")

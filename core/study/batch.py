@@ -28,8 +28,8 @@ from core.scene import (
     Scene,
     replace_loads,
     scene_from_dict,
-    settlement_share,
     solve,
+    strain_share,
 )
 from core.study.definition import apply_point
 from core.study.liftoff import (
@@ -138,7 +138,7 @@ def _scaled(answer: tuple[float, np.ndarray, float, list[str], float, float], fo
             outputs: Sequence[str]) -> tuple[np.ndarray, float, str]:
     """Outputs, error estimate and flags of a point with ``force`` [N/m] at the
     eccentricity of ``answer`` (its force, outputs, estimate, flags, largest |tilt|,
-    :func:`core.scene.settlement_share`)."""
+    :func:`core.scene.strain_share`)."""
     base_force, values, estimate, flags, tilt, share = answer
     ratio = force / base_force
     scale = np.array([1.0 if name in _LOAD_FREE_OUTPUTS else ratio for name in outputs])
@@ -156,7 +156,7 @@ def _kept_answer(result: Any, outputs: Sequence[str]
                  ) -> tuple[float, np.ndarray, float, list[str], float, float]:
     """What a solved point keeps to answer the points of its eccentricity: its force
     [N/m], outputs, error estimate, flags, largest |tilt| [rad] and
-    :func:`core.scene.settlement_share` (of several punches, whose points are never
+    :func:`core.scene.strain_share` (of several punches, whose points are never
     scaled, NaN for the force, the tilt and the share)."""
     if isinstance(result, PunchesSolution):
         return (np.nan, point_outputs(result, outputs),
@@ -167,7 +167,8 @@ def _kept_answer(result: Any, outputs: Sequence[str]
     force = result.scene.loading.get("force")
     return (float(force.spec) if force is not None else np.nan, point_outputs(result, outputs),
             float(result.info.get("error_estimate", np.nan)), list(result.flags), tilt,
-            settlement_share(result.scene, result.settlement, tilt))
+            strain_share(result.scene, result.settlement, tilt,
+                         float(np.nanmax(result.pressure_on_grid, initial=0.0))))
 
 
 def _liftoff_families(validated: Sequence[Scene | None],
@@ -280,7 +281,7 @@ def _one_family(scene: Scene, picked: list[tuple[int, float]],
     for key, answer in zip(picked[middle], answers, strict=True):
         if answer is not None:
             solved[key] = (answer.force, answer.values, answer.estimate, answer.flags,
-                           answer.tilt, answer.settlement_share)
+                           answer.tilt, answer.strain_share)
             done.append(key)
     return done
 

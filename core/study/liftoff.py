@@ -51,7 +51,7 @@ from core.scene import (
     narrowest_zone,
     plotting_grid,
     scene_model_error,
-    settlement_share,
+    strain_share,
     thick_coating,
 )
 from core.study.outputs import point_outputs
@@ -87,7 +87,7 @@ _SOLVE_ACCURACY = 1e-12
 class LiftoffAnswer:
     """One eccentricity's answer at the force ``force`` [N/m]: ``values`` (outputs x
     times, units of :data:`core.study.definition.OUTPUT_UNITS`), ``estimate`` (relative, -),
-    ``flags``, the largest |tilt| [rad] and :func:`core.scene.settlement_share`, as
+    ``flags``, the largest |tilt| [rad] and :func:`core.scene.strain_share`, as
     :func:`core.study.run_batch` keeps a solved point to scale it."""
 
     force: float
@@ -95,7 +95,7 @@ class LiftoffAnswer:
     estimate: float
     flags: list[str]
     tilt: float
-    settlement_share: float
+    strain_share: float
 
 
 def _callable(value: Any) -> Callable[[np.ndarray], np.ndarray]:
@@ -352,7 +352,8 @@ def _answer(scene: Scene, point: tuple[np.ndarray, SimpleNamespace], force: floa
     if scene_model_error(scene, share, zone)["estimate"] > scene.model_tol:
         point_flags.append("model_error")
     largest = float(np.max(np.abs(result.tilt)))
-    share = settlement_share(scene, result.settlement, largest)
+    share = strain_share(scene, result.settlement, largest,
+                         float(np.nanmax(result.pressure_on_grid, initial=0.0)))
     if share > 1.0:
         point_flags.append("large_settlement")
     if largest > LARGE_TILT:

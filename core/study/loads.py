@@ -42,7 +42,7 @@ from core.engines.layered import (
     uniform_layers,
 )
 from core.profiles import profile_values
-from core.scene import LARGE_TILT, Scene, contact_width, plotting_grid, settlement_share
+from core.scene import LARGE_TILT, Scene, contact_width, plotting_grid, strain_share
 from core.study.definition import OUTPUT_UNITS
 from core.validation import MAX_MAGNITUDE
 
@@ -160,6 +160,7 @@ class _Level:
     lost: np.ndarray
     tilt: np.ndarray
     settlement: np.ndarray
+    pressure_max: np.ndarray  # [Pa] the largest on the plotting grid over the times
 
 
 def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, np.ndarray],
@@ -205,8 +206,10 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
     # every point here is a full-contact answer: its contact set is the whole base
     width = contact_width([[(-a, a)]], a)[0]
     rows = np.empty((n, len(outputs), times.size))
+    pressure_max = np.zeros(n)
     for k in range(times.size):
         q = q_star * pressure_scale[k]
+        pressure_max = np.fmax(pressure_max, np.max(q, axis=0))
         for j, name in enumerate(outputs):
             if name in ("settlement", "tilt"):
                 rows[:, j, k] = dimensional[name]
@@ -224,7 +227,7 @@ def _answer_level(scene: Scene, response: LayeredResponse, given: Mapping[str, n
     for name in _NAMES:
         keep &= np.isfinite(dimensional[name]).reshape(n, -1).all(axis=1)
     return _Level(settled, keep & settled, rows, error, numerical, lost, fine["tilt"],
-                  a * fine["settlement"])
+                  a * fine["settlement"], pressure_max)
 
 
 def solve_load_batch(scene: Scene, loads: Mapping[str, np.ndarray],
@@ -262,7 +265,8 @@ def solve_load_batch(scene: Scene, loads: Mapping[str, np.ndarray],
                 # the numerical estimate stands for the coating model's (0 without one)
                 if scene.coating and level.numerical[i] > scene.model_tol:
                     point_flags.append("model_error")
-                if settlement_share(scene, level.settlement[i], level.tilt[i]) > 1.0:
+                if strain_share(scene, level.settlement[i], level.tilt[i],
+                                level.pressure_max[i]) > 1.0:
                     point_flags.append("large_settlement")
                 if abs(level.tilt[i]) > LARGE_TILT:
                     point_flags.append("large_tilt")

@@ -452,14 +452,33 @@ def test_flag_no_contact():
 
 
 def test_flag_large_settlement():
-    # the punch base moving down more than 1 % of the 4.02 m foundation: 4.08 cm under
-    # 500 MN/m (a load the explorer's number box accepts) raised no flag before
-    d = scene_file("uniform_flat")
-    d["loading"]["force"] = 5e8
+    # the punch base moving down more than 1 % of the 1 m bare layer: 1.09 cm under
+    # 800 MN/m (a load the explorer's number box accepts) raised no flag before
+    d = scene_file("bare_layer")
+    d["loading"]["force"] = 8e8
     result = solve(d)
     assert result.flags == ["large_settlement"]
     assert "small-strain" in result.flag_messages["large_settlement"]
-    d["loading"]["force"] = 4.5e8  # 3.7 cm
+    d["loading"]["force"] = 7e8  # 0.95 cm
+    assert solve(d).flags == []
+
+
+def test_flag_large_settlement_of_a_crushed_coating():
+    # A 0.2 MPa pad pressed 22.8 mm into its 20 mm had every strain badge green: the 4 m
+    # base hid the coating's strain. Its compression q_max (1 - nu^2) h / E over h:
+    # 1.06 % at 9 MN/m on the 800 MPa coating (0.73 mm of settlement, 0.02 % of the
+    # foundation), 0.94 % at 8 MN/m.
+    from core.scene import coating_strain_per_pressure
+
+    d = scene_file("uniform_flat")
+    d["coating"][0]["modulus"] = 2e5
+    crushed = solve(d)
+    assert crushed.settlement.max() > 0.02 and "large_settlement" in crushed.flags
+    d = scene_file("uniform_flat")
+    assert coating_strain_per_pressure(solve(d).scene) == pytest.approx((1 - 0.3**2) / 8e8)
+    d["loading"]["force"] = 9e6
+    assert solve(d).flags == ["large_settlement"]
+    d["loading"]["force"] = 8e6
     assert solve(d).flags == []
 
 
