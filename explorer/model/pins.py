@@ -96,6 +96,21 @@ def field_text(path: str, value: Any) -> str:
     return f"{symbol} = {_short(number / size)}" + (f" {unit}" if unit else "")
 
 
+def coating_text(scene: dict[str, Any]) -> str:
+    """The coating of a scene in a few words: "no coating", "h1 = 20 mm, E1 = 800 MPa"
+    for one layer of constant values, else its number of layers."""
+    layers = scene.get("coating") or []
+    if not layers:
+        return "no coating"
+    if len(layers) == 1:
+        parts = [field_text(f"coating.0.{name}", layers[0].get(name))
+                 for name in ("thickness", "modulus")
+                 if _number(layers[0].get(name)) is not None]
+        if parts:
+            return ", ".join(parts)
+    return f"{len(layers)} coating layer{'s' if len(layers) > 1 else ''}"
+
+
 def _short(number: float) -> str:
     """Three significant digits, without an exponent for the thousands (1000 kN/m)."""
     return f"{number:.0f}" if 1e3 <= abs(number) < 1e6 else f"{number:.3g}"
@@ -120,9 +135,14 @@ def pin_labels(scenes: list[dict[str, Any]]) -> list[str]:
     ecc = [eccentricity(scene) for scene in scenes]
     use_e = (bool(keys) and "loading.moment" in keys and None not in ecc
              and len({round(e, 12) for e in ecc if e is not None}) > 1)
+    if len({len(scene.get("coating") or []) for scene in scenes}) > 1:
+        # layers added or taken off: the coating named as a whole ("coating = []" and
+        # "h1 = None" read before)
+        keys = ["coating", *(key for key in keys if not key.startswith("coating"))]
     labels = []
     for k, (scene, flat) in enumerate(zip(scenes, flats, strict=True)):
         parts = [f"e = {_short(ecc[k] or 0.0)} m" if use_e and key == "loading.moment"
+                 else coating_text(scene) if key == "coating"
                  else field_text(key, flat.get(key)) for key in keys]
         parts = parts[:LABEL_FIELDS]
         if not parts:

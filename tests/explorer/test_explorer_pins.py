@@ -140,3 +140,14 @@ def test_the_steps_start_around_the_load_on_screen_and_say_what_they_refused(
     pins.step_from.value = 300.0
     pins.steps_button.clicks += 1
     assert len(pins.board) == 3 and app.screen.notice == ""
+
+
+def test_a_coating_added_or_taken_off_is_named_as_a_whole() -> None:
+    # the lesson on the edge pressure labelled its pins "coating = [], h1 = None" and
+    # "coating = None, h1 = 20 mm"
+    bare = _scene()
+    bare["coating"] = []
+    assert pin_labels([bare, _scene()]) == ["no coating", "h1 = 20 mm, E1 = 800 MPa"]
+    two = _scene()
+    two["coating"] = two["coating"] * 2
+    assert pin_labels([bare, two])[1] == "2 coating layers"
