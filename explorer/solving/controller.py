@@ -200,10 +200,32 @@ _METRES = re.compile(
 _MILLIMETRE_FIELDS = re.compile(r"(punches\[\d+\]\.)?coating\[\d+\]\.thickness")
 
 
+#: Fields whose box on the page has a unit of its own: (path, page unit, its size in the
+#: core's unit). A value the core refuses ("got 0", "is 0 Pa") is said in it.
+_BOX_UNITS = (
+    (re.compile(r"(punches\[\d+\]\.)?coating\[\d+\]\.modulus"), "MPa", 1e6),
+    (re.compile(r"base\.creep\.modulus(_final)?"), "GPa", 1e9),
+    (re.compile(r"base\.thickness|(punches\[\d+\]\.)?(punch\.)?half_width"), "m", 1.0),
+    (re.compile(r"base\.age_at_loading"), "days", 1.0),
+)
+#: A refused value in the core's messages: "got -3" or "is 0 Pa", then the end, a comma,
+#: a parenthesis or the place ("at x = ...").
+_REFUSED_VALUE = re.compile(r"(\b(?:got|is) )(-?\d+(?:\.\d*)?(?:e[+-]?\d+)?)"
+                            r"(?: (?:Pa|m|days?))?(?=$|[,;)]| at | \()")
+
+
 def format_error(message: str) -> str:
     """The core's ``"field.path: reason"`` message with the field also named in words,
-    and its SI values of forces, moments and stresses in the page's units (a coating's
-    thickness in mm, as its box)."""
+    its refused value in the unit of the field's box (a coating's thickness in mm, its
+    modulus in MPa, the base's in GPa), and its SI values of forces, moments and
+    stresses in the page's units."""
+    field = message.partition(":")[0].strip()
+    for pattern, unit, size in _BOX_UNITS:
+        if pattern.fullmatch(field):
+            message = _REFUSED_VALUE.sub(
+                lambda m, unit=unit, size=size: f"{m.group(1)}{float(m.group(2)) / size:.6g} "
+                                                f"{unit}", message)
+            break
     message = _page_units(message)
     if _MILLIMETRE_FIELDS.match(message.partition(":")[0].strip()):
         message = _METRES.sub(lambda m: f"{1e3 * float(m.group(1)):.6g} mm", message)

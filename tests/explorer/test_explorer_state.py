@@ -321,11 +321,24 @@ def test_format_error_says_loads_and_stresses_in_the_page_units():
                         ).endswith("is 0 mm at x = 0.5 m")
 
 
+def test_format_error_says_a_refused_value_in_the_unit_of_its_box():
+    # the coating's modulus box is in MPa and read "is 0 kPa"; the base's in GPa and its
+    # thickness, age and the half-width read "got 0", "got -1" with no unit
+    assert format_error("coating[0].modulus: must be > 0, is 0 Pa at x = -1 m").endswith(
+        "must be > 0, is 0 MPa at x = -1 m")
+    assert format_error("base.creep.modulus: must be > 0, got 0").endswith("got 0 GPa")
+    assert format_error("base.creep.modulus_final: must be > 0, got -3e+10 (final)"
+                        ).endswith("got -30 GPa (final)")
+    assert format_error("base.thickness: must be > 0, got -1").endswith("got -1 m")
+    assert format_error("base.age_at_loading: must be > 0, got -3").endswith("got -3 days")
+    assert format_error("punch.half_width: must be > 0, got 0").endswith("got 0 m")
+
+
 def test_format_error_names_the_field_in_words():
     assert describe_field("coating[1].thickness") == "Coating layer 2, thickness"
     assert describe_field("base.creep.rate") == "Base, creep, rate"
-    assert format_error("coating[0].modulus: must be > 0, got -1") == (
-        "Coating layer 1, modulus (coating[0].modulus): must be > 0, got -1")
+    assert format_error("coating[0].poisson: must be < 0.5, got 0.6") == (
+        "Coating layer 1, poisson (coating[0].poisson): must be < 0.5, got 0.6")
     assert format_error("no field here") == "no field here"
 
 
