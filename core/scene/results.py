@@ -85,7 +85,7 @@ FLAG_MESSAGES: dict[str, str] = {
                    "from measurements against a resolved finite-element model) exceeds "
                    "solver.model_tol: check the coating model (python -m core check).",
     "beyond_model_map": "The coating lies outside the range its model's error was measured "
-                        "on (info.model_error.beyond_map: softer against the base, or "
+                        "on (info.model_error.beyond_map: softer or stiffer against the base, or "
                         "nearer to incompressible): the estimate is an extrapolation. "
                         "Measure it: python -m core check, or the explorer's coating check.",
     "tol_not_met": "The solver could not reach the requested tolerance: see info.message.",
