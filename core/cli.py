@@ -221,7 +221,8 @@ def _write(path: Path, content: str | bytes) -> None:
 def _describe(scene: Scene | PunchesScene) -> str:
     if isinstance(scene, PunchesScene):
         first = scene.scenes[0]
-        return (f"{scene.name!r}: {len(scene.scenes)} punches (statements "
+        count = len(scene.scenes)
+        return (f"{scene.name!r}: {count} punch{'es' if count > 1 else ''} (statements "
                 f"{', '.join(str(s.statement) for s in scene.scenes)}), "
                 f"{len(first.coating)} coating layer(s), {first.times.size} time(s) up to "
                 f"{first.times[-1]:g} days after loading")
@@ -269,7 +270,8 @@ def _summary(result: SceneSolution) -> str:
     if result.info.get("contact") == "unilateral":
         for i in rows:
             zones = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in result.contact_set[i])
-            lines.append(f"contact at {result.times[i]:g} days: {zones or 'none'} m")
+            where = f"{zones} m" if zones else "none (the punch touches nothing)"
+            lines.append(f"contact at {result.times[i]:g} days: {where}")
     peak = largest_pressure(result).value_text(place_first=True)
     lines.append(f"largest contact pressure q: {peak}")
     lines.append(str(result.info.get("message", "")))
@@ -649,6 +651,9 @@ def _zones(zones: list[list[float]]) -> str:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     scene = _read(args.scene)
+    if isinstance(scene, PunchesScene):
+        raise _InputError(f"{args.scene}: the finite-element check is of one punch; run it "
+                          "on each punch's own scene")
     end = float(scene.times[-1])
     if not 0.0 <= args.time <= end:  # also refuses nan
         raise _InputError(f"--time: must be in [0, {end:g}] days after loading (the scene's "

@@ -51,12 +51,13 @@ def check_loads_touch(scene: Scene | PunchesScene) -> None:
     Scenes whose force is not given (settlement or tilt given) are not checked here. A
     scene of several punches is checked punch by punch, the field named
     ``punches[k].loading.<field>``, where it may lift off (``solver.contact`` "auto" or
-    "unilateral"): its full-contact model is linear in the loads, a punch unloaded or
-    pulled in it is a bonded one (the pair's influence coefficients are read that way).
+    "unilateral"), or where it is one punch: the full-contact model of several is linear
+    in the loads, a punch unloaded or pulled in it is a bonded one (the pair's influence
+    coefficients are read that way).
     """
     punches = getattr(scene, "scenes", None)
     if punches is not None:
-        if punches[0].contact == "full":
+        if punches[0].contact == "full" and len(punches) > 1:
             return
         for k, sub in enumerate(punches):
             try:

@@ -144,6 +144,11 @@ def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:
                 f"punches: punches[{i}] and punches[{j}] overlap or touch ([{spans[i][0]:g}, "
                 f"{spans[i][1]:g}] m and [{spans[j][0]:g}, {spans[j][1]:g}] m): move a centre "
                 "or narrow a punch so that a gap remains between them")
+    if len(scenes) > 1 and not scenes[0].coating:
+        # the bare layer's answer (its corners' square-root edges) is one punch's
+        raise ValueError("coating: several punches need at least one coating layer (the "
+                         "bare layer, no coating, is answered for one punch only): add a "
+                         "layer, or solve each punch on its own")
     if len(scenes) > 1 and not _uniform(common["coating"]):
         scenes = _along_x(common, scenes, centers, spans)
     # copies of only the parts kept (a whole scene's copy per part read was ~a tenth of a

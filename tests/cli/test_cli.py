@@ -284,3 +284,31 @@ def test_a_check_where_the_punch_touches_nothing_is_the_users_input(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "warning: fe_check: not run: the punch does not touch" in proc.stderr
     assert out.stat().st_size > 0
+
+
+def test_several_punches_without_coating_and_their_check_are_the_users_input(tmp_path):
+    # validate said ok and solve exited 1 with "m: must be > 0" (an internal name);
+    # check dumped an 11 kB line of the scene object and exited 1
+    data = json.loads((SCENES / "new_footing_beside_old.json").read_text())
+    data["coating"] = []
+    path = tmp_path / "bare.json"
+    path.write_text(json.dumps(data))
+    for command in ("validate", "solve"):
+        assert_one_line_error(run(command, path), "coating: several punches need at least "
+                                                  "one coating layer")
+    proc = run("check", SCENES / "new_footing_beside_old.json")
+    assert_one_line_error(proc, str(SCENES / "new_footing_beside_old.json")
+                          + ": the finite-element check is of one punch")
+    assert len(proc.stderr) < 300
+
+
+@pytest.mark.parametrize("command", ["validate", "solve"])
+def test_one_punch_in_the_punches_form_is_refused_as_one_punch(tmp_path, command):
+    # full contact: solve exited 1 naming loading.force, validate said ok
+    data = json.loads((SCENES / "new_footing_beside_old.json").read_text())
+    data["punches"] = data["punches"][:1]
+    data["punches"][0]["loading"] = {"force": -1e5, "moment": 0.0}
+    data["solver"]["contact"] = "full"
+    path = tmp_path / "one.json"
+    path.write_text(json.dumps(data))
+    assert_one_line_error(run(command, path), "punches[0].loading.force: the punch is pulled")
