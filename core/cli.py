@@ -665,7 +665,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
         report = check_scene(scene, args.time, level=args.level)
     except ValueError as exc:
         if str(exc).startswith("time: "):  # the time asked for (no contact then): input
-            raise _InputError(f"--time: {str(exc)[len('time: '):]}") from None
+            raise _InputError(f"--time (default 0): {str(exc)[len('time: '):]}; pass "
+                              "--time DAYS") from None
         print(f"error: check: {_one_line(exc)}", file=sys.stderr)
         return EXIT_SOLVER_FAILED
     except (ArithmeticError, RuntimeError, MemoryError) as exc:

@@ -277,7 +277,8 @@ def test_a_check_where_the_punch_touches_nothing_is_the_users_input(tmp_path):
     data["loading"] = {"settlement": -1e-3, "tilt": 0.0}  # held clear of the surface
     path = tmp_path / "scene.json"
     path.write_text(json.dumps(data))
-    assert_one_line_error(run("check", path), "--time: the punch does not touch the coating")
+    assert_one_line_error(run("check", path),
+                          "--time (default 0): the punch does not touch the coating")
     # the report is still written, said without a check
     out = tmp_path / "report.html"
     proc = run("report", path, "--fe-check", "-o", out)
