@@ -51,12 +51,13 @@ class SceneView:
         self.preset.param.watch(self._on_preset, "value")
         self.undo_button = pn.widgets.Button(label="↶ Undo", disabled=not history.can_undo,
                                              css_classes=["undo-button"])
-        self.undo_button.on_click(lambda e: _held(history.undo))
+        self._syncing = False  # the selector set to follow the scene, not to load one
+        self.undo_button.on_click(lambda e: _held(lambda: self._back(history.undo)))
         history.param.watch(lambda e: setattr(self.undo_button, "disabled", not e.new),
                             "can_undo")
         self.reset_button = pn.widgets.Button(label="Reset to the loaded scene",
                                               css_classes=["reset-button"])
-        self.reset_button.on_click(lambda e: _held(history.reset))
+        self.reset_button.on_click(lambda e: _held(lambda: self._back(history.reset)))
 
         self.statement = pn.widgets.Select(label="statement (which two are given)",
                                            options=list(STATEMENTS), value=s.loading.statement,
@@ -93,9 +94,24 @@ class SceneView:
     def _on_preset(self, event: Any) -> None:
         key = event.new
         self.preset_description.object = self._preset_text()
-        if not key or key not in self.presets:
+        if self._syncing or not key or key not in self.presets:
             return
         self.load_scene(self.presets[key])
+
+    def _back(self, action: Callable[[], None]) -> None:
+        """Undo or reset (``action``), then show the preset of the scene it brought back
+        (by its name; none for a scene of its own) with its description: an undo across
+        a preset change left the later preset's name and text on screen."""
+        action()
+        name = self.state.scene_name
+        key = next((k for k, scene in self.presets.items() if scene.get("name") == name), "")
+        if self.preset.value != key:
+            self._syncing = True
+            try:
+                self.preset.value = key
+            finally:
+                self._syncing = False
+        self.preset_description.object = self._preset_text()
 
     def forget_preset(self) -> None:
         """Show no preset as chosen (a scene from a file is a scene of its own)."""

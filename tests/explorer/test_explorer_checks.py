@@ -375,6 +375,23 @@ def test_undo_and_reset_return_to_earlier_scenes(explorer_app):
     assert app.controller.view.scene == start
 
 
+def test_undo_across_a_preset_change_shows_the_scene_it_brings_back(explorer_app):
+    # the selector and the description stayed at "Worn coating" while the uniform
+    # scene was back on screen
+    app = explorer_app()
+    tab = app.scene_tab
+    start = tab.preset.value
+    tab.preset.value = "worn_coating"
+    assert app.state.scene_name == app.presets["worn_coating"]["name"]
+    tab.undo_button.clicks += 1
+    assert tab.preset.value == start
+    assert app.state.to_scene()["name"] == app.presets[start]["name"]
+    assert tab.preset_description.object == app.presets[start]["description"]
+    tab.reset_button.clicks += 1  # the scene last loaded: the worn coating
+    assert tab.preset.value == "worn_coating"
+    assert tab.preset_description.object == app.presets["worn_coating"]["description"]
+
+
 def test_classical_solutions_carry_the_force_and_moment():
     """The half-space and bearing-rule pressures integrate to P and M (Chebyshev-Gauss
     for the edge singularity, measured agreement 1e-15; trapezoid rule on 2e5 intervals
