@@ -23,6 +23,9 @@ class CheckView:
         self.state = state
         self.limits = limits
         self.screen = screen
+        # why a limit typed was refused, beside the boxes (the page's notice is above the
+        # plots, out of sight from here)
+        self.limit_note = html_pane("", css_classes=["limit-refused"], visible=False)
         self.allowable_pressure = self._limit("allowable bearing pressure [kPa]",
                                               "allowable_pressure", "limit-pressure")
         self.settlement_limit = self._limit("settlement limit [mm]", "settlement_limit",
@@ -58,12 +61,18 @@ class CheckView:
             value = None  # an emptied box: the page sends NaN; not checked
         if value is not None and value < 0:
             good = getattr(self.limits, name)
-            self.screen.reject(f"{label}: must be a number >= 0 (leave it empty: not "
-                               f"checked), got {value:g}; the limit stays "
-                               + ("unset" if good is None else f"{good:g}"))
+            message = (f"{label}: must be a number >= 0 (leave it empty: not checked), "
+                       f"got {value:g}; the limit stays "
+                       + ("unset" if good is None else f"{good:g}"))
+            self.screen.reject(message)
+            self.limit_note.object = f"<span class='cp-msg'>Not accepted: {message}</span>"
+            self.limit_note.visible = True
             # the last good limit, on the page too (next_tick: see there)
             next_tick(lambda: setattr(box, "value", good))
             return
+        if value == getattr(self.limits, name):
+            return  # the last good limit put back (or nothing changed): the note stays
+        self.limit_note.visible = False
         setattr(self.limits, name, value)
 
     def show_eccentricity(self) -> None:
@@ -90,7 +99,7 @@ class CheckView:
                       "The check covers the whole history. A scene file's limits fill "
                       "them, and a saved scene keeps them.</small>"),
             self.allowable_pressure, self.settlement_limit, self.tilt_limit,
-            self.eccentricity).panel, **TAB_COLUMN)
+            self.limit_note, self.eccentricity).panel, **TAB_COLUMN)
 
     def _on_eccentricity(self, event: Any) -> None:
         """Set the moment so that M = e P (force and moment given, constant force)."""

@@ -442,6 +442,9 @@ def test_a_negative_limit_is_refused_saying_so_and_the_last_good_one_stays(page:
           "the refusal said", describe=lambda: page.pane_text(".notice"))
     until(lambda: box.input_value() == "50", "the last good limit back in the box",
           describe=box.input_value)
+    # beside the boxes too, still there once the box is back
+    until(lambda: "Not accepted: settlement limit [mm]" in page.pane_text(".limit-refused"),
+          "the refusal beside the box", describe=lambda: page.pane_text(".limit-refused"))
     assert "all set limits hold" in page.text(".design-check")
     # emptied: not checked, and the box is empty (it read "NaN")
     box.fill("")

@@ -463,3 +463,9 @@ def test_the_eccentricity_box_follows_the_loads_and_a_negative_limit_is_refused(
     assert app.limits.allowable_pressure == 300.0 and check.allowable_pressure.value == 300.0
     assert app.screen.notice.startswith("Value not accepted: allowable bearing pressure "
                                         "[kPa]: must be a number >= 0")
+    # said beside the boxes too (the notice above the plots was out of sight), and kept
+    # while the last good limit is put back
+    assert check.limit_note.visible
+    assert "Not accepted: allowable bearing pressure [kPa]" in check.limit_note.object
+    check.allowable_pressure.value = 250.0
+    assert not check.limit_note.visible
