@@ -23,6 +23,7 @@ from core.creep.design_codes import (
     default_tolerance,
     fit_advice,
 )
+from core.creep.design_codes import MAX_DURATION as MAX_CODE_DURATION
 from core.creep.design_codes import SPEC_FIELDS as CODE_SPEC_FIELDS
 from core.creep.fitted_kernel import integrated_kernel
 from core.creep.inputs import MAX_RATE, MAX_TERMS
@@ -49,6 +50,7 @@ __all__ = [
     "integrated_kernel",
     "Elastic",
     "KNOWN_MODELS",
+    "MAX_CODE_DURATION",
     "MAX_RATE",
     "MAX_TERMS",
     "RANGES",

@@ -25,7 +25,14 @@ from core.coating import (
     MODEL_TOL_RANGE,
     layer_compliance,
 )
-from core.creep import CodeCreep, Elastic, UserKernel, creep_model_from_spec, default_tolerance
+from core.creep import (
+    MAX_CODE_DURATION,
+    CodeCreep,
+    Elastic,
+    UserKernel,
+    creep_model_from_spec,
+    default_tolerance,
+)
 from core.problem import QUANTITIES, STATEMENTS
 from core.profiles import Profile, profile_values
 from core.scene import schema
@@ -156,6 +163,13 @@ def _validated(d: dict[str, Any]) -> Scene:
                          f"in [{lam_lo:g}, {lam_hi:g}], got {a / h_base:.6g}")
 
     times, times_spec = _times(d["times"], "times")
+    if isinstance(creep, CodeCreep) and float(times[-1]) > MAX_CODE_DURATION:
+        # the design codes' kernel is fitted over 100 years of loading: past it the fit
+        # would be read outside its range (named base.creep, in dimensionless ages)
+        last = "times.end" if isinstance(times_spec, dict) else f"times[{len(times) - 1}]"
+        raise ValueError(f"{last}: must be <= {MAX_CODE_DURATION:g} days after loading (100 "
+                         f"years, the span a design code's creep law is fitted for), got "
+                         f"{float(times[-1]):g}")
 
     loading = d["loading"]
     check_fields(loading, "loading", (), schema.optional_fields("loading"))

@@ -141,3 +141,18 @@ def test_a_formula_pole_between_check_samples_names_the_scene_field():
     with pytest.raises(ValueError, match=r"^coating\[0\]\.thickness: must be > 0, is -\S+ m "
                                          r"at x = 0\.1234\d* m, between the points"):
         solve(scene)
+
+
+def test_a_design_code_creep_law_past_its_100_years_names_the_times() -> None:
+    # it read "base.creep: creep kernel: fitted for dimensionless ages 1 to 5218.86 ...
+    # asked at 5219": the field at fault is the last output time, in days
+    from core.presets import read_preset
+
+    d = read_preset("young_concrete_50_years")
+    d["times"] = [0.0, 100.0, 36526.0]
+    with pytest.raises(ValueError, match=r"^times\[2\]: must be <= 36525 days after loading "
+                                         r"\(100 years, the span a design code's creep law "
+                                         r"is fitted for\), got 36526$"):
+        solve(d)
+    d["times"] = {"end": 36525.0, "count": 3}  # the whole span: answered
+    assert solve(d).times[-1] == 36525.0
