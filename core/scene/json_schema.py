@@ -20,6 +20,7 @@ from __future__ import annotations
 import difflib
 import itertools
 import json
+import re
 from collections.abc import Iterator, Mapping
 from functools import cache
 from importlib import resources
@@ -404,7 +405,11 @@ def _words(error: Any, root: str) -> Iterator[tuple[str, str]]:
     elif kind in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
         sign = {"minimum": ">=", "maximum": "<=", "exclusiveMinimum": ">",
                 "exclusiveMaximum": "<"}[kind]
-        yield path, f"must be {sign} {value:g}, got {got}"
+        # the field's unit, as its description ends ("... [day]"), on both numbers
+        unit = re.search(r"\[([^\]]+)\]\.?$", str(error.schema.get("description", "")))
+        unit = "" if unit is None or unit.group(1) == "-" else " " + unit.group(1)
+        unit = " days" if unit == " day" else unit
+        yield path, f"must be {sign} {value:g}{unit}, got {got}{unit if unit else ''}"
     elif kind == "const":
         yield path, f"must be {show_value(value)}, got {got}"
     elif kind == "enum":

@@ -187,7 +187,8 @@ def test_validate_reports_every_schema_problem_with_its_field(tmp_path: Path) ->
         "error: coating[0].poisson: must be < 0.5, got 0.7",
         "error: solver.tol: must be <= 0.01, got 1",
         "error: solver.contact: must be one of 'auto', 'full', 'unilateral', got 'sticky'",
-        "error: limits.allowable_pressure: must be >= 0, got -5",
+        # with the field's unit, as the validator gives it
+        "error: limits.allowable_pressure: must be >= 0 Pa, got -5 Pa",
     ]
 
 
