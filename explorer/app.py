@@ -516,11 +516,13 @@ class ExplorerApp(pn.viewable.Viewer):
         with pn.io.hold(), layout_batch.batch():
             try:
                 validated_scene(scene)
+                # before the load: a result found in the caches is drawn within it, and
+                # took the last scene's unit of pressure (MPa or kPa by the way it came)
+                self.scales.reset()
                 self.state.load_scene(scene)
             except ValueError as exc:
                 self.screen.notice = f"The scene was not loaded: {format_error(str(exc))}"
                 return False
-            self.scales.reset()
             self.history.loaded = scene
             self.screen.notice = ""
             self.check_tab.show_limits(scene.get("limits"))

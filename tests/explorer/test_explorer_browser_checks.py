@@ -58,6 +58,26 @@ def _choose_preset(page: Page, key: str, title_part: str) -> None:
           ".includes(t)", title_part)
 
 
+def test_a_preset_reads_its_pressure_in_the_unit_it_chooses_whatever_came_before(
+        page: Page, server: str, browser_context: object):
+    """The lift-off preset plotted q in MPa reached from the eccentric creep preset and in
+    kPa from the default one, on another page: its answer, found in the server's caches,
+    was drawn within the load, before the units were chosen again."""
+    read = ("() => Array.from(Bokeh.documents[0]._all_models.values())"
+            ".filter(m => m.axis_label && String(m.axis_label).startsWith('q ['))"
+            ".map(m => m.axis_label)")
+    _choose_preset(page, "eccentric_creep", "Eccentric force")
+    _choose_preset(page, "eccentric_footing_liftoff", "Eccentric footing")
+    from_creep = page.page.evaluate(read)
+    other = Page(browser_context, server)  # the default scene, then the cached answer
+    try:
+        _choose_preset(other, "eccentric_footing_liftoff", "Eccentric footing")
+        until(lambda: other.page.evaluate(read) == from_creep, "the same unit both ways",
+              30, lambda: (from_creep, other.page.evaluate(read)))
+    finally:
+        other.close()
+
+
 def _player_range(page: Page) -> dict:
     return page.page.locator(".time-player input[type=range]").first.evaluate(
         "e => ({min: e.min, max: e.max, value: e.value})")

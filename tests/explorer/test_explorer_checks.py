@@ -469,3 +469,4 @@ def test_the_eccentricity_box_follows_the_loads_and_a_negative_limit_is_refused(
     assert "Not accepted: allowable bearing pressure [kPa]" in check.limit_note.object
     check.allowable_pressure.value = 250.0
     assert not check.limit_note.visible
+
