@@ -310,12 +310,27 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
                                        float(times[i_max[1]]), float(x[i_max[0]]), limit))
             continue
         values = histories[quantity]
-        k = int(np.nanargmax(np.abs(values)))
+        k = _time_of_largest(values)
         lines.append(LimitCheck(name, quantity, label, float(values[k]), unit,
                                 float(times[k]), None, limit))
     q_min = LimitCheck(None, "q_min", "smallest contact pressure q_min", float(q[i_min]),
                        "Pa", float(times[i_min[1]]), float(x[i_min[0]]))
     return DesignCheck(tuple(lines), q_min)
+
+
+#: Values of a history within this share of its largest are the largest (round-off): a
+#: creep settlement levelling off read "largest at t = 887.7 days" for 1e-11 mm more there
+#: than at 1000 days.
+SAME_SHARE = 1e-9
+
+
+def _time_of_largest(values: np.ndarray) -> int:
+    """The index of the largest ``|values|``, the last of those within :data:`SAME_SHARE`
+    of it (a history that levels off reaches it by then, and stays)."""
+    size = np.abs(values)
+    k = int(np.nanargmax(size))
+    near = np.flatnonzero(size >= size[k] * (1.0 - SAME_SHARE))
+    return int(near[-1]) if near.size else k
 
 
 def _corner_line(name: str, label: str, unit: str, times: np.ndarray, x: np.ndarray,

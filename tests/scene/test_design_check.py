@@ -186,3 +186,18 @@ def test_a_limit_exceeded_only_at_the_very_corner_is_said_without_false_digits()
     line = solve(d).design_check().check("q_max")
     assert line.exceeded_within < 1e-6
     assert line.exceeded_text() == "within 0.001 mm of the corner"
+
+
+def test_the_time_of_a_largest_settlement_is_not_read_from_round_off() -> None:
+    # the aging preset's settlement levels off: 0.08747500214 mm at 887.7 days against
+    # 0.08747500213 at 1000 read "largest at t = 887.7 days"
+    from core.presets import read_preset
+
+    result = solve(read_preset("eccentric_creep"))
+    settlement = result.settlement
+    k = int(np.argmax(np.abs(settlement)))
+    assert abs(settlement[-1] - settlement[k]) < 1e-9 * abs(settlement[k])
+    line = check_design(result.times, result.x, result.pressure_on_grid, settlement,
+                        result.tilt).check("settlement")
+    # the value at that time: the largest to round-off
+    assert line.time == result.times[-1] and line.value == settlement[-1]
