@@ -311,6 +311,12 @@ def _cmd_validate(args: argparse.Namespace) -> int:
         except ValueError as exc:
             raise _InputError(str(exc)) from None
     kind = "study" if study else "scene"
+    if not study and has_punches(data) and any(k in data for k in ("punch", "loading")):
+        # both forms at once: the schema would list the fields of one form missing
+        try:
+            punches_from_dict(data)
+        except ValueError as exc:
+            raise _InputError(str(exc)) from None
     problems = schema_errors(data, load_json_schema(kind), root=kind)
     if problems:
         # each problem is one line; the full validation's messages follow once they are gone

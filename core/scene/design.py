@@ -224,6 +224,8 @@ class LimitCheck:
             return (f"{text}; limit {shown(self.limit, self.unit)}, exceeded "
                     f"{self.exceeded_text()}: FAIL")
         verdict = "pass" if self.passed else "FAIL"
+        if not math.isfinite(self.utilisation):  # a limit of 0 and a value beside it
+            return f"{text}; limit {shown(self.limit, self.unit)}, exceeded: {verdict}"
         return (f"{text}; limit {shown(self.limit, self.unit)}, utilisation "
                 f"{self.utilisation:.3g}: {verdict}")
 

@@ -313,3 +313,13 @@ def test_one_punch_in_the_punches_form_is_refused_as_one_punch(tmp_path, command
     path = tmp_path / "one.json"
     path.write_text(json.dumps(data))
     assert_one_line_error(run(command, path), "punches[0].loading.force: the punch is pulled")
+
+
+def test_validate_says_why_a_scene_gives_both_forms(tmp_path):
+    # validate said "loading: required field is missing"; solve gave the cause
+    data = json.loads((SCENES / "new_footing_beside_old.json").read_text())
+    data["punch"] = {"half_width": 1.0}
+    path = tmp_path / "both.json"
+    path.write_text(json.dumps(data))
+    for command in ("validate", "solve"):
+        assert_one_line_error(run(command, path), "punch: give either punch and loading")

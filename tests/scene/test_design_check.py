@@ -201,3 +201,11 @@ def test_the_time_of_a_largest_settlement_is_not_read_from_round_off() -> None:
                         result.tilt).check("settlement")
     # the value at that time: the largest to round-off
     assert line.time == result.times[-1] and line.value == settlement[-1]
+
+
+def test_a_zero_limit_is_exceeded_in_words() -> None:
+    # it printed "utilisation inf"
+    d = scene_file("uniform_flat")
+    d["limits"] = {"settlement_limit": 0.0}
+    line = solve(d).design_check().check("settlement")
+    assert line.describe().endswith("limit 0 m, exceeded: FAIL"), line.describe()
