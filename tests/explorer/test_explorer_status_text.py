@@ -25,7 +25,10 @@ def test_without_stage_timings_no_claim_of_what_was_recomputed() -> None:
 def test_stage_timings_all_fresh_say_so() -> None:
     stages = {"grid": {"seconds": 0.007, "cached": False},
               "solve": {"seconds": 0.017, "cached": False}}
-    text = plain_status(_view({"seconds": 0.024, "stages": stages, "error_estimate": 1e-7}))
+    # info["seconds"] is the solve's own (as the Nystrom engine reports it); the grid of
+    # a new geometry is timed apart and counts too: worn_coating read "Solved in under
+    # 1 ms" beside "grid 2.2 ms"
+    text = plain_status(_view({"seconds": 0.017, "stages": stages, "error_estimate": 1e-7}))
     assert text.startswith("Solved in 24 ms, everything computed afresh;"), text
 
 
