@@ -247,6 +247,8 @@ def test_percentages_for_people_never_in_exponent_notation():
     assert [percent_text(x) for x in (5e-10, 0.0181, 0.02, 0.000123, 0.0, 15.5)] == [
         "< 0.001 %", "1.81 %", "2 %", "0.0123 %", "0 %", "1550 %"]
     assert percent_text(0.0464, 2) == "4.6 %"
+    # a 1000 km coating's estimate read "16556648 %"
+    assert percent_text(165566.48) == "> 10000 %" and percent_text(100.0) == "10000 %"
 
 
 @pytest.mark.parametrize(("x", "message"), [
