@@ -318,8 +318,12 @@ class StudyView:
         result = event.new
         if result is None:
             return
-        times = {days_text(t, 6): k for k, t in enumerate(result.times)}
-        self.study_time.options = times
+        # four digits ("0.4378 days", not "0.437764 days"), more where they would merge
+        for digits in (4, 6, 10):
+            labels = [days_text(float(t), digits) for t in result.times]
+            if len(set(labels)) == len(labels):
+                break
+        self.study_time.options = {label: k for k, label in enumerate(labels)}
         self.study_time.value = len(result.times) - 1
         if self.study_charts is None:
             # built on a thread since the study started (a result loaded otherwise, or
