@@ -519,6 +519,7 @@ class ExplorerApp(pn.viewable.Viewer):
                 # before the load: a result found in the caches is drawn within it, and
                 # took the last scene's unit of pressure (MPa or kPa by the way it came)
                 self.scales.reset()
+                self.pins.forget_steps()
                 self.state.load_scene(scene)
             except ValueError as exc:
                 self.screen.notice = f"The scene was not loaded: {format_error(str(exc))}"

@@ -113,6 +113,11 @@ class PinsView:
             self._show_list()
         self._name_steps()
 
+    def forget_steps(self) -> None:
+        """A scene was loaded: the step boxes are filled again around its load with its
+        next result (they kept the last scene's range, 250 to 750 kN/m under 800)."""
+        self._stepped = None
+
     def stepped_quantity(self) -> str:
         """The load the steps change: the first given quantity (the first load slider)."""
         return self.state.loading.given[0]

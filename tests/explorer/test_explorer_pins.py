@@ -142,6 +142,16 @@ def test_the_steps_start_around_the_load_on_screen_and_say_what_they_refused(
     assert len(pins.board) == 3 and app.screen.notice == ""
 
 
+def test_the_steps_start_around_the_load_of_a_preset_loaded(explorer_app) -> None:
+    # they kept the last scene's range: 250 to 750 kN/m on a preset of 800 kN/m
+    app = explorer_app()
+    pins = app.pins
+    assert (pins.step_from.value, pins.step_to.value) == (250.0, 750.0)
+    app.scene_tab.preset.value = "eccentric_footing_liftoff"  # P = 800 kN/m
+    app.controller.solve_now()
+    assert (pins.step_from.value, pins.step_to.value) == (400.0, 1200.0)
+
+
 def test_a_coating_added_or_taken_off_is_named_as_a_whole() -> None:
     # the lesson on the edge pressure labelled its pins "coating = [], h1 = None" and
     # "coating = None, h1 = 20 mm"
