@@ -98,8 +98,8 @@ class LimitCheck:
     #: that :attr:`exceeded_within` can be read from it)
     asymptotic: bool = False
     #: [m] for an unbounded pressure with a limit: how far from the corner the pressure
-    #: on the answer's grid stays over the limit, at its worst time (the last grid point
-    #: over it); None: not past ``corner_distance``
+    #: on the answer's grid stays over the limit, at its worst time (linear between the
+    #: grid points either side of the limit); None: not past ``corner_distance``
     exceeded_on_grid: float | None = None
     #: whether the pressure is over the limit on the whole base at some time
     exceeded_everywhere: bool = False
