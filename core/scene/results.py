@@ -195,7 +195,8 @@ def strain_share(scene: Scene, settlement: Any, tilt: Any, pressure_max: float) 
     ``tilt`` [rad] as a share of ``LARGE_SETTLEMENT`` times the foundation's thickness
     (base and thickest coating stack), and of the coating's compression, its compliance
     over its thickness times the largest pressure ``pressure_max`` [Pa], as a share of
-    ``LARGE_COATING_STRAIN`` (:func:`coating_strain_per_pressure`). Above 1 raises
+    ``LARGE_COATING_STRAIN`` (:func:`coating_strain_per_pressure`: the largest ratio
+    with the largest pressure, a bound where the coating varies along x). Above 1 raises
     ``large_settlement``. It scales with the loads."""
     settlement = np.asarray(settlement, dtype=float)
     tilt = np.asarray(tilt, dtype=float)
