@@ -234,8 +234,10 @@ class Scene:
 
     @cached_property
     def sample_extremes(self) -> dict[str, float]:
-        """On :attr:`sample_x`: the range of ``m*`` (-), the largest gap [m] and the largest
-        coating thickness [m]; none depends on the loads, so a scene with other loads
+        """On :attr:`sample_x`: the range of ``m*`` (-), the largest gap [m], the largest
+        coating thickness [m] and the coating's largest strain per unit pressure, its
+        compliance over its thickness [1/Pa] (0 without coating); none depends on the
+        loads, so a scene with other loads
         (:func:`core.scene.replace_loads`) keeps them, and scenes of the same
         geometry and base modulus share them."""
         # m* = E0 / (2 (1 - nu^2) a) * compliance: the geometry, E0 and nu fix all four
@@ -249,9 +251,14 @@ class Scene:
         with np.errstate(all="ignore"):  # as in the solve that reports them
             m_star = problem.m(x / self.half_width) if callable(problem.m) \
                 else np.full(x.shape, problem.m)
+            thickness = self.coating_thickness(x)
+            strain = (self.coating_compliance(x) / thickness if self.coating
+                      else np.zeros(x.shape))
             return {"m_star_min": float(np.min(m_star)), "m_star_max": float(np.max(m_star)),
                     "gap_max_m": float(np.max(self.gap(x))),
-                    "coating_thickness_max_m": float(np.max(self.coating_thickness(x)))}
+                    "coating_thickness_max_m": float(np.max(thickness)),
+                    "coating_strain_per_pa": float(np.max(strain[np.isfinite(strain)],
+                                                          initial=0.0))}
 
     @cached_property
     def layer_modulus_max(self) -> tuple[float, ...]:

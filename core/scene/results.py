@@ -211,14 +211,9 @@ def coating_strain_per_pressure(scene: Scene) -> float:
     """The largest compressive strain of the coating per unit pressure [1/Pa]: its
     compliance ``sum c_k`` over its thickness ``sum h_k`` (the thin-layer model's
     ``(1 - nu^2) / E`` smooth, the constrained ``(1 + nu)(1 - 2 nu) / ((1 - nu) E)``
-    bonded), the largest on the plotting grid; 0 without coating."""
-    if not scene.coating:
-        return 0.0
-    x = plotting_grid(scene.half_width)
-    with np.errstate(all="ignore"):
-        ratio = scene.coating_compliance(x) / scene.coating_thickness(x)
-    ratio = ratio[np.isfinite(ratio)]
-    return float(np.max(ratio, initial=0.0))
+    bonded), the largest on the scene's samples (:attr:`Scene.sample_extremes`: once
+    per geometry, not per load step); 0 without coating."""
+    return scene.sample_extremes["coating_strain_per_pa"]
 
 
 def thick_coating(scene: Scene, zone: float | None = None) -> bool:
