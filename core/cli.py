@@ -489,12 +489,12 @@ def _cmd_report(args: argparse.Namespace) -> int:
         try:
             fe_check = check_scene(result.scene, 0.0, level=FE_CHECK_LEVEL)
         except ValueError as exc:
-            if not str(exc).startswith("time: "):
+            reason = _no_contact_then(exc)
+            if reason is None:
                 print(f"error: check: {_one_line(exc)}", file=sys.stderr)
                 return EXIT_SOLVER_FAILED
             # nothing touches at loading: the report is written without a check
-            print(f"warning: fe_check: not run: {_one_line(str(exc)[len('time: '):])}",
-                  file=sys.stderr)
+            print(f"warning: fe_check: not run: {_one_line(reason)}", file=sys.stderr)
         except (ArithmeticError, RuntimeError, MemoryError) as exc:
             print(f"error: check: {_one_line(exc)}", file=sys.stderr)
             return EXIT_SOLVER_FAILED
@@ -655,6 +655,14 @@ def _zones(zones: list[list[float]]) -> str:
     return " ".join(f"[{lo:.4g}, {hi:.4g}]" for lo, hi in zones) + " m"
 
 
+def _no_contact_then(exc: ValueError) -> str | None:
+    """Why :func:`core.scene.check_scene` refused the time it was asked for (the punch
+    touches nothing then: its refusal names ``time``), None for any other failure."""
+    prefix = "time: "
+    text = str(exc)
+    return text[len(prefix):] if text.startswith(prefix) else None
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     scene = _read(args.scene)
     if isinstance(scene, PunchesScene):
@@ -670,9 +678,9 @@ def _cmd_check(args: argparse.Namespace) -> int:
     try:
         report = check_scene(scene, args.time, level=args.level)
     except ValueError as exc:
-        if str(exc).startswith("time: "):  # the time asked for (no contact then): input
-            raise _InputError(f"--time (default 0): {str(exc)[len('time: '):]}; pass "
-                              "--time DAYS") from None
+        reason = _no_contact_then(exc)
+        if reason is not None:  # the time asked for: the user's input
+            raise _InputError(f"--time (default 0): {reason}; pass --time DAYS") from None
         print(f"error: check: {_one_line(exc)}", file=sys.stderr)
         return EXIT_SOLVER_FAILED
     except (ArithmeticError, RuntimeError, MemoryError) as exc:

@@ -388,9 +388,9 @@ def _unit_of(path: str) -> str:
     :data:`FIELDS`; '' for a field without one (a ratio) or not in it."""
     obj, _, name = path.rpartition(".")
     obj = re.sub(r"\[\d+\]", "[k]", obj)
-    if obj not in FIELDS:
+    if obj not in FIELDS or name not in {r.name for r in FIELDS[obj]}:
         return ""
-    unit = next((r.unit for r in FIELDS[obj] if r.name == name), "-")
+    unit = field_rule(obj, name).unit
     return "" if unit == "-" else unit
 
 
@@ -399,7 +399,7 @@ def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
     if isinstance(spec, Mapping):
         check_fields(spec, path, ("end", "count"), ("spacing",))
         end = positive_number(spec["end"], f"{path}.end")
-        _check_latest(end, f"{path}.end")
+        check_last_time(end, f"{path}.end")
         count = integer_in_range(spec["count"], f"{path}.count", 1, MAX_TIMES)
         spacing = spec.get("spacing", "linear")
         if spacing not in ("linear", "log"):
@@ -431,17 +431,25 @@ def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
         if values[-1] <= 0:
             raise ValueError(f"{path}: the last time must be > 0 days after loading (the "
                              "loads are functions of time on [0, last time])")
-        _check_latest(values[-1], f"{path}[{len(values) - 1}]")
+        check_last_time(values[-1], last_time_field(values, len(values), path))
         return np.array(values), values
     raise ValueError(f"{path}: must be an object {{end, count, spacing}} or a list of days "
                      f"after loading, got {show_value(spec)}")
 
 
-def _check_latest(end: float, path: str) -> None:
-    """Refuse an output time past :data:`MAX_DAYS`, naming ``path``."""
-    if end > MAX_DAYS:
-        raise ValueError(f"{path}: must be <= {MAX_DAYS:g} days after loading (about "
-                         f"{MAX_DAYS / 365.25:.0f} years), got {end:g}")
+def last_time_field(spec: Any, count: int, path: str = "times") -> str:
+    """The field that holds the last output time of the times ``spec`` with ``count``
+    times: ``times.end``, or the list's last entry ``times[k]``."""
+    return f"{path}.end" if isinstance(spec, Mapping) else f"{path}[{count - 1}]"
+
+
+def check_last_time(end: float, field: str, most: float = MAX_DAYS,
+                    why: str = f"about {MAX_DAYS / 365.25:.0f} years") -> None:
+    """Refuse a last output time ``end`` [day after loading] past ``most``, naming
+    ``field`` and saying ``why`` that bound."""
+    if end > most:
+        raise ValueError(f"{field}: must be <= {most:g} days after loading ({why}), got "
+                         f"{end:g}")
 
 
 def _spec_of(profile: Profile, given: Any) -> Any:

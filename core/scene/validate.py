@@ -163,13 +163,12 @@ def _validated(d: dict[str, Any]) -> Scene:
                          f"in [{lam_lo:g}, {lam_hi:g}], got {a / h_base:.6g}")
 
     times, times_spec = _times(d["times"], "times")
-    if isinstance(creep, CodeCreep) and float(times[-1]) > MAX_CODE_DURATION:
+    if isinstance(creep, CodeCreep):
         # the design codes' kernel is fitted over 100 years of loading: past it the fit
         # would be read outside its range (named base.creep, in dimensionless ages)
-        last = "times.end" if isinstance(times_spec, dict) else f"times[{len(times) - 1}]"
-        raise ValueError(f"{last}: must be <= {MAX_CODE_DURATION:g} days after loading (100 "
-                         f"years, the span a design code's creep law is fitted for), got "
-                         f"{float(times[-1]):g}")
+        schema.check_last_time(float(times[-1]), schema.last_time_field(times_spec, len(times)),
+                               MAX_CODE_DURATION, "100 years, the span a design code's creep "
+                               "law is fitted for")
 
     loading = d["loading"]
     check_fields(loading, "loading", (), schema.optional_fields("loading"))

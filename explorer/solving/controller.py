@@ -227,7 +227,7 @@ def format_error(message: str) -> str:
                                                 f"{unit}", message)
             break
     message = _page_units(message)
-    if _MILLIMETRE_FIELDS.match(message.partition(":")[0].strip()):
+    if _MILLIMETRE_FIELDS.match(field):
         message = _METRES.sub(lambda m: f"{1e3 * float(m.group(1)):.6g} mm", message)
     path, sep, reason = message.partition(":")
     if not sep or " " in path.strip():
