@@ -79,20 +79,26 @@ def test_two_punches_their_histories_and_a_drag_of_a_centre(server: str, page: P
     page.page.mouse.down()
     page.page.mouse.move(x + 30, y, steps=6)
     page.page.mouse.up()
-    # released: the new footing further right on the drawing and on q(x); the old one
-    # tilts less toward it
-    # (a drag slower than its solves is previewed, and the preview stays on screen until
-    # the answer of the release comes: the status line then no longer says "Preview")
-    until(lambda: page.page.evaluate(JS_PUNCH_LEFT)[1] > 2.5
+    # released: the new footing at the slider's last value on the drawing and on q(x); the
+    # old one tilts less toward it. (An answer of a step of the drag may arrive before the
+    # release's: wait for the release's own centre, not for any move. A drag slower than
+    # its solves is previewed, and the preview stays on screen until the answer of the
+    # release comes: the status line then no longer says "Preview".)
+    # (the slider's value as its box writes it: aria-valuenow is rounded to 0.1)
+    until(lambda: float(handle.get_attribute("aria-valuetext") or "nan") > 3.5,
+          "the slider moved")
+    centre = float(handle.get_attribute("aria-valuetext"))
+    until(lambda: page.page.evaluate(JS_PUNCH_LEFT)[1] == pytest.approx(centre - 1.0, abs=1e-9)
           and not page.page.evaluate(JS_SHOWN, "Preview (the base elastic at loading"),
-          "punch 2 moved", timeout=120)
-    moved = page.page.evaluate(JS_PUNCH_LEFT)[1]
-    until(lambda: page.page.evaluate(JS_Q_RIGHT) == pytest.approx(moved + 2.0, abs=1e-4),
+          "punch 2 moved to the slider's value", timeout=120,
+          describe=lambda: page.page.evaluate(JS_PUNCH_LEFT))
+    until(lambda: page.page.evaluate(JS_Q_RIGHT) == pytest.approx(centre + 1.0, abs=1e-4),
           "q(x) over the moved punch")
     until(lambda: 0 < page.page.evaluate(JS_HISTORY, ["tilt", 0])[-1] < tilt[-1],
           "the old footing tilts less")
-    until(lambda: page.page.evaluate(JS_SHOWN, f"punch 2 (x = {moved + 1.0:.3g} m)"),
-          "the readout of the moved punch")
+    until(lambda: page.page.evaluate(JS_SHOWN, f"punch 2 (x = {centre:.3g} m)"),
+          "the readout of the moved punch",
+          describe=lambda: page.text(".readout-punch-1"))
     assert page.errors == []
 
 
