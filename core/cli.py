@@ -102,7 +102,8 @@ STDIN_NAME = "<stdin>"
 #: FE mesh level of ``check`` by default and of ``report --fe-check`` (0: ~1 s, P to ~2e-4).
 FE_CHECK_LEVEL = 0
 
-_UNITS = {"settlement": "m", "tilt": "rad", "force": "N/m", "moment": "N"}
+#: Units of the histories in the text tables (the CSV columns keep ``moment_N``: N·m/m is N).
+_UNITS = {"settlement": "m", "tilt": "rad", "force": "N/m", "moment": "N·m/m"}
 
 
 class _InputError(Exception):

@@ -174,7 +174,7 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
     "loading": tuple(
         _rule(q, "t_profile", unit, f"Given {q} [{unit}], a function of t [day after "
               "loading].", required=False)
-        for q, unit in zip(QUANTITIES, ("m", "rad", "N/m", "N"), strict=True)),
+        for q, unit in zip(QUANTITIES, ("m", "rad", "N/m", "N·m/m"), strict=True)),
     "times": (
         _rule("end", "number", "day", "Last output time after loading.", low=0.0,
               low_open=True, high=MAX_DAYS),

@@ -23,7 +23,7 @@ force = spec["loading"]["force"]  # [N/m]
 eccentricities = np.linspace(0.0, 0.8, 17)
 tilt, width = [], []
 for e in eccentricities:
-    spec["loading"]["moment"] = force * e  # [N]
+    spec["loading"]["moment"] = force * e  # [N·m/m]
     result = core.solve(core.scene_from_dict(spec))
     tilt.append(result.tilt[0])
     width.append(sum(end - start for start, end in result.contact_set[0]))

@@ -83,6 +83,9 @@ def test_solve_without_output_prints_a_summary():
     proc = run("solve", SCENES / "rounded_graded.json")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.startswith("solved 'Rounded punch on a graded coating'")
+    # a moment per unit length reads in N·m/m (the CSV column keeps its name, moment_N)
+    assert proc.stdout.splitlines()[1].split() == ["time_day", "settlement_m", "tilt_rad",
+                                                   "force_N/m", "moment_N·m/m"]
     result = core.solve(core.load_scene(SCENES / "rounded_graded.json"))
     peak = result.pressure_on_grid.max()
     # in contact up to the punch's ends: unbounded there, given where the answer holds it

@@ -188,7 +188,7 @@ def test_many_jumps_are_refused_before_the_solver_sees_them() -> None:
     # presses it" (exit 1) after validation had passed it
     ("loading.force", 1e-320, "loading.force: 9.99989e-321 N/m at t = 0 days after loading "
                               "is too small"),
-    ("loading.moment", 1e-200, "loading.moment: 1e-200 N at t = 0 days after loading is too "
+    ("loading.moment", 1e-200, "loading.moment: 1e-200 N·m/m at t = 0 days after loading is too "
                                "small"),
     # a punch shape of 1e300 m gave an infinite pressure
     ("punch.shape", {"kind": "polynomial", "coefficients": [0, 1e300]},
