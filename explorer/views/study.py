@@ -42,6 +42,10 @@ from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
 NONE = "(none: a line over parameter 1)"
 
 
+#: A select box of a few short words beside three number boxes in the sidebar's width.
+NARROW_SELECT = "select.bk-input { padding-left: 6px; }"
+
+
 class _AxisInputs:
     """The widgets of one parameter: the field, from, to, points, spacing."""
 
@@ -56,8 +60,10 @@ class _AxisInputs:
         self.stop = pn.widgets.FloatInput(label="to", width=64, css_classes=[f"{css}-to"])
         self.count = pn.widgets.IntInput(label="points", value=9, start=2, width=66,
                                          css_classes=[f"{css}-count"])
+        # (its text once touched the arrow: a narrower left padding than the theme's 12 px)
         self.spacing = pn.widgets.Select(label="spacing", options=list(SPACINGS), width=68,
-                                         css_classes=[f"{css}-spacing"])
+                                         css_classes=[f"{css}-spacing"],
+                                         stylesheets=[NARROW_SELECT])
         self.row = pn.Row(self.start, self.stop, self.count, self.spacing,
                           sizing_mode="stretch_width", margin=0)
 

@@ -657,6 +657,47 @@ JS_PAST_THE_SIDEBAR = """() => {
   return {edge: Math.round(edge), shown: shown, past: past.slice(0, 8)};
 }"""
 
+# The room left of the Study tab's spacing boxes beside their shown word [px]: the box's
+# inner width less its paddings (the arrow sits in the right one) less the word's width.
+JS_SPACING_ROOM = """() => {
+  const out = [];
+  const stack = [document];
+  while (stack.length) {
+    const r = stack.pop();
+    for (const e of r.querySelectorAll('*')) {
+      if (e.shadowRoot) stack.push(e.shadowRoot);
+      if (!(e.classList && [...e.classList].some(c => /^study-p\\d-spacing$/.test(c)))) continue;
+      const box = e.shadowRoot && e.shadowRoot.querySelector('select');
+      if (!box || !box.offsetWidth) continue;
+      const style = getComputedStyle(box);
+      const pen = document.createElement('canvas').getContext('2d');
+      pen.font = style.font;
+      const word = box.options[box.selectedIndex].text;
+      out.push(box.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight)
+               - pen.measureText(word).width);
+    }
+  }
+  return out;
+}"""
+
+
+def test_the_study_spacing_box_shows_its_word_clear_of_the_arrow(page: Page):
+    """In presentation mode at 1024 px the spacing box's "linear" ran into its arrow (1.4 px
+    to spare): it keeps at least 4 px."""
+    page.page.set_viewport_size({"width": 1024, "height": 768})
+    page.page.locator(".presentation-toggle button").first.click()
+    page.open_tab("Study")
+    room: list = []
+
+    def shown() -> bool:
+        room[:] = page.page.evaluate(JS_SPACING_ROOM)
+        return len(room) >= 1
+
+    until(shown, "the spacing box", timeout=30)
+    assert min(room) >= 4.0, room
+    assert page.errors == []
+
+
 # The titles of the sidebar's tabs, read from the page (a tab added is checked too).
 @pytest.mark.parametrize("presenting", [False, True], ids=["1400px", "1024px-presenting"])
 def test_no_widget_of_any_tab_runs_past_the_sidebar(page: Page, presenting: bool):
