@@ -74,6 +74,11 @@ MAX_SCENE_TIMES = 2_000
 #: law is fitted for (the presets reach 50 years), and a time typed a thousand times too
 #: large ("1e9 days") is refused as the slip it is rather than answered.
 MAX_SCENE_DAYS = 100_000.0
+#: Oldest base at loading [day] (``base.age_at_loading``), as old as the latest output time
+#: is late: ages and times after loading add up in the time steps, where an age of 1e14
+#: days moved the settlement by 1e-6 (relative) and 1e16 days made a step's matrix singular
+#: (the steps of 50 days lost in the age's round-off).
+MAX_SCENE_AGE = MAX_SCENE_DAYS
 #: Most load durations of one ``core.creep_coefficient_curve`` call (a plotted curve
 #: needs a few hundred; each costs a few array operations).
 MAX_CURVE_POINTS = 100_000

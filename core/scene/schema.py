@@ -40,6 +40,8 @@ MAX_LAYERS = 10
 MAX_TIMES = limits.MAX_SCENE_TIMES
 #: Latest output time [day after loading].
 MAX_DAYS = limits.MAX_SCENE_DAYS
+#: Oldest base at loading [day].
+MAX_AGE = limits.MAX_SCENE_AGE
 #: Accepted range of the solver's relative tolerance, and its default.
 TOL_RANGE = (1e-12, 1e-2)
 DEFAULT_TOL = 1e-6
@@ -120,7 +122,7 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
               most=MAX_LAYERS),
         _rule("base", "object", "-", "The aging viscoelastic base layer."),
         _rule("loading", "object", "-", "Exactly two of settlement [m], tilt [rad], force "
-              "[N/m], moment [N], each a function of t [day after loading], forming one of "
+              "[N/m], moment [N·m/m], each a function of t [day after loading], forming one of "
               "the four statements."),
         _rule("times", "times", "day", "Output times after loading: {end, count, spacing} "
               f"or a list of 1 to {MAX_TIMES} increasing days after loading."),
@@ -167,7 +169,7 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
         _rule("poisson", "number", "-", "Poisson ratio nu of the base, in (-1, 0.5).",
               **_POISSON),
         _rule("age_at_loading", "number", "day", "Age tau0 of the base when the load is "
-              "applied (the base is made at age 0).", low=0.0, low_open=True),
+              "applied (the base is made at age 0).", low=0.0, low_open=True, high=MAX_AGE),
         _rule("creep", "creep", "-", "Creep model of the base (core/SCENES.md, 'Creep "
               "models')."),
     ),
