@@ -52,6 +52,7 @@ def _one_run(k: int, hogs: int) -> dict:
     work = Path(tempfile.mkdtemp(prefix=f"suite-at-load-{k}-"))
     clone = work / "clone"
     subprocess.run(["git", "clone", "-q", str(ROOT), str(clone)], check=True)
+    commit = tree_commit(clone)  # the tree may move on between runs
     stop = multiprocessing.Event()
     spinners = [multiprocessing.Process(target=_hog, args=(stop,), daemon=True)
                 for _ in range(hogs)]
@@ -80,7 +81,8 @@ def _one_run(k: int, hogs: int) -> dict:
     lines = [line.strip() for line in text.splitlines() if SUMMARY.search(line)]
     failed = [line for line in text.splitlines() if line.startswith("FAILED")]
     shutil.rmtree(work, ignore_errors=True)
-    return {"rc": rc, "wall": wall, "loads": loads, "lines": lines, "failed": failed}
+    return {"commit": commit, "rc": rc, "wall": wall, "loads": loads, "lines": lines,
+            "failed": failed}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -96,12 +98,12 @@ def main(argv: list[str] | None = None) -> int:
         runs.append(_one_run(k, args.hogs))
         r = runs[-1]
         print(f"run {k + 1}: exit {r['rc']}, {r['wall'] / 60:.1f} min", flush=True)
-    rows = ["| run | exit code | wall [min] | load (1 min): median, max | parts |",
-            "| --- | --- | --- | --- | --- |"]
+    rows = ["| run | commit | exit code | wall [min] | load (1 min): median, max | parts |",
+            "| --- | --- | --- | --- | --- | --- |"]
     for k, r in enumerate(runs, 1):
         loads = sorted(r["loads"]) or [float("nan")]
         parts = "; ".join(r["lines"])
-        rows.append(f"| {k} | {r['rc']} | {r['wall'] / 60:.1f} | "
+        rows.append(f"| {k} | {r['commit']} | {r['rc']} | {r['wall'] / 60:.1f} | "
                     f"{loads[len(loads) // 2]:.1f}, {loads[-1]:.1f} | {parts} |")
     failures = [f"- run {k}: {line}" for k, r in enumerate(runs, 1) for line in r["failed"]]
     green = sum(r["rc"] == 0 for r in runs)
