@@ -10,9 +10,9 @@ Run from the repository root (it takes ``--runs`` times ~10 minutes)::
 
     python -m benchmarks.suite_at_load --runs 5 --hogs 1
 
-Note: ``.ci/run`` installs the clone in editable mode, which takes over the environment's
-install of this package; re-install the working copy afterwards
-(``python -m pip install --no-deps -e .``).
+A failed run's clone and log are kept (the path is printed). Note: ``.ci/run`` installs
+the clone in editable mode, which takes over the environment's install of this package;
+re-install the working copy afterwards (``python -m pip install --no-deps -e .``).
 """
 
 from __future__ import annotations
@@ -80,7 +80,12 @@ def _one_run(k: int, hogs: int) -> dict:
     text = log.read_text(errors="replace")
     lines = [line.strip() for line in text.splitlines() if SUMMARY.search(line)]
     failed = [line for line in text.splitlines() if line.startswith("FAILED")]
-    shutil.rmtree(work, ignore_errors=True)
+    if rc == 0:
+        shutil.rmtree(work, ignore_errors=True)
+    else:  # kept to be read: the clone and its log
+        print(f"run {k + 1} failed: its log is {log}", flush=True)
+        for line in failed:
+            print(f"  {line}", flush=True)
     return {"commit": commit, "rc": rc, "wall": wall, "loads": loads, "lines": lines,
             "failed": failed}
 
