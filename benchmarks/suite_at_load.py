@@ -90,19 +90,9 @@ def _one_run(k: int, hogs: int) -> dict:
             "failed": failed}
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--runs", type=int, default=5, help="fresh-clone runs (default 5)")
-    parser.add_argument("--hogs", type=int, default=1,
-                        help="spinning processes beside each run (default 1)")
-    parser.add_argument("--out", type=Path, default=OUT, help="the report (Markdown)")
-    args = parser.parse_args(argv)
-    started, load_before, commit = datetime.now(timezone.utc), os.getloadavg()[0], tree_commit()
-    runs = []
-    for k in range(args.runs):
-        runs.append(_one_run(k, args.hogs))
-        r = runs[-1]
-        print(f"run {k + 1}: exit {r['rc']}, {r['wall'] / 60:.1f} min", flush=True)
+def report(runs: list[dict], planned: int, hogs: int, started: datetime, load_before: float,
+           commit: str) -> str:
+    """The Markdown page of the runs so far (of ``planned``)."""
     rows = ["| run | commit | exit code | wall [min] | load (1 min): median, max | parts |",
             "| --- | --- | --- | --- | --- | --- |"]
     for k, r in enumerate(runs, 1):
@@ -113,28 +103,47 @@ def main(argv: list[str] | None = None) -> int:
     failures = [f"- run {k}: {line}" for k, r in enumerate(runs, 1) for line in r["failed"]]
     green = sum(r["rc"] == 0 for r in runs)
     longest = max(r["wall"] for r in runs) / 60
-    text = "\n".join([
+    done = "" if len(runs) == planned else f" (of {planned} planned)"
+    return "\n".join([
         "# The test suite on fresh clones beside a CPU hog",
         "",
-        f"Made by `python -m benchmarks.suite_at_load --runs {args.runs} --hogs {args.hogs}`:",
+        f"Made by `python -m benchmarks.suite_at_load --runs {planned} --hogs {hogs}`:",
         "",
         *run_lines(started, load_before, os.getloadavg()[0],
                    "the load the suite itself and the hogs make", commit=commit),
         "",
         f"Each run: a fresh clone, `.ci/run` (installation, ruff, import "
-        f"contracts, the three pytest parts and the documentation), with {args.hogs} "
+        f"contracts, the three pytest parts and the documentation), with {hogs} "
         f"spinning process(es) beside it. Goal: every run green, each under about "
         f"{GOAL_MINUTES:g} minutes.",
         "",
-        f"**{green} of {len(runs)} runs green; the longest {longest:.1f} min.**",
+        f"**{green} of {len(runs)} runs{done} green; the longest {longest:.1f} min.**",
         "",
         *rows,
         "",
         *(["Failed tests:", "", *failures, ""] if failures else []),
-    ])
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text + "\n", encoding="utf-8")
+    ]) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--runs", type=int, default=5, help="fresh-clone runs (default 5)")
+    parser.add_argument("--hogs", type=int, default=1,
+                        help="spinning processes beside each run (default 1)")
+    parser.add_argument("--out", type=Path, default=OUT, help="the report (Markdown)")
+    args = parser.parse_args(argv)
+    started, load_before, commit = datetime.now(timezone.utc), os.getloadavg()[0], tree_commit()
+    runs: list[dict] = []
+    for k in range(args.runs):
+        runs.append(_one_run(k, args.hogs))
+        r = runs[-1]
+        print(f"run {k + 1}: exit {r['rc']}, {r['wall'] / 60:.1f} min", flush=True)
+        # written after every run: a series cut short still leaves its report
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(report(runs, args.runs, args.hogs, started, load_before, commit),
+                            encoding="utf-8")
     print(f"wrote {args.out}")
+    green = sum(r["rc"] == 0 for r in runs)
     return 0 if green == len(runs) else 1
 
 

@@ -103,8 +103,9 @@ soak_pid=$!
 docs_dir="${DOCS_BUILD_DIR:-${TMPDIR:-/tmp}/coated-punch-docs}"
 build_docs() {
     local start=$SECONDS
-    # only a former build is removed (Sphinx leaves .buildinfo in it)
-    if [ -e "$docs_dir" ] && [ ! -f "$docs_dir/.buildinfo" ]; then
+    # only a former build is removed (Sphinx leaves .buildinfo in it, or only .doctrees
+    # when the build was interrupted)
+    if [ -e "$docs_dir" ] && [ ! -f "$docs_dir/.buildinfo" ] && [ ! -d "$docs_dir/.doctrees" ]; then
         echo "DOCS_BUILD_DIR=$docs_dir exists and is not a Sphinx build: not removing it"
         return 1
     fi
