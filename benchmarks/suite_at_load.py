@@ -34,7 +34,7 @@ from typing import Any
 from benchmarks import run_lines, tree_commit
 
 ROOT = Path(__file__).resolve().parents[1]
-OUT = ROOT / "benchmarks" / "results" / "suite_at_load.md"
+RESULTS = ROOT / "benchmarks" / "results"
 #: The lines of the suite's output that summarise a part.
 SUMMARY = re.compile(r"(\d+ passed|\d+ failed|exit codes|built in)")
 #: The suite's bound (the developers' guide: "keep the suite under about 10 minutes").
@@ -130,8 +130,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=5, help="fresh-clone runs (default 5)")
     parser.add_argument("--hogs", type=int, default=1,
                         help="spinning processes beside each run (default 1)")
-    parser.add_argument("--out", type=Path, default=OUT, help="the report (Markdown)")
+    parser.add_argument("--out", type=Path, default=RESULTS, metavar="DIR",
+                        help="the folder of suite_at_load.md (default benchmarks/results)")
     args = parser.parse_args(argv)
+    if args.runs < 1:
+        parser.error(f"--runs: must be at least 1, got {args.runs}")
+    if args.hogs < 0:
+        parser.error(f"--hogs: must be at least 0, got {args.hogs}")
+    if args.out.exists() and not args.out.is_dir():
+        parser.error(f"--out: {args.out}: must be a folder")
+    target = args.out / "suite_at_load.md"
     started, load_before, commit = datetime.now(timezone.utc), os.getloadavg()[0], tree_commit()
     runs: list[dict] = []
     for k in range(args.runs):
@@ -139,10 +147,10 @@ def main(argv: list[str] | None = None) -> int:
         r = runs[-1]
         print(f"run {k + 1}: exit {r['rc']}, {r['wall'] / 60:.1f} min", flush=True)
         # written after every run: a series cut short still leaves its report
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(report(runs, args.runs, args.hogs, started, load_before, commit),
-                            encoding="utf-8")
-    print(f"wrote {args.out}")
+        args.out.mkdir(parents=True, exist_ok=True)
+        target.write_text(report(runs, args.runs, args.hogs, started, load_before, commit),
+                          encoding="utf-8")
+    print(f"wrote {target}")
     green = sum(r["rc"] == 0 for r in runs)
     return 0 if green == len(runs) else 1
 

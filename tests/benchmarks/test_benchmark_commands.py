@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks import cold_start, compare_servers, compare_trees, engines
+from benchmarks import cold_start, compare_servers, compare_trees, engines, suite_at_load
 
 
 def test_engines_out_is_a_folder_not_a_file_name(tmp_path: Path, capsys):
@@ -26,6 +26,19 @@ def test_cold_start_out_is_a_folder_not_a_file_name(tmp_path: Path, capsys):
     assert stop.value.code == 2
     assert "--out: " in capsys.readouterr().err
     assert target.read_text() == "kept\n"  # refused before any run
+
+
+@pytest.mark.parametrize("args", [["--out", "FILE"], ["--runs", "0"], ["--hogs", "-1"]])
+def test_suite_at_load_refuses_before_any_run(tmp_path: Path, capsys, args: list[str]):
+    """A file for the report's folder, no runs or negative hogs: refused before a clone."""
+    target = tmp_path / "suite_at_load.md"
+    target.write_text("kept\n")
+    args = [str(target) if a == "FILE" else a for a in args]
+    with pytest.raises(SystemExit) as stop:
+        suite_at_load.main(args)
+    assert stop.value.code == 2
+    assert f"{args[0]}: " in capsys.readouterr().err
+    assert target.read_text() == "kept\n"
 
 
 def test_compare_trees_refuses_a_folder_without_the_package(tmp_path: Path, capsys):
