@@ -351,28 +351,63 @@ def refine_ends(problem: Any, ends: list[float], pinned: list[bool], slopes: lis
         sol = problem.solve(ends, res)
         builds += 1
     if free and problem.needs_moved(output_error, end_error):
-        output_error += _moved_ends_error(problem, sol, ends, free, inward, end_error, res)
-        builds += len(free)
+        moved, made = _moved_ends_error(problem, sol, ends, free, inward, end_error, res,
+                                         tol)
+        output_error += moved
+        builds += made
     output_error = max(output_error, ZONE_ROUNDING)
     return Refined(sol, end_error, output_error, builds, level, converged)
 
 
 def _moved_ends_error(problem: Any, sol: Any, ends: list[float], free: list[int],
-                      inward: np.ndarray, end_error: float, res: Any) -> float:
+                      inward: np.ndarray, end_error: float, res: Any,
+                      tol: float = 0.0) -> tuple[float, int]:
     """The change of the outputs when each free end moves by its estimated error (into
-    the zone), summed over the ends: the part of the outputs' error the ends make.
+    the zone), summed over the ends: the part of the outputs' error the ends make; and
+    the solves it took.
 
     The rules' difference misses it where a zone is narrower than its panels (both rules
     then hold the same panels there): at e = 0.999 a, a zone 0.003 wide, the estimate read
-    0.0 while the settlement was 1.2e-9 off (its end 1.6e-8)."""
-    total = 0.0
-    for j, k in enumerate(free):
+    0.0 while the settlement was 1.2e-9 off (its end 1.6e-8).
+
+    Each end costs a solve of the whole problem. With more than :data:`MOVED_SAMPLE`
+    free ends, the ends of the narrowest zones and the outermost ends are moved first:
+    when their largest change times :data:`MOVED_SAFETY` times the number of free ends is
+    below :data:`MOVED_NEGLIGIBLE` of ``tol``, that bound stands for the sum; otherwise
+    every end is moved. A wavy punch touching at 37 crests (73 free ends) took 31 s for the
+    sum, 1.8e-11 at tol 1e-3 (each end 7e-14 to 4.8e-13, the largest at the outermost
+    zones); the bound reads 7.0e-11 from 4 solves."""
+    def change(j: int) -> float:
+        k = free[j]
         lo, hi = problem.walls(ends, k)
         moved = list(ends)
         moved[k] = float(np.clip(ends[k] + inward[j] * end_error,
                                  ends[k] - 0.5 * (ends[k] - lo), ends[k] + 0.5 * (hi - ends[k])))
-        total += problem.moved_error(problem.solve(moved, res), sol)
-    return total
+        return float(problem.moved_error(problem.solve(moved, res), sol))
+
+    if len(free) > MOVED_SAMPLE:
+        widths = [ends[k + 1] - ends[k] if k % 2 == 0 else ends[k] - ends[k - 1]
+                  for k in free]
+        order = [0, len(free) - 1] + [int(j) for j in np.argsort(widths, kind="stable")]
+        sample = list(dict.fromkeys(order))[:MOVED_SAMPLE]
+        changes = {j: change(j) for j in sample}
+        bound = MOVED_SAFETY * len(free) * max(changes.values())
+        if bound <= MOVED_NEGLIGIBLE * tol:
+            return bound, len(sample)
+        rest = sum(change(j) for j in range(len(free)) if j not in changes)
+        return sum(changes.values()) + rest, len(free)
+    return sum(change(j) for j in range(len(free))), len(free)
+
+
+#: Free ends up to which :func:`_moved_ends_error` moves every one; beyond, first a
+#: sample of this many (the ends of the narrowest zones and the outermost ends).
+MOVED_SAMPLE = 4
+#: The sample's largest change times this and the number of free ends bounds their sum
+#: (measured on the wavy punch's 73 ends: the sample held the largest, and the sum was
+#: 50 % of the number of ends times it).
+MOVED_SAFETY = 2.0
+#: ... where that bound is below this share of tol, else every end is moved.
+MOVED_NEGLIGIBLE = 0.01
 
 
 def _at(values: float | np.ndarray, free: list[int]) -> float | np.ndarray:
