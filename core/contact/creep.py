@@ -33,7 +33,7 @@ from core.contact.bands import (
     pinned_end,
 )
 from core.contact.march import march, march_outputs, rule_operator
-from core.contact.result import UNILATERAL_MARGIN, _Snapshot
+from core.contact.result import UNILATERAL_MARGIN, _Snapshot, not_within_tol
 from core.contact.step import Space, Step, nystrom_pressure
 from core.contact.systems import Mirror
 from core.contact.zones import ZONE_END_TOL, Resolution
@@ -681,5 +681,7 @@ def creep_verdict(error: float, end_error: float, time_error: float, space_error
         message += (f"; a zone end left the finely paneled band around the ends at "
                     f"{strays} time(s), its estimate does not hold there")
     if not success:
-        message += f"; not within tol {tol:.1e} (zone ends: {ZONE_END_TOL:g})"
+        message += not_within_tol(error, end_error, tol, ZONE_END_TOL) + (
+            f"; {run['unsettled']} step(s) with an unsettled contact set"
+            if run["unsettled"] else "")
     return success, flags, message

@@ -15,7 +15,7 @@ import numpy as np
 
 from core.contact.active_set import NoContact, zones_from_nodes
 from core.contact.nodal import nodal_operator, nodal_state
-from core.contact.result import UNILATERAL_MARGIN, _Snapshot
+from core.contact.result import UNILATERAL_MARGIN, _Snapshot, not_within_tol
 from core.contact.step import Space, Step, nystrom_pressure
 from core.contact.zones import ZONE_END_TOL, Resolution, refine_zone_ends, zone_kernel_accuracy
 from core.discretize import Panels
@@ -167,7 +167,8 @@ def verdict(error: float, end_error: float, verified: bool, converged: bool, tol
     message = (f"unilateral contact ({what}): estimated error {error:.1e}, zone ends to "
                f"{end_error:.1e} half-widths")
     if not success:
-        message += (f"; not within tol {tol:.1e} / zone-end tolerance {ZONE_END_TOL:g}"
+        message += (not_within_tol(error, end_error, tol, ZONE_END_TOL)
+                    + ("" if converged else "; the zone ends did not converge")
                     + ("" if verified else "; the contact set failed its check (q < 0 on "
                        "it or the surfaces overlap off it)"))
     return {"contact": "unilateral", "error_estimate": float(error),

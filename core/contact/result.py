@@ -23,6 +23,21 @@ from core.problem import SolveOutcome
 UNILATERAL_MARGIN = 3.0
 
 
+def not_within_tol(error: float, end_error: float, tol: float, end_tol: float) -> str:
+    """Why a lift-off answer is not a success, for its message: which of its estimate
+    (``error``, relative, held to ``tol`` with :data:`UNILATERAL_MARGIN`) and its zone
+    ends' (``end_error``, half-widths, held to ``end_tol``) missed, in numbers. An estimate
+    below tol but not below tol / 3 reads as a contradiction unless the margin is said."""
+    missed = []
+    if not error * UNILATERAL_MARGIN <= tol:
+        missed.append(f"{UNILATERAL_MARGIN:g} x the estimated error = "
+                      f"{UNILATERAL_MARGIN * error:.1e} is over tol {tol:.1e} (these "
+                      f"estimates have read up to {UNILATERAL_MARGIN:g}x low)")
+    if not end_error <= end_tol:
+        missed.append(f"the zone ends' error {end_error:.1e} is over {end_tol:g} half-widths")
+    return "; not within tol: " + " and ".join(missed) if missed else ""
+
+
 @dataclass(frozen=True)
 class _Snapshot:
     """What the pressure at one output time needs: the Nystrom pressure on ``panels``."""
