@@ -57,14 +57,22 @@ def read_regular_file(path: str | os.PathLike, max_bytes: int) -> bytes:
 def writable_target(path: str | os.PathLike) -> Path:
     """The file a write to ``path`` replaces (a symlink resolved to its target).
 
-    Raises ValueError if that file exists and is not a regular file or is read-only, or
-    if ``path`` names a directory.
+    Raises ValueError if that file exists and is not a regular file or is read-only, if
+    ``path`` names a directory, or if the folder it would go in does not exist or may not
+    be written (found before the work whose result it is, not after).
     """
     path = Path(path)
     target = Path(os.path.realpath(path)) if path.is_symlink() else path
     try:
         info = os.stat(target)
     except FileNotFoundError:
+        folder = target.parent
+        if not folder.is_dir():
+            raise ValueError(f"{path}: the folder {folder} does not exist (create it or "
+                             "choose another file)") from None
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise ValueError(f"{path}: the folder {folder} may not be written (choose "
+                             "another file)") from None
         return target
     if stat.S_ISDIR(info.st_mode):
         raise ValueError(f"{path}: is a directory, not a file")

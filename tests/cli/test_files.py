@@ -58,6 +58,26 @@ def test_cli_respects_a_read_only_output(tmp_path: Path, capsys):
     assert out.read_text() == "keep me\n"
 
 
+def test_cli_refuses_an_output_in_a_missing_folder_before_solving(tmp_path: Path, capsys,
+                                                                   monkeypatch):
+    """The folder was found missing only after the solve (12-14 s of a creeping scene,
+    then "cannot write"): the check runs before it, for every command's outputs."""
+    import core.cli
+
+    scene = write_scene(tmp_path / "scene.json")
+    solved: list[object] = []
+    monkeypatch.setattr(core.cli, "solve", lambda *a, **k: solved.append(a))
+    missing = tmp_path / "nofolder" / "x.json"
+    assert main(["solve", str(scene), "--output", str(missing)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --output:") and "the folder" in err and "does not exist" in err
+    assert main(["report", str(scene), "--output", str(tmp_path / "none" / "r.html")]) == 2
+    assert "does not exist" in capsys.readouterr().err
+    assert not solved and not missing.parent.exists()
+    with pytest.raises(ValueError, match="does not exist"):
+        save_scene(load_scene(scene), missing)
+
+
 def test_cli_writes_through_a_symlink(tmp_path: Path):
     scene = write_scene(tmp_path / "scene.json")
     target = tmp_path / "data" / "result.csv"
