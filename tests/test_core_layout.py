@@ -103,3 +103,18 @@ def test_the_public_names_the_readmes_use_resolve() -> None:
     assert names >= {"solve", "load_scene", "prepare", "solve_dimensionless", "sweep"}
     for name in sorted(names):
         assert getattr(core, name) is not None, name
+
+
+def test_the_documented_calls_name_presets_not_paths_into_the_source_tree() -> None:
+    """A wheel's user has no ``core/presets/scenes/`` below the current folder: the
+    guide's ``core.load_scene("core/presets/scenes/eccentric_creep.json")`` ended in
+    FileNotFoundError when run as a script elsewhere. ``preset:NAME`` reads the shipped
+    file wherever the program starts."""
+    root = CORE.parent
+    sources = [root / "README.md", root / "core/SCENES.md", *sorted(root.glob("docs/*.md")),
+               *sorted(root.glob("docs/guides/*.md")), *sorted(root.glob("docs/examples/*.py"))]
+    calls = re.compile(r"""(load_scene|sweep|load_study|read_scene)\(\s*["']core/presets/"""
+                       r"""|python -m core \w+ core/presets/|coated-punch \w+ core/presets/""")
+    found = [f"{path.name}: {m.group(0)}" for path in sources
+             for m in calls.finditer(path.read_text(encoding="utf-8"))]
+    assert not found, found

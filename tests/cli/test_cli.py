@@ -326,3 +326,27 @@ def test_validate_says_why_a_scene_gives_both_forms(tmp_path):
     path.write_text(json.dumps(data))
     for command in ("validate", "solve"):
         assert_one_line_error(run(command, path), "punch: give either punch and loading")
+
+
+def test_the_command_line_section_of_the_format_lists_every_command() -> None:
+    """SCENES.md's synopsis left out ``report`` and ``calibrate``, and its exit codes
+    spoke of ``solve --strict`` alone; the documentation's table said "solve, validate,
+    check and sweep"."""
+    import argparse
+    import re
+
+    from core.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions
+                    if isinstance(a, argparse._SubParsersAction)).choices
+    root = Path(__file__).resolve().parents[2]
+    text = (root / "core" / "SCENES.md").read_text(encoding="utf-8")
+    section = text[text.index("## Command line"):]
+    synopsis = section[:section.index("Exit codes")]
+    listed = set(re.findall(r"python -m core ([a-z]\w*)", synopsis))
+    assert listed == set(commands), sorted(set(commands) ^ listed)
+    for page in ("docs/reference/cli.md", "docs/getting_started.md"):
+        row = next(line for line in (root / page).read_text(encoding="utf-8").splitlines()
+                   if line.startswith("| `coated-punch`"))
+        assert all(name in row for name in commands if name != "schema"), (page, row)
