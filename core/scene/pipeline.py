@@ -93,9 +93,15 @@ def _costly_punches(scene: PunchesScene | Mapping[str, Any], exc: WorkLimitExcee
 
 
 def _costly(scene: Scene, exc: WorkLimitExceeded) -> str:
-    """The message of a solve stopped at its work bound, naming the field to change: a
-    load that varies in time (the usual cause: lift-off under creep follows it step by
-    step), else the tolerance."""
+    """The message of a solve stopped at its work bound, naming the field to change: the
+    punch's shape where the ends of many contact zones were being located (a wavy punch
+    touching at its crests: every zone's nodes in one dense system), else a load that
+    varies in time (the usual cause: lift-off under creep follows it step by step), else
+    the tolerance."""
+    if "contact zone" in exc.doing and getattr(scene.shape, "kind", None) != "constant":
+        return (f"punch.shape: {exc}; a shape that touches the coating in fewer places "
+                "(fewer waves or steps under the punch, a narrower punch), a looser "
+                "solver.tol, or solver.contact 'full' costs less")
     varying = [q for q, profile in scene.loading.items()
                if getattr(profile, "kind", None) != "constant"]
     field = f"loading.{varying[0]}" if varying else "solver.tol"
