@@ -23,15 +23,18 @@ from typing import Any
 import numpy as np
 
 import core
-from core.scene import provenance_lines
+from core.scene import DesignLimits as CoreLimits
+from core.scene import check_design, provenance_lines
 from core.study import PUNCH_OUTPUT
 
 from ..model import (
     QUANTITIES,
     QUANTITY_UNITS,
+    DesignLimits,
     ResultView,
     StudyResult,
     contact_widths,
+    scene_with_limits,
 )
 
 #: Significant digits of every number in a CSV file.
@@ -92,8 +95,11 @@ def flag_message(view: ResultView, flag: str) -> str:
     return text
 
 
-def _header(view: ResultView, what: str, units: Iterable[str]) -> list[str]:
-    scene = view.scene
+def _header(view: ResultView, what: str, units: Iterable[str],
+            limits: DesignLimits | None = None) -> list[str]:
+    # the Check tab's limits go into the scene and the check's verdict into the file, as
+    # the command line writes them (a file without them lost a failing check)
+    scene = view.scene if limits is None else scene_with_limits(view.scene, limits)
     given = ", ".join(view.given)
     lines = [
         f"# coated-punch explorer {project_version()}: {what}",
@@ -103,6 +109,12 @@ def _header(view: ResultView, what: str, units: Iterable[str]) -> list[str]:
         f"# given: {given}; computed: {', '.join(view.unknowns)} (and the pressure)",
         f"# accuracy: {accuracy_statement(view)}",
     ]
+    if "limits" in scene:
+        check = check_design(view.times, view.x, view.pressure, view.values["settlement"],
+                             view.values["tilt"], CoreLimits(**scene["limits"]),
+                             view.info.get("corner_pressure"))
+        lines.append(f"# design_check: {'pass' if check.passed else 'FAIL'}; "
+                     + "; ".join(line.describe() for line in check.checks))
     flags = flag_lines(view)
     if flags:
         lines.append("# WARNING: this result is flagged; the model cannot fully stand "
@@ -114,9 +126,10 @@ def _header(view: ResultView, what: str, units: Iterable[str]) -> list[str]:
     return lines
 
 
-def histories_csv(view: ResultView) -> str:
+def histories_csv(view: ResultView, limits: DesignLimits | None = None) -> str:
     """The four histories as CSV, in mm, mrad, kN/m and kN·m/m, time in days, and the
-    contact width and the lifted length in m (as the contact width plot shows them)."""
+    contact width and the lifted length in m (as the contact width plot shows them);
+    with the Check tab's ``limits`` in the scene and the design check's verdict."""
     width = 2 * view.geometry.half_width
     units = ["time_day: days after loading"]
     units += [f"{HISTORY_COLUMNS[q]}: {QUANTITY_UNITS[q][0]}"
@@ -124,7 +137,7 @@ def histories_csv(view: ResultView) -> str:
     units += [f"{CONTACT_COLUMNS[0]}: m, length of the base in contact (of 2a = "
               f"{number(width)} m)",
               f"{CONTACT_COLUMNS[1]}: m, length lifted off (2a - contact width)"]
-    lines = _header(view, "histories", units)
+    lines = _header(view, "histories", units, limits)
     flags = ";".join(view.flags)
     lines.append(",".join(["time_day", *(HISTORY_COLUMNS[q] for q in QUANTITIES),
                            *CONTACT_COLUMNS, "flags"]))
@@ -135,17 +148,19 @@ def histories_csv(view: ResultView) -> str:
     return "\n".join(lines) + "\n"
 
 
-def pressure_csv(view: ResultView, unit: tuple[str, float] | None = None) -> str:
+def pressure_csv(view: ResultView, unit: tuple[str, float] | None = None,
+                 limits: DesignLimits | None = None) -> str:
     """q(x, t) as CSV in long form (time, x, q), on the grid of the plotted line.
 
-    ``unit``: the pressure unit on screen and its size in Pa (default: the result's own).
+    ``unit``: the pressure unit on screen and its size in Pa (default: the result's own);
+    ``limits``: the Check tab's, as for :func:`histories_csv`.
     A row whose pressure is negative beyond the error band is marked ``lift_off``.
     """
     name, size = unit or view.pressure_unit
     column = f"q_{name}"
     lines = _header(view, "contact pressure q(x, t)", [
         "time_day: days after loading", "x_m: m from the punch centre",
-        f"{column}: {name} (compression positive)"])
+        f"{column}: {name} (compression positive)"], limits)
     lines.append(f"time_day,x_m,{column},flags")
     band = view.lift_off_band()
     q = view.pressure

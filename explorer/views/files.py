@@ -163,7 +163,8 @@ class FilesView:
         view = self.screen.shown()
         if view is None:
             return None
-        options: dict[str, Any] = {}
+        # the Check tab's limits in every file's scene, with the check they give
+        options: dict[str, Any] = {"limits": self.limits}
         if report:
             index = min(self.screen.time_index, len(view.times) - 1)
             # the FE check's measurement, where it was made for this scene (the report
@@ -192,7 +193,7 @@ class FilesView:
             return io.StringIO("")
         if view.several:  # every punch's columns, in SI units (the core's file)
             return io.StringIO(str(await self._fetch("to_csv") or ""))
-        return io.StringIO(await asyncio.to_thread(histories_csv, view))
+        return io.StringIO(await asyncio.to_thread(histories_csv, view, self.limits))
 
     async def _pressure_file(self) -> io.StringIO:
         view = self.screen.shown()
@@ -201,7 +202,7 @@ class FilesView:
         if view.several:  # q on every punch's zone, global x, in Pa (the core's file)
             return io.StringIO(str(await self._fetch("pressure_csv") or ""))
         unit = self.scales.pressure_unit(view)
-        return io.StringIO(await asyncio.to_thread(pressure_csv, view, unit))
+        return io.StringIO(await asyncio.to_thread(pressure_csv, view, unit, self.limits))
 
     async def _json_file(self) -> io.StringIO:
         text = await self._fetch("to_json")

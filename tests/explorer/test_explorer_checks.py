@@ -344,6 +344,29 @@ def test_the_report_holds_inputs_plots_flags_accuracy_and_version(explorer_app):
     assert files.pdf_report_download.filename.endswith("_report.pdf")
 
 
+def test_every_results_file_carries_the_check_tabs_limits_and_verdict(explorer_app):
+    """The page said "FAIL" (q_max 763 kPa against 400) while the JSON of everything had
+    ``"design_check": null`` and no ``limits`` in its scene, and the CSVs' scene line had
+    none either: only the saved scene and the report carried them."""
+    import asyncio
+
+    app = explorer_app(solved=True)
+    app.check_tab.allowable_pressure.value = 100.0  # kPa: the flat preset reaches ~500
+    files = app.files_tab
+    data = json.loads(asyncio.run(files._json_file()).getvalue())
+    assert data["scene"]["limits"] == {"allowable_pressure": 100000.0}
+    assert data["design_check"]["passed"] is False
+    for text in (asyncio.run(files._csv_file()).getvalue(),
+                 asyncio.run(files._pressure_file()).getvalue()):
+        meta, _, _ = parse_csv(text)
+        assert json.loads(meta["scene_json"])["limits"] == {"allowable_pressure": 100000.0}
+        assert meta["design_check"].startswith("FAIL; largest contact pressure q_max")
+    app.check_tab.allowable_pressure.value = None  # no limit: none in the files
+    data = json.loads(asyncio.run(files._json_file()).getvalue())
+    assert "limits" not in data["scene"] and data["design_check"] is None
+    assert "design_check" not in parse_csv(asyncio.run(files._csv_file()).getvalue())[0]
+
+
 def test_the_status_speaks_plainly_and_keeps_the_numbers_in_details():
     from explorer.views import status_html
 
