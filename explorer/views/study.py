@@ -58,7 +58,10 @@ class _AxisInputs:
         # past it, into the scene's axis label)
         self.start = pn.widgets.FloatInput(label="from", width=64, css_classes=[f"{css}-from"])
         self.stop = pn.widgets.FloatInput(label="to", width=64, css_classes=[f"{css}-to"])
-        self.count = pn.widgets.IntInput(label="points", value=9, start=2, width=66,
+        # no bounds on the box: a count the study refuses ("points: must be a whole
+        # number from 2 to ...") is said when it runs; with start=2 the box kept a typed 1
+        # or 0 while the study ran on the last count taken, without a word
+        self.count = pn.widgets.IntInput(label="points", value=9, width=66,
                                          css_classes=[f"{css}-count"])
         # (its text once touched the arrow: a narrower left padding than the theme's 12 px)
         self.spacing = pn.widgets.Select(label="spacing", options=list(SPACINGS), width=68,

@@ -142,3 +142,16 @@ def test_the_link_follows_the_scene_while_a_study_setting_is_bad(page: Page):
     until(lambda: linked() == (640e3, 5), "the new force and the last good study in the link",
           describe=linked)
     assert page.errors == []
+
+
+def test_too_few_points_typed_are_refused_in_words(page: Page):
+    """Typed into the points box, 1 or 0 stayed in the box while the study ran on the
+    last count taken (the box's lower bound refused it in the page, without a word)."""
+    page.open_tab("Study")
+    page.page.locator(".study-run button").first.wait_for(timeout=60_000 * patience())
+    for typed in ("1", "0"):
+        page.type_into(".study-p1-count", typed)
+        page.page.locator(".study-run button").first.click()
+        until(lambda typed=typed: f"points: must be a whole number from 2 to 200, got {typed}"
+              in status(page), f"the refusal of {typed} point(s)", 60, lambda: status(page))
+    assert page.errors == []

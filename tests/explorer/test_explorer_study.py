@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import asyncio
 import copy
+import html
 import json
 import time
 
@@ -19,6 +20,7 @@ from explorer.files import study_csv
 from explorer.model import ExplorerState, presets
 from explorer.model.study import (
     ECCENTRICITY,
+    MAX_AXIS_POINTS,
     MAX_POINTS,
     OUTPUTS,
     Axis,
@@ -150,6 +152,12 @@ def test_the_tab_draws_the_chart_and_writes_the_files(explorer_app):
     tab.study_first.count.value = MAX_POINTS + 1
     assert not tab.start()
     assert "parameter 1, points" in tab.study_status.object
+    # too few, as typed (the box once kept 1 or 0 while the study ran on 9 points)
+    for typed in (1, 0, -3):
+        tab.study_first.count.value = typed
+        assert not tab.start()
+        assert (f"parameter 1, points: must be a whole number from 2 to {MAX_AXIS_POINTS}, "
+                f"got {typed}") in html.unescape(tab.study_status.object)
     tab.study_first.count.value = 3
     assert tab.start()
     assert tab.study_run.wait(300)
