@@ -163,8 +163,12 @@ def _validated(d: dict[str, Any]) -> Scene:
                          "number)") from None
     lam_lo, lam_hi = schema.LAM_RANGE
     if not math.isfinite(a / h_base) or not lam_lo <= a / h_base <= lam_hi:
-        raise ValueError(f"base.thickness: the ratio punch.half_width / base.thickness must be "
-                         f"in [{lam_lo:g}, {lam_hi:g}], got {a / h_base:.6g}")
+        # both lengths said: the one changed may be the punch's (the page then still
+        # names base.thickness, the field of the ratio's bound), and the ratio has no unit
+        raise ValueError(f"base.thickness: the ratio punch.half_width / base.thickness = "
+                         f"{a:g} m / {h_base:g} m = {a / h_base:.6g} must be in "
+                         f"[{lam_lo:g}, {lam_hi:g}] (a thicker or thinner base, or a "
+                         "narrower or wider punch)")
 
     times, times_spec = _times(d["times"], "times")
     if isinstance(creep, CodeCreep):

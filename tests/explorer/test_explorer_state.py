@@ -299,6 +299,20 @@ def test_solver_crash_is_a_message_not_an_exception():
     assert "boom" in controller.error and controller.view is None
 
 
+def test_a_punch_too_wide_for_its_base_is_said_with_both_lengths_and_a_plain_ratio():
+    """A half-width of 1e6 m read "Base, thickness (base.thickness): the ratio ... must be
+    in [0.0001, 100], got 250000 m": the ratio with a unit, and the punch the user changed
+    not said."""
+    state = ExplorerState()
+    state.punch.half_width = 1e6
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    assert controller.error == (
+        "Base, thickness (base.thickness): the ratio punch.half_width / base.thickness = "
+        "1e+06 m / 2 m = 500000 must be in [0.0001, 100] (a thicker or thinner base, or a "
+        "narrower or wider punch)")
+
+
 def test_format_error_says_loads_and_stresses_in_the_page_units():
     # the sliders read kN/m and kN·m/m; the messages read "P = -200000 N/m"
     assert format_error("loading.force: the punch is pulled away (P = -200000 N/m at t = 0 "
