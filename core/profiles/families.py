@@ -73,14 +73,22 @@ def _build_step(spec: Mapping[str, Any], at: _At) -> Profile:
     if len(values) != len(breaks) + 1:
         raise ValueError(f"{field}.values: must have one entry more than breaks "
                          f"({len(breaks) + 1}), has {len(values)}")
+    # In time a step at or after the last output time is a load change that has not come
+    # yet: the history holds its earlier value (a scene's times shortened to its first
+    # 100 days, or a study's times, refused a step at 365 days). In x a step is a
+    # breakpoint of the geometry and must be on the punch.
+    later = at.variable == "t"
     for i, b in enumerate(breaks):
-        if not lo < b < hi:
-            raise ValueError(f"{field}.breaks[{i}]: must lie strictly inside the domain "
-                             f"({_fmt(lo)}, {_fmt(hi)}) of {at.variable}, is {_fmt(b)}")
+        if not (lo < b < hi or (later and b >= hi and math.isfinite(b))):
+            where = (f"after the start {_fmt(lo)} of {at.variable}" if later
+                     else f"strictly inside the domain ({_fmt(lo)}, {_fmt(hi)}) of "
+                     f"{at.variable}")
+            raise ValueError(f"{field}.breaks[{i}]: must lie {where}, is {_fmt(b)}")
     _strictly_increasing(breaks, f"{field}.breaks", at.variable, "entry")
     b_arr, y_arr = np.array(breaks), np.array(values)
     return Profile(kind="step", spec={"kind": "step", "values": values, "breaks": breaks},
-                   variable=at.variable, domain=at.domain, breakpoints=tuple(breaks),
+                   variable=at.variable, domain=at.domain,
+                   breakpoints=tuple(b for b in breaks if b < hi),
                    evaluate=lambda v: y_arr[np.searchsorted(b_arr, v, side="right")])
 
 

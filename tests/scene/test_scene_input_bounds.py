@@ -228,3 +228,30 @@ def test_a_solution_never_holds_nan(monkeypatch) -> None:
     with pytest.raises(ValueError, match=r"^scene: the computed settlement is not finite at "
                                          r"t = 100 days"):
         solve(edited("loading.force", 4.1e5))
+
+
+def test_a_load_step_after_the_last_output_time_is_one_that_has_not_come_yet() -> None:
+    """``new_footing_beside_old`` (its second footing's force steps at 365.25 days) with
+    its times cut to the first 100 days was refused: "breaks[0]: must lie strictly inside
+    the domain (0, 100) of t, is 365.25", as a study replacing the times would be. It now
+    answers as the force before the step; a step before loading is still refused."""
+    import copy
+
+    from core.presets import read_preset
+    from core.scene import solve
+
+    scene = read_preset("new_footing_beside_old")
+    step = scene["punches"][1]["loading"]["force"]
+    assert step["kind"] == "step" and step["breaks"] == [365.25]
+    scene["times"] = {"end": 100.0, "count": 5, "spacing": "linear"}
+    before = copy.deepcopy(scene)
+    before["punches"][1]["loading"]["force"] = step["values"][0]
+    cut, constant = solve(scene), solve(before)
+    for mine, theirs in zip(cut.punches, constant.punches, strict=True):
+        np.testing.assert_array_equal(mine.settlement, theirs.settlement)
+        np.testing.assert_array_equal(mine.tilt, theirs.tilt)
+    assert cut.scene.to_dict()["punches"][1]["loading"]["force"]["breaks"] == [365.25]
+    step["breaks"] = [0.0]
+    with pytest.raises(ValueError, match=r"punches\[1\]\.loading\.force\.breaks\[0\]: must "
+                                         r"lie after the start 0 of t, is 0"):
+        solve(scene)
