@@ -239,3 +239,28 @@ def test_the_report_of_a_bare_scene_says_there_is_no_coating():
     rows = dict(accuracy_rows(result))
     assert rows["coating model error (estimated, relative)"].startswith("0: no coating")
     assert rows["solved by"].endswith("no coating")
+
+
+@pytest.mark.parametrize("loading", [
+    {"settlement": -1e-3, "tilt": 0.0},
+    {"settlement": -1e-5, "moment": 0.0},
+    {"settlement": -6e-4, "tilt": 5e-4},    # tilted, its toe still 1e-4 m above (a = 1 m)
+])
+def test_a_punch_held_clear_of_the_bare_base_has_no_contact(loading: dict) -> None:
+    """As on a coated base: q = 0, P = M = 0, the flag ``no_contact``. It was refused as
+    "no contact zone with two free ends was found ... (the crown's contact would reach a
+    corner or vanish)" for a flat punch."""
+    d = bare(loading=loading, times={"end": 100.0, "count": 3, "spacing": "linear"})
+    d["punch"]["half_width"] = 1.0
+    result = solve(d)
+    assert result.flags == ["no_contact"] and result.info["success"]
+    assert np.all(result.force == 0.0) and np.all(result.moment == 0.0)
+    assert result.contact_set == [[], [], []] and np.all(result.contact_width == 0.0)
+    assert np.all(result.pressure_on_grid == 0.0)
+    np.testing.assert_array_equal(result.settlement, d["loading"]["settlement"])
+
+
+def test_a_punch_that_reaches_the_bare_base_is_not_taken_for_clear() -> None:
+    """Tilted so that its toe dips in (2e-4 + 5e-4 a > 0 at x = a): it touches there."""
+    result = solve(bare(loading={"settlement": 2e-4, "tilt": 5e-4}))
+    assert "no_contact" not in result.flags and result.force[0] > 0.0

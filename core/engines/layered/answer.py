@@ -203,6 +203,9 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
         if layers:
             return None  # the thin layer's unilateral solver answers
         pulls = max(error_estimate, LIFT_OFF_SHARE) * scale
+        clear = _held_clear(problem, times)
+        if clear is not None:
+            return _no_contact(scene, problem, times, clear, start)
         if history is not None:
             return _bare_creep_lift_off(scene, problem, times, answer, regular_part, pulls,
                                         start)
@@ -473,6 +476,61 @@ def _no_coating_model_error() -> dict[str, Any]:
     """``info["layered_model_error"]`` without coating: no coating to model, no error."""
     return {"estimate": 0.0, "force": 0.0, "moment": 0.0, "where_m": 0.0,
             "model": NO_COATING, "thin_layer_estimate": 0.0}
+
+
+#: Points of [-1, 1] where :func:`_held_clear` compares the punch with the surface (the
+#: gap's breakpoints added).
+CLEAR_POINTS = np.linspace(-1.0, 1.0, 4001)
+
+
+def _held_clear(problem: Any, times: np.ndarray) -> dict[str, np.ndarray] | None:
+    """The settlement and tilt [-] at ``times`` when the given loads hold the punch clear
+    of the bare surface at every one of them (a settlement given with a tilt, or with a
+    moment of 0: no contact then carries no moment, and the punch stays level), else None.
+
+    Clear: ``delta + alpha x - g(x) <= 0`` on the punch (settlement positive downward,
+    ``g >= 0`` the gap). A coated base answers this with the flag ``no_contact``; the
+    bare base's lift-off search took it for a crown whose zone could not be found."""
+    loads = _load_values(problem, times)
+    if "settlement" not in loads or not ({"tilt", "moment"} & set(loads)):
+        return None
+    delta = loads["settlement"]
+    if "tilt" in loads:
+        alpha = loads["tilt"]
+    elif np.all(loads["moment"] == 0.0):
+        alpha = np.zeros_like(delta)
+    else:
+        return None
+    x = np.unique(np.concatenate([CLEAR_POINTS, np.clip(problem.breakpoints, -1.0, 1.0)]))
+    g = problem.g(x) if callable(problem.g) else np.full(x.size, float(problem.g))
+    reach = delta[:, None] + alpha[:, None] * x[None, :] - np.asarray(g, dtype=float)[None, :]
+    if not np.all(np.max(reach, axis=1) <= 0.0):
+        return None
+    return {"settlement": np.array(delta, dtype=float), "tilt": np.array(alpha, dtype=float)}
+
+
+def _no_contact(scene: Any, problem: Any, times: np.ndarray, clear: dict[str, np.ndarray],
+                start: float) -> ContactSolution:
+    """The answer of a punch held clear of the bare base at every output time
+    (:func:`_held_clear`): no pressure, P = M = 0, an empty contact set (the scene's flag
+    ``no_contact``); exact, so its estimated error is 0."""
+    zero = np.zeros(times.size)
+    message = ("no contact: the given settlement and tilt hold the punch clear of the bare "
+               "base at every output time (q = 0, P = M = 0)")
+    info = _info(scene, problem, None, start, np.zeros(1), error_estimate=0.0, spatial=0.0,
+                 success=True, flags=[], message=message, modes=0, nodes=0, stages={},
+                 contact="unilateral")
+    info.update(max_abs_tilt=float(np.max(np.abs(clear["tilt"]), initial=0.0)),
+                coating_model=NO_COATING, layered_model_error=_no_coating_model_error(),
+                zone_end_error=0.0)
+
+    def evaluate(x: np.ndarray) -> np.ndarray:
+        return np.zeros((np.size(x), times.size))
+
+    return ContactSolution(times.copy(), clear["settlement"], clear["tilt"], zero.copy(),
+                           zero.copy(), info, None, np.zeros((0, times.size)),
+                           np.ones(times.size), None, None, _evaluate=evaluate,
+                           contact_set=[[] for _ in times])
 
 
 def _info(scene: Any, problem: Any, history: Any, start: float, q_interior: np.ndarray, *,
