@@ -44,6 +44,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import math
 import shutil
 import sys
 from collections.abc import Iterator, Sequence
@@ -58,6 +59,7 @@ from core.files import (
     same_file,
     writable_target,
 )
+from core.limits import MAX_SCENE_TIMES
 from core.optional import MissingDependency
 from core.presets import PRESET_PREFIX, preset_names, shipped_file, study_names
 from core.problem import QUANTITIES
@@ -604,10 +606,17 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         readings = readings_from_text(_stdin_text(), STDIN_NAME) \
             if args.readings == STDIO else read_readings(args.readings)
     bounds = _bounds(args.bound or [], args.fit)
+    # the forecast's options checked before the fit, named as typed (a forecast of 0 days
+    # was left out without a word; -5 was refused as "times.end")
+    if args.forecast is not None and not (math.isfinite(args.forecast) and args.forecast > 0):
+        raise _InputError(f"--forecast: must be a number of days > 0, got {args.forecast:g}")
+    if not 1 <= args.forecast_count <= MAX_SCENE_TIMES:
+        raise _InputError(f"--forecast-count: must be a whole number from 1 to "
+                          f"{MAX_SCENE_TIMES}, got {args.forecast_count}")
     try:
         fit = calibrate(scene, readings, fit=args.fit, bounds=bounds)
         forecast = fit.forecast({"end": args.forecast, "count": args.forecast_count,
-                                 "spacing": "log"}) if args.forecast else None
+                                 "spacing": "log"}) if args.forecast is not None else None
     except ValueError as exc:
         message = str(exc)
         if message.startswith(("fit", "bounds", "measurements", "scene", "settlement",

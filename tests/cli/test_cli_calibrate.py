@@ -3,6 +3,8 @@ naming the row and column of a bad reading, and ``--strict`` on a warning."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 from pathlib import Path
 
@@ -72,3 +74,21 @@ def test_strict_fails_on_a_warning(tmp_path: Path) -> None:
                    "coating[0].modulus", "--strict", "--output", tmp_path / "f.json", cwd=tmp_path)
     assert proc.returncode == EXIT_FLAGGED, proc.stderr
     assert "warning: calibrate: not identifiable" in proc.stderr
+
+
+def test_the_forecasts_options_are_named_as_typed(tmp_path: Path) -> None:
+    """``--forecast 0`` was left out without a word (exit 0, no forecast); ``-5`` and
+    ``--forecast-count 0`` were refused as ``times.end`` and ``times.count``."""
+    from core.cli import main
+
+    scene, readings = _files(tmp_path)
+    cases = [(["--forecast", "0"], "error: --forecast: must be a number of days > 0, got 0"),
+             (["--forecast", "-5"], "error: --forecast: must be a number of days > 0, got -5"),
+             (["--forecast", "100", "--forecast-count", "0"],
+              "error: --forecast-count: must be a whole number from 1 to 2000, got 0")]
+    for extra, said in cases:
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            code = main(["calibrate", str(scene), str(readings), "--fit", "loading.force",
+                         *extra])
+        assert code == EXIT_BAD_INPUT and err.getvalue().startswith(said), err.getvalue()
