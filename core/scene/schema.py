@@ -397,7 +397,10 @@ def _unit_of(path: str) -> str:
 
 
 def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
-    """The output times [day after loading] and their canonical spec."""
+    """The output times [day after loading] and their canonical spec (a list, a 1-D
+    NumPy array of them, or ``{end, count, spacing}``)."""
+    if isinstance(spec, np.ndarray) and spec.ndim == 1:
+        spec = spec.tolist()  # as the profiles' tables take them
     if isinstance(spec, Mapping):
         check_fields(spec, path, ("end", "count"), ("spacing",))
         end = positive_number(spec["end"], f"{path}.end")

@@ -255,3 +255,16 @@ def test_a_load_step_after_the_last_output_time_is_one_that_has_not_come_yet() -
     with pytest.raises(ValueError, match=r"punches\[1\]\.loading\.force\.breaks\[0\]: must "
                                          r"lie after the start 0 of t, is 0"):
         solve(scene)
+
+
+def test_output_times_may_be_a_numpy_array() -> None:
+    """``scene["times"] = np.array([0., 10., 365.])`` was refused ("must be an object ...
+    or a list"), where the profiles' tables and the fit's forecast take arrays."""
+    from core.presets import read_preset
+
+    listed = read_preset("uniform_flat")
+    listed["times"] = [0.0, 10.0, 365.0]
+    array = dict(listed, times=np.array([0.0, 10.0, 365.0]))
+    assert scene_from_dict(array).to_dict() == scene_from_dict(listed).to_dict()
+    with pytest.raises(ValueError, match=r"times\[1\]: times must increase"):
+        scene_from_dict(dict(listed, times=np.array([0.0, 0.0, 1.0])))
