@@ -139,7 +139,14 @@ def validate_geometry(lam: Any, m: Scalar, g: Scalar, breakpoints: Sequence[floa
 
 
 def validate_times(times: Any) -> np.ndarray:
-    """Output times as a float array: increasing, finite, the first >= 1."""
+    """Output times as a float array: increasing, finite, the first >= 1 (numbers, not
+    text: NumPy would read the string "1.0" as the time 1)."""
+    try:
+        text = np.asarray(times).dtype.kind in "SU"
+    except (TypeError, ValueError):
+        text = False  # ragged: refused below
+    if text:
+        raise ValueError(f"times: must be an array of numbers, got text: {times!r:.60}")
     try:
         t = np.asarray(times, dtype=float).ravel()
     except (TypeError, ValueError) as exc:

@@ -339,3 +339,17 @@ def test_bad_input_names_the_argument(kwargs, field):
     with pytest.raises(ValueError, match=rf"^{field}"):
         solve_dimensionless(args.pop("lam"), args.pop("m"), args.pop("g"), args.pop("times"),
                             **args)
+
+
+def test_times_as_text_are_refused_not_read_as_numbers() -> None:
+    """``solve_dimensionless(..., "1.0", ...)`` was answered at t = 1: NumPy reads the
+    string as a number. Text is refused naming ``times``; numbers in a list still go."""
+    import pytest
+
+    from core import solve_dimensionless
+
+    for times in ("1.0", ["1.0", "2.0"], b"1"):
+        with pytest.raises(ValueError, match=r"^times: must be an array of numbers, got text"):
+            solve_dimensionless(1.0, 0.05, 0.0, times, force=1.0, moment=0.0)
+    assert solve_dimensionless(1.0, 0.05, 0.0, [1.0, 2.0], force=1.0,
+                               moment=0.0).times.tolist() == [1.0, 2.0]
