@@ -124,8 +124,9 @@ class PinsView:
 
     def _name_steps(self) -> None:
         quantity = self.stepped_quantity()
+        # the steps take the place of the pins kept: said before the click, not after
         text = (f"<span class='pin-steps-name'>Pin steps of {NAMES[quantity]} "
-                f"[{QUANTITY_UNITS[quantity][0]}]:</span>")
+                f"[{QUANTITY_UNITS[quantity][0]}] (replaces the pins):</span>")
         if self.steps_label.object != text:
             self.steps_label.object = text
         if self._stepped != quantity or (self.step_from.value is None

@@ -101,6 +101,8 @@ def test_pin_the_steps_of_a_load_over_a_range(explorer_app) -> None:
     pins = app.pins
     # the first given load of the preset is the force; its steps replace the pins
     assert "force P [kN/m]" in pins.steps_label.object
+    # and the page says so before the click (a pin made by hand went without a word)
+    assert "(replaces the pins)" in pins.steps_label.object
     pins.pin_steps(5, 250.0, 750.0)
     assert [pin.label for pin in pins.board] == [
         "P = 250 kN/m", "P = 375 kN/m", "P = 500 kN/m", "P = 625 kN/m", "P = 750 kN/m"]
