@@ -18,6 +18,7 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
+import numpy as np
 import panel as pn
 
 from ..files import MAX_PAGE_DOWNLOAD_BYTES, study_csv
@@ -34,7 +35,7 @@ from ..model import (
     study_outputs,
 )
 from ..plots import DesignChart, design_chart_png, flag_note
-from ..solving import SolveController, StudyRun
+from ..solving import SolveController, StudyRun, format_error
 from .loop import PageLoop
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
 
@@ -85,6 +86,21 @@ class _AxisInputs:
         return Axis(self.field.value, _number(self.start.value), _number(self.stop.value),
                     self.count.value if self.count.value is not None else 0,
                     self.spacing.value)
+
+
+def _why_failed(result: Any) -> str:
+    """Why the study's points failed, for its summary: the first failed point's message
+    (the page said "1 failed (no value)" and nothing more), and how many other reasons
+    the CSV's ``error`` column holds."""
+    reasons = list(dict.fromkeys(str(e) for e in np.asarray(result.errors)[result.failed]
+                                 if str(e)))
+    if not reasons:
+        return ""
+    first = format_error(reasons[0])  # the field in words, loads in the page's units
+    first = first if len(first) <= 240 else first[:239] + "…"
+    more = len(reasons) - 1
+    return (f" Failed: {first}" + (f" (and {more} other reason{'s' if more > 1 else ''}: "
+                                   "the CSV's error column)" if more else ""))
 
 
 def _number(value: Any) -> float:
@@ -321,7 +337,7 @@ class StudyView:
             self._say(run.message, bad=run.status == "failed")
 
     def _done_text(self, result: Any) -> str:
-        return f"Done: {self.study_run.message}. Marks: {flag_note(result)}."
+        return f"Done: {self.study_run.message}. Marks: {flag_note(result)}.{_why_failed(result)}"
 
     def _on_result(self, event: Any) -> None:
         result = event.new

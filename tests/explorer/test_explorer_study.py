@@ -275,3 +275,19 @@ def test_a_link_keeps_the_study_settings(explorer_app):
     settings, message = read_study_query({"study": encode_scene({"axes": "x"})})
     assert settings is None and message.startswith("The study settings in the link were "
                                                    "not used")
+
+
+def test_a_failed_point_says_why_on_the_page(explorer_app):
+    """A force from -100 to 750 kN/m: the summary said "1 failed (no value)" and no more;
+    it now gives the failed point's reason."""
+    app = explorer_app(scene=screen_scene())
+    tab = app.study_tab
+    tab.study_first.fill(Axis("loading.force", -100.0, 750.0, 3))
+    assert tab.start()
+    assert tab.study_run.wait(300)
+    assert tab.study_run.status == "done", tab.study_run.message
+    assert int(tab.study_run.result.failed.sum()) == 1
+    said = html.unescape(tab.study_status.object)
+    assert "1 failed (no value). Failed: " in said, said
+    assert "Failed: Loading, force (loading.force): the punch is pulled away (P = -100 kN/m" \
+        in said, said
