@@ -18,7 +18,7 @@ from .fidelity import FidelityView
 from .loop import PageLoop
 from .punches import OnePunchOnly
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-from .widgets import ProfileEditor, PromptIntSlider
+from .widgets import ProfileEditor, PromptIntSlider, significant_format
 
 log = logging.getLogger(__name__)
 
@@ -66,11 +66,12 @@ class CoatingView:
                                                  color="primary", variant="outline",
                                                  sizing_mode="stretch_width")
         self.layer.param.watch(lambda *e: self.bind_layer(), "value")
-        self.thickness_editor = ProfileEditor("thickness", "mm", 0.5, 50.0, 0.1, "0[.]00",
+        self.thickness_editor = ProfileEditor("thickness", "mm", 0.5, 50.0, 0.1,
+                                              significant_format(),
                                               amplitude=("µm", -1000.0, 1000.0, 0.5),
                                               css="coating-thickness", live_when=live_when)
         self.modulus_editor = ProfileEditor("Young's modulus", "MPa", 1.0, 10000.0, 1.0,
-                                            "0[.]0", css="coating-modulus",
+                                            significant_format(), css="coating-modulus",
                                             live_when=live_when)
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
                                             variations=False, live_when=live_when)

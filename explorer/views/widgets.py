@@ -16,6 +16,7 @@ from typing import Any
 
 import panel as pn
 import param
+from bokeh.models import CustomJSTickFormatter
 from panel.io.state import set_curdoc
 
 from core.profiles import MAX_TABLE_BYTES, VARIATIONS, profile_from_csv
@@ -145,7 +146,20 @@ class EditableIntSlider(pn.widgets.EditableIntSlider):
                              "text box does).")
 
 
-def slider(label: str, start: float, end: float, step: float, fmt: str = "0[.]000",
+#: Significant digits of a box shown by :func:`significant_format`.
+SIGNIFICANT_DIGITS = 6
+
+
+def significant_format() -> CustomJSTickFormatter:
+    """A box format of :data:`SIGNIFICANT_DIGITS` significant digits: a fixed number of
+    decimals showed a coating 0.0001 mm thick as "0" while that thickness was solved (and
+    a modulus of 1e-6 MPa as "0"). A new model each time: one belongs to one page."""
+    return CustomJSTickFormatter(
+        code=f"return Number(Number(tick).toPrecision({SIGNIFICANT_DIGITS})).toString();")
+
+
+def slider(label: str, start: float, end: float, step: float,
+           fmt: str | CustomJSTickFormatter = "0[.]000",
            **kwargs: Any) -> pn.widgets.EditableFloatSlider:
     """A float slider with an input box (any value can be typed; the core validates it)."""
     return EditableSlider(label=label, start=start, end=end, step=step, format=fmt,
@@ -421,7 +435,7 @@ class ProfileEditor:
     """Level, variation kind and its parameters for one :class:`ProfileState`."""
 
     def __init__(self, label: str, unit: str, start: float, end: float, step: float,
-                 fmt: str = "0[.]00", variations: bool = True,
+                 fmt: str | CustomJSTickFormatter = "0[.]00", variations: bool = True,
                  amplitude: tuple[str, float, float, float] = ("%", -90.0, 500.0, 1.0),
                  css: str = "", live_when: Callable[[], bool] | None = None) -> None:
         """``amplitude``: unit of the variation ('%' of the level, or an absolute unit),

@@ -20,7 +20,7 @@ from tests.browser_pages import patience, require_browser  # noqa: E402
 
 require_browser()
 
-from tests.browser_pages import Page, page_fixtures  # noqa: E402
+from tests.browser_pages import Page, page_fixtures, until  # noqa: E402
 
 ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
 
@@ -103,6 +103,24 @@ def test_a_bad_value_shows_its_message_and_keeps_the_plots(page: Page):
     alert.wait_for(state="hidden", timeout=60_000 * patience())
     page.wait_text_change(".readout-settlement", settlement)
     assert "Traceback" not in page.page.content()
+    assert page.errors == []
+
+
+def test_a_tiny_coating_value_reads_in_its_box_as_solved(page: Page):
+    """A coating 0.0001 mm thick was solved while its box read "0" (two decimals), and a
+    modulus of 1e-6 MPa likewise: the boxes show six significant digits."""
+    settlement = page.text(".readout-settlement")
+    page.open_tab("Coating")
+    page.type_into(".coating-thickness", "0.0001")
+    page.wait_text_change(".readout-settlement", settlement)
+    box = page.page.locator(".coating-thickness input").first
+    assert box.input_value() == "0.0001"
+    page.type_into(".coating-thickness", "12.345678")
+    until(lambda: box.input_value() == "12.3457", "12.3457 in the thickness box",
+          describe=box.input_value)
+    page.type_into(".coating-thickness", "15")
+    until(lambda: box.input_value() == "15", "15 in the thickness box",
+          describe=box.input_value)
     assert page.errors == []
 
 
