@@ -23,6 +23,7 @@ centre.
 from __future__ import annotations
 
 import copy
+import copyreg
 import json
 import time
 from collections.abc import Mapping
@@ -424,3 +425,12 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
     result = PunchesSolution(scene, punches)
     result.info["cpu_seconds"] = time.thread_time() - started
     return result
+
+
+def _rebuilt(scene: PunchesScene) -> tuple[Any, tuple[dict[str, Any]]]:
+    """How a :class:`PunchesScene` is copied and pickled: rebuilt from its canonical dict
+    (as a single punch's scene, ``core.scene.validate``)."""
+    return punches_from_dict, (scene.to_dict(),)
+
+
+copyreg.pickle(PunchesScene, _rebuilt)

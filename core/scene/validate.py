@@ -7,6 +7,7 @@ the time stepping, creep beyond real materials), naming the field to change.
 
 from __future__ import annotations
 
+import copyreg
 import json
 import math
 from collections.abc import Mapping
@@ -544,3 +545,13 @@ def _check_creep(scene: Scene, problem: DimensionlessProblem) -> None:
             "strain over elastic strain under a stress held from loading to the last output "
             f"time) is {phi:.3g}, more than {schema.MAX_CREEP_COEFFICIENT:g}: far beyond real "
             "materials, and beyond what the time stepping can follow in reasonable time")
+
+
+def _rebuilt(scene: Scene) -> tuple[Any, tuple[dict[str, Any]]]:
+    """How a :class:`Scene` is copied and pickled: rebuilt from its canonical dict (its
+    profiles are closures, which do not pickle; ``copy.deepcopy`` and ``pickle`` refused
+    it), so that a scene goes to another process (``multiprocessing``, joblib) as a dict."""
+    return scene_from_dict, (scene.to_dict(),)
+
+
+copyreg.pickle(Scene, _rebuilt)

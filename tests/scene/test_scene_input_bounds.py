@@ -268,3 +268,29 @@ def test_output_times_may_be_a_numpy_array() -> None:
     assert scene_from_dict(array).to_dict() == scene_from_dict(listed).to_dict()
     with pytest.raises(ValueError, match=r"times\[1\]: times must increase"):
         scene_from_dict(dict(listed, times=np.array([0.0, 0.0, 1.0])))
+
+
+def _settlement_of(scene: Any) -> list[float]:
+    from core.scene import solve
+
+    return solve(scene).settlement.tolist()
+
+
+def test_a_scene_copies_and_goes_to_another_process() -> None:
+    """``copy.deepcopy`` and ``pickle`` refused a scene ("cannot pickle 'mappingproxy'";
+    its profiles are closures): a user's process pool could not take one. A scene now
+    travels as its canonical dict and is rebuilt, of one punch or of several."""
+    import copy
+    import multiprocessing
+    import pickle
+    from concurrent.futures import ProcessPoolExecutor
+
+    from core.scene import load_scene, solve
+
+    for name in ("eccentric_creep", "new_footing_beside_old"):
+        scene = load_scene(f"preset:{name}")
+        for copied in (copy.deepcopy(scene), pickle.loads(pickle.dumps(scene))):
+            assert type(copied) is type(scene) and copied.to_dict() == scene.to_dict()
+    scene = load_scene("preset:eccentric_creep")
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
+        assert pool.submit(_settlement_of, scene).result() == solve(scene).settlement.tolist()
