@@ -180,7 +180,12 @@ class FitView:
             readings = read_upload(data, name)
         except ValueError as exc:
             self.upload.clear()
-            self._readings_text(f"The readings were not used: {exc}", bad=True)
+            # the readings in use stay (nothing is lost), and the page says which they
+            # are: after a refused file, Fit ran on the previous one without a word
+            kept = "" if self.readings is None else (
+                f" The Fit button still uses the previous readings, {self.readings.source}: "
+                f"{readings_note(self.readings)}.")
+            self._readings_text(f"The readings were not used: {exc}.{kept}", bad=True)
             return
         self.show_readings(readings)
 

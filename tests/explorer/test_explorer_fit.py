@@ -5,6 +5,7 @@ forecast band, the fitted scene applied. The page runs the fit inline without a 
 from __future__ import annotations
 
 import asyncio
+import html
 
 import numpy as np
 import pytest
@@ -107,6 +108,22 @@ def test_a_bad_readings_file_is_refused_naming_line_and_column(explorer_app):
     assert "not a text file" in tab.readings_status.object
     tab.upload.param.update(filename="<b>x</b>.csv", value=b"time,settlement\n1,x\n")
     assert "<b>" not in tab.readings_status.object  # the file name is escaped
+
+
+def test_a_refused_file_after_a_good_one_says_which_readings_the_fit_uses(explorer_app):
+    """After good.csv, a refused text.csv said only "The readings were not used: ..."
+    while Fit stayed enabled and ran on good.csv's readings: the page now says so."""
+    app = explorer_app()
+    tab = app.fit_tab
+    tab.upload.param.update(filename="good.csv",
+                            value=b"time [day], settlement [mm]\n10, 1.0\n20, 1.2\n40, 1.3\n")
+    assert tab.readings is not None and not tab.fit_button.disabled
+    tab.upload.param.update(filename="text.csv",
+                            value=b"time [day], settlement [mm]\n10, 1.0\n20, abc\n")
+    message = html.unescape(tab.readings_status.object)
+    assert "The readings were not used: text.csv: line 3" in message
+    assert "The Fit button still uses the previous readings, good.csv: 3 " in message, message
+    assert tab.readings.source == "good.csv"
 
 
 def test_fields_are_checked_before_the_fit(explorer_app):
