@@ -226,10 +226,18 @@ class PunchState(param.Parameterized):
             rise = self.slope * _URAD * a
             return {"kind": "table", "points": [[-a, rise], [0.0, 0.0], [a, rise]],
                     "interpolation": "linear"}
+        # the step's and the land's edges must lie on the punch: said in the slider's words
+        # (the core's "punch.shape.breaks[0]: must lie strictly inside ..." named no box)
         if self.shape == "stepped":
+            if not -a < self.step_position < a:
+                raise ValueError(f"punch.shape: the step position must lie strictly inside "
+                                 f"the punch ({-a:g}, {a:g}) m, is {self.step_position:g} m")
             return {"kind": "step", "values": [0.0, self.step_height * _UM],
                     "breaks": [self.step_position]}
         if self.shape == "land":
+            if not 0.0 < self.land_width < 2.0 * a:
+                raise ValueError(f"punch.shape: the land width must be above 0 and below the "
+                                 f"punch's width 2a = {2.0 * a:g} m, is {self.land_width:g} m")
             h, half = self.land_height * _UM, 0.5 * self.land_width
             return {"kind": "step", "values": [h, 0.0, h], "breaks": [-half, half]}
         if self.shape == "wavy":

@@ -105,7 +105,11 @@ class PunchView:
         """Show the sliders of the chosen shape only."""
         p = self.state.punch
         a = p.half_width
-        self.step_position.update(start=-a, end=a)
+        # strictly inside the punch, as the step must be (the ends were refused), and the
+        # land no wider than it
+        margin = min(0.01, 0.1 * a)
+        self.step_position.update(start=-a + margin, end=a - margin)
+        self.land_width.update(start=min(0.05, a), end=2.0 * a - 2.0 * margin)
         shape = p.shape
         self.radius.visible = shape == "parabolic"
         self.slope.visible = shape == "wedge"

@@ -313,6 +313,34 @@ def test_a_punch_too_wide_for_its_base_is_said_with_both_lengths_and_a_plain_rat
         "narrower or wider punch)")
 
 
+def test_a_step_or_land_off_the_punch_is_said_in_the_sliders_words(explorer_app):
+    """The step position's slider reached x = a (End) and the land width 2 m on a punch
+    0.2 m wide: both were refused as "punch.shape.breaks[0]: must lie strictly inside the
+    domain ...", naming no box on the page. The sliders now stay inside the punch, and a
+    value typed past it is said in their words."""
+    def error(**punch: float | str) -> str:
+        state = ExplorerState()
+        state.punch.param.update(**punch)
+        controller = SolveController(state, executor=None, auto=False)
+        controller.solve_now()
+        return controller.error
+
+    assert error(shape="stepped", step_position=1.0) == (
+        "Punch, shape (punch.shape): the step position must lie strictly inside the punch "
+        "(-1, 1) m, is 1 m")
+    assert error(half_width=0.1, shape="land") == (
+        "Punch, shape (punch.shape): the land width must be above 0 and below the punch's "
+        "width 2a = 0.2 m, is 0.8 m")
+    assert error(shape="stepped", step_position=0.99) == ""
+    app = explorer_app()
+    app.state.punch.half_width = 0.5
+    view = app.punch_tab
+    view.refresh()
+    spec = view.step_position._spec
+    assert (spec["start"], spec["end"]) == (-0.49, 0.49)
+    assert view.land_width._spec["end"] == pytest.approx(0.98)
+
+
 def test_format_error_says_loads_and_stresses_in_the_page_units():
     # the sliders read kN/m and kN·m/m; the messages read "P = -200000 N/m"
     assert format_error("loading.force: the punch is pulled away (P = -200000 N/m at t = 0 "
