@@ -50,8 +50,10 @@ ECCENTRICITY = "eccentricity"
 SPACINGS = ("linear", "log")
 
 # fields offered, by path pattern: name on screen, unit on screen, SI per screen unit.
-# Other numbers of a scene (profile details, creep coefficients, solver settings) are
-# varied from a study file (python -m core sweep).
+# Other numbers of a scene (profile details, a Prony series' terms, solver settings) are
+# varied from a study file (python -m core sweep). The creep coefficients are offered:
+# they are what a back-analysis fits (docs/guides/back_analysis.md; the Fit tab offered
+# none, not even a design code's relative humidity).
 _FIELDS: tuple[tuple[str, str, str, float], ...] = (
     (r"loading\.force", "loading: force P", "kN/m", 1e3),
     (r"loading\.moment", "loading: moment M", "kN·m/m", 1e3),
@@ -66,6 +68,14 @@ _FIELDS: tuple[tuple[str, str, str, float], ...] = (
     (r"coating\[(\d+)\]\.poisson", "coating {k}: Poisson ratio", "-", 1.0),
     (r"base\.age_at_loading", "base: age at loading", "day", 1.0),
     (r"base\.creep\.modulus(_final)?", "base: Young's modulus", "GPa", 1e9),
+    (r"base\.creep\.compliance(_final)?", "base: final creep compliance C∞", "1/GPa",
+     1e-9),
+    (r"base\.creep\.rate", "base: creep rate γ", "1/day", 1.0),
+    (r"base\.creep\.aging", "base: aging creep A", "day/GPa", 1e-9),
+    (r"base\.creep\.beta", "base: modulus aging β", "-", 1.0),
+    (r"base\.creep\.alpha", "base: modulus aging rate α", "1/day", 1.0),
+    (r"base\.creep\.relative_humidity", "base: relative humidity RH", "%", 1.0),
+    (r"base\.creep\.notional_size", "base: notional size h", "mm", 1.0),
     (r"base\.thickness", "base: thickness H", "m", 1.0),
     (r"base\.poisson", "base: Poisson ratio", "-", 1.0),
     (r"punch\.half_width", "punch: half-width a", "m", 1.0),
@@ -213,7 +223,15 @@ def default_range(choice: Choice, scene: Mapping[str, Any] | None = None) -> Axi
         return Axis(choice.key, 0.0, round(half_width / 3 if v == 0 else 2 * abs(v), 6), 9)
     if v == 0:
         return Axis(choice.key, 0.0, 1.0, 9)
-    return Axis(choice.key, 0.5 * v, 1.5 * v, 9)
+    low, high = _BOUNDED.get(choice.key, (-math.inf, math.inf))
+    return Axis(choice.key, max(0.5 * v, low), min(1.5 * v, high), 9)
+
+
+#: Fields whose values the scene bounds [screen units]: their first range stays inside
+#: (a relative humidity of 60 % gave 30 to 90 %, below the codes' 40 %; SCENES.md).
+_BOUNDED = {"base.creep.relative_humidity": (40.0, 100.0),
+            "base.creep.notional_size": (50.0, 1500.0),
+            "base.creep.beta": (0.0, 0.95)}
 
 
 def _axis_values(axis: Axis, field: str) -> np.ndarray:
