@@ -63,7 +63,8 @@ class ContactDrawing:
         # in the base's corner: the load's arrow and its label use the top of the drawing
         self.scene_legend = legend_inside(scene_fig, "bottom_right", "11px")
         # beside the punch, just above the coating (placed at each time, see show_time)
-        self.zone_label = Label(x=0, y=0, text="", text_font_size="11px", y_offset=6,
+        self.zone_label = Label(x=0, y=0, text="", text_font_size="11px", x_offset=4,
+                                y_offset=-6, text_baseline="top",
                                 text_color="#333", background_fill_color="white",
                                 background_fill_alpha=0.7, name="contact_zone_label",
                                 level=MOVING)
@@ -144,10 +145,11 @@ class ContactDrawing:
                                     "ys": [p[1] for p in pieces]}
         t = float(view.times[index])
         width = float(self._widths[index]) if index < len(self._widths) else 2 * a
-        # at the drawing's left edge: 0.52 of the widest punch's half-width left of the
-        # loaded stretch (-1.52 a for one punch)
+        # at the drawing's left edge (0.52 of the widest punch's half-width left of the
+        # loaded stretch, -1.52 a for one punch), just below the base's top: above the
+        # surface it ran over the leftmost punch and its load's label at 1024 px
         widest = max((p.half_width for p in view.punches), default=a)
-        self.zone_label.update(x=view.span[0] - 0.52 * widest, y=float(np.max(y)))
+        self.zone_label.update(x=view.span[0] - 0.52 * widest, y=0.0)
         if width < 2 * a and lifted:
             self.zone_label.text = f"contact {width:.3f} m of {2 * a:.3g} m at t = {days_text(t)}"
         elif lifted:

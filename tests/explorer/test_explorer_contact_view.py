@@ -56,6 +56,10 @@ def test_the_bar_under_the_punch_is_the_contact_set_and_follows_the_time() -> No
     (xs0,) = drawing.zone_src.data["xs"]
     assert xs0[0] == view.contact_set[0][0][0] != start
     assert "contact 1.306 m of 2 m at t = 0 days" == drawing.zone_label.text
+    # written into the base just below its top, at the drawing's left: above the surface
+    # it ran over the leftmost punch and its load's label at 1024 px (two footings)
+    label = drawing.zone_label
+    assert (label.y, label.text_baseline) == (0.0, "top") and label.y_offset < 0
 
 
 def test_full_contact_draws_one_bar_over_the_whole_width() -> None:
