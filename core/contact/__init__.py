@@ -33,6 +33,7 @@ from core.contact.switch import (
 )
 from core.contact.unilateral import CONTACT_MODELS, solve_unilateral
 from core.contact.zones import (
+    LOCATING_ZONE_ENDS,
     ZONE_EDGE_WIDTH,
     ZONE_END_TOL,
     ZONE_PANEL_WIDTH,
@@ -43,6 +44,7 @@ from core.contact.zones import (
 __all__ = [
     "check_contact_model",
     "CONTACT_MODELS",
+    "LOCATING_ZONE_ENDS",
     "predicted_unilateral",
     "refuse_loads_without_contact",
     "Resolution",

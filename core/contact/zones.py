@@ -30,6 +30,9 @@ from core.work import check_work
 
 #: Accuracy aimed at for every free zone end [half-widths] (issue 13).
 ZONE_END_TOL = 1e-6
+#: What a zone solve says it was doing when the solve's work bound stops it (the scene
+#: level then names the punch's shape: ``core.scene.pipeline``).
+LOCATING_ZONE_ENDS = "locating the ends of"
 #: Quasi-Newton iterations on the zone ends per resolution level.
 MAX_END_ITERATIONS = 25
 #: The last quasi-Newton step on the ends is not made when it would move them by less
@@ -129,7 +132,7 @@ def solve_on_zones(space: Space, step: Step, ends: Sequence[float],
     """
     # each solve is dense in every zone's nodes (a wavy punch touching at 47 crests: 3000
     # to 5800 nodes, 0.4-3 s a solve): the solve's work bound is checked before each
-    check_work(f"locating the ends of {len(ends) // 2} contact zone(s)")
+    check_work(f"{LOCATING_ZONE_ENDS} {len(ends) // 2} contact zone(s)")
     panels = zone_panels(space, ends, res)
     x = panels.nodes
     op = kernel_operator(space.lam, panels, accuracy=accuracy).matrix
@@ -365,7 +368,7 @@ def refine_ends(problem: Any, ends: list[float], pinned: list[bool], slopes: lis
 
 def _moved_ends_error(problem: Any, sol: Any, ends: list[float], free: list[int],
                       inward: np.ndarray, end_error: float, res: Any,
-                      tol: float = 0.0) -> tuple[float, int]:
+                      tol: float) -> tuple[float, int]:
     """The change of the outputs when each free end moves by its estimated error (into
     the zone), summed over the ends: the part of the outputs' error the ends make; and
     the solves it took.

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from core.contact import LOCATING_ZONE_ENDS
 from core.engines.layered import LiftOffNotAnswered, solve_scene_layered
 from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
@@ -98,7 +99,8 @@ def _costly(scene: Scene, exc: WorkLimitExceeded) -> str:
     touching at its crests: every zone's nodes in one dense system), else a load that
     varies in time (the usual cause: lift-off under creep follows it step by step), else
     the tolerance."""
-    if "contact zone" in exc.doing and getattr(scene.shape, "kind", None) != "constant":
+    if exc.doing.startswith(LOCATING_ZONE_ENDS) and getattr(scene.shape, "kind",
+                                                            None) != "constant":
         return (f"punch.shape: {exc}; a shape that touches the coating in fewer places "
                 "(fewer waves or steps under the punch, a narrower punch), a looser "
                 "solver.tol, or solver.contact 'full' costs less")

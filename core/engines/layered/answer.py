@@ -202,10 +202,10 @@ def solve_scene_layered(scene: Any, problem: Any) -> ContactSolution | None:
     if lost and scene.contact in ("auto", "unilateral"):
         if layers:
             return None  # the thin layer's unilateral solver answers
-        pulls = max(error_estimate, LIFT_OFF_SHARE) * scale
         clear = _held_clear(problem, times)
         if clear is not None:
             return _no_contact(scene, problem, times, clear, start)
+        pulls = max(error_estimate, LIFT_OFF_SHARE) * scale
         if history is not None:
             return _bare_creep_lift_off(scene, problem, times, answer, regular_part, pulls,
                                         start)
