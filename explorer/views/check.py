@@ -10,7 +10,7 @@ import panel as pn
 from ..model import DesignLimits, ExplorerState, Screen, screen_limits
 from .punches import OnePunchOnly
 from .style import TAB_COLUMN, html_pane
-from .widgets import next_tick
+from .widgets import NumberBox, next_tick
 
 
 class CheckView:
@@ -31,7 +31,7 @@ class CheckView:
         self.settlement_limit = self._limit("settlement limit [mm]", "settlement_limit",
                                             "limit-settlement")
         self.tilt_limit = self._limit("tilt limit [mrad]", "tilt_limit", "limit-tilt")
-        self.eccentricity = pn.widgets.FloatInput(
+        self.eccentricity = NumberBox(
             label="eccentricity e = M/P [m] (sets the moment)", value=None,
             sizing_mode="stretch_width", css_classes=["eccentricity-input"])
         self._showing = False  # the box follows the loads: not a value typed
@@ -46,16 +46,15 @@ class CheckView:
         for name, value in screen_limits(spec).items():
             getattr(self, name).value = value
 
-    def _limit(self, label: str, name: str, css: str) -> pn.widgets.FloatInput:
+    def _limit(self, label: str, name: str, css: str) -> NumberBox:
         # no lower bound on the box: the page would clamp -5 to 0 unsaid, a limit that
         # every answer fails; a negative value is refused here, saying so
-        box = pn.widgets.FloatInput(label=label, value=None, sizing_mode="stretch_width",
-                                    css_classes=[css])
+        box = NumberBox(label=label, value=None, sizing_mode="stretch_width",
+                        css_classes=[css])
         box.param.watch(lambda e: self._on_limit(box, label, name, e), "value")
         return box
 
-    def _on_limit(self, box: pn.widgets.FloatInput, label: str, name: str,
-                  event: Any) -> None:
+    def _on_limit(self, box: NumberBox, label: str, name: str, event: Any) -> None:
         value = event.new
         if value is not None and value != value:
             value = None  # an emptied box: the page sends NaN; not checked

@@ -23,6 +23,7 @@ from ..model import (
     CodeCreepState,
     creep_coefficient_data,
 )
+from .widgets import NumberBox
 
 __all__ = ["CodeCreepPanel", "creep_coefficient_figure", "update_creep_figure"]
 
@@ -71,17 +72,17 @@ class CodeCreepPanel:
         self.strength_class = b.add("strength_class", pn.widgets.Select(
             label="strength class (or f_cm)", options=list(STRENGTH_CLASSES) + ["fcm"],
             sizing_mode="stretch_width", css_classes=["code-strength"]))
-        self.fcm = b.add("fcm", pn.widgets.FloatInput(
+        self.fcm = b.add("fcm", NumberBox(
             label="mean strength f_cm [MPa]", step=1.0, sizing_mode="stretch_width"))
         self.cement = b.add("cement", pn.widgets.Select(
             label="cement class", options={"S (slow)": "S", "N (normal)": "N", "R (rapid)": "R"},
             sizing_mode="stretch_width"))
-        self.relative_humidity = b.add("relative_humidity", pn.widgets.FloatInput(
+        self.relative_humidity = b.add("relative_humidity", NumberBox(
             label="relative humidity RH [%]", step=5.0, sizing_mode="stretch_width",
             css_classes=["code-rh"]))
-        self.notional_size = b.add("notional_size", pn.widgets.FloatInput(
+        self.notional_size = b.add("notional_size", NumberBox(
             label="notional size h = 2A/u [mm]", step=10.0, sizing_mode="stretch_width"))
-        self.temperature = b.add("temperature", pn.widgets.FloatInput(
+        self.temperature = b.add("temperature", NumberBox(
             label="temperature T [°C]", step=1.0, sizing_mode="stretch_width"))
         b.bind(base.code)
         self.figure, self.source = creep_coefficient_figure()

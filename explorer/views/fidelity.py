@@ -15,7 +15,7 @@ from typing import Any
 import panel as pn
 
 from explorer.model import CONTACT_MODELS, INTERFACES, MODEL_TOL_RANGE, ExplorerState, LayerState
-from explorer.views.widgets import Binding
+from explorer.views.widgets import Binding, NumberBox
 
 #: What each contact model means, as the selector shows it.
 CONTACT_LABELS: dict[str, str] = {
@@ -48,7 +48,7 @@ class FidelityView:
             label="contact model", options={v: k for k, v in CONTACT_LABELS.items()},
             sizing_mode="stretch_width", css_classes=["contact-select"]))
         low, high = (100.0 * v for v in MODEL_TOL_RANGE)
-        self.model_tol = self.solver_binding.add("model_tol_percent", pn.widgets.FloatInput(
+        self.model_tol = self.solver_binding.add("model_tol_percent", NumberBox(
             label="coating-model tolerance [%]", start=low, end=high, step=0.5,
             sizing_mode="stretch_width", css_classes=["model-tol-input"]), live=True)
         self.solver_binding.bind(state)

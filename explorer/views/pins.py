@@ -17,7 +17,7 @@ from ..plots import PIN_COLORS
 from ..solving import SolveController, format_error
 from .loop import PageLoop
 from .style import html_pane
-from .widgets import NAMES
+from .widgets import NAMES, CountBox, NumberBox
 
 #: How the notices of "Pin the steps" begin: steps refused as asked, a step refused by
 #: the solver (both cleared once steps are pinned as asked).
@@ -55,14 +55,14 @@ class PinsView:
         # "pin 5 steps of the force from A to B": a class sees a load's effect at once
         self.steps_label = html_pane("", margin=(8, 5, 0, 5), css_classes=["pin-steps-label"])
         number = {"width": 62, "margin": (0, 3)}
-        self.step_count = pn.widgets.IntInput(label="steps", value=5, start=2, end=MAX_PINS,
-                                              css_classes=["pin-steps-count"], **number)
+        self.step_count = CountBox(label="steps", value=5, start=2, end=MAX_PINS,
+                                   css_classes=["pin-steps-count"], **number)
         # empty until the first result fills them around its load (a box that starts at
         # 0 would step from 0 to 0)
-        self.step_from = pn.widgets.FloatInput(label="from", value=None,
-                                               css_classes=["pin-steps-from"], **number)
-        self.step_to = pn.widgets.FloatInput(label="to", value=None,
-                                             css_classes=["pin-steps-to"], **number)
+        self.step_from = NumberBox(label="from", value=None, css_classes=["pin-steps-from"],
+                                   **number)
+        self.step_to = NumberBox(label="to", value=None, css_classes=["pin-steps-to"],
+                                 **number)
         self._stepped: str | None = None  # the load the boxes were filled for
         self.steps_button = pn.widgets.Button(label="Pin the steps", color="default",
                                               css_classes=["pin-steps-button"])

@@ -38,6 +38,7 @@ from ..plots import DesignChart, design_chart_png, flag_note
 from ..solving import SolveController, StudyRun, format_error
 from .loop import PageLoop
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
+from .widgets import CountBox, NumberBox
 
 #: The second parameter's choice for "no second parameter".
 NONE = "(none: a line over parameter 1)"
@@ -57,13 +58,13 @@ class _AxisInputs:
                                        css_classes=[f"{css}-field"])
         # four boxes and their margins in the sidebar's width (the spacing once ran ~70 px
         # past it, into the scene's axis label)
-        self.start = pn.widgets.FloatInput(label="from", width=64, css_classes=[f"{css}-from"])
-        self.stop = pn.widgets.FloatInput(label="to", width=64, css_classes=[f"{css}-to"])
+        self.start = NumberBox(label="from", width=64, css_classes=[f"{css}-from"])
+        self.stop = NumberBox(label="to", width=64, css_classes=[f"{css}-to"])
         # no bounds on the box: a count the study refuses ("points: must be a whole
         # number from 2 to ...") is said when it runs; with start=2 the box kept a typed 1
         # or 0 while the study ran on the last count taken, without a word
-        self.count = pn.widgets.IntInput(label="points", value=9, width=66,
-                                         css_classes=[f"{css}-count"])
+        self.count = CountBox(label="points", value=9, width=66,
+                              css_classes=[f"{css}-count"])
         # (its text once touched the arrow: a narrower left padding than the theme's 12 px)
         self.spacing = pn.widgets.Select(label="spacing", options=list(SPACINGS), width=68,
                                          css_classes=[f"{css}-spacing"],

@@ -26,8 +26,8 @@ from ..solving import mark
 from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
 
 __all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
-           "EditableIntSlider", "EditableSlider", "HistoryEditor", "LazySlider",
-           "ProfileEditor", "TimePlayer", "slider", "watch_release"]
+           "CountBox", "EditableIntSlider", "EditableSlider", "HistoryEditor", "LazySlider",
+           "NumberBox", "PLAYER_BUTTONS", "ProfileEditor", "TimePlayer", "slider", "watch_release"]
 
 
 # Panel holds every change from the browser for 50 ms before handling it, to gather a
@@ -63,7 +63,32 @@ class PromptFloatSlider(pn.widgets.FloatSlider):
                                                    if p != "value_throttled")
 
 
-class PromptFloatInput(pn.widgets.FloatInput):
+# BokehJS draws a number box's arrows as empty buttons: no accessible name. Generated
+# content, clipped out of sight, names them (see _PLAYER_LABELS_CSS).
+_SPIN_LABELS_CSS = "\n".join([
+    ".bk-spin-btn::after { position: absolute; width: 1px; height: 1px; overflow: hidden;"
+    " clip-path: inset(50%); white-space: nowrap; }",
+    '.bk-spin-btn-up::after { content: "Increase"; }',
+    '.bk-spin-btn-down::after { content: "Decrease"; }'])
+
+
+class NumberBox(pn.widgets.FloatInput):
+    """A FloatInput whose arrow buttons are named."""
+
+    def __init__(self, **params: Any) -> None:
+        params["stylesheets"] = [*params.get("stylesheets", []), _SPIN_LABELS_CSS]
+        super().__init__(**params)
+
+
+class CountBox(pn.widgets.IntInput):
+    """An IntInput whose arrow buttons are named."""
+
+    def __init__(self, **params: Any) -> None:
+        params["stylesheets"] = [*params.get("stylesheets", []), _SPIN_LABELS_CSS]
+        super().__init__(**params)
+
+
+class PromptFloatInput(NumberBox):
     """A FloatInput whose browser changes are handled at once (no 50 ms debounce)."""
 
     _debounce = 0
@@ -79,17 +104,43 @@ class PromptIntSlider(pn.widgets.IntSlider):
     tooltips = param.Boolean(default=False, doc="Whether the handle shows its value.")
 
 
-class PromptIntInput(pn.widgets.IntInput):
+class PromptIntInput(CountBox):
     """An IntInput whose browser changes are handled at once (no 50 ms debounce)."""
 
     _debounce = 0
     _busy__ignore = _NOT_BUSY
 
 
+#: What each of the time player's buttons does, by the button's class in Panel's player.
+PLAYER_BUTTONS = {"slower": "Slower", "first": "First time", "previous": "Previous time",
+                  "reverse": "Play backwards", "pause": "Pause", "play": "Play",
+                  "next": "Next time", "last": "Last time", "faster": "Faster"}
+
+# Panel draws the player's buttons as bare icons: no title, no accessible name. Generated
+# content names a button (browsers read it into the accessible name) and shows as a small
+# tooltip on hover or keyboard focus; otherwise it is clipped out of sight.
+_PLAYER_LABELS_CSS = "\n".join([
+    "button { position: relative; }",
+    "button::after { position: absolute; left: 50%; bottom: calc(100% + 3px);"
+    " transform: translateX(-50%); white-space: nowrap; pointer-events: none; z-index: 10;"
+    " font-size: 11px; line-height: 1.3; color: #fff; background: #333;"
+    " border-radius: 3px; width: 1px; height: 1px; overflow: hidden;"
+    " clip-path: inset(50%); }",
+    "button:hover::after, button:focus-visible::after { width: auto; height: auto;"
+    " overflow: visible; clip-path: none; padding: 1px 5px; }",
+    *(f'button.{name}::after {{ content: "{label}"; }}'
+      for name, label in PLAYER_BUTTONS.items())])
+
+
 class TimePlayer(pn.widgets.Player):
-    """The player of the output times, left out of Panel's busy count (see above)."""
+    """The player of the output times, left out of Panel's busy count (see above), its
+    buttons named (``PLAYER_BUTTONS``)."""
 
     _busy__ignore = _NOT_BUSY
+
+    def __init__(self, **params: Any) -> None:
+        params["stylesheets"] = [*params.get("stylesheets", []), _PLAYER_LABELS_CSS]
+        super().__init__(**params)
 
 
 class EditableSlider(pn.widgets.EditableFloatSlider):

@@ -191,3 +191,47 @@ def test_three_pins_columns_can_be_reached_at_1024px(page: Page) -> None:
     assert box["overflow"] == "auto" and box["scroll"] > box["client"], box
     assert box["last"] <= box["right"] + 1, box  # scrolled, the last column is in view
     assert page.errors == []
+
+
+def _unnamed_buttons(page: Page) -> list[str]:
+    """The buttons of the page without an accessible name (Chromium's own computation),
+    as the start of their HTML and the classes of their widget."""
+    cdp = page.page.context.new_cdp_session(page.page)
+    try:
+        found = []
+        for node in cdp.send("Accessibility.getFullAXTree")["nodes"]:
+            if (node.get("role", {}).get("value") != "button" or node.get("ignored")
+                    or node.get("name", {}).get("value")):
+                continue
+            handle = cdp.send("DOM.resolveNode",
+                              {"backendNodeId": node["backendDOMNodeId"]})["object"]
+            found.append(cdp.send("Runtime.callFunctionOn", {
+                "objectId": handle["objectId"], "returnByValue": True,
+                "functionDeclaration": "function () { const host = this.getRootNode().host;"
+                " return this.outerHTML.slice(0, 80) + ' in ' +"
+                " (host ? host.className : ''); }"})["result"]["value"])
+        return found
+    finally:
+        cdp.detach()
+
+
+def test_every_button_has_a_name_the_players_in_a_tooltip(page: Page) -> None:
+    """The time player's buttons were bare icons and the number boxes' arrows empty
+    buttons: a screen reader read "button" twelve times, a teacher had no hint on hover."""
+    from explorer.views.widgets import PLAYER_BUTTONS
+
+    # each tab with number boxes, once one of its boxes is drawn
+    for tab, box in (("Scene", ".pin-steps-count"), ("Check", ".limit-settlement"),
+                     ("Study", ".study-p1-count")):
+        page.open_tab(tab)
+        until(lambda box=box: page.page.locator(box).first.is_visible(), f"{box} shown")
+        assert _unnamed_buttons(page) == [], tab
+    page.open_tab("Scene")
+    for label in PLAYER_BUTTONS.values():
+        assert page.page.get_by_role("button", name=label, exact=True).count() == 1, label
+    play = page.page.get_by_role("button", name="Play", exact=True).first
+    shown = "b => getComputedStyle(b, '::after').clipPath"
+    assert play.evaluate(shown) != "none"       # out of sight until pointed at
+    play.hover()
+    until(lambda: play.evaluate(shown) == "none", "the tooltip shown on hover")
+    assert page.errors == []
