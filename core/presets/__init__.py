@@ -45,6 +45,10 @@ def study_names() -> tuple[str, ...]:
     return _names("studies")
 
 
+#: What one of each kind of shipped file is called in a message.
+_ONE = {"scenes": "scene", "studies": "study"}
+
+
 def _known(kind: str) -> str:
     """The shipped names of ``kind``, as the refusal of another name lists them."""
     return f"known: {', '.join(_names(kind))}"
@@ -52,10 +56,10 @@ def _known(kind: str) -> str:
 
 def _read(kind: str, name: str) -> dict[str, Any]:
     if name not in _names(kind):
-        raise KeyError(f"no shipped {kind[:-1]} named {name!r}; {_known(kind)}")
+        raise KeyError(f"no shipped {_ONE[kind]} named {name!r}; {_known(kind)}")
     data = json.loads(_folder(kind).joinpath(f"{name}.json").read_text(encoding="utf-8"))
     if not isinstance(data, dict):
-        raise ValueError(f"the shipped {kind[:-1]} {name!r} is not a JSON object")
+        raise ValueError(f"the shipped {_ONE[kind]} {name!r} is not a JSON object")
     return data
 
 
@@ -89,6 +93,6 @@ def shipped_file(path: str | os.PathLike, kind: str) -> str | os.PathLike:
         return path
     name = path[len(PRESET_PREFIX):]
     if name not in _names(kind):
-        raise ValueError(f"{path}: no shipped {kind[:-1]} of that name; {_known(kind)}")
+        raise ValueError(f"{path}: no shipped {_ONE[kind]} of that name; {_known(kind)}")
     # an installed package is a folder of files (a wheel unpacks; a zipped one would not do)
     return Path(str(_folder(kind).joinpath(f"{name}.json")))

@@ -83,11 +83,11 @@ FLAG_MESSAGES: dict[str, str] = {
                   "doubtful.",
     "model_error": "The estimated error of the thin-coating model (info.model_error_estimate, "
                    "from measurements against a resolved finite-element model) exceeds "
-                   "solver.model_tol: check the coating model (python -m core check).",
+                   "solver.model_tol: check the coating model (coated-punch check).",
     "beyond_model_map": "The coating lies outside the range its model's error was measured "
                         "on (info.model_error.beyond_map: softer or stiffer against the base, or "
                         "nearer to incompressible): the estimate is an extrapolation. "
-                        "Measure it: python -m core check, or the explorer's coating check.",
+                        "Measure it: coated-punch check, or the explorer's coating check.",
     "tol_not_met": "The solver could not reach the requested tolerance: see info.message.",
     "unresolved_input": "A profile has features finer than the quadrature resolves: "
                         "see info.message.",

@@ -287,7 +287,7 @@ def plan_study(scene: Mapping[str, Any], axes: Sequence[Axis],
         raise ValueError(f"parameter {len(axes)}, points: the study has {n:,} points ("
                          + " x ".join(str(len(v)) for v in values) + f"), more than the "
                          f"limit of {max_points:,} of this page; use fewer points, or run "
-                         "it from a study file (python -m core sweep)")
+                         "it from a study file (coated-punch sweep)")
     vary = []
     for c, v in zip(choices, values, strict=True):
         if c.key == ECCENTRICITY:

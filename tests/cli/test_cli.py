@@ -344,7 +344,7 @@ def test_the_command_line_section_of_the_format_lists_every_command() -> None:
     text = (root / "core" / "SCENES.md").read_text(encoding="utf-8")
     section = text[text.index("## Command line"):]
     synopsis = section[:section.index("Exit codes")]
-    listed = set(re.findall(r"python -m core ([a-z]\w*)", synopsis))
+    listed = set(re.findall(r"coated-punch ([a-z]\w*)", synopsis))
     assert listed == set(commands), sorted(set(commands) ^ listed)
     for page in ("docs/reference/cli.md", "docs/getting_started.md"):
         row = next(line for line in (root / page).read_text(encoding="utf-8").splitlines()
