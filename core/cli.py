@@ -87,6 +87,7 @@ from core.scene import (
     schema_errors,
     schema_text,
     solve,
+    verdict_words,
 )
 from core.version import VERSION
 
@@ -256,7 +257,7 @@ def _punches_summary(result: PunchesSolution) -> str:
         lines.append(f"  flags: {', '.join(punch.flags) if punch.flags else 'none'}")
         if checks[k] is not None:
             lines.append(f"  design check (whole history): "
-                         f"{'pass' if checks[k].passed else 'FAIL'}")
+                         f"{verdict_words(checks[k].passed, punch.flags)}")
             lines.extend(f"    {line.describe()}" for line in checks[k].checks)
     lines.append(f"coating model: {result.info.get('coating_model')}")
     return "\n".join(lines)
@@ -287,7 +288,7 @@ def _summary(result: SceneSolution) -> str:
     check = result.design_check()
     if check is not None:
         lines.append(f"design check (whole history): "
-                     f"{'pass' if check.passed else 'FAIL'}")
+                     f"{verdict_words(check.passed, result.flags)}")
         lines.extend(f"  {line.describe()}" for line in check.checks)
     return "\n".join(lines)
 

@@ -4,7 +4,7 @@ with a check, as plain text rows (the HTML and PDF writers only lay them out).""
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from datetime import datetime, timezone
 from typing import Any
@@ -18,6 +18,7 @@ from core.scene import (
     PunchesSolution,
     SceneSolution,
     engine_text,
+    flagged_caution,
     flags_with_evidence,
     largest_pressure,
     model_error_evidence,
@@ -152,15 +153,20 @@ def _check_line(line: Any) -> str:
     return line.verdict_text(number=_number, shown=_shown, day="d")
 
 
-def design_section(result: SceneSolution) -> Section | None:
-    """The design check against the scene's limits, or None when the scene sets none."""
+def design_section(result: SceneSolution, flags: Sequence[str] | None = None
+                   ) -> Section | None:
+    """The design check against the scene's limits, or None when the scene sets none;
+    ``flags``: the answer's validity flags as the report shows them (default its own),
+    under which the verdict is qualified (:func:`core.scene.flagged_caution`)."""
     check = result.design_check()
     if check is None:
         return None
     rows = [(line.label, _check_line(line)) for line in (*check.checks, check.q_min)]
     failed = check.passed is False
-    return Section("Design check", "A limit is exceeded." if failed else
-                   "Every limit the scene sets holds.", rows, tone="bad" if failed else "good")
+    caution = flagged_caution(result.flags if flags is None else flags)
+    lead = "A limit is exceeded" if failed else "Every limit the scene sets holds"
+    return Section("Design check", f"{lead}, {caution}." if caution else f"{lead}.", rows,
+                   tone="bad" if failed or caution else "good")
 
 
 def calibration_section(calibration: Any) -> Section:
@@ -252,7 +258,7 @@ def sections(result: SceneSolution | PunchesSolution, time: float | None = None,
     else:
         out.append(Section("Validity", "No validity flag: the model stands behind this "
                            "result.", tone="good"))
-    design = design_section(result)
+    design = design_section(result, flags)
     if design is not None:
         out.append(design)
     out.append(Section("Results", rows=key_numbers(result, time)))

@@ -34,6 +34,7 @@ from core.scene import (
     LIFT_OFF_COLOUR,
     PunchesSolution,
     PunchSolution,
+    flagged_caution,
     holoviews_for_bokeh,
     pressure_unit,
     shown_times,
@@ -141,10 +142,11 @@ def punches_sections(result: PunchesSolution, time: float | None = None) -> list
                 for line in (*check.checks, check.q_min)]
         failed = [f"punches[{k}]" for k, check in enumerate(checks)
                   if check is not None and check.passed is False]
-        out.append(Section("Design check",
-                           f"A limit is exceeded under {', '.join(failed)}." if failed else
-                           "Every limit the scene sets holds under every punch.", rows,
-                           tone="bad" if failed else "good"))
+        caution = flagged_caution(result.flags)
+        lead = (f"A limit is exceeded under {', '.join(failed)}" if failed else
+                "Every limit the scene sets holds under every punch")
+        out.append(Section("Design check", f"{lead}, {caution}." if caution else f"{lead}.",
+                           rows, tone="bad" if failed or caution else "good"))
     for k, punch in enumerate(punches):
         view = local_view(punch)
         rows = [("zone", _zone(punch)), (f"at t = {_number(t)} d", _at_time(punch, k_t)),

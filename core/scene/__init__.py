@@ -49,7 +49,9 @@ from core.scene.design import (
     LimitCheck,
     check_design,
     design_check,
+    flagged_caution,
     largest_pressure,
+    verdict_words,
 )
 from core.scene.display import engine_text, known_contact_width, lifts_off_at, percent_text
 from core.scene.evidence import (
@@ -132,6 +134,8 @@ __all__ = [
     "largest_pressure",
     "lifts_off_at",
     "check_design",
+    "flagged_caution",
+    "verdict_words",
     "check_fields",
     "check_loads_touch",
     "check_scene",

@@ -11,7 +11,7 @@ magnitude of the extreme is at most the limit; a limit left out is not checked.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -262,6 +262,26 @@ class DesignCheck:
         """A JSON-able dict: ``passed`` and one entry per line (``checks``, ``q_min``)."""
         return {"passed": self.passed, "checks": [c.to_dict() for c in self.checks],
                 "q_min": self.q_min.to_dict()}
+
+
+def flagged_caution(flags: Sequence[str]) -> str:
+    """What a design check's verdict is worth on an answer carrying the validity ``flags``
+    (its ``flags``; ``solve --strict`` exits 4 on them): "" without any, else the caution
+    to put beside "pass" or "FAIL" (the numbers checked are those the flags doubt: a pad
+    whose model error is 70 % "passed" its pressure limit unqualified)."""
+    if not flags:
+        return ""
+    return (f"on an answer flagged {', '.join(flags)}: the check is only as good as that "
+            "answer, not to be relied on")
+
+
+def verdict_words(passed: bool | None, flags: Sequence[str] = ()) -> str:
+    """A check's verdict in words: "pass", "FAIL" or "no limit set", followed by
+    :func:`flagged_caution` of ``flags`` when there is a verdict and a flag."""
+    if passed is None:
+        return "no limit set"
+    caution = flagged_caution(flags)
+    return ("pass" if passed else "FAIL") + (f" ({caution})" if caution else "")
 
 
 def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,

@@ -13,6 +13,7 @@ import json
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
+from core.scene.design import verdict_words
 from core.scene.validate import scene_from_dict
 from core.version import VERSION
 
@@ -76,10 +77,11 @@ def csv_header(result: Any, what: str) -> str:
              f"{info.get('coating_model', '')}, estimated relative error "
              + (f"{float(estimate):.1e}" if isinstance(estimate, (int, float)) else "n/a")]
     lines.append("# flags: " + (", ".join(result.flags) or "none"))
-    checks = [(f"punches[{k}] ", c) for k, c in enumerate(result.design_checks())] \
-        if several else [("", result.design_check())]
-    for who, check in checks:
+    checks = [(f"punches[{k}] ", c, p.flags) for k, (c, p) in
+              enumerate(zip(result.design_checks(), result.punches, strict=True))] \
+        if several else [("", result.design_check(), result.flags)]
+    for who, check, flags in checks:
         if check is not None:
-            lines.append(f"# {who}design_check: {'pass' if check.passed else 'FAIL'}; "
+            lines.append(f"# {who}design_check: {verdict_words(check.passed, flags)}; "
                          + "; ".join(line.describe() for line in check.checks))
     return "\n".join(lines) + "\n"

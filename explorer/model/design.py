@@ -22,7 +22,7 @@ import numpy as np
 import param
 
 from core.scene import DesignLimits as CoreLimits
-from core.scene import LimitCheck, check_design
+from core.scene import LimitCheck, check_design, flagged_caution
 
 from .contact_zone import contact_widths
 from .results import ResultView
@@ -77,6 +77,8 @@ class DesignCheck:
     checks: list[Check] = field(default_factory=list)
     #: [day after loading] when the contact is narrowest (None: not known)
     narrowest_time: float | None = None
+    #: the answer's validity flags: a verdict on a flagged answer is qualified
+    flags: list[str] = field(default_factory=list)
 
     @property
     def passed(self) -> bool | None:
@@ -164,7 +166,7 @@ def design_check(view: ResultView, limits: DesignLimits | None = None) -> Design
                        contact_width=float(widths[j_narrow]),
                        full_width=2 * view.geometry.half_width,
                        eccentricity=moment / force if force > 0 else None, checks=checks,
-                       narrowest_time=float(view.times[j_narrow]))
+                       narrowest_time=float(view.times[j_narrow]), flags=list(view.flags))
 
 
 def check_html(check: DesignCheck) -> str:
@@ -176,6 +178,9 @@ def check_html(check: DesignCheck) -> str:
         head = "<span class='cp-badge cp-ok check-pass'>✓ all set limits hold</span>"
     else:
         head = "<span class='cp-badge cp-bad check-fail'>✗ a limit is exceeded</span>"
+    caution = flagged_caution(check.flags)
+    if passed is not None and caution:
+        head += f"<span class='cp-badge cp-bad check-flagged'>⚠ {html.escape(caution)}</span>"
     rows = []
     for c in check.checks + [check.q_min]:
         limit = "" if c.limit is None else plain_number(c.limit)

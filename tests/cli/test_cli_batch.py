@@ -156,6 +156,31 @@ def test_strict_fails_a_flagged_answer_and_the_flag_wins() -> None:
     assert "warning: design_check: largest settlement" in both.stderr
 
 
+def test_a_pass_on_a_flagged_answer_is_qualified_everywhere(tmp_path: Path) -> None:
+    """A two-layer pad whose coating model was 70 % off read "design check: pass" and
+    "Every limit the scene sets holds." beside its model_error flag: the verdict on a
+    flagged answer now says what it is worth, in the summary, the CSV and the report."""
+    from core.report import sections
+
+    scene = flagged_scene(settlement_limit=1.0)   # a limit that holds by far
+    summary = run_cli("solve", "-", stdin=json.dumps(scene))
+    assert summary.returncode == EXIT_OK, summary.stderr
+    caution = ("pass (on an answer flagged contact_lost: the check is only as good as "
+               "that answer, not to be relied on)")
+    assert f"design check (whole history): {caution}" in summary.stdout
+    written = run_cli("solve", "-", "-o", tmp_path / "r.csv", stdin=json.dumps(scene))
+    assert written.returncode == EXIT_OK, written.stderr
+    assert f"\n# design_check: {caution}; largest contact pressure" in \
+        (tmp_path / "r.csv").read_text()
+    design = next(s for s in sections(solve(scene)) if s.title == "Design check")
+    assert design.lead == ("Every limit the scene sets holds, on an answer flagged "
+                           "contact_lost: the check is only as good as that answer, not "
+                           "to be relied on.") and design.tone == "bad"
+    plain = next(s for s in sections(solve(quick_scene(settlement_limit=1.0)))
+                 if s.title == "Design check")
+    assert plain.lead == "Every limit the scene sets holds." and plain.tone == "good"
+
+
 def test_strict_in_a_process_of_its_own(tmp_path: Path) -> None:
     q_max, _ = extremes(quick_scene())
     path = tmp_path / "scene.json"

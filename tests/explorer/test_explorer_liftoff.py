@@ -109,3 +109,25 @@ def test_the_check_and_the_readout_write_realistic_values_without_an_exponent() 
     text = check_html(check)
     assert "20750" in text and "30000" in text and "e+0" not in text
     assert _fmt(123456.0) == "123460" and _fmt(0.040812) == "0.040812"
+
+
+def test_the_check_of_a_flagged_answer_says_its_pass_is_not_to_be_relied_on() -> None:
+    """The Check tab read "✓ all set limits hold" beside a model_error flag (a pad whose
+    coating model was 70 % off); the downloads' design_check line likewise."""
+    from explorer.files import histories_csv
+    from explorer.model import DesignLimits, check_html
+
+    state = ExplorerState()
+    scene = json.loads(json.dumps(presets()["eccentric_footing_liftoff"]))
+    scene["solver"]["contact"] = "full"     # the heel's tension kept: contact_lost
+    state.load_scene(scene)
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    assert "contact_lost" in controller.view.flags
+    limits = DesignLimits(settlement_limit=1e3)
+    text = check_html(design_check(controller.view, limits))
+    assert "✓ all set limits hold" in text and "check-flagged" in text
+    assert ("on an answer flagged contact_lost: the check is only as good as that answer, "
+            "not to be relied on") in text
+    assert "# design_check: pass (on an answer flagged contact_lost" in \
+        histories_csv(controller.view, limits)
