@@ -62,6 +62,7 @@ from core.contact.zones import (
     ZoneSolution,
     _walls,
     output_error,
+    pressure_error,
     refine_ends,
     zone_kernel_accuracy,
     zone_panels,
@@ -465,8 +466,13 @@ class CoupledEnds:
         return np.array([res.levels[p].edge for p in self.owner])
 
     def output_error(self, sol: CoupledZones, fine: CoupledZones) -> float:
-        """The largest of the punches' output errors (each punch's kept in ``errors``)."""
-        self.errors = [output_error(a, b) for a, b in zip(sol.parts, fine.parts, strict=True)]
+        """The largest of the punches' output and q errors (each punch's kept in
+        ``errors``; :func:`core.contact.zones.pressure_error` with the others' push)."""
+        self.errors = [max(output_error(a, b),
+                           pressure_error(space, step, a, b, self.accuracy, coupling))
+                       for a, b, space, step, coupling in zip(
+                           sol.parts, fine.parts, self.base.spaces, self.steps,
+                           fine.couplings, strict=True)]
         return max(self.errors)
 
     def moved_error(self, moved: CoupledZones, sol: CoupledZones) -> float:

@@ -77,6 +77,10 @@ def test_many_free_ends_are_moved_on_a_sample_whose_bound_covers_the_sum(monkeyp
         return value, made
 
     monkeypatch.setattr(zones, "_moved_ends_error", recorded)
+    # measured whatever the rules' difference reads (q's change between the rules now
+    # outweighs these ends' error, so the estimate would not move them)
+    monkeypatch.setattr(zones.OnePunch, "needs_moved",
+                        staticmethod(lambda error, end_error: end_error < np.inf))
     sampled = solve(_wavy_scene(3.0))
     sample = zones.MOVED_SAMPLE
     monkeypatch.setattr(zones, "MOVED_SAMPLE", 10**6)
@@ -84,7 +88,7 @@ def test_many_free_ends_are_moved_on_a_sample_whose_bound_covers_the_sum(monkeyp
     (ends, bound, made), (ends_all, total, made_all) = seen
     assert ends == ends_all == 22
     assert made == sample and made_all == 22
-    # measured: the bound 4.8e-14, the sum of the 22 changes 7.3e-15
+    # measured: the bound 7.4e-14, the sum of the 22 changes 1.3e-14
     assert total <= bound <= zones.MOVED_NEGLIGIBLE * 1e-3
     assert sampled.info["success"] and len(sampled.contact_set[0]) == 12
     np.testing.assert_array_equal(sampled.settlement, exact.settlement)
