@@ -80,11 +80,19 @@ def load_scene(path: str | os.PathLike) -> Scene | PunchesScene:
     return parse_scene_json(text, str(path))
 
 
-def scene_to_json(scene: Scene | Mapping[str, Any], schema: str | None = None) -> str:
-    """The canonical JSON text of a scene (validated first when given as a dict);
-    ``schema``: a ``"$schema"`` to write first (the file's JSON Schema, for editors)."""
-    scene = scene_from_dict(scene)
-    data = scene.to_dict()
+def scene_to_json(scene: Scene | PunchesScene | Mapping[str, Any],
+                  schema: str | None = None) -> str:
+    """The canonical JSON text of a scene, of one punch or several (validated first when
+    given as a dict); ``schema``: a ``"$schema"`` to write first (the file's JSON Schema,
+    for editors)."""
+    from core.scene.punches import PunchesScene, has_punches, punches_from_dict
+
+    if isinstance(scene, PunchesScene):
+        data = scene.to_dict()
+    elif isinstance(scene, Mapping) and has_punches(scene):
+        data = punches_from_dict(scene).to_dict()
+    else:
+        data = scene_from_dict(scene).to_dict()
     if schema is not None:
         if not isinstance(schema, str):
             raise ValueError(f"{SCHEMA_KEY}: must be a string, got {type(schema).__name__}")
@@ -92,9 +100,10 @@ def scene_to_json(scene: Scene | Mapping[str, Any], schema: str | None = None) -
     return json.dumps(data, indent=2, allow_nan=False) + "\n"
 
 
-def save_scene(scene: Scene | Mapping[str, Any], path: str | os.PathLike,
+def save_scene(scene: Scene | PunchesScene | Mapping[str, Any], path: str | os.PathLike,
                schema: str | None = None) -> None:
-    """Write a scene as JSON to ``path`` atomically (a dict is validated first).
+    """Write a scene (of one punch or several, as :func:`load_scene` reads them) as JSON
+    to ``path`` atomically (a dict is validated first).
 
     ``schema``: a ``"$schema"`` to write first, naming the file's JSON Schema for an
     editor (e.g. the relative path of ``scene.schema.json``, see core/SCENES.md); the

@@ -533,3 +533,14 @@ def test_the_time_steps_land_on_a_jump_of_any_punchs_loads(monkeypatch) -> None:
     assert jumps  # the second punch's force steps up at 365.25 days
     core.solve(d)
     assert seen and all(set(breaks) == jumps for breaks in seen)
+
+
+def test_a_scene_of_several_punches_saves_as_it_loads(tmp_path) -> None:
+    """``save_scene`` refused what ``load_scene`` gave ("scene: must be a JSON object, got
+    PunchesScene(...)", a 15 KB message); its dict was refused too."""
+    scene = core.load_scene("preset:new_footing_beside_old")
+    core.save_scene(scene, tmp_path / "object.json")
+    core.save_scene(scene.to_dict(), tmp_path / "dict.json")
+    assert (tmp_path / "object.json").read_text() == (tmp_path / "dict.json").read_text()
+    again = core.load_scene(tmp_path / "object.json")
+    assert type(again) is type(scene) and again.to_dict() == scene.to_dict()
