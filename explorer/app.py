@@ -167,6 +167,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.history = SceneHistory(self.state)
         self.figures = Figures(self.scales)
         self._initial_scene(scene, query or {})
+        self.state.param.watch(lambda _: self.screen.scene_changed(), "revision")
         self.link = AddressLink(self.screen, self.controller, self.loop,
                                 pn.state.location if self.loop.served else None,
                                 self._view_parts)

@@ -6,6 +6,9 @@ import param
 
 from .results import ResultView
 
+#: How the notice of a refused value begins.
+REFUSED = "Value not accepted: "
+
 
 class Screen(param.Parameterized):
     """The session's screen, shared by its views: the result on screen (what downloads,
@@ -34,4 +37,10 @@ class Screen(param.Parameterized):
 
     def reject(self, message: str) -> None:
         """Say on the page that a value typed or dragged was refused, and why."""
-        self.notice = f"Value not accepted: {message}"
+        self.notice = f"{REFUSED}{message}"
+
+    def scene_changed(self) -> None:
+        """A change of the scene was taken (a value typed again, a step, an undo, a reset,
+        a preset): a refusal on screen is over (it read "it stays 500" beside P = 600)."""
+        if self.notice.startswith(REFUSED):
+            self.notice = ""

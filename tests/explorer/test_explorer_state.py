@@ -627,3 +627,24 @@ def test_scene_files_load_and_bad_files_explain_themselves(explorer_app):
     assert "shape.csv" in app.punch_tab.shape_note.object
     app.punch_tab.shape_file.value = b"x,f\n-0.5,abc\n0,0\n"
     assert "punch.shape" in app.screen.notice and "line 2" in app.screen.notice
+
+
+def test_a_refusal_on_screen_ends_when_a_value_is_taken(explorer_app):
+    """"Value not accepted: force P [kN/m]: a number is needed (the box was empty); it
+    stays 500" stayed above the plots after 600 was typed and solved (and after an undo
+    or a reset)."""
+    app = explorer_app()
+    box = app.scene_tab.history_editors[0].value._value_edit
+    box.value = None                  # the box emptied
+    assert app.screen.notice.startswith("Value not accepted: ") and "stays" in \
+        app.screen.notice
+    app.scene_tab.history_editors[0].value.value = 600.0
+    assert app.screen.notice == ""
+    box.value = None
+    assert app.screen.notice.startswith("Value not accepted: ")
+    app.history.undo()                # an undo takes a scene too
+    assert app.screen.notice == ""
+    # a notice of another kind (a file, a link) is not a refusal: it stays
+    app.screen.notice = "The file 'x.json' is not text in UTF-8 (a scene file is JSON)."
+    app.scene_tab.history_editors[0].value.value = 650.0
+    assert app.screen.notice.startswith("The file 'x.json'")
