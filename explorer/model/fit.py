@@ -28,6 +28,7 @@ from core.scene import scene_from_dict
 from core.study import apply_point, number_at
 
 from .loading_state import QUANTITY_UNITS
+from .scene_parts import MAX_DESCRIPTION_CHARS, MAX_NAME_CHARS
 from .study import ECCENTRICITY, Choice, study_choices
 from .time_text import plain_number
 
@@ -112,8 +113,18 @@ class FitOutcome:
                 for j in range(n) for k in range(j + 1, n)]
 
     def fitted_scene(self) -> dict[str, Any]:
-        """The scene with the fitted values (the scene's own output times)."""
-        return self.calibration.scene.to_dict()
+        """The scene with the fitted values (the scene's own output times), named as
+        fitted and saying from what: applied, it passed for the scene fitted (a saved
+        file or report kept the preset's name)."""
+        scene = self.calibration.scene.to_dict()
+        name = str(scene.get("name", ""))
+        values = "; ".join(f"{label} = {value} ± {se} {unit}".rstrip()
+                           for label, value, se, unit in self.rows())
+        scene["name"] = f"{name[: MAX_NAME_CHARS - 9]} (fitted)"
+        scene["description"] = (f"Fitted on screen to the readings "
+                                f"{self.calibration.readings.source} from the scene "
+                                f"“{name}”: {values}.")[:MAX_DESCRIPTION_CHARS]
+        return scene
 
     def describes(self, scene: Mapping[str, Any]) -> bool:
         """Whether ``scene`` (a scene dict on screen) is this fit's fitted scene: the
@@ -139,9 +150,10 @@ FITTED_SCENE_RTOL = 1e-9
 
 def _canonical(scene: Mapping[str, Any]) -> str:
     """A scene as the core reads it (defaults filled in: the page leaves some out), as
-    sorted JSON, its name left out (a name does not change an answer)."""
+    sorted JSON, its name and description left out (they do not change an answer)."""
     data = scene_from_dict(dict(scene)).to_dict()
-    return json.dumps({k: v for k, v in data.items() if k != "name"}, sort_keys=True)
+    return json.dumps({k: v for k, v in data.items() if k not in ("name", "description")},
+                      sort_keys=True)
 
 
 def _error_text(se: float) -> str:

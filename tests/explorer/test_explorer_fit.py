@@ -60,8 +60,16 @@ def test_readings_are_drawn_fitted_and_the_fitted_scene_applied(explorer_app):
     assert len(band["t"]) == len(times) and band["t"][-1] == pytest.approx(times[-1])
     assert np.all(np.asarray(band["lower"]) <= np.asarray(band["upper"]))
     assert not tab.apply_button.disabled
+    name = app.state.to_scene()["name"]
     assert tab.apply()
-    assert app.state.to_scene()["coating"][0]["modulus"] == pytest.approx(value, rel=1e-9)
+    scene = app.state.to_scene()
+    assert scene["coating"][0]["modulus"] == pytest.approx(value, rel=1e-9)
+    # named as fitted and saying from what (it kept the preset's name: a saved file or
+    # a report passed for the preset)
+    assert scene["name"] == f"{name} (fitted)"
+    assert scene["description"].startswith(
+        f"Fitted on screen to the readings levelling.csv from the scene “{name}”: "
+        "coating 1: Young's modulus")
 
 
 def test_the_report_carries_the_fit_while_its_fitted_scene_is_shown(explorer_app):
