@@ -70,8 +70,10 @@ def plain_status(view: ResultView) -> str:
     elif len(redone) == len(stages):
         what = f"{took}, everything computed afresh"
     elif set(redone) <= LOAD_STAGES:
-        what = (f"{took}: only the response to the loads was recomputed "
-                "(the geometry and materials were unchanged)")
+        # (reused from an earlier solve of this geometry, not necessarily the last one:
+        # a preset switched to read "the geometry and materials were unchanged")
+        what = (f"{took}: only the response to the loads was recomputed (the geometry "
+                "and materials were solved before and reused)")
     else:
         what = (f"{took}: recomputed {', '.join(redone) or 'nothing'}; "
                 "the rest reused")

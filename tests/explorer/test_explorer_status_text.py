@@ -35,8 +35,11 @@ def test_stage_timings_all_fresh_say_so() -> None:
 def test_times_below_a_millisecond_and_unknown_times() -> None:
     stages = {"grid": {"seconds": 0.007, "cached": True},
               "solve": {"seconds": 0.0004, "cached": False}}
+    # reused from an earlier solve, not said to be unchanged (a preset switched to, its
+    # geometry solved before in the background, read "were unchanged")
     assert plain_status(_view({"seconds": 0.0004, "stages": stages})).startswith(
-        "Solved in under 1 ms: only the response to the loads")
+        "Solved in under 1 ms: only the response to the loads was recomputed (the "
+        "geometry and materials were solved before and reused);")
     assert plain_status(_view({})).startswith("Solved; no accuracy estimate")
 
 
