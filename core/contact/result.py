@@ -16,7 +16,7 @@ import numpy as np
 from core.contact.step import Space, Step, nystrom_pressure
 from core.discretize import Panels
 from core.kernel import FULL_ACCURACY
-from core.problem import SolveOutcome
+from core.problem import SolveOutcome, pressure_positions
 
 #: The unilateral solvers' ``success_margin`` (:func:`core.problem.accepts`): their
 #: Richardson and coarser-rule estimates can read up to ~3x low, as the projection's do.
@@ -111,9 +111,7 @@ class UnilateralSolution(SolveOutcome):
 
         The Nystrom formula on the contact set, exactly 0 off it (dimensionless).
         """
-        x = np.atleast_1d(np.asarray(x, dtype=float))
-        if x.ndim != 1 or np.any(~np.isfinite(x)) or np.any(np.abs(x) > 1.0):
-            raise ValueError("x: pressure is defined on [-1, 1] only")
+        x = pressure_positions(x, len(self._snapshots))
         count = len(self._snapshots)
         out = np.zeros((x.size, count))
         inside = np.zeros((x.size, count), dtype=bool)

@@ -25,7 +25,13 @@ from core.problem.inputs import (
     validate_time_inputs,
     validate_times,
 )
-from core.problem.result import INFO_KEYS, ContactSolution, SolveOutcome, accepts
+from core.problem.result import (
+    INFO_KEYS,
+    ContactSolution,
+    SolveOutcome,
+    accepts,
+    pressure_positions,
+)
 from core.problem.statements import (
     QUANTITIES,
     STATEMENTS,
@@ -43,6 +49,7 @@ __all__ = [
     "Geometry",
     "INFO_KEYS",
     "modal_system",
+    "pressure_positions",
     "ModalSystem",
     "QUANTITIES",
     "Scalar",

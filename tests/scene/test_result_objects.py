@@ -263,3 +263,23 @@ def test_bad_positions_of_the_pressure_are_named(x, message):
     with pytest.raises(ValueError) as info:
         result.pressure(x)
     assert str(info.value).startswith(message), str(info.value)
+
+
+@pytest.mark.parametrize("contact", ["full", "unilateral"])
+def test_the_dimensionless_pressure_is_bounded_as_the_scene_one(contact):
+    """``ContactSolution.pressure`` took any number of points: 5e6 ran 94 s (the scene's
+    solution refuses more than MAX_PRESSURE_VALUES values at once)."""
+    from core import limits
+    from core.solver import solve_dimensionless
+
+    answer = solve_dimensionless(1.0, 0.05, 0.0, [1.0, 2.0], force=1.0, moment=0.5,
+                                 tol=1e-4, contact=contact)
+    too_many = np.zeros(limits.MAX_PRESSURE_VALUES // 2 + 1)
+    with pytest.raises(ValueError, match=r"^x: 2000001 points at 2 times are more than the "
+                                         r"4000000 pressure values one call may compute"):
+        answer.pressure(too_many)
+    with pytest.raises(ValueError, match=r"^x: a number or a list of positions"):
+        answer.pressure(np.zeros((2, 3)))
+    with pytest.raises(ValueError, match=r"^x: pressure is defined on \[-1, 1\] only"):
+        answer.pressure([1.5])
+    assert answer.pressure(0.25).shape == (1, 2)
