@@ -684,7 +684,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
         raise _InputError(f"--time: must be in [0, {end:g}] days after loading (the scene's "
                           f"output times), got {args.time:g}")
     # imported here: a command that checks nothing starts without the FE modules
-    from core.scene import check_scene
+    from core.scene import check_scene, pressure_caution
 
     try:
         report = check_scene(scene, args.time, level=args.level)
@@ -706,7 +706,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
         print(f"{q + '_' + _UNITS[q]:>12} {report['fast'][q]:16.8g} {report['fe'][q]:16.8g} "
               f"{100 * report['errors'][q]:8.2f}%")
     print(f"{'pressure':>12} {'':>16} {'':>16} {100 * report['errors']['pressure']:8.2f}% "
-          "(largest on |x| <= 0.9 a)")
+          f"(largest on |x| <= 0.9 a, at x = {report['pressure_error_at_m']:.4g} m)")
+    caution = pressure_caution(report)
+    if caution:  # the verdict below is of the unknown scalars; q is not among them
+        print(f"warning: pressure: {caution}", file=sys.stderr)
     lift = report.get("lift_off")
     if lift is not None:
         print(f"{'contact':>12} {_zones(lift['fast']):>16} {_zones(lift['fe']):>16} "

@@ -117,11 +117,12 @@ from core.scene.schema import (
 from core.scene.validate import default_tol, replace_loads, scene_from_dict
 
 if TYPE_CHECKING:
-    from core.scene.coating_check import check_scene
+    from core.scene.coating_check import check_scene, pressure_caution
 
 # The finite-element check (and its FE modules), loaded on first use: a solve never
 # needs it, and the command line starts faster without it.
-_LAZY: dict[str, str] = {"check_scene": "core.scene.coating_check"}
+_LAZY: dict[str, str] = {"check_scene": "core.scene.coating_check",
+                         "pressure_caution": "core.scene.coating_check"}
 
 __all__ = [
     "default_tol",
@@ -139,6 +140,7 @@ __all__ = [
     "check_fields",
     "check_loads_touch",
     "check_scene",
+    "pressure_caution",
     "checked_key",
     "flags_with_evidence",
     "model_error_evidence",

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import html
 import logging
 import threading
 from collections.abc import Callable
@@ -10,7 +11,7 @@ from typing import Any
 
 import panel as pn
 
-from core.scene import check_scene, check_settled, checked_key, percent_text
+from core.scene import check_scene, check_settled, checked_key, percent_text, pressure_caution
 
 from ..model import SCREEN_LAYERS, ExplorerState, Screen
 from ..solving import SolveController, run_in_background
@@ -33,8 +34,10 @@ _CHECKS = threading.BoundedSemaphore(MAX_RUNNING_CHECKS)
 #: Rows of the check's table: quantity, unit shown, factor from SI.
 CHECK_ROWS = (("settlement", "mm", 1e3), ("tilt", "mrad", 1e3), ("force", "kN/m", 1e-3),
               ("moment", "kN·m/m", 1e-3))
-#: A value of the check's table below this share of its pair's scale is shown as 0.
-ROUND_OFF = 1e-12
+#: A value of the check's table below this share of its pair's scale is shown as 0: the
+#: FE solve's own round-off (the default scene's centred load: FE tilt -2.09e-15 rad, 8.6e-11
+#: of its settlement over a, read "-2.0939e-12 mrad").
+ROUND_OFF = 1e-9
 
 
 #: What the tab says with no coating layer (the scope of core's bare-base answer).
@@ -153,8 +156,11 @@ def check_report_html(report: dict[str, Any]) -> str:
                  for v in (report["fast"][name], fe[name])]
         rows.append(f"<tr><td>{name} [{unit}]</td><td>{shown[0]:.5g}</td>"
                     f"<td>{shown[1]:.5g}</td><td>{error}</td></tr>")
-    rows.append(f"<tr><td>pressure, |x| &le; 0.9 a</td><td></td><td></td>"
-                f"<td>{100 * errors['pressure']:.3f}</td></tr>")
+    where = report.get("pressure_error_at_m")
+    rows.append("<tr><td>pressure, |x| &le; 0.9 a"
+                + ("" if where is None else f" (largest at x = {where:.4g} m)")
+                + f"</td><td></td><td></td><td>{100 * errors['pressure']:.3f}</td></tr>")
+    caution = pressure_caution(report)
     return (
         f"<div class='coating-check-report'><small>At loading, against the resolved "
         f"finite-element model ({report['fe_dofs']:,} unknowns, "
@@ -163,7 +169,9 @@ def check_report_html(report: dict[str, Any]) -> str:
         f"{percent_text(report['model_error'])}, estimated {percent_text(report['estimate'])}</b>"
         + _contact_note(report)
         + "<table class='cp-readout'><tr><th></th><th>fast</th><th>FE</th><th>error [%]</th>"
-        "</tr>" + "".join(rows) + "</table></div>")
+        "</tr>" + "".join(rows) + "</table>"
+        + (f"<div class='check-pressure-caution' style='color:#9b1c1c;font-size:12px'>"
+           f"⚠ {html.escape(caution)}</div>" if caution else "") + "</div>")
 
 
 def _measured_word(report: dict[str, Any]) -> str:
