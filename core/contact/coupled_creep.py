@@ -57,6 +57,7 @@ from core.contact.creep import (
     _distance,
     _extrapolate,
     _outside_bands,
+    _rule_distance,
     controlled_march,
     creep_verdict,
     free_end_residual,
@@ -150,6 +151,15 @@ class CoupledMarches:
         punch's histories relative to its own size)."""
         pairs = [_distance(one, two) for one, two in zip(a, b, strict=True)]
         return max(d for d, _ in pairs), max(s for _, s in pairs)
+
+    @staticmethod
+    def rule_distance(rules: Sequence[Panels], a: list[dict[str, Any]],
+                      finer: Sequence[Panels], b: list[dict[str, Any]],
+                      bands: Sequence[list[tuple[float, float]]]) -> tuple[float, float]:
+        """The largest over the punches of :func:`core.contact.creep._rule_distance`
+        (``bands``: each punch's)."""
+        pairs = [_rule_distance(*five) for five in zip(rules, a, finer, b, bands, strict=True)]
+        return max(p[0] for p in pairs), max(p[1] for p in pairs)
 
     def end_slope(self, rules: Sequence[Panels], out: list[dict[str, Any]]) -> float:
         """The largest over the punches of :func:`core.contact.creep.free_end_slope`."""

@@ -769,11 +769,13 @@ def test_coarse_start_settles_on_the_set_found_from_full_contact(gap, loads):
 
 
 class _BandStub:
-    """Marches whose checks never agree, on a band 0.1 wide: a rule is its band width,
+    """Marches whose checks never agree on the zone ends (and on the outputs and q off
+    the bands where ``outputs`` is not 0), on a band 0.1 wide: a rule is its band width,
     its nodes 16 per panel over the band."""
 
-    def __init__(self) -> None:
+    def __init__(self, outputs: float = 0.0) -> None:
         self.marched: list[float] = []
+        self.outputs = outputs
 
     def rule(self, res, bands, width):
         return width
@@ -794,13 +796,16 @@ class _BandStub:
     def distance(a, b):
         return 1.0, 1.0
 
+    def rule_distance(self, rule, a, finer, b, bands):
+        return self.outputs, 1.0
+
 
 def test_band_panels_finer_than_0_005_are_a_last_resort(
         monkeypatch: pytest.MonkeyPatch) -> None:
     from core.contact import creep
 
-    def select(slope: float) -> tuple[float, list[float]]:
-        stub = _BandStub()
+    def select(slope: float, outputs: float = 0.0) -> tuple[float, list[float]]:
+        stub = _BandStub(outputs)
         rule, *_ = creep._select_rule(stub, np.array([1.0, 2.0]), None, 4, 1e-6, 1e-6,
                                       bands=[(0.0, 0.1)], slope=slope)
         return rule, stub.marched
@@ -811,6 +816,9 @@ def test_band_panels_finer_than_0_005_are_a_last_resort(
     assert creep.BAND_WIDTHS[-1] == 0.0025 < creep.LAST_RESORT_BELOW == 0.005
     # where it would not (no free end: slope 0), 0.005 stays the last
     assert select(0.0) == (0.005, [0.02, 0.01, 0.005, 0.0025])
+    # ... unless the outputs or q off the bands miss their share: the finer rule, whose
+    # base is finer too, is taken
+    assert select(0.0, outputs=1.0) == (0.0025, [0.02, 0.01, 0.005, 0.0025, 0.00125])
     # a check of more nodes than allowed is not marched
     monkeypatch.setattr(creep, "MAX_CHECK_NODES", 700)
     assert select(1.0) == (0.005, [0.02, 0.01, 0.005, 0.0025])
