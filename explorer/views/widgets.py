@@ -579,6 +579,20 @@ def _fit(widget: pn.widgets.Widget, value: float, default: tuple[float, float]) 
     widget.param.update(start=lo, end=hi)
 
 
+def _refit(widget: pn.widgets.Widget, value: Any, default: tuple[float, float]) -> None:
+    """After a change of ``value``: the default range again once the value is back in
+    it (one typed 1e6 kN/m left the force slider at 0 to 2e6 for good, a pixel ~3,000
+    kN/m), widened only where the value left the range shown."""
+    if not isinstance(value, (int, float)) or not math.isfinite(value):
+        return
+    lo, hi = default
+    if lo <= value <= hi:
+        if (widget.start, widget.end) != (lo, hi):
+            widget.param.update(start=lo, end=hi)
+    elif not widget.start <= value <= widget.end:
+        _fit(widget, value, default)
+
+
 class HistoryEditor:
     """Shape and parameters of the history of one given quantity (live while dragging)."""
 
@@ -601,7 +615,7 @@ class HistoryEditor:
         self.panel = pn.Column(self.title, self.kind, self.value, self.second, self.time,
                                self.note, sizing_mode="stretch_width", margin=0)
         self._watched: HistoryState | None = None
-        self._watcher: Any = None
+        self._watchers: list[Any] = []
         self._time_end = 365.0
         # the table upload of "custom (from file)", made when that kind is first chosen
         # (a file box costs the first page; most scenes never use one)
@@ -614,15 +628,22 @@ class HistoryEditor:
         lo, hi = QUANTITY_RANGES[q]
         step = (hi - lo) / 1000
         self.value.step = self.second.step = step
-        _fit(self.value, history.value, (lo, hi))
-        _fit(self.second, history.second, (min(lo, -hi) if q in ("tilt", "moment") else lo, hi))
+        ranges = {"value": (lo, hi),
+                  "second": (min(lo, -hi) if q in ("tilt", "moment") else lo, hi)}
+        _fit(self.value, history.value, ranges["value"])
+        _fit(self.second, history.second, ranges["second"])
         self.time.end = max(time_end, history.time)
         self._time_end = time_end
         self.binding.bind(history)
-        if self._watched is not None and self._watcher is not None:
-            self._watched.param.unwatch(self._watcher)
+        if self._watched is not None:
+            for watcher in self._watchers:
+                self._watched.param.unwatch(watcher)
         self._watched = history
-        self._watcher = history.param.watch(lambda *e: self.refresh(), ["kind", "custom"])
+        self._watchers = [
+            history.param.watch(lambda *e: self.refresh(), ["kind", "custom"]),
+            history.param.watch(lambda *events: [
+                _refit(getattr(self, e.name), e.new, ranges[e.name]) for e in events],
+                ["value", "second"])]
         self.refresh()
 
     def refresh(self) -> None:

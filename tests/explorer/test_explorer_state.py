@@ -648,3 +648,22 @@ def test_a_refusal_on_screen_ends_when_a_value_is_taken(explorer_app):
     app.screen.notice = "The file 'x.json' is not text in UTF-8 (a scene file is JSON)."
     app.scene_tab.history_editors[0].value.value = 650.0
     assert app.screen.notice.startswith("The file 'x.json'")
+
+
+def test_a_load_slider_returns_to_its_range_after_a_large_value(explorer_app):
+    """1e6 kN/m typed into the force box left the slider at 0 to 2e6 for good (a pixel
+    ~3,000 kN/m), through undo and reset."""
+    app = explorer_app()
+    slider = app.scene_tab.history_editors[0].value
+    home = (slider.start, slider.end)
+    assert home[0] <= 500.0 <= home[1]
+    slider._value_edit.value = 1e6              # typed: the slider widens to show it
+    assert app.state.loading.histories["force"].value == 1e6
+    assert slider.end >= 1e6
+    slider._value_edit.value = 500.0
+    assert app.state.loading.histories["force"].value == 500.0
+    assert (slider.start, slider.end) == home
+    app.state.loading.histories["force"].value = 2e6   # a file's or a link's value
+    assert slider.end >= 2e6 and slider.value == 2e6
+    app.history.undo()
+    assert (slider.start, slider.end) == home
