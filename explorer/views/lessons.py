@@ -11,6 +11,7 @@ import panel as pn
 from ..model import Lesson, lessons, step_scene
 from .pins import PinsView
 from .style import TAB_COLUMN, html_pane
+from .widgets import LabelledCheckbox
 
 
 class LessonsView:
@@ -18,7 +19,7 @@ class LessonsView:
 
     title = "Lessons"
 
-    def __init__(self, pins: PinsView, log_time: pn.widgets.Checkbox,
+    def __init__(self, pins: PinsView, log_time: LabelledCheckbox,
                  load_scene: Callable[[dict[str, Any]], bool]) -> None:
         """``pins``: a step left stays pinned; ``log_time``: the histories' log time
         axis, which a step may switch; ``load_scene``: shows a step's scene."""

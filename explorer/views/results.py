@@ -37,7 +37,7 @@ from .loop import PageLoop
 from .pins import PinsView
 from .status import held_text, preview_text, status_html
 from .style import NOTE_STYLE, html_pane
-from .widgets import NAMES, TimePlayer
+from .widgets import NAMES, LabelledCheckbox, TimePlayer
 
 #: Which validity flags are shown next to which plot.
 BADGES: dict[str, dict[str, tuple[str, str]]] = {
@@ -234,12 +234,12 @@ class ResultsView:
         self.time_label = html_pane("", margin=(12, 10))
         self.readout = html_pane("", sizing_mode="stretch_width")
         self.design = html_pane("", sizing_mode="stretch_width", css_classes=["design-pane"])
-        self.classical = pn.widgets.Checkbox(label="classical solutions on q(x)",
-                                             css_classes=["classical-toggle"])
+        self.classical = LabelledCheckbox("classical solutions on q(x)",
+                                          css_classes=["classical-toggle"])
         self.classical.param.watch(self._on_classical, "value")
         # long creep histories change most in their first days: a log axis shows both
-        self.log_time = pn.widgets.Checkbox(label="log time axis", css_classes=["log-time"],
-                                            margin=(5, 10))
+        self.log_time = LabelledCheckbox("log time axis", css_classes=["log-time"],
+                                         margin=(5, 10))
         self.log_time.param.watch(self._on_log_time, "value")
         self.time_axis = LogTime([figures.history_fig[q] for q in QUANTITIES])
         limits.param.watch(lambda *e: self.show_design(), list(

@@ -26,8 +26,9 @@ from ..solving import mark
 from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
 
 __all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
-           "CountBox", "EditableIntSlider", "EditableSlider", "HistoryEditor", "LazySlider",
-           "NumberBox", "PLAYER_BUTTONS", "ProfileEditor", "TimePlayer", "slider", "watch_release"]
+           "CountBox", "EditableIntSlider", "EditableSlider", "HistoryEditor",
+           "LabelledCheckbox", "LazySlider", "NumberBox", "PLAYER_BUTTONS", "ProfileEditor",
+           "TimePlayer", "slider", "watch_release"]
 
 
 # Panel holds every change from the browser for 50 ms before handling it, to gather a
@@ -141,6 +142,30 @@ class TimePlayer(pn.widgets.Player):
     def __init__(self, **params: Any) -> None:
         params["stylesheets"] = [*params.get("stylesheets", []), _PLAYER_LABELS_CSS]
         super().__init__(**params)
+
+
+class LabelledCheckbox(pn.viewable.Viewer):
+    """A checkbox whose words toggle it too and name it: Bokeh's ``Checkbox`` draws its
+    words as a plain block beside the box, so only the 13 px box took a click (hard to
+    hit on a projector or a touch screen) and the box had no accessible name. Drawn as
+    a group of one option, whose words are the box's label."""
+
+    value = param.Boolean(default=False, doc="Whether the box is ticked.")
+    disabled = param.Boolean(default=False, doc="Whether the box takes no change.")
+
+    def __init__(self, label: str, **params: Any) -> None:
+        value, disabled = params.pop("value", False), params.pop("disabled", False)
+        super().__init__(value=value, disabled=disabled)
+        self._label = label
+        self._group = pn.widgets.CheckBoxGroup(options=[label], value=[label] if value
+                                               else [], disabled=disabled, **params)
+        self._group.param.watch(lambda e: setattr(self, "value", label in e.new), "value")
+        self.param.watch(lambda e: setattr(self._group, "value", [label] if e.new else []),
+                         "value")
+        self.param.watch(lambda e: setattr(self._group, "disabled", e.new), "disabled")
+
+    def __panel__(self) -> pn.widgets.CheckBoxGroup:
+        return self._group
 
 
 class EditableSlider(pn.widgets.EditableFloatSlider):

@@ -234,4 +234,11 @@ def test_every_button_has_a_name_the_players_in_a_tooltip(page: Page) -> None:
     assert play.evaluate(shown) != "none"       # out of sight until pointed at
     play.hover()
     until(lambda: play.evaluate(shown) == "none", "the tooltip shown on hover")
+    # a checkbox's words toggle it and name it (only the 13 px box took a click)
+    box = page.page.get_by_role("checkbox", name="log time axis", exact=True)
+    assert not box.is_checked()
+    page.page.get_by_text("log time axis", exact=True).click()
+    until(box.is_checked, "the box ticked by its words")
+    page.page.get_by_text("log time axis", exact=True).click()
+    until(lambda: not box.is_checked(), "and unticked")
     assert page.errors == []
