@@ -17,7 +17,7 @@ from ..plots import PIN_COLORS
 from ..solving import SolveController, format_error
 from .loop import PageLoop
 from .style import html_pane
-from .widgets import NAMES, CountBox, NumberBox
+from .widgets import NAMES, TIGHT_NUMBER_BOX, CountBox, NumberBox
 
 #: How the notices of "Pin the steps" begin: steps refused as asked, a step refused by
 #: the solver (both cleared once steps are pinned as asked).
@@ -54,7 +54,9 @@ class PinsView:
         self.pin_list = pn.Column(margin=0, css_classes=["pin-list"])
         # "pin 5 steps of the force from A to B": a class sees a load's effect at once
         self.steps_label = html_pane("", margin=(8, 5, 0, 5), css_classes=["pin-steps-label"])
-        number = {"width": 62, "margin": (0, 3)}
+        # three boxes in the sidebar's width: narrower arrows and padding leave their
+        # digits room (0.025 and 0.075 read "0.02" and "0.07", 1500 "150")
+        number = {"width": 62, "margin": (0, 3), "stylesheets": [TIGHT_NUMBER_BOX]}
         self.step_count = CountBox(label="steps", value=5, start=2, end=MAX_PINS,
                                    css_classes=["pin-steps-count"], **number)
         # empty until the first result fills them around its load (a box that starts at
@@ -135,7 +137,9 @@ class PinsView:
             # stepped: the boxes held the last one's values, in its units)
             self._stepped = quantity
             value = float(self.state.loading.histories[quantity].value)
-            self.step_from.value, self.step_to.value = (0.5 * value, 1.5 * value) if value \
+            # to 6 significant digits: 1.5 x 0.05 read "0.07500000000000001" in its box
+            self.step_from.value, self.step_to.value = (
+                float(f"{0.5 * value:.6g}"), float(f"{1.5 * value:.6g}")) if value \
                 else (0.0, 1.0)
 
     def _on_steps(self) -> None:

@@ -28,7 +28,7 @@ from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
 __all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
            "CountBox", "EditableIntSlider", "EditableSlider", "HistoryEditor",
            "LabelledCheckbox", "LazySlider", "NumberBox", "PLAYER_BUTTONS", "ProfileEditor",
-           "TimePlayer", "slider", "watch_release"]
+           "TIGHT_NUMBER_BOX", "TimePlayer", "slider", "watch_release"]
 
 
 # Panel holds every change from the browser for 50 ms before handling it, to gather a
@@ -71,6 +71,11 @@ _SPIN_LABELS_CSS = "\n".join([
     " clip-path: inset(50%); white-space: nowrap; }",
     '.bk-spin-btn-up::after { content: "Increase"; }',
     '.bk-spin-btn-down::after { content: "Decrease"; }'])
+
+
+#: A narrow number box's arrows and padding cut to leave its digits room.
+TIGHT_NUMBER_BOX = ("input.bk-input { padding-left: 4px; padding-right: 16px; }\n"
+                    ".bk-spin-btn { width: 14px; }")
 
 
 class NumberBox(pn.widgets.FloatInput):

@@ -242,3 +242,18 @@ def test_every_button_has_a_name_the_players_in_a_tooltip(page: Page) -> None:
     page.page.get_by_text("log time axis", exact=True).click()
     until(lambda: not box.is_checked(), "and unticked")
     assert page.errors == []
+
+
+def test_the_pin_steps_boxes_show_their_digits(page: Page) -> None:
+    """The "Pin the steps" boxes (62 px) cut their values: 0.025 and 0.075 read "0.02"
+    and "0.07", 1500 "150"; and 1.5 x 0.05 filled in read 0.07500000000000001."""
+    page.open_tab("Scene")
+    for css, text in ((".pin-steps-from", "0.025"), (".pin-steps-to", "0.075"),
+                      (".pin-steps-to", "1500"), (".pin-steps-from", "12.5")):
+        box = page.page.locator(f"{css} input").first
+        box.fill(text)
+        box.press("Tab")
+        until(lambda box=box, text=text: box.input_value() == text, f"{css} holds {text}")
+        room = box.evaluate("b => [b.scrollWidth, b.clientWidth]")
+        assert room[0] <= room[1], (css, text, room)
+    assert page.errors == []
