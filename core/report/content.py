@@ -23,6 +23,7 @@ from core.scene import (
     largest_pressure,
     model_error_evidence,
     percent_text,
+    time_of_largest,
 )
 from core.version import VERSION
 
@@ -51,9 +52,11 @@ def _largest_pressure_text(result: Any, origin: float = 0.0) -> str:
     return line.value_text(number=_number, shown=_shown, day="d", place_first=True)
 
 
-def _at(times: np.ndarray, values: np.ndarray, pick: str) -> tuple[float, float]:
-    """The largest (by magnitude) value of a history and its time [day]."""
-    k = int(np.argmax(np.abs(values))) if pick == "abs" else int(np.argmax(values))
+def _at(times: np.ndarray, values: np.ndarray) -> tuple[float, float]:
+    """The largest (by magnitude) value of a history and its time [day], when the design
+    check and the page say it is (:func:`core.scene.time_of_largest`: a zero tilt read
+    "at t = 0 d" here and "at t = 365 days" on the page)."""
+    k = time_of_largest(values)
     return float(values[k]), float(times[k])
 
 
@@ -70,8 +73,8 @@ def key_numbers(result: SceneSolution, time: float | None = None,
     lifts off, when it does and the smallest contact width. Positions are ``origin + x``
     [m] (``x`` from the punch's centre; a punch of several: ``origin`` its centre)."""
     t = result.times
-    settlement, t_s = _at(t, result.settlement, "abs")
-    tilt, t_a = _at(t, result.tilt, "abs")
+    settlement, t_s = _at(t, result.settlement)
+    tilt, t_a = _at(t, result.tilt)
     rows = [
         ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {_number(t_s)} d"),
         ("largest tilt α", f"{_shown(tilt, 'rad')} at t = {_number(t_a)} d"),

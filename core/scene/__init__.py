@@ -51,6 +51,7 @@ from core.scene.design import (
     design_check,
     flagged_caution,
     largest_pressure,
+    time_of_largest,
     verdict_words,
 )
 from core.scene.display import engine_text, known_contact_width, lifts_off_at, percent_text
@@ -136,6 +137,7 @@ __all__ = [
     "lifts_off_at",
     "check_design",
     "flagged_caution",
+    "time_of_largest",
     "verdict_words",
     "check_fields",
     "check_loads_touch",

@@ -332,7 +332,7 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
                                        float(times[i_max[1]]), float(x[i_max[0]]), limit))
             continue
         values = histories[quantity]
-        k = _time_of_largest(values)
+        k = time_of_largest(values)
         lines.append(LimitCheck(name, quantity, label, float(values[k]), unit,
                                 float(times[k]), None, limit))
     q_min = LimitCheck(None, "q_min", "smallest contact pressure q_min", float(q[i_min]),
@@ -346,7 +346,7 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
 SAME_SHARE = 1e-9
 
 
-def _time_of_largest(values: np.ndarray) -> int:
+def time_of_largest(values: np.ndarray) -> int:
     """The index of the largest ``|values|``, the last of those within :data:`SAME_SHARE`
     of it (a history that levels off reaches it by then, and stays)."""
     size = np.abs(values)

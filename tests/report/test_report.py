@@ -245,3 +245,17 @@ def test_long_times_read_without_an_exponent():
     assert result.times[-1] > 1e4  # 50 years of days
     text = "".join(f"{label} {value}" for s in sections(result) for label, value in s.rows)
     assert "e+04" not in text and f"{round(result.times[-1], -1):.0f} d" in text
+
+
+def test_the_time_of_a_largest_value_is_the_design_checks():
+    """A centred load's zero tilt read "largest tilt 0 mrad at t = 0 d" in the report and
+    "at t = 365 days" on the page: one rule (core.scene.time_of_largest) for both."""
+    from core.report.content import key_numbers
+    from core.scene import design_check
+
+    result = core.solve(core.load_scene("preset:uniform_flat"))
+    rows = dict(key_numbers(result))
+    check = design_check(result)
+    assert rows["largest tilt α"] == f"0 mrad at t = {check.check('tilt').time:g} d" \
+        == "0 mrad at t = 365 d"
+    assert rows["largest settlement δ"].endswith(f"at t = {check.check('settlement').time:g} d")
