@@ -116,7 +116,9 @@ def _weights(readings: Readings) -> tuple[np.ndarray, np.ndarray, np.ndarray, bo
                        if getattr(readings, f"{name}_std") is None)
         raise ValueError(f"{missing}: required when both settlements and tilts are fitted "
                          "(without standard deviations the weight of metres against "
-                         "radians is unknown)")
+                         "radians is unknown): add the settlement_std and tilt_std "
+                         "columns, or leave out the series not to fit (a history this "
+                         "program wrote holds both)")
     y = np.concatenate([getattr(readings, name) for name in series])
     mask = np.isfinite(y)
     if given:

@@ -92,3 +92,29 @@ def test_the_forecasts_options_are_named_as_typed(tmp_path: Path) -> None:
             code = main(["calibrate", str(scene), str(readings), "--fit", "loading.force",
                          *extra])
         assert code == EXIT_BAD_INPUT and err.getvalue().startswith(said), err.getvalue()
+
+
+def test_a_history_this_program_wrote_says_how_to_fit_it(tmp_path: Path) -> None:
+    """SCENES.md said such a history "reads as it is"; it holds settlement and tilt, and
+    the refusal ("settlement_std: required when both ... are fitted") said no way on."""
+    scene, _ = _files(tmp_path)
+    history = tmp_path / "history.csv"
+    proc = run_cli("solve", scene, "-o", history, cwd=tmp_path)
+    assert proc.returncode == EXIT_OK, proc.stderr
+    proc = run_cli("calibrate", scene, history, "--fit", "base.creep.compliance",
+                   cwd=tmp_path)
+    assert proc.returncode == EXIT_BAD_INPUT
+    assert proc.stderr.startswith("error: settlement_std: required when both settlements "
+                                  "and tilts are fitted")
+    assert "add the settlement_std and tilt_std columns, or leave out the series not to " \
+           "fit" in proc.stderr
+    # its tilt column left out, it fits as it is
+    lines = history.read_text().splitlines()
+    head = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    names = lines[head].split(",")
+    keep = [i for i, name in enumerate(names) if not name.startswith("tilt")]
+    history.write_text("\n".join([*lines[:head], *(",".join(row.split(",")[i] for i in keep)
+                                                 for row in lines[head:])]) + "\n")
+    proc = run_cli("calibrate", scene, history, "--fit", "base.creep.compliance",
+                   cwd=tmp_path)
+    assert proc.returncode == EXIT_OK, proc.stderr
