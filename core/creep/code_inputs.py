@@ -42,8 +42,13 @@ RANGES: dict[str, dict[str, tuple[float, float, str]]] = {
     },
 }
 
-#: A strength class, "C<fck>/<fck,cube>" (MPa).
-STRENGTH_CLASS = re.compile(r"^\s*C\s*(\d{2,3})\s*/\s*(\d{2,3})\s*$")
+#: A strength class, "C<fck>/<fck,cube>" (MPa; "c30/37" too).
+STRENGTH_CLASS = re.compile(r"^\s*[Cc]\s*(\d{2,3})\s*/\s*(\d{2,3})\s*$")
+#: The classes' cube strength by cylinder strength [MPa] (EN 1992-1-1 Table 3.1, and fib
+#: MC2010 Table 5.1-1 to C120/140): a class is a pair of them ("C30/99" read as C30/37).
+CUBE_STRENGTHS: dict[int, int] = {12: 15, 16: 20, 20: 25, 25: 30, 30: 37, 35: 45, 40: 50,
+                                  45: 55, 50: 60, 55: 67, 60: 75, 70: 85, 80: 95, 90: 105,
+                                  100: 115, 110: 130, 120: 140}
 
 
 def _in_range(value: Any, model: str, name: str, field: str) -> float:
@@ -66,7 +71,11 @@ def mean_strength(fcm: Any, strength_class: Any, model: str, field: str) -> floa
     if match is None:
         raise ValueError(f"{field}.strength_class: must look like 'C30/37' (cylinder/cube "
                          f"strength in MPa), got {show_python(strength_class)}")
-    fck = float(match.group(1))
+    fck, cube = int(match.group(1)), int(match.group(2))
+    if CUBE_STRENGTHS.get(fck) != cube:
+        known = ", ".join(f"C{a}/{b}" for a, b in CUBE_STRENGTHS.items())
+        raise ValueError(f"{field}.strength_class: {show_python(strength_class)} is not a "
+                         f"strength class ({known}); give fcm [MPa] for another concrete")
     low, high, source = RANGES[model]["fcm"]
     if not low <= fck + DELTA_F <= high:
         raise ValueError(f"{field}.strength_class: fcm = fck + {DELTA_F:g} MPa must be in "

@@ -298,7 +298,9 @@ def _base() -> dict[str, Any]:
             "required": ["model"], "properties": {"model": {"const": model}}}}},
          "then": {"properties": {"age_at_loading": {
              "minimum": RANGES[model]["age_at_loading"][0],
-             "maximum": RANGES[model]["age_at_loading"][1]}}}}
+             "maximum": RANGES[model]["age_at_loading"][1],
+             "description": f"Age at loading under {model} ({RANGES[model]['age_at_loading'][2]}) "
+                            "[day]"}}}}
         for model in CODE_SPEC_FIELDS]
     return out
 
@@ -422,6 +424,8 @@ def _words(error: Any, root: str) -> Iterator[tuple[str, str]]:
         yield path, f"must be at most {value} characters, has {len(instance)}"
     elif kind == "pattern" and value == _NOT_BLANK:
         yield path, "must not be empty"
+    elif kind == "pattern" and value == STRENGTH_CLASS.pattern:
+        yield path, f"must look like 'C30/37' (cylinder/cube strength in MPa), got {got}"
     elif kind == "pattern":
         # a rule with its own reason is a fragment of a field's schema, without a type
         reason = error.schema.get("description") if "type" not in error.schema else None
@@ -450,6 +454,10 @@ def _words(error: Any, root: str) -> Iterator[tuple[str, str]]:
         yield path, error.message
 
 
+#: The keywords of a bound on a number.
+_BOUNDS = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
+
+
 def schema_errors(instance: Any, schema: Mapping[str, Any], root: str = "scene"
                   ) -> list[str]:
     """Every violation of ``schema`` by ``instance`` as ``"<field>: <reason>"``, the
@@ -459,7 +467,22 @@ def schema_errors(instance: Any, schema: Mapping[str, Any], root: str = "scene"
 
     validator = Draft202012Validator(schema)
     out: list[str] = []
-    for error in validator.iter_errors(instance):
+    errors = list(validator.iter_errors(instance))
+    # an object with too few or too many fields: a rule on which pair it holds says no
+    # more ("loading: tilt and moment is not one of the four statements" beside "exactly
+    # two of ... are needed, got tilt, force, moment")
+    counted = {tuple(e.absolute_path) for e in errors
+               if e.validator in ("minProperties", "maxProperties")}
+    # one line a field: of two bounds on one number the one a rule adds (a design code's
+    # age at loading, ">= 1 day") is said, not the general one as well ("> 0 days")
+    ruled = {tuple(e.absolute_path) for e in errors
+             if "then" in e.schema_path and e.validator in _BOUNDS}
+    for error in errors:
+        if error.validator == "not" and tuple(error.absolute_path) in counted:
+            continue
+        if (error.validator in _BOUNDS and "then" not in error.schema_path
+                and tuple(error.absolute_path) in ruled):
+            continue
         for path, reason in _words(error, root):
             line = f"{path}: {reason}"
             if line not in out:

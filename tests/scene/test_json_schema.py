@@ -239,7 +239,34 @@ def test_the_code_models_bound_the_age_at_loading_in_the_schema(scene_schema: di
     with pytest.raises(ValueError, match="age_at_loading"):
         scene_from_dict(scene)
     assert schema_errors(scene, scene_schema) == [
-        "base.age_at_loading: must be >= 1, got 0.5"]
+        "base.age_at_loading: must be >= 1 days, got 0.5 days"]
+    # one line a field: at 0 the code's bound, not the general "> 0 days" as well
+    assert schema_errors(edited("base.age_at_loading", 0, scene), scene_schema) == [
+        "base.age_at_loading: must be >= 1 days, got 0 days"]
+
+
+def test_a_strength_class_is_a_class_and_three_loads_one_line(scene_schema: dict) -> None:
+    """"c30/37" was refused with the pattern's regular expression, "C30/99" taken as
+    C30/37; three loads gave a second line "tilt and moment is not one of the four
+    statements"."""
+    def code(strength_class: str) -> dict:
+        return edited("base.creep", {"model": "fib_mc2010", "strength_class": strength_class,
+                                     "relative_humidity": 60, "notional_size": 300})
+
+    assert schema_errors(code("c30/37"), scene_schema) == []
+    assert scene_from_dict(code("c30/37")).to_dict()["base"]["creep"]["strength_class"] \
+        == "c30/37"
+    assert schema_errors(code("Cxx"), scene_schema) == [
+        "base.creep.strength_class: must look like 'C30/37' (cylinder/cube strength in MPa), "
+        "got 'Cxx'"]
+    with pytest.raises(ValueError, match=r"^base\.creep\.strength_class: 'C30/99' is not a "
+                                         r"strength class \(C12/15, .*C30/37, .*C120/140\); "
+                                         r"give fcm \[MPa\] for another concrete$"):
+        scene_from_dict(code("C30/99"))
+    three = edited("loading", {"tilt": 0.0, "force": 1.0, "moment": 0.1})
+    assert schema_errors(three, scene_schema) == [
+        "loading: exactly two of settlement, tilt, force, moment are needed, got tilt, "
+        "force, moment"]
 
 
 def test_the_reasons_are_worded_as_the_validator_words_them(scene_schema: dict) -> None:
