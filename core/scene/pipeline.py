@@ -12,6 +12,7 @@ path of their names.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Mapping
 from typing import Any
@@ -20,6 +21,7 @@ import numpy as np
 
 from core.contact import LOCATING_ZONE_ENDS
 from core.engines.layered import LiftOffNotAnswered, solve_scene_layered
+from core.scene.files import load_scene
 from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
 from core.scene.punches import (
@@ -36,13 +38,17 @@ from core.work import WorkLimitExceeded, one_blas_thread, work_bound
 
 
 @one_blas_thread()
-def solve(scene: Scene | PunchesScene | Mapping[str, Any]) -> SceneSolution | PunchesSolution:
-    """Solve a scene (a :class:`Scene` or a scene dict, validated first).
+def solve(scene: Scene | PunchesScene | Mapping[str, Any] | str | os.PathLike
+          ) -> SceneSolution | PunchesSolution:
+    """Solve a scene (a :class:`Scene` or a scene dict, validated first; a scene file's
+    path or ``"preset:NAME"`` is read by :func:`load_scene`, as the commands read it).
 
     Returns a :class:`SceneSolution` in SI units (m, rad, N/m, N, Pa; days after loading);
     a scene of several punches (``punches``, :mod:`core.scene.punches`) a
     :class:`core.scene.PunchesSolution`.
     """
+    if isinstance(scene, (str, os.PathLike)):
+        scene = load_scene(scene)
     if has_punches(scene):
         try:
             with work_bound():

@@ -186,6 +186,11 @@ def test_a_shipped_scene_or_study_is_named_preset_colon_name():
     with pytest.raises(ValueError, match="preset:nope: no shipped scene of that name; known: "
                                          "bare_layer, eccentric_creep"):
         core.load_scene("preset:nope")
+    # solve reads one as the commands do (it refused the string, sweep took it)
+    assert core.solve("preset:worn_coating").settlement.tolist() \
+        == core.solve(core.load_scene("preset:worn_coating")).settlement.tolist()
+    with pytest.raises(ValueError, match="preset:nope: no shipped scene of that name"):
+        core.solve("preset:nope")
     # (the study's own word: it read "no shipped studie")
     with pytest.raises(ValueError, match="preset:nope: no shipped study of that name; known: "
                                          "eccentric_design"):
