@@ -366,6 +366,11 @@ class PunchesSolution:
             return table
         return csv_header(self, "contact pressure q(x, t) over the surface, x global") + table
 
+    def to_xarray(self) -> Any:
+        """The answer as an ``xarray.Dataset`` over ``punch``, ``time`` [day] and ``x`` [m,
+        global] (:func:`core.scene.punches_output.to_xarray`)."""
+        return punches_output.to_xarray(self)
+
     def design_checks(self, limits: DesignLimits | None = None) -> list[DesignCheck | None]:
         """The design check of every punch, in order, over the whole history against
         ``limits`` [Pa, m, rad] (default: the scene's ``limits``), positions in the global

@@ -15,8 +15,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from core.optional import import_optional
 from core.scene.design import DesignCheck, DesignLimits, check_design
+from core.scene.display import HISTORIES
+from core.scene.files import scene_to_json
 from core.scene.results import history_columns, pressure_points
+from core.version import VERSION
 
 if TYPE_CHECKING:
     from core.scene.punches import PunchesSolution
@@ -114,3 +118,42 @@ def design_checks(result: PunchesSolution, limits: DesignLimits | None = None
             punch.times, punch.center + punch.x, punch.pressure_on_grid, punch.settlement,
             punch.tilt, given, corners))
     return out
+
+
+def to_xarray(result: PunchesSolution) -> Any:
+    """``result`` as an ``xarray.Dataset``: every punch's histories over ``punch`` and
+    ``time`` [day] (``center`` [m] and the contact width [m] beside them), the contact
+    pressure q over the surface on ``x`` [m, global x: each punch's plotting grid, punches
+    in order; q = 0 between them], with units and long names as
+    :meth:`core.scene.SceneSolution.to_xarray` gives them; the scene (canonical JSON), the
+    flags and the largest error estimate in the attributes."""
+    xr = import_optional("xarray", "PunchesSolution.to_xarray")
+    punches = result.punches
+    coords = {
+        "punch": ("punch", np.arange(len(punches)),
+                  {"long_name": "index of the punch in the scene's punches"}),
+        "time": ("time", result.times.copy(), {"units": "day", "long_name": "time after loading"}),
+        "x": ("x", result.x.copy(), {"units": "m", "long_name": "position along the surface"}),
+    }
+    variables: dict[str, Any] = {
+        "pressure": (("x", "time"), result.pressure_on_grid.copy(),
+                     {"units": "Pa", "long_name": "contact pressure", "symbol": "q"}),
+        "center": ("punch", np.array([p.center for p in punches]),
+                   {"units": "m", "long_name": "centre of the punch"}),
+        "contact_width": (("punch", "time"), np.array([p.contact_width for p in punches]),
+                          {"units": "m", "long_name": "length of the punch's contact set"}),
+    }
+    for name, (unit, long_name, symbol) in HISTORIES.items():
+        variables[name] = (("punch", "time"),
+                           np.array([np.asarray(getattr(p, name), dtype=float)
+                                     for p in punches]),
+                           {"units": unit, "long_name": f"{long_name}, of each punch",
+                            "symbol": symbol})
+    info = result.info
+    attrs = {"format": "coated-punch solution of several punches", "version": VERSION,
+             "scene_name": result.scene.name, "scene": scene_to_json(result.scene),
+             "flags": ",".join(result.flags),
+             "error_estimate": float(info.get("error_estimate", float("nan"))),
+             "success": int(bool(info.get("success", False))),
+             "coating_model": str(info.get("coating_model", ""))}
+    return xr.Dataset(variables, coords=coords, attrs=attrs)

@@ -114,3 +114,21 @@ def test_the_design_check_of_each_punch_is_in_the_global_x() -> None:
         assert abs(check.check("q_max").x - punch.center) <= \
             punch.scene.half_width * (1 + EDGE_ROUNDING)
     assert core.solve(_pair()).design_checks() == [None, None]
+
+
+def test_the_answer_as_an_xarray_dataset(pair: PunchesSolution, tmp_path) -> None:
+    """The README's route to a dataset (``result.to_xarray()``) was missing for several
+    punches: every punch's histories over (punch, time), q over the surface."""
+    import json
+
+    ds = pair.to_xarray()
+    assert dict(ds.sizes) == {"punch": 2, "time": pair.times.size, "x": pair.x.size}
+    for k, punch in enumerate(pair.punches):
+        for name in ("settlement", "tilt", "force", "moment", "contact_width"):
+            assert ds[name].sel(punch=k).values.tolist() == \
+                np.asarray(getattr(punch, name), dtype=float).tolist()
+        assert float(ds["center"][k]) == punch.center
+    assert np.array_equal(ds["pressure"].values, pair.pressure_on_grid)
+    assert ds["moment"].attrs["units"] == "N" and ds["x"].attrs["units"] == "m"
+    assert json.loads(ds.attrs["scene"]) == pair.scene.to_dict()
+    ds.to_netcdf(tmp_path / "pair.nc")    # every attribute a string or a number
