@@ -99,8 +99,11 @@ LESSONS: tuple[Lesson, ...] = (
                  "doubles, 0.0127 mm.",
                  {"coating.0": {"thickness": 0.02, "modulus": 8.0e8, "poisson": 0.3}}),
             Step("A thicker, softer coating (50 mm, 200 MPa) spreads the load almost "
-                 "evenly, 0.24 to 0.25 MPa across the whole punch: it acts like a bed of "
-                 "springs. The settlement is now 0.064 mm, mostly the coating's.",
+                 "evenly, 0.24 to 0.25 MPa from the middle to 25 mm from the edges: it "
+                 "acts almost like a bed of springs. (At the rigid corner itself the "
+                 "pressure on this elastic base still grows without bound, in a band "
+                 "thinner than the coating; the plot holds its value there, as the Check "
+                 "tab says.) The settlement is now 0.064 mm, mostly the coating's.",
                  {"coating.0.thickness": 0.05, "coating.0.modulus": 2.0e8}),
         ),
     ),

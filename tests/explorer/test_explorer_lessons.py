@@ -142,7 +142,12 @@ def test_the_coating_edges_lesson_says_what_the_solver_finds() -> None:
     # step 2: 1 cm from the edge 0.34 MPa, 0.23 MPa in the middle, 0.0127 mm
     assert f"{q1[2]:.2f}" == "0.34" and f"{q1[0]:.2f}" == "0.23"
     assert _rounds_to(_mm(thin, 0), "0.0127")
-    # step 3: 0.24 to 0.25 MPa over the punch (as drawn: the plotting grid), 0.064 mm
+    # step 3: 0.24 to 0.25 MPa up to 25 mm from the edges (as drawn: the plotting grid,
+    # which holds q within half the coating's thickness of a corner; the note said
+    # "across the whole punch" beside the check's "unbounded at the corner"), 0.064 mm
     grid = np.asarray(thick.pressure_on_grid)[:, 0] / 1e6
     assert f"{grid.min():.2f}" == "0.24" and f"{grid.max():.2f}" == "0.25"
+    corners = thick.info["corner_pressure"]
+    assert corners["held_within_m"] == pytest.approx(0.025) and corners["corners_m"] == [
+        -1.0, 1.0]
     assert _rounds_to(_mm(thick, 0), "0.064")
