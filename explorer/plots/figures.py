@@ -41,7 +41,6 @@ from .bokeh_data import (
     MOVING,
     f32,
     legend_above,
-    legend_inside,
     set_data,
     steady_range,
     wrap_legend,
@@ -241,11 +240,13 @@ class Figures:
         p.add_tools(HoverTool(renderers=[lines], tooltips=[
             ("", "@label"), ("t", "$snap_x{0.0} days"),
             (SYMBOLS[q], f"$snap_y{{0.0000}} {unit}")]))
-        # made with the figure: legend entries made later found no view in the page
+        # made with the figure: legend entries made later found no view in the page.
+        # Above the plot, in a row: inside at the top left it hid the old footing's step
+        # at one year (new_footing_beside_old), where every history starts
         p.add_layout(Legend(items=[
             LegendItem(label=f"punch {k + 1}", renderers=[lines], index=k, visible=False)
-            for k in range(SCREEN_PUNCHES)], visible=False))
-        legend_inside(p, "top_left")
+            for k in range(SCREEN_PUNCHES)], visible=False, orientation="horizontal",
+            margin=0, padding=2, spacing=8, label_text_font_size="10px"), "above")
         self.punch_history_src[q] = src
 
     def _show_punch_histories(self, view: ResultView) -> None:

@@ -270,3 +270,15 @@ def test_the_lesson_goes_through_its_steps_on_the_page(explorer_app) -> None:
     assert "Step 3 of 3" in view.lesson_note.object and len(app.pins.board) == 0
     assert app.controller.view.punches[1].center == 6.0
     assert copy.deepcopy(app.state.to_scene())["punches"][1]["center"] == 6.0
+
+
+def test_the_punches_legends_sit_above_their_histories(explorer_app) -> None:
+    """Inside at the top left, the punches' legend hid the old footing's step at one year
+    (new_footing_beside_old), where every history starts."""
+    from bokeh.models import Legend
+
+    app = explorer_app()
+    for fig in app.figures.history_fig.values():
+        legends = [m for m in fig.above if isinstance(m, Legend)]
+        assert len(legends) == 1 and legends[0].orientation == "horizontal"
+        assert not [m for m in fig.center if isinstance(m, Legend)]
