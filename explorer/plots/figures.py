@@ -36,6 +36,7 @@ from ..model import (
     ResultView,
     days_text,
     lifts_or_pulls,
+    plain_number,
 )
 from .bokeh_data import (
     MOVING,
@@ -424,7 +425,8 @@ class Figures:
         intervals = view.negative_intervals(index)
         set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
                                 "right": [hi for _, hi in intervals]})
-        self.q_fig.title.text = f"Pressure q(x), t = {days_text(t)}"
+        self._q_time = t
+        self._title_pressure()
         self.q_fig.yaxis.axis_label = f"q [{unit}]"
         self.q_hover.tooltips = [("x", "@x{0.000} m"), ("q", f"@q{{0.000}} {unit}")]
         if not pinned_drawn:
@@ -495,12 +497,25 @@ class Figures:
         if self.history_fig[q].title.text != text:
             self.history_fig[q].title.text = text
 
+    def _title_pressure(self) -> None:
+        """The pressure plot's title: the time shown; in presentation mode without its
+        years (beside the time player already), where at 1024 px it was cut ("Pressure
+        q(x), t = 1000 days (2.7")."""
+        t = getattr(self, "_q_time", None)
+        if t is None:
+            return
+        text = (f"q(x) at t = {plain_number(t)} days" if self._presenting
+                else f"Pressure q(x), t = {days_text(t)}")
+        if self.q_fig.title.text != text:
+            self.q_fig.title.text = text
+
     def set_presentation(self, on: bool) -> None:
         """Fonts a projector shows from the back of a room (ticks and labels of
         :data:`PRESENTATION_FONT`), or the normal ones."""
         self._presenting = on
         for q in QUANTITIES:
             self._title_history(q)
+        self._title_pressure()
         tick, label, title = ((PRESENTATION_FONT, PRESENTATION_FONT, PRESENTATION_FONT)
                               if on else ("11px", "13px", "13px"))
         for fig in self.all_figures():

@@ -253,6 +253,11 @@ class ResultsView:
     def content(self) -> pn.Column:
         """The main column of the page."""
         scene_pane, q_pane, image_pane, *history_panes = self._bokeh_panes
+        # the pins' controls beside the readout; below it in presentation mode, where the
+        # readout's larger text with two pins ran under them at 1024 px
+        self.pin_controls = pn.Column(self.pins.content(), self.classical)
+        self.readout_row = pn.Row(self.readout, self.pin_controls, sizing_mode="stretch_width")
+        self.below_readout = pn.Row(sizing_mode="stretch_width", margin=0)
         return pn.Column(
             self.link.address,
             self.notice_alert,
@@ -265,8 +270,8 @@ class ResultsView:
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
-            pn.Row(self.readout, pn.Column(self.pins.content(), self.classical),
-                   sizing_mode="stretch_width"),
+            self.readout_row,
+            self.below_readout,
             self.design,
             pn.Row(self.history_badges, self.log_time, sizing_mode="stretch_width"),
             pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
@@ -411,10 +416,20 @@ class ResultsView:
         self.alert.visible = bool(error)
 
     def set_presentation(self, on: bool) -> None:
-        """Projector fonts for the texts of the column (the figures set their own)."""
-        size = "17px" if on else ""
+        """Projector fonts for the texts of the column (the figures set their own), and
+        the pins' controls below the readout (beside it otherwise)."""
+        # back to the theme's size by name: emptied styles left 17 px on the page
+        size = "17px" if on else "var(--font-size)"
         for pane in (self.readout, self.status, self.design):
-            pane.styles = {"font-size": size} if on else {}
+            pane.styles = {"font-size": size}
+        if not hasattr(self, "readout_row"):  # (the page's column not made yet)
+            return
+        if on:
+            self.readout_row.objects = [self.readout]
+            self.below_readout.objects = [self.pin_controls]
+        else:
+            self.below_readout.objects = []
+            self.readout_row.objects = [self.readout, self.pin_controls]
 
     def _on_classical(self, event: Any) -> None:
         with pn.io.hold():

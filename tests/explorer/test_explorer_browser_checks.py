@@ -629,8 +629,24 @@ def test_presentation_mode_has_projector_fonts_at_1024(page: Page):
     # computed" ran past its 1024 px plot
     title = f"() => {doc}.get_model_by_name('settlement_figure').title.text"
     _wait(page, f"() => ({title})() === 'Settlement δ: computed'")
+    # the pressure's title without the years the player shows ("Pressure q(x), t = 1000
+    # days (2.7" was cut), and the pins' controls below the readout, not beside it (its
+    # 17 px text with two pins ran under them)
+    pressure = f"() => {doc}.get_model_by_name('pressure_figure').title.text"
+    _wait(page, f"() => /^q\\(x\\) at t = \\d+ days$/.test(({pressure})())")
+    readout = page.page.locator(".readout-scroll").first
+    pin = page.page.get_by_text("Pin this result").first
+    assert pin.bounding_box()["y"] > readout.bounding_box()["y"] + readout.bounding_box()[
+        "height"] - 1
+    assert readout.evaluate("e => getComputedStyle(e).fontSize") == "17px"
     page.page.locator(".presentation-toggle button").first.click()
     _wait(page, f"() => ({title})() === 'Settlement δ [mm]: computed'")
+    _wait(page, f"() => ({pressure})().startsWith('Pressure q(x), t = ')")
+    # back to the theme's size (emptied styles left 17 px), the controls beside it again
+    until(lambda: readout.evaluate("e => getComputedStyle(e).fontSize") == "12px",
+          "the readout's own size again")
+    until(lambda: pin.bounding_box()["x"] > readout.bounding_box()["x"] + 100,
+          "the pins' controls beside the readout")
     assert page.errors == []
 
 

@@ -38,4 +38,10 @@ def test_a_fifty_year_history_reads_in_days_and_years(explorer_app) -> None:
     assert "e+" not in app.results.time_label.object + app.results.readout.object
     app.figures.show_time(view, last)
     assert app.figures.q_fig.title.text == "Pressure q(x), t = 18260 days (50.0 years)"
+    # in presentation mode without its years (beside the player), where at 1024 px it
+    # was cut ("Pressure q(x), t = 1000 days (2.7"); back again after
+    app.figures.set_presentation(True)
+    assert app.figures.q_fig.title.text == "q(x) at t = 18260 days"
+    app.figures.set_presentation(False)
+    assert app.figures.q_fig.title.text == "Pressure q(x), t = 18260 days (50.0 years)"
     assert "e+" not in app.figures.contact.zone_label.text
