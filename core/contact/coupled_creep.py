@@ -57,7 +57,6 @@ from core.contact.creep import (
     _distance,
     _extrapolate,
     _outside_bands,
-    _rule_distance,
     controlled_march,
     creep_verdict,
     free_end_residual,
@@ -152,14 +151,18 @@ class CoupledMarches:
         pairs = [_distance(one, two) for one, two in zip(a, b, strict=True)]
         return max(d for d, _ in pairs), max(s for _, s in pairs)
 
-    @staticmethod
-    def rule_distance(rules: Sequence[Panels], a: list[dict[str, Any]],
+    def rule_distance(self, rules: Sequence[Panels], a: list[dict[str, Any]],
                       finer: Sequence[Panels], b: list[dict[str, Any]],
                       bands: Sequence[list[tuple[float, float]]]) -> tuple[float, float]:
-        """The largest over the punches of :func:`core.contact.creep._rule_distance`
-        (``bands``: each punch's)."""
-        pairs = [_rule_distance(*five) for five in zip(rules, a, finer, b, bands, strict=True)]
-        return max(p[0] for p in pairs), max(p[1] for p in pairs)
+        """:meth:`distance` (the histories): q between the rules, as one punch compares
+        it (:func:`core.contact.creep._q_between_rules`), would need each punch's formula
+        with the others' push, which its outputs do not keep."""
+        return self.distance(a, b)
+
+    @staticmethod
+    def banded(bands: Sequence[list[tuple[float, float]]]) -> bool:
+        """Whether the punches' rules on ``bands`` have band panels."""
+        return any(bool(b) for b in bands)
 
     def end_slope(self, rules: Sequence[Panels], out: list[dict[str, Any]]) -> float:
         """The largest over the punches of :func:`core.contact.creep.free_end_slope`."""

@@ -32,7 +32,7 @@ from core.contact.bands import (
     mirrored_bands,
     pinned_end,
 )
-from core.contact.march import march, march_outputs, rule_operator
+from core.contact.march import march, march_outputs, nodes_in, rule_operator
 from core.contact.result import UNILATERAL_MARGIN, _Snapshot, not_within_tol
 from core.contact.step import Space, Step, nystrom_pressure
 from core.contact.systems import Mirror
@@ -42,8 +42,8 @@ from core.discretize import (
     Panels,
     even_overall,
     even_per_node,
-    interpolation_weights,
     operator_rows,
+    panel_index,
 )
 from core.problem import accepts
 from core.time import time_grid
@@ -207,54 +207,72 @@ def _distance(a: dict[str, Any], b: dict[str, Any]) -> tuple[float, float]:
     return float(outputs), shift
 
 
-def _q_between_rules(rule: Panels, out: dict[str, Any], finer: Panels,
+def _q_between_rules(space: Space, rule: Panels, out: dict[str, Any], finer: Panels,
                      finer_out: dict[str, Any],
                      bands: Sequence[tuple[float, float]] = ()) -> float:
     """The largest change of q at the nodes of ``rule`` (the march ``out`` on it) from the
-    panel-wise interpolant of the march ``finer_out`` on the rule ``finer``, at every
-    output time, relative to the largest q; nodes whose panel on either rule meets a band
-    the free ends sweep (``bands``) or holds a zone end of either march at that time are
-    left out: q kinks there, now or in its memory of where the ends have been, which no
-    interpolant resolves (the ends' error times q's slope beside them is its estimate
-    there: ``controlled_march``). The histories compared alone missed q's
-    error at the punch's edges: 1.1e-6 at x = 0.999995 on a creeping base at tol 1e-6,
-    estimated 1.1e-7 (a flat punch in full contact, ``contact="unilateral"``)."""
-    q, q_fine = out["q"], finer_out["q"]
-    if q.size == 0 or q.shape[1] != q_fine.shape[1]:
+    pressure formula of the march ``finer_out`` on the rule ``finer`` there
+    (:func:`nystrom_pressure` of its effective density), relative to the largest q, at
+    the output times where neither march has a free end (an end inside (-1, 1) off the
+    breakpoints); nodes whose panel on either rule meets a band the free ends sweep
+    (``bands``) are left out too (q kinks where the ends have been).
+
+    The histories compared alone missed q's error at the punch's edges: 1.1e-6 at x =
+    0.999995 on a creeping base at tol 1e-6, estimated 1.1e-7 (a flat punch in full
+    contact, ``contact="unilateral"``). The finer rule's formula, not its panels'
+    polynomials: those read q's log-like edge layer to O(h) only (5.5e-5 against 6.9e-6
+    as the edge panels were halved, where the answers were within 7.6e-7 and 2e-8).
+    Where a free end is, the nodal q of the marches carries the end's kink through the
+    whole zone until the kink correction takes it out of the answer
+    (core/contact/kinks.py): compared there it read 5.8e-7 at x = -0.455 on a crowned
+    punch whose answer was within 5.8e-8 (and took the rule from 1056 to 1760 nodes);
+    there the ends' error times q's slope beside them is q's estimate
+    (``controlled_march``)."""
+    q = out["q"]
+    fixed = np.asarray(space.breakpoints, dtype=float)
+    times = [k for k in range(q.shape[1])
+             if not any(-1.0 < e < 1.0 and not np.any(np.abs(fixed - e) <= 1e-12)
+                        for e in (*out["ends"][k], *finer_out["ends"][k]))]
+    if q.size == 0 or not times or q.shape[1] != finer_out["q"].shape[1]:
         return 0.0
-    index, weights = interpolation_weights(finer, rule.nodes)
-    per_panel = q_fine.reshape(finer.n_panels, NODES_PER_PANEL, q_fine.shape[1])
-    at = np.einsum("ij,ijt->it", weights, per_panel[index])
+    x = rule.nodes
     own = np.repeat(np.arange(rule.n_panels), NODES_PER_PANEL)
-    spans = [(finer.centers[index] - finer.half_widths[index],
-              finer.centers[index] + finer.half_widths[index]),
-             (rule.centers[own] - rule.half_widths[own],
-              rule.centers[own] + rule.half_widths[own])]
-    swept = np.ones(q.shape[0], dtype=bool)
-    for lo, hi in spans:
+    index = panel_index(finer, x)
+    kept = np.ones(x.size, dtype=bool)
+    for lo, hi in ((rule.centers[own] - rule.half_widths[own],
+                    rule.centers[own] + rule.half_widths[own]),
+                   (finer.centers[index] - finer.half_widths[index],
+                    finer.centers[index] + finer.half_widths[index])):
         for a, b in bands:
-            swept &= ~((lo <= b) & (a <= hi))
+            kept &= ~((lo <= b) & (a <= hi))
+    if not kept.any():
+        return 0.0
+    x = x[kept]
+    rows = operator_rows(space.lam, finer, x)
     worst = 0.0
-    for k in range(q.shape[1]):
-        ends = np.array([e for e in (*out["ends"][k], *finer_out["ends"][k])
-                         if -1.0 < e < 1.0])
-        kept = swept.copy()
-        for lo, hi in spans if ends.size else ():
-            kept &= ~np.any((lo[:, None] < ends[None, :]) & (ends[None, :] < hi[:, None]),
-                            axis=1)
-        if kept.any():
-            worst = max(worst, float(np.max(np.abs(q[kept, k] - at[kept, k]))))
+    for k in times:
+        # where both marches touch (zones may end at a step of the punch: off them q is 0
+        # and the formula gives the gap's pull)
+        inside = np.ones(x.size, dtype=bool)
+        for ends in (out["ends"][k], finer_out["ends"][k]):
+            inside &= nodes_in(x, list(zip(ends[0::2], ends[1::2], strict=True)))
+        if not inside.any():
+            continue
+        formula = nystrom_pressure(
+            space, Step(float(finer_out["c"][k]), 1.0, {}), finer,
+            finer_out["effective"][:, k], float(finer_out["settlement"][k]),
+            float(finer_out["tilt"][k]), x[inside], rows=rows[inside])
+        worst = max(worst, float(np.max(np.abs(q[kept, k][inside] - formula))))
     return worst / max(float(np.max(np.abs(q))), 1e-300)
 
 
-def _rule_distance(rule: Panels, out: dict[str, Any], finer: Panels,
+def _rule_distance(space: Space, rule: Panels, out: dict[str, Any], finer: Panels,
                    finer_out: dict[str, Any], bands: Sequence[tuple[float, float]] = ()
                    ) -> tuple[float, float]:
     """:func:`_distance` of marches on two panel rules (``rule``, and every panel finer,
-    ``finer``), q compared too, off the ``bands`` the free ends sweep
-    (:func:`_q_between_rules`)."""
+    ``finer``), q compared too where no free end is (:func:`_q_between_rules`)."""
     outputs, shift = _distance(out, finer_out)
-    return max(outputs, _q_between_rules(rule, out, finer, finer_out, bands)), shift
+    return max(outputs, _q_between_rules(space, rule, out, finer, finer_out, bands)), shift
 
 
 #: The finest the zone ends are asked to for q beside them [half-widths]. What they
@@ -480,7 +498,17 @@ class OnePunchMarches:
         return march_outputs(run), run
 
     distance = staticmethod(_distance)
-    rule_distance = staticmethod(_rule_distance)
+
+    def rule_distance(self, rule: Panels, out: dict[str, Any], finer: Panels,
+                      finer_out: dict[str, Any], bands: list[tuple[float, float]]
+                      ) -> tuple[float, float]:
+        """:func:`_rule_distance` of this punch."""
+        return _rule_distance(self.space, rule, out, finer, finer_out, bands)
+
+    @staticmethod
+    def banded(bands: list[tuple[float, float]]) -> bool:
+        """Whether a rule on ``bands`` has band panels (the band width changes it)."""
+        return bool(bands)
     extrapolate = staticmethod(_extrapolate)
     borrow = staticmethod(_borrow_corrections)
 
@@ -696,6 +724,10 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         error, end_error = SPACE_FACTOR * diff, SPACE_FACTOR * shift
         if (error <= tol / 6 and end_error <= end_tol / 2) or width / 2.0 < BAND_WIDTHS[-1]:
             break
+        if not marches.banded(bands):
+            # no band panels, which the width would refine: the base is refined instead
+            # (the same rule, compared with itself, read 1e-14 with q 3e-7 off at tol 1e-7)
+            finer = marches.halved(finer)
         checking = marches.rule(finer, bands, width / 4.0)
         # (q off the bands missing its share asks the finer rule, whose base is finer too)
         if width / 2.0 < LAST_RESORT_BELOW and (

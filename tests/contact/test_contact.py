@@ -799,6 +799,10 @@ class _BandStub:
     def rule_distance(self, rule, a, finer, b, bands):
         return self.outputs, 1.0
 
+    @staticmethod
+    def banded(bands) -> bool:
+        return bool(bands)
+
 
 def test_band_panels_finer_than_0_005_are_a_last_resort(
         monkeypatch: pytest.MonkeyPatch) -> None:
