@@ -14,7 +14,7 @@
 
 from __future__ import annotations
 
-from core.creep.code_inputs import CEMENT_CLASSES, RANGES, STRENGTH_CLASS
+from core.creep.code_inputs import CEMENT_CLASSES, CUBE_STRENGTHS, RANGES, STRENGTH_CLASS
 from core.creep.design_codes import (
     DEFAULT_TOL_LADDER,
     FIT_ERROR_SHARE,
@@ -57,6 +57,7 @@ __all__ = [
     "SPEC_FIELDS",
     "stepping_kernel",
     "STRENGTH_CLASS",
+    "CUBE_STRENGTHS",
     "TERM_FIELDS",
     "UserKernel",
 ]

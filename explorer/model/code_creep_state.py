@@ -19,17 +19,17 @@ import numpy as np
 import param
 
 import core
-from core.creep import RANGES
+from core.creep import CUBE_STRENGTHS, RANGES
 
 #: The design-code creep models offered by name: spec model name -> label on screen.
 CODE_CREEP_MODELS: dict[str, str] = {
     "fib_mc2010": "fib Model Code 2010",
     "eurocode2": "Eurocode 2 (EN 1992-1-1, Annex B)",
 }
-#: Strength classes offered (EN 1992-1-1 Table 3.1); fcm = fck + 8 MPa in core.
-STRENGTH_CLASSES: tuple[str, ...] = (
-    "C20/25", "C25/30", "C30/37", "C35/45", "C40/50", "C45/55", "C50/60", "C55/67",
-    "C60/75", "C70/85", "C80/95", "C90/105")
+#: Strength classes offered: the tables' (EN 1992-1-1 Table 3.1, fib MC2010 to C120/140),
+#: as core reads them (fcm = fck + 8 MPa); a class a code does not cover is refused by core
+#: naming its range. Its own list here refused a scene's C12/15 that core accepts.
+STRENGTH_CLASSES: tuple[str, ...] = tuple(f"C{fck}/{cube}" for fck, cube in CUBE_STRENGTHS.items())
 #: Load durations of the plot [day]: 0.1 day to 100 years, log spaced.
 PLOT_DURATIONS: np.ndarray = np.geomspace(0.1, 36525.0, 161)
 
@@ -85,8 +85,10 @@ class CodeCreepState(param.Parameterized):
                                   "notional_size": spec["notional_size"],
                                   "temperature": spec.get("temperature", 20.0)}
         cls = spec.get("strength_class")
-        if isinstance(cls, str) and cls.replace(" ", "") in STRENGTH_CLASSES:
-            values["strength_class"] = cls.replace(" ", "")
+        # as core reads a class: spaces and the letter's case do not matter ("c30/37")
+        shown = cls.replace(" ", "").upper() if isinstance(cls, str) else None
+        if shown in STRENGTH_CLASSES:
+            values["strength_class"] = shown
         elif "fcm" in spec:
             values.update(strength_class="fcm", fcm=spec["fcm"])
         else:

@@ -84,3 +84,21 @@ def test_base_state_offers_the_code_models_and_round_trips_the_preset():
     state.base.code.relative_humidity = 20.0
     with pytest.raises(ValueError, match="base.creep.relative_humidity"):
         state.to_scene()
+
+
+def test_the_page_reads_every_class_core_reads():
+    """A scene's "c30/37" or C12/15 (taken by core) was refused on the page: its own
+    list, case-sensitive, began at C20/25. One list now, core's table."""
+    from core.creep import CUBE_STRENGTHS
+    from explorer.model import STRENGTH_CLASSES
+
+    assert STRENGTH_CLASSES == tuple(f"C{a}/{b}" for a, b in CUBE_STRENGTHS.items())
+    state = CodeCreepState()
+    base = {"model": "fib_mc2010", "relative_humidity": 60.0, "notional_size": 300.0}
+    for written, shown in (("c30/37", "C30/37"), ("C12/15", "C12/15"),
+                           ("C 120/140", "C120/140")):
+        state.load({**base, "strength_class": written})
+        assert state.strength_class == shown and state.spec()["strength_class"] == shown
+    with pytest.raises(ValueError, match="base.creep.strength_class: 'C30/99' is not one "
+                                         "of C12/15"):
+        state.load({**base, "strength_class": "C30/99"})
