@@ -117,7 +117,8 @@ class FitOutcome:
         fitted and saying from what: applied, it passed for the scene fitted (a saved
         file or report kept the preset's name)."""
         scene = self.calibration.scene.to_dict()
-        name = str(scene.get("name", ""))
+        # a fitted scene fitted again keeps one mark ("... (fitted) (fitted)")
+        name = str(scene.get("name", "")).removesuffix(" (fitted)") or "scene"
         values = "; ".join(f"{label} = {value} ± {se} {unit}".rstrip()
                            for label, value, se, unit in self.rows())
         scene["name"] = f"{name[: MAX_NAME_CHARS - 9]} (fitted)"

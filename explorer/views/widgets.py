@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import html
 import math
+import numbers
 from collections.abc import Callable
 from typing import Any
 
@@ -613,7 +614,8 @@ def _refit(widget: pn.widgets.Widget, value: Any, default: tuple[float, float]) 
     """After a change of ``value``: the default range again once the value is back in
     it (one typed 1e6 kN/m left the force slider at 0 to 2e6 for good, a pixel ~3,000
     kN/m), widened only where the value left the range shown."""
-    if not isinstance(value, (int, float)) or not math.isfinite(value):
+    if (not isinstance(value, numbers.Real) or isinstance(value, bool)
+            or not math.isfinite(value)):
         return
     lo, hi = default
     if lo <= value <= hi:
