@@ -62,7 +62,9 @@ LIFTED_LABEL = "lifted off (q = 0)"
 GIVEN_COLOR = "#8c8c8c"
 #: The readings of a back-analysis (Fit tab) and the fitted scene's forecast band.
 READINGS_COLOR = "#111111"
-FORECAST_COLOR = "#ff7f0e"
+#: The fitted scene's forecast: a colour no pin or punch takes (it was a pin's orange, and
+#: dashed like a pin, so a fitted curve read as pin 2)
+FORECAST_COLOR = "#17becf"
 #: The histories the readings of a back-analysis are drawn on.
 READ_SERIES = ("settlement", "tilt")
 
@@ -272,8 +274,8 @@ class Figures:
                                 name=f"forecast_{q}")
         p.varea(x="t", y1="lower", y2="upper", source=band, fill_color=FORECAST_COLOR,
                 fill_alpha=0.25)
-        p.line(x="t", y="v", source=band, line_color=FORECAST_COLOR, line_width=1.5,
-               line_dash="dashed")
+        p.line(x="t", y="v", source=band, line_color=FORECAST_COLOR, line_width=2,
+               line_dash="dotdash")
         src = ColumnDataSource(empty_columns("t", "v", "lower", "upper"),
                                name=f"readings_{q}")
         marks = p.scatter(x="t", y="v", source=src, size=6, color=READINGS_COLOR,

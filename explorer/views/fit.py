@@ -105,8 +105,10 @@ class FitView:
                       margin=0),
             self.readings_status, *self.fields, self.fit_button,
             self.fit_status, self.fit_table, self.apply_button,
-            html_pane(f"<small>The band on the histories is the fitted scene's "
-                      f"{100 * BAND_LEVEL:.0f} % band from the fields' uncertainty only, "
+            html_pane(f"<small>On the histories: the readings (black, with their "
+                      f"standard deviations) and the fitted scene's forecast (cyan, "
+                      f"dot-dashed) with its {100 * BAND_LEVEL:.0f} % band, from the "
+                      f"fields' uncertainty only, "
                       "not the model's error. Every step of a fit is a full solve at the "
                       "readings' times. Once the fitted values are applied, the printable "
                       "report (Files tab) carries the fit. The page's link keeps the "

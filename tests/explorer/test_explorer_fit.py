@@ -261,3 +261,11 @@ def test_a_served_fit_runs_in_a_worker_at_the_lower_priority(explorer_app, monke
     for name in ("settlement", "tilt", "settlement_std"):
         np.testing.assert_array_equal(getattr(fit.outcome.forecast, name),
                                       getattr(inline.forecast, name))
+
+
+def test_the_forecast_is_drawn_apart_from_the_pins_and_punches():
+    """The fitted curve was orange and dashed, as pin 2: a class read it as a pin."""
+    from explorer.plots import PIN_COLORS, PUNCH_COLORS
+    from explorer.plots.figures import FORECAST_COLOR
+
+    assert FORECAST_COLOR not in (*PIN_COLORS, *PUNCH_COLORS)
