@@ -37,9 +37,6 @@ PLOT_WIDTH, PLOT_HEIGHT = 400, 300
 PLOT_TITLES = ("contact pressure q(x, t) (grey: lifted off)", "settlement δ(t)", "tilt α(t)")
 #: Points of the geometry plots over [-a, a], besides both sides of every breakpoint.
 GEOMETRY_POINTS = 801
-#: The colours of the punches of several, in order (a line per punch in the histories).
-PUNCH_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2",
-                 "#17becf", "#7f7f7f")
 #: The shade of a punch's zone in the q(x) plot over the surface of several punches, and
 #: the group that tells its spans from the lift-off shade.
 ZONE_COLOUR, ZONE_GROUP = "#c6dbef", "Zone"

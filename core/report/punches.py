@@ -26,12 +26,12 @@ from core.report.inputs import number as _number
 from core.report.plots import (
     PLOT_HEIGHT,
     PLOT_WIDTH,
-    PUNCH_COLOURS,
     ZONE_COLOUR,
     ZONE_GROUP,
 )
 from core.scene import (
     LIFT_OFF_COLOUR,
+    PUNCH_COLOURS,
     PunchesSolution,
     PunchSolution,
     flagged_caution,

@@ -78,6 +78,7 @@ from core.scene.model import Scene
 from core.scene.pipeline import solve
 from core.scene.plotting import (
     LIFT_OFF_COLOUR,
+    PUNCH_COLOURS,
     holoviews_for_bokeh,
     pressure_unit,
     shown_times,
@@ -131,6 +132,7 @@ __all__ = [
     "LIFT_OFF_SHARE",
     "engine_text",
     "holoviews_for_bokeh",
+    "PUNCH_COLOURS",
     "known_contact_width",
     "percent_text",
     "largest_pressure",

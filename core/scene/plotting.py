@@ -1,6 +1,6 @@
-"""Plots of a :class:`~core.scene.SceneSolution` with HoloViews: the contact pressure q(x)
-at several times coloured by time, the settlement and the tilt over time, flags and
-lift-off in the titles.
+"""Plots of a :class:`~core.scene.SceneSolution` (and of several punches' answer) with
+HoloViews: the contact pressure q(x) at several times coloured by time, the settlement
+and the tilt over time, flags and lift-off in the titles.
 
 The only module of :mod:`core` that imports HoloViews, and only when a plot is asked for
 (``import core`` stays free of it). The plots carry options of the Bokeh backend, which
@@ -21,6 +21,7 @@ from core.scene.display import lifts_off_at, zones_text
 if TYPE_CHECKING:
     import holoviews
 
+    from core.scene.punches import PunchesSolution
     from core.scene.results import SceneSolution
 
 #: q(x) curves drawn when no times are asked for.
@@ -141,3 +142,48 @@ def plot_solution(result: SceneSolution, count: int = PLOT_CURVES,
     if result.flags:
         title += ": flags " + ", ".join(result.flags)
     return layout.opts(title=title, backend="bokeh")
+
+
+#: The colours of the punches of several, in order (a line per punch in the histories;
+#: the plots here and the report's).
+PUNCH_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2",
+                 "#17becf", "#7f7f7f")
+
+
+def plot_punches(result: PunchesSolution, count: int = PLOT_CURVES,
+                 times: Sequence[float] | None = None) -> holoviews.Layout:
+    """A HoloViews layout of an answer for several punches: q(x) [kPa or MPa] over the
+    surface (the global x [m]; each punch's plotting grid, q = 0 between them) at ``count``
+    output times (or those nearest to ``times`` [day]) coloured by time, and the
+    settlement [mm] and the tilt [mrad] over time with a line per punch; the flags in the
+    layout's title."""
+    hv = holoviews_for_bokeh("PunchesSolution.plot")
+    picked = shown_times(result.times, count, times)
+    x = result.x
+    q = result.pressure_on_grid[:, picked]
+    unit, size = pressure_unit(float(np.max(np.abs(q))) if q.size else 0.0)
+    colours = time_colours(len(picked))
+    x_dim = hv.Dimension("x", label="x", unit="m")
+    q_dim = hv.Dimension("q", label="q", unit=unit)
+    curves = [hv.Curve((x, q[:, j] / size), kdims=[x_dim], vdims=[q_dim],
+                       label=_days(result.times[k]))
+              .opts(color=colours[j], tools=["hover"], backend="bokeh")
+              for j, k in enumerate(picked)]
+    pressure = hv.Overlay(curves).opts(
+        title=f"{TITLES['pressure']}, {len(result.punches)} punches", width=PRESSURE_WIDTH,
+        height=PLOT_HEIGHT, legend_position="right", backend="bokeh")
+    t_dim = hv.Dimension("time", label="t", unit="day")
+    plots = [pressure]
+    for name, factor, shown in (("settlement", 1e3, "mm"), ("tilt", 1e3, "mrad")):
+        v_dim = hv.Dimension(name, label=name, unit=shown)
+        lines = [hv.Curve((result.times, np.asarray(getattr(p, name)) * factor),
+                          kdims=[t_dim], vdims=[v_dim], label=f"punches[{k}]")
+                 .opts(color=PUNCH_COLOURS[k % len(PUNCH_COLOURS)],
+                       tools=["hover"], backend="bokeh")
+                 for k, p in enumerate(result.punches)]
+        plots.append(hv.Overlay(lines).opts(title=TITLES[name], width=PLOT_WIDTH,
+                                            height=PLOT_HEIGHT, legend_position="right",
+                                            backend="bokeh"))
+    title = result.scene.name + (f": flags {', '.join(result.flags)}" if result.flags
+                                 else "")
+    return hv.Layout(plots).cols(3).opts(title=title, backend="bokeh")

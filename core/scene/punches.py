@@ -26,7 +26,7 @@ import copy
 import copyreg
 import json
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -365,6 +365,14 @@ class PunchesSolution:
         if not header:
             return table
         return csv_header(self, "contact pressure q(x, t) over the surface, x global") + table
+
+    def plot(self, count: int | None = None, times: Sequence[float] | None = None) -> Any:
+        """A ``holoviews.Layout``: q(x) over the surface at ``count`` output times (or
+        those nearest to ``times`` [day]) coloured by time, settlement [mm] and tilt [mrad]
+        over time with a line per punch (:func:`core.scene.plotting.plot_punches`)."""
+        from core.scene.plotting import PLOT_CURVES, plot_punches
+
+        return plot_punches(self, PLOT_CURVES if count is None else count, times)
 
     def to_xarray(self) -> Any:
         """The answer as an ``xarray.Dataset`` over ``punch``, ``time`` [day] and ``x`` [m,

@@ -132,3 +132,32 @@ def test_the_answer_as_an_xarray_dataset(pair: PunchesSolution, tmp_path) -> Non
     assert ds["moment"].attrs["units"] == "N" and ds["x"].attrs["units"] == "m"
     assert json.loads(ds.attrs["scene"]) == pair.scene.to_dict()
     ds.to_netcdf(tmp_path / "pair.nc")    # every attribute a string or a number
+
+
+def test_the_answer_plots_the_surface_and_every_punchs_histories(pair: PunchesSolution
+                                                                ) -> None:
+    """``result.plot()``, the README's route to a picture, was missing for several
+    punches: q over the surface coloured by time, a line per punch on the histories."""
+    import holoviews as hv
+    from bokeh.models import Axis
+
+    from core.scene import PUNCH_COLOURS
+
+    layout = pair.plot(count=3)
+    assert isinstance(layout, hv.Layout) and len(layout) == 3
+    pressure, settlement, tilt = layout
+    curves = list(pressure)
+    assert len(curves) == 3 and curves[0].kdims[0].unit == "m"
+    np.testing.assert_allclose(curves[-1].dimension_values(0), pair.x, rtol=0)
+    for overlay, name in ((settlement, "settlement"), (tilt, "tilt")):
+        lines = list(overlay)
+        assert [c.label for c in lines] == ["punches[0]", "punches[1]"]
+        for k, line in enumerate(lines):
+            np.testing.assert_allclose(line.dimension_values(1),
+                                       np.asarray(getattr(pair.punches[k], name)) * 1e3,
+                                       rtol=1e-15)
+            assert line.opts.get("style", backend="bokeh").kwargs["color"] == \
+                PUNCH_COLOURS[k]
+    labels = {a.axis_label for a in hv.render(layout, backend="bokeh").select(
+        {"type": Axis})}
+    assert {"x (m)", "t (day)", "settlement (mm)", "tilt (mrad)"} <= labels
