@@ -24,7 +24,9 @@ from bokeh.models import (
 )
 from bokeh.plotting import figure
 
-from ..model import Geometry, ResultView, plain_number
+from core.scene import PUNCH_COLOURS
+
+from ..model import SCREEN_PUNCHES, Geometry, ResultView, plain_number
 from .bokeh_data import MOVING, f32
 from .contact import ContactDrawing
 
@@ -35,8 +37,9 @@ _SLABS = 120
 TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
 #: The colour of each punch of a scene of several, in order (drawing, histories,
-#: readout): Bokeh's Category10 less its red, which marks loads and lift-off.
-PUNCH_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd")
+#: readout): core's (its plots and reports), Bokeh's Category10 less its red, which marks
+#: loads and lift-off; as many as the page edits.
+PUNCH_COLORS = PUNCH_COLOURS[:SCREEN_PUNCHES]
 
 
 def _nice(value: float) -> float:
