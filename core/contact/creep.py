@@ -498,6 +498,8 @@ class OnePunchMarches:
         return march_outputs(run), run
 
     distance = staticmethod(_distance)
+    extrapolate = staticmethod(_extrapolate)
+    borrow = staticmethod(_borrow_corrections)
 
     def rule_distance(self, rule: Panels, out: dict[str, Any], finer: Panels,
                       finer_out: dict[str, Any], bands: list[tuple[float, float]]
@@ -509,8 +511,6 @@ class OnePunchMarches:
     def banded(bands: list[tuple[float, float]]) -> bool:
         """Whether a rule on ``bands`` has band panels (the band width changes it)."""
         return bool(bands)
-    extrapolate = staticmethod(_extrapolate)
-    borrow = staticmethod(_borrow_corrections)
 
     def bands(self, out: dict[str, Any], bands: list[tuple[float, float]] | None = None
               ) -> list[tuple[float, float]]:

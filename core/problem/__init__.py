@@ -30,6 +30,7 @@ from core.problem.result import (
     ContactSolution,
     SolveOutcome,
     accepts,
+    positions,
     pressure_positions,
 )
 from core.problem.statements import (
@@ -49,6 +50,7 @@ __all__ = [
     "Geometry",
     "INFO_KEYS",
     "modal_system",
+    "positions",
     "pressure_positions",
     "ModalSystem",
     "QUANTITIES",

@@ -63,6 +63,7 @@ import numpy as np
 
 from core import limits
 from core.discretize import Basis
+from core.validation import show_value
 
 #: The ``info`` keys every engine's answer carries (see the module notes).
 INFO_KEYS = ("method", "success", "message", "flags", "error_estimate",
@@ -120,27 +121,38 @@ class SolveOutcome:
                 f"; flags: {', '.join(self.flags) or 'none'}>")
 
 
-# repr=False: the short repr of SolveOutcome, not every array and the whole info
-def pressure_positions(x: Any, times: int) -> np.ndarray:
-    """``x`` as points of [-1, 1] (dimensionless) where q is asked at ``times`` output
-    times: a number or a 1-D list of them, at most :data:`core.limits.MAX_PRESSURE_VALUES`
-    values in all (5e6 points at one time took 94 s). ValueError naming ``x`` otherwise."""
+def positions(x: Any, times: int, unit: str = "") -> np.ndarray:
+    """``x`` as positions where a pressure is asked at ``times`` output times: a number or
+    a 1-D list of finite numbers, at most :data:`core.limits.MAX_PRESSURE_VALUES` values in
+    all (5e6 points at one time took 94 s). ValueError naming ``x`` (and ``unit``, "m" for
+    a scene's) otherwise: a text, a 2-D array or NaN gave NumPy's own messages."""
+    written = f" [{unit}]" if unit else ""
     try:
         xs = np.atleast_1d(np.asarray(x, dtype=float))
     except (TypeError, ValueError):
-        raise ValueError("x: positions must be numbers in [-1, 1]") from None
+        raise ValueError(f"x: positions must be numbers{written}, got {show_value(x)}"
+                         ) from None
     if xs.ndim != 1:
-        raise ValueError(f"x: a number or a list of positions (one dimension), got an "
-                         f"array of shape {xs.shape}; pass x.ravel() and reshape the rows")
+        raise ValueError(f"x: a number or a list of positions{written} (one dimension), got "
+                         f"an array of shape {xs.shape}; pass x.ravel() and reshape the rows")
     if xs.size * max(times, 1) > limits.MAX_PRESSURE_VALUES:
         raise ValueError(f"x: {xs.size} points at {times} times are more than the "
                          f"{limits.MAX_PRESSURE_VALUES} pressure values one call may "
                          "compute; ask for fewer points (or in several calls)")
-    if np.any(~np.isfinite(xs)) or np.any(np.abs(xs) > 1.0):
+    if not np.all(np.isfinite(xs)):
+        raise ValueError(f"x: positions must be finite numbers{written}")
+    return xs
+
+
+def pressure_positions(x: Any, times: int) -> np.ndarray:
+    """:func:`positions` of the dimensionless answers, on [-1, 1]."""
+    xs = positions(x, times)
+    if np.any(np.abs(xs) > 1.0):
         raise ValueError("x: pressure is defined on [-1, 1] only")
     return xs
 
 
+# repr=False: the short repr of SolveOutcome, not every array and the whole info
 @dataclass(frozen=True, repr=False)
 class ContactSolution(SolveOutcome):
     """The answer of every engine, full contact (all quantities dimensionless).

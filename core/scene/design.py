@@ -258,6 +258,12 @@ class DesignCheck:
                 return c
         raise KeyError(quantity)
 
+    def summary(self, flags: Sequence[str] = ()) -> str:
+        """The verdict (:func:`verdict_words` with the answer's ``flags``) and every limit's
+        line, on one line: what the files' ``# design_check:`` header holds."""
+        return (f"{verdict_words(self.passed, flags)}; "
+                + "; ".join(line.describe() for line in self.checks))
+
     def to_dict(self) -> dict[str, Any]:
         """A JSON-able dict: ``passed`` and one entry per line (``checks``, ``q_min``)."""
         return {"passed": self.passed, "checks": [c.to_dict() for c in self.checks],

@@ -13,7 +13,6 @@ import json
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
-from core.scene.design import verdict_words
 from core.scene.validate import scene_from_dict
 from core.version import VERSION
 
@@ -82,6 +81,5 @@ def csv_header(result: Any, what: str) -> str:
         if several else [("", result.design_check(), result.flags)]
     for who, check, flags in checks:
         if check is not None:
-            lines.append(f"# {who}design_check: {verdict_words(check.passed, flags)}; "
-                         + "; ".join(line.describe() for line in check.checks))
+            lines.append(f"# {who}design_check: {check.summary(flags)}")
     return "\n".join(lines) + "\n"

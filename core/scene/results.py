@@ -15,11 +15,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from core import limits
 from core.cache import StageCache, fingerprint
 from core.coating import model_error_estimate, model_error_map, tilt_share
 from core.engines.layered import EXACT_LAYERED, NO_COATING, corner_reach, uniform_layers
-from core.problem import QUANTITIES
+from core.problem import QUANTITIES, positions
 from core.scene.contact_zone import (
     LIFT_OFF_SHARE,
     contact_width,
@@ -34,7 +33,6 @@ from core.scene.load_rates import oscillations
 from core.scene.model import Scene
 from core.scene.records import PROGRAM, csv_header
 from core.scene.schema import SCHEMA_VERSION, _jsonable
-from core.validation import show_value
 from core.version import VERSION
 
 if TYPE_CHECKING:
@@ -140,25 +138,9 @@ def scene_model_error(scene: Scene, share_of_tilt: float,
 
 
 def pressure_points(x: Any, times: int) -> np.ndarray:
-    """``x`` as positions [m] where a pressure is asked at ``times`` output times: a number
-    or a list (a 1-D array) of finite numbers, at most
-    :data:`core.limits.MAX_PRESSURE_VALUES` values in all. Raises ValueError naming
-    ``x`` (a text, a 2-D array or NaN gave NumPy's own messages)."""
-    try:
-        xs = np.atleast_1d(np.asarray(x, dtype=float))
-    except (TypeError, ValueError):
-        raise ValueError(f"x: positions must be numbers [m], got {show_value(x)}") from None
-    if xs.ndim != 1:
-        raise ValueError(f"x: a number or a list of positions [m] (one dimension), got an "
-                         f"array of shape {xs.shape}; pass x.ravel() and reshape the rows")
-    if xs.size * times > limits.MAX_PRESSURE_VALUES:
-        raise ValueError(
-            f"x: {xs.size} points at {times} times are more than the "
-            f"{limits.MAX_PRESSURE_VALUES} pressure values one call may compute; ask "
-            "for fewer points (or in several calls)")
-    if not np.all(np.isfinite(xs)):
-        raise ValueError("x: positions must be finite numbers [m]")
-    return xs
+    """``x`` as positions [m] where a pressure is asked at ``times`` output times
+    (:func:`core.problem.positions`)."""
+    return positions(x, times, "m")
 
 
 def corner_pressure(scene: Scene, coating_model: str,

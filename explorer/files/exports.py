@@ -24,7 +24,7 @@ import numpy as np
 
 import core
 from core.scene import DesignLimits as CoreLimits
-from core.scene import check_design, provenance_lines, verdict_words
+from core.scene import check_design, provenance_lines
 from core.study import PUNCH_OUTPUT
 
 from ..model import (
@@ -113,8 +113,7 @@ def _header(view: ResultView, what: str, units: Iterable[str],
         check = check_design(view.times, view.x, view.pressure, view.values["settlement"],
                              view.values["tilt"], CoreLimits(**scene["limits"]),
                              view.info.get("corner_pressure"))
-        lines.append(f"# design_check: {verdict_words(check.passed, view.flags)}; "
-                     + "; ".join(line.describe() for line in check.checks))
+        lines.append(f"# design_check: {check.summary(view.flags)}")
     flags = flag_lines(view)
     if flags:
         lines.append("# WARNING: this result is flagged; the model cannot fully stand "

@@ -79,20 +79,26 @@ TIGHT_NUMBER_BOX = ("input.bk-input { padding-left: 4px; padding-right: 16px; }\
                     ".bk-spin-btn { width: 14px; }")
 
 
-class NumberBox(pn.widgets.FloatInput):
+class _OwnStyle:
+    """A widget carrying the style sheet ``_own_css`` after those it is given."""
+
+    _own_css = ""
+
+    def __init__(self, **params: Any) -> None:
+        params["stylesheets"] = [*params.get("stylesheets", []), self._own_css]
+        super().__init__(**params)
+
+
+class NumberBox(_OwnStyle, pn.widgets.FloatInput):
     """A FloatInput whose arrow buttons are named."""
 
-    def __init__(self, **params: Any) -> None:
-        params["stylesheets"] = [*params.get("stylesheets", []), _SPIN_LABELS_CSS]
-        super().__init__(**params)
+    _own_css = _SPIN_LABELS_CSS
 
 
-class CountBox(pn.widgets.IntInput):
+class CountBox(_OwnStyle, pn.widgets.IntInput):
     """An IntInput whose arrow buttons are named."""
 
-    def __init__(self, **params: Any) -> None:
-        params["stylesheets"] = [*params.get("stylesheets", []), _SPIN_LABELS_CSS]
-        super().__init__(**params)
+    _own_css = _SPIN_LABELS_CSS
 
 
 class PromptFloatInput(NumberBox):
@@ -139,15 +145,12 @@ _PLAYER_LABELS_CSS = "\n".join([
       for name, label in PLAYER_BUTTONS.items())])
 
 
-class TimePlayer(pn.widgets.Player):
+class TimePlayer(_OwnStyle, pn.widgets.Player):
     """The player of the output times, left out of Panel's busy count (see above), its
     buttons named (``PLAYER_BUTTONS``)."""
 
     _busy__ignore = _NOT_BUSY
-
-    def __init__(self, **params: Any) -> None:
-        params["stylesheets"] = [*params.get("stylesheets", []), _PLAYER_LABELS_CSS]
-        super().__init__(**params)
+    _own_css = _PLAYER_LABELS_CSS
 
 
 class LabelledCheckbox(pn.viewable.Viewer):
