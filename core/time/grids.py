@@ -36,8 +36,16 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
     ``graded``: the first interval after the start and after each jump is split at
     ``length / 2**k`` (k = 1 .. graded) from its start before its steps are counted, so
     the steps grow geometrically out of the start (a creep law's transient just after a
-    load is applied, such as the ``(t - t0)^0.3`` of the design codes); these points do
-    not depend on ``refine``, so halving stays exact.
+    load is applied, such as the ``(t - t0)^0.3`` of the design codes); beyond that
+    interval, points at ``length * 2**k`` (k = 1, 2, ...) from the start, up to the next
+    jump, keep the steps growing at most twofold per interval (a design code's decays
+    spread over decades of time, so each one meets steps of the same size relative to its
+    decay time on every grid; with equal steps between output times a decade apart the
+    halved grids' differences shrank irregularly, ratios 3.5 then 2.2, and their Richardson
+    value of the fib MC2010 preset with 6 log-spaced outputs read 2.1e-4 off against an
+    estimate of 2.7e-5; now ratios 3.7 to 4.0). None falls within an eighth of its
+    distance from the start of a requested time. These points do not depend on
+    ``refine``, so halving stays exact.
 
     ``windows``: (from, to, longest step): the intervals between ``from`` and ``to`` (each
     ``to`` an interval end) get steps no longer than that (a creep law's decay, stepped
@@ -51,11 +59,19 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
     sides = {j: JUMP_SIDE * max(1.0, abs(j)) for j in inside}
     if graded:
         marks = np.unique(np.concatenate([times, inside]))
-        for start in [1.0] + [j + sides[j] for j in inside]:
+        starts = [1.0] + [j + sides[j] for j in inside]
+        for start, stop in zip(starts, starts[1:] + [float(times[-1])], strict=True):
             after = marks[marks > start * (1.0 + 1e-9)]
             if after.size:
                 length = float(after[0]) - start
                 ends += [(start + length * 2.0**-k, -1) for k in range(graded, 0, -1)]
+                # and on out of it, doubling, up to the next jump: the decays of a law
+                # whose rates spread over decades then each meet steps of one size
+                # relative to their decay time, at every halving alike
+                grown = start + length * 2.0 ** np.arange(1, 64)
+                # (not beside a requested time: a sliver of an interval buys nothing)
+                ends += [(float(t), -1) for t in grown[grown < stop * (1.0 - 1e-9)]
+                         if not np.any(np.abs(marks - t) <= (t - start) / 8.0)]
     # a window shorter than the nominal step ends on an interval end, so that each
     # interval is inside it or outside it
     windows = [(float(a), float(b), float(step)) for a, b, step in windows if step < h]

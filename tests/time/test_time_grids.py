@@ -118,3 +118,23 @@ def test_general_kernel_grid_holds_the_jumps():
     error = float(np.max(np.abs(sol.w[0] - exact)) / np.max(np.abs(exact)))
     # measured 1.1e-9, the estimate 1.1e-9
     assert sol.success and error <= 1e-8
+
+
+def test_a_graded_grid_grows_geometrically_out_of_each_start_and_halves_exactly():
+    from core.time import time_grid
+    times = np.array([1.0, 3.6, 15.7, 83.5, 465.0, 2610.0])
+    grid, widths, index = time_grid(times, 16, 0, jumps=(), graded=10)
+    assert np.array_equal(grid[index], times)
+    # beyond the first output: marks at 1 + 2.6 * 2^k, but none within 1/8 of its spacing of
+    # an output time (83.5 beside 1 + 2.6 * 32 = 84.2)
+    for k in (1, 2, 3, 4, 6, 7, 8, 9):
+        assert np.any(np.isclose(grid, 1.0 + 2.6 * 2.0**k)), k
+    assert not np.any(np.isclose(grid, 1.0 + 2.6 * 32.0))
+    # no step longer than the time since the start (until the nominal step takes over)
+    since = grid[1:-1] - 1.0
+    early = grid[2:] < 2610.0 / 16
+    assert np.all(widths[1:][early] <= since[early] * (1.0 + 1e-12))
+    # each halving halves every step of the grid before it
+    fine, fine_widths, fine_index = time_grid(times, 16, 1, jumps=(), graded=10)
+    assert np.array_equal(fine[::2], grid) and np.array_equal(fine[fine_index], times)
+    assert np.allclose(fine_widths[::2], widths / 2.0, rtol=1e-12, atol=0.0)
