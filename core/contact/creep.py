@@ -16,7 +16,7 @@ with the one of halved panels over a few of the output times (:func:`_select_rul
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -207,9 +207,16 @@ def _distance(a: dict[str, Any], b: dict[str, Any]) -> tuple[float, float]:
     return float(outputs), shift
 
 
+#: The other punches' part of q's formula at points ``x`` of one punch (several punches
+#: on one base): for each, its rows there and its effective densities over the output
+#: times, ``(rows (len(x), N_r), effective (N_r, times))``.
+Others = Callable[[np.ndarray], Sequence[tuple[np.ndarray, np.ndarray]]]
+
+
 def _q_between_rules(space: Space, rule: Panels, out: dict[str, Any], finer: Panels,
                      finer_out: dict[str, Any],
-                     bands: Sequence[tuple[float, float]] = ()) -> float:
+                     bands: Sequence[tuple[float, float]] = (),
+                     others: Others | None = None) -> float:
     """The largest change of q at the nodes of ``rule`` (the march ``out`` on it) from the
     pressure formula of the march ``finer_out`` on the rule ``finer`` there
     (:func:`nystrom_pressure` of its effective density), relative to the largest q, at
@@ -227,7 +234,10 @@ def _q_between_rules(space: Space, rule: Panels, out: dict[str, Any], finer: Pan
     (core/contact/kinks.py): compared there it read 5.8e-7 at x = -0.455 on a crowned
     punch whose answer was within 5.8e-8 (and took the rule from 1056 to 1760 nodes);
     there the ends' error times q's slope beside them is q's estimate
-    (``controlled_march``)."""
+    (``controlled_march``).
+
+    ``others``: the other punches on the base push this one's surface too; their part
+    of the formula (:data:`Others`, from the finer march)."""
     q = out["q"]
     fixed = np.asarray(space.breakpoints, dtype=float)
     times = [k for k in range(q.shape[1])
@@ -249,6 +259,7 @@ def _q_between_rules(space: Space, rule: Panels, out: dict[str, Any], finer: Pan
         return 0.0
     x = x[kept]
     rows = operator_rows(space.lam, finer, x)
+    pushing = () if others is None else others(x)
     worst = 0.0
     for k in times:
         # where both marches touch (zones may end at a step of the punch: off them q is 0
@@ -258,10 +269,13 @@ def _q_between_rules(space: Space, rule: Panels, out: dict[str, Any], finer: Pan
             inside &= nodes_in(x, list(zip(ends[0::2], ends[1::2], strict=True)))
         if not inside.any():
             continue
+        push = sum((-(r[inside] @ effective[:, k]) for r, effective in pushing),
+                   np.zeros(int(inside.sum())))
         formula = nystrom_pressure(
             space, Step(float(finer_out["c"][k]), 1.0, {}), finer,
             finer_out["effective"][:, k], float(finer_out["settlement"][k]),
-            float(finer_out["tilt"][k]), x[inside], rows=rows[inside])
+            float(finer_out["tilt"][k]), x[inside], rows=rows[inside],
+            memory_at=lambda _, push=push: push)
         worst = max(worst, float(np.max(np.abs(q[kept, k][inside] - formula))))
     return worst / max(float(np.max(np.abs(q))), 1e-300)
 
