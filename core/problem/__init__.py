@@ -39,6 +39,7 @@ from core.problem.statements import (
     ModalSystem,
     UnresolvedOperator,
     modal_system,
+    real_modes,
     statement_number,
 )
 
@@ -54,6 +55,7 @@ __all__ = [
     "pressure_positions",
     "ModalSystem",
     "QUANTITIES",
+    "real_modes",
     "Scalar",
     "SolveOutcome",
     "statement_number",

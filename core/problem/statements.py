@@ -113,7 +113,7 @@ class ModalSystem:
         return out
 
 
-def _real_modes(gamma: np.ndarray, psi: np.ndarray) -> np.ndarray:
+def real_modes(gamma: np.ndarray, psi: np.ndarray) -> np.ndarray:
     """Real eigenvectors from those of ``np.linalg.eig`` (columns of ``psi``).
 
     A nearly double eigenvalue may come out as a complex pair ``a +- ib`` (|b| at
@@ -164,7 +164,7 @@ def _free_modes(r_rot: np.ndarray, free: np.ndarray, groups: np.ndarray | None
     for part in parts:
         values, vectors = np.linalg.eig(r_rot[np.ix_(free[part], free[part])])
         gamma[part] = values
-        psi[np.ix_(part, part)] = _real_modes(values, vectors)
+        psi[np.ix_(part, part)] = real_modes(values, vectors)
     scale = float(np.max(np.abs(gamma))) if gamma.size else 1.0
     if gamma.size and (np.max(np.abs(gamma.imag)) > 1e-8 * scale or np.min(gamma.real) <= 0):
         raise UnresolvedOperator("operator: eigenvalues not real and positive; the grid does "
