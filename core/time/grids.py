@@ -60,7 +60,8 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
     if graded:
         marks = np.unique(np.concatenate([times, inside]))
         starts = [1.0] + [j + sides[j] for j in inside]
-        for start, stop in zip(starts, starts[1:] + [float(times[-1])], strict=True):
+        stops = [j - sides[j] for j in inside] + [float(times[-1])]
+        for start, stop in zip(starts, stops, strict=True):
             after = marks[marks > start * (1.0 + 1e-9)]
             if after.size:
                 length = float(after[0]) - start

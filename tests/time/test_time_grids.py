@@ -138,3 +138,19 @@ def test_a_graded_grid_grows_geometrically_out_of_each_start_and_halves_exactly(
     fine, fine_widths, fine_index = time_grid(times, 16, 1, jumps=(), graded=10)
     assert np.array_equal(fine[::2], grid) and np.array_equal(fine[fine_index], times)
     assert np.allclose(fine_widths[::2], widths / 2.0, rtol=1e-12, atol=0.0)
+
+
+def test_a_graded_grid_grows_again_out_of_a_load_jump_and_never_inside_it():
+    from core.time import time_grid
+
+    times = np.array([1.0, 2.0, 50.0, 400.0, 3000.0])
+    jump = 100.0
+    grid, _, index = time_grid(times, 16, 0, jumps=(jump,), graded=6)
+    assert np.array_equal(grid[index], times)
+    side = 1e-12 * jump
+    assert not np.any((grid > jump - side * 0.5) & (grid < jump + side * 0.5))
+    # after the jump: the first interval (to 400) graded, then doubling (300 * 2, 4, ...)
+    after = jump + side
+    for k in (1, 2, 3):
+        assert np.any(np.isclose(after + 300.0 * 2.0**k, grid)) == (after + 300.0 * 2.0**k
+                                                                    < 3000.0), k
