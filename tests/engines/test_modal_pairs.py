@@ -82,3 +82,31 @@ def test_several_punches_modes_take_a_complex_pair_of_rounding_size_too():
     # decomposition then refuses it)
     assert np.linalg.cond(form.psi) < 1e3
     assert np.allclose(np.sort(form.gamma), np.sort(np.linalg.eigvals(operator).real))
+
+
+def test_modes_that_are_nearly_dependent_are_refused_not_marched(monkeypatch):
+    """Whatever makes the mode matrix singular, a probe vector taken through it and back
+    refuses the modes (the time grids' estimate cannot see it: both grids go through the
+    same inverse)."""
+    import pytest
+
+    import core.problem.statements as statements
+    from core.creep.models import ExponentialCreep
+    from core.engines.nystrom.prepared import PreparedContact
+    from core.problem import UnresolvedOperator, validate_geometry
+
+    real = statements.real_modes
+
+    def one_vector_twice(gamma, psi):
+        out = real(gamma, psi)
+        out[:, 1] = out[:, 0]
+        return out
+
+    from core.cache import clear_caches
+
+    clear_caches()  # (modes of this grid kept by an earlier test would not be rebuilt)
+    monkeypatch.setattr(statements, "real_modes", one_vector_twice)
+    law = ExponentialCreep(modulus=3e10, compliance=3e-11, rate=0.05).dimensionless_kernel(28.0)
+    prepared = PreparedContact(validate_geometry(1.0, 0.05, 0.0, (), 1e-8))
+    with pytest.raises(UnresolvedOperator, match="nearly dependent"):
+        prepared.solve([1.0, 2.0], kernel=law, force=1.0, moment=0.1)

@@ -260,10 +260,19 @@ class ModalForm:
         # of its inverse (0.6 ms at 142 modes). The modal drive of a unit settlement and
         # tilt: a load history then costs an outer product, not a solve at every time read
         r_fk = ms.r_rot[np.ix_(ms.free, ms.known)]
+        # (with a probe vector taken through psi and back: nearly dependent modes map
+        # every march back wrongly, and no comparison of two time grids sees it)
+        probe = np.random.default_rng(0).standard_normal(ms.free.size)
         drives = np.linalg.solve(ms.psi, np.column_stack(
-            [self.gap[ms.free], ms.e0_rot[ms.free], ms.e1_rot[ms.free], r_fk]))
+            [self.gap[ms.free], ms.e0_rot[ms.free], ms.e1_rot[ms.free], ms.psi @ probe,
+             r_fk]))
+        defect = float(np.max(np.abs(drives[:, 3] - probe), initial=0.0))
+        if defect > MODAL_ROUNDING_SHARE * tol * float(np.max(np.abs(probe), initial=1.0)):
+            raise UnresolvedOperator(
+                f"operator: its modes are nearly dependent (a probe vector comes back "
+                f"{defect:.1e} off); the grid does not resolve the problem")
         self.gap_free, self.settlement_free, self.tilt_free = drives[:, :3].T.copy()
-        self.coupling = drives[:, 3:] if self.k else np.zeros((len(ms.free), 1))
+        self.coupling = drives[:, 4:] if self.k else np.zeros((len(ms.free), 1))
         # nodal values of the modal coordinates (free) and of the known ones, with the
         # rotation and psi folded in: a history then costs one product with the nodes
         # instead of psi, the rotation and the nodes in turn (two N x N x T products)
