@@ -390,3 +390,27 @@ def test_a_time_grid_lands_on_both_sides_of_every_load_jump():
     assert np.allclose(np.diff(grid), widths, rtol=0, atol=1e-13)
     assert all(np.array_equal(a, b) for a, b in zip(time_grid(times, 4, 1, jumps=[]), plain,
                                                    strict=True))
+
+
+def test_an_elastic_answer_estimates_its_spatial_error_from_a_coarser_rule():
+    """Its panels are fixed: on an elastic base it claimed success with an estimate of 0
+    while q was 2.4e-2 off at the edges of a stiff coating (m = 1e-6: a layer ~m wide that
+    the default edge grading, 1e-4, does not resolve). The rule one level coarser now
+    gives the spatial estimate. Reference: the default engine at tol 1e-11."""
+    from core.solver import solve_dimensionless
+
+    x = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 801),
+                                  -1.0 + np.geomspace(1e-10, 1e-2, 20),
+                                  1.0 - np.geomspace(1e-10, 1e-2, 20)]))
+    for m in (1e-6, 1e-3, 0.05):
+        reference = solve_dimensionless(1.0, m, 0.0, [1.0], force=1.0, moment=0.3, tol=1e-11)
+        answer = solve_dimensionless(1.0, m, 0.0, [1.0], force=1.0, moment=0.3, tol=1e-6,
+                                     method="collocation")
+        exact = reference.pressure(x)
+        error = float(np.max(np.abs(answer.pressure(x) - exact)) / np.max(np.abs(exact)))
+        estimate = answer.info["error_estimate"]
+        # measured (estimate, error): m 1e-6 (0.27, 2.4e-2), refused; 1e-3 (6.7e-7,
+        # 5.0e-8); 0.05 (3.5e-10, 2.5e-11)
+        assert answer.info["spatial_error_estimate"] == estimate  # elastic: no time error
+        assert error <= estimate, m
+        assert answer.info["success"] == (m > 1e-6), m

@@ -2,8 +2,9 @@
 
 Meant for cross-checks, not for speed (O(N steps^2) in time): it shares nothing with the
 other engines but the panel quadrature. Its panels are fixed by ``panels_per_unit`` and
-``edge_width``; ``tol`` sets only the time grid, the one part of its error it estimates
-(Richardson over halved grids, :mod:`core.engines.collocation.steps`).
+``edge_width``; ``tol`` sets the time grid (Richardson over halved grids,
+:mod:`core.engines.collocation.steps`), and on an elastic base the rule one level
+coarser estimates the spatial error (under creep it is not estimated).
 """
 
 from __future__ import annotations
