@@ -18,6 +18,7 @@ from core.contact.creep import free_end_slope
 from core.contact.result import UNILATERAL_MARGIN
 from core.creep.kernels import DegenerateKernel
 from core.solver import solve_dimensionless
+from tests.support.creep_laws import sparse_preset
 from tests.support.scenes import CONCRETE
 
 EXPONENTIAL = DegenerateKernel(age_at_loading=1.0, modulus_final=1.0, beta=0.0, alpha=0.0,
@@ -219,19 +220,9 @@ def test_two_punches_under_creep_estimate_q_at_their_edges() -> None:
     # at tol 1e-7, success with q 1.9e-7 off at x = -0.999995 (estimate 1.2e-8). With q
     # compared between the rules, each punch's formula with the other's push: measured
     # 2.2e-8 against an estimate of 2.4e-8.
-    import copy
-
-    import core
-
-    def solve(contact: str, tol: float):
-        scene = copy.deepcopy(core.load_scene("preset:new_footing_beside_old").to_dict())
-        scene["times"] = {"end": 18262.5, "count": 6, "spacing": "log"}
-        scene["solver"] = {"tol": tol, "contact": contact}
-        return core.solve(scene)
-
-    exact = solve("full", 1e-8)
+    exact = sparse_preset("new_footing_beside_old", "full", 1e-8)
     assert exact.info["success"] and not exact.flags
-    answer = solve("unilateral", 1e-7)
+    answer = sparse_preset("new_footing_beside_old", "unilateral", 1e-7)
     assert answer.info["success"]
     near = np.geomspace(1e-10, 1e-2, 40)
     x = np.unique(np.concatenate([X, -1.0 + near, 1.0 - near]))

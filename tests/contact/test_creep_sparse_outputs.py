@@ -23,6 +23,7 @@ import core.contact.creep as creep
 from core.contact.creep import transient_windows
 from core.creep.kernels import DegenerateKernel
 from core.time import time_grid
+from tests.support.creep_laws import sparse_preset
 
 
 def _design_point(moment: float, contact: str = "unilateral", tol: float = 1e-6):
@@ -117,15 +118,9 @@ def test_a_code_law_with_decades_between_its_outputs_is_honest() -> None:
     # value read 2.1e-4 off at tol 1e-4 (estimate 2.7e-5). The grids now grow geometrically
     # out of the loading: ratios 3.7, 3.9, 4.0; measured 1.4e-6 against the estimate 2.5e-6
     # (tol 1e-4) and 1.1e-7 against 2.5e-7 (tol 1e-6).
-    def solve(contact: str, tol: float):
-        scene = copy.deepcopy(core.load_scene("preset:young_concrete_50_years").to_dict())
-        scene["times"] = {"end": 18262.5, "count": 6, "spacing": "log"}
-        scene["solver"] = {"tol": tol, "contact": contact}
-        return core.solve(scene)
-
-    exact = solve("full", 1e-8)  # estimate 6.0e-9
+    exact = sparse_preset("young_concrete_50_years", "full", 1e-8)  # estimate 6.0e-9
     assert exact.info["success"]
     for tol in (1e-4, 1e-6):
-        answer = solve("unilateral", tol)
+        answer = sparse_preset("young_concrete_50_years", "unilateral", tol)
         assert answer.info["contact"] == "unilateral" and answer.info["success"]
         assert _error(answer, exact) <= answer.info["error_estimate"] <= tol

@@ -260,3 +260,16 @@ def receding_errors(result, full_first: bool = False) -> dict[str, float]:
     lows = np.array([zones[0][0] for zones in result.contact_set])
     ends = float(np.max(np.abs(lows - [zone.lo for zone in reference["elastic"].zones])))
     return {"histories": histories, "q": q, "ends": ends}
+
+
+def sparse_preset(name: str, contact: str, tol: float, count: int = 6) -> Any:
+    """The preset ``name`` solved with ``count`` log-spaced output times over its 50 years
+    (decades apart), ``contact`` and ``tol`` (``core.solve``)."""
+    import copy
+
+    import core
+
+    scene = copy.deepcopy(core.load_scene(f"preset:{name}").to_dict())
+    scene["times"] = {"end": 18262.5, "count": count, "spacing": "log"}
+    scene["solver"] = {"tol": tol, "contact": contact}
+    return core.solve(scene)
