@@ -38,7 +38,9 @@ from core.problem.statements import (
     STATEMENTS,
     ModalSystem,
     UnresolvedOperator,
+    check_mode_probe,
     modal_system,
+    mode_probe,
     real_modes,
     statement_number,
 )
@@ -46,11 +48,13 @@ from core.problem.statements import (
 __all__ = [
     "accepts",
     "as_function",
+    "check_mode_probe",
     "check_values",
     "ContactSolution",
     "Geometry",
     "INFO_KEYS",
     "modal_system",
+    "mode_probe",
     "positions",
     "pressure_positions",
     "ModalSystem",

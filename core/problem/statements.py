@@ -113,6 +113,39 @@ class ModalSystem:
         return out
 
 
+def check_mode_probe(back: np.ndarray, probe: np.ndarray, limit: float) -> None:
+    """Refuse modes that are nearly dependent.
+
+    A mode matrix whose columns are nearly dependent maps every modal march back
+    wrongly, and no comparison of two time grids sees it (both pass through its
+    inverse): the probe vector taken through ``psi`` and back must come back.
+
+    Parameters
+    ----------
+    back : numpy.ndarray
+        ``psi^-1 (psi @ probe)`` as the caller's inverse or factors give it.
+    probe : numpy.ndarray
+        The probe vector (:func:`mode_probe`).
+    limit : float
+        The largest relative defect allowed (a share of tol).
+
+    Raises
+    ------
+    UnresolvedOperator
+        When the probe comes back more than ``limit`` times its size off.
+    """
+    defect = float(np.max(np.abs(back - probe), initial=0.0))
+    if defect > limit * float(np.max(np.abs(probe), initial=1.0)):
+        raise UnresolvedOperator(
+            f"operator: its modes are nearly dependent (a probe vector comes back "
+            f"{defect:.1e} off); the grid does not resolve the problem")
+
+
+def mode_probe(size: int) -> np.ndarray:
+    """The probe vector of :func:`check_mode_probe` (fixed: the same answer every run)."""
+    return np.random.default_rng(0).standard_normal(size)
+
+
 def real_modes(gamma: np.ndarray, psi: np.ndarray) -> np.ndarray:
     """Real eigenvectors from those of ``np.linalg.eig``.
 

@@ -81,9 +81,9 @@ class CollocationSolution(ContactSolution):
     ``richardson``, ``nodes`` and ``nodal_pressure`` (the collocation solution itself,
     arrays); this class only reads the last two as attributes. ``error_estimate`` is the
     estimated relative error of the time discretization (NaN for one fixed grid without
-    Richardson) plus, on an elastic base, the spatial one (``spatial_error_estimate``: the
-    distance from the rule one level coarser); under creep the spatial error is not
-    estimated (``spatial_error_estimate`` NaN), its panels being fixed by
+    Richardson) plus, on an elastic base, the spatial one (``spatial_error_estimate``:
+    twice the distance from the rule one level coarser); under creep the spatial error is
+    not estimated (``spatial_error_estimate`` NaN), its panels being fixed by
     ``panels_per_unit`` and ``edge_width`` (a cross-check: refine them to see it).
     """
 
@@ -258,12 +258,12 @@ def solve_prepared(prepared: CollocationGeometry, times: np.ndarray,
     given histories by name, ``time_points`` a fixed grid (None: grids doubled until the
     estimate meets ``prepared.tol``, named ``tol_name`` in the message).
 
-    On an elastic base the answer on the rule one level coarser (``prepared.coarse``)
-    gives the spatial estimate, its distance from this one (the histories, and q at this
-    rule's nodes by the coarser answer's formula), which overestimates this rule's error
-    by the convergence of a level. Without it a fixed rule claimed success with an
-    estimate of 0: q off by 2.4e-2 at the edges of a stiff coating (m = 1e-6), whose layer
-    the default edge grading (1e-4) does not resolve."""
+    On an elastic base the spatial estimate is :data:`COARSER_FACTOR` times this answer's
+    distance from the one on the rule one level coarser (``prepared.coarse``: the
+    histories, and q at this rule's nodes by the coarser answer's formula). Without it a
+    fixed rule claimed success with an estimate of 0: q off by 2.4e-2 at the edges of a
+    stiff coating (m = 1e-6), whose layer the default edge grading (1e-4) does not
+    resolve."""
     answer = _march_prepared(prepared, times, c, kernel, loads, time_points, richardson,
                              tol_name)
     if not (kernel is None or times[-1] <= 1.0) or not prepared.coarser:

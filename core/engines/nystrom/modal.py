@@ -34,7 +34,13 @@ import numpy as np
 
 from core.discretize import MIRROR_TOL, even_per_node, mirrored_rule
 from core.engines.nystrom.bordered import NystromGrid
-from core.problem import ModalSystem, UnresolvedOperator, modal_system
+from core.problem import (
+    ModalSystem,
+    UnresolvedOperator,
+    check_mode_probe,
+    modal_system,
+    mode_probe,
+)
 from core.time import ModalProblem, solve_degenerate, solve_general
 
 Function = Callable[[np.ndarray], np.ndarray]
@@ -262,15 +268,11 @@ class ModalForm:
         r_fk = ms.r_rot[np.ix_(ms.free, ms.known)]
         # (with a probe vector taken through psi and back: nearly dependent modes map
         # every march back wrongly, and no comparison of two time grids sees it)
-        probe = np.random.default_rng(0).standard_normal(ms.free.size)
+        probe = mode_probe(ms.free.size)
         drives = np.linalg.solve(ms.psi, np.column_stack(
             [self.gap[ms.free], ms.e0_rot[ms.free], ms.e1_rot[ms.free], ms.psi @ probe,
              r_fk]))
-        defect = float(np.max(np.abs(drives[:, 3] - probe), initial=0.0))
-        if defect > MODAL_ROUNDING_SHARE * tol * float(np.max(np.abs(probe), initial=1.0)):
-            raise UnresolvedOperator(
-                f"operator: its modes are nearly dependent (a probe vector comes back "
-                f"{defect:.1e} off); the grid does not resolve the problem")
+        check_mode_probe(drives[:, 3], probe, MODAL_ROUNDING_SHARE * tol)
         self.gap_free, self.settlement_free, self.tilt_free = drives[:, :3].T.copy()
         self.coupling = drives[:, 4:] if self.k else np.zeros((len(ms.free), 1))
         # nodal values of the modal coordinates (free) and of the known ones, with the

@@ -37,7 +37,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.engines.nystrom.modal import MODAL_ROUNDING_SHARE
-from core.problem import QUANTITIES, TimeInputs, UnresolvedOperator, real_modes
+from core.problem import (
+    QUANTITIES,
+    TimeInputs,
+    UnresolvedOperator,
+    check_mode_probe,
+    mode_probe,
+    real_modes,
+)
 from core.time import ModalProblem, solve_degenerate, solve_general
 
 #: Per punch: the column of ``E`` (0: ``1``, 1: ``x``) a given force or moment fixes, and
@@ -114,15 +121,8 @@ class CoupledModalForm:
                 f"operator: its modes reach {float(np.max(np.abs(self.gamma))):.1e} (a nearly "
                 "first-kind equation); the grid does not resolve the problem")
         psi_lu = np.linalg.inv(self.psi)
-        # Nearly dependent eigenvectors map every modal march back wrongly, and no
-        # comparison of two time grids sees it (both pass through this inverse): a probe
-        # vector taken there and back checks the decomposition.
-        probe = np.random.default_rng(0).standard_normal(self.psi.shape[1])
-        defect = float(np.max(np.abs(psi_lu @ (self.psi @ probe) - probe), initial=0.0))
-        if defect > MODAL_ROUNDING_SHARE * tol * float(np.max(np.abs(probe), initial=1.0)):
-            raise UnresolvedOperator(
-                f"operator: its modes are nearly dependent (a probe vector comes back "
-                f"{defect:.1e} off); the grid does not resolve the problem")
+        probe = mode_probe(self.psi.shape[1])
+        check_mode_probe(psi_lu @ (self.psi @ probe), probe, MODAL_ROUNDING_SHARE * tol)
         rotated_e = q_full.T @ columns  # (N, 2n)
         self.e_k, self.e_f = rotated_e[:k], rotated_e[k:]
         gap_rot = -(q_full.T @ (s_in * gap))
