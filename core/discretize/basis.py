@@ -21,9 +21,10 @@ Three bases are offered:
              geometrically toward +-1 and every breakpoint (:func:`graded_cuts`), with
              degrees growing away from them. ``m q`` has ``(x - x_e) ln|x - x_e|`` and an
              edge layer of width ~m at each such point; this basis converges geometrically
-             in the settlement, tilt *and* the interior pressure (measured, m = 0.05:
-             pressure 2.5e-5 / 4e-8 / 2e-10 at 64 / 128 / 192 functions, against
-             8.8e-5 / 7.9e-6 / 1.4e-6 for ``global``). Its functions have kinks at the
+             in the settlement, tilt *and* the pressure on the whole of [-1, 1], edges
+             included (measured, m = 0.05: pressure 5.3e-4 / 7.8e-6 / 3.0e-7 / 6e-10 at
+             64 / 128 / 192 / 512 functions; on interior points only, ``global`` is still
+             1.4e-6 off at 192). Its functions have kinks at the
              element ends, so the Galerkin form needs
              :func:`core.discretize.galerkin_correction` on panels broken at the ends.
 

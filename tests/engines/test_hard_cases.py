@@ -1,23 +1,25 @@
 """The projection solver on the hard cases of the benchmark suite (smaller versions).
 
 For every case: convergence under refinement at an asserted algebraic rate, finite
-answers, equilibrium (int q = P, int x q = M), an error estimate within a factor 10 of
+answers, equilibrium (int q = P, int x q = M), an error estimate that bounds
 the error measured against an independent reference, and no claim of success for a
 tolerance that was not met. Then: orthonormality of large bases, extreme ``lam``, loads
 that reverse sign under creep, and a stiff creep kernel against its closed form.
 
 Errors are measured as the solver defines its tolerance: settlement and tilt relative to
 ``max(|delta|, |alpha|)``, force and moment relative to ``max(|P|, |M|)``, the pressure
-on interior points (|x| <= 0.95, 0.02 off breakpoints) relative to ``max|q|``, the largest
-over all output times. Every bound below quotes the value measured with the
-double-precision kernel (commit 4cf3e0b, graded default basis); margins leave room for
-other BLAS builds.
+on the whole of [-1, 1] (edges and both sides of every jump approached to 1e-10)
+relative to ``max|q|``, the largest over all output times. Every bound below quotes the
+value measured with the double-precision kernel; margins leave room for other BLAS
+builds.
 
-Checks that fail on that commit are solver defects, not loose bounds (numbers in the
-comments at each test): success is claimed for tolerances that were not met on the ten
-layers at tol 1e-3 (error 2.4e-3, estimate 9.3e-4), on the modulus jump at tol 1e-8
-(1.8e-8, estimate 6.0e-9) and for the load reversing sign under creep at tol 1e-4
-(1.02e-4, estimate 3.7e-5).
+The pressure was once measured on interior points only (|x| <= 0.95, 0.02 off jumps),
+as the solver then promised it: on the whole interval the same answers were 5e-5 to 8e-4
+off at the edges while claiming success at tol 1e-6 (the graded mesh stopped at a tenth
+of the edge layer). Earlier defects caught here: success claimed on the ten layers at tol
+1e-3 (error 2.4e-3, estimate 9.3e-4), on the modulus jump at tol 1e-8 (1.8e-8, estimate
+6.0e-9) and for the load reversing sign under creep at tol 1e-4 (1.02e-4, estimate
+3.7e-5).
 """
 
 from __future__ import annotations
@@ -84,28 +86,33 @@ CASES = {
     "rough_punch": Case(1.0, smooth_m, rough_g, reference=(8, 1e-4)),
     "thin_base": Case(50.0, smooth_m),
     "thick_base": Case(0.05, smooth_m),
-    "no_coating": Case(1.0, 1e-4, reference=(8, 1e-4)),
+    "no_coating": Case(1.0, 1e-4, reference=(8, 1e-7)),
     "ten_layers": Case(1.0, ten_layer_m),
 }
 
-#: Algebraic rate of the error in the number of modes, fitted over n = 32, 64, 128, per
-#: basis. Measured, piecewise: modulus jump 3.49, stepped 3.33, rough 5.36 (the 20
-#: wavelengths are resolved between 64 and 128 modes), thin 3.41, thick 3.37, no coating
-#: 1.11 (square-root edge layers of width 1e-4), ten layers 3.38. Graded: modulus jump
-#: 6.41, stepped 5.18, rough 3.41, thin 7.04, thick 8.26, no coating 5.08, ten layers 4.87.
+#: Algebraic rate of the error (q on the whole of [-1, 1], edges included) in the number
+#: of modes, fitted over n = 64, 128, 256, per basis. Measured, piecewise: modulus jump
+#: 2.07, stepped 2.02, rough 2.62, thin 1.99, thick 2.00, no coating 1.19 (square-root
+#: edge layers of width 1e-4), ten layers 2.00. Graded: modulus jump 4.56, stepped 3.72,
+#: rough 3.97, thin 5.96, thick 6.80, no coating 5.22, ten layers 4.55. (On interior
+#: points only the rates were 3.3-3.5 and 4.9-8.3: the edges converge last.)
+RATE_COUNTS = (64, 128, 256)
 RATES = {
-    "piecewise": {"modulus_jump": 3.0, "stepped_punch": 3.0, "rough_punch": 4.5,
-                  "thin_base": 3.0, "thick_base": 3.0, "no_coating": 0.9, "ten_layers": 3.0},
-    "graded": {"modulus_jump": 5.5, "stepped_punch": 4.5, "rough_punch": 3.0,
-               "thin_base": 6.0, "thick_base": 7.0, "no_coating": 4.5, "ten_layers": 4.0},
+    "piecewise": {"modulus_jump": 1.8, "stepped_punch": 1.7, "rough_punch": 2.2,
+                  "thin_base": 1.7, "thick_base": 1.7, "no_coating": 1.0, "ten_layers": 1.7},
+    "graded": {"modulus_jump": 3.9, "stepped_punch": 3.2, "rough_punch": 3.4,
+               "thin_base": 5.0, "thick_base": 5.8, "no_coating": 4.5, "ten_layers": 3.9},
 }
 
 
 def sample_points(breakpoints=()):
-    xs = np.sort(np.cos(np.pi * (np.arange(96) + 0.5) / 96) * 0.95)
+    """The whole of [-1, 1]: 2001 even points, and 25 more toward each edge and each side
+    of every jump, from 5e-2 down to 1e-10 away (the solver promises q there too)."""
+    near = np.geomspace(1e-10, 0.05, 25)
+    xs = [np.linspace(-1.0, 1.0, 2001), -1.0 + near, 1.0 - near]
     for b in breakpoints:
-        xs = xs[np.abs(xs - b) > 0.02]
-    return xs
+        xs += [b - near, b + near]
+    return np.unique(np.clip(np.concatenate(xs), -1.0, 1.0))
 
 
 def relative_error(sol, ref, xs) -> float:
@@ -171,7 +178,7 @@ def integrals(sol, breakpoints=()) -> tuple[np.ndarray, np.ndarray]:
 @pytest.mark.parametrize("kind", list(RATES))
 @pytest.mark.parametrize("name", list(CASES))
 def test_converges_at_rate_under_mode_refinement(name, kind):
-    counts = (32, 64, 128)
+    counts = RATE_COUNTS
     errors = []
     for n in counts:
         sol = projection(name, n_modes=n, basis=kind)
@@ -202,14 +209,16 @@ REACHABLE = (1e-3, 1e-4, 1e-5)
 
 @pytest.mark.parametrize("tol", REACHABLE)
 @pytest.mark.parametrize("name", list(CASES))
-def test_error_estimate_within_factor_10(name, tol):
-    # Measured estimate / error at tol 1e-3, 1e-4, 1e-5 (graded default): modulus jump
-    # 3.6, 3.6, 0.75; stepped 0.36 (all three); rough 0.31, 1.08, 1.08; thin 0.77, 0.77,
-    # 0.97; thick 0.40, 0.40, 6.0; no coating 0.92, 6.1, 6.1; ten layers 0.39, 0.50, 0.62.
+def test_error_estimate_bounds_the_error(name, tol):
+    # Measured estimate / error (q on the whole of [-1, 1]) at tol 1e-3, 1e-4, 1e-5 (graded
+    # default): modulus jump 8.2, 22, 4.3; stepped 1.5, 7.2, 7.2; rough 4.4, 20, 20; thin
+    # 2.2, 1.5, 6.1; thick 6.3, 1.8, 25; no coating 7.1, 66, 7.1; ten layers 8.2, 4.5, 17.
+    # The estimate is floored at the last level difference (the basis converges in steps),
+    # so it reads high rather than low.
     sol = projection(name, tol=tol)
     measured = error_of(name, sol)
     ratio = sol.info["error_estimate"] / measured
-    assert 0.1 <= ratio <= 10.0, (sol.info["error_estimate"], measured, sol.info["n_modes"])
+    assert 0.6 <= ratio <= 100.0, (sol.info["error_estimate"], measured, sol.info["n_modes"])
 
 
 @pytest.mark.parametrize("tol", (1e-3, 1e-4, 1e-5, 1e-6, 1e-8))
@@ -230,19 +239,20 @@ def test_success_only_when_tol_met(name, tol):
 
 def test_beyond_reach_says_so():
     # No coating at 1e-9: the edge layers of width 1e-4 hold the graded basis at a measured
-    # 2.3e-8 with 256 modes (estimate 1.8e-8).
+    # 4.7e-9 with 512 modes (estimate 3.3e-8).
     sol = projection("no_coating", tol=1e-9)
     assert not sol.info["success"]
     assert "tol_not_met" in sol.info["flags"]
     assert error_of("no_coating", sol) > 1e-9
     assert sol.info["error_estimate"] > 1e-9
-    # The rough punch at 1e-6 (graded default): measured 1.6e-5 at 256 modes (estimate
-    # 1.7e-5).
+    # The rough punch at 1e-6 (graded default): measured 2.1e-6 at 512 modes (estimate
+    # 9.6e-6).
     sol = projection("rough_punch", tol=1e-6)
     assert not sol.info["success"] and "tol_not_met" in sol.info["flags"]
     assert error_of("rough_punch", sol) > 1e-6
     assert sol.info["error_estimate"] > 1e-6
-    # The piecewise basis on the rough punch at 1e-8: measured 1.9e-7 (estimate 2.1e-7).
+    # The piecewise basis on the rough punch at 1e-8: measured 1.5e-4 at 512 modes
+    # (estimate 4.1e-5).
     sol = projection("rough_punch", tol=1e-8, basis="piecewise")
     assert not sol.info["success"] and "tol_not_met" in sol.info["flags"]
     assert error_of("rough_punch", sol) > 1e-8
@@ -277,16 +287,17 @@ def test_basis_orthonormal_to_machine_precision_at_160_modes():
 
 def test_tiny_and_huge_lam_in_one_run():
     xs = sample_points()
-    for lam, n_measured in ((0.01, 96), (100.0, 32)):
+    for lam, n_measured in ((0.01, 256), (100.0, 256)):
         sol = solve_dimensionless(lam, 0.1, 0.0, [1.0], force=1.0, moment=0.1, tol=1e-5)
         ref = solve_collocation(lam, 0.1, 0.0, [1.0], force=1.0, moment=0.1,
                                 panels_per_unit=4, edge_width=1e-3)
         assert_finite(sol)
         measured = relative_error(sol, ref, xs)
-        # Measured: lam 0.01: error 5.5e-8, estimate 3.1e-7, 96 modes; lam 100: error
-        # 1.8e-6, estimate 2.3e-6, 32 modes (references accurate to 6e-11 and 2e-11).
+        # Measured: lam 0.01: error 1.9e-8, estimate 4.7e-7, 256 modes; lam 100: error
+        # 2.1e-8, estimate 1.3e-7, 256 modes (references within 6e-10 and 5e-10 of the
+        # Nystrom answer at tol 1e-11, edges included).
         assert sol.info["success"] and measured <= 1e-5
-        assert 0.1 <= sol.info["error_estimate"] / measured <= 10.0
+        assert 0.6 <= sol.info["error_estimate"] / measured <= 100.0
         assert sol.info["n_modes"] <= 2 * n_measured
         p, m = integrals(sol)
         assert abs(p[0] - 1.0) < 1e-13 and abs(m[0] - 0.1) < 1e-13  # measured <= 4.4e-16
@@ -303,11 +314,11 @@ def test_tiny_and_huge_lam_in_one_run():
 def creep_reference(loads_key: str):
     """Tight projection at the first and last output times.
 
-    192 modes (estimate 6.7e-10 aging, 8.5e-10 cyclic load, measured); time tol 1e-8
+    512 modes (estimate 2.1e-9 aging, 2.4e-9 cyclic load, measured); time tol 1e-8
     (aging: the settlement differs from tol 1e-10 by 4e-12 relative).
     """
     return solve_dimensionless(1.0, smooth_m, 0.0, CREEP_TIMES[[0, -1]], c=C_OF_T,
-                               kernel=KERNEL, n_modes=192, tol=1e-8, **CREEP_LOADS[loads_key])
+                               kernel=KERNEL, n_modes=512, tol=1e-8, **CREEP_LOADS[loads_key])
 
 
 def cyclic_force(t):
@@ -372,9 +383,9 @@ def test_creep_converges_in_time_at_high_order(loads_key):
 @pytest.mark.parametrize("loads_key", list(CREEP_LOADS))
 def test_creep_converges_in_modes(loads_key):
     # Error at the first and last times against the tight reference (graded default).
-    # Measured, n = 16, 32, 64: aging 1.0e-2, 4.2e-4, 5.8e-6 (rate 5.4; estimate / error
-    # 3.8, 2.3, 7.5); cyclic load 1.1e-2, 4.6e-4, 5.6e-6 (rate 5.5; 2.4, 2.4, 6.9).
-    counts = (16, 32, 64)
+    # Measured, n = 64, 128, 256: aging 2.4e-4, 1.1e-5, 1.8e-8 (rate 6.8; estimate /
+    # error 1.9, 1.8, 26); cyclic load 2.5e-4, 1.2e-5, 1.9e-8 (rate 6.8; 1.9, 1.8, 26).
+    counts = (64, 128, 256)
     ref = creep_reference(loads_key)
     errors = []
     for n in counts:
@@ -383,21 +394,21 @@ def test_creep_converges_in_modes(loads_key):
                                   **CREEP_LOADS[loads_key])
         assert_finite(sol)
         errors.append(relative_error(sol, ref, sample_points()))
-        assert 0.1 <= sol.info["error_estimate"] / errors[-1] <= 10.0
+        assert 0.6 <= sol.info["error_estimate"] / errors[-1] <= 100.0
     rate = -np.polyfit(np.log(counts), np.log(errors), 1)[0]
-    assert rate >= 4.5, errors
+    assert rate >= 5.8, errors
 
 
 @pytest.mark.parametrize("tol", (1e-3, 1e-4, 1e-5))
 @pytest.mark.parametrize("loads_key", list(CREEP_LOADS))
 def test_creep_success_only_when_tol_met(loads_key, tol):
-    # Measured (graded default), tol 1e-3, 1e-4, 1e-5: aging 48, 64, 96 modes, errors
-    # 1.05e-4, 5.8e-6, 6.5e-8, estimates 7.8e-5, 4.4e-5, 3.8e-7; cyclic load 1.0e-4,
-    # 5.6e-6, 6.9e-8, estimates 1.0e-4, 4.0e-5, 4.7e-7. Equilibrium defects <= 1.6e-15.
+    # Measured (graded default), tol 1e-3, 1e-4, 1e-5: aging 96, 128, 256 modes, errors
+    # 3.2e-5, 1.1e-5, 3.5e-8, estimates 2.0e-4, 2.1e-5, 5.7e-7; cyclic load 3.5e-5,
+    # 1.2e-5, 2.3e-8, estimates 2.2e-4, 2.2e-5, 5.0e-7. Equilibrium defects <= 1.6e-15.
     sol = solve_dimensionless(1.0, smooth_m, 0.0, CREEP_TIMES[[0, -1]], c=C_OF_T,
                               kernel=KERNEL, tol=tol, **CREEP_LOADS[loads_key])
     measured = relative_error(sol, creep_reference(loads_key), sample_points())
-    assert 0.1 <= sol.info["error_estimate"] / measured <= 10.0
+    assert 0.6 <= sol.info["error_estimate"] / measured <= 100.0
     if sol.info["success"]:
         assert measured <= tol, (measured, sol.info["error_estimate"], sol.info["n_modes"])
     # Equilibrium at every time.
@@ -418,8 +429,8 @@ REVERSING = dict(c=C_OF_T, kernel=KERNEL, force=np.cos, moment=0.0)
 
 @cache
 def reversing_reference():
-    """128 modes, time tol 1e-8 (estimate 2.6e-9, measured)."""
-    return solve_dimensionless(1.0, smooth_m, 0.0, REVERSING_TIMES, n_modes=128, tol=1e-8,
+    """512 modes, time tol 1e-8 (estimate 1.9e-9, measured)."""
+    return solve_dimensionless(1.0, smooth_m, 0.0, REVERSING_TIMES, n_modes=512, tol=1e-8,
                                contact="full", **REVERSING)
 
 
@@ -432,8 +443,9 @@ def test_reversing_load_reference_agrees_with_collocation():
 
 @pytest.mark.parametrize("tol", (1e-3, 1e-4, 1e-5))
 def test_load_reversing_sign_under_creep(tol):
-    # Measured error / estimate (graded default), tol 1e-3, 1e-4, 1e-5: 1.02e-4 / 4.7e-5,
-    # 1.02e-4 / 3.7e-5 (success claimed at tol 1e-4: reported), 8.6e-8 / 4.6e-7.
+    # Measured error / estimate (graded default), tol 1e-3, 1e-4, 1e-5: 3.0e-5 / 1.9e-4,
+    # 1.1e-5 / 1.9e-5, 3.9e-8 / 5.3e-7 (once 1.02e-4 / 3.7e-5 at tol 1e-4: success
+    # claimed, reported).
     # the full-contact model answers a pull (flagged); the contact models refuse it
     sol = solve_dimensionless(1.0, smooth_m, 0.0, REVERSING_TIMES, tol=tol, contact="full",
                               **REVERSING)
@@ -445,7 +457,7 @@ def test_load_reversing_sign_under_creep(tol):
     assert np.all(np.sign(sol.force[[0, 4, 9]]) == [1, -1, 1])
     assert sol.settlement[0] > 0 > sol.settlement[4] and sol.settlement[9] > 0
     measured = relative_error(sol, reversing_reference(), sample_points())
-    assert 0.1 <= sol.info["error_estimate"] / measured <= 10.0
+    assert 0.6 <= sol.info["error_estimate"] / measured <= 100.0
     if sol.info["success"]:
         assert measured <= tol, (measured, sol.info["error_estimate"], sol.info["n_modes"])
 
@@ -464,11 +476,12 @@ def test_stiff_exponential_creep_matches_closed_form():
     # modulus: (I - V) q -> 2 q, so q(t) is the elastic answer for m/2, delta(t) twice its
     # delta (exp(-28000 * 0.001) = 7e-13: relaxed already at the second time); at t = 1 it
     # is the elastic answer for m. The piecewise basis for m and for m/2 spans the same
-    # space, so the identity holds to round-off at a fixed mode count. Measured (48 modes,
-    # 64 steps at tol 1e-4, time estimate 2.9e-10): t = 1: 0 and 2.4e-14 (q); later:
-    # settlement 3.5e-13, tilt 7.0e-13, q 4.9e-14.
+    # space, so the identity holds to round-off at a fixed mode count. Measured (256
+    # modes, 45 steps at tol 1e-3, time estimate 1.3e-8; the piecewise basis stalls at
+    # 6.5e-5 on the whole of [-1, 1], so tol 1e-4 is out of its reach): t = 1: 0 and
+    # 1.5e-15 (q); later: settlement 1.4e-13, tilt 1.2e-13, q 8.4e-14.
     kw = dict(kernel=_stiff_kernel(), force=1.0, moment=0.1, basis="piecewise")
-    sol = solve_dimensionless(1.0, smooth_m, 0.0, STIFF_TIMES, tol=1e-4, **kw)
+    sol = solve_dimensionless(1.0, smooth_m, 0.0, STIFF_TIMES, tol=1e-3, **kw)
     assert_finite(sol)
     assert sol.info["success"] and sol.info["n_steps"] < 1000
     n = sol.info["n_modes"]
@@ -488,8 +501,9 @@ def test_stiff_exponential_creep_matches_closed_form():
 
 
 def test_stiff_exponential_creep_default_basis():
-    # The same against tight elastic solves (tol 1e-10) with the default basis. Measured:
-    # 96 modes, 144 steps, error 7.4e-8, estimate 3.4e-7.
+    # The same against tight elastic solves (tol 1e-10, which they do not reach: estimates
+    # 1.3e-9 and 2.3e-9) with the default basis. Measured: 384 modes, 60 steps, error
+    # 2.7e-9, estimate 2.2e-8.
     sol = solve_dimensionless(1.0, smooth_m, 0.0, STIFF_TIMES, kernel=_stiff_kernel(),
                               force=1.0, moment=0.1, tol=1e-6)
     assert_finite(sol)
@@ -508,4 +522,4 @@ def test_stiff_exponential_creep_default_basis():
                    np.max(np.abs(q[:, k] - relaxed.pressure(xs)[:, 0])) / scale]
     measured = max(errors)
     assert measured <= 1e-6
-    assert 0.1 <= sol.info["error_estimate"] / measured <= 10.0
+    assert 0.6 <= sol.info["error_estimate"] / measured <= 100.0

@@ -146,39 +146,47 @@ def test_four_statements_are_consistent():
 # ------------------------------------------------------------------ convergence
 
 
-def test_graded_basis_convergence_on_smooth_coating():
-    """Settlement and interior q against n = 256 for a smooth coating.
+#: The whole of [-1, 1] (the solver promises q there): 201 even points and 20 toward each
+#: end, down to 1e-10 away.
+_NEAR = np.geomspace(1e-10, 0.05, 20)
+X_WHOLE = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 201), -1.0 + _NEAR, 1.0 - _NEAR]))
 
-    Measured (n = 16, 32, 64, 128): settlement 1.4e-5, 4.5e-7, 1.8e-8, 3.5e-11;
-    q 1.6e-2, 1.1e-3, 4.1e-5, 1.2e-8: faster than any power, as hp grading promises.
+
+def test_graded_basis_convergence_on_smooth_coating():
+    """Settlement and q on the whole of [-1, 1] against n = 512 for a smooth coating.
+
+    Measured (n = 32, 64, 128, 256): settlement 4.7e-7, 1.4e-9, 8.7e-14, 0; q 7.4e-3,
+    8.9e-4, 1.3e-5, 6.9e-8: faster than any power, as hp grading promises (the reference
+    is within 1e-9 of the Nystrom engine at tol 1e-11).
     """
-    x = np.linspace(-0.95, 0.95, 77)
-    ref = solve_dimensionless(1.0, smooth_m, 0.0, [1.0], force=1.0, moment=0.2, n_modes=256)
+    x = X_WHOLE
+    ref = solve_dimensionless(1.0, smooth_m, 0.0, [1.0], force=1.0, moment=0.2, n_modes=512)
     q_ref = ref.pressure(x)[:, 0]
     err_s, err_q = [], []
-    for n in (16, 32, 64, 128):
+    for n in (32, 64, 128, 256):
         s = solve_dimensionless(1.0, smooth_m, 0.0, [1.0], force=1.0, moment=0.2, n_modes=n)
         err_s.append(abs(s.settlement[0] - ref.settlement[0]) / ref.settlement[0])
         err_q.append(np.max(np.abs(s.pressure(x)[:, 0] - q_ref)) / np.max(np.abs(q_ref)))
     for k in range(3):
-        assert err_s[k + 1] < err_s[k] / 16  # at least order 4 per doubling; measured 25-500
-        assert err_q[k + 1] < err_q[k] / 10  # measured 14-3400
-    assert err_q[-1] < 1e-7
+        assert err_s[k + 1] < err_s[k] / 16  # at least order 4 per doubling; measured 300+
+        assert err_q[k + 1] < err_q[k] / 5  # measured 8.3, 67, 190
+    assert err_q[-1] < 3e-7
 
 
 def test_modulus_jump_graded_basis_beats_the_seeds():
-    """A jump of m: at n = 128 the interior q error is 5.7e-3 (global, the seed's basis),
-    1.8e-4 (piecewise) and 1.1e-5 (graded), against n = 256 graded."""
+    """A jump of m: at n = 128 the error of q on the whole of [-1, 1] (both sides of the
+    jump) is 5.2e-3 (global, the seed's basis), 5.7e-3 (piecewise) and 4.6e-4 (graded),
+    against n = 512 graded (within 5e-8 of the Nystrom engine at tol 1e-11)."""
     kw = dict(force=1.0, moment=0.2, breakpoints=[0.3])
-    ref = solve_dimensionless(1.0, jump_m, 0.0, [1.0], n_modes=256, **kw)
-    x = np.linspace(-0.95, 0.95, 77)
-    x = x[np.abs(x - 0.3) > 0.02]
+    ref = solve_dimensionless(1.0, jump_m, 0.0, [1.0], n_modes=512, **kw)
+    x = np.concatenate([X_WHOLE, 0.3 - _NEAR, 0.3 + _NEAR])
+    x = x[x != 0.3]
     q_ref = ref.pressure(x)[:, 0]
     err = {}
     for kind in ("global", "piecewise", "graded"):
         s = solve_dimensionless(1.0, jump_m, 0.0, [1.0], n_modes=128, basis=kind, **kw)
         err[kind] = np.max(np.abs(s.pressure(x)[:, 0] - q_ref)) / np.max(np.abs(q_ref))
-    assert err["graded"] < err["global"] / 100
+    assert err["graded"] < err["global"] / 5
     assert err["graded"] < err["piecewise"] / 5
 
 
@@ -268,7 +276,8 @@ def test_load_change_recomputes_no_spatial_stage(stage_evaluations):
 
 
 def test_gap_change_reuses_operator_and_basis(stage_evaluations):
-    kw = dict(tol=1e-5, method="projection")
+    # Below DIRECT_LARGEST_BELOW one basis is built (not one per cap tried).
+    kw = dict(tol=1e-8, method="projection")
     solve_dimensionless(1.1, smooth_m, lambda x: 0.01 * x**2, [1.0], force=1.0, moment=0.0,
                         **kw)
     before = stage_evaluations()
@@ -284,12 +293,13 @@ def test_gap_change_reuses_operator_and_basis(stage_evaluations):
 def test_a_coating_scaled_as_a_whole_reuses_the_basis(stage_evaluations):
     """The basis for m = s m1 is sqrt(s) times the basis for m1: a thickness or modulus
     slider of a uniform coating builds no new basis, and the answers stay right. (Only
-    while the graded mesh keeps its layers: 0.05 and 0.052 both get six toward each end.)"""
+    while the graded mesh keeps its layers: 0.05 and 0.052 both get 19 geometric layers
+    toward each end.)"""
     times = [1.0]
-    first = solve_dimensionless(1.0, 0.05, 0.0, times, force=1.0, moment=0.1, tol=1e-10,
+    first = solve_dimensionless(1.0, 0.05, 0.0, times, force=1.0, moment=0.1, tol=1e-8,
                                 method="projection")
     before = stage_evaluations()
-    second = solve_dimensionless(1.0, 0.052, 0.0, times, force=1.0, moment=0.1, tol=1e-10,
+    second = solve_dimensionless(1.0, 0.052, 0.0, times, force=1.0, moment=0.1, tol=1e-8,
                                  method="projection")
     after = stage_evaluations()
     assert after["basis"] == before["basis"]

@@ -50,9 +50,9 @@ from core.problem import ContactSolution, accepts, statement_number
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
 #: Mode counts tried in turn; the error estimate compares consecutive levels.
-MODE_LEVELS = (4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256)
+MODE_LEVELS = (4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256, 384, 512)
 #: Basis sizes built (a larger one only when a smaller one could not meet tol).
-BASIS_CAPS = (128, 256)
+BASIS_CAPS = (128, 256, 512)
 #: Below this tol the first basis built is the largest (measured: the graded basis needs
 #: 128-256 functions for 1e-8 on q, so a first try at 128 would be wasted work).
 DIRECT_LARGEST_BELOW = 1e-7
