@@ -7,8 +7,9 @@
   answer as a :class:`CollocationSolution` (a ``ContactSolution`` that also reads its
   nodal solution from ``info``);
 - :mod:`~core.engines.collocation.steps`: the trapezoid-product time stepping, and **the
-  error estimate**, in time only: Richardson over halved grids (``fixed_grids``,
-  ``adaptive_grids``). The panels are fixed, so the spatial error is not estimated.
+  error estimate in time**: Richardson over halved grids (``fixed_grids``,
+  ``adaptive_grids``). The panels are fixed; the rule one level coarser, marched on the
+  same grids (``grids_at``), estimates the spatial error.
 """
 
 from __future__ import annotations

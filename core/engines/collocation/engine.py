@@ -3,8 +3,8 @@
 Meant for cross-checks, not for speed (O(N steps^2) in time): it shares nothing with the
 other engines but the panel quadrature. Its panels are fixed by ``panels_per_unit`` and
 ``edge_width``; ``tol`` sets the time grid (Richardson over halved grids,
-:mod:`core.engines.collocation.steps`), and on an elastic base the rule one level
-coarser estimates the spatial error (under creep it is not estimated).
+:mod:`core.engines.collocation.steps`), and the rule one level coarser (under creep
+marched on the same time grids) estimates the spatial error.
 """
 
 from __future__ import annotations

@@ -227,9 +227,26 @@ def fixed_grids(system: CollocationSystem, times: np.ndarray, steps: int,
     return fine.combine(coarse), fine.distance(coarse) / 3.0, len(fine_grid) - 1
 
 
+def grids_at(system: CollocationSystem, times: np.ndarray, steps: int, level: int,
+             richardson: bool) -> GridResult:
+    """The result on the grid of ``steps`` nominal steps halved ``level`` times, with
+    ``richardson`` extrapolated from the grid once less halved, as :func:`fixed_grids`
+    (``level`` 1) and :func:`adaptive_grids` (its last level) combine them: another rule
+    marched on the same time grids errs the same in time, so the two differ by space."""
+    grid, widths, index = time_grid(times, steps, level)
+    result = system.march(grid, widths, index)
+    if not richardson or level < 1:
+        return result
+    grid, widths, index = time_grid(times, steps, level - 1)
+    return result.combine(system.march(grid, widths, index))
+
+
 def adaptive_grids(system: CollocationSystem, times: np.ndarray, richardson: bool,
-                    tol: float) -> tuple[GridResult, float, int, bool]:
-    """Double the grid until the estimated relative error in time is below ``tol``."""
+                    tol: float) -> tuple[GridResult, float, int, bool, int]:
+    """Double the grid until the estimated relative error in time is below ``tol``.
+
+    Returns the result, its estimated relative error in time, the number of steps, whether
+    the error met ``tol``, and the level (halvings of ``FIRST_STEPS``) of the result."""
     level = 0
     plain: list[GridResult] = []
     extrapolated: list[GridResult] = []
@@ -250,9 +267,9 @@ def adaptive_grids(system: CollocationSystem, times: np.ndarray, richardson: boo
             if len(plain) >= 2:
                 error = plain[-1].distance(plain[-2]) / 3.0
         if error <= tol:
-            return best, error, n_steps, True
+            return best, error, n_steps, True, level
         if 2 * n_steps > MAX_STEPS:
-            return best, error, n_steps, False
+            return best, error, n_steps, False, level
         level += 1
 
 
