@@ -308,7 +308,8 @@ def report(results: list[dict], goal: dict[str, float], command: str, out: Path,
                      f"{ms(p_c, 'cold_s')} | {ms(p_w, 'warm_s')} | {speed} | "
                      f"{r['agreement']:.1e} |")
     lines += ["", "## Successes off by more than tol", "",
-              "Runs that claim success while their error (above) exceeds their tol.", "",
+              "Runs that claim success while their error (the largest of delta, alpha, P, M "
+              "and q on the whole of [-1, 1]) exceeds their tol.", "",
               "| method | runs | successes | off by more than tol |", "| --- | --- | --- | --- |"]
     for method in ("nystrom", "projection"):
         runs = [run for r in results for run in r["runs"] if run["method"] == method]
