@@ -33,10 +33,13 @@ GRADED_OUTER = (0.5,)
 #: count, while 1e-7 reaches 1e-8 there (1e-9 and 1e-11 needed as many functions).
 GRADED_DEPTH = 1e-7
 #: At most this many geometric layers toward one singular point (the depth above needs
-#: ~22 at m = 1e-3).
+#: ~22 at m = 1e-3; :data:`GRADED_FINEST` stops a half-width of 1 at 27).
 GRADED_MAX_LAYERS = 40
 #: No element narrower than this (absolute, dimensionless x): next to +-1 doubles are
 #: 1.1e-16 apart, so an element of 1e-12 still holds ~1e4 distinct points for its nodes.
+#: Below m ~ 1e-5 the mesh therefore stops short of the edge layer, and the ranking of
+#: :func:`_element_model` reads a layer of ``GRADED_FINEST / GRADED_DEPTH`` (a nearly
+#: first-kind equation: its q is not resolved anyway, and the estimate says so).
 GRADED_FINEST = 1e-12
 #: Highest degree on one element: polynomials of degree <= 15 are integrated exactly by
 #: the 16-node product rule on every panel of the element, whatever its subdivision
@@ -67,11 +70,12 @@ def graded_cuts(breakpoints: Sequence[float], lam: float,
     Every interval ``[a, b]`` between consecutive hard points (``+-1`` and the jumps of
     ``m`` or ``g``) is cut at ``a + l f`` and ``b - l f`` for ``f`` in ``outer`` and
     ``f = ratio^j`` (``l = (b - a)/2``, ``j = 1, 2, ...``), down to an element of width
-    about ``depth * min(m, 1/lam)``: ``m q`` has ``(x - x_e) ln|x - x_e|`` at every hard
-    point ``x_e`` and a layer of width ~``m`` (thin base: ~``1/lam``) next to it, and a
-    geometric mesh with degrees growing away from ``x_e`` approximates both at an
-    exponential rate. ``m`` (dimensionless compliance, a number or a vectorized callable)
-    is sampled just inside each end. Returns the sorted soft cuts (dimensionless x).
+    about ``depth * min(m, 1/lam)`` (not below :data:`GRADED_FINEST`): ``m q`` has
+    ``(x - x_e) ln|x - x_e|`` at every hard point ``x_e`` and a layer of width ~``m``
+    (thin base: ~``1/lam``) next to it, and a geometric mesh with degrees growing away
+    from ``x_e`` approximates both at an exponential rate. ``m`` (dimensionless
+    compliance, a number or a vectorized callable) is sampled just inside each end.
+    Returns the sorted soft cuts (dimensionless x).
     """
     if not 0.0 < ratio < 1.0:
         raise ValueError(f"ratio: must lie in (0, 1), got {ratio}")

@@ -18,8 +18,8 @@ protocol :class:`Engine`, the registry :data:`ENGINES` (:func:`get_engine`,
   consecutive mode levels (:mod:`core.engines.projection.levels`), judged with margin 3
   in :mod:`core.engines.projection.solve`.
 - :mod:`core.engines.collocation` (``"collocation"``): an independent cross-check on fixed
-  panels; it estimates its time error (:mod:`core.engines.collocation.steps`) and, on an
-  elastic base, its spatial error against the rule one level coarser.
+  panels; it estimates its time error (:mod:`core.engines.collocation.steps`) and its
+  spatial error against the rule one level coarser (marched on the same time grids).
 - :mod:`core.engines.layered` (not registered): the exact kernel of uniform coating layers
   on an elastic base. It needs each layer's thickness, modulus, Poisson ratio and
   interface and the base's thickness and Poisson ratio, which the dimensionless inputs

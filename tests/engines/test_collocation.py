@@ -309,7 +309,7 @@ def test_creep_richardson_is_fourth_order(creep_oracle):
     assert np.all((ratios > 15.0) & (ratios < 17.0)), ratios
 
 
-def test_creep_default_time_grid_meets_its_tolerance(creep_oracle):
+def test_creep_default_time_grid_meets_its_tolerance_in_time_and_judges_space(creep_oracle):
     # Default: grids doubled from 16 steps until the estimated error is below 1e-6.
     # Measured: 72 steps, estimate 6.5e-8, true error 7.0e-8 (largest over delta, alpha and
     # the nodal q; 2.0e-7 relative to the settlement).

@@ -214,11 +214,12 @@ def test_error_estimate_bounds_the_error(name, tol):
     # default): modulus jump 8.2, 22, 4.3; stepped 1.5, 7.2, 7.2; rough 4.4, 20, 20; thin
     # 2.2, 1.5, 6.1; thick 6.3, 1.8, 25; no coating 7.1, 66, 7.1; ten layers 8.2, 4.5, 17.
     # The estimate is floored at the last level difference (the basis converges in steps),
-    # so it reads high rather than low.
+    # so it reads high rather than low: it bounds the error (the lowest ratio measured in
+    # this file is 1.5).
     sol = projection(name, tol=tol)
     measured = error_of(name, sol)
     ratio = sol.info["error_estimate"] / measured
-    assert 0.6 <= ratio <= 100.0, (sol.info["error_estimate"], measured, sol.info["n_modes"])
+    assert 1.0 <= ratio <= 100.0, (sol.info["error_estimate"], measured, sol.info["n_modes"])
 
 
 @pytest.mark.parametrize("tol", (1e-3, 1e-4, 1e-5, 1e-6, 1e-8))
@@ -297,7 +298,7 @@ def test_tiny_and_huge_lam_in_one_run():
         # 2.1e-8, estimate 1.3e-7, 256 modes (references within 6e-10 and 5e-10 of the
         # Nystrom answer at tol 1e-11, edges included).
         assert sol.info["success"] and measured <= 1e-5
-        assert 0.6 <= sol.info["error_estimate"] / measured <= 100.0
+        assert 1.0 <= sol.info["error_estimate"] / measured <= 100.0
         assert sol.info["n_modes"] <= 2 * n_measured
         p, m = integrals(sol)
         assert abs(p[0] - 1.0) < 1e-13 and abs(m[0] - 0.1) < 1e-13  # measured <= 4.4e-16
@@ -394,7 +395,7 @@ def test_creep_converges_in_modes(loads_key):
                                   **CREEP_LOADS[loads_key])
         assert_finite(sol)
         errors.append(relative_error(sol, ref, sample_points()))
-        assert 0.6 <= sol.info["error_estimate"] / errors[-1] <= 100.0
+        assert 1.0 <= sol.info["error_estimate"] / errors[-1] <= 100.0
     rate = -np.polyfit(np.log(counts), np.log(errors), 1)[0]
     assert rate >= 5.8, errors
 
@@ -408,7 +409,7 @@ def test_creep_success_only_when_tol_met(loads_key, tol):
     sol = solve_dimensionless(1.0, smooth_m, 0.0, CREEP_TIMES[[0, -1]], c=C_OF_T,
                               kernel=KERNEL, tol=tol, **CREEP_LOADS[loads_key])
     measured = relative_error(sol, creep_reference(loads_key), sample_points())
-    assert 0.6 <= sol.info["error_estimate"] / measured <= 100.0
+    assert 1.0 <= sol.info["error_estimate"] / measured <= 100.0
     if sol.info["success"]:
         assert measured <= tol, (measured, sol.info["error_estimate"], sol.info["n_modes"])
     # Equilibrium at every time.
@@ -457,7 +458,7 @@ def test_load_reversing_sign_under_creep(tol):
     assert np.all(np.sign(sol.force[[0, 4, 9]]) == [1, -1, 1])
     assert sol.settlement[0] > 0 > sol.settlement[4] and sol.settlement[9] > 0
     measured = relative_error(sol, reversing_reference(), sample_points())
-    assert 0.6 <= sol.info["error_estimate"] / measured <= 100.0
+    assert 1.0 <= sol.info["error_estimate"] / measured <= 100.0
     if sol.info["success"]:
         assert measured <= tol, (measured, sol.info["error_estimate"], sol.info["n_modes"])
 
@@ -522,4 +523,4 @@ def test_stiff_exponential_creep_default_basis():
                    np.max(np.abs(q[:, k] - relaxed.pressure(xs)[:, 0])) / scale]
     measured = max(errors)
     assert measured <= 1e-6
-    assert 0.6 <= sol.info["error_estimate"] / measured <= 100.0
+    assert 1.0 <= sol.info["error_estimate"] / measured <= 100.0

@@ -115,14 +115,14 @@ class CollocationGeometry:
     breakpoints: tuple[float, ...]
     tol: float
     seconds: float  # time of the preparation [s]
-    #: Whether an elastic answer is compared with the rule one level coarser (:attr:`coarse`)
+    #: Whether an answer is compared with the rule one level coarser (:attr:`coarse`)
     coarser: bool = True
 
     @cached_property
     def coarse(self) -> CollocationGeometry | None:
         """The rule one level coarser, pairs of this one's panels merged (each breakpoint
-        kept an edge), and the operator on it: its distance is the spatial estimate on an
-        elastic base (None when there is no coarser rule, or for the coarse rule itself).
+        kept an edge), and the operator on it: its distance is the spatial estimate (None
+        when there is no coarser rule, or for the coarse rule itself).
         Merged panels, not half the panels per unit and a coarser edge: those caps (panels
         at most 3 / lam wide, edge panels at most an eighth of their interval) could make
         the same rule again, whose distance, 0, let a wrong answer pass."""
@@ -187,7 +187,9 @@ def solve_collocation(
     relative error is below ``time_tol`` (at most 8192 steps; ``info["message"]`` says
     when that limit stops it). Both are ignored for an elastic base (``kernel=None``),
     where every requested time is solved on its own. ``richardson`` (default: on when a kernel is
-    given) combines the grids h and h/2 as ``(4 x_{h/2} - x_h) / 3``.
+    given) combines the grids h and h/2 as ``(4 x_{h/2} - x_h) / 3``. Success asks the
+    estimate in time plus the spatial one (twice the distance from the rule one level
+    coarser, marched on the same time grids) to be below ``time_tol``.
 
     Raises ValueError, naming the argument, for invalid input.
     """
@@ -227,7 +229,7 @@ def prepare_collocation(lam: float, m: Callable[[np.ndarray], np.ndarray],
                         ) -> CollocationGeometry:
     """The panel rule of :func:`collocation_panels` and the operator on it, for checked
     arguments (``started``: the clock [s] the preparation counts from, default now), and
-    with ``coarser`` an elastic answer compared with the rule one level coarser
+    with ``coarser`` an answer compared with the rule one level coarser
     (:attr:`CollocationGeometry.coarse`, made when first asked)."""
     started = time.perf_counter() if started is None else started
     panels = collocation_panels(lam, breakpoints, panels_per_unit=panels_per_unit,
@@ -282,13 +284,24 @@ def solve_prepared(prepared: CollocationGeometry, times: np.ndarray,
     error = time_error + spatial
     success = accepts(error, prepared.tol, SUCCESS_MARGIN)
     info.update(spatial_error_estimate=spatial, error_estimate=error, success=success)
+    # lift-off is judged against the whole estimate, as the other engines judge it
+    flags = [f for f in info["flags"] if f not in ("tol_not_met", "contact_lost")]
+    if info["min_pressure"] < -max(error if math.isfinite(error) else 0.0,
+                                   1e-12) * info["max_pressure"]:
+        flags.append("contact_lost")
     if not success:
-        info["flags"] = ["tol_not_met"] + [f for f in info["flags"] if f != "tol_not_met"]
+        flags.insert(0, "tol_not_met")
+        reasons = []
+        if info["message"] != "ok":  # the time part's own reason (a limit, no estimate)
+            reasons.append(f"time: {info['message']}")
         if not spatial * SUCCESS_MARGIN <= prepared.tol:
-            info["message"] = (f"estimated relative error {error:.1e} (space: the distance "
-                               f"from the rule one level coarser, {spatial:.1e}; time: "
-                               f"{time_error:.1e}) is above {tol_name} = "
-                               f"{prepared.tol:.1e}; refine panels_per_unit or edge_width")
+            reasons.append(f"space: the distance from the rule one level coarser gives "
+                           f"{spatial:.1e}; refine panels_per_unit or edge_width")
+        if not reasons:
+            reasons.append(f"space {spatial:.1e} and time {time_error:.1e} together")
+        info["message"] = (f"estimated relative error {error:.1e} is above {tol_name} = "
+                           f"{prepared.tol:.1e}: " + "; ".join(reasons))
+    info["flags"] = flags
     return answer
 
 

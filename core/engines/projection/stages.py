@@ -223,7 +223,9 @@ def _sample_points(breakpoints: Sequence[float], cuts: Sequence[float] = ()) -> 
     near = np.geomspace(1e-8, 0.05, 12)
     ends = [-1.0 + near, 1.0 - near, np.array([-1.0, 1.0]), np.asarray(cuts, dtype=float)]
     ends += [b + s * near for b in bps for s in (-1.0, 1.0)]
-    return np.unique(np.clip(np.concatenate([xs, *ends]), -1.0, 1.0))
+    xs = np.unique(np.clip(np.concatenate([xs, *ends]), -1.0, 1.0))
+    # On a jump itself q has no value (each side has its own): never sample there.
+    return xs[np.all(np.abs(xs[:, None] - bps[None, :]) > 1e-12, axis=1)] if bps.size else xs
 
 
 def _modes(disc: _Discretization, given: frozenset[str], n: int,
