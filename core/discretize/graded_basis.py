@@ -8,7 +8,8 @@ scenes) and orthonormalized in that order, so truncation is taking the first col
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import itertools
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 from numpy.polynomial import legendre as npleg
@@ -96,6 +97,47 @@ def graded_cuts(breakpoints: Sequence[float], lam: float,
             fractions += [ratio**j for j in range(1, layers + 1)]
             cuts.extend(end + inward * half * f for f in fractions)
     return tuple(sorted(cuts))
+
+
+#: Candidates orthogonalized against the chosen functions at once (one matrix product
+#: instead of one per candidate: the basis of 512 functions took 0.29 s, memory-bound).
+ORTHOGONALIZE_BLOCK = 64
+
+
+def _orthonormal_columns(vectors: Iterable[np.ndarray], size: int, count: int
+                         ) -> np.ndarray:
+    """The first ``count`` orthonormal columns Gram-Schmidt makes of ``vectors`` in their
+    order (each twice orthogonalized), skipping those already in the span: shape
+    ``(size, <= count)``. Blocks of :data:`ORTHOGONALIZE_BLOCK` are orthogonalized
+    against the columns chosen before them together, then one by one within the block;
+    the same columns as one at a time, to rounding."""
+    chosen = np.zeros((size, count))
+    n_chosen = 0
+    vectors = iter(vectors)
+    while n_chosen < count:
+        block = list(itertools.islice(vectors, ORTHOGONALIZE_BLOCK))
+        if not block:
+            break
+        v_block = np.column_stack(block)
+        norms0 = np.linalg.norm(v_block, axis=0)
+        before = chosen[:, :n_chosen]
+        for _ in range(2):
+            v_block -= before @ (before.T @ v_block)
+        start = n_chosen
+        for j in range(v_block.shape[1]):
+            if n_chosen == count:
+                break
+            v = v_block[:, j]
+            inside = chosen[:, start:n_chosen]
+            for _ in range(2):
+                v = v - inside @ (inside.T @ v)
+            norm = np.linalg.norm(v)
+            # In-span candidates leave ~1e-16 of their norm; new directions keep >~ 1e-4.
+            if norm < 1e-9 * norms0[j]:
+                continue
+            chosen[:, n_chosen] = v / norm
+            n_chosen += 1
+    return chosen[:, :n_chosen]
 
 
 def _bernstein_rho(gap: float, width: float) -> float:
@@ -242,25 +284,11 @@ def graded_basis(panels: Panels, wm: np.ndarray, count: int, breakpoints: Sequen
 
         return project(range(left, right), hat)
 
-    chosen = np.zeros((n_raw, count))
-    n_chosen = 0
     raw_1 = project(range(n_el), lambda e, t: np.ones_like(t))
     raw_x = project(range(n_el), lambda e, t: t)
-    for k in range(len(cands) + 2):
-        if n_chosen == count:
-            break
-        v = (raw_1, raw_x)[k] if k < 2 else candidate(*cands[k - 2][2:])
-        norm0 = np.linalg.norm(v)
-        q = chosen[:, :n_chosen]
-        for _ in range(2):
-            v = v - q @ (q.T @ v)
-        norm = np.linalg.norm(v)
-        # In-span candidates leave ~1e-16 of their norm; new directions keep >~ 1e-4.
-        if norm < 1e-9 * norm0:
-            continue
-        chosen[:, n_chosen] = v / norm
-        n_chosen += 1
-    chosen = chosen[:, :n_chosen]
+    ordered = itertools.chain((raw_1, raw_x), (candidate(*c[2:]) for c in cands))
+    chosen = _orthonormal_columns(ordered, n_raw, count)
+    n_chosen = chosen.shape[1]
     if n_chosen < 2:
         raise ValueError("basis: the graded basis needs at least 2 functions")
     if np.dot(raw_x, chosen[:, 1]) < 0:
