@@ -82,6 +82,11 @@ MAX_SCENE_AGE = MAX_SCENE_DAYS
 #: Most load durations of one ``core.creep_coefficient_curve`` call (a plotted curve
 #: needs a few hundred; each costs a few array operations).
 MAX_CURVE_POINTS = 100_000
+#: Least span from loading (t = 1) to the last output time on a creeping base, unless
+#: every output is at loading: the time stepper's first steps are fractions of the span,
+#: and spans of 1e-7 made them fall below the doubles' spacing at t ~ 1 (a singular
+#: matrix of its dense output). 5e-7 of the age at loading is about a second.
+MIN_CREEP_SPAN = 5e-7
 #: Most output times of ``core.solver.solve_dimensionless``: every output time is a
 #: column of each mode's history (256 modes x 3 arrays x 10000 times: 60 MB).
 MAX_SOLVER_TIMES = 10_000

@@ -181,6 +181,11 @@ def validate_time_inputs(times: Any, c: Scalar, kernel: Any,
     if kernel is not None:
         if not callable(kernel):
             raise ValueError("kernel: must be None or a vectorized callable K(t, tau)")
+        span = float(t[-1]) - 1.0
+        if 0.0 < span < limits.MIN_CREEP_SPAN:
+            raise ValueError(
+                f"times: on a creeping base the last output time must be at loading (t = 1) "
+                f"or at least {limits.MIN_CREEP_SPAN:g} after it, got t = {t[-1]:.12g}")
         tt = np.array([t[-1], t[-1], 0.5 * (1 + t[-1])])
         kv = np.asarray(kernel(tt, np.array([1.0, t[-1], 1.0])), dtype=float)
         if kv.shape != (3,) or not np.all(np.isfinite(kv)):

@@ -209,6 +209,13 @@ def _validated(d: dict[str, Any]) -> Scene:
                              "the age over the age at loading")
         raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
                          f"an age at loading of {tau0:g} days")
+    if creep.spec.get("model") != "elastic" and 0.0 < ages[-1] - 1.0 < limits.MIN_CREEP_SPAN:
+        # the time stepper's first steps are fractions of the span (the solver's bound)
+        raise ValueError(f"{schema.last_time_field(times_spec, len(times))}: on a creeping "
+                         f"base the last output time must be at least "
+                         f"{limits.MIN_CREEP_SPAN * tau0:.3g} days after loading "
+                         f"({limits.MIN_CREEP_SPAN:g} of the age at loading, {tau0:g} days), "
+                         f"got {float(times[-1]):g}")
 
     solver = check_fields(d.get("solver", {}), "solver", (), schema.optional_fields("solver"))
     tol = finite_number(solver["tol"] if "tol" in solver else default_tol(creep, tau0),

@@ -620,6 +620,23 @@ def test_bad_scene_is_refused_naming_the_field(path, value, message):
     assert str(info.value).startswith(message), str(info.value)
 
 
+def test_a_creeping_span_too_short_to_step_is_refused_naming_the_last_time():
+    """On a creeping base a last output time of 1e-6 days (3.6e-8 of the age at loading)
+    raised numpy's LinAlgError in the time stepper; it is refused naming times.end in
+    days. An elastic base answers it, and 1e-4 days creeps."""
+    creeping = {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11,
+                "rate": 0.05}
+    d = edit("base.creep", creeping)
+    d["times"] = {"end": 1e-6, "count": 3}
+    with pytest.raises(ValueError, match=r"^times\.end: on a creeping base the last output "
+                       r"time must be at least 1\.4e-05 days after loading"):
+        scene_from_dict(d)
+    d["times"] = [0.0, 1e-4]
+    scene_from_dict(d)
+    d = edit("times", {"end": 1e-6, "count": 3})
+    scene_from_dict(d)
+
+
 def test_modulus_message_names_layer_value_and_position():
     d = base_dict()
     d["coating"].append({"thickness": 0.01, "poisson": 0.3,

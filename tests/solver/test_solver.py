@@ -363,3 +363,27 @@ def test_times_as_text_are_refused_not_read_as_numbers() -> None:
             solve_dimensionless(1.0, 0.05, 0.0, times, force=1.0, moment=0.0)
     assert solve_dimensionless(1.0, 0.05, 0.0, [1.0, 2.0], force=1.0,
                                moment=0.0).times.tolist() == [1.0, 2.0]
+
+
+def test_a_creeping_span_too_short_to_step_is_refused_naming_times() -> None:
+    """Output times 1e-9 after loading on a creeping base raised numpy's LinAlgError
+    ("Singular matrix", in the dense output's weights: the first steps fell below the
+    doubles' spacing at t ~ 1). They are refused naming ``times``; a span of 5e-7, close
+    outputs inside a longer span, and an elastic base are answered."""
+    import pytest
+
+    from core import solve_dimensionless
+    from core.limits import MIN_CREEP_SPAN
+
+    def kernel(t, tau):
+        return -2.4 * np.exp(-2.9 * (t - tau))
+
+    kw = dict(kernel=kernel, force=1.0, moment=0.1, tol=1e-6, contact="full")
+    for method in (None, "projection"):
+        with pytest.raises(ValueError, match=r"^times: on a creeping base the last output"):
+            solve_dimensionless(1.0, 0.05, 0.0, [1.0, 1.0 + 1e-9], method=method, **kw)
+        for times in ([1.0, 1.0 + MIN_CREEP_SPAN], [1.0, 1.0 + 1e-9, 2.0]):
+            sol = solve_dimensionless(1.0, 0.05, 0.0, times, method=method, **kw)
+            assert sol.info["success"] and np.all(np.isfinite(sol.settlement))
+    elastic = solve_dimensionless(1.0, 0.05, 0.0, [1.0, 1.0 + 1e-12], force=1.0, moment=0.1)
+    assert elastic.info["success"]
