@@ -312,7 +312,8 @@ def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL
     both = nystrom(np.concatenate([a, b]), 2)
     fa, fb = both[:a.size], both[a.size:]
     for _ in range(_SECANT_STEPS):
-        slope = (fb - fa) / (b - a)
+        with np.errstate(divide="ignore", invalid="ignore"):  # an end already met: 0 / 0
+            slope = (fb - fa) / (b - a)
         ok = np.isfinite(slope) & (slope != 0.0)
         step_x = np.where(ok, -fb / np.where(ok, slope, 1.0), 0.0)
         a, fa = b, fb
