@@ -88,9 +88,16 @@ def test_a_held_drag_on_a_creep_scene_previews_while_the_handle_moves(server: st
     for k in range(1, 11):  # 10 moves of 4 px, 50 ms apart
         page.page.mouse.move(x + 4 * k, y)
         time.sleep(0.05)
-    # the button still down: previews drawn, and said
-    until(lambda: page.page.evaluate(DURING) >= 2, "two previews while the handle is held",
-          timeout=60)
+    # the button still down: previews drawn, and said. The hand keeps moving (between two
+    # positions) while it waits: on a slow machine the ten moves could all fall within the
+    # first preview's solve, and a held, still handle asks for nothing more.
+    wiggle = iter(range(1_000_000))
+
+    def two_previews_while_held() -> bool:
+        page.page.mouse.move(x + 40 + 4 * (next(wiggle) % 2), y)
+        return page.page.evaluate(DURING) >= 2
+
+    until(two_previews_while_held, "two previews while the handle is held", timeout=60)
     assert page.page.evaluate(JS_SHOWN, PREVIEW)
     assert page.page.evaluate("() => window.__up") is None
     # the link keeps the scene with creep on screen, never the preview's elastic base
