@@ -37,6 +37,7 @@ from core.creep import (
 from core.problem import QUANTITIES, STATEMENTS
 from core.profiles import Profile, profile_values
 from core.scene import schema
+from core.scene.at_loading import creeps
 from core.scene.design import DesignLimits
 from core.scene.load_rates import check_step_limit
 from core.scene.model import Layer, Scene
@@ -209,7 +210,7 @@ def _validated(d: dict[str, Any]) -> Scene:
                              "the age over the age at loading")
         raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
                          f"an age at loading of {tau0:g} days")
-    if creep.spec.get("model") != "elastic" and 0.0 < ages[-1] - 1.0 < limits.MIN_CREEP_SPAN:
+    if creeps(d) and 0.0 < ages[-1] - 1.0 < limits.MIN_CREEP_SPAN:
         # the time stepper's first steps are fractions of the span (the solver's bound)
         raise ValueError(f"{schema.last_time_field(times_spec, len(times))}: on a creeping "
                          f"base the last output time must be at least "

@@ -26,14 +26,12 @@ from core.discretize import (
 )
 from core.discretize.graded_basis import GRADED_DEPTH, GRADED_RATIO
 from core.engines.projection.matrices import galerkin_matrix
+from tests.support.points import whole_interval
 
 #: Points where the pressure is compared: the whole of [-1, 1] as the solver promises it,
 #: with 20 more toward each end and each side of the jumps of these tests (0.3, -0.4, 0.5),
 #: down to 1e-10 away.
-_NEAR = np.geomspace(1e-10, 0.05, 20)
-X_IN = np.unique(np.clip(np.concatenate(
-    [np.linspace(-1.0, 1.0, 381), -1.0 + _NEAR, 1.0 - _NEAR]
-    + [b + s * _NEAR for b in (0.3, -0.4, 0.5) for s in (-1.0, 1.0)]), -1.0, 1.0))
+X_IN = whole_interval(381, jumps=(0.3, -0.4, 0.5))
 
 
 def uniform_m(x: np.ndarray) -> np.ndarray:

@@ -14,6 +14,7 @@ from core.discretize import kernel_operator
 from core.engines.collocation.solve import collocation_panels, solve_collocation
 from core.kernel.plane import plane_kernel_regular
 from core.time import time_grid
+from tests.support.points import whole_interval
 
 X_CHECK = np.linspace(-1.0, 1.0, 401)
 
@@ -404,9 +405,7 @@ def test_an_elastic_answer_estimates_its_spatial_error_from_a_coarser_rule():
     1e-11."""
     from core.solver import solve_dimensionless
 
-    x = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 801),
-                                  -1.0 + np.geomspace(1e-10, 1e-2, 20),
-                                  1.0 - np.geomspace(1e-10, 1e-2, 20)]))
+    x = whole_interval(801, farthest=1e-2)
     for m in (1e-6, 1e-3, 0.05):
         reference = solve_dimensionless(1.0, m, 0.0, [1.0], force=1.0, moment=0.3, tol=1e-11)
         answer = solve_dimensionless(1.0, m, 0.0, [1.0], force=1.0, moment=0.3, tol=1e-6,
@@ -435,9 +434,7 @@ def test_a_creeping_answer_estimates_its_spatial_error_on_the_same_time_grids():
     3.5e-9)."""
     from core.solver import solve_dimensionless
 
-    x = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 801),
-                                  -1.0 + np.geomspace(1e-10, 1e-2, 20),
-                                  1.0 - np.geomspace(1e-10, 1e-2, 20)]))
+    x = whole_interval(801, farthest=1e-2)
     times = np.array([1.0, 2.0, 4.0, 8.0])
 
     def kernel(t, tau):

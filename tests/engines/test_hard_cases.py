@@ -36,6 +36,7 @@ from core.creep.models import ExponentialCreep
 from core.discretize import base_panels, build_basis, graded_cuts
 from core.engines.collocation.solve import solve_collocation
 from core.solver import solve_dimensionless as _solve_dimensionless
+from tests.support.points import whole_interval
 from tests.support.scenes import CONCRETE, TEN_LAYERS, jump_m, rough_g, smooth_m, stepped_g
 
 
@@ -108,11 +109,7 @@ RATES = {
 def sample_points(breakpoints=()):
     """The whole of [-1, 1]: 2001 even points, and 25 more toward each edge and each side
     of every jump, from 5e-2 down to 1e-10 away (the solver promises q there too)."""
-    near = np.geomspace(1e-10, 0.05, 25)
-    xs = [np.linspace(-1.0, 1.0, 2001), -1.0 + near, 1.0 - near]
-    for b in breakpoints:
-        xs += [b - near, b + near]
-    return np.unique(np.clip(np.concatenate(xs), -1.0, 1.0))
+    return whole_interval(2001, near=25, jumps=breakpoints)
 
 
 def relative_error(sol, ref, xs) -> float:

@@ -11,6 +11,7 @@ from scipy.linalg import expm
 
 from core.discretize import base_panels, graded_cuts, kernel_operator, operator_rows
 from core.solver import solve_dimensionless
+from tests.support.points import whole_interval
 
 
 def smooth_m(x):
@@ -148,8 +149,7 @@ def test_four_statements_are_consistent():
 
 #: The whole of [-1, 1] (the solver promises q there): 201 even points and 20 toward each
 #: end, down to 1e-10 away.
-_NEAR = np.geomspace(1e-10, 0.05, 20)
-X_WHOLE = np.unique(np.concatenate([np.linspace(-1.0, 1.0, 201), -1.0 + _NEAR, 1.0 - _NEAR]))
+X_WHOLE = whole_interval(201)
 
 
 def test_graded_basis_convergence_on_smooth_coating():
@@ -179,7 +179,7 @@ def test_modulus_jump_graded_basis_beats_the_seeds():
     against n = 512 graded (within 5e-8 of the Nystrom engine at tol 1e-11)."""
     kw = dict(force=1.0, moment=0.2, breakpoints=[0.3])
     ref = solve_dimensionless(1.0, jump_m, 0.0, [1.0], n_modes=512, **kw)
-    x = np.concatenate([X_WHOLE, 0.3 - _NEAR, 0.3 + _NEAR])
+    x = whole_interval(201, jumps=(0.3,))
     x = x[x != 0.3]
     q_ref = ref.pressure(x)[:, 0]
     err = {}

@@ -305,7 +305,7 @@ def _extrapolated_error(diffs: list[float]) -> float:
     """Error of the last level from the differences of consecutive levels.
 
     With a convergence ratio rho = d_k/d_{k-1} per level the remaining error after level k
-    is about d_k rho/(1 - rho) (a geometric tail), rho kept in [0.05, 0.9] so that a stall
+    is about d_k rho/(1 - rho) (a geometric tail), rho kept at most 0.9 so that a stall
     does not make the estimate absurd. The graded basis converges in steps: a level may
     add functions away from where the error is largest, so two levels can share that
     error and their difference drops while the error does not. The estimate is therefore
@@ -320,5 +320,5 @@ def _extrapolated_error(diffs: list[float]) -> float:
     d_prev, d_last = diffs[-2], diffs[-1]
     if d_prev <= 0:
         return d_last
-    rho = min(max(d_last / d_prev, 0.05), 0.9)
+    rho = min(d_last / d_prev, 0.9)
     return d_last * max(1.0, rho / (1.0 - rho))
