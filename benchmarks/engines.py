@@ -161,9 +161,9 @@ def sweep(scene: Scene, repeats: int) -> dict[str, Any]:
     return {"key": scene.key, "title": scene.title, "runs": runs, "agreement": agreement}
 
 
-def cheapest(runs: list[dict], method: str, which: str, target: float = TARGET,
-             measure: str = "error") -> dict | None:
-    ok = [r for r in runs if r["method"] == method and r[measure] <= target]
+def cheapest(runs: list[dict], method: str, which: str, target: float = TARGET
+             ) -> dict | None:
+    ok = [r for r in runs if r["method"] == method and r["error"] <= target]
     return min(ok, key=lambda r: r[which]) if ok else None
 
 
