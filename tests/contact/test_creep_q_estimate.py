@@ -19,6 +19,7 @@ from core.contact.result import UNILATERAL_MARGIN
 from core.creep.kernels import DegenerateKernel
 from core.solver import solve_dimensionless
 from tests.support.creep_laws import sparse_preset
+from tests.support.points import whole_interval
 from tests.support.scenes import CONCRETE
 
 EXPONENTIAL = DegenerateKernel(age_at_loading=1.0, modulus_final=1.0, beta=0.0, alpha=0.0,
@@ -189,8 +190,7 @@ def test_a_steeper_end_beside_a_step_is_located_again_when_its_slope_asks(
 
 #: q at the punch's edges, where the rules' check missed it: the last 1e-2 of [-1, 1]
 #: on a geometric grid down to 1e-10 from +-1, with the 2001 points
-EDGES = np.unique(np.concatenate([X, -1.0 + np.geomspace(1e-10, 1e-2, 40),
-                                  1.0 - np.geomspace(1e-10, 1e-2, 40)]))
+EDGES = whole_interval(2001, near=40, farthest=1e-2)
 
 
 @pytest.mark.parametrize("tol", [1e-6, 1e-7])
@@ -224,10 +224,8 @@ def test_two_punches_under_creep_estimate_q_at_their_edges() -> None:
     assert exact.info["success"] and not exact.flags
     answer = sparse_preset("new_footing_beside_old", "unilateral", 1e-7)
     assert answer.info["success"]
-    near = np.geomspace(1e-10, 1e-2, 40)
-    x = np.unique(np.concatenate([X, -1.0 + near, 1.0 - near]))
     for k, punch in enumerate(answer.punches):
-        at = x + punch.center
+        at = EDGES + punch.center  # (half-widths of 1 m)
         reference = exact.punches[k].pressure_at(at)
         error = np.max(np.abs(punch.pressure_at(at) - reference)) / np.max(np.abs(reference))
         assert error <= UNILATERAL_MARGIN * answer.info["error_estimate"] <= 1e-7, k
