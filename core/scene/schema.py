@@ -417,7 +417,11 @@ def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
         else:
             # the instant of loading, then count - 1 times geometrically spaced over the
             # last three decades before ``end`` (creep is fastest just after loading)
-            times = np.concatenate([[0.0], np.geomspace(end * 1e-3, end, count - 1)])
+            first = end * 1e-3
+            if not first > 0.0:
+                raise ValueError(f"{path}.end: too small for log-spaced times (a thousandth "
+                                 f"of it is 0 in double precision), got {show_value(end)}")
+            times = np.concatenate([[0.0], np.geomspace(first, end, count - 1)])
         times[-1] = end
         return times, {"end": end, "count": count, "spacing": spacing}
     if isinstance(spec, (list, tuple)):

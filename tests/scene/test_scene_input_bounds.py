@@ -134,6 +134,14 @@ def test_output_times_and_pressure_points_are_bounded(monkeypatch):
     assert result.pressure(np.zeros(points - 1)).shape == (points - 1, result.times.size)
 
 
+def test_a_last_time_too_small_for_log_spacing_is_refused_naming_it() -> None:
+    """A thousandth of the smallest double (the first log-spaced time) is 0: numpy's
+    geomspace raised "Geometric sequence cannot include zero", naming no field."""
+    scene = edited("times", {"end": 5e-324, "count": 40, "spacing": "log"})
+    with pytest.raises(ValueError, match=r"^times\.end: too small for log-spaced times"):
+        scene_from_dict(scene)
+
+
 @pytest.mark.slow
 def test_many_jumps_are_refused_before_the_solver_sees_them() -> None:
     """Each jump or kink adds a graded cluster of panels to a dense operator: a 50-row
