@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from core.contact.coupled import solve_unilateral_punches
 from core.contact.coupled_creep import solve_creep_punches
-from core.contact.step import Space
+from core.contact.step import LoadNotCarried, Space
 from core.contact.switch import (
     check_contact_model,
     predicted_unilateral,
@@ -44,6 +44,7 @@ from core.contact.zones import (
 __all__ = [
     "check_contact_model",
     "CONTACT_MODELS",
+    "LoadNotCarried",
     "LOCATING_ZONE_ENDS",
     "predicted_unilateral",
     "refuse_loads_without_contact",

@@ -38,7 +38,12 @@ class NodalState(_Resultants):
 
 
 class NoContact(ValueError):
-    """The loads leave no contact (the punch is pulled away)."""
+    """The loads leave no contact (the punch is pulled away); ``punch``: which punch of
+    several (None for one)."""
+
+    def __init__(self, message: str, punch: int | None = None) -> None:
+        super().__init__(message)
+        self.punch = punch
 
 
 def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarray, step: Step,

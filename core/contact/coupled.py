@@ -53,7 +53,7 @@ from core.contact.active_set import MAX_SWEEPS, NoContact, NodalState, zones_fro
 from core.contact.elastic import _bad_pins, _verify, verdict
 from core.contact.nodal import coarse_start, nodal_operator
 from core.contact.result import UnilateralSolution, _Snapshot
-from core.contact.step import Space, Step, check_loads, nystrom_pressure
+from core.contact.step import LoadNotCarried, Space, Step, check_loads, nystrom_pressure
 from core.contact.systems import BorderedLayout, StepSolver, bordered_operator
 from core.contact.unilateral import nodal_resolution, zone_resolution
 from core.contact.zones import (
@@ -311,8 +311,8 @@ def checked_loads(inputs: Sequence[TimeInputs], times: np.ndarray
                   for name, fn in one.loads.items()}
         try:
             check_loads(one.given, values, times)
-        except ValueError as exc:
-            raise ValueError(f"punches[{k}].{exc}") from None
+        except LoadNotCarried as exc:
+            raise exc.of_punch(k) from None
         loads.append(values)
     return loads
 
@@ -554,9 +554,9 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
         for p, given in enumerate(givens):
             count = int(np.count_nonzero(active[offsets[p]:offsets[p + 1]]))
             if count == 0 and any(given.get(k, 0.0) != 0.0 for k in ("force", "moment")):
-                raise NoContact(f"punches[{p}]: no node stays in contact")
+                raise NoContact(f"punches[{p}]: no node stays in contact", p)
             if 0 < count < 3 and not {"settlement", "tilt"} <= set(given):
-                raise NoContact(f"punches[{p}]: the contact shrinks to a point")
+                raise NoContact(f"punches[{p}]: the contact shrinks to a point", p)
         idx = np.nonzero(active)[0]
         q = np.zeros(x.size)
         if idx.size:

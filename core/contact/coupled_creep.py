@@ -69,7 +69,7 @@ from core.contact.creep import (
 from core.contact.kinks import Corrected, _contact_parts, _cut_rule, _part_rows, corrected_roots
 from core.contact.march import creep_memory, kink_correction, nodes_in, rule_operator
 from core.contact.result import UnilateralSolution
-from core.contact.step import Step, check_loads
+from core.contact.step import LoadNotCarried, Step, check_loads
 from core.contact.unilateral import creep_resolution
 from core.contact.zones import Resolution, zone_kernel_accuracy
 from core.discretize import NODES_PER_PANEL, Panels
@@ -226,8 +226,8 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
                                         grid.shape).astype(float) for name, fn in one.items()}
         try:
             check_loads(given, values, grid)
-        except ValueError as exc:
-            raise ValueError(f"punches[{k}].{exc}") from None
+        except LoadNotCarried as exc:
+            raise exc.of_punch(k) from None
         loads.append(values)
     memory_of = creep_memory(inp.kernel, grid, widths, system.x.size)
     wanted = {int(i): k for k, i in enumerate(out_index)}
@@ -252,8 +252,13 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
             states, settled = _step_states(base, system, step_data, displacement, start,
                                            solver, retry=n == 0)
         except NoContact as exc:
-            raise ValueError(f"{exc}: the loads pull the punch away at t = {grid[n]:g}"
-                             ) from None
+            message = f"{exc}: the loads pull the punch away at t = {grid[n]:g}"
+            if exc.punch is None:
+                raise ValueError(message) from None
+            given = marches.givens[exc.punch]
+            name = "force" if "force" in given else "moment"
+            raise LoadNotCarried(message, name, grid[n], exc.punch,
+                                 str(exc).split(": ", 1)[-1]) from None
         if n == 0 and first is not None and "zones" not in first and any(
                 s.active.any() for s in states):
             zones = []

@@ -105,20 +105,44 @@ def nystrom_pressure(space: Space, step: Step, panels: Panels, q: np.ndarray, de
         step.c * space.m(side))
 
 
+class LoadNotCarried(ValueError):
+    """A given load no contact can carry at a time the lift-off model steps through: the
+    force ``<= 0`` or the resultant outside the punch. ``quantity`` (``"force"`` or
+    ``"moment"``) and ``time`` (dimensionless t) let a scene name its field and the day;
+    ``punch``: which punch of several (None for one); ``detail``: what the contact did
+    (``"the contact shrinks to a point"``), where the loads alone do not say it; the
+    message is in the solver's terms."""
+
+    def __init__(self, message: str, quantity: str, time: float,
+                 punch: int | None = None, detail: str = "") -> None:
+        super().__init__(message)
+        self.quantity, self.time, self.punch = quantity, float(time), punch
+        self.detail = detail
+
+    def of_punch(self, k: int) -> LoadNotCarried:
+        """The same refusal for punch ``k`` of several (its message naming
+        ``punches[k]``)."""
+        return LoadNotCarried(f"punches[{k}].{self}", self.quantity, self.time, k,
+                              self.detail)
+
+
 def check_loads(statement_given: frozenset[str], loads: dict[str, np.ndarray],
                 times: np.ndarray) -> None:
-    """Refuse loads that pull the punch away (no contact can carry them)."""
+    """Refuse loads that pull the punch away (no contact can carry them):
+    :class:`LoadNotCarried`."""
     if "force" in loads:
         bad = loads["force"] <= 0.0
         if bad.any():
             t = times[int(np.argmax(bad))]
-            raise ValueError(f"force: must be > 0 for the punch to touch (a punch pulled away "
-                             f"has no contact), got {loads['force'][bad][0]:.6g} at t = {t:g}")
+            raise LoadNotCarried(f"force: must be > 0 for the punch to touch (a punch pulled "
+                                 f"away has no contact), got {loads['force'][bad][0]:.6g} at "
+                                 f"t = {t:g}", "force", t)
         if "moment" in loads:
             e = loads["moment"] / loads["force"]
             bad = np.abs(e) >= 1.0
             if bad.any():
                 k = int(np.argmax(bad))
-                raise ValueError(f"moment: the eccentricity M/P = {e[k]:.6g} at t = "
-                                 f"{times[k]:g} puts the load outside the punch (|M/P| must "
-                                 "be < 1 half-width): no contact can carry it")
+                raise LoadNotCarried(f"moment: the eccentricity M/P = {e[k]:.6g} at t = "
+                                     f"{times[k]:g} puts the load outside the punch (|M/P| "
+                                     "must be < 1 half-width): no contact can carry it",
+                                     "moment", times[k])

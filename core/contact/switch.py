@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from core.contact.step import LoadNotCarried
 from core.contact.unilateral import CONTACT_MODELS, FULL_CONTACT, solve_unilateral
 
 if TYPE_CHECKING:
@@ -170,6 +171,11 @@ def with_contact_model(full, contact: str, arguments: dict[str, Any]):
             # no unilateral answer exists, and the flagged full-contact one says so.
             full.info["contact"] = "full"
             full.info["unilateral_refused"] = str(exc)
+            if isinstance(exc, LoadNotCarried):
+                # what a scene needs to say it in its own terms (core.scene.load_limits)
+                full.info["unilateral_refused_load"] = {"quantity": exc.quantity,
+                                                        "time": exc.time,
+                                                        "detail": exc.detail}
             full.info["message"] += f"; unilateral contact refused: {exc}"
             # the punch lifts off, so the full-contact answer is not this scene's, however
             # well it meets tol: never a success

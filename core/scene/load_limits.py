@@ -16,9 +16,11 @@ and reads an unloaded or pulled punch as a bonded one.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from core.contact import LoadNotCarried
 
 if TYPE_CHECKING:
     from core.scene.model import Scene
@@ -107,3 +109,66 @@ def _check_one(scene: Scene) -> None:
                       f"is not inside the punch, |e| must be < a = {a:.6g} m")
         raise ValueError(f"loading.moment: {reason}: the resultant acts outside the base, "
                          "so no contact can carry it")
+
+
+def not_carried(scene: Scene, exc: LoadNotCarried, prefix: str = "") -> str:
+    """The message of a load the lift-off model found no contact for at one of the times
+    it steps through (``exc``, in the solver's terms: dimensionless time, half-widths), in
+    the scene's: the field ``{prefix}loading.<quantity>``, the time in days after loading
+    and the loads there [N/m, N·m/m]. ``prefix``: ``punches[k].`` for punch ``k`` of
+    several.
+
+    The checks before solving (:func:`check_loads_touch`) sample the histories; the solver
+    meets the loads on its own time grid, where a force of 0 (a ramp from nothing, which
+    the full-contact model answers) leaves the lift-off model nothing to answer: with no
+    pressure the punch's settlement is not determined."""
+    day = float(np.asarray(scene.dimensionless.days_after_loading(exc.time)))
+    at = np.array([day])
+
+    def value(name: str) -> float | None:
+        profile = scene.loading.get(name)
+        return None if profile is None else float(np.asarray(profile(at), dtype=float).ravel()[0])
+
+    force, moment = value("force"), value("moment")
+    when = f"t = {day:.6g} days after loading"
+    found = f" ({exc.detail})" if exc.detail else ""
+    if force is not None and force <= 0.0:
+        return (f"{prefix}loading.force: P = {force:.6g} N/m at {when}: the lift-off model "
+                "steps through every time and has no answer where nothing presses the punch "
+                "(its settlement is then not determined); a force > 0 from loading on is "
+                "answered, or solver.contact 'full' (a linear model) answers this history")
+    a = scene.half_width
+    if force is not None and moment is not None:
+        e = moment / force
+        if abs(e) >= a:
+            return (f"{prefix}loading.moment: the eccentricity e = M/P = {e:.6g} m at {when} "
+                    f"(M = {moment:.6g} N·m/m, P = {force:.6g} N/m) is not inside the punch, "
+                    f"|e| must be < a = {a:.6g} m: the resultant acts outside the base, so no "
+                    "contact can carry it")
+        return (f"{prefix}loading.moment: at {when} the eccentricity e = M/P = {e:.6g} m "
+                f"(a = {a:.6g} m) leaves the lift-off model no contact zone to carry the "
+                f"loads{found}; a smaller eccentricity there is answered")
+    settlement = value("settlement")
+    if settlement is not None:
+        # held at a given settlement, the punch is left above the surface as it creeps
+        return (f"{prefix}loading.settlement: {settlement:.6g} m at {when} leaves the punch "
+                f"above the surface, or touching it at a point at most{found}, and nothing "
+                f"then carries the given {exc.quantity}; a larger settlement there, or a "
+                "given force, is answered")
+    return (f"{prefix}loading.{exc.quantity}: at {when} the lift-off model finds no contact "
+            f"zone to carry the loads{found}")
+
+
+def reword_refused_lift_off(scene: Scene, info: dict[str, Any]) -> None:
+    """Say in the scene's terms (:func:`not_carried`) why the lift-off model refused the
+    loads of an ``"auto"`` answer left in full contact (``info["unilateral_refused"]`` and
+    the message, which the solver wrote with its dimensionless time)."""
+    load = info.pop("unilateral_refused_load", None)
+    refused = info.get("unilateral_refused")
+    if load is None or not isinstance(refused, str):
+        return
+    reason = not_carried(scene, LoadNotCarried(refused, load["quantity"], load["time"],
+                                               detail=load.get("detail", "")))
+    info["unilateral_refused"] = reason
+    if isinstance(info.get("message"), str):
+        info["message"] = info["message"].replace(refused, reason)

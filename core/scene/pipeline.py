@@ -19,10 +19,10 @@ from typing import Any
 
 import numpy as np
 
-from core.contact import LOCATING_ZONE_ENDS
+from core.contact import LOCATING_ZONE_ENDS, LoadNotCarried
 from core.engines.layered import LiftOffNotAnswered, solve_scene_layered
 from core.scene.files import load_scene
-from core.scene.load_limits import check_loads_touch
+from core.scene.load_limits import check_loads_touch, not_carried, reword_refused_lift_off
 from core.scene.model import Scene
 from core.scene.punches import (
     PunchesScene,
@@ -78,8 +78,11 @@ def solve(scene: Scene | PunchesScene | Mapping[str, Any] | str | os.PathLike
                 raise ValueError(lift_off_refusal())
             result = SceneSolution(scene, problem,
                                    problem.solve() if answer is None else answer)
+            reword_refused_lift_off(scene, result.info)
     except WorkLimitExceeded as exc:
         raise ValueError(_costly(scene, exc)) from None
+    except LoadNotCarried as exc:
+        raise ValueError(not_carried(scene, exc)) from None
     result.info["cpu_seconds"] = time.thread_time() - started
     _check_finite(result)
     return result

@@ -26,7 +26,8 @@ import copy
 import copyreg
 import json
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,14 +35,14 @@ import numpy as np
 
 from core import limits
 from core.coating import DEFAULT_INTERFACE
-from core.contact import solve_creep_punches, solve_unilateral_punches
+from core.contact import LoadNotCarried, solve_creep_punches, solve_unilateral_punches
 from core.engines.nystrom import PunchGeometry, solve_punches
 from core.problem import TimeInputs, validate_geometry, validate_time_inputs
 from core.profiles import shifted
 from core.scene import punches_output, schema
 from core.scene.contact_zone import contact_width, lift_off_length
 from core.scene.design import DesignCheck, DesignLimits
-from core.scene.load_limits import check_loads_touch
+from core.scene.load_limits import check_loads_touch, not_carried
 from core.scene.model import Scene
 from core.scene.records import csv_header
 from core.scene.results import SceneSolution
@@ -94,6 +95,17 @@ def _renamed(message: str, k: int) -> str:
             rest = message[len("punch."):] if prefix == "punch." else message
             return f"punches[{k}].{rest}"
     return message.replace("punch.half_width", f"punches[{k}].half_width")
+
+
+@contextmanager
+def _named_loads(scene: PunchesScene) -> Iterator[None]:
+    """A load the lift-off model finds no contact for at one of its times refused in the
+    words of the file (:func:`core.scene.load_limits.not_carried`)."""
+    try:
+        yield
+    except LoadNotCarried as exc:
+        k = 0 if exc.punch is None else exc.punch
+        raise ValueError(not_carried(scene.scenes[k], exc, f"punches[{k}].")) from None
 
 
 def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:
@@ -399,7 +411,10 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
     # a load no contact can carry is refused in every contact mode, as for one punch
     check_loads_touch(scene)
     if len(scene.scenes) == 1:
-        single = solve(scene.scenes[0])
+        try:
+            single = solve(scene.scenes[0])
+        except ValueError as exc:
+            raise ValueError(_renamed(str(exc), 0)) from None
         solution = single.dimensionless
         punches = [PunchSolution(scene.scenes[0], scene.centers[0], solution)]
     else:
@@ -414,7 +429,7 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
                                                {q: problem.loads.get(q) for q in
                                                 ("settlement", "tilt", "force", "moment")}))
         first = scene.scenes[0]
-        with np.errstate(all="ignore"):
+        with np.errstate(all="ignore"), _named_loads(scene):
             if first.contact == "unilateral":
                 answers = _lift_off(scene, geometries, inputs)
             else:

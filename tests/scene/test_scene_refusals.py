@@ -12,6 +12,7 @@ from typing import Any
 
 import pytest
 
+from core.presets import read_preset
 from core.scene import load_scene, scene_from_dict, solve
 from tests.conftest import DELETE, ODD, edited, elastic_dict, small_preset_scene
 
@@ -156,3 +157,72 @@ def test_a_design_code_creep_law_past_its_100_years_names_the_times() -> None:
         solve(d)
     d["times"] = {"end": 36525.0, "count": 3}  # the whole span: answered
     assert solve(d).times[-1] == 36525.0
+
+
+# -- loads the lift-off model meets on its own time grid --------------------------------
+# The checks before solving sample the load histories and allow an instant of P = 0 (the
+# full-contact model answers a ramp from nothing); the lift-off model steps through every
+# time and found none to answer there. It said "force: ... got 0 at t = 1" (the solver's
+# field name and its dimensionless time, age over age at loading) or "moment: the loads
+# pull the punch away at t = 876.875" (days were 875.875).
+
+def _ramp_from_nothing() -> dict[str, Any]:
+    d = small_preset_scene("uniform_flat")
+    d["loading"] = {"force": {"kind": "ramp", "start": 0.0, "end": 5e5, "duration": 10.0},
+                    "moment": 0.0}
+    d["solver"]["contact"] = "unilateral"
+    return d
+
+
+def test_a_ramp_from_nothing_under_lift_off_is_refused_naming_the_force_in_days() -> None:
+    with pytest.raises(ValueError, match=r"^loading\.force: P = 0 N/m at t = 0 days after "
+                                         r"loading: the lift-off model .* solver\.contact "
+                                         r"'full'"):
+        solve(_ramp_from_nothing())
+    d = _ramp_from_nothing()
+    d["solver"]["contact"] = "full"
+    assert solve(d).info["success"]
+
+
+def test_a_ramp_from_nothing_of_one_of_several_punches_names_that_punch() -> None:
+    d = read_preset("new_footing_beside_old")
+    d["punches"][1]["loading"]["force"] = {"kind": "ramp", "start": 0.0, "end": 5e5,
+                                           "duration": 5.0}
+    d["base"]["creep"] = {"model": "elastic", "modulus": 3e10}
+    d["times"] = [0.0, 1.0, 10.0]
+    d["solver"]["contact"] = "unilateral"
+    with pytest.raises(ValueError, match=r"^punches\[1\]\.loading\.force: P = 0 N/m at t = 0 "
+                                         r"days after loading"):
+        solve(d)
+
+
+def test_a_settlement_lifting_the_punch_off_the_crept_surface_names_it_in_days() -> None:
+    # a settlement held, then lowered at 500 days below what the creeping base has sunk
+    # to: the punch is above the surface and nothing carries the given moment
+    d = small_preset_scene("uniform_flat", count=8)
+    d["loading"] = {"settlement": {"kind": "step", "values": [1.5e-3, 2e-4],
+                                   "breaks": [500.0]}, "moment": 4.5e4}
+    d["times"] = {"end": 1000.0, "count": 8}
+    d["solver"]["contact"] = "unilateral"
+    with pytest.raises(ValueError, match=r"^loading\.settlement: 0\.0002 m at t = 500 days "
+                                         r"after loading leaves the punch above the "
+                                         r"surface.* the given moment") as refused:
+        solve(d)
+    assert "t = 1.0" not in str(refused.value)
+
+
+def test_an_auto_answer_left_in_full_contact_says_why_in_the_scenes_terms() -> None:
+    # a coating 3.4 mm thicker on the right stands 3.4 mm higher there: held at a
+    # settlement of 0.08 mm the punch touches near its right edge only, tilted to the
+    # surface; the lift-off model refused ("moment: the loads pull the punch away at t =
+    # 1.02172 (the contact shrinks to a point)", its dimensionless time) and auto kept the
+    # flagged full-contact answer
+    d = read_preset("stepped_punch")
+    d["coating"][0]["thickness"] = {"kind": "linear", "start": 0.0178, "end": 0.0212}
+    result = solve(d)
+    assert result.flags == ["contact_lost"] and not result.info["success"]
+    refused = result.info["unilateral_refused"]
+    assert re.match(r"loading\.settlement: 8e-05 m at t = \S+ days after loading leaves the "
+                    r"punch above the surface", refused), refused
+    assert result.info["message"].endswith("unilateral contact refused: " + refused)
+    assert "unilateral_refused_load" not in result.info
