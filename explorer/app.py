@@ -562,6 +562,8 @@ class ExplorerApp(pn.viewable.Viewer):
         self._connected = True
         if self.controller.view is not None and self.controller.view is not self.screen.drawn:
             self._on_view(None)
+        else:
+            self.results.page_loaded()
         self.tabs.fill_when_idle()
 
     def _newest(self) -> ResultView | None:

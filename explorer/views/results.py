@@ -492,6 +492,14 @@ class ResultsView:
 
         self.loop.later(lambda: move(0), 0)
 
+    def page_loaded(self) -> None:
+        """The browser has drawn the page: a player whose range and value were in the first
+        document (an answer the server had before the page was sent) took the value before
+        its maximum, HTML's default 100 (a link to a 200-time scene read the last time in
+        its label with the handle mid-track), so both are sent again (:meth:`_set_range`)."""
+        if self.loop.served and self.player.end > 1:
+            self._set_range(self.player.end, self.player.value)
+
     def push(self) -> None:
         """In a notebook, plain Bokeh models changed in place must be pushed by hand."""
         if not self.loop.served and self._bokeh_panes:

@@ -118,6 +118,25 @@ def test_time_slider_range_follows_a_preset_switch(page: Page):
     assert page.errors == []
 
 
+def test_a_link_to_a_scene_of_200_times_puts_the_handle_at_the_last(server: str,
+                                                                    browser_context: object):
+    """Opened from its link, the 50-year preset (200 output times) read the last time in
+    its label while the handle sat mid-track (100 of 0-199): the page's range input took
+    the value before its maximum (its default 100) when the page was first drawn with an
+    answer the server already had (the second visit)."""
+    for visit in ("first", "second, the answer known"):
+        other = Page(browser_context, server, "/app?preset=young_concrete_50_years")
+        try:
+            until(lambda page=other: _player_range(page) == {"min": "0", "max": "199",
+                                                              "value": "199"},
+                  f"the slider at the last of 200 times ({visit} visit)", 60,
+                  lambda page=other: _player_range(page))
+            assert "50.0 years" in other.text(".time-label")
+            assert other.errors == []
+        finally:
+            other.close()
+
+
 JS_TIME_RANGE = """() => { const r = Bokeh.documents[0].get_model_by_name('settlement_figure')
   .x_range; return [r.start, r.end]; }"""
 
