@@ -41,6 +41,7 @@ from .model import (
     read_fit_query,
     read_study_query,
     read_view_query,
+    screen_limits,
     validated_scene,
 )
 from .plots import Figures
@@ -170,7 +171,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.state.param.watch(lambda _: self.screen.scene_changed(), "revision")
         self.link = AddressLink(self.screen, self.controller, self.loop,
                                 pn.state.location if self.loop.served else None,
-                                self._view_parts)
+                                self._view_parts, self.limits)
         self.pins = PinsView(self.state, self.screen, self.controller, self.loop,
                              on_change=self._on_pins)
         self.results = ResultsView(self.screen, self.controller, self.loop, self.figures,
@@ -335,6 +336,10 @@ class ExplorerApp(pn.viewable.Viewer):
             try:
                 self.state.load_scene(chosen)
                 self.history.loaded = chosen
+                # a link's (or a given scene's) design limits, as a scene file's are taken
+                for name, value in screen_limits(chosen.get("limits")).items():
+                    if value is not None:
+                        setattr(self.limits, name, value)
             except ValueError as exc:
                 self.screen.notice = f"The scene could not be shown: {exc}"
         self.history.remember()

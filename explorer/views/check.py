@@ -49,8 +49,9 @@ class CheckView:
     def _limit(self, label: str, name: str, css: str) -> NumberBox:
         # no lower bound on the box: the page would clamp -5 to 0 unsaid, a limit that
         # every answer fails; a negative value is refused here, saying so
-        box = NumberBox(label=label, value=None, sizing_mode="stretch_width",
-                        css_classes=[css])
+        # (the session's limit: one from the page's link is there before this tab)
+        box = NumberBox(label=label, value=getattr(self.limits, name),
+                        sizing_mode="stretch_width", css_classes=[css])
         box.param.watch(lambda e: self._on_limit(box, label, name, e), "value")
         return box
 

@@ -9,7 +9,7 @@ from typing import Any
 
 import panel as pn
 
-from ..model import Screen, study_settings, view_query
+from ..model import DesignLimits, Screen, scene_with_limits, study_settings, view_query
 from ..solving import SolveController
 from .loop import PageLoop
 
@@ -24,12 +24,18 @@ class AddressLink:
     """Writes a link that reproduces the view into the page's address bar, calmly."""
 
     def __init__(self, screen: Screen, controller: SolveController, loop: PageLoop,
-                 location: Any, view_parts: Callable[[], tuple[int, list[Any], Any, Any]]) -> None:
+                 location: Any, view_parts: Callable[[], tuple[int, list[Any], Any, Any]],
+                 limits: DesignLimits | None = None) -> None:
         """``screen``: the result and time on screen; ``controller``: a link waits while a
         newer result is coming; ``location``: the page's address (None: not served, no
         link); ``view_parts``: the open tab, the pinned scenes, the Study tab's settings
-        and the Fit tab's, asked when the link is written."""
+        and the Fit tab's, asked when the link is written; ``limits``: the session's
+        design limits, which the link's scene carries (as a saved scene file does)."""
         self.screen = screen
+        self.limits = limits
+        if limits is not None:
+            limits.param.watch(lambda *_: self.schedule(),
+                               [n for n in limits.param if n != "name"])
         self.controller = controller
         self.loop = loop
         self.location = location
@@ -66,7 +72,9 @@ class AddressLink:
                     # a study setting being typed (points 1000, an empty box): the Study
                     # tab names it; the link keeps the last good settings and the scene
                     study = self._study
-            query = view_query(view.scene, self.screen.time_index, tab, pins, study, fit)
+            scene = (view.scene if self.limits is None
+                     else scene_with_limits(view.scene, self.limits))
+            query = view_query(scene, self.screen.time_index, tab, pins, study, fit)
             # the whole query at once: the values are URL-safe already (base64url, digits)
             link = "?" + "&".join(f"{k}={v}" for k, v in query.items() if v)
             if link != self.linked:

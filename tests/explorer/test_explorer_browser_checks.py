@@ -604,6 +604,41 @@ def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
         other.close()
 
 
+def test_a_link_keeps_the_design_limits(page: Page, server: str, browser_context: object):
+    """The limits typed in the Check tab are part of the scene a link carries, as of a
+    saved scene file: reopened from its link the page had them all empty ("no limits
+    set"), and a report printed there had no design check."""
+    page.open_tab("Check")
+    box = page.page.locator(".limit-pressure input").first
+    box.wait_for(timeout=30_000 * patience())
+    box.fill("1")  # kPa: any footing fails this
+    box.press("Enter")
+    until(lambda: "a limit is exceeded" in page.text(".design-check"), "FAIL")
+
+    def href() -> str:
+        return page.page.evaluate("() => window.location.href")
+
+    from explorer.model import decode_scene
+
+    def linked_limits() -> object:
+        query = dict(part.split("=", 1) for part in href().split("?", 1)[-1].split("&")
+                     if "=" in part)
+        return decode_scene(query["scene"]).get("limits") if "scene" in query else None
+
+    until(lambda: linked_limits() == {"allowable_pressure": 1000.0}, "the limit in the link",
+          describe=linked_limits)
+    other = Page(browser_context, server, "/app?" + href().split("?", 1)[1])
+    try:
+        until(lambda: "a limit is exceeded" in other.text(".design-check"), "FAIL again")
+        other.open_tab("Check")
+        again = other.page.locator(".limit-pressure input").first
+        again.wait_for(timeout=30_000 * patience())
+        assert again.input_value() == "1"
+        assert other.errors == []
+    finally:
+        other.close()
+
+
 # Every font size a model of the page sets: [how many, those not in px].
 JS_FONT_SIZES = """() => {
   let sizes = 0;
