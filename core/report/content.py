@@ -13,7 +13,6 @@ import numpy as np
 
 from core.report.contact import contact_text, lift_off_times, output_index
 from core.report.inputs import SHOWN_UNITS, input_rows
-from core.report.inputs import number as _number
 from core.scene import (
     PunchesSolution,
     SceneSolution,
@@ -22,6 +21,7 @@ from core.scene import (
     flags_with_evidence,
     largest_pressure,
     model_error_evidence,
+    number_text,
     percent_text,
     time_of_largest,
 )
@@ -49,7 +49,7 @@ def _largest_pressure_text(result: Any, origin: float = 0.0) -> str:
     line = largest_pressure(result)
     if line.x is not None and origin:
         line = replace(line, x=origin + line.x)
-    return line.value_text(number=_number, shown=_shown, day="d", place_first=True)
+    return line.value_text(number=number_text, shown=_shown, day="d", place_first=True)
 
 
 def _at(times: np.ndarray, values: np.ndarray) -> tuple[float, float]:
@@ -63,7 +63,7 @@ def _at(times: np.ndarray, values: np.ndarray) -> tuple[float, float]:
 def _shown(value: float, si_unit: str) -> str:
     """``value`` [``si_unit``] in the unit the report shows it in (:data:`SHOWN_UNITS`)."""
     unit, size = SHOWN_UNITS[si_unit]
-    return f"{_number(value / size)} {unit}"
+    return f"{number_text(value / size)} {unit}"
 
 
 def key_numbers(result: SceneSolution, time: float | None = None,
@@ -76,8 +76,8 @@ def key_numbers(result: SceneSolution, time: float | None = None,
     settlement, t_s = _at(t, result.settlement)
     tilt, t_a = _at(t, result.tilt)
     rows = [
-        ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {_number(t_s)} d"),
-        ("largest tilt α", f"{_shown(tilt, 'rad')} at t = {_number(t_a)} d"),
+        ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {number_text(t_s)} d"),
+        ("largest tilt α", f"{_shown(tilt, 'rad')} at t = {number_text(t_a)} d"),
         ("largest contact pressure q", _largest_pressure_text(result, origin)),
         ("force P at the last time", _shown(result.force[-1], "N/m")),
         ("moment M at the last time", _shown(result.moment[-1], "N")),
@@ -85,20 +85,20 @@ def key_numbers(result: SceneSolution, time: float | None = None,
     force = float(result.force[-1])
     if force != 0 and np.isfinite(force):
         rows.append(("eccentricity e = M/P at the last time",
-                     f"{_number(float(result.moment[-1]) / force)} m"))
+                     f"{number_text(float(result.moment[-1]) / force)} m"))
     k = output_index(result, time)
-    rows.append((f"contact at t = {_number(t[k])} d", contact_text(result, k, origin)))
+    rows.append((f"contact at t = {number_text(t[k])} d", contact_text(result, k, origin)))
     lifted = lift_off_times(result)
     if lifted.size:
         rows.append(("lift-off", f"at {lifted.size} of {len(t)} output times, first at "
-                                 f"t = {_number(t[lifted[0]])} d, last at "
-                                 f"t = {_number(t[lifted[-1]])} d (contact width plotted)"))
+                                 f"t = {number_text(t[lifted[0]])} d, last at "
+                                 f"t = {number_text(t[lifted[-1]])} d (contact width plotted)"))
     if result.info.get("contact") == "unilateral" and result.contact_set:
         width = result.contact_width
         k = int(np.argmin(width))
-        rows.append(("smallest contact width", f"{_number(width[k])} m of "
-                                               f"{_number(2 * result.scene.half_width)} m at "
-                                               f"t = {_number(t[k])} d"))
+        rows.append(("smallest contact width", f"{number_text(width[k])} m of "
+                                               f"{number_text(2 * result.scene.half_width)} m at "
+                                               f"t = {number_text(t[k])} d"))
     return rows
 
 
@@ -126,7 +126,7 @@ def accuracy_rows(result: SceneSolution,
         # in percent, as the page and the command line write them (the report read
         # "1.8e-02" where the page read 1.81 %)
         *([(f"coating model error ({evidence['label']}, relative)",
-            f"{percent_text(evidence['measured'])} at t = {_number(evidence['time_day'])} "
+            f"{percent_text(evidence['measured'])} at t = {number_text(evidence['time_day'])} "
             f"d (flagged above {percent_text(result.scene.model_tol)}: "
             + ("FLAGGED)" if evidence["flagged"] else "within)"))]
           if evidence["source"] == "measured" else []),
@@ -153,7 +153,7 @@ def _discretization(info: dict[str, Any]) -> str:
 def _check_line(line: Any) -> str:
     """A design-check line without its label: value, where, limit, utilisation, verdict,
     in the units of the results (kPa, mm, mrad)."""
-    return line.verdict_text(number=_number, shown=_shown, day="d")
+    return line.verdict_text(number=number_text, shown=_shown, day="d")
 
 
 def design_section(result: SceneSolution, flags: Sequence[str] | None = None
@@ -182,13 +182,13 @@ def calibration_section(calibration: Any) -> Section:
     values, errors, units = (calibration.values, calibration.standard_errors,
                              calibration.units)
     series = ", ".join(f"{name} [{SERIES_SI[name]}]" for name in readings.series)
-    rows = [("readings", f"{readings.count} ({series}), t = {_number(float(readings.time[0]))}"
-                         f" to {_number(float(readings.time[-1]))} d"
+    rows = [("readings", f"{readings.count} ({series}), t = {number_text(float(readings.time[0]))}"
+                         f" to {number_text(float(readings.time[-1]))} d"
                          + (", with standard deviations" if calibration.std_given else ""))]
     for path in calibration.paths:
         unit = f" {units[path]}" if units[path] else ""
-        rows.append((path, f"{_number(values[path], 6)} ± {_number(errors[path], 2)}{unit}"
-                           f" (start {_number(calibration.start[path], 6)}{unit})"))
+        rows.append((path, f"{number_text(values[path], 6)} ± {number_text(errors[path], 2)}{unit}"
+                           f" (start {number_text(calibration.start[path], 6)}{unit})"))
     corr = calibration.correlation
     paths = calibration.paths
     for j in range(len(paths)):

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from core.scene import Scene, solver_settings
+from core.scene import Scene, number_text, solver_settings
 
 #: Shown units of the histories and the pressure, by their SI unit: (unit, its size in SI).
 SHOWN_UNITS: dict[str, tuple[str, float]] = {
@@ -47,20 +47,8 @@ CREEP_MODELS: dict[str, str] = {
 LOAD_SAMPLES = 2001
 
 
-def number(value: float, digits: int = 4) -> str:
-    """``value`` with ``digits`` significant digits ("not finite" for NaN and infinity),
-    without an exponent from 0.001 to a million (50 years read "18260 d", not
-    "1.826e+04 d")."""
-    if not np.isfinite(value):
-        return "not finite"
-    if value == 0 or 1e-3 <= abs(value) < 1e6:
-        return np.format_float_positional(float(value), precision=digits, unique=False,
-                                          fractional=False, trim="-")
-    return f"{value:.{digits}g}"
-
-
 def _with_unit(value: float, unit: str) -> str:
-    return f"{number(value)} {unit}".rstrip()
+    return f"{number_text(value)} {unit}".rstrip()
 
 
 def profile_text(spec: Any, values: np.ndarray, unit: str, size: float) -> str:
@@ -71,7 +59,8 @@ def profile_text(spec: Any, values: np.ndarray, unit: str, size: float) -> str:
     kind = (f"formula {spec['expr']}" if "expr" in spec
             else f"{spec.get('kind', 'constant')} profile")
     lo, hi = float(np.min(values)) / size, float(np.max(values)) / size
-    span = number(lo) if number(lo) == number(hi) else f"{number(lo)} to {number(hi)}"
+    low, high = number_text(lo), number_text(hi)
+    span = low if low == high else f"{low} to {high}"
     return f"{span} {unit} ({kind})".replace("  ", " ")
 
 
@@ -97,8 +86,9 @@ def _creep_text(spec: dict[str, Any]) -> str:
 def _times_text(scene: Scene, spec: Any) -> str:
     times = scene.times
     if len(times) == 1:
-        return f"1 output time, {number(times[0])} d after loading"
-    text = f"{len(times)} output times, {number(times[0])} to {number(times[-1])} d after loading"
+        return f"1 output time, {number_text(times[0])} d after loading"
+    text = (f"{len(times)} output times, {number_text(times[0])} to "
+            f"{number_text(times[-1])} d after loading")
     if isinstance(spec, dict):
         return text + f" ({spec.get('spacing', 'linear')} spacing)"
     return text + (" (listed)" if isinstance(spec, list) else "")
@@ -111,7 +101,8 @@ def input_rows(scene: Scene) -> list[tuple[str, str]]:
     a = scene.half_width
     symbol, unit, size = SHAPE_UNIT
     shape = data["punch"].get("shape", 0.0)
-    rows = [("punch", f"half-width a = {number(a)} m (width 2a = {number(2 * a)} m); base "
+    rows = [("punch", f"half-width a = {number_text(a)} m (width 2a = "
+                      f"{number_text(2 * a)} m); base "
                       + ("flat" if shape == 0 else
                          f"{symbol} = {profile_text(shape, _values(scene.shape, x), unit, size)}"
                          " above its lowest point"))]
@@ -127,10 +118,10 @@ def input_rows(scene: Scene) -> list[tuple[str, str]]:
                      ", ".join(parts) + f", {layer.interface} interface"))
     if not scene.coating:
         rows.append(("coating", "none: the punch on the bare base"))
-    rows.append(("base", f"H = {number(scene.base_thickness)} m, ν = "
-                         f"{number(scene.base_poisson)}, age at loading τ0 = "
-                         f"{number(scene.age_at_loading)} d, modulus at loading E(τ0) = "
-                         f"{number(scene.modulus_at_loading() / 1e9)} GPa"))
+    rows.append(("base", f"H = {number_text(scene.base_thickness)} m, ν = "
+                         f"{number_text(scene.base_poisson)}, age at loading τ0 = "
+                         f"{number_text(scene.age_at_loading)} d, modulus at loading E(τ0) = "
+                         f"{number_text(scene.modulus_at_loading() / 1e9)} GPa"))
     rows.append(("base creep", _creep_text(data["base"]["creep"])))
     t = np.union1d(np.linspace(0.0, float(scene.times[-1]), LOAD_SAMPLES), scene.times)
     for name in LOADS:

@@ -22,7 +22,6 @@ import numpy as np
 from core.report.contact import lifted_parts, output_index
 from core.report.content import Section, accuracy_rows, key_numbers
 from core.report.inputs import SHOWN_UNITS, input_rows
-from core.report.inputs import number as _number
 from core.report.plots import (
     PLOT_HEIGHT,
     PLOT_WIDTH,
@@ -36,6 +35,7 @@ from core.scene import (
     PunchSolution,
     flagged_caution,
     holoviews_for_bokeh,
+    number_text,
     pressure_unit,
     shown_times,
     time_colours,
@@ -76,12 +76,12 @@ def local_view(punch: PunchSolution) -> PunchSolution:
 
 
 def _name(k: int, punch: PunchSolution) -> str:
-    return f"punches[{k}] at x = {_number(punch.center)} m"
+    return f"punches[{k}] at x = {number_text(punch.center)} m"
 
 
 def _shown(value: float, si_unit: str) -> str:
     unit, size = SHOWN_UNITS[si_unit]
-    return f"{_number(value / size)} {unit}"
+    return f"{number_text(value / size)} {unit}"
 
 
 def _at_time(punch: PunchSolution, k: int) -> str:
@@ -137,7 +137,7 @@ def punches_sections(result: PunchesSolution, time: float | None = None) -> list
     checks = result.design_checks()
     if any(check is not None for check in checks):
         rows = [(f"punches[{k}] {line.label}",
-                 line.verdict_text(number=_number, shown=_shown, day="d"))
+                 line.verdict_text(number=number_text, shown=_shown, day="d"))
                 for k, check in enumerate(checks) if check is not None
                 for line in (*check.checks, check.q_min)]
         failed = [f"punches[{k}]" for k, check in enumerate(checks)
@@ -149,7 +149,7 @@ def punches_sections(result: PunchesSolution, time: float | None = None) -> list
                            rows, tone="bad" if failed or caution else "good"))
     for k, punch in enumerate(punches):
         view = local_view(punch)
-        rows = [("zone", _zone(punch)), (f"at t = {_number(t)} d", _at_time(punch, k_t)),
+        rows = [("zone", _zone(punch)), (f"at t = {number_text(t)} d", _at_time(punch, k_t)),
                 *key_numbers(view, time, origin=punch.center),
                 ("flags", ", ".join(punch.flags) or "none")]
         out.append(Section(f"Results: {_name(k, punch)}", rows=rows,
@@ -162,7 +162,7 @@ def punches_sections(result: PunchesSolution, time: float | None = None) -> list
     for k, (punch, own_rows) in enumerate(zip(punches, own, strict=True)):
         for label, value in own_rows:
             # the punch's row (its half-width and base) leads with its centre
-            rows.append((f"punches[{k}]", f"centre x = {_number(punch.center)} m, {value}")
+            rows.append((f"punches[{k}]", f"centre x = {number_text(punch.center)} m, {value}")
                         if label == "punch" else (f"punches[{k}] {label}", value))
     out.append(Section("Inputs", rows=rows))
     return out
@@ -208,7 +208,7 @@ def surface_overlay(result: PunchesSolution, time: float | None = None) -> Any:
             elements.append(hv.VSpan(punch.center + lo, punch.center + hi).opts(
                 color=LIFT_OFF_COLOUR, alpha=0.5, backend="bokeh"))
     elements += [hv.Curve((x, q / size), kdims=[x_dim], vdims=[q_dim],
-                          label=f"t = {_number(float(result.times[j]))} d")
+                          label=f"t = {number_text(float(result.times[j]))} d")
                  .opts(color=colours[i], tools=["hover"], backend="bokeh")
                  for i, (j, (x, q)) in enumerate(zip(picked, curves, strict=True))]
     return hv.Overlay(elements).opts(
@@ -224,7 +224,8 @@ def surface_title(result: PunchesSolution) -> str:
 
 def _zone(punch: PunchSolution) -> str:
     a = punch.scene.half_width
-    return f"x = {_number(punch.center - a)} to {_number(punch.center + a)} m (shaded in q(x))"
+    return (f"x = {number_text(punch.center - a)} to {number_text(punch.center + a)} m "
+            "(shaded in q(x))")
 
 
 def history_overlay(result: PunchesSolution, name: str, symbol: str, si_unit: str) -> Any:

@@ -54,7 +54,13 @@ from core.scene.design import (
     time_of_largest,
     verdict_words,
 )
-from core.scene.display import engine_text, known_contact_width, lifts_off_at, percent_text
+from core.scene.display import (
+    engine_text,
+    known_contact_width,
+    lifts_off_at,
+    number_text,
+    percent_text,
+)
 from core.scene.evidence import (
     check_settled,
     checked_key,
@@ -134,6 +140,7 @@ __all__ = [
     "holoviews_for_bokeh",
     "PUNCH_COLOURS",
     "known_contact_width",
+    "number_text",
     "percent_text",
     "largest_pressure",
     "lifts_off_at",

@@ -75,6 +75,18 @@ def percent_text(share: float, digits: int = 3) -> str:
     return f"{value:.{digits}g} %"
 
 
+def number_text(value: float, digits: int = 4) -> str:
+    """``value`` with ``digits`` significant digits ("not finite" for NaN and infinity),
+    without an exponent from 0.001 to a million (50 years read "18260 d", not
+    "1.826e+04 d")."""
+    if not np.isfinite(value):
+        return "not finite"
+    if value == 0 or 1e-3 <= abs(value) < 1e6:
+        return np.format_float_positional(float(value), precision=digits, unique=False,
+                                          fractional=False, trim="-")
+    return f"{value:.{digits}g}"
+
+
 def _number(value: float) -> str:
     return f"{value:.4g}" if math.isfinite(value) else str(value)
 

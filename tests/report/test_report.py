@@ -247,6 +247,21 @@ def test_long_times_read_without_an_exponent():
     assert "e+04" not in text and f"{round(result.times[-1], -1):.0f} d" in text
 
 
+def test_the_plots_legends_read_long_times_without_an_exponent():
+    """The report's (and the notebook's) q(x) curves were labelled "t = 1.826e+04 d" beside
+    "t = 71.2 d"."""
+    import holoviews as hv
+
+    from core.report.plots import report_layout
+
+    result = core.solve(read_preset("young_concrete_50_years"))
+    layout, _ = report_layout(result, 0.0)
+    labels = [curve.label for curve in layout.traverse(lambda x: x, [hv.Curve])
+              if curve.label.startswith("t = ")]
+    assert labels and "t = 18260 d" in labels
+    assert not any("e+" in label for label in labels), labels
+
+
 def test_the_time_of_a_largest_value_is_the_design_checks():
     """A centred load's zero tilt read "largest tilt 0 mrad at t = 0 d" in the report and
     "at t = 365 days" on the page: one rule (core.scene.time_of_largest) for both."""
