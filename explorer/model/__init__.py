@@ -88,7 +88,7 @@ from .study import (
     study_choices,
     study_outputs,
 )
-from .time_text import days_text, plain_number
+from .time_text import days_text
 from .view_link import (
     read_fit_query,
     read_study_query,
@@ -110,7 +110,7 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "creep_coefficient_data", "days_text", "decode_scene", "default_range",
            "design_check", "eccentricity", "encode_scene", "fit_choices", "forecast_columns",
            "lessons", "lift_off_lengths", "lifts_off", "lifts_or_pulls", "model_evidence",
-           "plain_number", "plan_fit", "plan_study", "read_upload", "readings_columns",
+           "plan_fit", "plan_study", "read_upload", "readings_columns",
            "readings_note", "run_fit", "prepare_view", "preset_label", "presets",
            "read_fit_query", "read_study_query", "read_view_query", "shown_flags", "scene_limits",
            "scene_with_limits", "screen_limits", "step_scene", "study_choices", "study_outputs",

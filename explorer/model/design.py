@@ -22,12 +22,12 @@ import numpy as np
 import param
 
 from core.scene import DesignLimits as CoreLimits
-from core.scene import LimitCheck, check_design, flagged_caution
+from core.scene import LimitCheck, check_design, flagged_caution, number_text
 
 from .contact_zone import contact_widths
 from .results import ResultView
 from .state import QUANTITY_UNITS
-from .time_text import days_text, plain_number
+from .time_text import days_text
 
 
 class DesignLimits(param.Parameterized):
@@ -183,13 +183,13 @@ def check_html(check: DesignCheck) -> str:
         head += f"<span class='cp-badge cp-bad check-flagged'>⚠ {html.escape(caution)}</span>"
     rows = []
     for c in check.checks + [check.q_min]:
-        limit = "" if c.limit is None else plain_number(c.limit)
+        limit = "" if c.limit is None else number_text(c.limit)
         cls = {"pass": "cp-ok", "FAIL": "cp-bad"}.get(c.verdict, "")
-        value, where = plain_number(c.value), html.escape(c.where)
+        value, where = number_text(c.value), html.escape(c.where)
         if c.corner_distance is not None:
             # q ~ 1/sqrt(distance) at a rigid corner in contact: no largest value
             value = (f"<span class='check-unbounded'>unbounded at the corner</span>; "
-                     f"{plain_number(c.value)} at {plain_number(c.corner_distance, 2)} mm "
+                     f"{number_text(c.value)} at {number_text(c.corner_distance, 2)} mm "
                      "from it")
             if c.limit is not None:
                 where += f"; over the limit {html.escape(c.exceeded)}"

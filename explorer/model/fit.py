@@ -24,13 +24,12 @@ import numpy as np
 
 from core.back_analysis import Calibration, Forecast, Readings, calibrate, readings_from_text
 from core.limits import MAX_READINGS_BYTES
-from core.scene import scene_from_dict
+from core.scene import number_text, scene_from_dict
 from core.study import apply_point, number_at
 
 from .loading_state import QUANTITY_UNITS
 from .scene_parts import MAX_DESCRIPTION_CHARS, MAX_NAME_CHARS
 from .study import ECCENTRICITY, Choice, study_choices
-from .time_text import plain_number
 
 #: Most fields one fit of the page fits: each costs one more solve per step of the fit
 #: (its finite-difference column) and three already take up to ~6 s (measured on the
@@ -102,7 +101,7 @@ class FitOutcome:
         out = []
         for c in self.choices:
             value, se = values[c.key] / c.scale, errors[c.key] / c.scale
-            out.append((c.label, plain_number(value, 4), _error_text(se), c.unit))
+            out.append((c.label, number_text(value, 4), _error_text(se), c.unit))
         return out
 
     def correlations(self) -> list[tuple[str, str, float]]:
@@ -228,5 +227,5 @@ def readings_note(readings: Readings) -> str:
             else ""
         parts.append(f"{n} {name} reading{'s' if n != 1 else ''}{std}")
     t = readings.time
-    return (f"{' and '.join(parts)} from t = {plain_number(float(t[0]), 4)} to "
-            f"{plain_number(float(t[-1]), 4)} days after loading")
+    return (f"{' and '.join(parts)} from t = {number_text(float(t[0]), 4)} to "
+            f"{number_text(float(t[-1]), 4)} days after loading")

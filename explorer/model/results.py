@@ -181,7 +181,10 @@ def model_evidence(view: ResultView,
                    check: Mapping[str, Any] | None = None) -> dict[str, Any] | None:
     """The coating model's error to show for ``view`` (:func:`core.scene.model_error_evidence`):
     the FE check's measurement when ``check`` was made for its scene, else the estimate the
-    result carries; None for a result that carries none."""
+    result carries; None for a result that carries none, or whose scene has no coating
+    (the bare layer: no coating model, whose error of 0 % the page stated)."""
+    if not view.scene.get("coating"):
+        return None
     estimate = view.info.get("model_error_estimate")
     if not isinstance(estimate, (int, float)):
         return None

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
+from core.scene import number_text
 
 #: [day] per year (the Julian year: 50 years of loading are 18262.5 days).
 DAYS_PER_YEAR = 365.25
@@ -20,18 +20,11 @@ DAYS_PER_YEAR = 365.25
 YEARS_FROM_DAYS = 2 * DAYS_PER_YEAR
 
 
-def plain_number(value: float, digits: int = 4) -> str:
-    """``value`` with ``digits`` significant digits, without an exponent from 0.001 to a
-    million ("18260", "0.5", "1000"); beyond, and for NaN or infinity, as Python writes it."""
-    if math.isfinite(value) and (value == 0 or 1e-3 <= abs(value) < 1e6):
-        return np.format_float_positional(float(value), precision=digits, unique=False,
-                                          fractional=False, trim="-")
-    return f"{value:.{digits}g}"
-
-
 def days_text(t: float, digits: int = 4) -> str:
-    """A time ``t`` [day] after loading in words: "28 days", "18260 days (50.0 years)"."""
-    text = f"{plain_number(t, digits)} days"
+    """A time ``t`` [day] after loading in words: "28 days", "1 day", "18260 days (50.0
+    years)"."""
+    shown = number_text(t, digits)
+    text = f"{shown} {'day' if shown == '1' else 'days'}"
     if math.isfinite(t) and abs(t) >= YEARS_FROM_DAYS:
         text += f" ({t / DAYS_PER_YEAR:.1f} years)"
     return text

@@ -27,6 +27,8 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
+from core.scene import number_text
+
 from ..model import (
     QUANTITIES,
     QUANTITY_UNITS,
@@ -36,7 +38,6 @@ from ..model import (
     ResultView,
     days_text,
     lifts_or_pulls,
-    plain_number,
 )
 from .bokeh_data import (
     MOVING,
@@ -506,7 +507,7 @@ class Figures:
         t = getattr(self, "_q_time", None)
         if t is None:
             return
-        text = (f"q(x) at t = {plain_number(t)} days" if self._presenting
+        text = (f"q(x) at t = {number_text(t)} days" if self._presenting
                 else f"Pressure q(x), t = {days_text(t)}")
         if self.q_fig.title.text != text:
             self.q_fig.title.text = text

@@ -24,9 +24,9 @@ from bokeh.models import (
 )
 from bokeh.plotting import figure
 
-from core.scene import PUNCH_COLOURS
+from core.scene import PUNCH_COLOURS, number_text
 
-from ..model import SCREEN_PUNCHES, Geometry, ResultView, plain_number
+from ..model import SCREEN_PUNCHES, Geometry, ResultView
 from .bokeh_data import MOVING, f32
 from .contact import ContactDrawing
 
@@ -145,11 +145,11 @@ class SceneDrawing:
                               y_end=top + 0.02 * g.half_width, visible=True)
             where = f"e = M/P = {e:.3g} m" + ("" if inside else " (off the drawing)")
             self.arrow_label.update(x=xe, y=top + 0.3 * g.half_width,
-                                    text=f"P = {plain_number(force / 1e3)} kN/m, {where}")
+                                    text=f"P = {number_text(force / 1e3)} kN/m, {where}")
         else:
             self.arrow.visible = False
             self.arrow_label.update(x=-g.half_width, y=top + 0.3 * g.half_width,
-                                    text=f"P = {plain_number(force / 1e3)} kN/m (no "
+                                    text=f"P = {number_text(force / 1e3)} kN/m (no "
                                          "compressive load)")
 
     def _show_punch_arrows(self, view: ResultView, index: int) -> None:
@@ -168,7 +168,7 @@ class SceneDrawing:
             cols["y_end"].append(top + 0.02 * self._a_ref)
             cols["label_y"].append(top + 0.3 * self._a_ref)
             where = f", e = {e:.3g} m" if force > 0 and e else ""
-            cols["text"].append(f"{k + 1}: P = {plain_number(force / 1e3)} kN/m{where}")
+            cols["text"].append(f"{k + 1}: P = {number_text(force / 1e3)} kN/m{where}")
         self.punch_arrow_src.data = cols
 
     def show(self, view: ResultView, contact: ContactDrawing) -> None:

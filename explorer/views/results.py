@@ -9,7 +9,7 @@ from typing import Any
 import panel as pn
 import param
 
-from core.scene import percent_text
+from core.scene import number_text, percent_text
 
 from ..files import flag_message
 from ..model import (
@@ -25,7 +25,6 @@ from ..model import (
     design_check,
     lifts_off,
     model_evidence,
-    plain_number,
     shown_flags,
 )
 from ..plots import PIN_COLORS, PUNCH_COLORS, Figures, LogTime
@@ -60,7 +59,7 @@ BADGES: dict[str, dict[str, tuple[str, str]]] = {
 
 def _fmt(value: float) -> str:
     # five digits, without an exponent up to a million ("1.0000e+09" past 1e5 before)
-    return plain_number(value, 5)
+    return number_text(value, 5)
 
 
 def badges_html(view: ResultView | None, group: str,

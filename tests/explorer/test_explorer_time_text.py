@@ -6,22 +6,23 @@ import copy
 
 import pytest
 
-from explorer.model import days_text, plain_number
+from core.scene import number_text
+from explorer.model import days_text
 
 
 @pytest.mark.parametrize(("days", "text"), [
     (0.0, "0 days"), (14.7, "14.7 days"), (28.0, "28 days"), (365.0, "365 days"),
     (1000.0, "1000 days (2.7 years)"), (18262.5, "18260 days (50.0 years)"),
-    (0.0004, "0.0004 days"),
+    (0.0004, "0.0004 days"), (1.0, "1 day"), (1.00001, "1 day"), (1.5, "1.5 days"),
 ])
 def test_days_are_written_out(days: float, text: str) -> None:
     assert days_text(days) == text
 
 
 def test_plain_numbers_keep_the_exponent_only_beyond_a_million() -> None:
-    assert plain_number(123456.7) == "123500"
-    assert plain_number(0.30000000000000004) == "0.3"
-    assert plain_number(2.5e7) == "2.5e+07"
+    assert number_text(123456.7) == "123500"
+    assert number_text(0.30000000000000004) == "0.3"
+    assert number_text(2.5e7) == "2.5e+07"
 
 
 def test_a_fifty_year_history_reads_in_days_and_years(explorer_app) -> None:

@@ -108,3 +108,19 @@ def test_a_crown_lifting_off_the_creeping_bare_layer_is_drawn_as_its_zone_grows(
     assert contact_text(view, 0).startswith("contact ") and "lifted" in contact_text(view, 0)
     outside = np.abs(view.x) > 0.5 * widths[-1] + 1e-3
     assert np.all(view.pressure[outside, :] == 0) and np.all(np.isfinite(view.pressure))
+
+
+def test_the_status_of_a_bare_layer_states_no_coating_model_error(explorer_app):
+    """The bare layer has no coating model: the status line said "Coating model error 0 %
+    (estimated), within solver.model_tol 2 %"; the time "t = 1 days"."""
+    app = explorer_app("bare_layer", solved=True)
+    view = app.controller.view
+    app.results.draw(view, 0, True)
+    assert "Coating model error" not in app.results.status.object
+    assert app.results.evidence(view) is None
+    # one layer: the estimate is stated again
+    app.state.n_layers = 1
+    assert app.controller.wait(120) and app.controller.error == ""
+    coated = app.controller.view
+    app.results.draw(coated, 0, True)
+    assert "Coating model error" in app.results.status.object
