@@ -226,3 +226,26 @@ def test_an_auto_answer_left_in_full_contact_says_why_in_the_scenes_terms() -> N
                     r"punch above the surface", refused), refused
     assert result.info["message"].endswith("unilateral contact refused: " + refused)
     assert "unilateral_refused_load" not in result.info
+
+
+def test_several_punches_at_a_tol_their_coupled_solve_cannot_resolve_name_the_tol(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # the two footings at tol 1e-11 and 1e-12 (accepted: [1e-12, 1e-2]; 5-7 s of CPU
+    # each) said "operator: its modes are nearly dependent (a probe vector comes back
+    # 1.5e-10 off) ...", naming no field of the scene; one punch falls back to another
+    # engine, the coupled modes have none. The engine's refusal stands in for that solve.
+    import core.scene.punches as punches
+    from core.problem import UnresolvedOperator
+
+    def declined(*args: Any, **kwargs: Any) -> Any:
+        raise UnresolvedOperator("operator: its modes are nearly dependent (a probe vector "
+                                 "comes back 1.5e-10 off); the grid does not resolve the "
+                                 "problem")
+
+    monkeypatch.setattr(punches, "solve_punches", declined)
+    d = read_preset("new_footing_beside_old")
+    d["solver"]["tol"] = 1e-12
+    with pytest.raises(ValueError, match=r"^solver\.tol: 1e-12 asks more than the coupled "
+                                         r"solve of several punches resolves here "
+                                         r"\(operator: its modes are nearly dependent"):
+        solve(d)
