@@ -553,7 +553,10 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
     for _ in range(MAX_SWEEPS):
         for p, given in enumerate(givens):
             count = int(np.count_nonzero(active[offsets[p]:offsets[p + 1]]))
-            if count == 0 and any(given.get(k, 0.0) != 0.0 for k in ("force", "moment")):
+            # (a punch without contact whose settlement or tilt is unknown: nothing
+            # determines them, its system would be singular)
+            if count == 0 and (any(given.get(k, 0.0) != 0.0 for k in ("force", "moment"))
+                               or not {"settlement", "tilt"} <= set(given)):
                 raise NoContact(f"punches[{p}]: no node stays in contact", p)
             if 0 < count < 3 and not {"settlement", "tilt"} <= set(given):
                 raise NoContact(f"punches[{p}]: the contact shrinks to a point", p)
@@ -679,7 +682,13 @@ def solve_unilateral_punches(punches: Sequence[PunchGeometry], inputs: Sequence[
                 results[key] = _solve_one(base, steps, [r[0] for r in rules], op, nodal_res,
                                           res, tol)
             except NoContact as exc:
-                raise ValueError(f"{exc}: the loads pull the punch away") from None
+                message = f"{exc}: the loads pull the punch away"
+                if exc.punch is None:
+                    raise ValueError(message) from None
+                name = next((q for q in ("force", "moment") if q in givens[exc.punch]),
+                            "settlement")
+                raise LoadNotCarried(message, name, times[k], exc.punch,
+                                     str(exc).split(": ", 1)[-1]) from None
         per_time.append(results[key])
     seconds = _time.perf_counter() - started
     end_error = max(r["zone_end_error"] for r in per_time)

@@ -130,7 +130,8 @@ def not_carried(scene: Scene, exc: LoadNotCarried, prefix: str = "") -> str:
         return None if profile is None else float(np.asarray(profile(at), dtype=float).ravel()[0])
 
     force, moment = value("force"), value("moment")
-    when = f"t = {day:.6g} days after loading"
+    shown = f"{day:.6g}"
+    when = f"t = {shown} {'day' if shown == '1' else 'days'} after loading"
     found = f" ({exc.detail})" if exc.detail else ""
     if force is not None and force <= 0.0:
         return (f"{prefix}loading.force: P = {force:.6g} N/m at {when}: the lift-off model "
@@ -152,9 +153,10 @@ def not_carried(scene: Scene, exc: LoadNotCarried, prefix: str = "") -> str:
     if settlement is not None:
         # held at a given settlement, the punch is left above the surface as it creeps
         return (f"{prefix}loading.settlement: {settlement:.6g} m at {when} leaves the punch "
-                f"above the surface, or touching it at a point at most{found}, and nothing "
-                f"then carries the given {exc.quantity}; a larger settlement there, or a "
-                "given force, is answered")
+                f"above the surface, or touching it at a point at most{found}: no contact "
+                f"carries the given {exc.quantity} or holds the punch's tilt, and the "
+                "lift-off model has no answer; a larger settlement there, or a given force, "
+                "is answered")
     return (f"{prefix}loading.{exc.quantity}: at {when} the lift-off model finds no contact "
             f"zone to carry the loads{found}")
 

@@ -249,3 +249,24 @@ def test_several_punches_at_a_tol_their_coupled_solve_cannot_resolve_name_the_to
                                          r"solve of several punches resolves here "
                                          r"\(operator: its modes are nearly dependent"):
         solve(d)
+
+
+def test_a_punch_held_above_the_surface_its_neighbour_sinks_is_refused_naming_it() -> None:
+    # the right punch held at 0.01 mm, its tilt free (moment 0 given), beside one pressed
+    # 0.1 mm: the surface under it sinks below it, no node of it touches, and its tilt was
+    # left in the coupled system with nothing to fix it: numpy's "Singular matrix"
+    d = {"schema_version": 1, "name": "two punches, the second above the surface",
+         "punches": [{"center": 0.0, "half_width": 1.0,
+                      "loading": {"settlement": 1e-4, "tilt": 0.0}},
+                     {"center": 3.0, "half_width": 1.0,
+                      "loading": {"settlement": 1e-5, "moment": 0.0}}],
+         "coating": [{"thickness": 0.02, "modulus": 2e9, "poisson": 0.25}],
+         "base": {"thickness": 4.0, "poisson": 0.2, "age_at_loading": 7.0,
+                  "creep": {"model": "elastic", "modulus": 3e10}},
+         "times": [1.0]}
+    with pytest.raises(ValueError, match=r"^punches\[1\]\.loading\.settlement: 1e-05 m at "
+                                         r"t = 1 day after loading leaves the punch above "
+                                         r"the surface"):
+        solve(d)
+    d["punches"][1]["loading"]["settlement"] = 1e-4  # pressed on: answered
+    assert solve(d).info["success"]
