@@ -77,6 +77,12 @@ SUCCESS_MARGIN = 1.0
 #: beyond: q is infinite at the corners, and there it is 22x its value at the centre
 #: (flat punch, ``1 / sqrt(2 BARE_CORNER)``), which a plot of the punch width still shows.
 BARE_CORNER = 1e-3
+#: With coating, q is held within half the top layer's thickness of a corner, but never
+#: over more than this share of the half-width: a top layer as thick as the punch is wide
+#: held it over all of it (a 2 m layer under a half-width of 0.5 m: the reach -1, q
+#: infinite everywhere; 1.8 m: q everywhere its value at x = -0.8 a, unflagged). A thin
+#: coating (h <= 0.1 a) holds it over h / 2 as before.
+MAX_CORNER_HOLD = 0.05
 #: ``info["coating_model"]`` of a scene without coating layers (its coating-model error
 #: is 0: there is no coating to model).
 NO_COATING = "none (no coating)"
@@ -145,10 +151,11 @@ def bare_creep_declines(scene: Any, problem: Any) -> str | None:
 
 def corner_reach(layers: Sequence[UniformLayer], half_width: float) -> float:
     """``|t|`` [-] up to which ``pressure(x)`` is reported (held beyond): half the top
-    layer's thickness from the corner, ``BARE_CORNER`` without coating."""
+    layer's thickness from the corner, at most ``MAX_CORNER_HOLD`` of the half-width;
+    ``BARE_CORNER`` without coating."""
     if not layers:
         return 1.0 - BARE_CORNER
-    return 1.0 - 0.5 * layers[0].thickness / half_width
+    return 1.0 - min(0.5 * layers[0].thickness / half_width, MAX_CORNER_HOLD)
 
 
 def _load_values(problem: Any, times: np.ndarray) -> dict[str, np.ndarray]:
