@@ -127,13 +127,15 @@ def accuracy_rows(result: SceneSolution,
         # "1.8e-02" where the page read 1.81 %)
         *([(f"coating model error ({evidence['label']}, relative)",
             f"{percent_text(evidence['measured'])} at t = {number_text(evidence['time_day'])} "
-            f"d (flagged above {percent_text(result.scene.model_tol)}: "
-            + ("FLAGGED)" if evidence["flagged"] else "within)"))]
+            f"d (" + ("FLAGGED: above " if evidence["flagged"] else "within ")
+            + f"solver.model_tol {percent_text(result.scene.model_tol)})")]
           if evidence["source"] == "measured" else []),
         ("coating model error (estimated, relative)",
          "0: no coating, no coating model" if not result.scene.coating else
-         f"{percent_text(float(result.model_error['estimate']))} (flagged above "
-         f"{percent_text(result.scene.model_tol)})"
+         f"{percent_text(float(result.model_error['estimate']))} ("
+         + ("FLAGGED: above " if float(result.model_error["estimate"])
+            > result.scene.model_tol else "within ")
+         + f"solver.model_tol {percent_text(result.scene.model_tol)})"
          + ("; the FE check's measurement above overrides it"
             if evidence["source"] == "measured" else "")),
         ("solved by", engine_text(result)),

@@ -7,6 +7,7 @@ import holoviews  # noqa: F401  (installed by the test set-up)
 import pytest
 
 import core
+from core.presets import read_preset
 from core.report import report_html
 from core.report.content import describe
 from core.scene import check_scene, checked_key, model_error_evidence
@@ -43,8 +44,10 @@ def test_a_measurement_of_the_scene_overrides_the_estimate(result):
     assert "measured by the FE check" in validity["rows"]["model_error"]
     rows = text["Accuracy"]["rows"]
     # in percent, as the page writes them (the report read "3.6e-02")
-    assert rows[MEASURED_ROW].startswith("3.58 % at t = 0 d (flagged above 2 %: FLAGGED)")
-    assert rows[ESTIMATED_ROW].startswith("4.64 %")  # next to it, not replaced
+    assert rows[MEASURED_ROW].startswith("3.58 % at t = 0 d (FLAGGED: above "
+                                         "solver.model_tol 2 %)")
+    # next to it, not replaced; "1.39 % (flagged above 2 %)" read as a flag where none was
+    assert rows[ESTIMATED_ROW].startswith("4.64 % (FLAGGED: above solver.model_tol 2 %)")
 
 
 def test_a_measurement_within_the_tolerance_lowers_an_estimated_flag(result):
@@ -54,7 +57,7 @@ def test_a_measurement_within_the_tolerance_lowers_an_estimated_flag(result):
     assert "model_error" in strict.flags
     text = describe(strict, check=_check(scene, 0.005))
     assert "model_error" not in text["Validity"]["rows"]
-    assert "within" in text["Accuracy"]["rows"][MEASURED_ROW]
+    assert "(within solver.model_tol 1 %)" in text["Accuracy"]["rows"][MEASURED_ROW]
 
 
 def test_a_measurement_of_another_scene_is_ignored(result):
@@ -122,3 +125,11 @@ def test_without_a_check_only_the_threshold_is_read(monkeypatch):
     # with a check the whole scene is validated, to compare it with the checked one
     model_error_evidence(epoxy_on_pad_scene(), ESTIMATE, _check(epoxy_on_pad_scene(), MEASURED))
     assert len(calls) >= 1
+
+
+def test_an_estimate_within_the_tolerance_reads_within_it():
+    # "1.39 % (flagged above 2 %)" read as a flag where the estimate was within tol
+    quiet = core.solve(read_preset("uniform_flat"))
+    assert "model_error" not in quiet.flags
+    row = describe(quiet)["Accuracy"]["rows"][ESTIMATED_ROW]
+    assert row.endswith("(within solver.model_tol 2 %)") and "FLAGGED" not in row
