@@ -551,12 +551,14 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
     alpha = np.array([s.get("tilt", 0.0) for s in givens])
     nystrom = np.zeros(x.size)
     for _ in range(MAX_SWEEPS):
+        touching = bool(active.any())
         for p, given in enumerate(givens):
             count = int(np.count_nonzero(active[offsets[p]:offsets[p + 1]]))
-            # (a punch without contact whose settlement or tilt is unknown: nothing
-            # determines them, its system would be singular)
+            # (a punch without contact whose settlement or tilt is unknown beside one in
+            # contact: nothing determines them, the coupled system would be singular;
+            # with no punch in contact nothing is solved, as for one punch: no_contact)
             if count == 0 and (any(given.get(k, 0.0) != 0.0 for k in ("force", "moment"))
-                               or not {"settlement", "tilt"} <= set(given)):
+                               or (touching and not {"settlement", "tilt"} <= set(given))):
                 raise NoContact(f"punches[{p}]: no node stays in contact", p)
             if 0 < count < 3 and not {"settlement", "tilt"} <= set(given):
                 raise NoContact(f"punches[{p}]: the contact shrinks to a point", p)

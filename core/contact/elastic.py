@@ -16,7 +16,7 @@ import numpy as np
 from core.contact.active_set import NoContact, zones_from_nodes
 from core.contact.nodal import nodal_operator, nodal_state
 from core.contact.result import UNILATERAL_MARGIN, _Snapshot, not_within_tol
-from core.contact.step import Space, Step, nystrom_pressure
+from core.contact.step import LoadNotCarried, Space, Step, nystrom_pressure
 from core.contact.zones import ZONE_END_TOL, Resolution, refine_zone_ends, zone_kernel_accuracy
 from core.discretize import Panels
 from core.problem import accepts
@@ -36,8 +36,12 @@ def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
         key = (float(c_t[k]),) + tuple(sorted(given.items()))
         if key not in results:
             step = Step(float(c_t[k]), 1.0, given)
-            results[key] = _solve_one(space, step, base, op, m_nodes, g_nodes, res, tol,
-                                      nodal_res)
+            try:
+                results[key] = _solve_one(space, step, base, op, m_nodes, g_nodes, res, tol,
+                                          nodal_res)
+            except LoadNotCarried as exc:
+                raise LoadNotCarried(f"{exc} at t = {times[k]:g}", exc.quantity, times[k],
+                                     detail=exc.detail) from None
         per_time.append(results[key])
     snapshots = [r[0] for r in per_time]
     end_error = max(r[1]["zone_end_error"] for r in per_time)
@@ -74,7 +78,9 @@ def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: 
     except NoContact as exc:
         name = "force" if "force" in step.given else "moment" if "moment" in step.given \
             else "settlement"
-        raise ValueError(f"{name}: the loads pull the punch away ({exc})") from None
+        # (its time is the caller's: _solve_elastic gives it)
+        raise LoadNotCarried(f"{name}: the loads pull the punch away ({exc})", name, 0.0,
+                             detail=str(exc)) from None
     if not state.active.any():
         # Only a given settlement and tilt can leave the punch above the surface.
         zero = np.zeros(state.q.size)

@@ -157,6 +157,13 @@ def not_carried(scene: Scene, exc: LoadNotCarried, prefix: str = "") -> str:
                 f"carries the given {exc.quantity} or holds the punch's tilt, and the "
                 "lift-off model has no answer; a larger settlement there, or a given force, "
                 "is answered")
+    tilt = value("tilt")
+    if tilt is not None:
+        # a given tilt turns the punch about its centre onto one edge
+        return (f"{prefix}loading.tilt: {tilt:.6g} rad at {when} leaves the punch touching "
+                f"the surface at a point at most{found}, and no contact zone carries the "
+                f"given {exc.quantity}; a smaller tilt there, or a given moment, is "
+                "answered")
     return (f"{prefix}loading.{exc.quantity}: at {when} the lift-off model finds no contact "
             f"zone to carry the loads{found}")
 

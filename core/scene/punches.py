@@ -116,9 +116,9 @@ def _in_scene_terms(scene: PunchesScene) -> Iterator[None]:
         # one punch falls back to another engine; the coupled modes of several have none
         # (the preset of two footings at tol 1e-11 and 1e-12; at 1e-10 it is answered,
         # flagged tol_not_met)
-        raise ValueError(f"solver.tol: {scene.scenes[0].tol:g} asks more than the coupled "
-                         f"solve of several punches resolves here ({exc}); a looser tol is "
-                         "answered") from None
+        raise ValueError(f"solver.tol: the coupled solve of several punches does not "
+                         f"resolve this scene at tol {scene.scenes[0].tol:g} ({exc}); a "
+                         "looser tol may be answered") from None
 
 
 def punches_from_dict(d: Mapping[str, Any] | PunchesScene) -> PunchesScene:

@@ -165,8 +165,9 @@ def corner_pressure(scene: Scene, coating_model: str,
     # without coating q ~ K / sqrt(distance) holds from the held distance on (measured on
     # the bare layer preset: q sqrt(d) constant within 0.14 % from 1 to 2 mm, 1.2 % to
     # 10 mm); under a coating the answer is resolved to half the top layer's thickness
-    # from the corner, where q sqrt(d) is not yet constant (20 mm coating: it changes
-    # 36 % from 10 to 20 mm), so the distance where a limit is passed is not estimated
+    # from the corner (at most 5 % of the half-width), where q sqrt(d) is not yet
+    # constant (20 mm coating: it changes 36 % from 10 to 20 mm), so the distance where a
+    # limit is passed is not estimated
     return {"corners_m": [float(c) for c in corners], "held_within_m": held,
             "asymptotic": not scene.coating}
 

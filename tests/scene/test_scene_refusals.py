@@ -245,9 +245,10 @@ def test_several_punches_at_a_tol_their_coupled_solve_cannot_resolve_name_the_to
     monkeypatch.setattr(punches, "solve_punches", declined)
     d = read_preset("new_footing_beside_old")
     d["solver"]["tol"] = 1e-12
-    with pytest.raises(ValueError, match=r"^solver\.tol: 1e-12 asks more than the coupled "
-                                         r"solve of several punches resolves here "
-                                         r"\(operator: its modes are nearly dependent"):
+    with pytest.raises(ValueError, match=r"^solver\.tol: the coupled solve of several "
+                                         r"punches does not resolve this scene at tol "
+                                         r"1e-12 \(operator: its modes are nearly "
+                                         r"dependent"):
         solve(d)
 
 
@@ -270,3 +271,28 @@ def test_a_punch_held_above_the_surface_its_neighbour_sinks_is_refused_naming_it
         solve(d)
     d["punches"][1]["loading"]["settlement"] = 1e-4  # pressed on: answered
     assert solve(d).info["success"]
+    # both held above the surface: nothing touches, nothing is solved (as for one punch)
+    for punch in d["punches"]:
+        punch["loading"] = {"settlement": -1e-4, "moment": 0.0}
+    assert solve(d).flags == ["punches[0].no_contact", "punches[1].no_contact"]
+
+
+def test_a_single_punch_on_an_elastic_base_names_the_load_and_the_day() -> None:
+    # the elastic lift-off path said "moment: the loads pull the punch away (no node
+    # stays in contact)", and a given tilt turning the punch onto an edge was blamed on
+    # the force, with no way out
+    d = small_preset_scene("worn_coating", count=3)
+    d["loading"] = {"settlement": -1e-4, "moment": 1e4}
+    d["solver"]["contact"] = "unilateral"
+    with pytest.raises(ValueError, match=r"^loading\.settlement: -0\.0001 m at t = 0 days "
+                                         r"after loading leaves the punch above the "
+                                         r"surface"):
+        solve(d)
+    d = small_preset_scene("uniform_flat", count=3)
+    d["loading"] = {"tilt": 0.05, "force": 1e3}
+    d["solver"]["contact"] = "unilateral"
+    with pytest.raises(ValueError, match=r"^loading\.tilt: 0\.05 rad at t = 0 days after "
+                                         r"loading leaves the punch touching the surface "
+                                         r"at a point at most \(the contact shrinks to a "
+                                         r"point\)"):
+        solve(d)
