@@ -55,6 +55,7 @@ from core.scene.design import (
     verdict_words,
 )
 from core.scene.display import (
+    corner_note,
     engine_text,
     known_contact_width,
     lifts_off_at,
@@ -157,6 +158,7 @@ __all__ = [
     "model_error_evidence",
     "check_settled",
     "contact_width",
+    "corner_note",
     "csv_header",
     "creeps",
     "design_check",

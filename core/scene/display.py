@@ -12,6 +12,7 @@ from __future__ import annotations
 import html
 import json
 import math
+from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -286,3 +287,16 @@ def to_dataframe(result: SceneSolution) -> pandas.DataFrame:
     frame.attrs.update(metadata(result))
     frame.attrs["units"] = {"time": "day", **units}
     return frame
+
+
+def corner_note(corners: Mapping[str, Any] | None,
+                number: Callable[[float], str] = number_text) -> str | None:
+    """The ``#`` line of a pressure table whose answer has rigid corners in contact
+    (``info["corner_pressure"]``: ``corners_m`` [m], ``held_within_m`` [m]): the rows
+    there hold q's value at that distance, where q grows without bound; None without."""
+    if not corners:
+        return None
+    where = " and ".join(f"x = {number(float(c))} m" for c in corners["corners_m"])
+    return (f"# corner: q grows without bound toward the rigid corner at {where}; within "
+            f"{number(float(corners['held_within_m']))} m of it the rows hold its value at "
+            "that distance")

@@ -26,7 +26,13 @@ from core.scene.contact_zone import (
     narrowest_zone,
 )
 from core.scene.design import DesignCheck, DesignLimits, design_check
-from core.scene.display import HISTORIES, answered_settings, html_summary, text_summary
+from core.scene.display import (
+    HISTORIES,
+    answered_settings,
+    corner_note,
+    html_summary,
+    text_summary,
+)
 from core.scene.display import to_dataframe as _to_dataframe
 from core.scene.display import to_xarray as _to_xarray
 from core.scene.load_rates import oscillations
@@ -435,6 +441,9 @@ class SceneSolution:
         xs = self.x if x is None else np.atleast_1d(np.asarray(x, dtype=float))
         q = self.pressure_on_grid if x is None else self.pressure(xs)
         lines = [csv_header(self, "contact pressure q(x, t)").rstrip("\n")] if header else []
+        corner = corner_note(self.info.get("corner_pressure")) if header else None
+        if corner is not None:
+            lines.append(corner)
         lines.append("time_day,x_m,pressure_Pa")
         for j, t in enumerate(self.times):
             tt = repr(float(t))

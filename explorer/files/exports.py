@@ -24,7 +24,7 @@ import numpy as np
 
 import core
 from core.scene import DesignLimits as CoreLimits
-from core.scene import check_design, provenance_lines
+from core.scene import check_design, corner_note, provenance_lines
 from core.study import PUNCH_OUTPUT
 
 from ..model import (
@@ -160,6 +160,10 @@ def pressure_csv(view: ResultView, unit: tuple[str, float] | None = None,
     lines = _header(view, "contact pressure q(x, t)", [
         "time_day: days after loading", "x_m: m from the punch centre",
         f"{column}: {name} (compression positive)"], limits)
+    # the rows at a corner are a held value, not q there (the JSON says it too)
+    corner = corner_note(view.info.get("corner_pressure"), number)
+    if corner is not None:
+        lines.append(corner)
     lines.append(f"time_day,x_m,{column},flags")
     band = view.lift_off_band()
     q = view.pressure

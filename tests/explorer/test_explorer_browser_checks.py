@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -416,6 +417,23 @@ def test_the_creep_model_from_a_file_is_offered_only_with_one(page: Page):
     assert "aging creep (Arutyunyan)" in options
 
 
+def _typed_limit(page: Page, css: str, value: str, verdict: str) -> Any:
+    """Type ``value`` in the Check tab's limit box ``css`` and wait for the design check
+    to say ``verdict``; returns the box."""
+    page.open_tab("Check")
+    box = page.page.locator(f"{css} input").first
+    box.wait_for(timeout=30_000 * patience())
+    box.fill(value)
+    box.press("Enter")
+    until(lambda: verdict in page.text(".design-check"), verdict)
+    return box
+
+
+def _failing_pressure_limit(page: Page) -> Any:
+    """An allowable pressure of 1 kPa: any footing fails it."""
+    return _typed_limit(page, ".limit-pressure", "1", "a limit is exceeded")
+
+
 def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     """Feature 1 (design check), 2 (report) and 9 (status in words, details)."""
     # the status in plain words, the solver's numbers behind "details"
@@ -427,12 +445,7 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     until(lambda: "stages:" in details.inner_text(), "the stage timings")
     # the check, no limit yet
     until(lambda: "no limits set" in page.text(".design-check"), "the design check")
-    page.open_tab("Check")
-    box = page.page.locator(".limit-pressure input").first
-    box.wait_for(timeout=30_000 * patience())
-    box.fill("1")  # kPa: any footing fails this
-    box.press("Enter")
-    until(lambda: "a limit is exceeded" in page.text(".design-check"), "FAIL")
+    box = _failing_pressure_limit(page)
     box.fill("100000")
     box.press("Enter")
     until(lambda: "all set limits hold" in page.text(".design-check"), "pass")
@@ -468,12 +481,7 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
 
 def test_a_negative_limit_is_refused_saying_so_and_the_last_good_one_stays(page: Page):
     """The page once clamped -5 to 0 unsaid: a limit every answer fails."""
-    page.open_tab("Check")
-    box = page.page.locator(".limit-settlement input").first
-    box.wait_for(timeout=30_000 * patience())
-    box.fill("50")
-    box.press("Enter")
-    until(lambda: "all set limits hold" in page.text(".design-check"), "the limit checked")
+    box = _typed_limit(page, ".limit-settlement", "50", "all set limits hold")
     box.fill("-5")
     box.press("Enter")
     page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000 * patience())
@@ -608,12 +616,7 @@ def test_a_link_keeps_the_design_limits(page: Page, server: str, browser_context
     """The limits typed in the Check tab are part of the scene a link carries, as of a
     saved scene file: reopened from its link the page had them all empty ("no limits
     set"), and a report printed there had no design check."""
-    page.open_tab("Check")
-    box = page.page.locator(".limit-pressure input").first
-    box.wait_for(timeout=30_000 * patience())
-    box.fill("1")  # kPa: any footing fails this
-    box.press("Enter")
-    until(lambda: "a limit is exceeded" in page.text(".design-check"), "FAIL")
+    _failing_pressure_limit(page)
 
     def href() -> str:
         return page.page.evaluate("() => window.location.href")

@@ -124,3 +124,23 @@ def test_the_status_of_a_bare_layer_states_no_coating_model_error(explorer_app):
     coated = app.controller.view
     app.results.draw(coated, 0, True)
     assert "Coating model error" in app.results.status.object
+
+
+def test_the_pressure_csv_says_the_corner_rows_are_held():
+    """The bare layer's q CSV gave a finite 2.676 MPa at x = -1 m with nothing saying
+    that q grows without bound there and the row holds its value 1 mm away (only the
+    JSON's info.corner_pressure said so)."""
+    from core import solve
+    from explorer.files.exports import parse_csv, pressure_csv
+
+    scene = PRESETS["bare_layer"]
+    view = prepare_view(solve(scene), scene)
+    meta, names, table = parse_csv(pressure_csv(view))
+    assert meta["corner"] == ("q grows without bound toward the rigid corner at x = -1 m "
+                              "and x = 1 m; within 0.001 m of it the rows hold its value at "
+                              "that distance")
+    # the command line's and the API's table says the same
+    assert meta["corner"] in solve(scene).pressure_csv()
+    # a coated answer of the thin layer's springs has no corner line
+    coated = PRESETS["uniform_flat"]
+    assert "corner" not in parse_csv(pressure_csv(prepare_view(solve(coated), coated)))[0]
