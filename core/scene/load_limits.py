@@ -9,7 +9,9 @@ load, with the field to change, the value and the time in days after loading (th
 dimensionless solver would otherwise name ``t* = 1`` and half-widths).
 
 An instant where both ``P`` and ``M`` are zero (a ramp starting from nothing, a load
-taken off) carries nothing and is allowed; a load that is zero at every time is not.
+taken off) carries nothing and is allowed here; a load that is zero at every time is not.
+The lift-off model meets the loads again on its own time grid and has no answer at such
+an instant: :func:`not_carried` says so in the scene's terms.
 Of several punches, those of a full-contact scene are not checked: that model is linear
 and reads an unloaded or pulled punch as a bonded one.
 """
