@@ -144,13 +144,18 @@ class SceneDrawing:
             self.arrow.update(x_start=xe, x_end=xe, y_start=top + 0.45 * g.half_width,
                               y_end=top + 0.02 * g.half_width, visible=True)
             where = f"e = M/P = {e:.3g} m" + ("" if inside else " (off the drawing)")
+            # the words toward the middle of the drawing: to the right of an arrow at e =
+            # 0.83 m they ran off the plot ("P = 800 kN/m, e = M/P =", the value cut)
+            right = xe > 0
             self.arrow_label.update(x=xe, y=top + 0.3 * g.half_width,
-                                    text=f"P = {number_text(force / 1e3)} kN/m, {where}")
+                                    text=f"P = {number_text(force / 1e3)} kN/m, {where}",
+                                    text_align="right" if right else "left",
+                                    x_offset=-6 if right else 6)
         else:
             self.arrow.visible = False
             self.arrow_label.update(x=-g.half_width, y=top + 0.3 * g.half_width,
                                     text=f"P = {number_text(force / 1e3)} kN/m (no "
-                                         "compressive load)")
+                                         "compressive load)", text_align="left", x_offset=6)
 
     def _show_punch_arrows(self, view: ResultView, index: int) -> None:
         """Each punch's force at output ``index``, drawn at its e = M/P [m] (within the

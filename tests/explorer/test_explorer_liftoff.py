@@ -131,3 +131,16 @@ def test_the_check_of_a_flagged_answer_says_its_pass_is_not_to_be_relied_on() ->
             "not to be relied on") in text
     assert "# design_check: pass (on an answer flagged contact_lost" in \
         histories_csv(controller.view, limits)
+
+
+@pytest.mark.parametrize(("e", "align"), [(0.83, "right"), (-0.83, "left"), (0.0, "left")])
+def test_the_load_label_runs_toward_the_middle_of_the_drawing(explorer_app, e, align):
+    """At e = 0.83 m the load's label began at the arrow and ran off the drawing's right
+    edge at 1024 px ("P = 800 kN/m, e = M/P =", the value cut): it now ends at an arrow
+    right of the centre and begins at one left of it."""
+    scene = presets()["eccentric_footing_liftoff"]
+    scene["loading"] = {"force": 8e5, "moment": 8e5 * e}
+    app = explorer_app(scene=scene, solved=True)
+    label = app.figures.drawing.arrow_label
+    assert label.text.endswith(f"e = M/P = {e:.3g} m")
+    assert label.text_align == align and (label.x_offset < 0) == (align == "right")
