@@ -10,12 +10,12 @@ panel's interpolant of Q between the last contact node and the next), which
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from core.contact.step import Step, _bordered_solve, _given_rhs, _Resultants
+from core.contact.step import LoadNotCarried, Step, _bordered_solve, _given_rhs, _Resultants
 from core.contact.systems import StepSolver
 from core.discretize import BARYCENTRIC_WEIGHTS, GAUSS_NODES, NODES_PER_PANEL, Panels
 
@@ -38,12 +38,23 @@ class NodalState(_Resultants):
 
 
 class NoContact(ValueError):
-    """The loads leave no contact (the punch is pulled away); ``punch``: which punch of
-    several (None for one)."""
+    """The loads leave no contact (the punch is pulled away): ``reason``, what the contact
+    did; ``punch``: which punch of several (None for one; the message then names it)."""
 
-    def __init__(self, message: str, punch: int | None = None) -> None:
-        super().__init__(message)
-        self.punch = punch
+    def __init__(self, reason: str, punch: int | None = None) -> None:
+        super().__init__(reason if punch is None else f"punches[{punch}]: {reason}")
+        self.reason, self.punch = reason, punch
+
+    def at(self, time: float, given: Collection[str], message: str) -> LoadNotCarried:
+        """This refusal at the solver's time ``time`` as :class:`LoadNotCarried` (its
+        ``message`` in the solver's terms), naming :func:`refused_load` of ``given``."""
+        return LoadNotCarried(message, refused_load(given), time, self.punch, self.reason)
+
+
+def refused_load(given: Collection[str]) -> str:
+    """The given load a refusal for no contact names: the force, else the moment, else
+    the settlement (``given``: the punch's given quantities)."""
+    return next((q for q in ("force", "moment") if q in given), "settlement")
 
 
 def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarray, step: Step,

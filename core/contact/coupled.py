@@ -559,9 +559,9 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
             # with no punch in contact nothing is solved, as for one punch: no_contact)
             if count == 0 and (any(given.get(k, 0.0) != 0.0 for k in ("force", "moment"))
                                or (touching and not {"settlement", "tilt"} <= set(given))):
-                raise NoContact(f"punches[{p}]: no node stays in contact", p)
+                raise NoContact("no node stays in contact", p)
             if 0 < count < 3 and not {"settlement", "tilt"} <= set(given):
-                raise NoContact(f"punches[{p}]: the contact shrinks to a point", p)
+                raise NoContact("the contact shrinks to a point", p)
         idx = np.nonzero(active)[0]
         q = np.zeros(x.size)
         if idx.size:
@@ -687,10 +687,7 @@ def solve_unilateral_punches(punches: Sequence[PunchGeometry], inputs: Sequence[
                 message = f"{exc}: the loads pull the punch away"
                 if exc.punch is None:
                     raise ValueError(message) from None
-                name = next((q for q in ("force", "moment") if q in givens[exc.punch]),
-                            "settlement")
-                raise LoadNotCarried(message, name, times[k], exc.punch,
-                                     str(exc).split(": ", 1)[-1]) from None
+                raise exc.at(times[k], givens[exc.punch], message) from None
         per_time.append(results[key])
     seconds = _time.perf_counter() - started
     end_error = max(r["zone_end_error"] for r in per_time)

@@ -255,10 +255,7 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
             message = f"{exc}: the loads pull the punch away at t = {grid[n]:g}"
             if exc.punch is None:
                 raise ValueError(message) from None
-            given = marches.givens[exc.punch]
-            name = "force" if "force" in given else "moment"
-            raise LoadNotCarried(message, name, grid[n], exc.punch,
-                                 str(exc).split(": ", 1)[-1]) from None
+            raise exc.at(grid[n], marches.givens[exc.punch], message) from None
         if n == 0 and first is not None and "zones" not in first and any(
                 s.active.any() for s in states):
             zones = []

@@ -13,10 +13,10 @@ from typing import Any
 
 import numpy as np
 
-from core.contact.active_set import NoContact, zones_from_nodes
+from core.contact.active_set import NoContact, refused_load, zones_from_nodes
 from core.contact.nodal import nodal_operator, nodal_state
 from core.contact.result import UNILATERAL_MARGIN, _Snapshot, not_within_tol
-from core.contact.step import LoadNotCarried, Space, Step, nystrom_pressure
+from core.contact.step import Space, Step, nystrom_pressure
 from core.contact.zones import ZONE_END_TOL, Resolution, refine_zone_ends, zone_kernel_accuracy
 from core.discretize import Panels
 from core.problem import accepts
@@ -39,9 +39,9 @@ def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
             try:
                 results[key] = _solve_one(space, step, base, op, m_nodes, g_nodes, res, tol,
                                           nodal_res)
-            except LoadNotCarried as exc:
-                raise LoadNotCarried(f"{exc} at t = {times[k]:g}", exc.quantity, times[k],
-                                     detail=exc.detail) from None
+            except NoContact as exc:
+                raise exc.at(times[k], given, f"{refused_load(given)}: the loads pull the "
+                             f"punch away ({exc}) at t = {times[k]:g}") from None
         per_time.append(results[key])
     snapshots = [r[0] for r in per_time]
     end_error = max(r[1]["zone_end_error"] for r in per_time)
@@ -73,14 +73,7 @@ def _solve_elastic(space: Space, c_t: np.ndarray, loads: dict[str, np.ndarray],
 def _solve_one(space: Space, step: Step, base: Panels, op: np.ndarray, m_nodes: np.ndarray,
                g_nodes: np.ndarray, res: Resolution, tol: float,
                nodal_res: Resolution | None = None) -> tuple[_Snapshot, dict]:
-    try:
-        state = nodal_state(space, step, base, op, m_nodes, g_nodes, nodal_res)
-    except NoContact as exc:
-        name = "force" if "force" in step.given else "moment" if "moment" in step.given \
-            else "settlement"
-        # (its time is the caller's: _solve_elastic gives it)
-        raise LoadNotCarried(f"{name}: the loads pull the punch away ({exc})", name, 0.0,
-                             detail=str(exc)) from None
+    state = nodal_state(space, step, base, op, m_nodes, g_nodes, nodal_res)
     if not state.active.any():
         # Only a given settlement and tilt can leave the punch above the surface.
         zero = np.zeros(state.q.size)

@@ -22,10 +22,16 @@ from typing import Any
 import numpy as np
 
 from core.cache import StageCache, fingerprint
-from core.contact.active_set import NoContact, NodalState, nodal_active_set, zones_from_nodes
+from core.contact.active_set import (
+    NoContact,
+    NodalState,
+    nodal_active_set,
+    refused_load,
+    zones_from_nodes,
+)
 from core.contact.kinks import Corrected, corrected_roots, kinks_corrected
 from core.contact.memory import pressure_memory
-from core.contact.step import LoadNotCarried, Space, Step, check_loads
+from core.contact.step import Space, Step, check_loads
 from core.contact.systems import Mirror, StepSolver
 from core.contact.zones import zone_kernel_accuracy
 from core.discretize import KernelOperator, Panels, kernel_operator
@@ -126,9 +132,8 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
             state, count, settled = _step_state(base, op, m, g, step, displacement, start,
                                                 solver, retry=n == 0)
         except NoContact as exc:
-            name = "force" if "force" in step.given else "moment"
-            raise LoadNotCarried(f"{name}: the loads pull the punch away at t = {grid[n]:g} "
-                                 f"({exc})", name, grid[n], detail=str(exc)) from None
+            raise exc.at(grid[n], step.given, f"{refused_load(step.given)}: the loads pull "
+                         f"the punch away at t = {grid[n]:g} ({exc})") from None
         if n == 0 and first is not None and "zones" not in first and state.active.any():
             ends = zones_from_nodes(state, space.breakpoints)[0]
             first["zones"] = list(zip(ends[0::2], ends[1::2], strict=True))
