@@ -70,6 +70,10 @@ MAX_SOLVER_LAM = 1e3
 
 #: Most output times of a scene (``times.count`` or the length of the ``times`` list).
 MAX_SCENE_TIMES = 2_000
+#: [day] per year (the Julian year: 50 years of loading are 18262.5 days), for limits
+#: and times written in years.
+DAYS_PER_YEAR = 365.25
+
 #: Latest output time [day after loading], about 274 years: past any service life a creep
 #: law is fitted for (the presets reach 50 years), and a time typed a thousand times too
 #: large ("1e9 days") is refused as the slip it is rather than answered.

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from core.files import read_regular_file
-from core.limits import MAX_READINGS, MAX_READINGS_BYTES
+from core.limits import DAYS_PER_YEAR, MAX_READINGS, MAX_READINGS_BYTES
 from core.validation import finite_number, show_value
 
 #: The series a readings file may hold, with their SI units.
@@ -32,8 +32,8 @@ COLUMNS = ("time", "settlement", "settlement_std", "tilt", "tilt_std")
 #: Units a column may be given in, as factors to SI (time to days).
 UNIT_FACTORS: dict[str, dict[str, float]] = {
     "time": {"day": 1.0, "days": 1.0, "d": 1.0, "h": 1 / 24, "hour": 1 / 24,
-             "hours": 1 / 24, "week": 7.0, "weeks": 7.0, "year": 365.25, "years": 365.25,
-             "a": 365.25},
+             "hours": 1 / 24, "week": 7.0, "weeks": 7.0, "year": DAYS_PER_YEAR,
+             "years": DAYS_PER_YEAR, "a": DAYS_PER_YEAR},
     "settlement": {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6},
     "tilt": {"rad": 1.0, "mrad": 1e-3, "urad": 1e-6, "µrad": 1e-6, "μrad": 1e-6,
              "deg": math.pi / 180, "°": math.pi / 180},
@@ -44,7 +44,7 @@ MAX_SETTLEMENT = 10.0
 #: Largest tilt reading [rad] (about 29 degrees): beyond any small-angle model.
 MAX_TILT = 0.5
 #: Latest reading [day after loading]: 1000 years.
-MAX_TIME = 365_250.0
+MAX_TIME = 1000 * DAYS_PER_YEAR
 #: ``name [unit]`` or ``name (unit)`` in a header cell.
 _HEADER = re.compile(r"\s*([A-Za-z_]+)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*")
 #: Columns of this program's own history files that are not readings (forces, moments,

@@ -16,6 +16,7 @@ from core.report.inputs import SHOWN_UNITS, input_rows
 from core.scene import (
     PunchesSolution,
     SceneSolution,
+    days_text,
     engine_text,
     flagged_caution,
     flags_with_evidence,
@@ -49,13 +50,13 @@ def _largest_pressure_text(result: Any, origin: float = 0.0) -> str:
     line = largest_pressure(result)
     if line.x is not None and origin:
         line = replace(line, x=origin + line.x)
-    return line.value_text(number=number_text, shown=_shown, day="d", place_first=True)
+    return line.value_text(number=number_text, shown=_shown, place_first=True, time=days_text)
 
 
 def _at(times: np.ndarray, values: np.ndarray) -> tuple[float, float]:
     """The largest (by magnitude) value of a history and its time [day], when the design
     check and the page say it is (:func:`core.scene.time_of_largest`: a zero tilt read
-    "at t = 0 d" here and "at t = 365 days" on the page)."""
+    "at t = 0 days" here and "at t = 365 days" on the page)."""
     k = time_of_largest(values)
     return float(values[k]), float(times[k])
 
@@ -76,8 +77,8 @@ def key_numbers(result: SceneSolution, time: float | None = None,
     settlement, t_s = _at(t, result.settlement)
     tilt, t_a = _at(t, result.tilt)
     rows = [
-        ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {number_text(t_s)} d"),
-        ("largest tilt α", f"{_shown(tilt, 'rad')} at t = {number_text(t_a)} d"),
+        ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {days_text(t_s)}"),
+        ("largest tilt α", f"{_shown(tilt, 'rad')} at t = {days_text(t_a)}"),
         ("largest contact pressure q", _largest_pressure_text(result, origin)),
         ("force P at the last time", _shown(result.force[-1], "N/m")),
         ("moment M at the last time", _shown(result.moment[-1], "N")),
@@ -87,18 +88,18 @@ def key_numbers(result: SceneSolution, time: float | None = None,
         rows.append(("eccentricity e = M/P at the last time",
                      f"{number_text(float(result.moment[-1]) / force)} m"))
     k = output_index(result, time)
-    rows.append((f"contact at t = {number_text(t[k])} d", contact_text(result, k, origin)))
+    rows.append((f"contact at t = {days_text(t[k])}", contact_text(result, k, origin)))
     lifted = lift_off_times(result)
     if lifted.size:
         rows.append(("lift-off", f"at {lifted.size} of {len(t)} output times, first at "
-                                 f"t = {number_text(t[lifted[0]])} d, last at "
-                                 f"t = {number_text(t[lifted[-1]])} d (contact width plotted)"))
+                                 f"t = {days_text(t[lifted[0]])}, last at "
+                                 f"t = {days_text(t[lifted[-1]])} (contact width plotted)"))
     if result.info.get("contact") == "unilateral" and result.contact_set:
         width = result.contact_width
         k = int(np.argmin(width))
         rows.append(("smallest contact width", f"{number_text(width[k])} m of "
                                                f"{number_text(2 * result.scene.half_width)} m at "
-                                               f"t = {number_text(t[k])} d"))
+                                               f"t = {days_text(t[k])}"))
     return rows
 
 
@@ -126,8 +127,8 @@ def accuracy_rows(result: SceneSolution,
         # in percent, as the page and the command line write them (the report read
         # "1.8e-02" where the page read 1.81 %)
         *([(f"coating model error ({evidence['label']}, relative)",
-            f"{percent_text(evidence['measured'])} at t = {number_text(evidence['time_day'])} "
-            f"d (" + ("FLAGGED: above " if evidence["flagged"] else "within ")
+            f"{percent_text(evidence['measured'])} at t = {days_text(evidence['time_day'])} ("
+            + ("FLAGGED: above " if evidence["flagged"] else "within ")
             + f"solver.model_tol {percent_text(result.scene.model_tol)})")]
           if evidence["source"] == "measured" else []),
         ("coating model error (estimated, relative)",
@@ -155,7 +156,7 @@ def _discretization(info: dict[str, Any]) -> str:
 def _check_line(line: Any) -> str:
     """A design-check line without its label: value, where, limit, utilisation, verdict,
     in the units of the results (kPa, mm, mrad)."""
-    return line.verdict_text(number=number_text, shown=_shown, day="d")
+    return line.verdict_text(number=number_text, shown=_shown, time=days_text)
 
 
 def design_section(result: SceneSolution, flags: Sequence[str] | None = None
@@ -185,7 +186,7 @@ def calibration_section(calibration: Any) -> Section:
                              calibration.units)
     series = ", ".join(f"{name} [{SERIES_SI[name]}]" for name in readings.series)
     rows = [("readings", f"{readings.count} ({series}), t = {number_text(float(readings.time[0]))}"
-                         f" to {number_text(float(readings.time[-1]))} d"
+                         f" to {days_text(float(readings.time[-1]))}"
                          + (", with standard deviations" if calibration.std_given else ""))]
     for path in calibration.paths:
         unit = f" {units[path]}" if units[path] else ""

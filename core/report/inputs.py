@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from core.scene import Scene, number_text, solver_settings
+from core.scene import Scene, days_text, number_text, solver_settings
 
 #: Shown units of the histories and the pressure, by their SI unit: (unit, its size in SI).
 SHOWN_UNITS: dict[str, tuple[str, float]] = {
@@ -86,9 +86,9 @@ def _creep_text(spec: dict[str, Any]) -> str:
 def _times_text(scene: Scene, spec: Any) -> str:
     times = scene.times
     if len(times) == 1:
-        return f"1 output time, {number_text(times[0])} d after loading"
+        return f"1 output time, {days_text(times[0])} after loading"
     text = (f"{len(times)} output times, {number_text(times[0])} to "
-            f"{number_text(times[-1])} d after loading")
+            f"{days_text(times[-1])} after loading")
     if isinstance(spec, dict):
         return text + f" ({spec.get('spacing', 'linear')} spacing)"
     return text + (" (listed)" if isinstance(spec, list) else "")
@@ -120,7 +120,7 @@ def input_rows(scene: Scene) -> list[tuple[str, str]]:
         rows.append(("coating", "none: the punch on the bare base"))
     rows.append(("base", f"H = {number_text(scene.base_thickness)} m, ν = "
                          f"{number_text(scene.base_poisson)}, age at loading τ0 = "
-                         f"{number_text(scene.age_at_loading)} d, modulus at loading E(τ0) = "
+                         f"{days_text(scene.age_at_loading)}, modulus at loading E(τ0) = "
                          f"{number_text(scene.modulus_at_loading() / 1e9)} GPa"))
     rows.append(("base creep", _creep_text(data["base"]["creep"])))
     t = np.union1d(np.linspace(0.0, float(scene.times[-1]), LOAD_SAMPLES), scene.times)

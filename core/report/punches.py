@@ -33,6 +33,7 @@ from core.scene import (
     PUNCH_COLOURS,
     PunchesSolution,
     PunchSolution,
+    days_text,
     flagged_caution,
     holoviews_for_bokeh,
     number_text,
@@ -137,7 +138,7 @@ def punches_sections(result: PunchesSolution, time: float | None = None) -> list
     checks = result.design_checks()
     if any(check is not None for check in checks):
         rows = [(f"punches[{k}] {line.label}",
-                 line.verdict_text(number=number_text, shown=_shown, day="d"))
+                 line.verdict_text(number=number_text, shown=_shown, time=days_text))
                 for k, check in enumerate(checks) if check is not None
                 for line in (*check.checks, check.q_min)]
         failed = [f"punches[{k}]" for k, check in enumerate(checks)
@@ -149,7 +150,7 @@ def punches_sections(result: PunchesSolution, time: float | None = None) -> list
                            rows, tone="bad" if failed or caution else "good"))
     for k, punch in enumerate(punches):
         view = local_view(punch)
-        rows = [("zone", _zone(punch)), (f"at t = {number_text(t)} d", _at_time(punch, k_t)),
+        rows = [("zone", _zone(punch)), (f"at t = {days_text(t)}", _at_time(punch, k_t)),
                 *key_numbers(view, time, origin=punch.center),
                 ("flags", ", ".join(punch.flags) or "none")]
         out.append(Section(f"Results: {_name(k, punch)}", rows=rows,

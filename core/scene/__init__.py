@@ -56,6 +56,7 @@ from core.scene.design import (
 )
 from core.scene.display import (
     corner_note,
+    days_text,
     engine_text,
     known_contact_width,
     lifts_off_at,
@@ -141,6 +142,7 @@ __all__ = [
     "holoviews_for_bokeh",
     "PUNCH_COLOURS",
     "known_contact_width",
+    "days_text",
     "number_text",
     "percent_text",
     "largest_pressure",

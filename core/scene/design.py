@@ -186,19 +186,19 @@ class LimitCheck:
 
     def value_text(self, number: Callable[[float], str] = _six_digits,
                    shown: Callable[[float, str], str] | None = None,
-                   day: str = "days", place_first: bool = False) -> str:
+                   day: str = "days", place_first: bool = False,
+                   time: Callable[[float], str] | None = None) -> str:
         """Value and where (or, for an unbounded pressure, the corner and the value where
         it is read), without the limit: :meth:`verdict_text`'s arguments; ``place_first``
         writes ``x`` before ``t``."""
         if shown is None:
             def shown(value: float, unit: str) -> str:
                 return f"{number(value)} {unit}"
+        when = f"t = {time(self.time) if time else f'{number(self.time)} {day}'}"
         if self.unbounded:
             return (f"unbounded at the corner x = {number(self.x)} m (a rigid corner: q ~ "
                     f"1/sqrt(distance)); {shown(self.value, self.unit)} at "
-                    f"{number(1e3 * float(self.corner_distance))} mm from it, t = "
-                    f"{number(self.time)} {day}")
-        when = f"t = {number(self.time)} {day}"
+                    f"{number(1e3 * float(self.corner_distance))} mm from it, {when}")
         if self.x is None:
             where = when
         else:
@@ -208,16 +208,16 @@ class LimitCheck:
 
     def verdict_text(self, number: Callable[[float], str] = _six_digits,
                      shown: Callable[[float, str], str] | None = None,
-                     day: str = "days") -> str:
+                     day: str = "days", time: Callable[[float], str] | None = None) -> str:
         """Value, where, limit, utilisation and verdict (the report's table cell).
 
         ``number`` writes a time [day] or a position [m], ``shown`` a value and its unit
         (default: in the check's SI unit, by ``number``), ``day`` is the unit of time
-        written."""
+        written; ``time``, when given, writes a time [day] with its unit instead."""
         if shown is None:
             def shown(value: float, unit: str) -> str:
                 return f"{number(value)} {unit}"
-        text = self.value_text(number, shown, day)
+        text = self.value_text(number, shown, day, time=time)
         if self.limit is None:
             return text + "; no limit set"
         if self.unbounded:

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.engines.layered import NO_COATING
+from core.limits import DAYS_PER_YEAR
 from core.optional import import_optional
 from core.scene.contact_zone import LIFT_OFF_SHARE
 from core.scene.files import scene_to_json
@@ -86,6 +87,22 @@ def number_text(value: float, digits: int = 4) -> str:
         return np.format_float_positional(float(value), precision=digits, unique=False,
                                           fractional=False, trim="-")
     return f"{value:.{digits}g}"
+
+
+#: From this time on [day] the years are written beside the days: below two years the
+#: days are the natural reading (28 days, 365 days), beyond it the years.
+YEARS_FROM_DAYS = 2 * DAYS_PER_YEAR
+
+
+def days_text(t: float, digits: int = 4) -> str:
+    """A time ``t`` [day] after loading in words: "28 days", "1 day", "18260 days (50.0
+    years)" (:func:`number_text`'s digits: never "1.826e+04 d", which an engineer has to
+    decode)."""
+    shown = number_text(t, digits)
+    text = f"{shown} {'day' if shown == '1' else 'days'}"
+    if math.isfinite(t) and abs(t) >= YEARS_FROM_DAYS:
+        text += f" ({t / DAYS_PER_YEAR:.1f} years)"
+    return text
 
 
 def _number(value: float) -> str:

@@ -453,7 +453,7 @@ def last_time_field(spec: Any, count: int, path: str = "times") -> str:
 
 
 def check_last_time(end: float, field: str, most: float = MAX_DAYS,
-                    why: str = f"about {MAX_DAYS / 365.25:.0f} years") -> None:
+                    why: str = f"about {MAX_DAYS / limits.DAYS_PER_YEAR:.0f} years") -> None:
     """Refuse a last output time ``end`` [day after loading] past ``most``, naming
     ``field`` and saying ``why`` that bound."""
     if end > most:

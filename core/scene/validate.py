@@ -153,8 +153,9 @@ def _validated(d: dict[str, Any]) -> Scene:
     tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
     if tau0 > schema.MAX_AGE:
         raise ValueError(f"base.age_at_loading: must be <= {schema.MAX_AGE:g} days (about "
-                         f"{schema.MAX_AGE / 365.25:.0f} years: older, the age swamps the time "
-                         f"steps after loading in double precision), got {tau0:g}")
+                         f"{schema.MAX_AGE / limits.DAYS_PER_YEAR:.0f} years: older, the age "
+                         f"swamps the time steps after loading in double precision), got "
+                         f"{tau0:g}")
     try:
         creep = creep_model_from_spec(base["creep"], field="base.creep")
     except NumberTooLarge:

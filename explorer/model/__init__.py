@@ -16,7 +16,6 @@ prepared where it is solved), and the state can be used without a server.
 - ``links``, ``view_link``: the scene, and what else a link keeps, in the page's address.
 - ``undo``, ``history``: the scenes shown, for undo and reset.
 - ``screen``: what the page shows now (the result, the output time, a notice).
-- ``time_text``: times after loading in words, without an exponent.
 - ``study``: the Study tab's design studies, planned from the scene on screen.
 - ``fit``: the Fit tab's back-analysis: readings, the fields fitted, the outcome shown.
 """
@@ -88,7 +87,6 @@ from .study import (
     study_choices,
     study_outputs,
 )
-from .time_text import days_text
 from .view_link import (
     read_fit_query,
     read_study_query,
@@ -107,7 +105,7 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "PlannedStudy", "PunchEntryState", "PunchResult", "SCREEN_PUNCHES", "ProfileState",
            "ResultView", "SceneHistory", "Screen", "StudyResult",
            "check_html", "check_text", "contact_text", "contact_widths", "contact_zones",
-           "creep_coefficient_data", "days_text", "decode_scene", "default_range",
+           "creep_coefficient_data", "decode_scene", "default_range",
            "design_check", "eccentricity", "encode_scene", "fit_choices", "forecast_columns",
            "lessons", "lift_off_lengths", "lifts_off", "lifts_or_pulls", "model_evidence",
            "plan_fit", "plan_study", "read_upload", "readings_columns",

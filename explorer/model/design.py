@@ -22,12 +22,11 @@ import numpy as np
 import param
 
 from core.scene import DesignLimits as CoreLimits
-from core.scene import LimitCheck, check_design, flagged_caution, number_text
+from core.scene import LimitCheck, check_design, days_text, flagged_caution, number_text
 
 from .contact_zone import contact_widths
 from .results import ResultView
 from .state import QUANTITY_UNITS
-from .time_text import days_text
 
 
 class DesignLimits(param.Parameterized):

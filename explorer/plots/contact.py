@@ -12,12 +12,13 @@ from bokeh.core.properties import value as fixed_label
 from bokeh.models import ColumnDataSource, HoverTool, Label, Range1d, Span
 from bokeh.plotting import figure
 
+from core.scene import days_text
+
 from ..model import (
     Geometry,
     ResultView,
     contact_widths,
     contact_zones,
-    days_text,
     lift_off_lengths,
     lifts_off,
     lifts_or_pulls,

@@ -27,7 +27,7 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from core.scene import number_text
+from core.scene import days_text, number_text
 
 from ..model import (
     QUANTITIES,
@@ -36,7 +36,6 @@ from ..model import (
     DisplayScales,
     Pin,
     ResultView,
-    days_text,
     lifts_or_pulls,
 )
 from .bokeh_data import (

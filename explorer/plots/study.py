@@ -22,7 +22,9 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from ..model import StudyResult, days_text
+from core.scene import days_text
+
+from ..model import StudyResult
 
 #: Most tick labels along a heat map's axis.
 MAX_TICKS = 7

@@ -9,7 +9,7 @@ from typing import Any
 import panel as pn
 import param
 
-from core.scene import number_text, percent_text
+from core.scene import days_text, number_text, percent_text
 
 from ..files import flag_message
 from ..model import (
@@ -21,7 +21,6 @@ from ..model import (
     Screen,
     check_html,
     contact_text,
-    days_text,
     design_check,
     lifts_off,
     model_evidence,

@@ -21,6 +21,8 @@ from typing import Any
 import numpy as np
 import panel as pn
 
+from core.scene import days_text
+
 from ..files import MAX_PAGE_DOWNLOAD_BYTES, study_csv
 from ..model import (
     MAX_POINTS,
@@ -28,7 +30,6 @@ from ..model import (
     SPACINGS,
     Axis,
     ExplorerState,
-    days_text,
     default_range,
     plan_study,
     study_choices,

@@ -172,7 +172,7 @@ def test_the_tab_draws_the_chart_and_writes_the_files(explorer_app):
     result = tab.study_run.result
     np.testing.assert_allclose(data["y"], result.outputs["settlement"][:, -1] * 1e3)
     # the times offered read in four digits where they stay apart ("0.437764 days" read)
-    from explorer.model import days_text
+    from core.scene import days_text
 
     assert list(tab.study_time.options) == [days_text(float(t), 4) for t in result.times]
     tab.study_output.value = "q_max"

@@ -6,8 +6,7 @@ import copy
 
 import pytest
 
-from core.scene import number_text
-from explorer.model import days_text
+from core.scene import days_text, number_text
 
 
 @pytest.mark.parametrize(("days", "text"), [

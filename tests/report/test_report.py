@@ -49,7 +49,7 @@ def test_the_sections_say_validity_check_results_and_accuracy(checked):
     assert about["statement"] == "4: force and moment given"
     results = dict(sections(checked)[3].rows)
     assert "smallest contact width" in results  # the punch lifts off
-    assert re.fullmatch(r"[0-9.]+ kPa at x = 1 m, t = [0-9.]+ d",
+    assert re.fullmatch(r"[0-9.]+ kPa at x = 1 m, t = [0-9.]+ days \(2.7 years\)",
                         results["largest contact pressure q"])
     assert results["eccentricity e = M/P at the last time"] == "0.6 m"  # 480 / 800 kN
     accuracy = rows(checked, "Accuracy")
@@ -60,14 +60,15 @@ def test_the_inputs_are_listed_in_engineering_units(checked):
     inputs = rows(checked, "Inputs")
     assert inputs["punch"] == "half-width a = 1 m (width 2a = 2 m); base flat"
     assert inputs["coating layer 1"] == "h = 15 mm, E = 400 MPa, ν = 0.35, smooth interface"
-    assert inputs["base"] == ("H = 6 m, ν = 0.2, age at loading τ0 = 28 d, modulus at "
+    assert inputs["base"] == ("H = 6 m, ν = 0.2, age at loading τ0 = 28 days, modulus at "
                               "loading E(τ0) = 23.52 GPa")
     assert inputs["base creep"] == ("aging creep (Arutyunyan): E∞ = 30 GPa; β = 0.5; α = "
                                     "0.03 1/day; C∞ = 0.009 1/GPa; A = 0.48 day/GPa; γ = "
                                     "0.03 1/day")
     assert inputs["force P (given)"] == "800 kN/m"
     assert inputs["moment M (given)"] == "480 kN·m/m"
-    assert inputs["output times"] == "20 output times, 0 to 1000 d after loading (log spacing)"
+    assert inputs["output times"] == ("20 output times, 0 to 1000 days (2.7 years) after loading "
+                                     "(log spacing)")
     assert inputs["solver settings"] == "tol 0.0001, model_tol 0.02, contact auto"
 
 
@@ -82,7 +83,7 @@ def test_the_inputs_are_listed_in_engineering_units(checked):
     ("patched_insert", "base creep", "Prony series: E = 32 GPa; term 1: C = 0.01 1/GPa, "
                                      "A = 0 day/GPa, γ = 0.1 1/day; term 2:"),
     ("stepped_punch", "settlement δ (given)", "0.08 mm"),
-    ("rounded_graded", "output times", "1 output time, 1 d after loading"),
+    ("rounded_graded", "output times", "1 output time, 1 day after loading"),
 ])
 def test_profiles_and_creep_models_are_said_in_their_units(preset, label, text):
     from core.report.inputs import input_rows
@@ -103,12 +104,12 @@ def test_a_varying_load_is_given_by_its_range_and_kind():
 def test_the_contact_at_a_chosen_time_and_when_the_punch_lifts_off(checked):
     results = rows(checked, "Results", time=0.0)
     # the preset's description: at e = 0.6 m only 1.31 m of the 2 m carry the load
-    assert results["contact at t = 0 d"] == ("contact 1.306 m of 2 m (65 %), lifted 0.694 m: "
+    assert results["contact at t = 0 days"] == ("contact 1.306 m of 2 m (65 %), lifted 0.694 m: "
                                              "x = -1 to -0.306 m (unilateral contact)")
     assert results["lift-off"].startswith("at 20 of 20 output times, first at t = 0 d")
     # the nearest output time: 46.42 d for 50 d (log spacing to 1000 d)
-    assert "contact at t = 46.42 d" in rows(checked, "Results", time=50)
-    assert "contact at t = 1000 d" in rows(checked, "Results")  # the last by default
+    assert "contact at t = 46.42 days" in rows(checked, "Results", time=50)
+    assert "contact at t = 1000 days (2.7 years)" in rows(checked, "Results")  # the last by default
     assert output_index(checked, 1000.4) == 19
     for bad, reason in ((-3.0, "outside the output times, 0 to 1000 d"),
                         (2000.0, "outside the output times"), (float("nan"), "not a finite"),
@@ -119,13 +120,13 @@ def test_the_contact_at_a_chosen_time_and_when_the_punch_lifts_off(checked):
 
 def test_full_contact_is_said_and_a_lost_contact_named_not_physical():
     flat = rows(core.solve(read_preset("uniform_flat")), "Results")
-    assert flat["contact at t = 365 d"] == "full contact: the whole width 2a = 2 m touches"
+    assert flat["contact at t = 365 days"] == "full contact: the whole width 2a = 2 m touches"
     assert "lift-off" not in flat and "smallest contact width" not in flat
     scene = read_preset("eccentric_footing_liftoff")
     scene["solver"]["contact"] = "full"
     lost = core.solve(scene)
     assert "contact_lost" in lost.flags
-    text = rows(lost, "Results", time=0)["contact at t = 0 d"]
+    text = rows(lost, "Results", time=0)["contact at t = 0 days"]
     # where the full-contact pressure is negative: 0.37 m of the heel (measured; the
     # unilateral answer lifts 0.69 m)
     assert text.startswith("contact 1.628 m of 2 m (81 %), q < 0 (contact lost, not "
@@ -146,7 +147,7 @@ def test_the_html_report_embeds_bokeh_plots_and_the_scene(checked):
     assert "&quot;allowable_pressure&quot;: 1500000.0" in text  # the scene file, escaped
     # the plot of the contact over time, and the chosen time among the q(x) curves
     assert "contact width and lifted length (2a = 2 m)" in text
-    assert '"t = 100 d"' in text and "<td>contact at t = 100 d</td>" in text
+    assert '"t = 100 d"' in text and "<td>contact at t = 100 days</td>" in text
     assert "<h2>Inputs</h2>" in text and "punch base f(x)" not in text  # a flat punch
 
 
@@ -228,7 +229,7 @@ def test_the_command_line_describes_the_contact_at_the_time_asked_for(tmp_path):
     path = tmp_path / "r.html"
     done = run_cli("report", "preset:eccentric_footing_liftoff", "-o", path, "--time", "0")
     assert done.returncode == 0, done.stderr
-    assert "<td>contact at t = 0 d</td><td>contact 1.306 m of 2 m (65 %)" in path.read_text()
+    assert "<td>contact at t = 0 days</td><td>contact 1.306 m of 2 m (65 %)" in path.read_text()
     late = run_cli("report", "preset:eccentric_footing_liftoff", "-o", path, "--time", "5000")
     assert late.returncode == 2
     assert "--time: 5000 d is outside the output times, 0 to 1000 d" in late.stderr
@@ -240,11 +241,14 @@ def test_a_missing_plotting_package_is_named_with_its_extra(monkeypatch, checked
         report_pdf(checked)
 
 
-def test_long_times_read_without_an_exponent():
+def test_long_times_read_without_an_exponent_and_in_years():
+    """The report wrote "t = 18260 d" where the page writes "18260 days (50.0 years)": an
+    engineer filing a 50-year check reads years."""
     result = core.solve(read_preset("young_concrete_50_years"))
     assert result.times[-1] > 1e4  # 50 years of days
     text = "".join(f"{label} {value}" for s in sections(result) for label, value in s.rows)
-    assert "e+04" not in text and f"{round(result.times[-1], -1):.0f} d" in text
+    assert "e+04" not in text and "t = 18260 days (50.0 years)" in text
+    assert " d," not in text and not text.rstrip().endswith(" d")
 
 
 def test_the_plots_legends_read_long_times_without_an_exponent():
@@ -271,6 +275,7 @@ def test_the_time_of_a_largest_value_is_the_design_checks():
     result = core.solve(core.load_scene("preset:uniform_flat"))
     rows = dict(key_numbers(result))
     check = design_check(result)
-    assert rows["largest tilt α"] == f"0 mrad at t = {check.check('tilt').time:g} d" \
-        == "0 mrad at t = 365 d"
-    assert rows["largest settlement δ"].endswith(f"at t = {check.check('settlement').time:g} d")
+    assert rows["largest tilt α"] == f"0 mrad at t = {check.check('tilt').time:g} days" \
+        == "0 mrad at t = 365 days"
+    assert rows["largest settlement δ"].endswith(
+        f"at t = {check.check('settlement').time:g} days")

@@ -19,4 +19,4 @@ def test_the_report_gives_the_smallest_contact_width() -> None:
     # the lift-off preset narrows most at loading: 1.306 m of the 2 m
     assert k == 0 and f"{widths[k]:.4g}" == "1.306"
     assert dict(key_numbers(result))["smallest contact width"] == (
-        f"{widths[k]:.4g} m of 2 m at t = {result.times[k]:.4g} d")
+        f"{widths[k]:.4g} m of 2 m at t = {result.times[k]:.4g} days")

@@ -44,7 +44,7 @@ def test_a_measurement_of_the_scene_overrides_the_estimate(result):
     assert "measured by the FE check" in validity["rows"]["model_error"]
     rows = text["Accuracy"]["rows"]
     # in percent, as the page writes them (the report read "3.6e-02")
-    assert rows[MEASURED_ROW].startswith("3.58 % at t = 0 d (FLAGGED: above "
+    assert rows[MEASURED_ROW].startswith("3.58 % at t = 0 days (FLAGGED: above "
                                          "solver.model_tol 2 %)")
     # next to it, not replaced; "1.39 % (flagged above 2 %)" read as a flag where none was
     assert rows[ESTIMATED_ROW].startswith("4.64 % (FLAGGED: above solver.model_tol 2 %)")
