@@ -175,7 +175,9 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
     contact = html.escape(contact_text(view, index))
     return (f"<div class='readout'><b>At t = {days_text(t)} after loading</b> · {ecc}"
             # pins add two columns each: at 1024 px three pins' table is twice the box
-            # wide, and its last columns were cut off with no way to reach them
+            # wide, and its last columns were cut off with no way to reach them; its
+            # scroll bar is always drawn (an overlay bar hid that it scrolls) and the
+            # names stay in view while it scrolls
             f"<div class='readout-scroll'><table class='cp-readout'>{''.join(rows)}</table>"
             "</div>"
             f"<div class='contact-readout'>{contact}</div></div>")

@@ -15,6 +15,13 @@ CSS = """
 .cp-msg {font-size: 12px; color: #9b1c1c; margin-left: 4px; overflow-wrap: anywhere;}
 .coating-check-stale {opacity: 0.45;}
 .readout-scroll {overflow-x: auto; max-width: 100%;}
+.readout-scroll::-webkit-scrollbar {height: 8px;}
+.readout-scroll::-webkit-scrollbar-track {background: #f0f0f0;}
+.readout-scroll::-webkit-scrollbar-thumb {background: #b0b0b0; border-radius: 4px;}
+.readout-scroll .cp-readout td:first-child, .readout-scroll .cp-readout th:first-child
+  {position: sticky; left: 0; background: var(--background-color, #fff); z-index: 1;
+   min-width: 9em;}
+.readout-scroll .cp-readout td:not(:first-child) {white-space: nowrap;}
 .cp-status {font-size: 12px; color: #444;}
 .cp-status.model-flagged {color: #9b1c1c; font-weight: 600;}
 .cp-readout td, .cp-readout th {padding: 1px 8px; font-size: 13px; text-align: right;}

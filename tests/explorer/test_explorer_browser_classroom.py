@@ -171,12 +171,14 @@ JS_READOUT_SCROLL = """el => { const last = [...el.querySelectorAll('th')].pop()
   el.scrollLeft = el.scrollWidth;
   return {overflow: getComputedStyle(el).overflowX, client: el.clientWidth,
           scroll: el.scrollWidth, right: el.getBoundingClientRect().right,
-          last: last.getBoundingClientRect().right}; }"""
+          last: last.getBoundingClientRect().right, left: el.getBoundingClientRect().left,
+          name: el.querySelector('td').getBoundingClientRect().left}; }"""
 
 
 def test_three_pins_columns_can_be_reached_at_1024px(page: Page) -> None:
     """At 1024 px the readout with three pins is wider than its box: its last columns
-    were cut off with no scrollbar (839 px of table in 434 px)."""
+    were cut off with no scrollbar (839 px of table in 434 px). Scrolled to them, the
+    rows' names stay in view."""
     page.page.set_viewport_size({"width": 1024, "height": 768})
     clear = page.page.locator(".unpin-button button").first
     if clear.is_enabled():  # what earlier tests pinned
@@ -190,6 +192,7 @@ def test_three_pins_columns_can_be_reached_at_1024px(page: Page) -> None:
     box = page.page.locator(".readout-scroll").first.evaluate(JS_READOUT_SCROLL)
     assert box["overflow"] == "auto" and box["scroll"] > box["client"], box
     assert box["last"] <= box["right"] + 1, box  # scrolled, the last column is in view
+    assert box["name"] >= box["left"] - 1, box  # and the rows' names with it
     assert page.errors == []
 
 
