@@ -17,6 +17,8 @@ import panel as pn
 from bokeh.models import ColumnDataSource, HoverTool
 from bokeh.plotting import figure
 
+from core.scene import days_text
+
 from ..model import (
     CODE_CREEP_MODELS,
     STRENGTH_CLASSES,
@@ -55,7 +57,9 @@ def update_creep_figure(fig: Any, source: ColumnDataSource, state: CodeCreepStat
         return str(exc)
     source.data = data
     code = CODE_CREEP_MODELS[model or state.code_model]
-    fig.title.text = f"Creep coefficient φ(t, t₀), {code}, t₀ = {age_at_loading:g} days"
+    # two lines: one ran past the 1024 px page's sidebar ("..., fib Model Code 2010, " and
+    # the age at loading cut off)
+    fig.title.text = f"Creep coefficient φ(t, t₀)\n{code}, t₀ = {days_text(age_at_loading)}"
     return ""
 
 

@@ -260,3 +260,42 @@ def test_the_pin_steps_boxes_show_their_digits(page: Page) -> None:
         room = box.evaluate("b => [b.scrollWidth, b.clientWidth]")
         assert room[0] <= room[1], (css, text, room)
     assert page.errors == []
+
+
+# Widths [px] of a figure's title lines in the font Bokeh draws it with (bold 13px
+# helvetica), and of its frame, or null while it is not drawn.
+JS_TITLE_FIT = """(name) => {
+  const stack = Object.values(Bokeh.index);
+  while (stack.length) {
+    const v = stack.pop();
+    if (v.model && v.model.name === name && v.frame && v.frame.bbox.width > 0) {
+      const pen = document.createElement('canvas').getContext('2d');
+      pen.font = 'bold 13px helvetica';
+      return {frame: v.frame.bbox.width, text: v.model.title.text,
+              lines: v.model.title.text.split('\\n').map(l => pen.measureText(l).width)};
+    }
+    if (v.child_views) stack.push(...v.child_views);
+  }
+  return null;
+}"""
+
+
+def test_the_code_creep_plot_title_fits_the_sidebar_at_1024px(
+        server: str, browser_context: object) -> None:
+    """At 1024 px the Base tab's plot read "Creep coefficient φ(t, t₀), fib Model Code
+    2010, " and the age at loading was cut off."""
+    page = Page(browser_context, server, "/app?preset=young_concrete_50_years")
+    try:
+        page.page.set_viewport_size({"width": 1024, "height": 768})
+        page.open_tab("Base")
+        fit: dict = {}
+
+        def drawn() -> bool:
+            fit.update(page.page.evaluate(JS_TITLE_FIT, "creep_phi_figure") or {})
+            return "t₀ = 7 days" in fit.get("text", "")
+        until(drawn, "the creep plot drawn with its title", describe=lambda: fit)
+        assert "fib Model Code 2010" in fit["text"], fit
+        assert max(fit["lines"]) <= fit["frame"], fit
+        assert page.errors == []
+    finally:
+        page.close()
