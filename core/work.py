@@ -45,20 +45,52 @@ _BOUND: ContextVar[tuple[float, float] | None] = ContextVar("solve_work_bound", 
 _CANCELLED: ContextVar[Callable[[], bool] | None] = ContextVar("solve_cancelled", default=None)
 
 
+#: The address space each core of the machine adds to a memory bound [bytes]: the
+#: numerical libraries start a thread per core, and each maps its stack (8 MiB), a malloc
+#: arena (up to 64 MiB) and a BLAS buffer (~32 MiB) whether it uses them or not, so a fixed
+#: bound would refuse a process's start on a machine with many cores.
+PER_CORE_BYTES = 128 * 2**20
+
+
+def address_space_bound(work_bytes: int) -> int:
+    """The address-space bound [bytes] of a process whose work may take ``work_bytes``
+    [bytes] on this machine (:data:`PER_CORE_BYTES` added per core)."""
+    return work_bytes + (os.cpu_count() or 1) * PER_CORE_BYTES
+
+
+def bound_memory(work_bytes: int) -> int | None:
+    """Bound this process's address space to :func:`address_space_bound` of
+    ``work_bytes`` [bytes] (never above a bound set from outside): past it an allocation
+    raises ``MemoryError`` in this process alone. Returns the bound [bytes], or None where
+    the system has no such bound (Windows)."""
+    try:
+        import resource
+    except ImportError:
+        return None
+    limit = address_space_bound(work_bytes)
+    _, hard = resource.getrlimit(resource.RLIMIT_AS)
+    if hard != resource.RLIM_INFINITY:
+        limit = min(limit, hard)
+    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+    return limit
+
+
 class SolveCancelled(RuntimeError):
     """A solve stopped because its answer is no longer wanted (:func:`cancellable`)."""
 
 
 class WorkLimitExceeded(RuntimeError):
     """A solve spent its CPU-time bound; ``seconds`` is the bound [s], ``doing`` what the
-    solve was doing when it was stopped (words for a message)."""
+    solve was doing when it was stopped (words for a message), ``zones`` how many contact
+    zones it was following then (0: none, or not counted)."""
 
-    def __init__(self, seconds: float, doing: str) -> None:
+    def __init__(self, seconds: float, doing: str, zones: int = 0) -> None:
         super().__init__(f"the solve was stopped after {seconds:g} s of CPU time (the bound "
                          "of one solve, core.limits.MAX_SOLVE_CPU_SECONDS by default) while "
                          f"{doing}")
         self.seconds = seconds
         self.doing = doing
+        self.zones = zones
 
 
 @contextmanager
@@ -88,13 +120,14 @@ def cancellable(cancelled: Callable[[], bool]) -> Iterator[None]:
         _CANCELLED.reset(token)
 
 
-def check_work(doing: str) -> None:
+def check_work(doing: str, zones: int = 0) -> None:
     """Raise :class:`WorkLimitExceeded` if the bound of the solve in this thread is spent,
     :class:`SolveCancelled` if its answer is no longer wanted; ``doing``: what the loop
-    calling it does (e.g. "following lift-off under creep")."""
+    calling it does (e.g. "following lift-off under creep"), ``zones``: the contact zones
+    it follows (what made it costly when they are many)."""
     bound = _BOUND.get()
     if bound is not None and time.thread_time() > bound[0]:
-        raise WorkLimitExceeded(bound[1], doing)
+        raise WorkLimitExceeded(bound[1], doing, zones)
     cancelled = _CANCELLED.get()
     if cancelled is not None and cancelled():
         raise SolveCancelled(f"the solve was cancelled while {doing}")

@@ -35,7 +35,7 @@ import numpy as np
 from core.contact.active_set import NodalState, zones_from_nodes
 from core.contact.step import Space, Step
 from core.contact.systems import StepSolver, bordered_change, bordered_solve
-from core.contact.zones import ZONE_END_TOL
+from core.contact.zones import CORRECTING_ZONE_ENDS, ZONE_END_TOL
 from core.discretize import (
     BARYCENTRIC_WEIGHTS,
     GAUSS_NODES,
@@ -47,6 +47,7 @@ from core.discretize import (
     operator_rows_from_pairs,
 )
 from core.kernel import FULL_ACCURACY, legendre_log_moments
+from core.work import check_work
 
 #: Log moments at targets just off a part (1.05 < |z| <= NEAR_FIELD in its coordinate)
 #: by a 64-point Gauss rule: ln|z - t| is analytic within the ellipse through z (rho >=
@@ -58,17 +59,12 @@ _OVER_P = np.polynomial.legendre.legvander(_OVER_T, NODES_PER_PANEL - 1)
 
 
 def _part_rows(lam: float, part: Panels, targets: np.ndarray,
-               owners: tuple[np.ndarray, np.ndarray] | None = None,
                accuracy: float = FULL_ACCURACY) -> np.ndarray:
     """Rows of F (len(targets) x 16 P) on the panels ``part``: as
     :func:`core.discretize.operator_rows`, its near-field moments computed as above.
-    ``owners`` = (one label per target, one per panel): only the rows of a target's own
-    panels are exact then (the others are left with the far-field rule, for a caller
-    that discards them). ``accuracy``: absolute accuracy of the kernel values."""
+    ``accuracy``: absolute accuracy of the kernel values."""
     z = (targets[:, None] - part.centers[None, :]) / part.half_widths[None, :]
     near = np.abs(z) <= NEAR_FIELD
-    if owners is not None:
-        near &= owners[0][:, None] == owners[1][None, :]
     near_t, near_s = np.nonzero(near)
     zn = z[near_t, near_s]
     moments = np.empty((zn.size, NODES_PER_PANEL))
@@ -194,9 +190,8 @@ def kink_corrected(space: Space, step: Step, state: NodalState, op: np.ndarray,
 
 def kinks_corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
                     steps: list[tuple], accuracy: float = FULL_ACCURACY) -> list[Corrected]:
-    """:func:`kink_corrected` for several steps on one rule at once, each given as
-    (step, state, memory, memory_density, solver, (ends, pinned)): the rows of F of all
-    their cut parts at the rule's nodes come from one evaluation. Each step's
+    """:func:`kink_corrected` for several steps on one rule, each given as
+    (step, state, memory, memory_density, solver, (ends, pinned)). Each step's
     ``solver`` must still hold that step's factors (:meth:`StepSolver.snapshot`).
     ``accuracy``: absolute accuracy of the kernel values in those rows."""
     prepared = []
@@ -215,18 +210,18 @@ def kinks_corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
         return [Corrected(row[5], [], row[1].panels, row[9], row[1].q, np.zeros(0), None,
                           row[1].settlement, row[1].tilt, row[0]) for row in prepared]
     panels = prepared[0][1].panels
-    # one evaluation: every node against every step's cut parts (near-field weights only
-    # for each step's own; the other columns are never read)
-    bounds = np.cumsum([0] + [c.nodes.size for c in cuts])
-    rows_all = _part_rows(space.lam, Panels.side_by_side(cuts), panels.nodes, accuracy=accuracy)
-    for k, (step, state, memory, memory_density, solver, ends, free, idx, parts, cut,
-            values) in enumerate(prepared):
+    for step, state, memory, memory_density, solver, ends, free, idx, parts, cut, \
+            values in prepared:
         if not free:
             out.append(Corrected(ends, [], panels, cut, state.q, np.zeros(0), None,
                                  state.settlement, state.tilt, step))
             continue
         x, w = panels.nodes, panels.weights
-        cut_rows = rows_all[np.ix_(idx, np.arange(bounds[k], bounds[k + 1]))]
+        # F of this step's own cut parts at its own contact nodes only: every node against
+        # every step's cut parts at once computed the steps' count times the rows kept
+        # (a wavy punch with 50 zones at 20 output times: 430 MB for a 1/20 share read)
+        cut_rows = (_part_rows(space.lam, cut, x[idx], accuracy=accuracy) if cut.n_panels
+                    else np.zeros((idx.size, 0)))
         defect, d_force, d_moment = _defect(step, state, op, cut, values, parts, idx,
                                             cut_rows)
         if solver is None:
@@ -274,11 +269,6 @@ def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL
     if owner.size == 0:
         return out
     panels = steps[0].panels
-    cuts = [c.cut for c in steps]
-    cut_owner = np.concatenate([np.full(c.nodes.size, s) for s, c in enumerate(cuts)])
-    panel_owner = cut_owner[::NODES_PER_PANEL]
-    cut_density = np.concatenate([c.cut_density for c in steps])
-    joined_cuts = Panels.side_by_side(cuts)
     density = np.stack([c.density for c in steps])[owner]  # (ends, N)
     memory = None
     if any(c.memory_density is not None for c in steps):
@@ -288,19 +278,29 @@ def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL
     alpha = np.array([steps[s].alpha for s in owner])
     scale = np.array([steps[s].step.scale for s in owner])
     c_val = np.array([steps[s].step.c for s in owner])
-    mine = cut_owner[None, :] == owner[:, None]  # (ends, cut nodes): each end's own cut
     coupled = any(c.coupling is not None for c in steps)
+    owners = np.unique(owner)
+    zones = max(len(c.ends) for c in steps) // 2
+    doing = f"{CORRECTING_ZONE_ENDS} {zones} contact zone(s) under creep"
 
     def nystrom(t: np.ndarray, rep: int) -> np.ndarray:
+        check_work(doing, zones)
         base_rows = _part_rows(space.lam, panels, t, accuracy=accuracy)
-        # each end needs F of its own step's cut parts only (the rest is masked off)
-        cut_rows = _part_rows(space.lam, joined_cuts, t, (np.tile(owner, rep), panel_owner),
-                              accuracy)
-        dens = np.tile(density, (rep, 1))
-        fq = np.einsum("ij,ij->i", base_rows, dens) + (
-            cut_rows * np.tile(mine, (rep, 1))) @ cut_density
-        e = 0.0 if memory is None else np.einsum("ij,ij->i", base_rows,
-                                                 np.tile(memory, (rep, 1)))
+        # each of the rep blocks of targets against the same ends' densities (tiled
+        # copies of (ends, N) cost 150 MB each for a wavy punch's 2700 ends)
+        blocks = base_rows.reshape(rep, owner.size, -1)
+        fq = np.einsum("rij,ij->ri", blocks, density).ravel()
+        # each end needs F of its own step's cut parts only: one block per step (every
+        # end against every step's parts, then masked, was the steps' count times the
+        # work and memory: 1.8 GB and 26 s of one call for a wavy punch's 1288 ends)
+        of = np.tile(owner, rep)
+        for s in owners:
+            cut = steps[s].cut
+            if cut.n_panels:
+                at = of == s
+                fq[at] += _part_rows(space.lam, cut, t[at], accuracy=accuracy) \
+                    @ steps[s].cut_density
+        e = 0.0 if memory is None else np.einsum("rij,ij->ri", blocks, memory).ravel()
         if coupled:
             e = e + _couplings(steps, np.tile(owner, rep), t)
         return ((np.tile(delta, rep) + np.tile(alpha, rep) * t - space.g(t) + e

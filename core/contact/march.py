@@ -112,11 +112,12 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
               else None)
     solver = StepSolver(mirror)
     pending: list[tuple[int, Any]] = []
-    batch: list[tuple[int, tuple]] = []
     sweeps = 0
     unsettled = 0
+    # the zones at loading, as an earlier march found them, until this one has its own
+    zones = len(first["zones"]) if first is not None and "zones" in first else 0
     for n in range(steps):
-        check_work("following the contact zones under creep step by step")
+        check_work("following the contact zones under creep step by step", zones)
         memory_density = np.zeros(n_nodes)
         diag = 0.0
         if n > 0:
@@ -140,21 +141,20 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         sweeps += count
         unsettled += not settled
         active = state.active
+        # the runs of contact nodes: what makes a march costly when they are many
+        zones = int(active[0]) + int(np.count_nonzero(active[1:] & ~active[:-1]))
         memory_of.record(n, state.q)
         if n in wanted:
             nodal, pinned = ([], []) if not state.active.any() else zones_from_nodes(
                 state, space.breakpoints)[:2]
             if exact_ends and nodal:
-                # corrected in batches, each step with its own factors (kept by a
-                # snapshot); the roots of all at the end
-                batch.append((wanted[n], (step, state, displacement, memory_density,
-                                          solver.snapshot(), (nodal, pinned))))
-                if len(batch) == _KINK_BATCH:
-                    pending += _corrected(space, op, m, g, batch, accuracy)
-                    batch = []
+                # corrected at once, with this step's factors (a batch of steps held
+                # each one's: 440 MB for ten wavy contacts of 1700 nodes, and their cut
+                # parts are evaluated step by step anyway); the roots of all at the end
+                pending.append((wanted[n], kinks_corrected(space, op, m, g, [(
+                    step, state, displacement, memory_density, solver.snapshot(),
+                    (nodal, pinned))], accuracy)[0]))
             states[wanted[n]] = (state, step, memory_density, nodal, nodal)
-    if batch:
-        pending += _corrected(space, op, m, g, batch, accuracy)
     if pending:
         roots = corrected_roots(space, [c for _, c in pending], accuracy)
         for (k, c), ends in zip(pending, roots, strict=True):
@@ -201,18 +201,6 @@ def _step_state(base, op: np.ndarray, m: np.ndarray, g: np.ndarray, step: Step,
     state, count, settled = nodal_active_set(base, op, m, g, step, memory=displacement,
                                              start=start, solver=solver)
     return state, tried + count, settled
-
-
-#: Output times whose kink corrections are made together (one evaluation of F on their
-#: cut parts): each holds its step's LU factors meanwhile (~0.7 MB at 300 contact
-#: nodes), so the batch stays short.
-_KINK_BATCH = 10
-
-
-def _corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
-               batch: list[tuple[int, tuple]], accuracy: float) -> list[tuple[int, Any]]:
-    done = kinks_corrected(space, op, m, g, [row for _, row in batch], accuracy)
-    return [(k, c) for (k, _), c in zip(batch, done, strict=True)]
 
 
 def kink_correction(state: NodalState, corrected: Corrected) -> dict[str, Any]:

@@ -33,6 +33,8 @@ ZONE_END_TOL = 1e-6
 #: What a zone solve says it was doing when the solve's work bound stops it (the scene
 #: level then names the punch's shape: ``core.scene.pipeline``).
 LOCATING_ZONE_ENDS = "locating the ends of"
+#: The same, for the ends corrected at each time step of a march under creep.
+CORRECTING_ZONE_ENDS = "correcting the ends of"
 #: Quasi-Newton iterations on the zone ends per resolution level.
 MAX_END_ITERATIONS = 25
 #: The last quasi-Newton step on the ends is not made when it would move them by less

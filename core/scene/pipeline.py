@@ -102,14 +102,21 @@ def _costly_punches(scene: PunchesScene | Mapping[str, Any], exc: WorkLimitExcee
             "output times, a looser solver.tol, or solver.contact 'full' costs less")
 
 
+#: A solve stopped while it followed this many contact zones or more is said to be made
+#: costly by the punch's shape (a punch whose shape is not constant): loads alone give a
+#: flat or crowned punch one zone, a punch hollow in the middle two.
+MANY_ZONES = 3
+
+
 def _costly(scene: Scene, exc: WorkLimitExceeded) -> str:
     """The message of a solve stopped at its work bound, naming the field to change: the
-    punch's shape where the ends of many contact zones were being located (a wavy punch
-    touching at its crests: every zone's nodes in one dense system), else a load that
-    varies in time (the usual cause: lift-off under creep follows it step by step), else
-    the tolerance."""
-    if exc.doing.startswith(LOCATING_ZONE_ENDS) and getattr(scene.shape, "kind",
-                                                            None) != "constant":
+    punch's shape where the ends of contact zones were being located, or many zones
+    followed (a wavy punch touching at its crests: every zone's nodes in one dense
+    system, every zone's ends corrected at every output time), else a load that varies
+    in time (the usual cause: lift-off under creep follows it step by step), else the
+    tolerance."""
+    many = exc.doing.startswith(LOCATING_ZONE_ENDS) or exc.zones >= MANY_ZONES
+    if many and getattr(scene.shape, "kind", None) != "constant":
         return (f"punch.shape: {exc}; a shape that touches the coating in fewer places "
                 "(fewer waves or steps under the punch, a narrower punch), a looser "
                 "solver.tol, or solver.contact 'full' costs less")
