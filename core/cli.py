@@ -52,6 +52,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, NoReturn
 
+from core import limits
 from core.files import (
     atomic_write_bytes,
     atomic_write_text,
@@ -90,6 +91,7 @@ from core.scene import (
     verdict_words,
 )
 from core.version import VERSION
+from core.work import PER_CORE_BYTES, bound_memory
 
 EXIT_OK = 0
 EXIT_SOLVER_FAILED = 1
@@ -120,8 +122,32 @@ class _Parser(argparse.ArgumentParser):
         raise _InputError(f"{self.prog}: {message}")
 
 
-def _one_line(text: str) -> str:
+#: The address-space bound [bytes] this run set on itself (None: none, as when
+#: :func:`main` is called from Python).
+_MEMORY_BOUND: int | None = None
+
+
+def _one_line(text: str | BaseException) -> str:
+    """``text`` on one line; a ``MemoryError`` says which bound it met, and how to raise
+    it (numpy's own text names only the array it could not allocate)."""
+    if isinstance(text, MemoryError) and _MEMORY_BOUND is not None:
+        text = (f"needed more than the {_MEMORY_BOUND / 2**30:.3g} GiB of memory this run "
+                f"may take (--max-memory GIB raises it; the default "
+                f"{limits.MAX_RUN_MEMORY_BYTES / 2**30:g} GiB plus "
+                f"{PER_CORE_BYTES / 2**20:g} MiB per core, core.limits.MAX_RUN_MEMORY_BYTES)"
+                + (f": {text}" if str(text) else ""))
     return " ".join(str(text).split())
+
+
+def _gibibytes(text: str) -> float:
+    """The value of ``--max-memory`` [GiB]: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a number of GiB > 0, got {text!r}")
+    return value
 
 
 def _stdin_text() -> str:
@@ -747,7 +773,16 @@ def build_parser() -> argparse.ArgumentParser:
                                 metavar="{solve,validate,report,sweep,calibrate,check,schema}",
                                 parser_class=_Parser)
     sub.required = True
-    p_solve = sub.add_parser("solve", help="solve a scene and write the result")
+    # the commands that solve: the run bounds its own memory (core.limits)
+    memory = _Parser(add_help=False)
+    memory.add_argument("--max-memory", metavar="GIB", type=_gibibytes,
+                        default=limits.MAX_RUN_MEMORY_BYTES / 2**30,
+                        help="memory this run may take, as address space [GiB] (default "
+                             f"{limits.MAX_RUN_MEMORY_BYTES / 2**30:g}, plus "
+                             f"{PER_CORE_BYTES / 2**20:g} MiB per core); past it the run "
+                             "stops with a message")
+    p_solve = sub.add_parser("solve", help="solve a scene and write the result",
+                             parents=[memory])
     p_solve.add_argument("scene", help="scene file (JSON), '-' (standard input) or "
                                        "preset:NAME")
     p_solve.add_argument("--output", "-o", metavar="PATH",
@@ -771,7 +806,8 @@ def build_parser() -> argparse.ArgumentParser:
                                          "input) or preset:NAME")
     p_validate.set_defaults(run=_cmd_validate)
     p_report = sub.add_parser("report", help="solve a scene and write the printable report "
-                                             "(HTML or PDF)")
+                                             "(HTML or PDF)",
+                              parents=[memory])
     p_report.add_argument("scene", help="scene file (JSON), '-' (standard input) or "
                                         "preset:NAME")
     p_report.add_argument("--output", "-o", metavar="PATH", required=True,
@@ -798,7 +834,8 @@ def build_parser() -> argparse.ArgumentParser:
                           help="which files (default: scene)")
     p_schema.set_defaults(run=_cmd_schema)
     p_sweep = sub.add_parser("sweep", help="run a design study (format: 'Study files' in "
-                                           "the file formats) on Dask")
+                                           "the file formats) on Dask",
+                             parents=[memory])
     p_sweep.add_argument("study", help="study file (JSON) or preset:NAME")
     p_sweep.add_argument("--output", "-o", metavar="PATH", required=True,
                          help="result file: .nc (xarray dataset), .csv or .parquet (a row "
@@ -816,7 +853,8 @@ def build_parser() -> argparse.ArgumentParser:
     p_sweep.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     p_sweep.set_defaults(run=_cmd_sweep)
     p_cal = sub.add_parser("calibrate", help="fit scene fields to measured settlements and "
-                                             "tilts (back-analysis) and forecast them")
+                                             "tilts (back-analysis) and forecast them",
+                           parents=[memory])
     p_cal.add_argument("scene", help="scene file (JSON), '-' (standard input) or "
                                      "preset:NAME; its values start the fit")
     p_cal.add_argument("readings", help="readings file: CSV (time [day], settlement [m], "
@@ -846,7 +884,8 @@ def build_parser() -> argparse.ArgumentParser:
                             "near the noise)")
     p_cal.set_defaults(run=_cmd_calibrate)
     p_check = sub.add_parser("check", help="model error of the fast answer against a "
-                                           "resolved finite-element model of the coating")
+                                           "resolved finite-element model of the coating",
+                             parents=[memory])
     p_check.add_argument("scene", help="scene file (JSON) or preset:NAME")
     p_check.add_argument("--time", type=float, default=0.0, metavar="DAYS",
                          help="days after loading: base modulus and given loads (default 0)")
@@ -858,8 +897,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line with ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
+    global _MEMORY_BOUND
     try:
         args = build_parser().parse_args(argv)
+        if argv is None and getattr(args, "max_memory", None) is not None:
+            # run as a program: its own process (never a caller's Python session)
+            _MEMORY_BOUND = bound_memory(int(args.max_memory * 2**30))
         return int(args.run(args))
     except _InputError as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)

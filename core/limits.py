@@ -124,6 +124,13 @@ MAX_PRESSURE_VALUES = 4_000_000
 #: The slowest of 10,000 generated valid scenes took 0.7 s, the presets with 2000 output
 #: times at most 11 s; a creep lift-off driven by a sine tilt ran 600 s without it.
 MAX_SOLVE_CPU_SECONDS = 60.0
+#: The memory a run of the command line may take [bytes], as its address space (plus
+#: ``core.work.PER_CORE_BYTES`` per core; ``--max-memory`` changes it): a report with
+#: HoloViews, Bokeh and Matplotlib loaded maps 1.6 GiB (0.23 GiB resident), the costliest
+#: solve met (a punch touching at 200 crests under creep, stopped at its CPU bound) 1.7 GiB
+#: resident. The Python API leaves its caller's process unbounded: there the input limits
+#: and the CPU bound hold.
+MAX_RUN_MEMORY_BYTES = 4 * 2**30
 
 # ----------------------------------------------------------------------------- back-analysis
 

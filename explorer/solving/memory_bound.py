@@ -11,7 +11,7 @@ Nothing here imports Panel.
 
 from __future__ import annotations
 
-import os
+from core.work import address_space_bound
 
 #: The address space of a solver worker [bytes]: a worker that has written both reports
 #: (HoloViews, Bokeh and Matplotlib loaded) maps ~1.7 GiB with ~0.3 GiB resident, the FE
@@ -23,33 +23,6 @@ WORKER_MEMORY_BYTES = 4 * 1024**3
 #: preset (200 output times) peaked at 1.09 GiB mapped, 0.71 GiB resident; 100 points at
 #: 2000 output times at 1.14 GiB.
 STUDY_MEMORY_BYTES = 2 * 1024**3
-#: The address space each core of the machine adds to a bound [bytes]: the numerical
-#: libraries start a thread per core, and each maps its stack (8 MiB), a malloc arena
-#: (up to 64 MiB) and a BLAS buffer (~32 MiB) whether it uses them or not, so a fixed
-#: bound would refuse a worker's start on a machine with many cores.
-PER_CORE_BYTES = 128 * 1024**2
-
-
-def address_space_bound(work_bytes: int) -> int:
-    """The address-space bound [bytes] of a process whose work may take ``work_bytes``
-    [bytes] on this machine (:data:`PER_CORE_BYTES` added per core)."""
-    return work_bytes + (os.cpu_count() or 1) * PER_CORE_BYTES
-
-
-def bound_memory(work_bytes: int) -> int | None:
-    """Bound this process's address space to :func:`address_space_bound` of
-    ``work_bytes`` [bytes] (never above a bound set from outside); the bound [bytes], or
-    None where the system has no such bound (Windows)."""
-    try:
-        import resource
-    except ImportError:
-        return None
-    limit = address_space_bound(work_bytes)
-    _, hard = resource.getrlimit(resource.RLIMIT_AS)
-    if hard != resource.RLIM_INFINITY:
-        limit = min(limit, hard)
-    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
-    return limit
 
 
 def out_of_memory(what: str, work_bytes: int, advice: str) -> str:

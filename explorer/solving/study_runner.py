@@ -38,11 +38,12 @@ import param
 
 from core import set_stage_cache_budget
 from core.study import sweep
+from core.work import bound_memory
 
 from ..model import PlannedStudy, StudyResult
 from .background import BackgroundRun
 from .fair_share import SHARE, StudyShare, resume
-from .memory_bound import STUDY_MEMORY_BYTES, bound_memory, out_of_memory
+from .memory_bound import STUDY_MEMORY_BYTES, out_of_memory
 from .priority import lower_process_priority
 from .process_start import process_context
 

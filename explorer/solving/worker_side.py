@@ -23,13 +23,12 @@ from typing import TYPE_CHECKING, Any
 import core.report
 from core import release_freed_memory, set_stage_cache_budget, solve, stage_cache_bytes
 from core.scene import elastic_at_loading
-from core.work import cancellable
+from core.work import bound_memory, cancellable
 
 from ..model import FitOutcome, ResultView, prepare_view, run_fit
 from .memory_bound import (
     RELEASE_AFTER_S,
     WORKER_MEMORY_BYTES,
-    bound_memory,
     out_of_memory,
 )
 

@@ -18,15 +18,12 @@ from pathlib import Path
 
 import pytest
 
+from core.work import address_space_bound
 from explorer.model import ExplorerState, presets
 from explorer.model.study import Axis, plan_study
 from explorer.solving import StudyRun
 from explorer.solving.fair_share import CAN_PAUSE, StudyShare, process_state
-from explorer.solving.memory_bound import (
-    STUDY_MEMORY_BYTES,
-    WORKER_MEMORY_BYTES,
-    address_space_bound,
-)
+from explorer.solving.memory_bound import STUDY_MEMORY_BYTES, WORKER_MEMORY_BYTES
 from explorer.solving.priority import (
     BACKGROUND_NICENESS,
     PER_THREAD,
@@ -166,7 +163,8 @@ def test_a_study_process_is_bounded_in_memory() -> None:
     pytest.importorskip("resource")
     code = (
         "import resource\n"
-        "from explorer.solving.memory_bound import STUDY_MEMORY_BYTES, bound_memory\n"
+        "from core.work import bound_memory\n"
+        "from explorer.solving.memory_bound import STUDY_MEMORY_BYTES\n"
         "limit = bound_memory(STUDY_MEMORY_BYTES)\n"
         "assert limit == resource.getrlimit(resource.RLIMIT_AS)[0]\n"
         "try:\n"

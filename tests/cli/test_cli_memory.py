@@ -1,0 +1,54 @@
+"""A run of the command line bounds its own memory (core.limits.MAX_RUN_MEMORY_BYTES,
+``--max-memory``): a punch touching at 200 crests under creep took a run to 3.8 GiB
+before its CPU bound stopped it, where no memory bound was stated."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from core.cli import EXIT_BAD_INPUT, EXIT_SOLVER_FAILED
+from tests.cli_runs import run_cli
+from tests.conftest import scene_file
+
+
+def _wavy_lift_off(tmp_path: Path) -> Path:
+    """The lift-off preset under a 10 um wave of 10 mm: 34-51 contact zones under creep,
+    ~1 GiB resident at its peak (measured)."""
+    d = scene_file("eccentric_footing_liftoff")
+    d["punch"]["shape"] = {"kind": "sine", "mean": 0.0, "amplitude": 1e-5,
+                           "wavelength": 0.01, "phase": 0.0}
+    path = tmp_path / "wavy.json"
+    path.write_text(json.dumps(d))
+    return path
+
+
+def test_a_run_past_its_memory_bound_stops_saying_which_and_how_to_raise_it(
+        tmp_path: Path) -> None:
+    """Bounded to 0.3 GiB (0.55 GiB with two cores' share), the run stops within seconds
+    (measured 3.7 s) with one line naming the bound."""
+    done = run_cli("solve", _wavy_lift_off(tmp_path), "--max-memory", "0.3", "-o",
+                   tmp_path / "out.json", subprocess=True, timeout=120)
+    assert done.returncode == EXIT_SOLVER_FAILED, done.stderr
+    assert done.stderr.startswith("error: solve: needed more than the "), done.stderr
+    assert "of memory this run may take (--max-memory GIB raises it" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+    assert not (tmp_path / "out.json").exists()
+
+
+def test_the_bound_is_a_number_of_gibibytes() -> None:
+    for bad in ("0", "-1", "nan", "inf", "lots"):
+        done = run_cli("solve", "preset:uniform_flat", "--max-memory", bad)
+        assert done.returncode == EXIT_BAD_INPUT
+        assert "--max-memory: must be a number of GiB > 0" in done.stderr, done.stderr
+
+
+def test_a_run_called_from_python_leaves_its_caller_unbounded() -> None:
+    """``core.cli.main(argv)`` in a caller's process (a notebook, these tests) sets no
+    bound on that process: only a run as a program does."""
+    import resource
+
+    before = resource.getrlimit(resource.RLIMIT_AS)
+    done = run_cli("solve", "preset:uniform_flat", "--max-memory", "0.5")
+    assert done.returncode == 0, done.stderr
+    assert resource.getrlimit(resource.RLIMIT_AS) == before
