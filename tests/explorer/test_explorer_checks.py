@@ -333,7 +333,7 @@ def test_the_report_holds_inputs_plots_flags_accuracy_and_version(explorer_app):
                      "[^<]*: the check is only as good as that answer", text)
     assert "limit 100 kPa" in text
     assert "<h2>Inputs</h2>" in text and "<td>coating layer 1</td><td>h = 200 mm, E = " in text
-    assert "<td>contact at t = 365 d</td>" in text  # the time on screen: the last
+    assert "<td>contact at t = 365 days</td>" in text  # the time on screen: the last
     assert "&quot;allowable_pressure&quot;: 100000.0" in text  # the scene file, with it
     assert "solver settings</td><td>tol 1e-06, model_tol 0.02, contact auto" in text
     # the command line's report of the saved scene says the same, row by row

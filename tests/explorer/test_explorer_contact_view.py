@@ -178,14 +178,14 @@ def test_the_report_carries_the_contact_zone_and_its_history(explorer_app) -> No
     text = asyncio.run(app.files_tab._report_file()).getvalue()
     said = contact_text(app.screen.shown(), 0)
     assert said.startswith("contact 1.306 m of 2 m (65 %), lifted 0.694 m")
-    assert f"<td>contact at t = 0 d</td><td>{said}</td>" in text  # the readout's words
+    assert f"<td>contact at t = 0 days</td><td>{said}</td>" in text  # the readout's words
     assert "<td>lift-off</td><td>at 20 of 20 output times" in text
     assert "contact width and lifted length (2a = 2 m)" in text  # the plot's title
     app.screen.time_index = 11  # 46.42 d of the preset's log-spaced times
     text = asyncio.run(app.files_tab._report_file()).getvalue()
     said = contact_text(app.screen.shown(), 11)
     assert said.startswith("contact 1.339 m of 2 m (67 %)")  # the zone grows with creep
-    assert f"<td>contact at t = 46.42 d</td><td>{said}</td>" in text
+    assert f"<td>contact at t = 46.42 days</td><td>{said}</td>" in text
     flat = explorer_app("uniform_flat", solved=True)
     text = asyncio.run(flat.files_tab._report_file()).getvalue()
     assert "full contact: the whole width 2a = 2 m touches" in text

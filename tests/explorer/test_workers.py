@@ -109,7 +109,7 @@ def test_downloads_from_a_worker_hold_the_numbers_on_screen(processes, monkeypat
     # Check tab's limits (mm here), describing the time on screen
     report = session.download(view, "report_html", DesignLimits(settlement_limit=1e-3),
                               float(view.times[0]))
-    assert report.startswith("<!DOCTYPE html>") and "<td>contact at t = 0 d</td>" in report
+    assert report.startswith("<!DOCTYPE html>") and "<td>contact at t = 0 days</td>" in report
     assert "A limit is exceeded." in report and "; limit 0.001 mm, utilisation" in report
     assert session.download(view, "report_pdf").startswith(b"%PDF-")
 

@@ -106,7 +106,7 @@ def test_the_contact_at_a_chosen_time_and_when_the_punch_lifts_off(checked):
     # the preset's description: at e = 0.6 m only 1.31 m of the 2 m carry the load
     assert results["contact at t = 0 days"] == ("contact 1.306 m of 2 m (65 %), lifted 0.694 m: "
                                              "x = -1 to -0.306 m (unilateral contact)")
-    assert results["lift-off"].startswith("at 20 of 20 output times, first at t = 0 d")
+    assert results["lift-off"].startswith("at 20 of 20 output times, first at t = 0 days")
     # the nearest output time: 46.42 d for 50 d (log spacing to 1000 d)
     assert "contact at t = 46.42 days" in rows(checked, "Results", time=50)
     assert "contact at t = 1000 days (2.7 years)" in rows(checked, "Results")  # the last by default
