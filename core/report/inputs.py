@@ -90,7 +90,8 @@ def _times_text(scene: Scene, spec: Any) -> str:
     text = (f"{len(times)} output times, {number_text(times[0])} to "
             f"{days_text(times[-1])} after loading")
     if isinstance(spec, dict):
-        return text + f" ({spec.get('spacing', 'linear')} spacing)"
+        start = f" from {days_text(spec['start'])}" if spec.get("start") else ""
+        return text + f" ({spec.get('spacing', 'linear')} spacing{start})"
     return text + (" (listed)" if isinstance(spec, list) else "")
 
 

@@ -266,7 +266,7 @@ def _times() -> dict[str, Any]:
     rules = FIELDS["times"]
     most = next(r.high for r in rules if r.name == "count")
     return {"type": ["object", "array"],
-            "description": "Output times after loading [day]: {end, count, spacing} or a "
+            "description": "Output times after loading [day]: {end, count, spacing, start} or a "
                            "list of increasing days after loading (the first >= 0, the "
                            "last > 0).",
             "required": [r.name for r in rules if r.required],

@@ -182,8 +182,11 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
               low_open=True, high=MAX_DAYS),
         _rule("count", "integer", "-", "Number of output times.", low=1, high=MAX_TIMES),
         _rule("spacing", "choice", "-", "linear: equally spaced from 0; log: 0, then "
-              "geometrically spaced over the last three decades.", required=False,
+              "geometrically spaced from start to end.", required=False,
               choices=("linear", "log"), default="linear"),
+        _rule("start", "number", "day", "First output time after 0 with log spacing "
+              "(default end / 1000: the last three decades).", required=False, low=0.0,
+              low_open=True, high=MAX_DAYS),
     ),
     "solver": (
         _rule("tol", "number", "-", "Relative tolerance of the solver (default 1e-6; with "
@@ -402,7 +405,7 @@ def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
     if isinstance(spec, np.ndarray) and spec.ndim == 1:
         spec = spec.tolist()  # as the profiles' tables take them
     if isinstance(spec, Mapping):
-        check_fields(spec, path, ("end", "count"), ("spacing",))
+        check_fields(spec, path, ("end", "count"), ("spacing", "start"))
         end = positive_number(spec["end"], f"{path}.end")
         check_last_time(end, f"{path}.end")
         count = integer_in_range(spec["count"], f"{path}.count", 1, MAX_TIMES)
@@ -410,20 +413,34 @@ def _times(spec: Any, path: str) -> tuple[np.ndarray, Any]:
         if spacing not in ("linear", "log"):
             raise ValueError(f"{path}.spacing: must be 'linear' or 'log', "
                              f"got {show_value(spacing)}")
+        start = None
+        if spec.get("start") is not None:
+            start = positive_number(spec["start"], f"{path}.start")
+            if spacing != "log":
+                raise ValueError(f"{path}.start: sets the first time of log spacing only "
+                                 f"(spacing is {show_value(spacing)}); remove it, or set "
+                                 f"{path}.spacing 'log'")
+            if not start < end:
+                raise ValueError(f"{path}.start: must be < {path}.end ({end:g} days), got "
+                                 f"{show_value(spec['start'])}")
         if count == 1:
             times = np.array([end])
         elif spacing == "linear":
             times = np.linspace(0.0, end, count)
         else:
-            # the instant of loading, then count - 1 times geometrically spaced over the
-            # last three decades before ``end`` (creep is fastest just after loading)
-            first = end * 1e-3
+            # the instant of loading, then count - 1 times geometrically spaced from start
+            # (default: over the last three decades before ``end``; creep is fastest just
+            # after loading, and over 50 years those begin at 18 days)
+            first = end * 1e-3 if start is None else start
             if not first > 0.0:
                 raise ValueError(f"{path}.end: too small for log-spaced times (a thousandth "
                                  f"of it is 0 in double precision), got {show_value(end)}")
             times = np.concatenate([[0.0], np.geomspace(first, end, count - 1)])
         times[-1] = end
-        return times, {"end": end, "count": count, "spacing": spacing}
+        canonical = {"end": end, "count": count, "spacing": spacing}
+        if start is not None:
+            canonical["start"] = start
+        return times, canonical
     if isinstance(spec, (list, tuple)):
         if not 1 <= len(spec) <= MAX_TIMES:
             raise ValueError(f"{path}: must list 1 to {MAX_TIMES} times, got {len(spec)}")

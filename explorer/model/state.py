@@ -70,6 +70,10 @@ class ExplorerState(param.Parameterized):
                                doc="Number of output times.")
     time_spacing = param.Selector(default="linear", objects=["linear", "log"],
                                   doc="Spacing of the output times.")
+    time_start = param.Number(default=None, allow_None=True, bounds=(0.0, None),
+                              inclusive_bounds=(False, True),
+                              doc="First output time after 0 with log spacing [days after "
+                                  "loading] (None: a thousandth of the time span).")
     time_list = param.List(default=None, allow_None=True, item_type=(int, float),
                            doc="Explicit output times [days] from a file; cleared by any "
                                "change of the time span, count or spacing.")
@@ -116,10 +120,12 @@ class ExplorerState(param.Parameterized):
             names = [n for n in obj.param if n != "name"]
             obj.param.watch(self._on_change, names)
         self.param.watch(self._on_change, ["scene_name", "description", "n_layers",
-                                           "time_end", "time_count", "time_spacing", "tol",
+                                           "time_end", "time_count", "time_spacing",
+                                           "time_start", "tol",
                                            "time_list", "contact", "model_tol_percent",
                                            "n_punches"])
-        self.param.watch(self._on_times, ["time_end", "time_count", "time_spacing"])
+        self.param.watch(self._on_times, ["time_end", "time_count", "time_spacing",
+                                          "time_start"])
 
     # -- the accuracy a creep law allows ----------------------------------------------
     def _on_creep_law(self, *events: param.parameterized.Event) -> None:
@@ -238,7 +244,9 @@ class ExplorerState(param.Parameterized):
             **({} if several else {"loading": self.loading.to_dict()}),
             "times": (list(self.time_list) if self.time_list is not None else
                       {"end": self.time_end, "count": self.time_count,
-                       "spacing": self.time_spacing}),
+                       "spacing": self.time_spacing,
+                       **({"start": self.time_start} if self.time_spacing == "log"
+                          and self.time_start is not None else {})}),
             "solver": self._solver_dict(),
         }
         for key, value in self._extra.items():
@@ -322,6 +330,7 @@ class ExplorerState(param.Parameterized):
             time_end=times.get("end", self.time_end),
             time_count=times.get("count", self.time_count),
             time_spacing=times.get("spacing", self.time_spacing),
+            time_start=times.get("start"),
             tol=tol,
             contact=solver.get("contact", DEFAULT_CONTACT),
             model_tol_percent=100.0 * float(solver.get("model_tol", DEFAULT_MODEL_TOL)),

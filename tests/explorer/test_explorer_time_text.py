@@ -45,3 +45,16 @@ def test_a_fifty_year_history_reads_in_days_and_years(explorer_app) -> None:
     app.figures.set_presentation(False)
     assert app.figures.q_fig.title.text == "Pressure q(x), t = 18260 days (50.0 years)"
     assert "e+" not in app.figures.contact.zone_label.text
+
+
+def test_the_first_log_time_is_set_on_the_time_tab_and_kept_in_the_scene(explorer_app) -> None:
+    """The young-concrete preset starts its log spacing at 0.1 day (its default, the last
+    three decades of 50 years, began at 18 days); the box shows only with log spacing."""
+    app = explorer_app("young_concrete_50_years", solved=True)
+    assert app.screen.shown().times[1] == 0.1
+    box = app.times_tab.time_start
+    assert box.visible and box.value == 0.1
+    box.value = 1.0
+    assert app.state.time_start == 1.0 and app.state.to_dict()["times"]["start"] == 1.0
+    app.state.time_spacing = "linear"
+    assert not box.visible and "start" not in app.state.to_dict()["times"]

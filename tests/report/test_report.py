@@ -248,6 +248,8 @@ def test_long_times_read_without_an_exponent_and_in_years():
     assert result.times[-1] > 1e4  # 50 years of days
     text = "".join(f"{label} {value}" for s in sections(result) for label, value in s.rows)
     assert "e+04" not in text and "t = 18260 days (50.0 years)" in text
+    assert ("200 output times, 0 to 18260 days (50.0 years) after loading (log spacing "
+            "from 0.1 days)") in text
     assert " d," not in text and not text.rstrip().endswith(" d")
 
 

@@ -302,3 +302,24 @@ def test_a_scene_copies_and_goes_to_another_process() -> None:
     scene = load_scene("preset:eccentric_creep")
     with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
         assert pool.submit(_settlement_of, scene).result() == solve(scene).settlement.tolist()
+
+
+def test_log_spacing_may_start_where_the_creep_does() -> None:
+    """Log spacing spanned the last three decades only: over 50 years its first time after
+    loading was 18 days, and a young concrete's settlement grew from 0.030 mm (0.1 day) to
+    0.048 mm before it, undrawn. ``times.start`` sets that first time."""
+    scene = scene_from_dict(edited("times", {"end": 18262.5, "count": 5, "spacing": "log",
+                                             "start": 0.1}))
+    np.testing.assert_allclose(scene.times, [0.0, 0.1, 5.6735307, 321.88951, 18262.5],
+                               rtol=1e-7)
+    assert scene_from_dict(edited("times", {"end": 1000.0, "count": 3, "spacing": "log"})
+                           ).times[1] == 1.0  # the default: a thousandth of the end
+    for times, message in (
+            ({"end": 100.0, "count": 5, "start": 1.0},
+             r"^times\.start: sets the first time of log spacing only"),
+            ({"end": 100.0, "count": 5, "spacing": "log", "start": 100.0},
+             r"^times\.start: must be < times\.end \(100 days\), got 100"),
+            ({"end": 100.0, "count": 5, "spacing": "log", "start": -1.0},
+             r"^times\.start: must be > 0")):
+        with pytest.raises(ValueError, match=message):
+            scene_from_dict(edited("times", times))
