@@ -105,10 +105,6 @@ def days_text(t: float, digits: int = 4) -> str:
     return text
 
 
-def _number(value: float) -> str:
-    return f"{value:.4g}" if math.isfinite(value) else str(value)
-
-
 def known_contact_width(result: SceneSolution) -> np.ndarray | None:
     """:attr:`SceneSolution.contact_width` [m] at every output time (None if the answer
     has no contact set)."""
@@ -129,7 +125,7 @@ def lifts_off_at(result: SceneSolution, k: int = -1) -> bool:
 
 def zones_text(result: SceneSolution, k: int = -1) -> str:
     """The contact zones at ``times[k]`` as ``[lo, hi]`` in metres."""
-    return ", ".join(f"[{_number(lo)}, {_number(hi)}]" for lo, hi in result.contact_set[k])
+    return ", ".join(f"[{number_text(lo)}, {number_text(hi)}]" for lo, hi in result.contact_set[k])
 
 
 def engine_text(result: SceneSolution) -> str:
@@ -160,22 +156,22 @@ def headline(result: SceneSolution) -> str:
     """The scene's name, its statement and its output times."""
     scene, times = result.scene, result.times
     given = ", ".join(sorted(scene.given))
-    span = (f"{_number(times[0])} to {_number(times[-1])}" if len(times) > 1
-            else _number(times[0]))
+    span = (f"{number_text(times[0])} to {days_text(times[-1])}" if len(times) > 1
+            else days_text(times[0]))
     return (f"'{scene.name}': statement {scene.statement} ({given} given), {len(times)} "
-            f"output time{'s' * (len(times) != 1)}, {span} days after loading")
+            f"output time{'s' * (len(times) != 1)}, {span} after loading")
 
 
 def key_figures(result: SceneSolution) -> list[tuple[str, str]]:
     """The figures at the last output time as ``(name, value with unit)``."""
-    rows = [(name, f"{_number(float(getattr(result, name)[-1]) * factor)} {unit}")
+    rows = [(name, f"{number_text(float(getattr(result, name)[-1]) * factor)} {unit}")
             for name, factor, unit in SHOWN]
     q_max = float(np.max(result.pressure_on_grid[:, -1]))
-    rows.append(("max pressure", f"{_number(q_max * 1e-6)} MPa"))
+    rows.append(("max pressure", f"{number_text(q_max * 1e-6)} MPa"))
     if lifts_off_at(result):
         width = float(result.contact_width[-1])
-        rows.append(("contact width", f"{_number(width)} m of 2a = "
-                     f"{_number(2 * result.scene.half_width)} m (lift-off; contact on "
+        rows.append(("contact width", f"{number_text(width)} m of 2a = "
+                     f"{number_text(2 * result.scene.half_width)} m (lift-off; contact on "
                      f"{zones_text(result)} m)"))
     return rows
 
@@ -186,7 +182,7 @@ def text_summary(result: SceneSolution) -> str:
     at_last = ", ".join(f"{name} {value}" for name, value in figures
                         if name != "contact width")
     lines = [f"SceneSolution {headline(result)}",
-             f"  at t = {_number(result.times[-1])} days: {at_last}"]
+             f"  at t = {days_text(result.times[-1])}: {at_last}"]
     lines += [f"  {name} {value}" for name, value in figures if name == "contact width"]
     lines.append(f"  estimated error: {error_text(result)}")
     lines.append("  flags: " + (", ".join(result.flags) or "none"))
@@ -208,7 +204,7 @@ def html_summary(result: SceneSolution) -> str:
                 f'<td style="text-align:left">{value_html}</td></tr>')
 
     rows = [f'<tr><th colspan="2" style="text-align:left">at t = '
-            f"{e(_number(result.times[-1]))} days after loading</th></tr>"]
+            f"{e(days_text(result.times[-1]))} after loading</th></tr>"]
     rows += [row(name, e(value)) for name, value in key_figures(result)]
     rows.append(row("estimated error", e(error_text(result))))
     if result.flags:
