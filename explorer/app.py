@@ -41,7 +41,6 @@ from .model import (
     read_fit_query,
     read_study_query,
     read_view_query,
-    screen_limits,
     validated_scene,
 )
 from .plots import Figures
@@ -337,9 +336,7 @@ class ExplorerApp(pn.viewable.Viewer):
                 self.state.load_scene(chosen)
                 self.history.loaded = chosen
                 # a link's (or a given scene's) design limits, as a scene file's are taken
-                for name, value in screen_limits(chosen.get("limits")).items():
-                    if value is not None:
-                        setattr(self.limits, name, value)
+                self.limits.take(chosen.get("limits"))
             except ValueError as exc:
                 self.screen.notice = f"The scene could not be shown: {exc}"
         self.history.remember()
@@ -532,7 +529,7 @@ class ExplorerApp(pn.viewable.Viewer):
                 return False
             self.history.loaded = scene
             self.screen.notice = ""
-            self.check_tab.show_limits(scene.get("limits"))
+            self.limits.take(scene.get("limits"))
         return True
 
     def _load_file(self, scene: dict[str, Any]) -> bool:

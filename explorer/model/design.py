@@ -39,6 +39,12 @@ class DesignLimits(param.Parameterized):
     tilt_limit = param.Number(default=None, allow_None=True, bounds=(0, None),
                               doc="Largest tilt allowed, either way [mrad].")
 
+    def take(self, spec: Mapping[str, Any] | None) -> None:
+        """Take a scene file's (or a link's) ``limits`` (Pa, m, rad), when it has some:
+        all three, one it leaves out not checked; a scene without limits leaves these."""
+        if spec:
+            self.param.update(**screen_limits(spec))
+
 
 @dataclass
 class Check:

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from typing import Any
 
 import panel as pn
 
-from ..model import DesignLimits, ExplorerState, Screen, screen_limits
+from ..model import DesignLimits, ExplorerState, Screen
 from .punches import OnePunchOnly
 from .style import TAB_COLUMN, html_pane
 from .widgets import NumberBox, next_tick
@@ -38,14 +37,6 @@ class CheckView:
         self.eccentricity.param.watch(self._on_eccentricity, "value")
         self.show_eccentricity()
 
-    def show_limits(self, spec: Mapping[str, Any] | None) -> None:
-        """Fill the limits from a scene file's ``limits`` (Pa, m, rad), when it has some;
-        a scene without limits leaves those typed here."""
-        if not spec:
-            return
-        for name, value in screen_limits(spec).items():
-            getattr(self, name).value = value
-
     def _limit(self, label: str, name: str, css: str) -> NumberBox:
         # no lower bound on the box: the page would clamp -5 to 0 unsaid, a limit that
         # every answer fails; a negative value is refused here, saying so
@@ -53,6 +44,8 @@ class CheckView:
         box = NumberBox(label=label, value=getattr(self.limits, name),
                         sizing_mode="stretch_width", css_classes=[css])
         box.param.watch(lambda e: self._on_limit(box, label, name, e), "value")
+        # the limits a loaded scene brings (DesignLimits.take), shown
+        self.limits.param.watch(lambda e: setattr(box, "value", e.new), name)
         return box
 
     def _on_limit(self, box: NumberBox, label: str, name: str, event: Any) -> None:
