@@ -18,6 +18,7 @@ cheaper: the step count falls about as ``amplitude^(1/6)``, so a full-amplitude 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -88,3 +89,31 @@ def check_step_limit(loads: Mapping[str, Profile], lo: float, hi: float, tol: fl
             f"{cause} need at least {steps:.3g} time steps at tol {tol:g}, more than "
             f"{what} of {max_steps}; use a slower or smoother load, fewer jumps, a "
             "shorter time range or a larger solver.tol")
+
+
+#: Output times per period of an oscillating load below which its histories are
+#: flagged: eight draw a sine recognisably and read its peaks within 1 - cos(pi/8) = 8 %
+#: of its amplitude; at two (Nyquist's bound) a sine sampled at its zeros reads flat.
+SAMPLES_PER_PERIOD = 8
+
+
+def undersampled_loads(loads: Mapping[str, Profile], times: np.ndarray) -> list[str]:
+    """The fields of ``loads`` (field paths to histories in days) that oscillate faster
+    than the output ``times`` [day] sample them: a period (a sine's wavelength, a
+    formula's mean period over the times) under :data:`SAMPLES_PER_PERIOD` times the
+    widest spacing of the times.
+
+    The answer is right at every output time (the time stepping follows the load), but
+    drawn through them such a history is aliased, and the largest values read there (the
+    design check's) can miss the load's peaks between them."""
+    times = np.asarray(times, dtype=float)
+    if times.size < 2:
+        return []
+    widest = float(np.max(np.diff(times)))
+    out = []
+    for field, profile in loads.items():
+        periods = oscillations(profile, float(times[0]), float(times[-1]))
+        period = (float(times[-1]) - float(times[0])) / periods if periods > 0 else math.inf
+        if widest * SAMPLES_PER_PERIOD > period:
+            out.append(field)
+    return out

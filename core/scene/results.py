@@ -35,7 +35,7 @@ from core.scene.display import (
 )
 from core.scene.display import to_dataframe as _to_dataframe
 from core.scene.display import to_xarray as _to_xarray
-from core.scene.load_rates import oscillations
+from core.scene.load_rates import oscillations, undersampled_loads
 from core.scene.model import Scene
 from core.scene.records import PROGRAM, csv_header
 from core.scene.schema import SCHEMA_VERSION, _jsonable
@@ -97,6 +97,13 @@ FLAG_MESSAGES: dict[str, str] = {
                         "see info.message.",
     "contact_set_unverified": "The unilateral contact set failed its final check (q < 0 "
                               "on it, or the surfaces overlap off it): see info.message.",
+    "undersampled_load": "A given load oscillates faster than the output times sample it "
+                         "(fewer than 8 of them per period at their widest spacing; "
+                         "info.undersampled_loads names it): the answer is right at each "
+                         "output time, but its "
+                         "histories drawn through them are aliased, and the largest values "
+                         "read there (the design check's) can miss the peaks between them. "
+                         "Ask for more output times (times.count) or a shorter span.",
 }
 
 UNITS: dict[str, str] = {
@@ -255,6 +262,8 @@ class SceneSolution:
         self.model_error = dict(layered) if layered else scene_model_error(
             scene, tilt_share(a, self.settlement, self.tilt),
             narrowest_zone(self.contact_set, a))
+        self._undersampled = undersampled_loads(
+            {f"loading.{q}": profile for q, profile in scene.loading.items()}, self.times)
         self.flags = self._flags(solution)
         self.flag_messages = {
             name: FLAG_MESSAGES.get(name, f"{name}: {solution.info.get('message', '')}")
@@ -267,6 +276,8 @@ class SceneSolution:
         if corners is not None:
             self.info["corner_pressure"] = corners
         self.info["model_error"] = dict(self.model_error)
+        if self._undersampled:
+            self.info["undersampled_loads"] = list(self._undersampled)
         self.info["dimensional"] = self._extras()
 
     def _flags(self, solution: ContactSolution) -> list[str]:
@@ -294,6 +305,8 @@ class SceneSolution:
             flags.append("large_settlement")
         if largest_tilt > LARGE_TILT:
             flags.append("large_tilt")
+        if self._undersampled:
+            flags.append("undersampled_load")
         return list(dict.fromkeys(flags))
 
     def _extras(self) -> dict[str, Any]:

@@ -50,7 +50,9 @@ BADGES: dict[str, dict[str, tuple[str, str]]] = {
                  "no_contact": ("no contact at some times: the punch is clear of the surface",
                                 "")},
     "history": {"large_settlement": ("settlement beyond small strains", "small strains"),
-                "large_tilt": ("large tilt", "small tilt")},
+                "large_tilt": ("large tilt", "small tilt"),
+                "undersampled_load": ("load faster than the output times: histories "
+                                      "aliased (Time tab: more output times)", "")},
     "status": {"tol_not_met": ("tolerance not met", ""),
                "unresolved_input": ("input finer than the quadrature", "")},
 }
