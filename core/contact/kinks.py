@@ -210,18 +210,26 @@ def kinks_corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
         return [Corrected(row[5], [], row[1].panels, row[9], row[1].q, np.zeros(0), None,
                           row[1].settlement, row[1].tilt, row[0]) for row in prepared]
     panels = prepared[0][1].panels
-    for step, state, memory, memory_density, solver, ends, free, idx, parts, cut, \
-            values in prepared:
+    bounds = np.cumsum([0] + [c.nodes.size for c in cuts])
+    # few steps and parts (the lift-off preset: ~100k entries): every node against every
+    # step's cut parts in one call, each step reading its own columns (a call costs
+    # ~0.6 ms of overhead); many (a wavy punch, 50 zones: 430 MB for a 1/20 share read):
+    # each step's own parts at its own contact nodes
+    joint = (_part_rows(space.lam, Panels.side_by_side(cuts), panels.nodes,
+                        accuracy=accuracy)
+             if panels.size * int(bounds[-1]) <= BATCH_ENTRIES else None)
+    for k, (step, state, memory, memory_density, solver, ends, free, idx, parts, cut,
+            values) in enumerate(prepared):
         if not free:
             out.append(Corrected(ends, [], panels, cut, state.q, np.zeros(0), None,
                                  state.settlement, state.tilt, step))
             continue
         x, w = panels.nodes, panels.weights
-        # F of this step's own cut parts at its own contact nodes only: every node against
-        # every step's cut parts at once computed the steps' count times the rows kept
-        # (a wavy punch with 50 zones at 20 output times: 430 MB for a 1/20 share read)
-        cut_rows = (_part_rows(space.lam, cut, x[idx], accuracy=accuracy) if cut.n_panels
-                    else np.zeros((idx.size, 0)))
+        if joint is not None:
+            cut_rows = joint[np.ix_(idx, np.arange(bounds[k], bounds[k + 1]))]
+        else:
+            cut_rows = (_part_rows(space.lam, cut, x[idx], accuracy=accuracy)
+                        if cut.n_panels else np.zeros((idx.size, 0)))
         defect, d_force, d_moment = _defect(step, state, op, cut, values, parts, idx,
                                             cut_rows)
         if solver is None:
@@ -282,6 +290,15 @@ def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL
     owners = np.unique(owner)
     zones = max(len(c.ends) for c in steps) // 2
     doing = f"{CORRECTING_ZONE_ENDS} {zones} contact zone(s) under creep"
+    # few ends and parts: all in one call per evaluation, the other steps' columns
+    # masked off (a call per step cost the lift-off preset 18 of its 26 ms of roots)
+    cutting = [int(s) for s in owners if steps[int(s)].cut.n_panels]
+    columns = sum(steps[s].cut.size for s in cutting)
+    batched = None
+    if cutting and 2 * owner.size * columns <= BATCH_ENTRIES:
+        batched = (Panels.side_by_side([steps[s].cut for s in cutting]),
+                   np.concatenate([np.full(steps[s].cut.size, s) for s in cutting]),
+                   np.concatenate([steps[s].cut_density for s in cutting]))
 
     def nystrom(t: np.ndarray, rep: int) -> np.ndarray:
         check_work(doing, zones)
@@ -294,12 +311,18 @@ def corrected_roots(space: Space, steps: list[Corrected], accuracy: float = FULL
         # end against every step's parts, then masked, was the steps' count times the
         # work and memory: 1.8 GB and 26 s of one call for a wavy punch's 1288 ends)
         of = np.tile(owner, rep)
-        for s in owners:
-            cut = steps[s].cut
-            if cut.n_panels:
-                at = of == s
-                fq[at] += _part_rows(space.lam, cut, t[at], accuracy=accuracy) \
-                    @ steps[s].cut_density
+        if batched is not None:
+            joined, column_owner, joined_density = batched
+            rows = _part_rows(space.lam, joined, t, accuracy=accuracy)
+            rows[column_owner[None, :] != of[:, None]] = 0.0
+            fq += rows @ joined_density
+        else:
+            for s in owners:
+                cut = steps[s].cut
+                if cut.n_panels:
+                    at = of == s
+                    fq[at] += _part_rows(space.lam, cut, t[at], accuracy=accuracy) \
+                        @ steps[s].cut_density
         e = 0.0 if memory is None else np.einsum("rij,ij->ri", blocks, memory).ravel()
         if coupled:
             e = e + _couplings(steps, np.tile(owner, rep), t)
@@ -348,6 +371,10 @@ def _couplings(steps: list[Corrected], owner: np.ndarray, t: np.ndarray) -> np.n
     return out
 
 
+#: Entries (targets x cut-part columns) up to which the rows of F on the cut parts of
+#: several steps come from one call (8 MB): a call's overhead dominates below, the work
+#: discarded with the other steps' columns above.
+BATCH_ENTRIES = 2**20
 #: Secant steps on the Nystrom pressure at most (quadratic-like convergence from ~1e-4).
 _SECANT_STEPS = 6
 

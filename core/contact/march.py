@@ -29,12 +29,12 @@ from core.contact.active_set import (
     refused_load,
     zones_from_nodes,
 )
-from core.contact.kinks import Corrected, corrected_roots, kinks_corrected
+from core.contact.kinks import BATCH_ENTRIES, Corrected, corrected_roots, kinks_corrected
 from core.contact.memory import pressure_memory
 from core.contact.step import Space, Step, check_loads
 from core.contact.systems import Mirror, StepSolver
 from core.contact.zones import zone_kernel_accuracy
-from core.discretize import KernelOperator, Panels, kernel_operator
+from core.discretize import NODES_PER_PANEL, KernelOperator, Panels, kernel_operator
 from core.work import check_work
 
 #: The operators of the stepping's panel rules, keyed by lam and the panel edges (they
@@ -112,6 +112,8 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
               else None)
     solver = StepSolver(mirror)
     pending: list[tuple[int, Any]] = []
+    batch: list[tuple[int, tuple]] = []
+    columns = 0  # the batch's cut-part nodes, at most (two parts of a panel per end)
     sweeps = 0
     unsettled = 0
     # the zones at loading, as an earlier march found them, until this one has its own
@@ -148,13 +150,20 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
             nodal, pinned = ([], []) if not state.active.any() else zones_from_nodes(
                 state, space.breakpoints)[:2]
             if exact_ends and nodal:
-                # corrected at once, with this step's factors (a batch of steps held
-                # each one's: 440 MB for ten wavy contacts of 1700 nodes, and their cut
-                # parts are evaluated step by step anyway); the roots of all at the end
-                pending.append((wanted[n], kinks_corrected(space, op, m, g, [(
-                    step, state, displacement, memory_density, solver.snapshot(),
-                    (nodal, pinned))], accuracy)[0]))
+                # corrected in batches, each step with its own factors (kept by a
+                # snapshot), while the batch is small: its cut parts' rows come from one
+                # call (core.contact.kinks.BATCH_ENTRIES); many zones on many nodes are
+                # corrected at once (ten held steps of a wavy contact of 1700 nodes held
+                # 440 MB of factors); the roots of all at the end
+                batch.append((wanted[n], (step, state, displacement, memory_density,
+                                          solver.snapshot(), (nodal, pinned))))
+                columns += 2 * len(nodal) * NODES_PER_PANEL
+                if len(batch) == _KINK_BATCH or n_nodes * columns > BATCH_ENTRIES:
+                    pending += _corrected(space, op, m, g, batch, accuracy)
+                    batch, columns = [], 0
             states[wanted[n]] = (state, step, memory_density, nodal, nodal)
+    if batch:
+        pending += _corrected(space, op, m, g, batch, accuracy)
     if pending:
         roots = corrected_roots(space, [c for _, c in pending], accuracy)
         for (k, c), ends in zip(pending, roots, strict=True):
@@ -201,6 +210,18 @@ def _step_state(base, op: np.ndarray, m: np.ndarray, g: np.ndarray, step: Step,
     state, count, settled = nodal_active_set(base, op, m, g, step, memory=displacement,
                                              start=start, solver=solver)
     return state, tried + count, settled
+
+
+#: Output times whose kink corrections are made together at most (one evaluation of F on
+#: their cut parts while small): each holds its step's LU factors meanwhile (~0.7 MB at
+#: 300 contact nodes), so the batch stays short.
+_KINK_BATCH = 10
+
+
+def _corrected(space: Space, op: np.ndarray, m: np.ndarray, g: np.ndarray,
+               batch: list[tuple[int, tuple]], accuracy: float) -> list[tuple[int, Any]]:
+    done = kinks_corrected(space, op, m, g, [row for _, row in batch], accuracy)
+    return [(k, c) for (k, _), c in zip(batch, done, strict=True)]
 
 
 def kink_correction(state: NodalState, corrected: Corrected) -> dict[str, Any]:
