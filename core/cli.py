@@ -139,14 +139,22 @@ def _one_line(text: str | BaseException) -> str:
     return " ".join(str(text).split())
 
 
+#: The least ``--max-memory`` [GiB]: a run maps ~0.27 GiB before it solves (Python,
+#: numpy, scipy); a bound met while the BLAS library takes its work buffer left it
+#: retrying forever (0.001 GiB, spinning for 10 minutes), where a bound met by the
+#: solver's own arrays stops the run with a message.
+MIN_RUN_MEMORY_GIB = 0.5
+
+
 def _gibibytes(text: str) -> float:
-    """The value of ``--max-memory`` [GiB]: a finite number > 0."""
+    """The value of ``--max-memory`` [GiB]: a finite number >= :data:`MIN_RUN_MEMORY_GIB`."""
     try:
         value = float(text)
     except ValueError:
         value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"must be a number of GiB > 0, got {text!r}")
+    if not (math.isfinite(value) and value >= MIN_RUN_MEMORY_GIB):
+        raise argparse.ArgumentTypeError(f"must be a number of GiB >= {MIN_RUN_MEMORY_GIB:g}, "
+                                         f"got {text!r}")
     return value
 
 

@@ -30,8 +30,8 @@ def output_index(result: SceneSolution, time: float | None) -> int:
         raise ValueError(f"time: {time!r} is not a finite number of days after loading")
     # half a day of slack: a time typed to the day still finds the first or last output
     if not times[0] - 0.5 <= float(time) <= times[-1] + 0.5:
-        raise ValueError(f"time: {float(time):g} d is outside the output times, "
-                         f"{times[0]:g} to {times[-1]:g} d after loading")
+        raise ValueError(f"time: {float(time):g} days is outside the output times, "
+                         f"{times[0]:g} to {times[-1]:g} days after loading")
     return int(np.argmin(np.abs(times - float(time))))
 
 

@@ -209,7 +209,7 @@ def surface_overlay(result: PunchesSolution, time: float | None = None) -> Any:
             elements.append(hv.VSpan(punch.center + lo, punch.center + hi).opts(
                 color=LIFT_OFF_COLOUR, alpha=0.5, backend="bokeh"))
     elements += [hv.Curve((x, q / size), kdims=[x_dim], vdims=[q_dim],
-                          label=f"t = {number_text(float(result.times[j]))} d")
+                          label=f"t = {days_text(float(result.times[j]))}")
                  .opts(color=colours[i], tools=["hover"], backend="bokeh")
                  for i, (j, (x, q)) in enumerate(zip(picked, curves, strict=True))]
     return hv.Overlay(elements).opts(

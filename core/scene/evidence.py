@@ -16,7 +16,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from core.cache import fingerprint
-from core.scene.display import percent_text
+from core.scene.display import days_text, percent_text
 from core.scene.model import Scene
 from core.scene.results import FLAG_MESSAGES
 from core.scene.validate import scene_from_dict, solver_model_tol
@@ -88,7 +88,7 @@ def model_error_evidence(scene: Scene | Mapping[str, Any], estimate: float,
         time = float(check.get("time_day", 0.0))
         side = "above" if measured > tol else "within"
         message = (f"The coating model's error {MEASURED} (the resolved finite-element "
-                   f"model at t = {time:g} d) is {percent_text(measured)}, {side} "
+                   f"model at t = {days_text(time)}) is {percent_text(measured)}, {side} "
                    f"solver.model_tol {100 * tol:g} % (estimated: {percent_text(estimate)}).")
         return {"source": "measured", "label": MEASURED, "error": measured,
                 "estimate": estimate, "measured": measured, "time_day": time,

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.optional import import_optional
-from core.scene.display import lifts_off_at, number_text, zones_text
+from core.scene.display import days_text, lifts_off_at, zones_text
 
 if TYPE_CHECKING:
     import holoviews
@@ -79,7 +79,7 @@ def shown_times(times: np.ndarray, count: int = PLOT_CURVES,
 
 
 def _days(t: float) -> str:
-    return f"t = {number_text(t)} d"
+    return f"t = {days_text(t)}"
 
 
 def _lift_off_spans(hv: Any, result: SceneSolution) -> list[Any]:

@@ -55,6 +55,6 @@ def test_the_first_log_time_is_set_on_the_time_tab_and_kept_in_the_scene(explore
     box = app.times_tab.time_start
     assert box.visible and box.value == 0.1
     box.value = 1.0
-    assert app.state.time_start == 1.0 and app.state.to_dict()["times"]["start"] == 1.0
+    assert app.state.time_start == 1.0 and app.state.to_scene()["times"]["start"] == 1.0
     app.state.time_spacing = "linear"
-    assert not box.visible and "start" not in app.state.to_dict()["times"]
+    assert not box.visible and "start" not in app.state.to_scene()["times"]

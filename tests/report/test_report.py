@@ -111,7 +111,7 @@ def test_the_contact_at_a_chosen_time_and_when_the_punch_lifts_off(checked):
     assert "contact at t = 46.42 days" in rows(checked, "Results", time=50)
     assert "contact at t = 1000 days (2.7 years)" in rows(checked, "Results")  # the last by default
     assert output_index(checked, 1000.4) == 19
-    for bad, reason in ((-3.0, "outside the output times, 0 to 1000 d"),
+    for bad, reason in ((-3.0, "outside the output times, 0 to 1000 days"),
                         (2000.0, "outside the output times"), (float("nan"), "not a finite"),
                         ("7", "not a finite")):
         with pytest.raises(ValueError, match=f"^time: .*{reason}"):
@@ -147,7 +147,7 @@ def test_the_html_report_embeds_bokeh_plots_and_the_scene(checked):
     assert "&quot;allowable_pressure&quot;: 1500000.0" in text  # the scene file, escaped
     # the plot of the contact over time, and the chosen time among the q(x) curves
     assert "contact width and lifted length (2a = 2 m)" in text
-    assert '"t = 100 d"' in text and "<td>contact at t = 100 days</td>" in text
+    assert '"t = 100 days"' in text and "<td>contact at t = 100 days</td>" in text
     assert "<h2>Inputs</h2>" in text and "punch base f(x)" not in text  # a flat punch
 
 
@@ -232,7 +232,7 @@ def test_the_command_line_describes_the_contact_at_the_time_asked_for(tmp_path):
     assert "<td>contact at t = 0 days</td><td>contact 1.306 m of 2 m (65 %)" in path.read_text()
     late = run_cli("report", "preset:eccentric_footing_liftoff", "-o", path, "--time", "5000")
     assert late.returncode == 2
-    assert "--time: 5000 d is outside the output times, 0 to 1000 d" in late.stderr
+    assert "--time: 5000 days is outside the output times, 0 to 1000 days" in late.stderr
 
 
 def test_a_missing_plotting_package_is_named_with_its_extra(monkeypatch, checked):
@@ -264,7 +264,7 @@ def test_the_plots_legends_read_long_times_without_an_exponent():
     layout, _ = report_layout(result, 0.0)
     labels = [curve.label for curve in layout.traverse(lambda x: x, [hv.Curve])
               if curve.label.startswith("t = ")]
-    assert labels and "t = 18260 d" in labels
+    assert labels and "t = 18260 days (50.0 years)" in labels
     assert not any("e+" in label for label in labels), labels
 
 

@@ -16,7 +16,7 @@ import core
 from core.report import report_html, report_pdf, sections
 from core.report.content import key_numbers
 from core.report.punches import local_view
-from core.scene import PunchesSolution, number_text
+from core.scene import PunchesSolution, days_text
 from tests.support.punch_pairs import wide_and_narrow
 
 CREEP = {"model": "exponential", "modulus": 3.0e10, "compliance": 3.0e-11, "rate": 0.05}
@@ -112,7 +112,7 @@ def test_the_html_draws_the_surface_and_a_line_per_punch(pair: PunchesSolution) 
     assert "contact pressure q(x, t), 2 punches (zones shaded)" in text
     assert "<td>zone</td><td>x = 0.9 to 2.1 m (shaded in q(x))</td>" in text
     j = int(np.argmin(np.abs(pair.times - 30)))
-    assert f'"t = {number_text(pair.times[j])} d"' in text  # the chosen time
+    assert f'"t = {days_text(pair.times[j])}"' in text  # the chosen time
     # the plots' titles (Bokeh's JSON escapes the Greek letters)
     titles = set(re.findall(r'"text":"(\w+) [^"]*\(t\)"', text))
     assert titles == {"settlement", "tilt", "moment"}  # both forces are given constants

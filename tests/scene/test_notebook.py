@@ -72,6 +72,6 @@ def test_a_notebook_shows_the_result_its_dataset_and_its_plot(tmp_path: Path) ->
     assert shown_plot["data"]["text/plain"].startswith(":Layout")
     assert "application/vnd.holoviews_exec.v0+json" in shown_plot["data"]
     page = shown_plot["data"]["text/html"]
-    for text in ("contact pressure q(x, t)", "lift-off at t = 1000 d", "q (MPa)",
+    for text in ("contact pressure q(x, t)", "lift-off at t = 1000 days (2.7 years)", "q (MPa)",
                  "settlement (mm)", "tilt (mrad)"):
         assert text in page, text

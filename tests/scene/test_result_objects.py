@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import core
-from core.scene import FLAG_MESSAGES, SceneSolution, scene_from_dict, solve
+from core.scene import FLAG_MESSAGES, SceneSolution, days_text, scene_from_dict, solve
 from core.scene.files import scene_to_json
 from tests.conftest import base_scene, scene_file
 
@@ -196,7 +196,7 @@ def test_plot_is_a_layout_of_pressures_settlement_and_tilt(full: SceneSolution) 
     overlay, settlement, tilt = layout
     assert isinstance(overlay, hv.Overlay)
     curves = _curves(overlay)
-    assert [c.label for c in curves] == [f"t = {t:.4g} d" for t in full.times]
+    assert [c.label for c in curves] == [f"t = {days_text(t)}" for t in full.times]
     assert curves[0].kdims[0].unit == "m" and curves[0].vdims[0].unit == "kPa"
     # q below 1 MPa is drawn in kPa
     np.testing.assert_allclose(curves[-1].dimension_values("q"),
@@ -214,13 +214,13 @@ def test_plot_of_a_lift_off_shades_it_and_says_so(lift_off: SceneSolution) -> No
     layout = lift_off.plot(count=4)
     overlay = layout[0]
     assert len(_curves(overlay)) == 4
-    assert [c.label for c in _curves(overlay)][-1] == "t = 1000 d"
+    assert [c.label for c in _curves(overlay)][-1] == "t = 1000 days (2.7 years)"
     assert "MPa" == _curves(overlay)[0].vdims[0].unit
     spans = [e for e in overlay if isinstance(e, hv.VSpan)]
     lo = lift_off.contact_set[-1][0][0]
     assert [tuple(s.data) for s in spans] == [(-1.0, lo)]
     options = overlay.opts.get("plot", backend="bokeh").kwargs
-    assert "lift-off at t = 1000 d" in options["title"]
+    assert "lift-off at t = 1000 days (2.7 years)" in options["title"]
     # the overlay names its axes: the span's dimensions (x, y) must not
     assert (options["xlabel"], options["ylabel"]) == ("x (m)", "q (MPa)")
 
@@ -230,7 +230,7 @@ def test_plot_titles_carry_the_flags_and_render_with_bokeh(flagged: SceneSolutio
     from bokeh.models import Axis, Title
 
     layout = flagged.plot(times=[0.0, 100.0])
-    assert [c.label for c in _curves(layout[0])] == ["t = 0 d", "t = 100 d"]
+    assert [c.label for c in _curves(layout[0])] == ["t = 0 days", "t = 100 days"]
     assert layout.opts.get("plot", backend="bokeh").kwargs["title"] == \
         f"{ODD_NAME}: flags contact_lost"
     figure = hv.render(layout, backend="bokeh")
