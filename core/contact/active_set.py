@@ -174,6 +174,13 @@ def _root_between(f: Callable[[float], float], a: float, b: float, fa: float, fb
     return 0.5 * (a + b)
 
 
+def contact_runs(active: np.ndarray) -> int:
+    """The runs of contact nodes in the boolean ``active`` (the zones a march follows,
+    before their ends are found: what makes a march costly when they are many)."""
+    return int(active[0]) + int(np.count_nonzero(active[1:] & ~active[:-1])) \
+        if active.size else 0
+
+
 def zones_from_nodes(state: NodalState, breakpoints: Sequence[float] = ()
                      ) -> tuple[list[float], list[bool], list[float]]:
     """Zone ends from the nodal contact set: (ends, pinned flags, slopes of Q at the ends).

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from core.cache import fingerprint
-from core.contact.active_set import NoContact, NodalState, zones_from_nodes
+from core.contact.active_set import NoContact, NodalState, contact_runs, zones_from_nodes
 from core.contact.bands import band_rule, bands_from_ends, merge_bands
 from core.contact.coupled import (
     CoupledBase,
@@ -235,8 +235,10 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
     active = None
     solver = CoupledStepSolver()
     unsettled = 0
+    zones = 0  # the most runs of contact nodes under one punch, at the last step
     for n in range(steps):
-        check_work("following the contact zones of several punches under creep step by step")
+        check_work("following the contact zones of several punches under creep step by step",
+                   zones)
         memory_density = np.zeros(system.x.size)
         diag = 0.0
         if n > 0:
@@ -265,6 +267,7 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
                 zones.append(list(zip(ends[0::2], ends[1::2], strict=True)))
             first["zones"] = zones
         unsettled += not settled
+        zones = max(contact_runs(s.active) for s in states)
         active = np.concatenate([s.active for s in states])
         memory_of.record(n, np.concatenate([s.q for s in states]))
         if n in wanted:

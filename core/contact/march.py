@@ -25,6 +25,7 @@ from core.cache import StageCache, fingerprint
 from core.contact.active_set import (
     NoContact,
     NodalState,
+    contact_runs,
     nodal_active_set,
     refused_load,
     zones_from_nodes,
@@ -143,8 +144,7 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         sweeps += count
         unsettled += not settled
         active = state.active
-        # the runs of contact nodes: what makes a march costly when they are many
-        zones = int(active[0]) + int(np.count_nonzero(active[1:] & ~active[:-1]))
+        zones = contact_runs(active)
         memory_of.record(n, state.q)
         if n in wanted:
             nodal, pinned = ([], []) if not state.active.any() else zones_from_nodes(

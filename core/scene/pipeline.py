@@ -89,10 +89,19 @@ def solve(scene: Scene | PunchesScene | Mapping[str, Any] | str | os.PathLike
 
 
 def _costly_punches(scene: PunchesScene | Mapping[str, Any], exc: WorkLimitExceeded) -> str:
-    """:func:`_costly` for a scene of several punches: the first load that varies in
-    time, named ``punches[k].loading.<quantity>`` (else ``punches``)."""
+    """:func:`_costly` for a scene of several punches: the first shaped punch where many
+    zones were followed (``punches[k].shape``), else the first load that varies in time,
+    named ``punches[k].loading.<quantity>`` (else ``punches``)."""
+    subs = punches_from_dict(scene).scenes
+    if exc.zones >= MANY_ZONES:
+        shaped = [k for k, sub in enumerate(subs)
+                  if getattr(sub.shape, "kind", None) != "constant"]
+        if shaped:
+            return (f"punches[{shaped[0]}].shape: {exc}; a shape that touches the coating "
+                    "in fewer places (fewer waves or steps under the punch, a narrower "
+                    "punch), a looser solver.tol, or solver.contact 'full' costs less")
     field = "punches"
-    for k, sub in enumerate(punches_from_dict(scene).scenes):
+    for k, sub in enumerate(subs):
         varying = [q for q, profile in sub.loading.items()
                    if getattr(profile, "kind", None) != "constant"]
         if varying:

@@ -126,3 +126,16 @@ def test_lift_off_under_creep_at_many_crests_stops_naming_the_shape():
     message = str(refused.value)
     assert message.startswith("punch.shape: the solve was stopped after 3 s of CPU time")
     assert "contact zone" in message
+
+
+def test_several_punches_at_many_crests_stop_naming_the_shape() -> None:
+    """The same for two punches, one of them wavy: the message named
+    punches[0].loading... or punches, not the shape that made the zones."""
+    d = scene_file("new_footing_beside_old")
+    d["punches"][1]["shape"] = {"kind": "sine", "mean": 0.0, "amplitude": 1e-5,
+                                "wavelength": 0.01, "phase": 0.0}
+    d["solver"] = {**d.get("solver", {}), "contact": "unilateral"}
+    with work_bound(3.0), pytest.raises(ValueError) as refused:
+        solve(d)
+    assert str(refused.value).startswith(
+        "punches[1].shape: the solve was stopped after 3 s of CPU time"), refused.value
