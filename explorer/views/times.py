@@ -36,7 +36,7 @@ class TimesView:
         # where log spacing begins: over 50 years its default (the last three decades)
         # begins at 18 days, after most of a young concrete's early creep
         self.time_start = gb.add("time_start", NumberBox(
-            label="first time after loading [days] (empty: a thousandth of the span)",
+            label="first time after 0 [days] (empty: span / 1000)",
             start=0.0, step=1.0, sizing_mode="stretch_width", css_classes=["time-start"]))
         self.tol = gb.add("tol", pn.widgets.Select(
             label="accuracy target (relative)",
