@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import html
 from collections.abc import Callable
+from typing import Any
 
 import panel as pn
 
 from ..model import ExplorerState
 from .fidelity import FidelityView
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-from .widgets import Binding, EditableIntSlider, NumberBox, slider
+from .widgets import Binding, EditableIntSlider, NumberBox, next_tick, slider
 
 SPACINGS = {"linear": "linear", "log": "log"}
 
@@ -34,10 +35,14 @@ class TimesView:
         self.time_spacing = gb.add("time_spacing", pn.widgets.RadioButtonGroup(
             label="spacing", options=list(SPACINGS), sizing_mode="stretch_width"))
         # where log spacing begins: over 50 years its default (the last three decades)
-        # begins at 18 days, after most of a young concrete's early creep
-        self.time_start = gb.add("time_start", NumberBox(
-            label="first time after 0 [days] (empty: span / 1000)",
-            start=0.0, step=1.0, sizing_mode="stretch_width", css_classes=["time-start"]))
+        # begins at 18 days, after most of a young concrete's early creep. Not through
+        # the binding: an emptied box is a value here (the default), not a refusal
+        self._reject = reject
+        self.time_start = NumberBox(
+            label="first time after 0 [days] (empty: span / 1000)", value=s.time_start,
+            start=0.0, step=1.0, sizing_mode="stretch_width", css_classes=["time-start"])
+        self.time_start.param.watch(self._on_time_start, "value")
+        s.param.watch(self._show_time_start, "time_start")
         self.tol = gb.add("tol", pn.widgets.Select(
             label="accuracy target (relative)",
             options={f"{v:g}": v for v in s.param.tol.objects},
@@ -53,6 +58,25 @@ class TimesView:
         return pn.Column(self.time_end, self.time_count, self.time_spacing, self.time_start,
                          self.tol,
                          self.tol_note, self.fidelity.solver_panel, **TAB_COLUMN)
+
+    def _on_time_start(self, event: Any) -> None:
+        value = event.new
+        if value is not None and not value == value:  # an emptied box: the page sends NaN
+            value = None
+        if value == self.state.time_start:
+            return
+        try:
+            self.state.time_start = value
+        except ValueError:
+            self._reject(f"first time after 0: must be a number of days > 0 (leave it "
+                         f"empty: a thousandth of the span), got {value:g}; it stays "
+                         + ("empty" if self.state.time_start is None
+                            else f"{self.state.time_start:g}"))
+            next_tick(lambda: self._show_time_start())
+
+    def _show_time_start(self, *events: Any) -> None:
+        if self.time_start.value != self.state.time_start:
+            self.time_start.value = self.state.time_start
 
     def refresh(self) -> None:
         """Offer the tolerances the state allows; show the one set."""

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import copy
 
-import param
 import pytest
 
 from core.scene import days_text, number_text
@@ -50,14 +49,19 @@ def test_a_fifty_year_history_reads_in_days_and_years(explorer_app) -> None:
 
 def test_the_first_log_time_is_set_on_the_time_tab_and_kept_in_the_scene(explorer_app) -> None:
     """The young-concrete preset starts its log spacing at 0.1 day (its default, the last
-    three decades of 50 years, began at 18 days); the box shows only with log spacing."""
+    three decades of 50 years, began at 18 days); the box shows only with log spacing, an
+    emptied box is the default again, and a value <= 0 is refused saying so."""
     app = explorer_app("young_concrete_50_years", solved=True)
     assert app.screen.shown().times[1] == 0.1
     box = app.times_tab.time_start
     assert box.visible and box.value == 0.1
-    box.value = 1.0  # typed, then sent (a change waits for it where solves are slow)
-    with param.edit_constant(box):
-        box.value_throttled = 1.0
+    box.value = 1.0
     assert app.state.time_start == 1.0 and app.state.to_scene()["times"]["start"] == 1.0
+    box.value = -2.0
+    assert app.state.time_start == 1.0
+    assert "first time after 0: must be a number of days > 0" in app.screen.notice
+    box.value = None
+    assert app.state.time_start is None and "start" not in app.state.to_scene()["times"]
+    box.value = 0.5
     app.state.time_spacing = "linear"
     assert not box.visible and "start" not in app.state.to_scene()["times"]
