@@ -40,7 +40,8 @@ class TimesView:
         self._reject = reject
         self.time_start = NumberBox(
             label="first time after 0 [days] (empty: span / 1000)", value=s.time_start,
-            start=0.0, step=1.0, sizing_mode="stretch_width", css_classes=["time-start"])
+            # no lower bound on the box: the page would keep -1 on show unsent, unsaid
+            step=1.0, sizing_mode="stretch_width", css_classes=["time-start"])
         self.time_start.param.watch(self._on_time_start, "value")
         s.param.watch(self._show_time_start, "time_start")
         self.tol = gb.add("tol", pn.widgets.Select(

@@ -299,3 +299,42 @@ def test_the_code_creep_plot_title_fits_the_sidebar_at_1024px(
         assert page.errors == []
     finally:
         page.close()
+
+
+def _linked_times(page: Page) -> dict:
+    import urllib.parse
+
+    from explorer.model import decode_scene
+
+    query = urllib.parse.parse_qs(urllib.parse.urlparse(
+        page.page.evaluate("() => window.location.href")).query)
+    return decode_scene(query["scene"][0])["times"] if "scene" in query else {}
+
+
+def test_the_first_log_time_is_typed_emptied_and_refused_on_the_time_tab(
+        server: str, browser_context: object) -> None:
+    """The young-concrete preset's log spacing starts at 0.1 day (its last three decades
+    began at 18 days). Typed, the first time reaches the scene (and its link); emptied,
+    the default again; -1 is refused and the last good value comes back in the box."""
+    page = Page(browser_context, server, "/app?preset=young_concrete_50_years")
+    try:
+        page.open_tab("Time")
+        box = page.page.locator(".time-start input").first
+        box.wait_for(state="visible", timeout=30_000 * patience())
+        until(lambda: box.input_value() == "0.1", "the preset's first time in the box",
+              describe=box.input_value)
+        for typed, start in (("2", 2), ("-1", 2), ("", None)):
+            box.fill(typed)
+            box.press("Enter")
+            if typed == "-1":
+                until(lambda: "first time after 0: must be a number of days > 0" in
+                      page.pane_text(".notice"), "the refusal of -1",
+                      describe=lambda: page.pane_text(".notice"))
+                until(lambda: box.input_value() == "2", "the last good value back",
+                      describe=box.input_value)
+            until(lambda start=start: _linked_times(page).get("start") == start,
+                  f"the scene's first time {start} after {typed!r}",
+                  describe=lambda: _linked_times(page))
+        assert page.errors == []
+    finally:
+        page.close()
