@@ -50,6 +50,14 @@ class NoContact(ValueError):
         ``message`` in the solver's terms), naming :func:`refused_load` of ``given``."""
         return LoadNotCarried(message, refused_load(given), time, self.punch, self.reason)
 
+    def of_punches(self, time: float, givens: Sequence[Collection[str]],
+                   message: str) -> ValueError:
+        """This refusal among several punches (``givens``: each punch's given quantities):
+        :meth:`at` for the punch it names, else (no punch in contact) ``message`` alone."""
+        if self.punch is None:
+            return ValueError(message)
+        return self.at(time, givens[self.punch], message)
+
 
 def refused_load(given: Collection[str]) -> str:
     """The given load a refusal for no contact names: the force, else the moment, else

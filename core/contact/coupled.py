@@ -684,10 +684,8 @@ def solve_unilateral_punches(punches: Sequence[PunchGeometry], inputs: Sequence[
                 results[key] = _solve_one(base, steps, [r[0] for r in rules], op, nodal_res,
                                           res, tol)
             except NoContact as exc:
-                message = f"{exc}: the loads pull the punch away"
-                if exc.punch is None:
-                    raise ValueError(message) from None
-                raise exc.at(times[k], givens[exc.punch], message) from None
+                raise exc.of_punches(times[k], givens,
+                                     f"{exc}: the loads pull the punch away") from None
         per_time.append(results[key])
     seconds = _time.perf_counter() - started
     end_error = max(r["zone_end_error"] for r in per_time)

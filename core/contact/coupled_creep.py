@@ -254,10 +254,8 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
             states, settled = _step_states(base, system, step_data, displacement, start,
                                            solver, retry=n == 0)
         except NoContact as exc:
-            message = f"{exc}: the loads pull the punch away at t = {grid[n]:g}"
-            if exc.punch is None:
-                raise ValueError(message) from None
-            raise exc.at(grid[n], marches.givens[exc.punch], message) from None
+            raise exc.of_punches(grid[n], marches.givens, f"{exc}: the loads pull the punch "
+                                 f"away at t = {grid[n]:g}") from None
         if n == 0 and first is not None and "zones" not in first and any(
                 s.active.any() for s in states):
             zones = []

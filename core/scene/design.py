@@ -186,7 +186,7 @@ class LimitCheck:
 
     def value_text(self, number: Callable[[float], str] = _six_digits,
                    shown: Callable[[float, str], str] | None = None,
-                   day: str = "days", place_first: bool = False,
+                   place_first: bool = False,
                    time: Callable[[float], str] | None = None) -> str:
         """Value and where (or, for an unbounded pressure, the corner and the value where
         it is read), without the limit: :meth:`verdict_text`'s arguments; ``place_first``
@@ -194,7 +194,7 @@ class LimitCheck:
         if shown is None:
             def shown(value: float, unit: str) -> str:
                 return f"{number(value)} {unit}"
-        when = f"t = {time(self.time) if time else f'{number(self.time)} {day}'}"
+        when = f"t = {time(self.time) if time else f'{number(self.time)} days'}"
         if self.unbounded:
             return (f"unbounded at the corner x = {number(self.x)} m (a rigid corner: q ~ "
                     f"1/sqrt(distance)); {shown(self.value, self.unit)} at "
@@ -208,16 +208,16 @@ class LimitCheck:
 
     def verdict_text(self, number: Callable[[float], str] = _six_digits,
                      shown: Callable[[float, str], str] | None = None,
-                     day: str = "days", time: Callable[[float], str] | None = None) -> str:
+                     time: Callable[[float], str] | None = None) -> str:
         """Value, where, limit, utilisation and verdict (the report's table cell).
 
         ``number`` writes a time [day] or a position [m], ``shown`` a value and its unit
-        (default: in the check's SI unit, by ``number``), ``day`` is the unit of time
-        written; ``time``, when given, writes a time [day] with its unit instead."""
+        (default: in the check's SI unit, by ``number``), ``time`` a time [day] with its
+        unit (default: by ``number``, in days)."""
         if shown is None:
             def shown(value: float, unit: str) -> str:
                 return f"{number(value)} {unit}"
-        text = self.value_text(number, shown, day, time=time)
+        text = self.value_text(number, shown, time=time)
         if self.limit is None:
             return text + "; no limit set"
         if self.unbounded:
