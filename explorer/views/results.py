@@ -292,6 +292,9 @@ class ResultsView:
             self._set_range(max(len(view.times) - 1, 1), index)
         else:
             self.player.value = index
+        # one output time (an elastic scene): the player's range is 0 to 1 all the same
+        # (a range of one point is no slider), so it takes no move
+        self.player.disabled = len(view.times) < 2
         with param.discard_events(self.screen):
             self.screen.time_index = index
         self.show_time_texts(view, index)
@@ -453,8 +456,13 @@ class ResultsView:
         return player
 
     def _on_player(self, event: Any) -> None:
-        if not self._nudging:
-            self.screen.time_index = int(event.new)
+        if self._nudging:
+            return
+        # never past the last output time: a one-time scene's player reaches 1, and that
+        # index failed the pins and the lessons (IndexError on the server)
+        view = self.on_screen()[0]
+        last = None if view is None else len(view.times) - 1
+        self.screen.time_index = int(event.new) if last is None else min(int(event.new), last)
 
     def _set_range(self, end: int, value: int) -> None:
         """The player's range for a new number of output times, at ``value``.

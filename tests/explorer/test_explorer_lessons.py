@@ -151,3 +151,22 @@ def test_the_coating_edges_lesson_says_what_the_solver_finds() -> None:
     assert corners["held_within_m"] == pytest.approx(0.025) and corners["corners_m"] == [
         -1.0, 1.0]
     assert _rounds_to(_mm(thick, 0), "0.064")
+
+
+def test_a_one_time_scene_keeps_its_time_where_the_player_cannot_go(explorer_app) -> None:
+    """An elastic scene has one output time, but the player's range is 0 to 1 (a range
+    of one point is no slider): moved to its end, the time index went to 1, and pinning
+    or the coating lesson's next step raised IndexError on the server."""
+    app = explorer_app()
+    view = app.lessons_tab
+    view.lesson_select.value = "coating_edges"
+    assert app.controller.wait(60) and app.controller.error == ""
+    player = app.results.player
+    assert player.disabled and player.end == 1
+    player.value = 1    # what a click at its end sends, disabled or not
+    assert app.screen.time_index == 0
+    view.next_button.clicks += 1    # pins step 1, solves step 2
+    assert app.controller.wait(60) and app.controller.error == ""
+    assert "Step 2 of 3" in view.lesson_note.object and len(app.pins.board) == 1
+    app.pins.pin()
+    assert len(app.pins.board) == 2
