@@ -29,9 +29,11 @@ class TimesView:
         self.global_binding = Binding(reject, live_when=live_when)
         gb = self.global_binding
         self.time_end = gb.add("time_end", slider("time span [days after loading]", 1.0,
-                                                  3650.0, 1.0, "0[.]0"))
+                                                  3650.0, 1.0, "0[.]0",
+                                                  css_classes=["time-end"]))
         self.time_count = gb.add("time_count", EditableIntSlider(
-            label="output times", start=2, end=200, step=1, sizing_mode="stretch_width"))
+            label="output times", start=2, end=200, step=1, sizing_mode="stretch_width",
+            css_classes=["time-count"]))
         self.time_spacing = gb.add("time_spacing", pn.widgets.RadioButtonGroup(
             label="spacing", options=list(SPACINGS), sizing_mode="stretch_width"))
         # where log spacing begins: over 50 years its default (the last three decades)

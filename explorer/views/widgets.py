@@ -177,7 +177,40 @@ class LabelledCheckbox(pn.viewable.Viewer):
         return self._group
 
 
-class EditableSlider(pn.widgets.EditableFloatSlider):
+class _RangeKept:
+    """A composite slider whose handle's range comes back after a value typed outside it.
+
+    A value typed in the box beyond the slider's range widens the handle's range in the
+    page (Panel's own script, there only): a time span of 1e9 days, refused, left the
+    handle's range at 1e9, and every later span sat at its far left. Once a value inside
+    the range comes back (the last good one, or one typed), the range is sent again; a
+    value set on the slider from Python widens the range on both sides as before
+    (``_set_widget``)."""
+
+    def __init__(self, **params: Any) -> None:
+        super().__init__(**params)
+        self._stretched = False
+        self._value_edit.param.watch(self._on_typed, "value")
+        self.param.watch(self._on_value, "value")
+
+    def _on_typed(self, event: Any) -> None:
+        value = event.new
+        if value is not None and not (self.start <= value <= self.end):
+            self._stretched = True
+
+    def _on_value(self, event: Any) -> None:
+        value = event.new
+        if self._stretched and value is not None and self.start <= value <= self.end:
+            self._stretched = False
+            # the page's range is not the slider's in Python, which therefore sees no
+            # change in the same range: a step off and back sends it
+            step = self.step or 1
+            inner = self._slider
+            inner.param.update(start=self.start - step, end=self.end + step)
+            inner.param.update(start=self.start, end=self.end)
+
+
+class EditableSlider(_RangeKept, pn.widgets.EditableFloatSlider):
     """An EditableFloatSlider made of prompt parts."""
 
     _slider_widget = PromptFloatSlider
@@ -221,7 +254,7 @@ class EditableSlider(pn.widgets.EditableFloatSlider):
 _SYNC_VALUE = pn.widgets.EditableFloatSlider._sync_value
 
 
-class EditableIntSlider(pn.widgets.EditableIntSlider):
+class EditableIntSlider(_RangeKept, pn.widgets.EditableIntSlider):
     """An EditableIntSlider made of prompt parts."""
 
     _slider_widget = PromptIntSlider

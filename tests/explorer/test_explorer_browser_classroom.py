@@ -338,3 +338,30 @@ def test_the_first_log_time_is_typed_emptied_and_refused_on_the_time_tab(
         assert page.errors == []
     finally:
         page.close()
+
+
+def test_a_refused_time_span_leaves_the_handle_s_range_as_it_was(
+        server: str, browser_context: object) -> None:
+    """A span typed beyond the slider's range widens the handle's range in the page
+    (Panel's own script); refused (over 100000 days), it left the range at 1e9 days, and
+    every later span sat at the handle's far left. The next good span brings the range
+    back."""
+    page = Page(browser_context, server, "/app?preset=uniform_flat")
+    try:
+        page.open_tab("Time")
+        handle = page.page.locator(".time-end .noUi-handle").first
+        handle.wait_for(state="attached", timeout=30_000 * patience())
+        until(lambda: handle.get_attribute("aria-valuemax") == "3650.0",
+              "the span's range", describe=lambda: handle.get_attribute("aria-valuemax"))
+        page.type_into(".time-end", "1e9")
+        until(lambda: "times.end" in page.pane_text(".solve-error"),
+              "the refusal of 1e9 days", describe=lambda: page.pane_text(".solve-error"))
+        page.type_into(".time-end", "3000")
+        until(lambda: (handle.get_attribute("aria-valuemax"),
+                       handle.get_attribute("aria-valuenow")) == ("3650.0", "3000.0"),
+              "the range back, the handle at 3000 days",
+              describe=lambda: (handle.get_attribute("aria-valuemax"),
+                                handle.get_attribute("aria-valuenow")))
+        assert page.errors == []
+    finally:
+        page.close()
