@@ -82,7 +82,11 @@ def plain_status(view: ResultView) -> str:
     if not isinstance(err, (int, float)):
         accuracy = "no accuracy estimate"
     elif "tol_not_met" in view.flags:
-        accuracy = (f"accuracy target NOT met: estimated error {err:.0e}, target {tol:g}")
+        # two digits and the solver's reason: an error of 1.17e-8 read "1e-08, target
+        # 1e-08", and a lift-off answer misses where 3 x its estimate is over tol
+        reason = str(info.get("message", "")).partition("not within tol: ")[2]
+        accuracy = (f"accuracy target NOT met: estimated error {err:.2g}, target {tol:g}"
+                    + (f" ({reason})" if reason else ""))
     else:
         accuracy = f"accurate to about {max(err, 1e-16):.0e} (target {tol:g}, met)"
     return f"{what}; {accuracy}."
