@@ -22,7 +22,7 @@ from core.validation import finite_number, show_value
 #: The limit checks in order: (field of :class:`DesignLimits`, quantity, unit, label).
 CHECKS: tuple[tuple[str, str, str, str], ...] = (
     ("allowable_pressure", "q_max", "Pa", "largest contact pressure q_max"),
-    ("settlement_limit", "settlement", "m", "largest settlement"),
+    ("settlement_limit", "settlement", "m", "largest settlement δ (punch centre)"),
     ("tilt_limit", "tilt", "rad", "largest tilt"),
 )
 
@@ -36,7 +36,8 @@ class DesignLimits:
     """What the design must not exceed (``None``: not checked).
 
     ``allowable_pressure`` [Pa]: the largest contact pressure q over x and time;
-    ``settlement_limit`` [m]: the largest settlement delta (magnitude);
+    ``settlement_limit`` [m]: the largest settlement delta (magnitude), the punch centre's
+    (a tilted punch's edges move by alpha a more or less);
     ``tilt_limit`` [rad]: the largest tilt alpha, either way. Each finite and >= 0.
     """
 

@@ -40,10 +40,10 @@ def test_the_sections_say_validity_check_results_and_accuracy(checked):
     design = dict(sections(checked)[2].rows)
     assert sections(checked)[2].tone == "bad"
     assert design["largest contact pressure q_max"].endswith("FAIL")
-    assert design["largest settlement"].endswith(": pass")
+    assert design["largest settlement δ (punch centre)"].endswith(": pass")
     # in the units of the results: the limits of the fixture, 1.5e6 Pa and 0.01 m
     assert "; limit 1500 kPa, utilisation 1.31: FAIL" in design["largest contact pressure q_max"]
-    assert "; limit 10 mm, utilisation" in design["largest settlement"]
+    assert "; limit 10 mm, utilisation" in design["largest settlement δ (punch centre)"]
     about = dict(sections(checked)[0].rows)
     assert about["made by"].startswith(f"coated-punch {core.__version__}, ")
     assert about["statement"] == "4: force and moment given"
