@@ -74,6 +74,10 @@ LEGEND_FONT = "11px"
 #: Font size of ticks, axis labels and titles in presentation mode (a projector).
 #: Ticks an axis aims at in presentation mode (Bokeh's default is 6).
 PRESENTATION_TICKS = 4
+#: ... on the y axis of a plot at most ``SHORT_FIGURE`` px tall (normal mode's height;
+#: presentation mode makes it shorter still).
+PRESENTATION_SHORT_TICKS = 3
+SHORT_FIGURE = 210
 PRESENTATION_FONT = "18px"
 
 #: Longest scene name shown in the drawing's title [characters]: a Bokeh title does not
@@ -495,7 +499,12 @@ class Figures:
         without the unit (which its axis label gives) in presentation mode, where at
         1024 px the title ran past its plot ("Settlement δ [mm]: computed")."""
         unit = "" if self._presenting else f" [{QUANTITY_UNITS[q][0]}]"
-        text = f"{TITLES[q]} {SYMBOLS[q]}{unit}: {self._history_state[q]}"
+        state = self._history_state[q]
+        if self._presenting and "per punch" in state:
+            # at 18 px "Settlement δ: computed, per punch" was cut at 1024 px too; the
+            # colour of each punch's line says given or computed no more than this did
+            state = "per punch"
+        text = f"{TITLES[q]} {SYMBOLS[q]}{unit}: {state}"
         if self.history_fig[q].title.text != text:
             self.history_fig[q].title.text = text
 
@@ -528,6 +537,13 @@ class Figures:
                 # ticks of 18 px on a 240 px plot: fewer of them, or they touch
                 if hasattr(axis.ticker, "desired_num_ticks"):
                     axis.ticker.desired_num_ticks = PRESENTATION_TICKS if on else 6
+            if on and fig.height is not None and fig.height <= SHORT_FIGURE:
+                # the histories' and the contact width's plots are 170 px tall there,
+                # ~70 px of axis: four ticks of 18 px ran into each other ("0.08 0.06
+                # 0.04 0.02 0" on a settlement, "2 1.5 1 0.5 0" on a contact width)
+                for axis in fig.yaxis:
+                    if hasattr(axis.ticker, "desired_num_ticks"):
+                        axis.ticker.desired_num_ticks = PRESENTATION_SHORT_TICKS
             # hidden, not taken off: a toolbar put back (toolbar_location) made BokehJS
             # throw "cannot find a view for ToolbarPanel" as presentation mode ended
             fig.toolbar.visible = not on
@@ -535,7 +551,7 @@ class Figures:
         legend.label_text_font_size = "11px" if on else LEGEND_FONT
         legend.glyph_width = 14 if on else 20
         for q in QUANTITIES:
-            self.history_fig[q].height = 170 if on else 210
+            self.history_fig[q].height = 190 if on else 210
         self.scene_fig.height = self.inset_fig.height = 240 if on else 300
         self.contact_fig.height = 170 if on else 210
         self.q_fig.height = self.image_fig.height = 240 if on else 280

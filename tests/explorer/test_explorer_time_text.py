@@ -65,3 +65,23 @@ def test_the_first_log_time_is_set_on_the_time_tab_and_kept_in_the_scene(explore
     box.value = 0.5
     app.state.time_spacing = "linear"
     assert not box.visible and "start" not in app.state.to_scene()["times"]
+
+
+def test_presentation_mode_gives_short_plots_few_ticks_and_short_titles(explorer_app) -> None:
+    """At 1024x768 in presentation mode the histories of two punches were titled
+    "Settlement δ: computed, per p" (cut) and their y ticks of 18 px ran into each other
+    ("0.08 0.06 0.04 0.02 0"), as did the contact width's on the lift-off preset."""
+    app = explorer_app("new_footing_beside_old", solved=True)
+    figures = app.figures
+    short = [*figures.history_fig.values(), figures.contact_fig]
+    assert figures.history_fig["settlement"].title.text == \
+        "Settlement δ [mm]: computed, per punch"
+    figures.set_presentation(True)
+    assert figures.history_fig["settlement"].title.text == "Settlement δ: per punch"
+    assert figures.history_fig["force"].title.text == "Force P: per punch"
+    assert {fig.yaxis[0].ticker.desired_num_ticks for fig in short} == {3}
+    assert figures.q_fig.yaxis[0].ticker.desired_num_ticks == 4     # tall: as before
+    figures.set_presentation(False)
+    assert figures.history_fig["settlement"].title.text == \
+        "Settlement δ [mm]: computed, per punch"
+    assert {fig.yaxis[0].ticker.desired_num_ticks for fig in short} == {6}
