@@ -148,6 +148,8 @@ def not_carried(scene: Scene, exc: LoadNotCarried, prefix: str = "") -> str:
                     f"(M = {moment:.6g} N·m/m, P = {force:.6g} N/m) is not inside the punch, "
                     f"|e| must be < a = {a:.6g} m: the resultant acts outside the base, so no "
                     "contact can carry it")
+        if e == 0.0:
+            return _force_too_small(prefix, force, when, "centred (e = M/P = 0)", found)
         return (f"{prefix}loading.moment: at {when} the eccentricity e = M/P = {e:.6g} m "
                 f"(a = {a:.6g} m) leaves the lift-off model no contact zone to carry the "
                 f"loads{found}; a smaller eccentricity there is answered")
@@ -160,6 +162,9 @@ def not_carried(scene: Scene, exc: LoadNotCarried, prefix: str = "") -> str:
                 "lift-off model has no answer; a larger settlement there, or a given force, "
                 "is answered")
     tilt = value("tilt")
+    if tilt == 0.0 and force is not None:
+        # a level punch: no smaller tilt exists, the force is what is too small
+        return _force_too_small(prefix, force, when, "the punch level (tilt 0)", found)
     if tilt is not None:
         # a given tilt turns the punch about its centre onto one edge
         return (f"{prefix}loading.tilt: {tilt:.6g} rad at {when} leaves the punch touching "
@@ -168,6 +173,17 @@ def not_carried(scene: Scene, exc: LoadNotCarried, prefix: str = "") -> str:
                 "answered")
     return (f"{prefix}loading.{exc.quantity}: at {when} the lift-off model finds no contact "
             f"zone to carry the loads{found}")
+
+
+def _force_too_small(prefix: str, force: float, when: str, how: str, found: str) -> str:
+    """The message of a force whose contact the lift-off model does not find although the
+    moment or tilt given with it is 0: under a shaped punch (a crown) so small a force
+    presses a zone narrower than the model resolves. It named the moment or the tilt, and
+    asked for a smaller eccentricity or tilt than 0."""
+    return (f"{prefix}loading.force: P = {force:.6g} N/m at {when}, {how}, leaves the "
+            f"lift-off model no contact zone to carry it{found}: under this punch shape so "
+            "small a force touches over less than the model resolves; a larger force there "
+            "is answered")
 
 
 def reword_refused_lift_off(scene: Scene, info: dict[str, Any]) -> None:

@@ -296,3 +296,24 @@ def test_a_single_punch_on_an_elastic_base_names_the_load_and_the_day() -> None:
                                          r"at a point at most \(the contact shrinks to a "
                                          r"point\)"):
         solve(d)
+
+
+@pytest.mark.parametrize(("loading", "creep"), [
+    ({"force": 10.0, "moment": 0.0}, True),     # e = 0: "a smaller eccentricity" asked
+    ({"tilt": 0.0, "force": 0.01}, False),      # level: "a smaller tilt" asked
+])
+def test_a_force_too_small_for_a_crown_s_contact_is_named(loading, creep) -> None:
+    """Under the rounded punch so small a force touches over less than the lift-off model
+    resolves. The refusal named the moment (or the tilt) given as 0 and asked for a
+    smaller one; the force is the field to change."""
+    d = read_preset("rounded_graded")
+    d["loading"] = loading
+    d["solver"]["contact"] = "unilateral"
+    if creep:
+        d["base"]["creep"] = {"model": "exponential", "modulus": 3e10, "compliance": 3e-11,
+                              "rate": 0.05}
+        d["times"] = {"end": 100, "count": 10}
+    with pytest.raises(ValueError, match=r"^loading\.force: P = [0-9.]+ N/m at t = .*, "
+                       r"(centred \(e = M/P = 0\)|the punch level \(tilt 0\)), leaves the "
+                       r"lift-off model no contact zone .* a larger force there is answered"):
+        solve(d)
