@@ -201,6 +201,16 @@ def _validated(d: dict[str, Any]) -> Scene:
         raise ValueError(f"base.age_at_loading: {tau0:g} days is too small against the output "
                          f"times (up to {float(times[-1]):g} days after loading): the age over "
                          "the age at loading overflows double precision")
+    # (first: a span this short merges its times in the age over the age at loading
+    # too, which blamed the age; and a last time whose age rounds to the age at
+    # loading itself, 1e-15 days, was taken for t = 0 and answered)
+    if creeps(d) and 0.0 < float(times[-1]) and ages[-1] - 1.0 < limits.MIN_CREEP_SPAN:
+        # the time stepper's first steps are fractions of the span (the solver's bound)
+        raise ValueError(f"{schema.last_time_field(times_spec, len(times))}: on a creeping "
+                         f"base the last output time must be at least "
+                         f"{limits.MIN_CREEP_SPAN * tau0:.3g} days after loading "
+                         f"({limits.MIN_CREEP_SPAN:g} of the age at loading, {tau0:g} days), "
+                         f"got {float(times[-1]):g}")
     if np.any(np.diff(ages) <= 0):
         i = int(np.argmax(np.diff(ages) <= 0)) + 1
         if times[i] - times[i - 1] > RESOLVED_TIMES * float(times[-1]):
@@ -211,13 +221,6 @@ def _validated(d: dict[str, Any]) -> Scene:
                              "the age over the age at loading")
         raise ValueError(f"times[{i}]: too close to the time before it to be told apart at "
                          f"an age at loading of {tau0:g} days")
-    if creeps(d) and 0.0 < ages[-1] - 1.0 < limits.MIN_CREEP_SPAN:
-        # the time stepper's first steps are fractions of the span (the solver's bound)
-        raise ValueError(f"{schema.last_time_field(times_spec, len(times))}: on a creeping "
-                         f"base the last output time must be at least "
-                         f"{limits.MIN_CREEP_SPAN * tau0:.3g} days after loading "
-                         f"({limits.MIN_CREEP_SPAN:g} of the age at loading, {tau0:g} days), "
-                         f"got {float(times[-1]):g}")
 
     solver = check_fields(d.get("solver", {}), "solver", (), schema.optional_fields("solver"))
     tol = finite_number(solver["tol"] if "tol" in solver else default_tol(creep, tau0),

@@ -9,6 +9,7 @@ import copy
 import json
 import math
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -633,6 +634,15 @@ def test_a_creeping_span_too_short_to_step_is_refused_naming_the_last_time():
         scene_from_dict(d)
     d["times"] = [0.0, 1e-4]
     scene_from_dict(d)
+    # the same rule where the last time's age rounds to the age at loading (1e-15 days
+    # was answered as t = 0) and where log spacing merges the times in the age (1e-12
+    # days blamed base.age_at_loading)
+    for times, field in (([1e-15], "times[0]"),
+                         ({"end": 1e-12, "count": 10, "spacing": "log"}, "times.end")):
+        d["times"] = times
+        with pytest.raises(ValueError, match=rf"^{re.escape(field)}: on a creeping base the "
+                           r"last output time must be at least 1\.4e-05 days"):
+            scene_from_dict(d)
     d = edit("times", {"end": 1e-6, "count": 3})
     scene_from_dict(d)
 
