@@ -35,6 +35,7 @@ from core.engines.layered.answer import (
     corner_reach,
     layered_declines,
     solve_scene_layered,
+    thinnest_bare_base,
     uniform_layers,
 )
 from core.engines.layered.cache import gap_key, share_budget, stack_key
@@ -71,5 +72,6 @@ __all__ = [
     "share_budget",
     "solve_scene_layered",
     "stack_key",
+    "thinnest_bare_base",
     "uniform_layers",
 ]

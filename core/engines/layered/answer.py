@@ -42,6 +42,7 @@ punch corner's, not the coating's.
 
 from __future__ import annotations
 
+import math
 import re
 import time
 from collections.abc import Sequence
@@ -60,7 +61,7 @@ from core.kernel import UniformLayer, table_cost
 from core.problem import ContactSolution, accepts
 
 __all__ = ["bare_creep_declines", "corner_reach", "layered_declines", "LiftOffNotAnswered",
-           "solve_scene_layered"]
+           "solve_scene_layered", "thinnest_bare_base"]
 
 #: Time samples of the load histories for the largest tilt between output times.
 TILT_SAMPLES = 257
@@ -97,6 +98,24 @@ def _table_cost(largest_s: float, layers: tuple[UniformLayer, ...],
                 base_thickness: float) -> float:
     """:func:`core.kernel.table_cost`, kept per stack: ~20 ms of a warm solve."""
     return table_cost(largest_s, layers, base_thickness)
+
+
+def thinnest_bare_base(half_width: float) -> float:
+    """The thinnest base [m] (of a punch of half-width ``half_width`` [m] without coating)
+    whose kernel table stays within :data:`MAX_TABLE_COST` (``a / H`` ~88), to 0.1 %."""
+    def affordable(thickness: float) -> bool:
+        return _table_cost(2.0 * half_width / thickness, (), thickness) <= MAX_TABLE_COST
+
+    thin, thick = half_width / 1e4, half_width
+    for _ in range(40):       # bisection in log: the cost falls as the base thickens
+        middle = math.sqrt(thin * thick)
+        if affordable(middle):
+            thick = middle
+        else:
+            thin = middle
+        if thick / thin < 1.001:
+            break
+    return thick
 
 
 def _constant(profile: Any) -> float:
