@@ -306,10 +306,25 @@ def corner_note(corners: Mapping[str, Any] | None,
                 number: Callable[[float], str] = number_text) -> str | None:
     """The ``#`` line of a pressure table whose answer has rigid corners in contact
     (``info["corner_pressure"]``: ``corners_m`` [m], ``held_within_m`` [m]): the rows
-    there hold q's value at that distance, where q grows without bound; None without."""
+    there hold q's value at that distance, where q grows without bound, and leave out
+    the share of the force and moment it carries there (``held_force_share``,
+    ``held_moment_share``: a table integrated fell short of P by 2-9 % under thick
+    coatings, unsaid); None without."""
     if not corners:
         return None
     where = " and ".join(f"x = {number(float(c))} m" for c in corners["corners_m"])
-    return (f"# corner: q grows without bound toward the rigid corner at {where}; within "
+    note = (f"# corner: q grows without bound toward the rigid corner at {where}; within "
             f"{number(float(corners['held_within_m']))} m of it the rows hold its value at "
             "that distance")
+    force, moment = corners.get("held_force_share"), corners.get("held_moment_share")
+    if force is None:
+        return note
+    left = f"{_percent(force)} of the force P" + (
+        "" if moment is None else f" and {_percent(moment)} of the moment M")
+    return (f"{note}, and so leave out up to {left} (integrated, the rows fall short; the "
+            "force and moment columns are the answer's)")
+
+
+def _percent(share: float) -> str:
+    """A share [-] as a percentage of two significant digits ("2.2 %", "0.011 %")."""
+    return f"{100.0 * share:.2g} %"
