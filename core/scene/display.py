@@ -322,7 +322,7 @@ def corner_note(corners: Mapping[str, Any] | None,
     left = f"{_percent(force)} of the force P" + (
         "" if moment is None else f" and {_percent(moment)} of the moment M")
     return (f"{note}, and so leave out up to {left} (integrated, the rows fall short; the "
-            "force and moment columns are the answer's)")
+            "histories' force and moment are the answer's)")
 
 
 def _percent(share: float) -> str:
