@@ -72,13 +72,15 @@ READ_SERIES = ("settlement", "tilt")
 LEGEND_FONT = "11px"
 
 #: Font size of ticks, axis labels and titles in presentation mode (a projector).
+PRESENTATION_FONT = "18px"
 #: Ticks an axis aims at in presentation mode (Bokeh's default is 6).
 PRESENTATION_TICKS = 4
-#: ... on the y axis of a plot at most ``SHORT_FIGURE`` px tall (normal mode's height;
-#: presentation mode makes it shorter still).
+#: ... on the y axis of a short plot (the histories, the contact width): three ticks of
+#: 18 px fit its ~80 px of axis.
 PRESENTATION_SHORT_TICKS = 3
+#: The tallest a plot is in normal mode and still short [px] (presentation mode makes it
+#: shorter still).
 SHORT_FIGURE = 210
-PRESENTATION_FONT = "18px"
 
 #: Longest scene name shown in the drawing's title [characters]: a Bokeh title does not
 #: wrap, and at 1024 px a longer one was cut off.
@@ -538,9 +540,10 @@ class Figures:
                 if hasattr(axis.ticker, "desired_num_ticks"):
                     axis.ticker.desired_num_ticks = PRESENTATION_TICKS if on else 6
             if on and fig.height is not None and fig.height <= SHORT_FIGURE:
-                # the histories' and the contact width's plots are 170 px tall there,
-                # ~70 px of axis: four ticks of 18 px ran into each other ("0.08 0.06
-                # 0.04 0.02 0" on a settlement, "2 1.5 1 0.5 0" on a contact width)
+                # the histories' and the contact width's plots are 190 and 170 px tall
+                # there, ~70-80 px of axis: four ticks of 18 px ran into each other
+                # ("0.08 0.06 0.04 0.02 0" on a settlement, "2 1.5 1 0.5 0" on a
+                # contact width)
                 for axis in fig.yaxis:
                     if hasattr(axis.ticker, "desired_num_ticks"):
                         axis.ticker.desired_num_ticks = PRESENTATION_SHORT_TICKS

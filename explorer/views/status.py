@@ -82,14 +82,38 @@ def plain_status(view: ResultView) -> str:
     if not isinstance(err, (int, float)):
         accuracy = "no accuracy estimate"
     elif "tol_not_met" in view.flags:
-        # two digits and the solver's reason: an error of 1.17e-8 read "1e-08, target
-        # 1e-08", and a lift-off answer misses where 3 x its estimate is over tol
-        reason = str(info.get("message", "")).partition("not within tol: ")[2]
-        accuracy = (f"accuracy target NOT met: estimated error {err:.2g}, target {tol:g}"
-                    + (f" ({reason})" if reason else ""))
+        # digits enough to tell the two apart, and the solver's reason: an error of
+        # 1.17e-8 read "1e-08, target 1e-08", and a lift-off answer misses where 3 x its
+        # estimate is over tol
+        reason = missed_reason(str(info.get("message", "")))
+        accuracy = (f"accuracy target NOT met: estimated error {_apart(err, tol)}, target "
+                    f"{tol:g}" + (f"; {reason}" if reason else ""))
     else:
         accuracy = f"accurate to about {max(err, 1e-16):.0e} (target {tol:g}, met)"
     return f"{what}; {accuracy}."
+
+
+def _apart(value: float, other: float) -> str:
+    """``value`` to two significant digits, or as many more (up to six) as tell it from
+    ``other`` written the same way."""
+    for digits in range(2, 7):
+        text = f"{value:.{digits}g}"
+        if text != f"{other:.{digits}g}":
+            return text
+    return text
+
+
+def missed_reason(message: str) -> str:
+    """Why a solve's message says tol was not met, in the engines' own words: after
+    "not within tol: " (lift-off), in the parentheses of "not met (...)" (the projection
+    engine's margin) or after "not met: " (the others); empty when it does not say."""
+    for marker in ("not within tol: ", "not met: "):
+        if marker in message:
+            return message.partition(marker)[2].strip().rstrip(".")
+    if "not met (" in message:
+        inside, _, rest = message.partition("not met (")[2].partition(")")
+        return (inside + rest).strip().rstrip(".")
+    return ""
 
 
 def details_text(view: ResultView) -> str:

@@ -74,9 +74,22 @@ def test_a_missed_target_says_by_how_much_and_why() -> None:
                                        "message": message},
                                  flags=["tol_not_met"], scene={"solver": {"tol": 1e-8}})
     text = plain_status(view)
-    assert ("accuracy target NOT met: estimated error 1.2e-08, target 1e-08 (3 x the "
-            "estimated error = 3.5e-08 is over tol 1.0e-08") in text, text
-    # without a reason in the message, the two numbers alone
+    assert text.endswith("accuracy target NOT met: estimated error 1.2e-08, target 1e-08; "
+                         "3 x the estimated error = 3.5e-08 is over tol 1.0e-08 (these "
+                         "estimates have read up to 3x low)."), text
+    # without a reason in the message, the two numbers alone, with the digits that tell
+    # them apart (1.04e-8 read "1e-08" at two digits)
     view.info["message"] = "converged"
+    view.info["error_estimate"] = 1.04e-8
     assert plain_status(view).endswith(
-        "accuracy target NOT met: estimated error 1.2e-08, target 1e-08."), plain_status(view)
+        "accuracy target NOT met: estimated error 1.04e-08, target 1e-08."), plain_status(view)
+    # the other engines' words: the projection's margin and the Nystrom engine's reasons
+    view.info["error_estimate"] = 5e-9
+    view.info["message"] = ("tol 1.0e-08 not met (success needs the estimate below tol/3): "
+                            "time stepping: estimated error 5.0e-09")
+    assert plain_status(view).endswith("target 1e-08; success needs the estimate below "
+                                       "tol/3: time stepping: estimated error 5.0e-09."), \
+        plain_status(view)
+    view.info["message"] = "tol 1.0e-08 not met (success needs the estimate below tol/3)"
+    assert plain_status(view).endswith("target 1e-08; success needs the estimate below "
+                                       "tol/3."), plain_status(view)
