@@ -5,6 +5,7 @@ file opens and prints with no network), and the scene file itself."""
 from __future__ import annotations
 
 import html
+import re
 from collections.abc import Mapping
 from typing import Any
 
@@ -51,7 +52,21 @@ def _plots(result: SceneSolution | PunchesSolution, time: float | None,
     if calibration is not None and calibration.readings.settlement is not None:
         models.append(hv.render(readings_overlay(result, calibration), backend="bokeh"))
     script, divs = embed.components(models)
-    return resources.INLINE.render() + script, divs[0], "".join(divs[1:])
+    return _standalone(resources.INLINE.render()) + script, divs[0], "".join(divs[1:])
+
+
+#: A script the resources load from a relative address: none exists beside a report file.
+_RELATIVE_SCRIPT = re.compile(
+    r'<script[^>]*\ssrc="(?![a-z][a-z0-9+.-]*:|/)[^"]*"[^>]*>\s*</script>\s*', re.IGNORECASE)
+
+
+def _standalone(head: str) -> str:
+    """``head`` (Bokeh's resources, inline) without scripts loaded from a relative
+    address. Where Panel is imported (the command line's report loads HoloViews, which
+    loads it) Bokeh's resources carry Panel's module shim as
+    ``static/extensions/panel/...``, which a saved report has no server to fetch from: the
+    report's plots need only the inline Bokeh library."""
+    return _RELATIVE_SCRIPT.sub("", head)
 
 
 def report_html(result: SceneSolution | PunchesSolution, time: float | None = None,

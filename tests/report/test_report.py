@@ -151,6 +151,20 @@ def test_the_html_report_embeds_bokeh_plots_and_the_scene(checked):
     assert "<h2>Inputs</h2>" in text and "punch base f(x)" not in text  # a flat punch
 
 
+def test_the_html_report_loads_nothing_from_beside_it(checked):
+    """Panel, once imported (the command line's report loads HoloViews, which loads it),
+    adds its module shim to Bokeh's resources as ``static/extensions/panel/...``: a saved
+    report asked for a file that does not exist beside it. Every script is inline, or
+    from an absolute address."""
+    import re
+
+    import panel  # noqa: F401  (what a report made in the explorer's process has loaded)
+
+    text = report_html(checked)
+    sources = re.findall(r'<script[^>]*\ssrc="([^"]*)"', text)
+    assert all(re.match(r"[a-z][a-z0-9+.-]*:|/", s) for s in sources), sources
+
+
 def test_the_geometry_is_drawn_where_it_varies_and_no_lift_off_plot_in_full_contact():
     text = report_html(core.solve(read_preset("stepped_punch")))
     assert "punch base f(x) above its lowest point [mm]" in text
