@@ -16,6 +16,7 @@ from typing import Any
 
 import param
 
+from core import limits
 from core.coating import DEFAULT_INTERFACE, INTERFACES
 from core.profiles import VARIATIONS, variation_of
 
@@ -159,10 +160,12 @@ class LayerState(param.Parameterized):
 
 
 #: Longest scene name and description the explorer accepts [characters], from a file, a
-#: link or the page: a name is echoed into the drawing's title, the file names and the
-#: address bar (a 15-million-character name once went into all three).
-MAX_NAME_CHARS = 200
-MAX_DESCRIPTION_CHARS = 4000
+#: link or the page: the core's own bounds (``core.limits``; a name is echoed into the
+#: drawing's title, the file names and the address bar: a 15-million-character name once
+#: went into all three). The page's description bound was 4000 where a scene file's is
+#: 5000: a scene the command line solved was refused by the page.
+MAX_NAME_CHARS = limits.MAX_NAME_CHARS
+MAX_DESCRIPTION_CHARS = limits.MAX_DESCRIPTION_CHARS
 
 
 def check_text(field: str, value: Any, limit: int) -> str:
