@@ -898,7 +898,9 @@ def build_parser() -> argparse.ArgumentParser:
     p_check.add_argument("--time", type=float, default=0.0, metavar="DAYS",
                          help="days after loading: base modulus and given loads (default 0)")
     p_check.add_argument("--level", type=int, choices=(0, 1), default=FE_CHECK_LEVEL,
-                         help="FE mesh level: 0 (~1 s, force to ~2e-4) or 1 (~10 s, ~2e-5)")
+                         help="FE mesh level: 0 (~1 s, force to ~2e-4; up to ~20 s where the punch "
+                              "lifts off: the FE model finds its contact too) or 1 "
+                              "(~10 s, ~2e-5; longer where it lifts off)")
     p_check.set_defaults(run=_cmd_check)
     return parser
 
