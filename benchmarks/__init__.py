@@ -9,6 +9,8 @@ from __future__ import annotations
 import os
 import platform
 import subprocess
+import sys
+from collections.abc import Sequence
 from datetime import datetime
 from pathlib import Path
 
@@ -37,3 +39,15 @@ def run_lines(started: datetime, load_before: float, load_after: float,
             f"{os.cpu_count()} cores, Python {platform.python_version()}",
             f"- load average {load_before:.2f} before, {load_after:.2f} after"
             + (f" ({load_note})" if load_note else "")]
+
+
+def help_requested(doc: str | None, argv: Sequence[str] | None = None) -> None:
+    """Print ``doc`` (a script's docstring: what it measures and how it is run) and exit
+    when ``-h`` or ``--help`` is among the arguments (default: the command line's).
+
+    A script without its own option parser took ``--help`` for a run: it measured for
+    a minute and wrote over its committed report in ``benchmarks/results/``."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    if "-h" in args or "--help" in args:
+        print((doc or "").strip())
+        raise SystemExit(0)

@@ -308,4 +308,7 @@ def main(argv: list[str]) -> None:
 
 
 if __name__ == "__main__":
+    from benchmarks import help_requested
+
+    help_requested(__doc__)
     main(sys.argv[1:])

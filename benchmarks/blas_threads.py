@@ -105,6 +105,9 @@ def main(argv: list[str]) -> None:
 
 
 if __name__ == "__main__":
+    from benchmarks import help_requested
+
+    help_requested(__doc__)
     if sys.argv[1:2] == ["--child"]:
         child(sys.argv[2:])
     else:

@@ -69,4 +69,8 @@ def main(cases: list[str]) -> None:
 
 
 if __name__ == "__main__":
+    sys.path.insert(0, str(ROOT))
+    from benchmarks import help_requested
+
+    help_requested(__doc__)
     main(sys.argv[1:] or ["nested", "simple", "sine-0.5", "sine-0.35"])

@@ -305,4 +305,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    from benchmarks import help_requested
+
+    help_requested(__doc__)
     main()

@@ -104,4 +104,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
+    from benchmarks import help_requested
+
+    help_requested(__doc__)
     raise SystemExit(main())

@@ -103,4 +103,7 @@ def main(argv: list[str]) -> None:
 
 
 if __name__ == "__main__":
+    from benchmarks import help_requested
+
+    help_requested(__doc__)
     main([a for a in sys.argv[1:] if not a.startswith("--")])

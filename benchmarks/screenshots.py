@@ -109,4 +109,7 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    from benchmarks import help_requested
+
+    help_requested(__doc__)
     sys.exit(main())

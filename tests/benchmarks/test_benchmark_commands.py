@@ -83,3 +83,28 @@ def test_compare_servers_refuses_an_unknown_preset_before_starting_a_server():
     with pytest.raises(SystemExit) as stop:
         compare_servers.main([str(root), "no_such_preset", "--no-write"])
     assert "presets: unknown no_such_preset" in str(stop.value)
+
+
+def _scripts() -> list[Path]:
+    folder = Path(cold_start.__file__).resolve().parent
+    # (those with an option parser of their own answer --help through it)
+    return sorted(p for p in folder.glob("*.py")
+                  if p.name != "__init__.py" and 'if __name__ == "__main__":' in p.read_text()
+                  and "argparse" not in p.read_text())
+
+
+@pytest.mark.parametrize("script", _scripts(), ids=lambda p: p.stem)
+def test_every_benchmark_answers_help_without_running(script: Path):
+    """``--help`` prints what the script measures and writes nothing: a script without
+    its own option parser ran its benchmark (45 s) and wrote over its committed report."""
+    import subprocess
+    import sys
+
+    root = script.parent.parent
+    results = root / "benchmarks" / "results"
+    before = {p: p.stat().st_mtime_ns for p in results.iterdir()}
+    done = subprocess.run([sys.executable, "-m", f"benchmarks.{script.stem}", "--help"],
+                          cwd=root, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip(), "no help printed"
+    assert {p: p.stat().st_mtime_ns for p in results.iterdir()} == before
