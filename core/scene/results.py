@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 import math
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -189,12 +189,22 @@ def corner_pressure(scene: Scene, coating_model: str,
 #: between the held bands (:func:`held_shares`), split at the free zone ends of the answer
 #: (q sin(theta) is smooth inside a piece; a free end's square root at a piece's end: the
 #: bare layer's heel lifted at e = 0.6 a, 5.6e-8 of P off an adaptive quadrature split
-#: there, 3.5e-6 with 32 points, 6e-4 unsplit with 96); with more than ``HELD_SPLITS``
-#: distinct ends (a zone moving as the base creeps) one piece of ``HELD_UNSPLIT`` points
-#: (6.6e-6 of P off on that heel).
+#: there, 3.5e-6 with 32 points, 6e-4 unsplit with 96). Where the pieces' points at every
+#: output time would pass ``HELD_VALUES`` (zones that move as the loads or the base
+#: change: every time's integral is split at every time's ends) one piece of
+#: ``HELD_UNSPLIT`` points, fewer if the times ask it (6.6e-6 of P off on that heel).
 HELD_QUADRATURE = 128
-HELD_SPLITS = 32
 HELD_UNSPLIT = 1024
+HELD_VALUES = 1_000_000
+
+
+@lru_cache(maxsize=8)
+def _gauss_legendre(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [-1, 1], made once per count (128 of them took
+    1.8 ms, as long as the bare layer's whole load change)."""
+    nodes, weights = np.polynomial.legendre.leggauss(count)
+    nodes.flags.writeable = weights.flags.writeable = False
+    return nodes, weights
 
 
 def held_shares(pressure: Any, force: np.ndarray, moment: np.ndarray, half_width: float,
@@ -207,31 +217,38 @@ def held_shares(pressure: Any, force: np.ndarray, moment: np.ndarray, half_width
     [-] (None where the moment is 0 throughout). ``pressure(x)`` [Pa] is the answer's
     (held within ``held``); the force and moment are its exact resultants, so what the
     held rows miss is the resultant less their integral. ``contact_set`` [m]: the zones
-    per output time, whose free ends split the integral.
+    per output time; the integral at every time is split at the free ends of them all.
 
     Measured: a uniform 100 mm coating under P = 600 kN/m, M = 120 kN m/m, 2.2 % of P and
     6.6 % of M (a 2 m one 9.0 % and 20 %); the bare layer preset 1.1 % of P."""
     a = float(half_width)
     edge = 1.0 - held / a
-    ends = sorted({float(v) / a for zones in (contact_set or []) for zone in zones
-                   for v in zone if -edge < float(v) / a < edge})
-    cuts = [-edge, *ends, edge] if len(ends) <= HELD_SPLITS else [-edge, edge]
-    count = HELD_QUADRATURE if len(cuts) > 2 or not ends else HELD_UNSPLIT
-    nodes, weights = np.polynomial.legendre.leggauss(count)
-    x_parts, dx_parts = [], []
-    for lo, hi in zip(cuts[:-1], cuts[1:], strict=True):
-        low, high = math.acos(hi), math.acos(lo)
-        theta = 0.5 * (low + high) + 0.5 * (high - low) * nodes
-        x_parts.append(a * np.cos(theta))
-        dx_parts.append(0.5 * (high - low) * weights * a * np.sin(theta))
-    x, dx = np.concatenate(x_parts), np.concatenate(dx_parts)
-    q = pressure(x)
-    sides = pressure(np.array([-a * edge, a * edge]))
-    arm = a * edge + 0.5 * held           # the held rows' centroids, from the centre
     force = np.asarray(force, dtype=float)
     moment = np.asarray(moment, dtype=float)
-    force_left = force - dx @ q - (sides[0] + sides[1]) * held
-    moment_left = moment - (dx * x) @ q - (sides[1] - sides[0]) * held * arm
+    times = max(force.size, 1)
+    ends = sorted({float(v) / a for zones in (contact_set or []) for zone in zones
+                   for v in zone if -edge < float(v) / a < edge})
+    cuts = [-edge, *ends, edge]
+    count = HELD_QUADRATURE
+    if (len(cuts) - 1) * count * times > HELD_VALUES:
+        cuts = [-edge, edge]
+        count = max(HELD_QUADRATURE, min(HELD_UNSPLIT, HELD_VALUES // times))
+    nodes, weights = _gauss_legendre(count)
+    inner_force = np.zeros(force.shape)
+    inner_moment = np.zeros(force.shape)
+    for lo, hi in zip(cuts[:-1], cuts[1:], strict=True):
+        # a piece at a time: all the points at once could pass pressure(x)'s own bound
+        low, high = math.acos(hi), math.acos(lo)
+        theta = 0.5 * (low + high) + 0.5 * (high - low) * nodes
+        x = a * np.cos(theta)
+        dx = 0.5 * (high - low) * weights * a * np.sin(theta)
+        q = pressure(x)
+        inner_force = inner_force + dx @ q
+        inner_moment = inner_moment + (dx * x) @ q
+    sides = pressure(np.array([-a * edge, a * edge]))
+    arm = a * edge + 0.5 * held           # the held rows' centroids, from the centre
+    force_left = force - inner_force - (sides[0] + sides[1]) * held
+    moment_left = moment - inner_moment - (sides[1] - sides[0]) * held * arm
     # the largest share at any one time (a share at a small load counts as much); times
     # that carry next to nothing (a ramp from 0) say nothing of it
     largest = float(np.max(np.abs(force), initial=0.0))

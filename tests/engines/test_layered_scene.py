@@ -194,3 +194,23 @@ def test_the_held_share_is_the_largest_at_any_time_and_lift_off_is_integrated_by
     assert shortfall[-1] == pytest.approx(0.0107, abs=1e-4)
     assert result.info["corner_pressure"]["held_force_share"] == pytest.approx(
         float(np.max(shortfall)), abs=1e-5)
+
+
+def test_a_moving_zone_over_many_output_times_is_answered_with_its_held_share():
+    """Sixteen load steps, each lifting the heel to another end, over 2000 output times:
+    the share's integral, split at every end at once, asked the answer's pressure at
+    2048 points x 2000 times, over the bound of one call, and the solve failed. Past
+    HELD_VALUES the integral is one piece (500 points at 2000 times here)."""
+    from core.presets import read_preset
+
+    d = read_preset("bare_layer")
+    d["solver"]["contact"] = "unilateral"
+    d["loading"] = {"force": {"kind": "step", "values": list(np.linspace(2e5, 3e5, 16)),
+                              "breaks": list(np.linspace(5.0, 95.0, 15))},
+                    "moment": 1.2e5}
+    d["times"] = {"end": 100, "count": 2000}
+    result = solve(d)
+    ends = {zone[0] for zones in result.contact_set for zone in zones if zone[0] > -1.0}
+    assert len(ends) >= 15
+    # e = 0.6 to 0.4 m on a 1 m half-width: the heel's share as on the lifted preset
+    assert 0.0142 < result.info["corner_pressure"]["held_force_share"] < 0.0145
