@@ -104,16 +104,22 @@ def _apart(value: float, other: float) -> str:
 
 
 def missed_reason(message: str) -> str:
-    """Why a solve's message says tol was not met, in the engines' own words: after
-    "not within tol: " (lift-off), in the parentheses of "not met (...)" (the projection
-    engine's margin) or after "not met: " (the others); empty when it does not say."""
-    for marker in ("not within tol: ", "not met: "):
-        if marker in message:
-            return message.partition(marker)[2].strip().rstrip(".")
+    """Why a solve's message says tol was not met, in the engines' own words: after "not
+    met: " (the default and layered engines), in and after the parentheses of "not met
+    (...)" (the projection engine's margin), after "is above ...: " (the collocation
+    engine), else the reasons a verdict appends after "; " (lift-off: "not within tol:
+    ...", a zone end out of its band, ends that did not converge, an unsettled contact
+    set); empty when it does not say."""
+    if "not met: " in message:
+        return message.partition("not met: ")[2].strip().rstrip(".")
     if "not met (" in message:
         inside, _, rest = message.partition("not met (")[2].partition(")")
         return (inside + rest).strip().rstrip(".")
-    return ""
+    if " is above " in message:
+        return message.partition(" is above ")[2].partition(": ")[2].strip().rstrip(".")
+    reasons = [part.strip().removeprefix("not within tol: ")
+               for part in message.split("; ")[1:]]
+    return "; ".join(r for r in reasons if r).rstrip(".")
 
 
 def details_text(view: ResultView) -> str:

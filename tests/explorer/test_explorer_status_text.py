@@ -93,3 +93,31 @@ def test_a_missed_target_says_by_how_much_and_why() -> None:
     view.info["message"] = "tol 1.0e-08 not met (success needs the estimate below tol/3)"
     assert plain_status(view).endswith("target 1e-08; success needs the estimate below "
                                        "tol/3."), plain_status(view)
+
+
+def test_every_engine_s_reason_for_a_missed_target_is_said() -> None:
+    """The verdicts that miss for their zone ends, their contact set or a band their ends
+    left, and the collocation engine, have no "not met" in their message: the status said
+    the numbers alone, an estimate below its target NOT met."""
+    from explorer.views.status import missed_reason
+
+    assert missed_reason("unilateral contact (elastic): estimated error 1.0e-09, zone ends "
+                         "to 3.0e-07 half-widths; the zone ends did not converge") == \
+        "the zone ends did not converge"
+    assert missed_reason("unilateral contact under creep: 140 steps, estimated error "
+                         "1.0e-07 (...), zone ends to 1e-07 half-widths; a zone end left "
+                         "the finely paneled band around the ends at 2 time(s), its "
+                         "estimate does not hold there; not within tol: 3 x the estimated "
+                         "error = 3.0e-07 is over tol 1.0e-07") == (
+        "a zone end left the finely paneled band around the ends at 2 time(s), its "
+        "estimate does not hold there; 3 x the estimated error = 3.0e-07 is over tol "
+        "1.0e-07")
+    assert missed_reason("estimated relative error 2.0e-06 is above tol = 1.0e-06: space: "
+                         "the distance from the rule one level coarser gives 2.0e-06; "
+                         "refine panels_per_unit or edge_width") == (
+        "space: the distance from the rule one level coarser gives 2.0e-06; refine "
+        "panels_per_unit or edge_width")
+    assert missed_reason("tol 1.0e-08 not met: the grid reached 64 panels with estimated "
+                         "error 2.0e-08 in q; time stepping: done") == (
+        "the grid reached 64 panels with estimated error 2.0e-08 in q; time stepping: done")
+    assert missed_reason("converged") == ""
