@@ -55,18 +55,26 @@ def _plots(result: SceneSolution | PunchesSolution, time: float | None,
     return _standalone(resources.INLINE.render()) + script, divs[0], "".join(divs[1:])
 
 
-#: A script the resources load from a relative address: none exists beside a report file.
-_RELATIVE_SCRIPT = re.compile(
-    r'<script[^>]*\ssrc="(?![a-z][a-z0-9+.-]*:|/)[^"]*"[^>]*>\s*</script>\s*', re.IGNORECASE)
+#: An empty script element loading its source: ``src`` quoted either way or not.
+_LOADED_SCRIPT = re.compile(
+    r"""<script\b[^>]*?\ssrc\s*=\s*(?:"([^"]*)"|'([^']*)'|([^"'\s>]+))[^>]*>\s*</script>\s*""",
+    re.IGNORECASE)
+#: An address with a scheme (``https:``, ``data:``) or from another host (``//``).
+_ABSOLUTE = re.compile(r"[a-z][a-z0-9+.-]*:|//", re.IGNORECASE)
 
 
 def _standalone(head: str) -> str:
-    """``head`` (Bokeh's resources, inline) without scripts loaded from a relative
-    address. Where Panel is imported (the command line's report loads HoloViews, which
-    loads it) Bokeh's resources carry Panel's module shim as
-    ``static/extensions/panel/...``, which a saved report has no server to fetch from: the
-    report's plots need only the inline Bokeh library."""
-    return _RELATIVE_SCRIPT.sub("", head)
+    """``head`` (Bokeh's resources, inline) without scripts loaded from an address with
+    no scheme (relative, or from the root of a server): nothing answers those beside a
+    report file. Where Panel is imported (the command line's report loads HoloViews,
+    which loads it) Bokeh's resources carry Panel's module shim as
+    ``static/extensions/panel/...``; the report's plots need only the inline Bokeh
+    library."""
+    def kept(found: re.Match[str]) -> str:
+        source = next(group for group in found.groups() if group is not None)
+        return found.group(0) if _ABSOLUTE.match(source) else ""
+
+    return _LOADED_SCRIPT.sub(kept, head)
 
 
 def report_html(result: SceneSolution | PunchesSolution, time: float | None = None,

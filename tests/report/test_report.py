@@ -165,6 +165,18 @@ def test_the_html_report_loads_nothing_from_beside_it(checked):
     assert all(re.match(r"[a-z][a-z0-9+.-]*:|/", s) for s in sources), sources
 
 
+def test_a_script_from_an_address_without_a_scheme_is_left_out_however_quoted():
+    from core.report.html import _standalone
+
+    head = ('<script src="static/a.js"></script>\n<script src=\'static/b.js\'></script>'
+            '<script src=static/c.js></script><script type="module" src="/static/d.js">'
+            '</script><script src="https://cdn.example/e.js"></script>'
+            '<script src="//cdn.example/f.js"></script><script>var src = "x";</script>')
+    assert _standalone(head) == ('<script src="https://cdn.example/e.js"></script>'
+                                 '<script src="//cdn.example/f.js"></script>'
+                                 '<script>var src = "x";</script>')
+
+
 def test_the_geometry_is_drawn_where_it_varies_and_no_lift_off_plot_in_full_contact():
     text = report_html(core.solve(read_preset("stepped_punch")))
     assert "punch base f(x) above its lowest point [mm]" in text
