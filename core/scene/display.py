@@ -319,12 +319,8 @@ def corner_note(corners: Mapping[str, Any] | None,
     force, moment = corners.get("held_force_share"), corners.get("held_moment_share")
     if force is None:
         return note
-    left = f"{_percent(force)} of the force P" + (
-        "" if moment is None else f" and {_percent(moment)} of the moment M")
+    left = f"{percent_text(force, 2)} of the force P" + (
+        "" if moment is None else f" and {percent_text(moment, 2)} of the moment M")
     return (f"{note}, and so leave out up to {left} (integrated, the rows fall short; the "
             "histories' force and moment are the answer's)")
 
-
-def _percent(share: float) -> str:
-    """A share [-] as a percentage of two significant digits ("2.2 %", "0.011 %")."""
-    return f"{100.0 * share:.2g} %"

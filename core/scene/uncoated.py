@@ -51,8 +51,9 @@ def check_uncoated(scene: Any) -> None:
         # (the scope's words of shapes and creep said nothing of it)
         a, thickness = scene.half_width, scene.base_thickness
         # three digits, rounded up: the thickness said is one that is answered
-        step = 10.0 ** (math.floor(math.log10(thinnest_bare_base(a))) - 2)
-        least = math.ceil(thinnest_bare_base(a) / step) * step
+        thinnest = thinnest_bare_base(a)
+        step = 10.0 ** (math.floor(math.log10(thinnest)) - 2)
+        least = math.ceil(thinnest / step) * step
         raise ValueError(
             f"base.thickness: without coating layers the base must be at least "
             f"{least:.3g} m thick under this punch (a / H at most {a / least:.3g}), got "
