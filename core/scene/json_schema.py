@@ -411,7 +411,18 @@ def _words(error: Any, root: str) -> Iterator[tuple[str, str]]:
         unit = re.search(r"\[([^\]]+)\]\.?$", str(error.schema.get("description", "")))
         unit = "" if unit is None or unit.group(1) == "-" else " " + unit.group(1)
         unit = " days" if unit == " day" else unit
-        yield path, f"must be {sign} {value:g}{unit}, got {got}{unit if unit else ''}"
+        low = next(((k, error.schema[k]) for k in ("minimum", "exclusiveMinimum")
+                    if k in error.schema), None)
+        high = next(((k, error.schema[k]) for k in ("maximum", "exclusiveMaximum")
+                     if k in error.schema), None)
+        if low is not None and high is not None:
+            # both ends said at once, as the Python checks say them ("in (-1, 0.5)"): a
+            # value fixed above its upper end must not then fall under its lower one
+            bounds = (f"{'(' if low[0] == 'exclusiveMinimum' else '['}{low[1]:g}, "
+                      f"{high[1]:g}{')' if high[0] == 'exclusiveMaximum' else ']'}")
+            yield path, f"must be in {bounds}{unit}, got {got}{unit if unit else ''}"
+        else:
+            yield path, f"must be {sign} {value:g}{unit}, got {got}{unit if unit else ''}"
     elif kind == "const":
         yield path, f"must be {show_value(value)}, got {got}"
     elif kind == "enum":

@@ -239,10 +239,10 @@ def test_the_code_models_bound_the_age_at_loading_in_the_schema(scene_schema: di
     with pytest.raises(ValueError, match="age_at_loading"):
         scene_from_dict(scene)
     assert schema_errors(scene, scene_schema) == [
-        "base.age_at_loading: must be >= 1 days, got 0.5 days"]
+        "base.age_at_loading: must be in [1, 3650] days, got 0.5 days"]
     # one line a field: at 0 the code's bound, not the general "> 0 days" as well
     assert schema_errors(edited("base.age_at_loading", 0, scene), scene_schema) == [
-        "base.age_at_loading: must be >= 1 days, got 0 days"]
+        "base.age_at_loading: must be in [1, 3650] days, got 0 days"]
 
 
 def test_a_strength_class_is_a_class_and_three_loads_one_line(scene_schema: dict) -> None:
@@ -278,14 +278,19 @@ def test_the_reasons_are_worded_as_the_validator_words_them(scene_schema: dict) 
                          scene_schema) == [
         "loading: settlement and force is not one of the four statements (settlement+tilt, "
         "settlement+moment, tilt+force, force+moment)"]
+    # a field bounded at both ends is said as the validator says it: `coated-punch
+    # validate` read "must be < 0.5" where `solve` read "must be in (-1, 0.5)"
     assert schema_errors(edited("coating[0].poisson", 0.5), scene_schema) == [
-        "coating[0].poisson: must be < 0.5, got 0.5"]
+        "coating[0].poisson: must be in (-1, 0.5), got 0.5"]
+    with pytest.raises(ValueError) as refused:
+        scene_from_dict(edited("base.poisson", -2.0))
+    assert schema_errors(edited("base.poisson", -2.0), scene_schema) == [str(refused.value)]
     assert schema_errors(edited("base.thickness", DELETE), scene_schema) == [
         "base.thickness: required field is missing"]
     # every problem of a file at once, not only the first
     scene = edited("base.poisson", 2.0, edited("solver", {"tol": 1.0}))
     assert schema_errors(scene, scene_schema) == [
-        "base.poisson: must be < 0.5, got 2", "solver.tol: must be <= 0.01, got 1"]
+        "base.poisson: must be in (-1, 0.5), got 2", "solver.tol: must be in [1e-12, 0.01], got 1"]
 
 
 def _study(**changes: Any) -> dict:
