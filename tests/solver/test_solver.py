@@ -10,6 +10,7 @@ import pytest
 from scipy.linalg import expm
 
 from core.discretize import base_panels, graded_cuts, kernel_operator, operator_rows
+from core.problem import UnresolvedOperator
 from core.solver import solve_dimensionless
 from tests.support.points import whole_interval
 
@@ -387,3 +388,28 @@ def test_a_creeping_span_too_short_to_step_is_refused_naming_times() -> None:
             assert sol.info["success"] and np.all(np.isfinite(sol.settlement))
     elastic = solve_dimensionless(1.0, 0.05, 0.0, [1.0, 1.0 + 1e-12], force=1.0, moment=0.1)
     assert elastic.info["success"]
+
+
+def test_a_kernel_that_takes_the_compliance_through_zero_is_refused_naming_it() -> None:
+    """A kernel of 1e99 (a fuzzer's) failed deep in the default engine with "cannot
+    convert float NaN to integer"; one of -1e50 (a base 1e50 times softer after creep)
+    too. The first describes no material: 1 - int_1^t K du is the held stress's
+    compliance over the elastic one, and it goes negative. The second is a material the
+    engine cannot resolve: it declines, as for any grid it cannot resolve."""
+    def constant(value: float):
+        return lambda t, tau: np.full(np.broadcast(t, tau).shape, value)
+
+    for method in (None, "projection", "collocation"):
+        with pytest.raises(ValueError, match=r"^kernel: the compliance of a stress held "
+                                             r"since loading .* it is -1e\+99 at t = 2$"):
+            solve_dimensionless(1.0, 0.1, 0.0, [1.0, 2.0, 5.0], kernel=constant(1e99),
+                                force=1.0, moment=0.0, method=method)
+    # 0.6 per unit time: the compliance 1 - 0.6 (t - 1) passes zero at t = 8/3
+    with pytest.raises(ValueError, match=r"it is -1\.4 at t = 5$"):
+        solve_dimensionless(1.0, 0.1, 0.0, [1.0, 2.0, 5.0], kernel=constant(0.6), force=1.0,
+                            moment=0.0)
+    # the default engine declines it as it declines any grid it cannot resolve (with the
+    # engine left to the solver, the next one answers, unconverged: ~5 s)
+    with pytest.raises(UnresolvedOperator, match="does not resolve"):
+        solve_dimensionless(1.0, 0.1, 0.0, [1.0, 2.0], kernel=constant(-1e50), force=1.0,
+                            moment=0.0, tol=1e-6, method="nystrom")

@@ -337,6 +337,11 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             estimate = coarse_estimate
             break
         grid, responses, factor = fine, fine_responses, fine_factor
+        if not np.isfinite(estimate):
+            # a reference modulus so small (a base ~1e50 times softer after creep) that
+            # the coating's term underflows: no refinement resolves it here
+            estimate, resolved = np.inf, False
+            break
         if estimate <= target:
             break
         # Each further level gains ~16x: add the missing ones (the loop adds the last).
