@@ -120,7 +120,8 @@ class _Parser(argparse.ArgumentParser):
     """An argument parser whose usage errors are one line and exit with code 2."""
 
     def error(self, message: str) -> NoReturn:
-        raise _InputError(f"{self.prog}: {message}")
+        # (a bare `coated-punch` said only which arguments were missing)
+        raise _InputError(f"{self.prog}: {message} (see '{self.prog} --help')")
 
 
 #: The address-space bound [bytes] this run set on itself (None: none, as when
@@ -387,6 +388,10 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 def _output_format(option: str, path: Path | None, given: str | None) -> str | None:
     """``json`` or ``csv`` for an output: ``--format``, else the file's extension."""
     if path is None:
+        if given is not None:
+            # a summary has no format: taken silently, --format csv printed the summary
+            raise _InputError(f"--format: is the format of {option}, which is not given "
+                              f"(-o - writes {given.upper()} to standard output)")
         return None
     if given is not None:
         return given
@@ -850,7 +855,9 @@ def build_parser() -> argparse.ArgumentParser:
     p_sweep = sub.add_parser("sweep", help="run a design study (format: 'Study files' in "
                                            "the file formats) on Dask",
                              parents=[memory])
-    p_sweep.add_argument("study", help="study file (JSON) or preset:NAME")
+    p_sweep.add_argument("study", help="study file (JSON) or preset:NAME, one of the "
+                                       "shipped studies ("
+                                       + ", ".join(study_names()) + ")")
     p_sweep.add_argument("--output", "-o", metavar="PATH", required=True,
                          help="result file: .nc (xarray dataset), .csv or .parquet (a row "
                               "per point and time)")
@@ -900,7 +907,8 @@ def build_parser() -> argparse.ArgumentParser:
     p_check = sub.add_parser("check", help="model error of the fast answer against a "
                                            "resolved finite-element model of the coating",
                              parents=[memory])
-    p_check.add_argument("scene", help="scene file (JSON) or preset:NAME")
+    p_check.add_argument("scene", help="scene file (JSON), '-' (standard input) or "
+                                       "preset:NAME")
     p_check.add_argument("--time", type=float, default=0.0, metavar="DAYS",
                          help="days after loading: base modulus and given loads (default 0)")
     p_check.add_argument("--level", type=int, choices=(0, 1), default=FE_CHECK_LEVEL,

@@ -63,7 +63,7 @@ def import_optional(module: str, feature: str) -> ModuleType:
         extra = EXTRA_OF.get(top, "all")
         package = DISTRIBUTION_OF.get(top, top)
         raise MissingDependency(
-            f"{feature} needs {package}, which is not installed: "
+            f"{package} is needed for {feature} and is not installed: "
             f"pip install 'coated-punch[{extra}]'") from error
 
 

@@ -172,6 +172,14 @@ def test_bad_arguments(tmp_path: Path):
     assert_one_line_error(run("frobnicate"), "coated-punch: argument")
     assert_one_line_error(run("solve", SCENES / "uniform_flat.json", "-o", tmp_path / "r.txt"),
                           "--output: unsupported extension '.txt'")
+    # a bare command said only what was missing; now where to read more
+    bare = run()
+    assert_one_line_error(bare, "coated-punch: the following arguments are required")
+    assert bare.stderr.rstrip().endswith("(see 'coated-punch --help')"), bare.stderr
+    # a summary has no format: --format csv without --output printed it all the same
+    no_output = run("solve", "preset:worn_coating", "--format", "csv")
+    assert_one_line_error(no_output, "--format: is the format of --output, which is not "
+                                     "given (-o - writes CSV to standard output)")
 
 
 @pytest.mark.parametrize(("path", "value", "message"), BAD_VALUES[::3],

@@ -126,7 +126,7 @@ print("ok")
     run = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, env=env,
                          capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-3000:]
-    assert "a study's dataset needs xarray, which is not installed: " \
+    assert "xarray is needed for a study's dataset and is not installed: " \
            "pip install 'coated-punch[data]'" in run.stdout
     assert run.stdout.strip().endswith("ok")
 

@@ -167,10 +167,10 @@ def test_a_missing_data_library_names_the_extra(full: SceneSolution,
                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "xarray", None)
     monkeypatch.setitem(sys.modules, "pandas", None)
-    with pytest.raises(ImportError, match=r"to_xarray needs xarray.*pip install "
-                                          r"'coated-punch\[data\]'"):
+    with pytest.raises(ImportError, match=r"xarray is needed for SceneSolution.to_xarray.*"
+                                          r"pip install 'coated-punch\[data\]'"):
         full.to_xarray()
-    with pytest.raises(ImportError, match=r"to_dataframe needs pandas"):
+    with pytest.raises(ImportError, match=r"pandas is needed for SceneSolution.to_dataframe"):
         full.to_dataframe()
 
 
