@@ -74,6 +74,7 @@ from core.scene import (
     check_loads_touch,
     check_settled,
     corner_note,
+    estimated_quantity,
     flags_with_evidence,
     has_punches,
     largest_pressure,
@@ -323,9 +324,10 @@ def _summary(result: SceneSolution) -> str:
     lines.append(f"flags: {', '.join(result.flags) if result.flags else 'none'}")
     estimate = result.info.get("model_error_estimate")
     if estimate is not None:
+        quantity = estimated_quantity(result.scene.given, result.model_error.get("part"))
         lines.append(f"coating model error ({result.info.get('coating_model')}, estimate): "
-                     f"{percent_text(estimate, 2)} (solver.model_tol "
-                     f"{100 * result.scene.model_tol:g} %)")
+                     f"{percent_text(estimate, 2)}{' of ' + quantity if quantity else ''} "
+                     f"(solver.model_tol {100 * result.scene.model_tol:g} %)")
     check = result.design_check()
     if check is not None:
         lines.append(f"design check (whole history): "

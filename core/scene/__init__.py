@@ -66,6 +66,7 @@ from core.scene.display import (
 from core.scene.evidence import (
     check_settled,
     checked_key,
+    estimated_quantity,
     flags_with_evidence,
     model_error_evidence,
 )
@@ -156,6 +157,7 @@ __all__ = [
     "check_scene",
     "pressure_caution",
     "checked_key",
+    "estimated_quantity",
     "flags_with_evidence",
     "model_error_evidence",
     "check_settled",

@@ -31,6 +31,20 @@ MEASURED = "measured by the FE check"
 ESTIMATED = "estimated"
 
 
+def estimated_quantity(given: Any, part: str | None) -> str:
+    """The unknown whose coating-model error sets a result's estimate, in words (``"the
+    moment M"``): ``part`` is ``SceneSolution.model_error["part"]`` (``"force"``: the
+    force, or the settlement where the force is given; ``"moment"``: the moment, or the
+    tilt where the moment is given); ``given``: the scene's given loads (names). Empty
+    for no part."""
+    given = set(given)
+    if part == "moment":
+        return "the tilt α" if "moment" in given else "the moment M"
+    if part == "force":
+        return "the settlement δ" if "force" in given else "the force P"
+    return ""
+
+
 def checked_key(scene: Scene | Mapping[str, Any]) -> str:
     """Content hash of what :func:`core.scene.check_scene`'s answer depends on: equal for
     two scenes whose check gives the same measurement (``CHECKED_PARTS`` equal)."""

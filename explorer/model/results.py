@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from core import scene_from_dict
-from core.scene import flags_with_evidence, model_error_evidence
+from core.scene import estimated_quantity, flags_with_evidence, model_error_evidence
 
 from .state import QUANTITIES, QUANTITY_UNITS
 
@@ -188,7 +188,20 @@ def model_evidence(view: ResultView,
     estimate = view.info.get("model_error_estimate")
     if not isinstance(estimate, (int, float)):
         return None
-    return model_error_evidence(view.scene, float(estimate), check)
+    # (the FE check measures one punch: a report on screen is of another scene)
+    evidence = model_error_evidence(view.scene, float(estimate),
+                                    None if view.punches else check)
+    parts = view.info.get("model_error")
+    if evidence["source"] == "measured" or not isinstance(parts, Mapping):
+        return evidence
+    # whose error it is (a tilt of 0.3 % of the settlement made it the moment's)
+    punch = parts.get("punch")
+    if view.punches and isinstance(punch, int) and 0 <= punch < len(view.punches):
+        quantity = estimated_quantity(view.punches[punch].given, parts.get("part"))
+        evidence["quantity"] = f"{quantity} of punch {punch + 1}" if quantity else ""
+    elif isinstance(view.scene.get("loading"), Mapping):
+        evidence["quantity"] = estimated_quantity(view.scene["loading"], parts.get("part"))
+    return evidence
 
 
 def shown_flags(view: ResultView, evidence: Mapping[str, Any] | None) -> list[str]:
@@ -381,6 +394,13 @@ def _prepare_punches(solution: Any, scene: dict[str, Any]) -> ResultView:
                                        if m)
     info = {k: v for k, v in dict(solution.info).items() if k != "flags"}
     info["flags"] = list(solution.flags)
+    # the coating model's error of the scene: its worst punch's (the page showed none
+    # while every punch was within solver.model_tol)
+    errors = [dict(getattr(p, "model_error", None) or {}) for p in solution.punches]
+    if errors and all(isinstance(e.get("estimate"), (int, float)) for e in errors):
+        worst = max(range(len(errors)), key=lambda k: errors[k]["estimate"])
+        info["model_error_estimate"] = float(errors[worst]["estimate"])
+        info["model_error"] = {**errors[worst], "punch": worst}
     first = solution.punches[0].info
     info.setdefault("contact", first.get("contact", "full") if len(punches) == 1 else "full")
     union = [sorted(zone for p in punches for zone in p.contact_set[j])

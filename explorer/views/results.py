@@ -84,13 +84,15 @@ def badges_html(view: ResultView | None, group: str,
         if uncoated and flag not in flags:
             continue  # no coating: nothing of a coating to vouch for
         if flag == "model_error" and evidence is None and flag not in flags:
-            good = ""  # no evidence read (several punches): the estimate is not shown
+            good = ""  # no estimate read: nothing to vouch with
         text = flag_message(view, flag)
         if flag == "model_error" and evidence is not None:
             # a badge of the model's error says whether it was measured or estimated
+            of = f" of {evidence['quantity']}" if evidence.get("quantity") else ""
             bad, good = (f"{word} ({evidence['label']} "
-                         f"{percent_text(evidence['error'])})" for word in (bad, good))
-            text = evidence["message"]
+                         f"{percent_text(evidence['error'])}{of})" for word in (bad, good))
+            if not view.punches:  # (several: the flag's message names the punches)
+                text = evidence["message"]
         if flag == "model_error" and "beyond_model_map" in flags:
             good = ""  # an extrapolated estimate vouches for nothing: its own badge says so
         if flag in flags:

@@ -166,8 +166,11 @@ def model_error_text(evidence: Mapping[str, Any], extrapolated: bool = False) ->
         return (f"Coating model error {percent_text(evidence['error'])} (estimated, "
                 "extrapolated beyond the measured map): check it on the Coating tab.")
     side = "above" if evidence["flagged"] else "within"
-    return (f"Coating model error {percent_text(evidence['error'])} ({evidence['label']}), "
-            f"{side} solver.model_tol {100 * evidence['model_tol']:g} %.")
+    quantity = evidence.get("quantity")
+    of = f" of {quantity}" if quantity else ""
+    return (f"Coating model error {percent_text(evidence['error'])}{of} "
+            f"({evidence['label']}), {side} solver.model_tol "
+            f"{100 * evidence['model_tol']:g} %.")
 
 
 def status_html(view: ResultView | None, busy: bool,

@@ -43,7 +43,7 @@ def test_the_badge_follows_the_fe_check(page: Page):
     assert page.page.locator(".ok-model_error").count() == 0
     page.open_tab("Coating")
     flag = page.page.locator(".flag-model_error").first
-    assert "(estimated 5.45 %)" in flag.inner_text()
+    assert "(estimated 5.45 % of the tilt α)" in flag.inner_text()
     page.page.locator(".coating-check-button button").first.click()
     measured = "above solver.model_tol (measured by the FE check 4.7 %)"
     until(lambda: measured in flag.inner_text(), "the measured error in the badge", 180,

@@ -270,17 +270,19 @@ def test_the_pressure_plot_spans_the_punch_and_its_pins_set_by_the_server() -> N
     assert (rng.start, rng.end) == pytest.approx((-1.1 * b, 1.1 * b), rel=1e-12)
 
 
-def test_no_coating_badges_on_a_bare_layer_nor_an_unread_estimate() -> None:
+def test_no_coating_badges_on_a_bare_layer_and_several_punches_show_their_worst() -> None:
     # the bare preset showed "✓ coating thin | ✓ coating softer than base | ✓ coating
-    # model within solver.model_tol (estimated 0 %)"; several punches "✓ coating model
-    # within solver.model_tol" with no estimate behind it
+    # model within solver.model_tol (estimated 0 %)"
     from explorer.model import model_evidence
     from explorer.views.results import badges_html
 
     bare = _solved("bare_layer")
     assert "coating" not in badges_html(bare, "scene", model_evidence(bare))
+    # several punches: their worst punch's estimate, named (the page showed none while
+    # every punch was within solver.model_tol)
     pair = _solved("new_footing_beside_old")
-    assert "ok-model_error" not in badges_html(pair, "scene", model_evidence(pair))
+    assert ("coating model within solver.model_tol (estimated 1.31 % of the tilt α of "
+            "punch 1)") in badges_html(pair, "scene", model_evidence(pair))
     coated = _solved("uniform_flat")
     assert "ok-model_error" in badges_html(coated, "scene", model_evidence(coated))
 
