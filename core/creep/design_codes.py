@@ -153,13 +153,15 @@ class CodeCreep:
         """Creep function ``C(t, tau) = phi(t, tau)/E(28)`` [1/Pa] at ages [day]; 0 for t < tau."""
         return self.creep_coefficient(t, tau) / (1e6 * self._reference)
 
-    def _age_at_loading(self, value: Any, field: str) -> float:
+    def age_at_loading_in_range(self, value: Any, field: str) -> float:
+        """``value`` [day] as the age at loading, checked against the code's range
+        (:data:`RANGES`); a ``ValueError`` naming ``field`` and the range's source."""
         return _in_range(value, self.name, "age_at_loading", field)
 
     def relative_modulus(self, age_at_loading: float, *,
                          field: str = "age_at_loading") -> RelativeCodeModulus:
         """``c(t*) = E(tau0 t*) / E(tau0)`` [-]; ``age_at_loading`` tau0 [day]."""
-        return RelativeCodeModulus(self.inputs, self._age_at_loading(age_at_loading, field))
+        return RelativeCodeModulus(self.inputs, self.age_at_loading_in_range(age_at_loading, field))
 
     def dimensionless_kernel(self, age_at_loading: float, *,
                              field: str = "age_at_loading", tol: float | None = None):
@@ -173,7 +175,7 @@ class CodeCreep:
         """
         from core.creep.kernel_fit import fit_compliance, nonpositive_violation
 
-        tau0 = self._age_at_loading(age_at_loading, field)
+        tau0 = self.age_at_loading_in_range(age_at_loading, field)
         inputs = self.inputs
         c = RelativeCodeModulus(inputs, tau0)
         e0 = float(_FORMULAS[self.name][0](inputs, tau0))
@@ -240,7 +242,7 @@ def creep_coefficient_curve(spec: dict, age_at_loading: float, durations: Any, *
             or spec["model"] not in _FORMULAS:
         raise ValueError(f"{field}.model: must be one of " + ", ".join(sorted(_FORMULAS)))
     model = CodeCreep(spec["model"], spec, field)
-    t0 = model._age_at_loading(age_at_loading, "age_at_loading")
+    t0 = model.age_at_loading_in_range(age_at_loading, "age_at_loading")
     try:
         d = np.asarray(durations, dtype=float)
     except (TypeError, ValueError):

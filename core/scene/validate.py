@@ -150,12 +150,6 @@ def _validated(d: dict[str, Any]) -> Scene:
     base = check_fields(d["base"], "base", schema.required_fields("base"))
     h_base = positive_number(base["thickness"], "base.thickness")
     nu = _poisson(base["poisson"], "base.poisson")
-    tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
-    if tau0 > schema.MAX_AGE:
-        raise ValueError(f"base.age_at_loading: must be <= {schema.MAX_AGE:g} days (about "
-                         f"{schema.MAX_AGE / limits.DAYS_PER_YEAR:.0f} years: older, the age "
-                         f"swamps the time steps after loading in double precision), got "
-                         f"{tau0:g}")
     try:
         creep = creep_model_from_spec(base["creep"], field="base.creep")
     except NumberTooLarge:
@@ -164,6 +158,16 @@ def _validated(d: dict[str, Any]) -> Scene:
         # an overflow in a creep computation, with no parameter to name
         raise ValueError("base.creep: a number is too large for a double (must be a finite "
                          "number)") from None
+    if isinstance(creep, CodeCreep):
+        # a design code's own range is said first: "must be > 0" for 0 days let 0.5
+        # through, which the code then refused with its [1, 3650]
+        creep.age_at_loading_in_range(base["age_at_loading"], "base.age_at_loading")
+    tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
+    if tau0 > schema.MAX_AGE:
+        raise ValueError(f"base.age_at_loading: must be <= {schema.MAX_AGE:g} days (about "
+                         f"{schema.MAX_AGE / limits.DAYS_PER_YEAR:.0f} years: older, the age "
+                         f"swamps the time steps after loading in double precision), got "
+                         f"{tau0:g}")
     lam_lo, lam_hi = schema.LAM_RANGE
     if not math.isfinite(a / h_base) or not lam_lo <= a / h_base <= lam_hi:
         # both lengths said: the one changed may be the punch's (the page then still

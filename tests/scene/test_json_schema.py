@@ -240,6 +240,12 @@ def test_the_code_models_bound_the_age_at_loading_in_the_schema(scene_schema: di
         scene_from_dict(scene)
     assert schema_errors(scene, scene_schema) == [
         "base.age_at_loading: must be in [1, 3650] days, got 0.5 days"]
+    # the solver says the code's range first too: it said "must be > 0" for 0 days and
+    # "must be <= 100000 days" for 1e9 (the page showed those beside the code's range)
+    for age in (0, 0.5, -3, 1e9):
+        with pytest.raises(ValueError, match=r"^base\.age_at_loading: must be in \[1, 3650\] "
+                                             r"\(EN 1992-1-1 Figure 3\.1"):
+            scene_from_dict(edited("base.age_at_loading", age, scene))
     # one line a field: at 0 the code's bound, not the general "> 0 days" as well
     assert schema_errors(edited("base.age_at_loading", 0, scene), scene_schema) == [
         "base.age_at_loading: must be in [1, 3650] days, got 0 days"]
