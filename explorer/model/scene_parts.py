@@ -221,9 +221,13 @@ class PunchState(param.Parameterized):
         """The shape ``f(x)`` as a profile spec in metres."""
         a = self.half_width
         if self.shape == "parabolic":
-            radius = self.radius * _KM
-            # a zero radius must reach the core, which names the field, not crash here
-            curvature = 1.0 / (2.0 * radius) if radius != 0 else math.inf
+            # said in the box's words: 0 km read "punch.shape.coefficients[2]: must be a
+            # finite number, is inf", and -5 km drew a dished base under "crowned"
+            if not (math.isfinite(self.radius) and self.radius > 0.0):
+                raise ValueError(f"punch.shape: the crown radius R must be > 0 km, is "
+                                 f"{self.radius:g} km (a dished base is a custom shape: a "
+                                 "table of heights from a file)")
+            curvature = 1.0 / (2.0 * self.radius * _KM)
             return {"kind": "polynomial", "coefficients": [0.0, 0.0, curvature]}
         if self.shape == "wedge":
             rise = self.slope * _URAD * a

@@ -332,6 +332,14 @@ def test_a_step_or_land_off_the_punch_is_said_in_the_sliders_words(explorer_app)
         "Punch, shape (punch.shape): the land width must be above 0 and below the punch's "
         "width 2a = 0.2 m, is 0.8 m")
     assert error(shape="stepped", step_position=0.99) == ""
+    # the crown radius: 0 km read "Punch, shape, coefficients[2] (punch.shape.
+    # coefficients[2]): must be a finite number, is inf", and -5 km drew a dished base
+    # under "crowned"
+    for radius in (0.0, -5.0):
+        assert error(shape="parabolic", radius=radius) == (
+            f"Punch, shape (punch.shape): the crown radius R must be > 0 km, is {radius:g} "
+            "km (a dished base is a custom shape: a table of heights from a file)")
+    assert error(shape="parabolic", radius=0.5) == ""
     app = explorer_app()
     app.state.punch.half_width = 0.5
     view = app.punch_tab
