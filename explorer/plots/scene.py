@@ -210,9 +210,7 @@ class SceneDrawing:
                                "y": np.concatenate([bottom_y, [punch_top, punch_top]])}
         self.fig.x_range.update(start=-1.55 * a, end=1.55 * a)
         self.fig.y_range.update(start=-1.08 * depth, end=punch_top + 0.55 * a)
-        note = f"coating and punch profile drawn ×{scale:g} vertically" if scale > 1 else \
-            "drawn to scale"
-        self.scale_label.text = note
+        self._say_scale(scale, "coating and punch profile")
 
     def _show_punches(self, view: ResultView, contact: ContactDrawing) -> None:
         """Draw a scene of several punches: the coating along the loaded stretch and
@@ -257,8 +255,18 @@ class SceneDrawing:
         contact.set_surface(g.x, scale * total)
         self.fig.x_range.update(start=left - 0.05 * a_ref, end=right + 0.05 * a_ref)
         self.fig.y_range.update(start=-1.08 * depth, end=punch_top + 0.55 * a_ref)
-        self.scale_label.text = (f"coating and punch profiles drawn ×{scale:g} vertically"
-                                 if scale > 1 else "drawn to scale")
+        self._say_scale(scale, "coating and punch profiles")
+
+    def _say_scale(self, scale: float, what: str) -> None:
+        """The note in the corner and the y axis's label say the same of the drawing's
+        vertical ``scale`` (a bare layer read "drawn to scale" beside "y [m]
+        (exaggerated)")."""
+        self.scale_label.text = (f"{what} drawn ×{scale:g} vertically" if scale > 1
+                                 else "drawn to scale")
+        label = "y [m] (exaggerated)" if scale > 1 else "y [m]"
+        axis = self.fig.yaxis[0]
+        if axis.axis_label != label:  # (a label set anew lays the figure out)
+            axis.axis_label = label
 
     _punch_top = 0.0
     _a_ref = 1.0

@@ -302,3 +302,14 @@ def test_the_status_line_does_not_vouch_for_an_extrapolated_estimate() -> None:
     assert "beyond_model_map" in view.flags
     text = status_html(view, False, model_evidence(view))
     assert "extrapolated beyond the measured map" in text and "within solver" not in text
+
+
+def test_the_drawing_s_axis_says_what_its_corner_note_says() -> None:
+    """The bare layer read "drawn to scale" in the corner beside "y [m] (exaggerated)" on
+    the axis."""
+    for key, label, note in (("bare_layer", "y [m]", "drawn to scale"),
+                             ("uniform_flat", "y [m] (exaggerated)", "drawn ×")):
+        figures, _, _ = _drawn(key)
+        drawing = figures.drawing
+        assert drawing.fig.yaxis[0].axis_label == label, key
+        assert note in drawing.scale_label.text, (key, drawing.scale_label.text)
