@@ -187,7 +187,11 @@ class FeatureInset:
         p.add_tools(HoverTool(renderers=[punch], mode="vline", tooltips=[
             ("x", "@x{0.000} m"), ("punch base", "@punch{0.00} µm"),
             ("coating top", "@surface{0.00} µm")]))
-        legend_inside(p, "bottom_right")
+        # below the plot, not inside it: the coating's top is the lowest line of a uniform
+        # coating (heights above its highest point), and a legend in the corner hid it
+        legend = legend_inside(p, "bottom_left")
+        legend.margin = 0
+        p.add_layout(legend, "below")
         self.fig = p
 
     def hide(self) -> None:
