@@ -313,3 +313,12 @@ def test_the_drawing_s_axis_says_what_its_corner_note_says() -> None:
         drawing = figures.drawing
         assert drawing.fig.yaxis[0].axis_label == label, key
         assert note in drawing.scale_label.text, (key, drawing.scale_label.text)
+
+
+def test_the_features_legend_hides_no_line() -> None:
+    """Inside the inset's corner the legend hid the coating's top: heights are above the
+    coating's highest point, so a uniform coating's top is the plot's lowest line."""
+    figures, _, _ = _drawn("stepped_punch")
+    fig = figures.inset.fig
+    assert fig.visible
+    assert fig.legend[0] in fig.below and fig.legend[0] not in fig.center
