@@ -32,7 +32,8 @@ CREEP_MODELS: dict[str, str] = {
     "arutyunyan": "aging creep (Arutyunyan)",
     "fib_mc2010": "concrete, fib Model Code 2010",
     "eurocode2": "concrete, Eurocode 2",
-    "custom": "other model (from file)",
+    # (a preset's inline model too: "from file" read wrong on the patched insert)
+    "custom": "the scene's own model",
 }
 
 _GPA = 1e9
@@ -338,7 +339,7 @@ class BaseState(param.Parameterized):
         if self.creep_model == "custom":
             if self.custom is None:
                 # never solve another model than the one named on screen
-                raise ValueError("base.creep: 'other model (from file)' needs a creep model "
+                raise ValueError("base.creep: 'the scene's own model' needs a creep model "
                                  "from a scene file; choose one of the models offered")
             return copy.deepcopy(self.custom)
         return {"model": "elastic", "modulus": self.modulus * _GPA}

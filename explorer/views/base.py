@@ -69,14 +69,17 @@ class BaseView:
         self.base_modulus.label = ("final Young's modulus E∞ [GPa]" if model == "arutyunyan"
                                    else "Young's modulus E [GPa]")
         self.base_modulus.visible = model not in ("custom", *CODE_CREEP_MODELS)
-        # "other model (from file)" is offered only while the scene holds one: picked
+        # "the scene's own model" is offered only while the scene holds one: picked
         # without it, the base was silently solved as elastic
         offered = {v: k for k, v in CREEP_MODELS.items()
                    if k != "custom" or base.custom is not None}
         if offered != self.creep_model.options:
             self.creep_model.options = offered
         if model == "custom":
-            note = "A creep model from a file (kept as it is); choose another model to replace it."
+            kind = base.custom.get("model") if isinstance(base.custom, dict) else None
+            named = f" ('{kind}')" if isinstance(kind, str) else ""
+            note = (f"The scene's own creep model{named}, kept as the scene gives it; "
+                    "choose another model to replace it.")
         else:
             note = self.state.tol_note  # a design code's law raised the accuracy target
         self.creep_note.object = html.escape(note)

@@ -413,7 +413,7 @@ def test_the_creep_model_from_a_file_is_offered_only_with_one(page: Page):
     select = page.page.locator(".creep-select select").first
     select.wait_for(timeout=30_000 * patience())
     options = select.evaluate("s => [...s.options].map(o => o.textContent)")
-    assert "other model (from file)" not in options
+    assert "the scene's own model" not in options
     assert "aging creep (Arutyunyan)" in options
 
 

@@ -184,15 +184,20 @@ def test_other_creep_model_without_a_file_is_never_solved_as_elastic(explorer_ap
     assert "base.creep" in controller.error and "from a scene file" in controller.error
     assert controller.view is shown
     app = explorer_app()
-    assert "other model (from file)" not in app.base_tab.creep_model.options
+    assert "the scene's own model" not in app.base_tab.creep_model.options
     scene = json.loads(json.dumps(PRESETS["eccentric_creep"]))
     creep = scene["base"]["creep"]
     scene["base"]["creep"] = {"model": "prony", "modulus": creep["modulus_final"],
                               "terms": [{"compliance": 1e-11, "rate": 0.03}]}
     assert app.load_scene(scene), app.screen.notice  # a model the screen does not offer ...
     assert app.state.base.creep_model == "custom"  # ... is kept and offered by name
-    assert "other model (from file)" in app.base_tab.creep_model.options
+    assert "the scene's own model" in app.base_tab.creep_model.options
     assert app.controller.view.scene["base"]["creep"]["model"] == "prony"
+    # (named as what it is: the patched insert's inline model read "from a file")
+    app.base_tab.refresh()
+    assert app.base_tab.creep_note.object == (
+        "The scene&#x27;s own creep model (&#x27;prony&#x27;), kept as the scene gives it; "
+        "choose another model to replace it.")
 
 
 # ------------------------------------------------------------------ messages
