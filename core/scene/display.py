@@ -79,7 +79,7 @@ def percent_text(share: float, digits: int = 3) -> str:
 
 def number_text(value: float, digits: int = 4) -> str:
     """``value`` with ``digits`` significant digits ("not finite" for NaN and infinity),
-    without an exponent from 0.001 to a million (50 years read "18260 d", not
+    without an exponent from 0.001 to a million (50 years read "18260 d" at 4 digits, not
     "1.826e+04 d")."""
     if not np.isfinite(value):
         return "not finite"
@@ -94,13 +94,16 @@ def number_text(value: float, digits: int = 4) -> str:
 YEARS_FROM_DAYS = 2 * DAYS_PER_YEAR
 
 
-def days_text(t: float, digits: int = 4) -> str:
-    """A time ``t`` [day] after loading in words: "28 days", "1 day", "18260 days (50.0
-    years)" (:func:`number_text`'s digits: never "1.826e+04 d", which an engineer has to
-    decode)."""
+def days_text(t: float, digits: int = 4, years: bool = True) -> str:
+    """A time ``t`` [day] after loading in words: "28 days", "1 day", "18262.5 days (50.0
+    years)" (:func:`number_text`'s digits, never fewer than the whole days and one
+    decimal: never "1.826e+04 d", which an engineer has to decode, nor "18260 days" for
+    the 18262.5 a time span box reads); ``years``: the years beside long times."""
+    if math.isfinite(t) and abs(t) >= 1.0:
+        digits = max(digits, int(math.log10(abs(t))) + 2)
     shown = number_text(t, digits)
     text = f"{shown} {'day' if shown == '1' else 'days'}"
-    if math.isfinite(t) and abs(t) >= YEARS_FROM_DAYS:
+    if years and math.isfinite(t) and abs(t) >= YEARS_FROM_DAYS:
         text += f" ({t / DAYS_PER_YEAR:.1f} years)"
     return text
 

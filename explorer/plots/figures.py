@@ -27,7 +27,7 @@ from bokeh.models import (
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
-from core.scene import days_text, number_text
+from core.scene import days_text
 
 from ..model import (
     QUANTITIES,
@@ -517,7 +517,7 @@ class Figures:
         t = getattr(self, "_q_time", None)
         if t is None:
             return
-        text = (f"q(x) at t = {number_text(t)} days" if self._presenting
+        text = (f"q(x) at t = {days_text(t, years=False)}" if self._presenting
                 else f"Pressure q(x), t = {days_text(t)}")
         if self.q_fig.title.text != text:
             self.q_fig.title.text = text

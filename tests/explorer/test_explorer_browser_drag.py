@@ -52,10 +52,10 @@ def test_a_slow_drag_says_it_waits_and_long_times_read_in_years(server: str, pag
     from explorer.model.links import encode_scene
 
     page.page.goto(f"{server}/app?scene={encode_scene(_slow_scene())}")
-    until(lambda: "18260 days (50.0 years)" in page.text(".time-label"),
+    until(lambda: "18262.5 days (50.0 years)" in page.text(".time-label"),
           "the time label at 50 years", timeout=120, describe=lambda: page.text(".time-label"))
     assert "e+" not in page.text(".time-label")
-    assert page.page.evaluate(JS_SHOWN, "At t = 18260 days (50.0 years) after loading")
+    assert page.page.evaluate(JS_SHOWN, "At t = 18262.5 days (50.0 years) after loading")
     assert not page.page.evaluate(JS_SHOWN, LAG)
     # the lift-off engine reports no stages nor modes: the status line claims neither
     assert page.page.evaluate(JS_SHOWN, "unilateral contact under creep")   # its details

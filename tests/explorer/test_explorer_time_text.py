@@ -11,7 +11,7 @@ from core.scene import days_text, number_text
 
 @pytest.mark.parametrize(("days", "text"), [
     (0.0, "0 days"), (14.7, "14.7 days"), (28.0, "28 days"), (365.0, "365 days"),
-    (1000.0, "1000 days (2.7 years)"), (18262.5, "18260 days (50.0 years)"),
+    (1000.0, "1000 days (2.7 years)"), (18262.5, "18262.5 days (50.0 years)"),
     (0.0004, "0.0004 days"), (1.0, "1 day"), (1.00001, "1 day"), (1.5, "1.5 days"),
 ])
 def test_days_are_written_out(days: float, text: str) -> None:
@@ -33,17 +33,17 @@ def test_a_fifty_year_history_reads_in_days_and_years(explorer_app) -> None:
     view = app.screen.shown()
     last = len(view.times) - 1
     app.results.show_time_texts(view, last)
-    assert "t = 18260 days (50.0 years)" in app.results.time_label.object
-    assert "At t = 18260 days (50.0 years) after loading" in app.results.readout.object
+    assert "t = 18262.5 days (50.0 years)" in app.results.time_label.object
+    assert "At t = 18262.5 days (50.0 years) after loading" in app.results.readout.object
     assert "e+" not in app.results.time_label.object + app.results.readout.object
     app.figures.show_time(view, last)
-    assert app.figures.q_fig.title.text == "Pressure q(x), t = 18260 days (50.0 years)"
+    assert app.figures.q_fig.title.text == "Pressure q(x), t = 18262.5 days (50.0 years)"
     # in presentation mode without its years (beside the player), where at 1024 px it
     # was cut ("Pressure q(x), t = 1000 days (2.7"); back again after
     app.figures.set_presentation(True)
-    assert app.figures.q_fig.title.text == "q(x) at t = 18260 days"
+    assert app.figures.q_fig.title.text == "q(x) at t = 18262.5 days"
     app.figures.set_presentation(False)
-    assert app.figures.q_fig.title.text == "Pressure q(x), t = 18260 days (50.0 years)"
+    assert app.figures.q_fig.title.text == "Pressure q(x), t = 18262.5 days (50.0 years)"
     assert "e+" not in app.figures.contact.zone_label.text
 
 

@@ -287,10 +287,10 @@ def test_the_dimensionless_pressure_is_bounded_as_the_scene_one(contact):
 
 def test_a_notebook_reads_long_times_in_days_and_years() -> None:
     """A 50-year answer's repr and HTML table read "0 to 1.826e+04 days" and "at t =
-    1.826e+04 days", where the page and the report read "18260 days (50.0 years)"."""
+    1.826e+04 days", where the page and the report read "18262.5 days (50.0 years)"."""
     result = solve(core.load_scene("preset:young_concrete_50_years"))
     text, table = repr(result), result._repr_html_()
-    assert "0 to 18260 days (50.0 years) after loading" in text
-    assert "at t = 18260 days (50.0 years):" in text
-    assert "at t = 18260 days (50.0 years) after loading" in table
+    assert "0 to 18262.5 days (50.0 years) after loading" in text
+    assert "at t = 18262.5 days (50.0 years):" in text
+    assert "at t = 18262.5 days (50.0 years) after loading" in table
     assert "e+04" not in text + table
