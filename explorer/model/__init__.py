@@ -74,7 +74,7 @@ from .scene_parts import (
     check_text,
 )
 from .screen import Screen
-from .state import MODEL_TOL_RANGE, ExplorerState
+from .state import MODEL_TOL_RANGE, MODIFIED, ExplorerState
 from .study import (
     MAX_POINTS,
     OUTPUTS,
@@ -97,7 +97,7 @@ from .view_link import (
 
 __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESET", "INTERFACES",
            "MAX_DESCRIPTION_CHARS", "MAX_FIT_FIELDS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS",
-           "MODEL_TOL_RANGE", "ORDER", "OUTPUTS", "QUANTITIES",
+           "MODEL_TOL_RANGE", "MODIFIED", "ORDER", "OUTPUTS", "QUANTITIES",
            "QUANTITY_RANGES", "QUANTITY_UNITS", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS",
            "STRENGTH_CLASSES",
            "Axis", "CodeCreepState", "DesignLimits", "DisplayScales", "ExplorerState",

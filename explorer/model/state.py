@@ -53,6 +53,9 @@ __all__ = ["CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_CONTACT", "INTERFACES",
            "ProfileState", "PunchState", "check_text"]
 
 
+#: What the first change of a loaded scene appends to its name.
+MODIFIED = " (modified)"
+
 class ExplorerState(param.Parameterized):
     """Everything a user sets, turned into a scene dict by :meth:`to_scene`.
 
@@ -179,12 +182,12 @@ class ExplorerState(param.Parameterized):
             self._loaded_name = None  # the user names the scene now
             return
         self._loaded_name = None
-        if self.scene_name != loaded or loaded.endswith(" (modified)"):
+        if self.scene_name != loaded or loaded.endswith(MODIFIED):
             return
         self._batch += 1
         try:
             self.param.update(
-                scene_name=f"{loaded[: MAX_NAME_CHARS - 11]} (modified)",
+                scene_name=f"{loaded[: MAX_NAME_CHARS - len(MODIFIED)]}{MODIFIED}",
                 description=f"Changed on screen from the scene “{loaded}”.")
         finally:
             self._batch -= 1

@@ -30,6 +30,7 @@ from bokeh.plotting import figure
 from core.scene import days_text
 
 from ..model import (
+    MODIFIED,
     QUANTITIES,
     QUANTITY_UNITS,
     SCREEN_PUNCHES,
@@ -93,9 +94,14 @@ X_PADDING = 0.05
 
 
 def short(text: str, limit: int = TITLE_CHARS) -> str:
-    """``text`` cut to ``limit`` characters with an ellipsis."""
+    """``text`` cut to ``limit`` characters with an ellipsis; a changed scene's
+    " (modified)" is kept (the cut took it: "Eccentric footing: from full contact to…")."""
     text = " ".join(str(text).split())
-    return text if len(text) <= limit else text[: limit - 1].rstrip() + "…"
+    if len(text) <= limit:
+        return text
+    if text.endswith(MODIFIED) and limit > 2 * len(MODIFIED):
+        return short(text[: -len(MODIFIED)], limit - len(MODIFIED)) + MODIFIED
+    return text[: limit - 1].rstrip() + "…"
 
 
 class Figures:

@@ -85,3 +85,15 @@ def test_presentation_mode_gives_short_plots_few_ticks_and_short_titles(explorer
     assert figures.history_fig["settlement"].title.text == \
         "Settlement δ [mm]: computed, per punch"
     assert {fig.yaxis[0].ticker.desired_num_ticks for fig in short} == {6}
+
+
+def test_a_changed_scene_keeps_its_modified_in_the_drawing_s_title(explorer_app) -> None:
+    """The drawing's title is cut to fit 1024 px, and the cut took " (modified)":
+    "Scene: Eccentric footing: from full contact to…" did not say it had changed."""
+    from core.presets import read_preset
+
+    app = explorer_app(scene=read_preset("eccentric_footing_liftoff"), solved=True)
+    app.state.loading.histories["force"].value *= 1.01
+    assert app.controller.wait(120) and app.controller.error == "", app.controller.error
+    title = app.figures.scene_fig.title.text
+    assert title == "Scene: Eccentric footing: from full… (modified)", title
