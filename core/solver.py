@@ -73,8 +73,10 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         None (elastic base) or the creep kernel ``K(t, tau)`` of the Volterra operator
         ``V`` (vectorized); a :class:`core.creep.models.DegenerateKernel` is stepped in
         O(1) per mode and step. The compliance of a stress held since loading relative
-        to the elastic one, ``1 - int_1^t K(t, u) du``, must stay > 0 (checked at up to
-        16 of the output times).
+        to the elastic one, ``1 - int_1^t K(t, u) du``, must stay > 0
+        (:func:`core.problem.check_held_compliance`: a plain callable's at
+        ``core.problem.inputs.HELD_CHECKS`` of the output times, and every output time
+        by the default engine).
     settlement, tilt, force, moment : float or callable, optional
         Exactly two of ``delta``, ``alpha``, ``P``, ``M`` (numbers or callables of t):
         one of the four statements; the other two are solved for.

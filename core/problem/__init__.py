@@ -20,6 +20,7 @@ from core.problem.inputs import (
     Scalar,
     TimeInputs,
     as_function,
+    check_held_compliance,
     check_values,
     validate_geometry,
     validate_time_inputs,
@@ -48,6 +49,7 @@ from core.problem.statements import (
 __all__ = [
     "accepts",
     "as_function",
+    "check_held_compliance",
     "check_mode_probe",
     "check_values",
     "ContactSolution",

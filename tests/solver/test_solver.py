@@ -408,6 +408,15 @@ def test_a_kernel_that_takes_the_compliance_through_zero_is_refused_naming_it() 
     with pytest.raises(ValueError, match=r"it is -1\.4 at t = 5$"):
         solve_dimensionless(1.0, 0.1, 0.0, [1.0, 2.0, 5.0], kernel=constant(0.6), force=1.0,
                             moment=0.0)
+    # a compliance through zero at an output time the solve's inputs did not sample (16
+    # of 100): the default engine, which reads it at every time, refuses it too
+    times = np.linspace(1.0, 100.0, 100)
+
+    def at_t2(t, tau):
+        return np.where(np.abs(np.asarray(t) - times[1]) < 1e-9, 5.0, 0.0) + 0.0 * tau
+
+    with pytest.raises(ValueError, match=r"^kernel: .* it is -4 at t = 2$"):
+        solve_dimensionless(1.0, 0.1, 0.0, times, kernel=at_t2, force=1.0, moment=0.0)
     # the default engine declines it as it declines any grid it cannot resolve (with the
     # engine left to the solver, the next one answers, unconverged: ~5 s)
     with pytest.raises(UnresolvedOperator, match="does not resolve"):

@@ -339,7 +339,8 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
         grid, responses, factor = fine, fine_responses, fine_factor
         if not np.isfinite(estimate):
             # a reference modulus so small (a base ~1e50 times softer after creep) that
-            # the coating's term underflows: no refinement resolves it here
+            # the grid's responses overflow and its factor is singular: no refinement
+            # resolves it here
             estimate, resolved = np.inf, False
             break
         if estimate <= target:

@@ -47,6 +47,7 @@ from core.problem import (
     Geometry,
     Scalar,
     TimeInputs,
+    check_held_compliance,
     validate_geometry,
     validate_time_inputs,
 )
@@ -571,6 +572,9 @@ def creep_reference(inputs: TimeInputs) -> float:
     def compute() -> float:
         t = np.asarray(inputs.times, dtype=float)
         held = 1.0 + integrated_kernel(inputs.kernel, t, np.ones_like(t))
+        # every output time (the solve's inputs checked only a sample of a plain
+        # callable's): a compliance through zero made the ratio's log NaN
+        check_held_compliance(inputs.kernel, t, held)
         ratio = float(np.min(np.asarray(inputs.c(t), dtype=float) / held))
         if not ratio < 1.0 - REFERENCE_UNMOVED:
             return 1.0
