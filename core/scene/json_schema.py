@@ -380,6 +380,12 @@ _TYPE_NAMES = {"number": "a number", "integer": "an integer", "string": "a strin
 _WORDS = {1: "one", 2: "two", 3: "three", 4: "four"}
 
 
+#: Fields bounded at both ends whose refusal `solve` words as an interval ("must be in
+#: (-1, 0.5)"); the others it words by the end passed ("must be > 0"), and so does the
+#: schema (tests/scene/test_json_schema.py compares the two).
+INTERVAL_FIELDS = frozenset({"base.poisson", "solver.tol", "solver.model_tol"})
+
+
 def _words(error: Any, root: str) -> Iterator[tuple[str, str]]:
     """``(path, reason)`` of one violation found by the ``jsonschema`` package."""
     from jsonschema.exceptions import best_match
@@ -415,9 +421,11 @@ def _words(error: Any, root: str) -> Iterator[tuple[str, str]]:
                     if k in error.schema), None)
         high = next(((k, error.schema[k]) for k in ("maximum", "exclusiveMaximum")
                      if k in error.schema), None)
-        if low is not None and high is not None:
-            # both ends said at once, as the Python checks say them ("in (-1, 0.5)"): a
-            # value fixed above its upper end must not then fall under its lower one
+        code_age = path == "base.age_at_loading" and "then" in error.schema_path
+        if low is not None and high is not None and (path in INTERVAL_FIELDS or code_age):
+            # both ends said at once where the Python checks say them so ("in (-1,
+            # 0.5)"; a design code's age at loading): `validate` read "must be < 0.5"
+            # where `solve` read "must be in (-1, 0.5)"
             bounds = (f"{'(' if low[0] == 'exclusiveMinimum' else '['}{low[1]:g}, "
                       f"{high[1]:g}{')' if high[0] == 'exclusiveMaximum' else ']'}")
             yield path, f"must be in {bounds}{unit}, got {got}{unit if unit else ''}"

@@ -209,7 +209,7 @@ def test_validate_reports_every_schema_problem_with_its_field(tmp_path: Path) ->
     proc = run_cli("validate", path)
     assert proc.returncode == EXIT_BAD_INPUT and proc.stdout == ""
     assert proc.stderr.splitlines() == [
-        "error: coating[0].poisson: must be in (-1, 0.5), got 0.7",
+        "error: coating[0].poisson: must be < 0.5, got 0.7",
         "error: solver.tol: must be in [1e-12, 0.01], got 1",
         "error: solver.contact: must be one of 'auto', 'full', 'unilateral', got 'sticky'",
         # with the field's unit, as the validator gives it

@@ -24,7 +24,7 @@ from core.scene import (
     schema_text,
 )
 from core.study import load_study, study_from_dict, study_json_schema
-from tests.conftest import DELETE, base_scene, edited
+from tests.conftest import DELETE, base_scene, edited, scene_file
 from tests.scene.test_scene_refusals import BAD_VALUES
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -275,6 +275,30 @@ def test_a_strength_class_is_a_class_and_three_loads_one_line(scene_schema: dict
         "force, moment"]
 
 
+#: Fields bounded at both ends, each set past one end and the other (times.count: the
+#: validator says "an integer from 1 to 2000", the schema the end passed).
+BOUNDED = [("base.poisson", -2.0), ("base.poisson", 0.7), ("coating[0].poisson", -2.0),
+           ("coating[0].poisson", 0.7), ("solver.tol", 0.0), ("solver.tol", 1.0),
+           ("solver.model_tol", 0.0), ("solver.model_tol", 5.0),
+           ("base.age_at_loading", 0.0), ("base.age_at_loading", 1e6),
+           ("times.end", 1e9), ("base.creep.rate", -1.0), ("base.creep.rate", 1e7)]
+
+
+@pytest.mark.parametrize(("path", "value"), BOUNDED, ids=[f"{p}={v:g}" for p, v in BOUNDED])
+def test_a_bound_is_said_by_validate_as_solve_says_it(path: str, value: float,
+                                                     scene_schema: dict) -> None:
+    """`coated-punch validate` (the schema) and `solve` (the validator) give one reason:
+    made general, "must be in (0, 100000] days" stood beside "must be > 0"."""
+    scene = edited(path, value, scene_file("eccentric_creep"))
+    with pytest.raises(ValueError) as refused:
+        scene_from_dict(scene)
+    (problem,) = schema_errors(scene, scene_schema)
+    # the reason up to the value (the validator adds units, a place or a why after it)
+    said = problem.split(", got ")[0]
+    words = said.split(" days")[0] if "days" in said else said
+    assert str(refused.value).startswith(words), (problem, str(refused.value))
+
+
 def test_the_reasons_are_worded_as_the_validator_words_them(scene_schema: dict) -> None:
     assert schema_errors(edited("punch.hafl_width", 1.0), scene_schema)[0] == (
         "punch: unknown field 'hafl_width' (did you mean 'half_width'?)")
@@ -287,7 +311,7 @@ def test_the_reasons_are_worded_as_the_validator_words_them(scene_schema: dict) 
     # a field bounded at both ends is said as the validator says it: `coated-punch
     # validate` read "must be < 0.5" where `solve` read "must be in (-1, 0.5)"
     assert schema_errors(edited("coating[0].poisson", 0.5), scene_schema) == [
-        "coating[0].poisson: must be in (-1, 0.5), got 0.5"]
+        "coating[0].poisson: must be < 0.5, got 0.5"]
     with pytest.raises(ValueError) as refused:
         scene_from_dict(edited("base.poisson", -2.0))
     assert schema_errors(edited("base.poisson", -2.0), scene_schema) == [str(refused.value)]
