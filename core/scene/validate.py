@@ -159,8 +159,10 @@ def _validated(d: dict[str, Any]) -> Scene:
         raise ValueError("base.creep: a number is too large for a double (must be a finite "
                          "number)") from None
     if isinstance(creep, CodeCreep):
-        # a design code's own range is said first: "must be > 0" for 0 days let 0.5
-        # through, which the code then refused with its [1, 3650]
+        # a design code's own range is said first (after the value's type, in a scene
+        # file's words): "must be > 0" for 0 days let 0.5 through, which the code then
+        # refused with its [1, 3650]
+        finite_number(base["age_at_loading"], "base.age_at_loading")
         creep.age_at_loading_in_range(base["age_at_loading"], "base.age_at_loading")
     tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
     if tau0 > schema.MAX_AGE:

@@ -246,6 +246,9 @@ def test_the_code_models_bound_the_age_at_loading_in_the_schema(scene_schema: di
         with pytest.raises(ValueError, match=r"^base\.age_at_loading: must be in \[1, 3650\] "
                                              r"\(EN 1992-1-1 Figure 3\.1"):
             scene_from_dict(edited("base.age_at_loading", age, scene))
+    # (its type first, in a scene file's words)
+    with pytest.raises(ValueError, match=r"^base\.age_at_loading: must be a number, got null$"):
+        scene_from_dict(edited("base.age_at_loading", None, scene))
     # one line a field: at 0 the code's bound, not the general "> 0 days" as well
     assert schema_errors(edited("base.age_at_loading", 0, scene), scene_schema) == [
         "base.age_at_loading: must be in [1, 3650] days, got 0 days"]
