@@ -275,7 +275,7 @@ def _describe(scene: Scene | PunchesScene) -> str:
 
 def _punches_summary(result: PunchesSolution) -> str:
     """The summary of a scene of several punches: each punch's histories at the first and
-    last times, its largest pressure, estimate and flags."""
+    last times, its largest pressure, estimate, flags and coating model error."""
     lines = [f"solved {_describe(result.scene)}"]
     rows = sorted({0, result.times.size - 1})
     checks = result.design_checks()
@@ -292,6 +292,13 @@ def _punches_summary(result: PunchesSolution) -> str:
         lines.append(f"  largest contact pressure q: {line.value_text(place_first=True)}")
         lines.append(f"  {punch.info.get('message', '')}")
         lines.append(f"  flags: {', '.join(punch.flags) if punch.flags else 'none'}")
+        if punch.scene.coating:
+            quantity = estimated_quantity(punch.scene.given, punch.model_error.get("part"),
+                                          symbols=False)
+            lines.append(f"  coating model error (estimate): "
+                         f"{percent_text(punch.model_error['estimate'], 2)}"
+                         f"{' of ' + quantity if quantity else ''} (solver.model_tol "
+                         f"{100 * punch.scene.model_tol:g} %)")
         if checks[k] is not None:
             lines.append(f"  design check (whole history): "
                          f"{verdict_words(checks[k].passed, punch.flags)}")
@@ -324,7 +331,9 @@ def _summary(result: SceneSolution) -> str:
     lines.append(f"flags: {', '.join(result.flags) if result.flags else 'none'}")
     estimate = result.info.get("model_error_estimate")
     if estimate is not None:
-        quantity = estimated_quantity(result.scene.given, result.model_error.get("part"))
+        # (no Greek letters: a console's narrow character set may not hold them)
+        quantity = estimated_quantity(result.scene.given, result.model_error.get("part"),
+                                      symbols=False)
         lines.append(f"coating model error ({result.info.get('coating_model')}, estimate): "
                      f"{percent_text(estimate, 2)}{' of ' + quantity if quantity else ''} "
                      f"(solver.model_tol {100 * result.scene.model_tol:g} %)")

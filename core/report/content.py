@@ -18,6 +18,7 @@ from core.scene import (
     SceneSolution,
     days_text,
     engine_text,
+    estimated_quantity,
     flagged_caution,
     flags_with_evidence,
     largest_pressure,
@@ -110,6 +111,13 @@ def model_evidence(result: SceneSolution,
     return model_error_evidence(result.scene, float(result.model_error["estimate"]), check)
 
 
+def _of_quantity(result: SceneSolution) -> str:
+    """" of the moment M": whose error sets the coating model's estimate ("" when no one
+    unknown's does)."""
+    quantity = estimated_quantity(result.scene.given, result.model_error.get("part"))
+    return f" of {quantity}" if quantity else ""
+
+
 def accuracy_rows(result: SceneSolution,
                   check: Mapping[str, Any] | None = None) -> list[tuple[str, str]]:
     """The numerical error estimate against its target, and the coating model's error
@@ -133,7 +141,8 @@ def accuracy_rows(result: SceneSolution,
           if evidence["source"] == "measured" else []),
         ("coating model error (estimated, relative)",
          "0: no coating, no coating model" if not result.scene.coating else
-         f"{percent_text(float(result.model_error['estimate']))} ("
+         f"{percent_text(float(result.model_error['estimate']))}"
+         + _of_quantity(result) + " ("
          + ("FLAGGED: above " if float(result.model_error["estimate"])
             > result.scene.model_tol else "within ")
          + f"solver.model_tol {percent_text(result.scene.model_tol)})"

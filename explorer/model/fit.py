@@ -24,7 +24,7 @@ import numpy as np
 
 from core.back_analysis import Calibration, Forecast, Readings, calibrate, readings_from_text
 from core.limits import MAX_READINGS_BYTES
-from core.scene import number_text, scene_from_dict
+from core.scene import days_text, number_text, scene_from_dict
 from core.study import apply_point, number_at
 
 from .loading_state import QUANTITY_UNITS
@@ -227,5 +227,6 @@ def readings_note(readings: Readings) -> str:
             else ""
         parts.append(f"{n} {name} reading{'s' if n != 1 else ''}{std}")
     t = readings.time
-    return (f"{' and '.join(parts)} from t = {number_text(float(t[0]), 4)} to "
-            f"{number_text(float(t[-1]), 4)} days after loading")
+    # (the days as the page writes every time: a 50-year record ended at "18260 days")
+    return (f"{' and '.join(parts)} from t = {days_text(float(t[0]), years=False)} to "
+            f"{days_text(float(t[-1]), years=False)} after loading")

@@ -198,7 +198,9 @@ def model_evidence(view: ResultView,
     punch = parts.get("punch")
     if view.punches and isinstance(punch, int) and 0 <= punch < len(view.punches):
         quantity = estimated_quantity(view.punches[punch].given, parts.get("part"))
-        evidence["quantity"] = f"{quantity} of punch {punch + 1}" if quantity else ""
+        # (the punch is named whatever the part: a bound of both names no unknown)
+        evidence["quantity"] = (f"{quantity} of punch {punch + 1}" if quantity
+                                else f"punch {punch + 1}")
     elif isinstance(view.scene.get("loading"), Mapping):
         evidence["quantity"] = estimated_quantity(view.scene["loading"], parts.get("part"))
     return evidence

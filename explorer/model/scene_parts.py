@@ -226,8 +226,8 @@ class PunchState(param.Parameterized):
             # finite number, is inf", and -5 km drew a dished base under "crowned"
             if not (math.isfinite(self.radius) and self.radius > 0.0):
                 raise ValueError(f"punch.shape: the crown radius R must be > 0 km, is "
-                                 f"{self.radius:g} km (a dished base is a custom shape: a "
-                                 "table of heights from a file)")
+                                 f"{self.radius:g} km (a dished base is a custom shape, a "
+                                 "table of heights or a polynomial in a scene file)")
             curvature = 1.0 / (2.0 * self.radius * _KM)
             return {"kind": "polynomial", "coefficients": [0.0, 0.0, curvature]}
         if self.shape == "wedge":
@@ -288,7 +288,7 @@ class PunchState(param.Parameterized):
             values.update(shape="wavy", wave_amplitude=spec["amplitude"] / _UM,
                           wave_length=spec["wavelength"])
         else:
-            values.update(shape="custom", custom=copy.deepcopy(spec), custom_label="a file")
+            values.update(shape="custom", custom=copy.deepcopy(spec), custom_label="the scene")
         self.param.update(**values)
 
 

@@ -122,6 +122,14 @@ def legend_above(fig: Any, font_size: str | None = None) -> Any:
     return legend
 
 
+def legend_below(fig: Any, font_size: str = "10px") -> Any:
+    """Move the legend of ``fig`` below its plot, a compact column; returns it."""
+    legend = legend_inside(fig, "bottom_left", font_size)
+    legend.margin = 0
+    fig.add_layout(legend, "below")
+    return legend
+
+
 def legend_inside(fig: Any, location: str, font_size: str = "10px") -> Any:
     """Make the legend of ``fig`` a compact, half-transparent box at ``location`` inside
     its plot; returns it."""

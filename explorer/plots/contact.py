@@ -23,7 +23,7 @@ from ..model import (
     lifts_off,
     lifts_or_pulls,
 )
-from .bokeh_data import MOVING, f32, legend_above, legend_inside, set_data
+from .bokeh_data import MOVING, f32, legend_above, legend_below, legend_inside, set_data
 
 # navy: apart from the viridis colours of the coating it lies on; red as the lifted
 # (shaded) parts of q(x)
@@ -189,9 +189,7 @@ class FeatureInset:
             ("coating top", "@surface{0.00} µm")]))
         # below the plot, not inside it: the coating's top is the lowest line of a uniform
         # coating (heights above its highest point), and a legend in the corner hid it
-        legend = legend_inside(p, "bottom_left")
-        legend.margin = 0
-        p.add_layout(legend, "below")
+        legend_below(p)
         self.fig = p
 
     def hide(self) -> None:

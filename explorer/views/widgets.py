@@ -610,12 +610,12 @@ class ProfileEditor:
             self.position.visible = "position" in uses
             self.length.visible = "length" in uses
             self.mean.visible = not custom
-            note = ("Custom profile from a file (kept as it is). Choose another variation "
-                    "to replace it." if custom else "")
+            note = ("A custom profile, as the scene gives it (kept as it is). Choose "
+                    "another variation to replace it." if custom else "")
         elif custom:
-            note = "Varies across the punch (from a file); the level above is not used."
+            note = "Varies across the punch (as the scene gives it); the level above is not used."
         elif kind != "none":
-            note = "Varies across the punch (from a file) about the level above."
+            note = "Varies across the punch (as the scene gives it) about the level above."
         else:
             note = ""
         self.note.object = note
@@ -731,8 +731,9 @@ class HistoryEditor:
             self.time.label = _TIME_LABELS[kind]
         custom = kind == "custom" and history.custom is not None
         self.value.visible = not custom
-        self._say("Custom history from a file (kept as it is). Upload another table below, "
-                  "or choose another shape to replace it." if custom else "")
+        self._say("A custom history, as the scene or its table gives it (kept as it is). "
+                  "Upload another table below, or choose another shape to replace it."
+                  if custom else "")
         if kind == "custom" and self.upload is None:
             self.upload = BoundedUpload(accept=(".csv", ".txt"), max_bytes=MAX_TABLE_BYTES)
             self.upload.param.watch(self._on_table, "value")

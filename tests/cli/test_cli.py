@@ -362,3 +362,19 @@ def test_the_command_line_section_of_the_format_lists_every_command() -> None:
         row = next(line for line in (root / page).read_text(encoding="utf-8").splitlines()
                    if line.startswith("| `coated-punch`"))
         assert all(name in row for name in commands if name != "schema"), (page, row)
+
+
+def test_the_summary_says_whose_coating_model_error_it_is() -> None:
+    """The estimate is the worse of two parts: the force's (or the settlement's) and the
+    moment's (or the tilt's); the summary names it, without Greek letters (a console's
+    character set may not hold them), for one punch and for each of several."""
+    done = run("solve", "preset:worn_coating")
+    assert done.returncode == 0, done.stderr
+    line = next(s for s in done.stdout.splitlines() if s.startswith("coating model error"))
+    # the force is given: its settlement is the unknown
+    assert " % of the settlement (solver.model_tol 2 %)" in line, line
+    done = run("solve", "preset:new_footing_beside_old")
+    lines = [s for s in done.stdout.splitlines() if "coating model error" in s]
+    assert len(lines) == 2 and all(" % of the tilt (solver.model_tol 2 %)" in s
+                                   for s in lines), lines
+    assert not set("αδ") & set(done.stdout)

@@ -338,7 +338,8 @@ def test_a_step_or_land_off_the_punch_is_said_in_the_sliders_words(explorer_app)
     for radius in (0.0, -5.0):
         assert error(shape="parabolic", radius=radius) == (
             f"Punch, shape (punch.shape): the crown radius R must be > 0 km, is {radius:g} "
-            "km (a dished base is a custom shape: a table of heights from a file)")
+            "km (a dished base is a custom shape, a table of heights or a polynomial in a "
+            "scene file)")
     assert error(shape="parabolic", radius=0.5) == ""
     app = explorer_app()
     app.state.punch.half_width = 0.5

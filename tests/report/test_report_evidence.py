@@ -47,7 +47,8 @@ def test_a_measurement_of_the_scene_overrides_the_estimate(result):
     assert rows[MEASURED_ROW].startswith("3.58 % at t = 0 days (FLAGGED: above "
                                          "solver.model_tol 2 %)")
     # next to it, not replaced; "1.39 % (flagged above 2 %)" read as a flag where none was
-    assert rows[ESTIMATED_ROW].startswith("4.64 % (FLAGGED: above solver.model_tol 2 %)")
+    assert rows[ESTIMATED_ROW].startswith(
+        "4.64 % of the tilt α (FLAGGED: above solver.model_tol 2 %)")
 
 
 def test_a_measurement_within_the_tolerance_lowers_an_estimated_flag(result):
