@@ -53,6 +53,7 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 from core import limits
+from core.coating import model_error_quantity
 from core.files import (
     atomic_write_bytes,
     atomic_write_text,
@@ -74,7 +75,6 @@ from core.scene import (
     check_loads_touch,
     check_settled,
     corner_note,
-    estimated_quantity,
     flags_with_evidence,
     has_punches,
     largest_pressure,
@@ -293,7 +293,7 @@ def _punches_summary(result: PunchesSolution) -> str:
         lines.append(f"  {punch.info.get('message', '')}")
         lines.append(f"  flags: {', '.join(punch.flags) if punch.flags else 'none'}")
         if punch.scene.coating:
-            quantity = estimated_quantity(punch.scene.given, punch.model_error.get("part"),
+            quantity = model_error_quantity(punch.scene.given, punch.model_error.get("part"),
                                           symbols=False)
             lines.append(f"  coating model error (estimate): "
                          f"{percent_text(punch.model_error['estimate'], 2)}"
@@ -332,7 +332,7 @@ def _summary(result: SceneSolution) -> str:
     estimate = result.info.get("model_error_estimate")
     if estimate is not None:
         # (no Greek letters: a console's narrow character set may not hold them)
-        quantity = estimated_quantity(result.scene.given, result.model_error.get("part"),
+        quantity = model_error_quantity(result.scene.given, result.model_error.get("part"),
                                       symbols=False)
         lines.append(f"coating model error ({result.info.get('coating_model')}, estimate): "
                      f"{percent_text(estimate, 2)}{' of ' + quantity if quantity else ''} "
@@ -467,10 +467,15 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         _write(pressure_out, result.pressure_csv())
     for name in result.flags:
         print(f"warning: {name}: {_one_line(result.flag_messages[name].replace('see info.message', result.info.get('message', '')))}", file=sys.stderr)  # noqa: E501
+    _design_warnings(result)
+    return _strict_verdict(result) if args.strict else EXIT_OK
+
+
+def _design_warnings(result: SceneSolution) -> None:
+    """A ``warning: design_check:`` line on stderr for each limit the answer exceeds."""
     check = result.design_check()
     for line in check.failures if check is not None else ():
         print(f"warning: design_check: {_one_line(line.describe())}", file=sys.stderr)
-    return _strict_verdict(result) if args.strict else EXIT_OK
 
 
 def _solved_punches(args: argparse.Namespace, result: PunchesSolution, output: Path | None,
@@ -574,6 +579,8 @@ def _cmd_report(args: argparse.Namespace) -> int:
               "report keeps the estimate", file=sys.stderr)
     for name in flags:
         print(f"warning: {name}: {_one_line(messages[name])}", file=sys.stderr)
+    # (as solve says them: report said no word of an exceeded limit, --strict included)
+    _design_warnings(result)
     return _strict_verdict(result, flags) if args.strict else EXIT_OK
 
 

@@ -22,6 +22,7 @@ from core.coating.model import (
     layer_compliance,
     model_error_estimate,
     model_error_map,
+    model_error_quantity,
     tilt_share,
 )
 from core.optional import lazy_exports
@@ -51,6 +52,7 @@ __all__ = [
     "layer_compliance",
     "model_error_estimate",
     "model_error_map",
+    "model_error_quantity",
     "MODEL_TOL_RANGE",
     "NEGLIGIBLE_SHARE",
     "solve_stack",

@@ -224,6 +224,37 @@ def model_error_estimate(scene: Any, share_of_tilt: float = 1.0,
             "part": part, "beyond_map": beyond_map(parts)}
 
 
+def model_error_quantity(given: Any, part: str | None, symbols: bool = True) -> str:
+    """The unknown whose coating-model error sets a result's estimate, in words.
+
+    Parameters
+    ----------
+    given : iterable of str
+        The scene's given loads (``"settlement"``, ``"tilt"``, ``"force"``,
+        ``"moment"``; a scene's ``loading`` mapping will do).
+    part : str or None
+        :func:`model_error_estimate`'s ``"part"``: ``"force"`` (the force P, or the settlement
+        where the force is given) or ``"moment"`` (the moment M, or the tilt where the
+        moment is given); ``"both"`` or None name nothing.
+    symbols : bool, optional
+        With the paper's symbols ("the moment M", "the tilt α"); without them ("the
+        moment") for text that may meet a narrow character set (a console).
+
+    Returns
+    -------
+    str
+        E.g. ``"the moment M"``; empty for a part that names no one unknown.
+    """
+    given = set(given)
+    if part == "moment":
+        word, symbol = ("the tilt", "α") if "moment" in given else ("the moment", "M")
+    elif part == "force":
+        word, symbol = ("the settlement", "δ") if "force" in given else ("the force", "P")
+    else:
+        return ""
+    return f"{word} {symbol}" if symbols else word
+
+
 def beyond_map(parts: dict[str, np.ndarray]) -> list[str]:
     """Where the stack of :func:`model_error_map` lies outside the map's measurements, in
     words: a coating softer than the map's lowest ``E_c / E`` (0.001) against the base, or

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from core.coating import model_error_quantity
 from core.report.contact import contact_text, lift_off_times, output_index
 from core.report.inputs import SHOWN_UNITS, input_rows
 from core.scene import (
@@ -18,7 +19,6 @@ from core.scene import (
     SceneSolution,
     days_text,
     engine_text,
-    estimated_quantity,
     flagged_caution,
     flags_with_evidence,
     largest_pressure,
@@ -89,7 +89,12 @@ def key_numbers(result: SceneSolution, time: float | None = None,
         rows.append(("eccentricity e = M/P at the last time",
                      f"{number_text(float(result.moment[-1]) / force)} m"))
     k = output_index(result, time)
-    rows.append((f"contact at t = {days_text(t[k])}", contact_text(result, k, origin)))
+    # the output time nearest the one asked for, said so when it is another (365 days
+    # asked read "contact at t = 379.6 days" with no word of why)
+    nearest = ("" if time is None or abs(float(t[k]) - float(time)) <= 1e-9 * max(1.0, t[k])
+               else f" (the output time nearest the {days_text(float(time))} asked for)")
+    rows.append((f"contact at t = {days_text(t[k])}{nearest}",
+                 contact_text(result, k, origin)))
     lifted = lift_off_times(result)
     if lifted.size:
         rows.append(("lift-off", f"at {lifted.size} of {len(t)} output times, first at "
@@ -114,7 +119,7 @@ def model_evidence(result: SceneSolution,
 def _of_quantity(result: SceneSolution) -> str:
     """" of the moment M": whose error sets the coating model's estimate ("" when no one
     unknown's does)."""
-    quantity = estimated_quantity(result.scene.given, result.model_error.get("part"))
+    quantity = model_error_quantity(result.scene.given, result.model_error.get("part"))
     return f" of {quantity}" if quantity else ""
 
 
@@ -258,7 +263,8 @@ def sections(result: SceneSolution | PunchesSolution, time: float | None = None,
             + " given"),
         ("made by", f"coated-punch {VERSION}, {stamp}"),
         ("units", "plane strain, per metre out of plane; x in m from the punch centre; "
-                  "t in days after loading; pressure in kPa, compression positive; "
+                  "t in days after loading; pressure in kPa (the plots: kPa or MPa, as "
+                  "their axes say), compression positive; "
                   "settlement mm, tilt mrad, force kN/m, moment kN·m/m; the scene file "
                   "in SI"),
     ])]

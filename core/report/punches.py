@@ -126,7 +126,8 @@ def punches_sections(result: PunchesSolution, time: float | None = None) -> list
         ("made by", f"coated-punch {VERSION}, {stamp}"),
         ("units", "plane strain, per metre out of plane; x in m along the surface (the "
                   "scene file's x: each punch at its centre); t in days after loading; "
-                  "pressure in kPa, compression positive; settlement mm, tilt mrad, force "
+                  "pressure in kPa (the plots: kPa or MPa, as their axes say), compression "
+                  "positive; settlement mm, tilt mrad, force "
                   "kN/m, moment kN·m/m about each punch's own centre; the scene file in SI"),
     ])]
     flagged = [(f"punches[{k}].{name}", p.flag_messages.get(name, ""))

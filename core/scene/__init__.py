@@ -66,7 +66,6 @@ from core.scene.display import (
 from core.scene.evidence import (
     check_settled,
     checked_key,
-    estimated_quantity,
     flags_with_evidence,
     model_error_evidence,
 )
@@ -157,7 +156,6 @@ __all__ = [
     "check_scene",
     "pressure_caution",
     "checked_key",
-    "estimated_quantity",
     "flags_with_evidence",
     "model_error_evidence",
     "check_settled",

@@ -190,5 +190,6 @@ def pressure_caution(report: Mapping[str, Any]) -> str:
     return (f"the fast answer's q differs from the resolved model's by "
             f"{100 * error:.2f} % at x = {report['pressure_error_at_m']:.4g} m (over "
             f"solver.model_tol {100 * tol:g} %): q there, its largest value and a pressure "
-            "limit checked on it are not to be relied on (the thin layer's q is local: "
-            "beside an abrupt change of the coating it jumps where the resolved q is smooth)")
+            "limit checked on it are not to be relied on (the thin layer's q is local: it "
+            "follows the coating's compliance at each point, where the resolved layers "
+            "spread the load; beside an abrupt change of the coating it jumps)")

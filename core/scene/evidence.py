@@ -31,37 +31,6 @@ MEASURED = "measured by the FE check"
 ESTIMATED = "estimated"
 
 
-def estimated_quantity(given: Any, part: str | None, symbols: bool = True) -> str:
-    """The unknown whose coating-model error sets a result's estimate, in words.
-
-    Parameters
-    ----------
-    given : iterable of str
-        The scene's given loads (``"settlement"``, ``"tilt"``, ``"force"``,
-        ``"moment"``; a scene's ``loading`` mapping will do).
-    part : str or None
-        ``SceneSolution.model_error["part"]``: ``"force"`` (the force P, or the settlement
-        where the force is given) or ``"moment"`` (the moment M, or the tilt where the
-        moment is given); ``"both"`` or None name nothing.
-    symbols : bool, optional
-        With the paper's symbols ("the moment M", "the tilt α"); without them ("the
-        moment") for text that may meet a narrow character set (a console).
-
-    Returns
-    -------
-    str
-        E.g. ``"the moment M"``; empty for a part that names no one unknown.
-    """
-    given = set(given)
-    if part == "moment":
-        word, symbol = ("the tilt", "α") if "moment" in given else ("the moment", "M")
-    elif part == "force":
-        word, symbol = ("the settlement", "δ") if "force" in given else ("the force", "P")
-    else:
-        return ""
-    return f"{word} {symbol}" if symbols else word
-
-
 def checked_key(scene: Scene | Mapping[str, Any]) -> str:
     """Content hash of what :func:`core.scene.check_scene`'s answer depends on: equal for
     two scenes whose check gives the same measurement (``CHECKED_PARTS`` equal)."""

@@ -15,7 +15,8 @@ from typing import Any
 import numpy as np
 
 from core import scene_from_dict
-from core.scene import estimated_quantity, flags_with_evidence, model_error_evidence
+from core.coating import model_error_quantity
+from core.scene import flags_with_evidence, model_error_evidence
 
 from .state import QUANTITIES, QUANTITY_UNITS
 
@@ -197,12 +198,12 @@ def model_evidence(view: ResultView,
     # whose error it is (a tilt of 0.3 % of the settlement made it the moment's)
     punch = parts.get("punch")
     if view.punches and isinstance(punch, int) and 0 <= punch < len(view.punches):
-        quantity = estimated_quantity(view.punches[punch].given, parts.get("part"))
+        quantity = model_error_quantity(view.punches[punch].given, parts.get("part"))
         # (the punch is named whatever the part: a bound of both names no unknown)
         evidence["quantity"] = (f"{quantity} of punch {punch + 1}" if quantity
                                 else f"punch {punch + 1}")
     elif isinstance(view.scene.get("loading"), Mapping):
-        evidence["quantity"] = estimated_quantity(view.scene["loading"], parts.get("part"))
+        evidence["quantity"] = model_error_quantity(view.scene["loading"], parts.get("part"))
     return evidence
 
 

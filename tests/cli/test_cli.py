@@ -378,3 +378,8 @@ def test_the_summary_says_whose_coating_model_error_it_is() -> None:
     assert len(lines) == 2 and all(" % of the tilt (solver.model_tol 2 %)" in s
                                    for s in lines), lines
     assert not set("αδ") & set(done.stdout)
+    # and the CSV's head (it gave the solver's 4e-7 beside a bare model_error flag)
+    done = run("solve", "preset:eccentric_creep", "-o", "-", "--format", "csv")
+    assert done.returncode == 0, done.stderr
+    head = [s for s in done.stdout.splitlines() if s.startswith("# coating model error")]
+    assert len(head) == 1 and head[0].endswith(" % of the tilt (solver.model_tol 2 %)"), head

@@ -108,7 +108,8 @@ def test_the_contact_at_a_chosen_time_and_when_the_punch_lifts_off(checked):
                                              "x = -1 to -0.306 m (unilateral contact)")
     assert results["lift-off"].startswith("at 20 of 20 output times, first at t = 0 days")
     # the nearest output time: 46.42 d for 50 d (log spacing to 1000 d)
-    assert "contact at t = 46.42 days" in rows(checked, "Results", time=50)
+    assert ("contact at t = 46.42 days (the output time nearest the 50 days asked for)"
+            in rows(checked, "Results", time=50))
     assert "contact at t = 1000 days (2.7 years)" in rows(checked, "Results")  # the last by default
     assert output_index(checked, 1000.4) == 19
     for bad, reason in ((-3.0, "outside the output times, 0 to 1000 days"),
@@ -249,6 +250,8 @@ def test_the_command_line_writes_both_and_is_strict(tmp_path):
     assert strict.returncode == 3, strict.stderr
     assert "design check failed (settlement_limit)" in strict.stderr
     assert html_path.exists()  # written all the same
+    # the exceeded limit itself, as solve says it (report said no word of it)
+    assert "\nwarning: design_check: largest settlement" in "\n" + strict.stderr
 
 
 def test_the_command_line_describes_the_contact_at_the_time_asked_for(tmp_path):
@@ -256,6 +259,11 @@ def test_the_command_line_describes_the_contact_at_the_time_asked_for(tmp_path):
     done = run_cli("report", "preset:eccentric_footing_liftoff", "-o", path, "--time", "0")
     assert done.returncode == 0, done.stderr
     assert "<td>contact at t = 0 days</td><td>contact 1.306 m of 2 m (65 %)" in path.read_text()
+    # a time between the output times: the nearest, said so (365 read "at t = 316.2 days")
+    done = run_cli("report", "preset:eccentric_footing_liftoff", "-o", path, "--time", "365")
+    assert done.returncode == 0, done.stderr
+    assert ("<td>contact at t = 316.2 days (the output time nearest the 365 days asked "
+            "for)</td>") in path.read_text()
     late = run_cli("report", "preset:eccentric_footing_liftoff", "-o", path, "--time", "5000")
     assert late.returncode == 2
     assert "--time: 5000 days is outside the output times, 0 to 1000 days" in late.stderr

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
+from core.coating import model_error_quantity
 from core.creep import creep_model_from_spec
 from core.engines.layered import NO_COATING
 from core.scene import (
@@ -543,7 +544,15 @@ def test_solution_dict_is_json():
         assert all(line.startswith("# ") for line in head)
         assert text.endswith("\n".join(table) + "\n")
         assert {line.split(":")[0] for line in head} >= {
-            "# version", "# scene_json", "# solver", "# answered", "# flags"}
+            "# version", "# scene_json", "# solver", "# answered", "# flags",
+            "# coating model error (estimate)"}
+        # (a table's reader saw the solver's 4e-7 beside a bare model_error flag)
+        # (the exact layered kernel's: no part of a model error to name)
+        whose = model_error_quantity(result.scene.given, result.model_error.get("part"),
+                                     symbols=False)
+        line = next(s for s in head if s.startswith("# coating model error"))
+        assert line == "# coating model error (estimate): 5e-08 % (solver.model_tol 2 %)"
+        assert whose == "", line
 
 
 # ---------------------------------------------------------------------------- validation
