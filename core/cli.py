@@ -90,6 +90,7 @@ from core.scene import (
     schema_errors,
     schema_text,
     solve,
+    thin_edge_note,
     verdict_words,
 )
 from core.version import VERSION
@@ -288,8 +289,11 @@ def _punches_summary(result: PunchesSolution) -> str:
             values = [getattr(punch, q)[i] for q in QUANTITIES]
             lines.append(f"{result.times[i]:12.6g} " + " ".join(f"{v:16.8g}" for v in values))
         line = largest_pressure(punch)
+        edge = thin_edge_note(line, punch.scene.half_width, punch.info.get("coating_model"))
         line = replace(line, x=punch.center + line.x)  # the global x
         lines.append(f"  largest contact pressure q: {line.value_text(place_first=True)}")
+        if edge:
+            lines.append(f"    ({edge})")
         lines.append(f"  {punch.info.get('message', '')}")
         lines.append(f"  flags: {', '.join(punch.flags) if punch.flags else 'none'}")
         if punch.scene.coating:
@@ -320,8 +324,11 @@ def _summary(result: SceneSolution) -> str:
             zones = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in result.contact_set[i])
             where = f"{zones} m" if zones else "none (the punch touches nothing)"
             lines.append(f"contact at {result.times[i]:g} days: {where}")
-    peak = largest_pressure(result).value_text(place_first=True)
-    lines.append(f"largest contact pressure q: {peak}")
+    largest = largest_pressure(result)
+    lines.append(f"largest contact pressure q: {largest.value_text(place_first=True)}")
+    edge = thin_edge_note(largest, result.scene.half_width, result.info.get("coating_model"))
+    if edge:
+        lines.append(f"  ({edge})")
     held = corner_note(result.info.get("corner_pressure"))
     if held is not None:
         # what the q table's held rows leave out: a table integrated fell short of P by

@@ -46,6 +46,9 @@ from typing import Any
 
 import numpy as np
 
+#: The name of the thin coating model in a result's ``info["coating_model"]`` (the exact
+#: layered kernel's is ``core.engines.layered.EXACT_LAYERED``).
+THIN_LAYER = "thin layer"
 #: How a coating layer may be joined to what lies under it.
 INTERFACES = ("smooth", "bonded")
 DEFAULT_INTERFACE = "smooth"

@@ -25,6 +25,7 @@ from core.scene import (
     model_error_evidence,
     number_text,
     percent_text,
+    thin_edge_note,
     time_of_largest,
 )
 from core.version import VERSION
@@ -49,9 +50,13 @@ def _largest_pressure_text(result: Any, origin: float = 0.0) -> str:
     """The largest contact pressure, where and when (``origin + x`` [m]): unbounded at a
     rigid corner in contact, where the text says so (:func:`core.scene.largest_pressure`)."""
     line = largest_pressure(result)
+    # (the short words: the long ones ran the PDF's text onto a fourth page)
+    edge = thin_edge_note(line, result.scene.half_width, result.info.get("coating_model"),
+                          short=True)
     if line.x is not None and origin:
         line = replace(line, x=origin + line.x)
-    return line.value_text(number=number_text, shown=_shown, place_first=True, time=days_text)
+    text = line.value_text(number=number_text, shown=_shown, place_first=True, time=days_text)
+    return f"{text} ({edge})" if edge else text
 
 
 def _at(times: np.ndarray, values: np.ndarray) -> tuple[float, float]:

@@ -44,6 +44,8 @@ from core.scene.contact_zone import (
     narrowest_zone,
 )
 from core.scene.design import (
+    THIN_EDGE_NOTE,
+    THIN_EDGE_SHORT,
     DesignCheck,
     DesignLimits,
     LimitCheck,
@@ -51,6 +53,7 @@ from core.scene.design import (
     design_check,
     flagged_caution,
     largest_pressure,
+    thin_edge_note,
     time_of_largest,
     verdict_words,
 )
@@ -146,6 +149,9 @@ __all__ = [
     "number_text",
     "percent_text",
     "largest_pressure",
+    "thin_edge_note",
+    "THIN_EDGE_NOTE",
+    "THIN_EDGE_SHORT",
     "lifts_off_at",
     "check_design",
     "flagged_caution",

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from core.coating import THIN_LAYER
 from core.validation import finite_number, show_value
 
 #: The limit checks in order: (field of :class:`DesignLimits`, quantity, unit, label).
@@ -421,6 +422,35 @@ def _millimetres(distance: float) -> str:
     """A distance [m] in mm to two significant digits, never in exponent form."""
     return np.format_float_positional(1e3 * distance, precision=2, unique=False,
                                       fractional=False, trim="-")
+
+
+#: What the thin coating model's largest pressure at a punch's edge is, said beside it.
+THIN_EDGE_NOTE = (
+    "at the punch's edge: the thin coating model's value, bounded by its springs, where a "
+    "sharp rigid corner on the resolved coating carries a pressure without bound; the FE "
+    "check compares q away from the edges only")
+
+
+#: :data:`THIN_EDGE_NOTE` where room is short (a report's row).
+THIN_EDGE_SHORT = "at the edge: the thin coating model's springs bound it there"
+
+
+def thin_edge_note(line: LimitCheck, half_width: float, coating_model: str | None,
+                   short: bool = False) -> str:
+    """:data:`THIN_EDGE_NOTE` (``short``: :data:`THIN_EDGE_SHORT`) when the largest
+    pressure ``line`` (``q_max``, its ``x`` [m] from the punch's centre) lies at the edge
+    of a punch of ``half_width`` [m] answered by the thin coating model, else "".
+
+    The model's springs make q finite at a rigid corner where the resolved coating's is
+    not (q ~ 1 / sqrt(distance) under a flat punch): an engineer's check of
+    ``allowable_pressure`` read a finite utilisation there, and nothing said it was the
+    model's (a 0.01 % change of the coating modulus turned an answer of the exact kernel,
+    "unbounded at the corner", into one of the thin layer with a utilisation of 2.7).
+    """
+    if (coating_model != THIN_LAYER or line.x is None or line.unbounded
+            or not abs(abs(float(line.x)) - half_width) <= 1e-9 * half_width):
+        return ""
+    return THIN_EDGE_SHORT if short else THIN_EDGE_NOTE
 
 
 def largest_pressure(result: Any) -> LimitCheck:

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from core.coating import THIN_LAYER
 from core.engines.layered import NO_COATING
 from core.limits import DAYS_PER_YEAR
 from core.optional import import_optional
@@ -137,7 +138,7 @@ def engine_text(result: SceneSolution) -> str:
     contact = str(info.get("contact", "full"))
     parts = ([f"{info['method']} engine", f"{contact} contact"] if "method" in info
              else [f"{contact} contact solver"])
-    model = str(info.get("coating_model", "thin layer"))
+    model = str(info.get("coating_model", THIN_LAYER))
     parts.append("no coating" if model == NO_COATING else f"{model} coating model")
     if info.get("fallback"):
         parts.append(f"fallback: {info['fallback']}")

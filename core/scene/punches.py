@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from core import limits
-from core.coating import DEFAULT_INTERFACE
+from core.coating import DEFAULT_INTERFACE, THIN_LAYER
 from core.contact import LoadNotCarried, solve_creep_punches, solve_unilateral_punches
 from core.engines.nystrom import PunchGeometry, solve_punches
 from core.problem import (
@@ -343,7 +343,7 @@ class PunchesSolution:
             "error_estimate": max(float(p.info["error_estimate"]) for p in punches),
             "success": all(bool(p.info["success"]) for p in punches),
             "flags": list(self.flags),
-            "coating_model": punches[0].info.get("coating_model", "thin layer"),
+            "coating_model": punches[0].info.get("coating_model", THIN_LAYER),
             "message": _joint_message([str(p.info.get("message", "")) for p in punches]),
         }
 
@@ -462,7 +462,7 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
         punches = [PunchSolution(sub, center, answer) for sub, center, answer
                    in zip(scene.scenes, scene.centers, answers, strict=True)]
         for p in punches:
-            p.info["coating_model"] = "thin layer"
+            p.info["coating_model"] = THIN_LAYER
     result = PunchesSolution(scene, punches)
     result.info["cpu_seconds"] = time.thread_time() - started
     return result

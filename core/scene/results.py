@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.cache import StageCache, fingerprint
-from core.coating import model_error_estimate, model_error_map, tilt_share
+from core.coating import THIN_LAYER, model_error_estimate, model_error_map, tilt_share
 from core.engines.layered import EXACT_LAYERED, NO_COATING, corner_reach, uniform_layers
 from core.problem import QUANTITIES, positions
 from core.scene.contact_zone import (
@@ -348,7 +348,7 @@ class SceneSolution:
         self.info = dict(solution.info)
         self.info["flags"] = list(self.flags)
         self.info["model_error_estimate"] = self.model_error["estimate"]
-        self.info["coating_model"] = solution.info.get("coating_model", "thin layer")
+        self.info["coating_model"] = solution.info.get("coating_model", THIN_LAYER)
         corners = corner_pressure(scene, self.info["coating_model"], self.contact_set)
         if corners is not None:
             corners.update(held_shares(self.pressure, self.force, self.moment,

@@ -22,7 +22,14 @@ import numpy as np
 import param
 
 from core.scene import DesignLimits as CoreLimits
-from core.scene import LimitCheck, check_design, days_text, flagged_caution, number_text
+from core.scene import (
+    LimitCheck,
+    check_design,
+    days_text,
+    flagged_caution,
+    number_text,
+    thin_edge_note,
+)
 
 from .contact_zone import contact_widths
 from .results import ResultView
@@ -84,6 +91,9 @@ class DesignCheck:
     narrowest_time: float | None = None
     #: the answer's validity flags: a verdict on a flagged answer is qualified
     flags: list[str] = field(default_factory=list)
+    #: what the largest pressure is when it is the thin coating model's at a punch's
+    #: edge (:func:`core.scene.thin_edge_note`; "" otherwise)
+    edge_note: str = ""
 
     @property
     def passed(self) -> bool | None:
@@ -167,11 +177,15 @@ def design_check(view: ResultView, limits: DesignLimits | None = None) -> Design
     force = float(view.values["force"][-1])
     moment = float(view.values["moment"][-1])
     checks = [_on_screen(line, limits) for line in verdict.checks]
+    # (one punch: several draw their pressure over the whole surface, in global x)
+    edge = "" if view.punches else thin_edge_note(
+        verdict.checks[0], view.geometry.half_width, view.info.get("coating_model"))
     return DesignCheck(q_max=checks[0], q_min=_on_screen(verdict.q_min, limits),
                        contact_width=float(widths[j_narrow]),
                        full_width=2 * view.geometry.half_width,
                        eccentricity=moment / force if force > 0 else None, checks=checks,
-                       narrowest_time=float(view.times[j_narrow]), flags=list(view.flags))
+                       narrowest_time=float(view.times[j_narrow]), flags=list(view.flags),
+                       edge_note=edge)
 
 
 def check_html(check: DesignCheck) -> str:
@@ -216,4 +230,6 @@ def check_html(check: DesignCheck) -> str:
     return (f"<div class='design-check'><b>Design check</b> (whole history) {head}"
             f"<table class='cp-readout'><tr><th></th><th>value</th><th>where</th>"
             f"<th>limit</th><th></th></tr>{''.join(rows)}</table>"
-            f"<div class='cp-status'>{contact} · {ecc}</div></div>")
+            f"<div class='cp-status'>{contact} · {ecc}</div>"
+            + (f"<div class='cp-status check-edge'>q_max {html.escape(check.edge_note)}</div>"
+               if check.edge_note else "") + "</div>")

@@ -322,3 +322,15 @@ def test_the_features_legend_hides_no_line() -> None:
     fig = figures.inset.fig
     assert fig.visible
     assert fig.legend[0] in fig.below and fig.legend[0] not in fig.center
+
+
+def test_the_design_check_says_when_q_max_is_the_thin_layer_s_at_an_edge() -> None:
+    """The flat punch's q_max sits at x = a, where the thin coating model's springs bound
+    q; the stepped punch's at its step, inside; the bare layer's corner is unbounded and
+    says so in its own row."""
+    from explorer.model import check_html, design_check
+
+    html = check_html(design_check(_solved("uniform_flat")))
+    assert "check-edge" in html and "q_max at the punch&#x27;s edge: the thin coating" in html
+    for key in ("stepped_punch", "bare_layer"):
+        assert "check-edge" not in check_html(design_check(_solved(key))), key

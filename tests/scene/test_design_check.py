@@ -212,3 +212,31 @@ def test_a_zero_limit_is_exceeded_in_words() -> None:
     d["limits"] = {"settlement_limit": 0.0}
     line = solve(d).design_check().check("settlement")
     assert line.describe().endswith("limit 0 m, exceeded: FAIL"), line.describe()
+
+
+def test_the_thin_layer_s_largest_pressure_at_an_edge_says_whose_it_is() -> None:
+    """The thin coating model's springs bound q at a rigid corner, where the resolved
+    coating's pressure has no bound; an engineer's allowable-pressure check read a finite
+    utilisation there and nothing said it was the model's. The command line's summary
+    and the report's row now say it (the page's design check too: tests/explorer); not
+    where the largest pressure is inside the punch, nor for the exact kernel's unbounded
+    corner."""
+    from core.report.content import key_numbers
+    from core.scene import THIN_EDGE_NOTE, THIN_EDGE_SHORT, largest_pressure, thin_edge_note
+    from tests.cli_runs import run_cli
+
+    flat = solve(scene_file("uniform_flat"))  # a flat punch: q_max at x = a
+    line = largest_pressure(flat)
+    assert line.x == pytest.approx(1.0) and flat.info["coating_model"] == "thin layer"
+    assert thin_edge_note(line, flat.scene.half_width, "thin layer") == THIN_EDGE_NOTE
+    assert thin_edge_note(line, flat.scene.half_width, "exact layered") == ""
+    stepped = solve(scene_file("stepped_punch"))  # q_max at the step, inside
+    assert thin_edge_note(largest_pressure(stepped), stepped.scene.half_width,
+                          stepped.info["coating_model"]) == ""
+    bare = solve(scene_file("bare_layer"))  # unbounded: said by its own corner line
+    assert thin_edge_note(largest_pressure(bare), bare.scene.half_width, "thin layer") == ""
+
+    summary = run_cli("solve", "preset:uniform_flat").stdout
+    assert f"\n  ({THIN_EDGE_NOTE})\n" in summary
+    row = dict(key_numbers(flat))["largest contact pressure q"]
+    assert row.endswith(f" ({THIN_EDGE_SHORT})")  # (a page's row: the short words)
