@@ -422,7 +422,13 @@ def _words(error: Any, root: str) -> Iterator[tuple[str, str]]:
         high = next(((k, error.schema[k]) for k in ("maximum", "exclusiveMaximum")
                      if k in error.schema), None)
         code_age = path == "base.age_at_loading" and "then" in error.schema_path
-        if low is not None and high is not None and (path in INTERVAL_FIELDS or code_age):
+        if (error.schema.get("type") == "integer" and low is not None and high is not None
+                and low[0] == "minimum" and high[0] == "maximum"):
+            # a count, as the Python checks word one ("times.count: must be an integer
+            # from 1 to 2000"; the schema read "must be <= 2000")
+            yield path, (f"must be an integer from {low[1]:g} to {high[1]:g}, got "
+                         f"{got}{unit if unit else ''}")
+        elif low is not None and high is not None and (path in INTERVAL_FIELDS or code_age):
             # both ends said at once where the Python checks say them so ("in (-1,
             # 0.5)"; a design code's age at loading): `validate` read "must be < 0.5"
             # where `solve` read "must be in (-1, 0.5)"
