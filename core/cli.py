@@ -53,7 +53,6 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 from core import limits
-from core.coating import model_error_quantity
 from core.files import (
     atomic_write_bytes,
     atomic_write_text,
@@ -82,6 +81,7 @@ from core.scene import (
     load_scene,
     migrate,
     model_error_evidence,
+    model_error_line,
     percent_text,
     punches_from_dict,
     read_scene_json,
@@ -297,12 +297,7 @@ def _punches_summary(result: PunchesSolution) -> str:
         lines.append(f"  {punch.info.get('message', '')}")
         lines.append(f"  flags: {', '.join(punch.flags) if punch.flags else 'none'}")
         if punch.scene.coating:
-            quantity = model_error_quantity(punch.scene.given, punch.model_error.get("part"),
-                                          symbols=False)
-            lines.append(f"  coating model error (estimate): "
-                         f"{percent_text(punch.model_error['estimate'], 2)}"
-                         f"{' of ' + quantity if quantity else ''} (solver.model_tol "
-                         f"{100 * punch.scene.model_tol:g} %)")
+            lines.append(f"  coating model error (estimate): {model_error_line(punch)}")
         if checks[k] is not None:
             lines.append(f"  design check (whole history): "
                          f"{verdict_words(checks[k].passed, punch.flags)}")
@@ -336,14 +331,9 @@ def _summary(result: SceneSolution) -> str:
         lines.append(held.removeprefix("# "))
     lines.append(str(result.info.get("message", "")))
     lines.append(f"flags: {', '.join(result.flags) if result.flags else 'none'}")
-    estimate = result.info.get("model_error_estimate")
-    if estimate is not None:
-        # (no Greek letters: a console's narrow character set may not hold them)
-        quantity = model_error_quantity(result.scene.given, result.model_error.get("part"),
-                                      symbols=False)
+    if result.info.get("model_error_estimate") is not None:
         lines.append(f"coating model error ({result.info.get('coating_model')}, estimate): "
-                     f"{percent_text(estimate, 2)}{' of ' + quantity if quantity else ''} "
-                     f"(solver.model_tol {100 * result.scene.model_tol:g} %)")
+                     f"{model_error_line(result)}")
     check = result.design_check()
     if check is not None:
         lines.append(f"design check (whole history): "

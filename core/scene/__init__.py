@@ -64,7 +64,6 @@ from core.scene.display import (
     known_contact_width,
     lifts_off_at,
     number_text,
-    percent_text,
 )
 from core.scene.evidence import (
     check_settled,
@@ -104,6 +103,8 @@ from core.scene.punches import (
 )
 from core.scene.records import (
     csv_header,
+    model_error_line,
+    percent_text,
     provenance,
     provenance_lines,
     solver_settings,
@@ -148,6 +149,7 @@ __all__ = [
     "days_text",
     "number_text",
     "percent_text",
+    "model_error_line",
     "largest_pressure",
     "thin_edge_note",
     "THIN_EDGE_NOTE",

@@ -23,7 +23,7 @@ from core.limits import DAYS_PER_YEAR
 from core.optional import import_optional
 from core.scene.contact_zone import LIFT_OFF_SHARE
 from core.scene.files import scene_to_json
-from core.scene.records import solver_settings
+from core.scene.records import percent_text, solver_settings
 from core.scene.schema import SCHEMA_VERSION, _jsonable
 
 # the package root only, for its version: its imports of the upper layers are for type
@@ -50,32 +50,6 @@ SHOWN: tuple[tuple[str, float, str], ...] = (
     ("force", 1e-3, "kN/m"),
     ("moment", 1e-3, "kN m/m"),
 )
-
-
-#: Shares below this many percent are written as "< 0.001 %" (a numerical estimate of
-#: 5e-10 read "5e-08 %").
-PERCENT_FLOOR = 1e-3
-#: Shares above this many percent are written as "> 10000 %": an estimated coating-model
-#: error of a 1000 km coating read "16556648 %", digits that mean nothing but "no model".
-PERCENT_CEILING = 1e4
-
-
-def percent_text(share: float, digits: int = 3) -> str:
-    """A relative error or share [-] in percent for people: ``digits`` significant
-    figures, "< 0.001 %" below :data:`PERCENT_FLOOR`, "> 10000 %" above
-    :data:`PERCENT_CEILING`, never in exponent notation."""
-    value = 100.0 * float(share)
-    if not math.isfinite(value):
-        return f"{value} %"
-    if value == 0:
-        return "0 %"
-    if abs(value) < PERCENT_FLOOR:
-        return f"> -{PERCENT_FLOOR:g} %" if value < 0 else f"< {PERCENT_FLOOR:g} %"
-    if abs(value) > PERCENT_CEILING:
-        return f"< -{PERCENT_CEILING:g} %" if value < 0 else f"> {PERCENT_CEILING:g} %"
-    if abs(float(f"{value:.{digits}g}")) >= 10.0 ** digits:  # "g" would write an exponent
-        return f"{value:.0f} %"
-    return f"{value:.{digits}g} %"
 
 
 def number_text(value: float, digits: int = 4) -> str:

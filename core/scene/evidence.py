@@ -16,8 +16,9 @@ from collections.abc import Mapping
 from typing import Any
 
 from core.cache import fingerprint
-from core.scene.display import days_text, percent_text
+from core.scene.display import days_text
 from core.scene.model import Scene
+from core.scene.records import percent_text
 from core.scene.results import FLAG_MESSAGES
 from core.scene.validate import scene_from_dict, solver_model_tol
 

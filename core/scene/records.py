@@ -10,6 +10,7 @@ the table; each line is ``# key: value``).
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -59,6 +60,43 @@ def provenance_lines(scene: Scene | PunchesScene | Mapping[str, Any]) -> list[st
             f"# solver: {json.dumps(solver_settings(scene), **compact)}"]
 
 
+#: Shares below this many percent are written as "< 0.001 %" (a numerical estimate of
+#: 5e-10 read "5e-08 %").
+PERCENT_FLOOR = 1e-3
+#: Shares above this many percent are written as "> 10000 %": an estimated coating-model
+#: error of a 1000 km coating read "16556648 %", digits that mean nothing but "no model".
+PERCENT_CEILING = 1e4
+
+
+def percent_text(share: float, digits: int = 3) -> str:
+    """A relative error or share [-] in percent for people: ``digits`` significant
+    figures, "< 0.001 %" below :data:`PERCENT_FLOOR`, "> 10000 %" above
+    :data:`PERCENT_CEILING`, never in exponent notation."""
+    value = 100.0 * float(share)
+    if not math.isfinite(value):
+        return f"{value} %"
+    if value == 0:
+        return "0 %"
+    if abs(value) < PERCENT_FLOOR:
+        return f"> -{PERCENT_FLOOR:g} %" if value < 0 else f"< {PERCENT_FLOOR:g} %"
+    if abs(value) > PERCENT_CEILING:
+        return f"< -{PERCENT_CEILING:g} %" if value < 0 else f"> {PERCENT_CEILING:g} %"
+    if abs(float(f"{value:.{digits}g}")) >= 10.0 ** digits:  # "g" would write an exponent
+        return f"{value:.0f} %"
+    return f"{value:.{digits}g} %"
+
+
+def model_error_line(solution: Any, symbols: bool = False) -> str:
+    """The coating model's estimated error of one punch's answer in words, with whose it
+    is and the tolerance: "0.92 % of the tilt (solver.model_tol 2 %)". ``symbols``: the
+    paper's symbols beside the names (not on a console, whose character set may not hold
+    them)."""
+    error = solution.model_error
+    quantity = model_error_quantity(solution.scene.given, error.get("part"), symbols=symbols)
+    return (f"{percent_text(error['estimate'], 2)}{' of ' + quantity if quantity else ''} "
+            f"(solver.model_tol {100 * solution.scene.model_tol:g} %)")
+
+
 def csv_header(result: Any, what: str) -> str:
     """The ``#`` lines before a CSV table of ``result`` (a ``SceneSolution`` or a
     ``PunchesSolution``): what it is (``what``), the version, the scene, the solver
@@ -80,13 +118,8 @@ def csv_header(result: Any, what: str) -> str:
     # 4.3e-07" beside a bare "model_error" flag, where the answer erred by 2.5 %
     for who, one in ([(f"punches[{k}] ", p) for k, p in enumerate(result.punches)]
                      if several else [("", result)]):
-        if one.scene.coating and isinstance(one.model_error.get("estimate"), float):
-            quantity = model_error_quantity(one.scene.given, one.model_error.get("part"),
-                                            symbols=False)
-            lines.append(f"# {who}coating model error (estimate): "
-                         f"{100 * one.model_error['estimate']:.2g} %"
-                         + (f" of {quantity}" if quantity else "")
-                         + f" (solver.model_tol {100 * one.scene.model_tol:g} %)")
+        if one.scene.coating:
+            lines.append(f"# {who}coating model error (estimate): {model_error_line(one)}")
     lines.append("# flags: " + (", ".join(result.flags) or "none"))
     checks = [(f"punches[{k}] ", c, p.flags) for k, (c, p) in
               enumerate(zip(result.design_checks(), result.punches, strict=True))] \
