@@ -29,7 +29,7 @@ from core.back_analysis.readings import (
     readings_from_mapping,
     readings_from_text,
 )
-from core.back_analysis.result import BAND_LEVEL, Calibration, Forecast
+from core.back_analysis.result import BAND_LEVEL, Calibration, Forecast, quantile
 
 __all__ = [
     "BAND_LEVEL",
@@ -38,6 +38,7 @@ __all__ = [
     "FD_STEP",
     "FIT_SOLVER_TOL",
     "Forecast",
+    "quantile",
     "MAX_CONDITION",
     "MAX_SOLVER_ERROR_TO_NOISE",
     "read_readings",

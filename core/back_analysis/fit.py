@@ -30,7 +30,14 @@ from core.back_analysis.model import FD_STEP, FIT_SOLVER_TOL, Field, Model, fitt
 from core.back_analysis.readings import Readings, as_readings
 from core.back_analysis.result import Calibration
 from core.limits import MAX_FIT_SOLVES
-from core.scene import Scene, scene_from_dict
+from core.scene import (
+    PunchesScene,
+    Scene,
+    at_output_times,
+    has_punches,
+    load_scene,
+    scene_from_dict,
+)
 
 #: A fit whose normalised Jacobian has a condition number above this does not determine
 #: every field: along the weakest direction the readings pin a combination ~1000 times
@@ -86,15 +93,24 @@ SETTLED_DETERMINED = (f"the Gauss-Newton step along each combination of the fiel
                       "error (relative offset); the readings do not determine the others")
 
 
-def _working_scene(scene: Scene | Mapping[str, Any], readings: Readings) -> tuple[dict, dict]:
+def _working_scene(scene: Scene | Mapping[str, Any] | str | os.PathLike,
+                   readings: Readings) -> tuple[dict, dict]:
     """The canonical scene dict and the dict solved by the fit: the readings' times as
-    output times and the solver tolerance at most :data:`FIT_SOLVER_TOL`."""
+    output times (its loads the same functions of time: :func:`core.scene.at_output_times`)
+    and the solver tolerance at most :data:`FIT_SOLVER_TOL`."""
+    if isinstance(scene, (str, os.PathLike)):
+        scene = load_scene(scene)  # its messages start with the file's path
+    if isinstance(scene, PunchesScene) or (isinstance(scene, Mapping) and has_punches(scene)):
+        punches = scene.scenes if isinstance(scene, PunchesScene) else scene["punches"]
+        count = f"{len(punches)} punches" if isinstance(punches, (list, tuple)) else "punches"
+        raise ValueError(f"scene: holds {count} (punches); a fit takes a scene of one punch, "
+                         "whose readings are its settlement and tilt")
     try:
         base = scene_from_dict(scene).to_dict()
     except ValueError as exc:
-        raise ValueError(f"scene: {exc}") from None
-    work = dict(base)
-    work["times"] = [float(t) for t in readings.time]
+        # (a message of the scene's own starts "scene: " already)
+        raise ValueError(str(exc) if str(exc).startswith("scene") else f"scene: {exc}") from None
+    work = at_output_times(base, [float(t) for t in readings.time])
     solver = dict(work.get("solver", {}))
     solver["tol"] = min(float(solver.get("tol", FIT_SOLVER_TOL)), FIT_SOLVER_TOL)
     work["solver"] = solver
@@ -131,7 +147,7 @@ def _weights(readings: Readings) -> tuple[np.ndarray, np.ndarray, np.ndarray, bo
     return y, mask, sigma, given
 
 
-def calibrate(scene: Scene | Mapping[str, Any],
+def calibrate(scene: Scene | Mapping[str, Any] | str | os.PathLike,
               measurements: Readings | Mapping[str, Any] | str | os.PathLike,
               fit: Sequence[str], bounds: Mapping[str, Sequence[float | None]] | None = None,
               ) -> Calibration:
@@ -139,8 +155,11 @@ def calibrate(scene: Scene | Mapping[str, Any],
 
     Parameters
     ----------
-    scene : Scene or dict
-        The scene; its values of the fitted fields are the start of the fit.
+    scene : Scene, dict, str or path
+        The scene of one punch (a scene file's path or ``"preset:NAME"`` is read by
+        :func:`core.scene.load_scene`); its values of the fitted fields are the start of
+        the fit. Its loads are the same functions of time at the reading times as at its
+        own output times (a ``linear`` history keeps its own span).
     measurements : str, path, mapping or Readings
         A readings file (CSV or JSON, format in ``core/SCENES.md``) or a mapping with
         ``time`` [day after loading] and ``settlement`` [m] and/or ``tilt`` [rad] (lists),
@@ -322,7 +341,9 @@ def _covariance(J: np.ndarray, s2: float) -> tuple[np.ndarray, float]:
     condition = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
     tiny = sv[0] * np.finfo(float).eps * max(J.shape)
     inv = np.where(sv > tiny, 1.0 / np.where(sv > tiny, sv, 1.0) ** 2, np.inf)
-    with np.errstate(invalid="ignore"):
+    # (readings that no field moves, a tilt of a centred punch: J = 0, tiny = 0 and the
+    # covariance infinite, as the warnings say; no numpy warning on the way)
+    with np.errstate(invalid="ignore", divide="ignore"):
         cov_n = (vt.T * np.where(np.isfinite(inv), inv, 1.0 / tiny ** 2)) @ vt
     cov = s2 * cov_n / np.outer(safe, safe)
     cov[:, norms == 0] = np.inf

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.back_analysis.readings import SERIES_UNITS, Readings
-from core.scene import Scene, SceneSolution, provenance, scene_from_dict
+from core.scene import Scene, SceneSolution, at_output_times, provenance, scene_from_dict
 from core.study import apply_point
 
 if TYPE_CHECKING:
@@ -21,6 +21,27 @@ if TYPE_CHECKING:
 
 #: The default confidence level of a forecast's band.
 BAND_LEVEL = 0.95
+
+
+def quantile(level: float, dof: int | None = None) -> float:
+    """The factor ``z`` of a two-sided interval ``value -/+ z se`` of confidence ``level``.
+
+    Parameters
+    ----------
+    level : float
+        The confidence, in (0, 1).
+    dof : int or None
+        None where the readings' standard deviations were given (the covariance is
+        known): the normal quantile (1.96 at 0.95). Else the fit's degrees of freedom
+        ``n - p`` of the noise estimated from the residuals: Student's t quantile, which
+        accounts for that estimate's own scatter (3.18 at 0.95 with 3 degrees of freedom,
+        where 1.96 covers 86 %).
+    """
+    # (scipy.special: the quantiles without importing scipy.stats)
+    from scipy.special import ndtri, stdtrit
+
+    p = 0.5 + float(level) / 2
+    return float(ndtri(p) if dof is None else stdtrit(int(dof), p))
 
 
 def _jsonable_array(values: np.ndarray) -> list[float | None]:
@@ -32,9 +53,10 @@ class Forecast:
     """The fitted scene's settlement [m] and tilt [rad] at ``times`` [day after loading]
     with their standard deviations from the fitted fields' covariance (linearised: the
     delta method, the gradient by the fit's finite differences) and the band
-    ``value -/+ z std`` of confidence ``level`` (normal quantile ``z``). The band is the
-    uncertainty of the fitted fields alone: not the model's error nor the scatter of
-    future readings."""
+    ``value -/+ z std`` of confidence ``level`` (``z``: :func:`quantile` of the fit's
+    degrees of freedom ``dof``, None where the readings' standard deviations were given).
+    The band is the uncertainty of the fitted fields alone: not the model's error nor the
+    scatter of future readings."""
 
     times: np.ndarray
     settlement: np.ndarray
@@ -43,13 +65,12 @@ class Forecast:
     tilt_std: np.ndarray
     level: float
     solution: SceneSolution = field(repr=False)
+    dof: int | None = None
 
     @property
     def z(self) -> float:
-        """The normal quantile of the band's two-sided ``level``."""
-        from scipy.special import ndtri  # the normal quantile, without scipy.stats
-
-        return float(ndtri(0.5 + self.level / 2))
+        """The quantile of the band's two-sided ``level`` (:func:`quantile`)."""
+        return quantile(self.level, self.dof)
 
     def band(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """The lower and upper edge of the band of ``settlement`` or ``tilt``."""
@@ -154,6 +175,28 @@ class Calibration:
         se = np.sqrt(np.abs(np.diag(self.covariance)))
         return {f.path: float(s) for f, s in zip(self.fields, se, strict=True)}
 
+    def intervals(self, level: float = BAND_LEVEL) -> dict[str, tuple[float, float]]:
+        """The confidence interval of each fitted value by path, in the field's unit.
+
+        ``x -/+ z se(x)`` in the fit's coordinate ``x`` (the logarithm of a log-fitted
+        field: its interval is ``value * exp(-/+ z se(log value))``, positive and
+        lopsided as the field's uncertainty is), with ``z`` the :func:`quantile` of
+        ``level``: Student's t of the fit's degrees of freedom where the noise was
+        estimated from the residuals (``std_given`` False), else the normal one.
+        """
+        if not 0 < float(level) < 1:
+            raise ValueError(f"level: must be in (0, 1), got {level!r}")
+        z = quantile(level, None if self.std_given else self.dof)
+        se = np.sqrt(np.abs(np.diag(self.cov_x)))
+
+        def value(f: Field, x: float) -> float:
+            try:
+                return f.to_value(x)
+            except OverflowError:  # exp of a log-fitted field's undetermined end
+                return math.inf
+        return {f.path: (value(f, x - z * e), value(f, x + z * e))
+                for f, x, e in zip(self.fields, self.x, se, strict=True)}
+
     @property
     def correlation(self) -> np.ndarray:
         """The correlation of the fitted values (the order of :attr:`paths`)."""
@@ -224,9 +267,9 @@ class Calibration:
             raise ValueError(f"level: must be in (0, 1), got {level!r}")
         if not isinstance(times, Mapping):
             times = [float(t) for t in np.asarray(times, dtype=float).ravel()]
-        work = dict(self.work)
-        work["times"] = times
         try:
+            # (the fit's scene already holds its loads as functions of time alone)
+            work = at_output_times(self.work, times)
             scene_from_dict(work)
         except ValueError as exc:
             msg = str(exc)
@@ -239,7 +282,8 @@ class Calibration:
         solution = model.solve(self.x)
         m = solution.times.size
         return Forecast(np.asarray(solution.times, dtype=float), centre[:m], centre[m:],
-                        std[:m], std[m:], float(level), solution)
+                        std[:m], std[m:], float(level), solution,
+                        None if self.std_given else self.dof)
 
     def to_dict(self) -> dict[str, Any]:
         """The fit as JSON-able data with units: the fields (start, value, standard
@@ -247,8 +291,11 @@ class Calibration:
         residuals, the goodness of fit, the warnings, the fitted scene and the
         provenance (program version, scene, solver settings)."""
         se = self.standard_errors
+        intervals = self.intervals()
         fields = [{"path": f.path, "unit": f.unit, "start": f.start,
                    "value": self.values[f.path], "standard_error": se[f.path],
+                   f"interval_{round(100 * BAND_LEVEL)}": _jsonable_array(
+                       np.array(intervals[f.path])),
                    "bounds": [f.bounds[0] if math.isfinite(f.bounds[0]) else None,
                               f.bounds[1] if math.isfinite(f.bounds[1]) else None],
                    "fitted_as": "log" if f.log else "linear"} for f in self.fields]
@@ -289,6 +336,7 @@ class Calibration:
         """A short text summary: each field's value and standard error, the goodness of
         fit and the warnings."""
         se = self.standard_errors
+        intervals = self.intervals()
         width = max(len(p) for p in self.paths)
         n = self.readings.count
         lines = [f"fitted {len(self.fields)} field(s) to {n} reading(s) "
@@ -297,8 +345,10 @@ class Calibration:
         for f in self.fields:
             value = self.values[f.path]
             rel = se[f.path] / abs(value) if value else math.inf
+            low, high = intervals[f.path]
             lines.append(f"  {f.path:<{width}} = {value:.6g} +/- {se[f.path]:.2g} "
-                         f"{f.unit}".rstrip() + f"  ({100 * rel:.2g} %, start "
+                         f"{f.unit}".rstrip() + f"  ({100 * rel:.2g} %; "
+                         f"{100 * BAND_LEVEL:g} % interval {low:.4g} to {high:.4g}; start "
                          f"{f.start:.6g})")
         if len(self.fields) > 1:
             corr = self.correlation

@@ -26,6 +26,8 @@ returns a ``SceneSolution``.
 - ``evidence.py``: ``model_error_evidence``, the coating model's error every output shows
   (the FE check's measurement once run on the scene, else the estimate);
 - ``golden_section.py``: the least gap between punch and coating;
+- ``output_times.py``: ``at_output_times``, the scene at other output times with its
+  loads the same functions of time (a ``linear`` history pinned to its own end);
 - ``at_loading.py``: ``elastic_at_loading``, the scene whose base answers as at the instant
   of loading (elastic at its modulus then, ``modulus_at_loading``), and ``creeps``.
 """
@@ -85,6 +87,7 @@ from core.scene.json_schema import (
 )
 from core.scene.load_limits import check_loads_touch
 from core.scene.model import Scene
+from core.scene.output_times import at_output_times
 from core.scene.pipeline import solve
 from core.scene.plotting import (
     LIFT_OFF_COLOUR,
@@ -139,6 +142,7 @@ _LAZY: dict[str, str] = {"check_scene": "core.scene.coating_check",
                          "pressure_caution": "core.scene.coating_check"}
 
 __all__ = [
+    "at_output_times",
     "default_tol",
     "LIFT_OFF_COLOUR",
     "LIFT_OFF_SHARE",

@@ -104,6 +104,18 @@ class FitOutcome:
             out.append((c.label, number_text(value, 4), _error_text(se), c.unit))
         return out
 
+    def intervals(self) -> list[str]:
+        """The confidence interval (:data:`core.back_analysis.BAND_LEVEL`) of each field,
+        in the units on screen: Student's t where the noise was estimated from the
+        scatter (:meth:`core.back_analysis.Calibration.intervals`)."""
+        intervals = self.calibration.intervals()
+        out = []
+        for c in self.choices:
+            low, high = (v / c.scale for v in intervals[c.key])
+            out.append("unbounded" if not (math.isfinite(low) and math.isfinite(high))
+                       else f"{number_text(low, 4)} to {number_text(high, 4)}")
+        return out
+
     def correlations(self) -> list[tuple[str, str, float]]:
         """(field, field, correlation of their fitted values) of each pair."""
         corr = self.calibration.correlation

@@ -265,12 +265,15 @@ def outcome_html(outcome: FitOutcome) -> str:
     c = outcome.calibration
     rows = "".join(
         f"<tr class='fit-row'><td>{html.escape(label)}</td><td>{html.escape(value)} ± "
-        f"{html.escape(se)} {html.escape(unit)}</td></tr>"
-        for label, value, se, unit in outcome.rows())
+        f"{html.escape(se)} {html.escape(unit)}</td><td>{html.escape(interval)}</td></tr>"
+        for (label, value, se, unit), interval in zip(outcome.rows(), outcome.intervals(),
+                                                      strict=True))
     noise = ("the readings' standard deviations" if c.std_given
-             else "the noise estimated from the scatter about the fit")
+             else "the noise estimated from the scatter about the fit (the interval by "
+             f"Student's t, {c.dof} degrees of freedom)")
     parts = [f"<table class='fit-values' style='font-size:13px'>"
-             f"<tr><th>field</th><th>fitted value ± standard error</th></tr>{rows}</table>",
+             f"<tr><th>field</th><th>fitted value ± standard error</th>"
+             f"<th>{100 * BAND_LEVEL:g} % interval</th></tr>{rows}</table>",
              f"<div style='font-size:12px'>{c.readings.count} readings, "
              f"χ²/dof = {c.chi2_per_dof:.3g} ({c.dof} dof); standard errors from "
              f"{noise}.</div>"]

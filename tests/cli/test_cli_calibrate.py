@@ -118,3 +118,13 @@ def test_a_history_this_program_wrote_says_how_to_fit_it(tmp_path: Path) -> None
     proc = run_cli("calibrate", scene, history, "--fit", "base.creep.compliance",
                    cwd=tmp_path)
     assert proc.returncode == EXIT_OK, proc.stderr
+
+
+def test_a_scene_of_several_punches_is_refused_in_one_line(tmp_path: Path) -> None:
+    """It was refused with the whole repr of the scene (11 kB on one line)."""
+    _, readings = _files(tmp_path)
+    proc = run_cli("calibrate", "preset:new_footing_beside_old", readings, "--fit",
+                   "base.poisson", cwd=tmp_path)
+    assert proc.returncode == EXIT_BAD_INPUT
+    assert proc.stderr == ("error: scene: holds 2 punches (punches); a fit takes a scene of "
+                           "one punch, whose readings are its settlement and tilt\n")
