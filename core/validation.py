@@ -48,6 +48,10 @@ def _integer_text(value: int) -> str:
     return f"{text[:12]}... ({len(text)} digits)"
 
 
+#: The longest repr of a value a message echoes (a string or an object), in characters.
+SHOWN_REPR = 80
+
+
 def show_value(value: Any) -> str:
     """``value`` as a scene file would write it, short enough for a one-line message."""
     if isinstance(value, bool):
@@ -63,7 +67,9 @@ def show_value(value: Any) -> str:
         return "an object"
     if isinstance(value, (list, tuple)):
         return "a list"
-    return repr(value)
+    text = repr(value)
+    # (an object's repr can hold a whole scene: 11 kB of one line, measured)
+    return text if len(text) <= SHOWN_REPR else f"{text[:SHOWN_REPR - 3]}..."
 
 
 def show_python(value: Any) -> str:
