@@ -323,3 +323,14 @@ def test_log_spacing_may_start_where_the_creep_does() -> None:
              r"^times\.start: must be > 0")):
         with pytest.raises(ValueError, match=message):
             scene_from_dict(edited("times", times))
+
+
+def test_a_message_echoes_a_long_value_cut_short() -> None:
+    """An object passed where a scene dict is read was echoed whole (a scene of several
+    punches: 11 kB on one line)."""
+    punches = load_scene("preset:new_footing_beside_old")
+    with pytest.raises(ValueError) as info:
+        scene_from_dict(punches)
+    message = str(info.value)
+    assert message.startswith("scene: must be a JSON object, got PunchesScene(")
+    assert message.endswith("...") and len(message) < 140, message
