@@ -158,6 +158,8 @@ class PinBoard:
 
     def __init__(self) -> None:
         self.pins: list[Pin] = []
+        # the scene on screen: what a single pin is named against (None: not known)
+        self._on_screen: dict[str, Any] | None = None
 
     def __len__(self) -> int:
         return len(self.pins)
@@ -195,6 +197,19 @@ class PinBoard:
         """Drop every pin."""
         self.pins.clear()
 
+    def name_against(self, scene: dict[str, Any]) -> None:
+        """The scene on screen changed: a single pin is named by what differs from it
+        (alone, it differs from no other pin, and its scene's name was cut to
+        "1: Force, eccentricity and tilt…" in a lesson's first pin, where "P = 500 kN/m"
+        says what the class compares)."""
+        self._on_screen = scene
+        self._name()
+
     def _name(self) -> None:
-        for pin, label in zip(self.pins, pin_labels(self.scenes()), strict=True):
+        scenes = self.scenes()
+        if len(scenes) == 1 and self._on_screen is not None:
+            labels = pin_labels([*scenes, self._on_screen])[:1]
+        else:
+            labels = pin_labels(scenes)
+        for pin, label in zip(self.pins, labels, strict=True):
             pin.label = label

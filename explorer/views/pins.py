@@ -110,8 +110,13 @@ class PinsView:
 
     def on_result(self, view: ResultView) -> None:
         """A new result arrived (before it is drawn): pin it when pinning every step."""
+        before = [(id(pin.view), pin.label) for pin in self.board]
         if self.every_step.value:
             self.board.add(view)
+        self.board.name_against(view.scene)
+        # (the buttons are built again only when a pin came or was renamed: not at every
+        # step of a load slider)
+        if [(id(pin.view), pin.label) for pin in self.board] != before:
             self._show_list()
         self._name_steps()
 
