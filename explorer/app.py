@@ -264,7 +264,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self._views["files"] = FilesView(state, screen, controller, self.scales, self.limits,
                                          self._load_file, self.results.show_download_error)
         self._views["lessons"] = LessonsView(self.pins, self.results.log_time,
-                                             self.load_scene)
+                                             self._load_lesson_step)
         order = (("scene", SceneView), ("punch", PunchView), ("coating", CoatingView),
                  ("base", BaseView), ("times", TimesView), ("check", CheckView),
                  ("files", FilesView), ("lessons", LessonsView), ("study", StudyView),
@@ -512,8 +512,10 @@ class ExplorerApp(pn.viewable.Viewer):
         self.history.remember()
         self.controller.request()
 
-    def load_scene(self, scene: dict[str, Any]) -> bool:
-        """Validate a scene dict with the core and show it; False (and a notice) if bad."""
+    def load_scene(self, scene: dict[str, Any], same_family: bool = False) -> bool:
+        """Validate a scene dict with the core and show it; False (and a notice) if bad.
+        ``same_family``: the scene continues the one on screen (a lesson's next step), so
+        the unit of pressure and the colour scale stay (:class:`DisplayScales`)."""
         # one message to the page for every widget the scene sets, and the page's models
         # walked once for all the sliders it shows for the first time
         with pn.io.hold(), layout_batch.batch():
@@ -521,7 +523,8 @@ class ExplorerApp(pn.viewable.Viewer):
                 validated_scene(scene)
                 # before the load: a result found in the caches is drawn within it, and
                 # took the last scene's unit of pressure (MPa or kPa by the way it came)
-                self.scales.reset()
+                if not same_family:
+                    self.scales.reset()
                 self.pins.forget_steps()
                 self.state.load_scene(scene)
             except ValueError as exc:
@@ -530,6 +533,16 @@ class ExplorerApp(pn.viewable.Viewer):
             self.history.loaded = scene
             self.screen.notice = ""
             self.limits.take(scene.get("limits"))
+        return True
+
+    def _load_lesson_step(self, scene: dict[str, Any], first: bool) -> bool:
+        """A lesson's step: its steps keep one unit of pressure (a class read q in kPa at
+        one step and in MPa at the next), and the Scene tab shows the step's name and
+        note (it kept the preset's, "a centred force of 500 kN per metre", beside plots of
+        1000 kN/m)."""
+        if not self.load_scene(scene, same_family=not first):
+            return False
+        self.scene_tab.forget_preset()
         return True
 
     def _load_file(self, scene: dict[str, Any]) -> bool:

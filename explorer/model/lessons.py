@@ -102,8 +102,9 @@ LESSONS: tuple[Lesson, ...] = (
                  "evenly, 0.24 to 0.25 MPa from the middle to 25 mm from the edges: it "
                  "acts almost like a bed of springs. (At the rigid corner itself the "
                  "pressure on this elastic base still grows without bound, in a band "
-                 "thinner than the coating; the plot holds its value there, as the Check "
-                 "tab says.) The settlement is now 0.064 mm, mostly the coating's.",
+                 "thinner than the coating; across that band the plot holds the value "
+                 "25 mm from the corner, as the design check below the plots says.) The "
+                 "settlement is now 0.064 mm, mostly the coating's.",
                  {"coating.0.thickness": 0.05, "coating.0.modulus": 2.0e8}),
         ),
     ),
@@ -112,17 +113,17 @@ LESSONS: tuple[Lesson, ...] = (
         title="A new footing beside an old one",
         preset="new_footing_beside_old",
         steps=(
-            Step("Punch 1, the old footing, carries 600 kN/m from the start, on concrete 7 "
-                 "days old: it settles 0.026 mm at once and 0.065 mm by one year. Then "
-                 "punch 2, 1 m to its right, is loaded from its own weight (100 kN/m) to "
-                 "600 kN/m: the old footing goes down to 0.067 mm at once and to 0.085 mm "
-                 "at 50 years. It tilts toward the new one (its right side goes down): "
-                 "0.0012 mrad before, 0.0031 mrad just after and 0.0058 mrad at 50 years, "
-                 "its right edge 12 µm below its left. Why: the new load sinks the layer "
-                 "most under itself. Were the old footing to stay level, its right edge "
-                 "would lose support and its left carry more, off its centre; no moment "
-                 "holds it level, so it turns toward the neighbour until its pressure is "
-                 "centred again. The new footing, likewise, tilts toward the old one.",
+            Step("Punch 1, the old footing, carries 600 kN/m from the start, on concrete 7 days "
+                 "old: it settles 0.026 mm at once and 0.065 mm by one year. Then punch 2, its "
+                 "centre 3 m to the right (a gap of 1 m), is loaded from its own weight (100 kN/m)"
+                 " to 600 kN/m: the old footing goes down to 0.067 mm at once and to 0.085 mm at "
+                 "50 years. It tilts toward the new one (its right side goes down): 0.0012 mrad "
+                 "before, 0.0031 mrad just after and 0.0058 mrad at 50 years, its right edge 12 µm"
+                 " below its left. Why: the new load sinks the layer most under itself. Were the "
+                 "old footing to stay level, its right edge would lose support and its left carry "
+                 "more, off its centre; no moment holds it level, so it turns toward the neighbour"
+                 " until its pressure is centred again. The new footing, likewise, tilts toward "
+                 "the old one.",
                  log_time=True),
             Step("The same, but the new footing is never loaded beyond its own weight: "
                  "the old one settles 0.080 mm at 50 years and tilts 0.0015 mrad. So the "

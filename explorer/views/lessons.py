@@ -20,9 +20,10 @@ class LessonsView:
     title = "Lessons"
 
     def __init__(self, pins: PinsView, log_time: LabelledCheckbox,
-                 load_scene: Callable[[dict[str, Any]], bool]) -> None:
+                 load_scene: Callable[[dict[str, Any], bool], bool]) -> None:
         """``pins``: a step left stays pinned; ``log_time``: the histories' log time
-        axis, which a step may switch; ``load_scene``: shows a step's scene."""
+        axis, which a step may switch; ``load_scene(scene, first)``: shows a step's scene
+        (``first``: the lesson's start, where the display's scales start again)."""
         self.pins = pins
         self.log_time = log_time
         self.load_scene = load_scene
@@ -59,10 +60,11 @@ class LessonsView:
             self.previous_button.disabled = self.next_button.disabled = True
             return
         self.pins.unpin()
-        self.go(0, pin=False)
+        self.go(0, pin=False, first=True)
 
-    def go(self, index: int, pin: bool = True) -> None:
-        """Show step ``index`` (0 = first); the step left stays pinned going forward."""
+    def go(self, index: int, pin: bool = True, first: bool = False) -> None:
+        """Show step ``index`` (0 = first); the step left stays pinned going forward;
+        ``first``: the lesson starts."""
         lesson = self.lesson
         if lesson is None or not 0 <= index < len(lesson.steps):
             return
@@ -72,7 +74,7 @@ class LessonsView:
         self.step = index
         if step.log_time is not None:
             self.log_time.value = step.log_time
-        self.load_scene(step_scene(lesson, index))
+        self.load_scene(step_scene(lesson, index), first)
         self.previous_button.disabled = index == 0
         self.next_button.disabled = index == len(lesson.steps) - 1
         self.lesson_note.object = (

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import html
 from collections.abc import Callable
 from typing import Any
 
@@ -88,6 +89,12 @@ class SceneView:
         key = getattr(self, "preset", None) and self.preset.value
         scene = self.presets.get(key) if key else None
         if scene is None:
+            # a scene of its own (a file, a lesson's step) says what it is, as a preset does
+            loaded = self.history.loaded if hasattr(self, "history") else None
+            if isinstance(loaded, dict) and str(loaded.get("description", "")).strip():
+                # (a file's text, escaped: the pane renders HTML within Markdown)
+                return (f"**{html.escape(str(loaded.get('name', '')))}**: "
+                        f"{html.escape(str(loaded['description']))}")
             return "Your own scene: start from a preset, a file or a link."
         return str(scene.get("description", ""))
 
@@ -114,8 +121,10 @@ class SceneView:
         self.preset_description.object = self._preset_text()
 
     def forget_preset(self) -> None:
-        """Show no preset as chosen (a scene from a file is a scene of its own)."""
+        """Show no preset as chosen (a scene from a file or a lesson's step is a scene of
+        its own), and that scene's name and description."""
         self.preset.value = ""
+        self.preset_description.object = self._preset_text()
 
     def refresh(self, *events: Any) -> None:
         """Point the history editors at the two given quantities; name the unknowns."""

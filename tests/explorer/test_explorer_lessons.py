@@ -177,3 +177,29 @@ def test_a_one_time_scene_keeps_its_time_where_the_player_cannot_go(explorer_app
     assert "Step 2 of 3" in view.lesson_note.object and len(app.pins.board) == 1
     app.pins.pin()
     assert len(app.pins.board) == 2
+
+
+def test_a_lessons_steps_keep_one_unit_and_the_scene_tab_shows_the_step(explorer_app) -> None:
+    """The coating lesson's bare slab reads q in MPa (its edge runs past 1 MPa), the
+    coated steps in kPa: a class read the notes' MPa on an axis in kPa. Its steps now keep
+    the first step's unit, as a dragged slider does. The Scene tab kept the preset's name
+    and description ("... 500 kN per metre") beside a step's plots; it shows the step's."""
+    app = explorer_app()
+    view = app.lessons_tab
+    view.lesson_select.value = "coating_edges"
+    assert app.controller.wait(60) and app.controller.error == ""
+    assert app.scales.pressure_unit(app.controller.view)[0] == "MPa"
+    for step in (2, 3):
+        view.next_button.clicks += 1
+        assert app.controller.wait(60) and app.controller.error == ""
+        assert app.scales.pressure_unit(app.controller.view)[0] == "MPa", step
+        assert app.figures.q_fig.yaxis[0].axis_label.endswith("[MPa]")
+        text = app.scene_tab.preset_description.object
+        assert text.startswith(f"**What a coating does to the edge pressure, step {step} of "
+                               "3**: "), text
+        assert app.scene_tab.preset.value == ""
+    # a lesson started again, or a preset, chooses its unit afresh
+    view.lesson_select.value = "load_and_tilt"
+    assert app.controller.wait(60)
+    assert app.scales.pressure_unit(app.controller.view)[0] == "kPa"
+    assert "Force, eccentricity and tilt, step 1 of 4" in app.scene_tab.preset_description.object
