@@ -46,8 +46,8 @@ fi
 
 # The whole suite in three parts at once, one pytest each: the browser tests (marker
 # "browser": a served explorer and Chromium), the soak tests (marker "soak": servers and
-# worker processes started, stopped, killed and left idle, much of it waiting on them) and
-# the rest. One pytest keeps at most one core busy, and the soak part waits much of its
+# worker processes started, stopped, killed and left idle, much of it waiting on them)
+# with the checks of seconds each (marker "slow"), and the rest. One pytest keeps at most one core busy, and the soak part waits much of its
 # time; when one part ends first the others still have both cores. Measured on a fresh
 # clone, 2 cores with nothing else running (2026-11-30): 19.8-21.4 min with the
 # installation (rest 18.5-19.9, browser 16.0-17.6, soak 7.5-8.8 min, documentation
@@ -83,13 +83,18 @@ fi
 # Beside a CPU hog on the faster machine (AMD EPYC, 2026-12-04, fresh clones, five runs in
 # a row, all green): two busy loops (load 3.4-7) 11:09; one busy loop (load ~4-6) 8:20,
 # 8:02, 8:03 and 7:48, the rest part 7:31-8:03 of each.
+# On a fresh clone, quiet (2026-12-06, one after the other): the "slow" checks (67 of them,
+# ~130 s of one core) in the soak part instead of the rest's, 10:21 (rest 10:05, browser
+# 9:00, soak and slow 8:47, documentation 148 s; 824 s user CPU, 141 % of a core) against
+# 12:08 as above (rest 11:50, browser 8:25, soak 3:50; 853 s, 123 %): the soak part waits
+# much of its time, and the rest ran alone on one core for its last 3.5 minutes.
 # The parts share nothing: each has its own temporary directory, pytest cache and served
 # explorers (a free port each).
 work="$(mktemp -d -t coated-punch-suite.XXXXXX)"
 python -m pytest -q -m browser --basetemp "$work/browser" -o cache_dir=.pytest_cache/browser \
     >"$work/browser.log" 2>&1 &
 browser_pid=$!
-python -m pytest -q -m "soak and not browser" --basetemp "$work/soak" \
+python -m pytest -q -m "(soak or slow) and not browser" --basetemp "$work/soak" \
     -o cache_dir=.pytest_cache/soak >"$work/soak.log" 2>&1 &
 soak_pid=$!
 
@@ -118,7 +123,7 @@ docs_pid=$!
 # (kill fails once a job has ended: no status of its own may reach the exit code)
 trap 'kill "$browser_pid" "$soak_pid" "$docs_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
 set +e
-python -m pytest -q -m "not browser and not soak" --basetemp "$work/rest" \
+python -m pytest -q -m "not browser and not soak and not slow" --basetemp "$work/rest" \
     -o cache_dir=.pytest_cache/rest
 rest=$?
 wait "$browser_pid"
@@ -132,7 +137,7 @@ echo "---- documentation (sphinx -W) ----"
 cat "$work/docs.log"
 echo "---- browser tests (pytest -m browser) ----"
 cat "$work/browser.log"
-echo "---- soak tests (pytest -m soak) ----"
+echo "---- soak and slow tests (pytest -m \"(soak or slow) and not browser\") ----"
 cat "$work/soak.log"
 echo "---- exit codes: rest $rest, browser $browser, soak $soak, docs $docs ----"
 [ "$rest" -eq 0 ] && [ "$browser" -eq 0 ] && [ "$soak" -eq 0 ] && [ "$docs" -eq 0 ]
