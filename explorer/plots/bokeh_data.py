@@ -148,6 +148,12 @@ def legend_inside(fig: Any, location: str, font_size: str = "10px") -> Any:
 ONE_ROW_ENTRIES = 2
 
 
+def legend_rows(legend: Any) -> int:
+    """The rows of a legend laid out by :func:`wrap_legend`."""
+    shown = sum(1 for item in legend.items if item.visible)
+    return 1 if shown <= ONE_ROW_ENTRIES else -(-shown // 2)
+
+
 def wrap_legend(legend: Any) -> None:
     """One row of the entries shown when few, else two columns (see ONE_ROW_ENTRIES)."""
     shown = sum(1 for item in legend.items if item.visible)

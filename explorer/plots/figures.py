@@ -43,6 +43,7 @@ from .bokeh_data import (
     MOVING,
     f32,
     legend_above,
+    legend_rows,
     set_data,
     steady_range,
     wrap_legend,
@@ -71,6 +72,14 @@ READ_SERIES = ("settlement", "tilt")
 
 #: Font size of the entries of the legends above the plots (normal mode).
 LEGEND_FONT = "11px"
+
+#: Height of the pressure plot and of the q(x, t) map beside it [px], in presentation mode
+#: (True) and not, with a legend of one row.
+Q_HEIGHT = {True: 240, False: 280}
+#: Height of each further row of the q(x) legend above its plot [px] (11 px labels with
+#: their padding): the plot grows by it, so its frame keeps its height (five pins, three
+#: rows of entries, left a frame of ~70 px of a 240 px plot in presentation mode).
+LEGEND_ROW = 22
 
 #: Font size of ticks, axis labels and titles in presentation mode (a projector).
 PRESENTATION_FONT = "18px"
@@ -129,7 +138,7 @@ class Figures:
     # -- construction ----------------------------------------------------------------
     def _build_pressure(self) -> None:
         # the value axes are set here, not fitted in the page (see steady_range)
-        p = figure(height=280, sizing_mode="stretch_width", tools=TOOLS,
+        p = figure(height=Q_HEIGHT[False], sizing_mode="stretch_width", tools=TOOLS,
                    title="Contact pressure q(x)", toolbar_location="above",
                    name="pressure_figure", x_range=Range1d(-1, 1), y_range=Range1d(0, 1))
         p.toolbar.autohide = True
@@ -167,7 +176,7 @@ class Figures:
         self.q_fig = p
 
     def _build_image(self) -> None:
-        p = figure(height=280, sizing_mode="stretch_width", tools=TOOLS,
+        p = figure(height=Q_HEIGHT[False], sizing_mode="stretch_width", tools=TOOLS,
                    title="q(x, t)", toolbar_location="above", name="image_figure",
                    x_range=Range1d(-1, 1), y_range=Range1d(0, 1))
         p.toolbar.autohide = True
@@ -382,13 +391,24 @@ class Figures:
             self._history_state[q] = state
             self._title_history(q)
         self.pins.show(view, pins, index)
+        self._fit_legend()
         self.show_time(view, index, pins, pinned_drawn=True)
         self.fit_axes(view, pins)
 
     def show_pinned(self, view: ResultView, pins: Sequence[Pin], index: int) -> None:
         """Overlay (or clear) the pinned results on the histories and the pressure."""
         self.pins.show(view, pins, index)
+        self._fit_legend()
         self.fit_axes(view, pins)
+
+    def _fit_legend(self) -> None:
+        """The pressure plot and the map beside it as tall as the rows of the q(x) legend
+        need (:data:`LEGEND_ROW` each past the first), so that its frame keeps its
+        height."""
+        height = (Q_HEIGHT[self._presenting]
+                  + (legend_rows(self.q_fig.legend[0]) - 1) * LEGEND_ROW)
+        if self.q_fig.height != height:
+            self.q_fig.height = self.image_fig.height = height
 
     def fit_axes(self, view: ResultView, pins: Sequence[Pin] = ()) -> None:
         """Value axes of q(x) and the histories that hold the result at every output
@@ -476,6 +496,7 @@ class Figures:
             if any(r in self.classic_lines for r in item.renderers):
                 item.visible = shown
         wrap_legend(self.q_fig.legend[0])
+        self._fit_legend()
         if view is not None:
             self._show_classical(view, index)
 
@@ -563,7 +584,7 @@ class Figures:
             self.history_fig[q].height = 190 if on else 210
         self.scene_fig.height = self.inset_fig.height = 240 if on else 300
         self.contact_fig.height = 170 if on else 210
-        self.q_fig.height = self.image_fig.height = 240 if on else 280
+        self._fit_legend()
 
     def _show_image(self, view: ResultView) -> None:
         unit, size = self.scales.pressure_unit(view)

@@ -163,3 +163,23 @@ def test_a_coating_added_or_taken_off_is_named_as_a_whole() -> None:
     two = _scene()
     two["coating"] = two["coating"] * 2
     assert pin_labels([bare, two])[1] == "2 coating layers"
+
+
+def test_the_pressure_plot_grows_with_its_legend_so_its_frame_keeps_its_height(
+        explorer_app) -> None:
+    """Five pins and the current line: three rows of entries above a plot of 240 px in
+    presentation mode left a frame of ~70 px (a teacher's review at 1024x768). Each row
+    past the first makes the plot and the map beside it LEGEND_ROW taller."""
+    from explorer.plots.figures import LEGEND_ROW, Q_HEIGHT
+
+    app = explorer_app(solved=True)
+    figures = app.figures
+    assert figures.q_fig.height == Q_HEIGHT[False]
+    app.pins.pin_steps(5, 250.0, 750.0)
+    assert figures.q_fig.height == figures.image_fig.height == Q_HEIGHT[False] + 2 * LEGEND_ROW
+    figures.set_presentation(True)
+    assert figures.q_fig.height == Q_HEIGHT[True] + 2 * LEGEND_ROW
+    app.pins.unpin()
+    assert figures.q_fig.height == figures.image_fig.height == Q_HEIGHT[True]
+    figures.set_presentation(False)
+    assert figures.q_fig.height == Q_HEIGHT[False]
