@@ -256,7 +256,7 @@ class ExplorerApp(pn.viewable.Viewer):
             "times": lambda: TimesView(state, self._fidelity, screen.reject, live),
             "study": lambda: StudyView(state, controller, loop, self.link.schedule),
             "fit": lambda: FitView(state, controller, loop, self.figures, self.load_scene,
-                                   screen, on_settings=self.link.schedule),
+                                   screen, on_settings=self._fit_settings),
         }
         self._views["scene"] = SceneView(state, self.presets, self.preset_key, self.history,
                                          self.load_scene, controller, screen.reject, live)
@@ -534,6 +534,14 @@ class ExplorerApp(pn.viewable.Viewer):
             self.screen.notice = ""
             self.limits.take(scene.get("limits"))
         return True
+
+    def _fit_settings(self) -> None:
+        """The Fit tab's readings or fields changed: the link keeps them, and readings
+        over time on an answer at one output time bring its histories back."""
+        self.link.schedule()
+        view = self.screen.shown()
+        if view is not None:
+            self.results.follow_time_span(view)
 
     def _load_lesson_step(self, scene: dict[str, Any], first: bool) -> bool:
         """A lesson's step: its steps keep one unit of pressure (a class read q in kPa at

@@ -106,6 +106,11 @@ def badges_html(view: ResultView | None, group: str,
 
 #: The design check while a preview is on screen: no verdict on a history without creep
 #: (its largest settlement is the one at loading; the answer with creep comes on release).
+#: Said in place of the q(x, t) map and the histories of an answer at one output time.
+ONCE_NOTE = ("<div class='once-note' style='font-size:13px;color:#444'>One output time "
+             "({t}): the base answers at once (elastic) and holds that answer at every "
+             "later time, so there is no history to draw. A creeping base, or more output "
+             "times, draw the settlement, tilt and pressure over time.</div>")
 PREVIEW_DESIGN = ("<span class='cp-badge check-none design-preview'>design check on "
                   "release: the preview leaves out creep</span>")
 #: What the page does not show for a scene of several punches yet, said under its
@@ -237,6 +242,8 @@ class ResultsView:
         self.player_box = pn.Row(self.player, sizing_mode="stretch_width", margin=0)
         self.time_label = html_pane("", margin=(12, 10))
         self.readout = html_pane("", sizing_mode="stretch_width")
+        self.once_note = html_pane("", sizing_mode="stretch_width", visible=False,
+                                   css_classes=["once-note-pane"])
         self.design = html_pane("", sizing_mode="stretch_width", css_classes=["design-pane"])
         self.classical = LabelledCheckbox("classical solutions on q(x)",
                                           css_classes=["classical-toggle"])
@@ -257,6 +264,7 @@ class ResultsView:
     def content(self) -> pn.Column:
         """The main column of the page."""
         scene_pane, q_pane, image_pane, *history_panes = self._bokeh_panes
+        self.history_grid = pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width")
         # the pins' controls beside the readout; below it in presentation mode, where the
         # readout's larger text with two pins ran under them at 1024 px
         self.pin_controls = pn.Column(self.pins.content(), self.classical)
@@ -273,12 +281,13 @@ class ResultsView:
             pn.Row(scene_pane, self.contact_panes.inset_slot, sizing_mode="stretch_width"),
             self.pressure_badges,
             pn.Row(q_pane, image_pane, sizing_mode="stretch_width"),
+            self.once_note,
             pn.Row(self.player_box, self.time_label, sizing_mode="stretch_width"),
             self.readout_row,
             self.below_readout,
             self.design,
             pn.Row(self.history_badges, self.log_time, sizing_mode="stretch_width"),
-            pn.GridBox(*history_panes, ncols=2, sizing_mode="stretch_width"),
+            self.history_grid,
             self.contact_panes.width_slot,
             sizing_mode="stretch_width",
         )
@@ -297,6 +306,7 @@ class ResultsView:
         # one output time (an elastic scene): the player's range is 0 to 1 all the same
         # (a range of one point is no slider), so it takes no move
         self.player.disabled = len(view.times) < 2
+        self.follow_time_span(view)
         with param.discard_events(self.screen):
             self.screen.time_index = index
         self.show_time_texts(view, index)
@@ -309,6 +319,28 @@ class ResultsView:
         if self.time_axis.on:
             self.time_axis.fit()
         self.show_design(view)
+
+    def follow_time_span(self, view: ResultView) -> None:
+        """An answer at one output time (an elastic base answers at once, and holds at
+        every later time) has no history to draw: the q(x, t) map and the histories are
+        taken off (a map of one row and four plots of one dot each, on axes of 0.96 to
+        1.04 days), and a line says why; pinned results or readings over time keep
+        them."""
+        grid = getattr(self, "history_grid", None)
+        if grid is None:  # (the page's column is not built yet)
+            return
+        readings = self.figures.readings_src
+        over_time = (len(view.times) > 1
+                     or any(len(pin.view.times) > 1 for pin in self.pins.board.pins)
+                     or any(len(readings[q].data.get("t", ())) for q in readings))
+        # (the map's figure itself: its Bokeh pane takes its visibility from it)
+        for pane in (self.figures.image_fig, grid, self.log_time.__panel__()):
+            if pane.visible != over_time:
+                pane.visible = over_time
+        note = "" if over_time else ONCE_NOTE.format(t=days_text(float(view.times[0])))
+        if self.once_note.object != note:
+            self.once_note.object = note
+        self.once_note.visible = not over_time
 
     def evidence(self, view: ResultView | None) -> dict[str, Any] | None:
         """The coating model's error to show for ``view``: measured by the Coating tab's
@@ -368,6 +400,7 @@ class ResultsView:
         index = self.screen.time_index
         with pn.io.hold():
             self.figures.show_pinned(view, self.pins.board.pins, index)
+            self.follow_time_span(view)
             if self.time_axis.on:
                 self.time_axis.fit()
             self.show_time_texts(view, index)

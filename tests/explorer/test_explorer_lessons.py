@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import core
+from core.presets import read_preset
 from explorer.model import validated_scene
 from explorer.model.lessons import LESSONS, lessons, step_scene
 
@@ -203,3 +204,23 @@ def test_a_lessons_steps_keep_one_unit_and_the_scene_tab_shows_the_step(explorer
     assert app.controller.wait(60)
     assert app.scales.pressure_unit(app.controller.view)[0] == "kPa"
     assert "Force, eccentricity and tilt, step 1 of 4" in app.scene_tab.preset_description.object
+
+
+def test_an_answer_at_one_output_time_draws_no_history(explorer_app) -> None:
+    """The bare slab is elastic: one output time, and the page drew a q(x, t) map of one
+    row and four histories of one dot each on axes of 0.96 to 1.04 days. They are taken
+    off with a line saying why; a pinned answer over time brings them back."""
+    app = explorer_app("bare_layer", solved=True)
+    results = app.results
+    assert not results.history_grid.visible and not app.figures.image_fig.visible
+    assert results.once_note.visible and "One output time (1 day)" in results.once_note.object
+    app.load_scene(read_preset("uniform_flat"))
+    assert app.controller.wait(60) and app.controller.error == ""
+    assert results.history_grid.visible and app.figures.image_fig.visible
+    assert not results.once_note.visible
+    app.pins.pin()
+    app.load_scene(read_preset("bare_layer"))
+    assert app.controller.wait(60) and app.controller.error == ""
+    assert results.history_grid.visible  # the pin has 40 output times
+    app.pins.unpin()
+    assert not results.history_grid.visible and results.once_note.visible
