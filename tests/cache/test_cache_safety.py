@@ -9,6 +9,7 @@ object given that address.
 
 from __future__ import annotations
 
+import copy
 import gc
 
 import numpy as np
@@ -210,3 +211,45 @@ def test_kept_values_drop_the_least_recently_used_and_keep_the_newest():
     assert kept.values() == ["e" * 200] and kept.nbytes == 200
     kept.drop(lambda key: key != "e")
     assert len(kept) == 0 and kept.nbytes == 0
+
+
+def _with_force(scene: dict, force: object, times: list[float]) -> dict:
+    d = copy.deepcopy(scene)
+    d["times"] = times
+    if "punches" in d:
+        d["punches"][0]["loading"]["force"] = force
+    else:
+        d["loading"]["force"] = force
+    return d
+
+
+@pytest.mark.parametrize("preset", ["uniform_flat", "new_footing_beside_old"])
+@pytest.mark.parametrize(("times", "first"), [
+    # one output time: a force rising linearly to 500 kN/m and one held at 500 kN/m
+    # were one shape there, and the second's answer was given for the first (5 % off)
+    ([365.0], 5e5),
+    # two output times the loads meet at, held before the first instead of rising
+    ([100.0, 365.0], {"kind": "table", "interpolation": "linear",
+                      "points": [[0.0, 1e5 + 4e5 * 100 / 365],
+                                 [100.0, 1e5 + 4e5 * 100 / 365], [365.0, 5e5]]}),
+])
+def test_a_creep_answer_does_not_depend_on_the_loads_solved_before(
+        preset: str, times: list[float], first: object) -> None:
+    """The cached creep responses are keyed by each load's shape over the march's whole
+    span, not at the output times alone (core.engines.nystrom.prepared.SHAPE_KEY_SAMPLES),
+    for one punch and several."""
+    from core.cache import clear_caches
+    from core.presets import read_preset
+    from core.scene import solve
+
+    scene = read_preset(preset)
+    rising = {"kind": "linear", "start": 1e5, "end": 5e5}
+    clear_caches()
+    fresh = solve(_with_force(scene, rising, times))
+    clear_caches()
+    solve(_with_force(scene, first, times))
+    after = solve(_with_force(scene, rising, times))
+    if preset == "new_footing_beside_old":
+        fresh, after = fresh.punches[0], after.punches[0]
+    np.testing.assert_array_equal(after.settlement, fresh.settlement)
+    np.testing.assert_array_equal(after.tilt, fresh.tilt)

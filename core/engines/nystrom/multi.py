@@ -88,6 +88,7 @@ from core.engines.nystrom.prepared import (
     creep_reference,
     geometry_key,
     prepared_for,
+    shape_key_times,
 )
 from core.engines.nystrom.result import TimeSide, nystrom_solution
 from core.problem import QUANTITIES, ContactSolution, Geometry, TimeInputs
@@ -489,8 +490,11 @@ class CoupledPunches:
         """
         kernel_key, identity = content_key(kernel)
         givens = tuple(tuple(sorted(one.given)) for one in inputs)
+        # (the shapes and c sampled over the march's span too, as for one punch:
+        # prepared.SHAPE_KEY_SAMPLES)
+        span = shape_key_times(times)
         common = fingerprint("coupled modal", givens, times, c_t, kernel_key, time_tol,
-                             tuple(float(b) for b in breaks))
+                             tuple(float(b) for b in breaks), c(span))
 
         def zero(tt: np.ndarray) -> np.ndarray:
             return np.zeros(np.shape(tt))
@@ -511,7 +515,11 @@ class CoupledPunches:
                 loads[p].loads[name] = lambda tt, f=fn, a=amplitude: f(tt) / a
                 # the shape to SHAPE_DIGITS digits, as for one punch
                 shape = np.round(values / amplitude, SHAPE_DIGITS) + 0.0
-                parts.append((amplitude, (common, p, name, fingerprint(shape)), loads, 0.0))
+                between = np.round(np.broadcast_to(np.asarray(fn(span), dtype=float),
+                                                   span.shape) / amplitude,
+                                   SHAPE_DIGITS) + 0.0
+                parts.append((amplitude, (common, p, name, fingerprint(shape, between)),
+                              loads, 0.0))
         if form.has_gap or not parts:
             parts.append((1.0, (common, "gap"), quiet(), 1.0))
         joint_key = (identity, *(key for _, key, _, _ in parts))

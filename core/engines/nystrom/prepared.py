@@ -78,6 +78,15 @@ HISTORY_SAMPLES = {"elastic": 256, "creep": 64}
 #: response: far above the rounding of a unit conversion (1e-16), far below any tol, so a
 #: load change that only scales a load reuses the response of its shape.
 SHAPE_DIGITS = 12
+#: Points of the march's span ``[1, t*_end]`` (as many spaced evenly and as many
+#: geometrically) where a load's shape and ``c`` are sampled for the key of the cached
+#: creep response, besides the answer's own times: keyed on those alone, a force rising
+#: linearly to 500 kN/m and one held at 500 kN/m were one shape at a single output time,
+#: and the second's answer was given for the first (5 % off, found by a review); so were
+#: any two loads that meet at every output time and part between them or before the
+#: first. Jumps and kinks are keyed apart (``breaks``); a difference narrower than the
+#: samples' spacing and no jump is what the undersampling flag already reports.
+SHAPE_KEY_SAMPLES = 129
 
 
 @dataclass(frozen=True)
@@ -348,8 +357,9 @@ class PreparedContact:
         """
         c_t = inputs.c(times)
         kernel_key, identity = content_key(kernel)
+        span = shape_key_times(times)
         common = fingerprint("modal", tuple(sorted(inputs.given)), times, c_t, kernel_key,
-                             time_tol, breaks)
+                             time_tol, breaks, inputs.c(span))
         zero = {name: (lambda tt: np.zeros(np.shape(tt))) for name in inputs.loads}
         parts: list[tuple[float, tuple, dict[str, Callable], float]] = []
         for name, fn in sorted(inputs.loads.items()):
@@ -362,7 +372,9 @@ class PreparedContact:
             # the shape to SHAPE_DIGITS digits: a load scaled in other units (a force in
             # N turned dimensionless) differs from the cached shape by rounding alone
             shape = np.round(values / amplitude, SHAPE_DIGITS) + 0.0
-            parts.append((amplitude, (common, name, fingerprint(shape)), unit, 0.0))
+            between = np.round(np.asarray(fn(span), dtype=float) / amplitude,
+                               SHAPE_DIGITS) + 0.0
+            parts.append((amplitude, (common, name, fingerprint(shape, between)), unit, 0.0))
         if not self.geometry.g_is_zero or not parts:
             parts.append((1.0, (common, "gap"), zero, 1.0))
         weighted_error = 0.0
@@ -441,6 +453,16 @@ class PreparedContact:
             gap = times[after] - times[np.maximum(after - 1, 0)]
             samples = samples[gap > samples[1] - samples[0]]
         return np.union1d(times, samples)
+
+
+def shape_key_times(times: np.ndarray) -> np.ndarray:
+    """The times ``t*`` of the march's span ``[1, t*_end]`` where a load's shape is
+    sampled for its key (:data:`SHAPE_KEY_SAMPLES` evenly and as many geometrically)."""
+    start, end = 1.0, float(times[-1])
+    if not end > start:
+        return np.asarray(times, dtype=float)
+    return np.union1d(np.linspace(start, end, SHAPE_KEY_SAMPLES),
+                      np.geomspace(start, end, SHAPE_KEY_SAMPLES))
 
 
 @one_blas_thread()
