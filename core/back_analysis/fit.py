@@ -93,29 +93,38 @@ SETTLED_DETERMINED = (f"the Gauss-Newton step along each combination of the fiel
                       "error (relative offset); the readings do not determine the others")
 
 
+def reading_times(readings: Readings) -> list[float]:
+    """The readings' times [day after loading], the output times of the fit's solves."""
+    return [float(t) for t in readings.time]
+
+
 def _working_scene(scene: Scene | Mapping[str, Any] | str | os.PathLike,
                    readings: Readings) -> tuple[dict, dict]:
-    """The canonical scene dict and the dict solved by the fit: the readings' times as
-    output times (its loads the same functions of time: :func:`core.scene.at_output_times`)
-    and the solver tolerance at most :data:`FIT_SOLVER_TOL`."""
+    """The canonical scene dict and the dict the fit's values are set on: the solver
+    tolerance at most :data:`FIT_SOLVER_TOL`, the scene's own output times (the fit
+    solves it at the readings' times, each load the same function of time:
+    :class:`~core.back_analysis.model.Model`)."""
     if isinstance(scene, (str, os.PathLike)):
         scene = load_scene(scene)  # its messages start with the file's path
     if isinstance(scene, PunchesScene) or (isinstance(scene, Mapping) and has_punches(scene)):
         punches = scene.scenes if isinstance(scene, PunchesScene) else scene["punches"]
-        count = f"{len(punches)} punches" if isinstance(punches, (list, tuple)) else "punches"
-        raise ValueError(f"scene: holds {count} (punches); a fit takes a scene of one punch, "
-                         "whose readings are its settlement and tilt")
+        count = len(punches) if isinstance(punches, (list, tuple)) else 0
+        if count > 1:
+            raise ValueError(f"scene: holds {count} punches (punches); a fit takes a scene "
+                             "of one punch, whose readings are its settlement and tilt")
+        raise ValueError("scene: is written in the form of several punches (punches); a fit "
+                         "takes a scene of one punch written with punch and loading")
     try:
         base = scene_from_dict(scene).to_dict()
     except ValueError as exc:
         # (a message of the scene's own starts "scene: " already)
         raise ValueError(str(exc) if str(exc).startswith("scene") else f"scene: {exc}") from None
-    work = at_output_times(base, [float(t) for t in readings.time])
+    work = dict(base)
     solver = dict(work.get("solver", {}))
     solver["tol"] = min(float(solver.get("tol", FIT_SOLVER_TOL)), FIT_SOLVER_TOL)
     work["solver"] = solver
     try:
-        scene_from_dict(work)
+        scene_from_dict(at_output_times(work, reading_times(readings)))
     except ValueError as exc:
         raise ValueError(f"measurements: the scene cannot be solved at the reading times "
                          f"({exc})") from None
@@ -183,6 +192,8 @@ def calibrate(scene: Scene | Mapping[str, Any] | str | os.PathLike,
     ValueError
         For bad input, naming the field (``fit[0]: ...``, ``readings.csv: line 4, column
         tilt: ...``), or when the scene cannot be solved at the start.
+    OSError
+        When a scene or readings file cannot be read (``FileNotFoundError``...).
     """
     started = time.perf_counter()
     readings = as_readings(measurements)
@@ -193,7 +204,7 @@ def calibrate(scene: Scene | Mapping[str, Any] | str | os.PathLike,
     if n <= p:
         raise ValueError(f"measurements: {n} reading(s) cannot determine {p} field(s); give "
                          "more readings than fitted fields")
-    model = Model(work, fields, readings.series)
+    model = Model(work, fields, readings.series, reading_times(readings))
     x0 = np.array([f.to_x(f.start) for f in fields])
     lo = np.array([f.x_bounds[0] for f in fields])
     hi = np.array([f.x_bounds[1] for f in fields])

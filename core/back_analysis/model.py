@@ -19,7 +19,14 @@ from typing import Any
 import numpy as np
 
 from core.limits import MAX_FIT_PARAMETERS
-from core.scene import Scene, SceneSolution, replace_loads, scene_from_dict, solve
+from core.scene import (
+    Scene,
+    SceneSolution,
+    at_output_times,
+    replace_loads,
+    scene_from_dict,
+    solve,
+)
 from core.study import apply_point, field_unit, number_at
 from core.validation import finite_number, show_value
 
@@ -131,15 +138,20 @@ def fitted_fields(base: Mapping[str, Any], fit: Any, bounds: Any) -> tuple[Field
 class Model:
     """The readings the working scene predicts as a function of the fit's coordinates.
 
-    ``work`` is the scene dict solved (its times are those asked for), ``fields`` the
-    fitted fields. :meth:`solve` answers one point (a :class:`SceneSolution`);
+    ``work`` is the scene dict the fields' values are set on, ``times`` the output times
+    it is solved at (None: its own): the values are set first, then the times, each load
+    the same function of time as at the scene's own output times
+    (:func:`core.scene.at_output_times`: a ``linear`` history, whose ``end`` may be a
+    fitted field, keeps its span). ``fields`` are the fitted fields. :meth:`solve`
+    answers one point (a :class:`SceneSolution`);
     :meth:`values` the settlements and tilts (``series``) stacked in one vector;
     :meth:`jacobian` their forward differences. ``solves`` counts the solves.
     """
 
     def __init__(self, work: Mapping[str, Any], fields: Sequence[Field],
-                 series: Sequence[str]) -> None:
+                 series: Sequence[str], times: Any = None) -> None:
         self.work = dict(work)
+        self.times = times
         self.fields = tuple(fields)
         self.series = tuple(series)
         self.solves = 0
@@ -166,8 +178,9 @@ class Model:
         return {f.path: f.to_value(float(v)) for f, v in zip(self.fields, x, strict=True)}
 
     def scene_dict(self, x: Sequence[float]) -> dict[str, Any]:
-        """The working scene dict at ``x``."""
-        return apply_point(self.work, self.values_at(x))
+        """The scene dict solved at ``x``: the values set, then the output times."""
+        scene = apply_point(self.work, self.values_at(x))
+        return scene if self.times is None else at_output_times(scene, self.times)
 
     def solve(self, x: Sequence[float]) -> SceneSolution:
         """The answer at ``x`` (the last few are kept: the fit asks twice for a point)."""
@@ -176,7 +189,8 @@ class Model:
             return self._cache[key]
         if self._load_names is not None:
             if self._scene is None:
-                self._scene = scene_from_dict(self.work)
+                self._scene = scene_from_dict(self.work if self.times is None
+                                              else at_output_times(self.work, self.times))
             values = self.values_at(x)
             scene = replace_loads(self._scene, {name: values[f"loading.{name}"]
                                                 for name in self._load_names})

@@ -5,6 +5,7 @@ summary."""
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -15,6 +16,7 @@ import numpy as np
 from core.back_analysis.readings import SERIES_UNITS, Readings
 from core.scene import Scene, SceneSolution, at_output_times, provenance, scene_from_dict
 from core.study import apply_point
+from core.validation import show_value
 
 if TYPE_CHECKING:
     from core.back_analysis.model import Field, Model
@@ -40,8 +42,24 @@ def quantile(level: float, dof: int | None = None) -> float:
     # (scipy.special: the quantiles without importing scipy.stats)
     from scipy.special import ndtri, stdtrit
 
-    p = 0.5 + float(level) / 2
+    level = _level(level)
+    if dof is not None and (isinstance(dof, bool) or not isinstance(dof, numbers.Integral)
+                            or dof < 1):
+        raise ValueError(f"dof: must be a whole number >= 1 (or None), got {show_value(dof)}")
+    p = 0.5 + level / 2
     return float(ndtri(p) if dof is None else stdtrit(int(dof), p))
+
+
+def _level(level: Any) -> float:
+    """``level`` as a confidence in (0, 1), else a ValueError naming it."""
+    try:
+        value = float(level)
+    except (TypeError, ValueError):
+        raise ValueError(f"level: must be a number in (0, 1), got {show_value(level)}"
+                         ) from None
+    if not 0 < value < 1:
+        raise ValueError(f"level: must be in (0, 1), got {show_value(level)}")
+    return value
 
 
 def _jsonable_array(values: np.ndarray) -> list[float | None]:
@@ -79,7 +97,9 @@ class Forecast:
 
     def to_dict(self) -> dict[str, Any]:
         """The forecast as JSON-able lists with units."""
-        out: dict[str, Any] = {"times": self.times.tolist(), "level": self.level}
+        # the band's factor and what it is (Student's t of dof, or normal: null)
+        out: dict[str, Any] = {"times": self.times.tolist(), "level": self.level,
+                               "dof": self.dof, "z": self.z}
         for name in SERIES_UNITS:
             lower, upper = self.band(name)
             out |= {name: _jsonable_array(getattr(self, name)),
@@ -184,8 +204,6 @@ class Calibration:
         ``level``: Student's t of the fit's degrees of freedom where the noise was
         estimated from the residuals (``std_given`` False), else the normal one.
         """
-        if not 0 < float(level) < 1:
-            raise ValueError(f"level: must be in (0, 1), got {level!r}")
         z = quantile(level, None if self.std_given else self.dof)
         se = np.sqrt(np.abs(np.diag(self.cov_x)))
 
@@ -263,18 +281,15 @@ class Calibration:
         """
         from core.back_analysis.model import Model
 
-        if not 0 < float(level) < 1:
-            raise ValueError(f"level: must be in (0, 1), got {level!r}")
+        level = _level(level)
         if not isinstance(times, Mapping):
             times = [float(t) for t in np.asarray(times, dtype=float).ravel()]
         try:
-            # (the fit's scene already holds its loads as functions of time alone)
-            work = at_output_times(self.work, times)
-            scene_from_dict(work)
+            scene_from_dict(at_output_times(self.work, times))
         except ValueError as exc:
             msg = str(exc)
             raise ValueError(msg if msg.startswith("times") else f"times: {msg}") from None
-        model = Model(work, self.fields, tuple(SERIES_UNITS))
+        model = Model(self.work, self.fields, tuple(SERIES_UNITS), times)
         centre = model.values(self.x)
         gradient = model.jacobian(self.x, centre)
         var = np.einsum("ij,jk,ik->i", gradient, self.cov_x, gradient)

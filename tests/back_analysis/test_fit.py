@@ -356,3 +356,50 @@ def test_a_scene_is_given_as_core_solve_takes_it(tmp_path) -> None:
     assert by_name.values == by_path.values
     with pytest.raises(ValueError, match="^scene: must be a JSON object, got 3"):
         calibrate(3, readings, fit=["loading.force"])
+
+
+def test_the_end_of_a_linear_load_history_is_fitted_on_its_own_span() -> None:
+    """``loading.force.end`` of a ``linear`` history: the values are set on the scene at
+    its own times, then the reading times (pinning the history first refused the path,
+    a review found). Exact readings of the first half year give the end back (measured
+    2e-10 relative), and the forecast at the scene's last time is the scene's."""
+    scene = dict(SCENE, loading={"force": {"kind": "linear", "start": 1e5, "end": 5e5},
+                                 "moment": SCENE["loading"]["moment"]})
+    scene["times"] = {"end": 365.0, "count": 40, "spacing": "linear"}
+    own = core.solve(scene)
+    half = (own.times > 0) & (own.times <= 190)
+    start = dict(scene, loading=dict(scene["loading"], force={"kind": "linear",
+                                                               "start": 1e5, "end": 4e5}))
+    fit = calibrate(start, {"time": own.times[half].tolist(),
+                            "settlement": own.settlement[half].tolist()},
+                    fit=["loading.force.end"])
+    assert fit.values["loading.force.end"] == pytest.approx(5e5, rel=1e-8)
+    band = fit.forecast([365.0])
+    np.testing.assert_allclose(band.settlement, own.settlement[-1:], rtol=1e-8)
+
+
+def test_the_interval_factor_and_level_are_checked_and_recorded() -> None:
+    from core.back_analysis import quantile
+
+    for bad, field in (((0.95, 0), "dof"), ((0.95, 2.7), "dof"), ((1.0, None), "level"),
+                       (("high", None), "level"), ((float("nan"), 3), "level")):
+        with pytest.raises(ValueError, match=f"^{field}: "):
+            quantile(*bad)
+    exact = _exact()
+    fit = calibrate(SCENE, {"time": TIMES[:4].tolist(),
+                            "settlement": exact.settlement[:4].tolist()}, fit=["loading.force"])
+    with pytest.raises(ValueError, match="^level: must be a number in"):
+        fit.intervals("high")
+    d = fit.forecast([100.0]).to_dict()
+    assert d["dof"] == 3 and d["z"] == pytest.approx(quantile(0.95, 3))
+
+
+def test_a_scene_of_one_punch_written_as_punches_is_refused_saying_how_to_write_it() -> None:
+    one = core.load_scene("preset:new_footing_beside_old").to_dict()
+    one["punches"] = one["punches"][:1]
+    with pytest.raises(ValueError) as info:
+        calibrate(one, {"time": [10.0, 20.0, 30.0], "settlement": [1e-3, 1.1e-3, 1.2e-3]},
+                  fit=["base.poisson"])
+    assert str(info.value) == ("scene: is written in the form of several punches (punches); "
+                               "a fit takes a scene of one punch written with punch and "
+                               "loading")
