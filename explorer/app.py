@@ -30,6 +30,7 @@ from .fixes import (
 )
 from .model import (
     DEFAULT_PRESET,
+    MODIFIED,
     DesignLimits,
     DisplayScales,
     ExplorerState,
@@ -548,7 +549,11 @@ class ExplorerApp(pn.viewable.Viewer):
         one step and in MPa at the next), and the Scene tab shows the step's name and
         note (it kept the preset's, "a centred force of 500 kN per metre", beside plots of
         1000 kN/m)."""
-        if not self.load_scene(scene, same_family=not first):
+        # the same lesson's step on screen (changed or not): else a preset or a file was
+        # loaded meanwhile, and the step starts a family of its own
+        shown = self.state.scene_name.removesuffix(MODIFIED).rsplit(", step ", 1)[0]
+        same = not first and shown == str(scene["name"]).rsplit(", step ", 1)[0]
+        if not self.load_scene(scene, same_family=same):
             return False
         self.scene_tab.forget_preset()
         return True

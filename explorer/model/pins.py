@@ -197,11 +197,12 @@ class PinBoard:
         """Drop every pin."""
         self.pins.clear()
 
-    def name_against(self, scene: dict[str, Any]) -> None:
+    def name_against(self, scene: dict[str, Any] | None) -> None:
         """The scene on screen changed: a single pin is named by what differs from it
         (alone, it differs from no other pin, and its scene's name was cut to
         "1: Force, eccentricity and tilt…" in a lesson's first pin, where "P = 500 kN/m"
-        says what the class compares)."""
+        says what the class compares). None: no scene to name against (one of several
+        punches)."""
         self._on_screen = scene
         self._name()
 

@@ -113,7 +113,8 @@ class PinsView:
         before = [(id(pin.view), pin.label) for pin in self.board]
         if self.every_step.value:
             self.board.add(view)
-        self.board.name_against(view.scene)
+        # (pins compare results of one punch: none is named against several)
+        self.board.name_against(None if view.several else view.scene)
         # (the buttons are built again only when a pin came or was renamed: not at every
         # step of a load slider)
         if [(id(pin.view), pin.label) for pin in self.board] != before:

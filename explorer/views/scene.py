@@ -89,12 +89,13 @@ class SceneView:
         key = getattr(self, "preset", None) and self.preset.value
         scene = self.presets.get(key) if key else None
         if scene is None:
-            # a scene of its own (a file, a lesson's step) says what it is, as a preset does
-            loaded = self.history.loaded if hasattr(self, "history") else None
-            if isinstance(loaded, dict) and str(loaded.get("description", "")).strip():
+            # a scene of its own (a file, a lesson's step) says what it is, as a preset
+            # does: the scene on screen's (an undo brings its name and text back)
+            state = getattr(self, "state", None)
+            if state is not None and state.description.strip():
                 # (a file's text, escaped: the pane renders HTML within Markdown)
-                return (f"**{html.escape(str(loaded.get('name', '')))}**: "
-                        f"{html.escape(str(loaded['description']))}")
+                return (f"**{html.escape(state.scene_name)}**: "
+                        f"{html.escape(state.description)}")
             return "Your own scene: start from a preset, a file or a link."
         return str(scene.get("description", ""))
 

@@ -224,3 +224,24 @@ def test_an_answer_at_one_output_time_draws_no_history(explorer_app) -> None:
     assert results.history_grid.visible  # the pin has 40 output times
     app.pins.unpin()
     assert not results.history_grid.visible and results.once_note.visible
+
+
+def test_an_undo_in_a_lesson_shows_the_step_it_brings_back(explorer_app) -> None:
+    """The Scene tab read the last step loaded after an undo had brought the one before
+    back (a review); and a preset loaded in the middle of a lesson starts its own unit."""
+    app = explorer_app()
+    view = app.lessons_tab
+    view.lesson_select.value = "coating_edges"
+    assert app.controller.wait(60)
+    view.next_button.clicks += 1
+    assert app.controller.wait(60)
+    assert "step 2 of 3**" in app.scene_tab.preset_description.object
+    app.scene_tab.undo_button.clicks += 1
+    assert app.controller.wait(60)
+    assert "step 1 of 3**" in app.scene_tab.preset_description.object
+    app.load_scene(read_preset("eccentric_creep"))
+    assert app.controller.wait(60)
+    assert app.scales.pressure_unit(app.controller.view)[0] == "MPa"
+    view.next_button.clicks += 1   # step 2 again, after the preset: its own unit
+    assert app.controller.wait(60)
+    assert app.scales.pressure_unit(app.controller.view)[0] == "kPa"

@@ -183,3 +183,15 @@ def test_the_pressure_plot_grows_with_its_legend_so_its_frame_keeps_its_height(
     assert figures.q_fig.height == figures.image_fig.height == Q_HEIGHT[True]
     figures.set_presentation(False)
     assert figures.q_fig.height == Q_HEIGHT[False]
+
+
+def test_a_single_pin_is_not_named_against_several_punches(explorer_app) -> None:
+    """Named against a scene of several punches, every punch field differed: the pin of
+    the uniform scene read "a = 1 m, shape = 0 mm" (a review)."""
+    from core.presets import read_preset
+
+    app = explorer_app(solved=True)
+    app.pins.pin()
+    app.load_scene(read_preset("new_footing_beside_old"))
+    assert app.controller.wait(120) and app.controller.error == ""
+    assert [pin.label for pin in app.pins.board] == ["1: Uniform coating, flat punch"]
