@@ -9,6 +9,7 @@ the user's zoom. Nothing here imports Panel.
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Sequence
 
 from bokeh.core.properties import value as fixed_label
@@ -102,15 +103,26 @@ TITLE_CHARS = 40
 X_PADDING = 0.05
 
 
+#: The end of a lesson step's scene name (explorer.model.step_scene), kept by :func:`short`.
+_STEP_END = re.compile(r", step \d+ of \d+$")
+
+
 def short(text: str, limit: int = TITLE_CHARS) -> str:
     """``text`` cut to ``limit`` characters with an ellipsis; a changed scene's
-    " (modified)" is kept (the cut took it: "Eccentric footing: from full contact to…")."""
+    " (modified)" and a lesson step's ", step 2 of 4" are kept (the cut took them:
+    "Eccentric footing: from full contact to…", "Force, eccentricity and tilt, step 4
+    of…")."""
     text = " ".join(str(text).split())
     if len(text) <= limit:
         return text
-    if text.endswith(MODIFIED) and limit > 2 * len(MODIFIED):
-        return short(text[: -len(MODIFIED)], limit - len(MODIFIED)) + MODIFIED
-    return text[: limit - 1].rstrip() + "…"
+    step = _STEP_END.search(text)
+    end = MODIFIED if text.endswith(MODIFIED) else step.group() if step else ""
+    if end and limit > 2 * len(end):
+        return short(text[: -len(end)], limit - len(end)) + end
+    head = text[: limit - 1]
+    if text[limit - 1] != " " and " " in head:
+        head = head[: head.rfind(" ")]  # at a word's end ("tilt" read "ti…")
+    return head.rstrip(" ,;:") + "…"
 
 
 class Figures:

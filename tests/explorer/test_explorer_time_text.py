@@ -97,3 +97,15 @@ def test_a_changed_scene_keeps_its_modified_in_the_drawing_s_title(explorer_app)
     assert app.controller.wait(120) and app.controller.error == "", app.controller.error
     title = app.figures.scene_fig.title.text
     assert title == "Scene: Eccentric footing: from full… (modified)", title
+
+
+def test_a_lessons_step_keeps_its_number_in_the_drawing_s_title() -> None:
+    """A lesson step's name was cut before its number ("Force, eccentricity and tilt,
+    step 4 of…", at 1024 and 1366 px alike), and words mid-way ("ti…")."""
+    from explorer.plots.figures import short
+
+    assert short("Force, eccentricity and tilt, step 4 of 4") == (
+        "Force, eccentricity and…, step 4 of 4")
+    assert short("What a coating does to the edge pressure, step 3 of 3") == (
+        "What a coating does to the…, step 3 of 3")
+    assert short("Uniform coating, flat punch") == "Uniform coating, flat punch"
