@@ -83,7 +83,7 @@ fi
 # Beside a CPU hog on the faster machine (AMD EPYC, 2026-12-04, fresh clones, five runs in
 # a row, all green): two busy loops (load 3.4-7) 11:09; one busy loop (load ~4-6) 8:20,
 # 8:02, 8:03 and 7:48, the rest part 7:31-8:03 of each.
-# On a fresh clone, quiet (2026-12-06, one after the other): the "slow" checks (67 of them,
+# On a fresh clone, quiet (2026-12-06, one after the other): the "slow" checks (67 of them then,
 # ~130 s of one core) in the soak part instead of the rest's, 10:21 (rest 10:05, browser
 # 9:00, soak and slow 8:47, documentation 148 s; 824 s user CPU, 141 % of a core) against
 # 12:08 as above (rest 11:50, browser 8:25, soak 3:50; 853 s, 123 %): the soak part waits
