@@ -246,7 +246,7 @@ def test_a_linear_load_history_keeps_its_own_span_at_the_reading_times() -> None
     history over their span (a force rising from 100 to 500 kN/m over a year reached
     500 kN/m at the last reading, at half a year), and exact readings fitted from the
     truth gave a compliance 15 times too small. Now the readings of the scene's first
-    half year give the truth back (measured 2e-16 relative: the working scene is the
+    half year give the truth back (measured 1.7e-15 relative: the working scene is the
     scene), and the forecast at the scene's own times is the scene's answer."""
     scene = dict(SCENE, loading={"force": {"kind": "linear", "start": 1e5, "end": 5e5},
                                  "moment": SCENE["loading"]["moment"]})
@@ -362,7 +362,7 @@ def test_the_end_of_a_linear_load_history_is_fitted_on_its_own_span() -> None:
     """``loading.force.end`` of a ``linear`` history: the values are set on the scene at
     its own times, then the reading times (pinning the history first refused the path,
     a review found). Exact readings of the first half year give the end back (measured
-    2e-10 relative), and the forecast at the scene's last time is the scene's."""
+    1.2e-13 relative), and the forecast at the scene's last time is the scene's."""
     scene = dict(SCENE, loading={"force": {"kind": "linear", "start": 1e5, "end": 5e5},
                                  "moment": SCENE["loading"]["moment"]})
     scene["times"] = {"end": 365.0, "count": 40, "spacing": "linear"}
