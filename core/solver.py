@@ -103,7 +103,11 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         Engine options kept as keywords (see ``**options``): the projection's basis
         (``"graded"``, ``"piecewise"``, ``"global"``) and fixed mode count, the Nystrom
         engine's times where a given load history jumps or kinks (its steps land on
-        them). An engine that does not take one accepts its default value only.
+        them; give a narrow pulse's times too, which the steps could pass over). An
+        engine that does not take one accepts its default value only. A cached creep
+        response to a load is found again by the load's values at the output times and
+        at :func:`core.time.history_key_times` (the march's span and both sides of each
+        of ``time_breaks``): two callables that agree at all of them share it.
     **options
         Options of the chosen engine only (its ``prepare_options`` and
         ``solve_options``, documented with its ``prepare`` and ``solve``), e.g. the

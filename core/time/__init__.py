@@ -20,7 +20,7 @@ and ``solve_general`` (any kernel); the steppers behind them:
 from __future__ import annotations
 
 from core.time.exponential_weights import moments as exponential_moments
-from core.time.grids import time_grid
+from core.time.grids import history_key_times, time_grid
 from core.time.integration import solve_degenerate
 from core.time.product_quadrature import solve_general
 from core.time.radau import JUMP_SIDE
@@ -28,6 +28,7 @@ from core.time.volterra import ModalProblem
 
 __all__ = [
     "JUMP_SIDE",
+    "history_key_times",
     "exponential_moments",
     "ModalProblem",
     "solve_degenerate",

@@ -10,7 +10,11 @@ import numpy as np
 
 from core.time.radau import JUMP_SIDE
 
-__all__ = ["time_grid"]
+__all__ = ["history_key_times", "time_grid"]
+
+#: Points of a march's span ``[1, t_end]`` (as many spaced evenly and as many
+#: geometrically) where :func:`history_key_times` samples a history.
+KEY_SAMPLES = 129
 
 
 def time_grid(times: np.ndarray, steps: int, refine: int = 0,
@@ -108,3 +112,22 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
             if end == i:
                 index[out] = len(points) - 1
     return np.array(points), np.array(widths), index
+
+
+def history_key_times(times: np.ndarray, breaks: Sequence[float] = ()) -> np.ndarray:
+    """Where a given history (a load, ``c``) is sampled for the key of a cached time-stepped
+    response: the march's whole span ``[1, times[-1]]`` (dimensionless t), not the output
+    times alone, at :data:`KEY_SAMPLES` points evenly and as many geometrically (dense after
+    loading, where creep moves fastest), and on both sides of every jump or kink in
+    ``breaks``. Two histories that agree at all of them are stepped alike by a march that
+    lands on those breaks (a difference between samples, away from any break, is a
+    feature the march is not told of either: the scene passes its loads' features as
+    breaks)."""
+    start, end = 1.0, float(np.asarray(times, dtype=float)[-1])
+    parts = [np.asarray(times, dtype=float).ravel()]
+    if end > start:
+        parts += [np.linspace(start, end, KEY_SAMPLES), np.geomspace(start, end, KEY_SAMPLES)]
+    cuts = np.asarray([b for b in breaks if start < b < end], dtype=float)
+    if cuts.size:
+        parts += [cuts * (1 - JUMP_SIDE), cuts * (1 + JUMP_SIDE)]
+    return np.unique(np.concatenate(parts))

@@ -51,6 +51,7 @@ from core.problem import (
     validate_geometry,
     validate_time_inputs,
 )
+from core.time import history_key_times
 from core.work import one_blas_thread
 
 #: The time stepping aims this many times below its share of tol: its step-doubling
@@ -78,15 +79,6 @@ HISTORY_SAMPLES = {"elastic": 256, "creep": 64}
 #: response: far above the rounding of a unit conversion (1e-16), far below any tol, so a
 #: load change that only scales a load reuses the response of its shape.
 SHAPE_DIGITS = 12
-#: Points of the march's span ``[1, t*_end]`` (as many spaced evenly and as many
-#: geometrically) where a load's shape and ``c`` are sampled for the key of the cached
-#: creep response, besides the answer's own times: keyed on those alone, a force rising
-#: linearly to 500 kN/m and one held at 500 kN/m were one shape at a single output time,
-#: and the second's answer was given for the first (5 % off, found by a review); so were
-#: any two loads that meet at every output time and part between them or before the
-#: first. Jumps and kinks are keyed apart (``breaks``); a difference narrower than the
-#: samples' spacing and no jump is what the undersampling flag already reports.
-SHAPE_KEY_SAMPLES = 129
 
 
 @dataclass(frozen=True)
@@ -300,8 +292,11 @@ class PreparedContact:
         geometry = self.geometry
         times = inputs.times
         built_before = dict(self.counts)
+        # (from loading on, t* = 1: a jump before the first output time is marched too;
+        # it was dropped from the march and from the key of its response, 1e-3 off at
+        # tol 1e-6, a review found)
         breaks = np.array([b for b in np.asarray(time_breaks, dtype=float).ravel()
-                           if np.isfinite(b) and times[0] < b < times[-1]])
+                           if np.isfinite(b) and 1.0 < b < times[-1]])
         probe = self._history_times(times, "elastic" if inputs.kernel is None else "creep")
         if breaks.size:  # both sides of every jump are checked too
             probe = np.union1d(probe, np.concatenate([breaks * (1 - 1e-12),
@@ -357,7 +352,11 @@ class PreparedContact:
         """
         c_t = inputs.c(times)
         kernel_key, identity = content_key(kernel)
-        span = shape_key_times(times)
+        # the shapes and c over the march's span and both sides of its breaks, not at the
+        # output times alone: a force rising linearly to 500 kN/m and one held at 500 kN/m
+        # were one shape at a single output time, and the second's answer was given for
+        # the first (5 % off, found by a review)
+        span = history_key_times(times, breaks)
         common = fingerprint("modal", tuple(sorted(inputs.given)), times, c_t, kernel_key,
                              time_tol, breaks, inputs.c(span))
         zero = {name: (lambda tt: np.zeros(np.shape(tt))) for name in inputs.loads}
@@ -453,16 +452,6 @@ class PreparedContact:
             gap = times[after] - times[np.maximum(after - 1, 0)]
             samples = samples[gap > samples[1] - samples[0]]
         return np.union1d(times, samples)
-
-
-def shape_key_times(times: np.ndarray) -> np.ndarray:
-    """The times ``t*`` of the march's span ``[1, t*_end]`` where a load's shape is
-    sampled for its key (:data:`SHAPE_KEY_SAMPLES` evenly and as many geometrically)."""
-    start, end = 1.0, float(times[-1])
-    if not end > start:
-        return np.asarray(times, dtype=float)
-    return np.union1d(np.linspace(start, end, SHAPE_KEY_SAMPLES),
-                      np.geomspace(start, end, SHAPE_KEY_SAMPLES))
 
 
 @one_blas_thread()

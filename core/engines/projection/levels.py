@@ -17,7 +17,7 @@ from core.engines.projection.caches import _RESPONSE
 from core.engines.projection.matrices import GapTerms
 from core.engines.projection.stages import _Discretization, _Inputs
 from core.problem import QUANTITIES, ModalSystem
-from core.time import ModalProblem, solve_degenerate, solve_general
+from core.time import ModalProblem, history_key_times, solve_degenerate, solve_general
 
 # ---------------------------------------------------------------------- time stage
 
@@ -206,7 +206,9 @@ class _Superposition:
         self.disc, self.times, self.time_tol = disc, times, time_tol
         kernel_key = None if inp.kernel is None else getattr(inp.kernel, "key", None)
         self.cacheable = inp.kernel is None or kernel_key is not None
-        probe = np.unique(np.concatenate([np.linspace(1.0, times[-1], 129), times]))
+        # (the histories over the march's span, geometric samples too: steps at t* 1.02
+        # and 1.08 met at every even sample, and one took the other's answer)
+        probe = history_key_times(times)
         self.base_key = (disc.galerkin_key, tuple(sorted(inp.given)),
                          fingerprint(times, inp.c(probe), repr(kernel_key), time_tol))
         self.no_gap = replace(disc, gap=GapTerms(np.zeros_like(disc.gap.vector), 0.0, 0.0))
