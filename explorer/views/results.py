@@ -150,6 +150,16 @@ def punches_readout_html(view: ResultView, index: int) -> str:
             f"</div></div>")
 
 
+def change_text(value: float, other: float) -> str:
+    """The change from ``other`` to ``value`` in percent, three significant digits
+    ("+40 %", "+33.3 %", "-0.0123 %"; "0 %" for none, "n/a" from zero): "+100.00 %" and
+    "+0.00 %" read as more precise than the values beside them."""
+    if not other:
+        return "n/a"
+    change = 100 * (value - other) / abs(other)
+    return "0 %" if change == 0 else f"{change:+.3g} %"
+
+
 def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) -> str:
     """Values at the selected time: current, and each pin with the change to it (for
     several punches, each punch's; pins compare results of one punch)."""
@@ -175,7 +185,7 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
                f"<td class='readout-{q}'>{_fmt(value)}</td>")
         for k, (pinned, j) in enumerate(zip(others, times, strict=True)):
             other = float(pinned.display(q)[j])
-            change = f"{100 * (value - other) / abs(other):+.2f} %" if other else "n/a"
+            change = change_text(value, other)
             row += (f"<td class='pinned-{q} pin-{k}-{q}'>{_fmt(other)}</td>"
                     f"<td>{change}</td>")
         rows.append(row + "</tr>")

@@ -48,7 +48,7 @@ def test_pins_compare_several_results_and_go_one_by_one(explorer_app) -> None:
     assert app.results.readout.object.count("pinned-settlement") == 3
     # the settlement is linear in the force (elastic coating, linear creep): the
     # readout's change against the 500 kN/m pin is +40 %
-    assert "+40.00 %" in app.results.readout.object
+    assert "+40 %" in app.results.readout.object
     assert [b.label for b in app.pins.pin_list.objects] == [
         "✕ P = 500 kN/m", "✕ P = 600 kN/m", "✕ P = 700 kN/m"]
     app.pins.pin_list.objects[1].clicks += 1   # remove the middle one
@@ -195,3 +195,14 @@ def test_a_single_pin_is_not_named_against_several_punches(explorer_app) -> None
     app.load_scene(read_preset("new_footing_beside_old"))
     assert app.controller.wait(120) and app.controller.error == ""
     assert [pin.label for pin in app.pins.board] == ["1: Uniform coating, flat punch"]
+
+
+def test_a_change_is_given_to_three_digits() -> None:
+    """A teacher's review read "+100.00 %" and "+0.00 %" beside values of five digits."""
+    from explorer.views.results import change_text
+
+    assert change_text(2.0, 1.0) == "+100 %"
+    assert change_text(0.8, 0.6) == "+33.3 %"
+    assert change_text(1.0, 1.0) == "0 %"
+    assert change_text(0.999877, 1.0) == "-0.0123 %"
+    assert change_text(1.0, 0.0) == "n/a"
