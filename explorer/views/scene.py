@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import html
+import re
 from collections.abc import Callable
 from typing import Any
 
@@ -22,6 +23,13 @@ def _held(change: Callable[[], Any]) -> None:
     page's models walked once for the sliders it makes (``layout_batch``)."""
     with pn.io.hold(), layout_batch.batch():
         change()
+
+
+def _as_text(text: str) -> str:
+    """A file's text shown as it is in the Markdown pane: HTML escaped (the pane renders
+    HTML within Markdown) and the characters that format Markdown inline too ("2*3*4"
+    read "2<em>3</em>4")."""
+    return re.sub(r"([\\`*_\[\]$~#|])", r"\\\1", html.escape(text))
 
 
 class SceneView:
@@ -93,9 +101,8 @@ class SceneView:
             # does: the scene on screen's (an undo brings its name and text back)
             state = getattr(self, "state", None)
             if state is not None and state.description.strip():
-                # (a file's text, escaped: the pane renders HTML within Markdown)
-                return (f"**{html.escape(state.scene_name)}**: "
-                        f"{html.escape(state.description)}")
+                return (f"**{_as_text(state.scene_name)}**: "
+                        f"{_as_text(state.description)}")
             return "Your own scene: start from a preset, a file or a link."
         return str(scene.get("description", ""))
 

@@ -245,3 +245,16 @@ def test_an_undo_in_a_lesson_shows_the_step_it_brings_back(explorer_app) -> None
     view.next_button.clicks += 1   # step 2 again, after the preset: its own unit
     assert app.controller.wait(60)
     assert app.scales.pressure_unit(app.controller.view)[0] == "kPa"
+
+
+def test_a_files_name_and_description_are_shown_as_written(explorer_app) -> None:
+    """The Scene tab shows a scene of its own by its name and description, HTML and the
+    Markdown that formats inline escaped ("2*3*4" read "2<em>3</em>4")."""
+    from markdown_it import MarkdownIt
+
+    app = explorer_app()
+    scene = read_preset("uniform_flat")
+    scene["name"], scene["description"] = "Pad 2*3*4", "<b>bold</b> a_b `c` $5"
+    assert app._load_file(scene)
+    rendered = MarkdownIt().render(app.scene_tab.preset_description.object)
+    assert "<strong>Pad 2*3*4</strong>: &lt;b&gt;bold&lt;/b&gt; a_b `c` $5" in rendered
