@@ -82,11 +82,11 @@ from core.engines.nystrom.bordered import build_grid, touches
 from core.engines.nystrom.multi_modal import CoupledModalAnswer, CoupledModalForm
 from core.engines.nystrom.prepared import (
     HISTORY_SAMPLES,
-    SHAPE_DIGITS,
     TIME_SHARE,
     PreparedContact,
     creep_reference,
     geometry_key,
+    load_shape,
     prepared_for,
 )
 from core.engines.nystrom.result import TimeSide, nystrom_solution
@@ -494,7 +494,7 @@ class CoupledPunches:
         # (the shapes and c over the march's span and both sides of its breaks, as for
         # one punch: a temporary overload took another's answer, 1.3 % off, a review found)
         span = history_key_times(times, breaks)
-        common = fingerprint("coupled modal", givens, times, c_t, kernel_key, time_tol,
+        common = fingerprint("coupled modal", givens, times, kernel_key, time_tol,
                              tuple(float(b) for b in breaks), c(span))
 
         def zero(tt: np.ndarray) -> np.ndarray:
@@ -508,19 +508,12 @@ class CoupledPunches:
         for p, one in enumerate(inputs):
             for name in sorted(one.given):
                 fn = one.loads[name]
-                values = np.broadcast_to(np.asarray(fn(times), dtype=float), times.shape)
-                amplitude = float(values[np.argmax(np.abs(values))])
+                amplitude, shape = load_shape(fn, times, span)
                 if amplitude == 0.0:
                     continue
                 loads = quiet()
                 loads[p].loads[name] = lambda tt, f=fn, a=amplitude: f(tt) / a
-                # the shape to SHAPE_DIGITS digits, as for one punch
-                shape = np.round(values / amplitude, SHAPE_DIGITS) + 0.0
-                between = np.round(np.broadcast_to(np.asarray(fn(span), dtype=float),
-                                                   span.shape) / amplitude,
-                                   SHAPE_DIGITS) + 0.0
-                parts.append((amplitude, (common, p, name, fingerprint(shape, between)),
-                              loads, 0.0))
+                parts.append((amplitude, (common, p, name, fingerprint(shape)), loads, 0.0))
         if form.has_gap or not parts:
             parts.append((1.0, (common, "gap"), quiet(), 1.0))
         joint_key = (identity, *(key for _, key, _, _ in parts))

@@ -350,30 +350,23 @@ class PreparedContact:
         together, keyed by the times, c, the kernel and the shapes. A load slider changes
         an amplitude, so it costs a few array operations instead of a time integration.
         """
-        c_t = inputs.c(times)
         kernel_key, identity = content_key(kernel)
         # the shapes and c over the march's span and both sides of its breaks, not at the
         # output times alone: a force rising linearly to 500 kN/m and one held at 500 kN/m
         # were one shape at a single output time, and the second's answer was given for
         # the first (5 % off, found by a review)
         span = history_key_times(times, breaks)
-        common = fingerprint("modal", tuple(sorted(inputs.given)), times, c_t, kernel_key,
+        common = fingerprint("modal", tuple(sorted(inputs.given)), times, kernel_key,
                              time_tol, breaks, inputs.c(span))
         zero = {name: (lambda tt: np.zeros(np.shape(tt))) for name in inputs.loads}
         parts: list[tuple[float, tuple, dict[str, Callable], float]] = []
         for name, fn in sorted(inputs.loads.items()):
-            values = fn(times)
-            amplitude = float(values[np.argmax(np.abs(values))])
+            amplitude, shape = load_shape(fn, times, span)
             if amplitude == 0.0:
                 continue
             unit = dict(zero)
             unit[name] = lambda tt, f=fn, a=amplitude: f(tt) / a
-            # the shape to SHAPE_DIGITS digits: a load scaled in other units (a force in
-            # N turned dimensionless) differs from the cached shape by rounding alone
-            shape = np.round(values / amplitude, SHAPE_DIGITS) + 0.0
-            between = np.round(np.asarray(fn(span), dtype=float) / amplitude,
-                               SHAPE_DIGITS) + 0.0
-            parts.append((amplitude, (common, name, fingerprint(shape, between)), unit, 0.0))
+            parts.append((amplitude, (common, name, fingerprint(shape)), unit, 0.0))
         if not self.geometry.g_is_zero or not parts:
             parts.append((1.0, (common, "gap"), zero, 1.0))
         weighted_error = 0.0
@@ -388,6 +381,7 @@ class PreparedContact:
             answers = form.solve_parts(times, inputs.c, kernel,
                                        [(loads, gap) for _, _, loads, gap in parts],
                                        time_tol, breaks)
+            c_t = inputs.c(times)
             found = [(response, self._check_pressure(response, gap, c_t))
                      for (_, _, _, gap), response in zip(parts, answers, strict=True)]
             self.counts["time_response"] += len(found)
@@ -452,6 +446,22 @@ class PreparedContact:
             gap = times[after] - times[np.maximum(after - 1, 0)]
             samples = samples[gap > samples[1] - samples[0]]
         return np.union1d(times, samples)
+
+
+def load_shape(fn: Callable[[np.ndarray], np.ndarray], times: np.ndarray,
+               span: np.ndarray) -> tuple[float, np.ndarray]:
+    """A given load's amplitude (its value of largest size at ``times``) and its shape,
+    the load over the amplitude at ``span`` (:func:`core.time.history_key_times` of
+    ``times``, which holds them) to :data:`SHAPE_DIGITS` digits: the key of its cached
+    creep response, so that a load that only scales reuses it (one in other units, a force
+    in N turned dimensionless, differs by rounding alone). The shape is None where the
+    amplitude is 0 (the load is left out)."""
+    values = np.broadcast_to(np.asarray(fn(span), dtype=float), span.shape)
+    at_times = values[np.searchsorted(span, times)]
+    amplitude = float(at_times[np.argmax(np.abs(at_times))])
+    if amplitude == 0.0:
+        return 0.0, None
+    return amplitude, np.round(values / amplitude, SHAPE_DIGITS) + 0.0
 
 
 @one_blas_thread()
