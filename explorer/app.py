@@ -30,7 +30,6 @@ from .fixes import (
 )
 from .model import (
     DEFAULT_PRESET,
-    MODIFIED,
     DesignLimits,
     DisplayScales,
     ExplorerState,
@@ -38,6 +37,7 @@ from .model import (
     SceneHistory,
     Screen,
     decode_scene,
+    lesson_title,
     presets,
     read_fit_query,
     read_study_query,
@@ -551,8 +551,8 @@ class ExplorerApp(pn.viewable.Viewer):
         1000 kN/m)."""
         # the same lesson's step on screen (changed or not): else a preset or a file was
         # loaded meanwhile, and the step starts a family of its own
-        shown = self.state.scene_name.removesuffix(MODIFIED).rsplit(", step ", 1)[0]
-        same = not first and shown == str(scene["name"]).rsplit(", step ", 1)[0]
+        same = not first and lesson_title(self.state.scene_name) == lesson_title(
+            str(scene["name"]))
         if not self.load_scene(scene, same_family=same):
             return False
         self.scene_tab.forget_preset()

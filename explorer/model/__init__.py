@@ -54,7 +54,7 @@ from .fit import (
     run_fit,
 )
 from .history import SceneHistory
-from .lessons import Lesson, lessons, step_scene
+from .lessons import STEP_END, Lesson, lesson_title, lessons, step_scene
 from .links import decode_scene, encode_scene
 from .loading_state import QUANTITIES, QUANTITY_RANGES, QUANTITY_UNITS, STATEMENTS, HistoryState
 from .pins import MAX_PINS, Pin, PinBoard, eccentricity
@@ -99,7 +99,7 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "MAX_DESCRIPTION_CHARS", "MAX_FIT_FIELDS", "MAX_NAME_CHARS", "MAX_PINS", "MAX_POINTS",
            "MODEL_TOL_RANGE", "MODIFIED", "ORDER", "OUTPUTS", "QUANTITIES",
            "QUANTITY_RANGES", "QUANTITY_UNITS", "SCREEN_LAYERS", "SPACINGS", "STATEMENTS",
-           "STRENGTH_CLASSES",
+           "STEP_END", "STRENGTH_CLASSES",
            "Axis", "CodeCreepState", "DesignLimits", "DisplayScales", "ExplorerState",
            "FitOutcome", "Geometry", "HistoryState", "LayerState", "Lesson", "Pin", "PinBoard",
            "PlannedStudy", "PunchEntryState", "PunchResult", "SCREEN_PUNCHES", "ProfileState",
@@ -107,7 +107,8 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "check_html", "check_text", "contact_text", "contact_widths", "contact_zones",
            "creep_coefficient_data", "decode_scene", "default_range",
            "design_check", "eccentricity", "encode_scene", "fit_choices", "forecast_columns",
-           "lessons", "lift_off_lengths", "lifts_off", "lifts_or_pulls", "model_evidence",
+           "lesson_title", "lessons", "lift_off_lengths", "lifts_off", "lifts_or_pulls",
+           "model_evidence",
            "plan_fit", "plan_study", "read_upload", "readings_columns",
            "readings_note", "run_fit", "prepare_view", "preset_label", "presets",
            "read_fit_query", "read_study_query", "read_view_query", "shown_flags", "scene_limits",

@@ -10,10 +10,12 @@ numbers in the notes are the solver's, checked by ``tests/explorer/test_explorer
 from __future__ import annotations
 
 import copy
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
 from .presets import presets
+from .state import MODIFIED
 
 
 @dataclass(frozen=True)
@@ -144,6 +146,19 @@ LESSONS: tuple[Lesson, ...] = (
 )
 
 
+#: The end of a lesson step's scene name, after the lesson's title (:func:`step_scene`).
+STEP_SUFFIX = ", step {k} of {n}"
+#: :data:`STEP_SUFFIX` as it ends a name.
+STEP_END = re.compile(r", step \d+ of \d+$")
+
+
+def lesson_title(name: str) -> str | None:
+    """The lesson's title of a step's scene name (changed on screen or not: " (modified)"
+    left out), None for any other name."""
+    step = STEP_END.search(name.removesuffix(MODIFIED))
+    return None if step is None else name[: step.start()]
+
+
 def lessons() -> dict[str, Lesson]:
     """Lesson key -> lesson, in display order (those whose preset exists)."""
     available = presets()
@@ -173,6 +188,6 @@ def step_scene(lesson: Lesson, index: int) -> dict[str, Any]:
     for step in lesson.steps[: index + 1]:
         for path, value in step.changes.items():
             _set(scene, path, value)
-    scene["name"] = f"{lesson.title}, step {index + 1} of {len(lesson.steps)}"
+    scene["name"] = f"{lesson.title}{STEP_SUFFIX.format(k=index + 1, n=len(lesson.steps))}"
     scene["description"] = lesson.steps[index].note
     return scene

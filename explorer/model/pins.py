@@ -204,7 +204,8 @@ class PinBoard:
         says what the class compares). None: no scene to name against (one of several
         punches)."""
         self._on_screen = scene
-        self._name()
+        if len(self.pins) == 1:  # (the names of several pins are their own differences)
+            self._name()
 
     def _name(self) -> None:
         scenes = self.scenes()

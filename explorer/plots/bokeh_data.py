@@ -156,7 +156,6 @@ def legend_rows(legend: Any) -> int:
 
 def wrap_legend(legend: Any) -> None:
     """One row of the entries shown when few, else two columns (see ONE_ROW_ENTRIES)."""
-    shown = sum(1 for item in legend.items if item.visible)
-    columns = "auto" if shown <= ONE_ROW_ENTRIES else 2
+    columns = "auto" if legend_rows(legend) == 1 else 2
     if legend.ncols != columns:
         legend.ncols = columns

@@ -9,7 +9,6 @@ the user's zoom. Nothing here imports Panel.
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Sequence
 
 from bokeh.core.properties import value as fixed_label
@@ -35,6 +34,7 @@ from ..model import (
     QUANTITIES,
     QUANTITY_UNITS,
     SCREEN_PUNCHES,
+    STEP_END,
     DisplayScales,
     Pin,
     ResultView,
@@ -103,10 +103,6 @@ TITLE_CHARS = 40
 X_PADDING = 0.05
 
 
-#: The end of a lesson step's scene name (explorer.model.step_scene), kept by :func:`short`.
-_STEP_END = re.compile(r", step \d+ of \d+$")
-
-
 def short(text: str, limit: int = TITLE_CHARS) -> str:
     """``text`` cut to ``limit`` characters with an ellipsis; a changed scene's
     " (modified)" and a lesson step's ", step 2 of 4" are kept (the cut took them:
@@ -115,7 +111,7 @@ def short(text: str, limit: int = TITLE_CHARS) -> str:
     text = " ".join(str(text).split())
     if len(text) <= limit:
         return text
-    step = _STEP_END.search(text)
+    step = STEP_END.search(text)
     end = MODIFIED if text.endswith(MODIFIED) else step.group() if step else ""
     if end and limit > 2 * len(end):
         return short(text[: -len(end)], limit - len(end)) + end

@@ -104,13 +104,13 @@ def badges_html(view: ResultView | None, group: str,
     return "".join(parts)
 
 
-#: The design check while a preview is on screen: no verdict on a history without creep
-#: (its largest settlement is the one at loading; the answer with creep comes on release).
 #: Said in place of the q(x, t) map and the histories of an answer at one output time.
 ONCE_NOTE = ("<div class='once-note' style='font-size:13px;color:#444'>One output time "
              "({t}): the base answers at once (elastic) and holds that answer at every "
              "later time, so there is no history to draw. A creeping base, or more output "
              "times, draw the settlement, tilt and pressure over time.</div>")
+#: The design check while a preview is on screen: no verdict on a history without creep
+#: (its largest settlement is the one at loading; the answer with creep comes on release).
 PREVIEW_DESIGN = ("<span class='cp-badge check-none design-preview'>design check on "
                   "release: the preview leaves out creep</span>")
 #: What the page does not show for a scene of several punches yet, said under its
@@ -350,7 +350,8 @@ class ResultsView:
         note = "" if over_time else ONCE_NOTE.format(t=days_text(float(view.times[0])))
         if self.once_note.object != note:
             self.once_note.object = note
-        self.once_note.visible = not over_time
+        if self.once_note.visible == over_time:
+            self.once_note.visible = not over_time
 
     def evidence(self, view: ResultView | None) -> dict[str, Any] | None:
         """The coating model's error to show for ``view``: measured by the Coating tab's
