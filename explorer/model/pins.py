@@ -31,7 +31,7 @@ _UNITS: dict[str, tuple[str, str, float]] = {
     "punch.shape": ("shape", "mm", 1e-3),
     "base.thickness": ("H", "m", 1.0),
     "base.poisson": ("ν", "", 1.0),
-    "base.age_at_loading": ("t0", "days", 1.0),
+    "base.age_at_loading": ("τ₀", "days", 1.0),  # as the slider names it
     "base.creep.modulus": ("E", "GPa", 1e9),
     "base.creep.modulus_final": ("E∞", "GPa", 1e9),
     "times.end": ("t_end", "days", 1.0),

@@ -24,6 +24,10 @@ def test_pins_are_named_after_what_differs() -> None:
     thin = copy.deepcopy(base)
     thin["coating"][0]["thickness"] = 0.005
     assert pin_labels([base, thin]) == ["h1 = 20 mm", "h1 = 5 mm"]
+    # the age at loading by the symbol its slider shows (τ₀)
+    older = copy.deepcopy(base)
+    older["base"]["age_at_loading"] = 90.0
+    assert pin_labels([base, older]) == ["τ₀ = 28 days", "τ₀ = 90 days"]
     # a name and a description are no difference
     renamed = copy.deepcopy(base)
     renamed["name"], renamed["description"] = "other", "other"
