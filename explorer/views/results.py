@@ -314,8 +314,12 @@ class ResultsView:
         else:
             self.player.value = index
         # one output time (an elastic scene): the player's range is 0 to 1 all the same
-        # (a range of one point is no slider), so it takes no move
+        # (a range of one point is no slider), so it takes no move; off the page, where a
+        # greyed slider and play button read as broken (a teacher's audit): the time
+        # label beside it and the once-note say the one time
         self.player.disabled = len(view.times) < 2
+        if self.player_box.visible != (len(view.times) > 1):
+            self.player_box.visible = len(view.times) > 1
         self.follow_time_span(view)
         with param.discard_events(self.screen):
             self.screen.time_index = index

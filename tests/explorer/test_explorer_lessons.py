@@ -171,6 +171,7 @@ def test_a_one_time_scene_keeps_its_time_where_the_player_cannot_go(explorer_app
     assert app.controller.wait(60) and app.controller.error == ""
     player = app.results.player
     assert player.disabled and player.end == 1
+    assert not app.results.player_box.visible  # a greyed player read as broken
     player.value = 1    # what a click at its end sends, disabled or not
     assert app.screen.time_index == 0
     view.next_button.clicks += 1    # pins step 1, solves step 2
@@ -217,7 +218,7 @@ def test_an_answer_at_one_output_time_draws_no_history(explorer_app) -> None:
     app.load_scene(read_preset("uniform_flat"))
     assert app.controller.wait(60) and app.controller.error == ""
     assert results.history_grid.visible and app.figures.image_fig.visible
-    assert not results.once_note.visible
+    assert not results.once_note.visible and results.player_box.visible
     app.pins.pin()
     app.load_scene(read_preset("bare_layer"))
     assert app.controller.wait(60) and app.controller.error == ""
