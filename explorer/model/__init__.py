@@ -60,7 +60,15 @@ from .loading_state import QUANTITIES, QUANTITY_RANGES, QUANTITY_UNITS, STATEMEN
 from .pins import MAX_PINS, Pin, PinBoard, eccentricity
 from .presets import DEFAULT_PRESET, ORDER, preset_label, presets
 from .punches_state import SCREEN_PUNCHES, PunchEntryState, validated_scene
-from .results import Geometry, PunchResult, ResultView, model_evidence, prepare_view, shown_flags
+from .results import (
+    Geometry,
+    PunchResult,
+    ResultView,
+    load_jumps,
+    model_evidence,
+    prepare_view,
+    shown_flags,
+)
 from .scales import DisplayScales
 from .scene_parts import (
     CONTACT_MODELS,
@@ -110,7 +118,7 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "lesson_title", "lessons", "lift_off_lengths", "lifts_off", "lifts_or_pulls",
            "model_evidence",
            "plan_fit", "plan_study", "read_upload", "readings_columns",
-           "readings_note", "run_fit", "prepare_view", "preset_label", "presets",
+           "readings_note", "run_fit", "load_jumps", "prepare_view", "preset_label", "presets",
            "read_fit_query", "read_study_query", "read_view_query", "shown_flags", "scene_limits",
            "scene_with_limits", "screen_limits", "step_scene", "study_choices", "study_outputs",
            "study_settings", "validated_scene", "view_query"]

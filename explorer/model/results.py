@@ -107,6 +107,9 @@ class ResultView:
     # per output time, the intervals of x [m] in contact (solver's contact_set); empty
     # when the solution does not say
     contact_set: list[list[tuple[float, float]]] = field(default_factory=list)
+    # the times [day] where a given load jumps (of any punch of several): the histories
+    # are drawn broken there (:func:`load_jumps`)
+    jumps: tuple[float, ...] = ()
     # several punches (the ``punches`` form of a scene), in order; empty for one punch.
     # Then ``x`` and ``pressure`` run over the whole surface (NaN rows between punches
     # break the line), ``contact_set`` is the union of the punches' zones, and
@@ -255,6 +258,39 @@ def _values(profile: Any, x: np.ndarray) -> np.ndarray:
     return np.broadcast_to(np.asarray(profile(x), dtype=float), x.shape).copy()
 
 
+#: A load's value jumps at one of its non-smooth points where it changes across it by more
+#: than this share of its largest magnitude at the output times (a kink changes it by its
+#: slope times :data:`JUMP_PROBE`, round-off beside this).
+JUMP_SHARE = 1e-6
+#: Either side of a non-smooth point a load is read this share of the last output time
+#: away (a step's value is its new one from its break on).
+JUMP_PROBE = 1e-9
+
+
+def load_jumps(loading: Mapping[str, Any], times: np.ndarray) -> tuple[float, ...]:
+    """The times [day] in ``(times[0], times[-1]]`` where a given load of ``loading``
+    (name -> load history of the time [day] after loading) jumps: every history jumps
+    with it, between the output times either side, and is not to be drawn straight
+    across (a step of the new footing's force at one year read as a slope of two weeks,
+    a teacher's audit)."""
+    times = np.asarray(times, dtype=float)
+    if times.size < 2:
+        return ()
+    lo, hi = float(times[0]), float(times[-1])
+    probe = JUMP_PROBE * max(hi, 1.0)
+    found: set[float] = set()
+    for profile in loading.values():
+        points = [b for b in getattr(profile, "nonsmooth_points", lambda lo, hi: ())(lo, hi)
+                  if lo < b <= hi]
+        if not points:
+            continue
+        b = np.asarray(points, dtype=float)
+        size = float(np.max(np.abs(_values(profile, times)), initial=0.0))
+        change = np.abs(_values(profile, b) - _values(profile, b - probe))
+        found.update(float(t) for t in b[change > JUMP_SHARE * max(size, 1e-300)])
+    return tuple(sorted(found))
+
+
 def scene_geometry(scene: Any, points: int = LINE_POINTS) -> Geometry:
     """Evaluate the punch shape and the coating layers of a validated ``core.Scene``."""
     a = float(scene.half_width)
@@ -331,7 +367,8 @@ def prepare_view(solution: Any, scene: dict[str, Any]) -> ResultView:
                       x=x, pressure=pressure, image=image, geometry=scene_geometry(scene_obj),
                       flags=flags, flag_messages=messages, info=info,
                       contact_set=[[(float(lo), float(hi)) for lo, hi in zones]
-                                   for zones in getattr(solution, "contact_set", None) or []])
+                                   for zones in getattr(solution, "contact_set", None) or []],
+                      jumps=load_jumps(getattr(scene_obj, "loading", {}), times))
 
 
 def _punch_result(p: Any, spec: dict[str, Any]) -> PunchResult:
@@ -411,7 +448,9 @@ def _prepare_punches(solution: Any, scene: dict[str, Any]) -> ResultView:
     return ResultView(scene=scene, given=punches[0].given, times=times,
                       values=dict(punches[0].values), x=x, pressure=pressure, image=image,
                       geometry=geometry, flags=flags, flag_messages=messages, info=info,
-                      contact_set=union, punches=punches)
+                      contact_set=union, punches=punches,
+                      jumps=tuple(sorted({t for p in solution.punches
+                                          for t in load_jumps(p.scene.loading, times)})))
 
 
 def _punches_geometry(solution: Any) -> Geometry:

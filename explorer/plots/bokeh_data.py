@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -19,6 +20,22 @@ def f32(values: object) -> np.ndarray:
     """Plot data as float32: half the bytes to the page, and 7 significant digits, more
     than a screen resolves (the files keep the full numbers)."""
     return np.asarray(values, dtype=np.float32)
+
+
+def broken_at(times: object, values: object, jumps: Sequence[float] = ()
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """A history's ``times`` and ``values`` (float32, :func:`f32`) with a NaN point
+    between the two output times either side of each of ``jumps`` [day] (a given load's
+    jump: :func:`explorer.model.load_jumps`), where a line breaks: drawn straight across,
+    the jump of the history read as a slope between the output times."""
+    t, v = f32(times), f32(values)
+    if not len(jumps) or t.size < 2:
+        return t, v
+    # (on the times as solved: a jump at an output time breaks the line before it)
+    cut = np.unique(np.searchsorted(np.asarray(times, dtype=float),
+                                    np.asarray(jumps, dtype=float)))
+    cut = cut[(cut > 0) & (cut < t.size)]
+    return np.insert(t, cut, np.nan), np.insert(v, cut, np.nan)
 
 
 def _same(old: object, new: object) -> bool:

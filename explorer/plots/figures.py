@@ -42,6 +42,7 @@ from ..model import (
 )
 from .bokeh_data import (
     MOVING,
+    broken_at,
     f32,
     legend_above,
     legend_rows,
@@ -211,6 +212,7 @@ class Figures:
         self.forecast_src: dict[str, ColumnDataSource] = {}
         self.history_src: dict[str, ColumnDataSource] = {}
         self.history_point_src: dict[str, ColumnDataSource] = {}
+        self.jump_src: dict[str, ColumnDataSource] = {}
         self.history_fig = {}
         self._presenting = False
         self._history_state = dict.fromkeys(QUANTITIES, "computed")
@@ -237,6 +239,14 @@ class Figures:
             p.scatter(x="t", y="v", source=point, size=8, color="#d62728", level=MOVING)
             p.add_tools(HoverTool(renderers=[line], mode="vline", tooltips=[
                 ("t", "@t{0.0} days"), (SYMBOLS[q], f"@v{{0.0000}} {unit}")]))
+            # where a given load jumps: the line breaks there (broken_at), and a dashed
+            # mark says why
+            jumps = ColumnDataSource({"t": []}, name=f"{q}_jumps_source")
+            marks = p.vspan(x="t", source=jumps, line_color="#bbb", line_dash="dashed",
+                            line_width=1, name=f"{q}_jumps")
+            p.add_tools(HoverTool(renderers=[marks], tooltips=[
+                ("a given load jumps at t", "@t{0.0} days")]))
+            self.jump_src[q] = jumps
             cursor = Span(location=0, dimension="height", line_color="#999", line_dash="dotted",
                           level=MOVING)
             p.add_layout(cursor)
@@ -284,10 +294,11 @@ class Figures:
     def _show_punch_histories(self, view: ResultView) -> None:
         """A line per punch on each history (several punches), or none (one punch)."""
         n = len(view.punches)
-        times = f32(view.times) if n else None
         for q in QUANTITIES:
+            lines = [broken_at(view.times, view.punches[k].display(q), view.jumps)
+                     for k in range(n)]
             set_data(self.punch_history_src[q], {
-                "xs": [times] * n, "ys": [f32(view.punches[k].display(q)) for k in range(n)],
+                "xs": [t for t, _ in lines], "ys": [v for _, v in lines],
                 "color": list(PUNCH_COLORS[:n]),
                 "label": [f"punch {k + 1}" for k in range(n)]})
             legend = self.history_fig[q].legend[0]
@@ -387,9 +398,10 @@ class Figures:
         self._show_punch_histories(view)
         for q in QUANTITIES:
             given = q in view.given
-            shown = view.times if not view.several else []
-            set_data(self.history_src[q], {"t": f32(shown), "v": f32(
-                view.display(q) if not view.several else [])})
+            t, v = (broken_at(view.times, view.display(q), view.jumps)
+                    if not view.several else ([], []))
+            set_data(self.history_src[q], {"t": t, "v": v})
+            set_data(self.jump_src[q], {"t": f32(view.jumps)})
             self.history_line[q].glyph.line_color = GIVEN_COLOR if given else UNKNOWN_COLOR
             state = "given" if given else "computed"
             if view.several:

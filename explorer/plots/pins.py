@@ -14,7 +14,7 @@ from bokeh.core.properties import value
 from bokeh.models import ColumnDataSource, LegendItem
 
 from ..model import MAX_PINS, QUANTITIES, DisplayScales, Pin, ResultView
-from .bokeh_data import f32, set_data, wrap_legend
+from .bokeh_data import broken_at, f32, set_data, wrap_legend
 
 #: Colours of the pins, in pin order (none of them the blue of the current result).
 PIN_COLORS = ("#d62728", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2")
@@ -89,8 +89,9 @@ class PinLines:
                     self._labels[k] = pin.label
                 for q in QUANTITIES:
                     self.history_lines[q][k].visible = shown
-                    data = ({"t": f32(pin.view.times), "v": f32(pin.view.display(q))}
-                            if shown else {"t": [], "v": []})
+                    t, v = (broken_at(pin.view.times, pin.view.display(q), pin.view.jumps)
+                            if shown else ([], []))
+                    data = {"t": t, "v": v}
                     set_data(self.history_src[q][k], data)
             # the entries in columns when there are more than fit one row
             wrap_legend(self.q_fig.legend[0])
