@@ -123,8 +123,8 @@ def landing_points(profile: Any, t_end: float) -> tuple[float, ...]:
     on: where its value or slope may jump (``nonsmooth_points``), and its features a step
     could pass over unseen: every row of a table (a ``pchip`` table is smooth between its
     rows, and a three-day pulse through its rows was stepped over: the answer of the
-    constant load, 2 % off at tol 1e-6, a review found) and a bump's centre and one and
-    two widths either side of it."""
+    constant load, 2 % off at tol 1e-6, a review found), a bump's centre and one and
+    two widths either side of it, and a formula's few extremes (:func:`formula_features`)."""
     points = set(profile.nonsmooth_points(0.0, t_end)) if hasattr(
         profile, "nonsmooth_points") else set()
     spec = getattr(profile, "spec", None)
@@ -133,7 +133,55 @@ def landing_points(profile: Any, t_end: float) -> tuple[float, ...]:
     elif isinstance(spec, Mapping) and spec.get("kind") == "bump":
         centre, width = float(spec["center"]), float(spec["width"])
         points |= {centre + k * width for k in (-2, -1, 0, 1, 2)}
+    elif isinstance(spec, Mapping) and spec.get("kind") == "expr":
+        points |= set(formula_features(profile, t_end))
     return tuple(sorted(p for p in points if 0.0 < p < t_end))
+
+
+#: Samples of a formula load over ``[0, t_end]`` (days after loading) at which its
+#: extremes are looked for, evenly and as many again geometrically from
+#: ``t_end / FEATURE_SPAN`` (where a log-spaced scene's steps are short): a pulse wider
+#: than about two of them is seen (over a year, ~0.2 day evenly).
+FEATURE_SAMPLES = 4097
+#: The ratio of the last to the first of the geometric samples.
+FEATURE_SPAN = 1e6
+#: The samples, counted from an extreme's, that become landing points.
+FEATURE_OFFSETS = (-16, -8, -4, -2, -1, 0, 1, 2, 4, 8, 16)
+#: A formula with more extremes than this among its samples oscillates: none of them
+#: become landing points (its steps refine over it as over any smooth load, and the
+#: ``undersampled_load`` flag speaks for its output times).
+MAX_FEATURES = 32
+
+
+def formula_features(profile: Any, t_end: float) -> tuple[float, ...]:
+    """The times [day after loading] at a formula load's extremes among its samples
+    (:data:`FEATURE_SAMPLES`), with samples either side of each (:data:`FEATURE_OFFSETS`:
+    its flanks, of a width up to ~16 samples, too), so that the time
+    steps land on a narrow pulse: a five-hour pulse (``exp(-((t - 101.3) / 0.2)^2)``,
+    half the force) between the steps of the first grids was stepped over by every grid,
+    the answer of the steady force 8.6e-5 off at tol 1e-6, flagged nothing, where the
+    same pulse as a ``bump`` was answered. A pulse narrower than the samples' spacing
+    can still be stepped over: a ``bump`` or a ``table`` says where it is. Empty for more
+    than :data:`MAX_FEATURES` extremes, or a formula not finite at every sample."""
+    if not t_end > 0.0:
+        return ()
+    t = np.unique(np.concatenate([np.linspace(0.0, t_end, FEATURE_SAMPLES),
+                                  np.geomspace(t_end / FEATURE_SPAN, t_end, FEATURE_SAMPLES)]))
+    y = np.asarray(profile(t), dtype=float) * np.ones_like(t)
+    if not np.all(np.isfinite(y)):
+        return ()
+    slope = np.sign(np.diff(y))
+    # a plateau (slope 0) between a rise and a fall is no extreme of its own: its sides
+    # count, where the slope turns across it
+    moving = np.flatnonzero(slope != 0.0)
+    turns = moving[1:][slope[moving[1:]] != slope[moving[:-1]]]
+    if turns.size > MAX_FEATURES:
+        return ()
+    # the turn is between samples turns[k] -+ 1 (after a plateau, at its start); its
+    # flanks, of a width the samples do not tell, by samples 2, 4, 8 and 16 away
+    picked = np.unique(np.concatenate([turns + k for k in FEATURE_OFFSETS]))
+    picked = picked[(picked > 0) & (picked < t.size - 1)]
+    return tuple(float(v) for v in t[picked])
 
 
 def to_dimensionless(scene: Scene) -> DimensionlessProblem:
