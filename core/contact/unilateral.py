@@ -11,7 +11,8 @@ Elastic base (``kernel=None``): each time is solved on its own
 (:mod:`core.contact.elastic`), the zone ends located to ``ZONE_END_TOL`` by
 :mod:`core.contact.zones`. Creep: implicit stepping with the active
 set found at every step, on a rule refined where the zone ends travel
-(:mod:`core.contact.creep`, :mod:`core.contact.bands`).
+(:mod:`core.contact.creep`, :mod:`core.contact.bands`), the zone ends located to
+``ZONE_END_TOL`` or, at a looser tol, to tol / 10 (:func:`core.contact.creep.march_end_tol`).
 
 The answer is a :class:`UnilateralSolution` (:mod:`core.contact.result`, which also holds
 :func:`contact_set_from_pressure`: sampled pressures of any engine into contact sets);
