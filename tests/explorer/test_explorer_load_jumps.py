@@ -78,3 +78,31 @@ def test_the_new_footings_step_breaks_every_punchs_history_on_the_page(explorer_
     assert app.controller.wait(60) and app.controller.error == ""
     assert not len(figures.jump_src["settlement"].data["t"])
     assert not np.isnan(np.asarray(figures.history_src["settlement"].data["v"])).any()
+
+
+def test_the_values_at_loading_are_marked_at_the_edge_of_a_log_time_axis(explorer_app) -> None:
+    """A log time axis has no t = 0: the settlement "at once" a lesson speaks of (0.026 mm
+    for the old footing) was not on the plot. Open markers at the left edge of the log
+    range carry the values at t = 0 of every line, one per punch; the linear axis draws
+    them on the lines, and the markers go."""
+    app = explorer_app("new_footing_beside_old", solved=True)
+    view = app.controller.view
+    assert view.times[0] == 0.0
+    results, figures = app.results, app.figures
+    marks = dict(zip(("settlement", "tilt", "force", "moment"),
+                     results.time_axis.at_loading, strict=True))
+    assert all(not len(m.data["y"]) for m in marks.values())  # linear: on the lines
+    results.log_time.value = True
+    start = results.time_axis.log_range.start
+    settlement = marks["settlement"].data
+    assert settlement["y"] == pytest.approx([p.display("settlement")[0] for p in view.punches])
+    assert settlement["color"] == list(figures.punch_history_src["settlement"].data["color"])
+    assert all(start < x < view.times[1] for x in settlement["x"])
+    # one punch: the main line's value, in its colour; and back to linear
+    app.load_scene(read_preset("eccentric_creep"))
+    assert app.controller.wait(60) and app.controller.error == ""
+    one = app.controller.view
+    assert marks["settlement"].data["y"] == pytest.approx([one.display("settlement")[0]])
+    assert marks["force"].data["color"] == [figures.history_line["force"].glyph.line_color]
+    results.log_time.value = False
+    assert not len(marks["settlement"].data["y"])
