@@ -486,6 +486,37 @@ def test_a_flat_punch_pulled_up_at_both_corners_on_a_creeping_bare_base_is_refus
 
 
 @pytest.mark.slow
+def test_a_heel_that_lifts_late_in_a_moment_ramp_on_an_aging_bare_base_lifts_off():
+    """An audit: 800 kN/m and a moment ramped from 100 to 440 kN m/m over 100 days on a
+    3 m aging bare layer (the lift-off preset's law). The growing-zone trial kept the
+    whole base in contact, since the crept eccentricity lags the given one, while its
+    q* = (I - V)^-1 Q reached -841 kPa at the heel: success, no flag. Its zone recedes:
+    it is the elastic zone of the given loads once their eccentricity passes the
+    threshold (a flat punch on a bare base), (-0.7333, 1) a at the ramp's end, and the
+    tilt at 365 days is that of the receding-contact theory, 2.90049e-5 (the audit's sum
+    of J(t, tau) against 1601 elastic solves along the ramp, 2.2e-4 from the tool's full
+    contact before the heel lifts: its own discretization); it read 2.8485e-5 before."""
+    d = _bare({"force": 8e5, "moment": {"kind": "ramp", "start": 1e5, "end": 4.4e5,
+                                        "duration": 100.0}}, 1e-6, thickness=3.0)
+    d["base"]["creep"] = dict(read_preset("eccentric_footing_liftoff")["base"]["creep"])
+    d["base"]["age_at_loading"] = 28.0
+    d["times"] = {"end": 365.0, "count": 10, "spacing": "log"}
+    result = solve(d)
+    assert result.info["success"] and result.flags == [], result.info["message"]
+    x = np.linspace(-1.0, 1.0, 2001)
+    q = result.pressure(x)
+    assert q.min() >= 0.0, q.min()
+    final = solve(_bare({"force": 8e5, "moment": 4.4e5}, 1e-6, thickness=3.0))
+    (lo, hi), = final.contact_set[0]
+    assert lo == pytest.approx(-0.73334, abs=1e-5) and hi == 1.0
+    late = result.times >= 100.0
+    for zones in np.asarray(result.contact_set, dtype=float)[late]:
+        np.testing.assert_allclose(zones, [[lo, hi]], atol=1e-8)
+    assert np.all(np.asarray(result.contact_set, dtype=float)[result.times < 60.0]
+                  == [[-1.0, 1.0]])
+    assert result.tilt[-1] == pytest.approx(2.90049e-5, rel=5e-4)
+
+
 def test_random_loadings_of_a_creeping_bare_base_are_answered_or_refused_by_field():
     """Loads drawn at random in every statement (constant, ramps, steps, up and down again),
     flat or crowned, on a creeping or aging bare base: each scene is answered (finite,
@@ -530,6 +561,10 @@ def test_random_loadings_of_a_creeping_bare_base_are_answered_or_refused_by_fiel
         assert isinstance(result.info["success"], bool)
         for name in ("settlement", "tilt", "force", "moment"):
             assert np.all(np.isfinite(getattr(result, name))), name
+        if result.info["success"] and result.info["contact"] == "unilateral":
+            # a success pulls nowhere (a growing zone's q* did, an audit found)
+            q = result.pressure(np.linspace(-1.0, 1.0, 401))
+            assert q.min() >= 0.0, (loading, q.min())
     assert answered >= 2
 
 

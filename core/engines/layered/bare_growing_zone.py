@@ -391,6 +391,9 @@ def _on_grid(half_width: float, base: tuple[float, float, float], gap: Any, kern
     free = _free_corners(response, given, share)
     lifted = bare_lift_off(half_width, base, gap, given, free, modes, tol, solved=solved)
     _check_monotone(lifted, receding, grid)
+    if not receding:
+        _check_no_pull(_Grid(grid, index, relax, _kernel_parts(kernel, grid), lifted, {}),
+                       share)
     histories = {}
     scale = 1.0 if relaxation is None else relaxation
     for name in _NAMES:
@@ -850,6 +853,30 @@ class ZoneTurns(ValueError):
     def because(self, detail: str) -> ZoneTurns:
         """The same turn, refused for ``detail`` (the march's own reason)."""
         return ZoneTurns(self.between, detail)
+
+
+#: Why a growing zone was not given: its q* pulls at a corner in contact.
+PULLS = ("the growing zone's pressure pulls at a corner in contact as the base creeps: "
+         "the zone recedes there")
+#: Where a growing zone's q* is read for its sign beside a corner in contact [half-widths
+#: from the corner]: its singular part is positive there wherever the corner presses.
+PULL_REACH = 1e-3
+
+
+def _check_no_pull(answer: _Grid, share: float) -> None:
+    """Refuse (ValueError :data:`PULLS`) a growing zone whose q* = ``(I - V)^-1 Q`` is
+    below ``-share`` times its largest size beside a corner it touches: ``Q >= 0`` on the
+    elastic zones of the crept loads does not make q* so. A ramped moment on an aging bare
+    base, the crept eccentricity lagging the given one, kept the whole base in contact
+    while q* at the heel reached -841 kPa (an audit; the zone recedes instead, and the
+    receding answer holds)."""
+    x = np.array([-1.0 + PULL_REACH, 1.0 - PULL_REACH])
+    q = answer.pressure(x, 1.0 - PULL_REACH)
+    touching = np.array([[z.lo <= -1.0 for z in answer.lifted.zones],
+                         [z.hi >= 1.0 for z in answer.lifted.zones]])
+    size = float(np.max(np.abs(q), initial=0.0))
+    if np.any(touching & (q < -share * size)):
+        raise ValueError(PULLS)
 
 
 def _check_monotone(lifted: BareLiftOff, receding: bool, grid: np.ndarray) -> None:
