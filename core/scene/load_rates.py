@@ -35,11 +35,14 @@ FORMULA_SAMPLES = 2**15 + 1
 
 
 def oscillations(profile: Profile, lo: float, hi: float) -> float:
-    """Periods of ``profile`` on ``[lo, hi]`` (unit of its variable): exact for a sine,
+    """Periods of ``profile`` on ``[lo, hi]`` (unit of its variable): exact for a sine
+    (none for a sine of amplitude 0, a constant: it was flagged ``undersampled_load``),
     half the number of extrema of the samples for a formula (a formula faster than the
     samples counts as at least a quarter of them), 0 for the other families (their
     jumps and kinks are counted by :func:`required_steps`)."""
     if profile.kind == "sine":
+        if profile.spec["amplitude"] == 0:
+            return 0.0
         return (hi - lo) / profile.spec["wavelength"]
     if profile.kind != "expr":
         return 0.0

@@ -42,6 +42,11 @@ QUANTITY_RANGES: dict[str, tuple[float, float]] = {
 }
 
 
+#: The amplitude a sine chosen on the page starts at, as a share of its mean, where the
+#: history had no "second" value (a constant).
+SINE_SHARE = 0.2
+
+
 class HistoryState(param.Parameterized):
     """The history of one loading quantity, ``t`` in days after loading (display units)."""
 
@@ -59,6 +64,15 @@ class HistoryState(param.Parameterized):
         super().__init__(**params)
         self.quantity = quantity
         self.unit, self.scale = QUANTITY_UNITS[quantity]
+        self._loading = False  # load_spec sets the history as a file gives it
+        self.param.watch(self._on_kind, "kind")
+
+    def _on_kind(self, event: Any) -> None:
+        # a sine chosen on the page takes the "second" value it had, 0 from a constant:
+        # an amplitude of 0, a constant load (a teacher saw nothing change); it starts at
+        # SINE_SHARE of its mean instead (a file's sine keeps its own amplitude)
+        if event.new == "sine" and self.second == 0.0 and not self._loading:
+            self.second = SINE_SHARE * self.value
 
     def to_spec(self) -> float | dict[str, Any]:
         if self.kind == "custom" and self.custom is not None:
@@ -76,7 +90,11 @@ class HistoryState(param.Parameterized):
             for key in ("value", "second"):  # SI to display units; times are days
                 if key in values:
                     values[key] = values[key] / self.scale
-        self.param.update(**values)
+        self._loading = True
+        try:
+            self.param.update(**values)
+        finally:
+            self._loading = False
 
 
 class LoadingState(param.Parameterized):

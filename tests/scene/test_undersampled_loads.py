@@ -36,6 +36,14 @@ def test_a_sine_load_sampled_too_sparsely_is_flagged_and_named() -> None:
     assert np.count_nonzero(np.diff(np.sign(finer.force - 5e5)) != 0) >= 72
 
 
+def test_a_sine_of_amplitude_zero_is_no_oscillation() -> None:
+    """The page's sine starts at the amplitude it had (0 from a constant): a constant
+    load, flagged as aliased (a teacher's audit)."""
+    d = _sine_force(10.0, 40)
+    d["loading"]["force"]["amplitude"] = 0.0
+    assert "undersampled_load" not in solve(d).flags
+
+
 def test_log_spacing_is_judged_at_its_widest_spacing() -> None:
     """Dense early, 40 log-spaced times are 68 days apart at the end."""
     assert "undersampled_load" in solve(_sine_force(300.0, 40, "log")).flags
@@ -60,3 +68,22 @@ def test_the_page_shows_it_beside_the_histories(explorer_app) -> None:
     app = explorer_app(scene=_sine_force(10.0, 40), solved=True)
     badges = badges_html(app.screen.shown(), "history")
     assert "flag-undersampled_load" in badges and "Time tab: more output times" in badges
+
+
+def test_a_sine_chosen_on_the_page_starts_with_an_amplitude() -> None:
+    """Chosen after a constant, the page's sine took the constant's "second" value, 0: no
+    sine at all. It starts at SINE_SHARE of its mean; a file's sine of amplitude 0, or a
+    second value set before, is kept."""
+    from explorer.model.loading_state import SINE_SHARE, HistoryState
+
+    force = HistoryState("force", value=500.0, name="force")
+    force.kind = "sine"
+    assert force.second == SINE_SHARE * 500.0 and force.to_spec()["amplitude"] == 1e5
+    filed = HistoryState("force", value=500.0, name="filed")
+    filed.load_spec({"kind": "sine", "mean": 5e5, "amplitude": 0.0, "wavelength": 10.0,
+                     "phase": 0.0})
+    assert filed.kind == "sine" and filed.second == 0.0
+    ramped = HistoryState("force", value=500.0, name="ramped")
+    ramped.kind, ramped.second = "ramp", 100.0
+    ramped.kind = "sine"
+    assert ramped.second == 100.0
