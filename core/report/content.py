@@ -17,6 +17,7 @@ from core.report.inputs import SHOWN_UNITS, input_rows
 from core.scene import (
     PunchesSolution,
     SceneSolution,
+    answer_accuracy,
     days_text,
     engine_text,
     flagged_caution,
@@ -59,11 +60,12 @@ def _largest_pressure_text(result: Any, origin: float = 0.0) -> str:
     return f"{text} ({edge})" if edge else text
 
 
-def _at(times: np.ndarray, values: np.ndarray) -> tuple[float, float]:
+def _at(times: np.ndarray, values: np.ndarray, accuracy: float) -> tuple[float, float]:
     """The largest (by magnitude) value of a history and its time [day], when the design
-    check and the page say it is (:func:`core.scene.time_of_largest`: a zero tilt read
-    "at t = 0 days" here and "at t = 365 days" on the page)."""
-    k = time_of_largest(values)
+    check and the page say it is (:func:`core.scene.time_of_largest` to the answer's
+    ``accuracy``: a zero tilt read "at t = 0 days" here and "at t = 365 days" on the
+    page)."""
+    k = time_of_largest(values, accuracy)
     return float(values[k]), float(times[k])
 
 
@@ -80,8 +82,9 @@ def key_numbers(result: SceneSolution, time: float | None = None,
     lifts off, when it does and the smallest contact width. Positions are ``origin + x``
     [m] (``x`` from the punch's centre; a punch of several: ``origin`` its centre)."""
     t = result.times
-    settlement, t_s = _at(t, result.settlement)
-    tilt, t_a = _at(t, result.tilt)
+    accuracy = answer_accuracy(result.info)
+    settlement, t_s = _at(t, result.settlement, accuracy)
+    tilt, t_a = _at(t, result.tilt, accuracy)
     rows = [
         ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {days_text(t_s)}"),
         ("largest tilt α", f"{_shown(tilt, 'rad')} at t = {days_text(t_a)}"),

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.optional import import_optional
-from core.scene.design import DesignCheck, DesignLimits, check_design
+from core.scene.design import DesignCheck, DesignLimits, answer_accuracy, check_design
 from core.scene.display import HISTORIES
 from core.scene.files import scene_to_json
 from core.scene.results import history_columns, pressure_points
@@ -116,7 +116,7 @@ def design_checks(result: PunchesSolution, limits: DesignLimits | None = None
             corners = {**corners, "corners_m": [punch.center + c for c in corners["corners_m"]]}
         out.append(None if given is None or given.empty else check_design(
             punch.times, punch.center + punch.x, punch.pressure_on_grid, punch.settlement,
-            punch.tilt, given, corners))
+            punch.tilt, given, corners, answer_accuracy(punch.info)))
     return out
 
 

@@ -24,6 +24,7 @@ import param
 from core.scene import DesignLimits as CoreLimits
 from core.scene import (
     LimitCheck,
+    answer_accuracy,
     check_design,
     days_text,
     flagged_caution,
@@ -156,6 +157,8 @@ def _on_screen(line: LimitCheck, limits: DesignLimits | None) -> Check:
     where = f"t = {days_text(line.time)}"
     if line.x is not None:
         where = f"x = {line.x:.3g} m, " + where
+    if line.sign_note:
+        where += f" ({line.sign_note})"
     typed = None if limits is None or line.limit_name is None \
         else getattr(limits, line.limit_name)
     if line.unbounded:
@@ -171,7 +174,7 @@ def design_check(view: ResultView, limits: DesignLimits | None = None) -> Design
     contact width and the eccentricity the screen shows beside it."""
     verdict = check_design(view.times, view.x, view.pressure, view.values["settlement"],
                            view.values["tilt"], core_limits(limits),
-                           view.info.get("corner_pressure"))
+                           view.info.get("corner_pressure"), answer_accuracy(view.info))
     widths = contact_widths(view)
     j_narrow = int(np.argmin(widths))
     force = float(view.values["force"][-1])
