@@ -113,8 +113,8 @@ class ModalSystem:
         return out
 
 
-def check_mode_probe(back: np.ndarray, probe: np.ndarray, limit: float) -> None:
-    """Refuse modes that are nearly dependent.
+def check_mode_probe(back: np.ndarray, probe: np.ndarray, limit: float) -> float:
+    """Refuse modes that are nearly dependent; the probe's relative defect otherwise.
 
     A mode matrix whose columns are nearly dependent maps every modal march back
     wrongly, and no comparison of two time grids sees it (both pass through its
@@ -129,16 +129,23 @@ def check_mode_probe(back: np.ndarray, probe: np.ndarray, limit: float) -> None:
     limit : float
         The largest relative defect allowed (a share of tol).
 
+    Returns
+    -------
+    float
+        How far the probe came back, relative to its size (at most ``limit``).
+
     Raises
     ------
     UnresolvedOperator
         When the probe comes back more than ``limit`` times its size off.
     """
     defect = float(np.max(np.abs(back - probe), initial=0.0))
-    if defect > limit * float(np.max(np.abs(probe), initial=1.0)):
+    size = float(np.max(np.abs(probe), initial=1.0))
+    if defect > limit * size:
         raise UnresolvedOperator(
             f"operator: its modes are nearly dependent (a probe vector comes back "
             f"{defect:.1e} off); the grid does not resolve the problem")
+    return defect / size
 
 
 def mode_probe(size: int) -> np.ndarray:

@@ -328,8 +328,9 @@ class PreparedContact:
             at = np.searchsorted(merged, times)
             scalars = {k: v[at] for k, v in sc.items()}
             max_abs_tilt = float(np.max(np.abs(sc["tilt"])))
-            time_side = TimeSide(answer.time_error + fit_error, answer.steps, answer.success,
-                                 answer.message, fit_error)
+            # (the modes' probe defect maps every march back: it is the time side's too)
+            time_side = TimeSide(answer.time_error + fit_error + form.mode_defect,
+                                 answer.steps, answer.success, answer.message, fit_error)
 
             def pressure(x: np.ndarray) -> np.ndarray:
                 return merged_pressure(x, at)
