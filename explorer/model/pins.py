@@ -43,7 +43,7 @@ _LAYER_UNITS: dict[str, tuple[str, str, float]] = {
     "poisson": ("ν", "", 1.0),
 }
 #: Scene fields that say nothing about the mechanics (never a reason for a name).
-_IGNORED = ("schema_version", "name", "description")
+NOT_MECHANICS = ("schema_version", "name", "description")
 
 
 @dataclass
@@ -120,7 +120,7 @@ def _differing(flats: list[dict[str, Any]]) -> list[str]:
     keys: list[str] = []
     for flat in flats:
         keys.extend(k for k in flat if k not in keys)
-    return [k for k in keys if not k.startswith(_IGNORED)
+    return [k for k in keys if not k.startswith(NOT_MECHANICS)
             and len({repr(flat.get(k)) for flat in flats}) > 1]
 
 

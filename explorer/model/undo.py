@@ -3,10 +3,37 @@
 from __future__ import annotations
 
 import copy
+import time
 from typing import Any
+
+from .pins import NOT_MECHANICS, flatten
 
 #: Scenes kept for undo (a scene dict is a few kB).
 UNDO_DEPTH = 50
+#: Changes of the same one number one way, each within this many seconds [s] of the last,
+#: are one step of undo: a drag (one undo after dragging the force from 500 to 1128 kN/m
+#: took ten presses, back through every value the handle passed, a teacher's audit).
+COALESCE_S = 1.0
+
+
+def changed_fields(before: dict[str, Any], after: dict[str, Any]) -> set[str]:
+    """The scene fields (flattened paths, ``loading.force``) that differ, but for its name
+    and description (the first step of a drag renames the scene "(modified)")."""
+    a, b = flatten(before), flatten(after)
+    return {k for k in a.keys() | b.keys()
+            if a.get(k) != b.get(k) and not k.startswith(NOT_MECHANICS)}
+
+
+def _one_way(first: dict[str, Any], second: dict[str, Any], third: dict[str, Any],
+             field: str) -> bool:
+    """Whether ``field`` moves the same way from ``first`` to ``second`` as from
+    ``second`` to ``third`` (numbers; a drag's steps do, where values typed one after the
+    other, 1e6 then 500 then 2e6, need not)."""
+    values = [flatten(scene).get(field) for scene in (first, second, third)]
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        return False
+    a, b, c = (float(v) for v in values)
+    return (b - a) * (c - b) > 0
 
 
 class UndoStack:
@@ -15,11 +42,25 @@ class UndoStack:
     def __init__(self, depth: int = UNDO_DEPTH) -> None:
         self.depth = depth
         self._scenes: list[dict[str, Any]] = []
+        self._last = float("-inf")  # when the last scene was pushed [s, monotonic]
 
-    def push(self, scene: dict[str, Any]) -> None:
-        """Record ``scene`` as the current one (a repeat of the current is ignored)."""
+    def push(self, scene: dict[str, Any], now: float | None = None) -> None:
+        """Record ``scene`` as the current one (a repeat of the current is ignored). A
+        change of the same one number as the last change, the same way, within
+        :data:`COALESCE_S` of it (``now`` [s], default the monotonic clock), replaces the
+        last scene: one undo goes back to before them all."""
         if self._scenes and self._scenes[-1] == scene:
             return
+        now = time.monotonic() if now is None else float(now)
+        recent, self._last = now - self._last <= COALESCE_S, now
+        if recent and len(self._scenes) >= 2:
+            last = changed_fields(self._scenes[-2], self._scenes[-1])
+            if (len(last) == 1 and changed_fields(self._scenes[-1], scene) == last
+                    and _one_way(self._scenes[-2], self._scenes[-1], scene, *last)):
+                self._scenes[-1] = copy.deepcopy(scene)
+                if self._scenes[-1] == self._scenes[-2]:  # back where it started
+                    self._scenes.pop()
+                return
         self._scenes.append(copy.deepcopy(scene))
         del self._scenes[: -self.depth]
 

@@ -517,6 +517,28 @@ def test_an_emptied_slider_box_gets_its_value_back_and_says_why(page: Page):
     assert page.errors == []
 
 
+def test_one_undo_goes_back_to_before_a_drag_of_the_force(page: Page):
+    """A teacher dragged the force from 500 to 1128 kN/m and needed ten presses of Undo,
+    back through every value the handle passed: the drag is one step now."""
+    force = page.text(".readout-force")
+    handle = page.page.locator(".load-0-value .noUi-handle").first
+    box = handle.bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.page.mouse.move(x, y)
+    page.page.mouse.down()
+    for k in range(1, 9):   # a step every ~0.1 s, each solved and drawn
+        page.page.mouse.move(x + 8 * k, y)
+        page.page.wait_for_timeout(100)
+    page.page.mouse.up()
+    until(lambda: float(page.text(".readout-force")) > float(force) + 20,
+          "the dragged force solved", describe=lambda: page.text(".readout-force"))
+    page.page.wait_for_timeout(1500)   # the drag's last step solved and drawn
+    page.page.locator(".undo-button button").first.click()
+    until(lambda: page.text(".readout-force") == force, "one undo to the force before",
+          describe=lambda: page.text(".readout-force"))
+    assert page.errors == []
+
+
 def test_classical_solutions_undo_and_reset(page: Page):
     """Feature 6 (classical answers on request) and 7 (typed entry, undo, reset)."""
     doc = "Bokeh.documents[0]"

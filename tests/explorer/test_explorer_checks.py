@@ -414,6 +414,37 @@ def test_undo_and_reset_return_to_earlier_scenes(explorer_app):
     assert app.controller.view.scene == start
 
 
+def test_one_undo_goes_back_to_before_a_drag() -> None:
+    """Dragging the force from 500 to 1128 kN/m made ten steps of undo, back through every
+    value the handle passed (a teacher's audit). Changes of the same one number one way,
+    each within COALESCE_S of the last, are one step; another field, a pause or a turn
+    makes a new one."""
+    from explorer.model.undo import COALESCE_S, UndoStack
+
+    def scene(force: float, width: float = 1.0, name: str = "Uniform (modified)") -> dict:
+        return {"name": name, "loading": {"force": force}, "punch": {"half_width": width}}
+
+    stack = UndoStack()
+    stack.push(scene(500.0, name="Uniform"), now=0.0)   # its first step renames it too
+    for k, force in enumerate(np.linspace(562.0, 1128.0, 10)):
+        stack.push(scene(float(force)), now=1.0 + 0.1 * k)
+    assert stack.undo() == scene(500.0, name="Uniform") and not stack.can_undo
+    stack.push(scene(700.0), now=10.0)
+    stack.push(scene(700.0, 1.2), now=10.1)          # another field: a step of its own
+    stack.push(scene(700.0, 1.3), now=10.2 + COALESCE_S + 0.1)  # after a pause: one more
+    assert stack.undo() == scene(700.0, 1.2)
+    assert stack.undo() == scene(700.0)
+    stack.push(scene(800.0), now=20.0)
+    stack.push(scene(900.0), now=20.1)
+    stack.push(scene(600.0), now=20.2)               # dragged back: a step of its own
+    assert stack.undo() == scene(900.0) and stack.undo() == scene(700.0)
+    # values typed one after the other, not one way: a step each
+    stack.push(scene(1e6), now=30.0)
+    stack.push(scene(500.0), now=30.1)
+    stack.push(scene(2e6), now=30.2)
+    assert stack.undo() == scene(500.0) and stack.undo() == scene(1e6)
+
+
 def test_undo_across_a_preset_change_shows_the_scene_it_brings_back(explorer_app):
     # the selector and the description stayed at "Worn coating" while the uniform
     # scene was back on screen
