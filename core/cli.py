@@ -289,7 +289,8 @@ def _punches_summary(result: PunchesSolution) -> str:
             values = [getattr(punch, q)[i] for q in QUANTITIES]
             lines.append(f"{result.times[i]:12.6g} " + " ".join(f"{v:16.8g}" for v in values))
         line = largest_pressure(punch)
-        edge = thin_edge_note(line, punch.scene.half_width, punch.info.get("coating_model"))
+        edge = thin_edge_note(line, punch.scene.half_width, punch.info.get("coating_model"),
+                              dimensional=punch.info.get("dimensional"))
         line = replace(line, x=punch.center + line.x)  # the global x
         lines.append(f"  largest contact pressure q: {line.value_text(place_first=True)}")
         if edge:
@@ -321,7 +322,8 @@ def _summary(result: SceneSolution) -> str:
             lines.append(f"contact at {result.times[i]:g} days: {where}")
     largest = largest_pressure(result)
     lines.append(f"largest contact pressure q: {largest.value_text(place_first=True)}")
-    edge = thin_edge_note(largest, result.scene.half_width, result.info.get("coating_model"))
+    edge = thin_edge_note(largest, result.scene.half_width, result.info.get("coating_model"),
+                          dimensional=result.info.get("dimensional"))
     if edge:
         lines.append(f"  ({edge})")
     held = corner_note(result.info.get("corner_pressure"))

@@ -53,7 +53,7 @@ def _largest_pressure_text(result: Any, origin: float = 0.0) -> str:
     line = largest_pressure(result)
     # (the short words: the long ones ran the PDF's text onto a fourth page)
     edge = thin_edge_note(line, result.scene.half_width, result.info.get("coating_model"),
-                          short=True)
+                          short=True, dimensional=result.info.get("dimensional"))
     if line.x is not None and origin:
         line = replace(line, x=origin + line.x)
     text = line.value_text(number=number_text, shown=_shown, place_first=True, time=days_text)

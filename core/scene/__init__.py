@@ -48,6 +48,8 @@ from core.scene.contact_zone import (
 from core.scene.design import (
     THIN_EDGE_NOTE,
     THIN_EDGE_SHORT,
+    THIN_STEP_NOTE,
+    THIN_STEP_SHORT,
     DesignCheck,
     DesignLimits,
     LimitCheck,
@@ -159,6 +161,8 @@ __all__ = [
     "thin_edge_note",
     "THIN_EDGE_NOTE",
     "THIN_EDGE_SHORT",
+    "THIN_STEP_NOTE",
+    "THIN_STEP_SHORT",
     "lifts_off_at",
     "answer_accuracy",
     "check_design",

@@ -403,6 +403,7 @@ class SceneSolution:
             "gap_max_m": extremes["gap_max_m"],
             "coating_thickness_max_m": extremes["coating_thickness_max_m"],
             "breakpoints_m": list(scene.breakpoints),
+            "gap_steps_m": list(scene.gap_steps),
             "min_pressure_Pa": float(np.min(self.pressure_on_grid)),
             "max_pressure_Pa": float(np.max(self.pressure_on_grid)),
         }

@@ -182,7 +182,8 @@ def design_check(view: ResultView, limits: DesignLimits | None = None) -> Design
     checks = [_on_screen(line, limits) for line in verdict.checks]
     # (one punch: several draw their pressure over the whole surface, in global x)
     edge = "" if view.punches else thin_edge_note(
-        verdict.checks[0], view.geometry.half_width, view.info.get("coating_model"))
+        verdict.checks[0], view.geometry.half_width, view.info.get("coating_model"),
+        dimensional=view.info.get("dimensional"))
     return DesignCheck(q_max=checks[0], q_min=_on_screen(verdict.q_min, limits),
                        contact_width=float(widths[j_narrow]),
                        full_width=2 * view.geometry.half_width,

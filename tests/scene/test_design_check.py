@@ -270,6 +270,41 @@ def test_the_thin_layer_s_largest_pressure_at_an_edge_says_whose_it_is() -> None
     assert row.endswith(f" ({THIN_EDGE_SHORT})")  # (a page's row: the short words)
 
 
+def test_the_thin_layer_s_largest_pressure_beside_a_step_says_whose_it_is() -> None:
+    """The stepped preset with an allowable pressure of 800 kPa passed at 0.988: the thin
+    model's 790.6 kPa 3 mm from the step, where the resolved coating of the FE check
+    carries 893 kPa at 5 mm and 1.87 MPa at 1 mm (an engineer's audit), and nothing was
+    said (the note was for the punch's edges). Beside a step of the gap (within
+    STEP_REACH coating thicknesses) the command line, the report and the page say it; a
+    modulus patch (no step of the gap) is no step."""
+    from core.report.content import key_numbers
+    from core.scene import (
+        THIN_STEP_NOTE,
+        THIN_STEP_SHORT,
+        largest_pressure,
+        thin_edge_note,
+    )
+    from explorer.model import prepare_view
+    from explorer.model.design import design_check as page_check
+    from tests.cli_runs import run_cli
+
+    scene = scene_file("stepped_punch")
+    stepped = solve(scene)
+    dimensional = stepped.info["dimensional"]
+    assert dimensional["gap_steps_m"] == [-0.4, 0.4]
+    line = largest_pressure(stepped)
+    assert abs(abs(line.x) - 0.4) < 0.01
+    assert thin_edge_note(line, stepped.scene.half_width, stepped.info["coating_model"],
+                          dimensional=dimensional) == THIN_STEP_NOTE
+    assert f"\n  ({THIN_STEP_NOTE})\n" in run_cli("solve", "preset:stepped_punch").stdout
+    row = dict(key_numbers(stepped))["largest contact pressure q"]
+    assert row.endswith(f" ({THIN_STEP_SHORT})")
+    assert page_check(prepare_view(stepped, scene)).edge_note == THIN_STEP_NOTE
+    patched = solve(scene_file("patched_insert"))
+    assert patched.info["dimensional"]["breakpoints_m"] == [-0.15, 0.15]
+    assert patched.info["dimensional"]["gap_steps_m"] == []
+
+
 def test_a_negative_largest_settlement_says_the_centre_rises() -> None:
     """At e = 0.8 m the lift-off preset's centre rises: "largest settlement δ (punch
     centre) -0.02403 mm" said nothing of why it is negative (a teacher's audit). The
