@@ -428,7 +428,7 @@ def _corner_line(name: str, label: str, unit: str, times: np.ndarray, x: np.ndar
         return None
     on_grid, everywhere = None, False
     if limit is not None:
-        on_grid, everywhere = _over_from(x, q, best[2], limit)
+        on_grid, everywhere = _over_from(x, q, best[2], limit, held)
         if on_grid is not None and on_grid <= held * (1 + 1e-9):
             on_grid = None  # within the held values: the asymptote says more
     return LimitCheck(name, "q_max", label, best[0], unit, best[1], best[2], limit,
@@ -436,13 +436,17 @@ def _corner_line(name: str, label: str, unit: str, times: np.ndarray, x: np.ndar
                       exceeded_on_grid=on_grid, exceeded_everywhere=everywhere)
 
 
-def _over_from(x: np.ndarray, q: np.ndarray, corner: float,
-               limit: float) -> tuple[float | None, bool]:
+def _over_from(x: np.ndarray, q: np.ndarray, corner: float, limit: float,
+               held: float = 0.0) -> tuple[float | None, bool]:
     """How far from ``corner`` [m] the pressure ``q`` [Pa] on the grid ``x`` stays over
-    ``limit`` without a break, at its worst time (linear in q between the last grid
-    point over it and the next; None: not even the nearest point is over), and whether
-    it is over on the whole grid at some time."""
-    distance = np.abs(x - corner)
+    ``limit`` without a break, at its worst time (None: not even the nearest point is
+    over), and whether it is over on the whole grid at some time. Between the last grid
+    point over it and the next, ``1 / q^2`` is taken linear in the distance, which the
+    corner's ``q ~ K / sqrt(distance)`` makes exact (linear in q overstated the distance
+    by up to 6.3 % 1.3 to 2.3 mm from the bare layer's corner, an audit); the points
+    within ``held`` [m] of the corner, where q holds its value there, count at ``held``
+    (read at their own distance the reach came out 1.000 mm for a true 1.084)."""
+    distance = np.maximum(np.abs(x - corner), held)
     order = np.argsort(distance, kind="stable")
     d = distance[order]
     rows = np.nan_to_num(q[order], nan=-np.inf)
@@ -457,7 +461,12 @@ def _over_from(x: np.ndarray, q: np.ndarray, corner: float,
         if run == 0:
             continue
         d0, d1, q0, q1 = d[run - 1], d[run], rows[run - 1, j], rows[run, j]
-        at = d0 + (d1 - d0) * (q0 - limit) / (q0 - q1) if q0 > q1 else d0
+        if not q0 > q1:
+            at = d0
+        elif q1 > 0.0:
+            at = d0 + (d1 - d0) * (q0 ** -2 - limit ** -2) / (q0 ** -2 - q1 ** -2)
+        else:
+            at = d0 + (d1 - d0) * (q0 - limit) / (q0 - q1)
         reach = at if reach is None else max(reach, at)
     return (None if reach is None else float(reach)), False
 
