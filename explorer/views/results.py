@@ -172,7 +172,7 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
     for k, pin in enumerate(pins):
         color = PIN_COLORS[k]
         head += (f"<th style='border-bottom:3px dashed {color}'>{html.escape(pin.label)}"
-                 "</th><th>change</th>")
+                 "</th>")
     rows = [head + "</tr>"]
     others = [pin.view for pin in pins]
     times = [other.time_index(t) for other in others]
@@ -186,8 +186,11 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
         for k, (pinned, j) in enumerate(zip(others, times, strict=True)):
             other = float(pinned.display(q)[j])
             change = change_text(value, other)
-            row += (f"<td class='pinned-{q} pin-{k}-{q}'>{_fmt(other)}</td>"
-                    f"<td>{change}</td>")
+            # the change under the value, not in a column of its own: five pins took
+            # 875 px of a 653 px box at 1280 and their last columns were out of sight
+            # (a teacher's audit); now 6 columns, not 11
+            row += (f"<td><span class='pinned-{q} pin-{k}-{q}'>{_fmt(other)}</span><br>"
+                    f"<span class='cp-change'>{change}</span></td>")
         rows.append(row + "</tr>")
     force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
     ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"

@@ -15,6 +15,7 @@ CSS = """
 .cp-msg {font-size: 12px; color: #9b1c1c; margin-left: 4px; overflow-wrap: anywhere;}
 .coating-check-stale {opacity: 0.45;}
 .readout-scroll {overflow-x: auto; max-width: 100%;}
+.cp-change {font-size: 0.85em; color: #666;}
 .readout-scroll::-webkit-scrollbar {height: 8px;}
 .readout-scroll::-webkit-scrollbar-track {background: #f0f0f0;}
 .readout-scroll::-webkit-scrollbar-thumb {background: #b0b0b0; border-radius: 4px;}
