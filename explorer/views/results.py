@@ -33,29 +33,9 @@ from .contact import ContactPanes
 from .link import AddressLink
 from .loop import PageLoop
 from .pins import PinsView
-from .status import held_text, preview_text, status_html
+from .status import BADGES, held_text, preview_text, status_html
 from .style import NOTE_STYLE, html_pane
 from .widgets import NAMES, LabelledCheckbox, TimePlayer
-
-#: Which validity flags are shown next to which plot.
-BADGES: dict[str, dict[str, tuple[str, str]]] = {
-    # group: flag -> (text when raised, text when the check passes)
-    "scene": {"thick_coating": ("coating not thin", "coating thin"),
-              "stiff_coating": ("coating stiffer than base", "coating softer than base"),
-              "model_error": ("coating model error above solver.model_tol",
-                              "coating model within solver.model_tol"),
-              "beyond_model_map": ("coating model error extrapolated: check it (Coating "
-                                   "tab)", "")},
-    "pressure": {"contact_lost": ("contact lost: q < 0 (shaded)", "full contact"),
-                 "no_contact": ("no contact at some times: the punch is clear of the surface",
-                                "")},
-    "history": {"large_settlement": ("settlement beyond small strains", "small strains"),
-                "large_tilt": ("large tilt", "small tilt"),
-                "undersampled_load": ("load faster than the output times: histories "
-                                      "aliased (Time tab: more output times)", "")},
-    "status": {"tol_not_met": ("tolerance not met", ""),
-               "unresolved_input": ("input finer than the quadrature", "")},
-}
 
 
 def _fmt(value: float) -> str:

@@ -9,12 +9,49 @@ from __future__ import annotations
 
 import html
 import numbers
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from core.scene import percent_text
 
 from ..model import ResultView
+
+#: The validity badges of each plot group: flag -> (text when raised, text when the
+#: check passes).
+BADGES: dict[str, dict[str, tuple[str, str]]] = {
+    # group: flag -> (text when raised, text when the check passes)
+    "scene": {"thick_coating": ("coating not thin", "coating thin"),
+              "stiff_coating": ("coating stiffer than base", "coating softer than base"),
+              "model_error": ("coating model error above solver.model_tol",
+                              "coating model within solver.model_tol"),
+              "beyond_model_map": ("coating model error extrapolated: check it (Coating "
+                                   "tab)", "")},
+    "pressure": {"contact_lost": ("contact lost: q < 0 (shaded)", "full contact"),
+                 "no_contact": ("no contact at some times: the punch is clear of the surface",
+                                "")},
+    "history": {"large_settlement": ("settlement beyond small strains", "small strains"),
+                "large_tilt": ("large tilt", "small tilt"),
+                "undersampled_load": ("load faster than the output times: histories "
+                                      "aliased (Time tab: more output times)", "")},
+    "status": {"tol_not_met": ("tolerance not met", ""),
+               "unresolved_input": ("input finer than the quadrature", "")},
+}
+
+#: Raised flags the status line repeats at the top of the results (the model does not hold
+#: for the answer, or its histories are aliased): a force of 1e9 N/m settled 81 m on a 4 m
+#: slab with green badges at the top and the one warning below the design check (a
+#: teacher's audit). The model's error (its own note) and the accuracy target (the status
+#: line's own words) are said there already.
+STATUS_WARNINGS = ("thick_coating", "stiff_coating", "contact_lost", "no_contact",
+                   "large_settlement", "large_tilt", "undersampled_load")
+
+
+def raised_warnings(flags: Sequence[str]) -> list[str]:
+    """The words of the raised :data:`STATUS_WARNINGS` among ``flags``, in the badges'
+    order."""
+    return [bad for group in BADGES.values() for flag, (bad, _) in group.items()
+            if flag in STATUS_WARNINGS and flag in flags]
+
 
 #: The solver's stages (``info["stages"]``) in words: what a change made it redo.
 STAGE_WORDS = {
@@ -196,6 +233,10 @@ def status_html(view: ResultView | None, busy: bool,
                  f"{text_model}</span>")
     else:
         model = ""
-    return (f"<span class='cp-status solve-status'>{html.escape(text)}</span>{model} "
-            f"<details class='cp-status solve-details'><summary>details</summary>"
+    raised = raised_warnings(view.flags)
+    warning = ("" if not raised else
+               f" <span class='cp-status cp-msg status-warnings'>⚠ Flagged: "
+               f"{html.escape('; '.join(raised))} (the badges below say why).</span>")
+    return (f"<span class='cp-status solve-status'>{html.escape(text)}</span>{model}"
+            f"{warning} <details class='cp-status solve-details'><summary>details</summary>"
             f"{html.escape(details_text(view))}</details>")

@@ -326,11 +326,13 @@ def test_the_features_legend_hides_no_line() -> None:
 
 def test_the_design_check_says_when_q_max_is_the_thin_layer_s_at_an_edge() -> None:
     """The flat punch's q_max sits at x = a, where the thin coating model's springs bound
-    q; the stepped punch's at its step, inside; the bare layer's corner is unbounded and
-    says so in its own row."""
+    q; the stepped punch's beside its step, inside, where they bound it too (an
+    engineer's audit: the FE check's coating exceeds it within millimetres); the bare
+    layer's corner is unbounded and says so in its own row."""
     from explorer.model import check_html, design_check
 
     html = check_html(design_check(_solved("uniform_flat")))
     assert "check-edge" in html and "q_max at the punch&#x27;s edge: the thin coating" in html
-    for key in ("stepped_punch", "bare_layer"):
-        assert "check-edge" not in check_html(design_check(_solved(key))), key
+    stepped = check_html(design_check(_solved("stepped_punch")))
+    assert "q_max beside a step of the punch: the thin coating" in stepped
+    assert "check-edge" not in check_html(design_check(_solved("bare_layer")))

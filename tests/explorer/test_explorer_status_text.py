@@ -168,3 +168,23 @@ def test_several_punches_state_their_worst_punch_s_model_error(explorer_app) -> 
     assert (f"Coating model error {percent_text(errors[worst]['estimate'])} of the tilt α of "
             f"punch {worst + 1} (estimated), within solver.model_tol 2 %."
             ) in app.results.status.object
+
+
+def test_the_status_line_repeats_a_flag_the_model_does_not_hold_under() -> None:
+    """A force of 1e9 kN/m settled the uniform preset's slab 81 m with green badges at the
+    top and the one warning below the design check (a teacher's audit): the status line,
+    at the top, says it too; an answer without such a flag says nothing more."""
+    from core import solve
+    from core.presets import read_preset
+    from explorer.model import prepare_view
+    from explorer.views.status import status_html
+
+    scene = read_preset("uniform_flat")
+    scene["loading"]["force"] = 1e12
+    flagged = prepare_view(solve(scene), scene)
+    assert "large_settlement" in flagged.flags
+    text = status_html(flagged, False)
+    assert ("status-warnings'>⚠ Flagged: settlement beyond small strains (the badges "
+            "below say why).</span>") in text
+    plain = read_preset("uniform_flat")
+    assert "Flagged" not in status_html(prepare_view(solve(plain), plain), False)
