@@ -511,6 +511,9 @@ class ExplorerApp(pn.viewable.Viewer):
         self.tabs.touch()  # the closed tabs are filled once the page is left alone
         self.results.say_held(False)   # a release applied: the plots follow now
         self.history.remember()
+        lessons = self._made("lessons")
+        if lessons is not None:  # (a tab never opened has no lesson running)
+            lessons.follow(self.state.scene_name)
         self.controller.request()
 
     def load_scene(self, scene: dict[str, Any], same_family: bool = False) -> bool:

@@ -8,10 +8,17 @@ from typing import Any
 
 import panel as pn
 
-from ..model import Lesson, lessons, step_scene
+from ..model import MODIFIED, Lesson, lessons, step_scene
 from .pins import PinsView
 from .style import TAB_COLUMN, html_pane
 from .widgets import LabelledCheckbox
+
+#: What the Lessons tab says while the scene on screen is a step changed on the page.
+CHANGED_NOTE = ("<div class='cp-msg' style='font-size:13px'>You changed the scene of this "
+                "step: the note below speaks of the step as the lesson gives it. "
+                "<i>next</i> pins what is on screen and shows the next step as the lesson "
+                "gives it; <i>previous</i> or choosing the lesson again brings its steps "
+                "back.</div>")
 
 
 class LessonsView:
@@ -47,11 +54,25 @@ class LessonsView:
                                      "comparison.</small>", sizing_mode="stretch_width",
                                      css_classes=["lesson-note"])
 
+        # said while the scene on screen is no longer the step's (a teacher's edit)
+        self.changed_note = html_pane(CHANGED_NOTE, sizing_mode="stretch_width",
+                                      visible=False, css_classes=["lesson-changed"])
+
     def content(self) -> pn.Column:
         """The tab's column."""
         return pn.Column(self.lesson_select,
                          pn.Row(self.previous_button, self.next_button),
-                         self.lesson_note, **TAB_COLUMN)
+                         self.changed_note, self.lesson_note, **TAB_COLUMN)
+
+    def follow(self, scene_name: str) -> None:
+        """The scene on screen is now named ``scene_name``: while a lesson runs and the
+        scene is its step changed on the page (``(modified)``), the tab says that the
+        note speaks of the step as the lesson gives it and what next does (a teacher set
+        700 kN/m at the step of 1000: the note's numbers no longer matched, next pinned
+        the 700 and the next step went back to 1000, unsaid)."""
+        changed = self.lesson is not None and scene_name.endswith(MODIFIED)
+        if self.changed_note.visible != changed:
+            self.changed_note.visible = changed
 
     def start(self, key: str) -> None:
         """Begin the lesson ``key`` at its first step (clears the pins)."""

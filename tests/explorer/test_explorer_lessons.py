@@ -259,3 +259,23 @@ def test_a_files_name_and_description_are_shown_as_written(explorer_app) -> None
     assert app._load_file(scene)
     rendered = MarkdownIt().render(app.scene_tab.preset_description.object)
     assert "<strong>Pad 2*3*4</strong>: &lt;b&gt;bold&lt;/b&gt; a_b `c` $5" in rendered
+
+
+def test_a_step_changed_on_the_page_says_what_the_note_and_next_speak_of(explorer_app) -> None:
+    """A teacher set the force to 700 kN/m at the step of 1000: the note's numbers no longer
+    matched the page, next pinned the 700 and the next step went back to 1000, unsaid. The
+    tab says it while the step is changed, and not once a step is shown again."""
+    from explorer.views.lessons import CHANGED_NOTE
+
+    app = explorer_app()
+    view = app.lessons_tab
+    view.lesson_select.value = "load_and_tilt"
+    assert app.controller.wait(60)
+    view.next_button.clicks += 1
+    assert app.controller.wait(60) and not view.changed_note.visible
+    app.state.loading.histories["force"].value = 700.0
+    assert app.controller.wait(60)
+    assert view.changed_note.visible and view.changed_note.object == CHANGED_NOTE
+    view.next_button.clicks += 1          # pins the 700, shows step 3 as given
+    assert app.controller.wait(60) and not view.changed_note.visible
+    assert "P = 700 kN/m" in [pin.label for pin in app.pins.board][-1]
