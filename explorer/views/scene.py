@@ -72,7 +72,8 @@ class SceneView:
                                            options=list(STATEMENTS), value=s.loading.statement,
                                            sizing_mode="stretch_width",
                                            css_classes=["statement-select"])
-        self.statement.param.watch(lambda e: setattr(s.loading, "statement", e.new), "value")
+        self.controller = controller
+        self.statement.param.watch(self._on_statement, "value")
         s.loading.param.watch(self.refresh, "statement")
         self.history_editors = (HistoryEditor("load-0", reject), HistoryEditor("load-1", reject))
         self.unknowns_note = html_pane("", styles={"font-size": "13px"})
@@ -133,6 +134,22 @@ class SceneView:
         its own), and that scene's name and description."""
         self.preset.value = ""
         self.preset_description.object = self._preset_text()
+
+    def _on_statement(self, event: Any) -> None:
+        """A statement chosen on the page: the quantities it newly gives start at the
+        answer on screen, constant at its value at the last output time (they started at
+        0.05 mm and 0 mrad whatever the answer was, a teacher's audit: another scene);
+        on an elastic base the answer stays the same."""
+        loading = self.state.loading
+        if event.new == loading.statement:  # (the selector following the state)
+            return
+        view = self.controller.view
+        if view is not None and not view.several:
+            for q in STATEMENTS[event.new]:
+                if q not in loading.given:
+                    loading.histories[q].param.update(
+                        kind="constant", value=float(view.display(q)[-1]), custom=None)
+        loading.statement = event.new
 
     def refresh(self, *events: Any) -> None:
         """Point the history editors at the two given quantities; name the unknowns."""

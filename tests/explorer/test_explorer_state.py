@@ -676,3 +676,21 @@ def test_a_load_slider_returns_to_its_range_after_a_large_value(explorer_app):
     assert slider.end >= 2e6 and slider.value == 2e6
     app.history.undo()
     assert (slider.start, slider.end) == home
+
+
+def test_a_statement_chosen_on_the_page_starts_from_the_answer_on_screen(explorer_app) -> None:
+    """Switching to "settlement + tilt given" set δ 0.05 mm and α 0 whatever the answer
+    was (a teacher's audit): another scene. The newly given quantities start at the
+    answer's values at the last output time; on an elastic base the answer is the same."""
+    from core.presets import read_preset
+
+    app = explorer_app(scene=read_preset("bare_layer"), solved=True)   # elastic
+    before = app.controller.view
+    assert before.given == ("force", "moment")
+    app.scene_tab.statement.value = "settlement + tilt given"
+    assert app.controller.wait(60) and app.controller.error == ""
+    after = app.controller.view
+    assert after.given == ("settlement", "tilt")
+    for q in ("settlement", "tilt", "force", "moment"):
+        np.testing.assert_allclose(after.display(q)[-1], before.display(q)[-1],
+                                   rtol=1e-6, atol=1e-12)
