@@ -66,7 +66,7 @@ def _at(times: np.ndarray, values: np.ndarray, accuracy: float) -> tuple[float, 
     ``accuracy``: a zero tilt read "at t = 0 days" here and "at t = 365 days" on the
     page)."""
     k = time_of_largest(values, accuracy)
-    return float(values[k]), float(times[k])
+    return float(values[int(np.nanargmax(np.abs(values)))]), float(times[k])
 
 
 def _shown(value: float, si_unit: str) -> str:

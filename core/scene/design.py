@@ -347,6 +347,9 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
     times = np.asarray(times, dtype=float)
     x = np.asarray(x, dtype=float)
     q = np.asarray(pressure, dtype=float)
+    # the extremes' values are the largest and smallest (what a limit is held to); their
+    # time and place, where they are first reached to the answer's accuracy
+    q_largest, q_smallest = float(np.nanmax(q)), float(np.nanmin(q))
     i_max = _first_extreme(q, max, accuracy)
     i_min = _first_extreme(q, min, accuracy)
     histories = {"settlement": np.asarray(settlement, dtype=float),
@@ -356,14 +359,15 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
         limit = getattr(limits, name)
         if quantity == "q_max":
             lines.append(_corner_line(name, label, unit, times, x, q, limit, corners)
-                         or LimitCheck(name, quantity, label, float(q[i_max]), unit,
+                         or LimitCheck(name, quantity, label, q_largest, unit,
                                        float(times[i_max[1]]), float(x[i_max[0]]), limit))
             continue
         values = histories[quantity]
         k = time_of_largest(values, accuracy)
-        lines.append(LimitCheck(name, quantity, label, float(values[k]), unit,
+        largest = int(np.nanargmax(np.abs(values)))
+        lines.append(LimitCheck(name, quantity, label, float(values[largest]), unit,
                                 float(times[k]), None, limit))
-    q_min = LimitCheck(None, "q_min", "smallest contact pressure q_min", float(q[i_min]),
+    q_min = LimitCheck(None, "q_min", "smallest contact pressure q_min", q_smallest,
                        "Pa", float(times[i_min[1]]), float(x[i_min[0]]))
     return DesignCheck(tuple(lines), q_min)
 
@@ -377,14 +381,27 @@ def answer_accuracy(info: Mapping[str, Any]) -> float:
     return SAME_SHARE
 
 
+def _same_share(accuracy: float) -> float:
+    """The share within which values are the same: ``accuracy``, at least
+    :data:`SAME_SHARE`, at most :data:`LEAST_SHARE` (a failed answer's large estimate
+    would date a peak anywhere)."""
+    return min(max(accuracy, SAME_SHARE), LEAST_SHARE)
+
+
+#: The widest share :func:`_same_share` takes.
+LEAST_SHARE = 1e-3
+
+
 def time_of_largest(values: np.ndarray, accuracy: float = SAME_SHARE) -> int:
-    """The index of the largest ``|values|``: the first of those within ``accuracy``
-    (relative, at least :data:`SAME_SHARE`) of it, when the history reaches it (a
-    history that levels off read "largest at t = 887.7 days" for 1e-11 mm more there
-    than elsewhere; a zero history: its first time)."""
+    """The index of the time the largest ``|values|`` is reached: the first of those of
+    its sign within ``accuracy`` (relative, :func:`_same_share`) of it (a history that
+    levels off read "largest at t = 887.7 days" for 1e-11 mm more there than elsewhere;
+    a zero history: its first time). The largest value itself is ``values`` at
+    ``argmax |values|``: a limit is held to it, not to the value at this time."""
     size = np.abs(values)
     k = int(np.nanargmax(size))
-    near = np.flatnonzero(size >= size[k] * (1.0 - max(accuracy, SAME_SHARE)))
+    near = np.flatnonzero((size >= size[k] * (1.0 - _same_share(accuracy)))
+                          & (np.sign(values) == np.sign(values[k])))
     return int(near[0]) if near.size else k
 
 
@@ -396,8 +413,12 @@ def _first_extreme(q: np.ndarray, pick: Callable, accuracy: float) -> tuple[int,
     the round-off peaked (a teacher's audit)."""
     over_x = np.nanmax(q, axis=0) if pick is max else np.nanmin(q, axis=0)
     extreme = float(np.nanmax(over_x) if pick is max else np.nanmin(over_x))
-    slack = max(accuracy, SAME_SHARE) * float(np.nanmax(np.abs(q)))
+    slack = _same_share(accuracy) * float(np.nanmax(np.abs(q)))
     reached = (over_x >= extreme - slack) if pick is max else (over_x <= extreme + slack)
+    if not (np.isfinite(slack) and reached.any()):  # (an infinite pressure: where it is)
+        flat = np.nanargmax(q) if pick is max else np.nanargmin(q)
+        i, j = np.unravel_index(int(flat), q.shape)
+        return int(i), int(j)
     j = int(np.flatnonzero(reached)[0])
     # the place: of those within the accuracy of the time's extreme, the last (a centred
     # load's largest pressure is at both corners: the right one, to round-off either)
