@@ -58,8 +58,6 @@ class UndoStack:
             if (len(last) == 1 and changed_fields(self._scenes[-1], scene) == last
                     and _one_way(self._scenes[-2], self._scenes[-1], scene, *last)):
                 self._scenes[-1] = copy.deepcopy(scene)
-                if self._scenes[-1] == self._scenes[-2]:  # back where it started
-                    self._scenes.pop()
                 return
         self._scenes.append(copy.deepcopy(scene))
         del self._scenes[: -self.depth]
@@ -69,6 +67,9 @@ class UndoStack:
         if len(self._scenes) < 2:
             return None
         self._scenes.pop()
+        # the next change starts a step of its own (one within a second of the drag just
+        # undone was merged into the step it went back to, a review)
+        self._last = float("-inf")
         return copy.deepcopy(self._scenes[-1])
 
     @property

@@ -438,6 +438,13 @@ def test_one_undo_goes_back_to_before_a_drag() -> None:
     stack.push(scene(900.0), now=20.1)
     stack.push(scene(600.0), now=20.2)               # dragged back: a step of its own
     assert stack.undo() == scene(900.0) and stack.undo() == scene(700.0)
+    # a change just after an undo is a step of its own (it was merged into the step the
+    # undo went back to, a review)
+    stack.push(scene(1100.0), now=25.0)
+    stack.push(scene(1200.0), now=25.1)
+    assert stack.undo() == scene(700.0)
+    stack.push(scene(650.0), now=25.2)
+    assert stack.undo() == scene(700.0)
     # values typed one after the other, not one way: a step each
     stack.push(scene(1e6), now=30.0)
     stack.push(scene(500.0), now=30.1)

@@ -30,8 +30,10 @@ def _loading(force: dict, moment: object = 0.0) -> dict:
     ({"kind": "step", "values": [1e5, 6e5], "breaks": [150.0]}, (150.0,)),
     # at an output time: the value there is the new one, the one before the old
     ({"kind": "step", "values": [1e5, 6e5], "breaks": [365.25]}, (365.25,)),
-    # a ramp's end is a kink, not a jump
+    # a ramp's end is a kink, not a jump; a short one too (a 14-day ramp from 0 to 600
+    # kN/m over 50 years was drawn as a jump, a review)
     ({"kind": "ramp", "start": 1e5, "end": 6e5, "duration": 150.0}, ()),
+    ({"kind": "ramp", "start": 0.0, "end": 6e5, "duration": 0.05}, ()),
     ({"kind": "table", "points": [[0, 1e5], [150, 6e5], [400, 6e5]],
       "interpolation": "linear"}, ()),
     ({"kind": "table", "points": [[0, 1e5], [150, 6e5], [400, 6e5]],
