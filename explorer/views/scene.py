@@ -139,7 +139,7 @@ class SceneView:
         """A statement chosen on the page: the quantities it newly gives start at the
         answer on screen, constant at its value at the last output time (they started at
         0.05 mm and 0 mrad whatever the answer was, a teacher's audit: another scene);
-        on an elastic base the answer stays the same."""
+        on an elastic base under constant loads the answer stays the same."""
         loading = self.state.loading
         if event.new == loading.statement:  # (the selector following the state)
             return
