@@ -21,6 +21,12 @@ CHANGED_NOTE = ("<div class='cp-msg' style='font-size:13px'>You changed the scen
                 "back.</div>")
 
 
+#: A disabled "next" (before a lesson is chosen, at its last step) drawn grey: in the
+#: theme's primary colour, only lighter, it read as a button to press (a teacher's audit).
+DISABLED_GREY = (".bk-btn.bk-btn-primary:disabled {background-color: #d5d8dc !important; "
+                 "border-color: #d5d8dc !important; color: #4b5563 !important; opacity: 1;}")
+
+
 class LessonsView:
     """Choose a lesson, then go through its steps with next and previous."""
 
@@ -46,7 +52,8 @@ class LessonsView:
                                                  css_classes=["lesson-previous"])
         self.next_button = pn.widgets.Button(label="next ▶", disabled=True,
                                              color="primary",
-                                             css_classes=["lesson-next"])
+                                             css_classes=["lesson-next"],
+                                             stylesheets=[DISABLED_GREY])
         self.previous_button.on_click(lambda e: self.go(self.step - 1))
         self.next_button.on_click(lambda e: self.go(self.step + 1))
         self.lesson_note = html_pane("<small>A lesson loads a preset and changes a few "

@@ -132,8 +132,18 @@ def test_a_lesson_step_by_step_with_notes_and_pins(page: Page) -> None:
     page.open_tab("Lessons")
     select = page.page.locator(".lesson-select select").first
     select.wait_for(state="visible", timeout=30_000 * patience())
+    # next, disabled before a lesson is chosen, reads grey (it read as the theme's blue,
+    # only lighter: a button to press, a teacher's audit), and blue once it works
+    button = page.page.locator(".lesson-next button").first
+
+    def background() -> str:
+        return button.evaluate("b => getComputedStyle(b).backgroundColor")
+
+    if button.is_disabled():
+        assert background() == "rgb(213, 216, 220)"
     select.select_option(label="Force, eccentricity and tilt")
     until(lambda: "Step 1 of 4" in page.pane_text(".lesson-note"), "step 1")
+    assert background() != "rgb(213, 216, 220)"
     page.page.locator(".lesson-next button").first.click()
     until(lambda: page.text(".readout-force") == "1000", "step 2: the force doubled")
     until(lambda: "Step 2 of 4" in page.pane_text(".lesson-note"), "the note of step 2")
