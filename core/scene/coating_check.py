@@ -158,7 +158,8 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
     errors["pressure"] = float(np.max(np.abs(q_fast - q_fe)) / q_scale) if q_scale > 0 else 0.0
     # where q differs most [m] (beside an abrupt change of the coating the thin layer's q
     # jumps where the resolved one is smooth: 43 % at a 6x modulus step, the scalars 0.4 %)
-    pressure_at = float(x[int(np.argmax(np.abs(q_fast - q_fe)))])
+    worst = int(np.argmax(np.abs(q_fast - q_fe)))
+    pressure_at = float(x[worst])
     unknowns = [name for name in QUANTITIES if name not in scene.loading]
     return {
         "time_day": float(time),
@@ -167,6 +168,9 @@ def check_scene(scene: Scene | Mapping[str, Any], time: float = 0.0,
         "errors": errors,
         "model_error": max(abs(errors[name]) for name in unknowns),
         "pressure_error_at_m": pressure_at,
+        # the two pressures there [Pa] (a report's row read an error with empty values)
+        "pressure_fast_Pa": float(q_fast[worst]),
+        "pressure_fe_Pa": float(q_fe[worst]),
         "model_tol": scene.model_tol,
         "estimate": fast.info["model_error_estimate"],
         "coating_model": fast.info["coating_model"],

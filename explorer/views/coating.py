@@ -157,9 +157,14 @@ def check_report_html(report: dict[str, Any]) -> str:
         rows.append(f"<tr><td>{name} [{unit}]</td><td>{shown[0]:.5g}</td>"
                     f"<td>{shown[1]:.5g}</td><td>{error}</td></tr>")
     where = report.get("pressure_error_at_m")
-    rows.append("<tr><td>pressure, |x| &le; 0.9 a"
-                + ("" if where is None else f" (largest at x = {where:.4g} m)")
-                + f"</td><td></td><td></td><td>{100 * errors['pressure']:.3f}</td></tr>")
+    # q of each model where they differ most, in kPa (the cells were empty: an error
+    # beside no values, a teacher's audit)
+    at = [f"{v / 1e3:.5g}" if isinstance(v, (int, float)) else ""
+          for v in (report.get("pressure_fast_Pa"), report.get("pressure_fe_Pa"))]
+    rows.append("<tr><td>pressure q [kPa], |x| &le; 0.9 a"
+                + ("" if where is None else f" (at x = {where:.4g} m, where they differ most)")
+                + f"</td><td>{at[0]}</td><td>{at[1]}</td>"
+                f"<td>{100 * errors['pressure']:.3f}</td></tr>")
     caution = pressure_caution(report)
     return (
         f"<div class='coating-check-report'><small>At loading, against the resolved "

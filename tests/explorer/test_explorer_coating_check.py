@@ -127,9 +127,12 @@ def test_a_pressure_error_over_the_model_tolerance_is_said_with_where():
                      "moment": 4.5e-5},
               "model_error": 0.0039, "estimate": 0.0059, "coating_model": "thin layer",
               "half_width_m": 0.75, "given": ["settlement", "tilt"], "fe_dofs": 85803,
-              "fe_seconds": 1.1, "pressure_error_at_m": 0.15, "model_tol": 0.02}
+              "fe_seconds": 1.1, "pressure_error_at_m": 0.15, "model_tol": 0.02,
+              "pressure_fast_Pa": 1.52e6, "pressure_fe_Pa": 1.065e6}
     text = check_report_html(report)
-    assert "pressure, |x| &le; 0.9 a (largest at x = 0.15 m)" in text
+    # the two pressures there, in kPa (the cells were empty: an error beside no values)
+    assert ("pressure q [kPa], |x| &le; 0.9 a (at x = 0.15 m, where they differ most)"
+            "</td><td>1520</td><td>1065</td><td>42.750</td>") in text
     assert "check-pressure-caution" in text and "by 42.75 % at x = 0.15 m" in text
     assert "e-1" not in text
     report["errors"]["pressure"] = 0.01            # within the tolerance: nothing said
