@@ -41,6 +41,13 @@ Spec = float | dict[str, Any]
 # ----------------------------------------------------------------------------- validation
 
 
+#: :meth:`Profile.jump_points`: a jump changes the value by more than this share of the
+#: profile's largest magnitude across a point, read this share of the domain's size either
+#: side of it.
+JUMP_SHARE = 1e-6
+JUMP_PROBE = 1e-9
+
+
 def _json_type(value: Any) -> str:
     """The JSON name of a value's type, for messages read by scene-file authors."""
     if value is None:
@@ -197,6 +204,24 @@ class Profile(Immutable):
         low = self._domain[0] if lo is None else float(lo)
         high = self._domain[1] if hi is None else float(hi)
         return tuple(b for b in self._breakpoints if low < b < high)
+
+    def jump_points(self, lo: float | None = None,
+                    hi: float | None = None) -> tuple[float, ...]:
+        """The :meth:`nonsmooth_points` in ``(lo, hi)`` where the value itself jumps, not
+        only the slope: the change across the point, read :data:`JUMP_PROBE` of the
+        domain's size either side, is over :data:`JUMP_SHARE` of the profile's largest
+        magnitude on its :meth:`sample_points`, and holds as that distance grows tenfold
+        (a kink's change grows with it: a ramp of 14 days to 600 kN/m over 50 years
+        changed by 0.8 N/m across the probe, over the share, and read as a jump)."""
+        points = self.nonsmooth_points(lo, hi)
+        if not points:
+            return ()
+        b = np.asarray(points, dtype=float)
+        h = JUMP_PROBE * max(abs(self._domain[0]), abs(self._domain[1]), 1.0)
+        near = np.abs(self(b + h) - self(b - h))
+        far = np.abs(self(b + 10.0 * h) - self(b - 10.0 * h))
+        size = max(float(np.max(np.abs(self(self.sample_points())), initial=0.0)), 1e-300)
+        return tuple(float(v) for v in b[(near > JUMP_SHARE * size) & (near > 0.5 * far)])
 
     @property
     def variable(self) -> str:

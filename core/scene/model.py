@@ -39,11 +39,6 @@ _SAMPLE_EXTREMES = StageCache("sample_extremes", max_items=256, max_bytes=2**20)
 _LAYER_MODULUS_MAX = StageCache("layer_modulus_max", max_items=256, max_bytes=2**20)
 
 
-#: Either side of a breakpoint the gap is read this share of the half-width away, and a
-#: change over :data:`GAP_STEP_SHARE` of the gap's size (or the coating's thickness) is a
-#: step (a kink changes it by its slope times the probe: far less).
-GAP_STEP_PROBE = 1e-9
-GAP_STEP_SHARE = 1e-6
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,15 +129,9 @@ class Scene:
         """Points of (-a, a) [m] where the gap jumps: a step of the punch's base or of a
         coating's thickness, where a rigid corner presses into the coating (the thin
         coating model's springs bound q there; the resolved coating's is unbounded)."""
-        points = self.breakpoints
-        if not points:
-            return ()
-        b = np.asarray(points, dtype=float)
-        probe = GAP_STEP_PROBE * self.half_width
-        jump = np.abs(self.gap_variation(b + probe) - self.gap_variation(b - probe))
-        size = max(float(np.max(np.abs(self.gap_variation(self.sample_x)))),
-                   self.sample_extremes["coating_thickness_max_m"], 1e-300)
-        return tuple(float(v) for v in b[jump > GAP_STEP_SHARE * size])
+        a = self.half_width
+        parts = [self.shape] + [layer.thickness for layer in self.coating]
+        return tuple(sorted({b for part in parts for b in part.jump_points(-a, a)}))
 
     @cached_property
     def _geometry_key(self) -> str:

@@ -258,16 +258,6 @@ def _values(profile: Any, x: np.ndarray) -> np.ndarray:
     return np.broadcast_to(np.asarray(profile(x), dtype=float), x.shape).copy()
 
 
-#: A load's value jumps at one of its non-smooth points where it changes across it by more
-#: than this share of its largest magnitude at the output times, and by as much read ten
-#: times further away (a kink's change grows with the distance: a ramp of 14 days to 600
-#: kN/m changed by 0.8 N/m across the probe, over this share, and was drawn as a jump).
-JUMP_SHARE = 1e-6
-#: Before a non-smooth point a load is read this share of the last output time away, and
-#: ten times that (a step's value is its new one from its break on).
-JUMP_PROBE = 1e-9
-
-
 def load_jumps(loading: Mapping[str, Any], times: np.ndarray) -> tuple[float, ...]:
     """The times [day] in ``(times[0], times[-1]]`` where a given load of ``loading``
     (name -> load history of the time [day] after loading) jumps: every history jumps
@@ -278,20 +268,8 @@ def load_jumps(loading: Mapping[str, Any], times: np.ndarray) -> tuple[float, ..
     if times.size < 2:
         return ()
     lo, hi = float(times[0]), float(times[-1])
-    probe = JUMP_PROBE * max(hi, 1.0)
-    found: set[float] = set()
-    for profile in loading.values():
-        points = [b for b in getattr(profile, "nonsmooth_points", lambda lo, hi: ())(lo, hi)
-                  if lo < b <= hi]
-        if not points:
-            continue
-        b = np.asarray(points, dtype=float)
-        size = float(np.max(np.abs(_values(profile, times)), initial=0.0))
-        at = _values(profile, b)
-        near = np.abs(at - _values(profile, b - probe))
-        far = np.abs(at - _values(profile, b - 10.0 * probe))
-        jumps = (near > JUMP_SHARE * max(size, 1e-300)) & (near > 0.5 * far)
-        found.update(float(t) for t in b[jumps])
+    found = {b for profile in loading.values()
+             for b in profile.jump_points(lo, hi)}
     return tuple(sorted(found))
 
 
