@@ -229,6 +229,32 @@ class Model:
             columns.append(self._difference(x, f0, j, h[j]))
         return np.column_stack(columns)
 
+    def two_sided(self, x: Sequence[float], centre: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`jacobian` at ``x`` (``centre``: the values there) and the differences on
+        the other side of its steps, a column per field; a column of the second is NaN
+        where only one side is a point within the bounds that the solver accepts. Where
+        both are given, their mean is the central difference (error ~h^2 instead of ~h)
+        and half their difference measures the error of the one-sided one."""
+        x = np.asarray(x, dtype=float)
+        first = self.jacobian(x, centre)
+        h = self.steps(x)
+        other = np.full(first.shape, np.nan)
+        for j in range(len(x)):
+            sides = []
+            for step in (h[j], -h[j]):
+                xj = x.copy()
+                xj[j] += step
+                if not self.fields[j].x_bounds[0] <= xj[j] <= self.fields[j].x_bounds[1]:
+                    continue
+                try:
+                    sides.append((self.values(xj) - centre) / step)
+                except ValueError:
+                    continue
+            if len(sides) == 2:  # (the first side is what jacobian took)
+                other[:, j] = sides[1]
+        return first, other
+
     def _difference(self, x: np.ndarray, f0: np.ndarray, j: int, h: float) -> np.ndarray:
         """The one-sided difference of :meth:`values` along coordinate ``j``: the other
         side where the scene refuses the step's point (the answer sits at the edge of

@@ -227,9 +227,11 @@ class Calibration:
     @property
     def chi2_per_dof(self) -> float:
         """chi^2 over the degrees of freedom (readings minus fitted fields): near 1 when
-        the stated standard deviations match the scatter; the squared scatter in units of
-        the largest reading when no deviations are given."""
-        return self.chi2 / self.dof
+        the stated standard deviations match the scatter. NaN when no deviations are
+        given: the noise is then estimated from the scatter (:attr:`noise`), which makes
+        chi^2/dof 1 by construction, and the weights' scale is arbitrary (it read
+        0.0006, as if the model fitted far too well)."""
+        return self.chi2 / self.dof if self.std_given else math.nan
 
     @property
     def identifiable(self) -> bool:
@@ -327,10 +329,12 @@ class Calibration:
             "correlation": [[None if not math.isfinite(v) else float(v) for v in row]
                             for row in corr],
             "goodness_of_fit": {
-                "chi2": self.chi2, "dof": self.dof, "chi2_per_dof": self.chi2_per_dof,
+                # no chi^2 without deviations (chi2_per_dof)
+                "chi2": self.chi2 if self.std_given else None, "dof": self.dof,
+                "chi2_per_dof": self.chi2_per_dof if self.std_given else None,
                 "covariance": "(J^T J)^-1, the readings' standard deviations"
-                if self.std_given else "s^2 (J^T J)^-1, s^2 = chi2/dof (noise estimated "
-                                       "from the residuals)",
+                if self.std_given else "s^2 (J^T J)^-1, s^2 = the residuals' sum of "
+                                       "squares / dof (noise estimated from them)",
                 "noise": self.noise,
                 "condition_number": self.condition if math.isfinite(self.condition)
                 else None,
@@ -372,9 +376,10 @@ class Calibration:
             lines.append("correlations: " + "; ".join(pairs))
         noise = ", ".join(f"{name} {v:.3g} {SERIES_UNITS[name]}"
                           for name, v in self.noise.items())
-        lines.append(f"chi^2/dof = {self.chi2_per_dof:.3g} ({self.dof} dof); noise "
-                     f"{'given' if self.std_given else 'estimated from the residuals'}: "
-                     f"{noise}; solver error / noise = {self.solver_error_to_noise:.2g}")
+        lines.append((f"chi^2/dof = {self.chi2_per_dof:.3g} ({self.dof} dof); noise given: "
+                      if self.std_given else
+                      f"noise estimated from the scatter about the fit ({self.dof} dof): ")
+                     + f"{noise}; solver error / noise = {self.solver_error_to_noise:.2g}")
         for name in self.readings.series:
             rms = float(np.sqrt(np.nanmean(self.residuals[name] ** 2)))
             lines.append(f"rms residual of {name}: {rms:.3g} {SERIES_UNITS[name]}")

@@ -221,9 +221,14 @@ def calibration_section(calibration: Any) -> Section:
             value = float(corr[j, k])
             rows.append((f"correlation {paths[j]} ~ {paths[k]}",
                          f"{value:+.3f}" if np.isfinite(value) else "not finite"))
-    rows.append(("χ²/dof", f"{calibration.chi2_per_dof:.3g} ({calibration.dof} dof); "
-                           + ("the readings' standard deviations" if calibration.std_given
-                              else "noise estimated from the scatter about the fit")))
+    if calibration.std_given:
+        rows.append(("χ²/dof", f"{calibration.chi2_per_dof:.3g} ({calibration.dof} dof); "
+                               "the readings' standard deviations"))
+    else:  # no chi^2 without deviations (Calibration.chi2_per_dof)
+        noise = ", ".join(f"{name} {number_text(v, 3)} {SERIES_SI[name]}"
+                          for name, v in calibration.noise.items())
+        rows.append(("noise", f"estimated from the scatter about the fit "
+                              f"({calibration.dof} dof): {noise}"))
     warned = bool(calibration.warnings)
     lead = (f"{len(paths)} field(s) fitted to the readings (weighted least squares; "
             "standard errors from the linearised covariance)."

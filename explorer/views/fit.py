@@ -275,8 +275,8 @@ def outcome_html(outcome: FitOutcome) -> str:
              f"<tr><th>field</th><th>fitted value ± standard error</th>"
              f"<th>{100 * BAND_LEVEL:g} % interval</th></tr>{rows}</table>",
              f"<div style='font-size:12px'>{c.readings.count} readings, "
-             f"χ²/dof = {c.chi2_per_dof:.3g} ({c.dof} dof); standard errors from "
-             f"{noise}.</div>"]
+             + (f"χ²/dof = {c.chi2_per_dof:.3g} ({c.dof} dof); " if c.std_given else "")
+             + f"standard errors from {noise}.</div>"]
     pairs = outcome.correlations()
     if pairs:
         parts.append("<div style='font-size:12px'>correlations: " + "; ".join(

@@ -403,3 +403,108 @@ def test_a_scene_of_one_punch_written_as_punches_is_refused_saying_how_to_write_
     assert str(info.value) == ("scene: is written in the form of several punches (punches); "
                                "a fit takes a scene of one punch written with punch and "
                                "loading")
+
+
+#: Readings of the shipped creeping coating at seven times, 1 µm of noise.
+FLAT_TIMES = [1.0, 3.0, 10.0, 30.0, 100.0, 200.0, 365.0]
+
+
+def _flat_readings(truth: dict, seed: int) -> dict:
+    scene = apply_point(core.load_scene("preset:uniform_flat").to_dict(), truth)
+    scene["times"] = FLAT_TIMES
+    exact = core.solve(scene)
+    rng = np.random.default_rng(seed)
+    return {"time": FLAT_TIMES,
+            "settlement": (exact.settlement + 1e-6 * rng.standard_normal(7)).tolist()}
+
+
+def test_the_fitted_value_does_not_depend_on_the_overall_size_of_the_deviations() -> None:
+    """Scaling every deviation by one factor moves no least-squares minimum. The
+    solver's gradient test was absolute: from a creep rate 1000 times too fast (a flat
+    start), no deviations (weights of the largest reading, 44 µm) or 44 µm stopped the
+    fit at its start, rate 50 +/- 1e11, while 1 µm found 0.047."""
+    readings = _flat_readings({"base.creep.rate": 0.05}, 9)
+    start = apply_point(core.load_scene("preset:uniform_flat").to_dict(),
+                        {"base.creep.rate": 50.0})
+    fits = {std: calibrate(start, readings if std is None else {**readings,
+                                                                 "settlement_std": std},
+                           fit=["base.creep.rate"]) for std in (None, 1e-6, 4.4e-5)}
+    rate = "base.creep.rate"
+    ref = fits[1e-6]
+    assert ref.values[rate] == pytest.approx(0.0471, abs=1e-4)
+    for std, fit in fits.items():
+        # each stops within STEP_TO_SE = 1e-3 of its standard error of the minimum
+        assert abs(fit.values[rate] - ref.values[rate]) <= 1e-3 * (
+            fit.standard_errors[rate] + ref.standard_errors[rate])
+        if std is not None:
+            # the covariance scales with the deviations squared (measured 0.45 % apart:
+            # the linearisation taken at points 1e-3 standard errors apart)
+            assert fit.standard_errors[rate] == pytest.approx(
+                ref.standard_errors[rate] * std / 1e-6, rel=0.02)
+    # the noise estimated from the scatter (7 draws of 1 µm) gives a like error
+    assert fits[None].standard_errors[rate] == pytest.approx(ref.standard_errors[rate],
+                                                             rel=0.3)
+
+
+def test_a_field_the_readings_fix_is_not_flagged_for_its_small_influence() -> None:
+    """The base's Poisson ratio moves the settlement little (a 0.1 % step of it moves no
+    reading by 100 times the solver's tolerance, the old test), yet the readings fix it
+    to 14 %: the differences on either side of the step agree to 1e-3 of it (measured),
+    so its derivative and its standard error hold."""
+    readings = _flat_readings({}, 7)
+    start = apply_point(core.load_scene("preset:uniform_flat").to_dict(),
+                        {"base.poisson": 0.3})
+    fit = calibrate(start, {**readings, "settlement_std": 1e-6}, fit=["base.poisson"])
+    assert fit.identifiable and not fit.warnings, fit.warnings
+    low, high = fit.intervals()["base.poisson"]
+    assert low < 0.2 < high
+
+
+def test_a_field_whose_derivative_is_noise_is_flagged_with_its_measured_spread(
+        monkeypatch) -> None:
+    """Where the two sides of a step disagree (here, noise of 1e-5 of the settlement
+    added to every solve, as an unresolved solver would give), the field is flagged with
+    the measured disagreement, not a bound."""
+    from core.back_analysis import model as model_module
+
+    readings = _flat_readings({}, 7)
+    start = apply_point(core.load_scene("preset:uniform_flat").to_dict(),
+                        {"base.poisson": 0.3})
+    values = model_module.Model.values
+    rng = np.random.default_rng(3)
+
+    def noisy(self, x):
+        v = values(self, x)
+        return v * (1.0 + 1e-5 * rng.standard_normal(v.shape))
+
+    monkeypatch.setattr(model_module.Model, "values", noisy)
+    fit = calibrate(start, {**readings, "settlement_std": 1e-6}, fit=["base.poisson"])
+    assert any(w.startswith("base.poisson: its derivative is not resolved: the "
+                            "differences on either side of a step of 0.001 disagree by")
+               for w in fit.warnings), fit.warnings
+    assert not fit.identifiable
+
+
+def test_no_chi2_is_shown_where_the_noise_is_estimated_from_the_scatter() -> None:
+    """Without deviations the weights' scale is arbitrary (the largest reading) and the
+    estimated noise makes chi^2/dof 1 by construction: it read 0.0006, as if the model
+    fitted far too well. The estimated noise is shown instead; with deviations chi^2/dof
+    tests them."""
+    from core.report.content import calibration_section
+
+    readings = _flat_readings({}, 7)
+    estimated = calibrate("preset:uniform_flat", readings, fit=["base.creep.rate"])
+    assert np.isnan(estimated.chi2_per_dof)
+    assert "chi^2" not in estimated.summary()
+    assert "noise estimated from the scatter about the fit (6 dof): settlement " in (
+        estimated.summary())
+    goodness = estimated.to_dict()["goodness_of_fit"]
+    assert goodness["chi2"] is None and goodness["chi2_per_dof"] is None
+    rows = dict(calibration_section(estimated).rows)
+    assert "χ²/dof" not in rows and rows["noise"].startswith("estimated from the scatter")
+    stated = calibrate("preset:uniform_flat", {**readings, "settlement_std": 1e-6},
+                       fit=["base.creep.rate"])
+    assert 0.1 < stated.chi2_per_dof < 3.0  # 7 readings of the stated 1 µm noise
+    assert stated.to_dict()["goodness_of_fit"]["chi2_per_dof"] == stated.chi2_per_dof
+    assert f"chi^2/dof = {stated.chi2_per_dof:.3g} (6 dof)" in stated.summary()
+    assert "χ²/dof" in dict(calibration_section(stated).rows)
