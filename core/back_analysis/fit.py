@@ -28,7 +28,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import OptimizeResult, least_squares
 
 from core.back_analysis.model import FD_STEP, FIT_SOLVER_TOL, Field, Model, fitted_fields
 from core.back_analysis.readings import Readings, as_readings
@@ -102,6 +102,9 @@ SETTLED_DETERMINED = (f"the Gauss-Newton step along each combination of the fiel
                       f"the readings determine is below {STEP_TO_SE:g} of its standard "
                       "error (relative offset); the readings do not determine the others")
 
+#: The fit's status when no fitted field moves any reading at its start.
+NOTHING_MOVES = "no fitted field moves any reading at the start: nothing to fit"
+
 
 def reading_times(readings: Readings) -> list[float]:
     """The readings' times [day after loading], the output times of the fit's solves."""
@@ -136,8 +139,12 @@ def _working_scene(scene: Scene | Mapping[str, Any] | str | os.PathLike,
     try:
         scene_from_dict(at_output_times(work, reading_times(readings)))
     except ValueError as exc:
+        text = str(exc)
+        if text.startswith("times["):  # the scene's output times are the readings'
+            raise ValueError(f"measurements: time{text.removeprefix('times')}: the scene "
+                             "cannot be solved at this reading's time") from None
         raise ValueError(f"measurements: the scene cannot be solved at the reading times "
-                         f"({exc})") from None
+                         f"({text})") from None
     return base, work
 
 
@@ -270,13 +277,22 @@ def calibrate(scene: Scene | Mapping[str, Any] | str | os.PathLike,
     # of a field fitted by its logarithm, the start's size of another) instead of the
     # size of the logarithm of an SI value (~20-40): a first step along a direction the
     # readings hardly see took a 20 mm coating to 20 km.
-    answer = least_squares(lambda z: residuals(x0 + z), np.zeros_like(x0),
-                           jac=lambda z: jacobian(x0 + z), bounds=(lo - x0, hi - x0),
-                           method="trf", x_scale=1.0, xtol=X_TOL, ftol=F_TOL, gtol=None,
-                           max_nfev=max_nfev,
-                           **({"callback": lambda intermediate_result: settled(
-                               x0 + intermediate_result.x, intermediate_result.fun)}
-                              if STOPS_SETTLED else {}))
+    if not np.any(jacobian(x0)):
+        # no field moves any reading (the tilt of a centred punch): nothing to fit, and
+        # the trust region would divide 0 by 0 (the warnings below say why)
+        answer = OptimizeResult(x=np.zeros_like(x0), success=True, status=0, nfev=1,
+                                message=NOTHING_MOVES)
+    else:
+        # (numpy's warnings inside the solver on a partly degenerate Jacobian: the
+        # warnings below speak of it in the fit's words)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            answer = least_squares(
+                lambda z: residuals(x0 + z), np.zeros_like(x0),
+                jac=lambda z: jacobian(x0 + z), bounds=(lo - x0, hi - x0), method="trf",
+                x_scale=1.0, xtol=X_TOL, ftol=F_TOL, gtol=None, max_nfev=max_nfev,
+                **({"callback": lambda intermediate_result: settled(
+                    x0 + intermediate_result.x, intermediate_result.fun)}
+                   if STOPS_SETTLED else {}))
     if answer.status == -2:  # SciPy's status of a stop by the callback: settled
         answer.success = True
         answer.message = SETTLED_DETERMINED if stopped_determined else SETTLED
@@ -368,9 +384,11 @@ def _covariance(J: np.ndarray, s2: float) -> tuple[np.ndarray, float]:
     inv = np.where(sv > tiny, 1.0 / np.where(sv > tiny, sv, 1.0) ** 2, np.inf)
     # (readings that no field moves, a tilt of a centred punch: J = 0, tiny = 0 and the
     # covariance infinite, as the warnings say; no numpy warning on the way)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         cov_n = (vt.T * np.where(np.isfinite(inv), inv, 1.0 / tiny ** 2)) @ vt
-    cov = s2 * cov_n / np.outer(safe, safe)
+        cov = s2 * cov_n / np.outer(safe, safe)
+    # readings met exactly (s2 = 0) by a field they do not see: 0 * inf, not determined
+    cov[np.isnan(cov)] = np.inf
     cov[:, norms == 0] = np.inf
     cov[norms == 0, :] = np.inf
     return cov, condition

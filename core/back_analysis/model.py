@@ -110,6 +110,10 @@ def fitted_fields(base: Mapping[str, Any], fit: Any, bounds: Any) -> tuple[Field
     for i, path in enumerate(fit):
         start = number_at(base, path, f"fit[{i}]", "fitted",
                           "the output times are the readings' times")
+        if path.split(".", 1)[0] == "solver":
+            raise ValueError(f"fit[{i}]: {path!r} cannot be fitted (the solver's settings "
+                             "are not a property of the foundation: the readings say "
+                             "nothing of them)")
         if path in fit[:i]:
             raise ValueError(f"fit[{i}]: {path!r} is fitted twice")
         lo, hi = _bound_pair(bounds[path], f"bounds[{path}]") if path in bounds \
@@ -117,12 +121,13 @@ def fitted_fields(base: Mapping[str, Any], fit: Any, bounds: Any) -> tuple[Field
         if not lo <= start <= hi:
             raise ValueError(f"bounds[{path}]: the scene's value {start:.6g} (the start "
                              f"of the fit) is outside [{lo:.6g}, {hi:.6g}]")
+        for end, name in ((lo, "lower"), (hi, "upper")):
+            if start == end:
+                raise ValueError(f"bounds[{path}]: the start {start:.6g} is at the {name} "
+                                 "bound; start inside the bounds")
         log = start > 0 and (lo >= 0 or path not in bounds)
         if log:
             lo = max(lo, 0.0)
-            if start == lo:
-                raise ValueError(f"bounds[{path}]: the start {start:.6g} is at the lower "
-                                 "bound; start inside the bounds")
             scale = 1.0
         elif start != 0:
             scale = abs(start)

@@ -230,6 +230,10 @@ def readings_from_mapping(data: Mapping[str, Any], source: str = "readings") -> 
         if key not in data:
             continue
         value = data[key]
+        if hasattr(value, "__array__") and not isinstance(value, (str, bytes)):
+            # an array of any kind (numpy's 0-d array for one deviation, a table's column)
+            value = np.asarray(value)
+            value = value.item() if value.ndim == 0 else value
         unit = units.get(key, units.get(key.removesuffix("_std")))
         if unit is not None and not isinstance(unit, str):
             raise ValueError(f"units.{key}: must be a unit name, got {show_value(unit)}")

@@ -143,11 +143,23 @@ def test_a_degenerate_pair_stops_once_the_combination_the_readings_fix_has_settl
      "bounds[loading.moment]: not one of the fitted fields"),
     ({"fit": ["loading.force"], "bounds": {"loading.force": (5, 1)}},
      "bounds[loading.force]: high (1) must exceed low (5)"),
+    # the solver's tolerance read "solver.tol = 7.77e-07 +/- 31"
+    ({"fit": ["solver.tol"]}, "fit[0]: 'solver.tol' cannot be fitted (the solver's"),
+    # a start at the lower bound was refused and one at the upper bound taken
+    ({"fit": ["loading.force"], "bounds": {"loading.force": (2e5, 3e5)}},
+     "bounds[loading.force]: the start 200000 is at the lower bound"),
+    ({"fit": ["loading.force"], "bounds": {"loading.force": (1e5, 2e5)}},
+     "bounds[loading.force]: the start 200000 is at the upper bound"),
+    # a reading past the scene's last time was named as one of the scene's times
+    ({"fit": ["loading.force"], "measurements": {"time": [10.0, 20.0, 2e5],
+                                                 "settlement": [1e-3, 1.1e-3, 1.2e-3]}},
+     "measurements: time[2]: must be <= 100000 days after loading"),
 ])
 def test_bad_fits_are_named(kwargs: dict, message: str) -> None:
-    readings = {"time": [10.0, 20.0, 30.0], "settlement": [1e-3, 1.1e-3, 1.2e-3]}
+    kwargs = {"measurements": {"time": [10.0, 20.0, 30.0],
+                               "settlement": [1e-3, 1.1e-3, 1.2e-3]}} | kwargs
     with pytest.raises(ValueError) as info:
-        calibrate(SCENE, readings, **kwargs)
+        calibrate(SCENE, **kwargs)
     assert str(info.value).startswith(message), str(info.value)
 
 
@@ -508,3 +520,43 @@ def test_no_chi2_is_shown_where_the_noise_is_estimated_from_the_scatter() -> Non
     assert stated.to_dict()["goodness_of_fit"]["chi2_per_dof"] == stated.chi2_per_dof
     assert f"chi^2/dof = {stated.chi2_per_dof:.3g} (6 dof)" in stated.summary()
     assert "χ²/dof" in dict(calibration_section(stated).rows)
+
+
+def test_one_deviation_as_a_numpy_scalar_or_a_column_as_an_array_like_is_taken() -> None:
+    """``settlement_std=np.array(1e-6)`` raised TypeError (len() of unsized object); a
+    table's column (anything numpy reads as an array) was refused with its whole text."""
+
+    class Column:  # a table library's column: not a list, read through __array__
+        def __init__(self, values):
+            self.values = values
+
+        def __array__(self, dtype=None, copy=None):
+            return np.asarray(self.values, dtype=dtype)
+
+    readings = _flat_readings({}, 7)
+    plain = calibrate("preset:uniform_flat", {**readings, "settlement_std": 1e-6},
+                      fit=["base.creep.rate"])
+    arrays = calibrate("preset:uniform_flat",
+                       {"time": Column(readings["time"]),
+                        "settlement": Column(readings["settlement"]),
+                        "settlement_std": np.array(1e-6)}, fit=["base.creep.rate"])
+    assert arrays.values == plain.values and arrays.standard_errors == plain.standard_errors
+
+
+def test_readings_no_field_moves_give_warnings_and_no_numpy_warning() -> None:
+    """The tilts of a centred punch are zero whatever its creep: no field moves them. The
+    fit returned its start with warnings, and numpy's "invalid value" warnings leaked
+    from the covariance (0 * inf) and from the trust region (0 / 0)."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for tilts in ([0.0, 0.0, 0.0], [1e-6, 0.0, 0.0]):
+            fit = calibrate("preset:uniform_flat", {"time": [1.0, 10.0, 100.0],
+                                                    "tilt": tilts},
+                            fit=["base.creep.modulus"])
+            assert fit.values["base.creep.modulus"] == pytest.approx(3e10, rel=1e-12)
+            assert fit.standard_errors["base.creep.modulus"] == np.inf
+            assert not fit.identifiable
+            assert "base.creep.modulus: a step of 0.001 either way in its logarithm " \
+                   "changes no reading: the readings do not depend on it" in fit.warnings
