@@ -432,12 +432,17 @@ def solve_punches_scene(scene: Mapping[str, Any] | PunchesScene) -> PunchesSolut
         punches = [PunchSolution(scene.scenes[0], scene.centers[0], solution)]
     else:
         geometries, inputs = [], []
+        # the engine sees each punch in its own coordinates and the others by their
+        # distances: centres taken from the first punch's, so that the distances are not
+        # differences of large numbers (centres at 1e9 m moved the tilts by 8e-9, over
+        # an estimate of 2.5e-9)
+        origin = scene.centers[0]
         for sub, center in zip(scene.scenes, scene.centers, strict=True):
             problem = sub.dimensionless
             geometries.append(PunchGeometry(
                 validate_geometry(problem.lam, problem.m, problem.g, problem.breakpoints,
                                   problem.tol),
-                center / sub.base_thickness))
+                (center - origin) / sub.base_thickness))
             inputs.append(validate_time_inputs(problem.times, problem.c, problem.kernel,
                                                {q: problem.loads.get(q) for q in
                                                 ("settlement", "tilt", "force", "moment")}))

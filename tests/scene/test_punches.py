@@ -76,6 +76,24 @@ def test_the_contact_set_is_in_the_global_x() -> None:
                                result.punches[1].pressure([0.0]))
 
 
+def test_a_pair_far_from_the_origin_answers_as_the_same_pair_at_it() -> None:
+    """The engine takes the punches' distances from the first one's centre: taken as
+    differences of the global centres, a pair at 1e9 m moved its tilts by 8.4e-9 (the
+    estimate 2.5e-9, tol 1e-8), and at 1e15 m by 1 %."""
+    # (centres 0 and 2 m: shifted by these origins they stay exact in binary)
+    near = core.solve(_pair(0.5, tol=1e-8, widths=(1.0, 0.5)))
+    for origin in (1e9, -1e15):
+        d = _pair(0.5, tol=1e-8, widths=(1.0, 0.5))
+        for punch in d["punches"]:
+            punch["center"] += origin
+        far = core.solve(d)
+        for k in range(2):
+            for q in QUANTITIES:  # the same arithmetic: the same bits
+                np.testing.assert_array_equal(getattr(far.punches[k], q),
+                                              getattr(near.punches[k], q), err_msg=q)
+            assert far.punches[k].center == near.punches[k].center + origin
+
+
 def test_elastic_reciprocity() -> None:
     """Maxwell-Betti: the flexibility of the pair (settlement and tilt of each punch per
     unit force and moment on each) is symmetric."""
