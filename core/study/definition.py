@@ -37,6 +37,7 @@ from core.scene import (
     PunchesScene,
     Scene,
     check_fields,
+    check_loads_touch,
     has_punches,
     integer_in_range,
     load_scene,
@@ -233,7 +234,14 @@ def _grid(kind: str, spec: Any, field: str) -> tuple[float, ...]:
                              f"{show_value(spec)}")
         if len(spec) > MAX_STUDY_POINTS:
             raise ValueError(f"{field}: at most {MAX_STUDY_POINTS} values, got {len(spec)}")
-        return tuple(finite_number(v, f"{field}[{i}]") for i, v in enumerate(spec))
+        values = tuple(finite_number(v, f"{field}[{i}]") for i, v in enumerate(spec))
+        first: dict[float, int] = {}
+        for j, v in enumerate(values):
+            if v in first:
+                raise ValueError(f"{field}[{j}]: repeats {field}[{first[v]}] "
+                                 f"({show_value(v)}): equal points would repeat one solve")
+            first[v] = j
+        return values
     check_fields(spec, field, ("start", "stop", "count"))
     count = _count(spec["count"], f"{field}.count")
     if kind == "linspace":
@@ -247,6 +255,10 @@ def _grid(kind: str, spec: Any, field: str) -> tuple[float, ...]:
     if count > 1 and lo == hi:
         raise ValueError(f"{field}.stop: equals start ({show_value(lo)}): {count} equal "
                          "points would repeat one solve")
+    if count == 1 and lo != hi:
+        raise ValueError(f"{field}.count: 1 point is start alone, and stop "
+                         f"({show_value(hi)}) would be ignored; give a count of 2 or more, "
+                         f"or values: [{show_value(lo)}]")
     return tuple(float(v) for v in grid)
 
 
@@ -346,9 +358,15 @@ def validated_scene(d: Mapping[str, Any]) -> Scene | PunchesScene:
 
 def _base_scene(spec: Any, base_dir: Path | None) -> dict[str, Any]:
     if isinstance(spec, str):
-        if base_dir is None:
-            raise ValueError("scene: a scene file path needs the study's directory (use "
-                             "load_study, or give the scene inline)")
+        if spec.startswith("preset:"):  # as load_scene and the commands read it
+            try:
+                return load_scene(spec).to_dict()
+            except ValueError as exc:
+                raise ValueError(f"scene: {exc}") from None
+        if base_dir is None and not os.path.isabs(spec):
+            raise ValueError("scene: a relative scene file path needs the study's "
+                             "directory (use load_study, give an absolute path or "
+                             "preset:NAME, or give the scene inline)")
         path = Path(spec) if os.path.isabs(spec) else base_dir / spec
         try:
             return load_scene(path).to_dict()
@@ -410,12 +428,15 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
                          + (f"{len(vary)}" if isinstance(vary, (list, tuple))
                             else show_value(vary)))
     params = tuple(_parameter(spec, f"vary[{i}]", base) for i, spec in enumerate(vary))
-    seen: dict[str, int] = {}
+    # one field however its path is spelt (coating[00] is coating[0]): the later value
+    # would overwrite the earlier one, whose column would then name values never solved
+    seen: dict[tuple[str | int, ...], int] = {}
     for i, p in enumerate(params):
-        if p.path in seen:
+        parts = parse_path(p.path)
+        if parts in seen:
             raise ValueError(f"vary[{i}].field: {p.path!r} is already varied by "
-                             f"vary[{seen[p.path]}]")
-        seen[p.path] = i
+                             f"vary[{seen[parts]}] (as {params[seen[parts]].path!r})")
+        seen[parts] = i
 
     random = any(not p.is_grid for p in params)
     if random and "samples" not in d:
@@ -435,7 +456,9 @@ def study_from_dict(d: Mapping[str, Any], base_dir: str | os.PathLike | None = N
     for i, p in enumerate(params):
         for where, value in _extremes(p):
             try:
-                validated_scene(apply_point(base, {p.path: value}))
+                # the loads as a solve checks them too (a pulled punch, a resultant
+                # outside the base): validate said "ok" to grids every solve refuses
+                check_loads_touch(validated_scene(apply_point(base, {p.path: value})))
             except ValueError as exc:
                 raise ValueError(f"vary[{i}].{where}: the scene is invalid at {p.path} = "
                                  f"{value:.6g} ({exc})") from None

@@ -342,10 +342,15 @@ def _counts(parts: WorkDir, n_batches: int) -> dict[str, int]:
 
 
 def check_output(path: Path) -> None:
-    """Refuse an output path whose extension is not ``.nc``, ``.csv`` or ``.parquet``."""
+    """Refuse an output path whose extension is not ``.nc``, ``.csv`` or ``.parquet``, or
+    whose directory does not exist (a mistyped one was created, with the study's parts
+    beside the output)."""
     if path.suffix.lower() not in (".nc", ".csv", ".parquet"):
         raise ValueError(f"output: unsupported extension {path.suffix!r} (use .nc, .csv or "
                          ".parquet)")
+    if not path.parent.is_dir():
+        raise ValueError(f"output: the directory {str(path.parent)!r} does not exist (create "
+                         "it first, or choose another path)")
 
 
 def _variable_name(path: str) -> str:

@@ -279,19 +279,26 @@ def test_a_link_keeps_the_study_settings(explorer_app):
 
 
 def test_a_failed_point_says_why_on_the_page(explorer_app):
-    """A force from -100 to 750 kN/m: the summary said "1 failed (no value)" and no more;
-    it now gives the failed point's reason."""
+    """A force from 100 kN/m with a moment of 300 kN m/m (the eccentricity then 3 m, off
+    the 2 m base) to 750: the summary said "1 failed (no value)" and no more; it now
+    gives the failed point's reason. An axis whose end no solve takes (a force from
+    -100 kN/m, a punch pulled away) is not run at all, saying why."""
     app = explorer_app(scene=screen_scene())
     tab = app.study_tab
     tab.study_first.fill(Axis("loading.force", -100.0, 750.0, 3))
+    assert not tab.start()
+    said = html.unescape(tab.study_status.object)
+    assert "Not run: " in said and "the punch is pulled away" in said, said
+    tab.study_first.fill(Axis("loading.force", 100.0, 750.0, 3))
+    tab.study_second.field.value = "loading.moment"
+    tab.study_second.fill(Axis("loading.moment", 0.0, 300.0, 2))
     assert tab.start()
     assert tab.study_run.wait(300)
     assert tab.study_run.status == "done", tab.study_run.message
     assert int(tab.study_run.result.failed.sum()) == 1
     said = html.unescape(tab.study_status.object)
     assert "1 failed (no value). Failed: " in said, said
-    assert "Failed: Loading, force (loading.force): the punch is pulled away (P = -100 kN/m" \
-        in said, said
+    assert "Failed: Loading, moment (loading.moment): the eccentricity" in said, said
 
 
 def test_the_creep_coefficients_are_offered_and_vary_the_scene():

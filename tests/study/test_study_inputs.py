@@ -57,3 +57,69 @@ def test_study_output_names_of_any_type_are_refused_by_name(output) -> None:
     # a list inside "outputs" made an unhashable-type TypeError before the fix
     with pytest.raises(ValueError, match=r"^outputs\[1\]: unknown output"):
         study_from_dict(_study(outputs=["settlement", output]))
+
+
+def _liftoff_study(vary: list) -> dict[str, Any]:
+    return {"study_version": 1, "name": "audit", "scene": "preset:eccentric_footing_liftoff",
+            "vary": vary}
+
+
+@pytest.mark.parametrize(("vary", "message"), [
+    # two spellings of one field: the second overwrote the first, whose column then named
+    # values never solved (a 2e8 Pa modulus shown with the settlement of 4e8)
+    ([{"field": "coating[0].modulus", "values": [2e8, 8e8]},
+      {"field": "coating[00].modulus", "values": [4e8, 3.2e9]}],
+     "vary[1].field: 'coating[00].modulus' is already varied by vary[0] (as "
+     "'coating[0].modulus')"),
+    # loads every solve refuses passed validation ("ok: 2 points"), failing only when run
+    ([{"field": "loading.force", "values": [-1e5, 8e5]}],
+     "vary[0].values: the scene is invalid at loading.force = -100000 (loading.force: the punch is "
+     "pulled away"),
+    ([{"field": "loading.moment", "values": [0.0, 9e5]}],
+     "vary[0].values: the scene is invalid at loading.moment = 900000 (loading.moment: the "
+     "eccentricity"),
+    ([{"field": "punch.half_width", "values": [0.5, 1.0]}],
+     "vary[0].values: the scene is invalid at punch.half_width = 0.5 (loading.moment: the "
+     "eccentricity"),
+    # a grid that says less than it reads
+    ([{"field": "loading.force", "linspace": {"start": 1e5, "stop": 5e5, "count": 1}}],
+     "vary[0].linspace.count: 1 point is start alone, and stop (500000) would be ignored"),
+    ([{"field": "loading.force", "values": [1e5, 1e5, 2e5]}],
+     "vary[0].values[1]: repeats vary[0].values[0] (100000): equal points would repeat"),
+])
+def test_a_study_that_would_solve_other_points_than_it_names_is_refused(vary, message) -> None:
+    with pytest.raises(ValueError) as info:
+        study_from_dict(_liftoff_study(vary))
+    assert str(info.value).startswith(message), str(info.value)
+
+
+def test_a_study_takes_its_scene_as_a_preset_or_an_absolute_path(tmp_path) -> None:
+    """``"scene": "preset:NAME"`` read as a file name ("No such file or directory"),
+    although the commands and core.solve take it; an absolute path needed a directory."""
+    import json
+
+    import core
+
+    vary = [{"field": "loading.force", "values": [6e5, 8e5]}]
+    by_name = study_from_dict(_liftoff_study(vary))
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(core.load_scene("preset:eccentric_footing_liftoff").to_dict()))
+    by_path = study_from_dict({**_liftoff_study(vary), "scene": str(path)})
+    assert by_name.key == by_path.key and by_name.n_points == 2
+    with pytest.raises(ValueError, match=r"^scene: preset:nope: no shipped scene"):
+        study_from_dict({**_liftoff_study(vary), "scene": "preset:nope"})
+    with pytest.raises(ValueError, match=r"^scene: a relative scene file path needs"):
+        study_from_dict({**_liftoff_study(vary), "scene": "scene.json"})
+
+
+def test_an_output_in_a_directory_that_does_not_exist_is_refused(tmp_path) -> None:
+    """A mistyped directory was created (``-o /nonexist/x.csv`` made /nonexist)."""
+    from pathlib import Path
+
+    from core.study import check_output
+
+    with pytest.raises(ValueError, match=r"^output: the directory '.*missing' does not "):
+        check_output(tmp_path / "missing" / "x.csv")
+    assert not (tmp_path / "missing").exists()
+    check_output(tmp_path / "x.csv")
+    check_output(Path("x.csv"))  # the working directory
