@@ -79,8 +79,17 @@ FIELD_UNITS: dict[str, str] = {
     "poisson": "1", "age_at_loading": "day", "force": "N/m", "moment": "N",
     "settlement": "m", "tilt": "rad", "tol": "1", "rate": "1/day", "compliance": "1/Pa",
     "compliance_final": "1/Pa", "aging": "day/Pa", "relative_humidity": "%",
-    "notional_size": "mm", "temperature": "degC",
+    "notional_size": "mm", "temperature": "degC", "shape": "m", "alpha": "1/day",
+    "beta": "1", "fcm": "MPa", "model_tol": "1",
 }
+#: The fields whose value may be a profile object: its numbers' units follow from the
+#: field's (:func:`field_unit`).
+PROFILED = ("shape", "thickness", "modulus", "poisson", "force", "moment", "settlement",
+            "tilt")
+#: A profile's numbers in the profiled field's unit, and those that are positions (m
+#: along the surface, days in time for a load; core/profiles/build.py FAMILIES).
+PROFILE_VALUES = ("value", "start", "end", "values", "mean", "amplitude")
+PROFILE_POSITIONS = ("breaks", "wavelength", "center", "width", "duration")
 #: One part of a field path: a name and its list items (``coating[0]``).
 PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d{1,4}\])*)")
 
@@ -202,9 +211,33 @@ def output_unit(name: str) -> str:
 
 
 def field_unit(path: str) -> str:
-    """The unit of the scene field at ``path`` (:data:`FIELD_UNITS`; "" when unknown)."""
-    last = path.rsplit(".", 1)[-1].split("[", 1)[0]
-    return FIELD_UNITS.get(last, "")
+    """The unit of the scene field at ``path`` (:data:`FIELD_UNITS`; "" when unknown),
+    a number inside a profile object included (``coating[0].modulus.start`` in Pa,
+    ``loading.force.breaks[0]`` in days, ``punch.shape.coefficients[2]`` in 1/m)."""
+    parts = parse_path(path)
+    names = [part for part in parts if isinstance(part, str)]
+    last = names[-1]
+    if len(names) < 2 or names[-2] not in PROFILED:
+        return FIELD_UNITS.get(last, "")
+    owner = FIELD_UNITS.get(names[-2], "")
+    along = "day" if "loading" in names else "m"
+    if last in PROFILE_VALUES:
+        return owner
+    if last in PROFILE_POSITIONS:
+        return along
+    if last == "phase":
+        return "rad"
+    if last == "coefficients" and isinstance(parts[-1], int):  # of (x or t)^k
+        k = parts[-1]
+        if k == 0 or not owner:
+            return owner
+        if owner == along:  # a shape's: m / m^k
+            return "1" if k == 1 else f"1/{along}" + (f"^{k - 1}" if k > 2 else "")
+        return f"{owner}/{along}" + (f"^{k}" if k > 1 else "")
+    if last == "points" and len(parts) >= 2 and isinstance(parts[-1], int) \
+            and isinstance(parts[-2], int):
+        return along if parts[-1] == 0 else owner
+    return ""
 
 
 def apply_point(scene: Mapping[str, Any], values: Mapping[str, float]) -> dict[str, Any]:

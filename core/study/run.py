@@ -438,6 +438,17 @@ def _one_line(value: Any) -> str:
     return " ".join(str(value).split())
 
 
+def _column_name(name: str, unit: str) -> str:
+    """A long-form column: the name and its unit (``coating_0_modulus_Pa``,
+    ``loading_force_N_per_m``, ``base_creep_relative_humidity_percent``); a number of
+    unit 1, or of no known unit, keeps its name alone."""
+    if unit in ("", "1"):
+        return name
+    text = unit.replace("/", "_per_").replace("%", "percent").replace("^", "").replace(
+        "·", "_")
+    return f"{name}_{text}"
+
+
 def _long_rows(study: Study, points: StudyPoints, index: np.ndarray,
                arrays: Mapping[str, np.ndarray] | None, lost: str | None) -> dict[str, Any]:
     """One batch in long form: a row per (point, time)."""
@@ -445,14 +456,14 @@ def _long_rows(study: Study, points: StudyPoints, index: np.ndarray,
     rows: dict[str, Any] = {"point": np.repeat(index, n_t)}
     point = points(index)
     for p in study.parameters:
-        rows[_variable_name(p.path)] = np.repeat(point[p.path], n_t)
+        rows[_column_name(_variable_name(p.path), field_unit(p.path))] = np.repeat(
+            point[p.path], n_t)
     rows["sample"] = np.repeat(point["sample"], n_t)
     rows["time_day"] = np.tile(np.asarray(study.times), len(index))
     for j, name in enumerate(study.outputs):
-        unit = output_unit(name).replace("/", "_per_")
         values = np.full((len(index), n_t), np.nan) if arrays is None \
             else arrays["values"][:, j, :]
-        rows[f"{_variable_name(name)}_{unit}"] = values.reshape(-1)
+        rows[_column_name(_variable_name(name), output_unit(name))] = values.reshape(-1)
     estimate = np.full(len(index), np.nan) if arrays is None else arrays["error_estimate"]
     flags = np.full(len(index), "failed") if arrays is None else arrays["flags"]
     error = np.full(len(index), f"not computed: {lost}") if arrays is None else arrays["error"]
@@ -466,7 +477,7 @@ def write_output(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[in
                  path: Path, info: Mapping[str, Any]) -> None:
     """Write the results to ``path`` atomically: ``.nc`` the dataset of
     :func:`study_dataset`; ``.csv``/``.parquet`` one row per point and time (columns
-    ``point``, the varied fields, ``sample``, ``time_day``, each output with its unit,
+    ``point``, each varied field and each output with its unit, ``sample``, ``time_day``,
     ``error_estimate``, ``flags``, ``error``), written batch by batch in batch order."""
     suffix = path.suffix.lower()
     directory = path.parent if str(path.parent) else Path(".")

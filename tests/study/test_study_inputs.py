@@ -123,3 +123,38 @@ def test_an_output_in_a_directory_that_does_not_exist_is_refused(tmp_path) -> No
     assert not (tmp_path / "missing").exists()
     check_output(tmp_path / "x.csv")
     check_output(Path("x.csv"))  # the working directory
+
+
+@pytest.mark.parametrize(("path", "unit"), [
+    ("coating[0].modulus", "Pa"), ("punch.shape", "m"), ("base.creep.alpha", "1/day"),
+    ("base.creep.fcm", "MPa"), ("base.creep.beta", "1"), ("solver.model_tol", "1"),
+    ("coating[0].modulus.start", "Pa"), ("loading.force.values[1]", "N/m"),
+    ("loading.moment.amplitude", "N"), ("loading.force.breaks[0]", "day"),
+    ("coating[0].thickness.breaks[0]", "m"), ("punches[1].center", "m"),
+    ("loading.force.center", "day"), ("punch.shape.coefficients[2]", "1/m"),
+    ("coating[0].thickness.points[3][0]", "m"), ("coating[0].modulus.points[3][1]", "Pa"),
+])
+def test_every_varied_number_has_its_unit(path, unit) -> None:
+    """The unit of a study's or a fit's field: a number inside a profile object, the
+    punch's shape and three creep coefficients had none ('')."""
+    from core.study import field_unit
+
+    assert field_unit(path) == unit
+
+
+def test_the_long_form_names_each_varied_field_with_its_unit(tmp_path) -> None:
+    """The outputs' columns carried their units (settlement_m), the fields' did not."""
+    import csv
+
+    from core.study import sweep
+
+    study = study_from_dict(_liftoff_study([
+        {"field": "loading.force", "values": [7e5, 8e5]},
+        {"field": "coating[0].poisson",
+         "values": [0.3, 0.35]}]))
+    out = tmp_path / "s.csv"
+    sweep(study, output=out, progress=False, return_dataset=False)
+    with out.open() as f:
+        header = next(csv.reader(line for line in f if not line.startswith("#")))
+    assert header[:4] == ["point", "loading_force_N_per_m", "coating_0_poisson", "sample"]
+    assert "settlement_m" in header and "q_max_Pa" in header

@@ -143,7 +143,7 @@ def test_the_command_line_sweeps_the_spacing(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     rows = pd.read_csv(tmp_path / "r.csv", comment="#").sort_values(["point", "time_day"])
     assert [c for c in rows.columns if c.startswith("punches_")] == [
-        "punches_1_center", "punches_0_settlement_m", "punches_0_tilt_rad",
+        "punches_1_center_m", "punches_0_settlement_m", "punches_0_tilt_rad",
         "punches_1_settlement_m", "punches_1_tilt_rad"]
     direct = core.solve(apply_point(copy.deepcopy(study_from_dict(study).base),
                                     {"punches[1].center": CENTRES[1]}))
