@@ -447,9 +447,13 @@ def _identifiability(fields: Sequence[Field], cov: np.ndarray, condition: float,
                            f"({f.bounds[0 if name == 'lower' else 1]:.6g} {f.unit}): the "
                            "readings push it beyond, so it is not identified within the "
                            "bounds and its standard error does not hold")
-        if f.log and math.sqrt(abs(cov[j, j])) > 1.0:
+        if math.sqrt(abs(cov[j, j])) > 1.0:
+            # a coordinate's unit is a factor e (a log-fitted field) or the field's scale
             out.append(f"{f.path}: poorly determined (its standard error exceeds a factor "
-                       "e = 2.7 either way)")
+                       "e = 2.7 either way)" if f.log else
+                       f"{f.path}: poorly determined (its standard error exceeds its scale, "
+                       f"{f.scale:.3g} {f.unit}".rstrip() + ": the start's size, or half the "
+                       "range of its bounds)")
     return out
 
 
@@ -517,17 +521,22 @@ def _derivative_check(fields: Sequence[Field], first: np.ndarray, other: np.ndar
         if np.all(np.isfinite(other[:, j])):
             size = float(np.linalg.norm(0.5 * (first[:, j] + other[:, j])))
             spread = 0.5 * float(np.linalg.norm(first[:, j] - other[:, j]))
-            if size == 0.0:
+            if size == 0.0 and spread == 0.0:
                 out.append(f"{f.path}: a step of {FD_STEP:g} either way in its "
                            f"{'logarithm' if f.log else 'value over its scale'} changes no "
                            "reading: the readings do not depend on it")
+            elif size == 0.0:
+                out.append(f"{f.path}: a step of {FD_STEP:g} either way in its "
+                           f"{'logarithm' if f.log else 'value over its scale'} moves the "
+                           "readings alike: the answer is at a turning point of them, "
+                           "where they do not determine it to first order")
             elif spread > MAX_DERIVATIVE_SPREAD * size:
                 out.append(f"{f.path}: its derivative is not resolved: the differences on "
                            f"either side of a step of {FD_STEP:g} disagree by "
                            f"{100 * spread / size:.2g} % of it (more than "
-                           f"{100 * MAX_DERIVATIVE_SPREAD:g} %; the solver's error, or a "
-                           "kink of the answer within the step), so its standard error "
-                           "does not hold")
+                           f"{100 * MAX_DERIVATIVE_SPREAD:g} %): the readings hardly depend "
+                           "on it, or the solver's error or a kink of the answer within "
+                           "the step dominates it, so its standard error does not hold")
             continue
         if not any(np.max(np.abs(changes[a:b, j]), initial=0.0) > 100 * tol * size
                    for a, b, size in parts):

@@ -121,10 +121,7 @@ def fitted_fields(base: Mapping[str, Any], fit: Any, bounds: Any) -> tuple[Field
         if not lo <= start <= hi:
             raise ValueError(f"bounds[{path}]: the scene's value {start:.6g} (the start "
                              f"of the fit) is outside [{lo:.6g}, {hi:.6g}]")
-        for end, name in ((lo, "lower"), (hi, "upper")):
-            if start == end:
-                raise ValueError(f"bounds[{path}]: the start {start:.6g} is at the {name} "
-                                 "bound; start inside the bounds")
+        # (a start on a bound is moved strictly inside by the least-squares solver)
         log = start > 0 and (lo >= 0 or path not in bounds)
         if log:
             lo = max(lo, 0.0)

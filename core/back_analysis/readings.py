@@ -230,7 +230,14 @@ def readings_from_mapping(data: Mapping[str, Any], source: str = "readings") -> 
         if key not in data:
             continue
         value = data[key]
-        if hasattr(value, "__array__") and not isinstance(value, (str, bytes)):
+        if isinstance(value, np.ma.MaskedArray):
+            # a masked entry is a row without that reading (np.asarray would read the
+            # value under the mask as one)
+            under, hidden = np.ma.getdata(value), np.ma.getmaskarray(value)
+            value = (None if hidden.item() else under.item()) if value.ndim == 0 else [
+                None if m else v for v, m in zip(under.tolist(), hidden.tolist(),
+                                                 strict=True)]
+        elif hasattr(value, "__array__") and not isinstance(value, (str, bytes)):
             # an array of any kind (numpy's 0-d array for one deviation, a table's column)
             value = np.asarray(value)
             value = value.item() if value.ndim == 0 else value

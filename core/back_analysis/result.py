@@ -70,7 +70,7 @@ def _jsonable_array(values: np.ndarray) -> list[float | None]:
 class Forecast:
     """The fitted scene's settlement [m] and tilt [rad] at ``times`` [day after loading]
     with their standard deviations from the fitted fields' covariance (linearised: the
-    delta method, the gradient by the fit's finite differences) and the band
+    delta method, the gradient by central differences, as the covariance) and the band
     ``value -/+ z std`` of confidence ``level`` (``z``: :func:`quantile` of the fit's
     degrees of freedom ``dof``, None where the readings' standard deviations were given).
     The band is the uncertainty of the fitted fields alone: not the model's error nor the
@@ -119,7 +119,9 @@ class Calibration:
     ``values``, ``standard_errors`` (dicts by path, in each field's unit, the standard
     error of a log-fitted field by the delta method ``value * se(log value)``),
     ``correlation`` (rows and columns in the order of ``paths``), ``residuals`` (model
-    minus reading per series, NaN where a row has none), ``chi2``, ``dof`` and
+    minus reading per series, NaN where a row has none), ``chi2`` (the weighted
+    residuals' sum of squares: without deviations the weights are the largest reading's,
+    an arbitrary scale, and the JSON leaves it out), ``dof`` and
     ``chi2_per_dof``, ``warnings`` (not identifiable, a bound reached, the solver's error
     near the noise, ...), ``scene`` (the fitted scene, with the original output times)
     and :meth:`forecast`. ``std_given`` says which covariance: ``(J^T J)^-1`` with the
@@ -278,8 +280,8 @@ class Calibration:
         Returns
         -------
         Forecast
-            Values, standard deviations (delta method) and the band; one solve plus one
-            per fitted field.
+            Values, standard deviations (delta method, central differences) and the
+            band; one solve plus two per fitted field.
         """
         from core.back_analysis.model import Model
 
@@ -293,7 +295,11 @@ class Calibration:
             raise ValueError(msg if msg.startswith("times") else f"times: {msg}") from None
         model = Model(self.work, self.fields, tuple(SERIES_UNITS), times)
         centre = model.values(self.x)
-        gradient = model.jacobian(self.x, centre)
+        # central differences where both sides are points the scene accepts, as the
+        # covariance was taken (core.back_analysis.fit)
+        first, other = model.two_sided(self.x, centre)
+        both = np.all(np.isfinite(other), axis=0)
+        gradient = np.where(both, 0.5 * (first + np.where(both, other, 0.0)), first)
         var = np.einsum("ij,jk,ik->i", gradient, self.cov_x, gradient)
         std = np.sqrt(np.maximum(var, 0.0))
         solution = model.solve(self.x)

@@ -104,6 +104,13 @@ class FitOutcome:
             out.append((c.label, number_text(value, 4), _error_text(se), c.unit))
         return out
 
+    def noise_text(self) -> str:
+        """The noise the standard errors assume, per series, in the display unit (mm,
+        mrad): the readings' deviations, or the scatter about the fit."""
+        return ", ".join(f"{name} {number_text(v / QUANTITY_UNITS[name][1], 3)} "
+                         f"{QUANTITY_UNITS[name][0]}"
+                         for name, v in self.calibration.noise.items())
+
     def intervals(self) -> list[str]:
         """The confidence interval (:data:`core.back_analysis.BAND_LEVEL`) of each field,
         in the units on screen: Student's t where the noise was estimated from the

@@ -269,8 +269,9 @@ def outcome_html(outcome: FitOutcome) -> str:
         for (label, value, se, unit), interval in zip(outcome.rows(), outcome.intervals(),
                                                       strict=True))
     noise = ("the readings' standard deviations" if c.std_given
-             else "the noise estimated from the scatter about the fit (the interval by "
-             f"Student's t, {c.dof} degrees of freedom)")
+             else f"the noise estimated from the scatter about the fit, "
+             f"{outcome.noise_text()} (the interval by Student's t, {c.dof} degrees of "
+             "freedom)")
     parts = [f"<table class='fit-values' style='font-size:13px'>"
              f"<tr><th>field</th><th>fitted value ± standard error</th>"
              f"<th>{100 * BAND_LEVEL:g} % interval</th></tr>{rows}</table>",

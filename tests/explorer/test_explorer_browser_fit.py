@@ -86,7 +86,10 @@ def test_readings_are_uploaded_drawn_and_fitted(page: Page):
     until(lambda: "±" in page.pane_text(".fit-table"), "the fitted values", 240,
           lambda: page.pane_text(".fit-status"))
     table = page.pane_text(".fit-table")
-    assert "coating 1: Young's modulus" in table and "MPa" in table and "χ²/dof" in table
+    # no deviations in the readings: the noise estimated from the scatter, no chi^2
+    assert "coating 1: Young's modulus" in table and "MPa" in table
+    assert "noise estimated from the scatter about the fit, settlement " in table
+    assert "χ²/dof" not in table
     assert "Done: fitted" in page.pane_text(".fit-status")
     until(lambda: len(values(page, "forecast_settlement", "upper")) > 0, "the forecast band")
     lower = values(page, "forecast_settlement", "lower")

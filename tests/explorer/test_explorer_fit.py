@@ -56,7 +56,8 @@ def test_readings_are_drawn_fitted_and_the_fitted_scene_applied(explorer_app):
     assert "coating 1: Young&#x27;s modulus" in table and "MPa" in table and "±" in table
     # no deviations given: no chi^2, whose weights' scale is then arbitrary
     assert "χ²/dof" not in table and "7 readings" in table
-    assert "the noise estimated from the scatter about the fit" in table
+    assert "the noise estimated from the scatter about the fit, settlement " in table
+    assert f"settlement {outcome.calibration.noise['settlement'] * 1e3:.3g} mm" in table
     # the interval by Student's t of the fit's 6 degrees of freedom (2.447 se each side),
     # the noise being estimated from the scatter
     low, high = outcome.calibration.intervals()["coating[0].modulus"]
