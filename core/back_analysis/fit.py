@@ -30,7 +30,14 @@ from typing import Any
 import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
-from core.back_analysis.model import FD_STEP, FIT_SOLVER_TOL, Field, Model, fitted_fields
+from core.back_analysis.model import (
+    FD_STEP,
+    FIT_SOLVER_TOL,
+    MAX_CONDITION,
+    Field,
+    Model,
+    fitted_fields,
+)
 from core.back_analysis.readings import Readings, as_readings
 from core.back_analysis.result import Calibration
 from core.limits import MAX_FIT_SOLVES
@@ -43,12 +50,6 @@ from core.scene import (
     scene_from_dict,
 )
 
-#: A fit whose normalised Jacobian has a condition number above this does not determine
-#: every field: along the weakest direction the readings pin a combination ~1000 times
-#: less well than along the strongest (a correlation of 0.999998 between two fields). An
-#: exactly degenerate pair (coating thickness and modulus, whose ratio alone matters)
-#: measures ~1e4 and more, set by the finite differences' own error.
-MAX_CONDITION = 1e3
 #: Pairs more correlated than this are named in a warning, even when identifiable.
 STRONG_CORRELATION = 0.99
 #: The solver's error must be this far below the noise (as a fraction of the smallest
@@ -338,6 +339,7 @@ def calibrate(scene: Scene | Mapping[str, Any] | str | os.PathLike,
         start_residuals=_split(np.where(mask, f_start - y, np.nan), readings),
         chi2=chi2, dof=dof, std_given=std_given, noise_scale=math.sqrt(s2),
         condition=condition, solver_error_to_noise=ratio, warnings=tuple(warnings),
+        jacobian=J,
         unidentified=unidentified,
         solves=model.solves, seconds=time.perf_counter() - started,
         iterations=int(answer.nfev), status=str(answer.message), model=model,

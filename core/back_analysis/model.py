@@ -36,6 +36,21 @@ from core.validation import finite_number, show_value
 #: error is ~1e-3 of a derivative; a larger step costs accuracy in the curvature term
 #: (relative error of the derivative about half the step).
 FD_STEP = 1e-3
+#: A fit whose normalised Jacobian has a condition number above this does not determine
+#: every field: along the weakest direction the readings pin a combination ~1000 times
+#: less well than along the strongest (a correlation of 0.999998 between two fields). An
+#: exactly degenerate pair (coating thickness and modulus, whose ratio alone matters)
+#: measures ~1e4 and more, set by the finite differences' own error (~1e12
+#: with central ones).
+MAX_CONDITION = 1e3
+#: A forecast of a fit whose fields are not all determined has a band where it depends
+#: on the combinations the readings determine alone: its gradient's share along the
+#: others (the singular directions beyond :data:`MAX_CONDITION`) at most this, the
+#: central differences' own error (h^2 = 1e-6 of :data:`FD_STEP`). A settlement forecast
+#: of a coating's thickness and modulus, whose ratio alone counts, leaves 1.4e-13 to
+#: 3.8e-13 of it along the undetermined one (round-off; tests/back_analysis); a forecast
+#: that depends on that direction more has no band (infinite).
+UNDETERMINED_SHARE = 1e-6
 #: The solver tolerance of the fit's solves (the scene's own when tighter): the error
 #: estimate of the shipped young-concrete scene stays ~1.6e-5 (the creep kernel's fit)
 #: and its answers move by 1e-9 relative between tol 1e-4 and 1e-8, so the solves'
