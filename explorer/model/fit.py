@@ -230,10 +230,13 @@ def forecast_columns(forecast: Forecast | None) -> dict[str, dict[str, list[floa
             out[name] = {"t": [], "v": [], "lower": [], "upper": []}
             continue
         size = QUANTITY_UNITS[name][1]
-        lower, upper = forecast.band(name)
+        # no band where the readings do not determine the forecast (an infinite one):
+        # a gap in the drawn band
+        lower, upper = (np.where(np.isfinite(edge), edge / size, np.nan)
+                        for edge in forecast.band(name))
         out[name] = {"t": forecast.times.tolist(),
                      "v": (getattr(forecast, name) / size).tolist(),
-                     "lower": (lower / size).tolist(), "upper": (upper / size).tolist()}
+                     "lower": lower.tolist(), "upper": upper.tolist()}
     return out
 
 
