@@ -278,3 +278,18 @@ def test_the_forecast_is_drawn_apart_from_the_pins_and_punches():
     from explorer.plots.figures import FORECAST_COLOR
 
     assert FORECAST_COLOR not in (*PIN_COLORS, *PUNCH_COLORS)
+
+
+def test_a_forecast_the_readings_do_not_determine_is_drawn_without_a_band() -> None:
+    """An infinite band (a forecast of fields the readings do not fix) is a gap in the
+    drawn band, not infinities sent to the page."""
+    from core.back_analysis import Forecast
+    from explorer.model import forecast_columns
+
+    t = np.array([10.0, 100.0])
+    forecast = Forecast(t, np.array([1e-4, 2e-4]), np.zeros(2), np.array([1e-6, np.inf]),
+                        np.zeros(2), 0.95, solution=None)
+    columns = forecast_columns(forecast)["settlement"]
+    assert columns["v"] == pytest.approx([0.1, 0.2])  # mm
+    assert columns["lower"][0] == pytest.approx(0.1 - 1.96e-3, rel=1e-3)
+    assert np.isnan(columns["lower"][1]) and np.isnan(columns["upper"][1])
