@@ -47,11 +47,14 @@ from core.profiles import shifted
 from core.scene import punches_output, schema
 from core.scene.contact_zone import contact_width, lift_off_length
 from core.scene.design import DesignCheck, DesignLimits
+from core.scene.display import answered_settings
 from core.scene.load_limits import check_loads_touch, not_carried
 from core.scene.model import Scene
-from core.scene.records import csv_header
-from core.scene.results import SceneSolution
+from core.scene.records import PROGRAM, csv_header
+from core.scene.results import UNITS, SceneSolution
+from core.scene.schema import SCHEMA_VERSION, _jsonable
 from core.validation import bounded_list, finite_number
+from core.version import VERSION
 
 
 @dataclass(frozen=True, eq=False)
@@ -348,10 +351,26 @@ class PunchesSolution:
         }
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-able dict: the scene, and each punch's answer (its ``to_dict``)."""
-        return {"scene": self.scene.to_dict(), "times": self.times.tolist(),
-                "info": dict(self.info),
-                "punches": [dict(p.to_dict(), center=p.center) for p in self.punches]}
+        """A JSON-able dict, headed as one punch's (:meth:`SceneSolution.to_dict`): what
+        produced it (``format``, ``program``, ``version``, ``solver``), the scene, the
+        times, the flags, ``info`` and each punch's answer (its ``to_dict``, with its
+        ``center`` and its design check in the global x [m], as its ``contact_set``; its
+        ``x`` and ``pressure`` on its own coordinates, ``x - center``)."""
+        punches = []
+        for punch, check in zip(self.punches, self.design_checks(), strict=True):
+            # the punch's own dict checks its design on its own x: the global one instead
+            record = dict(punch.to_dict(), center=punch.center,
+                          design_check=None if check is None else _jsonable(check.to_dict()))
+            record["units"] = {**record["units"], "center": "m (global x)",
+                               "contact_set": "m (global x)"}
+            punches.append(record)
+        return _jsonable({
+            "format": punches_output.SOLUTION_OF_PUNCHES, "program": PROGRAM, "version": VERSION,
+            "solver": answered_settings(self.punches[0]), "schema_version": SCHEMA_VERSION,
+            "scene": self.scene.to_dict(),
+            "units": {"times": UNITS["times"], "center": "m (global x)"},
+            "times": self.times, "flags": self.flags, "info": dict(self.info),
+            "punches": punches})
 
     def to_json(self) -> str:
         """:meth:`to_dict` as compact JSON text."""

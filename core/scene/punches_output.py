@@ -22,6 +22,10 @@ from core.scene.files import scene_to_json
 from core.scene.results import history_columns, pressure_points
 from core.version import VERSION
 
+#: The ``format`` of a solution of several punches, in its JSON and its dataset's
+#: attributes.
+SOLUTION_OF_PUNCHES = "coated-punch solution of several punches"
+
 if TYPE_CHECKING:
     from core.scene.punches import PunchesSolution
 
@@ -150,7 +154,7 @@ def to_xarray(result: PunchesSolution) -> Any:
                            {"units": unit, "long_name": f"{long_name}, of each punch",
                             "symbol": symbol})
     info = result.info
-    attrs = {"format": "coated-punch solution of several punches", "version": VERSION,
+    attrs = {"format": SOLUTION_OF_PUNCHES, "version": VERSION,
              "scene_name": result.scene.name, "scene": scene_to_json(result.scene),
              "flags": ",".join(result.flags),
              "error_estimate": float(info.get("error_estimate", float("nan"))),

@@ -161,3 +161,27 @@ def test_the_answer_plots_the_surface_and_every_punchs_histories(pair: PunchesSo
     labels = {a.axis_label for a in hv.render(layout, backend="bokeh").select(
         {"type": Axis})}
     assert {"x (m)", "t (day)", "settlement (mm)", "tilt (mrad)"} <= labels
+
+
+def test_the_json_is_headed_as_one_punchs_and_checks_each_punch_in_the_global_x() -> None:
+    """The JSON of several punches had no format, program, version nor solver (a script
+    checking them failed on every such file), and each punch's design check read x on
+    the punch's own coordinates (q_max "at x = 1.0 m" where the report and
+    design_checks() say 4 m), beside a contact set in the global x."""
+    import json
+
+    result = core.solve(_pair(limits={"allowable_pressure": 5e5, "settlement_limit": 0.01}))
+    d = json.loads(result.to_json())
+    assert d["format"] == "coated-punch solution of several punches"
+    assert d["program"] == "coated-punch" and d["version"] == core.__version__
+    assert d["solver"]["tol"] == result.scene.to_dict()["solver"]["tol"]
+    assert d["flags"] == result.flags and d["units"]["center"] == "m (global x)"
+    for k, (record, check) in enumerate(zip(d["punches"], result.design_checks(),
+                                            strict=True)):
+        assert record["center"] == result.punches[k].center
+        assert record["design_check"] == json.loads(json.dumps(check.to_dict()))
+        assert record["units"]["contact_set"] == "m (global x)"
+    # punch 1 sits right of the origin: its x are the global ones, not its own
+    q_max = next(c for c in d["punches"][1]["design_check"]["checks"]
+                 if c["quantity"] == "q_max")
+    assert q_max["x_m"] > result.punches[0].scene.half_width
