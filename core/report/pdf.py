@@ -57,10 +57,24 @@ def _text_lines(result: SceneSolution | PunchesSolution, time: float | None,
     return lines
 
 
+def text_pages(lines: list[tuple[str, str, bool]]) -> list[list[tuple[str, str, bool]]]:
+    """``lines`` cut into pages of :data:`LINES_PER_PAGE`, no page starting with a blank
+    line (the blank after the last section made a blank page when the text ended at a
+    page's end)."""
+    pages: list[list[tuple[str, str, bool]]] = []
+    for line in lines:
+        if not pages or len(pages[-1]) == LINES_PER_PAGE:
+            if not line[0]:
+                continue
+            pages.append([])
+        pages[-1].append(line)
+    return pages
+
+
 def _text_pages(pdf, plt, lines: list[tuple[str, str, bool]], size: float = 8.5) -> None:
-    for start in range(0, len(lines), LINES_PER_PAGE):
+    for page in text_pages(lines):
         figure = plt.figure(figsize=PAGE)
-        for k, (text, tone, bold) in enumerate(lines[start:start + LINES_PER_PAGE]):
+        for k, (text, tone, bold) in enumerate(page):
             figure.text(0.07, 0.95 - k * 0.9 / LINES_PER_PAGE, text, fontsize=size,
                         color=COLOURS.get(tone, "#222222"), family="DejaVu Sans",
                         weight="bold" if bold else "normal", va="top")

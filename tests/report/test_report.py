@@ -319,3 +319,19 @@ def test_the_time_of_a_largest_value_is_the_design_checks():
         == "0 mrad at t = 0 days"
     assert rows["largest settlement δ"].endswith(
         f"at t = {days_text(check.check('settlement').time)}")
+
+
+def test_no_text_page_of_the_pdf_is_blank_or_starts_blank():
+    """The blank line after the last section made a blank second page when the text
+    ended at a page's end (63 lines, 62 a page: the lift-off preset's report)."""
+    from core.report.pdf import LINES_PER_PAGE, text_pages
+
+    line, blank = ("text", "", False), ("", "", False)
+    for count in (LINES_PER_PAGE - 1, LINES_PER_PAGE, LINES_PER_PAGE + 1, 2 * LINES_PER_PAGE):
+        lines = [line] * count + [blank]
+        pages = text_pages(lines)
+        assert all(page and page[0][0] for page in pages), count
+        assert sum(len(page) for page in pages) >= count
+    # a blank that falls at a page's start is dropped, others kept
+    pages = text_pages([line] * LINES_PER_PAGE + [blank, line, blank, line])
+    assert [len(p) for p in pages] == [LINES_PER_PAGE, 3]
