@@ -26,6 +26,7 @@ from core.scene import (
     model_error_evidence,
     number_text,
     percent_text,
+    pressure_caution,
     thin_edge_note,
     time_of_largest,
 )
@@ -165,6 +166,14 @@ def accuracy_rows(result: SceneSolution,
          + f"solver.model_tol {percent_text(result.scene.model_tol)})"
          + ("; the FE check's measurement above overrides it"
             if evidence["source"] == "measured" else "")),
+        *([("contact pressure against the FE model",
+            f"{number_text(check['pressure_fast_Pa'] / 1e3)} kPa against "
+            f"{number_text(check['pressure_fe_Pa'] / 1e3)} kPa at x = "
+            f"{number_text(check['pressure_error_at_m'])} m, where they differ most: "
+            f"{percent_text(check['errors']['pressure'])} of the largest pressure ("
+            + ("FLAGGED: above " if check["errors"]["pressure"] > result.scene.model_tol
+               else "within ") + f"solver.model_tol {percent_text(result.scene.model_tol)})")]
+          if evidence["source"] == "measured" and "pressure_fe_Pa" in check else []),
         ("solved by", engine_text(result)),
         ("discretization", _discretization(info)),
         ("solver's message", str(info.get("message", ""))),
@@ -185,11 +194,14 @@ def _check_line(line: Any) -> str:
     return line.verdict_text(number=number_text, shown=_shown, time=days_text)
 
 
-def design_section(result: SceneSolution, flags: Sequence[str] | None = None
-                   ) -> Section | None:
+def design_section(result: SceneSolution, flags: Sequence[str] | None = None,
+                   fe_check: Mapping[str, Any] | None = None) -> Section | None:
     """The design check against the scene's limits, or None when the scene sets none;
     ``flags``: the answer's validity flags as the report shows them (default its own),
-    under which the verdict is qualified (:func:`core.scene.flagged_caution`)."""
+    under which the verdict is qualified (:func:`core.scene.flagged_caution`);
+    ``fe_check``: an FE check made for this scene, whose pressure caution
+    (:func:`core.scene.pressure_caution`) is noted (the command line warned of it, the
+    report said nothing)."""
     check = result.design_check()
     if check is None:
         return None
@@ -197,8 +209,10 @@ def design_section(result: SceneSolution, flags: Sequence[str] | None = None
     failed = check.passed is False
     caution = flagged_caution(result.flags if flags is None else flags)
     lead = "A limit is exceeded" if failed else "Every limit the scene sets holds"
+    pressure = "" if fe_check is None else pressure_caution(fe_check)
     return Section("Design check", f"{lead}, {caution}." if caution else f"{lead}.", rows,
-                   tone="bad" if failed or caution else "good")
+                   notes=[f"FE check: {pressure}"] if pressure else [],
+                   tone="bad" if failed or caution or pressure else "good")
 
 
 def calibration_section(calibration: Any) -> Section:
@@ -296,7 +310,8 @@ def sections(result: SceneSolution | PunchesSolution, time: float | None = None,
     else:
         out.append(Section("Validity", "No validity flag: the model stands behind this "
                            "result.", tone="good"))
-    design = design_section(result, flags)
+    design = design_section(result, flags,
+                            check if evidence["source"] == "measured" else None)
     if design is not None:
         out.append(design)
     out.append(Section("Results", rows=key_numbers(result, time)))
@@ -316,5 +331,5 @@ def describe(result: SceneSolution, time: float | None = None,
              check: Mapping[str, Any] | None = None,
              calibration: Any = None) -> dict[str, Any]:
     """The report's text as one JSON-able dict (what the tests read)."""
-    return {s.title: {"lead": s.lead, "rows": dict(s.rows), "tone": s.tone}
+    return {s.title: {"lead": s.lead, "rows": dict(s.rows), "tone": s.tone, "notes": s.notes}
             for s in sections(result, time, check, calibration)}

@@ -134,3 +134,31 @@ def test_an_estimate_within_the_tolerance_reads_within_it():
     assert "model_error" not in quiet.flags
     row = describe(quiet)["Accuracy"]["rows"][ESTIMATED_ROW]
     assert row.endswith("(within solver.model_tol 2 %)") and "FLAGGED" not in row
+
+
+def test_the_fe_checks_pressure_is_reported_and_qualifies_the_design_check():
+    """``report --fe-check`` gave the settlement's measurement alone: the check's pressure
+    difference (8.5 % at x = -0.82 m, which the command line warns of) was not in the
+    report, and its design check passed a pressure limit with no word of it."""
+    scene = epoxy_on_pad_scene()
+    scene["limits"] = {"allowable_pressure": 1e8}
+    result = core.solve(scene)
+    check = {**_check(scene, MEASURED), "errors": {"pressure": 0.085}, "model_tol": 0.02,
+             "pressure_fast_Pa": 3.0e5, "pressure_fe_Pa": 2.7e5, "pressure_error_at_m": -0.82}
+    text = describe(result, check=check)
+    assert text["Accuracy"]["rows"]["contact pressure against the FE model"] == (
+        "300 kPa against 270 kPa at x = -0.82 m, where they differ most: 8.5 % of the "
+        "largest pressure (FLAGGED: above solver.model_tol 2 %)")
+    design = text["Design check"]
+    assert design["tone"] == "bad"
+    assert design["notes"] == ["FE check: the fast answer's q differs from the resolved "
+                               "model's by 8.50 % at x = -0.82 m (over solver.model_tol 2 %):"
+                               " q there, its largest value and a pressure limit checked on "
+                               "it are not to be relied on (the thin layer's q is local: it "
+                               "follows the coating's compliance at each point, where the "
+                               "resolved layers spread the load; beside an abrupt change of "
+                               "the coating it jumps)"]
+    # without the check, or with one of another scene, neither is said
+    plain = describe(result)
+    assert "contact pressure against the FE model" not in plain["Accuracy"]["rows"]
+    assert plain["Design check"]["notes"] == []
