@@ -407,6 +407,8 @@ def _output_format(option: str, path: Path | None, given: str | None) -> str | N
         return given
     if str(path) == STDIO:
         return "json"
+    if path.is_dir():  # (said before its missing extension)
+        raise _InputError(f"{option}: {path} is a directory; give a file's path")
     suffix = path.suffix.lower()
     if suffix not in (".json", ".csv"):
         raise _InputError(f"{option}: unsupported extension {path.suffix!r} "
@@ -434,10 +436,12 @@ def _strict_exit(reason: str, code: int) -> int:
     return code
 
 
-def _solve(path: str) -> SceneSolution | PunchesSolution | None:
-    """The answer for the scene at ``path``; None (the reason on stderr) when the solver
-    cannot answer a valid scene, which is not the user's input error."""
-    scene = _read(path)
+def _solve(path: str, scene: Scene | PunchesScene | None = None
+           ) -> SceneSolution | PunchesSolution | None:
+    """The answer for the scene at ``path`` (``scene``: that scene, read already); None
+    (the reason on stderr) when the solver cannot answer a valid scene, which is not the
+    user's input error."""
+    scene = _read(path) if scene is None else scene
     try:
         return solve(scene)
     except (ArithmeticError, ValueError, RuntimeError, MemoryError,
@@ -450,6 +454,11 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     output = Path(args.output) if args.output else None
     fmt = _output_format("--output", output, args.format)
     pressure_out = Path(args.pressure_csv) if args.pressure_csv else None
+    if pressure_out is not None and str(pressure_out) != STDIO \
+            and pressure_out.suffix.lower() != ".csv":
+        # (q(x, t) was written as CSV into a .json file)
+        raise _InputError(f"--pressure-csv: {pressure_out}: q(x, t) is written as CSV; give "
+                          "a .csv file (or - for standard output)")
     _check_outputs(args.scene, [("--output", output), ("--pressure-csv", pressure_out)])
     result = _solve(args.scene)
     if result is None:
@@ -527,17 +536,22 @@ def _cmd_report(args: argparse.Namespace) -> int:
     fmt = args.format or ("pdf" if output.suffix.lower() == ".pdf" else "html")
     if not stdout and output.suffix.lower() not in (".html", ".htm", ".pdf"):
         raise _InputError(f"--output: {output}: a report is .html or .pdf")
+    if not stdout and (fmt == "pdf") != (output.suffix.lower() == ".pdf"):
+        # (a PDF was written into a .html file)
+        raise _InputError(f"--format: {fmt} does not match --output {output}; give a "
+                          f".{'pdf' if fmt == 'pdf' else 'html'} file, or leave --format out")
     _check_outputs(args.scene, [("--output", output)])
-    result = _solve(args.scene)
-    if result is None:
-        return EXIT_SOLVER_FAILED
     # imported here: the report loads HoloViews and Bokeh (or Matplotlib), ~2 s
     from core.report import output_index, report_html, report_pdf
 
-    try:
-        output_index(result, args.time)
+    scene = _read(args.scene)
+    try:  # before the solve: a typo must not cost one
+        output_index(scene, args.time)
     except ValueError as exc:
         raise _InputError(f"--{exc}") from None
+    result = _solve(args.scene, scene)
+    if result is None:
+        return EXIT_SOLVER_FAILED
     if isinstance(result, PunchesSolution):
         if args.fe_check:
             raise _InputError("--fe-check: the finite-element check is of one punch; run "

@@ -383,3 +383,27 @@ def test_the_summary_says_whose_coating_model_error_it_is() -> None:
     assert done.returncode == 0, done.stderr
     head = [s for s in done.stdout.splitlines() if s.startswith("# coating model error")]
     assert len(head) == 1 and head[0].endswith(" % of the tilt (solver.model_tol 2 %)"), head
+
+
+def test_outputs_and_times_are_refused_before_any_solve(tmp_path: Path, monkeypatch):
+    """A directory as the output read "unsupported extension ''"; q(x, t) went as CSV
+    into a .json file and a PDF into a .html one; a report's --time out of range was
+    said only after the solve. Each is refused by name, and no solve runs."""
+    import core.cli as cli
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("solved before refusing the arguments")
+
+    monkeypatch.setattr(cli, "solve", no_solve)
+    assert_one_line_error(run("solve", "preset:worn_coating", "-o", tmp_path),
+                          f"--output: {tmp_path} is a directory; give a file's path")
+    assert_one_line_error(run("solve", "preset:worn_coating", "--pressure-csv",
+                              tmp_path / "q.json"),
+                          f"--pressure-csv: {tmp_path / 'q.json'}: q(x, t) is written as CSV")
+    assert_one_line_error(run("report", "preset:worn_coating", "-o", tmp_path / "r.html",
+                              "--format", "pdf"),
+                          f"--format: pdf does not match --output {tmp_path / 'r.html'}")
+    assert_one_line_error(run("report", "preset:worn_coating", "-o", tmp_path / "r.html",
+                              "--time", "-5"),
+                          "--time: -5 days is outside the output times")
+    assert not list(tmp_path.iterdir())
