@@ -74,6 +74,7 @@ from core.scene import (
     check_loads_touch,
     check_settled,
     corner_note,
+    days_text,
     flags_with_evidence,
     has_punches,
     largest_pressure,
@@ -267,11 +268,11 @@ def _describe(scene: Scene | PunchesScene) -> str:
         return (f"{scene.name!r}: {count} punch{'es' if count > 1 else ''} (statements "
                 f"{', '.join(str(s.statement) for s in scene.scenes)}), "
                 f"{len(first.coating)} coating layer(s), {first.times.size} time(s) up to "
-                f"{first.times[-1]:g} days after loading")
+                f"{days_text(first.times[-1])} after loading")
     given = " and ".join(q for q in QUANTITIES if q in scene.loading)
     return (f"{scene.name!r}: statement {scene.statement} ({given} given), "
             f"{len(scene.coating)} coating layer(s), {scene.times.size} time(s) up to "
-            f"{scene.times[-1]:g} days after loading")
+            f"{days_text(scene.times[-1])} after loading")
 
 
 def _punches_summary(result: PunchesSolution) -> str:
@@ -319,7 +320,7 @@ def _summary(result: SceneSolution) -> str:
         for i in rows:
             zones = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in result.contact_set[i])
             where = f"{zones} m" if zones else "none (the punch touches nothing)"
-            lines.append(f"contact at {result.times[i]:g} days: {where}")
+            lines.append(f"contact at {days_text(result.times[i])}: {where}")
     largest = largest_pressure(result)
     lines.append(f"largest contact pressure q: {largest.value_text(place_first=True)}")
     edge = thin_edge_note(largest, result.scene.half_width, result.info.get("coating_model"),
@@ -707,7 +708,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     summary = fit.summary()
     if forecast is not None:
         lower, upper = forecast.band("settlement")
-        summary += (f"\nforecast at {forecast.times[-1]:g} days: settlement "
+        summary += (f"\nforecast at {days_text(forecast.times[-1])}: settlement "
                     f"{forecast.settlement[-1]:.6g} m, {100 * forecast.level:g} % band "
                     f"[{lower[-1]:.6g}, {upper[-1]:.6g}] m (from the fitted fields' "
                     "uncertainty)")
@@ -774,13 +775,14 @@ def _cmd_check(args: argparse.Namespace) -> int:
         print(f"error: check: {_one_line(exc)}", file=sys.stderr)
         return EXIT_SOLVER_FAILED
     print(f"checked {_describe(scene)}")
-    print(f"resolved finite-element model at {report['time_day']:g} days after loading "
+    print(f"resolved finite-element model at {days_text(report['time_day'])} after loading "
           f"(base elastic at that modulus): {report['fe_dofs']} unknowns, "
           f"{report['fe_seconds']:.1f} s")
     print(f"{'quantity':>12} {'fast':>16} {'resolved':>16} {'error':>9}")
     for q in QUANTITIES:
+        # (+ 0.0: a difference below the digits shown read "-0.00%")
         print(f"{q + '_' + _UNITS[q]:>12} {report['fast'][q]:16.8g} {report['fe'][q]:16.8g} "
-              f"{100 * report['errors'][q]:8.2f}%")
+              f"{round(100 * report['errors'][q], 2) + 0.0:8.2f}%")
     # the two pressures where they differ most (the columns were empty)
     print(f"{'pressure_Pa':>12} {report['pressure_fast_Pa']:16.8g} "
           f"{report['pressure_fe_Pa']:16.8g} {100 * report['errors']['pressure']:8.2f}% "

@@ -210,7 +210,11 @@ class LimitCheck:
         if shown is None:
             def shown(value: float, unit: str) -> str:
                 return f"{number(value)} {unit}"
-        when = f"t = {time(self.time) if time else f'{number(self.time)} days'}"
+        if time is None:
+            def time(t: float) -> str:
+                text = number(t)
+                return f"{text} {'day' if text == '1' else 'days'}"
+        when = f"t = {time(self.time)}"
         if self.unbounded:
             return (f"unbounded at the corner x = {number(self.x)} m (a rigid corner: q ~ "
                     f"1/sqrt(distance)); {shown(self.value, self.unit)} at "

@@ -407,3 +407,32 @@ def test_outputs_and_times_are_refused_before_any_solve(tmp_path: Path, monkeypa
                               "--time", "-5"),
                           "--time: -5 days is outside the output times")
     assert not list(tmp_path.iterdir())
+
+
+def test_one_day_is_a_day_and_no_difference_reads_minus_zero(tmp_path: Path, monkeypatch):
+    """The summary read "at t = 1 days"; the check's table "-0.00%" for a difference
+    below its digits."""
+    import core.scene
+
+    scene = scene_dict()
+    scene["times"] = [1.0, 10.0]
+    scene["limits"] = {"allowable_pressure": 3e5}
+    scene["loading"] = {"force": {"kind": "step", "values": [5e5, 2e5], "breaks": [5.0]},
+                        "moment": 0.0}
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(scene))
+    summary = run("solve", path)
+    assert "t = 1 day," in summary.stdout and "1 days" not in summary.stdout
+
+    fast = {"settlement": 2.43e-5, "tilt": -1e-21, "force": 5e5, "moment": 0.0}
+    report = {"time_day": 0.0, "fast": fast, "fe": dict(fast, tilt=-2e-15),
+              "errors": {"settlement": 2.4e-3, "tilt": -1e-7, "force": 0.0, "moment": -1e-9,
+                         "pressure": 0.01},
+              "pressure_fast_Pa": 3.2e5, "pressure_fe_Pa": 3.1e5, "pressure_error_at_m": 0.9,
+              "model_error": 2.4e-3, "model_tol": 0.02, "estimate": 3e-3,
+              "coating_model": "thin layer", "given": ["force", "moment"],
+              "contact_lost": False, "lift_off": None, "scene_key": "", "half_width_m": 1.0,
+              "fe_seconds": 1.0, "fe_dofs": 100}
+    monkeypatch.setattr(core.scene, "check_scene", lambda *args, **kwargs: report)
+    checked = run("check", path)
+    assert "-0.00%" not in checked.stdout and "    0.00%" in checked.stdout, checked.stdout
