@@ -312,7 +312,20 @@ def _tab_message(message: str, choices: Sequence[Choice]) -> str:
     if match is None:
         return message
     i = int(match.group(1))
-    return f"parameter {i + 1} ({choices[i].label}): {message[match.end():]}"
+    rest = message[match.end():]
+    choice = choices[i]
+    # the grid's value as typed in the tab (it read "loading.force = -100000" for -100
+    # kN/m)
+    invalid = re.match(r"the scene is invalid at (\S+) = (\S+) \(", rest)
+    if invalid is not None and invalid.group(1) == choice.key:
+        try:
+            typed = float(invalid.group(2)) / choice.scale
+        except ValueError:
+            typed = None
+        if typed is not None:
+            rest = (f"the scene is invalid at {typed:.6g} {choice.unit}".rstrip() + " ("
+                    + rest[invalid.end():])
+    return f"parameter {i + 1} ({choice.label}): {rest}"
 
 
 @dataclass

@@ -295,7 +295,8 @@ class StudyView:
         try:
             planned = plan_study(self.state.to_scene(), axes)
         except ValueError as exc:
-            self._say(f"Not run: {exc}", bad=True)
+            # (the core's loads and stresses in the page's units: "P = -100000 N/m")
+            self._say(f"Not run: {format_error(str(exc))}", bad=True)
             return False
         self.study_run.start(planned)
         if self.study_charts is None and self._charts_built is None:

@@ -288,7 +288,9 @@ def test_a_failed_point_says_why_on_the_page(explorer_app):
     tab.study_first.fill(Axis("loading.force", -100.0, 750.0, 3))
     assert not tab.start()
     said = html.unescape(tab.study_status.object)
-    assert "Not run: " in said and "the punch is pulled away" in said, said
+    # in the tab's units, as typed (it read "loading.force = -100000 ... P = -100000 N/m")
+    assert "Not run: parameter 1 (loading: force P): the scene is invalid at -100 kN/m " \
+        "(loading.force: the punch is pulled away (P = -100 kN/m" in said, said
     tab.study_first.fill(Axis("loading.force", 100.0, 750.0, 3))
     tab.study_second.field.value = "loading.moment"
     tab.study_second.fill(Axis("loading.moment", 0.0, 300.0, 2))
