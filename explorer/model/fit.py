@@ -18,11 +18,19 @@ import math
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 
-from core.back_analysis import Calibration, Forecast, Readings, calibrate, readings_from_text
+from core.back_analysis import (
+    MAX_CONDITION,
+    Calibration,
+    Forecast,
+    Readings,
+    calibrate,
+    readings_from_text,
+)
 from core.limits import MAX_READINGS_BYTES
 from core.scene import days_text, number_text, scene_from_dict
 from core.study import apply_point, number_at
@@ -145,6 +153,31 @@ class FitOutcome:
                                 f"“{name}”: {values}.")[:MAX_DESCRIPTION_CHARS]
         return scene
 
+    @property
+    def determined(self) -> bool:
+        """Whether the readings determine every combination of the fields fitted (the
+        condition number at most :data:`core.back_analysis.MAX_CONDITION`): else the
+        fitted values are arbitrary along a combination (a coating's thickness and
+        modulus, whose ratio alone counts, went to 11 m and 279 GPa), not a scene to
+        apply."""
+        return self.calibration.condition <= MAX_CONDITION
+
+    def made_for(self, scene: Mapping[str, Any]) -> bool:
+        """Whether ``scene`` (a scene dict on screen) is the scene this fit was made from
+        or its fitted scene (names and descriptions aside): after any other change its
+        values and forecast are of another scene, and applying it would set that scene
+        back."""
+        try:
+            if _canonical(scene) == self._fitted_from:
+                return True
+        except ValueError:
+            return False
+        return self.describes(scene)
+
+    @cached_property
+    def _fitted_from(self) -> str:
+        return _canonical(self.calibration.base)
+
     def describes(self, scene: Mapping[str, Any]) -> bool:
         """Whether ``scene`` (a scene dict on screen) is this fit's fitted scene: the
         fitted values in its fields (to a relative 1e-9: a slider's unit conversion
@@ -157,7 +190,7 @@ class FitOutcome:
                                     rel_tol=FITTED_SCENE_RTOL):
                     return False
             restored = _canonical(apply_point(dict(scene), calibration.start))
-            fitted = _canonical(calibration.base)
+            fitted = self._fitted_from
         except ValueError:  # a field fitted is not in the scene, or the scene is refused
             return False
         return restored == fitted

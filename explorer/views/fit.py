@@ -41,6 +41,14 @@ from .upload import BoundedUpload
 
 #: The choice of "no field" for the second and third field.
 NONE = "(none)"
+#: The status of a fit once the scene on screen is another.
+STALE_FIT = ("The fit below was made for the scene as it was before the last change: its "
+             "forecast is hidden and Apply is off (it would set that scene back). Fit "
+             "again to fit this scene.")
+#: Under the table of a fit whose fields the readings do not all determine.
+NOT_APPLIED = ("Apply is off: the readings do not determine every field fitted (see the "
+               "warnings), so the fitted values are arbitrary along a combination of them; "
+               "fit fewer fields, or add readings that separate them.")
 
 
 class FitView:
@@ -84,6 +92,8 @@ class FitView:
         self.fit_run.param.watch(self._on_run, ["status", "message"])
         self.fit_run.param.watch(self._on_outcome, "outcome")
         self._choices: dict[str, Any] = {}
+        # whether the last fit is of the scene on screen (None: no fit shown)
+        self._current: bool | None = None
         # fields a link asked for that the scene on screen does not offer yet
         self._wanted: list[str | None] | None = None
         self.on_settings = on_settings or (lambda: None)
@@ -123,6 +133,7 @@ class FitView:
                 scene = self.state.to_scene()
             except ValueError:
                 return
+        self._follow(scene)
         choices = {c.key: c for c in fit_choices(scene)}
         if list(choices) == list(self._choices):
             self._choices = choices
@@ -138,6 +149,25 @@ class FitView:
                 select.value = next(iter(choices), None) if k == 0 else NONE
         if self._wanted is not None:
             self._choose(self._wanted)
+
+    def _follow(self, scene: dict[str, Any]) -> None:
+        """Mark the last fit as of another scene once the scene on screen changes (its
+        table and forecast looked current, and Apply set the earlier scene back: a force
+        typed after the fit returned to the fitted one), and as current again when the
+        scene is the fitted one or its fitted scene."""
+        outcome = self.fit_run.outcome
+        if outcome is None or self._current is None or self.fit_run.running:
+            return
+        current = outcome.made_for(scene)
+        if current == self._current:
+            return
+        self._current = current
+        self.apply_button.disabled = not (current and outcome.determined)
+        self.figures.show_forecast(forecast_columns(outcome.forecast if current else None))
+        if current:
+            self._say(f"Done: {self.fit_run.message}.")
+        else:
+            self._say(STALE_FIT, bad=True)
 
     def _choose(self, fields: list[str | None]) -> None:
         """Choose ``fields`` (None: no field) when the scene offers them all, else keep
@@ -198,6 +228,7 @@ class FitView:
         self.figures.show_forecast(forecast_columns(None))
         self.fit_table.object = ""
         self.apply_button.disabled = True
+        self._current = None
         self._readings_text(f"{readings.source}: {readings_note(readings)}.")
         self.fit_button.disabled = self.fit_run.running
         self.on_settings()
@@ -248,7 +279,8 @@ class FitView:
         if self.screen is not None:
             self.screen.fit = outcome
         self.figures.show_forecast(forecast_columns(outcome.forecast))
-        self.apply_button.disabled = False
+        self._current = True
+        self.apply_button.disabled = not outcome.determined
         self.fit_button.disabled = self.readings is None
 
     def apply(self) -> bool:
@@ -284,9 +316,18 @@ def outcome_html(outcome: FitOutcome) -> str:
             f"{html.escape(a)} ~ {html.escape(b)}: "
             f"{'n/a' if not np.isfinite(r) else f'{r:+.3f}'}" for a, b, r in pairs)
             + "</div>")
+    # the fields as the table names them (the warnings said "coating[0].thickness"
+    # beside "coating 1: thickness")
+    names = sorted(((choice.key, choice.label) for choice in outcome.choices),
+                   key=lambda pair: -len(pair[0]))
     for warning in c.warnings:
+        for key, label in names:
+            warning = warning.replace(key, label)
         parts.append(f"<div class='fit-warning' style='font-size:12px;color:#9b1c1c'>"
                      f"warning: {html.escape(warning)}</div>")
+    if not outcome.determined:
+        parts.append(f"<div class='fit-not-applied' style='font-size:12px;color:#9b1c1c'>"
+                     f"{html.escape(NOT_APPLIED)}</div>")
     if outcome.forecast_error:
         parts.append(f"<div class='fit-warning' style='font-size:12px;color:#9b1c1c'>no "
                      f"forecast: {html.escape(outcome.forecast_error)}</div>")

@@ -293,3 +293,53 @@ def test_a_forecast_the_readings_do_not_determine_is_drawn_without_a_band() -> N
     assert columns["v"] == pytest.approx([0.1, 0.2])  # mm
     assert columns["lower"][0] == pytest.approx(0.1 - 1.96e-3, rel=1e-3)
     assert np.isnan(columns["lower"][1]) and np.isnan(columns["upper"][1])
+
+
+def test_a_fit_of_another_scene_says_so_and_applies_nothing(explorer_app):
+    """A force typed after the fit: the table and the forecast looked current and Apply
+    set the force back to the fitted scene's. Now the status says the fit is of the
+    scene before, the forecast is hidden and Apply is off; back on the fitted scene, the
+    fit is current again."""
+    from explorer.views.fit import STALE_FIT
+
+    app = explorer_app(solved=True)
+    tab = app.fit_tab
+    tab.upload.param.update(filename="levelling.csv",
+                            value=_readings_text(app.state.to_scene()).encode())
+    tab.fields[0].value = "coating[0].modulus"
+    assert tab.start() and tab.fit_run.status == "done", tab.fit_run.message
+    assert not tab.apply_button.disabled
+    force = app.state.loading.histories["force"]
+    start = force.value
+    force.value = 1.3 * start
+    app.controller.wait()
+    assert tab.apply_button.disabled
+    assert html.unescape(STALE_FIT) in html.unescape(tab.fit_status.object)
+    assert len(app.figures.forecast_src["settlement"].data["t"]) == 0
+    force.value = start
+    app.controller.wait()
+    assert not tab.apply_button.disabled
+    assert tab.fit_status.object.count("Done: ") == 1
+    assert len(app.figures.forecast_src["settlement"].data["t"]) > 0
+    assert tab.apply()
+    app.controller.wait()
+    # the fitted scene on screen is the fit's too
+    assert not tab.apply_button.disabled and "Done: " in tab.fit_status.object
+
+
+def test_a_fit_the_readings_do_not_determine_is_not_applied(explorer_app):
+    """A coating's thickness and modulus (their ratio alone counts) went to 11 m and
+    279 GPa, and Apply installed them without a word; the warnings named the fields by
+    their scene paths beside the table's names."""
+    app = explorer_app(solved=True)
+    tab = app.fit_tab
+    tab.upload.param.update(filename="levelling.csv",
+                            value=_readings_text(app.state.to_scene()).encode())
+    tab.fields[0].value = "coating[0].thickness"
+    tab.fields[1].value = "coating[0].modulus"
+    assert tab.start() and tab.fit_run.status == "done", tab.fit_run.message
+    assert tab.apply_button.disabled
+    table = html.unescape(tab.fit_table.object)
+    assert "Apply is off: the readings do not determine every field fitted" in table
+    assert "not identifiable" in table and "coating[0]" not in table
+    assert "coating 1: thickness" in table
