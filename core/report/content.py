@@ -215,6 +215,10 @@ def design_section(result: SceneSolution, flags: Sequence[str] | None = None,
                    tone="bad" if failed or caution or pressure else "good")
 
 
+#: The confidence of the fitted values' intervals the report gives.
+INTERVAL_LEVEL = 0.95
+
+
 def calibration_section(calibration: Any) -> Section:
     """The back-analysis: the readings fitted, each fitted value with its standard error
     (in the field's unit), the correlations, chi^2/dof and the fit's warnings.
@@ -228,10 +232,16 @@ def calibration_section(calibration: Any) -> Section:
     rows = [("readings", f"{readings.count} ({series}), t = {number_text(float(readings.time[0]))}"
                          f" to {days_text(float(readings.time[-1]))}"
                          + (", with standard deviations" if calibration.std_given else ""))]
+    # (the page's column; the report had none)
+    intervals = calibration.intervals(INTERVAL_LEVEL)
+    level = f"{100 * INTERVAL_LEVEL:g}"
     for path in calibration.paths:
         unit = f" {units[path]}" if units[path] else ""
+        low, high = intervals[path]
         rows.append((path, f"{number_text(values[path], 6)} ± {number_text(errors[path], 2)}{unit}"
-                           f" (start {number_text(calibration.start[path], 6)}{unit})"))
+                           f" ({level} % interval {number_text(low, 4)} to "
+                           f"{number_text(high, 4)}{unit}; start "
+                           f"{number_text(calibration.start[path], 6)}{unit})"))
     corr = calibration.correlation
     paths = calibration.paths
     for j in range(len(paths)):

@@ -12,6 +12,7 @@ import pytest
 import core
 from core.presets import read_preset
 from core.report import report_html, report_pdf, sections, write_report
+from core.scene import number_text
 from tests.cli_runs import run_cli
 
 #: Reading times [day after loading] within the preset's output times.
@@ -42,8 +43,12 @@ def test_the_back_analysis_section_lists_the_fit(fitted):
     rows = dict(section.rows)
     assert rows["readings"].startswith("7 (settlement [m]), t = 5 to 300 d")
     assert "with standard deviations" in rows["readings"]
-    assert " ± " in rows["coating[0].modulus"] and rows["coating[0].modulus"].count(" Pa") == 2
-    assert rows["base.age_at_loading"].count(" day") == 2
+    # value ± error, the 95 % interval (the page's column) and the start, each in its unit
+    assert " ± " in rows["coating[0].modulus"] and rows["coating[0].modulus"].count(" Pa") == 3
+    assert rows["base.age_at_loading"].count(" day") == 3
+    low, high = calibration.intervals(0.95)["coating[0].modulus"]
+    assert f"(95 % interval {number_text(low, 4)} to {number_text(high, 4)} Pa; start" in (
+        rows["coating[0].modulus"])
     corr = rows["correlation coating[0].modulus ~ base.age_at_loading"]
     assert corr == f"{calibration.correlation[0, 1]:+.3f}"
     assert rows["χ²/dof"].startswith(f"{calibration.chi2_per_dof:.3g} (5 dof)")
