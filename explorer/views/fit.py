@@ -92,8 +92,10 @@ class FitView:
         self.fit_run.param.watch(self._on_run, ["status", "message"])
         self.fit_run.param.watch(self._on_outcome, "outcome")
         self._choices: dict[str, Any] = {}
-        # whether the last fit is of the scene on screen (None: no fit shown)
+        # whether the fit shown is of the scene on screen (None: no fit shown), and its
+        # status
         self._current: bool | None = None
+        self._done = ""
         # fields a link asked for that the scene on screen does not offer yet
         self._wanted: list[str | None] | None = None
         self.on_settings = on_settings or (lambda: None)
@@ -158,16 +160,17 @@ class FitView:
         outcome = self.fit_run.outcome
         if outcome is None or self._current is None or self.fit_run.running:
             return
-        current = outcome.made_for(scene)
+        self._show_current(outcome, outcome.made_for(scene))
+
+    def _show_current(self, outcome: FitOutcome, current: bool) -> None:
+        """Apply, the forecast and the status of the fit shown, of the scene on screen
+        (``current``) or of another."""
         if current == self._current:
             return
         self._current = current
         self.apply_button.disabled = not (current and outcome.determined)
         self.figures.show_forecast(forecast_columns(outcome.forecast if current else None))
-        if current:
-            self._say(f"Done: {self.fit_run.message}.")
-        else:
-            self._say(STALE_FIT, bad=True)
+        self._say(self._done if current else STALE_FIT, bad=not current)
 
     def _choose(self, fields: list[str | None]) -> None:
         """Choose ``fields`` (None: no field) when the scene offers them all, else keep
@@ -253,6 +256,12 @@ class FitView:
             self._say(f"Not fitted: {exc}", bad=True)
             return False
         self.fit_button.disabled = True
+        # the last fit's values leave the page with its Apply (a failed fit left them on,
+        # applicable, beside its failure)
+        self._current = None
+        self.fit_table.object = ""
+        self.apply_button.disabled = True
+        self.figures.show_forecast(forecast_columns(None))
         self.fit_run.start(scene, self.readings, self.chosen(), background=self.background)
         return True
 
@@ -269,7 +278,9 @@ class FitView:
         elif run.status == "failed":
             self._say(f"Not fitted: {run.message}", bad=True)
         elif run.status == "done":
-            self._say(f"Done: {run.message}.")
+            self._done = f"Done: {run.message}."
+            if self._current is not False:  # (a fit of another scene says so instead)
+                self._say(self._done)
 
     def _on_outcome(self, event: Any) -> None:
         outcome = event.new
@@ -278,9 +289,14 @@ class FitView:
         self.fit_table.object = outcome_html(outcome)
         if self.screen is not None:
             self.screen.fit = outcome
-        self.figures.show_forecast(forecast_columns(outcome.forecast))
-        self._current = True
-        self.apply_button.disabled = not outcome.determined
+        # the scene may have changed while the fit ran (seconds): shown current only
+        # when it is of the scene on screen
+        try:
+            current = outcome.made_for(self.state.to_scene())
+        except ValueError:
+            current = False
+        self._current = None
+        self._show_current(outcome, current)
         self.fit_button.disabled = self.readings is None
 
     def apply(self) -> bool:

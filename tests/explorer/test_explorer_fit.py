@@ -343,3 +343,47 @@ def test_a_fit_the_readings_do_not_determine_is_not_applied(explorer_app):
     assert "Apply is off: the readings do not determine every field fitted" in table
     assert "not identifiable" in table and "coating[0]" not in table
     assert "coating 1: thickness" in table
+
+
+def test_a_scene_changed_while_the_fit_runs_and_a_failed_fit_are_said(explorer_app,
+                                                                       monkeypatch):
+    """A force typed while the fit ran (seconds): its outcome came marked current, with
+    Apply on. A fit that failed left the last fit's table and Apply on beside its
+    failure, and back on that fit's scene the status read "Done: <the failure>"."""
+    import explorer.solving.fit_runner as fit_runner
+    from explorer.views.fit import STALE_FIT
+
+    app = explorer_app(solved=True)
+    tab = app.fit_tab
+    tab.upload.param.update(filename="levelling.csv",
+                            value=_readings_text(app.state.to_scene()).encode())
+    tab.fields[0].value = "coating[0].modulus"
+    force = app.state.loading.histories["force"]
+    start = force.value
+    fit_outcome = fit_runner.fit_outcome
+
+    def typed_meanwhile(*args, **kwargs):
+        outcome = fit_outcome(*args, **kwargs)
+        force.value = 1.3 * start
+        app.controller.wait()
+        return outcome
+
+    monkeypatch.setattr(fit_runner, "fit_outcome", typed_meanwhile)
+    assert tab.start() and tab.fit_run.status == "done", tab.fit_run.message
+    monkeypatch.undo()
+    assert tab.apply_button.disabled
+    assert html.unescape(STALE_FIT) in html.unescape(tab.fit_status.object)
+    force.value = start
+    app.controller.wait()
+    assert not tab.apply_button.disabled and "Done: fitted" in tab.fit_status.object
+    # a fit that fails takes the last one's values off the page
+    tab.fields[1].value = "coating[0].modulus"  # chosen twice
+    assert tab.start() is True or tab.fit_run.status == "failed"
+    assert tab.fit_run.status == "failed"
+    assert tab.apply_button.disabled and tab.fit_table.object == ""
+    force.value = 1.2 * start
+    app.controller.wait()
+    force.value = start
+    app.controller.wait()
+    assert tab.apply_button.disabled and "Not fitted: field 2: chosen twice" in (
+        html.unescape(tab.fit_status.object))
