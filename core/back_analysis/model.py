@@ -43,13 +43,18 @@ FD_STEP = 1e-3
 #: measures ~1e4 and more, set by the finite differences' own error (~1e12
 #: with central ones).
 MAX_CONDITION = 1e3
-#: A forecast of a fit whose fields are not all determined has a band where it depends
-#: on the combinations the readings determine alone: its gradient's share along the
-#: others (the singular directions beyond :data:`MAX_CONDITION`) at most this, the
-#: central differences' own error (h^2 = 1e-6 of :data:`FD_STEP`). A settlement forecast
-#: of a coating's thickness and modulus, whose ratio alone counts, leaves 1.4e-13 to
-#: 3.8e-13 of it along the undetermined one (round-off; tests/back_analysis); a forecast
-#: that depends on that direction more has no band (infinite).
+#: The central differences resolve a combination of the fields whose singular value
+#: (of the column-scaled Jacobian) is at least this share of the largest: their own error
+#: (h^2 = 1e-6 of :data:`FD_STEP`). Below it the covariance along that combination is the
+#: differences' round-off (a coating's thickness and modulus, whose ratio alone counts:
+#: 3.6e-13, a covariance of ~1e24), and a forecast is given a band from the resolved
+#: combinations alone, where its gradient's share along the others is at most
+#: :data:`UNDETERMINED_SHARE`, and none (infinite) otherwise. A merely ill-conditioned fit
+#: (condition 5e4, say) keeps its covariance's band.
+RESOLVED_SINGULAR_SHARE = 1e-6
+#: See :data:`RESOLVED_SINGULAR_SHARE`: the same error again. A settlement forecast of the
+#: thickness-and-modulus pair leaves 1.4e-13 to 3.8e-13 of it along the undetermined
+#: combination (round-off; tests/back_analysis).
 UNDETERMINED_SHARE = 1e-6
 #: The solver tolerance of the fit's solves (the scene's own when tighter): the error
 #: estimate of the shipped young-concrete scene stays ~1.6e-5 (the creep kernel's fit)

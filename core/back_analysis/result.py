@@ -312,24 +312,27 @@ class Calibration:
 
     def _forecast_variance(self, gradient: np.ndarray) -> np.ndarray:
         """``g^T cov g`` of each row ``g`` of ``gradient`` (outputs x fields, by the fit's
-        coordinates). Where the readings do not determine every field (the condition
-        number above :data:`~core.back_analysis.model.MAX_CONDITION`), the covariance is
-        that of the finite differences' error along the undetermined combinations
-        (~1e24 for a coating's thickness and modulus): a forecast is then given a band
-        from the determined combinations alone when its gradient's share along the others
-        is at most :data:`~core.back_analysis.model.UNDETERMINED_SHARE` (it depends on
-        what the readings fix: the ratio of thickness and modulus), and none (infinite)
-        otherwise. Through the covariance a forecast band read -0.04 to 0.04 m for a
-        settlement of 4.1e-5 m."""
-        from core.back_analysis.model import MAX_CONDITION, UNDETERMINED_SHARE
+        coordinates). Along a combination of the fields the finite differences do not
+        resolve (:data:`~core.back_analysis.model.RESOLVED_SINGULAR_SHARE`), the
+        covariance is their round-off (~1e24 for a coating's thickness and modulus): a
+        forecast is then given a band from the resolved combinations alone when its
+        gradient's share along the others is at most
+        :data:`~core.back_analysis.model.UNDETERMINED_SHARE` (it depends on what the
+        readings fix: the ratio of thickness and modulus), and none (infinite) otherwise.
+        Through the covariance a forecast band read -0.04 to 0.04 m for a settlement of
+        4.1e-5 m."""
+        from core.back_analysis.model import RESOLVED_SINGULAR_SHARE, UNDETERMINED_SHARE
 
-        if self.condition <= MAX_CONDITION or self.jacobian is None:
-            return np.einsum("ij,jk,ik->i", gradient, self.cov_x, gradient)
+        whole = np.einsum("ij,jk,ik->i", gradient, self.cov_x, gradient)
+        if self.jacobian is None:
+            return whole
         J = self.jacobian
         norms = np.linalg.norm(J, axis=0)
         safe = np.where(norms > 0, norms, 1.0)
         _, sv, vt = np.linalg.svd(J / safe, full_matrices=False)
-        keep = sv >= sv[0] / MAX_CONDITION if sv[0] > 0 else np.zeros(sv.size, bool)
+        keep = sv >= sv[0] * RESOLVED_SINGULAR_SHARE if sv[0] > 0 else np.zeros(sv.size, bool)
+        if keep.all():
+            return whole
         along = (gradient / safe) @ vt.T                      # (outputs, directions)
         size = np.linalg.norm(along, axis=1)
         var = self.noise_scale ** 2 * np.sum(

@@ -639,3 +639,24 @@ def test_a_degenerate_pairs_forecast_has_the_band_of_what_the_readings_fix() -> 
     # gave a band of width 0 here
     np.testing.assert_allclose(band.settlement_std, one.settlement_std, rtol=1e-6)
     np.testing.assert_allclose(band.settlement, one.settlement, rtol=1e-5)
+
+
+def test_an_ill_conditioned_but_resolved_fit_keeps_its_covariances_band() -> None:
+    """Two fields correlated to 1 - 1e-9 (condition 5e4) are resolved by the central
+    differences (their error ~1e-6): the forecast's band is the covariance's, not the
+    infinite one of an unresolved combination (a first cut at the warning's condition
+    1e3 gave inf)."""
+    import types
+
+    from core.back_analysis.fit import _covariance
+    from core.back_analysis.result import Calibration
+
+    rng = np.random.default_rng(0)
+    a = rng.standard_normal(20)
+    J = np.column_stack([a, a + 5e-5 * rng.standard_normal(20)])
+    cov, condition = _covariance(J, 1.0)
+    assert 1e4 < condition < 1e5
+    fit = types.SimpleNamespace(jacobian=J, cov_x=cov, noise_scale=1.0)
+    gradient = np.array([[1.0, 0.0], [1.0, 1.0], [1.0, -1.0]])
+    np.testing.assert_allclose(Calibration._forecast_variance(fit, gradient),
+                               np.einsum("ij,jk,ik->i", gradient, cov, gradient))
