@@ -87,9 +87,11 @@ def key_numbers(result: SceneSolution, time: float | None = None,
     settlement, t_s = _at(t, result.settlement, accuracy)
     tilt, t_a = _at(t, result.tilt, accuracy)
     force, moment = float(result.force[-1]), float(result.moment[-1])
-    # a moment within the answer's accuracy of the force's on the base is zero (the
-    # centred punch's round-off read "-1.113e-15 kN·m/m" and "e = -1.391e-18 m")
-    if abs(moment) <= accuracy * abs(force) * result.scene.half_width:
+    # a computed moment within the answer's accuracy (at most ROUND_OFF_SHARE) of the
+    # force's on the base is zero: the centred punch's round-off read "-1.113e-15
+    # kN·m/m" and "e = -1.391e-18 m" (a given moment is the user's, shown as given)
+    if "moment" not in result.scene.given and abs(moment) <= min(
+            accuracy, ROUND_OFF_SHARE) * abs(force) * result.scene.half_width:
         moment = 0.0
     rows = [
         ("largest settlement δ", f"{_shown(settlement, 'm')} at t = {days_text(t_s)}"),
@@ -210,11 +212,19 @@ def design_section(result: SceneSolution, flags: Sequence[str] | None = None,
     caution = flagged_caution(result.flags if flags is None else flags)
     lead = "A limit is exceeded" if failed else "Every limit the scene sets holds"
     pressure = "" if fe_check is None else pressure_caution(fe_check)
+    # (it qualifies a verdict on the pressure only: a scene limiting its settlement alone
+    # is not turned red by it)
+    limited = any(line.quantity == "q_max" and line.limit is not None
+                  for line in check.checks)
     return Section("Design check", f"{lead}, {caution}." if caution else f"{lead}.", rows,
                    notes=[f"FE check: {pressure}"] if pressure else [],
-                   tone="bad" if failed or caution or pressure else "good")
+                   tone="bad" if failed or caution or (pressure and limited) else "good")
 
 
+#: A computed moment at most this share of the force's on the base (P a), within the
+#: answer's accuracy, is round-off and reads 0 (a flagged answer's accuracy, up to 1e-3,
+#: would have zeroed eccentricities of a millimetre a metre).
+ROUND_OFF_SHARE = 1e-6
 #: The confidence of the fitted values' intervals the report gives.
 INTERVAL_LEVEL = 0.95
 
@@ -238,9 +248,11 @@ def calibration_section(calibration: Any) -> Section:
     for path in calibration.paths:
         unit = f" {units[path]}" if units[path] else ""
         low, high = intervals[path]
+        # (as the Fit tab says it: "unbounded", where "0 to not finite Pa" was read)
+        interval = (f"{number_text(low, 4)} to {number_text(high, 4)}{unit}"
+                    if np.isfinite(low) and np.isfinite(high) else "unbounded")
         rows.append((path, f"{number_text(values[path], 6)} ± {number_text(errors[path], 2)}{unit}"
-                           f" ({level} % interval {number_text(low, 4)} to "
-                           f"{number_text(high, 4)}{unit}; start "
+                           f" ({level} % interval {interval}; start "
                            f"{number_text(calibration.start[path], 6)}{unit})"))
     corr = calibration.correlation
     paths = calibration.paths

@@ -639,6 +639,12 @@ def test_a_degenerate_pairs_forecast_has_the_band_of_what_the_readings_fix() -> 
     # gave a band of width 0 here
     np.testing.assert_allclose(band.settlement_std, one.settlement_std, rtol=1e-6)
     np.testing.assert_allclose(band.settlement, one.settlement, rtol=1e-5)
+    # the report says the fields' intervals are unbounded, as the tab (it read "0 to not
+    # finite Pa")
+    from core.report.content import calibration_section
+
+    rows = dict(calibration_section(both).rows)
+    assert "(95 % interval unbounded; start" in rows["coating[0].modulus"]
 
 
 def test_an_ill_conditioned_but_resolved_fit_keeps_its_covariances_band() -> None:

@@ -158,6 +158,13 @@ def test_the_fe_checks_pressure_is_reported_and_qualifies_the_design_check():
                                "follows the coating's compliance at each point, where the "
                                "resolved layers spread the load; beside an abrupt change of "
                                "the coating it jumps)"]
+    # a scene that limits its settlement alone (its model error measured within tol, so
+    # no flag qualifies the verdict): the note, and no red for it
+    scene["limits"] = {"settlement_limit": 1.0}
+    settled = describe(core.solve(scene), check={**check, "model_error": 0.01,
+                                                 "scene_key": checked_key(scene)})
+    assert settled["Design check"]["notes"] == design["notes"]
+    assert settled["Design check"]["tone"] == "good"
     # without the check, or with one of another scene, neither is said
     plain = describe(result)
     assert "contact pressure against the FE model" not in plain["Accuracy"]["rows"]
