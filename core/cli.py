@@ -708,10 +708,12 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     summary = fit.summary()
     if forecast is not None:
         lower, upper = forecast.band("settlement")
+        band = (f"[{lower[-1]:.6g}, {upper[-1]:.6g}] m (from the fitted fields' uncertainty)"
+                if math.isfinite(float(upper[-1] - lower[-1])) else
+                "none: the readings do not determine it (see the warnings)")
         summary += (f"\nforecast at {days_text(forecast.times[-1])}: settlement "
                     f"{forecast.settlement[-1]:.6g} m, {100 * forecast.level:g} % band "
-                    f"[{lower[-1]:.6g}, {upper[-1]:.6g}] m (from the fitted fields' "
-                    "uncertainty)")
+                    f"{band}")
     if output is None or str(output) != STDIO:
         print("\n".join(line for line in summary.splitlines()
                         if not line.startswith("warning: ")))

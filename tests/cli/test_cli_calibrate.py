@@ -128,3 +128,24 @@ def test_a_scene_of_several_punches_is_refused_in_one_line(tmp_path: Path) -> No
     assert proc.returncode == EXIT_BAD_INPUT
     assert proc.stderr == ("error: scene: holds 2 punches (punches); a fit takes a scene of "
                            "one punch, whose readings are its settlement and tilt\n")
+
+
+def test_a_forecast_band_is_given_where_it_is_determined_and_none_where_not(
+        tmp_path: Path, monkeypatch) -> None:
+    """The readings fix a coating's h / E alone, and the settlement depends on that ratio
+    alone: its band is the ratio's (finite). A forecast the readings do not determine has
+    none, said so (the summary would have printed "[-inf, inf] m")."""
+    from core.back_analysis.result import Calibration
+
+    scene, readings = _files(tmp_path)
+    args = ("calibrate", scene, readings, "--fit", "coating[0].thickness", "--fit",
+            "coating[0].modulus", "--forecast", "3650")
+    proc = run_cli(*args, cwd=tmp_path)
+    assert proc.returncode == EXIT_OK, proc.stderr
+    line = next(t for t in proc.stdout.splitlines() if t.startswith("forecast at"))
+    assert "inf" not in line and "% band [" in line, line
+    monkeypatch.setattr(Calibration, "_forecast_variance",
+                        lambda self, gradient: np.full(gradient.shape[0], np.inf))
+    proc = run_cli(*args, cwd=tmp_path)
+    line = next(t for t in proc.stdout.splitlines() if t.startswith("forecast at"))
+    assert line.endswith("% band none: the readings do not determine it (see the warnings)")
