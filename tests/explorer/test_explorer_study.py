@@ -110,8 +110,8 @@ def test_eccentricity_sets_the_moment_from_the_force():
      "parameter 2: the eccentricity sets the moment"),
     ([Axis("solver.tol", 1e-6, 1e-4, 3)], "parameter 1: 'solver.tol' is not a field"),
     ([Axis("coating[0].modulus", -100.0, 900.0, 3)],
-     "parameter 1 (coating 1: Young's modulus): the scene is invalid at "
-     "coating[0].modulus = -1e+08"),
+     # the value as typed, in the tab's unit (it read "coating[0].modulus = -1e+08")
+     "parameter 1 (coating 1: Young's modulus): the scene is invalid at -100 MPa ("),
 ])
 def test_a_bad_study_is_refused_naming_the_field(axes, starts):
     with pytest.raises(ValueError) as info:
