@@ -86,6 +86,7 @@ from core.scene import (
     percent_text,
     punches_from_dict,
     read_scene_json,
+    save_scene,
     scene_from_dict,
     scene_json_schema,
     schema_errors,
@@ -598,6 +599,32 @@ def _cmd_report(args: argparse.Namespace) -> int:
     return _strict_verdict(result, flags) if args.strict else EXIT_OK
 
 
+def _cmd_preset(args: argparse.Namespace) -> int:
+    """List the shipped scenes, or write one as a scene file to start from."""
+    if args.name is None:
+        width = max(len(name) for name in preset_names())
+        for name in preset_names():
+            print(f"{name:<{width}}  {load_scene(PRESET_PREFIX + name).name}")
+        return EXIT_OK
+    if args.name.startswith(PRESET_PREFIX):  # (as SCENE takes it)
+        args.name = args.name[len(PRESET_PREFIX):]
+    try:
+        scene = load_scene(PRESET_PREFIX + args.name)
+    except ValueError as exc:
+        raise _InputError(str(exc)) from None
+    output = Path(args.output) if args.output else None
+    if output is None or str(output) == STDIO:
+        sys.stdout.write(json.dumps(scene.to_dict(), indent=1, allow_nan=False) + "\n")
+        return EXIT_OK
+    if output.suffix.lower() != ".json":
+        raise _InputError(f"--output: {output}: a scene file is .json")
+    _check_outputs(STDIO, [("--output", output)])
+    save_scene(scene, output)
+    print(f"written to {output}: the preset {args.name} ({scene.name}), to change and "
+          f"solve ('coated-punch validate {output}')")
+    return EXIT_OK
+
+
 def _cmd_schema(args: argparse.Namespace) -> int:
     if args.kind == "study":
         from core.study import study_json_schema
@@ -826,7 +853,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "'coated-punch schema scene' prints the JSON Schema.")
     parser.add_argument("--version", action="version", version=f"coated-punch {VERSION}")
     sub = parser.add_subparsers(dest="command",
-                                metavar="{solve,validate,report,sweep,calibrate,check,schema}",
+                                metavar="{solve,validate,report,sweep,calibrate,check,preset,schema}",
                                 parser_class=_Parser)
     sub.required = True
     # the commands that solve: the run bounds its own memory (core.limits)
@@ -885,6 +912,13 @@ def build_parser() -> argparse.ArgumentParser:
                                "next to the estimate; the measurement decides the "
                                "model_error flag")
     p_report.set_defaults(run=_cmd_report)
+    p_preset = sub.add_parser("preset", help="list the shipped scenes, or write one as a "
+                                             "scene file to start from")
+    p_preset.add_argument("name", nargs="?", help="the preset ("
+                          + ", ".join(preset_names()) + "); without it, the list")
+    p_preset.add_argument("--output", "-o", metavar="FILE.json",
+                          help="where to write it (default: standard output)")
+    p_preset.set_defaults(run=_cmd_preset)
     p_schema = sub.add_parser("schema", help="print the JSON Schema of scene or study files")
     p_schema.add_argument("kind", nargs="?", choices=tuple(SCHEMA_FILES), default="scene",
                           help="which files (default: scene)")

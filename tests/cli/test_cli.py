@@ -436,3 +436,23 @@ def test_one_day_is_a_day_and_no_difference_reads_minus_zero(tmp_path: Path, mon
     monkeypatch.setattr(core.scene, "check_scene", lambda *args, **kwargs: report)
     checked = run("check", path)
     assert "-0.00%" not in checked.stdout and "    0.00%" in checked.stdout, checked.stdout
+
+
+def test_a_preset_is_listed_and_written_out_to_start_from(tmp_path: Path):
+    """A user of the installed package had no scene file to follow the README's
+    commands with (``footing.json``): ``preset`` lists the shipped scenes and writes one
+    out, a file ``validate`` and ``solve`` read back as the preset."""
+    listed = run("preset")
+    assert listed.returncode == 0
+    assert [line.split()[0] for line in listed.stdout.splitlines()] == list(
+        core.presets.preset_names())
+    path = tmp_path / "footing.json"
+    written = run("preset", "eccentric_creep", "-o", path)
+    assert written.returncode == 0, written.stderr
+    assert core.load_scene(path) == core.load_scene("preset:eccentric_creep")
+    assert run("validate", path).returncode == 0
+    shown = run("preset", "preset:uniform_flat")  # as SCENE takes it; to standard output
+    assert json.loads(shown.stdout) == core.load_scene("preset:uniform_flat").to_dict()
+    assert_one_line_error(run("preset", "nope"), "preset:nope: no shipped scene of that name")
+    assert_one_line_error(run("preset", "uniform_flat", "-o", tmp_path / "s.txt"),
+                          f"--output: {tmp_path / 's.txt'}: a scene file is .json")
