@@ -45,6 +45,7 @@ import argparse
 import contextlib
 import json
 import math
+import os
 import shutil
 import sys
 from collections.abc import Iterator, Sequence
@@ -1008,6 +1009,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader of standard output left (``| head``): no error of ours, and nothing
+        # more to write (Python's flush at exit would raise again on the closed pipe)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_OK
     except Exception as exc:  # the promise is one line on stderr, never a traceback
         print(f"error: internal error ({type(exc).__name__}: {_one_line(exc)}); please "
               "report it with the scene file", file=sys.stderr)

@@ -456,3 +456,19 @@ def test_a_preset_is_listed_and_written_out_to_start_from(tmp_path: Path):
     assert_one_line_error(run("preset", "nope"), "preset:nope: no shipped scene of that name")
     assert_one_line_error(run("preset", "uniform_flat", "-o", tmp_path / "s.txt"),
                           f"--output: {tmp_path / 's.txt'}: a scene file is .json")
+
+
+def test_a_reader_that_leaves_early_is_no_error() -> None:
+    """``coated-punch solve ... | head -1`` read "error: internal error
+    (BrokenPipeError...)" and exit 1, three runs in four."""
+    import sys
+
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    for _ in range(3):
+        child = subprocess.Popen([sys.executable, "-m", "core", "solve", "preset:worn_coating",
+                                  "--pressure-csv", "-"], cwd=ROOT, env=env,
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        assert child.stdout.readline()  # one line, then the reader leaves
+        child.stdout.close()
+        err = child.stderr.read().decode()
+        assert child.wait(timeout=120) == 0 and err == "", err
