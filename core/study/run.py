@@ -344,13 +344,17 @@ def _counts(parts: WorkDir, n_batches: int) -> dict[str, int]:
 def check_output(path: Path) -> None:
     """Refuse an output path whose extension is not ``.nc``, ``.csv`` or ``.parquet``, or
     whose directory does not exist (a mistyped one was created, with the study's parts
-    beside the output)."""
+    beside the output); :class:`core.optional.MissingDependency` for ``.parquet`` without
+    pyarrow."""
     if path.suffix.lower() not in (".nc", ".csv", ".parquet"):
         raise ValueError(f"output: unsupported extension {path.suffix!r} (use .nc, .csv or "
                          ".parquet)")
     if not path.parent.is_dir():
         raise ValueError(f"output: the directory {str(path.parent)!r} does not exist (create "
                          "it first, or choose another path)")
+    if path.suffix.lower() == ".parquet":
+        # before the study, not after it (its points were all solved, then refused)
+        import_optional("pyarrow.parquet", "a study's Parquet table")
 
 
 def _variable_name(path: str) -> str:

@@ -158,3 +158,18 @@ def test_the_long_form_names_each_varied_field_with_its_unit(tmp_path) -> None:
         header = next(csv.reader(line for line in f if not line.startswith("#")))
     assert header[:4] == ["point", "loading_force_N_per_m", "coating_0_poisson", "sample"]
     assert "settlement_m" in header and "q_max_Pa" in header
+
+
+def test_a_parquet_output_without_pyarrow_is_refused_before_the_study(monkeypatch,
+                                                                     tmp_path) -> None:
+    """Every point was solved, then the table refused (pyarrow missing), its parts left."""
+    import sys
+
+    from core.optional import MissingDependency
+    from core.study import check_output
+
+    for name in ("pyarrow", "pyarrow.parquet"):  # not installed, as the import sees it
+        monkeypatch.setitem(sys.modules, name, None)
+    with pytest.raises(MissingDependency, match="pyarrow is needed for a study's Parquet"):
+        check_output(tmp_path / "r.parquet")
+    check_output(tmp_path / "r.csv")
