@@ -909,7 +909,8 @@ def build_parser() -> argparse.ArgumentParser:
                                "written all the same)")
     p_report.add_argument("--fe-check", action="store_true",
                           help="also run the finite-element check of the coating model at "
-                               "loading (as 'check', ~1 s) and report its measured error "
+                               "loading (as 'check': ~1 s, up to ~20 s where the punch lifts "
+                               "off) and report its measured error "
                                "next to the estimate; the measurement decides the "
                                "model_error flag")
     p_report.set_defaults(run=_cmd_report)

@@ -175,8 +175,10 @@ def report_pdf(result: SceneSolution | PunchesSolution, time: float | None = Non
     MissingDependency
         Without Matplotlib or HoloViews (the ``report`` extra).
     """
-    import_optional("holoviews", "the PDF report")
+    # Matplotlib first: its extra, report, brings HoloViews too (asked for first, the
+    # plot extra was named, and after it the report extra)
     import_optional("matplotlib", "the PDF report")
+    import_optional("holoviews", "the PDF report")
     import matplotlib
 
     matplotlib.use("Agg", force=False)

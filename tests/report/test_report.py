@@ -276,6 +276,10 @@ def test_a_missing_plotting_package_is_named_with_its_extra(monkeypatch, checked
     monkeypatch.setitem(sys.modules, "matplotlib", None)
     with pytest.raises(MissingDependency, match=r"coated-punch\[report\]"):
         report_pdf(checked)
+    # without both (the solver alone): the extra that brings both, not plot and then report
+    monkeypatch.setitem(sys.modules, "holoviews", None)
+    with pytest.raises(MissingDependency, match=r"coated-punch\[report\]"):
+        report_pdf(checked)
 
 
 def test_long_times_read_without_an_exponent_and_in_years():
