@@ -87,9 +87,9 @@ from core.scene import (
     percent_text,
     punches_from_dict,
     read_scene_json,
-    save_scene,
     scene_from_dict,
     scene_json_schema,
+    scene_to_json,
     schema_errors,
     schema_text,
     solve,
@@ -106,6 +106,9 @@ EXIT_BAD_INPUT = 2
 EXIT_DESIGN_FAILED = 3
 #: ``solve --strict``: the answer carries a validity flag (wins over a failed check).
 EXIT_FLAGGED = 4
+#: The reader of standard output left before the end (``| head``): the shell's code of a
+#: process ended by a closed pipe (128 + SIGPIPE).
+EXIT_BROKEN_PIPE = 141
 #: The name standing for standard input (a scene) or standard output (a file written).
 STDIO = "-"
 #: How standard input is named in messages.
@@ -603,6 +606,9 @@ def _cmd_report(args: argparse.Namespace) -> int:
 def _cmd_preset(args: argparse.Namespace) -> int:
     """List the shipped scenes, or write one as a scene file to start from."""
     if args.name is None:
+        if args.output:
+            raise _InputError("--output: give the preset to write (coated-punch preset NAME "
+                              "-o FILE.json); without a name the list is printed")
         width = max(len(name) for name in preset_names())
         for name in preset_names():
             print(f"{name:<{width}}  {load_scene(PRESET_PREFIX + name).name}")
@@ -615,14 +621,18 @@ def _cmd_preset(args: argparse.Namespace) -> int:
         raise _InputError(str(exc)) from None
     output = Path(args.output) if args.output else None
     if output is None or str(output) == STDIO:
-        sys.stdout.write(json.dumps(scene.to_dict(), indent=1, allow_nan=False) + "\n")
+        sys.stdout.write(scene_to_json(scene) + "\n")
         return EXIT_OK
     if output.suffix.lower() != ".json":
         raise _InputError(f"--output: {output}: a scene file is .json")
+    if output.exists() and not args.force:
+        # the file written is the one to edit: a second run wiped the edits
+        raise _InputError(f"--output: {output} exists (a scene being edited?); choose "
+                          "another file, or --force to replace it")
     _check_outputs(STDIO, [("--output", output)])
-    save_scene(scene, output)
+    _write(output, scene_to_json(scene) + "\n")
     print(f"written to {output}: the preset {args.name} ({scene.name}), to change and "
-          f"solve ('coated-punch validate {output}')")
+          f"solve (coated-punch validate '{output}')")
     return EXIT_OK
 
 
@@ -854,7 +864,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "'coated-punch schema scene' prints the JSON Schema.")
     parser.add_argument("--version", action="version", version=f"coated-punch {VERSION}")
     sub = parser.add_subparsers(dest="command",
-                                metavar="{solve,validate,report,sweep,calibrate,check,preset,schema}",
+                                metavar="{solve,validate,report,preset,schema,sweep,calibrate,check}",
                                 parser_class=_Parser)
     sub.required = True
     # the commands that solve: the run bounds its own memory (core.limits)
@@ -919,7 +929,10 @@ def build_parser() -> argparse.ArgumentParser:
     p_preset.add_argument("name", nargs="?", help="the preset ("
                           + ", ".join(preset_names()) + "); without it, the list")
     p_preset.add_argument("--output", "-o", metavar="FILE.json",
-                          help="where to write it (default: standard output)")
+                          help="where to write it (default: standard output); an existing "
+                               "file is kept unless --force")
+    p_preset.add_argument("--force", action="store_true",
+                          help="replace an existing --output file")
     p_preset.set_defaults(run=_cmd_preset)
     p_schema = sub.add_parser("schema", help="print the JSON Schema of scene or study files")
     p_schema.add_argument("kind", nargs="?", choices=tuple(SCHEMA_FILES), default="scene",
@@ -996,11 +1009,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line with ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
     global _MEMORY_BOUND
     try:
-        args = build_parser().parse_args(argv)
+        try:
+            args = build_parser().parse_args(argv)
+        except SystemExit:
+            sys.stdout.flush()  # (--version, --help: as below, a reader that left)
+            raise
         if argv is None and getattr(args, "max_memory", None) is not None:
             # run as a program: its own process (never a caller's Python session)
             _MEMORY_BOUND = bound_memory(int(args.max_memory * 2**30))
-        return int(args.run(args))
+        code = int(args.run(args))
+        # what print() left in the buffer is written here, where a reader that left is
+        # caught (at exit it read "Exception ignored ... BrokenPipeError", exit 120)
+        sys.stdout.flush()
+        return code
     except _InputError as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -1011,11 +1032,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("error: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
-        # the reader of standard output left (``| head``): no error of ours, and nothing
-        # more to write (Python's flush at exit would raise again on the closed pipe)
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        return EXIT_OK
+        # the reader of standard output left (``| head``): no message (it read "internal
+        # error"), the shell's code of a closed pipe, and nothing more written to it
+        # (Python's flush at exit would raise again)
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            try:
+                os.dup2(devnull, sys.stdout.fileno())
+            finally:
+                os.close(devnull)
+        except (OSError, ValueError):  # (a stdout without a descriptor: a caller's)
+            pass
+        return EXIT_BROKEN_PIPE
     except Exception as exc:  # the promise is one line on stderr, never a traceback
         print(f"error: internal error ({type(exc).__name__}: {_one_line(exc)}); please "
               "report it with the scene file", file=sys.stderr)

@@ -76,7 +76,7 @@ from core.scene.evidence import (
     flags_with_evidence,
     model_error_evidence,
 )
-from core.scene.files import load_scene, read_scene_json, save_scene
+from core.scene.files import load_scene, read_scene_json, save_scene, scene_to_json
 from core.scene.json_schema import DIALECT as JSON_SCHEMA_DIALECT
 from core.scene.json_schema import (
     SCHEMA_FILES,
@@ -212,6 +212,7 @@ __all__ = [
     "read_scene_json",
     "replace_loads",
     "save_scene",
+    "scene_to_json",
     "Scene",
     "scene_definitions",
     "scene_from_dict",
