@@ -135,17 +135,26 @@ class PlannedStudy:
         return tuple(len(v) for v in self.values)
 
 
+#: Creep models whose answers do not depend on the age at loading (their compliance is
+#: a function of the time since loading alone, or constant).
+NON_AGING = frozenset({"elastic", "exponential", "prony"})
+
+
 def study_choices(scene: Mapping[str, Any]) -> list[Choice]:
     """The fields of ``scene`` (a scene dict) the tab offers, loads first: each number
     the scene holds at a path of the table above, and the eccentricity e = M/P [m] when
     force and moment are both given as constants with P > 0."""
     out: list[Choice] = []
     fields = dict(numeric_fields(scene))
+    creep = scene.get("base", {}).get("creep", {})
+    model = creep.get("model") if isinstance(creep, Mapping) else None
     for pattern, label, unit, scale in _FIELDS:
         for path, value in fields.items():
             match = re.fullmatch(pattern, path)
             if match is None:
                 continue
+            if path == "base.age_at_loading" and model in NON_AGING:
+                continue  # it changes nothing (a study drew a constant, a fit "no reading")
             k = int(match.group(1)) + 1 if "{k}" in label else 0
             out.append(Choice(path, label.format(k=k), unit, scale, value / scale))
         if pattern == r"loading\.moment":

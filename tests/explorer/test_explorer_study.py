@@ -331,3 +331,18 @@ def test_the_creep_coefficients_are_offered_and_vary_the_scene():
         np.testing.assert_allclose(result.outputs["settlement"][j], want.settlement,
                                    rtol=1e-12)
     assert result.outputs["settlement"][1, -1] > result.outputs["settlement"][0, -1]
+
+
+def test_the_age_at_loading_is_offered_only_where_it_changes_the_answer():
+    """On a base that does not age (an elastic one, or creep as a function of the time
+    since loading alone) the age at loading changes nothing: a study of it drew a flat
+    line, a fit of it could only end in "moves no reading"."""
+    from core.presets import read_preset
+    from explorer.model import fit_choices, study_choices
+
+    for name, offered in (("uniform_flat", False), ("bare_layer", False),
+                          ("patched_insert", False), ("eccentric_creep", True),
+                          ("young_concrete_50_years", True)):
+        scene = read_preset(name)
+        for choices in (study_choices(scene), fit_choices(scene)):
+            assert ("base.age_at_loading" in [c.key for c in choices]) == offered, name
