@@ -31,6 +31,16 @@ def _readings_text(scene: dict) -> str:
     return readings_csv({"time": TIMES, "settlement": list(result.settlement * scatter)})
 
 
+def _with_readings(explorer_app):
+    """The default scene solved, and readings of :func:`_readings_text` uploaded to its
+    Fit tab: ``(app, tab)``."""
+    app = explorer_app(solved=True)
+    tab = app.fit_tab
+    tab.upload.param.update(filename="levelling.csv",
+                            value=_readings_text(app.state.to_scene()).encode())
+    return app, tab
+
+
 def test_readings_are_drawn_fitted_and_the_fitted_scene_applied(explorer_app):
     app = explorer_app(solved=True)
     tab = app.fit_tab
@@ -86,10 +96,7 @@ def test_the_report_carries_the_fit_while_its_fitted_scene_is_shown(explorer_app
     fitted value, the readings drawn over the settlement); before Apply, and once
     another value moves, the scene on screen is not the fitted one and the report says
     nothing of the fit."""
-    app = explorer_app(solved=True)
-    tab = app.fit_tab
-    tab.upload.param.update(filename="levelling.csv",
-                            value=_readings_text(app.state.to_scene()).encode())
+    app, tab = _with_readings(explorer_app)
     tab.fields[0].value = "coating[0].modulus"
     assert tab.start() and tab.fit_run.status == "done", tab.fit_run.message
     assert app.screen.fit is tab.fit_run.outcome
@@ -302,10 +309,7 @@ def test_a_fit_of_another_scene_says_so_and_applies_nothing(explorer_app):
     fit is current again."""
     from explorer.views.fit import STALE_FIT
 
-    app = explorer_app(solved=True)
-    tab = app.fit_tab
-    tab.upload.param.update(filename="levelling.csv",
-                            value=_readings_text(app.state.to_scene()).encode())
+    app, tab = _with_readings(explorer_app)
     tab.fields[0].value = "coating[0].modulus"
     assert tab.start() and tab.fit_run.status == "done", tab.fit_run.message
     assert not tab.apply_button.disabled
@@ -331,10 +335,7 @@ def test_a_fit_the_readings_do_not_determine_is_not_applied(explorer_app):
     """A coating's thickness and modulus (their ratio alone counts) went to 11 m and
     279 GPa, and Apply installed them without a word; the warnings named the fields by
     their scene paths beside the table's names."""
-    app = explorer_app(solved=True)
-    tab = app.fit_tab
-    tab.upload.param.update(filename="levelling.csv",
-                            value=_readings_text(app.state.to_scene()).encode())
+    app, tab = _with_readings(explorer_app)
     tab.fields[0].value = "coating[0].thickness"
     tab.fields[1].value = "coating[0].modulus"
     assert tab.start() and tab.fit_run.status == "done", tab.fit_run.message
@@ -353,10 +354,7 @@ def test_a_scene_changed_while_the_fit_runs_and_a_failed_fit_are_said(explorer_a
     import explorer.solving.fit_runner as fit_runner
     from explorer.views.fit import STALE_FIT
 
-    app = explorer_app(solved=True)
-    tab = app.fit_tab
-    tab.upload.param.update(filename="levelling.csv",
-                            value=_readings_text(app.state.to_scene()).encode())
+    app, tab = _with_readings(explorer_app)
     tab.fields[0].value = "coating[0].modulus"
     force = app.state.loading.histories["force"]
     start = force.value
