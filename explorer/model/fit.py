@@ -127,8 +127,10 @@ class FitOutcome:
         out = []
         for c in self.choices:
             low, high = (v / c.scale for v in intervals[c.key])
+            # (with its unit: the column read "24.84 to 25.4" beside "25.12 ± 0.12 GPa")
             out.append("unbounded" if not (math.isfinite(low) and math.isfinite(high))
-                       else f"{number_text(low, 4)} to {number_text(high, 4)}")
+                       else f"{number_text(low, 4)} to {number_text(high, 4)} "
+                            f"{c.unit}".rstrip())
         return out
 
     def correlations(self) -> list[tuple[str, str, float]]:

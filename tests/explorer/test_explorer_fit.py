@@ -73,7 +73,7 @@ def test_readings_are_drawn_fitted_and_the_fitted_scene_applied(explorer_app):
     low, high = outcome.calibration.intervals()["coating[0].modulus"]
     assert high - low == pytest.approx(2 * 2.446912 * se, rel=1e-3)
     assert "95 % interval" in table and "Student's t, 6 degrees of freedom" in table
-    assert f"{low / 1e6:.4g} to {high / 1e6:.4g}" in table
+    assert f"{low / 1e6:.4g} to {high / 1e6:.4g} MPa" in table
     band = app.figures.forecast_src["settlement"].data
     times = app.controller.view.times
     assert len(band["t"]) == len(times) and band["t"][-1] == pytest.approx(times[-1])
