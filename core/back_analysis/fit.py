@@ -36,7 +36,9 @@ from core.back_analysis.model import (
     MAX_CONDITION,
     Field,
     Model,
+    central,
     fitted_fields,
+    scaled_svd,
 )
 from core.back_analysis.readings import Readings, as_readings
 from core.back_analysis.result import Calibration
@@ -304,8 +306,7 @@ def calibrate(scene: Scene | Mapping[str, Any] | str | os.PathLike,
     # scene accepts (p more solves, once): their disagreement measures the derivatives'
     # error, which a one-sided difference cannot show
     first, other = (d[mask] / sigma[mask, None] for d in model.two_sided(x, values_fit))
-    both = np.all(np.isfinite(other), axis=0)
-    J = np.where(both, 0.5 * (first + np.where(both, other, 0.0)), first)
+    J = central(first, other)
     r = ((values_fit - y) / sigma)[mask]
     chi2 = float(r @ r)
     s2 = 1.0 if std_given else chi2 / dof
@@ -378,9 +379,7 @@ def _covariance(J: np.ndarray, s2: float) -> tuple[np.ndarray, float]:
     """``s^2 (J^T J)^-1`` by the singular values of J (a pseudo-inverse where J is
     singular: the covariance is then as large as the finite differences allow), and the
     condition number of J with its columns scaled to unit length."""
-    norms = np.linalg.norm(J, axis=0)
-    safe = np.where(norms > 0, norms, 1.0)
-    _, sv, vt = np.linalg.svd(J / safe, full_matrices=False)
+    norms, safe, _, sv, vt = scaled_svd(J)
     condition = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
     tiny = sv[0] * np.finfo(float).eps * max(J.shape)
     inv = np.where(sv > tiny, 1.0 / np.where(sv > tiny, sv, 1.0) ** 2, np.inf)
@@ -401,9 +400,7 @@ def _determined_step(J: np.ndarray, r: np.ndarray, s2: float) -> tuple[np.ndarra
     determine (the singular directions of the column-scaled ``J`` whose singular value is
     within :data:`MAX_CONDITION` of the largest), and whether it is below
     :data:`STEP_TO_SE` of each such combination's standard error ``sqrt(s2) / s_k``."""
-    norms = np.linalg.norm(J, axis=0)
-    safe = np.where(norms > 0, norms, 1.0)
-    u, sv, vt = np.linalg.svd(J / safe, full_matrices=False)
+    _, safe, u, sv, vt = scaled_svd(J)
     keep = sv >= sv[0] / MAX_CONDITION
     if sv[0] == 0 or not np.any(keep):
         return np.zeros(J.shape[1]), False

@@ -157,6 +157,24 @@ def fitted_fields(base: Mapping[str, Any], fit: Any, bounds: Any) -> tuple[Field
     return tuple(fields)
 
 
+def central(first: np.ndarray, other: np.ndarray) -> np.ndarray:
+    """The central differences of :meth:`Model.two_sided`'s two sides where a column has
+    both, the first side's where it has one (``other`` NaN)."""
+    both = np.all(np.isfinite(other), axis=0)
+    return np.where(both, 0.5 * (first + np.where(both, other, 0.0)), first)
+
+
+def scaled_svd(J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                       np.ndarray]:
+    """``(norms, safe, u, sv, vt)``: the singular values of ``J`` with its columns scaled
+    to unit length (``safe``: the norms, 1 for a zero column), the measure of which
+    combinations of the fields the readings determine."""
+    norms = np.linalg.norm(J, axis=0)
+    safe = np.where(norms > 0, norms, 1.0)
+    u, sv, vt = np.linalg.svd(J / safe, full_matrices=False)
+    return norms, safe, u, sv, vt
+
+
 class Model:
     """The readings the working scene predicts as a function of the fit's coordinates.
 

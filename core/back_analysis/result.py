@@ -286,7 +286,7 @@ class Calibration:
             Values, standard deviations (delta method, central differences) and the
             band; one solve plus two per fitted field.
         """
-        from core.back_analysis.model import Model
+        from core.back_analysis.model import Model, central
 
         level = _level(level)
         if not isinstance(times, Mapping):
@@ -300,9 +300,7 @@ class Calibration:
         centre = model.values(self.x)
         # central differences where both sides are points the scene accepts, as the
         # covariance was taken (core.back_analysis.fit)
-        first, other = model.two_sided(self.x, centre)
-        both = np.all(np.isfinite(other), axis=0)
-        gradient = np.where(both, 0.5 * (first + np.where(both, other, 0.0)), first)
+        gradient = central(*model.two_sided(self.x, centre))
         std = np.sqrt(np.maximum(self._forecast_variance(gradient), 0.0))
         solution = model.solve(self.x)
         m = solution.times.size
@@ -321,15 +319,16 @@ class Calibration:
         readings fix: the ratio of thickness and modulus), and none (infinite) otherwise.
         Through the covariance a forecast band read -0.04 to 0.04 m for a settlement of
         4.1e-5 m."""
-        from core.back_analysis.model import RESOLVED_SINGULAR_SHARE, UNDETERMINED_SHARE
+        from core.back_analysis.model import (
+            RESOLVED_SINGULAR_SHARE,
+            UNDETERMINED_SHARE,
+            scaled_svd,
+        )
 
         whole = np.einsum("ij,jk,ik->i", gradient, self.cov_x, gradient)
         if self.jacobian is None:
             return whole
-        J = self.jacobian
-        norms = np.linalg.norm(J, axis=0)
-        safe = np.where(norms > 0, norms, 1.0)
-        _, sv, vt = np.linalg.svd(J / safe, full_matrices=False)
+        _, safe, _, sv, vt = scaled_svd(self.jacobian)
         keep = sv >= sv[0] * RESOLVED_SINGULAR_SHARE if sv[0] > 0 else np.zeros(sv.size, bool)
         if keep.all():
             return whole

@@ -422,9 +422,9 @@ def _first_extreme(q: np.ndarray, pick: Callable, accuracy: float) -> tuple[int,
     extreme = float(np.nanmax(over_x) if pick is max else np.nanmin(over_x))
     # within the accuracy of the largest |q|, but no further from the extreme than its
     # digits shown: q_min "44.39 kPa at t = 287.4 days, x = 3.6 m" read 44.45 kPa there
-    slack = min(_same_share(accuracy) * float(np.nanmax(np.abs(q))),
-                SHOWN_SHARE * abs(extreme)) if extreme else \
-        _same_share(accuracy) * float(np.nanmax(np.abs(q)))
+    slack = _same_share(accuracy) * float(np.nanmax(np.abs(q)))
+    if extreme:
+        slack = min(slack, SHOWN_SHARE * abs(extreme))
     reached = (over_x >= extreme - slack) if pick is max else (over_x <= extreme + slack)
     if not (np.isfinite(slack) and reached.any()):  # (an infinite pressure: where it is)
         flat = np.nanargmax(q) if pick is max else np.nanargmin(q)

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from core.presets import shipped_file
+from core.presets import PRESET_PREFIX, shipped_file
 from core.scene import (
     MAX_SCENE_BYTES,
     SCHEMA_KEY,
@@ -391,7 +391,7 @@ def validated_scene(d: Mapping[str, Any]) -> Scene | PunchesScene:
 
 def _base_scene(spec: Any, base_dir: Path | None) -> dict[str, Any]:
     if isinstance(spec, str):
-        if spec.startswith("preset:"):  # as load_scene and the commands read it
+        if spec.startswith(PRESET_PREFIX):  # as load_scene and the commands read it
             try:
                 return load_scene(spec).to_dict()
             except ValueError as exc:
