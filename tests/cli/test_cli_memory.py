@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from core.cli import EXIT_BAD_INPUT, EXIT_SOLVER_FAILED
 from tests.cli_runs import run_cli
 from tests.conftest import scene_file
@@ -23,6 +25,7 @@ def _wavy_lift_off(tmp_path: Path) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_a_run_past_its_memory_bound_stops_saying_which_and_how_to_raise_it(
         tmp_path: Path) -> None:
     """Bounded to 0.5 GiB (0.75 GiB with two cores' share), the run stops within seconds

@@ -213,6 +213,7 @@ def test_q_at_the_edges_is_in_the_estimate_of_the_rules(tol: float) -> None:
     assert error <= UNILATERAL_MARGIN * answer.info["error_estimate"]
 
 
+@pytest.mark.slow
 def test_two_punches_under_creep_estimate_q_at_their_edges() -> None:
     # The preset's two footings (fib MC2010), six log-spaced outputs, answered by the
     # lift-off solver (both stay in full contact): the full-contact answer at tol 1e-8

@@ -374,6 +374,7 @@ def test_the_base_under_a_zone_moves_as_its_equation_says_on_it_and_as_quadratur
         assert value == pytest.approx(reference / np.pi, rel=1e-10, abs=1e-14 * scale)
 
 
+@pytest.mark.slow
 def test_a_heel_that_lifts_further_and_then_closes_again_is_marched_step_by_step():
     """The zone recedes until the moment's peak at 100 days, then grows: the points the
     heel left and reaches again keep a memory no elastic zone carries. It is marched step
@@ -517,6 +518,7 @@ def test_a_heel_that_lifts_late_in_a_moment_ramp_on_an_aging_bare_base_lifts_off
     assert result.tilt[-1] == pytest.approx(2.90049e-5, rel=5e-4)
 
 
+@pytest.mark.slow
 def test_random_loadings_of_a_creeping_bare_base_are_answered_or_refused_by_field():
     """Loads drawn at random in every statement (constant, ramps, steps, up and down again),
     flat or crowned, on a creeping or aging bare base: each scene is answered (finite,

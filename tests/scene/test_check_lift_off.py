@@ -31,6 +31,7 @@ def lifting() -> tuple[core.SceneSolution, dict]:
     return result, check_scene(result.scene, 0.0, level=0)
 
 
+@pytest.mark.slow
 def test_the_check_compares_the_lift_off_answers(lifting):
     result, report = lifting
     (lo, hi), = result.contact_set[0]
@@ -45,6 +46,7 @@ def test_the_check_compares_the_lift_off_answers(lifting):
     assert report["model_error"] == pytest.approx(0.84, abs=0.01)
 
 
+@pytest.mark.slow
 def test_the_measurement_keeps_the_flag_of_a_lifting_scene(lifting):
     result, report = lifting
     evidence = model_error_evidence(result.scene, result.model_error["estimate"], report)
@@ -57,6 +59,7 @@ def test_a_scene_in_full_contact_is_checked_in_full_contact():
     assert report["lift_off"] is None and "contact_ends" not in report["errors"]
 
 
+@pytest.mark.slow
 def test_the_command_line_check_prints_both_contact_sets(tmp_path):
     path = tmp_path / "scene.json"
     core.save_scene(_thick_coating_lifting_off(), path)
@@ -66,6 +69,7 @@ def test_the_command_line_check_prints_both_contact_sets(tmp_path):
     assert "warning: model_error" in run.stderr
 
 
+@pytest.mark.slow
 def test_the_estimate_of_a_lifting_punch_reads_the_map_at_its_zone(lifting):
     # Read at the punch width (h / 2a = 0.04) the map said 4.6 %; read at the zone
     # (0.154 m) it says 57 %, against 84 % measured: within the 0.8-1.9 times that seven
@@ -84,6 +88,7 @@ def test_a_punch_in_full_contact_reads_the_map_at_its_width():
     assert result.model_error["zone_m"] is None and "thick_coating" not in result.flags
 
 
+@pytest.mark.slow
 def test_a_check_in_full_contact_is_no_measurement_of_a_lifting_scene(lifting):
     # the key once left the contact model out: a full-contact check (0.02 %) cleared the
     # flag of the same scene answered with lift-off
@@ -98,6 +103,7 @@ def test_a_check_in_full_contact_is_no_measurement_of_a_lifting_scene(lifting):
     assert evidence["source"] == "estimated" and evidence["flagged"]
 
 
+@pytest.mark.slow
 def test_a_check_whose_fe_contact_set_did_not_settle_is_no_measurement(lifting):
     # fe_converged False was carried in the report and then ignored: the unsettled
     # numbers replaced the estimate as if measured
