@@ -116,11 +116,14 @@ def finite_number(value: Any, field: str, *, style: Style = JSON_STYLE) -> float
     return x
 
 
-def positive_number(value: Any, field: str, *, style: Style = JSON_STYLE) -> float:
-    """:func:`finite_number`, and > 0."""
+def positive_number(value: Any, field: str, *, style: Style = JSON_STYLE,
+                    unit: str = "") -> float:
+    """:func:`finite_number`, and > 0; ``unit`` (e.g. ``"m"``, ``"days"``) follows both
+    numbers of the message, as the JSON Schema's check words it."""
     x = finite_number(value, field, style=style)
     if x <= 0:
-        raise ValueError(f"{field}: must be > 0, got {style.show(value)}")
+        after = f" {unit}" if unit else ""
+        raise ValueError(f"{field}: must be > 0{after}, got {style.show(value)}{after}")
     return x
 
 

@@ -122,7 +122,7 @@ def _validated(d: dict[str, Any]) -> Scene:
 
     punch = check_fields(d["punch"], "punch", schema.required_fields("punch"),
                          schema.optional_fields("punch"))
-    a = positive_number(punch["half_width"], "punch.half_width")
+    a = positive_number(punch["half_width"], "punch.half_width", unit="m")
     x_domain = (-a, a)
     shape_spec = punch.get("shape", 0.0)
     shape = _profile(shape_spec, "punch.shape", "x", x_domain)
@@ -148,7 +148,7 @@ def _validated(d: dict[str, Any]) -> Scene:
         ))
 
     base = check_fields(d["base"], "base", schema.required_fields("base"))
-    h_base = positive_number(base["thickness"], "base.thickness")
+    h_base = positive_number(base["thickness"], "base.thickness", unit="m")
     nu = _poisson(base["poisson"], "base.poisson")
     try:
         creep = creep_model_from_spec(base["creep"], field="base.creep")
@@ -164,7 +164,8 @@ def _validated(d: dict[str, Any]) -> Scene:
         # refused with its [1, 3650]
         finite_number(base["age_at_loading"], "base.age_at_loading")
         creep.age_at_loading_in_range(base["age_at_loading"], "base.age_at_loading")
-    tau0 = positive_number(base["age_at_loading"], "base.age_at_loading")
+    tau0 = positive_number(base["age_at_loading"], "base.age_at_loading",
+                           unit="days")
     if tau0 > schema.MAX_AGE:
         raise ValueError(f"base.age_at_loading: must be <= {schema.MAX_AGE:g} days (about "
                          f"{schema.MAX_AGE / limits.DAYS_PER_YEAR:.0f} years: older, the age "

@@ -146,6 +146,26 @@ def test_validate_refuses_what_solve_would(tmp_path: Path):
                                     "loading is too small")
 
 
+@pytest.mark.parametrize("field, value, line", [
+    ("punch.half_width", -1.0, "punch.half_width: must be > 0 m, got -1 m"),
+    ("base.thickness", -2.0, "base.thickness: must be > 0 m, got -2 m"),
+    ("base.age_at_loading", -3.0, "base.age_at_loading: must be > 0 days, got -3 days"),
+    ("coating[0].thickness", -0.01, "coating[0].thickness: must be > 0 m, got -0.01 m"),
+])
+def test_validate_and_solve_word_a_refused_number_alike(tmp_path: Path, field: str,
+                                                        value: float, line: str):
+    """The schema's check (``validate``) gave the unit, the validator (``solve``, the
+    page, the API) did not ("must be > 0, got -1"); a constant coating thickness is a
+    profile, which both word by where it fails ("is -0.01 m at x = -1 m")."""
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(edited(field, value, scene_dict())))
+    validated = run("validate", path)
+    assert_one_line_error(validated, line)
+    if field.startswith("coating"):
+        line = f"{field}: must be > 0, is {value:g} m at x = "
+    assert_one_line_error(run("solve", path, "-o", tmp_path / "r.json"), line)
+
+
 def test_not_json(tmp_path: Path):
     path = tmp_path / "scene.json"
     path.write_text("{\n  \"schema_version\": 1,\n  oops\n}\n")

@@ -566,7 +566,7 @@ BAD_SCENES = [
     ("name", DELETE, "name: required field is missing"),
     ("name", "", "name: must not be empty"),
     ("colour", "red", "scene: unknown field 'colour'"),
-    ("punch.half_width", -1.0, "punch.half_width: must be > 0, got -1"),
+    ("punch.half_width", -1.0, "punch.half_width: must be > 0 m, got -1 m"),
     ("punch.half_width", True, "punch.half_width: must be a number, got true"),
     ("punch.half_width", "1", "punch.half_width: must be a number"),
     ("punch.half_width", None, "punch.half_width: must be a number, got null"),
