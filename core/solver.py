@@ -34,6 +34,7 @@ from core.problem import (
     validate_geometry,
     validate_time_inputs,
 )
+from core.time import undeclared_jumps
 from core.work import one_blas_thread
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
@@ -53,7 +54,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                         breakpoints: Sequence[float] = (), tol: float = 1e-8,
                         basis: str = "graded", n_modes: int | None = None,
                         method: str | None = None, contact: str = "auto",
-                        time_breaks: Sequence[float] = (), **options: Any) -> ContactSolution:
+                        time_breaks: Sequence[float] = (), find_jumps: bool = True,
+                        **options: Any) -> ContactSolution:
     """Solve the dimensionless contact problem of a rigid punch on the coated base.
 
     Parameters
@@ -103,11 +105,19 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         Engine options kept as keywords (see ``**options``): the projection's basis
         (``"graded"``, ``"piecewise"``, ``"global"``) and fixed mode count, the Nystrom
         engine's times where a given load history jumps or kinks (its steps land on
-        them; give a narrow pulse's times too, which the steps could pass over). An
-        engine that does not take one accepts its default value only. A cached creep
+        them; give a narrow pulse's times too, which the steps could pass over). Under
+        creep, a jump of a history given as a callable (a load, ``c``) that is not
+        among them is found by sampling and bisection and added
+        (``info["time_breaks_found"]``; ``find_jumps``); a pulse narrower than ~1/2000
+        of the span can hide between the samples. An engine that does not take one
+        accepts its default value only. A cached creep
         response to a load is found again by the load's values at the output times and
         at :func:`core.time.history_key_times` (the march's span and both sides of each
         of ``time_breaks``): two callables that agree at all of them share it.
+    find_jumps : bool, optional
+        Whether jumps of the histories given as callables that ``time_breaks`` lacks are
+        looked for under creep (0.6-0.7 ms of a load change on the aging presets); False
+        where the caller declares every one, as a scene does from its load profiles.
     **options
         Options of the chosen engine only (its ``prepare_options`` and
         ``solve_options``, documented with its ``prepare`` and ``solve``), e.g. the
@@ -141,18 +151,55 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
                            **loads)
     geometry = validate_geometry(lam, m, g, breakpoints, tol)
     inputs = validate_time_inputs(times, c, kernel, loads)
+    found = (_undeclared_jumps(inputs, {"c": c, **loads}, geometry.tol, time_breaks)
+             if find_jumps else ())
+    if found:
+        # the march lands on them as on declared ones (an engine without time breaks
+        # steps adaptively, or on its own grid)
+        time_breaks = tuple(sorted({*(float(b) for b in time_breaks), *found}))
+        unilateral_args["time_breaks"] = time_breaks
+        if "time_breaks" in asked:
+            asked["time_breaks"] = time_breaks
+    result = _answer(contact, engines, geometry, inputs, asked, unilateral_args, c)
+    if found:
+        result.info["time_breaks_found"] = list(found)
+    return result
+
+
+def _answer(contact: str, engines: list[Engine], geometry: Geometry, inputs: TimeInputs,
+            asked: dict[str, Any], unilateral_args: dict[str, Any], c: Scalar
+            ) -> ContactSolution:
+    """The answer of the contact model ``contact`` (see :func:`solve_dimensionless`)."""
     if contact == "unilateral":
         return solve_unilateral(**unilateral_args)
     # The check runs on the Nystrom engine's prepared geometry, which its full answer then
     # reuses. On an elastic base with a constant modulus that answer costs what the check
     # would (one combination of the prepared unit responses): no check first.
     if (contact == "auto" and engines[0].name == "nystrom"
-            and (kernel is not None or callable(c))):
+            and (inputs.kernel is not None or callable(c))):
         predicted = predicted_unilateral(unilateral_args, geometry, inputs)
         if predicted is not None:
             return predicted
     full = _first_answer(engines, geometry, inputs, asked)
     return with_contact_model(full, contact, unilateral_args)
+
+
+def _undeclared_jumps(inputs: TimeInputs, given: dict[str, Any], tol: float,
+                      declared: Sequence[float]) -> tuple[float, ...]:
+    """The jumps of the histories given as callables (``c`` and the loads of ``given``,
+    as the caller passed them) that ``declared`` does not hold
+    (:func:`core.time.undeclared_jumps`); none without creep, where each output time's
+    answer depends on the histories at that time alone."""
+    if inputs.kernel is None:
+        return ()
+    histories = [inputs.c if name == "c" else inputs.loads[name]
+                 for name, value in given.items()
+                 if callable(value) and (name == "c" or name in inputs.loads)]
+    end = float(inputs.times[-1])
+    found: set[float] = set()
+    for history in histories:
+        found.update(undeclared_jumps(history, 1.0, end, tol, declared))
+    return tuple(sorted(found))
 
 
 def _engines(method: object, basis: object, n_modes: object) -> list[Engine]:

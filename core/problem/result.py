@@ -42,8 +42,10 @@ key                        meaning
 ========================== ===================================================================
 
 :func:`core.solver.solve_dimensionless` adds ``contact`` (``"full"``; the unilateral model's
-answer, :class:`core.contact.result.UnilateralSolution`, has an ``info`` of its own) and, when
-the default engine declined and the next one answered, ``fallback`` (why).
+answer, :class:`core.contact.result.UnilateralSolution`, has an ``info`` of its own), when
+the default engine declined and the next one answered, ``fallback`` (why), and, under creep,
+``time_breaks_found``: the times where a history given as a callable jumps and that
+``time_breaks`` did not hold (:func:`core.time.undeclared_jumps`; the steps landed on them).
 
 Engine-specific keys: nystrom ``n_panels``, ``prepare_seconds`` (the geometry's
 preparation, done once), ``max_abs_tilt`` (largest |alpha| between the output times too),

@@ -105,7 +105,8 @@ class DimensionlessProblem:
         return solve_dimensionless(self.lam, self.m, self.g, self.times, c=self.c,
                                    kernel=self.kernel, breakpoints=self.breakpoints,
                                    tol=self.tol, contact=self.contact,
-                                   time_breaks=self.time_breaks, **self.loads)
+                                   time_breaks=self.time_breaks, find_jumps=False,
+                                   **self.loads)
 
 
 def days_after_loading(t_star: Any, tau0: float) -> np.ndarray:

@@ -14,7 +14,9 @@ and ``solve_general`` (any kernel); the steppers behind them:
   Richardson extrapolation;
 - ``volterra.py``: the problem and solution types the steppers share;
 - ``grids.py``: ``time_grid``, the fixed grids of the steppers that march on them (the
-  collocation engine, the unilateral contact march, the bare base's growing zone).
+  collocation engine, the unilateral contact march, the bare base's growing zone);
+- ``jumps.py``: ``undeclared_jumps``, the jumps of a given history its caller did not
+  declare (found by sampling and bisection).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from __future__ import annotations
 from core.time.exponential_weights import moments as exponential_moments
 from core.time.grids import history_key_times, time_grid
 from core.time.integration import solve_degenerate
+from core.time.jumps import undeclared_jumps
 from core.time.product_quadrature import solve_general
 from core.time.radau import JUMP_SIDE
 from core.time.volterra import ModalProblem
@@ -34,4 +37,5 @@ __all__ = [
     "solve_degenerate",
     "solve_general",
     "time_grid",
+    "undeclared_jumps",
 ]
