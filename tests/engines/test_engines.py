@@ -75,7 +75,7 @@ def test_an_unknown_method_is_refused_naming_the_registered_ones():
 
 
 @pytest.mark.parametrize(("method", "option"), [
-    ("projection", {"time_breaks": [1.5]}),
+    ("projection", {"time_points": 8}),
     ("nystrom", {"n_modes": 8}),
     ("nystrom", {"basis": "piecewise"}),
     ("nystrom", {"panels_per_unit": 4}),

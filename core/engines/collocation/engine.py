@@ -9,6 +9,8 @@ marched on the same time grids) estimates the spatial error.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from core.engines.collocation.solve import (
     SUCCESS_MARGIN,
     CollocationGeometry,
@@ -27,7 +29,7 @@ class CollocationEngine:
 
     name = "collocation"
     prepare_options = ("panels_per_unit", "edge_width")
-    solve_options = ("time_points", "richardson")
+    solve_options = ("time_points", "richardson", "time_breaks")
     success_margin = SUCCESS_MARGIN
 
     def prepare(self, geometry: Geometry, *, panels_per_unit: float = 8,
@@ -40,13 +42,15 @@ class CollocationEngine:
 
     def solve(self, prepared: CollocationGeometry, inputs: TimeInputs, *,
               time_points: int | None = None,
-              richardson: bool | None = None) -> CollocationSolution:
+              richardson: bool | None = None,
+              time_breaks: Sequence[float] = ()) -> CollocationSolution:
         """The full-contact answer for ``inputs``: ``time_points`` nominal steps over
         ``[1, times[-1]]`` (default: grids doubled until the estimate in time meets
-        ``tol``); ``richardson`` (default: on under creep) extrapolates grids h and h/2."""
+        ``tol``); ``richardson`` (default: on under creep) extrapolates grids h and h/2;
+        ``time_breaks``: times where a given history jumps (both sides are grid points)."""
         check_time_points(time_points)
         return solve_prepared(prepared, inputs.times, inputs.c, inputs.kernel, inputs.loads,
-                              time_points, richardson)
+                              time_points, richardson, time_breaks=time_breaks)
 
 
 #: The engine registered as ``"collocation"`` in :data:`core.engines.ENGINES`.

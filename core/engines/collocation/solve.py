@@ -166,6 +166,7 @@ def solve_collocation(
     time_points: int | None = None,
     richardson: bool | None = None,
     time_tol: float = DEFAULT_TIME_TOL,
+    time_breaks: Sequence[float] = (),
 ) -> CollocationSolution:
     """Solve the dimensionless contact problem by Nystrom collocation and trapezoid stepping.
 
@@ -189,7 +190,8 @@ def solve_collocation(
     where every requested time is solved on its own. ``richardson`` (default: on when a kernel is
     given) combines the grids h and h/2 as ``(4 x_{h/2} - x_h) / 3``. Success asks the
     estimate in time plus the spatial one (twice the distance from the rule one level
-    coarser, marched on the same time grids) to be below ``time_tol``.
+    coarser, marched on the same time grids) to be below ``time_tol``. ``time_breaks``:
+    times where a given history jumps; every time grid holds both sides of each.
 
     Raises ValueError, naming the argument, for invalid input.
     """
@@ -219,7 +221,7 @@ def solve_collocation(
 
     prepared = prepare_collocation(lam, m_fn, g_fn, cuts, ppu, edge, tol, started=started)
     return solve_prepared(prepared, times_arr, c_fn, kernel, loads, time_points, richardson,
-                          tol_name="time_tol")
+                          tol_name="time_tol", time_breaks=time_breaks)
 
 
 def prepare_collocation(lam: float, m: Callable[[np.ndarray], np.ndarray],
@@ -256,10 +258,12 @@ def solve_prepared(prepared: CollocationGeometry, times: np.ndarray,
                    c: Callable[[np.ndarray], np.ndarray], kernel: Callable | None,
                    loads: dict[str, Callable[[np.ndarray], np.ndarray]],
                    time_points: int | None, richardson: bool | None, *,
-                   tol_name: str = "tol") -> CollocationSolution:
+                   tol_name: str = "tol", time_breaks: Sequence[float] = ()
+                   ) -> CollocationSolution:
     """March the prepared rule through ``times`` for checked arguments: ``loads`` the two
     given histories by name, ``time_points`` a fixed grid (None: grids doubled until the
-    estimate meets ``prepared.tol``, named ``tol_name`` in the message).
+    estimate meets ``prepared.tol``, named ``tol_name`` in the message), every grid
+    holding both sides of each of ``time_breaks`` (times where a history jumps).
 
     The spatial estimate is :data:`COARSER_FACTOR` times this answer's distance from the
     one on the rule one level coarser (``prepared.coarse``: the histories, and q at this
@@ -268,8 +272,10 @@ def solve_prepared(prepared: CollocationGeometry, times: np.ndarray,
     differ by space. Without it a fixed rule claimed success with an estimate of 0: q off
     by 2.4e-2 at the edges of a stiff coating (m = 1e-6), whose layer the default edge
     grading (1e-4) does not resolve; under creep the estimate was NaN."""
+    jumps = tuple(sorted({float(b) for b in np.asarray(time_breaks, dtype=float).ravel()
+                          if np.isfinite(b) and 1.0 < b < float(times[-1])}))
     answer = _march_prepared(prepared, times, c, kernel, loads, time_points, richardson,
-                             tol_name)
+                             tol_name, jumps=jumps)
     if not prepared.coarser:
         return answer
     info = answer.info
@@ -277,7 +283,8 @@ def solve_prepared(prepared: CollocationGeometry, times: np.ndarray,
         spatial = math.nan
     else:
         coarse = _march_prepared(prepared.coarse, times, c, kernel, loads, time_points,
-                                 richardson, tol_name, on_grid=info["time_grid"])
+                                 richardson, tol_name, on_grid=info["time_grid"],
+                                 jumps=jumps)
         spatial = COARSER_FACTOR * _distance(answer, coarse)
         info["seconds"] += prepared.coarse.seconds + coarse.info["seconds"]
     time_error = float(info["time_error_estimate"])
@@ -326,8 +333,8 @@ def _march_prepared(prepared: CollocationGeometry, times: np.ndarray,
                     c: Callable[[np.ndarray], np.ndarray], kernel: Callable | None,
                     loads: dict[str, Callable[[np.ndarray], np.ndarray]],
                     time_points: int | None, richardson: bool | None,
-                    tol_name: str, on_grid: tuple[int, int] | None = None
-                    ) -> CollocationSolution:
+                    tol_name: str, on_grid: tuple[int, int] | None = None,
+                    jumps: Sequence[float] = ()) -> CollocationSolution:
     """:func:`solve_prepared` on the prepared rule alone (its time estimate only).
 
     ``on_grid``: ``(steps, level)`` of another answer's time grid (its ``info["time_grid"]``)
@@ -351,13 +358,15 @@ def _march_prepared(prepared: CollocationGeometry, times: np.ndarray,
         error = 0.0
         richardson = False
     elif on_grid is not None:
-        result = grids_at(system, times, on_grid[0], on_grid[1], richardson)
+        result = grids_at(system, times, on_grid[0], on_grid[1], richardson, jumps)
         error, n_steps, grid_used = 0.0, 0, on_grid
     elif time_points is not None:
-        result, error, n_steps = fixed_grids(system, times, int(time_points), richardson)
+        result, error, n_steps = fixed_grids(system, times, int(time_points), richardson,
+                                             jumps)
         grid_used = (int(time_points), 1 if richardson else 0)
     else:
-        result, error, n_steps, met, level = adaptive_grids(system, times, richardson, tol)
+        result, error, n_steps, met, level = adaptive_grids(system, times, richardson, tol,
+                                                            jumps)
         limited = not met
         grid_used = (FIRST_STEPS, level)
 

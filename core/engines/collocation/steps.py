@@ -10,7 +10,7 @@ estimate of the relative error in time. All quantities dimensionless.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -213,15 +213,16 @@ class CollocationSystem:
 
 
 def fixed_grids(system: CollocationSystem, times: np.ndarray, steps: int,
-                richardson: bool) -> tuple[GridResult, float, int]:
-    """Solve on ``steps`` nominal steps, and with ``richardson`` on the halved grid too.
+                richardson: bool, jumps: Sequence[float] = ()) -> tuple[GridResult, float, int]:
+    """Solve on ``steps`` nominal steps, and with ``richardson`` on the halved grid too;
+    ``jumps``: times where a given history jumps (every grid holds both sides of each).
 
     Returns the result (extrapolated when ``richardson``), its estimated relative error
     in time (NaN for one grid) and the number of steps of the finest grid.
     """
-    grid, widths, index = time_grid(times, steps)
+    grid, widths, index = time_grid(times, steps, jumps=jumps)
     coarse = system.march(grid, widths, index)
-    fine_grid, fine_widths, fine_index = time_grid(times, steps, 1)
+    fine_grid, fine_widths, fine_index = time_grid(times, steps, 1, jumps=jumps)
     fine = system.march(fine_grid, fine_widths, fine_index) if richardson else None
     if fine is None:
         return coarse, float("nan"), len(grid) - 1
@@ -231,21 +232,22 @@ def fixed_grids(system: CollocationSystem, times: np.ndarray, steps: int,
 
 
 def grids_at(system: CollocationSystem, times: np.ndarray, steps: int, level: int,
-             richardson: bool) -> GridResult:
+             richardson: bool, jumps: Sequence[float] = ()) -> GridResult:
     """The result on the grid of ``steps`` nominal steps halved ``level`` times, with
     ``richardson`` extrapolated from the grid once less halved, as :func:`fixed_grids`
     (``level`` 1) and :func:`adaptive_grids` (its last level) combine them: another rule
     marched on the same time grids errs the same in time, so the two differ by space."""
-    grid, widths, index = time_grid(times, steps, level)
+    grid, widths, index = time_grid(times, steps, level, jumps=jumps)
     result = system.march(grid, widths, index)
     if not richardson or level < 1:
         return result
-    grid, widths, index = time_grid(times, steps, level - 1)
+    grid, widths, index = time_grid(times, steps, level - 1, jumps=jumps)
     return result.combine(system.march(grid, widths, index))
 
 
 def adaptive_grids(system: CollocationSystem, times: np.ndarray, richardson: bool,
-                    tol: float) -> tuple[GridResult, float, int, bool, int]:
+                   tol: float, jumps: Sequence[float] = ()
+                   ) -> tuple[GridResult, float, int, bool, int]:
     """Double the grid until the estimated relative error in time is below ``tol``.
 
     Returns the result, its estimated relative error in time, the number of steps, whether
@@ -254,7 +256,7 @@ def adaptive_grids(system: CollocationSystem, times: np.ndarray, richardson: boo
     plain: list[GridResult] = []
     extrapolated: list[GridResult] = []
     while True:
-        grid, widths, index = time_grid(times, FIRST_STEPS, level)
+        grid, widths, index = time_grid(times, FIRST_STEPS, level, jumps=jumps)
         plain.append(system.march(grid, widths, index))
         n_steps = len(grid) - 1
         error = float("inf")

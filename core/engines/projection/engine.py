@@ -9,6 +9,7 @@ engine's options and keeps them with the geometry.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from core.engines.projection.solve import SUCCESS_MARGIN, check_options, solve_projection
@@ -34,7 +35,7 @@ class ProjectionEngine:
 
     name = "projection"
     prepare_options = ("basis", "n_modes")
-    solve_options = ()
+    solve_options = ("time_breaks",)
     success_margin = SUCCESS_MARGIN
 
     def prepare(self, geometry: Geometry, *, basis: str = "graded",
@@ -43,10 +44,13 @@ class ProjectionEngine:
         check_options(basis, n_modes)
         return ProjectionSetup(geometry, basis, n_modes)
 
-    def solve(self, prepared: ProjectionSetup, inputs: TimeInputs) -> ContactSolution:
-        """The full-contact answer for the time side ``inputs`` (dimensionless)."""
-        return solve_projection(joined_inputs(prepared.geometry, inputs), prepared.basis,
-                                prepared.n_modes)
+    def solve(self, prepared: ProjectionSetup, inputs: TimeInputs, *,
+              time_breaks: Sequence[float] = ()) -> ContactSolution:
+        """The full-contact answer for the time side ``inputs`` (dimensionless);
+        ``time_breaks``: times where a given history jumps or kinks, which the time steps
+        land on."""
+        return solve_projection(joined_inputs(prepared.geometry, inputs, time_breaks),
+                                prepared.basis, prepared.n_modes)
 
 
 #: The engine registered as ``"projection"`` in :data:`core.engines.ENGINES`.

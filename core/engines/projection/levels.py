@@ -152,9 +152,10 @@ def _solve_levels(inp: _Inputs, disc: _Discretization, systems: Sequence[ModalSy
     problem = ModalProblem(d=lambda tt: evaluate(tt)[0], r=lambda tt: evaluate(tt)[1],
                            u=lambda tt: evaluate(tt)[2], coupling=coupling / gamma[:, None])
     if hasattr(inp.kernel, "rates") and hasattr(inp.kernel, "exponential_parts"):
-        sol = solve_degenerate(inp.kernel, problem, times, tol=time_tol)
+        sol = solve_degenerate(inp.kernel, problem, times, tol=time_tol,
+                               breaks=inp.time_breaks)
     else:
-        sol = solve_general(inp.kernel, problem, times, tol=time_tol)
+        sol = solve_general(inp.kernel, problem, times, tol=time_tol, breaks=inp.time_breaks)
     results = []
     start = 0
     for st in setups:
@@ -208,9 +209,10 @@ class _Superposition:
         self.cacheable = inp.kernel is None or kernel_key is not None
         # (the histories over the march's span, geometric samples too: steps at t* 1.02
         # and 1.08 met at every even sample, and one took the other's answer)
-        probe = history_key_times(times)
+        probe = history_key_times(times, inp.time_breaks)
         self.base_key = (disc.galerkin_key, tuple(sorted(inp.given)),
-                         fingerprint(times, inp.c(probe), repr(kernel_key), time_tol))
+                         fingerprint(times, inp.c(probe), repr(kernel_key), time_tol,
+                                     inp.time_breaks))
         self.no_gap = replace(disc, gap=GapTerms(np.zeros_like(disc.gap.vector), 0.0, 0.0))
         # (weight, key, inputs, discretization) of each part
         self.parts: list[tuple[float, tuple, _Inputs, _Discretization]] = []

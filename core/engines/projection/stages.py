@@ -65,6 +65,8 @@ class _Inputs:
     given: frozenset[str]
     breakpoints: tuple[float, ...]
     tol: float
+    #: times where a given history jumps or kinks (the time steps land on them)
+    time_breaks: tuple[float, ...] = ()
 
 
 def validate_inputs(lam, m, g, times, c, kernel, loads, breakpoints, tol) -> _Inputs:
@@ -74,11 +76,17 @@ def validate_inputs(lam, m, g, times, c, kernel, loads, breakpoints, tol) -> _In
                          validate_time_inputs(times, c, kernel, loads))
 
 
-def joined_inputs(geometry: Geometry, timing: TimeInputs) -> _Inputs:
-    """A validated geometry and time side in the form the projection's stages take."""
+def joined_inputs(geometry: Geometry, timing: TimeInputs,
+                  time_breaks: Sequence[float] = ()) -> _Inputs:
+    """A validated geometry and time side in the form the projection's stages take;
+    ``time_breaks``: the times of (1, last output time) where a given history jumps or
+    kinks."""
+    end = float(timing.times[-1])
+    breaks = tuple(sorted({float(b) for b in np.asarray(time_breaks, dtype=float).ravel()
+                           if np.isfinite(b) and 1.0 < b < end}))
     return _Inputs(geometry.lam, geometry.m, geometry.g, geometry.g_is_zero, timing.times,
                    timing.c, timing.c_is_constant, timing.kernel, timing.loads, timing.given,
-                   geometry.breakpoints, geometry.tol)
+                   geometry.breakpoints, geometry.tol, breaks)
 
 
 # -------------------------------------------------------------------------- stages
