@@ -42,10 +42,14 @@ def read_scene_json(text: str, source: str = "scene") -> Any:
     """The JSON value of a scene file's text, read strictly: a field repeated in one
     object, a nesting too deep or a number beyond any double is refused (``ValueError``
     naming ``source``). The value is not yet validated as a scene."""
+    if not text.strip():
+        raise ValueError(f"{source}: the file is empty (a scene file is a JSON object)")
     try:
         return json.loads(text, object_pairs_hook=_no_duplicates, parse_int=_parse_int)
     except json.JSONDecodeError as exc:
-        raise ValueError(f"{source}: not valid JSON ({exc.msg} at line {exc.lineno}, "
+        # (some of json's messages end in "at": "Unterminated string starting at")
+        what = exc.msg.removesuffix(" at")
+        raise ValueError(f"{source}: not valid JSON ({what} at line {exc.lineno}, "
                          f"column {exc.colno})") from None
     except ValueError as exc:
         raise ValueError(f"{source}: {exc}") from None

@@ -115,7 +115,7 @@ class FilesView:
     # -- loading ---------------------------------------------------------------------
     def _on_scene_file(self, event: Any) -> None:
         data = event.new
-        if not data:
+        if data is None:  # (cleared before each file: the same file again is new)
             return
         try:
             self._read_scene_file(data)

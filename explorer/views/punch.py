@@ -127,7 +127,7 @@ class PunchView:
 
     def _on_shape_file(self, event: Any) -> None:
         data = event.new
-        if not data:
+        if data is None:  # (an empty file is said: "file is empty")
             return
         a = self.state.punch.half_width
         try:

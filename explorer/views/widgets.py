@@ -754,7 +754,7 @@ class HistoryEditor:
 
     def _on_table(self, event: Any) -> None:
         data, history = event.new, self._watched
-        if not data or history is None or self.upload is None:
+        if data is None or history is None or self.upload is None:
             return
         q = history.quantity
         try:

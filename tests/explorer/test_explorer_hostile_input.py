@@ -228,3 +228,23 @@ def test_the_live_bound_of_the_server_reaches_every_session(monkeypatch, explore
         with pytest.raises(ValueError, match="live_bound: must be a number of seconds from "
                                              "0.001 to 60, got"):
             explorer_app(live_bound=bad)
+
+
+def test_an_empty_file_is_said_and_not_taken_for_the_one_before(explorer_app) -> None:
+    """An empty scene file was taken silently (a green "Upload complete" and nothing
+    else), leaving an earlier refusal naming another file on screen; an empty table was
+    too. A truncated file read "starting at at line 1" (a teacher's audit)."""
+    app = explorer_app()
+    shown = app.controller.view
+    app.files_tab.load_file.filename = "notes.json"
+    app.files_tab.load_file.value = b'{"name": "x'
+    assert app.screen.notice == ("The file 'notes.json': not valid JSON (Unterminated "
+                                 "string starting at line 1, column 10)")
+    app.files_tab.load_file.filename = "empty.json"
+    app.files_tab.load_file.value = b""
+    assert app.screen.notice == ("The file 'empty.json': the file is empty (a scene file is "
+                                 "a JSON object)")
+    app.punch_tab.shape_file.filename = "empty.csv"
+    app.punch_tab.shape_file.value = b""
+    assert "punch.shape" in app.screen.notice and "empty" in app.screen.notice
+    assert app.controller.view is shown and app.controller.error == ""
