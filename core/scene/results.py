@@ -109,6 +109,8 @@ FLAG_MESSAGES: dict[str, str] = {
 UNITS: dict[str, str] = {
     "times": "day (after loading)",
     **{name: unit for name, (unit, _, _) in HISTORIES.items()},
+    # (a data file's "N" read as a force to an engineer filing it)
+    "moment": "N·m/m (a moment per metre of strip: N)",
     "x": "m (from the punch centre)",
     "pressure": "Pa (rows: x, columns: times)",
 }

@@ -56,6 +56,8 @@ def test_solve_to_json(tmp_path: Path):
     assert len(result["pressure"]) == 201 and all(len(row) == n for row in result["pressure"])
     assert result["flags"] == []
     assert result["units"]["force"] == "N/m"
+    # "N" alone read as a force to an engineer filing the file (a teacher's audit)
+    assert result["units"]["moment"].startswith("N·m/m")
     assert result["force"][0] == pytest.approx(8e5, rel=1e-12)
     assert result["settlement"][-1] > result["settlement"][0] > 0
 
