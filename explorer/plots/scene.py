@@ -209,7 +209,7 @@ class SceneDrawing:
         self.punch_src.data = {"x": np.concatenate([g.x, [a, -a]]),
                                "y": np.concatenate([bottom_y, [punch_top, punch_top]])}
         self.fig.x_range.update(start=-1.55 * a, end=1.55 * a)
-        self.fig.y_range.update(start=-1.08 * depth, end=punch_top + 0.55 * a)
+        self.fig.y_range.update(start=-1.08 * depth, end=_top_of_drawing(punch_top, a, depth))
         self._say_scale(scale, "coating and punch profile")
 
     def _show_punches(self, view: ResultView, contact: ContactDrawing) -> None:
@@ -254,7 +254,8 @@ class SceneDrawing:
                                  "name": [f"punch {k + 1}" for k in range(len(xs))]}
         contact.set_surface(g.x, scale * total)
         self.fig.x_range.update(start=left - 0.05 * a_ref, end=right + 0.05 * a_ref)
-        self.fig.y_range.update(start=-1.08 * depth, end=punch_top + 0.55 * a_ref)
+        self.fig.y_range.update(start=-1.08 * depth,
+                                end=_top_of_drawing(punch_top, a_ref, depth))
         self._say_scale(scale, "coating and punch profiles")
 
     def _say_scale(self, scale: float, what: str) -> None:
@@ -270,6 +271,18 @@ class SceneDrawing:
 
     _punch_top = 0.0
     _a_ref = 1.0
+
+
+#: Room above the punches for the loads' arrows and labels: at least this share of the
+#: drawing's height (a wide scene of several punches is drawn deep, and the labels, of a
+#: fixed size in pixels, ran out of its top in presentation mode at 1024x768).
+HEADROOM_SHARE = 0.25
+
+
+def _top_of_drawing(punch_top: float, a: float, depth: float) -> float:
+    """The y range's end [m, drawn]: 0.55 ``a`` above the punch top, or more where the
+    drawing is deep (``depth`` of base shown)."""
+    return punch_top + max(0.55 * a, HEADROOM_SHARE * (punch_top + 1.08 * depth))
 
 
 def _slabs(g: Geometry, left: float, right: float, count: int, scale: float

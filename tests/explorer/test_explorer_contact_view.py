@@ -336,3 +336,18 @@ def test_the_design_check_says_when_q_max_is_the_thin_layer_s_at_an_edge() -> No
     stepped = check_html(design_check(_solved("stepped_punch")))
     assert "q_max beside a step of the punch: the thin coating" in stepped
     assert "check-edge" not in check_html(design_check(_solved("bare_layer")))
+
+
+@pytest.mark.parametrize("key", ["new_footing_beside_old", "eccentric_footing_liftoff"])
+def test_the_drawing_leaves_room_above_the_punches_for_the_load_labels(key: str) -> None:
+    """The two footings' scene is drawn 3 m deep: 0.55 a above the punches was 13 % of
+    its height, and the loads' labels ("1: P = 600 kN/m") ran out of its top in
+    presentation mode at 1024x768 (a teacher's audit). The room is a quarter of the
+    drawing below it at least; the one punch's (depth at most 1.2 a) keeps its 0.55 a."""
+    figures, view, _ = _drawn(key)
+    drawing = figures.drawing
+    y = drawing.fig.y_range
+    top = drawing._punch_top
+    assert y.end - top >= 0.25 * (top - y.start) - 1e-12
+    assert y.end - top >= 0.55 * max(p.half_width for p in view.punches) if view.punches \
+        else y.end - top == pytest.approx(0.55 * view.geometry.half_width)
