@@ -23,6 +23,7 @@ import param
 from .fixes import (
     bokeh_fixes,
     closed_pages,
+    dropper_labels,
     gc_policy,
     idle_painter,
     install_in_process,
@@ -735,6 +736,7 @@ def create_app(**kwargs: Any) -> ExplorerApp:
         pn.state.on_session_destroyed(idle_release.session_closed)
         bokeh_fixes.install(pn.state.curdoc)
         idle_painter.install(pn.state.curdoc)
+        dropper_labels.install(pn.state.curdoc)
     if "query" not in kwargs:
         kwargs["query"] = _query_from_session()
     app = ExplorerApp(**kwargs)

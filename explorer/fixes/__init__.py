@@ -10,6 +10,7 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
   from the computed style at each paint; a renderer's place written on its element, not
   into a style sheet; a figure's base font size read once.
 - ``idle_painter``: the file dropper's frame loop, paused while nothing happens.
+- ``dropper_labels``: the file droppers' words for a file of a type they do not take.
 - ``closed_pages``: pages closed abruptly (a debug line, not a traceback), Panel's
   link registry released when a session ends, and Panel's busy-counter task started
   holding no page.
@@ -29,6 +30,7 @@ from . import (
     bokeh_fixes,
     closed_pages,
     design_updates,
+    dropper_labels,
     empty_inputs,
     gc_policy,
     idle_painter,
@@ -39,7 +41,8 @@ from . import (
     property_defaults,
 )
 
-__all__ = ["bokeh_fixes", "closed_pages", "design_updates", "empty_inputs", "gc_policy",
+__all__ = ["bokeh_fixes", "closed_pages", "design_updates", "dropper_labels", "empty_inputs",
+           "gc_policy",
            "idle_painter",
            "install_in_process", "layout_batch", "model_walk", "panel_fixes", "patch_refs",
            "property_defaults"]

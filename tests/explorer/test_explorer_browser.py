@@ -206,6 +206,12 @@ def test_an_oversized_upload_is_refused_in_the_page_and_a_scene_file_loads(page:
     upload.set_input_files(files=[{"name": "big.json", "mimeType": "application/json",
                                    "buffer": b"{" + b" " * (5 * 2**20) + b"}"}])
     page.page.get_by_text("File is too large").first.wait_for(timeout=30_000 * patience())
+    # a file of another type: the box says which it takes ("Expects  or application/json"
+    # before, a teacher's audit)
+    upload.set_input_files(files=[{"name": "notes.txt", "mimeType": "text/plain",
+                                   "buffer": b"notes"}])
+    page.page.get_by_text("Expects a file ending in .json").first.wait_for(
+        timeout=30_000 * patience())
     root = Path(__file__).resolve().parents[2]
     scene = json.loads((root / "core" / "presets" / "scenes" / "stepped_punch.json").read_text())
     scene["name"] = "uploaded in the browser"
