@@ -110,6 +110,11 @@ class LimitCheck:
     exceeded_on_grid: float | None = None
     #: whether the pressure is over the limit on the whole base at some time
     exceeded_everywhere: bool = False
+    #: whether the value stays at the extreme (to the answer's accuracy) from ``time`` to
+    #: the last output time, which comes later: a history that levels off ("largest
+    #: settlement ... at t = 489.4 days" read as an event to a class told it stops
+    #: growing after ~250 days, a teacher's audit); said "and after"
+    held: bool = False
 
     @property
     def sign_note(self) -> str:
@@ -189,7 +194,8 @@ class LimitCheck:
         out = {"quantity": self.quantity, "limit_name": self.limit_name,
                "label": self.label, "unit": self.unit, "value": plain(self.value),
                "limit": plain(self.limit), "utilisation": plain(self.utilisation),
-               "passed": self.passed, "time_day": plain(self.time), "x_m": plain(self.x)}
+               "passed": self.passed, "time_day": plain(self.time), "x_m": plain(self.x),
+               "held_after": self.held}
         if self.unbounded:
             out.update(unbounded=True, corner_distance_m=plain(self.corner_distance),
                        exceeded_within_m=plain(self.exceeded_within),
@@ -214,7 +220,7 @@ class LimitCheck:
             def time(t: float) -> str:
                 text = number(t)
                 return f"{text} {'day' if text == '1' else 'days'}"
-        when = f"t = {time(self.time)}"
+        when = f"t = {time(self.time)}" + (" and after" if self.held else "")
         if self.unbounded:
             return (f"unbounded at the corner x = {number(self.x)} m (a rigid corner: q ~ "
                     f"1/sqrt(distance)); {shown(self.value, self.unit)} at "
@@ -354,8 +360,8 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
     # the extremes' values are the largest and smallest (what a limit is held to); their
     # time and place, where they are first reached to the answer's accuracy
     q_largest, q_smallest = float(np.nanmax(q)), float(np.nanmin(q))
-    i_max = _first_extreme(q, max, accuracy)
-    i_min = _first_extreme(q, min, accuracy)
+    i_max, held_max = _first_extreme(q, max, accuracy)
+    i_min, held_min = _first_extreme(q, min, accuracy)
     histories = {"settlement": np.asarray(settlement, dtype=float),
                  "tilt": np.asarray(tilt, dtype=float)}
     lines = []
@@ -364,15 +370,19 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
         if quantity == "q_max":
             lines.append(_corner_line(name, label, unit, times, x, q, limit, corners)
                          or LimitCheck(name, quantity, label, q_largest, unit,
-                                       float(times[i_max[1]]), float(x[i_max[0]]), limit))
+                                       float(times[i_max[1]]), float(x[i_max[0]]), limit,
+                                       held=held_max))
             continue
         values = histories[quantity]
         k = time_of_largest(values, accuracy)
         largest = int(np.nanargmax(np.abs(values)))
+        size = np.abs(values)
+        held = bool(k < values.size - 1 and np.all(
+            size[k:] >= size[largest] * (1.0 - _same_share(accuracy))))
         lines.append(LimitCheck(name, quantity, label, float(values[largest]), unit,
-                                float(times[k]), None, limit))
+                                float(times[k]), None, limit, held=held))
     q_min = LimitCheck(None, "q_min", "smallest contact pressure q_min", q_smallest,
-                       "Pa", float(times[i_min[1]]), float(x[i_min[0]]))
+                       "Pa", float(times[i_min[1]]), float(x[i_min[0]]), held=held_min)
     return DesignCheck(tuple(lines), q_min)
 
 
@@ -412,12 +422,14 @@ def time_of_largest(values: np.ndarray, accuracy: float = SAME_SHARE) -> int:
     return int(near[0]) if near.size else k
 
 
-def _first_extreme(q: np.ndarray, pick: Callable, accuracy: float) -> tuple[int, int]:
+def _first_extreme(q: np.ndarray, pick: Callable, accuracy: float
+                   ) -> tuple[tuple[int, int], bool]:
     """``(i, j)`` of the largest (``pick`` max) or smallest (min) pressure of ``q`` (x,
     time): at the first time whose extreme over x is within ``accuracy`` (relative to the
-    largest |q|) of the whole one. The time of eccentric_creep's largest pressure, level
-    from ~435 days to seven digits, read 887.7 days (2.4 years) where the last digits of
-    the round-off peaked (a teacher's audit)."""
+    largest |q|) of the whole one; and whether every later time's is too (the extreme is
+    held from there on). The time of eccentric_creep's largest pressure, level from ~435
+    days to seven digits, read 887.7 days (2.4 years) where the last digits of the
+    round-off peaked (a teacher's audit)."""
     over_x = np.nanmax(q, axis=0) if pick is max else np.nanmin(q, axis=0)
     extreme = float(np.nanmax(over_x) if pick is max else np.nanmin(over_x))
     # within the accuracy of the largest |q|, but no further from the extreme than its
@@ -429,14 +441,15 @@ def _first_extreme(q: np.ndarray, pick: Callable, accuracy: float) -> tuple[int,
     if not (np.isfinite(slack) and reached.any()):  # (an infinite pressure: where it is)
         flat = np.nanargmax(q) if pick is max else np.nanargmin(q)
         i, j = np.unravel_index(int(flat), q.shape)
-        return int(i), int(j)
+        return (int(i), int(j)), False
     j = int(np.flatnonzero(reached)[0])
+    held = bool(j < reached.size - 1 and reached[j:].all())
     # the place: of those within the accuracy of the time's extreme, the last (a centred
     # load's largest pressure is at both corners: the right one, to round-off either)
     at = q[:, j]
     near = np.flatnonzero(at >= over_x[j] - slack) if pick is max else \
         np.flatnonzero(at <= over_x[j] + slack)
-    return int(near[-1]), j
+    return (int(near[-1]), j), held
 
 
 def _corner_line(name: str, label: str, unit: str, times: np.ndarray, x: np.ndarray,

@@ -154,7 +154,7 @@ def scene_with_limits(scene: dict[str, Any], limits: DesignLimits | None) -> dic
 def _on_screen(line: LimitCheck, limits: DesignLimits | None) -> Check:
     """A line of the core's check in the screen's units, with the limit as typed."""
     unit, size = _SCREEN_UNITS[line.quantity]
-    where = f"t = {days_text(line.time)}"
+    where = f"t = {days_text(line.time)}" + (" and after" if line.held else "")
     if line.x is not None:
         where = f"x = {line.x:.3g} m, " + where
     if line.sign_note:

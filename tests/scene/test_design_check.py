@@ -78,6 +78,32 @@ def test_the_check_finds_the_extremes_where_and_when() -> None:
     assert zero.check("tilt").utilisation == math.inf and zero.passed is False
 
 
+def test_an_extreme_a_history_levels_off_at_is_dated_and_after() -> None:
+    """A settlement that grows and then stays at its largest value (to the answer's
+    accuracy) read "largest ... at t = 489.4 days" on the creep preset, taken by a class
+    told it stops growing after ~250 days for an event (a teacher's audit): it is dated
+    when first reached "and after"; a peak that falls again, as before."""
+    times = np.array([0.0, 10.0, 100.0, 1000.0])
+    x = np.array([-1.0, 0.0, 1.0])
+    pressure = np.array([[1.0, 2.0, 3.0, 3.0], [4.0, 9.0, 9.0, 9.0],
+                         [1.0, 0.5, 0.7, 0.7]]) * 1e5
+    levels = np.array([0.001, 0.004, 0.004 * (1 - 1e-12), 0.004])
+    peaks = np.array([1e-4, 3e-4, 2e-4, 1e-4])
+    check = check_design(times, x, pressure, levels, peaks)
+    q_max, delta, alpha = check.checks
+    assert delta.held and delta.time == 10.0
+    assert delta.value_text() == "0.004 m at t = 10 days and after"
+    assert not alpha.held and alpha.value_text() == "0.0003 rad at t = 10 days"
+    assert q_max.held and q_max.value_text() == "900000 Pa at t = 10 days and after, x = 0 m"
+    assert check.to_dict()["checks"][1]["held_after"] is True
+    # reached only at the last output time: nothing after it to speak of
+    last = check_design(times, x, pressure, np.array([0.001, 0.002, 0.003, 0.004]), peaks)
+    assert not last.checks[1].held and last.checks[1].time == 1000.0
+    result = solve(scene_file("eccentric_creep"))
+    line = design_check(result).check("settlement")
+    assert line.held and line.time < result.times[-1]
+
+
 def test_a_solution_checks_its_scenes_limits() -> None:
     scene = scene_file("eccentric_creep")
     scene["times"] = {"end": 100.0, "count": 4}
