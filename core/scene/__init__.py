@@ -61,6 +61,7 @@ from core.scene.design import (
     thin_edge_note,
     time_of_largest,
     verdict_words,
+    without_round_off,
 )
 from core.scene.display import (
     corner_note,
@@ -168,6 +169,7 @@ __all__ = [
     "check_design",
     "flagged_caution",
     "time_of_largest",
+    "without_round_off",
     "verdict_words",
     "check_fields",
     "check_loads_touch",

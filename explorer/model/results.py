@@ -16,7 +16,7 @@ import numpy as np
 
 from core import scene_from_dict
 from core.coating import model_error_quantity
-from core.scene import flags_with_evidence, model_error_evidence
+from core.scene import flags_with_evidence, model_error_evidence, without_round_off
 
 from .state import QUANTITIES, QUANTITY_UNITS
 
@@ -289,18 +289,13 @@ def scene_geometry(scene: Any, points: int = LINE_POINTS) -> Geometry:
 
 
 def _drop_round_off(values: dict[str, np.ndarray], a: float) -> None:
-    """Show an exact zero where a quantity is round-off next to its partner's size.
+    """Show an exact zero where a quantity is round-off next to its partner's size
+    (:func:`core.scene.without_round_off`, as the core's design check reads them).
 
     A centred load gives a tilt of 1e-18 rad, which an autoscaled plot would blow up into
-    a curve. The partner sets the scale: settlement / a for the tilt, force * a for the
-    moment, and conversely. Downloads keep the solver's numbers untouched.
+    a curve. Downloads keep the solver's numbers untouched.
     """
-    peak = {q: float(np.max(np.abs(v))) if v.size else 0.0 for q, v in values.items()}
-    scale = {"tilt": peak["settlement"] / a, "settlement": peak["tilt"] * a,
-             "moment": peak["force"] * a, "force": peak["moment"] / a}
-    for q, v in values.items():
-        if 0 < peak[q] <= 1e-10 * scale[q]:
-            values[q] = np.zeros_like(v)
+    values.update(without_round_off(values, a))
 
 
 def _resample_time(times: np.ndarray, q: np.ndarray, rows: int) -> np.ndarray:

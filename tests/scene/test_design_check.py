@@ -19,6 +19,7 @@ from core.scene import (
     save_scene,
     scene_from_dict,
     solve,
+    without_round_off,
 )
 from core.study import study_from_dict
 from tests.conftest import base_scene, edited, scene_file
@@ -102,6 +103,29 @@ def test_an_extreme_a_history_levels_off_at_is_dated_and_after() -> None:
     result = solve(scene_file("eccentric_creep"))
     line = design_check(result).check("settlement")
     assert line.held and line.time < result.times[-1]
+
+
+def test_a_tilt_of_round_off_is_checked_and_said_as_zero() -> None:
+    """A centred force on the worn coating gives a tilt of -3e-21 rad beside 5e-5 m of
+    settlement: the report and the command line read "largest tilt -3.008e-18 mrad,
+    utilisation 3.01e-18" where the page read 0 (it dropped the round-off). The check
+    reads the histories as the page shows them; the answer keeps the solver's numbers."""
+    scene = scene_file("worn_coating")
+    scene["limits"] = {"tilt_limit": 1e-3}
+    result = solve(scene)
+    assert 0 < abs(result.tilt[-1]) < 1e-18  # (the solver's own number, kept)
+    line = design_check(result).check("tilt")
+    assert line.value == 0.0 and line.utilisation == 0.0
+    assert line.value_text() == "0 rad at t = 1 day"
+    histories = without_round_off({"settlement": result.settlement, "tilt": result.tilt,
+                                   "force": result.force, "moment": result.moment},
+                                  result.scene.half_width)
+    assert not histories["tilt"].any() and not histories["moment"].any()
+    assert np.array_equal(histories["settlement"], result.settlement)
+    # a real tilt beside it stays: 1e-9 of the settlement's scale is no round-off
+    small = without_round_off({"settlement": np.array([1e-3]), "tilt": np.array([1e-12])},
+                              1.0)
+    assert small["tilt"][0] == 1e-12
 
 
 def test_a_solution_checks_its_scenes_limits() -> None:
