@@ -17,14 +17,14 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
 
 import core
 from core.scene import DesignLimits as CoreLimits
-from core.scene import check_design, corner_note, provenance_lines
+from core.scene import answer_accuracy, check_design, corner_note, provenance_lines
 from core.study import PUNCH_OUTPUT
 
 from ..model import (
@@ -34,7 +34,9 @@ from ..model import (
     ResultView,
     StudyResult,
     contact_widths,
+    model_evidence,
     scene_with_limits,
+    shown_flags,
 )
 
 #: Significant digits of every number in a CSV file.
@@ -79,9 +81,17 @@ def accuracy_statement(view: ResultView) -> str:
             + (f"; {', '.join(counts)}" if counts else ""))
 
 
-def flag_lines(view: ResultView) -> list[str]:
-    """One line per raised flag with its explanation (the solver's message filled in)."""
-    return [f"{flag}: {flag_message(view, flag)}" for flag in view.flags]
+def flag_lines(view: ResultView, check: Mapping[str, Any] | None = None) -> list[str]:
+    """One line per flag raised as the page shows it (the FE ``check``'s measurement,
+    when made for this scene, raising or lowering ``model_error``), with its explanation
+    (the solver's message filled in; the measurement's words for ``model_error``)."""
+    evidence = model_evidence(view, check)
+    lines = []
+    for flag in shown_flags(view, evidence):
+        text = (evidence["message"] if flag == "model_error" and evidence is not None
+                and evidence["source"] == "measured" else flag_message(view, flag))
+        lines.append(f"{flag}: {text}")
+    return lines
 
 
 def flag_message(view: ResultView, flag: str) -> str:
@@ -96,7 +106,8 @@ def flag_message(view: ResultView, flag: str) -> str:
 
 
 def _header(view: ResultView, what: str, units: Iterable[str],
-            limits: DesignLimits | None = None) -> list[str]:
+            limits: DesignLimits | None = None,
+            check: Mapping[str, Any] | None = None) -> list[str]:
     # the Check tab's limits go into the scene and the check's verdict into the file, as
     # the command line writes them (a file without them lost a failing check)
     scene = view.scene if limits is None else scene_with_limits(view.scene, limits)
@@ -110,11 +121,13 @@ def _header(view: ResultView, what: str, units: Iterable[str],
         f"# accuracy: {accuracy_statement(view)}",
     ]
     if "limits" in scene:
-        check = check_design(view.times, view.x, view.pressure, view.values["settlement"],
-                             view.values["tilt"], CoreLimits(**scene["limits"]),
-                             view.info.get("corner_pressure"))
-        lines.append(f"# design_check: {check.summary(view.flags)}")
-    flags = flag_lines(view)
+        # (dated to the answer's accuracy, as the page, the report and the command line)
+        verdict = check_design(view.times, view.x, view.pressure, view.values["settlement"],
+                               view.values["tilt"], CoreLimits(**scene["limits"]),
+                               view.info.get("corner_pressure"), answer_accuracy(view.info))
+        lines.append(f"# design_check: "
+                     f"{verdict.summary(shown_flags(view, model_evidence(view, check)))}")
+    flags = flag_lines(view, check)
     if flags:
         lines.append("# WARNING: this result is flagged; the model cannot fully stand "
                      "behind it")
@@ -125,10 +138,12 @@ def _header(view: ResultView, what: str, units: Iterable[str],
     return lines
 
 
-def histories_csv(view: ResultView, limits: DesignLimits | None = None) -> str:
+def histories_csv(view: ResultView, limits: DesignLimits | None = None,
+                  check: Mapping[str, Any] | None = None) -> str:
     """The four histories as CSV, in mm, mrad, kN/m and kN·m/m, time in days, and the
     contact width and the lifted length in m (as the contact width plot shows them);
-    with the Check tab's ``limits`` in the scene and the design check's verdict."""
+    with the Check tab's ``limits`` in the scene and the design check's verdict, and the
+    flags as the page shows them (``check``: the Coating tab's FE check, when run)."""
     width = 2 * view.geometry.half_width
     units = ["time_day: days after loading"]
     units += [f"{HISTORY_COLUMNS[q]}: {QUANTITY_UNITS[q][0]}"
@@ -136,8 +151,8 @@ def histories_csv(view: ResultView, limits: DesignLimits | None = None) -> str:
     units += [f"{CONTACT_COLUMNS[0]}: m, length of the base in contact (of 2a = "
               f"{number(width)} m)",
               f"{CONTACT_COLUMNS[1]}: m, length lifted off (2a - contact width)"]
-    lines = _header(view, "histories", units, limits)
-    flags = ";".join(view.flags)
+    lines = _header(view, "histories", units, limits, check)
+    flags = ";".join(shown_flags(view, model_evidence(view, check)))
     lines.append(",".join(["time_day", *(HISTORY_COLUMNS[q] for q in QUANTITIES),
                            *CONTACT_COLUMNS, "flags"]))
     contact = contact_widths(view)
@@ -148,7 +163,8 @@ def histories_csv(view: ResultView, limits: DesignLimits | None = None) -> str:
 
 
 def pressure_csv(view: ResultView, unit: tuple[str, float] | None = None,
-                 limits: DesignLimits | None = None) -> str:
+                 limits: DesignLimits | None = None,
+                 check: Mapping[str, Any] | None = None) -> str:
     """q(x, t) as CSV in long form (time, x, q), on the grid of the plotted line.
 
     ``unit``: the pressure unit on screen and its size in Pa (default: the result's own);
@@ -159,7 +175,7 @@ def pressure_csv(view: ResultView, unit: tuple[str, float] | None = None,
     column = f"q_{name}"
     lines = _header(view, "contact pressure q(x, t)", [
         "time_day: days after loading", "x_m: m from the punch centre",
-        f"{column}: {name} (compression positive)"], limits)
+        f"{column}: {name} (compression positive)"], limits, check)
     # the rows at a corner are a held value, not q there (the JSON says it too)
     corner = corner_note(view.info.get("corner_pressure"), number)
     if corner is not None:

@@ -168,10 +168,12 @@ def _on_screen(line: LimitCheck, limits: DesignLimits | None) -> Check:
     return Check(line.label, line.value / size, unit, where, typed, line.passed)
 
 
-def design_check(view: ResultView, limits: DesignLimits | None = None) -> DesignCheck:
+def design_check(view: ResultView, limits: DesignLimits | None = None,
+                 flags: list[str] | None = None) -> DesignCheck:
     """The design check of ``view`` over its whole history, against ``limits``: the
     core's check (:func:`core.scene.check_design`) in the screen's units, with the
-    contact width and the eccentricity the screen shows beside it."""
+    contact width and the eccentricity the screen shows beside it; ``flags``: the
+    result's as the page shows them (default: the answer's own)."""
     verdict = check_design(view.times, view.x, view.pressure, view.values["settlement"],
                            view.values["tilt"], core_limits(limits),
                            view.info.get("corner_pressure"), answer_accuracy(view.info))
@@ -188,7 +190,8 @@ def design_check(view: ResultView, limits: DesignLimits | None = None) -> Design
                        contact_width=float(widths[j_narrow]),
                        full_width=2 * view.geometry.half_width,
                        eccentricity=moment / force if force > 0 else None, checks=checks,
-                       narrowest_time=float(view.times[j_narrow]), flags=list(view.flags),
+                       narrowest_time=float(view.times[j_narrow]),
+                       flags=list(view.flags if flags is None else flags),
                        edge_note=edge)
 
 

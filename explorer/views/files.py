@@ -193,7 +193,8 @@ class FilesView:
             return io.StringIO("")
         if view.several:  # every punch's columns, in SI units (the core's file)
             return io.StringIO(str(await self._fetch("to_csv") or ""))
-        return io.StringIO(await asyncio.to_thread(histories_csv, view, self.limits))
+        return io.StringIO(await asyncio.to_thread(histories_csv, view, self.limits,
+                                                   self.screen.model_check))
 
     async def _pressure_file(self) -> io.StringIO:
         view = self.screen.shown()
@@ -202,7 +203,8 @@ class FilesView:
         if view.several:  # q on every punch's zone, global x, in Pa (the core's file)
             return io.StringIO(str(await self._fetch("pressure_csv") or ""))
         unit = self.scales.pressure_unit(view)
-        return io.StringIO(await asyncio.to_thread(pressure_csv, view, unit, self.limits))
+        return io.StringIO(await asyncio.to_thread(pressure_csv, view, unit, self.limits,
+                                                   self.screen.model_check))
 
     async def _json_file(self) -> io.StringIO:
         text = await self._fetch("to_json")

@@ -388,7 +388,10 @@ class ResultsView:
         if preview:
             self.design.object = PREVIEW_DESIGN
             return
-        self.design.object = check_html(design_check(view, self.limits)) if view else ""
+        # its verdict qualified by the flags the badges show (the FE check's measurement
+        # lowers beyond_model_map, which the check still named)
+        self.design.object = check_html(design_check(
+            view, self.limits, shown_flags(view, self.evidence(view)))) if view else ""
 
     def show_pins(self) -> None:
         """Draw the pins on the figures and in the readout (they changed)."""

@@ -50,8 +50,9 @@ def test_the_sections_say_validity_check_results_and_accuracy(checked):
     results = dict(sections(checked)[3].rows)
     assert "smallest contact width" in results  # the punch lifts off
     # at the toe, the thin coating model's value, said so (core.scene.thin_edge_note)
-    assert re.fullmatch(r"[0-9.]+ kPa at x = 1 m, t = [0-9.]+ days( \([0-9.]+ years\))?( and after)? "
-                        r"\(at the edge: the thin coating model's springs bound it there\)",
+    assert re.fullmatch(r"[0-9.]+ kPa at x = 1 m, t = [0-9.]+ days( \([0-9.]+ years\))?"
+                        r"( and after)? \(at the edge: the thin coating model's springs "
+                        r"bound it there\)",
                         results["largest contact pressure q"])
     assert results["eccentricity e = M/P at the last time"] == "0.6 m"  # 480 / 800 kN
     accuracy = rows(checked, "Accuracy")
