@@ -58,12 +58,20 @@ class DesignLimits:
                 continue
             x = finite_number(value, f"limits.{name}")
             if x < 0:
-                raise ValueError(f"limits.{name}: must be >= 0, got {show_value(value)}")
+                unit = next(u for n, _, u, _ in CHECKS if n == name)
+                raise ValueError(f"limits.{name}: must be >= 0 {unit}, got "
+                                 f"{show_value(value)} {unit}")
             object.__setattr__(self, name, x)
 
     @classmethod
     def from_dict(cls, spec: Mapping[str, Any]) -> DesignLimits:
-        """The limits of a scene file's ``limits`` object (fields as in :data:`CHECKS`)."""
+        """The limits of a scene file's ``limits`` object (fields as in :data:`CHECKS`; a
+        limit not checked is left out: a ``null`` is refused, as the JSON Schema refuses
+        it, where it was taken silently for no limit)."""
+        for name, _, unit, _ in CHECKS:
+            if name in spec and spec[name] is None:
+                raise ValueError(f"limits.{name}: must be a number [{unit}], got null (leave "
+                                 "the field out to check no limit)")
         return cls(**{name: spec.get(name) for name, _, _, _ in CHECKS})
 
     def to_dict(self) -> dict[str, float]:

@@ -40,7 +40,11 @@ def test_limits_are_read_written_and_left_out_when_absent(tmp_path: Path) -> Non
 
 
 @pytest.mark.parametrize(("limits", "message"), [
-    ({"allowable_pressure": -1.0}, "limits.allowable_pressure: must be >= 0, got -1"),
+    # (in units, as validate's schema check says it, and null refused as the schema does:
+    # solve took it for no limit, an engineer's audit found)
+    ({"allowable_pressure": -1.0}, "limits.allowable_pressure: must be >= 0 Pa, got -1 Pa"),
+    ({"tilt_limit": None}, "limits.tilt_limit: must be a number [rad], got null (leave the "
+                           "field out to check no limit)"),
     ({"settlement_limit": True}, "limits.settlement_limit: must be a number, got true"),
     ({"tilt_limit": float("nan")}, "limits.tilt_limit: must be a finite number"),
     ({"settlement": 0.01}, "limits: unknown field 'settlement' (did you mean "
