@@ -42,5 +42,11 @@ class Screen(param.Parameterized):
     def scene_changed(self) -> None:
         """A change of the scene was taken (a value typed again, a step, an undo, a reset,
         a preset): a refusal on screen is over (it read "it stays 500" beside P = 600)."""
+        self.accepted()
+
+    def accepted(self) -> None:
+        """A value typed was taken (a change of the scene, a limit of the check): a
+        refusal on screen is over (a refused limit's "the limit stays 2000" stayed up for
+        minutes beside the limits typed after it, an engineer's audit found)."""
         if self.notice.startswith(REFUSED):
             self.notice = ""

@@ -34,6 +34,8 @@ class CheckView:
             label="eccentricity e = M/P [m] (sets the moment)", value=None,
             sizing_mode="stretch_width", css_classes=["eccentricity-input"])
         self._showing = False  # the box follows the loads: not a value typed
+        # the limit a refusal puts back in its box, by name: that change is no value typed
+        self._put_back: dict[str, float | None] = {}
         self.eccentricity.param.watch(self._on_eccentricity, "value")
         self.show_eccentricity()
 
@@ -61,12 +63,23 @@ class CheckView:
             self.limit_note.object = f"<span class='cp-msg'>Not accepted: {message}</span>"
             self.limit_note.visible = True
             # the last good limit, on the page too (next_tick: see there)
+            self._put_back[name] = good
             next_tick(lambda: setattr(box, "value", good))
             return
-        if value == getattr(self.limits, name):
-            return  # the last good limit put back (or nothing changed): the note stays
-        self.limit_note.visible = False
-        setattr(self.limits, name, value)
+        if name in self._put_back and value == self._put_back.pop(name):
+            return  # the last good limit put back: the refusal stays said
+        # a value taken (the limit in force typed again, too): the refusal is over
+        self.screen.accepted()
+        if value is None and getattr(self.limits, name) is not None:
+            # an emptied box, or text the box could not read ("abc" came as empty): the
+            # limit goes, said, not silently (the verdict turned green unsaid)
+            self.limit_note.object = (f"<span class='cp-msg'>{label}: emptied, not checked "
+                                      "(type a number to check it again)</span>")
+            self.limit_note.visible = True
+        else:
+            self.limit_note.visible = False
+        if value != getattr(self.limits, name):
+            setattr(self.limits, name, value)
 
     def show_eccentricity(self) -> None:
         """Show e = M/P of the loads on screen (empty when force and moment are not both

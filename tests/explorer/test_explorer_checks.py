@@ -549,6 +549,31 @@ def test_the_eccentricity_box_follows_the_loads_and_a_negative_limit_is_refused(
 
 
 
+def test_a_refused_limit_is_over_once_a_limit_is_taken_and_an_emptied_one_is_said(
+        explorer_app):
+    """An engineer's audit: after "-5" was refused, the banner "... the limit stays 2000"
+    stayed up for minutes while 2000, 0.1 and 0.07 were typed; text in a limit box ("abc",
+    which the page sends as empty) removed the limit without a word and the verdict
+    turned green."""
+    app = explorer_app(solved=True)
+    check = app.check_tab
+    check.allowable_pressure.value = 2000.0
+    check.allowable_pressure.value = -5.0
+    assert app.screen.notice.startswith("Value not accepted: allowable bearing pressure")
+    assert check.allowable_pressure.value == 2000.0  # put back, the refusal still said
+    assert app.screen.notice.startswith("Value not accepted: allowable bearing pressure")
+    check.settlement_limit.value = 0.1  # another limit taken: the refusal is over
+    assert app.screen.notice == "" and app.limits.settlement_limit == 0.1
+    check.allowable_pressure.value = -5.0
+    check.allowable_pressure.value = 1500.0  # its own box, a new limit
+    assert app.screen.notice == "" and not check.limit_note.visible
+    check.settlement_limit.value = None
+    assert app.limits.settlement_limit is None and check.limit_note.visible
+    assert "settlement limit [mm]: emptied, not checked" in check.limit_note.object
+    check.settlement_limit.value = 0.2
+    assert not check.limit_note.visible and app.limits.settlement_limit == 0.2
+
+
 def test_the_files_design_check_and_flags_are_the_pages():
     """An engineer's audit: the histories CSV of the lift-off preset dated its extremes at
     681.3 days where the page, the report, the JSON and the command line said 464.2 (the
