@@ -26,6 +26,7 @@ from core.scene import (
     LimitCheck,
     answer_accuracy,
     check_design,
+    contact_width,
     days_text,
     flagged_caution,
     number_text,
@@ -195,8 +196,44 @@ def design_check(view: ResultView, limits: DesignLimits | None = None,
                        edge_note=edge)
 
 
-def check_html(check: DesignCheck) -> str:
-    """The check as an HTML table with a headline (pass, FAIL, or no limits set)."""
+def punch_design_checks(view: ResultView, limits: DesignLimits | None = None
+                        ) -> list[DesignCheck]:
+    """The design check of each punch of a scene of several (:func:`design_check` of
+    each: its pressure on its own grid in the global x, its settlement and tilt about its
+    own centre, dated to its answer's accuracy), as the core checks them
+    (``PunchesSolution.design_checks``); empty for a scene of one punch."""
+    checks = []
+    for p in view.punches:
+        verdict = check_design(view.times, p.x, p.pressure, p.values["settlement"],
+                               p.values["tilt"], core_limits(limits), None,
+                               answer_accuracy({"error_estimate": p.error_estimate}))
+        local = [[(lo - p.center, hi - p.center) for lo, hi in zones]
+                 for zones in p.contact_set]
+        widths = contact_width(local, p.half_width)
+        j_narrow = int(np.argmin(widths))
+        force, moment = float(p.values["force"][-1]), float(p.values["moment"][-1])
+        checks.append(DesignCheck(
+            q_max=_on_screen(verdict.checks[0], limits),
+            q_min=_on_screen(verdict.q_min, limits), contact_width=float(widths[j_narrow]),
+            full_width=2 * p.half_width,
+            eccentricity=moment / force if force > 0 else None,
+            checks=[_on_screen(line, limits) for line in verdict.checks],
+            narrowest_time=float(view.times[j_narrow]), flags=list(p.flags)))
+    return checks
+
+
+def punches_check_html(view: ResultView, checks: list[DesignCheck]) -> str:
+    """The checks of :func:`punch_design_checks`, one table a punch, each named as the
+    page names it and as the files do (``punches[k]``, its centre in the global x)."""
+    return "".join(
+        check_html(check, f"Design check of punch {k + 1}", f"punches[{k}], centre x = "
+                   f"{number_text(p.center)} m; its moment and tilt about it")
+        for k, (p, check) in enumerate(zip(view.punches, checks, strict=True)))
+
+
+def check_html(check: DesignCheck, title: str = "Design check", about: str = "") -> str:
+    """The check as an HTML table with a headline (pass, FAIL, or no limits set);
+    ``title`` heads it, ``about`` says what it is of, beside the title."""
     passed = check.passed
     if passed is None:
         head = "<span class='cp-badge check-none'>no limits set: enter them to check</span>"
@@ -234,7 +271,8 @@ def check_html(check: DesignCheck) -> str:
         contact = f"full contact: {check.full_width:.4g} m at every time"
     ecc = ("e = M/P = undefined (P ≤ 0)" if check.eccentricity is None else
            f"e = M/P = {check.eccentricity:.4g} m (B/6 = {check.full_width / 6:.4g} m)")
-    return (f"<div class='design-check'><b>Design check</b> (whole history) {head}"
+    what = html.escape(f"whole history; {about}" if about else "whole history")
+    return (f"<div class='design-check'><b>{html.escape(title)}</b> ({what}) {head}"
             f"<table class='cp-readout'><tr><th></th><th>value</th><th>where</th>"
             f"<th>limit</th><th></th></tr>{''.join(rows)}</table>"
             f"<div class='cp-status'>{contact} · {ecc}</div>"

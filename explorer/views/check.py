@@ -98,14 +98,17 @@ class CheckView:
                 self._showing = False
 
     def content(self) -> pn.Column:
-        """The tab's column."""
-        return pn.Column(OnePunchOnly(
-            self.state, "The design check and the eccentricity",
+        """The tab's column: the limits (of each punch, for several: their checks were
+        the report's alone), then the eccentricity, of a scene of one punch."""
+        return pn.Column(
             html_pane("<small>Limits of the design check (leave empty: not checked). "
-                      "The check covers the whole history. A scene file's limits fill "
-                      "them, and a saved scene keeps them.</small>"),
+                      "The check covers the whole history, under each punch where there "
+                      "are several. A scene file's limits fill them, and a saved scene "
+                      "keeps them.</small>"),
             self.allowable_pressure, self.settlement_limit, self.tilt_limit,
-            self.limit_note, self.eccentricity).panel, **TAB_COLUMN)
+            self.limit_note,
+            OnePunchOnly(self.state, "The eccentricity box", self.eccentricity).panel,
+            **TAB_COLUMN)
 
     def _on_eccentricity(self, event: Any) -> None:
         """Set the moment so that M = e P (force and moment given, constant force)."""

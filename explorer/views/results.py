@@ -24,6 +24,8 @@ from ..model import (
     design_check,
     lifts_off,
     model_evidence,
+    punch_design_checks,
+    punches_check_html,
     shown_flags,
 )
 from ..plots import PIN_COLORS, PUNCH_COLORS, Figures, LogTime
@@ -95,10 +97,11 @@ PREVIEW_DESIGN = ("<span class='cp-badge check-none design-preview'>design check
                   "release: the preview leaves out creep</span>")
 #: What the page does not show for a scene of several punches yet, said under its
 #: readout (the features of one punch that are off for several).
-SEVERAL_PUNCHES_NOTE = ("Several punches: pins, the classical solutions, the design check, "
-                        "the coating model's FE check, studies and the back-analysis are "
-                        "for one punch and are off here; the Files tab's CSV files (SI "
-                        "units, a column per punch), reports and JSON hold every punch.")
+SEVERAL_PUNCHES_NOTE = ("Several punches: pins, the classical solutions, the coating "
+                        "model's FE check and the back-analysis are for one punch and are "
+                        "off here; the design check and studies take each punch; the Files "
+                        "tab's CSV files (SI units, a column per punch), reports and JSON "
+                        "hold every punch.")
 
 
 def punches_readout_html(view: ResultView, index: int) -> str:
@@ -383,7 +386,11 @@ class ResultsView:
         else:
             preview = view is self._preview
         if view is not None and view.several:
-            self.design.object = ""  # said by the readout's note
+            # each punch's, as its report and the command line check them (the page
+            # showed none, while its report read "A limit is exceeded under punches[0]")
+            self.design.object = punches_check_html(
+                view, punch_design_checks(view, self.limits)) if not preview else \
+                PREVIEW_DESIGN
             return
         if preview:
             self.design.object = PREVIEW_DESIGN

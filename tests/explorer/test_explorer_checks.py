@@ -603,3 +603,43 @@ def test_the_files_design_check_and_flags_are_the_pages():
     assert meta["flag model_error"].startswith("The coating model's error measured by the "
                                                "FE check")
     assert "flagged model_error" in meta["design_check"]
+
+
+def test_each_punch_of_several_is_checked_on_the_page_as_its_report_checks_it(
+        explorer_app):
+    """An engineer's audit: two footings loaded with limits showed no design check on the
+    page ("off here for now", every badge green) while the page's own report read "A
+    limit is exceeded under punches[0]". The limits apply to each punch, as the core
+    checks them; the page shows each punch's table, with the core's numbers."""
+    import re
+
+    import core
+    from core.scene import DesignLimits as CoreLimits
+    from explorer.model import DesignLimits, punch_design_checks
+
+    _, controller = solved("new_footing_beside_old")
+    view = controller.view
+    limits = DesignLimits(allowable_pressure=1000.0, settlement_limit=0.08, tilt_limit=0.01)
+    page = punch_design_checks(view, limits)
+    result = core.solve(view.scene)
+    cores = result.design_checks(CoreLimits(allowable_pressure=1e6, settlement_limit=8e-5,
+                                            tilt_limit=1e-5))
+    assert [c.passed for c in page] == [c.passed for c in cores] == [False, True]
+    for mine, theirs in zip(page, cores, strict=True):
+        for shown, line, size in zip(mine.checks, theirs.checks, (1e3, 1e-3, 1e-3),
+                                     strict=True):
+            assert shown.value == pytest.approx(line.value / size, rel=1e-9)
+            assert shown.verdict == ("pass" if line.passed else "FAIL")
+            assert float(re.search(r"t = ([0-9.]+) days", shown.where)[1]) == \
+                pytest.approx(line.time, rel=5e-4)
+    # on the page: the limits' boxes in the Check tab, each punch's table in the column
+    app = explorer_app()
+    app.load_scene(json.loads(json.dumps(view.scene)))
+    app.controller.solve_now()
+    app.check_tab.allowable_pressure.value = 1000.0
+    column = app.check_tab.content()
+    assert app.check_tab.allowable_pressure.visible and column.visible
+    app.results.show_design()
+    text = app.results.design.object
+    assert "Design check of punch 1" in text and "Design check of punch 2" in text
+    assert "punches[0], centre x = 0 m" in text and "a limit is exceeded" in text
