@@ -881,7 +881,8 @@ def build_parser() -> argparse.ArgumentParser:
                                        "preset:NAME")
     p_solve.add_argument("--output", "-o", metavar="PATH",
                          help="result file: .json (everything) or .csv (histories of "
-                              "settlement [m], tilt [rad], force [N/m], moment [N]); '-' "
+                              "settlement [m], tilt [rad], force [N/m], moment [N·m/m, column "
+                              "moment_N]); '-' "
                               "writes to standard output; default: print a summary")
     p_solve.add_argument("--format", choices=("json", "csv"),
                          help="format of --output (default: from its extension; JSON "
