@@ -64,6 +64,25 @@ def profile_text(spec: Any, values: np.ndarray, unit: str, size: float) -> str:
     return f"{span} {unit} ({kind})".replace("  ", " ")
 
 
+#: The most times a load history's steps and kinks are listed at (more: their span).
+LISTED_CHANGES = 6
+
+
+def _changes_text(profile: Any, t_end: float) -> str:
+    """When a load history steps or kinks within the output times [day] ("" where it does
+    not): the report gave a force stepping from 800 to 1600 kN/m as "800 to 1600 kN/m
+    (step profile)", its time in the appended JSON alone (an engineer's audit)."""
+    points = getattr(profile, "nonsmooth_points", None)
+    at = [] if points is None else [float(p) for p in points(0.0, t_end)]
+    if not at:
+        return ""
+    if len(at) <= LISTED_CHANGES:
+        times = ", ".join(number_text(p) for p in at)
+        return f"; it steps or kinks at t = {times} days"
+    return (f"; it steps or kinks {len(at)} times, from t = {number_text(at[0])} to "
+            f"{number_text(at[-1])} days")
+
+
 def _values(profile: Any, points: np.ndarray) -> np.ndarray:
     return np.broadcast_to(np.asarray(profile(points), dtype=float), points.shape)
 
@@ -130,7 +149,8 @@ def input_rows(scene: Scene) -> list[tuple[str, str]]:
             symbol, si = LOADS[name]
             unit, size = SHOWN_UNITS[si]
             rows.append((f"{name} {symbol} (given)", profile_text(
-                data["loading"][name], _values(scene.loading[name], t), unit, size)))
+                data["loading"][name], _values(scene.loading[name], t), unit, size)
+                + _changes_text(scene.loading[name], float(scene.times[-1]))))
     rows.append(("output times", _times_text(scene, data["times"])))
     settings = solver_settings(scene)
     rows.append(("solver settings", ", ".join(f"{k} {v:g}" if isinstance(v, float)

@@ -356,3 +356,15 @@ def test_a_moment_within_the_answers_accuracy_reads_zero():
     small["loading"]["moment"] = 1e-3 * small["loading"]["force"] * small["punch"]["half_width"]
     small["solver"] = {"tol": 1e-2}
     assert rows(core.solve(small), "Results")["moment M at the last time"] != "0 kN·m/m"
+
+
+def test_the_inputs_say_when_a_given_load_steps():
+    """An engineer's audit: a force stepping from 800 to 1600 kN/m at 200 days read
+    "800 to 1600 kN/m (step profile)", its time only in the appended scene JSON."""
+    scene = read_preset("uniform_flat")
+    scene["loading"]["force"] = {"kind": "step", "values": [8e5, 1.6e6], "breaks": [200.0]}
+    (inputs,) = [s for s in sections(core.solve(scene)) if s.title == "Inputs"]
+    rows = dict(inputs.rows)
+    assert rows["force P (given)"] == ("800 to 1600 kN/m (step profile); it steps or kinks "
+                                       "at t = 200 days")
+    assert rows["moment M (given)"] == "0 kN·m/m"
