@@ -101,7 +101,8 @@ def test_a_varying_load_is_given_by_its_range_and_kind():
     scene = read_preset("uniform_flat")
     scene["loading"]["force"] = {"kind": "ramp", "start": 0.0, "end": 5e5, "duration": 10.0}
     listed = dict(input_rows(scene_from_dict(scene)))
-    assert listed["force P (given)"] == "0 to 500 kN/m (ramp profile)"
+    assert listed["force P (given)"] == ("0 to 500 kN/m (ramp profile); it steps or kinks "
+                                         "at t = 10 days")
 
 
 def test_the_contact_at_a_chosen_time_and_when_the_punch_lifts_off(checked):
