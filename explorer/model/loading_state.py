@@ -45,6 +45,10 @@ QUANTITY_RANGES: dict[str, tuple[float, float]] = {
 #: The amplitude a sine chosen on the page starts at, as a share of its mean, where the
 #: history had no "second" value (a constant).
 SINE_SHARE = 0.2
+#: The value after a step chosen on the page, as a multiple of the value before it, where
+#: the history had no "second" value: 0 took a force away at 10 days, which no contact
+#: carries with a moment left ("M = 120 kN·m/m with no force", an engineer's audit).
+STEP_FACTOR = 2.0
 
 
 class HistoryState(param.Parameterized):
@@ -73,6 +77,8 @@ class HistoryState(param.Parameterized):
         # SINE_SHARE of its mean instead (a file's sine keeps its own amplitude)
         if event.new == "sine" and self.second == 0.0 and not self._loading:
             self.second = SINE_SHARE * self.value
+        elif event.new == "step" and self.second == 0.0 and not self._loading:
+            self.second = STEP_FACTOR * self.value
 
     def to_spec(self) -> float | dict[str, Any]:
         if self.kind == "custom" and self.custom is not None:

@@ -694,3 +694,21 @@ def test_a_statement_chosen_on_the_page_starts_from_the_answer_on_screen(explore
     for q in ("settlement", "tilt", "force", "moment"):
         np.testing.assert_allclose(after.display(q)[-1], before.display(q)[-1],
                                    rtol=1e-6, atol=1e-12)
+
+
+def test_a_step_chosen_on_the_page_starts_from_a_scene_that_solves(explorer_app):
+    """An engineer's audit: choosing the force history "step" on the lift-off preset set
+    "after the step 0 kN/m at 10 days", refused at once ("M = 480 kN·m/m with no
+    force"); the step now doubles the force, and the page solves it."""
+    app = explorer_app()
+    app.load_scene(json.loads(json.dumps(presets()["eccentric_footing_liftoff"])))
+    app.controller.solve_now()
+    force = app.state.loading.histories["force"]
+    force.kind = "step"
+    assert force.second == 2 * force.value == 1600.0
+    app.controller.solve_now()
+    assert app.controller.error == "" and app.controller.view.scene["loading"]["force"] == \
+        {"kind": "step", "values": [8e5, 1.6e6], "breaks": [10.0]}
+    # a file's step keeps its own values (read, not chosen)
+    force.load_spec({"kind": "step", "values": [8e5, 0.0], "breaks": [5.0]})
+    assert force.second == 0.0
