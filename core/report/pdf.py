@@ -71,15 +71,23 @@ def text_pages(lines: list[tuple[str, str, bool]]) -> list[list[tuple[str, str, 
     return pages
 
 
-def _text_pages(pdf, plt, lines: list[tuple[str, str, bool]], size: float = 8.5) -> None:
-    for page in text_pages(lines):
+def _text_pages(pdf, plt, lines: list[tuple[str, str, bool]], size: float = 8.5,
+                keep_last: bool = False) -> tuple[Any, float] | None:
+    """Write ``lines`` on pages of their own; with ``keep_last``, the last page is not
+    written but returned with how far down it is filled (share of the page from its top,
+    where what follows may go on), None without lines."""
+    pages = text_pages(lines)
+    for number, page in enumerate(pages):
         figure = plt.figure(figsize=PAGE)
         for k, (text, tone, bold) in enumerate(page):
             figure.text(0.07, 0.95 - k * 0.9 / LINES_PER_PAGE, text, fontsize=size,
                         color=COLOURS.get(tone, "#222222"), family="DejaVu Sans",
                         weight="bold" if bold else "normal", va="top")
+        if keep_last and number == len(pages) - 1:
+            return figure, 0.05 + len(page) * 0.9 / LINES_PER_PAGE
         pdf.savefig(figure)
         plt.close(figure)
+    return None
 
 
 def _style(element: Any) -> dict[str, Any]:
@@ -144,14 +152,24 @@ def _draw(axes: Any, item: Any, title: str) -> None:
         axes.legend(fontsize=6.5, loc="best", frameon=False)
 
 
-def _plot_page(plt: Any, layout: Any, titles: list[str]) -> Any:
-    """The report's plots, two a row, on one A4 page (a figure)."""
+def plots_height(layout: Any) -> float:
+    """The share of an A4 page the report's plots take, two a row, each row ~3 inches."""
+    rows = max(1, -(-len(list(layout)) // 2))
+    return min(0.88, rows * 0.29)
+
+
+#: Room between the last line of text and the plots' titles below it [share of the page].
+PLOTS_GAP = 0.05
+
+
+def _plot_page(plt: Any, layout: Any, titles: list[str], figure: Any = None,
+               top: float = 0.93) -> Any:
+    """The report's plots, two a row, on one A4 page (a figure: ``figure``, whose text
+    ends above ``top``, or a new page)."""
     items = list(layout)
     rows = max(1, -(-len(items) // 2))
-    figure = plt.figure(figsize=PAGE)
-    # the plots in the upper part of the page, each row ~3 inches high
-    top = 0.93
-    height = min(0.88, rows * 0.29)
+    figure = plt.figure(figsize=PAGE) if figure is None else figure
+    height = plots_height(items)
     grid = figure.add_gridspec(rows, 2, left=0.09, right=0.96, top=top, bottom=top - height,
                                hspace=0.55, wspace=0.32)
     for k, item in enumerate(items):
@@ -190,8 +208,16 @@ def report_pdf(result: SceneSolution | PunchesSolution, time: float | None = Non
     buffer = io.BytesIO()
     with PdfPages(buffer, metadata={"Title": f"Report: {result.scene.name or 'scene'}",
                                     "Creator": "coated-punch"}) as pdf:
-        _text_pages(pdf, plt, lines)
-        figure = _plot_page(plt, layout, titles)
+        # the plots below the last lines of text where they fit (a page of five lines
+        # and a page of plots after it read as a page left blank)
+        last = _text_pages(pdf, plt, lines, keep_last=True)
+        if last is not None and 0.95 - last[1] - PLOTS_GAP - plots_height(layout) >= 0.04:
+            figure = _plot_page(plt, layout, titles, last[0], 0.95 - last[1] - PLOTS_GAP)
+        else:
+            if last is not None:
+                pdf.savefig(last[0])
+                plt.close(last[0])
+            figure = _plot_page(plt, layout, titles)
         pdf.savefig(figure)
         plt.close(figure)
         scene = [(line, "", False) for raw in scene_json(result).splitlines()
