@@ -103,8 +103,8 @@ def solve_dimensionless(lam: float, m: Scalar, g: Scalar, times: Sequence[float]
         ``"auto"``: full contact first, unilateral only when it is lost.
     basis, n_modes, time_breaks : optional
         Engine options kept as keywords (see ``**options``): the projection's basis
-        (``"graded"``, ``"piecewise"``, ``"global"``) and fixed mode count, the Nystrom
-        engine's times where a given load history jumps or kinks (its steps land on
+        (``"graded"``, ``"piecewise"``, ``"global"``) and fixed mode count, and the times
+        where a given load history jumps or kinks (every engine's time grids land on
         them; give a narrow pulse's times too, which the steps could pass over). Under
         creep, a jump of a history given as a callable (a load, ``c``) that is not
         among them is found by sampling and bisection and added
@@ -237,7 +237,7 @@ def _first_answer(engines: list[Engine], geometry: Geometry, inputs: TimeInputs,
     """The full-contact answer of the first engine that does not decline.
 
     The options were asked of the first engine; a later one gets those it takes (the
-    default engine's ``time_breaks`` mean nothing to the projection's adaptive steps).
+    projection takes the default engine's ``time_breaks``, not its other options).
     """
     declined: UnresolvedOperator | None = None
     for engine in engines:

@@ -385,8 +385,11 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
         k = time_of_largest(values, accuracy)
         largest = int(np.nanargmax(np.abs(values)))
         size = np.abs(values)
-        held = bool(k < values.size - 1 and np.all(
-            size[k:] >= size[largest] * (1.0 - _same_share(accuracy))))
+        # (of its sign: a tilt of 2e-3, then -2e-3, then 2e-3 again is not held; a zero
+        # history has no extreme to hold)
+        held = bool(k < values.size - 1 and values[largest] != 0 and np.all(
+            (size[k:] >= size[largest] * (1.0 - _same_share(accuracy)))
+            & (np.sign(values[k:]) == np.sign(values[largest]))))
         lines.append(LimitCheck(name, quantity, label, float(values[largest]), unit,
                                 float(times[k]), None, limit, held=held))
     q_min = LimitCheck(None, "q_min", "smallest contact pressure q_min", q_smallest,

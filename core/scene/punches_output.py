@@ -16,7 +16,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from core.optional import import_optional
-from core.scene.design import DesignCheck, DesignLimits, answer_accuracy, check_design
+from core.scene.design import (
+    DesignCheck,
+    DesignLimits,
+    answer_accuracy,
+    check_design,
+    without_round_off,
+)
 from core.scene.display import HISTORIES
 from core.scene.files import scene_to_json
 from core.scene.results import history_columns, pressure_points
@@ -118,9 +124,13 @@ def design_checks(result: PunchesSolution, limits: DesignLimits | None = None
         corners = punch.info.get("corner_pressure")
         if corners:  # in the global x, as the grid
             corners = {**corners, "corners_m": [punch.center + c for c in corners["corners_m"]]}
+        # (round-off as zero, as one punch's check and the page read it)
+        histories = without_round_off({"settlement": punch.settlement, "tilt": punch.tilt},
+                                      punch.scene.half_width)
         out.append(None if given is None or given.empty else check_design(
-            punch.times, punch.center + punch.x, punch.pressure_on_grid, punch.settlement,
-            punch.tilt, given, corners, answer_accuracy(punch.info)))
+            punch.times, punch.center + punch.x, punch.pressure_on_grid,
+            histories["settlement"], histories["tilt"], given, corners,
+            answer_accuracy(punch.info)))
     return out
 
 

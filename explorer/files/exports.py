@@ -35,6 +35,7 @@ from ..model import (
     StudyResult,
     contact_widths,
     model_evidence,
+    punch_verdicts,
     scene_with_limits,
     shown_flags,
 )
@@ -120,7 +121,14 @@ def _header(view: ResultView, what: str, units: Iterable[str],
         f"# given: {given}; computed: {', '.join(view.unknowns)} (and the pressure)",
         f"# accuracy: {accuracy_statement(view)}",
     ]
-    if "limits" in scene:
+    if "limits" in scene and view.punches:
+        # each punch's, as the page, its report and the command line check them (one
+        # check of the first punch's histories with every punch's pressure said "pass"
+        # where the middle of three punches failed, a review found)
+        for k, verdict in enumerate(punch_verdicts(view, CoreLimits(**scene["limits"]))):
+            lines.append(f"# design_check punches[{k}]: "
+                         f"{verdict.summary(view.punches[k].flags)}")
+    elif "limits" in scene:
         # (dated to the answer's accuracy, as the page, the report and the command line)
         verdict = check_design(view.times, view.x, view.pressure, view.values["settlement"],
                                view.values["tilt"], CoreLimits(**scene["limits"]),

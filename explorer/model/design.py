@@ -203,10 +203,8 @@ def punch_design_checks(view: ResultView, limits: DesignLimits | None = None
     own centre, dated to its answer's accuracy), as the core checks them
     (``PunchesSolution.design_checks``); empty for a scene of one punch."""
     checks = []
-    for p in view.punches:
-        verdict = check_design(view.times, p.x, p.pressure, p.values["settlement"],
-                               p.values["tilt"], core_limits(limits), None,
-                               answer_accuracy({"error_estimate": p.error_estimate}))
+    for p, verdict in zip(view.punches, punch_verdicts(view, core_limits(limits)),
+                          strict=True):
         local = [[(lo - p.center, hi - p.center) for lo, hi in zones]
                  for zones in p.contact_set]
         widths = contact_width(local, p.half_width)
@@ -220,6 +218,16 @@ def punch_design_checks(view: ResultView, limits: DesignLimits | None = None
             checks=[_on_screen(line, limits) for line in verdict.checks],
             narrowest_time=float(view.times[j_narrow]), flags=list(p.flags)))
     return checks
+
+
+def punch_verdicts(view: ResultView, limits: CoreLimits) -> list[Any]:
+    """The core's check (:func:`core.scene.check_design`, SI units) of each punch of a
+    scene of several against ``limits`` (SI): its pressure on its own grid in the global
+    x, its settlement and tilt about its own centre, dated to its answer's accuracy."""
+    return [check_design(view.times, p.x, p.pressure, p.values["settlement"],
+                         p.values["tilt"], limits, None,
+                         answer_accuracy({"error_estimate": p.error_estimate}))
+            for p in view.punches]
 
 
 def punches_check_html(view: ResultView, checks: list[DesignCheck]) -> str:

@@ -101,6 +101,11 @@ def test_an_extreme_a_history_levels_off_at_is_dated_and_after() -> None:
     assert not alpha.held and alpha.value_text() == "0.0003 rad at t = 10 days"
     assert q_max.held and q_max.value_text() == "900000 Pa at t = 10 days and after, x = 0 m"
     assert check.to_dict()["checks"][1]["held_after"] is True
+    # of its sign (a tilt back and forth is not held), and a zero history holds nothing
+    swings = check_design(times, x, pressure, levels, np.array([0.0, 2e-3, -2e-3, 2e-3]))
+    assert not swings.checks[2].held and swings.checks[2].time == 10.0
+    still = check_design(times, x, pressure, levels, np.zeros(4))
+    assert not still.checks[2].held
     # reached only at the last output time: nothing after it to speak of
     last = check_design(times, x, pressure, np.array([0.001, 0.002, 0.003, 0.004]), peaks)
     assert not last.checks[1].held and last.checks[1].time == 1000.0
@@ -422,3 +427,46 @@ def test_an_extreme_is_dated_where_q_shows_its_digits():
             j = int(np.argmin(np.abs(result.times - line.time)))
             there = float(punch.pressure_at([line.x])[0, j])
             assert abs(there - line.value) <= SHOWN_SHARE * abs(line.value), line
+
+
+def _three_punches() -> dict:
+    """Three equal punches 3 m apart on an elastic base: the middle one's tilt is
+    round-off (1.6e-20 rad), the outer ones tilt toward it."""
+    def punch(center: float) -> dict:
+        return {"center": center, "half_width": 1.0, "shape": 0.0,
+                "loading": {"force": 6.0e5, "moment": 0.0}}
+
+    return {"schema_version": 1, "name": "three",
+            "punches": [punch(-3.0), punch(0.0), punch(3.0)],
+            "coating": [{"thickness": 0.02, "modulus": 2.0e9, "poisson": 0.25}],
+            "base": {"thickness": 4.0, "poisson": 0.2, "age_at_loading": 28.0,
+                     "creep": {"model": "elastic", "modulus": 3e10}},
+            "times": {"end": 10.0, "count": 3, "spacing": "linear"},
+            "solver": {"tol": 1e-6},
+            "limits": {"allowable_pressure": 1e7, "settlement_limit": 3e-5,
+                       "tilt_limit": 0.01}}
+
+
+def test_each_punch_is_checked_with_round_off_as_zero_and_by_its_own_histories() -> None:
+    """A review: the core's check of several punches read the middle punch's round-off
+    tilt (1.6e-20 rad) where one punch's check and the page read 0; and the explorer's
+    CSV checked every punch's pressure with the first punch's histories, "pass" where the
+    middle punch's settlement (3.11e-5 m) fails its limit of 3e-5 m."""
+    from explorer.files import histories_csv, parse_csv
+    from explorer.model import DesignLimits as ScreenLimits
+    from explorer.model import punch_design_checks
+    from explorer.model.results import prepare_view
+
+    scene = _three_punches()
+    result = solve(scene)
+    assert 0 < np.max(np.abs(result.punches[1].tilt)) < 1e-15
+    checks = result.design_checks()
+    assert checks[1].check("tilt").value == 0.0
+    assert [c.passed for c in checks] == [True, False, True]
+    view = prepare_view(result, scene)
+    limits = ScreenLimits(allowable_pressure=1e4, settlement_limit=0.03, tilt_limit=10.0)
+    assert [c.passed for c in punch_design_checks(view, limits)] == [True, False, True]
+    meta, _, _ = parse_csv(histories_csv(view, limits))
+    assert [meta[f"design_check punches[{k}]"].split(";")[0] for k in range(3)] == \
+        ["pass", "FAIL", "pass"]
+    assert "design_check" not in meta
