@@ -43,6 +43,30 @@ def test_each_jump_is_found_and_the_declared_ones_are_not_repeated():
                        [6.001, 6.004], rtol=JUMP_SIDE)
 
 
+@pytest.mark.parametrize(("history", "jumps"), [
+    # a jump of 1e-3 on a rise of 10 a unit of time (over a sample interval the rise is
+    # larger than the jump: the test of the change against its neighbours' missed it)
+    (lambda t: 10.0 * t + 1e-3 * (t >= 7.7), [7.7]),
+    # two jumps of one sign within one sample interval (both were dropped)
+    (lambda t: 1.0 + 2.0 * (t >= 4.3) + (t >= 4.302), [4.3, 4.302]),
+], ids=["on a rise", "two in one interval"])
+def test_a_jump_on_a_rise_and_two_close_jumps_are_found(history, jumps):
+    """Found and located to JUMP_SIDE (the answers: the next test)."""
+    found = undeclared_jumps(lambda t: history(np.asarray(t, dtype=float)), 1.0, 12.0, 1e-8)
+    assert np.allclose(found, jumps, rtol=JUMP_SIDE)
+
+
+def test_a_rise_steeper_than_the_march_can_tell_from_a_jump_is_landed_on():
+    """A ramp over 1e-9 units of time (a step written as an interpolation): the march
+    could not tell it from a jump (the settlement 2e-4 off at tol 1e-8, a review found);
+    the search lands on it (1.1e-12 off, measured)."""
+    def history(t):
+        return 1.0 + np.clip((np.asarray(t, dtype=float) - 4.3) / 1e-9, 0.0, 1.0)
+
+    found = undeclared_jumps(history, 1.0, 12.0, 1e-8)
+    assert found and all(4.3 - 1e-12 <= p <= 4.3 + 1e-9 for p in found)
+
+
 def test_a_jump_too_small_to_matter_at_tol_is_not_looked_for():
     history = _step(3.0, 1.0, 1.0 + 1e-9)
     assert undeclared_jumps(history, 1.0, 12.0, 1e-3) == ()
@@ -71,6 +95,25 @@ def test_a_force_that_jumps_undeclared_is_answered_within_tol(tol):
     assert np.max(np.abs(q - q_ref)) <= tol * np.max(np.abs(q_ref))
     settlement = np.max(np.abs(reference.settlement))
     assert np.max(np.abs(answer.settlement - reference.settlement)) <= tol * settlement
+
+
+@pytest.mark.parametrize(("force", "jumps"), [
+    (lambda t: np.asarray(t, dtype=float) / 12.0 + 1e-3 * (np.asarray(t) >= 7.7), (7.7,)),
+    (lambda t: 1.0 + (np.asarray(t) >= 4.3) + (np.asarray(t) >= 4.302), (4.3, 4.302)),
+    (lambda t: 1.0 + np.clip((np.asarray(t, dtype=float) - 4.3) / 1e-9, 0.0, 1.0),
+     (4.3, 4.3 + 1e-9)),
+], ids=["on a rise", "two close", "steep rise"])
+def test_the_jumps_a_review_found_missed_are_answered_within_tol(force, jumps):
+    """A review of the first search: success at tol 1e-8 with the settlement 3.5e-6,
+    7.9e-8 and 2.0e-4 off; now 1.7e-12, 2.0e-12 and 1.1e-12 (measured) against the
+    answers with the jumps declared at tol 1e-10."""
+    args = dict(lam=1.0, m=0.05, g=0.0, times=np.linspace(1.0, 12.0, 12), kernel=KERNEL,
+                force=force, moment=0.0)
+    reference = solve_dimensionless(tol=1e-10, time_breaks=jumps, **args)
+    answer = solve_dimensionless(tol=1e-8, **args)
+    assert answer.info["success"] and answer.info["time_breaks_found"]
+    settlement = np.max(np.abs(reference.settlement))
+    assert np.max(np.abs(answer.settlement - reference.settlement)) <= 1e-8 * settlement
 
 
 @pytest.mark.parametrize(("method", "tol"), [("projection", 1e-6), ("collocation", 1e-4)])
