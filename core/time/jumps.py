@@ -77,8 +77,12 @@ def undeclared_jumps(history: Callable[[np.ndarray], np.ndarray], start: float, 
     t = np.unique(np.concatenate([np.linspace(start, end, JUMP_SAMPLES),
                                   np.geomspace(start, end, JUMP_SAMPLES)]))
     f = _values(history, t)
-    if not np.all(np.isfinite(f)):
-        return ()  # the solve's own checks say what is wrong with the history
+    # where the history is not finite (a pole of a formula between the output times) the
+    # solve's own checks speak; the search looks at the rest
+    finite = np.isfinite(f)
+    t, f = t[finite], f[finite]
+    if t.size < 3:
+        return ()
     scale = float(np.max(np.abs(f)))
     if scale == 0.0:
         return ()
