@@ -17,6 +17,7 @@ import numpy as np
 from core.report.contact import lift_off_times, output_index
 from core.report.inputs import LAYER_FIELDS, SHAPE_UNIT
 from core.scene import (
+    PRESSURE_WIDTH,
     PunchesSolution,
     SceneSolution,
     holoviews_for_bokeh,
@@ -123,8 +124,14 @@ def report_layout(result: SceneSolution | PunchesSolution,
         extra.append((contact_title(result), contact_overlay(result)))
     extra.extend(geometry_curves(result))
     titles = [*PLOT_TITLES, *(title for title, _ in extra)]
+    items = [*layout, *(element for _, element in extra)]
+    # every plot as wide as q(x)'s (its legend beside it): a narrower one in its column of
+    # the page's grid was drawn a third as wide (the tilt's, ~120 px of plot on a 1500 px
+    # page, its ticks overlapping; an engineer's audit)
+    items = [items[0], *(item.opts(width=PRESSURE_WIDTH, backend="bokeh")
+                         for item in items[1:])]
     # a clone keeps the layout's title (the scene and its flags)
-    return layout.clone([*layout, *(element for _, element in extra)]).cols(2), titles
+    return layout.clone(items).cols(2), titles
 
 
 def readings_overlay(result: SceneSolution, calibration: Any) -> Any:

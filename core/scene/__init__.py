@@ -95,6 +95,7 @@ from core.scene.output_times import at_output_times
 from core.scene.pipeline import solve
 from core.scene.plotting import (
     LIFT_OFF_COLOUR,
+    PRESSURE_WIDTH,
     PUNCH_COLOURS,
     holoviews_for_bokeh,
     pressure_unit,
@@ -149,6 +150,7 @@ __all__ = [
     "at_output_times",
     "default_tol",
     "LIFT_OFF_COLOUR",
+    "PRESSURE_WIDTH",
     "LIFT_OFF_SHARE",
     "engine_text",
     "holoviews_for_bokeh",

@@ -401,3 +401,19 @@ def test_the_pdf_plots_go_below_the_last_lines_of_text_where_they_fit():
                                         subsequent_indent="      ") or [""])]
     scene_pages = len(text_pages([("Scene file (SI units)", "", True), *scene]))
     assert count == len(pages) + scene_pages  # no page of its own for the plots
+
+
+def test_the_html_plots_are_as_wide_as_the_pressures():
+    """An engineer's audit: on a 1500 px page the tilt plot, below q(x) in the page's
+    grid, was drawn ~120 px wide with its ticks overlapping: a plot narrower than q(x)'s
+    (400 against 580 px, its legend beside it) in the same column of Bokeh's grid is
+    squeezed. Every plot of the report is as wide as q(x)'s."""
+    import holoviews as hv
+    from bokeh.models import Plot
+
+    from core.report.plots import report_layout
+
+    layout, _ = report_layout(core.solve(read_preset("eccentric_footing_liftoff")))
+    figure = hv.render(layout, backend="bokeh")
+    widths = {plot.width for plot in figure.select({"type": Plot})}
+    assert len(widths) == 1, widths
