@@ -109,7 +109,9 @@ def punches_readout_html(view: ResultView, index: int) -> str:
     t = float(view.times[index])
     head = "<tr><th></th>" + "".join(
         f"<th class='readout-punch-{k}' style='border-bottom:3px solid {PUNCH_COLORS[k]}'>"
-        f"punch {k + 1} (x = {p.center:.3g} m)</th>" for k, p in enumerate(view.punches))
+        # (named as the files and the report name it too: "punches[1]" read as punch 1)
+        f"punch {k + 1} (punches[{k}], x = {p.center:.3g} m)</th>"
+        for k, p in enumerate(view.punches))
     rows = [head + "</tr>"]
     for q in QUANTITIES:
         unit = QUANTITY_UNITS[q][0]

@@ -62,7 +62,8 @@ def test_two_punches_their_histories_and_a_drag_of_a_centre(server: str, page: P
     assert old[-1] > new[-1] > 0
     tilt = page.page.evaluate(JS_HISTORY, ["tilt", 0])
     assert tilt[-1] > 0  # the old footing tilts toward the new one
-    until(lambda: page.page.evaluate(JS_SHOWN, "punch 2 (x = 3 m)"), "the readout per punch")
+    until(lambda: page.page.evaluate(JS_SHOWN, "punch 2 (punches[1], x = 3 m)"),
+          "the readout per punch")
     assert page.page.evaluate(JS_Q_RIGHT) == pytest.approx(4.0)
     # the Punch tab: choose punch 2 and drag its centre to the right
     page.open_tab("Punch")
@@ -97,7 +98,7 @@ def test_two_punches_their_histories_and_a_drag_of_a_centre(server: str, page: P
           "q(x) over the moved punch")
     until(lambda: 0 < page.page.evaluate(JS_HISTORY, ["tilt", 0])[-1] < tilt[-1],
           "the old footing tilts less")
-    until(lambda: page.page.evaluate(JS_SHOWN, f"punch 2 (x = {centre:.3g} m)"),
+    until(lambda: page.page.evaluate(JS_SHOWN, f"punch 2 (punches[1], x = {centre:.3g} m)"),
           "the readout of the moved punch",
           describe=lambda: page.text(".readout-punch-1"))
     assert page.errors == []

@@ -145,7 +145,8 @@ def test_the_page_shows_each_punch_and_turns_off_what_is_for_one(explorer_app) -
         (float(view.times[0]) - 0.05 * span, float(view.times[-1]) + 0.05 * span))
     assert not figures.history_line["settlement"].visible
     assert figures.drawing.punches_src.data["name"] == ["punch 1", "punch 2"]
-    assert "punch 2 (x = 3 m)" in app.results.readout.object
+    # named as the files name it too (an engineer's audit: punches[1] read as punch 1)
+    assert "punch 2 (punches[1], x = 3 m)" in app.results.readout.object
     assert "several-punches-note" in app.results.readout.object
     # off for several punches, with a note in their place
     assert app.pins.pin_button.disabled and app.results.classical.disabled
