@@ -460,7 +460,13 @@ def _first_extreme(q: np.ndarray, pick: Callable, accuracy: float
     at = q[:, j]
     near = np.flatnonzero(at >= over_x[j] - slack) if pick is max else \
         np.flatnonzero(at <= over_x[j] + slack)
-    return (int(near[-1]), j), held
+    i = int(near[-1])
+    # held at its place too: q_min = 0 "at x = -0.309 m, t = 0 days and after" read as
+    # if that point stayed lifted, where the zone grew over it (a browser check)
+    later = q[i, j:]
+    held = held and bool(np.all(later >= extreme - slack) if pick is max
+                         else np.all(later <= extreme + slack))
+    return (i, j), held
 
 
 def _corner_line(name: str, label: str, unit: str, times: np.ndarray, x: np.ndarray,

@@ -112,6 +112,13 @@ def test_an_extreme_a_history_levels_off_at_is_dated_and_after() -> None:
     result = solve(scene_file("eccentric_creep"))
     line = design_check(result).check("settlement")
     assert line.held and line.time < result.times[-1]
+    # held at its place too: q_min = 0 at a point the growing zone later covers is not
+    # "0 kPa at x = -0.309 m, t = 0 days and after" (a browser check)
+    moves = np.array([[0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 2.0, 2.0], [5.0, 5.0, 5.0, 5.0]])
+    lifted = check_design(times, x, moves, levels, peaks).q_min
+    assert (lifted.value, lifted.x, lifted.time) == (0.0, 0.0, 0.0) and not lifted.held
+    check = design_check(solve(scene_file("eccentric_footing_liftoff")))
+    assert check.q_min.value == 0.0 and not check.q_min.held
 
 
 def test_a_tilt_of_round_off_is_checked_and_said_as_zero() -> None:
