@@ -261,8 +261,17 @@ class LimitCheck:
         verdict = "pass" if self.passed else "FAIL"
         if not math.isfinite(self.utilisation):  # a limit of 0 and a value beside it
             return f"{text}; limit {shown(self.limit, self.unit)}, exceeded: {verdict}"
+        slip = (f" (over {UNIT_SLIP:g} times the limit: a scene file gives it in "
+                f"{self.unit})"
+                if self.utilisation > UNIT_SLIP else "")
         return (f"{text}; limit {shown(self.limit, self.unit)}, utilisation "
-                f"{self.utilisation:.3g}: {verdict}")
+                f"{self.utilisation:.3g}: {verdict}{slip}")
+
+
+#: A utilisation over this asks whether the limit was written in another unit: 2000 for
+#: an allowable pressure of 2000 kPa read 2000 Pa, utilisation 986, with no word (an
+#: engineer's audit; a file's limits are in Pa, m and rad).
+UNIT_SLIP = 100.0
 
 
 @dataclass(frozen=True)

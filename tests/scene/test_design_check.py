@@ -477,3 +477,16 @@ def test_each_punch_is_checked_with_round_off_as_zero_and_by_its_own_histories()
     assert [meta[f"design_check punches[{k}]"].split(";")[0] for k in range(3)] == \
         ["pass", "FAIL", "pass"]
     assert "design_check" not in meta
+
+
+def test_a_limit_far_under_the_value_asks_for_its_unit() -> None:
+    """An engineer's audit: 2000 typed for an allowable pressure of 2000 kPa read 2000 Pa,
+    "utilisation 986: FAIL" with no word of the unit."""
+    times, x = np.array([0.0, 1.0]), np.array([-1.0, 0.0, 1.0])
+    pressure = np.full((3, 2), 2e6)
+    check = check_design(times, x, pressure, np.array([1e-4, 1e-4]), np.zeros(2),
+                         DesignLimits(allowable_pressure=2000.0, settlement_limit=2e-4))
+    q_max, delta, _ = check.checks
+    assert q_max.verdict_text().endswith("utilisation 1e+03: FAIL (over 100 times the "
+                                         "limit: a scene file gives it in Pa)")
+    assert delta.verdict_text().endswith("utilisation 0.5: pass")
