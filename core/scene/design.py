@@ -52,13 +52,12 @@ class DesignLimits:
     tilt_limit: float | None = None
 
     def __post_init__(self) -> None:
-        for name, _, _, _ in CHECKS:
+        for name, _, unit, _ in CHECKS:
             value = getattr(self, name)
             if value is None:
                 continue
             x = finite_number(value, f"limits.{name}")
             if x < 0:
-                unit = next(u for n, _, u, _ in CHECKS if n == name)
                 raise ValueError(f"limits.{name}: must be >= 0 {unit}, got "
                                  f"{show_value(value)} {unit}")
             object.__setattr__(self, name, x)
@@ -391,14 +390,12 @@ def check_design(times: Any, x: Any, pressure: Any, settlement: Any, tilt: Any,
                                        held=held_max))
             continue
         values = histories[quantity]
+        reached = _at_largest(values, accuracy)
         k = time_of_largest(values, accuracy)
         largest = int(np.nanargmax(np.abs(values)))
-        size = np.abs(values)
         # (of its sign: a tilt of 2e-3, then -2e-3, then 2e-3 again is not held; a zero
         # history has no extreme to hold)
-        held = bool(k < values.size - 1 and values[largest] != 0 and np.all(
-            (size[k:] >= size[largest] * (1.0 - _same_share(accuracy)))
-            & (np.sign(values[k:]) == np.sign(values[largest]))))
+        held = bool(k < values.size - 1 and values[largest] != 0 and reached[k:].all())
         lines.append(LimitCheck(name, quantity, label, float(values[largest]), unit,
                                 float(times[k]), None, limit, held=held))
     q_min = LimitCheck(None, "q_min", "smallest contact pressure q_min", q_smallest,
@@ -435,11 +432,17 @@ def time_of_largest(values: np.ndarray, accuracy: float = SAME_SHARE) -> int:
     levels off read "largest at t = 887.7 days" for 1e-11 mm more there than elsewhere;
     a zero history: its first time). The largest value itself is ``values`` at
     ``argmax |values|``: a limit is held to it, not to the value at this time."""
+    near = np.flatnonzero(_at_largest(values, accuracy))
+    return int(near[0]) if near.size else int(np.nanargmax(np.abs(values)))
+
+
+def _at_largest(values: np.ndarray, accuracy: float) -> np.ndarray:
+    """Where ``values`` are their largest ``|values|``: of its sign and within
+    ``accuracy`` (relative, :func:`_same_share`) of it."""
     size = np.abs(values)
     k = int(np.nanargmax(size))
-    near = np.flatnonzero((size >= size[k] * (1.0 - _same_share(accuracy)))
-                          & (np.sign(values) == np.sign(values[k])))
-    return int(near[0]) if near.size else k
+    return (size >= size[k] * (1.0 - _same_share(accuracy))) & (
+        np.sign(values) == np.sign(values[k]))
 
 
 def _first_extreme(q: np.ndarray, pick: Callable, accuracy: float

@@ -24,7 +24,7 @@ import numpy as np
 
 import core
 from core.scene import DesignLimits as CoreLimits
-from core.scene import answer_accuracy, check_design, corner_note, provenance_lines
+from core.scene import corner_note, provenance_lines
 from core.study import PUNCH_OUTPUT
 
 from ..model import (
@@ -38,6 +38,7 @@ from ..model import (
     punch_verdicts,
     scene_with_limits,
     shown_flags,
+    view_verdict,
 )
 
 #: Significant digits of every number in a CSV file.
@@ -82,11 +83,11 @@ def accuracy_statement(view: ResultView) -> str:
             + (f"; {', '.join(counts)}" if counts else ""))
 
 
-def flag_lines(view: ResultView, check: Mapping[str, Any] | None = None) -> list[str]:
-    """One line per flag raised as the page shows it (the FE ``check``'s measurement,
-    when made for this scene, raising or lowering ``model_error``), with its explanation
-    (the solver's message filled in; the measurement's words for ``model_error``)."""
-    evidence = model_evidence(view, check)
+def flag_lines(view: ResultView, evidence: Mapping[str, Any] | None = None) -> list[str]:
+    """One line per flag raised as the page shows it (``evidence``:
+    :func:`explorer.model.model_evidence`, the FE check's measurement raising or lowering
+    ``model_error``; default: the answer's own flags), with its explanation (the solver's
+    message filled in; the measurement's words for ``model_error``)."""
     lines = []
     for flag in shown_flags(view, evidence):
         text = (evidence["message"] if flag == "model_error" and evidence is not None
@@ -108,7 +109,7 @@ def flag_message(view: ResultView, flag: str) -> str:
 
 def _header(view: ResultView, what: str, units: Iterable[str],
             limits: DesignLimits | None = None,
-            check: Mapping[str, Any] | None = None) -> list[str]:
+            evidence: Mapping[str, Any] | None = None) -> list[str]:
     # the Check tab's limits go into the scene and the check's verdict into the file, as
     # the command line writes them (a file without them lost a failing check)
     scene = view.scene if limits is None else scene_with_limits(view.scene, limits)
@@ -130,12 +131,9 @@ def _header(view: ResultView, what: str, units: Iterable[str],
                          f"{verdict.summary(view.punches[k].flags)}")
     elif "limits" in scene:
         # (dated to the answer's accuracy, as the page, the report and the command line)
-        verdict = check_design(view.times, view.x, view.pressure, view.values["settlement"],
-                               view.values["tilt"], CoreLimits(**scene["limits"]),
-                               view.info.get("corner_pressure"), answer_accuracy(view.info))
-        lines.append(f"# design_check: "
-                     f"{verdict.summary(shown_flags(view, model_evidence(view, check)))}")
-    flags = flag_lines(view, check)
+        verdict = view_verdict(view, CoreLimits(**scene["limits"]))
+        lines.append(f"# design_check: {verdict.summary(shown_flags(view, evidence))}")
+    flags = flag_lines(view, evidence)
     if flags:
         lines.append("# WARNING: this result is flagged; the model cannot fully stand "
                      "behind it")
@@ -159,8 +157,9 @@ def histories_csv(view: ResultView, limits: DesignLimits | None = None,
     units += [f"{CONTACT_COLUMNS[0]}: m, length of the base in contact (of 2a = "
               f"{number(width)} m)",
               f"{CONTACT_COLUMNS[1]}: m, length lifted off (2a - contact width)"]
-    lines = _header(view, "histories", units, limits, check)
-    flags = ";".join(shown_flags(view, model_evidence(view, check)))
+    evidence = model_evidence(view, check)
+    lines = _header(view, "histories", units, limits, evidence)
+    flags = ";".join(shown_flags(view, evidence))
     lines.append(",".join(["time_day", *(HISTORY_COLUMNS[q] for q in QUANTITIES),
                            *CONTACT_COLUMNS, "flags"]))
     contact = contact_widths(view)
@@ -183,7 +182,7 @@ def pressure_csv(view: ResultView, unit: tuple[str, float] | None = None,
     column = f"q_{name}"
     lines = _header(view, "contact pressure q(x, t)", [
         "time_day: days after loading", "x_m: m from the punch centre",
-        f"{column}: {name} (compression positive)"], limits, check)
+        f"{column}: {name} (compression positive)"], limits, model_evidence(view, check))
     # the rows at a corner are a held value, not q there (the JSON says it too)
     corner = corner_note(view.info.get("corner_pressure"), number)
     if corner is not None:

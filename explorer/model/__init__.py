@@ -44,6 +44,7 @@ from .design import (
     scene_limits,
     scene_with_limits,
     screen_limits,
+    view_verdict,
 )
 from .fit import (
     MAX_FIT_FIELDS,
@@ -125,4 +126,4 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "readings_note", "run_fit", "load_jumps", "prepare_view", "preset_label", "presets",
            "read_fit_query", "read_study_query", "read_view_query", "shown_flags", "scene_limits",
            "scene_with_limits", "screen_limits", "step_scene", "study_choices", "study_outputs",
-           "study_settings", "validated_scene", "view_query"]
+           "study_settings", "validated_scene", "view_query", "view_verdict"]

@@ -51,13 +51,17 @@ def contact_zones(view: ResultView, index: int) -> list[tuple[float, float]]:
     return lifted_intervals(view.negative_intervals(index), a)
 
 
+def punch_contact_widths(p: PunchResult) -> np.ndarray:
+    """The contact width [m] of one punch of several at each output time."""
+    return contact_width(_local_set(p), p.half_width)
+
+
 def contact_widths(view: ResultView) -> np.ndarray:
     """The contact width [m] at each output time (``2a`` in full contact), the core's
     :func:`core.scene.contact_width` of the view's contact set (summed over the punches,
     for several)."""
     if view.punches:
-        return np.sum([contact_width(_local_set(p), p.half_width) for p in view.punches],
-                      axis=0)
+        return np.sum([punch_contact_widths(p) for p in view.punches], axis=0)
     return contact_width(_contact_set(view), view.geometry.half_width)
 
 

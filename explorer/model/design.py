@@ -26,14 +26,13 @@ from core.scene import (
     LimitCheck,
     answer_accuracy,
     check_design,
-    contact_width,
     days_text,
     flagged_caution,
     number_text,
     thin_edge_note,
 )
 
-from .contact_zone import contact_widths
+from .contact_zone import contact_widths, punch_contact_widths
 from .results import ResultView
 from .state import QUANTITY_UNITS
 
@@ -175,25 +174,14 @@ def design_check(view: ResultView, limits: DesignLimits | None = None,
     core's check (:func:`core.scene.check_design`) in the screen's units, with the
     contact width and the eccentricity the screen shows beside it; ``flags``: the
     result's as the page shows them (default: the answer's own)."""
-    verdict = check_design(view.times, view.x, view.pressure, view.values["settlement"],
-                           view.values["tilt"], core_limits(limits),
-                           view.info.get("corner_pressure"), answer_accuracy(view.info))
-    widths = contact_widths(view)
-    j_narrow = int(np.argmin(widths))
-    force = float(view.values["force"][-1])
-    moment = float(view.values["moment"][-1])
-    checks = [_on_screen(line, limits) for line in verdict.checks]
+    verdict = view_verdict(view, core_limits(limits))
     # (one punch: several draw their pressure over the whole surface, in global x)
     edge = "" if view.punches else thin_edge_note(
         verdict.checks[0], view.geometry.half_width, view.info.get("coating_model"),
         dimensional=view.info.get("dimensional"))
-    return DesignCheck(q_max=checks[0], q_min=_on_screen(verdict.q_min, limits),
-                       contact_width=float(widths[j_narrow]),
-                       full_width=2 * view.geometry.half_width,
-                       eccentricity=moment / force if force > 0 else None, checks=checks,
-                       narrowest_time=float(view.times[j_narrow]),
-                       flags=list(view.flags if flags is None else flags),
-                       edge_note=edge)
+    return _on_screen_check(verdict, limits, view.times, contact_widths(view),
+                            2 * view.geometry.half_width, view.values,
+                            list(view.flags if flags is None else flags), edge)
 
 
 def punch_design_checks(view: ResultView, limits: DesignLimits | None = None
@@ -202,28 +190,38 @@ def punch_design_checks(view: ResultView, limits: DesignLimits | None = None
     each: its pressure on its own grid in the global x, its settlement and tilt about its
     own centre, dated to its answer's accuracy), as the core checks them
     (``PunchesSolution.design_checks``); empty for a scene of one punch."""
-    checks = []
-    for p, verdict in zip(view.punches, punch_verdicts(view, core_limits(limits)),
-                          strict=True):
-        local = [[(lo - p.center, hi - p.center) for lo, hi in zones]
-                 for zones in p.contact_set]
-        widths = contact_width(local, p.half_width)
-        j_narrow = int(np.argmin(widths))
-        force, moment = float(p.values["force"][-1]), float(p.values["moment"][-1])
-        checks.append(DesignCheck(
-            q_max=_on_screen(verdict.checks[0], limits),
-            q_min=_on_screen(verdict.q_min, limits), contact_width=float(widths[j_narrow]),
-            full_width=2 * p.half_width,
-            eccentricity=moment / force if force > 0 else None,
-            checks=[_on_screen(line, limits) for line in verdict.checks],
-            narrowest_time=float(view.times[j_narrow]), flags=list(p.flags)))
-    return checks
+    return [_on_screen_check(verdict, limits, view.times, punch_contact_widths(p),
+                             2 * p.half_width, p.values, list(p.flags))
+            for p, verdict in zip(view.punches, punch_verdicts(view, core_limits(limits)),
+                                  strict=True)]
+
+
+def _on_screen_check(verdict: Any, limits: DesignLimits | None, times: np.ndarray,
+                     widths: np.ndarray, full_width: float, values: Mapping[str, Any],
+                     flags: list[str], edge: str = "") -> DesignCheck:
+    """The core's ``verdict`` in the screen's units, with the narrowest contact of
+    ``widths`` [m] (of ``full_width``) and the eccentricity of the last loads of
+    ``values`` (SI histories) beside it."""
+    j_narrow = int(np.argmin(widths))
+    force, moment = float(values["force"][-1]), float(values["moment"][-1])
+    checks = [_on_screen(line, limits) for line in verdict.checks]
+    return DesignCheck(q_max=checks[0], q_min=_on_screen(verdict.q_min, limits),
+                       contact_width=float(widths[j_narrow]), full_width=full_width,
+                       eccentricity=moment / force if force > 0 else None, checks=checks,
+                       narrowest_time=float(times[j_narrow]), flags=flags, edge_note=edge)
+
+
+def view_verdict(view: ResultView, limits: CoreLimits) -> Any:
+    """The core's check (:func:`core.scene.check_design`, SI units) of a scene of one
+    punch against ``limits`` (SI), dated to its answer's accuracy."""
+    return check_design(view.times, view.x, view.pressure, view.values["settlement"],
+                        view.values["tilt"], limits, view.info.get("corner_pressure"),
+                        answer_accuracy(view.info))
 
 
 def punch_verdicts(view: ResultView, limits: CoreLimits) -> list[Any]:
-    """The core's check (:func:`core.scene.check_design`, SI units) of each punch of a
-    scene of several against ``limits`` (SI): its pressure on its own grid in the global
-    x, its settlement and tilt about its own centre, dated to its answer's accuracy."""
+    """:func:`view_verdict` of each punch of a scene of several: its pressure on its own
+    grid in the global x, its settlement and tilt about its own centre."""
     return [check_design(view.times, p.x, p.pressure, p.values["settlement"],
                          p.values["tilt"], limits, None,
                          answer_accuracy({"error_estimate": p.error_estimate}))
