@@ -220,11 +220,17 @@ def report_pdf(result: SceneSolution | PunchesSolution, time: float | None = Non
             figure = _plot_page(plt, layout, titles)
         pdf.savefig(figure)
         plt.close(figure)
-        scene = [(line, "", False) for raw in scene_json(result).splitlines()
-                 for line in (textwrap.wrap(raw, CHARACTERS_PER_LINE + 20,
-                                            subsequent_indent="      ") or [""])]
-        _text_pages(pdf, plt, [("Scene file (SI units)", "", True), *scene], size=6.5)
+        _text_pages(pdf, plt, scene_lines(result), size=6.5)
     return buffer.getvalue()
+
+
+def scene_lines(result: SceneSolution | PunchesSolution) -> list[tuple[str, str, bool]]:
+    """The lines of the PDF's last pages: the scene file (SI units) under its heading,
+    wrapped to the page."""
+    scene = [(line, "", False) for raw in scene_json(result).splitlines()
+             for line in (textwrap.wrap(raw, CHARACTERS_PER_LINE + 20,
+                                        subsequent_indent="      ") or [""])]
+    return [("Scene file (SI units)", "", True), *scene]
 
 
 def write_report(result: SceneSolution | PunchesSolution, path: str | os.PathLike,

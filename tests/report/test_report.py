@@ -375,17 +375,14 @@ def test_the_pdf_plots_go_below_the_last_lines_of_text_where_they_fit():
     """An engineer's audit: a page of five lines, then a page of plots, read as a page
     left blank; the two punches' report took 5 pages, now 4 (its last 8 lines of text and
     its plots on one)."""
-    pytest.importorskip("matplotlib")
     import re
-    import textwrap
 
     from core.report.pdf import (
-        CHARACTERS_PER_LINE,
         LINES_PER_PAGE,
         PLOTS_GAP,
         _text_lines,
         plots_height,
-        scene_json,
+        scene_lines,
         text_pages,
     )
     from core.report.plots import report_layout
@@ -395,11 +392,8 @@ def test_the_pdf_plots_go_below_the_last_lines_of_text_where_they_fit():
     used = 0.05 + len(pages[-1]) * 0.9 / LINES_PER_PAGE
     assert 0.95 - used - PLOTS_GAP - plots_height(report_layout(result, None)[0]) >= 0.04
     count = len(re.findall(rb"/Type\s*/Page[^s]", report_pdf(result)))
-    # the scene file's text, on pages of its own, as report_pdf wraps it
-    scene = [(line, "", False) for raw in scene_json(result).splitlines()
-             for line in (textwrap.wrap(raw, CHARACTERS_PER_LINE + 20,
-                                        subsequent_indent="      ") or [""])]
-    scene_pages = len(text_pages([("Scene file (SI units)", "", True), *scene]))
+    # the scene file's text, on pages of its own
+    scene_pages = len(text_pages(scene_lines(result)))
     assert count == len(pages) + scene_pages  # no page of its own for the plots
 
 
