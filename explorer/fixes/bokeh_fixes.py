@@ -1,8 +1,8 @@
-"""Five fixes applied in the page to BokehJS: style sheets rewritten with the same text,
+"""Six fixes applied in the page to BokehJS: style sheets rewritten with the same text,
 the page's layout computed once per frame (and not for a closed tab), colours and line
 styles no longer read back from the computed style at each paint, a renderer's place
-written on its element rather than into a style sheet, and a figure's base font size read
-once.
+written on its element rather than into a style sheet, a figure's base font size read
+once, and a canvas layer cleared to its edges.
 
 **Style sheets.** BokehJS (checked with 3.9.2) writes the text of a ``<style>`` element
 each time it paints a renderer (``update_position``) or lays a figure out, even when the
@@ -76,6 +76,17 @@ Measured with the placing fix above, both against neither: switches between five
 (answers cached, so the page's part), two runs of each alternated: the page's CPU per
 switch 442-724 -> 376-664 ms (sum over the five 2881, 2914 -> 2400, 2795 ms), the switch
 (choice to last frame) 349-706 -> 327-626 ms.
+
+**A canvas layer cleared to its edges.** BokehJS (3.9.2, ``CanvasLayer.prepare``) shifts
+a layer's drawing by half a pixel for crisp lines and then clears the layer's rectangle
+in the shifted coordinates: a strip half a pixel wide at its left and top edges is never
+cleared. The glyph layer paints its background over it; the overlay layer (the time
+cursors and the points at the time shown, :data:`explorer.plots.bokeh_data.MOVING`) is
+transparent and keeps whatever was drawn there. A figure that joins the page (the
+contact width plot at the first lift-off) is painted once before its frame is laid out,
+its cursor and point at x = 0; a red corner and a dotted stroke then stayed left of its
+title for good. The fix clears the whole layer with the shift undone; what is drawn is
+the same.
 """
 
 from __future__ import annotations
@@ -248,16 +259,42 @@ if (!own || typeof own.get !== "function") {
 }
 """
 
+#: Runs once per page when its document is ready (idempotent: a flag on the method). An
+#: SVG layer (export) is cleared as BokehJS does.
+WHOLE_CLEAR_JS = """
+const canvas = (window.Bokeh && Bokeh.require) ? Bokeh.require("core/util/canvas") : null;
+const Layer = canvas && canvas.CanvasLayer;
+if (!Layer || typeof Layer.prototype.clear !== "function") {
+  console.warn("explorer: BokehJS canvas layers have changed; the clearing fix is not applied");
+} else if (!Layer.prototype.clear.__whole) {
+  const clear = Layer.prototype.clear;
+  const whole = function () {
+    const {ctx, canvas} = this;
+    if (this.backend === "svg" || !(canvas instanceof HTMLCanvasElement)
+        || typeof ctx.setTransform !== "function") {
+      clear.call(this);
+      return;
+    }
+    ctx.save();
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.clearRect(0, 0, canvas.width, canvas.height);
+    ctx.restore();
+  };
+  whole.__whole = true;
+  Layer.prototype.clear = whole;
+}
+"""
+
 #: The prefix of the CSS variables BokehJS reads for visual properties (core/visuals).
 BOKEH_CSS_VARIABLE_PREFIX = "--bk-"
 
 
 def install(doc: Any) -> bool:
-    """Apply the five fixes in the page of Bokeh document ``doc`` once it is ready; False
+    """Apply the six fixes in the page of Bokeh document ``doc`` once it is ready; False
     (nothing done) when there is no document (a notebook, a script)."""
     if doc is None or not hasattr(doc, "js_on_event"):
         return False
     for code in (SAME_STYLE_JS, LAYOUT_ONCE_JS, NO_CSS_VARIABLES_JS, INLINE_POSITION_JS,
-                 BASE_FONT_ONCE_JS):
+                 BASE_FONT_ONCE_JS, WHOLE_CLEAR_JS):
         doc.js_on_event("document_ready", CustomJS(code=code))
     return True

@@ -603,6 +603,42 @@ def test_the_pressure_legend_stays_inside_its_plot_at_1024px(page: Page):
     assert page.errors == []
 
 
+# Pixels with ink on the two outermost columns and rows of a figure's overlay layer
+# (cursors, points at the time shown), or null while the figure is not drawn.
+JS_OVERLAY_EDGE_INK = """(name) => {
+  const found = [];
+  const walk = (v) => { if (v.model && v.model.name === name && v.canvas_view) found.push(v);
+                        for (const c of (v.child_views || [])) walk(c); };
+  Object.values(Bokeh.index).forEach(walk);
+  if (found.length !== 1) return null;
+  const c = found[0].canvas_view.overlays.canvas;
+  if (!c.width || !c.height) return null;
+  const ctx = c.getContext('2d');
+  let inked = 0;
+  for (const data of [ctx.getImageData(0, 0, 2, c.height).data,
+                      ctx.getImageData(0, 0, c.width, 2).data]) {
+    for (let i = 3; i < data.length; i += 4) if (data[i] > 0) inked += 1;
+  }
+  return inked;
+}"""
+
+
+def test_a_figure_that_joins_the_page_keeps_no_stale_marks(page: Page):
+    """The contact width plot joins the page at the first lift-off; painted once before
+    its frame was laid out, its time cursor and point (overlay layer) were drawn at x = 0,
+    and BokehJS's clearing left half a pixel of them: a red corner and a dotted stroke
+    stayed left of its title (explorer/fixes/bokeh_fixes.py). 12 inked pixels before
+    the fix, none after."""
+    _choose_preset(page, "eccentric_footing_liftoff", "Eccentric footing")
+    _wait(page, f"() => ({JS_OVERLAY_EDGE_INK})('contact_width_figure') !== null")
+    # two animation frames: the layout that follows the join, and its paint
+    inked = page.page.evaluate(f"""() => new Promise(r => requestAnimationFrame(
+        () => requestAnimationFrame(() => r(({JS_OVERLAY_EDGE_INK})('contact_width_figure')))))""")
+    assert inked == 0
+    assert page.page.evaluate(f"({JS_OVERLAY_EDGE_INK})('scene_figure')") == 0
+    assert page.errors == []
+
+
 def test_a_link_keeps_the_time_the_tab_and_the_pin(page: Page, server: str,
                                                    browser_context: object):
     """Feature 4: a copied link reopens the same view, pin included."""
