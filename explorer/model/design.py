@@ -229,17 +229,34 @@ def punch_verdicts(view: ResultView, limits: CoreLimits) -> list[Any]:
 
 
 def punches_check_html(view: ResultView, checks: list[DesignCheck]) -> str:
-    """The checks of :func:`punch_design_checks`, one table a punch, each named as the
-    page names it and as the files do (``punches[k]``, its centre in the global x)."""
-    return "".join(
-        check_html(check, f"Design check of punch {k + 1}", f"punches[{k}], centre x = "
-                   f"{number_text(p.center)} m; its moment and tilt about it")
-        for k, (p, check) in enumerate(zip(view.punches, checks, strict=True)))
+    """The checks of :func:`punch_design_checks`, each named as the page names it and as
+    the files do (``punches[k]``, its centre in the global x): one table, a heading and
+    rows a punch, so that the punches' columns line up."""
+    parts = [_check_parts(check, f"Design check of punch {k + 1}",
+                          f"punches[{k}], centre x = {number_text(p.center)} m; its moment "
+                          "and tilt about it")
+             for k, (p, check) in enumerate(zip(view.punches, checks, strict=True))]
+    body = "".join(
+        f"<tr><td colspan='5' class='check-heading'>{heading}</td></tr>{CHECK_HEADER}{rows}"
+        f"<tr><td colspan='5' class='check-footer'>{footer}</td></tr>"
+        for heading, rows, footer in parts)
+    return f"<div class='design-check'><table class='cp-readout'>{body}</table></div>"
+
+
+#: The column heads of a design check's table.
+CHECK_HEADER = "<tr><th></th><th>value</th><th>where</th><th>limit</th><th></th></tr>"
 
 
 def check_html(check: DesignCheck, title: str = "Design check", about: str = "") -> str:
     """The check as an HTML table with a headline (pass, FAIL, or no limits set);
     ``title`` heads it, ``about`` says what it is of, beside the title."""
+    heading, rows, footer = _check_parts(check, title, about)
+    return (f"<div class='design-check'>{heading}<table class='cp-readout'>{CHECK_HEADER}"
+            f"{rows}</table>{footer}</div>")
+
+
+def _check_parts(check: DesignCheck, title: str, about: str) -> tuple[str, str, str]:
+    """The heading (title and verdict), the table rows and the lines under them."""
     passed = check.passed
     if passed is None:
         head = "<span class='cp-badge check-none'>no limits set: enter them to check</span>"
@@ -278,9 +295,8 @@ def check_html(check: DesignCheck, title: str = "Design check", about: str = "")
     ecc = ("e = M/P = undefined (P ≤ 0)" if check.eccentricity is None else
            f"e = M/P = {check.eccentricity:.4g} m (B/6 = {check.full_width / 6:.4g} m)")
     what = html.escape(f"whole history; {about}" if about else "whole history")
-    return (f"<div class='design-check'><b>{html.escape(title)}</b> ({what}) {head}"
-            f"<table class='cp-readout'><tr><th></th><th>value</th><th>where</th>"
-            f"<th>limit</th><th></th></tr>{''.join(rows)}</table>"
-            f"<div class='cp-status'>{contact} · {ecc}</div>"
-            + (f"<div class='cp-status check-edge'>q_max {html.escape(check.edge_note)}</div>"
-               if check.edge_note else "") + "</div>")
+    heading = f"<b>{html.escape(title)}</b> ({what}) {head}"
+    footer = (f"<div class='cp-status'>{contact} · {ecc}</div>"
+              + (f"<div class='cp-status check-edge'>q_max {html.escape(check.edge_note)}</div>"
+                 if check.edge_note else ""))
+    return heading, "".join(rows), footer

@@ -28,6 +28,8 @@ CSS = """
 .cp-readout td, .cp-readout th {padding: 1px 8px; font-size: 13px; text-align: right;}
 .cp-readout th:first-child, .cp-readout td:first-child {text-align: left;}
 .cp-given {color: #777;}
+.design-check .cp-readout td.check-heading {text-align: left; padding: 10px 0 2px 0;}
+.design-check .cp-readout td.check-footer {text-align: left; padding: 0 0 4px 0;}
 .readout {overflow-x: auto;}
 """
 

@@ -479,6 +479,33 @@ def test_design_check_limits_eccentricity_report_and_status_details(page: Page):
     assert page.errors == []
 
 
+# Left edges [px] of the cells of each q_max row of the design check (one a punch).
+JS_CHECK_COLUMNS = """() => {
+  const out = [];
+  const walk = (root) => {
+    for (const row of root.querySelectorAll('.design-check tr')) {
+      if (!row.cells[0].textContent.startsWith('largest contact pressure')) continue;
+      out.push(Array.from(row.cells).map(c => Math.round(c.getBoundingClientRect().left)));
+    }
+    for (const el of root.querySelectorAll('*')) if (el.shadowRoot) walk(el.shadowRoot);
+  };
+  walk(document);
+  return out;
+}"""
+
+
+def test_the_design_checks_of_two_footings_line_up(page: Page):
+    """Each footing's design check was a table of its own, its columns where its widest
+    cell put them (the second's "where" 4 px right of the first's): now the punches share
+    one table (explorer/model/design.py, punches_check_html)."""
+    _choose_preset(page, "new_footing_beside_old", "new footing")
+    _failing_pressure_limit(page)
+    _wait(page, f"() => ({JS_CHECK_COLUMNS})().length === 2")
+    lefts = page.page.evaluate(JS_CHECK_COLUMNS)
+    assert lefts[0] == lefts[1]
+    assert page.errors == []
+
+
 def test_a_negative_limit_is_refused_saying_so_and_the_last_good_one_stays(page: Page):
     """The page once clamped -5 to 0 unsaid: a limit every answer fails."""
     box = _typed_limit(page, ".limit-settlement", "50", "all set limits hold")
