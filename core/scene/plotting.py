@@ -106,11 +106,12 @@ def pressure_overlay(result: SceneSolution, count: int = PLOT_CURVES,
               for j, k in enumerate(picked)]
     title = TITLES["pressure"]
     spans: list[Any] = []
+    # (a second line: one line was cut at the plot's width, e.g. "... contact on [-0.3486,")
     if lifts_off_at(result):
-        title += f"; lift-off at {_days(result.times[-1])}: contact on {zones_text(result)} m"
+        title += f"\nlift-off at {_days(result.times[-1])}: contact on {zones_text(result)} m"
         spans = _lift_off_spans(hv, result)
     if result.contact_lost:
-        title += "; contact lost (q < 0: not physical)"
+        title += "\ncontact lost (q < 0: not physical)"
     # the axes are labelled here: the spans' own dimensions (x, y) would name them
     return hv.Overlay(curves + spans).opts(
         title=title, xlabel=x_dim.pprint_label, ylabel=q_dim.pprint_label,
