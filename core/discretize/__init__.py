@@ -24,6 +24,7 @@ from core.discretize.panels import (
     GAUSS_WEIGHTS,
     MIRROR_TOL,
     NODES_PER_PANEL,
+    SHORT_SHARE,
     VALUES_TO_LEGENDRE,
     Panels,
     base_panels,
@@ -49,6 +50,7 @@ from core.discretize.quadrature import (
 
 __all__ = [
     "BARYCENTRIC_WEIGHTS",
+    "SHORT_SHARE",
     "base_panels",
     "even_overall",
     "even_per_node",

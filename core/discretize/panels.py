@@ -141,10 +141,14 @@ def _graded_interval(a: float, b: float, grade_a: bool, grade_b: bool, finest: f
     return list(edges)
 
 
+#: The finest panel of a short interval, a share of its length (:func:`base_panels`).
+SHORT_SHARE = 1.0 / 8.0
+
+
 def base_panels(lam: float, breakpoints: Sequence[float] = (), *,
                 edge_width: float | None = 1e-4, max_width: float = 0.25,
                 soft_cuts: Sequence[float] = (), soft_width: float | None = None,
-                ratio: float = 2.0) -> Panels:
+                ratio: float = 2.0, short_share: float = SHORT_SHARE) -> Panels:
     """Panels on [-1, 1] broken at ``breakpoints`` and graded toward them and toward +-1.
 
     ``edge_width`` is the width of the finest panel at each graded point; panels are at
@@ -160,7 +164,9 @@ def base_panels(lam: float, breakpoints: Sequence[float] = (), *,
     toward ``+-1`` or a breakpoint only happens on intervals wider than ``8 edge_width``: a
     narrower interval is itself the fine panel the grading would make. Without
     ``soft_cuts`` (and with a number for ``edge_width``) the panels are those of the plain
-    call.
+    call, whose finest panel on an interval of length ``L`` is at most ``short_share L``
+    (:data:`SHORT_SHARE`: an interval narrower than ``edge_width / short_share`` is
+    graded to its share of itself, not to ``edge_width``).
     """
     widest = min(max_width, 3.0 / lam)
     hard = [-1.0] + sorted(float(b) for b in breakpoints) + [1.0]
@@ -169,8 +175,8 @@ def base_panels(lam: float, breakpoints: Sequence[float] = (), *,
     if not len(soft_cuts) and np.isfinite(edge_width):
         edges: list[float] = [-1.0]
         for a, b in zip(hard[:-1], hard[1:], strict=True):
-            sub = _graded_interval(a, b, True, True, min(edge_width, (b - a) / 8), widest,
-                                   ratio=ratio)
+            sub = _graded_interval(a, b, True, True, min(edge_width, (b - a) * short_share),
+                                   widest, ratio=ratio)
             edges.extend(sub[1:])
         return Panels.from_edges(np.array(edges))
     soft = sorted({float(c) for c in soft_cuts})

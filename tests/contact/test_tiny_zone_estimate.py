@@ -1,9 +1,14 @@
 """A zone that shrinks toward the corner keeps an estimate of its error
-(core/contact/zones.py: ``_moved_ends_error``).
+(core/contact/zones.py: ``_moved_ends_error``, ``Resolution.short``).
 
 At e = 0.99 a and 0.999 a the zone is 0.03 and 0.003 half-widths wide, narrower than the
 panels of the rules whose difference is the estimate: both rules held the same panels on
 it, and the estimate read exactly 0.0 while the settlement was 4.8e-12 and 1.2e-9 off.
+Moving the ends by their error gave the estimate something, but the rules still held
+the same panels on such a zone (graded to an eighth of it whatever their edge width):
+at e = 0.99 a the answer was 6.5e-8 off at tol 1e-8 and 1e-10 with success, and a
+reference at tol 1e-10 was that same rule. Now each finer rule is finer there too, and
+the references are made on a first rule 16 times finer (:func:`_reference`).
 """
 
 from __future__ import annotations
@@ -21,28 +26,57 @@ def _solve(e: float, tol: float):
     return solve_dimensionless(1.0, 0.05, 0.0, [1.0], force=1.0, moment=e, tol=tol)
 
 
+def _reference(monkeypatch, e: float, tol: float = 1e-10):
+    """The answer at ``tol`` on a first rule 16 times finer everywhere (its width, its
+    grading at the ends and on short stretches): not one of the rules whose difference
+    is the answer's estimate."""
+    import core.contact.unilateral as unilateral
+    from core.contact.zones import Resolution
+
+    first = unilateral.zone_resolution
+
+    def finer(lam, m):
+        r = first(lam, m)
+        return Resolution(r.width / 16, r.edge / 16, r.short / 16)
+
+    with monkeypatch.context() as patch:
+        patch.setattr(unilateral, "zone_resolution", finer)
+        return _solve(e, tol)
+
+
+def _errors(answer, reference) -> list[float]:
+    """The settlement's, the tilt's and q's error of ``answer`` (relative, as tol)."""
+    kin = max(abs(reference.settlement[0]), abs(reference.tilt[0]))
+    q_ref = reference.pressure(X)
+    return [abs(answer.settlement[0] - reference.settlement[0]) / kin,
+            abs(answer.tilt[0] - reference.tilt[0]) / kin,
+            float(np.max(np.abs(answer.pressure(X) - q_ref)) / np.max(np.abs(q_ref)))]
+
+
 @pytest.mark.parametrize(("e", "width"), [(0.99, 0.0307), (0.999, 0.0030)])
-def test_a_narrow_zone_has_a_nonzero_estimate_that_covers_its_error(e: float,
-                                                                    width: float) -> None:
-    answer, reference = _solve(e, 1e-6), _solve(e, 1e-10)
+def test_a_narrow_zone_has_a_nonzero_estimate_that_covers_its_error(
+        e: float, width: float, monkeypatch) -> None:
+    answer = _solve(e, 1e-6)
     assert answer.info["success"] and answer.info["contact"] == "unilateral"
     (start, end), = answer.contact_set[0]
     assert end == 1.0 and 1.0 - start == pytest.approx(width, rel=0.02)
     estimate = answer.info["error_estimate"]
     assert estimate > 0.0
-    kin = max(abs(reference.settlement[0]), abs(reference.tilt[0]))
-    q_ref = reference.pressure(X)
-    errors = [abs(answer.settlement[0] - reference.settlement[0]) / kin,
-              abs(answer.tilt[0] - reference.tilt[0]) / kin,
-              float(np.max(np.abs(answer.pressure(X) - q_ref)) / np.max(np.abs(q_ref)))]
-    # The reference's rule is no finer on a zone this narrow (its own estimate: 2.5e-12
-    # and 4.9e-10); measured: 4.8e-12 / 1.2e-9 (settlement, tilt) and 2.5e-12 / 6.3e-10
-    # (q) against the estimates 3.9e-12 / 7.0e-10: 1.2 and 1.75 times the estimate,
-    # within the margin success allows the unilateral estimates (UNILATERAL_MARGIN: they
-    # may read up to ~3x low). With numpy 2.4 and scipy 1.17 the narrower zone's errors
-    # are 3.8e-12 and its estimate read 2.6e-13 before the rounding floor
-    # (core.contact.zones.ZONE_ROUNDING, 3e-12): the errors are rounding there.
-    assert max(errors) <= UNILATERAL_MARGIN * estimate
+    # measured: 3.7e-9 / 3.7e-9 / 4.2e-9 (settlement, tilt, q) against the estimate 6.3e-8
+    # at e = 0.99, 3.2e-10 / 3.2e-10 / 2.2e-10 against 5.4e-9 at e = 0.999
+    assert max(_errors(answer, _reference(monkeypatch, e))) <= estimate
+
+
+@pytest.mark.parametrize("tol", [1e-8, 1e-10])
+def test_a_narrow_zone_meets_a_fine_tol_where_it_says_so(tol: float, monkeypatch) -> None:
+    """At e = 0.99 a the zone is 0.03 half-widths wide: before each finer rule was finer
+    on it, tol 1e-8 and 1e-10 were met with success while the answer was 6.5e-8 off."""
+    answer = _solve(0.99, tol)
+    assert answer.info["success"]
+    errors = _errors(answer, _reference(monkeypatch, 0.99))
+    # measured: 1.6e-11 at tol 1e-8 (estimate 2.6e-10), 1e-13 at tol 1e-10 (1.7e-11)
+    assert max(errors) <= tol
+    assert max(errors) <= UNILATERAL_MARGIN * answer.info["error_estimate"]
 
 
 def _wavy_scene(half_width: float) -> dict:
