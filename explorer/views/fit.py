@@ -45,6 +45,12 @@ NONE = "(none)"
 STALE_FIT = ("The fit below was made for the scene as it was before the last change: its "
              "forecast is hidden and Apply is off (it would set that scene back). Fit "
              "again to fit this scene.")
+def earlier_readings_note(earlier: str, now: str) -> str:
+    """The status of a fit made from the readings ``earlier`` once ``now`` are shown."""
+    return (f"The fit below was made from the earlier readings, {earlier}; its forecast is "
+            f"drawn beside the readings now shown, {now}. Press Fit to fit these.")
+
+
 #: Under the table of a fit whose fields the readings do not all determine.
 NOT_APPLIED = ("Apply is off: the readings do not determine every field fitted (see the "
                "warnings), so the fitted values are arbitrary along a combination of them; "
@@ -225,15 +231,18 @@ class FitView:
         self.show_readings(readings)
 
     def show_readings(self, readings: Readings) -> None:
-        """Use ``readings`` (the last fit's values and band are cleared)."""
-        self.readings = readings
+        """Use ``readings``. The last fit stays on screen, said to be of the readings
+        before (its forecast beside the new readings checks it); Fit fits these. (New
+        readings cleared the fit's table and band and left "Done: fitted ..." over
+        nothing.)"""
+        earlier, self.readings = self.readings, readings
         self.figures.show_readings(readings_columns(readings))
-        self.figures.show_forecast(forecast_columns(None))
-        self.fit_table.object = ""
-        self.apply_button.disabled = True
-        self._current = None
         self._readings_text(f"{readings.source}: {readings_note(readings)}.")
         self.fit_button.disabled = self.fit_run.running
+        if self.fit_run.outcome is not None and earlier is not None and self.fit_table.object:
+            self._done = earlier_readings_note(earlier.source, readings.source)
+            if self._current:
+                self._say(self._done)
         self.on_settings()
 
     def _readings_text(self, text: str, bad: bool = False) -> None:

@@ -150,6 +150,27 @@ def test_a_refused_file_after_a_good_one_says_which_readings_the_fit_uses(explor
     assert tab.readings.source == "good.csv"
 
 
+def test_new_readings_keep_the_last_fit_on_screen_saying_of_which(explorer_app):
+    """New readings after a fit cleared its table and forecast and left "Done: fitted
+    ..." over nothing: the fit now stays, said to be of the earlier readings (its forecast
+    beside the new ones checks it), and Fit fits the new ones."""
+    app, tab = _with_readings(explorer_app)
+    tab.fields[0].value = "coating[0].modulus"
+    assert tab.start() and tab.fit_run.status == "done", tab.fit_run.message
+    table = tab.fit_table.object
+    band = dict(app.figures.forecast_src["settlement"].data)
+    tab.upload.param.update(filename="later.csv",
+                            value=b"time [day], settlement [mm]\n10, 1.0\n20, 1.2\n40, 1.3\n")
+    assert tab.readings.source == "later.csv"
+    assert len(app.figures.readings_src["settlement"].data["t"]) == 3
+    assert tab.fit_table.object == table
+    assert dict(app.figures.forecast_src["settlement"].data) == band
+    status = html.unescape(tab.fit_status.object)
+    assert "made from the earlier readings, levelling.csv" in status
+    assert "readings now shown, later.csv" in status and "Done:" not in status
+    assert not tab.fit_button.disabled
+
+
 def test_fields_are_checked_before_the_fit(explorer_app):
     app = explorer_app()
     scene = app.state.to_scene()
@@ -385,3 +406,15 @@ def test_a_scene_changed_while_the_fit_runs_and_a_failed_fit_are_said(explorer_a
     app.controller.wait()
     assert tab.apply_button.disabled and "Not fitted: field 2: chosen twice" in (
         html.unescape(tab.fit_status.object))
+
+
+def test_a_fit_ended_at_a_bound_shows_no_interval_past_it() -> None:
+    """As the core's summary and report (tests/back_analysis/test_fit.py): the tab's
+    interval column read an interval reaching past the bound the fit ended at."""
+    from explorer.model.fit import FitOutcome, fit_choices
+    from tests.back_analysis.test_fit import fit_at_a_bound
+
+    fit = fit_at_a_bound()
+    offered = {c.key: c for c in fit_choices(fit.base)}
+    outcome = FitOutcome(fit, None, tuple(offered[p] for p in fit.paths), 0.0)
+    assert outcome.intervals() == [fit.not_determined]
