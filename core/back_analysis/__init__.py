@@ -29,10 +29,17 @@ from core.back_analysis.readings import (
     readings_from_mapping,
     readings_from_text,
 )
-from core.back_analysis.result import BAND_LEVEL, Calibration, Forecast, quantile
+from core.back_analysis.result import (
+    BAND_LEVEL,
+    NOT_DETERMINED,
+    Calibration,
+    Forecast,
+    quantile,
+)
 
 __all__ = [
     "BAND_LEVEL",
+    "NOT_DETERMINED",
     "calibrate",
     "Calibration",
     "FD_STEP",

@@ -9,7 +9,7 @@ import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
@@ -23,6 +23,9 @@ if TYPE_CHECKING:
 
 #: The default confidence level of a forecast's band.
 BAND_LEVEL = 0.95
+#: In place of the interval of a field the readings do not determine
+#: (:meth:`Calibration.determined_intervals`).
+NOT_DETERMINED = "not determined by the readings (see the warnings)"
 
 
 def quantile(level: float, dof: int | None = None) -> float:
@@ -145,6 +148,8 @@ class Calibration:
     solver_error_to_noise: float
     warnings: tuple[str, ...]
     unidentified: tuple[str, ...]
+    #: What stands for the interval of a field the readings do not determine.
+    not_determined: ClassVar[str] = NOT_DETERMINED
     solves: int
     seconds: float
     iterations: int
@@ -219,6 +224,19 @@ class Calibration:
                 return math.inf
         return {f.path: (value(f, x - z * e), value(f, x + z * e))
                 for f, x, e in zip(self.fields, self.x, se, strict=True)}
+
+    def determined_intervals(self, level: float = BAND_LEVEL
+                             ) -> dict[str, tuple[float, float] | None]:
+        """:meth:`intervals` as they may be shown: None for a field the readings do not
+        determine (in :attr:`unidentified`: a bound reached, a combination not
+        identifiable, a derivative not resolved; its standard error does not hold, nor
+        an interval made from it: a fit ended at its lower bound of 28 GPa read "95 %
+        interval 27.2 to 28.8 GPa") or whose interval has an infinite end."""
+        out: dict[str, tuple[float, float] | None] = {}
+        for path, (low, high) in self.intervals(level).items():
+            out[path] = (None if path in self.unidentified
+                         or not (math.isfinite(low) and math.isfinite(high)) else (low, high))
+        return out
 
     @property
     def correlation(self) -> np.ndarray:
@@ -392,7 +410,7 @@ class Calibration:
         """A short text summary: each field's value and standard error, the goodness of
         fit and the warnings."""
         se = self.standard_errors
-        intervals = self.intervals()
+        intervals = self.determined_intervals()
         width = max(len(p) for p in self.paths)
         n = self.readings.count
         lines = [f"fitted {len(self.fields)} field(s) to {n} reading(s) "
@@ -401,10 +419,12 @@ class Calibration:
         for f in self.fields:
             value = self.values[f.path]
             rel = se[f.path] / abs(value) if value else math.inf
-            low, high = intervals[f.path]
+            shown = intervals[f.path]
+            interval = (NOT_DETERMINED if shown is None
+                        else f"{shown[0]:.4g} to {shown[1]:.4g}")
             lines.append(f"  {f.path:<{width}} = {value:.6g} +/- {se[f.path]:.2g} "
                          f"{f.unit}".rstrip() + f"  ({100 * rel:.2g} %; "
-                         f"{100 * BAND_LEVEL:g} % interval {low:.4g} to {high:.4g}; start "
+                         f"{100 * BAND_LEVEL:g} % interval {interval}; start "
                          f"{f.start:.6g})")
         if len(self.fields) > 1:
             corr = self.correlation

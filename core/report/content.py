@@ -243,14 +243,15 @@ def calibration_section(calibration: Any) -> Section:
                          f" to {days_text(float(readings.time[-1]))}"
                          + (", with standard deviations" if calibration.std_given else ""))]
     # (the page's column; the report had none)
-    intervals = calibration.intervals(INTERVAL_LEVEL)
+    intervals = calibration.determined_intervals(INTERVAL_LEVEL)
     level = f"{100 * INTERVAL_LEVEL:g}"
     for path in calibration.paths:
         unit = f" {units[path]}" if units[path] else ""
-        low, high = intervals[path]
-        # (as the Fit tab says it: "unbounded", where "0 to not finite Pa" was read)
-        interval = (f"{number_text(low, 4)} to {number_text(high, 4)}{unit}"
-                    if np.isfinite(low) and np.isfinite(high) else "unbounded")
+        shown = intervals[path]
+        # (as the Fit tab says it, where "0 to not finite Pa" and, at a bound, an
+        # interval past it were read)
+        interval = (calibration.not_determined if shown is None
+                    else f"{number_text(shown[0], 4)} to {number_text(shown[1], 4)}{unit}")
         rows.append((path, f"{number_text(values[path], 6)} ± {number_text(errors[path], 2)}{unit}"
                            f" ({level} % interval {interval}; start "
                            f"{number_text(calibration.start[path], 6)}{unit})"))

@@ -25,6 +25,7 @@ import numpy as np
 
 from core.back_analysis import (
     MAX_CONDITION,
+    NOT_DETERMINED,
     Calibration,
     Forecast,
     Readings,
@@ -123,14 +124,16 @@ class FitOutcome:
         """The confidence interval (:data:`core.back_analysis.BAND_LEVEL`) of each field,
         in the units on screen: Student's t where the noise was estimated from the
         scatter (:meth:`core.back_analysis.Calibration.intervals`)."""
-        intervals = self.calibration.intervals()
+        intervals = self.calibration.determined_intervals()
         out = []
         for c in self.choices:
-            low, high = (v / c.scale for v in intervals[c.key])
+            shown = intervals[c.key]
+            if shown is None:  # (a bound reached: an interval past the bound was read)
+                out.append(NOT_DETERMINED)
+                continue
+            low, high = (v / c.scale for v in shown)
             # (with its unit: the column read "24.84 to 25.4" beside "25.12 ± 0.12 GPa")
-            out.append("unbounded" if not (math.isfinite(low) and math.isfinite(high))
-                       else f"{number_text(low, 4)} to {number_text(high, 4)} "
-                            f"{c.unit}".rstrip())
+            out.append(f"{number_text(low, 4)} to {number_text(high, 4)} {c.unit}".rstrip())
         return out
 
     def correlations(self) -> list[tuple[str, str, float]]:

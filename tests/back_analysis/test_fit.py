@@ -639,12 +639,12 @@ def test_a_degenerate_pairs_forecast_has_the_band_of_what_the_readings_fix() -> 
     # gave a band of width 0 here
     np.testing.assert_allclose(band.settlement_std, one.settlement_std, rtol=1e-6)
     np.testing.assert_allclose(band.settlement, one.settlement, rtol=1e-5)
-    # the report says the fields' intervals are unbounded, as the tab (it read "0 to not
+    # the report says the fields' intervals are not determined, as the tab (it read "0 to not
     # finite Pa")
     from core.report.content import calibration_section
 
     rows = dict(calibration_section(both).rows)
-    assert "(95 % interval unbounded; start" in rows["coating[0].modulus"]
+    assert f"(95 % interval {both.not_determined}; start" in rows["coating[0].modulus"]
 
 
 def test_an_ill_conditioned_but_resolved_fit_keeps_its_covariances_band() -> None:
@@ -666,3 +666,33 @@ def test_an_ill_conditioned_but_resolved_fit_keeps_its_covariances_band() -> Non
     gradient = np.array([[1.0, 0.0], [1.0, 1.0], [1.0, -1.0]])
     np.testing.assert_allclose(Calibration._forecast_variance(fit, gradient),
                                np.einsum("ij,jk,ik->i", gradient, cov, gradient))
+
+
+
+def fit_at_a_bound() -> Calibration:
+    """Exact readings of the creep rate :data:`TRUTH`'s, fitted from 3 times it within
+    bounds of 1.5 to 4 times it: the fit ends at the lower bound."""
+    exact = _exact()
+    rate = TRUTH["base.creep.rate"]
+    readings = {"time": TIMES.tolist(), "settlement": exact.settlement.tolist(),
+                "settlement_std": SETTLEMENT_STD}
+    return calibrate(apply_point(SCENE, {**TRUTH, "base.creep.rate": 3 * rate}), readings,
+                     fit=["base.creep.rate"], bounds={"base.creep.rate": (1.5 * rate, 4 * rate)})
+
+
+def test_a_fit_ended_at_a_bound_gives_no_interval_past_it() -> None:
+    """The truth outside the bounds given: the fit ends at the bound, says so, and its
+    standard error does not hold there. Its summary read "95 % interval 2.72e+10 to
+    2.882e+10" for a lower bound of 28 GPa; the summary and the report now say the
+    readings do not determine it (the Fit tab too: tests/explorer/test_explorer_fit.py)."""
+    from core.report.content import calibration_section
+
+    fit = fit_at_a_bound()
+    assert fit.values["base.creep.rate"] == pytest.approx(1.5 * TRUTH["base.creep.rate"],
+                                                          rel=1e-6)
+    assert "base.creep.rate" in fit.unidentified
+    assert any("bound" in w for w in fit.warnings), fit.warnings
+    assert fit.determined_intervals()["base.creep.rate"] is None
+    assert f"95 % interval {fit.not_determined}; start" in fit.summary()
+    rows = dict(calibration_section(fit).rows)
+    assert f"(95 % interval {fit.not_determined}; start" in rows["base.creep.rate"]

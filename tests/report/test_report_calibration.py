@@ -48,7 +48,8 @@ def test_the_back_analysis_section_lists_the_fit(fitted):
     # the age, which this creep hardly feels (a standard error of 1e10 days), has an
     # unbounded interval, said so as on the Fit tab
     assert rows["base.age_at_loading"].count(" day") == 2
-    assert "(95 % interval unbounded; start 28 day)" in rows["base.age_at_loading"]
+    assert ("(95 % interval not determined by the readings (see the warnings); start 28 day)"
+            in rows["base.age_at_loading"])
     low, high = calibration.intervals(0.95)["coating[0].modulus"]
     assert f"(95 % interval {number_text(low, 4)} to {number_text(high, 4)} Pa; start" in (
         rows["coating[0].modulus"])
