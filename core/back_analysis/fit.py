@@ -221,9 +221,14 @@ def calibrate(scene: Scene | Mapping[str, Any] | str | os.PathLike,
     fields = fitted_fields(base, fit, bounds)
     y, mask, sigma, std_given = _weights(readings)
     n, p = int(mask.sum()), len(fields)
-    if n <= p:
-        raise ValueError(f"measurements: {n} reading(s) cannot determine {p} field(s); give "
-                         "more readings than fitted fields")
+    # With their deviations given as many readings as fields determine the fields and
+    # their errors (the covariance is known); without, the noise is estimated from what
+    # is left over, which needs more readings than fields.
+    if n < p or (n == p and not std_given):
+        raise ValueError(f"measurements: {n} reading(s) cannot determine {p} field(s)"
+                         + ("" if n < p else " and the readings' noise") + "; give more "
+                         "readings than fitted fields" + ("" if n < p else ", or the "
+                         "readings' standard deviations"))
     model = Model(work, fields, readings.series, reading_times(readings))
     x0 = np.array([f.to_x(f.start) for f in fields])
     lo = np.array([f.x_bounds[0] for f in fields])

@@ -253,8 +253,17 @@ class Calibration:
         the stated standard deviations match the scatter. NaN when no deviations are
         given: the noise is then estimated from the scatter (:attr:`noise`), which makes
         chi^2/dof 1 by construction, and the weights' scale is arbitrary (it read
-        0.0006, as if the model fitted far too well)."""
-        return self.chi2 / self.dof if self.std_given else math.nan
+        0.0006, as if the model fitted far too well); and with as many readings as
+        fields (no degree of freedom left: the fit passes through them)."""
+        return self.chi2 / self.dof if self.std_given and self.dof > 0 else math.nan
+
+    @property
+    def chi2_text(self) -> str:
+        """chi^2/dof as the summary, the report and the page give it (with deviations
+        given): its value and degrees of freedom, or why there is none."""
+        if self.dof == 0:
+            return "none (as many readings as fitted fields: the deviations are not checked)"
+        return f"{self.chi2_per_dof:.3g} ({self.dof} dof)"
 
     @property
     def identifiable(self) -> bool:
@@ -386,7 +395,8 @@ class Calibration:
             "goodness_of_fit": {
                 # no chi^2 without deviations (chi2_per_dof)
                 "chi2": self.chi2 if self.std_given else None, "dof": self.dof,
-                "chi2_per_dof": self.chi2_per_dof if self.std_given else None,
+                "chi2_per_dof": (self.chi2_per_dof if math.isfinite(self.chi2_per_dof)
+                                 else None),
                 "covariance": "(J^T J)^-1, the readings' standard deviations"
                 if self.std_given else "s^2 (J^T J)^-1, s^2 = the residuals' sum of "
                                        "squares / dof (noise estimated from them)",
@@ -433,7 +443,7 @@ class Calibration:
             lines.append("correlations: " + "; ".join(pairs))
         noise = ", ".join(f"{name} {v:.3g} {SERIES_UNITS[name]}"
                           for name, v in self.noise.items())
-        lines.append((f"chi^2/dof = {self.chi2_per_dof:.3g} ({self.dof} dof); noise given: "
+        lines.append((f"chi^2/dof = {self.chi2_text}; noise given: "
                       if self.std_given else
                       f"noise estimated from the scatter about the fit ({self.dof} dof): ")
                      + f"{noise}; solver error / noise = {self.solver_error_to_noise:.2g}")

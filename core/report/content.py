@@ -263,8 +263,7 @@ def calibration_section(calibration: Any) -> Section:
             rows.append((f"correlation {paths[j]} ~ {paths[k]}",
                          f"{value:+.3f}" if np.isfinite(value) else "not finite"))
     if calibration.std_given:
-        rows.append(("χ²/dof", f"{calibration.chi2_per_dof:.3g} ({calibration.dof} dof); "
-                               "the readings' standard deviations"))
+        rows.append(("χ²/dof", f"{calibration.chi2_text}; the readings' standard deviations"))
     else:  # no chi^2 without deviations (Calibration.chi2_per_dof)
         noise = ", ".join(f"{name} {number_text(v, 3)} {SERIES_SI[name]}"
                           for name, v in calibration.noise.items())

@@ -333,7 +333,7 @@ def outcome_html(outcome: FitOutcome) -> str:
              f"<tr><th>field</th><th>fitted value ± standard error</th>"
              f"<th>{100 * BAND_LEVEL:g} % interval</th></tr>{rows}</table>",
              f"<div style='font-size:12px'>{c.readings.count} readings, "
-             + (f"χ²/dof = {c.chi2_per_dof:.3g} ({c.dof} dof); " if c.std_given else "")
+             + (f"χ²/dof = {c.chi2_text}; " if c.std_given else "")
              + f"standard errors from {noise}.</div>"]
     pairs = outcome.correlations()
     if pairs:

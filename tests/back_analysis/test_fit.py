@@ -696,3 +696,29 @@ def test_a_fit_ended_at_a_bound_gives_no_interval_past_it() -> None:
     assert f"95 % interval {fit.not_determined}; start" in fit.summary()
     rows = dict(calibration_section(fit).rows)
     assert f"(95 % interval {fit.not_determined}; start" in rows["base.creep.rate"]
+
+
+def test_as_many_readings_as_fields_with_their_deviations_determine_them() -> None:
+    """With its standard deviation given, one reading determines one field (the
+    covariance is known): it was refused ("1 reading(s) cannot determine 1 field(s)").
+    Without deviations the noise needs more readings than fields, and the refusal says
+    so; chi^2/dof has no degree of freedom and is said to be none."""
+    exact = _exact()
+    k = 12
+    one = {"time": [float(TIMES[k])], "settlement": [float(exact.settlement[k])],
+           "settlement_std": SETTLEMENT_STD}
+    start = apply_point(SCENE, {**TRUTH, "base.creep.rate": 1.5 * TRUTH["base.creep.rate"]})
+    fit = calibrate(start, one, fit=["base.creep.rate"])
+    se = fit.standard_errors["base.creep.rate"]
+    # the one reading is exact: the fit stops within STEP_TO_SE (1e-3) of a standard
+    # error of the truth (measured: 2.5e-7 1/day off, se 2.4e-3, 12 % of the rate)
+    assert abs(fit.values["base.creep.rate"] - TRUTH["base.creep.rate"]) <= 1e-3 * se
+    assert fit.identifiable and fit.dof == 0 and math.isnan(fit.chi2_per_dof)
+    assert 0 < se < 0.25 * TRUTH["base.creep.rate"]
+    assert "chi^2/dof = none (as many readings as fitted fields" in fit.summary()
+    assert fit.to_dict()["goodness_of_fit"]["chi2_per_dof"] is None
+    json.dumps(fit.to_dict(), allow_nan=False)
+    del one["settlement_std"]
+    with pytest.raises(ValueError, match=r"1 reading\(s\) cannot determine 1 field\(s\) and "
+                                         r"the readings' noise; .* or the readings' standard"):
+        calibrate(start, one, fit=["base.creep.rate"])
