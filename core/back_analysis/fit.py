@@ -323,7 +323,13 @@ def calibrate(scene: Scene | Mapping[str, Any] | str | os.PathLike,
     warnings += _identifiability(fields, cov_x, condition, x, lo, hi)
     warnings += _edge_check(model, x, lo, hi)
     ratio = _solver_error_to_noise(solution, readings, sigma, mask, math.sqrt(s2))
-    if ratio > MAX_SOLVER_ERROR_TO_NOISE:
+    if s2 == 0.0:
+        # (no deviations, and the fit meets every reading: "the solver's error estimate
+        # is inf of the noise" was read where the noise estimate is 0)
+        warnings.append("the fit meets every reading exactly, so the scatter gives no "
+                        "noise to estimate the standard errors from: give "
+                        "the readings' standard deviations")
+    elif ratio > MAX_SOLVER_ERROR_TO_NOISE:
         warnings.append(f"the solver's error estimate is {ratio:.2g} of the noise (more "
                         f"than {MAX_SOLVER_ERROR_TO_NOISE:g}): the standard errors reflect "
                         "the solver as much as the readings (tighten solver.tol, or the "
@@ -427,11 +433,17 @@ def _identifiability(fields: Sequence[Field], cov: np.ndarray, condition: float,
                  if not np.isfinite(se[j])
                  or any(abs(corr[j, k]) > STRONG_CORRELATION for k in range(len(fields))
                         if k != j)]
-        which = ", ".join(worst or names)
-        out.append(f"not identifiable: the readings determine only a combination of "
-                   f"{which} (condition number {condition:.3g} of the scaled Jacobian, "
-                   f"above {MAX_CONDITION:g}); fix all but one of them, or add readings "
-                   "that separate them")
+        which = worst or names
+        reason = (f"(condition number {condition:.3g} of the scaled Jacobian, above "
+                  f"{MAX_CONDITION:g})")
+        if len(which) == 1:
+            # ("only a combination of" one field, "fix all but one of them", was read)
+            out.append(f"not identifiable: the readings do not determine {which[0]} "
+                       f"{reason}; add readings that depend on it")
+        else:
+            out.append(f"not identifiable: the readings determine only a combination of "
+                       f"{', '.join(which)} {reason}; fix all but one of them, or add "
+                       "readings that separate them")
     else:
         se = np.sqrt(np.diag(cov))
         # readings the scene meets exactly leave no scatter (se = 0): no correlation to

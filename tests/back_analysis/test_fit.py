@@ -722,3 +722,21 @@ def test_as_many_readings_as_fields_with_their_deviations_determine_them() -> No
     with pytest.raises(ValueError, match=r"1 reading\(s\) cannot determine 1 field\(s\) and "
                                          r"the readings' noise; .* or the readings' standard"):
         calibrate(start, one, fit=["base.creep.rate"])
+
+
+def test_one_field_the_readings_do_not_see_is_said_in_words_for_one() -> None:
+    """Tilts of a centred punch (0 whatever the base) fitted by the base's creep rate:
+    the warnings read "the readings determine only a combination of base.creep.rate ...
+    fix all but one of them" for the one field, and "the solver's error estimate is inf
+    of the noise" for readings met exactly without deviations."""
+    times = TIMES[:3].tolist()
+    centred = apply_point(SCENE, TRUTH)
+    centred["loading"] = dict(centred["loading"], moment=0.0)
+    fit = calibrate(centred, {"time": times, "tilt": [0.0, 0.0, 0.0]},
+                    fit=["base.creep.rate"])
+    assert not fit.identifiable
+    text = " ".join(fit.warnings)
+    assert ("not identifiable: the readings do not determine base.creep.rate (condition "
+            "number") in text and "add readings that depend on it" in text
+    assert "combination" not in text and "fix all but one" not in text
+    assert "the fit meets every reading exactly" in text and "inf of the noise" not in text
