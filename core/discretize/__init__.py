@@ -20,6 +20,7 @@ from core.discretize.galerkin import galerkin_correction
 from core.discretize.graded_basis import graded_cuts
 from core.discretize.panels import (
     BARYCENTRIC_WEIGHTS,
+    DENSE_SAMPLES,
     GAUSS_NODES,
     GAUSS_WEIGHTS,
     MIRROR_TOL,
@@ -49,6 +50,7 @@ from core.discretize.quadrature import (
 )
 
 __all__ = [
+    "DENSE_SAMPLES",
     "BARYCENTRIC_WEIGHTS",
     "SHORT_SHARE",
     "base_panels",

@@ -16,6 +16,7 @@ import numpy as np
 
 from core.cache import StageCache, fingerprint
 from core.discretize import (
+    DENSE_SAMPLES,
     Basis,
     KernelOperator,
     Panels,
@@ -140,8 +141,11 @@ def _discretize(inp: _Inputs, cap: int, kind: str, stages: dict[str, dict]) -> _
         cuts = ()
         width = _max_width(inp.lam, cap)
         start = base_panels(inp.lam, inp.breakpoints, max_width=width)
-    m_probe = inp.m(start.nodes)
-    g_probe = inp.g(start.nodes)
+    # (the panels resolve m and g on the even sample too: keyed on it, two m that differ
+    # between the start's nodes alone would share panels)
+    probe = np.concatenate([start.nodes, np.linspace(-1.0, 1.0, DENSE_SAMPLES)])
+    m_probe = inp.m(probe)
+    g_probe = inp.g(probe)
     panel_key = fingerprint("panels", inp.lam, inp.breakpoints, width, cuts, m_probe, g_probe)
 
     def make_panels():
