@@ -649,7 +649,7 @@ def _cmd_schema(args: argparse.Namespace) -> int:
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
     # imported here: a plain solve must not load Dask
-    from core.study import check_output, load_study, sweep
+    from core.study import LIMITS_NOT_CHECKED, check_output, load_study, sweep
 
     output = Path(args.output)
     try:
@@ -672,6 +672,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     print(f"{study.n_points} points in {info['batches']} batches ({info['batches_reused']} "
           f"reused), {info['points_failed']} failed, {info['points_flagged']} flagged, "
           f"{info['seconds']:.1f} s; written to {output}")
+    if study.base.get("limits"):
+        print(f"warning: sweep: {LIMITS_NOT_CHECKED}", file=sys.stderr)
     if info["batches_lost"]:
         print(f"error: sweep: {info['batches_lost']} batches were lost; run the same command "
               f"again to compute them (the others are kept in {work_dir})", file=sys.stderr)

@@ -18,6 +18,7 @@ from __future__ import annotations
 from core.study.definition import (
     FIELD_UNITS,
     FIXED_ROOTS,
+    LIMITS_NOT_CHECKED,
     PUNCH_OUTPUT,
     Study,
     apply_point,
@@ -36,6 +37,7 @@ __all__ = [
     "apply_point",
     "check_output",
     "FIELD_UNITS",
+    "LIMITS_NOT_CHECKED",
     "field_unit",
     "FIXED_ROOTS",
     "PUNCH_OUTPUT",

@@ -65,6 +65,20 @@ OUTPUT_UNITS: dict[str, str] = {
     "q_min": "Pa",
     "contact_width": "m",
 }
+#: What each output is (the ``long_name`` of its variable in a study's dataset).
+OUTPUT_NAMES: dict[str, str] = {
+    "settlement": "settlement of the punch centre",
+    "tilt": "tilt of the punch",
+    "force": "force on the punch per metre",
+    "moment": "moment on the punch per metre (N m/m)",
+    "q_max": "largest contact pressure (201 points of the base)",
+    "q_min": "smallest contact pressure (201 points of the base)",
+    "contact_width": "length of the contact set",
+}
+#: What a study says of the base scene's design limits, which it does not check.
+LIMITS_NOT_CHECKED = ("the base scene's design limits are not checked point by point: "
+                      "compare q_max, settlement and tilt with them (utilisation = value / "
+                      "limit), or solve a point's scene for its design check")
 #: An output of one punch of several: ``punches[k].<output>`` (k as the scene file's).
 PUNCH_OUTPUT = re.compile(r"punches\[(\d{1,4})\]\.([a-z_]+)")
 GRID_KINDS = ("values", "linspace", "logspace")

@@ -54,7 +54,15 @@ from core.files import atomic_write_text
 from core.optional import import_optional
 from core.scene import FLAG_MESSAGES
 from core.study.batch import run_batch
-from core.study.definition import Study, field_unit, load_study, output_unit
+from core.study.definition import (
+    LIMITS_NOT_CHECKED,
+    OUTPUT_NAMES,
+    PUNCH_OUTPUT,
+    Study,
+    field_unit,
+    load_study,
+    output_unit,
+)
 from core.study.plan import PLAN_ORDER, BatchPlan, batch_plan
 from core.study.points import StudyPoints, point_table
 from core.version import VERSION
@@ -401,7 +409,10 @@ def study_dataset(study: Study, parts: WorkDir, plan: BatchPlan, lost: Mapping[i
     coords["sample"] = ("point", table["sample"], {"long_name": "index of the random draw"})
     variables: dict[str, Any] = {}
     for j, name in enumerate(study.outputs):
-        attrs = {"units": output_unit(name)}
+        match = PUNCH_OUTPUT.fullmatch(name)
+        attrs = {"units": output_unit(name),
+                 "long_name": (f"punches[{match[1]}]: {OUTPUT_NAMES[match[2]]}" if match
+                               else OUTPUT_NAMES[name])}
         if _variable_name(name) != name:
             attrs["output"] = name  # a punch's of several: punches[1].tilt
         variables[_variable_name(name)] = (("point", "time"), data["values"][:, j, :], attrs)
@@ -435,6 +446,8 @@ def study_metadata(study: Study, info: Mapping[str, Any]) -> dict[str, Any]:
              "solver_settings": json.dumps(study.base.get("solver", {}), sort_keys=True),
              "grid_shape": json.dumps(list(study.grid_shape)),
              "samples": study.samples, "seed": study.seed}
+    if study.base.get("limits"):
+        attrs["design_limits"] = LIMITS_NOT_CHECKED
     return attrs | dict(info)
 
 

@@ -85,3 +85,29 @@ def test_the_command_line_sweep_writes_the_width_of_the_contact_set(
     for i, result in enumerate(solved(study)):
         np.testing.assert_array_equal(widths[i], result.contact_width)
     assert widths[0, -1] == pytest.approx(LAST_WIDTH, abs=5e-5)
+
+
+def test_a_study_of_a_scene_with_limits_says_they_are_not_checked(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A study whose base scene has design limits wrote no verdict and said nothing of
+    them (exit code 0), where ``solve --strict`` of its worst point fails: the dataset
+    and the command line now say the limits are not checked point by point. Its outputs
+    have a ``long_name`` too (only time, flags and the estimate had one)."""
+    import core.study
+    from core.study import LIMITS_NOT_CHECKED, study_from_dict, sweep
+
+    study = liftoff_study()
+    study["scene"]["limits"] = {"allowable_pressure": 1.5e6, "settlement_limit": 1.2e-4}
+    ds = sweep(study_from_dict(study), client="serial")
+    assert ds.attrs["design_limits"] == LIMITS_NOT_CHECKED
+    assert ds.q_min.attrs["long_name"].startswith("smallest contact pressure")
+    assert ds.contact_width.attrs["long_name"] == "length of the contact set"
+    plain = sweep(study_from_dict(liftoff_study()), client="serial")
+    assert "design_limits" not in plain.attrs
+    (tmp_path / "study.json").write_text(json.dumps(study))
+    run_sweep = core.study.sweep
+    monkeypatch.setattr(core.study, "sweep",
+                        lambda *args, **kwargs: run_sweep(*args, client="serial", **kwargs))
+    done = run_cli("sweep", "study.json", "--output", "r.csv", "--quiet", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert f"warning: sweep: {LIMITS_NOT_CHECKED}" in done.stderr

@@ -65,7 +65,8 @@ def test_each_point_is_the_scene_solved_on_its_own(spacing: Any) -> None:
         assert spacing.error_estimate.values[i] == direct.info["error_estimate"]
     assert spacing.punches_1_center.attrs == {"field": "punches[1].center", "kind": "values",
                                               "units": "m"}
-    assert spacing.punches_1_tilt.attrs == {"units": "rad", "output": "punches[1].tilt"}
+    assert spacing.punches_1_tilt.attrs == {"units": "rad", "output": "punches[1].tilt",
+                                            "long_name": "punches[1]: tilt of the punch"}
     assert not spacing.failed.values.any()
 
 
