@@ -37,6 +37,10 @@ class NodalState(_Resultants):
     nystrom: np.ndarray
 
 
+#: The reason of :class:`NoContact` where fewer than three nodes stay in contact.
+SHRINKS = "the contact shrinks to a point"
+
+
 class NoContact(ValueError):
     """The loads leave no contact (the punch is pulled away): ``reason``, what the contact
     did; ``punch``: which punch of several (None for one; the message then names it)."""
@@ -44,6 +48,16 @@ class NoContact(ValueError):
     def __init__(self, reason: str, punch: int | None = None) -> None:
         super().__init__(reason if punch is None else f"punches[{punch}]: {reason}")
         self.reason, self.punch = reason, punch
+
+    @property
+    def what(self) -> str:
+        """What the refusal says happened: the loads pull the punch away, or (where fewer
+        than three nodes stay in contact, :data:`SHRINKS`) the zone is narrower than the
+        rule resolves; a crown pressed by a small force read "the loads pull the punch
+        away"."""
+        if self.reason == SHRINKS:
+            return "the contact zone is narrower than the solver's rule resolves"
+        return "the loads pull the punch away"
 
     def at(self, time: float, given: Collection[str], message: str) -> LoadNotCarried:
         """This refusal at the solver's time ``time`` as :class:`LoadNotCarried` (its
@@ -99,7 +113,7 @@ def nodal_active_set(panels: Panels, op: np.ndarray, m: np.ndarray, g: np.ndarra
                     step.given.get(k, 0.0) != 0.0 for k in ("force", "moment")):
                 raise NoContact("no node stays in contact")
         elif idx.size < 3 and not {"settlement", "tilt"} <= set(step.given):
-            raise NoContact("the contact shrinks to a point")
+            raise NoContact(SHRINKS)
         else:
             q[idx], delta, alpha = _bordered_solve(op, m, x, w, step, rhs, idx, solver)
         if mirror is None:

@@ -49,7 +49,13 @@ from typing import Any
 
 import numpy as np
 
-from core.contact.active_set import MAX_SWEEPS, NoContact, NodalState, zones_from_nodes
+from core.contact.active_set import (
+    MAX_SWEEPS,
+    SHRINKS,
+    NoContact,
+    NodalState,
+    zones_from_nodes,
+)
 from core.contact.elastic import _bad_pins, _verify, verdict
 from core.contact.nodal import coarse_start, nodal_operator
 from core.contact.result import UnilateralSolution, _Snapshot
@@ -561,7 +567,7 @@ def coupled_active_set(base: CoupledBase, rules: Sequence[Panels], op: np.ndarra
                                or (touching and not {"settlement", "tilt"} <= set(given))):
                 raise NoContact("no node stays in contact", p)
             if 0 < count < 3 and not {"settlement", "tilt"} <= set(given):
-                raise NoContact("the contact shrinks to a point", p)
+                raise NoContact(SHRINKS, p)
         idx = np.nonzero(active)[0]
         q = np.zeros(x.size)
         if idx.size:
@@ -685,7 +691,7 @@ def solve_unilateral_punches(punches: Sequence[PunchGeometry], inputs: Sequence[
                                           res, tol)
             except NoContact as exc:
                 raise exc.of_punches(times[k], givens,
-                                     f"{exc}: the loads pull the punch away") from None
+                                     f"{exc}: {exc.what}") from None
         per_time.append(results[key])
     seconds = _time.perf_counter() - started
     end_error = max(r["zone_end_error"] for r in per_time)

@@ -254,8 +254,8 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
             states, settled = _step_states(base, system, step_data, displacement, start,
                                            solver, retry=n == 0)
         except NoContact as exc:
-            raise exc.of_punches(grid[n], marches.givens, f"{exc}: the loads pull the punch "
-                                 f"away at t = {grid[n]:g}") from None
+            raise exc.of_punches(grid[n], marches.givens,
+                                 f"{exc}: {exc.what} at t = {grid[n]:g}") from None
         if n == 0 and first is not None and "zones" not in first and any(
                 s.active.any() for s in states):
             zones = []

@@ -136,8 +136,8 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
             state, count, settled = _step_state(base, op, m, g, step, displacement, start,
                                                 solver, retry=n == 0)
         except NoContact as exc:
-            raise exc.at(grid[n], step.given, f"{refused_load(step.given)}: the loads pull "
-                         f"the punch away at t = {grid[n]:g} ({exc})") from None
+            raise exc.at(grid[n], step.given, f"{refused_load(step.given)}: {exc.what} "
+                         f"at t = {grid[n]:g} ({exc})") from None
         if n == 0 and first is not None and "zones" not in first and state.active.any():
             ends = zones_from_nodes(state, space.breakpoints)[0]
             first["zones"] = list(zip(ends[0::2], ends[1::2], strict=True))
