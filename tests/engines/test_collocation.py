@@ -488,3 +488,15 @@ def test_the_time_estimate_under_an_aging_kernel_bounds_the_error():
     # measured: estimate 1.9e-6, error 6.8e-7 (512 steps)
     assert answer.info["success"]
     assert error <= answer.info["error_estimate"] <= 1e-5
+
+
+def test_a_resolution_beyond_the_memory_bound_is_refused_naming_it() -> None:
+    """panels_per_unit 2000 asked numpy for 30.6 GiB and raised its MemoryError: the
+    nodes' dense operators are counted before they are made."""
+    from core.solver import solve_dimensionless
+
+    with pytest.raises(ValueError, match=r"^panels_per_unit: 2000 makes \d+ nodes, whose "
+                                         r"dense operators would take [\d.]+ GiB, over the 4 "
+                                         r"GiB a run may take"):
+        solve_dimensionless(1.0, 0.05, 0.0, [1.0], force=1.0, moment=0.1, tol=1e-8,
+                            method="collocation", panels_per_unit=2000)

@@ -87,3 +87,15 @@ def test_the_panels_interpolants_meet_m_between_their_nodes() -> None:
     assert resolved and panels.n_panels > start.n_panels
     # measured: 2.8e-9 of m's largest value
     assert _largest_miss(panels, m) <= 1e-8 * 0.55
+
+
+def test_an_undeclared_step_of_the_gap_says_to_declare_it() -> None:
+    """A step of g without its breakpoint is not resolved (flag ``unresolved_input``): the
+    message read only "the grid reached 108 panels with estimated error 4.5e-01 in q"."""
+    from core.engines.nystrom.result import UNRESOLVED_ADVICE
+
+    answer = solve_dimensionless(1.0, 0.05, lambda x: np.where(x > 0.3, 1e-4, 0.0), [1.0],
+                                 force=1.0, moment=0.0, tol=1e-6, contact="full")
+    assert not answer.info["success"] and "unresolved_input" in answer.info["flags"]
+    assert UNRESOLVED_ADVICE in answer.info["message"]
+    assert "give its x in breakpoints" in UNRESOLVED_ADVICE

@@ -54,6 +54,7 @@ from core.engines.collocation.steps import (
     fixed_grids,
     grids_at,
 )
+from core.limits import MAX_RUN_MEMORY_BYTES
 from core.problem import QUANTITIES as _QUANTITIES
 from core.problem import STATEMENTS as _STATEMENTS
 from core.problem import ContactSolution, accepts, validate_times
@@ -224,6 +225,11 @@ def solve_collocation(
                           tol_name="time_tol", time_breaks=time_breaks)
 
 
+#: Dense N x N matrices a collocation geometry holds at once (the operator, its
+#: factors, the coarser rule's): what its memory check counts.
+DENSE_COPIES = 3
+
+
 def prepare_collocation(lam: float, m: Callable[[np.ndarray], np.ndarray],
                         g: Callable[[np.ndarray], np.ndarray], breakpoints: Sequence[float],
                         panels_per_unit: float, edge_width: float, tol: float, *,
@@ -236,6 +242,13 @@ def prepare_collocation(lam: float, m: Callable[[np.ndarray], np.ndarray],
     started = time.perf_counter() if started is None else started
     panels = collocation_panels(lam, breakpoints, panels_per_unit=panels_per_unit,
                                 edge_width=edge_width)
+    dense = DENSE_COPIES * 8.0 * float(panels.size) ** 2
+    if dense > MAX_RUN_MEMORY_BYTES:
+        # (panels_per_unit 2000 asked numpy for 30.6 GiB and raised its MemoryError)
+        raise ValueError(f"panels_per_unit: {panels_per_unit:g} makes {panels.size} nodes, "
+                         f"whose dense operators would take {dense / 2**30:.3g} GiB, over "
+                         f"the {MAX_RUN_MEMORY_BYTES / 2**30:g} GiB a run may take: ask "
+                         "fewer panels a unit (or a larger edge_width)")
     return _geometry(lam, m, g, panels, breakpoints, tol, started, coarser)
 
 

@@ -33,6 +33,13 @@ class TimeSide:
     fit_error: float = 0.0  # the creep kernel's sum-of-exponentials fit (in ``error``)
 
 
+#: What a message says where m or g is not resolved by the panels (the flag
+#: ``unresolved_input``): a stepped gap without its breakpoint read only "the grid
+#: reached 109 panels with estimated error 4.5e-1 in q".
+UNRESOLVED_ADVICE = ("m or g has a feature the panels do not resolve, most likely a jump "
+                     "or kink: give its x in breakpoints")
+
+
 def nystrom_solution(prepared: Any, inputs: TimeInputs, scalars: dict[str, np.ndarray],
                      pressure: Callable[[np.ndarray], np.ndarray],
                      q_extremes: tuple[float, float], time_side: TimeSide, seconds: float,
@@ -65,7 +72,8 @@ def nystrom_solution(prepared: Any, inputs: TimeInputs, scalars: dict[str, np.nd
         reasons = []
         if prepared.spatial_error > tol or not prepared.resolved:
             reasons.append(f"the grid reached {grid.panels.n_panels} panels with "
-                           f"estimated error {prepared.spatial_error:.1e} in q")
+                           f"estimated error {prepared.spatial_error:.1e} in q"
+                           + ("" if prepared.resolved else f" ({UNRESOLVED_ADVICE})"))
         if not time_side.ok:
             reasons.append(f"time stepping: {time_side.message} (estimated error "
                            f"{time_error:.1e})")
