@@ -250,6 +250,9 @@ def _axis_values(axis: Axis, field: str) -> np.ndarray:
         raise ValueError(f"{field}, points: must be a whole number from 2 to "
                          f"{MAX_AXIS_POINTS}, got {axis.count!r}")
     for name, value in (("from", axis.start), ("to", axis.stop)):
+        if value is None or (isinstance(value, float) and math.isnan(value)):
+            # (an emptied box sends NaN: "must be a number, got nan" was read)
+            raise ValueError(f"{field}, {name}: is empty; give a number")
         if not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ValueError(f"{field}, {name}: must be a number, got {value!r}")
     if axis.start == axis.stop:
@@ -310,13 +313,15 @@ def plan_study(scene: Mapping[str, Any], axes: Sequence[Axis],
     try:
         study = study_from_dict(spec, max_points=max_points)
     except ValueError as exc:
-        raise ValueError(_tab_message(str(exc), choices)) from None
+        force = float(scene["loading"]["force"]) if ECCENTRICITY in keys else None
+        raise ValueError(_tab_message(str(exc), choices, force)) from None
     return PlannedStudy(study, tuple(choices), values, tuple(a.spacing for a in axes),
                         outputs)
 
 
-def _tab_message(message: str, choices: Sequence[Choice]) -> str:
-    """A core message about ``vary[i]`` said with the tab's names."""
+def _tab_message(message: str, choices: Sequence[Choice], force: float | None = None) -> str:
+    """A core message about ``vary[i]`` said with the tab's names (``force`` [N/m]: the
+    scene's, where the eccentricity sets the moment)."""
     match = re.match(r"vary\[(\d+)\](?:\.[a-z]+)?: ", message)
     if match is None:
         return message
@@ -326,10 +331,13 @@ def _tab_message(message: str, choices: Sequence[Choice]) -> str:
     # the grid's value as typed in the tab (it read "loading.force = -100000" for -100
     # kN/m)
     invalid = re.match(r"the scene is invalid at (\S+) = (\S+) \(", rest)
-    if invalid is not None and invalid.group(1) == choice.key:
+    # the eccentricity is varied as the moment: its value is e = M / P (it read
+    # "loading.moment = 1.2e+06" for e = 1.5 m)
+    varied = ("loading.moment" if choice.key == ECCENTRICITY and force else choice.key)
+    if invalid is not None and invalid.group(1) == varied:
         try:
-            typed = float(invalid.group(2)) / choice.scale
-        except ValueError:
+            typed = float(invalid.group(2)) / (force if varied != choice.key else choice.scale)
+        except (ValueError, ZeroDivisionError):
             typed = None
         if typed is not None:
             rest = (f"the scene is invalid at {typed:.6g} {choice.unit}".rstrip() + " ("

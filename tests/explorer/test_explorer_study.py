@@ -103,12 +103,17 @@ def test_eccentricity_sets_the_moment_from_the_force():
     ([Axis("loading.force", 100.0, 900.0, 1)], "parameter 1, points: must be a whole number"),
     ([Axis("loading.force", 0.0, 900.0, 5, "log")], "parameter 1, from: a log spacing"),
     ([Axis("loading.force", 500.0, 500.0, 5)], "parameter 1, to: equals 'from'"),
-    ([Axis("loading.force", float("nan"), 500.0, 5)], "parameter 1, from: must be a number"),
+    # an emptied box sends NaN (it read "must be a number, got nan")
+    ([Axis("loading.force", float("nan"), 500.0, 5)], "parameter 1, from: is empty; give a"),
+    ([Axis("loading.force", 100.0, float("inf"), 5)], "parameter 1, to: must be a number"),
     ([Axis("loading.force", 100.0, 900.0, 5), Axis("loading.force", 1.0, 2.0, 3)],
      "parameter 2: the same field as parameter 1"),
     ([Axis("loading.force", 100.0, 900.0, 5), Axis(ECCENTRICITY, 0.0, 0.2, 3)],
      "parameter 2: the eccentricity sets the moment"),
     ([Axis("solver.tol", 1e-6, 1e-4, 3)], "parameter 1: 'solver.tol' is not a field"),
+    # the eccentricity, varied as the moment (it read "loading.moment = 7.5e+05")
+    ([Axis(ECCENTRICITY, 0.0, 1.5, 4)],
+     "parameter 1 (loading: eccentricity e = M/P): the scene is invalid at 1.5 m ("),
     ([Axis("coating[0].modulus", -100.0, 900.0, 3)],
      # the value as typed, in the tab's unit (it read "coating[0].modulus = -1e+08")
      "parameter 1 (coating 1: Young's modulus): the scene is invalid at -100 MPa ("),
