@@ -25,6 +25,7 @@ from bokeh.plotting import figure
 from core.scene import days_text
 
 from ..model import StudyResult
+from .bokeh_data import legend_above
 
 #: Most tick labels along a heat map's axis.
 MAX_TICKS = 7
@@ -77,8 +78,9 @@ class DesignChart:
         fig.scatter("x", "y", source=self.source, size=6)
         fig.scatter("x", "y", source=self.flagged, marker="x", size=12, line_width=2,
                     color=FLAG_COLOR, legend_label="flagged")
-        fig.legend.location = "top_left"
-        fig.legend.background_fill_alpha = 0.6
+        # above the plot: at its top left the legend covered the first points (a study of
+        # the eccentricity from 0)
+        legend_above(fig, "11px")
         fig.add_tools(HoverTool(tooltips=[("x", "@x"), ("value", "@y"), ("flags", "@flags")]))
         fig.toolbar.logo = None
         return fig

@@ -79,6 +79,8 @@ def design_chart_png(result: StudyResult, output: str, time_index: int) -> bytes
     else:
         _heat_map(draw, result, z, (x0, y0, x1, y1), small, normal)
         _vertical_text(image, planned.choices[1].title, (20, (y0 + y1) / 2), normal)
+        # the colour bar's own label (its unit was only in the title)
+        _vertical_text(image, f"{name} [{unit}]", (WIDTH - 16, (y0 + y1) / 2), normal)
     draw.rectangle([x0, y0, x1, y1], outline=_INK)
     out = io.BytesIO()
     image.save(out, format="PNG")

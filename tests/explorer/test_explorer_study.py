@@ -224,6 +224,8 @@ def test_flagged_points_are_marked_on_the_chart_and_in_the_csv():
     chart.draw(result, "q_min", 1)
     np.testing.assert_allclose(chart.flagged.data["x"], [0.6])
     assert chart.shown.legend.visible  # the red cross is named
+    # above the plot: at its top left it covered the first points
+    assert chart.shown.legend[0] in chart.shown.above
     assert chart.flagged.data["y"][0] < 0  # kPa: the tension the flag is about
     rows = [line for line in study_csv(result).splitlines() if not line.startswith("#")]
     assert rows[-1].endswith('"contact_lost",""')
@@ -351,3 +353,22 @@ def test_the_age_at_loading_is_offered_only_where_it_changes_the_answer():
         scene = read_preset(name)
         for choices in (study_choices(scene), fit_choices(scene)):
             assert ("base.age_at_loading" in [c.key for c in choices]) == offered, name
+
+
+def test_the_heat_map_png_labels_its_colour_bar() -> None:
+    """The downloaded heat map's colour bar had no label (the output's unit was in the
+    title alone): its name and unit now stand beside it, as the page's does."""
+    import io
+
+    from PIL import Image
+
+    from explorer.plots.study_png import HEIGHT, WIDTH, design_chart_png
+
+    planned = plan_study(screen_scene(), [Axis("loading.force", 300.0, 700.0, 2),
+                                          Axis("coating[0].modulus", 400.0, 800.0, 2)])
+    runner = run(planned)
+    assert runner.status == "done", runner.message
+    image = Image.open(io.BytesIO(design_chart_png(runner.result, "settlement", 0)))
+    assert image.size == (WIDTH, HEIGHT)
+    strip = np.asarray(image.convert("L"))[:, WIDTH - 26:WIDTH - 6]
+    assert (strip < 128).sum() > 50  # the label's ink, right of the bar's ticks
