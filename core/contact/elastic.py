@@ -121,6 +121,8 @@ def _zones_from(space: Space, step: Step, base: Panels, ends: list[float],
 #: Points of the even sample on which a punch held by its settlement and tilt is checked
 #: for pressing into the coating where no node of the nodal rule is in contact.
 PRESS_SAMPLES = 8193
+#: Local maxima of that sample looked at more finely, at most.
+MAX_CRESTS = 256
 
 
 def pressed_between_nodes(space: Space, settlement: float, tilt: float
@@ -130,12 +132,14 @@ def pressed_between_nodes(space: Space, settlement: float, tilt: float
     node of the nodal rule is in contact (ends, pinned flags, slopes of Q as
     :func:`~core.contact.active_set.zones_from_nodes`); none where it presses nowhere.
 
-    ``p`` is read on an even sample of [-1, 1] (:data:`PRESS_SAMPLES`), 1024 times finer
-    around its largest value where no sample presses, and each stretch's ends are its
-    roots. The contact lies within these stretches (the coating and the base give way). A
-    crowned punch (g = 0.1 x^2, m = 0.05) held 1e-7 below its first touch presses on
-    +-1e-3, between the nodes: it was answered "no contact", P = 0, with success and an
-    estimate of 0.
+    ``p`` is read on an even sample of [-1, 1] (:data:`PRESS_SAMPLES`), and 1024 times
+    finer between the neighbours of each of its local maxima that the sample's curvature
+    allows to rise above 0 between samples (two equal crests: both). Each stretch's ends
+    are its roots; an end whose bracket holds a breakpoint (a step of g) is pinned there,
+    as :func:`~core.contact.active_set.zones_from_nodes` pins it. The contact lies within
+    these stretches (the coating and the base give way). A crowned punch (g = 0.1 x^2,
+    m = 0.05) held 1e-7 below its first touch presses on +-1e-3, between the nodes: it
+    was answered "no contact", P = 0, with success and an estimate of 0.
     """
     from scipy.optimize import brentq
 
@@ -144,32 +148,44 @@ def pressed_between_nodes(space: Space, settlement: float, tilt: float
 
     x = np.linspace(-1.0, 1.0, PRESS_SAMPLES)
     p = pressed(x)
-    if not (p > 0.0).any():
-        k = int(np.argmax(p))
-        x = np.linspace(x[max(k - 1, 0)], x[min(k + 1, x.size - 1)], 1025)
-        p = pressed(x)
-        if not (p > 0.0).any():
-            return [], [], []
-    inside = p > 0.0
-    flips = np.flatnonzero(np.diff(np.concatenate([[0], inside.astype(np.int8), [0]])))
-    ends: list[float] = []
-    pinned: list[bool] = []
-    slopes: list[float] = []
-    for i, j in zip(flips[0::2], flips[1::2] - 1, strict=True):
-        for k, outer in ((int(i), int(i) - 1), (int(j), int(j) + 1)):
-            if outer < 0 or outer >= x.size:
-                end = float(x[k])  # (at -1 or 1, or the local sample's end)
-            else:
-                end = float(brentq(lambda t: float(pressed(np.array([t]))[0]),
-                                   float(x[outer]), float(x[k]), xtol=1e-15))
-            edge = abs(end) == 1.0
-            step = 1e-9 * (1.0 if k == i else -1.0)
-            slope = (float(pressed(np.array([end + step]))[0]) / step
-                     / float(np.asarray(space.m(np.array([end])), dtype=float).ravel()[0]))
-            ends.append(end)
-            pinned.append(edge)
-            slopes.append(0.0 if edge else abs(slope) * (1.0 if k == i else -1.0))
-    return ends, pinned, slopes
+    samples = [(x, p)]
+    # local maxima below 0 that a parabola through them and their neighbours lifts above
+    inner = np.arange(1, x.size - 1)
+    bend = np.abs(p[:-2] - 2.0 * p[1:-1] + p[2:])
+    crests = inner[(p[1:-1] >= p[:-2]) & (p[1:-1] >= p[2:]) & (p[1:-1] <= 0.0)
+                   & (p[1:-1] + 0.5 * bend > 0.0)]
+    for k in crests[:MAX_CRESTS]:
+        fine = np.linspace(x[k - 1], x[k + 1], 1025)
+        samples.append((fine, pressed(fine)))
+    cuts = sorted(float(b) for b in space.breakpoints)
+    found: list[tuple[float, bool, float]] = []
+    for xs, ps in samples:
+        inside = ps > 0.0
+        flips = np.flatnonzero(np.diff(np.concatenate([[0], inside.astype(np.int8), [0]])))
+        for i, j in zip(flips[0::2], flips[1::2] - 1, strict=True):
+            for k, side in ((int(i), -1), (int(j), 1)):
+                outer = k + side
+                if outer < 0 or outer >= xs.size:
+                    found.append((float(xs[k]), abs(float(xs[k])) == 1.0, 0.0))
+                    continue
+                lo, hi = sorted((float(xs[outer]), float(xs[k])))
+                step = [b for b in cuts if lo <= b <= hi]
+                if step:  # (p jumps there: the zone ends at the step's corner)
+                    found.append((step[0], True, 0.0))
+                    continue
+                end = float(brentq(lambda t: float(pressed(np.array([t]))[0]), lo, hi,
+                                   xtol=1e-15))
+                inward = -1e-9 * side  # into the stretch
+                rise = float(pressed(np.array([end + inward]))[0]) / abs(inward)
+                m_end = float(np.asarray(space.m(np.array([end])), dtype=float).ravel()[0])
+                # Q rises into the zone: > 0 at its start, < 0 at its end
+                found.append((end, False, -side * abs(rise) / m_end))
+    # (a fine sample's stretch lies within the even sample's where that one found it)
+    found.sort(key=lambda item: item[0])
+    ends = [e for e, _, _ in found]
+    if len(ends) % 2 or any(b <= a for a, b in zip(ends[0::2], ends[1::2], strict=True)):
+        raise NoContact(SHRINKS)  # (stretches the samples did not part cleanly)
+    return ends, [f for _, f, _ in found], [s for _, _, s in found]
 
 
 def _bad_pins(space: Space, step: Step, sol, pinned: list[bool],

@@ -23,6 +23,7 @@ import numpy as np
 
 from core.cache import StageCache, fingerprint
 from core.contact.active_set import (
+    SHRINKS,
     NoContact,
     NodalState,
     contact_runs,
@@ -30,6 +31,7 @@ from core.contact.active_set import (
     refused_load,
     zones_from_nodes,
 )
+from core.contact.elastic import pressed_between_nodes
 from core.contact.kinks import BATCH_ENTRIES, Corrected, corrected_roots, kinks_corrected
 from core.contact.memory import pressure_memory
 from core.contact.step import Space, Step, check_loads
@@ -135,6 +137,14 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         try:
             state, count, settled = _step_state(base, op, m, g, step, displacement, start,
                                                 solver, retry=n == 0)
+            if (not state.active.any() and {"settlement", "tilt"} <= set(step.given)
+                    and not np.any(memory_density)
+                    and pressed_between_nodes(space, step.given["settlement"],
+                                              step.given["tilt"])[0]):
+                # it presses in between the nodes: not "no contact" (a crown held 1e-7
+                # below its first touch read P = 0 with success); the elastic path
+                # answers such a zone, the march refuses it
+                raise NoContact(SHRINKS)
         except NoContact as exc:
             raise exc.at(grid[n], step.given, f"{refused_load(step.given)}: {exc.what} "
                          f"at t = {grid[n]:g} ({exc})") from None

@@ -70,3 +70,45 @@ def test_a_zone_below_the_rule_is_refused_saying_so() -> None:
     message = answer.info["message"]
     assert "the contact zone is narrower than the solver's rule resolves" in message
     assert "pull the punch away" not in message
+
+
+def test_two_crests_between_the_samples_are_both_found() -> None:
+    """Two equal crests at x = +-0.5001 held 1e-10 below their touch press between the
+    even sample's points: only the sample's largest value was looked at more finely, and
+    one crest was dropped with success (P half, M not 0; found by a review)."""
+    crests = lambda x: 0.1 * (np.abs(x) - 0.5001) ** 2  # noqa: E731
+    answer = solve_dimensionless(1.0, M, crests, [1.0], settlement=1e-10, tilt=0.0,
+                                 tol=1e-8)
+    assert answer.info["success"]
+    (a, b), (c, d) = answer.contact_set[0]
+    assert a == pytest.approx(-d, rel=1e-9) and b == pytest.approx(-c, rel=1e-9)
+    # each crest carries what the single crown does (Winkler share 0.996 at 1e-10)
+    assert 0.99 < answer.force[0] / (2 * _winkler(1e-10)) < 0.998
+    assert abs(answer.moment[0]) <= 1e-9 * answer.force[0]
+
+
+def test_a_stretch_at_a_step_of_the_punch_is_pinned_at_its_corner() -> None:
+    """g steps from 0.1 to 0 at the declared breakpoint 0.3 and the tilt leaves only
+    (0.3, 0.3 + 2e-7) pressing: its left end was a root found inside the jump, not pinned
+    at the corner, and the answer carried a negative force (P = -2e-9, success False)."""
+    step = lambda x: np.where(np.asarray(x) > 0.3, 0.0, 0.1)  # noqa: E731
+    tilt = -0.05
+    answer = solve_dimensionless(1.0, M, step, [1.0], settlement=-tilt * (0.3 + 2e-7),
+                                 tilt=tilt, tol=1e-8, breakpoints=(0.3,))
+    assert answer.info["success"]
+    (start, end), = answer.contact_set[0]
+    assert start == 0.3 and 0.3 < end < 0.3 + 2e-7
+    assert answer.force[0] > 0.0
+
+
+def test_under_creep_a_stretch_between_the_nodes_is_refused_not_answered_empty() -> None:
+    """The march has no start between the nodes: it answered the same crown "no
+    contact", P = 0 at every time, with success; it now refuses, saying why."""
+    from tests.support.scenes import CONCRETE
+
+    with pytest.raises(ValueError, match="the contact zone is narrower than the solver's "
+                                         "rule resolves"):
+        solve_dimensionless(1.0, M, lambda x: 0.1 * x**2, [1.0, 2.0, 5.0],
+                            settlement=1e-7, tilt=0.0, tol=1e-6,
+                            c=CONCRETE.relative_modulus(28.0),
+                            kernel=CONCRETE.dimensionless_kernel(28.0), contact="unilateral")
