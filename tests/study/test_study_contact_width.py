@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from subprocess import CompletedProcess
 
 import numpy as np
 import pytest
@@ -71,15 +72,9 @@ def test_the_command_line_sweep_writes_the_width_of_the_contact_set(
     runner (the cluster itself: tests/study/test_sweep.py)."""
     import pandas as pd
 
-    import core.study
 
     study = liftoff_study()
-    (tmp_path / "study.json").write_text(json.dumps(study))
-    run_sweep = core.study.sweep
-    monkeypatch.setattr(core.study, "sweep",
-                        lambda *args, **kwargs: run_sweep(*args, client="serial", **kwargs))
-    done = run_cli("sweep", "study.json", "--output", "r.csv", "--quiet", cwd=tmp_path)
-    assert done.returncode == 0, done.stderr
+    _serial_cli_sweep(study, tmp_path, monkeypatch)
     rows = pd.read_csv(tmp_path / "r.csv", comment="#").sort_values(["point", "time_day"])
     widths = rows["contact_width_m"].to_numpy().reshape(len(MOMENTS), -1)
     for i, result in enumerate(solved(study)):
@@ -93,7 +88,6 @@ def test_a_study_of_a_scene_with_limits_says_they_are_not_checked(
     them (exit code 0), where ``solve --strict`` of its worst point fails: the dataset
     and the command line now say the limits are not checked point by point. Its outputs
     have a ``long_name`` too (only time, flags and the estimate had one)."""
-    import core.study
     from core.study import LIMITS_NOT_CHECKED, study_from_dict, sweep
 
     study = liftoff_study()
@@ -104,10 +98,20 @@ def test_a_study_of_a_scene_with_limits_says_they_are_not_checked(
     assert ds.contact_width.attrs["long_name"] == "length of the contact set"
     plain = sweep(study_from_dict(liftoff_study()), client="serial")
     assert "design_limits" not in plain.attrs
+    done = _serial_cli_sweep(study, tmp_path, monkeypatch)
+    assert f"warning: sweep: {LIMITS_NOT_CHECKED}" in done.stderr
+
+
+def _serial_cli_sweep(study: dict, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+                      ) -> CompletedProcess:
+    """``sweep study.json --output r.csv`` in ``tmp_path``, in this process, its Dask
+    cluster replaced by the serial runner; returns the finished run (exit code 0)."""
+    import core.study
+
     (tmp_path / "study.json").write_text(json.dumps(study))
     run_sweep = core.study.sweep
     monkeypatch.setattr(core.study, "sweep",
                         lambda *args, **kwargs: run_sweep(*args, client="serial", **kwargs))
     done = run_cli("sweep", "study.json", "--output", "r.csv", "--quiet", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
-    assert f"warning: sweep: {LIMITS_NOT_CHECKED}" in done.stderr
+    return done
