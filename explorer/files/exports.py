@@ -223,8 +223,8 @@ def describe(view: ResultView) -> dict[str, Any]:
 
 def study_csv(result: StudyResult) -> str:
     """A design study as CSV: ``#`` lines saying what was varied, then one row per point
-    and output time (the parameters and outputs in the units on screen, ``flags`` and
-    ``error`` of the point)."""
+    and output time (the parameters and outputs in the units on screen, the solver's
+    ``error_estimate`` (relative), ``flags`` and ``error`` of the point)."""
     planned = result.planned
     base = planned.study.base
     lines = [f"# coated-punch {project_version()}: design study around the scene "
@@ -239,18 +239,22 @@ def study_csv(result: StudyResult) -> str:
     header = [_study_column(c.label, c.unit) for c in planned.choices] + ["time_day"]
     header += [_study_column(_output_column(name), unit)
                for name, (_, unit, _) in planned.outputs.items()]
-    lines.append(",".join(header + ["flags", "error"]))
+    # (the command line's CSV had the estimate, the page's did not)
+    estimates = result.estimates
+    lines.append(",".join(header + ["error_estimate", "flags", "error"]))
     grids = np.meshgrid(*planned.values, indexing="ij")
     for index in np.ndindex(planned.shape):
         params = [number(float(g[index])) for g in grids]
         flags = '"' + result.flags[index] + '"'
         error = '"' + str(result.errors[index]).replace('"', '""') + '"'
+        estimate = "" if estimates is None or not math.isfinite(float(estimates[index])) \
+            else f"{float(estimates[index]):.3g}"
         for k, t in enumerate(result.times):
             row = params + [number(float(t))]
             for name, (_, _, factor) in planned.outputs.items():
                 value = float(result.outputs[name][index + (k,)])
                 row.append(number(value * factor) if math.isfinite(value) else "")
-            lines.append(",".join(row + [flags, error]))
+            lines.append(",".join(row + [estimate, flags, error]))
     return "\n".join(lines) + "\n"
 
 

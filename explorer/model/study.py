@@ -349,7 +349,8 @@ def _tab_message(message: str, choices: Sequence[Choice], force: float | None = 
 class StudyResult:
     """The answers of a study on its grid (SI units, see ``core.study.definition.OUTPUT_UNITS``):
     ``outputs[name]`` of shape ``grid + (len(times),)``, ``flags`` (comma-joined, or
-    ``failed``) and ``errors`` (a failed point's message) of the grid's shape."""
+    ``failed``), ``errors`` (a failed point's message) and ``estimates`` (the solver's
+    relative error estimate of each point, NaN where failed) of the grid's shape."""
 
     planned: PlannedStudy
     times: np.ndarray
@@ -357,6 +358,7 @@ class StudyResult:
     flags: np.ndarray
     errors: np.ndarray
     seconds: float
+    estimates: np.ndarray | None = None
 
     @classmethod
     def from_arrays(cls, planned: PlannedStudy, arrays: Mapping[str, Any]) -> StudyResult:
@@ -365,10 +367,13 @@ class StudyResult:
         shape = planned.shape
         outputs = {name: np.asarray(arrays[name], dtype=float).reshape(shape + (-1,))
                    for name in planned.outputs}
+        estimates = arrays.get("error_estimate")
         return cls(planned, np.asarray(arrays["time"], dtype=float), outputs,
                    np.asarray(arrays["flags"], dtype=str).reshape(shape),
                    np.asarray(arrays["error"], dtype=str).reshape(shape),
-                   float(arrays.get("seconds", 0.0)))
+                   float(arrays.get("seconds", 0.0)),
+                   None if estimates is None
+                   else np.asarray(estimates, dtype=float).reshape(shape))
 
     @property
     def failed(self) -> np.ndarray:

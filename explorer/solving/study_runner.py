@@ -82,7 +82,7 @@ def _run_study(planned: PlannedStudy, batch_points: int, out: Any, server_pid: i
         start, cpu = time.perf_counter(), time.process_time()
         ds = sweep(planned.study, client="serial", batch_points=batch_points,
                    progress=progress)
-        arrays = {name: ds[name].values for name in ("flags", "error")}
+        arrays = {name: ds[name].values for name in ("flags", "error", "error_estimate")}
         # a punch's output of several is named like punches_1_tilt, its path in "output"
         arrays |= {ds[name].attrs.get("output", name): ds[name].values
                    for name in ds.data_vars

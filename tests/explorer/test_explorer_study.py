@@ -187,6 +187,12 @@ def test_the_tab_draws_the_chart_and_writes_the_files(explorer_app):
     csv = tab._csv().getvalue().decode("utf-8").splitlines()
     header = next(line for line in csv if not line.startswith("#"))
     assert header.startswith("loading_force_p_kN_per_m,time_day,settlement_mm")
+    # each point's estimate, as the command line's file has it (the page's had none)
+    assert header.endswith(",error_estimate,flags,error")
+    first = next(line for line in csv if not line.startswith("#") and line != header)
+    estimate = float(first.split(",")[header.split(",").index("error_estimate")])
+    assert 0.0 < estimate == pytest.approx(float(result.estimates[0]), rel=1e-2)
+    assert estimate <= 1e-6  # the scene's tol
     assert len([line for line in csv if not line.startswith("#")]) == 1 + 3 * 2
     # a CSV over what the page sends is not offered, and the tab says what to do instead
     from explorer.files import MAX_PAGE_DOWNLOAD_BYTES

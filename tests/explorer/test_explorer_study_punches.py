@@ -103,7 +103,8 @@ def test_a_spacing_study_equals_the_solves_of_its_scenes() -> None:
               if not line.startswith("#")][0].split(",")
     assert header[:2] == ["punch_2_centre_x_m", "time_day"]
     assert "punch_1_settlement_mm" in header and "punch_2_contact_width_m" in header
-    assert len(header) == 2 + 10 + 2
+    assert len(header) == 2 + 10 + 3
+    assert header[-3:] == ["error_estimate", "flags", "error"]
 
 
 def test_a_link_keeps_a_punchs_output_and_refuses_others() -> None:
