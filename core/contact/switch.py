@@ -148,6 +148,22 @@ def predicted_unilateral(arguments: dict[str, Any], geometry: Geometry | None = 
         return None
     result.info["full_contact"] = {**check_info, "checked_at": first}
     result.info["seconds"] += float(check_info.get("seconds") or 0.0)
+    return unresolved_carried(result, check_info["flags"])
+
+
+def unresolved_carried(result, checked: list[str]):
+    """``result`` (a unilateral answer that did not succeed) flagged ``unresolved_input``
+    with the advice of :data:`~core.engines.nystrom.UNRESOLVED_ADVICE` when the
+    full-contact model that sent it there (its ``checked`` flags) did not resolve m or g:
+    a jump of m without its breakpoint read only "not within tol". A success is left as
+    it is: its own estimate stands."""
+    from core.engines.nystrom import UNRESOLVED_ADVICE
+
+    info = result.info
+    if "unresolved_input" in checked and not info.get("success", False) \
+            and "unresolved_input" not in info["flags"]:
+        info["flags"] = ["unresolved_input", *info["flags"]]
+        info["message"] += f"; the full-contact model found that {UNRESOLVED_ADVICE}"
     return result
 
 
@@ -187,6 +203,6 @@ def with_contact_model(full, contact: str, arguments: dict[str, Any]):
             "seconds": full.info.get("seconds"),
         }
         result.info["seconds"] += float(full.info.get("seconds", 0.0))
-        return result
+        return unresolved_carried(result, full.info["flags"])
     full.info["contact"] = "full"
     return replace(full, contact_set=[list(FULL_CONTACT) for _ in full.times])

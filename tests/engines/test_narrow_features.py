@@ -92,10 +92,26 @@ def test_the_panels_interpolants_meet_m_between_their_nodes() -> None:
 def test_an_undeclared_step_of_the_gap_says_to_declare_it() -> None:
     """A step of g without its breakpoint is not resolved (flag ``unresolved_input``): the
     message read only "the grid reached 108 panels with estimated error 4.5e-01 in q"."""
-    from core.engines.nystrom.result import UNRESOLVED_ADVICE
+    from core.engines.nystrom import UNRESOLVED_ADVICE
 
     answer = solve_dimensionless(1.0, 0.05, lambda x: np.where(x > 0.3, 1e-4, 0.0), [1.0],
                                  force=1.0, moment=0.0, tol=1e-6, contact="full")
     assert not answer.info["success"] and "unresolved_input" in answer.info["flags"]
     assert UNRESOLVED_ADVICE in answer.info["message"]
     assert "give its x in breakpoints" in UNRESOLVED_ADVICE
+
+
+def test_a_lift_off_over_an_undeclared_jump_of_m_carries_the_advice() -> None:
+    """A jump of m without its breakpoint, lifting off: the full-contact model flagged m
+    unresolved, and the unilateral answer it sent on read only "not within tol" (flags
+    ``tol_not_met``): it now carries the flag and the advice."""
+    from core.engines.nystrom import UNRESOLVED_ADVICE
+
+    jump = lambda x: np.where(np.asarray(x) > 0.3, 0.1, 0.05)  # noqa: E731
+    answer = solve_dimensionless(1.0, jump, 0.0, [1.0], force=1.0, moment=0.5, tol=1e-6)
+    assert answer.info["contact"] == "unilateral" and not answer.info["success"]
+    assert answer.info["flags"][0] == "unresolved_input"
+    assert UNRESOLVED_ADVICE in answer.info["message"]
+    declared = solve_dimensionless(1.0, jump, 0.0, [1.0], force=1.0, moment=0.5, tol=1e-6,
+                                   breakpoints=(0.3,))
+    assert declared.info["success"] and "unresolved_input" not in declared.info["flags"]

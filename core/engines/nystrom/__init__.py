@@ -42,6 +42,7 @@ from core.engines.nystrom.prepared import (
     prepared_for,
     solve_with_prepared,
 )
+from core.engines.nystrom.result import UNRESOLVED_ADVICE
 
 __all__ = [
     "COUPLED",
@@ -60,4 +61,5 @@ __all__ = [
     "prepared_for",
     "PreparedContact",
     "solve_with_prepared",
+    "UNRESOLVED_ADVICE",
 ]
