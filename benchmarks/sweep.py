@@ -329,7 +329,7 @@ def design_chart(path: Path) -> dict[str, Any]:
         filled = ax.contourf(ecc, modulus / 1e6, values, levels=14, cmap="viridis")
         lines = ax.contour(ecc, modulus / 1e6, values, levels=7, colors="white",
                            linewidths=0.6)
-        ax.clabel(lines, fontsize=7, fmt="%.3g")
+        labels = ax.clabel(lines, fontsize=7, fmt="%.3g")
         fig.colorbar(filled, ax=ax, label=f"{label}, {years:.0f} years after loading")
         if lifted.any():
             ax.contourf(ecc, modulus / 1e6, lifted.astype(float), levels=[0.5, 1.5],
@@ -343,6 +343,7 @@ def design_chart(path: Path) -> dict[str, Any]:
         if unmet.any() or failed.any():
             ax.legend(loc="upper left", fontsize=7)
         ax.set_yscale("log")
+        _drop_edge_labels(ax, labels)
         ax.set_xlabel("eccentricity e = M / P [m]")
         ax.set_ylabel("coating modulus [MPa]")
     axes[0].set_title("hatched, right of the red line: the heel has lifted off (unilateral "
@@ -354,6 +355,16 @@ def design_chart(path: Path) -> dict[str, Any]:
     return {"points": int(ds.sizes["point"]), "seconds": seconds,
             "failed": int(failed.sum()), "lifted": int(lifted.sum()),
             "tol_not_met": int(unmet.sum())}
+
+
+def _drop_edge_labels(ax: Any, labels: list) -> None:
+    """Remove the contour labels within 3 % of the axes' frame (in axes coordinates):
+    there the frame cut them in half (the "0" of the tilt at its left edge)."""
+    to_axes = ax.transData + ax.transAxes.inverted()
+    for text in labels:
+        u, v = to_axes.transform(text.get_position())
+        if not (0.03 < u < 0.97 and 0.03 < v < 0.97):
+            text.remove()
 
 
 def environment() -> str:
