@@ -180,7 +180,8 @@ def pressed_between_nodes(space: Space, settlement: float, tilt: float
                 m_end = float(np.asarray(space.m(np.array([end])), dtype=float).ravel()[0])
                 # Q rises into the zone: > 0 at its start, < 0 at its end
                 found.append((end, False, -side * abs(rise) / m_end))
-    # (a fine sample's stretch lies within the even sample's where that one found it)
+    # (each fine sample lies between two points of the even one that do not press: its
+    # stretches are apart from the even sample's)
     found.sort(key=lambda item: item[0])
     ends = [e for e, _, _ in found]
     if len(ends) % 2 or any(b <= a for a, b in zip(ends[0::2], ends[1::2], strict=True)):
