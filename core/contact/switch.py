@@ -8,6 +8,7 @@ the cheap check that lets ``"auto"`` skip a full-contact solve that would be thr
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
@@ -15,6 +16,7 @@ import numpy as np
 
 from core.contact.step import LoadNotCarried
 from core.contact.unilateral import CONTACT_MODELS, FULL_CONTACT, solve_unilateral
+from core.problem import UNRESOLVED_ADVICE
 
 if TYPE_CHECKING:
     from core.problem import Geometry, TimeInputs
@@ -151,14 +153,12 @@ def predicted_unilateral(arguments: dict[str, Any], geometry: Geometry | None = 
     return unresolved_carried(result, check_info["flags"])
 
 
-def unresolved_carried(result, checked: list[str]):
+def unresolved_carried(result: Any, checked: Sequence[str]) -> Any:
     """``result`` (a unilateral answer that did not succeed) flagged ``unresolved_input``
-    with the advice of :data:`~core.engines.nystrom.UNRESOLVED_ADVICE` when the
+    with the advice of :data:`~core.problem.UNRESOLVED_ADVICE` when the
     full-contact model that sent it there (its ``checked`` flags) did not resolve m or g:
     a jump of m without its breakpoint read only "not within tol". A success is left as
     it is: its own estimate stands."""
-    from core.engines.nystrom import UNRESOLVED_ADVICE
-
     info = result.info
     if "unresolved_input" in checked and not info.get("success", False) \
             and "unresolved_input" not in info["flags"]:

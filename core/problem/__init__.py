@@ -28,6 +28,7 @@ from core.problem.inputs import (
 )
 from core.problem.result import (
     INFO_KEYS,
+    UNRESOLVED_ADVICE,
     ContactSolution,
     SolveOutcome,
     accepts,
@@ -71,4 +72,5 @@ __all__ = [
     "validate_geometry",
     "validate_time_inputs",
     "validate_times",
+    "UNRESOLVED_ADVICE",
 ]

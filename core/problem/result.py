@@ -74,6 +74,14 @@ INFO_KEYS = ("method", "success", "message", "flags", "error_estimate",
              "max_pressure", "basis", "element_ends", "stages")
 
 
+#: What a message says where the flag ``unresolved_input`` is raised (m or g has a feature
+#: the engine's discretization does not resolve), the same for every engine and for a
+#: lift-off answer the full-contact model sent on.
+UNRESOLVED_ADVICE = ("m or g has a feature the panels do not resolve: give the x of a jump "
+                     "or kink in breakpoints (a roughness finer than the panels stays "
+                     "unresolved: a looser tol, or a smoother profile)")
+
+
 def accepts(error_estimate: float, tol: float, margin: float = 1.0) -> bool:
     """The one acceptance rule of every engine: ``margin * error_estimate <= tol``.
 

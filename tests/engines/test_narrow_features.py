@@ -92,20 +92,24 @@ def test_the_panels_interpolants_meet_m_between_their_nodes() -> None:
 def test_an_undeclared_step_of_the_gap_says_to_declare_it() -> None:
     """A step of g without its breakpoint is not resolved (flag ``unresolved_input``): the
     message read only "the grid reached 108 panels with estimated error 4.5e-01 in q"."""
-    from core.engines.nystrom import UNRESOLVED_ADVICE
+    from core.problem import UNRESOLVED_ADVICE
 
-    answer = solve_dimensionless(1.0, 0.05, lambda x: np.where(x > 0.3, 1e-4, 0.0), [1.0],
-                                 force=1.0, moment=0.0, tol=1e-6, contact="full")
-    assert not answer.info["success"] and "unresolved_input" in answer.info["flags"]
-    assert UNRESOLVED_ADVICE in answer.info["message"]
-    assert "give its x in breakpoints" in UNRESOLVED_ADVICE
+    step = lambda x: np.where(x > 0.3, 1e-4, 0.0)  # noqa: E731
+    rough = lambda x: 1e-4 * np.sin(300 * x)  # noqa: E731
+    # the same words from every engine (the projection's own flag a rough gap raises)
+    for g, method in ((step, "nystrom"), (rough, "projection")):
+        answer = solve_dimensionless(1.0, 0.05, g, [1.0], force=1.0, moment=0.0, tol=1e-6,
+                                     contact="full", method=method)
+        assert not answer.info["success"] and "unresolved_input" in answer.info["flags"]
+        assert UNRESOLVED_ADVICE in answer.info["message"], method
+    assert "give the x of a jump or kink in breakpoints" in UNRESOLVED_ADVICE
 
 
 def test_a_lift_off_over_an_undeclared_jump_of_m_carries_the_advice() -> None:
     """A jump of m without its breakpoint, lifting off: the full-contact model flagged m
     unresolved, and the unilateral answer it sent on read only "not within tol" (flags
     ``tol_not_met``): it now carries the flag and the advice."""
-    from core.engines.nystrom import UNRESOLVED_ADVICE
+    from core.problem import UNRESOLVED_ADVICE
 
     jump = lambda x: np.where(np.asarray(x) > 0.3, 0.1, 0.05)  # noqa: E731
     answer = solve_dimensionless(1.0, jump, 0.0, [1.0], force=1.0, moment=0.5, tol=1e-6)

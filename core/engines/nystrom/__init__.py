@@ -42,7 +42,6 @@ from core.engines.nystrom.prepared import (
     prepared_for,
     solve_with_prepared,
 )
-from core.engines.nystrom.result import UNRESOLVED_ADVICE
 
 __all__ = [
     "COUPLED",
@@ -61,5 +60,4 @@ __all__ = [
     "prepared_for",
     "PreparedContact",
     "solve_with_prepared",
-    "UNRESOLVED_ADVICE",
 ]

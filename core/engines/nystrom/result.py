@@ -14,7 +14,14 @@ from typing import Any
 import numpy as np
 
 from core.creep import FIT_ERROR_SHARE, fit_advice
-from core.problem import QUANTITIES, ContactSolution, TimeInputs, accepts, statement_number
+from core.problem import (
+    QUANTITIES,
+    UNRESOLVED_ADVICE,
+    ContactSolution,
+    TimeInputs,
+    accepts,
+    statement_number,
+)
 
 #: Margin of :func:`core.problem.accepts`: the estimate (the two-grid difference of
 #: :mod:`core.engines.nystrom.adapt` plus the step-doubling of the time stepping, which
@@ -31,13 +38,6 @@ class TimeSide:
     ok: bool = True
     message: str = "elastic base"
     fit_error: float = 0.0  # the creep kernel's sum-of-exponentials fit (in ``error``)
-
-
-#: What a message says where m or g is not resolved by the panels (the flag
-#: ``unresolved_input``): a stepped gap without its breakpoint read only "the grid
-#: reached 109 panels with estimated error 4.5e-1 in q".
-UNRESOLVED_ADVICE = ("m or g has a feature the panels do not resolve, most likely a jump "
-                     "or kink: give its x in breakpoints")
 
 
 def nystrom_solution(prepared: Any, inputs: TimeInputs, scalars: dict[str, np.ndarray],

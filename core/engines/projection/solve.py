@@ -45,7 +45,7 @@ from core.engines.projection.levels import (
     _Superposition,
 )
 from core.engines.projection.stages import _discretize, _Inputs, _modes
-from core.problem import ContactSolution, accepts, statement_number
+from core.problem import UNRESOLVED_ADVICE, ContactSolution, accepts, statement_number
 
 Scalar = float | Callable[[np.ndarray], np.ndarray]
 
@@ -215,8 +215,7 @@ def solve_projection(inp: _Inputs, basis: str = "graded",
         message = (f"tol {tol:.1e} not met (success needs the estimate below tol/"
                    f"{SUCCESS_MARGIN:g}): " + "; ".join(reasons))
     if not disc.resolved:
-        message += ("; m or g has features finer than the quadrature could resolve "
-                    "(declare jumps in breakpoints)")
+        message += f"; {UNRESOLVED_ADVICE}"
     info = {
         "method": "projection",
         "error_estimate": error_estimate,
