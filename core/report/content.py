@@ -162,10 +162,13 @@ def accuracy_rows(result: SceneSolution,
         ("coating model error (estimated, relative)",
          "0: no coating, no coating model" if not result.scene.coating else
          f"{percent_text(float(result.model_error['estimate']))}"
-         + _of_quantity(result) + " ("
-         + ("FLAGGED: above " if float(result.model_error["estimate"])
-            > result.scene.model_tol else "within ")
-         + f"solver.model_tol {percent_text(result.scene.model_tol)})"
+         + _of_quantity(result)
+         # read off the map beyond what was measured, an estimate bounds nothing
+         + (", EXTRAPOLATED beyond the measured map: no bound (run the coating check)"
+            if "beyond_model_map" in result.flags and evidence["source"] != "measured" else
+            " (" + ("FLAGGED: above " if float(result.model_error["estimate"])
+                    > result.scene.model_tol else "within ")
+            + f"solver.model_tol {percent_text(result.scene.model_tol)})")
          + ("; the FE check's measurement above overrides it"
             if evidence["source"] == "measured" else "")),
         *([("contact pressure against the FE model",

@@ -88,13 +88,19 @@ def percent_text(share: float, digits: int = 3) -> str:
 
 def model_error_line(solution: Any, symbols: bool = False) -> str:
     """The coating model's estimated error of one punch's answer in words, with whose it
-    is and the tolerance: "0.92 % of the tilt (solver.model_tol 2 %)". ``symbols``: the
+    is and the tolerance: "0.92 % of the tilt (solver.model_tol 2 %)", or that it is
+    extrapolated (flag ``beyond_model_map``), which bounds nothing. ``symbols``: the
     paper's symbols beside the names (not on a console, whose character set may not hold
     them)."""
     error = solution.model_error
     quantity = model_error_quantity(solution.scene.given, error.get("part"), symbols=symbols)
-    return (f"{percent_text(error['estimate'], 2)}{' of ' + quantity if quantity else ''} "
-            f"(solver.model_tol {100 * solution.scene.model_tol:g} %)")
+    text = f"{percent_text(error['estimate'], 2)}{' of ' + quantity if quantity else ''}"
+    if "beyond_model_map" in getattr(solution, "flags", ()):
+        # read off the map beyond what was measured: no ground for "within model_tol"
+        # (a coating of 1e-3 Pa read "0.98 % of the tilt (solver.model_tol 2 %)")
+        return (f"{text}, extrapolated beyond the measured map: no bound (measure it with "
+                "coated-punch check)")
+    return f"{text} (solver.model_tol {100 * solution.scene.model_tol:g} %)"
 
 
 def csv_header(result: Any, what: str) -> str:

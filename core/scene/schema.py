@@ -51,6 +51,11 @@ MAX_BREAKPOINTS = limits.MAX_BREAKPOINTS
 #: Accepted range of the dimensionless coating compliance m*: physical coatings are far
 #: inside it; the solver was measured finite for 1e-100 to 1e100.
 M_STAR_RANGE = (1e-30, 1e30)
+#: Accepted range of a Young's modulus [Pa], of each coating layer everywhere and of the
+#: base at loading: the softest gels (~1e4 Pa) to beyond diamond (~1.2e12 Pa). A modulus
+#: given in MPa or GPa where Pa is asked (800 for an 800 MPa polymer, 30 for C30/37's
+#: 33 GPa) falls below it; a coating of 1e-3 Pa was solved to a settlement of 5265 km.
+MODULUS_RANGE = (1e4, 1e13)
 #: Largest accepted gap between punch and coating surface, in half-widths a.
 MAX_GAP_RATIO = 1e3
 #: Accepted range of a / H (the limits and their measured cost: core/limits.py).
@@ -156,8 +161,9 @@ FIELDS: Mapping[str, tuple[FieldRule, ...]] = MappingProxyType({
     "coating[k]": (
         _rule("thickness", "x_profile", "m", "Thickness h_k(x) of the layer, > 0.", low=0.0,
               low_open=True),
-        _rule("modulus", "x_profile", "Pa", "Young's modulus E_k(x) of the layer, > 0.",
-              low=0.0, low_open=True),
+        _rule("modulus", "x_profile", "Pa", "Young's modulus E_k(x) of the layer, in "
+              f"[{MODULUS_RANGE[0]:g}, {MODULUS_RANGE[1]:g}].", low=MODULUS_RANGE[0],
+              high=MODULUS_RANGE[1]),
         _rule("poisson", "x_profile", "-", "Poisson ratio nu_k(x) of the layer, in (-1, 0.5).",
               **_POISSON),
         _rule("interface", "choice", "-", "How the layer is joined to what lies under it.",
@@ -352,8 +358,10 @@ def migrate(d: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _profile(spec: Any, path: str, variable: str, domain: tuple[float, float], *,
-             lower: float | None = None, upper: float | None = None) -> Profile:
-    """Build a profile and check that its values lie in the open range (lower, upper).
+             lower: float | None = None, upper: float | None = None,
+             inclusive: bool = False) -> Profile:
+    """Build a profile and check that its values lie in the open range (lower, upper)
+    (closed with ``inclusive``).
 
     Profiles are immutable, so a validated one is shared by every scene that has it: a
     slider step changes one field, and checking every profile again on thousands of
@@ -361,18 +369,21 @@ def _profile(spec: Any, path: str, variable: str, domain: tuple[float, float], *
     try:
         key = fingerprint("profile", json.dumps(spec, sort_keys=True, separators=(",", ":"),
                                                 allow_nan=False),
-                          path, variable, domain, lower, upper)
+                          path, variable, domain, lower, upper, inclusive)
     except (TypeError, ValueError):  # not plain JSON: validated without the memo
-        return _checked_profile(spec, path, variable, domain, lower, upper)
+        return _checked_profile(spec, path, variable, domain, lower, upper, inclusive)
     return _PROFILES.get_or_compute(
-        key, lambda: _checked_profile(spec, path, variable, domain, lower, upper))[0]
+        key, lambda: _checked_profile(spec, path, variable, domain, lower, upper,
+                                      inclusive))[0]
 
 
 def _checked_profile(spec: Any, path: str, variable: str, domain: tuple[float, float],
-                     lower: float | None, upper: float | None) -> Profile:
+                     lower: float | None, upper: float | None,
+                     inclusive: bool = False) -> Profile:
     profile = profile_from_spec(spec, field=path, variable=variable, domain=domain)
     try:
-        check_range(profile, field=path, domain=domain, lower=lower, upper=upper)
+        check_range(profile, field=path, domain=domain, lower=lower, upper=upper,
+                    lower_inclusive=inclusive, upper_inclusive=inclusive)
     except ValueError as exc:
         message = str(exc)
         # the position is in metres (x) or days after loading (t), the value in the

@@ -105,6 +105,25 @@ def _key_without_loads(d: Mapping[str, Any]) -> str | None:
         return None
 
 
+def _modulus(spec: Any, path: str, domain: tuple[float, float]) -> Profile:
+    """A layer's modulus profile, every value in :data:`~core.scene.schema.MODULUS_RANGE`
+    [Pa]; below it, the message asks whether the value was given in MPa or GPa."""
+    low, high = schema.MODULUS_RANGE
+    try:
+        return _profile(spec, path, "x", domain, lower=low, upper=high, inclusive=True)
+    except ValueError as exc:
+        raise ValueError(f"{exc}{_modulus_hint(str(exc))}") from None
+
+
+def _modulus_hint(message: str) -> str:
+    """What a modulus out of range most likely is, for its message."""
+    if "must be >= " in message:
+        return " (moduli are in Pa: 800 MPa is 8e8, 33 GPa is 3.3e10)"
+    if "must be <= " in message:
+        return " (stiffer than any material)"
+    return ""
+
+
 def _validated(d: dict[str, Any]) -> Scene:
     """:func:`scene_from_dict`'s checks of every field of the migrated dict ``d``."""
     if "punches" in d:
@@ -141,7 +160,7 @@ def _validated(d: dict[str, Any]) -> Scene:
         layers.append(Layer(
             thickness=_profile(spec["thickness"], f"{path}.thickness", "x", x_domain,
                                lower=0.0),
-            modulus=_profile(spec["modulus"], f"{path}.modulus", "x", x_domain, lower=0.0),
+            modulus=_modulus(spec["modulus"], f"{path}.modulus", x_domain),
             poisson=_profile(spec["poisson"], f"{path}.poisson", "x", x_domain,
                              lower=schema.POISSON_RANGE[0], upper=schema.POISSON_RANGE[1]),
             interface=interface,
@@ -359,6 +378,7 @@ def _check_solvable(scene: Scene) -> None:
     """
     with np.errstate(all="ignore"):
         problem = scene.dimensionless
+        _check_base_modulus(scene, problem.modulus_at_loading)
         # m* and g on the samples depend on the geometry, E0 and nu alone: a geometry
         # that passed is not sampled again (a load change)
         key = fingerprint("solvable", scene._geometry_key, problem.modulus_at_loading,
@@ -366,6 +386,21 @@ def _check_solvable(scene: Scene) -> None:
         _SOLVABLE_GEOMETRIES.get_or_compute(key, lambda: _check_coefficients(scene, problem))
         _check_creep(scene, problem)
         _check_loads_scalable(scene, problem)
+
+
+def _check_base_modulus(scene: Scene, e0: float) -> None:
+    """Refuse a base whose modulus at loading ``e0`` [Pa] leaves
+    :data:`~core.scene.schema.MODULUS_RANGE`, naming its creep model's field."""
+    low, high = schema.MODULUS_RANGE
+    if low <= e0 <= high:
+        return
+    creep = scene._data["base"]["creep"]
+    # a design-code law gives E0 by its strength class, not by a modulus field
+    field = ("base.creep.modulus" if isinstance(creep, Mapping) and "modulus" in creep
+             else "base.creep")
+    raise ValueError(f"{field}: the base's modulus at loading E0 is {e0:.6g} Pa, outside "
+                     f"[{low:g}, {high:g}] Pa"
+                     + _modulus_hint("must be >= " if e0 < low else "must be <= "))
 
 
 #: Geometries (with E0 and nu) whose m* and g passed :func:`_check_coefficients`.

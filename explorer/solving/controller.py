@@ -214,6 +214,15 @@ _REFUSED_VALUE = re.compile(r"(\b(?:got|is) )(-?\d+(?:\.\d*)?(?:e[+-]?\d+)?)"
                             r"(?: (?:Pa|m|days?))?(?=$|[,;)]| at | \()")
 
 
+#: A bound of a refused value in the core's messages: "must be >= 10000", "<= 1e+13" or
+#: the range "[10000, 1e+13] Pa".
+_BOUND = re.compile(r"(\bmust be (?:>=|<=|>|<) )(-?\d+(?:\.\d*)?(?:e[+-]?\d+)?)")
+_RANGE = re.compile(r"\[(-?\d+(?:\.\d*)?(?:e[+-]?\d+)?), (-?\d+(?:\.\d*)?(?:e[+-]?\d+)?)\]"
+                    r" Pa\b")
+#: The core's reminder that moduli are in Pa (a box in MPa or GPa has no use for it).
+_PASCAL_HINT = re.compile(r" \(moduli are in Pa[^)]*\)")
+
+
 def format_error(message: str) -> str:
     """The core's ``"field.path: reason"`` message with the field also named in words,
     its refused value in the unit of the field's box (a coating's thickness in mm, its
@@ -225,6 +234,14 @@ def format_error(message: str) -> str:
             message = _REFUSED_VALUE.sub(
                 lambda m, unit=unit, size=size: f"{m.group(1)}{float(m.group(2)) / size:.6g} "
                                                 f"{unit}", message)
+            if unit.endswith("Pa"):
+                message = _PASCAL_HINT.sub("", message)
+                message = _BOUND.sub(lambda m, unit=unit, size=size: m.group(0) if float(
+                    m.group(2)) == 0.0 else f"{m.group(1)}{float(m.group(2)) / size:.6g} {unit}",
+                    message)
+                message = _RANGE.sub(lambda m, unit=unit, size=size: (
+                    f"[{float(m.group(1)) / size:.6g}, {float(m.group(2)) / size:.6g}] {unit}"),
+                    message)
             break
     message = _page_units(message)
     if _MILLIMETRE_FIELDS.match(field):

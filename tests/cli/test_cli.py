@@ -133,7 +133,8 @@ def test_bad_value(tmp_path: Path):
     path = tmp_path / "bad.json"
     path.write_text(json.dumps(d))
     assert_one_line_error(run("validate", path),
-                          "coating[0].modulus: must be > 0, is -3e+06 Pa at x = 0.12 m")
+                          "coating[0].modulus: must be >= 10000, is -3e+06 Pa at x = 0.12 m "
+                          "(moduli are in Pa")
 
 
 def test_validate_refuses_what_solve_would(tmp_path: Path):

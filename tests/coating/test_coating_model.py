@@ -356,6 +356,25 @@ def test_a_stack_beyond_the_measured_map_is_flagged_until_measured() -> None:
     assert solve(soft).model_error["beyond_map"] == ["nu_c 0.495 is above the map's 0.49"]
 
 
+def test_an_extrapolated_estimate_is_not_said_within_model_tol(tmp_path) -> None:
+    """Beyond the map, the command line's and the report's line of the model error say it
+    is extrapolated and bounds nothing (a coating of 1e-3 Pa read "0.98 % of the tilt
+    (solver.model_tol 2 %)"); inside the map they give the tolerance."""
+    from core.report import report_html
+    from core.scene import model_error_line
+    from tests.support.epoxy_on_pad import epoxy_on_pad_scene, softer_pad_scene
+
+    beyond = solve(softer_pad_scene())
+    line = model_error_line(beyond)
+    assert "extrapolated beyond the measured map: no bound" in line, line
+    assert "model_tol" not in line
+    html = report_html(beyond)
+    assert "EXTRAPOLATED beyond the measured map: no bound" in html
+    inside = solve(epoxy_on_pad_scene())
+    assert "(solver.model_tol 2 %)" in model_error_line(inside)
+    assert "EXTRAPOLATED" not in report_html(inside)
+
+
 def _stack_of(*layers: tuple[float, float, float, str]) -> dict:
     """The epoxy-on-pad scene with the coating ``layers`` (thickness m, modulus Pa, nu,
     interface), top first."""

@@ -381,6 +381,13 @@ def test_format_error_says_a_refused_value_in_the_unit_of_its_box():
     assert format_error("base.creep.modulus_final: must be > 0, got -3e+10 (final)"
                         ).endswith("got -30 GPa (final)")
     assert format_error("base.thickness: must be > 0, got -1").endswith("got -1 m")
+    # the bounds in the box's unit too, without the reminder that the file's are in Pa
+    assert format_error("coating[0].modulus: must be >= 10000, is 800 Pa at x = -1 m (moduli "
+                        "are in Pa: 800 MPa is 8e8, 33 GPa is 3.3e10)").endswith(
+        "must be >= 0.01 MPa, is 0.0008 MPa at x = -1 m")
+    assert format_error("base.creep.modulus: the base's modulus at loading E0 is 30 Pa, "
+                        "outside [10000, 1e+13] Pa (moduli are in Pa: 800 MPa is 8e8)"
+                        ).endswith("E0 is 3e-08 GPa, outside [1e-05, 10000] GPa")
     assert format_error("base.age_at_loading: must be > 0, got -3").endswith("got -3 days")
     assert format_error("punch.half_width: must be > 0, got 0").endswith("got 0 m")
 

@@ -661,8 +661,9 @@ def test_modulus_message_names_layer_value_and_position():
     d = base_dict()
     d["coating"].append({"thickness": 0.01, "poisson": 0.3,
                          "modulus": {"kind": "step", "values": [1e9, -3e6], "breaks": [0.12]}})
-    with pytest.raises(ValueError, match=r"^coating\[1\]\.modulus: must be > 0, is -3e\+06 Pa "
-                                         r"at x = 0\.12 m$"):
+    with pytest.raises(ValueError, match=r"^coating\[1\]\.modulus: must be >= 10000, is -3e\+06 "
+                                         r"Pa at x = 0\.12 m \(moduli are in Pa: 800 MPa "
+                                         r"is 8e8, 33 GPa is 3\.3e10\)$"):
         scene_from_dict(d)
 
 

@@ -20,8 +20,17 @@ from tests.conftest import DELETE, ODD, edited, elastic_dict, small_preset_scene
 BAD_VALUES: list[tuple[str, Any, str]] = [
     ("coating[0].thickness", -0.01, "coating[0].thickness: must be > 0"),
     ("coating[0].thickness", 0.0, "coating[0].thickness: must be > 0"),
-    ("coating[0].modulus", -3e6, "coating[0].modulus: must be > 0"),
-    ("coating[0].modulus", 0, "coating[0].modulus: must be > 0"),
+    ("coating[0].modulus", -3e6, "coating[0].modulus: must be >= 10000"),
+    ("coating[0].modulus", 0, "coating[0].modulus: must be >= 10000"),
+    # a modulus typed in MPa (800 for 800 MPa) was solved to a settlement of kilometres
+    ("coating[0].modulus", 800, "coating[0].modulus: must be >= 10000, is 800 Pa at x = "
+                                "-1 m (moduli are in Pa: 800 MPa is 8e8"),
+    ("coating[0].modulus", 1e30, "coating[0].modulus: must be <= 1e+13, is 1e+30 Pa at x = "
+                                 "-1 m (stiffer than any material)"),
+    ("base.creep.modulus", 30.0, "base.creep.modulus: the base's modulus at loading E0 is 30 "
+                                 "Pa, outside [10000, 1e+13] Pa (moduli are in Pa"),
+    ("base.creep.modulus", 3e14, "base.creep.modulus: the base's modulus at loading E0 is "
+                                 "3e+14 Pa, outside [10000, 1e+13] Pa (stiffer than any"),
     ("base.thickness", 0.0, "base.thickness: must be > 0"),
     ("base.creep.modulus", -3e10, "base.creep.modulus: must be > 0"),
     ("coating[0].poisson", 0.5, "coating[0].poisson: must be < 0.5"),

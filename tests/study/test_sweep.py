@@ -109,7 +109,7 @@ def each_load_point_against_solve(study, grid, got, same_as_the_point) -> dict[s
     ({"vary": [{"field": "times.end", "values": [1]}]}, "vary[0].field: 'times.end' cannot"),
     ({"vary": [{"field": "coating[0].modulus", "values": [1e8, -1e8]}]},
      "vary[0].values: the scene is invalid at coating[0].modulus = -1e+08 "
-     "(coating[0].modulus: must be > 0"),
+     "(coating[0].modulus: must be >= 10000"),
     ({"vary": [{"field": "base.poisson", "uniform": {"low": 0.1, "high": 0.5}}],
       "samples": 4}, "vary[0].uniform.high: the scene is invalid"),
     ({"vary": [{"field": "base.poisson", "uniform": {"low": 0.3, "high": 0.1}}],
