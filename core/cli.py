@@ -61,7 +61,7 @@ from core.files import (
     same_file,
     writable_target,
 )
-from core.limits import MAX_SCENE_TIMES
+from core.limits import MAX_SCENE_DAYS, MAX_SCENE_TIMES
 from core.optional import MissingDependency
 from core.presets import PRESET_PREFIX, preset_names, shipped_file, study_names
 from core.problem import QUANTITIES
@@ -135,16 +135,23 @@ class _Parser(argparse.ArgumentParser):
 #: The address-space bound [bytes] this run set on itself (None: none, as when
 #: :func:`main` is called from Python).
 _MEMORY_BOUND: int | None = None
+#: The ``--max-memory`` it was set from [GiB].
+_MEMORY_ASKED: float | None = None
 
 
 def _one_line(text: str | BaseException) -> str:
     """``text`` on one line; a ``MemoryError`` says which bound it met, and how to raise
     it (numpy's own text names only the array it could not allocate)."""
     if isinstance(text, MemoryError) and _MEMORY_BOUND is not None:
+        # the bound is the asked one plus the threads' share per core: both said, so that
+        # "--max-memory 0.5" is not answered "the 0.75 GiB" unexplained
+        cores = os.cpu_count() or 1
+        asked = (limits.MAX_RUN_MEMORY_BYTES / 2**30 if _MEMORY_ASKED is None
+                 else _MEMORY_ASKED)
         text = (f"needed more than the {_MEMORY_BOUND / 2**30:.3g} GiB of memory this run "
-                f"may take (--max-memory GIB raises it; the default "
-                f"{limits.MAX_RUN_MEMORY_BYTES / 2**30:g} GiB plus "
-                f"{PER_CORE_BYTES / 2**20:g} MiB per core, core.limits.MAX_RUN_MEMORY_BYTES)"
+                f"may take (--max-memory {asked:g} GiB plus {PER_CORE_BYTES / 2**20:g} MiB "
+                f"for each of the {cores} cores; --max-memory GIB raises it, default "
+                f"{limits.MAX_RUN_MEMORY_BYTES / 2**30:g})"
                 + (f": {text}" if str(text) else ""))
     return " ".join(str(text).split())
 
@@ -479,10 +486,20 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         _write(output, result.to_csv())
     if pressure_out is not None:
         _write(pressure_out, result.pressure_csv())
+    _say_written(output, pressure_out)
     for name in result.flags:
         print(f"warning: {name}: {_one_line(result.flag_messages[name].replace('see info.message', result.info.get('message', '')))}", file=sys.stderr)  # noqa: E501
     _design_warnings(result)
     return _strict_verdict(result) if args.strict else EXIT_OK
+
+
+def _say_written(*outputs: Path | None) -> None:
+    """``written to ...`` of the files ``solve`` wrote, as ``preset`` and ``sweep`` say it
+    (a run with ``-o`` printed nothing); nothing when one of them is standard output,
+    whose data the line would spoil."""
+    files = [str(path) for path in outputs if path is not None]
+    if files and STDIO not in files:
+        print(f"written to {' and '.join(files)}")
 
 
 def _design_warnings(result: SceneSolution) -> None:
@@ -504,6 +521,7 @@ def _solved_punches(args: argparse.Namespace, result: PunchesSolution, output: P
         _write(output, result.to_csv())
     if pressure_out is not None:
         _write(pressure_out, result.pressure_csv())
+    _say_written(output, pressure_out)
     _punches_warnings(result)
     return _punches_strict(result) if args.strict else EXIT_OK
 
@@ -668,7 +686,12 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                      progress=not args.quiet and sys.stderr.isatty(),
                      return_dataset=False)
     except ValueError as exc:
-        raise _InputError(str(exc)) from None
+        if own_parts and not any(work_dir.glob("**/*.npz")):
+            shutil.rmtree(work_dir, ignore_errors=True)  # nothing computed: nothing to resume
+        message = str(exc)
+        if message.startswith("scheduler:"):
+            message = "--" + message  # the option that gave it
+        raise _InputError(message) from None
     print(f"{study.n_points} points in {info['batches']} batches ({info['batches_reused']} "
           f"reused), {info['points_failed']} failed, {info['points_flagged']} flagged, "
           f"{info['seconds']:.1f} s; written to {output}")
@@ -728,6 +751,10 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     # was left out without a word; -5 was refused as "times.end")
     if args.forecast is not None and not (math.isfinite(args.forecast) and args.forecast > 0):
         raise _InputError(f"--forecast: must be a number of days > 0, got {args.forecast:g}")
+    if args.forecast is not None and args.forecast > MAX_SCENE_DAYS:
+        # as a scene's times.end, but named as typed (it read "times.end: must be ...")
+        raise _InputError(f"--forecast: must be at most {MAX_SCENE_DAYS:g} days (about "
+                          f"{MAX_SCENE_DAYS / 365.25:.0f} years), got {args.forecast:g}")
     if not 1 <= args.forecast_count <= MAX_SCENE_TIMES:
         raise _InputError(f"--forecast-count: must be a whole number from 1 to "
                           f"{MAX_SCENE_TIMES}, got {args.forecast_count}")
@@ -1010,7 +1037,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line with ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
-    global _MEMORY_BOUND
+    global _MEMORY_BOUND, _MEMORY_ASKED
     try:
         try:
             args = build_parser().parse_args(argv)
@@ -1020,6 +1047,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if argv is None and getattr(args, "max_memory", None) is not None:
             # run as a program: its own process (never a caller's Python session)
             _MEMORY_BOUND = bound_memory(int(args.max_memory * 2**30))
+            _MEMORY_ASKED = float(args.max_memory)
         code = int(args.run(args))
         # what print() left in the buffer is written here, where a reader that left is
         # caught (at exit it read "Exception ignored ... BrokenPipeError", exit 120)

@@ -176,7 +176,13 @@ def _resolve_client(client: Any, scheduler: str | None) -> tuple[Any, Callable[[
     dask = import_optional("dask", "a study on Dask")
     address = scheduler or dask.config.get("scheduler-address", None)
     if address:
-        own = Client(address)
+        try:
+            own = Client(address)
+        except (OSError, ValueError, TypeError) as exc:
+            # an address that does not answer, or is not one (Dask's own words say which)
+            where = "scheduler" if scheduler else "the Dask config's scheduler-address"
+            raise ValueError(f"{where}: cannot connect to {address!r} "
+                             f"({' '.join(str(exc).split())})") from None
         return own, own.close
     # workers warmed as the cluster starts: imports and shared tables are not paid on
     # each worker's first batch (see core.study.warm)

@@ -46,6 +46,8 @@ def test_solve_to_json(tmp_path: Path):
     proc = run_cli("solve", SCENES / "eccentric_creep.json", "--output", out, subprocess=True)
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr == ""  # no flags on a shipped scene, no warnings of any library
+    # as preset and sweep say it (a run with --output printed nothing at all)
+    assert proc.stdout == f"written to {out}\n"
     result = json.loads(out.read_text())
     assert result["scene"]["name"] == "Eccentric force on young, aging concrete"
     n = len(result["times"])
@@ -67,6 +69,10 @@ def test_solve_to_csv_with_pressure(tmp_path: Path):
     pressure = tmp_path / "q.csv"
     proc = run("solve", SCENES / "patched_insert.json", "-o", out, "--pressure-csv", pressure)
     assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == f"written to {out} and {pressure}\n"
+    # with one of them on standard output, nothing is said there but its data
+    proc = run("solve", SCENES / "patched_insert.json", "-o", out, "--pressure-csv", "-")
+    assert proc.stdout.startswith("# ") and "written to" not in proc.stdout
     rows = list(csv.reader(line for line in io.StringIO(out.read_text())
                            if not line.startswith("#")))
     assert rows[0] == ["time_day", "settlement_m", "tilt_rad", "force_N_per_m", "moment_N"]

@@ -78,12 +78,16 @@ def test_strict_fails_on_a_warning(tmp_path: Path) -> None:
 
 def test_the_forecasts_options_are_named_as_typed(tmp_path: Path) -> None:
     """``--forecast 0`` was left out without a word (exit 0, no forecast); ``-5`` and
-    ``--forecast-count 0`` were refused as ``times.end`` and ``times.count``."""
+    ``--forecast-count 0`` were refused as ``times.end`` and ``times.count``, and ``1e9``
+    as ``times.end`` still."""
     from core.cli import main
 
     scene, readings = _files(tmp_path)
     cases = [(["--forecast", "0"], "error: --forecast: must be a number of days > 0, got 0"),
              (["--forecast", "-5"], "error: --forecast: must be a number of days > 0, got -5"),
+             # a forecast past the latest time a scene takes read "times.end: ..."
+             (["--forecast", "1e9"], "error: --forecast: must be at most 100000 days "
+                                     "(about 274 years), got 1e+09"),
              (["--forecast", "100", "--forecast-count", "0"],
               "error: --forecast-count: must be a whole number from 1 to 2000, got 0")]
     for extra, said in cases:

@@ -730,3 +730,24 @@ def test_liftoff_eccentricities_of_a_batch_are_one_family(monkeypatch):
     assert kinds == {"failed": 2, "unilateral": 48, "full": 2}
     print(f"largest difference to core.solve: {max(worst):.2e}; "
           f"of the contact width: {max(widths):.2e} a")
+
+
+def test_a_scheduler_that_does_not_answer_is_named_and_leaves_nothing(tmp_path: Path):
+    """``--scheduler`` at an address where nothing listens, or that is no address: exit 2
+    naming the option (it read "internal error (OSError: Timed out ...); please report it"
+    after 30 s), and no ``.parts`` folder left, since nothing was computed."""
+    import dask
+
+    study = tmp_path / "study.json"
+    study.write_text(json.dumps(small_study()))
+    output = tmp_path / "d.csv"
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        for address, says in (("tcp://127.0.0.1:1", "Timed out trying to connect"),
+                              ("foo", "missing port number")):
+            done = run_cli("sweep", study, "--output", output, "--scheduler", address)
+            assert done.returncode == 2, done.stderr
+            assert done.stderr.startswith(f"error: --scheduler: cannot connect to "
+                                          f"'{address}' ("), done.stderr
+            assert says in done.stderr and "internal error" not in done.stderr
+            assert not output.exists()
+            assert list(tmp_path.iterdir()) == [study]
