@@ -28,8 +28,9 @@ def _held(change: Callable[[], Any]) -> None:
 def _as_text(text: str) -> str:
     """A file's text shown as it is in the Markdown pane: HTML escaped (the pane renders
     HTML within Markdown) and the characters that format Markdown inline too ("2*3*4"
-    read "2<em>3</em>4")."""
-    return re.sub(r"([\\`*_\[\]$~#|])", r"\\\1", html.escape(text))
+    read "2<em>3</em>4"). Quotes are left as they are: their entities' "#", escaped as
+    Markdown, showed "coating&#x27;s"."""
+    return re.sub(r"([\\`*_\[\]$~#|])", r"\\\1", html.escape(text, quote=False))
 
 
 class SceneView:

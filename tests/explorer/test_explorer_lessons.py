@@ -259,6 +259,13 @@ def test_a_files_name_and_description_are_shown_as_written(explorer_app) -> None
     assert app._load_file(scene)
     rendered = MarkdownIt().render(app.scene_tab.preset_description.object)
     assert "<strong>Pad 2*3*4</strong>: &lt;b&gt;bold&lt;/b&gt; a_b `c` $5" in rendered
+    # quotes as written: their entity's "#", escaped as Markdown, read "coating&#x27;s"
+    # (the coating lesson's last step)
+    scene["name"], scene["description"] = "The pad's test", 'mostly the coating\'s, "so"'
+    assert app._load_file(scene)
+    rendered = MarkdownIt().render(app.scene_tab.preset_description.object)
+    assert "<strong>The pad's test</strong>: mostly the coating's, &quot;so&quot;" in rendered, \
+        rendered
 
 
 def test_a_step_changed_on_the_page_says_what_the_note_and_next_speak_of(explorer_app) -> None:
