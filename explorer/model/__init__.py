@@ -31,6 +31,7 @@ from .contact_zone import (
     contact_widths,
     contact_zones,
     lift_off_lengths,
+    lifted_times,
     lifts_off,
     lifts_or_pulls,
 )
@@ -119,7 +120,8 @@ __all__ = ["CODE_CREEP_MODELS", "CONTACT_MODELS", "CREEP_MODELS", "DEFAULT_PRESE
            "check_html", "check_text", "contact_text", "contact_widths", "contact_zones",
            "creep_coefficient_data", "decode_scene", "default_range",
            "design_check", "eccentricity", "encode_scene", "fit_choices", "forecast_columns",
-           "lesson_title", "lessons", "lift_off_lengths", "lifts_off", "lifts_or_pulls",
+           "lesson_title", "lessons", "lift_off_lengths", "lifted_times", "lifts_off",
+           "lifts_or_pulls",
            "model_evidence",
            "plan_fit", "plan_study", "punch_design_checks", "punch_verdicts", "punches_check_html",
            "read_upload", "readings_columns",

@@ -77,10 +77,17 @@ def lift_off_lengths(view: ResultView) -> np.ndarray:
 def lifts_off(view: ResultView) -> bool:
     """Whether the contact set is narrower than the base at some output time (the core's
     :func:`core.scene.lifts_off`; of any punch, for several)."""
+    return bool(np.any(lifted_times(view)))
+
+
+def lifted_times(view: ResultView) -> np.ndarray:
+    """At each output time, whether the contact set is narrower than the base (of any
+    punch, for several): boolean, shape (len(times),)."""
     if view.punches:
-        return any(bool(np.any(core_lifts_off(_local_set(p), p.half_width)))
-                   for p in view.punches)
-    return bool(np.any(core_lifts_off(_contact_set(view), view.geometry.half_width)))
+        return np.any([np.asarray(core_lifts_off(_local_set(p), p.half_width), dtype=bool)
+                       for p in view.punches], axis=0)
+    return np.asarray(core_lifts_off(_contact_set(view), view.geometry.half_width),
+                      dtype=bool)
 
 
 def lifts_or_pulls(view: ResultView) -> bool:

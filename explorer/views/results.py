@@ -6,6 +6,7 @@ import html
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
 import panel as pn
 import param
 
@@ -22,7 +23,7 @@ from ..model import (
     check_html,
     contact_text,
     design_check,
-    lifts_off,
+    lifted_times,
     model_evidence,
     punch_design_checks,
     punches_check_html,
@@ -45,20 +46,42 @@ def _fmt(value: float) -> str:
     return number_text(value, 5)
 
 
+def lift_off_badge(view: ResultView, index: int | None = None) -> str:
+    """The pressure plots' badge of a unilateral answer that lifts off at some output time
+    ('' if it never does): at the output time ``index`` shown, or, where the base is
+    wholly in contact then, when it lifts (a crowned punch lifting at loading read "part
+    of the base carries no load (shaded)" at 365 days, in full contact, nothing shaded)."""
+    if "contact_lost" in view.flags:
+        return ""  # a full-contact answer: its own badge says so
+    lifted = lifted_times(view)
+    if not lifted.any():
+        return ""
+    if index is None or lifted[min(index, lifted.size - 1)]:
+        return ('<span class="cp-badge cp-bad lift-off">⚠ lift-off: part of the base '
+                'carries no load (shaded)</span>')
+    when = np.asarray(view.times, dtype=float)[lifted]
+    span = days_text(float(when[0])) if when.size == 1 else \
+        f"{days_text(float(when[0]))} to {days_text(float(when[-1]))}"
+    return (f'<span class="cp-badge cp-bad lift-off lift-off-elsewhere">⚠ lift-off at t = '
+            f'{html.escape(span)}: full contact at the time shown</span>')
+
+
 def badges_html(view: ResultView | None, group: str,
-                evidence: Mapping[str, Any] | None = None) -> str:
+                evidence: Mapping[str, Any] | None = None, index: int | None = None) -> str:
     """Validity badges of one plot group (flag names as CSS classes, messages as tooltips).
 
     ``evidence``: :func:`explorer.model.model_evidence` of ``view``; the ``model_error``
-    badge says what it rests on (the FE check's measurement, else the estimate)."""
+    badge says what it rests on (the FE check's measurement, else the estimate).
+    ``index``: the output time shown, of which the pressure's lift-off badge speaks
+    (:func:`lift_off_badge`)."""
     if view is None:
         return ""
     flags = shown_flags(view, evidence)
     parts = []
-    lifted = group == "pressure" and lifts_off(view) and "contact_lost" not in view.flags
+    lift_off = lift_off_badge(view, index) if group == "pressure" else ""
+    lifted = bool(lift_off)
     if lifted:  # a unilateral solve: no q < 0, and no full contact either
-        parts.append('<span class="cp-badge cp-bad lift-off">⚠ lift-off: part of the base '
-                     'carries no load (shaded)</span>')
+        parts.append(lift_off)
     uncoated = group == "scene" and not view.scene.get("coating")
     for flag, (bad, good) in BADGES[group].items():
         if lifted and flag == "contact_lost":
@@ -315,7 +338,7 @@ class ResultsView:
         self._preview = view if preview else None
         self.status.object = status_html(view, self.busy.shown, self.evidence(view), preview)
         self.scene_badges.object = badges_html(view, "scene", self.evidence(view))
-        self.pressure_badges.object = badges_html(view, "pressure")
+        self.pressure_badges.object = badges_html(view, "pressure", index=index)
         self.history_badges.object = badges_html(view, "history")
         self.status_badges.object = badges_html(view, "status")
         if self.time_axis.on:
@@ -378,6 +401,9 @@ class ResultsView:
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{days_text(float(view.times[index]))}</span>")
         self.readout.object = readout_html(view, index, self.pins.board.pins)
+        badges = badges_html(view, "pressure", index=index)
+        if self.pressure_badges.object != badges:  # (a lift-off badge follows the time)
+            self.pressure_badges.object = badges
 
     def show_design(self, view: ResultView | None = None) -> None:
         """The design check of ``view`` (default: the result on screen) against the

@@ -9,6 +9,7 @@ from functools import cache
 import numpy as np
 import pytest
 
+from core.scene import days_text
 from explorer.model import (
     ExplorerState,
     ResultView,
@@ -165,6 +166,34 @@ def test_a_lift_off_is_badged_and_shaded_as_such_not_as_full_contact() -> None:
     labels = [item.label for item in figures.contact.scene_legend.items
               if figures.contact.lifted_line in item.renderers]
     assert labels == [value("lifted off (gap open)")]
+
+
+def test_the_lift_off_badge_speaks_of_the_time_shown() -> None:
+    """Just past the threshold (e = 0.41 m) the lift-off preset's heel lifts at loading
+    and creep closes it within weeks: at a later time the badge read "part of the base
+    carries no load (shaded)" beside a full contact, nothing shaded (a crowned default
+    did the same). It now says when the base lifted, and that the time shown is in full
+    contact."""
+    from explorer.model import lifted_times
+    from explorer.views import badges_html
+
+    scene = json.loads(json.dumps(presets()["eccentric_footing_liftoff"]))
+    scene["loading"]["moment"] = 0.41 * scene["loading"]["force"]
+    state = ExplorerState()
+    state.load_scene(scene)
+    controller = SolveController(state, executor=None, auto=False)
+    controller.solve_now()
+    view = controller.view
+    assert view is not None, controller.error
+    lifted = lifted_times(view)
+    assert lifted[0] and not lifted[-1], lifted
+    at_loading = badges_html(view, "pressure", index=0)
+    assert "part of the base carries no load (shaded)" in at_loading
+    late = badges_html(view, "pressure", index=len(view.times) - 1)
+    assert "carries no load" not in late, late
+    last = float(np.asarray(view.times)[lifted][-1])
+    assert (f"lift-off at t = 0 days to {days_text(last)}: full contact at the time "
+            "shown") in late, late
 
 
 @pytest.mark.slow
