@@ -56,6 +56,12 @@ def times_drawn(figures: Sequence[Any]) -> np.ndarray:
     return t[np.isfinite(t)]
 
 
+def _field(spec: Any, default: str) -> str:
+    """The column a glyph's coordinate reads (``default`` where it is not a column: the
+    contact width plot's lines read "width" and "lifted", the histories' "v")."""
+    return spec if isinstance(spec, str) else getattr(spec, "field", None) or default
+
+
 class LogTime:
     """Switches the time axis of figures that share one x range."""
 
@@ -127,9 +133,10 @@ class LogTime:
                             data.get("color", [None] * len(data.get("xs", []))),
                             strict=False)
                         if isinstance(glyph, MultiLine)
-                        else [(data.get("t", []), data.get("v", []), None)])
+                        else [(data.get(_field(glyph.x, "t"), []),
+                               data.get(_field(glyph.y, "v"), []), None)])
                 for t, v, color in rows:
-                    if len(t) and float(t[0]) == 0.0 and np.isfinite(float(v[0])):
+                    if len(t) and len(v) and float(t[0]) == 0.0 and np.isfinite(float(v[0])):
                         ys.append(float(v[0]))
                         colors.append(color if isinstance(color, str)
                                       else glyph.line_color)

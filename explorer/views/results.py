@@ -273,7 +273,9 @@ class ResultsView:
         self.log_time = LabelledCheckbox("log time axis", css_classes=["log-time"],
                                          margin=(5, 10))
         self.log_time.param.watch(self._on_log_time, "value")
-        self.time_axis = LogTime([figures.history_fig[q] for q in QUANTITIES])
+        # the contact width's history too (it stayed linear beside log histories)
+        self.time_axis = LogTime([*(figures.history_fig[q] for q in QUANTITIES),
+                                  figures.contact_fig])
         limits.param.watch(lambda *e: self.show_design(), list(
             n for n in limits.param if n != "name"))
         f = figures

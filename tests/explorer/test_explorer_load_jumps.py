@@ -91,7 +91,7 @@ def test_the_values_at_loading_are_marked_at_the_edge_of_a_log_time_axis(explore
     view = app.controller.view
     assert view.times[0] == 0.0
     results, figures = app.results, app.figures
-    marks = dict(zip(("settlement", "tilt", "force", "moment"),
+    marks = dict(zip(("settlement", "tilt", "force", "moment", "contact width"),
                      results.time_axis.at_loading, strict=True))
     assert all(not len(m.data["y"]) for m in marks.values())  # linear: on the lines
     results.log_time.value = True
@@ -108,3 +108,26 @@ def test_the_values_at_loading_are_marked_at_the_edge_of_a_log_time_axis(explore
     assert marks["force"].data["color"] == [figures.history_line["force"].glyph.line_color]
     results.log_time.value = False
     assert not len(marks["settlement"].data["y"])
+
+
+def test_the_contact_width_follows_a_log_time_axis(explorer_app) -> None:
+    """"log time axis" turned the four histories to log time and left the contact width's
+    linear, 0 to 1000 days, beside them (the lift-off preset, a teacher's audit); its
+    value at loading is marked at the log axis' edge as theirs are."""
+    from bokeh.models import LinearScale, LogScale
+
+    app = explorer_app("eccentric_footing_liftoff", solved=True)
+    view = app.controller.view
+    results, figures = app.results, app.figures
+    assert view.times[0] == 0.0 and isinstance(figures.contact_fig.x_scale, LinearScale)
+    results.log_time.value = True
+    assert isinstance(figures.contact_fig.x_scale, LogScale)
+    assert figures.contact_fig.x_range is results.time_axis.log_range
+    assert figures.contact_fig.xaxis[0].axis_label == \
+        figures.history_fig["settlement"].xaxis[0].axis_label
+    width_marks = results.time_axis.at_loading[-1].data
+    widths = figures.contact.width_src.data
+    assert width_marks["y"] == pytest.approx([widths["width"][0], widths["lifted"][0]])
+    results.log_time.value = False
+    assert isinstance(figures.contact_fig.x_scale, LinearScale)
+    assert not len(results.time_axis.at_loading[-1].data["y"])
