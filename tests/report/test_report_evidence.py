@@ -51,6 +51,19 @@ def test_a_measurement_of_the_scene_overrides_the_estimate(result):
         "4.64 % of the tilt α (FLAGGED: above solver.model_tol 2 %)")
 
 
+def test_a_measurement_names_its_unknown_and_both_answers(result):
+    """The report read "135 % at t = 0 days" where the page names the unknown measured
+    and shows the fast and the resolved answer (an engineer's audit)."""
+    check = {**_check(epoxy_on_pad_scene(), MEASURED),
+             "errors": {"settlement": 0.004, "tilt": MEASURED, "force": 0.0, "moment": 0.0},
+             "fast": {"settlement": 4.2e-5, "tilt": 6.2e-5, "force": 8e5, "moment": 2e5},
+             "fe": {"settlement": 4.18e-5, "tilt": 5.9857e-5, "force": 8e5, "moment": 2e5}}
+    rows = describe(result, check=check)["Accuracy"]["rows"]
+    assert rows[MEASURED_ROW].startswith(
+        "3.58 % of the tilt α (6.2e-05 rad fast against 5.9857e-05 rad resolved) at t = 0 "
+        "days (FLAGGED"), rows[MEASURED_ROW]
+
+
 def test_a_measurement_within_the_tolerance_lowers_an_estimated_flag(result):
     scene = epoxy_on_pad_scene()
     scene["solver"] = {"model_tol": 0.01}  # the estimate 4.64 % is flagged
