@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import html
 import numbers
+import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -237,6 +238,12 @@ def status_html(view: ResultView | None, busy: bool,
     warning = ("" if not raised else
                f" <span class='cp-status cp-msg status-warnings'>⚠ Flagged: "
                f"{html.escape('; '.join(raised))} (the badges below say why).</span>")
-    return (f"<span class='cp-status solve-status'>{html.escape(text)}</span>{model}"
-            f"{warning} <details class='cp-status solve-details'><summary>details</summary>"
-            f"{html.escape(details_text(view))}</details>")
+    # a percentage on one line ("135" ended a line, "%" began the next)
+    return _NUMBER_UNIT.sub("\\1&nbsp;\\2", (
+        f"<span class='cp-status solve-status'>{html.escape(text)}</span>{model}"
+        f"{warning} <details class='cp-status solve-details'><summary>details</summary>"
+        f"{html.escape(details_text(view))}</details>"))
+
+
+#: A number and the percent sign after it in the status line, kept together.
+_NUMBER_UNIT = re.compile(r"(\d) (%)")

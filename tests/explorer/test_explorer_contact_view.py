@@ -331,6 +331,8 @@ def test_the_status_line_does_not_vouch_for_an_extrapolated_estimate() -> None:
     assert "beyond_model_map" in view.flags
     text = status_html(view, False, model_evidence(view))
     assert "extrapolated beyond the measured map" in text and "within solver" not in text
+    # a number stays with its unit at a line's end ("135" ended a line, "%" began the next)
+    assert " %" not in text and "&nbsp;%" in text, text
 
 
 def test_the_drawing_s_axis_says_what_its_corner_note_says() -> None:
