@@ -31,6 +31,7 @@ CSS = """
 .design-check .cp-readout td.check-heading {text-align: left; padding: 10px 0 2px 0;}
 .design-check .cp-readout td.check-footer {text-align: left; padding: 0 0 4px 0;}
 .readout {overflow-x: auto;}
+.time-label {display: inline-block; min-width: 15.5em; white-space: nowrap;}
 """
 
 #: Style of the small grey notes under a group of widgets.

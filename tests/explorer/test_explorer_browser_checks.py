@@ -95,10 +95,18 @@ def test_time_slider_range_follows_a_preset_switch(page: Page):
           "the slider at the last of 60 times", 60, lambda: _player_range(page))
     # the first time, then the last, land where they say
     slider = page.page.locator(".time-player input[type=range]").first
+    buttons = page.page.locator(".time-player button")
     slider.fill("0")
     until(lambda: "t = 0 days" in page.text(".time-label"), "t = 0")
+    at_first = [buttons.nth(k).bounding_box()["x"] for k in range(buttons.count())]
     slider.fill("59")
     until(lambda: "t = 1000 days" in page.text(".time-label"), "t = 1000")
+    # the buttons stay where they were as the label grows ("t = 1000 days (2.7 years)"
+    # moved them ~30 px: a click meant for "first" stepped back one time)
+    until(lambda: [buttons.nth(k).bounding_box()["x"] for k in range(buttons.count())]
+          == at_first, "the player's buttons where they were at t = 0", 5,
+          lambda: ([buttons.nth(k).bounding_box()["x"] for k in range(buttons.count())],
+                   at_first))
     # the preset's text says what its curve shows (it levels off; not "for years")
     assert page.page.evaluate(JS_SHOWN, "level off after about 250 days")
     assert not page.page.evaluate(JS_SHOWN, "keep growing for years")
