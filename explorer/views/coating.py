@@ -69,15 +69,19 @@ class CoatingView:
                                                  color="primary", variant="outline",
                                                  sizing_mode="stretch_width")
         self.layer.param.watch(lambda *e: self.bind_layer(), "value")
+        # where an emptied or refused box is said (the thickness box emptied said nothing)
+        reject = None if screen is None else screen.reject
         self.thickness_editor = ProfileEditor("thickness", "mm", 0.5, 50.0, 0.1,
                                               significant_format(),
                                               amplitude=("µm", -1000.0, 1000.0, 0.5),
-                                              css="coating-thickness", live_when=live_when)
+                                              css="coating-thickness", live_when=live_when,
+                                              on_reject=reject)
         self.modulus_editor = ProfileEditor("Young's modulus", "MPa", 1.0, 10000.0, 1.0,
                                             significant_format(), css="coating-modulus",
-                                            live_when=live_when)
+                                            live_when=live_when, on_reject=reject)
         self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
-                                            variations=False, live_when=live_when)
+                                            variations=False, live_when=live_when,
+                                            on_reject=reject)
         self.layer_note = html_pane("", styles=NOTE_STYLE)
         self.bare_note = html_pane(BARE_NOTE, styles=NOTE_STYLE, css_classes=["bare-note"])
         self.check = CoatingCheckView(state, controller, loop, screen)

@@ -390,6 +390,8 @@ class Binding:
                 watch_release(widget, lambda event, dragged: released(dragged),
                               lambda: self._syncing)
         box = getattr(widget, "_value_edit", None)
+        if box is None and isinstance(widget, pn.widgets.FloatInput | pn.widgets.IntInput):
+            box = widget  # a number box of its own (the notional size stayed empty, unsaid)
         if box is not None:
             # the text box of a slider emptied: said, and the value shown again (the box
             # stayed empty, the value unchanged, and nothing said why)
@@ -555,11 +557,13 @@ class ProfileEditor:
     def __init__(self, label: str, unit: str, start: float, end: float, step: float,
                  fmt: str | CustomJSTickFormatter = "0[.]00", variations: bool = True,
                  amplitude: tuple[str, float, float, float] = ("%", -90.0, 500.0, 1.0),
-                 css: str = "", live_when: Callable[[], bool] | None = None) -> None:
+                 css: str = "", live_when: Callable[[], bool] | None = None,
+                 on_reject: Callable[[str], None] | None = None) -> None:
         """``amplitude``: unit of the variation ('%' of the level, or an absolute unit),
         its slider range and step. Without ``variations`` only the level is offered.
-        ``live_when``: see :class:`Binding`."""
-        self.binding = Binding(live_when=live_when)
+        ``live_when`` and ``on_reject`` (where a refused or emptied value is said): see
+        :class:`Binding`."""
+        self.binding = Binding(on_reject, live_when=live_when)
         self.variations = variations
         self.mean = self.binding.add("mean", slider(f"{label} [{unit}]", start, end, step, fmt,
                                                     css_classes=[css] if css else []))

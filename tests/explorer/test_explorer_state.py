@@ -666,6 +666,23 @@ def test_a_refusal_on_screen_ends_when_a_value_is_taken(explorer_app):
     assert app.screen.notice.startswith("The file 'x.json'")
 
 
+def test_every_emptied_number_box_says_so(explorer_app):
+    """The force box emptied said "a number is needed (the box was empty)", the coating
+    thickness's and the notional size's said nothing (the latter stayed empty while the
+    scene kept 300 mm: a teacher's audit)."""
+    app = explorer_app()
+    coating = app._view("coating")
+    coating.thickness_editor.mean._value_edit.value = None
+    assert app.screen.notice == ("Value not accepted: thickness [mm]: a number is needed "
+                                 "(the box was empty); it stays 20"), app.screen.notice
+    app = explorer_app("young_concrete_50_years")
+    size = app._view("base").code_creep.notional_size
+    size.value = None
+    assert app.screen.notice == ("Value not accepted: notional size h = 2A/u [mm]: a number "
+                                 "is needed (the box was empty); it stays 300"), \
+        app.screen.notice
+
+
 def test_a_load_slider_returns_to_its_range_after_a_large_value(explorer_app):
     """1e6 kN/m typed into the force box left the slider at 0 to 2e6 for good (a pixel
     ~3,000 kN/m), through undo and reset."""
