@@ -215,6 +215,7 @@ class Figures:
         self.jump_src: dict[str, ColumnDataSource] = {}
         self.history_fig = {}
         self._presenting = False
+        self._preview = False  # a dragged value's preview: the base without creep
         self._history_state = dict.fromkeys(QUANTITIES, "computed")
         self.history_line = {}
         self.history_cursor = {}
@@ -566,8 +567,18 @@ class Figures:
             return
         text = (f"q(x) at t = {days_text(t, years=False)}" if self._presenting
                 else f"Pressure q(x), t = {days_text(t)}")
+        if self._preview:
+            # the values of a preview are the base's without creep, whatever t is shown
+            text += ": preview" if self._presenting else ": preview, without creep"
         if self.q_fig.title.text != text:
             self.q_fig.title.text = text
+
+    def set_preview(self, on: bool) -> None:
+        """Whether the result drawn next is a preview of a dragged value (the base without
+        creep): the pressure plot's title says so beside its time."""
+        if self._preview != on:
+            self._preview = on
+            self._title_pressure()
 
     def set_presentation(self, on: bool) -> None:
         """Fonts a projector shows from the back of a room (ticks and labels of

@@ -168,9 +168,12 @@ def change_text(value: float, other: float) -> str:
     return "0 %" if change == 0 else f"{change:+.3g} %"
 
 
-def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) -> str:
+def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = (),
+                 preview: bool = False) -> str:
     """Values at the selected time: current, and each pin with the change to it (for
-    several punches, each punch's; pins compare results of one punch)."""
+    several punches, each punch's; pins compare results of one punch); ``preview``: the
+    values are a dragged value's preview (the base without creep), which the heading
+    says (it read "At t = 1000 days" over the values without creep)."""
     if view is None:
         return ""
     if view.several:
@@ -203,7 +206,8 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = ()) 
     force, moment = float(view.values["force"][index]), float(view.values["moment"][index])
     ecc = f"e = M/P = {moment / force:.4g} m" if force > 0 else "e = M/P undefined (P ≤ 0)"
     contact = html.escape(contact_text(view, index))
-    return (f"<div class='readout'><b>At t = {days_text(t)} after loading</b> · {ecc}"
+    said = " (preview, without creep)" if preview else ""
+    return (f"<div class='readout'><b>At t = {days_text(t)} after loading{said}</b> · {ecc}"
             # pins add two columns each: at 1024 px three pins' table is twice the box
             # wide, and its last columns were cut off with no way to reach them; its
             # scroll bar is always drawn (an overlay bar hid that it scrolls) and the
@@ -320,6 +324,7 @@ class ResultsView:
         """Show a new result at output time ``index`` (call inside ``pn.io.hold()``);
         ``preview``: a preview of a dragged value, which the status line says."""
         self.classical.disabled = view.several
+        self.figures.set_preview(preview)
         self.figures.show(view, index, self.pins.board.pins)
         self.contact_panes.update(view)
         if new_range:
@@ -336,8 +341,8 @@ class ResultsView:
         self.follow_time_span(view)
         with param.discard_events(self.screen):
             self.screen.time_index = index
-        self.show_time_texts(view, index)
         self._preview = view if preview else None
+        self.show_time_texts(view, index)
         self.status.object = status_html(view, self.busy.shown, self.evidence(view), preview)
         self.scene_badges.object = badges_html(view, "scene", self.evidence(view))
         self.pressure_badges.object = badges_html(view, "pressure", index=index)
@@ -402,7 +407,8 @@ class ResultsView:
         """The time label and the readout at output time ``index``."""
         self.time_label.object = (f"<span class='time-label'>t = "
                                   f"{days_text(float(view.times[index]))}</span>")
-        self.readout.object = readout_html(view, index, self.pins.board.pins)
+        self.readout.object = readout_html(view, index, self.pins.board.pins,
+                                           preview=self._preview is view)
         badges = badges_html(view, "pressure", index=index)
         if self.pressure_badges.object != badges:  # (a lift-off badge follows the time)
             self.pressure_badges.object = badges

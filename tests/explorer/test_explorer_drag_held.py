@@ -86,6 +86,10 @@ def test_a_creeping_base_previews_each_held_step_and_the_release_shows_creep_aga
         "Preview while you drag: solves with creep are too slow")
     assert "Preview (the base elastic at loading, without creep): Solved in" in \
         app.results.status.object
+    # the time's labels say so too (they read "At t = 1000 days" over values without
+    # creep: a teacher's audit)
+    assert app.figures.q_fig.title.text.endswith(": preview, without creep")
+    assert "after loading (preview, without creep)</b>" in app.results.readout.object
     # drawn at the time on screen; the result on screen (pins, downloads, the link) is
     # still the answer with creep
     assert not np.allclose(_pressure_line(app), drawn)
@@ -104,6 +108,8 @@ def test_a_creeping_base_previews_each_held_step_and_the_release_shows_creep_aga
     assert app.controller.view is not real and app.controller.preview is None
     assert app.screen.shown() is app.controller.view
     assert not app.results.held.visible and "Preview" not in app.results.status.object
+    assert "preview" not in app.figures.q_fig.title.text
+    assert "preview" not in app.results.readout.object
 
 
 def test_a_release_where_the_drag_began_shows_the_kept_answer_again(monkeypatch,
