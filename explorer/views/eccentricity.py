@@ -38,6 +38,8 @@ SLIDER_SPAN = 0.9
 #: When the slider cannot set the moment, and why.
 NOT_APPLICABLE = ("The eccentricity sets the moment when force and moment are given and "
                   "the force is a constant above zero.")
+#: What the greyed slider's note says while the force is not above zero.
+UNDEFINED = "e = M/P is undefined while the force P is not above zero."
 
 
 def lag_text(dragged: float, shown: float | None, cpu_seconds: float | None,
@@ -112,10 +114,18 @@ class EccentricityControl:
         a = self.state.punch.half_width
         self.slider.param.update(start=-SLIDER_SPAN * a, end=SLIDER_SPAN * a)
         e = self.eccentricity()
+        loading = self.state.loading
+        force = loading.histories["force"]
+        # a force typed <= 0 (refused at the solve) leaves e undefined for a moment: the
+        # slider stays in its place, greyed, so the boxes below do not move up under the
+        # next click (the moment box took a value meant for the force)
+        undefined = (e is None and loading.given == ("force", "moment")
+                     and force.kind == "constant")
         # not applicable: the note says why, without a dead slider taking the room
         self.slider.disabled = e is None
-        self.slider.visible = e is not None
-        self.note.object = "" if e is not None else NOT_APPLICABLE
+        self.slider.visible = e is not None or undefined
+        self.note.object = "" if e is not None else (UNDEFINED if undefined
+                                                     else NOT_APPLICABLE)
         self.note.visible = e is None
         if e is None:
             self.say_lag(None)

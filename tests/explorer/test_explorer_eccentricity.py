@@ -53,6 +53,20 @@ def test_the_slider_is_off_when_it_cannot_set_the_moment(explorer_app) -> None:
     assert "force and moment are given" in app.screen.notice
 
 
+def test_a_force_typed_at_zero_greys_the_slider_in_its_place(explorer_app) -> None:
+    """A force of 0 or less typed in the box took the eccentricity slider off, and the
+    moment box moved up where the force box had been: the next value typed for the force
+    went to the moment (a teacher's audit). The slider stays, greyed, and says why."""
+    app = explorer_app("uniform_flat", solved=True)
+    control = app.scene_tab.eccentric_load
+    app.state.loading.histories["force"].value = -100.0
+    assert control.slider.visible and control.slider.disabled
+    assert control.note.visible and "undefined while the force P is not above zero" in \
+        control.note.object
+    app.state.loading.histories["force"].value = 500.0
+    assert control.slider.visible and not control.slider.disabled and not control.note.visible
+
+
 def test_drag_steps_apply_at_once_only_while_solves_are_fast(monkeypatch, explorer_app) -> None:
     from explorer.views import eccentricity
 
