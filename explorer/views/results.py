@@ -432,9 +432,14 @@ class ResultsView:
             self.design.object = PREVIEW_DESIGN
             return
         # its verdict qualified by the flags the badges show (the FE check's measurement
-        # lowers beyond_model_map, which the check still named)
+        # lowers beyond_model_map, which the check still named); while the newest change
+        # is refused, of the last good result, said ("✓ all set limits hold" stood beside
+        # "Not solved" as if of the change)
+        about = ("of the last good result: the newest change was not solved"
+                 if self.controller.error else "")
         self.design.object = check_html(design_check(
-            view, self.limits, shown_flags(view, self.evidence(view)))) if view else ""
+            view, self.limits, shown_flags(view, self.evidence(view))), about=about) \
+            if view else ""
 
     def show_pins(self) -> None:
         """Draw the pins on the figures and in the readout (they changed)."""
@@ -498,6 +503,9 @@ class ResultsView:
                  else "There is no result to show yet: change the scene, or choose a preset.")
         self.alert.object = f"**Not solved:** {html.escape(error)}  \n{after}" if error else ""
         self.alert.visible = bool(error)
+        if bool(error) != getattr(self, "_refused", False):
+            self._refused = bool(error)
+            self.show_design()  # its heading says whose verdict it is
 
     def set_presentation(self, on: bool) -> None:
         """Projector fonts for the texts of the column (the figures set their own), and

@@ -643,3 +643,21 @@ def test_each_punch_of_several_is_checked_on_the_page_as_its_report_checks_it(
     text = app.results.design.object
     assert "Design check of punch 1" in text and "Design check of punch 2" in text
     assert "punches[0], centre x = 0 m" in text and "a limit is exceeded" in text
+
+
+def test_a_verdict_beside_a_refused_change_says_it_is_of_the_last_good_result(
+        explorer_app) -> None:
+    """A coating thickness of 0 refused ("Not solved"), then a limit entered: "✓ all set
+    limits hold" stood beside the refusal as if of the change (a teacher's audit). The
+    check's heading now says whose verdict it is, until a change is solved again."""
+    app = explorer_app(solved=True)
+    app.check_tab.allowable_pressure.value = 1e6
+    assert "all set limits hold" in app.results.design.object
+    assert "not solved" not in app.results.design.object
+    app.state.layers[0].thickness.mean = 0.0        # refused by the core
+    assert app.controller.wait(60) and app.controller.error
+    text = app.results.design.object
+    assert "of the last good result: the newest change was not solved" in text, text
+    app.state.layers[0].thickness.mean = 10.0
+    assert app.controller.wait(60) and app.controller.error == ""
+    assert "not solved" not in app.results.design.object
