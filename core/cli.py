@@ -47,6 +47,7 @@ import json
 import math
 import os
 import shutil
+import signal
 import sys
 from collections.abc import Iterator, Sequence
 from dataclasses import replace
@@ -1035,9 +1036,21 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Terminated(KeyboardInterrupt):
+    """A run asked to stop by SIGTERM: stopped as an interrupt is (a study's cluster
+    closed on the way out; it left "leaked semaphore objects" warnings and exit -15)."""
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    raise _Terminated
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line with ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
     global _MEMORY_BOUND, _MEMORY_ASKED
+    if argv is None:
+        # run as a program: SIGTERM stops it as Ctrl-C does (never a caller's handler)
+        signal.signal(signal.SIGTERM, _terminate)
     try:
         try:
             args = build_parser().parse_args(argv)
@@ -1059,6 +1072,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MissingDependency as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_SOLVER_FAILED
+    except _Terminated:
+        print("error: terminated", file=sys.stderr)
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130

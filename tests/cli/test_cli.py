@@ -529,3 +529,38 @@ def test_a_written_preset_is_not_overwritten_and_a_list_is_not_written(tmp_path:
     assert_one_line_error(run("preset", "-o", tmp_path / "list.json"),
                           "--output: give the preset to write")
     assert not (tmp_path / "list.json").exists()
+
+
+def test_a_run_stopped_by_sigterm_says_so_and_exits_as_the_shell_counts_it(tmp_path: Path):
+    """SIGTERM left a study's run with the multiprocessing "leaked semaphore objects"
+    warnings and exit -15; it now stops as Ctrl-C does: one line, exit 143 (a new user's
+    audit of the wheel). A solve that cannot finish within the test's patience stands in
+    for the study (its cluster is the same code path out)."""
+    import signal
+    import sys
+    import time
+
+    d = scene_file("eccentric_footing_liftoff")
+    d["punch"]["shape"] = {"kind": "sine", "mean": 0.0, "amplitude": 1e-5,
+                           "wavelength": 0.01, "phase": 0.0}   # runs for tens of seconds
+    path = tmp_path / "slow.json"
+    path.write_text(json.dumps(d))
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
+    child = subprocess.Popen([sys.executable, "-m", "core", "solve", str(path)], env=env,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def catches_sigterm() -> bool:
+        # the run's own handler is set (before it, SIGTERM ends the child at once)
+        with open(f"/proc/{child.pid}/status") as fh:
+            caught = next(line for line in fh if line.startswith("SigCgt:"))
+        return bool(int(caught.split()[1], 16) >> (signal.SIGTERM - 1) & 1)
+
+    deadline = time.monotonic() + 120
+    while not catches_sigterm():
+        assert child.poll() is None and time.monotonic() < deadline
+        time.sleep(0.05)
+    time.sleep(0.5)
+    child.send_signal(signal.SIGTERM)
+    out, err = child.communicate(timeout=60)
+    assert child.returncode == 143, (child.returncode, err)
+    assert err == "error: terminated\n", err
