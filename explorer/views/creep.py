@@ -57,9 +57,10 @@ def update_creep_figure(fig: Any, source: ColumnDataSource, state: CodeCreepStat
         return str(exc)
     source.data = data
     code = CODE_CREEP_MODELS[model or state.code_model]
-    # two lines: one ran past the 1024 px page's sidebar ("..., fib Model Code 2010, " and
-    # the age at loading cut off)
-    fig.title.text = f"Creep coefficient φ(t, t₀)\n{code}, t₀ = {days_text(age_at_loading)}"
+    # three lines: one ran past the 1024 px page's sidebar ("..., fib Model Code 2010, " and
+    # the age at loading cut off), and two cut Eurocode 2's ("... Annex B), t₀ = 28 day")
+    fig.title.text = (f"Creep coefficient φ(t, t₀)\n{code}\n"
+                      f"loaded at t₀ = {days_text(age_at_loading)}")
     return ""
 
 
