@@ -122,6 +122,37 @@ def short(text: str, limit: int = TITLE_CHARS) -> str:
     return head.rstrip(" ,;:") + "…"
 
 
+#: Longest line of the drawing's title in presentation mode [characters] (its 18 px
+#: font beside the inset of small features at 1024 px cut "..., step 2 of 3 (modifi"
+#: after 43).
+PRESENTING_TITLE_CHARS = 36
+
+
+def scene_title(name: str, presenting: bool = False) -> str:
+    """The drawing's title of a scene named ``name``: one line, or two of at most
+    :data:`TITLE_CHARS` characters of the name (:data:`PRESENTING_TITLE_CHARS` of the
+    title in presentation mode) each: a lesson step's "step 2 of 3" and a changed scene's
+    "(modified)" on the second, else the name split at the word that balances the lines
+    best, its end cut by :func:`short`."""
+    text = f"Scene: {' '.join(str(name).split())}"
+    limit = PRESENTING_TITLE_CHARS if presenting else len("Scene: ") + TITLE_CHARS
+    if len(text) <= limit:
+        return text
+    base = text.removesuffix(MODIFIED)
+    step = STEP_END.search(base)
+    if step:
+        tail = base[step.start():] + text[len(base):]
+        return f"{short(text[:len(text) - len(tail)], limit)}\n{tail.lstrip(', ')}"
+    spaces = [k for k, c in enumerate(base[:limit + 1]) if c == " " and k > len("Scene:")]
+    if not spaces:
+        return text[:limit - 1] + "…"  # no word ends on the first line
+    # the split nearest the middle whose second line fits whole, else the last one
+    fitting = [k for k in spaces if len(text) - k - 1 <= limit]
+    cut = min(fitting, key=lambda k: abs(2 * k - len(text))) if fitting else spaces[-1]
+    # the second line keeps a changed scene's " (modified)"
+    return f"{text[:cut]}\n{short(text[cut + 1:], limit)}"
+
+
 class Figures:
     """All figures of one session and the sources behind them."""
 
@@ -393,7 +424,8 @@ class Figures:
         if view.several:
             pins = ()  # pins compare results of one punch
         self.contact.show(view)
-        self.scene_fig.title.text = f"Scene: {short(view.scene.get('name', ''))}"
+        self._scene_name = str(view.scene.get("name", ""))
+        self._title_scene()
         self._show_image(view)
         self._label_strips(view)
         self._show_punch_histories(view)
@@ -573,6 +605,12 @@ class Figures:
         if self.q_fig.title.text != text:
             self.q_fig.title.text = text
 
+    def _title_scene(self) -> None:
+        """The drawing's title: the scene's name, on two lines where it is long."""
+        text = scene_title(getattr(self, "_scene_name", ""), self._presenting)
+        if self.scene_fig.title.text != text:
+            self.scene_fig.title.text = text
+
     def set_preview(self, on: bool) -> None:
         """Whether the result drawn next is a preview of a dragged value (the base without
         creep): the pressure plot's title says so beside its time."""
@@ -587,6 +625,8 @@ class Figures:
         for q in QUANTITIES:
             self._title_history(q)
         self._title_pressure()
+        if hasattr(self, "_scene_name"):
+            self._title_scene()
         tick, label, title = ((PRESENTATION_FONT, PRESENTATION_FONT, PRESENTATION_FONT)
                               if on else ("11px", "13px", "13px"))
         for fig in self.all_figures():

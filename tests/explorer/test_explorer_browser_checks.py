@@ -39,7 +39,7 @@ JS_TITLE_WIDTH = """(name) => {
   const fig = Bokeh.documents[0].get_model_by_name(name);
   const ctx = document.createElement('canvas').getContext('2d');
   ctx.font = 'bold 13px helvetica';
-  return ctx.measureText(fig.title.text).width;
+  return Math.max(...fig.title.text.split('\\n').map(l => ctx.measureText(l).width));
 }"""
 
 

@@ -96,7 +96,30 @@ def test_a_changed_scene_keeps_its_modified_in_the_drawing_s_title(explorer_app)
     app.state.loading.histories["force"].value *= 1.01
     assert app.controller.wait(120) and app.controller.error == "", app.controller.error
     title = app.figures.scene_fig.title.text
-    assert title == "Scene: Eccentric footing: from full… (modified)", title
+    assert title == "Scene: Eccentric footing: from full\ncontact to lift-off (modified)", title
+
+
+def test_a_long_scene_name_takes_two_lines_that_fit_in_presentation_mode() -> None:
+    """In presentation mode (18 px) the drawing's title beside the inset at 1024 px was
+    cut at "Scene: What a coating…, step 2 of 3 (modifi" (a teacher's audit); a long
+    name now takes two lines, a lesson's step and "(modified)" on the second, each line
+    within what fits, split where the lines balance."""
+    from explorer.model import presets
+    from explorer.plots.figures import PRESENTING_TITLE_CHARS, TITLE_CHARS, scene_title
+
+    assert scene_title("What a coating does to the edge pressure, step 2 of 3 (modified)",
+                       presenting=True) == ("Scene: What a coating does to the…\n"
+                                            "step 2 of 3 (modified)")
+    assert scene_title("Footing on young concrete, 50 years", presenting=True) == (
+        "Scene: Footing on young\nconcrete, 50 years")
+    assert scene_title("Uniform coating, flat punch") == "Scene: Uniform coating, flat punch"
+    assert scene_title("x" * 80) == "Scene: " + "x" * (TITLE_CHARS - 1) + "…"
+    for presenting, limit in ((False, len("Scene: ") + TITLE_CHARS),
+                              (True, PRESENTING_TITLE_CHARS)):
+        for scene in presets().values():
+            for name in (scene["name"], scene["name"] + " (modified)"):
+                lines = scene_title(name, presenting).split("\n")
+                assert len(lines) <= 2 and max(map(len, lines)) <= limit, lines
 
 
 def test_a_lessons_step_keeps_its_number_in_the_drawing_s_title() -> None:
