@@ -179,7 +179,7 @@ class FeatureInset:
                                     name="features_source")
         self.gap_area = p.varea(x="x", y1="surface", y2="punch", source=self.src,
                                 fill_color="#ffbb78", fill_alpha=0.6,
-                                legend_label="gap before loading")
+                                legend_label="initial gap")
         p.line(x="x", y="surface", source=self.src, line_color="#8c564b", line_width=2,
                legend_label="coating top")
         punch = p.line(x="x", y="punch", source=self.src, line_color="#333", line_width=2,
@@ -213,8 +213,9 @@ class FeatureInset:
         self.src.data = {"x": f32(g.x), "punch": f32(punch * 1e6),
                          "surface": f32(surface * 1e6)}
         # the size in the legend: a title longer than "Features [µm]" overflowed the
-        # inset's 220 px in presentation mode
-        label = fixed_label(f"gap before loading (≤ {float(np.max(gap)) * 1e6:.3g} µm)")
+        # inset's 220 px in presentation mode, and so did "gap before loading (≤ 25 µm)"
+        # under it, past the page's right edge at 1024 px
+        label = fixed_label(f"initial gap (≤ {float(np.max(gap)) * 1e6:.3g} µm)")
         for item in self.fig.legend[0].items:
             if self.gap_area in item.renderers and item.label != label:
                 item.label = label
