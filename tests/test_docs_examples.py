@@ -46,11 +46,16 @@ def _blocks() -> list[tuple[str, str, str]]:
 
 
 BLOCKS = _blocks()
+#: The blocks run here.
+RUN = [(name, code) for name, code, why in BLOCKS if not why]
 
 
 def test_the_pages_have_their_examples():
     assert len(BLOCKS) >= 15, [b[0] for b in BLOCKS]
-    assert sum(not why for _, _, why in BLOCKS) >= 12
+    assert len(RUN) >= 12
+    # left out: one sketch (the method's kernel interface) and the studies on a cluster
+    assert sorted(why for _, _, why in BLOCKS if why) == [
+        "a design study on a local cluster"] * 3 + ["a sketch"]
 
 
 def _users_files(folder: Path) -> None:
@@ -71,11 +76,9 @@ def _users_files(folder: Path) -> None:
     (folder / "readings.csv").write_text("time [day], settlement [mm]\n" + rows)
 
 
-@pytest.mark.parametrize(("code", "why"), [b[1:] for b in BLOCKS], ids=[b[0] for b in BLOCKS])
-def test_each_example_runs_as_written(code: str, why: str, tmp_path: Path,
+@pytest.mark.parametrize("code", [code for _, code in RUN], ids=[name for name, _ in RUN])
+def test_each_example_runs_as_written(code: str, tmp_path: Path,
                                       monkeypatch: pytest.MonkeyPatch) -> None:
-    if why:
-        pytest.skip(f"not run here: {why}")
     monkeypatch.chdir(tmp_path)
     if "scene.json" in code or "readings.csv" in code:
         _users_files(tmp_path)
