@@ -85,6 +85,8 @@ LEGEND_ROW = 22
 
 #: Font size of ticks, axis labels and titles in presentation mode (a projector).
 PRESENTATION_FONT = "18px"
+#: The colour bars' ticks and titles in presentation mode.
+PRESENTATION_BAR_FONT = "14px"
 #: Ticks an axis aims at in presentation mode (Bokeh's default is 6).
 PRESENTATION_TICKS = 4
 #: ... on the y axis of a short plot (the histories, the contact width): three ticks of
@@ -648,6 +650,11 @@ class Figures:
             # hidden, not taken off: a toolbar put back (toolbar_location) made BokehJS
             # throw "cannot find a view for ToolbarPanel" as presentation mode ended
             fig.toolbar.visible = not on
+            # the colour bars' ticks and titles larger too (they stayed at 11 px), short
+            # of the axes' 18 px: six decades on a bar of ~130 px would touch
+            for bar in fig.select({"type": ColorBar}):
+                bar.major_label_text_font_size = PRESENTATION_BAR_FONT if on else "11px"
+                bar.title_text_font_size = PRESENTATION_BAR_FONT if on else "13px"
         legend = self.q_fig.legend[0]
         legend.label_text_font_size = "11px" if on else LEGEND_FONT
         legend.glyph_width = 14 if on else 20

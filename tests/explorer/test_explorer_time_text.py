@@ -81,10 +81,19 @@ def test_presentation_mode_gives_short_plots_few_ticks_and_short_titles(explorer
     assert figures.history_fig["force"].title.text == "Force P: per punch"
     assert {fig.yaxis[0].ticker.desired_num_ticks for fig in short} == {3}
     assert figures.q_fig.yaxis[0].ticker.desired_num_ticks == 4     # tall: as before
+    # the colour bars' ticks and titles larger too (a teacher's audit found them at 11 px)
+    from bokeh.models import ColorBar
+
+    bars = [bar for fig in figures.all_figures() for bar in fig.select({"type": ColorBar})]
+    assert len(bars) >= 2  # the drawing's modulus, the q(x, t) map's pressure
+    assert {(b.major_label_text_font_size, b.title_text_font_size) for b in bars} == {
+        ("14px", "14px")}
     figures.set_presentation(False)
     assert figures.history_fig["settlement"].title.text == \
         "Settlement δ [mm]: computed, per punch"
     assert {fig.yaxis[0].ticker.desired_num_ticks for fig in short} == {6}
+    assert {(b.major_label_text_font_size, b.title_text_font_size) for b in bars} == {
+        ("11px", "13px")}
 
 
 def test_a_changed_scene_keeps_its_modified_in_the_drawing_s_title(explorer_app) -> None:
