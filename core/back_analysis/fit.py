@@ -339,6 +339,7 @@ def calibrate(scene: Scene | Mapping[str, Any] | str | os.PathLike,
     unresolved = _derivative_check(fields, first, other, sigma[mask, None] * model.steps(x),
                                    solution, readings, mask, float(work["solver"]["tol"]))
     warnings += unresolved
+    warnings += _flag_check(solution)
     unidentified = tuple(f.path for f in fields
                          if any(w.startswith(f.path + ":") or
                                 (w.startswith("not identifiable") and f.path in w)
@@ -384,6 +385,20 @@ def _split(vector: np.ndarray, readings: Readings) -> dict[str, np.ndarray]:
     """A stacked vector as one array per series."""
     m = readings.time.size
     return {name: vector[k * m:(k + 1) * m] for k, name in enumerate(readings.series)}
+
+
+def _flag_check(solution: Any) -> list[str]:
+    """A warning when the fitted scene's answer is flagged (its model does not hold, or
+    its numbers are doubtful there): settlements read in m where they were in mm fitted
+    a concrete of 17 MPa, flagged large_settlement and large_tilt, with no warning."""
+    flags = list(getattr(solution, "flags", ()))
+    if not flags:
+        return []
+    size = ({"large_settlement", "large_tilt"} & set(flags))
+    hint = (": readings in a wrong unit (mm read as m) fit such a scene; check them"
+            if size else "")
+    return [f"the fitted scene's answer is flagged {', '.join(flags)} (see the fitted "
+            f"scene's flags){hint}"]
 
 
 def _covariance(J: np.ndarray, s2: float) -> tuple[np.ndarray, float]:

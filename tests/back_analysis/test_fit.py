@@ -740,3 +740,21 @@ def test_one_field_the_readings_do_not_see_is_said_in_words_for_one() -> None:
             "number") in text and "add readings that depend on it" in text
     assert "combination" not in text and "fix all but one" not in text
     assert "the fit meets every reading exactly" in text and "inf of the noise" not in text
+
+
+def test_a_fit_to_a_scene_its_model_does_not_hold_for_warns() -> None:
+    """Settlements given in m where they were in mm (0.0727 for 0.0727 mm) fitted the
+    preset's concrete to ~17 MPa, an answer flagged large_settlement and large_tilt, and
+    the fit carried no warning (an audit). It now says the fitted scene is flagged, and
+    what most likely did it; readings in their unit fit with no such warning."""
+    from core.back_analysis import readings_from_csv
+
+    scene = core.load_scene("preset:eccentric_creep")
+    rows = "30, 0.0727\n100, 0.0827\n300, 0.0841\n1000, 0.0841\n"
+    good = calibrate(scene, readings_from_csv("time [day], settlement [mm]\n" + rows),
+                     fit=["base.creep.modulus_final"])
+    assert not any("flagged" in w for w in good.warnings), good.warnings
+    wrong = calibrate(scene, readings_from_csv("time [day], settlement [m]\n" + rows),
+                      fit=["base.creep.modulus_final"])
+    (warning,) = [w for w in wrong.warnings if "fitted scene's answer is flagged" in w]
+    assert "large_settlement" in warning and "wrong unit (mm read as m)" in warning, warning
