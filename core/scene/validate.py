@@ -395,9 +395,11 @@ def _check_base_modulus(scene: Scene, e0: float) -> None:
     if low <= e0 <= high:
         return
     creep = scene._data["base"]["creep"]
-    # a design-code law gives E0 by its strength class, not by a modulus field
-    field = ("base.creep.modulus" if isinstance(creep, Mapping) and "modulus" in creep
-             else "base.creep")
+    # the creep model's modulus field (Arutyunyan's E0 is E_inf (1 - beta e^(-alpha
+    # tau0)): its modulus_final); a design-code law gives E0 by its strength class
+    names = [name for name in ("modulus", "modulus_final")
+             if isinstance(creep, Mapping) and name in creep]
+    field = f"base.creep.{names[0]}" if names else "base.creep"
     raise ValueError(f"{field}: the base's modulus at loading E0 is {e0:.6g} Pa, outside "
                      f"[{low:g}, {high:g}] Pa"
                      + _modulus_hint("must be >= " if e0 < low else "must be <= "))

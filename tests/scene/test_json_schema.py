@@ -117,6 +117,7 @@ PYTHON_ONLY_BAD_VALUES = {
     "base.creep=kernel not finite", "times=decreasing",
     # the base's modulus at loading, which most creep models derive from their fields
     "base.creep.modulus=30.0", "base.creep.modulus=300000000000000.0",
+    "base.creep=arutyunyan modulus",
 }
 
 
@@ -127,6 +128,8 @@ def _bad_value_id(path: str, value: Any) -> str:
     if path == "coating[0].thickness" and isinstance(value, dict) \
             and len(value["points"]) == 2:
         return f"{path}=table decreasing"
+    if path == "base.creep" and isinstance(value, dict) and "expr" not in value:
+        return f"{path}={value['model']} modulus"
     if path == "base.creep" and isinstance(value, dict):
         return f"{path}=kernel " + ("positive" if "exp" in value["expr"] else "not finite")
     if path == "times" and value[0] == 0.0:

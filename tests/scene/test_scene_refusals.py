@@ -31,6 +31,11 @@ BAD_VALUES: list[tuple[str, Any, str]] = [
                                  "Pa, outside [10000, 1e+13] Pa (moduli are in Pa"),
     ("base.creep.modulus", 3e14, "base.creep.modulus: the base's modulus at loading E0 is "
                                  "3e+14 Pa, outside [10000, 1e+13] Pa (stiffer than any"),
+    # Arutyunyan's (the page's own creep model) by its modulus_final (it named base.creep)
+    ("base.creep", {"model": "arutyunyan", "modulus_final": 1e3, "beta": 0.5,
+                    "alpha": 0.03, "compliance_final": 9e-12, "aging": 4.8e-10,
+                    "rate": 0.03},
+     "base.creep.modulus_final: the base's modulus at loading E0 is"),
     ("base.thickness", 0.0, "base.thickness: must be > 0"),
     ("base.creep.modulus", -3e10, "base.creep.modulus: must be > 0"),
     ("coating[0].poisson", 0.5, "coating[0].poisson: must be < 0.5"),
