@@ -62,7 +62,7 @@ from core.files import (
     same_file,
     writable_target,
 )
-from core.limits import MAX_SCENE_DAYS, MAX_SCENE_TIMES
+from core.limits import MAX_SCENE_TIMES
 from core.optional import MissingDependency
 from core.presets import PRESET_PREFIX, preset_names, shipped_file, study_names
 from core.problem import QUANTITIES
@@ -707,6 +707,26 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _check_forecast_times(scene: Any, end: float, count: int) -> None:
+    """Refuse, before the fit, a forecast the scene cannot be solved to, named as typed:
+    its times as the scene's own (a design code's law is fitted for 100 years, any scene
+    for 100000 days), the refusal of ``times.end`` said of ``--forecast`` (it read
+    "times.end: must be <= ...", after the whole fit)."""
+    try:
+        data = scene.to_dict()
+    except AttributeError:  # (not a scene of one punch: the fit says what it takes)
+        return
+    data["times"] = {"end": end, "count": count, "spacing": "log"}
+    try:
+        scene_from_dict(data)
+    except ValueError as exc:
+        text = str(exc)
+        for field, option in (("times.end", "--forecast"), ("times.count", "--forecast-count"),
+                              ("times", "--forecast")):
+            if text.startswith(field + ":"):
+                raise _InputError(option + text[len(field):]) from None
+
+
 def _bounds(specs: Sequence[str], fit: Sequence[str]) -> dict[str, tuple[float | None,
                                                                          float | None]]:
     """``--bound PATH=LOW,HIGH`` options as a mapping (an empty end is no bound)."""
@@ -752,13 +772,11 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     # was left out without a word; -5 was refused as "times.end")
     if args.forecast is not None and not (math.isfinite(args.forecast) and args.forecast > 0):
         raise _InputError(f"--forecast: must be a number of days > 0, got {args.forecast:g}")
-    if args.forecast is not None and args.forecast > MAX_SCENE_DAYS:
-        # as a scene's times.end, but named as typed (it read "times.end: must be ...")
-        raise _InputError(f"--forecast: must be at most {MAX_SCENE_DAYS:g} days (about "
-                          f"{MAX_SCENE_DAYS / 365.25:.0f} years), got {args.forecast:g}")
     if not 1 <= args.forecast_count <= MAX_SCENE_TIMES:
         raise _InputError(f"--forecast-count: must be a whole number from 1 to "
                           f"{MAX_SCENE_TIMES}, got {args.forecast_count}")
+    if args.forecast is not None:
+        _check_forecast_times(scene, args.forecast, args.forecast_count)
     try:
         fit = calibrate(scene, readings, fit=args.fit, bounds=bounds)
         forecast = fit.forecast({"end": args.forecast, "count": args.forecast_count,

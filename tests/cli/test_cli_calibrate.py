@@ -86,8 +86,8 @@ def test_the_forecasts_options_are_named_as_typed(tmp_path: Path) -> None:
     cases = [(["--forecast", "0"], "error: --forecast: must be a number of days > 0, got 0"),
              (["--forecast", "-5"], "error: --forecast: must be a number of days > 0, got -5"),
              # a forecast past the latest time a scene takes read "times.end: ..."
-             (["--forecast", "1e9"], "error: --forecast: must be at most 100000 days "
-                                     "(about 274 years), got 1e+09"),
+             (["--forecast", "1e9"], "error: --forecast: must be <= 100000 days after "
+                                     "loading (about 274 years), got 1e+09"),
              (["--forecast", "100", "--forecast-count", "0"],
               "error: --forecast-count: must be a whole number from 1 to 2000, got 0")]
     for extra, said in cases:
@@ -96,6 +96,26 @@ def test_the_forecasts_options_are_named_as_typed(tmp_path: Path) -> None:
             code = main(["calibrate", str(scene), str(readings), "--fit", "loading.force",
                          *extra])
         assert code == EXIT_BAD_INPUT and err.getvalue().startswith(said), err.getvalue()
+
+
+def test_a_forecast_past_a_design_codes_span_is_refused_before_the_fit(tmp_path: Path
+                                                                         ) -> None:
+    """A design code's law is fitted for 100 years: --forecast 50000 on such a scene ran
+    the whole fit, then read "times.end: must be <= 36525 days" (a review)."""
+    from core.cli import main
+    from core.presets import read_preset
+
+    scene = tmp_path / "young.json"
+    scene.write_text(json.dumps(read_preset("young_concrete_50_years")))
+    readings = tmp_path / "r.csv"
+    readings.write_text("time [day], settlement [mm]\n30, 0.05\n100, 0.06\n")
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        code = main(["calibrate", str(scene), str(readings), "--fit",
+                     "base.creep.relative_humidity", "--forecast", "50000"])
+    assert code == EXIT_BAD_INPUT
+    assert err.getvalue().startswith("error: --forecast: must be <= 36525 days after "
+                                     "loading (100 years"), err.getvalue()
 
 
 def test_a_history_this_program_wrote_says_how_to_fit_it(tmp_path: Path) -> None:
