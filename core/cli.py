@@ -98,7 +98,7 @@ from core.scene import (
     verdict_words,
 )
 from core.version import VERSION
-from core.work import PER_CORE_BYTES, bound_memory
+from core.work import PER_CORE_BYTES, address_space_bound, bound_memory
 
 EXIT_OK = 0
 EXIT_SOLVER_FAILED = 1
@@ -149,11 +149,17 @@ def _one_line(text: str | BaseException) -> str:
         cores = os.cpu_count() or 1
         asked = (limits.MAX_RUN_MEMORY_BYTES / 2**30 if _MEMORY_ASKED is None
                  else _MEMORY_ASKED)
+        if _MEMORY_BOUND < address_space_bound(int(asked * 2**30)):
+            # a hard limit set outside (ulimit -Hv, a container) is lower: no option of
+            # this run raises it
+            why = ("the hard limit of this process's address space, set outside this "
+                   "program (ulimit -Hv or the container), lower than --max-memory asked")
+        else:
+            why = (f"--max-memory {asked:g} GiB plus {PER_CORE_BYTES / 2**20:g} MiB for "
+                   f"each of the {cores} cores; --max-memory GIB raises it, default "
+                   f"{limits.MAX_RUN_MEMORY_BYTES / 2**30:g}")
         text = (f"needed more than the {_MEMORY_BOUND / 2**30:.3g} GiB of memory this run "
-                f"may take (--max-memory {asked:g} GiB plus {PER_CORE_BYTES / 2**20:g} MiB "
-                f"for each of the {cores} cores; --max-memory GIB raises it, default "
-                f"{limits.MAX_RUN_MEMORY_BYTES / 2**30:g})"
-                + (f": {text}" if str(text) else ""))
+                f"may take ({why})" + (f": {text}" if str(text) else ""))
     return " ".join(str(text).split())
 
 

@@ -63,3 +63,30 @@ def test_a_run_called_from_python_leaves_its_caller_unbounded() -> None:
     done = run_cli("solve", "preset:uniform_flat", "--max-memory", "0.6")
     assert done.returncode == 0, done.stderr
     assert resource.getrlimit(resource.RLIMIT_AS) == before
+
+
+@pytest.mark.slow
+def test_a_bound_set_outside_is_not_explained_as_the_options(tmp_path: Path) -> None:
+    """Under a hard address-space limit set outside (ulimit -Hv, a container) lower than
+    --max-memory asks, the message explained the bound as "--max-memory X GiB plus ..."
+    and said the option raises it (a review); it now names the outside limit."""
+    import resource
+    import subprocess
+    import sys
+
+    from tests.cli_runs import ROOT
+
+    hard = int(0.75 * 2**30)
+
+    def lower_the_hard_limit() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (hard, hard))
+
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
+    done = subprocess.run([sys.executable, "-m", "core", "solve", str(_wavy_lift_off(tmp_path)),
+                           "--max-memory", "2", "-o", str(tmp_path / "out.json")],
+                          env=env, capture_output=True, text=True, timeout=120,
+                          preexec_fn=lower_the_hard_limit)
+    assert done.returncode == EXIT_SOLVER_FAILED, done.stderr
+    assert "the 0.75 GiB of memory this run may take (the hard limit of this process's " \
+           "address space, set outside this program" in done.stderr, done.stderr
+    assert "--max-memory GIB raises it" not in done.stderr
