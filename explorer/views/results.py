@@ -60,9 +60,15 @@ def lift_off_badge(view: ResultView, index: int | None = None) -> str:
         return ('<span class="cp-badge cp-bad lift-off">⚠ lift-off: part of the base '
                 'carries no load (shaded)</span>')
     when = np.asarray(view.times, dtype=float)[lifted]
-    span = days_text(float(when[0])) if when.size == 1 else \
-        f"{days_text(float(when[0]))} to {days_text(float(when[-1]))}"
-    return (f'<span class="cp-badge cp-bad lift-off lift-off-elsewhere">⚠ lift-off at t = '
+    first, last = days_text(float(when[0])), days_text(float(when[-1]))
+    runs = int(lifted[0]) + int(np.count_nonzero(lifted[1:] & ~lifted[:-1]))
+    if when.size == 1:
+        span = f"at t = {first}"
+    elif runs == 1:
+        span = f"at t = {first} to {last}"
+    else:  # lifted, in contact again, lifted: "0 to 1000 days" would take in the time shown
+        span = f"at {when.size} of {lifted.size} output times, first {first}, last {last}"
+    return (f'<span class="cp-badge cp-bad lift-off lift-off-elsewhere">⚠ lift-off '
             f'{html.escape(span)}: full contact at the time shown</span>')
 
 
@@ -127,8 +133,9 @@ SEVERAL_PUNCHES_NOTE = ("Several punches: pins, the classical solutions, the coa
                         "hold every punch.")
 
 
-def punches_readout_html(view: ResultView, index: int) -> str:
-    """Values of every punch of several at the selected time, a column per punch."""
+def punches_readout_html(view: ResultView, index: int, preview: bool = False) -> str:
+    """Values of every punch of several at the selected time, a column per punch
+    (``preview``: as :func:`readout_html`)."""
     t = float(view.times[index])
     head = "<tr><th></th>" + "".join(
         f"<th class='readout-punch-{k}' style='border-bottom:3px solid {PUNCH_COLORS[k]}'>"
@@ -149,8 +156,9 @@ def punches_readout_html(view: ResultView, index: int) -> str:
         for p in view.punches)
     rows.append(f"<tr><td>e = M/P</td>{eccs}</tr>")
     contact = html.escape(contact_text(view, index))
+    said = " (preview, without creep)" if preview else ""
     return (f"<div class='readout punches-readout'><b>At t = {days_text(t)} after loading"
-            f"</b> · each punch's moment and tilt about its own centre"
+            f"{said}</b> · each punch's moment and tilt about its own centre"
             f"<div class='readout-scroll'><table class='cp-readout'>{''.join(rows)}</table>"
             "</div>"
             f"<div class='contact-readout'>{contact}</div>"
@@ -177,7 +185,7 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = (),
     if view is None:
         return ""
     if view.several:
-        return punches_readout_html(view, index)
+        return punches_readout_html(view, index, preview)
     t = float(view.times[index])
     head = "<tr><th></th><th>current</th>"
     for k, pin in enumerate(pins):

@@ -197,6 +197,20 @@ def test_the_lift_off_badge_speaks_of_the_time_shown() -> None:
     last = float(np.asarray(view.times)[lifted][-1])
     assert (f"lift-off at t = 0 days to {days_text(last)}: full contact at the time "
             "shown") in late, late
+    # lifted, in contact, lifted again: no span that takes in the time shown (a review)
+    import dataclasses
+
+    times = np.asarray(view.times)
+    gap = int(np.argmax(~lifted))  # the first time in full contact
+    sets = [list(zones) for zones in view.contact_set]
+    sets[-1] = sets[0]  # the last time lifted as the first
+    again = dataclasses.replace(view, contact_set=sets)
+    relifted = lifted_times(again)
+    assert relifted[0] and not relifted[gap] and relifted[-1]
+    badge = badges_html(again, "pressure", index=gap)
+    assert (f"lift-off at {int(relifted.sum())} of {times.size} output times, first 0 days, "
+            f"last {days_text(float(times[-1]))}: full contact at the time shown") in badge, \
+        badge
 
 
 @pytest.mark.slow
@@ -385,3 +399,15 @@ def test_the_drawing_leaves_room_above_the_punches_for_the_load_labels(key: str)
     assert y.end - top >= 0.25 * (top - y.start) - 1e-12
     assert y.end - top >= 0.55 * max(p.half_width for p in view.punches) if view.punches \
         else y.end - top == pytest.approx(0.55 * view.geometry.half_width)
+
+
+def test_a_preview_of_several_punches_says_so_in_the_readout() -> None:
+    """The readout of several punches read "At t = ... after loading" over a preview's
+    values without creep (a review): it says it is a preview, as one punch's does."""
+    from explorer.views.results import readout_html
+
+    view = _solved("new_footing_beside_old")
+    assert view.several
+    shown = readout_html(view, len(view.times) - 1, preview=True)
+    assert "after loading (preview, without creep)</b>" in shown, shown
+    assert "preview" not in readout_html(view, len(view.times) - 1)
