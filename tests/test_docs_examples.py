@@ -8,7 +8,8 @@ namespace named ``__main__``. A block reading the user's own files (``scene.json
 ``readings.csv``) finds such files in its folder. Not run here: a block marked
 ``<!-- a sketch of the interface, not a script -->`` just above it, and the blocks that
 run a design study on a local cluster (~40 s each; the README's study example runs as a
-script in tests/test_readme.py, and they were run by hand as written).
+script in tests/test_readme.py, and they were run by hand as written): those are compiled,
+and every name they use must be imported or defined in them.
 """
 
 from __future__ import annotations
@@ -56,6 +57,19 @@ def test_the_pages_have_their_examples():
     # left out: one sketch (the method's kernel interface) and the studies on a cluster
     assert sorted(why for _, _, why in BLOCKS if why) == [
         "a design study on a local cluster"] * 3 + ["a sketch"]
+    # those on a cluster are Python at least, and name only what they import or define
+    # (a block used study_dict and my_dask_client, defined nowhere)
+    import builtins
+    import symtable
+
+    for name, code, why in BLOCKS:
+        if why != "a design study on a local cluster":
+            continue
+        table = symtable.symtable(code, name, "exec")
+        bound = {s.get_name() for s in table.get_symbols() if s.is_assigned()
+                 or s.is_imported()} | set(dir(builtins))
+        used = {s.get_name() for s in table.get_symbols() if s.is_referenced()}
+        assert used <= bound, (name, used - bound)
 
 
 def _users_files(folder: Path) -> None:
