@@ -112,16 +112,16 @@ def _modulus(spec: Any, path: str, domain: tuple[float, float]) -> Profile:
     try:
         return _profile(spec, path, "x", domain, lower=low, upper=high, inclusive=True)
     except ValueError as exc:
-        raise ValueError(f"{exc}{_modulus_hint(str(exc))}") from None
+        text = str(exc)
+        out = [below for below, rule in ((True, "must be >= "), (False, "must be <= "))
+               if rule in text]  # (neither: a value not finite)
+        raise ValueError(text + (_modulus_hint(out[0]) if out else "")) from None
 
 
-def _modulus_hint(message: str) -> str:
-    """What a modulus out of range most likely is, for its message."""
-    if "must be >= " in message:
-        return " (moduli are in Pa: 800 MPa is 8e8, 33 GPa is 3.3e10)"
-    if "must be <= " in message:
-        return " (stiffer than any material)"
-    return ""
+def _modulus_hint(below: bool) -> str:
+    """What a modulus below (``below``) or above the range most likely is."""
+    return (" (moduli are in Pa: 800 MPa is 8e8, 33 GPa is 3.3e10)" if below
+            else " (stiffer than any material)")
 
 
 def _validated(d: dict[str, Any]) -> Scene:
@@ -394,15 +394,18 @@ def _check_base_modulus(scene: Scene, e0: float) -> None:
     low, high = schema.MODULUS_RANGE
     if low <= e0 <= high:
         return
+    raise ValueError(f"{_base_modulus_field(scene)}: the base's modulus at loading E0 is "
+                     f"{e0:.6g} Pa, outside [{low:g}, {high:g}] Pa" + _modulus_hint(e0 < low))
+
+
+def _base_modulus_field(scene: Scene) -> str:
+    """The field that sets the base's modulus at loading: its creep model's ``modulus``,
+    or Arutyunyan's ``modulus_final`` (its E0 is E_inf (1 - beta e^(-alpha tau0))); a
+    design-code law gives E0 by its strength class: ``base.creep``."""
     creep = scene._data["base"]["creep"]
-    # the creep model's modulus field (Arutyunyan's E0 is E_inf (1 - beta e^(-alpha
-    # tau0)): its modulus_final); a design-code law gives E0 by its strength class
     names = [name for name in ("modulus", "modulus_final")
              if isinstance(creep, Mapping) and name in creep]
-    field = f"base.creep.{names[0]}" if names else "base.creep"
-    raise ValueError(f"{field}: the base's modulus at loading E0 is {e0:.6g} Pa, outside "
-                     f"[{low:g}, {high:g}] Pa"
-                     + _modulus_hint("must be >= " if e0 < low else "must be <= "))
+    return f"base.creep.{names[0]}" if names else "base.creep"
 
 
 #: Geometries (with E0 and nu) whose m* and g passed :func:`_check_coefficients`.
@@ -461,10 +464,7 @@ def _m_star_field(scene: Scene, x: float) -> str:
         if spread(h[k] / scene.half_width) > spread(e0 / e[k]):
             return f"coating[{k}].thickness"
         if spread(e0 / TYPICAL_MODULUS) > spread(e[k] / TYPICAL_MODULUS):
-            # a design-code law gives E0 by its strength class, not by a modulus field
-            creep = scene._data["base"]["creep"]
-            return ("base.creep.modulus" if isinstance(creep, Mapping) and "modulus" in creep
-                    else "base.creep")
+            return _base_modulus_field(scene)
         return f"coating[{k}].modulus"
 
 

@@ -256,6 +256,7 @@ class ResultsView:
         self.spinner = BusySpinner()
         self.status = html_pane("", sizing_mode="stretch_width", margin=(5, 5))
         self._evidence: tuple[tuple[int, int], dict[str, Any] | None] = ((0, 0), None)
+        self._refused = False  # a refusal on screen (the design check says so too)
         self._preview: ResultView | None = None  # the preview drawn, while it is
         self.busy = BusyIndicator(controller, loop, self.spinner, self.status,
                                   evidence=self.evidence, on_screen=self.on_screen)
@@ -353,7 +354,7 @@ class ResultsView:
         self.show_time_texts(view, index)
         self.status.object = status_html(view, self.busy.shown, self.evidence(view), preview)
         self.scene_badges.object = badges_html(view, "scene", self.evidence(view))
-        self.pressure_badges.object = badges_html(view, "pressure", index=index)
+        # (the pressure's badges with the time texts above: they follow the time shown)
         self.history_badges.object = badges_html(view, "history")
         self.status_badges.object = badges_html(view, "status")
         if self.time_axis.on:
@@ -511,7 +512,7 @@ class ResultsView:
                  else "There is no result to show yet: change the scene, or choose a preset.")
         self.alert.object = f"**Not solved:** {html.escape(error)}  \n{after}" if error else ""
         self.alert.visible = bool(error)
-        if bool(error) != getattr(self, "_refused", False):
+        if bool(error) != self._refused:
             self._refused = bool(error)
             self.show_design()  # its heading says whose verdict it is
 
