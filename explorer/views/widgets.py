@@ -665,6 +665,11 @@ def _refit(widget: pn.widgets.Widget, value: Any, default: tuple[float, float]) 
         _fit(widget, value, default)
 
 
+#: The number format of a history's value boxes (BokehJS's numbro: up to four decimals,
+#: trailing zeros dropped).
+HISTORY_FORMAT = "0.[0000]"
+
+
 class HistoryEditor:
     """Shape and parameters of the history of one given quantity (live while dragging)."""
 
@@ -675,11 +680,13 @@ class HistoryEditor:
         self.title = pn.pane.HTML("", margin=(8, 10, 0, 10))
         self.kind = self.binding.add("kind", pn.widgets.Select(
             label="history", options=HISTORY_KINDS, sizing_mode="stretch_width"))
-        self.value = self.binding.add("value", slider("value", 0.0, 1.0, 0.001, "0[.]0000",
+        # four decimals where a value needs them (a tilt in mrad), without trailing zeros:
+        # a typed moment of 777.48 read "777.4800" beside its readout's 777.48
+        self.value = self.binding.add("value", slider("value", 0.0, 1.0, 0.001, HISTORY_FORMAT,
                                                       css_classes=[f"{css}-value"] if css
                                                       else []), live=True)
         self.second = self.binding.add("second", slider("second", 0.0, 1.0, 0.001,
-                                                        "0[.]0000"), live=True)
+                                                        HISTORY_FORMAT), live=True)
         self.time = self.binding.add("time", slider("time [days]", 0.1, 365.0, 0.1, "0[.]0"),
                                      live=True)
         self.note = pn.pane.HTML("", margin=(0, 10), styles={"font-size": "12px",

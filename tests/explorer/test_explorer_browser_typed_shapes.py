@@ -1,5 +1,6 @@
 """Every slider of a shape or a profile variation takes a typed value (the crown radius,
-a patch's modulus, centre and width), in a real browser (Debian's Chromium).
+a patch's modulus, centre and width), and a load's box shows the value as typed, in a
+real browser (Debian's Chromium).
 
 These sliders once had no text box: a crown radius of 123.5 km or a patch 0.4 m wide
 could only be dragged to. The typed values are read back from the page's address link,
@@ -75,4 +76,18 @@ def test_a_patch_of_the_coating_modulus_is_typed(page: Page):
                     abs(s["coating"][0]["modulus"]["breaks"][0] - 0.05) < 1e-12,
                     "the typed patch in the link")
     assert scene["coating"][0]["modulus"]["values"][1] == pytest.approx(1.096e9, rel=1e-12)
+    assert page.errors == []
+
+
+def test_a_typed_moment_reads_as_typed_in_its_box(page: Page):
+    # the history boxes show up to four decimals (a tilt in mrad needs them): a moment of
+    # 777.48 kN m/m read "777.4800" in its box beside the readout's 777.48 (here 123.45
+    # kN m/m: the default force of 500 kN/m carries it within the base)
+    page.open_tab("Scene")
+    page.type_into(".load-1-value", "123.45")
+    box = page.page.locator(".load-1-value input").first
+    until(lambda: box.input_value() == "123.45", "123.45 in the moment's box", 60,
+          lambda: box.input_value())
+    _linked(page, lambda s: s["loading"].get("moment") == pytest.approx(123.45e3, rel=1e-12),
+            "the typed moment in the link")
     assert page.errors == []
