@@ -5,8 +5,9 @@ change asks for a solve. At most one solve per session runs at a time; requests 
 meanwhile collapse into one pending request (the newest), so a slider dragged through
 twenty values costs a handful of solves, not twenty. An outcome is shown only if no
 newer outcome has been shown already, so a slow old solve can never overwrite a newer
-answer. A rejected scene sets ``error`` (the core's message, naming the field) and leaves
-``view`` (the last good result) on screen.
+answer. A rejected scene sets ``error`` (the core's message, naming the field; the newest
+change's fault first, :func:`newest_fault`) and leaves ``view`` (the last good result) on
+screen.
 
 Previews (:meth:`SolveController.request_preview`): while a slider waits for its release
 (solves too slow to follow it), the page may ask for a cheaper scene of the dragged value
@@ -28,6 +29,7 @@ passes one that schedules on its Bokeh document); the default applies them at on
 
 from __future__ import annotations
 
+import copy
 import logging
 import re
 import threading
@@ -39,7 +41,7 @@ from typing import TYPE_CHECKING, Any
 
 import param
 
-from core import STAGE_CACHE_BYTES, solve
+from core import STAGE_CACHE_BYTES, scene_from_dict, solve
 from core.scene import creeps, elastic_at_loading
 from core.work import SolveCancelled
 
@@ -255,6 +257,114 @@ def format_error(message: str) -> str:
     return f"{words} ({path.strip()}):{reason}"
 
 
+#: At most this many values changed by one request are looked at on their own
+#: (:func:`newest_fault`): more (a preset, a file, an undo) is not one value typed.
+_NEWEST_CHANGES = 8
+
+
+def _changes(before: Any, now: Any, path: tuple = ()) -> list[tuple[tuple, Any]]:
+    """The values of the scene dict ``now`` that differ from ``before``: (path, value)
+    pairs, a path a tuple of keys and indices; a list whose length changed (a layer added)
+    is one value."""
+    if isinstance(before, dict) and isinstance(now, dict):
+        found: list[tuple[tuple, Any]] = []
+        for key in before.keys() | now.keys():
+            if key not in now:
+                return [(path, now)]
+            found += _changes(before.get(key, _MISSING), now[key], path + (key,))
+        return found
+    if isinstance(before, list) and isinstance(now, list) and len(before) == len(now):
+        found = []
+        for k, (old, new) in enumerate(zip(before, now, strict=True)):
+            found += _changes(old, new, path + (k,))
+        return found
+    return [] if before == now else [(path, now)]
+
+
+_MISSING = object()
+
+
+def _at(scene: Any, path: tuple) -> Any:
+    """The value at ``path`` in ``scene`` (``_MISSING`` where it has none)."""
+    for key in path:
+        try:
+            scene = scene[key]
+        except (KeyError, IndexError, TypeError):
+            return _MISSING
+    return scene
+
+
+def _with_changes(scene: dict[str, Any], changes: list[tuple[tuple, Any]]
+                  ) -> dict[str, Any] | None:
+    """``scene`` with ``changes`` (:func:`_changes`) made, or None where a path is not in
+    it (a layer that the scene has not)."""
+    out = copy.deepcopy(scene)
+    for path, value in changes:
+        if not path:
+            return None
+        target: Any = out
+        for key in path[:-1]:
+            try:
+                target = target[key]
+            except (KeyError, IndexError, TypeError):
+                return None
+        if isinstance(target, dict) or (isinstance(target, list)
+                                        and isinstance(path[-1], int)
+                                        and path[-1] < len(target)):
+            target[path[-1]] = copy.deepcopy(value)
+        else:
+            return None
+    return out
+
+
+def _refusal(scene: dict[str, Any] | None) -> str | None:
+    """The page's message of the core's refusal of ``scene`` (None where it is taken, or
+    not looked at)."""
+    if scene is None:
+        return None
+    try:
+        scene_from_dict(scene)
+    except ValueError as exc:
+        return format_error(str(exc))
+    except Exception:  # a courtesy: the refusal of the request stands alone
+        log.debug("scene not checked", exc_info=True)
+    return None
+
+
+def newest_fault(error: str, good: dict[str, Any] | None, before: dict[str, Any] | None,
+                 now: dict[str, Any] | None) -> str:
+    """The refusal ``error`` of the scene ``now`` (formatted, :func:`format_error`), with
+    the fault of the newest change first and the others still in the way after it.
+
+    The core checks a scene field by field and names the first field at fault: with a
+    coating 0 mm thick already refused, a base thickness of -1 m typed next read again
+    "coating thickness must be > 0", the value just typed not named; a Poisson ratio of
+    0.7 refused, then a coating typed 0 mm thick, named the coating alone. Here the values
+    changed from ``before`` (the scene asked before) to ``now`` are made on ``good`` (the
+    scene of the result on screen) alone, and undone on ``now``: the message names the
+    newest change's fault, then the fault of the rest.
+    """
+    if good is None or before is None or now is None:
+        return error
+    changes = _changes(before, now)
+    if not changes or len(changes) > _NEWEST_CHANGES:
+        return error
+    probe = _with_changes(good, changes)
+    newest = None if probe is None or probe == now else _refusal(probe)
+    # the others: the scene with the newest changes undone to the values on screen (not
+    # ``before``, whose fault the newest change may have mended)
+    undone = [(path, _at(good, path)) for path, _ in changes]
+    rest = None if any(v is _MISSING for _, v in undone) else _with_changes(now, undone)
+    faults: list[str] = []
+    for fault in (newest, error, _refusal(rest)):
+        if fault and fault not in faults:
+            faults.append(fault)
+    if len(faults) == 1:
+        return faults[0]
+    return (faults[0].rstrip(".") + ". Also still not accepted: "
+            + "; ".join(f.rstrip(".") for f in faults[1:]))
+
+
 def _reused(view: ResultView) -> ResultView:
     """A kept result as shown again: the same view, marked ``info["reused"]``."""
     return replace(view, info={**view.info, "reused": True})
@@ -312,6 +422,8 @@ class SolveController(param.Parameterized):
         self._preview_wanted: dict[str, Any] | None = None
         self._preview_running = False
         self._preview_generation = 0  # up by one at every request and stop_previews
+        # the scenes of the newest request and of the one before (newest_fault)
+        self._asked: tuple[dict[str, Any] | None, dict[str, Any] | None] = (None, None)
         if auto:
             state.param.watch(lambda event: self.request(), "revision")
 
@@ -333,9 +445,11 @@ class SolveController(param.Parameterized):
         try:
             scene = self.state.to_scene()
         except ValueError as exc:  # a state the screen cannot turn into a scene
+            self._ask(None)
             self.requests = rid
             self._deliver(rid, format_error(str(exc)))
             return rid
+        self._ask(scene)
         if self._executor is None:
             self.requests = rid
             self._deliver(rid, self._compute(scene))
@@ -367,6 +481,12 @@ class SolveController(param.Parameterized):
         if not queued:
             self._wait(rid, scene, sent)
         return rid
+
+    def _ask(self, scene: dict[str, Any] | None) -> None:
+        """Note the scene of a request (None: the state gave none), unless it is the one
+        asked last (a solve asked again)."""
+        if scene is None or scene != self._asked[1]:
+            self._asked = (self._asked[1], scene)
 
     def released(self) -> bool:
         """A slider was let go after a drag: the solve of a value dragged over, still
@@ -477,9 +597,13 @@ class SolveController(param.Parameterized):
             rid = self._latest
         self.requests = rid
         try:
-            outcome: ResultView | str = self._compute(self.state.to_scene())
+            scene = self.state.to_scene()
         except ValueError as exc:
-            outcome = format_error(str(exc))
+            self._ask(None)
+            outcome: ResultView | str = format_error(str(exc))
+        else:
+            self._ask(scene)
+            outcome = self._compute(scene)
         self._deliver(rid, outcome)
         return rid
 
@@ -645,6 +769,9 @@ class SolveController(param.Parameterized):
         with self._lock:
             latest = self._latest
         if isinstance(outcome, str):
+            if rid == latest and outcome:
+                outcome = newest_fault(outcome, None if self.view is None else self.view.scene,
+                                       *self._asked)
             self.param.update(error=outcome, busy=rid < latest, solves=self.solves + 1)
         else:
             self.param.update(view=outcome, error="", busy=rid < latest,

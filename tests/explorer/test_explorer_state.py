@@ -645,6 +645,39 @@ def test_scene_files_load_and_bad_files_explain_themselves(explorer_app):
     assert "punch.shape" in app.screen.notice and "line 2" in app.screen.notice
 
 
+def test_a_value_refused_beside_an_earlier_refusal_is_named_first(explorer_app):
+    """With a coating typed 0 mm thick (refused), a base thickness of -1 m typed next read
+    again "coating thickness must be > 0", the value just typed not named; and a Poisson
+    ratio of 0.7 then a coating of 0 mm named the coating alone. The newest value's fault
+    comes first, then the others still in the way; a mended one is no longer named."""
+    app = explorer_app()
+    coating, base = app._view("coating"), app._view("base")
+    thickness, poisson = coating.thickness_editor.mean._value_edit, base.base_poisson._value_edit
+    coating_fault = "Coating layer 1, thickness (coating[0].thickness): must be > 0"
+    base_fault = "Base, thickness (base.thickness): must be > 0 m, got -1 m"
+    poisson_fault = "Base, poisson (base.poisson): must be in (-1, 0.5), got 0.7"
+    thickness.value = 0.0
+    assert app.controller.error.startswith(coating_fault), app.controller.error
+    base.base_thickness._value_edit.value = -1.0
+    error = app.controller.error
+    assert error.startswith(base_fault + ". Also still not accepted: " + coating_fault), error
+    base.base_thickness._value_edit.value = 4.0     # the base mended: the coating alone
+    assert app.controller.error.startswith(coating_fault), app.controller.error
+    assert "Also" not in app.controller.error
+    thickness.value = 20.0
+    assert app.controller.error == ""
+    poisson.value = 0.7
+    assert app.controller.error == poisson_fault
+    thickness.value = 0.0
+    error = app.controller.error
+    assert error.startswith(coating_fault) and error.endswith(
+        "Also still not accepted: " + poisson_fault), error
+    thickness.value = 20.0                          # the coating mended: the ratio alone
+    assert app.controller.error == poisson_fault
+    poisson.value = 0.2
+    assert app.controller.error == "" and app.controller.view is not None
+
+
 def test_a_refusal_on_screen_ends_when_a_value_is_taken(explorer_app):
     """"Value not accepted: force P [kN/m]: a number is needed (the box was empty); it
     stays 500" stayed above the plots after 600 was typed and solved (and after an undo
