@@ -102,7 +102,7 @@ soak_pid=$!
 # (-W), so a renamed API, a broken docstring, a moved report or link, or a gallery example
 # that no longer runs fails the run. Always from an empty build directory: an incremental
 # build would not repeat the warnings of pages it skips. It runs beside the three parts
-# (~110 s of one core; measured in docs/conf.py's docstring). The pages stay in
+# (~35-110 s of one core, with the machine's speed; measured in docs/conf.py's docstring). The pages stay in
 # DOCS_BUILD_DIR (default ${TMPDIR:-/tmp}/coated-punch-docs, outside the source tree):
 # open index.html there.
 docs_dir="${DOCS_BUILD_DIR:-${TMPDIR:-/tmp}/coated-punch-docs}"

@@ -17,6 +17,7 @@ from typing import Any
 
 from generated_pages import write_if_changed
 from sphinx.application import Sphinx
+from sphinx.ext.autosummary import autosummary_toc
 from sphinx.pycode import ModuleAnalyzer
 from sphinx.util import logging
 
@@ -145,7 +146,31 @@ def generate(app: Sphinx) -> None:
     app.env.find_files(app.config, app.builder)
 
 
+#: Where autosummary writes the page of each function and class (its ``:toctree:``).
+STUBS = (OUT_DIR / "generated").as_posix()
+
+
+def off_the_tree(app: Sphinx, doctree: Any) -> None:
+    """Keep the page of each function and class out of the table of contents: reached
+    from its package's page (its table links it) and the search, not from the sidebar.
+
+    In the table of contents, the ~190 such pages made every page's sidebar list each of
+    them, and the theme builds that sidebar afresh for every page: ~60 % of the build's
+    time (cProfile, 237 pages), a list no reader scans. Each package page's hidden
+    toctree of them is taken out before the environment collects it (its collector runs
+    at priority 500), and the pages themselves are marked orphans (a page in no toctree
+    is otherwise a warning).
+    """
+    docname = app.env.docname
+    if docname.startswith(STUBS + "/"):
+        app.env.metadata[docname]["orphan"] = True
+    elif docname.startswith(OUT_DIR.as_posix() + "/"):
+        for node in list(doctree.findall(autosummary_toc)):
+            node.parent.remove(node)
+
+
 def setup(app: Sphinx) -> dict[str, Any]:
     # before autosummary (priority 500) makes the stub pages these pages ask for
     app.connect("builder-inited", generate, priority=400)
+    app.connect("doctree-read", off_the_tree, priority=400)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
