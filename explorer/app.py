@@ -391,13 +391,19 @@ class ExplorerApp(pn.viewable.Viewer):
         scene = self._scene_with(target, name, value)
         if scene is None:
             return
-        applied = self.state.to_scene()
+        try:
+            applied: dict[str, Any] | None = self.state.to_scene()
+        except ValueError:
+            # the value applied was refused (a crown radius of -3 km, its message on
+            # screen): the step away from it is previewed (it raised here, a traceback
+            # in the server's log)
+            applied = None
         if scene == applied:
             # back at the value applied (a release there may not even reach the server:
             # the browser sends only a changed value): the answer with creep again
             self.end_preview()
             return
-        if not self.controller.previews_differ(scene, applied):
+        if applied is not None and not self.controller.previews_differ(scene, applied):
             return  # a creep field alone (C∞, a rate): its preview would not move
         self._preview_scene = scene
         dragging, self._previewing = self._previewing, True

@@ -208,12 +208,15 @@ _BOX_UNITS = (
     (re.compile(r"(punches\[\d+\]\.)?coating\[\d+\]\.modulus"), "MPa", 1e6),
     (re.compile(r"base\.creep\.modulus(_final)?"), "GPa", 1e9),
     (re.compile(r"base\.thickness|(punches\[\d+\]\.)?(punch\.)?half_width"), "m", 1.0),
-    (re.compile(r"base\.age_at_loading"), "days", 1.0),
+    (re.compile(r"base\.age_at_loading|times\.(end|start)"), "days", 1.0),
+    # C∞ is typed in 1/GPa: "got -1e-09" read for a box showing -1
+    (re.compile(r"base\.creep\.compliance"), "1/GPa", 1e-9),
+    (re.compile(r"(punches\[\d+\]\.)?punch\.shape\.wavelength"), "m", 1.0),
 )
 #: A refused value in the core's messages: "got -3" or "is 0 Pa", then the end, a comma,
-#: a parenthesis or the place ("at x = ...").
+#: a colon, a parenthesis or the place ("at x = ...").
 _REFUSED_VALUE = re.compile(r"(\b(?:got|is) )(-?\d+(?:\.\d*)?(?:e[+-]?\d+)?)"
-                            r"(?: (?:Pa|m|days?))?(?=$|[,;)]| at | \()")
+                            r"(?: (?:Pa|m|days?))?(?=$|[,;:)]| at | \()")
 
 
 #: A bound of a refused value in the core's messages: "must be >= 10000", "<= 1e+13" or

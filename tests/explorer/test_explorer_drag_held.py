@@ -366,3 +366,21 @@ def test_a_release_after_a_drag_and_not_a_key_press_lets_the_released_value_go_f
     with param.edit_constant(control.slider):
         control.slider.value_throttled = e + 0.03
     assert calls == ["cancel", "cancel"]
+
+
+def test_a_drag_away_from_a_refused_value_is_previewed(monkeypatch, explorer_app) -> None:
+    # a crown radius of -3 km typed (refused, said on the page), then the slider dragged
+    # while solves were slow: the preview of the step raised ValueError (the state's own
+    # scene could not be made), a traceback in the server's log and no preview
+    from explorer import app as page
+
+    app = explorer_app("uniform_flat", solved=True)
+    app.state.punch.shape = "parabolic"
+    app.state.punch.radius = -3.0
+    assert "crown radius R must be > 0" in app.controller.error
+    monkeypatch.setitem(app.controller.view.info, "cpu_seconds", 3 * page.LIVE_SOLVE_S)
+    app.punch_tab.radius.widget.value = 20.0          # a drag step, held
+    assert app.state.punch.radius == -3.0
+    assert app.controller.preview is not None
+    assert app.controller.preview.scene["punch"]["shape"]["coefficients"][2] == \
+        pytest.approx(1.0 / (2.0 * 20e3))

@@ -390,6 +390,14 @@ def test_format_error_says_a_refused_value_in_the_unit_of_its_box():
                         ).endswith("E0 is 3e-08 GPa, outside [1e-05, 10000] GPa")
     assert format_error("base.age_at_loading: must be > 0, got -3").endswith("got -3 days")
     assert format_error("punch.half_width: must be > 0, got 0").endswith("got 0 m")
+    # C∞'s box is in 1/GPa (it read "got -1e-09" for a box showing -1); the time span's in
+    # days, the wavelength's in m (they read "got 0", "is 0")
+    assert format_error("base.creep.compliance: must be >= 0, got -1e-09: a negative value "
+                        "makes the compliance decrease in time, which is not creep"
+                        ).endswith("got -1 1/GPa: a negative value makes the compliance "
+                                   "decrease in time, which is not creep")
+    assert format_error("times.end: must be > 0, got 0").endswith("got 0 days")
+    assert format_error("punch.shape.wavelength: must be > 0, is 0").endswith("is 0 m")
 
 
 def test_format_error_names_the_field_in_words():
