@@ -178,7 +178,8 @@ def change_text(value: float, other: float) -> str:
 
 def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = (),
                  preview: bool = False) -> str:
-    """Values at the selected time: current, and each pin with the change to it (for
+    """Values at the selected time: current, and each pin with its change against the
+    current one (for
     several punches, each punch's; pins compare results of one punch); ``preview``: the
     values are a dragged value's preview (the base without creep), which the heading
     says (it read "At t = 1000 days" over the values without creep)."""
@@ -204,7 +205,10 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = (),
                f"<td class='readout-{q}'>{_fmt(value)}</td>")
         for k, (pinned, j) in enumerate(zip(others, times, strict=True)):
             other = float(pinned.display(q)[j])
-            change = change_text(value, other)
+            # the pin's value against the current one, under the pin's value: the
+            # current's against the pin's read as the pin's own change (a pin of 250
+            # kN/m beside 500 showed "+100 %", one of 750 "-33.3 %": a teacher's audit)
+            change = change_text(other, value)
             # the change under the value, not in a column of its own: five pins took
             # 875 px of a 653 px box at 1280 and their last columns were out of sight
             # (a teacher's audit); now 6 columns, not 11
@@ -222,8 +226,12 @@ def readout_html(view: ResultView | None, index: int, pins: Sequence[Pin] = (),
             # names stay in view while it scrolls
             f"<div class='readout-scroll'><table class='cp-readout'>{''.join(rows)}</table>"
             "</div>"
-            f"<div class='contact-readout'>{contact}</div></div>")
+            + (f"<div class='cp-status pins-note'>{PINS_NOTE}</div>" if pins else "")
+            + f"<div class='contact-readout'>{contact}</div></div>")
 
+
+#: What the percentages under the pins' values are.
+PINS_NOTE = "Under each pin: its value, and its change against the current one."
 
 
 #: Delay before a held drag is said on a served page [ms]: longer than from a key press's

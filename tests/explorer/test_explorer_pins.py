@@ -50,11 +50,13 @@ def test_pins_compare_several_results_and_go_one_by_one(explorer_app) -> None:
     assert [getattr(item.label, "value", item.label) for item in lines.legend_items[:3]] == [
         "P = 500 kN/m", "P = 600 kN/m", "P = 700 kN/m"]
     assert app.results.readout.object.count("pinned-settlement") == 3
-    # the settlement is linear in the force (elastic coating, linear creep): the
-    # readout's change against the 500 kN/m pin is +40 %, under the pin's value (five
-    # pins' 11 columns ran out of a 653 px box at 1280 px, a teacher's audit: 6 now)
+    # the settlement is linear in the force (elastic coating, linear creep): the 500
+    # kN/m pin's change against the current 700 is -28.6 %, under the pin's value (five
+    # pins' 11 columns ran out of a 653 px box at 1280 px, a teacher's audit: 6 now); it
+    # read +40 %, the current's change against the pin, which a teacher read as the pin's
     readout = app.results.readout.object
-    assert "<span class='cp-change'>+40 %</span>" in readout
+    assert "<span class='cp-change'>-28.6 %</span>" in readout
+    assert "its change against the current one" in readout
     assert ">change<" not in readout and readout.count("<th") == 2 + 3
     assert [b.label for b in app.pins.pin_list.objects] == [
         "✕ P = 500 kN/m", "✕ P = 600 kN/m", "✕ P = 700 kN/m"]
