@@ -10,7 +10,7 @@ import numpy as np
 import panel as pn
 import param
 
-from core.scene import days_text, number_text, percent_text
+from core.scene import creeps, days_text, number_text, percent_text
 
 from ..files import flag_message
 from ..model import (
@@ -115,11 +115,18 @@ def badges_html(view: ResultView | None, group: str,
     return "".join(parts)
 
 
-#: Said in place of the q(x, t) map and the histories of an answer at one output time.
+#: Said in place of the q(x, t) map and the histories of an answer at one output time,
+#: on a base that does not creep (:data:`ONCE_CREEP_NOTE` on one that does).
 ONCE_NOTE = ("<div class='once-note' style='font-size:13px;color:#444'>One output time "
              "({t}): the base answers at once (elastic) and holds that answer at every "
              "later time, so there is no history to draw. A creeping base, or more output "
              "times, draw the settlement, tilt and pressure over time.</div>")
+#: The same on a creeping base: its answer is that of the one time, creep included (the
+#: elastic words read beside a settlement 1.5 times the one at loading: an audit).
+ONCE_CREEP_NOTE = ("<div class='once-note' style='font-size:13px;color:#444'>One output "
+                   "time ({t}): the values are those at that time, creep since loading "
+                   "included; with one time there is no history to draw. More output "
+                   "times draw the settlement, tilt and pressure over time.</div>")
 #: The design check while a preview is on screen: no verdict on a history without creep
 #: (its largest settlement is the one at loading; the answer with creep comes on release).
 PREVIEW_DESIGN = ("<span class='cp-badge check-none design-preview'>design check on "
@@ -386,7 +393,8 @@ class ResultsView:
         for pane in (self.figures.image_fig, grid, self.log_time.__panel__()):
             if pane.visible != over_time:
                 pane.visible = over_time
-        note = "" if over_time else ONCE_NOTE.format(t=days_text(float(view.times[0])))
+        once = ONCE_CREEP_NOTE if creeps(view.scene) else ONCE_NOTE
+        note = "" if over_time else once.format(t=days_text(float(view.times[0])))
         if self.once_note.object != note:
             self.once_note.object = note
         if self.once_note.visible == over_time:

@@ -225,6 +225,18 @@ def test_an_answer_at_one_output_time_draws_no_history(explorer_app) -> None:
     assert results.history_grid.visible  # the pin has 40 output times
     app.pins.unpin()
     assert not results.history_grid.visible and results.once_note.visible
+    assert "answers at once (elastic)" in results.once_note.object
+
+
+def test_one_output_time_on_a_creeping_base_says_its_values_include_creep(explorer_app):
+    # the note read "the base answers at once (elastic) and holds that answer at every
+    # later time" beside a settlement at 1000 days 1.5 times the one at loading
+    app = explorer_app("eccentric_creep", solved=True)
+    app.state.time_count = 1
+    assert app.controller.wait(60) and app.controller.error == ""
+    note = app.results.once_note
+    assert note.visible and "creep since loading included" in note.object
+    assert "elastic" not in note.object
 
 
 def test_an_undo_in_a_lesson_shows_the_step_it_brings_back(explorer_app) -> None:
