@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from functools import cached_property, lru_cache
 from typing import TYPE_CHECKING, Any
 
@@ -30,6 +31,7 @@ from core.scene.display import (
     HISTORIES,
     answered_settings,
     corner_note,
+    days_text,
     html_summary,
     text_summary,
 )
@@ -595,13 +597,34 @@ def _check_finite(result: SceneSolution) -> None:
             message = str(result.info.get("message", ""))
             if "stopped at its limit" in message:
                 # the stepper gave up, which says nothing of double precision
+                said = _in_days(message.split("time stepping: ", 1)[-1],
+                                float(result.problem.age_at_loading))
                 raise ValueError(f"{_fastest_load(result.scene)}: the time stepping could "
-                                 "not follow the loads: "
-                                 + message.split("time stepping: ", 1)[-1])
+                                 "not follow the loads: " + said)
             raise ValueError(
                 f"scene: the computed {name} is not finite at t = {result.times[j]:.6g} days "
                 "after loading: the sizes in this scene (moduli, loads, lengths) are too far "
                 "apart for double precision")
+
+
+#: The stepper's "at t = 539.146 of 2609.93": its times are dimensionless.
+_STEPPED_TO = re.compile(r"at t = (\S+) of (\S+?):")
+
+
+def _in_days(message: str, age_at_loading: float) -> str:
+    """The stepper's ``message`` with its dimensionless times ``t = 1 + (age - tau0) /
+    tau0`` said in days after loading (it read "at t = 539.146 of 2609.93" over a span of
+    18262.5 days), without an estimate of the error of an answer not reached."""
+    def days(match: re.Match) -> str:
+        reached, end = ((float(match.group(k)) - 1.0) * age_at_loading for k in (1, 2))
+        return f"at {days_text(reached)} of {days_text(end)} after loading:"
+
+    # (no estimate of an answer not reached: "estimated error nan" said nothing)
+    message = re.sub(r" \(estimated error (?:nan|inf)\)", "", message)
+    try:
+        return _STEPPED_TO.sub(days, message)
+    except ValueError:
+        return message
 
 
 def _fastest_load(scene: Scene) -> str:

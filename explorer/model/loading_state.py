@@ -9,6 +9,7 @@ Nothing here imports Panel.
 from __future__ import annotations
 
 import copy
+from collections.abc import Callable
 from typing import Any
 
 import param
@@ -49,6 +50,11 @@ SINE_SHARE = 0.2
 #: the history had no "second" value: 0 took a force away at 10 days, which no contact
 #: carries with a moment left ("M = 120 kN·m/m with no force", an engineer's audit).
 STEP_FACTOR = 2.0
+#: At most this many periods of a sine chosen on the page over the time span (its period
+#: is lengthened to span / SINE_PERIODS where it had more): the page's 10 days over the
+#: 50-year preset, 1826 periods, ran 28 s into the time stepping's limit and was refused;
+#: 40 periods of 457 days there solve in 0.8 s (tol 1e-4).
+SINE_PERIODS = 40
 
 
 class HistoryState(param.Parameterized):
@@ -69,16 +75,31 @@ class HistoryState(param.Parameterized):
         self.quantity = quantity
         self.unit, self.scale = QUANTITY_UNITS[quantity]
         self._loading = False  # load_spec sets the history as a file gives it
+        #: the time span of the scene [days] (set by the state that holds the history)
+        self.span: Callable[[], float] = lambda: 365.0
+        # the kind whose meaning ``second`` has (None: none yet)
+        self._second_of: str | None = None
         self.param.watch(self._on_kind, "kind")
 
     def _on_kind(self, event: Any) -> None:
-        # a sine chosen on the page takes the "second" value it had, 0 from a constant:
-        # an amplitude of 0, a constant load (a teacher saw nothing change); it starts at
-        # SINE_SHARE of its mean instead (a file's sine keeps its own amplitude)
-        if event.new == "sine" and self.second == 0.0 and not self._loading:
-            self.second = SINE_SHARE * self.value
-        elif event.new == "step" and self.second == 0.0 and not self._loading:
-            self.second = STEP_FACTOR * self.value
+        """A kind chosen on the page starts from values that solve: ``second`` is a load
+        for a ramp (its start: 0) and a step (the value after it: STEP_FACTOR times the
+        one before), a departure for a sine (its amplitude: SINE_SHARE of its mean), so it
+        is set afresh where it meant something else. A sine once took the "after the
+        step" value of 1000 kN/m as its amplitude about 500 ("the punch is pulled away"),
+        and from a constant an amplitude of 0 (a teacher saw nothing change). A sine's
+        period is at most span / SINE_PERIODS. A file's history keeps its own values."""
+        new = event.new
+        if self._loading:
+            return  # (load_spec notes what ``second`` means)
+        if new not in ("ramp", "step", "sine") or new == self._second_of:
+            return
+        values: dict[str, float] = {"second": {"sine": SINE_SHARE, "step": STEP_FACTOR,
+                                               "ramp": 0.0}[new] * self.value}
+        if new == "sine" and self.time > 0 and self.span() / self.time > SINE_PERIODS:
+            values["time"] = float(f"{self.span() / SINE_PERIODS:.3g}")
+        self._second_of = new
+        self.param.update(**values)
 
     def to_spec(self) -> float | dict[str, Any]:
         if self.kind == "custom" and self.custom is not None:
@@ -101,6 +122,7 @@ class HistoryState(param.Parameterized):
             self.param.update(**values)
         finally:
             self._loading = False
+        self._second_of = self.kind if self.kind in ("ramp", "step", "sine") else None
 
 
 class LoadingState(param.Parameterized):

@@ -105,6 +105,9 @@ class ExplorerState(param.Parameterized):
         self.base = BaseState(name="base")
         self.loading = LoadingState(name="loading")
         self.punch_entries = [PunchEntryState(name=f"punches{k}") for k in range(SCREEN_PUNCHES)]
+        for loading in (self.loading, *(entry.loading for entry in self.punch_entries)):
+            for history in loading.histories.values():
+                history.span = self._span
         self._extra: dict[str, Any] = {}
         # name of the scene as loaded, while it is shown unchanged (see _rename_modified)
         self._loaded_name: str | None = None
@@ -191,6 +194,12 @@ class ExplorerState(param.Parameterized):
                 description=f"Changed on screen from the scene “{loaded}”.")
         finally:
             self._batch -= 1
+
+    def _span(self) -> float:
+        """The time span of the scene [days after loading]: its last output time."""
+        if self.time_list:
+            return float(max(self.time_list))
+        return float(self.time_end)
 
     def _on_times(self, *events: param.parameterized.Event) -> None:
         if not self._batch and self.time_list is not None:

@@ -761,6 +761,36 @@ def test_a_statement_chosen_on_the_page_starts_from_the_answer_on_screen(explore
                                    rtol=1e-6, atol=1e-12)
 
 
+def test_a_sine_chosen_after_a_step_starts_from_a_scene_that_solves(explorer_app):
+    """An audit: history "step" then "sine" took the value after the step (1000 kN/m)
+    as the sine's amplitude about 500 ("the punch is pulled away"); and on the 50-year
+    preset the sine's 10-day period (1826 periods) ran 28 s into the time stepping's
+    limit and was refused. A kind chosen on the page starts from its own values; a
+    sine's period is at most the span over SINE_PERIODS."""
+    from explorer.model.loading_state import SINE_PERIODS, SINE_SHARE, STEP_FACTOR
+
+    app = explorer_app()
+    force = app.state.loading.histories["force"]
+    force.kind = "step"
+    assert force.second == STEP_FACTOR * force.value == 1000.0
+    force.kind = "sine"
+    assert force.second == SINE_SHARE * force.value == 100.0 and force.time == 10.0
+    app.controller.solve_now()
+    assert app.controller.error == ""
+    force.kind = "ramp"                       # a ramp from nothing up to the force
+    assert force.second == 0.0
+    force.kind = "constant"
+    force.kind = "ramp"                       # back: its own values kept
+    assert force.second == 0.0
+    app.load_scene(json.loads(json.dumps(presets()["young_concrete_50_years"])))
+    force = app.state.loading.histories["force"]
+    force.kind = "sine"
+    assert force.time == pytest.approx(18262.5 / SINE_PERIODS, rel=1e-3)
+    app.controller.solve_now()
+    assert app.controller.error == "", app.controller.error
+    assert app.controller.view.scene["loading"]["force"]["kind"] == "sine"
+
+
 def test_a_step_chosen_on_the_page_starts_from_a_scene_that_solves(explorer_app):
     """An engineer's audit: choosing the force history "step" on the lift-off preset set
     "after the step 0 kN/m at 10 days", refused at once ("M = 480 kN·m/m with no

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -118,6 +119,11 @@ def test_the_step_limit_is_named_when_it_is_hit(monkeypatch):
                                          "faster") as info:
         solve(scene_from_dict(_sine_force(10.0)))
     assert "double precision" not in str(info.value)
+    # where it stopped, in days after loading (it read the stepper's dimensionless "at t =
+    # 539.146 of 2609.93" over a span of 18262.5 days)
+    reached = re.search(r"steps at ([\d.]+) days of 365 days after loading: ", str(info.value))
+    assert reached and 0.0 < float(reached.group(1)) < 365.0, str(info.value)
+    assert "nan" not in str(info.value)
 
 
 def test_output_times_and_pressure_points_are_bounded(monkeypatch):
