@@ -59,7 +59,14 @@ class BoundedUpload(pn.viewable.Viewer):
         self._clears.value += 1
 
     def _on_drop(self, event: Any) -> None:
-        for name, data in (event.new or {}).items():
+        # The dropper keeps every file dropped in one dict (a file removed on the page is
+        # not taken out of it), and the same name dropped again keeps its first place:
+        # a table dropped a second time, after another, read as that other one (an
+        # audit). Only the newest is in it now.
+        dropped = dict(event.new or {})
+        self._box.value.clear()
+        self._box.mime_type.clear()
+        for name, data in dropped.items():
             raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
             # the same file again is a new request (e.g. after fixing the scene on screen)
             self.param.update(filename=str(name)[:MAX_FILENAME_CHARS], value=None)

@@ -248,3 +248,28 @@ def test_an_empty_file_is_said_and_not_taken_for_the_one_before(explorer_app) ->
     app.punch_tab.shape_file.value = b""
     assert "punch.shape" in app.screen.notice and "empty" in app.screen.notice
     assert app.controller.view is shown and app.controller.error == ""
+
+
+def test_a_table_dropped_again_after_another_is_the_one_taken(explorer_app) -> None:
+    """The dropper keeps every file dropped in one dict, in the order first dropped: a
+    history table dropped a second time, after another, was read as that other one (the
+    page went on saying "Custom history from hist_nohdr.csv": an audit). The dropper's
+    own events (Panel's FileDropper._process_event, one chunk each) drive it here."""
+    from types import SimpleNamespace
+
+    app = explorer_app()
+    force = app.state.loading.histories["force"]
+    force.kind = "custom"
+    editor = app.scene_tab.history_editors[0]
+    dropper = editor.upload._box
+
+    def drop(name: str, text: str) -> None:
+        dropper._process_event(SimpleNamespace(event_name="upload_event", data={
+            "name": name, "chunk": 1, "total_chunks": 1, "type": "text/csv",
+            "data": text.encode()}))
+
+    drop("first.csv", "0,300000\n365,300000\n")
+    drop("second.csv", "0,400000\n365,400000\n")
+    drop("first.csv", "0,500000\n365,500000\n")     # the first name, dropped again
+    assert "from first.csv" in editor.note.object, editor.note.object
+    assert force.custom["points"] == [[0.0, 500000.0], [365.0, 500000.0]]
