@@ -82,7 +82,8 @@ def profile_from_csv(data: bytes | str, *, field: str, variable: str = "x",
     first = lines[0][1]
     separator = ";" if ";" in first else "," if "," in first else None
     first_cells = _split(first, separator)
-    if not first_cells or any(_cell_number(c) is None for c in first_cells):
+    header = not first_cells or any(_cell_number(c) is None for c in first_cells)
+    if header:
         lines = lines[1:]  # a header; later lines must all be data
         if lines:
             first = lines[0][1]
@@ -91,7 +92,16 @@ def profile_from_csv(data: bytes | str, *, field: str, variable: str = "x",
         raise ValueError(f"{field}: file has too many rows ({len(lines)}, at most "
                          f"{max_rows})")
     if len(lines) < 2:
-        raise ValueError(f"{field}: file needs at least 2 data rows, has {len(lines)}")
+        # a line of words after the header is named as such (two lines of words read
+        # "needs at least 2 data rows, has 1", which did not say what was wrong)
+        for n, line in lines:
+            for column, cell in enumerate(_split(line, separator), start=1):
+                if _cell_number(cell) is None:
+                    shown = cell if len(cell) <= 40 else cell[:40] + "..."
+                    raise ValueError(f"{field}: line {n}, column {column}: {shown!r} is "
+                                     "not a number")
+        said = " (its first line, not numbers, is read as a header)" if header else ""
+        raise ValueError(f"{field}: file needs at least 2 data rows, has {len(lines)}{said}")
 
     points: list[list[float]] = []
     for n, line in lines:

@@ -425,8 +425,13 @@ def test_csv_interpolation_and_variable() -> None:
     ("0,1\n1,0x10\n", "coating[0].modulus: line 2, column 2: '0x10' is not a number"),
     ("0,1\n1,1_0\n", "coating[0].modulus: line 2, column 2: '1_0' is not a number"),
     ("0,1\n\u0661,2\n", "coating[0].modulus: line 2, column 1: '\u0661' is not a number"),
-    ("x,E\n0,1\n", "coating[0].modulus: file needs at least 2 data rows, has 1"),
-    ("x,E\n", "coating[0].modulus: file needs at least 2 data rows, has 0"),
+    ("x,E\n0,1\n", "coating[0].modulus: file needs at least 2 data rows, has 1 (its first "
+                 "line, not numbers, is read as a header)"),
+    ("x,E\n", "coating[0].modulus: file needs at least 2 data rows, has 0 (its first line, "
+            "not numbers, is read as a header)"),
+    ("0,1\n", "coating[0].modulus: file needs at least 2 data rows, has 1"),
+    # two lines of words read "needs at least 2 data rows, has 1" (an audit)
+    ("hello world\nfoo\n", "coating[0].modulus: line 2, column 1: 'foo' is not a number"),
     ("", "coating[0].modulus: file is empty"),
     (" \n\n", "coating[0].modulus: file is empty"),
     ("0,1\n0.5,2\n0.5,3\n",
@@ -741,7 +746,7 @@ def test_uploaded_tables_have_limits_and_clear_errors() -> None:
     refused(b"x,f\n" + b"0,0\n" * 300_000, r"^punch\.shape: file is too large \(1200004 bytes")
     rows = "".join(f"{k / 20000},{k}\n" for k in range(10_001))
     refused(rows, r"^punch\.shape: file has too many rows \(10001, at most 10000\)")
-    refused(b"x,f\n0.1,1\n", r"^punch\.shape: file needs at least 2 data rows, has 1")
+    refused(b"x,f\n0.1,1\n", r"^punch\.shape: file needs at least 2 data rows, has 1 ")
     refused(b"x,f\n0.1,1\n0.2,=cmd|' /C calc'!A0\n", r"^punch\.shape: line 3, column 2: "
                                                    r"\"=cmd\|' /C calc'!A0\" is not a number")
     refused(b"x,f\n0.2,1\n0.1,2\n", r"^punch\.shape: x values must be strictly increasing "
