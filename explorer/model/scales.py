@@ -2,11 +2,12 @@
 
 A *scene family* is what the user loaded (a preset, a file, a link) and every edit made
 to it since. Within a family the pressure keeps one unit (kPa or MPa, chosen from the
-first result) and the q(x, t) image keeps one colour scale, widened (to a round number)
-when a result falls outside it: so that dragging a slider changes the colours, not the
-meaning of the colours, and a peak crossing 1 MPa does not relabel every axis. A result
-that fills less than :data:`SHRINK_BELOW` of the scale (a much softer change after a
-stiff one) gets its own scale again: a map drawn in one colour says nothing.
+first result) and the q(x, t) image keeps one colour scale, about the values of the
+results (round numbers), widened when a result falls outside it: so that dragging a
+slider changes the colours, not the meaning of the colours, and a peak crossing 1 MPa
+does not relabel every axis. A result that spans less than :data:`SHRINK_BELOW` of the
+scale (a much softer change after a stiff one, a nearly uniform pressure) gets its own
+scale again: a map drawn in one colour says nothing.
 Nothing here imports Panel or Bokeh.
 """
 
@@ -66,20 +67,40 @@ class DisplayScales:
         return self._unit
 
     def image_range(self, view: ResultView) -> tuple[float, float]:
-        """Colour range of q(x, t) [display unit]: round numbers that cover every result
-        of the family seen so far (zero included, so that lift-off reads at a glance),
-        narrowed to this result's own when it spans less than :data:`SHRINK_BELOW` of
-        them."""
+        """Colour range of q(x, t) [display unit]: round numbers about this result's
+        values (:func:`own_range`), widened to those of the family seen before while this
+        result spans at least :data:`SHRINK_BELOW` of them (a drag keeps its colours),
+        its own again where it spans less."""
         size = self.pressure_unit(view)[1]
         img = view.image
-        lo = float(np.nanmin(img)) / size if img.size else 0.0
-        hi = float(np.nanmax(img)) / size if img.size else 1.0
-        lo = -nice_ceiling(-lo) if lo < 0 else 0.0
-        hi = nice_ceiling(hi) if hi > 0 else 1.0
+        finite = img[np.isfinite(img)] / size if img.size else np.zeros(0)
+        lo, hi = own_range(float(finite.min()) if finite.size else 0.0,
+                           float(finite.max()) if finite.size else 1.0)
         if self._range is not None:
             old_lo, old_hi = self._range
-            extent = max(abs(lo), hi)
-            if extent >= SHRINK_BELOW * max(abs(old_lo), old_hi):
+            if hi - lo >= SHRINK_BELOW * (old_hi - old_lo):
                 lo, hi = min(lo, old_lo), max(hi, old_hi)
         self._range = (lo, hi)
         return self._range
+
+
+#: Colour steps of the q(x, t) scale over the values of one result (:func:`own_range`).
+COLOUR_STEPS = 5
+
+
+def own_range(lo: float, hi: float) -> tuple[float, float]:
+    """A colour range about the values ``lo`` to ``hi`` [display unit]: their ends
+    rounded out to a round step (1, 2, 2.5, 5 times a power of ten) of about a
+    :data:`COLOUR_STEPS`-th of their span. Zero is not forced in: a scale from 0 drew a
+    coating of five layers (235 to 292 kPa, on 0 to 500) in one colour; a lift-off has
+    q = 0 in it, its lowest colour."""
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return 0.0, 1.0
+    if hi - lo <= 1e-9 * max(abs(lo), abs(hi)):
+        # one value (a uniform pressure): a step about it
+        step = nice_ceiling(abs(hi) / COLOUR_STEPS) if hi else 1.0
+        return lo - step, hi + step
+    step = nice_ceiling((hi - lo) / COLOUR_STEPS)
+    low, high = math.floor(lo / step) * step, math.ceil(hi / step) * step
+    # (a pressure never below 0 keeps its scale there: no colour for "below zero")
+    return (max(low, 0.0) if lo >= 0.0 else low), high

@@ -17,7 +17,7 @@ import pytest
 
 from explorer.files import histories_csv, number, parse_csv, pressure_csv
 from explorer.model import MAX_NAME_CHARS, ExplorerState, presets
-from explorer.model.scales import DisplayScales, nice_ceiling
+from explorer.model.scales import DisplayScales, nice_ceiling, own_range
 from explorer.solving import SolveController
 from tests.cli_runs import run_cli
 
@@ -114,7 +114,29 @@ def test_one_pressure_unit_and_a_colour_scale_that_follows_the_results():
     assert scales.pressure_unit(low) == ("kPa", 1e3)
     huge = replace(low, pressure=low.pressure * 1000, image=low.image * 1000)
     assert scales.pressure_unit(huge) == ("MPa", 1e6)
-    assert scales.image_range(huge)[1] == nice_ceiling(float(huge.image.max()) / 1e6)
+    lo, hi = scales.image_range(huge)
+    assert (lo, hi) == own_range(float(huge.image.min()) / 1e6, float(huge.image.max()) / 1e6)
+    assert lo <= float(huge.image.min()) / 1e6 and float(huge.image.max()) / 1e6 <= hi
+
+
+def test_the_colour_scale_is_about_the_values_not_from_zero():
+    """A scale from 0 drew a coating of five layers (235 to 292 kPa on 0 to 500 kPa) in
+    one colour (an audit): the scale is about the values, in round steps; a lift-off
+    (q = 0 in it) starts at 0, and no pressure above 0 gets a colour below it."""
+    assert own_range(235.0, 292.0) == (220.0, 300.0)
+    assert own_range(194.0, 519.0) == (100.0, 600.0)
+    assert own_range(0.0, 1028.0) == (0.0, 1250.0)
+    assert own_range(3.0, 1028.0)[0] == 0.0
+    assert own_range(500.0, 500.0) == (400.0, 600.0)       # a uniform pressure
+    _, controller = solved()
+    view = controller.view
+    scales = DisplayScales()
+    unit = scales.pressure_unit(view)[1]
+    lo, hi = scales.image_range(view)
+    q_lo, q_hi = float(view.image.min()) / unit, float(view.image.max()) / unit
+    assert lo <= q_lo and q_hi <= hi
+    # the values fill most of the scale (they filled 40 % of one from 0)
+    assert (q_hi - q_lo) / (hi - lo) > 0.5, (lo, hi, q_lo, q_hi)
 
 
 def test_pressure_just_below_zero_within_the_error_band_is_not_shaded():
