@@ -340,3 +340,23 @@ def test_a_message_echoes_a_long_value_cut_short() -> None:
     message = str(info.value)
     assert message.startswith("scene: must be a JSON object, got PunchesScene(")
     assert message.endswith("...") and len(message) < 140, message
+
+
+def test_a_tol_past_double_precision_at_the_edges_is_not_met_not_a_crash():
+    """A base 91 times softer after creep (C = 3e-9 /Pa, E 30 GPa) at tol 1e-10 graded
+    the punch's edges ~30 times, panels of 1e-18 whose nodes were 1.0 itself: a raw
+    "LinAlgError: Array must not contain infs or NaNs" (a researcher's audit). The
+    grading stops before its nodes collapse: an answer flagged ``tol_not_met``."""
+    scene = {"schema_version": 1, "name": "soft after creep",
+             "punch": {"half_width": 1.0, "shape": 0.0},
+             "coating": [{"thickness": 0.015, "modulus": 4e8, "poisson": 0.35,
+                          "interface": "smooth"}],
+             "base": {"thickness": 6.0, "poisson": 0.2, "age_at_loading": 28.0,
+                      "creep": {"model": "exponential", "modulus": 3e10,
+                                "compliance": 3e-9, "rate": 0.05}},
+             "loading": {"force": 8e5, "moment": 1.2e5},
+             "times": {"end": 1000.0, "count": 20, "spacing": "log"},
+             "solver": {"tol": 1e-10}}
+    result = solve(scene_from_dict(scene))
+    assert not result.info["success"] and "tol_not_met" in result.flags
+    assert np.all(np.isfinite(result.settlement))

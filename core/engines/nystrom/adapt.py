@@ -138,6 +138,14 @@ def grade(edges: np.ndarray, singular: np.ndarray, levels: int, split: float = 0
     return np.unique(np.concatenate([edges, *new]))
 
 
+def collapsed(grid: NystromGrid) -> bool:
+    """Whether the grading went past what double precision resolves: nodes at a
+    singular point itself, a non-finite operator. A base 91 times softer after creep
+    asked tol 1e-10 of ~30 levels toward the edges, panels of 1e-18 whose nodes were 1.0
+    itself, and the modal form raised a bare LinAlgError (a researcher's audit)."""
+    return not bool(np.all(np.isfinite(grid.operator)))
+
+
 def _coarse_operator_at(coarse: NystromGrid, fine: NystromGrid, kept_new: np.ndarray,
                         kept_old: np.ndarray, fresh: np.ndarray, nodal: np.ndarray,
                         accuracy: float) -> np.ndarray:
@@ -194,6 +202,8 @@ class AdaptiveGrid:
     factor: NodalLU | DeferredFactor | None = None
     # (c_ref m + A)^-1 [1, x(, -g)] on ``grid``: the statement-1 responses the loop solved
     responses: np.ndarray | None = None
+    # the grading stopped where a finer one would collapse (:func:`collapsed`)
+    narrowest: bool = False
 
 
 def _remembering(f: Function) -> Function:
@@ -305,6 +315,7 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
     interior = float(np.max(tails))
     # 2. Grading toward +-1 and the jumps: two solves one level (h -> h/4) apart.
     estimate = np.inf
+    narrowest = False
     for _ in range(MAX_ROUNDS):
         rounds += 1
         fine_edges = grade(grid.panels.edges, singular, 1, LEVEL_SPLIT)
@@ -312,6 +323,9 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             resolved = False
             break
         fine = build_grid(lam, fine_edges, m, g, grid, accuracy)
+        if collapsed(fine):
+            resolved, narrowest = False, True
+            break
         # The coarse answer at the fine nodes: its nodal values where the panel is shared
         # (the Nystrom formula returns them there), the formula at the new nodes only.
         kept_new, kept_old, fresh = shared_panels(grid.panels, fine.panels)
@@ -352,8 +366,12 @@ def adapt(lam: float, m: Function, g: Function, g_is_zero: bool,
             if len(edges) - 1 > MAX_PANELS:
                 resolved = False
                 break
-            grid = build_grid(lam, edges, m, g, grid, accuracy)
+            finer = build_grid(lam, edges, m, g, grid, accuracy)
+            if collapsed(finer):
+                resolved, narrowest = False, True
+                break
+            grid = finer
             responses, factor = factored_responses(grid, c_ref, with_gap)
     estimate = max(estimate, ROUND_OFF)
     return AdaptiveGrid(grid, estimate, resolved and estimate <= target, rounds, c_ref,
-                        factor, responses)
+                        factor, responses, narrowest)

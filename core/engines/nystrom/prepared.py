@@ -147,6 +147,7 @@ class PreparedContact:
         self.grid = adaptive.grid
         self.spatial_error = adaptive.spatial_error
         self.resolved = adaptive.resolved
+        self.narrowest = adaptive.narrowest
         # LU of c m + A at the modulus the grid was refined at: the bordered system of a
         # statement at that c needs only a 2 x 2 Schur complement on top of it.
         self._factor_c, self._factor = adaptive.c_ref, adaptive.factor

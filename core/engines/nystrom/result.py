@@ -55,6 +55,7 @@ def nystrom_solution(prepared: Any, inputs: TimeInputs, scalars: dict[str, np.nd
     error = float(prepared.spatial_error + time_error)
     success = accepts(error, tol, SUCCESS_MARGIN) and prepared.resolved and time_side.ok
     flags = []
+    narrowest = getattr(prepared, "narrowest", False)
     if not prepared.resolved:
         flags.append("unresolved_input")
     if not success:
@@ -70,7 +71,15 @@ def nystrom_solution(prepared: Any, inputs: TimeInputs, scalars: dict[str, np.nd
                    f"({n} nodes, {grid.panels.n_panels} panels)")
     else:
         reasons = []
-        if prepared.spatial_error > tol or not prepared.resolved:
+        if narrowest:
+            # (the edges' grading runs out there whether tol is past what double
+            # precision gives, or an undeclared jump inside keeps the estimate up)
+            reasons.append("the grading toward the punch's edges and the jumps reached "
+                           "the narrowest panels double precision resolves, with estimated "
+                           "error "
+                           f"{prepared.spatial_error:.1e} in q: a tol no finer than that "
+                           f"can be met, unless {UNRESOLVED_ADVICE}")
+        elif prepared.spatial_error > tol or not prepared.resolved:
             reasons.append(f"the grid reached {grid.panels.n_panels} panels with "
                            f"estimated error {prepared.spatial_error:.1e} in q"
                            + ("" if prepared.resolved else f" ({UNRESOLVED_ADVICE})"))
