@@ -24,7 +24,8 @@ from core.validation import finite_number, show_value
 CHECKS: tuple[tuple[str, str, str, str], ...] = (
     ("allowable_pressure", "q_max", "Pa", "largest contact pressure q_max"),
     ("settlement_limit", "settlement", "m", "largest settlement δ (punch centre)"),
-    ("tilt_limit", "tilt", "rad", "largest tilt"),
+    # (the largest either way, its sign kept: "largest tilt -0.0094 mrad" puzzled a reader)
+    ("tilt_limit", "tilt", "rad", "largest tilt α (either way, signed)"),
 )
 
 

@@ -11,11 +11,12 @@ from .exports import (
     flag_message,
     histories_csv,
     number,
+    page_words,
     parse_csv,
     pressure_csv,
     project_version,
     study_csv,
 )
 
-__all__ = ["flag_message", "histories_csv", "MAX_PAGE_DOWNLOAD_BYTES", "number", "parse_csv",
-           "pressure_csv", "project_version", "study_csv"]
+__all__ = ["flag_message", "histories_csv", "MAX_PAGE_DOWNLOAD_BYTES", "number",
+           "page_words", "parse_csv", "pressure_csv", "project_version", "study_csv"]

@@ -90,16 +90,33 @@ def flag_lines(view: ResultView, evidence: Mapping[str, Any] | None = None) -> l
     message filled in; the measurement's words for ``model_error``)."""
     lines = []
     for flag in shown_flags(view, evidence):
-        text = (evidence["message"] if flag == "model_error" and evidence is not None
-                and evidence["source"] == "measured" else flag_message(view, flag))
+        text = (page_words(evidence["message"]) if flag == "model_error"
+                and evidence is not None and evidence["source"] == "measured"
+                else flag_message(view, flag))
         lines.append(f"{flag}: {text}")
     return lines
 
 
+#: The core's pointers to the command line, as the page says them (the coating model's
+#: badge read "check the coating model (coated-punch check)", a command a page user
+#: never sees).
+_PAGE_WORDS = (("coated-punch check, or the explorer's coating check",
+                "the Coating tab's FE check"),
+               ("coated-punch check", "the Coating tab's FE check"))
+
+
+def page_words(text: str) -> str:
+    """``text`` (a core message) with its pointers to the command line in the page's
+    words."""
+    for core_words, ours in _PAGE_WORDS:
+        text = text.replace(core_words, ours)
+    return text
+
+
 def flag_message(view: ResultView, flag: str) -> str:
-    """The explanation of ``flag``; the core's pointer to its report is replaced by the
-    report's own text, which the page and the files show."""
-    text = view.flag_messages.get(flag, flag)
+    """The explanation of ``flag``, in the page's words; the core's pointer to its report
+    is replaced by the report's own text, which the page and the files show."""
+    text = page_words(view.flag_messages.get(flag, flag))
     detail = str(view.info.get("message", "")).strip()
     if "see info.message" in text:
         text = text.replace("see info.message", detail or "no further detail").rstrip(".")

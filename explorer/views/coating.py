@@ -47,6 +47,13 @@ BARE_NOTE = ("<small>No coating: the punch presses the bare base, whose pressure
              "coating does.</small>")
 
 
+#: The tab's first line, with layers and without.
+TOP_NOTE = ("<small>Layer 1 touches the punch. Changes apply while you drag when solves are "
+            "quick, else when you release a slider.</small>")
+TOP_NOTE_BARE = ("<small>Changes apply while you drag when solves are quick, else when you "
+                 "release a slider.</small>")
+
+
 class CoatingView:
     """Widgets of ``state.layers``: thickness h(x), modulus E(x), Poisson ratio of each."""
 
@@ -85,14 +92,16 @@ class CoatingView:
         self.layer_note = html_pane("", styles=NOTE_STYLE)
         self.bare_note = html_pane(BARE_NOTE, styles=NOTE_STYLE, css_classes=["bare-note"])
         self.check = CoatingCheckView(state, controller, loop, screen)
+        # (said of the layers only while there are layers: "Layer 1 touches the punch"
+        # read above "no coating" at 0 layers)
+        self.top_note = html_pane(TOP_NOTE)
         s.param.watch(lambda *e: self.refresh(), "n_layers")
         self.refresh()
 
     def content(self) -> pn.Column:
         """The tab's column."""
         return pn.Column(
-            html_pane("<small>Layer 1 touches the punch. Changes apply while you drag "
-                      "when solves are quick, else when you release a slider.</small>"),
+            self.top_note,
             self.n_layers, self.bare_note, self.layer, self.layer_note,
             self.thickness_editor.panel,
             self.modulus_editor.panel, self.poisson_editor.panel,
@@ -108,6 +117,7 @@ class CoatingView:
         self.n_layers.value = shown
         bare = shown == 0
         self.bare_note.visible = bare
+        self.top_note.object = TOP_NOTE_BARE if bare else TOP_NOTE
         for part in self.layer_parts:
             part.visible = not bare
         if bare:

@@ -12,7 +12,7 @@ import param
 
 from core.scene import creeps, days_text, number_text, percent_text
 
-from ..files import flag_message
+from ..files import flag_message, page_words
 from ..model import (
     QUANTITIES,
     QUANTITY_UNITS,
@@ -103,7 +103,7 @@ def badges_html(view: ResultView | None, group: str,
             bad, good = (f"{word} ({evidence['label']} "
                          f"{percent_text(evidence['error'])}{of})" for word in (bad, good))
             if not view.punches:  # (several: the flag's message names the punches)
-                text = evidence["message"]
+                text = page_words(evidence["message"])
         if flag == "model_error" and "beyond_model_map" in flags:
             good = ""  # an extrapolated estimate vouches for nothing: its own badge says so
         if flag in flags:

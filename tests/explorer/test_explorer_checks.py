@@ -70,6 +70,14 @@ def test_a_flagged_result_leaves_with_its_flag_in_the_units_on_screen():
     assert meta["unit contact_width_m"].startswith("m, ")
     assert meta["unit lifted_length_m"].startswith("m, ")
     assert "WARNING" in meta and "solver.model_tol" in meta["flag model_error"]
+    # the page's words, not the command line's ("check the coating model (coated-punch
+    # check)", a command a page user never sees: an audit)
+    assert "coated-punch check" not in meta["flag model_error"]
+    assert "the Coating tab's FE check" in meta["flag model_error"]
+    from explorer.model import model_evidence
+    from explorer.views.results import badges_html
+    badges = badges_html(view, "scene", model_evidence(view, None))
+    assert "the Coating tab" in badges and "coated-punch check" not in badges
     assert "see info.message" not in histories_csv(view)
     assert np.all(table[:, 3] == 500.0)  # the preset's 5e5 N/m in kN/m, exactly
     # the columns are the plotted numbers to the digits written (10 significant)

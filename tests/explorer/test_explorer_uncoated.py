@@ -54,10 +54,12 @@ def test_the_coating_tab_hides_the_layer_widgets_with_no_layer(explorer_app):
     assert tab.n_layers.start == 0 and tab.n_layers.value == 0
     assert tab.bare_note.visible
     assert not any(part.visible for part in tab.layer_parts)
+    # (the tab's first line read "Layer 1 touches the punch" above "no coating")
+    assert "Layer 1" not in tab.top_note.object
     assert app.controller.view.geometry.thickness == []
     # one layer: its editors come back, the note goes
     app.state.n_layers = 1
-    assert not tab.bare_note.visible
+    assert not tab.bare_note.visible and "Layer 1 touches the punch" in tab.top_note.object
     assert all(part.visible for part in tab.layer_parts)
     assert tab.layer.options == ["1"]
     app.state.n_layers = 0

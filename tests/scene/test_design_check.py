@@ -133,6 +133,8 @@ def test_a_tilt_of_round_off_is_checked_and_said_as_zero() -> None:
     line = design_check(result).check("tilt")
     assert line.value == 0.0 and line.utilisation == 0.0
     assert line.value_text() == "0 rad at t = 1 day"
+    # the largest either way, signed: "largest tilt [mrad] -0.009397" puzzled a reader
+    assert line.label == "largest tilt α (either way, signed)"
     histories = without_round_off({"settlement": result.settlement, "tilt": result.tilt,
                                    "force": result.force, "moment": result.moment},
                                   result.scene.half_width)
