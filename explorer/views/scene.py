@@ -9,8 +9,10 @@ from typing import Any
 
 import panel as pn
 
+from core.scene import days_text, number_text
+
 from ..fixes import layout_batch
-from ..model import STATEMENTS, ExplorerState, SceneHistory, preset_label
+from ..model import QUANTITY_UNITS, STATEMENTS, ExplorerState, SceneHistory, preset_label
 from ..solving import SolveController
 from .eccentricity import EccentricityControl
 from .punches import OnePunchOnly
@@ -78,6 +80,11 @@ class SceneView:
         s.loading.param.watch(self.refresh, "statement")
         self.history_editors = (HistoryEditor("load-0", reject), HistoryEditor("load-1", reject))
         self.unknowns_note = html_pane("", styles={"font-size": "13px"})
+        # where the quantities a statement newly gives came from, until one is changed
+        self._taken = ""
+        for history in s.loading.histories.values():
+            history.param.watch(self._given_changed, ["value", "kind", "second", "time",
+                                                      "custom"])
         self.eccentric_load = EccentricityControl(state, controller, reject, drag)
         self.loading = OnePunchOnly(
             state, "This loading", self.statement, self.eccentric_load.panel,
@@ -145,11 +152,23 @@ class SceneView:
         if event.new == loading.statement:  # (the selector following the state)
             return
         view = self.controller.view
+        taken = []
         if view is not None and not view.several:
             for q in STATEMENTS[event.new]:
                 if q not in loading.given:
-                    loading.histories[q].param.update(
-                        kind="constant", value=float(view.display(q)[-1]), custom=None)
+                    value = float(view.display(q)[-1])
+                    loading.histories[q].param.update(kind="constant", value=value,
+                                                      custom=None)
+                    taken.append(f"{NAMES[q]} = {number_text(value, 5)} "
+                                 f"{QUANTITY_UNITS[q][0]}")
+        # said, as the loads it replaced are not brought back by switching back (force
+        # and moment 800 and 120 came back as 740.27 and 110.99 after three switches on
+        # a creeping base: an audit)
+        self._taken = ("" if not taken else
+                       f"Now given, held at the answer's values at "
+                       f"t = {days_text(float(view.times[-1]))}: {', '.join(taken)}. "
+                       "Under creep the answer then changes, and a switch back takes the "
+                       "values of that answer, not the loads given before.")
         loading.statement = event.new
 
     def refresh(self, *events: Any) -> None:
@@ -160,4 +179,13 @@ class SceneView:
         for editor, q in zip(self.history_editors, loading.given, strict=True):
             editor.bind(loading.histories[q], self.state.time_end)
         unknowns = " and ".join(NAMES[q] for q in loading.unknowns)
-        self.unknowns_note.object = f"Computed: <b>{unknowns}</b> (and the pressure)."
+        taken = ("" if not self._taken else "<br><small class='statement-taken'>"
+                 f"{html.escape(self._taken, quote=False)}</small>")
+        self.unknowns_note.object = f"Computed: <b>{unknowns}</b> (and the pressure).{taken}"
+
+    def _given_changed(self, *events: Any) -> None:
+        """A given load changed (typed, a file, another scene): what the last statement
+        took from the answer is no longer what is given."""
+        if self._taken:
+            self._taken = ""
+            self.refresh()

@@ -761,6 +761,21 @@ def test_a_statement_chosen_on_the_page_starts_from_the_answer_on_screen(explore
                                    rtol=1e-6, atol=1e-12)
 
 
+def test_a_statement_chosen_says_where_its_given_values_came_from(explorer_app):
+    """Switching the statement took the answer's values as the new given loads, silently:
+    force and moment 800 and 120 came back as 740.27 and 110.99 after three switches on
+    a creeping base (an audit). The page says what it took, until a given load changes."""
+    app = explorer_app("eccentric_creep", solved=True)
+    tab = app.scene_tab
+    tab.statement.value = "settlement + tilt given"
+    assert app.controller.wait(60)
+    note = tab.unknowns_note.object
+    assert "Now given, held at the answer's values at t = 1000 days" in note
+    assert "settlement δ = 0.087475 mm" in note and "a switch back takes" in note
+    app.state.loading.histories["settlement"].value = 0.09
+    assert "Now given" not in tab.unknowns_note.object
+
+
 def test_a_sine_chosen_after_a_step_starts_from_a_scene_that_solves(explorer_app):
     """An audit: history "step" then "sine" took the value after the step (1000 kN/m)
     as the sine's amplitude about 500 ("the punch is pulled away"); and on the 50-year
