@@ -82,9 +82,9 @@ class SceneView:
         self.unknowns_note = html_pane("", styles={"font-size": "13px"})
         # where the quantities a statement newly gives came from, until one is changed
         self._taken = ""
-        for history in s.loading.histories.values():
-            history.param.watch(self._given_changed, ["value", "kind", "second", "time",
-                                                      "custom"])
+        for load in s.loading.histories.values():
+            load.param.watch(self._given_changed, ["value", "kind", "second", "time",
+                                                   "custom"])
         self.eccentric_load = EccentricityControl(state, controller, reject, drag)
         self.loading = OnePunchOnly(
             state, "This loading", self.statement, self.eccentric_load.panel,
