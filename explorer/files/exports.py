@@ -102,7 +102,13 @@ def flag_lines(view: ResultView, evidence: Mapping[str, Any] | None = None) -> l
 #: never sees).
 _PAGE_WORDS = (("coated-punch check, or the explorer's coating check",
                 "the Coating tab's FE check"),
-               ("coated-punch check", "the Coating tab's FE check"))
+               ("coated-punch check", "the Coating tab's FE check"),
+               # the page has no breakpoints to give (its profiles declare theirs): a
+               # wavelength of 1e-9 m read "give the x of a jump or kink in breakpoints"
+               ("give the x of a jump or kink in breakpoints (a roughness finer than the "
+                "panels stays unresolved: a looser tol, or a smoother profile)",
+                "a roughness finer than the panels stays unresolved: a looser accuracy "
+                "target (Time tab), or a smoother or wider profile"))
 
 
 def page_words(text: str) -> str:

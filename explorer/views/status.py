@@ -15,6 +15,7 @@ from typing import Any
 
 from core.scene import percent_text
 
+from ..files import page_words
 from ..model import ResultView
 
 #: The validity badges of each plot group: flag -> (text when raised, text when the
@@ -123,7 +124,7 @@ def plain_status(view: ResultView) -> str:
         # digits enough to tell the two apart, and the solver's reason: an error of
         # 1.17e-8 read "1e-08, target 1e-08", and a lift-off answer misses where 3 x its
         # estimate is over tol
-        reason = missed_reason(str(info.get("message", "")))
+        reason = page_words(missed_reason(str(info.get("message", ""))))
         accuracy = (f"accuracy target NOT met: estimated error {_apart(err, tol)}, target "
                     f"{tol:g}" + (f"; {reason}" if reason else ""))
     else:

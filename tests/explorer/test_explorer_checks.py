@@ -691,3 +691,15 @@ def test_a_verdict_beside_a_refused_change_says_it_is_of_the_last_good_result(
     app.state.layers[0].thickness.mean = 10.0
     assert app.controller.wait(60) and app.controller.error == ""
     assert "not solved" not in app.results.design.object
+
+
+def test_the_solvers_advice_is_said_in_the_pages_words():
+    """A wavy base of wavelength 1e-9 m ended "give the x of a jump or kink in
+    breakpoints", a field the page does not have (its profiles declare their own)."""
+    from core.problem import UNRESOLVED_ADVICE
+    from explorer.files import page_words
+    from explorer.views.status import missed_reason
+
+    message = f"tol 1.0e-06 not met: the grid reached 128 panels ({UNRESOLVED_ADVICE})"
+    said = page_words(missed_reason(message))
+    assert "breakpoints" not in said and "a looser accuracy target (Time tab)" in said
