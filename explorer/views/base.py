@@ -27,7 +27,7 @@ class BaseView:
         bb = self.base
         self.base_thickness = bb.add("thickness", slider("thickness H [m]", 0.1, 20.0, 0.05,
                                                          "0[.]00", css_classes=["base-thickness"]))
-        self.base_poisson = bb.add("poisson", slider("Poisson ratio", 0.0, 0.49, 0.01))
+        self.base_poisson = bb.add("poisson", slider("Poisson ratio [-]", 0.0, 0.49, 0.01))
         self.base_modulus = bb.add("modulus", slider("Young's modulus E [GPa]", 0.1, 60.0, 0.1,
                                                      "0[.]0"))
         self.creep_model = bb.add("creep_model", pn.widgets.Select(

@@ -822,3 +822,15 @@ def test_a_step_chosen_on_the_page_starts_from_a_scene_that_solves(explorer_app)
     # a file's step keeps its own values (read, not chosen)
     force.load_spec({"kind": "step", "values": [8e5, 0.0], "breaks": [5.0]})
     assert force.second == 0.0
+
+
+def test_every_slider_of_the_base_and_the_coating_names_its_unit(explorer_app):
+    # the base's "Poisson ratio" had no "[-]" where the coating's had (an audit)
+    import panel as pn
+
+    app = explorer_app()
+    for tab in ("base", "coating"):
+        sliders = app._view(tab).content().select(pn.widgets.EditableFloatSlider)
+        assert sliders
+        for widget in sliders:
+            assert widget.name.endswith("]"), (tab, widget.name)
