@@ -1,0 +1,76 @@
+"""A run of the creep march's rule selection again, from the band width an earlier run
+chose, starts from that run's rule (core.contact.creep._select_rule).
+
+Its first candidate was built on the scene's base whatever width it started from, where
+the earlier run's rule of that width was on a halved one: a heel lifting off under strong
+creep (C = 1e-9 /Pa, tol 1e-6) was answered on panels twice as wide at the toe as the
+rule the first run had checked, q at x = +a 1.5e-6 off (against a reference graded four
+times finer there) with an estimate of 2.2e-7, success True. With the fix the answer is
+the first run's rule (1168 nodes) and q at the toe is 3.9e-7 off (a researcher's audit:
+a flat punch 2 m wide, 15 mm of coating at 400 MPa, 6 m of base at 30 GPa with C 1e-9
+/Pa and rate 0.05 /day, 800 kN/m and 500 kN m/m, 20 times to 1000 days). That solve takes
+14 s of CPU, so the logic is held here on a stand-in of the marches."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from core.contact.bands import BAND_WIDTHS
+from core.contact.creep import _select_rule
+
+
+class _Marches:
+    """Records the rules built; every check passes at once."""
+
+    def __init__(self) -> None:
+        self.built: list[tuple[object, float]] = []
+
+    def rule(self, res, bands, width):
+        self.built.append((res, width))
+        return (res, width)
+
+    @staticmethod
+    def halved(res):
+        return ("halved", res)
+
+    @staticmethod
+    def banded(bands) -> bool:
+        return bool(bands)
+
+    @staticmethod
+    def nodes(rule) -> int:
+        return 16
+
+    def run(self, rule, grid, widths, index, exact_ends=True, first=None):
+        return {}, {}
+
+    @staticmethod
+    def rule_distance(rule, out, finer, finer_out, bands):
+        return 0.0, 0.0
+
+
+def _first_rules(bands, start_width):
+    marches = _Marches()
+    _select_rule(marches, np.array([1.0, 2.0, 5.0]), "res", 4, 1e-6, 1e-6, bands=bands,
+                 start_width=start_width)
+    return marches.built[:2]
+
+
+def test_a_first_run_starts_on_the_scenes_base():
+    assert _first_rules([(0.4, 0.5)], BAND_WIDTHS[0]) == [
+        ("res", BAND_WIDTHS[0]), (("halved", "res"), BAND_WIDTHS[0] / 2)]
+
+
+def test_a_run_again_with_bands_starts_on_the_halved_base_as_the_first_run_chose():
+    # the first run's rules after its first candidate were all on the halved base, their
+    # checks too (with bands the base is halved once, the bands' panels then)
+    width = BAND_WIDTHS[2]
+    assert _first_rules([(0.4, 0.5)], width) == [
+        (("halved", "res"), width), (("halved", "res"), width / 2)]
+
+
+def test_a_run_again_without_bands_starts_on_the_base_halved_once_per_step():
+    width = BAND_WIDTHS[2]          # two steps from the first width
+    assert _first_rules([], width) == [
+        (("halved", ("halved", "res")), width),
+        (("halved", ("halved", ("halved", "res"))), width / 2)]
