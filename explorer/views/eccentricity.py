@@ -19,7 +19,7 @@ import panel as pn
 from ..model import ExplorerState, eccentricity
 from ..solving import SolveController
 from .style import NOTE_STYLE, html_pane
-from .widgets import _set_widget, slider, watch_release
+from .widgets import _set_widget, next_tick, slider, watch_release
 
 #: Drag steps of the slider are applied at once while the last solve took less than this
 #: [s] of CPU time; slower, the moment is set on release. The speed goal of a lift-off
@@ -189,7 +189,16 @@ class EccentricityControl:
 
     def apply(self, e: float | None) -> None:
         """Set the moment M = e P [kN·m/m] (constant) for the eccentricity ``e`` [m]."""
-        if self._syncing or e is None:
+        if self._syncing:
+            return
+        if e is None:
+            # the box emptied: said, and the box shows the eccentricity kept (it stayed
+            # blank, nothing said: an audit), as every other box does
+            kept = self.eccentricity()
+            if kept is not None:
+                self.reject(f"{self.slider.name}: a number is needed (the box was empty); "
+                            f"it stays {kept:g}")
+                next_tick(self.refresh)
             return
         if not self.applicable():
             self.reject(NOT_APPLICABLE)

@@ -728,6 +728,18 @@ def test_every_emptied_number_box_says_so(explorer_app):
         app.screen.notice
 
 
+def test_the_eccentricity_box_emptied_says_so_and_shows_the_value_kept(explorer_app):
+    # it stayed blank, nothing said (an audit), where every other box says so
+    app = explorer_app("eccentric_creep", solved=True)
+    eccentricity = app.scene_tab.eccentric_load.slider
+    eccentricity._value_edit.value = None
+    assert app.screen.notice == ("Value not accepted: eccentricity e = M/P [m] (sets the "
+                                 "moment): a number is needed (the box was empty); it stays "
+                                 "0.15"), app.screen.notice
+    assert eccentricity.value == 0.15
+    assert app.state.loading.histories["moment"].value == 120.0
+
+
 def test_a_load_slider_returns_to_its_range_after_a_large_value(explorer_app):
     """1e6 kN/m typed into the force box left the slider at 0 to 2e6 for good (a pixel
     ~3,000 kN/m), through undo and reset."""
