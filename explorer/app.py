@@ -390,6 +390,9 @@ class ExplorerApp(pn.viewable.Viewer):
         preview (:meth:`end_preview`)."""
         scene = self._scene_with(target, name, value)
         if scene is None:
+            # a value with no scene (back at a refused one): no preview of another value
+            # stays under it (the release there may not even reach the server)
+            self.end_preview()
             return
         try:
             applied: dict[str, Any] | None = self.state.to_scene()

@@ -77,28 +77,26 @@ class HistoryState(param.Parameterized):
         self._loading = False  # load_spec sets the history as a file gives it
         #: the time span of the scene [days] (set by the state that holds the history)
         self.span: Callable[[], float] = lambda: 365.0
-        # the kind whose meaning ``second`` has (None: none yet)
-        self._second_of: str | None = None
         self.param.watch(self._on_kind, "kind")
 
     def _on_kind(self, event: Any) -> None:
         """A kind chosen on the page starts from values that solve: ``second`` is a load
         for a ramp (its start: 0) and a step (the value after it: STEP_FACTOR times the
         one before), a departure for a sine (its amplitude: SINE_SHARE of its mean), so it
-        is set afresh where it meant something else. A sine once took the "after the
-        step" value of 1000 kN/m as its amplitude about 500 ("the punch is pulled away"),
-        and from a constant an amplitude of 0 (a teacher saw nothing change). A sine's
-        period is at most span / SINE_PERIODS. A file's history keeps its own values."""
+        is set afresh at every choice. A sine once took the "after the step" value of
+        1000 kN/m as its amplitude about 500 ("the punch is pulled away"), and from a
+        constant an amplitude of 0 (a teacher saw nothing change). A sine's period is at
+        most span / SINE_PERIODS. A file's history keeps its own values."""
         new = event.new
-        if self._loading:
-            return  # (load_spec notes what ``second`` means)
-        if new not in ("ramp", "step", "sine") or new == self._second_of:
+        if self._loading or new not in ("ramp", "step", "sine"):
             return
+        # (every choice afresh: a sine chosen again after a constant kept an amplitude of
+        # 100 about a mean typed down to 50, and a period of 10 days over a span widened
+        # to 50 years since: a review)
         values: dict[str, float] = {"second": {"sine": SINE_SHARE, "step": STEP_FACTOR,
                                                "ramp": 0.0}[new] * self.value}
         if new == "sine" and self.time > 0 and self.span() / self.time > SINE_PERIODS:
             values["time"] = float(f"{self.span() / SINE_PERIODS:.3g}")
-        self._second_of = new
         self.param.update(**values)
 
     def to_spec(self) -> float | dict[str, Any]:
@@ -122,7 +120,6 @@ class HistoryState(param.Parameterized):
             self.param.update(**values)
         finally:
             self._loading = False
-        self._second_of = self.kind if self.kind in ("ramp", "step", "sine") else None
 
 
 class LoadingState(param.Parameterized):

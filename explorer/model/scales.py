@@ -97,10 +97,17 @@ def own_range(lo: float, hi: float) -> tuple[float, float]:
     if not (math.isfinite(lo) and math.isfinite(hi)):
         return 0.0, 1.0
     if hi - lo <= 1e-9 * max(abs(lo), abs(hi)):
+        if hi == 0.0:
+            return 0.0, 1.0  # no pressure at all
         # one value (a uniform pressure): a step about it
-        step = nice_ceiling(abs(hi) / COLOUR_STEPS) if hi else 1.0
-        return lo - step, hi + step
-    step = nice_ceiling((hi - lo) / COLOUR_STEPS)
-    low, high = math.floor(lo / step) * step, math.ceil(hi / step) * step
+        step = nice_ceiling(abs(hi) / COLOUR_STEPS)
+        low, high = lo - step, hi + step
+    else:
+        step = nice_ceiling((hi - lo) / COLOUR_STEPS)
+        # (a value a rounding below a step's multiple is on it: 0.3 / 0.1 = 2.9999...)
+        low = math.floor(lo / step + 1e-9) * step
+        high = math.ceil(hi / step - 1e-9) * step
+    digits = max(0, 1 - math.floor(math.log10(step)))
+    low, high = round(low, digits), round(high, digits)
     # (a pressure never below 0 keeps its scale there: no colour for "below zero")
     return (max(low, 0.0) if lo >= 0.0 else low), high

@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING, Any
 import param
 
 from core import STAGE_CACHE_BYTES, scene_from_dict, solve
-from core.scene import creeps, elastic_at_loading
+from core.scene import creeps, elastic_at_loading, punches_from_dict
 from core.work import SolveCancelled
 
 from ..model import DesignLimits, ExplorerState, ResultView, prepare_view, scene_with_limits
@@ -210,7 +210,7 @@ _BOX_UNITS = (
     (re.compile(r"base\.thickness|(punches\[\d+\]\.)?(punch\.)?half_width"), "m", 1.0),
     (re.compile(r"base\.age_at_loading|times\.(end|start)"), "days", 1.0),
     # C∞ is typed in 1/GPa: "got -1e-09" read for a box showing -1
-    (re.compile(r"base\.creep\.compliance"), "1/GPa", 1e-9),
+    (re.compile(r"base\.creep\.compliance(_final)?"), "1/GPa", 1e-9),
     (re.compile(r"(punches\[\d+\]\.)?punch\.shape\.wavelength"), "m", 1.0),
 )
 #: A refused value in the core's messages: "got -3" or "is 0 Pa", then the end, a comma,
@@ -321,45 +321,84 @@ def _with_changes(scene: dict[str, Any], changes: list[tuple[tuple, Any]]
 
 
 def _refusal(scene: dict[str, Any] | None) -> str | None:
-    """The page's message of the core's refusal of ``scene`` (None where it is taken, or
-    not looked at)."""
+    """The core's refusal of ``scene`` as it raised it (``"field.path: reason"``; None
+    where it is taken, or not looked at)."""
     if scene is None:
         return None
     try:
-        scene_from_dict(scene)
+        (punches_from_dict if "punches" in scene else scene_from_dict)(scene)
     except ValueError as exc:
-        return format_error(str(exc))
+        return str(exc)
     except Exception:  # a courtesy: the refusal of the request stands alone
         log.debug("scene not checked", exc_info=True)
     return None
 
 
+#: A field path of the core's messages: ``coating[0].thickness`` -> its keys and indices.
+_PATH_PART = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
+
+
+def _path_of(message: str) -> tuple | None:
+    """The field path a core message names (``"coating[0].thickness: ..."``), as keys
+    and indices; None where it names none."""
+    path = message.partition(":")[0].strip()
+    if not path or " " in path:
+        return None
+    return tuple(int(index) if index else key for key, index in _PATH_PART.findall(path))
+
+
+def _related(path: tuple, paths: list[tuple]) -> bool:
+    """Whether ``path`` is one of ``paths``, inside one, or holds one."""
+    return any(path[:len(p)] == p or p[:len(path)] == path for p in paths)
+
+
+#: Older faults set aside at most, looking for the newest change's (:func:`newest_fault`).
+_OLDER_FAULTS = 4
+
+
 def newest_fault(error: str, good: dict[str, Any] | None, before: dict[str, Any] | None,
                  now: dict[str, Any] | None) -> str:
     """The refusal ``error`` of the scene ``now`` (formatted, :func:`format_error`), with
-    the fault of the newest change first and the others still in the way after it.
+    the fault of the newest change first and the one still in the way before it after.
 
     The core checks a scene field by field and names the first field at fault: with a
     coating 0 mm thick already refused, a base thickness of -1 m typed next read again
     "coating thickness must be > 0", the value just typed not named; a Poisson ratio of
     0.7 refused, then a coating typed 0 mm thick, named the coating alone. Here the values
-    changed from ``before`` (the scene asked before) to ``now`` are made on ``good`` (the
-    scene of the result on screen) alone, and undone on ``now``: the message names the
-    newest change's fault, then the fault of the rest.
+    changed from ``before`` (the scene asked before) to ``now`` are the newest; the older
+    faults the core names in ``now`` are set back to their values in ``good`` (the scene
+    of the result on screen), one at a time, until it names a newest value (its fault
+    comes first) or none (the newest values are taken). Values typed since ``good`` and
+    taken stay as typed (a time span's end typed, then its start, is not blamed on the
+    start). The fault of the rest (the newest values set back) follows.
     """
     if good is None or before is None or now is None:
         return error
     changes = _changes(before, now)
-    if not changes or len(changes) > _NEWEST_CHANGES:
+    newest_paths = [path for path, _ in changes if path]
+    if not newest_paths or len(changes) > _NEWEST_CHANGES:
         return error
-    probe = _with_changes(good, changes)
-    newest = None if probe is None or probe == now else _refusal(probe)
-    # the others: the scene with the newest changes undone to the values on screen (not
-    # ``before``, whose fault the newest change may have mended)
-    undone = [(path, _at(good, path)) for path, _ in changes]
-    rest = None if any(v is _MISSING for _, v in undone) else _with_changes(now, undone)
+    probe: dict[str, Any] | None = now
+    newest = None
+    for _ in range(_OLDER_FAULTS + 1):
+        fault = _refusal(probe)
+        path = None if fault is None else _path_of(fault)
+        if fault is None or path is None:
+            break
+        if _related(path, newest_paths):
+            newest = format_error(fault)
+            break
+        kept = _at(good, path)
+        if kept is _MISSING or probe is None:
+            break
+        probe = _with_changes(probe, [(path, kept)])
+    # the others: ``now`` with the newest values set back to those on screen (not
+    # ``before``, whose fault the newest value may have mended)
+    undone = [(path, _at(good, path)) for path in newest_paths]
+    rest = None if any(v is _MISSING for _, v in undone) else _refusal(
+        _with_changes(now, undone))
     faults: list[str] = []
-    for fault in (newest, error, _refusal(rest)):
+    for fault in (newest, error, None if rest is None else format_error(rest)):
         if fault and fault not in faults:
             faults.append(fault)
     if len(faults) == 1:

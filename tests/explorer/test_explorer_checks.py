@@ -136,6 +136,8 @@ def test_the_colour_scale_is_about_the_values_not_from_zero():
     assert own_range(0.0, 1028.0) == (0.0, 1250.0)
     assert own_range(3.0, 1028.0)[0] == 0.0
     assert own_range(500.0, 500.0) == (400.0, 600.0)       # a uniform pressure
+    assert own_range(0.0, 0.0) == (0.0, 1.0)               # none (it read -1 to 1)
+    assert own_range(0.3, 0.7) == (0.3, 0.7)               # (it read 0.2 to 0.70...01)
     _, controller = solved()
     view = controller.view
     scales = DisplayScales()

@@ -384,3 +384,5 @@ def test_a_drag_away_from_a_refused_value_is_previewed(monkeypatch, explorer_app
     assert app.controller.preview is not None
     assert app.controller.preview.scene["punch"]["shape"]["coefficients"][2] == \
         pytest.approx(1.0 / (2.0 * 20e3))
+    app.preview_step(app.state.punch, "radius", -3.0)  # back at the refused value
+    assert app.controller.preview is None and not app._previewing

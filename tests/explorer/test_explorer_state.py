@@ -400,6 +400,8 @@ def test_format_error_says_a_refused_value_in_the_unit_of_its_box():
                         "makes the compliance decrease in time, which is not creep"
                         ).endswith("got -1 1/GPa: a negative value makes the compliance "
                                    "decrease in time, which is not creep")
+    assert format_error("base.creep.compliance_final: must be >= 0, got -1e-09").endswith(
+        "got -1 1/GPa")                             # (Arutyunyan's C∞, the same box)
     assert format_error("times.end: must be > 0, got 0").endswith("got 0 days")
     assert format_error("punch.shape.wavelength: must be > 0, is 0").endswith("is 0 m")
 
@@ -686,8 +688,34 @@ def test_a_value_refused_beside_an_earlier_refusal_is_named_first(explorer_app):
         "Also still not accepted: " + poisson_fault), error
     thickness.value = 20.0                          # the coating mended: the ratio alone
     assert app.controller.error == poisson_fault
+    # values typed since the result on screen and taken stay as typed: an end of the time
+    # span typed, then a start past the old end, is not the start's fault (a review)
+    app.state.time_end = 5000.0
+    app.state.time_start = 1000.0
+    assert app.controller.error == poisson_fault, app.controller.error
     poisson.value = 0.2
     assert app.controller.error == "" and app.controller.view is not None
+
+
+def test_a_value_refused_on_a_scene_of_several_punches_is_named_first():
+    # the scene of several punches was checked as one of one punch, and every refusal
+    # read "Punches (punches): a scene of several punches is read by ..." (a review)
+    import copy
+
+    from core.scene import punches_from_dict
+    from explorer.solving.controller import newest_fault
+
+    good = presets()["new_footing_beside_old"]
+    before = copy.deepcopy(good)
+    before["base"]["poisson"] = 0.7
+    now = copy.deepcopy(before)
+    now["punches"][1]["half_width"] = -1.0
+    with pytest.raises(ValueError) as refused:
+        punches_from_dict(now)
+    error = format_error(str(refused.value))
+    assert newest_fault(error, good, before, now) == (
+        "Punch 2, half width (punches[1].half_width): must be > 0 m, got -1 m. Also still "
+        "not accepted: Base, poisson (base.poisson): must be in (-1, 0.5), got 0.7")
 
 
 def test_a_refusal_on_screen_ends_when_a_value_is_taken(explorer_app):
@@ -810,9 +838,12 @@ def test_a_sine_chosen_after_a_step_starts_from_a_scene_that_solves(explorer_app
     assert app.controller.error == ""
     force.kind = "ramp"                       # a ramp from nothing up to the force
     assert force.second == 0.0
+    # a sine chosen again after the force was typed lower starts from the new force (it
+    # kept an amplitude of 100 about 50: refused, a review)
     force.kind = "constant"
-    force.kind = "ramp"                       # back: its own values kept
-    assert force.second == 0.0
+    force.value = 50.0
+    force.kind = "sine"
+    assert force.second == SINE_SHARE * 50.0
     app.load_scene(json.loads(json.dumps(presets()["young_concrete_50_years"])))
     force = app.state.loading.histories["force"]
     force.kind = "sine"

@@ -74,11 +74,14 @@ def nystrom_solution(prepared: Any, inputs: TimeInputs, scalars: dict[str, np.nd
         if narrowest:
             # (the edges' grading runs out there whether tol is past what double
             # precision gives, or an undeclared jump inside keeps the estimate up)
-            reasons.append("the grading toward the punch's edges and the jumps reached "
-                           "the narrowest panels double precision resolves, with estimated "
-                           "error "
-                           f"{prepared.spatial_error:.1e} in q: a tol no finer than that "
-                           f"can be met, unless {UNRESOLVED_ADVICE}")
+            reasons.append(
+                "the grading toward the punch's edges and the jumps reached the narrowest "
+                "panels double precision resolves, "
+                + (f"with estimated error {prepared.spatial_error:.1e} in q: a tol no finer "
+                   "than that can be met"
+                   if np.isfinite(prepared.spatial_error) else
+                   "before an error of q could be estimated: a looser tol")
+                + f", unless {UNRESOLVED_ADVICE}")
         elif prepared.spatial_error > tol or not prepared.resolved:
             reasons.append(f"the grid reached {grid.panels.n_panels} panels with "
                            f"estimated error {prepared.spatial_error:.1e} in q"
