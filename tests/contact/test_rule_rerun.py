@@ -74,3 +74,28 @@ def test_a_run_again_without_bands_starts_on_the_base_halved_once_per_step():
     assert _first_rules([], width) == [
         (("halved", ("halved", "res")), width),
         (("halved", ("halved", ("halved", "res"))), width / 2)]
+
+
+class _Converging(_Marches):
+    """The checks fail until the candidate's band width is ``enough``."""
+
+    def __init__(self, enough: float) -> None:
+        super().__init__()
+        self.enough = enough
+
+    def rule_distance(self, rule, out, finer, finer_out, bands):
+        return (1.0, 1.0) if rule[1] > self.enough * (1 + 1e-9) else (0.0, 0.0)
+
+
+def test_a_run_again_starts_from_the_rule_the_first_run_chose():
+    # what the module's docstring says, end to end: the first run halves its band width
+    # until its check passes; a run from the width it chose starts from the same rule
+    for bands in ([(0.4, 0.5)], []):
+        first = _Converging(BAND_WIDTHS[2])
+        chosen, _, _, note = _select_rule(first, np.array([1.0, 2.0, 5.0]), "res", 4, 1e-6,
+                                          1e-6, bands=bands)
+        assert note["width"] == BAND_WIDTHS[2] and chosen[1] == BAND_WIDTHS[2]
+        again = _Converging(BAND_WIDTHS[2])
+        rerun, *_ = _select_rule(again, np.array([1.0, 2.0, 5.0]), "res", 4, 1e-6, 1e-6,
+                                 bands=bands, start_width=note["width"])
+        assert again.built[0] == chosen and rerun == chosen, bands
