@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 
+import numpy as np
 from bokeh.core.properties import value as fixed_label
 from bokeh.models import (
     ColorBar,
@@ -63,6 +64,10 @@ UNKNOWN_COLOR = "#1f77b4"
 #: the parts a unilateral solve lifted off (q = 0 there).
 LOST_LABEL = "q < 0 (contact lost)"
 LIFTED_LABEL = "lifted off (q = 0)"
+#: The marks at a rigid corner in contact on an exact layered coating or a bare base,
+#: where q rises without bound and the answer holds it from ``held_within_m`` on (the
+#: flat end of the line read as a bounded maximum: an audit).
+CORNER_LABEL = "q → ∞ at the corner (held within {within})"
 GIVEN_COLOR = "#8c8c8c"
 #: The readings of a back-analysis (Fit tab) and the fitted scene's forecast band.
 READINGS_COLOR = "#111111"
@@ -204,6 +209,10 @@ class Figures:
                    legend_label="Winkler / trapezoid")]
         line = p.line(x="x", y="q", source=self.q_src, line_color=UNKNOWN_COLOR, line_width=2.5,
                       legend_label="current")
+        self.corner_src = ColumnDataSource(empty_columns("x", "q"), name="corner_source")
+        self.corner_marks = p.scatter(x="x", y="q", source=self.corner_src, marker="triangle",
+                                      size=10, fill_color="#333333", line_color=None,
+                                      legend_label=CORNER_LABEL.format(within="a few mm"))
         self.q_hover = HoverTool(renderers=[line], tooltips=[("x", "@x{0.000} m"),
                                                              ("q", "@q{0.000} kPa")],
                                  mode="vline", name="q_hover")
@@ -213,7 +222,7 @@ class Figures:
         legend = legend_above(p, LEGEND_FONT)
         legend.click_policy = "hide"
         for item in legend.items:
-            if any(r in self.classic_lines for r in item.renderers):
+            if any(r in (*self.classic_lines, self.corner_marks) for r in item.renderers):
                 item.visible = False
         self.q_fig = p
 
@@ -511,6 +520,7 @@ class Figures:
         t = float(view.times[index])
         q = view.pressure[:, index]
         set_data(self.q_src, {"x": f32(view.x), "q": f32(q / size)})
+        self._show_corners(view, q / size)
         intervals = view.negative_intervals(index)
         set_data(self.neg_src, {"left": [lo for lo, _ in intervals],
                                 "right": [hi for _, hi in intervals]})
@@ -529,6 +539,27 @@ class Figures:
             set_data(self.history_point_src[name], {"t": [t] * len(values), "v": values})
         self.drawing.show_arrow(view, index)
         self.contact.show_time(view, index)
+
+    def _show_corners(self, view: ResultView, q: np.ndarray) -> None:
+        """Mark the rigid corners where q is unbounded and drawn held (``info
+        ["corner_pressure"]``), at the held value, with the width held in the legend."""
+        corner = None if view.several else view.info.get("corner_pressure")
+        xs: list[float] = []
+        if corner and q.size:
+            ends = {-1: float(q[0]), 1: float(q[-1])}
+            a = float(view.x[-1])
+            xs = [float(c) for c in corner.get("corners_m", ()) if abs(abs(float(c)) - a)
+                  <= 1e-9 * max(a, 1.0)]
+        set_data(self.corner_src, {"x": xs, "q": [ends[1 if x > 0 else -1] for x in xs]})
+        for item in self.q_fig.legend[0].items:
+            if self.corner_marks in item.renderers:
+                if xs:
+                    within = float(corner.get("held_within_m", 0.0))
+                    label = CORNER_LABEL.format(within=f"{1e3 * within:.3g} mm")
+                    if item.label != fixed_label(label):
+                        item.label = fixed_label(label)
+                if item.visible != bool(xs):
+                    item.visible = bool(xs)
 
     def _label_strips(self, view: ResultView) -> None:
         label = LIFTED_LABEL if view.info.get("contact") == "unilateral" else LOST_LABEL

@@ -148,3 +148,22 @@ def test_the_pressure_csv_says_the_corner_rows_are_held():
     # a coated answer of the thin layer's springs has no corner line
     coated = PRESETS["uniform_flat"]
     assert "corner" not in parse_csv(pressure_csv(prepare_view(solve(coated), coated)))[0]
+
+
+def test_a_corner_where_q_is_unbounded_is_marked_with_the_width_held(explorer_app):
+    """The exact layered answer (and the bare base's) holds q within a few mm of a rigid
+    corner in contact, where it rises without bound: the flat end of the line read as a
+    bounded maximum (an audit of rounded_graded). The corners are marked, and the legend
+    says how wide the band held is; a coating of the thin-layer model has none."""
+    app = explorer_app("rounded_graded", solved=True)
+    figures = app.figures
+    held = app.controller.view.info["corner_pressure"]
+    assert figures.corner_src.data["x"] == [-0.5, 0.5]
+    line = figures.q_src.data["q"]
+    assert figures.corner_src.data["q"] == pytest.approx([line[0], line[-1]], rel=1e-6)
+    [item] = [i for i in figures.q_fig.legend[0].items if figures.corner_marks in i.renderers]
+    assert item.visible and item.label.value == (
+        f"q → ∞ at the corner (held within {1e3 * held['held_within_m']:.3g} mm)")
+    app.load_scene(presets()["uniform_flat"])
+    assert app.controller.wait(60)
+    assert figures.corner_src.data["x"] == [] and not item.visible
