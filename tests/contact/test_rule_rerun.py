@@ -109,19 +109,14 @@ def test_a_near_miss_of_tol_is_mended_by_the_time_grids_not_refused():
     against a tol 1e-8 answer q 7.9e-9, settlement 1.0e-7 and tilt 3.2e-7 off (of their
     largest values; 2.8 s of CPU against 2.0 for the refusal)."""
     from core import solve
+    from tests.conftest import scene_file
 
-    scene = {"schema_version": 1, "name": "a step into lift-off",
-             "punch": {"half_width": 1.0, "shape": 0.0},
-             "coating": [{"thickness": 0.015, "modulus": 4e8, "poisson": 0.35,
-                          "interface": "smooth"}],
-             "base": {"thickness": 6.0, "poisson": 0.2, "age_at_loading": 28.0,
-                      "creep": {"model": "exponential", "modulus": 3e10,
-                                "compliance": 3e-11, "rate": 0.05}},
-             "loading": {"force": {"kind": "step", "values": [8e5, 2e5], "breaks": [10.0]},
-                         "moment": {"kind": "step", "values": [1.2e5, 1.4e5],
-                                    "breaks": [10.0]}},
-             "times": [0, 0.5, 1, 9.99, 10, 10.01, 10.5, 20, 100, 1000, 10000],
-             "solver": {"tol": 1e-6}}
+    scene = scene_file("eccentric_creep")  # its base given an exponential law
+    scene["base"]["creep"] = {"model": "exponential", "modulus": 3e10, "compliance": 3e-11,
+                              "rate": 0.05}
+    scene["loading"] = {"force": {"kind": "step", "values": [8e5, 2e5], "breaks": [10.0]},
+                        "moment": {"kind": "step", "values": [1.2e5, 1.4e5], "breaks": [10.0]}}
+    scene["times"] = [0, 0.5, 1, 9.99, 10, 10.01, 10.5, 20, 100, 1000, 10000]
     info = solve(scene).info
     assert info["contact"] == "unilateral" and info["success"], info["message"]
     assert 3 * info["error_estimate"] <= 1e-6

@@ -347,16 +347,11 @@ def test_a_tol_past_double_precision_at_the_edges_is_not_met_not_a_crash():
     the punch's edges ~30 times, panels of 1e-18 whose nodes were 1.0 itself: a raw
     "LinAlgError: Array must not contain infs or NaNs" (a researcher's audit). The
     grading stops before its nodes collapse: an answer flagged ``tol_not_met``."""
-    scene = {"schema_version": 1, "name": "soft after creep",
-             "punch": {"half_width": 1.0, "shape": 0.0},
-             "coating": [{"thickness": 0.015, "modulus": 4e8, "poisson": 0.35,
-                          "interface": "smooth"}],
-             "base": {"thickness": 6.0, "poisson": 0.2, "age_at_loading": 28.0,
-                      "creep": {"model": "exponential", "modulus": 3e10,
-                                "compliance": 3e-9, "rate": 0.05}},
-             "loading": {"force": 8e5, "moment": 1.2e5},
-             "times": {"end": 1000.0, "count": 20, "spacing": "log"},
-             "solver": {"tol": 1e-10}}
+    scene = scene_file("eccentric_creep")  # its base given an exponential law
+    scene["base"]["creep"] = {"model": "exponential", "modulus": 3e10, "compliance": 3e-9,
+                              "rate": 0.05}
+    scene["times"]["count"] = 20
+    scene["solver"] = {"tol": 1e-10}
     result = solve(scene_from_dict(scene))
     assert not result.info["success"] and "tol_not_met" in result.flags
     assert np.all(np.isfinite(result.settlement))
