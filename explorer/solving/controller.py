@@ -43,6 +43,7 @@ import param
 
 from core import STAGE_CACHE_BYTES, scene_from_dict, solve
 from core.scene import creeps, elastic_at_loading, punches_from_dict
+from core.study import parse_path
 from core.work import SolveCancelled
 
 from ..model import DesignLimits, ExplorerState, ResultView, prepare_view, scene_with_limits
@@ -334,17 +335,17 @@ def _refusal(scene: dict[str, Any] | None) -> str | None:
     return None
 
 
-#: A field path of the core's messages: ``coating[0].thickness`` -> its keys and indices.
-_PATH_PART = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
-
-
 def _path_of(message: str) -> tuple | None:
     """The field path a core message names (``"coating[0].thickness: ..."``), as keys
-    and indices; None where it names none."""
+    and indices (the core's own reading of a path, as a study's); None where it names
+    none."""
     path = message.partition(":")[0].strip()
     if not path or " " in path:
         return None
-    return tuple(int(index) if index else key for key, index in _PATH_PART.findall(path))
+    try:
+        return parse_path(path)
+    except ValueError:
+        return None
 
 
 def _related(path: tuple, paths: list[tuple]) -> bool:

@@ -393,8 +393,8 @@ class ResultsView:
         for pane in (self.figures.image_fig, grid, self.log_time.__panel__()):
             if pane.visible != over_time:
                 pane.visible = over_time
-        once = ONCE_CREEP_NOTE if creeps(view.scene) else ONCE_NOTE
-        note = "" if over_time else once.format(t=days_text(float(view.times[0])))
+        note = "" if over_time else (ONCE_CREEP_NOTE if creeps(view.scene) else ONCE_NOTE
+                                     ).format(t=days_text(float(view.times[0])))
         if self.once_note.object != note:
             self.once_note.object = note
         if self.once_note.visible == over_time:
