@@ -425,20 +425,16 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
     """
     times = inp.times
     tol = inp.tol
+    marches = OnePunchMarches(space, inp, even_problem(space, inp, loads))
     (base, out, run, band_note, strays, error, end_error, time_error,
-     space_error, end_q_error) = controlled_march(OnePunchMarches(space, inp,
-                                                                  even_problem(space, inp,
-                                                                               loads)),
-                                                  times, tol,
-                                                  res, first_steps, jumps,
-                                                  graded_halvings(inp.kernel, times),
+     space_error, end_q_error) = controlled_march(marches, times, tol, res, first_steps,
+                                                  jumps, graded_halvings(inp.kernel, times),
                                                   transient_windows(inp.kernel, times, jumps,
                                                                   tol))
     sweeps, steps = run["sweeps"], run["steps"]
     zones = _zones_of(out)
-    snapshots = [output_snapshot(base, out, k, zones[k]) for k in range(times.size)]
-    residual = free_end_residual(space, snapshots, float(np.max(np.abs(out["q"]),
-                                                                initial=0.0)))
+    snapshots = marches.snapshots(base, out)
+    residual = marches.residual(base, out)
     error, end_q_error = error + residual, end_q_error + residual
     success, flags, message = creep_verdict(error, end_error, time_error, space_error, run,
                                             strays, tol, "under creep", end_q_error)
@@ -500,6 +496,7 @@ class OnePunchMarches:
 
     def __init__(self, space: Space, inp: Any, even: bool = False) -> None:
         self.space, self.inp, self.even = space, inp, even
+        self._snapshots: tuple[dict[str, Any], list[_Snapshot]] | None = None
 
     def rule(self, res: Resolution, bands: list[tuple[float, float]], width: float) -> Panels:
         if self.even:
@@ -562,12 +559,20 @@ class OnePunchMarches:
         """:func:`free_end_slope` of the outputs ``out`` of a march on ``rule``."""
         return free_end_slope(rule.nodes, out["q"], out["ends"], self.space.breakpoints)
 
+    def snapshots(self, rule: Panels, out: dict[str, Any]) -> list[_Snapshot]:
+        """:func:`output_snapshot` of each output time of ``out`` (a march on ``rule``),
+        kept for the last ``out`` asked: the error control's last look and the answer
+        read the same ones."""
+        if self._snapshots is None or self._snapshots[0] is not out:
+            zones = _zones_of(out)
+            self._snapshots = (out, [output_snapshot(rule, out, k, zones[k])
+                                     for k in range(len(zones))])
+        return self._snapshots[1]
+
     def residual(self, rule: Panels, out: dict[str, Any]) -> float:
         """:func:`free_end_residual` of the outputs ``out`` of a march on ``rule`` (what
         :func:`solve_creep` adds to the estimate)."""
-        zones = _zones_of(out)
-        snapshots = [output_snapshot(rule, out, k, zones[k]) for k in range(len(zones))]
-        return free_end_residual(self.space, snapshots,
+        return free_end_residual(self.space, self.snapshots(rule, out),
                                  float(np.max(np.abs(out["q"]), initial=0.0)))
 
 
