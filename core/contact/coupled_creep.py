@@ -54,6 +54,7 @@ from core.contact.creep import (
     FIRST_STEPS,
     LOCATE_EDGE,
     _borrow_corrections,
+    _corner_q_between_rules,
     _distance,
     _extrapolate,
     _outside_bands,
@@ -131,6 +132,10 @@ class CoupledMarches:
         return Resolutions(tuple(Resolution(r.width / 2.0, r.edge / 2.0) for r in res.levels))
 
     @staticmethod
+    def edges_halved(res: Resolutions) -> Resolutions:
+        return Resolutions(tuple(Resolution(r.width, r.edge / 2.0) for r in res.levels))
+
+    @staticmethod
     def nodes(rule: tuple[Panels, ...]) -> int:
         """How many nodes the coupled marches on ``rule`` are dense in (all punches')."""
         return int(sum(panels.nodes.size for panels in rule))
@@ -154,21 +159,30 @@ class CoupledMarches:
 
     def rule_distance(self, rules: Sequence[Panels], a: list[dict[str, Any]],
                       finer: Sequence[Panels], b: list[dict[str, Any]],
-                      bands: Sequence[list[tuple[float, float]]]) -> tuple[float, float]:
+                      bands: Sequence[list[tuple[float, float]]]
+                      ) -> tuple[float, float, float]:
         """:meth:`distance`, and q between the rules punch by punch as one punch compares
         it (:func:`core.contact.creep._q_between_rules`: the finer march's formula at the
-        coarser nodes, off the bands and at the times that punch has no free end), each
-        punch's formula with the others' push (their effective densities on the finer
-        rules). The histories alone missed q at the edges: two punches on a creeping base
-        (EC2), q 5.5e-7 off at x = 0.992 with a spatial estimate of 2e-9."""
+        coarser nodes, off the bands and at the times that punch has no free end; and
+        :func:`core.contact.creep._corner_q_between_rules` at its corners), each punch's
+        formula with the others' push (their effective densities). The histories alone
+        missed q at the edges: two punches on a creeping base (EC2), q 5.5e-7 off at x =
+        0.992 with a spatial estimate of 2e-9. The third value: the corners' part."""
         outputs, shift = self.distance(a, b)
+        corners = 0.0
         for p, space in enumerate(self.base.spaces):
-            def others(x: np.ndarray, p: int = p) -> list[tuple[np.ndarray, np.ndarray]]:
-                return [(self.base.rows(p, r, finer[r], x), b[r]["effective"])
-                        for r in self.base.pairs[p] if finer[r].size]
+            def pushing(rules_of: Sequence[Panels], answers: list[dict[str, Any]],
+                        p: int = p) -> Callable[[np.ndarray], list]:
+                def others(x: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+                    return [(self.base.rows(p, r, rules_of[r], x), answers[r]["effective"])
+                            for r in self.base.pairs[p] if rules_of[r].size]
+                return others
+
             outputs = max(outputs, _q_between_rules(space, rules[p], a[p], finer[p], b[p],
-                                                    bands[p], others))
-        return outputs, shift
+                                                    bands[p], pushing(finer, b)))
+            corners = max(corners, _corner_q_between_rules(
+                space, rules[p], a[p], finer[p], b[p], (pushing(rules, a), pushing(finer, b))))
+        return max(outputs, corners), shift, corners
 
     @staticmethod
     def banded(bands: Sequence[list[tuple[float, float]]]) -> bool:

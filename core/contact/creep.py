@@ -239,10 +239,8 @@ def _q_between_rules(space: Space, rule: Panels, out: dict[str, Any], finer: Pan
     ``others``: the other punches on the base push this one's surface too; their part
     of the formula (:data:`Others`, from the finer march)."""
     q = out["q"]
-    fixed = np.asarray(space.breakpoints, dtype=float)
     times = [k for k in range(q.shape[1])
-             if not any(-1.0 < e < 1.0 and not np.any(np.abs(fixed - e) <= 1e-12)
-                        for e in (*out["ends"][k], *finer_out["ends"][k]))]
+             if not _free_end_at(space, out, finer_out, k)]
     if q.size == 0 or not times or q.shape[1] != finer_out["q"].shape[1]:
         return 0.0
     x = rule.nodes
@@ -280,13 +278,91 @@ def _q_between_rules(space: Space, rule: Panels, out: dict[str, Any], finer: Pan
     return worst / max(float(np.max(np.abs(q))), 1e-300)
 
 
+def _free_end_at(space: Space, out: dict[str, Any], finer_out: dict[str, Any], k: int
+                 ) -> bool:
+    """Whether either march has a free end (inside (-1, 1), off the breakpoints) at output
+    time ``k``."""
+    fixed = np.asarray(space.breakpoints, dtype=float)
+    return any(-1.0 < e < 1.0 and not np.any(np.abs(fixed - e) <= 1e-12)
+               for e in (*out["ends"][k], *finer_out["ends"][k]))
+
+
+def corner_points(breakpoints: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """The punch's corners as (points, inward): +-1 from inside, each breakpoint from
+    both sides (q may jump there) [half-widths]."""
+    inner = [float(b) for b in breakpoints if -1.0 < float(b) < 1.0]
+    points = np.array([-1.0, 1.0, *inner, *inner])
+    inward = np.array([1.0, -1.0, *([-1.0] * len(inner)), *([1.0] * len(inner))])
+    return points, inward
+
+
+def _corner_q_between_rules(space: Space, rule: Panels, out: dict[str, Any],
+                            finer: Panels, finer_out: dict[str, Any],
+                            others: tuple[Others, Others] | None = None) -> float:
+    """The largest change of q at the punch's corners (:func:`corner_points`, each side in
+    contact in both marches) between the answers of marches on two rules at the output
+    times with a free end, each the kink-corrected pressure of :func:`output_snapshot`,
+    relative to the largest q.
+
+    :func:`_q_between_rules` leaves out those times, where the nodal q carries the end's
+    kink: under lift-off, all of them, and q at the toe of a heel
+    lifting off under strong creep was 3.85e-7 off (tol 1e-6, against a reference graded
+    eight times finer there) with a spatial estimate of 7.8e-9. The corrected answers
+    compared at the corners, where q is steepest and the grading there tells, read 1.1e-6,
+    2.9e-7 and 7.6e-8 as the edge panels went from 0.01 to 0.0025 (measured).
+
+    ``others``: the other punches on the base push this one's surface too
+    (:data:`Others`: of the march ``out``, then of ``finer_out``)."""
+    points, inward = corner_points(space.breakpoints)
+    scale = max(float(np.max(np.abs(out["q"]), initial=0.0)), 1e-300)
+    if out["q"].size == 0 or out["q"].shape[1] != finer_out["q"].shape[1]:
+        return 0.0
+    answers = [(rule, out, operator_rows(space.lam, rule, points)),
+               (finer, finer_out, operator_rows(space.lam, finer, points))]
+    pushes = ((), ()) if others is None else (others[0](points), others[1](points))
+    beside = points + 1e-9 * inward  # (a side in contact: a point just beside it in a zone)
+    worst = 0.0
+    for k in range(out["q"].shape[1]):
+        if not _free_end_at(space, out, finer_out, k):
+            continue  # (q there is compared at the nodes, the corners' beside them)
+        zones = [_ends_zones(answer["ends"][k]) for _, answer, _ in answers]
+        inside = nodes_in(beside, zones[0]) & nodes_in(beside, zones[1])
+        if not inside.any():
+            continue
+        values = []
+        for (panels, answer, rows), mine, pushing in zip(answers, zones, pushes, strict=True):
+            snap = output_snapshot(panels, answer, k, mine)
+            own = snap.displacement(space.lam)
+            push = sum((-(r[inside] @ effective[:, k]) for r, effective in pushing),
+                       np.zeros(int(inside.sum())))
+
+            def displacement(t: np.ndarray, own: Any = own, push: Any = push) -> np.ndarray:
+                return push if own is None else own(t) + push
+
+            values.append(nystrom_pressure(space, snap.step, snap.panels, snap.q,
+                                           snap.settlement, snap.tilt, points[inside],
+                                           inward[inside], displacement,
+                                           rows=rows[inside]))
+        worst = max(worst, float(np.max(np.abs(values[0] - values[1]))))
+    return worst / scale
+
+
+def _ends_zones(ends: Sequence[float]) -> list[tuple[float, float]]:
+    """A time's zone ends (start, end, start, ...) as its zones."""
+    return [(float(ends[2 * i]), float(ends[2 * i + 1])) for i in range(len(ends) // 2)]
+
+
 def _rule_distance(space: Space, rule: Panels, out: dict[str, Any], finer: Panels,
                    finer_out: dict[str, Any], bands: Sequence[tuple[float, float]] = ()
-                   ) -> tuple[float, float]:
+                   ) -> tuple[float, float, float]:
     """:func:`_distance` of marches on two panel rules (``rule``, and every panel finer,
-    ``finer``), q compared too where no free end is (:func:`_q_between_rules`)."""
+    ``finer``), q compared too where no free end is (:func:`_q_between_rules`) and at the
+    punch's corners at every time (:func:`_corner_q_between_rules`): (the largest
+    relative difference, the largest shift of a zone end, the corners' part)."""
     outputs, shift = _distance(out, finer_out)
-    return max(outputs, _q_between_rules(space, rule, out, finer, finer_out, bands)), shift
+    corners = _corner_q_between_rules(space, rule, out, finer, finer_out)
+    return (max(outputs, _q_between_rules(space, rule, out, finer, finer_out, bands),
+                corners), shift, corners)
 
 
 #: Under creep the zone ends are located to the larger of ``ZONE_END_TOL`` and this share
@@ -509,6 +585,11 @@ class OnePunchMarches:
         return Resolution(res.width / 2.0, res.edge / 2.0)
 
     @staticmethod
+    def edges_halved(res: Resolution) -> Resolution:
+        """The grading at +-1 and the breakpoints halved, the base width kept."""
+        return Resolution(res.width, res.edge / 2.0)
+
+    @staticmethod
     def nodes(rule: Panels) -> int:
         """How many nodes the marches on ``rule`` are dense in."""
         return int(rule.nodes.size)
@@ -535,7 +616,7 @@ class OnePunchMarches:
 
     def rule_distance(self, rule: Panels, out: dict[str, Any], finer: Panels,
                       finer_out: dict[str, Any], bands: list[tuple[float, float]]
-                      ) -> tuple[float, float]:
+                      ) -> tuple[float, float, float]:
         """:func:`_rule_distance` of this punch."""
         return _rule_distance(self.space, rule, out, finer, finer_out, bands)
 
@@ -590,13 +671,13 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
     first: dict[str, Any] = {}
 
     def rule_and_march(end_tol: float, bands: Any = None, slope: float = 0.0,
-                       start_width: float = BAND_WIDTHS[0]) -> tuple:
+                       start: dict[str, Any] | None = None) -> tuple:
         """The rule (its bands located first unless given, with q's ``slope`` at the free
-        ends; its band panels from ``start_width`` down) and the time grids on it."""
+        ends; from the last comparison ``start`` of an earlier run) and the time grids on it."""
         base, space_error, space_shift, band_note = _select_rule(
             marches, times, res, first_steps, tol, end_tol, bands=bands, first=first,
             jumps=jumps, graded=graded, windows=windows, slope=slope,
-            start_width=start_width)
+            start=start)
         end_tol = band_note["end_tol"]  # finer where q beside the ends asks for it
         out, time_error, end_shift, run = _in_time(
             marches, times, base, first_steps,
@@ -640,7 +721,7 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
         if end_tol < min(end_error, 0.5 * band_note["end_tol"]) or last_resort:
             (base, space_error, space_shift, band_note, out, time_error, end_shift, run,
              strays) = rule_and_march(min(end_tol, band_note["end_tol"]), band_note["bands"],
-                                      slope, band_note["width"])
+                                      slope, band_note["start"])
             end_error = float(end_shift + space_shift)
             slope = marches.end_slope(base, out)
     end_q_error = end_error * slope if slope > 0.0 else 0.0
@@ -745,7 +826,7 @@ def _check_times(times: np.ndarray, count: int = 0) -> np.ndarray:
 def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, tol: float,
                  end_tol: float, bands: Any = None, first: dict[str, Any] | None = None,
                  jumps: Sequence[float] = (), graded: int = 0, windows: Windows = (),
-                 slope: float = 0.0, start_width: float = BAND_WIDTHS[0]
+                 slope: float = 0.0, start: dict[str, Any] | None = None
                  ) -> tuple[Any, float, float, dict[str, Any]]:
     """The panel rule of the stepping and its spatial error (outputs, zone ends).
 
@@ -757,10 +838,14 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     their difference meets a sixth of ``tol`` and half the zone-end tolerance (half of
     what success asks; or ``BAND_WIDTHS`` run out; below ``LAST_RESORT_BELOW`` only where
     the ends' error times q's ``slope`` beside them would alone fail tol, and while the
-    next check's rule has at most ``MAX_CHECK_NODES`` nodes). ``slope``
-    (:func:`free_end_slope`): the caller's, or the locating march's where it locates the
-    bands. ``start_width``: the first band width tried (the last one a run on the same
-    bands chose: a run asking finer ends would not stop at a coarser one).
+    next check's rule has at most ``MAX_CHECK_NODES`` nodes). Where q at the punch's
+    corners is what misses (:func:`_corner_q_between_rules`), the grading there is halved
+    with the bands' panels, which do not reach it; a comparison whose two rules share
+    that grading reads the corners' part of the last one that did not (their error is
+    at most that). ``slope`` (:func:`free_end_slope`): the caller's, or the locating
+    march's where it locates the bands. ``start``: the band note of an earlier run on the
+    same bands, whose last comparison (its rules, the corners' part) this run starts
+    from (a run asking finer ends would not stop at a coarser rule).
     """
     check = _check_times(times)
     grid, widths, index = time_grid(check, first_steps, 0, jumps, graded, windows)
@@ -784,33 +869,43 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         slope = marches.end_slope(locating, located)
         if slope > 0.0:
             end_tol = min(end_tol, end_tol_for_q(tol, slope))
-    # every panel finer: the base width halved, its grading at +-1 and the breakpoints too
-    base, finer = res, marches.halved(res)
-    if start_width < BAND_WIDTHS[0]:
-        # A run again from the band width an earlier run chose starts from that run's
-        # rule: its first candidate was on ``res``, every later one on a halved base (once
-        # with bands, once per step without). Built on ``res`` instead, a
-        # lift-off of the heel under strong creep took panels twice as wide at +-1 as the
-        # rule checked before, q at the toe 1.5e-6 off at tol 1e-6 with an estimate of
-        # 2.2e-7 (the check compares the histories, which the edge barely moves).
-        steps = max(1, int(round(np.log2(BAND_WIDTHS[0] / start_width))))
-        for _ in range(1 if marches.banded(bands) else steps):
-            base = marches.halved(base)
-        finer = base if marches.banded(bands) else marches.halved(base)
-    width = start_width
+    if start is None:
+        # every panel finer: the base width halved, its grading at +-1 and the breakpoints
+        # too
+        base, finer, width = res, marches.halved(res), BAND_WIDTHS[0]
+        corners_differ, corner_error = True, 0.0
+    else:
+        # A run again starts from the earlier run's last comparison. Built on ``res``
+        # instead, a lift-off of the heel under strong creep took panels twice as wide at
+        # +-1 as the rule checked before, q at the toe 1.5e-6 off at tol 1e-6 with an
+        # estimate of 2.2e-7 (the check compares the histories, which the edge barely
+        # moves).
+        base, finer = start["bases"]
+        width, corners_differ, corner_error = (start["width"], start["corners_differ"],
+                                               start["corner_error"])
     rule = marches.rule(base, bands, width)
     current = check_march(rule)
     half = marches.rule(finer, bands, width / 2.0)
+    half_base = finer
     while True:
         halved = check_march(half)
-        diff, shift = marches.rule_distance(rule, current, half, halved, bands)
-        error, end_error = SPACE_FACTOR * diff, SPACE_FACTOR * shift
+        diff, shift, corners = marches.rule_distance(rule, current, half, halved, bands)
+        if corners_differ:
+            corner_error = SPACE_FACTOR * corners
+        error = max(SPACE_FACTOR * diff, corner_error)
+        end_error = SPACE_FACTOR * shift
+        last = {"bases": (base, half_base), "width": width, "corners_differ": corners_differ,
+                "corner_error": corner_error}
         if (error <= tol / 6 and end_error <= end_tol / 2) or width / 2.0 < BAND_WIDTHS[-1]:
             break
         if not marches.banded(bands):
             # no band panels, which the width would refine: the base is refined instead
             # (the same rule, compared with itself, read 1e-14 with q 3e-7 off at tol 1e-7)
             finer = marches.halved(finer)
+        elif corner_error > tol / 6:
+            # (q at the toe of a heel lifting off under strong creep: 1.1e-6 with the edge
+            # panels 0.01 wide, the bands' panels halved to 0.005 left it there)
+            finer = marches.edges_halved(finer)
         checking = marches.rule(finer, bands, width / 4.0)
         # (q off the bands missing its share asks the finer rule, whose base is finer too)
         if width / 2.0 < LAST_RESORT_BELOW and (
@@ -818,10 +913,13 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
                 or marches.nodes(checking) > MAX_CHECK_NODES):
             break
         # The halved rule becomes the candidate (its base is already the finer one).
+        corners_differ = not marches.banded(bands) or corner_error > tol / 6
         width /= 2.0
+        base, half_base = half_base, finer
         rule, current, half = half, halved, checking
     return rule, float(error), float(end_error), {"bands": bands, "width": width,
-                                                  "end_tol": end_tol, "slope": slope}
+                                                  "end_tol": end_tol, "slope": slope,
+                                                  "start": last}
 
 
 def _outside_bands(ends: list[list[float]], bands: list[tuple[float, float]],

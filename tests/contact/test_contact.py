@@ -784,6 +784,8 @@ class _BandStub:
     def halved(res):
         return res
 
+    edges_halved = halved
+
     @staticmethod
     def nodes(rule) -> int:
         return int(round(16 * 0.1 / rule))
@@ -797,7 +799,7 @@ class _BandStub:
         return 1.0, 1.0
 
     def rule_distance(self, rule, a, finer, b, bands):
-        return self.outputs, 1.0
+        return self.outputs, 1.0, 0.0
 
     @staticmethod
     def banded(bands) -> bool:
