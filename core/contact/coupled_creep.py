@@ -53,6 +53,7 @@ from core.contact.coupled import (
 from core.contact.creep import (
     FIRST_STEPS,
     LOCATE_EDGE,
+    MarchMemo,
     _borrow_corrections,
     _corner_q_between_rules,
     _distance,
@@ -114,6 +115,7 @@ class CoupledMarches:
         self.base, self.inp, self.loads, self.tol = base, inputs[0], tuple(loads), tol
         self.givens = tuple(one.given for one in inputs)
         self._systems: dict[str, CoupledRules] = {}
+        self._memo = MarchMemo()
 
     def system(self, rules: Sequence[Panels]) -> CoupledRules:
         key = fingerprint(*(np.asarray(rule.edges, dtype=float) for rule in rules))
@@ -147,8 +149,12 @@ class CoupledMarches:
     def run(self, rules: Sequence[Panels], grid: np.ndarray, widths: np.ndarray,
             index: np.ndarray, exact_ends: bool = True, first: dict[str, Any] | None = None
             ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-        run = march_punches(self, self.system(rules), grid, widths, index, exact_ends, first)
-        return punch_outputs(run), run
+        def make() -> tuple[list[dict[str, Any]], dict[str, Any]]:
+            run = march_punches(self, self.system(rules), grid, widths, index, exact_ends,
+                                first)
+            return punch_outputs(run), run
+
+        return self._memo.get(tuple(rules), grid, widths, index, exact_ends, make)
 
     @staticmethod
     def distance(a: list[dict[str, Any]], b: list[dict[str, Any]]) -> tuple[float, float]:
