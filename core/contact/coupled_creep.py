@@ -61,6 +61,7 @@ from core.contact.creep import (
     _outside_bands,
     _q_between_rules,
     controlled_march,
+    corners_refined,
     creep_verdict,
     free_end_residual,
     free_end_slope,
@@ -156,6 +157,10 @@ class CoupledMarches:
 
         return self._memo.get(tuple(rules), grid, widths, index, exact_ends, make)
 
+    def keep(self, *rules: Sequence[Panels]) -> None:
+        """Forget the marches on any rules but ``rules`` (one rule per punch each)."""
+        self._memo.keep(*(tuple(one) for one in rules))
+
     @staticmethod
     def distance(a: list[dict[str, Any]], b: list[dict[str, Any]]) -> tuple[float, float]:
         """The largest over the punches of :func:`core.contact.creep._distance` (each
@@ -166,16 +171,18 @@ class CoupledMarches:
     def rule_distance(self, rules: Sequence[Panels], a: list[dict[str, Any]],
                       finer: Sequence[Panels], b: list[dict[str, Any]],
                       bands: Sequence[list[tuple[float, float]]]
-                      ) -> tuple[float, float, float]:
+                      ) -> tuple[float, float, np.ndarray, np.ndarray]:
         """:meth:`distance`, and q between the rules punch by punch as one punch compares
         it (:func:`core.contact.creep._q_between_rules`: the finer march's formula at the
         coarser nodes, off the bands and at the times that punch has no free end; and
         :func:`core.contact.creep._corner_q_between_rules` at its corners), each punch's
         formula with the others' push (their effective densities). The histories alone
         missed q at the edges: two punches on a creeping base (EC2), q 5.5e-7 off at x =
-        0.992 with a spatial estimate of 2e-9. The third value: the corners' part."""
+        0.992 with a spatial estimate of 2e-9. The third and fourth values: each corner's
+        part and whether it is refined (:func:`core.contact.creep.corners_refined`), punch
+        by punch."""
         outputs, shift = self.distance(a, b)
-        corners = 0.0
+        corners, refined = [], []
         for p, space in enumerate(self.base.spaces):
             def pushing(rules_of: Sequence[Panels], answers: list[dict[str, Any]],
                         p: int = p) -> Callable[[np.ndarray], list]:
@@ -186,9 +193,12 @@ class CoupledMarches:
 
             outputs = max(outputs, _q_between_rules(space, rules[p], a[p], finer[p], b[p],
                                                     bands[p], pushing(finer, b)))
-            corners = max(corners, _corner_q_between_rules(
+            corners.append(_corner_q_between_rules(
                 space, rules[p], a[p], finer[p], b[p], (pushing(rules, a), pushing(finer, b))))
-        return max(outputs, corners), shift, corners
+            refined.append(corners_refined(space, rules[p], finer[p]))
+        parts = np.concatenate(corners)
+        return (max(outputs, float(np.max(parts, initial=0.0))), shift, parts,
+                np.concatenate(refined))
 
     @staticmethod
     def banded(bands: Sequence[list[tuple[float, float]]]) -> bool:

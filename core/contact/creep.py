@@ -298,11 +298,11 @@ def corner_points(breakpoints: Sequence[float]) -> tuple[np.ndarray, np.ndarray]
 
 def _corner_q_between_rules(space: Space, rule: Panels, out: dict[str, Any],
                             finer: Panels, finer_out: dict[str, Any],
-                            others: tuple[Others, Others] | None = None) -> float:
-    """The largest change of q at the punch's corners (:func:`corner_points`, each side in
-    contact in both marches) between the answers of marches on two rules at the output
-    times with a free end, each the kink-corrected pressure of :func:`output_snapshot`,
-    relative to the largest q.
+                            others: tuple[Others, Others] | None = None) -> np.ndarray:
+    """The largest change of q at each of the punch's corners (:func:`corner_points`, a
+    side in contact in both marches) between the answers of marches on two rules at the
+    output times with a free end, each the kink-corrected pressure of
+    :func:`output_snapshot`, relative to the largest q (0 where never compared).
 
     :func:`_q_between_rules` leaves out those times, where the nodal q carries the end's
     kink: under lift-off, all of them, and q at the toe of a heel
@@ -315,13 +315,13 @@ def _corner_q_between_rules(space: Space, rule: Panels, out: dict[str, Any],
     (:data:`Others`: of the march ``out``, then of ``finer_out``)."""
     points, inward = corner_points(space.breakpoints)
     scale = max(float(np.max(np.abs(out["q"]), initial=0.0)), 1e-300)
+    worst = np.zeros(points.size)
     if out["q"].size == 0 or out["q"].shape[1] != finer_out["q"].shape[1]:
-        return 0.0
+        return worst
     answers = [(rule, out, operator_rows(space.lam, rule, points)),
                (finer, finer_out, operator_rows(space.lam, finer, points))]
     pushes = ((), ()) if others is None else (others[0](points), others[1](points))
     beside = points + 1e-9 * inward  # (a side in contact: a point just beside it in a zone)
-    worst = 0.0
     for k in range(out["q"].shape[1]):
         if not _free_end_at(space, out, finer_out, k):
             continue  # (q there is compared at the nodes, the corners' beside them)
@@ -343,8 +343,19 @@ def _corner_q_between_rules(space: Space, rule: Panels, out: dict[str, Any],
                                            snap.settlement, snap.tilt, points[inside],
                                            inward[inside], displacement,
                                            rows=rows[inside]))
-        worst = max(worst, float(np.max(np.abs(values[0] - values[1]))))
+        worst[inside] = np.maximum(worst[inside], np.abs(values[0] - values[1]))
     return worst / scale
+
+
+def corners_refined(space: Space, rule: Panels, finer: Panels) -> np.ndarray:
+    """Whether ``finer``'s panel beside each corner (:func:`corner_points`, on its side)
+    is narrower than ``rule``'s: the grading at +-1 and the breakpoints halved, or band
+    panels over a breakpoint narrowed. Where it is not, the two rules' q there differs by
+    next to nothing, whatever either's error."""
+    points, inward = corner_points(space.breakpoints)
+    beside = points + 1e-9 * inward
+    return (finer.half_widths[panel_index(finer, beside)]
+            < (1.0 - 1e-9) * rule.half_widths[panel_index(rule, beside)])
 
 
 def _ends_zones(ends: Sequence[float]) -> list[tuple[float, float]]:
@@ -354,15 +365,17 @@ def _ends_zones(ends: Sequence[float]) -> list[tuple[float, float]]:
 
 def _rule_distance(space: Space, rule: Panels, out: dict[str, Any], finer: Panels,
                    finer_out: dict[str, Any], bands: Sequence[tuple[float, float]] = ()
-                   ) -> tuple[float, float, float]:
+                   ) -> tuple[float, float, np.ndarray, np.ndarray]:
     """:func:`_distance` of marches on two panel rules (``rule``, and every panel finer,
     ``finer``), q compared too where no free end is (:func:`_q_between_rules`) and at the
-    punch's corners at every time (:func:`_corner_q_between_rules`): (the largest
-    relative difference, the largest shift of a zone end, the corners' part)."""
+    punch's corners at the times with a free end (:func:`_corner_q_between_rules`): (the
+    largest relative difference, the largest shift of a zone end, each corner's part,
+    whether ``finer`` is graded finer there, :func:`corners_refined`)."""
     outputs, shift = _distance(out, finer_out)
     corners = _corner_q_between_rules(space, rule, out, finer, finer_out)
     return (max(outputs, _q_between_rules(space, rule, out, finer, finer_out, bands),
-                corners), shift, corners)
+                float(np.max(corners, initial=0.0))), shift, corners,
+            corners_refined(space, rule, finer))
 
 
 #: Under creep the zone ends are located to the larger of ``ZONE_END_TOL`` and this share
@@ -566,27 +579,37 @@ def even_problem(space: Space, inp: Any, loads: dict[str, np.ndarray]) -> bool:
 class MarchMemo:
     """The marches of one solve, each kept by its rules and time grid: a run again of the
     rule selection (its last comparison) or of the time grids (their coarser levels, on
-    one rule) reads them instead of marching again (fib MC2010 lifting off at e = a / 2,
-    tol 1e-6: nine of the fourteen marches of its end re-location, 3.5 of 7.8 s of CPU).
-    The marches of one solve start from the same zones at loading (``first``), so one
-    rule and grid give one march. Each read gets its own list of zone ends, which
-    :func:`_borrow_corrections` changes in place."""
+    one rule) reads them instead of marching again (``liftoff_mc2010`` of
+    ``benchmarks/creep_honesty.py``, fib MC2010 lifting off, tol 1e-6: nine of the
+    fourteen marches of its end re-location, 3.5 of 7.8 s of CPU). The marches of one
+    solve start from the same zones at loading (``first``), so one rule and grid give one
+    march. Each read gets its own list of zone ends, which :func:`_borrow_corrections`
+    changes in place. Once a rule is chosen, only the marches on it and on its check
+    are kept (:meth:`keep`): the others cannot be asked again."""
 
     def __init__(self) -> None:
         self._kept: dict[tuple, tuple[Any, dict[str, Any]]] = {}
+
+    @staticmethod
+    def _rules_key(rules: Sequence[Panels]) -> tuple[bytes, ...]:
+        return tuple(np.asarray(rule.edges, dtype=float).tobytes() for rule in rules)
 
     def get(self, rules: tuple[Panels, ...], grid: np.ndarray, widths: np.ndarray,
             index: np.ndarray, exact_ends: bool,
             make: Callable[[], tuple[Any, dict[str, Any]]]) -> tuple[Any, dict[str, Any]]:
         """(outputs, the march) on ``rules`` and the grid, made by ``make`` the first time;
         the outputs: a dict, or a list of dicts (one per punch)."""
-        key = (tuple(np.asarray(rule.edges, dtype=float).tobytes() for rule in rules),
-               np.asarray(grid, dtype=float).tobytes(), np.asarray(widths).tobytes(),
-               np.asarray(index).tobytes(), bool(exact_ends))
+        key = (self._rules_key(rules), np.asarray(grid, dtype=float).tobytes(),
+               np.asarray(widths).tobytes(), np.asarray(index).tobytes(), bool(exact_ends))
         if key not in self._kept:
             self._kept[key] = make()
         outputs, run = self._kept[key]
         return _own_ends(outputs), run
+
+    def keep(self, *rules: tuple[Panels, ...]) -> None:
+        """Forget every march but those on one of ``rules`` (each one rule per punch)."""
+        wanted = {self._rules_key(one) for one in rules}
+        self._kept = {key: value for key, value in self._kept.items() if key[0] in wanted}
 
 
 def _own_ends(outputs: Any) -> Any:
@@ -648,13 +671,17 @@ class OnePunchMarches:
 
         return self._memo.get((rule,), grid, widths, index, exact_ends, make)
 
+    def keep(self, *rules: Panels) -> None:
+        """Forget the marches on any rule but ``rules`` (:meth:`MarchMemo.keep`)."""
+        self._memo.keep(*((rule,) for rule in rules))
+
     distance = staticmethod(_distance)
     extrapolate = staticmethod(_extrapolate)
     borrow = staticmethod(_borrow_corrections)
 
     def rule_distance(self, rule: Panels, out: dict[str, Any], finer: Panels,
                       finer_out: dict[str, Any], bands: list[tuple[float, float]]
-                      ) -> tuple[float, float, float]:
+                      ) -> tuple[float, float, np.ndarray, np.ndarray]:
         """:func:`_rule_distance` of this punch."""
         return _rule_distance(self.space, rule, out, finer, finer_out, bands)
 
@@ -717,6 +744,7 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
             jumps=jumps, graded=graded, windows=windows, slope=slope,
             start=start)
         end_tol = band_note["end_tol"]  # finer where q beside the ends asks for it
+        marches.keep(*band_note["start"]["rules"])  # (what a run again may read)
         out, time_error, end_shift, run = _in_time(
             marches, times, base, first_steps,
             max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
@@ -878,12 +906,13 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     the ends' error times q's ``slope`` beside them would alone fail tol, and while the
     next check's rule has at most ``MAX_CHECK_NODES`` nodes). Where q at the punch's
     corners is what misses (:func:`_corner_q_between_rules`), the grading there is halved
-    with the bands' panels, which do not reach it; a comparison whose two rules share
-    that grading reads the corners' part of the last one that did not (their error is
-    at most that). ``slope`` (:func:`free_end_slope`): the caller's, or the locating
-    march's where it locates the bands. ``start``: the band note of an earlier run on the
-    same bands, whose last comparison (its rules, the corners' part) this run starts
-    from (a run asking finer ends would not stop at a coarser rule).
+    with the bands' panels, which do not reach it; at a corner where the two rules of a
+    comparison have one panel (:func:`corners_refined`), its part is the one of the last
+    comparison that refined it (its error is at most that). ``slope``
+    (:func:`free_end_slope`): the caller's, or the locating march's where it locates the
+    bands. ``start``: the band note of an earlier run on the same bands, whose last
+    comparison (its rules, the corners' parts) this run starts from (a run asking finer
+    ends would not stop at a coarser rule).
     """
     check = _check_times(times)
     grid, widths, index = time_grid(check, first_steps, 0, jumps, graded, windows)
@@ -911,7 +940,7 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         # every panel finer: the base width halved, its grading at +-1 and the breakpoints
         # too
         base, finer, width = res, marches.halved(res), BAND_WIDTHS[0]
-        corners_differ, corner_error = True, 0.0
+        kept = None  # each corner's part, as the last comparison refining it read it
     else:
         # A run again starts from the earlier run's last comparison. Built on ``res``
         # instead, a lift-off of the heel under strong creep took panels twice as wide at
@@ -919,21 +948,23 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         # estimate of 2.2e-7 (the check compares the histories, which the edge barely
         # moves).
         base, finer = start["bases"]
-        width, corners_differ, corner_error = (start["width"], start["corners_differ"],
-                                               start["corner_error"])
+        width, kept = start["width"], start["corners"]
     rule = marches.rule(base, bands, width)
     current = check_march(rule)
     half = marches.rule(finer, bands, width / 2.0)
     half_base = finer
     while True:
         halved = check_march(half)
-        diff, shift, corners = marches.rule_distance(rule, current, half, halved, bands)
-        if corners_differ:
-            corner_error = SPACE_FACTOR * corners
+        diff, shift, corners, refined = marches.rule_distance(rule, current, half, halved,
+                                                              bands)
+        measured = SPACE_FACTOR * np.asarray(corners, dtype=float)
+        kept = measured if kept is None else np.where(refined, measured,
+                                                      np.maximum(kept, measured))
+        corner_error = float(np.max(kept, initial=0.0))
         error = max(SPACE_FACTOR * diff, corner_error)
         end_error = SPACE_FACTOR * shift
-        last = {"bases": (base, half_base), "width": width, "corners_differ": corners_differ,
-                "corner_error": corner_error}
+        last = {"bases": (base, half_base), "width": width, "corners": kept,
+                "rules": (rule, half)}
         if (error <= tol / 6 and end_error <= end_tol / 2) or width / 2.0 < BAND_WIDTHS[-1]:
             break
         if not marches.banded(bands):
@@ -951,7 +982,6 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
                 or marches.nodes(checking) > MAX_CHECK_NODES):
             break
         # The halved rule becomes the candidate (its base is already the finer one).
-        corners_differ = not marches.banded(bands) or corner_error > tol / 6
         width /= 2.0
         base, half_base = half_base, finer
         rule, current, half = half, halved, checking

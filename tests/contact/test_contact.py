@@ -799,7 +799,7 @@ class _BandStub:
         return 1.0, 1.0
 
     def rule_distance(self, rule, a, finer, b, bands):
-        return self.outputs, 1.0, 0.0
+        return self.outputs, 1.0, np.zeros(1), np.ones(1, dtype=bool)
 
     @staticmethod
     def banded(bands) -> bool:
