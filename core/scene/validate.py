@@ -39,7 +39,11 @@ from core.profiles import Profile, profile_values
 from core.scene import schema
 from core.scene.at_loading import creeps
 from core.scene.design import DesignLimits
-from core.scene.load_rates import check_step_limit
+from core.scene.load_rates import (
+    CODE_STEPS_PER_PERIOD,
+    STEPS_PER_PERIOD,
+    check_step_limit,
+)
 from core.scene.model import Layer, Scene
 from core.scene.schema import (
     _jsonable,
@@ -336,7 +340,9 @@ def _check_load_rates(scene: Scene) -> None:
     check_step_limit({f"loading.{q}": p for q, p in scene.loading.items()}, 0.0,
                      float(scene.times[-1]), scene.tol,
                      limits.MAX_KERNEL_GRID_POINTS if general else limits.MAX_TIME_STEPS,
-                     "the time grid's limit" if general else "the time stepping's limit")
+                     "the time grid's limit" if general else "the time stepping's limit",
+                     CODE_STEPS_PER_PERIOD if isinstance(scene.creep, CodeCreep)
+                     else STEPS_PER_PERIOD)
 
 
 def _x_profiles(scene: Scene) -> list[tuple[str, Profile]]:
