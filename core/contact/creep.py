@@ -300,16 +300,19 @@ def _corner_q_between_rules(space: Space, rule: Panels, out: dict[str, Any],
                             finer: Panels, finer_out: dict[str, Any],
                             others: tuple[Others, Others] | None = None) -> np.ndarray:
     """The largest change of q at each of the punch's corners (:func:`corner_points`, a
-    side in contact in both marches) between the answers of marches on two rules at the
-    output times with a free end, each the kink-corrected pressure of
-    :func:`output_snapshot`, relative to the largest q (0 where never compared).
+    side in contact in both marches) between the answers of marches on two rules at every
+    output time, each the kink-corrected pressure of :func:`output_snapshot`, relative to
+    the largest q (0 where never compared).
 
-    :func:`_q_between_rules` leaves out those times, where the nodal q carries the end's
-    kink: under lift-off, all of them, and q at the toe of a heel
+    :func:`_q_between_rules` leaves out the times with a free end, where the nodal q
+    carries the end's kink: under lift-off, all of them, and q at the toe of a heel
     lifting off under strong creep was 3.85e-7 off (tol 1e-6, against a reference graded
     eight times finer there) with a spatial estimate of 7.8e-9. The corrected answers
     compared at the corners, where q is steepest and the grading there tells, read 1.1e-6,
-    2.9e-7 and 7.6e-8 as the edge panels went from 0.01 to 0.0025 (measured).
+    2.9e-7 and 7.6e-8 as the edge panels went from 0.01 to 0.0025 (measured). At the
+    other times its nodes stop short of the corners: a crown spread over the whole punch
+    on a fast-creeping base had q 1.3e-5 off at x = -0.999995 at tol 1e-4, estimated
+    1.4e-6 (an auditor's find).
 
     ``others``: the other punches on the base push this one's surface too
     (:data:`Others`: of the march ``out``, then of ``finer_out``)."""
@@ -323,8 +326,6 @@ def _corner_q_between_rules(space: Space, rule: Panels, out: dict[str, Any],
     pushes = ((), ()) if others is None else (others[0](points), others[1](points))
     beside = points + 1e-9 * inward  # (a side in contact: a point just beside it in a zone)
     for k in range(out["q"].shape[1]):
-        if not _free_end_at(space, out, finer_out, k):
-            continue  # (q there is compared at the nodes, the corners' beside them)
         zones = [_ends_zones(answer["ends"][k]) for _, answer, _ in answers]
         inside = nodes_in(beside, zones[0]) & nodes_in(beside, zones[1])
         if not inside.any():
@@ -368,7 +369,7 @@ def _rule_distance(space: Space, rule: Panels, out: dict[str, Any], finer: Panel
                    ) -> tuple[float, float, np.ndarray, np.ndarray]:
     """:func:`_distance` of marches on two panel rules (``rule``, and every panel finer,
     ``finer``), q compared too where no free end is (:func:`_q_between_rules`) and at the
-    punch's corners at the times with a free end (:func:`_corner_q_between_rules`): (the
+    punch's corners (:func:`_corner_q_between_rules`): (the
     largest relative difference, the largest shift of a zone end, each corner's part,
     whether ``finer`` is graded finer there, :func:`corners_refined`)."""
     outputs, shift = _distance(out, finer_out)
@@ -902,7 +903,8 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     bands, half the base width and half its grading at +-1 and the breakpoints, so that
     a rule without bands is checked too), halving ``w`` until ``SPACE_FACTOR`` times
     their difference meets a sixth of ``tol`` and half the zone-end tolerance (half of
-    what success asks; or ``BAND_WIDTHS`` run out; below ``LAST_RESORT_BELOW`` only where
+    what success asks; or ``BAND_WIDTHS`` run out, for a rule without bands its check's
+    nodes; below ``LAST_RESORT_BELOW`` only where
     the ends' error times q's ``slope`` beside them would alone fail tol, and while the
     next check's rule has at most ``MAX_CHECK_NODES`` nodes). Where q at the punch's
     corners is what misses (:func:`_corner_q_between_rules`), the grading there is halved
@@ -965,11 +967,15 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         end_error = SPACE_FACTOR * shift
         last = {"bases": (base, half_base), "width": width, "corners": kept,
                 "rules": (rule, half)}
-        if (error <= tol / 6 and end_error <= end_tol / 2) or width / 2.0 < BAND_WIDTHS[-1]:
+        if (error <= tol / 6 and end_error <= end_tol / 2) or (
+                width / 2.0 < BAND_WIDTHS[-1] and marches.banded(bands)):
             break
         if not marches.banded(bands):
             # no band panels, which the width would refine: the base is refined instead
-            # (the same rule, compared with itself, read 1e-14 with q 3e-7 off at tol 1e-7)
+            # (the same rule, compared with itself, read 1e-14 with q 3e-7 off at tol 1e-7),
+            # while its check has at most MAX_CHECK_NODES nodes, whatever BAND_WIDTHS say
+            # (q compared at the corners, full contact at tol 1e-7 missed tol by 2 % when
+            # the widths ran out; a finer rule met it: 1184 nodes, 2.7 s of CPU against 0.8)
             finer = marches.halved(finer)
         elif corner_error > tol / 6:
             # (q at the toe of a heel lifting off under strong creep: 1.1e-6 with the edge

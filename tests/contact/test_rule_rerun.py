@@ -9,8 +9,8 @@ wide at the toe as the rule the first run had checked, q at x = +a 1.5e-6 off wi
 estimate of 2.2e-7, success True. Once that was mended (q 3.85e-7 off, estimate 2.2e-7),
 the check still compared rules with one grading at +-1 after its first step, and q at the
 corners only at times without a free end (under lift-off: never); its spatial part read
-7.8e-9. Now the corners are compared at the times with a free end, their grading halved
-while they miss:
+7.8e-9. Now the corners are compared at every time, their grading halved while they
+miss:
 q at the toe 9.6e-8 off, spatial part 1.5e-7, estimate 3.6e-7 (over tol / 3: refused,
 where the answer's error is within tol; 15.6 s of CPU as before). A researcher's audit: a
 flat punch 2 m wide, 15 mm of coating at 400 MPa, 6 m of base at 30 GPa with C 1e-9 /Pa
