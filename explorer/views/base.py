@@ -26,24 +26,21 @@ class BaseView:
         self.base = Binding(reject, live_when=live_when)
         bb = self.base
         self.base_thickness = bb.add("thickness", slider("thickness H [m]", 0.1, 20.0, 0.05,
-                                                         "0[.]00", css_classes=["base-thickness"]))
+                                                         css_classes=["base-thickness"]))
         self.base_poisson = bb.add("poisson", slider("Poisson ratio [-]", 0.0, 0.49, 0.01))
-        self.base_modulus = bb.add("modulus", slider("Young's modulus E [GPa]", 0.1, 60.0, 0.1,
-                                                     "0[.]0"))
+        self.base_modulus = bb.add("modulus", slider("Young's modulus E [GPa]", 0.1, 60.0, 0.1))
         self.creep_model = bb.add("creep_model", pn.widgets.Select(
             label="creep model", options={v: k for k, v in CREEP_MODELS.items()},
             sizing_mode="stretch_width", css_classes=["creep-select"]))
         self.compliance = bb.add("compliance", slider("final creep compliance C∞ [1/GPa]",
-                                                           0.0, 0.1, 0.0005, "0[.]0000"))
-        self.rate = bb.add("rate", slider("creep rate γ [1/day]", 0.001, 1.0, 0.001,
-                                               "0[.]000"))
+                                                           0.0, 0.1, 0.0005))
+        self.rate = bb.add("rate", slider("creep rate γ [1/day]", 0.001, 1.0, 0.001))
         self.beta = bb.add("beta", slider("modulus aging β [-]", 0.0, 0.95, 0.01))
         self.alpha = bb.add("alpha", slider("modulus aging rate α [1/day]", 0.001, 1.0,
                                                  0.001))
-        self.aging = bb.add("aging", slider("aging creep A [day/GPa]", 0.0, 5.0, 0.01,
-                                                 "0[.]00"))
+        self.aging = bb.add("aging", slider("aging creep A [day/GPa]", 0.0, 5.0, 0.01))
         self.age = bb.add("age_at_loading", slider("age at loading τ₀ [days]", 1.0, 3650.0,
-                                                   1.0, "0[.]0"))
+                                                   1.0))
         self.creep_note = html_pane("", styles=NOTE_STYLE)
         bb.bind(s.base)
         s.base.param.watch(lambda *e: self.refresh(), ["creep_model", "custom"])

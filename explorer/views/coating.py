@@ -86,7 +86,7 @@ class CoatingView:
         self.modulus_editor = ProfileEditor("Young's modulus", "MPa", 1.0, 10000.0, 1.0,
                                             significant_format(), css="coating-modulus",
                                             live_when=live_when, on_reject=reject)
-        self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01, "0[.]000",
+        self.poisson_editor = ProfileEditor("Poisson ratio", "-", 0.0, 0.49, 0.01,
                                             variations=False, live_when=live_when,
                                             on_reject=reject)
         self.layer_note = html_pane("", styles=NOTE_STYLE)

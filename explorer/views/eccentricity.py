@@ -76,7 +76,7 @@ class EccentricityControl:
         self.controller = controller
         self.reject = reject
         self.slider = slider("eccentricity e = M/P [m] (sets the moment)", -1.0, 1.0, 0.01,
-                             "0[.]000", css_classes=["eccentricity-slider"])
+                             css_classes=["eccentricity-slider"])
         self.note = html_pane("", styles=NOTE_STYLE, visible=False)
         # said while a drag step waits for the release (the plots lag behind the box)
         self.lag = html_pane("", styles=NOTE_STYLE, visible=False,

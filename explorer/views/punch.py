@@ -43,19 +43,18 @@ class PunchView:
                                                        sizing_mode="stretch_width"))
         # each shape's sliders are made when the shape is first chosen (LazySlider)
         self.radius = LazySlider(pb, "radius", "crown radius R [km]", 1.0, 500.0, 0.5,
-                                 "0[.]0", css_classes=["punch-crown-radius"])
-        self.slope = LazySlider(pb, "slope", "slope of each face [µrad]", 0.0, 200.0, 0.5,
-                                "0[.]0")
+                                 css_classes=["punch-crown-radius"])
+        self.slope = LazySlider(pb, "slope", "slope of each face [µrad]", 0.0, 200.0, 0.5)
         self.step_height = LazySlider(pb, "step_height",
                                       "step height [µm] (right part raised)", -100.0, 100.0,
-                                      0.5, "0[.]0")
+                                      0.5)
         self.step_position = LazySlider(pb, "step_position", "step position x [m]", -1.0,
                                         1.0, 0.01)
         self.land_height = LazySlider(pb, "land_height", "land height [µm] (middle protrudes)",
-                                      0.0, 100.0, 0.5, "0[.]0")
+                                      0.0, 100.0, 0.5)
         self.land_width = LazySlider(pb, "land_width", "land width [m]", 0.05, 2.0, 0.01)
         self.wave_amplitude = LazySlider(pb, "wave_amplitude", "wave amplitude [µm]", 0.0,
-                                         50.0, 0.1, "0[.]0")
+                                         50.0, 0.1)
         self.wave_length = LazySlider(pb, "wave_length", "wavelength [m]", 0.02, 5.0, 0.01)
         self.shape_file = BoundedUpload(accept=(".csv", ".txt"), max_bytes=MAX_TABLE_BYTES)
         self.shape_file.param.watch(self._on_shape_file, "value")

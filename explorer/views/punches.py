@@ -66,7 +66,7 @@ class PunchesSection:
         self.select.param.watch(lambda e: self.bind(), "value")
         self.where = Binding(reject, live_when=live_when)
         self.center = self.where.add("center", slider(
-            "centre x [m]", -10.0, 10.0, 0.01, "0[.]00", css_classes=["punch-center"]))
+            "centre x [m]", -10.0, 10.0, 0.01, css_classes=["punch-center"]))
         self.shape = Binding(reject, live_when=live_when)
         self.half_width = self.shape.add("half_width", slider(
             "half-width a [m]", 0.1, 5.0, 0.01, css_classes=["punch-half-width-of"]))

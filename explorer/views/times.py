@@ -29,7 +29,7 @@ class TimesView:
         self.global_binding = Binding(reject, live_when=live_when)
         gb = self.global_binding
         self.time_end = gb.add("time_end", slider("time span [days after loading]", 1.0,
-                                                  3650.0, 1.0, "0[.]0",
+                                                  3650.0, 1.0,
                                                   css_classes=["time-end"]))
         self.time_count = gb.add("time_count", EditableIntSlider(
             label="output times", start=2, end=200, step=1, sizing_mode="stretch_width",

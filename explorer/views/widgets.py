@@ -269,18 +269,22 @@ SIGNIFICANT_DIGITS = 6
 
 
 def significant_format() -> CustomJSTickFormatter:
-    """A box format of :data:`SIGNIFICANT_DIGITS` significant digits: a fixed number of
-    decimals showed a coating 0.0001 mm thick as "0" while that thickness was solved (and
-    a modulus of 1e-6 MPa as "0"). A new model each time: one belongs to one page."""
+    """A box format of :data:`SIGNIFICANT_DIGITS` significant digits, trailing zeros
+    dropped: a fixed number of decimals showed a coating 0.0001 mm thick as "0" while that
+    thickness was solved (a modulus of 1e-6 MPa, a creep rate of 0.0002 /day, a C∞ of
+    1e-5 /GPa likewise), and a typed moment of 777.48 as "777.4800". A new model each
+    time: one belongs to one page."""
     return CustomJSTickFormatter(
         code=f"return Number(Number(tick).toPrecision({SIGNIFICANT_DIGITS})).toString();")
 
 
 def slider(label: str, start: float, end: float, step: float,
-           fmt: str | CustomJSTickFormatter = "0[.]000",
+           fmt: str | CustomJSTickFormatter | None = None,
            **kwargs: Any) -> pn.widgets.EditableFloatSlider:
-    """A float slider with an input box (any value can be typed; the core validates it)."""
-    return EditableSlider(label=label, start=start, end=end, step=step, format=fmt,
+    """A float slider with an input box (any value can be typed; the core validates it),
+    its value shown in ``fmt`` (default :func:`significant_format`)."""
+    return EditableSlider(label=label, start=start, end=end, step=step,
+                          format=significant_format() if fmt is None else fmt,
                           sizing_mode="stretch_width", **kwargs)
 
 
@@ -512,7 +516,7 @@ class LazySlider:
     """
 
     def __init__(self, binding: Binding, name: str, label: str, start: float, end: float,
-                 step: float, fmt: str = "0[.]000", **kwargs: Any) -> None:
+                 step: float, fmt: str | None = None, **kwargs: Any) -> None:
         self.binding, self.name = binding, name
         self._spec: dict[str, Any] = dict(label=label, start=start, end=end, step=step,
                                           fmt=fmt, **kwargs)
@@ -555,7 +559,7 @@ class ProfileEditor:
     """Level, variation kind and its parameters for one :class:`ProfileState`."""
 
     def __init__(self, label: str, unit: str, start: float, end: float, step: float,
-                 fmt: str | CustomJSTickFormatter = "0[.]00", variations: bool = True,
+                 fmt: str | CustomJSTickFormatter | None = None, variations: bool = True,
                  amplitude: tuple[str, float, float, float] = ("%", -90.0, 500.0, 1.0),
                  css: str = "", live_when: Callable[[], bool] | None = None,
                  on_reject: Callable[[str], None] | None = None) -> None:
@@ -578,7 +582,7 @@ class ProfileEditor:
             a_label = f"{a_unit} of the level" if a_unit == "%" else a_unit
             self.amplitude = LazySlider(
                 self.binding, "amplitude", f"variation A [{a_label}]", a_lo, a_hi, a_step,
-                "0[.]0", css_classes=[f"{css}-amplitude"] if css else [])
+                css_classes=[f"{css}-amplitude"] if css else [])
             self.position = LazySlider(
                 self.binding, "position", "step position / patch or bump centre [m]",
                 -1.0, 1.0, 0.01, css_classes=[f"{css}-position"] if css else [])
@@ -665,11 +669,6 @@ def _refit(widget: pn.widgets.Widget, value: Any, default: tuple[float, float]) 
         _fit(widget, value, default)
 
 
-#: The number format of a history's value boxes (BokehJS's numbro: up to four decimals,
-#: trailing zeros dropped).
-HISTORY_FORMAT = "0.[0000]"
-
-
 class HistoryEditor:
     """Shape and parameters of the history of one given quantity (live while dragging)."""
 
@@ -680,14 +679,12 @@ class HistoryEditor:
         self.title = pn.pane.HTML("", margin=(8, 10, 0, 10))
         self.kind = self.binding.add("kind", pn.widgets.Select(
             label="history", options=HISTORY_KINDS, sizing_mode="stretch_width"))
-        # four decimals where a value needs them (a tilt in mrad), without trailing zeros:
-        # a typed moment of 777.48 read "777.4800" beside its readout's 777.48
-        self.value = self.binding.add("value", slider("value", 0.0, 1.0, 0.001, HISTORY_FORMAT,
+        self.value = self.binding.add("value", slider("value", 0.0, 1.0, 0.001,
                                                       css_classes=[f"{css}-value"] if css
                                                       else []), live=True)
-        self.second = self.binding.add("second", slider("second", 0.0, 1.0, 0.001,
-                                                        HISTORY_FORMAT), live=True)
-        self.time = self.binding.add("time", slider("time [days]", 0.1, 365.0, 0.1, "0[.]0"),
+        self.second = self.binding.add("second", slider("second", 0.0, 1.0, 0.001),
+                                       live=True)
+        self.time = self.binding.add("time", slider("time [days]", 0.1, 365.0, 0.1),
                                      live=True)
         self.note = pn.pane.HTML("", margin=(0, 10), styles={"font-size": "12px",
                                                               "color": "#666"})
