@@ -66,6 +66,7 @@ from core.contact.creep import (
     free_end_residual,
     free_end_slope,
     graded_halvings,
+    largest_part,
     output_snapshot,
     transient_windows,
 )
@@ -197,8 +198,7 @@ class CoupledMarches:
                 space, rules[p], a[p], finer[p], b[p], (pushing(rules, a), pushing(finer, b))))
             refined.append(corners_refined(space, rules[p], finer[p]))
         parts = np.concatenate(corners)
-        return (max(outputs, float(np.max(parts, initial=0.0))), shift, parts,
-                np.concatenate(refined))
+        return (max(outputs, largest_part(parts)), shift, parts, np.concatenate(refined))
 
     @staticmethod
     def banded(bands: Sequence[list[tuple[float, float]]]) -> bool:

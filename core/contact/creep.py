@@ -302,7 +302,7 @@ def _corner_q_between_rules(space: Space, rule: Panels, out: dict[str, Any],
     """The largest change of q at each of the punch's corners (:func:`corner_points`, a
     side in contact in both marches) between the answers of marches on two rules at every
     output time, each the kink-corrected pressure of :func:`output_snapshot`, relative to
-    the largest q (0 where never compared).
+    the largest q (NaN where never compared: no side of it in contact in both).
 
     :func:`_q_between_rules` leaves out the times with a free end, where the nodal q
     carries the end's kink: under lift-off, all of them, and q at the toe of a heel
@@ -318,7 +318,7 @@ def _corner_q_between_rules(space: Space, rule: Panels, out: dict[str, Any],
     (:data:`Others`: of the march ``out``, then of ``finer_out``)."""
     points, inward = corner_points(space.breakpoints)
     scale = max(float(np.max(np.abs(out["q"]), initial=0.0)), 1e-300)
-    worst = np.zeros(points.size)
+    worst = np.full(points.size, np.nan)
     if out["q"].size == 0 or out["q"].shape[1] != finer_out["q"].shape[1]:
         return worst
     answers = [(rule, out, operator_rows(space.lam, rule, points)),
@@ -344,8 +344,14 @@ def _corner_q_between_rules(space: Space, rule: Panels, out: dict[str, Any],
                                            snap.settlement, snap.tilt, points[inside],
                                            inward[inside], displacement,
                                            rows=rows[inside]))
-        worst[inside] = np.maximum(worst[inside], np.abs(values[0] - values[1]))
+        worst[inside] = np.fmax(worst[inside], np.abs(values[0] - values[1]))
     return worst / scale
+
+
+def largest_part(parts: np.ndarray) -> float:
+    """The largest of the corners' parts, those never compared (NaN) aside; 0 if none."""
+    parts = np.asarray(parts, dtype=float)
+    return float(np.nanmax(parts)) if np.isfinite(parts).any() else 0.0
 
 
 def corners_refined(space: Space, rule: Panels, finer: Panels) -> np.ndarray:
@@ -375,8 +381,7 @@ def _rule_distance(space: Space, rule: Panels, out: dict[str, Any], finer: Panel
     outputs, shift = _distance(out, finer_out)
     corners = _corner_q_between_rules(space, rule, out, finer, finer_out)
     return (max(outputs, _q_between_rules(space, rule, out, finer, finer_out, bands),
-                float(np.max(corners, initial=0.0))), shift, corners,
-            corners_refined(space, rule, finer))
+                largest_part(corners)), shift, corners, corners_refined(space, rule, finer))
 
 
 #: Under creep the zone ends are located to the larger of ``ZONE_END_TOL`` and this share
@@ -959,10 +964,11 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         halved = check_march(half)
         diff, shift, corners, refined = marches.rule_distance(rule, current, half, halved,
                                                               bands)
+        # (a corner not compared, NaN, keeps what was measured of it before)
         measured = SPACE_FACTOR * np.asarray(corners, dtype=float)
-        kept = measured if kept is None else np.where(refined, measured,
-                                                      np.maximum(kept, measured))
-        corner_error = float(np.max(kept, initial=0.0))
+        kept = measured if kept is None else np.where(
+            np.asarray(refined) & np.isfinite(measured), measured, np.fmax(kept, measured))
+        corner_error = largest_part(kept)
         error = max(SPACE_FACTOR * diff, corner_error)
         end_error = SPACE_FACTOR * shift
         last = {"bases": (base, half_base), "width": width, "corners": kept,
@@ -982,6 +988,9 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
             # panels 0.01 wide, the bands' panels halved to 0.005 left it there)
             finer = marches.edges_halved(finer)
         checking = marches.rule(finer, bands, width / 4.0)
+        if (not marches.banded(bands) and width / 2.0 < BAND_WIDTHS[-1]
+                and marches.nodes(checking) <= marches.nodes(half)):
+            break  # (a rule past the band widths that no longer grows: nothing more to try)
         # (q off the bands missing its share asks the finer rule, whose base is finer too)
         if width / 2.0 < LAST_RESORT_BELOW and (
                 (error <= tol / 6 and accepts(end_error * slope, tol, UNILATERAL_MARGIN))

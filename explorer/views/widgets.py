@@ -264,8 +264,9 @@ class EditableIntSlider(_RangeKept, pn.widgets.EditableIntSlider):
                              "text box does).")
 
 
-#: Significant digits of a box shown by :func:`significant_format`.
-SIGNIFICANT_DIGITS = 6
+#: Significant digits of a box shown by :func:`significant_format`: every value of the
+#: page's units to its hundredths (six rounded a modulus of 1234567.8 MPa to 1234570).
+SIGNIFICANT_DIGITS = 8
 
 
 def significant_format() -> CustomJSTickFormatter:

@@ -161,6 +161,54 @@ def test_a_run_again_after_a_last_resort_stop_starts_from_the_comparison_made(mo
     assert again.built[:2] == [chosen, made]
 
 
+class _Never(_Marches):
+    """A check that never meets tol, on rules whose nodes grow as ``growth`` says."""
+
+    def __init__(self, growth) -> None:
+        super().__init__()
+        self.growth = growth
+
+    def nodes(self, rule) -> int:
+        return self.growth(rule[0][0])
+
+    def rule_distance(self, rule, out, finer, finer_out, bands):
+        return 1.0, 0.0, np.zeros(1), np.ones(1, dtype=bool)
+
+
+def test_a_rule_without_bands_is_refined_until_its_check_is_too_large_or_stops_growing(
+        monkeypatch):
+    # past the band widths a rule without bands is refined while its check has at most
+    # MAX_CHECK_NODES nodes; one whose nodes no longer grow ends there (width kept > 0)
+    from core.contact import creep
+
+    monkeypatch.setattr(creep, "MAX_CHECK_NODES", 1000)
+    growing = _Never(lambda halvings: 16 * 2 ** halvings)
+    rule, *_ = _select(growing, [])
+    assert growing.nodes(growing.built[-1]) > 1000 >= growing.nodes(rule)
+    flat = _Never(lambda halvings: 16)
+    rule, *_ = _select(flat, [])
+    assert len(flat.built) < 10 and rule[1] > 0.0
+
+
+class _Uncompared(_Corners):
+    """As _Corners, but the corner is in contact in both marches of the first comparison
+    only (the later ones do not compare it: NaN)."""
+
+    def rule_distance(self, rule, out, finer, finer_out, bands):
+        off, shift, corners, refined = super().rule_distance(rule, out, finer, finer_out,
+                                                             bands)
+        if rule[1] < BAND_WIDTHS[0]:
+            corners = np.array([np.nan])
+        return off, shift, corners, np.array([True])
+
+
+def test_a_corner_not_compared_keeps_its_part_measured_before():
+    marches = _Uncompared(1e-7, enough=BAND_WIDTHS[2])
+    _, error, _, note = _select(marches, [(0.4, 0.5)])
+    first = SPACE_FACTOR * abs(marches.error(((0, 0), 0)) - marches.error(((1, 1), 0)))
+    assert error == first and note["start"]["corners"] == [first]
+
+
 def test_a_march_read_again_from_the_memo_has_zone_ends_of_its_own():
     # _borrow_corrections changes a march's ends in place: a second read must not see it
     from core.contact.creep import MarchMemo

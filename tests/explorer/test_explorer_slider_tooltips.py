@@ -20,16 +20,17 @@ def test_no_slider_of_the_page_has_a_tooltip(explorer_app):
     assert shown == []
 
 
-def test_every_slider_box_shows_its_value_to_six_significant_digits(explorer_app):
+def test_every_slider_box_shows_its_value_to_significant_digits(explorer_app):
     """A box of a fixed number of decimals showed a creep rate of 0.0002 /day, a C∞ of
     1e-5 /GPa or a coating 0.0001 mm thick as "0" while the value was solved (and a moment
-    of 777.48 as "777.4800"); every box now shows six significant digits, trailing zeros
-    dropped. The sliders of the punch shapes and variations are made when first shown."""
+    of 777.48 as "777.4800"); every box now shows SIGNIFICANT_DIGITS significant digits,
+    trailing zeros dropped. The sliders of the punch shapes and variations are made when
+    first shown."""
     import gc
 
     from bokeh.models import CustomJSTickFormatter
 
-    from explorer.views.widgets import LazySlider
+    from explorer.views.widgets import SIGNIFICANT_DIGITS, LazySlider
 
     app = explorer_app()
     for index in range(len(app.tabs.sidebar)):
@@ -41,5 +42,6 @@ def test_every_slider_box_shows_its_value_to_six_significant_digits(explorer_app
     boxes += [w for w in made if w is not None]
     assert len(boxes) > 30
     fixed = [w.name for w in boxes if not (isinstance(w.format, CustomJSTickFormatter)
-                                            and "toPrecision(6)" in w.format.code)]
+                                            and f"toPrecision({SIGNIFICANT_DIGITS})"
+                                            in w.format.code)]
     assert fixed == []
