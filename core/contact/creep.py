@@ -375,9 +375,9 @@ def _rule_distance(space: Space, rule: Panels, out: dict[str, Any], finer: Panel
                    ) -> tuple[float, float, np.ndarray, np.ndarray]:
     """:func:`_distance` of marches on two panel rules (``rule``, and every panel finer,
     ``finer``), q compared too where no free end is (:func:`_q_between_rules`) and at the
-    punch's corners (:func:`_corner_q_between_rules`): (the
-    largest relative difference, the largest shift of a zone end, each corner's part,
-    whether ``finer`` is graded finer there, :func:`corners_refined`)."""
+    punch's corners (:func:`_corner_q_between_rules`): (the largest relative difference,
+    the largest shift of a zone end, each corner's part, whether ``finer`` is graded finer
+    there, :func:`corners_refined`)."""
     outputs, shift = _distance(out, finer_out)
     corners = _corner_q_between_rules(space, rule, out, finer, finer_out)
     return (max(outputs, _q_between_rules(space, rule, out, finer, finer_out, bands),
