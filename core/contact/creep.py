@@ -876,6 +876,15 @@ def _in_time(marches: Any, times: np.ndarray, base: Any, first_steps: int, budge
     return out, float(time_error), float(end_shift), run
 
 
+#: A rule without band panels (full contact) is compared down to this "width": one
+#: halving of its base more than ``BAND_WIDTHS`` give a banded rule. With q compared at the
+#: corners, full contact at tol 1e-7 missed tol by 2 % when the widths ran out, and one
+#: finer rule met it (1184 nodes, 2.7 s of CPU against 0.8); unbounded, two footings in
+#: full contact at tol 1e-7 refined on to 32 s of CPU (11 s before) for an estimate of
+#: 1.5e-8 where 2.4e-8 had met tol.
+UNBANDED_LAST = BAND_WIDTHS[-1] / 2.0
+
+
 #: The least ratio of successive differences of three grids (each of half the steps of
 #: the last) at which their outputs are taken to converge at order 2 (ratio 4) and are
 #: extrapolated. Below it the error of the finest is ``last difference / (ratio - 1)``
@@ -973,15 +982,14 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
         end_error = SPACE_FACTOR * shift
         last = {"bases": (base, half_base), "width": width, "corners": kept,
                 "rules": (rule, half)}
-        if (error <= tol / 6 and end_error <= end_tol / 2) or (
-                width / 2.0 < BAND_WIDTHS[-1] and marches.banded(bands)):
+        if (error <= tol / 6 and end_error <= end_tol / 2) or width / 2.0 < (
+                BAND_WIDTHS[-1] if marches.banded(bands) else UNBANDED_LAST):
             break
         if not marches.banded(bands):
             # no band panels, which the width would refine: the base is refined instead
             # (the same rule, compared with itself, read 1e-14 with q 3e-7 off at tol 1e-7),
-            # while its check has at most MAX_CHECK_NODES nodes, whatever BAND_WIDTHS say
-            # (q compared at the corners, full contact at tol 1e-7 missed tol by 2 % when
-            # the widths ran out; a finer rule met it: 1184 nodes, 2.7 s of CPU against 0.8)
+            # once more than the band widths allow (UNBANDED_LAST), while its check has at
+            # most MAX_CHECK_NODES nodes
             finer = marches.halved(finer)
         elif corner_error > tol / 6:
             # (q at the toe of a heel lifting off under strong creep: 1.1e-6 with the edge

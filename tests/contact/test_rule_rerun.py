@@ -175,16 +175,20 @@ class _Never(_Marches):
         return 1.0, 0.0, np.zeros(1), np.ones(1, dtype=bool)
 
 
-def test_a_rule_without_bands_is_refined_until_its_check_is_too_large_or_stops_growing(
-        monkeypatch):
-    # past the band widths a rule without bands is refined while its check has at most
-    # MAX_CHECK_NODES nodes; one whose nodes no longer grow ends there (width kept > 0)
+def test_a_rule_without_bands_is_refined_once_past_the_band_widths_at_most(monkeypatch):
+    # a rule without bands is compared once more than a banded one (UNBANDED_LAST), while
+    # its check has at most MAX_CHECK_NODES nodes; one whose nodes no longer grow ends there
     from core.contact import creep
 
-    monkeypatch.setattr(creep, "MAX_CHECK_NODES", 1000)
     growing = _Never(lambda halvings: 16 * 2 ** halvings)
     rule, *_ = _select(growing, [])
-    assert growing.nodes(growing.built[-1]) > 1000 >= growing.nodes(rule)
+    assert rule[1] == creep.UNBANDED_LAST == BAND_WIDTHS[-1] / 2
+    banded = _Never(lambda halvings: 16 * 2 ** halvings)
+    assert _select(banded, [(0.4, 0.5)])[0][1] == BAND_WIDTHS[-1]
+    monkeypatch.setattr(creep, "MAX_CHECK_NODES", 200)
+    capped = _Never(lambda halvings: 16 * 2 ** halvings)
+    rule, *_ = _select(capped, [])
+    assert capped.nodes(capped.built[-1]) > 200 >= capped.nodes(rule)
     flat = _Never(lambda halvings: 16)
     rule, *_ = _select(flat, [])
     assert len(flat.built) < 10 and rule[1] > 0.0
