@@ -60,6 +60,7 @@ from core.contact.creep import (
     _extrapolate,
     _outside_bands,
     _q_between_rules,
+    _zones_of,
     controlled_march,
     corners_refined,
     creep_verdict,
@@ -490,8 +491,7 @@ def solve_creep_punches(punches: Sequence[PunchGeometry], inputs: Sequence[TimeI
                                                                   time_breaks, tol))
     zones_of, snapshots_of = [], []
     for p, mine in enumerate(out):
-        zones = [[(float(e[2 * i]), float(e[2 * i + 1])) for i in range(len(e) // 2)]
-                 for e in mine["ends"]]
+        zones = _zones_of(mine)
         snapshots = []
         for k in range(times.size):
             # each punch's pressure as one punch's (kink-corrected where made, see

@@ -557,8 +557,7 @@ def solve_creep(space: Space, inp: Any, c_t: np.ndarray, loads: dict[str, np.nda
 
 def _zones_of(out: dict[str, Any]) -> list[list[tuple[float, float]]]:
     """The contact zones of each output time of a march's outputs ``out``."""
-    return [[(float(e[2 * i]), float(e[2 * i + 1])) for i in range(len(e) // 2)]
-            for e in out["ends"]]
+    return [_ends_zones(ends) for ends in out["ends"]]
 
 
 #: Points x > 0 at which :func:`even_problem` compares m and g with their mirror images
@@ -917,8 +916,8 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
     bands, half the base width and half its grading at +-1 and the breakpoints, so that
     a rule without bands is checked too), halving ``w`` until ``SPACE_FACTOR`` times
     their difference meets a sixth of ``tol`` and half the zone-end tolerance (half of
-    what success asks; or ``BAND_WIDTHS`` run out, for a rule without bands its check's
-    nodes; below ``LAST_RESORT_BELOW`` only where
+    what success asks; or ``BAND_WIDTHS`` run out, for a rule without bands one halving
+    past them, :data:`UNBANDED_LAST`; below ``LAST_RESORT_BELOW`` only where
     the ends' error times q's ``slope`` beside them would alone fail tol, and while the
     next check's rule has at most ``MAX_CHECK_NODES`` nodes). Where q at the punch's
     corners is what misses (:func:`_corner_q_between_rules`), the grading there is halved
@@ -996,9 +995,6 @@ def _select_rule(marches: Any, times: np.ndarray, res: Any, first_steps: int, to
             # panels 0.01 wide, the bands' panels halved to 0.005 left it there)
             finer = marches.edges_halved(finer)
         checking = marches.rule(finer, bands, width / 4.0)
-        if (not marches.banded(bands) and width / 2.0 < BAND_WIDTHS[-1]
-                and marches.nodes(checking) <= marches.nodes(half)):
-            break  # (a rule past the band widths that no longer grows: nothing more to try)
         # (q off the bands missing its share asks the finer rule, whose base is finer too)
         if width / 2.0 < LAST_RESORT_BELOW and (
                 (error <= tol / 6 and accepts(end_error * slope, tol, UNILATERAL_MARGIN))

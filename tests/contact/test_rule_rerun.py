@@ -177,7 +177,7 @@ class _Never(_Marches):
 
 def test_a_rule_without_bands_is_refined_once_past_the_band_widths_at_most(monkeypatch):
     # a rule without bands is compared once more than a banded one (UNBANDED_LAST), while
-    # its check has at most MAX_CHECK_NODES nodes; one whose nodes no longer grow ends there
+    # its check has at most MAX_CHECK_NODES nodes; one whose nodes no longer grow ends too
     from core.contact import creep
 
     growing = _Never(lambda halvings: 16 * 2 ** halvings)
