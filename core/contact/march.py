@@ -37,7 +37,14 @@ from core.contact.memory import pressure_memory
 from core.contact.step import Space, Step, check_loads
 from core.contact.systems import Mirror, StepSolver
 from core.contact.zones import zone_kernel_accuracy
-from core.discretize import NODES_PER_PANEL, KernelOperator, Panels, kernel_operator
+from core.discretize import (
+    BARYCENTRIC_WEIGHTS,
+    GAUSS_NODES,
+    NODES_PER_PANEL,
+    KernelOperator,
+    Panels,
+    kernel_operator,
+)
 from core.work import check_work
 
 #: The operators of the stepping's panel rules, keyed by lam and the panel edges (they
@@ -121,6 +128,7 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
     unsettled = 0
     # the zones at loading, as an earlier march found them, until this one has its own
     zones = len(first["zones"]) if first is not None and "zones" in first else 0
+    corners = np.zeros((steps, 2))
     for n in range(steps):
         check_work("following the contact zones under creep step by step", zones)
         memory_density = np.zeros(n_nodes)
@@ -154,6 +162,7 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         sweeps += count
         unsettled += not settled
         active = state.active
+        corners[n] = corner_pressure(base, state.nystrom)
         zones = contact_runs(active)
         memory_of.record(n, state.q)
         if n in wanted:
@@ -179,9 +188,29 @@ def march(space: Space, inp: Any, base, op: np.ndarray, m: np.ndarray, g: np.nda
         for (k, c), ends in zip(pending, roots, strict=True):
             states[k] = states[k][:3] + (ends, states[k][4], kink_correction(states[k][0], c))
     return {"states": states, "sweeps": sweeps, "unsettled": unsettled, "steps": steps - 1,
-            "breakpoints": space.breakpoints,
+            "breakpoints": space.breakpoints, "grid": grid, "corner_pressure": corners,
             "factorizations": solver.factorizations,
             "back_substitutions": solver.back_substitutions}
+
+
+def corner_pressure(panels: Panels, nystrom: np.ndarray) -> np.ndarray:
+    """The Nystrom pressure Q of a step (:class:`NodalState`) at x = -1 and +1, from the
+    interpolant of the first and the last panel's nodes [dimensionless, like q].
+
+    Q is one smooth function across a free end: q inside the zone, minus the gap over
+    c m outside it. So it is positive where a corner is in contact and negative where it
+    has lifted, and it passes through zero, smoothly in time, where the corner touches
+    down or lifts off: the root between two steps of opposite signs locates that time
+    (:func:`core.contact.creep.corner_contact_changes`), which the march's trapezoid
+    steps must land on (a kink of q in time; inside a step Richardson's estimate read a
+    crown's q at 1/5 of its error)."""
+    values = np.empty(2)
+    for side, (panel, end) in enumerate(((0, -1.0), (panels.n_panels - 1, 1.0))):
+        local = nystrom[panel * NODES_PER_PANEL:(panel + 1) * NODES_PER_PANEL]
+        # the barycentric form holds off the nodes too: its value at the panel's end
+        ratio = BARYCENTRIC_WEIGHTS / (end - GAUSS_NODES)
+        values[side] = ratio @ local / ratio.sum()
+    return values
 
 
 def creep_memory(kernel: Any, grid: np.ndarray, widths: np.ndarray, n_nodes: int) -> Any:

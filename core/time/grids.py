@@ -19,7 +19,8 @@ KEY_SAMPLES = 129
 
 def time_grid(times: np.ndarray, steps: int, refine: int = 0,
               jumps: Sequence[float] = (), graded: int = 0,
-              windows: Sequence[tuple[float, float, float]] = ()
+              windows: Sequence[tuple[float, float, float]] = (),
+              kinks: Sequence[float] = ()
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A grid on ``[1, times[-1]]`` containing every requested time (dimensionless t).
 
@@ -54,6 +55,10 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
     ``windows``: (from, to, longest step): the intervals between ``from`` and ``to`` (each
     ``to`` an interval end) get steps no longer than that (a creep law's decay, stepped
     finely while it lasts); also independent of ``refine``.
+
+    ``kinks``: times where the answer has a kink the grid must land on (a corner of the
+    punch touching down or lifting off, located by the march itself): each an interval
+    end, as a requested time is, but not an output; also independent of ``refine``.
     """
     times = np.asarray(times, dtype=float)
     h = (times[-1] - 1.0) / steps
@@ -82,6 +87,9 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
     windows = [(float(a), float(b), float(step)) for a, b, step in windows if step < h]
     ends += [(b, -1) for _, b, _ in windows if 1.0 < b < float(times[-1])
              and all(abs(b - j) > sides[j] for j in inside)]
+    ends += [(float(t), -1) for t in kinks if 1.0 < t < float(times[-1])
+             and not np.any(np.abs(times - t) <= 1e-9 * t)
+             and all(abs(t - j) > sides[j] for j in inside)]
     on_jump: dict[int, int] = {}
     for j, side in sides.items():
         ends += [(j - side, -1), (j + side, -1)]

@@ -309,3 +309,68 @@ def test_q_at_the_corners_a_spreading_crown_reaches_is_in_the_estimate(
     error = float(np.max(np.abs(answer.pressure(corners) - reference.pressure(corners)))
                   / np.max(np.abs(reference.pressure(X))))
     assert error <= answer.info["error_estimate"] <= 1e-4 / UNILATERAL_MARGIN
+
+
+@pytest.mark.slow
+def test_a_corner_touching_down_between_steps_is_stepped_on() -> None:
+    """A crown on a fast-creeping base (kernel (4, 2)) spreads to the whole punch at
+    t = 1.0718, inside the first step of every grid: q has a kink in time there, and
+    Richardson's estimate of the grids read it low: success at tol 1e-4, estimate 1.6e-5,
+    q 8.0e-5 off at x = -0.984, t = 2 (an auditor's find). The grids now land on the
+    touchdown (located from the Nystrom pressure at the corners, then again on grids
+    landing near it): estimate 1.1e-5, q 4.2e-6 off (against a tol-1e-9 answer graded 64
+    times finer at the corners, on grids landing there). The reference here: the answer
+    at tol 1e-6 (refused at an estimate of 9.8e-7, 5.6e-7 off against that one)."""
+    from core.contact import creep
+    from core.creep.kernels import DegenerateKernel
+
+    fast = DegenerateKernel(age_at_loading=1.0, modulus_final=1.0, beta=0.0, alpha=0.0,
+                            terms=((4.0, 0.0, 2.0),))
+    located: list[list[float]] = []
+    changes = creep.corner_contact_changes
+
+    def spy(run):
+        located.append(changes(run))
+        return located[-1]
+
+    def crown(tol: float):
+        return solve_dimensionless(1.0, 0.05, lambda x: 0.02 * np.asarray(x) ** 2,
+                                   np.linspace(1.0, 12.0, 12), kernel=fast, force=0.05,
+                                   moment=0.0, tol=tol, contact="unilateral")
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(creep, "corner_contact_changes", spy)
+        answer = crown(1e-4)
+    assert answer.info["success"] and answer.contact_set[0] != [(-1.0, 1.0)]
+    assert answer.contact_set[1] == [(-1.0, 1.0)]
+    # the first grids' line put it at 1.0750, the grids landing there at 1.0721
+    assert located[0] == [pytest.approx(1.07498, abs=1e-4)]
+    assert located[-1] == [pytest.approx(1.07181, abs=5e-4)]
+    reference = crown(1e-6)
+    assert reference.info["error_estimate"] <= 1e-6
+    points = np.concatenate([X, -1.0 + np.geomspace(1e-10, 1e-2, 40),
+                             1.0 - np.geomspace(1e-10, 1e-2, 40)])
+    exact = reference.pressure(points)
+    error = float(np.max(np.abs(answer.pressure(points) - exact)) / np.max(np.abs(exact)))
+    assert error <= answer.info["error_estimate"] <= 1e-4 / UNILATERAL_MARGIN
+
+
+def test_a_corner_contact_change_is_the_root_of_its_nystrom_pressure() -> None:
+    """The Nystrom pressure at +-1 (a panel's interpolant at its end, off the nodes) and
+    the root of its line between the two steps where it changes sign."""
+    from core.contact.creep import corner_contact_changes
+    from core.contact.march import corner_pressure
+    from core.discretize import Panels
+
+    panels = Panels.from_edges(np.array([-1.0, -0.9, 0.0, 0.95, 1.0]))
+    cubic = 0.3 - 0.2 * panels.nodes + 0.7 * panels.nodes**3
+    assert corner_pressure(panels, cubic) == pytest.approx([-0.2, 0.8], abs=1e-13)
+    grid = np.array([1.0, 1.5, 2.0, 3.0])
+    # the left corner lifts off between 2 and 3 (root 2.25), the right touches down
+    # between 1 and 1.5 (root 1.1); a flicker within rounding of zero is none
+    corners = np.array([[0.3, 0.2, 0.1, -0.3], [-0.1, 0.4, 0.5, 0.6]])
+    run = {"grid": grid, "corner_pressure": corners.T}
+    assert corner_contact_changes(run) == pytest.approx([1.1, 2.25], abs=1e-14)
+    run["corner_pressure"] = np.array([[1.0, 1e-12, -1e-12, 1e-12], [1.0] * 4]).T
+    assert corner_contact_changes(run) == []
+    assert corner_contact_changes({"grid": grid}) == []

@@ -154,3 +154,22 @@ def test_a_graded_grid_grows_again_out_of_a_load_jump_and_never_inside_it():
     for k in (1, 2, 3):
         assert np.any(np.isclose(after + 300.0 * 2.0**k, grid)) == (after + 300.0 * 2.0**k
                                                                     < 3000.0), k
+
+
+def test_every_grid_lands_on_a_kink_and_halves_exactly():
+    """A corner touching down inside a step (core/contact/creep.py:
+    ``corner_contact_changes``) is an interval end of every grid, not an output."""
+    from core.time import time_grid
+
+    times = np.linspace(1.0, 12.0, 12)
+    kink = 1.0718
+    coarse, widths, index = time_grid(times, 16, 0, kinks=(kink,))
+    assert np.any(coarse == kink) and np.array_equal(coarse[index], times)
+    assert np.all(widths > 0.0)
+    fine, fine_widths, fine_index = time_grid(times, 16, 1, kinks=(kink,))
+    assert np.array_equal(fine[::2], coarse) and np.array_equal(fine[fine_index], times)
+    assert np.allclose(fine_widths[::2], widths / 2.0, rtol=1e-12, atol=0.0)
+    # one on an output time, outside the span or on a jump's sides adds nothing
+    plain = time_grid(times, 16, 0, jumps=(5.5,))[0]
+    ignored = time_grid(times, 16, 0, jumps=(5.5,), kinks=(3.0, 0.5, 13.0, 5.5))[0]
+    assert np.array_equal(plain, ignored)
