@@ -63,14 +63,23 @@ MAX_HALVINGS = 4
 #: half-widths); graded ten times it took 836 steps and met tol 1e-4 with 4.6e-7 (zone
 #: ends 1.9e-7).
 GRADED_HALVINGS = 10
-#: Times the grids are made again on the located touchdowns and lift-offs of the corners
-#: (:func:`corner_contact_changes`), at most, and the move of a located time, in steps of
-#: the grid there, below which they are not. A crown spreading to +-1 on a fast creeping
-#: base (kernel (4, 2), tol 1e-6; touchdown at t = 1.0718050) located it 0.0017 off (5 %
-#: of a step) on the first grids, 8.5e-5 off on grids landing there; one pass more moved
-#: q by 2.5e-8 (its error 5.6e-7 -> 5.3e-7) for a third more work.
-KINK_PASSES = 2
+#: The move of a corner's change (:func:`corner_contact_changes`) between where it was
+#: located before the time grids and where their finest march puts it, in steps of that
+#: grid there, above which the grids are made again landing on the latter. A crown
+#: spreading to +-1 on a fast creeping base (kernel (4, 2), tol 1e-6; touchdown at
+#: t = 1.0718050) had it 0.0017 off (5 % of a step) on grids located by the first march
+#: alone, 8.5e-5 off on grids landing there; one pass more moved q by 2.5e-8 (its error
+#: 5.6e-7 -> 5.3e-7). Located first on finer grids (``KINK_LEVEL``): 8.4e-5 off.
 KINK_MOVE = 0.1
+#: Where a corner's change is located before the time grids (:func:`_corner_kinks`): on
+#: the grid of this many halvings of the first, then again with the step that holds it
+#: split into this many.
+KINK_LEVEL = 2
+KINK_ZOOM_STEPS = 16
+#: A corner whose Nystrom pressure stays within this fraction of tol (of the largest
+#: pressure at a corner) on both sides of a sign change has no kink to land on: it hovers
+#: at contact, and its kink moves q by about as little.
+KINK_FLOOR = 1e-3
 
 
 def graded_halvings(kernel: Any, times: np.ndarray) -> int:
@@ -751,10 +760,15 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
     first: dict[str, Any] = {}
     # where a corner touches down or lifts off, once located: every later grid lands there
     kinks: list[float] = []
+    sought: list[bool] = []
 
     def in_time(base: Any, space_error: float, space_shift: float, end_tol: float
                 ) -> tuple[dict[str, Any], float, float, dict[str, Any]]:
         """:func:`_in_time` on ``base`` with what its rule left of the budgets."""
+        if not sought:
+            sought.append(True)
+            kinks[:] = _corner_kinks(marches, times, base, first_steps, first, jumps,
+                                     graded, windows, KINK_FLOOR * tol)
         return _in_time(marches, times, base, first_steps,
                         max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
                         max(end_tol - space_shift, end_tol / 2), first, jumps, graded,
@@ -787,15 +801,15 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
         (base, space_error, space_shift, band_note, out, time_error, end_shift, run,
          strays) = rule_and_march(band_note["end_tol"],
                                   marches.bands(out, band_note["bands"]), band_note["slope"])
-    located = corner_contact_changes(run)
-    for _ in range(KINK_PASSES):
-        # a corner touched down or lifted off inside a step: the grids again, landing there
-        if not _kinks_moved(kinks, located, run):
-            break
+    located = _landing(corner_contact_changes(run, KINK_FLOOR * tol), times, first_steps,
+                       jumps, graded, windows)
+    if _kinks_moved(kinks, located, run):
+        # the finest grids put a corner's change elsewhere than the coarse march located
+        # it (or where it saw none): the grids again, landing there
         kinks[:] = located
         out, time_error, end_shift, run = in_time(base, space_error, space_shift,
                                                   band_note["end_tol"])
-        located = corner_contact_changes(run)
+        strays = marches.strays(out, band_note["bands"])
     end_error = float(end_shift + space_shift)
     slope = marches.end_slope(base, out)
     rest = float(time_error + space_error)
@@ -904,19 +918,20 @@ def _in_time(marches: Any, times: np.ndarray, base: Any, first_steps: int, budge
     return out, float(time_error), float(end_shift), run
 
 
-def corner_contact_changes(run: dict[str, Any]) -> list[float]:
+def corner_contact_changes(run: dict[str, Any], floor: float = 1e-9) -> list[float]:
     """The times where a corner of the punch (x = -1 or +1) touches down or lifts off
     between two steps of the march ``run``: the root of the line through its Nystrom
     pressure at the two (:func:`core.contact.march.corner_pressure`; dimensionless t,
-    sorted). On a grid that lands near such a time the step beside it is short, so the
-    line's error, of the order of the step times its distance to the root, shrinks as
-    the grids are made again there. Sign changes within rounding of zero (1e-9 of the
-    largest value) are none. A march of several punches (no corner pressure kept):
-    none."""
+    sorted; the two corners of an even problem, a few roundings apart, give one). On a
+    grid that lands near such a time the step beside it is short, so the line's error,
+    of the order of the step times its distance to the root, shrinks as the grids are
+    made again there. A sign change between two values within ``floor`` of the largest
+    pressure at a corner is none (a corner hovering at contact: its kink is as small). A
+    march of several punches (no corner pressure kept): none."""
     corners, grid = run.get("corner_pressure"), run.get("grid")
     if corners is None or corners.size == 0:
         return []
-    floor = 1e-9 * float(np.max(np.abs(corners)))
+    floor = floor * max(float(np.max(corners)), 0.0)
     found: set[float] = set()
     for values in corners.T:
         for i in np.flatnonzero((values[1:] > 0.0) != (values[:-1] > 0.0)):
@@ -924,7 +939,56 @@ def corner_contact_changes(run: dict[str, Any]) -> list[float]:
             if max(abs(a), abs(b)) <= floor:
                 continue
             found.add(float(grid[i] - a * (grid[i + 1] - grid[i]) / (b - a)))
-    return sorted(found)
+    times = sorted(found)
+    return [t for k, t in enumerate(times) if k == 0 or t - times[k - 1] > 1e-9 * t]
+
+
+def _corner_kinks(marches: Any, times: np.ndarray, base: Any, first_steps: int,
+                  first: dict[str, Any], jumps: Sequence[float], graded: int,
+                  windows: Windows, floor: float) -> list[float]:
+    """Where a corner touches down or lifts off (:func:`corner_contact_changes`): seen on
+    the march that checked the rule ``base`` (:func:`_select_rule`'s, kept), located on
+    the time grid ``KINK_LEVEL`` halvings finer than the first (the march's own error
+    before the change shrinks with its steps: on the first grid a heel lifting off as its
+    eccentricity grew was 0.0036 off), then on that grid with ``KINK_ZOOM_STEPS`` steps
+    in the step holding each (the line through a step's ends is off by about the step
+    times its distance to the root). Those marches stop at the last change. ``floor``:
+    that of :func:`corner_contact_changes`."""
+    grid, widths, index = time_grid(_check_times(times), first_steps, 0, jumps, graded,
+                                    windows)
+    _, run = marches.run(base, grid, widths, index, first=first)
+    located = corner_contact_changes(run, floor)
+    zoom, starts = list(windows), []
+    for zoomed in (False, True):
+        located = _landing(located, times, first_steps, jumps, graded, windows)
+        if not located:
+            break
+        brackets = []
+        for t in located:
+            i = int(np.clip(np.searchsorted(run["grid"], t), 1, run["grid"].size - 1))
+            brackets.append((float(run["grid"][i - 1]), float(run["grid"][i])))
+        if zoomed:
+            zoom += [(a, b, 2**KINK_LEVEL * (b - a) / KINK_ZOOM_STEPS) for a, b in brackets]
+            starts += [a for a, _ in brackets]
+        grid, widths, _ = time_grid(times, first_steps, KINK_LEVEL, jumps, graded, zoom,
+                                    starts)
+        end = max(b for _, b in brackets)
+        last = min(int(np.searchsorted(grid, end * (1.0 - 1e-12))), grid.size - 1)
+        _, run = marches.run(base, grid[:last + 1], widths[:last], np.array([last]),
+                             exact_ends=False, first=first)
+        located = corner_contact_changes(run, floor) or located
+    return located
+
+
+def _landing(located: list[float], times: np.ndarray, first_steps: int,
+             jumps: Sequence[float], graded: int, windows: Windows) -> list[float]:
+    """Those of the ``located`` changes a time grid lands on (:func:`time_grid`'s
+    ``kinks``): not one on a load jump, which every grid holds, nor one beside an output
+    time."""
+    if not located:
+        return located
+    grid = time_grid(times, first_steps, 0, jumps, graded, windows, located)[0]
+    return [t for t in located if np.any(grid == t)]
 
 
 def _kinks_moved(kinks: Sequence[float], located: Sequence[float], run: dict[str, Any]

@@ -15,6 +15,10 @@ __all__ = ["history_key_times", "time_grid"]
 #: Points of a march's span ``[1, t_end]`` (as many spaced evenly and as many
 #: geometrically) where :func:`history_key_times` samples a history.
 KEY_SAMPLES = 129
+#: A kink (``time_grid(..., kinks=)``) within this many nominal steps of another interval
+#: end is taken to be on it: a sliver of a step would cost a factorization of its own,
+#: and the kink's error, of the order of its distance times the step, is as small.
+KINK_SNAP = 1e-4
 
 
 def time_grid(times: np.ndarray, steps: int, refine: int = 0,
@@ -58,7 +62,8 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
 
     ``kinks``: times where the answer has a kink the grid must land on (a corner of the
     punch touching down or lifting off, located by the march itself): each an interval
-    end, as a requested time is, but not an output; also independent of ``refine``.
+    end, as a requested time is, but not an output (none within ``KINK_SNAP`` nominal
+    steps of another end, or inside a jump's sides); also independent of ``refine``.
     """
     times = np.asarray(times, dtype=float)
     h = (times[-1] - 1.0) / steps
@@ -87,9 +92,12 @@ def time_grid(times: np.ndarray, steps: int, refine: int = 0,
     windows = [(float(a), float(b), float(step)) for a, b, step in windows if step < h]
     ends += [(b, -1) for _, b, _ in windows if 1.0 < b < float(times[-1])
              and all(abs(b - j) > sides[j] for j in inside)]
-    ends += [(float(t), -1) for t in kinks if 1.0 < t < float(times[-1])
-             and not np.any(np.abs(times - t) <= 1e-9 * t)
-             and all(abs(t - j) > sides[j] for j in inside)]
+    for t in sorted(float(k) for k in kinks):
+        # (not beside another end or a jump's sides: a sliver of a step buys nothing)
+        if (1.0 < t < float(times[-1]) and not np.any(np.abs(times - t) <= KINK_SNAP * h)
+                and all(abs(t - j) > sides[j] for j in inside)
+                and all(abs(t - e) > KINK_SNAP * h for e, _ in ends)):
+            ends.append((t, -1))
     on_jump: dict[int, int] = {}
     for j, side in sides.items():
         ends += [(j - side, -1), (j + side, -1)]

@@ -311,48 +311,67 @@ def test_q_at_the_corners_a_spreading_crown_reaches_is_in_the_estimate(
     assert error <= answer.info["error_estimate"] <= 1e-4 / UNILATERAL_MARGIN
 
 
+FAST = DegenerateKernel(age_at_loading=1.0, modulus_final=1.0, beta=0.0, alpha=0.0,
+                        terms=((4.0, 0.0, 2.0),))
+
+
+def _fast_crown(tol: float, force: float = 0.05):
+    return solve_dimensionless(1.0, 0.05, lambda x: 0.02 * np.asarray(x) ** 2,
+                               np.linspace(1.0, 12.0, 12), kernel=FAST, force=force,
+                               moment=0.0, tol=tol, contact="unilateral")
+
+
 @pytest.mark.slow
 def test_a_corner_touching_down_between_steps_is_stepped_on() -> None:
     """A crown on a fast-creeping base (kernel (4, 2)) spreads to the whole punch at
-    t = 1.0718, inside the first step of every grid: q has a kink in time there, and
+    t = 1.0718050, inside the first step of every grid: q has a kink in time there, and
     Richardson's estimate of the grids read it low: success at tol 1e-4, estimate 1.6e-5,
-    q 8.0e-5 off at x = -0.984, t = 2 (an auditor's find). The grids now land on the
-    touchdown (located from the Nystrom pressure at the corners, then again on grids
-    landing near it): estimate 1.1e-5, q 4.2e-6 off (against a tol-1e-9 answer graded 64
+    q 8.0e-5 off at x = -0.984, t = 2 (an auditor's find). The touchdown is now located
+    (from the Nystrom pressure at the corners, on finer grids up to it) and every grid
+    lands there: estimate 1.1e-5, q 4.2e-6 off (against a tol-1e-9 answer graded 64
     times finer at the corners, on grids landing there). The reference here: the answer
-    at tol 1e-6 (refused at an estimate of 9.8e-7, 5.6e-7 off against that one)."""
+    at tol 1e-6 (refused at an estimate of 9.6e-7, 5.3e-7 off against that one)."""
     from core.contact import creep
-    from core.creep.kernels import DegenerateKernel
 
-    fast = DegenerateKernel(age_at_loading=1.0, modulus_final=1.0, beta=0.0, alpha=0.0,
-                            terms=((4.0, 0.0, 2.0),))
     located: list[list[float]] = []
     changes = creep.corner_contact_changes
 
-    def spy(run):
-        located.append(changes(run))
+    def spy(run, floor=1e-9):
+        located.append(changes(run, floor))
         return located[-1]
-
-    def crown(tol: float):
-        return solve_dimensionless(1.0, 0.05, lambda x: 0.02 * np.asarray(x) ** 2,
-                                   np.linspace(1.0, 12.0, 12), kernel=fast, force=0.05,
-                                   moment=0.0, tol=tol, contact="unilateral")
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(creep, "corner_contact_changes", spy)
-        answer = crown(1e-4)
+        answer = _fast_crown(1e-4)
     assert answer.info["success"] and answer.contact_set[0] != [(-1.0, 1.0)]
     assert answer.contact_set[1] == [(-1.0, 1.0)]
-    # the first grids' line put it at 1.0750, the grids landing there at 1.0721
-    assert located[0] == [pytest.approx(1.07498, abs=1e-4)]
-    assert located[-1] == [pytest.approx(1.07181, abs=5e-4)]
-    reference = crown(1e-6)
+    # the rule's check march put it at 1.213, the finer grids up to it at 1.0963 and
+    # 1.07189, the time grids landing there at 1.07183 (measured)
+    assert located[0] == [pytest.approx(1.2132, abs=1e-3)]
+    assert located[-1] == [pytest.approx(1.0718050, abs=1e-4)]
+    reference = _fast_crown(1e-6)
     assert reference.info["error_estimate"] <= 1e-6
     points = np.concatenate([X, -1.0 + np.geomspace(1e-10, 1e-2, 40),
                              1.0 - np.geomspace(1e-10, 1e-2, 40)])
     exact = reference.pressure(points)
     error = float(np.max(np.abs(answer.pressure(points) - exact)) / np.max(np.abs(exact)))
     assert error <= answer.info["error_estimate"] <= 1e-4 / UNILATERAL_MARGIN
+
+
+def test_both_corners_of_an_even_problem_touching_down_are_one_time() -> None:
+    """The two corners of an even problem change sign at once, their values a few
+    roundings apart (summed in opposite orders): located as two times 2e-16 apart, the
+    grids made a step of zero width and the march read "the loads pull the punch away"
+    (a reviewer's find, forces 0.048846 and 0.058846 of the crown above)."""
+    for force in (0.045 + 0.015 * 10 / 39, 0.045 + 0.015 * 36 / 39):
+        answer = _fast_crown(1e-4, force)
+        assert answer.info["success"] and answer.contact_set[-1] == [(-1.0, 1.0)]
+    from core.contact.creep import corner_contact_changes
+
+    run = {"grid": np.array([1.0, 2.0]),
+           "corner_pressure": np.array([[-0.3, -0.30000000000000016], [0.7, 0.7]])}
+    # (their lines' roots: 1.3 and 1.3000000000000003)
+    assert corner_contact_changes(run) == [1.3]
 
 
 def test_a_corner_contact_change_is_the_root_of_its_nystrom_pressure() -> None:

@@ -169,7 +169,11 @@ def test_every_grid_lands_on_a_kink_and_halves_exactly():
     fine, fine_widths, fine_index = time_grid(times, 16, 1, kinks=(kink,))
     assert np.array_equal(fine[::2], coarse) and np.array_equal(fine[fine_index], times)
     assert np.allclose(fine_widths[::2], widths / 2.0, rtol=1e-12, atol=0.0)
-    # one on an output time, outside the span or on a jump's sides adds nothing
+    # one on an output time or within KINK_SNAP steps of one (or of another kink),
+    # outside the span or on a jump's sides adds nothing
     plain = time_grid(times, 16, 0, jumps=(5.5,))[0]
-    ignored = time_grid(times, 16, 0, jumps=(5.5,), kinks=(3.0, 0.5, 13.0, 5.5))[0]
+    ignored = time_grid(times, 16, 0, jumps=(5.5,),
+                        kinks=(3.0, 3.0 + 1e-7, 0.5, 13.0, 5.5))[0]
     assert np.array_equal(plain, ignored)
+    twins = time_grid(times, 16, 0, kinks=(kink, kink + 2e-16))[0]
+    assert np.array_equal(twins, coarse) and np.all(np.diff(twins) > 0.0)
