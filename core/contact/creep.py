@@ -67,15 +67,16 @@ GRADED_HALVINGS = 10
 #: located before the time grids and where their finest march puts it, in steps of that
 #: grid there, above which the grids are made again landing on the latter. A crown
 #: spreading to +-1 on a fast creeping base (kernel (4, 2), tol 1e-6; touchdown at
-#: t = 1.0718050) had it 0.0017 off (5 % of a step) on grids located by the first march
-#: alone, 8.5e-5 off on grids landing there; one pass more moved q by 2.5e-8 (its error
-#: 5.6e-7 -> 5.3e-7). Located first on finer grids (``KINK_LEVEL``): 8.4e-5 off.
+#: t = 1.0718050) had it 0.0017 off (5 % of a step) before the grids, 8.5e-5 off on grids
+#: landing there: the grids again moved q by 2.5e-8 (its error 5.6e-7 -> 5.3e-7).
 KINK_MOVE = 0.1
 #: Where a corner's change is located before the time grids (:func:`_corner_kinks`): on
 #: the grid of this many halvings of the first, then again with the step that holds it
-#: split into this many.
-KINK_LEVEL = 2
-KINK_ZOOM_STEPS = 16
+#: split into this many. Measured (the crown above; a heel lifting off as its
+#: eccentricity grows, at t = 2.2425): 0.0017 and 0.0003 off, for 10-15 % more work than
+#: the time grids alone (two halvings and 16 parts: 8.4e-5 and 0.0003, 25-30 %).
+KINK_LEVEL = 1
+KINK_ZOOM_STEPS = 8
 #: A corner whose Nystrom pressure stays within this fraction of tol (of the largest
 #: pressure at a corner) on both sides of a sign change has no kink to land on: it hovers
 #: at contact, and its kink moves q by about as little.
