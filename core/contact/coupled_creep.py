@@ -72,7 +72,13 @@ from core.contact.creep import (
     transient_windows,
 )
 from core.contact.kinks import Corrected, _contact_parts, _cut_rule, _part_rows, corrected_roots
-from core.contact.march import creep_memory, kink_correction, nodes_in, rule_operator
+from core.contact.march import (
+    corner_pressure,
+    creep_memory,
+    kink_correction,
+    nodes_in,
+    rule_operator,
+)
 from core.contact.result import UnilateralSolution
 from core.contact.step import LoadNotCarried, Step, check_loads
 from core.contact.unilateral import creep_resolution
@@ -267,6 +273,8 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
     solver = CoupledStepSolver()
     unsettled = 0
     zones = 0  # the most runs of contact nodes under one punch, at the last step
+    # each punch's Nystrom pressure at its corners, every step (where one touches down)
+    corners = np.zeros((steps, 2 * len(system.rules)))
     for n in range(steps):
         check_work("following the contact zones of several punches under creep step by step",
                    zones)
@@ -296,6 +304,8 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
                 zones.append(list(zip(ends[0::2], ends[1::2], strict=True)))
             first["zones"] = zones
         unsettled += not settled
+        corners[n] = np.concatenate([corner_pressure(rule, s.nystrom)
+                                     for rule, s in zip(system.rules, states, strict=True)])
         zones = max(contact_runs(s.active) for s in states)
         active = np.concatenate([s.active for s in states])
         memory_of.record(n, np.concatenate([s.q for s in states]))
@@ -318,8 +328,9 @@ def march_punches(marches: CoupledMarches, system: CoupledRules, grid: np.ndarra
             for (k, _), found in zip(batch, roots, strict=True):
                 ends[k][p] = found
     return {"outputs": outputs, "ends": ends, "unsettled": unsettled, "steps": steps - 1,
-            "system": system, "factorizations": solver.factorizations,
-            "iterations": solver.iterations, "direct_solves": solver.direct}
+            "system": system, "grid": grid, "corner_pressure": corners,
+            "factorizations": solver.factorizations, "iterations": solver.iterations,
+            "direct_solves": solver.direct}
 
 
 def _step_states(base: CoupledBase, system: CoupledRules, steps: Sequence[Step],

@@ -928,7 +928,8 @@ def corner_contact_changes(run: dict[str, Any], floor: float = 1e-9) -> list[flo
     of the order of the step times its distance to the root, shrinks as the grids are
     made again there. A sign change between two values within ``floor`` of the largest
     pressure at a corner is none (a corner hovering at contact: its kink is as small). A
-    march of several punches (no corner pressure kept): none."""
+    march of several punches keeps two corners for each (one grid lands on every
+    punch's changes)."""
     corners, grid = run.get("corner_pressure"), run.get("grid")
     if corners is None or corners.size == 0:
         return []
