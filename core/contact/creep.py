@@ -979,18 +979,19 @@ def _corner_kinks(marches: Any, times: np.ndarray, base: Any, first_steps: int,
         _, run = marches.run(base, grid[:last + 1], widths[:last], np.array([last]),
                              exact_ends=False, first=first)
         located = corner_contact_changes(run, floor) or located
-    return located
+    return _landing(located, times, first_steps, jumps, graded, windows)
 
 
 def _landing(located: list[float], times: np.ndarray, first_steps: int,
              jumps: Sequence[float], graded: int, windows: Windows) -> list[float]:
-    """Those of the ``located`` changes a time grid lands on (:func:`time_grid`'s
-    ``kinks``): not one on a load jump, which every grid holds, nor one beside an output
-    time."""
+    """Those of the ``located`` changes the time grids would not land on without them
+    (:func:`time_grid`'s ``kinks``): not one on a load jump or on an output time, which
+    every grid holds, nor one beside them."""
     if not located:
         return located
+    plain = time_grid(times, first_steps, 0, jumps, graded, windows)[0]
     grid = time_grid(times, first_steps, 0, jumps, graded, windows, located)[0]
-    return [t for t in located if np.any(grid == t)]
+    return [t for t in located if np.any(grid == t) and not np.any(plain == t)]
 
 
 def _kinks_moved(kinks: Sequence[float], located: Sequence[float], run: dict[str, Any]

@@ -399,3 +399,38 @@ def test_a_corner_contact_change_is_the_root_of_its_nystrom_pressure() -> None:
     assert corner_contact_changes(run, 1e-7) == []
     assert len(corner_contact_changes(run, 1e-8)) == 2
     assert corner_contact_changes({"grid": grid}) == []
+
+
+def test_a_corner_change_is_located_on_finer_grids_up_to_it_and_not_on_an_output() -> None:
+    """:func:`core.contact.creep._corner_kinks` on stand-in marches whose Nystrom pressure
+    at +1 is ``d (1 + d / 2)``, ``d = t - t0`` (a simple root at t0): seen on the rule's
+    check march, located on the grid one halving finer and then zoomed, each march
+    stopping at the step that holds it; at an output time (which every grid holds) or
+    within a sliver of one, none, and no march beyond the check."""
+    from core.contact.creep import _corner_kinks
+
+    class StandIn:
+        def __init__(self, t0: float) -> None:
+            self.t0, self.grids = t0, []
+
+        def run(self, base, grid, widths, index, exact_ends=True, first=None):
+            self.grids.append(grid)
+            d = grid - self.t0
+            corners = np.column_stack([np.ones(grid.size), d * (1.0 + 0.5 * d)])
+            return None, {"grid": grid, "corner_pressure": corners}
+
+    times = np.linspace(1.0, 12.0, 12)
+    for t0 in (3.0, 3.0 + 1e-6):
+        marches = StandIn(t0)
+        assert _corner_kinks(marches, times, None, 16, {}, (), 0, (), 1e-9) == []
+        assert len(marches.grids) == 1
+    marches = StandIn(3.3)
+    # (its other root, t0 - 2 = 1.3, is a change too)
+    located = _corner_kinks(marches, times, None, 16, {}, (), 0, (), 1e-9)
+    assert located == [pytest.approx(1.3, abs=2e-4), pytest.approx(3.3, abs=2e-4)]
+    # measured 1.2e-4 off: the zoom's steps 0.043, the root's curvature f''/f' = 1
+    # the check march's step [3, 3.5] holds it: the finer grid's march stops at 3.5,
+    # and the zoom's splits its step [3.25, 3.5] in eight
+    check, finer, zoomed = marches.grids
+    assert finer[-1] == zoomed[-1] == 3.5 and np.diff(finer).max() == 0.25
+    assert np.allclose(np.diff(zoomed[zoomed >= 3.25]), 0.03125, rtol=1e-12, atol=0.0)
