@@ -93,8 +93,11 @@ def start_local_cluster(n_workers: int | None = None,
 
     workers = n_workers or os.cpu_count() or 1
     # one single-threaded worker process per core; BLAS threads would only compete
+    # (the scheduler's HTTP server, dashboard or not, on a free port: on Dask's 8787 a
+    # second study at once, the page's beside the command line's, warned it was taken)
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                            host="127.0.0.1", dashboard_address=None,
+                           scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                            env=dict.fromkeys(BLAS_THREAD_VARIABLES, "1"))
     client = Client(cluster)
 
