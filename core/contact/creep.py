@@ -761,17 +761,21 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
     first: dict[str, Any] = {}
     # where a corner touches down or lifts off, once located: every later grid lands there
     kinks: list[float] = []
-    sought: list[bool] = []
+    sought = False
+
+    def time_budget(space_error: float) -> float:
+        """What the panel rule's ``space_error`` leaves of tol / 3 to the time grids."""
+        return max(tol / UNILATERAL_MARGIN - space_error, tol / 6)
 
     def in_time(base: Any, space_error: float, space_shift: float, end_tol: float
                 ) -> tuple[dict[str, Any], float, float, dict[str, Any]]:
         """:func:`_in_time` on ``base`` with what its rule left of the budgets."""
+        nonlocal sought
         if not sought:
-            sought.append(True)
+            sought = True
             kinks[:] = _corner_kinks(marches, times, base, first_steps, first, jumps,
                                      graded, windows, KINK_FLOOR * tol)
-        return _in_time(marches, times, base, first_steps,
-                        max(tol / UNILATERAL_MARGIN - space_error, tol / 6),
+        return _in_time(marches, times, base, first_steps, time_budget(space_error),
                         max(end_tol - space_shift, end_tol / 2), first, jumps, graded,
                         windows, kinks)
 
@@ -804,8 +808,7 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
                                   marches.bands(out, band_note["bands"]), band_note["slope"])
     located = _landing(corner_contact_changes(run, KINK_FLOOR * tol), times, first_steps,
                        jumps, graded, windows)
-    if (time_error <= max(tol / UNILATERAL_MARGIN - space_error, tol / 6)
-            and _kinks_moved(kinks, located, run)):
+    if time_error <= time_budget(space_error) and _kinks_moved(kinks, located, run):
         # the finest grids put a corner's change elsewhere than the coarse march located
         # it (or where it saw none): the grids again, landing there; not where they ran
         # out of halvings, which refuses the answer whatever they land on (a heel lifting
@@ -842,13 +845,13 @@ def controlled_march(marches: Any, times: np.ndarray, tol: float, res: Any,
             slope = marches.end_slope(base, out)
     end_q_error = end_error * slope if slope > 0.0 else 0.0
     error = float(time_error + space_error + end_q_error)
-    time_budget = max(tol / UNILATERAL_MARGIN - space_error, tol / 6)
     # (what the caller adds for q at the free ends, where the marches say: only near tol)
     residual = marches.residual(base, out) if (
         hasattr(marches, "residual") and np.isfinite(error)
         and error > 0.5 * tol / UNILATERAL_MARGIN and error <= tol) else 0.0
     shortfall = error + residual - tol / UNILATERAL_MARGIN
-    if (not strays and np.isfinite(error) and 0.0 < shortfall < time_error <= time_budget):
+    if (not strays and np.isfinite(error)
+            and 0.0 < shortfall < time_error <= time_budget(space_error)):
         # Each part met its own budget, their sum misses (q beside the free ends takes
         # its share after the time grids are chosen, and the caller adds q's residue at
         # them, ``marches.residual``): the time grids alone can mend it,
@@ -1005,7 +1008,9 @@ def _kinks_moved(kinks: Sequence[float], located: Sequence[float], run: dict[str
     by more than ``KINK_MOVE`` of the steps of its grid there."""
     if len(kinks) != len(located):
         return True
-    grid = run["grid"] if kinks else np.zeros(0)
+    if not kinks:
+        return False
+    grid = run["grid"]
     steps = np.diff(grid)
     for old, new in zip(kinks, located, strict=True):
         # the grid's steps there (the longest of two each side: a kink splits a step into
