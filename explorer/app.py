@@ -221,6 +221,7 @@ class ExplorerApp(pn.viewable.Viewer):
         self.controller.param.watch(self._on_view, "view")
         self.controller.param.watch(self._on_preview, "preview")
         self.controller.param.watch(self._on_settled, "busy")
+        self.controller.param.watch(self._on_answered, "solves")
         self.controller.param.watch(self.results.on_status, ["error", "busy"])
         self.screen.param.watch(self._on_time, "time_index")
         self.screen.param.watch(self._on_notice, "notice")
@@ -472,6 +473,13 @@ class ExplorerApp(pn.viewable.Viewer):
         if (not event.new and self._drawn_preview is not None and not self._previewing
                 and self.controller.view is not None):
             self._draw(self.controller.view)
+
+    def _on_answered(self, event: Any) -> None:
+        # the newest request answered (and drawn: the view's watcher came first): a pause
+        # of the user's starts here (one undo step for a drag whose steps a loaded server
+        # took seconds apart)
+        if not self.controller.busy:
+            self.history.went_idle()
 
     def _on_preview(self, event: Any) -> None:
         if self.controller.preview is None or not self._previewing:

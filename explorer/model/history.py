@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 import param
@@ -22,13 +23,21 @@ class SceneHistory(param.Parameterized):
         self._undoing = False
         #: the scene as it was loaded (the preset, the file, the link)
         self.loaded: dict[str, Any] | None = None
+        # when the session last sat idle, its answers in [s, monotonic]; None: not told
+        self._idle_since: float | None = None
+
+    def went_idle(self, at: float | None = None) -> None:
+        """The session's answers are in and drawn (``at`` [s], default now on the
+        monotonic clock): a change from here on follows a pause of the user's, whose
+        length decides whether it joins the change before (:meth:`UndoStack.push`)."""
+        self._idle_since = time.monotonic() if at is None else float(at)
 
     def remember(self) -> None:
         """Keep the scene now in the state (a change happened)."""
         if self._undoing:
             return
         try:
-            self.stack.push(self.state.to_scene())
+            self.stack.push(self.state.to_scene(), idle_since=self._idle_since)
         except ValueError:
             return  # a state that is no scene (its message comes with the solve)
         self.can_undo = self.stack.can_undo

@@ -12,7 +12,10 @@ from .pins import NOT_MECHANICS, flatten
 UNDO_DEPTH = 50
 #: Changes of the same one number one way, each within this many seconds [s] of the last,
 #: are one step of undo: a drag (one undo after dragging the force from 500 to 1128 kN/m
-#: took ten presses, back through every value the handle passed, a teacher's audit).
+#: took ten presses, back through every value the handle passed, a teacher's audit). The
+#: seconds are those the session sat idle, its last answer in (see :meth:`UndoStack.push`):
+#: on a loaded server a drag's steps reached the session more than a second apart while it
+#: drew the answers before them, and one drag made two steps of undo.
 COALESCE_S = 1.0
 
 
@@ -44,15 +47,27 @@ class UndoStack:
         self._scenes: list[dict[str, Any]] = []
         self._last = float("-inf")  # when the last scene was pushed [s, monotonic]
 
-    def push(self, scene: dict[str, Any], now: float | None = None) -> None:
+    def push(self, scene: dict[str, Any], now: float | None = None,
+             idle_since: float | None = None) -> None:
         """Record ``scene`` as the current one (a repeat of the current is ignored). A
         change of the same one number as the last change, the same way, within
         :data:`COALESCE_S` of it (``now`` [s], default the monotonic clock), replaces the
-        last scene: one undo goes back to before them all."""
+        last scene: one undo goes back to before them all.
+
+        ``idle_since`` [s, the same clock]: when the session last sat idle (its answers
+        in), if its caller knows. The pause is then counted from there: a change that
+        came while the answer to the last one was still being solved or drawn is no
+        pause (on a loaded server a drag's steps reach the session seconds apart), and
+        one after the session went idle pauses from that moment. None: from the last
+        change."""
         if self._scenes and self._scenes[-1] == scene:
             return
         now = time.monotonic() if now is None else float(now)
-        recent, self._last = now - self._last <= COALESCE_S, now
+        since = self._last
+        if idle_since is not None:
+            # busy from the last change until now: no pause at all
+            since = now if idle_since < self._last else max(self._last, float(idle_since))
+        recent, self._last = now - since <= COALESCE_S, now
         if recent and len(self._scenes) >= 2:
             last = changed_fields(self._scenes[-2], self._scenes[-1])
             if (len(last) == 1 and changed_fields(self._scenes[-1], scene) == last

@@ -484,6 +484,63 @@ def test_one_undo_goes_back_to_before_a_drag() -> None:
     assert stack.undo() == scene(500.0) and stack.undo() == scene(1e6)
 
 
+class _Later(Executor):
+    """An executor that keeps its work until :meth:`run` (a server busy with it)."""
+
+    def __init__(self) -> None:
+        self.work: list = []
+
+    def submit(self, fn, /, *args, **kwargs):  # noqa: ANN001
+        self.work.append((fn, args, kwargs))
+        return Future()
+
+    def run(self) -> None:
+        while self.work:
+            fn, args, kwargs = self.work.pop(0)
+            fn(*args, **kwargs)
+
+
+def test_a_drag_that_a_busy_server_takes_seconds_apart_is_one_step_of_undo(
+        explorer_app, monkeypatch):
+    """On a loaded server a drag of the force reached the session more than COALESCE_S
+    apart while it drew the answers before them, and one undo went back only to the
+    middle of the drag (852 of 500 -> 1130 kN/m, the browser test under load). The pause
+    that ends a step is the user's: counted from the session's last answer, not from the
+    last change."""
+    from types import SimpleNamespace
+
+    import explorer.model.history as history_module
+    import explorer.model.undo as undo_module
+    from explorer.model.undo import COALESCE_S
+
+    clock = [1000.0]
+    fake = SimpleNamespace(monotonic=lambda: clock[0])
+    monkeypatch.setattr(undo_module, "time", fake)
+    monkeypatch.setattr(history_module, "time", fake, raising=False)
+    work = _Later()
+    app = explorer_app(executor=work)
+    work.run()
+    force = app.state.loading.histories["force"]
+    before = force.value
+    # values in no cache (a cached answer comes at once)
+    steps = [before + 12.345 + 31.0 * k for k in range(4)]
+    for k, value in enumerate(steps[:3]):
+        clock[0] = 2000.0 + 3.0 * COALESCE_S * k   # the server took them seconds apart
+        force.value = value                          # while solving the first of them
+    work.run()                                       # the answer in: the session idles
+    assert not app.controller.busy
+    clock[0] += 0.5 * COALESCE_S                     # the drag went on without a pause
+    force.value = steps[3]
+    work.run()
+    clock[0] += 3.0 * COALESCE_S                     # a pause: a step of its own
+    force.value = steps[3] + 40.0
+    work.run()
+    app.history.undo()
+    assert force.value == steps[3]
+    app.history.undo()
+    assert force.value == before
+
+
 def test_undo_across_a_preset_change_shows_the_scene_it_brings_back(explorer_app):
     # the selector and the description stayed at "Worn coating" while the uniform
     # scene was back on screen
