@@ -64,9 +64,9 @@ class UndoStack:
             return
         now = time.monotonic() if now is None else float(now)
         since = self._last
-        if idle_since is not None:
+        if idle_since is not None and since > float("-inf"):  # (not just after an undo)
             # busy from the last change until now: no pause at all
-            since = now if idle_since < self._last else max(self._last, float(idle_since))
+            since = now if idle_since < since else max(since, float(idle_since))
         recent, self._last = now - since <= COALESCE_S, now
         if recent and len(self._scenes) >= 2:
             last = changed_fields(self._scenes[-2], self._scenes[-1])

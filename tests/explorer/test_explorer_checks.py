@@ -537,6 +537,14 @@ def test_a_drag_that_a_busy_server_takes_seconds_apart_is_one_step_of_undo(
     work.run()
     app.history.undo()
     assert force.value == steps[3]
+    work.run()
+    # a change just after an undo is a step of its own, however soon after the answer
+    clock[0] += 0.1 * COALESCE_S
+    force.value = steps[3] + 10.0
+    work.run()
+    app.history.undo()
+    assert force.value == steps[3]
+    work.run()
     app.history.undo()
     assert force.value == before
 
