@@ -43,14 +43,18 @@ def installed(tmp_path_factory) -> dict[str, Path]:
     """The wheel, and a virtual environment with it installed; ``away``: a folder outside
     the checkout to run from."""
     base = tmp_path_factory.mktemp("wheel")
-    # the working tree as git would commit it (tracked and new files, nothing ignored)
+    # the working tree as git would commit it (tracked and new files, nothing ignored), but
+    # for this test run's own temporary folders where --basetemp puts them in the checkout
+    # (their "current" links point outside it, which the extraction below refuses)
+    runs = tmp_path_factory.getbasetemp().resolve()
     files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "-z"], cwd=ROOT,
                            capture_output=True, check=True).stdout.split(b"\0")
     source = base / "source"
     with tarfile.open(base / "tree.tar", "w") as tar:
         for name in filter(None, files):
-            if (ROOT / name.decode()).exists():
-                tar.add(ROOT / name.decode(), arcname=name.decode())
+            path = ROOT / name.decode()
+            if path.exists() and not path.is_relative_to(runs):
+                tar.add(path, arcname=name.decode())
     with tarfile.open(base / "tree.tar") as tar:
         tar.extractall(source, filter="data")
     dist = base / "dist"
