@@ -66,7 +66,7 @@ class UndoStack:
         since = self._last
         if idle_since is not None and since > float("-inf"):  # (not just after an undo)
             # busy from the last change until now: no pause at all
-            since = now if idle_since < since else max(since, float(idle_since))
+            since = now if idle_since < since else float(idle_since)
         recent, self._last = now - since <= COALESCE_S, now
         if recent and len(self._scenes) >= 2:
             last = changed_fields(self._scenes[-2], self._scenes[-1])

@@ -516,7 +516,7 @@ def test_a_drag_that_a_busy_server_takes_seconds_apart_is_one_step_of_undo(
     clock = [1000.0]
     fake = SimpleNamespace(monotonic=lambda: clock[0])
     monkeypatch.setattr(undo_module, "time", fake)
-    monkeypatch.setattr(history_module, "time", fake, raising=False)
+    monkeypatch.setattr(history_module, "time", fake)
     work = _Later()
     app = explorer_app(executor=work)
     work.run()
