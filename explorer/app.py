@@ -144,6 +144,15 @@ class DragSteps:
         a drag (not a key press)."""
         self._app.released(dragged)
 
+    def gesture_step(self) -> None:
+        """A slider's handle moved: its changes up to :meth:`gesture_ended` are one step of
+        undo (:meth:`~explorer.model.SceneHistory.drag_step`)."""
+        self._app.history.drag_step()
+
+    def gesture_ended(self) -> None:
+        """The page released the handle (its last value, if new, is in the state)."""
+        self._app.history.drag_ended()
+
 
 class ExplorerApp(pn.viewable.Viewer):
     """One session of the explorer: its model objects, views and page."""

@@ -25,6 +25,22 @@ class SceneHistory(param.Parameterized):
         self.loaded: dict[str, Any] | None = None
         # when the session last sat idle, its answers in [s, monotonic]; None: not told
         self._idle_since: float | None = None
+        # the drag of a slider under way (its id), if one: its steps are one step of undo
+        self._gestures = 0
+        self._gesture: int | None = None
+
+    def drag_step(self) -> None:
+        """A slider's handle moved (a drag's step, or a key press): the changes from here
+        to the page's release of it (:meth:`drag_ended`) are one step of undo, however far
+        apart they reach the session."""
+        if self._gesture is None:
+            self._gestures += 1
+            self._gesture = self._gestures
+
+    def drag_ended(self) -> None:
+        """The page released a slider's handle (its last value, if new, is in the state):
+        the next change starts a step of its own."""
+        self._gesture = None
 
     def went_idle(self, at: float | None = None) -> None:
         """The session's answers are in and drawn (``at`` [s], default now on the
@@ -37,7 +53,8 @@ class SceneHistory(param.Parameterized):
         if self._undoing:
             return
         try:
-            self.stack.push(self.state.to_scene(), idle_since=self._idle_since)
+            self.stack.push(self.state.to_scene(), idle_since=self._idle_since,
+                            gesture=self._gesture)
         except ValueError:
             return  # a state that is no scene (its message comes with the solve)
         self.can_undo = self.stack.can_undo

@@ -46,9 +46,10 @@ class UndoStack:
         self.depth = depth
         self._scenes: list[dict[str, Any]] = []
         self._last = float("-inf")  # when the last scene was pushed [s, monotonic]
+        self._last_gesture: int | None = None  # the drag the last scene came from
 
     def push(self, scene: dict[str, Any], now: float | None = None,
-             idle_since: float | None = None) -> None:
+             idle_since: float | None = None, gesture: int | None = None) -> None:
         """Record ``scene`` as the current one (a repeat of the current is ignored). A
         change of the same one number as the last change, the same way, within
         :data:`COALESCE_S` of it (``now`` [s], default the monotonic clock), replaces the
@@ -59,7 +60,13 @@ class UndoStack:
         came while the answer to the last one was still being solved or drawn is no
         pause (on a loaded server a drag's steps reach the session seconds apart), and
         one after the session went idle pauses from that moment. None: from the last
-        change."""
+        change.
+
+        ``gesture``: the drag of a slider the change is a step of (an id, from the first
+        step to the page's release of the handle; None: none). A step of the same drag
+        as the last change, of the same one number, joins it whichever way and however
+        long after: a page or a server too busy to keep up spaced one drag's steps more
+        than a second apart, and one undo went back to the middle of the drag."""
         if self._scenes and self._scenes[-1] == scene:
             return
         now = time.monotonic() if now is None else float(now)
@@ -68,10 +75,13 @@ class UndoStack:
             # busy from the last change until now: no pause at all
             since = now if idle_since < since else float(idle_since)
         recent, self._last = now - since <= COALESCE_S, now
-        if recent and len(self._scenes) >= 2:
+        same_drag = gesture is not None and gesture == self._last_gesture
+        self._last_gesture = gesture
+        if (recent or same_drag) and len(self._scenes) >= 2:
             last = changed_fields(self._scenes[-2], self._scenes[-1])
             if (len(last) == 1 and changed_fields(self._scenes[-1], scene) == last
-                    and _one_way(self._scenes[-2], self._scenes[-1], scene, *last)):
+                    and (same_drag or _one_way(self._scenes[-2], self._scenes[-1], scene,
+                                               *last))):
                 self._scenes[-1] = copy.deepcopy(scene)
                 return
         self._scenes.append(copy.deepcopy(scene))
@@ -85,6 +95,7 @@ class UndoStack:
         # the next change starts a step of its own (one within a second of the drag just
         # undone was merged into the step it went back to, a review)
         self._last = float("-inf")
+        self._last_gesture = None
         return copy.deepcopy(self._scenes[-1])
 
     @property

@@ -75,8 +75,8 @@ class PunchesSection:
                                            sizing_mode="stretch_width",
                                            css_classes=["punch-statement"])
         self.statement.param.watch(self._on_statement, "value")
-        self.history_editors = (HistoryEditor("punch-load-0", reject),
-                                HistoryEditor("punch-load-1", reject))
+        self.history_editors = (HistoryEditor("punch-load-0", reject, live_when),
+                                HistoryEditor("punch-load-1", reject, live_when))
         self.note = html_pane(
             "Each punch's settlement and tilt are its own, its moment is about its own "
             "centre. Punches may not overlap or touch: the solver says which do. Loads "

@@ -78,7 +78,8 @@ class SceneView:
         self.controller = controller
         self.statement.param.watch(self._on_statement, "value")
         s.loading.param.watch(self.refresh, "statement")
-        self.history_editors = (HistoryEditor("load-0", reject), HistoryEditor("load-1", reject))
+        self.history_editors = (HistoryEditor("load-0", reject, drag),
+                                HistoryEditor("load-1", reject, drag))
         self.unknowns_note = html_pane("", styles={"font-size": "13px"})
         # where the quantities a statement newly gives came from, until one is changed
         self._taken = ""

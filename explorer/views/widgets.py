@@ -230,6 +230,11 @@ class EditableSlider(_RangeKept, pn.widgets.EditableFloatSlider):
         """
         self._slider._releases = False
 
+    def watch_handle_release(self, callback: Callable[[], None]) -> None:
+        """Call ``callback()`` at each release of the handle by the page (the end of a
+        drag, or of a key press), after the step it ends reached the composite."""
+        self._slider.param.watch(lambda event: callback(), "value_throttled")
+
     def watch_drag_first(self, callback: Callable[[Any], None]) -> None:
         """Call ``callback(value)`` [the slider's value] at each move of the slider,
         before the composite's own watchers bring its value and text box in line.
@@ -383,17 +388,28 @@ class Binding:
             # a drag step reaches the state before the text box follows (the watcher
             # above then finds the state at the value already: no second change)
             widget.watch_drag_first(lambda value, name=name: self._lead(name, value))
-            widget.apply_steps_only()
+            ended = getattr(self._live_when, "gesture_ended", None)
+            if ended is None:
+                widget.apply_steps_only()
+            else:
+                # the page's release of the handle ends the drag's one step of undo (a
+                # busy page or server spaced one drag's steps more than a second apart)
+                widget.watch_handle_release(lambda: None if self._syncing else ended())
         if event == "value_throttled" and self._live_when is not None:
             widget.param.watch(lambda e, name=name: self._drag_step(name, e.new), "value")
             # a policy that previews held steps hears of the release too (after the
             # state has taken the value; not a value set from the state: a tab made
             # mid-drag ended its preview)
             released = getattr(self._live_when, "released", None)
+            ended = getattr(self._live_when, "gesture_ended", None)
             if released is not None:
+                def let_go(event: Any, dragged: bool) -> None:
+                    released(dragged)
+                    if ended is not None:
+                        ended()  # the drag's one step of undo ends here
+
                 # (its drag steps note the drag themselves: ExplorerApp._drag_step_applies)
-                watch_release(widget, lambda event, dragged: released(dragged),
-                              lambda: self._syncing)
+                watch_release(widget, let_go, lambda: self._syncing)
         box = getattr(widget, "_value_edit", None)
         if box is None and isinstance(widget, pn.widgets.FloatInput | pn.widgets.IntInput):
             box = widget  # a number box of its own (the notional size stayed empty, unsaid)
@@ -429,6 +445,10 @@ class Binding:
     def _lead(self, name: str, value: Any) -> None:
         # the slider moved ahead of its composite: the state follows it now, and the
         # composite brings itself in line afterwards (not from here, as an echo)
+        step = getattr(self._live_when, "gesture_step", None)
+        if (step is not None and not self._syncing and self._target is not None
+                and value is not None and value != getattr(self._target, name)):
+            step()  # a step of the handle (not an echo of the state's value)
         self._leading = name
         try:
             self._to_target(name, value)
@@ -439,6 +459,9 @@ class Binding:
         # a value shown from the state (``bind``, a preset) is no drag: nothing to ask
         if self._syncing or self._live_when is None:
             return
+        step = getattr(self._live_when, "gesture_step", None)
+        if step is not None:
+            step()  # the changes up to the release are one step of undo
         if self._live_when():
             self._to_target(name, value)
             return
@@ -673,10 +696,13 @@ def _refit(widget: pn.widgets.Widget, value: Any, default: tuple[float, float]) 
 class HistoryEditor:
     """Shape and parameters of the history of one given quantity (live while dragging)."""
 
-    def __init__(self, css: str = "", on_reject: Callable[[str], None] | None = None) -> None:
+    def __init__(self, css: str = "", on_reject: Callable[[str], None] | None = None,
+                 drag: Any = None) -> None:
         """``css``: the class prefix of its widgets; ``on_reject``: says a refused value
-        (an emptied box)."""
-        self.binding = Binding(on_reject)
+        (an emptied box); ``drag``: hears where a drag of its sliders starts and ends
+        (``gesture_step()``, ``gesture_ended()``: one step of undo; the explorer's
+        :class:`~explorer.app.DragSteps`), or None."""
+        self.binding = Binding(on_reject, live_when=drag)
         self.title = pn.pane.HTML("", margin=(8, 10, 0, 10))
         self.kind = self.binding.add("kind", pn.widgets.Select(
             label="history", options=HISTORY_KINDS, sizing_mode="stretch_width"))

@@ -549,6 +549,45 @@ def test_a_drag_that_a_busy_server_takes_seconds_apart_is_one_step_of_undo(
     assert force.value == before
 
 
+def test_a_drag_the_page_sends_seconds_apart_is_one_step_of_undo(explorer_app, monkeypatch):
+    """A busy page (Chromium beside the suite's other parts) sent a drag's steps more than
+    COALESCE_S apart while the session sat idle, its answers in: one undo went back to the
+    middle of the drag (802 of 500 -> ~1130 kN/m). The page's release of the handle ends
+    the drag's step of undo, however long its steps took; a second drag is a step of its
+    own."""
+    from types import SimpleNamespace
+
+    import param
+
+    import explorer.model.history as history_module
+    import explorer.model.undo as undo_module
+    from explorer.model.undo import COALESCE_S
+
+    clock = [1000.0]
+    fake = SimpleNamespace(monotonic=lambda: clock[0])
+    monkeypatch.setattr(undo_module, "time", fake)
+    monkeypatch.setattr(history_module, "time", fake)
+    app = explorer_app(solved=True)
+    handle = app.scene_tab.history_editors[0].value._slider   # the force's, as the page's
+    force = app.state.loading.histories["force"]
+    before = force.value
+
+    def drag(values: list[float]) -> None:
+        for value in values:
+            clock[0] += 3.0 * COALESCE_S   # each step long after the last answer
+            handle.value = value
+        with param.edit_constant(handle):
+            handle.value_throttled = values[-1]    # the release
+
+    drag([before + 31.25 * k for k in range(1, 5)])
+    assert force.value == before + 125.0
+    drag([before + 125.0 + 17.5 * k for k in range(1, 4)])
+    app.history.undo()
+    assert force.value == before + 125.0
+    app.history.undo()
+    assert force.value == before
+
+
 def test_undo_across_a_preset_change_shows_the_scene_it_brings_back(explorer_app):
     # the selector and the description stayed at "Worn coating" while the uniform
     # scene was back on screen
