@@ -180,18 +180,9 @@ _GRADING, _PANELS = 0.25, 20
 _AGE_PANELS = 8
 
 
-def _graded_rule(panels: int, scale: float) -> tuple[np.ndarray, np.ndarray]:
-    """Nodes and weights on [0, scale] for ``int_0^scale f(s) ds``, graded toward 0."""
-    edges = np.concatenate([[0.0], scale * _GRADING ** np.arange(panels, -1, -1)])
-    width = np.diff(edges)
-    nodes = (edges[:-1, None] + width[:, None] * _GL_X[None, :]).ravel()
-    weights = (width[:, None] * _GL_W[None, :]).ravel()
-    return nodes, weights
-
-
-def _even_rule(panels: int) -> tuple[np.ndarray, np.ndarray]:
-    """Nodes and weights on [0, 1] for ``int_0^1 f(y) dy``, panels of equal width."""
-    edges = np.linspace(0.0, 1.0, panels + 1)
+def _rule_on(edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes and weights of the 6-point Gauss-Legendre rule on each panel between
+    ``edges``."""
     width = np.diff(edges)
     nodes = (edges[:-1, None] + width[:, None] * _GL_X[None, :]).ravel()
     weights = (width[:, None] * _GL_W[None, :]).ravel()
@@ -200,8 +191,9 @@ def _even_rule(panels: int) -> tuple[np.ndarray, np.ndarray]:
 
 #: lag fractions ``s = (t - u) / (t - tau)`` of the later half, and ``y`` of the earlier
 #: one (``u = tau (mid / tau)^y``)
-_LAG_NODES, _LAG_WEIGHTS = _graded_rule(_PANELS, 0.5)
-_AGE_NODES, _AGE_WEIGHTS = _even_rule(_AGE_PANELS)
+_LAG_NODES, _LAG_WEIGHTS = _rule_on(np.concatenate(
+    [[0.0], 0.5 * _GRADING ** np.arange(_PANELS, -1, -1)]))
+_AGE_NODES, _AGE_WEIGHTS = _rule_on(np.linspace(0.0, 1.0, _AGE_PANELS + 1))
 
 
 def integrated_kernel(kernel: Callable, t: ArrayLike, tau: ArrayLike) -> np.ndarray:

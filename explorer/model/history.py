@@ -42,11 +42,11 @@ class SceneHistory(param.Parameterized):
         the next change starts a step of its own."""
         self._gesture = None
 
-    def went_idle(self, at: float | None = None) -> None:
-        """The session's answers are in and drawn (``at`` [s], default now on the
-        monotonic clock): a change from here on follows a pause of the user's, whose
-        length decides whether it joins the change before (:meth:`UndoStack.push`)."""
-        self._idle_since = time.monotonic() if at is None else float(at)
+    def went_idle(self) -> None:
+        """The session's answers are in and drawn (now, on the monotonic clock): a change
+        from here on follows a pause of the user's, whose length decides whether it joins
+        the change before (:meth:`UndoStack.push`)."""
+        self._idle_since = time.monotonic()
 
     def remember(self) -> None:
         """Keep the scene now in the state (a change happened)."""

@@ -383,12 +383,13 @@ class Binding:
         dragging too when ``live_when`` says so. ``check`` refuses a value (ValueError)
         before it reaches the state; the widget then shows the state's value again."""
         event = "value" if live or "value_throttled" not in widget.param else "value_throttled"
+        # a policy that makes one step of undo of a drag hears where the page released it
+        ended = getattr(self._live_when, "gesture_ended", None)
         widget.param.watch(lambda e, name=name: self._to_target(name, e.new), event)
         if live and isinstance(widget, EditableSlider):
             # a drag step reaches the state before the text box follows (the watcher
             # above then finds the state at the value already: no second change)
             widget.watch_drag_first(lambda value, name=name: self._lead(name, value))
-            ended = getattr(self._live_when, "gesture_ended", None)
             if ended is None:
                 widget.apply_steps_only()
             else:
@@ -401,7 +402,6 @@ class Binding:
             # state has taken the value; not a value set from the state: a tab made
             # mid-drag ended its preview)
             released = getattr(self._live_when, "released", None)
-            ended = getattr(self._live_when, "gesture_ended", None)
             if released is not None:
                 def let_go(event: Any, dragged: bool) -> None:
                     released(dragged)
