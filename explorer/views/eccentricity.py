@@ -68,8 +68,9 @@ class EccentricityControl:
                  reject: Callable[[str], None], drag: Any = None) -> None:
         """``controller``: its last solve's time decides whether drag steps apply;
         ``reject``: says why a value was refused; ``drag``: where a held step's moment
-        goes (``drag.held(history, "value", M)``) and the release
-        (``drag.released(dragged)``),
+        goes (``drag.held(history, "value", M)``), the release
+        (``drag.released(dragged)``) and, where it has them, the steps and the end of
+        the drag's one step of undo (``drag.gesture_step()``, ``drag.gesture_ended()``),
         as for the other sliders (:class:`~.widgets.Binding`); None: nowhere."""
         self.state = state
         self.drag = drag
@@ -143,6 +144,11 @@ class EccentricityControl:
             return
         if self.drag is not None:
             self.drag.dragging()  # its results are spaced out, as every drag's
+            step = getattr(self.drag, "gesture_step", None)
+            if step is not None and event.new is not None:
+                # the moves up to the release are one step of undo, however far apart
+                # in time the page or the server spaced them (as every slider's)
+                step()
         if self.controller.solved_within(LIVE_SOLVE_S):
             self.say_lag(None)
             self.apply(event.new)
@@ -158,6 +164,9 @@ class EccentricityControl:
         self.apply(event.new)
         if self.drag is not None:
             self.drag.released(dragged)
+            ended = getattr(self.drag, "gesture_ended", None)
+            if ended is not None:
+                ended()  # the drag's one step of undo ends with the released value
 
     def _on_result(self, event: Any) -> None:
         if self.lag.visible:

@@ -588,6 +588,50 @@ def test_a_drag_the_page_sends_seconds_apart_is_one_step_of_undo(explorer_app, m
     assert force.value == before
 
 
+def test_a_drag_of_the_eccentricity_is_one_step_of_undo_however_slow(explorer_app,
+                                                                      monkeypatch):
+    """The eccentricity slider has its own drag handlers: its drags kept the rule of
+    COALESCE_S, so a drag whose steps the page or the server spaced out made several steps
+    of undo (one undo went back to the middle of the drag). The release ends its one step,
+    as every other slider's."""
+    from types import SimpleNamespace
+
+    import param
+
+    import explorer.model.history as history_module
+    import explorer.model.undo as undo_module
+    from explorer.model.undo import COALESCE_S
+
+    clock = [1000.0]
+    fake = SimpleNamespace(monotonic=lambda: clock[0])
+    monkeypatch.setattr(undo_module, "time", fake)
+    monkeypatch.setattr(history_module, "time", fake)
+    app = explorer_app(solved=True)
+    control = app.scene_tab.eccentric_load
+    assert control.applicable()
+    moment = app.state.loading.histories["moment"]
+    force = app.state.loading.histories["force"].value
+    before = moment.value
+
+    def drag(values: list[float]) -> None:
+        for value in values:
+            clock[0] += 3.0 * COALESCE_S   # each step long after the last answer
+            control.slider.value = value
+            assert app.controller.wait(30)
+        with param.edit_constant(control.slider):
+            control.slider.value_throttled = values[-1]    # the release
+        assert app.controller.wait(30)
+
+    drag([0.05 * k for k in range(1, 5)])
+    assert moment.value == pytest.approx(0.2 * force)
+    drag([0.2 - 0.03 * k for k in range(1, 4)])
+    assert moment.value == pytest.approx(0.11 * force)
+    app.history.undo()
+    assert moment.value == pytest.approx(0.2 * force)
+    app.history.undo()
+    assert moment.value == before
+
+
 def test_undo_across_a_preset_change_shows_the_scene_it_brings_back(explorer_app):
     # the selector and the description stayed at "Worn coating" while the uniform
     # scene was back on screen
