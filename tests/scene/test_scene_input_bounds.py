@@ -113,24 +113,34 @@ def _code_sine(wavelength: float, amplitude: float, age: float = 7.0,
     return d
 
 
-def test_a_design_codes_law_is_held_to_its_own_steps_per_period():
+def test_a_design_codes_law_is_held_to_its_own_steps_per_period(monkeypatch):
     """A design code's fitted kernel needs 11-43 steps a period (module notes of
     core.scene.load_rates), the exponential law 4.7: held to the latter, a 10-day sine
     over 50 years passed the check and ran ~28 s into the step limit before its
     refusal."""
+    import core.engines.nystrom.prepared as prepared_module
+    from core.cache import clear_caches
     from core.scene.load_rates import CODE_STEPS_PER_PERIOD, required_steps
 
     with pytest.raises(ValueError, match=r"^loading\.force\.wavelength: the load varies "
                                          r"faster .* about 1\.83e\+03 oscillations"):
         scene_from_dict(_code_sine(10.0, 3e5))
     # the bound stays under the steps taken where the fewest were measured (fib MC2010
-    # loaded at 365 days, a 30-day period, relative amplitude 0.09, tol 1e-4: 681 steps
-    # for 40 periods, the bound 439)
+    # loaded at 365 days, a 30-day period, relative amplitude 0.09, tol 1e-4: 681
+    # adaptive steps for 40 periods with the time steps aimed at tol / 30, the bound 439;
+    # at the default aim, looser, the exponential collocation meets it in 993 steps, in a
+    # third of the CPU time)
     scene = scene_from_dict(_code_sine(30.0, 6e4, age=365.0, end=1200.0))
     steps = solve(scene).info["n_steps"]
     bound = required_steps(scene.loading["force"], 0.0, 1200.0, scene.tol,
                            CODE_STEPS_PER_PERIOD)
-    assert 0.5 * steps < bound <= steps
+    assert bound <= steps
+    with monkeypatch.context() as patch:
+        patch.setattr(prepared_module, "TIME_LEFT_SHARE", 0.0)
+        clear_caches()
+        fewest = solve(scene).info["n_steps"]
+    clear_caches()
+    assert 0.5 * fewest < bound <= fewest
 
 
 def test_the_step_limit_is_named_when_it_is_hit(monkeypatch):
