@@ -75,6 +75,8 @@ def time_tolerance(tol: float, spatial_error: float, fit_error: float,
     left = tol - spatial_error - fit_error - defect
     floor = tol / TIME_SHARE
     return max(floor, TIME_LEFT_SHARE * left) if np.isfinite(left) else floor
+
+
 #: Points (Chebyshev, plus both sides of every jump) where q >= 0 is checked.
 CHECK_POINTS = 401
 #: Times per block when the extremes of q over the check points are formed (see _extremes):
