@@ -36,8 +36,9 @@ from core.time import ModalProblem, solve_degenerate, solve_general
 __all__ = ["BareCreepAnswer", "TIME_SHARE", "solve_bare_creep"]
 
 #: The time stepping aims this many times below tol: its step-doubling estimate read up
-#: to ~20x the true error on decaying creep (as the other engines take it,
-#: core/engines/nystrom/prepared.py).
+#: to ~20x the true error on decaying creep (the floor of the default engine's aim, which
+#: otherwise takes half of what its panel rule and the kernel's fit leave of tol:
+#: ``time_tolerance`` in core/engines/nystrom/prepared.py).
 TIME_SHARE = 30.0
 
 
