@@ -56,10 +56,10 @@ RESOLVED_SINGULAR_SHARE = 1e-6
 #: thickness-and-modulus pair leaves 1.4e-13 to 3.8e-13 of it along the undetermined
 #: combination (round-off; tests/back_analysis).
 UNDETERMINED_SHARE = 1e-6
-#: The solver tolerance of the fit's solves (the scene's own when tighter): the error
-#: estimate of the shipped young-concrete scene stays ~1.6e-5 (the creep kernel's fit)
-#: and its answers move by 1e-9 relative between tol 1e-4 and 1e-8, so the solves'
-#: error is far below any derivative the steps above measure.
+#: The solver tolerance of the fit's solves (the scene's own when tighter): at it the
+#: shipped young-concrete scene's settlement is 3.9e-9 from the answer at tol 1e-11
+#: (1.6e-6 at tol 1e-4; benchmarks/results/creep_honesty.md), so the solves' error is
+#: far below any derivative the steps above measure.
 FIT_SOLVER_TOL = 1e-6
 
 
