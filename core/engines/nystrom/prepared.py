@@ -597,6 +597,31 @@ REFERENCE_STEPS_PER_OCTAVE = 4
 #: coefficient of 1e-9).
 REFERENCE_UNMOVED = 1e-6
 
+#: A creep law's ``c / F`` (a kernel with a ``key``: checked where it was made) is
+#: evaluated at this many of the output times spread evenly over their indices and as
+#: many spread geometrically (the first and the last among them), then at every output
+#: time between the neighbours of the smallest. Over all 262 times the held compliance
+#: took 51 ms of a 190 ms new scene of the two-footing preset (36 exponentials,
+#: amplitudes varying with the age); sampled, 154 ms in all, the same smallest ratio:
+#: measured on 180 scenes of fib MC2010 and Eurocode 2 (ages 1-3650 days, 1-100 years,
+#: 20-500 outputs) and 162 of the exponential and aging laws, to 2.8e-16.
+REFERENCE_SAMPLES = 24
+
+
+def _sampled_minimum(t: np.ndarray, ratios: Callable[[np.ndarray], np.ndarray]) -> float:
+    """The smallest of ``ratios(t)`` from :data:`REFERENCE_SAMPLES` of the times ``t``
+    and every time between the neighbours of the smallest of them."""
+    pick = np.unique(np.geomspace(1, t.size, REFERENCE_SAMPLES).round().astype(int) - 1)
+    pick = np.union1d(pick, np.unique(np.linspace(0, t.size - 1, REFERENCE_SAMPLES)
+                                      .round().astype(int)))
+    sampled = ratios(t[pick])
+    k = int(np.argmin(sampled))
+    lo, hi = pick[max(k - 1, 0)], pick[min(k + 1, pick.size - 1)]
+    between = np.setdiff1d(np.arange(lo, hi + 1), pick)
+    rest = ratios(t[between]) if between.size else np.empty(0)
+    return float(min(np.min(sampled), np.min(rest, initial=np.inf)))
+
+
 _REFERENCES = StageCache("creep_reference", max_items=256, max_bytes=2**16,
                          sizeof=lambda _: 8)
 
@@ -619,13 +644,20 @@ def creep_reference(inputs: TimeInputs) -> float:
         return 1.0
     key = getattr(inputs.kernel, "key", None)
 
+    def ratios(t: np.ndarray) -> np.ndarray:
+        held = 1.0 + integrated_kernel(inputs.kernel, t, np.ones_like(t))
+        # a compliance through zero made the ratio's log NaN
+        check_held_compliance(inputs.kernel, t, held)
+        return np.asarray(inputs.c(t), dtype=float) / held
+
     def compute() -> float:
         t = np.asarray(inputs.times, dtype=float)
-        held = 1.0 + integrated_kernel(inputs.kernel, t, np.ones_like(t))
-        # every output time (the solve's inputs checked only a sample of a plain
-        # callable's): a compliance through zero made the ratio's log NaN
-        check_held_compliance(inputs.kernel, t, held)
-        ratio = float(np.min(np.asarray(inputs.c(t), dtype=float) / held))
+        if key is None or t.size <= REFERENCE_SAMPLES:
+            # every output time: the solve's inputs checked only a sample of a plain
+            # callable's compliance
+            ratio = float(np.min(ratios(t)))
+        else:
+            ratio = _sampled_minimum(t, ratios)
         if not ratio < 1.0 - REFERENCE_UNMOVED:
             return 1.0
         steps = REFERENCE_STEPS_PER_OCTAVE
