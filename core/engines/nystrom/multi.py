@@ -444,14 +444,15 @@ class CoupledPunches:
             answer, checks, terms = self._superposed(self.modal(givens, tol), inputs, probe,
                                                      first.c, c_probe, kernel, time_tol,
                                                      breaks)
-            if time_tol > tol / TIME_SHARE and not all(
-                    accepts(pc.spatial_error + error + fit_error, pc.geometry.tol,
+            if time_tol > tol / TIME_SHARE and answer.success and not all(
+                    accepts(pc.spatial_error + (error + fit_error), pc.geometry.tol,
                             SUCCESS_MARGIN)
                     for pc, error in zip(self.prepared, answer.time_errors
                                          or (answer.time_error,) * len(self.punches),
                                          strict=True)):
                 # a punch whose answer is small beside its parts' (a light punch beside
-                # a heavy one, loads that cancel on it): the stepping at its floor
+                # a heavy one, loads that cancel on it): the stepping at its floor (not
+                # where it stopped at its step limit: it would stop there again)
                 answer, checks, terms = self._superposed(
                     self.modal(givens, tol), inputs, probe, first.c, c_probe, kernel,
                     tol / TIME_SHARE, breaks)
