@@ -46,6 +46,17 @@ def _at_floor(monkeypatch: pytest.MonkeyPatch, scene: dict):
         return solve(scene)
 
 
+def _aimed_far_above_tol(monkeypatch: pytest.MonkeyPatch, scene: dict):
+    """The answer with ``TIME_LEFT_SHARE`` 50 (the first stepping stops at its coarsest
+    grids, its estimate over tol), which succeeds, and the floor's answer."""
+    floor = _at_floor(monkeypatch, scene)
+    monkeypatch.setattr(prepared_module, "TIME_LEFT_SHARE", 50.0)
+    clear_caches()
+    answer = solve(scene)
+    assert answer.info["success"]
+    return answer, floor
+
+
 def test_a_loose_tol_buys_fewer_steps_and_stays_within_its_estimate(monkeypatch):
     scene = _ten_years(1e-4)
     floor = _at_floor(monkeypatch, scene)
@@ -68,12 +79,7 @@ def test_an_answer_whose_time_part_misses_tol_is_stepped_again_at_the_floor(monk
     """With the aim put far above tol (``TIME_LEFT_SHARE`` 50), the first stepping stops
     at its coarsest grids, its estimate over tol: the answer is stepped again at
     ``tol / TIME_SHARE`` and is the floor's answer, to the digit."""
-    scene = _ten_years(1e-6)
-    floor = _at_floor(monkeypatch, scene)
-    monkeypatch.setattr(prepared_module, "TIME_LEFT_SHARE", 50.0)
-    clear_caches()
-    answer = solve(scene)
-    assert answer.info["success"]
+    answer, floor = _aimed_far_above_tol(monkeypatch, _ten_years(1e-6))
     assert answer.info["n_steps"] == floor.info["n_steps"]
     np.testing.assert_array_equal(answer.settlement, floor.settlement)
 
@@ -90,12 +96,7 @@ def test_several_punches_whose_time_part_misses_tol_are_stepped_again_at_the_flo
         monkeypatch):
     """As for one punch: each punch's estimate is its own, and the stepping is done again
     at ``tol / TIME_SHARE`` when one of them misses tol."""
-    scene = _two_footings(1e-5)
-    floor = _at_floor(monkeypatch, scene)
-    monkeypatch.setattr(prepared_module, "TIME_LEFT_SHARE", 50.0)
-    clear_caches()
-    answer = solve(scene)
-    assert answer.info["success"]
+    answer, floor = _aimed_far_above_tol(monkeypatch, _two_footings(1e-5))
     for punch, alone in zip(answer.punches, floor.punches, strict=True):
         assert punch.info["n_steps"] == alone.info["n_steps"]
         np.testing.assert_array_equal(punch.settlement, alone.settlement)
