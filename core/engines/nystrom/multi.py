@@ -88,10 +88,11 @@ from core.engines.nystrom.prepared import (
     geometry_key,
     load_shape,
     prepared_for,
+    step_again_at_floor,
     time_tolerance,
 )
-from core.engines.nystrom.result import SUCCESS_MARGIN, TimeSide, nystrom_solution
-from core.problem import QUANTITIES, ContactSolution, Geometry, TimeInputs, accepts
+from core.engines.nystrom.result import TimeSide, nystrom_solution
+from core.problem import QUANTITIES, ContactSolution, Geometry, TimeInputs
 from core.time import history_key_times
 
 
@@ -441,21 +442,16 @@ class CoupledPunches:
             # what the most demanding punch's panel rule leaves to the time stepping
             time_tol = time_tolerance(tol, max(pc.spatial_error for pc in self.prepared),
                                       fit_error)
-            answer, checks, terms = self._superposed(self.modal(givens, tol), inputs, probe,
-                                                     first.c, c_probe, kernel, time_tol,
-                                                     breaks)
-            if time_tol > tol / TIME_SHARE and answer.success and not all(
-                    accepts(pc.spatial_error + (error + fit_error), pc.geometry.tol,
-                            SUCCESS_MARGIN)
-                    for pc, error in zip(self.prepared, answer.time_errors
-                                         or (answer.time_error,) * len(self.punches),
-                                         strict=True)):
-                # a punch whose answer is small beside its parts' (a light punch beside
-                # a heavy one, loads that cancel on it): the stepping at its floor (not
-                # where it stopped at its step limit: it would stop there again)
+            form = self.modal(givens, tol)
+            answer, checks, terms = self._superposed(form, inputs, probe, first.c, c_probe,
+                                                     kernel, time_tol, breaks)
+            errors = answer.time_errors or (answer.time_error,) * len(self.punches)
+            if step_again_at_floor(time_tol, tol, answer.success, [
+                    (pc.spatial_error + (error + fit_error), pc.geometry.tol)
+                    for pc, error in zip(self.prepared, errors, strict=True)]):
+                # (a light punch beside a heavy one: its answer small beside its parts')
                 answer, checks, terms = self._superposed(
-                    self.modal(givens, tol), inputs, probe, first.c, c_probe, kernel,
-                    tol / TIME_SHARE, breaks)
+                    form, inputs, probe, first.c, c_probe, kernel, tol / TIME_SHARE, breaks)
             nodal, effective, scalars_all = answer.nodal, answer.effective, answer.scalars
             # each punch's time error its own (a far neighbour's march does not count)
             time_sides = [TimeSide(error + fit_error, answer.steps, answer.success,

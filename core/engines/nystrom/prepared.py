@@ -28,7 +28,7 @@ import threading
 import time as _time
 import weakref
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -80,6 +80,17 @@ def time_tolerance(tol: float, spatial_error: float, fit_error: float,
     left = tol - spatial_error - fit_error - defect
     floor = tol / TIME_SHARE
     return max(floor, TIME_LEFT_SHARE * left) if np.isfinite(left) else floor
+
+
+def step_again_at_floor(time_tol: float, tol: float, stepped: bool,
+                        parts: Iterable[tuple[float, float]]) -> bool:
+    """Whether an answer stepped at the aim ``time_tol`` (:func:`time_tolerance`) is to
+    be stepped again at ``tol / TIME_SHARE``: it was aimed above that, its stepping
+    finished (one stopped at its step limit would stop there again) and one of ``parts``
+    (its whole error estimate, as success sums it, and the tol it must meet) misses:
+    responses to loads that cancel, each with its own error, against a small answer."""
+    return (time_tol > tol / TIME_SHARE and stepped
+            and not all(accepts(error, part_tol, SUCCESS_MARGIN) for error, part_tol in parts))
 
 
 #: Points (Chebyshev, plus both sides of every jump) where q >= 0 is checked.
@@ -343,12 +354,8 @@ class PreparedContact:
             answer = self._superposed(form, merged, inputs, kernel, time_tol, breaks)
             # (the time side's error as nystrom_solution adds it to the spatial one)
             time_part = answer.time_error + fit_error + form.mode_defect
-            if (time_tol > geometry.tol / TIME_SHARE and answer.success
-                    and not accepts(self.spatial_error + time_part, geometry.tol,
-                                    SUCCESS_MARGIN)):
-                # the responses' errors add up against an answer smaller than they are
-                # (loads whose parts cancel): the stepping at the floor of its aim (not
-                # where it stopped at its step limit: it would stop there again)
+            if step_again_at_floor(time_tol, geometry.tol, answer.success,
+                                   [(self.spatial_error + time_part, geometry.tol)]):
                 answer = self._superposed(form, merged, inputs, kernel,
                                           geometry.tol / TIME_SHARE, breaks)
             q_extremes = answer.q_extremes
