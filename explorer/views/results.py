@@ -37,7 +37,7 @@ from .link import AddressLink
 from .loop import PageLoop
 from .pins import PinsView
 from .status import BADGES, held_text, preview_text, status_html
-from .style import NOTE_STYLE, html_pane
+from .style import NOTE_STYLE, html_pane, set_shown
 from .widgets import NAMES, LabelledCheckbox, TimePlayer
 
 
@@ -291,8 +291,8 @@ class ResultsView:
         self.player_box = pn.Row(self.player, sizing_mode="stretch_width", margin=0)
         self.time_label = html_pane("", margin=(12, 10))
         self.readout = html_pane("", sizing_mode="stretch_width")
-        self.once_note = html_pane("", sizing_mode="stretch_width", visible=False,
-                                   css_classes=["once-note-pane"])
+        self.once_note = html_pane("", sizing_mode="stretch_width", css_classes=["once-note-pane"],
+                                   styles={"display": "none"})
         self.design = html_pane("", sizing_mode="stretch_width", css_classes=["design-pane"])
         self.classical = LabelledCheckbox("classical solutions on q(x)",
                                           css_classes=["classical-toggle"])
@@ -360,8 +360,7 @@ class ResultsView:
         # greyed slider and play button read as broken (a teacher's audit): the time
         # label beside it and the once-note say the one time
         self.player.disabled = len(view.times) < 2
-        if self.player_box.visible != (len(view.times) > 1):
-            self.player_box.visible = len(view.times) > 1
+        set_shown(self.player_box, len(view.times) > 1)
         self.follow_time_span(view)
         with param.discard_events(self.screen):
             self.screen.time_index = index
@@ -389,16 +388,14 @@ class ResultsView:
         over_time = (len(view.times) > 1
                      or any(len(pin.view.times) > 1 for pin in self.pins.board.pins)
                      or any(len(readings[q].data.get("t", ())) for q in readings))
-        # (the map's figure itself: its Bokeh pane takes its visibility from it)
+        # (the map's figure itself: its Bokeh pane puts the figure on the page as it is)
         for pane in (self.figures.image_fig, grid, self.log_time.__panel__()):
-            if pane.visible != over_time:
-                pane.visible = over_time
+            set_shown(pane, over_time)
         note = "" if over_time else (ONCE_CREEP_NOTE if creeps(view.scene) else ONCE_NOTE
                                      ).format(t=days_text(float(view.times[0])))
         if self.once_note.object != note:
             self.once_note.object = note
-        if self.once_note.visible == over_time:
-            self.once_note.visible = not over_time
+        set_shown(self.once_note, not over_time)
 
     def evidence(self, view: ResultView | None) -> dict[str, Any] | None:
         """The coating model's error to show for ``view``: measured by the Coating tab's
