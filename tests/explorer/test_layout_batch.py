@@ -23,6 +23,7 @@ from panel.viewable import Renderable
 
 from core.presets import read_preset
 from explorer.fixes import layout_batch
+from explorer.views import PageLoop
 from explorer.views.widgets import slider
 
 
@@ -145,6 +146,40 @@ def test_a_preset_switch_walks_the_page_once(explorer_app, monkeypatch) -> None:
         assert app.load_scene(read_preset("rounded_graded"))
     assert counts["recompute"] == 1 and counts["preprocess"] <= 1, counts
     assert app.controller.wait(120) and app.controller.error == ""
+    # back and forth between presets whose sliders are made: no model added or dropped,
+    # no walk, and the document's models are still those of its roots (served: outside
+    # a server the time player is made anew for each range, see ResultsView._set_range)
+    monkeypatch.setattr(PageLoop, "served", property(lambda self: True))
+    monkeypatch.setattr(app.loop, "later", lambda *args, **kwargs: None)
+    for name in ("uniform_flat", "rounded_graded"):
+        with set_curdoc(doc), counted_walks(doc, monkeypatch) as counts:
+            assert app.load_scene(read_preset(name))
+        assert counts["recompute"] == 0, (name, counts)
+        assert app.controller.wait(120) and app.controller.error == ""
+    reachable = set().union(*(root.references() for root in doc.roots))
+    assert set(doc.models) == reachable
+
+
+def test_a_block_that_changes_no_models_walks_nothing(monkeypatch) -> None:
+    """Bokeh recomputes when its last freeze ends, changed or not: a batch that adds or
+    drops no model ends without the walk; one that sets a property holding a model
+    (Bokeh's ``models.invalidate``, no freeze of Panel's) still walks once."""
+    from bokeh.models import Div
+
+    doc = Document()
+    page, holders, root = _page(doc)
+    try:
+        with set_curdoc(doc), counted_walks(doc, monkeypatch) as counts:
+            with layout_batch.batch(doc):
+                page.objects[-1].value = 0.5
+            assert counts["recompute"] == 0 and doc.models._freeze_count == 0
+            div = Div(text="added by Bokeh alone")
+            with layout_batch.batch(doc):
+                root.children[0].children = [div]
+            assert counts["recompute"] == 1 and div.id in doc.models
+        assert "invalidate" not in vars(doc.models)
+    finally:
+        state._views.pop(root.ref["id"], None)
 
 
 def test_a_document_without_bokehs_freeze_is_left_as_it_is() -> None:
