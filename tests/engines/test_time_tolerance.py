@@ -13,7 +13,12 @@ import pytest
 
 import core.engines.nystrom.prepared as prepared_module
 from core.cache import clear_caches
-from core.engines.nystrom.prepared import TIME_LEFT_SHARE, TIME_SHARE, time_tolerance
+from core.engines.nystrom.prepared import (
+    TIME_LEFT_SHARE,
+    TIME_SHARE,
+    step_again_at_floor,
+    time_tolerance,
+)
 from core.scene import solve
 from tests.conftest import scene_file
 
@@ -28,6 +33,20 @@ def test_the_time_steps_aim_at_half_of_what_space_and_the_fit_leave():
     assert time_tolerance(1e-4, 2e-4, 0.0) == pytest.approx(1e-4 / TIME_SHARE)
     assert time_tolerance(1e-4, float("nan"), 0.0) == pytest.approx(1e-4 / TIME_SHARE)
     assert time_tolerance(1e-4, float("inf"), 0.0) == pytest.approx(1e-4 / TIME_SHARE)
+
+
+def test_the_floor_is_taken_again_when_any_one_part_misses():
+    """Several punches: each punch's estimate is a part with its own tol; one part that
+    misses (the other within) is enough to step again, unless the aim was the floor
+    already or the stepping stopped at its step limit (it would stop there again)."""
+    tol = 1e-6
+    within, missing = (0.5 * tol, tol), (2.0 * tol, tol)
+    aim = 0.5 * tol
+    assert step_again_at_floor(aim, tol, True, [within, missing])
+    assert step_again_at_floor(aim, tol, True, [missing, within])
+    assert not step_again_at_floor(aim, tol, True, [within, within])
+    assert not step_again_at_floor(tol / TIME_SHARE, tol, True, [within, missing])
+    assert not step_again_at_floor(aim, tol, False, [within, missing])
 
 
 def _ten_years(tol: float) -> dict:
