@@ -60,6 +60,7 @@ from .views import (
     LessonsView,
     PageLoop,
     PinsView,
+    PromptToggle,
     PunchView,
     ResultsView,
     SceneView,
@@ -509,7 +510,7 @@ class ExplorerApp(pn.viewable.Viewer):
             "</div>",
             sizing_mode="stretch_width")
         self.header = header
-        self.presenting = pn.widgets.Toggle(label="Presentation mode", width=170,
+        self.presenting = PromptToggle(label="Presentation mode", width=170,
                                             css_classes=["presentation-toggle"])
         self.presenting.param.watch(self._on_presentation, "value")
         return pn.Column(pn.Row(header, self.presenting, sizing_mode="stretch_width"),

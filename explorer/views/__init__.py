@@ -40,10 +40,11 @@ from .study import StudyView
 from .style import html_pane
 from .tabs import COMPLETE_CLASS, FILL_TABS_AFTER_MS, DeferredTabs
 from .times import TimesView
+from .widgets import PromptToggle
 
 __all__ = ["BUSY_AFTER_MS", "CONTACT_LABELS", "FILL_TABS_AFTER_MS", "LINK_EVERY_MS",
            "HELD_AFTER_MS",
            "AddressLink", "BaseView", "COMPLETE_CLASS", "CheckView", "CoatingView",
            "DeferredTabs", "FidelityView", "FilesView", "FitView", "LessonsView",
-           "PageLoop", "PinsView", "PunchView", "ResultsView", "SceneView", "StudyView",
-           "TimesView", "badges_html", "html_pane", "readout_html", "status_html"]
+           "PageLoop", "PinsView", "PromptToggle", "PunchView", "ResultsView", "SceneView",
+           "StudyView", "TimesView", "badges_html", "html_pane", "readout_html", "status_html"]

@@ -10,7 +10,7 @@ import panel as pn
 from ..model import CODE_CREEP_MODELS, CREEP_MODELS, ExplorerState
 from .creep import CodeCreepPanel
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-from .widgets import Binding, slider
+from .widgets import Binding, PromptSelect, slider
 
 
 class BaseView:
@@ -29,7 +29,7 @@ class BaseView:
                                                          css_classes=["base-thickness"]))
         self.base_poisson = bb.add("poisson", slider("Poisson ratio [-]", 0.0, 0.49, 0.01))
         self.base_modulus = bb.add("modulus", slider("Young's modulus E [GPa]", 0.1, 60.0, 0.1))
-        self.creep_model = bb.add("creep_model", pn.widgets.Select(
+        self.creep_model = bb.add("creep_model", PromptSelect(
             label="creep model", options={v: k for k, v in CREEP_MODELS.items()},
             sizing_mode="stretch_width", css_classes=["creep-select"]))
         self.compliance = bb.add("compliance", slider("final creep compliance C∞ [1/GPa]",

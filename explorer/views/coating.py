@@ -19,7 +19,7 @@ from .fidelity import FidelityView
 from .loop import PageLoop
 from .punches import OnePunchOnly
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-from .widgets import ProfileEditor, PromptIntSlider, significant_format
+from .widgets import ProfileEditor, PromptIntSlider, PromptRadioButtonGroup, significant_format
 
 log = logging.getLogger(__name__)
 
@@ -72,7 +72,7 @@ class CoatingView:
                                         value=min(s.n_layers, SCREEN_LAYERS),
                                         sizing_mode="stretch_width")
         self.n_layers.param.watch(lambda e: setattr(s, "n_layers", e.new), "value_throttled")
-        self.layer = pn.widgets.RadioButtonGroup(label="edit layer", options=["1"], value="1",
+        self.layer = PromptRadioButtonGroup(label="edit layer", options=["1"], value="1",
                                                  color="primary", variant="outline",
                                                  sizing_mode="stretch_width")
         self.layer.param.watch(lambda *e: self.bind_layer(), "value")

@@ -25,7 +25,7 @@ from ..model import (
     CodeCreepState,
     creep_coefficient_data,
 )
-from .widgets import NumberBox
+from .widgets import NumberBox, PromptSelect
 
 __all__ = ["CodeCreepPanel", "creep_coefficient_figure", "update_creep_figure"]
 
@@ -74,12 +74,12 @@ class CodeCreepPanel:
     def __init__(self, base: Any, binding: Any) -> None:
         self._base = base
         b = binding
-        self.strength_class = b.add("strength_class", pn.widgets.Select(
+        self.strength_class = b.add("strength_class", PromptSelect(
             label="strength class (or f_cm)", options=list(STRENGTH_CLASSES) + ["fcm"],
             sizing_mode="stretch_width", css_classes=["code-strength"]))
         self.fcm = b.add("fcm", NumberBox(
             label="mean strength f_cm [MPa]", step=1.0, sizing_mode="stretch_width"))
-        self.cement = b.add("cement", pn.widgets.Select(
+        self.cement = b.add("cement", PromptSelect(
             label="cement class", options={"S (slow)": "S", "N (normal)": "N", "R (rapid)": "R"},
             sizing_mode="stretch_width"))
         self.relative_humidity = b.add("relative_humidity", NumberBox(

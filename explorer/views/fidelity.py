@@ -15,7 +15,7 @@ from typing import Any
 import panel as pn
 
 from explorer.model import CONTACT_MODELS, INTERFACES, MODEL_TOL_RANGE, ExplorerState, LayerState
-from explorer.views.widgets import Binding, NumberBox
+from explorer.views.widgets import Binding, NumberBox, PromptRadioButtonGroup, PromptSelect
 
 #: What each contact model means, as the selector shows it.
 CONTACT_LABELS: dict[str, str] = {
@@ -40,11 +40,11 @@ class FidelityView:
     def __init__(self, state: ExplorerState,
                  on_reject: Callable[[str], None] | None = None) -> None:
         self.layer_binding = Binding(on_reject)
-        self.interface = self.layer_binding.add("interface", pn.widgets.RadioButtonGroup(
+        self.interface = self.layer_binding.add("interface", PromptRadioButtonGroup(
             label="interface with the layer below", options=list(INTERFACES),
             sizing_mode="stretch_width", css_classes=["layer-interface"]))
         self.solver_binding = Binding(on_reject)
-        self.contact = self.solver_binding.add("contact", pn.widgets.Select(
+        self.contact = self.solver_binding.add("contact", PromptSelect(
             label="contact model", options={v: k for k, v in CONTACT_LABELS.items()},
             sizing_mode="stretch_width", css_classes=["contact-select"]))
         low, high = (100.0 * v for v in MODEL_TOL_RANGE)

@@ -38,6 +38,7 @@ from .loop import PageLoop
 from .punches import OnePunchOnly
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
 from .upload import BoundedUpload
+from .widgets import PromptSelect
 
 #: The choice of "no field" for the second and third field.
 NONE = "(none)"
@@ -84,7 +85,7 @@ class FitView:
         self.upload.param.watch(self._on_upload, "value")
         self.readings_status = html_pane("<small><i>No readings yet.</i></small>",
                                          css_classes=["fit-readings"], **stretch)
-        self.fields = [pn.widgets.Select(label=f"field {k + 1} to fit",
+        self.fields = [PromptSelect(label=f"field {k + 1} to fit",
                                          css_classes=[f"fit-field-{k + 1}"], **stretch)
                        for k in range(MAX_FIT_FIELDS)]
         self.fit_button = pn.widgets.Button(label="Fit", color="primary", disabled=True,

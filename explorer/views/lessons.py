@@ -11,7 +11,7 @@ import panel as pn
 from ..model import MODIFIED, Lesson, lessons, step_scene
 from .pins import PinsView
 from .style import TAB_COLUMN, html_pane
-from .widgets import LabelledCheckbox
+from .widgets import LabelledCheckbox, PromptSelect
 
 #: What the Lessons tab says while the scene on screen is a step changed on the page.
 CHANGED_NOTE = ("<div class='cp-msg' style='font-size:13px'>You changed the scene of this "
@@ -44,7 +44,7 @@ class LessonsView:
         self.lesson: Lesson | None = None
         self.step = 0
         options = {"(choose a lesson)": ""} | {v.title: k for k, v in self.lessons.items()}
-        self.lesson_select = pn.widgets.Select(label="lesson", options=options, value="",
+        self.lesson_select = PromptSelect(label="lesson", options=options, value="",
                                                sizing_mode="stretch_width",
                                                css_classes=["lesson-select"])
         self.lesson_select.param.watch(lambda e: self.start(e.new), "value")

@@ -17,7 +17,7 @@ from ..plots import PIN_COLORS
 from ..solving import SolveController, format_error
 from .loop import PageLoop
 from .style import html_pane
-from .widgets import NAMES, TIGHT_NUMBER_BOX, CountBox, NumberBox
+from .widgets import NAMES, TIGHT_NUMBER_BOX, CountBox, NumberBox, PromptCheckbox
 
 #: How the notices of "Pin the steps" begin: steps refused as asked, a step refused by
 #: the solver (both cleared once steps are pinned as asked).
@@ -45,7 +45,7 @@ class PinsView:
                                               disabled=True, css_classes=["unpin-button"])
         # each new result is pinned as it arrives (the oldest pin goes when there are
         # six): a class moves a slider step by step, and the steps stay on the plots
-        self.every_step = pn.widgets.Checkbox(label="pin every step",
+        self.every_step = PromptCheckbox(label="pin every step",
                                               css_classes=["pin-every-step"])
         # the result on screen is the first step: pinned when the box is ticked
         self.every_step.param.watch(lambda e: e.new and self.pin(), "value")

@@ -15,7 +15,7 @@ from ..model import ExplorerState, Screen
 from ..solving import format_error
 from .punches import PunchesSection
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-from .widgets import Binding, BoundedUpload, LazySlider, slider
+from .widgets import Binding, BoundedUpload, LazySlider, PromptSelect, slider
 
 SHAPES = {
     "flat": "flat", "crowned (parabolic, radius R)": "parabolic",
@@ -39,7 +39,7 @@ class PunchView:
         pb = self.punch
         self.half_width = pb.add("half_width", slider("half-width a [m]", 0.1, 5.0, 0.01,
                                                       css_classes=["punch-half-width"]))
-        self.shape = pb.add("shape", pn.widgets.Select(label="base shape", options=SHAPES,
+        self.shape = pb.add("shape", PromptSelect(label="base shape", options=SHAPES,
                                                        sizing_mode="stretch_width"))
         # each shape's sliders are made when the shape is first chosen (LazySlider)
         self.radius = LazySlider(pb, "radius", "crown radius R [km]", 1.0, 500.0, 0.5,

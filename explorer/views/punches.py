@@ -18,7 +18,7 @@ import panel as pn
 from ..model import SCREEN_PUNCHES, STATEMENTS, ExplorerState, PunchEntryState
 from ..plots import PUNCH_COLORS
 from .style import NOTE_STYLE, html_pane
-from .widgets import NAMES, Binding, HistoryEditor, slider
+from .widgets import NAMES, Binding, HistoryEditor, PromptRadioButtonGroup, PromptSelect, slider
 
 
 class OnePunchOnly:
@@ -60,7 +60,7 @@ class PunchesSection:
                                                css_classes=["punch-remove"])
         self.add_button.on_click(lambda e: self.add())
         self.remove_button.on_click(lambda e: self.remove())
-        self.select = pn.widgets.RadioButtonGroup(options=["1"], value="1", color="primary",
+        self.select = PromptRadioButtonGroup(options=["1"], value="1", color="primary",
                                                   variant="outline",
                                                   css_classes=["punch-select"])
         self.select.param.watch(lambda e: self.bind(), "value")
@@ -70,7 +70,7 @@ class PunchesSection:
         self.shape = Binding(reject, live_when=live_when)
         self.half_width = self.shape.add("half_width", slider(
             "half-width a [m]", 0.1, 5.0, 0.01, css_classes=["punch-half-width-of"]))
-        self.statement = pn.widgets.Select(label="statement (which two are given)",
+        self.statement = PromptSelect(label="statement (which two are given)",
                                            options=list(STATEMENTS),
                                            sizing_mode="stretch_width",
                                            css_classes=["punch-statement"])

@@ -17,7 +17,7 @@ from ..solving import SolveController
 from .eccentricity import EccentricityControl
 from .punches import OnePunchOnly
 from .style import TAB_COLUMN, html_pane
-from .widgets import NAMES, HistoryEditor
+from .widgets import NAMES, HistoryEditor, PromptSelect
 
 
 def _held(change: Callable[[], Any]) -> None:
@@ -54,7 +54,7 @@ class SceneView:
         self.load_scene = load_scene
         options = {"(custom scene)": ""}
         options.update({preset_label(k, v): k for k, v in presets.items()})
-        self.preset = pn.widgets.Select(label="Preset scene", options=options,
+        self.preset = PromptSelect(label="Preset scene", options=options,
                                         value=preset_key or "",
                                         sizing_mode="stretch_width",
                                         css_classes=["preset-select"])
@@ -71,7 +71,7 @@ class SceneView:
                                               css_classes=["reset-button"])
         self.reset_button.on_click(lambda e: _held(lambda: self._back(history.reset)))
 
-        self.statement = pn.widgets.Select(label="statement (which two are given)",
+        self.statement = PromptSelect(label="statement (which two are given)",
                                            options=list(STATEMENTS), value=s.loading.statement,
                                            sizing_mode="stretch_width",
                                            css_classes=["statement-select"])

@@ -39,7 +39,7 @@ from ..plots import DesignChart, design_chart_png, flag_note
 from ..solving import SolveController, StudyRun, format_error
 from .loop import PageLoop
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane, slug
-from .widgets import CountBox, NumberBox
+from .widgets import CountBox, NumberBox, PromptSelect
 
 #: The second parameter's choice for "no second parameter".
 NONE = "(none: a line over parameter 1)"
@@ -55,7 +55,7 @@ class _AxisInputs:
     def __init__(self, n: int, optional: bool) -> None:
         css = f"study-p{n}"
         self.optional = optional
-        self.field = pn.widgets.Select(label=f"parameter {n}", sizing_mode="stretch_width",
+        self.field = PromptSelect(label=f"parameter {n}", sizing_mode="stretch_width",
                                        css_classes=[f"{css}-field"])
         # four boxes and their margins in the sidebar's width (the spacing once ran ~70 px
         # past it, into the scene's axis label)
@@ -67,7 +67,7 @@ class _AxisInputs:
         self.count = CountBox(label="points", value=9, width=66,
                               css_classes=[f"{css}-count"])
         # (its text once touched the arrow: a narrower left padding than the theme's 12 px)
-        self.spacing = pn.widgets.Select(label="spacing", options=list(SPACINGS), width=68,
+        self.spacing = PromptSelect(label="spacing", options=list(SPACINGS), width=68,
                                          css_classes=[f"{css}-spacing"],
                                          stylesheets=[NARROW_SELECT])
         self.row = pn.Row(self.start, self.stop, self.count, self.spacing,
@@ -131,10 +131,10 @@ class StudyView:
         self.study_first = _AxisInputs(1, optional=False)
         self.study_second = _AxisInputs(2, optional=True)
         stretch = {"sizing_mode": "stretch_width"}
-        self.study_output = pn.widgets.Select(
+        self.study_output = PromptSelect(
             label="output", options={f"{n} [{u}]": k for k, (n, u, _) in OUTPUTS.items()},
             css_classes=["study-output"], **stretch)
-        self.study_time = pn.widgets.Select(label="at time after loading", options={},
+        self.study_time = PromptSelect(label="at time after loading", options={},
                                             css_classes=["study-time"], **stretch)
         self.study_run_button = pn.widgets.Button(label="Run study", color="primary",
                                                   css_classes=["study-run"], **stretch)

@@ -11,7 +11,15 @@ import panel as pn
 from ..model import ExplorerState
 from .fidelity import FidelityView
 from .style import NOTE_STYLE, TAB_COLUMN, html_pane
-from .widgets import Binding, EditableIntSlider, NumberBox, next_tick, slider
+from .widgets import (
+    Binding,
+    EditableIntSlider,
+    NumberBox,
+    PromptRadioButtonGroup,
+    PromptSelect,
+    next_tick,
+    slider,
+)
 
 SPACINGS = {"linear": "linear", "log": "log"}
 
@@ -34,7 +42,7 @@ class TimesView:
         self.time_count = gb.add("time_count", EditableIntSlider(
             label="output times", start=2, end=200, step=1, sizing_mode="stretch_width",
             css_classes=["time-count"]))
-        self.time_spacing = gb.add("time_spacing", pn.widgets.RadioButtonGroup(
+        self.time_spacing = gb.add("time_spacing", PromptRadioButtonGroup(
             label="spacing", options=list(SPACINGS), sizing_mode="stretch_width"))
         # where log spacing begins: over 50 years its default (the last three decades)
         # begins at 18 days, after most of a young concrete's early creep. Not through
@@ -46,7 +54,7 @@ class TimesView:
             step=1.0, sizing_mode="stretch_width", css_classes=["time-start"])
         self.time_start.param.watch(self._on_time_start, "value")
         s.param.watch(self._show_time_start, "time_start")
-        self.tol = gb.add("tol", pn.widgets.Select(
+        self.tol = gb.add("tol", PromptSelect(
             label="accuracy target (relative)",
             options={f"{v:g}": v for v in s.param.tol.objects},
             sizing_mode="stretch_width", css_classes=["tol-select"]))

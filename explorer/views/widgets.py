@@ -65,6 +65,38 @@ class PromptFloatSlider(pn.widgets.FloatSlider):
                                                    if p != "value_throttled")
 
 
+class PromptSelect(pn.widgets.Select):
+    """A Select whose choice is handled at once: Panel waits 50 ms for a further change
+    of a widget's value before it takes it up, which a choice from a list never brings
+    (the 50 ms were a tenth of a preset switch)."""
+
+    _debounce = 0
+
+
+class PromptRadioButtonGroup(pn.widgets.RadioButtonGroup):
+    """A RadioButtonGroup whose choice is handled at once (see :class:`PromptSelect`)."""
+
+    _debounce = 0
+
+
+class PromptCheckbox(pn.widgets.Checkbox):
+    """A Checkbox whose tick is handled at once (see :class:`PromptSelect`)."""
+
+    _debounce = 0
+
+
+class PromptToggle(pn.widgets.Toggle):
+    """A Toggle whose press is handled at once (see :class:`PromptSelect`)."""
+
+    _debounce = 0
+
+
+class PromptCheckBoxGroup(pn.widgets.CheckBoxGroup):
+    """A CheckBoxGroup whose ticks are handled at once (see :class:`PromptSelect`)."""
+
+    _debounce = 0
+
+
 # BokehJS draws a number box's arrows as empty buttons: no accessible name. Generated
 # content, clipped out of sight, names them (see _PLAYER_LABELS_CSS).
 _SPIN_LABELS_CSS = "\n".join([
@@ -166,7 +198,7 @@ class LabelledCheckbox(pn.viewable.Viewer):
         value, disabled = params.pop("value", False), params.pop("disabled", False)
         super().__init__(value=value, disabled=disabled)
         self._label = label
-        self._group = pn.widgets.CheckBoxGroup(options=[label], value=[label] if value
+        self._group = PromptCheckBoxGroup(options=[label], value=[label] if value
                                                else [], disabled=disabled, **params)
         self._group.param.watch(lambda e: setattr(self, "value", label in e.new), "value")
         self.param.watch(lambda e: setattr(self._group, "value", [label] if e.new else []),
@@ -599,7 +631,7 @@ class ProfileEditor:
                                  styles={"font-size": "12px", "color": "#666"})
         widgets: list[Any] = [self.mean]
         if variations:
-            self.kind = self.binding.add("kind", pn.widgets.Select(
+            self.kind = self.binding.add("kind", PromptSelect(
                 label=f"{label}: variation across the punch", options=PROFILE_KINDS,
                 sizing_mode="stretch_width"))
             a_unit, a_lo, a_hi, a_step = amplitude
@@ -704,7 +736,7 @@ class HistoryEditor:
         :class:`~explorer.app.DragSteps`), or None."""
         self.binding = Binding(on_reject, live_when=drag)
         self.title = pn.pane.HTML("", margin=(8, 10, 0, 10))
-        self.kind = self.binding.add("kind", pn.widgets.Select(
+        self.kind = self.binding.add("kind", PromptSelect(
             label="history", options=HISTORY_KINDS, sizing_mode="stretch_width"))
         self.value = self.binding.add("value", slider("value", 0.0, 1.0, 0.001,
                                                       css_classes=[f"{css}-value"] if css
