@@ -27,7 +27,7 @@ from ..model import (
 )
 from ..solving import SolveController
 from .style import TAB_COLUMN, html_pane, slug
-from .widgets import Binding, BoundedUpload
+from .widgets import Binding, BoundedUpload, PromptTextAreaInput, PromptTextInput
 
 
 class FilesView:
@@ -53,11 +53,11 @@ class FilesView:
         self.load_scene = load_scene
         self.show_error = show_error
         self.naming = Binding(screen.reject)
-        self.scene_name = self.naming.add("scene_name", pn.widgets.TextInput(
+        self.scene_name = self.naming.add("scene_name", PromptTextInput(
             label="scene name", sizing_mode="stretch_width", max_length=MAX_NAME_CHARS,
             css_classes=["scene-name"]),
             check=lambda v: check_text("scene name", v, MAX_NAME_CHARS))
-        self.description = self.naming.add("description", pn.widgets.TextAreaInput(
+        self.description = self.naming.add("description", PromptTextAreaInput(
             label="description (saved with the scene)", sizing_mode="stretch_width",
             max_length=MAX_DESCRIPTION_CHARS, height=90, css_classes=["scene-description"]),
             check=lambda v: check_text("description", v, MAX_DESCRIPTION_CHARS))

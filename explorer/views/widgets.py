@@ -66,9 +66,16 @@ class PromptFloatSlider(pn.widgets.FloatSlider):
 
 
 class PromptSelect(pn.widgets.Select):
-    """A Select whose choice is handled at once: Panel waits 50 ms for a further change
-    of a widget's value before it takes it up, which a choice from a list never brings
-    (the 50 ms were a tenth of a preset switch)."""
+    """A Select whose choice is handled at once.
+
+    Panel waits 50 ms for a further change of a widget's value before it takes it up
+    (``_debounce``), which a choice from a list, a tick or a typed number never brings
+    (the 50 ms were a tenth of a preset switch). And widgets that wait and widgets that do
+    not take up their changes out of the order the page sent them: the time slider moved
+    and a preset chosen at once reached the server preset first, and the slider's range
+    stayed the old preset's. So every widget the user sets takes its change up at once
+    (a test walks the page); a slider's superseded steps are dropped by the solving's own
+    rule (one request pending per session), not by waiting."""
 
     _debounce = 0
 
@@ -93,6 +100,18 @@ class PromptToggle(pn.widgets.Toggle):
 
 class PromptCheckBoxGroup(pn.widgets.CheckBoxGroup):
     """A CheckBoxGroup whose ticks are handled at once (see :class:`PromptSelect`)."""
+
+    _debounce = 0
+
+
+class PromptTextInput(pn.widgets.TextInput):
+    """A TextInput whose text is taken up at once (see :class:`PromptSelect`)."""
+
+    _debounce = 0
+
+
+class PromptTextAreaInput(pn.widgets.TextAreaInput):
+    """A TextAreaInput whose text is taken up at once (see :class:`PromptSelect`)."""
 
     _debounce = 0
 
@@ -122,21 +141,25 @@ class _OwnStyle:
 
 
 class NumberBox(_OwnStyle, pn.widgets.FloatInput):
-    """A FloatInput whose arrow buttons are named."""
+    """A FloatInput whose arrow buttons are named, its changes taken up at once (see
+    :class:`PromptSelect`)."""
 
+    _debounce = 0
     _own_css = _SPIN_LABELS_CSS
 
 
 class CountBox(_OwnStyle, pn.widgets.IntInput):
-    """An IntInput whose arrow buttons are named."""
+    """An IntInput whose arrow buttons are named, its changes taken up at once (see
+    :class:`PromptSelect`)."""
 
+    _debounce = 0
     _own_css = _SPIN_LABELS_CSS
 
 
 class PromptFloatInput(NumberBox):
-    """A FloatInput whose browser changes are handled at once (no 50 ms debounce)."""
+    """A FloatInput whose browser changes are handled at once (a :class:`NumberBox`) and
+    left out of Panel's busy count."""
 
-    _debounce = 0
     _busy__ignore = _NOT_BUSY
 
 
@@ -150,9 +173,9 @@ class PromptIntSlider(pn.widgets.IntSlider):
 
 
 class PromptIntInput(CountBox):
-    """An IntInput whose browser changes are handled at once (no 50 ms debounce)."""
+    """An IntInput whose browser changes are handled at once (a :class:`CountBox`) and
+    left out of Panel's busy count."""
 
-    _debounce = 0
     _busy__ignore = _NOT_BUSY
 
 
@@ -181,6 +204,7 @@ class TimePlayer(_OwnStyle, pn.widgets.Player):
     """The player of the output times, left out of Panel's busy count (see above), its
     buttons named (``PLAYER_BUTTONS``)."""
 
+    _debounce = 0  # (see PromptSelect)
     _busy__ignore = _NOT_BUSY
     _own_css = _PLAYER_LABELS_CSS
 
