@@ -8,7 +8,8 @@ is used through its module (``panel_fixes.install()``), so a test can replace on
 - ``bokeh_fixes``: style sheets BokehJS rewrites with the same text; the page's layout
   computed once per frame, not once per change; colours and line styles not read back
   from the computed style at each paint; a renderer's place written on its element, not
-  into a style sheet; a figure's base font size read once.
+  into a style sheet; a figure's base font size read once; a canvas layer cleared to its
+  edges; a figure off the page not laid out.
 - ``idle_painter``: the file dropper's frame loop, paused while nothing happens.
 - ``dropper_labels``: the file droppers' words for a file of a type they do not take.
 - ``closed_pages``: pages closed abruptly (a debug line, not a traceback), Panel's

@@ -1,8 +1,8 @@
-"""Six fixes applied in the page to BokehJS: style sheets rewritten with the same text,
+"""Seven fixes applied in the page to BokehJS: style sheets rewritten with the same text,
 the page's layout computed once per frame (and not for a closed tab), colours and line
 styles no longer read back from the computed style at each paint, a renderer's place
 written on its element rather than into a style sheet, a figure's base font size read
-once, and a canvas layer cleared to its edges.
+once, a canvas layer cleared to its edges, and a figure off the page not laid out.
 
 **Style sheets.** BokehJS (checked with 3.9.2) writes the text of a ``<style>`` element
 each time it paints a renderer (``update_position``) or lays a figure out, even when the
@@ -87,6 +87,17 @@ contact width plot at the first lift-off) is painted once before its frame is la
 its cursor and point at x = 0; a red corner and a dotted stroke then stayed left of its
 title for good. The fix clears the whole layer with the shift undone; what is drawn is
 the same.
+
+**A figure off the page not laid out.** At every paint a figure asks whether its axes,
+title or legend changed size and, if so, lays itself out again
+(``PlotView._invalidate_layout_if_needed``). A figure taken off the page (``display:
+none``: the histories and the q(x, t) map of an answer at one output time,
+``explorer/views/style.py``) has no size, so each paint found its axes "changed" and laid
+the figure out: three figures at every load step of an elastic preset, ~75 ms of the
+page's ~110 ms of CPU a key step (a DevTools CPU profile of force steps on the bare layer
+preset). The fix lays out only a figure that is on the page; one that is off keeps its
+layout due, done at its first paint once shown (the data that brings it back repaints
+it, and the page's growth lays the page out).
 """
 
 from __future__ import annotations
@@ -285,16 +296,42 @@ if (!Layer || typeof Layer.prototype.clear !== "function") {
 }
 """
 
+#: Runs once per page when its document is ready (idempotent: a flag on the method).
+SHOWN_ONLY_LAYOUT_JS = """
+const plots = (window.Bokeh && Bokeh.require) ? Bokeh.require("models/plots/plot_canvas")
+                                              : null;
+const PlotView = plots && plots.PlotView;
+if (!PlotView || typeof PlotView.prototype._invalidate_layout_if_needed !== "function") {
+  console.warn("explorer: BokehJS plots have changed; the fix for figures off the page is "
+               + "not applied");
+} else if (!PlotView.prototype._invalidate_layout_if_needed.__shown_only) {
+  const check = PlotView.prototype._invalidate_layout_if_needed;
+  // figures off the page whose layout was left due (for the page's tests)
+  const count = window.__explorerOffPageLayouts = {left: 0};
+  const shownOnly = function () {
+    // display: none (its own or an ancestor's, across shadow roots): no box at all
+    if (this.el.getClientRects().length === 0) {
+      count.left += 1;
+      this._needs_layout = true;
+      return;
+    }
+    check.call(this);
+  };
+  shownOnly.__shown_only = true;
+  PlotView.prototype._invalidate_layout_if_needed = shownOnly;
+}
+"""
+
 #: The prefix of the CSS variables BokehJS reads for visual properties (core/visuals).
 BOKEH_CSS_VARIABLE_PREFIX = "--bk-"
 
 
 def install(doc: Any) -> bool:
-    """Apply the six fixes in the page of Bokeh document ``doc`` once it is ready; False
+    """Apply the seven fixes in the page of Bokeh document ``doc`` once it is ready; False
     (nothing done) when there is no document (a notebook, a script)."""
     if doc is None or not hasattr(doc, "js_on_event"):
         return False
     for code in (SAME_STYLE_JS, LAYOUT_ONCE_JS, NO_CSS_VARIABLES_JS, INLINE_POSITION_JS,
-                 BASE_FONT_ONCE_JS, WHOLE_CLEAR_JS):
+                 BASE_FONT_ONCE_JS, WHOLE_CLEAR_JS, SHOWN_ONLY_LAYOUT_JS):
         doc.js_on_event("document_ready", CustomJS(code=code))
     return True
