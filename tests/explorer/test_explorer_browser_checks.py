@@ -638,13 +638,16 @@ def test_the_pressure_legend_stays_inside_its_plot_at_1024px(page: Page):
     assert page.errors == []
 
 
-# Pixels with ink on the two outermost columns and rows of a figure's overlay layer
-# (cursors, points at the time shown), or null while the figure is not drawn.
-JS_OVERLAY_EDGE_INK = """(name) => {
+# The figure views of the page whose model is named ``name`` (JS statements: ``found``).
+JS_FIGURE_VIEWS = """
   const found = [];
   const walk = (v) => { if (v.model && v.model.name === name && v.canvas_view) found.push(v);
                         for (const c of (v.child_views || [])) walk(c); };
-  Object.values(Bokeh.index).forEach(walk);
+  Object.values(Bokeh.index).forEach(walk);"""
+
+# Pixels with ink on the two outermost columns and rows of a figure's overlay layer
+# (cursors, points at the time shown), or null while the figure is not drawn.
+JS_OVERLAY_EDGE_INK = """(name) => {""" + JS_FIGURE_VIEWS + """
   if (found.length !== 1) return null;
   const c = found[0].canvas_view.overlays.canvas;
   if (!c.width || !c.height) return null;
@@ -676,11 +679,7 @@ def test_a_figure_that_joins_the_page_keeps_no_stale_marks(page: Page):
 
 # A figure's frame as BokehJS last laid it out against its element on the page: [frame
 # width, element width] in px, or null while the figure has no view.
-JS_FRAME_AND_ELEMENT = """(name) => {
-  const found = [];
-  const walk = (v) => { if (v.model && v.model.name === name && v.frame) found.push(v);
-                        for (const c of (v.child_views || [])) walk(c); };
-  Object.values(Bokeh.index).forEach(walk);
+JS_FRAME_AND_ELEMENT = """(name) => {""" + JS_FIGURE_VIEWS + """
   if (found.length !== 1) return null;
   return [found[0].frame.bbox.width, found[0].el.getBoundingClientRect().width];
 }"""
