@@ -511,7 +511,7 @@ class ExplorerApp(pn.viewable.Viewer):
             sizing_mode="stretch_width")
         self.header = header
         self.presenting = PromptToggle(label="Presentation mode", width=170,
-                                            css_classes=["presentation-toggle"])
+                                       css_classes=["presentation-toggle"])
         self.presenting.param.watch(self._on_presentation, "value")
         return pn.Column(pn.Row(header, self.presenting, sizing_mode="stretch_width"),
                          pn.Row(sidebar, self.results.content(), sizing_mode="stretch_width"),

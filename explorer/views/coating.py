@@ -73,8 +73,8 @@ class CoatingView:
                                         sizing_mode="stretch_width")
         self.n_layers.param.watch(lambda e: setattr(s, "n_layers", e.new), "value_throttled")
         self.layer = PromptRadioButtonGroup(label="edit layer", options=["1"], value="1",
-                                                 color="primary", variant="outline",
-                                                 sizing_mode="stretch_width")
+                                            color="primary", variant="outline",
+                                            sizing_mode="stretch_width")
         self.layer.param.watch(lambda *e: self.bind_layer(), "value")
         # where an emptied or refused box is said (the thickness box emptied said nothing)
         reject = None if screen is None else screen.reject

@@ -86,7 +86,7 @@ class FitView:
         self.readings_status = html_pane("<small><i>No readings yet.</i></small>",
                                          css_classes=["fit-readings"], **stretch)
         self.fields = [PromptSelect(label=f"field {k + 1} to fit",
-                                         css_classes=[f"fit-field-{k + 1}"], **stretch)
+                                    css_classes=[f"fit-field-{k + 1}"], **stretch)
                        for k in range(MAX_FIT_FIELDS)]
         self.fit_button = pn.widgets.Button(label="Fit", color="primary", disabled=True,
                                             css_classes=["fit-run"], **stretch)

@@ -45,8 +45,8 @@ class LessonsView:
         self.step = 0
         options = {"(choose a lesson)": ""} | {v.title: k for k, v in self.lessons.items()}
         self.lesson_select = PromptSelect(label="lesson", options=options, value="",
-                                               sizing_mode="stretch_width",
-                                               css_classes=["lesson-select"])
+                                          sizing_mode="stretch_width",
+                                          css_classes=["lesson-select"])
         self.lesson_select.param.watch(lambda e: self.start(e.new), "value")
         self.previous_button = pn.widgets.Button(label="◀ previous", disabled=True,
                                                  css_classes=["lesson-previous"])

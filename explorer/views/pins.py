@@ -46,7 +46,7 @@ class PinsView:
         # each new result is pinned as it arrives (the oldest pin goes when there are
         # six): a class moves a slider step by step, and the steps stay on the plots
         self.every_step = PromptCheckbox(label="pin every step",
-                                              css_classes=["pin-every-step"])
+                                         css_classes=["pin-every-step"])
         # the result on screen is the first step: pinned when the box is ticked
         self.every_step.param.watch(lambda e: e.new and self.pin(), "value")
         self.pin_button.on_click(lambda e: self.pin())

@@ -40,7 +40,7 @@ class PunchView:
         self.half_width = pb.add("half_width", slider("half-width a [m]", 0.1, 5.0, 0.01,
                                                       css_classes=["punch-half-width"]))
         self.shape = pb.add("shape", PromptSelect(label="base shape", options=SHAPES,
-                                                       sizing_mode="stretch_width"))
+                                                  sizing_mode="stretch_width"))
         # each shape's sliders are made when the shape is first chosen (LazySlider)
         self.radius = LazySlider(pb, "radius", "crown radius R [km]", 1.0, 500.0, 0.5,
                                  css_classes=["punch-crown-radius"])

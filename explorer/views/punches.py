@@ -61,8 +61,8 @@ class PunchesSection:
         self.add_button.on_click(lambda e: self.add())
         self.remove_button.on_click(lambda e: self.remove())
         self.select = PromptRadioButtonGroup(options=["1"], value="1", color="primary",
-                                                  variant="outline",
-                                                  css_classes=["punch-select"])
+                                             variant="outline",
+                                             css_classes=["punch-select"])
         self.select.param.watch(lambda e: self.bind(), "value")
         self.where = Binding(reject, live_when=live_when)
         self.center = self.where.add("center", slider(
@@ -71,9 +71,9 @@ class PunchesSection:
         self.half_width = self.shape.add("half_width", slider(
             "half-width a [m]", 0.1, 5.0, 0.01, css_classes=["punch-half-width-of"]))
         self.statement = PromptSelect(label="statement (which two are given)",
-                                           options=list(STATEMENTS),
-                                           sizing_mode="stretch_width",
-                                           css_classes=["punch-statement"])
+                                      options=list(STATEMENTS),
+                                      sizing_mode="stretch_width",
+                                      css_classes=["punch-statement"])
         self.statement.param.watch(self._on_statement, "value")
         self.history_editors = (HistoryEditor("punch-load-0", reject, live_when),
                                 HistoryEditor("punch-load-1", reject, live_when))

@@ -55,9 +55,9 @@ class SceneView:
         options = {"(custom scene)": ""}
         options.update({preset_label(k, v): k for k, v in presets.items()})
         self.preset = PromptSelect(label="Preset scene", options=options,
-                                        value=preset_key or "",
-                                        sizing_mode="stretch_width",
-                                        css_classes=["preset-select"])
+                                   value=preset_key or "",
+                                   sizing_mode="stretch_width",
+                                   css_classes=["preset-select"])
         self.preset_description = pn.pane.Markdown(self._preset_text(), margin=(0, 10),
                                                    styles={"font-size": "13px"})
         self.preset.param.watch(self._on_preset, "value")
@@ -72,9 +72,9 @@ class SceneView:
         self.reset_button.on_click(lambda e: _held(lambda: self._back(history.reset)))
 
         self.statement = PromptSelect(label="statement (which two are given)",
-                                           options=list(STATEMENTS), value=s.loading.statement,
-                                           sizing_mode="stretch_width",
-                                           css_classes=["statement-select"])
+                                      options=list(STATEMENTS), value=s.loading.statement,
+                                      sizing_mode="stretch_width",
+                                      css_classes=["statement-select"])
         self.controller = controller
         self.statement.param.watch(self._on_statement, "value")
         s.loading.param.watch(self.refresh, "statement")

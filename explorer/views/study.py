@@ -56,7 +56,7 @@ class _AxisInputs:
         css = f"study-p{n}"
         self.optional = optional
         self.field = PromptSelect(label=f"parameter {n}", sizing_mode="stretch_width",
-                                       css_classes=[f"{css}-field"])
+                                  css_classes=[f"{css}-field"])
         # four boxes and their margins in the sidebar's width (the spacing once ran ~70 px
         # past it, into the scene's axis label)
         self.start = NumberBox(label="from", width=64, css_classes=[f"{css}-from"])
@@ -68,8 +68,8 @@ class _AxisInputs:
                               css_classes=[f"{css}-count"])
         # (its text once touched the arrow: a narrower left padding than the theme's 12 px)
         self.spacing = PromptSelect(label="spacing", options=list(SPACINGS), width=68,
-                                         css_classes=[f"{css}-spacing"],
-                                         stylesheets=[NARROW_SELECT])
+                                    css_classes=[f"{css}-spacing"],
+                                    stylesheets=[NARROW_SELECT])
         self.row = pn.Row(self.start, self.stop, self.count, self.spacing,
                           sizing_mode="stretch_width", margin=0)
 
@@ -135,7 +135,7 @@ class StudyView:
             label="output", options={f"{n} [{u}]": k for k, (n, u, _) in OUTPUTS.items()},
             css_classes=["study-output"], **stretch)
         self.study_time = PromptSelect(label="at time after loading", options={},
-                                            css_classes=["study-time"], **stretch)
+                                       css_classes=["study-time"], **stretch)
         self.study_run_button = pn.widgets.Button(label="Run study", color="primary",
                                                   css_classes=["study-run"], **stretch)
         self.study_cancel_button = pn.widgets.Button(label="Cancel", disabled=True,

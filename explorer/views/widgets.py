@@ -223,7 +223,7 @@ class LabelledCheckbox(pn.viewable.Viewer):
         super().__init__(value=value, disabled=disabled)
         self._label = label
         self._group = PromptCheckBoxGroup(options=[label], value=[label] if value
-                                               else [], disabled=disabled, **params)
+                                          else [], disabled=disabled, **params)
         self._group.param.watch(lambda e: setattr(self, "value", label in e.new), "value")
         self.param.watch(lambda e: setattr(self._group, "value", [label] if e.new else []),
                          "value")
