@@ -11,10 +11,11 @@ and the session ties what happens in one to the others.
 
 from __future__ import annotations
 
+import contextlib
 import html
 import logging
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import panel as pn
@@ -145,6 +146,22 @@ class DragSteps:
         a drag (not a key press)."""
         self._app.released(dragged)
 
+    @contextlib.contextmanager
+    def applying(self) -> Iterator[None]:
+        """Within: a drag step of a slider that applies every step (a load) reaches the
+        state. The solve it asks lets this session's running one finish (that answer is
+        the drag's next frame: a lift-off scene under creep took ~0.3 s a solve, and each
+        step cancelled the one before, so a drag drew nothing until its release); the
+        release cancels it instead (:meth:`released`). Where solves are slower than the
+        live bound the page says that the plots follow the handle behind it."""
+        app = self._app
+        app._drag_step_now = True
+        try:
+            yield
+        finally:
+            app._drag_step_now = False
+        app.say_following()
+
     def gesture_step(self) -> None:
         """A slider's handle moved: its changes up to :meth:`gesture_ended` are one step of
         undo (:meth:`~explorer.model.SceneHistory.drag_step`)."""
@@ -168,6 +185,10 @@ class ExplorerApp(pn.viewable.Viewer):
         the server's ``--live-bound``)."""
         super().__init__(**params)
         self.live_bound = None if live_bound is None else check_live_bound(live_bound)
+        # within a drag step of a slider that applies every step (DragSteps.applying)
+        self._drag_step_now = False
+        # the note that the plots follow a load's drag behind the handle is up
+        self._following = False
         self.loop = PageLoop(pn.state.curdoc)
         self.state = ExplorerState()
         self.screen = Screen()
@@ -379,6 +400,15 @@ class ExplorerApp(pn.viewable.Viewer):
         self.results.say_held(not fast, self._last_cpu_seconds(), self._drawn_preview is not None)
         return fast
 
+    def say_following(self) -> None:
+        """After a drag step of a slider that applies every step: where solves are slower
+        than the live bound, the page says that the plots follow the handle behind it
+        (each frame the last value solved), until the release."""
+        following = not self.fast_solves()
+        if following != self._following:  # (said once a drag, not at every step)
+            self._following = following
+            self.results.say_held(following, self._last_cpu_seconds(), following=True)
+
     @property
     def _drawn_preview(self) -> ResultView | None:
         """The preview on screen, if one (the results view keeps what it drew)."""
@@ -462,6 +492,8 @@ class ExplorerApp(pn.viewable.Viewer):
         self._released_at = time.monotonic()
         if dragged:
             self.controller.released()
+        self._following = False  # (a load's drag applied its value before: no revision)
+        self.results.say_held(False)
         self.end_preview()
 
     def end_preview(self) -> None:
@@ -537,12 +569,17 @@ class ExplorerApp(pn.viewable.Viewer):
     def _on_revision(self, event: Any) -> None:
         mark("revision")
         self.tabs.touch()  # the closed tabs are filled once the page is left alone
-        self.results.say_held(False)   # a release applied: the plots follow now
+        if not self._drag_step_now:
+            # a release applied: the plots follow now (a drag step of a load says its own
+            # note after this, DragSteps.applying: hidden and shown again at every step,
+            # the page would lay out twice a step)
+            self._following = False
+            self.results.say_held(False)
         self.history.remember()
         lessons = self._made("lessons")
         if lessons is not None:  # (a tab never opened has no lesson running)
             lessons.follow(self.state.scene_name)
-        self.controller.request()
+        self.controller.request(keep_running=self._drag_step_now)
 
     def load_scene(self, scene: dict[str, Any], same_family: bool = False) -> bool:
         """Validate a scene dict with the core and show it; False (and a notice) if bad.
@@ -695,7 +732,8 @@ class ExplorerApp(pn.viewable.Viewer):
         coating = self._made("coating")
         if coating is not None:
             coating.check.follow(view.scene)  # a report of another scene says so
-        self.results.say_held(False)
+        if not self._following:  # (a load's drag draws the answers solved meanwhile)
+            self.results.say_held(False)
         with pn.io.hold():
             self.results.draw(view, index, new_range=shown is None or len(shown.times) != n)
             self.files_tab.name_files(view)

@@ -476,8 +476,11 @@ class SolveController(param.Parameterized):
         return self._executor
 
     # -- requests --------------------------------------------------------------------
-    def request(self) -> int:
-        """Ask for a solve of the current state; returns the request id."""
+    def request(self, keep_running: bool = False) -> int:
+        """Ask for a solve of the current state; returns the request id. ``keep_running``:
+        a drag step of a slider that applies every step, whose solve waits for this
+        session's running one (the drag's next frame) instead of cancelling it after
+        :data:`CANCEL_AFTER_S`; the release cancels it (:meth:`released`)."""
         with self._lock:
             self._latest += 1
             rid = self._latest
@@ -513,7 +516,8 @@ class SolveController(param.Parameterized):
                 self._pending = (rid, scene)
             self._running = True
             running = self._in_worker
-        if (queued and running is not None and self._processes is not None
+        if (queued and not keep_running and running is not None
+                and self._processes is not None
                 and time.monotonic() - running[1] > CANCEL_AFTER_S):
             self._processes.cancel(running[0])
         # the worker first: the watchers of ``requests`` and ``busy`` (the status line)

@@ -36,7 +36,7 @@ from .contact import ContactPanes
 from .link import AddressLink
 from .loop import PageLoop
 from .pins import PinsView
-from .status import BADGES, held_text, preview_text, status_html
+from .status import BADGES, following_text, held_text, preview_text, status_html
 from .style import NOTE_STYLE, html_pane, set_shown
 from .widgets import NAMES, LabelledCheckbox, TimePlayer
 
@@ -486,10 +486,12 @@ class ResultsView:
             self.link.schedule()  # a link skipped while busy, if no newer result came
 
     def say_held(self, held: bool, cpu_seconds: float | None = None,
-                 preview: bool = False) -> None:
+                 preview: bool = False, following: bool = False) -> None:
         """Say (``held``) or stop saying that a dragged slider waits for its release, the
         last solve having taken ``cpu_seconds`` [s] of CPU time (None: not known);
-        ``preview``: the plots show a preview of the dragged value meanwhile (said at once).
+        ``preview``: the plots show a preview of the dragged value meanwhile (said at once);
+        ``following``: the slider applies every step and the plots follow it as fast as
+        the solves go (a load), each frame the last value solved.
 
         On a served page the note comes :data:`HELD_AFTER_MS` after the step, if no
         release came meanwhile: a key press on such a slider is a step and its release at
@@ -500,7 +502,8 @@ class ResultsView:
             if self.held.visible:
                 self.held.object, self.held.visible = "", False
             return
-        text = preview_text(cpu_seconds) if preview else held_text(cpu_seconds)
+        text = (preview_text(cpu_seconds) if preview
+                else following_text(cpu_seconds) if following else held_text(cpu_seconds))
 
         def show() -> None:
             # (a preview drawn since this note was scheduled says its own note)

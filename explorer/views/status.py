@@ -184,6 +184,15 @@ def held_text(cpu_seconds: float | None) -> str:
             "last result and update when you release it.")
 
 
+def following_text(cpu_seconds: float | None) -> str:
+    """What the page says while a dragged slider that applies every step (a load) is
+    ahead of the plots: each solve takes ``cpu_seconds`` [s] of CPU time (None: not
+    known), so the plots show the last value solved, a few a second."""
+    took = "" if cpu_seconds is None else f" (the last one took {_duration(cpu_seconds)})"
+    return (f"Solves are too slow to follow a dragged slider at every step{took}: the "
+            "plots show the last value solved and catch up when you release it.")
+
+
 def preview_text(cpu_seconds: float | None) -> str:
     """What the page says while it shows a preview of a dragged slider's value (solves
     with creep too slow to follow it, ``cpu_seconds`` [s] the last one; None: not

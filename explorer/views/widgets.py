@@ -9,6 +9,7 @@ layer or whichever two loads are given.
 
 from __future__ import annotations
 
+import contextlib
 import html
 import math
 import numbers
@@ -286,10 +287,12 @@ class EditableSlider(_RangeKept, pn.widgets.EditableFloatSlider):
         """
         self._slider._releases = False
 
-    def watch_handle_release(self, callback: Callable[[], None]) -> None:
-        """Call ``callback()`` at each release of the handle by the page (the end of a
-        drag, or of a key press), after the step it ends reached the composite."""
-        self._slider.param.watch(lambda event: callback(), "value_throttled")
+    def watch_handle_release(self, callback: Callable[[bool], None]) -> None:
+        """Call ``callback(dragged)`` at each release of the handle by the page (the end
+        of a drag, or of a key press), after the step it ends reached the composite;
+        ``dragged``: as :func:`watch_release`'s."""
+        watch_release(self._slider, lambda event, dragged: callback(dragged),
+                      lambda: False)
 
     def watch_drag_first(self, callback: Callable[[Any], None]) -> None:
         """Call ``callback(value)`` [the slider's value] at each move of the slider,
@@ -450,8 +453,19 @@ class Binding:
                 widget.apply_steps_only()
             else:
                 # the page's release of the handle ends the drag's one step of undo (a
-                # busy page or server spaced one drag's steps more than a second apart)
-                widget.watch_handle_release(lambda: None if self._syncing else ended())
+                # busy page or server spaced one drag's steps more than a second apart),
+                # and a policy that lets a drag's solves run hears of it (its last one
+                # gives way to the released value's)
+                released = getattr(self._live_when, "released", None)
+
+                def handle_released(dragged: bool) -> None:
+                    if self._syncing:
+                        return
+                    if released is not None:
+                        released(dragged)
+                    ended()
+
+                widget.watch_handle_release(handle_released)
         if event == "value_throttled" and self._live_when is not None:
             widget.param.watch(lambda e, name=name: self._drag_step(name, e.new), "value")
             # a policy that previews held steps hears of the release too (after the
@@ -506,8 +520,14 @@ class Binding:
                 and value is not None and value != getattr(self._target, name)):
             step()  # a step of the handle (not an echo of the state's value)
         self._leading = name
+        # a policy may treat the solve this step asks as a frame of a drag
+        # (:meth:`~explorer.app.DragSteps.applying`)
+        applying = getattr(self._live_when, "applying", None)
+        if applying is None or self._syncing or self._target is None:
+            applying = contextlib.nullcontext  # (a value shown from the state)
         try:
-            self._to_target(name, value)
+            with applying():
+                self._to_target(name, value)
         finally:
             self._leading = None
 

@@ -386,3 +386,59 @@ def test_a_drag_away_from_a_refused_value_is_previewed(monkeypatch, explorer_app
         pytest.approx(1.0 / (2.0 * 20e3))
     app.preview_step(app.state.punch, "radius", -3.0)  # back at the refused value
     assert app.controller.preview is None and not app._previewing
+
+
+def test_a_drag_of_a_load_lets_its_solves_finish_and_says_the_plots_follow(
+        monkeypatch, explorer_app) -> None:
+    """A load slider applies every drag step. On the lift-off preset under creep a solve
+    took ~0.3 s and each step cancelled the one running after 0.25 s, so a drag of the
+    force drew nothing until its release (benchmarks/results/explorer_latency_presets.md:
+    0 updates during the drag). A drag step now lets the running solve finish (its answer
+    is the drag's next frame), the page says that the plots follow behind the handle, and
+    the release (after a drag, not a key press) cancels what still runs and ends the
+    note."""
+    from explorer.views.status import following_text
+
+    app = explorer_app("eccentric_footing_liftoff", solved=True)
+    asked: list[bool] = []
+    cancels: list[str] = []
+    request = app.controller.request
+
+    def recorded(keep_running: bool = False) -> int:
+        asked.append(keep_running)
+        return request(keep_running=keep_running)
+
+    monkeypatch.setattr(app.controller, "request", recorded)
+    monkeypatch.setattr(app.controller, "released", lambda: cancels.append("cancel") or False)
+    monkeypatch.setattr(app, "fast_solves", lambda: False)   # the preset's ~0.3 s a solve
+    handle = app.scene_tab.history_editors[0].value._slider   # the force's, as the page's
+    force = app.state.loading.histories["force"]
+    before = force.value
+    for k in (1, 2, 3):                                       # a drag
+        handle.value = before + 10.0 * k
+    assert asked == [True, True, True] and force.value == before + 30.0
+    assert app.results.held.visible
+    # (said once a drag, with the CPU time of the answer on screen then)
+    assert app.results.held.object.split(" (")[0] == following_text(None).split(":")[0]
+    with param.edit_constant(handle):
+        handle.value_throttled = before + 30.0                # the release
+    assert cancels == ["cancel"] and not app.results.held.visible
+    handle.value = before + 40.0                              # a key press
+    with param.edit_constant(handle):
+        handle.value_throttled = before + 40.0
+    assert cancels == ["cancel"] and not app.results.held.visible
+    assert force.value == before + 40.0
+    app.state.loading.histories["force"].value = before       # not a drag step (a box)
+    assert asked[-1] is False
+
+
+def test_a_drag_of_a_load_on_fast_solves_says_nothing(monkeypatch, explorer_app) -> None:
+    """Where solves keep up with a drag no note comes and goes at each step (the page
+    would lay out twice a step)."""
+    app = explorer_app("bare_layer", solved=True)
+    shown: list[bool] = []
+    app.results.held.param.watch(lambda event: shown.append(event.new), "visible")
+    handle = app.scene_tab.history_editors[0].value._slider
+    for _ in range(3):
+        handle.value = handle.value + 10.0
+    assert shown == [] and not app.results.held.visible

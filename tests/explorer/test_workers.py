@@ -189,6 +189,34 @@ def test_a_newer_request_cancels_a_slow_solve_of_the_same_session(processes,
     assert session.view.scene == small_scene()
 
 
+def test_a_drag_step_of_a_load_lets_the_running_solve_finish(processes,
+                                                             monkeypatch) -> None:
+    """A drag step of a slider that applies every step (``keep_running``) waits for the
+    running solve, however long it has run: its answer is the drag's next frame (each
+    step of a ~0.3 s lift-off solve cancelled the one before, and a drag drew nothing).
+    Any other request still cancels it after CANCEL_AFTER_S."""
+    from tests.scene.test_work_bound import _sine_tilt_on_creep
+
+    monkeypatch.setattr(controller_module, "_PROCESSES", processes)
+    RESULTS.clear()
+    state = ExplorerState()
+    session = SolveController(state, auto=False)
+    cancelled: list[Any] = []
+    cancel = processes.cancel
+    monkeypatch.setattr(processes, "cancel", lambda sent: cancelled.append(sent) or cancel(sent))
+    slow = _sine_tilt_on_creep()
+    monkeypatch.setattr(state, "to_scene", lambda: slow)
+    session.request()
+    time.sleep(2 * controller_module.CANCEL_AFTER_S)  # it runs in its worker meanwhile
+    monkeypatch.setattr(state, "to_scene", lambda: small_scene())
+    session.request(keep_running=True)
+    assert cancelled == []
+    session.request()               # not a drag step (a typed value, a preset)
+    assert len(cancelled) == 1
+    assert session.wait(120)
+    assert session.error == "" and session.view.scene == small_scene()
+
+
 def test_a_release_cancels_the_solve_of_a_value_dragged_over(processes,
                                                               monkeypatch) -> None:
     """At a slider's release after a drag, the solve of a value dragged over that still runs
