@@ -287,12 +287,12 @@ class EditableSlider(_RangeKept, pn.widgets.EditableFloatSlider):
         """
         self._slider._releases = False
 
-    def watch_handle_release(self, callback: Callable[[bool], None]) -> None:
-        """Call ``callback(dragged)`` at each release of the handle by the page (the end
-        of a drag, or of a key press), after the step it ends reached the composite;
-        ``dragged``: as :func:`watch_release`'s."""
-        watch_release(self._slider, lambda event, dragged: callback(dragged),
-                      lambda: False)
+    def watch_handle_release(self, callback: Callable[[Any, bool], None],
+                             skip: Callable[[], bool]) -> None:
+        """:func:`watch_release` of the handle: ``callback(event, dragged)`` at each
+        release by the page (the end of a drag, or of a key press), after the step it
+        ends reached the composite, unless ``skip()``."""
+        watch_release(self._slider, callback, skip)
 
     def watch_drag_first(self, callback: Callable[[Any], None]) -> None:
         """Call ``callback(value)`` [the slider's value] at each move of the slider,
@@ -442,8 +442,19 @@ class Binding:
         dragging too when ``live_when`` says so. ``check`` refuses a value (ValueError)
         before it reaches the state; the widget then shows the state's value again."""
         event = "value" if live or "value_throttled" not in widget.param else "value_throttled"
-        # a policy that makes one step of undo of a drag hears where the page released it
+        # a policy that makes one step of undo of a drag hears where the page released it,
+        # and one that previews held steps or lets a drag's solves run hears of the
+        # release too (after the state has taken the value; not a value set from the
+        # state: a tab made mid-drag ended its preview)
         ended = getattr(self._live_when, "gesture_ended", None)
+        released = getattr(self._live_when, "released", None)
+
+        def let_go(event: Any, dragged: bool) -> None:
+            if released is not None:
+                released(dragged)
+            if ended is not None:
+                ended()  # the drag's one step of undo ends here
+
         widget.param.watch(lambda e, name=name: self._to_target(name, e.new), event)
         if live and isinstance(widget, EditableSlider):
             # a drag step reaches the state before the text box follows (the watcher
@@ -452,32 +463,13 @@ class Binding:
             if ended is None:
                 widget.apply_steps_only()
             else:
-                # the page's release of the handle ends the drag's one step of undo (a
-                # busy page or server spaced one drag's steps more than a second apart),
-                # and a policy that lets a drag's solves run hears of it (its last one
+                # at the page's release of the handle (a busy page or server spaced one
+                # drag's steps more than a second apart; a drag's solve still running
                 # gives way to the released value's)
-                released = getattr(self._live_when, "released", None)
-
-                def handle_released(dragged: bool) -> None:
-                    if self._syncing:
-                        return
-                    if released is not None:
-                        released(dragged)
-                    ended()
-
-                widget.watch_handle_release(handle_released)
+                widget.watch_handle_release(let_go, lambda: self._syncing)
         if event == "value_throttled" and self._live_when is not None:
             widget.param.watch(lambda e, name=name: self._drag_step(name, e.new), "value")
-            # a policy that previews held steps hears of the release too (after the
-            # state has taken the value; not a value set from the state: a tab made
-            # mid-drag ended its preview)
-            released = getattr(self._live_when, "released", None)
             if released is not None:
-                def let_go(event: Any, dragged: bool) -> None:
-                    released(dragged)
-                    if ended is not None:
-                        ended()  # the drag's one step of undo ends here
-
                 # (its drag steps note the drag themselves: ExplorerApp._drag_step_applies)
                 watch_release(widget, let_go, lambda: self._syncing)
         box = getattr(widget, "_value_edit", None)
