@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import panel as pn
@@ -54,9 +55,11 @@ class CheckView:
         value = event.new
         if value is not None and value != value:
             value = None  # an emptied box: the page sends NaN; not checked
-        if value is not None and value < 0:
+        if value is not None and (value < 0 or not math.isfinite(value)):
+            # (a limit of infinity, "1e400" typed, was taken unsaid: never checked)
             good = getattr(self.limits, name)
-            message = (f"{label}: must be a number >= 0 (leave it empty: not checked), "
+            need = "a number >= 0" if math.isfinite(value) else "a finite number >= 0"
+            message = (f"{label}: must be {need} (leave it empty: not checked), "
                        f"got {value:g}; the limit stays "
                        + ("unset" if good is None else f"{good:g}"))
             self.screen.reject(message)
@@ -115,6 +118,11 @@ class CheckView:
         e = event.new
         loading = self.state.loading
         if e is None or self._showing:
+            return
+        if not math.isfinite(e):
+            self.screen.reject(f"eccentricity e = M/P [m]: must be a finite number, got {e}; "
+                               "the moment stays as it is.")
+            next_tick(self.show_eccentricity)  # the box says what the loads give
             return
         force = loading.histories["force"]
         if loading.given != ("force", "moment") or force.kind != "constant":

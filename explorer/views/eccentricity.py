@@ -19,7 +19,7 @@ import panel as pn
 from ..model import ExplorerState, eccentricity
 from ..solving import SolveController
 from .style import NOTE_STYLE, html_pane
-from .widgets import _set_widget, next_tick, slider, watch_release
+from .widgets import _set_widget, next_tick, slider, unusable_number, watch_release
 
 #: Drag steps of the slider are applied at once while the last solve took less than this
 #: [s] of CPU time; slower, the moment is set on release. The speed goal of a lift-off
@@ -149,7 +149,8 @@ class EccentricityControl:
                 # the moves up to the release are one step of undo, however far apart
                 # in time the page or the server spaced them (as every slider's)
                 step()
-        if self.controller.solved_within(LIVE_SOLVE_S):
+        if self.controller.solved_within(LIVE_SOLVE_S) or unusable_number(event.new):
+            # (an emptied box or a number not finite is refused at once, not held)
             self.say_lag(None)
             self.apply(event.new)
             return
@@ -200,13 +201,14 @@ class EccentricityControl:
         """Set the moment M = e P [kN·m/m] (constant) for the eccentricity ``e`` [m]."""
         if self._syncing:
             return
-        if e is None:
-            # the box emptied: said, and the box shows the eccentricity kept (it stayed
-            # blank, nothing said: an audit), as every other box does
+        reason = unusable_number(e)
+        if reason is not None:
+            # the box emptied, or a number not finite: said, and the box shows the
+            # eccentricity kept (it stayed blank, nothing said: an audit), as every other
+            # box does
             kept = self.eccentricity()
             if kept is not None:
-                self.reject(f"{self.slider.name}: a number is needed (the box was empty); "
-                            f"it stays {kept:g}")
+                self.reject(f"{self.slider.name}: {reason}; it stays {kept:g}")
                 next_tick(self.refresh)
             return
         if not self.applicable():

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import html
+import logging
 import math
 import numbers
 from collections.abc import Callable
@@ -27,10 +28,12 @@ from ..model import QUANTITY_RANGES, HistoryState, ProfileState
 from ..solving import mark
 from .upload import MAX_FILENAME_CHARS, UPLOAD_CHUNK_BYTES, BoundedUpload
 
+log = logging.getLogger(__name__)
+
 __all__ = ["MAX_FILENAME_CHARS", "UPLOAD_CHUNK_BYTES", "Binding", "BoundedUpload",
            "CountBox", "EditableIntSlider", "EditableSlider", "HistoryEditor",
            "LabelledCheckbox", "LazySlider", "NumberBox", "PLAYER_BUTTONS", "ProfileEditor",
-           "TIGHT_NUMBER_BOX", "TimePlayer", "slider", "watch_release"]
+           "TIGHT_NUMBER_BOX", "TimePlayer", "slider", "unusable_number", "watch_release"]
 
 
 # Panel holds every change from the browser for 50 ms before handling it, to gather a
@@ -234,11 +237,46 @@ class LabelledCheckbox(pn.viewable.Viewer):
         return self._group
 
 
+#: What the page does when a number is typed in a composite slider's box beyond the
+#: handle's range: Panel's own script (1.9: widen the range to it) for a finite number
+#: only. An emptied box (null) or a non-finite number ("1e400" reads as Infinity) leaves
+#: the range alone: noUiSlider throws on a range that is not a finite number, and the
+#: throw cut short the rest of that message from the server; after "1e400" in the force
+#: box the page took no preset, reset or undo any more, then showed parts of two scenes
+#: (a user's audit). The value itself still goes to the server, which refuses it.
+FINITE_WIDEN_JS = """
+const value = cb_obj.value;
+if (value != null && Number.isFinite(value)) {
+  if (value < slider.start)
+    slider.start = value;
+  else if (value > slider.end)
+    slider.end = value;
+}
+"""
+
+
+def finite_widening(box: pn.widgets.Widget) -> bool:
+    """Replace Panel's script that widens the handle's range to a value typed in ``box``
+    (a composite slider's text box) by :data:`FINITE_WIDEN_JS`; False (a warning, the
+    script left as it is) if Panel's script is not found."""
+    from panel.links import Callback
+
+    for callback in Callback.registry.get(box, []):
+        code = callback.code
+        if isinstance(code, dict) and "slider.end = cb_obj.value" in str(code.get("value")):
+            callback.code = {**code, "value": FINITE_WIDEN_JS}
+            return True
+    log.warning("Panel's editable slider has changed; a non-finite number typed in its box "
+                "may break the page")
+    return False
+
+
 class _RangeKept:
     """A composite slider whose handle's range comes back after a value typed outside it.
 
     A value typed in the box beyond the slider's range widens the handle's range in the
-    page (Panel's own script, there only): a time span of 1e9 days, refused, left the
+    page (Panel's own script, there only, for a finite number: :func:`finite_widening`):
+    a time span of 1e9 days, refused, left the
     handle's range at 1e9, and every later span sat at its far left. Once a value inside
     the range comes back (the last good one, or one typed), the range is sent again; a
     value set on the slider from Python widens the range on both sides as before
@@ -246,6 +284,7 @@ class _RangeKept:
 
     def __init__(self, **params: Any) -> None:
         super().__init__(**params)
+        finite_widening(self._value_edit)
         self._stretched = False
         self._value_edit.param.watch(self._on_typed, "value")
         self.param.watch(self._on_value, "value")
@@ -395,6 +434,19 @@ def watch_release(widget: pn.widgets.Widget, released: Callable[[Any, bool], Non
     widget.param.watch(let_go, "value_throttled")
 
 
+def unusable_number(value: Any) -> str | None:
+    """Why ``value``, typed in a number box, cannot be taken (None: it can): an emptied box
+    (None), or a number that is not finite ("1e400" reads as Infinity in the page). Every
+    number of a scene is finite; such a value, taken, left the page's parts out of step
+    (:data:`FINITE_WIDEN_JS`)."""
+    if value is None:
+        return "a number is needed (the box was empty)"
+    if isinstance(value, numbers.Real) and not isinstance(value, bool) \
+            and not math.isfinite(value):
+        return f"must be a finite number, got {value}"
+    return None
+
+
 def next_tick(callback: Callable[[], None]) -> None:
     """Run ``callback`` on the served page's next tick (at once outside a server): a
     widget's value set while the page's own change of it is handled is not sent back to
@@ -486,12 +538,13 @@ class Binding:
         return widget
 
     def _emptied(self, name: str, widget: pn.widgets.Widget, value: Any) -> None:
-        if value is not None or self._syncing or self._target is None:
+        reason = unusable_number(value)
+        if reason is None or self._syncing or self._target is None:
             return
-        kept = getattr(self._target, name)  # the composite took the None: the state has not
+        # the composite took the value, the state did not (:meth:`_to_target`)
+        kept = getattr(self._target, name)
         if self._on_reject is not None:
-            self._on_reject(f"{widget.name}: a number is needed (the box was empty); it "
-                            f"stays {kept:g}")
+            self._on_reject(f"{widget.name}: {reason}; it stays {kept:g}")
 
         def show() -> None:
             self._syncing = True
@@ -568,8 +621,8 @@ class Binding:
 
     def _to_target(self, name: str, value: Any) -> None:
         mark("widget_value")
-        if self._syncing or self._target is None or value is None:
-            return
+        if self._syncing or self._target is None or unusable_number(value) is not None:
+            return  # (an emptied box or a non-finite number: said by _emptied)
         try:
             if name in self._checks:
                 self._checks[name](value)

@@ -552,6 +552,30 @@ def test_an_emptied_slider_box_gets_its_value_back_and_says_why(page: Page):
     assert page.errors == []
 
 
+def test_an_infinite_number_in_a_slider_box_is_refused_and_the_page_goes_on(page: Page):
+    """A user's audit: "1e400" typed in the force box (Infinity in the page) widened the
+    handle's range to it in the page, where noUiSlider threw ("'range' value isn't
+    numeric"), and the page's parts went out of step: the preset selector, reset and
+    undo then did nothing, and a value typed after a preset switch showed parts of two
+    scenes. Refused now as an emptied box is (said, the value back in the box); the page
+    throws nothing and the next preset is shown whole."""
+    box = page.page.locator(".load-0-value input").first
+    box.wait_for(timeout=30_000 * patience())
+    kept = box.input_value()
+    page.type_into(".load-0-value", "1e400")
+    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000 * patience())
+    until(lambda: "must be a finite number" in page.pane_text(".notice"), "the refusal said",
+          describe=lambda: page.pane_text(".notice"))
+    until(lambda: box.input_value() == kept, "the value back in the box",
+          describe=box.input_value)
+    assert page.text(".readout-force") == kept
+    _choose_preset(page, "eccentric_footing_liftoff", "Eccentric footing")
+    until(lambda: page.text(".readout-force") == "800" and box.input_value() == "800",
+          "the preset's force in the readout and the box",
+          describe=lambda: (page.text(".readout-force"), box.input_value()))
+    assert page.errors == []
+
+
 def test_one_undo_goes_back_to_before_a_drag_of_the_force(page: Page):
     """A teacher dragged the force from 500 to 1128 kN/m and needed ten presses of Undo,
     back through every value the handle passed: the drag is one step now."""

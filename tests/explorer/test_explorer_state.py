@@ -768,6 +768,50 @@ def test_the_eccentricity_box_emptied_says_so_and_shows_the_value_kept(explorer_
     assert app.state.loading.histories["moment"].value == 120.0
 
 
+# (no NaN: the page sends an emptied box's NaN, which Panel reads as None)
+@pytest.mark.parametrize("typed", [math.inf, -math.inf])
+def test_a_number_that_is_not_finite_is_refused_in_every_kind_of_box(explorer_app, typed):
+    """"1e400" typed in the force box (Infinity in the page) reached the scene state: the
+    answer was "not solved", and the page's script widened the handle's range to it,
+    where noUiSlider threw and cut the server's messages short (a user's audit: the
+    preset selector, reset and undo then did nothing, and the page showed parts of two
+    scenes). Refused as an emptied box is: said, the value kept in the box and the
+    state, the answer on screen kept; in the Check tab too (a limit of infinity was taken
+    unsaid: never checked)."""
+    from explorer.views.widgets import FINITE_WIDEN_JS
+
+    app = explorer_app("eccentric_creep", solved=True)
+    shown = app.controller.view
+    force = app.scene_tab.history_editors[0].value
+    force._value_edit.value = typed
+    assert app.screen.notice == ("Value not accepted: force P [kN/m]: must be a finite "
+                                 f"number, got {typed}; it stays 800"), app.screen.notice
+    assert force.value == 800.0 and app.state.loading.histories["force"].value == 800.0
+    assert app.controller.view is shown and app.controller.error == ""
+    eccentricity = app.scene_tab.eccentric_load.slider
+    eccentricity._value_edit.value = typed
+    assert app.screen.notice == ("Value not accepted: eccentricity e = M/P [m] (sets the "
+                                 f"moment): must be a finite number, got {typed}; it stays "
+                                 "0.15"), app.screen.notice
+    assert eccentricity.value == 0.15
+    assert app.state.loading.histories["moment"].value == 120.0
+    check = app.check_tab
+    check.allowable_pressure.value = 2000.0
+    check.allowable_pressure.value = typed
+    assert app.screen.notice.startswith("Value not accepted: allowable bearing pressure "
+                                        "[kPa]: must be a finite number >= 0"), \
+        app.screen.notice
+    assert app.limits.allowable_pressure == 2000.0
+    check.eccentricity.value = typed
+    assert "must be a finite number" in app.screen.notice
+    assert app.state.loading.histories["moment"].value == 120.0
+    # the page's own script widens the handle's range to finite numbers only
+    from panel.links import Callback
+
+    scripts = [c.code["value"] for c in Callback.registry.get(force._value_edit, [])]
+    assert scripts == [FINITE_WIDEN_JS]
+
+
 def test_a_load_slider_returns_to_its_range_after_a_large_value(explorer_app):
     """1e6 kN/m typed into the force box left the slider at 0 to 2e6 for good (a pixel
     ~3,000 kN/m), through undo and reset."""
