@@ -105,11 +105,20 @@ def test_the_lesson_is_true_to_the_numbers() -> None:
     near = _solve(KEY, 0.41)
     widths = _widths(near)
     assert near.info["contact"] == "unilateral" and widths[0] < 2.0
-    # ... and creep closes that gap again: full contact within about three weeks (the
-    # first output time in full contact; the one before, 14.7 days, still lifts)
-    assert "back into full contact within about three weeks" in text
-    back = near.times[int(np.argmax(widths >= 2.0 - 1e-9))]
-    assert 14 < back <= 22, back
+    # ... and creep closes that gap again, after about 17 days: the preset's first output
+    # time in full contact is 21.5 days, the one before, 14.7 days, still lifts (the text
+    # said "within about three weeks"; a user's audit solved every half day: lifted at 17.0
+    # days, in full contact at 17.5)
+    assert ("back into full contact after about 17 days (the page's output times, spaced "
+            "in log time, show it between 14.7 and 21.5 days)") in text
+    k = int(np.argmax(widths >= 2.0 - 1e-9))
+    assert (round(float(near.times[k - 1]), 1), round(float(near.times[k]), 1)) == (14.7, 21.5)
+    scene = copy.deepcopy(presets()[KEY])
+    scene["loading"]["moment"] = 0.41 * scene["loading"]["force"]
+    scene["times"] = [16.5, 17.0, 17.5, 18.0]
+    from core import solve
+
+    assert list(_widths(solve(scene)) >= 2.0 - 1e-9) == [False, False, True, True]
     # at the preset's 0.6 m: 1.31 m at loading, 1.35 m within ~150 days; peak 1.75 -> 1.97
     sol = _solve(KEY, 0.6)
     w = _widths(sol)
