@@ -501,9 +501,9 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
 
 def _say_written(*outputs: Path | None) -> None:
-    """``written to ...`` of the files ``solve`` wrote, as ``preset`` and ``sweep`` say it
-    (a run with ``-o`` printed nothing); nothing when one of them is standard output,
-    whose data the line would spoil."""
+    """``written to ...`` of the files ``solve`` or ``report`` wrote, as ``preset`` and
+    ``sweep`` say it (a run with ``-o`` printed nothing); nothing when one of them is
+    standard output, whose data the line would spoil."""
     files = [str(path) for path in outputs if path is not None]
     if files and STDIO not in files:
         print(f"written to {' and '.join(files)}")
@@ -589,6 +589,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
                               "it on each punch's own scene")
         _write(output, report_pdf(result, args.time) if fmt == "pdf"
                else report_html(result, args.time))
+        _say_written(output)
         _punches_warnings(result)
         return _punches_strict(result) if args.strict else EXIT_OK
     fe_check = None
@@ -611,6 +612,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
         _write(output, report_pdf(result, args.time, check=fe_check))
     else:
         _write(output, report_html(result, args.time, check=fe_check))
+    _say_written(output)  # (the report was the one command that wrote a file unsaid)
     evidence = model_error_evidence(result.scene, result.model_error["estimate"], fe_check)
     flags = flags_with_evidence(result.flags, evidence)
     messages = {**result.flag_messages, "model_error": evidence["message"]}

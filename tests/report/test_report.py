@@ -241,10 +241,17 @@ def test_the_pdf_plots_are_the_reports_in_its_colours():
 
 def test_the_command_line_writes_both_and_is_strict(tmp_path):
     html_path, pdf_path = tmp_path / "r.html", tmp_path / "r.pdf"
-    assert run_cli("report", "preset:uniform_flat", "-o", html_path).returncode == 0
+    done = run_cli("report", "preset:uniform_flat", "-o", html_path)
+    # said as solve, preset and sweep say it (the report alone wrote its file unsaid: an
+    # audit)
+    assert done.returncode == 0 and done.stdout == f"written to {html_path}\n"
     assert "Coated punch: " in html_path.read_text()
-    assert run_cli("report", "preset:uniform_flat", "-o", pdf_path).returncode == 0
+    done = run_cli("report", "preset:uniform_flat", "-o", pdf_path)
+    assert done.returncode == 0 and done.stdout == f"written to {pdf_path}\n"
     assert pdf_path.read_bytes().startswith(b"%PDF-")
+    # on standard output, the report alone
+    assert run_cli("report", "preset:uniform_flat", "-o", "-").stdout.rstrip().endswith(
+        "</html>")
     bad = run_cli("report", "preset:uniform_flat", "-o", tmp_path / "r.txt")
     assert bad.returncode == 2 and "a report is .html or .pdf" in bad.stderr
     scene = read_preset("uniform_flat")
