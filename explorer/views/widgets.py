@@ -276,11 +276,10 @@ class _RangeKept:
 
     A value typed in the box beyond the slider's range widens the handle's range in the
     page (Panel's own script, there only, for a finite number: :func:`finite_widening`):
-    a time span of 1e9 days, refused, left the
-    handle's range at 1e9, and every later span sat at its far left. Once a value inside
-    the range comes back (the last good one, or one typed), the range is sent again; a
-    value set on the slider from Python widens the range on both sides as before
-    (``_set_widget``)."""
+    a time span of 1e9 days, refused, left the handle's range at 1e9, and every later
+    span sat at its far left. Once a value inside the range comes back (the last good
+    one, or one typed), the range is sent again; a value set on the slider from Python
+    widens the range on both sides as before (``_set_widget``)."""
 
     def __init__(self, **params: Any) -> None:
         super().__init__(**params)

@@ -538,18 +538,28 @@ def test_a_negative_limit_is_refused_saying_so_and_the_last_good_one_stays(page:
 
 def test_an_emptied_slider_box_gets_its_value_back_and_says_why(page: Page):
     """The force's box emptied stayed empty (the force unchanged), with no word."""
+    _refused_in_the_force_box(page, "", "a number is needed")
+    assert page.errors == []
+
+
+def _refused_in_the_force_box(page: Page, typed: str, said: str) -> str:
+    """Type ``typed`` in the force's box ("": empty it) and wait for its refusal (``said``
+    in the page's notice) and the force kept back in the box; returns that force."""
     box = page.page.locator(".load-0-value input").first
     box.wait_for(timeout=30_000 * patience())
     kept = box.input_value()
-    box.fill("")
-    box.press("Enter")
+    if typed:
+        page.type_into(".load-0-value", typed)
+    else:
+        box.fill("")
+        box.press("Enter")
     page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000 * patience())
-    until(lambda: "a number is needed" in page.pane_text(".notice"), "the refusal said",
+    until(lambda: said in page.pane_text(".notice"), "the refusal said",
           describe=lambda: page.pane_text(".notice"))
     until(lambda: box.input_value() == kept, "the value back in the box",
           describe=box.input_value)
     assert page.text(".readout-force") == kept
-    assert page.errors == []
+    return kept
 
 
 def test_an_infinite_number_in_a_slider_box_is_refused_and_the_page_goes_on(page: Page):
@@ -559,16 +569,8 @@ def test_an_infinite_number_in_a_slider_box_is_refused_and_the_page_goes_on(page
     undo then did nothing, and a value typed after a preset switch showed parts of two
     scenes. Refused now as an emptied box is (said, the value back in the box); the page
     throws nothing and the next preset is shown whole."""
+    _refused_in_the_force_box(page, "1e400", "must be a finite number")
     box = page.page.locator(".load-0-value input").first
-    box.wait_for(timeout=30_000 * patience())
-    kept = box.input_value()
-    page.type_into(".load-0-value", "1e400")
-    page.page.locator(".notice").first.wait_for(state="visible", timeout=30_000 * patience())
-    until(lambda: "must be a finite number" in page.pane_text(".notice"), "the refusal said",
-          describe=lambda: page.pane_text(".notice"))
-    until(lambda: box.input_value() == kept, "the value back in the box",
-          describe=box.input_value)
-    assert page.text(".readout-force") == kept
     _choose_preset(page, "eccentric_footing_liftoff", "Eccentric footing")
     until(lambda: page.text(".readout-force") == "800" and box.input_value() == "800",
           "the preset's force in the readout and the box",
